@@ -1,0 +1,205 @@
+/* genmat: make the systems in matrices/ reproducibly (fixed seeds, public API only).
+ *
+ *   genmat OUTDIR            write every generated system into OUTDIR
+ *   genmat --sparse N K S OUT.mtx OUT_b.mtx
+ *                            a random nonnegative n x n matrix with K nonzeros per row
+ *                            (random columns) and every row sum equal to S
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ulam.h"
+
+/* Write M and b as DIR/NAME.mtx and DIR/NAME_b.mtx; exit on failure (a tool, not a library). */
+static void save(const char *dir, const char *name, const ulam_csr *M, const double *b,
+                 const char *comment)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.mtx", dir, name);
+    int s = ulam_mm_write_matrix(path, M, comment);
+    snprintf(path, sizeof path, "%s/%s_b.mtx", dir, name);
+    if (!s) s = ulam_mm_write_vector(path, b, M->nrows, "right-hand side b");
+    if (s) {
+        fprintf(stderr, "genmat: %s: %s\n", path, ulam_strerror(s));
+        exit(1);
+    }
+}
+
+/* A random matrix with k distinct random columns per row; row i's |values| sum to rowsum;
+ * signed != 0 gives each entry a random sign. */
+static ulam_csr *random_sparse(int64_t n, int k, double rowsum, int signed_, uint64_t seed)
+{
+    int64_t nz = n * k;
+    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
+    double *tx = malloc((size_t)nz * sizeof *tx);
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 0);
+    for (int64_t i = 0; i < n; i++) {
+        double sum = 0;
+        int64_t base = i * k;
+        for (int m = 0; m < k; m++) {
+            int32_t j;
+            int fresh;
+            do { /* distinct columns within the row */
+                j = (int32_t)ulam_rng_bounded(&r, (uint64_t)n);
+                fresh = 1;
+                for (int q = 0; q < m; q++) fresh &= tj[base + q] != j;
+            } while (!fresh && k < n);
+            ti[base + m] = (int32_t)i;
+            tj[base + m] = j;
+            tx[base + m] = 0.1 + ulam_rng_uniform(&r);
+            sum += tx[base + m];
+        }
+        for (int m = 0; m < k; m++) {
+            tx[base + m] *= rowsum / sum;
+            if (signed_ && ulam_rng_uniform(&r) < 0.5) tx[base + m] = -tx[base + m];
+        }
+    }
+    ulam_csr *M = NULL;
+    ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M);
+    free(ti);
+    free(tj);
+    free(tx);
+    return M;
+}
+
+/* A vector of n uniform values in [lo, hi). */
+static double *random_vector(int64_t n, double lo, double hi, uint64_t seed)
+{
+    double *b = malloc((size_t)n * sizeof *b);
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 1);
+    for (int64_t i = 0; i < n; i++) b[i] = lo + (hi - lo) * ulam_rng_uniform(&r);
+    return b;
+}
+
+/* The 5-point Laplacian on a g x g grid (A form, diagonal 4). */
+static ulam_csr *poisson2d(int g)
+{
+    int64_t n = (int64_t)g * g, nz = 5 * n, k = 0;
+    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
+    double *tx = malloc((size_t)nz * sizeof *tx);
+    for (int y = 0; y < g; y++)
+        for (int x = 0; x < g; x++) {
+            int32_t i = y * g + x;
+            int32_t nb[4] = {x > 0 ? i - 1 : -1, x < g - 1 ? i + 1 : -1, y > 0 ? i - g : -1,
+                             y < g - 1 ? i + g : -1};
+            ti[k] = i, tj[k] = i, tx[k++] = 4.0;
+            for (int q = 0; q < 4; q++)
+                if (nb[q] >= 0) ti[k] = i, tj[k] = nb[q], tx[k++] = -1.0;
+        }
+    ulam_csr *A = NULL;
+    ulam_csr_from_triplets(n, n, k, ti, tj, tx, &A);
+    free(ti);
+    free(tj);
+    free(tx);
+    return A;
+}
+
+/* A radiosity-like dense M = diag(rho) F: n patches on a circle's two arcs, F_ij
+ * proportional to 1 / (1 + d_ij^2) with unit row sums, reflectances in [0.3, 0.8]. */
+static ulam_csr *radiosity_like(int64_t n, uint64_t seed)
+{
+    int64_t nz = n * (n - 1), k = 0;
+    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
+    double *tx = malloc((size_t)nz * sizeof *tx);
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 2);
+    for (int64_t i = 0; i < n; i++) {
+        double rho = 0.3 + 0.5 * ulam_rng_uniform(&r), sum = 0;
+        int64_t base = k;
+        for (int64_t j = 0; j < n; j++) {
+            if (j == i) continue;
+            double d = (double)(i - j) / (double)n * 8.0;
+            ti[k] = (int32_t)i, tj[k] = (int32_t)j, tx[k] = 1.0 / (1.0 + d * d);
+            sum += tx[k++];
+        }
+        for (int64_t q = base; q < k; q++) tx[q] *= rho / sum;
+    }
+    ulam_csr *M = NULL;
+    ulam_csr_from_triplets(n, n, k, ti, tj, tx, &M);
+    free(ti);
+    free(tj);
+    free(tx);
+    return M;
+}
+
+/* Emission: a few bright patches, the rest dark. */
+static double *emitters(int64_t n)
+{
+    double *b = calloc((size_t)n, sizeof *b);
+    for (int64_t i = 0; i < n; i += n / 5) b[i] = 10.0;
+    return b;
+}
+
+/* Write every system of matrices/ that is generated rather than written by hand. */
+static void all(const char *dir)
+{
+    char comment[256];
+    ulam_csr *M = poisson2d(20);
+    double *b = random_vector(400, 1.0, 1.0, 0); /* all ones */
+    save(dir, "poisson20", M, b,
+         "2-D Poisson 5-point matrix A on a 20 x 20 grid (n = 400); use --jacobi");
+    ulam_csr_free(M), free(b);
+
+    M = random_sparse(1000, 8, 0.9, 0, 1000);
+    b = random_vector(1000, 0.0, 1.0, 1000);
+    save(dir, "randsub1000", M, b,
+         "random sparse substochastic M, n = 1000, 8 nonzeros/row, every row sum 0.9");
+    ulam_csr_free(M), free(b);
+
+    M = radiosity_like(100, 100);
+    b = emitters(100);
+    save(dir, "radiosity100", M, b,
+         "radiosity-like dense substochastic M = diag(rho) F, n = 100, rho in [0.3, 0.8]");
+    ulam_csr_free(M), free(b);
+
+    M = random_sparse(200, 8, 0.8, 1, 200);
+    b = random_vector(200, -1.0, 1.0, 200);
+    save(dir, "signed200", M, b,
+         "random signed sparse M, n = 200, 8 nonzeros/row, row sums of |M| 0.8: rho(|M|) < 1");
+    ulam_csr_free(M), free(b);
+
+    M = random_sparse(200, 8, 1.3, 1, 201);
+    b = random_vector(200, -1.0, 1.0, 201);
+    snprintf(comment, sizeof comment, "random signed sparse M, n = 200, 8 nonzeros/row, row "
+             "sums of |M| 1.3: rho(M) < 1 < rho(|M|), Neumann converges, walks do not");
+    save(dir, "signed_edge200", M, b, comment);
+    ulam_csr_free(M), free(b);
+
+    M = random_sparse(200, 8, 1.1, 0, 202);
+    b = random_vector(200, 0.0, 1.0, 202);
+    save(dir, "divergent200", M, b,
+         "random nonnegative sparse M, n = 200, every row sum 1.1: rho(M) = 1.1 > 1, divergent");
+    ulam_csr_free(M), free(b);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc == 2) {
+        all(argv[1]);
+        return 0;
+    }
+    if (argc == 7 && !strcmp(argv[1], "--sparse")) {
+        int64_t n = atoll(argv[2]);
+        int k = atoi(argv[3]);
+        double s = atof(argv[4]);
+        if (n < 2 || k < 1 || k > n) {
+            fprintf(stderr, "genmat: need N >= 2 and 1 <= K <= N\n");
+            return 2;
+        }
+        ulam_csr *M = random_sparse(n, k, s, 0, (uint64_t)n);
+        double *b = random_vector(n, 0.0, 1.0, (uint64_t)n);
+        char comment[128];
+        snprintf(comment, sizeof comment, "random sparse M, n = %lld, %d nonzeros/row, row sums %g",
+                 (long long)n, k, s);
+        int st = ulam_mm_write_matrix(argv[5], M, comment);
+        if (!st) st = ulam_mm_write_vector(argv[6], b, n, "right-hand side b");
+        ulam_csr_free(M), free(b);
+        if (st) fprintf(stderr, "genmat: %s\n", ulam_strerror(st));
+        return st ? 1 : 0;
+    }
+    fprintf(stderr, "usage: genmat OUTDIR | genmat --sparse N K S OUT.mtx OUT_b.mtx\n");
+    return 2;
+}

@@ -1,0 +1,228 @@
+/* ulam: linear systems (I - M) x = b by von Neumann-Ulam random walks.
+ *
+ * The one public header.  Conventions (CSparse / GSL style):
+ *   - every fallible function returns an int status (ULAM_OK == 0), see ulam_strerror();
+ *   - functions that read files also fill an optional ulam_error with the line and a
+ *     sentence saying what was expected;
+ *   - indices are 0-based in this API (the command line and Matrix Market files are 1-based);
+ *   - inputs are const, outputs are caller-owned, every _free accepts and returns NULL;
+ *   - the library never prints and never exits.
+ */
+#ifndef ULAM_H
+#define ULAM_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define ULAM_VERSION "0.1.0"
+
+/* ---------------------------------------------------------------- status codes */
+
+enum ulam_status {
+    ULAM_OK = 0,
+    ULAM_EINVAL,       /* invalid argument passed to the API */
+    ULAM_ENOMEM,       /* out of memory */
+    ULAM_EIO,          /* file cannot be opened, read or written */
+    ULAM_EEMPTY,       /* input file is empty */
+    ULAM_EBANNER,      /* missing or malformed %%MatrixMarket banner */
+    ULAM_EUNSUPPORTED, /* valid Matrix Market, but a kind ulam does not handle (complex, ...) */
+    ULAM_ESIZELINE,    /* missing or malformed size line */
+    ULAM_EOVERFLOW,    /* sizes too large to represent or allocate */
+    ULAM_ETOOFEW,      /* fewer entries than the size line declares */
+    ULAM_ETOOMANY,     /* more entries than the size line declares */
+    ULAM_EINDEX,       /* row or column index out of range */
+    ULAM_ESYNTAX,      /* malformed entry: not a number, missing or extra fields */
+    ULAM_ENONFINITE,   /* NaN or infinite value */
+    ULAM_ENOTSQUARE,   /* square matrix required */
+    ULAM_EDIM,         /* dimensions do not agree (e.g. length of b) */
+    ULAM_EZERODIAG,    /* zero diagonal entry where a Jacobi splitting needs it */
+    ULAM_ESINGULAR,    /* the system matrix is singular */
+    ULAM_EMEMLIMIT,    /* the dense matrix would exceed the memory limit */
+    ULAM_ENOCONV,      /* an iteration did not converge within its cap */
+    ULAM_NSTATUS
+};
+
+/* A short English description of a status code (never NULL). */
+const char *ulam_strerror(int status);
+
+/* Details of a failure: the status, a 1-based input line (0 if none), a 0-based row
+ * or index the failure concerns (-1 if none), and a sentence saying what was expected. */
+typedef struct ulam_error {
+    int status;
+    long line;
+    int64_t index;
+    char msg[256];
+} ulam_error;
+
+/* ---------------------------------------------------------------- sparse matrices */
+
+/* Compressed sparse row matrix.  Plain data: rowptr has nrows+1 entries (64-bit, so
+ * nnz may exceed 2^31), colidx and val have rowptr[nrows] entries; columns are sorted
+ * and unique within each row and no stored value is zero. */
+typedef struct ulam_csr {
+    int64_t nrows, ncols;
+    int64_t *rowptr;
+    int32_t *colidx;
+    double *val;
+} ulam_csr;
+
+/* Largest dimension a matrix may have (column indices are 32-bit). */
+#define ULAM_MAX_DIM INT32_MAX
+
+/* Allocate an nrows x ncols matrix with room for nnz entries (rowptr zeroed). */
+ulam_csr *ulam_csr_alloc(int64_t nrows, int64_t ncols, int64_t nnz);
+
+/* Free a matrix; accepts NULL and returns NULL. */
+ulam_csr *ulam_csr_free(ulam_csr *A);
+
+/* Number of stored entries. */
+int64_t ulam_csr_nnz(const ulam_csr *A);
+
+/* Build a CSR matrix from triplets (0-based); duplicates are summed, zeros dropped. */
+int ulam_csr_from_triplets(int64_t nrows, int64_t ncols, int64_t nz, const int32_t *ti,
+                           const int32_t *tj, const double *tx, ulam_csr **out);
+
+/* The transpose of A (new matrix in *out). */
+int ulam_csr_transpose(const ulam_csr *A, ulam_csr **out);
+
+/* A deep copy of A. */
+int ulam_csr_copy(const ulam_csr *A, ulam_csr **out);
+
+/* y = A x (use_abs != 0: y = |A| x). */
+int ulam_csr_matvec(const ulam_csr *A, int use_abs, const double *x, double *y);
+
+/* Dense row-major copy of A into a caller buffer of nrows*ncols doubles. */
+int ulam_csr_to_dense(const ulam_csr *A, double *dense);
+
+/* Summary statistics of a square matrix M (the walk kernel's raw material). */
+typedef struct ulam_csr_stats {
+    int64_t n, nnz;
+    int64_t row_nnz_min, row_nnz_max;
+    double row_nnz_mean;
+    int nonnegative;      /* every entry >= 0 */
+    double abs_rowsum_min; /* min_i sum_j |M_ij| */
+    double abs_rowsum_max; /* max_i sum_j |M_ij| */
+    int substochastic;    /* nonnegative and every row sum <= 1 */
+} ulam_csr_stats;
+
+/* Fill *st with the statistics of A. */
+int ulam_csr_stats_compute(const ulam_csr *A, ulam_csr_stats *st);
+
+/* Damped Jacobi splitting of A x = b: M = I - omega D^-1 A, bp = omega D^-1 b
+ * (omega = 1 is plain Jacobi).  bp has A->nrows entries.  A zero diagonal entry
+ * fails with ULAM_EZERODIAG and err->index naming the row. */
+int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, double *bp,
+                ulam_error *err);
+
+/* ---------------------------------------------------------------- Matrix Market */
+
+/* Read a sparse matrix ("coordinate" real/integer/pattern, general/symmetric/
+ * skew-symmetric; duplicates summed, explicit zeros dropped; symmetric files are
+ * expanded).  name is used only in error details. */
+int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
+
+/* As ulam_mm_read_matrix_file, opening path. */
+int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err);
+
+/* Read a dense vector: "array" m x 1, or "coordinate" m x 1 (missing entries are 0).
+ * *x is malloc'd with *n entries. */
+int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
+
+/* As ulam_mm_read_vector_file, opening path. */
+int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *err);
+
+/* Write A as "coordinate real general" with an optional one-line comment.  The file is
+ * written to a temporary name and renamed into place only when complete. */
+int ulam_mm_write_matrix(const char *path, const ulam_csr *A, const char *comment);
+
+/* Write x as "array real general" n x 1, atomically like ulam_mm_write_matrix. */
+int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const char *comment);
+
+/* ---------------------------------------------------------------- direct solve */
+
+/* What a LAPACK direct solve reports besides the solution. */
+typedef struct ulam_direct_info {
+    double rcond;    /* reciprocal 1-norm condition number of I - M (LAPACKE_dgecon) */
+    double residual; /* ||b - (I - M) x||_inf / ||b||_inf */
+    double seconds;  /* wall time of assembly, factorisation and solve */
+    size_t bytes;    /* memory the dense matrix needed */
+} ulam_direct_info;
+
+/* Bytes the dense n x n reference solve needs, or 0 if that overflows size_t. */
+size_t ulam_direct_bytes(int64_t n);
+
+/* Solve (I - M) x = b densely with LAPACKE_dgesv.  Refuses with ULAM_EMEMLIMIT when the
+ * dense matrix would exceed max_bytes (0: no limit); a singular system fails with
+ * ULAM_ESINGULAR (err->index is the zero pivot).  info may be NULL. */
+int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
+                      ulam_direct_info *info, ulam_error *err);
+
+/* ---------------------------------------------------------------- spectral radius */
+
+/* Options of the spectral radius estimate: ARPACK's implicitly restarted Arnoldi
+ * (dense dgeev for n <= 128), stopped when the dominant Ritz pair reaches
+ * ||A u - lambda u|| <= tol |lambda|. */
+typedef struct ulam_spectral_opts {
+    double tol;       /* relative residual tolerance (default 1e-6) */
+    int max_restarts; /* cap on implicit restarts (default 300) */
+    int krylov_dim;   /* Arnoldi basis size, ARPACK's ncv (default 20) */
+    uint64_t seed;    /* start vector seed for signed matrices */
+} ulam_spectral_opts;
+
+/* The default options. */
+ulam_spectral_opts ulam_spectral_defaults(void);
+
+/* Result of a spectral radius estimate. */
+typedef struct ulam_radius {
+    double rho;       /* |lambda| of the dominant Ritz value */
+    double residual;  /* ||A u - lambda u|| / (|lambda| ||u||) of the dominant pair */
+    int matvecs;      /* matrix-vector products spent */
+    int converged;    /* residual <= tol */
+} ulam_radius;
+
+/* Spectral radius of A (use_abs == 0) or of |A| (use_abs != 0, the Perron root).
+ * opts may be NULL for the defaults.  Not converging is reported in out->converged,
+ * not as a failure. */
+int ulam_spectral_radius(const ulam_csr *A, int use_abs, const ulam_spectral_opts *opts,
+                         ulam_radius *out);
+
+/* Spectral radius of a linear operator given as y = op(ctx, x), n x n. */
+int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double *x, double *y),
+                            const void *ctx, int positive_start, const ulam_spectral_opts *opts,
+                            ulam_radius *out);
+
+/* ---------------------------------------------------------------- random numbers */
+
+/* xoshiro256** 1.0 (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
+ * ACM TOMS 2021; https://prng.di.unimi.it), seeded through splitmix64.  Caller-owned. */
+typedef struct ulam_rng {
+    uint64_t s[4];
+} ulam_rng;
+
+/* Seed from a 64-bit seed and a stream number (e.g. a walk or block index). */
+void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream);
+
+/* Next 64 random bits. */
+uint64_t ulam_rng_next(ulam_rng *r);
+
+/* Uniform double in [0, 1) with 53 random bits. */
+double ulam_rng_uniform(ulam_rng *r);
+
+/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
+uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
+
+/* ---------------------------------------------------------------- utilities */
+
+/* Monotonic wall clock in seconds. */
+double ulam_now(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* ULAM_H */

@@ -1,0 +1,60 @@
+/* The command-line tool: a thin layer that parses options, calls libulam and prints. */
+#ifndef ULAM_CLI_H
+#define ULAM_CLI_H
+
+#include "ulam.h"
+
+/* Exit codes (documented in README.md): 0 success, 1 internal failure, 2 usage error,
+ * 3 walks would diverge, 10 + status for a library status, 130 interrupted. */
+enum { EXIT_USAGE = 2, EXIT_DIVERGE = 3, EXIT_STATUS_BASE = 10, EXIT_INTERRUPTED = 130 };
+
+/* The exit code for a library status. */
+int cli_exit_code(int status);
+
+/* Print "ulam: file:line: error: <status>: expected <msg>" and return the exit code. */
+int cli_report(const char *file, const ulam_error *err);
+
+/* Print "ulam: <command>: <message>" for a usage error and return EXIT_USAGE. */
+int cli_usage_error(const char *command, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* Parse an integer option value in [lo, hi]; 0 on success, else prints and returns EXIT_USAGE. */
+int cli_parse_int(const char *command, const char *opt, const char *s, int64_t lo, int64_t hi,
+                  int64_t *out);
+
+/* Parse a finite real option value in [lo, hi]. */
+int cli_parse_real(const char *command, const char *opt, const char *s, double lo, double hi,
+                   double *out);
+
+/* Parse a byte count with an optional K, M, G or T suffix (powers of 1024). */
+int cli_parse_bytes(const char *command, const char *opt, const char *s, size_t *out);
+
+/* What a subcommand needs to know about the system it solves. */
+typedef struct cli_system {
+    const char *matrix_path, *rhs_path;
+    int jacobi;   /* the file holds A of A x = b: use M = I - omega D^-1 A */
+    double omega; /* damping of the Jacobi splitting (1 = plain Jacobi) */
+    ulam_csr *M;  /* the iteration matrix */
+    double *b;    /* the right-hand side (NULL if no --rhs and none needed) */
+} cli_system;
+
+/* Load M (and b if rhs_path is set, or zeros when jacobi needs one); 0 or an exit code. */
+int cli_load_system(cli_system *s);
+
+/* Free what cli_load_system loaded. */
+void cli_system_free(cli_system *s);
+
+/* Print a JSON number (null when not finite). */
+void cli_json_number(const char *key, double v, int last);
+
+/* Print a JSON string (escaped). */
+void cli_json_string(const char *key, const char *v, int last);
+
+/* Subcommands: each takes the argv that starts at its own name. */
+int cli_info(int argc, char **argv);
+int cli_direct(int argc, char **argv);
+
+#endif

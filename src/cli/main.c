@@ -1,0 +1,33 @@
+/* ulam: the command-line entry point; dispatches to one file per subcommand. */
+#include "cli.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static const char *const usage =
+    "usage: ulam <command> [options]   (ulam <command> --help for details)\n"
+    "\n"
+    "Solve (I - M) x = b by von Neumann-Ulam random walks, checked against LAPACK.\n"
+    "\n"
+    "commands:\n"
+    "  info     describe M: sizes, signs, spectral radii, convergence verdicts\n"
+    "  direct   LAPACK dense reference solve\n"
+    "\n"
+    "Matrices and vectors are Matrix Market files.  Indices on the command line are\n"
+    "1-based, as in Matrix Market files (the C API is 0-based).\n";
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        fputs(usage, argc < 2 ? stderr : stdout);
+        return argc < 2 ? EXIT_USAGE : 0;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        printf("ulam %s\n", ULAM_VERSION);
+        return 0;
+    }
+    if (!strcmp(argv[1], "info")) return cli_info(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "direct")) return cli_direct(argc - 1, argv + 1);
+    fprintf(stderr, "ulam: unknown command '%s'\n%s", argv[1], usage);
+    return EXIT_USAGE;
+}

@@ -1,0 +1,67 @@
+/* xoshiro256** 1.0 by David Blackman and Sebastiano Vigna (2018, public domain; see
+ * "Scrambled linear pseudorandom number generators", ACM TOMS 47(4), 2021 and
+ * https://prng.di.unimi.it/xoshiro256starstar.c), seeded through splitmix64. */
+#include "ulam.h"
+
+/* splitmix64 step (Steele, Lea and Flood, "Fast splittable pseudorandom number
+ * generators", OOPSLA 2014): advance *x and return a well-mixed 64-bit value. */
+static uint64_t splitmix64(uint64_t *x)
+{
+    uint64_t z = (*x += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+/* Seed from (seed, stream): distinct pairs give unrelated 256-bit states. */
+void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream)
+{
+    uint64_t x = seed;
+    uint64_t h = splitmix64(&x);
+    uint64_t y = stream ^ 0x632be59bd9b4e019ULL;
+    x = h ^ splitmix64(&y);
+    for (int k = 0; k < 4; k++) r->s[k] = splitmix64(&x);
+    if (!(r->s[0] | r->s[1] | r->s[2] | r->s[3])) r->s[0] = 1; /* the one forbidden state */
+}
+
+static inline uint64_t rotl(uint64_t x, int k)
+{
+    return (x << k) | (x >> (64 - k));
+}
+
+/* Next 64 random bits. */
+uint64_t ulam_rng_next(ulam_rng *r)
+{
+    uint64_t *s = r->s;
+    const uint64_t result = rotl(s[1] * 5, 7) * 9;
+    const uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rotl(s[3], 45);
+    return result;
+}
+
+/* Uniform double in [0, 1): the top 53 bits times 2^-53. */
+double ulam_rng_uniform(ulam_rng *r)
+{
+    return (double)(ulam_rng_next(r) >> 11) * 0x1.0p-53;
+}
+
+/* Unbiased integer in [0, bound): Lemire, "Fast random integer generation in an
+ * interval", ACM TOMACS 29(1), 2019. */
+uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound)
+{
+    __uint128_t m = (__uint128_t)ulam_rng_next(r) * bound;
+    uint64_t lo = (uint64_t)m;
+    if (lo < bound) {
+        uint64_t threshold = (0 - bound) % bound;
+        while (lo < threshold) {
+            m = (__uint128_t)ulam_rng_next(r) * bound;
+            lo = (uint64_t)m;
+        }
+    }
+    return (uint64_t)(m >> 64);
+}

@@ -1,0 +1,141 @@
+/* Errors, allocation, clock and atomic output files. */
+#include "internal.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static const char *const messages[ULAM_NSTATUS] = {
+    [ULAM_OK] = "success",
+    [ULAM_EINVAL] = "invalid argument",
+    [ULAM_ENOMEM] = "out of memory",
+    [ULAM_EIO] = "cannot open, read or write file",
+    [ULAM_EEMPTY] = "empty input",
+    [ULAM_EBANNER] = "missing or malformed Matrix Market banner",
+    [ULAM_EUNSUPPORTED] = "unsupported Matrix Market kind",
+    [ULAM_ESIZELINE] = "missing or malformed size line",
+    [ULAM_EOVERFLOW] = "sizes too large",
+    [ULAM_ETOOFEW] = "fewer entries than declared",
+    [ULAM_ETOOMANY] = "more entries than declared",
+    [ULAM_EINDEX] = "index out of range",
+    [ULAM_ESYNTAX] = "malformed entry",
+    [ULAM_ENONFINITE] = "non-finite value",
+    [ULAM_ENOTSQUARE] = "matrix is not square",
+    [ULAM_EDIM] = "dimensions do not agree",
+    [ULAM_EZERODIAG] = "zero on the diagonal",
+    [ULAM_ESINGULAR] = "singular system",
+    [ULAM_EMEMLIMIT] = "exceeds the memory limit",
+    [ULAM_ENOCONV] = "iteration did not converge",
+};
+
+/* A short English description of a status code. */
+const char *ulam_strerror(int status)
+{
+    if (status < 0 || status >= ULAM_NSTATUS || !messages[status]) return "unknown status";
+    return messages[status];
+}
+
+/* Record a failure in err and return status. */
+int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
+{
+    if (!err) return status;
+    err->status = status;
+    err->line = line;
+    err->index = index;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+/* Reset err to "no error". */
+void ulam__clear(ulam_error *err)
+{
+    if (!err) return;
+    err->status = ULAM_OK;
+    err->line = 0;
+    err->index = -1;
+    err->msg[0] = '\0';
+}
+
+/* malloc of n items of size sz, NULL on overflow. */
+void *ulam__malloc(size_t n, size_t sz)
+{
+    if (sz && n > SIZE_MAX / sz) return NULL;
+    size_t bytes = n * sz;
+    return malloc(bytes ? bytes : 1);
+}
+
+/* calloc of n items of size sz. */
+void *ulam__calloc(size_t n, size_t sz)
+{
+    return calloc(n ? n : 1, sz ? sz : 1);
+}
+
+/* Monotonic wall clock in seconds. */
+double ulam_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Open a temporary file beside path. */
+int ulam__out_open(ulam__outfile *o, const char *path)
+{
+    memset(o, 0, sizeof *o);
+    size_t len = strlen(path);
+    o->path = ulam__malloc(len + 1, 1);
+    o->tmp = ulam__malloc(len + 16, 1);
+    if (!o->path || !o->tmp) {
+        ulam__out_abort(o);
+        return ULAM_ENOMEM;
+    }
+    memcpy(o->path, path, len + 1);
+    snprintf(o->tmp, len + 16, "%s.tmp.XXXXXX", path);
+    int fd = mkstemp(o->tmp);
+    if (fd < 0) {
+        o->tmp[0] = '\0';
+        ulam__out_abort(o);
+        return ULAM_EIO;
+    }
+    mode_t mask = umask(0);
+    umask(mask);
+    (void)fchmod(fd, 0666 & ~mask); /* mkstemp makes 0600; give the usual permissions */
+    o->f = fdopen(fd, "w");
+    if (!o->f) {
+        close(fd);
+        ulam__out_abort(o);
+        return ULAM_EIO;
+    }
+    return ULAM_OK;
+}
+
+/* Flush, close and rename into place. */
+int ulam__out_commit(ulam__outfile *o)
+{
+    int bad = ferror(o->f) || fflush(o->f) != 0;
+    bad |= fclose(o->f) != 0;
+    o->f = NULL;
+    if (!bad && rename(o->tmp, o->path) == 0) {
+        o->tmp[0] = '\0';
+        ulam__out_abort(o);
+        return ULAM_OK;
+    }
+    ulam__out_abort(o);
+    return ULAM_EIO;
+}
+
+/* Close and remove the temporary file. */
+void ulam__out_abort(ulam__outfile *o)
+{
+    if (o->f) fclose(o->f);
+    if (o->tmp && o->tmp[0]) remove(o->tmp);
+    free(o->tmp);
+    free(o->path);
+    memset(o, 0, sizeof *o);
+}

@@ -1,0 +1,244 @@
+/* Matrix Market reading and writing: every good kind, every malformed input class. */
+#include "testutil.h"
+
+#include <string.h>
+#include <unistd.h>
+
+typedef struct {
+    const char *file;
+    int status;
+    long line;
+    int as_vector;
+} bad_case;
+
+/* Each malformed input, the status it must get, and the line it must name. */
+static const bad_case bad_cases[] = {
+    {"tests/data/empty.mtx", ULAM_EEMPTY, 1, 0},
+    {"tests/data/no_banner.mtx", ULAM_EBANNER, 1, 0},
+    {"tests/data/bad_format.mtx", ULAM_EBANNER, 1, 0},
+    {"tests/data/complex.mtx", ULAM_EUNSUPPORTED, 1, 0},
+    {"tests/data/hermitian.mtx", ULAM_EUNSUPPORTED, 1, 0},
+    {"tests/data/no_size.mtx", ULAM_ESIZELINE, 3, 0},
+    {"tests/data/bad_size.mtx", ULAM_ESIZELINE, 3, 0},
+    {"tests/data/negative_size.mtx", ULAM_ESIZELINE, 2, 0},
+    {"tests/data/too_few.mtx", ULAM_ETOOFEW, 4, 0},
+    {"tests/data/too_many.mtx", ULAM_ETOOMANY, 5, 0},
+    {"tests/data/index_zero.mtx", ULAM_EINDEX, 4, 0},
+    {"tests/data/row_too_big.mtx", ULAM_EINDEX, 4, 0},
+    {"tests/data/col_too_big.mtx", ULAM_EINDEX, 4, 0},
+    {"tests/data/not_a_number.mtx", ULAM_ESYNTAX, 4, 0},
+    {"tests/data/index_not_a_number.mtx", ULAM_ESYNTAX, 4, 0},
+    {"tests/data/nan.mtx", ULAM_ENONFINITE, 3, 0},
+    {"tests/data/inf.mtx", ULAM_ENONFINITE, 4, 0},
+    {"tests/data/missing_value.mtx", ULAM_ESYNTAX, 4, 0},
+    {"tests/data/extra_field.mtx", ULAM_ESYNTAX, 4, 0},
+    {"tests/data/huge_dims.mtx", ULAM_EOVERFLOW, 2, 0},
+    {"tests/data/huge_nnz.mtx", ULAM_ETOOFEW, 2, 0},
+    {"tests/data/nnz_exceeds_size.mtx", ULAM_EOVERFLOW, 2, 0},
+    {"tests/data/skew_diagonal.mtx", ULAM_EINDEX, 4, 0},
+    {"tests/data/integer_not_integer.mtx", ULAM_ESYNTAX, 3, 0},
+    {"tests/data/vector_not_column.mtx", ULAM_EDIM, 0, 1},
+    {"tests/data/vector_too_short.mtx", ULAM_ETOOFEW, 4, 1},
+    {"tests/data/does_not_exist.mtx", ULAM_EIO, 0, 0},
+};
+
+/* A malformed file fails with its status and line, and leaves the output NULL. */
+static void test_bad(void **state)
+{
+    const bad_case *c = *state;
+    ulam_error err;
+    int s;
+    if (c->as_vector) {
+        double *x = (double *)1;
+        int64_t n = -1;
+        s = ulam_mm_read_vector(c->file, &x, &n, &err);
+        assert_null(x);
+    } else {
+        ulam_csr *A = (ulam_csr *)1;
+        s = ulam_mm_read_matrix(c->file, &A, &err);
+        assert_null(A);
+    }
+    if (s != c->status || err.line != c->line)
+        print_error("%s: got status %d (%s) at line %ld: %s\n", c->file, s, ulam_strerror(s),
+                    err.line, err.msg);
+    assert_int_equal(s, c->status);
+    assert_int_equal(err.status, c->status);
+    assert_int_equal(err.line, c->line);
+    assert_true(strlen(err.msg) > 5); /* says what was expected */
+}
+
+/* Symmetric files are expanded to both triangles. */
+static void test_symmetric(void **state)
+{
+    (void)state;
+    ulam_csr *A = must_read("tests/data/symmetric.mtx");
+    assert_int_equal(ulam_csr_nnz(A), 6);
+    assert_close(csr_get(A, 0, 1), -1.0, 0);
+    assert_close(csr_get(A, 1, 0), -1.0, 0);
+    assert_close(csr_get(A, 1, 2), -1.0, 0);
+    assert_close(csr_get(A, 2, 2), 2.0, 0);
+    assert_close(csr_get(A, 1, 1), 0.0, 0);
+    ulam_csr_free(A);
+}
+
+/* Skew-symmetric files mirror with a sign change. */
+static void test_skew(void **state)
+{
+    (void)state;
+    ulam_csr *A = must_read("tests/data/skew.mtx");
+    assert_int_equal(ulam_csr_nnz(A), 4);
+    assert_close(csr_get(A, 1, 0), 0.5, 0);
+    assert_close(csr_get(A, 0, 1), -0.5, 0);
+    assert_close(csr_get(A, 2, 0), -2.0, 0);
+    assert_close(csr_get(A, 0, 2), 2.0, 0);
+    ulam_csr_free(A);
+}
+
+/* Pattern entries are ones; integer entries keep their values. */
+static void test_pattern_and_integer(void **state)
+{
+    (void)state;
+    ulam_csr *P = must_read("tests/data/pattern.mtx");
+    assert_int_equal(ulam_csr_nnz(P), 3);
+    assert_close(csr_get(P, 2, 0), 1.0, 0);
+    ulam_csr *I = must_read("tests/data/integer.mtx");
+    assert_close(csr_get(I, 0, 0), -3.0, 0);
+    assert_close(csr_get(I, 1, 1), 7.0, 0);
+    ulam_csr_free(P);
+    ulam_csr_free(I);
+}
+
+/* Duplicates are summed; explicit zeros and entries that cancel are dropped. */
+static void test_duplicates(void **state)
+{
+    (void)state;
+    ulam_csr *A = must_read("tests/data/duplicates.mtx");
+    assert_int_equal(ulam_csr_nnz(A), 1);
+    assert_close(csr_get(A, 0, 0), 0.5, 0);
+    ulam_csr_free(A);
+}
+
+/* CR LF line ends, blank lines, upper-case banners and a missing final newline are read. */
+static void test_lenient_text(void **state)
+{
+    (void)state;
+    ulam_csr *A = must_read("tests/data/crlf.mtx");
+    assert_close(csr_get(A, 1, 1), 0.25, 0);
+    ulam_csr *B = must_read("tests/data/banner_case.mtx");
+    assert_close(csr_get(B, 0, 0), 3.0, 0);
+    ulam_csr *C = must_read("tests/data/no_final_newline.mtx");
+    assert_close(csr_get(C, 0, 0), 0.5, 0);
+    ulam_csr_free(A);
+    ulam_csr_free(B);
+    ulam_csr_free(C);
+}
+
+/* Dense array matrices are read column by column, zeros dropped. */
+static void test_dense_array(void **state)
+{
+    (void)state;
+    ulam_csr *A = must_read("tests/data/dense_array.mtx");
+    assert_int_equal(ulam_csr_nnz(A), 3);
+    assert_close(csr_get(A, 0, 0), 1.0, 0);
+    assert_close(csr_get(A, 0, 1), 3.0, 0);
+    assert_close(csr_get(A, 1, 1), 4.0, 0);
+    ulam_csr_free(A);
+}
+
+/* Vectors come as array n x 1 or coordinate n x 1. */
+static void test_vectors(void **state)
+{
+    (void)state;
+    int64_t n;
+    double *x = must_read_vector("matrices/chain4_b.mtx", &n);
+    assert_int_equal(n, 4);
+    assert_close(x[3], 2.0, 0);
+    free(x);
+    x = must_read_vector("tests/data/vector_coordinate.mtx", &n);
+    assert_int_equal(n, 4);
+    assert_close(x[0], 0.0, 0);
+    assert_close(x[1], 5.0, 0);
+    assert_close(x[3], -1.0, 0);
+    free(x);
+}
+
+/* Writing then reading returns the same matrix and vector, bit for bit. */
+static void test_roundtrip(void **state)
+{
+    (void)state;
+    ulam_csr *A = must_read("matrices/randsub1000.mtx");
+    char path[] = "/tmp/ulam_test_rtXXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    assert_int_equal(ulam_mm_write_matrix(path, A, "round trip"), ULAM_OK);
+    ulam_csr *B = NULL;
+    assert_int_equal(ulam_mm_read_matrix(path, &B, NULL), ULAM_OK);
+    assert_int_equal(ulam_csr_nnz(A), ulam_csr_nnz(B));
+    assert_memory_equal(A->rowptr, B->rowptr, (size_t)(A->nrows + 1) * sizeof *A->rowptr);
+    assert_memory_equal(A->colidx, B->colidx, (size_t)ulam_csr_nnz(A) * sizeof *A->colidx);
+    assert_memory_equal(A->val, B->val, (size_t)ulam_csr_nnz(A) * sizeof *A->val);
+    double v[3] = {1.0 / 3.0, -2e-300, 12345.678};
+    assert_int_equal(ulam_mm_write_vector(path, v, 3, NULL), ULAM_OK);
+    int64_t n;
+    double *w = must_read_vector(path, &n);
+    assert_int_equal(n, 3);
+    assert_memory_equal(v, w, sizeof v);
+    free(w);
+    remove(path);
+    ulam_csr_free(A);
+    ulam_csr_free(B);
+}
+
+/* A vector holding NaN is refused and no file is left behind. */
+static void test_write_refuses_nonfinite(void **state)
+{
+    (void)state;
+    const char *path = "/tmp/ulam_test_nonfinite.mtx";
+    remove(path);
+    double v[2] = {1.0, NAN};
+    assert_int_equal(ulam_mm_write_vector(path, v, 2, NULL), ULAM_ENONFINITE);
+    assert_int_equal(access(path, F_OK), -1);
+}
+
+/* Writing into a directory that does not exist fails with ULAM_EIO. */
+static void test_write_unwritable(void **state)
+{
+    (void)state;
+    double v[1] = {1.0};
+    assert_int_equal(ulam_mm_write_vector("/nonexistent-dir/x.mtx", v, 1, NULL), ULAM_EIO);
+}
+
+/* Reading from a memory stream (what the fuzzer does) gives the same as from a file. */
+static void test_read_from_stream(void **state)
+{
+    (void)state;
+    static char text[] = "%%MatrixMarket matrix coordinate real general\n2 2 2\n1 2 0.5\n2 1 0.25\n";
+    FILE *f = fmemopen(text, sizeof text - 1, "r");
+    assert_non_null(f);
+    ulam_csr *A = NULL;
+    assert_int_equal(ulam_mm_read_matrix_file(f, "mem", &A, NULL), ULAM_OK);
+    fclose(f);
+    assert_close(csr_get(A, 0, 1), 0.5, 0);
+    assert_close(csr_get(A, 1, 0), 0.25, 0);
+    ulam_csr_free(A);
+}
+
+int main(void)
+{
+    enum { NBAD = sizeof bad_cases / sizeof bad_cases[0] };
+    struct CMUnitTest tests[NBAD + 12];
+    size_t k = 0;
+    for (size_t i = 0; i < NBAD; i++)
+        tests[k++] = (struct CMUnitTest){bad_cases[i].file, test_bad, NULL, NULL, (void *)&bad_cases[i]};
+    const struct CMUnitTest good[] = {
+        cmocka_unit_test(test_symmetric),       cmocka_unit_test(test_skew),
+        cmocka_unit_test(test_pattern_and_integer), cmocka_unit_test(test_duplicates),
+        cmocka_unit_test(test_lenient_text),    cmocka_unit_test(test_dense_array),
+        cmocka_unit_test(test_vectors),         cmocka_unit_test(test_roundtrip),
+        cmocka_unit_test(test_write_refuses_nonfinite), cmocka_unit_test(test_write_unwritable),
+        cmocka_unit_test(test_read_from_stream),
+    };
+    for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) tests[k++] = good[i];
+    return _cmocka_run_group_tests("mmio", tests, k, NULL, NULL);
+}
