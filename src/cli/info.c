@@ -35,9 +35,12 @@ static void print_text(const cli_system *s, const ulam_csr_stats *st, const ulam
            r->matvecs, r->converged ? "" : ", NOT converged");
     printf("rho(|M|)         %.6f (residual %.1e, %d matvecs%s)\n", ra->rho, ra->residual,
            ra->matvecs, ra->converged ? "" : ", NOT converged");
-    printf("Neumann series   %s\n", r->rho < 1 ? "converges (rho(M) < 1)" : "diverges (rho(M) >= 1)");
-    printf("walks            %s\n", ra->rho < 1 ? "converge (rho(|M|) < 1)"
-                                                 : "diverge (rho(|M|) >= 1): use 'ulam direct'");
+    const char *unsure = " [estimate not converged: verdict uncertain]";
+    printf("Neumann series   %s%s\n", r->rho < 1 ? "converges (rho(M) < 1)" : "diverges (rho(M) >= 1)",
+           r->converged ? "" : unsure);
+    printf("walks            %s%s\n",
+           ra->rho < 1 ? "converge (rho(|M|) < 1)" : "diverge (rho(|M|) >= 1): use 'ulam direct'",
+           ra->converged ? "" : unsure);
 }
 
 /* Print the JSON object. */

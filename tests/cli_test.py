@@ -1,0 +1,145 @@
+#!/usr/bin/env python3
+"""Command-line behaviour of `ulam`: exit codes, located error messages, output files.
+
+A table of cases, each (arguments, expected exit code, regex the stderr must match,
+regex the stdout must match).  Exit codes are 10 + the library status (see README).
+Run from the source root: cli_test.py path/to/ulam
+"""
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+STATUS = ["OK", "EINVAL", "ENOMEM", "EIO", "EEMPTY", "EBANNER", "EUNSUPPORTED", "ESIZELINE",
+          "EOVERFLOW", "ETOOFEW", "ETOOMANY", "EINDEX", "ESYNTAX", "ENONFINITE", "ENOTSQUARE",
+          "EDIM", "EZERODIAG", "ESINGULAR", "EMEMLIMIT", "ENOCONV"]
+
+
+def code(name):
+    return 10 + STATUS.index(name)
+
+
+D = "tests/data/"
+M = "matrices/"
+BAD_FILES = [
+    ("empty.mtx", "EEMPTY", 1), ("no_banner.mtx", "EBANNER", 1), ("bad_format.mtx", "EBANNER", 1),
+    ("complex.mtx", "EUNSUPPORTED", 1), ("hermitian.mtx", "EUNSUPPORTED", 1),
+    ("no_size.mtx", "ESIZELINE", 3), ("bad_size.mtx", "ESIZELINE", 3),
+    ("too_few.mtx", "ETOOFEW", 4), ("too_many.mtx", "ETOOMANY", 5),
+    ("index_zero.mtx", "EINDEX", 4), ("row_too_big.mtx", "EINDEX", 4),
+    ("not_a_number.mtx", "ESYNTAX", 4), ("nan.mtx", "ENONFINITE", 3), ("inf.mtx", "ENONFINITE", 4),
+    ("missing_value.mtx", "ESYNTAX", 4), ("huge_dims.mtx", "EOVERFLOW", 2),
+    ("huge_nnz.mtx", "ETOOFEW", 2), ("skew_diagonal.mtx", "EINDEX", 4),
+]
+
+CASES = []
+for f, status, line in BAD_FILES:
+    CASES.append((["info", D + f], code(status), rf"^ulam: {re.escape(D + f)}:{line}: error: .*expected ", ""))
+CASES += [
+    (["info", D + "does_not_exist.mtx"], code("EIO"), r"does_not_exist.mtx: error: .*No such file", ""),
+    (["info", D + "nonsquare.mtx"], code("ENOTSQUARE"), r"nonsquare.mtx: error: .*square", ""),
+    (["direct", M + "chain4.mtx", "--rhs", D + "ones3.mtx"], code("EDIM"),
+     r"ones3.mtx: error: .*expected 4 entries", ""),
+    (["direct", M + "chain4.mtx", "--rhs", D + "vector_not_column.mtx"], code("EDIM"),
+     r"vector_not_column.mtx: error: .*column vector", ""),
+    (["direct", D + "singular.mtx", "--rhs", D + "ones3.mtx"], code("ESINGULAR"), r"singular", ""),
+    (["direct", D + "zero_diagonal.mtx", "--rhs", D + "ones3.mtx", "--jacobi"], code("EZERODIAG"),
+     r"diagonal entry in row 2", ""),
+    (["direct", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--max-mem", "1M"],
+     code("EMEMLIMIT"), r"memory limit.*needs", ""),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "5"], 2, r"--index 5 is out of range 1..4", ""),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "0"], 2, r"--index expects an integer", ""),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--max-mem", "lots"], 2, r"--max-mem expects a size", ""),
+    (["direct", M + "chain4.mtx"], 2, r"needs --rhs", ""),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--bogus"], 2, r"unrecognized option", ""),
+    (["info"], 2, r"exactly one matrix", ""),
+    (["frobnicate"], 2, r"unknown command 'frobnicate'", ""),
+    ([], 2, r"usage: ulam", ""),
+    (["--help"], 0, r"^$", r"1-based"),
+    (["direct", "--help"], 0, r"^$", r"1-based"),
+    (["info", M + "chain4.mtx"], 0, r"^$", r"walks\s+converge"),
+    (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(\|M\|\)\s+0\.98883"),
+    (["info", M + "signed_edge200.mtx"], 0, r"^$", r"walks\s+diverge"),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "4"], 0, r"^$", r"x\[4\]\s+3\.68174"),
+]
+
+
+def run(ulam, args):
+    p = subprocess.run([ulam] + args, capture_output=True, text=True, timeout=120)
+    return p.returncode, p.stdout, p.stderr
+
+
+def check_table(ulam):
+    failures = 0
+    for args, want_rc, err_re, out_re in CASES:
+        rc, out, err = run(ulam, args)
+        ok = rc == want_rc and re.search(err_re, err, re.M) and re.search(out_re, out, re.M)
+        if not ok:
+            failures += 1
+            print(f"FAIL ulam {' '.join(args)}: rc {rc} (want {want_rc})\n  stderr: {err.strip()}\n  stdout: {out.strip()[:300]}")
+    return failures, len(CASES)
+
+
+def check_json(ulam):
+    """--json prints one object with the documented keys; values match the text output."""
+    rc, out, _ = run(ulam, ["info", M + "signed_edge200.mtx", "--json"])
+    o = json.loads(out)
+    assert rc == 0
+    for k in ["n", "nnz", "nonnegative", "substochastic", "rho", "rho_abs", "neumann_converges", "walks_converge"]:
+        assert k in o, k
+    assert o["neumann_converges"] is True and o["walks_converge"] is False
+    assert abs(o["rho_abs"] - 1.3) < 1e-6 and o["rho"] < 1
+    rc, out, _ = run(ulam, ["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "1", "--json"])
+    o = json.loads(out)
+    for k in ["n", "index", "value", "rcond", "residual", "seconds"]:
+        assert k in o, k
+    assert o["index"] == 1 and abs(o["value"] - 2.9329173166926679) < 1e-12 and o["residual"] < 1e-14
+
+
+def check_outputs(ulam):
+    """--out writes a readable solution; a failed run leaves an old file intact and no temp files."""
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "x.mtx")
+        rc, _, _ = run(ulam, ["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--out", out])
+        assert rc == 0
+        lines = open(out).read().split("\n")
+        assert lines[0] == "%%MatrixMarket matrix array real general" and "4 1" in lines
+        with open(out, "w") as f:
+            f.write("old\n")
+        rc, _, _ = run(ulam, ["direct", D + "singular.mtx", "--rhs", D + "ones3.mtx", "--out", out])
+        assert rc == code("ESINGULAR")
+        assert open(out).read() == "old\n", "failed run clobbered the old output"
+        assert os.listdir(d) == ["x.mtx"], os.listdir(d)
+        rc, _, err = run(ulam, ["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--out", d + "/no/such/dir/x.mtx"])
+        assert rc == code("EIO") and "error" in err
+
+
+def check_genmat(genmat):
+    """examples/genmat reproduces every generated file in matrices/ byte for byte."""
+    with tempfile.TemporaryDirectory() as d:
+        assert subprocess.run([genmat, d], timeout=120).returncode == 0
+        made = sorted(os.listdir(d))
+        assert len(made) == 12, made
+        for f in made:
+            assert open(os.path.join(d, f), "rb").read() == open(M + f, "rb").read(), f
+
+
+def main():
+    ulam, genmat = sys.argv[1], sys.argv[2]
+    failures, n = check_table(ulam)
+    extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat)]
+    for f, arg in extra:
+        try:
+            f(arg)
+        except AssertionError as e:
+            failures += 1
+            print(f"FAIL {f.__name__}: {e}")
+    total = n + len(extra)
+    print(f"{total - failures} passed, {failures} failed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
