@@ -44,6 +44,7 @@ enum ulam_status {
     ULAM_ESINGULAR,    /* the system matrix is singular */
     ULAM_EMEMLIMIT,    /* the dense matrix would exceed the memory limit */
     ULAM_ENOCONV,      /* an iteration did not converge within its cap */
+    ULAM_EUNDEFINED,   /* the estimator is undefined for this system (p* = 0 where it scores) */
     ULAM_NSTATUS
 };
 
@@ -215,6 +216,74 @@ double ulam_rng_uniform(ulam_rng *r);
 
 /* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
 uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
+
+/* ---------------------------------------------------------------- random walks */
+
+enum ulam_mode { ULAM_ADJOINT = 0, ULAM_FORWARD = 1 };
+enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2 };
+
+/* How to walk and when to stop.  Start from ulam_walk_defaults(). */
+typedef struct ulam_walk_opts {
+    int mode;            /* ULAM_ADJOINT (one x_i) or ULAM_FORWARD (every x_i) */
+    int estimator;       /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */
+    int64_t index;       /* 0-based component reported (the start state in adjoint mode) */
+    double continue_q;   /* fixed continuation probability in (0, 1); <= 0: analog min(1, S_i) */
+    double roulette;     /* weight window floor W: below it survive with |w|/W at weight W; 0 off */
+    double split;        /* weight window ceiling: above it split into ceil(|w|/W) copies; 0 off */
+    uint64_t seed;       /* walk k uses the stream (seed, k): same result for any thread count */
+    int threads;         /* 0: all cores */
+    int64_t max_walks;   /* stop after this many walks (0: no limit) */
+    double rel_err;      /* stop once stderr / |estimate| <= rel_err after >= 1000 walks (0 off) */
+    double max_seconds;  /* stop after this much wall time (0 off) */
+    int64_t max_steps;   /* a walk longer than this is cut and counted (default 10^6) */
+    const volatile int *interrupt; /* stop at the next block when *interrupt != 0 (may be NULL) */
+} ulam_walk_opts;
+
+/* The defaults: adjoint collision walks, index 0, analog kernel, seed 1, all cores,
+ * 10^5 walks, walk cap 10^6 steps. */
+ulam_walk_opts ulam_walk_defaults(void);
+
+/* What a run has found so far. */
+typedef struct ulam_walk_result {
+    double estimate;   /* of x_index */
+    double std_error;  /* standard error of the estimate */
+    double ci95[2];    /* estimate -+ 1.959964 std_error */
+    double variance;   /* per-walk (per-history) sample variance */
+    int64_t walks;     /* histories completed */
+    int64_t steps;     /* transitions made */
+    int64_t cut;       /* walks cut at max_steps */
+    double seconds;    /* wall time spent walking */
+    int threads;       /* threads used */
+    int interrupted;   /* stopped by *interrupt */
+} ulam_walk_result;
+
+/* An opaque walk solver: the kernel, the statistics and the stopping state. */
+typedef struct ulam_solver ulam_solver;
+
+/* Prepare walks on (I - M) x = b (the kernel is built once here).  Refuses an absorption
+ * estimator when a state it can score at has p* = 0 (ULAM_EUNDEFINED, err->index naming it). */
+int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                      ulam_solver **out, ulam_error *err);
+
+/* Run one round of walks (a fixed number of blocks); ULAM_OK. */
+int ulam_solver_iterate(ulam_solver *s);
+
+/* Nonzero once a stopping rule (walks, rel_err, time, interrupt) is met. */
+int ulam_solver_done(const ulam_solver *s);
+
+/* The result so far. */
+void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r);
+
+/* Forward mode: every component's estimate and standard error (arrays of n; either may be
+ * NULL).  Adjoint mode: ULAM_EINVAL. */
+int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error);
+
+/* Free a solver; accepts and returns NULL. */
+ulam_solver *ulam_solver_free(ulam_solver *s);
+
+/* Allocate, iterate until done, report, free: the whole run in one call. */
+int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+               ulam_walk_result *result, ulam_error *err);
 
 /* ---------------------------------------------------------------- utilities */
 

@@ -29,6 +29,7 @@ static const char *const messages[ULAM_NSTATUS] = {
     [ULAM_ESINGULAR] = "singular system",
     [ULAM_EMEMLIMIT] = "exceeds the memory limit",
     [ULAM_ENOCONV] = "iteration did not converge",
+    [ULAM_EUNDEFINED] = "estimator undefined for this system",
 };
 
 /* A short English description of a status code. */

@@ -56,5 +56,6 @@ void cli_json_string(const char *key, const char *v, int last);
 /* Subcommands: each takes the argv that starts at its own name. */
 int cli_info(int argc, char **argv);
 int cli_direct(int argc, char **argv);
+int cli_solve(int argc, char **argv);
 
 #endif

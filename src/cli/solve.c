@@ -1,0 +1,262 @@
+/* ulam solve: one unknown (adjoint) or every unknown (forward) by random walks. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static const char *const usage =
+    "usage: ulam solve M.mtx --rhs b.mtx --index I [--mode adjoint|forward]\n"
+    "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"
+    "                  [--time S] [--seed S] [--threads T] [--continue Q] [--roulette W]\n"
+    "                  [--split W] [--max-steps K] [--jacobi [--omega W]] [--check] [--json]\n"
+    "                  [--out x.mtx] [--errors e.mtx]\n"
+    "\n"
+    "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
+    "Indices are 1-based, as in Matrix Market files.\n"
+    "\n"
+    "  --mode adjoint     start walks at I and gather b (default): one unknown, cheaply\n"
+    "  --mode forward     start walks from the source b and tally where they go: every unknown\n"
+    "                     (--out x.mtx, --errors e.mtx write all estimates and standard errors)\n"
+    "  --estimator E      collision (score at every visit, default), absorption (score where\n"
+    "                     the walk ends, / p*), expected (score the exact next-step expectation)\n"
+    "  --walks N          stop after N walks (default 100000 when no rule is given)\n"
+    "  --rel-err E        stop once stderr / |estimate| <= E (after at least 1000 walks)\n"
+    "  --time S           stop after S seconds; the first rule reached wins\n"
+    "  --seed S           walk k uses stream (S, k): identical results for any --threads\n"
+    "  --threads T        threads (default: all cores)\n"
+    "  --continue Q       continue with probability Q in every state (default: analog,\n"
+    "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased\n"
+    "  --roulette W       Russian roulette below weight W (survive with |w|/W, weight W)\n"
+    "  --split W          split particles above weight W into ceil(|w|/W) copies\n"
+    "  --max-steps K      cut walks longer than K steps and count them (default 1000000)\n"
+    "  --jacobi           the file holds A of A x = b; walk on M = I - omega D^-1 A\n"
+    "  --omega W          damping of the Jacobi splitting (default 1)\n"
+    "  --check            also solve with LAPACK: adds direct, direct_seconds and\n"
+    "                     z = (estimate - direct) / stderr\n"
+    "  --json             print one JSON object\n"
+    "\n"
+    "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C\n"
+    "exits at once.\n";
+
+static volatile int interrupted;
+
+/* SIGINT: the first asks the walks to stop, the second exits at once. */
+static void on_sigint(int sig)
+{
+    (void)sig;
+    if (interrupted) _exit(EXIT_INTERRUPTED);
+    interrupted = 1;
+}
+
+static const char *const mode_names[] = {"adjoint", "forward"};
+static const char *const est_names[] = {"collision", "absorption", "expected"};
+
+/* Index of word in names[0..n), or -1. */
+static int lookup(const char *word, const char *const *names, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (!strcmp(word, names[k])) return k;
+    return -1;
+}
+
+typedef struct {
+    int check, json;
+    double direct, direct_seconds;
+    uint64_t seed;
+} report_opts;
+
+/* Print the human-readable block. */
+static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
+{
+    double mean_len = r->walks ? (double)r->steps / (double)r->walks : 0.0;
+    double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
+    printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->index + 1,
+           o->index < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+           r->interrupted ? "  [INTERRUPTED]" : "");
+    printf("method          %s walks, %s estimator\n", mode_names[o->mode], est_names[o->estimator]);
+    printf("walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
+           (long long)o->max_steps, r->cut ? ": the estimate is biased by the cut" : "");
+    printf("steps           %lld (mean walk length %.4g)\n", (long long)r->steps, mean_len);
+    printf("variance        %.6g per walk (relative error %.3g)\n", r->variance, rel);
+    printf("seconds         %.4f (%.3g M steps/s, %d threads, seed %llu)\n", r->seconds,
+           r->seconds > 0 ? (double)r->steps / r->seconds / 1e6 : 0.0, r->threads,
+           (unsigned long long)ro->seed);
+    printf("figure of merit %.4g (1 / (relative variance x seconds))\n",
+           r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : INFINITY);
+    if (ro->check)
+        printf("direct          %.10g (LAPACK, %.4f s), z = %.3f\n", ro->direct, ro->direct_seconds,
+               (r->estimate - ro->direct) / r->std_error);
+}
+
+/* Print the JSON object. */
+static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
+{
+    double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
+    printf("{\"index\": %lld, ", (long long)o->index + 1);
+    cli_json_number("estimate", r->estimate, 0);
+    cli_json_number("stderr", r->std_error, 0);
+    printf("\"ci95\": [%.17g, %.17g], ", r->ci95[0], r->ci95[1]);
+    cli_json_number("variance", r->variance, 0);
+    printf("\"walks\": %lld, \"steps\": %lld, \"cut\": %lld, ", (long long)r->walks, (long long)r->steps,
+           (long long)r->cut);
+    cli_json_number("mean_length", r->walks ? (double)r->steps / (double)r->walks : 0.0, 0);
+    cli_json_number("seconds", r->seconds, 0);
+    cli_json_number("steps_per_second", r->seconds > 0 ? (double)r->steps / r->seconds : 0.0, 0);
+    cli_json_number("figure_of_merit", r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : NAN, 0);
+    cli_json_string("mode", mode_names[o->mode], 0);
+    cli_json_string("estimator", est_names[o->estimator], 0);
+    printf("\"seed\": %llu, \"threads\": %d, ", (unsigned long long)ro->seed, r->threads);
+    if (ro->check) {
+        cli_json_number("direct", ro->direct, 0);
+        cli_json_number("direct_seconds", ro->direct_seconds, 0);
+        cli_json_number("z", (r->estimate - ro->direct) / r->std_error, 0);
+    }
+    printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
+}
+
+/* LAPACK value of x_index for --check; 0 or an exit code. */
+static int direct_check(const cli_system *s, int64_t index, report_opts *ro)
+{
+    double *x = malloc((size_t)s->M->nrows * sizeof *x);
+    ulam_direct_info info;
+    ulam_error err;
+    int status = x ? ulam_direct_solve(s->M, s->b, x, (size_t)4 << 30, &info, &err) : ULAM_ENOMEM;
+    if (!x) err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the direct solution"};
+    if (!status) {
+        ro->direct = x[index];
+        ro->direct_seconds = info.seconds;
+    }
+    free(x);
+    return status ? cli_report(s->matrix_path, &err) : 0;
+}
+
+/* Write the forward vectors; 0 or an exit code. */
+static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, const char *errors)
+{
+    double *x = malloc((size_t)n * sizeof *x), *e = malloc((size_t)n * sizeof *e);
+    int status = x && e ? ulam_solver_vectors(sv, x, e) : ULAM_ENOMEM;
+    const char *path = out;
+    if (!status && out) status = ulam_mm_write_vector(out, x, n, "forward random-walk estimates of x");
+    if (!status && errors) {
+        path = errors;
+        status = ulam_mm_write_vector(errors, e, n, "standard errors of the forward estimates");
+    }
+    free(x), free(e);
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable output file and finite values"};
+    return cli_report(path, &err);
+}
+
+/* ulam solve. */
+int cli_solve(int argc, char **argv)
+{
+    static const struct option longopts[] = {
+        {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
+        {"mode", required_argument, 0, 'm'},      {"estimator", required_argument, 0, 'e'},
+        {"walks", required_argument, 0, 'n'},     {"rel-err", required_argument, 0, 'r'},
+        {"time", required_argument, 0, 't'},      {"seed", required_argument, 0, 's'},
+        {"threads", required_argument, 0, 'T'},   {"continue", required_argument, 0, 'q'},
+        {"roulette", required_argument, 0, 'R'},  {"split", required_argument, 0, 'S'},
+        {"max-steps", required_argument, 0, 'K'}, {"jacobi", no_argument, 0, 'j'},
+        {"omega", required_argument, 0, 'w'},     {"check", no_argument, 0, 'c'},
+        {"json", no_argument, 0, 'J'},            {"out", required_argument, 0, 'o'},
+        {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
+    cli_system s = {.omega = 1.0};
+    ulam_walk_opts o = ulam_walk_defaults();
+    report_opts ro = {.seed = 1};
+    const char *out = NULL, *errors = NULL;
+    int64_t index = 0, v;
+    int c, rc, any_rule = 0;
+    o.max_walks = 0;
+    optind = 0;
+    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'b': s.rhs_path = optarg; break;
+        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &index))) return rc; break;
+        case 'm':
+            if ((o.mode = lookup(optarg, mode_names, 2)) < 0)
+                return cli_usage_error("solve", "--mode expects adjoint or forward, got '%s'", optarg);
+            break;
+        case 'e':
+            if ((o.estimator = lookup(optarg, est_names, 3)) < 0)
+                return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
+            break;
+        case 'n': if ((rc = cli_parse_int("solve", "--walks", optarg, 1, INT64_MAX / 2, &o.max_walks))) return rc; any_rule = 1; break;
+        case 'r': if ((rc = cli_parse_real("solve", "--rel-err", optarg, 1e-12, 1.0, &o.rel_err))) return rc; any_rule = 1; break;
+        case 't': if ((rc = cli_parse_real("solve", "--time", optarg, 1e-6, 1e9, &o.max_seconds))) return rc; any_rule = 1; break;
+        case 's': if ((rc = cli_parse_int("solve", "--seed", optarg, 0, INT64_MAX, &v))) return rc; o.seed = ro.seed = (uint64_t)v; break;
+        case 'T': if ((rc = cli_parse_int("solve", "--threads", optarg, 1, 1024, &v))) return rc; o.threads = (int)v; break;
+        case 'q': if ((rc = cli_parse_real("solve", "--continue", optarg, 1e-9, 1 - 1e-12, &o.continue_q))) return rc; break;
+        case 'R': if ((rc = cli_parse_real("solve", "--roulette", optarg, 1e-300, 1e300, &o.roulette))) return rc; break;
+        case 'S': if ((rc = cli_parse_real("solve", "--split", optarg, 1e-300, 1e300, &o.split))) return rc; break;
+        case 'K': if ((rc = cli_parse_int("solve", "--max-steps", optarg, 1, INT64_MAX / 2, &o.max_steps))) return rc; break;
+        case 'j': s.jacobi = 1; break;
+        case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
+        case 'c': ro.check = 1; break;
+        case 'J': ro.json = 1; break;
+        case 'o': out = optarg; break;
+        case 'E': errors = optarg; break;
+        case 'h': fputs(usage, stdout); return 0;
+        default: return cli_usage_error("solve", "unknown option");
+        }
+    }
+    if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
+    if (!s.rhs_path) return cli_usage_error("solve", "needs --rhs b.mtx");
+    if (!index && o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
+    if ((out || errors) && o.mode != ULAM_FORWARD)
+        return cli_usage_error("solve", "--out and --errors need --mode forward");
+    if (o.roulette > 0 && o.split > 0 && o.split <= o.roulette)
+        return cli_usage_error("solve", "--split W must exceed --roulette W");
+    if (!any_rule) o.max_walks = 100000;
+    s.matrix_path = argv[optind];
+    if ((rc = cli_load_system(&s))) return rc;
+    if (index > s.M->nrows) {
+        rc = cli_usage_error("solve", "--index %lld is out of range 1..%lld", (long long)index, (long long)s.M->nrows);
+        cli_system_free(&s);
+        return rc;
+    }
+    o.index = index ? index - 1 : 0;
+    if (ro.check && (rc = direct_check(&s, o.index, &ro))) {
+        cli_system_free(&s);
+        return rc;
+    }
+    ulam_solver *sv = NULL;
+    ulam_error err;
+    o.interrupt = &interrupted;
+    int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err);
+    if (status) {
+        rc = cli_report(s.matrix_path, &err);
+        cli_system_free(&s);
+        return rc;
+    }
+    struct sigaction sa = {.sa_handler = on_sigint};
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
+    signal(SIGINT, SIG_DFL);
+    ulam_walk_result r;
+    ulam_solver_result(sv, &r);
+    rc = 0;
+    if (status) {
+        fprintf(stderr, "ulam: %s: error: %s: a walk produced a non-finite weight or score after %lld "
+                        "walks; nothing was averaged in from it (is rho(|M|) < 1? see 'ulam info')\n",
+                s.matrix_path, ulam_strerror(status), (long long)r.walks);
+        rc = cli_exit_code(status);
+    } else if (o.mode == ULAM_FORWARD && (out || errors) && !r.interrupted) {
+        rc = write_vectors(sv, s.M->nrows, out, errors);
+    }
+    if (!status && !rc) {
+        if (ro.json) print_json(&o, &r, &ro);
+        else print_text(&o, &r, &ro);
+        if (r.interrupted) rc = EXIT_INTERRUPTED;
+    }
+    ulam_solver_free(sv);
+    cli_system_free(&s);
+    return rc;
+}

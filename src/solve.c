@@ -1,0 +1,377 @@
+/* The walk solver: budget, threads, stopping, interruption.
+ *
+ * Walks are numbered; walk k draws from the stream (seed, k).  They run in blocks of BLOCK
+ * walks, ROUND blocks per round; threads take blocks dynamically, but every block's result is
+ * stored by its index and merged in index order (Chan's formula for the adjoint score,
+ * per-state sums for forward tallies), so the result is bit-for-bit the same for any number
+ * of threads.  Stopping rules are checked between rounds; an interrupt or the time limit
+ * also stops blocks that have not started. */
+#include "stats.h"
+#include "walk.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+enum { BLOCK = 256, ROUND = 64, STACK = 4096 };
+
+typedef struct {
+    ulam__moments m;    /* adjoint scores */
+    ulam__tallies t;    /* forward tallies */
+    int64_t walks, steps, cut, nonfinite;
+    int complete;
+} block_result;
+
+struct ulam_solver {
+    ulam_walk_opts o;
+    int64_t n;
+    ulam_kernel *k;
+    ulam__walker w;
+    double *b, *mb;
+    ulam_csr *mt;
+    ulam__slot *src;
+    int threads;
+    ulam__scratch *scratch; /* one per thread */
+    block_result *blocks;   /* one per block of a round */
+    /* accumulated */
+    ulam__moments adj;
+    double *sum, *sumsq; /* forward per-state sums of history tallies */
+    int64_t walks, steps, cut, nonfinite, next_walk;
+    double seconds, t0;
+    int done, interrupted, status;
+};
+
+/* The defaults. */
+ulam_walk_opts ulam_walk_defaults(void)
+{
+    return (ulam_walk_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_COLLISION, .seed = 1,
+                            .max_walks = 100000, .max_steps = 1000000};
+}
+
+/* Free a solver; accepts and returns NULL. */
+ulam_solver *ulam_solver_free(ulam_solver *s)
+{
+    if (!s) return NULL;
+    ulam__kernel_free(s->k);
+    free(s->b), free(s->mb), free(s->src), free(s->sum), free(s->sumsq);
+    ulam_csr_free(s->mt);
+    if (s->scratch)
+        for (int t = 0; t < s->threads; t++) {
+            free(s->scratch[t].stack_s), free(s->scratch[t].stack_w);
+            free(s->scratch[t].hist), free(s->scratch[t].touched);
+        }
+    if (s->blocks)
+        for (int q = 0; q < ROUND; q++) free(s->blocks[q].t.t);
+    free(s->scratch), free(s->blocks);
+    free(s);
+    return NULL;
+}
+
+/* Check the options against M. */
+static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *err)
+{
+    if (M->nrows != M->ncols)
+        return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
+    if (o->mode != ULAM_ADJOINT && o->mode != ULAM_FORWARD)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "mode adjoint or forward");
+    if (o->estimator < ULAM_COLLISION || o->estimator > ULAM_EXPECTED)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision, absorption or expected");
+    if (o->index < 0 || o->index >= M->nrows)
+        return ulam__fail(err, ULAM_EINVAL, 0, o->index, "an index from 0 to %lld", (long long)M->nrows - 1);
+    if (o->continue_q > 0 && !(o->continue_q < 1))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a continuation probability below 1");
+    if (o->roulette < 0 || o->split < 0 || (o->split > 0 && o->roulette > 0 && o->split <= o->roulette))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "0 < roulette W < split W (or either off)");
+    if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
+    if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a stopping rule: walks, rel_err or time");
+    return ULAM_OK;
+}
+
+/* Refuse absorption when a reachable state with p* = 0 would have to score. */
+static int check_absorption(ulam_solver *s, ulam_error *err)
+{
+    char *seen = ulam__calloc((size_t)s->n, 1);
+    if (!seen) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
+    if (s->o.mode == ULAM_ADJOINT) seen[s->o.index] = 1;
+    else
+        for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
+    ulam__kernel_reach(s->k, seen);
+    int64_t bad = -1;
+    for (int64_t i = 0; i < s->n && bad < 0; i++) {
+        int scores = s->o.mode == ULAM_ADJOINT ? s->b[i] != 0.0 : 1;
+        if (seen[i] && scores && s->k->pstar[i] <= 0.0) bad = i;
+    }
+    free(seen);
+    if (bad >= 0)
+        return ulam__fail(err, ULAM_EUNDEFINED, 0, bad,
+                          "p* > 0 wherever the absorption estimator scores; state %lld (1-based) is "
+                          "reachable and never terminates (its row sum of |%s| is >= 1): use the "
+                          "collision estimator or --continue Q",
+                          (long long)bad + 1, s->o.mode == ULAM_ADJOINT ? "M" : "M' (column of M)");
+    return ULAM_OK;
+}
+
+/* The forward source distribution |b| / ||b||_1 as an alias table. */
+static int build_source(ulam_solver *s)
+{
+    int64_t n = s->n;
+    double *p = ulam__malloc((size_t)n, sizeof *p), *scaled = ulam__malloc((size_t)n, sizeof *scaled);
+    int32_t *out = ulam__malloc((size_t)n, sizeof *out);
+    int64_t *small = ulam__malloc((size_t)n, sizeof *small), *large = ulam__malloc((size_t)n, sizeof *large);
+    s->src = ulam__malloc((size_t)n, sizeof *s->src);
+    int status = ULAM_ENOMEM;
+    if (p && scaled && out && small && large && s->src) {
+        double norm = 0.0;
+        for (int64_t i = 0; i < n; i++) norm += fabs(s->b[i]);
+        s->w.bnorm1 = norm;
+        for (int64_t i = 0; i < n; i++) {
+            p[i] = norm > 0 ? fabs(s->b[i]) / norm : 1.0 / (double)n;
+            out[i] = s->b[i] < 0 ? ~(int32_t)i : (int32_t)i;
+        }
+        ulam__alias_build(p, out, n, s->src, scaled, small, large);
+        status = ULAM_OK;
+    }
+    free(p), free(scaled), free(out), free(small), free(large);
+    return status;
+}
+
+/* Allocate per-thread scratch and per-block results. */
+static int alloc_work(ulam_solver *s)
+{
+    s->scratch = calloc((size_t)s->threads, sizeof *s->scratch);
+    s->blocks = calloc(ROUND, sizeof *s->blocks);
+    if (!s->scratch || !s->blocks) return ULAM_ENOMEM;
+    for (int t = 0; t < s->threads; t++) {
+        ulam__scratch *sc = &s->scratch[t];
+        sc->stack_cap = STACK;
+        sc->stack_s = ulam__malloc(STACK, sizeof *sc->stack_s);
+        sc->stack_w = ulam__malloc(STACK, sizeof *sc->stack_w);
+        if (!sc->stack_s || !sc->stack_w) return ULAM_ENOMEM;
+        if (s->o.mode == ULAM_FORWARD) {
+            sc->hist = ulam__calloc((size_t)s->n, sizeof *sc->hist);
+            sc->touched = ulam__calloc((size_t)s->n * (sizeof(int64_t) + 1), 1); /* + mark[] */
+            if (!sc->hist || !sc->touched) return ULAM_ENOMEM;
+        }
+    }
+    if (s->o.mode == ULAM_FORWARD) {
+        s->sum = ulam__calloc((size_t)s->n, sizeof *s->sum);
+        s->sumsq = ulam__calloc((size_t)s->n, sizeof *s->sumsq);
+        if (!s->sum || !s->sumsq) return ULAM_ENOMEM;
+    }
+    return ULAM_OK;
+}
+
+/* Prepare walks on (I - M) x = b. */
+int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                      ulam_solver **out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!M || !b || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
+    *out = NULL;
+    ulam_walk_opts o = opts ? *opts : ulam_walk_defaults();
+    int status = check_opts(M, &o, err);
+    if (status) return status;
+    ulam_solver *s = calloc(1, sizeof *s);
+    if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
+    s->o = o;
+    s->n = M->nrows;
+#ifdef _OPENMP
+    s->threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+#else
+    s->threads = 1;
+#endif
+    s->b = ulam__malloc((size_t)s->n, sizeof *s->b);
+    if (!s->b) goto nomem;
+    memcpy(s->b, b, (size_t)s->n * sizeof *s->b);
+    if (o.mode == ULAM_FORWARD) {
+        if (ulam_csr_transpose(M, &s->mt)) goto nomem;
+        if (ulam__kernel_build(s->mt, o.continue_q, &s->k)) goto nomem;
+        if (build_source(s)) goto nomem;
+    } else {
+        if (ulam__kernel_build(M, o.continue_q, &s->k)) goto nomem;
+        if (o.estimator == ULAM_EXPECTED) {
+            s->mb = ulam__malloc((size_t)s->n, sizeof *s->mb);
+            if (!s->mb) goto nomem;
+            ulam_csr_matvec(M, 0, s->b, s->mb);
+        }
+    }
+    if (o.estimator == ULAM_ABSORPTION && (status = check_absorption(s, err))) {
+        ulam_solver_free(s);
+        return status;
+    }
+    if (alloc_work(s)) goto nomem;
+    s->w = (ulam__walker){.k = s->k, .b = s->b, .mb = s->mb, .mt = s->mt, .src = s->src,
+                          .bnorm1 = s->w.bnorm1, .estimator = o.estimator, .roulette = o.roulette,
+                          .split = o.split, .max_steps = o.max_steps};
+    s->t0 = -1;
+    *out = s;
+    return ULAM_OK;
+nomem:
+    ulam_solver_free(s);
+    return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walk kernel and workspace");
+}
+
+/* Nonzero when the run must stop before starting another block. */
+static int must_stop(const ulam_solver *s)
+{
+    if (s->o.interrupt && *s->o.interrupt) return 1;
+    return s->o.max_seconds > 0 && ulam_now() - s->t0 >= s->o.max_seconds;
+}
+
+/* Run walks [first, first + count) of block q on thread t. */
+static void run_block(ulam_solver *s, int q, int64_t first, int64_t count, int t)
+{
+    block_result *br = &s->blocks[q];
+    ulam__scratch *sc = &s->scratch[t];
+    br->m = (ulam__moments){0, 0, 0};
+    br->t.len = 0;
+    br->walks = br->steps = br->cut = br->nonfinite = 0;
+    br->complete = 0;
+    if (must_stop(s)) return;
+    for (int64_t k = first; k < first + count; k++) {
+        ulam_rng r;
+        ulam_rng_seed(&r, s->o.seed, (uint64_t)k);
+        ulam__history h = {0, 0, 0};
+        if (s->o.mode == ULAM_ADJOINT) {
+            double x = ulam__adjoint_history(&s->w, s->o.index, &r, sc, &h);
+            if (!h.nonfinite) ulam__moments_add(&br->m, x);
+        } else if (ulam__forward_history(&s->w, &r, sc, &br->t, &h)) {
+            return; /* out of memory: the block stays incomplete */
+        }
+        br->steps += h.steps;
+        br->cut += h.cut;
+        br->nonfinite += h.nonfinite;
+        br->walks++;
+        if ((k & 63) == 63 && s->o.interrupt && *s->o.interrupt) return;
+    }
+    br->complete = 1;
+}
+
+/* Merge a completed block into the totals. */
+static void merge_block(ulam_solver *s, const block_result *br)
+{
+    ulam__moments_merge(&s->adj, &br->m);
+    for (int64_t q = 0; q < br->t.len; q++) {
+        double v = br->t.t[q].value;
+        s->sum[br->t.t[q].state] += v;
+        s->sumsq[br->t.t[q].state] += v * v;
+    }
+    s->walks += br->walks;
+    s->steps += br->steps;
+    s->cut += br->cut;
+    s->nonfinite += br->nonfinite;
+}
+
+/* Run one round of walks. */
+int ulam_solver_iterate(ulam_solver *s)
+{
+    if (!s) return ULAM_EINVAL;
+    if (s->done) return s->status;
+    double start = ulam_now();
+    if (s->t0 < 0) s->t0 = start;
+    int64_t left = s->o.max_walks > 0 ? s->o.max_walks - s->next_walk : INT64_MAX;
+    int nb = 0;
+    while (nb < ROUND && left > (int64_t)nb * BLOCK) nb++;
+    int64_t first = s->next_walk;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(s->threads)
+    for (int q = 0; q < nb; q++) {
+        int t = 0;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+#endif
+        int64_t b0 = first + (int64_t)q * BLOCK;
+        int64_t cnt = left - (int64_t)q * BLOCK < BLOCK ? left - (int64_t)q * BLOCK : BLOCK;
+        run_block(s, q, b0, cnt, t);
+    }
+    for (int q = 0; q < nb; q++) {
+        if (!s->blocks[q].complete) { /* interrupted or out of time: keep what came before */
+            s->done = 1;
+            break;
+        }
+        merge_block(s, &s->blocks[q]);
+        s->next_walk += s->blocks[q].walks;
+    }
+    s->seconds += ulam_now() - start;
+    if (s->o.interrupt && *s->o.interrupt) s->interrupted = s->done = 1;
+    if (s->nonfinite) {
+        s->done = 1;
+        s->status = ULAM_ENONFINITE;
+    }
+    ulam_walk_result r;
+    ulam_solver_result(s, &r);
+    if (s->o.max_walks > 0 && s->next_walk >= s->o.max_walks) s->done = 1;
+    if (s->o.rel_err > 0 && r.walks >= 1000 && r.std_error <= s->o.rel_err * fabs(r.estimate)) s->done = 1;
+    if (s->o.max_seconds > 0 && ulam_now() - s->t0 >= s->o.max_seconds) s->done = 1;
+    return s->status;
+}
+
+/* Nonzero once a stopping rule is met. */
+int ulam_solver_done(const ulam_solver *s)
+{
+    return !s || s->done;
+}
+
+/* Forward estimate and standard error of component i from the sums. */
+static void forward_component(const ulam_solver *s, int64_t i, double *est, double *se, double *var)
+{
+    double N = (double)s->walks;
+    double mean = N > 0 ? s->sum[i] / N : 0.0;
+    double v = N > 1 ? fmax(0.0, (s->sumsq[i] - N * mean * mean) / (N - 1)) : 0.0;
+    *est = mean + (s->o.estimator == ULAM_EXPECTED ? s->b[i] : 0.0);
+    *var = v;
+    *se = N > 0 ? sqrt(v / N) : INFINITY;
+}
+
+/* The result so far. */
+void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
+{
+    memset(r, 0, sizeof *r);
+    if (!s) return;
+    if (s->o.mode == ULAM_ADJOINT) {
+        r->estimate = s->adj.mean;
+        r->variance = ulam__moments_variance(&s->adj);
+        r->std_error = s->adj.n > 0 ? sqrt(r->variance / (double)s->adj.n) : INFINITY;
+    } else {
+        forward_component(s, s->o.index, &r->estimate, &r->std_error, &r->variance);
+    }
+    r->ci95[0] = r->estimate - 1.959963984540054 * r->std_error;
+    r->ci95[1] = r->estimate + 1.959963984540054 * r->std_error;
+    r->walks = s->walks;
+    r->steps = s->steps;
+    r->cut = s->cut;
+    r->seconds = s->seconds;
+    r->threads = s->threads;
+    r->interrupted = s->interrupted;
+}
+
+/* Forward mode: every component's estimate and standard error. */
+int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error)
+{
+    if (!s || s->o.mode != ULAM_FORWARD) return ULAM_EINVAL;
+    for (int64_t i = 0; i < s->n; i++) {
+        double e, se, v;
+        forward_component(s, i, &e, &se, &v);
+        if (x) x[i] = e;
+        if (std_error) std_error[i] = se;
+    }
+    return ULAM_OK;
+}
+
+/* The whole run in one call. */
+int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+               ulam_walk_result *result, ulam_error *err)
+{
+    ulam_solver *s = NULL;
+    int status = ulam_solver_alloc(M, b, opts, &s, err);
+    if (status) return status;
+    while (!status && !ulam_solver_done(s)) status = ulam_solver_iterate(s);
+    if (result) ulam_solver_result(s, result);
+    if (status) ulam__fail(err, status, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
+    ulam_solver_free(s);
+    return status;
+}
