@@ -64,6 +64,34 @@ static ulam_csr *random_sparse(int64_t n, int k, double rowsum, int signed_, uin
     return M;
 }
 
+/* A doubly substochastic M = sum_k w_k P_k over k random permutations P_k, weights w_k > 0
+ * summing to s: every row and every column sums to s, so adjoint and forward analog walks
+ * both keep weight 1 (coinciding entries are summed). */
+static ulam_csr *random_doubly(int64_t n, int k, double s, uint64_t seed)
+{
+    int64_t nz = n * k;
+    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
+    double *tx = malloc((size_t)nz * sizeof *tx), sum = 0, *w = malloc((size_t)k * sizeof *w);
+    int32_t *perm = malloc((size_t)n * sizeof *perm);
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 3);
+    for (int q = 0; q < k; q++) sum += w[q] = 0.2 + ulam_rng_uniform(&r);
+    for (int q = 0; q < k; q++) {
+        for (int64_t i = 0; i < n; i++) perm[i] = (int32_t)i;
+        for (int64_t i = n - 1; i > 0; i--) { /* Fisher-Yates */
+            int64_t j = (int64_t)ulam_rng_bounded(&r, (uint64_t)i + 1);
+            int32_t t = perm[i];
+            perm[i] = perm[j], perm[j] = t;
+        }
+        for (int64_t i = 0; i < n; i++)
+            ti[q * n + i] = (int32_t)i, tj[q * n + i] = perm[i], tx[q * n + i] = s * w[q] / sum;
+    }
+    ulam_csr *M = NULL;
+    ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M);
+    free(ti), free(tj), free(tx), free(w), free(perm);
+    return M;
+}
+
 /* A vector of n uniform values in [lo, hi). */
 static double *random_vector(int64_t n, double lo, double hi, uint64_t seed)
 {
@@ -143,10 +171,11 @@ static void all(const char *dir)
          "2-D Poisson 5-point matrix A on a 20 x 20 grid (n = 400); use --jacobi");
     ulam_csr_free(M), free(b);
 
-    M = random_sparse(1000, 8, 0.9, 0, 1000);
+    M = random_doubly(1000, 8, 0.9, 1000);
     b = random_vector(1000, 0.0, 1.0, 1000);
     save(dir, "randsub1000", M, b,
-         "random sparse substochastic M, n = 1000, 8 nonzeros/row, every row sum 0.9");
+         "random sparse doubly substochastic M (8 weighted random permutations), n = 1000, every "
+         "row and column sum 0.9");
     ulam_csr_free(M), free(b);
 
     M = radiosity_like(100, 100);

@@ -14,7 +14,7 @@ import tempfile
 
 STATUS = ["OK", "EINVAL", "ENOMEM", "EIO", "EEMPTY", "EBANNER", "EUNSUPPORTED", "ESIZELINE",
           "EOVERFLOW", "ETOOFEW", "ETOOMANY", "EINDEX", "ESYNTAX", "ENONFINITE", "ENOTSQUARE",
-          "EDIM", "EZERODIAG", "ESINGULAR", "EMEMLIMIT", "ENOCONV"]
+          "EDIM", "EZERODIAG", "ESINGULAR", "EMEMLIMIT", "ENOCONV", "EUNDEFINED"]
 
 
 def code(name):
@@ -64,6 +64,25 @@ CASES += [
     (["info", M + "signed_edge200.mtx"], 0, r"^$", r"walks\s+diverge"),
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "4"], 0, r"^$", r"x\[4\]\s+3\.68174"),
 ]
+SOLVE = ["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx"]
+CASES += [
+    (SOLVE + ["--index", "1", "--walks", "-5"], 2, r"--walks expects an integer", ""),
+    (SOLVE + ["--index", "1", "--rel-err", "0"], 2, r"--rel-err expects a number", ""),
+    (SOLVE + ["--index", "1", "--threads", "0"], 2, r"--threads expects an integer", ""),
+    (SOLVE + ["--index", "1", "--seed", "12x"], 2, r"--seed expects an integer", ""),
+    (SOLVE + ["--index", "1", "--mode", "sideways"], 2, r"--mode expects adjoint or forward", ""),
+    (SOLVE + ["--index", "1", "--estimator", "psychic"], 2, r"--estimator expects", ""),
+    (SOLVE + ["--index", "1", "--continue", "1"], 2, r"--continue expects a number", ""),
+    (SOLVE + ["--index", "1", "--roulette", "2", "--split", "1"], 2, r"--split W must exceed", ""),
+    (SOLVE + ["--index", "9"], 2, r"--index 9 is out of range 1..4", ""),
+    (SOLVE, 2, r"adjoint walks need --index", ""),
+    (SOLVE + ["--index", "1", "--out", "/tmp/x.mtx"], 2, r"--out and --errors need --mode forward", ""),
+    (["solve", D + "absorb_undefined.mtx", "--rhs", D + "ones3.mtx", "--index", "1", "--estimator", "absorption"],
+     code("EUNDEFINED"), r"state 2 \(1-based\) is reachable and never terminates", ""),
+    (SOLVE + ["--index", "2", "--walks", "20000", "--check"], 0, r"^$", r"direct\s+2\.34009.*z = "),
+    (SOLVE + ["--index", "2", "--walks", "20000", "--mode", "forward", "--estimator", "expected"], 0, r"^$",
+     r"forward walks, expected estimator"),
+]
 
 
 def run(ulam, args):
@@ -98,6 +117,64 @@ def check_json(ulam):
     assert o["index"] == 1 and abs(o["value"] - 2.9329173166926679) < 1e-12 and o["residual"] < 1e-14
 
 
+def check_solve_json(ulam):
+    """solve --json has the documented keys; --check adds direct and z; threads do not matter."""
+    base = SOLVE + ["--index", "3", "--walks", "50000", "--seed", "5", "--json", "--check"]
+    outs = []
+    for t in ("1", "2"):
+        rc, out, _ = run(ulam, base + ["--threads", t])
+        assert rc == 0
+        outs.append(json.loads(out))
+    o = outs[0]
+    for k in ["index", "estimate", "stderr", "ci95", "variance", "walks", "steps", "seconds", "mode",
+              "estimator", "seed", "threads", "interrupted", "direct", "direct_seconds", "z"]:
+        assert k in o, k
+    assert o["index"] == 3 and o["walks"] == 50000 and o["interrupted"] is False
+    assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
+    assert o["ci95"][0] < o["estimate"] < o["ci95"][1]
+    assert outs[0]["estimate"] == outs[1]["estimate"] and outs[0]["variance"] == outs[1]["variance"]
+
+
+def check_forward_files(ulam):
+    """forward --out and --errors write every component; each within 5 sigma of LAPACK, and
+    about 95% within their 95% interval (binomial: 1000 components, 4 sigma band)."""
+    with tempfile.TemporaryDirectory() as d:
+        x, e, ref = (os.path.join(d, f) for f in ("x.mtx", "e.mtx", "ref.mtx"))
+        rc, _, err = run(ulam, ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx",
+                                "--mode", "forward", "--walks", "200000", "--out", x, "--errors", e])
+        assert rc == 0, err
+        rc, _, _ = run(ulam, ["direct", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--out", ref])
+        assert rc == 0
+        read = lambda p: [float(v) for v in open(p).read().split("\n")[3:] if v]
+        xs, es, rs = read(x), read(e), read(ref)
+        assert len(xs) == len(es) == len(rs) == 1000
+        assert all(abs(a - b) < 5 * s for a, b, s in zip(xs, rs, es))
+        covered = sum(abs(a - b) < 1.959964 * s for a, b, s in zip(xs, rs, es))
+        assert 922 <= covered <= 978, covered
+
+
+def check_interrupt(ulam):
+    """Ctrl-C prints the estimate so far, marked interrupted, with exit code 130 (no sleeps:
+    wait until the process has installed its SIGINT handler, then send it)."""
+    import signal
+    import time
+    p = subprocess.Popen([ulam] + SOLVE + ["--index", "1", "--walks", "100000000000", "--json"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        try:
+            caught = [l for l in open(f"/proc/{p.pid}/status") if l.startswith("SigCgt:")]
+        except OSError:
+            break
+        if caught and int(caught[0].split()[1], 16) & (1 << (signal.SIGINT - 1)):
+            break
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=60)
+    assert p.returncode == 130, p.returncode
+    o = json.loads(out)
+    assert o["interrupted"] is True and o["walks"] > 0
+
+
 def check_outputs(ulam):
     """--out writes a readable solution; a failed run leaves an old file intact and no temp files."""
     with tempfile.TemporaryDirectory() as d:
@@ -129,7 +206,8 @@ def check_genmat(genmat):
 def main():
     ulam, genmat = sys.argv[1], sys.argv[2]
     failures, n = check_table(ulam)
-    extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat)]
+    extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
+             (check_forward_files, ulam), (check_interrupt, ulam)]
     for f, arg in extra:
         try:
             f(arg)

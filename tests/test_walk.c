@@ -1,0 +1,345 @@
+/* The walk engine, tested statistically with fixed seeds.
+ *
+ * Exact variances of the adjoint estimators (any kernel q_i, p_ij; w = M_ij / (q_i p_ij)):
+ * let M^_ij = M_ij^2 / (q_i p_ij), the second-moment matrix, and X_i the score of a walk
+ * started at i.
+ *   collision:  X_i = b_i + [continue] w X_j, so E X_i^2 = b_i^2 + 2 b_i (M x)_i + (M^ v)_i,
+ *               i.e. (I - M^) v = b o b + 2 b o (x - b)          (o: elementwise product)
+ *   absorption: X_i = [stop] b_i / p*_i + [continue] w X_j, so (I - M^) v = b o b / p*
+ *   expected:   X_i = b_i + Y_i, Y_i = c_i + [continue] w Y_j with c = M b, y = x - b, so
+ *               (I - M^) u = c o c + 2 c o (y - c) and Var X_i = u_i - y_i^2
+ * and Var X_i = v_i - x_i^2 in the first two.  For the analog kernel p_ij = |M_ij| / S_i,
+ * M^_ij = |M_ij| S_i / q_i. */
+#include "testutil.h"
+
+#include <string.h>
+
+typedef struct {
+    ulam_csr *M;
+    double *b, *x; /* x: LAPACK solution */
+    int64_t n;
+} sys;
+
+/* Load matrices/NAME.mtx and its b, and solve it with LAPACK. */
+static sys load(const char *name)
+{
+    char mp[256], bp[256];
+    snprintf(mp, sizeof mp, "matrices/%s.mtx", name);
+    snprintf(bp, sizeof bp, "matrices/%s_b.mtx", name);
+    sys s;
+    s.M = must_read(mp);
+    s.b = must_read_vector(bp, &s.n);
+    s.x = malloc((size_t)s.n * sizeof *s.x);
+    assert_int_equal(ulam_direct_solve(s.M, s.b, s.x, 0, NULL, NULL), ULAM_OK);
+    return s;
+}
+
+/* Free a loaded system. */
+static void unload(sys *s)
+{
+    ulam_csr_free(s->M);
+    free(s->b), free(s->x);
+}
+
+/* Run walks; must succeed. */
+static ulam_walk_result run(const sys *s, ulam_walk_opts o)
+{
+    ulam_walk_result r;
+    ulam_error err;
+    int st = ulam_solve(s->M, s->b, &o, &r, &err);
+    if (st) print_error("ulam_solve: %s: %s\n", ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    assert_true(r.walks == o.max_walks);
+    return r;
+}
+
+/* |estimate - LAPACK| < 4 sigma. */
+static void assert_agrees(const sys *s, const ulam_walk_result *r, int64_t index)
+{
+    if (!(fabs(r->estimate - s->x[index]) < 4 * r->std_error))
+        print_error("estimate %.10g, LAPACK %.10g, stderr %.3g (z = %.2f)\n", r->estimate, s->x[index],
+                    r->std_error, (r->estimate - s->x[index]) / r->std_error);
+    assert_true(fabs(r->estimate - s->x[index]) < 4 * r->std_error);
+    assert_true(r->std_error > 0 && r->std_error < 0.05 * (fabs(s->x[index]) + 1));
+}
+
+/* Every mode and estimator on three systems agrees with LAPACK within 4 sigma.  Forward
+ * absorption is refused where a column of |M| sums past 1 (p* = 0 in the kernel of M'):
+ * on randsub1000 that refusal is the expected outcome (with a fixed q its variance there is
+ * infinite, which the stability guards chart); on signed200 it runs with q = 0.8. */
+static void test_agreement(void **state)
+{
+    (void)state;
+    static const struct { const char *name; int64_t index; } systems[] = {
+        {"chain4", 1}, {"randsub1000", 7}, {"signed200", 3}};
+    for (size_t k = 0; k < 3; k++) {
+        sys s = load(systems[k].name);
+        for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++)
+            for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
+                ulam_walk_opts o = ulam_walk_defaults();
+                o.mode = mode;
+                o.estimator = est;
+                o.index = systems[k].index;
+                o.max_walks = mode == ULAM_FORWARD && s.n > 100 ? 400000 : 100000;
+                o.seed = 100 + k;
+                ulam_solver *sv = NULL;
+                int st = ulam_solver_alloc(s.M, s.b, &o, &sv, NULL);
+                ulam_solver_free(sv);
+                if (st == ULAM_EUNDEFINED) {
+                    assert_true(est == ULAM_ABSORPTION && mode == ULAM_FORWARD && k > 0);
+                    if (k == 1) continue;
+                    o.continue_q = 0.8;
+                    o.max_walks = 1600000;
+                }
+                ulam_walk_result r = run(&s, o);
+                assert_agrees(&s, &r, o.index);
+            }
+        unload(&s);
+    }
+}
+
+/* Over 200 seeds the 95% interval covers the LAPACK value 90% to 99% of the time. */
+static void test_coverage(void **state)
+{
+    (void)state;
+    sys s = load("chain4");
+    for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+        int covered = 0;
+        for (int seed = 0; seed < 200; seed++) { /* case seed: reruns exactly */
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.estimator = est;
+            o.index = 0;
+            o.max_walks = 2000;
+            o.seed = (uint64_t)seed;
+            ulam_walk_result r = run(&s, o);
+            covered += r.ci95[0] <= s.x[0] && s.x[0] <= r.ci95[1];
+        }
+        print_message("estimator %d: 95%% interval covered the LAPACK value %d / 200 times\n", est, covered);
+        assert_in_range(covered, 180, 198);
+    }
+    unload(&s);
+}
+
+/* The second-moment matrix M^ of the kernel (analog or fixed q). */
+static ulam_csr *second_moment(const ulam_csr *M, double q_fixed)
+{
+    ulam_csr *H = NULL;
+    assert_int_equal(ulam_csr_copy(M, &H), ULAM_OK);
+    for (int64_t i = 0; i < M->nrows; i++) {
+        double S = 0;
+        for (int64_t k = M->rowptr[i]; k < M->rowptr[i + 1]; k++) S += fabs(M->val[k]);
+        double q = q_fixed > 0 ? q_fixed : fmin(1.0, S);
+        for (int64_t k = M->rowptr[i]; k < M->rowptr[i + 1]; k++) H->val[k] = fabs(M->val[k]) * S / q;
+    }
+    return H;
+}
+
+/* Exact per-walk variance of the adjoint estimator at index (formulas at the top). */
+static double exact_variance(const sys *s, int est, int64_t index, double q_fixed)
+{
+    int64_t n = s->n;
+    ulam_csr *H = second_moment(s->M, q_fixed);
+    double *rhs = malloc((size_t)n * sizeof *rhs), *v = malloc((size_t)n * sizeof *v),
+           *c = malloc((size_t)n * sizeof *c);
+    ulam_csr_matvec(s->M, 0, s->b, c);
+    for (int64_t i = 0; i < n; i++) {
+        double S = 0;
+        for (int64_t k = s->M->rowptr[i]; k < s->M->rowptr[i + 1]; k++) S += fabs(s->M->val[k]);
+        double pstar = 1 - (q_fixed > 0 ? q_fixed : fmin(1.0, S));
+        double y = s->x[i] - s->b[i];
+        if (est == ULAM_COLLISION) rhs[i] = s->b[i] * s->b[i] + 2 * s->b[i] * (s->x[i] - s->b[i]);
+        else if (est == ULAM_ABSORPTION) rhs[i] = s->b[i] * s->b[i] / pstar;
+        else rhs[i] = c[i] * c[i] + 2 * c[i] * (y - c[i]);
+    }
+    assert_int_equal(ulam_direct_solve(H, rhs, v, 0, NULL, NULL), ULAM_OK);
+    double mean = est == ULAM_EXPECTED ? s->x[index] - s->b[index] : s->x[index];
+    double var = v[index] - mean * mean;
+    free(rhs), free(v), free(c);
+    ulam_csr_free(H);
+    return var;
+}
+
+/* At 10^6 walks the per-walk sample variance is within 5% of the exact one, for every adjoint
+ * estimator, on the chain (analog, weight 1) and the signed system (weights +-1, and with a
+ * fixed continuation 0.75 where weights grow as (0.8 / 0.75)^k). */
+static void test_exact_variance(void **state)
+{
+    (void)state;
+    static const struct { const char *name; int64_t index; double q; } cases[] = {
+        {"chain4", 1, 0}, {"signed200", 3, 0}, {"signed200", 3, 0.75}};
+    static const char *const names[] = {"collision", "absorption", "expected"};
+    for (size_t k = 0; k < 3; k++) {
+        sys s = load(cases[k].name);
+        for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.estimator = est;
+            o.index = cases[k].index;
+            o.continue_q = cases[k].q;
+            o.max_walks = 1000000;
+            o.seed = 7;
+            ulam_walk_result r = run(&s, o);
+            double exact = exact_variance(&s, est, o.index, cases[k].q);
+            print_message("%s x[%lld] q=%g %-10s variance: measured %.6g, exact %.6g (%+.2f%%)\n",
+                          cases[k].name, (long long)o.index + 1, cases[k].q, names[est], r.variance,
+                          exact, 100 * (r.variance / exact - 1));
+            assert_true(exact > 0);
+            assert_close(r.variance, exact, 0.05 * exact);
+        }
+        unload(&s);
+    }
+}
+
+/* Roulette (weights shrinking under --continue 0.95 on the chain) and splitting (weights
+ * growing under --continue 0.5 on the signed system) leave the estimate unbiased. */
+static void test_roulette_and_splitting(void **state)
+{
+    (void)state;
+    sys s = load("chain4");
+    for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = mode;
+        o.index = 2;
+        o.continue_q = 0.95;
+        o.max_walks = 200000;
+        ulam_walk_result plain = run(&s, o);
+        o.roulette = 0.5;
+        ulam_walk_result rr = run(&s, o);
+        assert_agrees(&s, &rr, 2);
+        assert_true(rr.steps < plain.steps); /* roulette did cut walks short */
+    }
+    unload(&s);
+    s = load("signed200");
+    for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = mode;
+        o.index = 3;
+        o.continue_q = 0.5;
+        o.max_walks = 200000;
+        ulam_walk_result plain = run(&s, o);
+        o.split = 2.0;
+        o.roulette = 0.25;
+        ulam_walk_result ws = run(&s, o);
+        assert_agrees(&s, &ws, 3);
+        assert_true(ws.steps > plain.steps); /* splitting did make copies */
+    }
+    unload(&s);
+}
+
+/* Same seed and walk count: bit-for-bit the same result with 1 and 2 threads. */
+static void test_threads_identical(void **state)
+{
+    (void)state;
+    sys s = load("randsub1000");
+    for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = mode;
+        o.index = 5;
+        o.max_walks = 50000;
+        o.seed = 99;
+        o.threads = 1;
+        ulam_walk_result a = run(&s, o);
+        o.threads = 2;
+        ulam_walk_result b = run(&s, o);
+        assert_memory_equal(&a.estimate, &b.estimate, sizeof a.estimate);
+        assert_memory_equal(&a.variance, &b.variance, sizeof a.variance);
+        assert_true(a.steps == b.steps);
+    }
+    unload(&s);
+}
+
+/* Forward mode estimates every component with its own error bar. */
+static void test_forward_vectors(void **state)
+{
+    (void)state;
+    sys s = load("radiosity100");
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.mode = ULAM_FORWARD;
+    o.max_walks = 200000;
+    ulam_solver *sv = NULL;
+    assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_OK);
+    while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+    double *x = malloc((size_t)s.n * sizeof *x), *e = malloc((size_t)s.n * sizeof *e);
+    assert_int_equal(ulam_solver_vectors(sv, x, e), ULAM_OK);
+    int within = 0;
+    for (int64_t i = 0; i < s.n; i++) {
+        assert_true(e[i] > 0);
+        within += fabs(x[i] - s.x[i]) < 1.959964 * e[i];
+        assert_true(fabs(x[i] - s.x[i]) < 5 * e[i]);
+    }
+    print_message("forward: %d / 100 components within their 95%% interval\n", within);
+    assert_in_range(within, 85, 100);
+    free(x), free(e);
+    ulam_solver_free(sv);
+    unload(&s);
+}
+
+/* Absorption is refused, naming the state, where a reachable state with b != 0 never ends. */
+static void test_absorption_refused(void **state)
+{
+    (void)state;
+    int32_t i[3] = {0, 1, 2}, j[3] = {1, 2, 0};
+    double v[3] = {0.5, 1.0, 0.3}, b[3] = {1, 1, 1};
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(3, 3, 3, i, j, v, &M), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.estimator = ULAM_ABSORPTION;
+    ulam_solver *sv = NULL;
+    ulam_error err;
+    assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, &err), ULAM_EUNDEFINED);
+    assert_null(sv);
+    assert_int_equal(err.index, 1);
+    assert_non_null(strstr(err.msg, "state 2"));
+    o.estimator = ULAM_COLLISION;
+    assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, &err), ULAM_OK);
+    ulam_solver_free(sv);
+    ulam_csr_free(M);
+}
+
+/* Options are checked before anything runs. */
+static void test_bad_options(void **state)
+{
+    (void)state;
+    sys s = load("chain4");
+    ulam_walk_opts o = ulam_walk_defaults();
+    ulam_solver *sv = NULL;
+    o.index = 4;
+    assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_EINVAL);
+    o = ulam_walk_defaults();
+    o.continue_q = 1.0;
+    assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_EINVAL);
+    o = ulam_walk_defaults();
+    o.max_walks = 0;
+    assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_EINVAL);
+    assert_null(sv);
+    assert_null(ulam_solver_free(NULL));
+    unload(&s);
+}
+
+/* --rel-err stops once the relative standard error is reached, after at least 1000 walks. */
+static void test_rel_err_stop(void **state)
+{
+    (void)state;
+    sys s = load("randsub1000");
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.max_walks = 0;
+    o.rel_err = 0.005;
+    o.index = 11;
+    ulam_walk_result r;
+    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_true(r.walks >= 1000);
+    assert_true(r.std_error <= 0.005 * fabs(r.estimate));
+    assert_true(fabs(r.estimate - s.x[11]) < 4 * r.std_error);
+    unload(&s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_agreement),         cmocka_unit_test(test_coverage),
+        cmocka_unit_test(test_exact_variance),    cmocka_unit_test(test_roulette_and_splitting),
+        cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_forward_vectors),
+        cmocka_unit_test(test_absorption_refused), cmocka_unit_test(test_bad_options),
+        cmocka_unit_test(test_rel_err_stop),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
