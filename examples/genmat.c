@@ -26,6 +26,17 @@ static void save(const char *dir, const char *name, const ulam_csr *M, const dou
     }
 }
 
+/* Build an n x n CSR matrix from triplets and free the triplet arrays. */
+static ulam_csr *build(int64_t n, int64_t nz, int32_t *ti, int32_t *tj, double *tx)
+{
+    ulam_csr *M = NULL;
+    ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M);
+    free(ti);
+    free(tj);
+    free(tx);
+    return M;
+}
+
 /* A random matrix with k distinct random columns per row; row i's |values| sum to rowsum;
  * signed != 0 gives each entry a random sign. */
 static ulam_csr *random_sparse(int64_t n, int k, double rowsum, int signed_, uint64_t seed)
@@ -56,12 +67,7 @@ static ulam_csr *random_sparse(int64_t n, int k, double rowsum, int signed_, uin
             if (signed_ && ulam_rng_uniform(&r) < 0.5) tx[base + m] = -tx[base + m];
         }
     }
-    ulam_csr *M = NULL;
-    ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M);
-    free(ti);
-    free(tj);
-    free(tx);
-    return M;
+    return build(n, nz, ti, tj, tx);
 }
 
 /* A doubly substochastic M = sum_k w_k P_k over k random permutations P_k, weights w_k > 0
@@ -86,10 +92,8 @@ static ulam_csr *random_doubly(int64_t n, int k, double s, uint64_t seed)
         for (int64_t i = 0; i < n; i++)
             ti[q * n + i] = (int32_t)i, tj[q * n + i] = perm[i], tx[q * n + i] = s * w[q] / sum;
     }
-    ulam_csr *M = NULL;
-    ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M);
-    free(ti), free(tj), free(tx), free(w), free(perm);
-    return M;
+    free(w), free(perm);
+    return build(n, nz, ti, tj, tx);
 }
 
 /* A vector of n uniform values in [lo, hi). */
@@ -117,12 +121,7 @@ static ulam_csr *poisson2d(int g)
             for (int q = 0; q < 4; q++)
                 if (nb[q] >= 0) ti[k] = i, tj[k] = nb[q], tx[k++] = -1.0;
         }
-    ulam_csr *A = NULL;
-    ulam_csr_from_triplets(n, n, k, ti, tj, tx, &A);
-    free(ti);
-    free(tj);
-    free(tx);
-    return A;
+    return build(n, k, ti, tj, tx);
 }
 
 /* A radiosity-like dense M = diag(rho) F: n patches on a circle's two arcs, F_ij
@@ -145,12 +144,7 @@ static ulam_csr *radiosity_like(int64_t n, uint64_t seed)
         }
         for (int64_t q = base; q < k; q++) tx[q] *= rho / sum;
     }
-    ulam_csr *M = NULL;
-    ulam_csr_from_triplets(n, n, k, ti, tj, tx, &M);
-    free(ti);
-    free(tj);
-    free(tx);
-    return M;
+    return build(n, k, ti, tj, tx);
 }
 
 /* Emission: a few bright patches, the rest dark. */
