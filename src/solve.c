@@ -61,7 +61,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
     if (s->scratch)
         for (int t = 0; t < s->threads; t++) {
             free(s->scratch[t].stack_s), free(s->scratch[t].stack_w);
-            free(s->scratch[t].hist), free(s->scratch[t].touched);
+            free(s->scratch[t].hist), free(s->scratch[t].touched), free(s->scratch[t].mark);
         }
     if (s->blocks)
         for (int q = 0; q < ROUND; q++) free(s->blocks[q].t.t);
@@ -116,8 +116,8 @@ static int check_absorption(ulam_solver *s, ulam_error *err)
     return ULAM_OK;
 }
 
-/* The forward source distribution |b| / ||b||_1 as an alias table. */
-static int build_source(ulam_solver *s)
+/* The forward source distribution |b| / ||b||_1 as an alias table; sets *bnorm1. */
+static int build_source(ulam_solver *s, double *bnorm1)
 {
     int64_t n = s->n;
     double *p = ulam__malloc((size_t)n, sizeof *p), *scaled = ulam__malloc((size_t)n, sizeof *scaled);
@@ -128,7 +128,7 @@ static int build_source(ulam_solver *s)
     if (p && scaled && out && small && large && s->src) {
         double norm = 0.0;
         for (int64_t i = 0; i < n; i++) norm += fabs(s->b[i]);
-        s->w.bnorm1 = norm;
+        *bnorm1 = norm;
         for (int64_t i = 0; i < n; i++) {
             p[i] = norm > 0 ? fabs(s->b[i]) / norm : 1.0 / (double)n;
             out[i] = s->b[i] < 0 ? ~(int32_t)i : (int32_t)i;
@@ -154,8 +154,9 @@ static int alloc_work(ulam_solver *s)
         if (!sc->stack_s || !sc->stack_w) return ULAM_ENOMEM;
         if (s->o.mode == ULAM_FORWARD) {
             sc->hist = ulam__calloc((size_t)s->n, sizeof *sc->hist);
-            sc->touched = ulam__calloc((size_t)s->n * (sizeof(int64_t) + 1), 1); /* + mark[] */
-            if (!sc->hist || !sc->touched) return ULAM_ENOMEM;
+            sc->touched = ulam__malloc((size_t)s->n, sizeof *sc->touched);
+            sc->mark = ulam__calloc((size_t)s->n, 1);
+            if (!sc->hist || !sc->touched || !sc->mark) return ULAM_ENOMEM;
         }
     }
     if (s->o.mode == ULAM_FORWARD) {
@@ -176,6 +177,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     ulam_walk_opts o = opts ? *opts : ulam_walk_defaults();
     int status = check_opts(M, &o, err);
     if (status) return status;
+    double bnorm1 = 0.0;
     ulam_solver *s = calloc(1, sizeof *s);
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
     s->o = o;
@@ -191,7 +193,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     if (o.mode == ULAM_FORWARD) {
         if (ulam_csr_transpose(M, &s->mt)) goto nomem;
         if (ulam__kernel_build(s->mt, o.continue_q, &s->k)) goto nomem;
-        if (build_source(s)) goto nomem;
+        if (build_source(s, &bnorm1)) goto nomem;
     } else {
         if (ulam__kernel_build(M, o.continue_q, &s->k)) goto nomem;
         if (o.estimator == ULAM_EXPECTED) {
@@ -206,7 +208,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     }
     if (alloc_work(s)) goto nomem;
     s->w = (ulam__walker){.k = s->k, .b = s->b, .mb = s->mb, .mt = s->mt, .src = s->src,
-                          .bnorm1 = s->w.bnorm1, .estimator = o.estimator, .roulette = o.roulette,
+                          .bnorm1 = bnorm1, .estimator = o.estimator, .roulette = o.roulette,
                           .split = o.split, .max_steps = o.max_steps};
     s->t0 = -1;
     *out = s;

@@ -92,17 +92,17 @@ double ulam__adjoint_history(const ulam__walker *w, int64_t start, ulam_rng *r, 
 }
 
 /* Add v to state s's tally for this history. */
-static void tally(ulam__scratch *sc, unsigned char *mark, int32_t s, double v)
+static void tally(ulam__scratch *sc, int32_t s, double v)
 {
-    if (!mark[s]) {
-        mark[s] = 1;
+    if (!sc->mark[s]) {
+        sc->mark[s] = 1;
         sc->touched[sc->ntouched++] = s;
     }
     sc->hist[s] += v;
 }
 
 /* Move this history's tallies to out and clear them. */
-static int emit(ulam__scratch *sc, unsigned char *mark, ulam__tallies *out)
+static int emit(ulam__scratch *sc, ulam__tallies *out)
 {
     if (out->len + sc->ntouched > out->cap) {
         int64_t cap = out->cap ? out->cap : 1024;
@@ -116,7 +116,7 @@ static int emit(ulam__scratch *sc, unsigned char *mark, ulam__tallies *out)
         int64_t s = sc->touched[q];
         out->t[out->len++] = (ulam__tally){(int32_t)s, sc->hist[s]};
         sc->hist[s] = 0.0;
-        mark[s] = 0;
+        sc->mark[s] = 0;
     }
     sc->ntouched = 0;
     return ULAM_OK;
@@ -127,7 +127,6 @@ int ulam__forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc,
                           ulam__history *h)
 {
     const ulam_kernel *k = w->k;
-    unsigned char *mark = (unsigned char *)(sc->touched + k->n); /* mark[] follows touched[] */
     const ulam__slot *src = w->src + ulam_rng_bounded(r, (uint64_t)k->n);
     int32_t o = ulam_rng_uniform(r) < src->thresh ? src->a : src->b;
     int32_t s0 = o < 0 ? ~o : o;
@@ -138,13 +137,13 @@ int ulam__forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc,
         int32_t s = sc->stack_s[top];
         double wt = sc->stack_w[top];
         for (;;) {
-            if (w->estimator == ULAM_COLLISION) tally(sc, mark, s, wt);
+            if (w->estimator == ULAM_COLLISION) tally(sc, s, wt);
             else if (w->estimator == ULAM_EXPECTED)
                 for (int64_t q = w->mt->rowptr[s]; q < w->mt->rowptr[s + 1]; q++)
-                    tally(sc, mark, w->mt->colidx[q], wt * w->mt->val[q]);
+                    tally(sc, w->mt->colidx[q], wt * w->mt->val[q]);
             o = ulam__kernel_step(k, s, r);
             if (o == ULAM__TERMINATE) {
-                if (w->estimator == ULAM_ABSORPTION) tally(sc, mark, s, wt / k->pstar[s]);
+                if (w->estimator == ULAM_ABSORPTION) tally(sc, s, wt / k->pstar[s]);
                 break;
             }
             s = move(k, s, o, &wt);
@@ -162,5 +161,5 @@ int ulam__forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc,
             if (!window(w, s, &wt, r, sc, &top)) break;
         }
     }
-    return emit(sc, mark, out);
+    return emit(sc, out);
 }

@@ -36,6 +36,7 @@ typedef struct {
     int64_t stack_cap;
     double *hist;     /* forward: this history's tally per state */
     int64_t *touched; /* forward: states with a tally in this history */
+    unsigned char *mark; /* forward: mark[s] != 0 when s is in touched[] */
     int64_t ntouched;
 } ulam__scratch;
 

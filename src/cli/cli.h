@@ -34,18 +34,24 @@ int cli_parse_bytes(const char *command, const char *opt, const char *s, size_t 
 
 /* What a subcommand needs to know about the system it solves. */
 typedef struct cli_system {
+    const char *command;  /* subcommand name, for messages */
     const char *matrix_path, *rhs_path;
+    int64_t index;        /* 1-based --index to check against n once loaded (0: none) */
     int jacobi;   /* the file holds A of A x = b: use M = I - omega D^-1 A */
     double omega; /* damping of the Jacobi splitting (1 = plain Jacobi) */
     ulam_csr *M;  /* the iteration matrix */
     double *b;    /* the right-hand side (NULL if no --rhs and none needed) */
 } cli_system;
 
-/* Load M (and b if rhs_path is set, or zeros when jacobi needs one); 0 or an exit code. */
+/* Load M (and b if rhs_path is set, or zeros when jacobi needs one) and check index
+ * against n; 0 or an exit code (nothing stays loaded on failure). */
 int cli_load_system(cli_system *s);
 
 /* Free what cli_load_system loaded. */
 void cli_system_free(cli_system *s);
+
+/* Solve the loaded system densely into a new *x; 0 or an exit code (error reported). */
+int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info);
 
 /* Print a JSON number (null when not finite). */
 void cli_json_number(const char *key, double v, int last);

@@ -134,6 +134,12 @@ int cli_load_system(cli_system *s)
     }
     s->M = A;
     s->b = b;
+    if (s->index > A->nrows) {
+        int rc = cli_usage_error(s->command, "--index %lld is out of range 1..%lld",
+                                 (long long)s->index, (long long)A->nrows);
+        cli_system_free(s);
+        return rc;
+    }
     return 0;
 }
 
@@ -143,6 +149,18 @@ void cli_system_free(cli_system *s)
     s->M = ulam_csr_free(s->M);
     free(s->b);
     s->b = NULL;
+}
+
+/* Solve the loaded system densely into a new *x; 0 or an exit code. */
+int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info)
+{
+    ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
+    *x = malloc((size_t)s->M->nrows * sizeof **x);
+    int status = *x ? ulam_direct_solve(s->M, s->b, *x, max_mem, info, &err) : ULAM_ENOMEM;
+    if (!status) return 0;
+    free(*x);
+    *x = NULL;
+    return cli_report(s->matrix_path, &err);
 }
 
 /* Print a JSON number (null when not finite). */

@@ -64,16 +64,15 @@ int cli_direct(int argc, char **argv)
         {"jacobi", no_argument, 0, 'j'},        {"omega", required_argument, 0, 'w'},
         {"json", no_argument, 0, 'J'},          {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0}};
-    cli_system s = {.omega = 1.0};
+    cli_system s = {.command = "direct", .omega = 1.0};
     const char *out = NULL;
-    int64_t index = 0;
     size_t max_mem = (size_t)4 << 30;
     int json = 0, c, rc;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
         switch (c) {
         case 'b': s.rhs_path = optarg; break;
-        case 'i': if ((rc = cli_parse_int("direct", "--index", optarg, 1, ULAM_MAX_DIM, &index))) return rc; break;
+        case 'i': if ((rc = cli_parse_int("direct", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
         case 'o': out = optarg; break;
         case 'm': if ((rc = cli_parse_bytes("direct", "--max-mem", optarg, &max_mem))) return rc; break;
         case 'j': s.jacobi = 1; break;
@@ -87,26 +86,18 @@ int cli_direct(int argc, char **argv)
     if (!s.rhs_path) return cli_usage_error("direct", "needs --rhs b.mtx");
     s.matrix_path = argv[optind];
     if ((rc = cli_load_system(&s))) return rc;
-    if (index > s.M->nrows) {
-        rc = cli_usage_error("direct", "--index %lld is out of range 1..%lld", (long long)index,
-                             (long long)s.M->nrows);
-        cli_system_free(&s);
-        return rc;
-    }
-    double *x = malloc((size_t)s.M->nrows * sizeof *x);
+    double *x = NULL;
     ulam_direct_info info;
-    ulam_error err;
-    int status = x ? ulam_direct_solve(s.M, s.b, x, max_mem, &info, &err) : ULAM_ENOMEM;
-    if (!x) err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the solution"};
-    if (status) {
-        rc = cli_report(s.matrix_path, &err);
+    int status;
+    if ((rc = cli_direct_solve(&s, max_mem, &x, &info))) {
+        /* reported */
     } else if (out && (status = ulam_mm_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct"))) {
-        err = (ulam_error){.status = status, .msg = "a writable output file"};
+        ulam_error err = {.status = status, .msg = "a writable output file"};
         rc = cli_report(out, &err);
+    } else if (json) {
+        print_json(&s, x, s.index, &info);
     } else {
-        if (json) print_json(&s, x, index, &info);
-        else print_text(&s, x, index, &info, out);
-        rc = 0;
+        print_text(&s, x, s.index, &info, out);
     }
     free(x);
     cli_system_free(&s);

@@ -75,7 +75,7 @@ int cli_info(int argc, char **argv)
         {"jacobi", no_argument, 0, 'j'}, {"omega", required_argument, 0, 'w'},
         {"tol", required_argument, 0, 't'}, {"json", no_argument, 0, 'J'},
         {"help", no_argument, 0, 'h'},   {0, 0, 0, 0}};
-    cli_system s = {.omega = 1.0};
+    cli_system s = {.command = "info", .omega = 1.0};
     ulam_spectral_opts so = ulam_spectral_defaults();
     int json = 0, c, rc;
     optind = 0;

@@ -122,17 +122,14 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
 /* LAPACK value of x_index for --check; 0 or an exit code. */
 static int direct_check(const cli_system *s, int64_t index, report_opts *ro)
 {
-    double *x = malloc((size_t)s->M->nrows * sizeof *x);
+    double *x;
     ulam_direct_info info;
-    ulam_error err;
-    int status = x ? ulam_direct_solve(s->M, s->b, x, (size_t)4 << 30, &info, &err) : ULAM_ENOMEM;
-    if (!x) err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the direct solution"};
-    if (!status) {
-        ro->direct = x[index];
-        ro->direct_seconds = info.seconds;
-    }
+    int rc = cli_direct_solve(s, (size_t)4 << 30, &x, &info);
+    if (rc) return rc;
+    ro->direct = x[index];
+    ro->direct_seconds = info.seconds;
     free(x);
-    return status ? cli_report(s->matrix_path, &err) : 0;
+    return 0;
 }
 
 /* Write the forward vectors; 0 or an exit code. */
@@ -167,18 +164,18 @@ int cli_solve(int argc, char **argv)
         {"json", no_argument, 0, 'J'},            {"out", required_argument, 0, 'o'},
         {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0}};
-    cli_system s = {.omega = 1.0};
+    cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};
     const char *out = NULL, *errors = NULL;
-    int64_t index = 0, v;
+    int64_t v;
     int c, rc, any_rule = 0;
     o.max_walks = 0;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
         switch (c) {
         case 'b': s.rhs_path = optarg; break;
-        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &index))) return rc; break;
+        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
         case 'm':
             if ((o.mode = lookup(optarg, mode_names, 2)) < 0)
                 return cli_usage_error("solve", "--mode expects adjoint or forward, got '%s'", optarg);
@@ -208,7 +205,7 @@ int cli_solve(int argc, char **argv)
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
     if (!s.rhs_path) return cli_usage_error("solve", "needs --rhs b.mtx");
-    if (!index && o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
+    if (!s.index && o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
     if ((out || errors) && o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
     if (o.roulette > 0 && o.split > 0 && o.split <= o.roulette)
@@ -216,12 +213,7 @@ int cli_solve(int argc, char **argv)
     if (!any_rule) o.max_walks = 100000;
     s.matrix_path = argv[optind];
     if ((rc = cli_load_system(&s))) return rc;
-    if (index > s.M->nrows) {
-        rc = cli_usage_error("solve", "--index %lld is out of range 1..%lld", (long long)index, (long long)s.M->nrows);
-        cli_system_free(&s);
-        return rc;
-    }
-    o.index = index ? index - 1 : 0;
+    o.index = s.index ? s.index - 1 : 0;
     if (ro.check && (rc = direct_check(&s, o.index, &ro))) {
         cli_system_free(&s);
         return rc;
