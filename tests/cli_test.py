@@ -171,8 +171,10 @@ def check_interrupt(ulam):
     p.send_signal(signal.SIGINT)
     out, _ = p.communicate(timeout=60)
     assert p.returncode == 130, p.returncode
-    o = json.loads(out)
-    assert o["interrupted"] is True and o["walks"] > 0
+    o = json.loads(out)  # valid JSON even when no block had finished (ci95 then null)
+    assert o["interrupted"] is True and o["walks"] >= 0
+    if o["walks"] == 0:
+        assert o["ci95"] == [None, None] and o["stderr"] is None
 
 
 def check_outputs(ulam):

@@ -53,6 +53,9 @@ void cli_system_free(cli_system *s);
 /* Solve the loaded system densely into a new *x; 0 or an exit code (error reported). */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info);
 
+/* Print a bare JSON number (null when not finite). */
+void cli_json_value(double v);
+
 /* Print a JSON number (null when not finite). */
 void cli_json_number(const char *key, double v, int last);
 

@@ -163,11 +163,19 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
     return cli_report(s->matrix_path, &err);
 }
 
+/* Print a bare JSON number (null when not finite). */
+void cli_json_value(double v)
+{
+    if (isfinite(v)) printf("%.17g", v);
+    else printf("null");
+}
+
 /* Print a JSON number (null when not finite). */
 void cli_json_number(const char *key, double v, int last)
 {
-    if (isfinite(v)) printf("\"%s\": %.17g%s", key, v, last ? "" : ", ");
-    else printf("\"%s\": null%s", key, last ? "" : ", ");
+    printf("\"%s\": ", key);
+    cli_json_value(v);
+    printf("%s", last ? "" : ", ");
 }
 
 /* Print a JSON string (escaped). */

@@ -100,7 +100,11 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     printf("{\"index\": %lld, ", (long long)o->index + 1);
     cli_json_number("estimate", r->estimate, 0);
     cli_json_number("stderr", r->std_error, 0);
-    printf("\"ci95\": [%.17g, %.17g], ", r->ci95[0], r->ci95[1]);
+    printf("\"ci95\": [");
+    cli_json_value(r->ci95[0]);
+    printf(", ");
+    cli_json_value(r->ci95[1]);
+    printf("], ");
     cli_json_number("variance", r->variance, 0);
     printf("\"walks\": %lld, \"steps\": %lld, \"cut\": %lld, ", (long long)r->walks, (long long)r->steps,
            (long long)r->cut);
