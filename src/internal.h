@@ -6,6 +6,27 @@
 
 #include <stdarg.h>
 
+/* xoshiro256** step, inline for the walkers (ulam_rng_next is this). */
+static inline uint64_t ulam__rng_next(ulam_rng *r)
+{
+    uint64_t *s = r->s;
+    const uint64_t x = s[1] * 5, result = ((x << 7) | (x >> 57)) * 9;
+    const uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = (s[3] << 45) | (s[3] >> 19);
+    return result;
+}
+
+/* Uniform double in [0, 1) from the top 53 bits. */
+static inline double ulam__rng_uniform(ulam_rng *r)
+{
+    return (double)(ulam__rng_next(r) >> 11) * 0x1.0p-53;
+}
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -21,6 +42,11 @@ void *ulam__malloc(size_t n, size_t sz);
 
 /* calloc of n items of size sz, NULL on failure (n == 0 allocates one byte). */
 void *ulam__calloc(size_t n, size_t sz);
+
+/* Uninitialised memory for a large random-access table: cache-line aligned, and for tables
+ * of 2 MB or more, 2 MB aligned with transparent huge pages requested (fewer TLB misses on
+ * random access).  n items of size sz; freed with free(); NULL on overflow or failure. */
+void *ulam__alloc_big(size_t n, size_t sz);
 
 /* An output file written under a temporary name and renamed into place on commit. */
 typedef struct ulam__outfile {

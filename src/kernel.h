@@ -1,4 +1,4 @@
-/* The walk kernel (internal): alias tables with termination folded in. */
+/* The walk kernel (internal): one array of rows, each a header and its alias slots. */
 #ifndef ULAM_KERNEL_H
 #define ULAM_KERNEL_H
 
@@ -7,20 +7,32 @@
 /* Outcome code for "the walk terminates here". */
 #define ULAM__TERMINATE INT32_MIN
 
-/* One alias slot: take a when u < thresh, else b.  An outcome j >= 0 moves to j keeping the
- * sign; ~j (< 0) moves to j flipping the sign; ULAM__TERMINATE ends the walk. */
+/* One alias slot: with the 64-bit fraction u of the draw that picked it, take a when
+ * u < thresh, else b.  An outcome r >= 0 moves to the row at unit r keeping the weight's
+ * sign; ~r (< 0) moves there flipping it; ULAM__TERMINATE ends the walk. */
 typedef struct {
-    double thresh;
+    uint64_t thresh;
     int32_t a, b;
 } ulam__slot;
 
-/* Rows of slots (row i: ptr[i] .. ptr[i+1], one more than its nonzeros), the weight factor
- * S_i / q_i and the termination probability p*_i of each state. */
+/* A row's header, two units long, followed by its len alias slots: everything a step from
+ * this state reads sits in one contiguous run of memory. */
+typedef struct {
+    double factor; /* S_i / q_i: the weight's factor on every move */
+    double visit;  /* scored (times the weight) on every visit */
+    double end;    /* scored (times the weight) when the walk terminates here */
+    int32_t len;   /* alias slots (nonzeros + 1 for termination) */
+    int32_t state; /* i */
+} ulam__row;
+
+#define ULAM__HEAD 2 /* units in a header */
+
+/* The kernel: 16-byte units holding the rows; row i starts at unit at[i]; pstar[i] = 1 - q_i.
+ * Offsets are int32, so a kernel holds under 2^31 units (32 GB). */
 typedef struct ulam_kernel {
-    int64_t n;
-    int64_t *ptr;
-    ulam__slot *slot;
-    double *factor;
+    int64_t n, units;
+    ulam__slot *mem;
+    int64_t *at;
     double *pstar;
 } ulam_kernel;
 
@@ -29,7 +41,7 @@ typedef struct ulam_kernel {
 void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slot *s, double *scaled,
                        int64_t *small, int64_t *large);
 
-/* Build the kernel of K (continue_q <= 0: analog). */
+/* Build the kernel of K (continue_q <= 0: analog); visit and end scores start at 0. */
 int ulam__kernel_build(const ulam_csr *K, double continue_q, ulam_kernel **out);
 
 /* Free a kernel; accepts NULL. */
@@ -38,12 +50,36 @@ ulam_kernel *ulam__kernel_free(ulam_kernel *k);
 /* Mark in seen[] every state reachable from those already marked. */
 void ulam__kernel_reach(const ulam_kernel *k, char *seen);
 
-/* One step from state i: returns the encoded outcome. */
-static inline int32_t ulam__kernel_step(const ulam_kernel *k, int64_t i, ulam_rng *r)
+/* The header of the row at unit u. */
+static inline ulam__row *ulam__kernel_row(const ulam_kernel *k, int64_t u)
 {
-    int64_t base = k->ptr[i], len = k->ptr[i + 1] - base;
-    const ulam__slot *s = k->slot + base + (int64_t)ulam_rng_bounded(r, (uint64_t)len);
-    return ulam_rng_uniform(r) < s->thresh ? s->a : s->b;
+    return (ulam__row *)(void *)(k->mem + u);
+}
+
+/* An index in [0, len) by Lemire's unbiased multiply-and-reject draw (ACM TOMACS 29(1),
+ * 2019); *frac gets the low half of the same product, uniform on a lattice of spacing
+ * len / 2^64, which decides the alias slot's coin without a second draw. */
+static inline uint64_t ulam__draw_index(ulam_rng *r, uint64_t len, uint64_t *frac)
+{
+    __uint128_t m = (__uint128_t)ulam__rng_next(r) * len;
+    if ((uint64_t)m < len) {
+        uint64_t floor = (0 - len) % len;
+        while ((uint64_t)m < floor) m = (__uint128_t)ulam__rng_next(r) * len;
+    }
+    *frac = (uint64_t)m;
+    return (uint64_t)(m >> 64);
+}
+
+/* Draw a slot of row h; *frac is to be compared with its threshold. */
+static inline const ulam__slot *ulam__kernel_pick(const ulam__row *h, ulam_rng *r, uint64_t *frac)
+{
+    return (const ulam__slot *)(const void *)h + ULAM__HEAD + ulam__draw_index(r, (uint64_t)h->len, frac);
+}
+
+/* The outcome of slot s for fraction frac. */
+static inline int32_t ulam__slot_outcome(const ulam__slot *s, uint64_t frac)
+{
+    return frac < s->thresh ? s->a : s->b;
 }
 
 #endif

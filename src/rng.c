@@ -1,7 +1,7 @@
 /* xoshiro256** 1.0 by David Blackman and Sebastiano Vigna (2018, public domain; see
  * "Scrambled linear pseudorandom number generators", ACM TOMS 47(4), 2021 and
  * https://prng.di.unimi.it/xoshiro256starstar.c), seeded through splitmix64. */
-#include "ulam.h"
+#include "internal.h"
 
 /* splitmix64 step (Steele, Lea and Flood, "Fast splittable pseudorandom number
  * generators", OOPSLA 2014): advance *x and return a well-mixed 64-bit value. */
@@ -24,30 +24,16 @@ void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream)
     if (!(r->s[0] | r->s[1] | r->s[2] | r->s[3])) r->s[0] = 1; /* the one forbidden state */
 }
 
-static inline uint64_t rotl(uint64_t x, int k)
-{
-    return (x << k) | (x >> (64 - k));
-}
-
 /* Next 64 random bits. */
 uint64_t ulam_rng_next(ulam_rng *r)
 {
-    uint64_t *s = r->s;
-    const uint64_t result = rotl(s[1] * 5, 7) * 9;
-    const uint64_t t = s[1] << 17;
-    s[2] ^= s[0];
-    s[3] ^= s[1];
-    s[1] ^= s[2];
-    s[0] ^= s[3];
-    s[2] ^= t;
-    s[3] = rotl(s[3], 45);
-    return result;
+    return ulam__rng_next(r);
 }
 
 /* Uniform double in [0, 1): the top 53 bits times 2^-53. */
 double ulam_rng_uniform(ulam_rng *r)
 {
-    return (double)(ulam_rng_next(r) >> 11) * 0x1.0p-53;
+    return ulam__rng_uniform(r);
 }
 
 /* Unbiased integer in [0, bound): Lemire, "Fast random integer generation in an

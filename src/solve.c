@@ -1,8 +1,8 @@
 /* The walk solver: budget, threads, stopping, interruption.
  *
- * Walks are numbered; walk k draws from the stream (seed, k).  They run in blocks of BLOCK
- * walks, ROUND blocks per round; threads take blocks dynamically, but every block's result is
- * stored by its index and merged in index order (Chan's formula for the adjoint score,
+ * Walks run in blocks of BLOCK walks, ROUND blocks per round; block q draws from the stream
+ * (seed, q) (one splitmix64 seeding per block, not per walk).  Threads take blocks
+ * dynamically, but every block's result is stored by its index and merged in index order (Chan's formula for the adjoint score,
  * per-state sums for forward tallies), so the result is bit-for-bit the same for any number
  * of threads.  Stopping rules are checked between rounds; an interrupt or the time limit
  * also stops blocks that have not started. */
@@ -16,26 +16,21 @@
 #include <omp.h>
 #endif
 
-enum { BLOCK = 256, ROUND = 64, STACK = 4096 };
-
-typedef struct {
-    ulam__moments m;    /* adjoint scores */
-    ulam__tallies t;    /* forward tallies */
-    int64_t walks, steps, cut, nonfinite;
-    int complete;
-} block_result;
+/* Walks per block, blocks per round, split-stack entries per thread; kernels up to CACHED
+ * bytes (this machine's L2) walk 16 histories interleaved, larger ones 32 (measured best). */
+enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20 };
 
 struct ulam_solver {
     ulam_walk_opts o;
     int64_t n;
     ulam_kernel *k;
     ulam__walker w;
-    double *b, *mb;
+    double *b;
     ulam_csr *mt;
     ulam__slot *src;
     int threads;
     ulam__scratch *scratch; /* one per thread */
-    block_result *blocks;   /* one per block of a round */
+    ulam__block *blocks;   /* one per block of a round */
     /* accumulated */
     ulam__moments adj;
     double *sum, *sumsq; /* forward per-state sums of history tallies */
@@ -56,7 +51,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
 {
     if (!s) return NULL;
     ulam__kernel_free(s->k);
-    free(s->b), free(s->mb), free(s->src), free(s->sum), free(s->sumsq);
+    free(s->b), free(s->src), free(s->sum), free(s->sumsq);
     ulam_csr_free(s->mt);
     if (s->scratch)
         for (int t = 0; t < s->threads; t++) {
@@ -140,6 +135,25 @@ static int build_source(ulam_solver *s, double *bnorm1)
     return status;
 }
 
+/* Write into the kernel's rows what a visit and a termination score (see walk.c). */
+static int set_scores(ulam_solver *s, const ulam_csr *M)
+{
+    int est = s->o.estimator, adj = s->o.mode == ULAM_ADJOINT;
+    double *mb = NULL;
+    if (adj && est == ULAM_EXPECTED) {
+        if (!(mb = ulam__malloc((size_t)s->n, sizeof *mb))) return ULAM_ENOMEM;
+        ulam_csr_matvec(M, 0, s->b, mb);
+    }
+    for (int64_t i = 0; i < s->n; i++) {
+        ulam__row *h = ulam__kernel_row(s->k, s->k->at[i]);
+        double g = adj ? s->b[i] : 1.0, ps = s->k->pstar[i];
+        h->visit = est == ULAM_COLLISION ? g : mb ? mb[i] : 0.0;
+        h->end = est == ULAM_ABSORPTION && ps > 0 ? g / ps : 0.0;
+    }
+    free(mb);
+    return ULAM_OK;
+}
+
 /* Allocate per-thread scratch and per-block results. */
 static int alloc_work(ulam_solver *s)
 {
@@ -194,22 +208,21 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         if (ulam_csr_transpose(M, &s->mt)) goto nomem;
         if (ulam__kernel_build(s->mt, o.continue_q, &s->k)) goto nomem;
         if (build_source(s, &bnorm1)) goto nomem;
-    } else {
-        if (ulam__kernel_build(M, o.continue_q, &s->k)) goto nomem;
-        if (o.estimator == ULAM_EXPECTED) {
-            s->mb = ulam__malloc((size_t)s->n, sizeof *s->mb);
-            if (!s->mb) goto nomem;
-            ulam_csr_matvec(M, 0, s->b, s->mb);
-        }
+    } else if (ulam__kernel_build(M, o.continue_q, &s->k)) {
+        goto nomem;
     }
+    if (set_scores(s, M)) goto nomem;
     if (o.estimator == ULAM_ABSORPTION && (status = check_absorption(s, err))) {
         ulam_solver_free(s);
         return status;
     }
     if (alloc_work(s)) goto nomem;
-    s->w = (ulam__walker){.k = s->k, .b = s->b, .mb = s->mb, .mt = s->mt, .src = s->src,
-                          .bnorm1 = bnorm1, .estimator = o.estimator, .roulette = o.roulette,
-                          .split = o.split, .max_steps = o.max_steps};
+    s->w = (ulam__walker){.k = s->k, .start = s->k->at[o.index], .mt = s->mt, .src = s->src,
+                          .bnorm1 = bnorm1, .roulette = o.roulette, .split = o.split,
+                          .max_steps = o.max_steps, .interrupt = o.interrupt,
+                          .lanes = s->k->units * (int64_t)sizeof(ulam__slot) <= CACHED ? 16 : 32};
+    if (o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED) s->w.score0 = s->b[o.index];
+    if (o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED) s->w.expected = 1;
     s->t0 = -1;
     *out = s;
     return ULAM_OK;
@@ -228,34 +241,18 @@ static int must_stop(const ulam_solver *s)
 /* Run walks [first, first + count) of block q on thread t. */
 static void run_block(ulam_solver *s, int q, int64_t first, int64_t count, int t)
 {
-    block_result *br = &s->blocks[q];
-    ulam__scratch *sc = &s->scratch[t];
-    br->m = (ulam__moments){0, 0, 0};
-    br->t.len = 0;
-    br->walks = br->steps = br->cut = br->nonfinite = 0;
+    ulam__block *br = &s->blocks[q];
     br->complete = 0;
+    br->walks = 0;
     if (must_stop(s)) return;
-    for (int64_t k = first; k < first + count; k++) {
-        ulam_rng r;
-        ulam_rng_seed(&r, s->o.seed, (uint64_t)k);
-        ulam__history h = {0, 0, 0};
-        if (s->o.mode == ULAM_ADJOINT) {
-            double x = ulam__adjoint_history(&s->w, s->o.index, &r, sc, &h);
-            if (!h.nonfinite) ulam__moments_add(&br->m, x);
-        } else if (ulam__forward_history(&s->w, &r, sc, &br->t, &h)) {
-            return; /* out of memory: the block stays incomplete */
-        }
-        br->steps += h.steps;
-        br->cut += h.cut;
-        br->nonfinite += h.nonfinite;
-        br->walks++;
-        if ((k & 63) == 63 && s->o.interrupt && *s->o.interrupt) return;
-    }
-    br->complete = 1;
+    ulam_rng r;
+    ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / BLOCK));
+    if (s->o.mode == ULAM_ADJOINT) ulam__adjoint_block(&s->w, count, &r, &s->scratch[t], br);
+    else ulam__forward_block(&s->w, count, &r, &s->scratch[t], br);
 }
 
 /* Merge a completed block into the totals. */
-static void merge_block(ulam_solver *s, const block_result *br)
+static void merge_block(ulam_solver *s, const ulam__block *br)
 {
     ulam__moments_merge(&s->adj, &br->m);
     for (int64_t q = 0; q < br->t.len; q++) {

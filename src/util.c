@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -75,6 +76,20 @@ void *ulam__malloc(size_t n, size_t sz)
 void *ulam__calloc(size_t n, size_t sz)
 {
     return calloc(n ? n : 1, sz ? sz : 1);
+}
+
+/* Aligned memory for a big random-access table, huge pages requested where it is large. */
+void *ulam__alloc_big(size_t n, size_t sz)
+{
+    if (sz && n > SIZE_MAX / sz) return NULL;
+    size_t bytes = n * sz, align = bytes >= ((size_t)2 << 20) ? (size_t)2 << 20 : 64;
+    if (bytes > SIZE_MAX - align) return NULL;
+    size_t size = (bytes + align - 1) / align * align;
+    void *p = aligned_alloc(align, size ? size : align);
+#ifdef MADV_HUGEPAGE
+    if (p && align > 64) madvise(p, size, MADV_HUGEPAGE); /* advice only: failure is harmless */
+#endif
+    return p;
 }
 
 /* Monotonic wall clock in seconds. */

@@ -2,93 +2,178 @@
  *
  * Adjoint (one x_i): start at i with weight 1.  Collision scores sum_m w_m b_{i_m} over every
  * visited state; absorption scores w_k b_{i_k} / p*_{i_k} where the walk ends; expected scores
- * b_i + sum_m w_m (M b)_{i_m}, the exact expectation of the next step's score.
+ * b_i + sum_m w_m (M b)_{i_m}, the exact expectation of the next step's score.  The solver
+ * writes these per-state scores into the kernel's row headers (visit and end), so one loop
+ * serves all three.
  * Forward (every x_i): a source j ~ |b_j| / ||b||_1 with weight ||b||_1 sign(b_j), steps on the
  * kernel of M'; collision tallies w at every visited state, absorption w / p* where the walk
  * ends, expected w M_{k s} at every neighbour k of each visited state s (plus b, added later).
  * The weight window: below `roulette` a particle survives with probability |w| / W at weight
  * W; above `split` it becomes ceil(|w| / W) copies of w / copies.  Both keep every estimator
- * unbiased. */
+ * unbiased.
+ *
+ * Adjoint histories run w->lanes at a time, interleaved: each pass first draws every lane's
+ * alias slot (and prefetches it), then reads every lane's slot and moves (prefetching the
+ * next row), so the memory latency of one lane's step hides behind the others' work.  Lanes
+ * share the block's generator in a fixed order, so a block's result does not depend on
+ * timing. */
 #include "walk.h"
 
 #include <math.h>
 #include <stdlib.h>
 
-/* Push a particle; the caller guarantees room. */
-static void push(ulam__scratch *sc, int64_t *top, int32_t s, double wt)
+enum { LANES = 32 }; /* at most; the solver picks 16 for kernels that fit in cache */
+
+/* Ask for the cache line at p ahead of its use. */
+static inline void prefetch(const void *p)
 {
-    sc->stack_s[*top] = s;
-    sc->stack_w[*top] = wt;
-    (*top)++;
+#if defined(__GNUC__)
+    __builtin_prefetch(p, 0, 3);
+#else
+    (void)p;
+#endif
 }
 
-/* The weight window after a move; 0 when roulette killed the particle. */
-static int window(const ulam__walker *w, int32_t s, double *wt, ulam_rng *r, ulam__scratch *sc,
-                  int64_t *top)
+/* A particle stack: one lane's share of the scratch stacks. */
+typedef struct {
+    int32_t *s;
+    double *w;
+    int64_t top, cap;
+} stack;
+
+/* The weight window after a move to row u; 0 when roulette killed the particle. */
+static int window(const ulam__walker *w, int32_t u, double *wt, ulam_rng *r, stack *st)
 {
     double a = fabs(*wt);
     if (w->roulette > 0 && a < w->roulette) {
-        if (ulam_rng_uniform(r) * w->roulette >= a) return 0;
+        if (ulam__rng_uniform(r) * w->roulette >= a) return 0;
         *wt = copysign(w->roulette, *wt);
     } else if (w->split > 0 && a > w->split) {
         double want = ceil(a / w->split);
-        int64_t room = sc->stack_cap - *top + 1;
+        int64_t room = st->cap - st->top + 1;
         int64_t m = want < (double)room ? (int64_t)want : room;
         if (m > 1) {
             *wt /= (double)m;
-            for (int64_t c = 1; c < m; c++) push(sc, top, s, *wt);
+            for (int64_t c = 1; c < m; c++) {
+                st->s[st->top] = u;
+                st->w[st->top++] = *wt;
+            }
         }
     }
     return 1;
 }
 
-/* Move from s along outcome o: update weight and state. */
-static inline int32_t move(const ulam_kernel *k, int32_t s, int32_t o, double *wt)
+/* Decode an outcome into the target row's unit, flipping the weight's sign if asked. */
+static inline int32_t target(int32_t o, double f, double *wt)
 {
-    *wt *= k->factor[s];
-    if (o < 0) {
-        *wt = -*wt;
-        return ~o;
-    }
-    return o;
+    *wt *= o < 0 ? -f : f;
+    return o < 0 ? ~o : o;
 }
 
-/* One adjoint history from start: its score. */
-double ulam__adjoint_history(const ulam__walker *w, int64_t start, ulam_rng *r, ulam__scratch *sc,
-                             ulam__history *h)
+/* One adjoint lane: the particle it carries and its history so far. */
+typedef struct {
+    const ulam__row *h;  /* the particle's row */
+    const ulam__slot *s; /* the slot drawn for its next step */
+    uint64_t frac;
+    double w, score;
+    int64_t len; /* steps in this history */
+    stack st;
+} lane;
+
+/* Start a new history in lane x. */
+static void lane_start(const ulam__walker *w, lane *x)
 {
-    const ulam_kernel *k = w->k;
-    const double *b = w->b;
-    double score = w->estimator == ULAM_EXPECTED ? b[start] : 0.0;
-    int64_t top = 0, len = 0;
-    push(sc, &top, (int32_t)start, 1.0);
-    while (top > 0) {
-        top--;
-        int32_t s = sc->stack_s[top];
-        double wt = sc->stack_w[top];
-        for (;;) {
-            if (w->estimator == ULAM_COLLISION) score += wt * b[s];
-            else if (w->estimator == ULAM_EXPECTED) score += wt * w->mb[s];
-            int32_t o = ulam__kernel_step(k, s, r);
-            if (o == ULAM__TERMINATE) {
-                if (w->estimator == ULAM_ABSORPTION) score += wt * b[s] / k->pstar[s];
-                break;
-            }
-            s = move(k, s, o, &wt);
-            h->steps++;
-            if (++len > w->max_steps) {
-                h->cut = 1;
-                return score;
-            }
-            if (!isfinite(wt)) {
-                h->nonfinite = 1;
-                return score;
-            }
-            if (!window(w, s, &wt, r, sc, &top)) break;
-        }
+    x->h = ulam__kernel_row(w->k, w->start);
+    x->w = 1.0;
+    x->score = w->score0;
+    x->len = 0;
+    x->st.top = 0;
+}
+
+/* Lane x's particle has ended: 1 if another of its history's particles is waiting. */
+static int lane_pop(const ulam__walker *w, lane *x)
+{
+    if (x->st.top == 0) return 0;
+    x->st.top--;
+    x->h = ulam__kernel_row(w->k, x->st.s[x->st.top]);
+    x->w = x->st.w[x->st.top];
+    prefetch(x->h);
+    return 1;
+}
+
+/* Lane x's step: 1 while its particle lives on. */
+static inline int lane_move(const ulam__walker *w, lane *x, ulam_rng *r, ulam__block *out)
+{
+    int32_t o = ulam__slot_outcome(x->s, x->frac);
+    if (o == ULAM__TERMINATE) {
+        x->score += x->w * x->h->end;
+        return 0;
     }
-    if (!isfinite(score)) h->nonfinite = 1;
-    return score;
+    int32_t u = target(o, x->h->factor, &x->w);
+    x->h = ulam__kernel_row(w->k, u);
+    prefetch(x->h);
+    out->steps++;
+    if (++x->len > w->max_steps) { /* cut: the rest of the history is dropped */
+        out->cut++;
+        x->st.top = 0;
+        return 0;
+    }
+    return (w->roulette <= 0 && w->split <= 0) || window(w, u, &x->w, r, &x->st);
+}
+
+/* Record a finished history's score (a non-finite one is counted, never averaged). */
+static void record(ulam__block *out, double score)
+{
+    if (isfinite(score)) ulam__moments_add(&out->m, score);
+    else out->nonfinite++;
+    out->walks++;
+}
+
+/* Run count adjoint histories, w->lanes at a time, counting into a local block (the caller's
+ * blocks sit side by side in memory, and writing them on every step would share cache lines
+ * between threads). */
+void ulam__adjoint_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam__scratch *sc,
+                         ulam__block *out)
+{
+    ulam__block acc = {.t = out->t};
+    acc.t.len = 0;
+    lane L[LANES];
+    int lanes = w->lanes < 1 ? 1 : w->lanes > LANES ? LANES : w->lanes;
+    int64_t cap = sc->stack_cap / lanes, started = 0;
+    int act = 0;
+    for (; act < lanes && started < count; act++, started++) {
+        L[act].st = (stack){sc->stack_s + act * cap, sc->stack_w + act * cap, 0, cap};
+        lane_start(w, &L[act]);
+    }
+    while (act > 0) {
+        for (int l = 0; l < act; l++) {
+            lane *x = &L[l];
+            x->score += x->w * x->h->visit;
+            x->s = ulam__kernel_pick(x->h, r, &x->frac);
+            prefetch(x->s);
+        }
+        for (int l = 0; l < act;) {
+            lane *x = &L[l];
+            if (lane_move(w, x, r, &acc) || lane_pop(w, x)) {
+                l++;
+                continue;
+            }
+            record(&acc, x->score);
+            if (started < count) {
+                if ((started & 63) == 0 && w->interrupt && *w->interrupt) break;
+                lane_start(w, x);
+                started++;
+                l++;
+            } else {
+                stack keep = x->st; /* the lane that moves in brings its own stack */
+                *x = L[--act];
+                L[act].st = keep;
+            }
+        }
+        if (started < count && w->interrupt && *w->interrupt) break;
+    }
+    acc.complete = act == 0;
+    *out = acc;
 }
 
 /* Add v to state s's tally for this history. */
@@ -122,44 +207,65 @@ static int emit(ulam__scratch *sc, ulam__tallies *out)
     return ULAM_OK;
 }
 
-/* One forward history: appends its (state, tally) pairs to out. */
-int ulam__forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc, ulam__tallies *out,
-                          ulam__history *h)
+/* Tally a visit to row h with weight wt. */
+static void forward_visit(const ulam__walker *w, ulam__scratch *sc, const ulam__row *h, double wt)
+{
+    if (h->visit != 0.0) tally(sc, h->state, wt * h->visit);
+    if (w->expected)
+        for (int64_t q = w->mt->rowptr[h->state]; q < w->mt->rowptr[h->state + 1]; q++)
+            tally(sc, w->mt->colidx[q], wt * w->mt->val[q]);
+}
+
+/* One forward history: its (state, tally) pairs go to out->t. */
+static int forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc, ulam__block *out)
 {
     const ulam_kernel *k = w->k;
-    const ulam__slot *src = w->src + ulam_rng_bounded(r, (uint64_t)k->n);
-    int32_t o = ulam_rng_uniform(r) < src->thresh ? src->a : src->b;
-    int32_t s0 = o < 0 ? ~o : o;
-    int64_t top = 0, len = 0;
-    push(sc, &top, s0, o < 0 ? -w->bnorm1 : w->bnorm1);
-    while (top > 0) {
-        top--;
-        int32_t s = sc->stack_s[top];
-        double wt = sc->stack_w[top];
+    uint64_t frac;
+    const ulam__slot *src = w->src + ulam__draw_index(r, (uint64_t)k->n, &frac);
+    int32_t o = ulam__slot_outcome(src, frac);
+    stack st = {sc->stack_s, sc->stack_w, 1, sc->stack_cap};
+    st.s[0] = (int32_t)k->at[o < 0 ? ~o : o];
+    st.w[0] = o < 0 ? -w->bnorm1 : w->bnorm1;
+    int64_t len = 0;
+    while (st.top > 0) {
+        st.top--;
+        const ulam__row *h = ulam__kernel_row(k, st.s[st.top]);
+        double wt = st.w[st.top];
         for (;;) {
-            if (w->estimator == ULAM_COLLISION) tally(sc, s, wt);
-            else if (w->estimator == ULAM_EXPECTED)
-                for (int64_t q = w->mt->rowptr[s]; q < w->mt->rowptr[s + 1]; q++)
-                    tally(sc, w->mt->colidx[q], wt * w->mt->val[q]);
-            o = ulam__kernel_step(k, s, r);
+            forward_visit(w, sc, h, wt);
+            const ulam__slot *sl = ulam__kernel_pick(h, r, &frac);
+            o = ulam__slot_outcome(sl, frac);
             if (o == ULAM__TERMINATE) {
-                if (w->estimator == ULAM_ABSORPTION) tally(sc, s, wt / k->pstar[s]);
+                if (h->end != 0.0) tally(sc, h->state, wt * h->end);
                 break;
             }
-            s = move(k, s, o, &wt);
-            h->steps++;
-            if (++len > w->max_steps) {
-                h->cut = 1;
-                top = 0;
+            int32_t u = target(o, h->factor, &wt);
+            h = ulam__kernel_row(k, u);
+            out->steps++;
+            if (++len > w->max_steps || !isfinite(wt)) {
+                out->cut += len > w->max_steps;
+                out->nonfinite += !isfinite(wt);
+                st.top = 0;
                 break;
             }
-            if (!isfinite(wt)) {
-                h->nonfinite = 1;
-                top = 0;
-                break;
-            }
-            if (!window(w, s, &wt, r, sc, &top)) break;
+            if (!window(w, u, &wt, r, &st)) break;
         }
     }
-    return emit(sc, out);
+    out->walks++;
+    return emit(sc, &out->t);
+}
+
+/* Run count forward histories, one at a time, counting into a local block. */
+void ulam__forward_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam__scratch *sc,
+                         ulam__block *out)
+{
+    ulam__block acc = {.t = out->t};
+    acc.t.len = 0;
+    int64_t c = 0;
+    for (; c < count; c++) {
+        if (forward_history(w, r, sc, &acc)) break; /* out of memory: incomplete */
+        if ((c & 63) == 63 && w->interrupt && *w->interrupt) break;
+    }
+    acc.complete = c == count;
+    *out = acc;
 }

@@ -3,6 +3,7 @@
 #define ULAM_WALK_H
 
 #include "kernel.h"
+#include "stats.h"
 
 /* A (state, tally) pair a forward history emits when it ends. */
 typedef struct {
@@ -16,42 +17,47 @@ typedef struct {
     int64_t len, cap;
 } ulam__tallies;
 
-/* Everything a walker reads: shared, read-only during a run. */
+/* Everything a walker reads: shared, read-only during a run.  What a visit or a termination
+ * scores lives in the kernel's row headers (visit, end). */
 typedef struct {
     const ulam_kernel *k;
-    const double *b;       /* right-hand side (adjoint scores) */
-    const double *mb;      /* M b (adjoint expected estimator) */
-    const ulam_csr *mt;    /* M' (forward expected estimator: column s of M) */
-    const ulam__slot *src; /* forward: alias table of |b| over n outcomes */
+    int64_t start;         /* adjoint: the start row's unit */
+    double score0;         /* adjoint: added to every history (b_i for the expected estimator) */
+    const ulam_csr *mt;    /* forward expected estimator: M' (column s of M is row s) */
+    const ulam__slot *src; /* forward: alias table of |b| over n outcomes (encoded states) */
     double bnorm1;         /* forward: ||b||_1 */
-    int estimator;
+    int expected;          /* forward: scatter expected tallies */
     double roulette, split;
     int64_t max_steps;
+    int lanes; /* adjoint histories interleaved (1 to 32) */
+    volatile const int *interrupt;
 } ulam__walker;
 
-/* Per-thread scratch: the split stack and the forward history tally. */
+/* Per-thread scratch: the split stacks and the forward history tally. */
 typedef struct {
-    int32_t *stack_s;
+    int32_t *stack_s; /* row units */
     double *stack_w;
     int64_t stack_cap;
-    double *hist;     /* forward: this history's tally per state */
-    int64_t *touched; /* forward: states with a tally in this history */
+    double *hist;        /* forward: this history's tally per state */
+    int64_t *touched;    /* forward: states with a tally in this history */
     unsigned char *mark; /* forward: mark[s] != 0 when s is in touched[] */
     int64_t ntouched;
 } ulam__scratch;
 
-/* What one history did. */
+/* What a block of histories produced. */
 typedef struct {
-    int64_t steps;
-    int cut, nonfinite;
-} ulam__history;
+    ulam__moments m; /* adjoint scores */
+    ulam__tallies t; /* forward tallies */
+    int64_t walks, steps, cut, nonfinite;
+    int complete; /* 0 when interrupted or out of memory */
+} ulam__block;
 
-/* One adjoint history from start: its score. */
-double ulam__adjoint_history(const ulam__walker *w, int64_t start, ulam_rng *r, ulam__scratch *sc,
-                             ulam__history *h);
+/* Run count adjoint histories drawing from r into out (reset first). */
+void ulam__adjoint_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam__scratch *sc,
+                         ulam__block *out);
 
-/* One forward history: appends its (state, tally) pairs to out; ULAM_ENOMEM on failure. */
-int ulam__forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc, ulam__tallies *out,
-                          ulam__history *h);
+/* Run count forward histories drawing from r into out (reset first). */
+void ulam__forward_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam__scratch *sc,
+                         ulam__block *out);
 
 #endif
