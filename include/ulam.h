@@ -197,6 +197,51 @@ int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double 
                             const void *ctx, int positive_start, const ulam_spectral_opts *opts,
                             ulam_radius *out);
 
+/* ---------------------------------------------------------------- stability guards */
+
+/* Options of the power iteration for nonnegative operators. */
+typedef struct ulam_power_opts {
+    double tol;   /* stop when (upper - lower) <= tol * upper, or when for 5 iterations the
+                     changes, extrapolated as a geometric series, add up to <= tol * rho,
+                     or when upper <= tol (default 1e-4) */
+    int max_iter; /* iteration cap (default 1000) */
+} ulam_power_opts;
+
+/* The default options. */
+ulam_power_opts ulam_power_defaults(void);
+
+/* Spectral radius of a nonnegative operator by power iteration, with Collatz-Wielandt bounds
+ * from the same iterates: for any positive x, min_i (Ax)_i / x_i <= rho(A) <= max_i (Ax)_i / x_i. */
+typedef struct ulam_power {
+    double rho;          /* the estimate, sum(Ax) / sum(x) at the last iterate */
+    double lower, upper; /* certified bounds: lower <= rho(A) <= upper */
+    int iterations;      /* matrix-vector products */
+    int converged;       /* stopped by the tolerance, not the cap */
+    double seconds;
+} ulam_power;
+
+/* rho(diag(left) |A| diag(right)); left and right may be NULL (all ones).  opts may be NULL. */
+int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
+                        const ulam_power_opts *opts, ulam_power *out, ulam_error *err);
+
+/* A radius against 1: below 0.99 fine, in [0.99, 1) near the edge, >= 1 failing.  Certified
+ * bounds decide first (upper < 0.99: fine; lower >= 1: failing), then the estimate. */
+enum ulam_verdict { ULAM_VERDICT_OK = 0, ULAM_VERDICT_EDGE = 1, ULAM_VERDICT_FAIL = 2 };
+int ulam_verdict_of(const ulam_power *p);
+
+/* The guards of a walk on M with continuation continue_q (<= 0: analog):
+ *   abs:    rho(|M|) (= rho(|M'|)): the walk's expectation is a convergent series iff < 1;
+ *   hat[m]: rho(M^) of the mode m kernel's second-moment matrix M^_ij = K_ij^2 / (q_i p_ij),
+ *           K = M (adjoint) or M' (forward): the estimators' variance is finite iff < 1. */
+typedef struct ulam_guard {
+    ulam_power abs, hat[2];
+    int verdict_abs, verdict_hat[2];
+} ulam_guard;
+
+/* Estimate the three radii (opts may be NULL). */
+int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_power_opts *opts,
+                     ulam_guard *g, ulam_error *err);
+
 /* ---------------------------------------------------------------- random numbers */
 
 /* xoshiro256** 1.0 (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
@@ -230,7 +275,7 @@ typedef struct ulam_walk_opts {
     double continue_q;   /* fixed continuation probability in (0, 1); <= 0: analog min(1, S_i) */
     double roulette;     /* weight window floor W: below it survive with |w|/W at weight W; 0 off */
     double split;        /* weight window ceiling: above it split into ceil(|w|/W) copies; 0 off */
-    uint64_t seed;       /* walk k uses the stream (seed, k): same result for any thread count */
+    uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */
     int threads;         /* 0: all cores */
     int64_t max_walks;   /* stop after this many walks (0: no limit) */
     double rel_err;      /* stop once stderr / |estimate| <= rel_err after >= 1000 walks (0 off) */
@@ -251,7 +296,8 @@ typedef struct ulam_walk_result {
     double variance;   /* per-walk (per-history) sample variance */
     int64_t walks;     /* histories completed */
     int64_t steps;     /* transitions made */
-    int64_t cut;       /* walks cut at max_steps */
+    int64_t cut;       /* walks cut at max_steps (the estimate is biased by them) */
+    double max_share;  /* largest single score^2 / sum of scores^2: near 1, one walk dominates */
     double seconds;    /* wall time spent walking */
     int threads;       /* threads used */
     int interrupted;   /* stopped by *interrupt */

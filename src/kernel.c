@@ -152,7 +152,7 @@ int ulam__kernel_build(const ulam_csr *K, double continue_q, ulam_kernel **out)
         return ULAM_ENOMEM;
     }
     int failed = 0;
-#pragma omp parallel reduction(| : failed)
+#pragma omp parallel reduction(| : failed) if (n > 50000)
     {
         scratch w;
         if (!scratch_get(&w, maxlen + 1)) failed = 1;

@@ -35,6 +35,7 @@ struct ulam_solver {
     ulam__moments adj;
     double *sum, *sumsq; /* forward per-state sums of history tallies */
     int64_t walks, steps, cut, nonfinite, next_walk;
+    double maxsq; /* the largest single score^2 (forward: of the reported component) */
     double seconds, t0;
     int done, interrupted, status;
 };
@@ -255,10 +256,12 @@ static void run_block(ulam_solver *s, int q, int64_t first, int64_t count, int t
 static void merge_block(ulam_solver *s, const ulam__block *br)
 {
     ulam__moments_merge(&s->adj, &br->m);
+    s->maxsq = fmax(s->maxsq, br->maxsq);
     for (int64_t q = 0; q < br->t.len; q++) {
         double v = br->t.t[q].value;
         s->sum[br->t.t[q].state] += v;
         s->sumsq[br->t.t[q].state] += v * v;
+        if (br->t.t[q].state == s->o.index) s->maxsq = fmax(s->maxsq, v * v);
     }
     s->walks += br->walks;
     s->steps += br->steps;
@@ -331,13 +334,17 @@ void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
 {
     memset(r, 0, sizeof *r);
     if (!s) return;
+    double sumsq;
     if (s->o.mode == ULAM_ADJOINT) {
         r->estimate = s->adj.mean;
         r->variance = ulam__moments_variance(&s->adj);
         r->std_error = s->adj.n > 0 ? sqrt(r->variance / (double)s->adj.n) : INFINITY;
+        sumsq = s->adj.m2 + (double)s->adj.n * s->adj.mean * s->adj.mean;
     } else {
         forward_component(s, s->o.index, &r->estimate, &r->std_error, &r->variance);
+        sumsq = s->sumsq[s->o.index];
     }
+    r->max_share = sumsq > 0 ? fmin(1.0, s->maxsq / sumsq) : 0.0;
     r->ci95[0] = r->estimate - 1.959963984540054 * r->std_error;
     r->ci95[1] = r->estimate + 1.959963984540054 * r->std_error;
     r->walks = s->walks;

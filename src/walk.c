@@ -124,8 +124,12 @@ static inline int lane_move(const ulam__walker *w, lane *x, ulam_rng *r, ulam__b
 /* Record a finished history's score (a non-finite one is counted, never averaged). */
 static void record(ulam__block *out, double score)
 {
-    if (isfinite(score)) ulam__moments_add(&out->m, score);
-    else out->nonfinite++;
+    if (isfinite(score)) {
+        ulam__moments_add(&out->m, score);
+        out->maxsq = fmax(out->maxsq, score * score);
+    } else {
+        out->nonfinite++;
+    }
     out->walks++;
 }
 

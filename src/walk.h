@@ -49,6 +49,7 @@ typedef struct {
     ulam__moments m; /* adjoint scores */
     ulam__tallies t; /* forward tallies */
     int64_t walks, steps, cut, nonfinite;
+    double maxsq; /* adjoint: the largest score^2 */
     int complete; /* 0 when interrupted or out of memory */
 } ulam__block;
 

@@ -60,12 +60,28 @@ CASES += [
     (["--help"], 0, r"^$", r"1-based"),
     (["direct", "--help"], 0, r"^$", r"1-based"),
     (["info", M + "chain4.mtx"], 0, r"^$", r"walks\s+converge"),
-    (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(\|M\|\)\s+0\.98883"),
+    (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(M\)\s+0\.98883"),
+    (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(\|M\|\)\s+0\.988[78]"),
+    (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"0\.50\s+0\.9944\d+\s+0\.994[34]\d+\s+converges"),
+    (["info", M + "randsub1000.mtx", "--continue", "0.5"], 0, r"^$", r"variance adjoint infinite"),
     (["info", M + "signed_edge200.mtx"], 0, r"^$", r"walks\s+diverge"),
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "4"], 0, r"^$", r"x\[4\]\s+3\.68174"),
 ]
 SOLVE = ["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx"]
+DIV = ["solve", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1"]
+RS = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1"]
 CASES += [
+    # the guards: refusal, --force, the walk cap, the non-finite stop, infinite variance, the edge
+    (DIV, 3, r"rho\(\|M\|\) = 1\.1 .*>= 1.*divergent series.*ulam direct.*--jacobi.*--force", r"^$"),
+    (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1"], 3,
+     r"rho\(\|M\|\) = 1\.3 ", r"^$"),
+    (DIV + ["--force", "--max-steps", "50", "--walks", "1000"], 0, r"Running anyway \(--force\)",
+     r"1000 cut at 50 steps: the estimate is biased by the cut"),
+    (DIV + ["--force", "--walks", "100"], code("ENONFINITE"), r"non-finite weight or score", r"^$"),
+    (RS + ["--continue", "0.5"], 0, r"rho\(M\^\) = 1\.62 >= 1 .* variance is infinite",
+     r"no confidence interval: the variance is infinite"),
+    (["solve", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--index", "1", "--jacobi", "--omega", "0.5",
+      "--walks", "2000"], 0, r"rho\(\|M\|\) = 0\.99\d+ is within 1% of 1", r"\+-"),
     (SOLVE + ["--index", "1", "--walks", "-5"], 2, r"--walks expects an integer", ""),
     (SOLVE + ["--index", "1", "--rel-err", "0"], 2, r"--rel-err expects a number", ""),
     (SOLVE + ["--index", "1", "--threads", "0"], 2, r"--threads expects an integer", ""),
@@ -109,7 +125,8 @@ def check_json(ulam):
     for k in ["n", "nnz", "nonnegative", "substochastic", "rho", "rho_abs", "neumann_converges", "walks_converge"]:
         assert k in o, k
     assert o["neumann_converges"] is True and o["walks_converge"] is False
-    assert abs(o["rho_abs"] - 1.3) < 1e-6 and o["rho"] < 1
+    assert abs(o["rho_abs"] - 1.3) < 1e-6 and o["rho"] < 1 and o["rho_abs_lower"] >= 1
+    assert o["variance_finite_adjoint"] is False and abs(o["rho_hat_adjoint"] - 1.69) < 1e-6
     rc, out, _ = run(ulam, ["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "1", "--json"])
     o = json.loads(out)
     for k in ["n", "index", "value", "rcond", "residual", "seconds"]:
@@ -133,6 +150,13 @@ def check_solve_json(ulam):
     assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
     assert o["ci95"][0] < o["estimate"] < o["ci95"][1]
     assert outs[0]["estimate"] == outs[1]["estimate"] and outs[0]["variance"] == outs[1]["variance"]
+    assert o["variance_finite"] is True and o["heavy_tail"] is False and 0 < o["max_share"] < 0.01
+    assert abs(o["rho_abs"] - 0.748408) < 1e-4
+    # infinite variance: no interval, and one walk dominates the sum of squares
+    rc, out, _ = run(ulam, RS + ["--continue", "0.5", "--json", "--seed", "3"])
+    o = json.loads(out)
+    assert rc == 0 and o["variance_finite"] is False and o["ci95"] is None, o
+    assert abs(o["rho_hat"] - 1.62) < 1e-6 and o["heavy_tail"] is True and o["max_share"] > 0.05, o
 
 
 def check_forward_files(ulam):

@@ -225,6 +225,35 @@ static void test_roulette_and_splitting(void **state)
     unload(&s);
 }
 
+/* --jacobi and --omega: walks on M = I - w D^-1 A for Poisson's A agree with LAPACK. */
+static void test_jacobi_poisson(void **state)
+{
+    (void)state;
+    sys s = load("poisson20"); /* s.M holds A here; replaced by its splitting below */
+    ulam_csr *A = s.M;
+    double *bp = malloc((size_t)s.n * sizeof *bp);
+    for (int k = 0; k < 2; k++) {
+        double omega = k ? 0.8 : 1.0;
+        assert_int_equal(ulam_jacobi(A, s.b, omega, &s.M, bp, NULL), ULAM_OK);
+        double *b = s.b;
+        s.b = bp;
+        assert_int_equal(ulam_direct_solve(s.M, s.b, s.x, 0, NULL, NULL), ULAM_OK);
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.index = 210;
+        o.max_walks = 20000;
+        o.seed = 7 + (uint64_t)k;
+        ulam_walk_result r = run(&s, o);
+        print_message("poisson20 --jacobi --omega %.1f: x[211] = %.6g +- %.2g, LAPACK %.6g\n", omega,
+                      r.estimate, r.std_error, s.x[210]);
+        assert_agrees(&s, &r, 210);
+        s.b = b;
+        ulam_csr_free(s.M);
+    }
+    s.M = A;
+    free(bp);
+    unload(&s);
+}
+
 /* Same seed and walk count: bit-for-bit the same result with 1 and 2 threads. */
 static void test_threads_identical(void **state)
 {
@@ -339,7 +368,7 @@ int main(void)
         cmocka_unit_test(test_exact_variance),    cmocka_unit_test(test_roulette_and_splitting),
         cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_forward_vectors),
         cmocka_unit_test(test_absorption_refused), cmocka_unit_test(test_bad_options),
-        cmocka_unit_test(test_rel_err_stop),
+        cmocka_unit_test(test_rel_err_stop),      cmocka_unit_test(test_jacobi_poisson),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -62,6 +62,19 @@ void cli_json_number(const char *key, double v, int last);
 /* Print a JSON string (escaped). */
 void cli_json_string(const char *key, const char *v, int last);
 
+/* A verdict in words. */
+const char *cli_verdict_word(int verdict);
+
+/* Print a power-iteration radius with its bounds (no newline). */
+void cli_print_power(const ulam_power *p);
+
+/* Run the stability guards for a walk in mode on s, printing warnings; 0 to go on, or
+ * EXIT_DIVERGE (message printed) when rho(|M|) >= 1 and not force. */
+int cli_guard(const cli_system *s, double continue_q, int mode, int force, ulam_guard *g);
+
+/* One walk's share of the sum of squared scores above which a run warns of a heavy tail. */
+#define CLI_HEAVY_SHARE 0.05
+
 /* Subcommands: each takes the argv that starts at its own name. */
 int cli_info(int argc, char **argv);
 int cli_direct(int argc, char **argv);

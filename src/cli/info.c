@@ -6,22 +6,28 @@
 #include <string.h>
 
 static const char *const usage =
-    "usage: ulam info M.mtx [--jacobi [--omega W]] [--tol T] [--json]\n"
+    "usage: ulam info M.mtx [--jacobi [--omega W]] [--continue Q] [--tol T] [--json]\n"
     "\n"
     "Describe the iteration matrix M of (I - M) x = b: size, nonzeros per row, signs,\n"
-    "row sums of |M| (the continuation probabilities of an analog walk), the spectral\n"
-    "radii of M and |M| (restarted Arnoldi, relative residual tolerance T, default 1e-6),\n"
-    "and whether the Neumann series sum M^k b converges (rho(M) < 1) and whether its\n"
-    "random-walk estimate does (rho(|M|) < 1).\n"
+    "row sums of |M| (the continuation probabilities of an analog walk), and the guards:\n"
+    "  rho(M)          restarted Arnoldi (ARPACK), relative residual tolerance T (default\n"
+    "                  1e-6): the Neumann series sum M^k b converges iff < 1;\n"
+    "  rho(|M|)        power iteration with Collatz-Wielandt bounds: the walks converge iff < 1;\n"
+    "  rho(M^) adjoint the second-moment matrix of the adjoint kernel, and\n"
+    "  rho(M^) forward of the forward kernel: each estimator's variance is finite iff < 1.\n"
     "\n"
-    "  --jacobi     the file holds A of A x = b; describe M = I - omega D^-1 A\n"
+    "  --jacobi     the file holds A of A x = b; describe M = I - omega D^-1 A, and list\n"
+    "               rho(M) and rho(|M|) for omega = 1, 0.9, ..., 0.5 (n <= 100000)\n"
     "  --omega W    damping of the Jacobi splitting (default 1)\n"
-    "  --tol T      relative residual tolerance of the radius estimates\n"
+    "  --continue Q the kernel's fixed continuation probability (default: analog)\n"
+    "  --tol T      relative residual tolerance of the rho(M) estimate\n"
     "  --json       print one JSON object\n";
+
+static const char *const unsure = " [estimate not converged: verdict uncertain]";
 
 /* Print the human-readable report. */
 static void print_text(const cli_system *s, const ulam_csr_stats *st, const ulam_radius *r,
-                       const ulam_radius *ra)
+                       const ulam_guard *g)
 {
     printf("matrix           %s%s\n", s->matrix_path, s->jacobi ? " (Jacobi splitting of A)" : "");
     printf("n                %lld\n", (long long)st->n);
@@ -31,21 +37,40 @@ static void print_text(const cli_system *s, const ulam_csr_stats *st, const ulam
     printf("signs            %s\n", st->nonnegative ? "nonnegative" : "mixed (weights carry signs)");
     printf("row sums of |M|  min %.6g, max %.6g\n", st->abs_rowsum_min, st->abs_rowsum_max);
     printf("substochastic    %s\n", st->substochastic ? "yes" : "no");
-    printf("rho(M)           %.6f (residual %.1e, %d matvecs%s)\n", r->rho, r->residual,
-           r->matvecs, r->converged ? "" : ", NOT converged");
-    printf("rho(|M|)         %.6f (residual %.1e, %d matvecs%s)\n", ra->rho, ra->residual,
-           ra->matvecs, ra->converged ? "" : ", NOT converged");
-    const char *unsure = " [estimate not converged: verdict uncertain]";
-    printf("Neumann series   %s%s\n", r->rho < 1 ? "converges (rho(M) < 1)" : "diverges (rho(M) >= 1)",
+    printf("rho(M)           %.6f (residual %.1e, %d matvecs%s)\n", r->rho, r->residual, r->matvecs,
+           r->converged ? "" : ", NOT converged");
+    printf("rho(|M|)         ");
+    cli_print_power(&g->abs);
+    printf("\nrho(M^) adjoint  ");
+    cli_print_power(&g->hat[ULAM_ADJOINT]);
+    printf("\nrho(M^) forward  ");
+    cli_print_power(&g->hat[ULAM_FORWARD]);
+    printf("\nNeumann series   %s%s\n", r->rho < 1 ? "converges (rho(M) < 1)" : "diverges (rho(M) >= 1)",
            r->converged ? "" : unsure);
-    printf("walks            %s%s\n",
-           ra->rho < 1 ? "converge (rho(|M|) < 1)" : "diverge (rho(|M|) >= 1): use 'ulam direct'",
-           ra->converged ? "" : unsure);
+    printf("walks            %s (rho(|M|) %s)\n",
+           g->verdict_abs == ULAM_VERDICT_FAIL ? "diverge: use 'ulam direct'" : "converge",
+           cli_verdict_word(g->verdict_abs));
+    for (int m = 0; m < 2; m++)
+        printf("variance %s %s (rho(M^) %s)\n", m == ULAM_ADJOINT ? "adjoint" : "forward",
+               g->verdict_hat[m] == ULAM_VERDICT_FAIL ? "infinite: no error bar can be trusted" : "finite",
+               cli_verdict_word(g->verdict_hat[m]));
+}
+
+/* Print one radius as JSON keys prefix, prefix_lower, prefix_upper, prefix_converged. */
+static void json_power(const char *prefix, const ulam_power *p)
+{
+    char key[64];
+    cli_json_number(prefix, p->rho, 0);
+    snprintf(key, sizeof key, "%s_lower", prefix);
+    cli_json_number(key, p->lower, 0);
+    snprintf(key, sizeof key, "%s_upper", prefix);
+    cli_json_number(key, p->upper, 0);
+    printf("\"%s_converged\": %s, ", prefix, p->converged ? "true" : "false");
 }
 
 /* Print the JSON object. */
 static void print_json(const cli_system *s, const ulam_csr_stats *st, const ulam_radius *r,
-                       const ulam_radius *ra)
+                       const ulam_guard *g)
 {
     printf("{");
     cli_json_string("matrix", s->matrix_path, 0);
@@ -61,11 +86,36 @@ static void print_json(const cli_system *s, const ulam_csr_stats *st, const ulam
     cli_json_number("rho", r->rho, 0);
     cli_json_number("rho_residual", r->residual, 0);
     printf("\"rho_converged\": %s, ", r->converged ? "true" : "false");
-    cli_json_number("rho_abs", ra->rho, 0);
-    cli_json_number("rho_abs_residual", ra->residual, 0);
-    printf("\"rho_abs_converged\": %s, ", ra->converged ? "true" : "false");
+    json_power("rho_abs", &g->abs);
+    json_power("rho_hat_adjoint", &g->hat[ULAM_ADJOINT]);
+    json_power("rho_hat_forward", &g->hat[ULAM_FORWARD]);
     printf("\"neumann_converges\": %s, ", r->rho < 1 ? "true" : "false");
-    printf("\"walks_converge\": %s}\n", ra->rho < 1 ? "true" : "false");
+    printf("\"walks_converge\": %s, ", g->verdict_abs != ULAM_VERDICT_FAIL ? "true" : "false");
+    printf("\"variance_finite_adjoint\": %s, ", g->verdict_hat[0] != ULAM_VERDICT_FAIL ? "true" : "false");
+    printf("\"variance_finite_forward\": %s}\n", g->verdict_hat[1] != ULAM_VERDICT_FAIL ? "true" : "false");
+}
+
+/* For --jacobi: rho(M) and rho(|M|) of the splitting at several dampings. */
+static int print_omegas(const cli_system *base, const ulam_spectral_opts *so)
+{
+    printf("damping          omega   rho(M)     rho(|M|)   Neumann    walks\n");
+    for (int k = 0; k <= 5; k++) {
+        cli_system s = {.command = "info", .matrix_path = base->matrix_path, .jacobi = 1, .omega = 1.0 - 0.1 * k};
+        ulam_radius r;
+        ulam_power pa;
+        int rc = cli_load_system(&s);
+        if (rc) return rc;
+        int status = ulam_spectral_radius(s.M, 0, so, &r);
+        if (!status) status = ulam_spectral_power(s.M, NULL, NULL, NULL, &pa, NULL);
+        cli_system_free(&s);
+        if (status) return cli_exit_code(status);
+        printf("                 %5.2f   %-9.6f  %-9.6f  %-9s  %s\n", s.omega, r.rho, pa.rho,
+               r.rho < 1 ? "converges" : "diverges", ulam_verdict_of(&pa) == ULAM_VERDICT_FAIL ? "diverge" : "converge");
+    }
+    printf("                 (rho(|I - w D^-1 A|) = 1 - w + w rho(|J|) for 0 < w <= 1: damping can shrink\n"
+           "                 rho(M) when J has eigenvalues near -1, but never brings the walks'\n"
+           "                 rho(|M|) below plain Jacobi's)\n");
+    return 0;
 }
 
 /* ulam info. */
@@ -74,9 +124,11 @@ int cli_info(int argc, char **argv)
     static const struct option longopts[] = {
         {"jacobi", no_argument, 0, 'j'}, {"omega", required_argument, 0, 'w'},
         {"tol", required_argument, 0, 't'}, {"json", no_argument, 0, 'J'},
-        {"help", no_argument, 0, 'h'},   {0, 0, 0, 0}};
+        {"continue", required_argument, 0, 'q'}, {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
     cli_system s = {.command = "info", .omega = 1.0};
     ulam_spectral_opts so = ulam_spectral_defaults();
+    double continue_q = 0.0;
     int json = 0, c, rc;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
@@ -84,6 +136,7 @@ int cli_info(int argc, char **argv)
         case 'j': s.jacobi = 1; break;
         case 'w': if ((rc = cli_parse_real("info", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 't': if ((rc = cli_parse_real("info", "--tol", optarg, 1e-14, 0.5, &so.tol))) return rc; break;
+        case 'q': if ((rc = cli_parse_real("info", "--continue", optarg, 1e-9, 1 - 1e-12, &continue_q))) return rc; break;
         case 'J': json = 1; break;
         case 'h': fputs(usage, stdout); return 0;
         default: return cli_usage_error("info", "unknown option");
@@ -93,17 +146,21 @@ int cli_info(int argc, char **argv)
     s.matrix_path = argv[optind];
     if ((rc = cli_load_system(&s))) return rc;
     ulam_csr_stats st;
-    ulam_radius r, ra;
+    ulam_radius r;
+    ulam_guard g;
+    ulam_error err = {0};
     ulam_csr_stats_compute(s.M, &st);
     int status = ulam_spectral_radius(s.M, 0, &so, &r);
-    if (!status) status = ulam_spectral_radius(s.M, 1, &so, &ra);
+    if (status) err = (ulam_error){.status = status, .msg = "memory for the radius estimate"};
+    else status = ulam_guard_check(s.M, continue_q, NULL, &g, &err);
     if (status) {
-        ulam_error e = {.status = status, .msg = "memory for the radius estimate"};
+        rc = cli_report(s.matrix_path, &err);
         cli_system_free(&s);
-        return cli_report(s.matrix_path, &e);
+        return rc;
     }
-    if (json) print_json(&s, &st, &r, &ra);
-    else print_text(&s, &st, &r, &ra);
+    if (json) print_json(&s, &st, &r, &g);
+    else print_text(&s, &st, &r, &g);
+    if (!json && s.jacobi && st.n <= 100000) rc = print_omegas(&s, &so);
     cli_system_free(&s);
-    return 0;
+    return rc;
 }

@@ -14,7 +14,7 @@ static const char *const usage =
     "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"
     "                  [--time S] [--seed S] [--threads T] [--continue Q] [--roulette W]\n"
     "                  [--split W] [--max-steps K] [--jacobi [--omega W]] [--check] [--json]\n"
-    "                  [--out x.mtx] [--errors e.mtx]\n"
+    "                  [--out x.mtx] [--errors e.mtx] [--force]\n"
     "\n"
     "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
     "Indices are 1-based, as in Matrix Market files.\n"
@@ -27,7 +27,7 @@ static const char *const usage =
     "  --walks N          stop after N walks (default 100000 when no rule is given)\n"
     "  --rel-err E        stop once stderr / |estimate| <= E (after at least 1000 walks)\n"
     "  --time S           stop after S seconds; the first rule reached wins\n"
-    "  --seed S           walk k uses stream (S, k): identical results for any --threads\n"
+    "  --seed S           block q of walks uses stream (S, q): identical results for any --threads\n"
     "  --threads T        threads (default: all cores)\n"
     "  --continue Q       continue with probability Q in every state (default: analog,\n"
     "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased\n"
@@ -39,6 +39,11 @@ static const char *const usage =
     "  --check            also solve with LAPACK: adds direct, direct_seconds and\n"
     "                     z = (estimate - direct) / stderr\n"
     "  --json             print one JSON object\n"
+    "  --force            walk even when rho(|M|) >= 1 (otherwise refused with exit 3)\n"
+    "\n"
+    "Before walking, the guards estimate rho(|M|) (the walks converge iff < 1) and rho(M^) of\n"
+    "the kernel's second-moment matrix (the variance is finite iff < 1); with rho(M^) >= 1 the\n"
+    "run goes on but reports no confidence interval.\n"
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C\n"
     "exits at once.\n";
@@ -68,16 +73,29 @@ typedef struct {
     int check, json;
     double direct, direct_seconds;
     uint64_t seed;
+    ulam_guard g;
+    int variance_finite;
 } report_opts;
+
+/* Nonzero when one walk dominates the sum of squares: a heavy tail. */
+static int heavy(const ulam_walk_result *r)
+{
+    return r->walks >= 1000 && r->max_share > CLI_HEAVY_SHARE;
+}
 
 /* Print the human-readable block. */
 static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
 {
     double mean_len = r->walks ? (double)r->steps / (double)r->walks : 0.0;
     double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
-    printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->index + 1,
-           o->index < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
-           r->interrupted ? "  [INTERRUPTED]" : "");
+    if (ro->variance_finite)
+        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->index + 1,
+               o->index < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+               r->interrupted ? "  [INTERRUPTED]" : "");
+    else
+        printf("x[%lld]%*s%.10g (no confidence interval: the variance is infinite, rho(M^) >= 1; the "
+               "sample stderr %.3g means nothing)%s\n", (long long)o->index + 1, o->index < 9 ? 10 : 9, "",
+               r->estimate, r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
     printf("method          %s walks, %s estimator\n", mode_names[o->mode], est_names[o->estimator]);
     printf("walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
            (long long)o->max_steps, r->cut ? ": the estimate is biased by the cut" : "");
@@ -88,6 +106,11 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
            (unsigned long long)ro->seed);
     printf("figure of merit %.4g (1 / (relative variance x seconds))\n",
            r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : INFINITY);
+    printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", ro->g.abs.rho,
+           cli_verdict_word(ro->g.verdict_abs), ro->g.hat[o->mode].rho, cli_verdict_word(ro->g.verdict_hat[o->mode]));
+    if (heavy(r))
+        printf("heavy tail      one walk holds %.1f%% of the sum of squared scores: the error bar is "
+               "not to be trusted\n", 100 * r->max_share);
     if (ro->check)
         printf("direct          %.10g (LAPACK, %.4f s), z = %.3f\n", ro->direct, ro->direct_seconds,
                (r->estimate - ro->direct) / r->std_error);
@@ -100,11 +123,20 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     printf("{\"index\": %lld, ", (long long)o->index + 1);
     cli_json_number("estimate", r->estimate, 0);
     cli_json_number("stderr", r->std_error, 0);
-    printf("\"ci95\": [");
-    cli_json_value(r->ci95[0]);
-    printf(", ");
-    cli_json_value(r->ci95[1]);
-    printf("], ");
+    if (ro->variance_finite) {
+        printf("\"ci95\": [");
+        cli_json_value(r->ci95[0]);
+        printf(", ");
+        cli_json_value(r->ci95[1]);
+        printf("], ");
+    } else {
+        printf("\"ci95\": null, ");
+    }
+    printf("\"variance_finite\": %s, ", ro->variance_finite ? "true" : "false");
+    cli_json_number("rho_abs", ro->g.abs.rho, 0);
+    cli_json_number("rho_hat", ro->g.hat[o->mode].rho, 0);
+    cli_json_number("max_share", r->max_share, 0);
+    printf("\"heavy_tail\": %s, ", heavy(r) ? "true" : "false");
     cli_json_number("variance", r->variance, 0);
     printf("\"walks\": %lld, \"steps\": %lld, \"cut\": %lld, ", (long long)r->walks, (long long)r->steps,
            (long long)r->cut);
@@ -167,13 +199,13 @@ int cli_solve(int argc, char **argv)
         {"omega", required_argument, 0, 'w'},     {"check", no_argument, 0, 'c'},
         {"json", no_argument, 0, 'J'},            {"out", required_argument, 0, 'o'},
         {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
-        {0, 0, 0, 0}};
+        {"force", no_argument, 0, 'F'},           {0, 0, 0, 0}};
     cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};
     const char *out = NULL, *errors = NULL;
     int64_t v;
-    int c, rc, any_rule = 0;
+    int c, rc, any_rule = 0, force = 0;
     o.max_walks = 0;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
@@ -201,6 +233,7 @@ int cli_solve(int argc, char **argv)
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'c': ro.check = 1; break;
         case 'J': ro.json = 1; break;
+        case 'F': force = 1; break;
         case 'o': out = optarg; break;
         case 'E': errors = optarg; break;
         case 'h': fputs(usage, stdout); return 0;
@@ -218,6 +251,11 @@ int cli_solve(int argc, char **argv)
     s.matrix_path = argv[optind];
     if ((rc = cli_load_system(&s))) return rc;
     o.index = s.index ? s.index - 1 : 0;
+    if ((rc = cli_guard(&s, o.continue_q, o.mode, force, &ro.g))) {
+        cli_system_free(&s);
+        return rc;
+    }
+    ro.variance_finite = ro.g.verdict_hat[o.mode] != ULAM_VERDICT_FAIL;
     if (ro.check && (rc = direct_check(&s, o.index, &ro))) {
         cli_system_free(&s);
         return rc;
