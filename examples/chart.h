@@ -37,28 +37,20 @@ static inline void out_commit(out_file *o)
     fprintf(stderr, "wrote %s\n", o->path);
 }
 
-/* Draw DIR/NAME.png with gnuplot (pngcairo) from a script; data files are named relative to
- * DIR.  Returns 0, or 1 (with a message) when gnuplot is missing or fails. */
+/* Draw DIR/NAME.png with ulam_gnuplot from a printf-style script (data files relative to
+ * DIR).  Returns 0, or 1 with a message when gnuplot is missing or fails. */
 static inline int chart_draw(const char *dir, const char *name, int width, int height, const char *fmt, ...)
 {
-    char png[4096], tmp[4200], cmd[4400];
-    snprintf(png, sizeof png, "%s/%s.png", dir, name);
-    snprintf(tmp, sizeof tmp, "%s.tmp.png", png);
-    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot", dir);
-    FILE *g = popen(cmd, "w");
-    if (!g) return fprintf(stderr, "gnuplot: cannot start\n"), 1;
-    fprintf(g, "set terminal pngcairo size %d,%d font 'sans,10'\nset output '%s.png.tmp.png'\n", width, height, name);
-    fprintf(g, "set datafile separator ','\nset key top left\nset grid\n");
+    static char script[16384];
     va_list ap;
     va_start(ap, fmt);
-    vfprintf(g, fmt, ap);
+    int len = vsnprintf(script, sizeof script, fmt, ap);
     va_end(ap);
-    if (pclose(g) != 0 || rename(tmp, png)) {
-        remove(tmp);
-        fprintf(stderr, "gnuplot failed for %s (install gnuplot-nox); the CSV is written\n", png);
+    if (len < 0 || (size_t)len >= sizeof script || ulam_gnuplot(dir, name, width, height, script)) {
+        fprintf(stderr, "gnuplot failed for %s/%s.png (install gnuplot-nox); the CSV is written\n", dir, name);
         return 1;
     }
-    fprintf(stderr, "wrote %s\n", png);
+    fprintf(stderr, "wrote %s/%s.png\n", dir, name);
     return 0;
 }
 

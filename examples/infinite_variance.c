@@ -35,7 +35,7 @@ int main(int argc, char **argv)
     out_commit(&o);
     chart_draw(dir, "infinite_variance", 1100, 450,
                "set multiplot layout 1,2 title 'Infinite variance: x_1 of one system (ρ(|M|) = 0.9), two kernels'\n"
-               "set logscale x\nset xlabel 'walks'\nset format x '10^{%%L}'\n"
+               "set key top left\nset logscale x\nset xlabel 'walks'\nset format x '10^{%%L}'\n"
                "set title 'running estimate and claimed 95%% interval'\nset key bottom right\n"
                "plot 'infinite_variance.csv' u ($1==0?$2:1/0):3:($4*1.96) w yerrorlines pt 7 t 'analog kernel, ρ(M̂) = %.2f', "
                "'' u ($1==1?$2*1.15:1/0):3:($4*1.96) w yerrorlines pt 5 t 'q = 0.5, ρ(M̂) = %.2f', '' u 2:5 w l lw 2 t 'LAPACK'\n"

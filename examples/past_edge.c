@@ -39,7 +39,7 @@ int main(int argc, char **argv)
     out_commit(&o);
     chart_draw(dir, "past_edge", 1100, 450,
                "set multiplot layout 1,2 title 'Past the edge: forced adjoint walks (q = 0.5), running estimate of x_1 with its claimed 95%% interval'\n"
-               "set logscale x\nset xlabel 'walks'\nset format x '10^{%%L}'\nset key bottom left\n"
+               "set key top left\nset logscale x\nset xlabel 'walks'\nset format x '10^{%%L}'\nset key bottom left\n"
                "set title \"%s\" font ',9'\n"
                "plot 'past_edge.csv' u ($1==0?$2:1/0):3:($4*1.96) w yerrorlines pt 7 t 'walk estimate', '' u ($1==0?$2:1/0):5 w l lw 2 t 'LAPACK'\n"
                "set title \"%s\" font ',9'\n"

@@ -331,6 +331,42 @@ ulam_solver *ulam_solver_free(ulam_solver *s);
 int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                ulam_walk_result *result, ulam_error *err);
 
+/* ---------------------------------------------------------------- studies */
+
+/* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
+void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
+
+/* What R runs of one method at one budget say, against the exact value. */
+typedef struct ulam_cell {
+    int runs;
+    double rmse;        /* sqrt(mean (estimate - exact)^2) */
+    double mean_stderr; /* the mean reported standard error */
+    double honesty;     /* rmse / mean_stderr: 1 when the error bars are honest */
+    double coverage;    /* share of runs whose 95% interval holds the exact value */
+    double seconds;     /* mean seconds per run */
+    double work;        /* work-normalised variance rmse^2 x seconds (lower is better) */
+} ulam_cell;
+
+/* Summarise n runs (arrays of n) into *out. */
+void ulam_cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
+                       double exact, ulam_cell *out);
+
+/* The collision-absorption law for a forward analog walk started at state j and counting
+ * particles at j, with termination probability p*_j = pstar and no-return probability s:
+ * visits are geometric, so Var(collision) = (1 - s) / s^2 and Var(absorption) = 1 / (p* s) -
+ * 1 / s^2; collision is no worse iff p* <= s / (2 - s).  Writes the two variances. */
+void ulam_law_variances(double pstar, double s, double *var_collision, double *var_absorption);
+
+/* The no-return probability s of state j of the forward kernel of M (walks on the rows of
+ * M', analog q): 1 - sum_k P_jk h_k with h the hitting probabilities of j (a linear solve).
+ * ULAM_OK, ULAM_ENOMEM or ULAM_ESINGULAR. */
+int ulam_law_noreturn(const ulam_csr *M, int64_t j, double *s, double *pstar, ulam_error *err);
+
+/* Draw DIR/NAME.png with gnuplot (pngcairo, width x height pixels) from script, run in DIR;
+ * written under a temporary name and renamed into place.  ULAM_EIO when gnuplot is missing
+ * or fails (nothing is left behind). */
+int ulam_gnuplot(const char *dir, const char *name, int width, int height, const char *script);
+
 /* ---------------------------------------------------------------- utilities */
 
 /* Monotonic wall clock in seconds. */

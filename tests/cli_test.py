@@ -177,13 +177,10 @@ def check_forward_files(ulam):
         assert 922 <= covered <= 978, covered
 
 
-def check_interrupt(ulam):
-    """Ctrl-C prints the estimate so far, marked interrupted, with exit code 130 (no sleeps:
-    wait until the process has installed its SIGINT handler, then send it)."""
+def interrupt_when_ready(p):
+    """Send SIGINT once process p has installed its handler (polled in /proc, no sleeps)."""
     import signal
     import time
-    p = subprocess.Popen([ulam] + SOLVE + ["--index", "1", "--walks", "100000000000", "--json"],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:
         try:
@@ -193,12 +190,64 @@ def check_interrupt(ulam):
         if caught and int(caught[0].split()[1], 16) & (1 << (signal.SIGINT - 1)):
             break
     p.send_signal(signal.SIGINT)
+
+
+def check_interrupt(ulam):
+    """Ctrl-C prints the estimate so far, marked interrupted, with exit code 130 (no sleeps:
+    wait until the process has installed its SIGINT handler, then send it)."""
+    import signal
+    import time
+    p = subprocess.Popen([ulam] + SOLVE + ["--index", "1", "--walks", "100000000000", "--json"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    interrupt_when_ready(p)
     out, _ = p.communicate(timeout=60)
     assert p.returncode == 130, p.returncode
     o = json.loads(out)  # valid JSON even when no block had finished (ci95 then null)
     assert o["interrupted"] is True and o["walks"] >= 0
     if o["walks"] == 0:
         assert o["ci95"] == [None, None] and o["stderr"] is None
+
+
+def check_study(ulam):
+    """study: rows per run, a summary per cell, resume without duplicates, a torn last line cut,
+    refusals listed, Ctrl-C keeps finished rows."""
+    import signal
+    import tempfile
+    import time
+    d = tempfile.mkdtemp()
+    args = ["study", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "2", "--methods",
+            "adjoint-collision-plain,forward-expected-split", "--budgets", "100,1000", "--repeats", "5", "--out", d]
+    rc, _, err = run(ulam, args)
+    rows = open(f"{d}/runs.csv").read().splitlines()
+    assert rc == 0 and len(rows) == 21 and rows[0].startswith("method,budget,repeat"), (rc, err, len(rows))
+    summary = open(f"{d}/summary.csv").read().splitlines()
+    assert len(summary) == 5, summary
+    for line in summary[1:]:
+        f = line.split(",")
+        assert int(f[2]) == 5 and 0 <= float(f[6]) <= 1 and float(f[3]) > 0, line
+    rc, _, err = run(ulam, args)
+    assert rc == 0 and "resuming: 20 runs" in err, err
+    assert open(f"{d}/runs.csv").read().splitlines() == rows  # nothing run twice
+    with open(f"{d}/runs.csv", "w") as fh:  # lose three rows and tear the last line
+        fh.write("\n".join(rows[:-3]) + "\n" + rows[-3][:20])
+    rc, _, err = run(ulam, args)
+    again = open(f"{d}/runs.csv").read().splitlines()
+    assert rc == 0 and "resuming: 17 runs" in err and len(again) == 21, (err, again[-4:])
+    assert all(len(l.split(",")) == 11 for l in again), again
+    rc, _, err = run(ulam, ["study", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "--index", "3", "--methods",
+                            "forward-absorption-plain,adjoint-collision-plain", "--budgets", "100", "--repeats", "2",
+                            "--out", d + "/s"])
+    assert rc == 0 and re.search(r"forward-absorption-plain refused: .*p\* > 0", err), err
+    rc, _, err = run(ulam, ["study", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1",
+                            "--out", d + "/x"])
+    assert rc == 3 and "rho(|M|) = 1.1 >= 1" in err, (rc, err)
+    p = subprocess.Popen([ulam] + args[:6] + ["--methods", "adjoint-collision-plain", "--budgets", "100000000000",
+                                              "--repeats", "3", "--out", d + "/i"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    interrupt_when_ready(p)
+    p.communicate(timeout=60)
+    assert p.returncode == 130, p.returncode
+    assert open(f"{d}/i/runs.csv").read() == "method,budget,repeat,seed,estimate,stderr,abs_error,walks,steps,seconds,covered\n"
 
 
 def check_outputs(ulam):
@@ -233,7 +282,7 @@ def main():
     ulam, genmat = sys.argv[1], sys.argv[2]
     failures, n = check_table(ulam)
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
-             (check_forward_files, ulam), (check_interrupt, ulam)]
+             (check_forward_files, ulam), (check_interrupt, ulam), (check_study, ulam)]
     for f, arg in extra:
         try:
             f(arg)

@@ -254,6 +254,42 @@ static void test_jacobi_poisson(void **state)
     unload(&s);
 }
 
+/* The collision-absorption law (lecture notes): the chain of examples/law.c with s = 0.5,
+ * boundary p* = 1/3, at p* = 0.2 (collision wins), 0.32 (near) and 0.45 (absorption wins):
+ * s from the linear solve matches s = p* + (1 - p*)(1 - c), and each measured forward variance
+ * at 10^6 walks is within 5% of the exact one. */
+static void test_collision_absorption_law(void **state)
+{
+    (void)state;
+    const double ps[3] = {0.2, 0.32, 0.45}, s = 0.5;
+    for (int k = 0; k < 3; k++) {
+        double c = 1 - (s - ps[k]) / (1 - ps[k]), b[4] = {1, 0, 0, 0}, v[2], s2, p2;
+        int32_t ti[6], tj[6];
+        double tx[6];
+        for (int q = 0; q < 3; q++) {
+            ti[q] = q + 1, tj[q] = 0, tx[q] = (1 - ps[k]) / 3;
+            ti[3 + q] = 0, tj[3 + q] = q + 1, tx[3 + q] = c;
+        }
+        ulam_csr *M = NULL;
+        assert_int_equal(ulam_csr_from_triplets(4, 4, 6, ti, tj, tx, &M), ULAM_OK);
+        assert_int_equal(ulam_law_noreturn(M, 0, &s2, &p2, NULL), ULAM_OK);
+        assert_close(s2, s, 1e-12);
+        assert_close(p2, ps[k], 1e-12);
+        ulam_law_variances(ps[k], s, &v[0], &v[1]);
+        sys sy = {.M = M, .b = b, .n = 4};
+        for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.mode = ULAM_FORWARD, o.estimator = est, o.max_walks = 1000000, o.seed = 40 + (uint64_t)k;
+            ulam_walk_result r = run(&sy, o);
+            print_message("law p* = %.2f (boundary 0.333) %-10s variance measured %.5g, exact %.5g (%+.2f%%)\n",
+                          ps[k], est ? "absorption" : "collision", r.variance, v[est], 100 * (r.variance / v[est] - 1));
+            assert_close(r.variance, v[est], 0.05 * v[est]);
+        }
+        assert_true(k == 1 || (v[0] < v[1]) == (ps[k] < s / (2 - s)));
+        ulam_csr_free(M);
+    }
+}
+
 /* Same seed and walk count: bit-for-bit the same result with 1 and 2 threads. */
 static void test_threads_identical(void **state)
 {
@@ -369,6 +405,7 @@ int main(void)
         cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_forward_vectors),
         cmocka_unit_test(test_absorption_refused), cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_rel_err_stop),      cmocka_unit_test(test_jacobi_poisson),
+        cmocka_unit_test(test_collision_absorption_law),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

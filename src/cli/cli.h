@@ -79,5 +79,6 @@ int cli_guard(const cli_system *s, double continue_q, int mode, int force, ulam_
 int cli_info(int argc, char **argv);
 int cli_direct(int argc, char **argv);
 int cli_solve(int argc, char **argv);
+int cli_study(int argc, char **argv);
 
 #endif

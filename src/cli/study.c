@@ -1,0 +1,416 @@
+/* ulam study: every method at every budget, R repeats each, against the exact value; rows
+ * appended to runs.csv as they finish (a rerun resumes), then summary.csv and charts. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static const char *const usage =
+    "usage: ulam study M.mtx --rhs b.mtx --index I [--methods LIST] [--budgets LIST |\n"
+    "                  --time-budgets LIST] [--repeats R] [--out DIR] [--seed S] [--threads T]\n"
+    "                  [--jacobi [--omega W]]\n"
+    "\n"
+    "Run every method (mode-estimator-window: adjoint|forward, collision|absorption|expected,\n"
+    "plain|roulette|split) at every budget R times with distinct seeds, and compare each run\n"
+    "with the exact x_I (LAPACK when n <= 8000, else Gauss-Seidel run to convergence).\n"
+    "\n"
+    "  --methods LIST       comma-separated method names (default: all 18), e.g.\n"
+    "                       adjoint-collision-plain,forward-expected-split\n"
+    "  --budgets LIST       walks per run (default 100,1000,10000,100000,1000000)\n"
+    "  --time-budgets LIST  seconds per run instead of walk counts\n"
+    "  --repeats R          runs per method and budget (default 30)\n"
+    "  --out DIR            output directory (default study): runs.csv (a row per run, appended\n"
+    "                       and flushed as each finishes; rerunning resumes), summary.csv,\n"
+    "                       reference.csv, rmse.png, work.png, coverage.png\n"
+    "  --seed S             base seed (default 1); run r of method m at budget k has its own\n"
+    "\n"
+    "Windows: roulette W = 0.5 w0, split W = 2 w0 (w0 the starting weight).  Ctrl-C keeps\n"
+    "every finished row and writes the summary (exit 130); a second Ctrl-C exits at once.\n";
+
+enum { NMETHOD = 18, MAXBUDGET = 16, MAXREPEAT = 4096 };
+static const char *const mode_names[] = {"adjoint", "forward"};
+static const char *const est_names[] = {"collision", "absorption", "expected"};
+static const char *const window_names[] = {"plain", "roulette", "split"};
+
+typedef struct {
+    char name[40];
+    int mode, est, window, on;
+    char why[320]; /* non-empty: refused */
+    int infinite;  /* rho(M^) >= 1: runs, flagged */
+} method;
+
+typedef struct {
+    cli_system s;
+    method m[NMETHOD];
+    double budget[MAXBUDGET];
+    int nbudget, time_budgets, repeats, threads;
+    uint64_t seed;
+    const char *out;
+    double exact;
+    double *est, *se, *sec; /* [m][b][r] */
+    unsigned char *done;
+} study;
+
+static volatile int interrupted;
+
+/* SIGINT: the first stops after the current run, the second exits at once. */
+static void on_sigint(int sig)
+{
+    (void)sig;
+    if (interrupted) _exit(EXIT_INTERRUPTED);
+    interrupted = 1;
+}
+
+/* Flat index of (method, budget, repeat). */
+static size_t at(const study *st, int m, int b, int r)
+{
+    return ((size_t)m * MAXBUDGET + (size_t)b) * (size_t)st->repeats + (size_t)r;
+}
+
+/* The 18 methods, all on. */
+static void methods_init(method *m)
+{
+    for (int k = 0; k < NMETHOD; k++) {
+        m[k] = (method){.mode = k / 9, .est = k / 3 % 3, .window = k % 3, .on = 1};
+        snprintf(m[k].name, sizeof m[k].name, "%s-%s-%s", mode_names[m[k].mode], est_names[m[k].est],
+                 window_names[m[k].window]);
+    }
+}
+
+/* Keep only the listed methods; 0 or a usage error. */
+static int methods_select(method *m, const char *list)
+{
+    for (int k = 0; k < NMETHOD; k++) m[k].on = 0;
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", list);
+    for (char *save, *w = strtok_r(buf, ",", &save); w; w = strtok_r(NULL, ",", &save)) {
+        int k = 0;
+        while (k < NMETHOD && strcmp(m[k].name, w)) k++;
+        if (k == NMETHOD)
+            return cli_usage_error("study", "--methods: unknown method '%s' (names like adjoint-collision-plain)", w);
+        m[k].on = 1;
+    }
+    return 0;
+}
+
+/* Parse a comma-separated list of positive numbers; 0 or a usage error. */
+static int parse_budgets(study *st, const char *opt, const char *list, int integer)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", list);
+    st->nbudget = 0;
+    for (char *save, *w = strtok_r(buf, ",", &save); w; w = strtok_r(NULL, ",", &save)) {
+        if (st->nbudget == MAXBUDGET) return cli_usage_error("study", "%s: at most %d budgets", opt, MAXBUDGET);
+        double v;
+        int64_t iv;
+        int rc = integer ? cli_parse_int("study", opt, w, 1, INT64_MAX / 2, &iv)
+                         : cli_parse_real("study", opt, w, 1e-6, 1e6, &v);
+        if (rc) return rc;
+        st->budget[st->nbudget++] = integer ? (double)iv : v;
+    }
+    return st->nbudget ? 0 : cli_usage_error("study", "%s expects a list of numbers", opt);
+}
+
+/* Refuse what the guards or the estimator's definition refuse, flag infinite variance. */
+static int screen_methods(study *st)
+{
+    ulam_guard g;
+    ulam_error err;
+    int status = ulam_guard_check(st->s.M, 0.0, NULL, &g, &err);
+    if (status) return cli_report(st->s.matrix_path, &err);
+    int left = 0;
+    for (int k = 0; k < NMETHOD; k++) {
+        method *m = &st->m[k];
+        if (!m->on) continue;
+        if (g.verdict_abs == ULAM_VERDICT_FAIL) {
+            snprintf(m->why, sizeof m->why, "rho(|M|) = %.4g >= 1: the walks diverge", g.abs.rho);
+        } else {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.mode = m->mode, o.estimator = m->est, o.index = st->s.index - 1, o.max_walks = 1;
+            ulam_solver *sv = NULL;
+            if (ulam_solver_alloc(st->s.M, st->s.b, &o, &sv, &err))
+                snprintf(m->why, sizeof m->why, "%s: expected %s", ulam_strerror(err.status), err.msg);
+            ulam_solver_free(sv);
+        }
+        m->infinite = g.verdict_hat[m->mode] == ULAM_VERDICT_FAIL;
+        if (m->why[0]) fprintf(stderr, "ulam: study: %s refused: %s\n", m->name, m->why);
+        else if (m->infinite)
+            fprintf(stderr, "ulam: study: %s runs with infinite variance (rho(M^) = %.4g): its error bars mean nothing\n",
+                    m->name, g.hat[m->mode].rho);
+        left += !m->why[0];
+    }
+    if (!left) fprintf(stderr, "ulam: study: every selected method is refused\n");
+    return left ? 0 : EXIT_DIVERGE;
+}
+
+/* Read the finished rows of an earlier run of this study; cut a torn last line. */
+static void resume(study *st, const char *path)
+{
+    FILE *f = fopen(path, "r+");
+    if (!f) return;
+    char line[1024], name[64];
+    long good = 0;
+    int rows = 0;
+    while (fgets(line, sizeof line, f)) {
+        size_t len = strlen(line);
+        if (len == 0 || line[len - 1] != '\n') break; /* torn by a kill: dropped below */
+        double budget, e, se, sec;
+        int r;
+        if (sscanf(line, "%63[^,],%lf,%d,%*u,%lf,%lf,%*f,%*d,%*d,%lf", name, &budget, &r, &e, &se, &sec) == 6)
+            for (int m = 0; m < NMETHOD; m++)
+                for (int b = 0; b < st->nbudget; b++)
+                    if (!strcmp(st->m[m].name, name) && st->budget[b] == budget && r >= 0 && r < st->repeats) {
+                        size_t i = at(st, m, b, r);
+                        st->est[i] = e, st->se[i] = se, st->sec[i] = sec, st->done[i] = 1;
+                        rows++;
+                    }
+        good = ftell(f);
+    }
+    fflush(f);
+    if (ftruncate(fileno(f), good)) good = 0;
+    fclose(f);
+    if (rows) fprintf(stderr, "ulam: study: resuming: %d runs already in %s\n", rows, path);
+}
+
+/* One run; 0 when it finished (not interrupted) and was recorded. */
+static int one_run(study *st, int m, int b, int r, FILE *f)
+{
+    const method *me = &st->m[m];
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.mode = me->mode, o.estimator = me->est, o.index = st->s.index - 1, o.threads = st->threads;
+    o.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
+    o.interrupt = &interrupted;
+    if (st->time_budgets) o.max_walks = 0, o.max_seconds = st->budget[b];
+    else o.max_walks = (int64_t)st->budget[b];
+    double w0 = me->mode == ULAM_FORWARD ? 0.0 : 1.0; /* forward particles start at ||b||_1 */
+    if (me->mode == ULAM_FORWARD)
+        for (int64_t i = 0; i < st->s.M->nrows; i++) w0 += fabs(st->s.b[i]);
+    if (me->window >= 1) o.roulette = 0.5 * w0;
+    if (me->window == 2) o.split = 2.0 * w0;
+    ulam_walk_result res;
+    if (ulam_solve(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted) return 1;
+    size_t i = at(st, m, b, r);
+    st->est[i] = res.estimate, st->se[i] = res.std_error, st->sec[i] = res.seconds, st->done[i] = 1;
+    fprintf(f, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", me->name, st->budget[b], r,
+            (unsigned long long)o.seed, res.estimate, res.std_error, fabs(res.estimate - st->exact),
+            (long long)res.walks, (long long)res.steps, res.seconds,
+            fabs(res.estimate - st->exact) <= 1.959963984540054 * res.std_error);
+    fflush(f);
+    return 0;
+}
+
+/* Run every missing run, appending to runs.csv; 0, or EXIT_INTERRUPTED. */
+static int run_all(study *st)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/runs.csv", st->out);
+    resume(st, path);
+    FILE *f = fopen(path, "a");
+    if (!f) {
+        ulam_error e = {.status = ULAM_EIO, .msg = "a writable output directory"};
+        return cli_report(path, &e);
+    }
+    if (ftell(f) == 0) fprintf(f, "method,budget,repeat,seed,estimate,stderr,abs_error,walks,steps,seconds,covered\n");
+    int cells = 0, total = 0, tty = isatty(2);
+    for (int m = 0; m < NMETHOD; m++) total += st->m[m].on && !st->m[m].why[0];
+    total *= st->nbudget;
+    double t0 = ulam_now();
+    struct sigaction sa = {.sa_handler = on_sigint};
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    for (int b = 0; b < st->nbudget && !interrupted; b++)
+        for (int m = 0; m < NMETHOD && !interrupted; m++) {
+            if (!st->m[m].on || st->m[m].why[0]) continue;
+            for (int r = 0; r < st->repeats && !interrupted; r++)
+                if (!st->done[at(st, m, b, r)]) one_run(st, m, b, r, f);
+            cells++;
+            double el = ulam_now() - t0;
+            if (tty)
+                fprintf(stderr, "\rulam: study: cells %d/%d, %.1f s elapsed, about %.0f s left   ", cells, total,
+                        el, el / cells * (total - cells));
+        }
+    signal(SIGINT, SIG_DFL);
+    if (tty) fputc('\n', stderr);
+    fclose(f);
+    return interrupted ? EXIT_INTERRUPTED : 0;
+}
+
+/* The exact x_I and the reference lines: LAPACK (n <= 8000: its time and its error against
+ * Gauss-Seidel run to convergence) and Gauss-Seidel from x = 0 (time against its error on
+ * x_I), into reference.csv.  0 or an exit code. */
+static int references(study *st)
+{
+    int64_t n = st->s.M->nrows, I = st->s.index - 1;
+    double *x = calloc((size_t)n, sizeof *x), *xd = NULL;
+    if (!x) return cli_exit_code(ULAM_ENOMEM);
+    for (int k = 0; k < 100000; k++) { /* the converged reference */
+        double old = x[I];
+        ulam_gauss_seidel_sweep(st->s.M, st->s.b, x);
+        if (k > 10 && fabs(x[I] - old) <= 1e-16 * fabs(x[I])) break;
+    }
+    st->exact = x[I];
+    char path[4096];
+    snprintf(path, sizeof path, "%s/reference.csv", st->out);
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        free(x);
+        ulam_error e = {.status = ULAM_EIO, .msg = "a writable output directory"};
+        return cli_report(path, &e);
+    }
+    fprintf(f, "kind,seconds,error\n");
+    ulam_direct_info info;
+    if (n <= 8000 && (xd = malloc((size_t)n * sizeof *xd)) && !ulam_direct_solve(st->s.M, st->s.b, xd, 0, &info, NULL)) {
+        fprintf(f, "lapack,%.6g,%.6g\n", info.seconds, fabs(xd[I] - st->exact) + 1e-300);
+        st->exact = xd[I];
+    }
+    free(xd);
+    double t = 0;
+    for (int64_t i = 0; i < n; i++) x[i] = 0;
+    for (int k = 1; k <= 100000; k++) {
+        double t0 = ulam_now();
+        ulam_gauss_seidel_sweep(st->s.M, st->s.b, x);
+        t += ulam_now() - t0;
+        double e = fabs(x[I] - st->exact);
+        if ((k & (k - 1)) == 0 || e <= 1e-9 * fabs(st->exact)) fprintf(f, "gs,%.6g,%.6g\n", t, e + 1e-300);
+        if (e <= 1e-9 * fabs(st->exact)) break;
+    }
+    free(x);
+    fclose(f);
+    return 0;
+}
+
+/* summary.csv (a row per cell) and bars.csv (per method, at the largest budget). */
+static int summarise(study *st)
+{
+    char path[4096], path2[4096];
+    snprintf(path, sizeof path, "%s/summary.csv", st->out);
+    snprintf(path2, sizeof path2, "%s/bars.csv", st->out);
+    FILE *f = fopen(path, "w"), *g = fopen(path2, "w");
+    if (!f || !g) {
+        if (f) fclose(f);
+        if (g) fclose(g);
+        ulam_error e = {.status = ULAM_EIO, .msg = "a writable output directory"};
+        return cli_report(path, &e);
+    }
+    fprintf(f, "method,budget,runs,rmse,mean_stderr,honesty,coverage,seconds,work,variance_finite\n");
+    fprintf(g, "method,work,coverage,honesty\n");
+    double *e = malloc((size_t)st->repeats * 3 * sizeof *e);
+    for (int m = 0; m < NMETHOD && e; m++) {
+        if (!st->m[m].on || st->m[m].why[0]) continue;
+        ulam_cell last = {0};
+        for (int b = 0; b < st->nbudget; b++) {
+            int k = 0;
+            for (int r = 0; r < st->repeats; r++) {
+                size_t i = at(st, m, b, r);
+                if (st->done[i]) e[k] = st->est[i], e[st->repeats + k] = st->se[i], e[2 * st->repeats + k++] = st->sec[i];
+            }
+            if (!k) continue;
+            ulam_cell c;
+            ulam_cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, &c);
+            fprintf(f, "%s,%.17g,%d,%.6g,%.6g,%.4g,%.4g,%.6g,%.6g,%s\n", st->m[m].name, st->budget[b], c.runs,
+                    c.rmse, c.mean_stderr, c.honesty, c.coverage, c.seconds, c.work,
+                    st->m[m].infinite ? "false" : "true");
+            last = c;
+        }
+        if (last.runs) fprintf(g, "%s,%.6g,%.4g,%.4g\n", st->m[m].name, last.work, last.coverage, last.honesty);
+    }
+    free(e);
+    fclose(f);
+    fclose(g);
+    return 0;
+}
+
+/* The three charts. */
+static void charts(const study *st)
+{
+    char names[NMETHOD * 40] = "", script[8192];
+    for (int m = 0; m < NMETHOD; m++)
+        if (st->m[m].on && !st->m[m].why[0]) strcat(strcat(names, st->m[m].name), " ");
+    snprintf(script, sizeof script,
+             "set title 'ulam study: RMSE of x_%lld against seconds per run'\n"
+             "set logscale xy\nset format x '10^{%%L}'\nset format y '10^{%%L}'\nset xlabel 'seconds per run'\n"
+             "set ylabel 'RMSE'\nset key outside right font ',8'\n"
+             "set fit quiet\nset fit logfile '/dev/null'\nf(x) = a / sqrt(x)\na = 0\nfit f(x) 'summary.csv' u 8:4 via a\n"
+             "plot for [m in \"%s\"] 'summary.csv' u (strcol(1) eq m ? $8 : 1/0):4 w lp t m, "
+             "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 t 'Gauss-Seidel, whole vector', "
+             "'' u (strcol(1) eq 'lapack' ? $2 : 1/0):3 w p pt 9 ps 2 t 'LAPACK dgesv (error vs refined)', "
+             "f(x) dt 2 lc 'black' t '1/sqrt(t) slope'\n",
+             (long long)st->s.index, names);
+    if (ulam_gnuplot(st->out, "rmse", 1200, 700, script))
+        fprintf(stderr, "ulam: study: gnuplot failed (install gnuplot-nox): charts not drawn, CSVs written\n");
+    ulam_gnuplot(st->out, "work", 1000, 500,
+                 "set title 'work-normalised variance RMSE^2 x seconds at the largest budget (lower wins)'\n"
+                 "set style data histograms\nset style fill solid 0.6\nset logscale y\nset format y '10^{%L}'\n"
+                 "set xtics rotate by -40 font ',8'\nset key off\nplot 'bars.csv' u 2:xtic(1)\n");
+    ulam_gnuplot(st->out, "coverage", 1000, 500,
+                 "set title 'coverage of the 95% interval at the largest budget'\nset style data histograms\n"
+                 "set style fill solid 0.6\nset yrange [0:1]\nset xtics rotate by -40 font ',8'\nset key off\n"
+                 "plot 'bars.csv' u 3:xtic(1), 0.95 dt 2 lc 'black'\n");
+}
+
+/* ulam study. */
+int cli_study(int argc, char **argv)
+{
+    static const struct option longopts[] = {
+        {"rhs", required_argument, 0, 'b'},     {"index", required_argument, 0, 'i'},
+        {"methods", required_argument, 0, 'm'}, {"budgets", required_argument, 0, 'n'},
+        {"time-budgets", required_argument, 0, 't'}, {"repeats", required_argument, 0, 'R'},
+        {"out", required_argument, 0, 'o'},     {"seed", required_argument, 0, 's'},
+        {"threads", required_argument, 0, 'T'}, {"jacobi", no_argument, 0, 'j'},
+        {"omega", required_argument, 0, 'w'},   {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
+    static study st;
+    st = (study){.s = {.command = "study", .omega = 1.0}, .repeats = 30, .seed = 1, .out = "study"};
+    methods_init(st.m);
+    parse_budgets(&st, "--budgets", "100,1000,10000,100000,1000000", 1);
+    int64_t v;
+    int c, rc;
+    optind = 0;
+    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'b': st.s.rhs_path = optarg; break;
+        case 'i': if ((rc = cli_parse_int("study", "--index", optarg, 1, ULAM_MAX_DIM, &st.s.index))) return rc; break;
+        case 'm': if ((rc = methods_select(st.m, optarg))) return rc; break;
+        case 'n': if ((rc = parse_budgets(&st, "--budgets", optarg, 1))) return rc; st.time_budgets = 0; break;
+        case 't': if ((rc = parse_budgets(&st, "--time-budgets", optarg, 0))) return rc; st.time_budgets = 1; break;
+        case 'R': if ((rc = cli_parse_int("study", "--repeats", optarg, 2, MAXREPEAT, &v))) return rc; st.repeats = (int)v; break;
+        case 'o': st.out = optarg; break;
+        case 's': if ((rc = cli_parse_int("study", "--seed", optarg, 0, UINT32_MAX, &v))) return rc; st.seed = (uint64_t)v; break;
+        case 'T': if ((rc = cli_parse_int("study", "--threads", optarg, 1, 1024, &v))) return rc; st.threads = (int)v; break;
+        case 'j': st.s.jacobi = 1; break;
+        case 'w': if ((rc = cli_parse_real("study", "--omega", optarg, 1e-6, 2.0, &st.s.omega))) return rc; break;
+        case 'h': fputs(usage, stdout); return 0;
+        default: return cli_usage_error("study", "unknown option");
+        }
+    }
+    if (optind != argc - 1) return cli_usage_error("study", "expects exactly one matrix file");
+    if (!st.s.rhs_path) return cli_usage_error("study", "needs --rhs b.mtx");
+    if (!st.s.index) return cli_usage_error("study", "needs --index I");
+    st.s.matrix_path = argv[optind];
+    if (mkdir(st.out, 0777) && access(st.out, W_OK)) {
+        ulam_error e = {.status = ULAM_EIO, .msg = "a directory that can be created or written"};
+        return cli_report(st.out, &e);
+    }
+    if ((rc = cli_load_system(&st.s))) return rc;
+    size_t cells = (size_t)NMETHOD * MAXBUDGET * (size_t)st.repeats;
+    st.est = malloc(cells * sizeof *st.est), st.se = malloc(cells * sizeof *st.se);
+    st.sec = malloc(cells * sizeof *st.sec), st.done = calloc(cells, 1);
+    rc = st.est && st.se && st.sec && st.done ? 0 : cli_exit_code(ULAM_ENOMEM);
+    if (!rc) rc = screen_methods(&st);
+    if (!rc) rc = references(&st);
+    if (!rc) rc = run_all(&st);
+    if (rc == 0 || rc == EXIT_INTERRUPTED) {
+        int rs = summarise(&st);
+        if (!rs) charts(&st);
+        else rc = rs;
+    }
+    free(st.est), free(st.se), free(st.sec), free(st.done);
+    cli_system_free(&st.s);
+    return rc;
+}

@@ -1,0 +1,32 @@
+/* Charts: gnuplot (pngcairo) fed a script on a pipe, the PNG renamed into place when done. */
+#include "internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Draw DIR/NAME.png from script. */
+int ulam_gnuplot(const char *dir, const char *name, int width, int height, const char *script)
+{
+    if (!dir || !name || !script || strchr(dir, '\'') || strchr(name, '\'')) return ULAM_EINVAL;
+    size_t len = strlen(dir) + strlen(name) + 64;
+    char *png = ulam__malloc(len, 1), *tmp = ulam__malloc(len, 1), *cmd = ulam__malloc(len, 1);
+    int status = ULAM_ENOMEM;
+    if (png && tmp && cmd) {
+        snprintf(png, len, "%s/%s.png", dir, name);
+        snprintf(tmp, len, "%s/%s.png.tmp.png", dir, name);
+        snprintf(cmd, len, "cd '%s' && gnuplot 2>/dev/null", dir);
+        FILE *g = popen(cmd, "w");
+        status = ULAM_EIO;
+        if (g) {
+            fprintf(g, "set terminal pngcairo size %d,%d font 'sans,10'\nset output '%s.png.tmp.png'\n"
+                       "set datafile separator ','\nset grid\n%s\nset output\n",
+                    width, height, name, script);
+            int rc = pclose(g);
+            status = rc == 0 && rename(tmp, png) == 0 ? ULAM_OK : ULAM_EIO;
+        }
+        if (status) remove(tmp);
+    }
+    free(png), free(tmp), free(cmd);
+    return status;
+}
