@@ -1,6 +1,8 @@
 /* genmat: make the systems in matrices/ reproducibly (fixed seeds, public API only).
  *
  *   genmat OUTDIR            write every generated system into OUTDIR
+ *   genmat --radiosity N OUT.mtx OUT_b.mtx
+ *                            a radiosity-like dense n x n M = diag(rho) F and emissions b
  *   genmat --sparse N K S OUT.mtx OUT_b.mtx
  *                            a random nonnegative n x n matrix with K nonzeros per row
  *                            (random columns) and every row sum equal to S
@@ -143,6 +145,16 @@ int main(int argc, char **argv)
         if (st) fprintf(stderr, "genmat: %s\n", ulam_strerror(st));
         return st ? 1 : 0;
     }
-    fprintf(stderr, "usage: genmat OUTDIR | genmat --sparse N K S OUT.mtx OUT_b.mtx\n");
+    if (argc == 5 && !strcmp(argv[1], "--radiosity") && atoll(argv[2]) >= 5) {
+        int64_t n = atoll(argv[2]);
+        ulam_csr *M = radiosity_like(n, (uint64_t)n);
+        double *b = emitters(n);
+        int st = ulam_mm_write_matrix(argv[3], M, "radiosity-like dense M = diag(rho) F, rho in [0.3, 0.8]");
+        if (!st) st = ulam_mm_write_vector(argv[4], b, n, "emissions b");
+        ulam_csr_free(M), free(b);
+        if (st) fprintf(stderr, "genmat: %s\n", ulam_strerror(st));
+        return st ? 1 : 0;
+    }
+    fprintf(stderr, "usage: genmat OUTDIR | genmat --radiosity N OUT.mtx OUT_b.mtx | genmat --sparse N K S OUT.mtx OUT_b.mtx\n");
     return 2;
 }
