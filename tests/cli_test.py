@@ -238,6 +238,10 @@ def check_study(ulam):
                             "forward-absorption-plain,adjoint-collision-plain", "--budgets", "100", "--repeats", "2",
                             "--out", d + "/s"])
     assert rc == 0 and re.search(r"forward-absorption-plain refused: .*p\* > 0", err), err
+    rc, _, err = run(ulam, args[:6] + ["--methods", "adjoint-expected-plain", "--time-budgets", "0.001,0.002",
+                                       "--repeats", "3", "--out", d + "/t"])
+    timed = open(f"{d}/t/runs.csv").read().splitlines()
+    assert rc == 0 and len(timed) == 7 and all(int(l.split(",")[7]) > 0 for l in timed[1:]), (err, timed)
     rc, _, err = run(ulam, ["study", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1",
                             "--out", d + "/x"])
     assert rc == 3 and "rho(|M|) = 1.1 >= 1" in err, (rc, err)
