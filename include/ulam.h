@@ -279,7 +279,7 @@ typedef struct ulam_walk_opts {
     int threads;         /* 0: all cores */
     int64_t max_walks;   /* stop after this many walks (0: no limit) */
     double rel_err;      /* stop once stderr / |estimate| <= rel_err after >= 1000 walks (0 off) */
-    double max_seconds;  /* stop after this much wall time (0 off) */
+    double max_seconds;  /* stop after this much wall time (0 off); the first block always runs */
     int64_t max_steps;   /* a walk longer than this is cut and counted (default 10^6) */
     const volatile int *interrupt; /* stop at the next block when *interrupt != 0 (may be NULL) */
 } ulam_walk_opts;

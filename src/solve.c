@@ -245,7 +245,7 @@ static void run_block(ulam_solver *s, int q, int64_t first, int64_t count, int t
     ulam__block *br = &s->blocks[q];
     br->complete = 0;
     br->walks = 0;
-    if (must_stop(s)) return;
+    if (first > 0 ? must_stop(s) : s->o.interrupt && *s->o.interrupt) return; /* block 0 always runs */
     ulam_rng r;
     ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / BLOCK));
     if (s->o.mode == ULAM_ADJOINT) ulam__adjoint_block(&s->w, count, &r, &s->scratch[t], br);

@@ -194,7 +194,8 @@ static int one_run(study *st, int m, int b, int r, FILE *f)
     if (me->window >= 1) o.roulette = 0.5 * w0;
     if (me->window == 2) o.split = 2.0 * w0;
     ulam_walk_result res;
-    if (ulam_solve(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted) return 1;
+    if (ulam_solve(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted || res.walks < 2 || !isfinite(res.std_error))
+        return 1; /* nothing non-finite reaches runs.csv */
     size_t i = at(st, m, b, r);
     st->est[i] = res.estimate, st->se[i] = res.std_error, st->sec[i] = res.seconds, st->done[i] = 1;
     fprintf(f, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", me->name, st->budget[b], r,
