@@ -117,7 +117,7 @@ static double *factors(const ulam_csr *M, double continue_q, int cols)
     for (int64_t i = 0; i < n; i++)
         for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) f[cols ? M->colidx[q] : i] += fabs(M->val[q]);
     for (int64_t i = 0; i < n; i++) {
-        double qi = f[i] == 0.0 ? 0.0 : continue_q > 0 ? continue_q : fmin(1.0, f[i]);
+        double qi = ulam__continuation(f[i], continue_q);
         f[i] = qi > 0 ? f[i] / qi : 0.0;
     }
     return f;

@@ -21,6 +21,27 @@ static inline uint64_t ulam__rng_next(ulam_rng *r)
     return result;
 }
 
+/* An index in [0, len) by Lemire's unbiased multiply-and-reject draw ("Fast random integer
+ * generation in an interval", ACM TOMACS 29(1), 2019); *frac gets the low half of the same
+ * product, uniform on a lattice of spacing len / 2^64 (the walkers use it as a coin). */
+static inline uint64_t ulam__rng_index(ulam_rng *r, uint64_t len, uint64_t *frac)
+{
+    __uint128_t m = (__uint128_t)ulam__rng_next(r) * len;
+    if ((uint64_t)m < len) {
+        uint64_t floor = (0 - len) % len;
+        while ((uint64_t)m < floor) m = (__uint128_t)ulam__rng_next(r) * len;
+    }
+    *frac = (uint64_t)m;
+    return (uint64_t)(m >> 64);
+}
+
+/* The continuation probability of a state whose row of |K| sums to S: fixed continue_q when
+ * given (> 0), else analog min(1, S); 0 for an empty row. */
+static inline double ulam__continuation(double S, double continue_q)
+{
+    return S == 0.0 ? 0.0 : continue_q > 0 ? continue_q : (S < 1.0 ? S : 1.0);
+}
+
 /* Uniform double in [0, 1) from the top 53 bits. */
 static inline double ulam__rng_uniform(ulam_rng *r)
 {

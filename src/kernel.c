@@ -109,7 +109,7 @@ static void build_row(const ulam_csr *K, int64_t i, double continue_q, ulam_kern
     int64_t b = K->rowptr[i], len = K->rowptr[i + 1] - b;
     double S = 0.0;
     for (int64_t q = b; q < b + len; q++) S += fabs(K->val[q]);
-    double qi = S == 0.0 ? 0.0 : continue_q > 0 ? continue_q : fmin(1.0, S);
+    double qi = ulam__continuation(S, continue_q);
     ulam__row *h = ulam__kernel_row(k, k->at[i]);
     *h = (ulam__row){.factor = qi > 0 ? S / qi : 0.0, .len = (int32_t)(len + 1), .state = (int32_t)i};
     k->pstar[i] = 1.0 - qi;
@@ -186,7 +186,7 @@ void ulam__kernel_reach(const ulam_kernel *k, char *seen)
             int32_t outs[2] = {s[q].a, s[q].b};
             for (int t = 0; t < 2; t++) {
                 if (outs[t] == ULAM__TERMINATE) continue;
-                int32_t j = ulam__kernel_row(k, outs[t] < 0 ? ~outs[t] : outs[t])->state;
+                int32_t j = ulam__kernel_row(k, ulam__outcome_target(outs[t]))->state;
                 if (!seen[j]) {
                     seen[j] = 1;
                     stack[top++] = j;

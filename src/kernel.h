@@ -56,24 +56,17 @@ static inline ulam__row *ulam__kernel_row(const ulam_kernel *k, int64_t u)
     return (ulam__row *)(void *)(k->mem + u);
 }
 
-/* An index in [0, len) by Lemire's unbiased multiply-and-reject draw (ACM TOMACS 29(1),
- * 2019); *frac gets the low half of the same product, uniform on a lattice of spacing
- * len / 2^64, which decides the alias slot's coin without a second draw. */
-static inline uint64_t ulam__draw_index(ulam_rng *r, uint64_t len, uint64_t *frac)
-{
-    __uint128_t m = (__uint128_t)ulam__rng_next(r) * len;
-    if ((uint64_t)m < len) {
-        uint64_t floor = (0 - len) % len;
-        while ((uint64_t)m < floor) m = (__uint128_t)ulam__rng_next(r) * len;
-    }
-    *frac = (uint64_t)m;
-    return (uint64_t)(m >> 64);
-}
-
 /* Draw a slot of row h; *frac is to be compared with its threshold. */
 static inline const ulam__slot *ulam__kernel_pick(const ulam__row *h, ulam_rng *r, uint64_t *frac)
 {
-    return (const ulam__slot *)(const void *)h + ULAM__HEAD + ulam__draw_index(r, (uint64_t)h->len, frac);
+    return (const ulam__slot *)(const void *)h + ULAM__HEAD + ulam__rng_index(r, (uint64_t)h->len, frac);
+}
+
+/* The row unit (or state, in a source table) an outcome other than ULAM__TERMINATE names;
+ * o < 0 also flips the weight's sign. */
+static inline int32_t ulam__outcome_target(int32_t o)
+{
+    return o < 0 ? ~o : o;
 }
 
 /* The outcome of slot s for fraction frac. */

@@ -36,18 +36,9 @@ double ulam_rng_uniform(ulam_rng *r)
     return ulam__rng_uniform(r);
 }
 
-/* Unbiased integer in [0, bound): Lemire, "Fast random integer generation in an
- * interval", ACM TOMACS 29(1), 2019. */
+/* Unbiased integer in [0, bound) (Lemire's multiply-and-reject, see internal.h). */
 uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound)
 {
-    __uint128_t m = (__uint128_t)ulam_rng_next(r) * bound;
-    uint64_t lo = (uint64_t)m;
-    if (lo < bound) {
-        uint64_t threshold = (0 - bound) % bound;
-        while (lo < threshold) {
-            m = (__uint128_t)ulam_rng_next(r) * bound;
-            lo = (uint64_t)m;
-        }
-    }
-    return (uint64_t)(m >> 64);
+    uint64_t frac;
+    return ulam__rng_index(r, bound, &frac);
 }

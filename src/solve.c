@@ -2,9 +2,9 @@
  *
  * Walks run in blocks of BLOCK walks, ROUND blocks per round; block q draws from the stream
  * (seed, q) (one splitmix64 seeding per block, not per walk).  Threads take blocks
- * dynamically, but every block's result is stored by its index and merged in index order (Chan's formula for the adjoint score,
- * per-state sums for forward tallies), so the result is bit-for-bit the same for any number
- * of threads.  Stopping rules are checked between rounds; an interrupt or the time limit
+ * dynamically, but every block's result is stored by its index and merged in index order
+ * (Chan's formula for the adjoint score, per-state sums for forward tallies), so the result is
+ * bit-for-bit the same for any number of threads.  Stopping rules are checked between rounds; an interrupt or the time limit
  * also stops blocks that have not started. */
 #include "stats.h"
 #include "walk.h"

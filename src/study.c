@@ -50,7 +50,7 @@ static int kernel_without(const ulam_csr *M, int64_t j, ulam_csr **Q, double *c,
     for (int64_t i = 0; i < K->nrows; i++) {
         double S = 0;
         for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++) S += fabs(K->val[q]);
-        double qi = fmin(1.0, S);
+        double qi = ulam__continuation(S, 0.0);
         if (i == j) *Sj = S;
         c[i] = 0;
         for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++) {
@@ -83,7 +83,7 @@ int ulam_law_noreturn(const ulam_csr *M, int64_t j, double *s, double *pstar, ul
         double back = 0;
         for (int64_t k = 0; k < n; k++) back += pj[k] * (k == j ? 1.0 : h[k]);
         *s = 1 - back;
-        *pstar = 1 - fmin(1.0, Sj);
+        *pstar = 1 - ulam__continuation(Sj, 0.0);
     }
     ulam_csr_free(Q);
     free(c), free(pj), free(h);

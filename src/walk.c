@@ -67,7 +67,7 @@ static int window(const ulam__walker *w, int32_t u, double *wt, ulam_rng *r, sta
 static inline int32_t target(int32_t o, double f, double *wt)
 {
     *wt *= o < 0 ? -f : f;
-    return o < 0 ? ~o : o;
+    return ulam__outcome_target(o);
 }
 
 /* One adjoint lane: the particle it carries and its history so far. */
@@ -225,10 +225,10 @@ static int forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc
 {
     const ulam_kernel *k = w->k;
     uint64_t frac;
-    const ulam__slot *src = w->src + ulam__draw_index(r, (uint64_t)k->n, &frac);
+    const ulam__slot *src = w->src + ulam__rng_index(r, (uint64_t)k->n, &frac);
     int32_t o = ulam__slot_outcome(src, frac);
     stack st = {sc->stack_s, sc->stack_w, 1, sc->stack_cap};
-    st.s[0] = (int32_t)k->at[o < 0 ? ~o : o];
+    st.s[0] = (int32_t)k->at[ulam__outcome_target(o)];
     st.w[0] = o < 0 ? -w->bnorm1 : w->bnorm1;
     int64_t len = 0;
     while (st.top > 0) {

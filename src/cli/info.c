@@ -3,6 +3,7 @@
 
 #include <getopt.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char *const usage =
@@ -95,23 +96,33 @@ static void print_json(const cli_system *s, const ulam_csr_stats *st, const ulam
     printf("\"variance_finite_forward\": %s}\n", g->verdict_hat[1] != ULAM_VERDICT_FAIL ? "true" : "false");
 }
 
-/* For --jacobi: rho(M) and rho(|M|) of the splitting at several dampings. */
+/* For --jacobi: rho(M) and rho(|M|) of the splitting at several dampings (A read once). */
 static int print_omegas(const cli_system *base, const ulam_spectral_opts *so)
 {
+    ulam_csr *A = NULL;
+    ulam_error err;
+    int status = ulam_mm_read_matrix(base->matrix_path, &A, &err);
+    if (status) return cli_report(base->matrix_path, &err);
+    int64_t n = A->nrows;
+    double *b = calloc((size_t)n, sizeof *b), *bp = malloc((size_t)n * sizeof *bp);
+    if (!b || !bp) status = ULAM_ENOMEM;
     printf("damping          omega   rho(M)     rho(|M|)   Neumann    walks\n");
-    for (int k = 0; k <= 5; k++) {
-        cli_system s = {.command = "info", .matrix_path = base->matrix_path, .jacobi = 1, .omega = 1.0 - 0.1 * k};
+    for (int k = 0; k <= 5 && !status; k++) {
+        double omega = 1.0 - 0.1 * k;
+        ulam_csr *M = NULL;
         ulam_radius r;
         ulam_power pa;
-        int rc = cli_load_system(&s);
-        if (rc) return rc;
-        int status = ulam_spectral_radius(s.M, 0, so, &r);
-        if (!status) status = ulam_spectral_power(s.M, NULL, NULL, NULL, &pa, NULL);
-        cli_system_free(&s);
-        if (status) return cli_exit_code(status);
-        printf("                 %5.2f   %-9.6f  %-9.6f  %-9s  %s\n", s.omega, r.rho, pa.rho,
-               r.rho < 1 ? "converges" : "diverges", ulam_verdict_of(&pa) == ULAM_VERDICT_FAIL ? "diverge" : "converge");
+        status = ulam_jacobi(A, b, omega, &M, bp, NULL);
+        if (!status) status = ulam_spectral_radius(M, 0, so, &r);
+        if (!status) status = ulam_spectral_power(M, NULL, NULL, NULL, &pa, NULL);
+        ulam_csr_free(M);
+        if (!status)
+            printf("                 %5.2f   %-9.6f  %-9.6f  %-9s  %s\n", omega, r.rho, pa.rho,
+                   r.rho < 1 ? "converges" : "diverges", ulam_verdict_of(&pa) == ULAM_VERDICT_FAIL ? "diverge" : "converge");
     }
+    ulam_csr_free(A);
+    free(b), free(bp);
+    if (status) return cli_exit_code(status);
     printf("                 (rho(|I - w D^-1 A|) = 1 - w + w rho(|J|) for 0 < w <= 1: damping can shrink\n"
            "                 rho(M) when J has eigenvalues near -1, but never brings the walks'\n"
            "                 rho(|M|) below plain Jacobi's)\n");
