@@ -45,6 +45,10 @@ enum ulam_status {
     ULAM_EMEMLIMIT,    /* the dense matrix would exceed the memory limit */
     ULAM_ENOCONV,      /* an iteration did not converge within its cap */
     ULAM_EUNDEFINED,   /* the estimator is undefined for this system (p* = 0 where it scores) */
+    ULAM_EGEOMETRY,    /* a degenerate, non-planar or non-convex face */
+    ULAM_ENOTFOUND,    /* a named thing (material, label) is not defined */
+    ULAM_ERANGE,       /* a value outside its allowed range (a reflectance outside [0, 1)) */
+    ULAM_EDEVICE,      /* the ray-casting device (Embree) failed */
     ULAM_NSTATUS
 };
 
@@ -58,6 +62,8 @@ typedef struct ulam_error {
     long line;
     int64_t index;
     char msg[256];
+    char file[256]; /* the file the line is in when it is not the one the caller named (an MTL
+                       file read for an OBJ file); empty otherwise */
 } ulam_error;
 
 /* ---------------------------------------------------------------- sparse matrices */
@@ -366,6 +372,167 @@ int ulam_law_noreturn(const ulam_csr *M, int64_t j, double *s, double *pstar, ul
  * written under a temporary name and renamed into place.  ULAM_EIO when gnuplot is missing
  * or fails (nothing is left behind). */
 int ulam_gnuplot(const char *dir, const char *name, int width, int height, const char *script);
+
+/* ---------------------------------------------------------------- radiosity */
+
+/* A scene of planar convex patches with diffuse RGB reflectance and emission: the radiosity
+ * equation B = E + diag(rho) F B per colour channel.  Plain data; arrays of 3 hold RGB or
+ * xyz per patch, patch p's polygon is vidx[start[p] .. start[p+1]) (counter-clockwise seen
+ * from the side its normal points to, the side that emits and reflects). */
+typedef struct ulam_scene {
+    int64_t npatches, nverts;
+    double *vert;    /* 3 * nverts coordinates */
+    int64_t *start;  /* npatches + 1 */
+    int32_t *vidx;   /* start[npatches] vertex indices */
+    double *normal;  /* 3 * npatches unit normals */
+    double *area;    /* npatches */
+    double *rho;     /* 3 * npatches reflectances in [0, 1) */
+    double *emit;    /* 3 * npatches emissions (radiosity units) */
+    int64_t *face;   /* npatches: the face of the OBJ file a patch came from (0-based) */
+    int64_t nfaces;
+    int32_t *group;  /* npatches: index into groups (the o / g name in force), -1 for none */
+    int64_t ngroups;
+    char **groups;
+} ulam_scene;
+
+/* Read a Wavefront OBJ file (v; f with 3 or more vertices, v, v/t, v/t/n or v//n, negative
+ * indices relative; o, g; usemtl; mtllib, relative to the OBJ's folder) and its MTL files
+ * (newmtl; Kd = reflectance in [0, 1), Ke = emission >= 0).  One patch per face.  Errors
+ * carry the line, and err->file names the MTL file when the error is in one. */
+int ulam_scene_read_obj(const char *path, ulam_scene **out, ulam_error *err);
+
+/* Split every patch into patches no longer than max_side on a side (quads into a grid,
+ * triangles into m^2 similar triangles, larger polygons through a fan); face and group
+ * are kept. */
+int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out);
+
+/* Free a scene; accepts and returns NULL. */
+ulam_scene *ulam_scene_free(ulam_scene *s);
+
+/* The patch a label names: the patch of group label nearest the group's area centroid.
+ * ULAM_ENOTFOUND when no patch has that label. */
+int ulam_scene_find(const ulam_scene *s, const char *label, int64_t *patch);
+
+/* Total emitted power sum_p A_p E_p per channel. */
+void ulam_scene_power(const ulam_scene *s, double power[3]);
+
+/* A ray caster over a scene (Embree 3): opaque. */
+typedef struct ulam_tracer ulam_tracer;
+
+/* Build the ray-casting structure for s (which must outlive it). */
+int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err);
+
+/* Free a tracer; accepts and returns NULL. */
+ulam_tracer *ulam_tracer_free(ulam_tracer *t);
+
+/* The patch the ray org + t dir (t > 0, dir unit) first hits, or -1 when it leaves the
+ * scene; *front (may be NULL) is 1 when it hits the patch's front side. */
+int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3],
+                         int *front);
+
+/* A cosine-distributed ray leaving a uniform point of patch p: the patch it reaches
+ * (front side) is j with probability exactly F_pj; -1 when it leaves the scene or hits a
+ * back side (the light is lost).  Draws from r. */
+int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
+
+/* Form factors F_ij estimated by casting `rays` cosine-distributed rays from uniform points of
+ * each patch i (the share that reaches j); stream (seed, i) for patch i, so F does not
+ * depend on the number of threads (0: all cores). */
+int ulam_form_factors(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads,
+                      ulam_csr **F, ulam_error *err);
+
+/* How well an estimated F obeys the laws of form factors. */
+typedef struct ulam_ff_report {
+    double reciprocity; /* sum |A_i F_ij - A_j F_ji| / sum A_i F_ij over pairs i < j, j < i */
+    double rowsum_min, rowsum_max, rowsum_mean; /* 1 in a closed scene */
+    int64_t nnz;
+} ulam_ff_report;
+
+/* Fill *r for F on s. */
+int ulam_form_factor_report(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r);
+
+/* Exact form factor between directly opposed parallel a x b rectangles at distance c
+ * (Howell's catalogue, C-11). */
+double ulam_ff_parallel_rectangles(double a, double b, double c);
+
+/* Exact form factor from a w x l rectangle to an h x l rectangle perpendicular to it that
+ * shares its edge of length l (Howell's catalogue, C-14). */
+double ulam_ff_perpendicular_rectangles(double w, double h, double l);
+
+/* The radiosity system of channel c: M = diag(rho_c) F (new *M) and b = E_c (npatches). */
+int ulam_radiosity_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
+                          double *b);
+
+/* Solve the three channels' systems with LAPACKE_dgesv into B (3 * npatches, RGB per patch);
+ * refuses with ULAM_EMEMLIMIT like ulam_direct_solve.  info (may be NULL) sums the three. */
+int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
+                          ulam_direct_info *info, ulam_error *err);
+
+/* The standard error of the direct solution B (from ulam_radiosity_direct on an F estimated
+ * with `rays` rays a patch) at patch p, per channel: the first-order propagation of the
+ * multinomial noise of each row of F, se^2 = sum_k (G_pk rho_k)^2 v_k / rays with
+ * G = (I - M)^-1 (one transposed LAPACK solve a channel) and v_k = sum_j F_kj B_j^2 -
+ * (sum_j F_kj B_j)^2. */
+int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                                int64_t p, size_t max_bytes, double se[3], ulam_error *err);
+
+/* What a patch walk run has found: RGB radiosity of the patch opts->index. */
+typedef struct ulam_rad_result {
+    double radiosity[3];
+    double std_error[3];
+    int64_t walks;    /* histories (gathering walks or shot particles) */
+    int64_t rays;     /* rays cast */
+    int64_t cut;      /* walks cut at max_steps */
+    double max_share; /* the largest single score^2 / sum of scores^2 (channel sum) */
+    double seconds;
+    int threads, interrupted;
+} ulam_rad_result;
+
+/* An opaque patch-walk solver: walks that sample F by ray casting, never forming it. */
+typedef struct ulam_rad_solver ulam_rad_solver;
+
+/* Prepare walks on scene t (the tracer's): opts->mode ULAM_ADJOINT gathers at patch
+ * opts->index (continuation max_c rho_c of the patch, weights rho_c / q), ULAM_FORWARD
+ * shoots particles from the emitters in proportion to power and tallies every patch;
+ * estimator ULAM_COLLISION or ULAM_ABSORPTION; the stopping rules, seed, threads and
+ * interrupt of ulam_walk_opts (continue_q, roulette and split must be 0). */
+int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
+                          ulam_error *err);
+
+/* Run one round of walks; ULAM_OK or ULAM_ENONFINITE. */
+int ulam_rad_solver_iterate(ulam_rad_solver *s);
+
+/* Nonzero once a stopping rule is met (rel_err: every nonzero channel). */
+int ulam_rad_solver_done(const ulam_rad_solver *s);
+
+/* The result so far. */
+void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r);
+
+/* Shooting: every patch's RGB radiosity and standard error (3 * npatches each; either may be
+ * NULL).  Gathering: ULAM_EINVAL. */
+int ulam_rad_solver_vectors(const ulam_rad_solver *s, double *B, double *std_error);
+
+/* Free; accepts and returns NULL. */
+ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s);
+
+/* A pinhole camera. */
+typedef struct ulam_camera {
+    double eye[3], dir[3], up[3];
+    double focal, film; /* focal length and film width, same unit (mm) */
+} ulam_camera;
+
+/* The Cornell box camera: eye (278, 273, -800), looking along +z, 35 mm lens, 25 mm film. */
+ulam_camera ulam_camera_cornell(void);
+
+/* Render B (3 * npatches) as width x height 8-bit sRGB (3 bytes a pixel, rows top first):
+ * one ray per pixel centre, the hit patch's radiosity times exposure, clamped, sRGB-encoded
+ * (flat shading).  exposure <= 0 picks 1 / (the 99th percentile of the largest channel over
+ * the pixels of patches that do not emit); the exposure used goes to *used (may be NULL). */
+int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width,
+                int height, double exposure, unsigned char *rgb, double *used);
+
+/* Write an 8-bit RGB image as PNG (libpng), atomically. */
+int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb);
 
 /* ---------------------------------------------------------------- utilities */
 

@@ -31,6 +31,10 @@ static const char *const messages[ULAM_NSTATUS] = {
     [ULAM_EMEMLIMIT] = "exceeds the memory limit",
     [ULAM_ENOCONV] = "iteration did not converge",
     [ULAM_EUNDEFINED] = "estimator undefined for this system",
+    [ULAM_EGEOMETRY] = "degenerate, non-planar or non-convex face",
+    [ULAM_ENOTFOUND] = "not defined",
+    [ULAM_ERANGE] = "value out of range",
+    [ULAM_EDEVICE] = "ray-casting device failed",
 };
 
 /* A short English description of a status code. */
@@ -47,6 +51,7 @@ int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char
     err->status = status;
     err->line = line;
     err->index = index;
+    err->file[0] = '\0';
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(err->msg, sizeof err->msg, fmt, ap);
@@ -62,6 +67,7 @@ void ulam__clear(ulam_error *err)
     err->line = 0;
     err->index = -1;
     err->msg[0] = '\0';
+    err->file[0] = '\0';
 }
 
 /* malloc of n items of size sz, NULL on overflow. */

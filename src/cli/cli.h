@@ -80,5 +80,6 @@ int cli_info(int argc, char **argv);
 int cli_direct(int argc, char **argv);
 int cli_solve(int argc, char **argv);
 int cli_study(int argc, char **argv);
+int cli_radiosity(int argc, char **argv);
 
 #endif

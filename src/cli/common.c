@@ -18,6 +18,7 @@ int cli_exit_code(int status)
 int cli_report(const char *file, const ulam_error *err)
 {
     fprintf(stderr, "ulam: ");
+    if (err->file[0]) file = err->file;
     if (file && err->line > 0) fprintf(stderr, "%s:%ld: ", file, err->line);
     else if (file) fprintf(stderr, "%s: ", file);
     fprintf(stderr, "error: %s", ulam_strerror(err->status));

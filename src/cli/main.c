@@ -14,6 +14,7 @@ static const char *const usage =
     "  solve    one unknown (adjoint) or all (forward) by random walks, with error bars\n"
     "  direct   LAPACK dense reference solve\n"
     "  study    every method at every budget, repeated: accuracy against time, charts\n"
+    "  radiosity  a patch scene (OBJ + MTL): one patch by ray-cast walks, or all, or LAPACK\n"
     "\n"
     "Matrices and vectors are Matrix Market files.  Indices on the command line are\n"
     "1-based, as in Matrix Market files (the C API is 0-based).\n";
@@ -32,6 +33,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "direct")) return cli_direct(argc - 1, argv + 1);
     if (!strcmp(argv[1], "solve")) return cli_solve(argc - 1, argv + 1);
     if (!strcmp(argv[1], "study")) return cli_study(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "radiosity")) return cli_radiosity(argc - 1, argv + 1);
     fprintf(stderr, "ulam: unknown command '%s'\n%s", argv[1], usage);
     return EXIT_USAGE;
 }

@@ -1,0 +1,436 @@
+/* ulam radiosity: a patch scene's radiosity by walks that sample F by ray casting, checked
+ * against the LAPACK solve of the assembled system. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static const char *const usage =
+    "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot]\n"
+    "                      [--estimator collision|absorption] [--walks N] [--rel-err E] [--time S]\n"
+    "                      [--seed S] [--threads T] [--max-steps K] [--subdivide L] [--ff-rays K]\n"
+    "                      [--direct] [--check] [--matrix-walk] [--max-mem SIZE]\n"
+    "                      [--image out.png] [--size WxH] [--exposure X] [--json]\n"
+    "\n"
+    "Radiosity B = E + diag(rho) F B of a scene of diffuse patches (Wavefront OBJ + MTL: Kd is\n"
+    "the reflectance, Ke the emission), per RGB channel.\n"
+    "\n"
+    "  --patch K|LABEL   the patch to answer: 1-based number, or an o/g label (the label's patch\n"
+    "                    nearest its centre)\n"
+    "  --mode gather     walks from the patch that gather emission (default; needs --patch):\n"
+    "                    one patch without forming F\n"
+    "  --mode shoot      particles from the emitters, tallied on every patch (for --image)\n"
+    "  --estimator E     collision (score at every patch, default) or absorption (where it stops)\n"
+    "  --walks N, --rel-err E, --time S, --seed S, --threads T, --max-steps K: as in ulam solve\n"
+    "                    (--rel-err: every nonzero channel)\n"
+    "  --subdivide L     split faces into patches no longer than L on a side\n"
+    "  --ff-rays K       rays per patch when forming F (default 1000)\n"
+    "  --direct          form F by ray casting and solve M = diag(rho_c) F with LAPACKE_dgesv\n"
+    "  --check           with --patch: also the direct solve, and z = (walk - direct) / stderr\n"
+    "  --matrix-walk     walk on the assembled M (ulam solve's engine) instead of casting rays:\n"
+    "                    walks and LAPACK then share the very same F\n"
+    "  --max-mem SIZE    refuse a direct solve needing more (default 4G)\n"
+    "  --image out.png   render the shooting (or else direct) solution from the Cornell camera\n"
+    "  --size WxH        image size (default 512x512)\n"
+    "  --exposure X      radiosity scale before the sRGB curve (default: auto)\n"
+    "  --json            print one JSON object\n"
+    "\n"
+    "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
+
+static volatile int interrupted;
+
+/* SIGINT: the first asks the walks to stop, the second exits at once. */
+static void on_sigint(int sig)
+{
+    (void)sig;
+    if (interrupted) _exit(EXIT_INTERRUPTED);
+    interrupted = 1;
+}
+
+static const char *const mode_names[] = {"gather", "shoot"};
+static const char *const est_names[] = {"collision", "absorption"};
+static const char *const chan = "RGB";
+
+/* Everything the command was asked. */
+typedef struct {
+    const char *scene, *patch, *image;
+    double subdivide, exposure;
+    int64_t ff_rays;
+    int direct, check, matrix_walk, json, width, height;
+    size_t max_mem;
+    ulam_walk_opts o;
+} args;
+
+/* What the walks found. */
+typedef struct {
+    double B[3], se[3];
+    int64_t walks, steps;
+    double seconds;
+    int threads, interrupted;
+    double *all; /* shooting: 3 per patch */
+} walked;
+
+/* Index of word in names[0..n), or -1. */
+static int lookup(const char *word, const char *const *names, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (!strcmp(word, names[k])) return k;
+    return -1;
+}
+
+/* Parse the options into a; 0, or an exit code (with -1 meaning: --help printed). */
+static int parse(int argc, char **argv, args *a)
+{
+    static const struct option longopts[] = {
+        {"patch", required_argument, 0, 'p'},     {"mode", required_argument, 0, 'm'},
+        {"estimator", required_argument, 0, 'e'}, {"walks", required_argument, 0, 'n'},
+        {"rel-err", required_argument, 0, 'r'},   {"time", required_argument, 0, 't'},
+        {"seed", required_argument, 0, 's'},      {"threads", required_argument, 0, 'T'},
+        {"max-steps", required_argument, 0, 'K'}, {"subdivide", required_argument, 0, 'L'},
+        {"ff-rays", required_argument, 0, 'f'},   {"direct", no_argument, 0, 'd'},
+        {"check", no_argument, 0, 'c'},           {"matrix-walk", no_argument, 0, 'M'},
+        {"max-mem", required_argument, 0, 'x'},   {"image", required_argument, 0, 'i'},
+        {"size", required_argument, 0, 'z'},      {"exposure", required_argument, 0, 'X'},
+        {"json", no_argument, 0, 'J'},            {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
+    const char *cmd = "radiosity";
+    int64_t v;
+    int c, rc, any_rule = 0;
+    optind = 0;
+    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'p': a->patch = optarg; break;
+        case 'm':
+            if ((a->o.mode = lookup(optarg, mode_names, 2)) < 0)
+                return cli_usage_error(cmd, "--mode expects gather or shoot, got '%s'", optarg);
+            break;
+        case 'e':
+            if ((a->o.estimator = lookup(optarg, est_names, 2)) < 0)
+                return cli_usage_error(cmd, "--estimator expects collision or absorption, got '%s'", optarg);
+            break;
+        case 'n': if ((rc = cli_parse_int(cmd, "--walks", optarg, 1, INT64_MAX / 2, &a->o.max_walks))) return rc; any_rule = 1; break;
+        case 'r': if ((rc = cli_parse_real(cmd, "--rel-err", optarg, 1e-12, 1.0, &a->o.rel_err))) return rc; any_rule = 1; break;
+        case 't': if ((rc = cli_parse_real(cmd, "--time", optarg, 1e-6, 1e9, &a->o.max_seconds))) return rc; any_rule = 1; break;
+        case 's': if ((rc = cli_parse_int(cmd, "--seed", optarg, 0, INT64_MAX, &v))) return rc; a->o.seed = (uint64_t)v; break;
+        case 'T': if ((rc = cli_parse_int(cmd, "--threads", optarg, 1, 1024, &v))) return rc; a->o.threads = (int)v; break;
+        case 'K': if ((rc = cli_parse_int(cmd, "--max-steps", optarg, 1, INT64_MAX / 2, &a->o.max_steps))) return rc; break;
+        case 'L': if ((rc = cli_parse_real(cmd, "--subdivide", optarg, 1e-9, 1e300, &a->subdivide))) return rc; break;
+        case 'f': if ((rc = cli_parse_int(cmd, "--ff-rays", optarg, 1, INT32_MAX, &a->ff_rays))) return rc; break;
+        case 'd': a->direct = 1; break;
+        case 'c': a->check = 1; break;
+        case 'M': a->matrix_walk = 1; break;
+        case 'x': if ((rc = cli_parse_bytes(cmd, "--max-mem", optarg, &a->max_mem))) return rc; break;
+        case 'i': a->image = optarg; break;
+        case 'z':
+            if (sscanf(optarg, "%dx%d", &a->width, &a->height) != 2 || a->width < 1 || a->height < 1 ||
+                a->width > 16384 || a->height > 16384)
+                return cli_usage_error(cmd, "--size expects WxH from 1x1 to 16384x16384, got '%s'", optarg);
+            break;
+        case 'X': if ((rc = cli_parse_real(cmd, "--exposure", optarg, 1e-300, 1e300, &a->exposure))) return rc; break;
+        case 'J': a->json = 1; break;
+        case 'h': fputs(usage, stdout); return -1;
+        default: return cli_usage_error(cmd, "unknown option");
+        }
+    }
+    if (optind != argc - 1) return cli_usage_error(cmd, "expects exactly one scene file");
+    a->scene = argv[optind];
+    if (!a->patch && a->o.mode == ULAM_ADJOINT && !a->direct)
+        return cli_usage_error(cmd, "needs --patch K (gathering answers one patch), --mode shoot or --direct");
+    if (a->check && !a->patch) return cli_usage_error(cmd, "--check needs --patch K");
+    if (a->image && a->o.mode == ULAM_ADJOINT && !a->direct)
+        return cli_usage_error(cmd, "--image needs --mode shoot or --direct (gathering answers one patch)");
+    if (!any_rule) a->o.max_walks = 100000;
+    return 0;
+}
+
+/* The 0-based patch that --patch names; 0 or an exit code. */
+static int find_patch(const ulam_scene *s, const char *arg, int64_t *p)
+{
+    char *end;
+    long long k = strtoll(arg, &end, 10);
+    if (end != arg && !*end) {
+        if (k < 1 || k > s->npatches)
+            return cli_usage_error("radiosity", "--patch %s is out of range 1..%lld", arg, (long long)s->npatches);
+        *p = k - 1;
+        return 0;
+    }
+    if (ulam_scene_find(s, arg, p) == ULAM_OK) return 0;
+    fprintf(stderr, "ulam radiosity: --patch '%s' is neither a patch number nor a label; labels:", arg);
+    for (int64_t g = 0; g < s->ngroups; g++) fprintf(stderr, " %s", s->groups[g]);
+    fprintf(stderr, "\n");
+    return EXIT_USAGE;
+}
+
+/* Ray walks (gathering or shooting); 0 or an exit code. */
+static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
+{
+    ulam_rad_solver *sv = NULL;
+    ulam_error err;
+    int status = ulam_rad_solver_alloc(t, &a->o, &sv, &err);
+    if (status) return cli_report(a->scene, &err);
+    struct sigaction sa = {.sa_handler = on_sigint};
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    while (!status && !ulam_rad_solver_done(sv)) status = ulam_rad_solver_iterate(sv);
+    signal(SIGINT, SIG_DFL);
+    ulam_rad_result r;
+    ulam_rad_solver_result(sv, &r);
+    memcpy(w->B, r.radiosity, sizeof w->B);
+    memcpy(w->se, r.std_error, sizeof w->se);
+    w->walks = r.walks, w->steps = r.rays, w->seconds = r.seconds, w->threads = r.threads;
+    w->interrupted = r.interrupted;
+    if (!status && a->o.mode == ULAM_FORWARD) {
+        if (!(w->all = malloc((size_t)np * 3 * sizeof *w->all))) status = ULAM_ENOMEM;
+        else ulam_rad_solver_vectors(sv, w->all, NULL);
+    }
+    ulam_rad_solver_free(sv);
+    if (!status) return 0;
+    fprintf(stderr, "ulam: %s: error: %s\n", a->scene, ulam_strerror(status));
+    return cli_exit_code(status);
+}
+
+/* Walks on the assembled M, one channel at a time; 0 or an exit code. */
+static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, walked *w)
+{
+    int64_t n = s->npatches;
+    double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
+    if (a->o.mode == ULAM_FORWARD) w->all = malloc((size_t)n * 3 * sizeof *w->all);
+    int status = b && x && (a->o.mode == ULAM_ADJOINT || w->all) ? ULAM_OK : ULAM_ENOMEM;
+    ulam_error err = {.status = status};
+    struct sigaction sa = {.sa_handler = on_sigint};
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    for (int c = 0; c < 3 && !status && !interrupted; c++) {
+        ulam_csr *M = NULL;
+        ulam_solver *sv = NULL;
+        if ((status = ulam_radiosity_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
+            ulam_csr_free(M);
+            break;
+        }
+        while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
+        ulam_walk_result r;
+        ulam_solver_result(sv, &r);
+        w->B[c] = r.estimate, w->se[c] = r.std_error;
+        w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds;
+        w->threads = r.threads, w->interrupted |= r.interrupted;
+        if (!status && w->all) {
+            ulam_solver_vectors(sv, x, NULL);
+            for (int64_t i = 0; i < n; i++) w->all[3 * i + c] = x[i];
+        }
+        ulam_solver_free(sv);
+        ulam_csr_free(M);
+    }
+    signal(SIGINT, SIG_DFL);
+    free(b), free(x);
+    if (!status) return 0;
+    err.status = status;
+    return cli_report(a->scene, &err);
+}
+
+/* Print a JSON array of three numbers under key. */
+static void json_triple(const char *key, const double *v)
+{
+    printf("\"%s\": [", key);
+    for (int c = 0; c < 3; c++) {
+        cli_json_value(v[c]);
+        printf(c < 2 ? ", " : "], ");
+    }
+}
+
+/* What the run found, as text or JSON. */
+typedef struct {
+    const ulam_scene *s;
+    int64_t patch, faces;
+    const ulam_csr *F;
+    ulam_ff_report ff;
+    double ff_seconds, direct_seconds, exposure;
+    const double *Bdirect;
+    double direct_se[3]; /* at the patch, from the noise of F (ray walks with --check) */
+    const walked *w;
+} report;
+
+/* (walk - direct) / the combined standard error at the patch, channel c. */
+static double zscore(const report *r, int c)
+{
+    double d = r->Bdirect[3 * r->patch + c], sw = r->w->se[c], sf = r->direct_se[c];
+    return (r->w->B[c] - d) / sqrt(sw * sw + sf * sf);
+}
+
+/* Print the text report. */
+static void print_text(const args *a, const report *r)
+{
+    printf("scene        %s: %lld faces, %lld patches\n", a->scene, (long long)r->faces, (long long)r->s->npatches);
+    if (r->F)
+        printf("form factors %lld rays a patch, %.3f s: reciprocity error %.3g, row sums %.4f .. %.4f "
+               "(mean %.4f), %lld nonzeros\n", (long long)a->ff_rays, r->ff_seconds, r->ff.reciprocity,
+               r->ff.rowsum_min, r->ff.rowsum_max, r->ff.rowsum_mean, (long long)r->ff.nnz);
+    if (r->Bdirect) printf("direct       LAPACKE_dgesv, 3 channels, %.3f s\n", r->direct_seconds);
+    if (r->patch >= 0) {
+        int32_t g = r->s->group[r->patch];
+        printf("patch        %lld (%s, face %lld, area %.6g)\n", (long long)r->patch + 1,
+               g >= 0 ? r->s->groups[g] : "unlabelled", (long long)r->s->face[r->patch] + 1, r->s->area[r->patch]);
+    }
+    const walked *w = r->w;
+    if (w && r->patch >= 0) {
+        for (int c = 0; c < 3; c++)
+            printf("radiosity %c  %.8g +- %.3g%s\n", chan[c], w->B[c], w->se[c], w->interrupted ? "  [INTERRUPTED]" : "");
+    }
+    if (w)
+        printf("walks        %lld %s %s walks%s, %lld %s, %.4f s (%.3g M %s/s, %d threads)\n", (long long)w->walks,
+               a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], "", (long long)w->steps,
+               a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
+               a->matrix_walk ? "steps" : "rays", w->threads);
+    if (r->Bdirect && r->patch >= 0)
+        for (int c = 0; c < 3; c++) {
+            printf("direct %c     %.8g", chan[c], r->Bdirect[3 * r->patch + c]);
+            if (!a->matrix_walk) printf(" +- %.3g (form-factor noise)", r->direct_se[c]);
+            if (w) printf("  z = %.3f", zscore(r, c));
+            printf("\n");
+        }
+    if (a->image) printf("image        %s (exposure %.4g)\n", a->image, r->exposure);
+}
+
+/* Print the JSON object. */
+static void print_json(const args *a, const report *r)
+{
+    printf("{\"scene\": \"%s\", \"patches\": %lld, ", a->scene, (long long)r->s->npatches);
+    if (r->patch >= 0) {
+        int32_t g = r->s->group[r->patch];
+        printf("\"patch\": %lld, ", (long long)r->patch + 1);
+        cli_json_string("label", g >= 0 ? r->s->groups[g] : "", 0);
+    }
+    const walked *w = r->w;
+    if (w) {
+        if (r->patch >= 0) {
+            json_triple("radiosity", w->B);
+            json_triple("stderr", w->se);
+        }
+        cli_json_string("mode", mode_names[a->o.mode], 0);
+        cli_json_string("estimator", est_names[a->o.estimator], 0);
+        printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, ", a->matrix_walk ? "true" : "false",
+               (long long)w->walks, a->matrix_walk ? "steps" : "rays", (long long)w->steps);
+        cli_json_number("seconds", w->seconds, 0);
+        printf("\"interrupted\": %s, ", w->interrupted ? "true" : "false");
+    }
+    if (r->F) {
+        printf("\"ff_rays\": %lld, ", (long long)a->ff_rays);
+        cli_json_number("ff_seconds", r->ff_seconds, 0);
+        cli_json_number("reciprocity", r->ff.reciprocity, 0);
+        cli_json_number("rowsum_min", r->ff.rowsum_min, 0);
+        cli_json_number("rowsum_max", r->ff.rowsum_max, 0);
+    }
+    if (r->Bdirect && r->patch >= 0) {
+        double z[3];
+        for (int c = 0; c < 3; c++) z[c] = w ? zscore(r, c) : NAN;
+        json_triple("direct", r->Bdirect + 3 * r->patch);
+        json_triple("direct_stderr", r->direct_se);
+        if (w) json_triple("z", z);
+        cli_json_number("direct_seconds", r->direct_seconds, 0);
+    }
+    printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
+}
+
+/* Render B into a->image; 0 or an exit code. */
+static int write_image(const args *a, const ulam_tracer *t, const double *B, double *used)
+{
+    unsigned char *rgb = malloc((size_t)a->width * (size_t)a->height * 3);
+    ulam_camera cam = ulam_camera_cornell();
+    int status = rgb ? ulam_render(t, B, &cam, a->width, a->height, a->exposure, rgb, used) : ULAM_ENOMEM;
+    if (!status) status = ulam_png_write(a->image, a->width, a->height, rgb);
+    free(rgb);
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable PNG file"};
+    return cli_report(a->image, &err);
+}
+
+/* The scene, subdivided if asked; 0 or an exit code. */
+static int load_scene(const args *a, ulam_scene **out, int64_t *faces)
+{
+    ulam_error err;
+    ulam_scene *s = NULL;
+    if (ulam_scene_read_obj(a->scene, &s, &err)) return cli_report(a->scene, &err);
+    *faces = s->nfaces;
+    if (a->subdivide > 0) {
+        ulam_scene *d = NULL;
+        int status = ulam_scene_subdivide(s, a->subdivide, &d);
+        ulam_scene_free(s);
+        if (status) {
+            err = (ulam_error){.status = status, .msg = "a subdivision that fits in memory"};
+            return cli_report(a->scene, &err);
+        }
+        s = d;
+    }
+    *out = s;
+    return 0;
+}
+
+/* Form F and, if asked, solve directly; 0 or an exit code. */
+static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene *s, report *r, ulam_csr **F,
+                          double **Bd)
+{
+    ulam_error err;
+    double t0 = ulam_now();
+    if (ulam_form_factors(t, a->ff_rays, a->o.seed, a->o.threads, F, &err)) return cli_report(a->scene, &err);
+    r->ff_seconds = ulam_now() - t0;
+    ulam_form_factor_report(s, *F, &r->ff);
+    r->F = *F;
+    if (!a->direct && !a->check) return 0;
+    if (!(*Bd = malloc((size_t)s->npatches * 3 * sizeof **Bd))) {
+        err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the solution"};
+        return cli_report(a->scene, &err);
+    }
+    ulam_direct_info info;
+    if (ulam_radiosity_direct(s, *F, a->max_mem, *Bd, &info, &err)) return cli_report(a->scene, &err);
+    r->direct_seconds = info.seconds;
+    r->Bdirect = *Bd;
+    if (r->patch >= 0 && !a->matrix_walk &&
+        ulam_radiosity_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
+        return cli_report(a->scene, &err);
+    return 0;
+}
+
+/* ulam radiosity. */
+int cli_radiosity(int argc, char **argv)
+{
+    args a = {.ff_rays = 1000, .width = 512, .height = 512, .max_mem = (size_t)4 << 30, .o = ulam_walk_defaults()};
+    a.o.max_walks = 0;
+    a.o.interrupt = &interrupted;
+    int rc = parse(argc, argv, &a);
+    if (rc) return rc < 0 ? 0 : rc;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = NULL;
+    ulam_csr *F = NULL;
+    double *Bd = NULL;
+    walked w = {0};
+    report r = {.patch = -1, .w = NULL};
+    ulam_error err;
+    if ((rc = load_scene(&a, &s, &r.faces))) return rc;
+    r.s = s;
+    if (a.patch && (rc = find_patch(s, a.patch, &r.patch))) goto done;
+    a.o.index = r.patch >= 0 ? r.patch : 0;
+    if (ulam_tracer_alloc(s, &t, &err)) {
+        rc = cli_report(a.scene, &err);
+        goto done;
+    }
+    if ((a.direct || a.check || a.matrix_walk) && (rc = form_and_solve(&a, t, s, &r, &F, &Bd))) goto done;
+    if (a.patch || a.o.mode == ULAM_FORWARD) {
+        rc = a.matrix_walk ? matrix_walks(&a, s, F, &w) : ray_walks(&a, t, s->npatches, &w);
+        if (rc) goto done;
+        r.w = &w;
+    }
+    if (a.image && !w.interrupted && (rc = write_image(&a, t, w.all ? w.all : Bd, &r.exposure))) goto done;
+    if (a.json) print_json(&a, &r);
+    else print_text(&a, &r);
+    if (w.interrupted) rc = EXIT_INTERRUPTED;
+done:
+    free(w.all), free(Bd);
+    ulam_csr_free(F);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    return rc;
+}

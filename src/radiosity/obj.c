@@ -1,0 +1,453 @@
+/* Wavefront OBJ and MTL reader: planar convex faces with diffuse reflectance and emission.
+ * Every error names the file and line and says what was expected; nothing is read past it. */
+#include "rad.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A material: its name and the two colours ulam uses. */
+typedef struct {
+    char *name;
+    double kd[3], ke[3];
+} mtl;
+
+/* A face: where its vertex list starts, its material and group. */
+typedef struct {
+    int64_t start;
+    int32_t mat, group;
+} objface;
+
+/* Reader state: growable arrays of vertices, faces, materials and groups. */
+typedef struct {
+    double *v;
+    int64_t nv, cap_v;
+    int32_t *idx;
+    int64_t nidx, cap_idx;
+    objface *faces;
+    int64_t nf, cap_f;
+    mtl *mats;
+    int64_t nmats, cap_mats;
+    char **groups;
+    int64_t ngroups, cap_groups;
+    int32_t cur_mat, cur_group;
+    char *dir; /* the OBJ file's folder, with a trailing slash, or "" */
+    ulam_error *err;
+} objr;
+
+/* Make room for need items in *p (capacity *cap, item size sz); 0 or ULAM_ENOMEM. */
+static int grow(void **p, int64_t *cap, int64_t need, size_t sz)
+{
+    if (need <= *cap) return ULAM_OK;
+    int64_t c = *cap ? *cap : 16;
+    while (c < need) {
+        if (c > INT64_MAX / 2) return ULAM_ENOMEM;
+        c *= 2;
+    }
+    if ((uint64_t)c > SIZE_MAX / sz) return ULAM_ENOMEM;
+    void *q = realloc(*p, (size_t)c * sz);
+    if (!q) return ULAM_ENOMEM;
+    *p = q;
+    *cap = c;
+    return ULAM_OK;
+}
+
+/* A copy of the string s (NULL when out of memory). */
+static char *dup_str(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d) memcpy(d, s, n);
+    return d;
+}
+
+/* Free everything the reader holds. */
+static void objr_free(objr *o)
+{
+    for (int64_t i = 0; i < o->nmats; i++) free(o->mats[i].name);
+    for (int64_t i = 0; i < o->ngroups; i++) free(o->groups[i]);
+    free(o->v), free(o->idx), free(o->faces);
+    free(o->mats), free(o->groups), free(o->dir);
+}
+
+/* Strip a comment and trailing white space (including a CR) in place. */
+static void trim(char *line)
+{
+    char *hash = strchr(line, '#');
+    if (hash) *hash = '\0';
+    size_t n = strlen(line);
+    while (n && strchr(" \t\r\n\f\v", line[n - 1])) line[--n] = '\0';
+}
+
+/* The rest of the line after the keyword, leading blanks skipped. */
+static char *rest_of(char *s)
+{
+    while (*s == ' ' || *s == '\t') s++;
+    return s;
+}
+
+/* Parse up to max finite numbers from s into x; the count, or -1 on a token that is not a
+ * number, -2 on a non-finite one, -3 on more than max. */
+static int parse_numbers(char *s, double *x, int max)
+{
+    int k = 0;
+    char *tok, *save = NULL;
+    for (tok = strtok_r(s, " \t", &save); tok; tok = strtok_r(NULL, " \t", &save)) {
+        if (k == max) return -3;
+        char *end;
+        errno = 0;
+        double v = strtod(tok, &end);
+        if (end == tok || *end) return -1;
+        if (!isfinite(v)) return -2;
+        x[k++] = v;
+    }
+    return k;
+}
+
+/* The material called name, or -1. */
+static int64_t find_mat(const objr *o, const char *name)
+{
+    for (int64_t i = 0; i < o->nmats; i++)
+        if (!strcmp(o->mats[i].name, name)) return i;
+    return -1;
+}
+
+/* The group called name, or -1. */
+static int64_t find_group(const objr *o, const char *name)
+{
+    for (int64_t i = 0; i < o->ngroups; i++)
+        if (!strcmp(o->groups[i], name)) return i;
+    return -1;
+}
+
+/* Fail at line of an MTL file: like ulam__fail, naming the file. */
+static int mtl_fail(objr *o, const char *path, int status, long line, const char *fmt, const char *arg)
+{
+    ulam__fail(o->err, status, line, -1, fmt, arg);
+    if (o->err) snprintf(o->err->file, sizeof o->err->file, "%s", path);
+    return status;
+}
+
+/* Read one RGB statement (Kd or Ke) of an MTL file into c. */
+static int mtl_colour(objr *o, const char *path, long line, char *args, int is_kd, double c[3])
+{
+    const char *what = is_kd ? "Kd r g b: a reflectance in [0, 1) per channel"
+                             : "Ke r g b: a finite emission >= 0 per channel";
+    char *a = rest_of(args);
+    if (!strncmp(a, "spectral", 8) || !strncmp(a, "xyz", 3))
+        return mtl_fail(o, path, ULAM_EUNSUPPORTED, line, "%s (RGB only)", what);
+    int k = parse_numbers(a, c, 3);
+    if (k == -2) return mtl_fail(o, path, ULAM_ENONFINITE, line, "%s", what);
+    if (k != 1 && k != 3) return mtl_fail(o, path, ULAM_ESYNTAX, line, "%s (1 or 3 numbers)", what);
+    if (k == 1) c[1] = c[2] = c[0];
+    for (int i = 0; i < 3; i++)
+        if (c[i] < 0 || (is_kd && c[i] >= 1))
+            return mtl_fail(o, path, ULAM_ERANGE, line, "%s", what);
+    return ULAM_OK;
+}
+
+/* Read the MTL file name (relative to the OBJ's folder); obj_line is the mtllib line. */
+static int read_mtl(objr *o, const char *name, long obj_line)
+{
+    size_t len = strlen(o->dir) + strlen(name) + 1;
+    char *path = malloc(len);
+    if (!path) return ulam__fail(o->err, ULAM_ENOMEM, obj_line, -1, "memory for a file name");
+    snprintf(path, len, "%s%s", name[0] == '/' ? "" : o->dir, name);
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        int e = errno;
+        ulam__fail(o->err, ULAM_EIO, obj_line, -1, "a readable MTL file %s (%s)", path, strerror(e));
+        free(path);
+        return ULAM_EIO;
+    }
+    char *buf = NULL;
+    size_t cap = 0;
+    long line = 0;
+    int status = ULAM_OK;
+    mtl *cur = NULL;
+    while (!status && getline(&buf, &cap, f) != -1) {
+        line++;
+        trim(buf);
+        char *s = rest_of(buf);
+        if (!*s) continue;
+        char *sp = s + strcspn(s, " \t");
+        char *args = *sp ? (*sp = '\0', sp + 1) : sp;
+        if (!strcmp(s, "newmtl")) {
+            char *nm = rest_of(args);
+            if (!*nm) {
+                status = mtl_fail(o, path, ULAM_ESYNTAX, line, "%s", "newmtl NAME");
+                break;
+            }
+            int64_t i = find_mat(o, nm);
+            if (i < 0) {
+                if (grow((void **)&o->mats, &o->cap_mats, o->nmats + 1, sizeof(mtl)) ||
+                    !(o->mats[o->nmats].name = dup_str(nm))) {
+                    status = mtl_fail(o, path, ULAM_ENOMEM, line, "%s", "memory for a material");
+                    break;
+                }
+                i = o->nmats++;
+            }
+            cur = &o->mats[i];
+            memset(cur->kd, 0, sizeof cur->kd);
+            memset(cur->ke, 0, sizeof cur->ke);
+        } else if (!strcmp(s, "Kd") || !strcmp(s, "Ke")) {
+            if (!cur) {
+                status = mtl_fail(o, path, ULAM_ESYNTAX, line, "%s", "newmtl before the first colour");
+                break;
+            }
+            int kd = s[1] == 'd';
+            double c[3];
+            status = mtl_colour(o, path, line, args, kd, c);
+            if (!status) memcpy(kd ? cur->kd : cur->ke, c, sizeof c);
+        } /* every other MTL statement (Ka, Ks, Ns, d, illum, map_*, ...) is not ulam's business */
+    }
+    if (!status && ferror(f)) status = mtl_fail(o, path, ULAM_EIO, line, "%s", "a readable file");
+    free(buf);
+    fclose(f);
+    free(path);
+    return status;
+}
+
+/* mtllib: one or more MTL files. */
+static int do_mtllib(objr *o, char *args, long line)
+{
+    char *tok, *save = NULL;
+    int any = 0;
+    for (tok = strtok_r(args, " \t", &save); tok; tok = strtok_r(NULL, " \t", &save)) {
+        int status = read_mtl(o, tok, line);
+        if (status) return status;
+        any = 1;
+    }
+    return any ? ULAM_OK : ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "mtllib FILE.mtl");
+}
+
+/* o / g: the label of the faces that follow. */
+static int do_group(objr *o, char *args, long line)
+{
+    char *nm = rest_of(args);
+    if (!*nm) {
+        o->cur_group = -1;
+        return ULAM_OK;
+    }
+    int64_t i = find_group(o, nm);
+    if (i < 0) {
+        if (o->ngroups >= INT32_MAX || grow((void **)&o->groups, &o->cap_groups, o->ngroups + 1, sizeof(char *)) ||
+            !(o->groups[o->ngroups] = dup_str(nm)))
+            return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for a group name");
+        i = o->ngroups++;
+    }
+    o->cur_group = (int32_t)i;
+    return ULAM_OK;
+}
+
+/* usemtl NAME: the material of the faces that follow. */
+static int do_usemtl(objr *o, char *args, long line)
+{
+    char *nm = rest_of(args);
+    if (!*nm) return ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "usemtl NAME");
+    int64_t i = find_mat(o, nm);
+    if (i < 0)
+        return ulam__fail(o->err, ULAM_ENOTFOUND, line, -1,
+                          "a material defined by an earlier mtllib file; '%.100s' is not", nm);
+    o->cur_mat = (int32_t)i;
+    return ULAM_OK;
+}
+
+/* v x y z [w | r g b]. */
+static int do_vertex(objr *o, char *args, long line)
+{
+    double x[6];
+    int k = parse_numbers(args, x, 6);
+    if (k == -2) return ulam__fail(o->err, ULAM_ENONFINITE, line, -1, "finite vertex coordinates");
+    if (k != 3 && k != 4 && k != 6)
+        return ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "v x y z (three numbers, optionally w or r g b)");
+    if (o->nv >= INT32_MAX || grow((void **)&o->v, &o->cap_v, 3 * (o->nv + 1), sizeof(double)))
+        return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for the vertices");
+    memcpy(o->v + 3 * o->nv++, x, 3 * sizeof(double));
+    return ULAM_OK;
+}
+
+/* One face vertex token: v, v/t, v/t/n or v//n; the 0-based vertex or -1 (error set). */
+static int64_t face_index(objr *o, const char *tok, long line)
+{
+    char *end;
+    errno = 0;
+    long long i = strtoll(tok, &end, 10);
+    if (end == tok || (*end && *end != '/') || errno == ERANGE) {
+        ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "a face vertex v, v/t, v/t/n or v//n; got '%.40s'", tok);
+        return -1;
+    }
+    for (const char *c = end; *c; c++)
+        if (!strchr("0123456789-/", *c)) {
+            ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "a face vertex v, v/t, v/t/n or v//n; got '%.40s'", tok);
+            return -1;
+        }
+    long long k = i > 0 ? i - 1 : i < 0 ? o->nv + i : -1;
+    if (k < 0 || k >= o->nv) {
+        ulam__fail(o->err, ULAM_EINDEX, line, -1,
+                    "a vertex index from 1 to %lld or -1 to -%lld (vertices defined so far); got %lld",
+                    (long long)o->nv, (long long)o->nv, i);
+        return -1;
+    }
+    return k;
+}
+
+/* Check that face f's polygon is a proper planar convex polygon. */
+static int check_face(objr *o, const int32_t *idx, int64_t n, long line)
+{
+    double N[3], L;
+    for (int64_t a = 0; a < n; a++)
+        if (idx[a] == idx[(a + 1) % n])
+            return ulam__fail(o->err, ULAM_EGEOMETRY, line, -1, "distinct consecutive vertices (a degenerate face)");
+    ulam__polygon_normal(o->v, idx, n, N, &L);
+    double len = sqrt(ulam__dot3(N, N));
+    if (!(L > 0) || !(len > 1e-12 * L * L))
+        return ulam__fail(o->err, ULAM_EGEOMETRY, line, -1, "a face with nonzero area (this one is degenerate)");
+    double u[3] = {N[0] / len, N[1] / len, N[2] / len}, c[3] = {0, 0, 0};
+    for (int64_t a = 0; a < n; a++)
+        for (int d = 0; d < 3; d++) c[d] += o->v[3 * idx[a] + d] / (double)n;
+    double turn = 0.0;
+    for (int64_t a = 0; a < n; a++) {
+        double dv[3], e1[3], e2[3], x[3];
+        ulam__sub3(o->v + 3 * idx[a], c, dv);
+        if (fabs(ulam__dot3(dv, u)) > 1e-5 * L)
+            return ulam__fail(o->err, ULAM_EGEOMETRY, line, -1,
+                              "a planar face (vertex %lld is %.3g off its plane; split it into triangles)",
+                              (long long)a + 1, fabs(ulam__dot3(dv, u)));
+        ulam__sub3(o->v + 3 * idx[(a + 1) % n], o->v + 3 * idx[a], e1);
+        ulam__sub3(o->v + 3 * idx[(a + 2) % n], o->v + 3 * idx[(a + 1) % n], e2);
+        ulam__cross3(e1, e2, x);
+        double s = ulam__dot3(x, u);
+        if (s < -1e-9 * L * L)
+            return ulam__fail(o->err, ULAM_EGEOMETRY, line, -1, "a convex face (it turns back at vertex %lld)",
+                              (long long)(a + 1) % n + 1);
+        turn += atan2(s, ulam__dot3(e1, e2));
+    }
+    if (fabs(turn - 2 * M_PI) > 1e-6)
+        return ulam__fail(o->err, ULAM_EGEOMETRY, line, -1, "a simple convex face (this one winds around twice)");
+    return ULAM_OK;
+}
+
+/* f v1 v2 v3 ...: a face. */
+static int do_face(objr *o, char *args, long line)
+{
+    if (o->cur_mat < 0)
+        return ulam__fail(o->err, ULAM_ENOTFOUND, line, -1, "a usemtl line before the first face");
+    int64_t n0 = o->nidx;
+    char *tok, *save = NULL;
+    for (tok = strtok_r(args, " \t", &save); tok; tok = strtok_r(NULL, " \t", &save)) {
+        int64_t k = face_index(o, tok, line);
+        if (k < 0) return o->err ? o->err->status : ULAM_ESYNTAX;
+        if (grow((void **)&o->idx, &o->cap_idx, o->nidx + 1, sizeof(int32_t)))
+            return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for the faces");
+        o->idx[o->nidx++] = (int32_t)k;
+    }
+    int64_t n = o->nidx - n0;
+    if (n < 3) return ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "a face with at least 3 vertices");
+    int status = check_face(o, o->idx + n0, n, line);
+    if (status) return status;
+    if (grow((void **)&o->faces, &o->cap_f, o->nf + 1, sizeof(objface)))
+        return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for the faces");
+    o->faces[o->nf++] = (objface){.start = n0, .mat = o->cur_mat, .group = o->cur_group};
+    return ULAM_OK;
+}
+
+/* OBJ statements ulam reads past: texture and normal data, smoothing, lines, points and
+ * display attributes. */
+static int ignored(const char *kw)
+{
+    static const char *const skip[] = {"vt", "vn", "vp", "s", "l", "p", "mg", "lod", "usemap", "maplib",
+                                       "shadow_obj", "trace_obj", "bevel", "c_interp", "d_interp"};
+    for (size_t i = 0; i < sizeof skip / sizeof *skip; i++)
+        if (!strcmp(kw, skip[i])) return 1;
+    return 0;
+}
+
+/* Read the statements of an open OBJ file. */
+static int read_statements(objr *o, FILE *f)
+{
+    char *buf = NULL;
+    size_t cap = 0;
+    long line = 0;
+    ssize_t got;
+    int status = ULAM_OK;
+    while (!status && (got = getline(&buf, &cap, f)) != -1) {
+        line++;
+        if ((size_t)got != strlen(buf)) {
+            status = ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "text (this line holds a NUL byte)");
+            break;
+        }
+        trim(buf);
+        char *s = rest_of(buf);
+        if (!*s) continue;
+        char *sp = s + strcspn(s, " \t");
+        char *args = *sp ? (*sp = '\0', sp + 1) : sp;
+        if (!strcmp(s, "v")) status = do_vertex(o, args, line);
+        else if (!strcmp(s, "f")) status = do_face(o, args, line);
+        else if (!strcmp(s, "o") || !strcmp(s, "g")) status = do_group(o, args, line);
+        else if (!strcmp(s, "usemtl")) status = do_usemtl(o, args, line);
+        else if (!strcmp(s, "mtllib")) status = do_mtllib(o, args, line);
+        else if (!ignored(s))
+            status = ulam__fail(o->err, ULAM_ESYNTAX, line, -1,
+                                "an OBJ statement ulam reads (v, f, o, g, usemtl, mtllib; vt, vn, s, l ignored), "
+                                "not '%.40s'", s);
+    }
+    if (!status && ferror(f)) status = ulam__fail(o->err, ULAM_EIO, line, -1, "a readable file");
+    if (!status && o->nf == 0) status = ulam__fail(o->err, ULAM_EEMPTY, line, -1, "at least one face");
+    free(buf);
+    return status;
+}
+
+/* The scene: one patch per face. */
+static int build_scene(objr *o, ulam_scene **out)
+{
+    ulam_scene *s = ulam__scene_alloc(o->nf, o->nv, o->nidx, o->ngroups);
+    if (!s) return ULAM_ENOMEM;
+    memcpy(s->vert, o->v, (size_t)(3 * o->nv) * sizeof(double));
+    memcpy(s->vidx, o->idx, (size_t)o->nidx * sizeof(int32_t));
+    for (int64_t p = 0; p < o->nf; p++) {
+        const mtl *m = &o->mats[o->faces[p].mat];
+        s->start[p] = o->faces[p].start;
+        memcpy(s->rho + 3 * p, m->kd, sizeof m->kd);
+        memcpy(s->emit + 3 * p, m->ke, sizeof m->ke);
+        s->face[p] = p;
+        s->group[p] = o->faces[p].group;
+    }
+    s->start[o->nf] = o->nidx;
+    for (int64_t g = 0; g < o->ngroups; g++) {
+        s->groups[g] = o->groups[g];
+        o->groups[g] = NULL;
+    }
+    s->ngroups = o->ngroups;
+    s->nfaces = o->nf;
+    o->ngroups = 0;
+    ulam__scene_geometry(s);
+    *out = s;
+    return ULAM_OK;
+}
+
+/* Read an OBJ scene. */
+int ulam_scene_read_obj(const char *path, ulam_scene **out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!path || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path and an output");
+    *out = NULL;
+    objr o = {.cur_mat = -1, .cur_group = -1, .err = err};
+    const char *slash = strrchr(path, '/');
+    size_t dl = slash ? (size_t)(slash - path) + 1 : 0;
+    if (!(o.dir = malloc(dl + 1))) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a file name");
+    memcpy(o.dir, path, dl);
+    o.dir[dl] = '\0';
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        int e = errno;
+        objr_free(&o);
+        return ulam__fail(err, ULAM_EIO, 0, -1, "a readable OBJ file (%s)", strerror(e));
+    }
+    int status = read_statements(&o, f);
+    fclose(f);
+    if (!status && (status = build_scene(&o, out)))
+        ulam__fail(err, status, 0, -1, "memory for the scene");
+    objr_free(&o);
+    return status;
+}

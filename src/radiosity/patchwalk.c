@@ -1,0 +1,445 @@
+/* Patch walks: the radiosity equation B = E + diag(rho) F B solved by walks that sample F by
+ * casting rays, never forming it.
+ *
+ * Gathering (adjoint) estimates B_i: a walk starts at patch i with weight 1 per channel; at
+ * patch p it continues with probability q_p = max_c rho_pc, multiplying the weights by
+ * rho_pc / q_p, and moves to the patch its cosine-distributed ray reaches (probability F_pj);
+ * a ray that leaves the scene or hits a back side ends it.  Collision scores W E_p at every
+ * patch; absorption scores W E_p / (1 - q_p) where the walk stops by its coin.
+ *
+ * Shooting (forward) estimates every patch's power P = A B from P = A E + diag(rho) F' P (by
+ * reciprocity): a particle leaves an emitter chosen in proportion to its power with weight
+ * Phi E_c / sum_c E_c, continues with q_p, and its weights take rho_jc / q_p at the patch j
+ * it reaches.  Tallies per patch, then B_j = P_j / A_j.
+ *
+ * As in ulam_solve, block k of walks draws from the stream (seed, k) and blocks merge in
+ * index order: the result does not depend on the number of threads. */
+#include "rad.h"
+
+#include "../stats.h"
+
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+enum { RBLOCK = 256, RROUND = 32 };
+
+/* A shooting history's tally at one patch. */
+typedef struct {
+    int32_t patch;
+    double v[3];
+} rad_tally;
+
+/* What a block of walks produced. */
+typedef struct {
+    ulam__moments m[3]; /* gathering scores per channel */
+    double sq, maxsq;   /* sum and largest square of the channel-summed score (of the patch) */
+    rad_tally *t;       /* shooting tallies */
+    int64_t len, cap;
+    int64_t walks, rays, cut, nonfinite;
+    int complete, nomem;
+} rad_block;
+
+/* Per-thread scratch of a shooting history. */
+typedef struct {
+    double *hist; /* 3 per patch */
+    int32_t *touched;
+    unsigned char *mark;
+    int64_t ntouched;
+} rad_scratch;
+
+struct ulam_rad_solver {
+    ulam_walk_opts o;
+    const ulam_tracer *t;
+    const ulam_scene *s;
+    int threads;
+    double *q;            /* continuation per patch: max_c rho */
+    double *cdf, ptot;    /* shooting: cumulative power over emitters */
+    int64_t *emitter, nem;
+    rad_scratch *scratch;
+    rad_block *blocks;
+    ulam__moments m[3];
+    double *sum, *sumsq; /* shooting: per patch and channel, of history tallies */
+    double sq, maxsq;
+    int64_t walks, rays, cut, nonfinite, next_walk;
+    double seconds, t0;
+    int done, interrupted, status;
+};
+
+/* Free; accepts and returns NULL. */
+ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s)
+{
+    if (!s) return NULL;
+    if (s->scratch)
+        for (int k = 0; k < s->threads; k++)
+            free(s->scratch[k].hist), free(s->scratch[k].touched), free(s->scratch[k].mark);
+    if (s->blocks)
+        for (int k = 0; k < RROUND; k++) free(s->blocks[k].t);
+    free(s->q), free(s->cdf), free(s->emitter), free(s->scratch), free(s->blocks);
+    free(s->sum), free(s->sumsq);
+    free(s);
+    return NULL;
+}
+
+/* Check the options for a patch walk. */
+static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, ulam_error *err)
+{
+    if (o->mode != ULAM_ADJOINT && o->mode != ULAM_FORWARD)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "mode gathering (adjoint) or shooting (forward)");
+    if (o->estimator != ULAM_COLLISION && o->estimator != ULAM_ABSORPTION)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision or absorption");
+    if (o->index < 0 || o->index >= sc->npatches)
+        return ulam__fail(err, ULAM_EINVAL, 0, o->index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
+    if (o->continue_q != 0 || o->roulette != 0 || o->split != 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette or split (patch walks continue "
+                                                   "with the patch's largest reflectance)");
+    if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
+    if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a stopping rule: walks, rel_err or time");
+    return ULAM_OK;
+}
+
+/* The shooting source: emitters and their cumulative power (channel sums). */
+static int build_source(ulam_rad_solver *s, ulam_error *err)
+{
+    const ulam_scene *sc = s->s;
+    int64_t n = sc->npatches;
+    s->emitter = ulam__malloc((size_t)n, sizeof *s->emitter);
+    s->cdf = ulam__malloc((size_t)n, sizeof *s->cdf);
+    if (!s->emitter || !s->cdf) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the emitters");
+    for (int64_t p = 0; p < n; p++) {
+        const double *E = sc->emit + 3 * p;
+        double phi = sc->area[p] * (E[0] + E[1] + E[2]);
+        if (phi > 0) {
+            s->ptot += phi;
+            s->emitter[s->nem] = p;
+            s->cdf[s->nem++] = s->ptot;
+        }
+    }
+    if (s->nem == 0) return ulam__fail(err, ULAM_EUNDEFINED, 0, -1, "an emitting patch (Ke > 0) to shoot from");
+    return ULAM_OK;
+}
+
+/* Allocate per-thread scratch and per-block results. */
+static int alloc_work(ulam_rad_solver *s)
+{
+    int64_t n = s->s->npatches;
+    s->scratch = calloc((size_t)s->threads, sizeof *s->scratch);
+    s->blocks = calloc(RROUND, sizeof *s->blocks);
+    s->q = ulam__malloc((size_t)n, sizeof *s->q);
+    if (!s->scratch || !s->blocks || !s->q) return ULAM_ENOMEM;
+    for (int64_t p = 0; p < n; p++) s->q[p] = ulam__max3(s->s->rho + 3 * p);
+    if (s->o.mode == ULAM_ADJOINT) return ULAM_OK;
+    for (int k = 0; k < s->threads; k++) {
+        rad_scratch *sc = &s->scratch[k];
+        sc->hist = ulam__calloc((size_t)(3 * n), sizeof *sc->hist);
+        sc->touched = ulam__malloc((size_t)n, sizeof *sc->touched);
+        sc->mark = ulam__calloc((size_t)n, 1);
+        if (!sc->hist || !sc->touched || !sc->mark) return ULAM_ENOMEM;
+    }
+    s->sum = ulam__calloc((size_t)(3 * n), sizeof *s->sum);
+    s->sumsq = ulam__calloc((size_t)(3 * n), sizeof *s->sumsq);
+    return s->sum && s->sumsq ? ULAM_OK : ULAM_ENOMEM;
+}
+
+/* Prepare patch walks. */
+int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
+                          ulam_error *err)
+{
+    ulam__clear(err);
+    if (!t || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer and an output");
+    *out = NULL;
+    ulam_walk_opts o = opts ? *opts : ulam_walk_defaults();
+    int status = check_opts(ulam__tracer_scene(t), &o, err);
+    if (status) return status;
+    ulam_rad_solver *s = calloc(1, sizeof *s);
+    if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
+    s->o = o;
+    s->t = t;
+    s->s = ulam__tracer_scene(t);
+#ifdef _OPENMP
+    s->threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+#else
+    s->threads = 1;
+#endif
+    s->t0 = -1;
+    if (o.mode == ULAM_FORWARD && (status = build_source(s, err))) {
+        ulam_rad_solver_free(s);
+        return status;
+    }
+    if (alloc_work(s)) {
+        ulam_rad_solver_free(s);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walk workspace");
+    }
+    *out = s;
+    return ULAM_OK;
+}
+
+/* One gathering walk from the patch: its RGB score. */
+static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_block *br)
+{
+    const ulam_scene *sc = s->s;
+    int absorb = s->o.estimator == ULAM_ABSORPTION;
+    int64_t p = s->o.index;
+    double W[3] = {1, 1, 1};
+    score[0] = score[1] = score[2] = 0.0;
+    for (int64_t step = 0;; step++) {
+        const double *E = sc->emit + 3 * p, q = s->q[p];
+        if (!absorb)
+            for (int c = 0; c < 3; c++) score[c] += W[c] * E[c];
+        if (ulam__rng_uniform(r) >= q) { /* stops here */
+            if (absorb)
+                for (int c = 0; c < 3; c++) score[c] += W[c] * E[c] / (1.0 - q);
+            return;
+        }
+        if (step >= s->o.max_steps) {
+            br->cut++;
+            return;
+        }
+        for (int c = 0; c < 3; c++) W[c] *= sc->rho[3 * p + c] / q;
+        int64_t j = ulam_tracer_shoot(s->t, p, r);
+        br->rays++;
+        if (j < 0) return;
+        p = j;
+    }
+}
+
+/* Add w to the history tally of patch p. */
+static void tally(rad_scratch *sc, int64_t p, const double w[3], double scale)
+{
+    if (!sc->mark[p]) sc->mark[p] = 1, sc->touched[sc->ntouched++] = (int32_t)p;
+    for (int c = 0; c < 3; c++) sc->hist[3 * p + c] += w[c] * scale;
+}
+
+/* One shooting history: tallies in sc. */
+static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_block *br)
+{
+    const ulam_scene *scn = s->s;
+    int absorb = s->o.estimator == ULAM_ABSORPTION;
+    double u = ulam__rng_uniform(r) * s->ptot;
+    int64_t lo = 0, hi = s->nem - 1;
+    while (lo < hi) { /* the first emitter whose cumulative power exceeds u */
+        int64_t mid = lo + (hi - lo) / 2;
+        if (s->cdf[mid] > u) hi = mid;
+        else lo = mid + 1;
+    }
+    int64_t p = s->emitter[lo];
+    const double *E0 = scn->emit + 3 * p;
+    double W[3], esum = E0[0] + E0[1] + E0[2];
+    for (int c = 0; c < 3; c++) W[c] = s->ptot * E0[c] / esum;
+    for (int64_t step = 0;; step++) {
+        double q = s->q[p];
+        if (!absorb) tally(sc, p, W, 1.0);
+        if (ulam__rng_uniform(r) >= q) {
+            if (absorb) tally(sc, p, W, 1.0 / (1.0 - q));
+            return;
+        }
+        if (step >= s->o.max_steps) {
+            br->cut++;
+            return;
+        }
+        int64_t j = ulam_tracer_shoot(s->t, p, r);
+        br->rays++;
+        if (j < 0) return;
+        for (int c = 0; c < 3; c++) W[c] *= scn->rho[3 * j + c] / q;
+        p = j;
+    }
+}
+
+/* Move a finished shooting history's tallies into the block; 0 or ULAM_ENOMEM. */
+static int flush_history(rad_scratch *sc, rad_block *br)
+{
+    if (br->len + sc->ntouched > br->cap) {
+        int64_t cap = br->cap ? br->cap : 1024;
+        while (cap < br->len + sc->ntouched) cap *= 2;
+        rad_tally *t = realloc(br->t, (size_t)cap * sizeof *t);
+        if (!t) return ULAM_ENOMEM;
+        br->t = t, br->cap = cap;
+    }
+    for (int64_t k = 0; k < sc->ntouched; k++) {
+        int32_t p = sc->touched[k];
+        rad_tally *e = &br->t[br->len++];
+        e->patch = p;
+        for (int c = 0; c < 3; c++) {
+            e->v[c] = sc->hist[3 * p + c];
+            if (!isfinite(e->v[c])) br->nonfinite++;
+            sc->hist[3 * p + c] = 0.0;
+        }
+        sc->mark[p] = 0;
+    }
+    sc->ntouched = 0;
+    return ULAM_OK;
+}
+
+/* Nonzero when the run must stop before starting another block. */
+static int must_stop(const ulam_rad_solver *s)
+{
+    if (s->o.interrupt && *s->o.interrupt) return 1;
+    return s->o.max_seconds > 0 && ulam_now() - s->t0 >= s->o.max_seconds;
+}
+
+/* Run walks [first, first + count) as block k on thread th. */
+static void run_block(const ulam_rad_solver *s, rad_block *br, int64_t first, int64_t count, int th)
+{
+    ulam__moments zero = {0};
+    br->m[0] = br->m[1] = br->m[2] = zero;
+    br->sq = br->maxsq = 0.0;
+    br->len = br->walks = br->rays = br->cut = br->nonfinite = 0;
+    br->complete = br->nomem = 0;
+    if (first > 0 ? must_stop(s) : s->o.interrupt && *s->o.interrupt) return; /* block 0 always runs */
+    ulam_rng r;
+    ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / RBLOCK));
+    for (int64_t w = 0; w < count; w++) {
+        if (s->o.mode == ULAM_ADJOINT) {
+            double sc[3];
+            gather(s, &r, sc, br);
+            for (int c = 0; c < 3; c++) {
+                ulam__moments_add(&br->m[c], sc[c]);
+                if (!isfinite(sc[c])) br->nonfinite++;
+            }
+            double x = sc[0] + sc[1] + sc[2];
+            br->sq += x * x;
+            br->maxsq = fmax(br->maxsq, x * x);
+        } else {
+            shoot(s, &r, &s->scratch[th], br);
+            if (flush_history(&s->scratch[th], br)) {
+                br->nomem = 1;
+                return;
+            }
+        }
+        br->walks++;
+    }
+    br->complete = 1;
+}
+
+/* Merge a completed block into the totals. */
+static void merge_block(ulam_rad_solver *s, const rad_block *br)
+{
+    for (int c = 0; c < 3; c++) ulam__moments_merge(&s->m[c], &br->m[c]);
+    s->sq += br->sq;
+    s->maxsq = fmax(s->maxsq, br->maxsq);
+    for (int64_t k = 0; k < br->len; k++) {
+        const rad_tally *e = &br->t[k];
+        for (int c = 0; c < 3; c++) {
+            s->sum[3 * e->patch + c] += e->v[c];
+            s->sumsq[3 * e->patch + c] += e->v[c] * e->v[c];
+        }
+        if (e->patch == s->o.index) {
+            double x = e->v[0] + e->v[1] + e->v[2];
+            s->sq += x * x;
+            s->maxsq = fmax(s->maxsq, x * x);
+        }
+    }
+    s->walks += br->walks;
+    s->rays += br->rays;
+    s->cut += br->cut;
+    s->nonfinite += br->nonfinite;
+}
+
+/* Nonzero when every nonzero channel has stderr <= rel_err |estimate| (and one is nonzero). */
+static int precise_enough(const ulam_rad_result *r, double rel_err)
+{
+    int any = 0;
+    for (int c = 0; c < 3; c++) {
+        if (r->radiosity[c] == 0.0) continue;
+        if (!(r->std_error[c] <= rel_err * fabs(r->radiosity[c]))) return 0;
+        any = 1;
+    }
+    return any;
+}
+
+/* Run one round of walks. */
+int ulam_rad_solver_iterate(ulam_rad_solver *s)
+{
+    if (!s) return ULAM_EINVAL;
+    if (s->done) return s->status;
+    double start = ulam_now();
+    if (s->t0 < 0) s->t0 = start;
+    int64_t left = s->o.max_walks > 0 ? s->o.max_walks - s->next_walk : INT64_MAX;
+    int nb = 0;
+    while (nb < RROUND && left > (int64_t)nb * RBLOCK) nb++;
+    int64_t first = s->next_walk;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(s->threads)
+    for (int k = 0; k < nb; k++) {
+        int th = 0;
+#ifdef _OPENMP
+        th = omp_get_thread_num();
+#endif
+        int64_t rest = left - (int64_t)k * RBLOCK;
+        run_block(s, &s->blocks[k], first + (int64_t)k * RBLOCK, rest < RBLOCK ? rest : RBLOCK, th);
+    }
+    for (int k = 0; k < nb; k++) {
+        if (s->blocks[k].nomem) s->status = ULAM_ENOMEM;
+        if (!s->blocks[k].complete) {
+            s->done = 1;
+            break;
+        }
+        merge_block(s, &s->blocks[k]);
+        s->next_walk += s->blocks[k].walks;
+    }
+    s->seconds += ulam_now() - start;
+    if (s->o.interrupt && *s->o.interrupt) s->interrupted = s->done = 1;
+    if (s->nonfinite && !s->status) s->status = ULAM_ENONFINITE;
+    if (s->status) s->done = 1;
+    ulam_rad_result r;
+    ulam_rad_solver_result(s, &r);
+    if (s->o.max_walks > 0 && s->next_walk >= s->o.max_walks) s->done = 1;
+    if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(&r, s->o.rel_err)) s->done = 1;
+    if (s->o.max_seconds > 0 && ulam_now() - s->t0 >= s->o.max_seconds) s->done = 1;
+    return s->status;
+}
+
+/* Nonzero once a stopping rule is met. */
+int ulam_rad_solver_done(const ulam_rad_solver *s)
+{
+    return !s || s->done;
+}
+
+/* Shooting estimate and standard error of patch p's radiosity in channel c. */
+static void shot_component(const ulam_rad_solver *s, int64_t p, int c, double *est, double *se)
+{
+    double N = (double)s->walks, A = s->s->area[p];
+    double mean = N > 0 ? s->sum[3 * p + c] / N : 0.0;
+    double v = N > 1 ? fmax(0.0, (s->sumsq[3 * p + c] - N * mean * mean) / (N - 1)) : 0.0;
+    *est = mean / A;
+    *se = N > 0 ? sqrt(v / N) / A : INFINITY;
+}
+
+/* The result so far. */
+void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
+{
+    memset(r, 0, sizeof *r);
+    if (!s) return;
+    for (int c = 0; c < 3; c++) {
+        if (s->o.mode == ULAM_ADJOINT) {
+            r->radiosity[c] = s->m[c].mean;
+            r->std_error[c] = s->m[c].n > 0 ? sqrt(ulam__moments_variance(&s->m[c]) / (double)s->m[c].n) : INFINITY;
+        } else {
+            shot_component(s, s->o.index, c, &r->radiosity[c], &r->std_error[c]);
+        }
+    }
+    r->max_share = s->sq > 0 ? fmin(1.0, s->maxsq / s->sq) : 0.0;
+    r->walks = s->walks;
+    r->rays = s->rays;
+    r->cut = s->cut;
+    r->seconds = s->seconds;
+    r->threads = s->threads;
+    r->interrupted = s->interrupted;
+}
+
+/* Shooting: every patch. */
+int ulam_rad_solver_vectors(const ulam_rad_solver *s, double *B, double *std_error)
+{
+    if (!s || s->o.mode != ULAM_FORWARD) return ULAM_EINVAL;
+    for (int64_t p = 0; p < s->s->npatches; p++)
+        for (int c = 0; c < 3; c++) {
+            double e, se;
+            shot_component(s, p, c, &e, &se);
+            if (B) B[3 * p + c] = e;
+            if (std_error) std_error[3 * p + c] = se;
+        }
+    return ULAM_OK;
+}

@@ -1,0 +1,50 @@
+/* Radiosity internals shared by scene, rays, form factors, patch walks and images. */
+#ifndef ULAM_RAD_H
+#define ULAM_RAD_H
+
+#include "../internal.h"
+
+#include <math.h>
+
+/* a - b, a x b, a . b for 3-vectors. */
+static inline void ulam__sub3(const double *a, const double *b, double *o)
+{
+    o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2];
+}
+static inline void ulam__cross3(const double *a, const double *b, double *o)
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+static inline double ulam__dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* The largest channel of an RGB triple. */
+static inline double ulam__max3(const double *v)
+{
+    return fmax(v[0], fmax(v[1], v[2]));
+}
+
+/* Newell's normal of polygon v[idx[0..n)] (length = twice the area) and its longest edge. */
+void ulam__polygon_normal(const double *vert, const int32_t *idx, int64_t n, double normal[3],
+                          double *longest);
+
+/* Area, unit normal of every patch (after the vertex lists are set). */
+void ulam__scene_geometry(ulam_scene *s);
+
+/* A uniform point of patch p (area-weighted fan triangle, then uniform in it). */
+void ulam__patch_point(const ulam_scene *s, int64_t p, ulam_rng *r, double pt[3]);
+
+/* A cosine-distributed unit direction about unit normal n. */
+void ulam__cosine_dir(const double n[3], ulam_rng *r, double d[3]);
+
+/* The scene a tracer was built on. */
+const ulam_scene *ulam__tracer_scene(const ulam_tracer *t);
+
+/* Allocate an empty scene with room for the given counts (arrays uninitialised). */
+ulam_scene *ulam__scene_alloc(int64_t npatches, int64_t nverts, int64_t nidx, int64_t ngroups);
+
+#endif

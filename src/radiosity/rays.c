@@ -1,0 +1,137 @@
+/* Ray casting with Embree 3: one triangle geometry (each patch a fan of triangles), the patch
+ * from the hit primitive, and an origin offset along the normal so a ray never hits the
+ * patch it leaves. */
+#include "rad.h"
+
+#include <embree3/rtcore.h>
+#include <stdlib.h>
+
+struct ulam_tracer {
+    const ulam_scene *s;
+    RTCDevice dev;
+    RTCScene scene;
+    int64_t *prim_patch; /* triangle -> patch */
+    double eps;          /* origin offset: 1e-5 of the scene's diagonal */
+};
+
+/* Free a tracer; accepts and returns NULL. */
+ulam_tracer *ulam_tracer_free(ulam_tracer *t)
+{
+    if (!t) return NULL;
+    if (t->scene) rtcReleaseScene(t->scene);
+    if (t->dev) rtcReleaseDevice(t->dev);
+    free(t->prim_patch);
+    free(t);
+    return NULL;
+}
+
+/* The scene a tracer was built on. */
+const ulam_scene *ulam__tracer_scene(const ulam_tracer *t)
+{
+    return t->s;
+}
+
+/* Fill Embree's vertex and index buffers with the patches' fan triangles. */
+static void fill_buffers(ulam_tracer *t, float *vb, unsigned *ib)
+{
+    const ulam_scene *s = t->s;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int64_t v = 0; v < s->nverts; v++)
+        for (int d = 0; d < 3; d++) {
+            vb[3 * v + d] = (float)s->vert[3 * v + d];
+            lo[d] = fmin(lo[d], s->vert[3 * v + d]);
+            hi[d] = fmax(hi[d], s->vert[3 * v + d]);
+        }
+    int64_t tri = 0;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        const int32_t *v = s->vidx + s->start[p];
+        for (int64_t k = 1; k + 1 < s->start[p + 1] - s->start[p]; k++, tri++) {
+            ib[3 * tri] = (unsigned)v[0], ib[3 * tri + 1] = (unsigned)v[k], ib[3 * tri + 2] = (unsigned)v[k + 1];
+            t->prim_patch[tri] = p;
+        }
+    }
+    double e[3];
+    ulam__sub3(hi, lo, e);
+    t->eps = 1e-5 * sqrt(ulam__dot3(e, e));
+}
+
+/* Build the ray-casting structure for s. */
+int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s || !out || s->npatches < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a scene with patches");
+    *out = NULL;
+    int64_t ntri = s->start[s->npatches] - 2 * s->npatches;
+    if (ntri < 1 || ntri > (int64_t)UINT32_MAX / 4 || s->nverts > (int64_t)UINT32_MAX / 4)
+        return ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "fewer than 2^30 triangles and vertices");
+    ulam_tracer *t = calloc(1, sizeof *t);
+    if (!t || !(t->prim_patch = ulam__malloc((size_t)ntri, sizeof *t->prim_patch))) {
+        ulam_tracer_free(t);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the ray tracer");
+    }
+    t->s = s;
+    if (!(t->dev = rtcNewDevice(NULL))) {
+        ulam_tracer_free(t);
+        return ulam__fail(err, ULAM_EDEVICE, 0, -1, "an Embree device (rtcNewDevice failed)");
+    }
+    t->scene = rtcNewScene(t->dev);
+    RTCGeometry g = rtcNewGeometry(t->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *vb = t->scene && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        3 * sizeof(float), (size_t)s->nverts) : NULL;
+    unsigned *ib = vb ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                3 * sizeof(unsigned), (size_t)ntri) : NULL;
+    if (!ib) {
+        if (g) rtcReleaseGeometry(g);
+        ulam_tracer_free(t);
+        return ulam__fail(err, ULAM_EDEVICE, 0, -1, "Embree buffers for %lld triangles", (long long)ntri);
+    }
+    fill_buffers(t, vb, ib);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(t->scene, g);
+    rtcReleaseGeometry(g);
+    rtcSetSceneFlags(t->scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(t->scene, RTC_BUILD_QUALITY_HIGH);
+    rtcCommitScene(t->scene);
+    if (rtcGetDeviceError(t->dev) != RTC_ERROR_NONE) {
+        ulam_tracer_free(t);
+        return ulam__fail(err, ULAM_EDEVICE, 0, -1, "an Embree scene (building it failed)");
+    }
+    *out = t;
+    return ULAM_OK;
+}
+
+/* The first patch the ray hits, or -1. */
+int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3], int *front)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    rh.ray.org_x = (float)org[0], rh.ray.org_y = (float)org[1], rh.ray.org_z = (float)org[2];
+    rh.ray.dir_x = (float)dir[0], rh.ray.dir_y = (float)dir[1], rh.ray.dir_z = (float)dir[2];
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = INFINITY;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = ~0u;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(t->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
+    int64_t p = t->prim_patch[rh.hit.primID];
+    if (front) *front = ulam__dot3(dir, t->s->normal + 3 * p) < 0;
+    return p;
+}
+
+/* A cosine-distributed ray from a uniform point of patch p: the patch reached, front side. */
+int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r)
+{
+    const double *n = t->s->normal + 3 * p;
+    double o[3], d[3];
+    ulam__patch_point(t->s, p, r, o);
+    for (int k = 0; k < 3; k++) o[k] += t->eps * n[k];
+    ulam__cosine_dir(n, r, d);
+    int front = 0;
+    int64_t j = ulam_tracer_cast(t, o, d, &front);
+    return j >= 0 && front ? j : -1;
+}

@@ -1,0 +1,321 @@
+/* Scenes of patches: allocation, geometry, subdivision, labels, sampling points and directions. */
+#include "rad.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Allocate an empty scene with room for the given counts. */
+ulam_scene *ulam__scene_alloc(int64_t np, int64_t nv, int64_t nidx, int64_t ngroups)
+{
+    ulam_scene *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    s->npatches = np;
+    s->nverts = nv;
+    s->vert = ulam__malloc((size_t)(3 * nv), sizeof(double));
+    s->start = ulam__malloc((size_t)(np + 1), sizeof(int64_t));
+    s->vidx = ulam__malloc((size_t)nidx, sizeof(int32_t));
+    s->normal = ulam__malloc((size_t)(3 * np), sizeof(double));
+    s->area = ulam__malloc((size_t)np, sizeof(double));
+    s->rho = ulam__malloc((size_t)(3 * np), sizeof(double));
+    s->emit = ulam__malloc((size_t)(3 * np), sizeof(double));
+    s->face = ulam__malloc((size_t)np, sizeof(int64_t));
+    s->group = ulam__malloc((size_t)np, sizeof(int32_t));
+    s->groups = ulam__calloc((size_t)ngroups, sizeof(char *));
+    if (!s->vert || !s->start || !s->vidx || !s->normal || !s->area || !s->rho || !s->emit ||
+        !s->face || !s->group || !s->groups)
+        return ulam_scene_free(s);
+    return s;
+}
+
+/* Free a scene; accepts and returns NULL. */
+ulam_scene *ulam_scene_free(ulam_scene *s)
+{
+    if (!s) return NULL;
+    if (s->groups)
+        for (int64_t g = 0; g < s->ngroups; g++) free(s->groups[g]);
+    free(s->vert), free(s->start), free(s->vidx), free(s->normal), free(s->area);
+    free(s->rho), free(s->emit), free(s->face), free(s->group), free(s->groups);
+    free(s);
+    return NULL;
+}
+
+/* Newell's normal (twice the area in length) and the longest edge of a polygon. */
+void ulam__polygon_normal(const double *vert, const int32_t *idx, int64_t n, double N[3], double *longest)
+{
+    N[0] = N[1] = N[2] = 0.0;
+    *longest = 0.0;
+    for (int64_t a = 0; a < n; a++) {
+        const double *p = vert + 3 * idx[a], *q = vert + 3 * idx[(a + 1) % n];
+        N[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        N[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        N[2] += (p[0] - q[0]) * (p[1] + q[1]);
+        double e[3];
+        ulam__sub3(q, p, e);
+        *longest = fmax(*longest, sqrt(ulam__dot3(e, e)));
+    }
+}
+
+/* Area and unit normal of every patch. */
+void ulam__scene_geometry(ulam_scene *s)
+{
+    for (int64_t p = 0; p < s->npatches; p++) {
+        double N[3], L;
+        ulam__polygon_normal(s->vert, s->vidx + s->start[p], s->start[p + 1] - s->start[p], N, &L);
+        double len = sqrt(ulam__dot3(N, N));
+        s->area[p] = 0.5 * len;
+        for (int d = 0; d < 3; d++) s->normal[3 * p + d] = len > 0 ? N[d] / len : 0.0;
+    }
+}
+
+/* Total emitted power per channel. */
+void ulam_scene_power(const ulam_scene *s, double power[3])
+{
+    power[0] = power[1] = power[2] = 0.0;
+    for (int64_t p = 0; p < s->npatches; p++)
+        for (int c = 0; c < 3; c++) power[c] += s->area[p] * s->emit[3 * p + c];
+}
+
+/* A patch being built by subdivision: its vertices are appended to the output scene. */
+typedef struct {
+    ulam_scene *o;
+    int64_t np, nv, nidx; /* used so far */
+    int64_t src;          /* the patch being split */
+} builder;
+
+/* Append vertex x to the builder's scene; its index. */
+static int32_t add_vertex(builder *b, const double x[3])
+{
+    memcpy(b->o->vert + 3 * b->nv, x, 3 * sizeof(double));
+    return (int32_t)b->nv++;
+}
+
+/* Append a patch with vertices v[0..n) (already added) copying the source's attributes. */
+static void add_patch(builder *b, const ulam_scene *s, const int32_t *v, int n)
+{
+    ulam_scene *o = b->o;
+    o->start[b->np] = b->nidx;
+    for (int k = 0; k < n; k++) o->vidx[b->nidx++] = v[k];
+    memcpy(o->rho + 3 * b->np, s->rho + 3 * b->src, 3 * sizeof(double));
+    memcpy(o->emit + 3 * b->np, s->emit + 3 * b->src, 3 * sizeof(double));
+    o->face[b->np] = s->face[b->src];
+    o->group[b->np] = s->group[b->src];
+    b->np++;
+    o->start[b->np] = b->nidx;
+}
+
+/* Divisions of an edge pair so no piece exceeds L. */
+static int64_t divisions(const double *a, const double *b, const double *c, const double *d, double L)
+{
+    double e1[3], e2[3];
+    ulam__sub3(b, a, e1);
+    ulam__sub3(d, c, e2);
+    double len = fmax(sqrt(ulam__dot3(e1, e1)), sqrt(ulam__dot3(e2, e2)));
+    double m = ceil(len / L);
+    return m < 1 ? 1 : (int64_t)m;
+}
+
+/* Pieces a patch splits into: m*k quads, m^2 triangles, or a fan's triangles split. */
+static int64_t pieces(const ulam_scene *s, int64_t p, double L, int64_t *m, int64_t *k)
+{
+    const int32_t *v = s->vidx + s->start[p];
+    int64_t n = s->start[p + 1] - s->start[p];
+    const double *x = s->vert;
+    if (n == 4) {
+        *m = divisions(x + 3 * v[0], x + 3 * v[1], x + 3 * v[3], x + 3 * v[2], L);
+        *k = divisions(x + 3 * v[0], x + 3 * v[3], x + 3 * v[1], x + 3 * v[2], L);
+        return *m * *k;
+    }
+    int64_t total = 0;
+    for (int64_t t = 1; t + 1 < n; t++) {
+        const double *a = x + 3 * v[0], *b = x + 3 * v[t], *c = x + 3 * v[t + 1];
+        int64_t d = divisions(a, b, b, c, L), d2 = divisions(c, a, a, b, L);
+        d = d > d2 ? d : d2;
+        if (n == 3) *m = d;
+        total += d * d;
+    }
+    if (n > 4) {
+        double N[3], longest;
+        ulam__polygon_normal(x, v, n, N, &longest);
+        if (longest <= L) total = 1; /* small enough: kept whole */
+    }
+    return total;
+}
+
+/* Split quad v into an m x k bilinear grid. */
+static void split_quad(builder *b, const ulam_scene *s, const int32_t *v, int64_t m, int64_t k)
+{
+    const double *P[4];
+    for (int i = 0; i < 4; i++) P[i] = s->vert + 3 * v[i];
+    int32_t first = (int32_t)b->nv;
+    for (int64_t j = 0; j <= k; j++)
+        for (int64_t i = 0; i <= m; i++) {
+            double u = (double)i / (double)m, w = (double)j / (double)k, x[3];
+            for (int d = 0; d < 3; d++)
+                x[d] = (1 - u) * (1 - w) * P[0][d] + u * (1 - w) * P[1][d] + u * w * P[2][d] + (1 - u) * w * P[3][d];
+            add_vertex(b, x);
+        }
+    for (int64_t j = 0; j < k; j++)
+        for (int64_t i = 0; i < m; i++) {
+            int32_t a = first + (int32_t)(j * (m + 1) + i);
+            int32_t q[4] = {a, a + 1, a + 1 + (int32_t)(m + 1), a + (int32_t)(m + 1)};
+            add_patch(b, s, q, 4);
+        }
+}
+
+/* Split triangle (A, B, C) into m^2 similar triangles. */
+static void split_triangle(builder *b, const ulam_scene *s, const double *A, const double *B, const double *C,
+                           int64_t m)
+{
+    int32_t first = (int32_t)b->nv;
+    for (int64_t j = 0; j <= m; j++)
+        for (int64_t i = 0; i + j <= m; i++) {
+            double x[3];
+            for (int d = 0; d < 3; d++)
+                x[d] = A[d] + ((double)i / (double)m) * (B[d] - A[d]) + ((double)j / (double)m) * (C[d] - A[d]);
+            add_vertex(b, x);
+        }
+    /* row j starts at offset j*(m+1) - j*(j-1)/2 */
+#define AT(i, j) (first + (int32_t)((j) * (m + 1) - (j) * ((j) - 1) / 2 + (i)))
+    for (int64_t j = 0; j < m; j++)
+        for (int64_t i = 0; i + j < m; i++) {
+            int32_t t[3] = {AT(i, j), AT(i + 1, j), AT(i, j + 1)};
+            add_patch(b, s, t, 3);
+            if (i + j + 1 < m) {
+                int32_t u[3] = {AT(i + 1, j), AT(i + 1, j + 1), AT(i, j + 1)};
+                add_patch(b, s, u, 3);
+            }
+        }
+#undef AT
+}
+
+/* Split every patch so no side exceeds max_side. */
+int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out)
+{
+    if (!s || !out || !(max_side > 0) || !isfinite(max_side)) return ULAM_EINVAL;
+    *out = NULL;
+    int64_t np = 0, nv = 0, nidx = 0, m = 1, k = 1;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        int64_t n = s->start[p + 1] - s->start[p], c = pieces(s, p, max_side, &m, &k);
+        if (c > (int64_t)INT32_MAX - np) return ULAM_EOVERFLOW;
+        np += c;
+        nv += n == 4 ? (m + 1) * (k + 1) : c == 1 && n > 4 ? n : (n - 2) * (c + 2 * (int64_t)sqrt((double)c) + 3);
+        nidx += n == 4 ? 4 * c : c == 1 && n > 4 ? n : 3 * c;
+        if (nv > (int64_t)INT32_MAX) return ULAM_EOVERFLOW;
+    }
+    ulam_scene *o = ulam__scene_alloc(np, nv, nidx, s->ngroups);
+    if (!o) return ULAM_ENOMEM;
+    for (int64_t g = 0; g < s->ngroups; g++) {
+        size_t len = strlen(s->groups[g]) + 1;
+        if (!(o->groups[g] = malloc(len))) {
+            o->ngroups = g;
+            ulam_scene_free(o);
+            return ULAM_ENOMEM;
+        }
+        memcpy(o->groups[g], s->groups[g], len);
+    }
+    o->ngroups = s->ngroups;
+    o->nfaces = s->nfaces;
+    builder b = {.o = o};
+    o->start[0] = 0;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        const int32_t *v = s->vidx + s->start[p];
+        int64_t n = s->start[p + 1] - s->start[p], c = pieces(s, p, max_side, &m, &k);
+        b.src = p;
+        if (n == 4) {
+            split_quad(&b, s, v, m, k);
+        } else if (c == 1 && n > 4) {
+            int32_t w[64], *ww = n <= 64 ? w : malloc((size_t)n * sizeof *ww);
+            if (!ww) {
+                ulam_scene_free(o);
+                return ULAM_ENOMEM;
+            }
+            for (int64_t a = 0; a < n; a++) ww[a] = add_vertex(&b, s->vert + 3 * v[a]);
+            add_patch(&b, s, ww, (int)n);
+            if (ww != w) free(ww);
+        } else {
+            for (int64_t t = 1; t + 1 < n; t++) {
+                const double *A = s->vert + 3 * v[0], *B = s->vert + 3 * v[t], *C = s->vert + 3 * v[t + 1];
+                int64_t d = divisions(A, B, B, C, max_side), d2 = divisions(C, A, A, B, max_side);
+                split_triangle(&b, s, A, B, C, d > d2 ? d : d2);
+            }
+        }
+    }
+    o->nverts = b.nv;
+    ulam__scene_geometry(o);
+    *out = o;
+    return ULAM_OK;
+}
+
+/* The patch of group label nearest the group's area centroid. */
+int ulam_scene_find(const ulam_scene *s, const char *label, int64_t *patch)
+{
+    if (!s || !label || !patch) return ULAM_EINVAL;
+    int64_t g = -1;
+    for (int64_t i = 0; i < s->ngroups && g < 0; i++)
+        if (!strcmp(s->groups[i], label)) g = i;
+    double c[3] = {0, 0, 0}, A = 0;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        if (g < 0 || s->group[p] != g) continue;
+        const int32_t *v = s->vidx + s->start[p];
+        int64_t n = s->start[p + 1] - s->start[p];
+        for (int64_t a = 0; a < n; a++)
+            for (int d = 0; d < 3; d++) c[d] += s->area[p] * s->vert[3 * v[a] + d] / (double)n;
+        A += s->area[p];
+    }
+    if (g < 0 || !(A > 0)) return ULAM_ENOTFOUND;
+    double best = INFINITY;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        if (s->group[p] != g) continue;
+        const int32_t *v = s->vidx + s->start[p];
+        int64_t n = s->start[p + 1] - s->start[p];
+        double m[3] = {0, 0, 0}, e[3];
+        for (int64_t a = 0; a < n; a++)
+            for (int d = 0; d < 3; d++) m[d] += s->vert[3 * v[a] + d] / (double)n;
+        for (int d = 0; d < 3; d++) e[d] = m[d] - c[d] / A;
+        if (ulam__dot3(e, e) < best) best = ulam__dot3(e, e), *patch = p;
+    }
+    return ULAM_OK;
+}
+
+/* Twice the area of triangle (a, b, c). */
+static double tri_area2(const double *a, const double *b, const double *c)
+{
+    double e1[3], e2[3], x[3];
+    ulam__sub3(b, a, e1);
+    ulam__sub3(c, a, e2);
+    ulam__cross3(e1, e2, x);
+    return sqrt(ulam__dot3(x, x));
+}
+
+/* A uniform point of patch p. */
+void ulam__patch_point(const ulam_scene *s, int64_t p, ulam_rng *r, double pt[3])
+{
+    const int32_t *v = s->vidx + s->start[p];
+    int64_t n = s->start[p + 1] - s->start[p], t = 1;
+    const double *A = s->vert + 3 * v[0];
+    if (n > 3) { /* pick a fan triangle in proportion to its area */
+        double u = ulam__rng_uniform(r) * 2.0 * s->area[p], acc = 0.0;
+        for (t = 1; t + 2 < n; t++) {
+            acc += tri_area2(A, s->vert + 3 * v[t], s->vert + 3 * v[t + 1]);
+            if (u < acc) break;
+        }
+    }
+    const double *B = s->vert + 3 * v[t], *C = s->vert + 3 * v[t + 1];
+    double a = ulam__rng_uniform(r), b = ulam__rng_uniform(r);
+    if (a + b > 1.0) a = 1.0 - a, b = 1.0 - b; /* fold the parallelogram onto the triangle */
+    for (int d = 0; d < 3; d++) pt[d] = A[d] + a * (B[d] - A[d]) + b * (C[d] - A[d]);
+}
+
+/* A cosine-distributed direction about n (Malley's method: a uniform disc point lifted). */
+void ulam__cosine_dir(const double n[3], ulam_rng *r, double d[3])
+{
+    double t[3], b[3];
+    /* an orthonormal frame (Duff et al., "Building an orthonormal basis, revisited", 2017) */
+    double sign = n[2] >= 0 ? 1.0 : -1.0, a = -1.0 / (sign + n[2]), c = n[0] * n[1] * a;
+    t[0] = 1.0 + sign * n[0] * n[0] * a, t[1] = sign * c, t[2] = -sign * n[0];
+    b[0] = c, b[1] = sign + n[1] * n[1] * a, b[2] = -n[1];
+    double u1 = ulam__rng_uniform(r), u2 = ulam__rng_uniform(r);
+    double rad = sqrt(u1), phi = 2.0 * M_PI * u2, x = rad * cos(phi), y = rad * sin(phi);
+    double z = sqrt(fmax(0.0, 1.0 - u1));
+    for (int k = 0; k < 3; k++) d[k] = x * t[k] + y * b[k] + z * n[k];
+}

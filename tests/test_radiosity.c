@@ -1,0 +1,346 @@
+/* The radiosity front end: OBJ/MTL reading and its errors, subdivision, form factors against
+ * Howell's exact values, the furnace test, and every walk mode against LAPACK on the cube and
+ * the Cornell box.  Fixed seeds; tolerances from the reported standard errors. */
+#include "testutil.h"
+
+#include <string.h>
+
+/* Read a scene that must parse. */
+static ulam_scene *must_scene(const char *path)
+{
+    ulam_scene *s = NULL;
+    ulam_error err;
+    int st = ulam_scene_read_obj(path, &s, &err);
+    if (st) print_error("%s:%ld: %s: %s\n", path, err.line, ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    return s;
+}
+
+/* A tracer that must build. */
+static ulam_tracer *must_tracer(const ulam_scene *s)
+{
+    ulam_tracer *t = NULL;
+    assert_int_equal(ulam_tracer_alloc(s, &t, NULL), ULAM_OK);
+    return t;
+}
+
+/* Run a patch walk to the end. */
+static ulam_rad_result rad_walk(const ulam_tracer *t, int mode, int est, int64_t patch, int64_t walks,
+                                uint64_t seed, ulam_rad_solver **keep)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.mode = mode, o.estimator = est, o.index = patch, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    ulam_rad_solver *sv = NULL;
+    ulam_error err;
+    int st = ulam_rad_solver_alloc(t, &o, &sv, &err);
+    if (st) print_error("%s: %s\n", ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
+    ulam_rad_result r;
+    ulam_rad_solver_result(sv, &r);
+    if (keep) *keep = sv;
+    else ulam_rad_solver_free(sv);
+    return r;
+}
+
+/* The unit cube reads as six unit patches facing inwards. */
+static void test_read_cube(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("examples/scenes/cube.obj");
+    assert_int_equal(s->npatches, 6);
+    assert_int_equal(s->ngroups, 6);
+    for (int64_t p = 0; p < 6; p++) {
+        assert_close(s->area[p], 1.0, 1e-12);
+        double c[3] = {0, 0, 0};
+        for (int64_t k = s->start[p]; k < s->start[p + 1]; k++)
+            for (int d = 0; d < 3; d++) c[d] += s->vert[3 * s->vidx[k] + d] / 4;
+        double in = 0;
+        for (int d = 0; d < 3; d++) in += s->normal[3 * p + d] * (0.5 - c[d]);
+        assert_close(in, 0.5, 1e-12); /* the normal points to the centre */
+        assert_close(s->rho[3 * p], 0.5, 0), assert_close(s->emit[3 * p + 2], 1.0, 0);
+    }
+    int64_t p = -1;
+    assert_int_equal(ulam_scene_find(s, "back", &p), ULAM_OK);
+    assert_int_equal(p, 5);
+    assert_int_equal(ulam_scene_find(s, "attic", &p), ULAM_ENOTFOUND);
+    ulam_scene_free(s);
+}
+
+/* The accepted syntax: CRLF, comments, v/t/n, negative indices, groups, a pentagon, Kd r. */
+static void test_read_good(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("tests/data/obj/good.obj");
+    assert_int_equal(s->npatches, 2);
+    assert_int_equal(s->start[2] - s->start[1], 5);
+    assert_string_equal(s->groups[s->group[0]], "first");
+    assert_string_equal(s->groups[s->group[1]], "second");
+    assert_close(s->area[0], 1.0, 1e-12);
+    assert_close(s->area[1], 0.85, 1e-12); /* the convex pentagon, by the shoelace formula */
+    assert_close(s->rho[3 * 1 + 1], 0.5, 0);
+    assert_close(s->emit[3 * 1], 1.0, 0);
+    assert_close(s->normal[2], 1.0, 1e-12);
+    ulam_scene_free(s);
+}
+
+/* Every bad file fails with its status, line and (for MTL errors) file. */
+static void test_read_errors(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *file;
+        int status;
+        long line;
+        const char *in; /* err.file ends with this, or NULL: the OBJ itself */
+    } cases[] = {
+        {"missing_mtl.obj", ULAM_EIO, 1, NULL},
+        {"unknown_material.obj", ULAM_ENOTFOUND, 2, NULL},
+        {"kd_range.obj", ULAM_ERANGE, 4, "kd_range.mtl"},
+        {"kd_nan.obj", ULAM_ENONFINITE, 2, "kd_nan.mtl"},
+        {"ke_negative.obj", ULAM_ERANGE, 2, "ke_negative.mtl"},
+        {"kd_before_newmtl.obj", ULAM_ESYNTAX, 1, "kd_before_newmtl.mtl"},
+        {"nonplanar.obj", ULAM_EGEOMETRY, 8, NULL},
+        {"degenerate.obj", ULAM_EGEOMETRY, 8, NULL},
+        {"repeated_vertex.obj", ULAM_EGEOMETRY, 7, NULL},
+        {"nonconvex.obj", ULAM_EGEOMETRY, 8, NULL},
+        {"index_range.obj", ULAM_EINDEX, 7, NULL},
+        {"index_zero.obj", ULAM_EINDEX, 7, NULL},
+        {"index_negative_range.obj", ULAM_EINDEX, 7, NULL},
+        {"no_usemtl.obj", ULAM_ENOTFOUND, 6, NULL},
+        {"bad_vertex.obj", ULAM_ESYNTAX, 3, NULL},
+        {"short_vertex.obj", ULAM_ESYNTAX, 3, NULL},
+        {"inf_vertex.obj", ULAM_ENONFINITE, 3, NULL},
+        {"unknown_statement.obj", ULAM_ESYNTAX, 7, NULL},
+        {"empty.obj", ULAM_EEMPTY, 2, NULL},
+        {"two_vertices.obj", ULAM_ESYNTAX, 7, NULL},
+        {"bad_face_token.obj", ULAM_ESYNTAX, 7, NULL},
+        {"does_not_exist.obj", ULAM_EIO, 0, NULL},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        char path[256];
+        snprintf(path, sizeof path, "tests/data/obj/%s", cases[k].file);
+        ulam_scene *s = (ulam_scene *)&s; /* must come back NULL */
+        ulam_error err;
+        int st = ulam_scene_read_obj(path, &s, &err);
+        if (st != cases[k].status || err.line != cases[k].line)
+            print_error("%s: status %d line %ld (%s), expected %d line %ld\n", cases[k].file, st, err.line,
+                        err.msg, cases[k].status, cases[k].line);
+        assert_int_equal(st, cases[k].status);
+        assert_int_equal(err.line, cases[k].line);
+        assert_null(s);
+        assert_true(strlen(err.msg) > 0);
+        if (cases[k].in) {
+            size_t a = strlen(err.file), b = strlen(cases[k].in);
+            assert_true(a >= b && !strcmp(err.file + a - b, cases[k].in));
+        } else {
+            assert_string_equal(err.file, "");
+        }
+    }
+}
+
+/* Subdivision keeps area, faces and labels; sides end up no longer than L. */
+static void test_subdivide(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("examples/scenes/cornell_box.obj"), *d = NULL;
+    double L = 60.0, A0 = 0, A1 = 0;
+    assert_int_equal(ulam_scene_subdivide(s, L, &d), ULAM_OK);
+    assert_true(d->npatches > 20 * s->npatches);
+    for (int64_t p = 0; p < s->npatches; p++) A0 += s->area[p];
+    double face_area[32] = {0};
+    for (int64_t p = 0; p < d->npatches; p++) {
+        A1 += d->area[p];
+        face_area[d->face[p]] += d->area[p];
+        assert_true(d->group[p] == s->group[d->face[p]]);
+        for (int c = 0; c < 3; c++) assert_close(d->rho[3 * p + c], s->rho[3 * d->face[p] + c], 0);
+        for (int64_t k = d->start[p]; k < d->start[p + 1]; k++) {
+            int64_t k2 = k + 1 < d->start[p + 1] ? k + 1 : d->start[p];
+            double e2 = 0;
+            for (int c = 0; c < 3; c++) {
+                double e = d->vert[3 * d->vidx[k2] + c] - d->vert[3 * d->vidx[k] + c];
+                e2 += e * e;
+            }
+            assert_true(sqrt(e2) <= L * (1 + 1e-12));
+        }
+    }
+    assert_close(A1, A0, 1e-9 * A0);
+    for (int64_t f = 0; f < s->npatches; f++) assert_close(face_area[f], s->area[f], 1e-9 * s->area[f]);
+    ulam_scene_free(d);
+    assert_int_equal(ulam_scene_subdivide(s, 0.0, &d), ULAM_EINVAL);
+    ulam_scene_free(s);
+}
+
+/* Ray-cast form factors against Howell's exact values: within 3 sigma of the binomial. */
+static void test_form_factors_exact(void **state)
+{
+    (void)state;
+    assert_close(ulam_ff_parallel_rectangles(1, 1, 1), 0.19982, 1e-5);
+    assert_close(ulam_ff_perpendicular_rectangles(1, 1, 1), 0.20004, 1e-5);
+    const char *files[2] = {"examples/scenes/parallel_squares.obj", "examples/scenes/perpendicular_squares.obj"};
+    double exact[2] = {ulam_ff_parallel_rectangles(1, 1, 1), ulam_ff_perpendicular_rectangles(1, 1, 1)};
+    int64_t rays = 1000000;
+    for (int k = 0; k < 2; k++) {
+        ulam_scene *s = must_scene(files[k]);
+        ulam_tracer *t = must_tracer(s);
+        ulam_csr *F = NULL;
+        assert_int_equal(ulam_form_factors(t, rays, 7 + (uint64_t)k, 2, &F, NULL), ULAM_OK);
+        double sigma = sqrt(exact[k] * (1 - exact[k]) / (double)rays);
+        assert_close(csr_get(F, 0, 1), exact[k], 3 * sigma);
+        assert_close(csr_get(F, 1, 0), exact[k], 3 * sigma); /* equal areas: F_10 = F_01 */
+        ulam_ff_report r;
+        assert_int_equal(ulam_form_factor_report(s, F, &r), ULAM_OK);
+        assert_true(r.reciprocity < 6 * sigma / exact[k]);
+        ulam_csr_free(F);
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
+}
+
+/* Furnace: the closed cube with uniform E = 1 and rho = 1/2 has B = 2 everywhere. */
+static void test_furnace(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("examples/scenes/cube.obj");
+    ulam_tracer *t = must_tracer(s);
+    ulam_csr *F = NULL;
+    assert_int_equal(ulam_form_factors(t, 20000, 3, 2, &F, NULL), ULAM_OK);
+    ulam_ff_report r;
+    ulam_form_factor_report(s, F, &r);
+    assert_close(r.rowsum_min, 1.0, 1e-12); /* closed: no ray escapes */
+    assert_close(r.rowsum_max, 1.0, 1e-12);
+    double B[18];
+    assert_int_equal(ulam_radiosity_direct(s, F, 0, B, NULL, NULL), ULAM_OK);
+    for (int k = 0; k < 18; k++) assert_close(B[k], 2.0, 1e-3);
+    for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+        for (int64_t p = 0; p < 6; p += 5) {
+            ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, est, p, 20000, 11 + (uint64_t)p, NULL);
+            for (int c = 0; c < 3; c++) assert_close(g.radiosity[c], 2.0, 4 * g.std_error[c] + 1e-12);
+            assert_true(g.rays > 0);
+        }
+        ulam_rad_solver *sv = NULL;
+        ulam_rad_result sh = rad_walk(t, ULAM_FORWARD, est, 0, 50000, 5, &sv);
+        double all[18], se[18];
+        assert_int_equal(ulam_rad_solver_vectors(sv, all, se), ULAM_OK);
+        for (int k = 0; k < 18; k++) {
+            assert_true(se[k] > 0 && se[k] < 0.05);
+            assert_close(all[k], 2.0, 4 * se[k]);
+        }
+        assert_close(sh.radiosity[0], all[0], 0);
+        ulam_rad_solver_free(sv);
+    }
+    ulam_csr_free(F);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* The Cornell box, subdivided: every walk mode against LAPACK.  Matrix walks share F with the
+ * direct solve (4 sigma); ray walks sample the exact F, so the tolerance adds the direct
+ * solution's own error from the noise of F (ulam_radiosity_direct_error). */
+static void test_cornell_against_direct(void **state)
+{
+    (void)state;
+    ulam_scene *s0 = must_scene("examples/scenes/cornell_box.obj"), *s = NULL;
+    assert_int_equal(ulam_scene_subdivide(s0, 300.0, &s), ULAM_OK);
+    ulam_scene_free(s0);
+    ulam_tracer *t = must_tracer(s);
+    int64_t rays = 100000, n = s->npatches;
+    ulam_csr *F = NULL;
+    assert_int_equal(ulam_form_factors(t, rays, 1, 2, &F, NULL), ULAM_OK);
+    double *B = malloc((size_t)(3 * n) * sizeof *B);
+    assert_int_equal(ulam_radiosity_direct(s, F, 0, B, NULL, NULL), ULAM_OK);
+    const char *labels[3] = {"floor", "back_wall", "tall_block"};
+    for (int k = 0; k < 3; k++) {
+        int64_t p;
+        assert_int_equal(ulam_scene_find(s, labels[k], &p), ULAM_OK);
+        double sf[3];
+        assert_int_equal(ulam_radiosity_direct_error(s, F, rays, B, p, 0, sf, NULL), ULAM_OK);
+        for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+            ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, est, p, est == ULAM_ABSORPTION ? 1200000 : 300000, 100 + (uint64_t)(2 * k + est), NULL);
+            for (int c = 0; c < 3; c++) {
+                double tol = 4 * sqrt(g.std_error[c] * g.std_error[c] + sf[c] * sf[c]);
+                assert_true(tol < 0.25 * B[3 * p + c]); /* a test that can fail */
+                assert_close(g.radiosity[c], B[3 * p + c], tol);
+            }
+            /* the matrix walk on the same F, one channel at a time */
+            for (int c = 0; c < 3; c++) {
+                ulam_csr *M = NULL;
+                double *b = malloc((size_t)n * sizeof *b);
+                assert_int_equal(ulam_radiosity_system(s, F, c, &M, b), ULAM_OK);
+                ulam_walk_opts o = ulam_walk_defaults();
+                o.index = p, o.estimator = est, o.max_walks = 200000, o.seed = 7 + (uint64_t)c, o.threads = 2;
+                ulam_walk_result w;
+                assert_int_equal(ulam_solve(M, b, &o, &w, NULL), ULAM_OK);
+                assert_close(w.estimate, B[3 * p + c], 4 * w.std_error);
+                ulam_csr_free(M);
+                free(b);
+            }
+        }
+    }
+    /* shooting: every patch at once, against the direct solution */
+    for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+        ulam_rad_solver *sv = NULL;
+        rad_walk(t, ULAM_FORWARD, est, 0, 200000, 9 + (uint64_t)est, &sv);
+        double *all = malloc((size_t)(3 * n) * sizeof *all), *se = malloc((size_t)(3 * n) * sizeof *se);
+        ulam_rad_solver_vectors(sv, all, se);
+        for (int k = 0; k < 3; k++) {
+            int64_t p;
+            ulam_scene_find(s, labels[k], &p);
+            double sf[3];
+            ulam_radiosity_direct_error(s, F, rays, B, p, 0, sf, NULL);
+            for (int c = 0; c < 3; c++)
+                assert_close(all[3 * p + c], B[3 * p + c], 4 * sqrt(se[3 * p + c] * se[3 * p + c] + sf[c] * sf[c]));
+        }
+        free(all), free(se);
+        ulam_rad_solver_free(sv);
+    }
+    free(B);
+    ulam_csr_free(F);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* Patch walks give bit-identical results for 1 and 2 threads; bad options are refused. */
+static void test_threads_and_options(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("examples/scenes/cornell_box.obj");
+    ulam_tracer *t = must_tracer(s);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 0, o.max_walks = 30000, o.seed = 42;
+    ulam_rad_result r[2];
+    for (int k = 0; k < 2; k++) {
+        o.threads = k + 1;
+        ulam_rad_solver *sv = NULL;
+        assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
+        while (!ulam_rad_solver_done(sv)) ulam_rad_solver_iterate(sv);
+        ulam_rad_solver_result(sv, &r[k]);
+        ulam_rad_solver_free(sv);
+    }
+    assert_int_equal(r[0].walks, 30000);
+    assert_int_equal(r[0].rays, r[1].rays);
+    assert_memory_equal(r[0].radiosity, r[1].radiosity, sizeof r[0].radiosity);
+    ulam_rad_solver *sv = NULL;
+    ulam_error err;
+    o.index = s->npatches;
+    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
+    o.index = 0, o.estimator = ULAM_EXPECTED;
+    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
+    o.estimator = ULAM_COLLISION, o.roulette = 0.5;
+    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
+    assert_null(sv);
+    assert_int_equal(ulam_rad_solver_vectors(NULL, NULL, NULL), ULAM_EINVAL);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_read_cube),          cmocka_unit_test(test_read_good),
+        cmocka_unit_test(test_read_errors),        cmocka_unit_test(test_subdivide),
+        cmocka_unit_test(test_form_factors_exact), cmocka_unit_test(test_furnace),
+        cmocka_unit_test(test_cornell_against_direct), cmocka_unit_test(test_threads_and_options),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
