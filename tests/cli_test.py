@@ -14,7 +14,8 @@ import tempfile
 
 STATUS = ["OK", "EINVAL", "ENOMEM", "EIO", "EEMPTY", "EBANNER", "EUNSUPPORTED", "ESIZELINE",
           "EOVERFLOW", "ETOOFEW", "ETOOMANY", "EINDEX", "ESYNTAX", "ENONFINITE", "ENOTSQUARE",
-          "EDIM", "EZERODIAG", "ESINGULAR", "EMEMLIMIT", "ENOCONV", "EUNDEFINED"]
+          "EDIM", "EZERODIAG", "ESINGULAR", "EMEMLIMIT", "ENOCONV", "EUNDEFINED", "EGEOMETRY",
+          "ENOTFOUND", "ERANGE", "EDEVICE"]
 
 
 def code(name):
@@ -98,6 +99,32 @@ CASES += [
     (SOLVE + ["--index", "2", "--walks", "20000", "--check"], 0, r"^$", r"direct\s+2\.34009.*z = "),
     (SOLVE + ["--index", "2", "--walks", "20000", "--mode", "forward", "--estimator", "expected"], 0, r"^$",
      r"forward walks, expected estimator"),
+]
+
+
+O = D + "obj/"
+SC = "examples/scenes/"
+BAD_SCENES = [  # file, status, the file:line the message must name
+    ("missing_mtl.obj", "EIO", O + "missing_mtl.obj:1"), ("unknown_material.obj", "ENOTFOUND", O + "unknown_material.obj:2"),
+    ("kd_range.obj", "ERANGE", O + "kd_range.mtl:4"), ("ke_negative.obj", "ERANGE", O + "ke_negative.mtl:2"),
+    ("nonplanar.obj", "EGEOMETRY", O + "nonplanar.obj:8"), ("degenerate.obj", "EGEOMETRY", O + "degenerate.obj:8"),
+    ("nonconvex.obj", "EGEOMETRY", O + "nonconvex.obj:8"), ("index_range.obj", "EINDEX", O + "index_range.obj:7"),
+    ("no_usemtl.obj", "ENOTFOUND", O + "no_usemtl.obj:6"), ("bad_vertex.obj", "ESYNTAX", O + "bad_vertex.obj:3"),
+    ("unknown_statement.obj", "ESYNTAX", O + "unknown_statement.obj:7"), ("empty.obj", "EEMPTY", O + "empty.obj:2"),
+]
+for f, status, where in BAD_SCENES:
+    CASES.append((["radiosity", O + f, "--patch", "1"], code(status), rf"^ulam: {re.escape(where)}: error: .*expected ", ""))
+CASES += [
+    (["radiosity", SC + "cube.obj"], 2, r"needs --patch K", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "7"], 2, r"--patch 7 is out of range 1..6", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "attic"], 2, r"neither a patch number nor a label; labels: floor ceiling", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--image", "x.png"], 2, r"--image needs --mode shoot or --direct", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "-5"], 2, r"--walks expects an integer", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--subdivide", "0"], 2, r"--subdivide expects a number", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--mode", "sideways"], 2, r"--mode expects gather or shoot", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--size", "0x5"], 2, r"--size expects WxH", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "1000", "--estimator", "absorption"], 0, r"^$", r"radiosity R  2 \+- 0"),
+    (["radiosity", SC + "cube.obj", "--direct", "--max-mem", "10"], code("EMEMLIMIT"), r"memory limit", ""),
 ]
 
 
@@ -272,6 +299,36 @@ def check_outputs(ulam):
         assert rc == code("EIO") and "error" in err
 
 
+def check_radiosity(ulam):
+    """ulam radiosity: JSON fields, --check agreement, matrix walks, shooting images, atomic PNG."""
+    rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "300", "--patch", "back_wall",
+                              "--check", "--ff-rays", "50000", "--walks", "200000", "--json"])
+    assert rc == 0, err
+    j = json.loads(out)
+    assert j["label"] == "back_wall" and j["patches"] == 49 and j["mode"] == "gather"
+    for key in ("radiosity", "stderr", "direct", "direct_stderr", "z"):
+        assert len(j[key]) == 3, key
+    assert all(abs(z) < 4 for z in j["z"]), j["z"]
+    assert all(0 < s < 0.1 * b for s, b in zip(j["stderr"], j["radiosity"])), j
+    rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "300", "--patch", "10",
+                              "--check", "--matrix-walk", "--estimator", "absorption", "--ff-rays", "2000",
+                              "--walks", "100000", "--json"])
+    assert rc == 0, err
+    j = json.loads(out)
+    assert j["matrix_walk"] and j["patch"] == 10 and all(abs(z) < 4 for z in j["z"]), j
+    with tempfile.TemporaryDirectory() as d:
+        png = d + "/box.png"
+        rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--mode", "shoot", "--walks", "20000",
+                                  "--image", png, "--size", "64x48"])
+        assert rc == 0, err
+        data = open(png, "rb").read()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and data[16:24] == bytes([0, 0, 0, 64, 0, 0, 0, 48])
+        rc, _, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "1000",
+                                "--image", d + "/no/such/dir/x.png"])
+        assert rc == code("EIO") and "x.png" in err, err
+        assert sorted(os.listdir(d)) == ["box.png"], os.listdir(d)
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -286,7 +343,8 @@ def main():
     ulam, genmat = sys.argv[1], sys.argv[2]
     failures, n = check_table(ulam)
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
-             (check_forward_files, ulam), (check_interrupt, ulam), (check_study, ulam)]
+             (check_forward_files, ulam), (check_interrupt, ulam), (check_study, ulam),
+             (check_radiosity, ulam)]
     for f, arg in extra:
         try:
             f(arg)

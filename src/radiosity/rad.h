@@ -35,8 +35,12 @@ void ulam__polygon_normal(const double *vert, const int32_t *idx, int64_t n, dou
 /* Area, unit normal of every patch (after the vertex lists are set). */
 void ulam__scene_geometry(ulam_scene *s);
 
-/* A uniform point of patch p (area-weighted fan triangle, then uniform in it). */
-void ulam__patch_point(const ulam_scene *s, int64_t p, ulam_rng *r, double pt[3]);
+/* The share of patch p's area in its first fan triangle when it is a quad (else 1). */
+double ulam__first_share(const ulam_scene *s, int64_t p);
+
+/* A uniform point of patch p (area-weighted fan triangle, then uniform in it); share is
+ * ulam__first_share(s, p). */
+void ulam__patch_point(const ulam_scene *s, int64_t p, double share, ulam_rng *r, double pt[3]);
 
 /* A cosine-distributed unit direction about unit normal n. */
 void ulam__cosine_dir(const double n[3], ulam_rng *r, double d[3]);

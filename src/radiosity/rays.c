@@ -11,6 +11,7 @@ struct ulam_tracer {
     RTCDevice dev;
     RTCScene scene;
     int64_t *prim_patch; /* triangle -> patch */
+    double *share;       /* per patch: ulam__first_share */
     double eps;          /* origin offset: 1e-5 of the scene's diagonal */
 };
 
@@ -21,6 +22,7 @@ ulam_tracer *ulam_tracer_free(ulam_tracer *t)
     if (t->scene) rtcReleaseScene(t->scene);
     if (t->dev) rtcReleaseDevice(t->dev);
     free(t->prim_patch);
+    free(t->share);
     free(t);
     return NULL;
 }
@@ -65,11 +67,13 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
     if (ntri < 1 || ntri > (int64_t)UINT32_MAX / 4 || s->nverts > (int64_t)UINT32_MAX / 4)
         return ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "fewer than 2^30 triangles and vertices");
     ulam_tracer *t = calloc(1, sizeof *t);
-    if (!t || !(t->prim_patch = ulam__malloc((size_t)ntri, sizeof *t->prim_patch))) {
+    if (!t || !(t->prim_patch = ulam__malloc((size_t)ntri, sizeof *t->prim_patch)) ||
+        !(t->share = ulam__malloc((size_t)s->npatches, sizeof *t->share))) {
         ulam_tracer_free(t);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the ray tracer");
     }
     t->s = s;
+    for (int64_t p = 0; p < s->npatches; p++) t->share[p] = ulam__first_share(s, p);
     if (!(t->dev = rtcNewDevice(NULL))) {
         ulam_tracer_free(t);
         return ulam__fail(err, ULAM_EDEVICE, 0, -1, "an Embree device (rtcNewDevice failed)");
@@ -128,7 +132,7 @@ int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r)
 {
     const double *n = t->s->normal + 3 * p;
     double o[3], d[3];
-    ulam__patch_point(t->s, p, r, o);
+    ulam__patch_point(t->s, p, t->share[p], r, o);
     for (int k = 0; k < 3; k++) o[k] += t->eps * n[k];
     ulam__cosine_dir(n, r, d);
     int front = 0;

@@ -287,13 +287,24 @@ static double tri_area2(const double *a, const double *b, const double *c)
     return sqrt(ulam__dot3(x, x));
 }
 
-/* A uniform point of patch p. */
-void ulam__patch_point(const ulam_scene *s, int64_t p, ulam_rng *r, double pt[3])
+/* The share of a quad's area in its first fan triangle (1 for triangles). */
+double ulam__first_share(const ulam_scene *s, int64_t p)
+{
+    const int32_t *v = s->vidx + s->start[p];
+    if (s->start[p + 1] - s->start[p] != 4) return 1.0;
+    const double *A = s->vert + 3 * v[0];
+    return tri_area2(A, s->vert + 3 * v[1], s->vert + 3 * v[2]) / (2.0 * s->area[p]);
+}
+
+/* A uniform point of patch p; share is ulam__first_share(s, p). */
+void ulam__patch_point(const ulam_scene *s, int64_t p, double share, ulam_rng *r, double pt[3])
 {
     const int32_t *v = s->vidx + s->start[p];
     int64_t n = s->start[p + 1] - s->start[p], t = 1;
     const double *A = s->vert + 3 * v[0];
-    if (n > 3) { /* pick a fan triangle in proportion to its area */
+    if (n == 4) {
+        t = ulam__rng_uniform(r) < share ? 1 : 2;
+    } else if (n > 4) { /* pick a fan triangle in proportion to its area */
         double u = ulam__rng_uniform(r) * 2.0 * s->area[p], acc = 0.0;
         for (t = 1; t + 2 < n; t++) {
             acc += tri_area2(A, s->vert + 3 * v[t], s->vert + 3 * v[t + 1]);
@@ -306,7 +317,8 @@ void ulam__patch_point(const ulam_scene *s, int64_t p, ulam_rng *r, double pt[3]
     for (int d = 0; d < 3; d++) pt[d] = A[d] + a * (B[d] - A[d]) + b * (C[d] - A[d]);
 }
 
-/* A cosine-distributed direction about n (Malley's method: a uniform disc point lifted). */
+/* A cosine-distributed direction about n (Malley's method: a uniform disc point, drawn by
+ * rejection from the square (no trigonometry), lifted to the hemisphere). */
 void ulam__cosine_dir(const double n[3], ulam_rng *r, double d[3])
 {
     double t[3], b[3];
@@ -314,8 +326,12 @@ void ulam__cosine_dir(const double n[3], ulam_rng *r, double d[3])
     double sign = n[2] >= 0 ? 1.0 : -1.0, a = -1.0 / (sign + n[2]), c = n[0] * n[1] * a;
     t[0] = 1.0 + sign * n[0] * n[0] * a, t[1] = sign * c, t[2] = -sign * n[0];
     b[0] = c, b[1] = sign + n[1] * n[1] * a, b[2] = -n[1];
-    double u1 = ulam__rng_uniform(r), u2 = ulam__rng_uniform(r);
-    double rad = sqrt(u1), phi = 2.0 * M_PI * u2, x = rad * cos(phi), y = rad * sin(phi);
-    double z = sqrt(fmax(0.0, 1.0 - u1));
+    double x, y, rr;
+    do {
+        x = 2.0 * ulam__rng_uniform(r) - 1.0;
+        y = 2.0 * ulam__rng_uniform(r) - 1.0;
+        rr = x * x + y * y;
+    } while (rr >= 1.0);
+    double z = sqrt(1.0 - rr);
     for (int k = 0; k < 3; k++) d[k] = x * t[k] + y * b[k] + z * n[k];
 }
