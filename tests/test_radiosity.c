@@ -43,6 +43,28 @@ static ulam_rad_result rad_walk(const ulam_tracer *t, int mode, int est, int64_t
     return r;
 }
 
+/* Matrix walks on the assembled M of channel c, mode and estimator: x_p and its stderr, or with
+ * all != NULL (forward) every component. */
+static ulam_walk_result matrix_walk(const ulam_scene *s, const ulam_csr *F, int c, int mode, int est, int64_t p,
+                                    int64_t walks, uint64_t seed, double *all, double *all_se)
+{
+    ulam_csr *M = NULL;
+    double *b = malloc((size_t)s->npatches * sizeof *b);
+    assert_int_equal(ulam_radiosity_system(s, F, c, &M, b), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.mode = mode, o.index = p, o.estimator = est, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    ulam_solver *sv = NULL;
+    assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, NULL), ULAM_OK);
+    while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+    ulam_walk_result w;
+    ulam_solver_result(sv, &w);
+    if (all) assert_int_equal(ulam_solver_vectors(sv, all, all_se), ULAM_OK);
+    ulam_solver_free(sv);
+    ulam_csr_free(M);
+    free(b);
+    return w;
+}
+
 /* The unit cube reads as six unit patches facing inwards. */
 static void test_read_cube(void **state)
 {
@@ -228,6 +250,12 @@ static void test_furnace(void **state)
         }
         assert_close(sh.radiosity[0], all[0], 0);
         ulam_rad_solver_free(sv);
+        /* matrix walks on the assembled M, both modes */
+        double x[6], xse[6];
+        ulam_walk_result m = matrix_walk(s, F, 1, ULAM_ADJOINT, est, 2, 20000, 3, NULL, NULL);
+        assert_close(m.estimate, 2.0, 4 * m.std_error + 1e-12);
+        matrix_walk(s, F, 2, ULAM_FORWARD, est, 0, 50000, 4, x, xse);
+        for (int k = 0; k < 6; k++) assert_close(x[k], 2.0, 4 * xse[k] + 1e-12);
     }
     ulam_csr_free(F);
     ulam_tracer_free(t);
@@ -264,18 +292,34 @@ static void test_cornell_against_direct(void **state)
             }
             /* the matrix walk on the same F, one channel at a time */
             for (int c = 0; c < 3; c++) {
-                ulam_csr *M = NULL;
-                double *b = malloc((size_t)n * sizeof *b);
-                assert_int_equal(ulam_radiosity_system(s, F, c, &M, b), ULAM_OK);
-                ulam_walk_opts o = ulam_walk_defaults();
-                o.index = p, o.estimator = est, o.max_walks = 200000, o.seed = 7 + (uint64_t)c, o.threads = 2;
-                ulam_walk_result w;
-                assert_int_equal(ulam_solve(M, b, &o, &w, NULL), ULAM_OK);
+                ulam_walk_result w = matrix_walk(s, F, c, ULAM_ADJOINT, est, p, 200000, 7 + (uint64_t)c, NULL, NULL);
                 assert_close(w.estimate, B[3 * p + c], 4 * w.std_error);
-                ulam_csr_free(M);
-                free(b);
             }
         }
+    }
+    /* forward matrix walks: every patch of one channel at once.  Forward absorption is refused:
+     * the forward kernel walks the columns of diag(rho) F, and some sum to more than 1 (p* = 0). */
+    {
+        ulam_csr *M = NULL;
+        double *b = malloc((size_t)n * sizeof *b);
+        ulam_radiosity_system(s, F, 0, &M, b);
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = ULAM_FORWARD, o.estimator = ULAM_ABSORPTION;
+        ulam_solver *sv = NULL;
+        assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, NULL), ULAM_EUNDEFINED);
+        ulam_csr_free(M);
+        free(b);
+    }
+    for (int c = 0; c < 3; c++) {
+        double *x = malloc((size_t)n * sizeof *x), *xse = malloc((size_t)n * sizeof *xse);
+        matrix_walk(s, F, c, ULAM_FORWARD, ULAM_COLLISION, 0, 400000, 21 + (uint64_t)c, x, xse);
+        for (int k = 0; k < 3; k++) {
+            int64_t p;
+            ulam_scene_find(s, labels[k], &p);
+            assert_true(xse[p] < 0.05 * B[3 * p + c]);
+            assert_close(x[p], B[3 * p + c], 4 * xse[p]);
+        }
+        free(x), free(xse);
     }
     /* shooting: every patch at once, against the direct solution */
     for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
