@@ -173,10 +173,10 @@ int ulam__kernel_build(const ulam_csr *K, double continue_q, ulam_kernel **out)
 }
 
 /* States reachable from the start set (marked in seen[]) along the kernel's moves. */
-void ulam__kernel_reach(const ulam_kernel *k, char *seen)
+int ulam__kernel_reach(const ulam_kernel *k, char *seen)
 {
     int64_t *stack = ulam__malloc((size_t)k->n, sizeof *stack), top = 0;
-    if (!stack) return;
+    if (!stack) return ULAM_ENOMEM;
     for (int64_t i = 0; i < k->n; i++)
         if (seen[i]) stack[top++] = i;
     while (top > 0) {
@@ -195,4 +195,5 @@ void ulam__kernel_reach(const ulam_kernel *k, char *seen)
         }
     }
     free(stack);
+    return ULAM_OK;
 }

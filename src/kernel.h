@@ -47,8 +47,8 @@ int ulam__kernel_build(const ulam_csr *K, double continue_q, ulam_kernel **out);
 /* Free a kernel; accepts NULL. */
 ulam_kernel *ulam__kernel_free(ulam_kernel *k);
 
-/* Mark in seen[] every state reachable from those already marked. */
-void ulam__kernel_reach(const ulam_kernel *k, char *seen);
+/* Mark in seen[] every state reachable from those already marked; ULAM_OK or ULAM_ENOMEM. */
+int ulam__kernel_reach(const ulam_kernel *k, char *seen);
 
 /* The header of the row at unit u. */
 static inline ulam__row *ulam__kernel_row(const ulam_kernel *k, int64_t u)

@@ -330,9 +330,13 @@ static int triplets_push(triplets *t, int32_t i, int32_t j, double x)
     return ULAM_OK;
 }
 
-/* Reserve exactly cap triplets up front. */
+/* Reserve room for the triplets the size line announces, but at most 2^20 up front: a hostile
+ * size line must not make the reader allocate what the file does not hold (more entries grow
+ * the arrays by doubling). */
 static int triplets_reserve(triplets *t, int64_t cap)
 {
+    if (cap > ((int64_t)1 << 20)) cap = (int64_t)1 << 20;
+    if (cap < 1) cap = 1;
     t->i = ulam__malloc((size_t)cap, sizeof *t->i);
     t->j = ulam__malloc((size_t)cap, sizeof *t->j);
     t->x = ulam__malloc((size_t)cap, sizeof *t->x);

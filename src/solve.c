@@ -96,7 +96,10 @@ static int check_absorption(ulam_solver *s, ulam_error *err)
     if (s->o.mode == ULAM_ADJOINT) seen[s->o.index] = 1;
     else
         for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
-    ulam__kernel_reach(s->k, seen);
+    if (ulam__kernel_reach(s->k, seen)) {
+        free(seen);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
+    }
     int64_t bad = -1;
     for (int64_t i = 0; i < s->n && bad < 0; i++) {
         int scores = s->o.mode == ULAM_ADJOINT ? s->b[i] != 0.0 : 1;
@@ -291,6 +294,7 @@ int ulam_solver_iterate(ulam_solver *s)
         run_block(s, q, b0, cnt, t);
     }
     for (int q = 0; q < nb; q++) {
+        if (s->blocks[q].nomem) s->status = ULAM_ENOMEM;
         if (!s->blocks[q].complete) { /* interrupted or out of time: keep what came before */
             s->done = 1;
             break;
@@ -300,10 +304,8 @@ int ulam_solver_iterate(ulam_solver *s)
     }
     s->seconds += ulam_now() - start;
     if (s->o.interrupt && *s->o.interrupt) s->interrupted = s->done = 1;
-    if (s->nonfinite) {
-        s->done = 1;
-        s->status = ULAM_ENONFINITE;
-    }
+    if (s->nonfinite && !s->status) s->status = ULAM_ENONFINITE;
+    if (s->status) s->done = 1;
     ulam_walk_result r;
     ulam_solver_result(s, &r);
     if (s->o.max_walks > 0 && s->next_walk >= s->o.max_walks) s->done = 1;
@@ -377,7 +379,10 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
     if (status) return status;
     while (!status && !ulam_solver_done(s)) status = ulam_solver_iterate(s);
     if (result) ulam_solver_result(s, result);
-    if (status) ulam__fail(err, status, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
+    if (status == ULAM_ENONFINITE)
+        ulam__fail(err, status, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
+    else if (status)
+        ulam__fail(err, status, 0, -1, "memory for the walks' tallies");
     ulam_solver_free(s);
     return status;
 }

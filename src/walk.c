@@ -267,7 +267,10 @@ void ulam__forward_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam
     acc.t.len = 0;
     int64_t c = 0;
     for (; c < count; c++) {
-        if (forward_history(w, r, sc, &acc)) break; /* out of memory: incomplete */
+        if (forward_history(w, r, sc, &acc)) { /* out of memory: the run must fail, not stop short */
+            acc.nomem = 1;
+            break;
+        }
         if ((c & 63) == 63 && w->interrupt && *w->interrupt) break;
     }
     acc.complete = c == count;

@@ -51,6 +51,7 @@ typedef struct {
     int64_t walks, steps, cut, nonfinite;
     double maxsq; /* adjoint: the largest score^2 */
     int complete; /* 0 when interrupted or out of memory */
+    int nomem;    /* a tally list could not grow: the run fails with ULAM_ENOMEM */
 } ulam__block;
 
 /* Run count adjoint histories drawing from r into out (reset first). */
