@@ -287,6 +287,12 @@ static int read_header(reader *r, const char *name, mm_header *h, ulam_error *er
         return ulam__fail(err, ULAM_ENOTSQUARE, r->line, -1,
                           "a square matrix for a symmetric file, got %lld x %lld",
                           (long long)h->m, (long long)h->n);
+    int64_t dim_cap = ((int64_t)1 << 24) + 64 * h->nnz; /* nnz <= INT64_MAX / 32: no overflow */
+    if (h->format == FMT_COORD && (h->m > dim_cap || h->n > dim_cap))
+        return ulam__fail(err, ULAM_EOVERFLOW, r->line, -1,
+                          "dimensions at most 2^24 + 64 x entries = %lld (a size line of %lld x %lld with "
+                          "%lld entries would only allocate empty rows)",
+                          (long long)dim_cap, (long long)h->m, (long long)h->n, (long long)h->nnz);
     if ((double)h->nnz > (double)h->m * (double)h->n)
         return ulam__fail(err, ULAM_EOVERFLOW, r->line, -1,
                           "at most rows*columns = %.0f entries, the size line says %lld",

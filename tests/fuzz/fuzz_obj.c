@@ -3,6 +3,7 @@
  * temporary folder and read back.  A scene that parses is also subdivided. */
 #include "ulam.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,8 +44,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     snprintf(path, sizeof path, "%s/f.obj", dir);
     ulam_scene *s = NULL, *d = NULL;
     ulam_error err;
-    if (ulam_scene_read_obj(path, &s, &err) == ULAM_OK && s->nverts < 1000 && s->npatches < 1000) {
-        ulam_scene_subdivide(s, 1.0, &d); /* the scene's own scale, capped by the patch count */
+    if (ulam_scene_read_obj(path, &s, &err) == ULAM_OK && s->npatches < 1000) {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, d2 = 0;
+        for (int64_t v = 0; v < s->nverts; v++)
+            for (int c = 0; c < 3; c++)
+                lo[c] = fmin(lo[c], s->vert[3 * v + c]), hi[c] = fmax(hi[c], s->vert[3 * v + c]);
+        for (int c = 0; c < 3; c++) d2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+        if (d2 > 0 && isfinite(d2)) ulam_scene_subdivide(s, sqrt(d2) / 4, &d); /* a few pieces a face */
         ulam_scene_free(d);
     }
     ulam_scene_free(s);
