@@ -48,6 +48,23 @@ static inline double ulam__rng_uniform(ulam_rng *r)
     return (double)(ulam__rng_next(r) >> 11) * 0x1.0p-53;
 }
 
+/* Threads a run uses: requested when > 0, else all cores (1 without OpenMP). */
+int ulam__threads(int requested);
+
+/* Nonzero when a block whose first walk is `first` may start: not interrupted and, unless it is
+ * the run's first block (which always runs, so a time limit still yields an estimate), not out
+ * of time (t0: when the run started). */
+int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first);
+
+/* One round of a block-parallel walk run: up to `round` blocks of `block` walks from walk `next`
+ * (no further than o->max_walks), shared dynamically among `threads`; block k runs as
+ * run(ctx, k, its first walk, its walk count, thread).  Returns the number of blocks. */
+int ulam__round(const ulam_walk_opts *o, int64_t next, int block, int round, int threads,
+                void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread), void *ctx);
+
+/* Nonzero when the walk or time budget of o is spent after `walks` walks. */
+int ulam__budget_spent(const ulam_walk_opts *o, double t0, int64_t walks);
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -63,6 +80,11 @@ void *ulam__malloc(size_t n, size_t sz);
 
 /* calloc of n items of size sz, NULL on failure (n == 0 allocates one byte). */
 void *ulam__calloc(size_t n, size_t sz);
+
+/* Make room for need items of size sz in a growable array: pp is the address of its pointer
+ * (a T **), *cap its capacity (doubling from 16; both are updated); ULAM_OK, or ULAM_ENOMEM
+ * leaving the array as it was. */
+int ulam__grow(void *pp, int64_t *cap, int64_t need, size_t sz);
 
 /* Uninitialised memory for a large random-access table: cache-line aligned, and for tables
  * of 2 MB or more, 2 MB aligned with transparent huge pages requested (fewer TLB misses on

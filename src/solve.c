@@ -200,11 +200,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
     s->o = o;
     s->n = M->nrows;
-#ifdef _OPENMP
-    s->threads = o.threads > 0 ? o.threads : omp_get_max_threads();
-#else
-    s->threads = 1;
-#endif
+    s->threads = ulam__threads(o.threads);
     s->b = ulam__malloc((size_t)s->n, sizeof *s->b);
     if (!s->b) goto nomem;
     memcpy(s->b, b, (size_t)s->n * sizeof *s->b);
@@ -235,20 +231,58 @@ nomem:
     return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walk kernel and workspace");
 }
 
-/* Nonzero when the run must stop before starting another block. */
-static int must_stop(const ulam_solver *s)
+/* Threads a run uses. */
+int ulam__threads(int requested)
 {
-    if (s->o.interrupt && *s->o.interrupt) return 1;
-    return s->o.max_seconds > 0 && ulam_now() - s->t0 >= s->o.max_seconds;
+#ifdef _OPENMP
+    return requested > 0 ? requested : omp_get_max_threads();
+#else
+    (void)requested;
+    return 1;
+#endif
 }
 
-/* Run walks [first, first + count) of block q on thread t. */
-static void run_block(ulam_solver *s, int q, int64_t first, int64_t count, int t)
+/* Nonzero when a block starting at walk first may start. */
+int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first)
 {
+    if (o->interrupt && *o->interrupt) return 0;
+    return first == 0 || !(o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds);
+}
+
+/* One round of blocks, in parallel. */
+int ulam__round(const ulam_walk_opts *o, int64_t next, int block, int round, int threads,
+                void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread), void *ctx)
+{
+    int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX;
+    int nb = 0;
+    while (nb < round && left > (int64_t)nb * block) nb++;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int k = 0; k < nb; k++) {
+        int t = 0;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+#endif
+        int64_t rest = left - (int64_t)k * block;
+        run(ctx, k, next + (int64_t)k * block, rest < block ? rest : block, t);
+    }
+    return nb;
+}
+
+/* Nonzero when the walk or time budget is spent. */
+int ulam__budget_spent(const ulam_walk_opts *o, double t0, int64_t walks)
+{
+    if (o->max_walks > 0 && walks >= o->max_walks) return 1;
+    return o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds;
+}
+
+/* Run walks [first, first + count) as block q on thread t (ctx: the solver). */
+static void run_block(void *ctx, int q, int64_t first, int64_t count, int t)
+{
+    ulam_solver *s = ctx;
     ulam__block *br = &s->blocks[q];
     br->complete = 0;
     br->walks = 0;
-    if (first > 0 ? must_stop(s) : s->o.interrupt && *s->o.interrupt) return; /* block 0 always runs */
+    if (!ulam__block_may_start(&s->o, s->t0, first)) return;
     ulam_rng r;
     ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / BLOCK));
     if (s->o.mode == ULAM_ADJOINT) ulam__adjoint_block(&s->w, count, &r, &s->scratch[t], br);
@@ -279,20 +313,7 @@ int ulam_solver_iterate(ulam_solver *s)
     if (s->done) return s->status;
     double start = ulam_now();
     if (s->t0 < 0) s->t0 = start;
-    int64_t left = s->o.max_walks > 0 ? s->o.max_walks - s->next_walk : INT64_MAX;
-    int nb = 0;
-    while (nb < ROUND && left > (int64_t)nb * BLOCK) nb++;
-    int64_t first = s->next_walk;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(s->threads)
-    for (int q = 0; q < nb; q++) {
-        int t = 0;
-#ifdef _OPENMP
-        t = omp_get_thread_num();
-#endif
-        int64_t b0 = first + (int64_t)q * BLOCK;
-        int64_t cnt = left - (int64_t)q * BLOCK < BLOCK ? left - (int64_t)q * BLOCK : BLOCK;
-        run_block(s, q, b0, cnt, t);
-    }
+    int nb = ulam__round(&s->o, s->next_walk, BLOCK, ROUND, s->threads, run_block, s);
     for (int q = 0; q < nb; q++) {
         if (s->blocks[q].nomem) s->status = ULAM_ENOMEM;
         if (!s->blocks[q].complete) { /* interrupted or out of time: keep what came before */
@@ -308,9 +329,8 @@ int ulam_solver_iterate(ulam_solver *s)
     if (s->status) s->done = 1;
     ulam_walk_result r;
     ulam_solver_result(s, &r);
-    if (s->o.max_walks > 0 && s->next_walk >= s->o.max_walks) s->done = 1;
+    if (ulam__budget_spent(&s->o, s->t0, s->next_walk)) s->done = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && r.std_error <= s->o.rel_err * fabs(r.estimate)) s->done = 1;
-    if (s->o.max_seconds > 0 && ulam_now() - s->t0 >= s->o.max_seconds) s->done = 1;
     return s->status;
 }
 

@@ -84,6 +84,25 @@ void *ulam__calloc(size_t n, size_t sz)
     return calloc(n ? n : 1, sz ? sz : 1);
 }
 
+/* Make room for need items in the growable array at *pp of capacity *cap (doubling from 16). */
+int ulam__grow(void *pp, int64_t *cap, int64_t need, size_t sz)
+{
+    if (need <= *cap) return ULAM_OK;
+    void *p; /* the pointer is read and written by memcpy: pp points at a T *, not a void * */
+    memcpy(&p, pp, sizeof p);
+    int64_t c = *cap ? *cap : 16;
+    while (c < need) {
+        if (c > INT64_MAX / 2) return ULAM_ENOMEM;
+        c *= 2;
+    }
+    if ((uint64_t)c > SIZE_MAX / sz) return ULAM_ENOMEM;
+    void *q = realloc(p, (size_t)c * sz);
+    if (!q) return ULAM_ENOMEM;
+    memcpy(pp, &q, sizeof q);
+    *cap = c;
+    return ULAM_OK;
+}
+
 /* Aligned memory for a big random-access table, huge pages requested where it is large. */
 void *ulam__alloc_big(size_t n, size_t sz)
 {

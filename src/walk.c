@@ -193,14 +193,7 @@ static void tally(ulam__scratch *sc, int32_t s, double v)
 /* Move this history's tallies to out and clear them. */
 static int emit(ulam__scratch *sc, ulam__tallies *out)
 {
-    if (out->len + sc->ntouched > out->cap) {
-        int64_t cap = out->cap ? out->cap : 1024;
-        while (cap < out->len + sc->ntouched) cap *= 2;
-        ulam__tally *t = realloc(out->t, (size_t)cap * sizeof *t);
-        if (!t) return ULAM_ENOMEM;
-        out->t = t;
-        out->cap = cap;
-    }
+    if (ulam__grow(&out->t, &out->cap, out->len + sc->ntouched, sizeof *out->t)) return ULAM_ENOMEM;
     for (int64_t q = 0; q < sc->ntouched; q++) {
         int64_t s = sc->touched[q];
         out->t[out->len++] = (ulam__tally){(int32_t)s, sc->hist[s]};

@@ -53,6 +53,18 @@ void cli_system_free(cli_system *s);
 /* Solve the loaded system densely into a new *x; 0 or an exit code (error reported). */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info);
 
+/* Set by the first Ctrl-C while cli_catch_sigint is in force (walks stop at their next block). */
+extern volatile int cli_interrupted;
+
+/* Catch SIGINT: the first sets cli_interrupted, a second exits at once with EXIT_INTERRUPTED. */
+void cli_catch_sigint(void);
+
+/* Restore the default SIGINT. */
+void cli_release_sigint(void);
+
+/* Index of word in names[0..n), or -1. */
+int cli_lookup(const char *word, const char *const *names, int n);
+
 /* Print a bare JSON number (null when not finite). */
 void cli_json_value(double v);
 

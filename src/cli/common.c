@@ -2,11 +2,45 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <signal.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+volatile int cli_interrupted;
+
+/* SIGINT: the first asks the walks to stop, the second exits at once. */
+static void on_sigint(int sig)
+{
+    (void)sig;
+    if (cli_interrupted) _exit(EXIT_INTERRUPTED);
+    cli_interrupted = 1;
+}
+
+/* Catch SIGINT. */
+void cli_catch_sigint(void)
+{
+    struct sigaction sa = {.sa_handler = on_sigint};
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+}
+
+/* Restore the default SIGINT. */
+void cli_release_sigint(void)
+{
+    signal(SIGINT, SIG_DFL);
+}
+
+/* Index of word in names[0..n), or -1. */
+int cli_lookup(const char *word, const char *const *names, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (!strcmp(word, names[k])) return k;
+    return -1;
+}
 
 /* The exit code for a library status. */
 int cli_exit_code(int status)

@@ -4,11 +4,9 @@
 
 #include <getopt.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 static const char *const usage =
     "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot]\n"
@@ -42,16 +40,6 @@ static const char *const usage =
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
 
-static volatile int interrupted;
-
-/* SIGINT: the first asks the walks to stop, the second exits at once. */
-static void on_sigint(int sig)
-{
-    (void)sig;
-    if (interrupted) _exit(EXIT_INTERRUPTED);
-    interrupted = 1;
-}
-
 static const char *const mode_names[] = {"gather", "shoot"};
 static const char *const est_names[] = {"collision", "absorption"};
 static const char *const chan = "RGB";
@@ -74,14 +62,6 @@ typedef struct {
     int threads, interrupted;
     double *all; /* shooting: 3 per patch */
 } walked;
-
-/* Index of word in names[0..n), or -1. */
-static int lookup(const char *word, const char *const *names, int n)
-{
-    for (int k = 0; k < n; k++)
-        if (!strcmp(word, names[k])) return k;
-    return -1;
-}
 
 /* Parse the options into a; 0, or an exit code (with -1 meaning: --help printed). */
 static int parse(int argc, char **argv, args *a)
@@ -106,11 +86,11 @@ static int parse(int argc, char **argv, args *a)
         switch (c) {
         case 'p': a->patch = optarg; break;
         case 'm':
-            if ((a->o.mode = lookup(optarg, mode_names, 2)) < 0)
+            if ((a->o.mode = cli_lookup(optarg, mode_names, 2)) < 0)
                 return cli_usage_error(cmd, "--mode expects gather or shoot, got '%s'", optarg);
             break;
         case 'e':
-            if ((a->o.estimator = lookup(optarg, est_names, 2)) < 0)
+            if ((a->o.estimator = cli_lookup(optarg, est_names, 2)) < 0)
                 return cli_usage_error(cmd, "--estimator expects collision or absorption, got '%s'", optarg);
             break;
         case 'n': if ((rc = cli_parse_int(cmd, "--walks", optarg, 1, INT64_MAX / 2, &a->o.max_walks))) return rc; any_rule = 1; break;
@@ -173,11 +153,9 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     ulam_error err;
     int status = ulam_rad_solver_alloc(t, &a->o, &sv, &err);
     if (status) return cli_report(a->scene, &err);
-    struct sigaction sa = {.sa_handler = on_sigint};
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
+    cli_catch_sigint();
     while (!status && !ulam_rad_solver_done(sv)) status = ulam_rad_solver_iterate(sv);
-    signal(SIGINT, SIG_DFL);
+    cli_release_sigint();
     ulam_rad_result r;
     ulam_rad_solver_result(sv, &r);
     memcpy(w->B, r.radiosity, sizeof w->B);
@@ -202,10 +180,8 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
     if (a->o.mode == ULAM_FORWARD) w->all = malloc((size_t)n * 3 * sizeof *w->all);
     int status = b && x && (a->o.mode == ULAM_ADJOINT || w->all) ? ULAM_OK : ULAM_ENOMEM;
     ulam_error err = {.status = status};
-    struct sigaction sa = {.sa_handler = on_sigint};
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    for (int c = 0; c < 3 && !status && !interrupted; c++) {
+    cli_catch_sigint();
+    for (int c = 0; c < 3 && !status && !cli_interrupted; c++) {
         ulam_csr *M = NULL;
         ulam_solver *sv = NULL;
         if ((status = ulam_radiosity_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
@@ -225,7 +201,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
         ulam_solver_free(sv);
         ulam_csr_free(M);
     }
-    signal(SIGINT, SIG_DFL);
+    cli_release_sigint();
     free(b), free(x);
     if (!status) return 0;
     err.status = status;
@@ -281,8 +257,8 @@ static void print_text(const args *a, const report *r)
             printf("radiosity %c  %.8g +- %.3g%s\n", chan[c], w->B[c], w->se[c], w->interrupted ? "  [INTERRUPTED]" : "");
     }
     if (w)
-        printf("walks        %lld %s %s walks%s, %lld %s, %.4f s (%.3g M %s/s, %d threads)\n", (long long)w->walks,
-               a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], "", (long long)w->steps,
+        printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)\n", (long long)w->walks,
+               a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads);
     if (r->Bdirect && r->patch >= 0)
@@ -399,7 +375,7 @@ int cli_radiosity(int argc, char **argv)
 {
     args a = {.ff_rays = 1000, .width = 512, .height = 512, .max_mem = (size_t)4 << 30, .o = ulam_walk_defaults()};
     a.o.max_walks = 0;
-    a.o.interrupt = &interrupted;
+    a.o.interrupt = &cli_interrupted;
     int rc = parse(argc, argv, &a);
     if (rc) return rc < 0 ? 0 : rc;
     ulam_scene *s = NULL;

@@ -3,11 +3,9 @@
 
 #include <getopt.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 static const char *const usage =
     "usage: ulam solve M.mtx --rhs b.mtx --index I [--mode adjoint|forward]\n"
@@ -48,26 +46,8 @@ static const char *const usage =
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C\n"
     "exits at once.\n";
 
-static volatile int interrupted;
-
-/* SIGINT: the first asks the walks to stop, the second exits at once. */
-static void on_sigint(int sig)
-{
-    (void)sig;
-    if (interrupted) _exit(EXIT_INTERRUPTED);
-    interrupted = 1;
-}
-
 static const char *const mode_names[] = {"adjoint", "forward"};
 static const char *const est_names[] = {"collision", "absorption", "expected"};
-
-/* Index of word in names[0..n), or -1. */
-static int lookup(const char *word, const char *const *names, int n)
-{
-    for (int k = 0; k < n; k++)
-        if (!strcmp(word, names[k])) return k;
-    return -1;
-}
 
 typedef struct {
     int check, json;
@@ -213,11 +193,11 @@ int cli_solve(int argc, char **argv)
         case 'b': s.rhs_path = optarg; break;
         case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
         case 'm':
-            if ((o.mode = lookup(optarg, mode_names, 2)) < 0)
+            if ((o.mode = cli_lookup(optarg, mode_names, 2)) < 0)
                 return cli_usage_error("solve", "--mode expects adjoint or forward, got '%s'", optarg);
             break;
         case 'e':
-            if ((o.estimator = lookup(optarg, est_names, 3)) < 0)
+            if ((o.estimator = cli_lookup(optarg, est_names, 3)) < 0)
                 return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
             break;
         case 'n': if ((rc = cli_parse_int("solve", "--walks", optarg, 1, INT64_MAX / 2, &o.max_walks))) return rc; any_rule = 1; break;
@@ -262,18 +242,16 @@ int cli_solve(int argc, char **argv)
     }
     ulam_solver *sv = NULL;
     ulam_error err;
-    o.interrupt = &interrupted;
+    o.interrupt = &cli_interrupted;
     int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err);
     if (status) {
         rc = cli_report(s.matrix_path, &err);
         cli_system_free(&s);
         return rc;
     }
-    struct sigaction sa = {.sa_handler = on_sigint};
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
+    cli_catch_sigint();
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
-    signal(SIGINT, SIG_DFL);
+    cli_release_sigint();
     ulam_walk_result r;
     ulam_solver_result(sv, &r);
     rc = 0;

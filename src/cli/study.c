@@ -4,7 +4,6 @@
 
 #include <getopt.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -56,16 +55,6 @@ typedef struct {
     double *est, *se, *sec; /* [m][b][r] */
     unsigned char *done;
 } study;
-
-static volatile int interrupted;
-
-/* SIGINT: the first stops after the current run, the second exits at once. */
-static void on_sigint(int sig)
-{
-    (void)sig;
-    if (interrupted) _exit(EXIT_INTERRUPTED);
-    interrupted = 1;
-}
 
 /* Flat index of (method, budget, repeat). */
 static size_t at(const study *st, int m, int b, int r)
@@ -185,7 +174,7 @@ static int one_run(study *st, int m, int b, int r, FILE *f)
     ulam_walk_opts o = ulam_walk_defaults();
     o.mode = me->mode, o.estimator = me->est, o.index = st->s.index - 1, o.threads = st->threads;
     o.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
-    o.interrupt = &interrupted;
+    o.interrupt = &cli_interrupted;
     if (st->time_budgets) o.max_walks = 0, o.max_seconds = st->budget[b];
     else o.max_walks = (int64_t)st->budget[b];
     double w0 = me->mode == ULAM_FORWARD ? 0.0 : 1.0; /* forward particles start at ||b||_1 */
@@ -222,13 +211,11 @@ static int run_all(study *st)
     for (int m = 0; m < NMETHOD; m++) total += st->m[m].on && !st->m[m].why[0];
     total *= st->nbudget;
     double t0 = ulam_now();
-    struct sigaction sa = {.sa_handler = on_sigint};
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    for (int b = 0; b < st->nbudget && !interrupted; b++)
-        for (int m = 0; m < NMETHOD && !interrupted; m++) {
+    cli_catch_sigint();
+    for (int b = 0; b < st->nbudget && !cli_interrupted; b++)
+        for (int m = 0; m < NMETHOD && !cli_interrupted; m++) {
             if (!st->m[m].on || st->m[m].why[0]) continue;
-            for (int r = 0; r < st->repeats && !interrupted; r++)
+            for (int r = 0; r < st->repeats && !cli_interrupted; r++)
                 if (!st->done[at(st, m, b, r)]) one_run(st, m, b, r, f);
             cells++;
             double el = ulam_now() - t0;
@@ -236,10 +223,10 @@ static int run_all(study *st)
                 fprintf(stderr, "\rulam: study: cells %d/%d, %.1f s elapsed, about %.0f s left   ", cells, total,
                         el, el / cells * (total - cells));
         }
-    signal(SIGINT, SIG_DFL);
+    cli_release_sigint();
     if (tty) fputc('\n', stderr);
     fclose(f);
-    return interrupted ? EXIT_INTERRUPTED : 0;
+    return cli_interrupted ? EXIT_INTERRUPTED : 0;
 }
 
 /* The exact x_I and the reference lines: LAPACK (n <= 8000: its time and its error against

@@ -46,11 +46,7 @@ int ulam_form_factors(const ulam_tracer *t, int64_t rays, uint64_t seed, int thr
     *F = NULL;
     const ulam_scene *s = ulam__tracer_scene(t);
     int64_t n = s->npatches, w = rays < n ? rays : n; /* a row has at most w entries */
-    int nth = 1;
-#ifdef _OPENMP
-    nth = threads > 0 ? threads : omp_get_max_threads();
-#endif
-    (void)threads;
+    int nth = ulam__threads(threads);
     int32_t *cols = ulam__malloc((size_t)n, (size_t)w * sizeof(int32_t));
     double *vals = ulam__malloc((size_t)n, (size_t)w * sizeof(double));
     int64_t *len = ulam__malloc((size_t)n, sizeof *len);

@@ -35,23 +35,6 @@ typedef struct {
     ulam_error *err;
 } objr;
 
-/* Make room for need items in *p (capacity *cap, item size sz); 0 or ULAM_ENOMEM. */
-static int grow(void **p, int64_t *cap, int64_t need, size_t sz)
-{
-    if (need <= *cap) return ULAM_OK;
-    int64_t c = *cap ? *cap : 16;
-    while (c < need) {
-        if (c > INT64_MAX / 2) return ULAM_ENOMEM;
-        c *= 2;
-    }
-    if ((uint64_t)c > SIZE_MAX / sz) return ULAM_ENOMEM;
-    void *q = realloc(*p, (size_t)c * sz);
-    if (!q) return ULAM_ENOMEM;
-    *p = q;
-    *cap = c;
-    return ULAM_OK;
-}
-
 /* A copy of the string s (NULL when out of memory). */
 static char *dup_str(const char *s)
 {
@@ -83,6 +66,18 @@ static void trim(char *line)
 static char *rest_of(char *s)
 {
     while (*s == ' ' || *s == '\t') s++;
+    return s;
+}
+
+/* Split a line in place into its keyword (returned; NULL for a blank or comment line) and the
+ * rest (*args), after cutting the comment and trailing white space. */
+static char *statement(char *line, char **args)
+{
+    trim(line);
+    char *s = rest_of(line);
+    if (!*s) return NULL;
+    char *sp = s + strcspn(s, " \t");
+    *args = *sp ? (*sp = '\0', sp + 1) : sp;
     return s;
 }
 
@@ -167,11 +162,8 @@ static int read_mtl(objr *o, const char *name, long obj_line)
     mtl *cur = NULL;
     while (!status && getline(&buf, &cap, f) != -1) {
         line++;
-        trim(buf);
-        char *s = rest_of(buf);
-        if (!*s) continue;
-        char *sp = s + strcspn(s, " \t");
-        char *args = *sp ? (*sp = '\0', sp + 1) : sp;
+        char *args, *s = statement(buf, &args);
+        if (!s) continue;
         if (!strcmp(s, "newmtl")) {
             char *nm = rest_of(args);
             if (!*nm) {
@@ -180,7 +172,7 @@ static int read_mtl(objr *o, const char *name, long obj_line)
             }
             int64_t i = find_mat(o, nm);
             if (i < 0) {
-                if (grow((void **)&o->mats, &o->cap_mats, o->nmats + 1, sizeof(mtl)) ||
+                if (ulam__grow(&o->mats, &o->cap_mats, o->nmats + 1, sizeof(mtl)) ||
                     !(o->mats[o->nmats].name = dup_str(nm))) {
                     status = mtl_fail(o, path, ULAM_ENOMEM, line, "%s", "memory for a material");
                     break;
@@ -231,7 +223,7 @@ static int do_group(objr *o, char *args, long line)
     }
     int64_t i = find_group(o, nm);
     if (i < 0) {
-        if (o->ngroups >= INT32_MAX || grow((void **)&o->groups, &o->cap_groups, o->ngroups + 1, sizeof(char *)) ||
+        if (o->ngroups >= INT32_MAX || ulam__grow(&o->groups, &o->cap_groups, o->ngroups + 1, sizeof(char *)) ||
             !(o->groups[o->ngroups] = dup_str(nm)))
             return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for a group name");
         i = o->ngroups++;
@@ -261,7 +253,7 @@ static int do_vertex(objr *o, char *args, long line)
     if (k == -2) return ulam__fail(o->err, ULAM_ENONFINITE, line, -1, "finite vertex coordinates");
     if (k != 3 && k != 4 && k != 6)
         return ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "v x y z (three numbers, optionally w or r g b)");
-    if (o->nv >= INT32_MAX || grow((void **)&o->v, &o->cap_v, 3 * (o->nv + 1), sizeof(double)))
+    if (o->nv >= INT32_MAX || ulam__grow(&o->v, &o->cap_v, 3 * (o->nv + 1), sizeof(double)))
         return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for the vertices");
     memcpy(o->v + 3 * o->nv++, x, 3 * sizeof(double));
     return ULAM_OK;
@@ -338,7 +330,7 @@ static int do_face(objr *o, char *args, long line)
     for (tok = strtok_r(args, " \t", &save); tok; tok = strtok_r(NULL, " \t", &save)) {
         int64_t k = face_index(o, tok, line);
         if (k < 0) return o->err ? o->err->status : ULAM_ESYNTAX;
-        if (grow((void **)&o->idx, &o->cap_idx, o->nidx + 1, sizeof(int32_t)))
+        if (ulam__grow(&o->idx, &o->cap_idx, o->nidx + 1, sizeof(int32_t)))
             return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for the faces");
         o->idx[o->nidx++] = (int32_t)k;
     }
@@ -346,7 +338,7 @@ static int do_face(objr *o, char *args, long line)
     if (n < 3) return ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "a face with at least 3 vertices");
     int status = check_face(o, o->idx + n0, n, line);
     if (status) return status;
-    if (grow((void **)&o->faces, &o->cap_f, o->nf + 1, sizeof(objface)))
+    if (ulam__grow(&o->faces, &o->cap_f, o->nf + 1, sizeof(objface)))
         return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for the faces");
     o->faces[o->nf++] = (objface){.start = n0, .mat = o->cur_mat, .group = o->cur_group};
     return ULAM_OK;
@@ -377,11 +369,8 @@ static int read_statements(objr *o, FILE *f)
             status = ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "text (this line holds a NUL byte)");
             break;
         }
-        trim(buf);
-        char *s = rest_of(buf);
-        if (!*s) continue;
-        char *sp = s + strcspn(s, " \t");
-        char *args = *sp ? (*sp = '\0', sp + 1) : sp;
+        char *args, *s = statement(buf, &args);
+        if (!s) continue;
         if (!strcmp(s, "v")) status = do_vertex(o, args, line);
         else if (!strcmp(s, "f")) status = do_face(o, args, line);
         else if (!strcmp(s, "o") || !strcmp(s, "g")) status = do_group(o, args, line);

@@ -20,9 +20,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 enum { RBLOCK = 256, RROUND = 32 };
 
@@ -160,11 +157,7 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam
     s->o = o;
     s->t = t;
     s->s = ulam__tracer_scene(t);
-#ifdef _OPENMP
-    s->threads = o.threads > 0 ? o.threads : omp_get_max_threads();
-#else
-    s->threads = 1;
-#endif
+    s->threads = ulam__threads(o.threads);
     s->t0 = -1;
     if (o.mode == ULAM_FORWARD && (status = build_source(s, err))) {
         ulam_rad_solver_free(s);
@@ -252,13 +245,7 @@ static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_bl
 /* Move a finished shooting history's tallies into the block; 0 or ULAM_ENOMEM. */
 static int flush_history(rad_scratch *sc, rad_block *br)
 {
-    if (br->len + sc->ntouched > br->cap) {
-        int64_t cap = br->cap ? br->cap : 1024;
-        while (cap < br->len + sc->ntouched) cap *= 2;
-        rad_tally *t = realloc(br->t, (size_t)cap * sizeof *t);
-        if (!t) return ULAM_ENOMEM;
-        br->t = t, br->cap = cap;
-    }
+    if (ulam__grow(&br->t, &br->cap, br->len + sc->ntouched, sizeof *br->t)) return ULAM_ENOMEM;
     for (int64_t k = 0; k < sc->ntouched; k++) {
         int32_t p = sc->touched[k];
         rad_tally *e = &br->t[br->len++];
@@ -274,22 +261,17 @@ static int flush_history(rad_scratch *sc, rad_block *br)
     return ULAM_OK;
 }
 
-/* Nonzero when the run must stop before starting another block. */
-static int must_stop(const ulam_rad_solver *s)
+/* Run walks [first, first + count) as block k on thread th (ctx: the solver). */
+static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
 {
-    if (s->o.interrupt && *s->o.interrupt) return 1;
-    return s->o.max_seconds > 0 && ulam_now() - s->t0 >= s->o.max_seconds;
-}
-
-/* Run walks [first, first + count) as block k on thread th. */
-static void run_block(const ulam_rad_solver *s, rad_block *br, int64_t first, int64_t count, int th)
-{
+    const ulam_rad_solver *s = ctx;
+    rad_block *br = &s->blocks[k];
     ulam__moments zero = {0};
     br->m[0] = br->m[1] = br->m[2] = zero;
     br->sq = br->maxsq = 0.0;
     br->len = br->walks = br->rays = br->cut = br->nonfinite = 0;
     br->complete = br->nomem = 0;
-    if (first > 0 ? must_stop(s) : s->o.interrupt && *s->o.interrupt) return; /* block 0 always runs */
+    if (!ulam__block_may_start(&s->o, s->t0, first)) return;
     ulam_rng r;
     ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / RBLOCK));
     for (int64_t w = 0; w < count; w++) {
@@ -358,19 +340,7 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     if (s->done) return s->status;
     double start = ulam_now();
     if (s->t0 < 0) s->t0 = start;
-    int64_t left = s->o.max_walks > 0 ? s->o.max_walks - s->next_walk : INT64_MAX;
-    int nb = 0;
-    while (nb < RROUND && left > (int64_t)nb * RBLOCK) nb++;
-    int64_t first = s->next_walk;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(s->threads)
-    for (int k = 0; k < nb; k++) {
-        int th = 0;
-#ifdef _OPENMP
-        th = omp_get_thread_num();
-#endif
-        int64_t rest = left - (int64_t)k * RBLOCK;
-        run_block(s, &s->blocks[k], first + (int64_t)k * RBLOCK, rest < RBLOCK ? rest : RBLOCK, th);
-    }
+    int nb = ulam__round(&s->o, s->next_walk, RBLOCK, RROUND, s->threads, run_block, s);
     for (int k = 0; k < nb; k++) {
         if (s->blocks[k].nomem) s->status = ULAM_ENOMEM;
         if (!s->blocks[k].complete) {
@@ -386,9 +356,8 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     if (s->status) s->done = 1;
     ulam_rad_result r;
     ulam_rad_solver_result(s, &r);
-    if (s->o.max_walks > 0 && s->next_walk >= s->o.max_walks) s->done = 1;
+    if (ulam__budget_spent(&s->o, s->t0, s->next_walk)) s->done = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(&r, s->o.rel_err)) s->done = 1;
-    if (s->o.max_seconds > 0 && ulam_now() - s->t0 >= s->o.max_seconds) s->done = 1;
     return s->status;
 }
 

@@ -89,12 +89,13 @@ static int32_t add_vertex(builder *b, const double x[3])
     return (int32_t)b->nv++;
 }
 
-/* Append a patch with vertices v[0..n) (already added) copying the source's attributes. */
-static void add_patch(builder *b, const ulam_scene *s, const int32_t *v, int n)
+/* Append a patch with vertices v[0..n) (already added; v == NULL: the last n vertices added),
+ * copying the source's attributes. */
+static void add_patch(builder *b, const ulam_scene *s, const int32_t *v, int64_t n)
 {
     ulam_scene *o = b->o;
     o->start[b->np] = b->nidx;
-    for (int k = 0; k < n; k++) o->vidx[b->nidx++] = v[k];
+    for (int64_t k = 0; k < n; k++) o->vidx[b->nidx++] = v ? v[k] : (int32_t)(b->nv - n + k);
     memcpy(o->rho + 3 * b->np, s->rho + 3 * b->src, 3 * sizeof(double));
     memcpy(o->emit + 3 * b->np, s->emit + 3 * b->src, 3 * sizeof(double));
     o->face[b->np] = s->face[b->src];
@@ -103,7 +104,8 @@ static void add_patch(builder *b, const ulam_scene *s, const int32_t *v, int n)
     o->start[b->np] = b->nidx;
 }
 
-/* Divisions of an edge pair so no piece exceeds L. */
+/* Divisions of an edge pair so no piece exceeds L (capped at 2^31: more would overflow the
+ * patch count, which the caller then refuses). */
 static int64_t divisions(const double *a, const double *b, const double *c, const double *d, double L)
 {
     double e1[3], e2[3];
@@ -111,11 +113,21 @@ static int64_t divisions(const double *a, const double *b, const double *c, cons
     ulam__sub3(d, c, e2);
     double len = fmax(sqrt(ulam__dot3(e1, e1)), sqrt(ulam__dot3(e2, e2)));
     double m = ceil(len / L);
-    return m < 1 ? 1 : (int64_t)m;
+    return m < 1 ? 1 : m > 2147483648.0 ? (int64_t)1 << 31 : (int64_t)m;
 }
 
-/* Pieces a patch splits into: m*k quads, m^2 triangles, or a fan's triangles split. */
-static int64_t pieces(const ulam_scene *s, int64_t p, double L, int64_t *m, int64_t *k)
+/* Divisions of triangle (A, B, C): its longest side over L. */
+static int64_t tri_divisions(const double *A, const double *B, const double *C, double L)
+{
+    int64_t d = divisions(A, B, B, C, L), d2 = divisions(C, A, A, B, L);
+    return d > d2 ? d : d2;
+}
+
+/* How patch p splits: returns the pieces and sets *nv to the vertices they add; quads split
+ * into an *m x *k grid, triangles into d^2 similar triangles (through a fan for larger
+ * polygons, which are kept whole when no side exceeds L).  Counts past INT32_MAX mean
+ * "too many". */
+static int64_t plan(const ulam_scene *s, int64_t p, double L, int64_t *m, int64_t *k, int64_t *nv)
 {
     const int32_t *v = s->vidx + s->start[p];
     int64_t n = s->start[p + 1] - s->start[p];
@@ -123,20 +135,23 @@ static int64_t pieces(const ulam_scene *s, int64_t p, double L, int64_t *m, int6
     if (n == 4) {
         *m = divisions(x + 3 * v[0], x + 3 * v[1], x + 3 * v[3], x + 3 * v[2], L);
         *k = divisions(x + 3 * v[0], x + 3 * v[3], x + 3 * v[1], x + 3 * v[2], L);
+        *nv = (*m + 1) * (*k + 1);
         return *m * *k;
-    }
-    int64_t total = 0;
-    for (int64_t t = 1; t + 1 < n; t++) {
-        const double *a = x + 3 * v[0], *b = x + 3 * v[t], *c = x + 3 * v[t + 1];
-        int64_t d = divisions(a, b, b, c, L), d2 = divisions(c, a, a, b, L);
-        d = d > d2 ? d : d2;
-        if (n == 3) *m = d;
-        total += d * d;
     }
     if (n > 4) {
         double N[3], longest;
         ulam__polygon_normal(x, v, n, N, &longest);
-        if (longest <= L) total = 1; /* small enough: kept whole */
+        if (longest <= L) {
+            *nv = n;
+            return 1;
+        }
+    }
+    int64_t total = 0;
+    *nv = 0;
+    for (int64_t t = 1; t + 1 < n && total <= INT32_MAX; t++) {
+        int64_t d = tri_divisions(x + 3 * v[0], x + 3 * v[t], x + 3 * v[t + 1], L);
+        total += d * d;
+        *nv += (d + 1) * (d + 2) / 2;
     }
     return total;
 }
@@ -193,14 +208,13 @@ int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out)
 {
     if (!s || !out || !(max_side > 0) || !isfinite(max_side)) return ULAM_EINVAL;
     *out = NULL;
-    int64_t np = 0, nv = 0, nidx = 0, m = 1, k = 1;
+    int64_t np = 0, nv = 0, nidx = 0, m = 1, k = 1, pv;
     for (int64_t p = 0; p < s->npatches; p++) {
-        int64_t n = s->start[p + 1] - s->start[p], c = pieces(s, p, max_side, &m, &k);
-        if (c > (int64_t)INT32_MAX - np) return ULAM_EOVERFLOW;
+        int64_t n = s->start[p + 1] - s->start[p], c = plan(s, p, max_side, &m, &k, &pv);
+        if (c > (int64_t)INT32_MAX - np || pv > (int64_t)INT32_MAX - nv) return ULAM_EOVERFLOW;
         np += c;
-        nv += n == 4 ? (m + 1) * (k + 1) : c == 1 && n > 4 ? n : (n - 2) * (c + 2 * (int64_t)sqrt((double)c) + 3);
+        nv += pv;
         nidx += n == 4 ? 4 * c : c == 1 && n > 4 ? n : 3 * c;
-        if (nv > (int64_t)INT32_MAX) return ULAM_EOVERFLOW;
     }
     ulam_scene *o = ulam__scene_alloc(np, nv, nidx, s->ngroups);
     if (!o) return ULAM_ENOMEM;
@@ -219,24 +233,17 @@ int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out)
     o->start[0] = 0;
     for (int64_t p = 0; p < s->npatches; p++) {
         const int32_t *v = s->vidx + s->start[p];
-        int64_t n = s->start[p + 1] - s->start[p], c = pieces(s, p, max_side, &m, &k);
+        int64_t n = s->start[p + 1] - s->start[p], c = plan(s, p, max_side, &m, &k, &pv);
         b.src = p;
         if (n == 4) {
             split_quad(&b, s, v, m, k);
-        } else if (c == 1 && n > 4) {
-            int32_t w[64], *ww = n <= 64 ? w : malloc((size_t)n * sizeof *ww);
-            if (!ww) {
-                ulam_scene_free(o);
-                return ULAM_ENOMEM;
-            }
-            for (int64_t a = 0; a < n; a++) ww[a] = add_vertex(&b, s->vert + 3 * v[a]);
-            add_patch(&b, s, ww, (int)n);
-            if (ww != w) free(ww);
+        } else if (c == 1 && n > 4) { /* kept whole */
+            for (int64_t a = 0; a < n; a++) add_vertex(&b, s->vert + 3 * v[a]);
+            add_patch(&b, s, NULL, n);
         } else {
             for (int64_t t = 1; t + 1 < n; t++) {
                 const double *A = s->vert + 3 * v[0], *B = s->vert + 3 * v[t], *C = s->vert + 3 * v[t + 1];
-                int64_t d = divisions(A, B, B, C, max_side), d2 = divisions(C, A, A, B, max_side);
-                split_triangle(&b, s, A, B, C, d > d2 ? d : d2);
+                split_triangle(&b, s, A, B, C, tri_divisions(A, B, C, max_side));
             }
         }
     }
