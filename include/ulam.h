@@ -150,6 +150,25 @@ int ulam_mm_write_matrix(const char *path, const ulam_csr *A, const char *commen
 /* Write x as "array real general" n x 1, atomically like ulam_mm_write_matrix. */
 int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const char *comment);
 
+/* An output file written under a temporary name in the same directory and renamed into place
+ * by ulam_outfile_commit: a reader sees the old file or the complete new one, never a part.
+ * Every file the library and the CLI write goes through it.  Write to f between open and
+ * commit; on any failure call ulam_outfile_abort, which leaves an old file at path intact. */
+typedef struct ulam_outfile {
+    FILE *f;    /* the temporary file, open for writing */
+    char *path; /* the final name */
+    char *tmp;  /* the temporary name (path.tmp.XXXXXX) */
+} ulam_outfile;
+
+/* Open a temporary file beside path; ULAM_OK, ULAM_ENOMEM or ULAM_EIO (o is then empty). */
+int ulam_outfile_open(ulam_outfile *o, const char *path);
+
+/* Flush, close and rename into place; ULAM_OK, or ULAM_EIO with the temporary file removed. */
+int ulam_outfile_commit(ulam_outfile *o);
+
+/* Close and remove the temporary file; accepts an empty (zeroed or aborted) o. */
+void ulam_outfile_abort(ulam_outfile *o);
+
 /* ---------------------------------------------------------------- direct solve */
 
 /* What a LAPACK direct solve reports besides the solution. */
@@ -527,7 +546,8 @@ ulam_camera ulam_camera_cornell(void);
 /* Render B (3 * npatches) as width x height 8-bit sRGB (3 bytes a pixel, rows top first):
  * one ray per pixel centre, the hit patch's radiosity times exposure, clamped, sRGB-encoded
  * (flat shading).  exposure <= 0 picks 1 / (the 99th percentile of the largest channel over
- * the pixels of patches that do not emit); the exposure used goes to *used (may be NULL). */
+ * the pixels of patches that do not emit); the exposure used goes to *used (may be NULL).
+ * ULAM_ENONFINITE if any of B is not finite, ULAM_EOVERFLOW if the image cannot be sized. */
 int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width,
                 int height, double exposure, unsigned char *rgb, double *used);
 

@@ -91,20 +91,4 @@ int ulam__grow(void *pp, int64_t *cap, int64_t need, size_t sz);
  * random access).  n items of size sz; freed with free(); NULL on overflow or failure. */
 void *ulam__alloc_big(size_t n, size_t sz);
 
-/* An output file written under a temporary name and renamed into place on commit. */
-typedef struct ulam__outfile {
-    FILE *f;
-    char *path;
-    char *tmp;
-} ulam__outfile;
-
-/* Open a temporary file beside path; ULAM_EIO if that fails. */
-int ulam__out_open(ulam__outfile *o, const char *path);
-
-/* Flush, close and rename into place; on any error remove the temporary file. */
-int ulam__out_commit(ulam__outfile *o);
-
-/* Close and remove the temporary file, leaving any old file at path intact. */
-void ulam__out_abort(ulam__outfile *o);
-
 #endif

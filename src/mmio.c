@@ -552,8 +552,8 @@ static void write_comment(FILE *f, const char *comment)
 int ulam_mm_write_matrix(const char *path, const ulam_csr *A, const char *comment)
 {
     if (!path || !A) return ULAM_EINVAL;
-    ulam__outfile o;
-    int status = ulam__out_open(&o, path);
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
     if (status) return status;
     fprintf(o.f, "%%%%MatrixMarket matrix coordinate real general\n");
     write_comment(o.f, comment);
@@ -562,7 +562,7 @@ int ulam_mm_write_matrix(const char *path, const ulam_csr *A, const char *commen
     for (int64_t i = 0; i < A->nrows; i++)
         for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
             fprintf(o.f, "%lld %d %.17g\n", (long long)i + 1, A->colidx[k] + 1, A->val[k]);
-    return ulam__out_commit(&o);
+    return ulam_outfile_commit(&o);
 }
 
 /* Write x as array real general n x 1, atomically; non-finite values are refused. */
@@ -571,12 +571,12 @@ int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const cha
     if (!path || !x || n < 1) return ULAM_EINVAL;
     for (int64_t k = 0; k < n; k++)
         if (!isfinite(x[k])) return ULAM_ENONFINITE;
-    ulam__outfile o;
-    int status = ulam__out_open(&o, path);
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
     if (status) return status;
     fprintf(o.f, "%%%%MatrixMarket matrix array real general\n");
     write_comment(o.f, comment);
     fprintf(o.f, "%lld 1\n", (long long)n);
     for (int64_t k = 0; k < n; k++) fprintf(o.f, "%.17g\n", x[k]);
-    return ulam__out_commit(&o);
+    return ulam_outfile_commit(&o);
 }

@@ -126,14 +126,14 @@ double ulam_now(void)
 }
 
 /* Open a temporary file beside path. */
-int ulam__out_open(ulam__outfile *o, const char *path)
+int ulam_outfile_open(ulam_outfile *o, const char *path)
 {
     memset(o, 0, sizeof *o);
     size_t len = strlen(path);
     o->path = ulam__malloc(len + 1, 1);
     o->tmp = ulam__malloc(len + 16, 1);
     if (!o->path || !o->tmp) {
-        ulam__out_abort(o);
+        ulam_outfile_abort(o);
         return ULAM_ENOMEM;
     }
     memcpy(o->path, path, len + 1);
@@ -141,7 +141,7 @@ int ulam__out_open(ulam__outfile *o, const char *path)
     int fd = mkstemp(o->tmp);
     if (fd < 0) {
         o->tmp[0] = '\0';
-        ulam__out_abort(o);
+        ulam_outfile_abort(o);
         return ULAM_EIO;
     }
     mode_t mask = umask(0);
@@ -150,29 +150,30 @@ int ulam__out_open(ulam__outfile *o, const char *path)
     o->f = fdopen(fd, "w");
     if (!o->f) {
         close(fd);
-        ulam__out_abort(o);
+        ulam_outfile_abort(o);
         return ULAM_EIO;
     }
     return ULAM_OK;
 }
 
 /* Flush, close and rename into place. */
-int ulam__out_commit(ulam__outfile *o)
+int ulam_outfile_commit(ulam_outfile *o)
 {
+    if (!o || !o->f) return ULAM_EINVAL;
     int bad = ferror(o->f) || fflush(o->f) != 0;
     bad |= fclose(o->f) != 0;
     o->f = NULL;
     if (!bad && rename(o->tmp, o->path) == 0) {
         o->tmp[0] = '\0';
-        ulam__out_abort(o);
+        ulam_outfile_abort(o);
         return ULAM_OK;
     }
-    ulam__out_abort(o);
+    ulam_outfile_abort(o);
     return ULAM_EIO;
 }
 
 /* Close and remove the temporary file. */
-void ulam__out_abort(ulam__outfile *o)
+void ulam_outfile_abort(ulam_outfile *o)
 {
     if (o->f) fclose(o->f);
     if (o->tmp && o->tmp[0]) remove(o->tmp);

@@ -239,6 +239,73 @@ def check_interrupt(ulam):
         assert o["ci95"] == [None, None] and o["stderr"] is None
 
 
+def check_second_interrupt(ulam):
+    """A second Ctrl-C exits at once.  solve's stdout is a pipe the test has filled, so the
+    process cannot finish its output: after the first Ctrl-C (the walks stop, or the blocked
+    write is restarted) it would wait forever; the second must end it with 130, and none of its
+    output may have got through."""
+    import signal
+    r, w = os.pipe()
+    os.set_blocking(w, False)
+    filled = 0
+    for chunk in (4096, 1):  # whole pages, then single bytes up to the last free byte
+        try:
+            while True:
+                filled += os.write(w, b"x" * chunk)
+        except BlockingIOError:
+            pass
+    os.set_blocking(w, True)  # O_NONBLOCK belongs to the shared file description: undo it
+    p = subprocess.Popen([ulam] + SOLVE + ["--index", "1", "--walks", "100000", "--json"], stdout=w,
+                         stderr=subprocess.DEVNULL)
+    os.close(w)
+    interrupt_when_ready(p)
+    pending = True
+    while pending and p.poll() is None:  # the first must be taken before the second is sent
+        try:
+            st = {l.split(":")[0]: int(l.split()[1], 16) for l in open(f"/proc/{p.pid}/status")
+                  if l.startswith(("SigPnd:", "ShdPnd:"))}
+        except OSError:
+            break
+        pending = any(v & (1 << (signal.SIGINT - 1)) for v in st.values())
+    assert p.poll() is None, "solve finished its output into a full pipe?"
+    p.send_signal(signal.SIGINT)
+    try:
+        p.wait(timeout=60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    os.set_blocking(r, False)
+    got = b""
+    try:
+        while True:
+            block = os.read(r, 65536)
+            if not block:
+                break
+            got += block
+    except BlockingIOError:
+        pass
+    os.close(r)
+    assert p.returncode == 130, p.returncode
+    assert got == b"x" * filled, "output got through after the second Ctrl-C"
+
+
+def check_study_nonfinite(ulam):
+    """M = 0: every walk scores 1 exactly, so the standard error is 0 and honesty (RMSE / mean
+    standard error) is 0/0.  The CSVs carry an empty field there, never inf or nan; no
+    temporary file is left in the output directory."""
+    with tempfile.TemporaryDirectory() as d:
+        rc, _, err = run(ulam, ["study", D + "zero1.mtx", "--rhs", D + "one1.mtx", "--index", "1", "--methods",
+                                "adjoint-collision-plain,adjoint-absorption-plain", "--budgets", "100",
+                                "--repeats", "3", "--out", d])
+        assert rc == 0, (rc, err)
+        for name in ("runs.csv", "summary.csv", "bars.csv", "reference.csv"):
+            text = open(os.path.join(d, name)).read().lower()
+            assert "inf" not in text and "nan" not in text, (name, text)
+        summary = open(os.path.join(d, "summary.csv")).read().splitlines()
+        assert len(summary) == 3 and all(l.split(",")[5] == "" for l in summary[1:]), summary
+        assert all(".tmp." not in f for f in os.listdir(d)), os.listdir(d)
+
+
 def check_study(ulam):
     """study: rows per run, a summary per cell, resume without duplicates, a torn last line cut,
     refusals listed, Ctrl-C keeps finished rows."""
@@ -347,7 +414,8 @@ def main():
     ulam, genmat = sys.argv[1], sys.argv[2]
     failures, n = check_table(ulam)
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
-             (check_forward_files, ulam), (check_interrupt, ulam), (check_study, ulam),
+             (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
+             (check_study, ulam), (check_study_nonfinite, ulam),
              (check_radiosity, ulam)]
     for f, arg in extra:
         try:

@@ -170,6 +170,9 @@ static void test_invalid(void **state)
     assert_null(A);
     assert_null(ulam_csr_free(NULL));
     assert_null(ulam_csr_alloc(-1, 3, 0));
+    assert_null(ulam_csr_alloc(3, 3, INT64_MAX));     /* nnz x sizeof overflows size_t */
+    assert_null(ulam_csr_alloc(3, 3, INT64_MAX / 8)); /* fits size_t, no such memory */
+    assert_null(ulam_csr_alloc((int64_t)1 << 40, 3, 0)); /* past ULAM_MAX_DIM */
     assert_string_equal(ulam_strerror(ULAM_OK), "success");
     assert_string_equal(ulam_strerror(-5), "unknown status");
     for (int s = 0; s < ULAM_NSTATUS; s++) assert_true(strlen(ulam_strerror(s)) > 3);

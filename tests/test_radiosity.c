@@ -234,6 +234,16 @@ static void test_furnace(void **state)
     double B[18];
     assert_int_equal(ulam_radiosity_direct(s, F, 0, B, NULL, NULL), ULAM_OK);
     for (int k = 0; k < 18; k++) assert_close(B[k], 2.0, 1e-3);
+    /* an image of it: 2 x exposure 0.25 = 0.5 linear = sRGB byte 188; a NaN makes no picture */
+    ulam_camera cam = {.eye = {0.5, 0.5, 0.5}, .dir = {0, 0, -1}, .up = {0, 1, 0}, .focal = 1.0, .film = 1.0};
+    unsigned char rgb[4 * 4 * 3];
+    double two[18];
+    for (int k = 0; k < 18; k++) two[k] = 2.0;
+    assert_int_equal(ulam_render(t, two, &cam, 4, 4, 0.25, rgb, NULL), ULAM_OK);
+    for (int k = 0; k < 48; k++) assert_int_equal(rgb[k], 188);
+    assert_int_equal(ulam_render(t, two, &cam, INT32_MAX, INT32_MAX, 1.0, rgb, NULL), ULAM_EOVERFLOW);
+    two[7] = NAN;
+    assert_int_equal(ulam_render(t, two, &cam, 4, 4, 0.25, rgb, NULL), ULAM_ENONFINITE);
     for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
         for (int64_t p = 0; p < 6; p += 5) {
             ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, est, p, 20000, 11 + (uint64_t)p, NULL);

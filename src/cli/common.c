@@ -20,10 +20,10 @@ static void on_sigint(int sig)
     cli_interrupted = 1;
 }
 
-/* Catch SIGINT. */
+/* Catch SIGINT; a write blocked on a full pipe is restarted after the first. */
 void cli_catch_sigint(void)
 {
-    struct sigaction sa = {.sa_handler = on_sigint};
+    struct sigaction sa = {.sa_handler = on_sigint, .sa_flags = SA_RESTART};
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
 }

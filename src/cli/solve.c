@@ -251,7 +251,6 @@ int cli_solve(int argc, char **argv)
     }
     cli_catch_sigint();
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
-    cli_release_sigint();
     ulam_walk_result r;
     ulam_solver_result(sv, &r);
     rc = 0;
@@ -268,6 +267,8 @@ int cli_solve(int argc, char **argv)
         else print_text(&o, &r, &ro);
         if (r.interrupted) rc = EXIT_INTERRUPTED;
     }
+    fflush(stdout); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
+    cli_release_sigint();
     ulam_solver_free(sv);
     cli_system_free(&s);
     return rc;

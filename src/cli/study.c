@@ -1,5 +1,7 @@
-/* ulam study: every method at every budget, R repeats each, against the exact value; rows
- * appended to runs.csv as they finish (a rerun resumes), then summary.csv and charts. */
+/* ulam study: every method at every budget, R repeats each, against the exact value; runs.csv
+ * rewritten whole (temporary file, then rename) after each cell and on Ctrl-C, so a rerun
+ * resumes; then summary.csv and charts.  No output file is ever seen half written, and no
+ * non-finite number is written: an undefined statistic is an empty field. */
 #include "cli.h"
 
 #include <getopt.h>
@@ -24,8 +26,8 @@ static const char *const usage =
     "  --budgets LIST       walks per run (default 100,1000,10000,100000,1000000)\n"
     "  --time-budgets LIST  seconds per run instead of walk counts\n"
     "  --repeats R          runs per method and budget (default 30)\n"
-    "  --out DIR            output directory (default study): runs.csv (a row per run, appended\n"
-    "                       and flushed as each finishes; rerunning resumes), summary.csv,\n"
+    "  --out DIR            output directory (default study): runs.csv (a row per run, saved\n"
+    "                       after each method and budget; rerunning resumes), summary.csv,\n"
     "                       reference.csv, rmse.png, work.png, coverage.png\n"
     "  --seed S             base seed (default 1); run r of method m at budget k has its own\n"
     "\n"
@@ -54,7 +56,10 @@ typedef struct {
     double exact;
     double *est, *se, *sec; /* [m][b][r] */
     unsigned char *done;
+    char **row; /* [m][b][r]: the runs.csv line of a finished run */
 } study;
+
+static const char runs_header[] = "method,budget,repeat,seed,estimate,stderr,abs_error,walks,steps,seconds,covered\n";
 
 /* Flat index of (method, budget, repeat). */
 static size_t at(const study *st, int m, int b, int r)
@@ -138,37 +143,61 @@ static int screen_methods(study *st)
     return left ? 0 : EXIT_DIVERGE;
 }
 
-/* Read the finished rows of an earlier run of this study; cut a torn last line. */
+/* v as %.6g in buf, or an empty field when it is not finite (an undefined statistic). */
+static const char *num(char buf[32], double v)
+{
+    if (isfinite(v)) snprintf(buf, 32, "%.6g", v);
+    else buf[0] = '\0';
+    return buf;
+}
+
+/* Keep the finished rows of an earlier run of this study (a torn line, left by an older
+ * version that appended, is dropped). */
 static void resume(study *st, const char *path)
 {
-    FILE *f = fopen(path, "r+");
+    FILE *f = fopen(path, "r");
     if (!f) return;
     char line[1024], name[64];
-    long good = 0;
     int rows = 0;
     while (fgets(line, sizeof line, f)) {
         size_t len = strlen(line);
-        if (len == 0 || line[len - 1] != '\n') break; /* torn by a kill: dropped below */
+        if (len == 0 || line[len - 1] != '\n') break;
         double budget, e, se, sec;
         int r;
-        if (sscanf(line, "%63[^,],%lf,%d,%*u,%lf,%lf,%*f,%*d,%*d,%lf", name, &budget, &r, &e, &se, &sec) == 6)
+        if (sscanf(line, "%63[^,],%lf,%d,%*u,%lf,%lf,%*f,%*d,%*d,%lf", name, &budget, &r, &e, &se, &sec) == 6 &&
+            isfinite(e) && isfinite(se) && isfinite(sec))
             for (int m = 0; m < NMETHOD; m++)
                 for (int b = 0; b < st->nbudget; b++)
                     if (!strcmp(st->m[m].name, name) && st->budget[b] == budget && r >= 0 && r < st->repeats) {
                         size_t i = at(st, m, b, r);
+                        if (st->done[i] || !(st->row[i] = strdup(line))) continue;
                         st->est[i] = e, st->se[i] = se, st->sec[i] = sec, st->done[i] = 1;
                         rows++;
                     }
-        good = ftell(f);
     }
-    fflush(f);
-    if (ftruncate(fileno(f), good)) good = 0;
     fclose(f);
     if (rows) fprintf(stderr, "ulam: study: resuming: %d runs already in %s\n", rows, path);
 }
 
+/* Write every finished row to runs.csv (temporary file, then rename); 0 or an exit code. */
+static int save_runs(const study *st)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/runs.csv", st->out);
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (!status) {
+        fputs(runs_header, o.f);
+        for (size_t i = 0, n = at(st, NMETHOD, 0, 0); i < n; i++)
+            if (st->done[i]) fputs(st->row[i], o.f);
+        status = ulam_outfile_commit(&o);
+    }
+    ulam_error e = {.status = status, .msg = "a writable output directory"};
+    return status ? cli_report(path, &e) : 0;
+}
+
 /* One run; 0 when it finished (not interrupted) and was recorded. */
-static int one_run(study *st, int m, int b, int r, FILE *f)
+static int one_run(study *st, int m, int b, int r)
 {
     const method *me = &st->m[m];
     ulam_walk_opts o = ulam_walk_defaults();
@@ -185,48 +214,47 @@ static int one_run(study *st, int m, int b, int r, FILE *f)
     ulam_walk_result res;
     if (ulam_solve(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted || res.walks < 2 || !isfinite(res.std_error))
         return 1; /* nothing non-finite reaches runs.csv */
+    char line[512];
+    snprintf(line, sizeof line, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", me->name, st->budget[b], r,
+             (unsigned long long)o.seed, res.estimate, res.std_error, fabs(res.estimate - st->exact),
+             (long long)res.walks, (long long)res.steps, res.seconds,
+             fabs(res.estimate - st->exact) <= 1.959963984540054 * res.std_error);
     size_t i = at(st, m, b, r);
+    if (!(st->row[i] = strdup(line))) return 1;
     st->est[i] = res.estimate, st->se[i] = res.std_error, st->sec[i] = res.seconds, st->done[i] = 1;
-    fprintf(f, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", me->name, st->budget[b], r,
-            (unsigned long long)o.seed, res.estimate, res.std_error, fabs(res.estimate - st->exact),
-            (long long)res.walks, (long long)res.steps, res.seconds,
-            fabs(res.estimate - st->exact) <= 1.959963984540054 * res.std_error);
-    fflush(f);
     return 0;
 }
 
-/* Run every missing run, appending to runs.csv; 0, or EXIT_INTERRUPTED. */
+/* Run every missing run, saving runs.csv after each cell (and every 10 s within one) and on
+ * Ctrl-C; 0, EXIT_INTERRUPTED, or an exit code when runs.csv cannot be written. */
 static int run_all(study *st)
 {
     char path[4096];
     snprintf(path, sizeof path, "%s/runs.csv", st->out);
     resume(st, path);
-    FILE *f = fopen(path, "a");
-    if (!f) {
-        ulam_error e = {.status = ULAM_EIO, .msg = "a writable output directory"};
-        return cli_report(path, &e);
-    }
-    if (ftell(f) == 0) fprintf(f, "method,budget,repeat,seed,estimate,stderr,abs_error,walks,steps,seconds,covered\n");
-    int cells = 0, total = 0, tty = isatty(2);
+    int rc = save_runs(st), cells = 0, total = 0, tty = isatty(2);
+    if (rc) return rc;
     for (int m = 0; m < NMETHOD; m++) total += st->m[m].on && !st->m[m].why[0];
     total *= st->nbudget;
-    double t0 = ulam_now();
+    double t0 = ulam_now(), saved = t0;
     cli_catch_sigint();
-    for (int b = 0; b < st->nbudget && !cli_interrupted; b++)
-        for (int m = 0; m < NMETHOD && !cli_interrupted; m++) {
+    for (int b = 0; b < st->nbudget && !cli_interrupted && !rc; b++)
+        for (int m = 0; m < NMETHOD && !cli_interrupted && !rc; m++) {
             if (!st->m[m].on || st->m[m].why[0]) continue;
-            for (int r = 0; r < st->repeats && !cli_interrupted; r++)
-                if (!st->done[at(st, m, b, r)]) one_run(st, m, b, r, f);
+            for (int r = 0; r < st->repeats && !cli_interrupted && !rc; r++)
+                if (!st->done[at(st, m, b, r)] && !one_run(st, m, b, r) && ulam_now() - saved > 10.0)
+                    rc = save_runs(st), saved = ulam_now();
+            if (!rc) rc = save_runs(st), saved = ulam_now();
             cells++;
             double el = ulam_now() - t0;
             if (tty)
                 fprintf(stderr, "\rulam: study: cells %d/%d, %.1f s elapsed, about %.0f s left   ", cells, total,
                         el, el / cells * (total - cells));
         }
+    if (!rc) rc = save_runs(st); /* the rows finished before Ctrl-C */
     cli_release_sigint();
     if (tty) fputc('\n', stderr);
-    fclose(f);
-    return cli_interrupted ? EXIT_INTERRUPTED : 0;
+    return rc ? rc : cli_interrupted ? EXIT_INTERRUPTED : 0;
 }
 
 /* The exact x_I and the reference lines: LAPACK (n <= 8000: its time and its error against
@@ -243,18 +271,20 @@ static int references(study *st)
         if (k > 10 && fabs(x[I] - old) <= 1e-16 * fabs(x[I])) break;
     }
     st->exact = x[I];
-    char path[4096];
+    char path[4096], v[2][32];
     snprintf(path, sizeof path, "%s/reference.csv", st->out);
-    FILE *f = fopen(path, "w");
-    if (!f) {
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (status) {
         free(x);
-        ulam_error e = {.status = ULAM_EIO, .msg = "a writable output directory"};
+        ulam_error e = {.status = status, .msg = "a writable output directory"};
         return cli_report(path, &e);
     }
+    FILE *f = o.f;
     fprintf(f, "kind,seconds,error\n");
     ulam_direct_info info;
     if (n <= 8000 && (xd = malloc((size_t)n * sizeof *xd)) && !ulam_direct_solve(st->s.M, st->s.b, xd, 0, &info, NULL)) {
-        fprintf(f, "lapack,%.6g,%.6g\n", info.seconds, fabs(xd[I] - st->exact) + 1e-300);
+        fprintf(f, "lapack,%s,%s\n", num(v[0], info.seconds), num(v[1], fabs(xd[I] - st->exact) + 1e-300));
         st->exact = xd[I];
     }
     free(xd);
@@ -265,27 +295,30 @@ static int references(study *st)
         ulam_gauss_seidel_sweep(st->s.M, st->s.b, x);
         t += ulam_now() - t0;
         double e = fabs(x[I] - st->exact);
-        if ((k & (k - 1)) == 0 || e <= 1e-9 * fabs(st->exact)) fprintf(f, "gs,%.6g,%.6g\n", t, e + 1e-300);
-        if (e <= 1e-9 * fabs(st->exact)) break;
+        if ((k & (k - 1)) == 0 || e <= 1e-9 * fabs(st->exact))
+            fprintf(f, "gs,%s,%s\n", num(v[0], t), num(v[1], e + 1e-300));
+        if (!(e > 1e-9 * fabs(st->exact))) break;
     }
     free(x);
-    fclose(f);
-    return 0;
+    ulam_error e = {.status = ulam_outfile_commit(&o), .msg = "a writable output directory"};
+    return e.status ? cli_report(path, &e) : 0;
 }
 
 /* summary.csv (a row per cell) and bars.csv (per method, at the largest budget). */
 static int summarise(study *st)
 {
-    char path[4096], path2[4096];
-    snprintf(path, sizeof path, "%s/summary.csv", st->out);
-    snprintf(path2, sizeof path2, "%s/bars.csv", st->out);
-    FILE *f = fopen(path, "w"), *g = fopen(path2, "w");
-    if (!f || !g) {
-        if (f) fclose(f);
-        if (g) fclose(g);
-        ulam_error e = {.status = ULAM_EIO, .msg = "a writable output directory"};
-        return cli_report(path, &e);
+    char path[2][4096], v[6][32];
+    snprintf(path[0], sizeof path[0], "%s/summary.csv", st->out);
+    snprintf(path[1], sizeof path[1], "%s/bars.csv", st->out);
+    ulam_outfile o[2] = {{0}};
+    int k = 0, status = ULAM_OK;
+    for (; k < 2 && !status; k++) status = ulam_outfile_open(&o[k], path[k]);
+    if (status) {
+        ulam_outfile_abort(&o[0]);
+        ulam_error err = {.status = status, .msg = "a writable output directory"};
+        return cli_report(path[k - 1], &err);
     }
+    FILE *f = o[0].f, *g = o[1].f;
     fprintf(f, "method,budget,runs,rmse,mean_stderr,honesty,coverage,seconds,work,variance_finite\n");
     fprintf(g, "method,work,coverage,honesty\n");
     double *e = malloc((size_t)st->repeats * 3 * sizeof *e);
@@ -301,17 +334,21 @@ static int summarise(study *st)
             if (!k) continue;
             ulam_cell c;
             ulam_cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, &c);
-            fprintf(f, "%s,%.17g,%d,%.6g,%.6g,%.4g,%.4g,%.6g,%.6g,%s\n", st->m[m].name, st->budget[b], c.runs,
-                    c.rmse, c.mean_stderr, c.honesty, c.coverage, c.seconds, c.work,
-                    st->m[m].infinite ? "false" : "true");
+            fprintf(f, "%s,%.17g,%d,%s,%s,%s,%s,%s,%s,%s\n", st->m[m].name, st->budget[b], c.runs,
+                    num(v[0], c.rmse), num(v[1], c.mean_stderr), num(v[2], c.honesty), num(v[3], c.coverage),
+                    num(v[4], c.seconds), num(v[5], c.work), st->m[m].infinite ? "false" : "true");
             last = c;
         }
-        if (last.runs) fprintf(g, "%s,%.6g,%.4g,%.4g\n", st->m[m].name, last.work, last.coverage, last.honesty);
+        if (last.runs)
+            fprintf(g, "%s,%s,%s,%s\n", st->m[m].name, num(v[0], last.work), num(v[1], last.coverage),
+                    num(v[2], last.honesty));
     }
+    status = e ? ULAM_OK : ULAM_ENOMEM;
     free(e);
-    fclose(f);
-    fclose(g);
-    return 0;
+    for (k = 0; k < 2 && !status; k++) status = ulam_outfile_commit(&o[k]);
+    ulam_outfile_abort(&o[0]), ulam_outfile_abort(&o[1]); /* whatever was not committed */
+    ulam_error err = {.status = status, .msg = "a writable output directory"};
+    return status ? cli_report(path[k ? k - 1 : 0], &err) : 0;
 }
 
 /* The three charts. */
@@ -388,8 +425,8 @@ int cli_study(int argc, char **argv)
     if ((rc = cli_load_system(&st.s))) return rc;
     size_t cells = (size_t)NMETHOD * MAXBUDGET * (size_t)st.repeats;
     st.est = malloc(cells * sizeof *st.est), st.se = malloc(cells * sizeof *st.se);
-    st.sec = malloc(cells * sizeof *st.sec), st.done = calloc(cells, 1);
-    rc = st.est && st.se && st.sec && st.done ? 0 : cli_exit_code(ULAM_ENOMEM);
+    st.sec = malloc(cells * sizeof *st.sec), st.done = calloc(cells, 1), st.row = calloc(cells, sizeof *st.row);
+    rc = st.est && st.se && st.sec && st.done && st.row ? 0 : cli_exit_code(ULAM_ENOMEM);
     if (!rc) rc = screen_methods(&st);
     if (!rc) rc = references(&st);
     if (!rc) rc = run_all(&st);
@@ -398,7 +435,8 @@ int cli_study(int argc, char **argv)
         if (!rs) charts(&st);
         else rc = rs;
     }
-    free(st.est), free(st.se), free(st.sec), free(st.done);
+    for (size_t i = 0; st.row && i < cells; i++) free(st.row[i]);
+    free(st.est), free(st.se), free(st.sec), free(st.done), free(st.row);
     cli_system_free(&st.s);
     return rc;
 }

@@ -16,7 +16,7 @@ ulam_camera ulam_camera_cornell(void)
 /* The sRGB transfer curve of a linear value in [0, 1], as a byte. */
 static unsigned char srgb_byte(double v)
 {
-    v = v < 0 ? 0 : v > 1 ? 1 : v;
+    v = v > 0 ? (v < 1 ? v : 1) : 0;
     double e = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
     return (unsigned char)lround(255.0 * e);
 }
@@ -65,6 +65,8 @@ int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, i
     if (!t || !B || !cam || !rgb || width < 1 || height < 1 || !(cam->focal > 0) || !(cam->film > 0))
         return ULAM_EINVAL;
     const ulam_scene *s = ulam__tracer_scene(t);
+    for (int64_t k = 0; k < 3 * s->npatches; k++)
+        if (!isfinite(B[k])) return ULAM_ENONFINITE; /* no picture of a failed solve */
     size_t np = (size_t)width * (size_t)height;
     if (np > SIZE_MAX / 8 / 3) return ULAM_EOVERFLOW;
     int64_t *hit = ulam__malloc(np, sizeof *hit);
@@ -117,12 +119,12 @@ static int png_stream(FILE *f, int width, int height, const unsigned char *rgb)
 int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb)
 {
     if (!path || !rgb || width < 1 || height < 1) return ULAM_EINVAL;
-    ulam__outfile o;
-    int status = ulam__out_open(&o, path);
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
     if (status) return status;
     if ((status = png_stream(o.f, width, height, rgb))) {
-        ulam__out_abort(&o);
+        ulam_outfile_abort(&o);
         return status;
     }
-    return ulam__out_commit(&o);
+    return ulam_outfile_commit(&o);
 }
