@@ -90,6 +90,11 @@ ulam_csr *ulam_csr_free(ulam_csr *A);
 /* Number of stored entries. */
 int64_t ulam_csr_nnz(const ulam_csr *A);
 
+/* ULAM_OK when A holds the invariants above (rowptr from 0 rising to nnz, columns in range,
+ * sorted and unique in each row, values finite and nonzero); else the status of the first
+ * breach (ULAM_ESYNTAX, ULAM_EINDEX, ULAM_ENONFINITE; ULAM_EINVAL for bad sizes). */
+int ulam_csr_check(const ulam_csr *A);
+
 /* Build a CSR matrix from triplets (0-based); duplicates are summed, zeros dropped. */
 int ulam_csr_from_triplets(int64_t nrows, int64_t ncols, int64_t nz, const int32_t *ti,
                            const int32_t *tj, const double *tx, ulam_csr **out);
@@ -149,6 +154,18 @@ int ulam_mm_write_matrix(const char *path, const ulam_csr *A, const char *commen
 
 /* Write x as "array real general" n x 1, atomically like ulam_mm_write_matrix. */
 int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const char *comment);
+
+/* ---------------------------------------------------------------- binary caches */
+
+/* A parsed matrix or vector saved as its arrays behind a header (native byte order), so a
+ * second run reads instead of parsing.  tag identifies the source (the CLI uses its size and
+ * modification time): a cache whose tag differs is refused with ULAM_ENOTFOUND, one written
+ * on another byte order with ULAM_EBANNER, a truncated or inconsistent one with ULAM_ESYNTAX
+ * (its CSR structure is checked as a parse would be).  Written atomically. */
+int ulam_cache_write_csr(const char *path, const ulam_csr *A, const uint64_t tag[2]);
+int ulam_cache_read_csr(const char *path, const uint64_t tag[2], ulam_csr **A, ulam_error *err);
+int ulam_cache_write_vector(const char *path, const double *x, int64_t n, const uint64_t tag[2]);
+int ulam_cache_read_vector(const char *path, const uint64_t tag[2], double **x, int64_t *n, ulam_error *err);
 
 /* An output file written under a temporary name in the same directory and renamed into place
  * by ulam_outfile_commit: a reader sees the old file or the complete new one, never a part.

@@ -38,6 +38,25 @@ int64_t ulam_csr_nnz(const ulam_csr *A)
     return A ? A->rowptr[A->nrows] : 0;
 }
 
+/* Check that A holds the CSR invariants: rowptr from 0 rising to nnz, columns in range,
+ * sorted and unique within each row, values finite and nonzero. */
+int ulam_csr_check(const ulam_csr *A)
+{
+    if (!A || !A->rowptr || A->nrows < 0 || A->ncols < 0 || A->nrows > ULAM_MAX_DIM || A->ncols > ULAM_MAX_DIM)
+        return ULAM_EINVAL;
+    if (A->rowptr[0] != 0) return ULAM_ESYNTAX;
+    for (int64_t i = 0; i < A->nrows; i++) {
+        if (A->rowptr[i + 1] < A->rowptr[i]) return ULAM_ESYNTAX;
+        for (int64_t p = A->rowptr[i]; p < A->rowptr[i + 1]; p++) {
+            if (A->colidx[p] < 0 || A->colidx[p] >= A->ncols) return ULAM_EINDEX;
+            if (p > A->rowptr[i] && A->colidx[p] <= A->colidx[p - 1]) return ULAM_ESYNTAX;
+            if (!isfinite(A->val[p])) return ULAM_ENONFINITE;
+            if (A->val[p] == 0.0) return ULAM_ESYNTAX;
+        }
+    }
+    return ULAM_OK;
+}
+
 typedef struct {
     int32_t j;
     double x;

@@ -249,11 +249,14 @@ int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first)
     return first == 0 || !(o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds);
 }
 
-/* One round of blocks, in parallel. */
+/* One round of blocks, in parallel.  Rounds grow 1, 2, 4, ... blocks up to round (a round
+ * is as long as all before it), so a --rel-err or time rule is checked often while little has
+ * run, and the schedule depends on walks done only, never on the thread count. */
 int ulam__round(const ulam_walk_opts *o, int64_t next, int block, int round, int threads,
                 void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread), void *ctx)
 {
-    int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX;
+    int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX, done = next / block;
+    if (done + 1 < round) round = (int)(done + 1);
     int nb = 0;
     while (nb < round && left > (int64_t)nb * block) nb++;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)

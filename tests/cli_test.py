@@ -289,6 +289,28 @@ def check_second_interrupt(ulam):
     assert got == b"x" * filled, "output got through after the second Ctrl-C"
 
 
+def check_cache(ulam):
+    """--cache: the first run parses and writes FILE.ulamcache, the second reads it and gives the
+    same answer, a changed file is parsed again."""
+    import shutil
+    with tempfile.TemporaryDirectory() as d:
+        for f in ("signed200.mtx", "signed200_b.mtx"):
+            shutil.copy(M + f, d)
+        args = ["solve", d + "/signed200.mtx", "--rhs", d + "/signed200_b.mtx", "--index", "5", "--walks", "20000",
+                "--json", "--cache"]
+        rc, out1, err = run(ulam, args)
+        assert rc == 0 and err.count("cache written") == 2, err
+        assert sorted(os.listdir(d)) == ["signed200.mtx", "signed200.mtx.ulamcache", "signed200_b.mtx",
+                                         "signed200_b.mtx.ulamcache"], os.listdir(d)
+        rc, out2, err = run(ulam, args)
+        assert rc == 0 and err.count("loaded from its cache") == 2, err
+        assert json.loads(out1)["estimate"] == json.loads(out2)["estimate"]
+        with open(d + "/signed200_b.mtx", "a") as fh:
+            fh.write("% changed\n")
+        rc, _, err = run(ulam, args)
+        assert rc == 0 and err.count("loaded from its cache") == 1 and err.count("cache written") == 1, err
+
+
 def check_study_nonfinite(ulam):
     """M = 0: every walk scores 1 exactly, so the standard error is 0 and honesty (RMSE / mean
     standard error) is 0/0.  The CSVs carry an empty field there, never inf or nan; no
@@ -415,7 +437,7 @@ def main():
     failures, n = check_table(ulam)
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
-             (check_study, ulam), (check_study_nonfinite, ulam),
+             (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
              (check_radiosity, ulam)]
     for f, arg in extra:
         try:

@@ -39,6 +39,7 @@ typedef struct cli_system {
     int64_t index;        /* 1-based --index to check against n once loaded (0: none) */
     int jacobi;   /* the file holds A of A x = b: use M = I - omega D^-1 A */
     double omega; /* damping of the Jacobi splitting (1 = plain Jacobi) */
+    int cache;    /* read and write binary caches beside the files (--cache) */
     ulam_csr *M;  /* the iteration matrix */
     double *b;    /* the right-hand side (NULL if no --rhs and none needed) */
 } cli_system;

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <sys/stat.h>
 
 volatile int cli_interrupted;
 
@@ -121,11 +122,47 @@ int cli_parse_bytes(const char *command, const char *opt, const char *s, size_t 
 }
 
 /* Load M (and b); 0 or an exit code. */
+/* The identity of a source file for its cache: size and modification time (ns). */
+static int file_tag(const char *path, uint64_t tag[2])
+{
+    struct stat st;
+    if (stat(path, &st)) return -1;
+    tag[0] = (uint64_t)st.st_size;
+    tag[1] = (uint64_t)st.st_mtim.tv_sec * 1000000000u + (uint64_t)st.st_mtim.tv_nsec;
+    return 0;
+}
+
+/* Read a matrix (vec == NULL) or vector through its cache PATH.ulamcache when cache is set: a
+ * cache for the file as it is now is read, else the file is parsed and the cache written
+ * (a failure to write it is only a warning).  A library status, err filled. */
+static int read_cached(const char *path, int cache, ulam_csr **A, double **vec, int64_t *n, ulam_error *err)
+{
+    char cpath[4200];
+    uint64_t tag[2];
+    double t0 = ulam_now();
+    int use = cache && strlen(path) < 4096 && !file_tag(path, tag);
+    if (use) {
+        snprintf(cpath, sizeof cpath, "%s.ulamcache", path);
+        int st = vec ? ulam_cache_read_vector(cpath, tag, vec, n, err) : ulam_cache_read_csr(cpath, tag, A, err);
+        if (!st) {
+            fprintf(stderr, "ulam: %s: loaded from its cache in %.3f s\n", path, ulam_now() - t0);
+            return ULAM_OK;
+        }
+    }
+    int status = vec ? ulam_mm_read_vector(path, vec, n, err) : ulam_mm_read_matrix(path, A, err);
+    if (status || !use) return status;
+    double parsed = ulam_now() - t0;
+    int st = vec ? ulam_cache_write_vector(cpath, *vec, *n, tag) : ulam_cache_write_csr(cpath, *A, tag);
+    if (st) fprintf(stderr, "ulam: %s: warning: cache not written: %s\n", cpath, ulam_strerror(st));
+    else fprintf(stderr, "ulam: %s: parsed in %.3f s, cache written to %s\n", path, parsed, cpath);
+    return ULAM_OK;
+}
+
 int cli_load_system(cli_system *s)
 {
     ulam_error err;
     ulam_csr *A = NULL;
-    int status = ulam_mm_read_matrix(s->matrix_path, &A, &err);
+    int status = read_cached(s->matrix_path, s->cache, &A, NULL, NULL, &err);
     if (status) return cli_report(s->matrix_path, &err);
     if (A->nrows != A->ncols) {
         fprintf(stderr, "ulam: %s: error: %s: expected a square matrix, got %lld x %lld\n",
@@ -137,7 +174,7 @@ int cli_load_system(cli_system *s)
     int64_t n = A->nrows, nb = n;
     double *b = NULL;
     if (s->rhs_path) {
-        status = ulam_mm_read_vector(s->rhs_path, &b, &nb, &err);
+        status = read_cached(s->rhs_path, s->cache, NULL, &b, &nb, &err);
         if (status) {
             ulam_csr_free(A);
             return cli_report(s->rhs_path, &err);

@@ -2,6 +2,7 @@
 #include "cli.h"
 
 #include <getopt.h>
+#include <sys/resource.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,7 +13,7 @@ static const char *const usage =
     "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"
     "                  [--time S] [--seed S] [--threads T] [--continue Q] [--roulette W]\n"
     "                  [--split W] [--max-steps K] [--jacobi [--omega W]] [--check] [--json]\n"
-    "                  [--out x.mtx] [--errors e.mtx] [--force]\n"
+    "                  [--out x.mtx] [--errors e.mtx] [--force] [--cache]\n"
     "\n"
     "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
     "Indices are 1-based, as in Matrix Market files.\n"
@@ -38,6 +39,8 @@ static const char *const usage =
     "                     z = (estimate - direct) / stderr\n"
     "  --json             print one JSON object\n"
     "  --force            walk even when rho(|M|) >= 1 (otherwise refused with exit 3)\n"
+    "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
+    "                     that instead of parsing while the file is unchanged (size, mtime)\n"
     "\n"
     "Before walking, the guards estimate rho(|M|) (the walks converge iff < 1) and rho(M^) of\n"
     "the kernel's second-moment matrix (the variance is finite iff < 1); with rho(M^) >= 1 the\n"
@@ -55,7 +58,15 @@ typedef struct {
     uint64_t seed;
     ulam_guard g;
     int variance_finite;
+    double load_seconds, kernel_seconds; /* reading the inputs; building the walk kernel */
 } report_opts;
+
+/* Peak resident memory of this process so far, in MiB. */
+static double peak_rss_mib(void)
+{
+    struct rusage ru;
+    return getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
+}
 
 /* Nonzero when one walk dominates the sum of squares: a heavy tail. */
 static int heavy(const ulam_walk_result *r)
@@ -91,6 +102,8 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (heavy(r))
         printf("heavy tail      one walk holds %.1f%% of the sum of squared scores: the error bar is "
                "not to be trusted\n", 100 * r->max_share);
+    printf("load            %.3f s inputs, %.3f s kernel; peak memory %.0f MiB\n", ro->load_seconds,
+           ro->kernel_seconds, peak_rss_mib());
     if (ro->check)
         printf("direct          %.10g (LAPACK, %.4f s), z = %.3f\n", ro->direct, ro->direct_seconds,
                (r->estimate - ro->direct) / r->std_error);
@@ -127,6 +140,9 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     cli_json_string("mode", mode_names[o->mode], 0);
     cli_json_string("estimator", est_names[o->estimator], 0);
     printf("\"seed\": %llu, \"threads\": %d, ", (unsigned long long)ro->seed, r->threads);
+    cli_json_number("load_seconds", ro->load_seconds, 0);
+    cli_json_number("kernel_seconds", ro->kernel_seconds, 0);
+    cli_json_number("peak_rss_mib", peak_rss_mib(), 0);
     if (ro->check) {
         cli_json_number("direct", ro->direct, 0);
         cli_json_number("direct_seconds", ro->direct_seconds, 0);
@@ -179,7 +195,8 @@ int cli_solve(int argc, char **argv)
         {"omega", required_argument, 0, 'w'},     {"check", no_argument, 0, 'c'},
         {"json", no_argument, 0, 'J'},            {"out", required_argument, 0, 'o'},
         {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
-        {"force", no_argument, 0, 'F'},           {0, 0, 0, 0}};
+        {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
+        {0, 0, 0, 0}};
     cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};
@@ -210,6 +227,7 @@ int cli_solve(int argc, char **argv)
         case 'S': if ((rc = cli_parse_real("solve", "--split", optarg, 1e-300, 1e300, &o.split))) return rc; break;
         case 'K': if ((rc = cli_parse_int("solve", "--max-steps", optarg, 1, INT64_MAX / 2, &o.max_steps))) return rc; break;
         case 'j': s.jacobi = 1; break;
+        case 'C': s.cache = 1; break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'c': ro.check = 1; break;
         case 'J': ro.json = 1; break;
@@ -229,7 +247,9 @@ int cli_solve(int argc, char **argv)
         return cli_usage_error("solve", "--split W must exceed --roulette W");
     if (!any_rule) o.max_walks = 100000;
     s.matrix_path = argv[optind];
+    double t0 = ulam_now();
     if ((rc = cli_load_system(&s))) return rc;
+    ro.load_seconds = ulam_now() - t0;
     o.index = s.index ? s.index - 1 : 0;
     if ((rc = cli_guard(&s, o.continue_q, o.mode, force, &ro.g))) {
         cli_system_free(&s);
@@ -243,12 +263,12 @@ int cli_solve(int argc, char **argv)
     ulam_solver *sv = NULL;
     ulam_error err;
     o.interrupt = &cli_interrupted;
+    t0 = ulam_now();
     int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err);
-    if (status) {
-        rc = cli_report(s.matrix_path, &err);
-        cli_system_free(&s);
-        return rc;
-    }
+    ro.kernel_seconds = ulam_now() - t0;
+    int64_t n = s.M->nrows;
+    cli_system_free(&s); /* the solver holds its own kernel and b: walk without M */
+    if (status) return cli_report(s.matrix_path, &err);
     cli_catch_sigint();
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     ulam_walk_result r;
@@ -260,7 +280,7 @@ int cli_solve(int argc, char **argv)
                 s.matrix_path, ulam_strerror(status), (long long)r.walks);
         rc = cli_exit_code(status);
     } else if (o.mode == ULAM_FORWARD && (out || errors) && !r.interrupted) {
-        rc = write_vectors(sv, s.M->nrows, out, errors);
+        rc = write_vectors(sv, n, out, errors);
     }
     if (!status && !rc) {
         if (ro.json) print_json(&o, &r, &ro);

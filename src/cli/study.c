@@ -15,7 +15,7 @@
 static const char *const usage =
     "usage: ulam study M.mtx --rhs b.mtx --index I [--methods LIST] [--budgets LIST |\n"
     "                  --time-budgets LIST] [--repeats R] [--out DIR] [--seed S] [--threads T]\n"
-    "                  [--jacobi [--omega W]]\n"
+    "                  [--jacobi [--omega W]] [--cache]\n"
     "\n"
     "Run every method (mode-estimator-window: adjoint|forward, collision|absorption|expected,\n"
     "plain|roulette|split) at every budget R times with distinct seeds, and compare each run\n"
@@ -29,6 +29,7 @@ static const char *const usage =
     "  --out DIR            output directory (default study): runs.csv (a row per run, saved\n"
     "                       after each method and budget; rerunning resumes), summary.csv,\n"
     "                       reference.csv, rmse.png, work.png, coverage.png\n"
+    "  --cache              binary copies of the inputs beside them, as in 'ulam solve'\n"
     "  --seed S             base seed (default 1); run r of method m at budget k has its own\n"
     "\n"
     "Windows: roulette W = 0.5 w0, split W = 2 w0 (w0 the starting weight).  Ctrl-C keeps\n"
@@ -389,7 +390,7 @@ int cli_study(int argc, char **argv)
         {"out", required_argument, 0, 'o'},     {"seed", required_argument, 0, 's'},
         {"threads", required_argument, 0, 'T'}, {"jacobi", no_argument, 0, 'j'},
         {"omega", required_argument, 0, 'w'},   {"help", no_argument, 0, 'h'},
-        {0, 0, 0, 0}};
+        {"cache", no_argument, 0, 'C'},         {0, 0, 0, 0}};
     static study st;
     st = (study){.s = {.command = "study", .omega = 1.0}, .repeats = 30, .seed = 1, .out = "study"};
     methods_init(st.m);
@@ -409,6 +410,7 @@ int cli_study(int argc, char **argv)
         case 's': if ((rc = cli_parse_int("study", "--seed", optarg, 0, UINT32_MAX, &v))) return rc; st.seed = (uint64_t)v; break;
         case 'T': if ((rc = cli_parse_int("study", "--threads", optarg, 1, 1024, &v))) return rc; st.threads = (int)v; break;
         case 'j': st.s.jacobi = 1; break;
+        case 'C': st.s.cache = 1; break;
         case 'w': if ((rc = cli_parse_real("study", "--omega", optarg, 1e-6, 2.0, &st.s.omega))) return rc; break;
         case 'h': fputs(usage, stdout); return 0;
         default: return cli_usage_error("study", "unknown option");

@@ -7,34 +7,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "ulam.h"
-
-/* Random M (row sums 0.9, 8 random columns per row) built directly in CSR. */
-static ulam_csr *random_csr(int64_t n)
-{
-    const int k = 8;
-    ulam_csr *M = ulam_csr_alloc(n, n, n * k);
-    if (!M) return NULL;
-    ulam_rng r;
-    ulam_rng_seed(&r, (uint64_t)n, 0);
-    for (int64_t i = 0; i < n; i++) {
-        M->rowptr[i + 1] = (i + 1) * k;
-        double sum = 0;
-        for (int q = 0; q < k; q++) {
-            M->colidx[i * k + q] = (int32_t)ulam_rng_bounded(&r, (uint64_t)n);
-            sum += M->val[i * k + q] = 0.1 + ulam_rng_uniform(&r);
-        }
-        for (int q = 0; q < k; q++) M->val[i * k + q] *= 0.9 / sum;
-    }
-    return M; /* duplicate columns within a row are harmless for walking */
-}
+#include "gen.h"
 
 int main(void)
 {
     const int64_t sizes[2] = {1000, 10000000};
     printf("%-12s %8s %14s %12s %10s\n", "n", "threads", "steps", "seconds", "M steps/s");
     for (int s = 0; s < 2; s++) {
-        ulam_csr *M = random_csr(sizes[s]);
+        ulam_csr *M = bench_random_csr(sizes[s]);
         double *b = M ? malloc((size_t)sizes[s] * sizeof *b) : NULL;
         if (!b) {
             fprintf(stderr, "out of memory for n = %lld\n", (long long)sizes[s]);
