@@ -310,6 +310,19 @@ enum ulam_mode { ULAM_ADJOINT = 0, ULAM_FORWARD = 1 };
 enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2 };
 
 /* How to walk and when to stop.  Start from ulam_walk_defaults(). */
+/* Walks spread over processes (MPI ranks, say; the library itself knows nothing of MPI).
+ * Process `rank` of `nranks` runs the blocks q with q mod nranks = rank; after every round,
+ * allgather gives every process every block's result, so each merges all blocks in the same
+ * order and reaches the same totals, bit for bit, and the same stopping decisions as one
+ * process running them all with the same seed.  allgather must concatenate every process's
+ * `bytes` bytes at `mine` in rank order into a new malloc'd *all of *total bytes, returning 0,
+ * or nonzero on failure (the run then stops with ULAM_EIO). */
+typedef struct ulam_share {
+    int rank, nranks;
+    int (*allgather)(void *ctx, const void *mine, size_t bytes, void **all, size_t *total);
+    void *ctx;
+} ulam_share;
+
 typedef struct ulam_walk_opts {
     int mode;            /* ULAM_ADJOINT (one x_i) or ULAM_FORWARD (every x_i) */
     int estimator;       /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */
@@ -324,6 +337,7 @@ typedef struct ulam_walk_opts {
     double max_seconds;  /* stop after this much wall time (0 off); the first block always runs */
     int64_t max_steps;   /* a walk longer than this is cut and counted (default 10^6) */
     const volatile int *interrupt; /* stop at the next block when *interrupt != 0 (may be NULL) */
+    const ulam_share *share; /* NULL: this process runs every block */
 } ulam_walk_opts;
 
 /* The defaults: adjoint collision walks, index 0, analog kernel, seed 1, all cores,

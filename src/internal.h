@@ -62,8 +62,21 @@ int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first);
 int ulam__round(const ulam_walk_opts *o, int64_t next, int block, int round, int threads,
                 void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread), void *ctx);
 
-/* Nonzero when the walk or time budget of o is spent after `walks` walks. */
-int ulam__budget_spent(const ulam_walk_opts *o, double t0, int64_t walks);
+/* Nonzero when this process runs block q (always, without a share). */
+int ulam__mine(const ulam_share *sh, int64_t q);
+
+/* Where a block struct keeps its tallies: a pointer, a length and a capacity (int64). */
+typedef struct {
+    size_t size, tally_size;
+    size_t off_ptr, off_len, off_cap;
+} ulam__block_layout;
+
+/* After a round of nb blocks from block q0: with a share, send the blocks this process ran
+ * and receive the others' into blocks[] (nb structs laid out as L says).  *stop gets the
+ * stop flags of every process or'ed (1: time is up, 2: interrupted); without a share, this
+ * process's.  ULAM_OK, ULAM_ENOMEM or ULAM_EIO (the exchange failed). */
+int ulam__share_round(const ulam_walk_opts *o, double t0, void *blocks, const ulam__block_layout *L, int nb,
+                      int64_t q0, int *stop);
 
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)

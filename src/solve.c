@@ -10,6 +10,7 @@
 #include "walk.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef _OPENMP
@@ -271,11 +272,105 @@ int ulam__round(const ulam_walk_opts *o, int64_t next, int block, int round, int
     return nb;
 }
 
-/* Nonzero when the walk or time budget is spent. */
-int ulam__budget_spent(const ulam_walk_opts *o, double t0, int64_t walks)
+/* Nonzero when this process runs block q. */
+int ulam__mine(const ulam_share *sh, int64_t q)
 {
-    if (o->max_walks > 0 && walks >= o->max_walks) return 1;
-    return o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds;
+    return !sh || sh->nranks <= 1 || q % sh->nranks == sh->rank;
+}
+
+/* This process's stop flags: 1 time is up, 2 interrupted. */
+static int local_stop(const ulam_walk_opts *o, double t0)
+{
+    int f = o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds ? 1 : 0;
+    return f | (o->interrupt && *o->interrupt ? 2 : 0);
+}
+
+/* Append n bytes to the buffer *buf of length *len and capacity *cap. */
+static int put(unsigned char **buf, int64_t *len, int64_t *cap, const void *p, size_t n)
+{
+    if (ulam__grow(buf, cap, *len + (int64_t)n, 1)) return ULAM_ENOMEM;
+    if (n) memcpy(*buf + *len, p, n);
+    *len += (int64_t)n;
+    return ULAM_OK;
+}
+
+/* This process's message: its length and stop flags, then for each block it ran, its index,
+ * struct and tallies. */
+static int pack(const void *blocks, const ulam__block_layout *L, int nb, int64_t q0, const ulam_share *sh,
+                int stop, unsigned char **buf, int64_t *len)
+{
+    int64_t cap = 0, tlen, head[2] = {0, stop};
+    int status = put(buf, len, &cap, head, sizeof head);
+    for (int64_t k = 0; k < nb && !status; k++) {
+        if (!ulam__mine(sh, q0 + k)) continue;
+        const unsigned char *b = (const unsigned char *)blocks + (size_t)k * L->size;
+        void *t;
+        memcpy(&t, b + L->off_ptr, sizeof t);
+        memcpy(&tlen, b + L->off_len, sizeof tlen);
+        if (!(status = put(buf, len, &cap, &k, sizeof k)) && !(status = put(buf, len, &cap, b, L->size)))
+            status = put(buf, len, &cap, t, (size_t)tlen * L->tally_size);
+    }
+    if (!status) memcpy(*buf, len, sizeof *len);
+    return status;
+}
+
+/* Read one process's message (n bytes at p) into blocks[], each block keeping its own tally
+ * storage; *stop |= its flags. */
+static int unpack(const unsigned char *p, size_t n, void *blocks, const ulam__block_layout *L, int nb, int *stop)
+{
+    int64_t head[2];
+    memcpy(head, p, sizeof head);
+    *stop |= (int)head[1];
+    for (size_t at = sizeof head; at < n;) {
+        int64_t k, tlen, cap;
+        if (n - at < sizeof k + L->size) return ULAM_EIO;
+        memcpy(&k, p + at, sizeof k);
+        if (k < 0 || k >= nb) return ULAM_EIO;
+        unsigned char *b = (unsigned char *)blocks + (size_t)k * L->size;
+        void *t;
+        memcpy(&t, b + L->off_ptr, sizeof t);
+        memcpy(&cap, b + L->off_cap, sizeof cap);
+        memcpy(b, p + at + sizeof k, L->size);
+        at += sizeof k + L->size;
+        memcpy(&tlen, b + L->off_len, sizeof tlen);
+        memcpy(b + L->off_ptr, &t, sizeof t);
+        memcpy(b + L->off_cap, &cap, sizeof cap);
+        if (tlen < 0 || (uint64_t)tlen > (n - at) / L->tally_size) return ULAM_EIO;
+        if (ulam__grow(b + L->off_ptr, &cap, tlen, L->tally_size)) return ULAM_ENOMEM;
+        memcpy(b + L->off_cap, &cap, sizeof cap);
+        memcpy(&t, b + L->off_ptr, sizeof t);
+        if (tlen) memcpy(t, p + at, (size_t)tlen * L->tally_size);
+        at += (size_t)tlen * L->tally_size;
+    }
+    return ULAM_OK;
+}
+
+/* Exchange a round's blocks between the processes of o->share. */
+int ulam__share_round(const ulam_walk_opts *o, double t0, void *blocks, const ulam__block_layout *L, int nb,
+                      int64_t q0, int *stop)
+{
+    const ulam_share *sh = o->share;
+    *stop = local_stop(o, t0);
+    if (!sh || sh->nranks <= 1) return ULAM_OK;
+    unsigned char *mine = NULL;
+    int64_t len = 0, head[2] = {sizeof head, *stop | 4}; /* 4: this process failed */
+    int status = pack(blocks, L, nb, q0, sh, *stop, &mine, &len);
+    void *all = NULL;
+    size_t total = 0; /* every process takes part, even one that failed to pack */
+    if (sh->allgather(sh->ctx, status ? (void *)head : mine, status ? sizeof head : (size_t)len, &all, &total))
+        status = ULAM_EIO;
+    free(mine);
+    for (size_t at = 0; !status && at < total;) {
+        int64_t n;
+        if (total - at < 2 * sizeof n) status = ULAM_EIO;
+        else memcpy(&n, (const unsigned char *)all + at, sizeof n);
+        if (!status && (n < (int64_t)(2 * sizeof n) || (uint64_t)n > total - at)) status = ULAM_EIO;
+        if (!status) status = unpack((const unsigned char *)all + at, (size_t)n, blocks, L, nb, stop);
+        at += status ? 0 : (size_t)n;
+    }
+    if (!status && (*stop & 4)) status = ULAM_ENOMEM; /* another process could not pack */
+    free(all);
+    return status;
 }
 
 /* Run walks [first, first + count) as block q on thread t (ctx: the solver). */
@@ -285,7 +380,7 @@ static void run_block(void *ctx, int q, int64_t first, int64_t count, int t)
     ulam__block *br = &s->blocks[q];
     br->complete = 0;
     br->walks = 0;
-    if (!ulam__block_may_start(&s->o, s->t0, first)) return;
+    if (!ulam__mine(s->o.share, first / BLOCK) || !ulam__block_may_start(&s->o, s->t0, first)) return;
     ulam_rng r;
     ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / BLOCK));
     if (s->o.mode == ULAM_ADJOINT) ulam__adjoint_block(&s->w, count, &r, &s->scratch[t], br);
@@ -316,7 +411,12 @@ int ulam_solver_iterate(ulam_solver *s)
     if (s->done) return s->status;
     double start = ulam_now();
     if (s->t0 < 0) s->t0 = start;
-    int nb = ulam__round(&s->o, s->next_walk, BLOCK, ROUND, s->threads, run_block, s);
+    int nb = ulam__round(&s->o, s->next_walk, BLOCK, ROUND, s->threads, run_block, s), stop = 0;
+    static const ulam__block_layout layout = {sizeof(ulam__block), sizeof(ulam__tally),
+                                              offsetof(ulam__block, t.t), offsetof(ulam__block, t.len),
+                                              offsetof(ulam__block, t.cap)};
+    int st = ulam__share_round(&s->o, s->t0, s->blocks, &layout, nb, s->next_walk / BLOCK, &stop);
+    if (st) s->status = st, nb = 0;
     for (int q = 0; q < nb; q++) {
         if (s->blocks[q].nomem) s->status = ULAM_ENOMEM;
         if (!s->blocks[q].complete) { /* interrupted or out of time: keep what came before */
@@ -327,12 +427,12 @@ int ulam_solver_iterate(ulam_solver *s)
         s->next_walk += s->blocks[q].walks;
     }
     s->seconds += ulam_now() - start;
-    if (s->o.interrupt && *s->o.interrupt) s->interrupted = s->done = 1;
+    if (stop & 2) s->interrupted = s->done = 1;
     if (s->nonfinite && !s->status) s->status = ULAM_ENONFINITE;
     if (s->status) s->done = 1;
     ulam_walk_result r;
     ulam_solver_result(s, &r);
-    if (ulam__budget_spent(&s->o, s->t0, s->next_walk)) s->done = 1;
+    if ((stop & 1) || (s->o.max_walks > 0 && s->next_walk >= s->o.max_walks)) s->done = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && r.std_error <= s->o.rel_err * fabs(r.estimate)) s->done = 1;
     return s->status;
 }

@@ -57,6 +57,15 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
 /* Set by the first Ctrl-C while cli_catch_sigint is in force (walks stop at their next block). */
 extern volatile int cli_interrupted;
 
+/* Walks shared across MPI ranks (NULL: this process alone) and this process's rank (0 alone).
+ * Only rank 0 prints results and writes files. */
+extern const ulam_share *cli_share;
+extern int cli_rank;
+
+/* With -Dmpi=enabled: start MPI when launched by mpirun, and end it (src/cli/mpi.c). */
+void cli_mpi_init(int *argc, char ***argv);
+void cli_mpi_finalize(void);
+
 /* Catch SIGINT: the first sets cli_interrupted, a second exits at once with EXIT_INTERRUPTED. */
 void cli_catch_sigint(void);
 

@@ -12,6 +12,8 @@
 #include <sys/stat.h>
 
 volatile int cli_interrupted;
+const ulam_share *cli_share;
+int cli_rank;
 
 /* SIGINT: the first asks the walks to stop, the second exits at once. */
 static void on_sigint(int sig)

@@ -19,7 +19,8 @@ static const char *const usage =
     "Matrices and vectors are Matrix Market files.  Indices on the command line are\n"
     "1-based, as in Matrix Market files (the C API is 0-based).\n";
 
-int main(int argc, char **argv)
+/* Run the subcommand. */
+static int dispatch(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
         fputs(usage, argc < 2 ? stderr : stdout);
@@ -36,4 +37,17 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "radiosity")) return cli_radiosity(argc - 1, argv + 1);
     fprintf(stderr, "ulam: unknown command '%s'\n%s", argv[1], usage);
     return EXIT_USAGE;
+}
+
+int main(int argc, char **argv)
+{
+#ifdef ULAM_MPI
+    cli_mpi_init(&argc, &argv);
+#endif
+    int rc = dispatch(argc, argv);
+#ifdef ULAM_MPI
+    fflush(stdout);
+    cli_mpi_finalize();
+#endif
+    return rc;
 }

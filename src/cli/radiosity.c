@@ -375,7 +375,7 @@ int cli_radiosity(int argc, char **argv)
 {
     args a = {.ff_rays = 1000, .width = 512, .height = 512, .max_mem = (size_t)4 << 30, .o = ulam_walk_defaults()};
     a.o.max_walks = 0;
-    a.o.interrupt = &cli_interrupted;
+    a.o.interrupt = &cli_interrupted, a.o.share = cli_share;
     int rc = parse(argc, argv, &a);
     if (rc) return rc < 0 ? 0 : rc;
     ulam_scene *s = NULL;
@@ -399,7 +399,7 @@ int cli_radiosity(int argc, char **argv)
         if (rc) goto done;
         r.w = &w;
     }
-    if (a.image && !w.interrupted && (rc = write_image(&a, t, w.all ? w.all : Bd, &r.exposure))) goto done;
+    if (a.image && !w.interrupted && cli_rank == 0 && (rc = write_image(&a, t, w.all ? w.all : Bd, &r.exposure))) goto done;
     if (a.json) print_json(&a, &r);
     else print_text(&a, &r);
     if (w.interrupted) rc = EXIT_INTERRUPTED;

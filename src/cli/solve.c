@@ -139,7 +139,8 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     cli_json_number("figure_of_merit", r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : NAN, 0);
     cli_json_string("mode", mode_names[o->mode], 0);
     cli_json_string("estimator", est_names[o->estimator], 0);
-    printf("\"seed\": %llu, \"threads\": %d, ", (unsigned long long)ro->seed, r->threads);
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)ro->seed, r->threads,
+           cli_share ? cli_share->nranks : 1);
     cli_json_number("load_seconds", ro->load_seconds, 0);
     cli_json_number("kernel_seconds", ro->kernel_seconds, 0);
     cli_json_number("peak_rss_mib", peak_rss_mib(), 0);
@@ -262,7 +263,7 @@ int cli_solve(int argc, char **argv)
     }
     ulam_solver *sv = NULL;
     ulam_error err;
-    o.interrupt = &cli_interrupted;
+    o.interrupt = &cli_interrupted, o.share = cli_share;
     t0 = ulam_now();
     int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err);
     ro.kernel_seconds = ulam_now() - t0;
@@ -279,7 +280,7 @@ int cli_solve(int argc, char **argv)
                         "walks; nothing was averaged in from it (is rho(|M|) < 1? see 'ulam info')\n",
                 s.matrix_path, ulam_strerror(status), (long long)r.walks);
         rc = cli_exit_code(status);
-    } else if (o.mode == ULAM_FORWARD && (out || errors) && !r.interrupted) {
+    } else if (o.mode == ULAM_FORWARD && (out || errors) && !r.interrupted && cli_rank == 0) {
         rc = write_vectors(sv, n, out, errors);
     }
     if (!status && !rc) {

@@ -183,6 +183,7 @@ static void resume(study *st, const char *path)
 /* Write every finished row to runs.csv (temporary file, then rename); 0 or an exit code. */
 static int save_runs(const study *st)
 {
+    if (cli_rank) return 0; /* under MPI, rank 0 writes */
     char path[4096];
     snprintf(path, sizeof path, "%s/runs.csv", st->out);
     ulam_outfile o;
@@ -204,7 +205,7 @@ static int one_run(study *st, int m, int b, int r)
     ulam_walk_opts o = ulam_walk_defaults();
     o.mode = me->mode, o.estimator = me->est, o.index = st->s.index - 1, o.threads = st->threads;
     o.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
-    o.interrupt = &cli_interrupted;
+    o.interrupt = &cli_interrupted, o.share = cli_share;
     if (st->time_budgets) o.max_walks = 0, o.max_seconds = st->budget[b];
     else o.max_walks = (int64_t)st->budget[b];
     double w0 = me->mode == ULAM_FORWARD ? 0.0 : 1.0; /* forward particles start at ||b||_1 */
@@ -274,14 +275,18 @@ static int references(study *st)
     st->exact = x[I];
     char path[4096], v[2][32];
     snprintf(path, sizeof path, "%s/reference.csv", st->out);
-    ulam_outfile o;
-    int status = ulam_outfile_open(&o, path);
+    ulam_outfile o = {0};
+    int status = cli_rank ? ULAM_OK : ulam_outfile_open(&o, path); /* under MPI, rank 0 writes */
     if (status) {
         free(x);
         ulam_error e = {.status = status, .msg = "a writable output directory"};
         return cli_report(path, &e);
     }
-    FILE *f = o.f;
+    FILE *f = o.f ? o.f : fopen("/dev/null", "w");
+    if (!f) {
+        free(x);
+        return cli_exit_code(ULAM_EIO);
+    }
     fprintf(f, "kind,seconds,error\n");
     ulam_direct_info info;
     if (n <= 8000 && (xd = malloc((size_t)n * sizeof *xd)) && !ulam_direct_solve(st->s.M, st->s.b, xd, 0, &info, NULL)) {
@@ -301,6 +306,7 @@ static int references(study *st)
         if (!(e > 1e-9 * fabs(st->exact))) break;
     }
     free(x);
+    if (!o.f) return fclose(f), 0;
     ulam_error e = {.status = ulam_outfile_commit(&o), .msg = "a writable output directory"};
     return e.status ? cli_report(path, &e) : 0;
 }
@@ -432,7 +438,7 @@ int cli_study(int argc, char **argv)
     if (!rc) rc = screen_methods(&st);
     if (!rc) rc = references(&st);
     if (!rc) rc = run_all(&st);
-    if (rc == 0 || rc == EXIT_INTERRUPTED) {
+    if ((rc == 0 || rc == EXIT_INTERRUPTED) && cli_rank == 0) {
         int rs = summarise(&st);
         if (!rs) charts(&st);
         else rc = rs;

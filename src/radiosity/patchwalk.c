@@ -271,7 +271,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     br->sq = br->maxsq = 0.0;
     br->len = br->walks = br->rays = br->cut = br->nonfinite = 0;
     br->complete = br->nomem = 0;
-    if (!ulam__block_may_start(&s->o, s->t0, first)) return;
+    if (!ulam__mine(s->o.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->t0, first)) return;
     ulam_rng r;
     ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / RBLOCK));
     for (int64_t w = 0; w < count; w++) {
@@ -340,7 +340,11 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     if (s->done) return s->status;
     double start = ulam_now();
     if (s->t0 < 0) s->t0 = start;
-    int nb = ulam__round(&s->o, s->next_walk, RBLOCK, RROUND, s->threads, run_block, s);
+    int nb = ulam__round(&s->o, s->next_walk, RBLOCK, RROUND, s->threads, run_block, s), stop = 0;
+    static const ulam__block_layout layout = {sizeof(rad_block), sizeof(rad_tally), offsetof(rad_block, t),
+                                              offsetof(rad_block, len), offsetof(rad_block, cap)};
+    int st = ulam__share_round(&s->o, s->t0, s->blocks, &layout, nb, s->next_walk / RBLOCK, &stop);
+    if (st) s->status = st, nb = 0;
     for (int k = 0; k < nb; k++) {
         if (s->blocks[k].nomem) s->status = ULAM_ENOMEM;
         if (!s->blocks[k].complete) {
@@ -351,12 +355,12 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
         s->next_walk += s->blocks[k].walks;
     }
     s->seconds += ulam_now() - start;
-    if (s->o.interrupt && *s->o.interrupt) s->interrupted = s->done = 1;
+    if (stop & 2) s->interrupted = s->done = 1;
     if (s->nonfinite && !s->status) s->status = ULAM_ENONFINITE;
     if (s->status) s->done = 1;
     ulam_rad_result r;
     ulam_rad_solver_result(s, &r);
-    if (ulam__budget_spent(&s->o, s->t0, s->next_walk)) s->done = 1;
+    if ((stop & 1) || (s->o.max_walks > 0 && s->next_walk >= s->o.max_walks)) s->done = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(&r, s->o.rel_err)) s->done = 1;
     return s->status;
 }

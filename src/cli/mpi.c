@@ -1,0 +1,58 @@
+/* Walks across MPI ranks (built with -Dmpi=enabled): the exchange the library's ulam_share asks
+ * for, as MPI_Allgatherv.  MPI starts only under a launcher (mpirun sets OMPI_COMM_WORLD_SIZE
+ * or PMIX_RANK), so the same binary still runs alone without one. */
+#include "cli.h"
+
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+static ulam_share share;
+static int started;
+
+/* Concatenate every rank's bytes in rank order (the ulam_share contract). */
+static int allgather(void *ctx, const void *mine, size_t bytes, void **all, size_t *total)
+{
+    (void)ctx;
+    int k = share.nranks;
+    int *counts = malloc((size_t)k * sizeof *counts), *displs = malloc((size_t)k * sizeof *displs);
+    int mine_n = bytes > (size_t)INT32_MAX ? -1 : (int)bytes, bad = 0;
+    if (!counts || !displs || MPI_Allgather(&mine_n, 1, MPI_INT, counts, 1, MPI_INT, MPI_COMM_WORLD) != MPI_SUCCESS)
+        bad = 1;
+    size_t sum = 0;
+    for (int r = 0; r < k && !bad; r++) {
+        if (counts[r] < 0 || sum + (size_t)counts[r] > (size_t)INT32_MAX) bad = 1;
+        else displs[r] = (int)sum, sum += (size_t)counts[r];
+    }
+    char *buf = bad ? NULL : malloc(sum ? sum : 1);
+    if (!bad && (!buf || MPI_Allgatherv(mine, mine_n, MPI_BYTE, buf, counts, displs, MPI_BYTE, MPI_COMM_WORLD) !=
+                             MPI_SUCCESS))
+        bad = 1; /* (a failed malloc here leaves the others waiting: MPI's error handler ends the job) */
+    free(counts), free(displs);
+    if (bad) {
+        free(buf);
+        return 1;
+    }
+    *all = buf, *total = sum;
+    return 0;
+}
+
+/* Start MPI when launched by mpirun; ranks other than 0 print nothing on stdout. */
+void cli_mpi_init(int *argc, char ***argv)
+{
+    if (!getenv("OMPI_COMM_WORLD_SIZE") && !getenv("PMIX_RANK") && !getenv("PMI_SIZE")) return;
+    if (MPI_Init(argc, argv) != MPI_SUCCESS) return;
+    started = 1;
+    MPI_Comm_rank(MPI_COMM_WORLD, &share.rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &share.nranks);
+    share.allgather = allgather;
+    if (share.nranks > 1) cli_share = &share;
+    cli_rank = share.rank;
+    if (cli_rank && !freopen("/dev/null", "w", stdout)) fclose(stdout);
+}
+
+/* End MPI if it was started. */
+void cli_mpi_finalize(void)
+{
+    if (started) MPI_Finalize();
+}

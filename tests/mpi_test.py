@@ -1,0 +1,74 @@
+#!/usr/bin/env python3
+"""Walks across MPI ranks (built with -Dmpi=enabled): `mpirun -np 2 ulam ...` must give, bit for
+bit, what one process gives with the same seed and walk count, for solve (adjoint and forward,
+whose --out file must match byte for byte), study (runs.csv estimates) and radiosity.
+Run from the source root: mpi_test.py path/to/ulam path/to/mpirun"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+           OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_btl="self,vader", OMPI_MCA_btl_vader_single_copy_mechanism="none",
+           OMPI_MCA_plm_rsh_agent="")
+
+
+def run(cmd):
+    p = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
+    assert p.returncode == 0, (cmd, p.returncode, p.stderr)
+    return p.stdout
+
+
+def main():
+    ulam, mpirun = sys.argv[1], sys.argv[2]
+    par = [mpirun, "--oversubscribe", "-np", "2", ulam]
+    failures = 0
+    with tempfile.TemporaryDirectory() as d:
+        cases = [
+            ("solve adjoint", ["solve", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx", "--index", "7",
+                               "--walks", "50000", "--seed", "9", "--json"], None),
+            ("solve adjoint rel-err", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
+                                       "--index", "3", "--rel-err", "0.005", "--json"], None),
+            ("solve forward", ["solve", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
+                               "1", "--mode", "forward", "--walks", "30000", "--json", "--out", "{d}/x.mtx"], "x.mtx"),
+            ("radiosity", ["radiosity", "examples/scenes/cornell_box.obj", "--patch", "floor", "--subdivide", "300",
+                           "--walks", "20000", "--json"], None),
+            ("study", ["study", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx", "--index", "2", "--methods",
+                       "adjoint-collision-plain,forward-collision-plain", "--budgets", "1000,5000", "--repeats", "3",
+                       "--out", "{d}/s"], "s/runs.csv"),
+        ]
+        for name, args, outfile in cases:
+            try:
+                res = []
+                for launcher in ([ulam], par):
+                    out = run(launcher + [a.format(d=d) for a in args])
+                    if outfile and outfile.endswith("runs.csv"):  # drop the seconds column (wall time)
+                        rows = open(os.path.join(d, outfile)).read().splitlines()
+                        res.append([",".join(r.split(",")[:9]) for r in rows])
+                    elif outfile:
+                        res.append((json.loads(out), open(os.path.join(d, outfile)).read()))
+                    else:
+                        res.append(json.loads(out))
+                one, two = res
+                if name.startswith("solve"):
+                    for k in ("estimate", "stderr", "walks", "steps", "variance"):
+                        a, b = (one[0] if outfile else one)[k], (two[0] if outfile else two)[k]
+                        assert a == b, (name, k, a, b)
+                    assert (two[0] if outfile else two)["ranks"] == 2, "not distributed"
+                    if outfile:
+                        assert one[1] == two[1], "forward --out files differ"
+                elif name == "radiosity":
+                    assert one["radiosity"] == two["radiosity"] and one["stderr"] == two["stderr"], (one, two)
+                else:
+                    assert one == two and len(one) == 13, (one, two)
+                print(f"ok {name}")
+            except AssertionError as e:
+                failures += 1
+                print(f"FAIL {name}: {e}")
+    print(f"{len(cases) - failures} passed, {failures} failed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
