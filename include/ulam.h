@@ -309,7 +309,6 @@ uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
 enum ulam_mode { ULAM_ADJOINT = 0, ULAM_FORWARD = 1 };
 enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2 };
 
-/* How to walk and when to stop.  Start from ulam_walk_defaults(). */
 /* Walks spread over processes (MPI ranks, say; the library itself knows nothing of MPI).
  * Process `rank` of `nranks` runs the blocks q with q mod nranks = rank; after every round,
  * allgather gives every process every block's result, so each merges all blocks in the same
@@ -323,6 +322,7 @@ typedef struct ulam_share {
     void *ctx;
 } ulam_share;
 
+/* How to walk and when to stop.  Start from ulam_walk_defaults(). */
 typedef struct ulam_walk_opts {
     int mode;            /* ULAM_ADJOINT (one x_i) or ULAM_FORWARD (every x_i) */
     int estimator;       /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */

@@ -29,7 +29,8 @@ static int cache_write(const char *path, const char magic[8], const int64_t dims
     return ulam_outfile_commit(&o);
 }
 
-/* Open a cache and check its magic, byte order, tag and length against the dims it states. */
+/* Open a cache and check its magic, byte order, tag and the sizes it states (its length is
+ * checked by reading: read_all). */
 static int cache_open(const char *path, const char magic[8], const uint64_t tag[2], int64_t dims[3], FILE **fp,
                       ulam_error *err)
 {
@@ -93,7 +94,7 @@ int ulam_cache_read_csr(const char *path, const uint64_t tag[2], ulam_csr **A, u
              read_all(f, B->colidx, (size_t)d[2] * sizeof *B->colidx, 0) &&
              read_all(f, B->val, (size_t)d[2] * sizeof *B->val, 1);
     fclose(f);
-    if (!ok || B->rowptr[0] != 0 || B->rowptr[d[0]] != d[2] || ulam_csr_check(B) != ULAM_OK) {
+    if (!ok || B->rowptr[d[0]] != d[2] || ulam_csr_check(B) != ULAM_OK) { /* nnz first: the check reads that far */
         ulam_csr_free(B);
         return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a complete, consistent cache (truncated or corrupt)");
     }

@@ -51,32 +51,39 @@ static inline double ulam__rng_uniform(ulam_rng *r)
 /* Threads a run uses: requested when > 0, else all cores (1 without OpenMP). */
 int ulam__threads(int requested);
 
+/* The calling thread's number in the enclosing OpenMP team (0 outside one or without OpenMP). */
+int ulam__thread_num(void);
+
 /* Nonzero when a block whose first walk is `first` may start: not interrupted and, unless it is
  * the run's first block (which always runs, so a time limit still yields an estimate), not out
  * of time (t0: when the run started). */
 int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first);
 
-/* One round of a block-parallel walk run: up to `round` blocks of `block` walks from walk `next`
- * (no further than o->max_walks), shared dynamically among `threads`; block k runs as
- * run(ctx, k, its first walk, its walk count, thread).  Returns the number of blocks. */
-int ulam__round(const ulam_walk_opts *o, int64_t next, int block, int round, int threads,
-                void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread), void *ctx);
+/* A block-parallel walk run as the round driver sees it: blocks of `block` walks, at most
+ * `round` a round; block k runs as run(ctx, k, its first walk, its walk count, thread) and
+ * leaves its result in the k-th struct of the caller's array, `size` bytes each, whose tallies
+ * (tally_size bytes each) sit behind a pointer, a length and a capacity (int64) at the offsets
+ * given, so results can be sent between processes. */
+typedef struct {
+    int block, round;
+    void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread);
+    size_t size, tally_size;
+    size_t off_ptr, off_len, off_cap;
+} ulam__blocks;
+
+/* One round from walk `next` (no further than o->max_walks), shared dynamically among
+ * `threads`, its *nb block results left in results[].  With o->share, every process's blocks
+ * are then exchanged so all hold all of them.  *stop gets the stop flags (1: time is up,
+ * 2: interrupted), or'ed over the processes.  ULAM_OK, ULAM_ENOMEM or ULAM_EIO (the exchange
+ * failed; *nb is then 0). */
+int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int threads, void *ctx,
+                void *results, int *nb, int *stop);
+
+/* Nonzero when the walk budget is spent after `walks` walks or the stop flags say time is up. */
+int ulam__budget_spent(const ulam_walk_opts *o, int stop, int64_t walks);
 
 /* Nonzero when this process runs block q (always, without a share). */
 int ulam__mine(const ulam_share *sh, int64_t q);
-
-/* Where a block struct keeps its tallies: a pointer, a length and a capacity (int64). */
-typedef struct {
-    size_t size, tally_size;
-    size_t off_ptr, off_len, off_cap;
-} ulam__block_layout;
-
-/* After a round of nb blocks from block q0: with a share, send the blocks this process ran
- * and receive the others' into blocks[] (nb structs laid out as L says).  *stop gets the
- * stop flags of every process or'ed (1: time is up, 2: interrupted); without a share, this
- * process's.  ULAM_OK, ULAM_ENOMEM or ULAM_EIO (the exchange failed). */
-int ulam__share_round(const ulam_walk_opts *o, double t0, void *blocks, const ulam__block_layout *L, int nb,
-                      int64_t q0, int *stop);
 
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)

@@ -243,33 +243,21 @@ int ulam__threads(int requested)
 #endif
 }
 
+/* The calling thread's number in its OpenMP team. */
+int ulam__thread_num(void)
+{
+#ifdef _OPENMP
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
 /* Nonzero when a block starting at walk first may start. */
 int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first)
 {
     if (o->interrupt && *o->interrupt) return 0;
     return first == 0 || !(o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds);
-}
-
-/* One round of blocks, in parallel.  Rounds grow 1, 2, 4, ... blocks up to round (a round
- * is as long as all before it), so a --rel-err or time rule is checked often while little has
- * run, and the schedule depends on walks done only, never on the thread count. */
-int ulam__round(const ulam_walk_opts *o, int64_t next, int block, int round, int threads,
-                void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread), void *ctx)
-{
-    int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX, done = next / block;
-    if (done + 1 < round) round = (int)(done + 1);
-    int nb = 0;
-    while (nb < round && left > (int64_t)nb * block) nb++;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int k = 0; k < nb; k++) {
-        int t = 0;
-#ifdef _OPENMP
-        t = omp_get_thread_num();
-#endif
-        int64_t rest = left - (int64_t)k * block;
-        run(ctx, k, next + (int64_t)k * block, rest < block ? rest : block, t);
-    }
-    return nb;
 }
 
 /* Nonzero when this process runs block q. */
@@ -296,7 +284,7 @@ static int put(unsigned char **buf, int64_t *len, int64_t *cap, const void *p, s
 
 /* This process's message: its length and stop flags, then for each block it ran, its index,
  * struct and tallies. */
-static int pack(const void *blocks, const ulam__block_layout *L, int nb, int64_t q0, const ulam_share *sh,
+static int pack(const void *blocks, const ulam__blocks *L, int nb, int64_t q0, const ulam_share *sh,
                 int stop, unsigned char **buf, int64_t *len)
 {
     int64_t cap = 0, tlen, head[2] = {0, stop};
@@ -316,7 +304,7 @@ static int pack(const void *blocks, const ulam__block_layout *L, int nb, int64_t
 
 /* Read one process's message (n bytes at p) into blocks[], each block keeping its own tally
  * storage; *stop |= its flags. */
-static int unpack(const unsigned char *p, size_t n, void *blocks, const ulam__block_layout *L, int nb, int *stop)
+static int unpack(const unsigned char *p, size_t n, void *blocks, const ulam__blocks *L, int nb, int *stop)
 {
     int64_t head[2];
     memcpy(head, p, sizeof head);
@@ -345,9 +333,10 @@ static int unpack(const unsigned char *p, size_t n, void *blocks, const ulam__bl
     return ULAM_OK;
 }
 
-/* Exchange a round's blocks between the processes of o->share. */
-int ulam__share_round(const ulam_walk_opts *o, double t0, void *blocks, const ulam__block_layout *L, int nb,
-                      int64_t q0, int *stop)
+/* Exchange a round's nb blocks (from block q0) between the processes of o->share; *stop gets
+ * the stop flags or'ed over them (this process's alone without a share). */
+static int exchange(const ulam_walk_opts *o, double t0, void *blocks, const ulam__blocks *L, int nb, int64_t q0,
+                    int *stop)
 {
     const ulam_share *sh = o->share;
     *stop = local_stop(o, t0);
@@ -371,6 +360,32 @@ int ulam__share_round(const ulam_walk_opts *o, double t0, void *blocks, const ul
     if (!status && (*stop & 4)) status = ULAM_ENOMEM; /* another process could not pack */
     free(all);
     return status;
+}
+
+/* One round of blocks, in parallel, then the exchange between processes.  Rounds grow 1, 2,
+ * 4, ... blocks up to B->round (a round is as long as all before it), so a --rel-err or time
+ * rule is checked often while little has run, and the schedule depends on walks done only,
+ * never on the thread count. */
+int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int threads, void *ctx,
+                void *results, int *nb, int *stop)
+{
+    int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX, done = next / B->block;
+    int round = done + 1 < B->round ? (int)(done + 1) : B->round, n = 0;
+    while (n < round && left > (int64_t)n * B->block) n++;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int k = 0; k < n; k++) {
+        int64_t rest = left - (int64_t)k * B->block;
+        B->run(ctx, k, next + (int64_t)k * B->block, rest < B->block ? rest : B->block, ulam__thread_num());
+    }
+    int status = exchange(o, t0, results, B, n, done, stop);
+    *nb = status ? 0 : n;
+    return status;
+}
+
+/* Nonzero when the walk budget is spent or the stop flags say time is up. */
+int ulam__budget_spent(const ulam_walk_opts *o, int stop, int64_t walks)
+{
+    return (stop & 1) || (o->max_walks > 0 && walks >= o->max_walks);
 }
 
 /* Run walks [first, first + count) as block q on thread t (ctx: the solver). */
@@ -411,12 +426,11 @@ int ulam_solver_iterate(ulam_solver *s)
     if (s->done) return s->status;
     double start = ulam_now();
     if (s->t0 < 0) s->t0 = start;
-    int nb = ulam__round(&s->o, s->next_walk, BLOCK, ROUND, s->threads, run_block, s), stop = 0;
-    static const ulam__block_layout layout = {sizeof(ulam__block), sizeof(ulam__tally),
-                                              offsetof(ulam__block, t.t), offsetof(ulam__block, t.len),
-                                              offsetof(ulam__block, t.cap)};
-    int st = ulam__share_round(&s->o, s->t0, s->blocks, &layout, nb, s->next_walk / BLOCK, &stop);
-    if (st) s->status = st, nb = 0;
+    static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally),
+                                   offsetof(ulam__block, t.t), offsetof(ulam__block, t.len),
+                                   offsetof(ulam__block, t.cap)};
+    int nb, stop, st = ulam__round(&B, &s->o, s->t0, s->next_walk, s->threads, s, s->blocks, &nb, &stop);
+    if (st) s->status = st;
     for (int q = 0; q < nb; q++) {
         if (s->blocks[q].nomem) s->status = ULAM_ENOMEM;
         if (!s->blocks[q].complete) { /* interrupted or out of time: keep what came before */
@@ -432,7 +446,7 @@ int ulam_solver_iterate(ulam_solver *s)
     if (s->status) s->done = 1;
     ulam_walk_result r;
     ulam_solver_result(s, &r);
-    if ((stop & 1) || (s->o.max_walks > 0 && s->next_walk >= s->o.max_walks)) s->done = 1;
+    if (ulam__budget_spent(&s->o, stop, s->next_walk)) s->done = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && r.std_error <= s->o.rel_err * fabs(r.estimate)) s->done = 1;
     return s->status;
 }

@@ -123,7 +123,6 @@ int cli_parse_bytes(const char *command, const char *opt, const char *s, size_t 
     return 0;
 }
 
-/* Load M (and b); 0 or an exit code. */
 /* The identity of a source file for its cache: size and modification time (ns). */
 static int file_tag(const char *path, uint64_t tag[2])
 {
@@ -160,6 +159,7 @@ static int read_cached(const char *path, int cache, ulam_csr **A, double **vec, 
     return ULAM_OK;
 }
 
+/* Load M (and b); 0 or an exit code. */
 int cli_load_system(cli_system *s)
 {
     ulam_error err;

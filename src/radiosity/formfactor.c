@@ -4,9 +4,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 /* Order of two int32_t for qsort. */
 static int cmp_int32(const void *a, const void *b)
@@ -56,10 +53,7 @@ int ulam_form_factors(const ulam_tracer *t, int64_t rays, uint64_t seed, int thr
     if (!status) {
 #pragma omp parallel for schedule(dynamic, 16) num_threads(nth)
         for (int64_t i = 0; i < n; i++) {
-            int th = 0;
-#ifdef _OPENMP
-            th = omp_get_thread_num();
-#endif
+            int th = ulam__thread_num();
             len[i] = ff_row(t, i, rays, seed, count + (size_t)th * (size_t)n, touched + (size_t)th * (size_t)n,
                             cols + (size_t)i * (size_t)w, vals + (size_t)i * (size_t)w);
         }

@@ -340,11 +340,10 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     if (s->done) return s->status;
     double start = ulam_now();
     if (s->t0 < 0) s->t0 = start;
-    int nb = ulam__round(&s->o, s->next_walk, RBLOCK, RROUND, s->threads, run_block, s), stop = 0;
-    static const ulam__block_layout layout = {sizeof(rad_block), sizeof(rad_tally), offsetof(rad_block, t),
-                                              offsetof(rad_block, len), offsetof(rad_block, cap)};
-    int st = ulam__share_round(&s->o, s->t0, s->blocks, &layout, nb, s->next_walk / RBLOCK, &stop);
-    if (st) s->status = st, nb = 0;
+    static const ulam__blocks B = {RBLOCK, RROUND, run_block, sizeof(rad_block), sizeof(rad_tally),
+                                   offsetof(rad_block, t), offsetof(rad_block, len), offsetof(rad_block, cap)};
+    int nb, stop, st = ulam__round(&B, &s->o, s->t0, s->next_walk, s->threads, s, s->blocks, &nb, &stop);
+    if (st) s->status = st;
     for (int k = 0; k < nb; k++) {
         if (s->blocks[k].nomem) s->status = ULAM_ENOMEM;
         if (!s->blocks[k].complete) {
@@ -360,7 +359,7 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     if (s->status) s->done = 1;
     ulam_rad_result r;
     ulam_rad_solver_result(s, &r);
-    if ((stop & 1) || (s->o.max_walks > 0 && s->next_walk >= s->o.max_walks)) s->done = 1;
+    if (ulam__budget_spent(&s->o, stop, s->next_walk)) s->done = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(&r, s->o.rel_err)) s->done = 1;
     return s->status;
 }

@@ -155,44 +155,53 @@ static void dgesv_run(const ulam_csr *M, const double *b, int64_t I, double r[2]
     free(x);
 }
 
-/* Gauss-Seidel from 0: the time until x_I is within 1% of ref (or, ref unknown, converged). */
+/* Gauss-Seidel from 0: the time until x_I is within 1% of *ref.  With *ref unknown (NaN) it
+ * sweeps to convergence (x_I moving by <= 1e-13 relative), which sets *ref, and finds the 1%
+ * time in the trace of x_I it kept on the way. */
 static outcome gs_run(const ulam_csr *M, const double *b, int64_t I, double *ref)
 {
     int64_t n = M->nrows;
     outcome o = {.seconds = -1};
-    double *x = calloc((size_t)n, sizeof *x), t = 0, hit = -1, e_prev = 0, rate = 0;
-    int known = !isnan(*ref), k = 0;
-    double old = 0, change = INFINITY;
+    int known = !isnan(*ref), k = 0, cap = 0;
+    double *x = calloc((size_t)n, sizeof *x), t = 0, e_prev = 0, rate = 0, old = 0;
+    double *xs = NULL, *ts = NULL; /* the trace: x_I and seconds after each sweep (ref unknown) */
     while (x && t < GS_CAP) {
         double t0 = ulam_now();
         ulam_gauss_seidel_sweep(M, b, x);
         t += ulam_now() - t0, k++;
-        change = fabs(x[I] - old), old = x[I];
         if (known) {
             double e = fabs(x[I] - *ref);
             if (k > 1 && e_prev > 0) rate = 0.9 * rate + 0.1 * (e / e_prev);
             e_prev = e;
             if (e <= 0.01 * fabs(*ref)) {
-                hit = t;
+                o.seconds = t;
                 break;
             }
-        } else if (change <= 1e-13 * fabs(x[I]) && k > 10) {
+            continue;
+        }
+        if (k > cap) {
+            cap = cap ? 2 * cap : 256;
+            double *nx = realloc(xs, (size_t)cap * sizeof *xs), *nt = nx ? realloc(ts, (size_t)cap * sizeof *ts) : NULL;
+            if (nx) xs = nx;
+            if (nt) ts = nt;
+            if (!nx || !nt) break;
+        }
+        xs[k - 1] = x[I], ts[k - 1] = t;
+        if (k > 10 && fabs(x[I] - old) <= 1e-13 * fabs(x[I])) { /* converged: the reference */
+            *ref = x[I];
+            for (int j = 0; j < k && o.seconds < 0; j++)
+                if (fabs(xs[j] - *ref) <= 0.01 * fabs(*ref)) o.seconds = ts[j];
             break;
         }
+        old = x[I];
     }
-    if (!known && x) { /* converged: it is the reference; find when it was within 1%: rerun */
-        *ref = x[I];
-        free(x);
-        return gs_run(M, b, I, ref);
-    }
-    if (hit >= 0) o.seconds = hit;
-    else if (x && rate > 0 && rate < 1) { /* project: e_prev * rate^m = 1% |ref| */
+    if (known && o.seconds < 0 && x && rate > 0 && rate < 1) { /* project: e_prev * rate^m = 1% |ref| */
         double m = log(0.01 * fabs(*ref) / e_prev) / log(rate);
         o.seconds = t * (1.0 + m / k), o.projected = 1;
         snprintf(o.note, sizeof o.note, "%d sweeps in %.0f s, error %.2g%%, rate %.6f", k, t,
                  100 * e_prev / fabs(*ref), rate);
     }
-    free(x);
+    free(x), free(xs), free(ts);
     return o;
 }
 
