@@ -328,6 +328,9 @@ typedef struct ulam_walk_opts {
     int estimator;       /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */
     int64_t index;       /* 0-based component reported (the start state in adjoint mode) */
     double continue_q;   /* fixed continuation probability in (0, 1); <= 0: analog min(1, S_i) */
+    int whole_kernel;    /* 1: build the walk kernel's every row before walking; 0: build each
+                            row when a walk first reaches it, and the rest at once when walks
+                            have reached 1/16 of them (a run that far will reach most) */
     double roulette;     /* weight window floor W: below it survive with |w|/W at weight W; 0 off */
     double split;        /* weight window ceiling: above it split into ceil(|w|/W) copies; 0 off */
     uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */
@@ -353,6 +356,7 @@ typedef struct ulam_walk_result {
     int64_t walks;     /* histories completed */
     int64_t steps;     /* transitions made */
     int64_t cut;       /* walks cut at max_steps (the estimate is biased by them) */
+    int64_t rows;      /* rows of the walk kernel built: states reached, or n once built whole */
     double max_share;  /* largest single score^2 / sum of scores^2: near 1, one walk dominates */
     double seconds;    /* wall time spent walking */
     int threads;       /* threads used */
@@ -362,8 +366,11 @@ typedef struct ulam_walk_result {
 /* An opaque walk solver: the kernel, the statistics and the stopping state. */
 typedef struct ulam_solver ulam_solver;
 
-/* Prepare walks on (I - M) x = b (the kernel is built once here).  Refuses an absorption
- * estimator when a state it can score at has p* = 0 (ULAM_EUNDEFINED, err->index naming it). */
+/* Prepare walks on (I - M) x = b.  M and b are borrowed: they must stay unchanged until the
+ * solver is freed, for the walk kernel's rows are built from them when a walk first reaches
+ * them (so a query for one x_i reads and keeps only the rows its walks visit).  Refuses an
+ * absorption estimator when a state it can score at has p* = 0 (ULAM_EUNDEFINED, err->index
+ * naming it). */
 int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                       ulam_solver **out, ulam_error *err);
 

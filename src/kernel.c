@@ -8,7 +8,15 @@
  * Vose's method (M. D. Vose, "A linear algorithm for generating random numbers with a given
  * distribution", IEEE TSE 17(9), 1991), so a step costs one 64-bit draw.  Each row's header
  * (factor, scores, length) sits just before its slots, and outcomes name the target row's
- * position, so a step touches one row's memory and nothing else. */
+ * position, so a step touches one row's memory and nothing else.
+ *
+ * Rows are built lazily.  The first walk to reach state j builds its row from the borrowed K at
+ * the next free place of an arena (so rows a run visits are packed densely, and the rest of
+ * the reservation is never touched), its moves naming target states not yet placed.  The first
+ * walk to take such a move looks the target's place up (building that row if need be) and
+ * rewrites the outcome to name it, so later steps cost what they cost in a kernel built whole.
+ * A query for one x_i visits a small part of a large system: it pays for, and keeps in memory,
+ * only the rows its walks reach. */
 #include "kernel.h"
 
 #include <math.h>
@@ -20,8 +28,7 @@ ulam_kernel *ulam__kernel_free(ulam_kernel *k)
 {
     if (!k) return NULL;
     free(k->mem);
-    free(k->at);
-    free(k->pstar);
+    free((void *)k->where);
     free(k);
     return NULL;
 }
@@ -32,9 +39,17 @@ static uint64_t threshold(double f)
     return f >= 1.0 ? UINT64_MAX : f <= 0.0 ? 0 : (uint64_t)(f * 0x1.0p64);
 }
 
+/* Write slot s: take a below threshold t, else b. */
+static void set_slot(ulam__slot *s, uint64_t t, int32_t a, int32_t b)
+{
+    s->thresh = t;
+    atomic_store_explicit(&s->a, a, memory_order_relaxed);
+    atomic_store_explicit(&s->b, b, memory_order_relaxed);
+}
+
 /* Vose's alias table for the m outcomes with probabilities p (summing to 1) into s. */
 void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slot *s, double *scaled,
-                        int64_t *small, int64_t *large)
+                       int64_t *small, int64_t *large)
 {
     int64_t ns = 0, nl = 0;
     for (int64_t k = 0; k < m; k++) {
@@ -44,7 +59,7 @@ void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slo
     }
     while (ns > 0 && nl > 0) {
         int64_t a = small[--ns], g = large[nl - 1];
-        s[a] = (ulam__slot){threshold(scaled[a]), out[a], out[g]};
+        set_slot(&s[a], threshold(scaled[a]), out[a], out[g]);
         scaled[g] = (scaled[g] + scaled[a]) - 1.0;
         if (scaled[g] < 1.0) {
             nl--;
@@ -53,144 +68,180 @@ void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slo
     }
     while (nl > 0) { /* leftovers are 1 up to rounding */
         int64_t g = large[--nl];
-        s[g] = (ulam__slot){UINT64_MAX, out[g], out[g]};
+        set_slot(&s[g], UINT64_MAX, out[g], out[g]);
     }
     while (ns > 0) {
         int64_t a = small[--ns];
-        s[a] = (ulam__slot){UINT64_MAX, out[a], out[a]};
+        set_slot(&s[a], UINT64_MAX, out[a], out[a]);
     }
 }
 
-/* Encode moving to the row at unit u with the sign of v. */
-static int32_t encode(int64_t u, double v)
-{
-    return v < 0 ? ~(int32_t)u : (int32_t)u;
-}
-
-/* Lay out the rows: at[i] is row i's first unit; returns the total, or -1 past int32. */
-static int64_t layout(const ulam_csr *K, int64_t *at)
-{
-    int64_t u = 0;
-    for (int64_t i = 0; i < K->nrows; i++) {
-        at[i] = u;
-        u += ULAM__HEAD + (K->rowptr[i + 1] - K->rowptr[i]) + 1;
-        if (u >= INT32_MAX) return -1;
-    }
-    return u;
-}
-
-/* Scratch for building alias tables of up to m outcomes. */
-typedef struct {
-    double *p, *scaled;
-    int32_t *o;
-    int64_t *small, *large;
-} scratch;
-
-/* Allocate scratch for m outcomes; 0 on failure (what was allocated is freed by drop). */
-static int scratch_get(scratch *w, int64_t m)
-{
-    w->p = ulam__malloc((size_t)m, sizeof *w->p);
-    w->scaled = ulam__malloc((size_t)m, sizeof *w->scaled);
-    w->o = ulam__malloc((size_t)m, sizeof *w->o);
-    w->small = ulam__malloc((size_t)m, sizeof *w->small);
-    w->large = ulam__malloc((size_t)m, sizeof *w->large);
-    return w->p && w->scaled && w->o && w->small && w->large;
-}
-
-/* Free scratch. */
-static void scratch_drop(scratch *w)
-{
-    free(w->p), free(w->scaled), free(w->o), free(w->small), free(w->large);
-}
-
-/* Fill row i: header, then the alias table of its moves and termination. */
-static void build_row(const ulam_csr *K, int64_t i, double continue_q, ulam_kernel *k, scratch *w)
-{
-    int64_t b = K->rowptr[i], len = K->rowptr[i + 1] - b;
-    double S = 0.0;
-    for (int64_t q = b; q < b + len; q++) S += fabs(K->val[q]);
-    double qi = ulam__continuation(S, continue_q);
-    ulam__row *h = ulam__kernel_row(k, k->at[i]);
-    *h = (ulam__row){.factor = qi > 0 ? S / qi : 0.0, .len = (int32_t)(len + 1), .state = (int32_t)i};
-    k->pstar[i] = 1.0 - qi;
-    for (int64_t q = 0; q < len; q++) {
-        w->p[q] = qi * fabs(K->val[b + q]) / S;
-        w->o[q] = encode(k->at[K->colidx[b + q]], K->val[b + q]);
-    }
-    w->p[len] = k->pstar[i];
-    w->o[len] = ULAM__TERMINATE;
-    ulam__alias_build(w->p, w->o, len + 1, k->mem + k->at[i] + ULAM__HEAD, w->scaled, w->small, w->large);
-}
-
-/* Prefetch the row positions that row i's outcomes will look up (random reads). */
-static void prefetch_targets(const ulam_csr *K, const int64_t *at, int64_t i)
-{
-#if defined(__GNUC__)
-    if (i < K->nrows)
-        for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++) __builtin_prefetch(at + K->colidx[q]);
-#else
-    (void)K, (void)at, (void)i;
-#endif
-}
-
-/* Build the kernel of K; continue_q <= 0 means analog q_i = min(1, S_i).  Rows are built in
- * parallel; the positions of rows a few ahead are prefetched. */
-int ulam__kernel_build(const ulam_csr *K, double continue_q, ulam_kernel **out)
+/* The kernel of K: its size is reserved (not touched) and no row is built. */
+int ulam__kernel_alloc(const ulam_csr *K, double continue_q, ulam__scores scores, ulam_kernel **out)
 {
     *out = NULL;
-    int64_t n = K->nrows, maxlen = 0;
+    int64_t n = K->nrows, nnz = K->rowptr[n], maxlen = 1;
     for (int64_t i = 0; i < n; i++)
-        if (K->rowptr[i + 1] - K->rowptr[i] > maxlen) maxlen = K->rowptr[i + 1] - K->rowptr[i];
+        if (K->rowptr[i + 1] - K->rowptr[i] + 1 > maxlen) maxlen = K->rowptr[i + 1] - K->rowptr[i] + 1;
+    if (n >= ULAM__UNRESOLVED || nnz > ULAM__UNRESOLVED - (ULAM__HEAD + 1) * n) return ULAM_EOVERFLOW;
     ulam_kernel *k = calloc(1, sizeof *k);
     if (!k) return ULAM_ENOMEM;
-    k->n = n;
-    k->at = ulam__alloc_big((size_t)n, sizeof *k->at);
-    k->pstar = ulam__malloc((size_t)n, sizeof *k->pstar);
-    if (!k->at || !k->pstar || (k->units = layout(K, k->at)) < 0 ||
-        !(k->mem = ulam__alloc_big((size_t)k->units, sizeof *k->mem))) {
+    k->n = n, k->cap = nnz + (ULAM__HEAD + 1) * n, k->maxlen = maxlen;
+    k->K = K, k->continue_q = continue_q, k->scores = scores;
+    atomic_init(&k->top, 0);
+    atomic_init(&k->built, 0);
+    k->where = ulam__alloc_big((size_t)n, sizeof *k->where);
+    k->mem = ulam__alloc_big((size_t)k->cap, sizeof *k->mem);
+    if (!k->where || !k->mem) {
         ulam__kernel_free(k);
         return ULAM_ENOMEM;
     }
-    int failed = 0;
-#pragma omp parallel reduction(| : failed) if (n > 50000)
-    {
-        scratch w;
-        if (!scratch_get(&w, maxlen + 1)) failed = 1;
-#pragma omp for schedule(static, 4096)
-        for (int64_t i = 0; i < n; i++) {
-            if (failed) continue;
-            prefetch_targets(K, k->at, i + 16);
-            build_row(K, i, continue_q, k, &w);
-        }
-        scratch_drop(&w);
-    }
-    if (failed) {
-        ulam__kernel_free(k);
-        return ULAM_ENOMEM;
-    }
+    for (int64_t i = 0; i < n; i++) atomic_init(&k->where[i], 0); /* no row built */
     *out = k;
     return ULAM_OK;
 }
 
-/* States reachable from the start set (marked in seen[]) along the kernel's moves. */
-int ulam__kernel_reach(const ulam_kernel *k, char *seen)
+/* Scratch for building rows of up to k->maxlen outcomes. */
+int ulam__kscratch_alloc(const ulam_kernel *k, ulam__kscratch *w)
 {
-    int64_t *stack = ulam__malloc((size_t)k->n, sizeof *stack), top = 0;
-    if (!stack) return ULAM_ENOMEM;
+    size_t m = (size_t)k->maxlen;
+    w->p = ulam__malloc(m, sizeof *w->p);
+    w->scaled = ulam__malloc(m, sizeof *w->scaled);
+    w->o = ulam__malloc(m, sizeof *w->o);
+    w->small = ulam__malloc(m, sizeof *w->small);
+    w->large = ulam__malloc(m, sizeof *w->large);
+    return w->p && w->scaled && w->o && w->small && w->large ? ULAM_OK : ULAM_ENOMEM;
+}
+
+/* Free scratch. */
+void ulam__kscratch_free(ulam__kscratch *w)
+{
+    free(w->p), free(w->scaled), free(w->o), free(w->small), free(w->large);
+    *w = (ulam__kscratch){0};
+}
+
+/* The sum S_i of row i of |K|. */
+static double row_sum(const ulam_csr *K, int64_t i)
+{
+    double S = 0.0;
+    for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++) S += fabs(K->val[q]);
+    return S;
+}
+
+/* The continuation probability q_i of row i. */
+double ulam__kernel_q(const ulam_csr *K, int64_t i, double continue_q)
+{
+    return ulam__continuation(row_sum(K, i), continue_q);
+}
+
+/* What a visit to and a termination at row i score (see ulam__scores). */
+static void row_scores(const ulam_kernel *k, int64_t i, double pstar, double *visit, double *end)
+{
+    const ulam__scores *s = &k->scores;
+    double g = s->b ? s->b[i] : 1.0, mb = 0.0;
+    if (s->estimator == ULAM_EXPECTED && s->b)
+        for (int64_t q = k->K->rowptr[i]; q < k->K->rowptr[i + 1]; q++) mb += k->K->val[q] * s->b[k->K->colidx[q]];
+    *visit = s->estimator == ULAM_COLLISION ? g : mb;
+    *end = s->estimator == ULAM_ABSORPTION && pstar > 0 ? g / pstar : 0.0;
+}
+
+/* Build row i at header h: factor, scores and the alias table of its moves and termination.
+ * Moves name their target rows' units when `placed` (every row has its place), else target
+ * states still to be resolved. */
+static void build_row(const ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam__kscratch *w)
+{
+    const ulam_csr *K = k->K;
+    int64_t b = K->rowptr[i], len = K->rowptr[i + 1] - b;
+    double S = row_sum(K, i), qi = ulam__continuation(S, k->continue_q);
+    *h = (ulam__row){.factor = qi > 0 ? S / qi : 0.0, .len = (int32_t)(len + 1), .state = (int32_t)i};
+    row_scores(k, i, 1.0 - qi, &h->visit, &h->end);
+    for (int64_t q = 0; q < len; q++) {
+        int64_t j = K->colidx[b + q];
+        int32_t t = placed ? atomic_load_explicit(&k->where[j], memory_order_relaxed) - 1 : ULAM__UNRESOLVED + (int32_t)j;
+        w->p[q] = qi * fabs(K->val[b + q]) / S;
+        w->o[q] = K->val[b + q] < 0 ? ~t : t;
+    }
+    w->p[len] = 1.0 - qi;
+    w->o[len] = ULAM__TERMINATE;
+    ulam__alias_build(w->p, w->o, len + 1, (ulam__slot *)(void *)h + ULAM__HEAD, w->scaled, w->small, w->large);
+}
+
+/* State j's row: the thread that claims it (where 0 -> -1) takes the next units of the arena,
+ * builds the row there and publishes its place; any other thread waits for that. */
+int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
+{
+    int32_t v = atomic_load_explicit(&k->where[j], memory_order_acquire), expect = 0;
+    if (v > 0) return v - 1;
+    if (atomic_compare_exchange_strong_explicit(&k->where[j], &expect, -1, memory_order_acquire,
+                                                memory_order_acquire)) {
+        int64_t size = ULAM__HEAD + k->K->rowptr[j + 1] - k->K->rowptr[j] + 1;
+        int64_t u = atomic_fetch_add_explicit(&k->top, size, memory_order_relaxed);
+        build_row(k, j, ulam__kernel_row(k, u), 0, w);
+        atomic_store_explicit(&k->where[j], (int32_t)u + 1, memory_order_release);
+        atomic_fetch_add_explicit(&k->built, 1, memory_order_relaxed);
+        return (int32_t)u;
+    }
+    while ((v = atomic_load_explicit(&k->where[j], memory_order_acquire)) < 0) continue;
+    return v - 1;
+}
+
+/* The row an unresolved outcome leads to; the outcome is rewritten to name it directly
+ * (racing walkers write the same value). */
+int32_t ulam__kernel_resolve(ulam_kernel *k, _Atomic int32_t *field, int32_t o, ulam__kscratch *w)
+{
+    int32_t u = ulam__kernel_unit(k, ulam__outcome_target(o) - ULAM__UNRESOLVED, w);
+    atomic_store_explicit(field, o < 0 ? ~u : u, memory_order_release);
+    return u;
+}
+
+/* Prefetch the places of the targets of row i (random reads). */
+static void prefetch_targets(const ulam_kernel *k, int64_t i)
+{
+#if defined(__GNUC__)
+    if (i < k->n)
+        for (int64_t q = k->K->rowptr[i]; q < k->K->rowptr[i + 1]; q++)
+            __builtin_prefetch((const void *)&k->where[k->K->colidx[q]]);
+#else
+    (void)k, (void)i;
+#endif
+}
+
+/* Build every row not built yet: place them all after the built ones, then build them in
+ * parallel, streaming K once, with their moves resolved. */
+void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
+{
+    const ulam_csr *K = k->K;
+    int64_t from = atomic_load(&k->top), u = from;
     for (int64_t i = 0; i < k->n; i++)
+        if (atomic_load_explicit(&k->where[i], memory_order_relaxed) == 0) {
+            atomic_store_explicit(&k->where[i], (int32_t)u + 1, memory_order_relaxed);
+            u += ULAM__HEAD + K->rowptr[i + 1] - K->rowptr[i] + 1;
+        }
+    atomic_store(&k->top, u);
+    atomic_store(&k->built, k->n);
+#pragma omp parallel for schedule(static, 4096) num_threads(threads)
+    for (int64_t i = 0; i < k->n; i++) {
+        int64_t at = atomic_load_explicit(&k->where[i], memory_order_relaxed) - 1;
+        prefetch_targets(k, i + 16);
+        if (at >= from) build_row(k, i, ulam__kernel_row(k, at), 1, &w[ulam__thread_num()]);
+    }
+}
+
+/* States reachable from the start set (marked in seen[]) along the walk's moves. */
+int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen)
+{
+    int64_t n = K->nrows, *stack = ulam__malloc((size_t)n, sizeof *stack), top = 0;
+    if (!stack) return ULAM_ENOMEM;
+    for (int64_t i = 0; i < n; i++)
         if (seen[i]) stack[top++] = i;
     while (top > 0) {
-        const ulam__row *h = ulam__kernel_row(k, k->at[stack[--top]]);
-        const ulam__slot *s = (const ulam__slot *)(const void *)h + ULAM__HEAD;
-        for (int32_t q = 0; q < h->len; q++) {
-            int32_t outs[2] = {s[q].a, s[q].b};
-            for (int t = 0; t < 2; t++) {
-                if (outs[t] == ULAM__TERMINATE) continue;
-                int32_t j = ulam__kernel_row(k, ulam__outcome_target(outs[t]))->state;
-                if (!seen[j]) {
-                    seen[j] = 1;
-                    stack[top++] = j;
-                }
+        int64_t i = stack[--top];
+        if (ulam__kernel_q(K, i, continue_q) <= 0) continue;
+        for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++) {
+            int64_t j = K->colidx[q];
+            if (K->val[q] != 0.0 && !seen[j]) {
+                seen[j] = 1;
+                stack[top++] = j;
             }
         }
     }

@@ -1,18 +1,26 @@
-/* The walk kernel (internal): one array of rows, each a header and its alias slots. */
+/* The walk kernel (internal): an arena of rows, each a header and its alias slots, built the
+ * first time a walk reaches the row. */
 #ifndef ULAM_KERNEL_H
 #define ULAM_KERNEL_H
 
 #include "internal.h"
 
+#include <stdatomic.h>
+
 /* Outcome code for "the walk terminates here". */
 #define ULAM__TERMINATE INT32_MIN
 
+/* Outcome targets from here up name the state t - ULAM__UNRESOLVED, whose row's place is not
+ * yet known; below it they name the row's unit. */
+#define ULAM__UNRESOLVED (INT32_C(1) << 30)
+
 /* One alias slot: with the 64-bit fraction u of the draw that picked it, take a when
- * u < thresh, else b.  An outcome r >= 0 moves to the row at unit r keeping the weight's
- * sign; ~r (< 0) moves there flipping it; ULAM__TERMINATE ends the walk. */
+ * u < thresh, else b.  An outcome r >= 0 moves to target r keeping the weight's sign; ~r (< 0)
+ * moves there flipping it; ULAM__TERMINATE ends the walk.  A walk that follows an unresolved
+ * target rewrites it to the row's unit (the only write to a built row). */
 typedef struct {
     uint64_t thresh;
-    int32_t a, b;
+    _Atomic int32_t a, b;
 } ulam__slot;
 
 /* A row's header, two units long, followed by its len alias slots: everything a step from
@@ -27,28 +35,70 @@ typedef struct {
 
 #define ULAM__HEAD 2 /* units in a header */
 
-/* The kernel: 16-byte units holding the rows; row i starts at unit at[i]; pstar[i] = 1 - q_i.
- * Offsets are int32, so a kernel holds under 2^31 units (32 GB). */
+/* What visits and terminations score, with g_i = b[i] (1 when b is NULL): collision g_i per
+ * visit, absorption g_i / p*_i per termination, expected (K b)_i per visit (0 without b). */
+typedef struct {
+    const double *b;
+    int estimator;
+} ulam__scores;
+
+/* The kernel of a borrowed matrix K.  Rows are built when first reached and placed one after
+ * another in an arena of 16-byte units, so the memory a run touches is the rows it visits,
+ * densely packed; where[i] is 0 until row i is built, -1 while a thread builds it, then its
+ * unit + 1.  Units and states are below 2^30 (a 16 GB kernel). */
 typedef struct ulam_kernel {
-    int64_t n, units;
+    int64_t n, cap, maxlen; /* cap: units reserved (all rows); maxlen: the longest row's outcomes */
+    _Atomic int64_t top;    /* units handed out */
+    _Atomic int64_t built;  /* rows built */
     ulam__slot *mem;
-    int64_t *at;
-    double *pstar;
+    _Atomic int32_t *where;
+    const ulam_csr *K;
+    double continue_q;
+    ulam__scores scores;
 } ulam_kernel;
+
+/* Per-thread scratch for building rows of up to maxlen outcomes. */
+typedef struct {
+    double *p, *scaled;
+    int32_t *o;
+    int64_t *small, *large;
+} ulam__kscratch;
 
 /* Vose's alias table of m outcomes out[] with probabilities p[] (sum 1) into s[0..m-1];
  * scaled, small and large are scratch arrays of m entries. */
 void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slot *s, double *scaled,
                        int64_t *small, int64_t *large);
 
-/* Build the kernel of K (continue_q <= 0: analog); visit and end scores start at 0. */
-int ulam__kernel_build(const ulam_csr *K, double continue_q, ulam_kernel **out);
+/* The kernel of K (which must outlive it; continue_q <= 0: analog), no row built yet: O(n)
+ * time and 4 bytes a state.  ULAM_OK, ULAM_ENOMEM, or ULAM_EOVERFLOW past 2^30 units. */
+int ulam__kernel_alloc(const ulam_csr *K, double continue_q, ulam__scores scores, ulam_kernel **out);
 
 /* Free a kernel; accepts NULL. */
 ulam_kernel *ulam__kernel_free(ulam_kernel *k);
 
-/* Mark in seen[] every state reachable from those already marked; ULAM_OK or ULAM_ENOMEM. */
-int ulam__kernel_reach(const ulam_kernel *k, char *seen);
+/* Scratch for building k's rows; ULAM_OK or ULAM_ENOMEM (free it with ulam__kscratch_free). */
+int ulam__kscratch_alloc(const ulam_kernel *k, ulam__kscratch *w);
+
+/* Free scratch (its arrays may be NULL). */
+void ulam__kscratch_free(ulam__kscratch *w);
+
+/* The unit of state j's row, building it first if no walk has; safe when threads race. */
+int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w);
+
+/* Resolve the unresolved outcome o found in *field: the target row's unit, written back. */
+int32_t ulam__kernel_resolve(ulam_kernel *k, _Atomic int32_t *field, int32_t o, ulam__kscratch *w);
+
+/* Build every row no walk has built yet, with `threads` threads (w[t]: thread t's scratch),
+ * while no walk runs: for a run that visits most states, streaming K once beats building row
+ * by row at first visits (random reads). */
+void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w);
+
+/* The continuation probability q_i of row i of K. */
+double ulam__kernel_q(const ulam_csr *K, int64_t i, double continue_q);
+
+/* Mark in seen[] every state of K reachable from those already marked by the walk's moves
+ * (the nonzeros of rows with q_i > 0); ULAM_OK or ULAM_ENOMEM. */
+int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen);
 
 /* The header of the row at unit u. */
 static inline ulam__row *ulam__kernel_row(const ulam_kernel *k, int64_t u)
@@ -57,22 +107,35 @@ static inline ulam__row *ulam__kernel_row(const ulam_kernel *k, int64_t u)
 }
 
 /* Draw a slot of row h; *frac is to be compared with its threshold. */
-static inline const ulam__slot *ulam__kernel_pick(const ulam__row *h, ulam_rng *r, uint64_t *frac)
+static inline ulam__slot *ulam__kernel_pick(ulam__row *h, ulam_rng *r, uint64_t *frac)
 {
-    return (const ulam__slot *)(const void *)h + ULAM__HEAD + ulam__rng_index(r, (uint64_t)h->len, frac);
+    return (ulam__slot *)(void *)h + ULAM__HEAD + ulam__rng_index(r, (uint64_t)h->len, frac);
 }
 
-/* The row unit (or state, in a source table) an outcome other than ULAM__TERMINATE names;
- * o < 0 also flips the weight's sign. */
+/* The target (row unit, unresolved state code or source state) of an outcome other than
+ * ULAM__TERMINATE; o < 0 also flips the weight's sign. */
 static inline int32_t ulam__outcome_target(int32_t o)
 {
     return o < 0 ? ~o : o;
 }
 
-/* The outcome of slot s for fraction frac. */
-static inline int32_t ulam__slot_outcome(const ulam__slot *s, uint64_t frac)
+/* The outcome field of slot s that fraction frac selects. */
+static inline _Atomic int32_t *ulam__slot_field(ulam__slot *s, uint64_t frac)
 {
-    return frac < s->thresh ? s->a : s->b;
+    return frac < s->thresh ? &s->a : &s->b;
+}
+
+/* The outcome in a slot's field. */
+static inline int32_t ulam__outcome(_Atomic int32_t *field)
+{
+    return atomic_load_explicit(field, memory_order_acquire);
+}
+
+/* The row unit a move with outcome o (from *field) reaches. */
+static inline int32_t ulam__kernel_target(ulam_kernel *k, _Atomic int32_t *field, int32_t o, ulam__kscratch *w)
+{
+    int32_t t = ulam__outcome_target(o);
+    return t < ULAM__UNRESOLVED ? t : ulam__kernel_resolve(k, field, o, w);
 }
 
 #endif

@@ -18,24 +18,27 @@
 #endif
 
 /* Walks per block, blocks per round, split-stack entries per thread; kernels up to CACHED
- * bytes (this machine's L2) walk 16 histories interleaved, larger ones 32 (measured best). */
-enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20 };
+ * bytes (this machine's L2) walk 16 histories interleaved, larger ones 32 (measured best).
+ * Once walks have built 1 / COMPLETE of the kernel row by row, the rest is built at once. */
+enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = 16 };
 
 struct ulam_solver {
     ulam_walk_opts o;
     int64_t n;
     ulam_kernel *k;
     ulam__walker w;
-    double *b;
+    const double *b; /* the caller's, borrowed like M */
     ulam_csr *mt;
     ulam__slot *src;
     int threads;
     ulam__scratch *scratch; /* one per thread */
+    ulam__kscratch *ks;     /* one per thread: room to build a kernel row */
     ulam__block *blocks;   /* one per block of a round */
     /* accumulated */
     ulam__moments adj;
     double *sum, *sumsq; /* forward per-state sums of history tallies */
     int64_t walks, steps, cut, nonfinite, next_walk;
+    int complete; /* the kernel is built whole */
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
     double seconds, t0;
     int done, interrupted, status;
@@ -53,16 +56,18 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
 {
     if (!s) return NULL;
     ulam__kernel_free(s->k);
-    free(s->b), free(s->src), free(s->sum), free(s->sumsq);
+    free(s->src), free(s->sum), free(s->sumsq);
     ulam_csr_free(s->mt);
     if (s->scratch)
         for (int t = 0; t < s->threads; t++) {
             free(s->scratch[t].stack_s), free(s->scratch[t].stack_w);
             free(s->scratch[t].hist), free(s->scratch[t].touched), free(s->scratch[t].mark);
         }
+    if (s->ks)
+        for (int t = 0; t < s->threads; t++) ulam__kscratch_free(&s->ks[t]);
     if (s->blocks)
         for (int q = 0; q < ROUND; q++) free(s->blocks[q].t.t);
-    free(s->scratch), free(s->blocks);
+    free(s->scratch), free(s->ks), free(s->blocks);
     free(s);
     return NULL;
 }
@@ -90,21 +95,21 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
 }
 
 /* Refuse absorption when a reachable state with p* = 0 would have to score. */
-static int check_absorption(ulam_solver *s, ulam_error *err)
+static int check_absorption(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
     char *seen = ulam__calloc((size_t)s->n, 1);
     if (!seen) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
     if (s->o.mode == ULAM_ADJOINT) seen[s->o.index] = 1;
     else
         for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
-    if (ulam__kernel_reach(s->k, seen)) {
+    if (ulam__kernel_reach(K, s->o.continue_q, seen)) {
         free(seen);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
     }
     int64_t bad = -1;
     for (int64_t i = 0; i < s->n && bad < 0; i++) {
         int scores = s->o.mode == ULAM_ADJOINT ? s->b[i] != 0.0 : 1;
-        if (seen[i] && scores && s->k->pstar[i] <= 0.0) bad = i;
+        if (seen[i] && scores && ulam__kernel_q(K, i, s->o.continue_q) >= 1.0) bad = i;
     }
     free(seen);
     if (bad >= 0)
@@ -140,37 +145,20 @@ static int build_source(ulam_solver *s, double *bnorm1)
     return status;
 }
 
-/* Write into the kernel's rows what a visit and a termination score (see walk.c). */
-static int set_scores(ulam_solver *s, const ulam_csr *M)
-{
-    int est = s->o.estimator, adj = s->o.mode == ULAM_ADJOINT;
-    double *mb = NULL;
-    if (adj && est == ULAM_EXPECTED) {
-        if (!(mb = ulam__malloc((size_t)s->n, sizeof *mb))) return ULAM_ENOMEM;
-        ulam_csr_matvec(M, 0, s->b, mb);
-    }
-    for (int64_t i = 0; i < s->n; i++) {
-        ulam__row *h = ulam__kernel_row(s->k, s->k->at[i]);
-        double g = adj ? s->b[i] : 1.0, ps = s->k->pstar[i];
-        h->visit = est == ULAM_COLLISION ? g : mb ? mb[i] : 0.0;
-        h->end = est == ULAM_ABSORPTION && ps > 0 ? g / ps : 0.0;
-    }
-    free(mb);
-    return ULAM_OK;
-}
-
 /* Allocate per-thread scratch and per-block results. */
 static int alloc_work(ulam_solver *s)
 {
     s->scratch = calloc((size_t)s->threads, sizeof *s->scratch);
+    s->ks = calloc((size_t)s->threads, sizeof *s->ks);
     s->blocks = calloc(ROUND, sizeof *s->blocks);
-    if (!s->scratch || !s->blocks) return ULAM_ENOMEM;
+    if (!s->scratch || !s->ks || !s->blocks) return ULAM_ENOMEM;
     for (int t = 0; t < s->threads; t++) {
         ulam__scratch *sc = &s->scratch[t];
         sc->stack_cap = STACK;
         sc->stack_s = ulam__malloc(STACK, sizeof *sc->stack_s);
         sc->stack_w = ulam__malloc(STACK, sizeof *sc->stack_w);
-        if (!sc->stack_s || !sc->stack_w) return ULAM_ENOMEM;
+        sc->ks = &s->ks[t];
+        if (!sc->stack_s || !sc->stack_w || ulam__kscratch_alloc(s->k, sc->ks)) return ULAM_ENOMEM;
         if (s->o.mode == ULAM_FORWARD) {
             sc->hist = ulam__calloc((size_t)s->n, sizeof *sc->hist);
             sc->touched = ulam__malloc((size_t)s->n, sizeof *sc->touched);
@@ -202,26 +190,30 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     s->o = o;
     s->n = M->nrows;
     s->threads = ulam__threads(o.threads);
-    s->b = ulam__malloc((size_t)s->n, sizeof *s->b);
-    if (!s->b) goto nomem;
-    memcpy(s->b, b, (size_t)s->n * sizeof *s->b);
+    s->b = b;
+    const ulam_csr *K = M;
     if (o.mode == ULAM_FORWARD) {
-        if (ulam_csr_transpose(M, &s->mt)) goto nomem;
-        if (ulam__kernel_build(s->mt, o.continue_q, &s->k)) goto nomem;
-        if (build_source(s, &bnorm1)) goto nomem;
-    } else if (ulam__kernel_build(M, o.continue_q, &s->k)) {
-        goto nomem;
+        if (ulam_csr_transpose(M, &s->mt) || build_source(s, &bnorm1)) goto nomem;
+        K = s->mt;
     }
-    if (set_scores(s, M)) goto nomem;
-    if (o.estimator == ULAM_ABSORPTION && (status = check_absorption(s, err))) {
+    ulam__scores sc = {o.mode == ULAM_ADJOINT ? b : NULL, o.estimator};
+    if ((status = ulam__kernel_alloc(K, o.continue_q, sc, &s->k)) == ULAM_EOVERFLOW) {
+        ulam_solver_free(s);
+        return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
+    }
+    if (status) goto nomem;
+    if (o.estimator == ULAM_ABSORPTION && (status = check_absorption(s, K, err))) {
         ulam_solver_free(s);
         return status;
     }
     if (alloc_work(s)) goto nomem;
-    s->w = (ulam__walker){.k = s->k, .start = s->k->at[o.index], .mt = s->mt, .src = s->src,
+    if (o.whole_kernel) ulam__kernel_complete(s->k, s->threads, s->ks);
+    s->complete = o.whole_kernel != 0;
+    s->w = (ulam__walker){.k = s->k, .mt = s->mt, .src = s->src,
                           .bnorm1 = bnorm1, .roulette = o.roulette, .split = o.split,
                           .max_steps = o.max_steps, .interrupt = o.interrupt,
-                          .lanes = s->k->units * (int64_t)sizeof(ulam__slot) <= CACHED ? 16 : 32};
+                          .lanes = s->k->cap * (int64_t)sizeof(ulam__slot) <= CACHED ? 16 : 32};
+    if (o.mode == ULAM_ADJOINT) s->w.start = ulam__kernel_unit(s->k, o.index, &s->ks[0]);
     if (o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED) s->w.score0 = s->b[o.index];
     if (o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED) s->w.expected = 1;
     s->t0 = -1;
@@ -426,6 +418,10 @@ int ulam_solver_iterate(ulam_solver *s)
     if (s->done) return s->status;
     double start = ulam_now();
     if (s->t0 < 0) s->t0 = start;
+    if (!s->complete && atomic_load(&s->k->top) * COMPLETE > s->k->cap) {
+        ulam__kernel_complete(s->k, s->threads, s->ks);
+        s->complete = 1;
+    }
     static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally),
                                    offsetof(ulam__block, t.t), offsetof(ulam__block, t.len),
                                    offsetof(ulam__block, t.cap)};
@@ -489,6 +485,7 @@ void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
     r->walks = s->walks;
     r->steps = s->steps;
     r->cut = s->cut;
+    r->rows = atomic_load(&s->k->built);
     r->seconds = s->seconds;
     r->threads = s->threads;
     r->interrupted = s->interrupted;

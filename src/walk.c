@@ -2,9 +2,9 @@
  *
  * Adjoint (one x_i): start at i with weight 1.  Collision scores sum_m w_m b_{i_m} over every
  * visited state; absorption scores w_k b_{i_k} / p*_{i_k} where the walk ends; expected scores
- * b_i + sum_m w_m (M b)_{i_m}, the exact expectation of the next step's score.  The solver
- * writes these per-state scores into the kernel's row headers (visit and end), so one loop
- * serves all three.
+ * b_i + sum_m w_m (M b)_{i_m}, the exact expectation of the next step's score.  The kernel
+ * keeps these per-state scores in its row headers (visit and end), so one loop serves all
+ * three; a walker enters a row (building it on the first visit) before it reads it.
  * Forward (every x_i): a source j ~ |b_j| / ||b||_1 with weight ||b||_1 sign(b_j), steps on the
  * kernel of M'; collision tallies w at every visited state, absorption w / p* where the walk
  * ends, expected w M_{k s} at every neighbour k of each visited state s (plus b, added later).
@@ -63,17 +63,19 @@ static int window(const ulam__walker *w, int32_t u, double *wt, ulam_rng *r, sta
     return 1;
 }
 
-/* Decode an outcome into the target row's unit, flipping the weight's sign if asked. */
-static inline int32_t target(int32_t o, double f, double *wt)
+/* Take the move to outcome o (read from *field) of a row with factor f: the weight gets the
+ * factor and the move's sign; returns the target row's unit. */
+static inline int32_t target(ulam_kernel *k, _Atomic int32_t *field, int32_t o, double f, double *wt,
+                             ulam__kscratch *ks)
 {
     *wt *= o < 0 ? -f : f;
-    return ulam__outcome_target(o);
+    return ulam__kernel_target(k, field, o, ks);
 }
 
 /* One adjoint lane: the particle it carries and its history so far. */
 typedef struct {
-    const ulam__row *h;  /* the particle's row */
-    const ulam__slot *s; /* the slot drawn for its next step */
+    ulam__row *h;  /* the particle's row */
+    ulam__slot *s; /* the slot drawn for its next step */
     uint64_t frac;
     double w, score;
     int64_t len; /* steps in this history */
@@ -102,14 +104,15 @@ static int lane_pop(const ulam__walker *w, lane *x)
 }
 
 /* Lane x's step: 1 while its particle lives on. */
-static inline int lane_move(const ulam__walker *w, lane *x, ulam_rng *r, ulam__block *out)
+static inline int lane_move(const ulam__walker *w, lane *x, ulam_rng *r, ulam__kscratch *ks, ulam__block *out)
 {
-    int32_t o = ulam__slot_outcome(x->s, x->frac);
+    _Atomic int32_t *f = ulam__slot_field(x->s, x->frac);
+    int32_t o = ulam__outcome(f);
     if (o == ULAM__TERMINATE) {
         x->score += x->w * x->h->end;
         return 0;
     }
-    int32_t u = target(o, x->h->factor, &x->w);
+    int32_t u = target(w->k, f, o, x->h->factor, &x->w, ks);
     x->h = ulam__kernel_row(w->k, u);
     prefetch(x->h);
     out->steps++;
@@ -158,7 +161,7 @@ void ulam__adjoint_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam
         }
         for (int l = 0; l < act;) {
             lane *x = &L[l];
-            if (lane_move(w, x, r, &acc) || lane_pop(w, x)) {
+            if (lane_move(w, x, r, sc->ks, &acc) || lane_pop(w, x)) {
                 l++;
                 continue;
             }
@@ -216,27 +219,28 @@ static void forward_visit(const ulam__walker *w, ulam__scratch *sc, const ulam__
 /* One forward history: its (state, tally) pairs go to out->t. */
 static int forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc, ulam__block *out)
 {
-    const ulam_kernel *k = w->k;
+    ulam_kernel *k = w->k;
     uint64_t frac;
-    const ulam__slot *src = w->src + ulam__rng_index(r, (uint64_t)k->n, &frac);
-    int32_t o = ulam__slot_outcome(src, frac);
+    ulam__slot *src = w->src + ulam__rng_index(r, (uint64_t)k->n, &frac);
+    int32_t o = ulam__outcome(ulam__slot_field(src, frac));
     stack st = {sc->stack_s, sc->stack_w, 1, sc->stack_cap};
-    st.s[0] = (int32_t)k->at[ulam__outcome_target(o)];
+    st.s[0] = ulam__kernel_unit(k, ulam__outcome_target(o), sc->ks);
     st.w[0] = o < 0 ? -w->bnorm1 : w->bnorm1;
     int64_t len = 0;
     while (st.top > 0) {
         st.top--;
-        const ulam__row *h = ulam__kernel_row(k, st.s[st.top]);
+        ulam__row *h = ulam__kernel_row(k, st.s[st.top]);
         double wt = st.w[st.top];
         for (;;) {
             forward_visit(w, sc, h, wt);
-            const ulam__slot *sl = ulam__kernel_pick(h, r, &frac);
-            o = ulam__slot_outcome(sl, frac);
+            ulam__slot *sl = ulam__kernel_pick(h, r, &frac); /* sets frac */
+            _Atomic int32_t *f = ulam__slot_field(sl, frac);
+            o = ulam__outcome(f);
             if (o == ULAM__TERMINATE) {
                 if (h->end != 0.0) tally(sc, h->state, wt * h->end);
                 break;
             }
-            int32_t u = target(o, h->factor, &wt);
+            int32_t u = target(k, f, o, h->factor, &wt, sc->ks);
             h = ulam__kernel_row(k, u);
             out->steps++;
             if (++len > w->max_steps || !isfinite(wt)) {

@@ -20,11 +20,11 @@ typedef struct {
 /* Everything a walker reads: shared, read-only during a run.  What a visit or a termination
  * scores lives in the kernel's row headers (visit, end). */
 typedef struct {
-    const ulam_kernel *k;
+    ulam_kernel *k;        /* its rows are built as walks reach them */
     int64_t start;         /* adjoint: the start row's unit */
     double score0;         /* adjoint: added to every history (b_i for the expected estimator) */
     const ulam_csr *mt;    /* forward expected estimator: M' (column s of M is row s) */
-    const ulam__slot *src; /* forward: alias table of |b| over n outcomes (encoded states) */
+    ulam__slot *src;       /* forward: alias table of |b| over n outcomes (encoded states) */
     double bnorm1;         /* forward: ||b||_1 */
     int expected;          /* forward: scatter expected tallies */
     double roulette, split;
@@ -33,8 +33,10 @@ typedef struct {
     volatile const int *interrupt;
 } ulam__walker;
 
-/* Per-thread scratch: the split stacks and the forward history tally. */
+/* Per-thread scratch: the split stacks, the forward history tally, and room to build a row
+ * of the kernel when a walk first reaches it. */
 typedef struct {
+    ulam__kscratch *ks;
     int32_t *stack_s; /* row units */
     double *stack_w;
     int64_t stack_cap;

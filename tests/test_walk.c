@@ -312,6 +312,30 @@ static void test_threads_identical(void **state)
     unload(&s);
 }
 
+/* The walk kernel is built as walks reach its rows: a short run builds at most one row per
+ * step or start, a long one ends with the whole kernel (built at once after 1/16), and
+ * neither changes a bit of the result against a kernel built whole before walking. */
+static void test_lazy_kernel(void **state)
+{
+    (void)state;
+    sys s = load("randsub1000");
+    static const int64_t budgets[2] = {16, 50000};
+    for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++)
+        for (int k = 0; k < 2; k++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.mode = mode, o.index = 5, o.max_walks = budgets[k], o.seed = 7 + (uint64_t)k, o.threads = 2;
+            ulam_walk_result lazy = run(&s, o);
+            o.whole_kernel = 1;
+            ulam_walk_result whole = run(&s, o);
+            assert_memory_equal(&lazy.estimate, &whole.estimate, sizeof lazy.estimate);
+            assert_memory_equal(&lazy.variance, &whole.variance, sizeof lazy.variance);
+            assert_true(lazy.steps == whole.steps && whole.rows == s.n);
+            if (k == 0) assert_true(lazy.rows <= lazy.steps + lazy.walks && lazy.rows < s.n / 4);
+            else assert_true(lazy.rows == s.n);
+        }
+    unload(&s);
+}
+
 /* Forward mode estimates every component with its own error bar. */
 static void test_forward_vectors(void **state)
 {
@@ -402,7 +426,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_agreement),         cmocka_unit_test(test_coverage),
         cmocka_unit_test(test_exact_variance),    cmocka_unit_test(test_roulette_and_splitting),
-        cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_forward_vectors),
+        cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_lazy_kernel),
+        cmocka_unit_test(test_forward_vectors),
         cmocka_unit_test(test_absorption_refused), cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_rel_err_stop),      cmocka_unit_test(test_jacobi_poisson),
         cmocka_unit_test(test_collision_absorption_law),

@@ -13,7 +13,7 @@ static const char *const usage =
     "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"
     "                  [--time S] [--seed S] [--threads T] [--continue Q] [--roulette W]\n"
     "                  [--split W] [--max-steps K] [--jacobi [--omega W]] [--check] [--json]\n"
-    "                  [--out x.mtx] [--errors e.mtx] [--force] [--cache]\n"
+    "                  [--out x.mtx] [--errors e.mtx] [--force] [--cache] [--whole-kernel]\n"
     "\n"
     "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
     "Indices are 1-based, as in Matrix Market files.\n"
@@ -41,6 +41,9 @@ static const char *const usage =
     "  --force            walk even when rho(|M|) >= 1 (otherwise refused with exit 3)\n"
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
     "                     that instead of parsing while the file is unchanged (size, mtime)\n"
+    "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
+    "                     is built when a walk first reaches it, so one unknown of a large\n"
+    "                     system reads and keeps only the rows its walks visit)\n"
     "\n"
     "Before walking, the guards estimate rho(|M|) (the walks converge iff < 1) and rho(M^) of\n"
     "the kernel's second-moment matrix (the variance is finite iff < 1); with rho(M^) >= 1 the\n"
@@ -90,7 +93,8 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     printf("method          %s walks, %s estimator\n", mode_names[o->mode], est_names[o->estimator]);
     printf("walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
            (long long)o->max_steps, r->cut ? ": the estimate is biased by the cut" : "");
-    printf("steps           %lld (mean walk length %.4g)\n", (long long)r->steps, mean_len);
+    printf("steps           %lld (mean walk length %.4g; kernel rows built %lld)\n", (long long)r->steps, mean_len,
+           (long long)r->rows);
     printf("variance        %.6g per walk (relative error %.3g)\n", r->variance, rel);
     printf("seconds         %.4f (%.3g M steps/s, %d threads, seed %llu)\n", r->seconds,
            r->seconds > 0 ? (double)r->steps / r->seconds / 1e6 : 0.0, r->threads,
@@ -143,6 +147,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
            cli_share ? cli_share->nranks : 1);
     cli_json_number("load_seconds", ro->load_seconds, 0);
     cli_json_number("kernel_seconds", ro->kernel_seconds, 0);
+    printf("\"kernel_rows\": %lld, ", (long long)r->rows);
     cli_json_number("peak_rss_mib", peak_rss_mib(), 0);
     if (ro->check) {
         cli_json_number("direct", ro->direct, 0);
@@ -197,7 +202,7 @@ int cli_solve(int argc, char **argv)
         {"json", no_argument, 0, 'J'},            {"out", required_argument, 0, 'o'},
         {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
         {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
-        {0, 0, 0, 0}};
+        {"whole-kernel", no_argument, 0, 'W'},    {0, 0, 0, 0}};
     cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};
@@ -229,6 +234,7 @@ int cli_solve(int argc, char **argv)
         case 'K': if ((rc = cli_parse_int("solve", "--max-steps", optarg, 1, INT64_MAX / 2, &o.max_steps))) return rc; break;
         case 'j': s.jacobi = 1; break;
         case 'C': s.cache = 1; break;
+        case 'W': o.whole_kernel = 1; break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'c': ro.check = 1; break;
         case 'J': ro.json = 1; break;
@@ -268,8 +274,10 @@ int cli_solve(int argc, char **argv)
     int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err);
     ro.kernel_seconds = ulam_now() - t0;
     int64_t n = s.M->nrows;
-    cli_system_free(&s); /* the solver holds its own kernel and b: walk without M */
-    if (status) return cli_report(s.matrix_path, &err);
+    if (status) {
+        cli_system_free(&s);
+        return cli_report(s.matrix_path, &err);
+    }
     cli_catch_sigint();
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     ulam_walk_result r;
