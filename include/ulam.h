@@ -330,7 +330,7 @@ typedef struct ulam_walk_opts {
     double continue_q;   /* fixed continuation probability in (0, 1); <= 0: analog min(1, S_i) */
     int whole_kernel;    /* 1: build the walk kernel's every row before walking; 0: build each
                             row when a walk first reaches it, and the rest at once when walks
-                            have reached 1/16 of them (a run that far will reach most) */
+                            have reached 1/4 of them (a run that far will reach most) */
     double roulette;     /* weight window floor W: below it survive with |w|/W at weight W; 0 off */
     double split;        /* weight window ceiling: above it split into ceil(|w|/W) copies; 0 off */
     uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */

@@ -313,7 +313,7 @@ static void test_threads_identical(void **state)
 }
 
 /* The walk kernel is built as walks reach its rows: a short run builds at most one row per
- * step or start, a long one ends with the whole kernel (built at once after 1/16), and
+ * step or start, a long one ends with the whole kernel (built at once after 1/4), and
  * neither changes a bit of the result against a kernel built whole before walking. */
 static void test_lazy_kernel(void **state)
 {
