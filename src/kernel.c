@@ -187,10 +187,10 @@ int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
 
 /* The row an unresolved outcome leads to; the outcome is rewritten to name it directly
  * (racing walkers write the same value). */
-int32_t ulam__kernel_resolve(ulam_kernel *k, _Atomic int32_t *field, int32_t o, ulam__kscratch *w)
+int32_t ulam__kernel_resolve(ulam_kernel *k, ulam__slot *s, uint64_t frac, int32_t o, ulam__kscratch *w)
 {
     int32_t u = ulam__kernel_unit(k, ulam__outcome_target(o) - ULAM__UNRESOLVED, w);
-    atomic_store_explicit(field, o < 0 ? ~u : u, memory_order_release);
+    atomic_store_explicit(frac < s->thresh ? &s->a : &s->b, o < 0 ? ~u : u, memory_order_release);
     return u;
 }
 

@@ -85,8 +85,9 @@ void ulam__kscratch_free(ulam__kscratch *w);
 /* The unit of state j's row, building it first if no walk has; safe when threads race. */
 int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w);
 
-/* Resolve the unresolved outcome o found in *field: the target row's unit, written back. */
-int32_t ulam__kernel_resolve(ulam_kernel *k, _Atomic int32_t *field, int32_t o, ulam__kscratch *w);
+/* Resolve the unresolved outcome o that fraction frac took from slot s: the target row's unit,
+ * written back into the slot. */
+int32_t ulam__kernel_resolve(ulam_kernel *k, ulam__slot *s, uint64_t frac, int32_t o, ulam__kscratch *w);
 
 /* Build every row no walk has built yet, with `threads` threads (w[t]: thread t's scratch),
  * while no walk runs: for a run that visits most states, streaming K once beats building row
@@ -119,23 +120,20 @@ static inline int32_t ulam__outcome_target(int32_t o)
     return o < 0 ? ~o : o;
 }
 
-/* The outcome field of slot s that fraction frac selects. */
-static inline _Atomic int32_t *ulam__slot_field(ulam__slot *s, uint64_t frac)
+/* The outcome of slot s for fraction frac.  Both are read and one is selected without a
+ * branch (the coin is unpredictable: a branch here costs a third of the in-cache speed). */
+static inline int32_t ulam__slot_outcome(ulam__slot *s, uint64_t frac)
 {
-    return frac < s->thresh ? &s->a : &s->b;
+    int32_t a = atomic_load_explicit(&s->a, memory_order_acquire);
+    int32_t b = atomic_load_explicit(&s->b, memory_order_acquire);
+    return frac < s->thresh ? a : b;
 }
 
-/* The outcome in a slot's field. */
-static inline int32_t ulam__outcome(_Atomic int32_t *field)
-{
-    return atomic_load_explicit(field, memory_order_acquire);
-}
-
-/* The row unit a move with outcome o (from *field) reaches. */
-static inline int32_t ulam__kernel_target(ulam_kernel *k, _Atomic int32_t *field, int32_t o, ulam__kscratch *w)
+/* The row unit a move with outcome o (taken by frac from slot s) reaches. */
+static inline int32_t ulam__kernel_target(ulam_kernel *k, ulam__slot *s, uint64_t frac, int32_t o, ulam__kscratch *w)
 {
     int32_t t = ulam__outcome_target(o);
-    return t < ULAM__UNRESOLVED ? t : ulam__kernel_resolve(k, field, o, w);
+    return t < ULAM__UNRESOLVED ? t : ulam__kernel_resolve(k, s, frac, o, w);
 }
 
 #endif

@@ -65,11 +65,11 @@ static int window(const ulam__walker *w, int32_t u, double *wt, ulam_rng *r, sta
 
 /* Take the move to outcome o (read from *field) of a row with factor f: the weight gets the
  * factor and the move's sign; returns the target row's unit. */
-static inline int32_t target(ulam_kernel *k, _Atomic int32_t *field, int32_t o, double f, double *wt,
+static inline int32_t target(ulam_kernel *k, ulam__slot *s, uint64_t frac, int32_t o, double f, double *wt,
                              ulam__kscratch *ks)
 {
     *wt *= o < 0 ? -f : f;
-    return ulam__kernel_target(k, field, o, ks);
+    return ulam__kernel_target(k, s, frac, o, ks);
 }
 
 /* One adjoint lane: the particle it carries and its history so far. */
@@ -106,13 +106,12 @@ static int lane_pop(const ulam__walker *w, lane *x)
 /* Lane x's step: 1 while its particle lives on. */
 static inline int lane_move(const ulam__walker *w, lane *x, ulam_rng *r, ulam__kscratch *ks, ulam__block *out)
 {
-    _Atomic int32_t *f = ulam__slot_field(x->s, x->frac);
-    int32_t o = ulam__outcome(f);
+    int32_t o = ulam__slot_outcome(x->s, x->frac);
     if (o == ULAM__TERMINATE) {
         x->score += x->w * x->h->end;
         return 0;
     }
-    int32_t u = target(w->k, f, o, x->h->factor, &x->w, ks);
+    int32_t u = target(w->k, x->s, x->frac, o, x->h->factor, &x->w, ks);
     x->h = ulam__kernel_row(w->k, u);
     prefetch(x->h);
     out->steps++;
@@ -222,7 +221,7 @@ static int forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc
     ulam_kernel *k = w->k;
     uint64_t frac;
     ulam__slot *src = w->src + ulam__rng_index(r, (uint64_t)k->n, &frac);
-    int32_t o = ulam__outcome(ulam__slot_field(src, frac));
+    int32_t o = ulam__slot_outcome(src, frac);
     stack st = {sc->stack_s, sc->stack_w, 1, sc->stack_cap};
     st.s[0] = ulam__kernel_unit(k, ulam__outcome_target(o), sc->ks);
     st.w[0] = o < 0 ? -w->bnorm1 : w->bnorm1;
@@ -234,13 +233,12 @@ static int forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc
         for (;;) {
             forward_visit(w, sc, h, wt);
             ulam__slot *sl = ulam__kernel_pick(h, r, &frac); /* sets frac */
-            _Atomic int32_t *f = ulam__slot_field(sl, frac);
-            o = ulam__outcome(f);
+            o = ulam__slot_outcome(sl, frac);
             if (o == ULAM__TERMINATE) {
                 if (h->end != 0.0) tally(sc, h->state, wt * h->end);
                 break;
             }
-            int32_t u = target(k, f, o, h->factor, &wt, sc->ks);
+            int32_t u = target(k, sl, frac, o, h->factor, &wt, sc->ks);
             h = ulam__kernel_row(k, u);
             out->steps++;
             if (++len > w->max_steps || !isfinite(wt)) {
