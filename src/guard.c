@@ -123,6 +123,28 @@ static double *factors(const ulam_csr *M, double continue_q, int cols)
     return f;
 }
 
+/* Nonzero when all n factors are 1: diag(f) |M| is then |M|, and so is its radius. */
+static int all_ones(const double *f, int64_t n)
+{
+    for (int64_t i = 0; i < n; i++)
+        if (f[i] != 1.0) return 0;
+    return 1;
+}
+
+/* rho of the second-moment matrix with factors f (left of |M| for rows, right for columns):
+ * rho(|M|) itself, taking no time, when every factor is 1 (an analog kernel of rows or
+ * columns summing to at most 1), for the power iteration would repeat it exactly. */
+static int hat_power(const ulam_csr *M, const double *f, int cols, const ulam_power_opts *opts,
+                     const ulam_power *abs, ulam_power *out, ulam_error *err)
+{
+    if (all_ones(f, M->nrows)) {
+        *out = *abs;
+        out->seconds = 0.0;
+        return ULAM_OK;
+    }
+    return ulam_spectral_power(M, cols ? NULL : f, cols ? f : NULL, opts, out, err);
+}
+
 /* The three radii and their verdicts. */
 int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_power_opts *opts,
                      ulam_guard *g, ulam_error *err)
@@ -133,8 +155,8 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_power_opts
     double *fr = factors(M, continue_q, 0), *fc = factors(M, continue_q, 1);
     int status = fr && fc ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel factors");
     if (!status) status = ulam_spectral_power(M, NULL, NULL, opts, &g->abs, err);
-    if (!status) status = ulam_spectral_power(M, fr, NULL, opts, &g->hat[ULAM_ADJOINT], err);
-    if (!status) status = ulam_spectral_power(M, NULL, fc, opts, &g->hat[ULAM_FORWARD], err);
+    if (!status) status = hat_power(M, fr, 0, opts, &g->abs, &g->hat[ULAM_ADJOINT], err);
+    if (!status) status = hat_power(M, fc, 1, opts, &g->abs, &g->hat[ULAM_FORWARD], err);
     free(fr), free(fc);
     if (status) return status;
     g->verdict_abs = ulam_verdict_of(&g->abs);
