@@ -76,13 +76,19 @@ void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slo
     }
 }
 
+/* The outcomes of row i: its moves and termination. */
+static int64_t row_outcomes(const ulam_csr *K, int64_t i)
+{
+    return K->rowptr[i + 1] - K->rowptr[i] + 1;
+}
+
 /* The kernel of K: its size is reserved (not touched) and no row is built. */
 int ulam__kernel_alloc(const ulam_csr *K, double continue_q, ulam__scores scores, ulam_kernel **out)
 {
     *out = NULL;
     int64_t n = K->nrows, nnz = K->rowptr[n], maxlen = 1;
     for (int64_t i = 0; i < n; i++)
-        if (K->rowptr[i + 1] - K->rowptr[i] + 1 > maxlen) maxlen = K->rowptr[i + 1] - K->rowptr[i] + 1;
+        if (row_outcomes(K, i) > maxlen) maxlen = row_outcomes(K, i);
     if (n >= ULAM__UNRESOLVED || nnz > ULAM__UNRESOLVED - (ULAM__HEAD + 1) * n) return ULAM_EOVERFLOW;
     ulam_kernel *k = calloc(1, sizeof *k);
     if (!k) return ULAM_ENOMEM;
@@ -151,7 +157,7 @@ static void row_scores(const ulam_kernel *k, int64_t i, double pstar, double *vi
 static void build_row(const ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam__kscratch *w)
 {
     const ulam_csr *K = k->K;
-    int64_t b = K->rowptr[i], len = K->rowptr[i + 1] - b;
+    int64_t b = K->rowptr[i], len = row_outcomes(K, i) - 1;
     double S = row_sum(K, i), qi = ulam__continuation(S, k->continue_q);
     *h = (ulam__row){.factor = qi > 0 ? S / qi : 0.0, .len = (int32_t)(len + 1), .state = (int32_t)i};
     row_scores(k, i, 1.0 - qi, &h->visit, &h->end);
@@ -174,8 +180,7 @@ int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
     if (v > 0) return v - 1;
     if (atomic_compare_exchange_strong_explicit(&k->where[j], &expect, -1, memory_order_acquire,
                                                 memory_order_acquire)) {
-        int64_t size = ULAM__HEAD + k->K->rowptr[j + 1] - k->K->rowptr[j] + 1;
-        int64_t u = atomic_fetch_add_explicit(&k->top, size, memory_order_relaxed);
+        int64_t u = atomic_fetch_add_explicit(&k->top, ULAM__HEAD + row_outcomes(k->K, j), memory_order_relaxed);
         build_row(k, j, ulam__kernel_row(k, u), 0, w);
         atomic_store_explicit(&k->where[j], (int32_t)u + 1, memory_order_release);
         atomic_fetch_add_explicit(&k->built, 1, memory_order_relaxed);
@@ -215,7 +220,7 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
     for (int64_t i = 0; i < k->n; i++)
         if (atomic_load_explicit(&k->where[i], memory_order_relaxed) == 0) {
             atomic_store_explicit(&k->where[i], (int32_t)u + 1, memory_order_relaxed);
-            u += ULAM__HEAD + K->rowptr[i + 1] - K->rowptr[i] + 1;
+            u += ULAM__HEAD + row_outcomes(K, i);
         }
     atomic_store(&k->top, u);
     atomic_store(&k->built, k->n);

@@ -41,7 +41,6 @@ struct ulam_solver {
     ulam__moments adj;
     double *sum, *sumsq; /* forward per-state sums of history tallies */
     int64_t walks, steps, cut, nonfinite, next_walk;
-    int complete; /* the kernel is built whole */
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
     double seconds, t0;
     int done, interrupted, status;
@@ -211,7 +210,6 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     }
     if (alloc_work(s)) goto nomem;
     if (o.whole_kernel) ulam__kernel_complete(s->k, s->threads, s->ks);
-    s->complete = o.whole_kernel != 0;
     s->w = (ulam__walker){.k = s->k, .mt = s->mt, .src = s->src,
                           .bnorm1 = bnorm1, .roulette = o.roulette, .split = o.split,
                           .max_steps = o.max_steps, .interrupt = o.interrupt,
@@ -421,10 +419,8 @@ int ulam_solver_iterate(ulam_solver *s)
     if (s->done) return s->status;
     double start = ulam_now();
     if (s->t0 < 0) s->t0 = start;
-    if (!s->complete && atomic_load(&s->k->top) * COMPLETE > s->k->cap) {
+    if (atomic_load(&s->k->built) < s->n && atomic_load(&s->k->top) * COMPLETE > s->k->cap)
         ulam__kernel_complete(s->k, s->threads, s->ks);
-        s->complete = 1;
-    }
     static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally),
                                    offsetof(ulam__block, t.t), offsetof(ulam__block, t.len),
                                    offsetof(ulam__block, t.cap)};

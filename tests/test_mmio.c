@@ -174,10 +174,7 @@ static void test_roundtrip(void **state)
     assert_int_equal(ulam_mm_write_matrix(path, A, "round trip"), ULAM_OK);
     ulam_csr *B = NULL;
     assert_int_equal(ulam_mm_read_matrix(path, &B, NULL), ULAM_OK);
-    assert_int_equal(ulam_csr_nnz(A), ulam_csr_nnz(B));
-    assert_memory_equal(A->rowptr, B->rowptr, (size_t)(A->nrows + 1) * sizeof *A->rowptr);
-    assert_memory_equal(A->colidx, B->colidx, (size_t)ulam_csr_nnz(A) * sizeof *A->colidx);
-    assert_memory_equal(A->val, B->val, (size_t)ulam_csr_nnz(A) * sizeof *A->val);
+    assert_csr_same(A, B);
     double v[3] = {1.0 / 3.0, -2e-300, 12345.678};
     assert_int_equal(ulam_mm_write_vector(path, v, 3, NULL), ULAM_OK);
     int64_t n;
@@ -238,11 +235,7 @@ static void test_cache(void **state)
     const uint64_t tag[2] = {12345, 678}, other[2] = {12345, 679};
     assert_int_equal(ulam_cache_write_csr(path, A, tag), ULAM_OK);
     assert_int_equal(ulam_cache_read_csr(path, tag, &B, &err), ULAM_OK);
-    assert_int_equal(B->nrows, A->nrows);
-    assert_int_equal(ulam_csr_nnz(B), ulam_csr_nnz(A));
-    assert_memory_equal(B->rowptr, A->rowptr, (size_t)(A->nrows + 1) * sizeof *A->rowptr);
-    assert_memory_equal(B->colidx, A->colidx, (size_t)ulam_csr_nnz(A) * sizeof *A->colidx);
-    assert_memory_equal(B->val, A->val, (size_t)ulam_csr_nnz(A) * sizeof *A->val);
+    assert_csr_same(B, A);
     B = ulam_csr_free(B);
     assert_int_equal(ulam_cache_read_csr(path, other, &B, &err), ULAM_ENOTFOUND); /* source changed */
     assert_null(B);

@@ -67,4 +67,15 @@ static inline double csr_get(const ulam_csr *A, int64_t i, int64_t j)
     return 0.0;
 }
 
+/* Fail unless A and B are the same matrix, array for array. */
+static inline void assert_csr_same(const ulam_csr *A, const ulam_csr *B)
+{
+    assert_int_equal(A->nrows, B->nrows);
+    assert_int_equal(A->ncols, B->ncols);
+    assert_int_equal(ulam_csr_nnz(A), ulam_csr_nnz(B));
+    assert_memory_equal(A->rowptr, B->rowptr, (size_t)(A->nrows + 1) * sizeof *A->rowptr);
+    assert_memory_equal(A->colidx, B->colidx, (size_t)ulam_csr_nnz(A) * sizeof *A->colidx);
+    assert_memory_equal(A->val, B->val, (size_t)ulam_csr_nnz(A) * sizeof *A->val);
+}
+
 #endif
