@@ -19,7 +19,7 @@
 extern "C" {
 #endif
 
-#define ULAM_VERSION "0.1.0"
+#include "ulam_version.h" /* ULAM_VERSION, _MAJOR, _MINOR, _PATCH */
 
 /* ---------------------------------------------------------------- status codes */
 
