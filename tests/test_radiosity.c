@@ -5,6 +5,12 @@
 
 #include <string.h>
 
+/* a . b for 3-vectors. */
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
 /* Read a scene that must parse. */
 static ulam_scene *must_scene(const char *path)
 {
@@ -63,6 +69,124 @@ static ulam_walk_result matrix_walk(const ulam_scene *s, const ulam_csr *F, int 
     ulam_csr_free(M);
     free(b);
     return w;
+}
+
+/* Exact F of a scene whose patches are the faces of an axis-aligned unit cube (by their
+ * normals: opposite faces Howell C-11, the four others C-14), or of two opposed a x b
+ * rectangles at c (pair = 1; other patches see nothing). */
+static ulam_csr *exact_F(const ulam_scene *s, int pair, double a, double b, double c)
+{
+    int32_t ti[36], tj[36];
+    double tx[36];
+    int64_t nz = 0;
+    if (pair) {
+        double f = ulam_ff_parallel_rectangles(a, b, c);
+        ti[0] = 0, tj[0] = 1, tx[0] = f, ti[1] = 1, tj[1] = 0, tx[1] = f, nz = 2;
+    } else {
+        assert_int_equal(s->npatches, 6);
+        for (int32_t i = 0; i < 6; i++)
+            for (int32_t j = 0; j < 6; j++) {
+                double d = dot3(s->normal + 3 * i, s->normal + 3 * j);
+                if (d > 0.5) continue;
+                ti[nz] = i, tj[nz] = j;
+                tx[nz++] = d < -0.5 ? ulam_ff_parallel_rectangles(1, 1, 1) : ulam_ff_perpendicular_rectangles(1, 1, 1);
+            }
+    }
+    ulam_csr *F = NULL;
+    assert_int_equal(ulam_csr_from_triplets(s->npatches, s->npatches, nz, ti, tj, tx, &F), ULAM_OK);
+    return F;
+}
+
+/* A closed-form scene: file, the patch to check, and how to build its exact F. */
+typedef struct {
+    const char *file;
+    int64_t patch;
+    int pair;
+    double a, b, c;
+} exact_scene;
+
+/* Every mode at the scene's patch against the exact answer (LAPACK on the exact F): gathering
+ * and shooting with both estimators, matrix walks on a ray-cast F (error bar with F's noise)
+ * and the direct solve on it.  Each |z| < 4; the z-scores are printed. */
+static void check_all_modes(const exact_scene *e, int64_t walks, uint64_t seed)
+{
+    char path[256];
+    snprintf(path, sizeof path, "tests/data/rad/%s", e->file);
+    ulam_scene *s = must_scene(path);
+    ulam_tracer *t = must_tracer(s);
+    int64_t n = s->npatches, p = e->patch, rays = 20000;
+    ulam_csr *Fx = exact_F(s, e->pair, e->a, e->b, e->c), *F = NULL;
+    double *Bx = malloc((size_t)(3 * n) * sizeof *Bx), *Bd = malloc((size_t)(3 * n) * sizeof *Bd);
+    assert_int_equal(ulam_radiosity_direct(s, Fx, 0, Bx, NULL, NULL), ULAM_OK);
+    assert_int_equal(ulam_form_factors(t, rays, seed, 2, &F, NULL), ULAM_OK);
+    assert_int_equal(ulam_radiosity_direct(s, F, 0, Bd, NULL, NULL), ULAM_OK);
+    double sf[3];
+    assert_int_equal(ulam_radiosity_direct_error(s, F, rays, Bd, p, 0, sf, NULL), ULAM_OK);
+    const char *names[6] = {"gather collision", "gather absorption", "shoot collision", "shoot absorption",
+                            "matrix-walk collision", "matrix-walk absorption"};
+    for (int m = 0; m < 7; m++) {
+        double est[3], se[3];
+        if (m < 4) {
+            ulam_rad_result r = rad_walk(t, m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, m % 2 ? ULAM_ABSORPTION : ULAM_COLLISION,
+                                         p, walks, seed + (uint64_t)m, NULL);
+            assert_int_equal(r.cut, 0);
+            memcpy(est, r.radiosity, sizeof est), memcpy(se, r.std_error, sizeof se);
+        } else if (m < 6) {
+            for (int c = 0; c < 3; c++) {
+                ulam_walk_result w = matrix_walk(s, F, c, ULAM_ADJOINT, m % 2 ? ULAM_ABSORPTION : ULAM_COLLISION, p,
+                                                 walks, seed + 10 + (uint64_t)c, NULL, NULL);
+                est[c] = w.estimate, se[c] = sqrt(w.std_error * w.std_error + sf[c] * sf[c]);
+            }
+        } else {
+            memcpy(est, Bd + 3 * p, sizeof est), memcpy(se, sf, sizeof se);
+        }
+        double z[3];
+        for (int c = 0; c < 3; c++) z[c] = se[c] > 0 ? (est[c] - Bx[3 * p + c]) / se[c] : 0.0;
+        print_message("%s patch %lld exact %.6f %.6f %.6f  %-22s z %+.2f %+.2f %+.2f\n", e->file, (long long)p + 1,
+                      Bx[3 * p], Bx[3 * p + 1], Bx[3 * p + 2], m < 6 ? names[m] : "direct", z[0], z[1], z[2]);
+        for (int c = 0; c < 3; c++) {
+            double x = Bx[3 * p + c], tol = 4 * se[c] + 1e-9 * (1 + fabs(x));
+            if (fabs(est[c] - x) > tol)
+                print_error("%s: %s channel %d: %.6f, exact %.6f, tolerance %.3g\n", e->file, m < 6 ? names[m] : "direct", c,
+                            est[c], x, tol);
+            assert_close(est[c], x, tol);
+            assert_true(se[c] < 0.05 * fabs(x) + 1e-12); /* a test that can fail */
+        }
+    }
+    free(Bx), free(Bd);
+    ulam_csr_free(F), ulam_csr_free(Fx);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* Black emitters (Kd 0) and emitters that reflect: every particle leaves its emitter.  Shooting
+ * from a black lamp gave 0 +- 0; a black and a grey lamp, the grey one's light only. */
+static void test_black_emitters(void **state)
+{
+    (void)state;
+    static const exact_scene scenes[] = {
+        {"black_emitter.obj", 1, 1, 1, 1.5, 0.5}, /* B = 0.5 F = 0.2378 */
+        {"black_grey.obj", 1, 1, 1, 1.5, 0.5},    /* B_grey = 1 + 0.5 F */
+        {"reflecting_emitter.obj", 0, 1, 1, 1.5, 0.5},
+        {"reflecting_emitter.obj", 1, 1, 1, 1.5, 0.5},
+        {"tiny_kd_emitter.obj", 1, 1, 1, 1.5, 0.5},
+        {"cube_black_lamp.obj", 0, 0, 0, 0, 0}, /* the floor, below the lamp */
+        {"cube_black_lamp.obj", 3, 0, 0, 0, 0}, /* the red wall */
+    };
+    for (size_t k = 0; k < sizeof scenes / sizeof *scenes; k++) {
+        check_all_modes(&scenes[k], 20000, 1000 + 17 * (uint64_t)k);
+    }
+    /* a lamp of Kd 0.001 shoots as well as a black one: the receiver's error is the binomial
+     * one of the single bounce, not 30 times it (1 / sqrt(0.001) when survival was the lamp's Kd) */
+    ulam_scene *s = must_scene("tests/data/rad/tiny_kd_emitter.obj");
+    ulam_tracer *t = must_tracer(s);
+    ulam_rad_result r = rad_walk(t, ULAM_FORWARD, ULAM_COLLISION, 1, 20000, 3, NULL);
+    double F = ulam_ff_parallel_rectangles(1, 1.5, 0.5), se1 = 0.5 * sqrt(F * (1 - F) / 20000);
+    print_message("tiny Kd lamp: shooting stderr %.3g, single-bounce binomial %.3g\n", r.std_error[0], se1);
+    assert_true(r.std_error[0] < 1.2 * se1);
+    assert_true(r.rays < 3 * 20000);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
 }
 
 /* The unit cube reads as six unit patches facing inwards. */
@@ -395,6 +519,7 @@ int main(void)
         cmocka_unit_test(test_read_errors),        cmocka_unit_test(test_subdivide),
         cmocka_unit_test(test_form_factors_exact), cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_cornell_against_direct), cmocka_unit_test(test_threads_and_options),
+        cmocka_unit_test(test_black_emitters),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
