@@ -543,6 +543,8 @@ typedef struct ulam_rad_result {
     double max_share; /* the largest single score^2 / sum of scores^2 (channel sum) */
     double seconds;
     int threads, interrupted;
+    int zero; /* rel_err could never be met: every channel exactly 0 with zero variance after
+               * the first round (no walk scored); the run stopped there */
 } ulam_rad_result;
 
 /* An opaque patch-walk solver: walks that sample F by ray casting, never forming it. */
@@ -559,7 +561,8 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam
 /* Run one round of walks; ULAM_OK or ULAM_ENONFINITE. */
 int ulam_rad_solver_iterate(ulam_rad_solver *s);
 
-/* Nonzero once a stopping rule is met (rel_err: every nonzero channel). */
+/* Nonzero once a stopping rule is met (rel_err: every nonzero channel; or every channel is
+ * exactly 0 with zero variance, when the result's zero is set). */
 int ulam_rad_solver_done(const ulam_rad_solver *s);
 
 /* The result so far. */

@@ -130,6 +130,10 @@ CASES += [
     (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "1000", "--estimator", "absorption"], 0, r"^$", r"radiosity R  2 \+- 0"),
     (["radiosity", SC + "cube.obj", "--direct", "--max-mem", "10"], code("EMEMLIMIT"), r"memory limit", ""),
 ]
+R = D + "rad/"
+for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends --rel-err (it spun forever)
+    CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0, r"^$",
+                  r"radiosity R  0 \+- 0\n.*\n.*\nnote .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))
 
 
 def run(ulam, args):

@@ -205,6 +205,46 @@ static void test_far_and_gap(void **state)
         check_all_modes(&scenes[k], 20000, 2000 + 13 * (uint64_t)k);
 }
 
+/* --rel-err on a patch whose answer is exactly 0 (it faces away from everything; a scene with
+ * no emitter) spun forever: a zero answer with zero variance after the first round is an answer,
+ * and the run says the relative error cannot be met and stops.  Every mode, bounded walks. */
+static void test_rel_err_zero(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("tests/data/rad/small_gap.obj");
+    ulam_tracer *t = must_tracer(s);
+    for (int m = 0; m < 4; m++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, o.estimator = m % 2 ? ULAM_ABSORPTION : ULAM_COLLISION;
+        o.index = 2, o.rel_err = 0.01, o.max_walks = 0, o.seed = 5, o.threads = 2; /* the far patch, facing away */
+        ulam_rad_solver *sv = NULL;
+        assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
+        int rounds = 0;
+        while (!ulam_rad_solver_done(sv) && rounds < 100) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK), rounds++;
+        ulam_rad_result r;
+        ulam_rad_solver_result(sv, &r);
+        print_message("mode %d: %d rounds, %lld walks, zero %d\n", m, rounds, (long long)r.walks, r.zero);
+        assert_true(ulam_rad_solver_done(sv));
+        assert_true(r.walks >= 1000 && r.walks <= 65536);
+        assert_int_equal(r.zero, 1);
+        for (int c = 0; c < 3; c++) assert_true(r.radiosity[c] == 0 && r.std_error[c] == 0);
+        ulam_rad_solver_free(sv);
+    }
+    /* the receiver, with light: the rule is met as before and zero stays 0 */
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 1, o.rel_err = 0.02, o.max_walks = 0, o.seed = 5, o.threads = 2;
+    ulam_rad_solver *sv = NULL;
+    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
+    while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
+    ulam_rad_result r;
+    ulam_rad_solver_result(sv, &r);
+    assert_int_equal(r.zero, 0);
+    assert_true(r.std_error[0] <= 0.02 * r.radiosity[0] && r.radiosity[0] > 0);
+    ulam_rad_solver_free(sv);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
 /* The unit cube reads as six unit patches facing inwards. */
 static void test_read_cube(void **state)
 {
@@ -536,6 +576,7 @@ int main(void)
         cmocka_unit_test(test_form_factors_exact), cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_cornell_against_direct), cmocka_unit_test(test_threads_and_options),
         cmocka_unit_test(test_black_emitters),     cmocka_unit_test(test_far_and_gap),
+        cmocka_unit_test(test_rel_err_zero),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

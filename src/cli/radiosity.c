@@ -60,6 +60,7 @@ typedef struct {
     int64_t walks, steps;
     double seconds;
     int threads, interrupted;
+    int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
     double *all; /* shooting: 3 per patch */
 } walked;
 
@@ -161,7 +162,7 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     memcpy(w->B, r.radiosity, sizeof w->B);
     memcpy(w->se, r.std_error, sizeof w->se);
     w->walks = r.walks, w->steps = r.rays, w->seconds = r.seconds, w->threads = r.threads;
-    w->interrupted = r.interrupted;
+    w->interrupted = r.interrupted, w->zero = r.zero;
     if (!status && a->o.mode == ULAM_FORWARD) {
         if (!(w->all = malloc((size_t)np * 3 * sizeof *w->all))) status = ULAM_ENOMEM;
         else ulam_rad_solver_vectors(sv, w->all, NULL);
@@ -203,6 +204,8 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
     }
     cli_release_sigint();
     free(b), free(x);
+    w->zero = a->o.rel_err > 0;
+    for (int c = 0; c < 3; c++) w->zero &= w->B[c] == 0 && w->se[c] == 0;
     if (!status) return 0;
     err.status = status;
     return cli_report(a->scene, &err);
@@ -255,6 +258,9 @@ static void print_text(const args *a, const report *r)
     if (w && r->patch >= 0) {
         for (int c = 0; c < 3; c++)
             printf("radiosity %c  %.8g +- %.3g%s\n", chan[c], w->B[c], w->se[c], w->interrupted ? "  [INTERRUPTED]" : "");
+        if (w->zero)
+            printf("note         every channel is exactly 0 with zero variance after %lld walks (no walk scored):\n"
+                   "             --rel-err can never be met, so the walks stopped there\n", (long long)w->walks);
     }
     if (w)
         printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)\n", (long long)w->walks,
@@ -291,7 +297,7 @@ static void print_json(const args *a, const report *r)
         printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, ", a->matrix_walk ? "true" : "false",
                (long long)w->walks, a->matrix_walk ? "steps" : "rays", (long long)w->steps);
         cli_json_number("seconds", w->seconds, 0);
-        printf("\"interrupted\": %s, ", w->interrupted ? "true" : "false");
+        printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
     }
     if (r->F) {
         printf("\"ff_rays\": %lld, ", (long long)a->ff_rays);

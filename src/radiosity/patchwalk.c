@@ -65,7 +65,7 @@ struct ulam_rad_solver {
     double sq, maxsq;
     int64_t walks, rays, cut, nonfinite, next_walk;
     double seconds, t0;
-    int done, interrupted, status;
+    int done, interrupted, zero, status;
 };
 
 /* Free; accepts and returns NULL. */
@@ -339,6 +339,15 @@ static int precise_enough(const ulam_rad_result *r, double rel_err)
     return any;
 }
 
+/* Nonzero when every channel is exactly 0 with zero variance: no walk scored, and a relative
+ * error can never be met. */
+static int all_zero(const ulam_rad_result *r)
+{
+    for (int c = 0; c < 3; c++)
+        if (r->radiosity[c] != 0.0 || r->std_error[c] != 0.0) return 0;
+    return 1;
+}
+
 /* Run one round of walks. */
 int ulam_rad_solver_iterate(ulam_rad_solver *s)
 {
@@ -367,6 +376,7 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     ulam_rad_solver_result(s, &r);
     if (ulam__budget_spent(&s->o, stop, s->next_walk)) s->done = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(&r, s->o.rel_err)) s->done = 1;
+    if (s->o.rel_err > 0 && r.walks >= 1000 && all_zero(&r)) s->done = s->zero = 1; /* can never be met */
     return s->status;
 }
 
@@ -406,6 +416,7 @@ void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
     r->seconds = s->seconds;
     r->threads = s->threads;
     r->interrupted = s->interrupted;
+    r->zero = s->zero;
 }
 
 /* Shooting: every patch. */
