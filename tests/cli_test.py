@@ -134,6 +134,9 @@ R = D + "rad/"
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends --rel-err (it spun forever)
     CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0, r"^$",
                   r"radiosity R  0 \+- 0\n.*\n.*\nnote .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))
+for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # cuts at --max-steps were silent (96 for 1000)
+    CASES.append((["radiosity", R + "furnace999.obj", "--patch", "1", "--max-steps", "100", "--walks", "2000"] + extra,
+                  0, r"^$", r"^warning +\d+ of \d+ walks cut at --max-steps 100: the estimate is biased low"))
 
 
 def run(ulam, args):
@@ -413,6 +416,10 @@ def check_radiosity(ulam):
     assert rc == 0, err
     j = json.loads(out)
     assert j["matrix_walk"] and j["patch"] == 10 and all(abs(z) < 4 for z in j["z"]), j
+    rc, out, err = run(ulam, ["radiosity", R + "furnace999.obj", "--patch", "1", "--max-steps", "100", "--walks",
+                              "1000", "--json"])
+    j = json.loads(out)
+    assert rc == 0 and j["max_steps"] == 100 and 800 < j["cut"] <= 1000 and j["walks"] == 1000, j
     with tempfile.TemporaryDirectory() as d:
         png = d + "/box.png"
         rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--mode", "shoot", "--walks", "20000",

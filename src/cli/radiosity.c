@@ -57,7 +57,7 @@ typedef struct {
 /* What the walks found. */
 typedef struct {
     double B[3], se[3];
-    int64_t walks, steps;
+    int64_t walks, steps, cut; /* cut: walks stopped at --max-steps */
     double seconds;
     int threads, interrupted;
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
@@ -162,7 +162,7 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     memcpy(w->B, r.radiosity, sizeof w->B);
     memcpy(w->se, r.std_error, sizeof w->se);
     w->walks = r.walks, w->steps = r.rays, w->seconds = r.seconds, w->threads = r.threads;
-    w->interrupted = r.interrupted, w->zero = r.zero;
+    w->interrupted = r.interrupted, w->zero = r.zero, w->cut = r.cut;
     if (!status && a->o.mode == ULAM_FORWARD) {
         if (!(w->all = malloc((size_t)np * 3 * sizeof *w->all))) status = ULAM_ENOMEM;
         else ulam_rad_solver_vectors(sv, w->all, NULL);
@@ -193,7 +193,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
         ulam_walk_result r;
         ulam_solver_result(sv, &r);
         w->B[c] = r.estimate, w->se[c] = r.std_error;
-        w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds;
+        w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds, w->cut += r.cut;
         w->threads = r.threads, w->interrupted |= r.interrupted;
         if (!status && w->all) {
             ulam_solver_vectors(sv, x, NULL);
@@ -267,6 +267,10 @@ static void print_text(const args *a, const report *r)
                a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads);
+    if (w && w->cut)
+        printf("warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
+               "             beyond the cut is lost) and the error bar does not cover the bias\n",
+               (long long)w->cut, (long long)w->walks, (long long)a->o.max_steps);
     if (r->Bdirect && r->patch >= 0)
         for (int c = 0; c < 3; c++) {
             printf("direct %c     %.8g", chan[c], r->Bdirect[3 * r->patch + c]);
@@ -294,8 +298,9 @@ static void print_json(const args *a, const report *r)
         }
         cli_json_string("mode", mode_names[a->o.mode], 0);
         cli_json_string("estimator", est_names[a->o.estimator], 0);
-        printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, ", a->matrix_walk ? "true" : "false",
-               (long long)w->walks, a->matrix_walk ? "steps" : "rays", (long long)w->steps);
+        printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, \"cut\": %lld, \"max_steps\": %lld, ",
+               a->matrix_walk ? "true" : "false", (long long)w->walks, a->matrix_walk ? "steps" : "rays",
+               (long long)w->steps, (long long)w->cut, (long long)a->o.max_steps);
         cli_json_number("seconds", w->seconds, 0);
         printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
     }
