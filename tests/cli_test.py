@@ -133,7 +133,9 @@ CASES += [
 R = D + "rad/"
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends --rel-err (it spun forever)
     CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0, r"^$",
-                  r"radiosity R  0 \+- 0\n.*\n.*\nnote .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))
+                  r"radiosity R  0 \+- 0.*\n.*\n.*\nnote .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))
+CASES.append((["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--max-mem", "10"], 0, r"^$",
+              r"radiosity R  \S+ \+- \S+ \(walk noise only, CONDITIONAL on the sampled F"))
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # cuts at --max-steps were silent (96 for 1000)
     CASES.append((["radiosity", R + "furnace999.obj", "--patch", "1", "--max-steps", "100", "--walks", "2000"] + extra,
                   0, r"^$", r"^warning +\d+ of \d+ walks cut at --max-steps 100: the estimate is biased low"))
@@ -420,6 +422,19 @@ def check_radiosity(ulam):
                               "1000", "--json"])
     j = json.loads(out)
     assert rc == 0 and j["max_steps"] == 100 and 800 < j["cut"] <= 1000 and j["walks"] == 1000, j
+    # --matrix-walk's error bar includes the noise of F (it was the walk's alone: |z| > 4 for most seeds)
+    F = 0.47557643653294696  # Howell C-11, 1 x 1.5 at 0.5
+    big = []
+    for seed in range(30):
+        rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--walks",
+                                  "100000", "--seed", str(seed), "--json"])
+        j = json.loads(out)
+        assert rc == 0 and len(j["walk_stderr"]) == 3 and len(j["ff_stderr"]) == 3, j
+        assert all(abs(s * s - w * w - f * f) < 1e-12 for s, w, f in zip(j["stderr"], j["walk_stderr"], j["ff_stderr"]))
+        big += [seed for b, s in zip(j["radiosity"], j["stderr"]) if abs(b - 0.5 * F) > 4 * s]
+    assert len(big) <= 1, big
+    rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk"])
+    assert rc == 0 and re.search(r"radiosity R  \S+ \+- \S+ \(walk \S+, form factors \S+\)", out), out
     with tempfile.TemporaryDirectory() as d:
         png = d + "/box.png"
         rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--mode", "shoot", "--walks", "20000",

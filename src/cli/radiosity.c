@@ -56,7 +56,7 @@ typedef struct {
 
 /* What the walks found. */
 typedef struct {
-    double B[3], se[3];
+    double B[3], se[3], se_walk[3]; /* se: with --matrix-walk, the walk's and F's noise combined */
     int64_t walks, steps, cut; /* cut: walks stopped at --max-steps */
     double seconds;
     int threads, interrupted;
@@ -161,6 +161,7 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     ulam_rad_solver_result(sv, &r);
     memcpy(w->B, r.radiosity, sizeof w->B);
     memcpy(w->se, r.std_error, sizeof w->se);
+    memcpy(w->se_walk, r.std_error, sizeof w->se_walk);
     w->walks = r.walks, w->steps = r.rays, w->seconds = r.seconds, w->threads = r.threads;
     w->interrupted = r.interrupted, w->zero = r.zero, w->cut = r.cut;
     if (!status && a->o.mode == ULAM_FORWARD) {
@@ -192,7 +193,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
         while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
         ulam_walk_result r;
         ulam_solver_result(sv, &r);
-        w->B[c] = r.estimate, w->se[c] = r.std_error;
+        w->B[c] = r.estimate, w->se[c] = w->se_walk[c] = r.std_error;
         w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds, w->cut += r.cut;
         w->threads = r.threads, w->interrupted |= r.interrupted;
         if (!status && w->all) {
@@ -229,14 +230,16 @@ typedef struct {
     ulam_ff_report ff;
     double ff_seconds, direct_seconds, exposure;
     const double *Bdirect;
-    double direct_se[3]; /* at the patch, from the noise of F (ray walks with --check) */
+    double direct_se[3]; /* at the patch, from the noise of F (--check, --matrix-walk) */
+    int ff_se_known;     /* direct_se was computed (--matrix-walk: unless --max-mem refused it) */
     const walked *w;
 } report;
 
-/* (walk - direct) / the combined standard error at the patch, channel c. */
-static double zscore(const report *r, int c)
+/* (walk - direct) / the standard error of the difference at the patch, channel c: matrix walks
+ * share F with the direct solve (walk noise alone), ray walks sample the exact F (both). */
+static double zscore(const args *a, const report *r, int c)
 {
-    double d = r->Bdirect[3 * r->patch + c], sw = r->w->se[c], sf = r->direct_se[c];
+    double d = r->Bdirect[3 * r->patch + c], sw = r->w->se_walk[c], sf = a->matrix_walk ? 0.0 : r->direct_se[c];
     return (r->w->B[c] - d) / sqrt(sw * sw + sf * sf);
 }
 
@@ -256,8 +259,12 @@ static void print_text(const args *a, const report *r)
     }
     const walked *w = r->w;
     if (w && r->patch >= 0) {
-        for (int c = 0; c < 3; c++)
-            printf("radiosity %c  %.8g +- %.3g%s\n", chan[c], w->B[c], w->se[c], w->interrupted ? "  [INTERRUPTED]" : "");
+        for (int c = 0; c < 3; c++) {
+            printf("radiosity %c  %.8g +- %.3g", chan[c], w->B[c], w->se[c]);
+            if (a->matrix_walk && r->ff_se_known) printf(" (walk %.3g, form factors %.3g)", w->se_walk[c], r->direct_se[c]);
+            else if (a->matrix_walk) printf(" (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
+            printf("%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
+        }
         if (w->zero)
             printf("note         every channel is exactly 0 with zero variance after %lld walks (no walk scored):\n"
                    "             --rel-err can never be met, so the walks stopped there\n", (long long)w->walks);
@@ -274,8 +281,8 @@ static void print_text(const args *a, const report *r)
     if (r->Bdirect && r->patch >= 0)
         for (int c = 0; c < 3; c++) {
             printf("direct %c     %.8g", chan[c], r->Bdirect[3 * r->patch + c]);
-            if (!a->matrix_walk) printf(" +- %.3g (form-factor noise)", r->direct_se[c]);
-            if (w) printf("  z = %.3f", zscore(r, c));
+            if (r->ff_se_known) printf(" +- %.3g (form-factor noise)", r->direct_se[c]);
+            if (w) printf("  z = %.3f%s", zscore(a, r, c), a->matrix_walk ? " (walk noise: the same F)" : "");
             printf("\n");
         }
     if (a->image) printf("image        %s (exposure %.4g)\n", a->image, r->exposure);
@@ -295,6 +302,10 @@ static void print_json(const args *a, const report *r)
         if (r->patch >= 0) {
             json_triple("radiosity", w->B);
             json_triple("stderr", w->se);
+            if (a->matrix_walk) {
+                json_triple("walk_stderr", w->se_walk);
+                if (r->ff_se_known) json_triple("ff_stderr", r->direct_se);
+            }
         }
         cli_json_string("mode", mode_names[a->o.mode], 0);
         cli_json_string("estimator", est_names[a->o.estimator], 0);
@@ -313,9 +324,9 @@ static void print_json(const args *a, const report *r)
     }
     if (r->Bdirect && r->patch >= 0) {
         double z[3];
-        for (int c = 0; c < 3; c++) z[c] = w ? zscore(r, c) : NAN;
+        for (int c = 0; c < 3; c++) z[c] = w ? zscore(a, r, c) : NAN;
         json_triple("direct", r->Bdirect + 3 * r->patch);
-        json_triple("direct_stderr", r->direct_se);
+        if (r->ff_se_known) json_triple("direct_stderr", r->direct_se);
         if (w) json_triple("z", z);
         cli_json_number("direct_seconds", r->direct_seconds, 0);
     }
@@ -366,7 +377,9 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
     r->ff_seconds = ulam_now() - t0;
     ulam_form_factor_report(s, *F, &r->ff);
     r->F = *F;
-    if (!a->direct && !a->check) return 0;
+    int need = a->direct || a->check, for_error = a->matrix_walk && r->patch >= 0;
+    if (!need && !for_error) return 0;
+    if (!need && ulam_direct_bytes(s->npatches) > a->max_mem) return 0; /* the error bar is then labelled */
     if (!(*Bd = malloc((size_t)s->npatches * 3 * sizeof **Bd))) {
         err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the solution"};
         return cli_report(a->scene, &err);
@@ -374,11 +387,21 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
     ulam_direct_info info;
     if (ulam_radiosity_direct(s, *F, a->max_mem, *Bd, &info, &err)) return cli_report(a->scene, &err);
     r->direct_seconds = info.seconds;
-    r->Bdirect = *Bd;
-    if (r->patch >= 0 && !a->matrix_walk &&
-        ulam_radiosity_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
-        return cli_report(a->scene, &err);
+    if (need) r->Bdirect = *Bd;
+    if (r->patch >= 0) {
+        if (ulam_radiosity_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
+            return cli_report(a->scene, &err);
+        r->ff_se_known = 1;
+    }
     return 0;
+}
+
+/* --matrix-walk: the error bar of the answer adds the noise of F (the walks are conditional
+ * on the sampled F; the answer's error against the true B is both). */
+static void combine_errors(const report *r, walked *w)
+{
+    if (!r->ff_se_known) return;
+    for (int c = 0; c < 3; c++) w->se[c] = sqrt(w->se_walk[c] * w->se_walk[c] + r->direct_se[c] * r->direct_se[c]);
 }
 
 /* ulam radiosity. */
@@ -408,6 +431,7 @@ int cli_radiosity(int argc, char **argv)
     if (a.patch || a.o.mode == ULAM_FORWARD) {
         rc = a.matrix_walk ? matrix_walks(&a, s, F, &w) : ray_walks(&a, t, s->npatches, &w);
         if (rc) goto done;
+        if (a.matrix_walk) combine_errors(&r, &w);
         r.w = &w;
     }
     if (a.image && !w.interrupted && cli_rank == 0 && (rc = write_image(&a, t, w.all ? w.all : Bd, &r.exposure))) goto done;
