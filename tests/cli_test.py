@@ -448,6 +448,32 @@ def check_radiosity(ulam):
         assert sorted(os.listdir(d)) == ["box.png"], os.listdir(d)
 
 
+def check_radiosity_interrupt(ulam):
+    """An interrupted image run says [INTERRUPTED], writes no picture and does not claim one
+    ('image int.png (exposure 0)' was printed); output paths are checked before any work (a run
+    of 10^11 particles into a missing directory must fail at once, not after the walks)."""
+    with tempfile.TemporaryDirectory() as d:
+        png = d + "/int.png"
+        p = subprocess.Popen([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+                              "--image", png], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        interrupt_when_ready(p)
+        out, err = p.communicate(timeout=60)
+        assert p.returncode == 130, (p.returncode, err)
+        assert "[INTERRUPTED]" in out and re.search(r"^image +not written: the run was interrupted", out, re.M), out
+        assert "exposure" not in out and os.listdir(d) == [], (out, os.listdir(d))
+        p = subprocess.Popen([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+                              "--json", "--image", png], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        interrupt_when_ready(p)
+        out, err = p.communicate(timeout=60)
+        j = json.loads(out)
+        assert p.returncode == 130 and j["interrupted"] is True and j["image"] is None, j
+        for bad in (d + "/no/such/dir/x.png", d):  # a missing directory; a directory itself
+            rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+                                      "--image", bad])
+            assert rc == code("EIO") and out == "" and re.search(r"error: .*expected a writable", err), (rc, out, err)
+        assert os.listdir(d) == [], os.listdir(d)
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -464,7 +490,7 @@ def main():
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
-             (check_radiosity, ulam)]
+             (check_radiosity, ulam), (check_radiosity_interrupt, ulam)]
     for f, arg in extra:
         try:
             f(arg)

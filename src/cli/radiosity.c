@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static const char *const usage =
     "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot]\n"
@@ -229,6 +230,7 @@ typedef struct {
     const ulam_csr *F;
     ulam_ff_report ff;
     double ff_seconds, direct_seconds, exposure;
+    int image_written;
     const double *Bdirect;
     double direct_se[3]; /* at the patch, from the noise of F (--check, --matrix-walk) */
     int ff_se_known;     /* direct_se was computed (--matrix-walk: unless --max-mem refused it) */
@@ -270,10 +272,10 @@ static void print_text(const args *a, const report *r)
                    "             --rel-err can never be met, so the walks stopped there\n", (long long)w->walks);
     }
     if (w)
-        printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)\n", (long long)w->walks,
+        printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)%s\n", (long long)w->walks,
                a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
-               a->matrix_walk ? "steps" : "rays", w->threads);
+               a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
     if (w && w->cut)
         printf("warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
                "             beyond the cut is lost) and the error bar does not cover the bias\n",
@@ -285,7 +287,8 @@ static void print_text(const args *a, const report *r)
             if (w) printf("  z = %.3f%s", zscore(a, r, c), a->matrix_walk ? " (walk noise: the same F)" : "");
             printf("\n");
         }
-    if (a->image) printf("image        %s (exposure %.4g)\n", a->image, r->exposure);
+    if (a->image && r->image_written) printf("image        %s (exposure %.4g)\n", a->image, r->exposure);
+    else if (a->image && w && w->interrupted) printf("image        not written: the run was interrupted\n");
 }
 
 /* Print the JSON object. */
@@ -330,6 +333,10 @@ static void print_json(const args *a, const report *r)
         if (w) json_triple("z", z);
         cli_json_number("direct_seconds", r->direct_seconds, 0);
     }
+    if (a->image) {
+        if (r->image_written) cli_json_string("image", a->image, 0), cli_json_number("exposure", r->exposure, 0);
+        else printf("\"image\": null, ");
+    }
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
 }
 
@@ -344,6 +351,20 @@ static int write_image(const args *a, const ulam_tracer *t, const double *B, dou
     if (!status) return 0;
     ulam_error err = {.status = status, .msg = "a writable PNG file"};
     return cli_report(a->image, &err);
+}
+
+/* Check before any work that path can be written (a temporary file can be made beside it and
+ * it is not a directory); 0 or an exit code. */
+static int check_output(const char *path)
+{
+    struct stat st;
+    ulam_outfile o;
+    int status = stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? ULAM_EIO : ulam_outfile_open(&o, path);
+    if (!status) ulam_outfile_abort(&o);
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable output file (in an existing, writable directory; not a "
+                                               "directory)"};
+    return cli_report(path, &err);
 }
 
 /* The scene, subdivided if asked; 0 or an exit code. */
@@ -419,6 +440,7 @@ int cli_radiosity(int argc, char **argv)
     walked w = {0};
     report r = {.patch = -1, .w = NULL};
     ulam_error err;
+    if (a.image && (rc = check_output(a.image))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
     r.s = s;
     if (a.patch && (rc = find_patch(s, a.patch, &r.patch))) goto done;
@@ -434,7 +456,10 @@ int cli_radiosity(int argc, char **argv)
         if (a.matrix_walk) combine_errors(&r, &w);
         r.w = &w;
     }
-    if (a.image && !w.interrupted && cli_rank == 0 && (rc = write_image(&a, t, w.all ? w.all : Bd, &r.exposure))) goto done;
+    if (a.image && !w.interrupted && cli_rank == 0) {
+        if ((rc = write_image(&a, t, w.all ? w.all : Bd, &r.exposure))) goto done;
+        r.image_written = 1;
+    }
     if (a.json) print_json(&a, &r);
     else print_text(&a, &r);
     if (w.interrupted) rc = EXIT_INTERRUPTED;
