@@ -115,6 +115,7 @@ BAD_SCENES = [  # file, status, the file:line the message must name
     ("nonconvex.obj", "EGEOMETRY", O + "nonconvex.obj:8"), ("index_range.obj", "EINDEX", O + "index_range.obj:7"),
     ("no_usemtl.obj", "ENOTFOUND", O + "no_usemtl.obj:6"), ("bad_vertex.obj", "ESYNTAX", O + "bad_vertex.obj:3"),
     ("unknown_statement.obj", "ESYNTAX", O + "unknown_statement.obj:7"), ("empty.obj", "EEMPTY", O + "empty.obj:2"),
+    ("repeated_newmtl.obj", "ESYNTAX", O + "repeated_newmtl.mtl:7"), ("kd_spectral.obj", "EUNSUPPORTED", O + "kd_spectral.mtl:2"),
 ]
 for f, status, where in BAD_SCENES:
     CASES.append((["radiosity", O + f, "--patch", "1"], code(status), rf"^ulam: {re.escape(where)}: error: .*expected ", ""))
@@ -131,6 +132,13 @@ CASES += [
     (["radiosity", SC + "cube.obj", "--direct", "--max-mem", "10"], code("EMEMLIMIT"), r"memory limit", ""),
 ]
 R = D + "rad/"
+CASES += [
+    (["radiosity", O + "repeated_newmtl.obj", "--patch", "1"], code("ESYNTAX"),
+     r"repeated_newmtl.mtl:7: error: .*'lamp' is already defined at .*repeated_newmtl.mtl:2", ""),
+    (["radiosity", O + "kd_spectral.obj", "--patch", "1"], code("EUNSUPPORTED"),
+     r"kd_spectral.mtl:2: error: unsupported kind of data: expected Kd r g b \(RGB only\): this file gives a spectral curve", ""),
+    (["radiosity", O + "unknown_statement.obj", "--patch", "1"], code("ESYNTAX"), r"vt, vn, vp, s, l, p, mg, lod, .* ignored", ""),
+]
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends --rel-err (it spun forever)
     CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0, r"^$",
                   r"radiosity R  0 \+- 0.*\n.*\n.*\nnote .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))

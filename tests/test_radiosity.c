@@ -342,6 +342,8 @@ static void test_read_errors(void **state)
         {"two_vertices.obj", ULAM_ESYNTAX, 7, NULL},
         {"bad_face_token.obj", ULAM_ESYNTAX, 7, NULL},
         {"does_not_exist.obj", ULAM_EIO, 0, NULL},
+        {"repeated_newmtl.obj", ULAM_ESYNTAX, 7, "repeated_newmtl.mtl"}, /* silently reset the lamp's Ke */
+        {"kd_spectral.obj", ULAM_EUNSUPPORTED, 2, "kd_spectral.mtl"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         char path[256];
@@ -363,6 +365,37 @@ static void test_read_errors(void **state)
             assert_string_equal(err.file, "");
         }
     }
+}
+
+/* What the MTL and OBJ errors say: a repeated material names its first definition, a spectral
+ * colour says it is one (the status read 'unsupported Matrix Market kind'), and the statements
+ * ulam reads past are listed whole in the unknown-statement message and are all accepted. */
+static void test_read_messages(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_error err;
+    assert_int_equal(ulam_scene_read_obj("tests/data/obj/repeated_newmtl.obj", &s, &err), ULAM_ESYNTAX);
+    print_message("%s\n", err.msg);
+    assert_non_null(strstr(err.msg, "'lamp'") && strstr(err.msg, "repeated_newmtl.mtl:2"));
+    assert_int_equal(ulam_scene_read_obj("tests/data/obj/kd_spectral.obj", &s, &err), ULAM_EUNSUPPORTED);
+    print_message("%s: %s\n", ulam_strerror(ULAM_EUNSUPPORTED), err.msg);
+    assert_non_null(strstr(err.msg, "spectral"));
+    assert_null(strstr(ulam_strerror(ULAM_EUNSUPPORTED), "Matrix Market"));
+    assert_int_equal(ulam_scene_read_obj("tests/data/obj/unknown_statement.obj", &s, &err), ULAM_ESYNTAX);
+    print_message("%s\n", err.msg);
+    static const char *const skipped[] = {"vt", "vn", "vp", "s", "l", "p", "mg", "lod", "usemap", "maplib",
+                                         "shadow_obj", "trace_obj", "bevel", "c_interp", "d_interp"};
+    for (size_t k = 0; k < sizeof skipped / sizeof *skipped; k++) {
+        char word[32];
+        snprintf(word, sizeof word, " %s,", skipped[k]);
+        if (!strstr(err.msg, word)) snprintf(word, sizeof word, " %s ignored", skipped[k]);
+        if (!strstr(err.msg, word)) print_error("'%s' missing from: %s\n", skipped[k], err.msg);
+        assert_non_null(strstr(err.msg, word));
+    }
+    s = must_scene("tests/data/obj/ignored_statements.obj"); /* vp, mg, lod */
+    assert_int_equal(s->npatches, 1);
+    ulam_scene_free(s);
 }
 
 /* Subdivision keeps area, faces and labels; sides end up no longer than L. */
@@ -597,6 +630,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_read_cube),          cmocka_unit_test(test_read_good),
         cmocka_unit_test(test_read_errors),        cmocka_unit_test(test_subdivide),
+        cmocka_unit_test(test_read_messages),
         cmocka_unit_test(test_form_factors_exact), cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_cornell_against_direct), cmocka_unit_test(test_threads_and_options),
         cmocka_unit_test(test_black_emitters),     cmocka_unit_test(test_far_and_gap),
