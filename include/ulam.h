@@ -466,9 +466,18 @@ int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out)
 /* Free a scene; accepts and returns NULL. */
 ulam_scene *ulam_scene_free(ulam_scene *s);
 
-/* The patch a label names: the patch of group label nearest the group's area centroid.
- * ULAM_ENOTFOUND when no patch has that label. */
+/* The patch a label names: the patch of group label that contains the group's area centroid
+ * (the lowest-numbered one when the centroid is on a shared edge); when none contains it (a
+ * label that is not flat, like a block, whose centroid is inside it), the patch of that label
+ * whose area centroid is nearest.  Does not depend on the subdivision but through the patch
+ * sizes.  ULAM_ENOTFOUND when no patch has that label. */
 int ulam_scene_find(const ulam_scene *s, const char *label, int64_t *patch);
+
+/* The area centroid of patch p. */
+void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3]);
+
+/* The area centroid of the patches labelled label; ULAM_ENOTFOUND when there are none. */
+int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3]);
 
 /* Total emitted power sum_p A_p E_p per channel. */
 void ulam_scene_power(const ulam_scene *s, double power[3]);
@@ -532,6 +541,11 @@ int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_byt
  * (sum_j F_kj B_j)^2. */
 int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                                 int64_t p, size_t max_bytes, double se[3], ulam_error *err);
+
+/* The same at every patch (se: 3 * npatches): G = (I - M)^-1 whole by one LAPACKE_dgesv with
+ * npatches right-hand sides a channel, so two dense matrices (ULAM_EMEMLIMIT past max_bytes). */
+int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                                 size_t max_bytes, double *se, ulam_error *err);
 
 /* What a patch walk run has found: RGB radiosity of the patch opts->index. */
 typedef struct ulam_rad_result {

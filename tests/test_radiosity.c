@@ -398,6 +398,74 @@ static void test_read_messages(void **state)
     ulam_scene_free(s);
 }
 
+/* Nonzero when point x lies in patch p (on its plane and inside every edge, within tol). */
+static int patch_contains(const ulam_scene *s, int64_t p, const double x[3], double tol)
+{
+    const double *n = s->normal + 3 * p;
+    int64_t k0 = s->start[p], m = s->start[p + 1] - k0;
+    const double *v0 = s->vert + 3 * s->vidx[k0];
+    double d[3] = {x[0] - v0[0], x[1] - v0[1], x[2] - v0[2]};
+    if (fabs(dot3(d, n)) > tol) return 0;
+    for (int64_t k = 0; k < m; k++) {
+        const double *a = s->vert + 3 * s->vidx[k0 + k], *b = s->vert + 3 * s->vidx[k0 + (k + 1) % m];
+        double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {x[0] - a[0], x[1] - a[1], x[2] - a[2]};
+        double c[3] = {e[1] * w[2] - e[2] * w[1], e[2] * w[0] - e[0] * w[2], e[0] * w[1] - e[1] * w[0]};
+        if (dot3(c, n) < -tol * sqrt(dot3(e, e))) return 0;
+    }
+    return 1;
+}
+
+/* --patch LABEL picks the patch that contains the label's area centroid, whatever the
+ * subdivision (the patch nearest by vertex average did not, and its value swung 3x with L);
+ * a label whose centroid is on none of its patches (a block: it is inside) gets the patch whose
+ * centroid is nearest.  Centroids are area centroids. */
+static void test_find_rule(void **state)
+{
+    (void)state;
+    ulam_scene *s0 = must_scene("examples/scenes/cornell_box.obj");
+    static const double L[] = {7, 10, 20, 25, 33, 50, 60, 75, 100, 150, 300, 1000};
+    static const char *const labels[] = {"floor", "back_wall", "ceiling", "light"};
+    double c0[4][3];
+    for (int k = 0; k < 4; k++) {
+        int64_t p;
+        assert_int_equal(ulam_scene_find(s0, labels[k], &p), ULAM_OK);
+        assert_int_equal(ulam_scene_label_centroid(s0, labels[k], c0[k]), ULAM_OK);
+    }
+    assert_close(c0[0][0], 275.5, 2), assert_close(c0[0][1], 0.0, 1e-9), assert_close(c0[0][2], 279.7, 2);
+    for (size_t i = 0; i < sizeof L / sizeof *L; i++) {
+        ulam_scene *s = NULL;
+        assert_int_equal(ulam_scene_subdivide(s0, L[i], &s), ULAM_OK);
+        for (int k = 0; k < 4; k++) {
+            int64_t p = -1;
+            double c[3];
+            assert_int_equal(ulam_scene_find(s, labels[k], &p), ULAM_OK);
+            assert_int_equal(ulam_scene_label_centroid(s, labels[k], c), ULAM_OK);
+            for (int d = 0; d < 3; d++) assert_close(c[d], c0[k][d], 1e-6 * (1 + fabs(c0[k][d]))); /* L does not move it */
+            if (!patch_contains(s, p, c, 1e-6)) print_error("L = %g, %s: patch %lld does not contain the centroid\n", L[i], labels[k], (long long)p);
+            assert_true(patch_contains(s, p, c, 1e-6));
+            assert_string_equal(s->groups[s->group[p]], labels[k]);
+        }
+        ulam_scene_free(s);
+    }
+    /* the tall block: its centroid is inside it, on none of its faces; the nearest centroid */
+    int64_t p;
+    double c[3], pc[3], best = INFINITY;
+    assert_int_equal(ulam_scene_find(s0, "tall_block", &p), ULAM_OK);
+    assert_int_equal(ulam_scene_label_centroid(s0, "tall_block", c), ULAM_OK);
+    for (int64_t q = 0; q < s0->npatches; q++) {
+        if (s0->group[q] != s0->group[p]) continue;
+        assert_false(patch_contains(s0, q, c, 1e-6));
+        ulam_scene_centroid(s0, q, pc);
+        double d[3] = {pc[0] - c[0], pc[1] - c[1], pc[2] - c[2]};
+        best = fmin(best, dot3(d, d));
+    }
+    ulam_scene_centroid(s0, p, pc);
+    double d[3] = {pc[0] - c[0], pc[1] - c[1], pc[2] - c[2]};
+    assert_close(dot3(d, d), best, 0);
+    assert_int_equal(ulam_scene_label_centroid(s0, "attic", c), ULAM_ENOTFOUND);
+    ulam_scene_free(s0);
+}
+
 /* Subdivision keeps area, faces and labels; sides end up no longer than L. */
 static void test_subdivide(void **state)
 {
@@ -525,6 +593,15 @@ static void test_cornell_against_direct(void **state)
     double *B = malloc((size_t)(3 * n) * sizeof *B);
     assert_int_equal(ulam_radiosity_direct(s, F, 0, B, NULL, NULL), ULAM_OK);
     const char *labels[3] = {"floor", "back_wall", "tall_block"};
+    double *se_all = malloc((size_t)(3 * n) * sizeof *se_all);
+    assert_int_equal(ulam_radiosity_direct_errors(s, F, rays, B, 0, se_all, NULL), ULAM_OK);
+    for (int64_t p = 0; p < n; p++) { /* every patch's error at once, as one patch's alone */
+        double sf[3];
+        assert_int_equal(ulam_radiosity_direct_error(s, F, rays, B, p, 0, sf, NULL), ULAM_OK);
+        for (int c = 0; c < 3; c++) assert_close(se_all[3 * p + c], sf[c], 1e-9 * sf[c] + 1e-15);
+    }
+    assert_int_equal(ulam_radiosity_direct_errors(s, F, rays, B, ulam_direct_bytes(n), se_all, NULL), ULAM_EMEMLIMIT);
+    free(se_all);
     for (int k = 0; k < 3; k++) {
         int64_t p;
         assert_int_equal(ulam_scene_find(s, labels[k], &p), ULAM_OK);
@@ -630,7 +707,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_read_cube),          cmocka_unit_test(test_read_good),
         cmocka_unit_test(test_read_errors),        cmocka_unit_test(test_subdivide),
-        cmocka_unit_test(test_read_messages),
+        cmocka_unit_test(test_read_messages),      cmocka_unit_test(test_find_rule),
         cmocka_unit_test(test_form_factors_exact), cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_cornell_against_direct), cmocka_unit_test(test_threads_and_options),
         cmocka_unit_test(test_black_emitters),     cmocka_unit_test(test_far_and_gap),
