@@ -415,7 +415,7 @@ def check_radiosity(ulam):
                               "--check", "--ff-rays", "50000", "--walks", "200000", "--json"])
     assert rc == 0, err
     j = json.loads(out)
-    assert j["label"] == "back_wall" and j["patches"] == 49 and j["mode"] == "gather"
+    assert j["label"] == "back_wall" and j["npatches"] == 49 and j["mode"] == "gather"
     for key in ("radiosity", "stderr", "direct", "direct_stderr", "z"):
         assert len(j[key]) == 3, key
     assert all(abs(z) < 4 for z in j["z"]), j["z"]
@@ -482,6 +482,51 @@ def check_radiosity_interrupt(ulam):
         assert os.listdir(d) == [], os.listdir(d)
 
 
+def check_radiosity_patches(ulam):
+    """Every patch out: --list, --out FILE.csv (atomic, every row, walks beside the direct solve
+    within 4 sigma), --all (a patches array in JSON), the chosen patch's centroid."""
+    import csv
+    rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "300", "--list"])
+    lines = out.strip().split("\n")
+    assert rc == 0 and len(lines) == 50 and lines[0].split()[:3] == ["patch", "label", "face"], out[:300]
+    rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "300", "--list", "--json"])
+    j = json.loads(out)
+    assert rc == 0 and len(j["patches"]) == 49 and j["patches"][48]["patch"] == 49 and j["patches"][0]["area"] > 0, j
+    rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--walks", "1000"])
+    assert rc == 0 and re.search(r"^patch +\d+ \(floor, face 1, area \S+, centroid 275\.\d+ 0 279\.\d+\)", out, re.M), out
+    with tempfile.TemporaryDirectory() as d:
+        path = d + "/p.csv"
+        rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--mode", "shoot", "--direct", "--walks",
+                                  "40000", "--ff-rays", "20000", "--out", path])
+        assert rc == 0 and f"patches      6 rows written to {path}" in out, (out, err)
+        rows = list(csv.DictReader(open(path)))
+        assert len(rows) == 6 and [r["label"] for r in rows] == ["floor", "ceiling", "left", "right", "front", "back"]
+        assert rows[1]["R"] == "1" and rows[1]["R_se"] == "0", rows[1]  # the black lamp: B = E exactly
+        zs = []
+        for r in rows:
+            for c in "RGB":
+                w, sw, b, sb = (float(r[k]) for k in (c, c + "_se", "direct_" + c, "direct_" + c + "_se"))
+                if sw > 0:
+                    zs.append((w - b) / (sw * sw + sb * sb) ** 0.5)
+        assert len(zs) == 15 and all(abs(z) < 4 for z in zs), zs
+        with open(path, "w") as f:
+            f.write("old\n")
+        rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--direct", "--max-mem", "10", "--out", path])
+        assert rc == code("EMEMLIMIT") and open(path).read() == "old\n" and os.listdir(d) == ["p.csv"], (rc, err)
+        rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--mode", "shoot", "--walks", "100000000000",
+                                  "--out", d + "/no/such/dir/p.csv"])
+        assert rc == code("EIO") and out == "", (rc, out, err)
+    rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--patch", "1", "--out", "x.csv"])
+    assert rc == 2 and "--out needs --mode shoot or --direct" in err, err
+    rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--mode", "shoot", "--walks", "2000", "--all",
+                              "--json"])
+    j = json.loads(out)
+    assert rc == 0 and j["npatches"] == 6 and len(j["patches"]) == 6 and j["patches"][3]["label"] == "right", j
+    assert all(len([k for k in p if k in ("R", "G", "B", "R_se", "G_se", "B_se")]) == 6 for p in j["patches"])
+    rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--mode", "shoot", "--walks", "2000", "--all"])
+    assert rc == 0 and re.search(r"^ +4 right +4 +1 +0\.5 +0\.5 +1 ", out, re.M), out
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -498,7 +543,8 @@ def main():
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
-             (check_radiosity, ulam), (check_radiosity_interrupt, ulam)]
+             (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
+             (check_radiosity_patches, ulam)]
     for f, arg in extra:
         try:
             f(arg)

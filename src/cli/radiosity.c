@@ -14,13 +14,16 @@ static const char *const usage =
     "                      [--estimator collision|absorption] [--walks N] [--rel-err E] [--time S]\n"
     "                      [--seed S] [--threads T] [--max-steps K] [--subdivide L] [--ff-rays K]\n"
     "                      [--direct] [--check] [--matrix-walk] [--max-mem SIZE]\n"
-    "                      [--image out.png] [--size WxH] [--exposure X] [--json]\n"
+    "                      [--image out.png] [--size WxH] [--exposure X] [--camera C]\n"
+    "                      [--out patches.csv] [--all] [--list] [--json]\n"
     "\n"
     "Radiosity B = E + diag(rho) F B of a scene of diffuse patches (Wavefront OBJ + MTL: Kd is\n"
     "the reflectance, Ke the emission), per RGB channel.\n"
     "\n"
     "  --patch K|LABEL   the patch to answer: 1-based number, or an o/g label (the label's patch\n"
-    "                    nearest its centre)\n"
+    "                    that contains the label's area centroid; else the one whose centroid is\n"
+    "                    nearest it)\n"
+    "  --list            print the patches (number, label, face, centroid, area) and stop\n"
     "  --mode gather     walks from the patch that gather emission (default; needs --patch):\n"
     "                    one patch without forming F\n"
     "  --mode shoot      particles from the emitters, tallied on every patch (for --image)\n"
@@ -34,9 +37,16 @@ static const char *const usage =
     "  --matrix-walk     walk on the assembled M (ulam solve's engine) instead of casting rays:\n"
     "                    walks and LAPACK then share the very same F\n"
     "  --max-mem SIZE    refuse a direct solve needing more (default 4G)\n"
-    "  --image out.png   render the shooting (or else direct) solution from the Cornell camera\n"
+    "  --image out.png   render the shooting (or else direct) solution\n"
+    "  --camera C        ex,ey,ez,ax,ay,az,ux,uy,uz,fov: eye, look-at point, up and horizontal\n"
+    "                    field of view in degrees; 'cornell' for the Cornell box camera; default:\n"
+    "                    frame the scene's bounding box, looking along +z\n"
     "  --size WxH        image size (default 512x512)\n"
     "  --exposure X      radiosity scale before the sRGB curve (default: auto)\n"
+    "  --out FILE.csv    every patch: number, label, face, centroid, area, R G B and standard\n"
+    "                    errors (and the direct values with --check or --direct); needs --mode\n"
+    "                    shoot or --direct\n"
+    "  --all             print every patch too (a table; with --json a patches array)\n"
     "  --json            print one JSON object\n"
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
@@ -47,10 +57,12 @@ static const char *const chan = "RGB";
 
 /* Everything the command was asked. */
 typedef struct {
-    const char *scene, *patch, *image;
+    const char *scene, *patch, *image, *out;
     double subdivide, exposure;
     int64_t ff_rays;
-    int direct, check, matrix_walk, json, width, height;
+    int direct, check, matrix_walk, json, width, height, all, list;
+    int camera_given; /* --camera: cam holds it */
+    ulam_camera cam;
     size_t max_mem;
     ulam_walk_opts o;
 } args;
@@ -62,8 +74,34 @@ typedef struct {
     double seconds;
     int threads, interrupted;
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
-    double *all; /* shooting: 3 per patch */
+    double *all, *all_se; /* shooting: 3 per patch each */
 } walked;
+
+/* Parse --camera: 'cornell', or ex,ey,ez,ax,ay,az,ux,uy,uz,fov (degrees, horizontal). */
+static int parse_camera(const char *cmd, const char *arg, ulam_camera *cam)
+{
+    if (!strcmp(arg, "cornell")) {
+        *cam = ulam_camera_cornell();
+        return 0;
+    }
+    double x[10];
+    int used = 0;
+    if (sscanf(arg, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf%n", &x[0], &x[1], &x[2], &x[3], &x[4], &x[5], &x[6], &x[7],
+               &x[8], &x[9], &used) == 10 && !arg[used]) {
+        double d[3] = {x[3] - x[0], x[4] - x[1], x[5] - x[2]}, dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        double c[3] = {d[1] * x[8] - d[2] * x[7], d[2] * x[6] - d[0] * x[8], d[0] * x[7] - d[1] * x[6]};
+        int finite = 1;
+        for (int k = 0; k < 10; k++) finite &= isfinite(x[k]);
+        if (finite && dd > 0 && c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > 1e-12 * dd * (x[6] * x[6] + x[7] * x[7] + x[8] * x[8]) &&
+            x[9] > 0 && x[9] < 180) {
+            *cam = (ulam_camera){.eye = {x[0], x[1], x[2]}, .dir = {d[0], d[1], d[2]}, .up = {x[6], x[7], x[8]},
+                                 .focal = 1.0, .film = 2.0 * tan(x[9] * M_PI / 360.0)};
+            return 0;
+        }
+    }
+    return cli_usage_error(cmd, "--camera expects 'cornell' or ex,ey,ez,ax,ay,az,ux,uy,uz,fov (eye, look-at point "
+                                "apart from it, an up not along the view, fov in (0, 180) degrees), got '%s'", arg);
+}
 
 /* Parse the options into a; 0, or an exit code (with -1 meaning: --help printed). */
 static int parse(int argc, char **argv, args *a)
@@ -79,6 +117,8 @@ static int parse(int argc, char **argv, args *a)
         {"max-mem", required_argument, 0, 'x'},   {"image", required_argument, 0, 'i'},
         {"size", required_argument, 0, 'z'},      {"exposure", required_argument, 0, 'X'},
         {"json", no_argument, 0, 'J'},            {"help", no_argument, 0, 'h'},
+        {"out", required_argument, 0, 'o'},       {"all", no_argument, 0, 'A'},
+        {"list", no_argument, 0, 'l'},            {"camera", required_argument, 0, 'C'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int64_t v;
@@ -115,12 +155,20 @@ static int parse(int argc, char **argv, args *a)
             break;
         case 'X': if ((rc = cli_parse_real(cmd, "--exposure", optarg, 1e-300, 1e300, &a->exposure))) return rc; break;
         case 'J': a->json = 1; break;
+        case 'o': a->out = optarg; break;
+        case 'A': a->all = 1; break;
+        case 'l': a->list = 1; break;
+        case 'C': if ((rc = parse_camera(cmd, optarg, &a->cam))) return rc; a->camera_given = 1; break;
         case 'h': fputs(usage, stdout); return -1;
         default: return cli_usage_error(cmd, "unknown option");
         }
     }
     if (optind != argc - 1) return cli_usage_error(cmd, "expects exactly one scene file");
     a->scene = argv[optind];
+    if (a->list) return 0;
+    if ((a->out || a->all) && a->o.mode == ULAM_ADJOINT && !a->direct)
+        return cli_usage_error(cmd, "%s needs --mode shoot or --direct (gathering answers one patch)",
+                               a->out ? "--out" : "--all");
     if (!a->patch && a->o.mode == ULAM_ADJOINT && !a->direct)
         return cli_usage_error(cmd, "needs --patch K (gathering answers one patch), --mode shoot or --direct");
     if (a->check && !a->patch) return cli_usage_error(cmd, "--check needs --patch K");
@@ -166,8 +214,10 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     w->walks = r.walks, w->steps = r.rays, w->seconds = r.seconds, w->threads = r.threads;
     w->interrupted = r.interrupted, w->zero = r.zero, w->cut = r.cut;
     if (!status && a->o.mode == ULAM_FORWARD) {
-        if (!(w->all = malloc((size_t)np * 3 * sizeof *w->all))) status = ULAM_ENOMEM;
-        else ulam_rad_solver_vectors(sv, w->all, NULL);
+        w->all = malloc((size_t)np * 3 * sizeof *w->all);
+        w->all_se = malloc((size_t)np * 3 * sizeof *w->all_se);
+        if (!w->all || !w->all_se) status = ULAM_ENOMEM;
+        else ulam_rad_solver_vectors(sv, w->all, w->all_se);
     }
     ulam_rad_solver_free(sv);
     if (!status) return 0;
@@ -179,9 +229,12 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
 static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, walked *w)
 {
     int64_t n = s->npatches;
-    double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
-    if (a->o.mode == ULAM_FORWARD) w->all = malloc((size_t)n * 3 * sizeof *w->all);
-    int status = b && x && (a->o.mode == ULAM_ADJOINT || w->all) ? ULAM_OK : ULAM_ENOMEM;
+    double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x), *e = malloc((size_t)n * sizeof *e);
+    if (a->o.mode == ULAM_FORWARD) {
+        w->all = malloc((size_t)n * 3 * sizeof *w->all);
+        w->all_se = malloc((size_t)n * 3 * sizeof *w->all_se);
+    }
+    int status = b && x && e && (a->o.mode == ULAM_ADJOINT || (w->all && w->all_se)) ? ULAM_OK : ULAM_ENOMEM;
     ulam_error err = {.status = status};
     cli_catch_sigint();
     for (int c = 0; c < 3 && !status && !cli_interrupted; c++) {
@@ -198,14 +251,14 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
         w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds, w->cut += r.cut;
         w->threads = r.threads, w->interrupted |= r.interrupted;
         if (!status && w->all) {
-            ulam_solver_vectors(sv, x, NULL);
-            for (int64_t i = 0; i < n; i++) w->all[3 * i + c] = x[i];
+            ulam_solver_vectors(sv, x, e);
+            for (int64_t i = 0; i < n; i++) w->all[3 * i + c] = x[i], w->all_se[3 * i + c] = e[i];
         }
         ulam_solver_free(sv);
         ulam_csr_free(M);
     }
     cli_release_sigint();
-    free(b), free(x);
+    free(b), free(x), free(e);
     w->zero = a->o.rel_err > 0;
     for (int c = 0; c < 3; c++) w->zero &= w->B[c] == 0 && w->se[c] == 0;
     if (!status) return 0;
@@ -223,6 +276,106 @@ static void json_triple(const char *key, const double *v)
     }
 }
 
+/* Every patch's values for --out and --all (NULL arrays: not known): the answer (the walks' if
+ * they covered every patch, else the direct one) with its standard error, and the direct
+ * answer beside walks. */
+typedef struct {
+    const double *B, *se, *Bd, *sed;
+} patch_values;
+
+enum { ROW_TEXT, ROW_CSV, ROW_JSON };
+
+/* One value of a patch row: CSV leaves an unknown one empty, JSON writes null. */
+static void row_value(FILE *f, int fmt, const char *key, double v, int first)
+{
+    if (fmt == ROW_JSON) {
+        fprintf(f, "%s\"%s\": ", first ? "" : ", ", key);
+        if (isfinite(v)) fprintf(f, "%.17g", v);
+        else fputs("null", f);
+    } else if (fmt == ROW_CSV) {
+        fputc(',', f);
+        if (isfinite(v)) fprintf(f, "%.17g", v);
+    } else {
+        if (isfinite(v)) fprintf(f, " %12.6g", v);
+        else fprintf(f, " %12s", "-");
+    }
+}
+
+/* The header of the patch rows (text and CSV); v NULL: geometry only (--list). */
+static void row_header(FILE *f, int fmt, const patch_values *v)
+{
+    static const char *const geo[] = {"x", "y", "z", "area"}, *const val[] = {"R", "G", "B", "R_se", "G_se", "B_se"};
+    fprintf(f, fmt == ROW_CSV ? "patch,label,face" : "%6s %-16s %6s", "patch", "label", "face");
+    for (int k = 0; k < 4; k++) fprintf(f, fmt == ROW_CSV ? ",%s" : " %12s", geo[k]);
+    for (int k = 0; v && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",%s" : " %12s", val[k]);
+    for (int k = 0; v && v->Bd && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",direct_%s" : " direct_%-5s", val[k]);
+    fputc('\n', f);
+}
+
+/* One patch's row: number, label, face, centroid, area, then (v) the values. */
+static void row(FILE *f, int fmt, const ulam_scene *s, int64_t p, const patch_values *v)
+{
+    static const char *const geo[] = {"x", "y", "z", "area"};
+    static const char *const val[] = {"R", "G", "B", "R_se", "G_se", "B_se"};
+    static const char *const dir[] = {"direct_R", "direct_G", "direct_B", "direct_R_se", "direct_G_se", "direct_B_se"};
+    int32_t g = s->group[p];
+    const char *label = g >= 0 ? s->groups[g] : "";
+    double x[4];
+    ulam_scene_centroid(s, p, x);
+    x[3] = s->area[p];
+    if (fmt == ROW_JSON) {
+        fprintf(f, "{\"patch\": %lld, \"label\": \"", (long long)p + 1);
+        for (const char *c = label; *c; c++)
+            if (*c == '"' || *c == '\\') fprintf(f, "\\%c", *c);
+            else if ((unsigned char)*c < 0x20) fprintf(f, "\\u%04x", *c);
+            else fputc(*c, f);
+        fprintf(f, "\", \"face\": %lld", (long long)s->face[p] + 1);
+    } else if (fmt == ROW_CSV) {
+        fprintf(f, "%lld,\"", (long long)p + 1); /* the label quoted, quotes doubled (RFC 4180) */
+        for (const char *c = label; *c; c++) fputs(*c == '"' ? "\"\"" : (char[2]){*c, 0}, f);
+        fprintf(f, "\",%lld", (long long)s->face[p] + 1);
+    } else {
+        fprintf(f, "%6lld %-16s %6lld", (long long)p + 1, *label ? label : "-", (long long)s->face[p] + 1);
+    }
+    for (int k = 0; k < 4; k++) row_value(f, fmt, geo[k], x[k], 0);
+    for (int k = 0; v && k < 6; k++) {
+        const double *a = k < 3 ? v->B : v->se;
+        row_value(f, fmt, val[k], a ? a[3 * p + k % 3] : NAN, 0);
+    }
+    for (int k = 0; v && v->Bd && k < 6; k++) {
+        const double *a = k < 3 ? v->Bd : v->sed;
+        row_value(f, fmt, dir[k], a ? a[3 * p + k % 3] : NAN, 0);
+    }
+    fputs(fmt == ROW_JSON ? "}" : "\n", f);
+}
+
+/* --list: the patches after subdivision, as a table or a JSON array. */
+static void print_list(const args *a, const ulam_scene *s)
+{
+    if (a->json) printf("{\"scene\": \"%s\", \"patches\": [", a->scene);
+    else row_header(stdout, ROW_TEXT, NULL);
+    for (int64_t p = 0; p < s->npatches; p++) {
+        if (a->json && p) printf(", ");
+        row(stdout, a->json ? ROW_JSON : ROW_TEXT, s, p, NULL);
+    }
+    if (a->json) printf("]}\n");
+}
+
+/* --out: every patch as CSV, atomically; 0 or an exit code. */
+static int write_csv(const char *path, const ulam_scene *s, const patch_values *v)
+{
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (!status) {
+        row_header(o.f, ROW_CSV, v);
+        for (int64_t p = 0; p < s->npatches; p++) row(o.f, ROW_CSV, s, p, v);
+        status = ulam_outfile_commit(&o);
+    }
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable output file"};
+    return cli_report(path, &err);
+}
+
 /* What the run found, as text or JSON. */
 typedef struct {
     const ulam_scene *s;
@@ -230,10 +383,13 @@ typedef struct {
     const ulam_csr *F;
     ulam_ff_report ff;
     double ff_seconds, direct_seconds, exposure;
-    int image_written;
+    int image_written, out_written;
+    patch_values pv;
     const double *Bdirect;
     double direct_se[3]; /* at the patch, from the noise of F (--check, --matrix-walk) */
     int ff_se_known;     /* direct_se was computed (--matrix-walk: unless --max-mem refused it) */
+    double *direct_se_all; /* every patch's (--out, --all), NULL when not computed */
+    const double *w_all_se_conditional; /* matrix forward walks whose se lack F's noise, or NULL */
     const walked *w;
 } report;
 
@@ -256,8 +412,11 @@ static void print_text(const args *a, const report *r)
     if (r->Bdirect) printf("direct       LAPACKE_dgesv, 3 channels, %.3f s\n", r->direct_seconds);
     if (r->patch >= 0) {
         int32_t g = r->s->group[r->patch];
-        printf("patch        %lld (%s, face %lld, area %.6g)\n", (long long)r->patch + 1,
-               g >= 0 ? r->s->groups[g] : "unlabelled", (long long)r->s->face[r->patch] + 1, r->s->area[r->patch]);
+        double c[3];
+        ulam_scene_centroid(r->s, r->patch, c);
+        printf("patch        %lld (%s, face %lld, area %.6g, centroid %.6g %.6g %.6g)\n", (long long)r->patch + 1,
+               g >= 0 ? r->s->groups[g] : "unlabelled", (long long)r->s->face[r->patch] + 1, r->s->area[r->patch],
+               c[0], c[1], c[2]);
     }
     const walked *w = r->w;
     if (w && r->patch >= 0) {
@@ -287,6 +446,14 @@ static void print_text(const args *a, const report *r)
             if (w) printf("  z = %.3f%s", zscore(a, r, c), a->matrix_walk ? " (walk noise: the same F)" : "");
             printf("\n");
         }
+    if (a->out && r->out_written)
+        printf("patches      %lld rows written to %s%s\n", (long long)r->s->npatches, a->out,
+               r->pv.se == r->w_all_se_conditional ? " (standard errors: walk noise only, CONDITIONAL on the sampled F)" : "");
+    else if (a->out && w && w->interrupted) printf("patches      not written: the run was interrupted\n");
+    if (a->all) {
+        row_header(stdout, ROW_TEXT, &r->pv);
+        for (int64_t p = 0; p < r->s->npatches; p++) row(stdout, ROW_TEXT, r->s, p, &r->pv);
+    }
     if (a->image && r->image_written) printf("image        %s (exposure %.4g)\n", a->image, r->exposure);
     else if (a->image && w && w->interrupted) printf("image        not written: the run was interrupted\n");
 }
@@ -294,11 +461,14 @@ static void print_text(const args *a, const report *r)
 /* Print the JSON object. */
 static void print_json(const args *a, const report *r)
 {
-    printf("{\"scene\": \"%s\", \"patches\": %lld, ", a->scene, (long long)r->s->npatches);
+    printf("{\"scene\": \"%s\", \"npatches\": %lld, ", a->scene, (long long)r->s->npatches);
     if (r->patch >= 0) {
         int32_t g = r->s->group[r->patch];
+        double c[3];
+        ulam_scene_centroid(r->s, r->patch, c);
         printf("\"patch\": %lld, ", (long long)r->patch + 1);
         cli_json_string("label", g >= 0 ? r->s->groups[g] : "", 0);
+        json_triple("centroid", c);
     }
     const walked *w = r->w;
     if (w) {
@@ -336,6 +506,18 @@ static void print_json(const args *a, const report *r)
     if (a->image) {
         if (r->image_written) cli_json_string("image", a->image, 0), cli_json_number("exposure", r->exposure, 0);
         else printf("\"image\": null, ");
+    }
+    if (a->out) {
+        if (r->out_written) cli_json_string("out", a->out, 0);
+        else printf("\"out\": null, ");
+    }
+    if (a->all) {
+        printf("\"stderr_conditional_on_F\": %s, \"patches\": [", r->pv.se == r->w_all_se_conditional ? "true" : "false");
+        for (int64_t p = 0; p < r->s->npatches; p++) {
+            if (p) printf(", ");
+            row(stdout, ROW_JSON, r->s, p, &r->pv);
+        }
+        printf("], ");
     }
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
 }
@@ -398,7 +580,8 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
     r->ff_seconds = ulam_now() - t0;
     ulam_form_factor_report(s, *F, &r->ff);
     r->F = *F;
-    int need = a->direct || a->check, for_error = a->matrix_walk && r->patch >= 0;
+    int need = a->direct || a->check, every = a->out || a->all;
+    int for_error = a->matrix_walk && (r->patch >= 0 || (every && a->o.mode == ULAM_FORWARD));
     if (!need && !for_error) return 0;
     if (!need && ulam_direct_bytes(s->npatches) > a->max_mem) return 0; /* the error bar is then labelled */
     if (!(*Bd = malloc((size_t)s->npatches * 3 * sizeof **Bd))) {
@@ -414,15 +597,38 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
             return cli_report(a->scene, &err);
         r->ff_se_known = 1;
     }
+    if (every && (a->direct || a->matrix_walk || a->check)) { /* every patch's error from F's noise */
+        if (!(r->direct_se_all = malloc((size_t)s->npatches * 3 * sizeof *r->direct_se_all))) {
+            err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the standard errors"};
+            return cli_report(a->scene, &err);
+        }
+        int st = ulam_radiosity_direct_errors(s, *F, a->ff_rays, *Bd, a->max_mem, r->direct_se_all, &err);
+        if (st == ULAM_EMEMLIMIT) free(r->direct_se_all), r->direct_se_all = NULL; /* the rows say unknown */
+        else if (st) return cli_report(a->scene, &err);
+    }
     return 0;
 }
 
 /* --matrix-walk: the error bar of the answer adds the noise of F (the walks are conditional
  * on the sampled F; the answer's error against the true B is both). */
-static void combine_errors(const report *r, walked *w)
+static void combine_errors(report *r, walked *w)
 {
-    if (!r->ff_se_known) return;
-    for (int c = 0; c < 3; c++) w->se[c] = sqrt(w->se_walk[c] * w->se_walk[c] + r->direct_se[c] * r->direct_se[c]);
+    for (int c = 0; c < 3 && r->ff_se_known; c++)
+        w->se[c] = sqrt(w->se_walk[c] * w->se_walk[c] + r->direct_se[c] * r->direct_se[c]);
+    if (!w->all_se) return;
+    if (!r->direct_se_all) {
+        r->w_all_se_conditional = w->all_se;
+        return;
+    }
+    for (int64_t k = 0; k < 3 * r->s->npatches; k++)
+        w->all_se[k] = sqrt(w->all_se[k] * w->all_se[k] + r->direct_se_all[k] * r->direct_se_all[k]);
+}
+
+/* The values of every patch for --out and --all. */
+static patch_values every_patch(const args *a, const report *r, const walked *w, const double *Bd)
+{
+    if (w->all) return (patch_values){w->all, w->all_se, (a->direct || a->check) ? Bd : NULL, r->direct_se_all};
+    return (patch_values){Bd, r->direct_se_all, NULL, NULL};
 }
 
 /* ulam radiosity. */
@@ -441,8 +647,13 @@ int cli_radiosity(int argc, char **argv)
     report r = {.patch = -1, .w = NULL};
     ulam_error err;
     if (a.image && (rc = check_output(a.image))) return rc;
+    if (a.out && (rc = check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
     r.s = s;
+    if (a.list) {
+        print_list(&a, s);
+        goto done;
+    }
     if (a.patch && (rc = find_patch(s, a.patch, &r.patch))) goto done;
     a.o.index = r.patch >= 0 ? r.patch : 0;
     if (ulam_tracer_alloc(s, &t, &err)) {
@@ -456,6 +667,11 @@ int cli_radiosity(int argc, char **argv)
         if (a.matrix_walk) combine_errors(&r, &w);
         r.w = &w;
     }
+    r.pv = every_patch(&a, &r, &w, Bd);
+    if (a.out && !w.interrupted && cli_rank == 0) {
+        if ((rc = write_csv(a.out, s, &r.pv))) goto done;
+        r.out_written = 1;
+    }
     if (a.image && !w.interrupted && cli_rank == 0) {
         if ((rc = write_image(&a, t, w.all ? w.all : Bd, &r.exposure))) goto done;
         r.image_written = 1;
@@ -464,7 +680,7 @@ int cli_radiosity(int argc, char **argv)
     else print_text(&a, &r);
     if (w.interrupted) rc = EXIT_INTERRUPTED;
 done:
-    free(w.all), free(Bd);
+    free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all);
     ulam_csr_free(F);
     ulam_tracer_free(t);
     ulam_scene_free(s);
