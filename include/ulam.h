@@ -598,13 +598,29 @@ typedef struct ulam_camera {
 /* The Cornell box camera: eye (278, 273, -800), looking along +z, 35 mm lens, 25 mm film. */
 ulam_camera ulam_camera_cornell(void);
 
+/* A camera framing the scene's bounding box for a width x height picture: looking along +z at
+ * its centre from the -z side, up +y, the Cornell lens, as near as lets the box's near face
+ * fill the picture (3% margin).  On the Cornell box: eye (278, 274.4, -802). */
+ulam_camera ulam_camera_frame(const ulam_scene *s, int width, int height);
+
+/* What a render saw. */
+typedef struct ulam_render_info {
+    double exposure;        /* the exposure used */
+    int exposure_set;       /* given, or set from the pixels (0: nothing lit in view, 1 used) */
+    int64_t pixels_hit;     /* pixels that see a patch's front */
+    int64_t pixels_emitter; /* of them, pixels that see an emitter (0: no emitter in view) */
+} ulam_render_info;
+
 /* Render B (3 * npatches) as width x height 8-bit sRGB (3 bytes a pixel, rows top first):
- * one ray per pixel centre, the hit patch's radiosity times exposure, clamped, sRGB-encoded
- * (flat shading).  exposure <= 0 picks 1 / (the 99th percentile of the largest channel over
- * the pixels of patches that do not emit); the exposure used goes to *used (may be NULL).
- * ULAM_ENONFINITE if any of B is not finite, ULAM_EOVERFLOW if the image cannot be sized. */
+ * one ray per pixel centre, the radiosity of the first patch whose front it meets (back sides
+ * are seen through, so a camera outside a closed room sees in) times exposure, clamped,
+ * sRGB-encoded (flat shading).  exposure <= 0 picks 1 / (the 99th percentile of the largest
+ * channel over the pixels of patches that do not emit; over all pixels when those are all
+ * black or absent); *info (may be NULL) says what was used
+ * and seen.  ULAM_ENONFINITE if any of B is not finite, ULAM_EOVERFLOW if the image cannot be
+ * sized. */
 int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width,
-                int height, double exposure, unsigned char *rgb, double *used);
+                int height, double exposure, unsigned char *rgb, ulam_render_info *info);
 
 /* Write an 8-bit RGB image as PNG (libpng), atomically. */
 int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb);

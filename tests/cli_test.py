@@ -482,6 +482,44 @@ def check_radiosity_interrupt(ulam):
         assert os.listdir(d) == [], os.listdir(d)
 
 
+def png_black(path):
+    """Whether a PNG (8-bit RGB, as ulam writes) is all black: every byte of its rows but the
+    filter bytes is 0 under any filter exactly when every pixel is."""
+    import struct
+    import zlib
+    data, pos, idat, width = open(path, "rb").read(), 8, b"", 0
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"IHDR":
+            width = struct.unpack(">I", data[pos + 8:pos + 12])[0]
+        if kind == b"IDAT":
+            idat += data[pos + 8:pos + 8 + n]
+        pos += 12 + n
+    raw, stride = zlib.decompress(idat), 1 + 3 * width
+    return not any(raw[k] for k in range(len(raw)) if k % stride)
+
+
+def check_radiosity_images(ulam):
+    """--image on scenes that are not the Cornell box: framed from the bounding box (the cube
+    was a black picture), --camera, and warnings when no emitter or nothing lit is in view."""
+    with tempfile.TemporaryDirectory() as d:
+        png = d + "/x.png"
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "2000", "--image", png,
+                                  "--size", "32x24"])
+        assert rc == 0 and err == "" and not png_black(png), (rc, err)
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "2000", "--image", png,
+                                  "--camera", "0.5,0.5,-5,0.5,0.5,-10,0,1,0,40"])  # looking away
+        assert rc == 0 and "the camera sees no patch" in err and png_black(png), (rc, err)
+        rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--mode", "shoot", "--walks", "2000", "--image",
+                                  png, "--size", "16x16"])
+        assert rc == 0 and re.search(r"warning: .*x.png: no emitter is in view", err) and not png_black(png), err
+        rc, out, err = run(ulam, ["radiosity", R + "small_gap.obj", "--mode", "shoot", "--walks", "2000", "--image",
+                                  png, "--camera", "1000.1,0.005,0.005,1000,0.005,0.005,0,1,0,20"])  # the dark far patch
+        assert rc == 0 and "nothing lit is in view, so the exposure cannot be set" in err, err
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--image", png, "--camera", "1,2,3"])
+        assert rc == 2 and "--camera expects" in err, err
+
+
 def check_radiosity_patches(ulam):
     """Every patch out: --list, --out FILE.csv (atomic, every row, walks beside the direct solve
     within 4 sigma), --all (a patches array in JSON), the chosen patch's centroid."""
@@ -544,7 +582,7 @@ def main():
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
              (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
-             (check_radiosity_patches, ulam)]
+             (check_radiosity_patches, ulam), (check_radiosity_images, ulam)]
     for f, arg in extra:
         try:
             f(arg)

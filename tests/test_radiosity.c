@@ -577,6 +577,55 @@ static void test_furnace(void **state)
     ulam_scene_free(s);
 }
 
+/* Pictures of scenes that are not the Cornell box: the camera frames the bounding box (the
+ * Cornell camera, 1000 units from a unit cube, saw its front face's back: a black picture), back
+ * sides are seen through (a closed room is seen into), and the render says when no emitter is
+ * in view and when nothing lit is, so that the exposure cannot be set. */
+static void test_render_framing(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("examples/scenes/cornell_box.obj");
+    ulam_camera f = ulam_camera_frame(s, 512, 512), c = ulam_camera_cornell();
+    for (int d = 0; d < 3; d++) assert_close(f.eye[d], c.eye[d], 5.0), assert_close(f.dir[d], c.dir[d], 0);
+    ulam_scene_free(s);
+    static const struct {
+        const char *file;
+        int64_t hit_min, emitter_min, emitter_max;
+        int zero_B, exposure_set;
+    } cases[] = {
+        {"examples/scenes/cube.obj", 64, 64, 64, 0, 1},          /* closed, all emit: exposed by the emitters */
+        {"tests/data/rad/black_emitter.obj", 16, 0, 0, 0, 1},    /* the lamp faces away: no emitter in view */
+        {"tests/data/rad/cube_black_lamp.obj", 64, 1, 63, 0, 1}, /* the lamp on top, in view */
+        {"tests/data/rad/black_emitter.obj", 16, 0, 0, 1, 0},    /* nothing lit: no exposure */
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        s = must_scene(cases[k].file);
+        ulam_tracer *t = must_tracer(s);
+        double *B = malloc((size_t)(3 * s->npatches) * sizeof *B);
+        for (int64_t p = 0; p < s->npatches; p++)
+            for (int ch = 0; ch < 3; ch++) B[3 * p + ch] = cases[k].zero_B ? 0.0 : s->emit[3 * p + ch] + 0.25;
+        unsigned char rgb[8 * 8 * 3];
+        ulam_render_info in;
+        ulam_camera cam = ulam_camera_frame(s, 8, 8);
+        assert_int_equal(ulam_render(t, B, &cam, 8, 8, 0, rgb, &in), ULAM_OK);
+        print_message("%s: %lld pixels see a patch, %lld an emitter, exposure %g (%s)\n", cases[k].file,
+                      (long long)in.pixels_hit, (long long)in.pixels_emitter, in.exposure, in.exposure_set ? "set" : "not set");
+        int lit = 0;
+        for (int i = 0; i < 8 * 8 * 3; i++) lit += rgb[i] > 0;
+        if (in.pixels_hit < cases[k].hit_min || in.pixels_emitter < cases[k].emitter_min ||
+            in.pixels_emitter > cases[k].emitter_max || in.exposure_set != cases[k].exposure_set ||
+            lit != (cases[k].zero_B ? 0 : 3 * in.pixels_hit))
+            print_error("case %zu: %d lit channel values\n", k, lit);
+        assert_true(in.pixels_hit >= cases[k].hit_min);
+        assert_true(in.pixels_emitter >= cases[k].emitter_min && in.pixels_emitter <= cases[k].emitter_max);
+        assert_int_equal(in.exposure_set, cases[k].exposure_set);
+        assert_int_equal(lit, cases[k].zero_B ? 0 : 3 * in.pixels_hit);
+        free(B);
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
+}
+
 /* The Cornell box, subdivided: every walk mode against LAPACK.  Matrix walks share F with the
  * direct solve (4 sigma); ray walks sample the exact F, so the tolerance adds the direct
  * solution's own error from the noise of F (ulam_radiosity_direct_error). */
@@ -712,6 +761,7 @@ int main(void)
         cmocka_unit_test(test_cornell_against_direct), cmocka_unit_test(test_threads_and_options),
         cmocka_unit_test(test_black_emitters),     cmocka_unit_test(test_far_and_gap),
         cmocka_unit_test(test_rel_err_zero),       cmocka_unit_test(test_shoot_coverage),
+        cmocka_unit_test(test_render_framing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

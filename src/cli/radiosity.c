@@ -522,17 +522,28 @@ static void print_json(const args *a, const report *r)
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
 }
 
-/* Render B into a->image; 0 or an exit code. */
-static int write_image(const args *a, const ulam_tracer *t, const double *B, double *used)
+/* Render B into a->image, warning when the picture cannot show the light; 0 or an exit code. */
+static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s, const double *B, double *used)
 {
     unsigned char *rgb = malloc((size_t)a->width * (size_t)a->height * 3);
-    ulam_camera cam = ulam_camera_cornell();
-    int status = rgb ? ulam_render(t, B, &cam, a->width, a->height, a->exposure, rgb, used) : ULAM_ENOMEM;
+    ulam_camera cam = a->camera_given ? a->cam : ulam_camera_frame(s, a->width, a->height);
+    ulam_render_info info;
+    int status = rgb ? ulam_render(t, B, &cam, a->width, a->height, a->exposure, rgb, &info) : ULAM_ENOMEM;
     if (!status) status = ulam_png_write(a->image, a->width, a->height, rgb);
     free(rgb);
-    if (!status) return 0;
-    ulam_error err = {.status = status, .msg = "a writable PNG file"};
-    return cli_report(a->image, &err);
+    if (status) {
+        ulam_error err = {.status = status, .msg = "a writable PNG file"};
+        return cli_report(a->image, &err);
+    }
+    *used = info.exposure;
+    if (!info.pixels_hit)
+        fprintf(stderr, "ulam radiosity: warning: %s: the camera sees no patch's front (try --camera)\n", a->image);
+    else if (!info.pixels_emitter)
+        fprintf(stderr, "ulam radiosity: warning: %s: no emitter is in view of the camera\n", a->image);
+    if (info.pixels_hit && !info.exposure_set)
+        fprintf(stderr, "ulam radiosity: warning: %s: nothing lit is in view, so the exposure cannot be set "
+                        "(1 used; give --exposure or --camera)\n", a->image);
+    return 0;
 }
 
 /* Check before any work that path can be written (a temporary file can be made beside it and
@@ -673,7 +684,7 @@ int cli_radiosity(int argc, char **argv)
         r.out_written = 1;
     }
     if (a.image && !w.interrupted && cli_rank == 0) {
-        if ((rc = write_image(&a, t, w.all ? w.all : Bd, &r.exposure))) goto done;
+        if ((rc = write_image(&a, t, s, w.all ? w.all : Bd, &r.exposure))) goto done;
         r.image_written = 1;
     }
     if (a.json) print_json(&a, &r);

@@ -24,6 +24,7 @@ typedef struct {
     struct RTCIntersectContext ctx; /* first, so Embree's pointer is ours */
     const ulam_tracer *t;
     int64_t self;
+    const double *cull; /* the ray's direction when back sides are passed through, or NULL */
 } ray_context;
 
 /* Free a tracer; accepts and returns NULL. */
@@ -74,14 +75,16 @@ static void fill_buffers(ulam_tracer *t, float *vb, unsigned *ib)
     }
 }
 
-/* Embree's filter: reject hits on the patch the ray leaves (primID is the hit's sixth SoA field,
- * RTCHitN_primID, which rtcore_ray.h defines for C++ only). */
+/* Embree's filter: reject hits on the patch the ray leaves, and (camera rays) on back sides
+ * (primID is the hit's sixth SoA field, RTCHitN_primID, which rtcore_ray.h defines for C++ only). */
 static void skip_self(const struct RTCFilterFunctionNArguments *a)
 {
     const ray_context *rc = (const ray_context *)a->context;
-    for (unsigned i = 0; i < a->N; i++)
-        if (a->valid[i] && rc->self >= 0 && rc->t->prim_patch[((const unsigned *)a->hit)[5 * a->N + i]] == rc->self)
-            a->valid[i] = 0;
+    for (unsigned i = 0; i < a->N; i++) {
+        if (!a->valid[i]) continue;
+        int64_t p = rc->t->prim_patch[((const unsigned *)a->hit)[5 * a->N + i]];
+        if (p == rc->self || (rc->cull && ulam__dot3(rc->cull, rc->t->s->normal + 3 * p) >= 0)) a->valid[i] = 0;
+    }
 }
 
 /* Build the ray-casting structure for s. */
@@ -132,10 +135,11 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
     return ULAM_OK;
 }
 
-/* The first patch other than self the ray hits, or -1. */
-static int64_t cast_from(const ulam_tracer *t, const double org[3], const double dir[3], int64_t self, int *front)
+/* The first patch other than self the ray hits (with cull, the first whose front it hits), or -1. */
+static int64_t cast_from(const ulam_tracer *t, const double org[3], const double dir[3], int64_t self, int cull,
+                         int *front)
 {
-    ray_context rc = {.t = t, .self = self};
+    ray_context rc = {.t = t, .self = self, .cull = cull ? dir : NULL};
     rtcInitIntersectContext(&rc.ctx);
     struct RTCRayHit rh;
     rh.ray.org_x = (float)(org[0] - t->centre[0]), rh.ray.org_y = (float)(org[1] - t->centre[1]);
@@ -159,7 +163,13 @@ static int64_t cast_from(const ulam_tracer *t, const double org[3], const double
 /* The first patch the ray hits, or -1. */
 int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3], int *front)
 {
-    return cast_from(t, org, dir, -1, front);
+    return cast_from(t, org, dir, -1, 0, front);
+}
+
+/* The first patch whose front the ray hits (back sides are seen through), or -1. */
+int64_t ulam__tracer_cast_front(const ulam_tracer *t, const double org[3], const double dir[3])
+{
+    return cast_from(t, org, dir, -1, 1, NULL);
 }
 
 /* A cosine-distributed ray from a uniform point of patch p: the patch reached, front side. */
@@ -169,6 +179,6 @@ int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r)
     ulam__patch_point(t->s, p, t->share[p], r, o);
     ulam__cosine_dir(t->s->normal + 3 * p, r, d);
     int front = 0;
-    int64_t j = cast_from(t, o, d, p, &front);
+    int64_t j = cast_from(t, o, d, p, 0, &front);
     return j >= 0 && front ? j : -1;
 }
