@@ -470,11 +470,12 @@ def check_radiosity_interrupt(ulam):
         assert "[INTERRUPTED]" in out and re.search(r"^image +not written: the run was interrupted", out, re.M), out
         assert "exposure" not in out and os.listdir(d) == [], (out, os.listdir(d))
         p = subprocess.Popen([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
-                              "--json", "--image", png], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                              "--json", "--image", png, "--out", d + "/p.csv"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
         interrupt_when_ready(p)
         out, err = p.communicate(timeout=60)
         j = json.loads(out)
-        assert p.returncode == 130 and j["interrupted"] is True and j["image"] is None, j
+        assert p.returncode == 130 and j["interrupted"] is True and j["image"] is None and j["out"] is None, j
         for bad in (d + "/no/such/dir/x.png", d):  # a missing directory; a directory itself
             rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
                                       "--image", bad])

@@ -190,6 +190,42 @@ static void test_black_emitters(void **state)
     ulam_scene_free(s);
 }
 
+/* The Cornell box with a black light (Kd 0): shooting rendered a black room.  Shooting at three
+ * patches agrees with gathering (which never needed the lamp to reflect) within 4 sigma of
+ * their difference, for both estimators. */
+static void test_cornell_black_light(void **state)
+{
+    (void)state;
+    ulam_scene *s0 = must_scene("tests/data/rad/cornell_black_light.obj"), *s = NULL;
+    assert_int_equal(ulam_scene_subdivide(s0, 300.0, &s), ULAM_OK);
+    ulam_scene_free(s0);
+    ulam_tracer *t = must_tracer(s);
+    const char *labels[3] = {"floor", "back_wall", "tall_block"};
+    for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+        ulam_rad_solver *sv = NULL;
+        rad_walk(t, ULAM_FORWARD, est, 0, 100000, 31 + (uint64_t)est, &sv);
+        double *all = malloc((size_t)(3 * s->npatches) * sizeof *all), *se = malloc((size_t)(3 * s->npatches) * sizeof *se);
+        ulam_rad_solver_vectors(sv, all, se);
+        for (int k = 0; k < 3; k++) {
+            int64_t p;
+            assert_int_equal(ulam_scene_find(s, labels[k], &p), ULAM_OK);
+            ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, est, p, 100000, 41 + (uint64_t)(k + 3 * est), NULL);
+            for (int c = 0; c < 3; c++) {
+                double sd = sqrt(se[3 * p + c] * se[3 * p + c] + g.std_error[c] * g.std_error[c]);
+                print_message("black light, %s, %s %c: shoot %.5g +- %.2g, gather %.5g +- %.2g, z %+.2f\n",
+                              est ? "absorption" : "collision", labels[k], "RGB"[c], all[3 * p + c], se[3 * p + c],
+                              g.radiosity[c], g.std_error[c], (all[3 * p + c] - g.radiosity[c]) / sd);
+                assert_true(all[3 * p + c] > 0 && sd < 0.2 * g.radiosity[c]); /* lit, and a test that can fail */
+                assert_close(all[3 * p + c], g.radiosity[c], 4 * sd);
+            }
+        }
+        free(all), free(se);
+        ulam_rad_solver_free(sv);
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
 /* Scenes far from the origin and with small gaps: ray origins offset by 1e-5 of the scene's
  * diagonal and rounded to float lost the light (the furnace at 600 gave 1.01 +- 0.02 for 10;
  * two squares 0.005 apart beside a patch 1000 units away gave 0 for 0.495). */
@@ -760,6 +796,7 @@ int main(void)
         cmocka_unit_test(test_form_factors_exact), cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_cornell_against_direct), cmocka_unit_test(test_threads_and_options),
         cmocka_unit_test(test_black_emitters),     cmocka_unit_test(test_far_and_gap),
+        cmocka_unit_test(test_cornell_black_light),
         cmocka_unit_test(test_rel_err_zero),       cmocka_unit_test(test_shoot_coverage),
         cmocka_unit_test(test_render_framing),
     };
