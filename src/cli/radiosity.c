@@ -285,22 +285,6 @@ typedef struct {
 
 enum { ROW_TEXT, ROW_CSV, ROW_JSON };
 
-/* One value of a patch row: CSV leaves an unknown one empty, JSON writes null. */
-static void row_value(FILE *f, int fmt, const char *key, double v, int first)
-{
-    if (fmt == ROW_JSON) {
-        fprintf(f, "%s\"%s\": ", first ? "" : ", ", key);
-        if (isfinite(v)) fprintf(f, "%.17g", v);
-        else fputs("null", f);
-    } else if (fmt == ROW_CSV) {
-        fputc(',', f);
-        if (isfinite(v)) fprintf(f, "%.17g", v);
-    } else {
-        if (isfinite(v)) fprintf(f, " %12.6g", v);
-        else fprintf(f, " %12s", "-");
-    }
-}
-
 /* The header of the patch rows (text and CSV); v NULL: geometry only (--list). */
 static void row_header(FILE *f, int fmt, const patch_values *v)
 {
@@ -312,41 +296,42 @@ static void row_header(FILE *f, int fmt, const patch_values *v)
     fputc('\n', f);
 }
 
-/* One patch's row: number, label, face, centroid, area, then (v) the values. */
+/* One patch's row: number, label, face, centroid, area, then (v) the values; an unknown value
+ * is an empty CSV field, '-' in the table, null in JSON (which goes to stdout). */
 static void row(FILE *f, int fmt, const ulam_scene *s, int64_t p, const patch_values *v)
 {
-    static const char *const geo[] = {"x", "y", "z", "area"};
-    static const char *const val[] = {"R", "G", "B", "R_se", "G_se", "B_se"};
-    static const char *const dir[] = {"direct_R", "direct_G", "direct_B", "direct_R_se", "direct_G_se", "direct_B_se"};
-    int32_t g = s->group[p];
-    const char *label = g >= 0 ? s->groups[g] : "";
-    double x[4];
+    static const char *const keys[] = {"x", "y", "z", "area", "R", "G", "B", "R_se", "G_se", "B_se",
+                                       "direct_R", "direct_G", "direct_B", "direct_R_se", "direct_G_se", "direct_B_se"};
+    double x[16];
+    int n = 4;
     ulam_scene_centroid(s, p, x);
     x[3] = s->area[p];
+    const double *cols[4] = {v ? v->B : NULL, v ? v->se : NULL, v ? v->Bd : NULL, v ? v->sed : NULL};
+    for (int k = 0; v && k < (v->Bd ? 4 : 2); k++)
+        for (int c = 0; c < 3; c++) x[n++] = cols[k] ? cols[k][3 * p + c] : NAN;
+    int32_t g = s->group[p];
+    const char *label = g >= 0 ? s->groups[g] : "";
     if (fmt == ROW_JSON) {
-        fprintf(f, "{\"patch\": %lld, \"label\": \"", (long long)p + 1);
-        for (const char *c = label; *c; c++)
-            if (*c == '"' || *c == '\\') fprintf(f, "\\%c", *c);
-            else if ((unsigned char)*c < 0x20) fprintf(f, "\\u%04x", *c);
-            else fputc(*c, f);
-        fprintf(f, "\", \"face\": %lld", (long long)s->face[p] + 1);
-    } else if (fmt == ROW_CSV) {
+        printf("{\"patch\": %lld, ", (long long)p + 1);
+        cli_json_string("label", label, 0);
+        printf("\"face\": %lld, ", (long long)s->face[p] + 1);
+        for (int k = 0; k < n; k++) cli_json_number(keys[k], x[k], k == n - 1);
+        printf("}");
+        return;
+    }
+    if (fmt == ROW_CSV) {
         fprintf(f, "%lld,\"", (long long)p + 1); /* the label quoted, quotes doubled (RFC 4180) */
         for (const char *c = label; *c; c++) fputs(*c == '"' ? "\"\"" : (char[2]){*c, 0}, f);
         fprintf(f, "\",%lld", (long long)s->face[p] + 1);
     } else {
         fprintf(f, "%6lld %-16s %6lld", (long long)p + 1, *label ? label : "-", (long long)s->face[p] + 1);
     }
-    for (int k = 0; k < 4; k++) row_value(f, fmt, geo[k], x[k], 0);
-    for (int k = 0; v && k < 6; k++) {
-        const double *a = k < 3 ? v->B : v->se;
-        row_value(f, fmt, val[k], a ? a[3 * p + k % 3] : NAN, 0);
+    for (int k = 0; k < n; k++) {
+        if (fmt == ROW_CSV) fputc(',', f);
+        if (isfinite(x[k])) fprintf(f, fmt == ROW_CSV ? "%.17g" : " %12.6g", x[k]);
+        else if (fmt == ROW_TEXT) fprintf(f, " %12s", "-");
     }
-    for (int k = 0; v && v->Bd && k < 6; k++) {
-        const double *a = k < 3 ? v->Bd : v->sed;
-        row_value(f, fmt, dir[k], a ? a[3 * p + k % 3] : NAN, 0);
-    }
-    fputs(fmt == ROW_JSON ? "}" : "\n", f);
+    fputc('\n', f);
 }
 
 /* --list: the patches after subdivision, as a table or a JSON array. */
