@@ -413,7 +413,9 @@ static void print_text(const args *a, const report *r)
         }
         if (w->zero)
             printf("note         every channel is exactly 0 with zero variance after %lld walks (no walk scored):\n"
-                   "             --rel-err can never be met, so the walks stopped there\n", (long long)w->walks);
+                   "             --rel-err can never be met by a zero estimate, so the walks stopped there; if the\n"
+                   "             answer is not exactly 0, a walk scores with probability below 3/%lld = %.2g (95%%)\n",
+                   (long long)w->walks, (long long)w->walks, 3.0 / (double)w->walks);
     }
     if (w)
         printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)%s\n", (long long)w->walks,
