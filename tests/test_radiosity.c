@@ -239,6 +239,25 @@ static void test_far_and_gap(void **state)
     };
     for (size_t k = 0; k < sizeof scenes / sizeof *scenes; k++)
         check_all_modes(&scenes[k], 20000, 2000 + 13 * (uint64_t)k);
+    /* float resolution: centred, the far furnace is as fine as one at the origin (uncentred it
+     * would be FLT_EPSILON * 601 = 7e-5); the small patch 1000 units away is 168 steps across */
+    static const struct {
+        const char *file;
+        double lo, hi;
+        int64_t patch;
+    } res[] = {{"tests/data/rad/far_furnace.obj", 1e-8, 1e-7, -1}, {"tests/data/rad/small_gap.obj", 5e-3, 7e-3, 2},
+               {"examples/scenes/cornell_box.obj", 1e-7, 1e-5, -1}};
+    for (int k = 0; k < 3; k++) {
+        ulam_scene *s = must_scene(res[k].file);
+        ulam_tracer *t = must_tracer(s);
+        int64_t p = -2;
+        double r = ulam_tracer_resolution(t, &p);
+        print_message("%s: resolution %.3g at patch %lld\n", res[k].file, r, (long long)p + 1);
+        assert_true(r >= res[k].lo && r <= res[k].hi);
+        if (res[k].patch >= 0) assert_int_equal(p, res[k].patch);
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
 }
 
 /* Coverage of shooting's error bar (the mode a black lamp broke): the exact

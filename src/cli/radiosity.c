@@ -658,6 +658,12 @@ int cli_radiosity(int argc, char **argv)
         rc = cli_report(a.scene, &err);
         goto done;
     }
+    int64_t coarse;
+    double res = ulam_tracer_resolution(t, &coarse);
+    if (res > 1e-3 && cli_rank == 0)
+        fprintf(stderr, "ulam radiosity: warning: %s: patch %lld is only %.0f float steps across where it lies: ray "
+                        "casting resolves it to %.2g of its size (move the scene's parts closer together)\n",
+                a.scene, (long long)coarse + 1, 1.0 / res, res);
     if ((a.direct || a.check || a.matrix_walk) && (rc = form_and_solve(&a, t, s, &r, &F, &Bd))) goto done;
     if (a.patch || a.o.mode == ULAM_FORWARD) {
         rc = a.matrix_walk ? matrix_walks(&a, s, F, &w) : ray_walks(&a, t, s->npatches, &w);

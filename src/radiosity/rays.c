@@ -8,6 +8,7 @@
 #include "rad.h"
 
 #include <embree3/rtcore.h>
+#include <float.h>
 #include <stdlib.h>
 
 struct ulam_tracer {
@@ -17,6 +18,8 @@ struct ulam_tracer {
     int64_t *prim_patch; /* triangle -> patch */
     double *share;       /* per patch: ulam__first_share */
     double centre[3];    /* of the bounding box: Embree's coordinates are relative to it */
+    double resolution;   /* the largest float step at a patch over the patch's size */
+    int64_t coarsest;    /* the patch where it is */
 };
 
 /* An intersection context that knows the patch a ray leaves (-1: none). */
@@ -68,11 +71,24 @@ static void fill_buffers(ulam_tracer *t, float *vb, unsigned *ib)
     int64_t tri = 0;
     for (int64_t p = 0; p < s->npatches; p++) {
         const int32_t *v = s->vidx + s->start[p];
+        double far = 0.0; /* the largest centred coordinate of the patch */
+        for (int64_t k = 0; k < s->start[p + 1] - s->start[p]; k++)
+            for (int d = 0; d < 3; d++) far = fmax(far, fabs(s->vert[3 * v[k] + d] - t->centre[d]));
+        double r = FLT_EPSILON * far / sqrt(s->area[p]);
+        if (r > t->resolution) t->resolution = r, t->coarsest = p;
         for (int64_t k = 1; k + 1 < s->start[p + 1] - s->start[p]; k++, tri++) {
             ib[3 * tri] = (unsigned)v[0], ib[3 * tri + 1] = (unsigned)v[k], ib[3 * tri + 2] = (unsigned)v[k + 1];
             t->prim_patch[tri] = p;
         }
     }
+}
+
+/* How finely Embree's floats resolve the scene: the largest float step at a patch over the
+ * patch's size, and that patch. */
+double ulam_tracer_resolution(const ulam_tracer *t, int64_t *patch)
+{
+    if (patch) *patch = t ? t->coarsest : -1;
+    return t ? t->resolution : NAN;
 }
 
 /* Embree's filter: reject hits on the patch the ray leaves, and (camera rays) on back sides
