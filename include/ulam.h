@@ -466,9 +466,18 @@ int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out)
 /* Free a scene; accepts and returns NULL. */
 ulam_scene *ulam_scene_free(ulam_scene *s);
 
-/* The patch a label names: the patch of group label nearest the group's area centroid.
- * ULAM_ENOTFOUND when no patch has that label. */
+/* The patch a label names: the patch of group label that contains the group's area centroid
+ * (the lowest-numbered one when the centroid is on a shared edge); when none contains it (a
+ * label that is not flat, like a block, whose centroid is inside it), the patch of that label
+ * whose area centroid is nearest.  Does not depend on the subdivision but through the patch
+ * sizes.  ULAM_ENOTFOUND when no patch has that label. */
 int ulam_scene_find(const ulam_scene *s, const char *label, int64_t *patch);
+
+/* The area centroid of patch p. */
+void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3]);
+
+/* The area centroid of the patches labelled label; ULAM_ENOTFOUND when there are none. */
+int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3]);
 
 /* Total emitted power sum_p A_p E_p per channel. */
 void ulam_scene_power(const ulam_scene *s, double power[3]);
@@ -481,6 +490,13 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err);
 
 /* Free a tracer; accepts and returns NULL. */
 ulam_tracer *ulam_tracer_free(ulam_tracer *t);
+
+/* How finely ray casting resolves the scene: Embree works in float (relative to the scene's
+ * centre), so a patch far from the centre and small is resolved only to the float step there;
+ * the largest (float step at the patch) / sqrt(its area) over the patches, that patch in
+ * *patch (may be NULL).  Above 10^-3 the geometry that rays see is off by more than 0.1% of a
+ * patch. */
+double ulam_tracer_resolution(const ulam_tracer *t, int64_t *patch);
 
 /* The patch the ray org + t dir (t > 0, dir unit) first hits, or -1 when it leaves the
  * scene; *front (may be NULL) is 1 when it hits the patch's front side. */
@@ -533,6 +549,11 @@ int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_byt
 int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                                 int64_t p, size_t max_bytes, double se[3], ulam_error *err);
 
+/* The same at every patch (se: 3 * npatches): G = (I - M)^-1 whole by one LAPACKE_dgesv with
+ * npatches right-hand sides a channel, so two dense matrices (ULAM_EMEMLIMIT past max_bytes). */
+int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                                 size_t max_bytes, double *se, ulam_error *err);
+
 /* What a patch walk run has found: RGB radiosity of the patch opts->index. */
 typedef struct ulam_rad_result {
     double radiosity[3];
@@ -543,6 +564,8 @@ typedef struct ulam_rad_result {
     double max_share; /* the largest single score^2 / sum of scores^2 (channel sum) */
     double seconds;
     int threads, interrupted;
+    int zero; /* rel_err could never be met: every channel exactly 0 with zero variance after
+               * the first round (no walk scored); the run stopped there */
 } ulam_rad_result;
 
 /* An opaque patch-walk solver: walks that sample F by ray casting, never forming it. */
@@ -559,7 +582,8 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam
 /* Run one round of walks; ULAM_OK or ULAM_ENONFINITE. */
 int ulam_rad_solver_iterate(ulam_rad_solver *s);
 
-/* Nonzero once a stopping rule is met (rel_err: every nonzero channel). */
+/* Nonzero once a stopping rule is met (rel_err: every nonzero channel; or every channel is
+ * exactly 0 with zero variance, when the result's zero is set). */
 int ulam_rad_solver_done(const ulam_rad_solver *s);
 
 /* The result so far. */
@@ -581,13 +605,29 @@ typedef struct ulam_camera {
 /* The Cornell box camera: eye (278, 273, -800), looking along +z, 35 mm lens, 25 mm film. */
 ulam_camera ulam_camera_cornell(void);
 
+/* A camera framing the scene's bounding box for a width x height picture: looking along +z at
+ * its centre from the -z side, up +y, the Cornell lens, as near as lets the box's near face
+ * fill the picture (3% margin).  On the Cornell box: eye (278, 274.4, -802). */
+ulam_camera ulam_camera_frame(const ulam_scene *s, int width, int height);
+
+/* What a render saw. */
+typedef struct ulam_render_info {
+    double exposure;        /* the exposure used */
+    int exposure_set;       /* given, or set from the pixels (0: nothing lit in view, 1 used) */
+    int64_t pixels_hit;     /* pixels that see a patch's front */
+    int64_t pixels_emitter; /* of them, pixels that see an emitter (0: no emitter in view) */
+} ulam_render_info;
+
 /* Render B (3 * npatches) as width x height 8-bit sRGB (3 bytes a pixel, rows top first):
- * one ray per pixel centre, the hit patch's radiosity times exposure, clamped, sRGB-encoded
- * (flat shading).  exposure <= 0 picks 1 / (the 99th percentile of the largest channel over
- * the pixels of patches that do not emit); the exposure used goes to *used (may be NULL).
- * ULAM_ENONFINITE if any of B is not finite, ULAM_EOVERFLOW if the image cannot be sized. */
+ * one ray per pixel centre, the radiosity of the first patch whose front it meets (back sides
+ * are seen through, so a camera outside a closed room sees in) times exposure, clamped,
+ * sRGB-encoded (flat shading).  exposure <= 0 picks 1 / (the 99th percentile of the largest
+ * channel over the pixels of patches that do not emit; over all pixels when those are all
+ * black or absent); *info (may be NULL) says what was used
+ * and seen.  ULAM_ENONFINITE if any of B is not finite, ULAM_EOVERFLOW if the image cannot be
+ * sized. */
 int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width,
-                int height, double exposure, unsigned char *rgb, double *used);
+                int height, double exposure, unsigned char *rgb, ulam_render_info *info);
 
 /* Write an 8-bit RGB image as PNG (libpng), atomically. */
 int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb);

@@ -115,6 +115,7 @@ BAD_SCENES = [  # file, status, the file:line the message must name
     ("nonconvex.obj", "EGEOMETRY", O + "nonconvex.obj:8"), ("index_range.obj", "EINDEX", O + "index_range.obj:7"),
     ("no_usemtl.obj", "ENOTFOUND", O + "no_usemtl.obj:6"), ("bad_vertex.obj", "ESYNTAX", O + "bad_vertex.obj:3"),
     ("unknown_statement.obj", "ESYNTAX", O + "unknown_statement.obj:7"), ("empty.obj", "EEMPTY", O + "empty.obj:2"),
+    ("repeated_newmtl.obj", "ESYNTAX", O + "repeated_newmtl.mtl:7"), ("kd_spectral.obj", "EUNSUPPORTED", O + "kd_spectral.mtl:2"),
 ]
 for f, status, where in BAD_SCENES:
     CASES.append((["radiosity", O + f, "--patch", "1"], code(status), rf"^ulam: {re.escape(where)}: error: .*expected ", ""))
@@ -130,6 +131,23 @@ CASES += [
     (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "1000", "--estimator", "absorption"], 0, r"^$", r"radiosity R  2 \+- 0"),
     (["radiosity", SC + "cube.obj", "--direct", "--max-mem", "10"], code("EMEMLIMIT"), r"memory limit", ""),
 ]
+R = D + "rad/"
+CASES += [
+    (["radiosity", O + "repeated_newmtl.obj", "--patch", "1"], code("ESYNTAX"),
+     r"repeated_newmtl.mtl:7: error: .*'lamp' is already defined at .*repeated_newmtl.mtl:2", ""),
+    (["radiosity", O + "kd_spectral.obj", "--patch", "1"], code("EUNSUPPORTED"),
+     r"kd_spectral.mtl:2: error: unsupported kind of data: expected Kd r g b \(RGB only\): this file gives a spectral curve", ""),
+    (["radiosity", O + "unknown_statement.obj", "--patch", "1"], code("ESYNTAX"), r"vt, vn, vp, s, l, p, mg, lod, .* ignored", ""),
+]
+for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends --rel-err (it spun forever)
+    CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0,
+                  r"^ulam radiosity: warning: .*small_gap.obj: patch 3 is only 168 float steps across where it lies",
+                  r"radiosity R  0 \+- 0.*\n.*\n.*\nnote .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))
+CASES.append((["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--max-mem", "10"], 0, r"^$",
+              r"radiosity R  \S+ \+- \S+ \(walk noise only, CONDITIONAL on the sampled F"))
+for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # cuts at --max-steps were silent (96 for 1000)
+    CASES.append((["radiosity", R + "furnace999.obj", "--patch", "1", "--max-steps", "100", "--walks", "2000"] + extra,
+                  0, r"^$", r"^warning +\d+ of \d+ walks cut at --max-steps 100: the estimate is biased low"))
 
 
 def run(ulam, args):
@@ -398,7 +416,7 @@ def check_radiosity(ulam):
                               "--check", "--ff-rays", "50000", "--walks", "200000", "--json"])
     assert rc == 0, err
     j = json.loads(out)
-    assert j["label"] == "back_wall" and j["patches"] == 49 and j["mode"] == "gather"
+    assert j["label"] == "back_wall" and j["npatches"] == 49 and j["mode"] == "gather"
     for key in ("radiosity", "stderr", "direct", "direct_stderr", "z"):
         assert len(j[key]) == 3, key
     assert all(abs(z) < 4 for z in j["z"]), j["z"]
@@ -409,6 +427,23 @@ def check_radiosity(ulam):
     assert rc == 0, err
     j = json.loads(out)
     assert j["matrix_walk"] and j["patch"] == 10 and all(abs(z) < 4 for z in j["z"]), j
+    rc, out, err = run(ulam, ["radiosity", R + "furnace999.obj", "--patch", "1", "--max-steps", "100", "--walks",
+                              "1000", "--json"])
+    j = json.loads(out)
+    assert rc == 0 and j["max_steps"] == 100 and 800 < j["cut"] <= 1000 and j["walks"] == 1000, j
+    # --matrix-walk's error bar includes the noise of F (it was the walk's alone: |z| > 4 for most seeds)
+    F = 0.47557643653294696  # Howell C-11, 1 x 1.5 at 0.5
+    big = []
+    for seed in range(30):
+        rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--walks",
+                                  "20000", "--threads", "1", "--seed", str(seed), "--json"])
+        j = json.loads(out)
+        assert rc == 0 and len(j["walk_stderr"]) == 3 and len(j["ff_stderr"]) == 3, j
+        assert all(abs(s * s - w * w - f * f) < 1e-12 for s, w, f in zip(j["stderr"], j["walk_stderr"], j["ff_stderr"]))
+        big += [seed for b, s in zip(j["radiosity"], j["stderr"]) if abs(b - 0.5 * F) > 4 * s]
+    assert len(big) <= 1, big
+    rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk"])
+    assert rc == 0 and re.search(r"radiosity R  \S+ \+- \S+ \(walk \S+, form factors \S+\)", out), out
     with tempfile.TemporaryDirectory() as d:
         png = d + "/box.png"
         rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--mode", "shoot", "--walks", "20000",
@@ -420,6 +455,116 @@ def check_radiosity(ulam):
                                 "--image", d + "/no/such/dir/x.png"])
         assert rc == code("EIO") and "x.png" in err, err
         assert sorted(os.listdir(d)) == ["box.png"], os.listdir(d)
+
+
+def check_radiosity_interrupt(ulam):
+    """An interrupted image run says [INTERRUPTED], writes no picture and does not claim one
+    ('image int.png (exposure 0)' was printed); output paths are checked before any work (a run
+    of 10^11 particles into a missing directory must fail at once, not after the walks)."""
+    with tempfile.TemporaryDirectory() as d:
+        png = d + "/int.png"
+        p = subprocess.Popen([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+                              "--image", png], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        interrupt_when_ready(p)
+        out, err = p.communicate(timeout=60)
+        assert p.returncode == 130, (p.returncode, err)
+        assert "[INTERRUPTED]" in out and re.search(r"^image +not written: the run was interrupted", out, re.M), out
+        assert "exposure" not in out and os.listdir(d) == [], (out, os.listdir(d))
+        p = subprocess.Popen([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+                              "--json", "--image", png, "--out", d + "/p.csv"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+        interrupt_when_ready(p)
+        out, err = p.communicate(timeout=60)
+        j = json.loads(out)
+        assert p.returncode == 130 and j["interrupted"] is True and j["image"] is None and j["out"] is None, j
+        for bad in (d + "/no/such/dir/x.png", d):  # a missing directory; a directory itself
+            rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+                                      "--image", bad])
+            assert rc == code("EIO") and out == "" and re.search(r"error: .*expected a writable", err), (rc, out, err)
+        assert os.listdir(d) == [], os.listdir(d)
+
+
+def png_black(path):
+    """Whether a PNG (8-bit RGB, as ulam writes) is all black: every byte of its rows but the
+    filter bytes is 0 under any filter exactly when every pixel is."""
+    import struct
+    import zlib
+    data, pos, idat, width = open(path, "rb").read(), 8, b"", 0
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"IHDR":
+            width = struct.unpack(">I", data[pos + 8:pos + 12])[0]
+        if kind == b"IDAT":
+            idat += data[pos + 8:pos + 8 + n]
+        pos += 12 + n
+    raw, stride = zlib.decompress(idat), 1 + 3 * width
+    return not any(raw[k] for k in range(len(raw)) if k % stride)
+
+
+def check_radiosity_images(ulam):
+    """--image on scenes that are not the Cornell box: framed from the bounding box (the cube
+    was a black picture), --camera, and warnings when no emitter or nothing lit is in view."""
+    with tempfile.TemporaryDirectory() as d:
+        png = d + "/x.png"
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "2000", "--image", png,
+                                  "--size", "32x24"])
+        assert rc == 0 and err == "" and not png_black(png), (rc, err)
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "2000", "--image", png,
+                                  "--camera", "0.5,0.5,-5,0.5,0.5,-10,0,1,0,40"])  # looking away
+        assert rc == 0 and "the camera sees no patch" in err and png_black(png), (rc, err)
+        rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--mode", "shoot", "--walks", "2000", "--image",
+                                  png, "--size", "16x16"])
+        assert rc == 0 and re.search(r"warning: .*x.png: no emitter is in view", err) and not png_black(png), err
+        rc, out, err = run(ulam, ["radiosity", R + "small_gap.obj", "--mode", "shoot", "--walks", "2000", "--image",
+                                  png, "--camera", "1000.1,0.005,0.005,1000,0.005,0.005,0,1,0,20"])  # the dark far patch
+        assert rc == 0 and "nothing lit is in view, so the exposure cannot be set" in err, err
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--image", png, "--camera", "1,2,3"])
+        assert rc == 2 and "--camera expects" in err, err
+
+
+def check_radiosity_patches(ulam):
+    """Every patch out: --list, --out FILE.csv (atomic, every row, walks beside the direct solve
+    within 4 sigma), --all (a patches array in JSON), the chosen patch's centroid."""
+    import csv
+    rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "300", "--list"])
+    lines = out.strip().split("\n")
+    assert rc == 0 and len(lines) == 50 and lines[0].split()[:3] == ["patch", "label", "face"], out[:300]
+    rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "300", "--list", "--json"])
+    j = json.loads(out)
+    assert rc == 0 and len(j["patches"]) == 49 and j["patches"][48]["patch"] == 49 and j["patches"][0]["area"] > 0, j
+    rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--walks", "1000"])
+    assert rc == 0 and re.search(r"^patch +\d+ \(floor, face 1, area \S+, centroid 275\.\d+ 0 279\.\d+\)", out, re.M), out
+    with tempfile.TemporaryDirectory() as d:
+        path = d + "/p.csv"
+        rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--mode", "shoot", "--direct", "--walks",
+                                  "40000", "--ff-rays", "20000", "--out", path])
+        assert rc == 0 and f"patches      6 rows written to {path}" in out, (out, err)
+        rows = list(csv.DictReader(open(path)))
+        assert len(rows) == 6 and [r["label"] for r in rows] == ["floor", "ceiling", "left", "right", "front", "back"]
+        assert rows[1]["R"] == "1" and rows[1]["R_se"] == "0", rows[1]  # the black lamp: B = E exactly
+        zs = []
+        for r in rows:
+            for c in "RGB":
+                w, sw, b, sb = (float(r[k]) for k in (c, c + "_se", "direct_" + c, "direct_" + c + "_se"))
+                if sw > 0:
+                    zs.append((w - b) / (sw * sw + sb * sb) ** 0.5)
+        assert len(zs) == 15 and all(abs(z) < 4 for z in zs), zs
+        with open(path, "w") as f:
+            f.write("old\n")
+        rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--direct", "--max-mem", "10", "--out", path])
+        assert rc == code("EMEMLIMIT") and open(path).read() == "old\n" and os.listdir(d) == ["p.csv"], (rc, err)
+        rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--mode", "shoot", "--walks", "100000000000",
+                                  "--out", d + "/no/such/dir/p.csv"])
+        assert rc == code("EIO") and out == "", (rc, out, err)
+    rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--patch", "1", "--out", "x.csv"])
+    assert rc == 2 and "--out needs --mode shoot or --direct" in err, err
+    rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--mode", "shoot", "--walks", "2000", "--all",
+                              "--json"])
+    j = json.loads(out)
+    assert rc == 0 and j["npatches"] == 6 and len(j["patches"]) == 6 and j["patches"][3]["label"] == "right", j
+    assert all(len([k for k in p if k in ("R", "G", "B", "R_se", "G_se", "B_se")]) == 6 for p in j["patches"])
+    rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--mode", "shoot", "--walks", "2000", "--all"])
+    assert rc == 0 and re.search(r"^ +4 right +4 +1 +0\.5 +0\.5 +1 ", out, re.M), out
 
 
 def check_genmat(genmat):
@@ -438,7 +583,8 @@ def main():
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
-             (check_radiosity, ulam)]
+             (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
+             (check_radiosity_patches, ulam), (check_radiosity_images, ulam)]
     for f, arg in extra:
         try:
             f(arg)

@@ -34,6 +34,8 @@ def main():
                                "1", "--mode", "forward", "--walks", "30000", "--json", "--out", "{d}/x.mtx"], "x.mtx"),
             ("radiosity", ["radiosity", "examples/scenes/cornell_box.obj", "--patch", "floor", "--subdivide", "300",
                            "--walks", "20000", "--json"], None),
+            ("radiosity shoot", ["radiosity", "tests/data/rad/cornell_black_light.obj", "--subdivide", "300", "--mode",
+                                 "shoot", "--walks", "20000", "--json", "--out", "{d}/p.csv"], "p.csv"),
             ("study", ["study", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx", "--index", "2", "--methods",
                        "adjoint-collision-plain,forward-collision-plain", "--budgets", "1000,5000", "--repeats", "3",
                        "--out", "{d}/s"], "s/runs.csv"),
@@ -60,6 +62,8 @@ def main():
                         assert one[1] == two[1], "forward --out files differ"
                 elif name == "radiosity":
                     assert one["radiosity"] == two["radiosity"] and one["stderr"] == two["stderr"], (one, two)
+                elif name == "radiosity shoot":  # every patch, black light: the CSV byte for byte
+                    assert one[0]["walks"] == two[0]["walks"] and one[1] == two[1] and one[1].count("\n") == 50, "differ"
                 else:
                     assert one == two and len(one) == 13, (one, two)
                 print(f"ok {name}")

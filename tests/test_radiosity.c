@@ -5,6 +5,12 @@
 
 #include <string.h>
 
+/* a . b for 3-vectors. */
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
 /* Read a scene that must parse. */
 static ulam_scene *must_scene(const char *path)
 {
@@ -63,6 +69,259 @@ static ulam_walk_result matrix_walk(const ulam_scene *s, const ulam_csr *F, int 
     ulam_csr_free(M);
     free(b);
     return w;
+}
+
+/* Exact F of a scene whose patches are the faces of an axis-aligned unit cube (by their
+ * normals: opposite faces Howell C-11, the four others C-14), or of two opposed a x b
+ * rectangles at c (pair = 1; other patches see nothing). */
+static ulam_csr *exact_F(const ulam_scene *s, int pair, double a, double b, double c)
+{
+    int32_t ti[36], tj[36];
+    double tx[36];
+    int64_t nz = 0;
+    if (pair) {
+        double f = ulam_ff_parallel_rectangles(a, b, c);
+        ti[0] = 0, tj[0] = 1, tx[0] = f, ti[1] = 1, tj[1] = 0, tx[1] = f, nz = 2;
+    } else {
+        assert_int_equal(s->npatches, 6);
+        for (int32_t i = 0; i < 6; i++)
+            for (int32_t j = 0; j < 6; j++) {
+                double d = dot3(s->normal + 3 * i, s->normal + 3 * j);
+                if (d > 0.5) continue;
+                ti[nz] = i, tj[nz] = j;
+                tx[nz++] = d < -0.5 ? ulam_ff_parallel_rectangles(1, 1, 1) : ulam_ff_perpendicular_rectangles(1, 1, 1);
+            }
+    }
+    ulam_csr *F = NULL;
+    assert_int_equal(ulam_csr_from_triplets(s->npatches, s->npatches, nz, ti, tj, tx, &F), ULAM_OK);
+    return F;
+}
+
+/* A closed-form scene: file, the patch to check, and how to build its exact F. */
+typedef struct {
+    const char *file;
+    int64_t patch;
+    int pair;
+    double a, b, c;
+} exact_scene;
+
+/* Every mode at the scene's patch against the exact answer (LAPACK on the exact F): gathering
+ * and shooting with both estimators, matrix walks on a ray-cast F (error bar with F's noise)
+ * and the direct solve on it.  Each |z| < 4; the z-scores are printed. */
+static void check_all_modes(const exact_scene *e, int64_t walks, uint64_t seed)
+{
+    char path[256];
+    snprintf(path, sizeof path, "tests/data/rad/%s", e->file);
+    ulam_scene *s = must_scene(path);
+    ulam_tracer *t = must_tracer(s);
+    int64_t n = s->npatches, p = e->patch, rays = 20000;
+    ulam_csr *Fx = exact_F(s, e->pair, e->a, e->b, e->c), *F = NULL;
+    double *Bx = malloc((size_t)(3 * n) * sizeof *Bx), *Bd = malloc((size_t)(3 * n) * sizeof *Bd);
+    assert_int_equal(ulam_radiosity_direct(s, Fx, 0, Bx, NULL, NULL), ULAM_OK);
+    assert_int_equal(ulam_form_factors(t, rays, seed, 2, &F, NULL), ULAM_OK);
+    assert_int_equal(ulam_radiosity_direct(s, F, 0, Bd, NULL, NULL), ULAM_OK);
+    double sf[3];
+    assert_int_equal(ulam_radiosity_direct_error(s, F, rays, Bd, p, 0, sf, NULL), ULAM_OK);
+    const char *names[6] = {"gather collision", "gather absorption", "shoot collision", "shoot absorption",
+                            "matrix-walk collision", "matrix-walk absorption"};
+    for (int m = 0; m < 7; m++) {
+        double est[3], se[3];
+        if (m < 4) {
+            ulam_rad_result r = rad_walk(t, m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, m % 2 ? ULAM_ABSORPTION : ULAM_COLLISION,
+                                         p, walks, seed + (uint64_t)m, NULL);
+            assert_int_equal(r.cut, 0);
+            memcpy(est, r.radiosity, sizeof est), memcpy(se, r.std_error, sizeof se);
+        } else if (m < 6) {
+            for (int c = 0; c < 3; c++) {
+                ulam_walk_result w = matrix_walk(s, F, c, ULAM_ADJOINT, m % 2 ? ULAM_ABSORPTION : ULAM_COLLISION, p,
+                                                 walks, seed + 10 + (uint64_t)c, NULL, NULL);
+                est[c] = w.estimate, se[c] = sqrt(w.std_error * w.std_error + sf[c] * sf[c]);
+            }
+        } else {
+            memcpy(est, Bd + 3 * p, sizeof est), memcpy(se, sf, sizeof se);
+        }
+        double z[3];
+        for (int c = 0; c < 3; c++) /* z 0 where the answer is exact (zero variance up to rounding) */
+            z[c] = se[c] > 1e-12 * (1 + fabs(Bx[3 * p + c])) ? (est[c] - Bx[3 * p + c]) / se[c] : 0.0;
+        print_message("%s patch %lld exact %.6f %.6f %.6f  %-22s z %+.2f %+.2f %+.2f\n", e->file, (long long)p + 1,
+                      Bx[3 * p], Bx[3 * p + 1], Bx[3 * p + 2], m < 6 ? names[m] : "direct", z[0], z[1], z[2]);
+        for (int c = 0; c < 3; c++) {
+            double x = Bx[3 * p + c], tol = 4 * se[c] + 1e-9 * (1 + fabs(x));
+            if (fabs(est[c] - x) > tol)
+                print_error("%s: %s channel %d: %.6f, exact %.6f, tolerance %.3g\n", e->file, m < 6 ? names[m] : "direct", c,
+                            est[c], x, tol);
+            assert_close(est[c], x, tol);
+            assert_true(se[c] < 0.05 * fabs(x) + 1e-12); /* a test that can fail */
+        }
+    }
+    free(Bx), free(Bd);
+    ulam_csr_free(F), ulam_csr_free(Fx);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* Black emitters (Kd 0) and emitters that reflect: every particle leaves its emitter.  Shooting
+ * from a black lamp gave 0 +- 0; a black and a grey lamp, the grey one's light only. */
+static void test_black_emitters(void **state)
+{
+    (void)state;
+    static const exact_scene scenes[] = {
+        {"black_emitter.obj", 1, 1, 1, 1.5, 0.5}, /* B = 0.5 F = 0.2378 */
+        {"black_grey.obj", 1, 1, 1, 1.5, 0.5},    /* B_grey = 1 + 0.5 F */
+        {"reflecting_emitter.obj", 0, 1, 1, 1.5, 0.5},
+        {"reflecting_emitter.obj", 1, 1, 1, 1.5, 0.5},
+        {"tiny_kd_emitter.obj", 1, 1, 1, 1.5, 0.5},
+        {"cube_black_lamp.obj", 0, 0, 0, 0, 0}, /* the floor, below the lamp */
+        {"cube_black_lamp.obj", 3, 0, 0, 0, 0}, /* the red wall */
+    };
+    for (size_t k = 0; k < sizeof scenes / sizeof *scenes; k++) {
+        check_all_modes(&scenes[k], 20000, 1000 + 17 * (uint64_t)k);
+    }
+    /* a lamp of Kd 0.001 shoots as well as a black one: the receiver's error is the binomial
+     * one of the single bounce, not 30 times it (1 / sqrt(0.001) when survival was the lamp's Kd) */
+    ulam_scene *s = must_scene("tests/data/rad/tiny_kd_emitter.obj");
+    ulam_tracer *t = must_tracer(s);
+    ulam_rad_result r = rad_walk(t, ULAM_FORWARD, ULAM_COLLISION, 1, 20000, 3, NULL);
+    double F = ulam_ff_parallel_rectangles(1, 1.5, 0.5), se1 = 0.5 * sqrt(F * (1 - F) / 20000);
+    print_message("tiny Kd lamp: shooting stderr %.3g, single-bounce binomial %.3g\n", r.std_error[0], se1);
+    assert_true(r.std_error[0] < 1.2 * se1);
+    assert_true(r.rays < 3 * 20000);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* The Cornell box with a black light (Kd 0): shooting rendered a black room.  Shooting at three
+ * patches agrees with gathering (which never needed the lamp to reflect) within 4 sigma of
+ * their difference, for both estimators. */
+static void test_cornell_black_light(void **state)
+{
+    (void)state;
+    ulam_scene *s0 = must_scene("tests/data/rad/cornell_black_light.obj"), *s = NULL;
+    assert_int_equal(ulam_scene_subdivide(s0, 300.0, &s), ULAM_OK);
+    ulam_scene_free(s0);
+    ulam_tracer *t = must_tracer(s);
+    const char *labels[3] = {"floor", "back_wall", "tall_block"};
+    for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+        ulam_rad_solver *sv = NULL;
+        rad_walk(t, ULAM_FORWARD, est, 0, 100000, 31 + (uint64_t)est, &sv);
+        double *all = malloc((size_t)(3 * s->npatches) * sizeof *all), *se = malloc((size_t)(3 * s->npatches) * sizeof *se);
+        ulam_rad_solver_vectors(sv, all, se);
+        for (int k = 0; k < 3; k++) {
+            int64_t p;
+            assert_int_equal(ulam_scene_find(s, labels[k], &p), ULAM_OK);
+            ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, est, p, 100000, 41 + (uint64_t)(k + 3 * est), NULL);
+            for (int c = 0; c < 3; c++) {
+                double sd = sqrt(se[3 * p + c] * se[3 * p + c] + g.std_error[c] * g.std_error[c]);
+                print_message("black light, %s, %s %c: shoot %.5g +- %.2g, gather %.5g +- %.2g, z %+.2f\n",
+                              est ? "absorption" : "collision", labels[k], "RGB"[c], all[3 * p + c], se[3 * p + c],
+                              g.radiosity[c], g.std_error[c], (all[3 * p + c] - g.radiosity[c]) / sd);
+                assert_true(all[3 * p + c] > 0 && sd < 0.2 * g.radiosity[c]); /* lit, and a test that can fail */
+                assert_close(all[3 * p + c], g.radiosity[c], 4 * sd);
+            }
+        }
+        free(all), free(se);
+        ulam_rad_solver_free(sv);
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* Scenes far from the origin and with small gaps: ray origins offset by 1e-5 of the scene's
+ * diagonal and rounded to float lost the light (the furnace at 600 gave 1.01 +- 0.02 for 10;
+ * two squares 0.005 apart beside a patch 1000 units away gave 0 for 0.495). */
+static void test_far_and_gap(void **state)
+{
+    (void)state;
+    static const exact_scene scenes[] = {
+        {"far_furnace.obj", 0, 0, 0, 0, 0},       /* B = 1 / (1 - 0.9) = 10 */
+        {"far_furnace.obj", 4, 0, 0, 0, 0},
+        {"small_gap.obj", 1, 1, 1, 1, 0.005},     /* B = 0.5 F(1, 1, 0.005) = 0.4950 */
+    };
+    for (size_t k = 0; k < sizeof scenes / sizeof *scenes; k++)
+        check_all_modes(&scenes[k], 20000, 2000 + 13 * (uint64_t)k);
+    /* float resolution: centred, the far furnace is as fine as one at the origin (uncentred it
+     * would be FLT_EPSILON * 601 = 7e-5); the small patch 1000 units away is 168 steps across */
+    static const struct {
+        const char *file;
+        double lo, hi;
+        int64_t patch;
+    } res[] = {{"tests/data/rad/far_furnace.obj", 1e-8, 1e-7, -1}, {"tests/data/rad/small_gap.obj", 5e-3, 7e-3, 2},
+               {"examples/scenes/cornell_box.obj", 1e-7, 1e-5, -1}};
+    for (int k = 0; k < 3; k++) {
+        ulam_scene *s = must_scene(res[k].file);
+        ulam_tracer *t = must_tracer(s);
+        int64_t p = -2;
+        double r = ulam_tracer_resolution(t, &p);
+        print_message("%s: resolution %.3g at patch %lld\n", res[k].file, r, (long long)p + 1);
+        assert_true(r >= res[k].lo && r <= res[k].hi);
+        if (res[k].patch >= 0) assert_int_equal(p, res[k].patch);
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
+}
+
+/* Coverage of shooting's error bar (the mode a black lamp broke): the exact
+ * answer of the reflecting emitter's receiver lies within 1.96 sigma in 95% of runs.  Over 200
+ * seeds, binomial (200, 0.95): P(count <= 179) = 0.0012, P(count >= 198) = 0.0023; both sides
+ * can fail.  (1000 seeds of 2000 particles: 966, 963, 957 inside; mean z -0.02, var z 0.92.) */
+static void test_shoot_coverage(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("tests/data/rad/reflecting_emitter.obj");
+    ulam_tracer *t = must_tracer(s);
+    ulam_csr *Fx = exact_F(s, 1, 1, 1.5, 0.5);
+    double Bx[6];
+    assert_int_equal(ulam_radiosity_direct(s, Fx, 0, Bx, NULL, NULL), ULAM_OK);
+    int inside[3] = {0, 0, 0};
+    for (uint64_t seed = 0; seed < 200; seed++) {
+        ulam_rad_result r = rad_walk(t, ULAM_FORWARD, ULAM_COLLISION, 1, 2000, 5000 + seed, NULL);
+        for (int c = 0; c < 3; c++) inside[c] += fabs(r.radiosity[c] - Bx[3 + c]) <= 1.96 * r.std_error[c];
+    }
+    print_message("shooting coverage of the 95%% interval over 200 seeds: R %d G %d B %d\n", inside[0], inside[1], inside[2]);
+    for (int c = 0; c < 3; c++) assert_true(inside[c] >= 180 && inside[c] <= 197);
+    ulam_csr_free(Fx);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* --rel-err on a patch whose answer is exactly 0 (it faces away from everything; a scene with
+ * no emitter) spun forever: a zero answer with zero variance after the first round is an answer,
+ * and the run says the relative error cannot be met and stops.  Every mode, bounded walks. */
+static void test_rel_err_zero(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("tests/data/rad/small_gap.obj");
+    ulam_tracer *t = must_tracer(s);
+    for (int m = 0; m < 4; m++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, o.estimator = m % 2 ? ULAM_ABSORPTION : ULAM_COLLISION;
+        o.index = 2, o.rel_err = 0.01, o.max_walks = 0, o.seed = 5, o.threads = 2; /* the far patch, facing away */
+        ulam_rad_solver *sv = NULL;
+        assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
+        int rounds = 0;
+        while (!ulam_rad_solver_done(sv) && rounds < 100) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK), rounds++;
+        ulam_rad_result r;
+        ulam_rad_solver_result(sv, &r);
+        print_message("mode %d: %d rounds, %lld walks, zero %d\n", m, rounds, (long long)r.walks, r.zero);
+        assert_true(ulam_rad_solver_done(sv));
+        assert_true(r.walks >= 1000 && r.walks <= 65536);
+        assert_int_equal(r.zero, 1);
+        for (int c = 0; c < 3; c++) assert_true(r.radiosity[c] == 0 && r.std_error[c] == 0);
+        ulam_rad_solver_free(sv);
+    }
+    /* the receiver, with light: the rule is met as before and zero stays 0 */
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 1, o.rel_err = 0.02, o.max_walks = 0, o.seed = 5, o.threads = 2;
+    ulam_rad_solver *sv = NULL;
+    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
+    while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
+    ulam_rad_result r;
+    ulam_rad_solver_result(sv, &r);
+    assert_int_equal(r.zero, 0);
+    assert_true(r.std_error[0] <= 0.02 * r.radiosity[0] && r.radiosity[0] > 0);
+    ulam_rad_solver_free(sv);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
 }
 
 /* The unit cube reads as six unit patches facing inwards. */
@@ -138,6 +397,8 @@ static void test_read_errors(void **state)
         {"two_vertices.obj", ULAM_ESYNTAX, 7, NULL},
         {"bad_face_token.obj", ULAM_ESYNTAX, 7, NULL},
         {"does_not_exist.obj", ULAM_EIO, 0, NULL},
+        {"repeated_newmtl.obj", ULAM_ESYNTAX, 7, "repeated_newmtl.mtl"}, /* silently reset the lamp's Ke */
+        {"kd_spectral.obj", ULAM_EUNSUPPORTED, 2, "kd_spectral.mtl"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         char path[256];
@@ -159,6 +420,105 @@ static void test_read_errors(void **state)
             assert_string_equal(err.file, "");
         }
     }
+}
+
+/* What the MTL and OBJ errors say: a repeated material names its first definition, a spectral
+ * colour says it is one (the status read 'unsupported Matrix Market kind'), and the statements
+ * ulam reads past are listed whole in the unknown-statement message and are all accepted. */
+static void test_read_messages(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_error err;
+    assert_int_equal(ulam_scene_read_obj("tests/data/obj/repeated_newmtl.obj", &s, &err), ULAM_ESYNTAX);
+    print_message("%s\n", err.msg);
+    assert_non_null(strstr(err.msg, "'lamp'") && strstr(err.msg, "repeated_newmtl.mtl:2"));
+    assert_int_equal(ulam_scene_read_obj("tests/data/obj/kd_spectral.obj", &s, &err), ULAM_EUNSUPPORTED);
+    print_message("%s: %s\n", ulam_strerror(ULAM_EUNSUPPORTED), err.msg);
+    assert_non_null(strstr(err.msg, "spectral"));
+    assert_null(strstr(ulam_strerror(ULAM_EUNSUPPORTED), "Matrix Market"));
+    assert_int_equal(ulam_scene_read_obj("tests/data/obj/unknown_statement.obj", &s, &err), ULAM_ESYNTAX);
+    print_message("%s\n", err.msg);
+    static const char *const skipped[] = {"vt", "vn", "vp", "s", "l", "p", "mg", "lod", "usemap", "maplib",
+                                         "shadow_obj", "trace_obj", "bevel", "c_interp", "d_interp"};
+    for (size_t k = 0; k < sizeof skipped / sizeof *skipped; k++) {
+        char word[32];
+        snprintf(word, sizeof word, " %s,", skipped[k]);
+        if (!strstr(err.msg, word)) snprintf(word, sizeof word, " %s ignored", skipped[k]);
+        if (!strstr(err.msg, word)) print_error("'%s' missing from: %s\n", skipped[k], err.msg);
+        assert_non_null(strstr(err.msg, word));
+    }
+    s = must_scene("tests/data/obj/ignored_statements.obj"); /* vp, mg, lod */
+    assert_int_equal(s->npatches, 1);
+    ulam_scene_free(s);
+}
+
+/* Nonzero when point x lies in patch p (on its plane and inside every edge, within tol). */
+static int patch_contains(const ulam_scene *s, int64_t p, const double x[3], double tol)
+{
+    const double *n = s->normal + 3 * p;
+    int64_t k0 = s->start[p], m = s->start[p + 1] - k0;
+    const double *v0 = s->vert + 3 * s->vidx[k0];
+    double d[3] = {x[0] - v0[0], x[1] - v0[1], x[2] - v0[2]};
+    if (fabs(dot3(d, n)) > tol) return 0;
+    for (int64_t k = 0; k < m; k++) {
+        const double *a = s->vert + 3 * s->vidx[k0 + k], *b = s->vert + 3 * s->vidx[k0 + (k + 1) % m];
+        double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {x[0] - a[0], x[1] - a[1], x[2] - a[2]};
+        double c[3] = {e[1] * w[2] - e[2] * w[1], e[2] * w[0] - e[0] * w[2], e[0] * w[1] - e[1] * w[0]};
+        if (dot3(c, n) < -tol * sqrt(dot3(e, e))) return 0;
+    }
+    return 1;
+}
+
+/* --patch LABEL picks the patch that contains the label's area centroid, whatever the
+ * subdivision (the patch nearest by vertex average did not, and its value swung 3x with L);
+ * a label whose centroid is on none of its patches (a block: it is inside) gets the patch whose
+ * centroid is nearest.  Centroids are area centroids. */
+static void test_find_rule(void **state)
+{
+    (void)state;
+    ulam_scene *s0 = must_scene("examples/scenes/cornell_box.obj");
+    static const double L[] = {7, 10, 20, 25, 33, 50, 60, 75, 100, 150, 300, 1000};
+    static const char *const labels[] = {"floor", "back_wall", "ceiling", "light"};
+    double c0[4][3];
+    for (int k = 0; k < 4; k++) {
+        int64_t p;
+        assert_int_equal(ulam_scene_find(s0, labels[k], &p), ULAM_OK);
+        assert_int_equal(ulam_scene_label_centroid(s0, labels[k], c0[k]), ULAM_OK);
+    }
+    assert_close(c0[0][0], 275.5, 2), assert_close(c0[0][1], 0.0, 1e-9), assert_close(c0[0][2], 279.7, 2);
+    for (size_t i = 0; i < sizeof L / sizeof *L; i++) {
+        ulam_scene *s = NULL;
+        assert_int_equal(ulam_scene_subdivide(s0, L[i], &s), ULAM_OK);
+        for (int k = 0; k < 4; k++) {
+            int64_t p = -1;
+            double c[3];
+            assert_int_equal(ulam_scene_find(s, labels[k], &p), ULAM_OK);
+            assert_int_equal(ulam_scene_label_centroid(s, labels[k], c), ULAM_OK);
+            for (int d = 0; d < 3; d++) assert_close(c[d], c0[k][d], 1e-6 * (1 + fabs(c0[k][d]))); /* L does not move it */
+            if (!patch_contains(s, p, c, 1e-6)) print_error("L = %g, %s: patch %lld does not contain the centroid\n", L[i], labels[k], (long long)p);
+            assert_true(patch_contains(s, p, c, 1e-6));
+            assert_string_equal(s->groups[s->group[p]], labels[k]);
+        }
+        ulam_scene_free(s);
+    }
+    /* the tall block: its centroid is inside it, on none of its faces; the nearest centroid */
+    int64_t p;
+    double c[3], pc[3], best = INFINITY;
+    assert_int_equal(ulam_scene_find(s0, "tall_block", &p), ULAM_OK);
+    assert_int_equal(ulam_scene_label_centroid(s0, "tall_block", c), ULAM_OK);
+    for (int64_t q = 0; q < s0->npatches; q++) {
+        if (s0->group[q] != s0->group[p]) continue;
+        assert_false(patch_contains(s0, q, c, 1e-6));
+        ulam_scene_centroid(s0, q, pc);
+        double d[3] = {pc[0] - c[0], pc[1] - c[1], pc[2] - c[2]};
+        best = fmin(best, dot3(d, d));
+    }
+    ulam_scene_centroid(s0, p, pc);
+    double d[3] = {pc[0] - c[0], pc[1] - c[1], pc[2] - c[2]};
+    assert_close(dot3(d, d), best, 0);
+    assert_int_equal(ulam_scene_label_centroid(s0, "attic", c), ULAM_ENOTFOUND);
+    ulam_scene_free(s0);
 }
 
 /* Subdivision keeps area, faces and labels; sides end up no longer than L. */
@@ -272,6 +632,55 @@ static void test_furnace(void **state)
     ulam_scene_free(s);
 }
 
+/* Pictures of scenes that are not the Cornell box: the camera frames the bounding box (the
+ * Cornell camera, 1000 units from a unit cube, saw its front face's back: a black picture), back
+ * sides are seen through (a closed room is seen into), and the render says when no emitter is
+ * in view and when nothing lit is, so that the exposure cannot be set. */
+static void test_render_framing(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("examples/scenes/cornell_box.obj");
+    ulam_camera f = ulam_camera_frame(s, 512, 512), c = ulam_camera_cornell();
+    for (int d = 0; d < 3; d++) assert_close(f.eye[d], c.eye[d], 5.0), assert_close(f.dir[d], c.dir[d], 0);
+    ulam_scene_free(s);
+    static const struct {
+        const char *file;
+        int64_t hit_min, emitter_min, emitter_max;
+        int zero_B, exposure_set;
+    } cases[] = {
+        {"examples/scenes/cube.obj", 64, 64, 64, 0, 1},          /* closed, all emit: exposed by the emitters */
+        {"tests/data/rad/black_emitter.obj", 16, 0, 0, 0, 1},    /* the lamp faces away: no emitter in view */
+        {"tests/data/rad/cube_black_lamp.obj", 64, 1, 63, 0, 1}, /* the lamp on top, in view */
+        {"tests/data/rad/black_emitter.obj", 16, 0, 0, 1, 0},    /* nothing lit: no exposure */
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        s = must_scene(cases[k].file);
+        ulam_tracer *t = must_tracer(s);
+        double *B = malloc((size_t)(3 * s->npatches) * sizeof *B);
+        for (int64_t p = 0; p < s->npatches; p++)
+            for (int ch = 0; ch < 3; ch++) B[3 * p + ch] = cases[k].zero_B ? 0.0 : s->emit[3 * p + ch] + 0.25;
+        unsigned char rgb[8 * 8 * 3];
+        ulam_render_info in;
+        ulam_camera cam = ulam_camera_frame(s, 8, 8);
+        assert_int_equal(ulam_render(t, B, &cam, 8, 8, 0, rgb, &in), ULAM_OK);
+        print_message("%s: %lld pixels see a patch, %lld an emitter, exposure %g (%s)\n", cases[k].file,
+                      (long long)in.pixels_hit, (long long)in.pixels_emitter, in.exposure, in.exposure_set ? "set" : "not set");
+        int lit = 0;
+        for (int i = 0; i < 8 * 8 * 3; i++) lit += rgb[i] > 0;
+        if (in.pixels_hit < cases[k].hit_min || in.pixels_emitter < cases[k].emitter_min ||
+            in.pixels_emitter > cases[k].emitter_max || in.exposure_set != cases[k].exposure_set ||
+            lit != (cases[k].zero_B ? 0 : 3 * in.pixels_hit))
+            print_error("case %zu: %d lit channel values\n", k, lit);
+        assert_true(in.pixels_hit >= cases[k].hit_min);
+        assert_true(in.pixels_emitter >= cases[k].emitter_min && in.pixels_emitter <= cases[k].emitter_max);
+        assert_int_equal(in.exposure_set, cases[k].exposure_set);
+        assert_int_equal(lit, cases[k].zero_B ? 0 : 3 * in.pixels_hit);
+        free(B);
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
+}
+
 /* The Cornell box, subdivided: every walk mode against LAPACK.  Matrix walks share F with the
  * direct solve (4 sigma); ray walks sample the exact F, so the tolerance adds the direct
  * solution's own error from the noise of F (ulam_radiosity_direct_error). */
@@ -288,6 +697,15 @@ static void test_cornell_against_direct(void **state)
     double *B = malloc((size_t)(3 * n) * sizeof *B);
     assert_int_equal(ulam_radiosity_direct(s, F, 0, B, NULL, NULL), ULAM_OK);
     const char *labels[3] = {"floor", "back_wall", "tall_block"};
+    double *se_all = malloc((size_t)(3 * n) * sizeof *se_all);
+    assert_int_equal(ulam_radiosity_direct_errors(s, F, rays, B, 0, se_all, NULL), ULAM_OK);
+    for (int64_t p = 0; p < n; p++) { /* every patch's error at once, as one patch's alone */
+        double sf[3];
+        assert_int_equal(ulam_radiosity_direct_error(s, F, rays, B, p, 0, sf, NULL), ULAM_OK);
+        for (int c = 0; c < 3; c++) assert_close(se_all[3 * p + c], sf[c], 1e-9 * sf[c] + 1e-15);
+    }
+    assert_int_equal(ulam_radiosity_direct_errors(s, F, rays, B, ulam_direct_bytes(n), se_all, NULL), ULAM_EMEMLIMIT);
+    free(se_all);
     for (int k = 0; k < 3; k++) {
         int64_t p;
         assert_int_equal(ulam_scene_find(s, labels[k], &p), ULAM_OK);
@@ -393,8 +811,13 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_read_cube),          cmocka_unit_test(test_read_good),
         cmocka_unit_test(test_read_errors),        cmocka_unit_test(test_subdivide),
+        cmocka_unit_test(test_read_messages),      cmocka_unit_test(test_find_rule),
         cmocka_unit_test(test_form_factors_exact), cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_cornell_against_direct), cmocka_unit_test(test_threads_and_options),
+        cmocka_unit_test(test_black_emitters),     cmocka_unit_test(test_far_and_gap),
+        cmocka_unit_test(test_cornell_black_light),
+        cmocka_unit_test(test_rel_err_zero),       cmocka_unit_test(test_shoot_coverage),
+        cmocka_unit_test(test_render_framing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

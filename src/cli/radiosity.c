@@ -7,19 +7,23 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static const char *const usage =
     "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot]\n"
     "                      [--estimator collision|absorption] [--walks N] [--rel-err E] [--time S]\n"
     "                      [--seed S] [--threads T] [--max-steps K] [--subdivide L] [--ff-rays K]\n"
     "                      [--direct] [--check] [--matrix-walk] [--max-mem SIZE]\n"
-    "                      [--image out.png] [--size WxH] [--exposure X] [--json]\n"
+    "                      [--image out.png] [--size WxH] [--exposure X] [--camera C]\n"
+    "                      [--out patches.csv] [--all] [--list] [--json]\n"
     "\n"
     "Radiosity B = E + diag(rho) F B of a scene of diffuse patches (Wavefront OBJ + MTL: Kd is\n"
     "the reflectance, Ke the emission), per RGB channel.\n"
     "\n"
     "  --patch K|LABEL   the patch to answer: 1-based number, or an o/g label (the label's patch\n"
-    "                    nearest its centre)\n"
+    "                    that contains the label's area centroid; else the one whose centroid is\n"
+    "                    nearest it)\n"
+    "  --list            print the patches (number, label, face, centroid, area) and stop\n"
     "  --mode gather     walks from the patch that gather emission (default; needs --patch):\n"
     "                    one patch without forming F\n"
     "  --mode shoot      particles from the emitters, tallied on every patch (for --image)\n"
@@ -33,9 +37,16 @@ static const char *const usage =
     "  --matrix-walk     walk on the assembled M (ulam solve's engine) instead of casting rays:\n"
     "                    walks and LAPACK then share the very same F\n"
     "  --max-mem SIZE    refuse a direct solve needing more (default 4G)\n"
-    "  --image out.png   render the shooting (or else direct) solution from the Cornell camera\n"
+    "  --image out.png   render the shooting (or else direct) solution\n"
+    "  --camera C        ex,ey,ez,ax,ay,az,ux,uy,uz,fov: eye, look-at point, up and horizontal\n"
+    "                    field of view in degrees; 'cornell' for the Cornell box camera; default:\n"
+    "                    frame the scene's bounding box, looking along +z\n"
     "  --size WxH        image size (default 512x512)\n"
     "  --exposure X      radiosity scale before the sRGB curve (default: auto)\n"
+    "  --out FILE.csv    every patch: number, label, face, centroid, area, R G B and standard\n"
+    "                    errors (and the direct values with --check or --direct); needs --mode\n"
+    "                    shoot or --direct\n"
+    "  --all             print every patch too (a table; with --json a patches array)\n"
     "  --json            print one JSON object\n"
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
@@ -46,22 +57,51 @@ static const char *const chan = "RGB";
 
 /* Everything the command was asked. */
 typedef struct {
-    const char *scene, *patch, *image;
+    const char *scene, *patch, *image, *out;
     double subdivide, exposure;
     int64_t ff_rays;
-    int direct, check, matrix_walk, json, width, height;
+    int direct, check, matrix_walk, json, width, height, all, list;
+    int camera_given; /* --camera: cam holds it */
+    ulam_camera cam;
     size_t max_mem;
     ulam_walk_opts o;
 } args;
 
 /* What the walks found. */
 typedef struct {
-    double B[3], se[3];
-    int64_t walks, steps;
+    double B[3], se[3], se_walk[3]; /* se: with --matrix-walk, the walk's and F's noise combined */
+    int64_t walks, steps, cut; /* cut: walks stopped at --max-steps */
     double seconds;
     int threads, interrupted;
-    double *all; /* shooting: 3 per patch */
+    int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
+    double *all, *all_se; /* shooting: 3 per patch each */
 } walked;
+
+/* Parse --camera: 'cornell', or ex,ey,ez,ax,ay,az,ux,uy,uz,fov (degrees, horizontal). */
+static int parse_camera(const char *cmd, const char *arg, ulam_camera *cam)
+{
+    if (!strcmp(arg, "cornell")) {
+        *cam = ulam_camera_cornell();
+        return 0;
+    }
+    double x[10];
+    int used = 0;
+    if (sscanf(arg, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf%n", &x[0], &x[1], &x[2], &x[3], &x[4], &x[5], &x[6], &x[7],
+               &x[8], &x[9], &used) == 10 && !arg[used]) {
+        double d[3] = {x[3] - x[0], x[4] - x[1], x[5] - x[2]}, dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        double c[3] = {d[1] * x[8] - d[2] * x[7], d[2] * x[6] - d[0] * x[8], d[0] * x[7] - d[1] * x[6]};
+        int finite = 1;
+        for (int k = 0; k < 10; k++) finite &= isfinite(x[k]);
+        if (finite && dd > 0 && c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > 1e-12 * dd * (x[6] * x[6] + x[7] * x[7] + x[8] * x[8]) &&
+            x[9] > 0 && x[9] < 180) {
+            *cam = (ulam_camera){.eye = {x[0], x[1], x[2]}, .dir = {d[0], d[1], d[2]}, .up = {x[6], x[7], x[8]},
+                                 .focal = 1.0, .film = 2.0 * tan(x[9] * M_PI / 360.0)};
+            return 0;
+        }
+    }
+    return cli_usage_error(cmd, "--camera expects 'cornell' or ex,ey,ez,ax,ay,az,ux,uy,uz,fov (eye, look-at point "
+                                "apart from it, an up not along the view, fov in (0, 180) degrees), got '%s'", arg);
+}
 
 /* Parse the options into a; 0, or an exit code (with -1 meaning: --help printed). */
 static int parse(int argc, char **argv, args *a)
@@ -77,6 +117,8 @@ static int parse(int argc, char **argv, args *a)
         {"max-mem", required_argument, 0, 'x'},   {"image", required_argument, 0, 'i'},
         {"size", required_argument, 0, 'z'},      {"exposure", required_argument, 0, 'X'},
         {"json", no_argument, 0, 'J'},            {"help", no_argument, 0, 'h'},
+        {"out", required_argument, 0, 'o'},       {"all", no_argument, 0, 'A'},
+        {"list", no_argument, 0, 'l'},            {"camera", required_argument, 0, 'C'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int64_t v;
@@ -113,12 +155,20 @@ static int parse(int argc, char **argv, args *a)
             break;
         case 'X': if ((rc = cli_parse_real(cmd, "--exposure", optarg, 1e-300, 1e300, &a->exposure))) return rc; break;
         case 'J': a->json = 1; break;
+        case 'o': a->out = optarg; break;
+        case 'A': a->all = 1; break;
+        case 'l': a->list = 1; break;
+        case 'C': if ((rc = parse_camera(cmd, optarg, &a->cam))) return rc; a->camera_given = 1; break;
         case 'h': fputs(usage, stdout); return -1;
         default: return cli_usage_error(cmd, "unknown option");
         }
     }
     if (optind != argc - 1) return cli_usage_error(cmd, "expects exactly one scene file");
     a->scene = argv[optind];
+    if (a->list) return 0;
+    if ((a->out || a->all) && a->o.mode == ULAM_ADJOINT && !a->direct)
+        return cli_usage_error(cmd, "%s needs --mode shoot or --direct (gathering answers one patch)",
+                               a->out ? "--out" : "--all");
     if (!a->patch && a->o.mode == ULAM_ADJOINT && !a->direct)
         return cli_usage_error(cmd, "needs --patch K (gathering answers one patch), --mode shoot or --direct");
     if (a->check && !a->patch) return cli_usage_error(cmd, "--check needs --patch K");
@@ -160,11 +210,14 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     ulam_rad_solver_result(sv, &r);
     memcpy(w->B, r.radiosity, sizeof w->B);
     memcpy(w->se, r.std_error, sizeof w->se);
+    memcpy(w->se_walk, r.std_error, sizeof w->se_walk);
     w->walks = r.walks, w->steps = r.rays, w->seconds = r.seconds, w->threads = r.threads;
-    w->interrupted = r.interrupted;
+    w->interrupted = r.interrupted, w->zero = r.zero, w->cut = r.cut;
     if (!status && a->o.mode == ULAM_FORWARD) {
-        if (!(w->all = malloc((size_t)np * 3 * sizeof *w->all))) status = ULAM_ENOMEM;
-        else ulam_rad_solver_vectors(sv, w->all, NULL);
+        w->all = malloc((size_t)np * 3 * sizeof *w->all);
+        w->all_se = malloc((size_t)np * 3 * sizeof *w->all_se);
+        if (!w->all || !w->all_se) status = ULAM_ENOMEM;
+        else ulam_rad_solver_vectors(sv, w->all, w->all_se);
     }
     ulam_rad_solver_free(sv);
     if (!status) return 0;
@@ -176,9 +229,12 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
 static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, walked *w)
 {
     int64_t n = s->npatches;
-    double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
-    if (a->o.mode == ULAM_FORWARD) w->all = malloc((size_t)n * 3 * sizeof *w->all);
-    int status = b && x && (a->o.mode == ULAM_ADJOINT || w->all) ? ULAM_OK : ULAM_ENOMEM;
+    double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x), *e = malloc((size_t)n * sizeof *e);
+    if (a->o.mode == ULAM_FORWARD) {
+        w->all = malloc((size_t)n * 3 * sizeof *w->all);
+        w->all_se = malloc((size_t)n * 3 * sizeof *w->all_se);
+    }
+    int status = b && x && e && (a->o.mode == ULAM_ADJOINT || (w->all && w->all_se)) ? ULAM_OK : ULAM_ENOMEM;
     ulam_error err = {.status = status};
     cli_catch_sigint();
     for (int c = 0; c < 3 && !status && !cli_interrupted; c++) {
@@ -191,18 +247,20 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
         while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
         ulam_walk_result r;
         ulam_solver_result(sv, &r);
-        w->B[c] = r.estimate, w->se[c] = r.std_error;
-        w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds;
+        w->B[c] = r.estimate, w->se[c] = w->se_walk[c] = r.std_error;
+        w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds, w->cut += r.cut;
         w->threads = r.threads, w->interrupted |= r.interrupted;
         if (!status && w->all) {
-            ulam_solver_vectors(sv, x, NULL);
-            for (int64_t i = 0; i < n; i++) w->all[3 * i + c] = x[i];
+            ulam_solver_vectors(sv, x, e);
+            for (int64_t i = 0; i < n; i++) w->all[3 * i + c] = x[i], w->all_se[3 * i + c] = e[i];
         }
         ulam_solver_free(sv);
         ulam_csr_free(M);
     }
     cli_release_sigint();
-    free(b), free(x);
+    free(b), free(x), free(e);
+    w->zero = a->o.rel_err > 0;
+    for (int c = 0; c < 3; c++) w->zero &= w->B[c] == 0 && w->se[c] == 0;
     if (!status) return 0;
     err.status = status;
     return cli_report(a->scene, &err);
@@ -218,6 +276,91 @@ static void json_triple(const char *key, const double *v)
     }
 }
 
+/* Every patch's values for --out and --all (NULL arrays: not known): the answer (the walks' if
+ * they covered every patch, else the direct one) with its standard error, and the direct
+ * answer beside walks. */
+typedef struct {
+    const double *B, *se, *Bd, *sed;
+} patch_values;
+
+enum { ROW_TEXT, ROW_CSV, ROW_JSON };
+
+/* The header of the patch rows (text and CSV); v NULL: geometry only (--list). */
+static void row_header(FILE *f, int fmt, const patch_values *v)
+{
+    static const char *const geo[] = {"x", "y", "z", "area"}, *const val[] = {"R", "G", "B", "R_se", "G_se", "B_se"};
+    fprintf(f, fmt == ROW_CSV ? "patch,label,face" : "%6s %-16s %6s", "patch", "label", "face");
+    for (int k = 0; k < 4; k++) fprintf(f, fmt == ROW_CSV ? ",%s" : " %12s", geo[k]);
+    for (int k = 0; v && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",%s" : " %12s", val[k]);
+    for (int k = 0; v && v->Bd && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",direct_%s" : " direct_%-5s", val[k]);
+    fputc('\n', f);
+}
+
+/* One patch's row: number, label, face, centroid, area, then (v) the values; an unknown value
+ * is an empty CSV field, '-' in the table, null in JSON (which goes to stdout). */
+static void row(FILE *f, int fmt, const ulam_scene *s, int64_t p, const patch_values *v)
+{
+    static const char *const keys[] = {"x", "y", "z", "area", "R", "G", "B", "R_se", "G_se", "B_se",
+                                       "direct_R", "direct_G", "direct_B", "direct_R_se", "direct_G_se", "direct_B_se"};
+    double x[16];
+    int n = 4;
+    ulam_scene_centroid(s, p, x);
+    x[3] = s->area[p];
+    const double *cols[4] = {v ? v->B : NULL, v ? v->se : NULL, v ? v->Bd : NULL, v ? v->sed : NULL};
+    for (int k = 0; v && k < (v->Bd ? 4 : 2); k++)
+        for (int c = 0; c < 3; c++) x[n++] = cols[k] ? cols[k][3 * p + c] : NAN;
+    int32_t g = s->group[p];
+    const char *label = g >= 0 ? s->groups[g] : "";
+    if (fmt == ROW_JSON) {
+        printf("{\"patch\": %lld, ", (long long)p + 1);
+        cli_json_string("label", label, 0);
+        printf("\"face\": %lld, ", (long long)s->face[p] + 1);
+        for (int k = 0; k < n; k++) cli_json_number(keys[k], x[k], k == n - 1);
+        printf("}");
+        return;
+    }
+    if (fmt == ROW_CSV) {
+        fprintf(f, "%lld,\"", (long long)p + 1); /* the label quoted, quotes doubled (RFC 4180) */
+        for (const char *c = label; *c; c++) fputs(*c == '"' ? "\"\"" : (char[2]){*c, 0}, f);
+        fprintf(f, "\",%lld", (long long)s->face[p] + 1);
+    } else {
+        fprintf(f, "%6lld %-16s %6lld", (long long)p + 1, *label ? label : "-", (long long)s->face[p] + 1);
+    }
+    for (int k = 0; k < n; k++) {
+        if (fmt == ROW_CSV) fputc(',', f);
+        if (isfinite(x[k])) fprintf(f, fmt == ROW_CSV ? "%.17g" : " %12.6g", x[k]);
+        else if (fmt == ROW_TEXT) fprintf(f, " %12s", "-");
+    }
+    fputc('\n', f);
+}
+
+/* --list: the patches after subdivision, as a table or a JSON array. */
+static void print_list(const args *a, const ulam_scene *s)
+{
+    if (a->json) printf("{\"scene\": \"%s\", \"patches\": [", a->scene);
+    else row_header(stdout, ROW_TEXT, NULL);
+    for (int64_t p = 0; p < s->npatches; p++) {
+        if (a->json && p) printf(", ");
+        row(stdout, a->json ? ROW_JSON : ROW_TEXT, s, p, NULL);
+    }
+    if (a->json) printf("]}\n");
+}
+
+/* --out: every patch as CSV, atomically; 0 or an exit code. */
+static int write_csv(const char *path, const ulam_scene *s, const patch_values *v)
+{
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (!status) {
+        row_header(o.f, ROW_CSV, v);
+        for (int64_t p = 0; p < s->npatches; p++) row(o.f, ROW_CSV, s, p, v);
+        status = ulam_outfile_commit(&o);
+    }
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable output file"};
+    return cli_report(path, &err);
+}
+
 /* What the run found, as text or JSON. */
 typedef struct {
     const ulam_scene *s;
@@ -225,15 +368,21 @@ typedef struct {
     const ulam_csr *F;
     ulam_ff_report ff;
     double ff_seconds, direct_seconds, exposure;
+    int image_written, out_written;
+    patch_values pv;
     const double *Bdirect;
-    double direct_se[3]; /* at the patch, from the noise of F (ray walks with --check) */
+    double direct_se[3]; /* at the patch, from the noise of F (--check, --matrix-walk) */
+    int ff_se_known;     /* direct_se was computed (--matrix-walk: unless --max-mem refused it) */
+    double *direct_se_all; /* every patch's (--out, --all), NULL when not computed */
+    const double *w_all_se_conditional; /* matrix forward walks whose se lack F's noise, or NULL */
     const walked *w;
 } report;
 
-/* (walk - direct) / the combined standard error at the patch, channel c. */
-static double zscore(const report *r, int c)
+/* (walk - direct) / the standard error of the difference at the patch, channel c: matrix walks
+ * share F with the direct solve (walk noise alone), ray walks sample the exact F (both). */
+static double zscore(const args *a, const report *r, int c)
 {
-    double d = r->Bdirect[3 * r->patch + c], sw = r->w->se[c], sf = r->direct_se[c];
+    double d = r->Bdirect[3 * r->patch + c], sw = r->w->se_walk[c], sf = a->matrix_walk ? 0.0 : r->direct_se[c];
     return (r->w->B[c] - d) / sqrt(sw * sw + sf * sf);
 }
 
@@ -248,50 +397,83 @@ static void print_text(const args *a, const report *r)
     if (r->Bdirect) printf("direct       LAPACKE_dgesv, 3 channels, %.3f s\n", r->direct_seconds);
     if (r->patch >= 0) {
         int32_t g = r->s->group[r->patch];
-        printf("patch        %lld (%s, face %lld, area %.6g)\n", (long long)r->patch + 1,
-               g >= 0 ? r->s->groups[g] : "unlabelled", (long long)r->s->face[r->patch] + 1, r->s->area[r->patch]);
+        double c[3];
+        ulam_scene_centroid(r->s, r->patch, c);
+        printf("patch        %lld (%s, face %lld, area %.6g, centroid %.6g %.6g %.6g)\n", (long long)r->patch + 1,
+               g >= 0 ? r->s->groups[g] : "unlabelled", (long long)r->s->face[r->patch] + 1, r->s->area[r->patch],
+               c[0], c[1], c[2]);
     }
     const walked *w = r->w;
     if (w && r->patch >= 0) {
-        for (int c = 0; c < 3; c++)
-            printf("radiosity %c  %.8g +- %.3g%s\n", chan[c], w->B[c], w->se[c], w->interrupted ? "  [INTERRUPTED]" : "");
+        for (int c = 0; c < 3; c++) {
+            printf("radiosity %c  %.8g +- %.3g", chan[c], w->B[c], w->se[c]);
+            if (a->matrix_walk && r->ff_se_known) printf(" (walk %.3g, form factors %.3g)", w->se_walk[c], r->direct_se[c]);
+            else if (a->matrix_walk) printf(" (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
+            printf("%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
+        }
+        if (w->zero)
+            printf("note         every channel is exactly 0 with zero variance after %lld walks (no walk scored):\n"
+                   "             --rel-err can never be met by a zero estimate, so the walks stopped there; if the\n"
+                   "             answer is not exactly 0, a walk scores with probability below 3/%lld = %.2g (95%%)\n",
+                   (long long)w->walks, (long long)w->walks, 3.0 / (double)w->walks);
     }
     if (w)
-        printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)\n", (long long)w->walks,
+        printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)%s\n", (long long)w->walks,
                a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
-               a->matrix_walk ? "steps" : "rays", w->threads);
+               a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
+    if (w && w->cut)
+        printf("warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
+               "             beyond the cut is lost) and the error bar does not cover the bias\n",
+               (long long)w->cut, (long long)w->walks, (long long)a->o.max_steps);
     if (r->Bdirect && r->patch >= 0)
         for (int c = 0; c < 3; c++) {
             printf("direct %c     %.8g", chan[c], r->Bdirect[3 * r->patch + c]);
-            if (!a->matrix_walk) printf(" +- %.3g (form-factor noise)", r->direct_se[c]);
-            if (w) printf("  z = %.3f", zscore(r, c));
+            if (r->ff_se_known) printf(" +- %.3g (form-factor noise)", r->direct_se[c]);
+            if (w) printf("  z = %.3f%s", zscore(a, r, c), a->matrix_walk ? " (walk noise: the same F)" : "");
             printf("\n");
         }
-    if (a->image) printf("image        %s (exposure %.4g)\n", a->image, r->exposure);
+    if (a->out && r->out_written)
+        printf("patches      %lld rows written to %s%s\n", (long long)r->s->npatches, a->out,
+               r->pv.se == r->w_all_se_conditional ? " (standard errors: walk noise only, CONDITIONAL on the sampled F)" : "");
+    else if (a->out && w && w->interrupted) printf("patches      not written: the run was interrupted\n");
+    if (a->all) {
+        row_header(stdout, ROW_TEXT, &r->pv);
+        for (int64_t p = 0; p < r->s->npatches; p++) row(stdout, ROW_TEXT, r->s, p, &r->pv);
+    }
+    if (a->image && r->image_written) printf("image        %s (exposure %.4g)\n", a->image, r->exposure);
+    else if (a->image && w && w->interrupted) printf("image        not written: the run was interrupted\n");
 }
 
 /* Print the JSON object. */
 static void print_json(const args *a, const report *r)
 {
-    printf("{\"scene\": \"%s\", \"patches\": %lld, ", a->scene, (long long)r->s->npatches);
+    printf("{\"scene\": \"%s\", \"npatches\": %lld, ", a->scene, (long long)r->s->npatches);
     if (r->patch >= 0) {
         int32_t g = r->s->group[r->patch];
+        double c[3];
+        ulam_scene_centroid(r->s, r->patch, c);
         printf("\"patch\": %lld, ", (long long)r->patch + 1);
         cli_json_string("label", g >= 0 ? r->s->groups[g] : "", 0);
+        json_triple("centroid", c);
     }
     const walked *w = r->w;
     if (w) {
         if (r->patch >= 0) {
             json_triple("radiosity", w->B);
             json_triple("stderr", w->se);
+            if (a->matrix_walk) {
+                json_triple("walk_stderr", w->se_walk);
+                if (r->ff_se_known) json_triple("ff_stderr", r->direct_se);
+            }
         }
         cli_json_string("mode", mode_names[a->o.mode], 0);
         cli_json_string("estimator", est_names[a->o.estimator], 0);
-        printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, ", a->matrix_walk ? "true" : "false",
-               (long long)w->walks, a->matrix_walk ? "steps" : "rays", (long long)w->steps);
+        printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, \"cut\": %lld, \"max_steps\": %lld, ",
+               a->matrix_walk ? "true" : "false", (long long)w->walks, a->matrix_walk ? "steps" : "rays",
+               (long long)w->steps, (long long)w->cut, (long long)a->o.max_steps);
         cli_json_number("seconds", w->seconds, 0);
-        printf("\"interrupted\": %s, ", w->interrupted ? "true" : "false");
+        printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
     }
     if (r->F) {
         printf("\"ff_rays\": %lld, ", (long long)a->ff_rays);
@@ -302,26 +484,67 @@ static void print_json(const args *a, const report *r)
     }
     if (r->Bdirect && r->patch >= 0) {
         double z[3];
-        for (int c = 0; c < 3; c++) z[c] = w ? zscore(r, c) : NAN;
+        for (int c = 0; c < 3; c++) z[c] = w ? zscore(a, r, c) : NAN;
         json_triple("direct", r->Bdirect + 3 * r->patch);
-        json_triple("direct_stderr", r->direct_se);
+        if (r->ff_se_known) json_triple("direct_stderr", r->direct_se);
         if (w) json_triple("z", z);
         cli_json_number("direct_seconds", r->direct_seconds, 0);
+    }
+    if (a->image) {
+        if (r->image_written) cli_json_string("image", a->image, 0), cli_json_number("exposure", r->exposure, 0);
+        else printf("\"image\": null, ");
+    }
+    if (a->out) {
+        if (r->out_written) cli_json_string("out", a->out, 0);
+        else printf("\"out\": null, ");
+    }
+    if (a->all) {
+        printf("\"stderr_conditional_on_F\": %s, \"patches\": [", r->pv.se == r->w_all_se_conditional ? "true" : "false");
+        for (int64_t p = 0; p < r->s->npatches; p++) {
+            if (p) printf(", ");
+            row(stdout, ROW_JSON, r->s, p, &r->pv);
+        }
+        printf("], ");
     }
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
 }
 
-/* Render B into a->image; 0 or an exit code. */
-static int write_image(const args *a, const ulam_tracer *t, const double *B, double *used)
+/* Render B into a->image, warning when the picture cannot show the light; 0 or an exit code. */
+static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s, const double *B, double *used)
 {
     unsigned char *rgb = malloc((size_t)a->width * (size_t)a->height * 3);
-    ulam_camera cam = ulam_camera_cornell();
-    int status = rgb ? ulam_render(t, B, &cam, a->width, a->height, a->exposure, rgb, used) : ULAM_ENOMEM;
+    ulam_camera cam = a->camera_given ? a->cam : ulam_camera_frame(s, a->width, a->height);
+    ulam_render_info info;
+    int status = rgb ? ulam_render(t, B, &cam, a->width, a->height, a->exposure, rgb, &info) : ULAM_ENOMEM;
     if (!status) status = ulam_png_write(a->image, a->width, a->height, rgb);
     free(rgb);
+    if (status) {
+        ulam_error err = {.status = status, .msg = "a writable PNG file"};
+        return cli_report(a->image, &err);
+    }
+    *used = info.exposure;
+    if (!info.pixels_hit)
+        fprintf(stderr, "ulam radiosity: warning: %s: the camera sees no patch's front (try --camera)\n", a->image);
+    else if (!info.pixels_emitter)
+        fprintf(stderr, "ulam radiosity: warning: %s: no emitter is in view of the camera\n", a->image);
+    if (info.pixels_hit && !info.exposure_set)
+        fprintf(stderr, "ulam radiosity: warning: %s: nothing lit is in view, so the exposure cannot be set "
+                        "(1 used; give --exposure or --camera)\n", a->image);
+    return 0;
+}
+
+/* Check before any work that path can be written (a temporary file can be made beside it and
+ * it is not a directory); 0 or an exit code. */
+static int check_output(const char *path)
+{
+    struct stat st;
+    ulam_outfile o;
+    int status = stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? ULAM_EIO : ulam_outfile_open(&o, path);
+    if (!status) ulam_outfile_abort(&o);
     if (!status) return 0;
-    ulam_error err = {.status = status, .msg = "a writable PNG file"};
-    return cli_report(a->image, &err);
+    ulam_error err = {.status = status, .msg = "a writable output file (in an existing, writable directory; not a "
+                                               "directory)"};
+    return cli_report(path, &err);
 }
 
 /* The scene, subdivided if asked; 0 or an exit code. */
@@ -355,7 +578,10 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
     r->ff_seconds = ulam_now() - t0;
     ulam_form_factor_report(s, *F, &r->ff);
     r->F = *F;
-    if (!a->direct && !a->check) return 0;
+    int need = a->direct || a->check, every = a->out || a->all;
+    int for_error = a->matrix_walk && (r->patch >= 0 || (every && a->o.mode == ULAM_FORWARD));
+    if (!need && !for_error) return 0;
+    if (!need && ulam_direct_bytes(s->npatches) > a->max_mem) return 0; /* the error bar is then labelled */
     if (!(*Bd = malloc((size_t)s->npatches * 3 * sizeof **Bd))) {
         err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the solution"};
         return cli_report(a->scene, &err);
@@ -363,11 +589,44 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
     ulam_direct_info info;
     if (ulam_radiosity_direct(s, *F, a->max_mem, *Bd, &info, &err)) return cli_report(a->scene, &err);
     r->direct_seconds = info.seconds;
-    r->Bdirect = *Bd;
-    if (r->patch >= 0 && !a->matrix_walk &&
-        ulam_radiosity_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
-        return cli_report(a->scene, &err);
+    if (need) r->Bdirect = *Bd;
+    if (r->patch >= 0) {
+        if (ulam_radiosity_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
+            return cli_report(a->scene, &err);
+        r->ff_se_known = 1;
+    }
+    if (every && (a->direct || a->matrix_walk || a->check)) { /* every patch's error from F's noise */
+        if (!(r->direct_se_all = malloc((size_t)s->npatches * 3 * sizeof *r->direct_se_all))) {
+            err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the standard errors"};
+            return cli_report(a->scene, &err);
+        }
+        int st = ulam_radiosity_direct_errors(s, *F, a->ff_rays, *Bd, a->max_mem, r->direct_se_all, &err);
+        if (st == ULAM_EMEMLIMIT) free(r->direct_se_all), r->direct_se_all = NULL; /* the rows say unknown */
+        else if (st) return cli_report(a->scene, &err);
+    }
     return 0;
+}
+
+/* --matrix-walk: the error bar of the answer adds the noise of F (the walks are conditional
+ * on the sampled F; the answer's error against the true B is both). */
+static void combine_errors(report *r, walked *w)
+{
+    for (int c = 0; c < 3 && r->ff_se_known; c++)
+        w->se[c] = sqrt(w->se_walk[c] * w->se_walk[c] + r->direct_se[c] * r->direct_se[c]);
+    if (!w->all_se) return;
+    if (!r->direct_se_all) {
+        r->w_all_se_conditional = w->all_se;
+        return;
+    }
+    for (int64_t k = 0; k < 3 * r->s->npatches; k++)
+        w->all_se[k] = sqrt(w->all_se[k] * w->all_se[k] + r->direct_se_all[k] * r->direct_se_all[k]);
+}
+
+/* The values of every patch for --out and --all. */
+static patch_values every_patch(const args *a, const report *r, const walked *w, const double *Bd)
+{
+    if (w->all) return (patch_values){w->all, w->all_se, (a->direct || a->check) ? Bd : NULL, r->direct_se_all};
+    return (patch_values){Bd, r->direct_se_all, NULL, NULL};
 }
 
 /* ulam radiosity. */
@@ -385,26 +644,47 @@ int cli_radiosity(int argc, char **argv)
     walked w = {0};
     report r = {.patch = -1, .w = NULL};
     ulam_error err;
+    if (a.image && (rc = check_output(a.image))) return rc;
+    if (a.out && (rc = check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
     r.s = s;
+    if (a.list) {
+        print_list(&a, s);
+        goto done;
+    }
     if (a.patch && (rc = find_patch(s, a.patch, &r.patch))) goto done;
     a.o.index = r.patch >= 0 ? r.patch : 0;
     if (ulam_tracer_alloc(s, &t, &err)) {
         rc = cli_report(a.scene, &err);
         goto done;
     }
+    int64_t coarse;
+    double res = ulam_tracer_resolution(t, &coarse);
+    if (res > 1e-3 && cli_rank == 0)
+        fprintf(stderr, "ulam radiosity: warning: %s: patch %lld is only %.0f float steps across where it lies: ray "
+                        "casting resolves it to %.2g of its size (move the scene's parts closer together)\n",
+                a.scene, (long long)coarse + 1, 1.0 / res, res);
     if ((a.direct || a.check || a.matrix_walk) && (rc = form_and_solve(&a, t, s, &r, &F, &Bd))) goto done;
     if (a.patch || a.o.mode == ULAM_FORWARD) {
         rc = a.matrix_walk ? matrix_walks(&a, s, F, &w) : ray_walks(&a, t, s->npatches, &w);
         if (rc) goto done;
+        if (a.matrix_walk) combine_errors(&r, &w);
         r.w = &w;
     }
-    if (a.image && !w.interrupted && cli_rank == 0 && (rc = write_image(&a, t, w.all ? w.all : Bd, &r.exposure))) goto done;
+    r.pv = every_patch(&a, &r, &w, Bd);
+    if (a.out && !w.interrupted && cli_rank == 0) {
+        if ((rc = write_csv(a.out, s, &r.pv))) goto done;
+        r.out_written = 1;
+    }
+    if (a.image && !w.interrupted && cli_rank == 0) {
+        if ((rc = write_image(&a, t, s, w.all ? w.all : Bd, &r.exposure))) goto done;
+        r.image_written = 1;
+    }
     if (a.json) print_json(&a, &r);
     else print_text(&a, &r);
     if (w.interrupted) rc = EXIT_INTERRUPTED;
 done:
-    free(w.all), free(Bd);
+    free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all);
     ulam_csr_free(F);
     ulam_tracer_free(t);
     ulam_scene_free(s);

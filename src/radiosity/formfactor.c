@@ -2,6 +2,7 @@
  * formulas; the radiosity system M = diag(rho_c) F and its LAPACK solve. */
 #include "rad.h"
 
+#include <lapacke.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -188,6 +189,20 @@ int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_byt
     return status;
 }
 
+/* rho_kc^2 v_k / rays: the variance that row k's multinomial noise puts on (M B)_k, channel c,
+ * with v_k = sum_j F_kj B_j^2 - (sum_j F_kj B_j)^2. */
+static double row_noise(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B, int64_t k, int c)
+{
+    double m1 = 0.0, m2 = 0.0;
+    for (int64_t q = F->rowptr[k]; q < F->rowptr[k + 1]; q++) {
+        double x = B[3 * F->colidx[q] + c];
+        m1 += F->val[q] * x;
+        m2 += F->val[q] * x * x;
+    }
+    double r = s->rho[3 * k + c];
+    return r * r * fmax(0.0, m2 - m1 * m1) / (double)rays;
+}
+
 /* Standard error of the direct B at patch p from the noise of F. */
 int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                                 int64_t p, size_t max_bytes, double se[3], ulam_error *err)
@@ -206,21 +221,55 @@ int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t 
             ulam__fail(err, status, 0, -1, "memory for the transposed system");
         } else if (!(status = ulam_direct_solve(Mt, e, g, max_bytes, NULL, err))) {
             double var = 0.0; /* g = row p of (I - M)^-1 */
-            for (int64_t k = 0; k < n; k++) {
-                double m1 = 0.0, m2 = 0.0;
-                for (int64_t q = F->rowptr[k]; q < F->rowptr[k + 1]; q++) {
-                    double x = B[3 * F->colidx[q] + c];
-                    m1 += F->val[q] * x;
-                    m2 += F->val[q] * x * x;
-                }
-                double w = g[k] * s->rho[3 * k + c];
-                var += w * w * fmax(0.0, m2 - m1 * m1) / (double)rays;
-            }
+            for (int64_t k = 0; k < n; k++) var += g[k] * g[k] * row_noise(s, F, rays, B, k, c);
             se[c] = sqrt(var);
         }
         ulam_csr_free(M);
         ulam_csr_free(Mt);
     }
     free(e), free(g);
+    return status;
+}
+
+/* Standard errors of the direct B at every patch from the noise of F: G = (I - M)^-1 whole
+ * (LAPACKE_dgesv of (I - M)' with the identity: X = G'), se_p^2 = sum_k G_pk^2 noise_k. */
+int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                                 size_t max_bytes, double *se, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s || !F || !B || !se || rays < 1 || F->nrows != s->npatches || F->ncols != s->npatches)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a scene, its F, B, rays >= 1 and an output");
+    int64_t n = s->npatches;
+    size_t bytes = ulam_direct_bytes(n);
+    if (bytes == 0 || n > (int64_t)INT32_MAX || bytes > SIZE_MAX / 2)
+        return ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "two dense matrices whose size fits in memory");
+    if (max_bytes && 2 * bytes > max_bytes)
+        return ulam__fail(err, ULAM_EMEMLIMIT, 0, -1, "at most %.3g GiB for two dense matrices; n = %lld needs %.3g GiB",
+                          (double)max_bytes / 1073741824.0, (long long)n, 2.0 * (double)bytes / 1073741824.0);
+    double *a = ulam__malloc((size_t)n * (size_t)n, sizeof *a), *x = ulam__malloc((size_t)n * (size_t)n, sizeof *x);
+    double *noise = ulam__malloc((size_t)n, sizeof *noise);
+    lapack_int *ipiv = ulam__malloc((size_t)n, sizeof *ipiv);
+    int status = a && x && noise && ipiv ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "two dense %lld x %lld matrices", (long long)n, (long long)n);
+    for (int c = 0; c < 3 && !status; c++) {
+        memset(a, 0, (size_t)n * (size_t)n * sizeof *a);
+        memset(x, 0, (size_t)n * (size_t)n * sizeof *x);
+        for (int64_t k = 0; k < n; k++) { /* column k of (I - M)' is row k of I - M, column-major */
+            a[k + k * n] = 1.0, x[k + k * n] = 1.0;
+            for (int64_t q = F->rowptr[k]; q < F->rowptr[k + 1]; q++) a[F->colidx[q] + k * n] -= s->rho[3 * k + c] * F->val[q];
+            noise[k] = row_noise(s, F, rays, B, k, c);
+        }
+        lapack_int info = LAPACKE_dgesv(LAPACK_COL_MAJOR, (lapack_int)n, (lapack_int)n, a, (lapack_int)n, ipiv, x,
+                                        (lapack_int)n);
+        if (info) {
+            status = ulam__fail(err, info > 0 ? ULAM_ESINGULAR : ULAM_EINVAL, 0, -1, "a nonsingular I - M");
+            break;
+        }
+        for (int64_t p = 0; p < n; p++) { /* X = G': column p of X is row p of G */
+            double var = 0.0;
+            for (int64_t k = 0; k < n; k++) var += x[k + p * n] * x[k + p * n] * noise[k];
+            se[3 * p + c] = sqrt(var);
+        }
+    }
+    free(a), free(x), free(noise), free(ipiv);
     return status;
 }

@@ -37,7 +37,7 @@ static int normalise(double v[3])
     return 1;
 }
 
-/* The patch each pixel centre sees (-1: nothing). */
+/* The patch each pixel centre sees (-1: nothing); back sides are seen through. */
 static void cast_pixels(const ulam_tracer *t, const ulam_camera *cam, int w, int h, int64_t *hit)
 {
     double f[3] = {cam->dir[0], cam->dir[1], cam->dir[2]}, up[3] = {cam->up[0], cam->up[1], cam->up[2]}, right[3];
@@ -52,16 +52,34 @@ static void cast_pixels(const ulam_tracer *t, const ulam_camera *cam, int w, int
             double sx = ((double)x + 0.5 - 0.5 * w) * pitch, sy = (0.5 * h - (double)y - 0.5) * pitch, d[3];
             for (int k = 0; k < 3; k++) d[k] = cam->focal * f[k] + sx * right[k] + sy * up[k];
             normalise(d);
-            int front = 0;
-            int64_t p = ulam_tracer_cast(t, cam->eye, d, &front);
-            hit[(size_t)y * (size_t)w + (size_t)x] = front ? p : -1;
+            hit[(size_t)y * (size_t)w + (size_t)x] = ulam__tracer_cast_front(t, cam->eye, d);
         }
+}
+
+/* A camera that frames the scene's bounding box: looking along +z at its centre from the -z
+ * side, up +y, with the Cornell lens (35 mm, 25 mm film), just far enough (3% margin) that the
+ * box's near face fills the wider of the two directions of a width x height picture; the
+ * deeper parts of the box then appear smaller and are in view too. */
+ulam_camera ulam_camera_frame(const ulam_scene *s, int width, int height)
+{
+    ulam_camera cam = ulam_camera_cornell();
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int64_t v = 0; s && v < s->nverts; v++)
+        for (int d = 0; d < 3; d++) lo[d] = fmin(lo[d], s->vert[3 * v + d]), hi[d] = fmax(hi[d], s->vert[3 * v + d]);
+    if (!s || !s->nverts || width < 1 || height < 1) return cam;
+    double tx = 0.5 * cam.film / cam.focal, ty = tx * (double)height / (double)width, e[3];
+    ulam__sub3(hi, lo, e);
+    double d = 1.03 * fmax(0.5 * e[0] / tx, 0.5 * e[1] / ty);
+    d = fmax(d, 1e-3 * sqrt(ulam__dot3(e, e)) + 1e-300); /* a scene flat in x and y */
+    cam.eye[0] = 0.5 * (lo[0] + hi[0]), cam.eye[1] = 0.5 * (lo[1] + hi[1]), cam.eye[2] = lo[2] - d;
+    return cam;
 }
 
 /* Render B as 8-bit sRGB. */
 int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width, int height,
-                double exposure, unsigned char *rgb, double *used)
+                double exposure, unsigned char *rgb, ulam_render_info *info)
 {
+    if (info) *info = (ulam_render_info){0};
     if (!t || !B || !cam || !rgb || width < 1 || height < 1 || !(cam->focal > 0) || !(cam->film > 0))
         return ULAM_EINVAL;
     const ulam_scene *s = ulam__tracer_scene(t);
@@ -76,17 +94,24 @@ int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, i
         return ULAM_ENOMEM;
     }
     cast_pixels(t, cam, width, height, hit);
-    if (!(exposure > 0)) { /* 1 / the 99th percentile over pixels of patches that do not emit */
+    ulam_render_info in = {.exposure = exposure, .exposure_set = exposure > 0};
+    for (int all = 0; all < 2 && !(in.exposure > 0); all++) { /* 1 / the 99th percentile over pixels
+                                                                * of patches that do not emit, else all */
         size_t m = 0;
         for (size_t k = 0; k < np; k++)
-            if (hit[k] >= 0 && ulam__max3(s->emit + 3 * hit[k]) == 0) lum[m++] = ulam__max3(B + 3 * hit[k]);
+            if (hit[k] >= 0 && (all || ulam__max3(s->emit + 3 * hit[k]) == 0)) lum[m++] = ulam__max3(B + 3 * hit[k]);
         qsort(lum, m, sizeof *lum, cmp_double);
         double top = m ? lum[(size_t)(0.99 * (double)(m - 1))] : 0.0;
-        exposure = top > 0 && isfinite(top) ? 1.0 / top : 1.0;
+        if (top > 0 && isfinite(top)) in.exposure = 1.0 / top, in.exposure_set = 1;
+    }
+    if (!(in.exposure > 0)) in.exposure = 1.0;
+    for (size_t k = 0; k < np; k++) {
+        in.pixels_hit += hit[k] >= 0;
+        in.pixels_emitter += hit[k] >= 0 && ulam__max3(s->emit + 3 * hit[k]) > 0;
     }
     for (size_t k = 0; k < np; k++)
-        for (int c = 0; c < 3; c++) rgb[3 * k + c] = hit[k] >= 0 ? srgb_byte(exposure * B[3 * hit[k] + c]) : 0;
-    if (used) *used = exposure;
+        for (int c = 0; c < 3; c++) rgb[3 * k + c] = hit[k] >= 0 ? srgb_byte(in.exposure * B[3 * hit[k] + c]) : 0;
+    if (info) *info = in;
     free(hit), free(lum);
     return ULAM_OK;
 }

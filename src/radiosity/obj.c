@@ -8,7 +8,8 @@
 
 /* A material: its name and the two colours ulam uses. */
 typedef struct {
-    char *name;
+    char *name, *file; /* file and line of its newmtl */
+    long line;
     double kd[3], ke[3];
 } mtl;
 
@@ -47,7 +48,7 @@ static char *dup_str(const char *s)
 /* Free everything the reader holds. */
 static void objr_free(objr *o)
 {
-    for (int64_t i = 0; i < o->nmats; i++) free(o->mats[i].name);
+    for (int64_t i = 0; i < o->nmats; i++) free(o->mats[i].name), free(o->mats[i].file);
     for (int64_t i = 0; i < o->ngroups; i++) free(o->groups[i]);
     free(o->v), free(o->idx), free(o->faces);
     free(o->mats), free(o->groups), free(o->dir);
@@ -129,8 +130,16 @@ static int mtl_colour(objr *o, const char *path, long line, char *args, int is_k
     const char *what = is_kd ? "Kd r g b: a reflectance in [0, 1) per channel"
                              : "Ke r g b: a finite emission >= 0 per channel";
     char *a = rest_of(args);
-    if (!strncmp(a, "spectral", 8) || !strncmp(a, "xyz", 3))
-        return mtl_fail(o, path, ULAM_EUNSUPPORTED, line, "%s (RGB only)", what);
+    if (!strncmp(a, "spectral", 8))
+        return mtl_fail(o, path, ULAM_EUNSUPPORTED, line,
+                        is_kd ? "Kd r g b (RGB only): this file gives a spectral curve, 'Kd spectral %.100s'"
+                              : "Ke r g b (RGB only): this file gives a spectral curve, 'Ke spectral %.100s'",
+                        rest_of(a + 8));
+    if (!strncmp(a, "xyz", 3))
+        return mtl_fail(o, path, ULAM_EUNSUPPORTED, line,
+                        is_kd ? "Kd r g b (RGB only): this file gives CIE XYZ, 'Kd xyz %.100s'"
+                              : "Ke r g b (RGB only): this file gives CIE XYZ, 'Ke xyz %.100s'",
+                        rest_of(a + 3));
     int k = parse_numbers(a, c, 3);
     if (k == -2) return mtl_fail(o, path, ULAM_ENONFINITE, line, "%s", what);
     if (k != 1 && k != 3) return mtl_fail(o, path, ULAM_ESYNTAX, line, "%s (1 or 3 numbers)", what);
@@ -171,17 +180,24 @@ static int read_mtl(objr *o, const char *name, long obj_line)
                 break;
             }
             int64_t i = find_mat(o, nm);
-            if (i < 0) {
-                if (ulam__grow(&o->mats, &o->cap_mats, o->nmats + 1, sizeof(mtl)) ||
-                    !(o->mats[o->nmats].name = dup_str(nm))) {
-                    status = mtl_fail(o, path, ULAM_ENOMEM, line, "%s", "memory for a material");
-                    break;
-                }
-                i = o->nmats++;
+            if (i >= 0) { /* a second definition would silently reset the first (a lamp loses its Ke) */
+                char what[600];
+                snprintf(what, sizeof what, "a new material name in newmtl: '%.100s' is already defined at %.200s:%ld",
+                         nm, o->mats[i].file, o->mats[i].line);
+                status = mtl_fail(o, path, ULAM_ESYNTAX, line, "%s", what);
+                break;
             }
-            cur = &o->mats[i];
-            memset(cur->kd, 0, sizeof cur->kd);
-            memset(cur->ke, 0, sizeof cur->ke);
+            if (ulam__grow(&o->mats, &o->cap_mats, o->nmats + 1, sizeof(mtl))) {
+                status = mtl_fail(o, path, ULAM_ENOMEM, line, "%s", "memory for a material");
+                break;
+            }
+            cur = &o->mats[o->nmats];
+            *cur = (mtl){.name = dup_str(nm), .file = dup_str(path), .line = line};
+            o->nmats++;
+            if (!cur->name || !cur->file) {
+                status = mtl_fail(o, path, ULAM_ENOMEM, line, "%s", "memory for a material");
+                break;
+            }
         } else if (!strcmp(s, "Kd") || !strcmp(s, "Ke")) {
             if (!cur) {
                 status = mtl_fail(o, path, ULAM_ESYNTAX, line, "%s", "newmtl before the first colour");
@@ -345,14 +361,28 @@ static int do_face(objr *o, char *args, long line)
 }
 
 /* OBJ statements ulam reads past: texture and normal data, smoothing, lines, points and
- * display attributes. */
+ * display attributes.  The one list: the unknown-statement message is made from it. */
+static const char *const skip[] = {"vt", "vn", "vp", "s", "l", "p", "mg", "lod", "usemap", "maplib",
+                                   "shadow_obj", "trace_obj", "bevel", "c_interp", "d_interp"};
+enum { NSKIP = sizeof skip / sizeof *skip };
+
+/* Nonzero when kw is a statement ulam reads past. */
 static int ignored(const char *kw)
 {
-    static const char *const skip[] = {"vt", "vn", "vp", "s", "l", "p", "mg", "lod", "usemap", "maplib",
-                                       "shadow_obj", "trace_obj", "bevel", "c_interp", "d_interp"};
-    for (size_t i = 0; i < sizeof skip / sizeof *skip; i++)
+    for (size_t i = 0; i < NSKIP; i++)
         if (!strcmp(kw, skip[i])) return 1;
     return 0;
+}
+
+/* The error for an OBJ statement ulam neither reads nor ignores. */
+static int unknown_statement(objr *o, const char *kw, long line)
+{
+    char list[256] = "";
+    size_t n = 0;
+    for (size_t i = 0; i < NSKIP && n < sizeof list; i++)
+        n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", i ? ", " : "", skip[i]);
+    return ulam__fail(o->err, ULAM_ESYNTAX, line, -1,
+                      "an OBJ statement ulam reads (v, f, o, g, usemtl, mtllib; %s ignored), not '%.40s'", list, kw);
 }
 
 /* Read the statements of an open OBJ file. */
@@ -376,10 +406,7 @@ static int read_statements(objr *o, FILE *f)
         else if (!strcmp(s, "o") || !strcmp(s, "g")) status = do_group(o, args, line);
         else if (!strcmp(s, "usemtl")) status = do_usemtl(o, args, line);
         else if (!strcmp(s, "mtllib")) status = do_mtllib(o, args, line);
-        else if (!ignored(s))
-            status = ulam__fail(o->err, ULAM_ESYNTAX, line, -1,
-                                "an OBJ statement ulam reads (v, f, o, g, usemtl, mtllib; vt, vn, s, l ignored), "
-                                "not '%.40s'", s);
+        else if (!ignored(s)) status = unknown_statement(o, s, line);
     }
     if (!status && ferror(f)) status = ulam__fail(o->err, ULAM_EIO, line, -1, "a readable file");
     if (!status && o->nf == 0) status = ulam__fail(o->err, ULAM_EEMPTY, line, -1, "at least one face");

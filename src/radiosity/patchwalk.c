@@ -7,10 +7,13 @@
  * a ray that leaves the scene or hits a back side ends it.  Collision scores W E_p at every
  * patch; absorption scores W E_p / (1 - q_p) where the walk stops by its coin.
  *
- * Shooting (forward) estimates every patch's power P = A B from P = A E + diag(rho) F' P (by
- * reciprocity): a particle leaves an emitter chosen in proportion to its power with weight
- * Phi E_c / sum_c E_c, continues with q_p, and its weights take rho_jc / q_p at the patch j
- * it reaches.  Tallies per patch, then B_j = P_j / A_j.
+ * Shooting (forward) estimates every patch's reflected power R = P - A E from P = A E +
+ * diag(rho) F' P (by reciprocity): a particle leaves an emitter chosen in proportion to its
+ * power with weight Phi E_c / sum_c E_c and always casts its first ray (emission is not
+ * reflection: a black lamp shoots as well as a grey one).  At the patch j it reaches, j
+ * reflects rho_jc W_c (collision tallies that; absorption tallies it / (1 - q_j) where the
+ * particle stops), and the particle survives with q_j, its weights becoming rho_jc W_c / q_j.
+ * Then B_j = E_j + R_j / A_j.
  *
  * As in ulam_solve, block k of walks draws from the stream (seed, k) and blocks merge in
  * index order: the result does not depend on the number of threads. */
@@ -62,7 +65,7 @@ struct ulam_rad_solver {
     double sq, maxsq;
     int64_t walks, rays, cut, nonfinite, next_walk;
     double seconds, t0;
-    int done, interrupted, status;
+    int done, interrupted, zero, status;
 };
 
 /* Free; accepts and returns NULL. */
@@ -207,7 +210,9 @@ static void tally(rad_scratch *sc, int64_t p, const double w[3], double scale)
     for (int c = 0; c < 3; c++) sc->hist[3 * p + c] += w[c] * scale;
 }
 
-/* One shooting history: tallies in sc. */
+/* One shooting history: tallies in sc.  Emission is not reflection: the particle always leaves
+ * its emitter (the emitted power A E is known exactly and added in shot_component); at each
+ * patch j it reaches, j reflects rho_j W, and survival there is decided by q_j. */
 static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_block *br)
 {
     const ulam_scene *scn = s->s;
@@ -224,12 +229,6 @@ static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_bl
     double W[3], esum = E0[0] + E0[1] + E0[2];
     for (int c = 0; c < 3; c++) W[c] = s->ptot * E0[c] / esum;
     for (int64_t step = 0;; step++) {
-        double q = s->q[p];
-        if (!absorb) tally(sc, p, W, 1.0);
-        if (ulam__rng_uniform(r) >= q) {
-            if (absorb) tally(sc, p, W, 1.0 / (1.0 - q));
-            return;
-        }
         if (step >= s->o.max_steps) {
             br->cut++;
             return;
@@ -237,7 +236,14 @@ static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_bl
         int64_t j = ulam_tracer_shoot(s->t, p, r);
         br->rays++;
         if (j < 0) return;
-        for (int c = 0; c < 3; c++) W[c] *= scn->rho[3 * j + c] / q;
+        const double *rho = scn->rho + 3 * j;
+        double q = s->q[j], R[3] = {W[0] * rho[0], W[1] * rho[1], W[2] * rho[2]}; /* reflected by j */
+        if (!absorb) tally(sc, j, R, 1.0);
+        if (ulam__rng_uniform(r) >= q) {
+            if (absorb) tally(sc, j, R, 1.0 / (1.0 - q));
+            return;
+        }
+        for (int c = 0; c < 3; c++) W[c] = R[c] / q;
         p = j;
     }
 }
@@ -333,6 +339,15 @@ static int precise_enough(const ulam_rad_result *r, double rel_err)
     return any;
 }
 
+/* Nonzero when every channel is exactly 0 with zero variance: no walk scored, and a relative
+ * error can never be met. */
+static int all_zero(const ulam_rad_result *r)
+{
+    for (int c = 0; c < 3; c++)
+        if (r->radiosity[c] != 0.0 || r->std_error[c] != 0.0) return 0;
+    return 1;
+}
+
 /* Run one round of walks. */
 int ulam_rad_solver_iterate(ulam_rad_solver *s)
 {
@@ -361,6 +376,7 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     ulam_rad_solver_result(s, &r);
     if (ulam__budget_spent(&s->o, stop, s->next_walk)) s->done = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(&r, s->o.rel_err)) s->done = 1;
+    if (s->o.rel_err > 0 && r.walks >= 1000 && all_zero(&r)) s->done = s->zero = 1; /* can never be met */
     return s->status;
 }
 
@@ -376,7 +392,7 @@ static void shot_component(const ulam_rad_solver *s, int64_t p, int c, double *e
     double N = (double)s->walks, A = s->s->area[p];
     double mean = N > 0 ? s->sum[3 * p + c] / N : 0.0;
     double v = N > 1 ? fmax(0.0, (s->sumsq[3 * p + c] - N * mean * mean) / (N - 1)) : 0.0;
-    *est = mean / A;
+    *est = s->s->emit[3 * p + c] + mean / A; /* the emission exactly, the reflected light by the walks */
     *se = N > 0 ? sqrt(v / N) / A : INFINITY;
 }
 
@@ -400,6 +416,7 @@ void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
     r->seconds = s->seconds;
     r->threads = s->threads;
     r->interrupted = s->interrupted;
+    r->zero = s->zero;
 }
 
 /* Shooting: every patch. */

@@ -45,6 +45,10 @@ void ulam__patch_point(const ulam_scene *s, int64_t p, double share, ulam_rng *r
 /* A cosine-distributed unit direction about unit normal n. */
 void ulam__cosine_dir(const double n[3], ulam_rng *r, double d[3]);
 
+/* The first patch whose front the ray org + t dir hits, back sides seen through (a camera
+ * outside a closed room sees into it), or -1. */
+int64_t ulam__tracer_cast_front(const ulam_tracer *t, const double org[3], const double dir[3]);
+
 /* The scene a tracer was built on. */
 const ulam_scene *ulam__tracer_scene(const ulam_tracer *t);
 

@@ -1,9 +1,14 @@
 /* Ray casting with Embree 3: one triangle geometry (each patch a fan of triangles), the patch
- * from the hit primitive, and an origin offset along the normal so a ray never hits the
- * patch it leaves. */
+ * from the hit primitive.  Self-intersection is avoided by identity, not by distance: a filter
+ * function rejects every hit on the patch a ray leaves (a planar convex patch cannot be hit by
+ * a ray leaving its front, so this is exact), and the ray starts at the sampled point itself.
+ * Embree works in float, so vertices and origins are taken relative to the centre of the
+ * scene's bounding box (computed in double): a scene far from the origin keeps the precision
+ * of one at the origin, and no offset has to outgrow a float's rounding there. */
 #include "rad.h"
 
 #include <embree3/rtcore.h>
+#include <float.h>
 #include <stdlib.h>
 
 struct ulam_tracer {
@@ -12,8 +17,18 @@ struct ulam_tracer {
     RTCScene scene;
     int64_t *prim_patch; /* triangle -> patch */
     double *share;       /* per patch: ulam__first_share */
-    double eps;          /* origin offset: 1e-5 of the scene's diagonal */
+    double centre[3];    /* of the bounding box: Embree's coordinates are relative to it */
+    double resolution;   /* the largest float step at a patch over the patch's size */
+    int64_t coarsest;    /* the patch where it is */
 };
+
+/* An intersection context that knows the patch a ray leaves (-1: none). */
+typedef struct {
+    struct RTCIntersectContext ctx; /* first, so Embree's pointer is ours */
+    const ulam_tracer *t;
+    int64_t self;
+    const double *cull; /* the ray's direction when back sides are passed through, or NULL */
+} ray_context;
 
 /* Free a tracer; accepts and returns NULL. */
 ulam_tracer *ulam_tracer_free(ulam_tracer *t)
@@ -33,28 +48,59 @@ const ulam_scene *ulam__tracer_scene(const ulam_tracer *t)
     return t->s;
 }
 
-/* Fill Embree's vertex and index buffers with the patches' fan triangles. */
-static void fill_buffers(ulam_tracer *t, float *vb, unsigned *ib)
+/* The bounding box centre of the scene's vertices. */
+static void scene_centre(const ulam_scene *s, double c[3])
 {
-    const ulam_scene *s = t->s;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int64_t v = 0; v < s->nverts; v++)
         for (int d = 0; d < 3; d++) {
-            vb[3 * v + d] = (float)s->vert[3 * v + d];
             lo[d] = fmin(lo[d], s->vert[3 * v + d]);
             hi[d] = fmax(hi[d], s->vert[3 * v + d]);
         }
+    for (int d = 0; d < 3; d++) c[d] = s->nverts ? 0.5 * (lo[d] + hi[d]) : 0.0;
+}
+
+/* Fill Embree's vertex and index buffers with the patches' fan triangles (relative to the
+ * centre). */
+static void fill_buffers(ulam_tracer *t, float *vb, unsigned *ib)
+{
+    const ulam_scene *s = t->s;
+    scene_centre(s, t->centre);
+    for (int64_t v = 0; v < s->nverts; v++)
+        for (int d = 0; d < 3; d++) vb[3 * v + d] = (float)(s->vert[3 * v + d] - t->centre[d]);
     int64_t tri = 0;
     for (int64_t p = 0; p < s->npatches; p++) {
         const int32_t *v = s->vidx + s->start[p];
+        double far = 0.0; /* the largest centred coordinate of the patch */
+        for (int64_t k = 0; k < s->start[p + 1] - s->start[p]; k++)
+            for (int d = 0; d < 3; d++) far = fmax(far, fabs(s->vert[3 * v[k] + d] - t->centre[d]));
+        double r = FLT_EPSILON * far / sqrt(s->area[p]);
+        if (r > t->resolution) t->resolution = r, t->coarsest = p;
         for (int64_t k = 1; k + 1 < s->start[p + 1] - s->start[p]; k++, tri++) {
             ib[3 * tri] = (unsigned)v[0], ib[3 * tri + 1] = (unsigned)v[k], ib[3 * tri + 2] = (unsigned)v[k + 1];
             t->prim_patch[tri] = p;
         }
     }
-    double e[3];
-    ulam__sub3(hi, lo, e);
-    t->eps = 1e-5 * sqrt(ulam__dot3(e, e));
+}
+
+/* How finely Embree's floats resolve the scene: the largest float step at a patch over the
+ * patch's size, and that patch. */
+double ulam_tracer_resolution(const ulam_tracer *t, int64_t *patch)
+{
+    if (patch) *patch = t ? t->coarsest : -1;
+    return t ? t->resolution : NAN;
+}
+
+/* Embree's filter: reject hits on the patch the ray leaves, and (camera rays) on back sides
+ * (primID is the hit's sixth SoA field, RTCHitN_primID, which rtcore_ray.h defines for C++ only). */
+static void skip_self(const struct RTCFilterFunctionNArguments *a)
+{
+    const ray_context *rc = (const ray_context *)a->context;
+    for (unsigned i = 0; i < a->N; i++) {
+        if (!a->valid[i]) continue;
+        int64_t p = rc->t->prim_patch[((const unsigned *)a->hit)[5 * a->N + i]];
+        if (p == rc->self || (rc->cull && ulam__dot3(rc->cull, rc->t->s->normal + 3 * p) >= 0)) a->valid[i] = 0;
+    }
 }
 
 /* Build the ray-casting structure for s. */
@@ -90,6 +136,7 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
         return ulam__fail(err, ULAM_EDEVICE, 0, -1, "Embree buffers for %lld triangles", (long long)ntri);
     }
     fill_buffers(t, vb, ib);
+    rtcSetGeometryIntersectFilterFunction(g, skip_self);
     rtcCommitGeometry(g);
     rtcAttachGeometry(t->scene, g);
     rtcReleaseGeometry(g);
@@ -104,13 +151,15 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
     return ULAM_OK;
 }
 
-/* The first patch the ray hits, or -1. */
-int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3], int *front)
+/* The first patch other than self the ray hits (with cull, the first whose front it hits), or -1. */
+static int64_t cast_from(const ulam_tracer *t, const double org[3], const double dir[3], int64_t self, int cull,
+                         int *front)
 {
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    ray_context rc = {.t = t, .self = self, .cull = cull ? dir : NULL};
+    rtcInitIntersectContext(&rc.ctx);
     struct RTCRayHit rh;
-    rh.ray.org_x = (float)org[0], rh.ray.org_y = (float)org[1], rh.ray.org_z = (float)org[2];
+    rh.ray.org_x = (float)(org[0] - t->centre[0]), rh.ray.org_y = (float)(org[1] - t->centre[1]);
+    rh.ray.org_z = (float)(org[2] - t->centre[2]);
     rh.ray.dir_x = (float)dir[0], rh.ray.dir_y = (float)dir[1], rh.ray.dir_z = (float)dir[2];
     rh.ray.tnear = 0.0f;
     rh.ray.tfar = INFINITY;
@@ -120,22 +169,32 @@ int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double
     rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(t->scene, &ctx, &rh);
+    rtcIntersect1(t->scene, &rc.ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
     int64_t p = t->prim_patch[rh.hit.primID];
     if (front) *front = ulam__dot3(dir, t->s->normal + 3 * p) < 0;
     return p;
 }
 
+/* The first patch the ray hits, or -1. */
+int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3], int *front)
+{
+    return cast_from(t, org, dir, -1, 0, front);
+}
+
+/* The first patch whose front the ray hits (back sides are seen through), or -1. */
+int64_t ulam__tracer_cast_front(const ulam_tracer *t, const double org[3], const double dir[3])
+{
+    return cast_from(t, org, dir, -1, 1, NULL);
+}
+
 /* A cosine-distributed ray from a uniform point of patch p: the patch reached, front side. */
 int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r)
 {
-    const double *n = t->s->normal + 3 * p;
     double o[3], d[3];
     ulam__patch_point(t->s, p, t->share[p], r, o);
-    for (int k = 0; k < 3; k++) o[k] += t->eps * n[k];
-    ulam__cosine_dir(n, r, d);
+    ulam__cosine_dir(t->s->normal + 3 * p, r, d);
     int front = 0;
-    int64_t j = ulam_tracer_cast(t, o, d, &front);
+    int64_t j = cast_from(t, o, d, p, 0, &front);
     return j >= 0 && front ? j : -1;
 }

@@ -253,37 +253,6 @@ int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out)
     return ULAM_OK;
 }
 
-/* The patch of group label nearest the group's area centroid. */
-int ulam_scene_find(const ulam_scene *s, const char *label, int64_t *patch)
-{
-    if (!s || !label || !patch) return ULAM_EINVAL;
-    int64_t g = -1;
-    for (int64_t i = 0; i < s->ngroups && g < 0; i++)
-        if (!strcmp(s->groups[i], label)) g = i;
-    double c[3] = {0, 0, 0}, A = 0;
-    for (int64_t p = 0; p < s->npatches; p++) {
-        if (g < 0 || s->group[p] != g) continue;
-        const int32_t *v = s->vidx + s->start[p];
-        int64_t n = s->start[p + 1] - s->start[p];
-        for (int64_t a = 0; a < n; a++)
-            for (int d = 0; d < 3; d++) c[d] += s->area[p] * s->vert[3 * v[a] + d] / (double)n;
-        A += s->area[p];
-    }
-    if (g < 0 || !(A > 0)) return ULAM_ENOTFOUND;
-    double best = INFINITY;
-    for (int64_t p = 0; p < s->npatches; p++) {
-        if (s->group[p] != g) continue;
-        const int32_t *v = s->vidx + s->start[p];
-        int64_t n = s->start[p + 1] - s->start[p];
-        double m[3] = {0, 0, 0}, e[3];
-        for (int64_t a = 0; a < n; a++)
-            for (int d = 0; d < 3; d++) m[d] += s->vert[3 * v[a] + d] / (double)n;
-        for (int d = 0; d < 3; d++) e[d] = m[d] - c[d] / A;
-        if (ulam__dot3(e, e) < best) best = ulam__dot3(e, e), *patch = p;
-    }
-    return ULAM_OK;
-}
-
 /* Twice the area of triangle (a, b, c). */
 static double tri_area2(const double *a, const double *b, const double *c)
 {
@@ -292,6 +261,92 @@ static double tri_area2(const double *a, const double *b, const double *c)
     ulam__sub3(c, a, e2);
     ulam__cross3(e1, e2, x);
     return sqrt(ulam__dot3(x, x));
+}
+
+/* The area centroid of patch p (its fan triangles' centroids weighted by their areas). */
+void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3])
+{
+    const int32_t *v = s->vidx + s->start[p];
+    int64_t n = s->start[p + 1] - s->start[p];
+    const double *A = s->vert + 3 * v[0];
+    double w = 0.0;
+    c[0] = c[1] = c[2] = 0.0;
+    for (int64_t t = 1; t + 1 < n; t++) {
+        const double *B = s->vert + 3 * v[t], *C = s->vert + 3 * v[t + 1];
+        double a = tri_area2(A, B, C);
+        for (int d = 0; d < 3; d++) c[d] += a * (A[d] + B[d] + C[d]) / 3.0;
+        w += a;
+    }
+    for (int d = 0; d < 3; d++) c[d] = w > 0 ? c[d] / w : A[d];
+}
+
+/* The index of group label, or -1. */
+static int64_t group_of(const ulam_scene *s, const char *label)
+{
+    for (int64_t i = 0; i < s->ngroups; i++)
+        if (!strcmp(s->groups[i], label)) return i;
+    return -1;
+}
+
+/* The area centroid of the patches labelled label. */
+int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3])
+{
+    if (!s || !label || !c) return ULAM_EINVAL;
+    int64_t g = group_of(s, label);
+    double A = 0.0, m[3];
+    c[0] = c[1] = c[2] = 0.0;
+    for (int64_t p = 0; g >= 0 && p < s->npatches; p++) {
+        if (s->group[p] != g) continue;
+        ulam_scene_centroid(s, p, m);
+        for (int d = 0; d < 3; d++) c[d] += s->area[p] * m[d];
+        A += s->area[p];
+    }
+    if (!(A > 0)) return ULAM_ENOTFOUND;
+    for (int d = 0; d < 3; d++) c[d] /= A;
+    return ULAM_OK;
+}
+
+/* Nonzero when x lies in patch p: within tol of its plane and inside every edge, tol being
+ * 10^-9 of the patch's size (rounding, so that a point on a shared edge is in both). */
+static int contains(const ulam_scene *s, int64_t p, const double x[3])
+{
+    const double *n = s->normal + 3 * p;
+    const int32_t *v = s->vidx + s->start[p];
+    int64_t m = s->start[p + 1] - s->start[p];
+    double tol = 1e-9 * sqrt(s->area[p]), d[3];
+    ulam__sub3(x, s->vert + 3 * v[0], d);
+    if (fabs(ulam__dot3(d, n)) > tol) return 0;
+    for (int64_t k = 0; k < m; k++) {
+        const double *a = s->vert + 3 * v[k], *b = s->vert + 3 * v[(k + 1) % m];
+        double e[3], w[3], c[3];
+        ulam__sub3(b, a, e);
+        ulam__sub3(x, a, w);
+        ulam__cross3(e, w, c);
+        if (ulam__dot3(c, n) < -tol * sqrt(ulam__dot3(e, e))) return 0;
+    }
+    return 1;
+}
+
+/* The patch of group label containing the group's area centroid, else the nearest by centroid. */
+int ulam_scene_find(const ulam_scene *s, const char *label, int64_t *patch)
+{
+    if (!s || !label || !patch) return ULAM_EINVAL;
+    double c[3], m[3], e[3], best = INFINITY;
+    int status = ulam_scene_label_centroid(s, label, c);
+    if (status) return status;
+    int64_t g = group_of(s, label);
+    for (int64_t p = 0; p < s->npatches; p++)
+        if (s->group[p] == g && contains(s, p, c)) {
+            *patch = p;
+            return ULAM_OK;
+        }
+    for (int64_t p = 0; p < s->npatches; p++) {
+        if (s->group[p] != g) continue;
+        ulam_scene_centroid(s, p, m);
+        ulam__sub3(m, c, e);
+        if (ulam__dot3(e, e) < best) best = ulam__dot3(e, e), *patch = p;
+    }
+    return ULAM_OK;
 }
 
 /* The share of a quad's area in its first fan triangle (1 for triangles). */

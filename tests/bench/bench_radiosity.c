@@ -2,7 +2,7 @@
  * rays, against forming F by ray casting and solving the three channels with LAPACK.
  *
  * The box is subdivided to about 2,000, 10,000 and 40,000 patches.  The walk answers the
- * floor's middle patch (the label's patch nearest its centre) with the collision estimator,
+ * floor's middle patch (the label's patch containing its area centroid) with the collision estimator,
  * stopping at 1% on every channel.  The direct route forms F with 1000 rays a patch and calls
  * ulam_radiosity_direct (skipped when the dense matrix exceeds 4 GB); its own error at the
  * patch from the noise of F is reported, with the rays a patch it would need for 1% and the
