@@ -27,6 +27,12 @@ ulam_power_opts ulam_power_defaults(void)
     return (ulam_power_opts){.tol = 1e-4, .max_iter = 1000};
 }
 
+/* The default guard options: all three radii, stopped once certified. */
+ulam_guard_opts ulam_guard_defaults(void)
+{
+    return (ulam_guard_opts){.need = ULAM_GUARD_ALL, .power = ulam_power_defaults()};
+}
+
 /* y = diag(left) |A| xr (threaded only where the product is big enough to pay for it). */
 static void apply(const ulam_csr *A, const double *left, const double *xr, double *y)
 {
@@ -56,14 +62,18 @@ static double step(int64_t n, double *x, const double *y, double *lo, double *hi
     return est;
 }
 
-/* rho(diag(left) |A| diag(right)) by shifted power iteration with Collatz-Wielandt bounds. */
-int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
-                        const ulam_power_opts *opts, ulam_power *out, ulam_error *err)
+/* Nonzero when [lower, upper] decides a verdict and its warning: wholly below 0.99, wholly at
+ * or above 1, or wholly in [0.99, 1). */
+static int certain(double lower, double upper)
 {
-    ulam__clear(err);
-    if (!A || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
-    if (A->nrows != A->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix");
-    ulam_power_opts o = opts ? *opts : ulam_power_defaults();
+    return upper < 0.99 || lower >= 1.0 || (lower >= 0.99 && upper < 1.0);
+}
+
+/* Power iteration on diag(left) |A| diag(right) from bounds [lower, upper] already known
+ * (the one-pass sums); out keeps the tighter bounds of both. */
+static int power_from(const ulam_csr *A, const double *left, const double *right, const ulam_power_opts *o,
+                      ulam_power *out, ulam_error *err)
+{
     int64_t n = A->nrows;
     double t0 = ulam_now();
     double *x = ulam__malloc((size_t)n, sizeof *x), *y = ulam__malloc((size_t)n, sizeof *y);
@@ -73,11 +83,12 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
         if (right) free(xr);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for three vectors of %lld", (long long)n);
     }
-    *out = (ulam_power){.lower = 0.0, .upper = INFINITY};
     for (int64_t i = 0; i < n; i++) x[i] = 1.0;
     int stable = 0;
     double prev = -1.0, change = INFINITY;
-    while (out->iterations < o.max_iter && !out->converged && n > 0) {
+    /* certifying, an estimate that has converged while the bounds still straddle a threshold
+     * goes on: the bounds close in later */
+    while (out->iterations < o->max_iter && n > 0 && !(o->certify ? certain(out->lower, out->upper) : out->converged)) {
         if (right)
             for (int64_t i = 0; i < n; i++) xr[i] = right[i] * x[i];
         apply(A, left, xr, y);
@@ -88,39 +99,69 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
         /* the changes shrink geometrically at about `ratio`: the ones still to come add up to ahead */
         double c = fabs(out->rho - prev), ratio = c / change;
         double ahead = prev >= 0 && isfinite(change) && ratio < 1 ? c * ratio / (1 - ratio) : INFINITY;
-        stable = ahead <= o.tol * out->rho ? stable + 1 : 0;
+        stable = ahead <= o->tol * out->rho ? stable + 1 : 0;
         prev = out->rho, change = c;
-        out->converged = out->upper - out->lower <= o.tol * out->upper || stable >= 5 || out->upper <= o.tol;
+        out->converged = out->upper - out->lower <= o->tol * out->upper || stable >= 5 || out->upper <= o->tol;
     }
-    if (n == 0) out->upper = 0.0, out->converged = 1;
+    if (n == 0) out->lower = out->upper = 0.0, out->converged = 1;
     out->rho = fmin(fmax(out->rho, out->lower), out->upper);
-    out->seconds = ulam_now() - t0;
+    out->seconds += ulam_now() - t0;
     free(x), free(y);
     if (right) free(xr);
     return ULAM_OK;
 }
 
-/* Fine, near the edge or failing: certified bounds first, then the estimate. */
+/* rho(diag(left) |A| diag(right)) by shifted power iteration with Collatz-Wielandt bounds. */
+int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
+                        const ulam_power_opts *opts, ulam_power *out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!A || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
+    if (A->nrows != A->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix");
+    ulam_power_opts o = opts ? *opts : ulam_power_defaults();
+    *out = (ulam_power){.lower = 0.0, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
+    return power_from(A, left, right, &o, out, err);
+}
+
+/* Certified bounds alone decide: below 0.99 fine, below 1 near the edge, from 1 up failing,
+ * straddling 1 unknown. */
 int ulam_verdict_of(const ulam_power *p)
 {
     if (p->upper < 0.99) return ULAM_VERDICT_OK;
-    if (p->lower >= 1.0 || p->rho >= 1.0) return ULAM_VERDICT_FAIL;
-    return p->rho >= 0.99 ? ULAM_VERDICT_EDGE : ULAM_VERDICT_OK;
+    if (p->upper < 1.0) return ULAM_VERDICT_EDGE;
+    if (p->lower >= 1.0) return ULAM_VERDICT_FAIL;
+    return ULAM_VERDICT_UNKNOWN;
 }
 
-/* The kernel factors S_i / q_i of the rows (cols == 0) or columns (cols != 0) of |M|. */
-static double *factors(const ulam_csr *M, double continue_q, int cols)
+/* 1 finite, 0 infinite, -1 unknown: the variance of walks in mode by g. */
+int ulam_guard_variance(const ulam_guard *g, int mode)
 {
-    int64_t n = M->nrows;
-    double *f = ulam__calloc((size_t)n, sizeof *f);
-    if (!f) return NULL;
-    for (int64_t i = 0; i < n; i++)
-        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) f[cols ? M->colidx[q] : i] += fabs(M->val[q]);
-    for (int64_t i = 0; i < n; i++) {
-        double qi = ulam__continuation(f[i], continue_q);
-        f[i] = qi > 0 ? f[i] / qi : 0.0;
-    }
-    return f;
+    int v = g->verdict_hat[mode == ULAM_FORWARD];
+    return v == ULAM_VERDICT_OK || v == ULAM_VERDICT_EDGE ? 1 : v == ULAM_VERDICT_FAIL ? 0 : -1;
+}
+
+/* The one-pass sums of a nonnegative matrix A: min and max of its row sums r and column sums c
+ * bound its radius (min r <= rho <= max r, the same for c, as rho(A) = rho(A')). */
+typedef struct {
+    double rmin, rmax, cmin, cmax, total;
+} sums;
+
+/* Bounds from the sums into a fresh radius (estimate: the first power step's sum(A1)/n). */
+static ulam_power from_sums(const sums *s, int64_t n)
+{
+    ulam_power p = {.lower = fmax(s->rmin, s->cmin), .upper = fmin(s->rmax, s->cmax), .rowsum_max = s->rmax,
+                    .colsum_max = s->cmax};
+    if (n == 0) p.lower = p.upper = 0.0;
+    p.rho = fmin(fmax(n > 0 ? s->total / (double)n : 0.0, p.lower), p.upper);
+    p.converged = isfinite(p.upper) && p.upper - p.lower <= 1e-12 * p.upper;
+    return p;
+}
+
+/* min and max of the n entries of v into *lo, *hi. */
+static void range(const double *v, int64_t n, double *lo, double *hi)
+{
+    *lo = n ? INFINITY : 0.0, *hi = 0.0;
+    for (int64_t i = 0; i < n; i++) *lo = fmin(*lo, v[i]), *hi = fmax(*hi, v[i]);
 }
 
 /* Nonzero when all n factors are 1: diag(f) |M| is then |M|, and so is its radius. */
@@ -131,35 +172,140 @@ static int all_ones(const double *f, int64_t n)
     return 1;
 }
 
-/* rho of the second-moment matrix with factors f (left of |M| for rows, right for columns):
- * rho(|M|) itself, taking no time, when every factor is 1 (an analog kernel of rows or
- * columns summing to at most 1), for the power iteration would repeat it exactly. */
-static int hat_power(const ulam_csr *M, const double *f, int cols, const ulam_power_opts *opts,
-                     const ulam_power *abs, ulam_power *out, ulam_error *err)
+/* Scratch of the guard check: per-state sums and factors. */
+typedef struct {
+    double *S, *C;   /* row and column sums of |M| */
+    double *fr, *fc; /* kernel factors S_i / q_i of rows (adjoint) and columns (forward) */
+    double *ca;      /* column sums of diag(fr) |M| */
+    double *rf;      /* row sums of |M| diag(fc) */
+} guard_work;
+
+/* Free the scratch. */
+static void work_free(guard_work *w)
 {
-    if (all_ones(f, M->nrows)) {
-        *out = *abs;
-        out->seconds = 0.0;
-        return ULAM_OK;
-    }
-    return ulam_spectral_power(M, cols ? NULL : f, cols ? f : NULL, opts, out, err);
+    free(w->S), free(w->C), free(w->fr), free(w->fc), free(w->ca), free(w->rf);
 }
 
-/* The three radii and their verdicts. */
-int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_power_opts *opts,
+/* The one pass over M (row by row): S, C, fr, and the column sums of diag(fr) |M| (each row
+ * is read twice while it is in cache); then fc. */
+static int sum_pass(const ulam_csr *M, double continue_q, guard_work *w)
+{
+    int64_t n = M->nrows;
+    w->S = ulam__calloc((size_t)n, sizeof(double)), w->C = ulam__calloc((size_t)n, sizeof(double));
+    w->fr = ulam__malloc((size_t)n, sizeof(double)), w->fc = ulam__malloc((size_t)n, sizeof(double));
+    w->ca = ulam__calloc((size_t)n, sizeof(double));
+    if (!w->S || !w->C || !w->fr || !w->fc || !w->ca) return ULAM_ENOMEM;
+    for (int64_t i = 0; i < n; i++) {
+        double s = 0.0;
+        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) {
+            s += fabs(M->val[q]);
+            w->C[M->colidx[q]] += fabs(M->val[q]);
+        }
+        w->S[i] = s;
+        w->fr[i] = ulam__factor(s, continue_q);
+        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) w->ca[M->colidx[q]] += w->fr[i] * fabs(M->val[q]);
+    }
+    for (int64_t j = 0; j < n; j++) w->fc[j] = ulam__factor(w->C[j], continue_q);
+    return ULAM_OK;
+}
+
+/* The row sums of |M| diag(fc), which need every fc first: a second pass. */
+static int forward_rows(const ulam_csr *M, guard_work *w)
+{
+    int64_t n = M->nrows;
+    if (!(w->rf = ulam__malloc((size_t)n, sizeof(double)))) return ULAM_ENOMEM;
+    for (int64_t i = 0; i < n; i++) {
+        double s = 0.0;
+        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) s += fabs(M->val[q]) * w->fc[M->colidx[q]];
+        w->rf[i] = s;
+    }
+    return ULAM_OK;
+}
+
+/* The sums of diag(f) |M| (rows = f o S, columns ca) or of |M| diag(f) (rows rf, columns
+ * f o C); rf may be NULL (not computed: the row bound is then infinite). */
+static sums hat_sums(const guard_work *w, int64_t n, int forward)
+{
+    sums s = {0};
+    const double *f = forward ? w->fc : w->fr, *base = forward ? w->C : w->S;
+    s.rmin = n ? INFINITY : 0.0, s.cmin = s.rmin;
+    for (int64_t i = 0; i < n; i++) {
+        double scaled = f[i] * base[i]; /* adjoint: row i of diag(f)|M|; forward: column i of |M|diag(f) */
+        double other = forward ? (w->rf ? w->rf[i] : INFINITY) : w->ca[i];
+        double r = forward ? other : scaled, c = forward ? scaled : other;
+        s.rmin = fmin(s.rmin, r), s.rmax = fmax(s.rmax, r);
+        s.cmin = fmin(s.cmin, c), s.cmax = fmax(s.cmax, c);
+        s.total += c; /* the sum of all entries: the column sums add up to it */
+    }
+    if (forward && !w->rf) s.rmin = 0.0;
+    return s;
+}
+
+/* One radius: the sums' bounds, then power iteration unless they certify (or o->tight). */
+static int radius(const ulam_csr *M, const double *left, const double *right, const sums *sm,
+                  const ulam_guard_opts *o, ulam_power *out, ulam_error *err)
+{
+    double t0 = ulam_now();
+    *out = from_sums(sm, M->nrows);
+    out->seconds = 0.0;
+    int status = ULAM_OK;
+    if (!out->converged && (o->tight || !certain(out->lower, out->upper))) {
+        ulam_power_opts po = o->power;
+        po.certify = !o->tight;
+        status = power_from(M, left, right, &po, out, err);
+    }
+    out->seconds = ulam_now() - t0;
+    return status;
+}
+
+/* The radii asked for and their verdicts. */
+int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
                      ulam_guard *g, ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !g) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
     if (M->nrows != M->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
-    double *fr = factors(M, continue_q, 0), *fc = factors(M, continue_q, 1);
-    int status = fr && fc ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel factors");
-    if (!status) status = ulam_spectral_power(M, NULL, NULL, opts, &g->abs, err);
-    if (!status) status = hat_power(M, fr, 0, opts, &g->abs, &g->hat[ULAM_ADJOINT], err);
-    if (!status) status = hat_power(M, fc, 1, opts, &g->abs, &g->hat[ULAM_FORWARD], err);
-    free(fr), free(fc);
+    ulam_guard_opts o = opts ? *opts : ulam_guard_defaults();
+    if (!o.need) o.need = ULAM_GUARD_ALL;
+    int64_t n = M->nrows;
+    double t0 = ulam_now();
+    ulam_power none = {.upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
+    *g = (ulam_guard){.continue_q = continue_q, .abs = none, .hat = {none, none}};
+    guard_work w = {0};
+    int status = sum_pass(M, continue_q, &w);
+    if (!status && (o.need & ULAM_GUARD_FORWARD)) { /* the second pass only when the column sums do not certify */
+        sums f = hat_sums(&w, n, 1);
+        if (o.tight || !certain(fmax(f.cmin, 0.0), f.cmax)) status = forward_rows(M, &w);
+    }
+    if (status) {
+        work_free(&w);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel factors");
+    }
+    double pass = ulam_now() - t0;
+    sums a = {0};
+    range(w.S, n, &a.rmin, &a.rmax), range(w.C, n, &a.cmin, &a.cmax);
+    for (int64_t i = 0; i < n; i++) a.total += w.S[i];
+    int ones[2] = {all_ones(w.fr, n), all_ones(w.fc, n)}, need = o.need;
+    for (int m = 0; m < 2; m++)
+        if ((o.need & ULAM_GUARD_HAT(m)) && ones[m]) need |= ULAM_GUARD_ABS; /* M^ is |M| itself */
+    if (need & ULAM_GUARD_ABS) status = radius(M, NULL, NULL, &a, &o, &g->abs, err);
+    for (int m = 0; m < 2 && !status; m++) {
+        if (!(need & ULAM_GUARD_HAT(m))) continue;
+        if (ones[m]) {
+            g->hat[m] = g->abs;
+            g->hat[m].seconds = 0.0;
+            continue;
+        }
+        sums h = hat_sums(&w, n, m == ULAM_FORWARD);
+        const double *f = m == ULAM_FORWARD ? w.fc : w.fr;
+        status = radius(M, m == ULAM_FORWARD ? NULL : f, m == ULAM_FORWARD ? f : NULL, &h, &o, &g->hat[m], err);
+    }
+    work_free(&w);
     if (status) return status;
-    g->verdict_abs = ulam_verdict_of(&g->abs);
-    for (int m = 0; m < 2; m++) g->verdict_hat[m] = ulam_verdict_of(&g->hat[m]);
+    g->computed = need;
+    g->abs.seconds += pass; /* the one pass is charged to rho(|M|) */
+    g->verdict_abs = need & ULAM_GUARD_ABS ? ulam_verdict_of(&g->abs) : ULAM_VERDICT_UNKNOWN;
+    for (int m = 0; m < 2; m++)
+        g->verdict_hat[m] = need & ULAM_GUARD_HAT(m) ? ulam_verdict_of(&g->hat[m]) : ULAM_VERDICT_UNKNOWN;
     return ULAM_OK;
 }

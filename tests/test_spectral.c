@@ -241,8 +241,38 @@ static void test_guard(void **state)
     assert_true(g.abs.lower >= 1.0); /* certified */
     assert_int_equal(g.verdict_abs, ULAM_VERDICT_FAIL);
     ulam_csr_free(M);
-    ulam_power edge = {.rho = 0.995, .lower = 0.99, .upper = 1.001};
-    assert_int_equal(ulam_verdict_of(&edge), ULAM_VERDICT_EDGE);
+}
+
+/* Radii within 1e-3 of 1 on either side, where 1000 power iterations do not converge: a
+ * verdict is certified only by bounds on one side of 1, otherwise it is unknown (never the
+ * side the unconverged estimate happens to fall on). */
+static void test_guard_near_one(void **state)
+{
+    (void)state;
+    static const double radii[] = {1.0005, 1.0009, 0.9995, 0.9991};
+    for (int k = 0; k < 4; k++) {
+        ulam_csr *M = near_one_matrix(300, radii[k]);
+        ulam_guard g;
+        assert_int_equal(ulam_guard_check(M, 0.0, NULL, &g, NULL), ULAM_OK);
+        int v = g.verdict_abs, certain = radii[k] > 1 ? ULAM_VERDICT_FAIL : ULAM_VERDICT_EDGE;
+        if (!(g.abs.lower <= radii[k] * (1 + 1e-12) && radii[k] <= g.abs.upper * (1 + 1e-12)) ||
+            (v != certain && v != ULAM_VERDICT_UNKNOWN))
+            print_error("case %d: rho %.6g: verdict %d, bounds [%.6g, %.6g], estimate %.6g, %d iterations\n", k,
+                        radii[k], v, g.abs.lower, g.abs.upper, g.abs.rho, g.abs.iterations);
+        assert_true(g.abs.lower <= radii[k] * (1 + 1e-12) && radii[k] <= g.abs.upper * (1 + 1e-12));
+        assert_true(v == certain || v == ULAM_VERDICT_UNKNOWN);
+        if (v == ULAM_VERDICT_FAIL) assert_true(g.abs.lower >= 1.0);
+        if (v == ULAM_VERDICT_EDGE) assert_true(g.abs.upper < 1.0);
+        ulam_csr_free(M);
+    }
+    ulam_power p = {.rho = 0.995, .lower = 0.99, .upper = 1.001}; /* straddles 1: not certified */
+    assert_int_equal(ulam_verdict_of(&p), ULAM_VERDICT_UNKNOWN);
+    p = (ulam_power){.rho = 0.989, .lower = 0.985, .upper = 1.001001};
+    assert_int_equal(ulam_verdict_of(&p), ULAM_VERDICT_UNKNOWN);
+    p = (ulam_power){.rho = 0.995, .lower = 0.9, .upper = 0.999};
+    assert_int_equal(ulam_verdict_of(&p), ULAM_VERDICT_EDGE);
+    p = (ulam_power){.rho = 1.0, .lower = 1.0, .upper = 1.3};
+    assert_int_equal(ulam_verdict_of(&p), ULAM_VERDICT_FAIL);
 }
 
 int main(void)
@@ -253,7 +283,7 @@ int main(void)
         cmocka_unit_test(test_scaled_stochastic), cmocka_unit_test(test_rotation_blocks),
         cmocka_unit_test(test_degenerate),     cmocka_unit_test(test_committed),
         cmocka_unit_test(test_power_known),    cmocka_unit_test(test_power_scaled),
-        cmocka_unit_test(test_guard),
+        cmocka_unit_test(test_guard),          cmocka_unit_test(test_guard_near_one),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

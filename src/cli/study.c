@@ -44,7 +44,7 @@ typedef struct {
     char name[40];
     int mode, est, window, on;
     char why[320]; /* non-empty: refused */
-    int infinite;  /* rho(M^) >= 1: runs, flagged */
+    int infinite;  /* rho(M^) not certified below 1: runs, flagged */
 } method;
 
 typedef struct {
@@ -54,6 +54,7 @@ typedef struct {
     int nbudget, time_budgets, repeats, threads;
     uint64_t seed;
     const char *out;
+    ulam_guard g; /* the verdicts, computed once for every run */
     double exact;
     double *est, *se, *sec; /* [m][b][r] */
     unsigned char *done;
@@ -115,29 +116,30 @@ static int parse_budgets(study *st, const char *opt, const char *list, int integ
 /* Refuse what the guards or the estimator's definition refuse, flag infinite variance. */
 static int screen_methods(study *st)
 {
-    ulam_guard g;
+    ulam_guard *g = &st->g;
     ulam_error err;
-    int status = ulam_guard_check(st->s.M, 0.0, NULL, &g, &err);
+    int status = ulam_guard_check(st->s.M, 0.0, NULL, g, &err);
     if (status) return cli_report(st->s.matrix_path, &err);
     int left = 0;
     for (int k = 0; k < NMETHOD; k++) {
         method *m = &st->m[k];
         if (!m->on) continue;
-        if (g.verdict_abs == ULAM_VERDICT_FAIL) {
-            snprintf(m->why, sizeof m->why, "rho(|M|) = %.4g >= 1: the walks diverge", g.abs.rho);
+        if (g->verdict_abs >= ULAM_VERDICT_FAIL) {
+            snprintf(m->why, sizeof m->why, "rho(|M|) in [%.4g, %.4g] is not certified below 1: the walks may diverge",
+                     g->abs.lower, g->abs.upper);
         } else {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.mode = m->mode, o.estimator = m->est, o.index = st->s.index - 1, o.max_walks = 1;
+            o.mode = m->mode, o.estimator = m->est, o.index = st->s.index - 1, o.max_walks = 1, o.guard = g;
             ulam_solver *sv = NULL;
             if (ulam_solver_alloc(st->s.M, st->s.b, &o, &sv, &err))
                 snprintf(m->why, sizeof m->why, "%s: expected %s", ulam_strerror(err.status), err.msg);
             ulam_solver_free(sv);
         }
-        m->infinite = g.verdict_hat[m->mode] == ULAM_VERDICT_FAIL;
+        m->infinite = ulam_guard_variance(g, m->mode) != 1;
         if (m->why[0]) fprintf(stderr, "ulam: study: %s refused: %s\n", m->name, m->why);
         else if (m->infinite)
-            fprintf(stderr, "ulam: study: %s runs with infinite variance (rho(M^) = %.4g): its error bars mean nothing\n",
-                    m->name, g.hat[m->mode].rho);
+            fprintf(stderr, "ulam: study: %s runs with a variance not certified finite (rho(M^) in [%.4g, %.4g]): its "
+                    "error bars mean nothing\n", m->name, g->hat[m->mode].lower, g->hat[m->mode].upper);
         left += !m->why[0];
     }
     if (!left) fprintf(stderr, "ulam: study: every selected method is refused\n");
@@ -205,7 +207,7 @@ static int one_run(study *st, int m, int b, int r)
     ulam_walk_opts o = ulam_walk_defaults();
     o.mode = me->mode, o.estimator = me->est, o.index = st->s.index - 1, o.threads = st->threads;
     o.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
-    o.interrupt = &cli_interrupted, o.share = cli_share;
+    o.interrupt = &cli_interrupted, o.share = cli_share, o.guard = &st->g, o.force = 1;
     if (st->time_budgets) o.max_walks = 0, o.max_seconds = st->budget[b];
     else o.max_walks = (int64_t)st->budget[b];
     double w0 = me->mode == ULAM_FORWARD ? 0.0 : 1.0; /* forward particles start at ||b||_1 */
