@@ -209,6 +209,92 @@ def check_forward_files(ulam):
         assert 922 <= covered <= 978, covered
 
 
+def write_mtx(path, n, entries):
+    with open(path, "w") as f:
+        f.write(f"%%MatrixMarket matrix coordinate real general\n{n} {n} {len(entries)}\n")
+        f.writelines(f"{i} {j} {v!r}\n" for i, j, v in entries)
+
+
+def write_vec(path, values):
+    with open(path, "w") as f:
+        f.write(f"%%MatrixMarket matrix array real general\n{len(values)} 1\n")
+        f.writelines(f"{v!r}\n" for v in values)
+
+
+def check_honest_verdicts(ulam):
+    """Verdicts only from bounds: a radius 5e-4 above 1 that power iteration cannot pin is
+    unknown, refused (exit 3) and without an interval under --force; --rel-err with an infinite
+    variance is refused (exit 4) naming the radius and the finite mode, and runs when --walks
+    bounds it; forward --errors marks unreached components (nan) and infinite variance."""
+    import math
+    with tempfile.TemporaryDirectory() as d:
+        n, c = 300, 1.0005 / math.cos(math.pi / 301)
+        dd = [math.exp(0.4 * math.sin(0.05 * k)) for k in range(n)]
+        ent = []
+        for k in range(n - 1):
+            ent += [(k + 1, k + 2, c * 0.5 * dd[k + 1] / dd[k]), (k + 2, k + 1, c * 0.5 * dd[k] / dd[k + 1])]
+        write_mtx(f"{d}/near.mtx", n, ent)
+        write_vec(f"{d}/ones.mtx", [1.0] * n)
+        near = ["solve", f"{d}/near.mtx", "--rhs", f"{d}/ones.mtx", "--index", "150"]
+        rc, out, err = run(ulam, near)
+        assert rc == 3 and "the bounds straddle 1" in err and out == "", (rc, err)
+        rc, out, err = run(ulam, near + ["--force", "--walks", "200", "--max-steps", "10000", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["variance_finite"] is None and o["ci95"] is None, (rc, err, o)
+        assert o["rho_abs_lower"] < 1 <= o["rho_abs_upper"], o
+        rc, out, _ = run(ulam, ["info", f"{d}/near.mtx", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["walks_converge"] is None and o["rho_abs_lower"] < 1 <= o["rho_abs_upper"], o
+        # the star: adjoint rho(M^) = sqrt(1.25) (row 1 sums to 5), forward 0.5
+        write_mtx(f"{d}/star.mtx", 11, [(1, k, 0.5) for k in range(2, 12)] + [(k, 1, 0.05) for k in range(2, 12)])
+        write_vec(f"{d}/b11.mtx", [1.0] * 11)
+        star = ["solve", f"{d}/star.mtx", "--rhs", f"{d}/b11.mtx", "--index", "1"]
+        rc, out, err = run(ulam, star + ["--rel-err", "0.01"])
+        assert rc == 4 and "rho(M^) of the adjoint kernel" in err and "forward mode's is finite" in err, (rc, err)
+        assert out == ""
+        rc, out, err = run(ulam, star + ["--rel-err", "0.01", "--walks", "2000", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["variance_finite"] is False and o["rel_err_met"] is False and o["walks"] == 2000, o
+        rc, out, err = run(ulam, star + ["--rel-err", "0.01", "--mode", "forward", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["rel_err_met"] is True and o["stderr"] <= 0.01 * abs(o["estimate"]), o
+        # forward: state 4 is reached once in ~10^5 walks, state 3 never
+        write_mtx(f"{d}/thin.mtx", 4, [(1, 2, 0.5), (2, 1, 0.5), (4, 1, 1e-5)])
+        write_vec(f"{d}/b4.mtx", [1.0, 1.0, 0.0, 0.0])
+        rc, out, err = run(ulam, ["solve", f"{d}/thin.mtx", "--rhs", f"{d}/b4.mtx", "--mode", "forward", "--walks", "1000",
+                                  "--errors", f"{d}/e.mtx", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["unreached"] == 2, (rc, err, o)
+        lines = open(f"{d}/e.mtx").read().splitlines()
+        assert "% 2 components unreached" in "\n".join(lines) and lines[-2:] == ["nan", "nan"], lines
+        rc, out, err = run(ulam, ["solve", f"{d}/star.mtx", "--rhs", f"{d}/b11.mtx", "--mode", "forward", "--walks", "1000",
+                                  "--continue", "0.1", "--errors", f"{d}/e2.mtx", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["variance_finite"] is False, (rc, err, o)
+        assert "% VARIANCE INFINITE" in open(f"{d}/e2.mtx").read()
+
+
+def check_study_question(ulam):
+    """A study resumes only the same question: another matrix or --index is refused naming the
+    field, --force starts afresh; the study says where its files went."""
+    with tempfile.TemporaryDirectory() as d:
+        base = ["study", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--methods", "adjoint-collision-plain",
+                "--budgets", "100", "--repeats", "3", "--out", d]
+        rc, _, err = run(ulam, base + ["--index", "2"])
+        assert rc == 0 and f"wrote {d}/: runs.csv" in err, (rc, err)
+        rc, _, err = run(ulam, base + ["--index", "3"])
+        assert rc == 2 and "index is 2 there, 3 here" in err, (rc, err)
+        other = ["study", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx"] + base[4:] + ["--index", "2"]
+        rc, _, err = run(ulam, other)
+        assert rc == 2 and "n is 4 there, 1000 here" in err, (rc, err)
+        rc, _, err = run(ulam, base + ["--index", "3", "--force"])
+        rows = open(f"{d}/runs.csv").read().splitlines()
+        assert rc == 0 and "resuming" not in err and len(rows) == 4, (rc, err, rows)
+        os.remove(f"{d}/question.txt")
+        rc, _, err = run(ulam, base + ["--index", "3"])
+        assert rc == 2 and "no question.txt" in err, (rc, err)
+
+
 def interrupt_when_ready(p):
     """Send SIGINT once process p has installed its handler (polled in /proc, no sleeps)."""
     import signal
@@ -439,7 +525,7 @@ def main():
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
-             (check_radiosity, ulam)]
+             (check_radiosity, ulam), (check_honest_verdicts, ulam), (check_study_question, ulam)]
     for f, arg in extra:
         try:
             f(arg)
