@@ -21,6 +21,10 @@
 #include <math.h>
 #include <stdlib.h>
 
+/* Iterations spent, once a radius is certified below 1, on settling whether it is below 0.99
+ * (the warning's margin). */
+enum { MARGIN_TRIES = 20 };
+
 /* The default options. */
 ulam_power_opts ulam_power_defaults(void)
 {
@@ -87,8 +91,11 @@ static int power_from(const ulam_csr *A, const double *left, const double *right
     int stable = 0;
     double prev = -1.0, change = INFINITY;
     /* certifying, an estimate that has converged while the bounds still straddle a threshold
-     * goes on: the bounds close in later */
-    while (out->iterations < o->max_iter && n > 0 && !(o->certify ? certain(out->lower, out->upper) : out->converged)) {
+     * goes on (the bounds close in later); once the radius is certified below 1, at most
+     * MARGIN_TRIES more iterations try to settle the warning's 0.99 */
+    int extra = 0;
+    while (out->iterations < o->max_iter && n > 0 && !(o->certify ? certain(out->lower, out->upper) : out->converged) &&
+           !(o->certify && out->upper < 1.0 && extra++ >= MARGIN_TRIES)) {
         if (right)
             for (int64_t i = 0; i < n; i++) xr[i] = right[i] * x[i];
         apply(A, left, xr, y);
@@ -241,14 +248,61 @@ static sums hat_sums(const guard_work *w, int64_t n, int forward)
     return s;
 }
 
-/* One radius: the sums' bounds, then power iteration unless they certify (or o->tight). */
-static int radius(const ulam_csr *M, const double *left, const double *right, const sums *sm,
+/* Column sums of |M| in double-double (Knuth's TwoSum per addition): hi + lo, so a column is
+ * known to sum to at most 1, or below it, even when a tiny entry vanishes into a sum of 1. */
+static int column_sums_dd(const ulam_csr *M, double **hi, double **lo)
+{
+    int64_t n = M->nrows;
+    *hi = ulam__calloc((size_t)n, sizeof **hi), *lo = ulam__calloc((size_t)n, sizeof **lo);
+    if (!*hi || !*lo) return ULAM_ENOMEM;
+    for (int64_t i = 0; i < n; i++)
+        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) {
+            int32_t j = M->colidx[q];
+            double a = (*hi)[j], v = fabs(M->val[q]), t = a + v, bb = t - a;
+            (*lo)[j] += (a - (t - bb)) + (v - bb);
+            (*hi)[j] = t;
+        }
+    return ULAM_OK;
+}
+
+/* Nonzero when every column of |M| sums to at most 1 and every state is reachable in the graph
+ * of M (i -> j for M_ij != 0) from a column summing to less than 1: |M|' is then substochastic
+ * and from each of its states a deficient row can be reached, so some power of it has every
+ * row sum below 1, and rho(|M|) < 1 strictly (by how much, unknown).  -1: out of memory. */
+static int deficient_reach(const ulam_csr *M)
+{
+    int64_t n = M->nrows, head = 0, tail = 0;
+    double *hi = NULL, *lo = NULL;
+    char *seen = ulam__calloc((size_t)n, 1);
+    int32_t *queue = ulam__malloc((size_t)n, sizeof *queue);
+    int ok = column_sums_dd(M, &hi, &lo) == ULAM_OK && seen && queue ? 1 : -1;
+    for (int64_t j = 0; j < n && ok > 0; j++) {
+        if (hi[j] > 1.0 || (hi[j] == 1.0 && lo[j] > 0.0)) ok = 0;
+        else if (hi[j] < 1.0 && hi[j] + lo[j] < 1.0) seen[j] = 1, queue[tail++] = (int32_t)j;
+    }
+    while (ok > 0 && head < tail) {
+        int32_t i = queue[head++];
+        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++)
+            if (!seen[M->colidx[q]]) seen[M->colidx[q]] = 1, queue[tail++] = M->colidx[q];
+    }
+    free(hi), free(lo), free(seen), free(queue);
+    return ok > 0 ? tail == n : ok;
+}
+
+/* One radius: the sums' bounds (and for rho(|M|) itself, reach != 0, the reachability
+ * certificate of rho < 1), then power iteration unless they certify (or o->tight). */
+static int radius(const ulam_csr *M, const double *left, const double *right, const sums *sm, int reach,
                   const ulam_guard_opts *o, ulam_power *out, ulam_error *err)
 {
     double t0 = ulam_now();
     *out = from_sums(sm, M->nrows);
     out->seconds = 0.0;
     int status = ULAM_OK;
+    if (reach && !certain(out->lower, out->upper) && out->upper >= 1.0 && sm->cmax <= 1.0 && sm->cmin < 1.0) {
+        int r = deficient_reach(M);
+        if (r < 0) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
+        if (r) out->upper = nextafter(1.0, 0.0), out->lower = fmin(out->lower, out->upper);
+    }
     if (!out->converged && (o->tight || !certain(out->lower, out->upper))) {
         ulam_power_opts po = o->power;
         po.certify = !o->tight;
@@ -288,7 +342,7 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
     int ones[2] = {all_ones(w.fr, n), all_ones(w.fc, n)}, need = o.need;
     for (int m = 0; m < 2; m++)
         if ((o.need & ULAM_GUARD_HAT(m)) && ones[m]) need |= ULAM_GUARD_ABS; /* M^ is |M| itself */
-    if (need & ULAM_GUARD_ABS) status = radius(M, NULL, NULL, &a, &o, &g->abs, err);
+    if (need & ULAM_GUARD_ABS) status = radius(M, NULL, NULL, &a, 1, &o, &g->abs, err);
     for (int m = 0; m < 2 && !status; m++) {
         if (!(need & ULAM_GUARD_HAT(m))) continue;
         if (ones[m]) {
@@ -298,7 +352,7 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
         }
         sums h = hat_sums(&w, n, m == ULAM_FORWARD);
         const double *f = m == ULAM_FORWARD ? w.fc : w.fr;
-        status = radius(M, m == ULAM_FORWARD ? NULL : f, m == ULAM_FORWARD ? f : NULL, &h, &o, &g->hat[m], err);
+        status = radius(M, m == ULAM_FORWARD ? NULL : f, m == ULAM_FORWARD ? f : NULL, &h, 0, &o, &g->hat[m], err);
     }
     work_free(&w);
     if (status) return status;

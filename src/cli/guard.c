@@ -57,8 +57,9 @@ void cli_guard_diverge(const cli_system *s, const ulam_guard *g, int force)
 void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assume_finite)
 {
     if (g->verdict_abs == ULAM_VERDICT_EDGE)
-        fprintf(stderr, "ulam: %s: warning: rho(|M|) <= %.6g is within 1%% of 1: walks will be long "
-                        "(mean length about 1 / (1 - rho))\n", s->matrix_path, g->abs.upper);
+        fprintf(stderr, "ulam: %s: warning: rho(|M|) is certified below 1 but not below 0.99 (bounds [%.6g, %.6g)): "
+                        "walks may be long (mean length about 1 / (1 - rho))\n", s->matrix_path, g->abs.lower,
+                g->abs.upper);
     const ulam_power *h = &g->hat[mode];
     const char *kernel = mode == ULAM_ADJOINT ? "adjoint" : "forward";
     if (g->verdict_hat[mode] == ULAM_VERDICT_FAIL)
@@ -73,8 +74,9 @@ void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assu
                               : ", so it is treated as infinite: no confidence interval (--assume-finite-variance "
                                 "prints one anyway)");
     else if (g->verdict_hat[mode] == ULAM_VERDICT_EDGE)
-        fprintf(stderr, "ulam: %s: warning: rho(M^) <= %.6g is within 1%% of 1: the variance is finite "
-                        "but may be huge, and the error bar converges slowly\n", s->matrix_path, h->upper);
+        fprintf(stderr, "ulam: %s: warning: rho(M^) is certified below 1 but not below 0.99 (bounds [%.6g, %.6g)): "
+                        "the variance is finite but may be huge, and the error bar converges slowly\n",
+                s->matrix_path, h->lower, h->upper);
 }
 
 /* Print a JSON verdict on a variance: true, false or null (unknown). */
