@@ -193,25 +193,31 @@ static void work_free(guard_work *w)
     free(w->S), free(w->C), free(w->fr), free(w->fc), free(w->ca), free(w->rf);
 }
 
-/* The one pass over M (row by row): S, C, fr, and the column sums of diag(fr) |M| (each row
- * is read twice while it is in cache); then fc. */
-static int sum_pass(const ulam_csr *M, double continue_q, guard_work *w)
+/* The pass over M's rows: S and fr, reading M in order; with cols, also C, fc and the column
+ * sums of diag(fr) |M| (a scatter to random columns, each row read twice while in cache),
+ * made only when the row sums alone do not settle the run's verdicts. */
+static int sum_pass(const ulam_csr *M, double continue_q, int cols, guard_work *w)
 {
     int64_t n = M->nrows;
-    w->S = ulam__calloc((size_t)n, sizeof(double)), w->C = ulam__calloc((size_t)n, sizeof(double));
-    w->fr = ulam__malloc((size_t)n, sizeof(double)), w->fc = ulam__malloc((size_t)n, sizeof(double));
-    w->ca = ulam__calloc((size_t)n, sizeof(double));
-    if (!w->S || !w->C || !w->fr || !w->fc || !w->ca) return ULAM_ENOMEM;
-    for (int64_t i = 0; i < n; i++) {
-        double s = 0.0;
-        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) {
-            s += fabs(M->val[q]);
-            w->C[M->colidx[q]] += fabs(M->val[q]);
+    if (!w->S) {
+        w->S = ulam__malloc((size_t)n, sizeof(double)), w->fr = ulam__malloc((size_t)n, sizeof(double));
+        if (!w->S || !w->fr) return ULAM_ENOMEM;
+        for (int64_t i = 0; i < n; i++) {
+            double s = 0.0;
+            for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) s += fabs(M->val[q]);
+            w->S[i] = s;
+            w->fr[i] = ulam__factor(s, continue_q);
         }
-        w->S[i] = s;
-        w->fr[i] = ulam__factor(s, continue_q);
-        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) w->ca[M->colidx[q]] += w->fr[i] * fabs(M->val[q]);
     }
+    if (!cols) return ULAM_OK;
+    w->C = ulam__calloc((size_t)n, sizeof(double)), w->ca = ulam__calloc((size_t)n, sizeof(double));
+    w->fc = ulam__malloc((size_t)n, sizeof(double));
+    if (!w->C || !w->ca || !w->fc) return ULAM_ENOMEM;
+    for (int64_t i = 0; i < n; i++)
+        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) {
+            w->C[M->colidx[q]] += fabs(M->val[q]);
+            w->ca[M->colidx[q]] += w->fr[i] * fabs(M->val[q]);
+        }
     for (int64_t j = 0; j < n; j++) w->fc[j] = ulam__factor(w->C[j], continue_q);
     return ULAM_OK;
 }
@@ -238,68 +244,74 @@ static sums hat_sums(const guard_work *w, int64_t n, int forward)
     s.rmin = n ? INFINITY : 0.0, s.cmin = s.rmin;
     for (int64_t i = 0; i < n; i++) {
         double scaled = f[i] * base[i]; /* adjoint: row i of diag(f)|M|; forward: column i of |M|diag(f) */
-        double other = forward ? (w->rf ? w->rf[i] : INFINITY) : w->ca[i];
+        double other = forward ? (w->rf ? w->rf[i] : INFINITY) : w->ca ? w->ca[i] : INFINITY;
         double r = forward ? other : scaled, c = forward ? scaled : other;
         s.rmin = fmin(s.rmin, r), s.rmax = fmax(s.rmax, r);
         s.cmin = fmin(s.cmin, c), s.cmax = fmax(s.cmax, c);
         s.total += c; /* the sum of all entries: the column sums add up to it */
     }
     if (forward && !w->rf) s.rmin = 0.0;
+    if (!forward && !w->ca) s.cmin = 0.0;
     return s;
 }
 
-/* Column sums of |M| in double-double (Knuth's TwoSum per addition): hi + lo, so a column is
- * known to sum to at most 1, or below it, even when a tiny entry vanishes into a sum of 1. */
-static int column_sums_dd(const ulam_csr *M, double **hi, double **lo)
+/* Nonzero when every state is reachable in the graph of G (i -> j for G_ij != 0) from a
+ * state marked deficient (-1: out of memory). */
+static int all_reached(const ulam_csr *G, char *seen)
+{
+    int64_t n = G->nrows, head = 0, tail = 0;
+    int32_t *queue = ulam__malloc((size_t)n, sizeof *queue);
+    if (!queue) return -1;
+    for (int64_t j = 0; j < n; j++)
+        if (seen[j]) queue[tail++] = (int32_t)j;
+    while (head < tail) {
+        int32_t i = queue[head++];
+        for (int64_t q = G->rowptr[i]; q < G->rowptr[i + 1]; q++)
+            if (!seen[G->colidx[q]]) seen[G->colidx[q]] = 1, queue[tail++] = G->colidx[q];
+    }
+    free(queue);
+    return tail == n;
+}
+
+/* The walk kernel's own certificate of rho < 1.  Rows (adjoint walks on M): every row sum S_i
+ * of |M| is at most 1, as the kernel computes it in floating point, so every weight factor is
+ * exactly 1 and the kernel is a substochastic chain whose row probabilities sum to exactly 1;
+ * if from every state a state with S_i < 1 (where walks may end) can be reached, the chain is
+ * transient, some power of it has every row sum below 1, and its radius is below 1 (strictly:
+ * by how much, unknown).  Columns (forward walks on M') the same with the column sums C.
+ * 1 certified, 0 not, -1 out of memory. */
+static int kernel_transient(const ulam_csr *M, const double *sums, int rows)
 {
     int64_t n = M->nrows;
-    *hi = ulam__calloc((size_t)n, sizeof **hi), *lo = ulam__calloc((size_t)n, sizeof **lo);
-    if (!*hi || !*lo) return ULAM_ENOMEM;
     for (int64_t i = 0; i < n; i++)
-        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) {
-            int32_t j = M->colidx[q];
-            double a = (*hi)[j], v = fabs(M->val[q]), t = a + v, bb = t - a;
-            (*lo)[j] += (a - (t - bb)) + (v - bb);
-            (*hi)[j] = t;
-        }
-    return ULAM_OK;
-}
-
-/* Nonzero when every column of |M| sums to at most 1 and every state is reachable in the graph
- * of M (i -> j for M_ij != 0) from a column summing to less than 1: |M|' is then substochastic
- * and from each of its states a deficient row can be reached, so some power of it has every
- * row sum below 1, and rho(|M|) < 1 strictly (by how much, unknown).  -1: out of memory. */
-static int deficient_reach(const ulam_csr *M)
-{
-    int64_t n = M->nrows, head = 0, tail = 0;
-    double *hi = NULL, *lo = NULL;
+        if (sums[i] > 1.0) return 0;
     char *seen = ulam__calloc((size_t)n, 1);
-    int32_t *queue = ulam__malloc((size_t)n, sizeof *queue);
-    int ok = column_sums_dd(M, &hi, &lo) == ULAM_OK && seen && queue ? 1 : -1;
-    for (int64_t j = 0; j < n && ok > 0; j++) {
-        if (hi[j] > 1.0 || (hi[j] == 1.0 && lo[j] > 0.0)) ok = 0;
-        else if (hi[j] < 1.0 && hi[j] + lo[j] < 1.0) seen[j] = 1, queue[tail++] = (int32_t)j;
+    ulam_csr *T = NULL;
+    if (!seen || (rows && ulam_csr_transpose(M, &T))) {
+        free(seen);
+        return -1;
     }
-    while (ok > 0 && head < tail) {
-        int32_t i = queue[head++];
-        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++)
-            if (!seen[M->colidx[q]]) seen[M->colidx[q]] = 1, queue[tail++] = M->colidx[q];
-    }
-    free(hi), free(lo), free(seen), free(queue);
-    return ok > 0 ? tail == n : ok;
+    for (int64_t i = 0; i < n; i++) seen[i] = sums[i] < 1.0;
+    int r = all_reached(rows ? T : M, seen); /* rows: states that reach a deficient one in M */
+    ulam_csr_free(T);
+    free(seen);
+    return r;
 }
 
-/* One radius: the sums' bounds (and for rho(|M|) itself, reach != 0, the reachability
- * certificate of rho < 1), then power iteration unless they certify (or o->tight). */
-static int radius(const ulam_csr *M, const double *left, const double *right, const sums *sm, int reach,
-                  const ulam_guard_opts *o, ulam_power *out, ulam_error *err)
+/* One radius: the sums' bounds (and for rho(|M|) itself, when S and C are given, the kernels'
+ * certificate of rho < 1: rows if reach & 1, columns if reach & 2, all those asked must hold),
+ * then power iteration unless they certify (or o->tight). */
+static int radius(const ulam_csr *M, const double *left, const double *right, const sums *sm, const double *S,
+                  const double *C, int reach, const ulam_guard_opts *o, ulam_power *out, ulam_error *err)
 {
     double t0 = ulam_now();
     *out = from_sums(sm, M->nrows);
     out->seconds = 0.0;
     int status = ULAM_OK;
-    if (reach && !certain(out->lower, out->upper) && out->upper >= 1.0 && sm->cmax <= 1.0 && sm->cmin < 1.0) {
-        int r = deficient_reach(M);
+    if (reach && !certain(out->lower, out->upper) && out->upper >= 1.0) {
+        int r = 1;
+        for (int v = 0; v < 2 && r > 0; v++)
+            if (reach & (1 << v)) r = (v ? C : S) ? kernel_transient(M, v ? C : S, v == 0) : 0;
         if (r < 0) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
         if (r) out->upper = nextafter(1.0, 0.0), out->lower = fmin(out->lower, out->upper);
     }
@@ -326,7 +338,17 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
     ulam_power none = {.upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
     *g = (ulam_guard){.continue_q = continue_q, .abs = none, .hat = {none, none}};
     guard_work w = {0};
-    int status = sum_pass(M, continue_q, &w);
+    int status = sum_pass(M, continue_q, 0, &w), cols = o.tight || (o.need & ULAM_GUARD_FORWARD);
+    if (!status && !cols) { /* the column sums only when the row sums do not certify */
+        double lo, hi;
+        range(w.S, n, &lo, &hi);
+        cols = !certain(lo, hi);
+        if ((o.need & ULAM_GUARD_ADJOINT) && !all_ones(w.fr, n)) {
+            sums h = hat_sums(&w, n, 0);
+            cols |= !certain(h.rmin, h.rmax);
+        }
+    }
+    if (!status && cols) status = sum_pass(M, continue_q, 1, &w);
     if (!status && (o.need & ULAM_GUARD_FORWARD)) { /* the second pass only when the column sums do not certify */
         sums f = hat_sums(&w, n, 1);
         if (o.tight || !certain(fmax(f.cmin, 0.0), f.cmax)) status = forward_rows(M, &w);
@@ -336,13 +358,15 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel factors");
     }
     double pass = ulam_now() - t0;
-    sums a = {0};
-    range(w.S, n, &a.rmin, &a.rmax), range(w.C, n, &a.cmin, &a.cmax);
+    sums a = {.cmin = 0.0, .cmax = INFINITY};
+    range(w.S, n, &a.rmin, &a.rmax);
+    if (w.C) range(w.C, n, &a.cmin, &a.cmax);
     for (int64_t i = 0; i < n; i++) a.total += w.S[i];
-    int ones[2] = {all_ones(w.fr, n), all_ones(w.fc, n)}, need = o.need;
+    int ones[2] = {all_ones(w.fr, n), w.fc && all_ones(w.fc, n)}, need = o.need;
     for (int m = 0; m < 2; m++)
         if ((o.need & ULAM_GUARD_HAT(m)) && ones[m]) need |= ULAM_GUARD_ABS; /* M^ is |M| itself */
-    if (need & ULAM_GUARD_ABS) status = radius(M, NULL, NULL, &a, 1, &o, &g->abs, err);
+    int reach = (need & ULAM_GUARD_ADJOINT ? 1 : 0) | (need & ULAM_GUARD_FORWARD ? 2 : 0);
+    if (need & ULAM_GUARD_ABS) status = radius(M, NULL, NULL, &a, w.S, w.C, reach ? reach : 3, &o, &g->abs, err);
     for (int m = 0; m < 2 && !status; m++) {
         if (!(need & ULAM_GUARD_HAT(m))) continue;
         if (ones[m]) {
@@ -352,7 +376,8 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
         }
         sums h = hat_sums(&w, n, m == ULAM_FORWARD);
         const double *f = m == ULAM_FORWARD ? w.fc : w.fr;
-        status = radius(M, m == ULAM_FORWARD ? NULL : f, m == ULAM_FORWARD ? f : NULL, &h, 0, &o, &g->hat[m], err);
+        status = radius(M, m == ULAM_FORWARD ? NULL : f, m == ULAM_FORWARD ? f : NULL, &h, NULL, NULL, 0, &o, &g->hat[m],
+                        err);
     }
     work_free(&w);
     if (status) return status;
