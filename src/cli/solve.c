@@ -114,17 +114,19 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
            cli_verdict_word(ro->g.verdict_hat[o->mode]));
     if (isfinite(r->score_bound))
         printf("tail            a single score is at most %.4g: one more walk could move the estimate by at "
-               "most %.3g%%%s\n", r->score_bound, 100 * r->tail_bound,
-               o->rel_err > 0 ? "" : "");
+               "most %.3g%%\n", r->score_bound, 100 * r->tail_bound);
     else
         printf("tail            scores are unbounded (walk length, weights): no walk count rules out an unseen "
                "large score; the variance's own relative error is %.3g\n", r->variance_rel_error);
     if (o->mode == ULAM_FORWARD)
         printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
                (long long)r->unreached, (long long)ro->n);
-    if (o->rel_err > 0)
-        printf("rel-err         %s (target %.3g; the rule needs %.4g walks at this estimate)\n",
+    if (o->rel_err > 0 && r->min_walks > 0)
+        printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate)\n",
                r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks);
+    else if (o->rel_err > 0)
+        printf("rel-err         %s (target %.3g; no score bound: the standard error and the fourth-moment check "
+               "decide)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
     if (ro->check)
