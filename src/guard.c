@@ -23,7 +23,8 @@
 
 /* Iterations spent, once a radius is certified below 1, on settling whether it is below 0.99
  * (the warning's margin). */
-enum { MARGIN_TRIES = 20 };
+enum { MARGIN_TRIES = 20, SUPPORT_EVERY = 10 };
+#define SUPPORT_CUT 1e-10 /* the support of an iterate for support_lower */
 
 /* The default options. */
 ulam_power_opts ulam_power_defaults(void)
@@ -73,6 +74,24 @@ static int certain(double lower, double upper)
     return upper < 0.99 || lower >= 1.0 || (lower >= 0.99 && upper < 1.0);
 }
 
+/* A lower bound on the radius from the iterate x restricted to its support (entries below
+ * SUPPORT_CUT of the largest set to 0): for nonnegative A, x >= 0, x != 0 and A x >= lambda x
+ * give rho(A) >= lambda (Collatz-Wielandt), and outside the support A x >= 0 = lambda x holds
+ * anyway, so states that cannot reach the dominant class (a dangling row, say, whose ratio is 0)
+ * no longer pin the bound at 0.  xt and yt are scratch of n. */
+static double support_lower(const ulam_csr *A, const double *left, const double *right, const double *x, double *xt,
+                            double *yt)
+{
+    int64_t n = A->nrows;
+    double mx = 0.0, lam = INFINITY;
+    for (int64_t i = 0; i < n; i++) mx = fmax(mx, x[i]);
+    for (int64_t i = 0; i < n; i++) xt[i] = x[i] >= SUPPORT_CUT * mx ? x[i] * (right ? right[i] : 1.0) : 0.0;
+    apply(A, left, xt, yt);
+    for (int64_t i = 0; i < n; i++)
+        if (xt[i] > 0) lam = fmin(lam, yt[i] / (xt[i] / (right ? right[i] : 1.0)));
+    return isfinite(lam) ? lam : 0.0;
+}
+
 /* Power iteration on diag(left) |A| diag(right) from bounds [lower, upper] already known
  * (the one-pass sums); out keeps the tighter bounds of both. */
 static int power_from(const ulam_csr *A, const double *left, const double *right, const ulam_power_opts *o,
@@ -82,10 +101,11 @@ static int power_from(const ulam_csr *A, const double *left, const double *right
     double t0 = ulam_now();
     double *x = ulam__malloc((size_t)n, sizeof *x), *y = ulam__malloc((size_t)n, sizeof *y);
     double *xr = right ? ulam__malloc((size_t)n, sizeof *xr) : x;
-    if (!x || !y || !xr) {
-        free(x), free(y);
+    double *xt = ulam__malloc((size_t)n, sizeof *xt), *yt = ulam__malloc((size_t)n, sizeof *yt);
+    if (!x || !y || !xr || !xt || !yt) {
+        free(x), free(y), free(xt), free(yt);
         if (right) free(xr);
-        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for three vectors of %lld", (long long)n);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for five vectors of %lld", (long long)n);
     }
     for (int64_t i = 0; i < n; i++) x[i] = 1.0;
     int stable = 0;
@@ -103,6 +123,8 @@ static int power_from(const ulam_csr *A, const double *left, const double *right
         out->rho = step(n, x, y, &lo, &hi);
         out->iterations++;
         out->lower = fmax(out->lower, lo), out->upper = fmin(out->upper, hi);
+        if (out->iterations % SUPPORT_EVERY == 0 && out->lower < out->upper)
+            out->lower = fmin(fmax(out->lower, support_lower(A, left, right, x, xt, yt)), out->upper);
         /* the changes shrink geometrically at about `ratio`: the ones still to come add up to ahead */
         double c = fabs(out->rho - prev), ratio = c / change;
         double ahead = prev >= 0 && isfinite(change) && ratio < 1 ? c * ratio / (1 - ratio) : INFINITY;
@@ -113,7 +135,7 @@ static int power_from(const ulam_csr *A, const double *left, const double *right
     if (n == 0) out->lower = out->upper = 0.0, out->converged = 1;
     out->rho = fmin(fmax(out->rho, out->lower), out->upper);
     out->seconds += ulam_now() - t0;
-    free(x), free(y);
+    free(x), free(y), free(xt), free(yt);
     if (right) free(xr);
     return ULAM_OK;
 }
