@@ -84,6 +84,10 @@ CASES += [
     (["solve", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--index", "1", "--jacobi", "--omega", "0.5",
       "--walks", "2000"], 0, r"rho\(\|M\|\) is certified below 1 but not below 0\.99 \(bounds \[0\.9\d+, 1\)\)", r"\+-"),
     (SOLVE + ["--index", "1", "--walks", "-5"], 2, r"--walks expects an integer", ""),
+    # the score-bound minimum out of reach: said after the first round, collision/expected named
+    (SOLVE + ["--index", "2", "--estimator", "absorption", "--rel-err", "0.0001", "--walks", "2000"], 0,
+     r"a single absorption score can reach 5, so the rule needs about .* walks .*more than --walks.*collision and expected",
+     r"rel-err\s+NOT met"),
     (SOLVE + ["--index", "1", "--rel-err", "0"], 2, r"--rel-err expects a number", ""),
     (SOLVE + ["--index", "1", "--threads", "0"], 2, r"--threads expects an integer", ""),
     (SOLVE + ["--index", "1", "--seed", "twelve"], 2, r"--seed expects an integer from 0", ""),
