@@ -32,6 +32,7 @@ enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = 4 };
 #define REL_MIN 1000
 #define EB_RANGE 12.283413301 /* 3 ln(60) */
 #define VAR_REL_MAX 0.25
+#define TAIL_E 0.01 /* the target a run without rel_err reports its tail_bound at */
 
 struct ulam_solver {
     ulam_walk_opts o;
@@ -52,6 +53,9 @@ struct ulam_solver {
     ulam_guard g;        /* the verdicts, checked before walking */
     int var_finite;      /* 1, 0 or -1 (ulam_guard_variance, or 1 by assume_finite) */
     double bound, range; /* the largest |score| a walk can make; the scores' range (INFINITY: none) */
+    double per_step, qmax; /* collision, expected: the largest |score| of one visit, the largest
+                              continuation over reachable states (walk length tail q^l) */
+    int signs;             /* scores may take both signs */
     int64_t walks, steps, cut, nonfinite, next_walk;
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
     double seconds, t0;
@@ -134,14 +138,22 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     }
     int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = 0;
     int64_t bad = -1;
-    double w0 = 1.0, fbig = 0.0, gmax = 0.0;
+    int expected = s->o.estimator == ULAM_EXPECTED;
+    double w0 = 1.0, fbig = 0.0, gmax = 0.0, vmax = 0.0, qmax = 0.0;
     for (int64_t i = 0; i < s->n; i++) {
         if (!seen[i]) continue;
-        double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q);
+        double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
         fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
-        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) neg |= K->val[k] < 0;
-        int scores = adj ? s->b[i] != 0.0 : i == s->o.index;
+        qmax = fmax(qmax, q);
+        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
+            neg |= K->val[k] < 0;
+            if (adj && expected) c += K->val[k] * s->b[K->colidx[k]];
+        }
         if (absorb && (adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
+        /* what one visit scores: b_i (collision), (M b)_i (expected), forward 1 at the index */
+        double v = adj ? fabs(expected ? c : s->b[i]) : i == s->o.index ? (expected ? INFINITY : 1.0) : 0.0;
+        vmax = fmax(vmax, v);
+        int scores = adj ? s->b[i] != 0.0 : i == s->o.index;
         if (!scores) continue;
         double g = adj ? fabs(s->b[i]) : 1.0;
         gmax = fmax(gmax, absorb ? (q < 1.0 ? g / (1.0 - q) : INFINITY) : INFINITY);
@@ -160,9 +172,12 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
                           "reachable and never terminates (its row sum of |%s| is >= 1): use the "
                           "collision estimator or --continue Q",
                           (long long)bad + 1, adj ? "M" : "M' (column of M)");
-    double W = fbig <= 1.0 ? (s->o.roulette > w0 ? s->o.roulette : w0) : INFINITY;
+    double W = fbig <= 1.0 && !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) : INFINITY;
+    s->signs = pos && neg;
     s->bound = gmax > 0 ? W * gmax : 0.0;
-    s->range = s->bound * (pos && neg ? 2.0 : 1.0);
+    s->range = s->bound * (s->signs ? 2.0 : 1.0);
+    s->per_step = vmax > 0 ? W * vmax : 0.0;
+    s->qmax = qmax;
     return ULAM_OK;
 }
 
@@ -295,7 +310,8 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
-    s->bound = s->range = INFINITY;
+    s->bound = s->range = s->per_step = INFINITY;
+    s->qmax = 1.0;
     if ((o.estimator == ULAM_ABSORPTION || o.rel_err > 0) && (status = check_reach(s, K, err))) {
         ulam_solver_free(s);
         return status;
@@ -518,7 +534,7 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
 {
     double E = s->o.rel_err, m = fabs(r->estimate);
     if (!(E > 0) || s->var_finite != 1 || r->walks < REL_MIN) return 0;
-    if (s->bound == 0.0) return 1; /* nothing that scores is reachable: x is 0 exactly */
+    if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
     if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.index] == 0))
         return 0;
     return r->std_error <= E * m && (double)r->walks >= r->min_walks && r->variance_rel_error <= VAR_REL_MAX;
@@ -577,6 +593,21 @@ static void forward_component(const ulam_solver *s, int64_t i, double *est, doub
     if (s->sum[i] == 0.0 && s->sumsq[i] == 0.0) *se = NAN; /* no walk tallied it: no estimate */
 }
 
+/* The range of a single score the rel_err rule uses at estimate m and target E: the bound on a
+ * score (absorption); for collision and expected, whose scores grow with the walk's length, the
+ * range of walks of at most l steps, l the length past which walks can add no more than E |m|
+ * to the mean: visits score at most per_step and a walk is alive after k steps with
+ * probability at most qmax^k, so the rest adds at most per_step qmax^(l+1) / (1 - qmax).
+ * INFINITY when no bound holds (qmax = 1, weights that can grow). */
+static double score_range(const ulam_solver *s, double m, double E)
+{
+    if (isfinite(s->range) || s->bound == 0.0) return s->range;
+    if (s->per_step == 0.0) return 0.0;
+    if (!isfinite(s->per_step) || !(s->qmax < 1.0) || !(m > 0)) return INFINITY;
+    double steps = s->qmax > 0 ? ceil(log(s->per_step / (E * m * (1.0 - s->qmax))) / log(1.0 / s->qmax)) : 0.0;
+    return s->per_step * fmax(1.0, steps + 1.0) * (s->signs ? 2.0 : 1.0);
+}
+
 /* The result so far; the forward count of unreached components (O(n)) when asked. */
 static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached)
 {
@@ -597,11 +628,12 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->max_share = sumsq > 0 ? fmin(1.0, s->maxsq / sumsq) : 0.0;
     r->variance_finite = s->var_finite;
     r->variance_rel_error = mom->m2 > 0 ? ulam__moments_variance_rel_error(mom) : mom->n > 1 ? 0.0 : INFINITY;
-    double m = fabs(r->estimate), N = (double)s->walks;
+    double m = fabs(r->estimate), N = (double)s->walks, E = s->o.rel_err > 0 ? s->o.rel_err : TAIL_E;
+    double R = score_range(s, m, E);
     r->score_bound = s->bound;
-    r->tail_bound = s->bound == 0.0 ? 0.0 : N > 0 && m > 0 ? s->range / (N * m) : INFINITY;
-    r->min_walks = !(s->o.rel_err > 0) || !isfinite(s->range) || s->range == 0.0 ? 0.0
-                   : m > 0 ? ceil(EB_RANGE * s->range / (s->o.rel_err * m)) : INFINITY;
+    r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
+    r->min_walks = !(s->o.rel_err > 0) || !isfinite(R) || R == 0.0 ? 0.0
+                   : m > 0 ? ceil(EB_RANGE * R / (s->o.rel_err * m)) : INFINITY;
     r->rel_err_met = s->met;
     double half = s->var_finite == 1 ? 1.959963984540054 * r->std_error : NAN;
     r->ci95[0] = r->estimate - half;

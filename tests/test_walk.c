@@ -545,6 +545,31 @@ static void test_forward_unreached(void **state)
     unload(&s);
 }
 
+/* Collision on a sticky rare cluster (rare_system with the three rare states' rows pointing at
+ * each other: walks that reach them, once in about 10^4, stay about 500 steps scoring 40 each,
+ * 45% of x): a single score has no bound, but walks longer than l add under E |m|, so the rule
+ * asks for ~10^6 walks and does not stop at 2000 (the old rule stopped at 1024 walks in 95 of
+ * 100 seeds, 45% low; with the score-bound minimum 18 of 20 seeds covered at E = 0.1). */
+static void test_rel_err_collision_tail(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M0 = rare_system(200, 0.002, 40, 0.00003, 1, &b), *T = NULL, *M = NULL;
+    for (int i = 0; i < 3; i++)
+        for (int64_t q = M0->rowptr[i]; q < M0->rowptr[i + 1]; q++) M0->colidx[q] = (int32_t)((i + 1 + q % 2) % 3);
+    assert_int_equal(ulam_csr_transpose(M0, &T), ULAM_OK); /* re-sort the rewired rows */
+    assert_int_equal(ulam_csr_transpose(T, &M), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 3, o.rel_err = 0.1, o.max_walks = 2000;
+    ulam_walk_result r;
+    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    print_message("sticky cluster, collision, 2000 walks: the rule needs %.3g walks (tail bound %.3g)\n", r.min_walks,
+                  r.tail_bound);
+    assert_true(!isfinite(r.score_bound) && isfinite(r.tail_bound));
+    assert_true(r.min_walks > 1e6 && !r.rel_err_met && r.walks == 2000);
+    ulam_csr_free(M0), ulam_csr_free(T), ulam_csr_free(M), free(b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -556,7 +581,7 @@ int main(void)
         cmocka_unit_test(test_rel_err_stop),      cmocka_unit_test(test_jacobi_poisson),
         cmocka_unit_test(test_collision_absorption_law),
         cmocka_unit_test(test_solver_guards),     cmocka_unit_test(test_rel_err_infinite_refused),
-        cmocka_unit_test(test_forward_unreached),
+        cmocka_unit_test(test_forward_unreached), cmocka_unit_test(test_rel_err_collision_tail),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -115,6 +115,10 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (isfinite(r->score_bound))
         printf("tail            a single score is at most %.4g: one more walk could move the estimate by at "
                "most %.3g%%\n", r->score_bound, 100 * r->tail_bound);
+    else if (isfinite(r->tail_bound))
+        printf("tail            scores grow with the walk's length; walks short enough to matter (the rest add under "
+               "%.3g%% of the answer) could move it by at most %.3g%% more\n", 100 * (o->rel_err > 0 ? o->rel_err : 0.01),
+               100 * r->tail_bound);
     else
         printf("tail            scores are unbounded (walk length, weights): no walk count rules out an unseen "
                "large score; the variance's own relative error is %.3g\n", r->variance_rel_error);
@@ -246,11 +250,17 @@ static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const 
 {
     double limit = o->max_walks > 0 ? (double)o->max_walks : 1e8;
     if (!(o->rel_err > 0) || !(r->min_walks > limit)) return;
-    fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %s score can reach %.4g, so the rule needs about %.3g "
-                    "walks at this estimate before it may stop (%s); the collision and expected estimators score b "
-                    "directly and have no such tail\n", s->matrix_path, o->rel_err,
-            o->estimator == ULAM_ABSORPTION ? "absorption" : "", r->score_bound, r->min_walks,
-            o->max_walks > 0 ? "more than --walks" : "out of reach in practice");
+    if (isfinite(r->score_bound))
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %s score can reach %.4g, so the rule needs about "
+                        "%.3g walks at this estimate before it may stop (%s)%s\n", s->matrix_path, o->rel_err,
+                o->estimator == ULAM_ABSORPTION ? "absorption" : "", r->score_bound, r->min_walks,
+                o->max_walks > 0 ? "more than --walks" : "out of reach in practice",
+                o->estimator == ULAM_ABSORPTION ? "; the collision and expected estimators score b directly and "
+                                                  "have no such tail" : "");
+    else
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g: scores grow with the walk's length, so the rule needs about "
+                        "%.3g walks at this estimate before it may stop (%s)\n", s->matrix_path, o->rel_err, r->min_walks,
+                o->max_walks > 0 ? "more than --walks" : "out of reach in practice");
 }
 
 /* ulam solve. */
