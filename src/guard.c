@@ -110,11 +110,12 @@ static int power_from(const ulam_csr *A, const double *left, const double *right
     for (int64_t i = 0; i < n; i++) x[i] = 1.0;
     int stable = 0;
     double prev = -1.0, change = INFINITY;
-    /* certifying, an estimate that has converged while the bounds still straddle a threshold
-     * goes on (the bounds close in later); once the radius is certified below 1, at most
+    /* an estimate that has converged while the bounds still straddle a threshold goes on (the
+     * bounds close in later); certifying, once the radius is certified below 1, at most
      * MARGIN_TRIES more iterations try to settle the warning's 0.99 */
     int extra = 0;
-    while (out->iterations < o->max_iter && n > 0 && !(o->certify ? certain(out->lower, out->upper) : out->converged) &&
+    while (out->iterations < o->max_iter && n > 0 &&
+           !(certain(out->lower, out->upper) && (o->certify || out->converged)) &&
            !(o->certify && out->upper < 1.0 && extra++ >= MARGIN_TRIES)) {
         if (right)
             for (int64_t i = 0; i < n; i++) xr[i] = right[i] * x[i];
@@ -123,14 +124,14 @@ static int power_from(const ulam_csr *A, const double *left, const double *right
         out->rho = step(n, x, y, &lo, &hi);
         out->iterations++;
         out->lower = fmax(out->lower, lo), out->upper = fmin(out->upper, hi);
-        if (out->iterations % SUPPORT_EVERY == 0 && out->lower < out->upper)
-            out->lower = fmin(fmax(out->lower, support_lower(A, left, right, x, xt, yt)), out->upper);
         /* the changes shrink geometrically at about `ratio`: the ones still to come add up to ahead */
         double c = fabs(out->rho - prev), ratio = c / change;
         double ahead = prev >= 0 && isfinite(change) && ratio < 1 ? c * ratio / (1 - ratio) : INFINITY;
         stable = ahead <= o->tol * out->rho ? stable + 1 : 0;
         prev = out->rho, change = c;
         out->converged = out->upper - out->lower <= o->tol * out->upper || stable >= 5 || out->upper <= o->tol;
+        if ((out->converged || out->iterations % SUPPORT_EVERY == 0) && out->lower < out->upper)
+            out->lower = fmin(fmax(out->lower, support_lower(A, left, right, x, xt, yt)), out->upper);
     }
     if (n == 0) out->lower = out->upper = 0.0, out->converged = 1;
     out->rho = fmin(fmax(out->rho, out->lower), out->upper);
