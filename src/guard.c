@@ -337,6 +337,11 @@ static int radius(const ulam_csr *M, const double *left, const double *right, co
             if (reach & (1 << v)) r = (v ? C : S) ? kernel_transient(M, v ? C : S, v == 0) : 0;
         if (r < 0) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
         if (r) out->upper = nextafter(1.0, 0.0), out->lower = fmin(out->lower, out->upper);
+        if (r && !o->tight) { /* certain: below 1; the 0.99 margin is left open (at sums of 1 power
+                                 * iteration would seldom settle it) */
+            out->seconds = ulam_now() - t0;
+            return ULAM_OK;
+        }
     }
     if (!out->converged && (o->tight || !certain(out->lower, out->upper))) {
         ulam_power_opts po = o->power;
