@@ -215,13 +215,14 @@ static int check_verdicts(const ulam_csr *M, ulam_solver *s, ulam_error *err)
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_HAT(other);
     if (!(og.computed & go.need) && ulam_guard_check(M, o->continue_q, &go, &og, NULL)) og.verdict_hat[other] = ULAM_VERDICT_UNKNOWN;
-    int ok = ulam_guard_variance(&og, other) == 1;
+    char also[96] = "; the other mode's is not certified finite either";
+    if (ulam_guard_variance(&og, other) == 1)
+        snprintf(also, sizeof also, "; the %s mode's is finite, %.4g < 1", other == ULAM_ADJOINT ? "adjoint" : "forward",
+                 og.hat[other].upper);
     return ulam__fail(err, ULAM_EINFVAR, 0, -1,
-                      "a finite variance for a relative-error target: rho(M^) of the %s kernel is in [%.4g, %.4g] "
-                      "(%s)%s%s%.4g%s", o->mode == ULAM_ADJOINT ? "adjoint" : "forward", h->lower, h->upper,
-                      s->var_finite == 0 ? ">= 1: infinite" : "straddles 1: unknown",
-                      ok ? "; the " : "", ok ? (other == ULAM_ADJOINT ? "adjoint mode's is finite, " : "forward mode's is finite, ") : "",
-                      ok ? og.hat[other].upper : 0.0, ok ? " < 1" : "; bound the run by walks or time instead");
+                      "a finite variance for a relative-error target: rho(M^) of the %s kernel is in [%.4g, %.4g] (%s)%s",
+                      o->mode == ULAM_ADJOINT ? "adjoint" : "forward", h->lower, h->upper,
+                      s->var_finite == 0 ? ">= 1: infinite" : "straddles 1: unknown", also);
 }
 
 /* The forward source distribution |b| / ||b||_1 as an alias table; sets *bnorm1. */
