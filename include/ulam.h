@@ -409,9 +409,13 @@ typedef struct ulam_walk_result {
                             assume_finite), 0 infinite, -1 unknown; ci95 is NaN unless 1 */
     double score_bound;  /* the largest |score| a walk can make (absorption: W max |b_j| / p*_j over
                             reachable scoring states, W the weight bound); INFINITY: unbounded */
-    double tail_bound;   /* score_bound / (walks |estimate|): the most one more walk could move the
-                            estimate, relatively; luck-independent (INFINITY: unbounded) */
-    double min_walks;    /* the walk count the rel_err rule needs at this estimate (0: none) */
+    double tail_bound;   /* R / (walks |estimate|), R the range the rel_err rule uses (score_bound,
+                            or for collision and expected the range of walks short enough to
+                            matter at the rel_err target, 1% without one): how far one more walk
+                            could move the estimate, relatively; luck-independent (INFINITY: no
+                            bound) */
+    double min_walks;    /* the walk count the rel_err rule's range term needs at this estimate
+                            (0: no bound) */
     double variance_rel_error; /* relative standard error of `variance` (fourth moment) */
     int rel_err_met;     /* 1: stopped by the rel_err rule */
     int64_t unreached;   /* forward: components no walk has tallied (no estimate at all) */
