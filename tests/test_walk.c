@@ -409,7 +409,8 @@ static void test_bad_options(void **state)
     unload(&s);
 }
 
-/* --rel-err stops once the relative standard error is reached, after at least 1000 walks. */
+/* --rel-err stops once the relative standard error is reached, after at least 1000 walks; with
+ * nothing reachable that scores (b = 0) it stops at once with x = 0. */
 static void test_rel_err_stop(void **state)
 {
     (void)state;
@@ -423,6 +424,9 @@ static void test_rel_err_stop(void **state)
     assert_true(r.walks >= 1000);
     assert_true(r.std_error <= 0.005 * fabs(r.estimate));
     assert_true(fabs(r.estimate - s.x[11]) < 4 * r.std_error);
+    for (int64_t i = 0; i < s.n; i++) s.b[i] = 0.0; /* x = 0 exactly: the rule ends at once, never spins */
+    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_true(r.rel_err_met && r.estimate == 0.0 && r.walks < 2048);
     unload(&s);
 }
 
