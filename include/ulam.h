@@ -49,6 +49,8 @@ enum ulam_status {
     ULAM_ENOTFOUND,    /* a named thing (material, label) is not defined */
     ULAM_ERANGE,       /* a value outside its allowed range (a reflectance outside [0, 1)) */
     ULAM_EDEVICE,      /* the ray-casting device (Embree) failed */
+    ULAM_EDIVERGE,     /* rho(|M|) is not certified below 1: the walks may diverge */
+    ULAM_EINFVAR,      /* a relative-error target with a variance not certified finite */
     ULAM_NSTATUS
 };
 
@@ -247,18 +249,25 @@ typedef struct ulam_power_opts {
                      changes, extrapolated as a geometric series, add up to <= tol * rho,
                      or when upper <= tol (default 1e-4) */
     int max_iter; /* iteration cap (default 1000) */
+    int certify;  /* nonzero: stop as soon as the bounds certify a verdict (ulam_verdict_of)
+                     with its warning margin: upper < 0.99, lower >= 1, or 0.99 <= lower and
+                     upper < 1 (default 0: iterate to the tolerance) */
 } ulam_power_opts;
 
 /* The default options. */
 ulam_power_opts ulam_power_defaults(void);
 
 /* Spectral radius of a nonnegative operator by power iteration, with Collatz-Wielandt bounds
- * from the same iterates: for any positive x, min_i (Ax)_i / x_i <= rho(A) <= max_i (Ax)_i / x_i. */
+ * from the same iterates: for any positive x, min_i (Ax)_i / x_i <= rho(A) <= max_i (Ax)_i / x_i.
+ * Plain data, so a certificate can be stored and read back (a prepared system). */
 typedef struct ulam_power {
-    double rho;          /* the estimate, sum(Ax) / sum(x) at the last iterate */
+    double rho;          /* the estimate, sum(Ax) / sum(x) at the last iterate: a crude one
+                            unless converged (then only the bounds are certain) */
     double lower, upper; /* certified bounds: lower <= rho(A) <= upper */
-    int iterations;      /* matrix-vector products */
-    int converged;       /* stopped by the tolerance, not the cap */
+    double rowsum_max, colsum_max; /* the one-pass bounds: largest row and column sums of the
+                                      matrix (INFINITY when not computed) */
+    int iterations;      /* matrix-vector products (0: the one-pass bounds sufficed) */
+    int converged;       /* stopped by the tolerance: rho is an estimate to tol */
     double seconds;
 } ulam_power;
 
@@ -266,23 +275,54 @@ typedef struct ulam_power {
 int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
                         const ulam_power_opts *opts, ulam_power *out, ulam_error *err);
 
-/* A radius against 1: below 0.99 fine, in [0.99, 1) near the edge, >= 1 failing.  Certified
- * bounds decide first (upper < 0.99: fine; lower >= 1: failing), then the estimate. */
-enum ulam_verdict { ULAM_VERDICT_OK = 0, ULAM_VERDICT_EDGE = 1, ULAM_VERDICT_FAIL = 2 };
+/* A radius against 1, from its certified bounds alone (never from an unconverged estimate):
+ * OK when upper < 0.99; EDGE (finite, within 1% of 1) when upper < 1; FAIL when lower >= 1;
+ * UNKNOWN when the bounds straddle 1, which callers treat as FAIL unless told otherwise. */
+enum ulam_verdict { ULAM_VERDICT_OK = 0, ULAM_VERDICT_EDGE = 1, ULAM_VERDICT_FAIL = 2, ULAM_VERDICT_UNKNOWN = 3 };
 int ulam_verdict_of(const ulam_power *p);
 
-/* The guards of a walk on M with continuation continue_q (<= 0: analog):
+/* The radii a guard check computes: rho(|M|), the adjoint and the forward rho(M^). */
+enum { ULAM_GUARD_ABS = 1, ULAM_GUARD_ADJOINT = 2, ULAM_GUARD_FORWARD = 4, ULAM_GUARD_ALL = 7 };
+
+/* The bit of ULAM_GUARD_* for the rho(M^) of walks in mode (ULAM_ADJOINT, ULAM_FORWARD). */
+#define ULAM_GUARD_HAT(mode) ((mode) == 1 ? ULAM_GUARD_FORWARD : ULAM_GUARD_ADJOINT)
+
+/* What a guard check computes and how far. */
+typedef struct ulam_guard_opts {
+    int need;  /* ULAM_GUARD_* bits (0: all three) */
+    int tight; /* nonzero: iterate every radius to the tolerance (ulam info); 0: stop as soon
+                  as the bounds certify the verdict (one O(nnz) pass when row or column sums do) */
+    ulam_power_opts power; /* the iteration (certify is set by tight) */
+} ulam_guard_opts;
+
+/* The defaults: all three radii, stopped once certified. */
+ulam_guard_opts ulam_guard_defaults(void);
+
+/* The guards of a walk on M with continuation continue_q (<= 0: analog), a plain struct (a
+ * certificate a prepared-system file can store and reload):
  *   abs:    rho(|M|) (= rho(|M'|)): the walk's expectation is a convergent series iff < 1;
  *   hat[m]: rho(M^) of the mode m kernel's second-moment matrix M^_ij = K_ij^2 / (q_i p_ij),
- *           K = M (adjoint) or M' (forward): the estimators' variance is finite iff < 1. */
+ *           K = M (adjoint) or M' (forward): the estimators' variance is finite iff < 1.
+ * Each radius carries its one-pass row/column-sum bounds, its certified bounds (the tighter of
+ * those and the power iteration's), its estimate and whether it converged; verdicts come from
+ * the bounds only.  A radius not computed has verdict ULAM_VERDICT_UNKNOWN and bounds
+ * [0, INFINITY]. */
 typedef struct ulam_guard {
+    double continue_q; /* the kernel the radii describe */
+    int computed;      /* ULAM_GUARD_* bits of the radii computed */
     ulam_power abs, hat[2];
     int verdict_abs, verdict_hat[2];
 } ulam_guard;
 
-/* Estimate the three radii (opts may be NULL). */
-int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_power_opts *opts,
+/* Compute the radii opts->need asks for (opts may be NULL: ulam_guard_defaults()): one pass over
+ * M gives every row and column sum bound; power iteration runs only for a radius those do not
+ * certify (or for every radius when opts->tight). */
+int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
                      ulam_guard *g, ulam_error *err);
+
+/* Whether g certifies the variance of walks in mode finite: 1 finite (rho(M^) < 1), 0 infinite
+ * (rho(M^) >= 1), -1 unknown (the bounds straddle 1, or that radius was not computed). */
+int ulam_guard_variance(const ulam_guard *g, int mode);
 
 /* ---------------------------------------------------------------- random numbers */
 
@@ -336,11 +376,17 @@ typedef struct ulam_walk_opts {
     uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */
     int threads;         /* 0: all cores */
     int64_t max_walks;   /* stop after this many walks (0: no limit) */
-    double rel_err;      /* stop once stderr / |estimate| <= rel_err after >= 1000 walks (0 off) */
+    double rel_err;      /* stop once the relative-error rule holds (see ulam_solve); 0 off */
     double max_seconds;  /* stop after this much wall time (0 off); the first block always runs */
     int64_t max_steps;   /* a walk longer than this is cut and counted (default 10^6) */
     const volatile int *interrupt; /* stop at the next block when *interrupt != 0 (may be NULL) */
     const ulam_share *share; /* NULL: this process runs every block */
+    int force;           /* 1: walk even when rho(|M|) is not certified below 1 (else ULAM_EDIVERGE) */
+    int assume_finite;   /* 1: treat a variance the guards cannot certify either way as finite */
+    const ulam_guard *guard; /* the verdicts for this M and continue_q computed before (an earlier
+                                solver's ulam_solver_guard, a prepared system): used instead of
+                                computing them when they hold the radii this run needs; NULL:
+                                the solver computes them */
 } ulam_walk_opts;
 
 /* The defaults: adjoint collision walks, index 0, analog kernel, seed 1, all cores,
@@ -357,7 +403,22 @@ typedef struct ulam_walk_result {
     int64_t steps;     /* transitions made */
     int64_t cut;       /* walks cut at max_steps (the estimate is biased by them) */
     int64_t rows;      /* rows of the walk kernel built: states reached, or n once built whole */
-    double max_share;  /* largest single score^2 / sum of scores^2: near 1, one walk dominates */
+    double max_share;  /* largest single score^2 / sum of scores^2 (luck: it is large only in the
+                          runs that happened to see a large score; see tail_bound) */
+    int variance_finite; /* the guards' verdict on rho(M^): 1 certified finite (or assumed with
+                            assume_finite), 0 infinite, -1 unknown; ci95 is NaN unless 1 */
+    double score_bound;  /* the largest |score| a walk can make (absorption: W max |b_j| / p*_j over
+                            reachable scoring states, W the weight bound); INFINITY: unbounded */
+    double tail_bound;   /* R / (walks |estimate|), R the range the rel_err rule uses (score_bound,
+                            or for collision and expected the range of walks short enough to
+                            matter at the rel_err target, 1% without one): how far one more walk
+                            could move the estimate, relatively; luck-independent (INFINITY: no
+                            bound) */
+    double min_walks;    /* the walk count the rel_err rule's range term needs at this estimate
+                            (0: no bound) */
+    double variance_rel_error; /* relative standard error of `variance` (fourth moment) */
+    int rel_err_met;     /* 1: stopped by the rel_err rule */
+    int64_t unreached;   /* forward: components no walk has tallied (no estimate at all) */
     double seconds;    /* wall time spent walking */
     int threads;       /* threads used */
     int interrupted;   /* stopped by *interrupt */
@@ -368,14 +429,25 @@ typedef struct ulam_solver ulam_solver;
 
 /* Prepare walks on (I - M) x = b.  M and b are borrowed: they must stay unchanged until the
  * solver is freed, for the walk kernel's rows are built from them when a walk first reaches
- * them (so a query for one x_i reads and keeps only the rows its walks visit).  Refuses an
- * absorption estimator when a state it can score at has p* = 0 (ULAM_EUNDEFINED, err->index
- * naming it). */
+ * them (so a query for one x_i reads and keeps only the rows its walks visit).
+ * Before any walk it takes the guards' verdicts (opts->guard, or ulam_guard_check on rho(|M|)
+ * and this mode's rho(M^), stopped once certified) and keeps them (ulam_solver_guard):
+ *   - rho(|M|) not certified below 1 (>= 1, or bounds straddling 1): ULAM_EDIVERGE unless
+ *     opts->force;
+ *   - rho(M^) not certified below 1: the variance counts as infinite (result variance_finite
+ *     0 or -1, ci95 NaN; opts->assume_finite makes an unknown one finite), the rel_err rule
+ *     never fires, and a rel_err run with neither max_walks nor max_seconds is refused with
+ *     ULAM_EINFVAR (err->msg names the radius, and the other mode when its variance is finite);
+ *   - absorption where a reachable scoring state has p* = 0: ULAM_EUNDEFINED, err->index
+ *     naming it. */
 int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                       ulam_solver **out, ulam_error *err);
 
 /* Run one round of walks (a fixed number of blocks); ULAM_OK. */
 int ulam_solver_iterate(ulam_solver *s);
+
+/* The guards' verdicts the solver walks under (a plain struct to keep or store). */
+void ulam_solver_guard(const ulam_solver *s, ulam_guard *g);
 
 /* Nonzero once a stopping rule (walks, rel_err, time, interrupt) is met. */
 int ulam_solver_done(const ulam_solver *s);
@@ -384,15 +456,29 @@ int ulam_solver_done(const ulam_solver *s);
 void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r);
 
 /* Forward mode: every component's estimate and standard error (arrays of n; either may be
- * NULL).  Adjoint mode: ULAM_EINVAL. */
+ * NULL); a component no walk has tallied has no estimate: x 0 (expected: b_i) and standard
+ * error NaN.  Adjoint mode: ULAM_EINVAL. */
 int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error);
 
 /* Free a solver; accepts and returns NULL. */
 ulam_solver *ulam_solver_free(ulam_solver *s);
 
-/* Allocate, iterate until done, report, free: the whole run in one call. */
+/* Allocate, iterate until done, report, free: the whole run in one call, with the refusals of
+ * ulam_solver_alloc (guards checked first).  It always ends: rel_err alone stops at 10^9
+ * walks at most (ULAM_REL_ERR_CAP; rel_err_met 0).
+ * The rel_err rule (opts->rel_err = E, variance certified finite), checked after each round,
+ * stops when all of these hold (N walks, estimate m, standard error se):
+ *   N >= 1000, m != 0 and, forward, the watched component opts->index has been tallied;
+ *   se <= E |m|;
+ *   N >= 3 ln(3 / 0.05) R / (E |m|) when a single score is bounded (R = score_bound, twice it
+ *     when scores take both signs): the empirical-Bernstein range term at 95%, so any class
+ *     of scores worth E of the answer has been seen about 12 times before a stop;
+ *   the variance's own relative standard error (fourth moment) <= 0.25. */
 int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                ulam_walk_result *result, ulam_error *err);
+
+/* The walk cap of a run whose only rule is rel_err. */
+#define ULAM_REL_ERR_CAP 1000000000
 
 /* ---------------------------------------------------------------- studies */
 

@@ -21,10 +21,21 @@
 #include <math.h>
 #include <stdlib.h>
 
+/* Iterations spent, once a radius is certified below 1, on settling whether it is below 0.99
+ * (the warning's margin). */
+enum { MARGIN_TRIES = 20, SUPPORT_EVERY = 10 };
+#define SUPPORT_CUT 1e-10 /* the support of an iterate for support_lower */
+
 /* The default options. */
 ulam_power_opts ulam_power_defaults(void)
 {
     return (ulam_power_opts){.tol = 1e-4, .max_iter = 1000};
+}
+
+/* The default guard options: all three radii, stopped once certified. */
+ulam_guard_opts ulam_guard_defaults(void)
+{
+    return (ulam_guard_opts){.need = ULAM_GUARD_ALL, .power = ulam_power_defaults()};
 }
 
 /* y = diag(left) |A| xr (threaded only where the product is big enough to pay for it). */
@@ -56,28 +67,56 @@ static double step(int64_t n, double *x, const double *y, double *lo, double *hi
     return est;
 }
 
-/* rho(diag(left) |A| diag(right)) by shifted power iteration with Collatz-Wielandt bounds. */
-int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
-                        const ulam_power_opts *opts, ulam_power *out, ulam_error *err)
+/* Nonzero when [lower, upper] decides a verdict and its warning: wholly below 0.99, wholly at
+ * or above 1, or wholly in [0.99, 1). */
+static int certain(double lower, double upper)
 {
-    ulam__clear(err);
-    if (!A || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
-    if (A->nrows != A->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix");
-    ulam_power_opts o = opts ? *opts : ulam_power_defaults();
+    return upper < 0.99 || lower >= 1.0 || (lower >= 0.99 && upper < 1.0);
+}
+
+/* A lower bound on the radius from the iterate x restricted to its support (entries below
+ * SUPPORT_CUT of the largest set to 0): for nonnegative A, x >= 0, x != 0 and A x >= lambda x
+ * give rho(A) >= lambda (Collatz-Wielandt), and outside the support A x >= 0 = lambda x holds
+ * anyway, so states that cannot reach the dominant class (a dangling row, say, whose ratio is 0)
+ * no longer pin the bound at 0.  xt and yt are scratch of n. */
+static double support_lower(const ulam_csr *A, const double *left, const double *right, const double *x, double *xt,
+                            double *yt)
+{
+    int64_t n = A->nrows;
+    double mx = 0.0, lam = INFINITY;
+    for (int64_t i = 0; i < n; i++) mx = fmax(mx, x[i]);
+    for (int64_t i = 0; i < n; i++) xt[i] = x[i] >= SUPPORT_CUT * mx ? x[i] * (right ? right[i] : 1.0) : 0.0;
+    apply(A, left, xt, yt);
+    for (int64_t i = 0; i < n; i++)
+        if (xt[i] > 0) lam = fmin(lam, yt[i] / (xt[i] / (right ? right[i] : 1.0)));
+    return isfinite(lam) ? lam : 0.0;
+}
+
+/* Power iteration on diag(left) |A| diag(right) from bounds [lower, upper] already known
+ * (the one-pass sums); out keeps the tighter bounds of both. */
+static int power_from(const ulam_csr *A, const double *left, const double *right, const ulam_power_opts *o,
+                      ulam_power *out, ulam_error *err)
+{
     int64_t n = A->nrows;
     double t0 = ulam_now();
     double *x = ulam__malloc((size_t)n, sizeof *x), *y = ulam__malloc((size_t)n, sizeof *y);
     double *xr = right ? ulam__malloc((size_t)n, sizeof *xr) : x;
-    if (!x || !y || !xr) {
-        free(x), free(y);
+    double *xt = ulam__malloc((size_t)n, sizeof *xt), *yt = ulam__malloc((size_t)n, sizeof *yt);
+    if (!x || !y || !xr || !xt || !yt) {
+        free(x), free(y), free(xt), free(yt);
         if (right) free(xr);
-        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for three vectors of %lld", (long long)n);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for five vectors of %lld", (long long)n);
     }
-    *out = (ulam_power){.lower = 0.0, .upper = INFINITY};
     for (int64_t i = 0; i < n; i++) x[i] = 1.0;
     int stable = 0;
     double prev = -1.0, change = INFINITY;
-    while (out->iterations < o.max_iter && !out->converged && n > 0) {
+    /* an estimate that has converged while the bounds still straddle a threshold goes on (the
+     * bounds close in later); certifying, once the radius is certified below 1, at most
+     * MARGIN_TRIES more iterations try to settle the warning's 0.99 */
+    int extra = 0;
+    while (out->iterations < o->max_iter && n > 0 &&
+           !(certain(out->lower, out->upper) && (o->certify || out->converged)) &&
+           !(o->certify && out->upper < 1.0 && extra++ >= MARGIN_TRIES)) {
         if (right)
             for (int64_t i = 0; i < n; i++) xr[i] = right[i] * x[i];
         apply(A, left, xr, y);
@@ -88,39 +127,71 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
         /* the changes shrink geometrically at about `ratio`: the ones still to come add up to ahead */
         double c = fabs(out->rho - prev), ratio = c / change;
         double ahead = prev >= 0 && isfinite(change) && ratio < 1 ? c * ratio / (1 - ratio) : INFINITY;
-        stable = ahead <= o.tol * out->rho ? stable + 1 : 0;
+        stable = ahead <= o->tol * out->rho ? stable + 1 : 0;
         prev = out->rho, change = c;
-        out->converged = out->upper - out->lower <= o.tol * out->upper || stable >= 5 || out->upper <= o.tol;
+        out->converged = out->upper - out->lower <= o->tol * out->upper || stable >= 5 || out->upper <= o->tol;
+        if ((out->converged || out->iterations % SUPPORT_EVERY == 0) && out->lower < out->upper)
+            out->lower = fmin(fmax(out->lower, support_lower(A, left, right, x, xt, yt)), out->upper);
     }
-    if (n == 0) out->upper = 0.0, out->converged = 1;
+    if (n == 0) out->lower = out->upper = 0.0, out->converged = 1;
     out->rho = fmin(fmax(out->rho, out->lower), out->upper);
-    out->seconds = ulam_now() - t0;
-    free(x), free(y);
+    out->seconds += ulam_now() - t0;
+    free(x), free(y), free(xt), free(yt);
     if (right) free(xr);
     return ULAM_OK;
 }
 
-/* Fine, near the edge or failing: certified bounds first, then the estimate. */
+/* rho(diag(left) |A| diag(right)) by shifted power iteration with Collatz-Wielandt bounds. */
+int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
+                        const ulam_power_opts *opts, ulam_power *out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!A || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
+    if (A->nrows != A->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix");
+    ulam_power_opts o = opts ? *opts : ulam_power_defaults();
+    *out = (ulam_power){.lower = 0.0, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
+    return power_from(A, left, right, &o, out, err);
+}
+
+/* Certified bounds alone decide: below 0.99 fine, below 1 near the edge, from 1 up failing,
+ * straddling 1 unknown. */
 int ulam_verdict_of(const ulam_power *p)
 {
     if (p->upper < 0.99) return ULAM_VERDICT_OK;
-    if (p->lower >= 1.0 || p->rho >= 1.0) return ULAM_VERDICT_FAIL;
-    return p->rho >= 0.99 ? ULAM_VERDICT_EDGE : ULAM_VERDICT_OK;
+    if (p->upper < 1.0) return ULAM_VERDICT_EDGE;
+    if (p->lower >= 1.0) return ULAM_VERDICT_FAIL;
+    return ULAM_VERDICT_UNKNOWN;
 }
 
-/* The kernel factors S_i / q_i of the rows (cols == 0) or columns (cols != 0) of |M|. */
-static double *factors(const ulam_csr *M, double continue_q, int cols)
+/* 1 finite, 0 infinite, -1 unknown: the variance of walks in mode by g. */
+int ulam_guard_variance(const ulam_guard *g, int mode)
 {
-    int64_t n = M->nrows;
-    double *f = ulam__calloc((size_t)n, sizeof *f);
-    if (!f) return NULL;
-    for (int64_t i = 0; i < n; i++)
-        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) f[cols ? M->colidx[q] : i] += fabs(M->val[q]);
-    for (int64_t i = 0; i < n; i++) {
-        double qi = ulam__continuation(f[i], continue_q);
-        f[i] = qi > 0 ? f[i] / qi : 0.0;
-    }
-    return f;
+    int v = g->verdict_hat[mode == ULAM_FORWARD];
+    return v == ULAM_VERDICT_OK || v == ULAM_VERDICT_EDGE ? 1 : v == ULAM_VERDICT_FAIL ? 0 : -1;
+}
+
+/* The one-pass sums of a nonnegative matrix A: min and max of its row sums r and column sums c
+ * bound its radius (min r <= rho <= max r, the same for c, as rho(A) = rho(A')). */
+typedef struct {
+    double rmin, rmax, cmin, cmax, total;
+} sums;
+
+/* Bounds from the sums into a fresh radius (estimate: the first power step's sum(A1)/n). */
+static ulam_power from_sums(const sums *s, int64_t n)
+{
+    ulam_power p = {.lower = fmax(s->rmin, s->cmin), .upper = fmin(s->rmax, s->cmax), .rowsum_max = s->rmax,
+                    .colsum_max = s->cmax};
+    if (n == 0) p.lower = p.upper = 0.0;
+    p.rho = fmin(fmax(n > 0 ? s->total / (double)n : 0.0, p.lower), p.upper);
+    p.converged = isfinite(p.upper) && p.upper - p.lower <= 1e-12 * p.upper;
+    return p;
+}
+
+/* min and max of the n entries of v into *lo, *hi. */
+static void range(const double *v, int64_t n, double *lo, double *hi)
+{
+    *lo = n ? INFINITY : 0.0, *hi = 0.0;
+    for (int64_t i = 0; i < n; i++) *lo = fmin(*lo, v[i]), *hi = fmax(*hi, v[i]);
 }
 
 /* Nonzero when all n factors are 1: diag(f) |M| is then |M|, and so is its radius. */
@@ -131,35 +202,217 @@ static int all_ones(const double *f, int64_t n)
     return 1;
 }
 
-/* rho of the second-moment matrix with factors f (left of |M| for rows, right for columns):
- * rho(|M|) itself, taking no time, when every factor is 1 (an analog kernel of rows or
- * columns summing to at most 1), for the power iteration would repeat it exactly. */
-static int hat_power(const ulam_csr *M, const double *f, int cols, const ulam_power_opts *opts,
-                     const ulam_power *abs, ulam_power *out, ulam_error *err)
+/* Scratch of the guard check: per-state sums and factors. */
+typedef struct {
+    double *S, *C;   /* row and column sums of |M| */
+    double *fr, *fc; /* kernel factors S_i / q_i of rows (adjoint) and columns (forward) */
+    double *ca;      /* column sums of diag(fr) |M| */
+    double *rf;      /* row sums of |M| diag(fc) */
+} guard_work;
+
+/* Free the scratch. */
+static void work_free(guard_work *w)
 {
-    if (all_ones(f, M->nrows)) {
-        *out = *abs;
-        out->seconds = 0.0;
-        return ULAM_OK;
-    }
-    return ulam_spectral_power(M, cols ? NULL : f, cols ? f : NULL, opts, out, err);
+    free(w->S), free(w->C), free(w->fr), free(w->fc), free(w->ca), free(w->rf);
 }
 
-/* The three radii and their verdicts. */
-int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_power_opts *opts,
+/* The pass over M's rows: S and fr, reading M in order; with cols, also C, fc and the column
+ * sums of diag(fr) |M| (a scatter to random columns, each row read twice while in cache),
+ * made only when the row sums alone do not settle the run's verdicts. */
+static int sum_pass(const ulam_csr *M, double continue_q, int cols, guard_work *w)
+{
+    int64_t n = M->nrows;
+    if (!w->S) {
+        w->S = ulam__malloc((size_t)n, sizeof(double)), w->fr = ulam__malloc((size_t)n, sizeof(double));
+        if (!w->S || !w->fr) return ULAM_ENOMEM;
+        for (int64_t i = 0; i < n; i++) {
+            double s = 0.0;
+            for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) s += fabs(M->val[q]);
+            w->S[i] = s;
+            w->fr[i] = ulam__factor(s, continue_q);
+        }
+    }
+    if (!cols) return ULAM_OK;
+    w->C = ulam__calloc((size_t)n, sizeof(double)), w->ca = ulam__calloc((size_t)n, sizeof(double));
+    w->fc = ulam__malloc((size_t)n, sizeof(double));
+    if (!w->C || !w->ca || !w->fc) return ULAM_ENOMEM;
+    for (int64_t i = 0; i < n; i++)
+        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) {
+            w->C[M->colidx[q]] += fabs(M->val[q]);
+            w->ca[M->colidx[q]] += w->fr[i] * fabs(M->val[q]);
+        }
+    for (int64_t j = 0; j < n; j++) w->fc[j] = ulam__factor(w->C[j], continue_q);
+    return ULAM_OK;
+}
+
+/* The row sums of |M| diag(fc), which need every fc first: a second pass. */
+static int forward_rows(const ulam_csr *M, guard_work *w)
+{
+    int64_t n = M->nrows;
+    if (!(w->rf = ulam__malloc((size_t)n, sizeof(double)))) return ULAM_ENOMEM;
+    for (int64_t i = 0; i < n; i++) {
+        double s = 0.0;
+        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) s += fabs(M->val[q]) * w->fc[M->colidx[q]];
+        w->rf[i] = s;
+    }
+    return ULAM_OK;
+}
+
+/* The sums of diag(f) |M| (rows = f o S, columns ca) or of |M| diag(f) (rows rf, columns
+ * f o C); rf may be NULL (not computed: the row bound is then infinite). */
+static sums hat_sums(const guard_work *w, int64_t n, int forward)
+{
+    sums s = {0};
+    const double *f = forward ? w->fc : w->fr, *base = forward ? w->C : w->S;
+    s.rmin = n ? INFINITY : 0.0, s.cmin = s.rmin;
+    for (int64_t i = 0; i < n; i++) {
+        double scaled = f[i] * base[i]; /* adjoint: row i of diag(f)|M|; forward: column i of |M|diag(f) */
+        double other = forward ? (w->rf ? w->rf[i] : INFINITY) : w->ca ? w->ca[i] : INFINITY;
+        double r = forward ? other : scaled, c = forward ? scaled : other;
+        s.rmin = fmin(s.rmin, r), s.rmax = fmax(s.rmax, r);
+        s.cmin = fmin(s.cmin, c), s.cmax = fmax(s.cmax, c);
+        s.total += c; /* the sum of all entries: the column sums add up to it */
+    }
+    if (forward && !w->rf) s.rmin = 0.0;
+    if (!forward && !w->ca) s.cmin = 0.0;
+    return s;
+}
+
+/* Nonzero when every state is reachable in the graph of G (i -> j for G_ij != 0) from a
+ * state marked deficient (-1: out of memory). */
+static int all_reached(const ulam_csr *G, char *seen)
+{
+    int64_t n = G->nrows, head = 0, tail = 0;
+    int32_t *queue = ulam__malloc((size_t)n, sizeof *queue);
+    if (!queue) return -1;
+    for (int64_t j = 0; j < n; j++)
+        if (seen[j]) queue[tail++] = (int32_t)j;
+    while (head < tail) {
+        int32_t i = queue[head++];
+        for (int64_t q = G->rowptr[i]; q < G->rowptr[i + 1]; q++)
+            if (!seen[G->colidx[q]]) seen[G->colidx[q]] = 1, queue[tail++] = G->colidx[q];
+    }
+    free(queue);
+    return tail == n;
+}
+
+/* The walk kernel's own certificate of rho < 1.  Rows (adjoint walks on M): every row sum S_i
+ * of |M| is at most 1, as the kernel computes it in floating point, so every weight factor is
+ * exactly 1 and the kernel is a substochastic chain whose row probabilities sum to exactly 1;
+ * if from every state a state with S_i < 1 (where walks may end) can be reached, the chain is
+ * transient, some power of it has every row sum below 1, and its radius is below 1 (strictly:
+ * by how much, unknown).  Columns (forward walks on M') the same with the column sums C.
+ * 1 certified, 0 not, -1 out of memory. */
+static int kernel_transient(const ulam_csr *M, const double *sums, int rows)
+{
+    int64_t n = M->nrows;
+    for (int64_t i = 0; i < n; i++)
+        if (sums[i] > 1.0) return 0;
+    char *seen = ulam__calloc((size_t)n, 1);
+    ulam_csr *T = NULL;
+    if (!seen || (rows && ulam_csr_transpose(M, &T))) {
+        free(seen);
+        return -1;
+    }
+    for (int64_t i = 0; i < n; i++) seen[i] = sums[i] < 1.0;
+    int r = all_reached(rows ? T : M, seen); /* rows: states that reach a deficient one in M */
+    ulam_csr_free(T);
+    free(seen);
+    return r;
+}
+
+/* One radius: the sums' bounds (and for rho(|M|) itself, when S and C are given, the kernels'
+ * certificate of rho < 1: rows if reach & 1, columns if reach & 2, all those asked must hold),
+ * then power iteration unless they certify (or o->tight). */
+static int radius(const ulam_csr *M, const double *left, const double *right, const sums *sm, const double *S,
+                  const double *C, int reach, const ulam_guard_opts *o, ulam_power *out, ulam_error *err)
+{
+    double t0 = ulam_now();
+    *out = from_sums(sm, M->nrows);
+    out->seconds = 0.0;
+    int status = ULAM_OK;
+    if (reach && !certain(out->lower, out->upper) && out->upper >= 1.0) {
+        int r = 1;
+        for (int v = 0; v < 2 && r > 0; v++)
+            if (reach & (1 << v)) r = (v ? C : S) ? kernel_transient(M, v ? C : S, v == 0) : 0;
+        if (r < 0) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
+        if (r) out->upper = nextafter(1.0, 0.0), out->lower = fmin(out->lower, out->upper);
+        if (r && !o->tight) { /* certain: below 1; the 0.99 margin is left open (at sums of 1 power
+                                 * iteration would seldom settle it) */
+            out->seconds = ulam_now() - t0;
+            return ULAM_OK;
+        }
+    }
+    if (!out->converged && (o->tight || !certain(out->lower, out->upper))) {
+        ulam_power_opts po = o->power;
+        po.certify = !o->tight;
+        status = power_from(M, left, right, &po, out, err);
+    }
+    out->seconds = ulam_now() - t0;
+    return status;
+}
+
+/* The radii asked for and their verdicts. */
+int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
                      ulam_guard *g, ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !g) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
     if (M->nrows != M->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
-    double *fr = factors(M, continue_q, 0), *fc = factors(M, continue_q, 1);
-    int status = fr && fc ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel factors");
-    if (!status) status = ulam_spectral_power(M, NULL, NULL, opts, &g->abs, err);
-    if (!status) status = hat_power(M, fr, 0, opts, &g->abs, &g->hat[ULAM_ADJOINT], err);
-    if (!status) status = hat_power(M, fc, 1, opts, &g->abs, &g->hat[ULAM_FORWARD], err);
-    free(fr), free(fc);
+    ulam_guard_opts o = opts ? *opts : ulam_guard_defaults();
+    if (!o.need) o.need = ULAM_GUARD_ALL;
+    int64_t n = M->nrows;
+    double t0 = ulam_now();
+    ulam_power none = {.upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
+    *g = (ulam_guard){.continue_q = continue_q, .abs = none, .hat = {none, none}};
+    guard_work w = {0};
+    int status = sum_pass(M, continue_q, 0, &w), cols = o.tight || (o.need & ULAM_GUARD_FORWARD);
+    if (!status && !cols) { /* the column sums only when the row sums do not certify */
+        double lo, hi;
+        range(w.S, n, &lo, &hi);
+        cols = !certain(lo, hi);
+        if ((o.need & ULAM_GUARD_ADJOINT) && !all_ones(w.fr, n)) {
+            sums h = hat_sums(&w, n, 0);
+            cols |= !certain(h.rmin, h.rmax);
+        }
+    }
+    if (!status && cols) status = sum_pass(M, continue_q, 1, &w);
+    if (!status && (o.need & ULAM_GUARD_FORWARD)) { /* the second pass only when the column sums do not certify */
+        sums f = hat_sums(&w, n, 1);
+        if (o.tight || !certain(fmax(f.cmin, 0.0), f.cmax)) status = forward_rows(M, &w);
+    }
+    if (status) {
+        work_free(&w);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel factors");
+    }
+    double pass = ulam_now() - t0;
+    sums a = {.cmin = 0.0, .cmax = INFINITY};
+    range(w.S, n, &a.rmin, &a.rmax);
+    if (w.C) range(w.C, n, &a.cmin, &a.cmax);
+    for (int64_t i = 0; i < n; i++) a.total += w.S[i];
+    int ones[2] = {all_ones(w.fr, n), w.fc && all_ones(w.fc, n)}, need = o.need;
+    for (int m = 0; m < 2; m++)
+        if ((o.need & ULAM_GUARD_HAT(m)) && ones[m]) need |= ULAM_GUARD_ABS; /* M^ is |M| itself */
+    int reach = (need & ULAM_GUARD_ADJOINT ? 1 : 0) | (need & ULAM_GUARD_FORWARD ? 2 : 0);
+    if (need & ULAM_GUARD_ABS) status = radius(M, NULL, NULL, &a, w.S, w.C, reach ? reach : 3, &o, &g->abs, err);
+    for (int m = 0; m < 2 && !status; m++) {
+        if (!(need & ULAM_GUARD_HAT(m))) continue;
+        if (ones[m]) {
+            g->hat[m] = g->abs;
+            g->hat[m].seconds = 0.0;
+            continue;
+        }
+        sums h = hat_sums(&w, n, m == ULAM_FORWARD);
+        const double *f = m == ULAM_FORWARD ? w.fc : w.fr;
+        status = radius(M, m == ULAM_FORWARD ? NULL : f, m == ULAM_FORWARD ? f : NULL, &h, NULL, NULL, 0, &o, &g->hat[m],
+                        err);
+    }
+    work_free(&w);
     if (status) return status;
-    g->verdict_abs = ulam_verdict_of(&g->abs);
-    for (int m = 0; m < 2; m++) g->verdict_hat[m] = ulam_verdict_of(&g->hat[m]);
+    g->computed = need;
+    g->abs.seconds += pass; /* the one pass is charged to rho(|M|) */
+    g->verdict_abs = need & ULAM_GUARD_ABS ? ulam_verdict_of(&g->abs) : ULAM_VERDICT_UNKNOWN;
+    for (int m = 0; m < 2; m++)
+        g->verdict_hat[m] = need & ULAM_GUARD_HAT(m) ? ulam_verdict_of(&g->hat[m]) : ULAM_VERDICT_UNKNOWN;
     return ULAM_OK;
 }

@@ -42,6 +42,13 @@ static inline double ulam__continuation(double S, double continue_q)
     return S == 0.0 ? 0.0 : continue_q > 0 ? continue_q : (S < 1.0 ? S : 1.0);
 }
 
+/* The weight factor S / q of a state whose row of |K| sums to S (0 for an empty row). */
+static inline double ulam__factor(double S, double continue_q)
+{
+    double q = ulam__continuation(S, continue_q);
+    return q > 0 ? S / q : 0.0;
+}
+
 /* Uniform double in [0, 1) from the top 53 bits. */
 static inline double ulam__rng_uniform(ulam_rng *r)
 {

@@ -25,6 +25,15 @@
  * what the pass costs (the rent-or-buy rule), and a run that far will likely reach the rest. */
 enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = 4 };
 
+/* The rel_err rule (derived in README.md, "When to trust the error bar"): at least REL_MIN
+ * walks; the empirical-Bernstein range term 3 ln(3 / delta) R / N at delta = 0.05 within
+ * E |estimate| (so N >= EB_RANGE R / (E |estimate|)); the variance's own relative standard
+ * error at most VAR_REL_MAX. */
+#define REL_MIN 1000
+#define EB_RANGE 12.283413301 /* 3 ln(60) */
+#define VAR_REL_MAX 0.25
+#define TAIL_E 0.01 /* the target a run without rel_err reports its tail_bound at */
+
 struct ulam_solver {
     ulam_walk_opts o;
     int64_t n;
@@ -39,11 +48,18 @@ struct ulam_solver {
     ulam__block *blocks;   /* one per block of a round */
     /* accumulated */
     ulam__moments adj;
+    ulam__moments watched; /* forward: the moments of component o.index's history tallies */
     double *sum, *sumsq; /* forward per-state sums of history tallies */
+    ulam_guard g;        /* the verdicts, checked before walking */
+    int var_finite;      /* 1, 0 or -1 (ulam_guard_variance, or 1 by assume_finite) */
+    double bound, range; /* the largest |score| a walk can make; the scores' range (INFINITY: none) */
+    double per_step, qmax; /* collision, expected: the largest |score| of one visit, the largest
+                              continuation over reachable states (walk length tail q^l) */
+    int signs;             /* scores may take both signs */
     int64_t walks, steps, cut, nonfinite, next_walk;
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
     double seconds, t0;
-    int done, interrupted, status;
+    int done, interrupted, status, met;
 };
 
 /* The defaults. */
@@ -96,8 +112,20 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
     return ULAM_OK;
 }
 
-/* Refuse absorption when a reachable state with p* = 0 would have to score. */
-static int check_absorption(ulam_solver *s, const ulam_csr *K, ulam_error *err)
+/* The sum of |K| over row i. */
+static double row_sum(const ulam_csr *K, int64_t i)
+{
+    double S = 0.0;
+    for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++) S += fabs(K->val[q]);
+    return S;
+}
+
+/* Over the states walks can reach (seen): absorption's p* > 0 wherever it scores (else
+ * ULAM_EUNDEFINED naming the state), and the bound on a single score and the scores' range
+ * (s->bound, s->range): 0 when nothing that scores is reachable; for absorption W |g_i| / p*_i,
+ * W the weight bound (the start weight, or the roulette weight when larger, as long as no
+ * reachable state's factor S / q exceeds 1); otherwise unbounded. */
+static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
     char *seen = ulam__calloc((size_t)s->n, 1);
     if (!seen) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
@@ -108,10 +136,34 @@ static int check_absorption(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         free(seen);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
     }
+    int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = 0;
     int64_t bad = -1;
-    for (int64_t i = 0; i < s->n && bad < 0; i++) {
-        int scores = s->o.mode == ULAM_ADJOINT ? s->b[i] != 0.0 : 1;
-        if (seen[i] && scores && ulam__kernel_q(K, i, s->o.continue_q) >= 1.0) bad = i;
+    int expected = s->o.estimator == ULAM_EXPECTED;
+    double w0 = 1.0, fbig = 0.0, gmax = 0.0, vmax = 0.0, qmax = 0.0;
+    for (int64_t i = 0; i < s->n; i++) {
+        if (!seen[i]) continue;
+        double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
+        fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
+        qmax = fmax(qmax, q);
+        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
+            neg |= K->val[k] < 0;
+            if (adj && expected) c += K->val[k] * s->b[K->colidx[k]];
+        }
+        if (absorb && (adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
+        /* what one visit scores: b_i (collision), (M b)_i (expected), forward 1 at the index */
+        double v = adj ? fabs(expected ? c : s->b[i]) : i == s->o.index ? (expected ? INFINITY : 1.0) : 0.0;
+        vmax = fmax(vmax, v);
+        int scores = adj ? s->b[i] != 0.0 : i == s->o.index;
+        if (!scores) continue;
+        double g = adj ? fabs(s->b[i]) : 1.0;
+        gmax = fmax(gmax, absorb ? (q < 1.0 ? g / (1.0 - q) : INFINITY) : INFINITY);
+        if (adj) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
+    }
+    if (!adj)
+        for (int64_t i = 0; i < s->n; i++) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
+    if (!adj) {
+        w0 = 0.0;
+        for (int64_t i = 0; i < s->n; i++) w0 += fabs(s->b[i]);
     }
     free(seen);
     if (bad >= 0)
@@ -119,8 +171,58 @@ static int check_absorption(ulam_solver *s, const ulam_csr *K, ulam_error *err)
                           "p* > 0 wherever the absorption estimator scores; state %lld (1-based) is "
                           "reachable and never terminates (its row sum of |%s| is >= 1): use the "
                           "collision estimator or --continue Q",
-                          (long long)bad + 1, s->o.mode == ULAM_ADJOINT ? "M" : "M' (column of M)");
+                          (long long)bad + 1, adj ? "M" : "M' (column of M)");
+    double W = fbig <= 1.0 && !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) : INFINITY;
+    s->signs = pos && neg;
+    s->bound = gmax > 0 ? W * gmax : 0.0;
+    s->range = s->bound * (s->signs ? 2.0 : 1.0);
+    s->per_step = vmax > 0 ? W * vmax : 0.0;
+    s->qmax = qmax;
     return ULAM_OK;
+}
+
+/* The guards' verdicts for this run: opts->guard when it holds them, else computed (rho(|M|)
+ * and this mode's rho(M^), stopped once certified). */
+static int take_guard(const ulam_csr *M, const ulam_walk_opts *o, ulam_guard *g, ulam_error *err)
+{
+    int need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(o->mode);
+    double q = o->continue_q > 0 ? o->continue_q : 0.0;
+    if (o->guard && (o->guard->continue_q > 0 ? o->guard->continue_q : 0.0) == q && (o->guard->computed & need) == need) {
+        *g = *o->guard;
+        return ULAM_OK;
+    }
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = need;
+    return ulam_guard_check(M, o->continue_q, &go, g, err);
+}
+
+/* Refuse what the verdicts refuse: walks not certified to converge (unless force), a
+ * relative-error target the variance cannot honour with nothing else to end the run. */
+static int check_verdicts(const ulam_csr *M, ulam_solver *s, ulam_error *err)
+{
+    const ulam_walk_opts *o = &s->o;
+    const ulam_power *a = &s->g.abs, *h = &s->g.hat[o->mode];
+    if (s->g.verdict_abs >= ULAM_VERDICT_FAIL && !o->force)
+        return ulam__fail(err, ULAM_EDIVERGE, 0, -1,
+                          "rho(|M|) certified below 1; its bounds are [%.6g, %.6g]%s: the walks' expected score "
+                          "may be a divergent series (force walks anyway)", a->lower, a->upper,
+                          s->g.verdict_abs == ULAM_VERDICT_FAIL ? "" : ", not certain either way");
+    s->var_finite = ulam_guard_variance(&s->g, o->mode);
+    if (s->var_finite < 0 && o->assume_finite) s->var_finite = 1;
+    if (s->var_finite == 1 || !(o->rel_err > 0) || o->max_walks > 0 || o->max_seconds > 0) return ULAM_OK;
+    int other = 1 - o->mode;
+    ulam_guard og = s->g;
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_HAT(other);
+    if (!(og.computed & go.need) && ulam_guard_check(M, o->continue_q, &go, &og, NULL)) og.verdict_hat[other] = ULAM_VERDICT_UNKNOWN;
+    char also[96] = "; the other mode's is not certified finite either";
+    if (ulam_guard_variance(&og, other) == 1)
+        snprintf(also, sizeof also, "; the %s mode's is finite, %.4g < 1", other == ULAM_ADJOINT ? "adjoint" : "forward",
+                 og.hat[other].upper);
+    return ulam__fail(err, ULAM_EINFVAR, 0, -1,
+                      "a finite variance for a relative-error target: rho(M^) of the %s kernel is in [%.4g, %.4g] (%s)%s",
+                      o->mode == ULAM_ADJOINT ? "adjoint" : "forward", h->lower, h->upper,
+                      s->var_finite == 0 ? ">= 1: infinite" : "straddles 1: unknown", also);
 }
 
 /* The forward source distribution |b| / ||b||_1 as an alias table; sets *bnorm1. */
@@ -190,9 +292,14 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     ulam_solver *s = calloc(1, sizeof *s);
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
     s->o = o;
-    s->n = M->nrows;
-    s->threads = ulam__threads(o.threads);
     s->b = b;
+    s->n = M->nrows;
+    if ((status = take_guard(M, &o, &s->g, err)) || (status = check_verdicts(M, s, err))) {
+        ulam_solver_free(s);
+        return status;
+    }
+    if (o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0) s->o.max_walks = ULAM_REL_ERR_CAP;
+    s->threads = ulam__threads(o.threads);
     const ulam_csr *K = M;
     if (o.mode == ULAM_FORWARD) {
         if (ulam_csr_transpose(M, &s->mt) || build_source(s, &bnorm1)) goto nomem;
@@ -204,7 +311,9 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
-    if (o.estimator == ULAM_ABSORPTION && (status = check_absorption(s, K, err))) {
+    s->bound = s->range = s->per_step = INFINITY;
+    s->qmax = 1.0;
+    if ((o.estimator == ULAM_ABSORPTION || o.rel_err > 0) && (status = check_reach(s, K, err))) {
         ulam_solver_free(s);
         return status;
     }
@@ -395,21 +504,41 @@ static void run_block(void *ctx, int q, int64_t first, int64_t count, int t)
     else ulam__forward_block(&s->w, count, &r, &s->scratch[t], br);
 }
 
-/* Merge a completed block into the totals. */
+/* Merge a completed block into the totals (forward: the watched component's moments count
+ * the block's histories that did not tally it as zeros). */
 static void merge_block(ulam_solver *s, const ulam__block *br)
 {
     ulam__moments_merge(&s->adj, &br->m);
     s->maxsq = fmax(s->maxsq, br->maxsq);
+    ulam__moments w = {0};
     for (int64_t q = 0; q < br->t.len; q++) {
         double v = br->t.t[q].value;
         s->sum[br->t.t[q].state] += v;
         s->sumsq[br->t.t[q].state] += v * v;
-        if (br->t.t[q].state == s->o.index) s->maxsq = fmax(s->maxsq, v * v);
+        if (br->t.t[q].state == s->o.index) s->maxsq = fmax(s->maxsq, v * v), ulam__moments_add(&w, v);
+    }
+    if (s->o.mode == ULAM_FORWARD) {
+        ulam__moments zeros = {.n = br->walks - w.n};
+        ulam__moments_merge(&w, &zeros);
+        ulam__moments_merge(&s->watched, &w);
     }
     s->walks += br->walks;
     s->steps += br->steps;
     s->cut += br->cut;
     s->nonfinite += br->nonfinite;
+}
+
+static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached);
+
+/* Nonzero when the rel_err rule holds for r (see ulam_solve in ulam.h). */
+static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
+{
+    double E = s->o.rel_err, m = fabs(r->estimate);
+    if (!(E > 0) || s->var_finite != 1 || r->walks < REL_MIN) return 0;
+    if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
+    if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.index] == 0))
+        return 0;
+    return r->std_error <= E * m && (double)r->walks >= r->min_walks && r->variance_rel_error <= VAR_REL_MAX;
 }
 
 /* Run one round of walks. */
@@ -440,9 +569,9 @@ int ulam_solver_iterate(ulam_solver *s)
     if (s->nonfinite && !s->status) s->status = ULAM_ENONFINITE;
     if (s->status) s->done = 1;
     ulam_walk_result r;
-    ulam_solver_result(s, &r);
+    result(s, &r, 0);
     if (ulam__budget_spent(&s->o, stop, s->next_walk)) s->done = 1;
-    if (s->o.rel_err > 0 && r.walks >= 1000 && r.std_error <= s->o.rel_err * fabs(r.estimate)) s->done = 1;
+    if (rel_err_met(s, &r)) s->done = s->met = 1;
     return s->status;
 }
 
@@ -452,7 +581,8 @@ int ulam_solver_done(const ulam_solver *s)
     return !s || s->done;
 }
 
-/* Forward estimate and standard error of component i from the sums. */
+/* Forward estimate and standard error of component i from the sums; the error is NaN when no
+ * walk has tallied it (unreached: 0 +- 0 would claim certainty). */
 static void forward_component(const ulam_solver *s, int64_t i, double *est, double *se, double *var)
 {
     double N = (double)s->walks;
@@ -461,14 +591,31 @@ static void forward_component(const ulam_solver *s, int64_t i, double *est, doub
     *est = mean + (s->o.estimator == ULAM_EXPECTED ? s->b[i] : 0.0);
     *var = v;
     *se = N > 0 ? sqrt(v / N) : INFINITY;
+    if (s->sum[i] == 0.0 && s->sumsq[i] == 0.0) *se = NAN; /* no walk tallied it: no estimate */
 }
 
-/* The result so far. */
-void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
+/* The range of a single score the rel_err rule uses at estimate m and target E: the bound on a
+ * score (absorption); for collision and expected, whose scores grow with the walk's length, the
+ * range of walks of at most l steps, l the length past which walks can add no more than E |m|
+ * to the mean: visits score at most per_step and a walk is alive after k steps with
+ * probability at most qmax^k, so the rest adds at most per_step qmax^(l+1) / (1 - qmax).
+ * INFINITY when no bound holds (qmax = 1, weights that can grow). */
+static double score_range(const ulam_solver *s, double m, double E)
+{
+    if (isfinite(s->range) || s->bound == 0.0) return s->range;
+    if (s->per_step == 0.0) return 0.0;
+    if (!isfinite(s->per_step) || !(s->qmax < 1.0) || !(m > 0)) return INFINITY;
+    double steps = s->qmax > 0 ? ceil(log(s->per_step / (E * m * (1.0 - s->qmax))) / log(1.0 / s->qmax)) : 0.0;
+    return s->per_step * fmax(1.0, steps + 1.0) * (s->signs ? 2.0 : 1.0);
+}
+
+/* The result so far; the forward count of unreached components (O(n)) when asked. */
+static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached)
 {
     memset(r, 0, sizeof *r);
     if (!s) return;
     double sumsq;
+    const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
     if (s->o.mode == ULAM_ADJOINT) {
         r->estimate = s->adj.mean;
         r->variance = ulam__moments_variance(&s->adj);
@@ -477,10 +624,21 @@ void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
     } else {
         forward_component(s, s->o.index, &r->estimate, &r->std_error, &r->variance);
         sumsq = s->sumsq[s->o.index];
+        for (int64_t i = 0; count_unreached && i < s->n; i++) r->unreached += s->sum[i] == 0.0 && s->sumsq[i] == 0.0;
     }
     r->max_share = sumsq > 0 ? fmin(1.0, s->maxsq / sumsq) : 0.0;
-    r->ci95[0] = r->estimate - 1.959963984540054 * r->std_error;
-    r->ci95[1] = r->estimate + 1.959963984540054 * r->std_error;
+    r->variance_finite = s->var_finite;
+    r->variance_rel_error = mom->m2 > 0 ? ulam__moments_variance_rel_error(mom) : mom->n > 1 ? 0.0 : INFINITY;
+    double m = fabs(r->estimate), N = (double)s->walks, E = s->o.rel_err > 0 ? s->o.rel_err : TAIL_E;
+    double R = score_range(s, m, E);
+    r->score_bound = s->bound;
+    r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
+    r->min_walks = !(s->o.rel_err > 0) || !isfinite(R) || R == 0.0 ? 0.0
+                   : m > 0 ? ceil(EB_RANGE * R / (s->o.rel_err * m)) : INFINITY;
+    r->rel_err_met = s->met;
+    double half = s->var_finite == 1 ? 1.959963984540054 * r->std_error : NAN;
+    r->ci95[0] = r->estimate - half;
+    r->ci95[1] = r->estimate + half;
     r->walks = s->walks;
     r->steps = s->steps;
     r->cut = s->cut;
@@ -488,6 +646,18 @@ void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
     r->seconds = s->seconds;
     r->threads = s->threads;
     r->interrupted = s->interrupted;
+}
+
+/* The result so far. */
+void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
+{
+    result(s, r, 1);
+}
+
+/* The guards' verdicts the solver walks under. */
+void ulam_solver_guard(const ulam_solver *s, ulam_guard *g)
+{
+    if (s && g) *g = s->g;
 }
 
 /* Forward mode: every component's estimate and standard error. */

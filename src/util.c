@@ -35,6 +35,8 @@ static const char *const messages[ULAM_NSTATUS] = {
     [ULAM_ENOTFOUND] = "not defined",
     [ULAM_ERANGE] = "value out of range",
     [ULAM_EDEVICE] = "ray-casting device failed",
+    [ULAM_EDIVERGE] = "walks not certified to converge",
+    [ULAM_EINFVAR] = "variance not certified finite",
 };
 
 /* A short English description of a status code. */

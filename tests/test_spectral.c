@@ -241,8 +241,74 @@ static void test_guard(void **state)
     assert_true(g.abs.lower >= 1.0); /* certified */
     assert_int_equal(g.verdict_abs, ULAM_VERDICT_FAIL);
     ulam_csr_free(M);
-    ulam_power edge = {.rho = 0.995, .lower = 0.99, .upper = 1.001};
-    assert_int_equal(ulam_verdict_of(&edge), ULAM_VERDICT_EDGE);
+}
+
+/* Radii within 1e-3 of 1 on either side, where 1000 power iterations do not converge: a
+ * verdict is certified only by bounds on one side of 1, otherwise it is unknown (never the
+ * side the unconverged estimate happens to fall on). */
+static void test_guard_near_one(void **state)
+{
+    (void)state;
+    static const double radii[] = {1.0005, 1.0009, 0.9995, 0.9991};
+    for (int k = 0; k < 4; k++) {
+        ulam_csr *M = near_one_matrix(300, radii[k]);
+        ulam_guard g;
+        assert_int_equal(ulam_guard_check(M, 0.0, NULL, &g, NULL), ULAM_OK);
+        int v = g.verdict_abs, certain = radii[k] > 1 ? ULAM_VERDICT_FAIL : ULAM_VERDICT_EDGE;
+        if (!(g.abs.lower <= radii[k] * (1 + 1e-12) && radii[k] <= g.abs.upper * (1 + 1e-12)) ||
+            (v != certain && v != ULAM_VERDICT_UNKNOWN))
+            print_error("case %d: rho %.6g: verdict %d, bounds [%.6g, %.6g], estimate %.6g, %d iterations\n", k,
+                        radii[k], v, g.abs.lower, g.abs.upper, g.abs.rho, g.abs.iterations);
+        assert_true(g.abs.lower <= radii[k] * (1 + 1e-12) && radii[k] <= g.abs.upper * (1 + 1e-12));
+        assert_true(v == certain || v == ULAM_VERDICT_UNKNOWN);
+        if (v == ULAM_VERDICT_FAIL) assert_true(g.abs.lower >= 1.0);
+        if (v == ULAM_VERDICT_EDGE) assert_true(g.abs.upper < 1.0);
+        ulam_csr_free(M);
+    }
+    ulam_power p = {.rho = 0.995, .lower = 0.99, .upper = 1.001}; /* straddles 1: not certified */
+    assert_int_equal(ulam_verdict_of(&p), ULAM_VERDICT_UNKNOWN);
+    p = (ulam_power){.rho = 0.989, .lower = 0.985, .upper = 1.001001};
+    assert_int_equal(ulam_verdict_of(&p), ULAM_VERDICT_UNKNOWN);
+    p = (ulam_power){.rho = 0.995, .lower = 0.9, .upper = 0.999};
+    assert_int_equal(ulam_verdict_of(&p), ULAM_VERDICT_EDGE);
+    p = (ulam_power){.rho = 1.0, .lower = 1.0, .upper = 1.3};
+    assert_int_equal(ulam_verdict_of(&p), ULAM_VERDICT_FAIL);
+}
+
+/* Column sums at most 1 with some below 1, every state reachable from those: rho < 1 strictly
+ * (a certificate without iterating to it).  5-point Jacobi on a 200 x 200 grid: rho =
+ * cos(pi / 201) = 0.99988, whose Collatz-Wielandt upper bound stays at 1 for thousands of
+ * iterations; a closed pair of states with column sums 1 has rho = 1 and is not certified. */
+static void test_guard_reach_certificate(void **state)
+{
+    (void)state;
+    enum { L = 200, N = L * L };
+    int32_t *ti = malloc(4 * N * sizeof *ti), *tj = malloc(4 * N * sizeof *tj);
+    double *tx = malloc(4 * N * sizeof *tx);
+    int64_t nz = 0;
+    for (int r = 0; r < L; r++)
+        for (int c = 0; c < L; c++) {
+            int nb[4][2] = {{r - 1, c}, {r + 1, c}, {r, c - 1}, {r, c + 1}};
+            for (int k = 0; k < 4; k++)
+                if (nb[k][0] >= 0 && nb[k][0] < L && nb[k][1] >= 0 && nb[k][1] < L)
+                    ti[nz] = r * L + c, tj[nz] = nb[k][0] * L + nb[k][1], tx[nz++] = 0.25;
+        }
+    ulam_csr *M = build(N, nz, ti, tj, tx);
+    ulam_guard g;
+    assert_int_equal(ulam_guard_check(M, 0.0, NULL, &g, NULL), ULAM_OK);
+    print_message("grid 200 x 200: rho(|M|) in [%.6g, %.17g), %d iterations\n", g.abs.lower, g.abs.upper, g.abs.iterations);
+    assert_int_equal(g.verdict_abs, ULAM_VERDICT_EDGE);
+    assert_int_equal(g.verdict_hat[ULAM_ADJOINT], ULAM_VERDICT_EDGE);
+    assert_true(g.abs.upper < 1.0 && g.abs.lower <= cos(M_PI / (L + 1)) && g.abs.iterations <= 20);
+    ulam_csr_free(M);
+    int32_t ci[4] = {0, 1, 2, 3}, cj[4] = {1, 0, 0, 2};
+    double cx[4] = {1.0, 1.0, 0.0, 0.5};
+    cx[2] = 1e-300; /* column 0 sums to 1 + 1e-300 (1 in double): no certificate, rho = 1 */
+    M = build(4, 4, ci, cj, cx);
+    assert_int_equal(ulam_guard_check(M, 0.0, NULL, &g, NULL), ULAM_OK);
+    assert_true(g.verdict_abs == ULAM_VERDICT_FAIL || g.verdict_abs == ULAM_VERDICT_UNKNOWN);
+    ulam_csr_free(M);
+    free(ti), free(tj), free(tx);
 }
 
 int main(void)
@@ -253,7 +319,8 @@ int main(void)
         cmocka_unit_test(test_scaled_stochastic), cmocka_unit_test(test_rotation_blocks),
         cmocka_unit_test(test_degenerate),     cmocka_unit_test(test_committed),
         cmocka_unit_test(test_power_known),    cmocka_unit_test(test_power_scaled),
-        cmocka_unit_test(test_guard),
+        cmocka_unit_test(test_guard),          cmocka_unit_test(test_guard_near_one),
+        cmocka_unit_test(test_guard_reach_certificate),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

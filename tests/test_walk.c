@@ -409,7 +409,8 @@ static void test_bad_options(void **state)
     unload(&s);
 }
 
-/* --rel-err stops once the relative standard error is reached, after at least 1000 walks. */
+/* --rel-err stops once the relative standard error is reached, after at least 1000 walks; with
+ * nothing reachable that scores (b = 0) it stops at once with x = 0. */
 static void test_rel_err_stop(void **state)
 {
     (void)state;
@@ -423,7 +424,154 @@ static void test_rel_err_stop(void **state)
     assert_true(r.walks >= 1000);
     assert_true(r.std_error <= 0.005 * fabs(r.estimate));
     assert_true(fabs(r.estimate - s.x[11]) < 4 * r.std_error);
+    for (int64_t i = 0; i < s.n; i++) s.b[i] = 0.0; /* x = 0 exactly: the rule ends at once, never spins */
+    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_true(r.rel_err_met && r.estimate == 0.0 && r.walks < 2048);
     unload(&s);
+}
+
+/* The solver takes the guards' verdicts before walking and refuses what the CLI refuses: a
+ * certified rho(|M|) >= 1 (divergent200: it used to return ULAM_OK and a number), an uncertified
+ * one (a radius 5e-4 above 1 that 1000 power iterations cannot pin), unless force; then a
+ * variance not certified finite gets no interval. */
+static void test_solver_guards(void **state)
+{
+    (void)state;
+    sys s = load("divergent200");
+    ulam_walk_opts o = ulam_walk_defaults();
+    ulam_walk_result r;
+    ulam_error err;
+    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_EDIVERGE);
+    assert_non_null(strstr(err.msg, "rho(|M|)"));
+    o.force = 1, o.max_steps = 50, o.max_walks = 1000;
+    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(r.variance_finite, 0);
+    assert_true(isnan(r.ci95[0]) && isnan(r.ci95[1]));
+    unload(&s);
+    ulam_csr *M = near_one_matrix(300, 1.0005);
+    double *b = malloc(300 * sizeof *b);
+    for (int k = 0; k < 300; k++) b[k] = 1.0;
+    o = ulam_walk_defaults();
+    o.index = 150;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EDIVERGE);
+    assert_non_null(strstr(err.msg, "not certain"));
+    o.force = 1, o.max_walks = 200, o.max_steps = 10000;
+    ulam_solver *sv = NULL;
+    assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, &err), ULAM_OK);
+    ulam_guard g;
+    ulam_solver_guard(sv, &g);
+    assert_int_equal(g.verdict_abs, ULAM_VERDICT_UNKNOWN);
+    assert_int_equal(ulam_guard_variance(&g, ULAM_ADJOINT), -1); /* analog, row sums near 1: M^ = |M| */
+    while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+    ulam_solver_result(sv, &r);
+    assert_int_equal(r.variance_finite, -1);
+    assert_true(isnan(r.ci95[0]));
+    ulam_solver_free(sv);
+    o.assume_finite = 1; /* the user's word that unknown is finite: an interval again */
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(r.variance_finite, 1);
+    assert_true(isfinite(r.ci95[0]));
+    o.guard = &g, o.assume_finite = 0; /* verdicts handed in are used, not recomputed */
+    g.verdict_hat[ULAM_ADJOINT] = ULAM_VERDICT_OK;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(r.variance_finite, 1);
+    ulam_csr_free(M), free(b);
+}
+
+/* A relative-error target with a variance that is not finite can never be met: refused at the
+ * start (ULAM_EINFVAR, naming the radius and the mode whose variance is finite) unless walks or
+ * time bound the run.  The star below has rho(|M|) = 0.5, adjoint rho(M^) = sqrt(1.25) (row 0
+ * sums to 5) and forward rho(M^) = 0.5 (every column sums to at most 1). */
+static void test_rel_err_infinite_refused(void **state)
+{
+    (void)state;
+    int32_t i[20], j[20];
+    double v[20], b[11];
+    for (int k = 0; k < 10; k++) {
+        i[k] = 0, j[k] = k + 1, v[k] = 0.5;
+        i[10 + k] = k + 1, j[10 + k] = 0, v[10 + k] = 0.05;
+    }
+    for (int k = 0; k < 11; k++) b[k] = 1.0;
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(11, 11, 20, i, j, v, &M), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.max_walks = 0, o.rel_err = 0.01;
+    ulam_walk_result r;
+    ulam_error err;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
+    assert_non_null(strstr(err.msg, "adjoint kernel"));
+    assert_non_null(strstr(err.msg, "forward mode's is finite"));
+    o.max_walks = 5000; /* bounded: runs, and the rule never fires */
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_true(r.walks == 5000 && !r.rel_err_met && r.variance_finite == 0);
+    o.max_walks = 0, o.mode = ULAM_FORWARD; /* the finite mode meets it */
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_true(r.rel_err_met && r.std_error <= 0.01 * fabs(r.estimate));
+    ulam_csr_free(M);
+}
+
+/* Forward mode at 1000 walks: a component no walk tallied has no estimate (NaN error, counted),
+ * never 0 +- 0 (states 1-3 of rare_system here have rows summing to 1e-4 and b = 0: forward
+ * walks reach each about once in 7000 walks, and x there is about 2.5e-4, which came out as
+ * exactly 0 +- 0); --rel-err watches a component only once walks have reached it. */
+static void test_forward_unreached(void **state)
+{
+    (void)state;
+    sys s;
+    s.n = 200;
+    s.M = rare_system(200, 0.9999, 0, 0.0, 1, &s.b);
+    s.x = malloc(200 * sizeof *s.x);
+    assert_int_equal(ulam_direct_solve(s.M, s.b, s.x, 0, NULL, NULL), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.mode = ULAM_FORWARD, o.max_walks = 1000, o.seed = 4;
+    ulam_solver *sv = NULL;
+    assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_OK);
+    while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+    ulam_walk_result r;
+    ulam_solver_result(sv, &r);
+    double *x = malloc((size_t)s.n * sizeof *x), *e = malloc((size_t)s.n * sizeof *e);
+    assert_int_equal(ulam_solver_vectors(sv, x, e), ULAM_OK);
+    int64_t nan = 0, zero = 0, first = -1;
+    for (int64_t k = 0; k < s.n; k++) {
+        nan += isnan(e[k]), zero += e[k] == 0.0 && s.x[k] != 0.0;
+        if (isnan(e[k]) && first < 0) first = k;
+    }
+    print_message("forward, 1000 walks: %lld of %lld components unreached, %lld reported 0 +- 0\n", (long long)nan,
+                  (long long)s.n, (long long)zero);
+    assert_true(nan > 0 && nan == r.unreached);
+    assert_int_equal(zero, 0);
+    ulam_solver_free(sv);
+    o.index = first, o.max_walks = 0, o.rel_err = 0.2; /* an unreached component, watched */
+    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_true(r.rel_err_met && isfinite(r.std_error) && r.std_error <= 0.2 * fabs(r.estimate));
+    assert_true(fabs(r.estimate - s.x[first]) < 4 * r.std_error);
+    free(x), free(e);
+    unload(&s);
+}
+
+/* Collision on a sticky rare cluster (rare_system with the three rare states' rows pointing at
+ * each other: walks that reach them, once in about 10^4, stay about 500 steps scoring 40 each,
+ * 45% of x): a single score has no bound, but walks longer than l add under E |m|, so the rule
+ * asks for ~10^6 walks and does not stop at 2000 (the old rule stopped at 1024 walks in 95 of
+ * 100 seeds, 45% low; with the score-bound minimum 18 of 20 seeds covered at E = 0.1). */
+static void test_rel_err_collision_tail(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M0 = rare_system(200, 0.002, 40, 0.00003, 1, &b), *T = NULL, *M = NULL;
+    for (int i = 0; i < 3; i++)
+        for (int64_t q = M0->rowptr[i]; q < M0->rowptr[i + 1]; q++) M0->colidx[q] = (int32_t)((i + 1 + q % 2) % 3);
+    assert_int_equal(ulam_csr_transpose(M0, &T), ULAM_OK); /* re-sort the rewired rows */
+    assert_int_equal(ulam_csr_transpose(T, &M), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 3, o.rel_err = 0.1, o.max_walks = 2000;
+    ulam_walk_result r;
+    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    print_message("sticky cluster, collision, 2000 walks: the rule needs %.3g walks (tail bound %.3g)\n", r.min_walks,
+                  r.tail_bound);
+    assert_true(!isfinite(r.score_bound) && isfinite(r.tail_bound));
+    assert_true(r.min_walks > 1e6 && !r.rel_err_met && r.walks == 2000);
+    ulam_csr_free(M0), ulam_csr_free(T), ulam_csr_free(M), free(b);
 }
 
 int main(void)
@@ -436,6 +584,8 @@ int main(void)
         cmocka_unit_test(test_absorption_refused), cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_rel_err_stop),      cmocka_unit_test(test_jacobi_poisson),
         cmocka_unit_test(test_collision_absorption_law),
+        cmocka_unit_test(test_solver_guards),     cmocka_unit_test(test_rel_err_infinite_refused),
+        cmocka_unit_test(test_forward_unreached), cmocka_unit_test(test_rel_err_collision_tail),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

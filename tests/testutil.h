@@ -78,4 +78,56 @@ static inline void assert_csr_same(const ulam_csr *A, const ulam_csr *B)
     assert_memory_equal(A->val, B->val, (size_t)ulam_csr_nnz(A) * sizeof *A->val);
 }
 
+/* A nonnegative n x n matrix whose Perron root is exactly rho but whose row and column sums
+ * vary (so no one-pass bound is tight) and whose spectral gap is ~1/n^2 (so power iteration
+ * converges slowly): rho / cos(pi / (n + 1)) D^-1 T D, T the path graph's tridiagonal (1/2
+ * off the diagonal, radius cos(pi / (n + 1))), D = diag(exp(0.4 sin(0.05 k))). */
+static inline ulam_csr *near_one_matrix(int32_t n, double rho)
+{
+    int32_t *ti = malloc(2 * (size_t)n * sizeof *ti), *tj = malloc(2 * (size_t)n * sizeof *tj);
+    double *tx = malloc(2 * (size_t)n * sizeof *tx), c = rho / cos(M_PI / (n + 1));
+    int64_t nz = 0;
+    for (int32_t k = 0; k + 1 < n; k++) {
+        double dk = exp(0.4 * sin(0.05 * k)), dl = exp(0.4 * sin(0.05 * (k + 1)));
+        ti[nz] = k, tj[nz] = k + 1, tx[nz++] = c * 0.5 * dl / dk;
+        ti[nz] = k + 1, tj[nz] = k, tx[nz++] = c * 0.5 * dk / dl;
+    }
+    ulam_csr *A = NULL;
+    int s = ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &A);
+    free(ti), free(tj), free(tx);
+    assert_int_equal(s, ULAM_OK);
+    return A;
+}
+
+/* A system with rare high absorption scores (the kind that fools optional stopping): states 0..2
+ * are rare, with p* = pstar and b = brare, their rows (1 - pstar in all) going to 4 bulk states;
+ * every bulk state i >= 3 moves to 4 bulk states (row sum 0.55..0.85) and with probability eps
+ * to a rare one, and has b_i ~ U(0, 1).  Walks start at a bulk state (index 3).  seed picks the
+ * structure.  *b is malloc'd. */
+static inline ulam_csr *rare_system(int32_t n, double pstar, double brare, double eps, uint64_t seed, double **b)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 77);
+    int32_t *ti = malloc(6 * (size_t)n * sizeof *ti), *tj = malloc(6 * (size_t)n * sizeof *tj);
+    double *tx = malloc(6 * (size_t)n * sizeof *tx);
+    *b = malloc((size_t)n * sizeof **b);
+    int64_t nz = 0;
+    for (int32_t i = 0; i < n; i++) {
+        int rare = i < 3;
+        double w[4], sw = 0, total = rare ? 1 - pstar : 0.55 + 0.3 * ulam_rng_uniform(&r);
+        for (int k = 0; k < 4; k++) sw += w[k] = 0.2 + ulam_rng_uniform(&r);
+        for (int k = 0; k < 4; k++) { /* distinct bulk targets: one from each quarter of the bulk */
+            int32_t q = (n - 3) / 4;
+            ti[nz] = i, tj[nz] = 3 + k * q + (int32_t)ulam_rng_bounded(&r, (uint64_t)q), tx[nz++] = total * w[k] / sw;
+        }
+        if (!rare && eps > 0) ti[nz] = i, tj[nz] = (int32_t)ulam_rng_bounded(&r, 3), tx[nz++] = eps;
+        (*b)[i] = rare ? brare : ulam_rng_uniform(&r);
+    }
+    ulam_csr *A = NULL;
+    int s = ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &A);
+    free(ti), free(tj), free(tx);
+    assert_int_equal(s, ULAM_OK);
+    return A;
+}
+
 #endif

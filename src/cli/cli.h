@@ -5,8 +5,8 @@
 #include "ulam.h"
 
 /* Exit codes (documented in README.md): 0 success, 1 internal failure, 2 usage error,
- * 3 walks would diverge, 10 + status for a library status, 130 interrupted. */
-enum { EXIT_USAGE = 2, EXIT_DIVERGE = 3, EXIT_STATUS_BASE = 10, EXIT_INTERRUPTED = 130 };
+ * 3 walks would diverge, 4 a --rel-err target with a variance not certified finite, 10 + status for a library status, 130 interrupted. */
+enum { EXIT_USAGE = 2, EXIT_DIVERGE = 3, EXIT_INFVAR = 4, EXIT_STATUS_BASE = 10, EXIT_INTERRUPTED = 130 };
 
 /* The exit code for a library status. */
 int cli_exit_code(int status);
@@ -90,12 +90,23 @@ const char *cli_verdict_word(int verdict);
 /* Print a power-iteration radius with its bounds (no newline). */
 void cli_print_power(const ulam_power *p);
 
-/* Run the stability guards for a walk in mode on s, printing warnings; 0 to go on, or
- * EXIT_DIVERGE (message printed) when rho(|M|) >= 1 and not force. */
-int cli_guard(const cli_system *s, double continue_q, int mode, int force, ulam_guard *g);
+/* The guards' radii for a walk in mode on s (rho(|M|) and that mode's rho(M^), stopped once
+ * certified); 0 or an exit code (error reported).  The solver takes them (ulam_walk_opts.guard)
+ * and refuses what they refuse. */
+int cli_guard(const cli_system *s, double continue_q, int mode, ulam_guard *g);
 
-/* One walk's share of the sum of squared scores above which a run warns of a heavy tail. */
-#define CLI_HEAVY_SHARE 0.05
+/* Print why walks whose rho(|M|) is not certified below 1 are refused (a warning under force). */
+void cli_guard_diverge(const cli_system *s, const ulam_guard *g, int force);
+
+/* Print the warnings of radii near 1, past it or unknown that do not stop a run. */
+void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assume_finite);
+
+/* Print a JSON verdict on a variance: true, false or null (unknown). */
+void cli_json_variance(const char *key, int finite);
+
+/* Print a radius as JSON keys prefix (the estimate when converged, else the upper bound),
+ * prefix_is ("estimate" or "upper bound"), prefix_lower, prefix_upper, prefix_converged. */
+void cli_json_radius(const char *prefix, const ulam_power *p);
 
 /* Subcommands: each takes the argv that starts at its own name. */
 int cli_info(int argc, char **argv);

@@ -1,4 +1,4 @@
-/* The stability guards as the commands report them: refusal, warnings, verdict words. */
+/* The stability guards as the commands report them: refusal messages, warnings, verdict words. */
 #include "cli.h"
 
 #include <stdio.h>
@@ -6,43 +6,96 @@
 /* A verdict in words. */
 const char *cli_verdict_word(int verdict)
 {
-    return verdict == ULAM_VERDICT_OK ? "below 1" : verdict == ULAM_VERDICT_EDGE ? "within 1% of 1" : "at or above 1";
+    switch (verdict) {
+    case ULAM_VERDICT_OK: return "below 1";
+    case ULAM_VERDICT_EDGE: return "below 1, not certified below 0.99";
+    case ULAM_VERDICT_FAIL: return "at or above 1";
+    default: return "unknown: the bounds straddle 1";
+    }
 }
 
-/* Print a radius as "0.900000 (certified in [lo, hi], k iterations)". */
+/* Print a radius as "0.900000 (bounds [lo, hi], k iterations, s, converged or a bound)". */
 void cli_print_power(const ulam_power *p)
 {
     printf("%.6f (bounds [%.6f, %.6f], %d iterations, %.3f s%s)", p->rho, p->lower, p->upper,
-           p->iterations, p->seconds, p->converged ? "" : ", NOT converged");
+           p->iterations, p->seconds,
+           p->converged ? "" : p->iterations == 0 ? ", certified by row/column sums; the value is not an estimate"
+                                                  : ", NOT converged: only the bounds are certain");
 }
 
-/* Run the guards for a walk in mode on s; 0 to go on, EXIT_DIVERGE (message printed) to stop. */
-int cli_guard(const cli_system *s, double continue_q, int mode, int force, ulam_guard *g)
+/* The guards' radii for a walk in mode on s (rho(|M|) and that mode's rho(M^), stopped once
+ * certified); 0 or an exit code (error reported). */
+int cli_guard(const cli_system *s, double continue_q, int mode, ulam_guard *g)
 {
     ulam_error err;
-    int status = ulam_guard_check(s->M, continue_q, NULL, g, &err);
-    if (status) return cli_report(s->matrix_path, &err);
-    if (g->verdict_abs == ULAM_VERDICT_FAIL) {
-        fprintf(stderr,
-                "ulam: %s: %s: rho(|M|) = %.6g (bounds [%.6g, %.6g]) is >= 1, so the walks' expected "
-                "score is a divergent series and any estimate with an error bar would be garbage. "
-                "Solve it with 'ulam direct'%s.%s\n",
-                s->matrix_path, force ? "warning" : "error", g->abs.rho, g->abs.lower, g->abs.upper,
-                s->jacobi ? " (damping with --omega cannot help: rho(|I - w D^-1 A|) = 1 - w + w rho(|J|))"
-                          : ", or if the file holds A of A x = b, try --jacobi",
-                force ? " Running anyway (--force)." : " --force runs the walks anyway.");
-        if (!force) return EXIT_DIVERGE;
-    } else if (g->verdict_abs == ULAM_VERDICT_EDGE) {
-        fprintf(stderr, "ulam: %s: warning: rho(|M|) = %.6g is within 1%% of 1: walks will be long "
-                        "(mean length about 1 / (1 - rho))\n", s->matrix_path, g->abs.rho);
-    }
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(mode);
+    int status = ulam_guard_check(s->M, continue_q, &go, g, &err);
+    return status ? cli_report(s->matrix_path, &err) : 0;
+}
+
+/* The refusal of walks whose rho(|M|) is not certified below 1 (or its warning under --force). */
+void cli_guard_diverge(const cli_system *s, const ulam_guard *g, int force)
+{
+    const ulam_power *a = &g->abs;
+    const char *kind = force ? "warning" : "error";
+    if (g->verdict_abs == ULAM_VERDICT_FAIL)
+        fprintf(stderr, "ulam: %s: %s: rho(|M|) is >= 1 (certified: bounds [%.6g, %.6g]), so the walks' expected "
+                        "score is a divergent series and any estimate with an error bar would be garbage. ",
+                s->matrix_path, kind, a->lower, a->upper);
+    else
+        fprintf(stderr, "ulam: %s: %s: rho(|M|) is in [%.6g, %.6g] after %d iterations: the bounds straddle 1, so "
+                        "whether the walks converge is unknown, and unknown is treated as divergent. ",
+                s->matrix_path, kind, a->lower, a->upper, a->iterations);
+    fprintf(stderr, "Solve it with 'ulam direct'%s.%s\n",
+            s->jacobi ? " (damping with --omega cannot help: rho(|I - w D^-1 A|) = 1 - w + w rho(|J|))"
+                      : ", or if the file holds A of A x = b, try --jacobi",
+            force ? " Running anyway (--force)." : " --force runs the walks anyway.");
+}
+
+/* Warnings for radii near or past 1 that do not stop the run. */
+void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assume_finite)
+{
+    if (g->verdict_abs == ULAM_VERDICT_EDGE)
+        fprintf(stderr, "ulam: %s: warning: rho(|M|) is certified below 1 but not below 0.99 (bounds [%.6g, %.6g)): "
+                        "walks may be long (mean length about 1 / (1 - rho))\n", s->matrix_path, g->abs.lower,
+                g->abs.upper);
     const ulam_power *h = &g->hat[mode];
+    const char *kernel = mode == ULAM_ADJOINT ? "adjoint" : "forward";
     if (g->verdict_hat[mode] == ULAM_VERDICT_FAIL)
-        fprintf(stderr, "ulam: %s: warning: rho(M^) = %.6g >= 1 for the %s kernel: the estimator's "
+        fprintf(stderr, "ulam: %s: warning: rho(M^) >= 1 (bounds [%.6g, %.6g]) for the %s kernel: the estimator's "
                         "variance is infinite, so no error bar it reports can be trusted\n",
-                s->matrix_path, h->rho, mode == ULAM_ADJOINT ? "adjoint" : "forward");
+                s->matrix_path, h->lower, h->upper, kernel);
+    else if (g->verdict_hat[mode] == ULAM_VERDICT_UNKNOWN)
+        fprintf(stderr, "ulam: %s: warning: rho(M^) of the %s kernel is in [%.6g, %.6g] after %d iterations: "
+                        "whether the variance is finite is unknown%s\n", s->matrix_path, kernel, h->lower,
+                h->upper, h->iterations,
+                assume_finite ? "; --assume-finite-variance: the interval is printed anyway"
+                              : ", so it is treated as infinite: no confidence interval (--assume-finite-variance "
+                                "prints one anyway)");
     else if (g->verdict_hat[mode] == ULAM_VERDICT_EDGE)
-        fprintf(stderr, "ulam: %s: warning: rho(M^) = %.6g is within 1%% of 1: the variance is finite "
-                        "but huge, and the error bar converges slowly\n", s->matrix_path, h->rho);
-    return 0;
+        fprintf(stderr, "ulam: %s: warning: rho(M^) is certified below 1 but not below 0.99 (bounds [%.6g, %.6g)): "
+                        "the variance is finite but may be huge, and the error bar converges slowly\n",
+                s->matrix_path, h->lower, h->upper);
+}
+
+/* Print a JSON verdict on a variance: true, false or null (unknown). */
+void cli_json_variance(const char *key, int finite)
+{
+    printf("\"%s\": %s, ", key, finite == 1 ? "true" : finite == 0 ? "false" : "null");
+}
+
+/* Print a radius as JSON keys prefix (the estimate when converged, else the upper bound),
+ * prefix_is ("estimate" or "upper bound"), prefix_lower, prefix_upper, prefix_converged. */
+void cli_json_radius(const char *prefix, const ulam_power *p)
+{
+    char key[64];
+    cli_json_number(prefix, p->converged ? p->rho : p->upper, 0);
+    snprintf(key, sizeof key, "%s_is", prefix);
+    cli_json_string(key, p->converged ? "estimate" : "upper bound", 0);
+    snprintf(key, sizeof key, "%s_lower", prefix);
+    cli_json_number(key, p->lower, 0);
+    snprintf(key, sizeof key, "%s_upper", prefix);
+    cli_json_number(key, p->upper, 0);
+    printf("\"%s_converged\": %s, ", prefix, p->converged ? "true" : "false");
 }

@@ -49,24 +49,16 @@ static void print_text(const cli_system *s, const ulam_csr_stats *st, const ulam
     printf("\nNeumann series   %s%s\n", r->rho < 1 ? "converges (rho(M) < 1)" : "diverges (rho(M) >= 1)",
            r->converged ? "" : unsure);
     printf("walks            %s (rho(|M|) %s)\n",
-           g->verdict_abs == ULAM_VERDICT_FAIL ? "diverge: use 'ulam direct'" : "converge",
+           g->verdict_abs == ULAM_VERDICT_FAIL ? "diverge: use 'ulam direct'"
+           : g->verdict_abs == ULAM_VERDICT_UNKNOWN ? "unknown: refused unless --force" : "converge",
            cli_verdict_word(g->verdict_abs));
-    for (int m = 0; m < 2; m++)
+    for (int m = 0; m < 2; m++) {
+        int v = ulam_guard_variance(g, m);
         printf("variance %s %s (rho(M^) %s)\n", m == ULAM_ADJOINT ? "adjoint" : "forward",
-               g->verdict_hat[m] == ULAM_VERDICT_FAIL ? "infinite: no error bar can be trusted" : "finite",
+               v == 0 ? "infinite: no error bar can be trusted"
+               : v < 0 ? "unknown: treated as infinite (no interval) unless --assume-finite-variance" : "finite",
                cli_verdict_word(g->verdict_hat[m]));
-}
-
-/* Print one radius as JSON keys prefix, prefix_lower, prefix_upper, prefix_converged. */
-static void json_power(const char *prefix, const ulam_power *p)
-{
-    char key[64];
-    cli_json_number(prefix, p->rho, 0);
-    snprintf(key, sizeof key, "%s_lower", prefix);
-    cli_json_number(key, p->lower, 0);
-    snprintf(key, sizeof key, "%s_upper", prefix);
-    cli_json_number(key, p->upper, 0);
-    printf("\"%s_converged\": %s, ", prefix, p->converged ? "true" : "false");
+    }
 }
 
 /* Print the JSON object. */
@@ -87,13 +79,15 @@ static void print_json(const cli_system *s, const ulam_csr_stats *st, const ulam
     cli_json_number("rho", r->rho, 0);
     cli_json_number("rho_residual", r->residual, 0);
     printf("\"rho_converged\": %s, ", r->converged ? "true" : "false");
-    json_power("rho_abs", &g->abs);
-    json_power("rho_hat_adjoint", &g->hat[ULAM_ADJOINT]);
-    json_power("rho_hat_forward", &g->hat[ULAM_FORWARD]);
+    cli_json_radius("rho_abs", &g->abs);
+    cli_json_radius("rho_hat_adjoint", &g->hat[ULAM_ADJOINT]);
+    cli_json_radius("rho_hat_forward", &g->hat[ULAM_FORWARD]);
     printf("\"neumann_converges\": %s, ", r->rho < 1 ? "true" : "false");
-    printf("\"walks_converge\": %s, ", g->verdict_abs != ULAM_VERDICT_FAIL ? "true" : "false");
-    printf("\"variance_finite_adjoint\": %s, ", g->verdict_hat[0] != ULAM_VERDICT_FAIL ? "true" : "false");
-    printf("\"variance_finite_forward\": %s}\n", g->verdict_hat[1] != ULAM_VERDICT_FAIL ? "true" : "false");
+    cli_json_variance("walks_converge", g->verdict_abs <= ULAM_VERDICT_EDGE ? 1 : g->verdict_abs == ULAM_VERDICT_FAIL ? 0 : -1);
+    cli_json_variance("variance_finite_adjoint", ulam_guard_variance(g, ULAM_ADJOINT));
+    cli_json_variance("variance_finite_forward", ulam_guard_variance(g, ULAM_FORWARD));
+    cli_json_number("guard_seconds", g->abs.seconds + g->hat[0].seconds + g->hat[1].seconds, 1);
+    printf("}\n");
 }
 
 /* For --jacobi: rho(M) and rho(|M|) of the splitting at several dampings (A read once). */
@@ -118,7 +112,7 @@ static int print_omegas(const cli_system *base, const ulam_spectral_opts *so)
         ulam_csr_free(M);
         if (!status)
             printf("                 %5.2f   %-9.6f  %-9.6f  %-9s  %s\n", omega, r.rho, pa.rho,
-                   r.rho < 1 ? "converges" : "diverges", ulam_verdict_of(&pa) == ULAM_VERDICT_FAIL ? "diverge" : "converge");
+                   r.rho < 1 ? "converges" : "diverges", ulam_verdict_of(&pa) <= ULAM_VERDICT_EDGE ? "converge" : ulam_verdict_of(&pa) == ULAM_VERDICT_FAIL ? "diverge" : "unknown");
     }
     ulam_csr_free(A);
     free(b), free(bp);
@@ -163,7 +157,11 @@ int cli_info(int argc, char **argv)
     ulam_csr_stats_compute(s.M, &st);
     int status = ulam_spectral_radius(s.M, 0, &so, &r);
     if (status) err = (ulam_error){.status = status, .msg = "memory for the radius estimate"};
-    else status = ulam_guard_check(s.M, continue_q, NULL, &g, &err);
+    else {
+        ulam_guard_opts go = ulam_guard_defaults();
+        go.tight = 1; /* info reports the radii themselves, not only the verdicts */
+        status = ulam_guard_check(s.M, continue_q, &go, &g, &err);
+    }
     if (status) {
         rc = cli_report(s.matrix_path, &err);
         cli_system_free(&s);

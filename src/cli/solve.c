@@ -13,7 +13,8 @@ static const char *const usage =
     "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"
     "                  [--time S] [--seed S] [--threads T] [--continue Q] [--roulette W]\n"
     "                  [--split W] [--max-steps K] [--jacobi [--omega W]] [--check] [--json]\n"
-    "                  [--out x.mtx] [--errors e.mtx] [--force] [--cache] [--whole-kernel]\n"
+    "                  [--out x.mtx] [--errors e.mtx] [--force] [--assume-finite-variance]\n"
+    "                  [--cache] [--whole-kernel]\n"
     "\n"
     "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
     "Indices are 1-based, as in Matrix Market files.\n"
@@ -24,7 +25,11 @@ static const char *const usage =
     "  --estimator E      collision (score at every visit, default), absorption (score where\n"
     "                     the walk ends, / p*), expected (score the exact next-step expectation)\n"
     "  --walks N          stop after N walks (default 100000 when no rule is given)\n"
-    "  --rel-err E        stop once stderr / |estimate| <= E (after at least 1000 walks)\n"
+    "  --rel-err E        stop once stderr / |estimate| <= E, and only once enough walks have run\n"
+    "                     for the error bar to be trusted (README: 'When to trust the error\n"
+    "                     bar'); it watches x_I (--index, default 1 in forward mode) and never\n"
+    "                     stops while no walk has reached it; refused (exit 4) when the variance\n"
+    "                     is not certified finite, unless --walks or --time bounds the run\n"
     "  --time S           stop after S seconds; the first rule reached wins\n"
     "  --seed S           block q of walks uses stream (S, q): identical results for any --threads\n"
     "  --threads T        threads (default: all cores)\n"
@@ -38,15 +43,19 @@ static const char *const usage =
     "  --check            also solve with LAPACK: adds direct, direct_seconds and\n"
     "                     z = (estimate - direct) / stderr\n"
     "  --json             print one JSON object\n"
-    "  --force            walk even when rho(|M|) >= 1 (otherwise refused with exit 3)\n"
+    "  --force            walk even when rho(|M|) is not certified below 1 (otherwise refused\n"
+    "                     with exit 3)\n"
+    "  --assume-finite-variance  print a confidence interval when the guards cannot tell\n"
+    "                     whether rho(M^) < 1 (unknown is otherwise treated as infinite)\n"
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
     "                     that instead of parsing while the file is unchanged (size, mtime)\n"
     "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
     "                     is built when a walk first reaches it, so one unknown of a large\n"
     "                     system reads and keeps only the rows its walks visit)\n"
     "\n"
-    "Before walking, the guards estimate rho(|M|) (the walks converge iff < 1) and rho(M^) of\n"
-    "the kernel's second-moment matrix (the variance is finite iff < 1); with rho(M^) >= 1 the\n"
+    "Before walking, the guards bound rho(|M|) (the walks converge iff < 1) and rho(M^) of\n"
+    "the kernel's second-moment matrix (the variance is finite iff < 1); a verdict counts only\n"
+    "when its certified bounds lie on one side of 1.  With rho(M^) not certified below 1 the\n"
     "run goes on but reports no confidence interval.\n"
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C\n"
@@ -60,7 +69,8 @@ typedef struct {
     double direct, direct_seconds;
     uint64_t seed;
     ulam_guard g;
-    int variance_finite;
+    int assume_finite;
+    int64_t n;
     double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the solver set-up */
 } report_opts;
 
@@ -71,25 +81,23 @@ static double peak_rss_mib(void)
     return getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
 }
 
-/* Nonzero when one walk dominates the sum of squares: a heavy tail. */
-static int heavy(const ulam_walk_result *r)
-{
-    return r->walks >= 1000 && r->max_share > CLI_HEAVY_SHARE;
-}
-
 /* Print the human-readable block. */
 static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
 {
     double mean_len = r->walks ? (double)r->steps / (double)r->walks : 0.0;
     double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
-    if (ro->variance_finite)
+    if (o->mode == ULAM_FORWARD && isnan(r->std_error))
+        printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->index + 1,
+               o->index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
+    else if (r->variance_finite == 1)
         printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->index + 1,
                o->index < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
                r->interrupted ? "  [INTERRUPTED]" : "");
     else
-        printf("x[%lld]%*s%.10g (no confidence interval: the variance is infinite, rho(M^) >= 1; the "
-               "sample stderr %.3g means nothing)%s\n", (long long)o->index + 1, o->index < 9 ? 10 : 9, "",
-               r->estimate, r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
+        printf("x[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
+               "means nothing)%s\n", (long long)o->index + 1, o->index < 9 ? 10 : 9, "", r->estimate,
+               r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
+               r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
     printf("method          %s walks, %s estimator\n", mode_names[o->mode], est_names[o->estimator]);
     printf("walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
            (long long)o->max_steps, r->cut ? ": the estimate is biased by the cut" : "");
@@ -101,11 +109,28 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
            (unsigned long long)ro->seed);
     printf("figure of merit %.4g (1 / (relative variance x seconds))\n",
            r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : INFINITY);
-    printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", ro->g.abs.rho,
-           cli_verdict_word(ro->g.verdict_abs), ro->g.hat[o->mode].rho, cli_verdict_word(ro->g.verdict_hat[o->mode]));
-    if (heavy(r))
-        printf("heavy tail      one walk holds %.1f%% of the sum of squared scores: the error bar is "
-               "not to be trusted\n", 100 * r->max_share);
+    printf("guards          rho(|M|) in [%.6g, %.6g] (%s), rho(M^) in [%.6g, %.6g] (%s)\n", ro->g.abs.lower,
+           ro->g.abs.upper, cli_verdict_word(ro->g.verdict_abs), ro->g.hat[o->mode].lower, ro->g.hat[o->mode].upper,
+           cli_verdict_word(ro->g.verdict_hat[o->mode]));
+    if (isfinite(r->score_bound))
+        printf("tail            a single score is at most %.4g: one more walk could move the estimate by at "
+               "most %.3g%%\n", r->score_bound, 100 * r->tail_bound);
+    else if (isfinite(r->tail_bound))
+        printf("tail            scores grow with the walk's length; walks short enough to matter (the rest add under "
+               "%.3g%% of the answer) could move it by at most %.3g%% more\n", 100 * (o->rel_err > 0 ? o->rel_err : 0.01),
+               100 * r->tail_bound);
+    else
+        printf("tail            scores are unbounded (walk length, weights): no walk count rules out an unseen "
+               "large score; the variance's own relative error is %.3g\n", r->variance_rel_error);
+    if (o->mode == ULAM_FORWARD)
+        printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
+               (long long)r->unreached, (long long)ro->n);
+    if (o->rel_err > 0 && r->min_walks > 0)
+        printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate)\n",
+               r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks);
+    else if (o->rel_err > 0)
+        printf("rel-err         %s (target %.3g; no score bound: the standard error and the fourth-moment check "
+               "decide)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
     if (ro->check)
@@ -120,7 +145,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     printf("{\"index\": %lld, ", (long long)o->index + 1);
     cli_json_number("estimate", r->estimate, 0);
     cli_json_number("stderr", r->std_error, 0);
-    if (ro->variance_finite) {
+    if (r->variance_finite == 1) {
         printf("\"ci95\": [");
         cli_json_value(r->ci95[0]);
         printf(", ");
@@ -129,11 +154,18 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     } else {
         printf("\"ci95\": null, ");
     }
-    printf("\"variance_finite\": %s, ", ro->variance_finite ? "true" : "false");
-    cli_json_number("rho_abs", ro->g.abs.rho, 0);
-    cli_json_number("rho_hat", ro->g.hat[o->mode].rho, 0);
+    cli_json_variance("variance_finite", r->variance_finite);
+    cli_json_radius("rho_abs", &ro->g.abs);
+    cli_json_radius("rho_hat", &ro->g.hat[o->mode]);
     cli_json_number("max_share", r->max_share, 0);
-    printf("\"heavy_tail\": %s, ", heavy(r) ? "true" : "false");
+    cli_json_number("score_bound", r->score_bound, 0);
+    cli_json_number("tail_bound", r->tail_bound, 0);
+    cli_json_number("variance_rel_error", r->variance_rel_error, 0);
+    if (o->rel_err > 0) {
+        cli_json_number("min_walks", r->min_walks, 0);
+        printf("\"rel_err_met\": %s, ", r->rel_err_met ? "true" : "false");
+    }
+    if (o->mode == ULAM_FORWARD) printf("\"unreached\": %lld, ", (long long)r->unreached);
     cli_json_number("variance", r->variance, 0);
     printf("\"walks\": %lld, \"steps\": %lld, \"cut\": %lld, ", (long long)r->walks, (long long)r->steps,
            (long long)r->cut);
@@ -171,21 +203,64 @@ static int direct_check(const cli_system *s, int64_t index, report_opts *ro)
     return 0;
 }
 
+/* The standard errors as a Matrix Market array, atomically: NaN for a component no walk reached
+ * (ulam_mm_write_vector refuses non-finite values), with the comments saying so and whether the
+ * variance is finite.  ULAM_OK or a status. */
+static int write_errors(const char *path, const double *e, int64_t n, const ulam_walk_result *r)
+{
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (status) return status;
+    fprintf(o.f, "%%%%MatrixMarket matrix array real general\n%% standard errors of the forward estimates\n");
+    if (r->variance_finite != 1)
+        fprintf(o.f, "%% VARIANCE %s (rho(M^) of the forward kernel %s): these standard errors mean nothing\n",
+                r->variance_finite == 0 ? "INFINITE" : "NOT CERTIFIED FINITE",
+                r->variance_finite == 0 ? ">= 1" : "straddles 1");
+    if (r->unreached)
+        fprintf(o.f, "%% %lld components unreached (no walk tallied them): their error is nan, they have no estimate\n",
+                (long long)r->unreached);
+    fprintf(o.f, "%lld 1\n", (long long)n);
+    for (int64_t k = 0; k < n; k++) fprintf(o.f, isnan(e[k]) ? "nan\n" : "%.17g\n", e[k]);
+    return ulam_outfile_commit(&o);
+}
+
 /* Write the forward vectors; 0 or an exit code. */
-static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, const char *errors)
+static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, const char *errors,
+                         const ulam_walk_result *r)
 {
     double *x = malloc((size_t)n * sizeof *x), *e = malloc((size_t)n * sizeof *e);
     int status = x && e ? ulam_solver_vectors(sv, x, e) : ULAM_ENOMEM;
     const char *path = out;
-    if (!status && out) status = ulam_mm_write_vector(out, x, n, "forward random-walk estimates of x");
+    if (!status && out) status = ulam_mm_write_vector(out, x, n, r->unreached ? "forward random-walk estimates of x "
+                                                                 "(unreached components: 0, no estimate; see the errors)"
+                                                               : "forward random-walk estimates of x");
     if (!status && errors) {
         path = errors;
-        status = ulam_mm_write_vector(errors, e, n, "standard errors of the forward estimates");
+        status = write_errors(errors, e, n, r);
     }
     free(x), free(e);
     if (!status) return 0;
     ulam_error err = {.status = status, .msg = "a writable output file and finite values"};
     return cli_report(path, &err);
+}
+
+/* After the first round: say so when the rel-err rule's minimum walk count (from the bound on a
+ * single score) is out of reach, and name the estimators without that tail. */
+static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const ulam_walk_result *r)
+{
+    double limit = o->max_walks > 0 ? (double)o->max_walks : 1e8;
+    if (!(o->rel_err > 0) || !(r->min_walks > limit)) return;
+    if (isfinite(r->score_bound))
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %s score can reach %.4g, so the rule needs about "
+                        "%.3g walks at this estimate before it may stop (%s)%s\n", s->matrix_path, o->rel_err,
+                o->estimator == ULAM_ABSORPTION ? "absorption" : "", r->score_bound, r->min_walks,
+                o->max_walks > 0 ? "more than --walks" : "out of reach in practice",
+                o->estimator == ULAM_ABSORPTION ? "; the collision and expected estimators score b directly and "
+                                                  "have no such tail" : "");
+    else
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g: scores grow with the walk's length, so the rule needs about "
+                        "%.3g walks at this estimate before it may stop (%s)\n", s->matrix_path, o->rel_err, r->min_walks,
+                o->max_walks > 0 ? "more than --walks" : "out of reach in practice");
 }
 
 /* ulam solve. */
@@ -203,7 +278,8 @@ int cli_solve(int argc, char **argv)
         {"json", no_argument, 0, 'J'},            {"out", required_argument, 0, 'o'},
         {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
         {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
-        {"whole-kernel", no_argument, 0, 'W'},    {0, 0, 0, 0}};
+        {"whole-kernel", no_argument, 0, 'W'},    {"assume-finite-variance", no_argument, 0, 'A'},
+        {0, 0, 0, 0}};
     cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};
@@ -240,6 +316,7 @@ int cli_solve(int argc, char **argv)
         case 'c': ro.check = 1; break;
         case 'J': ro.json = 1; break;
         case 'F': force = 1; break;
+        case 'A': ro.assume_finite = 1; break;
         case 'o': out = optarg; break;
         case 'E': errors = optarg; break;
         case 'h': fputs(usage, stdout); return 0;
@@ -259,30 +336,49 @@ int cli_solve(int argc, char **argv)
     if ((rc = cli_load_system(&s))) return rc;
     ro.load_seconds = ulam_now() - t0;
     o.index = s.index ? s.index - 1 : 0;
-    if ((rc = cli_guard(&s, o.continue_q, o.mode, force, &ro.g))) {
+    if ((rc = cli_guard(&s, o.continue_q, o.mode, &ro.g))) {
         cli_system_free(&s);
         return rc;
     }
     ro.guard_seconds = ro.g.abs.seconds + ro.g.hat[0].seconds + ro.g.hat[1].seconds;
-    ro.variance_finite = ro.g.verdict_hat[o.mode] != ULAM_VERDICT_FAIL;
-    if (ro.check && (rc = direct_check(&s, o.index, &ro))) {
-        cli_system_free(&s);
-        return rc;
-    }
+    ro.n = s.M->nrows;
     ulam_solver *sv = NULL;
     ulam_error err;
-    o.interrupt = &cli_interrupted, o.share = cli_share;
+    o.interrupt = &cli_interrupted, o.share = cli_share, o.guard = &ro.g, o.force = force;
+    o.assume_finite = ro.assume_finite;
     t0 = ulam_now();
-    int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err);
+    int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err); /* refuses what the guards refuse */
     ro.kernel_seconds = ulam_now() - t0;
     int64_t n = s.M->nrows;
+    if (status == ULAM_EDIVERGE) {
+        cli_guard_diverge(&s, &ro.g, 0);
+        cli_system_free(&s);
+        return EXIT_DIVERGE;
+    }
+    if (status == ULAM_EINFVAR) {
+        fprintf(stderr, "ulam: %s: error: --rel-err %g can never be met: it needs %s. Bound the run with --walks N "
+                        "or --time S (no confidence interval is then printed)\n", s.matrix_path, o.rel_err, err.msg);
+        cli_system_free(&s);
+        return EXIT_INFVAR;
+    }
     if (status) {
         cli_system_free(&s);
         return cli_report(s.matrix_path, &err);
     }
+    if (ro.g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(&s, &ro.g, 1);
+    cli_guard_warn(&s, &ro.g, o.mode, ro.assume_finite);
+    if (ro.check && (rc = direct_check(&s, o.index, &ro))) {
+        ulam_solver_free(sv);
+        cli_system_free(&s);
+        return rc;
+    }
     cli_catch_sigint();
-    while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     ulam_walk_result r;
+    for (int first = 1; !status && !ulam_solver_done(sv); first = 0) {
+        status = ulam_solver_iterate(sv);
+        ulam_solver_result(sv, &r);
+        if (first && !status) rel_err_warning(&s, &o, &r);
+    }
     ulam_solver_result(sv, &r);
     rc = 0;
     if (status) {
@@ -291,7 +387,7 @@ int cli_solve(int argc, char **argv)
                 s.matrix_path, ulam_strerror(status), (long long)r.walks);
         rc = cli_exit_code(status);
     } else if (o.mode == ULAM_FORWARD && (out || errors) && !r.interrupted && cli_rank == 0) {
-        rc = write_vectors(sv, n, out, errors);
+        rc = write_vectors(sv, n, out, errors, &r);
     }
     if (!status && !rc) {
         if (ro.json) print_json(&o, &r, &ro);

@@ -4,6 +4,7 @@
  * non-finite number is written: an undefined statistic is an empty field. */
 #include "cli.h"
 
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -15,7 +16,7 @@
 static const char *const usage =
     "usage: ulam study M.mtx --rhs b.mtx --index I [--methods LIST] [--budgets LIST |\n"
     "                  --time-budgets LIST] [--repeats R] [--out DIR] [--seed S] [--threads T]\n"
-    "                  [--jacobi [--omega W]] [--cache]\n"
+    "                  [--jacobi [--omega W]] [--cache] [--force]\n"
     "\n"
     "Run every method (mode-estimator-window: adjoint|forward, collision|absorption|expected,\n"
     "plain|roulette|split) at every budget R times with distinct seeds, and compare each run\n"
@@ -31,6 +32,12 @@ static const char *const usage =
     "                       reference.csv, rmse.png, work.png, coverage.png\n"
     "  --cache              binary copies of the inputs beside them, as in 'ulam solve'\n"
     "  --seed S             base seed (default 1); run r of method m at budget k has its own\n"
+    "  --force              start afresh when --out holds runs of a different question\n"
+    "\n"
+    "A rerun resumes only the same question: DIR/question.txt records a fingerprint of it (the\n"
+    "contents of M and b, n, --index, --jacobi and --omega, --seed, the methods, walk or time\n"
+    "budgets); a rerun that differs in any of them is refused, naming the field (exit 2),\n"
+    "unless --force discards the old runs.\n"
     "\n"
     "Windows: roulette W = 0.5 w0, split W = 2 w0 (w0 the starting weight).  Ctrl-C keeps\n"
     "every finished row and writes the summary (exit 130); a second Ctrl-C exits at once.\n";
@@ -44,16 +51,17 @@ typedef struct {
     char name[40];
     int mode, est, window, on;
     char why[320]; /* non-empty: refused */
-    int infinite;  /* rho(M^) >= 1: runs, flagged */
+    int infinite;  /* rho(M^) not certified below 1: runs, flagged */
 } method;
 
 typedef struct {
     cli_system s;
     method m[NMETHOD];
     double budget[MAXBUDGET];
-    int nbudget, time_budgets, repeats, threads;
+    int nbudget, time_budgets, repeats, threads, force;
     uint64_t seed;
     const char *out;
+    ulam_guard g; /* the verdicts, computed once for every run */
     double exact;
     double *est, *se, *sec; /* [m][b][r] */
     unsigned char *done;
@@ -115,29 +123,30 @@ static int parse_budgets(study *st, const char *opt, const char *list, int integ
 /* Refuse what the guards or the estimator's definition refuse, flag infinite variance. */
 static int screen_methods(study *st)
 {
-    ulam_guard g;
+    ulam_guard *g = &st->g;
     ulam_error err;
-    int status = ulam_guard_check(st->s.M, 0.0, NULL, &g, &err);
+    int status = ulam_guard_check(st->s.M, 0.0, NULL, g, &err);
     if (status) return cli_report(st->s.matrix_path, &err);
     int left = 0;
     for (int k = 0; k < NMETHOD; k++) {
         method *m = &st->m[k];
         if (!m->on) continue;
-        if (g.verdict_abs == ULAM_VERDICT_FAIL) {
-            snprintf(m->why, sizeof m->why, "rho(|M|) = %.4g >= 1: the walks diverge", g.abs.rho);
+        if (g->verdict_abs >= ULAM_VERDICT_FAIL) {
+            snprintf(m->why, sizeof m->why, "rho(|M|) in [%.4g, %.4g] is not certified below 1: the walks may diverge",
+                     g->abs.lower, g->abs.upper);
         } else {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.mode = m->mode, o.estimator = m->est, o.index = st->s.index - 1, o.max_walks = 1;
+            o.mode = m->mode, o.estimator = m->est, o.index = st->s.index - 1, o.max_walks = 1, o.guard = g;
             ulam_solver *sv = NULL;
             if (ulam_solver_alloc(st->s.M, st->s.b, &o, &sv, &err))
                 snprintf(m->why, sizeof m->why, "%s: expected %s", ulam_strerror(err.status), err.msg);
             ulam_solver_free(sv);
         }
-        m->infinite = g.verdict_hat[m->mode] == ULAM_VERDICT_FAIL;
+        m->infinite = ulam_guard_variance(g, m->mode) != 1;
         if (m->why[0]) fprintf(stderr, "ulam: study: %s refused: %s\n", m->name, m->why);
         else if (m->infinite)
-            fprintf(stderr, "ulam: study: %s runs with infinite variance (rho(M^) = %.4g): its error bars mean nothing\n",
-                    m->name, g.hat[m->mode].rho);
+            fprintf(stderr, "ulam: study: %s runs with a variance not certified finite (rho(M^) in [%.4g, %.4g]): its "
+                    "error bars mean nothing\n", m->name, g->hat[m->mode].lower, g->hat[m->mode].upper);
         left += !m->why[0];
     }
     if (!left) fprintf(stderr, "ulam: study: every selected method is refused\n");
@@ -205,7 +214,7 @@ static int one_run(study *st, int m, int b, int r)
     ulam_walk_opts o = ulam_walk_defaults();
     o.mode = me->mode, o.estimator = me->est, o.index = st->s.index - 1, o.threads = st->threads;
     o.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
-    o.interrupt = &cli_interrupted, o.share = cli_share;
+    o.interrupt = &cli_interrupted, o.share = cli_share, o.guard = &st->g, o.force = 1;
     if (st->time_budgets) o.max_walks = 0, o.max_seconds = st->budget[b];
     else o.max_walks = (int64_t)st->budget[b];
     double w0 = me->mode == ULAM_FORWARD ? 0.0 : 1.0; /* forward particles start at ||b||_1 */
@@ -225,6 +234,91 @@ static int one_run(study *st, int m, int b, int r)
     if (!(st->row[i] = strdup(line))) return 1;
     st->est[i] = res.estimate, st->se[i] = res.std_error, st->sec[i] = res.seconds, st->done[i] = 1;
     return 0;
+}
+
+/* FNV-1a 64 of n bytes, continuing from h. */
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *c = p;
+    for (size_t k = 0; k < n; k++) h = (h ^ c[k]) * 0x100000001b3ULL;
+    return h;
+}
+
+/* The question a study answers, one "field value" line each, into buf. */
+static void fingerprint(const study *st, char *buf, size_t len)
+{
+    const ulam_csr *M = st->s.M;
+    int64_t n = M->nrows, nz = ulam_csr_nnz(M);
+    uint64_t hm = fnv(0xcbf29ce484222325ULL, M->rowptr, (size_t)(n + 1) * sizeof *M->rowptr);
+    hm = fnv(fnv(hm, M->colidx, (size_t)nz * sizeof *M->colidx), M->val, (size_t)nz * sizeof *M->val);
+    uint64_t hb = fnv(0xcbf29ce484222325ULL, st->s.b, (size_t)n * sizeof *st->s.b);
+    char methods[NMETHOD * 40] = "";
+    for (int m = 0; m < NMETHOD; m++)
+        if (st->m[m].on) strcat(strcat(methods, methods[0] ? "," : ""), st->m[m].name);
+    snprintf(buf, len,
+             "n %lld\nmatrix %016llx\nrhs %016llx\nindex %lld\njacobi %d\nomega %.17g\nseed %llu\nmethods %s\n"
+             "budgets %s\n",
+             (long long)n, (unsigned long long)hm, (unsigned long long)hb, (long long)st->s.index, st->s.jacobi,
+             st->s.jacobi ? st->s.omega : 1.0, (unsigned long long)st->seed, methods,
+             st->time_budgets ? "seconds" : "walks");
+}
+
+/* The first line of a and b (fingerprints) that differs, its field name in field[]; 0 if none. */
+static int differs(const char *a, const char *b, char field[32], char was[256], char now[256])
+{
+    while (*a || *b) {
+        size_t la = strcspn(a, "\n"), lb = strcspn(b, "\n");
+        if (la != lb || strncmp(a, b, la)) {
+            size_t f = strcspn(b, " \n");
+            snprintf(field, 32, "%.*s", (int)(f < 31 ? f : 31), b);
+            const char *va = memchr(a, ' ', la), *vb = memchr(b, ' ', lb);
+            snprintf(was, 256, "%.*s", va ? (int)(la - (size_t)(va + 1 - a)) : 0, va ? va + 1 : "");
+            snprintf(now, 256, "%.*s", vb ? (int)(lb - (size_t)(vb + 1 - b)) : 0, vb ? vb + 1 : "");
+            return 1;
+        }
+        a += la + (a[la] == '\n'), b += lb + (b[lb] == '\n');
+    }
+    return 0;
+}
+
+/* Resume only the same question: compare DIR/question.txt with this study's fingerprint (an
+ * old runs.csv without one is a different question); a mismatch is an error naming the field,
+ * or with --force the old runs are discarded.  Then write the fingerprint.  0 or an exit code. */
+static int check_question(study *st)
+{
+    char path[4096], runs[4096], mine[2048], theirs[2048] = "", field[32], was[256], now[256];
+    snprintf(path, sizeof path, "%s/question.txt", st->out);
+    snprintf(runs, sizeof runs, "%s/runs.csv", st->out);
+    fingerprint(st, mine, sizeof mine);
+    FILE *f = fopen(path, "r");
+    if (f) {
+        size_t k = fread(theirs, 1, sizeof theirs - 1, f);
+        theirs[k] = '\0';
+        fclose(f);
+    }
+    int old_runs = access(runs, F_OK) == 0;
+    int mismatch = f ? differs(theirs, mine, field, was, now) : old_runs;
+    if (mismatch && !st->force) {
+        if (f)
+            fprintf(stderr, "ulam: study: %s holds the runs of a different question: %s is %s there, %s here; "
+                            "--force starts afresh (discarding them), or choose another --out\n",
+                    st->out, field, was, now);
+        else
+            fprintf(stderr, "ulam: study: %s holds runs.csv but no question.txt saying what question it answers; "
+                            "--force starts afresh (discarding it), or choose another --out\n", st->out);
+        return EXIT_USAGE;
+    }
+    if (mismatch && cli_rank == 0 && remove(runs) && errno != ENOENT) {
+        ulam_error e = {.status = ULAM_EIO, .msg = "a runs.csv that can be removed (--force)"};
+        return cli_report(runs, &e);
+    }
+    if (mismatch) fprintf(stderr, "ulam: study: --force: the old runs in %s are discarded\n", st->out);
+    if (cli_rank) return 0;
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (!status) fputs(mine, o.f), status = ulam_outfile_commit(&o);
+    ulam_error e = {.status = status, .msg = "a writable output directory"};
+    return status ? cli_report(path, &e) : 0;
 }
 
 /* Run every missing run, saving runs.csv after each cell (and every 10 s within one) and on
@@ -358,8 +452,8 @@ static int summarise(study *st)
     return status ? cli_report(path[k ? k - 1 : 0], &err) : 0;
 }
 
-/* The three charts. */
-static void charts(const study *st)
+/* The three charts; nonzero when gnuplot failed. */
+static int charts(const study *st)
 {
     char names[NMETHOD * 40] = "", script[8192];
     for (int m = 0; m < NMETHOD; m++)
@@ -374,8 +468,10 @@ static void charts(const study *st)
              "'' u (strcol(1) eq 'lapack' ? $2 : 1/0):3 w p pt 9 ps 2 t 'LAPACK dgesv (error vs refined)', "
              "f(x) dt 2 lc 'black' t '1/sqrt(t) slope'\n",
              (long long)st->s.index, names);
-    if (ulam_gnuplot(st->out, "rmse", 1200, 700, script))
+    if (ulam_gnuplot(st->out, "rmse", 1200, 700, script)) {
         fprintf(stderr, "ulam: study: gnuplot failed (install gnuplot-nox): charts not drawn, CSVs written\n");
+        return 1;
+    }
     ulam_gnuplot(st->out, "work", 1000, 500,
                  "set title 'work-normalised variance RMSE^2 x seconds at the largest budget (lower wins)'\n"
                  "set style data histograms\nset style fill solid 0.6\nset logscale y\nset format y '10^{%L}'\n"
@@ -384,6 +480,7 @@ static void charts(const study *st)
                  "set title 'coverage of the 95% interval at the largest budget'\nset style data histograms\n"
                  "set style fill solid 0.6\nset yrange [0:1]\nset xtics rotate by -40 font ',8'\nset key off\n"
                  "plot 'bars.csv' u 3:xtic(1), 0.95 dt 2 lc 'black'\n");
+    return 0;
 }
 
 /* ulam study. */
@@ -396,7 +493,8 @@ int cli_study(int argc, char **argv)
         {"out", required_argument, 0, 'o'},     {"seed", required_argument, 0, 's'},
         {"threads", required_argument, 0, 'T'}, {"jacobi", no_argument, 0, 'j'},
         {"omega", required_argument, 0, 'w'},   {"help", no_argument, 0, 'h'},
-        {"cache", no_argument, 0, 'C'},         {0, 0, 0, 0}};
+        {"cache", no_argument, 0, 'C'},         {"force", no_argument, 0, 'F'},
+        {0, 0, 0, 0}};
     static study st;
     st = (study){.s = {.command = "study", .omega = 1.0}, .repeats = 30, .seed = 1, .out = "study"};
     methods_init(st.m);
@@ -417,6 +515,7 @@ int cli_study(int argc, char **argv)
         case 'T': if ((rc = cli_parse_int("study", "--threads", optarg, 1, 1024, &v))) return rc; st.threads = (int)v; break;
         case 'j': st.s.jacobi = 1; break;
         case 'C': st.s.cache = 1; break;
+        case 'F': st.force = 1; break;
         case 'w': if ((rc = cli_parse_real("study", "--omega", optarg, 1e-6, 2.0, &st.s.omega))) return rc; break;
         case 'h': fputs(usage, stdout); return 0;
         default: return cli_usage_error("study", "unknown option");
@@ -435,13 +534,19 @@ int cli_study(int argc, char **argv)
     st.est = malloc(cells * sizeof *st.est), st.se = malloc(cells * sizeof *st.se);
     st.sec = malloc(cells * sizeof *st.sec), st.done = calloc(cells, 1), st.row = calloc(cells, sizeof *st.row);
     rc = st.est && st.se && st.sec && st.done && st.row ? 0 : cli_exit_code(ULAM_ENOMEM);
+    if (!rc) rc = check_question(&st);
     if (!rc) rc = screen_methods(&st);
     if (!rc) rc = references(&st);
     if (!rc) rc = run_all(&st);
     if ((rc == 0 || rc == EXIT_INTERRUPTED) && cli_rank == 0) {
         int rs = summarise(&st);
-        if (!rs) charts(&st);
-        else rc = rs;
+        if (!rs) {
+            int drawn = !charts(&st);
+            fprintf(stderr, "ulam: study: wrote %s/: runs.csv, summary.csv, bars.csv, reference.csv, question.txt%s\n",
+                    st.out, drawn ? ", rmse.png, work.png, coverage.png" : "");
+        } else {
+            rc = rs;
+        }
     }
     for (size_t i = 0; st.row && i < cells; i++) free(st.row[i]);
     free(st.est), free(st.se), free(st.sec), free(st.done), free(st.row);
