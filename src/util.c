@@ -35,6 +35,7 @@ static const char *const messages[ULAM_NSTATUS] = {
     [ULAM_ENOTFOUND] = "not defined",
     [ULAM_ERANGE] = "value out of range",
     [ULAM_EDEVICE] = "ray-casting device failed",
+    [ULAM_ESTALL] = "the residual stopped decreasing",
 };
 
 /* A short English description of a status code. */

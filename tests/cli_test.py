@@ -427,7 +427,7 @@ def check_genmat(genmat):
     with tempfile.TemporaryDirectory() as d:
         assert subprocess.run([genmat, d], timeout=120).returncode == 0
         made = sorted(os.listdir(d))
-        assert len(made) == 12, made
+        assert len(made) == 14, made
         for f in made:
             assert open(os.path.join(d, f), "rb").read() == open(M + f, "rb").read(), f
 

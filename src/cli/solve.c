@@ -204,6 +204,7 @@ int cli_solve(int argc, char **argv)
         {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
         {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
         {"whole-kernel", no_argument, 0, 'W'},    {0, 0, 0, 0}};
+    if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv);
     cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};
