@@ -81,20 +81,32 @@ static const char *outcome(int status)
                                                                                                          : "failed";
 }
 
-/* Print the text report: one line an iteration, then the totals. */
+/* Nonzero when the method walks. */
+static int walking(int method)
+{
+    return method == ULAM_SEQUENTIAL || method == ULAM_MCSA;
+}
+
+/* Print one iteration's line (the header before the first). */
+static void print_step(const ulam_outer_step *s, int walks)
+{
+    if (s->iteration == 1) printf("%-5s %-12s %-12s %-10s %-10s\n", "iter", "residual", "histories", "rel_sd", "seconds");
+    printf("%-5d %-12.4e %-12lld %-10.3g %-10.4f\n", s->iteration, s->residual, (long long)s->histories,
+           walks ? s->rel_sd : 0.0, s->seconds);
+    fflush(stdout);
+}
+
+/* Nonzero when iteration k's line is printed as it ends: the first 10, then every 500th (the
+ * last is printed when the run ends). */
+static int shown(int k)
+{
+    return k <= 10 || k % 500 == 0;
+}
+
+/* Print the text report's totals (the iterations were printed as they ended). */
 static void print_text(const report *p)
 {
-    int walks = p->method == ULAM_SEQUENTIAL || p->method == ULAM_MCSA;
-    if (p->nsteps) printf("%-5s %-12s %-12s %-10s %-10s\n", "iter", "residual", "histories", "rel_sd", "seconds");
-    for (int k = 0; k < p->nsteps; k++) {
-        const ulam_outer_step *s = &p->steps[k];
-        if (!walks && k >= 10 && k < p->nsteps - 5) {
-            if (k == 10) printf("...\n");
-            continue;
-        }
-        printf("%-5d %-12.4e %-12lld %-10.3g %-10.4f\n", s->iteration, s->residual, (long long)s->histories,
-               walks ? s->rel_sd : 0.0, s->seconds);
-    }
+    int walks = walking(p->method);
     int64_t hist;
     double walk_s;
     totals(p, &hist, &walk_s);
@@ -124,7 +136,7 @@ static void print_json(const report *p)
     totals(p, &hist, &walk_s);
     printf("{");
     cli_json_string("method", method_names[p->method], 0);
-    if (p->method == ULAM_SEQUENTIAL || p->method == ULAM_MCSA) cli_json_string("estimator", est_names[p->o->walk.estimator], 0);
+    if (walking(p->method)) cli_json_string("estimator", est_names[p->o->walk.estimator], 0);
     cli_json_string("outcome", outcome(p->status), 0);
     printf("\"converged\": %s, \"iterations\": %d, ", p->status == ULAM_OK ? "true" : "false", p->iterations);
     if (p->method == KRYLOV_GMRES) printf("\"restart\": %d, ", p->restart);
@@ -134,7 +146,7 @@ static void print_json(const report *p)
     printf("\"histories\": %lld, ", (long long)hist);
     cli_json_number("seconds", p->seconds, 0);
     cli_json_number("walk_seconds", walk_s, 0);
-    if (p->method == ULAM_SEQUENTIAL || p->method == ULAM_MCSA) {
+    if (walking(p->method)) {
         cli_json_number("rho_abs", p->g.abs.rho, 0);
         cli_json_number("rho_hat", p->g.hat[ULAM_FORWARD].rho, 0);
     }
@@ -222,8 +234,13 @@ static int run(const cli_system *s, const ulam_outer_opts *o, report *p, ulam_ou
         }
         status = ulam_outer_iterate(it, &(*steps)[p->nsteps]);
         p->nsteps++;
+        if (!p->json && cli_rank == 0 && shown(p->nsteps)) print_step(&(*steps)[p->nsteps - 1], walking(p->method));
     }
     cli_release_sigint();
+    if (!p->json && cli_rank == 0 && p->nsteps && !shown(p->nsteps)) {
+        printf("...\n");
+        print_step(&(*steps)[p->nsteps - 1], walking(p->method));
+    }
     p->seconds = ulam_now() - t0;
     p->status = status;
     p->iterations = p->nsteps;
@@ -341,7 +358,7 @@ int cli_solve_method(int argc, char **argv)
     if ((rc = cli_load_system(&s))) return rc;
     p.index = s.index;
     o.walk.share = cli_share, o.walk.interrupt = &cli_interrupted;
-    if ((p.method == ULAM_SEQUENTIAL || p.method == ULAM_MCSA) && (rc = cli_guard(&s, o.walk.continue_q, ULAM_FORWARD, force, &p.g))) {
+    if (walking(p.method) && (rc = cli_guard(&s, o.walk.continue_q, ULAM_FORWARD, force, &p.g))) {
         cli_system_free(&s);
         return rc;
     }
