@@ -89,6 +89,26 @@ def check_json_out(ulam):
         assert rc == ENOCONV and not os.path.exists(y) and sorted(os.listdir(d)) == ["x.mtx"]
 
 
+def check_interrupt(ulam):
+    """Ctrl-C during the walks ends the run after the current correction: exit 130, outcome
+    'interrupted', no --out file (the solution has not converged)."""
+    import signal
+    with tempfile.TemporaryDirectory() as d:
+        x = os.path.join(d, "x.mtx")
+        p = subprocess.Popen([ulam, "solve", M + "poisson900.mtx", "--rhs", M + "poisson900_b.mtx", "--jacobi",
+                              "--method", "mcsa", "--json", "--out", x], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+        while True:  # wait until the SIGINT handler is installed (polled in /proc, no sleeps)
+            caught = [l for l in open(f"/proc/{p.pid}/status") if l.startswith("SigCgt:")]
+            if caught and int(caught[0].split()[1], 16) & (1 << (signal.SIGINT - 1)):
+                break
+        p.send_signal(signal.SIGINT)
+        out, _ = p.communicate(timeout=120)
+        o = json.loads(out)
+        assert p.returncode == 130 and o["outcome"] == "interrupted" and o["converged"] is False, (p.returncode, o)
+        assert o["iterations"] >= 1 and os.listdir(d) == [], os.listdir(d)
+
+
 def scipy_counts():
     """SciPy's CG and GMRES iteration counts on the systems ulam sees (I - M, or D^-1 A with --jacobi)."""
     import numpy as np
@@ -138,13 +158,13 @@ def check_krylov(ulam):
 def main():
     ulam = sys.argv[1]
     failures = check_table(ulam)
-    for f in (check_json_out, check_krylov):
+    for f in (check_json_out, check_interrupt, check_krylov):
         try:
             f(ulam)
         except AssertionError as e:
             failures += 1
             print(f"FAIL {f.__name__}: {e}")
-    print(f"{len(CASES) + 2 - failures} passed, {failures} failed")
+    print(f"{len(CASES) + 3 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 

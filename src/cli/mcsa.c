@@ -59,7 +59,7 @@ typedef struct {
     const ulam_outer_opts *o;
     const cli_system *s;
     const ulam_outer_step *steps;
-    int method, nsteps, iterations, restart, status, json, check;
+    int method, nsteps, iterations, restart, status, converged, json, check;
     double residual;
     int64_t index; /* 1-based, 0: none */
     const double *x;
@@ -75,10 +75,10 @@ static void totals(const report *p, int64_t *hist, double *walk_s)
 }
 
 /* The outcome in words. */
-static const char *outcome(int status)
+static const char *outcome(const report *p)
 {
-    return status == ULAM_OK ? "converged" : status == ULAM_ESTALL ? "stalled" : status == ULAM_ENOCONV ? "capped"
-                                                                                                         : "failed";
+    return p->converged ? "converged" : p->status == ULAM_ESTALL ? "stalled" : p->status == ULAM_ENOCONV ? "capped"
+                                      : p->status == ULAM_OK    ? "interrupted" : "failed";
 }
 
 /* Nonzero when the method walks. */
@@ -113,7 +113,7 @@ static void print_text(const report *p)
     printf("method          %s%s%s, tol %g%s\n", method_names[p->method], walks ? ", " : "",
            walks ? est_names[p->o->walk.estimator] : "", p->o->tol, walks ? "" : " (no walks)");
     if (p->method == KRYLOV_GMRES) printf("restart         %d\n", p->restart);
-    printf("outcome         %s after %d iterations%s, residual %.4e\n", outcome(p->status), p->iterations,
+    printf("outcome         %s after %d iterations%s, residual %.4e\n", outcome(p), p->iterations,
            p->method >= KRYLOV_CG ? " (matrix-vector products)" : "", p->residual);
     if (walks)
         printf("histories       %lld (%.4g per iteration), eps1 %g\n", (long long)hist,
@@ -137,8 +137,8 @@ static void print_json(const report *p)
     printf("{");
     cli_json_string("method", method_names[p->method], 0);
     if (walking(p->method)) cli_json_string("estimator", est_names[p->o->walk.estimator], 0);
-    cli_json_string("outcome", outcome(p->status), 0);
-    printf("\"converged\": %s, \"iterations\": %d, ", p->status == ULAM_OK ? "true" : "false", p->iterations);
+    cli_json_string("outcome", outcome(p), 0);
+    printf("\"converged\": %s, \"iterations\": %d, ", p->converged ? "true" : "false", p->iterations);
     if (p->method == KRYLOV_GMRES) printf("\"restart\": %d, ", p->restart);
     cli_json_number("tol", p->o->tol, 0);
     cli_json_number("eps1", p->o->eps1, 0);
@@ -244,6 +244,7 @@ static int run(const cli_system *s, const ulam_outer_opts *o, report *p, ulam_ou
     p->seconds = ulam_now() - t0;
     p->status = status;
     p->iterations = p->nsteps;
+    p->converged = ulam_outer_converged(it);
     p->residual = p->nsteps ? (*steps)[p->nsteps - 1].residual : 1.0;
     *x = malloc((size_t)s->M->nrows * sizeof **x);
     if (*x) memcpy(*x, ulam_outer_x(it), (size_t)s->M->nrows * sizeof **x);
@@ -266,6 +267,7 @@ static int run_krylov(const cli_system *s, const ulam_outer_opts *o, report *p, 
     p->status = p->method == KRYLOV_CG ? ulam_cg(s->M, s->b, o->tol, cap, *x, &p->iterations, &p->residual)
                                        : ulam_gmres(s->M, s->b, p->restart, o->tol, cap, *x, &p->iterations, &p->residual);
     p->seconds = ulam_now() - t0;
+    p->converged = p->status == ULAM_OK;
     if (p->status == ULAM_ENOMEM) return cli_exit_code(p->status);
     return 0;
 }
@@ -371,7 +373,7 @@ int cli_solve_method(int argc, char **argv)
         rc = cli_exit_code(p.status);
     } else if (!rc) {
         if (p.check) rc = direct_error(&s, x, &p);
-        if (!rc && out && cli_rank == 0 && p.status == ULAM_OK &&
+        if (!rc && out && cli_rank == 0 && p.converged &&
             ulam_mm_write_vector(out, x, s.M->nrows, "outer-iteration solution x")) {
             ulam_error err = {.status = ULAM_EIO, .msg = "a writable output file"};
             rc = cli_report(out, &err);
