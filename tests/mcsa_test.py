@@ -92,17 +92,13 @@ def check_json_out(ulam):
 def check_interrupt(ulam):
     """Ctrl-C during the walks ends the run after the current correction: exit 130, outcome
     'interrupted', no --out file (the solution has not converged)."""
-    import signal
+    from cli_test import interrupt_when_ready  # beside this file
     with tempfile.TemporaryDirectory() as d:
         x = os.path.join(d, "x.mtx")
         p = subprocess.Popen([ulam, "solve", M + "poisson900.mtx", "--rhs", M + "poisson900_b.mtx", "--jacobi",
                               "--method", "mcsa", "--json", "--out", x], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
-        while True:  # wait until the SIGINT handler is installed (polled in /proc, no sleeps)
-            caught = [l for l in open(f"/proc/{p.pid}/status") if l.startswith("SigCgt:")]
-            if caught and int(caught[0].split()[1], 16) & (1 << (signal.SIGINT - 1)):
-                break
-        p.send_signal(signal.SIGINT)
+        interrupt_when_ready(p)
         out, _ = p.communicate(timeout=120)
         o = json.loads(out)
         assert p.returncode == 130 and o["outcome"] == "interrupted" and o["converged"] is False, (p.returncode, o)
