@@ -155,8 +155,8 @@ static void print_json(const report *p)
         cli_json_number("estimate", p->x[p->index - 1], 0);
     }
     if (p->check) cli_json_number("relative_error", p->err_direct, 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"history\": [", (unsigned long long)p->o->walk.seed,
-           p->o->walk.threads);
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, \"history\": [", (unsigned long long)p->o->walk.seed,
+           p->o->walk.threads, cli_share ? cli_share->nranks : 1);
     for (int k = 0; k < p->nsteps; k++) {
         const ulam_outer_step *s = &p->steps[k];
         printf("%s{\"iteration\": %d, ", k ? ", " : "", s->iteration);
