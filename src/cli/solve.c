@@ -50,7 +50,10 @@ static const char *const usage =
     "run goes on but reports no confidence interval.\n"
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C\n"
-    "exits at once.\n";
+    "exits at once.\n"
+    "\n"
+    "Every unknown to a residual tolerance (MCSA, sequential MC, Krylov): see\n"
+    "'ulam solve --method mcsa --help'.\n";
 
 static const char *const mode_names[] = {"adjoint", "forward"};
 static const char *const est_names[] = {"collision", "absorption", "expected"};
