@@ -7,6 +7,7 @@
  *                            a random nonnegative n x n matrix with K nonzeros per row
  *                            (random columns) and every row sum equal to S
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -85,6 +86,16 @@ static void all(const char *dir)
     double *b = random_vector(400, 1.0, 1.0, 0); /* all ones */
     save(dir, "poisson20", M, b,
          "2-D Poisson 5-point matrix A on a 20 x 20 grid (n = 400); use --jacobi");
+    ulam_csr_free(M), free(b);
+
+    M = poisson2d(30); /* Benzi et al. 2017: 32 nodes a direction, h = 1/31, f = sin(pi x) sin(pi y) */
+    b = malloc(900 * sizeof *b);
+    for (int y = 0; y < 30; y++)
+        for (int x = 0; x < 30; x++)
+            b[y * 30 + x] = sin(M_PI * (x + 1) / 31.0) * sin(M_PI * (y + 1) / 31.0) / (31.0 * 31.0);
+    save(dir, "poisson900", M, b,
+         "-Laplace u = sin(pi x) sin(pi y) on the unit square, u = 0 on its boundary: 5-point A = h^2 "
+         "(-Laplace_h), h = 1/31 (30 x 30 unknowns; b = h^2 f); use --jacobi (Benzi et al. 2017)");
     ulam_csr_free(M), free(b);
 
     M = random_doubly(1000, 8, 0.9, 1000);

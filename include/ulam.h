@@ -51,6 +51,7 @@ enum ulam_status {
     ULAM_EDEVICE,      /* the ray-casting device (Embree) failed */
     ULAM_EDIVERGE,     /* rho(|M|) is not certified below 1: the walks may diverge */
     ULAM_EINFVAR,      /* a relative-error target with a variance not certified finite */
+    ULAM_ESTALL,       /* an outer iteration's residual stopped decreasing */
     ULAM_NSTATUS
 };
 
@@ -479,6 +480,96 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
 
 /* The walk cap of a run whose only rule is rel_err. */
 #define ULAM_REL_ERR_CAP 1000000000
+
+/* ---------------------------------------------------------------- outer iterations */
+
+/* Iterations on (I - M) x = b from x = 0 that stop on the exact residual
+ * ||b - (I - M) x||_2 / ||b||_2 <= tol:
+ *   ULAM_RICHARDSON  x <- M x + b (the deterministic reference);
+ *   ULAM_GAUSS_SEIDEL one sweep of ulam_gauss_seidel_sweep;
+ *   ULAM_SEQUENTIAL  Halton's sequential Monte Carlo: r = b - (I - M) x, delta ~ (I - M)^-1 r
+ *                    by forward walks from r, x <- x + delta;
+ *   ULAM_MCSA        Monte Carlo Synthetic Acceleration (Evans and Mosher): a Richardson step
+ *                    x <- M x + b, then the residual, its walk correction and the update.
+ * The walks of an iteration run in batches until the apparent relative standard deviation of
+ * the correction, ||stderr||_1 / ||delta||_1, is below eps1 (Benzi et al., Numer. Linear
+ * Algebra Appl. 2017, criterion for the method that estimates every component), or the
+ * history cap is reached. */
+enum ulam_method { ULAM_RICHARDSON = 0, ULAM_GAUSS_SEIDEL = 1, ULAM_SEQUENTIAL = 2, ULAM_MCSA = 3 };
+
+/* Options of an outer iteration.  Start from ulam_outer_defaults(). */
+typedef struct ulam_outer_opts {
+    int method;            /* enum ulam_method (default ULAM_MCSA) */
+    double tol;            /* residual reduction, in (0, 1) (default 1e-8) */
+    int max_iter;          /* iteration cap, >= 1 (default 1000; 100000 for the deterministic) */
+    int stall;             /* end with ULAM_ESTALL after this many iterations without a new
+                              smallest residual (0: 5 with walks, 100 without) */
+    double eps1;           /* adaptive threshold on ||stderr||_1 / ||delta||_1, in (0, 1)
+                              (default 0.1) */
+    int64_t max_histories; /* history cap of one correction (default 10^8) */
+    ulam_walk_opts walk;   /* the walks: estimator, seed, threads, continue_q, max_steps,
+                              roulette, split, interrupt, share (mode is forced to forward; the
+                              seed of iteration l is drawn from the stream (seed, l)) */
+} ulam_outer_opts;
+
+/* The defaults: MCSA, tol 1e-8, eps1 0.1, expected-value forward walks, seed 1. */
+ulam_outer_opts ulam_outer_defaults(void);
+
+/* What one iteration did. */
+typedef struct ulam_outer_step {
+    int iteration;        /* 1-based */
+    double residual;      /* ||b - (I - M) x||_2 / ||b||_2 after it */
+    int64_t histories;    /* walks of its correction (0 without walks) */
+    int64_t steps, cut;   /* their transitions, and walks cut at max_steps */
+    double rel_sd;        /* ||stderr||_1 / ||delta||_1 the correction reached */
+    double seconds;       /* wall time of the iteration */
+    double walk_seconds;  /* of which walking */
+} ulam_outer_step;
+
+/* An outer iteration's workspace (opaque). */
+typedef struct ulam_outer ulam_outer;
+
+/* Prepare the iteration on (I - M) x = b (M and b borrowed until freed).  Refuses options
+ * out of range (ULAM_EINVAL), a non-square M, and b = 0 (ULAM_EINVAL: nothing to reduce). */
+int ulam_outer_alloc(const ulam_csr *M, const double *b, const ulam_outer_opts *opts, ulam_outer **out,
+                     ulam_error *err);
+
+/* One iteration; fills *step (may be NULL).  ULAM_OK while it may go on or once converged;
+ * then ULAM_ENOCONV at the iteration cap, ULAM_ESTALL when the residual stopped decreasing,
+ * ULAM_ENONFINITE for a non-finite residual or walk, ULAM_ENOMEM; each also ends the run. */
+int ulam_outer_iterate(ulam_outer *s, ulam_outer_step *step);
+
+/* Nonzero once converged, failed, interrupted or capped. */
+int ulam_outer_done(const ulam_outer *s);
+
+/* Nonzero once ||r||_2 / ||b||_2 <= tol. */
+int ulam_outer_converged(const ulam_outer *s);
+
+/* The current iterate (n entries, owned by s). */
+const double *ulam_outer_x(const ulam_outer *s);
+
+/* Free; accepts and returns NULL. */
+ulam_outer *ulam_outer_free(ulam_outer *s);
+
+/* Iterate until done into x (n entries); steps (may be NULL) gets up to max_steps records,
+ * *nsteps (may be NULL) the iterations run.  Returns the last iterate's status. */
+int ulam_outer_solve(const ulam_csr *M, const double *b, const ulam_outer_opts *opts, double *x,
+                     ulam_outer_step *steps, int max_steps, int *nsteps, ulam_error *err);
+
+/* ---------------------------------------------------------------- Krylov peers */
+
+/* Krylov solvers for (I - M) x = b from x = 0, stopped when ||b - (I - M) x||_2 / ||b||_2 <=
+ * tol (the true residual, recomputed at the end): conjugate gradients for symmetric positive
+ * definite I - M (ulam_cg), restarted GMRES(restart) with modified Gram-Schmidt and Givens
+ * rotations otherwise (ulam_gmres).  *iterations gets the matrix-vector products spent on
+ * Krylov vectors, *residual the final relative residual.  ULAM_OK or ULAM_ENOCONV at max_iter. */
+int ulam_cg(const ulam_csr *M, const double *b, double tol, int max_iter, double *x, int *iterations,
+            double *residual);
+int ulam_gmres(const ulam_csr *M, const double *b, int restart, double tol, int max_iter, double *x,
+               int *iterations, double *residual);
+
+/* Nonzero when M equals its transpose exactly. */
+int ulam_csr_symmetric(const ulam_csr *M);
 
 /* ---------------------------------------------------------------- studies */
 

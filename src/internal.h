@@ -92,6 +92,10 @@ int ulam__budget_spent(const ulam_walk_opts *o, int stop, int64_t walks);
 /* Nonzero when this process runs block q (always, without a share). */
 int ulam__mine(const ulam_share *sh, int64_t q);
 
+/* Restart a forward solver on right-hand side b (borrowed) with seed: the kernel is kept,
+ * tallies, counts and stopping state are reset (src/solve.c; used by the outer iterations). */
+int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_error *err);
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -689,3 +689,32 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
     ulam_solver_free(s);
     return status;
 }
+
+/* Restart a forward solver on a new right-hand side b (borrowed like the first) with a new
+ * seed: the kernel and workspace are kept (the kernel of a forward walk does not depend on b),
+ * the source table is rebuilt and every tally, count and stopping state is reset. */
+int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s || !b || s->o.mode != ULAM_FORWARD) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a forward solver and b");
+    free(s->src);
+    s->src = NULL;
+    s->b = b;
+    s->o.seed = seed;
+    double bnorm1 = 0.0;
+    if (build_source(s, &bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");
+    if (s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0) {
+        int status = check_reach(s, s->mt, err); /* the score bounds depend on b */
+        if (status) return status;
+    }
+    s->w.src = s->src;
+    s->w.bnorm1 = bnorm1;
+    memset(s->sum, 0, (size_t)s->n * sizeof *s->sum);
+    memset(s->sumsq, 0, (size_t)s->n * sizeof *s->sumsq);
+    s->adj = s->watched = (ulam__moments){0};
+    s->walks = s->steps = s->cut = s->nonfinite = s->next_walk = 0;
+    s->maxsq = s->seconds = 0.0;
+    s->t0 = -1;
+    s->done = s->interrupted = s->status = s->met = 0;
+    return ULAM_OK;
+}

@@ -37,6 +37,7 @@ static const char *const messages[ULAM_NSTATUS] = {
     [ULAM_EDEVICE] = "ray-casting device failed",
     [ULAM_EDIVERGE] = "walks not certified to converge",
     [ULAM_EINFVAR] = "variance not certified finite",
+    [ULAM_ESTALL] = "the residual stopped decreasing",
 };
 
 /* A short English description of a status code. */

@@ -32,6 +32,8 @@ def main():
                                        "--index", "3", "--rel-err", "0.005", "--json"], None),
             ("solve forward", ["solve", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
                                "1", "--mode", "forward", "--walks", "30000", "--json", "--out", "{d}/x.mtx"], "x.mtx"),
+            ("solve mcsa", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx", "--method",
+                            "mcsa", "--tol", "1e-6", "--json", "--out", "{d}/m.mtx"], "m.mtx"),
             ("radiosity", ["radiosity", "examples/scenes/cornell_box.obj", "--patch", "floor", "--subdivide", "300",
                            "--walks", "20000", "--json"], None),
             ("radiosity shoot", ["radiosity", "tests/data/rad/cornell_black_light.obj", "--subdivide", "300", "--mode",
@@ -53,7 +55,11 @@ def main():
                     else:
                         res.append(json.loads(out))
                 one, two = res
-                if name.startswith("solve"):
+                if name == "solve mcsa":  # the same iterations, walks and residuals; the same x file
+                    strip = lambda o: [dict(h, seconds=0, walk_seconds=0) for h in o["history"]]
+                    assert strip(one[0]) == strip(two[0]) and one[0]["residual"] == two[0]["residual"], (one, two)
+                    assert two[0]["ranks"] == 2 and one[1] == two[1], "not distributed, or x files differ"
+                elif name.startswith("solve"):
                     for k in ("estimate", "stderr", "walks", "steps", "variance"):
                         a, b = (one[0] if outfile else one)[k], (two[0] if outfile else two)[k]
                         assert a == b, (name, k, a, b)

@@ -158,6 +158,27 @@ static int walk_run(int mode, int est)
 static int op_walk_adjoint(void) { return walk_run(ULAM_ADJOINT, ULAM_COLLISION); }
 static int op_walk_forward(void) { return walk_run(ULAM_FORWARD, ULAM_ABSORPTION); }
 
+/* Sequential MC and MCSA (the walk solver built once and restarted on each residual), CG and
+ * GMRES. */
+static int op_outer(void)
+{
+    ulam_csr *M = NULL;
+    double *b = NULL, x[4];
+    int64_t n;
+    int s = ulam_mm_read_matrix("matrices/chain4.mtx", &M, NULL);
+    if (!s) s = ulam_mm_read_vector("matrices/chain4_b.mtx", &b, &n, NULL);
+    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA && !s; m++) {
+        ulam_outer_opts o = ulam_outer_defaults();
+        o.method = m, o.tol = 1e-3, o.walk.threads = 2;
+        s = ulam_outer_solve(M, b, &o, x, NULL, 0, NULL, NULL);
+    }
+    int its;
+    double res;
+    if (!s) s = ulam_gmres(M, b, 2, 1e-8, 100, x, &its, &res);
+    ulam_csr_free(M), free(b);
+    return s;
+}
+
 /* The guards and the direct solve. */
 static int op_guard_direct(void)
 {
@@ -206,6 +227,7 @@ static void test_countdown(void **state)
                {op_walk_adjoint, "adjoint walks"},
                {op_walk_forward, "forward walks"},
                {op_guard_direct, "guards and direct solve"},
+               {op_outer, "sequential MC, MCSA, GMRES"},
                {op_radiosity, "OBJ reader, tracer, form factors, patch walks"}};
     for (size_t k = 0; k < sizeof ops / sizeof *ops; k++) {
         long optional, n = countdown(ops[k].op, ops[k].name, &optional);

@@ -113,6 +113,10 @@ int cli_info(int argc, char **argv);
 int cli_direct(int argc, char **argv);
 int cli_solve(int argc, char **argv);
 int cli_study(int argc, char **argv);
+
+/* ulam solve --method (src/cli/mcsa.c): nonzero when argv asks for it, and the command. */
+int cli_solve_wants_method(int argc, char **argv);
+int cli_solve_method(int argc, char **argv);
 int cli_radiosity(int argc, char **argv);
 
 #endif

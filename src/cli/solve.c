@@ -59,7 +59,10 @@ static const char *const usage =
     "run goes on but reports no confidence interval.\n"
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C\n"
-    "exits at once.\n";
+    "exits at once.\n"
+    "\n"
+    "Every unknown to a residual tolerance (MCSA, sequential MC, Krylov): see\n"
+    "'ulam solve --method mcsa --help'.\n";
 
 static const char *const mode_names[] = {"adjoint", "forward"};
 static const char *const est_names[] = {"collision", "absorption", "expected"};
@@ -280,6 +283,7 @@ int cli_solve(int argc, char **argv)
         {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
         {"whole-kernel", no_argument, 0, 'W'},    {"assume-finite-variance", no_argument, 0, 'A'},
         {0, 0, 0, 0}};
+    if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv);
     cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};

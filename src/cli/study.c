@@ -63,6 +63,7 @@ typedef struct {
     const char *out;
     ulam_guard g; /* the verdicts, computed once for every run */
     double exact;
+    int forward_walks; /* rho(|M|) < 1 and the forward rho(M^) < 1: the outer iterations can walk */
     double *est, *se, *sec; /* [m][b][r] */
     unsigned char *done;
     char **row; /* [m][b][r]: the runs.csv line of a finished run */
@@ -127,6 +128,8 @@ static int screen_methods(study *st)
     ulam_error err;
     int status = ulam_guard_check(st->s.M, 0.0, NULL, g, &err);
     if (status) return cli_report(st->s.matrix_path, &err);
+    st->forward_walks = (g->verdict_abs == ULAM_VERDICT_OK || g->verdict_abs == ULAM_VERDICT_EDGE) &&
+                        ulam_guard_variance(g, ULAM_FORWARD) == 1;
     int left = 0;
     for (int k = 0; k < NMETHOD; k++) {
         method *m = &st->m[k];
@@ -353,6 +356,45 @@ static int run_all(study *st)
     return rc ? rc : cli_interrupted ? EXIT_INTERRUPTED : 0;
 }
 
+/* Reference lines of the methods that solve for every unknown: sequential MC and MCSA (one
+ * run each, seed --seed, 10^-10 or OUTER_SECONDS, only when forward walks have finite
+ * variance) and the Krylov peer (CG when M is symmetric, else GMRES(30); a run a tolerance
+ * 10^-1 .. 10^-10): error on x_I against seconds, into f. */
+static void outer_references(const study *st, FILE *f)
+{
+    enum { OUTER_SECONDS = 60 };
+    int64_t n = st->s.M->nrows, I = st->s.index - 1;
+    double *x = malloc((size_t)n * sizeof *x);
+    char v[2][32];
+    if (!x) return;
+    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA && st->forward_walks; m++) {
+        ulam_outer_opts o = ulam_outer_defaults();
+        o.method = m, o.tol = 1e-10, o.walk.seed = st->seed, o.walk.threads = st->threads;
+        o.walk.interrupt = &cli_interrupted, o.max_histories = 20 * n > 1000000 ? 20 * n : 1000000;
+        ulam_outer *it = NULL;
+        if (ulam_outer_alloc(st->s.M, st->s.b, &o, &it, NULL)) continue;
+        double t = 0;
+        while (!ulam_outer_done(it) && t < OUTER_SECONDS && !cli_interrupted) {
+            ulam_outer_step step;
+            ulam_outer_iterate(it, &step);
+            t += step.seconds;
+            fprintf(f, "%s,%s,%s\n", m == ULAM_MCSA ? "mcsa" : "sequential", num(v[0], t),
+                    num(v[1], fabs(ulam_outer_x(it)[I] - st->exact) + 1e-300));
+        }
+        ulam_outer_free(it);
+    }
+    int cg = ulam_csr_symmetric(st->s.M);
+    for (int k = 1; k <= 10 && !cli_interrupted; k++) {
+        int its;
+        double res, t0 = ulam_now();
+        int status = cg ? ulam_cg(st->s.M, st->s.b, pow(10.0, -k), 100000, x, &its, &res)
+                        : ulam_gmres(st->s.M, st->s.b, 30, pow(10.0, -k), 100000, x, &its, &res);
+        if (status == ULAM_OK || status == ULAM_ENOCONV)
+            fprintf(f, "%s,%s,%s\n", cg ? "cg" : "gmres", num(v[0], ulam_now() - t0), num(v[1], fabs(x[I] - st->exact) + 1e-300));
+    }
+    free(x);
+}
+
 /* The exact x_I and the reference lines: LAPACK (n <= 8000: its time and its error against
  * Gauss-Seidel run to convergence) and Gauss-Seidel from x = 0 (time against its error on
  * x_I), into reference.csv.  0 or an exit code. */
@@ -400,6 +442,7 @@ static int references(study *st)
         if (!(e > 1e-9 * fabs(st->exact))) break;
     }
     free(x);
+    outer_references(st, f);
     if (!o.f) return fclose(f), 0;
     ulam_error e = {.status = ulam_outfile_commit(&o), .msg = "a writable output directory"};
     return e.status ? cli_report(path, &e) : 0;
@@ -461,13 +504,17 @@ static int charts(const study *st)
     snprintf(script, sizeof script,
              "set title 'ulam study: RMSE of x_%lld against seconds per run'\n"
              "set logscale xy\nset format x '10^{%%L}'\nset format y '10^{%%L}'\nset xlabel 'seconds per run'\n"
-             "set ylabel 'RMSE'\nset key outside right font ',8'\n"
+             "set ylabel 'RMSE (reference lines: the error of one run)'\nset key outside right font ',8'\n"
+             "set yrange [%g:*]\n"
              "set fit quiet\nset fit logfile '/dev/null'\nf(x) = a / sqrt(x)\na = 0\nfit f(x) 'summary.csv' u 8:4 via a\n"
              "plot for [m in \"%s\"] 'summary.csv' u (strcol(1) eq m ? $8 : 1/0):4 w lp t m, "
              "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 t 'Gauss-Seidel, whole vector', "
              "'' u (strcol(1) eq 'lapack' ? $2 : 1/0):3 w p pt 9 ps 2 t 'LAPACK dgesv (error vs refined)', "
+             "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 2 pt 5 t 'sequential MC, every unknown (one run)', "
+             "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 2 pt 7 t 'MCSA, every unknown (one run)', "
+             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 2 pt 3 t 'Krylov (CG or GMRES(30))', "
              "f(x) dt 2 lc 'black' t '1/sqrt(t) slope'\n",
-             (long long)st->s.index, names);
+             (long long)st->s.index, st->exact != 0 ? 1e-9 * fabs(st->exact) : 1e-12, names);
     if (ulam_gnuplot(st->out, "rmse", 1200, 700, script)) {
         fprintf(stderr, "ulam: study: gnuplot failed (install gnuplot-nox): charts not drawn, CSVs written\n");
         return 1;

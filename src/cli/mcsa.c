@@ -1,0 +1,404 @@
+/* ulam solve --method: every unknown to a residual tolerance by an outer iteration
+ * (sequential Monte Carlo, MCSA, or the deterministic Richardson and Gauss-Seidel). */
+#include "cli.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const usage =
+    "usage: ulam solve M.mtx --rhs b.mtx --method mcsa|sequential|richardson|gauss-seidel|cg|gmres\n"
+    "                  [--tol T] [--max-iter K] [--eps1 E] [--max-histories N] [--stall K]\n"
+    "                  [--restart K]\n"
+    "                  [--estimator collision|absorption|expected] [--seed S] [--threads T]\n"
+    "                  [--continue Q] [--max-steps K] [--jacobi [--omega W]] [--json]\n"
+    "                  [--out x.mtx [--index I]] [--check] [--force] [--cache]\n"
+    "\n"
+    "Every unknown of (I - M) x = b by an outer iteration from x = 0 that stops when the exact\n"
+    "residual ||b - (I - M) x||_2 / ||b||_2 is at most T:\n"
+    "\n"
+    "  --method mcsa         Monte Carlo Synthetic Acceleration: a Richardson step x <- M x + b,\n"
+    "                        then the correction (I - M)^-1 r of its residual by forward walks\n"
+    "  --method sequential   Halton's sequential Monte Carlo: the walk correction alone\n"
+    "  --method richardson   x <- M x + b (no walks; the reference iteration)\n"
+    "  --method gauss-seidel one Gauss-Seidel sweep an iteration (no walks)\n"
+    "  --method cg           conjugate gradients (the Krylov peer for symmetric M)\n"
+    "  --method gmres        restarted GMRES (--restart K, default 30), the peer otherwise\n"
+    "  --tol T               residual reduction, 0 < T < 1 (default 1e-8)\n"
+    "  --max-iter K          iteration cap (default 1000 with walks, 100000 without)\n"
+    "  --eps1 E              walk each correction until ||stderr||_1 / ||delta||_1 < E (default 0.1)\n"
+    "  --max-histories N     cap on one correction's walks (default 100000000)\n"
+    "  --stall K             stop (exit 10 + ESTALL) after K iterations without a new smallest\n"
+    "                        residual (default 5 with walks, 100 without)\n"
+    "  --estimator E         of the forward walks (default expected)\n"
+    "  --seed S              iteration l walks with a seed drawn from stream (S, l): identical\n"
+    "                        results for any --threads\n"
+    "  --out x.mtx           write the solution; --index I also prints x_I\n"
+    "  --check               also solve with LAPACK and report the relative error of x\n"
+    "  --json                one JSON object with the history of every iteration\n"
+    "  --jacobi, --omega, --continue, --max-steps, --threads, --force, --cache: as for walks\n"
+    "\n"
+    "Each iteration prints its residual, its walks (histories) and its seconds.\n";
+
+static const char *const method_names[] = {"richardson", "gauss-seidel", "sequential", "mcsa", "cg", "gmres"};
+enum { KRYLOV_CG = 4, KRYLOV_GMRES = 5 }; /* the Krylov peers: not outer iterations */
+static const char *const est_names[] = {"collision", "absorption", "expected"};
+
+/* Nonzero when argv (after the subcommand) asks for an outer iteration. */
+int cli_solve_wants_method(int argc, char **argv)
+{
+    for (int k = 1; k < argc; k++)
+        if (!strcmp(argv[k], "--method") || !strncmp(argv[k], "--method=", 9)) return 1;
+    return 0;
+}
+
+/* What the report needs besides the steps. */
+typedef struct {
+    const ulam_outer_opts *o;
+    const cli_system *s;
+    const ulam_outer_step *steps;
+    int method, nsteps, iterations, restart, status, converged, json, check;
+    double residual;
+    int64_t index; /* 1-based, 0: none */
+    const double *x;
+    double err_direct, direct_seconds, seconds;
+    ulam_guard g;
+} report;
+
+/* Sum of the steps' histories and walk seconds. */
+static void totals(const report *p, int64_t *hist, double *walk_s)
+{
+    *hist = 0, *walk_s = 0;
+    for (int k = 0; k < p->nsteps; k++) *hist += p->steps[k].histories, *walk_s += p->steps[k].walk_seconds;
+}
+
+/* The outcome in words. */
+static const char *outcome(const report *p)
+{
+    return p->converged ? "converged" : p->status == ULAM_ESTALL ? "stalled" : p->status == ULAM_ENOCONV ? "capped"
+                                      : p->status == ULAM_OK    ? "interrupted" : "failed";
+}
+
+/* Nonzero when the method walks. */
+static int walking(int method)
+{
+    return method == ULAM_SEQUENTIAL || method == ULAM_MCSA;
+}
+
+/* Print one iteration's line (the header before the first). */
+static void print_step(const ulam_outer_step *s, int walks)
+{
+    if (s->iteration == 1) printf("%-5s %-12s %-12s %-10s %-10s\n", "iter", "residual", "histories", "rel_sd", "seconds");
+    printf("%-5d %-12.4e %-12lld %-10.3g %-10.4f\n", s->iteration, s->residual, (long long)s->histories,
+           walks ? s->rel_sd : 0.0, s->seconds);
+    fflush(stdout);
+}
+
+/* Nonzero when iteration k's line is printed as it ends: the first 10, then every 500th (the
+ * last is printed when the run ends). */
+static int shown(int k)
+{
+    return k <= 10 || k % 500 == 0;
+}
+
+/* Print the text report's totals (the iterations were printed as they ended). */
+static void print_text(const report *p)
+{
+    int walks = walking(p->method);
+    int64_t hist;
+    double walk_s;
+    totals(p, &hist, &walk_s);
+    printf("method          %s%s%s, tol %g%s\n", method_names[p->method], walks ? ", " : "",
+           walks ? est_names[p->o->walk.estimator] : "", p->o->tol, walks ? "" : " (no walks)");
+    if (p->method == KRYLOV_GMRES) printf("restart         %d\n", p->restart);
+    printf("outcome         %s after %d iterations%s, residual %.4e\n", outcome(p), p->iterations,
+           p->method >= KRYLOV_CG ? " (matrix-vector products)" : "", p->residual);
+    if (walks)
+        printf("histories       %lld (%.4g per iteration), eps1 %g\n", (long long)hist,
+               p->nsteps ? (double)hist / p->nsteps : 0.0, p->o->eps1);
+    printf("seconds         %.4f (walks %.4f)\n", p->seconds, walk_s);
+    if (walks)
+        printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", p->g.abs.rho,
+               cli_verdict_word(p->g.verdict_abs), p->g.hat[ULAM_FORWARD].rho,
+               cli_verdict_word(p->g.verdict_hat[ULAM_FORWARD]));
+    if (p->index && p->x) printf("x[%lld]%*s%.12g\n", (long long)p->index, p->index < 10 ? 10 : 9, "", p->x[p->index - 1]);
+    if (p->check) printf("direct          relative error ||x - x_LAPACK||_2 / ||x_LAPACK||_2 = %.4e (LAPACK %.4f s)\n",
+                         p->err_direct, p->direct_seconds);
+}
+
+/* Print the JSON object with the history. */
+static void print_json(const report *p)
+{
+    int64_t hist;
+    double walk_s;
+    totals(p, &hist, &walk_s);
+    printf("{");
+    cli_json_string("method", method_names[p->method], 0);
+    if (walking(p->method)) cli_json_string("estimator", est_names[p->o->walk.estimator], 0);
+    cli_json_string("outcome", outcome(p), 0);
+    printf("\"converged\": %s, \"iterations\": %d, ", p->converged ? "true" : "false", p->iterations);
+    if (p->method == KRYLOV_GMRES) printf("\"restart\": %d, ", p->restart);
+    cli_json_number("tol", p->o->tol, 0);
+    cli_json_number("eps1", p->o->eps1, 0);
+    cli_json_number("residual", p->residual, 0);
+    printf("\"histories\": %lld, ", (long long)hist);
+    cli_json_number("seconds", p->seconds, 0);
+    cli_json_number("walk_seconds", walk_s, 0);
+    if (walking(p->method)) {
+        cli_json_number("rho_abs", p->g.abs.rho, 0);
+        cli_json_number("rho_hat", p->g.hat[ULAM_FORWARD].rho, 0);
+    }
+    if (p->index && p->x) {
+        printf("\"index\": %lld, ", (long long)p->index);
+        cli_json_number("estimate", p->x[p->index - 1], 0);
+    }
+    if (p->check) cli_json_number("relative_error", p->err_direct, 0);
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, \"history\": [", (unsigned long long)p->o->walk.seed,
+           p->o->walk.threads, cli_share ? cli_share->nranks : 1);
+    for (int k = 0; k < p->nsteps; k++) {
+        const ulam_outer_step *s = &p->steps[k];
+        printf("%s{\"iteration\": %d, ", k ? ", " : "", s->iteration);
+        cli_json_number("residual", s->residual, 0);
+        printf("\"histories\": %lld, \"steps\": %lld, \"cut\": %lld, ", (long long)s->histories, (long long)s->steps,
+               (long long)s->cut);
+        cli_json_number("rel_sd", s->histories ? s->rel_sd : NAN, 0);
+        cli_json_number("walk_seconds", s->walk_seconds, 0);
+        cli_json_number("seconds", s->seconds, 1);
+        printf("}");
+    }
+    printf("]}\n");
+}
+
+/* The relative 2-norm error of x against LAPACK; 0 or an exit code. */
+static int direct_error(const cli_system *s, const double *x, report *p)
+{
+    double *xd, num = 0, den = 0;
+    ulam_direct_info info;
+    int rc = cli_direct_solve(s, (size_t)4 << 30, &xd, &info);
+    if (rc) return rc;
+    for (int64_t i = 0; i < s->M->nrows; i++) num += (x[i] - xd[i]) * (x[i] - xd[i]), den += xd[i] * xd[i];
+    p->err_direct = den > 0 ? sqrt(num / den) : sqrt(num);
+    p->direct_seconds = info.seconds;
+    free(xd);
+    return 0;
+}
+
+/* Print why the run ended early (not for a converged one). */
+static void print_failure(const report *p)
+{
+    double res = p->residual;
+    if (p->status == ULAM_ESTALL)
+        fprintf(stderr, "ulam: %s: error: %s: the residual made no new low in the last %s iterations (now "
+                        "%.3g after %d, tolerance %g): the corrections no longer reduce it (is rho(M^) < 1? a "
+                        "smaller --eps1 walks more a correction)\n",
+                p->s->matrix_path, ulam_strerror(p->status), p->o->stall ? "--stall" : "(default 5 or 100)", res,
+                p->iterations, p->o->tol);
+    else if (p->status == ULAM_ENOCONV)
+        fprintf(stderr, "ulam: %s: error: %s: residual %.3g after --max-iter %d iterations (tolerance %g)\n",
+                p->s->matrix_path, ulam_strerror(p->status), res, p->iterations, p->o->tol);
+    else
+        fprintf(stderr, "ulam: %s: error: %s after %d iterations (is rho(|M|) < 1? see 'ulam info')\n",
+                p->s->matrix_path, ulam_strerror(p->status), p->nsteps);
+}
+
+/* Check before the work that out can be written (a temporary file beside it, removed). */
+static int check_output(const char *out)
+{
+    ulam_outfile f;
+    int status = ulam_outfile_open(&f, out);
+    if (!status) ulam_outfile_abort(&f);
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable output file (its directory must exist)"};
+    return cli_report(out, &err);
+}
+
+/* Run the iteration, printing nothing; fills p (steps malloc'd); 0 or an exit code. */
+static int run(const cli_system *s, const ulam_outer_opts *o, report *p, ulam_outer_step **steps, double **x)
+{
+    ulam_outer *it = NULL;
+    ulam_error err;
+    int status = ulam_outer_alloc(s->M, s->b, o, &it, &err), cap = 0;
+    if (status) return cli_report(s->matrix_path, &err);
+    double t0 = ulam_now();
+    cli_catch_sigint();
+    while (!ulam_outer_done(it)) {
+        if (p->nsteps == cap) {
+            ulam_outer_step *g = realloc(*steps, (size_t)(cap = cap ? 2 * cap : 64) * sizeof *g);
+            if (!g) {
+                status = ULAM_ENOMEM;
+                break;
+            }
+            *steps = g;
+        }
+        status = ulam_outer_iterate(it, &(*steps)[p->nsteps]);
+        p->nsteps++;
+        if (!p->json && cli_rank == 0 && shown(p->nsteps)) print_step(&(*steps)[p->nsteps - 1], walking(p->method));
+    }
+    cli_release_sigint();
+    if (!p->json && cli_rank == 0 && p->nsteps && !shown(p->nsteps)) {
+        printf("...\n");
+        print_step(&(*steps)[p->nsteps - 1], walking(p->method));
+    }
+    p->seconds = ulam_now() - t0;
+    p->status = status;
+    p->iterations = p->nsteps;
+    p->converged = ulam_outer_converged(it);
+    p->residual = p->nsteps ? (*steps)[p->nsteps - 1].residual : 1.0;
+    *x = malloc((size_t)s->M->nrows * sizeof **x);
+    if (*x) memcpy(*x, ulam_outer_x(it), (size_t)s->M->nrows * sizeof **x);
+    ulam_outer_free(it);
+    return *x ? 0 : cli_exit_code(ULAM_ENOMEM);
+}
+
+/* Run a Krylov peer into a new *x; 0 or an exit code. */
+static int run_krylov(const cli_system *s, const ulam_outer_opts *o, report *p, double **x)
+{
+    *x = malloc((size_t)s->M->nrows * sizeof **x);
+    if (!*x) return cli_exit_code(ULAM_ENOMEM);
+    int cap = o->max_iter ? o->max_iter : 100000;
+    double t0 = ulam_now();
+    if (p->method == KRYLOV_CG && !ulam_csr_symmetric(s->M)) {
+        fprintf(stderr, "ulam: %s: error: --method cg needs a symmetric M (I - M symmetric positive definite); "
+                        "use --method gmres\n", s->matrix_path);
+        return EXIT_USAGE;
+    }
+    p->status = p->method == KRYLOV_CG ? ulam_cg(s->M, s->b, o->tol, cap, *x, &p->iterations, &p->residual)
+                                       : ulam_gmres(s->M, s->b, p->restart, o->tol, cap, *x, &p->iterations, &p->residual);
+    p->seconds = ulam_now() - t0;
+    p->converged = p->status == ULAM_OK;
+    if (p->status == ULAM_ENOMEM) return cli_exit_code(p->status);
+    return 0;
+}
+
+/* ulam solve --method. */
+int cli_solve_method(int argc, char **argv)
+{
+    static const struct option longopts[] = {
+        {"rhs", required_argument, 0, 'b'},     {"method", required_argument, 0, 'M'},
+        {"tol", required_argument, 0, 'l'},     {"max-iter", required_argument, 0, 'k'},
+        {"eps1", required_argument, 0, 'p'},    {"max-histories", required_argument, 0, 'H'},
+        {"stall", required_argument, 0, 'a'},   {"estimator", required_argument, 0, 'e'},
+        {"seed", required_argument, 0, 's'},    {"threads", required_argument, 0, 'T'},
+        {"continue", required_argument, 0, 'q'}, {"max-steps", required_argument, 0, 'K'},
+        {"jacobi", no_argument, 0, 'j'},        {"omega", required_argument, 0, 'w'},
+        {"json", no_argument, 0, 'J'},          {"out", required_argument, 0, 'o'},
+        {"index", required_argument, 0, 'i'},   {"check", no_argument, 0, 'c'},
+        {"force", no_argument, 0, 'F'},         {"cache", no_argument, 0, 'C'},
+        {"restart", required_argument, 0, 'r'}, {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
+    cli_system s = {.command = "solve", .omega = 1.0};
+    ulam_outer_opts o = ulam_outer_defaults();
+    report p = {.o = &o, .s = &s, .method = ULAM_MCSA, .restart = 30};
+    const char *out = NULL;
+    int64_t v;
+    int c, rc, force = 0;
+    optind = 0;
+    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'b': s.rhs_path = optarg; break;
+        case 'M':
+            if ((p.method = cli_lookup(optarg, method_names, 6)) < 0)
+                return cli_usage_error("solve", "--method expects mcsa, sequential, richardson, gauss-seidel, cg or "
+                                                "gmres, got '%s'", optarg);
+            if (p.method < KRYLOV_CG) o.method = p.method;
+            break;
+        case 'r':
+            if ((rc = cli_parse_int("solve", "--restart", optarg, 1, 10000, &v))) return rc;
+            p.restart = (int)v;
+            break;
+        case 'l': {
+            char *end;
+            o.tol = strtod(optarg, &end);
+            if (end == optarg || *end || !(o.tol > 0 && o.tol < 1))
+                return cli_usage_error("solve", "--tol expects a residual reduction strictly between 0 and 1 "
+                                                "(such as 1e-8), got '%s'", optarg);
+            break;
+        }
+        case 'k':
+            if ((rc = cli_parse_int("solve", "--max-iter", optarg, 1, 100000000, &v))) return rc;
+            o.max_iter = (int)v;
+            break;
+        case 'p': {
+            char *end;
+            o.eps1 = strtod(optarg, &end);
+            if (end == optarg || *end || !(o.eps1 > 0 && o.eps1 < 1))
+                return cli_usage_error("solve", "--eps1 expects a relative standard deviation strictly between "
+                                                "0 and 1 (such as 0.1), got '%s'", optarg);
+            break;
+        }
+        case 'H': if ((rc = cli_parse_int("solve", "--max-histories", optarg, 1, INT64_MAX / 2, &o.max_histories))) return rc; break;
+        case 'a': if ((rc = cli_parse_int("solve", "--stall", optarg, 1, 1000000, &v))) return rc; o.stall = (int)v; break;
+        case 'e':
+            if ((o.walk.estimator = cli_lookup(optarg, est_names, 3)) < 0)
+                return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
+            break;
+        case 's': if ((rc = cli_parse_int("solve", "--seed", optarg, 0, INT64_MAX, &v))) return rc; o.walk.seed = (uint64_t)v; break;
+        case 'T': if ((rc = cli_parse_int("solve", "--threads", optarg, 1, 1024, &v))) return rc; o.walk.threads = (int)v; break;
+        case 'q': if ((rc = cli_parse_real("solve", "--continue", optarg, 1e-9, 1 - 1e-12, &o.walk.continue_q))) return rc; break;
+        case 'K': if ((rc = cli_parse_int("solve", "--max-steps", optarg, 1, INT64_MAX / 2, &o.walk.max_steps))) return rc; break;
+        case 'j': s.jacobi = 1; break;
+        case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
+        case 'J': p.json = 1; break;
+        case 'o': out = optarg; break;
+        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
+        case 'c': p.check = 1; break;
+        case 'F': force = 1; break;
+        case 'C': s.cache = 1; break;
+        case 'h': fputs(usage, stdout); return 0;
+        default: return cli_usage_error("solve", "unknown option (for --method: see 'ulam solve --method mcsa --help')");
+        }
+    }
+    if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
+    if (!s.rhs_path) return cli_usage_error("solve", "needs --rhs b.mtx");
+    if (s.index && !out)
+        return cli_usage_error("solve", "--method solves for every unknown: --index I needs --out x.mtx "
+                                        "(the solution file) beside it");
+    s.matrix_path = argv[optind];
+    if (out && (rc = check_output(out))) return rc;
+    if ((rc = cli_load_system(&s))) return rc;
+    p.index = s.index;
+    o.walk.share = cli_share, o.walk.interrupt = &cli_interrupted;
+    if (walking(p.method) && (rc = cli_guard(&s, o.walk.continue_q, ULAM_FORWARD, &p.g))) {
+        cli_system_free(&s);
+        return rc;
+    }
+    if (walking(p.method) && p.g.verdict_abs >= ULAM_VERDICT_FAIL) {
+        cli_guard_diverge(&s, &p.g, force);
+        if (!force) {
+            cli_system_free(&s);
+            return EXIT_DIVERGE;
+        }
+    }
+    if (walking(p.method)) cli_guard_warn(&s, &p.g, ULAM_FORWARD, 0);
+    o.walk.guard = &p.g, o.walk.force = force; /* the walks' solver takes these verdicts */
+    ulam_outer_step *steps = NULL;
+    double *x = NULL;
+    rc = p.method >= KRYLOV_CG ? run_krylov(&s, &o, &p, &x) : run(&s, &o, &p, &steps, &x);
+    p.steps = steps, p.x = x;
+    if (!rc && p.status && p.status != ULAM_ESTALL && p.status != ULAM_ENOCONV) {
+        print_failure(&p);
+        rc = cli_exit_code(p.status);
+    } else if (!rc) {
+        if (p.check) rc = direct_error(&s, x, &p);
+        if (!rc && out && cli_rank == 0 && p.converged &&
+            ulam_mm_write_vector(out, x, s.M->nrows, "outer-iteration solution x")) {
+            ulam_error err = {.status = ULAM_EIO, .msg = "a writable output file"};
+            rc = cli_report(out, &err);
+        }
+        if (!rc && cli_rank == 0) {
+            if (p.json) print_json(&p);
+            else print_text(&p);
+        }
+        if (!rc && p.status) {
+            print_failure(&p);
+            rc = cli_exit_code(p.status);
+        }
+        if (!rc && cli_interrupted) rc = EXIT_INTERRUPTED;
+    }
+    fflush(stdout);
+    free(steps), free(x);
+    cli_system_free(&s);
+    return rc;
+}
