@@ -554,6 +554,20 @@ int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t 
 int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                                  size_t max_bytes, double *se, ulam_error *err);
 
+/* Gathering's next-event estimators (opts->estimator of ulam_rad_solver_alloc, gathering only).
+ * At every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in
+ * proportion to its power A_l sum_c E_lc, y uniform on it) and a uniform point x on p; one
+ * shadow ray scores W rho_p E_l cos cos_l A_l / (pi r^2 P_l) (P_l: l's share of the power)
+ * when y is visible from x and both face each other.  The walk's own cosine rays that reach an
+ * emitter are combined with it by multiple importance sampling (Veach's power heuristic,
+ * exponent 2, or the balance heuristic), or not counted at all (light sampling alone, which
+ * has infinite variance at a patch that shares an edge with a light). */
+enum ulam_rad_estimator {
+    ULAM_NEXT_EVENT = 3,         /* light sampling + the walk's hits, power heuristic (default) */
+    ULAM_NEXT_EVENT_BALANCE = 4, /* the same, balance heuristic */
+    ULAM_NEXT_EVENT_LIGHT = 5    /* light sampling alone */
+};
+
 /* What a patch walk run has found: RGB radiosity of the patch opts->index. */
 typedef struct ulam_rad_result {
     double radiosity[3];
@@ -574,7 +588,8 @@ typedef struct ulam_rad_solver ulam_rad_solver;
 /* Prepare walks on scene t (the tracer's): opts->mode ULAM_ADJOINT gathers at patch
  * opts->index (continuation max_c rho_c of the patch, weights rho_c / q), ULAM_FORWARD
  * shoots particles from the emitters in proportion to power and tallies every patch;
- * estimator ULAM_COLLISION or ULAM_ABSORPTION; the stopping rules, seed, threads and
+ * estimator ULAM_COLLISION or ULAM_ABSORPTION, or for gathering one of ulam_rad_estimator
+ * (rays then counts the shadow rays too); the stopping rules, seed, threads and
  * interrupt of ulam_walk_opts (continue_q, roulette and split must be 0). */
 int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
                           ulam_error *err);

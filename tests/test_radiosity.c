@@ -122,11 +122,16 @@ static void check_all_modes(const exact_scene *e, int64_t walks, uint64_t seed)
     assert_int_equal(ulam_radiosity_direct(s, F, 0, Bd, NULL, NULL), ULAM_OK);
     double sf[3];
     assert_int_equal(ulam_radiosity_direct_error(s, F, rays, Bd, p, 0, sf, NULL), ULAM_OK);
-    const char *names[6] = {"gather collision", "gather absorption", "shoot collision", "shoot absorption",
-                            "matrix-walk collision", "matrix-walk absorption"};
-    for (int m = 0; m < 7; m++) {
+    const char *names[10] = {"gather collision", "gather absorption", "shoot collision", "shoot absorption",
+                             "matrix-walk collision", "matrix-walk absorption", "direct", "next-event MIS power",
+                             "next-event MIS balance", "next-event light only"};
+    for (int m = 0; m < 10; m++) {
         double est[3], se[3];
-        if (m < 4) {
+        if (m >= 7) {
+            ulam_rad_result r = rad_walk(t, ULAM_ADJOINT, ULAM_NEXT_EVENT + (m - 7), p, walks, seed + 20 + (uint64_t)m, NULL);
+            assert_int_equal(r.cut, 0);
+            memcpy(est, r.radiosity, sizeof est), memcpy(se, r.std_error, sizeof se);
+        } else if (m < 4) {
             ulam_rad_result r = rad_walk(t, m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, m % 2 ? ULAM_ABSORPTION : ULAM_COLLISION,
                                          p, walks, seed + (uint64_t)m, NULL);
             assert_int_equal(r.cut, 0);
@@ -144,14 +149,16 @@ static void check_all_modes(const exact_scene *e, int64_t walks, uint64_t seed)
         for (int c = 0; c < 3; c++) /* z 0 where the answer is exact (zero variance up to rounding) */
             z[c] = se[c] > 1e-12 * (1 + fabs(Bx[3 * p + c])) ? (est[c] - Bx[3 * p + c]) / se[c] : 0.0;
         print_message("%s patch %lld exact %.6f %.6f %.6f  %-22s z %+.2f %+.2f %+.2f\n", e->file, (long long)p + 1,
-                      Bx[3 * p], Bx[3 * p + 1], Bx[3 * p + 2], m < 6 ? names[m] : "direct", z[0], z[1], z[2]);
+                      Bx[3 * p], Bx[3 * p + 1], Bx[3 * p + 2], names[m], z[0], z[1], z[2]);
         for (int c = 0; c < 3; c++) {
             double x = Bx[3 * p + c], tol = 4 * se[c] + 1e-9 * (1 + fabs(x));
             if (fabs(est[c] - x) > tol)
-                print_error("%s: %s channel %d: %.6f, exact %.6f, tolerance %.3g\n", e->file, m < 6 ? names[m] : "direct", c,
+                print_error("%s: %s channel %d: %.6f, exact %.6f, tolerance %.3g\n", e->file, names[m], c,
                             est[c], x, tol);
             assert_close(est[c], x, tol);
-            assert_true(se[c] < 0.05 * fabs(x) + 1e-12); /* a test that can fail */
+            /* a test that can fail; light sampling alone is not held to it (its 1 / r^2: the
+             * small gap's receiver at 0.005 from the lamp) */
+            assert_true(se[c] < 0.05 * fabs(x) + 1e-12 || m == 9);
         }
     }
     free(Bx), free(Bd);

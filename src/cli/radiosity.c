@@ -11,7 +11,8 @@
 
 static const char *const usage =
     "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot]\n"
-    "                      [--estimator collision|absorption] [--walks N] [--rel-err E] [--time S]\n"
+    "                      [--estimator collision|absorption|next-event] [--mis power|balance|none]\n"
+    "                      [--walks N] [--rel-err E] [--time S]\n"
     "                      [--seed S] [--threads T] [--max-steps K] [--subdivide L] [--ff-rays K]\n"
     "                      [--direct] [--check] [--matrix-walk] [--max-mem SIZE]\n"
     "                      [--image out.png] [--size WxH] [--exposure X] [--camera C]\n"
@@ -27,7 +28,12 @@ static const char *const usage =
     "  --mode gather     walks from the patch that gather emission (default; needs --patch):\n"
     "                    one patch without forming F\n"
     "  --mode shoot      particles from the emitters, tallied on every patch (for --image)\n"
-    "  --estimator E     collision (score at every patch, default) or absorption (where it stops)\n"
+    "  --estimator E     collision (score at every patch, default) or absorption (where it stops);\n"
+    "                    next-event (gathering by rays): at every patch a walk visits, one shadow\n"
+    "                    ray to a point on an emitter (drawn by power and area)\n"
+    "  --mis H           next-event with the walk's own emitter hits by multiple importance\n"
+    "                    sampling: power (default) or balance heuristic; none: light sampling\n"
+    "                    alone (infinite variance at a patch sharing an edge with a light)\n"
     "  --walks N, --rel-err E, --time S, --seed S, --threads T, --max-steps K: as in ulam solve\n"
     "                    (--rel-err: every nonzero channel)\n"
     "  --subdivide L     split faces into patches no longer than L on a side\n"
@@ -52,7 +58,8 @@ static const char *const usage =
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
 
 static const char *const mode_names[] = {"gather", "shoot"};
-static const char *const est_names[] = {"collision", "absorption"};
+static const char *const est_names[] = {"collision", "absorption", "next-event"};
+static const char *const mis_names[] = {"power", "balance", "none"};
 static const char *const chan = "RGB";
 
 /* Everything the command was asked. */
@@ -61,6 +68,7 @@ typedef struct {
     double subdivide, exposure;
     int64_t ff_rays;
     int direct, check, matrix_walk, json, width, height, all, list;
+    int est, mis; /* indices into est_names and mis_names (-1: --mis not given) */
     int camera_given; /* --camera: cam holds it */
     ulam_camera cam;
     size_t max_mem;
@@ -119,6 +127,7 @@ static int parse(int argc, char **argv, args *a)
         {"json", no_argument, 0, 'J'},            {"help", no_argument, 0, 'h'},
         {"out", required_argument, 0, 'o'},       {"all", no_argument, 0, 'A'},
         {"list", no_argument, 0, 'l'},            {"camera", required_argument, 0, 'C'},
+        {"mis", required_argument, 0, 'H'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int64_t v;
@@ -132,8 +141,12 @@ static int parse(int argc, char **argv, args *a)
                 return cli_usage_error(cmd, "--mode expects gather or shoot, got '%s'", optarg);
             break;
         case 'e':
-            if ((a->o.estimator = cli_lookup(optarg, est_names, 2)) < 0)
-                return cli_usage_error(cmd, "--estimator expects collision or absorption, got '%s'", optarg);
+            if ((a->est = cli_lookup(optarg, est_names, 3)) < 0)
+                return cli_usage_error(cmd, "--estimator expects collision, absorption or next-event, got '%s'", optarg);
+            break;
+        case 'H':
+            if ((a->mis = cli_lookup(optarg, mis_names, 3)) < 0)
+                return cli_usage_error(cmd, "--mis expects power, balance or none, got '%s'", optarg);
             break;
         case 'n': if ((rc = cli_parse_int(cmd, "--walks", optarg, 1, INT64_MAX / 2, &a->o.max_walks))) return rc; any_rule = 1; break;
         case 'r': if ((rc = cli_parse_real(cmd, "--rel-err", optarg, 1e-12, 1.0, &a->o.rel_err))) return rc; any_rule = 1; break;
@@ -166,6 +179,11 @@ static int parse(int argc, char **argv, args *a)
     if (optind != argc - 1) return cli_usage_error(cmd, "expects exactly one scene file");
     a->scene = argv[optind];
     if (a->list) return 0;
+    if (a->mis >= 0 && a->est != 2) return cli_usage_error(cmd, "--mis needs --estimator next-event");
+    if (a->est == 2 && (a->o.mode != ULAM_ADJOINT || a->matrix_walk))
+        return cli_usage_error(cmd, "--estimator next-event is for gathering by rays (not --mode shoot or "
+                                    "--matrix-walk)");
+    a->o.estimator = a->est < 2 ? a->est : ULAM_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
     if ((a->out || a->all) && a->o.mode == ULAM_ADJOINT && !a->direct)
         return cli_usage_error(cmd, "%s needs --mode shoot or --direct (gathering answers one patch)",
                                a->out ? "--out" : "--all");
@@ -468,7 +486,8 @@ static void print_json(const args *a, const report *r)
             }
         }
         cli_json_string("mode", mode_names[a->o.mode], 0);
-        cli_json_string("estimator", est_names[a->o.estimator], 0);
+        cli_json_string("estimator", est_names[a->est], 0);
+        if (a->est == 2) cli_json_string("mis", mis_names[a->mis > 0 ? a->mis : 0], 0);
         printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, \"cut\": %lld, \"max_steps\": %lld, ",
                a->matrix_walk ? "true" : "false", (long long)w->walks, a->matrix_walk ? "steps" : "rays",
                (long long)w->steps, (long long)w->cut, (long long)a->o.max_steps);
@@ -632,7 +651,7 @@ static patch_values every_patch(const args *a, const report *r, const walked *w,
 /* ulam radiosity. */
 int cli_radiosity(int argc, char **argv)
 {
-    args a = {.ff_rays = 1000, .width = 512, .height = 512, .max_mem = (size_t)4 << 30, .o = ulam_walk_defaults()};
+    args a = {.mis = -1, .ff_rays = 1000, .width = 512, .height = 512, .max_mem = (size_t)4 << 30, .o = ulam_walk_defaults()};
     a.o.max_walks = 0;
     a.o.interrupt = &cli_interrupted, a.o.share = cli_share;
     int rc = parse(argc, argv, &a);
