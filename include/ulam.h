@@ -644,6 +644,34 @@ typedef struct ulam_render_info {
 int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width,
                 int height, double exposure, unsigned char *rgb, ulam_render_info *info);
 
+/* How many pixel centres of a width x height picture see each patch's front (pixels:
+ * npatches), with the rays of ulam_render. */
+int ulam_view_pixels(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t *pixels);
+
+/* What a view gather did. */
+typedef struct ulam_view_info {
+    int64_t npatches, seen; /* patches in the scene, and those some pixel sees */
+    int64_t pixels_hit;     /* pixels that see a patch */
+    int64_t camera_rays;    /* width * height */
+    int64_t walks, rays;    /* gathering walks and their rays (shadow rays included) */
+    int64_t unmet;          /* seen patches that stopped short of their target (budget, time) */
+    int64_t cut;            /* walks cut at max_steps */
+    double seconds;         /* all of it, camera rays included */
+    int threads, interrupted;
+} ulam_view_info;
+
+/* Images that solve only what is seen: cast the camera's primary rays (ulam_view_pixels), then
+ * gather every patch some pixel sees, and no other, each with its own solver run (opts: the
+ * gathering estimator, seed, threads, max_walks a patch, max_steps, interrupt; max_seconds
+ * for the whole) to relative error opts->rel_err (n_max / n_p)^coverage on every nonzero
+ * channel, n_p its pixels and n_max the most any patch has: coverage 0 holds every seen
+ * patch to rel_err; 0.25 minimises the walks for a given pixel-summed squared error
+ * (sum_p n_p se_p^2 at cost sum_p 1 / se_p^2: se_p ~ n_p^-1/4).  Patch p's walks use the seed
+ * drawn from stream (opts->seed, p), so the result does not depend on threads.  B and se
+ * (3 * npatches) get the seen patches' answers; unseen patches get B 0 and se NaN. */
+int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, int height, double coverage,
+                     const ulam_walk_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err);
+
 /* Write an 8-bit RGB image as PNG (libpng), atomically. */
 int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb);
 

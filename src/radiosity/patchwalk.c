@@ -457,6 +457,19 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     return s->status;
 }
 
+/* Restart a gathering solver at patch p with relative target rel_err and seed: the statistics
+ * are cleared, the workspace kept (so that many patches cost no allocation). */
+void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds)
+{
+    ulam__moments zero = {0};
+    s->o.index = p, s->o.rel_err = rel_err, s->o.seed = seed, s->o.max_seconds = max_seconds;
+    s->m[0] = s->m[1] = s->m[2] = zero;
+    s->sq = s->maxsq = s->seconds = 0.0;
+    s->walks = s->rays = s->cut = s->nonfinite = s->next_walk = 0;
+    s->t0 = -1;
+    s->done = s->interrupted = s->zero = s->status = 0;
+}
+
 /* Nonzero once a stopping rule is met. */
 int ulam_rad_solver_done(const ulam_rad_solver *s)
 {

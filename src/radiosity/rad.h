@@ -68,6 +68,10 @@ int ulam__tracer_sees(const ulam_tracer *t, int64_t p, const double x[3], int64_
 /* The scene a tracer was built on. */
 const ulam_scene *ulam__tracer_scene(const ulam_tracer *t);
 
+/* Restart a gathering solver at patch p (rel_err, seed and max_seconds replaced), its
+ * statistics cleared and its workspace kept. */
+void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds);
+
 /* Allocate an empty scene with room for the given counts (arrays uninitialised). */
 ulam_scene *ulam__scene_alloc(int64_t npatches, int64_t nverts, int64_t nidx, int64_t ngroups);
 
