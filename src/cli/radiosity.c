@@ -727,6 +727,10 @@ int cli_radiosity(int argc, char **argv)
     walked w = {0};
     report r = {.patch = -1, .w = NULL};
     ulam_error err;
+    if (a.est == 2 && a.mis == 2 && cli_rank == 0)
+        fprintf(stderr, "ulam radiosity: warning: --mis none (light sampling alone) has infinite variance at a patch "
+                        "that shares an edge with a light or nearly touches one: there the error bar can be far too "
+                        "small (the edge-lamp scene: z = -4.6); the MIS default is bounded\n");
     if (a.image && (rc = check_output(a.image))) return rc;
     if (a.out && (rc = check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
