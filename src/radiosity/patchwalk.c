@@ -216,12 +216,13 @@ static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_b
 }
 
 /* The weight of a strategy of density a against the other's b: the power heuristic (exponent 2),
- * the balance heuristic, or 1 for light sampling alone (whose partner then gets 0). */
+ * the balance heuristic, or 1 for light sampling alone (whose partner then gets 0).  In the
+ * ratio form, a landing point at distance 0 (a = inf) gets weight 1, not NaN. */
 static double mis_weight(int estimator, double a, double b, int light)
 {
     if (estimator == ULAM_NEXT_EVENT_LIGHT) return light ? 1.0 : 0.0;
-    if (estimator == ULAM_NEXT_EVENT_BALANCE) return a / (a + b);
-    return a * a / (a * a + b * b);
+    double r = b / a;
+    return estimator == ULAM_NEXT_EVENT_BALANCE ? 1.0 / (1.0 + r) : 1.0 / (1.0 + r * r);
 }
 
 /* The emitter drawn in proportion to power from u in [0, ptot). */
