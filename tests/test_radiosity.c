@@ -225,6 +225,16 @@ static void test_cornell_black_light(void **state)
                 assert_true(all[3 * p + c] > 0 && sd < 0.2 * g.radiosity[c]); /* lit, and a test that can fail */
                 assert_close(all[3 * p + c], g.radiosity[c], 4 * sd);
             }
+            if (est == ULAM_ABSORPTION) continue;
+            /* next-event (MIS power): light samples on a lamp that reflects nothing */
+            ulam_rad_result ne = rad_walk(t, ULAM_ADJOINT, ULAM_NEXT_EVENT, p, 20000, 51 + (uint64_t)k, NULL);
+            for (int c = 0; c < 3; c++) {
+                double sd = sqrt(se[3 * p + c] * se[3 * p + c] + ne.std_error[c] * ne.std_error[c]);
+                print_message("black light, %s %c: shoot %.5g, next-event %.5g +- %.2g, z %+.2f\n", labels[k], "RGB"[c],
+                              all[3 * p + c], ne.radiosity[c], ne.std_error[c], (all[3 * p + c] - ne.radiosity[c]) / sd);
+                assert_true(ne.std_error[c] < 0.1 * ne.radiosity[c]);
+                assert_close(all[3 * p + c], ne.radiosity[c], 4 * sd);
+            }
         }
         free(all), free(se);
         ulam_rad_solver_free(sv);
