@@ -731,6 +731,20 @@ int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t 
 int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                                  size_t max_bytes, double *se, ulam_error *err);
 
+/* Gathering's next-event estimators (opts->estimator of ulam_rad_solver_alloc, gathering only).
+ * At every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in
+ * proportion to its power A_l sum_c E_lc, y uniform on it) and a uniform point x on p; one
+ * shadow ray scores W rho_p E_l cos cos_l A_l / (pi r^2 P_l) (P_l: l's share of the power)
+ * when y is visible from x and both face each other.  The walk's own cosine rays that reach an
+ * emitter are combined with it by multiple importance sampling (Veach's power heuristic,
+ * exponent 2, or the balance heuristic), or not counted at all (light sampling alone, which
+ * has infinite variance at a patch that shares an edge with a light). */
+enum ulam_rad_estimator {
+    ULAM_NEXT_EVENT = 3,         /* light sampling + the walk's hits, power heuristic (default) */
+    ULAM_NEXT_EVENT_BALANCE = 4, /* the same, balance heuristic */
+    ULAM_NEXT_EVENT_LIGHT = 5    /* light sampling alone */
+};
+
 /* What a patch walk run has found: RGB radiosity of the patch opts->index. */
 typedef struct ulam_rad_result {
     double radiosity[3];
@@ -751,7 +765,8 @@ typedef struct ulam_rad_solver ulam_rad_solver;
 /* Prepare walks on scene t (the tracer's): opts->mode ULAM_ADJOINT gathers at patch
  * opts->index (continuation max_c rho_c of the patch, weights rho_c / q), ULAM_FORWARD
  * shoots particles from the emitters in proportion to power and tallies every patch;
- * estimator ULAM_COLLISION or ULAM_ABSORPTION; the stopping rules, seed, threads and
+ * estimator ULAM_COLLISION or ULAM_ABSORPTION, or for gathering one of ulam_rad_estimator
+ * (rays then counts the shadow rays too); the stopping rules, seed, threads and
  * interrupt of ulam_walk_opts (continue_q, roulette and split must be 0). */
 int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
                           ulam_error *err);
@@ -805,6 +820,34 @@ typedef struct ulam_render_info {
  * sized. */
 int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width,
                 int height, double exposure, unsigned char *rgb, ulam_render_info *info);
+
+/* How many pixel centres of a width x height picture see each patch's front (pixels:
+ * npatches), with the rays of ulam_render. */
+int ulam_view_pixels(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t *pixels);
+
+/* What a view gather did. */
+typedef struct ulam_view_info {
+    int64_t npatches, seen; /* patches in the scene, and those some pixel sees */
+    int64_t pixels_hit;     /* pixels that see a patch */
+    int64_t camera_rays;    /* width * height */
+    int64_t walks, rays;    /* gathering walks and their rays (shadow rays included) */
+    int64_t unmet;          /* seen patches that stopped short of their target (budget, time) */
+    int64_t cut;            /* walks cut at max_steps */
+    double seconds;         /* all of it, camera rays included */
+    int threads, interrupted;
+} ulam_view_info;
+
+/* Images that solve only what is seen: cast the camera's primary rays (ulam_view_pixels), then
+ * gather every patch some pixel sees, and no other, each with its own solver run (opts: the
+ * gathering estimator, seed, threads, max_walks a patch, max_steps, interrupt; max_seconds
+ * for the whole) to relative error opts->rel_err (n_max / n_p)^coverage on every nonzero
+ * channel, n_p its pixels and n_max the most any patch has: coverage 0 holds every seen
+ * patch to rel_err; 0.25 minimises the walks for a given pixel-summed squared error
+ * (sum_p n_p se_p^2 at cost sum_p 1 / se_p^2: se_p ~ n_p^-1/4).  Patch p's walks use the seed
+ * drawn from stream (opts->seed, p), so the result does not depend on threads.  B and se
+ * (3 * npatches) get the seen patches' answers; unseen patches get B 0 and se NaN. */
+int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, int height, double coverage,
+                     const ulam_walk_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err);
 
 /* Write an 8-bit RGB image as PNG (libpng), atomically. */
 int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb);

@@ -120,7 +120,7 @@ CASES += [
     (["radiosity", SC + "cube.obj"], 2, r"needs --patch K", ""),
     (["radiosity", SC + "cube.obj", "--patch", "7"], 2, r"--patch 7 is out of range 1..6", ""),
     (["radiosity", SC + "cube.obj", "--patch", "attic"], 2, r"neither a patch number nor a label; labels: floor ceiling", ""),
-    (["radiosity", SC + "cube.obj", "--patch", "1", "--image", "x.png"], 2, r"--image needs --mode shoot or --direct", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--image", "x.png"], 2, r"--image needs --mode shoot, --direct or --view-gather", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "-5"], 2, r"--walks expects an integer", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--subdivide", "0"], 2, r"--subdivide expects a number", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--mode", "sideways"], 2, r"--mode expects gather or shoot", ""),
@@ -145,6 +145,54 @@ CASES.append((["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-w
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # cuts at --max-steps were silent (96 for 1000)
     CASES.append((["radiosity", R + "furnace999.obj", "--patch", "1", "--max-steps", "100", "--walks", "2000"] + extra,
                   0, r"^$", r"^warning +\d+ of \d+ walks cut at --max-steps 100: the estimate is biased low"))
+
+
+CASES += [
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--mis", "power"], 2, r"--mis needs --estimator next-event", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "next-event", "--mis", "heavy"], 2,
+     r"--mis expects power, balance or none", ""),
+    (["radiosity", SC + "cube.obj", "--mode", "shoot", "--estimator", "next-event"], 2,
+     r"next-event is for gathering by rays", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "next-event", "--matrix-walk"], 2,
+     r"next-event is for gathering by rays", ""),
+    (["radiosity", SC + "cube.obj", "--view-gather", "--rel-err", "0.1"], 2, r"--view-gather needs --image and --rel-err", ""),
+    (["radiosity", SC + "cube.obj", "--view-gather", "--image", "x.png"], 2, r"--view-gather needs --image and --rel-err", ""),
+    (["radiosity", SC + "cube.obj", "--view-gather", "--rel-err", "0.1", "--image", "x.png", "--coverage", "2"], 2,
+     r"--coverage expects a number", ""),
+    # the black lamp's receiver by next-event (exact 0.5 F = 0.2378) and the edge lamp's wall
+    (["radiosity", R + "black_emitter.obj", "--patch", "2", "--estimator", "next-event", "--walks", "1000"], 0, r"^$",
+     r"radiosity R  0\.2[0-9]+ \+- "),
+    (["radiosity", R + "back_faces.obj", "--patch", "behind", "--estimator", "next-event", "--mis", "none", "--walks",
+      "1000"], 0, r"^ulam radiosity: warning: --mis none .* infinite variance", r"radiosity R  0 \+- 0"),
+]
+
+
+def check_radiosity_next_event(ulam):
+    """next-event in JSON (estimator and mis), within 4 sigma of the exact answer; --view-gather
+    on the cube writes a picture and reports what it saw, JSON 'view'."""
+    import math
+    F = 0.4755766  # Howell C-11 (1, 1.5, 0.5)
+    for mis in ("power", "balance", "none"):
+        rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--estimator", "next-event",
+                                  "--mis", mis, "--walks", "20000", "--json", "--seed", "3"])
+        assert rc == 0, err
+        j = json.loads(out)
+        assert j["estimator"] == "next-event" and j["mis"] == mis, j
+        assert all(abs(b - 0.5 * F) < 4 * e and 0 < e < 0.01 for b, e in zip(j["radiosity"], j["stderr"])), j
+    with tempfile.TemporaryDirectory() as d:
+        png = os.path.join(d, "v.png")
+        rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "150", "--view-gather",
+                                  "--rel-err", "0.1", "--image", png, "--size", "16x16", "--json"])
+        assert rc == 0, err
+        j = json.loads(out)
+        v = j["view"]
+        assert j["estimator"] == "next-event" and 0 < v["seen"] < v["npatches"] == j["npatches"], v
+        assert v["camera_rays"] == 256 and v["unmet"] == 0 and v["rays"] == j["rays"] > 0, v
+        assert j["image"] == png and not png_black(png)
+        rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "150", "--view-gather",
+                                  "--rel-err", "0.1", "--image", png, "--size", "16x16", "--walks", "1000"])
+        assert rc == 0 and re.search(r"^view +\d+ of \d+ patches seen", out, re.M), out
+        assert re.search(r"^warning +\d+ seen patches stopped short of their target", out, re.M), out
 
 
 def run(ulam, args):
@@ -683,7 +731,8 @@ def main():
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
              (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
-             (check_honest_verdicts, ulam), (check_study_question, ulam)]
+             (check_honest_verdicts, ulam), (check_study_question, ulam),
+             (check_radiosity_next_event, ulam)]
     for f, arg in extra:
         try:
             f(arg)

@@ -36,6 +36,10 @@ def main():
                             "mcsa", "--tol", "1e-6", "--json", "--out", "{d}/m.mtx"], "m.mtx"),
             ("radiosity", ["radiosity", "examples/scenes/cornell_box.obj", "--patch", "floor", "--subdivide", "300",
                            "--walks", "20000", "--json"], None),
+            ("radiosity next-event", ["radiosity", "examples/scenes/cornell_box.obj", "--patch", "floor", "--subdivide",
+                                      "300", "--estimator", "next-event", "--rel-err", "0.02", "--json"], None),
+            ("radiosity view", ["radiosity", "examples/scenes/cornell_box.obj", "--subdivide", "150", "--view-gather",
+                                "--rel-err", "0.1", "--size", "12x12", "--json", "--image", "{d}/v.png"], "v.png"),
             ("radiosity shoot", ["radiosity", "tests/data/rad/cornell_black_light.obj", "--subdivide", "300", "--mode",
                                  "shoot", "--walks", "20000", "--json", "--out", "{d}/p.csv"], "p.csv"),
             ("study", ["study", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx", "--index", "2", "--methods",
@@ -51,7 +55,8 @@ def main():
                         rows = open(os.path.join(d, outfile)).read().splitlines()
                         res.append([",".join(r.split(",")[:9]) for r in rows])
                     elif outfile:
-                        res.append((json.loads(out), open(os.path.join(d, outfile)).read()))
+                        mode = "rb" if outfile.endswith(".png") else "r"
+                        res.append((json.loads(out), open(os.path.join(d, outfile), mode).read()))
                     else:
                         res.append(json.loads(out))
                 one, two = res
@@ -66,8 +71,11 @@ def main():
                     assert (two[0] if outfile else two)["ranks"] == 2, "not distributed"
                     if outfile:
                         assert one[1] == two[1], "forward --out files differ"
-                elif name == "radiosity":
+                elif name in ("radiosity", "radiosity next-event"):
                     assert one["radiosity"] == two["radiosity"] and one["stderr"] == two["stderr"], (one, two)
+                    assert one["rays"] == two["rays"], (one, two)
+                elif name == "radiosity view":  # the seen patches gathered across ranks: the picture byte for byte
+                    assert one[0]["view"]["rays"] == two[0]["view"]["rays"] and one[1] == two[1], "differ"
                 elif name == "radiosity shoot":  # every patch, black light: the CSV byte for byte
                     assert one[0]["walks"] == two[0]["walks"] and one[1] == two[1] and one[1].count("\n") == 50, "differ"
                 else:

@@ -11,10 +11,12 @@
 
 static const char *const usage =
     "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot]\n"
-    "                      [--estimator collision|absorption] [--walks N] [--rel-err E] [--time S]\n"
+    "                      [--estimator collision|absorption|next-event] [--mis power|balance|none]\n"
+    "                      [--walks N] [--rel-err E] [--time S]\n"
     "                      [--seed S] [--threads T] [--max-steps K] [--subdivide L] [--ff-rays K]\n"
     "                      [--direct] [--check] [--matrix-walk] [--max-mem SIZE]\n"
     "                      [--image out.png] [--size WxH] [--exposure X] [--camera C]\n"
+    "                      [--view-gather] [--coverage X]\n"
     "                      [--out patches.csv] [--all] [--list] [--json]\n"
     "\n"
     "Radiosity B = E + diag(rho) F B of a scene of diffuse patches (Wavefront OBJ + MTL: Kd is\n"
@@ -27,7 +29,12 @@ static const char *const usage =
     "  --mode gather     walks from the patch that gather emission (default; needs --patch):\n"
     "                    one patch without forming F\n"
     "  --mode shoot      particles from the emitters, tallied on every patch (for --image)\n"
-    "  --estimator E     collision (score at every patch, default) or absorption (where it stops)\n"
+    "  --estimator E     collision (score at every patch, default) or absorption (where it stops);\n"
+    "                    next-event (gathering by rays): at every patch a walk visits, one shadow\n"
+    "                    ray to a point on an emitter (drawn by power and area)\n"
+    "  --mis H           next-event with the walk's own emitter hits by multiple importance\n"
+    "                    sampling: power (default) or balance heuristic; none: light sampling\n"
+    "                    alone (infinite variance at a patch sharing an edge with a light)\n"
     "  --walks N, --rel-err E, --time S, --seed S, --threads T, --max-steps K: as in ulam solve\n"
     "                    (--rel-err: every nonzero channel)\n"
     "  --subdivide L     split faces into patches no longer than L on a side\n"
@@ -38,6 +45,12 @@ static const char *const usage =
     "                    walks and LAPACK then share the very same F\n"
     "  --max-mem SIZE    refuse a direct solve needing more (default 4G)\n"
     "  --image out.png   render the shooting (or else direct) solution\n"
+    "  --view-gather     with --image and --rel-err E: gather only the patches the camera sees,\n"
+    "                    each to E (n_max / n)^X on every channel, n its pixels, n_max the most\n"
+    "                    any patch has (--estimator: next-event unless given; --walks: a cap\n"
+    "                    per patch, --time: for all)\n"
+    "  --coverage X      that exponent, in [0, 1] (default 0.25, the fewest walks for a given\n"
+    "                    pixel-summed squared error; 0: every seen patch to E)\n"
     "  --camera C        ex,ey,ez,ax,ay,az,ux,uy,uz,fov: eye, look-at point, up and horizontal\n"
     "                    field of view in degrees; 'cornell' for the Cornell box camera; default:\n"
     "                    frame the scene's bounding box, looking along +z\n"
@@ -52,7 +65,8 @@ static const char *const usage =
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
 
 static const char *const mode_names[] = {"gather", "shoot"};
-static const char *const est_names[] = {"collision", "absorption"};
+static const char *const est_names[] = {"collision", "absorption", "next-event"};
+static const char *const mis_names[] = {"power", "balance", "none"};
 static const char *const chan = "RGB";
 
 /* Everything the command was asked. */
@@ -61,6 +75,9 @@ typedef struct {
     double subdivide, exposure;
     int64_t ff_rays;
     int direct, check, matrix_walk, json, width, height, all, list;
+    int est, mis; /* indices into est_names and mis_names (-1: not given) */
+    int view;     /* --view-gather */
+    double coverage;
     int camera_given; /* --camera: cam holds it */
     ulam_camera cam;
     size_t max_mem;
@@ -119,6 +136,8 @@ static int parse(int argc, char **argv, args *a)
         {"json", no_argument, 0, 'J'},            {"help", no_argument, 0, 'h'},
         {"out", required_argument, 0, 'o'},       {"all", no_argument, 0, 'A'},
         {"list", no_argument, 0, 'l'},            {"camera", required_argument, 0, 'C'},
+        {"mis", required_argument, 0, 'H'},       {"view-gather", no_argument, 0, 'V'},
+        {"coverage", required_argument, 0, 'G'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int64_t v;
@@ -132,8 +151,12 @@ static int parse(int argc, char **argv, args *a)
                 return cli_usage_error(cmd, "--mode expects gather or shoot, got '%s'", optarg);
             break;
         case 'e':
-            if ((a->o.estimator = cli_lookup(optarg, est_names, 2)) < 0)
-                return cli_usage_error(cmd, "--estimator expects collision or absorption, got '%s'", optarg);
+            if ((a->est = cli_lookup(optarg, est_names, 3)) < 0)
+                return cli_usage_error(cmd, "--estimator expects collision, absorption or next-event, got '%s'", optarg);
+            break;
+        case 'H':
+            if ((a->mis = cli_lookup(optarg, mis_names, 3)) < 0)
+                return cli_usage_error(cmd, "--mis expects power, balance or none, got '%s'", optarg);
             break;
         case 'n': if ((rc = cli_parse_int(cmd, "--walks", optarg, 1, INT64_MAX / 2, &a->o.max_walks))) return rc; any_rule = 1; break;
         case 'r': if ((rc = cli_parse_real(cmd, "--rel-err", optarg, 1e-12, 1.0, &a->o.rel_err))) return rc; any_rule = 1; break;
@@ -155,6 +178,8 @@ static int parse(int argc, char **argv, args *a)
             break;
         case 'X': if ((rc = cli_parse_real(cmd, "--exposure", optarg, 1e-300, 1e300, &a->exposure))) return rc; break;
         case 'J': a->json = 1; break;
+        case 'V': a->view = 1; break;
+        case 'G': if ((rc = cli_parse_real(cmd, "--coverage", optarg, 0.0, 1.0, &a->coverage))) return rc; break;
         case 'o': a->out = optarg; break;
         case 'A': a->all = 1; break;
         case 'l': a->list = 1; break;
@@ -166,14 +191,26 @@ static int parse(int argc, char **argv, args *a)
     if (optind != argc - 1) return cli_usage_error(cmd, "expects exactly one scene file");
     a->scene = argv[optind];
     if (a->list) return 0;
+    if (a->view && a->est < 0) a->est = 2; /* --view-gather: next-event unless told */
+    if (a->est < 0) a->est = 0;
+    if (a->view && (!a->image || !(a->o.rel_err > 0) || a->o.mode != ULAM_ADJOINT || a->direct || a->matrix_walk ||
+                    a->patch || a->check || a->out || a->all))
+        return cli_usage_error(cmd, "--view-gather needs --image and --rel-err, and gathers by rays only (no --mode "
+                                    "shoot, --direct, --matrix-walk, --patch, --check, --out or --all)");
+    if (a->mis >= 0 && a->est != 2) return cli_usage_error(cmd, "--mis needs --estimator next-event");
+    if (a->est == 2 && (a->o.mode != ULAM_ADJOINT || a->matrix_walk))
+        return cli_usage_error(cmd, "--estimator next-event is for gathering by rays (not --mode shoot or "
+                                    "--matrix-walk)");
+    a->o.estimator = a->est < 2 ? a->est : ULAM_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
     if ((a->out || a->all) && a->o.mode == ULAM_ADJOINT && !a->direct)
         return cli_usage_error(cmd, "%s needs --mode shoot or --direct (gathering answers one patch)",
                                a->out ? "--out" : "--all");
-    if (!a->patch && a->o.mode == ULAM_ADJOINT && !a->direct)
+    if (!a->patch && a->o.mode == ULAM_ADJOINT && !a->direct && !a->view)
         return cli_usage_error(cmd, "needs --patch K (gathering answers one patch), --mode shoot or --direct");
     if (a->check && !a->patch) return cli_usage_error(cmd, "--check needs --patch K");
-    if (a->image && a->o.mode == ULAM_ADJOINT && !a->direct)
-        return cli_usage_error(cmd, "--image needs --mode shoot or --direct (gathering answers one patch)");
+    if (a->image && a->o.mode == ULAM_ADJOINT && !a->direct && !a->view)
+        return cli_usage_error(cmd, "--image needs --mode shoot, --direct or --view-gather (gathering answers one "
+                                    "patch)");
     if (!any_rule) a->o.max_walks = 100000;
     return 0;
 }
@@ -376,6 +413,7 @@ typedef struct {
     double *direct_se_all; /* every patch's (--out, --all), NULL when not computed */
     const double *w_all_se_conditional; /* matrix forward walks whose se lack F's noise, or NULL */
     const walked *w;
+    ulam_view_info view; /* --view-gather */
 } report;
 
 /* (walk - direct) / the standard error of the difference at the patch, channel c: matrix walks
@@ -422,6 +460,15 @@ static void print_text(const args *a, const report *r)
                a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
+    if (a->view)
+        printf("view         %lld of %lld patches seen (%lld of %lld pixels), each to %.3g (n_max / n)^%.3g: "
+               "%lld camera rays + %lld walk rays, %.4f s%s\n", (long long)r->view.seen, (long long)r->view.npatches,
+               (long long)r->view.pixels_hit, (long long)r->view.camera_rays, a->o.rel_err, a->coverage,
+               (long long)r->view.camera_rays, (long long)r->view.rays, r->view.seconds,
+               r->view.unmet ? "" : ", every seen patch met its target");
+    if (a->view && r->view.unmet)
+        printf("warning      %lld seen patches stopped short of their target (--walks or --time)\n",
+               (long long)r->view.unmet);
     if (w && w->cut)
         printf("warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
                "             beyond the cut is lost) and the error bar does not cover the bias\n",
@@ -468,12 +515,23 @@ static void print_json(const args *a, const report *r)
             }
         }
         cli_json_string("mode", mode_names[a->o.mode], 0);
-        cli_json_string("estimator", est_names[a->o.estimator], 0);
+        cli_json_string("estimator", est_names[a->est], 0);
+        if (a->est == 2) cli_json_string("mis", mis_names[a->mis > 0 ? a->mis : 0], 0);
         printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, \"cut\": %lld, \"max_steps\": %lld, ",
                a->matrix_walk ? "true" : "false", (long long)w->walks, a->matrix_walk ? "steps" : "rays",
                (long long)w->steps, (long long)w->cut, (long long)a->o.max_steps);
         cli_json_number("seconds", w->seconds, 0);
         printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
+    }
+    if (a->view) {
+        printf("\"view\": {\"seen\": %lld, \"npatches\": %lld, \"pixels_hit\": %lld, \"camera_rays\": %lld, "
+               "\"walks\": %lld, \"rays\": %lld, \"unmet\": %lld, ", (long long)r->view.seen,
+               (long long)r->view.npatches, (long long)r->view.pixels_hit, (long long)r->view.camera_rays,
+               (long long)r->view.walks, (long long)r->view.rays, (long long)r->view.unmet);
+        cli_json_number("rel_err", a->o.rel_err, 0);
+        cli_json_number("coverage", a->coverage, 0);
+        cli_json_number("seconds", r->view.seconds, 1);
+        printf("}, ");
     }
     if (r->F) {
         printf("\"ff_rays\": %lld, ", (long long)a->ff_rays);
@@ -509,11 +567,37 @@ static void print_json(const args *a, const report *r)
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
 }
 
+/* The camera asked for, or the one framing the scene. */
+static ulam_camera camera_of(const args *a, const ulam_scene *s)
+{
+    return a->camera_given ? a->cam : ulam_camera_frame(s, a->width, a->height);
+}
+
+/* --view-gather: the seen patches' answers into w->all; 0 or an exit code. */
+static int view_walks(const args *a, const ulam_tracer *t, const ulam_scene *s, walked *w, ulam_view_info *vi)
+{
+    ulam_camera cam = camera_of(a, s);
+    ulam_error err;
+    w->all = malloc((size_t)s->npatches * 3 * sizeof *w->all);
+    w->all_se = malloc((size_t)s->npatches * 3 * sizeof *w->all_se);
+    if (!w->all || !w->all_se) {
+        err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the solution"};
+        return cli_report(a->scene, &err);
+    }
+    cli_catch_sigint();
+    int status = ulam_view_gather(t, &cam, a->width, a->height, a->coverage, &a->o, w->all, w->all_se, vi, &err);
+    cli_release_sigint();
+    if (status) return cli_report(a->scene, &err);
+    w->walks = vi->walks, w->steps = vi->rays, w->seconds = vi->seconds, w->cut = vi->cut;
+    w->interrupted = vi->interrupted, w->threads = vi->threads;
+    return 0;
+}
+
 /* Render B into a->image, warning when the picture cannot show the light; 0 or an exit code. */
 static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s, const double *B, double *used)
 {
     unsigned char *rgb = malloc((size_t)a->width * (size_t)a->height * 3);
-    ulam_camera cam = a->camera_given ? a->cam : ulam_camera_frame(s, a->width, a->height);
+    ulam_camera cam = camera_of(a, s);
     ulam_render_info info;
     int status = rgb ? ulam_render(t, B, &cam, a->width, a->height, a->exposure, rgb, &info) : ULAM_ENOMEM;
     if (!status) status = ulam_png_write(a->image, a->width, a->height, rgb);
@@ -632,7 +716,7 @@ static patch_values every_patch(const args *a, const report *r, const walked *w,
 /* ulam radiosity. */
 int cli_radiosity(int argc, char **argv)
 {
-    args a = {.ff_rays = 1000, .width = 512, .height = 512, .max_mem = (size_t)4 << 30, .o = ulam_walk_defaults()};
+    args a = {.est = -1, .mis = -1, .coverage = 0.25, .ff_rays = 1000, .width = 512, .height = 512, .max_mem = (size_t)4 << 30, .o = ulam_walk_defaults()};
     a.o.max_walks = 0;
     a.o.interrupt = &cli_interrupted, a.o.share = cli_share;
     int rc = parse(argc, argv, &a);
@@ -644,6 +728,10 @@ int cli_radiosity(int argc, char **argv)
     walked w = {0};
     report r = {.patch = -1, .w = NULL};
     ulam_error err;
+    if (a.est == 2 && a.mis == 2 && cli_rank == 0)
+        fprintf(stderr, "ulam radiosity: warning: --mis none (light sampling alone) has infinite variance at a patch "
+                        "that shares an edge with a light or nearly touches one: there the error bar can be far too "
+                        "small (the edge-lamp scene: z = -4.6); the MIS default is bounded\n");
     if (a.image && (rc = check_output(a.image))) return rc;
     if (a.out && (rc = check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
@@ -665,7 +753,10 @@ int cli_radiosity(int argc, char **argv)
                         "casting resolves it to %.2g of its size (move the scene's parts closer together)\n",
                 a.scene, (long long)coarse + 1, 1.0 / res, res);
     if ((a.direct || a.check || a.matrix_walk) && (rc = form_and_solve(&a, t, s, &r, &F, &Bd))) goto done;
-    if (a.patch || a.o.mode == ULAM_FORWARD) {
+    if (a.view) {
+        if ((rc = view_walks(&a, t, s, &w, &r.view))) goto done;
+        r.w = &w;
+    } else if (a.patch || a.o.mode == ULAM_FORWARD) {
         rc = a.matrix_walk ? matrix_walks(&a, s, F, &w) : ray_walks(&a, t, s->npatches, &w);
         if (rc) goto done;
         if (a.matrix_walk) combine_errors(&r, &w);

@@ -56,6 +56,22 @@ static void cast_pixels(const ulam_tracer *t, const ulam_camera *cam, int w, int
         }
 }
 
+/* How many pixel centres see each patch's front. */
+int ulam_view_pixels(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t *pixels)
+{
+    if (!t || !cam || !pixels || width < 1 || height < 1 || !(cam->focal > 0) || !(cam->film > 0)) return ULAM_EINVAL;
+    size_t np = (size_t)width * (size_t)height;
+    if (np > SIZE_MAX / 8 / 3) return ULAM_EOVERFLOW;
+    int64_t *hit = ulam__malloc(np, sizeof *hit);
+    if (!hit) return ULAM_ENOMEM;
+    cast_pixels(t, cam, width, height, hit);
+    memset(pixels, 0, (size_t)ulam__tracer_scene(t)->npatches * sizeof *pixels);
+    for (size_t k = 0; k < np; k++)
+        if (hit[k] >= 0) pixels[hit[k]]++;
+    free(hit);
+    return ULAM_OK;
+}
+
 /* A camera that frames the scene's bounding box: looking along +z at its centre from the -z
  * side, up +y, with the Cornell lens (35 mm, 25 mm film), just far enough (3% margin) that the
  * box's near face fills the wider of the two directions of a width x height picture; the

@@ -15,6 +15,16 @@
  * particle stops), and the particle survives with q_j, its weights becoming rho_jc W_c / q_j.
  * Then B_j = E_j + R_j / A_j.
  *
+ * Next-event gathering (ULAM_NEXT_EVENT*) scores E_i at the start and, at every patch p a
+ * walk visits, one light sample: a point y on an emitter l drawn with area density
+ * p_L(y) = sum_c E_lc / P (P = sum_l A_l sum_c E_lc) and a uniform point x of p, scoring
+ * W rho_p E_l G(x, y) / p_L(y) w_L with G = cos cos_l / (pi r^2) when the shadow ray sees y.
+ * The walk's cosine ray from p that lands on an emitter j at y scores W' E_j w_C, where
+ * p_C(y) = G(x, y) is the area density of that landing point.  w_L + w_C = 1 (power or
+ * balance heuristic of p_L and p_C; w_L = 1, w_C = 0 for light sampling alone), so each
+ * patch's direct term rho_p sum_j F_pj E_j is counted once in expectation; x is uniform on p
+ * in both strategies, so the expectation is the patch-averaged F_pj (README).
+ *
  * As in ulam_solve, block k of walks draws from the stream (seed, k) and blocks merge in
  * index order: the result does not depend on the number of threads. */
 #include "rad.h"
@@ -88,8 +98,9 @@ static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, ulam_error 
 {
     if (o->mode != ULAM_ADJOINT && o->mode != ULAM_FORWARD)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "mode gathering (adjoint) or shooting (forward)");
-    if (o->estimator != ULAM_COLLISION && o->estimator != ULAM_ABSORPTION)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision or absorption");
+    int nee = o->estimator >= ULAM_NEXT_EVENT && o->estimator <= ULAM_NEXT_EVENT_LIGHT;
+    if (o->estimator != ULAM_COLLISION && o->estimator != ULAM_ABSORPTION && !(nee && o->mode == ULAM_ADJOINT))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision or absorption (next-event: gathering only)");
     if (o->index < 0 || o->index >= sc->npatches)
         return ulam__fail(err, ULAM_EINVAL, 0, o->index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
     if (o->continue_q != 0 || o->roulette != 0 || o->split != 0)
@@ -119,7 +130,8 @@ static int build_source(ulam_rad_solver *s, ulam_error *err)
             s->cdf[s->nem++] = s->ptot;
         }
     }
-    if (s->nem == 0) return ulam__fail(err, ULAM_EUNDEFINED, 0, -1, "an emitting patch (Ke > 0) to shoot from");
+    if (s->nem == 0 && s->o.mode == ULAM_FORWARD)
+        return ulam__fail(err, ULAM_EUNDEFINED, 0, -1, "an emitting patch (Ke > 0) to shoot from");
     return ULAM_OK;
 }
 
@@ -162,7 +174,7 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam
     s->s = ulam__tracer_scene(t);
     s->threads = ulam__threads(o.threads);
     s->t0 = -1;
-    if (o.mode == ULAM_FORWARD && (status = build_source(s, err))) {
+    if ((o.mode == ULAM_FORWARD || o.estimator >= ULAM_NEXT_EVENT) && (status = build_source(s, err))) {
         ulam_rad_solver_free(s);
         return status;
     }
@@ -203,6 +215,78 @@ static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_b
     }
 }
 
+/* The weight of a strategy of density a against the other's b: the power heuristic (exponent 2),
+ * the balance heuristic, or 1 for light sampling alone (whose partner then gets 0).  In the
+ * ratio form, a landing point at distance 0 (a = inf) gets weight 1, not NaN. */
+static double mis_weight(int estimator, double a, double b, int light)
+{
+    if (estimator == ULAM_NEXT_EVENT_LIGHT) return light ? 1.0 : 0.0;
+    double r = b / a;
+    return estimator == ULAM_NEXT_EVENT_BALANCE ? 1.0 / (1.0 + r) : 1.0 / (1.0 + r * r);
+}
+
+/* The emitter drawn in proportion to power from u in [0, ptot). */
+static int64_t pick_emitter(const ulam_rad_solver *s, double u)
+{
+    int64_t lo = 0, hi = s->nem - 1;
+    while (lo < hi) { /* the first emitter whose cumulative power exceeds u */
+        int64_t mid = lo + (hi - lo) / 2;
+        if (s->cdf[mid] > u) hi = mid;
+        else lo = mid + 1;
+    }
+    return s->emitter[lo];
+}
+
+/* Next event at patch p: one light sample's score, weighted, added to score (W before p's
+ * reflection). */
+static void light_sample(const ulam_rad_solver *s, ulam_rng *r, int64_t p, const double W[3], double score[3],
+                         rad_block *br)
+{
+    const ulam_scene *sc = s->s;
+    int64_t l = pick_emitter(s, ulam__rng_uniform(r) * s->ptot);
+    double x[3], y[3];
+    ulam__tracer_point(s->t, p, r, x);
+    ulam__tracer_point(s->t, l, r, y);
+    ulam__hit h;
+    int seen = ulam__tracer_sees(s->t, p, x, l, y, &h);
+    br->rays += h.cos_from > 0 && h.cos_to > 0 && p != l; /* a shadow ray was cast */
+    if (!seen) return;
+    const double *E = sc->emit + 3 * l, *rho = sc->rho + 3 * p;
+    double pl = (E[0] + E[1] + E[2]) / s->ptot, G = h.cos_from * h.cos_to / (M_PI * h.dist * h.dist);
+    double f = G / pl * mis_weight(s->o.estimator, pl, G, 1);
+    for (int c = 0; c < 3; c++) score[c] += W[c] * rho[c] * E[c] * f;
+}
+
+/* One next-event gathering walk from the patch: its RGB score. */
+static void gather_next_event(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_block *br)
+{
+    const ulam_scene *sc = s->s;
+    int64_t p = s->o.index;
+    double W[3] = {1, 1, 1};
+    for (int c = 0; c < 3; c++) score[c] = sc->emit[3 * p + c];
+    for (int64_t step = 0;; step++) {
+        double q = s->q[p];
+        if (q > 0 && s->nem) light_sample(s, r, p, W, score, br);
+        if (ulam__rng_uniform(r) >= q) return;
+        if (step >= s->o.max_steps) {
+            br->cut++;
+            return;
+        }
+        for (int c = 0; c < 3; c++) W[c] *= sc->rho[3 * p + c] / q;
+        ulam__hit h;
+        int64_t j = ulam__tracer_shoot_hit(s->t, p, r, &h);
+        br->rays++;
+        if (j < 0) return;
+        const double *E = sc->emit + 3 * j;
+        double esum = E[0] + E[1] + E[2];
+        if (esum > 0) { /* the walk's own hit on an emitter, weighted against light sampling */
+            double pc = h.cos_from * h.cos_to / (M_PI * h.dist * h.dist), w = mis_weight(s->o.estimator, pc, esum / s->ptot, 0);
+            for (int c = 0; c < 3; c++) score[c] += W[c] * E[c] * w;
+        }
+        p = j;
+    }
+}
+
 /* Add w to the history tally of patch p. */
 static void tally(rad_scratch *sc, int64_t p, const double w[3], double scale)
 {
@@ -217,14 +301,7 @@ static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_bl
 {
     const ulam_scene *scn = s->s;
     int absorb = s->o.estimator == ULAM_ABSORPTION;
-    double u = ulam__rng_uniform(r) * s->ptot;
-    int64_t lo = 0, hi = s->nem - 1;
-    while (lo < hi) { /* the first emitter whose cumulative power exceeds u */
-        int64_t mid = lo + (hi - lo) / 2;
-        if (s->cdf[mid] > u) hi = mid;
-        else lo = mid + 1;
-    }
-    int64_t p = s->emitter[lo];
+    int64_t p = pick_emitter(s, ulam__rng_uniform(r) * s->ptot);
     const double *E0 = scn->emit + 3 * p;
     double W[3], esum = E0[0] + E0[1] + E0[2];
     for (int c = 0; c < 3; c++) W[c] = s->ptot * E0[c] / esum;
@@ -283,7 +360,8 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     for (int64_t w = 0; w < count; w++) {
         if (s->o.mode == ULAM_ADJOINT) {
             double sc[3];
-            gather(s, &r, sc, br);
+            if (s->o.estimator >= ULAM_NEXT_EVENT) gather_next_event(s, &r, sc, br);
+            else gather(s, &r, sc, br);
             for (int c = 0; c < 3; c++) {
                 ulam__moments_add(&br->m[c], sc[c]);
                 if (!isfinite(sc[c])) br->nonfinite++;
@@ -378,6 +456,19 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(&r, s->o.rel_err)) s->done = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && all_zero(&r)) s->done = s->zero = 1; /* can never be met */
     return s->status;
+}
+
+/* Restart a gathering solver at patch p with relative target rel_err and seed: the statistics
+ * are cleared, the workspace kept (so that many patches cost no allocation). */
+void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds)
+{
+    ulam__moments zero = {0};
+    s->o.index = p, s->o.rel_err = rel_err, s->o.seed = seed, s->o.max_seconds = max_seconds;
+    s->m[0] = s->m[1] = s->m[2] = zero;
+    s->sq = s->maxsq = s->seconds = 0.0;
+    s->walks = s->rays = s->cut = s->nonfinite = s->next_walk = 0;
+    s->t0 = -1;
+    s->done = s->interrupted = s->zero = s->status = 0;
 }
 
 /* Nonzero once a stopping rule is met. */

@@ -49,8 +49,28 @@ void ulam__cosine_dir(const double n[3], ulam_rng *r, double d[3]);
  * outside a closed room sees into it), or -1. */
 int64_t ulam__tracer_cast_front(const ulam_tracer *t, const double org[3], const double dir[3]);
 
+/* Where a ray landed: its length and the cosines at its two ends (at the patch it left, and
+ * at the patch it reached, positive on its front). */
+typedef struct {
+    double dist, cos_from, cos_to;
+} ulam__hit;
+
+/* ulam_tracer_shoot, and where the ray lands (h may be NULL). */
+int64_t ulam__tracer_shoot_hit(const ulam_tracer *t, int64_t p, ulam_rng *r, ulam__hit *h);
+
+/* A uniform point of patch p. */
+void ulam__tracer_point(const ulam_tracer *t, int64_t p, ulam_rng *r, double pt[3]);
+
+/* A shadow ray: nonzero when the segment from x (on patch p) to y (on patch l) leaves p's front,
+ * reaches l's front and meets no other patch on the way; *h gets its length and cosines. */
+int ulam__tracer_sees(const ulam_tracer *t, int64_t p, const double x[3], int64_t l, const double y[3], ulam__hit *h);
+
 /* The scene a tracer was built on. */
 const ulam_scene *ulam__tracer_scene(const ulam_tracer *t);
+
+/* Restart a gathering solver at patch p (rel_err, seed and max_seconds replaced), its
+ * statistics cleared and its workspace kept. */
+void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds);
 
 /* Allocate an empty scene with room for the given counts (arrays uninitialised). */
 ulam_scene *ulam__scene_alloc(int64_t npatches, int64_t nverts, int64_t nidx, int64_t ngroups);

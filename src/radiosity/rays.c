@@ -151,9 +151,10 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
     return ULAM_OK;
 }
 
-/* The first patch other than self the ray hits (with cull, the first whose front it hits), or -1. */
+/* The first patch other than self the ray hits (with cull, the first whose front it hits), or -1;
+ * *dist (may be NULL) its distance. */
 static int64_t cast_from(const ulam_tracer *t, const double org[3], const double dir[3], int64_t self, int cull,
-                         int *front)
+                         int *front, double *dist)
 {
     ray_context rc = {.t = t, .self = self, .cull = cull ? dir : NULL};
     rtcInitIntersectContext(&rc.ctx);
@@ -173,28 +174,63 @@ static int64_t cast_from(const ulam_tracer *t, const double org[3], const double
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
     int64_t p = t->prim_patch[rh.hit.primID];
     if (front) *front = ulam__dot3(dir, t->s->normal + 3 * p) < 0;
+    if (dist) *dist = rh.ray.tfar;
     return p;
 }
 
 /* The first patch the ray hits, or -1. */
 int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3], int *front)
 {
-    return cast_from(t, org, dir, -1, 0, front);
+    return cast_from(t, org, dir, -1, 0, front, NULL);
 }
 
 /* The first patch whose front the ray hits (back sides are seen through), or -1. */
 int64_t ulam__tracer_cast_front(const ulam_tracer *t, const double org[3], const double dir[3])
 {
-    return cast_from(t, org, dir, -1, 1, NULL);
+    return cast_from(t, org, dir, -1, 1, NULL, NULL);
 }
 
 /* A cosine-distributed ray from a uniform point of patch p: the patch reached, front side. */
 int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r)
 {
-    double o[3], d[3];
+    return ulam__tracer_shoot_hit(t, p, r, NULL);
+}
+
+/* The same, and where it lands (h may be NULL). */
+int64_t ulam__tracer_shoot_hit(const ulam_tracer *t, int64_t p, ulam_rng *r, ulam__hit *h)
+{
+    double o[3], d[3], dist = 0.0;
     ulam__patch_point(t->s, p, t->share[p], r, o);
     ulam__cosine_dir(t->s->normal + 3 * p, r, d);
     int front = 0;
-    int64_t j = cast_from(t, o, d, p, 0, &front);
-    return j >= 0 && front ? j : -1;
+    int64_t j = cast_from(t, o, d, p, 0, &front, &dist);
+    if (j < 0 || !front) return -1;
+    if (h) {
+        h->dist = dist;
+        h->cos_from = ulam__dot3(d, t->s->normal + 3 * p);
+        h->cos_to = -ulam__dot3(d, t->s->normal + 3 * j);
+    }
+    return j;
+}
+
+/* A uniform point of patch p. */
+void ulam__tracer_point(const ulam_tracer *t, int64_t p, ulam_rng *r, double pt[3])
+{
+    ulam__patch_point(t->s, p, t->share[p], r, pt);
+}
+
+/* Nonzero when the segment from x (on patch p) to y (on patch l) leaves p's front, reaches l's
+ * front and meets no other patch first; *h gets the distance and the two cosines either way. */
+int ulam__tracer_sees(const ulam_tracer *t, int64_t p, const double x[3], int64_t l, const double y[3], ulam__hit *h)
+{
+    double d[3];
+    ulam__sub3(y, x, d);
+    double r = sqrt(ulam__dot3(d, d));
+    h->dist = r, h->cos_from = h->cos_to = 0.0;
+    if (!(r > 0)) return 0;
+    for (int k = 0; k < 3; k++) d[k] /= r;
+    h->cos_from = ulam__dot3(d, t->s->normal + 3 * p);
+    h->cos_to = -ulam__dot3(d, t->s->normal + 3 * l);
+    if (!(h->cos_from > 0) || !(h->cos_to > 0) || p == l) return 0; /* from a back side, or at a light's back */
+    return cast_from(t, x, d, p, 0, NULL, NULL) == l;
 }

@@ -1,17 +1,26 @@
-/* Benchmark: one patch of the Cornell box to 1% relative error by gathering walks that cast
- * rays, against forming F by ray casting and solving the three channels with LAPACK.
+/* Benchmark: radiosity queries on the Cornell box, every route side by side in one run.
  *
- * The box is subdivided to about 2,000, 10,000 and 40,000 patches.  The walk answers the
- * floor's middle patch (the label's patch containing its area centroid) with the collision estimator,
- * stopping at 1% on every channel.  The direct route forms F with 1000 rays a patch and calls
- * ulam_radiosity_direct (skipped when the dense matrix exceeds 4 GB); its own error at the
- * patch from the noise of F is reported, with the rays a patch it would need for 1% and the
- * time that projects to.  Usage: bench_radiosity [scene.obj] (run from the source root). */
+ * 1. One patch (the floor's: the label's patch containing its area centroid) to 1% relative
+ *    error on R, G and B at about 2,000, 10,000 and 40,000 patches: collision gathering and
+ *    next-event gathering with MIS (power heuristic), against forming F by ray casting with
+ *    1000 rays a patch and solving the three channels with LAPACK (measured where the dense
+ *    matrix fits in 4 GB; beyond, extrapolated from the largest measured size: F's time in
+ *    proportion to the patches, LAPACK's to their cube).
+ * 2. Patches next to a light, a fixed number of walks for each estimator: the Cornell ceiling
+ *    patch beside the light, and tests/data/rad/edge_lamp.obj (a wall sharing an edge with a
+ *    lamp, exact answer 0.5 F(C-14)): the variance a walk, the largest score's share of the sum
+ *    of squares, and (edge lamp) z against the exact answer.
+ * 3. An image at about 40,000 patches (W x H, default 16x16): --view-gather at 1% on every
+ *    seen patch (coverage 0), against shooting (a run of P particles, default 2,000,000,
+ *    projected to the particles that bring every seen patch to 1%: P (worst rel. error / 1%)^2)
+ *    and against the direct route (what it would need).
+ * Usage: bench_radiosity [scene.obj [WxH [P]]] (run from the source root). */
 #include "ulam.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* The Cornell box subdivided to about target patches (bisection on the side length). */
 static ulam_scene *subdivided(const ulam_scene *s, int64_t target)
@@ -36,9 +45,79 @@ static ulam_scene *subdivided(const ulam_scene *s, int64_t target)
     return best;
 }
 
+/* Gather at patch p with estimator est until rel_err (or walks, when rel_err is 0). */
+static ulam_rad_result gather(const ulam_tracer *t, int est, int64_t p, double rel_err, int64_t walks)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = p, o.estimator = est, o.max_walks = walks, o.rel_err = rel_err, o.seed = 1;
+    ulam_rad_solver *sv = NULL;
+    ulam_rad_result r = {0};
+    if (ulam_rad_solver_alloc(t, &o, &sv, NULL)) return r;
+    while (!ulam_rad_solver_done(sv)) ulam_rad_solver_iterate(sv);
+    ulam_rad_solver_result(sv, &r);
+    ulam_rad_solver_free(sv);
+    return r;
+}
+
+/* The largest relative standard error over the channels. */
+static double worst_rel(const double *B, const double *se)
+{
+    double w = 0;
+    for (int c = 0; c < 3; c++)
+        if (B[c] != 0) w = fmax(w, se[c] / fabs(B[c]));
+    return w;
+}
+
+/* The ceiling patch beside the light: nearest (by centroid) to the point just past the light's
+ * largest-x edge, at the ceiling's height. */
+static int64_t beside_light(const ulam_scene *s)
+{
+    double hi = -INFINITY, lc[3], cc[3];
+    if (ulam_scene_label_centroid(s, "light", lc) || ulam_scene_label_centroid(s, "ceiling", cc)) return -1;
+    for (int64_t p = 0; p < s->npatches; p++)
+        if (s->group[p] >= 0 && !strcmp(s->groups[s->group[p]], "light"))
+            for (int64_t k = s->start[p]; k < s->start[p + 1]; k++) hi = fmax(hi, s->vert[3 * s->vidx[k]]);
+    int64_t best = -1;
+    double bd = INFINITY;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        if (s->group[p] < 0 || strcmp(s->groups[s->group[p]], "ceiling")) continue;
+        double c[3];
+        ulam_scene_centroid(s, p, c);
+        double dx = c[0] - (hi + 0.5 * sqrt(s->area[p])), dz = c[2] - lc[2], d = dx * dx + dz * dz;
+        if (d < bd) bd = d, best = p;
+    }
+    return best;
+}
+
+static const int ests[4] = {ULAM_COLLISION, ULAM_NEXT_EVENT, ULAM_NEXT_EVENT_BALANCE, ULAM_NEXT_EVENT_LIGHT};
+static const char *const est_name[4] = {"collision", "next-event MIS power", "next-event MIS balance",
+                                        "next-event light only"};
+
+/* Part 2: the estimators at patch p, walks each; exact < 0 when unknown. */
+static void near_light(const char *what, const ulam_tracer *t, int64_t p, int64_t walks, double exact)
+{
+    printf("\n%s (patch %lld), %lld walks each\n\n", what, (long long)p + 1, (long long)walks);
+    printf("| estimator | R | stderr | variance a walk (R) | ratio to collision | largest share | rays | z vs exact |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    double v0 = 0;
+    for (int k = 0; k < 4; k++) {
+        ulam_rad_result r = gather(t, ests[k], p, 0, walks);
+        double v = r.std_error[0] * r.std_error[0] * (double)r.walks;
+        if (k == 0) v0 = v;
+        printf("| %s | %.6g | %.3g | %.4g | %.3f | %.3g | %lld |", est_name[k], r.radiosity[0], r.std_error[0], v,
+               v / v0, r.max_share, (long long)r.rays);
+        if (exact >= 0) printf(" %+.2f |\n", (r.radiosity[0] - exact) / r.std_error[0]);
+        else printf(" |\n");
+        fflush(stdout);
+    }
+}
+
 int main(int argc, char **argv)
 {
     const char *path = argc > 1 ? argv[1] : "examples/scenes/cornell_box.obj";
+    int W = 16, H = 16;
+    if (argc > 2 && (sscanf(argv[2], "%dx%d", &W, &H) != 2 || W < 1 || H < 1)) return 2;
+    int64_t P = argc > 3 ? atoll(argv[3]) : 2000000;
     ulam_scene *s0 = NULL;
     ulam_error err;
     if (ulam_scene_read_obj(path, &s0, &err)) {
@@ -46,43 +125,36 @@ int main(int argc, char **argv)
         return 1;
     }
     const int64_t targets[3] = {2000, 10000, 40000}, ff_rays = 1000;
-    printf("Cornell box, one patch (floor, middle) to 1%% relative error on R, G and B\n\n");
-    printf("| patches | walk s | walks | rays | M rays/s | F (1000 rays/patch) s | LAPACK s | direct total s "
-           "| speed-up | direct's own error | rays/patch for 1%% | direct at 1%%, projected s |\n");
+    printf("1. Cornell box, one patch (floor) to 1%% relative error on R, G and B\n\n");
+    printf("| patches | collision s | rays | next-event s | rays | rays ratio | time ratio | F (1000 rays/patch) s "
+           "| LAPACK s | direct total s | speed-up over collision | speed-up over next-event |\n");
     printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    double f_per_patch = 0, lapack_n = 0, lapack_s = 0;
     for (int k = 0; k < 3; k++) {
         ulam_scene *s = subdivided(s0, targets[k]);
         ulam_tracer *t = NULL;
         int64_t p = 0;
         if (!s || ulam_tracer_alloc(s, &t, &err) || ulam_scene_find(s, "floor", &p)) return 1;
-        ulam_walk_opts o = ulam_walk_defaults();
-        o.index = p, o.max_walks = 0, o.rel_err = 0.01, o.seed = 1;
-        ulam_rad_solver *sv = NULL;
-        if (ulam_rad_solver_alloc(t, &o, &sv, &err)) return 1;
-        while (!ulam_rad_solver_done(sv)) ulam_rad_solver_iterate(sv);
-        ulam_rad_result r;
-        ulam_rad_solver_result(sv, &r);
-        ulam_rad_solver_free(sv);
-        printf("| %lld | %.3f | %lld | %lld | %.2f |", (long long)s->npatches, r.seconds, (long long)r.walks,
-               (long long)r.rays, (double)r.rays / r.seconds / 1e6);
+        ulam_rad_result c = gather(t, ULAM_COLLISION, p, 0.01, 0), e = gather(t, ULAM_NEXT_EVENT, p, 0.01, 0);
+        printf("| %lld | %.3f | %lld | %.4f | %lld | %.1f | %.1f |", (long long)s->npatches, c.seconds,
+               (long long)c.rays, e.seconds, (long long)e.rays, (double)c.rays / (double)e.rays, c.seconds / e.seconds);
         size_t bytes = ulam_direct_bytes(s->npatches);
         if (bytes == 0 || bytes > ((size_t)4 << 30)) {
-            printf(" not run | %.1f GB dense: over the 4 GB limit | | | | | |\n", (double)bytes / 1e9);
+            double n = (double)s->npatches, tf = f_per_patch * n, tl = lapack_s * pow(n / lapack_n, 3);
+            printf(" %.1f (extrapolated) | %.0f (extrapolated, n^3 from %.0f; %.1f GB dense) | %.0f | %.0fx | %.0fx |\n",
+                   tf, tl, lapack_n, (double)bytes / 1e9, tf + tl, (tf + tl) / c.seconds, (tf + tl) / e.seconds);
         } else {
             ulam_csr *F = NULL;
             double t0 = ulam_now();
             if (ulam_form_factors(t, ff_rays, 1, 0, &F, &err)) return 1;
             double tf = ulam_now() - t0;
-            double *B = malloc((size_t)(3 * s->npatches) * sizeof *B), se[3];
+            double *B = malloc((size_t)(3 * s->npatches) * sizeof *B);
             ulam_direct_info info;
             if (ulam_radiosity_direct(s, F, 0, B, &info, &err)) return 1;
-            ulam_radiosity_direct_error(s, F, ff_rays, B, p, 0, se, &err);
-            double rel = 0;
-            for (int c = 0; c < 3; c++) rel = fmax(rel, se[c] / B[3 * p + c]);
-            double need = (double)ff_rays * (rel / 0.01) * (rel / 0.01);
-            double total = tf + info.seconds, projected = tf * need / (double)ff_rays + info.seconds;
-            printf(" %.2f | %.2f | %.2f | %.0fx | %.1f%% | %.3g | %.3g (%.0fx) |\n", tf, info.seconds, total,
-                   total / r.seconds, 100 * rel, need, projected, projected / r.seconds);
+            double total = tf + info.seconds;
+            f_per_patch = tf / (double)s->npatches, lapack_n = (double)s->npatches, lapack_s = info.seconds;
+            printf(" %.2f | %.2f | %.2f | %.0fx | %.0fx |\n", tf, info.seconds, total, total / c.seconds,
+                   total / e.seconds);
             free(B);
             ulam_csr_free(F);
         }
@@ -90,6 +162,80 @@ int main(int argc, char **argv)
         ulam_tracer_free(t);
         ulam_scene_free(s);
     }
+    { /* 2. next to a light */
+        ulam_scene *s = subdivided(s0, 10000), *el = NULL;
+        ulam_tracer *t = NULL, *te = NULL;
+        int64_t q = s && !ulam_tracer_alloc(s, &t, &err) ? beside_light(s) : -1;
+        if (q >= 0) near_light("2a. Cornell box at ~10,000 patches, the ceiling patch beside the light", t, q, 200000, -1);
+        if (!ulam_scene_read_obj("tests/data/rad/edge_lamp.obj", &el, &err) && !ulam_tracer_alloc(el, &te, &err))
+            near_light("2b. edge_lamp.obj: a wall sharing an edge with the lamp, exact 0.5 F(C-14)", te, 1, 200000,
+                       0.5 * ulam_ff_perpendicular_rectangles(1, 1, 1));
+        ulam_tracer_free(te), ulam_tracer_free(t);
+        ulam_scene_free(el), ulam_scene_free(s);
+    }
+
+    /* 3. an image at ~40,000 patches */
+    ulam_scene *s = subdivided(s0, 40000);
+    ulam_tracer *t = NULL;
+    if (!s || ulam_tracer_alloc(s, &t, &err)) return 1;
+    int64_t n = s->npatches;
+    ulam_camera cam = ulam_camera_frame(s, W, H);
+    double *B = malloc((size_t)(3 * n) * sizeof *B), *se = malloc((size_t)(3 * n) * sizeof *se);
+    double *Bs = malloc((size_t)(3 * n) * sizeof *Bs), *ses = malloc((size_t)(3 * n) * sizeof *ses);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.estimator = ULAM_NEXT_EVENT, o.max_walks = 0, o.rel_err = 0.01, o.seed = 1;
+    ulam_view_info vi;
+    if (!B || !se || !Bs || !ses || ulam_view_gather(t, &cam, W, H, 0.0, &o, B, se, &vi, &err)) return 1;
+    ulam_walk_opts so = ulam_walk_defaults();
+    so.mode = ULAM_FORWARD, so.max_walks = P, so.seed = 1;
+    ulam_rad_solver *sv = NULL;
+    if (ulam_rad_solver_alloc(t, &so, &sv, &err)) return 1;
+    while (!ulam_rad_solver_done(sv)) ulam_rad_solver_iterate(sv);
+    ulam_rad_result sr;
+    ulam_rad_solver_result(sv, &sr);
+    ulam_rad_solver_vectors(sv, Bs, ses);
+    ulam_rad_solver_free(sv);
+    int64_t *pix = malloc((size_t)n * sizeof *pix);
+    if (!pix || ulam_view_pixels(t, &cam, W, H, pix)) return 1;
+    double worst = 0, worst_view = 0, *rel = malloc((size_t)n * sizeof *rel);
+    int64_t m = 0;
+    for (int64_t p = 0; p < n; p++) {
+        if (!pix[p]) continue;
+        double w = worst_rel(Bs + 3 * p, ses + 3 * p);
+        worst = fmax(worst, w), rel[m++] = w;
+        worst_view = fmax(worst_view, worst_rel(B + 3 * p, se + 3 * p));
+    }
+    double median = 0;
+    if (m) { /* the median by a partial sort would do; m is small */
+        for (int64_t i = 1; i < m; i++)
+            for (int64_t j = i; j > 0 && rel[j - 1] > rel[j]; j--) {
+                double x = rel[j];
+                rel[j] = rel[j - 1], rel[j - 1] = x;
+            }
+        median = rel[m / 2];
+    }
+    double need = (double)P * (worst / 0.01) * (worst / 0.01), need_med = (double)P * (median / 0.01) * (median / 0.01);
+    double proj = sr.seconds * need / (double)P, proj_med = sr.seconds * need_med / (double)P;
+    printf("\n3. An image of the Cornell box at %lld patches, %dx%d, every seen patch to 1%%\n\n", (long long)n, W, H);
+    printf("| route | patches solved | rays | seconds | worst seen patch's rel. error | ratio to view-gather |\n");
+    printf("|---|---:|---:|---:|---:|---:|\n");
+    printf("| --view-gather (next-event MIS, coverage 0) | %lld of %lld | %lld + %lld camera | %.2f | %.4f | 1 |\n",
+           (long long)vi.seen, (long long)n, (long long)vi.rays, (long long)vi.camera_rays, vi.seconds, worst_view);
+    printf("| shooting, %lld particles (measured) | all %lld | %lld | %.2f | %.3f (median %.3f) | %.2f |\n",
+           (long long)P, (long long)n, (long long)sr.rays, sr.seconds, worst, median, sr.seconds / vi.seconds);
+    printf("| shooting to 1%% on the worst seen patch (projected: %.3g particles) | all | %.3g | %.0f | 0.01 | %.0fx |\n",
+           need, (double)sr.rays * need / (double)P, proj, proj / vi.seconds);
+    printf("| shooting to 1%% on the median seen patch (projected: %.3g particles) | all | %.3g | %.0f | 0.01 | %.0fx |\n",
+           need_med, (double)sr.rays * need_med / (double)P, proj_med, proj_med / vi.seconds);
+    size_t bytes = ulam_direct_bytes(n);
+    double tf = f_per_patch * (double)n, tl = lapack_s * pow((double)n / lapack_n, 3);
+    printf("| direct: F (1000 rays/patch) + LAPACK (extrapolated from %.0f patches) | all | %.3g | %.0f | "
+           "F's noise, not 1%% | %.0fx |\n", lapack_n, (double)n * ff_rays, tf + tl, (tf + tl) / vi.seconds);
+    printf("\nThe direct route needs %.1f GB for one dense %lld x %lld matrix (ulam_direct_bytes), over the 4 GB "
+           "default limit.\n", (double)bytes / 1e9, (long long)n, (long long)n);
+    free(B), free(se), free(Bs), free(ses), free(pix), free(rel);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
     ulam_scene_free(s0);
     return 0;
 }
