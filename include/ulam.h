@@ -21,6 +21,9 @@ extern "C" {
 
 #include "ulam_version.h" /* ULAM_VERSION, _MAJOR, _MINOR, _PATCH */
 
+/* The standard normal's 97.5% quantile: every 95% interval is estimate -+ ULAM_Z95 stderr. */
+#define ULAM_Z95 1.959963984540054
+
 /* ---------------------------------------------------------------- status codes */
 
 enum ulam_status {

@@ -25,13 +25,6 @@
  * what the pass costs (the rent-or-buy rule), and a run that far will likely reach the rest. */
 enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = 4 };
 
-/* The rel_err rule (derived in README.md, "When to trust the error bar"): at least REL_MIN
- * walks; the empirical-Bernstein range term 3 ln(3 / delta) R / N at delta = 0.05 within
- * E |estimate| (so N >= EB_RANGE R / (E |estimate|)); the variance's own relative standard
- * error at most VAR_REL_MAX. */
-#define REL_MIN 1000
-#define EB_RANGE 12.283413301 /* 3 ln(60) */
-#define VAR_REL_MAX 0.25
 #define TAIL_E 0.01 /* the target a run without rel_err reports its tail_bound at */
 
 struct ulam_solver {
@@ -534,11 +527,11 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
 {
     double E = s->o.rel_err, m = fabs(r->estimate);
-    if (!(E > 0) || s->var_finite != 1 || r->walks < REL_MIN) return 0;
+    if (!(E > 0) || s->var_finite != 1 || r->walks < ULAM__REL_MIN) return 0;
     if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
     if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.index] == 0))
         return 0;
-    return r->std_error <= E * m && (double)r->walks >= r->min_walks && r->variance_rel_error <= VAR_REL_MAX;
+    return ulam__rel_err_holds(r->walks, m, r->std_error, r->min_walks, r->variance_rel_error, E);
 }
 
 /* Run one round of walks. */
@@ -602,11 +595,8 @@ static void forward_component(const ulam_solver *s, int64_t i, double *est, doub
  * INFINITY when no bound holds (qmax = 1, weights that can grow). */
 static double score_range(const ulam_solver *s, double m, double E)
 {
-    if (isfinite(s->range) || s->bound == 0.0) return s->range;
-    if (s->per_step == 0.0) return 0.0;
-    if (!isfinite(s->per_step) || !(s->qmax < 1.0) || !(m > 0)) return INFINITY;
-    double steps = s->qmax > 0 ? ceil(log(s->per_step / (E * m * (1.0 - s->qmax))) / log(1.0 / s->qmax)) : 0.0;
-    return s->per_step * fmax(1.0, steps + 1.0) * (s->signs ? 2.0 : 1.0);
+    if (s->bound == 0.0) return s->range;
+    return ulam__score_range(s->range, s->per_step, s->qmax, s->signs, m, E);
 }
 
 /* The result so far; the forward count of unreached components (O(n)) when asked. */
@@ -633,10 +623,9 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     double R = score_range(s, m, E);
     r->score_bound = s->bound;
     r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
-    r->min_walks = !(s->o.rel_err > 0) || !isfinite(R) || R == 0.0 ? 0.0
-                   : m > 0 ? ceil(EB_RANGE * R / (s->o.rel_err * m)) : INFINITY;
+    r->min_walks = ulam__rel_min_walks(R, s->o.rel_err, m);
     r->rel_err_met = s->met;
-    double half = s->var_finite == 1 ? 1.959963984540054 * r->std_error : NAN;
+    double half = s->var_finite == 1 ? ULAM_Z95 * r->std_error : NAN;
     r->ci95[0] = r->estimate - half;
     r->ci95[1] = r->estimate + half;
     r->walks = s->walks;

@@ -49,3 +49,28 @@ double ulam__moments_variance_rel_error(const ulam__moments *m)
     double N = (double)m->n, s2 = m->m2 / (N - 1.0), mu4 = m->m4 / N;
     return sqrt(fmax(0.0, mu4 - s2 * s2) / N) / s2;
 }
+
+/* The range of a single score the rel_err rule uses. */
+double ulam__score_range(double range, double per_step, double qmax, int signs, double m, double E)
+{
+    if (isfinite(range) || range == 0.0) return range;
+    if (per_step == 0.0) return 0.0;
+    if (!isfinite(per_step) || !(qmax < 1.0) || !(m > 0) || !(E > 0)) return INFINITY;
+    double steps = qmax > 0 ? ceil(log(per_step / (E * m * (1.0 - qmax))) / log(1.0 / qmax)) : 0.0;
+    return per_step * fmax(1.0, steps + 1.0) * (signs ? 2.0 : 1.0);
+}
+
+/* The walks the range term needs. */
+double ulam__rel_min_walks(double R, double E, double m)
+{
+    if (!(E > 0) || !isfinite(R) || R == 0.0) return 0.0;
+    return m > 0 ? ceil(ULAM__EB_RANGE * R / (E * m)) : INFINITY;
+}
+
+/* Whether the rel_err rule holds. */
+int ulam__rel_err_holds(int64_t n, double m, double se, double min_walks, double var_rel_error, double E)
+{
+    m = fabs(m);
+    return E > 0 && n >= ULAM__REL_MIN && m > 0 && se <= E * m && (double)n >= min_walks &&
+           var_rel_error <= ULAM__VAR_REL_MAX;
+}

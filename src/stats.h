@@ -26,4 +26,27 @@ double ulam__moments_variance(const ulam__moments *m);
  * sample has seen a rare large score only a few times.  INFINITY when the variance is 0. */
 double ulam__moments_variance_rel_error(const ulam__moments *m);
 
+/* The rel_err stopping rule, shared by matrix and patch walks (derived in README.md, "When to
+ * trust the error bar"): at least ULAM__REL_MIN walks; stderr <= E |m|; the empirical-Bernstein
+ * range term 3 ln(3 / delta) R / N at delta = 0.05 within E |m|, so N >= ULAM__EB_RANGE R /
+ * (E |m|); the variance's own relative standard error at most ULAM__VAR_REL_MAX. */
+#define ULAM__REL_MIN 1000
+#define ULAM__EB_RANGE 12.283413301 /* 3 ln(60) */
+#define ULAM__VAR_REL_MAX 0.25
+
+/* The range R of a single walk's score the rule uses: range when finite (a bounded score);
+ * else, for scores that add per_step at most at each visit of walks that survive a step with
+ * probability at most qmax, the range of walks of at most l steps, l chosen so that longer walks
+ * add at most E m to the mean (per_step qmax^(l+1) / (1 - qmax) <= E m), doubled when scores
+ * take both signs; INFINITY when no bound holds (qmax = 1, per_step infinite); 0 when nothing
+ * scores (range 0 or per_step 0). */
+double ulam__score_range(double range, double per_step, double qmax, int signs, double m, double E);
+
+/* The walks the range term needs at estimate m (> 0): ceil(ULAM__EB_RANGE R / (E m)); 0 when
+ * there is no target or no finite nonzero R, INFINITY when m = 0. */
+double ulam__rel_min_walks(double R, double E, double m);
+
+/* Whether the rule holds for n walks at estimate m with standard error se. */
+int ulam__rel_err_holds(int64_t n, double m, double se, double min_walks, double var_rel_error, double E);
+
 #endif

@@ -24,7 +24,7 @@ void ulam_cell_summary(int n, const double *estimate, const double *std_error, c
     for (int k = 0; k < n; k++) {
         double e = estimate[k] - exact;
         se2 += e * e, se += std_error[k], t += seconds[k];
-        covered += fabs(e) <= 1.959963984540054 * std_error[k];
+        covered += fabs(e) <= ULAM_Z95 * std_error[k];
     }
     double N = n > 0 ? n : 1;
     *out = (ulam_cell){.runs = n, .rmse = sqrt(se2 / N), .mean_stderr = se / N, .coverage = covered / N,

@@ -232,7 +232,7 @@ static int one_run(study *st, int m, int b, int r)
     snprintf(line, sizeof line, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", me->name, st->budget[b], r,
              (unsigned long long)o.seed, res.estimate, res.std_error, fabs(res.estimate - st->exact),
              (long long)res.walks, (long long)res.steps, res.seconds,
-             fabs(res.estimate - st->exact) <= 1.959963984540054 * res.std_error);
+             fabs(res.estimate - st->exact) <= ULAM_Z95 * res.std_error);
     size_t i = at(st, m, b, r);
     if (!(st->row[i] = strdup(line))) return 1;
     st->est[i] = res.estimate, st->se[i] = res.std_error, st->sec[i] = res.seconds, st->done[i] = 1;
