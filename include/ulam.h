@@ -760,6 +760,11 @@ typedef struct ulam_rad_result {
     int threads, interrupted;
     int zero; /* rel_err could never be met: every channel exactly 0 with zero variance after
                * the first round (no walk scored); the run stopped there */
+    double min_walks;          /* gathering with rel_err: the walks the rule's range term needs at
+                                  this estimate (largest over channels; 0 when unbounded) */
+    double variance_rel_error; /* gathering with rel_err: the largest relative standard error of
+                                  a channel's variance (fourth moment); the rule wants <= 0.25 */
+    int rel_err_met;           /* the run stopped because the rel_err rule holds */
 } ulam_rad_result;
 
 /* An opaque patch-walk solver: walks that sample F by ray casting, never forming it. */

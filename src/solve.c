@@ -618,7 +618,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     }
     r->max_share = sumsq > 0 ? fmin(1.0, s->maxsq / sumsq) : 0.0;
     r->variance_finite = s->var_finite;
-    r->variance_rel_error = mom->m2 > 0 ? ulam__moments_variance_rel_error(mom) : mom->n > 1 ? 0.0 : INFINITY;
+    r->variance_rel_error = ulam__moments_variance_rel_error(mom);
     double m = fabs(r->estimate), N = (double)s->walks, E = s->o.rel_err > 0 ? s->o.rel_err : TAIL_E;
     double R = score_range(s, m, E);
     r->score_bound = s->bound;

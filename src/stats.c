@@ -45,7 +45,8 @@ double ulam__moments_variance(const ulam__moments *m)
 /* Relative standard error of the sample variance from the fourth moment. */
 double ulam__moments_variance_rel_error(const ulam__moments *m)
 {
-    if (m->n < 2 || !(m->m2 > 0)) return INFINITY;
+    if (m->n < 2) return INFINITY;
+    if (!(m->m2 > 0)) return 0.0; /* every score alike: the sample variance 0 varies by nothing */
     double N = (double)m->n, s2 = m->m2 / (N - 1.0), mu4 = m->m4 / N;
     return sqrt(fmax(0.0, mu4 - s2 * s2) / N) / s2;
 }

@@ -23,7 +23,8 @@ double ulam__moments_variance(const ulam__moments *m);
 /* The relative standard error of the sample variance itself, sqrt((mu4 - s^4) / n) / s^2 from
  * the fourth central moment (P. Pebay, "Formulas for robust, one-pass parallel computation of
  * covariances and arbitrary-order statistical moments", Sandia SAND2008-6212): large while the
- * sample has seen a rare large score only a few times.  INFINITY when the variance is 0. */
+ * sample has seen a rare large score only a few times.  INFINITY below two observations, 0
+ * when every observation is alike. */
 double ulam__moments_variance_rel_error(const ulam__moments *m);
 
 /* The rel_err stopping rule, shared by matrix and patch walks (derived in README.md, "When to

@@ -195,6 +195,33 @@ def check_radiosity_next_event(ulam):
         assert re.search(r"^warning +\d+ seen patches stopped short of their target", out, re.M), out
 
 
+def check_radiosity_rare_lamp(ulam):
+    """Rare high scores in gathering: a floor lit by a dim 1 x 1 panel and a tiny lamp 10^4 times
+    brighter with 10^-4 of its area (equal power; exact B = 0.5 (F_panel + 10^4 F_lamp) = 0.21981,
+    Howell C-11 and the lamp's point form factor averaged over the floor).  The old --rel-err
+    rule stopped collision walks after 3840 walks at 0.10 +- 0.005 (z = -24) in every seed: the
+    lamp, 55% of the answer, had not been hit.  Now collision's rule is never met before a walk
+    count it announces (next-event named), and next-event's intervals cover."""
+    exact, scene = 0.21981, R + "rare_lamp.obj"
+    for seed in range(1, 11):
+        rc, out, err = run(ulam, ["radiosity", scene, "--patch", "floor", "--rel-err", "0.05", "--walks", "20000",
+                                  "--json", "--seed", str(seed)])
+        assert rc == 0, err
+        j = json.loads(out)
+        assert j["rel_err_met"] is False and j["min_walks"] > 1e8 and j["walks"] == 20000, (seed, j)
+        assert "--estimator next-event samples the emitters directly" in err, (seed, err)
+    covered = 0
+    for seed in range(1, 101):
+        rc, out, err = run(ulam, ["radiosity", scene, "--patch", "floor", "--rel-err", "0.05", "--estimator",
+                                  "next-event", "--json", "--seed", str(seed)])
+        assert rc == 0, err
+        j = json.loads(out)
+        assert j["rel_err_met"] is True, (seed, j)
+        covered += abs(j["radiosity"][0] - exact) <= 1.959964 * j["stderr"][0]
+    # binomial(100, 0.95): P(X < 88) = 0.0015
+    assert covered >= 88, f"next-event on the rare lamp: {covered} of 100 intervals cover"
+
+
 def run(ulam, args):
     p = subprocess.run([ulam] + args, capture_output=True, text=True, timeout=120)
     return p.returncode, p.stdout, p.stderr
@@ -732,7 +759,7 @@ def main():
              (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
-             (check_radiosity_next_event, ulam)]
+             (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam)]
     for f, arg in extra:
         try:
             f(arg)

@@ -91,6 +91,8 @@ typedef struct {
     double seconds;
     int threads, interrupted;
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
+    int rel_err_met;  /* ray gathering: the run stopped because the --rel-err rule holds */
+    double min_walks; /* ray gathering: the walks the rule's range term needs (0: unbounded) */
     double *all, *all_se; /* shooting: 3 per patch each */
 } walked;
 
@@ -233,6 +235,20 @@ static int find_patch(const ulam_scene *s, const char *arg, int64_t *p)
     return EXIT_USAGE;
 }
 
+/* After the first round: say so when the rel-err rule's minimum walk count (the bound on one
+ * walk's score: a bright emitter a walk rarely hits) is out of reach, and name next-event. */
+static void rel_err_warning(const args *a, const ulam_rad_solver *sv)
+{
+    ulam_rad_result r;
+    ulam_rad_solver_result(sv, &r);
+    double limit = a->o.max_walks > 0 && a->o.max_walks < ULAM_REL_ERR_CAP ? (double)a->o.max_walks : 1e8;
+    if (!(a->o.rel_err > 0) || !(r.min_walks > limit)) return;
+    fprintf(stderr, "ulam: %s: warning: --rel-err %g: one walk can score up to a bright emitter's radiosity at every "
+                    "bounce, so the rule needs about %.3g walks at this estimate before it may stop (%s): "
+                    "--estimator next-event samples the emitters directly and has no such tail\n",
+            a->scene, a->o.rel_err, r.min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
+}
+
 /* Ray walks (gathering or shooting); 0 or an exit code. */
 static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
 {
@@ -241,7 +257,10 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     int status = ulam_rad_solver_alloc(t, &a->o, &sv, &err);
     if (status) return cli_report(a->scene, &err);
     cli_catch_sigint();
-    while (!status && !ulam_rad_solver_done(sv)) status = ulam_rad_solver_iterate(sv);
+    for (int round = 0; !status && !ulam_rad_solver_done(sv); round++) {
+        status = ulam_rad_solver_iterate(sv);
+        if (round == 0) rel_err_warning(a, sv);
+    }
     cli_release_sigint();
     ulam_rad_result r;
     ulam_rad_solver_result(sv, &r);
@@ -250,6 +269,7 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     memcpy(w->se_walk, r.std_error, sizeof w->se_walk);
     w->walks = r.walks, w->steps = r.rays, w->seconds = r.seconds, w->threads = r.threads;
     w->interrupted = r.interrupted, w->zero = r.zero, w->cut = r.cut;
+    w->rel_err_met = r.rel_err_met, w->min_walks = r.min_walks;
     if (!status && a->o.mode == ULAM_FORWARD) {
         w->all = malloc((size_t)np * 3 * sizeof *w->all);
         w->all_se = malloc((size_t)np * 3 * sizeof *w->all_se);
@@ -449,6 +469,9 @@ static void print_text(const args *a, const report *r)
             else if (a->matrix_walk) printf(" (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
             printf("%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
         }
+        if (a->o.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT && !w->zero)
+            printf("rel-err      %s (%g; the rule's range term wants %.3g walks)\n", w->rel_err_met ? "met" : "NOT met",
+                   a->o.rel_err, w->min_walks);
         if (w->zero)
             printf("note         every channel is exactly 0 with zero variance after %lld walks (no walk scored):\n"
                    "             --rel-err can never be met by a zero estimate, so the walks stopped there; if the\n"
@@ -522,6 +545,10 @@ static void print_json(const args *a, const report *r)
                (long long)w->steps, (long long)w->cut, (long long)a->o.max_steps);
         cli_json_number("seconds", w->seconds, 0);
         printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
+        if (a->o.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT) {
+            printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
+            cli_json_number("min_walks", w->min_walks, 0);
+        }
     }
     if (a->view) {
         printf("\"view\": {\"seen\": %lld, \"npatches\": %lld, \"pixels_hit\": %lld, \"camera_rays\": %lld, "

@@ -66,6 +66,7 @@ struct ulam_rad_solver {
     const ulam_scene *s;
     int threads;
     double *q;            /* continuation per patch: max_c rho */
+    double per_step[3], range[3], qmax; /* gathering: the score bounds of the rel_err rule */
     double *cdf, ptot;    /* shooting: cumulative power over emitters */
     int64_t *emitter, nem;
     rad_scratch *scratch;
@@ -75,7 +76,7 @@ struct ulam_rad_solver {
     double sq, maxsq;
     int64_t walks, rays, cut, nonfinite, next_walk;
     double seconds, t0;
-    int done, interrupted, zero, status;
+    int done, interrupted, zero, status, met;
 };
 
 /* Free; accepts and returns NULL. */
@@ -135,6 +136,30 @@ static int build_source(ulam_rad_solver *s, ulam_error *err)
     return ULAM_OK;
 }
 
+/* Gathering's bounds for the rel_err rule, over the whole scene (weights rho_c / q <= 1):
+ * collision scores at most max_p E_pc a visit and a walk survives a step with probability at
+ * most qmax = max_p q_p; absorption scores at most max_p E_pc / (1 - q_p) once; next-event's
+ * light samples (1 / r^2 near a light) have no bound, so only the variance check guards them. */
+static void score_bounds(ulam_rad_solver *s)
+{
+    const ulam_scene *sc = s->s;
+    int nee = s->o.estimator >= ULAM_NEXT_EVENT;
+    s->qmax = 0.0;
+    for (int c = 0; c < 3; c++) s->per_step[c] = s->range[c] = 0.0;
+    for (int64_t p = 0; p < sc->npatches; p++) {
+        s->qmax = fmax(s->qmax, s->q[p]);
+        for (int c = 0; c < 3; c++) {
+            double E = sc->emit[3 * p + c];
+            s->per_step[c] = fmax(s->per_step[c], E);
+            s->range[c] = fmax(s->range[c], E > 0 ? E / (1.0 - s->q[p]) : 0.0);
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        if (s->o.estimator != ULAM_ABSORPTION) s->range[c] = s->per_step[c] > 0 ? INFINITY : 0.0;
+        if (nee && s->per_step[c] > 0) s->per_step[c] = INFINITY;
+    }
+}
+
 /* Allocate per-thread scratch and per-block results. */
 static int alloc_work(ulam_rad_solver *s)
 {
@@ -144,7 +169,10 @@ static int alloc_work(ulam_rad_solver *s)
     s->q = ulam__malloc((size_t)n, sizeof *s->q);
     if (!s->scratch || !s->blocks || !s->q) return ULAM_ENOMEM;
     for (int64_t p = 0; p < n; p++) s->q[p] = ulam__max3(s->s->rho + 3 * p);
-    if (s->o.mode == ULAM_ADJOINT) return ULAM_OK;
+    if (s->o.mode == ULAM_ADJOINT) {
+        score_bounds(s);
+        return ULAM_OK;
+    }
     for (int k = 0; k < s->threads; k++) {
         rad_scratch *sc = &s->scratch[k];
         sc->hist = ulam__calloc((size_t)(3 * n), sizeof *sc->hist);
@@ -174,6 +202,7 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam
     s->s = ulam__tracer_scene(t);
     s->threads = ulam__threads(o.threads);
     s->t0 = -1;
+    if (o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0) s->o.max_walks = ULAM_REL_ERR_CAP;
     if ((o.mode == ULAM_FORWARD || o.estimator >= ULAM_NEXT_EVENT) && (status = build_source(s, err))) {
         ulam_rad_solver_free(s);
         return status;
@@ -405,13 +434,26 @@ static void merge_block(ulam_rad_solver *s, const rad_block *br)
     s->nonfinite += br->nonfinite;
 }
 
-/* Nonzero when every nonzero channel has stderr <= rel_err |estimate| (and one is nonzero). */
-static int precise_enough(const ulam_rad_result *r, double rel_err)
+/* Gathering: the walks the rel_err rule's range term needs in channel c at its estimate. */
+static double channel_min_walks(const ulam_rad_solver *s, int c, double E)
+{
+    double m = fabs(s->m[c].mean);
+    return ulam__rel_min_walks(ulam__score_range(s->range[c], s->per_step[c], s->qmax, 0, m, E), E, m);
+}
+
+/* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
+ * takes the whole rule (ulam__rel_err_holds); shooting, whose tallies keep no fourth moment,
+ * the standard error alone. */
+static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, double rel_err)
 {
     int any = 0;
     for (int c = 0; c < 3; c++) {
         if (r->radiosity[c] == 0.0) continue;
-        if (!(r->std_error[c] <= rel_err * fabs(r->radiosity[c]))) return 0;
+        if (s->o.mode == ULAM_FORWARD ? !(r->std_error[c] <= rel_err * fabs(r->radiosity[c]))
+                                      : !ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c],
+                                                             channel_min_walks(s, c, rel_err),
+                                                             ulam__moments_variance_rel_error(&s->m[c]), rel_err))
+            return 0;
         any = 1;
     }
     return any;
@@ -453,7 +495,7 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     ulam_rad_result r;
     ulam_rad_solver_result(s, &r);
     if (ulam__budget_spent(&s->o, stop, s->next_walk)) s->done = 1;
-    if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(&r, s->o.rel_err)) s->done = 1;
+    if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(s, &r, s->o.rel_err)) s->done = s->met = 1;
     if (s->o.rel_err > 0 && r.walks >= 1000 && all_zero(&r)) s->done = s->zero = 1; /* can never be met */
     return s->status;
 }
@@ -468,7 +510,7 @@ void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uin
     s->sq = s->maxsq = s->seconds = 0.0;
     s->walks = s->rays = s->cut = s->nonfinite = s->next_walk = 0;
     s->t0 = -1;
-    s->done = s->interrupted = s->zero = s->status = 0;
+    s->done = s->interrupted = s->zero = s->status = s->met = 0;
 }
 
 /* Nonzero once a stopping rule is met. */
@@ -501,6 +543,11 @@ void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
         }
     }
     r->max_share = s->sq > 0 ? fmin(1.0, s->maxsq / s->sq) : 0.0;
+    for (int c = 0; c < 3 && s->o.mode == ULAM_ADJOINT && s->o.rel_err > 0; c++)
+        if (s->m[c].mean != 0.0) {
+            r->min_walks = fmax(r->min_walks, channel_min_walks(s, c, s->o.rel_err));
+            r->variance_rel_error = fmax(r->variance_rel_error, ulam__moments_variance_rel_error(&s->m[c]));
+        }
     r->walks = s->walks;
     r->rays = s->rays;
     r->cut = s->cut;
@@ -508,6 +555,7 @@ void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
     r->threads = s->threads;
     r->interrupted = s->interrupted;
     r->zero = s->zero;
+    r->rel_err_met = s->met;
 }
 
 /* Shooting: every patch. */
