@@ -394,6 +394,82 @@ ulam_solver *ulam_solver_free(ulam_solver *s);
 int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                ulam_walk_result *result, ulam_error *err);
 
+/* ---------------------------------------------------------------- point sources: push and bidirectional */
+
+/* Reverse local push from a target t on the adjoint equation (src/push.c): estimates p and
+ * residuals r with x_t = <p, b> + <r, x> for every b, where (I - M) x = b.  Pushing j moves r_j
+ * into p_j and adds M_jk r_j to r_k over row j of M.  An opaque workspace, reused across
+ * targets (a new start clears only the states the last one touched). */
+typedef struct ulam_push ulam_push;
+
+/* What the pushes since the last start did. */
+typedef struct ulam_push_info {
+    int64_t target;  /* 0-based; -1 before any start */
+    double rmax;     /* every |r_j| <= rmax once a run has returned ULAM_OK */
+    int64_t pushes;  /* states pushed */
+    int64_t ops;     /* work: nonzeros of M read, plus one per push */
+    int64_t touched; /* states whose p or r was ever set */
+    int64_t support; /* states with r_j != 0 */
+    double r_sum, r_max; /* sum and largest of |r_j| */
+    double seconds;  /* wall time in ulam_push_run */
+} ulam_push_info;
+
+/* A workspace for pushes on the square matrix M, which is borrowed until the workspace is freed. */
+int ulam_push_alloc(const ulam_csr *M, ulam_push **out);
+
+/* Free a workspace; accepts and returns NULL. */
+ulam_push *ulam_push_free(ulam_push *w);
+
+/* Start over for target t (0-based): p = 0, r = e_t; ULAM_EINVAL when t is out of range. */
+int ulam_push_start(ulam_push *w, int64_t target);
+
+/* Push every state with |r_j| > rmax until none is left (FIFO order); ULAM_EINVAL for rmax <= 0 or
+ * no start; ULAM_ENOCONV when the work passes max_ops (> 0; 0 is no cap), the invariant intact. */
+int ulam_push_run(ulam_push *w, double rmax, int64_t max_ops);
+
+/* The dense estimates p and residuals r (n entries each, owned by the workspace). */
+const double *ulam_push_estimates(const ulam_push *w);
+const double *ulam_push_residuals(const ulam_push *w);
+
+/* Fill *info about the pushes since the last start. */
+void ulam_push_report(const ulam_push *w, ulam_push_info *info);
+
+/* Bidirectional estimate of x_t of (I - M) x = e_s (src/bidir.c; Lofgren, Banerjee, Goel, "Personalized
+ * PageRank estimation and search: a bidirectional approach", WSDM 2016): a reverse push from t gives
+ * x_t = p_s + <r, x>, and <r, x> = e_s' (I - M')^-1 r is the unknown s of the system (M', r),
+ * estimated by the adjoint walk solver on M' from s scoring r (walks forward from the source).
+ * Each score is at most rmax x the walk's weight sum, so the variance falls with rmax. */
+typedef struct ulam_bidir_opts {
+    int64_t target, source; /* 0-based t and s */
+    double rmax;       /* push threshold; <= 0: balance the push's work against the walks' predicted work */
+    double min_value;  /* the smallest |x_t| the balance plans for (<= 0: 1 / n) */
+    int64_t max_push_ops; /* cap on the push's work (0: 100 nnz(M) + 10^6); past it ULAM_ENOCONV */
+    ulam_walk_opts walk;  /* the walks' kernel, seed, threads and stopping rules (mode and index are
+                             set here); rel_err applies to the whole estimate p_s + <r, x> */
+} ulam_bidir_opts;
+
+/* The defaults: balanced rmax, min_value 1 / n, ulam_walk_defaults() walks. */
+ulam_bidir_opts ulam_bidir_defaults(void);
+
+/* What a bidirectional estimate found. */
+typedef struct ulam_bidir_result {
+    double estimate, std_error, ci95[2]; /* of x_t: p_s plus the walks' estimate of <r, x> */
+    double push_part;      /* p_s, exact given the push */
+    ulam_push_info push;   /* the push (its seconds are push_seconds) */
+    ulam_walk_result walks; /* the walks' estimate of <r, x> (0 walks when r = 0: exact) */
+    int64_t pilot_walks;   /* walks that measured the mean walk length for the balance */
+    double mean_visits;    /* states a walk visits on average (pilot) */
+    double predicted_walks; /* walks the balance predicted for the target at the chosen rmax */
+    double seconds;        /* the whole estimate: pilot, push, walk set-up and walks */
+} ulam_bidir_result;
+
+/* Estimate x_t of (I - M) x = e_s with push workspace w (on M) and Mt, the transpose of M (borrowed;
+ * computing it is one O(nnz) pass the caller makes once for any number of queries).  ULAM_OK,
+ * ULAM_EINVAL (bad options, index out of range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap),
+ * the walk solver's statuses. */
+int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
+                     ulam_error *err);
+
 /* ---------------------------------------------------------------- studies */
 
 /* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
