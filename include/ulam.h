@@ -459,7 +459,7 @@ typedef struct ulam_bidir_result {
     ulam_walk_result walks; /* the walks' estimate of <r, x> (0 walks when r = 0: exact) */
     int64_t pilot_walks;   /* walks that measured the mean walk length for the balance */
     double mean_visits;    /* states a walk visits on average (pilot) */
-    double predicted_walks; /* walks the balance predicted for the target at the chosen rmax */
+    double predicted_walks; /* walks the balance predicted for the target at its rmax (NaN: rmax given) */
     double seconds;        /* the whole estimate: pilot, push, walk set-up and walks */
 } ulam_bidir_result;
 

@@ -86,14 +86,13 @@ static double predicted_walks(const ulam_bidir_opts *o, double rmax, double visi
 /* Push from t: to o->rmax, or halving rmax while the push's work is below the walks' predicted work. */
 static int push(ulam_push *w, const ulam_bidir_opts *o, double visits, int64_t cap, double *walks)
 {
+    if (o->rmax > 0) {
+        *walks = NAN; /* no balance, no prediction */
+        return ulam_push_run(w, o->rmax, cap);
+    }
     const double *p = ulam_push_estimates(w);
     int64_t n = ulam__push_matrix(w)->nrows;
     double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n;
-    if (o->rmax > 0) {
-        int status = ulam_push_run(w, o->rmax, cap);
-        *walks = predicted_walks(o, o->rmax, visits, fmax(delta, fabs(p[o->source])));
-        return status;
-    }
     double rmax = 1.0;
     int status = ulam_push_run(w, rmax, cap); /* r = e_t: nothing to push yet */
     for (;;) {

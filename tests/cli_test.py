@@ -105,6 +105,24 @@ CASES += [
      r"forward walks, expected estimator"),
 ]
 
+PS = ["solve", M + "randsub1000.mtx", "--index", "7"]
+CASES += [
+    # point sources: --source S sets b = e_S (src/cli/bidir.c)
+    (PS + ["--source", "1001"], 2, r"--source 1001 is out of range 1..1000", r"^$"),
+    (PS + ["--source", "0"], 2, r"--source expects an integer from 1", r"^$"),
+    (PS + ["--source", "3", "--rhs", M + "randsub1000_b.mtx"], 2, r"--source S sets b = e_S: it cannot go with --rhs", r"^$"),
+    (PS + ["--source", "3", "--rmax", "0"], 2, r"--rmax expects a number from", r"^$"),
+    (PS + ["--source", "3", "--rmax", "-0.1"], 2, r"--rmax expects a number from", r"^$"),
+    (PS + ["--source", "3", "--rmax", "nan"], 2, r"--rmax expects a number from", r"^$"),
+    (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
+    (["solve", M + "randsub1000.mtx", "--source", "3"], 2, r"--source S needs --index I", r"^$"),
+    (PS + ["--source", "3", "--method", "forward"], 2, r"go with --method bidirectional, got 'forward'", r"^$"),
+    (PS + ["--source", "3", "--out", "x.mtx"], 2, r"unknown option for a --source solve", r"^$"),
+    (["solve", M + "divergent200.mtx", "--index", "1", "--source", "2"], 3, r"rho\(\|M\|\) = 1\.1 .*>= 1", r"^$"),
+    (PS + ["--source", "3", "--walks", "20000", "--check"], 0, r"^$", r"method\s+bidirectional.*\n.*push\s+rmax"),
+    (["solve", "--source", "1", "--help"], 0, r"^$", r"reverse push from I"),
+]
+
 
 O = D + "obj/"
 SC = "examples/scenes/"
@@ -422,6 +440,37 @@ def check_radiosity(ulam):
         assert sorted(os.listdir(d)) == ["box.png"], os.listdir(d)
 
 
+def check_bidir(ulam):
+    """solve --source --json: seconds covers the whole estimate and push_seconds the push; the
+    estimate agrees with LAPACK within 4 sigma; threads do not matter; --rel-err stops on the
+    whole estimate; a push that leaves no residual is exact."""
+    base = PS + ["--source", "3", "--rmax", "0.02", "--walks", "30000", "--json", "--check"]
+    outs = []
+    for t in ("1", "2"):
+        rc, out, err = run(ulam, base + ["--threads", t])
+        assert rc == 0, err
+        outs.append(json.loads(out))
+    o = outs[0]
+    for k in ["index", "source", "method", "estimate", "stderr", "ci95", "rmax", "push_part", "pushes", "push_ops",
+              "residual_support", "push_seconds", "walks", "steps", "walk_seconds", "seconds", "transpose_seconds",
+              "direct", "z", "interrupted"]:
+        assert k in o, k
+    assert o["method"] == "bidirectional" and o["index"] == 7 and o["source"] == 3 and o["walks"] == 30000, o
+    assert o["rmax"] == 0.02 and o["rmax_balanced"] is False and o["pushes"] > 0 and o["residual_support"] > 0, o
+    assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
+    assert o["push_seconds"] <= o["seconds"] and o["walk_seconds"] <= o["seconds"], o
+    assert outs[0]["estimate"] == outs[1]["estimate"] and outs[0]["stderr"] == outs[1]["stderr"]
+    rc, out, err = run(ulam, PS + ["--source", "3", "--rel-err", "0.02", "--json"])
+    o = json.loads(out)
+    assert rc == 0 and o["rmax_balanced"] is True and o["pilot_walks"] == 1024, o
+    assert o["stderr"] <= 0.02 * abs(o["estimate"]) and o["walks"] >= 1000, o
+    rc, out, err = run(ulam, ["solve", D + "dag5.mtx", "--index", "1", "--source", "5", "--rmax", "1e-3", "--json",
+                              "--check"])
+    o = json.loads(out)
+    assert rc == 0 and o["residual_support"] == 0 and o["walks"] == 0 and o["stderr"] == 0, o
+    assert abs(o["estimate"] - o["direct"]) < 1e-14 and o["estimate"] > 0.3, o
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -438,7 +487,7 @@ def main():
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
-             (check_radiosity, ulam)]
+             (check_radiosity, ulam), (check_bidir, ulam)]
     for f, arg in extra:
         try:
             f(arg)

@@ -101,6 +101,9 @@ int cli_guard(const cli_system *s, double continue_q, int mode, int force, ulam_
 int cli_info(int argc, char **argv);
 int cli_direct(int argc, char **argv);
 int cli_solve(int argc, char **argv);
+/* solve with a point source (--source S, src/cli/bidir.c): cli_solve hands argv over when claimed. */
+int cli_bidir_claims(int argc, char **argv);
+int cli_bidir(int argc, char **argv);
 int cli_study(int argc, char **argv);
 int cli_radiosity(int argc, char **argv);
 

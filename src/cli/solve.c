@@ -14,6 +14,8 @@ static const char *const usage =
     "                  [--time S] [--seed S] [--threads T] [--continue Q] [--roulette W]\n"
     "                  [--split W] [--max-steps K] [--jacobi [--omega W]] [--check] [--json]\n"
     "                  [--out x.mtx] [--errors e.mtx] [--force] [--cache] [--whole-kernel]\n"
+    "       ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R] ...\n"
+    "                  (b = e_S: a reverse push from I and walks from S; --source --help)\n"
     "\n"
     "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
     "Indices are 1-based, as in Matrix Market files.\n"
@@ -204,6 +206,7 @@ int cli_solve(int argc, char **argv)
         {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
         {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
         {"whole-kernel", no_argument, 0, 'W'},    {0, 0, 0, 0}};
+    if (cli_bidir_claims(argc, argv)) return cli_bidir(argc, argv); /* --source S: src/cli/bidir.c */
     cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};
