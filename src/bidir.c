@@ -21,7 +21,7 @@
 /* Pilot walks that measure E[V]; a walk step's cost in push operations (a push operation
  * reads one nonzero and updates one residual, a step draws from an alias row: measured near
  * equal by bench_bidir); the walks before a relative-error rule may stop (as the solver's). */
-enum { PILOT = 1024, MIN_WALKS = 1000 };
+enum { PILOT = 256, MIN_WALKS = 1000 };
 static const double STEP_COST = 1.0, DEFAULT_REL_ERR = 0.1;
 
 /* The defaults. */
@@ -99,13 +99,17 @@ static int push(ulam_push *w, const ulam_bidir_opts *o, double visits, int64_t c
         ulam_push_info pi;
         ulam_push_report(w, &pi);
         *walks = predicted_walks(o, rmax, visits, fmax(delta, fabs(p[o->source])));
-        if (status || pi.support == 0 || (double)pi.ops >= *walks * visits * STEP_COST) return status;
+        if (status || pi.support == 0 || *walks <= MIN_WALKS || (double)pi.ops >= *walks * visits * STEP_COST)
+            return status; /* below MIN_WALKS more pushing saves no walks */
         rmax /= 2;
         status = ulam_push_run(w, rmax, cap);
     }
 }
 
-/* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr. */
+/* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr.  The relative-error
+ * rule waits for walks that scored differently: while every walk has scored the same (none has
+ * reached the residual, say) the sample variance is 0 and says nothing about the rare walk
+ * that would. */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
                 ulam_walk_result *wr, ulam_error *err)
 {
@@ -116,7 +120,7 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     while (!status && !ulam_solver_done(sv)) {
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, wr);
-        if (o->walk.rel_err > 0 && wr->walks >= MIN_WALKS &&
+        if (o->walk.rel_err > 0 && wr->walks >= MIN_WALKS && wr->variance > 0 &&
             wr->std_error <= o->walk.rel_err * fabs(push_part + wr->estimate))
             break;
     }
