@@ -470,6 +470,51 @@ typedef struct ulam_bidir_result {
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err);
 
+/* ---------------------------------------------------------------- choosing the method */
+
+/* One candidate of ulam_auto_choose: a mode, an estimator and a continuation. */
+typedef struct ulam_auto_candidate {
+    int mode, estimator;
+    double continue_q;    /* <= 0: analog */
+    ulam_power hat;       /* rho(M^) of this candidate's kernel, with Collatz-Wielandt bounds */
+    int certified;        /* hat.upper < 1 and rho(|M|)'s upper bound < 1: variance certified finite */
+    int status;           /* ULAM_OK, or why the solver refused it (ULAM_EUNDEFINED: absorption with p* = 0) */
+    int64_t pilot_walks;  /* 0: not piloted (not certified, or refused) */
+    double estimate, variance, seconds_per_walk; /* the pilot's (its estimate is not used) */
+    double cost;          /* variance x seconds per walk; INFINITY when not piloted */
+    double predicted_seconds; /* walks for base rel_err x seconds a walk (NaN without rel_err) */
+} ulam_auto_candidate;
+
+/* At most 2 modes x 3 estimators x 2 continuations. */
+#define ULAM_AUTO_MAX 12
+
+/* What the choice may vary: a pinned part keeps base's value. */
+typedef struct ulam_auto_opts {
+    int pin_mode, pin_estimator, pin_continue;
+    double continue_q;   /* the fixed continuation tried beside analog (default 0.9) */
+    int64_t pilot_walks; /* walks a pilot (default 2048) */
+} ulam_auto_opts;
+
+/* The default options: nothing pinned, Q = 0.9, 2048 pilot walks. */
+ulam_auto_opts ulam_auto_defaults(void);
+
+/* The candidates and the choice. */
+typedef struct ulam_auto_result {
+    int ncand;
+    ulam_auto_candidate cand[ULAM_AUTO_MAX];
+    int chosen;     /* the certified, piloted candidate of least cost; -1 when none is certified */
+    int closest;    /* the candidate of least rho(M^) (named when none is certified) */
+    ulam_power abs; /* rho(|M|) */
+    double seconds; /* guards and pilots */
+} ulam_auto_result;
+
+/* Screen mode x estimator x continuation (less what is pinned) with the guards, keep the candidates
+ * whose variance is certified finite, run a pilot of each (seeds of their own, so the walks that then
+ * estimate with the chosen method are fresh and the choice does not bias them) and choose the least
+ * variance x seconds per walk.  Walks across processes (base->share) agree on rank 0's choice. */
+int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                     ulam_auto_result *res, ulam_error *err);
+
 /* ---------------------------------------------------------------- studies */
 
 /* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */

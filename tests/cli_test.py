@@ -123,6 +123,15 @@ CASES += [
     (["solve", "--source", "1", "--help"], 0, r"^$", r"reverse push from I"),
 ]
 
+CASES += [
+    # --method auto (src/cli/auto.c)
+    (RS + ["--method", "sideways"], 2, r"--method expects auto or bidirectional, got 'sideways'", r"^$"),
+    (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--method", "auto",
+      "--rel-err", "0.01"], 3, r"error: --method auto: no candidate has a certified finite variance; the closest is .*"
+     r"a --rel-err target cannot be met honestly", r"^$"),
+    (RS + ["--method", "auto", "--walks", "20000"], 0, r"^$", r"auto\s+chose the least variance x seconds a walk from 12 candidates"),
+]
+
 
 O = D + "obj/"
 SC = "examples/scenes/"
@@ -471,6 +480,27 @@ def check_bidir(ulam):
     assert abs(o["estimate"] - o["direct"]) < 1e-14 and o["estimate"] > 0.3, o
 
 
+def check_auto(ulam):
+    """solve --method auto --json: the candidates (certified iff the upper bound of rho(M^) is below 1),
+    the chosen one is what ran, the estimate agrees with LAPACK; pins leave only what they allow."""
+    rc, out, err = run(ulam, RS + ["--method", "auto", "--rel-err", "0.02", "--json", "--check"])
+    assert rc == 0, err
+    o = json.loads(out)
+    a = o["auto"]
+    assert len(a["candidates"]) == 12 and 0 <= a["chosen"] < 12, a
+    for c in a["candidates"]:
+        assert c["certified"] == (c["rho_hat_upper"] < 1), c
+        assert (c["pilot_walks"] > 0) == (c["certified"] and c["status"] == "ok"), c
+    ch = a["candidates"][a["chosen"]]
+    assert ch["mode"] == o["mode"] and ch["estimator"] == o["estimator"], (ch, o)
+    assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"] and o["stderr"] <= 0.02 * abs(o["estimate"]), o
+    rc, out, err = run(ulam, RS + ["--method", "auto", "--mode", "forward", "--continue", "0.8", "--walks", "5000", "--json"])
+    assert rc == 0, err
+    o = json.loads(out)
+    assert len(o["auto"]["candidates"]) == 3 and o["mode"] == "forward", o
+    assert all(c["mode"] == "forward" and c["continue"] == 0.8 for c in o["auto"]["candidates"]), o
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -487,7 +517,7 @@ def main():
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
-             (check_radiosity, ulam), (check_bidir, ulam)]
+             (check_radiosity, ulam), (check_bidir, ulam), (check_auto, ulam)]
     for f, arg in extra:
         try:
             f(arg)

@@ -64,6 +64,7 @@ typedef struct {
     ulam_guard g;
     int variance_finite;
     double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the solver set-up */
+    const ulam_auto_result *au; /* --method auto: the candidates and the choice (else NULL) */
 } report_opts;
 
 /* Peak resident memory of this process so far, in MiB. */
@@ -110,6 +111,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
                "not to be trusted\n", 100 * r->max_share);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
+    if (ro->au) cli_auto_print_text(ro->au);
     if (ro->check)
         printf("direct          %.10g (LAPACK, %.4f s), z = %.3f\n", ro->direct, ro->direct_seconds,
                (r->estimate - ro->direct) / r->std_error);
@@ -157,6 +159,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         cli_json_number("direct_seconds", ro->direct_seconds, 0);
         cli_json_number("z", (r->estimate - ro->direct) / r->std_error, 0);
     }
+    if (ro->au) cli_auto_print_json(ro->au);
     printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
 }
 
@@ -205,14 +208,16 @@ int cli_solve(int argc, char **argv)
         {"json", no_argument, 0, 'J'},            {"out", required_argument, 0, 'o'},
         {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
         {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
-        {"whole-kernel", no_argument, 0, 'W'},    {0, 0, 0, 0}};
+        {"whole-kernel", no_argument, 0, 'W'},    {"method", required_argument, 0, 'A'},
+        {0, 0, 0, 0}};
     if (cli_bidir_claims(argc, argv)) return cli_bidir(argc, argv); /* --source S: src/cli/bidir.c */
     cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};
     const char *out = NULL, *errors = NULL;
     int64_t v;
-    int c, rc, any_rule = 0, force = 0;
+    int c, rc, any_rule = 0, force = 0, autom = 0;
+    ulam_auto_result au;
     o.max_walks = 0;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
@@ -239,6 +244,10 @@ int cli_solve(int argc, char **argv)
         case 'j': s.jacobi = 1; break;
         case 'C': s.cache = 1; break;
         case 'W': o.whole_kernel = 1; break;
+        case 'A':
+            if (strcmp(optarg, "auto")) return cli_usage_error("solve", "--method expects auto or bidirectional, got '%s'", optarg);
+            autom = 1;
+            break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'c': ro.check = 1; break;
         case 'J': ro.json = 1; break;
@@ -262,6 +271,12 @@ int cli_solve(int argc, char **argv)
     if ((rc = cli_load_system(&s))) return rc;
     ro.load_seconds = ulam_now() - t0;
     o.index = s.index ? s.index - 1 : 0;
+    o.share = cli_share;
+    if (autom && (rc = cli_auto_choose(&s, argc, argv, &o, &au))) {
+        cli_system_free(&s);
+        return rc;
+    }
+    ro.au = autom ? &au : NULL;
     if ((rc = cli_guard(&s, o.continue_q, o.mode, force, &ro.g))) {
         cli_system_free(&s);
         return rc;

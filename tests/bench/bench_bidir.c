@@ -12,7 +12,10 @@
  *   bidirectional  balanced rmax, stopped by rel_err 0.1 on the whole estimate;
  *   walks          the same code with rmax 2 (no push: r = e_t), i.e. walks from s counting visits
  *                  to t; capped at WALK_CAP seconds, a capped pair's time projected as
- *                  seconds x (reached / 10%)^2 (marked);
+ *                  seconds x (reached / 10%)^2 (marked *); when no walk has reached t by the cap,
+ *                  from the bound Var(visits to t) >= x_t - x_t^2 (visits are integers, so
+ *                  V^2 >= V): at least 100 (1 - x_t) / x_t walks at the measured seconds a walk
+ *                  (a lower bound, marked !);
  *   push           push alone with rmax halving from 1 until |p_s - x_t| <= 10% x_t, checked
  *                  against the exact value (an oracle stop: a lower bound on what push alone
  *                  needs without knowing x_t); capped at PUSH_CAP seconds (a lower bound, marked).
@@ -147,7 +150,7 @@ static double push_alone(ulam_push *w, int64_t s, int64_t t, double exact, int *
 static void row(const char *name, const series *S, const series *ref)
 {
     int marked = 0;
-    for (int k = 0; k < PAIRS; k++) marked += S->marked[k];
+    for (int k = 0; k < PAIRS; k++) marked += S->marked[k] > 0;
     double med = quantile(S->seconds, PAIRS, 0.5), p90 = quantile(S->seconds, PAIRS, 0.9);
     double rmed = med / quantile(ref->seconds, PAIRS, 0.5), rp90 = p90 / quantile(ref->seconds, PAIRS, 0.9);
     double ratio[PAIRS];
@@ -210,7 +213,9 @@ int main(int argc, char **argv)
             sum_push_s += rb.push.seconds, sum_walk_s += rb.walks.seconds;
             double rel = rw.std_error / fabs(rw.estimate);
             wk.seconds[k] = rw.seconds;
-            if (!(rel <= REL * 1.0001)) /* capped: REL needs (rel / REL)^2 times the walks */
+            if (rw.walks.variance == 0) /* capped before any walk scored: a lower bound, below */
+                wk.seconds[k] = rw.seconds * 100 * (1 - x[t]) / x[t] / (double)rw.walks.walks, wk.marked[k] = 2;
+            else if (!(rel <= REL * 1.0001)) /* capped: REL needs (rel / REL)^2 times the walks */
                 wk.seconds[k] = rw.seconds * (rel / REL) * (rel / REL), wk.marked[k] = 1;
             else
                 wk.covered += rw.ci95[0] <= x[t] && x[t] <= rw.ci95[1], wk.intervals++;
@@ -219,7 +224,7 @@ int main(int argc, char **argv)
             printf("%4d %8lld %8lld %12.5g %10.5f %9.5f %9.5f %9.2g %10lld %10.3g %7.2f %9.4f%s %9.4f%s %9.2g\n", k + 1,
                    (long long)s + 1, (long long)t + 1, x[t], rb.seconds, rb.push.seconds, rb.walks.seconds, rb.push.rmax,
                    (long long)rb.walks.walks, rb.predicted_walks, (rb.estimate - x[t]) / rb.std_error, wk.seconds[k],
-                   wk.marked[k] ? "*" : " ", pu.seconds[k], pu.marked[k] ? ">" : " ", prmax);
+                   wk.marked[k] == 2 ? "!" : wk.marked[k] ? "*" : " ", pu.seconds[k], pu.marked[k] ? ">" : " ", prmax);
             fflush(stdout);
         }
         src++;
@@ -232,7 +237,7 @@ int main(int argc, char **argv)
     printf("%-22s %10s %10s %10s %10s %13s   %-7s   %s\n", "method", "median", "p90", "med/bidir", "p90/bidir",
            "median ratio", "cover95", "marked");
     row("bidirectional", &bi, &bi);
-    row("walks (* projected)", &wk, &bi);
+    row("walks (*, ! projected)", &wk, &bi);
     row("push, oracle (> cap)", &pu, &bi);
     printf("bidirectional push seconds: median %.4f, p90 %.4f of the whole query\n", quantile(bi.other, PAIRS, 0.5),
            quantile(bi.other, PAIRS, 0.9));
