@@ -61,9 +61,11 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     if (r->push.support == 0)
         printf("walks           none: the push left no residual, the value is exact (to rounding)\n");
     else
-        printf("walks           %lld (%lld cut, %lld steps, %d threads; predicted %.3g; pilot %lld walks, %.3g "
-               "visits a walk)\n", (long long)w->walks, (long long)w->cut, (long long)w->steps, w->threads,
-               r->predicted_walks, (long long)r->pilot_walks, r->mean_visits);
+        printf("walks           %lld (%lld cut, %lld steps, %d threads)\n", (long long)w->walks, (long long)w->cut,
+               (long long)w->steps, w->threads);
+    if (o->rmax <= 0)
+        printf("balance         pilot %lld walks, %.3g visits a walk; %.3g walks predicted at this rmax\n",
+               (long long)r->pilot_walks, r->mean_visits, r->predicted_walks);
     printf("seconds         %.4f (push %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
            r->push.seconds, w->seconds, (unsigned long long)o->walk.seed, rp->transpose_seconds);
     printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
