@@ -66,6 +66,7 @@ static int pilot(const ulam_csr *Mt, const double *scores, const ulam_bidir_opts
     ulam_walk_opts po = walk_opts(o);
     po.estimator = ULAM_COLLISION;
     po.max_walks = PILOT, po.max_seconds = 0, po.share = NULL, po.whole_kernel = 0;
+    po.threads = 1; /* one partial block: a thread team would only be woken (same result for any count) */
     po.seed = o->walk.seed ^ UINT64_C(0x9e3779b97f4a7c15);
     ulam_walk_result r;
     int status = ulam_solve(Mt, scores, &po, &r, err);
