@@ -493,9 +493,10 @@ typedef struct ulam_auto_opts {
     int pin_mode, pin_estimator, pin_continue;
     double continue_q;   /* the fixed continuation tried beside analog (default 0.9) */
     int64_t pilot_walks; /* walks a pilot (default 2048) */
+    double pilot_seconds; /* and at most this long, its first block of 1024 walks whole (default 0.02; 0 off) */
 } ulam_auto_opts;
 
-/* The default options: nothing pinned, Q = 0.9, 2048 pilot walks. */
+/* The default options: nothing pinned, Q = 0.9, pilots of 2048 walks or 0.02 s. */
 ulam_auto_opts ulam_auto_defaults(void);
 
 /* The candidates and the choice. */

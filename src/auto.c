@@ -18,7 +18,7 @@ static const uint64_t PILOT_SEED = UINT64_C(0x5851f42d4c957f2d);
 /* The default options. */
 ulam_auto_opts ulam_auto_defaults(void)
 {
-    return (ulam_auto_opts){.continue_q = 0.9, .pilot_walks = 2048};
+    return (ulam_auto_opts){.continue_q = 0.9, .pilot_walks = 2048, .pilot_seconds = 0.02};
 }
 
 /* Run one candidate's pilot; its status (ULAM_OK or the solver's refusal).  Seconds per walk are
@@ -30,7 +30,7 @@ static int pilot(const ulam_csr *M, const double *b, const ulam_walk_opts *base,
 {
     ulam_walk_opts o = *base;
     o.mode = c->mode, o.estimator = c->estimator, o.continue_q = c->continue_q;
-    o.max_walks = ao->pilot_walks, o.rel_err = 0, o.max_seconds = 0;
+    o.max_walks = ao->pilot_walks, o.rel_err = 0, o.max_seconds = ao->pilot_seconds;
     o.seed = base->seed ^ (PILOT_SEED + (uint64_t)k);
     ulam_solver *sv = NULL;
     int status = ulam_solver_alloc(M, b, &o, &sv, NULL);
@@ -80,8 +80,8 @@ int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *b
     ulam__clear(err);
     if (!M || !b || !base || !res) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b, options and a result");
     ulam_auto_opts a = ao ? *ao : ulam_auto_defaults();
-    if (!(a.continue_q > 0 && a.continue_q < 1) || a.pilot_walks < 1)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a fixed continuation in (0, 1) and pilot walks >= 1");
+    if (!(a.continue_q > 0 && a.continue_q < 1) || a.pilot_walks < 1 || !(a.pilot_seconds >= 0))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a fixed continuation in (0, 1), pilot walks >= 1, pilot seconds >= 0");
     memset(res, 0, sizeof *res);
     res->chosen = res->closest = -1;
     double t0 = ulam_now();
