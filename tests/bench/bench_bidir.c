@@ -13,8 +13,9 @@
  *   walks          the walk solver alone: adjoint on M' from s with b = e_t (walks from s counting
  *                  visits to t), the same stopping rule; capped at WALK_CAP seconds, a capped
  *                  pair's time projected as its set-up and walks so far plus the walks still
- *                  needed (variance / (10% x_t estimate)^2 - walks) at the seconds a walk of its
- *                  last round (rows built by then: the one-off costs are counted once; marked *);
+ *                  needed (variance / (10% x_t estimate)^2 - walks) at the least seconds a walk
+ *                  over its rounds (the one-off row builds and kernel completion are counted once,
+ *                  not scaled, and the rate is the walks' best: favourable to walks; marked *);
  *                  when no walk has reached t by the cap, from the bound Var(visits to t) >=
  *                  x_t - x_t^2 (visits are integers, so V^2 >= V): at least 100 (1 - x_t) / x_t
  *                  walks (a lower bound, marked !);
@@ -137,7 +138,7 @@ static double walks_alone(const ulam_csr *Mt, double *e, int64_t s, int64_t t, d
     o.index = s, o.threads = 1, o.seed = seed, o.max_walks = 0, o.max_seconds = WALK_CAP, o.max_steps = INT64_MAX / 4;
     e[t] = 1.0;
     ulam_solver *sv = NULL;
-    double t0 = ulam_now(), rate = 0;
+    double t0 = ulam_now(), rate = INFINITY;
     ulam_walk_result r = {0};
     int reached = 0;
     if (!ulam_solver_alloc(Mt, e, &o, &sv, NULL)) {
@@ -146,7 +147,7 @@ static double walks_alone(const ulam_csr *Mt, double *e, int64_t s, int64_t t, d
             int64_t w0 = r.walks;
             if (ulam_solver_iterate(sv)) break;
             ulam_solver_result(sv, &r);
-            if (r.walks > w0) rate = (r.seconds - s0) / (double)(r.walks - w0);
+            if (r.walks > w0) rate = fmin(rate, (r.seconds - s0) / (double)(r.walks - w0));
             reached = r.walks >= 1000 && r.variance > 0 && r.std_error <= REL * fabs(r.estimate);
         }
     }
