@@ -64,6 +64,7 @@ static void assert_invariant(const ulam_push *w, const ulam_csr *M, int64_t t, c
 /* The seeded table of systems: n, entries a row, signed, largest row sum of |M|. */
 static const struct { int64_t n; int k, signed_; double rowsum; } systems[] = {
     {12, 3, 0, 0.9}, {40, 4, 1, 0.9}, {60, 2, 0, 0.95}, {80, 6, 1, 0.8}, {150, 5, 0, 0.85}, {30, 8, 1, 0.7},
+    {50, 4, 0, 0.9995}, /* rows of |M| up to 1 - 5e-4: long walks, a push that converges slowly */
 };
 enum { NSYS = sizeof systems / sizeof systems[0] };
 
@@ -265,6 +266,29 @@ static void test_bidir_rules(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* The time rule stops a run with no walk cap (its first block whole), and a run of a handful of
+ * walks reports what it has: an estimate within 4 sigma when the walks scored differently. */
+static void test_bidir_small_budgets(void **state)
+{
+    (void)state;
+    ulam_csr *M = random_system(80, 6, 0, 0.9, 3), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = exact_column(M, 3);
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    o.source = 3, o.target = 10, o.rmax = 0.05, o.walk.max_walks = 0, o.walk.max_seconds = 1e-6;
+    ulam_bidir_result res = bidir(M, Mt, &o);
+    assert_true(res.walks.walks >= 1 && res.walks.walks <= 1024 && isfinite(res.estimate));
+    assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
+    for (int64_t walks = 1; walks <= 16; walks *= 4) {
+        o.walk.max_seconds = 0, o.walk.max_walks = walks;
+        res = bidir(M, Mt, &o);
+        assert_true(res.walks.walks == walks && isfinite(res.estimate));
+        if (walks > 1 && res.std_error > 0) assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
+    }
+    free(x);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 /* A rare score does not stop a --rel-err run at 0 +- 0: walks from 1 reach the target 0 with
  * probability 0.001, so the first 1024 often all score 0 (zero sample variance). */
 static void test_bidir_rare_score(void **state)
@@ -297,6 +321,7 @@ int main(void)
         cmocka_unit_test(test_push_invariant), cmocka_unit_test(test_push_bad_input),
         cmocka_unit_test(test_bidir_unbiased), cmocka_unit_test(test_bidir_coverage),
         cmocka_unit_test(test_bidir_rules),    cmocka_unit_test(test_bidir_rare_score),
+        cmocka_unit_test(test_bidir_small_budgets),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
