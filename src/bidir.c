@@ -16,6 +16,7 @@
 #include "push.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Pilot walks that measure E[V]; a walk step's cost in push operations (a push operation
@@ -107,10 +108,33 @@ static int push(ulam_push *w, const ulam_bidir_opts *o, double visits, int64_t c
     }
 }
 
+/* 1 when every walk from s on Mt must score the same value, so a zero sample variance is exact:
+ * no state with r != 0 is reachable from s in one step or more, and r_s = 0 or s has no moves
+ * (every estimator then scores 0, or r_s at s alone); 0 when some walk could score differently;
+ * -1 out of memory.  A search over the states reachable from s. */
+static int deterministic(const ulam_csr *Mt, const double *r, int64_t s)
+{
+    int64_t n = Mt->nrows, head = 0, len = 0;
+    unsigned char *seen = ulam__calloc((size_t)n, 1);
+    int32_t *queue = ulam__malloc((size_t)n, sizeof *queue);
+    int found = !seen || !queue ? -1 : r[s] != 0 && Mt->rowptr[s + 1] > Mt->rowptr[s];
+    if (found == 0) queue[len++] = (int32_t)s;
+    while (found == 0 && head < len) {
+        int64_t i = queue[head++];
+        for (int64_t k = Mt->rowptr[i]; k < Mt->rowptr[i + 1] && !found; k++) {
+            int64_t j = Mt->colidx[k];
+            if (r[j] != 0) found = 1;
+            if (!seen[j]) seen[j] = 1, queue[len++] = (int32_t)j;
+        }
+    }
+    free(seen), free(queue);
+    return found < 0 ? -1 : !found;
+}
+
 /* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr.  The relative-error
  * rule waits for walks that scored differently: while every walk has scored the same (none has
  * reached the residual, say) the sample variance is 0 and says nothing about the rare walk
- * that would. */
+ * that would, unless no walk can score anything else (deterministic()). */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
                 ulam_walk_result *wr, ulam_error *err)
 {
@@ -118,12 +142,18 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     ulam_solver *sv = NULL;
     int status = ulam_solver_alloc(Mt, r, &wo, &sv, err);
     if (status) return status;
+    int exact = 0; /* 1: the walks are deterministic; -1: not (checked once) */
     while (!status && !ulam_solver_done(sv)) {
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, wr);
-        if (o->walk.rel_err > 0 && wr->walks >= MIN_WALKS && wr->variance > 0 &&
-            wr->std_error <= o->walk.rel_err * fabs(push_part + wr->estimate))
-            break;
+        if (o->walk.rel_err <= 0 || wr->walks < MIN_WALKS) continue;
+        if (wr->variance == 0 && exact == 0) {
+            int d = deterministic(Mt, r, o->source);
+            if (d < 0) status = ULAM_ENOMEM;
+            exact = d > 0 ? 1 : -1;
+            if (d) break;
+        }
+        if (wr->variance > 0 && wr->std_error <= o->walk.rel_err * fabs(push_part + wr->estimate)) break;
     }
     ulam_solver_result(sv, wr);
     ulam_solver_free(sv);

@@ -121,6 +121,9 @@ CASES += [
     (["solve", M + "divergent200.mtx", "--index", "1", "--source", "2"], 3, r"rho\(\|M\|\) = 1\.1 .*>= 1", r"^$"),
     (PS + ["--source", "3", "--walks", "20000", "--check"], 0, r"^$", r"method\s+bidirectional.*\n.*push\s+rmax"),
     (["solve", "--source", "1", "--help"], 0, r"^$", r"reverse push from I"),
+    # walks that can only score 0 end a --rel-err run (they used to run forever)
+    (["solve", D + "dag5.mtx", "--index", "5", "--source", "1", "--rmax", "2", "--rel-err", "0.1"], 0, r"^$",
+     r"x\[5\]\s+0 \+- 0 "),
 ]
 
 CASES += [

@@ -266,6 +266,38 @@ static void test_bidir_rules(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* A --rel-err run ends when the walks cannot score anything but one value: no residual state
+ * reachable from the source (the walk part is exactly 0), or a source without moves whose own
+ * residual is all a walk scores.  Before, every walk scored the same forever and the run never
+ * stopped (a zero sample variance no longer stops it, test_bidir_rare_score). */
+static void test_bidir_deterministic_walks(void **state)
+{
+    (void)state;
+    /* M_ij = 0.3 for j = i + 1, i + 2 (7 states): x_t = 0 for t > s, and state 6 has no moves in M */
+    int32_t ti[] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5}, tj[] = {1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6};
+    double tx[] = {0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3};
+    ulam_csr *N = NULL, *Nt = NULL;
+    assert_int_equal(ulam_csr_from_triplets(7, 7, 11, ti, tj, tx, &N), ULAM_OK);
+    assert_int_equal(ulam_csr_transpose(N, &Nt), ULAM_OK);
+    static const struct { int64_t s, t; double rmax; int est; } cases[] = {
+        {1, 5, 2, ULAM_COLLISION}, /* no push; walks from 1 on N' never reach 5: x = 0 exactly */
+        {1, 5, 2, ULAM_EXPECTED},  {1, 5, 2, ULAM_ABSORPTION},
+        {0, 0, 2, ULAM_COLLISION}, /* walks from 0 on N' have no moves and score r_0 = 1: x = 1 */
+    };
+    for (int k = 0; k < 4; k++) { /* case k */
+        double *x = exact_column(N, cases[k].s);
+        ulam_bidir_opts o = ulam_bidir_defaults();
+        o.source = cases[k].s, o.target = cases[k].t, o.rmax = cases[k].rmax, o.walk.estimator = cases[k].est;
+        o.walk.max_walks = 0, o.walk.rel_err = 0.1;
+        ulam_bidir_result res = bidir(N, Nt, &o);
+        if (!(res.std_error == 0 && res.estimate == x[cases[k].t]))
+            print_error("case %d: %.6g +- %.3g, exact %.6g\n", k, res.estimate, res.std_error, x[cases[k].t]);
+        assert_true(res.std_error == 0 && res.estimate == x[cases[k].t] && res.walks.walks >= 1000);
+        free(x);
+    }
+    ulam_csr_free(N), ulam_csr_free(Nt);
+}
+
 /* The time rule stops a run with no walk cap (its first block whole), and a run of a handful of
  * walks reports what it has: an estimate within 4 sigma when the walks scored differently. */
 static void test_bidir_small_budgets(void **state)
@@ -321,7 +353,7 @@ int main(void)
         cmocka_unit_test(test_push_invariant), cmocka_unit_test(test_push_bad_input),
         cmocka_unit_test(test_bidir_unbiased), cmocka_unit_test(test_bidir_coverage),
         cmocka_unit_test(test_bidir_rules),    cmocka_unit_test(test_bidir_rare_score),
-        cmocka_unit_test(test_bidir_small_budgets),
+        cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
