@@ -224,16 +224,22 @@ static void test_bidir_coverage(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* M_ij = 0.3 for j = i + 1, i + 2 over 7 states: nilpotent, so every push ends with r = 0. */
+static ulam_csr *nilpotent(void)
+{
+    int32_t ti[] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5}, tj[] = {1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6};
+    double tx[] = {0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3};
+    ulam_csr *N = NULL;
+    assert_int_equal(ulam_csr_from_triplets(7, 7, 11, ti, tj, tx, &N), ULAM_OK);
+    return N;
+}
+
 /* A push that leaves no residual is exact (no walks, zero stderr); a --rel-err rule stops on the
  * whole estimate p_s + <r, x>; the result does not depend on the thread count. */
 static void test_bidir_rules(void **state)
 {
     (void)state;
-    /* M_ij = 0.3 for j = i + 1, i + 2: nilpotent, so the push from 1 ends with r = 0 */
-    int32_t ti[] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5}, tj[] = {1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6};
-    double tx[] = {0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3};
-    ulam_csr *N = NULL, *Nt = NULL;
-    assert_int_equal(ulam_csr_from_triplets(7, 7, 11, ti, tj, tx, &N), ULAM_OK);
+    ulam_csr *N = nilpotent(), *Nt = NULL; /* the push from 1 ends with r = 0 */
     assert_int_equal(ulam_csr_transpose(N, &Nt), ULAM_OK);
     double *xn = exact_column(N, 5);
     ulam_bidir_opts o = ulam_bidir_defaults();
@@ -273,11 +279,7 @@ static void test_bidir_rules(void **state)
 static void test_bidir_deterministic_walks(void **state)
 {
     (void)state;
-    /* M_ij = 0.3 for j = i + 1, i + 2 (7 states): x_t = 0 for t > s, and state 6 has no moves in M */
-    int32_t ti[] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5}, tj[] = {1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6};
-    double tx[] = {0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3};
-    ulam_csr *N = NULL, *Nt = NULL;
-    assert_int_equal(ulam_csr_from_triplets(7, 7, 11, ti, tj, tx, &N), ULAM_OK);
+    ulam_csr *N = nilpotent(), *Nt = NULL; /* x_t = 0 for t > s; N' has no moves from 0 */
     assert_int_equal(ulam_csr_transpose(N, &Nt), ULAM_OK);
     static const struct { int64_t s, t; double rmax; int est; } cases[] = {
         {1, 5, 2, ULAM_COLLISION}, /* no push; walks from 1 on N' never reach 5: x = 0 exactly */
