@@ -23,7 +23,7 @@
  *                  against the exact value (an oracle stop: a lower bound on what push alone
  *                  needs without knowing x_t); capped at PUSH_CAP seconds (a lower bound, marked).
  * The transpose M' is built once (its time is printed apart): a query never repeats it.
- * Usage: bench_bidir [L] (default 20: n = 1048576). */
+ * Usage: bench_bidir [L [SOURCES]] (default 20 and 20: n = 1048576, 100 pairs). */
 #include "gen.h"
 
 #include <math.h>
@@ -184,16 +184,16 @@ static double push_alone(ulam_push *w, int64_t s, int64_t t, double exact, int *
     }
 }
 
-/* Print one row of the table. */
-static void row(const char *name, const series *S, const series *ref)
+/* Print one row of the table over the first np pairs. */
+static void row(const char *name, const series *S, const series *ref, int np)
 {
     int marked = 0;
-    for (int k = 0; k < PAIRS; k++) marked += S->marked[k] > 0;
-    double med = quantile(S->seconds, PAIRS, 0.5), p90 = quantile(S->seconds, PAIRS, 0.9);
-    double rmed = med / quantile(ref->seconds, PAIRS, 0.5), rp90 = p90 / quantile(ref->seconds, PAIRS, 0.9);
+    for (int k = 0; k < np; k++) marked += S->marked[k] > 0;
+    double med = quantile(S->seconds, np, 0.5), p90 = quantile(S->seconds, np, 0.9);
+    double rmed = med / quantile(ref->seconds, np, 0.5), rp90 = p90 / quantile(ref->seconds, np, 0.9);
     double ratio[PAIRS];
-    for (int k = 0; k < PAIRS; k++) ratio[k] = S->seconds[k] / ref->seconds[k];
-    printf("%-22s %10.4f %10.4f %9.1fx %9.1fx %12.1fx   ", name, med, p90, rmed, rp90, quantile(ratio, PAIRS, 0.5));
+    for (int k = 0; k < np; k++) ratio[k] = S->seconds[k] / ref->seconds[k];
+    printf("%-22s %10.4f %10.4f %9.1fx %9.1fx %12.1fx   ", name, med, p90, rmed, rp90, quantile(ratio, np, 0.5));
     if (S->intervals) printf("%3d/%-3d", S->covered, S->intervals);
     else printf("  -    ");
     printf("   %d\n", marked);
@@ -201,9 +201,9 @@ static void row(const char *name, const series *S, const series *ref)
 
 int main(int argc, char **argv)
 {
-    int L = argc > 1 ? atoi(argv[1]) : 20;
-    if (L < 8 || L > 24) {
-        fprintf(stderr, "usage: bench_bidir [L], 8 <= L <= 24\n");
+    int L = argc > 1 ? atoi(argv[1]) : 20, nsrc = argc > 2 ? atoi(argv[2]) : SOURCES, np = nsrc * TARGETS;
+    if (L < 8 || L > 24 || nsrc < 1 || nsrc > SOURCES) {
+        fprintf(stderr, "usage: bench_bidir [L [SOURCES]], 8 <= L <= 24, 1 <= SOURCES <= %d\n", SOURCES);
         return 2;
     }
     double t0 = ulam_now();
@@ -229,7 +229,7 @@ int main(int argc, char **argv)
     int k = 0;
     printf("\n%4s %8s %8s %12s %10s %9s %9s %9s %10s %10s %7s %9s %9s %9s\n", "pair", "s", "t", "exact", "bidir_s",
            "push_s", "walks_s", "rmax", "walks", "predicted", "z", "walk1_s", "push1_s", "push1_rmax");
-    for (int src = 0; src < SOURCES;) {
+    for (int src = 0; src < nsrc;) {
         int64_t s = (int64_t)ulam_rng_bounded(&r, (uint64_t)n);
         double g0 = ulam_now();
         int sweeps = exact_column(M, s, x, old, b);
@@ -262,19 +262,19 @@ int main(int argc, char **argv)
         }
         src++;
     }
-    printf("\nexact values: Gauss-Seidel, %.1f s for %d sources (up to %.0f sweeps)\n", gs_seconds, SOURCES, gs_max_sweeps);
+    printf("\nexact values: Gauss-Seidel, %.1f s for %d sources (up to %.0f sweeps)\n", gs_seconds, nsrc, gs_max_sweeps);
     printf("bidirectional work: push %.3g operations/s, walks %.3g steps/s (one thread; the balance takes a step "
            "as 1 operation)\n", sum_push_ops / sum_push_s, sum_steps / sum_walk_s);
     printf("\n%d pairs at %.0f%% relative error, one thread; seconds per query (median, 90th percentile), ratios to "
-           "bidirectional\n", PAIRS, 100 * REL);
+           "bidirectional\n", np, 100 * REL);
     printf("%-22s %10s %10s %10s %10s %13s   %-7s   %s\n", "method", "median", "p90", "med/bidir", "p90/bidir",
            "median ratio", "cover95", "marked");
-    row("bidirectional", &bi, &bi);
-    row("walks (*, ! projected)", &wk, &bi);
-    row("push, oracle (> cap)", &pu, &bi);
+    row("bidirectional", &bi, &bi, np);
+    row("walks (*, ! projected)", &wk, &bi, np);
+    row("push, oracle (> cap)", &pu, &bi, np);
     printf("bidirectional parts: push median %.4f s (p90 %.4f), walks median %.4f s (p90 %.4f); the rest is the "
-           "pilot and the walk solver's set-up\n", quantile(bi.other, PAIRS, 0.5), quantile(bi.other, PAIRS, 0.9),
-           quantile(bi.walk, PAIRS, 0.5), quantile(bi.walk, PAIRS, 0.9));
+           "pilot and the walk solver's set-up\n", quantile(bi.other, np, 0.5), quantile(bi.other, np, 0.9),
+           quantile(bi.walk, np, 0.5), quantile(bi.walk, np, 0.9));
     free(x), free(old), free(b), free(e), free(cand);
     ulam_push_free(w);
     ulam_csr_free(M), ulam_csr_free(Mt);
