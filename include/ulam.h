@@ -391,6 +391,8 @@ typedef struct ulam_walk_opts {
                                 solver's ulam_solver_guard, a prepared system): used instead of
                                 computing them when they hold the radii this run needs; NULL:
                                 the solver computes them */
+    double rel_err_offset; /* a known exact part c of the answer c + estimate (bidirectional's push
+                              part): rel_err is then relative to |c + estimate| (0: none) */
 } ulam_walk_opts;
 
 /* The defaults: adjoint collision walks, index 0, analog kernel, seed 1, all cores,
@@ -573,6 +575,128 @@ int ulam_gmres(const ulam_csr *M, const double *b, int restart, double tol, int 
 
 /* Nonzero when M equals its transpose exactly. */
 int ulam_csr_symmetric(const ulam_csr *M);
+
+/* ---------------------------------------------------------------- point sources: push and bidirectional */
+
+/* Reverse local push from a target t on the adjoint equation (src/push.c): estimates p and
+ * residuals r with x_t = <p, b> + <r, x> for every b, where (I - M) x = b.  Pushing j moves r_j
+ * into p_j and adds M_jk r_j to r_k over row j of M.  An opaque workspace, reused across
+ * targets (a new start clears only the states the last one touched). */
+typedef struct ulam_push ulam_push;
+
+/* What the pushes since the last start did. */
+typedef struct ulam_push_info {
+    int64_t target;  /* 0-based; -1 before any start */
+    double rmax;     /* every |r_j| <= rmax once a run has returned ULAM_OK */
+    int64_t pushes;  /* states pushed */
+    int64_t ops;     /* work: nonzeros of M read, plus one per push */
+    int64_t touched; /* states whose p or r was ever set */
+    int64_t support; /* states with r_j != 0 */
+    double r_sum, r_max; /* sum and largest of |r_j| */
+    double seconds;  /* wall time in ulam_push_run */
+} ulam_push_info;
+
+/* A workspace for pushes on the square matrix M, which is borrowed until the workspace is freed. */
+int ulam_push_alloc(const ulam_csr *M, ulam_push **out);
+
+/* Free a workspace; accepts and returns NULL. */
+ulam_push *ulam_push_free(ulam_push *w);
+
+/* Start over for target t (0-based): p = 0, r = e_t; ULAM_EINVAL when t is out of range. */
+int ulam_push_start(ulam_push *w, int64_t target);
+
+/* Push every state with |r_j| > rmax until none is left (FIFO order); ULAM_EINVAL for rmax <= 0 or
+ * no start; ULAM_ENOCONV when the work passes max_ops (> 0; 0 is no cap), the invariant intact. */
+int ulam_push_run(ulam_push *w, double rmax, int64_t max_ops);
+
+/* The dense estimates p and residuals r (n entries each, owned by the workspace). */
+const double *ulam_push_estimates(const ulam_push *w);
+const double *ulam_push_residuals(const ulam_push *w);
+
+/* Fill *info about the pushes since the last start. */
+void ulam_push_report(const ulam_push *w, ulam_push_info *info);
+
+/* Bidirectional estimate of x_t of (I - M) x = e_s (src/bidir.c; Lofgren, Banerjee, Goel, "Personalized
+ * PageRank estimation and search: a bidirectional approach", WSDM 2016): a reverse push from t gives
+ * x_t = p_s + <r, x>, and <r, x> = e_s' (I - M')^-1 r is the unknown s of the system (M', r),
+ * estimated by the adjoint walk solver on M' from s scoring r (walks forward from the source).
+ * Each score is at most rmax x the walk's weight sum, so the variance falls with rmax. */
+typedef struct ulam_bidir_opts {
+    int64_t target, source; /* 0-based t and s */
+    double rmax;       /* push threshold; <= 0: balance the push's work against the walks' predicted work */
+    double min_value;  /* the smallest |x_t| the balance plans for (<= 0: 1 / n) */
+    int64_t max_push_ops; /* cap on the push's work (0: 100 nnz(M) + 10^6); past it ULAM_ENOCONV */
+    ulam_walk_opts walk;  /* the walks' kernel, seed, threads and stopping rules (mode and index are
+                             set here); rel_err applies to the whole estimate p_s + <r, x> */
+} ulam_bidir_opts;
+
+/* The defaults: balanced rmax, min_value 1 / n, ulam_walk_defaults() walks. */
+ulam_bidir_opts ulam_bidir_defaults(void);
+
+/* What a bidirectional estimate found. */
+typedef struct ulam_bidir_result {
+    double estimate, std_error, ci95[2]; /* of x_t: p_s plus the walks' estimate of <r, x> */
+    double push_part;      /* p_s, exact given the push */
+    ulam_push_info push;   /* the push (its seconds are push_seconds) */
+    ulam_walk_result walks; /* the walks' estimate of <r, x> (0 walks when r = 0: exact) */
+    int64_t pilot_walks;   /* walks that measured the mean walk length for the balance */
+    double mean_visits;    /* states a walk visits on average (pilot) */
+    double predicted_walks; /* walks the balance predicted for the target at its rmax (NaN: rmax given) */
+    double seconds;        /* the whole estimate: pilot, push, walk set-up and walks */
+} ulam_bidir_result;
+
+/* Estimate x_t of (I - M) x = e_s with push workspace w (on M) and Mt, the transpose of M (borrowed;
+ * computing it is one O(nnz) pass the caller makes once for any number of queries).  ULAM_OK,
+ * ULAM_EINVAL (bad options, index out of range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap),
+ * the walk solver's statuses. */
+int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
+                     ulam_error *err);
+
+/* ---------------------------------------------------------------- choosing the method */
+
+/* One candidate of ulam_auto_choose: a mode, an estimator and a continuation. */
+typedef struct ulam_auto_candidate {
+    int mode, estimator;
+    double continue_q;    /* <= 0: analog */
+    ulam_power hat;       /* rho(M^) of this candidate's kernel, with Collatz-Wielandt bounds */
+    int certified;        /* hat.upper < 1 and rho(|M|)'s upper bound < 1: variance certified finite */
+    int status;           /* ULAM_OK, or why the solver refused it (ULAM_EUNDEFINED: absorption with p* = 0) */
+    int64_t pilot_walks;  /* 0: not piloted (not certified, or refused) */
+    double estimate, variance, seconds_per_walk; /* the pilot's (its estimate is not used) */
+    double cost;          /* variance x seconds per walk; INFINITY when not piloted */
+    double predicted_seconds; /* walks for base rel_err x seconds a walk (NaN without rel_err) */
+} ulam_auto_candidate;
+
+/* At most 2 modes x 3 estimators x 2 continuations. */
+#define ULAM_AUTO_MAX 12
+
+/* What the choice may vary: a pinned part keeps base's value. */
+typedef struct ulam_auto_opts {
+    int pin_mode, pin_estimator, pin_continue;
+    double continue_q;   /* the fixed continuation tried beside analog (default 0.9) */
+    int64_t pilot_walks; /* walks a pilot (default 2048) */
+    double pilot_seconds; /* and at most this long, its first block of 1024 walks whole (default 0.02; 0 off) */
+} ulam_auto_opts;
+
+/* The default options: nothing pinned, Q = 0.9, pilots of 2048 walks or 0.02 s. */
+ulam_auto_opts ulam_auto_defaults(void);
+
+/* The candidates and the choice. */
+typedef struct ulam_auto_result {
+    int ncand;
+    ulam_auto_candidate cand[ULAM_AUTO_MAX];
+    int chosen;     /* the certified, piloted candidate of least cost; -1 when none is certified */
+    int closest;    /* the candidate of least rho(M^) (named when none is certified) */
+    ulam_power abs; /* rho(|M|) */
+    double seconds; /* guards and pilots */
+} ulam_auto_result;
+
+/* Screen mode x estimator x continuation (less what is pinned) with the guards, keep the candidates
+ * whose variance is certified finite, run a pilot of each (seeds of their own, so the walks that then
+ * estimate with the chosen method are fresh and the choice does not bias them) and choose the least
+ * variance x seconds per walk.  Walks across processes (base->share) agree on rank 0's choice. */
+int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                     ulam_auto_result *res, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
 

@@ -526,7 +526,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
 /* Nonzero when the rel_err rule holds for r (see ulam_solve in ulam.h). */
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
 {
-    double E = s->o.rel_err, m = fabs(r->estimate);
+    double E = s->o.rel_err, m = fabs(r->estimate + s->o.rel_err_offset);
     if (!(E > 0) || s->var_finite != 1 || r->walks < ULAM__REL_MIN) return 0;
     if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
     if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.index] == 0))
@@ -619,7 +619,8 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->max_share = sumsq > 0 ? fmin(1.0, s->maxsq / sumsq) : 0.0;
     r->variance_finite = s->var_finite;
     r->variance_rel_error = ulam__moments_variance_rel_error(mom);
-    double m = fabs(r->estimate), N = (double)s->walks, E = s->o.rel_err > 0 ? s->o.rel_err : TAIL_E;
+    double m = fabs(r->estimate + s->o.rel_err_offset), N = (double)s->walks;
+    double E = s->o.rel_err > 0 ? s->o.rel_err : TAIL_E;
     double R = score_range(s, m, E);
     r->score_bound = s->bound;
     r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;

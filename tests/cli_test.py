@@ -102,6 +102,36 @@ CASES += [
      r"forward walks, expected estimator"),
 ]
 
+PS = ["solve", M + "randsub1000.mtx", "--index", "7"]
+CASES += [
+    # point sources: --source S sets b = e_S (src/cli/bidir.c)
+    (PS + ["--source", "1001"], 2, r"--source 1001 is out of range 1..1000", r"^$"),
+    (PS + ["--source", "0"], 2, r"--source expects an integer from 1", r"^$"),
+    (PS + ["--source", "3", "--rhs", M + "randsub1000_b.mtx"], 2, r"--source S sets b = e_S: it cannot go with --rhs", r"^$"),
+    (PS + ["--source", "3", "--rmax", "0"], 2, r"--rmax expects a number from", r"^$"),
+    (PS + ["--source", "3", "--rmax", "-0.1"], 2, r"--rmax expects a number from", r"^$"),
+    (PS + ["--source", "3", "--rmax", "nan"], 2, r"--rmax expects a number from", r"^$"),
+    (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
+    (["solve", M + "randsub1000.mtx", "--source", "3"], 2, r"--source S needs --index I", r"^$"),
+    (PS + ["--source", "3", "--method", "forward"], 2, r"go with --method bidirectional, got 'forward'", r"^$"),
+    (PS + ["--source", "3", "--out", "x.mtx"], 2, r"unknown option for a --source solve", r"^$"),
+    (["solve", M + "divergent200.mtx", "--index", "1", "--source", "2"], 3, r"rho\(\|M\|\) is >= 1 \(certified: bounds \[1\.1, 1\.1\]\)", r"^$"),
+    (PS + ["--source", "3", "--walks", "20000", "--check"], 0, r"^$", r"method\s+bidirectional.*\n.*push\s+rmax"),
+    (["solve", "--source", "1", "--help"], 0, r"^$", r"reverse push from I"),
+    # walks that can only score 0 end a --rel-err run (they used to run forever)
+    (["solve", D + "dag5.mtx", "--index", "5", "--source", "1", "--rmax", "2", "--rel-err", "0.1"], 0, r"^$",
+     r"x\[5\]\s+0 \+- 0 "),
+]
+
+CASES += [
+    # --method auto (src/cli/auto.c)
+    (RS + ["--method", "sideways"], 2, r"--method expects auto, bidirectional \(with --source\), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got 'sideways'", r"^$"),
+    (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--method", "auto",
+      "--rel-err", "0.01"], 3, r"error: --method auto: no candidate has a certified finite variance; the closest is .*"
+     r"a --rel-err target cannot be met honestly", r"^$"),
+    (RS + ["--method", "auto", "--walks", "20000"], 0, r"^$", r"auto\s+chose the least variance x seconds a walk from 12 candidates"),
+]
+
 
 O = D + "obj/"
 SC = "examples/scenes/"
@@ -738,6 +768,56 @@ def check_radiosity_patches(ulam):
     assert all(len([k for k in p if k in ("R", "G", "B", "R_se", "G_se", "B_se")]) == 6 for p in j["patches"])
     rc, out, err = run(ulam, ["radiosity", R + "cube_black_lamp.obj", "--mode", "shoot", "--walks", "2000", "--all"])
     assert rc == 0 and re.search(r"^ +4 right +4 +1 +0\.5 +0\.5 +1 ", out, re.M), out
+def check_bidir(ulam):
+    """solve --source --json: seconds covers the whole estimate and push_seconds the push; the
+    estimate agrees with LAPACK within 4 sigma; threads do not matter; --rel-err stops on the
+    whole estimate; a push that leaves no residual is exact."""
+    base = PS + ["--source", "3", "--rmax", "0.02", "--walks", "30000", "--json", "--check"]
+    outs = []
+    for t in ("1", "2"):
+        rc, out, err = run(ulam, base + ["--threads", t])
+        assert rc == 0, err
+        outs.append(json.loads(out))
+    o = outs[0]
+    for k in ["index", "source", "method", "estimate", "stderr", "ci95", "rmax", "push_part", "pushes", "push_ops",
+              "residual_support", "push_seconds", "walks", "steps", "walk_seconds", "seconds", "transpose_seconds",
+              "direct", "z", "interrupted"]:
+        assert k in o, k
+    assert o["method"] == "bidirectional" and o["index"] == 7 and o["source"] == 3 and o["walks"] == 30000, o
+    assert o["rmax"] == 0.02 and o["rmax_balanced"] is False and o["pushes"] > 0 and o["residual_support"] > 0, o
+    assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
+    assert o["push_seconds"] <= o["seconds"] and o["walk_seconds"] <= o["seconds"], o
+    assert outs[0]["estimate"] == outs[1]["estimate"] and outs[0]["stderr"] == outs[1]["stderr"]
+    rc, out, err = run(ulam, PS + ["--source", "3", "--rel-err", "0.02", "--json"])
+    o = json.loads(out)
+    assert rc == 0 and o["rmax_balanced"] is True and o["pilot_walks"] == 256, o
+    assert o["stderr"] <= 0.02 * abs(o["estimate"]) and o["walks"] >= 1000, o
+    rc, out, err = run(ulam, ["solve", D + "dag5.mtx", "--index", "1", "--source", "5", "--rmax", "1e-3", "--json",
+                              "--check"])
+    o = json.loads(out)
+    assert rc == 0 and o["residual_support"] == 0 and o["walks"] == 0 and o["stderr"] == 0, o
+    assert abs(o["estimate"] - o["direct"]) < 1e-14 and o["estimate"] > 0.3, o
+
+
+def check_auto(ulam):
+    """solve --method auto --json: the candidates (certified iff the upper bound of rho(M^) is below 1),
+    the chosen one is what ran, the estimate agrees with LAPACK; pins leave only what they allow."""
+    rc, out, err = run(ulam, RS + ["--method", "auto", "--rel-err", "0.02", "--json", "--check"])
+    assert rc == 0, err
+    o = json.loads(out)
+    a = o["auto"]
+    assert len(a["candidates"]) == 12 and 0 <= a["chosen"] < 12, a
+    for c in a["candidates"]:
+        assert c["certified"] == (c["rho_hat_upper"] < 1), c
+        assert (c["pilot_walks"] > 0) == (c["certified"] and c["status"] == "ok"), c
+    ch = a["candidates"][a["chosen"]]
+    assert ch["mode"] == o["mode"] and ch["estimator"] == o["estimator"], (ch, o)
+    assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"] and o["stderr"] <= 0.02 * abs(o["estimate"]), o
+    rc, out, err = run(ulam, RS + ["--method", "auto", "--mode", "forward", "--continue", "0.8", "--walks", "5000", "--json"])
+    assert rc == 0, err
+    o = json.loads(out)
+    assert len(o["auto"]["candidates"]) == 3 and o["mode"] == "forward", o
+    assert all(c["mode"] == "forward" and c["continue"] == 0.8 for c in o["auto"]["candidates"]), o
 
 
 def check_genmat(genmat):
@@ -759,7 +839,8 @@ def main():
              (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
-             (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam)]
+             (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
+             (check_bidir, ulam), (check_auto, ulam)]
     for f, arg in extra:
         try:
             f(arg)

@@ -30,6 +30,8 @@ def main():
                                "--walks", "50000", "--seed", "9", "--json"], None),
             ("solve adjoint rel-err", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
                                        "--index", "3", "--rel-err", "0.005", "--json"], None),
+            ("solve bidirectional", ["solve", "matrices/randsub1000.mtx", "--index", "7", "--source", "3",
+                                     "--rel-err", "0.01", "--json"], None),
             ("solve forward", ["solve", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
                                "1", "--mode", "forward", "--walks", "30000", "--json", "--out", "{d}/x.mtx"], "x.mtx"),
             ("solve mcsa", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx", "--method",

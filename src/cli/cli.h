@@ -112,6 +112,15 @@ void cli_json_radius(const char *prefix, const ulam_power *p);
 int cli_info(int argc, char **argv);
 int cli_direct(int argc, char **argv);
 int cli_solve(int argc, char **argv);
+/* solve with a point source (--source S, src/cli/bidir.c): cli_solve hands argv over when claimed. */
+int cli_bidir_claims(int argc, char **argv);
+int cli_bidir(int argc, char **argv);
+
+/* solve --method auto (src/cli/auto.c): choose the method for the loaded s and set o (what argv pins
+ * stays); 0 or an exit code.  Then print the candidates as text, or as the JSON key "auto". */
+int cli_auto_choose(const cli_system *s, int argc, char **argv, ulam_walk_opts *o, ulam_auto_result *res);
+void cli_auto_print_text(const ulam_auto_result *res);
+void cli_auto_print_json(const ulam_auto_result *res);
 int cli_study(int argc, char **argv);
 
 /* ulam solve --method (src/cli/mcsa.c): nonzero when argv asks for it, and the command. */

@@ -49,8 +49,12 @@ static const char *const est_names[] = {"collision", "absorption", "expected"};
 /* Nonzero when argv (after the subcommand) asks for an outer iteration. */
 int cli_solve_wants_method(int argc, char **argv)
 {
-    for (int k = 1; k < argc; k++)
-        if (!strcmp(argv[k], "--method") || !strncmp(argv[k], "--method=", 9)) return 1;
+    for (int k = 1; k < argc; k++) {
+        const char *v = !strncmp(argv[k], "--method=", 9) ? argv[k] + 9
+                        : !strcmp(argv[k], "--method") && k + 1 < argc ? argv[k + 1] : NULL;
+        if (!strcmp(argv[k], "--method") && !v) return 1; /* its parser reports the missing value */
+        if (v && strcmp(v, "auto") && strcmp(v, "bidirectional")) return 1; /* those two: cli_solve, cli_bidir */
+    }
     return 0;
 }
 
@@ -300,8 +304,8 @@ int cli_solve_method(int argc, char **argv)
         case 'b': s.rhs_path = optarg; break;
         case 'M':
             if ((p.method = cli_lookup(optarg, method_names, 6)) < 0)
-                return cli_usage_error("solve", "--method expects mcsa, sequential, richardson, gauss-seidel, cg or "
-                                                "gmres, got '%s'", optarg);
+                return cli_usage_error("solve", "--method expects auto, bidirectional (with --source), mcsa, "
+                                                "sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
             if (p.method < KRYLOV_CG) o.method = p.method;
             break;
         case 'r':

@@ -15,6 +15,9 @@ static const char *const usage =
     "                  [--split W] [--max-steps K] [--jacobi [--omega W]] [--check] [--json]\n"
     "                  [--out x.mtx] [--errors e.mtx] [--force] [--assume-finite-variance]\n"
     "                  [--cache] [--whole-kernel]\n"
+    "                  [--method auto]\n"
+    "       ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R] ...\n"
+    "                  (b = e_S: a reverse push from I and walks from S; --source --help)\n"
     "\n"
     "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
     "Indices are 1-based, as in Matrix Market files.\n"
@@ -49,6 +52,9 @@ static const char *const usage =
     "                     whether rho(M^) < 1 (unknown is otherwise treated as infinite)\n"
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
     "                     that instead of parsing while the file is unchanged (size, mtime)\n"
+    "  --method auto      choose mode, estimator and continuation (those given stay pinned)\n"
+    "                     among candidates the guards certify, by short pilots; fresh walks\n"
+    "                     then estimate with the choice\n"
     "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
     "                     is built when a walk first reaches it, so one unknown of a large\n"
     "                     system reads and keeps only the rows its walks visit)\n"
@@ -75,6 +81,7 @@ typedef struct {
     int assume_finite;
     int64_t n;
     double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the solver set-up */
+    const ulam_auto_result *au; /* --method auto: the candidates and the choice (else NULL) */
 } report_opts;
 
 /* Peak resident memory of this process so far, in MiB. */
@@ -136,6 +143,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
                "decide)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
+    if (ro->au) cli_auto_print_text(ro->au);
     if (ro->check)
         printf("direct          %.10g (LAPACK, %.4f s), z = %.3f\n", ro->direct, ro->direct_seconds,
                (r->estimate - ro->direct) / r->std_error);
@@ -190,6 +198,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         cli_json_number("direct_seconds", ro->direct_seconds, 0);
         cli_json_number("z", (r->estimate - ro->direct) / r->std_error, 0);
     }
+    if (ro->au) cli_auto_print_json(ro->au);
     printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
 }
 
@@ -282,14 +291,16 @@ int cli_solve(int argc, char **argv)
         {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
         {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
         {"whole-kernel", no_argument, 0, 'W'},    {"assume-finite-variance", no_argument, 0, 'A'},
-        {0, 0, 0, 0}};
-    if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv);
+        {"method", required_argument, 0, 'U'},  {0, 0, 0, 0}};
+    if (cli_bidir_claims(argc, argv)) return cli_bidir(argc, argv); /* --source S: src/cli/bidir.c */
+    if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv); /* src/cli/mcsa.c */
     cli_system s = {.command = "solve", .omega = 1.0};
     ulam_walk_opts o = ulam_walk_defaults();
     report_opts ro = {.seed = 1};
     const char *out = NULL, *errors = NULL;
     int64_t v;
-    int c, rc, any_rule = 0, force = 0;
+    int c, rc, any_rule = 0, force = 0, autom = 0;
+    ulam_auto_result au;
     o.max_walks = 0;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
@@ -316,6 +327,11 @@ int cli_solve(int argc, char **argv)
         case 'j': s.jacobi = 1; break;
         case 'C': s.cache = 1; break;
         case 'W': o.whole_kernel = 1; break;
+        case 'U':
+            if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
+            if (strcmp(optarg, "auto")) return cli_usage_error("solve", "--method expects auto, bidirectional (with --source), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
+            autom = 1;
+            break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'c': ro.check = 1; break;
         case 'J': ro.json = 1; break;
@@ -340,6 +356,12 @@ int cli_solve(int argc, char **argv)
     if ((rc = cli_load_system(&s))) return rc;
     ro.load_seconds = ulam_now() - t0;
     o.index = s.index ? s.index - 1 : 0;
+    o.share = cli_share;
+    if (autom && (rc = cli_auto_choose(&s, argc, argv, &o, &au))) {
+        cli_system_free(&s);
+        return rc;
+    }
+    ro.au = autom ? &au : NULL;
     if ((rc = cli_guard(&s, o.continue_q, o.mode, &ro.g))) {
         cli_system_free(&s);
         return rc;

@@ -1,0 +1,252 @@
+/* ulam solve --source S: one entry x_I of (I - M) x = e_S, by a reverse push from I and walks
+ * from S (--method bidirectional).  Reached from cli_solve through cli_bidir_claims. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const usage =
+    "usage: ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R]\n"
+    "                  [--min-value V] [--estimator collision|absorption|expected] [--walks N]\n"
+    "                  [--rel-err E] [--time S] [--seed S] [--threads T] [--continue Q]\n"
+    "                  [--max-steps K] [--check] [--json] [--force] [--cache]\n"
+    "\n"
+    "Estimate x_I of (I - M) x = e_S (a point source at S; no --rhs file) with an error bar:\n"
+    "a reverse push from I on the adjoint equation leaves x_I = p_S + <r, x> with every\n"
+    "|r_j| <= R, then walks from S (on the columns of M) score the residual r.\n"
+    "Indices are 1-based.\n"
+    "\n"
+    "  --rmax R           push threshold (default: balance the push's work against the work\n"
+    "                     the walks are predicted to need for the target)\n"
+    "  --min-value V      the smallest x_I the balance plans for (default 1 / n)\n"
+    "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
+    "  the other options are those of 'ulam solve'; the walks are walks on M' from S, so the\n"
+    "  guards reported are those of the forward kernel\n";
+
+/* Nonzero when argv asks for a point-source solve (--source, --rmax or --method bidirectional). */
+int cli_bidir_claims(int argc, char **argv)
+{
+    for (int k = 1; k < argc; k++) {
+        const char *a = argv[k];
+        if (!strcmp(a, "--")) break;
+        if (!strcmp(a, "--source") || !strncmp(a, "--source=", 9) || !strcmp(a, "--rmax") || !strncmp(a, "--rmax=", 7))
+            return 1;
+        if (!strcmp(a, "--method=bidirectional") || (!strcmp(a, "--method") && k + 1 < argc && !strcmp(argv[k + 1], "bidirectional")))
+            return 1;
+    }
+    return 0;
+}
+
+typedef struct {
+    int json, check;
+    double direct, transpose_seconds, load_seconds, guard_seconds;
+    ulam_guard g;
+} report;
+
+/* Print the human-readable block. */
+static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, const report *rp)
+{
+    const ulam_walk_result *w = &r->walks;
+    printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->target + 1,
+           o->target < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+           w->interrupted ? "  [INTERRUPTED]" : "");
+    printf("method          bidirectional: reverse push from %lld, walks from source %lld (%s rmax)\n",
+           (long long)o->target + 1, (long long)o->source + 1, o->rmax > 0 ? "given" : "balanced");
+    printf("push            rmax %.3g: %lld pushes, %lld operations, %.4f s; p_S = %.10g; residual on %lld "
+           "states, sum %.3g\n", r->push.rmax, (long long)r->push.pushes, (long long)r->push.ops, r->push.seconds,
+           r->push_part, (long long)r->push.support, r->push.r_sum);
+    if (r->push.support == 0)
+        printf("walks           none: the push left no residual, the value is exact (to rounding)\n");
+    else
+        printf("walks           %lld (%lld cut, %lld steps, %d threads)\n", (long long)w->walks, (long long)w->cut,
+               (long long)w->steps, w->threads);
+    if (o->rmax <= 0)
+        printf("balance         pilot %lld walks, %.3g visits a walk; %.3g walks predicted at this rmax\n",
+               (long long)r->pilot_walks, r->mean_visits, r->predicted_walks);
+    printf("seconds         %.4f (push %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
+           r->push.seconds, w->seconds, (unsigned long long)o->walk.seed, rp->transpose_seconds);
+    printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
+           cli_verdict_word(rp->g.verdict_abs), rp->g.hat[ULAM_FORWARD].rho, cli_verdict_word(rp->g.verdict_hat[ULAM_FORWARD]));
+    printf("load            %.3f s inputs, %.3f s guards\n", rp->load_seconds, rp->guard_seconds);
+    if (rp->check)
+        printf("direct          %.10g (LAPACK), z = %.3f\n", rp->direct,
+               r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN);
+}
+
+/* Print the JSON object. */
+static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, const report *rp)
+{
+    const ulam_walk_result *w = &r->walks;
+    int finite = rp->g.verdict_hat[ULAM_FORWARD] != ULAM_VERDICT_FAIL;
+    printf("{\"index\": %lld, \"source\": %lld, ", (long long)o->target + 1, (long long)o->source + 1);
+    cli_json_string("method", "bidirectional", 0);
+    cli_json_number("estimate", r->estimate, 0);
+    cli_json_number("stderr", r->std_error, 0);
+    printf("\"ci95\": ");
+    if (finite) {
+        printf("[");
+        cli_json_value(r->ci95[0]);
+        printf(", ");
+        cli_json_value(r->ci95[1]);
+        printf("], ");
+    } else {
+        printf("null, ");
+    }
+    printf("\"variance_finite\": %s, ", finite ? "true" : "false");
+    cli_json_number("rho_abs", rp->g.abs.rho, 0);
+    cli_json_number("rho_hat", rp->g.hat[ULAM_FORWARD].rho, 0);
+    cli_json_number("rmax", r->push.rmax, 0);
+    printf("\"rmax_balanced\": %s, ", o->rmax > 0 ? "false" : "true");
+    cli_json_number("push_part", r->push_part, 0);
+    printf("\"pushes\": %lld, \"push_ops\": %lld, \"residual_support\": %lld, ", (long long)r->push.pushes,
+           (long long)r->push.ops, (long long)r->push.support);
+    cli_json_number("residual_sum", r->push.r_sum, 0);
+    cli_json_number("push_seconds", r->push.seconds, 0);
+    printf("\"walks\": %lld, \"steps\": %lld, \"cut\": %lld, \"pilot_walks\": %lld, ", (long long)w->walks,
+           (long long)w->steps, (long long)w->cut, (long long)r->pilot_walks);
+    cli_json_number("variance", w->variance, 0);
+    cli_json_number("mean_visits", r->mean_visits, 0);
+    cli_json_number("predicted_walks", r->predicted_walks, 0);
+    cli_json_number("walk_seconds", w->seconds, 0);
+    cli_json_number("seconds", r->seconds, 0);
+    cli_json_number("transpose_seconds", rp->transpose_seconds, 0);
+    cli_json_number("load_seconds", rp->load_seconds, 0);
+    cli_json_number("guard_seconds", rp->guard_seconds, 0);
+    cli_json_string("estimator", o->walk.estimator == ULAM_COLLISION ? "collision"
+                                 : o->walk.estimator == ULAM_ABSORPTION ? "absorption" : "expected", 0);
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->walk.seed, w->threads,
+           cli_share ? cli_share->nranks : 1);
+    if (rp->check) {
+        cli_json_number("direct", rp->direct, 0);
+        cli_json_number("z", r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN, 0);
+    }
+    printf("\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
+}
+
+/* Load the system with b = e_S, check S, run the guards and --check; 0 or an exit code. */
+static int prepare(cli_system *s, int64_t source, int force, double continue_q, report *rp)
+{
+    double t0 = ulam_now();
+    int rc = cli_load_system(s);
+    if (rc) return rc;
+    rp->load_seconds = ulam_now() - t0;
+    int64_t n = s->M->nrows;
+    if (source > n)
+        return cli_usage_error("solve", "--source %lld is out of range 1..%lld", (long long)source, (long long)n);
+    if (!(s->b = calloc((size_t)n, sizeof *s->b))) {
+        fprintf(stderr, "ulam: %s: error: %s\n", s->matrix_path, ulam_strerror(ULAM_ENOMEM));
+        return cli_exit_code(ULAM_ENOMEM);
+    }
+    s->b[source - 1] = 1.0;
+    if ((rc = cli_guard(s, continue_q, ULAM_FORWARD, &rp->g))) return rc;
+    if (rp->g.verdict_abs >= ULAM_VERDICT_FAIL) {
+        cli_guard_diverge(s, &rp->g, force);
+        if (!force) return EXIT_DIVERGE;
+    }
+    cli_guard_warn(s, &rp->g, ULAM_FORWARD, 0);
+    rp->guard_seconds = rp->g.abs.seconds + rp->g.hat[0].seconds + rp->g.hat[1].seconds;
+    if (rp->check) {
+        double *x;
+        if ((rc = cli_direct_solve(s, (size_t)4 << 30, &x, NULL))) return rc;
+        rp->direct = x[s->index - 1];
+        free(x);
+    }
+    return 0;
+}
+
+/* Transpose, push, walk and print; 0 or an exit code. */
+static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
+{
+    ulam_csr *Mt = NULL;
+    ulam_push *w = NULL;
+    double t0 = ulam_now();
+    int status = ulam_csr_transpose(s->M, &Mt);
+    rp->transpose_seconds = ulam_now() - t0;
+    if (!status) status = ulam_push_alloc(s->M, &w);
+    ulam_error err = {.status = status, .msg = "memory for the transpose and the push"};
+    ulam_bidir_result r;
+    o->walk.interrupt = &cli_interrupted, o->walk.share = cli_share;
+    cli_catch_sigint();
+    if (!status) status = ulam_bidir_solve(w, Mt, o, &r, &err);
+    int rc = status ? cli_report(s->matrix_path, &err) : 0;
+    if (!status) {
+        if (rp->json) print_json(o, &r, rp);
+        else print_text(o, &r, rp);
+        if (r.walks.interrupted) rc = EXIT_INTERRUPTED;
+    }
+    fflush(stdout);
+    cli_release_sigint();
+    ulam_push_free(w);
+    ulam_csr_free(Mt);
+    return rc;
+}
+
+/* ulam solve --source S. */
+int cli_bidir(int argc, char **argv)
+{
+    static const struct option longopts[] = {
+        {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
+        {"source", required_argument, 0, 'u'},    {"method", required_argument, 0, 'M'},
+        {"rmax", required_argument, 0, 'x'},      {"min-value", required_argument, 0, 'v'},
+        {"estimator", required_argument, 0, 'e'}, {"walks", required_argument, 0, 'n'},
+        {"rel-err", required_argument, 0, 'r'},   {"time", required_argument, 0, 't'},
+        {"seed", required_argument, 0, 's'},      {"threads", required_argument, 0, 'T'},
+        {"continue", required_argument, 0, 'q'},  {"max-steps", required_argument, 0, 'K'},
+        {"check", no_argument, 0, 'c'},           {"json", no_argument, 0, 'J'},
+        {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
+        {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
+    static const char *const est_names[] = {"collision", "absorption", "expected"};
+    cli_system s = {.command = "solve", .omega = 1.0};
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    report rp = {0};
+    int64_t v, source = 0;
+    int c, rc, any_rule = 0, force = 0;
+    o.walk.max_walks = 0;
+    optind = 0;
+    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'b': s.rhs_path = optarg; break;
+        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
+        case 'u': if ((rc = cli_parse_int("solve", "--source", optarg, 1, ULAM_MAX_DIM, &source))) return rc; break;
+        case 'M':
+            if (strcmp(optarg, "bidirectional"))
+                return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
+            break;
+        case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &o.rmax))) return rc; break;
+        case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &o.min_value))) return rc; break;
+        case 'e':
+            if ((o.walk.estimator = cli_lookup(optarg, est_names, 3)) < 0)
+                return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
+            break;
+        case 'n': if ((rc = cli_parse_int("solve", "--walks", optarg, 1, INT64_MAX / 2, &o.walk.max_walks))) return rc; any_rule = 1; break;
+        case 'r': if ((rc = cli_parse_real("solve", "--rel-err", optarg, 1e-12, 1.0, &o.walk.rel_err))) return rc; any_rule = 1; break;
+        case 't': if ((rc = cli_parse_real("solve", "--time", optarg, 1e-6, 1e9, &o.walk.max_seconds))) return rc; any_rule = 1; break;
+        case 's': if ((rc = cli_parse_int("solve", "--seed", optarg, 0, INT64_MAX, &v))) return rc; o.walk.seed = (uint64_t)v; break;
+        case 'T': if ((rc = cli_parse_int("solve", "--threads", optarg, 1, 1024, &v))) return rc; o.walk.threads = (int)v; break;
+        case 'q': if ((rc = cli_parse_real("solve", "--continue", optarg, 1e-9, 1 - 1e-12, &o.walk.continue_q))) return rc; break;
+        case 'K': if ((rc = cli_parse_int("solve", "--max-steps", optarg, 1, INT64_MAX / 2, &o.walk.max_steps))) return rc; break;
+        case 'c': rp.check = 1; break;
+        case 'J': rp.json = 1; break;
+        case 'F': force = 1; break;
+        case 'C': s.cache = 1; break;
+        case 'h': fputs(usage, stdout); return 0;
+        default: return cli_usage_error("solve", "unknown option for a --source solve");
+        }
+    }
+    if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
+    if (s.rhs_path) return cli_usage_error("solve", "--source S sets b = e_S: it cannot go with --rhs");
+    if (!source) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
+    if (!s.index) return cli_usage_error("solve", "--source S needs --index I");
+    if (!any_rule) o.walk.max_walks = 100000;
+    o.walk.force = force;
+    s.matrix_path = argv[optind];
+    if (!(rc = prepare(&s, source, force, o.walk.continue_q, &rp))) {
+        o.target = s.index - 1, o.source = source - 1;
+        rc = run(&s, &o, &rp);
+    }
+    cli_system_free(&s);
+    return rc;
+}

@@ -1,0 +1,282 @@
+/* Single-pair queries on a heavy-tailed directed graph: bidirectional (push + walks) against pure
+ * walks and against the push alone, each to 10% relative error, side by side in one run.
+ *
+ * Graph: R-MAT (Chakrabarti, Zhan, Faloutsos 2004; a = 0.57, b = c = 0.19, d = 0.05) with 2^L states
+ * and 8 2^L edges, states relabelled by a random permutation, all from stream (L, 0).  M = 0.85 P'
+ * with P the random-walk matrix of the out-edges (multi-edges counted), so x = (I - M)^-1 e_s is
+ * personalized PageRank from s (over 0.15) and x_t of one pair is the BiPPR setting: the push from t
+ * runs over in-edges (rows of M), the walks from s over out-edges (rows of M').
+ * Pairs: SOURCES random sources with at least TARGETS states t != s of x_t >= 1/n, TARGETS of those
+ * drawn uniformly; exact values from Gauss-Seidel converged to a change <= 1e-15 per sweep.
+ * Methods, one thread each, all to relative error 10%:
+ *   bidirectional  balanced rmax, stopped by rel_err 0.1 on the whole estimate;
+ *   walks          the walk solver alone: adjoint on M' from s with b = e_t (walks from s counting
+ *                  visits to t), the same stopping rule; capped at WALK_CAP seconds, a capped
+ *                  pair's time projected as its set-up and walks so far plus the walks still
+ *                  needed (variance / (10% x_t estimate)^2 - walks) at the least seconds a walk
+ *                  over its rounds (the one-off row builds and kernel completion are counted once,
+ *                  not scaled, and the rate is the walks' best: favourable to walks; marked *);
+ *                  when no walk has reached t by the cap, from the bound Var(visits to t) >=
+ *                  x_t - x_t^2 (visits are integers, so V^2 >= V): at least 100 (1 - x_t) / x_t
+ *                  walks (a lower bound, marked !);
+ *   push           push alone with rmax halving from 1 until |p_s - x_t| <= 10% x_t, checked
+ *                  against the exact value (an oracle stop: a lower bound on what push alone
+ *                  needs without knowing x_t); capped at PUSH_CAP seconds (a lower bound, marked).
+ * The transpose M' is built once (its time is printed apart): a query never repeats it.
+ * Usage: bench_bidir [L [SOURCES]] (default 20 and 20: n = 1048576, 100 pairs). */
+#include "gen.h"
+
+#include <math.h>
+
+enum { SOURCES = 20, TARGETS = 5, PAIRS = SOURCES * TARGETS };
+static const double WALK_CAP = 2.0, PUSH_CAP = 5.0, REL = 0.1, ALPHA = 0.85;
+
+/* The R-MAT graph's M = ALPHA P' (n = 2^L, 8 n edges); *dangling counts states without out-edges. */
+static ulam_csr *rmat(int L, int64_t *dangling, int64_t *maxin, int64_t *maxout)
+{
+    int64_t n = (int64_t)1 << L, m = 8 * n;
+    ulam_rng r;
+    ulam_rng_seed(&r, (uint64_t)L, 0);
+    int32_t *perm = malloc((size_t)n * sizeof *perm), *src = malloc((size_t)m * sizeof *src);
+    int32_t *dst = malloc((size_t)m * sizeof *dst);
+    int64_t *outdeg = calloc((size_t)n, sizeof *outdeg), *indeg = calloc((size_t)n, sizeof *indeg);
+    double *val = malloc((size_t)m * sizeof *val);
+    ulam_csr *M = NULL;
+    if (!perm || !src || !dst || !outdeg || !indeg || !val) goto done;
+    for (int64_t i = 0; i < n; i++) perm[i] = (int32_t)i;
+    for (int64_t i = n - 1; i > 0; i--) { /* Fisher-Yates */
+        int64_t j = (int64_t)ulam_rng_bounded(&r, (uint64_t)i + 1);
+        int32_t t = perm[i];
+        perm[i] = perm[j], perm[j] = t;
+    }
+    for (int64_t e = 0; e < m; e++) {
+        int64_t u = 0, v = 0;
+        for (int l = 0; l < L; l++) {
+            double q = ulam_rng_uniform(&r);
+            int down = q >= 0.57 + 0.19, right = (q >= 0.57 && q < 0.76) || q >= 0.95;
+            u = 2 * u + down, v = 2 * v + right;
+        }
+        src[e] = perm[u], dst[e] = perm[v];
+        outdeg[perm[u]]++, indeg[perm[v]]++;
+    }
+    *dangling = *maxin = *maxout = 0;
+    for (int64_t i = 0; i < n; i++) {
+        *dangling += outdeg[i] == 0;
+        if (indeg[i] > *maxin) *maxin = indeg[i];
+        if (outdeg[i] > *maxout) *maxout = outdeg[i];
+    }
+    for (int64_t e = 0; e < m; e++) val[e] = ALPHA / (double)outdeg[src[e]];
+    /* M_vu = ALPHA P_uv: row v of M holds v's in-neighbours u */
+    if (ulam_csr_from_triplets(n, n, m, dst, src, val, &M)) M = NULL;
+done:
+    free(perm), free(src), free(dst), free(outdeg), free(indeg), free(val);
+    return M;
+}
+
+/* x = (I - M)^-1 e_s by Gauss-Seidel until no entry moves by more than 1e-15; the sweeps done. */
+static int exact_column(const ulam_csr *M, int64_t s, double *x, double *old, double *b)
+{
+    int64_t n = M->nrows;
+    memset(x, 0, (size_t)n * sizeof *x);
+    memset(b, 0, (size_t)n * sizeof *b);
+    b[s] = 1.0;
+    int sweeps = 0;
+    for (double change = INFINITY; change > 1e-15 && sweeps < 2000; sweeps++) {
+        memcpy(old, x, (size_t)n * sizeof *x);
+        ulam_gauss_seidel_sweep(M, b, x);
+        change = 0;
+        for (int64_t i = 0; i < n; i++) change = fmax(change, fabs(x[i] - old[i]));
+    }
+    return sweeps;
+}
+
+/* One method's per-pair outcome. */
+typedef struct {
+    double seconds[PAIRS];
+    int marked[PAIRS]; /* walks: projected; push: capped (a lower bound) */
+    int covered, intervals;
+    double other[PAIRS], walk[PAIRS]; /* bidirectional: push and walk seconds */
+} series;
+
+/* qsort order of doubles. */
+static int cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The q-quantile (nearest rank) of v[0..n). */
+static double quantile(const double *v, int n, double q)
+{
+    double s[PAIRS];
+    memcpy(s, v, (size_t)n * sizeof *s);
+    qsort(s, (size_t)n, sizeof *s, cmp);
+    int k = (int)ceil(q * n) - 1;
+    return s[k < 0 ? 0 : k];
+}
+
+/* A bidirectional query (rmax 0: balanced). */
+static int query(ulam_push *w, const ulam_csr *Mt, int64_t s, int64_t t, double rmax, double cap, uint64_t seed,
+                 ulam_bidir_result *res)
+{
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    o.source = s, o.target = t, o.rmax = rmax;
+    o.walk.max_walks = 0, o.walk.rel_err = REL, o.walk.max_seconds = cap, o.walk.threads = 1, o.walk.seed = seed;
+    o.walk.max_steps = INT64_MAX / 4;
+    ulam_error err;
+    int st = ulam_bidir_solve(w, Mt, &o, res, &err);
+    if (st) fprintf(stderr, "bidir: pair (%lld, %lld): %s: %s\n", (long long)s, (long long)t, ulam_strerror(st), err.msg);
+    return st;
+}
+
+/* Pure walks from s counting visits to t (e: zeros, n entries); seconds (projected when capped: *mark
+ * 1, or 2 for a lower bound) and whether the 95% interval covers exact (-1: no interval). */
+static double walks_alone(const ulam_csr *Mt, double *e, int64_t s, int64_t t, double exact, uint64_t seed, int *mark,
+                          int *covers)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = s, o.threads = 1, o.seed = seed, o.max_walks = 0, o.max_seconds = WALK_CAP, o.max_steps = INT64_MAX / 4;
+    e[t] = 1.0;
+    ulam_solver *sv = NULL;
+    double t0 = ulam_now(), rate = INFINITY;
+    ulam_walk_result r = {0};
+    int reached = 0;
+    if (!ulam_solver_alloc(Mt, e, &o, &sv, NULL)) {
+        while (!ulam_solver_done(sv) && !reached) {
+            double s0 = r.seconds;
+            int64_t w0 = r.walks;
+            if (ulam_solver_iterate(sv)) break;
+            ulam_solver_result(sv, &r);
+            if (r.walks > w0) rate = fmin(rate, (r.seconds - s0) / (double)(r.walks - w0));
+            reached = r.walks >= 1000 && r.variance > 0 && r.std_error <= REL * fabs(r.estimate);
+        }
+    }
+    double total = ulam_now() - t0;
+    ulam_solver_free(sv);
+    e[t] = 0.0;
+    *mark = 0, *covers = -1;
+    if (reached) {
+        *covers = r.ci95[0] <= exact && exact <= r.ci95[1];
+        return total;
+    }
+    double need = r.variance > 0 ? r.variance / (REL * r.estimate * REL * r.estimate) : 100 * (1 - exact) / exact;
+    *mark = r.variance > 0 ? 1 : 2;
+    return total + fmax(0.0, need - (double)r.walks) * rate;
+}
+
+/* Push alone from t, rmax halving, until p_s is within REL of exact (or PUSH_CAP); seconds, *capped. */
+static double push_alone(ulam_push *w, int64_t s, int64_t t, double exact, int *capped, double *rmax_reached)
+{
+    ulam_push_start(w, t);
+    ulam_push_info pi;
+    for (double rmax = 1.0;; rmax /= 2) {
+        ulam_push_run(w, rmax, 0);
+        ulam_push_report(w, &pi);
+        *rmax_reached = rmax;
+        if (fabs(ulam_push_estimates(w)[s] - exact) <= REL * exact || pi.support == 0) {
+            *capped = 0;
+            return pi.seconds;
+        }
+        if (pi.seconds > PUSH_CAP) {
+            *capped = 1;
+            return pi.seconds;
+        }
+    }
+}
+
+/* Print one row of the table over the first np pairs. */
+static void row(const char *name, const series *S, const series *ref, int np)
+{
+    int marked = 0;
+    for (int k = 0; k < np; k++) marked += S->marked[k] > 0;
+    double med = quantile(S->seconds, np, 0.5), p90 = quantile(S->seconds, np, 0.9);
+    double rmed = med / quantile(ref->seconds, np, 0.5), rp90 = p90 / quantile(ref->seconds, np, 0.9);
+    double ratio[PAIRS];
+    for (int k = 0; k < np; k++) ratio[k] = S->seconds[k] / ref->seconds[k];
+    printf("%-22s %10.4f %10.4f %9.1fx %9.1fx %12.1fx   ", name, med, p90, rmed, rp90, quantile(ratio, np, 0.5));
+    if (S->intervals) printf("%3d/%-3d", S->covered, S->intervals);
+    else printf("  -    ");
+    printf("   %d\n", marked);
+}
+
+int main(int argc, char **argv)
+{
+    int L = argc > 1 ? atoi(argv[1]) : 20, nsrc = argc > 2 ? atoi(argv[2]) : SOURCES, np = nsrc * TARGETS;
+    if (L < 8 || L > 24 || nsrc < 1 || nsrc > SOURCES) {
+        fprintf(stderr, "usage: bench_bidir [L [SOURCES]], 8 <= L <= 24, 1 <= SOURCES <= %d\n", SOURCES);
+        return 2;
+    }
+    double t0 = ulam_now();
+    int64_t dangling = 0, maxin = 0, maxout = 0;
+    ulam_csr *M = rmat(L, &dangling, &maxin, &maxout), *Mt = NULL;
+    int64_t n = (int64_t)1 << L;
+    if (!M) return fprintf(stderr, "bidir: out of memory\n"), 1;
+    printf("R-MAT 2^%d: n = %lld, nnz(M) = %lld (8n edges, multi-edges merged), %lld dangling, max in-degree %lld, "
+           "max out-degree %lld; built in %.1f s\n", L, (long long)n, (long long)ulam_csr_nnz(M), (long long)dangling,
+           (long long)maxin, (long long)maxout, ulam_now() - t0);
+    t0 = ulam_now();
+    ulam_push *w = NULL;
+    if (ulam_csr_transpose(M, &Mt) || ulam_push_alloc(M, &w)) return fprintf(stderr, "bidir: out of memory\n"), 1;
+    printf("transpose M' (once, for every query): %.3f s\n", ulam_now() - t0);
+    double *x = malloc((size_t)n * sizeof *x), *old = malloc((size_t)n * sizeof *old), *b = malloc((size_t)n * sizeof *b);
+    double *e = calloc((size_t)n, sizeof *e);
+    int64_t *cand = malloc((size_t)n * sizeof *cand);
+    if (!x || !old || !b || !e || !cand) return fprintf(stderr, "bidir: out of memory\n"), 1;
+    static series bi, wk, pu;
+    ulam_rng r;
+    ulam_rng_seed(&r, (uint64_t)L, 1);
+    double gs_seconds = 0, sum_push_ops = 0, sum_steps = 0, sum_push_s = 0, sum_walk_s = 0, gs_max_sweeps = 0;
+    int k = 0;
+    printf("\n%4s %8s %8s %12s %10s %9s %9s %9s %10s %10s %7s %9s %9s %9s\n", "pair", "s", "t", "exact", "bidir_s",
+           "push_s", "walks_s", "rmax", "walks", "predicted", "z", "walk1_s", "push1_s", "push1_rmax");
+    for (int src = 0; src < nsrc;) {
+        int64_t s = (int64_t)ulam_rng_bounded(&r, (uint64_t)n);
+        double g0 = ulam_now();
+        int sweeps = exact_column(M, s, x, old, b);
+        gs_seconds += ulam_now() - g0;
+        gs_max_sweeps = fmax(gs_max_sweeps, sweeps);
+        int64_t nc = 0;
+        for (int64_t i = 0; i < n; i++)
+            if (i != s && x[i] >= 1.0 / (double)n) cand[nc++] = i;
+        if (nc < TARGETS) continue; /* a source reaching too little: draw another */
+        for (int q = 0; q < TARGETS; q++, k++) {
+            int64_t j = q + (int64_t)ulam_rng_bounded(&r, (uint64_t)(nc - q)); /* without replacement */
+            int64_t t = cand[j];
+            cand[j] = cand[q], cand[q] = t;
+            ulam_bidir_result rb;
+            if (query(w, Mt, s, t, 0, 0, (uint64_t)k + 1, &rb)) return 1;
+            bi.seconds[k] = rb.seconds, bi.other[k] = rb.push.seconds, bi.walk[k] = rb.walks.seconds;
+            bi.covered += rb.ci95[0] <= x[t] && x[t] <= rb.ci95[1], bi.intervals++;
+            sum_push_ops += (double)rb.push.ops, sum_steps += (double)rb.walks.steps;
+            sum_push_s += rb.push.seconds, sum_walk_s += rb.walks.seconds;
+            int covers;
+            wk.seconds[k] = walks_alone(Mt, e, s, t, x[t], (uint64_t)k + 1, &wk.marked[k], &covers);
+            if (covers >= 0) wk.covered += covers, wk.intervals++;
+            double prmax;
+            pu.seconds[k] = push_alone(w, s, t, x[t], &pu.marked[k], &prmax);
+            printf("%4d %8lld %8lld %12.5g %10.5f %9.5f %9.5f %9.2g %10lld %10.3g %7.2f %9.4f%s %9.4f%s %9.2g\n", k + 1,
+                   (long long)s + 1, (long long)t + 1, x[t], rb.seconds, rb.push.seconds, rb.walks.seconds, rb.push.rmax,
+                   (long long)rb.walks.walks, rb.predicted_walks, (rb.estimate - x[t]) / rb.std_error, wk.seconds[k],
+                   wk.marked[k] == 2 ? "!" : wk.marked[k] ? "*" : " ", pu.seconds[k], pu.marked[k] ? ">" : " ", prmax);
+            fflush(stdout);
+        }
+        src++;
+    }
+    printf("\nexact values: Gauss-Seidel, %.1f s for %d sources (up to %.0f sweeps)\n", gs_seconds, nsrc, gs_max_sweeps);
+    printf("bidirectional work: push %.3g operations/s, walks %.3g steps/s (one thread; the balance takes a step "
+           "as 1 operation)\n", sum_push_ops / sum_push_s, sum_steps / sum_walk_s);
+    printf("\n%d pairs at %.0f%% relative error, one thread; seconds per query (median, 90th percentile), ratios to "
+           "bidirectional\n", np, 100 * REL);
+    printf("%-22s %10s %10s %10s %10s %13s   %-7s   %s\n", "method", "median", "p90", "med/bidir", "p90/bidir",
+           "median ratio", "cover95", "marked");
+    row("bidirectional", &bi, &bi, np);
+    row("walks (*, ! projected)", &wk, &bi, np);
+    row("push, oracle (> cap)", &pu, &bi, np);
+    printf("bidirectional parts: push median %.4f s (p90 %.4f), walks median %.4f s (p90 %.4f); the rest is the "
+           "pilot and the walk solver's set-up\n", quantile(bi.other, np, 0.5), quantile(bi.other, np, 0.9),
+           quantile(bi.walk, np, 0.5), quantile(bi.walk, np, 0.9));
+    free(x), free(old), free(b), free(e), free(cand);
+    ulam_push_free(w);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+    return 0;
+}

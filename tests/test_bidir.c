@@ -1,0 +1,361 @@
+/* Reverse push and the bidirectional estimator for point sources, against LAPACK.
+ *
+ * The push's invariant x_t = <p, b> + <r, x> is checked to rounding for several b; the
+ * bidirectional estimate of x_t of (I - M) x = e_s within 4 sigma of LAPACK over a seeded table
+ * of systems (case k draws from stream (k, 0): a failure prints k and reruns exactly); coverage
+ * of its 95% interval over 200 seeds with a binomial bound. */
+#include "testutil.h"
+
+#include <string.h>
+
+/* A random n x n system with k entries a row (columns drawn with replacement, duplicates summed),
+ * values U(0.2, 1) with a random sign when signed_, each row of |M| scaled to sum to U(0.3, rowsum). */
+static ulam_csr *random_system(int64_t n, int k, int signed_, double rowsum, uint64_t seed)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 0);
+    int64_t nz = n * k;
+    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
+    double *tx = malloc((size_t)nz * sizeof *tx);
+    for (int64_t i = 0; i < n; i++) {
+        double sum = 0, target = 0.3 + (rowsum - 0.3) * ulam_rng_uniform(&r);
+        for (int q = 0; q < k; q++) {
+            int64_t e = i * k + q;
+            ti[e] = (int32_t)i;
+            tj[e] = (int32_t)ulam_rng_bounded(&r, (uint64_t)n);
+            tx[e] = 0.2 + 0.8 * ulam_rng_uniform(&r);
+            sum += tx[e];
+            if (signed_ && ulam_rng_uniform(&r) < 0.4) tx[e] = -tx[e];
+        }
+        for (int q = 0; q < k; q++) tx[i * k + q] *= target / sum;
+    }
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M), ULAM_OK);
+    free(ti), free(tj), free(tx);
+    return M;
+}
+
+/* x = (I - M)^-1 e_s by LAPACK (a new array). */
+static double *exact_column(const ulam_csr *M, int64_t s)
+{
+    int64_t n = M->nrows;
+    double *b = calloc((size_t)n, sizeof *b), *x = malloc((size_t)n * sizeof *x);
+    b[s] = 1.0;
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    free(b);
+    return x;
+}
+
+/* Fail unless x_t = <p, b> + <r, x> to rounding for the workspace's state. */
+static void assert_invariant(const ulam_push *w, const ulam_csr *M, int64_t t, const double *b, const double *x,
+                             int k)
+{
+    const double *p = ulam_push_estimates(w), *r = ulam_push_residuals(w);
+    double sum = 0, scale = fabs(x[t]);
+    for (int64_t j = 0; j < M->nrows; j++) {
+        sum += p[j] * b[j] + r[j] * x[j];
+        scale += fabs(p[j] * b[j]) + fabs(r[j] * x[j]);
+    }
+    if (!(fabs(sum - x[t]) <= 1e-13 * scale + 1e-300))
+        print_error("case %d: <p, b> + <r, x> = %.17g, x_t = %.17g\n", k, sum, x[t]);
+    assert_close(sum, x[t], 1e-13 * scale + 1e-300);
+}
+
+/* The seeded table of systems: n, entries a row, signed, largest row sum of |M|. */
+static const struct { int64_t n; int k, signed_; double rowsum; } systems[] = {
+    {12, 3, 0, 0.9}, {40, 4, 1, 0.9}, {60, 2, 0, 0.95}, {80, 6, 1, 0.8}, {150, 5, 0, 0.85}, {30, 8, 1, 0.7},
+    {50, 4, 0, 0.9995}, /* rows of |M| up to 1 - 5e-4: long walks, a push that converges slowly */
+};
+enum { NSYS = sizeof systems / sizeof systems[0] };
+
+/* The invariant holds after every run of pushes, for three right-hand sides, at thresholds
+ * falling from 0.5 to 1e-6; every residual is then at most rmax; a cap stops the push with
+ * ULAM_ENOCONV and the invariant intact. */
+static void test_push_invariant(void **state)
+{
+    (void)state;
+    for (int k = 0; k < NSYS; k++) {
+        ulam_csr *M = random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k);
+        int64_t n = M->nrows;
+        ulam_rng rg;
+        ulam_rng_seed(&rg, (uint64_t)k, 1);
+        double *b[3], *x[3];
+        for (int q = 0; q < 3; q++) {
+            b[q] = malloc((size_t)n * sizeof *b[q]);
+            x[q] = malloc((size_t)n * sizeof *x[q]);
+            for (int64_t j = 0; j < n; j++) b[q][j] = q == 0 ? (j == 1) : ulam_rng_uniform(&rg) - (q == 2 ? 0.5 : 0);
+            assert_int_equal(ulam_direct_solve(M, b[q], x[q], 0, NULL, NULL), ULAM_OK);
+        }
+        ulam_push *w = NULL;
+        assert_int_equal(ulam_push_alloc(M, &w), ULAM_OK);
+        for (int64_t t = 0; t < n; t += n / 4) {
+            assert_int_equal(ulam_push_start(w, t), ULAM_OK);
+            for (int q = 0; q < 3; q++) assert_invariant(w, M, t, b[q], x[q], k);
+            for (double rmax = 0.5; rmax >= 1e-6; rmax /= 7) {
+                assert_int_equal(ulam_push_run(w, rmax, 0), ULAM_OK);
+                ulam_push_info pi;
+                ulam_push_report(w, &pi);
+                assert_true(pi.r_max <= rmax);
+                assert_true(pi.rmax == rmax && pi.target == t && pi.pushes > 0);
+                for (int q = 0; q < 3; q++) assert_invariant(w, M, t, b[q], x[q], k);
+            }
+            assert_int_equal(ulam_push_start(w, t), ULAM_OK); /* a cap cuts a deep push short */
+            assert_int_equal(ulam_push_run(w, 1e-12, 5), ULAM_ENOCONV);
+            for (int q = 0; q < 3; q++) assert_invariant(w, M, t, b[q], x[q], k);
+            assert_int_equal(ulam_push_run(w, 1e-12, 0), ULAM_OK); /* and goes on from there */
+            for (int q = 0; q < 3; q++) assert_invariant(w, M, t, b[q], x[q], k);
+        }
+        for (int q = 0; q < 3; q++) free(b[q]), free(x[q]);
+        ulam_push_free(w);
+        ulam_csr_free(M);
+    }
+}
+
+/* Bad arguments are refused. */
+static void test_push_bad_input(void **state)
+{
+    (void)state;
+    ulam_csr *M = random_system(10, 2, 0, 0.9, 99), *R = ulam_csr_alloc(3, 4, 0);
+    ulam_push *w = NULL;
+    assert_int_equal(ulam_push_alloc(R, &w), ULAM_ENOTSQUARE);
+    assert_null(w);
+    assert_int_equal(ulam_push_alloc(M, &w), ULAM_OK);
+    assert_int_equal(ulam_push_run(w, 0.1, 0), ULAM_EINVAL); /* not started */
+    assert_int_equal(ulam_push_start(w, 10), ULAM_EINVAL);
+    assert_int_equal(ulam_push_start(w, -1), ULAM_EINVAL);
+    assert_int_equal(ulam_push_start(w, 3), ULAM_OK);
+    assert_int_equal(ulam_push_run(w, 0.0, 0), ULAM_EINVAL);
+    assert_int_equal(ulam_push_run(w, -1.0, 0), ULAM_EINVAL);
+    assert_int_equal(ulam_push_run(w, NAN, 0), ULAM_EINVAL);
+    ulam_csr *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    ulam_bidir_result res;
+    ulam_error err;
+    o.source = 10;
+    assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL);
+    assert_non_null(strstr(err.msg, "source"));
+    o.source = 0, o.target = -1;
+    assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL);
+    o.target = 0, o.rmax = INFINITY;
+    assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL);
+    o.rmax = 0;
+    assert_int_equal(ulam_bidir_solve(w, R, &o, &res, &err), ULAM_EINVAL); /* not M's transpose */
+    assert_null(ulam_push_free(NULL));
+    ulam_push_free(w);
+    ulam_csr_free(M), ulam_csr_free(Mt), ulam_csr_free(R);
+}
+
+/* Run a bidirectional estimate; must succeed. */
+static ulam_bidir_result bidir(const ulam_csr *M, const ulam_csr *Mt, const ulam_bidir_opts *o)
+{
+    ulam_push *w = NULL;
+    assert_int_equal(ulam_push_alloc(M, &w), ULAM_OK);
+    ulam_bidir_result res;
+    ulam_error err;
+    int st = ulam_bidir_solve(w, Mt, o, &res, &err);
+    if (st) print_error("ulam_bidir_solve: %s: %s\n", ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    ulam_push_free(w);
+    return res;
+}
+
+/* Within 4 sigma of LAPACK on every system of the table, for a fixed rmax and the balanced one,
+ * with the collision and expected estimators; the walks do part of the work (r != 0). */
+static void test_bidir_unbiased(void **state)
+{
+    (void)state;
+    static const double rmaxes[] = {0.3, 0.05, 0};
+    for (int k = 0; k < NSYS; k++) {
+        ulam_csr *M = random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k), *Mt = NULL;
+        assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+        int64_t n = M->nrows, s = (k * 7 + 1) % n, t = (k * 3 + 2) % n;
+        double *x = exact_column(M, s);
+        for (int q = 0; q < 3; q++)
+            for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est += 2) {
+                ulam_bidir_opts o = ulam_bidir_defaults();
+                o.source = s, o.target = t, o.rmax = rmaxes[q];
+                o.walk.max_walks = 20000, o.walk.estimator = est, o.walk.seed = (uint64_t)(k * 10 + q);
+                ulam_bidir_result res = bidir(M, Mt, &o);
+                if (res.std_error == 0) { /* no residual left, or none the walks reach: exact */
+                    assert_true(q == 2 || res.push.support > 0);
+                    assert_close(res.estimate, x[t], 1e-12 * fabs(x[t]) + 1e-300);
+                    continue;
+                }
+                double z = (res.estimate - x[t]) / (res.std_error + 1e-13 * fabs(x[t])); /* + LAPACK's rounding */
+                if (!(fabs(z) < 4))
+                    print_error("case %d rmax %g est %d: estimate %.10g, LAPACK %.10g, stderr %.3g (z = %.2f)\n", k,
+                                rmaxes[q], est, res.estimate, x[t], res.std_error, z);
+                assert_true(res.walks.walks == 20000);
+                assert_true(fabs(z) < 4);
+                assert_close(res.estimate - res.push_part, res.walks.estimate, 1e-15 * (fabs(res.estimate) + 1));
+                assert_close(res.ci95[1] - res.ci95[0], 2 * 1.959963984540054 * res.std_error, 1e-12);
+                assert_true(res.seconds >= res.push.seconds);
+                if (q == 2) assert_true(res.pilot_walks == 256 && res.mean_visits >= 1);
+            }
+        free(x);
+        ulam_csr_free(M), ulam_csr_free(Mt);
+    }
+}
+
+/* Over 200 seeds the 95% interval covers the LAPACK value 180 to 198 times (Bin(200, 0.95) falls
+ * outside with probability about 0.002), with a threshold that leaves most of the value to the walks. */
+static void test_bidir_coverage(void **state)
+{
+    (void)state;
+    ulam_csr *M = random_system(40, 4, 1, 0.9, 1), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = exact_column(M, 5);
+    int covered = 0;
+    double push_part = 0;
+    for (int seed = 0; seed < 200; seed++) { /* case seed: reruns exactly */
+        ulam_bidir_opts o = ulam_bidir_defaults();
+        o.source = 5, o.target = 17, o.rmax = 0.2;
+        o.walk.max_walks = 2000, o.walk.seed = (uint64_t)seed;
+        ulam_bidir_result res = bidir(M, Mt, &o);
+        covered += res.ci95[0] <= x[17] && x[17] <= res.ci95[1];
+        push_part = res.push_part;
+    }
+    print_message("95%% interval covered the LAPACK value %d / 200 times (x = %.6g, push part %.6g)\n", covered,
+                  x[17], push_part);
+    assert_true(fabs(push_part - x[17]) > 0.1 * fabs(x[17]));
+    assert_in_range(covered, 180, 198);
+    free(x);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
+/* M_ij = 0.3 for j = i + 1, i + 2 over 7 states: nilpotent, so every push ends with r = 0. */
+static ulam_csr *nilpotent(void)
+{
+    int32_t ti[] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5}, tj[] = {1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6};
+    double tx[] = {0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3};
+    ulam_csr *N = NULL;
+    assert_int_equal(ulam_csr_from_triplets(7, 7, 11, ti, tj, tx, &N), ULAM_OK);
+    return N;
+}
+
+/* A push that leaves no residual is exact (no walks, zero stderr); a --rel-err rule stops on the
+ * whole estimate p_s + <r, x>; the result does not depend on the thread count. */
+static void test_bidir_rules(void **state)
+{
+    (void)state;
+    ulam_csr *N = nilpotent(), *Nt = NULL; /* the push from 1 ends with r = 0 */
+    assert_int_equal(ulam_csr_transpose(N, &Nt), ULAM_OK);
+    double *xn = exact_column(N, 5);
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    o.source = 5, o.target = 1, o.rmax = 1e-3;
+    ulam_bidir_result res = bidir(N, Nt, &o);
+    assert_true(res.push.support == 0 && res.walks.walks == 0 && res.std_error == 0);
+    assert_close(res.estimate, xn[1], 1e-15);
+    assert_true(xn[1] > 0.1);
+    free(xn);
+    ulam_csr_free(N), ulam_csr_free(Nt);
+    ulam_csr *M = random_system(80, 6, 0, 0.9, 3), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = exact_column(M, 3);
+    o = ulam_bidir_defaults();
+    o.source = 3, o.target = 10, o.rmax = 0.05, o.walk.max_walks = 0, o.walk.rel_err = 0.01;
+    res = bidir(M, Mt, &o);
+    print_message("rel-err 0.01: %lld walks, relative error %.3g\n", (long long)res.walks.walks,
+                  res.std_error / fabs(res.estimate));
+    assert_true(res.walks.walks >= 1000 && res.std_error <= 0.01 * fabs(res.estimate));
+    assert_true(res.walks.walks > 1024 && res.std_error > 0.005 * fabs(res.estimate)); /* near the target */
+    assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
+    o.rmax = 0, o.walk.rel_err = 0, o.walk.max_walks = 5000, o.walk.threads = 1;
+    ulam_bidir_result one = bidir(M, Mt, &o);
+    o.walk.threads = 2;
+    ulam_bidir_result two = bidir(M, Mt, &o);
+    assert_memory_equal(&one.estimate, &two.estimate, sizeof one.estimate);
+    assert_memory_equal(&one.std_error, &two.std_error, sizeof one.std_error);
+    assert_true(one.push.rmax == two.push.rmax && one.push.pushes == two.push.pushes);
+    free(x);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
+/* A --rel-err run ends when the walks cannot score anything but one value: no residual state
+ * reachable from the source (the walk part is exactly 0), or a source without moves whose own
+ * residual is all a walk scores.  Before, every walk scored the same forever and the run never
+ * stopped (a zero sample variance no longer stops it, test_bidir_rare_score). */
+static void test_bidir_deterministic_walks(void **state)
+{
+    (void)state;
+    ulam_csr *N = nilpotent(), *Nt = NULL; /* x_t = 0 for t > s; N' has no moves from 0 */
+    assert_int_equal(ulam_csr_transpose(N, &Nt), ULAM_OK);
+    static const struct { int64_t s, t; double rmax; int est; } cases[] = {
+        {1, 5, 2, ULAM_COLLISION}, /* no push; walks from 1 on N' never reach 5: x = 0 exactly */
+        {1, 5, 2, ULAM_EXPECTED},  {1, 5, 2, ULAM_ABSORPTION},
+        {0, 0, 2, ULAM_COLLISION}, /* walks from 0 on N' have no moves and score r_0 = 1: x = 1 */
+    };
+    for (int k = 0; k < 4; k++) { /* case k */
+        double *x = exact_column(N, cases[k].s);
+        ulam_bidir_opts o = ulam_bidir_defaults();
+        o.source = cases[k].s, o.target = cases[k].t, o.rmax = cases[k].rmax, o.walk.estimator = cases[k].est;
+        o.walk.max_walks = 0, o.walk.rel_err = 0.1;
+        ulam_bidir_result res = bidir(N, Nt, &o);
+        if (!(res.std_error == 0 && res.estimate == x[cases[k].t]))
+            print_error("case %d: %.6g +- %.3g, exact %.6g\n", k, res.estimate, res.std_error, x[cases[k].t]);
+        assert_true(res.std_error == 0 && res.estimate == x[cases[k].t] && res.walks.walks >= 1000);
+        free(x);
+    }
+    ulam_csr_free(N), ulam_csr_free(Nt);
+}
+
+/* The time rule stops a run with no walk cap (its first block whole), and a run of a handful of
+ * walks reports what it has: an estimate within 4 sigma when the walks scored differently. */
+static void test_bidir_small_budgets(void **state)
+{
+    (void)state;
+    ulam_csr *M = random_system(80, 6, 0, 0.9, 3), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = exact_column(M, 3);
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    o.source = 3, o.target = 10, o.rmax = 0.05, o.walk.max_walks = 0, o.walk.max_seconds = 1e-6;
+    ulam_bidir_result res = bidir(M, Mt, &o);
+    assert_true(res.walks.walks >= 1 && res.walks.walks <= 1024 && isfinite(res.estimate));
+    assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
+    for (int64_t walks = 1; walks <= 16; walks *= 4) {
+        o.walk.max_seconds = 0, o.walk.max_walks = walks;
+        res = bidir(M, Mt, &o);
+        assert_true(res.walks.walks == walks && isfinite(res.estimate));
+        if (walks > 1 && res.std_error > 0) assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
+    }
+    free(x);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
+/* A rare score does not stop a --rel-err run at 0 +- 0: walks from 1 reach the target 0 with
+ * probability 0.001, so the first 1024 often all score 0 (zero sample variance). */
+static void test_bidir_rare_score(void **state)
+{
+    (void)state;
+    int32_t ti[] = {0, 1}, tj[] = {1, 1};
+    double tx[] = {0.001, 0.5};
+    ulam_csr *M = NULL, *Mt = NULL;
+    assert_int_equal(ulam_csr_from_triplets(2, 2, 2, ti, tj, tx, &M), ULAM_OK);
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = exact_column(M, 1);
+    for (int seed = 0; seed < 10; seed++) { /* case seed */
+        ulam_bidir_opts o = ulam_bidir_defaults();
+        o.source = 1, o.target = 0, o.rmax = 2; /* no push: every score is a walk's */
+        o.walk.max_walks = 0, o.walk.rel_err = 0.1, o.walk.seed = (uint64_t)seed;
+        ulam_bidir_result res = bidir(M, Mt, &o);
+        if (!(res.std_error > 0 && fabs(res.estimate - x[0]) < 4 * res.std_error))
+            print_error("seed %d: %.6g +- %.3g after %lld walks, exact %.6g\n", seed, res.estimate, res.std_error,
+                        (long long)res.walks.walks, x[0]);
+        assert_true(res.std_error > 0 && res.std_error <= 0.1 * res.estimate);
+        assert_true(fabs(res.estimate - x[0]) < 4 * res.std_error);
+    }
+    free(x);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_push_invariant), cmocka_unit_test(test_push_bad_input),
+        cmocka_unit_test(test_bidir_unbiased), cmocka_unit_test(test_bidir_coverage),
+        cmocka_unit_test(test_bidir_rules),    cmocka_unit_test(test_bidir_rare_score),
+        cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
