@@ -221,52 +221,10 @@ static void test_read_from_stream(void **state)
     ulam_csr_free(A);
 }
 
-/* Binary caches read back exactly; a stale, foreign, truncated or corrupt one is refused. */
-static void test_cache(void **state)
-{
-    (void)state;
-    ulam_csr *A = NULL, *B = NULL;
-    ulam_error err;
-    assert_int_equal(ulam_mm_read_matrix("matrices/signed200.mtx", &A, &err), ULAM_OK);
-    char path[] = "/tmp/ulam_cache_testXXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
-    const uint64_t tag[2] = {12345, 678}, other[2] = {12345, 679};
-    assert_int_equal(ulam_cache_write_csr(path, A, tag), ULAM_OK);
-    assert_int_equal(ulam_cache_read_csr(path, tag, &B, &err), ULAM_OK);
-    assert_csr_same(B, A);
-    B = ulam_csr_free(B);
-    assert_int_equal(ulam_cache_read_csr(path, other, &B, &err), ULAM_ENOTFOUND); /* source changed */
-    assert_null(B);
-    double *v = NULL;
-    int64_t n = 0;
-    assert_int_equal(ulam_cache_read_vector(path, tag, &v, &n, &err), ULAM_EBANNER); /* not a vector */
-    FILE *f = fopen(path, "r+b"); /* a column index past the end: the structure check finds it */
-    assert_non_null(f);
-    fseek(f, 8 + 48 + (long)(A->nrows + 1) * 8, SEEK_SET);
-    int32_t bad = (int32_t)A->ncols;
-    fwrite(&bad, sizeof bad, 1, f);
-    fclose(f);
-    assert_int_equal(ulam_cache_read_csr(path, tag, &B, &err), ULAM_ESYNTAX);
-    assert_int_equal(truncate(path, 100), 0);
-    assert_int_equal(ulam_cache_read_csr(path, tag, &B, &err), ULAM_ESYNTAX);
-    assert_null(B);
-    double x[3] = {1.5, -2, 1e300};
-    assert_int_equal(ulam_cache_write_vector(path, x, 3, tag), ULAM_OK);
-    assert_int_equal(ulam_cache_read_vector(path, tag, &v, &n, &err), ULAM_OK);
-    assert_int_equal(n, 3);
-    assert_memory_equal(v, x, sizeof x);
-    free(v);
-    assert_int_equal(ulam_cache_read_vector("/nonexistent/x", tag, &v, &n, &err), ULAM_EIO);
-    remove(path);
-    ulam_csr_free(A);
-}
-
 int main(void)
 {
     enum { NBAD = sizeof bad_cases / sizeof bad_cases[0] };
-    struct CMUnitTest tests[NBAD + 12];
+    struct CMUnitTest tests[NBAD + 11];
     size_t k = 0;
     for (size_t i = 0; i < NBAD; i++)
         tests[k++] = (struct CMUnitTest){bad_cases[i].file, test_bad, NULL, NULL, (void *)&bad_cases[i]};
@@ -276,7 +234,7 @@ int main(void)
         cmocka_unit_test(test_lenient_text),    cmocka_unit_test(test_dense_array),
         cmocka_unit_test(test_vectors),         cmocka_unit_test(test_roundtrip),
         cmocka_unit_test(test_write_refuses_nonfinite), cmocka_unit_test(test_write_unwritable),
-        cmocka_unit_test(test_read_from_stream), cmocka_unit_test(test_cache),
+        cmocka_unit_test(test_read_from_stream),
     };
     for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) tests[k++] = good[i];
     return _cmocka_run_group_tests("mmio", tests, k, NULL, NULL);

@@ -16,12 +16,18 @@ void cli_print_power(const ulam_power *p)
            p->iterations, p->seconds, p->converged ? "" : ", NOT converged");
 }
 
-/* Run the guards for a walk in mode on s; 0 to go on, EXIT_DIVERGE (message printed) to stop. */
-int cli_guard(const cli_system *s, double continue_q, int mode, int force, ulam_guard *g)
+/* Run the guards for a walk in mode on s; 0 to go on, EXIT_DIVERGE (message printed) to stop.
+ * A prepared file's certificate made for this continuation serves instead of a pass over M
+ * (ulam_certificate_guard); otherwise a mapped M is verified whole first. */
+int cli_guard(cli_system *s, double continue_q, int mode, int force, ulam_guard *g)
 {
     ulam_error err;
-    int status = ulam_guard_check(s->M, continue_q, NULL, g, &err);
-    if (status) return cli_report(s->matrix_path, &err);
+    if (ulam_certificate_guard(s->cert, continue_q, NULL, g)) {
+        int rc = cli_system_verify(s);
+        if (rc) return rc;
+        int status = ulam_guard_check(s->M, continue_q, NULL, g, &err);
+        if (status) return cli_report(s->matrix_path, &err);
+    }
     if (g->verdict_abs == ULAM_VERDICT_FAIL) {
         fprintf(stderr,
                 "ulam: %s: %s: rho(|M|) = %.6g (bounds [%.6g, %.6g]) is >= 1, so the walks' expected "
