@@ -141,12 +141,32 @@ int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error
 /* As ulam_mm_read_matrix_file, opening path. */
 int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err);
 
+/* Options of the matrix reader. */
+typedef struct ulam_mm_opts {
+    int threads;     /* 0: all cores; 1: the sequential streaming reader.  A regular file of
+                        coordinate general kind is read by `threads` threads in chunks split at
+                        line starts, straight into the CSR arrays when its rows rise through the
+                        file; any error is found and located (file:line) by the sequential
+                        reader, which reads on from the size line */
+    int libc_strtod; /* 1: reals by the C library's strtod (the same doubles, slower: the reader
+                        as it was, for comparisons) */
+} ulam_mm_opts;
+
+/* As ulam_mm_read_matrix_file with options (o NULL: all cores, ulam_strtod). */
+int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
+
 /* Read a dense vector: "array" m x 1, or "coordinate" m x 1 (missing entries are 0).
  * *x is malloc'd with *n entries. */
 int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
 
 /* As ulam_mm_read_vector_file, opening path. */
 int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *err);
+
+/* strtod(s, end) exactly (the same double and end for every input, C locale), faster for
+ * decimals of up to 19 significant digits with normal results (Clinger's fast path, else the
+ * Eisel-Lemire algorithm); everything else is strtod's own work.  errno is set only when
+ * strtod itself runs. */
+double ulam_strtod(const char *s, char **end);
 
 /* Write A as "coordinate real general" with an optional one-line comment.  The file is
  * written to a temporary name and renamed into place only when complete. */

@@ -99,7 +99,7 @@ static int sort_row(int32_t *j, double *x, int64_t len)
 }
 
 /* Sort every row, sum duplicates and drop zeros, compacting A in place. */
-static int csr_canonicalize(ulam_csr *A)
+int ulam__csr_canonicalize(ulam_csr *A)
 {
     int64_t out = 0, start = 0;
     for (int64_t i = 0; i < A->nrows; i++) {
@@ -146,7 +146,7 @@ int ulam_csr_from_triplets(int64_t nrows, int64_t ncols, int64_t nz, const int32
         A->val[p] = tx[k];
     }
     free(next);
-    int status = csr_canonicalize(A);
+    int status = ulam__csr_canonicalize(A);
     if (status) {
         ulam_csr_free(A);
         return status;

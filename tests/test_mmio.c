@@ -221,10 +221,73 @@ static void test_read_from_stream(void **state)
     ulam_csr_free(A);
 }
 
+/* ulam_strtod gives strtod's double (bit for bit) and end on input s; prints case k on failure. */
+static void same_as_strtod(const char *s, long k)
+{
+    char *e1, *e2;
+    double a = ulam_strtod(s, &e1), b = strtod(s, &e2);
+    if (memcmp(&a, &b, sizeof a) || e1 != e2)
+        fail_msg("case %ld '%s': ulam_strtod %a (end +%td), strtod %a (end +%td)", k, s, a, e1 - s, b, e2 - s);
+}
+
+/* The fast number parser against strtod: a corpus of edge cases (17-digit values, ties,
+ * subnormals, the exponent limits, more digits than 64 bits hold, forms strtod parses and the
+ * reader refuses), then seeded random doubles printed several ways and random decimal strings. */
+static void test_strtod(void **state)
+{
+    (void)state;
+    static const char *const corpus[] = {
+        "0", "-0", "+0", "0.0", "00000", "1", "-1", "+1.5", ".5", "5.", "-.5e1", "1e0", "1E+2", "1e-2",
+        "0.1", "0.2", "0.3", "0.30000000000000004", "0.1000000000000000055511151231257827021181583404541015625",
+        "3.141592653589793", "3.1415926535897932", "2.718281828459045235360287", "0.09999999999999999",
+        "1.7976931348623157e308", "1.7976931348623158e308", "1.7976931348623159e308", "1e308", "1e309",
+        "2.2250738585072014e-308", "2.2250738585072011e-308", "2.2250738585072009e-308", "4.9406564584124654e-324",
+        "5e-324", "2.4703282292062327e-324", "2.4703282292062328e-324", "1e-320", "1e-400", "1e-342", "1e-343",
+        "9007199254740992", "9007199254740993", "9007199254740994", "9007199254740995", "9007199254740993.0000001",
+        "18446744073709551615", "18446744073709551616", "1844674407370955161", "9999999999999999999",
+        "99999999999999999999", "12345678901234567890123", "1e22", "1e23", "8.988465674311579e307",
+        "7.3177701707893310e+15", "1.00000000000000011102230246251565404236316680908203125",
+        "1.00000000000000011102230246251565404236316680908203124", "1.00000000000000011102230246251565404236316680908203126",
+        "4503599627370496.5", "4503599627370497.5", "0.000000000000000000000000000001234567890123456789",
+        "123456789012345678e-30", "1e", "1e+", "1e-", "e5", ".", "-", "+", "", "   1.25", "\t-2.5e3x", "1.5 2",
+        "inf", "-inf", "INF", "infinity", "nan", "NaN", "nan(0x1)", "0x1p3", "0X1.8P1", "-0x", "0x", "1e99999999999",
+        "1e-99999999999", "0e99999999999", "1.0000000000000000000000000000000000000000000001", "00000000000000000000001.5",
+        "100000000000000000000000", "1000000000000000000000000e-24", "7e-10", "6.02214076e23", "1.602176634e-19",
+    };
+    long k = 0;
+    for (size_t i = 0; i < sizeof corpus / sizeof corpus[0]; i++) same_as_strtod(corpus[i], k++);
+    static const char *const fmts[] = {"%.17g", "%.16g", "%.15g", "%.6e", "%.20e", "%g", "%.17e", "%.3f"};
+    ulam_rng r;
+    ulam_rng_seed(&r, 17, 0);
+    char buf[512];
+    for (int t = 0; t < 40000; t++) {
+        uint64_t bits = ulam_rng_next(&r);
+        if (t % 4 == 1) bits &= 0x800FFFFFFFFFFFFFu; /* subnormal */
+        if (t % 4 == 2) bits = (bits & 0x800FFFFFFFFFFFFFu) | (uint64_t)(1023 + (int)(bits >> 52) % 60 - 30) << 52;
+        double x;
+        memcpy(&x, &bits, sizeof x);
+        if (!isfinite(x)) continue;
+        for (size_t f = 0; f < sizeof fmts / sizeof fmts[0]; f++) {
+            snprintf(buf, sizeof buf, fmts[f], x);
+            same_as_strtod(buf, k++);
+        }
+    }
+    for (int t = 0; t < 40000; t++) { /* random digits, point and exponent */
+        int nd = 1 + (int)ulam_rng_bounded(&r, 24), dot = (int)ulam_rng_bounded(&r, (uint64_t)nd + 1), m = 0;
+        if (ulam_rng_bounded(&r, 2)) buf[m++] = '-';
+        for (int d = 0; d < nd; d++) {
+            if (d == dot) buf[m++] = '.';
+            buf[m++] = (char)('0' + ulam_rng_bounded(&r, 10));
+        }
+        m += snprintf(buf + m, sizeof buf - (size_t)m, "e%d", (int)ulam_rng_bounded(&r, 700) - 350);
+        same_as_strtod(buf, k++);
+    }
+}
+
 int main(void)
 {
     enum { NBAD = sizeof bad_cases / sizeof bad_cases[0] };
-    struct CMUnitTest tests[NBAD + 11];
+    struct CMUnitTest tests[NBAD + 12];
     size_t k = 0;
     for (size_t i = 0; i < NBAD; i++)
         tests[k++] = (struct CMUnitTest){bad_cases[i].file, test_bad, NULL, NULL, (void *)&bad_cases[i]};
@@ -234,7 +297,7 @@ int main(void)
         cmocka_unit_test(test_lenient_text),    cmocka_unit_test(test_dense_array),
         cmocka_unit_test(test_vectors),         cmocka_unit_test(test_roundtrip),
         cmocka_unit_test(test_write_refuses_nonfinite), cmocka_unit_test(test_write_unwritable),
-        cmocka_unit_test(test_read_from_stream),
+        cmocka_unit_test(test_read_from_stream), cmocka_unit_test(test_strtod),
     };
     for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) tests[k++] = good[i];
     return _cmocka_run_group_tests("mmio", tests, k, NULL, NULL);
