@@ -505,11 +505,13 @@ static char *span_next(span *s)
     }
 }
 
-/* One chunk of the entries: a byte range starting at a line, its data lines (counted in the
- * first pass), where its entries go, and what the second pass found. */
+/* One chunk of the entries: a byte range starting at a line, and the entries parsed from it
+ * (rows, columns, values, in file order). */
 typedef struct {
-    int64_t from, to, entries, first;
-    int32_t row_first, row_last;
+    int64_t from, to;
+    int32_t *row, *col;
+    double *val;
+    int64_t len, cap;
     int sorted, zeros, bad, nomem;
 } chunk;
 
@@ -529,126 +531,110 @@ static int64_t line_start(int fd, int64_t at, int64_t end)
     return end;
 }
 
-/* Open the span of chunk c; 0 without memory. */
-static int span_open(span *s, int fd, const chunk *c)
+/* Room for one more entry in chunk c. */
+static int chunk_grow(chunk *c)
 {
-    *s = (span){.fd = fd, .pos = c->from, .end = c->to, .cap = CHUNK_BUF};
-    s->buf = malloc(s->cap);
-    return s->buf != NULL;
+    if (c->len < c->cap) return ULAM_OK;
+    int64_t cap = c->cap, need = c->len + 1 + c->len / 2;
+    if (ulam__grow(&c->row, &cap, need, sizeof *c->row)) return ULAM_ENOMEM;
+    cap = c->cap;
+    if (ulam__grow(&c->col, &cap, need, sizeof *c->col)) return ULAM_ENOMEM;
+    cap = c->cap;
+    if (ulam__grow(&c->val, &cap, need, sizeof *c->val)) return ULAM_ENOMEM;
+    c->cap = cap;
+    return ULAM_OK;
 }
 
-/* First pass over chunk c: count its data lines (neither comments nor blank). */
-static void count_chunk(int fd, chunk *c)
+/* Free chunk c's entries. */
+static void chunk_free(chunk *c)
 {
-    span s;
-    if (!span_open(&s, fd, c)) {
-        c->bad = c->nomem = 1;
-        return;
-    }
-    char *line;
-    while ((line = span_next(&s)) != NULL) c->entries += line[0] != '%' && !at_end(line);
-    c->bad = s.failed != 0, c->nomem = s.failed == 2;
-    free(s.buf);
+    free(c->row), free(c->col), free(c->val);
+    c->row = c->col = NULL, c->val = NULL;
 }
 
-/* Second pass over chunk c: parse its entries into rows ti[], A's colidx and val from c->first,
- * noting whether its rows rise and whether it holds zeros.  Any failure (a malformed line, a
- * count that disagrees with the first pass) marks it bad: the sequential reader then finds and
- * locates the error. */
-static void parse_chunk(int fd, const mm_header *h, chunk *c, int32_t *ti, ulam_csr *A)
+/* Parse chunk c's entries, noting whether its rows rise and whether it holds zeros.  Any
+ * failure (a malformed line) marks it bad: the sequential reader then finds and locates the
+ * error. */
+static void parse_chunk(int fd, const mm_header *h, chunk *c)
 {
-    span s;
-    if (!span_open(&s, fd, c)) {
-        c->bad = c->nomem = 1;
-        return;
-    }
-    int64_t k = c->first, last = c->first + c->entries;
-    int32_t prev = -1;
+    span s = {.fd = fd, .pos = c->from, .end = c->to, .cap = CHUNK_BUF};
+    s.buf = malloc(s.cap);
     c->sorted = 1;
+    int32_t prev = -1;
     char *line;
-    while (!c->bad && (line = span_next(&s)) != NULL) {
+    while (s.buf && !c->bad && (line = span_next(&s)) != NULL) {
         if (line[0] == '%' || at_end(line)) continue;
         int64_t i, j;
         double x;
-        if (k == last || parse_coord(0, line, h, &i, &j, &x, NULL)) {
+        if (parse_coord(0, line, h, &i, &j, &x, NULL)) {
             c->bad = 1;
             break;
         }
-        ti[k] = (int32_t)(i - 1), A->colidx[k] = (int32_t)(j - 1), A->val[k++] = x;
-        if (prev < 0) c->row_first = (int32_t)(i - 1);
-        if ((int32_t)(i - 1) < prev) c->sorted = 0;
+        if (chunk_grow(c)) {
+            c->bad = c->nomem = 1;
+            break;
+        }
+        c->row[c->len] = (int32_t)(i - 1), c->col[c->len] = (int32_t)(j - 1), c->val[c->len++] = x;
+        c->sorted &= (int32_t)(i - 1) >= prev;
         prev = (int32_t)(i - 1);
         c->zeros |= x == 0.0;
     }
-    c->row_last = prev;
-    if (s.failed || k != last) c->bad = 1;
-    c->nomem |= s.failed == 2;
+    if (!s.buf || s.failed == 2) c->bad = c->nomem = 1;
+    if (s.failed) c->bad = 1;
     free(s.buf);
 }
 
-/* Drop the entries whose value is zero (the sequential reader never stores them), keeping
- * the order of the rest; the new count. */
-static int64_t drop_zeros(int32_t *ti, ulam_csr *A, int64_t nz)
-{
-    int64_t out = 0;
-    for (int64_t k = 0; k < nz; k++)
-        if (A->val[k] != 0.0) ti[out] = ti[k], A->colidx[out] = A->colidx[k], A->val[out++] = A->val[k];
-    return out;
-}
-
 /* The entries of a regular file of coordinate general kind, in parallel: chunks split at line
- * starts, a first pass counting each chunk's entries, a second parsing them straight into the
- * CSR arrays (rows into ti).  Rows that rise through the file (as written by most tools) need
- * no reordering: rowptr is counted from ti; otherwise the triplets are sorted as the sequential
- * reader sorts them.  ULAM_OK with *A, ULAM_ENOMEM, or -1 when anything disagrees (the caller
- * then reads sequentially from where the header ended, which locates every error). */
-static int read_entries_parallel(const reader *r, int fd, int64_t data, const mm_header *h, int threads,
+ * starts are parsed by `threads` threads, then moved in file order into the CSR arrays (each
+ * chunk freed as it is moved, so the peak is about the entries once) without the zeros, which
+ * the sequential reader never stores.  Rows that rise through the file (as written by most
+ * tools) need no reordering: rowptr is counted as the rows go by; otherwise the triplets are
+ * sorted as the sequential reader sorts them.  ULAM_OK with *out, ULAM_ENOMEM, or -1 when
+ * anything disagrees (the caller then reads sequentially from where the header ended, which
+ * finds and locates every error). */
+static int read_entries_parallel(int fd, int64_t data, int64_t end, const mm_header *h, int threads,
                                  ulam_csr **out)
 {
-    int64_t end = r->size + (data - (r->read_total - (int64_t)(r->len - r->pos))), bytes = end - data;
+    int64_t bytes = end - data;
     int nc = threads * 8;
     if (bytes < (int64_t)nc * 65536) nc = bytes / 65536 > 0 ? (int)(bytes / 65536) : 1;
     chunk *c = calloc((size_t)nc, sizeof *c);
-    ulam_csr *A = c ? ulam_csr_alloc(h->m, h->n, h->nnz) : NULL;
-    int32_t *ti = A ? ulam__alloc_big((size_t)h->nnz, sizeof *ti) : NULL;
-    if (!ti) {
-        free(c), ulam_csr_free(A);
-        return ULAM_ENOMEM;
-    }
+    if (!c) return ULAM_ENOMEM;
     for (int k = 0; k < nc; k++) {
         c[k].from = k ? c[k - 1].to : data;
         c[k].to = k == nc - 1 ? end : line_start(fd, data + bytes / nc * (k + 1), end);
         if (c[k].to < c[k].from) c[k].to = c[k].from;
+        c[k].cap = 0;
     }
-    int bad = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int k = 0; k < nc; k++) count_chunk(fd, &c[k]);
+    for (int k = 0; k < nc; k++) parse_chunk(fd, h, &c[k]);
     int64_t total = 0;
-    for (int k = 0; k < nc; k++) c[k].first = total, total += c[k].entries, bad |= c[k].bad;
-    if (!bad && total == h->nnz) {
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-        for (int k = 0; k < nc; k++) parse_chunk(fd, h, &c[k], ti, A);
-    }
-    int sorted = 1, zeros = 0, nomem = 0;
+    int bad = 0, nomem = 0, sorted = 1;
     int32_t prev = -1;
-    for (int k = 0; k < nc; k++) nomem |= c[k].nomem;
-    for (int k = 0; k < nc && !bad; k++) {
-        bad |= c[k].bad || total != h->nnz;
-        if (!c[k].entries) continue;
-        sorted &= c[k].sorted && c[k].row_first >= prev;
-        zeros |= c[k].zeros;
-        prev = c[k].row_last;
+    for (int k = 0; k < nc; k++) {
+        total += c[k].len, bad |= c[k].bad, nomem |= c[k].nomem;
+        if (!c[k].len) continue;
+        sorted &= c[k].sorted && c[k].row[0] >= prev;
+        prev = c[k].row[c[k].len - 1];
+    }
+    ulam_csr *A = !bad && total == h->nnz ? ulam_csr_alloc(h->m, h->n, total) : NULL;
+    int32_t *ti = A && !sorted ? ulam__alloc_big((size_t)total, sizeof *ti) : NULL;
+    int status = nomem || (A && !sorted && !ti) || (!A && !bad && total == h->nnz) ? ULAM_ENOMEM : A ? ULAM_OK : -1;
+    int64_t nz = 0;
+    for (int k = 0; k < nc; k++) {
+        for (int64_t q = 0; !status && q < c[k].len; q++) {
+            if (c[k].zeros && c[k].val[q] == 0.0) continue;
+            if (sorted) A->rowptr[c[k].row[q] + 1]++;
+            else ti[nz] = c[k].row[q];
+            A->colidx[nz] = c[k].col[q], A->val[nz++] = c[k].val[q];
+        }
+        chunk_free(&c[k]);
     }
     free(c);
-    int status = ULAM_OK;
-    int64_t nz = bad ? 0 : zeros ? drop_zeros(ti, A, h->nnz) : h->nnz;
-    if (nomem) status = ULAM_ENOMEM;
-    else if (bad) status = -1;
-    else if (sorted) {
-        for (int64_t k = 0; k < nz; k++) A->rowptr[ti[k] + 1]++;
+    if (!status && sorted) {
         for (int64_t i = 0; i < h->m; i++) A->rowptr[i + 1] += A->rowptr[i];
-        status = ulam__csr_canonicalize(A);
-    } else {
+        status = ulam__csr_canonicalize(A, threads);
+    } else if (!status) {
         ulam_csr *B = NULL;
         status = ulam_csr_from_triplets(h->m, h->n, nz, ti, A->colidx, A->val, &B);
         ulam_csr_free(A);
@@ -684,7 +670,7 @@ int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, u
     if (!status && threads > 1 && fd >= 0 && start >= 0 && r.size >= 0 && h.format == FMT_COORD &&
         h.symmetry == SYM_GENERAL && h.nnz > 0) {
         int64_t data = start + r.read_total - (int64_t)(r.len - r.pos); /* the byte after the size line */
-        int st = read_entries_parallel(&r, fd, data, &h, threads, A);
+        int st = read_entries_parallel(fd, data, start + r.size, &h, threads, A);
         if (st != -1) {
             free(r.buf);
             return st ? ulam__fail(err, st, 0, -1, "memory for %lld entries", (long long)h.nnz) : ULAM_OK;

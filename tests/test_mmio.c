@@ -284,10 +284,95 @@ static void test_strtod(void **state)
     }
 }
 
+/* Write a coordinate file of nrows x nrows with k entries a row to path: rows rising (or
+ * not), with comments, blank lines, CRLF ends, explicit zeros and repeated entries mixed in;
+ * bad_line > 0 replaces that line (1-based) with text. */
+static void write_big(const char *path, int64_t nrows, int k, int shuffled, long bad_line, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    ulam_rng r;
+    ulam_rng_seed(&r, 99, (uint64_t)shuffled);
+    fprintf(f, "%%%%MatrixMarket matrix coordinate real general\n%% a comment\n%lld %lld %lld\n", (long long)nrows,
+            (long long)nrows, (long long)(nrows * k));
+    long line = 3;
+    for (int64_t q = 0; q < nrows * k; q++) {
+        int64_t i = shuffled ? (int64_t)ulam_rng_bounded(&r, (uint64_t)nrows) : q / k;
+        if (q % 997 == 0 && (bad_line <= 0 || line + 2 < bad_line - 1 || line > bad_line)) fprintf(f, "%% comment inside\n\n"), line += 2;
+        line++;
+        if (line == bad_line) fprintf(f, "%s\n", text);
+        else if (q % 101 == 0) fprintf(f, "%lld %lld 0\r\n", (long long)i + 1, (long long)(i % nrows) + 1);
+        else if (q % 103 == 0) fprintf(f, "%lld 1 %.17g\n", (long long)i + 1, ulam_rng_uniform(&r) - 0.5);
+        else
+            fprintf(f, "%lld %llu %.17g\n", (long long)i + 1, (unsigned long long)ulam_rng_bounded(&r, (uint64_t)nrows) + 1,
+                    ulam_rng_uniform(&r) - 0.5);
+    }
+    fclose(f);
+}
+
+/* Read path with the given threads (and libc's strtod or not). */
+static int read_with(const char *path, int threads, int libc, ulam_csr **A, ulam_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    ulam_mm_opts o = {.threads = threads, .libc_strtod = libc};
+    int st = ulam_mm_read_matrix_opts(f, path, &o, A, err);
+    fclose(f);
+    return st;
+}
+
+/* The parallel reader gives the sequential reader's matrix (rows rising or not, comments,
+ * zeros, repeats, CRLF), and every error at the same line with the same status (each case
+ * prints its index when it fails). */
+static void test_parallel_read(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_mm_parXXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    for (int shuffled = 0; shuffled < 2; shuffled++) {
+        write_big(path, 3000, 8, shuffled, 0, NULL);
+        ulam_csr *A = NULL, *B = NULL;
+        assert_int_equal(read_with(path, 1, 1, &A, NULL), ULAM_OK);
+        assert_int_equal(read_with(path, 2, 0, &B, NULL), ULAM_OK);
+        assert_csr_same(A, B);
+        ulam_csr_free(B);
+        assert_int_equal(read_with(path, 3, 0, &B, NULL), ULAM_OK);
+        assert_csr_same(A, B);
+        ulam_csr_free(A), ulam_csr_free(B);
+    }
+    static const struct {
+        long line;
+        const char *text;
+        int status;
+    } bad[] = {{5000, "12 x 0.5", ULAM_ESYNTAX},      {20000, "1 3001 0.5", ULAM_EINDEX},
+               {12345, "7 7 nan", ULAM_ENONFINITE},   {23999, "1 2 0.5 9", ULAM_ESYNTAX},
+               {7, "0 1 1", ULAM_EINDEX},             {18000, "% now a comment: one entry too few", ULAM_ETOOFEW},
+               {9000, "1 1 1e999", ULAM_ENONFINITE}, {24100, "5 5 1", ULAM_ETOOMANY}};
+    for (size_t c = 0; c < sizeof bad / sizeof bad[0]; c++) {
+        write_big(path, 3000, 8, 0, bad[c].line, bad[c].text);
+        if (bad[c].status == ULAM_ETOOMANY) { /* one entry more than declared, at the end */
+            FILE *f = fopen(path, "a");
+            fprintf(f, "5 5 1\n");
+            fclose(f);
+        }
+        ulam_csr *A = NULL;
+        ulam_error e1, e2;
+        int s1 = read_with(path, 1, 1, &A, &e1), s2 = read_with(path, 2, 0, &A, &e2);
+        if (s1 != bad[c].status || s2 != s1 || e1.line != e2.line || strcmp(e1.msg, e2.msg))
+            fail_msg("bad case %zu: sequential %d at line %ld, parallel %d at line %ld", c, s1, e1.line, s2, e2.line);
+        if (bad[c].status != ULAM_ETOOMANY && bad[c].status != ULAM_ETOOFEW && e2.line != bad[c].line)
+            fail_msg("bad case %zu: line %ld, expected %ld", c, e2.line, bad[c].line);
+        assert_null(A);
+    }
+    remove(path);
+}
+
 int main(void)
 {
     enum { NBAD = sizeof bad_cases / sizeof bad_cases[0] };
-    struct CMUnitTest tests[NBAD + 12];
+    struct CMUnitTest tests[NBAD + 13];
     size_t k = 0;
     for (size_t i = 0; i < NBAD; i++)
         tests[k++] = (struct CMUnitTest){bad_cases[i].file, test_bad, NULL, NULL, (void *)&bad_cases[i]};
@@ -298,6 +383,7 @@ int main(void)
         cmocka_unit_test(test_vectors),         cmocka_unit_test(test_roundtrip),
         cmocka_unit_test(test_write_refuses_nonfinite), cmocka_unit_test(test_write_unwritable),
         cmocka_unit_test(test_read_from_stream), cmocka_unit_test(test_strtod),
+        cmocka_unit_test(test_parallel_read),
     };
     for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) tests[k++] = good[i];
     return _cmocka_run_group_tests("mmio", tests, k, NULL, NULL);
