@@ -204,6 +204,17 @@ static int entries_ok(const ulam_csr *K, int64_t i)
     return 1;
 }
 
+/* Ask for what building state j's row reads first: its place and its range in rowptr. */
+static void prefetch_state(const ulam_kernel *k, int64_t j)
+{
+#if defined(__GNUC__)
+    __builtin_prefetch((const void *)&k->where[j]);
+    __builtin_prefetch((const void *)&k->K->rowptr[j]);
+#else
+    (void)k, (void)j;
+#endif
+}
+
 /* Build row i at header h: factor, scores and the alias table of its moves and termination.
  * Moves name their target rows' units when `placed` (every row has its place), else target
  * states still to be resolved.  A corrupt row (or no memory for its scratch) builds the dead
@@ -232,6 +243,7 @@ static void build_row(ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam_
     }
     for (int64_t q = 0; q < len; q++) {
         int64_t j = K->colidx[b + q];
+        if (!placed) prefetch_state(k, j); /* a walk here moves to one of these next */
         int32_t t = placed ? atomic_load_explicit(&k->where[j], memory_order_relaxed) - 1 : ULAM__UNRESOLVED + (int32_t)j;
         w->p[q] = qi * fabs(K->val[b + q]) / S;
         w->o[q] = K->val[b + q] < 0 ? ~t : t;

@@ -332,6 +332,11 @@ def check_prepare(ulam):
         assert rc == 0, err
         rc, info, err = run(ulam, ["info", sysf, "--json"])
         assert rc == 0 and json.loads(info)["n"] == 200, err
+        rc, _, err = run(ulam, ["study", sysf, "--index", "2", "--methods", "adjoint-collision-plain", "--budgets",
+                                "100", "--repeats", "2", "--out", d + "/study"])
+        assert rc == 0 and os.path.exists(d + "/study/runs.csv"), err
+        import shutil
+        shutil.rmtree(d + "/study")
         rc, _, err = run(ulam, ["solve", sysf, "--index", "5", "--jacobi"])
         assert rc == 2 and "prepared system" in err, err
         # Jacobi splitting stored, no b: solve needs --rhs
