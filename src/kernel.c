@@ -110,13 +110,13 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, ulam__scores scores
     atomic_init(&k->built, 0);
     atomic_init(&k->status, ULAM_OK);
     atomic_init(&k->bad, -1);
-    k->where = ulam__alloc_big((size_t)n, sizeof *k->where);
+    k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built; the pages of
+                                                              states never reached stay untouched */
     k->mem = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->mem);
     if (!k->where || !k->mem) {
         ulam__kernel_free(k);
         return ULAM_ENOMEM;
     }
-    for (int64_t i = 0; i < n; i++) atomic_init(&k->where[i], 0); /* no row built */
     dead_row(ulam__kernel_row(k, k->cap), -1);
     *out = k;
     return ULAM_OK;
