@@ -168,11 +168,15 @@ int main(int argc, char **argv)
                 ok = ok && !old_cache(cpath, "ulamCSR1", dm, tm, pm, bm);
                 snprintf(cpath, sizeof cpath, "%s.ulamcache", bpath);
                 ok = ok && !old_cache(cpath, "ulamVEC1", dv, tb, pv, bv);
+                before.rc = ok ? -3 : -1;
+            }
+            ulam_csr_free(M); /* before the runs: a child's peak RSS counts what this process holds */
+            free(b);
+            if (before.rc == -3) {
                 char *args[] = {(char *)old, "solve", mpath, "--rhs", bpath, "--index", idx, "--rel-err", "0.01",
                                 "--threads", "2", "--json", "--cache", NULL};
-                if (ok) before = median_run(args);
+                before = median_run(args);
             }
-            ulam_csr_free(M);
             char *args[] = {argv[1], "solve", sysf, "--index", idx, "--rel-err", "0.01", "--threads", "2", "--json", NULL};
             figures after = median_run(args);
             double sp_s = NAN, xI = NAN;
@@ -190,7 +194,6 @@ int main(int argc, char **argv)
                        (long long)n, "", k ? "prepared" : "before", f->load, f->guards, f->setup, f->walks, f->whole,
                        f->cpu, f->rss, f->rows, sp_s, f->whole / sp_s, fabs(f->estimate - xI) / f->stderr_);
             }
-            free(b);
             char cmd[400];
             snprintf(cmd, sizeof cmd, "rm -f %s/*", dir);
             if (system(cmd)) rc = 1;

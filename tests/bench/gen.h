@@ -124,8 +124,8 @@ static inline double bench_json_number(const char *text, const char *key)
 }
 
 /* Run argv with stdout captured into out (stderr to /dev/null when quiet); wall seconds into
- * *wall, its CPU seconds (user + system) into *cpu, its peak RSS in MiB into *rss.  The exit
- * status, or -1. */
+ * *wall, its CPU seconds (user + system) into *cpu, its peak RSS in MiB into *rss (which counts
+ * what this process had resident when it forked: free big arrays first).  The exit status, or -1. */
 static inline int bench_run(char *const argv[], char *out, size_t cap, int quiet, double *wall, double *cpu,
                             double *rss)
 {
