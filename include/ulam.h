@@ -147,6 +147,20 @@ int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error
 /* As ulam_mm_read_matrix_file, opening path. */
 int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err);
 
+/* Options of the matrix reader. */
+typedef struct ulam_mm_opts {
+    int threads;     /* 0: all cores; 1: the sequential streaming reader.  A regular file of
+                        coordinate general kind is read by `threads` threads in chunks split at
+                        line starts, straight into the CSR arrays when its rows rise through the
+                        file; any error is found and located (file:line) by the sequential
+                        reader, which reads on from the size line */
+    int libc_strtod; /* 1: reals by the C library's strtod (the same doubles, slower: the reader
+                        as it was, for comparisons) */
+} ulam_mm_opts;
+
+/* As ulam_mm_read_matrix_file with options (o NULL: all cores, ulam_strtod). */
+int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
+
 /* Read a dense vector: "array" m x 1, or "coordinate" m x 1 (missing entries are 0).
  * *x is malloc'd with *n entries. */
 int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
@@ -154,24 +168,18 @@ int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, 
 /* As ulam_mm_read_vector_file, opening path. */
 int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *err);
 
+/* strtod(s, end) exactly (the same double and end for every input, C locale), faster for
+ * decimals of up to 19 significant digits with normal results (Clinger's fast path, else the
+ * Eisel-Lemire algorithm); everything else is strtod's own work.  errno is set only when
+ * strtod itself runs. */
+double ulam_strtod(const char *s, char **end);
+
 /* Write A as "coordinate real general" with an optional one-line comment.  The file is
  * written to a temporary name and renamed into place only when complete. */
 int ulam_mm_write_matrix(const char *path, const ulam_csr *A, const char *comment);
 
 /* Write x as "array real general" n x 1, atomically like ulam_mm_write_matrix. */
 int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const char *comment);
-
-/* ---------------------------------------------------------------- binary caches */
-
-/* A parsed matrix or vector saved as its arrays behind a header (native byte order), so a
- * second run reads instead of parsing.  tag identifies the source (the CLI uses its size and
- * modification time): a cache whose tag differs is refused with ULAM_ENOTFOUND, one written
- * on another byte order with ULAM_EBANNER, a truncated or inconsistent one with ULAM_ESYNTAX
- * (its CSR structure is checked as a parse would be).  Written atomically. */
-int ulam_cache_write_csr(const char *path, const ulam_csr *A, const uint64_t tag[2]);
-int ulam_cache_read_csr(const char *path, const uint64_t tag[2], ulam_csr **A, ulam_error *err);
-int ulam_cache_write_vector(const char *path, const double *x, int64_t n, const uint64_t tag[2]);
-int ulam_cache_read_vector(const char *path, const uint64_t tag[2], double **x, int64_t *n, ulam_error *err);
 
 /* An output file written under a temporary name in the same directory and renamed into place
  * by ulam_outfile_commit: a reader sees the old file or the complete new one, never a part.
@@ -327,6 +335,101 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
 /* Whether g certifies the variance of walks in mode finite: 1 finite (rho(M^) < 1), 0 infinite
  * (rho(M^) >= 1), -1 unknown (the bounds straddle 1, or that radius was not computed). */
 int ulam_guard_variance(const ulam_guard *g, int mode);
+
+/* ---------------------------------------------------------------- prepared systems */
+
+/* A prepared system: M (and b) of (I - M) x = b as one binary file that is mapped read-only
+ * and used in place, so a query reads only the pages of the rows its walks reach (the layout
+ * is documented in docs/prepared.md: a 1024-byte little-endian header with the sizes, the
+ * array offsets, the file length, a certificate section and an FNV-1a checksum of the header,
+ * then rowptr int64[nrows + 1], colidx int32[nnz], val double[nnz] and b double[nrows], each
+ * at a 4096-byte boundary).  `ulam prepare` writes one; `--cache` keeps one beside each input
+ * (a vector's holds only b), tagged with the source's size and modification time. */
+typedef struct ulam_system ulam_system;
+
+/* What the guards certified for a prepared system, so a query needs no pass over M: the
+ * radii of ulam_guard_check for the kernel of continuation continue_q under power-iteration
+ * options (tol, max_iter), and the row- and column-sum bounds of |M| (the largest of either
+ * bounds rho(|M|) from above).  Stored in a versioned section of the header (version 1 holds
+ * these fields; a reader ignores a version it does not know and the guards run as usual). */
+typedef struct ulam_certificate {
+    double continue_q; /* <= 0: the analog kernel */
+    double tol;
+    int max_iter;
+    double rowsum_min, rowsum_max, colsum_min, colsum_max; /* of |M| */
+    ulam_guard guard;
+} ulam_certificate;
+
+/* What to write: M and/or b (n entries; with M, n = M->nrows), an optional source tag (the
+ * CLI's cache: size and mtime), the Jacobi damping omega that made M (0: M as read) and an
+ * optional certificate. */
+typedef struct ulam_system_desc {
+    const ulam_csr *M;
+    const double *b;
+    int64_t n;
+    uint64_t tag[2];
+    double omega;
+    const ulam_certificate *cert;
+} ulam_system_desc;
+
+/* Write a prepared system to f (positioned at 0; the caller closes it): ULAM_OK, ULAM_EINVAL
+ * or ULAM_EIO. */
+int ulam_system_write_file(FILE *f, const ulam_system_desc *d);
+
+/* Write a prepared system to path atomically (through ulam_outfile). */
+int ulam_system_write(const char *path, const ulam_system_desc *d);
+
+/* Map the prepared system at path read-only.  The header is checked whole: magic
+ * (ULAM_EBANNER), version and byte order (ULAM_EUNSUPPORTED), checksum, sizes, offsets and
+ * the file's length against them, rowptr[0] = 0 and rowptr[nrows] = nnz (ULAM_ESYNTAX; a
+ * truncated file fails here); tag, when not NULL, must match the stored one (ULAM_ENOTFOUND).
+ * The arrays are NOT read: ulam_system_check verifies them, and the walk kernel checks each
+ * row it builds (ulam_solver_iterate fails with ULAM_ESYNTAX on a corrupt one), so a query
+ * that uses the certificate reads only the rows it walks. */
+int ulam_system_open(const char *path, const uint64_t tag[2], ulam_system **out, ulam_error *err);
+
+/* As ulam_system_open on bytes already in memory (borrowed: they must outlive the system). */
+int ulam_system_from_memory(const void *data, size_t bytes, const uint64_t tag[2], ulam_system **out,
+                            ulam_error *err);
+
+/* 1 when path starts with the prepared-system magic, 0 otherwise (unreadable included). */
+int ulam_system_is_file(const char *path);
+
+/* Verify the arrays as a parse would: the CSR invariants (ulam_csr_check) and a finite b;
+ * one pass over the file.  ULAM_OK or ULAM_ESYNTAX / ULAM_EINDEX / ULAM_ENONFINITE. */
+int ulam_system_check(const ulam_system *s, ulam_error *err);
+
+/* The mapped matrix (NULL when the file holds only b): read-only, owned by s (never pass it
+ * to ulam_csr_free), valid until ulam_system_free.  Not verified: a walk checks each row it
+ * builds, but anything that reads all of M (the guards ulam_solver_alloc runs unless
+ * ulam_walk_opts.guard holds them, a direct solve) needs ulam_system_check first; a query
+ * passes the certificate's guards instead (ulam_certificate_guard). */
+const ulam_csr *ulam_system_matrix(const ulam_system *s);
+
+/* The mapped b (NULL when the file holds none); *n (may be NULL) gets its length. */
+const double *ulam_system_rhs(const ulam_system *s, int64_t *n);
+
+/* The stored certificate, or NULL when there is none (or of a version this reader does not know). */
+const ulam_certificate *ulam_system_certificate(const ulam_system *s);
+
+/* The Jacobi damping the stored M was made with (0: none). */
+double ulam_system_omega(const ulam_system *s);
+
+/* Unmap and free; accepts and returns NULL. */
+ulam_system *ulam_system_free(ulam_system *s);
+
+/* The certificate of M: the guards of ulam_guard_check(M, continue_q, opts) and the row and
+ * column sums of |M| (one more pass). */
+int ulam_certificate_compute(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
+                             ulam_certificate *c, ulam_error *err);
+
+/* The guards a query would compute, taken from certificate c when it was made for the same
+ * continuation and power-iteration options and holds the radii opts->need asks for (opts NULL:
+ * the defaults, all three; never for opts->tight): ULAM_OK with *g
+ * filled (its seconds 0: no pass was made), or ULAM_ENOTFOUND when c is NULL or does not
+ * apply (the caller then runs ulam_guard_check). */
+int ulam_certificate_guard(const ulam_certificate *c, double continue_q, const ulam_guard_opts *opts,
+                           ulam_guard *g);
 
 /* ---------------------------------------------------------------- random numbers */
 

@@ -1,135 +1,342 @@
-/* Binary caches of a parsed matrix or vector: the arrays as they sit in memory behind a
- * header, so a second run loads by reading, not parsing.  Layout (native byte order, checked
- * by a marker): char magic[8] ("ulamCSR1" or "ulamVEC1"), uint64 order marker, int64 nrows,
- * ncols, nnz, uint64 tag[2] (the caller's identity of the source: size and mtime), then
- * rowptr int64[nrows + 1], colidx int32[nnz], val double[nnz] (a vector: val double[nrows]). */
+/* Prepared systems: M and b of (I - M) x = b as one file mapped read-only and used in place
+ * (docs/prepared.md).  The header is 1024 bytes of little-endian 64-bit words:
+ *
+ *   word  0      magic "ulamSYS1"
+ *   word  1      version (1) | header bytes (1024) << 32
+ *   word  2      flags: 1 matrix, 2 b, 4 certificate
+ *   words 3-5    nrows, ncols, nnz
+ *   words 6-9    byte offsets of rowptr int64[nrows + 1], colidx int32[nnz], val double[nnz],
+ *                b double[nrows] (0 when absent), each a multiple of 4096
+ *   word  10     the file's length in bytes
+ *   words 11-12  the source's tag (the CLI's cache: size and mtime; 0 from `ulam prepare`)
+ *   word  13     the Jacobi damping omega that made M (double; 0: M as read)
+ *   words 32-126 the certificate section: word 32 its version (1) | its bytes << 32, then
+ *                version 1's fields (see put_cert)
+ *   word  127    FNV-1a 64 of bytes 0 .. 1015
+ *
+ * Opening checks the header whole but reads no array beyond rowptr[0] and rowptr[nrows]:
+ * ulam_system_check verifies them, and the walk kernel checks each row it builds. */
 #include "internal.h"
 
+#include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
-enum { HEADER_WORDS = 6 };
-static const uint64_t ORDER = 0x0102030405060708u;
+enum {
+    HEADER = 1024, WORDS = HEADER / 8, ALIGN = 4096, VERSION = 1,
+    F_MATRIX = 1, F_RHS = 2, F_CERT = 4,
+    W_FLAGS = 2, W_DIMS = 3, W_OFF = 6, W_LEN = 10, W_TAG = 11, W_OMEGA = 13,
+    W_CERT = 32, W_SUM = WORDS - 1, CERT_VERSION = 2, CERT_WORDS = 36
+};
+static const char MAGIC[8] = {'u', 'l', 'a', 'm', 'S', 'Y', 'S', '1'};
 
-/* Write the header and arrays to an atomic output file. */
-static int cache_write(const char *path, const char magic[8], const int64_t dims[3], const uint64_t tag[2],
-                       const void *const parts[3], const size_t bytes[3])
+struct ulam_system {
+    ulam_csr csr;          /* pointers into the mapping */
+    const double *b;
+    int64_t n;
+    int has_matrix, has_cert;
+    double omega;
+    ulam_certificate cert;
+    void *map;             /* the mapping (NULL: borrowed memory) */
+    size_t map_bytes;
+};
+
+/* FNV-1a 64 of bytes p[0 .. n). */
+static uint64_t fnv1a(const unsigned char *p, size_t n)
 {
+    uint64_t h = 0xcbf29ce484222325u;
+    for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 0x100000001b3u;
+    return h;
+}
+
+/* Nonzero on a little-endian machine (the only one that can use the file in place). */
+static int little_endian(void)
+{
+    const uint16_t one = 1;
+    unsigned char c;
+    memcpy(&c, &one, 1);
+    return c == 1;
+}
+
+/* A double's bits as a header word, and back. */
+static uint64_t bits(double x)
+{
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    return u;
+}
+static double real(uint64_t u)
+{
+    double x;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+
+/* One radius as 8 words: rho, lower, upper, rowsum_max, colsum_max, iterations, converged,
+ * seconds. */
+static void put_power(uint64_t *w, const ulam_power *p)
+{
+    w[0] = bits(p->rho), w[1] = bits(p->lower), w[2] = bits(p->upper);
+    w[3] = bits(p->rowsum_max), w[4] = bits(p->colsum_max);
+    w[5] = (uint64_t)(int64_t)p->iterations, w[6] = (uint64_t)p->converged, w[7] = bits(p->seconds);
+}
+static void get_power(const uint64_t *w, ulam_power *p)
+{
+    *p = (ulam_power){.rho = real(w[0]), .lower = real(w[1]), .upper = real(w[2]), .rowsum_max = real(w[3]),
+                      .colsum_max = real(w[4]), .iterations = (int)(int64_t)w[5], .converged = w[6] != 0,
+                      .seconds = real(w[7])};
+}
+
+/* Certificate version 2 from word 33: continue_q, tol, max_iter, rowsum min and max, colsum min
+ * and max, then |M|, M^ adjoint, M^ forward (8 words each), the three verdicts and the guard's
+ * computed bits. */
+static void put_cert(uint64_t *w, const ulam_certificate *c)
+{
+    w[0] = (uint64_t)CERT_VERSION | (uint64_t)(CERT_WORDS * 8) << 32;
+    w[1] = bits(c->continue_q), w[2] = bits(c->tol), w[3] = (uint64_t)(int64_t)c->max_iter;
+    w[4] = bits(c->rowsum_min), w[5] = bits(c->rowsum_max), w[6] = bits(c->colsum_min), w[7] = bits(c->colsum_max);
+    put_power(w + 8, &c->guard.abs);
+    put_power(w + 16, &c->guard.hat[0]);
+    put_power(w + 24, &c->guard.hat[1]);
+    w[32] = (uint64_t)c->guard.verdict_abs, w[33] = (uint64_t)c->guard.verdict_hat[0];
+    w[34] = (uint64_t)c->guard.verdict_hat[1], w[35] = (uint64_t)c->guard.computed;
+}
+
+/* Read certificate version 2; 0 when the section is of another version or inconsistent. */
+static int get_cert(const uint64_t *w, ulam_certificate *c)
+{
+    if (w[0] != ((uint64_t)CERT_VERSION | (uint64_t)(CERT_WORDS * 8) << 32)) return 0;
+    *c = (ulam_certificate){.continue_q = real(w[1]), .tol = real(w[2]), .max_iter = (int)(int64_t)w[3],
+                            .rowsum_min = real(w[4]), .rowsum_max = real(w[5]), .colsum_min = real(w[6]),
+                            .colsum_max = real(w[7])};
+    get_power(w + 8, &c->guard.abs);
+    get_power(w + 16, &c->guard.hat[0]);
+    get_power(w + 24, &c->guard.hat[1]);
+    for (int k = 0; k < 3; k++)
+        if (w[32 + k] > ULAM_VERDICT_UNKNOWN) return 0;
+    if (w[35] > (uint64_t)ULAM_GUARD_ALL) return 0;
+    c->guard.verdict_abs = (int)w[32], c->guard.verdict_hat[0] = (int)w[33], c->guard.verdict_hat[1] = (int)w[34];
+    c->guard.computed = (int)w[35];
+    c->guard.continue_q = c->continue_q;
+    return 1;
+}
+
+/* Round x up to the alignment. */
+static uint64_t aligned(uint64_t x)
+{
+    return (x + ALIGN - 1) / ALIGN * ALIGN;
+}
+
+/* Write bytes p[0 .. n) and then zeros up to the next boundary; *at advances. */
+static int put_part(FILE *f, const void *p, size_t n, uint64_t *at)
+{
+    static const unsigned char zeros[ALIGN];
+    if (n && fwrite(p, 1, n, f) != n) return 0;
+    size_t pad = (size_t)(aligned(*at + n) - (*at + n));
+    *at += n + pad;
+    return !pad || fwrite(zeros, 1, pad, f) == pad;
+}
+
+/* Write a prepared system to f. */
+int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
+{
+    if (!f || !d || (!d->M && !d->b) || !little_endian()) return ULAM_EINVAL;
+    const ulam_csr *M = d->M;
+    int64_t n = M ? M->nrows : d->n, nnz = M ? M->rowptr[M->nrows] : 0;
+    if (n < 0 || (M && d->n != M->nrows && d->b)) return ULAM_EINVAL;
+    uint64_t w[WORDS] = {0}, at = HEADER;
+    size_t part[4] = {M ? ((size_t)n + 1) * 8 : 0, (size_t)nnz * 4, (size_t)nnz * 8, d->b ? (size_t)n * 8 : 0};
+    memcpy(&w[0], MAGIC, 8);
+    w[1] = (uint64_t)VERSION | (uint64_t)HEADER << 32;
+    w[W_FLAGS] = (M ? F_MATRIX : 0) | (d->b ? F_RHS : 0) | (d->cert ? F_CERT : 0);
+    w[W_DIMS] = (uint64_t)n, w[W_DIMS + 1] = (uint64_t)(M ? M->ncols : 1), w[W_DIMS + 2] = (uint64_t)nnz;
+    at = aligned(at);
+    for (int k = 0; k < 4; k++) {
+        w[W_OFF + k] = part[k] || (k < 3 && M) || (k == 3 && d->b) ? at : 0;
+        at = aligned(at + part[k]);
+    }
+    w[W_LEN] = at;
+    w[W_TAG] = d->tag[0], w[W_TAG + 1] = d->tag[1];
+    w[W_OMEGA] = bits(d->omega);
+    if (d->cert) put_cert(w + W_CERT, d->cert);
+    w[W_SUM] = fnv1a((const unsigned char *)w, (size_t)W_SUM * 8);
+    const void *src[4] = {M ? (const void *)M->rowptr : NULL, M ? (const void *)M->colidx : NULL,
+                          M ? (const void *)M->val : NULL, d->b};
+    uint64_t pos = 0;
+    int ok = put_part(f, w, HEADER, &pos);
+    for (int k = 0; k < 4 && ok; k++)
+        if (w[W_OFF + k]) ok = put_part(f, src[k], part[k], &pos);
+    return ok && pos == at ? ULAM_OK : ULAM_EIO;
+}
+
+/* Write a prepared system to path atomically. */
+int ulam_system_write(const char *path, const ulam_system_desc *d)
+{
+    if (!path || !d) return ULAM_EINVAL;
     ulam_outfile o;
     int status = ulam_outfile_open(&o, path);
     if (status) return status;
-    uint64_t head[HEADER_WORDS] = {ORDER, (uint64_t)dims[0], (uint64_t)dims[1], (uint64_t)dims[2], tag[0], tag[1]};
-    int ok = fwrite(magic, 1, 8, o.f) == 8 && fwrite(head, sizeof head, 1, o.f) == 1;
-    for (int k = 0; k < 3 && ok; k++) ok = bytes[k] == 0 || fwrite(parts[k], 1, bytes[k], o.f) == bytes[k];
-    if (!ok) {
+    status = ulam_system_write_file(o.f, d);
+    if (status) {
         ulam_outfile_abort(&o);
-        return ULAM_EIO;
+        return status;
     }
     return ulam_outfile_commit(&o);
 }
 
-/* Open a cache and check its magic, byte order, tag and the sizes it states (its length is
- * checked by reading: read_all). */
-static int cache_open(const char *path, const char magic[8], const uint64_t tag[2], int64_t dims[3], FILE **fp,
-                      ulam_error *err)
+/* Nonzero when an array of bytes at offset off lies inside a file of len bytes past the header. */
+static int inside(uint64_t off, uint64_t bytes, uint64_t len)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return ulam__fail(err, ULAM_EIO, 0, -1, "a readable cache file");
-    char m[8];
-    uint64_t h[HEADER_WORDS];
-    if (fread(m, 1, 8, f) != 8 || memcmp(m, magic, 8) || fread(h, sizeof h, 1, f) != 1 || h[0] != ORDER) {
-        fclose(f);
-        return ulam__fail(err, ULAM_EBANNER, 0, -1, "an ulam cache written on this kind of machine");
+    return off >= HEADER && off % ALIGN == 0 && off <= len && bytes <= len - off;
+}
+
+/* Check the header of the len bytes at p and fill s (its arrays point into p). */
+static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam_system *s, ulam_error *err)
+{
+    uint64_t w[WORDS];
+    if (len < 8 || memcmp(p, MAGIC, 8))
+        return ulam__fail(err, ULAM_EBANNER, 0, -1, "an ulam prepared system (magic 'ulamSYS1')");
+    if (!little_endian()) return ulam__fail(err, ULAM_EUNSUPPORTED, 0, -1, "a little-endian machine");
+    if (len < HEADER)
+        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a header of %d bytes (the file has %zu: truncated)", HEADER, len);
+    memcpy(w, p, HEADER);
+    if (w[1] != ((uint64_t)VERSION | (uint64_t)HEADER << 32))
+        return ulam__fail(err, ULAM_EUNSUPPORTED, 0, -1, "format version 1 (got %llu)", (unsigned long long)(w[1] & 0xffffffffu));
+    if (fnv1a(p, (size_t)W_SUM * 8) != w[W_SUM])
+        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a header matching its checksum (the header is corrupt)");
+    if (w[W_LEN] != len)
+        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a file of %llu bytes as its header states, got %zu (truncated?)",
+                          (unsigned long long)w[W_LEN], len);
+    uint64_t flags = w[W_FLAGS], n = w[W_DIMS], nc = w[W_DIMS + 1], nnz = w[W_DIMS + 2];
+    int m = (flags & F_MATRIX) != 0, r = (flags & F_RHS) != 0;
+    if ((flags & ~(uint64_t)(F_MATRIX | F_RHS | F_CERT)) || (!m && !r) || n > ULAM_MAX_DIM || nc > ULAM_MAX_DIM ||
+        nnz > (uint64_t)INT64_MAX / 32 || (!m && (nnz || nc != 1)))
+        return ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "sizes that fit (got %llu x %llu, %llu entries)",
+                          (unsigned long long)n, (unsigned long long)nc, (unsigned long long)nnz);
+    uint64_t bytes[4] = {m ? (n + 1) * 8 : 0, m ? nnz * 4 : 0, m ? nnz * 8 : 0, r ? n * 8 : 0};
+    for (int k = 0; k < 4; k++) {
+        int present = k < 3 ? m : r;
+        if (present ? !inside(w[W_OFF + k], bytes[k], len) : w[W_OFF + k] != 0)
+            return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "arrays inside the file at 4096-byte boundaries (array %d is not)", k);
     }
-    if (h[4] != tag[0] || h[5] != tag[1]) {
-        fclose(f);
+    if (tag && (w[W_TAG] != tag[0] || w[W_TAG + 1] != tag[1]))
         return ulam__fail(err, ULAM_ENOTFOUND, 0, -1, "a cache of the current source file (it changed)");
+    *s = (ulam_system){.n = (int64_t)n, .has_matrix = m, .omega = real(w[W_OMEGA])};
+    if (m) {
+        s->csr = (ulam_csr){.nrows = (int64_t)n, .ncols = (int64_t)nc, .rowptr = (int64_t *)(uintptr_t)(p + w[W_OFF]),
+                            .colidx = (int32_t *)(uintptr_t)(p + w[W_OFF + 1]),
+                            .val = (double *)(uintptr_t)(p + w[W_OFF + 2])};
+        if (s->csr.rowptr[0] != 0 || s->csr.rowptr[n] != (int64_t)nnz)
+            return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "rowptr from 0 to the %llu entries the header states",
+                              (unsigned long long)nnz);
     }
-    for (int k = 0; k < 3; k++) dims[k] = (int64_t)h[k + 1];
-    if (dims[0] < 0 || dims[1] < 0 || dims[2] < 0 || dims[0] > ULAM_MAX_DIM || dims[1] > ULAM_MAX_DIM ||
-        dims[2] > INT64_MAX / 32) {
-        fclose(f);
-        return ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "sizes that fit (got %lld x %lld, %lld entries)",
-                          (long long)dims[0], (long long)dims[1], (long long)dims[2]);
-    }
-    *fp = f;
+    if (r) s->b = (const double *)(const void *)(p + w[W_OFF + 3]);
+    s->has_cert = (flags & F_CERT) && get_cert(w + W_CERT, &s->cert);
     return ULAM_OK;
 }
 
-/* Read exactly bytes into p, and then find the end of the file. */
-static int read_all(FILE *f, void *p, size_t bytes, int last)
-{
-    if (bytes && fread(p, 1, bytes, f) != bytes) return 0;
-    return !last || fgetc(f) == EOF;
-}
-
-/* Write A to a binary cache at path, tagged with the identity of its source. */
-int ulam_cache_write_csr(const char *path, const ulam_csr *A, const uint64_t tag[2])
-{
-    if (!path || !A || !tag) return ULAM_EINVAL;
-    int64_t nnz = A->rowptr[A->nrows], dims[3] = {A->nrows, A->ncols, nnz};
-    const void *parts[3] = {A->rowptr, A->colidx, A->val};
-    size_t bytes[3] = {((size_t)A->nrows + 1) * sizeof *A->rowptr, (size_t)nnz * sizeof *A->colidx,
-                       (size_t)nnz * sizeof *A->val};
-    return cache_write(path, "ulamCSR1", dims, tag, parts, bytes);
-}
-
-/* Read a matrix cache written for the same tag; its structure is checked as a parse would. */
-int ulam_cache_read_csr(const char *path, const uint64_t tag[2], ulam_csr **A, ulam_error *err)
+/* As ulam_system_open on bytes already in memory. */
+int ulam_system_from_memory(const void *data, size_t bytes, const uint64_t tag[2], ulam_system **out, ulam_error *err)
 {
     ulam__clear(err);
-    if (!path || !tag || !A) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path, a tag and a result");
-    *A = NULL;
-    int64_t d[3];
-    FILE *f = NULL;
-    int status = cache_open(path, "ulamCSR1", tag, d, &f, err);
-    if (status) return status;
-    ulam_csr *B = ulam_csr_alloc(d[0], d[1], d[2]);
-    if (!B) {
-        fclose(f);
-        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld entries", (long long)d[2]);
+    if (!data || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "bytes and a result");
+    *out = NULL;
+    if ((uintptr_t)data % 8) return ulam__fail(err, ULAM_EINVAL, 0, -1, "bytes aligned to 8");
+    ulam_system *s = malloc(sizeof *s);
+    if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a system");
+    int status = parse(data, bytes, tag, s, err);
+    if (status) {
+        free(s);
+        return status;
     }
-    int ok = read_all(f, B->rowptr, ((size_t)d[0] + 1) * sizeof *B->rowptr, 0) &&
-             read_all(f, B->colidx, (size_t)d[2] * sizeof *B->colidx, 0) &&
-             read_all(f, B->val, (size_t)d[2] * sizeof *B->val, 1);
-    fclose(f);
-    if (!ok || B->rowptr[d[0]] != d[2] || ulam_csr_check(B) != ULAM_OK) { /* nnz first: the check reads that far */
-        ulam_csr_free(B);
-        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a complete, consistent cache (truncated or corrupt)");
-    }
-    *A = B;
+    *out = s;
     return ULAM_OK;
 }
 
-/* Write x (n values) to a binary cache at path, tagged with the identity of its source. */
-int ulam_cache_write_vector(const char *path, const double *x, int64_t n, const uint64_t tag[2])
-{
-    if (!path || !x || n < 0 || !tag) return ULAM_EINVAL;
-    int64_t dims[3] = {n, 1, n};
-    const void *parts[3] = {x, NULL, NULL};
-    size_t bytes[3] = {(size_t)n * sizeof *x, 0, 0};
-    return cache_write(path, "ulamVEC1", dims, tag, parts, bytes);
-}
-
-/* Read a vector cache written for the same tag into a new *x of *n values. */
-int ulam_cache_read_vector(const char *path, const uint64_t tag[2], double **x, int64_t *n, ulam_error *err)
+/* Map the prepared system at path read-only. */
+int ulam_system_open(const char *path, const uint64_t tag[2], ulam_system **out, ulam_error *err)
 {
     ulam__clear(err);
-    if (!path || !tag || !x || !n) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path, a tag and a result");
-    *x = NULL;
-    int64_t d[3];
-    FILE *f = NULL;
-    int status = cache_open(path, "ulamVEC1", tag, d, &f, err);
-    if (status) return status;
-    double *v = d[1] == 1 && d[2] == d[0] ? ulam__malloc((size_t)d[0], sizeof *v) : NULL;
-    int ok = v && read_all(f, v, (size_t)d[0] * sizeof *v, 1);
-    fclose(f);
-    for (int64_t i = 0; ok && i < d[0]; i++) ok = isfinite(v[i]);
-    if (!ok) {
-        free(v);
-        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a complete, consistent cache (truncated or corrupt)");
+    if (!path || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path and a result");
+    *out = NULL;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) || !S_ISREG(st.st_mode)) {
+        if (fd >= 0) close(fd);
+        return ulam__fail(err, ULAM_EIO, 0, -1, "a readable prepared system file");
     }
-    *x = v, *n = d[0];
+    size_t len = (size_t)st.st_size;
+    void *map = len ? mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0) : MAP_FAILED;
+    close(fd);
+    if (map == MAP_FAILED) {
+        if (len == 0) return ulam__fail(err, ULAM_EBANNER, 0, -1, "an ulam prepared system (the file is empty)");
+        return ulam__fail(err, ULAM_EIO, 0, -1, "a file that can be mapped");
+    }
+    int status = ulam_system_from_memory(map, len, tag, out, err);
+    if (status) {
+        munmap(map, len);
+        return status;
+    }
+    (*out)->map = map, (*out)->map_bytes = len;
     return ULAM_OK;
+}
+
+/* 1 when path starts with the prepared-system magic. */
+int ulam_system_is_file(const char *path)
+{
+    char m[8];
+    FILE *f = path ? fopen(path, "rb") : NULL;
+    int yes = f && fread(m, 1, 8, f) == 8 && !memcmp(m, MAGIC, 8);
+    if (f) fclose(f);
+    return yes;
+}
+
+/* Verify the arrays as a parse would. */
+int ulam_system_check(const ulam_system *s, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a system");
+    int status = s->has_matrix ? ulam_csr_check(&s->csr) : ULAM_OK;
+    if (status) return ulam__fail(err, status, 0, -1, "a consistent matrix (the prepared file is corrupt)");
+    for (int64_t i = 0; s->b && i < s->n; i++)
+        if (!isfinite(s->b[i])) return ulam__fail(err, ULAM_ENONFINITE, 0, i, "finite b (the prepared file is corrupt)");
+    return ULAM_OK;
+}
+
+/* The mapped matrix, or NULL. */
+const ulam_csr *ulam_system_matrix(const ulam_system *s)
+{
+    return s && s->has_matrix ? &s->csr : NULL;
+}
+
+/* The mapped b, or NULL. */
+const double *ulam_system_rhs(const ulam_system *s, int64_t *n)
+{
+    if (n) *n = s ? s->n : 0;
+    return s ? s->b : NULL;
+}
+
+/* The stored certificate, or NULL. */
+const ulam_certificate *ulam_system_certificate(const ulam_system *s)
+{
+    return s && s->has_cert ? &s->cert : NULL;
+}
+
+/* The Jacobi damping of the stored M. */
+double ulam_system_omega(const ulam_system *s)
+{
+    return s ? s->omega : 0.0;
+}
+
+/* Unmap and free. */
+ulam_system *ulam_system_free(ulam_system *s)
+{
+    if (!s) return NULL;
+    if (s->map) munmap(s->map, s->map_bytes);
+    free(s);
+    return NULL;
 }

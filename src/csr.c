@@ -98,14 +98,23 @@ static int sort_row(int32_t *j, double *x, int64_t len)
     return ULAM_OK;
 }
 
-/* Sort every row, sum duplicates and drop zeros, compacting A in place. */
-static int csr_canonicalize(ulam_csr *A)
+/* Sort every row, sum duplicates and drop zeros, compacting A in place.  Rows are sorted in
+ * parallel (threads; they are independent); the compaction, needed only when some row holds a
+ * repeated column or a zero, is one sequential pass. */
+int ulam__csr_canonicalize(ulam_csr *A, int threads)
 {
+    int nomem = 0, compact = 0;
+#pragma omp parallel for schedule(dynamic, 4096) num_threads(threads) reduction(|| : nomem, compact) if (threads > 1)
+    for (int64_t i = 0; i < A->nrows; i++) {
+        int64_t a = A->rowptr[i], b = A->rowptr[i + 1];
+        if (sort_row(A->colidx + a, A->val + a, b - a)) nomem = 1;
+        for (int64_t k = a; k < b; k++) compact = compact || A->val[k] == 0.0 || (k > a && A->colidx[k] == A->colidx[k - 1]);
+    }
+    if (nomem) return ULAM_ENOMEM;
+    if (!compact) return ULAM_OK;
     int64_t out = 0, start = 0;
     for (int64_t i = 0; i < A->nrows; i++) {
         int64_t end = A->rowptr[i + 1];
-        int status = sort_row(A->colidx + start, A->val + start, end - start);
-        if (status) return status;
         A->rowptr[i] = out;
         for (int64_t k = start; k < end;) {
             int32_t j = A->colidx[k];
@@ -146,7 +155,7 @@ int ulam_csr_from_triplets(int64_t nrows, int64_t ncols, int64_t nz, const int32
         A->val[p] = tx[k];
     }
     free(next);
-    int status = csr_canonicalize(A);
+    int status = ulam__csr_canonicalize(A, 1);
     if (status) {
         ulam_csr_free(A);
         return status;

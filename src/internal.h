@@ -122,4 +122,8 @@ int ulam__grow(void *pp, int64_t *cap, int64_t need, size_t sz);
  * random access).  n items of size sz; freed with free(); NULL on overflow or failure. */
 void *ulam__alloc_big(size_t n, size_t sz);
 
+/* Sort every row of A by column (with `threads` threads), sum duplicates and drop zeros,
+ * compacting A in place. */
+int ulam__csr_canonicalize(ulam_csr *A, int threads);
+
 #endif

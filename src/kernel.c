@@ -16,7 +16,14 @@
  * walk to take such a move looks the target's place up (building that row if need be) and
  * rewrites the outcome to name it, so later steps cost what they cost in a kernel built whole.
  * A query for one x_i visits a small part of a large system: it pays for, and keeps in memory,
- * only the rows its walks reach. */
+ * only the rows its walks reach.
+ *
+ * K may be a prepared file mapped in place and not verified beyond its header, so every row
+ * is checked as it is built (its rowptr range, columns, values and score finite): a corrupt
+ * row, or a row that would overflow the arena, is replaced by the dead row at the arena's end
+ * (which terminates at once and scores nothing) and recorded in k->status, which the solver
+ * turns into a failed run.  The per-thread scratch grows to the longest row built, so nothing
+ * reads all of K before the walks. */
 #include "kernel.h"
 
 #include <math.h>
@@ -45,6 +52,13 @@ static void set_slot(ulam__slot *s, uint64_t t, int32_t a, int32_t b)
     s->thresh = t;
     atomic_store_explicit(&s->a, a, memory_order_relaxed);
     atomic_store_explicit(&s->b, b, memory_order_relaxed);
+}
+
+/* A row at h that terminates at once and scores nothing (state i). */
+static void dead_row(ulam__row *h, int64_t i)
+{
+    *h = (ulam__row){.len = 1, .state = (int32_t)i};
+    set_slot((ulam__slot *)(void *)h + ULAM__HEAD, UINT64_MAX, ULAM__TERMINATE, ULAM__TERMINATE);
 }
 
 /* Vose's alias table for the m outcomes with probabilities p (summing to 1) into s. */
@@ -86,37 +100,52 @@ static int64_t row_outcomes(const ulam_csr *K, int64_t i)
 int ulam__kernel_alloc(const ulam_csr *K, double continue_q, ulam__scores scores, ulam_kernel **out)
 {
     *out = NULL;
-    int64_t n = K->nrows, nnz = K->rowptr[n], maxlen = 1;
-    for (int64_t i = 0; i < n; i++)
-        if (row_outcomes(K, i) > maxlen) maxlen = row_outcomes(K, i);
-    if (n >= ULAM__UNRESOLVED || nnz > ULAM__UNRESOLVED - (ULAM__HEAD + 1) * n) return ULAM_EOVERFLOW;
+    int64_t n = K->nrows, nnz = K->rowptr[n];
+    if (n >= ULAM__UNRESOLVED || nnz > ULAM__UNRESOLVED - (ULAM__HEAD + 1) * (n + 1)) return ULAM_EOVERFLOW;
     ulam_kernel *k = calloc(1, sizeof *k);
     if (!k) return ULAM_ENOMEM;
-    k->n = n, k->cap = nnz + (ULAM__HEAD + 1) * n, k->maxlen = maxlen;
+    k->n = n, k->cap = nnz + (ULAM__HEAD + 1) * n;
     k->K = K, k->continue_q = continue_q, k->scores = scores;
     atomic_init(&k->top, 0);
     atomic_init(&k->built, 0);
-    k->where = ulam__alloc_big((size_t)n, sizeof *k->where);
-    k->mem = ulam__alloc_big((size_t)k->cap, sizeof *k->mem);
+    atomic_init(&k->status, ULAM_OK);
+    atomic_init(&k->bad, -1);
+    k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built; the pages of
+                                                              states never reached stay untouched */
+    k->mem = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->mem);
     if (!k->where || !k->mem) {
         ulam__kernel_free(k);
         return ULAM_ENOMEM;
     }
-    for (int64_t i = 0; i < n; i++) atomic_init(&k->where[i], 0); /* no row built */
+    dead_row(ulam__kernel_row(k, k->cap), -1);
     *out = k;
     return ULAM_OK;
 }
 
-/* Scratch for building rows of up to k->maxlen outcomes. */
+/* Room in scratch w for rows of m outcomes (grown to at least twice what it had). */
+static int kscratch_fit(ulam__kscratch *w, int64_t m)
+{
+    if (m <= w->cap) return ULAM_OK;
+    int64_t c = w->cap;
+    if (ulam__grow(&w->p, &c, m, sizeof *w->p)) return ULAM_ENOMEM;
+    c = w->cap;
+    if (ulam__grow(&w->scaled, &c, m, sizeof *w->scaled)) return ULAM_ENOMEM;
+    c = w->cap;
+    if (ulam__grow(&w->o, &c, m, sizeof *w->o)) return ULAM_ENOMEM;
+    c = w->cap;
+    if (ulam__grow(&w->small, &c, m, sizeof *w->small)) return ULAM_ENOMEM;
+    c = w->cap;
+    if (ulam__grow(&w->large, &c, m, sizeof *w->large)) return ULAM_ENOMEM;
+    w->cap = c;
+    return ULAM_OK;
+}
+
+/* Scratch for building rows, sized for short ones (it grows when a longer row is built). */
 int ulam__kscratch_alloc(const ulam_kernel *k, ulam__kscratch *w)
 {
-    size_t m = (size_t)k->maxlen;
-    w->p = ulam__malloc(m, sizeof *w->p);
-    w->scaled = ulam__malloc(m, sizeof *w->scaled);
-    w->o = ulam__malloc(m, sizeof *w->o);
-    w->small = ulam__malloc(m, sizeof *w->small);
-    w->large = ulam__malloc(m, sizeof *w->large);
-    return w->p && w->scaled && w->o && w->small && w->large ? ULAM_OK : ULAM_ENOMEM;
+    (void)k;
+    *w = (ulam__kscratch){0};
+    return kscratch_fit(w, 64);
 }
 
 /* Free scratch. */
@@ -151,18 +180,70 @@ static void row_scores(const ulam_kernel *k, int64_t i, double pstar, double *vi
     *end = s->estimator == ULAM_ABSORPTION && pstar > 0 ? g / pstar : 0.0;
 }
 
+/* Record the first failure of the kernel (status, at row i). */
+static void fail(ulam_kernel *k, int status, int64_t i)
+{
+    int ok = ULAM_OK;
+    if (atomic_compare_exchange_strong(&k->status, &ok, status)) atomic_store(&k->bad, i);
+}
+
+/* Nonzero when row i's range in rowptr lies within K's entries (a prepared file is trusted no
+ * further than its header). */
+static int range_ok(const ulam_csr *K, int64_t i)
+{
+    int64_t a = K->rowptr[i], b = K->rowptr[i + 1];
+    return a >= 0 && a <= b && b <= K->rowptr[K->nrows];
+}
+
+/* Nonzero when the entries of row i (range checked) are columns in range with finite, nonzero
+ * values. */
+static int entries_ok(const ulam_csr *K, int64_t i)
+{
+    for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++)
+        if (K->colidx[q] < 0 || K->colidx[q] >= K->ncols || !isfinite(K->val[q]) || K->val[q] == 0.0) return 0;
+    return 1;
+}
+
+/* Ask for what building state j's row reads first: its place and its range in rowptr. */
+static void prefetch_state(const ulam_kernel *k, int64_t j)
+{
+#if defined(__GNUC__)
+    __builtin_prefetch((const void *)&k->where[j]);
+    __builtin_prefetch((const void *)&k->K->rowptr[j]);
+#else
+    (void)k, (void)j;
+#endif
+}
+
 /* Build row i at header h: factor, scores and the alias table of its moves and termination.
  * Moves name their target rows' units when `placed` (every row has its place), else target
- * states still to be resolved. */
-static void build_row(const ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam__kscratch *w)
+ * states still to be resolved.  A corrupt row (or no memory for its scratch) builds the dead
+ * row instead and is recorded. */
+static void build_row(ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam__kscratch *w)
 {
     const ulam_csr *K = k->K;
+    if (!entries_ok(K, i)) {
+        dead_row(h, i);
+        fail(k, ULAM_ESYNTAX, i);
+        return;
+    }
     int64_t b = K->rowptr[i], len = row_outcomes(K, i) - 1;
+    if (kscratch_fit(w, len + 1)) {
+        dead_row(h, i);
+        fail(k, ULAM_ENOMEM, i);
+        return;
+    }
     double S = row_sum(K, i), qi = ulam__continuation(S, k->continue_q);
     *h = (ulam__row){.factor = qi > 0 ? S / qi : 0.0, .len = (int32_t)(len + 1), .state = (int32_t)i};
     row_scores(k, i, 1.0 - qi, &h->visit, &h->end);
+    if (!isfinite(h->factor) || !isfinite(h->visit) || !isfinite(h->end)) {
+        dead_row(h, i);
+        fail(k, ULAM_ENONFINITE, i);
+        return;
+    }
     for (int64_t q = 0; q < len; q++) {
         int64_t j = K->colidx[b + q];
+        if (!placed) prefetch_state(k, j); /* a walk here moves to one of these next */
         int32_t t = placed ? atomic_load_explicit(&k->where[j], memory_order_relaxed) - 1 : ULAM__UNRESOLVED + (int32_t)j;
         w->p[q] = qi * fabs(K->val[b + q]) / S;
         w->o[q] = K->val[b + q] < 0 ? ~t : t;
@@ -180,8 +261,11 @@ int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
     if (v > 0) return v - 1;
     if (atomic_compare_exchange_strong_explicit(&k->where[j], &expect, -1, memory_order_acquire,
                                                 memory_order_acquire)) {
-        int64_t u = atomic_fetch_add_explicit(&k->top, ULAM__HEAD + row_outcomes(k->K, j), memory_order_relaxed);
-        build_row(k, j, ulam__kernel_row(k, u), 0, w);
+        int64_t len = range_ok(k->K, j) ? ULAM__HEAD + row_outcomes(k->K, j) : 0;
+        int64_t u = len ? atomic_fetch_add_explicit(&k->top, len, memory_order_relaxed) : k->cap;
+        if (len && u + len > k->cap) u = k->cap; /* rowptr's ranges overlap: the file is corrupt */
+        if (u < k->cap) build_row(k, j, ulam__kernel_row(k, u), 0, w);
+        else fail(k, ULAM_ESYNTAX, j);
         atomic_store_explicit(&k->where[j], (int32_t)u + 1, memory_order_release);
         atomic_fetch_add_explicit(&k->built, 1, memory_order_relaxed);
         return (int32_t)u;
@@ -219,8 +303,13 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
     int64_t from = atomic_load(&k->top), u = from;
     for (int64_t i = 0; i < k->n; i++)
         if (atomic_load_explicit(&k->where[i], memory_order_relaxed) == 0) {
-            atomic_store_explicit(&k->where[i], (int32_t)u + 1, memory_order_relaxed);
-            u += ULAM__HEAD + row_outcomes(K, i);
+            int64_t len = range_ok(K, i) ? ULAM__HEAD + row_outcomes(K, i) : 0;
+            if (!len || u + len > k->cap) {
+                fail(k, ULAM_ESYNTAX, i);
+                len = 0;
+            }
+            atomic_store_explicit(&k->where[i], (int32_t)(len ? u : k->cap) + 1, memory_order_relaxed);
+            u += len;
         }
     atomic_store(&k->top, u);
     atomic_store(&k->built, k->n);
@@ -228,7 +317,7 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
     for (int64_t i = 0; i < k->n; i++) {
         int64_t at = atomic_load_explicit(&k->where[i], memory_order_relaxed) - 1;
         prefetch_targets(k, i + 16);
-        if (at >= from) build_row(k, i, ulam__kernel_row(k, at), 1, &w[ulam__thread_num()]);
+        if (at >= from && at < k->cap) build_row(k, i, ulam__kernel_row(k, at), 1, &w[ulam__thread_num()]);
     }
 }
 
@@ -241,10 +330,14 @@ int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen)
         if (seen[i]) stack[top++] = i;
     while (top > 0) {
         int64_t i = stack[--top];
+        if (!range_ok(K, i) || !entries_ok(K, i)) {
+            free(stack);
+            return ULAM_ESYNTAX;
+        }
         if (ulam__kernel_q(K, i, continue_q) <= 0) continue;
         for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++) {
             int64_t j = K->colidx[q];
-            if (K->val[q] != 0.0 && !seen[j]) {
+            if (!seen[j]) {
                 seen[j] = 1;
                 stack[top++] = j;
             }

@@ -47,9 +47,12 @@ typedef struct {
  * densely packed; where[i] is 0 until row i is built, -1 while a thread builds it, then its
  * unit + 1.  Units and states are below 2^30 (a 16 GB kernel). */
 typedef struct ulam_kernel {
-    int64_t n, cap, maxlen; /* cap: units reserved (all rows); maxlen: the longest row's outcomes */
+    int64_t n, cap;         /* cap: units reserved (all rows); the dead row sits at unit cap */
     _Atomic int64_t top;    /* units handed out */
     _Atomic int64_t built;  /* rows built */
+    _Atomic int status;     /* ULAM_OK, or the first row's failure: ULAM_ESYNTAX (corrupt),
+                               ULAM_ENONFINITE (a non-finite score) or ULAM_ENOMEM (scratch) */
+    _Atomic int64_t bad;    /* the row of that failure (-1: none) */
     ulam__slot *mem;
     _Atomic int32_t *where;
     const ulam_csr *K;
@@ -57,11 +60,12 @@ typedef struct ulam_kernel {
     ulam__scores scores;
 } ulam_kernel;
 
-/* Per-thread scratch for building rows of up to maxlen outcomes. */
+/* Per-thread scratch for building rows of up to cap outcomes (grown as rows need). */
 typedef struct {
     double *p, *scaled;
     int32_t *o;
     int64_t *small, *large;
+    int64_t cap;
 } ulam__kscratch;
 
 /* Vose's alias table of m outcomes out[] with probabilities p[] (sum 1) into s[0..m-1];
@@ -98,7 +102,8 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w);
 double ulam__kernel_q(const ulam_csr *K, int64_t i, double continue_q);
 
 /* Mark in seen[] every state of K reachable from those already marked by the walk's moves
- * (the nonzeros of rows with q_i > 0); ULAM_OK or ULAM_ENOMEM. */
+ * (the nonzeros of rows with q_i > 0); ULAM_OK, ULAM_ENOMEM, or ULAM_ESYNTAX when a row it
+ * reaches is corrupt (rows are checked as the kernel checks them). */
 int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen);
 
 /* The header of the row at unit u. */

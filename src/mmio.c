@@ -11,6 +11,7 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 enum { FMT_COORD, FMT_ARRAY };
 enum { FLD_REAL, FLD_INTEGER, FLD_PATTERN };
@@ -30,6 +31,7 @@ typedef struct {
 typedef struct {
     int format, field, symmetry;
     int64_t m, n, nnz; /* nnz: declared entries (m*n for array) */
+    int libc_strtod;   /* reals by the C library's strtod (the reader as it was, for comparisons) */
 } mm_header;
 
 /* Growing triplet arrays. */
@@ -143,13 +145,14 @@ static int scan_int(const char **pp, int64_t *v)
     return 0;
 }
 
-/* Scan a real number; 0 on success, -1 if malformed, 2 if NaN or infinite. */
-static int scan_real(const char **pp, double *v)
+/* Scan a real number (by the C library's strtod when libc, else ulam_strtod: the same
+ * double); 0 on success, -1 if malformed, 2 if NaN or infinite. */
+static int scan_real(const char **pp, int libc, double *v)
 {
     const char *p = skip_ws(*pp);
     char *end;
     errno = 0;
-    double x = strtod(p, &end);
+    double x = libc ? strtod(p, &end) : ulam_strtod(p, &end);
     if (end == p || (*end && *end != ' ' && *end != '\t')) return -1;
     *pp = end;
     *v = x;
@@ -351,20 +354,20 @@ static int triplets_reserve(triplets *t, int64_t cap)
 }
 
 /* Parse one index field: 1..limit. */
-static int parse_index(reader *r, const char **p, int64_t limit, const char *what, int64_t *out,
+static int parse_index(long line, const char **p, int64_t limit, const char *what, int64_t *out,
                        ulam_error *err)
 {
     int s = scan_int(p, out);
     if (s < 0)
-        return ulam__fail(err, ULAM_ESYNTAX, r->line, -1, "an integer %s index", what);
+        return ulam__fail(err, ULAM_ESYNTAX, line, -1, "an integer %s index", what);
     if (s > 0 || *out < 1 || *out > limit)
-        return ulam__fail(err, ULAM_EINDEX, r->line, -1, "a %s index between 1 and %lld", what,
+        return ulam__fail(err, ULAM_EINDEX, line, -1, "a %s index between 1 and %lld", what,
                           (long long)limit);
     return ULAM_OK;
 }
 
 /* Parse one value field according to the header's field. */
-static int parse_value(reader *r, const char **p, const mm_header *h, double *x, ulam_error *err)
+static int parse_value(long line, const char **p, const mm_header *h, double *x, ulam_error *err)
 {
     if (h->field == FLD_PATTERN) {
         *x = 1.0;
@@ -373,32 +376,32 @@ static int parse_value(reader *r, const char **p, const mm_header *h, double *x,
     if (h->field == FLD_INTEGER) {
         int64_t v;
         int s = scan_int(p, &v);
-        if (s < 0) return ulam__fail(err, ULAM_ESYNTAX, r->line, -1, "an integer value");
-        if (s > 0) return ulam__fail(err, ULAM_EOVERFLOW, r->line, -1, "a 64-bit integer value");
+        if (s < 0) return ulam__fail(err, ULAM_ESYNTAX, line, -1, "an integer value");
+        if (s > 0) return ulam__fail(err, ULAM_EOVERFLOW, line, -1, "a 64-bit integer value");
         *x = (double)v;
         return ULAM_OK;
     }
-    int s = scan_real(p, x);
-    if (s < 0) return ulam__fail(err, ULAM_ESYNTAX, r->line, -1, "a real value");
+    int s = scan_real(p, h->libc_strtod, x);
+    if (s < 0) return ulam__fail(err, ULAM_ESYNTAX, line, -1, "a real value");
     if (s > 0)
-        return ulam__fail(err, ULAM_ENONFINITE, r->line, -1, "a finite real value (no NaN or Inf)");
+        return ulam__fail(err, ULAM_ENONFINITE, line, -1, "a finite real value (no NaN or Inf)");
     return ULAM_OK;
 }
 
 /* Parse one coordinate entry line into (i, j, x), 1-based indices. */
-static int parse_coord(reader *r, const char *line, const mm_header *h, int64_t *i, int64_t *j,
+static int parse_coord(long line, const char *text, const mm_header *h, int64_t *i, int64_t *j,
                        double *x, ulam_error *err)
 {
-    const char *p = line;
+    const char *p = text;
     int status;
-    if ((status = parse_index(r, &p, h->m, "row", i, err))) return status;
-    if ((status = parse_index(r, &p, h->n, "column", j, err))) return status;
-    if ((status = parse_value(r, &p, h, x, err))) return status;
+    if ((status = parse_index(line, &p, h->m, "row", i, err))) return status;
+    if ((status = parse_index(line, &p, h->n, "column", j, err))) return status;
+    if ((status = parse_value(line, &p, h, x, err))) return status;
     if (!at_end(p))
-        return ulam__fail(err, ULAM_ESYNTAX, r->line, -1, "%s on an entry line",
+        return ulam__fail(err, ULAM_ESYNTAX, line, -1, "%s on an entry line",
                           h->field == FLD_PATTERN ? "two indices only" : "two indices and a value only");
     if (h->symmetry == SYM_SKEW && *i == *j)
-        return ulam__fail(err, ULAM_EINDEX, r->line, -1,
+        return ulam__fail(err, ULAM_EINDEX, line, -1,
                           "no diagonal entries in a skew-symmetric file");
     return ULAM_OK;
 }
@@ -426,10 +429,10 @@ static int read_entries(reader *r, const mm_header *h, triplets *t, ulam_error *
         int64_t i, j;
         double x;
         if (h->format == FMT_COORD) {
-            if ((status = parse_coord(r, line, h, &i, &j, &x, err))) return status;
+            if ((status = parse_coord(r->line, line, h, &i, &j, &x, err))) return status;
         } else {
             const char *p = line;
-            if ((status = parse_value(r, &p, h, &x, err))) return status;
+            if ((status = parse_value(r->line, &p, h, &x, err))) return status;
             if (!at_end(p))
                 return ulam__fail(err, ULAM_ESYNTAX, r->line, -1, "one value per line in an array");
             i = k % h->m + 1;
@@ -451,6 +454,7 @@ static int read_all(FILE *f, const char *name, mm_header *h, triplets *t, ulam_e
 {
     reader r;
     memset(t, 0, sizeof *t);
+    memset(h, 0, sizeof *h);
     if (reader_init(&r, f)) {
         free(r.buf);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a read buffer");
@@ -462,20 +466,230 @@ static int read_all(FILE *f, const char *name, mm_header *h, triplets *t, ulam_e
     return status;
 }
 
-/* Read a sparse matrix from f. */
-int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err)
+/* A byte range [pos, end) of a file read by pread through a growing buffer, line by line. */
+typedef struct {
+    int fd;
+    int64_t pos, end;
+    char *buf;
+    size_t cap, len, at;
+    int failed; /* 1 a read error, 2 no memory */
+} span;
+
+/* The next line of the span, NUL-terminated without its newline (or CR LF), as reader_next
+ * gives it; NULL at the end (or on failure: s->failed). */
+static char *span_next(span *s)
+{
+    for (;;) {
+        char *start = s->buf + s->at;
+        char *nl = memchr(start, '\n', s->len - s->at);
+        if (nl || (s->pos == s->end && s->at < s->len)) {
+            char *e = nl ? nl : s->buf + s->len;
+            *e = '\0';
+            if (e > start && e[-1] == '\r') e[-1] = '\0';
+            s->at = (size_t)(e - s->buf) + (nl ? 1 : 0);
+            return start;
+        }
+        if (s->pos == s->end) return NULL;
+        memmove(s->buf, start, s->len - s->at);
+        s->len -= s->at, s->at = 0;
+        if (s->cap - s->len < 2) {
+            char *nb = s->cap < SIZE_MAX / 2 ? realloc(s->buf, s->cap * 2) : NULL;
+            if (!nb) return s->failed = 2, NULL;
+            s->buf = nb, s->cap *= 2;
+        }
+        size_t want = s->cap - s->len - 1;
+        if ((int64_t)want > s->end - s->pos) want = (size_t)(s->end - s->pos);
+        ssize_t got = pread(s->fd, s->buf + s->len, want, (off_t)s->pos);
+        if (got <= 0) return s->failed = 1, NULL;
+        s->pos += got, s->len += (size_t)got;
+    }
+}
+
+/* One chunk of the entries: a byte range starting at a line, and the entries parsed from it
+ * (rows, columns, values, in file order). */
+typedef struct {
+    int64_t from, to;
+    int32_t *row, *col;
+    double *val;
+    int64_t len, cap;
+    int sorted, zeros, bad, nomem;
+} chunk;
+
+enum { CHUNK_BUF = 1 << 20 };
+
+/* The first line start at or after byte at (at > from: the byte after a newline), or end. */
+static int64_t line_start(int fd, int64_t at, int64_t end)
+{
+    char b[4096];
+    for (at--; at < end;) {
+        ssize_t got = pread(fd, b, sizeof b, (off_t)at);
+        if (got <= 0) return end;
+        char *nl = memchr(b, '\n', (size_t)got);
+        if (nl) return at + (nl - b) + 1 < end ? at + (nl - b) + 1 : end;
+        at += got;
+    }
+    return end;
+}
+
+/* Room for one more entry in chunk c. */
+static int chunk_grow(chunk *c)
+{
+    if (c->len < c->cap) return ULAM_OK;
+    int64_t cap = c->cap, need = c->len + 1 + c->len / 2;
+    if (ulam__grow(&c->row, &cap, need, sizeof *c->row)) return ULAM_ENOMEM;
+    cap = c->cap;
+    if (ulam__grow(&c->col, &cap, need, sizeof *c->col)) return ULAM_ENOMEM;
+    cap = c->cap;
+    if (ulam__grow(&c->val, &cap, need, sizeof *c->val)) return ULAM_ENOMEM;
+    c->cap = cap;
+    return ULAM_OK;
+}
+
+/* Free chunk c's entries. */
+static void chunk_free(chunk *c)
+{
+    free(c->row), free(c->col), free(c->val);
+    c->row = c->col = NULL, c->val = NULL;
+}
+
+/* Parse chunk c's entries, noting whether its rows rise and whether it holds zeros.  Any
+ * failure (a malformed line) marks it bad: the sequential reader then finds and locates the
+ * error. */
+static void parse_chunk(int fd, const mm_header *h, chunk *c)
+{
+    span s = {.fd = fd, .pos = c->from, .end = c->to, .cap = CHUNK_BUF};
+    s.buf = malloc(s.cap);
+    c->sorted = 1;
+    int32_t prev = -1;
+    char *line;
+    while (s.buf && !c->bad && (line = span_next(&s)) != NULL) {
+        if (line[0] == '%' || at_end(line)) continue;
+        int64_t i, j;
+        double x;
+        if (parse_coord(0, line, h, &i, &j, &x, NULL)) {
+            c->bad = 1;
+            break;
+        }
+        if (chunk_grow(c)) {
+            c->bad = c->nomem = 1;
+            break;
+        }
+        c->row[c->len] = (int32_t)(i - 1), c->col[c->len] = (int32_t)(j - 1), c->val[c->len++] = x;
+        c->sorted &= (int32_t)(i - 1) >= prev;
+        prev = (int32_t)(i - 1);
+        c->zeros |= x == 0.0;
+    }
+    if (!s.buf || s.failed == 2) c->bad = c->nomem = 1;
+    if (s.failed) c->bad = 1;
+    free(s.buf);
+}
+
+/* The entries of a regular file of coordinate general kind, in parallel: chunks split at line
+ * starts are parsed by `threads` threads, then moved in file order into the CSR arrays (each
+ * chunk freed as it is moved, so the peak is about the entries once) without the zeros, which
+ * the sequential reader never stores.  Rows that rise through the file (as written by most
+ * tools) need no reordering: rowptr is counted as the rows go by; otherwise the triplets are
+ * sorted as the sequential reader sorts them.  ULAM_OK with *out, ULAM_ENOMEM, or -1 when
+ * anything disagrees (the caller then reads sequentially from where the header ended, which
+ * finds and locates every error). */
+static int read_entries_parallel(int fd, int64_t data, int64_t end, const mm_header *h, int threads,
+                                 ulam_csr **out)
+{
+    int64_t bytes = end - data;
+    int nc = threads * 8;
+    if (bytes < (int64_t)nc * 65536) nc = bytes / 65536 > 0 ? (int)(bytes / 65536) : 1;
+    chunk *c = calloc((size_t)nc, sizeof *c);
+    if (!c) return ULAM_ENOMEM;
+    for (int k = 0; k < nc; k++) {
+        c[k].from = k ? c[k - 1].to : data;
+        c[k].to = k == nc - 1 ? end : line_start(fd, data + bytes / nc * (k + 1), end);
+        if (c[k].to < c[k].from) c[k].to = c[k].from;
+        c[k].cap = 0;
+    }
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int k = 0; k < nc; k++) parse_chunk(fd, h, &c[k]);
+    int64_t total = 0;
+    int bad = 0, nomem = 0, sorted = 1;
+    int32_t prev = -1;
+    for (int k = 0; k < nc; k++) {
+        total += c[k].len, bad |= c[k].bad, nomem |= c[k].nomem;
+        if (!c[k].len) continue;
+        sorted &= c[k].sorted && c[k].row[0] >= prev;
+        prev = c[k].row[c[k].len - 1];
+    }
+    ulam_csr *A = !bad && total == h->nnz ? ulam_csr_alloc(h->m, h->n, total) : NULL;
+    int32_t *ti = A && !sorted ? ulam__alloc_big((size_t)total, sizeof *ti) : NULL;
+    int status = nomem || (A && !sorted && !ti) || (!A && !bad && total == h->nnz) ? ULAM_ENOMEM : A ? ULAM_OK : -1;
+    int64_t nz = 0;
+    for (int k = 0; k < nc; k++) {
+        for (int64_t q = 0; !status && q < c[k].len; q++) {
+            if (c[k].zeros && c[k].val[q] == 0.0) continue;
+            if (sorted) A->rowptr[c[k].row[q] + 1]++;
+            else ti[nz] = c[k].row[q];
+            A->colidx[nz] = c[k].col[q], A->val[nz++] = c[k].val[q];
+        }
+        chunk_free(&c[k]);
+    }
+    free(c);
+    if (!status && sorted) {
+        for (int64_t i = 0; i < h->m; i++) A->rowptr[i + 1] += A->rowptr[i];
+        status = ulam__csr_canonicalize(A, threads);
+    } else if (!status) {
+        ulam_csr *B = NULL;
+        status = ulam_csr_from_triplets(h->m, h->n, nz, ti, A->colidx, A->val, &B);
+        ulam_csr_free(A);
+        A = B;
+    }
+    free(ti);
+    if (status) {
+        ulam_csr_free(A);
+        return status;
+    }
+    *out = A;
+    return ULAM_OK;
+}
+
+/* Read a sparse matrix from f with options o (NULL: the defaults). */
+int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err)
 {
     ulam__clear(err);
     if (!f || !A) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a file and an output pointer");
     *A = NULL;
-    mm_header h;
-    triplets t;
-    int status = read_all(f, name ? name : "input", &h, &t, err);
-    if (status) return status;
-    status = ulam_csr_from_triplets(h.m, h.n, t.len, t.i, t.j, t.x, A);
+    ulam_mm_opts opts = o ? *o : (ulam_mm_opts){0};
+    name = name ? name : "input";
+    int threads = ulam__threads(opts.threads), fd = fileno(f);
+    long start = ftell(f);
+    mm_header h = {.libc_strtod = opts.libc_strtod};
+    triplets t = {0};
+    reader r;
+    if (reader_init(&r, f)) {
+        free(r.buf);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a read buffer");
+    }
+    int status = read_header(&r, name, &h, err);
+    if (!status && threads > 1 && fd >= 0 && start >= 0 && r.size >= 0 && h.format == FMT_COORD &&
+        h.symmetry == SYM_GENERAL && h.nnz > 0) {
+        int64_t data = start + r.read_total - (int64_t)(r.len - r.pos); /* the byte after the size line */
+        int st = read_entries_parallel(fd, data, start + r.size, &h, threads, A);
+        if (st != -1) {
+            free(r.buf);
+            return st ? ulam__fail(err, st, 0, -1, "memory for %lld entries", (long long)h.nnz) : ULAM_OK;
+        }
+    }
+    if (!status) status = read_entries(&r, &h, &t, err);
+    free(r.buf);
+    if (!status) {
+        status = ulam_csr_from_triplets(h.m, h.n, t.len, t.i, t.j, t.x, A);
+        if (status) ulam__fail(err, status, 0, -1, "memory to build the sparse matrix");
+    }
     triplets_free(&t);
-    if (status) return ulam__fail(err, status, 0, -1, "memory to build the sparse matrix");
-    return ULAM_OK;
+    return status;
+}
+
+/* Read a sparse matrix from f. */
+int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err)
+{
+    return ulam_mm_read_matrix_opts(f, name, NULL, A, err);
 }
 
 /* Open path for reading, recording a failure in err. */

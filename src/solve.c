@@ -125,9 +125,12 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     if (s->o.mode == ULAM_ADJOINT) seen[s->o.index] = 1;
     else
         for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
-    if (ulam__kernel_reach(K, s->o.continue_q, seen)) {
+    int status = ulam__kernel_reach(K, s->o.continue_q, seen);
+    if (status) {
         free(seen);
-        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
+        return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for a reachability check")
+                                     : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, "
+                                                  "nonzero values (the matrix is corrupt)");
     }
     int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = 0;
     int64_t bad = -1;
@@ -271,6 +274,18 @@ static int alloc_work(ulam_solver *s)
     return ULAM_OK;
 }
 
+/* The kernel's failure (a corrupt row of a mapped file, a non-finite score or no memory to
+ * build a row) as a status with err filled; ULAM_OK when it has none. */
+static int kernel_failure(const ulam_kernel *k, ulam_error *err)
+{
+    int status = atomic_load(&k->status);
+    if (!status) return ULAM_OK;
+    int64_t i = atomic_load(&k->bad);
+    if (status == ULAM_ENOMEM) return ulam__fail(err, status, 0, i, "memory to build a walk kernel row");
+    return ulam__fail(err, status, 0, i, "row %lld (1-based) with its range in rowptr, columns in range and "
+                      "finite, nonzero values and score (the matrix is corrupt)", (long long)i + 1);
+}
+
 /* Prepare walks on (I - M) x = b. */
 int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                       ulam_solver **out, ulam_error *err)
@@ -319,6 +334,10 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     if (o.mode == ULAM_ADJOINT) s->w.start = ulam__kernel_unit(s->k, o.index, &s->ks[0]);
     if (o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED) s->w.score0 = s->b[o.index];
     if (o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED) s->w.expected = 1;
+    if ((status = kernel_failure(s->k, err))) {
+        ulam_solver_free(s);
+        return status;
+    }
     s->t0 = -1;
     *out = s;
     return ULAM_OK;
@@ -559,6 +578,7 @@ int ulam_solver_iterate(ulam_solver *s)
     }
     s->seconds += ulam_now() - start;
     if (stop & 2) s->interrupted = s->done = 1;
+    if ((st = atomic_load(&s->k->status))) s->status = st, s->done = 1; /* a corrupt row: the run fails */
     if (s->nonfinite && !s->status) s->status = ULAM_ENONFINITE;
     if (s->status) s->done = 1;
     ulam_walk_result r;

@@ -532,6 +532,76 @@ def check_cache(ulam):
         assert rc == 0 and err.count("loaded from its cache") == 1 and err.count("cache written") == 1, err
 
 
+def check_prepare(ulam):
+    """ulam prepare writes a prepared system; solve, info and study take it where they take a
+    matrix, with the same answer as from text and no guard pass; a truncated, damaged or
+    foreign file is refused with a located message; nothing is written when the output path
+    cannot be written or the input is bad."""
+    with tempfile.TemporaryDirectory() as d:
+        sysf = d + "/s.ulam"
+        rc, out, err = run(ulam, ["prepare", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "-o", sysf])
+        assert rc == 0 and "prepared" in out and os.listdir(d) == ["s.ulam"], (rc, out, err, os.listdir(d))
+        common = ["--index", "5", "--walks", "20000", "--json", "--threads", "2"]
+        rc, text, err = run(ulam, ["solve", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx"] + common)
+        assert rc == 0, err
+        rc, prep, err = run(ulam, ["solve", sysf] + common)
+        assert rc == 0, err
+        a, b = json.loads(text), json.loads(prep)
+        assert a["estimate"] == b["estimate"] and a["stderr"] == b["stderr"], (a, b)
+        assert b["guard_seconds"] == 0 and b["rho_abs"] == a["rho_abs"], b
+        rc, fwd, err = run(ulam, ["solve", sysf, "--mode", "forward", "--walks", "2000", "--json"])
+        assert rc == 0, err
+        rc, info, err = run(ulam, ["info", sysf, "--json"])
+        assert rc == 0 and json.loads(info)["n"] == 200, err
+        rc, _, err = run(ulam, ["study", sysf, "--index", "2", "--methods", "adjoint-collision-plain", "--budgets",
+                                "100", "--repeats", "2", "--out", d + "/study"])
+        assert rc == 0 and os.path.exists(d + "/study/runs.csv"), err
+        import shutil
+        shutil.rmtree(d + "/study")
+        rc, _, err = run(ulam, ["solve", sysf, "--index", "5", "--jacobi"])
+        assert rc == 2 and "prepared system" in err, err
+        # Jacobi splitting stored, no b: solve needs --rhs
+        rc, _, err = run(ulam, ["prepare", M + "poisson20.mtx", "--jacobi", "-o", d + "/p.ulam"])
+        assert rc == 0, err
+        rc, _, err = run(ulam, ["solve", d + "/p.ulam", "--index", "3"])
+        assert rc == 2 and "holds no b" in err, err
+        rc, _, err = run(ulam, ["solve", M + "poisson20.mtx", "--jacobi", "--rhs", M + "poisson20_b.mtx", "--index",
+                                "3", "--walks", "5000", "--json"])
+        rc2, out2, err2 = run(ulam, ["solve", d + "/p.ulam", "--rhs", M + "poisson20_b.mtx", "--index", "3",
+                                     "--walks", "5000", "--json"])
+        assert rc == 0 and rc2 == 0, err2
+        raw = open(sysf, "rb").read()
+        damaged = [(raw[:-1], "ESYNTAX", "truncated"), (raw[:100], "ESYNTAX", "truncated"),
+                   (b"ulamSYS2" + raw[8:], "EBANNER", "prepared system"),
+                   (raw[:40] + bytes([raw[40] ^ 1]) + raw[41:], "ESYNTAX", "checksum")]
+        for k, (data, status, word) in enumerate(damaged):
+            bad = d + f"/bad{k}.ulam"
+            with open(bad, "wb") as fh:
+                fh.write(data)
+            rc, out, err = run(ulam, ["solve", bad, "--index", "5", "--walks", "100"])
+            if status == "EBANNER":  # no longer a prepared file: parsed as Matrix Market
+                assert rc != 0 and out == "", (k, rc, err)
+            else:
+                assert rc == code(status) and re.search(rf"^ulam: {re.escape(bad)}: error: .*{word}", err), (k, rc, err)
+            os.remove(bad)
+        # a damaged row behind a sound header: refused when a walk reaches it, or by the check
+        data = bytearray(raw)
+        colidx = int.from_bytes(raw[56:64], "little")
+        data[colidx:colidx + 4] = (999).to_bytes(4, "little")
+        with open(d + "/rows.ulam", "wb") as fh:
+            fh.write(bytes(data))
+        rc, out, err = run(ulam, ["solve", d + "/rows.ulam", "--index", "1", "--walks", "1000"])
+        assert rc == code("ESYNTAX") and "corrupt" in err and out == "", (rc, err)
+        rc, out, err = run(ulam, ["info", d + "/rows.ulam"])
+        assert rc != 0 and "corrupt" in err and out == "", (rc, err)
+        os.remove(d + "/rows.ulam")
+        # the output is checked before the work, and a failed prepare leaves nothing
+        rc, _, err = run(ulam, ["prepare", M + "signed200.mtx", "-o", d + "/no/such/dir/s.ulam"])
+        assert rc == code("EIO"), err
+        rc, _, err = run(ulam, ["prepare", D + "nan.mtx", "-o", d + "/x.ulam"])
+        assert rc == code("ENONFINITE") and sorted(os.listdir(d)) == ["p.ulam", "s.ulam"], os.listdir(d)
+
+
 def check_study_nonfinite(ulam):
     """M = 0: every walk scores 1 exactly, so the standard error is 0 and honesty (RMSE / mean
     standard error) is 0/0.  The CSVs carry an empty field there, never inf or nan; no
@@ -835,7 +905,7 @@ def main():
     failures, n = check_table(ulam)
     extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
-             (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
+             (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),

@@ -221,52 +221,158 @@ static void test_read_from_stream(void **state)
     ulam_csr_free(A);
 }
 
-/* Binary caches read back exactly; a stale, foreign, truncated or corrupt one is refused. */
-static void test_cache(void **state)
+/* ulam_strtod gives strtod's double (bit for bit) and end on input s; prints case k on failure. */
+static void same_as_strtod(const char *s, long k)
+{
+    char *e1, *e2;
+    double a = ulam_strtod(s, &e1), b = strtod(s, &e2);
+    if (memcmp(&a, &b, sizeof a) || e1 != e2)
+        fail_msg("case %ld '%s': ulam_strtod %a (end +%td), strtod %a (end +%td)", k, s, a, e1 - s, b, e2 - s);
+}
+
+/* The fast number parser against strtod: a corpus of edge cases (17-digit values, ties,
+ * subnormals, the exponent limits, more digits than 64 bits hold, forms strtod parses and the
+ * reader refuses), then seeded random doubles printed several ways and random decimal strings. */
+static void test_strtod(void **state)
 {
     (void)state;
-    ulam_csr *A = NULL, *B = NULL;
-    ulam_error err;
-    assert_int_equal(ulam_mm_read_matrix("matrices/signed200.mtx", &A, &err), ULAM_OK);
-    char path[] = "/tmp/ulam_cache_testXXXXXX";
+    static const char *const corpus[] = {
+        "0", "-0", "+0", "0.0", "00000", "1", "-1", "+1.5", ".5", "5.", "-.5e1", "1e0", "1E+2", "1e-2",
+        "0.1", "0.2", "0.3", "0.30000000000000004", "0.1000000000000000055511151231257827021181583404541015625",
+        "3.141592653589793", "3.1415926535897932", "2.718281828459045235360287", "0.09999999999999999",
+        "1.7976931348623157e308", "1.7976931348623158e308", "1.7976931348623159e308", "1e308", "1e309",
+        "2.2250738585072014e-308", "2.2250738585072011e-308", "2.2250738585072009e-308", "4.9406564584124654e-324",
+        "5e-324", "2.4703282292062327e-324", "2.4703282292062328e-324", "1e-320", "1e-400", "1e-342", "1e-343",
+        "9007199254740992", "9007199254740993", "9007199254740994", "9007199254740995", "9007199254740993.0000001",
+        "18446744073709551615", "18446744073709551616", "1844674407370955161", "9999999999999999999",
+        "99999999999999999999", "12345678901234567890123", "1e22", "1e23", "8.988465674311579e307",
+        "7.3177701707893310e+15", "1.00000000000000011102230246251565404236316680908203125",
+        "1.00000000000000011102230246251565404236316680908203124", "1.00000000000000011102230246251565404236316680908203126",
+        "4503599627370496.5", "4503599627370497.5", "0.000000000000000000000000000001234567890123456789",
+        "123456789012345678e-30", "1e", "1e+", "1e-", "e5", ".", "-", "+", "", "   1.25", "\t-2.5e3x", "1.5 2",
+        "inf", "-inf", "INF", "infinity", "nan", "NaN", "nan(0x1)", "0x1p3", "0X1.8P1", "-0x", "0x", "1e99999999999",
+        "1e-99999999999", "0e99999999999", "1.0000000000000000000000000000000000000000000001", "00000000000000000000001.5",
+        "100000000000000000000000", "1000000000000000000000000e-24", "7e-10", "6.02214076e23", "1.602176634e-19",
+    };
+    long k = 0;
+    for (size_t i = 0; i < sizeof corpus / sizeof corpus[0]; i++) same_as_strtod(corpus[i], k++);
+    static const char *const fmts[] = {"%.17g", "%.16g", "%.15g", "%.6e", "%.20e", "%g", "%.17e", "%.3f"};
+    ulam_rng r;
+    ulam_rng_seed(&r, 17, 0);
+    char buf[512];
+    for (int t = 0; t < 40000; t++) {
+        uint64_t bits = ulam_rng_next(&r);
+        if (t % 4 == 1) bits &= 0x800FFFFFFFFFFFFFu; /* subnormal */
+        if (t % 4 == 2) bits = (bits & 0x800FFFFFFFFFFFFFu) | (uint64_t)(1023 + (int)(bits >> 52) % 60 - 30) << 52;
+        double x;
+        memcpy(&x, &bits, sizeof x);
+        if (!isfinite(x)) continue;
+        for (size_t f = 0; f < sizeof fmts / sizeof fmts[0]; f++) {
+            snprintf(buf, sizeof buf, fmts[f], x);
+            same_as_strtod(buf, k++);
+        }
+    }
+    for (int t = 0; t < 40000; t++) { /* random digits, point and exponent */
+        int nd = 1 + (int)ulam_rng_bounded(&r, 24), dot = (int)ulam_rng_bounded(&r, (uint64_t)nd + 1), m = 0;
+        if (ulam_rng_bounded(&r, 2)) buf[m++] = '-';
+        for (int d = 0; d < nd; d++) {
+            if (d == dot) buf[m++] = '.';
+            buf[m++] = (char)('0' + ulam_rng_bounded(&r, 10));
+        }
+        m += snprintf(buf + m, sizeof buf - (size_t)m, "e%d", (int)ulam_rng_bounded(&r, 700) - 350);
+        same_as_strtod(buf, k++);
+    }
+}
+
+/* Write a coordinate file of nrows x nrows with k entries a row to path: rows rising (or
+ * not), with comments, blank lines, CRLF ends, explicit zeros and repeated entries mixed in;
+ * bad_line > 0 replaces that line (1-based) with text. */
+static void write_big(const char *path, int64_t nrows, int k, int shuffled, long bad_line, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    ulam_rng r;
+    ulam_rng_seed(&r, 99, (uint64_t)shuffled);
+    fprintf(f, "%%%%MatrixMarket matrix coordinate real general\n%% a comment\n%lld %lld %lld\n", (long long)nrows,
+            (long long)nrows, (long long)(nrows * k));
+    long line = 3;
+    for (int64_t q = 0; q < nrows * k; q++) {
+        int64_t i = shuffled ? (int64_t)ulam_rng_bounded(&r, (uint64_t)nrows) : q / k;
+        if (q % 997 == 0 && (bad_line <= 0 || line + 2 < bad_line - 1 || line > bad_line)) fprintf(f, "%% comment inside\n\n"), line += 2;
+        line++;
+        if (line == bad_line) fprintf(f, "%s\n", text);
+        else if (q % 101 == 0) fprintf(f, "%lld %lld 0\r\n", (long long)i + 1, (long long)(i % nrows) + 1);
+        else if (q % 103 == 0) fprintf(f, "%lld 1 %.17g\n", (long long)i + 1, ulam_rng_uniform(&r) - 0.5);
+        else
+            fprintf(f, "%lld %llu %.17g\n", (long long)i + 1, (unsigned long long)ulam_rng_bounded(&r, (uint64_t)nrows) + 1,
+                    ulam_rng_uniform(&r) - 0.5);
+    }
+    fclose(f);
+}
+
+/* Read path with the given threads (and libc's strtod or not). */
+static int read_with(const char *path, int threads, int libc, ulam_csr **A, ulam_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    ulam_mm_opts o = {.threads = threads, .libc_strtod = libc};
+    int st = ulam_mm_read_matrix_opts(f, path, &o, A, err);
+    fclose(f);
+    return st;
+}
+
+/* The parallel reader gives the sequential reader's matrix (rows rising or not, comments,
+ * zeros, repeats, CRLF), and every error at the same line with the same status (each case
+ * prints its index when it fails). */
+static void test_parallel_read(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_mm_parXXXXXX";
     int fd = mkstemp(path);
     assert_true(fd >= 0);
     close(fd);
-    const uint64_t tag[2] = {12345, 678}, other[2] = {12345, 679};
-    assert_int_equal(ulam_cache_write_csr(path, A, tag), ULAM_OK);
-    assert_int_equal(ulam_cache_read_csr(path, tag, &B, &err), ULAM_OK);
-    assert_csr_same(B, A);
-    B = ulam_csr_free(B);
-    assert_int_equal(ulam_cache_read_csr(path, other, &B, &err), ULAM_ENOTFOUND); /* source changed */
-    assert_null(B);
-    double *v = NULL;
-    int64_t n = 0;
-    assert_int_equal(ulam_cache_read_vector(path, tag, &v, &n, &err), ULAM_EBANNER); /* not a vector */
-    FILE *f = fopen(path, "r+b"); /* a column index past the end: the structure check finds it */
-    assert_non_null(f);
-    fseek(f, 8 + 48 + (long)(A->nrows + 1) * 8, SEEK_SET);
-    int32_t bad = (int32_t)A->ncols;
-    fwrite(&bad, sizeof bad, 1, f);
-    fclose(f);
-    assert_int_equal(ulam_cache_read_csr(path, tag, &B, &err), ULAM_ESYNTAX);
-    assert_int_equal(truncate(path, 100), 0);
-    assert_int_equal(ulam_cache_read_csr(path, tag, &B, &err), ULAM_ESYNTAX);
-    assert_null(B);
-    double x[3] = {1.5, -2, 1e300};
-    assert_int_equal(ulam_cache_write_vector(path, x, 3, tag), ULAM_OK);
-    assert_int_equal(ulam_cache_read_vector(path, tag, &v, &n, &err), ULAM_OK);
-    assert_int_equal(n, 3);
-    assert_memory_equal(v, x, sizeof x);
-    free(v);
-    assert_int_equal(ulam_cache_read_vector("/nonexistent/x", tag, &v, &n, &err), ULAM_EIO);
+    for (int shuffled = 0; shuffled < 2; shuffled++) {
+        write_big(path, 3000, 8, shuffled, 0, NULL);
+        ulam_csr *A = NULL, *B = NULL;
+        assert_int_equal(read_with(path, 1, 1, &A, NULL), ULAM_OK);
+        assert_int_equal(read_with(path, 2, 0, &B, NULL), ULAM_OK);
+        assert_csr_same(A, B);
+        ulam_csr_free(B);
+        assert_int_equal(read_with(path, 3, 0, &B, NULL), ULAM_OK);
+        assert_csr_same(A, B);
+        ulam_csr_free(A), ulam_csr_free(B);
+    }
+    static const struct {
+        long line;
+        const char *text;
+        int status;
+    } bad[] = {{5000, "12 x 0.5", ULAM_ESYNTAX},      {20000, "1 3001 0.5", ULAM_EINDEX},
+               {12345, "7 7 nan", ULAM_ENONFINITE},   {23999, "1 2 0.5 9", ULAM_ESYNTAX},
+               {7, "0 1 1", ULAM_EINDEX},             {18000, "% now a comment: one entry too few", ULAM_ETOOFEW},
+               {9000, "1 1 1e999", ULAM_ENONFINITE}, {24100, "5 5 1", ULAM_ETOOMANY}};
+    for (size_t c = 0; c < sizeof bad / sizeof bad[0]; c++) {
+        write_big(path, 3000, 8, 0, bad[c].line, bad[c].text);
+        if (bad[c].status == ULAM_ETOOMANY) { /* one entry more than declared, at the end */
+            FILE *f = fopen(path, "a");
+            fprintf(f, "5 5 1\n");
+            fclose(f);
+        }
+        ulam_csr *A = NULL;
+        ulam_error e1, e2;
+        int s1 = read_with(path, 1, 1, &A, &e1), s2 = read_with(path, 2, 0, &A, &e2);
+        if (s1 != bad[c].status || s2 != s1 || e1.line != e2.line || strcmp(e1.msg, e2.msg))
+            fail_msg("bad case %zu: sequential %d at line %ld, parallel %d at line %ld", c, s1, e1.line, s2, e2.line);
+        if (bad[c].status != ULAM_ETOOMANY && bad[c].status != ULAM_ETOOFEW && e2.line != bad[c].line)
+            fail_msg("bad case %zu: line %ld, expected %ld", c, e2.line, bad[c].line);
+        assert_null(A);
+    }
     remove(path);
-    ulam_csr_free(A);
 }
 
 int main(void)
 {
     enum { NBAD = sizeof bad_cases / sizeof bad_cases[0] };
-    struct CMUnitTest tests[NBAD + 12];
+    struct CMUnitTest tests[NBAD + 13];
     size_t k = 0;
     for (size_t i = 0; i < NBAD; i++)
         tests[k++] = (struct CMUnitTest){bad_cases[i].file, test_bad, NULL, NULL, (void *)&bad_cases[i]};
@@ -276,7 +382,8 @@ int main(void)
         cmocka_unit_test(test_lenient_text),    cmocka_unit_test(test_dense_array),
         cmocka_unit_test(test_vectors),         cmocka_unit_test(test_roundtrip),
         cmocka_unit_test(test_write_refuses_nonfinite), cmocka_unit_test(test_write_unwritable),
-        cmocka_unit_test(test_read_from_stream), cmocka_unit_test(test_cache),
+        cmocka_unit_test(test_read_from_stream), cmocka_unit_test(test_strtod),
+        cmocka_unit_test(test_parallel_read),
     };
     for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) tests[k++] = good[i];
     return _cmocka_run_group_tests("mmio", tests, k, NULL, NULL);

@@ -136,11 +136,12 @@ static int prepare(cli_system *s, int64_t source, int force, double continue_q, 
     int64_t n = s->M->nrows;
     if (source > n)
         return cli_usage_error("solve", "--source %lld is out of range 1..%lld", (long long)source, (long long)n);
-    if (!(s->b = calloc((size_t)n, sizeof *s->b))) {
+    if (!(s->own_b = calloc((size_t)n, sizeof *s->own_b))) {
         fprintf(stderr, "ulam: %s: error: %s\n", s->matrix_path, ulam_strerror(ULAM_ENOMEM));
         return cli_exit_code(ULAM_ENOMEM);
     }
-    s->b[source - 1] = 1.0;
+    s->own_b[source - 1] = 1.0;
+    s->b = s->own_b; /* freed by cli_system_free */
     if ((rc = cli_guard(s, continue_q, ULAM_FORWARD, &rp->g))) return rc;
     if (rp->g.verdict_abs >= ULAM_VERDICT_FAIL) {
         cli_guard_diverge(s, &rp->g, force);

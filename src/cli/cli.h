@@ -40,13 +40,24 @@ typedef struct cli_system {
     int jacobi;   /* the file holds A of A x = b: use M = I - omega D^-1 A */
     double omega; /* damping of the Jacobi splitting (1 = plain Jacobi) */
     int cache;    /* read and write binary caches beside the files (--cache) */
-    ulam_csr *M;  /* the iteration matrix */
-    double *b;    /* the right-hand side (NULL if no --rhs and none needed) */
+    int lazy;     /* the command reads M only where walks reach (adjoint solve): a mapped
+                     file is then verified only if its certificate does not serve the guards */
+    const ulam_csr *M;  /* the iteration matrix (owned, or mapped from a prepared file) */
+    const double *b;    /* the right-hand side (NULL if no --rhs and none needed) */
+    const ulam_certificate *cert; /* the guards a prepared file certified (NULL: none) */
+    int verified;       /* M and b checked whole (parsed, or ulam_system_check passed) */
+    ulam_csr *own_M;    /* what M and b point to when this owns them */
+    double *own_b;
+    ulam_system *sys_M, *sys_b; /* mappings behind M and b */
 } cli_system;
 
-/* Load M (and b if rhs_path is set, or zeros when jacobi needs one) and check index
- * against n; 0 or an exit code (nothing stays loaded on failure). */
+/* Load M (and b if rhs_path is set, or from a prepared file, or zeros when jacobi needs
+ * one) and check index against n; a prepared file (or a --cache copy) is mapped, and checked
+ * whole unless s->lazy; 0 or an exit code (nothing stays loaded on failure). */
 int cli_load_system(cli_system *s);
+
+/* Check a mapped M and b whole (ulam_system_check) if not yet done; 0 or an exit code. */
+int cli_system_verify(cli_system *s);
 
 /* Free what cli_load_system loaded. */
 void cli_system_free(cli_system *s);
@@ -91,9 +102,10 @@ const char *cli_verdict_word(int verdict);
 void cli_print_power(const ulam_power *p);
 
 /* The guards' radii for a walk in mode on s (rho(|M|) and that mode's rho(M^), stopped once
- * certified); 0 or an exit code (error reported).  The solver takes them (ulam_walk_opts.guard)
- * and refuses what they refuse. */
-int cli_guard(const cli_system *s, double continue_q, int mode, ulam_guard *g);
+ * certified): a prepared file's certificate made for this continuation serves instead of a pass
+ * over M (ulam_certificate_guard), else a mapped M is verified whole first; 0 or an exit code
+ * (error reported).  The solver takes them (ulam_walk_opts.guard) and refuses what they refuse. */
+int cli_guard(cli_system *s, double continue_q, int mode, ulam_guard *g);
 
 /* Print why walks whose rho(|M|) is not certified below 1 are refused (a warning under force). */
 void cli_guard_diverge(const cli_system *s, const ulam_guard *g, int force);
@@ -127,5 +139,6 @@ int cli_study(int argc, char **argv);
 int cli_solve_wants_method(int argc, char **argv);
 int cli_solve_method(int argc, char **argv);
 int cli_radiosity(int argc, char **argv);
+int cli_prepare(int argc, char **argv);
 
 #endif

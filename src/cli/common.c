@@ -133,84 +133,135 @@ static int file_tag(const char *path, uint64_t tag[2])
     return 0;
 }
 
-/* Read a matrix (vec == NULL) or vector through its cache PATH.ulamcache when cache is set: a
- * cache for the file as it is now is read, else the file is parsed and the cache written
- * (a failure to write it is only a warning).  A library status, err filled. */
-static int read_cached(const char *path, int cache, ulam_csr **A, double **vec, int64_t *n, ulam_error *err)
+/* Read a matrix (vec == NULL) or vector.  A prepared file is mapped (*sys); with cache, its
+ * copy PATH.ulamcache (a prepared file) is mapped when it was made from the file as it is now,
+ * else the file is parsed (*A or *vec) and the copy written (a failure to write it is only a
+ * warning).  A library status, err filled. */
+static int read_input(const char *path, int cache, ulam_system **sys, ulam_csr **A, double **vec, int64_t *n,
+                      ulam_error *err)
 {
     char cpath[4200];
     uint64_t tag[2];
     double t0 = ulam_now();
+    if (ulam_system_is_file(path)) {
+        int status = ulam_system_open(path, NULL, sys, err);
+        if (!status && (vec ? !ulam_system_rhs(*sys, NULL) : !ulam_system_matrix(*sys))) {
+            *sys = ulam_system_free(*sys);
+            *err = (ulam_error){.status = ULAM_ENOTFOUND, .index = -1};
+            snprintf(err->msg, sizeof err->msg, "%s", vec ? "a prepared system holding b (prepare it with --rhs)"
+                                                          : "a prepared system holding a matrix (this one holds only b)");
+            status = ULAM_ENOTFOUND;
+        }
+        return status;
+    }
     int use = cache && strlen(path) < 4096 && !file_tag(path, tag);
     if (use) {
         snprintf(cpath, sizeof cpath, "%s.ulamcache", path);
-        int st = vec ? ulam_cache_read_vector(cpath, tag, vec, n, err) : ulam_cache_read_csr(cpath, tag, A, err);
-        if (!st) {
+        if (!ulam_system_open(cpath, tag, sys, err) && (vec ? ulam_system_rhs(*sys, NULL) != NULL : ulam_system_matrix(*sys) != NULL)) {
             fprintf(stderr, "ulam: %s: loaded from its cache in %.3f s\n", path, ulam_now() - t0);
             return ULAM_OK;
         }
+        *sys = ulam_system_free(*sys);
     }
     int status = vec ? ulam_mm_read_vector(path, vec, n, err) : ulam_mm_read_matrix(path, A, err);
     if (status || !use) return status;
     double parsed = ulam_now() - t0;
-    int st = vec ? ulam_cache_write_vector(cpath, *vec, *n, tag) : ulam_cache_write_csr(cpath, *A, tag);
+    ulam_system_desc d = {.M = vec ? NULL : *A, .b = vec ? *vec : NULL, .n = vec ? *n : (*A)->nrows,
+                          .tag = {tag[0], tag[1]}};
+    int st = ulam_system_write(cpath, &d);
     if (st) fprintf(stderr, "ulam: %s: warning: cache not written: %s\n", cpath, ulam_strerror(st));
     else fprintf(stderr, "ulam: %s: parsed in %.3f s, cache written to %s\n", path, parsed, cpath);
     return ULAM_OK;
+}
+
+/* Check a mapped M and b whole if not yet done. */
+int cli_system_verify(cli_system *s)
+{
+    ulam_error err;
+    if (s->verified) return 0;
+    if (s->sys_M && ulam_system_check(s->sys_M, &err)) {
+        cli_system_free(s);
+        return cli_report(s->matrix_path, &err);
+    }
+    if (s->sys_b && ulam_system_check(s->sys_b, &err)) {
+        cli_system_free(s);
+        return cli_report(s->rhs_path, &err);
+    }
+    s->verified = 1;
+    return 0;
+}
+
+/* Replace M and b by the Jacobi splitting of the loaded A (b zeros without --rhs). */
+static int load_jacobi(cli_system *s)
+{
+    int rc = cli_system_verify(s); /* a mapped copy is checked before the splitting reads it all */
+    if (rc) return rc;
+    ulam_error err;
+    int64_t n = s->M->nrows;
+    ulam_csr *M = NULL;
+    double *zeros = s->b ? NULL : calloc((size_t)n, sizeof *zeros), *bp = malloc((size_t)n * sizeof *bp);
+    const double *b = s->b ? s->b : zeros;
+    int status = b && bp ? ulam_jacobi(s->M, b, s->omega > 0 ? s->omega : 1.0, &M, bp, &err) : ULAM_ENOMEM;
+    free(zeros);
+    int with_b = s->b != NULL;
+    if (status) {
+        free(bp);
+        if (status == ULAM_ENOMEM) err.status = status, err.line = 0, err.msg[0] = '\0';
+        cli_system_free(s);
+        return cli_report(s->matrix_path, &err);
+    }
+    cli_system_free(s);
+    s->M = s->own_M = M;
+    if (with_b) s->b = s->own_b = bp;
+    else free(bp);
+    s->verified = 1;
+    return 0;
 }
 
 /* Load M (and b); 0 or an exit code. */
 int cli_load_system(cli_system *s)
 {
     ulam_error err;
-    ulam_csr *A = NULL;
-    int status = read_cached(s->matrix_path, s->cache, &A, NULL, NULL, &err);
+    int prepared = ulam_system_is_file(s->matrix_path);
+    if (prepared && s->jacobi)
+        return cli_usage_error(s->command, "%s is a prepared system: it holds M already (prepare it with --jacobi)",
+                               s->matrix_path);
+    int status = read_input(s->matrix_path, s->cache, &s->sys_M, &s->own_M, NULL, NULL, &err);
     if (status) return cli_report(s->matrix_path, &err);
-    if (A->nrows != A->ncols) {
+    s->M = s->own_M ? s->own_M : ulam_system_matrix(s->sys_M);
+    if (prepared) s->cert = ulam_system_certificate(s->sys_M);
+    if (s->M->nrows != s->M->ncols) {
         fprintf(stderr, "ulam: %s: error: %s: expected a square matrix, got %lld x %lld\n",
-                s->matrix_path, ulam_strerror(ULAM_ENOTSQUARE), (long long)A->nrows,
-                (long long)A->ncols);
-        ulam_csr_free(A);
+                s->matrix_path, ulam_strerror(ULAM_ENOTSQUARE), (long long)s->M->nrows,
+                (long long)s->M->ncols);
+        cli_system_free(s);
         return cli_exit_code(ULAM_ENOTSQUARE);
     }
-    int64_t n = A->nrows, nb = n;
-    double *b = NULL;
+    int64_t n = s->M->nrows, nb = n;
     if (s->rhs_path) {
-        status = read_cached(s->rhs_path, s->cache, NULL, &b, &nb, &err);
+        status = read_input(s->rhs_path, s->cache, &s->sys_b, NULL, &s->own_b, &nb, &err);
         if (status) {
-            ulam_csr_free(A);
+            cli_system_free(s);
             return cli_report(s->rhs_path, &err);
         }
+        s->b = s->own_b ? s->own_b : ulam_system_rhs(s->sys_b, &nb);
         if (nb != n) {
             fprintf(stderr, "ulam: %s: error: %s: expected %lld entries to match %s, got %lld\n",
                     s->rhs_path, ulam_strerror(ULAM_EDIM), (long long)n, s->matrix_path,
                     (long long)nb);
-            ulam_csr_free(A);
-            free(b);
+            cli_system_free(s);
             return cli_exit_code(ULAM_EDIM);
         }
-    } else if (s->jacobi) {
-        b = calloc((size_t)n, sizeof *b);
+    } else if (prepared) {
+        s->b = ulam_system_rhs(s->sys_M, NULL);
     }
-    if (s->jacobi) {
-        ulam_csr *M = NULL;
-        double *bp = malloc((size_t)n * sizeof *bp);
-        status = b && bp ? ulam_jacobi(A, b, s->omega > 0 ? s->omega : 1.0, &M, bp, &err) : ULAM_ENOMEM;
-        ulam_csr_free(A);
-        free(b);
-        if (status) {
-            free(bp);
-            if (status == ULAM_ENOMEM) err.status = status, err.line = 0, err.msg[0] = '\0';
-            return cli_report(s->matrix_path, &err);
-        }
-        A = M;
-        b = s->rhs_path ? bp : (free(bp), (double *)NULL);
-    }
-    s->M = A;
-    s->b = b;
-    if (s->index > A->nrows) {
-        int rc = cli_usage_error(s->command, "--index %lld is out of range 1..%lld",
-                                 (long long)s->index, (long long)A->nrows);
+    s->verified = !s->sys_M && !s->sys_b;
+    int rc = s->jacobi ? load_jacobi(s) : 0;
+    if (!rc && !s->lazy) rc = cli_system_verify(s);
+    if (rc) return rc;
+    if (s->index > s->M->nrows) {
+        rc = cli_usage_error(s->command, "--index %lld is out of range 1..%lld",
+                             (long long)s->index, (long long)s->M->nrows);
         cli_system_free(s);
         return rc;
     }
@@ -220,9 +271,12 @@ int cli_load_system(cli_system *s)
 /* Free what cli_load_system loaded. */
 void cli_system_free(cli_system *s)
 {
-    s->M = ulam_csr_free(s->M);
-    free(s->b);
-    s->b = NULL;
+    s->own_M = ulam_csr_free(s->own_M);
+    free(s->own_b);
+    s->own_b = NULL;
+    s->sys_M = ulam_system_free(s->sys_M);
+    s->sys_b = ulam_system_free(s->sys_b);
+    s->M = NULL, s->b = NULL, s->cert = NULL;
 }
 
 /* Solve the loaded system densely into a new *x; 0 or an exit code. */

@@ -83,9 +83,13 @@ int cli_direct(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("direct", "expects exactly one matrix file");
-    if (!s.rhs_path) return cli_usage_error("direct", "needs --rhs b.mtx");
+    if (!s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("direct", "needs --rhs b.mtx");
     s.matrix_path = argv[optind];
     if ((rc = cli_load_system(&s))) return rc;
+    if (!s.b) {
+        cli_system_free(&s);
+        return cli_usage_error("direct", "needs --rhs b.mtx (%s holds no b)", s.matrix_path);
+    }
     double *x = NULL;
     ulam_direct_info info;
     int status;

@@ -25,11 +25,14 @@ void cli_print_power(const ulam_power *p)
 
 /* The guards' radii for a walk in mode on s (rho(|M|) and that mode's rho(M^), stopped once
  * certified); 0 or an exit code (error reported). */
-int cli_guard(const cli_system *s, double continue_q, int mode, ulam_guard *g)
+int cli_guard(cli_system *s, double continue_q, int mode, ulam_guard *g)
 {
     ulam_error err;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(mode);
+    if (!ulam_certificate_guard(s->cert, continue_q, &go, g)) return 0;
+    int rc = cli_system_verify(s);
+    if (rc) return rc;
     int status = ulam_guard_check(s->M, continue_q, &go, g, &err);
     return status ? cli_report(s->matrix_path, &err) : 0;
 }

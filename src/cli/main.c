@@ -15,8 +15,9 @@ static const char *const usage =
     "  direct   LAPACK dense reference solve\n"
     "  study    every method at every budget, repeated: accuracy against time, charts\n"
     "  radiosity  a patch scene (OBJ + MTL): one patch by ray-cast walks, or all, or LAPACK\n"
+    "  prepare  write M, b and the guards' certificate as a file that queries map in place\n"
     "\n"
-    "Matrices and vectors are Matrix Market files.  Indices on the command line are\n"
+    "Matrices and vectors are Matrix Market files (or prepared systems).  Indices on the command line are\n"
     "1-based, as in Matrix Market files (the C API is 0-based).\n";
 
 /* Run the subcommand. */
@@ -35,6 +36,7 @@ static int dispatch(int argc, char **argv)
     if (!strcmp(argv[1], "solve")) return cli_solve(argc - 1, argv + 1);
     if (!strcmp(argv[1], "study")) return cli_study(argc - 1, argv + 1);
     if (!strcmp(argv[1], "radiosity")) return cli_radiosity(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "prepare")) return cli_prepare(argc - 1, argv + 1);
     fprintf(stderr, "ulam: unknown command '%s'\n%s", argv[1], usage);
     return EXIT_USAGE;
 }

@@ -21,6 +21,8 @@ static const char *const usage =
     "\n"
     "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
     "Indices are 1-based, as in Matrix Market files.\n"
+    "M.mtx may be a prepared system (ulam prepare): it is mapped and read only where the walks\n"
+    "go, its certificate serves the guards, and it holds b unless --rhs is given.\n"
     "\n"
     "  --mode adjoint     start walks at I and gather b (default): one unknown, cheaply\n"
     "  --mode forward     start walks from the source b and tally where they go: every unknown\n"
@@ -344,7 +346,7 @@ int cli_solve(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (!s.rhs_path) return cli_usage_error("solve", "needs --rhs b.mtx");
+    if (!s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("solve", "needs --rhs b.mtx");
     if (!s.index && o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
     if ((out || errors) && o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
@@ -352,8 +354,13 @@ int cli_solve(int argc, char **argv)
         return cli_usage_error("solve", "--split W must exceed --roulette W");
     if (!any_rule) o.max_walks = 100000;
     s.matrix_path = argv[optind];
+    s.lazy = o.mode == ULAM_ADJOINT && !ro.check && !cli_share; /* read only the rows walks reach */
     double t0 = ulam_now();
     if ((rc = cli_load_system(&s))) return rc;
+    if (!s.b) {
+        cli_system_free(&s);
+        return cli_usage_error("solve", "needs --rhs b.mtx (%s holds no b)", s.matrix_path);
+    }
     ro.load_seconds = ulam_now() - t0;
     o.index = s.index ? s.index - 1 : 0;
     o.share = cli_share;
@@ -407,7 +414,15 @@ int cli_solve(int argc, char **argv)
     }
     ulam_solver_result(sv, &r);
     rc = 0;
-    if (status) {
+    if (status == ULAM_ENOMEM) {
+        fprintf(stderr, "ulam: %s: error: %s: expected memory to build the walk kernel's rows\n", s.matrix_path,
+                ulam_strerror(status));
+        rc = cli_exit_code(status);
+    } else if (status && status != ULAM_ENONFINITE) {
+        fprintf(stderr, "ulam: %s: error: %s: expected rows the walks reach to be consistent (row data of "
+                        "the mapped file is corrupt: prepare it again)\n", s.matrix_path, ulam_strerror(status));
+        rc = cli_exit_code(status);
+    } else if (status) {
         fprintf(stderr, "ulam: %s: error: %s: a walk produced a non-finite weight or score after %lld "
                         "walks; nothing was averaged in from it (is rho(|M|) < 1? see 'ulam info')\n",
                 s.matrix_path, ulam_strerror(status), (long long)r.walks);

@@ -569,7 +569,7 @@ int cli_study(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("study", "expects exactly one matrix file");
-    if (!st.s.rhs_path) return cli_usage_error("study", "needs --rhs b.mtx");
+    if (!st.s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("study", "needs --rhs b.mtx");
     if (!st.s.index) return cli_usage_error("study", "needs --index I");
     st.s.matrix_path = argv[optind];
     if (mkdir(st.out, 0777) && access(st.out, W_OK)) {
@@ -577,6 +577,10 @@ int cli_study(int argc, char **argv)
         return cli_report(st.out, &e);
     }
     if ((rc = cli_load_system(&st.s))) return rc;
+    if (!st.s.b) {
+        cli_system_free(&st.s);
+        return cli_usage_error("study", "needs --rhs b.mtx (%s holds no b)", st.s.matrix_path);
+    }
     size_t cells = (size_t)NMETHOD * MAXBUDGET * (size_t)st.repeats;
     st.est = malloc(cells * sizeof *st.est), st.se = malloc(cells * sizeof *st.se);
     st.sec = malloc(cells * sizeof *st.sec), st.done = calloc(cells, 1), st.row = calloc(cells, sizeof *st.row);

@@ -5,45 +5,9 @@
  * walk kernel rows built, and the peak resident memory against the CSR size.  Targets: parsing < 10 x the walk time, or a second
  * run that loads in under a second; peak RSS <= 2.5 x the CSR.  usage: bench_load path/to/ulam */
 #include <math.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 
 #include "gen.h"
-
-/* The number after "key": in a JSON text, or NAN. */
-static double json_number(const char *text, const char *key)
-{
-    char pat[64];
-    snprintf(pat, sizeof pat, "\"%s\": ", key);
-    const char *p = strstr(text, pat);
-    return p ? atof(p + strlen(pat)) : NAN;
-}
-
-/* Run argv with stdout captured into out; the child's peak RSS in MiB into *rss.  Exit status. */
-static int run(char *const argv[], char *out, size_t cap, double *rss)
-{
-    int fd[2];
-    if (pipe(fd)) return -1;
-    pid_t pid = fork();
-    if (pid == 0) {
-        dup2(fd[1], 1);
-        close(fd[0]), close(fd[1]);
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    close(fd[1]);
-    size_t len = 0;
-    ssize_t got;
-    while (len + 1 < cap && (got = read(fd[0], out + len, cap - 1 - len)) > 0) len += (size_t)got;
-    out[len] = '\0';
-    close(fd[0]);
-    int status = 0;
-    struct rusage ru;
-    wait4(pid, &status, 0, &ru);
-    *rss = (double)ru.ru_maxrss / 1024.0;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 int main(int argc, char **argv)
 {
@@ -76,12 +40,12 @@ int main(int argc, char **argv)
            "load/walk", "rows", "peak MiB", "peak/CSR");
     int rc = 0;
     for (int k = 0; k < 2 && !rc; k++) {
-        double rss = 0;
-        rc = run(args, out, sizeof out, &rss);
-        double load = json_number(out, "load_seconds"), kern = json_number(out, "kernel_seconds");
-        double walk = json_number(out, "seconds"), guard = json_number(out, "guard_seconds");
+        double rss = 0, wall, cpu;
+        rc = bench_run(args, out, sizeof out, 0, &wall, &cpu, &rss);
+        double load = bench_json_number(out, "load_seconds"), kern = bench_json_number(out, "kernel_seconds");
+        double walk = bench_json_number(out, "seconds"), guard = bench_json_number(out, "guard_seconds");
         printf("%-16s %9.3f %9.3f %9.4f %9.4f %10.0f %10.0f %9.0f %9.2f\n", k ? "second (cache)" : "first (parse)", load,
-               guard, kern, walk, load / walk, json_number(out, "kernel_rows"), rss, rss / csr_mib);
+               guard, kern, walk, load / walk, bench_json_number(out, "kernel_rows"), rss, rss / csr_mib);
     }
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf %s", dir);

@@ -2,9 +2,12 @@
 #ifndef ULAM_BENCH_GEN_H
 #define ULAM_BENCH_GEN_H
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "ulam.h"
@@ -31,6 +34,28 @@ static inline ulam_csr *bench_random_csr(int64_t n)
     return M; /* a column drawn twice in a row is harmless for walking and solving */
 }
 
+/* Screened diffusion on an L x L grid (n = L^2): one implicit step of diffusion with
+ * absorption, M_ii = 0.1 and 0.2 to each of the 4 neighbours (5 nonzeros a row inside, fewer
+ * on the edge), so rows sum to at most 0.9 and M is symmetric: (I - M) is positive definite
+ * (CG applies), and a walk stays near its start. */
+static inline ulam_csr *bench_screened_csr(int64_t L)
+{
+    int64_t n = L * L, nz = 0;
+    ulam_csr *M = ulam_csr_alloc(n, n, 5 * n);
+    if (!M) return NULL;
+    for (int64_t i = 0; i < L; i++)
+        for (int64_t j = 0; j < L; j++) {
+            const int64_t at[5][2] = {{i - 1, j}, {i, j - 1}, {i, j}, {i, j + 1}, {i + 1, j}}; /* column order */
+            for (int k = 0; k < 5; k++) {
+                if (at[k][0] < 0 || at[k][0] >= L || at[k][1] < 0 || at[k][1] >= L) continue;
+                M->colidx[nz] = (int32_t)(at[k][0] * L + at[k][1]);
+                M->val[nz++] = k == 2 ? 0.1 : 0.2;
+            }
+            M->rowptr[i * L + j + 1] = nz;
+        }
+    return M;
+}
+
 /* b_i = 0.5 + U(0, 1) from stream (n, 1). */
 static inline double *bench_random_rhs(int64_t n)
 {
@@ -40,6 +65,23 @@ static inline double *bench_random_rhs(int64_t n)
     ulam_rng_seed(&r, (uint64_t)n, 1);
     for (int64_t i = 0; i < n; i++) b[i] = 0.5 + ulam_rng_uniform(&r);
     return b;
+}
+
+/* M with each row's columns sorted and repeated ones summed (the form a parse gives and
+ * ulam_csr_check wants), in place of M (freed); NULL when out of memory. */
+static inline ulam_csr *bench_canonical(ulam_csr *M)
+{
+    int64_t nz = M->rowptr[M->nrows];
+    int32_t *ti = malloc((size_t)nz * sizeof *ti);
+    ulam_csr *C = NULL;
+    if (ti) {
+        for (int64_t i = 0; i < M->nrows; i++)
+            for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) ti[q] = (int32_t)i;
+        if (ulam_csr_from_triplets(M->nrows, M->ncols, nz, ti, M->colidx, M->val, &C)) C = NULL;
+    }
+    free(ti);
+    ulam_csr_free(M);
+    return C;
 }
 
 /* Resident set size of this process now, in bytes (/proc/self/statm); 0 if unreadable. */
@@ -70,6 +112,48 @@ static inline double bench_peak_rss(void)
 static inline double bench_csr_bytes(const ulam_csr *M)
 {
     return (double)(M->nrows + 1) * 8.0 + (double)M->rowptr[M->nrows] * 12.0;
+}
+
+/* The number after "key": in a JSON text, or NAN. */
+static inline double bench_json_number(const char *text, const char *key)
+{
+    char pat[64];
+    snprintf(pat, sizeof pat, "\"%s\": ", key);
+    const char *p = strstr(text, pat);
+    return p ? atof(p + strlen(pat)) : NAN;
+}
+
+/* Run argv with stdout captured into out (stderr to /dev/null when quiet); wall seconds into
+ * *wall, its CPU seconds (user + system) into *cpu, its peak RSS in MiB into *rss (which counts
+ * what this process had resident when it forked: free big arrays first).  The exit status, or -1. */
+static inline int bench_run(char *const argv[], char *out, size_t cap, int quiet, double *wall, double *cpu,
+                            double *rss)
+{
+    int fd[2];
+    if (pipe(fd)) return -1;
+    double t0 = ulam_now();
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(fd[1], 1);
+        if (quiet && !freopen("/dev/null", "w", stderr)) _exit(126);
+        close(fd[0]), close(fd[1]);
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    close(fd[1]);
+    size_t len = 0;
+    ssize_t got;
+    while (len + 1 < cap && (got = read(fd[0], out + len, cap - 1 - len)) > 0) len += (size_t)got;
+    out[len] = '\0';
+    close(fd[0]);
+    int status = 0;
+    struct rusage ru;
+    wait4(pid, &status, 0, &ru);
+    *wall = ulam_now() - t0;
+    *cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
+           1e-6 * (double)ru.ru_stime.tv_usec;
+    *rss = (double)ru.ru_maxrss / 1024.0;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 #endif

@@ -1,0 +1,326 @@
+/* Prepared systems: written and mapped back exactly, stale and corrupt files refused at open
+ * (a table of damaged headers), corrupt arrays refused by the check and by the walk kernel
+ * when a walk reaches them, and a query that reads no page of rows its walks do not reach. */
+#include "testutil.h"
+
+#include <string.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+/* The bytes of a prepared file of M and b in *len, malloc'd (via a temporary file). */
+static unsigned char *file_bytes(const ulam_system_desc *d, size_t *len)
+{
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    assert_int_equal(ulam_system_write_file(f, d), ULAM_OK);
+    long n = ftell(f);
+    rewind(f);
+    unsigned char *p = malloc((size_t)n + 8);
+    assert_non_null(p);
+    assert_int_equal(fread(p, 1, (size_t)n, f), (size_t)n);
+    fclose(f);
+    *len = (size_t)n;
+    return p;
+}
+
+/* The header word k. */
+static uint64_t word(const unsigned char *p, int k)
+{
+    uint64_t w;
+    memcpy(&w, p + 8 * k, 8);
+    return w;
+}
+
+/* Set header word k and recompute the checksum (FNV-1a 64 of bytes 0 .. 1015), as a writer
+ * with other intentions would. */
+static void set_word(unsigned char *p, int k, uint64_t w)
+{
+    memcpy(p + 8 * k, &w, 8);
+    uint64_t h = 0xcbf29ce484222325u;
+    for (int i = 0; i < 1016; i++) h = (h ^ p[i]) * 0x100000001b3u;
+    memcpy(p + 1016, &h, 8);
+}
+
+/* Open bytes p[0 .. len) copied to aligned memory; the status. */
+static int open_copy(const unsigned char *p, size_t len, const uint64_t *tag, ulam_system **s)
+{
+    void *q = NULL;
+    assert_int_equal(posix_memalign(&q, 4096, len ? len : 1), 0);
+    memcpy(q, p, len);
+    ulam_error err;
+    int status = ulam_system_from_memory(q, len, tag, s, &err);
+    if (status) {
+        assert_true(err.msg[0] != '\0');
+        free(q);
+    } else {
+        ulam_system_free(*s); /* the memory is borrowed: free it after */
+        *s = NULL;
+        free(q);
+    }
+    return status;
+}
+
+/* matrices/NAME.mtx and NAME_b.mtx, and the certificate of the analog guards. */
+static void load_certified(const char *name, ulam_csr **A, double **b, int64_t *n, ulam_certificate *c)
+{
+    char path[128];
+    snprintf(path, sizeof path, "matrices/%s.mtx", name);
+    assert_int_equal(ulam_mm_read_matrix(path, A, NULL), ULAM_OK);
+    snprintf(path, sizeof path, "matrices/%s_b.mtx", name);
+    assert_int_equal(ulam_mm_read_vector(path, b, n, NULL), ULAM_OK);
+    assert_int_equal(ulam_certificate_compute(*A, 0.0, NULL, c, NULL), ULAM_OK);
+}
+
+/* A file round trip: matrix, b, tag, omega and certificate come back as written. */
+static void test_roundtrip(void **state)
+{
+    (void)state;
+    ulam_csr *A = NULL;
+    double *b = NULL;
+    int64_t n = 0;
+    ulam_certificate c;
+    load_certified("signed200", &A, &b, &n, &c);
+    assert_true(c.rowsum_max >= c.guard.abs.lower && c.colsum_max >= c.guard.abs.lower);
+    char path[] = "/tmp/ulam_system_testXXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    ulam_system_desc d = {.M = A, .b = b, .n = n, .tag = {12345, 678}, .omega = 0.75, .cert = &c};
+    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    assert_int_equal(ulam_system_is_file(path), 1);
+    assert_int_equal(ulam_system_is_file("matrices/signed200.mtx"), 0);
+    ulam_system *s = NULL;
+    ulam_error err;
+    const uint64_t tag[2] = {12345, 678}, other[2] = {12345, 679};
+    assert_int_equal(ulam_system_open(path, other, &s, &err), ULAM_ENOTFOUND); /* source changed */
+    assert_null(s);
+    assert_int_equal(ulam_system_open(path, tag, &s, &err), ULAM_OK);
+    assert_int_equal(ulam_system_check(s, &err), ULAM_OK);
+    assert_csr_same(ulam_system_matrix(s), A);
+    int64_t nb = 0;
+    assert_memory_equal(ulam_system_rhs(s, &nb), b, (size_t)n * sizeof *b);
+    assert_int_equal(nb, n);
+    assert_close(ulam_system_omega(s), 0.75, 0);
+    const ulam_certificate *r = ulam_system_certificate(s);
+    assert_non_null(r);
+    assert_memory_equal(&r->guard.abs, &c.guard.abs, sizeof c.guard.abs);
+    assert_memory_equal(r->guard.hat, c.guard.hat, sizeof c.guard.hat);
+    assert_int_equal(r->guard.verdict_abs, c.guard.verdict_abs);
+    assert_close(r->colsum_max, c.colsum_max, 0);
+    /* the certificate serves the analog guards and nothing else */
+    ulam_guard g, h;
+    assert_int_equal(ulam_certificate_guard(r, 0.0, NULL, &g), ULAM_OK);
+    assert_int_equal(ulam_guard_check(A, 0.0, NULL, &h, NULL), ULAM_OK);
+    assert_close(g.abs.rho, h.abs.rho, 0);
+    assert_close(g.hat[1].upper, h.hat[1].upper, 0);
+    assert_close(g.abs.seconds, 0, 0);
+    assert_int_equal(ulam_certificate_guard(r, 0.5, NULL, &g), ULAM_ENOTFOUND);
+    ulam_guard_opts po = ulam_guard_defaults();
+    po.power.tol = 1e-8;
+    assert_int_equal(ulam_certificate_guard(r, 0.0, &po, &g), ULAM_ENOTFOUND);
+    assert_int_equal(ulam_certificate_guard(NULL, 0.0, NULL, &g), ULAM_ENOTFOUND);
+    s = ulam_system_free(s);
+    /* a vector alone */
+    d = (ulam_system_desc){.b = b, .n = n};
+    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    assert_int_equal(ulam_system_open(path, NULL, &s, &err), ULAM_OK);
+    assert_null(ulam_system_matrix(s));
+    assert_null(ulam_system_certificate(s));
+    assert_memory_equal(ulam_system_rhs(s, &nb), b, (size_t)n * sizeof *b);
+    s = ulam_system_free(s);
+    assert_int_equal(ulam_system_open("/nonexistent/x", NULL, &s, &err), ULAM_EIO);
+    assert_int_equal(truncate(path, 0), 0);
+    assert_int_equal(ulam_system_open(path, NULL, &s, &err), ULAM_EBANNER);
+    remove(path);
+    ulam_csr_free(A);
+    free(b);
+}
+
+/* Damaged headers: each is refused at open with its status (the failing case prints its index). */
+static void test_damaged(void **state)
+{
+    (void)state;
+    ulam_csr *A = NULL;
+    double *b = NULL;
+    int64_t n = 0;
+    ulam_certificate c;
+    load_certified("chain4", &A, &b, &n, &c);
+    ulam_system_desc d = {.M = A, .b = b, .n = n, .cert = &c};
+    size_t len;
+    unsigned char *good = file_bytes(&d, &len);
+    enum { NCASE = 13 };
+    static const int want[NCASE] = {ULAM_EBANNER, ULAM_ESYNTAX, ULAM_ESYNTAX, ULAM_ESYNTAX, ULAM_ESYNTAX,
+                                    ULAM_EUNSUPPORTED, ULAM_EOVERFLOW, ULAM_ESYNTAX, ULAM_ESYNTAX, ULAM_ESYNTAX,
+                                    ULAM_EOVERFLOW, ULAM_ESYNTAX, ULAM_EBANNER};
+    for (int k = 0; k < NCASE; k++) {
+        unsigned char *p = malloc(len + 8);
+        memcpy(p, good, len);
+        size_t l = len;
+        switch (k) {
+        case 0: p[3] ^= 1; break;                              /* wrong magic */
+        case 1: l = len - 1; break;                            /* truncated by a byte */
+        case 2: l = 600; break;                                /* truncated inside the header */
+        case 3: p[len] = 0, l = len + 1; break;                /* a byte appended */
+        case 4: p[8 * 5] ^= 1; break;                          /* nnz changed: the checksum disagrees */
+        case 5: set_word(p, 1, 2 | (uint64_t)1024 << 32); break; /* a version this reader does not know */
+        case 6: set_word(p, 3, (uint64_t)1 << 40); break;      /* n past 2^31 */
+        case 7: set_word(p, 7, word(p, 7) + 8); break;         /* colidx off its boundary */
+        case 8: set_word(p, 8, word(p, 10)); break;            /* val past the end of the file */
+        case 9: set_word(p, 5, word(p, 5) - 1); break;         /* rowptr[n] disagrees with nnz */
+        case 10: set_word(p, 2, word(p, 2) | 64); break;       /* an unknown flag */
+        case 11: set_word(p, 10, word(p, 10) + 4096); break;   /* stated length past the file */
+        case 12: l = 4; break;                                 /* shorter than the magic */
+        }
+        ulam_system *s = NULL;
+        int st = open_copy(p, l, NULL, &s);
+        if (st != want[k]) fail_msg("damaged case %d: status %d, expected %d", k, st, want[k]);
+        free(p);
+    }
+    /* a certificate section of a later version is ignored, not trusted */
+    unsigned char *p = malloc(len);
+    memcpy(p, good, len);
+    set_word(p, 32, 3 | word(p, 32) >> 32 << 32);
+    void *q = NULL;
+    assert_int_equal(posix_memalign(&q, 4096, len), 0);
+    memcpy(q, p, len);
+    ulam_system *s = NULL;
+    assert_int_equal(ulam_system_from_memory(q, len, NULL, &s, NULL), ULAM_OK);
+    assert_null(ulam_system_certificate(s));
+    ulam_system_free(s);
+    free(q), free(p), free(good);
+    ulam_csr_free(A);
+    free(b);
+}
+
+/* A block-diagonal system: rows 0..B-1 move only among themselves (a ring, 4 a row), the rest
+ * likewise among rows B..n-1; every row sums to 0.8. */
+static ulam_csr *two_blocks(int64_t n, int64_t B)
+{
+    ulam_csr *M = ulam_csr_alloc(n, n, 4 * n);
+    for (int64_t i = 0; i < n; i++) {
+        int64_t lo = i < B ? 0 : B, m = i < B ? B : n - B, c[4];
+        for (int k = 0; k < 4; k++) c[k] = lo + (i - lo + 1 + k) % m;
+        for (int a = 0; a < 4; a++) /* sorted */
+            for (int z = a + 1; z < 4; z++)
+                if (c[z] < c[a]) {
+                    int64_t t = c[a];
+                    c[a] = c[z], c[z] = t;
+                }
+        for (int k = 0; k < 4; k++) M->colidx[4 * i + k] = (int32_t)c[k], M->val[4 * i + k] = 0.2;
+        M->rowptr[i + 1] = 4 * (i + 1);
+    }
+    return M;
+}
+
+/* Protect the whole pages of [lo, hi) bytes at p from any access. */
+static void protect(unsigned char *p, size_t lo, size_t hi)
+{
+    lo = (lo + 4095) / 4096 * 4096, hi = hi / 4096 * 4096;
+    if (hi > lo) assert_int_equal(mprotect(p + lo, hi - lo, PROT_NONE), 0);
+}
+
+/* A query on a mapped file reads no page of the rows its walks cannot reach: those pages are
+ * made unreadable, and an adjoint run from block 0 still completes (a read would fault).  Its
+ * estimate is that of the parsed matrix, bit for bit. */
+static void test_lazy_pages(void **state)
+{
+    (void)state;
+    const int64_t n = 8192, B = 64, far = 2048;
+    ulam_csr *M = two_blocks(n, B);
+    double *b = malloc((size_t)n * sizeof *b);
+    for (int64_t i = 0; i < n; i++) b[i] = 1.0 + (double)(i % 7);
+    ulam_system_desc d = {.M = M, .b = b, .n = n};
+    size_t len;
+    unsigned char *bytes = file_bytes(&d, &len);
+    unsigned char *p = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    assert_true(p != MAP_FAILED);
+    memcpy(p, bytes, len);
+    free(bytes);
+    size_t off[4] = {word(p, 6), word(p, 7), word(p, 8), word(p, 9)}, sz[4] = {8, 16, 32, 8};
+    for (int k = 0; k < 4; k++) /* rows far .. n-1, keeping rowptr[n] */
+        protect(p, off[k] + (size_t)far * sz[k], off[k] + (size_t)(n - (k == 0)) * sz[k]);
+    ulam_system *s = NULL;
+    assert_int_equal(ulam_system_from_memory(p, len, NULL, &s, NULL), ULAM_OK);
+    ulam_guard g; /* the verdicts a prepared file's certificate would carry: no pass over M */
+    assert_int_equal(ulam_guard_check(M, 0.0, NULL, &g, NULL), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 3, o.max_walks = 20000, o.threads = 2, o.guard = &g;
+    ulam_walk_result r1, r2;
+    ulam_error err;
+    assert_int_equal(ulam_solve(ulam_system_matrix(s), ulam_system_rhs(s, NULL), &o, &r1, &err), ULAM_OK);
+    assert_int_equal(ulam_solve(M, b, &o, &r2, &err), ULAM_OK);
+    assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
+    assert_int_equal(r1.rows, B);
+    o.estimator = ULAM_ABSORPTION; /* the reachability check too reads only what it reaches */
+    assert_int_equal(ulam_solve(ulam_system_matrix(s), ulam_system_rhs(s, NULL), &o, &r1, &err), ULAM_OK);
+    ulam_system_free(s);
+    munmap(p, len);
+    ulam_csr_free(M);
+    free(b);
+}
+
+/* Corrupt arrays behind a sound header: the check refuses them, and so does a walk that reaches
+ * them (at set-up when the start row is bad, else at the round that reaches one); a walk that
+ * does not reach them never sees them.  Each case prints its index when it fails. */
+static void test_corrupt_rows(void **state)
+{
+    (void)state;
+    const int64_t n = 256, B = 16;
+    ulam_csr *M = two_blocks(n, B);
+    double *b = malloc((size_t)n * sizeof *b);
+    for (int64_t i = 0; i < n; i++) b[i] = 1.0;
+    ulam_system_desc d = {.M = M, .b = b, .n = n};
+    size_t len;
+    unsigned char *good = file_bytes(&d, &len);
+    ulam_guard g; /* the verdicts of the sound M, as a certificate would carry them */
+    assert_int_equal(ulam_guard_check(M, 0.0, NULL, &g, NULL), ULAM_OK);
+    enum { NCASE = 7 };
+    for (int k = 0; k < NCASE; k++) {
+        void *q = NULL;
+        assert_int_equal(posix_memalign(&q, 4096, len), 0);
+        unsigned char *p = q;
+        memcpy(p, good, len);
+        int64_t *rowptr = (int64_t *)(void *)(p + word(p, 6));
+        int32_t *col = (int32_t *)(void *)(p + word(p, 7));
+        double *val = (double *)(void *)(p + word(p, 8)), *rhs = (double *)(void *)(p + word(p, 9));
+        int64_t row = B + 5; /* in block 1, reached from index B */
+        switch (k) {
+        case 0: col[4 * row + 1] = (int32_t)n; break;       /* column out of range */
+        case 1: col[4 * row] = -7; break;                    /* negative column */
+        case 2: val[4 * row + 2] = NAN; break;               /* non-finite value */
+        case 3: val[4 * row + 3] = 0.0; break;               /* stored zero */
+        case 4: rowptr[row + 1] = 4 * n + 100; break;        /* a range past the entries */
+        case 5: rowptr[row] = rowptr[row + 1] + 4; break;    /* a range running backwards */
+        case 6: rhs[row] = INFINITY; break;                  /* non-finite b */
+        }
+        ulam_system *s = NULL;
+        ulam_error err;
+        assert_int_equal(ulam_system_from_memory(p, len, NULL, &s, &err), ULAM_OK);
+        if (ulam_system_check(s, &err) == ULAM_OK) fail_msg("corrupt case %d: passed the check", k);
+        for (int start = 0; start < 3; start++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.index = start == 0 ? B : start == 1 ? row : 3, o.max_walks = 5000, o.threads = 1, o.guard = &g;
+            ulam_walk_result r;
+            int st = ulam_solve(ulam_system_matrix(s), ulam_system_rhs(s, NULL), &o, &r, &err);
+            int bad = st == ULAM_ESYNTAX || st == ULAM_ENONFINITE;
+            if (start < 2 && !bad) fail_msg("corrupt case %d, start %lld: status %d", k, (long long)o.index, st);
+            if (start == 2 && st != ULAM_OK) fail_msg("corrupt case %d: the other block failed (%d)", k, st);
+        }
+        ulam_system_free(s);
+        free(q);
+    }
+    free(good);
+    ulam_csr_free(M);
+    free(b);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_roundtrip),
+        cmocka_unit_test(test_damaged),
+        cmocka_unit_test(test_lazy_pages),
+        cmocka_unit_test(test_corrupt_rows),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
