@@ -103,8 +103,19 @@ static int lane_pop(const ulam__walker *w, lane *x)
     return 1;
 }
 
+/* What every step reads of the walker, copied into the block's locals: the outcomes are read
+ * with acquire (a row a walk resolves may have been built by another thread), which forbids the
+ * compiler to keep values it loaded from shared memory across them, so reading these through
+ * the walker would reload them on every step. */
+typedef struct {
+    ulam__slot *mem;
+    int64_t max_steps;
+    int window; /* roulette or splitting in force */
+} step_consts;
+
 /* Lane x's step: 1 while its particle lives on. */
-static inline int lane_move(const ulam__walker *w, lane *x, ulam_rng *r, ulam__kscratch *ks, ulam__block *out)
+static inline int lane_move(const ulam__walker *w, step_consts c, lane *x, ulam_rng *r, ulam__kscratch *ks,
+                            ulam__block *out)
 {
     int32_t o = ulam__slot_outcome(x->s, x->frac);
     if (o == ULAM__TERMINATE) {
@@ -112,15 +123,15 @@ static inline int lane_move(const ulam__walker *w, lane *x, ulam_rng *r, ulam__k
         return 0;
     }
     int32_t u = target(w->k, x->s, x->frac, o, x->h->factor, &x->w, ks);
-    x->h = ulam__kernel_row(w->k, u);
+    x->h = (ulam__row *)(void *)(c.mem + u);
     prefetch(x->h);
     out->steps++;
-    if (++x->len > w->max_steps) { /* cut: the rest of the history is dropped */
+    if (++x->len > c.max_steps) { /* cut: the rest of the history is dropped */
         out->cut++;
         x->st.top = 0;
         return 0;
     }
-    return (w->roulette <= 0 && w->split <= 0) || window(w, u, &x->w, r, &x->st);
+    return !c.window || window(w, u, &x->w, r, &x->st);
 }
 
 /* Record a finished history's score (a non-finite one is counted, never averaged). */
@@ -147,6 +158,7 @@ void ulam__adjoint_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam
     int lanes = w->lanes < 1 ? 1 : w->lanes > LANES ? LANES : w->lanes;
     int64_t cap = sc->stack_cap / lanes, started = 0;
     int act = 0;
+    const step_consts c = {w->k->mem, w->max_steps, w->roulette > 0 || w->split > 0};
     for (; act < lanes && started < count; act++, started++) {
         L[act].st = (stack){sc->stack_s + act * cap, sc->stack_w + act * cap, 0, cap};
         lane_start(w, &L[act]);
@@ -160,7 +172,7 @@ void ulam__adjoint_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam
         }
         for (int l = 0; l < act;) {
             lane *x = &L[l];
-            if (lane_move(w, x, r, sc->ks, &acc) || lane_pop(w, x)) {
+            if (lane_move(w, c, x, r, sc->ks, &acc) || lane_pop(w, x)) {
                 l++;
                 continue;
             }
