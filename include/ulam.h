@@ -552,8 +552,16 @@ typedef struct ulam_solver ulam_solver;
 int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                       ulam_solver **out, ulam_error *err);
 
-/* Run one round of walks (a fixed number of blocks); ULAM_OK. */
+/* Run one round of walks (rounds grow 1, 2, 4 ... 64 blocks of 1024 walks as walks accumulate,
+ * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
+ * ULAM_ENOMEM, ULAM_EIO (the share's allgather), ULAM_ESYNTAX (a corrupt row of a mapped
+ * file); ulam_solver_error says why. */
 int ulam_solver_iterate(ulam_solver *s);
+
+/* Why the run failed (the status ulam_solver_iterate returned), with err filled: the row of a
+ * corrupt mapped file, no memory, a failed exchange, a non-finite score; ULAM_OK while it has
+ * not failed. */
+int ulam_solver_error(const ulam_solver *s, ulam_error *err);
 
 /* The guards' verdicts the solver walks under (a plain struct to keep or store). */
 void ulam_solver_guard(const ulam_solver *s, ulam_guard *g);
@@ -885,9 +893,6 @@ void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3]);
 
 /* The area centroid of the patches labelled label; ULAM_ENOTFOUND when there are none. */
 int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3]);
-
-/* Total emitted power sum_p A_p E_p per channel. */
-void ulam_scene_power(const ulam_scene *s, double power[3]);
 
 /* A ray caster over a scene (Embree 3): opaque. */
 typedef struct ulam_tracer ulam_tracer;

@@ -143,11 +143,9 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     if (status) return status;
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     ulam_solver_result(sv, wr);
+    if (status) ulam_solver_error(sv, err);
     ulam_solver_free(sv);
-    if (status == ULAM_ENONFINITE)
-        return ulam__fail(err, status, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
-    if (status) return ulam__fail(err, status, 0, -1, "memory for the walks' tallies");
-    return ULAM_OK;
+    return status;
 }
 
 /* Estimate x_t of (I - M) x = e_s. */

@@ -692,12 +692,24 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
     if (status) return status;
     while (!status && !ulam_solver_done(s)) status = ulam_solver_iterate(s);
     if (result) ulam_solver_result(s, result);
-    if (status == ULAM_ENONFINITE)
-        ulam__fail(err, status, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
-    else if (status)
-        ulam__fail(err, status, 0, -1, "memory for the walks' tallies");
+    if (status) ulam_solver_error(s, err);
     ulam_solver_free(s);
     return status;
+}
+
+/* Why the run failed, with err filled; ULAM_OK while it has not. */
+int ulam_solver_error(const ulam_solver *s, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s || !s->status) return ULAM_OK;
+    int status = kernel_failure(s->k, err);
+    if (status) return status;
+    switch (s->status) {
+    case ULAM_ENONFINITE: return ulam__fail(err, s->status, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
+    case ULAM_ENOMEM: return ulam__fail(err, s->status, 0, -1, "memory for the walks' tallies");
+    case ULAM_EIO: return ulam__fail(err, s->status, 0, -1, "an exchange of walk results between processes (allgather failed)");
+    default: return ulam__fail(err, s->status, 0, -1, "walks that run to their end");
+    }
 }
 
 /* Restart a forward solver on a new right-hand side b (borrowed like the first) with a new

@@ -63,7 +63,7 @@ static int window(const ulam__walker *w, int32_t u, double *wt, ulam_rng *r, sta
     return 1;
 }
 
-/* Take the move to outcome o (read from *field) of a row with factor f: the weight gets the
+/* Take the move to outcome o (read from the alias slot s) of a row with factor f: the weight gets the
  * factor and the move's sign; returns the target row's unit. */
 static inline int32_t target(ulam_kernel *k, ulam__slot *s, uint64_t frac, int32_t o, double f, double *wt,
                              ulam__kscratch *ks)

@@ -44,7 +44,8 @@ CASES += [
     (["direct", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--max-mem", "1M"],
      code("EMEMLIMIT"), r"memory limit.*needs", ""),
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "5"], 2, r"--index 5 is out of range 1..4", ""),
-    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "0"], 2, r"--index expects an integer", ""),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "0"], 2,
+     r"--index expects an integer from 1 to \d+ \(1-based, as in Matrix Market files\), got '0'", ""),
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--max-mem", "lots"], 2, r"--max-mem expects a size", ""),
     (["direct", M + "chain4.mtx"], 2, r"needs --rhs", ""),
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--bogus"], 2, r"unrecognized option", ""),
@@ -62,6 +63,11 @@ CASES += [
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "4"], 0, r"^$", r"x\[4\]\s+3\.68174"),
 ]
 SOLVE = ["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx"]
+CASES += [  # counts written as whole numbers in exponent form are counts; fractions are not
+    (SOLVE + ["--index", "1", "--walks", "2e4"], 0, r"^$", r"walks\s+20000 "),
+    (SOLVE + ["--index", "1", "--walks", "1.5"], 2, r"--walks expects an integer from 1 to \d+, got '1\.5'", ""),
+    (SOLVE + ["--index", "1", "--walks", "1e30"], 2, r"--walks expects an integer", ""),
+]
 DIV = ["solve", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1"]
 RS = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1"]
 CASES += [

@@ -83,9 +83,16 @@ int cli_parse_int(const char *command, const char *opt, const char *s, int64_t l
     char *end;
     errno = 0;
     long long v = strtoll(s, &end, 10);
+    if (end != s && (*end == 'e' || *end == 'E' || *end == '.')) { /* 1e12, 2.5e6: whole numbers */
+        double d = strtod(s, &end);
+        int whole = !*end && d == floor(d) && fabs(d) <= 9007199254740992.0; /* 2^53: exact */
+        v = whole ? (long long)d : v, errno = whole ? 0 : ERANGE;
+    }
     if (end == s || *end || errno == ERANGE || v < lo || v > hi)
-        return cli_usage_error(command, "%s expects an integer from %lld to %lld, got '%s'", opt,
-                               (long long)lo, (long long)hi, s);
+        return cli_usage_error(command, "%s expects an integer from %lld to %lld%s, got '%s'", opt,
+                               (long long)lo, (long long)hi,
+                               lo == 1 && v == 0 && (strstr(opt, "index") || strstr(opt, "source") || strstr(opt, "patch"))
+                                   ? " (1-based, as in Matrix Market files)" : "", s);
     *out = v;
     return 0;
 }

@@ -394,7 +394,11 @@ static void row(FILE *f, int fmt, const ulam_scene *s, int64_t p, const patch_va
 /* --list: the patches after subdivision, as a table or a JSON array. */
 static void print_list(const args *a, const ulam_scene *s)
 {
-    if (a->json) printf("{\"scene\": \"%s\", \"patches\": [", a->scene);
+    if (a->json) {
+        printf("{");
+        cli_json_string("scene", a->scene, 0);
+        printf("\"patches\": [");
+    }
     else row_header(stdout, ROW_TEXT, NULL);
     for (int64_t p = 0; p < s->npatches; p++) {
         if (a->json && p) printf(", ");

@@ -502,12 +502,14 @@ static int charts(const study *st)
     for (int m = 0; m < NMETHOD; m++)
         if (st->m[m].on && !st->m[m].why[0]) strcat(strcat(names, st->m[m].name), " ");
     snprintf(script, sizeof script,
-             "set title 'ulam study: RMSE of x_%lld against seconds per run'\n"
+             "set title 'ulam study: RMSE of x_{%lld} against seconds per run'\n"
              "set logscale xy\nset format x '10^{%%L}'\nset format y '10^{%%L}'\nset xlabel 'seconds per run'\n"
              "set ylabel 'RMSE (reference lines: the error of one run)'\nset key outside right font ',8'\n"
              "set yrange [%g:*]\n"
              "set fit quiet\nset fit logfile '/dev/null'\nf(x) = a / sqrt(x)\na = 0\nfit f(x) 'summary.csv' u 8:4 via a\n"
-             "plot for [m in \"%s\"] 'summary.csv' u (strcol(1) eq m ? $8 : 1/0):4 w lp t m, "
+             "M = \"%s\"\n" /* one colour and dash per method: 8 colours, then the next dash pattern */
+             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) ? $8 : 1/0):4 w lp "
+             "linecolor i dashtype 1 + (i - 1) / 8 pointtype i title word(M, i), "
              "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 t 'Gauss-Seidel, whole vector', "
              "'' u (strcol(1) eq 'lapack' ? $2 : 1/0):3 w p pt 9 ps 2 t 'LAPACK dgesv (error vs refined)', "
              "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 2 pt 5 t 'sequential MC, every unknown (one run)', "
@@ -522,10 +524,10 @@ static int charts(const study *st)
     ulam_gnuplot(st->out, "work", 1000, 500,
                  "set title 'work-normalised variance RMSE^2 x seconds at the largest budget (lower wins)'\n"
                  "set style data histograms\nset style fill solid 0.6\nset logscale y\nset format y '10^{%L}'\n"
-                 "set xtics rotate by -40 font ',8'\nset key off\nplot 'bars.csv' u 2:xtic(1)\n");
+                 "set xtics rotate by -40 font ',8'\nset bmargin 7\nset key off\nplot 'bars.csv' u 2:xtic(1)\n");
     ulam_gnuplot(st->out, "coverage", 1000, 500,
                  "set title 'coverage of the 95% interval at the largest budget'\nset style data histograms\n"
-                 "set style fill solid 0.6\nset yrange [0:1]\nset xtics rotate by -40 font ',8'\nset key off\n"
+                 "set style fill solid 0.6\nset yrange [0:1]\nset xtics rotate by -40 font ',8'\nset bmargin 7\nset key off\n"
                  "plot 'bars.csv' u 3:xtic(1), 0.95 dt 2 lc 'black'\n");
     return 0;
 }

@@ -67,14 +67,6 @@ void ulam__scene_geometry(ulam_scene *s)
     }
 }
 
-/* Total emitted power per channel. */
-void ulam_scene_power(const ulam_scene *s, double power[3])
-{
-    power[0] = power[1] = power[2] = 0.0;
-    for (int64_t p = 0; p < s->npatches; p++)
-        for (int c = 0; c < 3; c++) power[c] += s->area[p] * s->emit[3 * p + c];
-}
-
 /* A patch being built by subdivision: its vertices are appended to the output scene. */
 typedef struct {
     ulam_scene *o;
