@@ -67,6 +67,13 @@ CASES += [  # counts written as whole numbers in exponent form are counts; fract
     (SOLVE + ["--index", "1", "--walks", "2e4"], 0, r"^$", r"walks\s+20000 "),
     (SOLVE + ["--index", "1", "--walks", "1.5"], 2, r"--walks expects an integer from 1 to \d+, got '1\.5'", ""),
     (SOLVE + ["--index", "1", "--walks", "1e30"], 2, r"--walks expects an integer", ""),
+    # output paths are checked before any work: 10^11 walks would not end within the test's timeout
+    (SOLVE + ["--index", "1", "--mode", "forward", "--walks", "1e11", "--out", "/nonexistent/dir/x.mtx"], 13,
+     r"/nonexistent/dir/x\.mtx: error: .*writable output file", r"^$"),
+    (SOLVE + ["--index", "1", "--mode", "forward", "--walks", "1e11", "--out", "x_ok.mtx", "--errors",
+              "/nonexistent/dir/e.mtx"], 13, r"/nonexistent/dir/e\.mtx: error: .*writable output file", r"^$"),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--out", "/nonexistent/dir/x.mtx"], 13,
+     r"/nonexistent/dir/x\.mtx: error: .*writable output file", r"^$"),
 ]
 DIV = ["solve", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1"]
 RS = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1"]

@@ -141,4 +141,8 @@ int cli_solve_method(int argc, char **argv);
 int cli_radiosity(int argc, char **argv);
 int cli_prepare(int argc, char **argv);
 
+/* Check before any work that path can be written (a temporary file beside it, not a directory);
+ * 0 or an exit code (reported). */
+int cli_check_output(const char *path);
+
 #endif

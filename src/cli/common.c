@@ -324,3 +324,17 @@ void cli_json_string(const char *key, const char *v, int last)
     }
     printf("\"%s", last ? "" : ", ");
 }
+
+/* Check before any work that path can be written (a temporary file can be made beside it and
+ * it is not a directory); 0 or an exit code (reported). */
+int cli_check_output(const char *path)
+{
+    struct stat st;
+    ulam_outfile o;
+    int status = stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? ULAM_EIO : ulam_outfile_open(&o, path);
+    if (!status) ulam_outfile_abort(&o);
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable output file (in an existing, writable directory; not a "
+                                               "directory)"};
+    return cli_report(path, &err);
+}

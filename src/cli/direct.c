@@ -85,6 +85,7 @@ int cli_direct(int argc, char **argv)
     if (optind != argc - 1) return cli_usage_error("direct", "expects exactly one matrix file");
     if (!s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("direct", "needs --rhs b.mtx");
     s.matrix_path = argv[optind];
+    if (out && (rc = cli_check_output(out))) return rc;
     if ((rc = cli_load_system(&s))) return rc;
     if (!s.b) {
         cli_system_free(&s);

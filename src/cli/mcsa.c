@@ -207,17 +207,6 @@ static void print_failure(const report *p)
                 p->s->matrix_path, ulam_strerror(p->status), p->nsteps);
 }
 
-/* Check before the work that out can be written (a temporary file beside it, removed). */
-static int check_output(const char *out)
-{
-    ulam_outfile f;
-    int status = ulam_outfile_open(&f, out);
-    if (!status) ulam_outfile_abort(&f);
-    if (!status) return 0;
-    ulam_error err = {.status = status, .msg = "a writable output file (its directory must exist)"};
-    return cli_report(out, &err);
-}
-
 /* Run the iteration, printing nothing; fills p (steps malloc'd); 0 or an exit code. */
 static int run(const cli_system *s, const ulam_outer_opts *o, report *p, ulam_outer_step **steps, double **x)
 {
@@ -360,7 +349,7 @@ int cli_solve_method(int argc, char **argv)
         return cli_usage_error("solve", "--method solves for every unknown: --index I needs --out x.mtx "
                                         "(the solution file) beside it");
     s.matrix_path = argv[optind];
-    if (out && (rc = check_output(out))) return rc;
+    if (out && (rc = cli_check_output(out))) return rc;
     if ((rc = cli_load_system(&s))) return rc;
     p.index = s.index;
     o.walk.share = cli_share, o.walk.interrupt = &cli_interrupted;

@@ -648,20 +648,6 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
     return 0;
 }
 
-/* Check before any work that path can be written (a temporary file can be made beside it and
- * it is not a directory); 0 or an exit code. */
-static int check_output(const char *path)
-{
-    struct stat st;
-    ulam_outfile o;
-    int status = stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? ULAM_EIO : ulam_outfile_open(&o, path);
-    if (!status) ulam_outfile_abort(&o);
-    if (!status) return 0;
-    ulam_error err = {.status = status, .msg = "a writable output file (in an existing, writable directory; not a "
-                                               "directory)"};
-    return cli_report(path, &err);
-}
-
 /* The scene, subdivided if asked; 0 or an exit code. */
 static int load_scene(const args *a, ulam_scene **out, int64_t *faces)
 {
@@ -763,8 +749,8 @@ int cli_radiosity(int argc, char **argv)
         fprintf(stderr, "ulam radiosity: warning: --mis none (light sampling alone) has infinite variance at a patch "
                         "that shares an edge with a light or nearly touches one: there the error bar can be far too "
                         "small (the edge-lamp scene: z = -4.6); the MIS default is bounded\n");
-    if (a.image && (rc = check_output(a.image))) return rc;
-    if (a.out && (rc = check_output(a.out))) return rc;
+    if (a.image && (rc = cli_check_output(a.image))) return rc;
+    if (a.out && (rc = cli_check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
     r.s = s;
     if (a.list) {

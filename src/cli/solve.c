@@ -355,6 +355,7 @@ int cli_solve(int argc, char **argv)
     if (!any_rule) o.max_walks = 100000;
     s.matrix_path = argv[optind];
     s.lazy = o.mode == ULAM_ADJOINT && !ro.check && !cli_share; /* read only the rows walks reach */
+    if ((out && (rc = cli_check_output(out))) || (errors && (rc = cli_check_output(errors)))) return rc;
     double t0 = ulam_now();
     if ((rc = cli_load_system(&s))) return rc;
     if (!s.b) {
