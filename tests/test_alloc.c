@@ -7,6 +7,9 @@
  * blocks are tracked in a hash set: memory that libc allocates itself (getline's buffer) and
  * the library frees is not counted. */
 #include "testutil.h"
+#ifdef ULAM_RADIOSITY
+#include "ulam_radiosity.h"
+#endif
 
 #include <execinfo.h>
 #include <pthread.h>
@@ -192,6 +195,7 @@ static int op_guard_direct(void)
     return s;
 }
 
+#ifdef ULAM_RADIOSITY
 /* The OBJ reader, subdivision, tracer, form factors and both patch walks. */
 static int op_radiosity(void)
 {
@@ -215,6 +219,7 @@ static int op_radiosity(void)
     ulam_scene_free(s), ulam_scene_free(s0);
     return st;
 }
+#endif
 
 /* Each operation survives the failure of each of its allocations. */
 static void test_countdown(void **state)
@@ -228,7 +233,10 @@ static void test_countdown(void **state)
                {op_walk_forward, "forward walks"},
                {op_guard_direct, "guards and direct solve"},
                {op_outer, "sequential MC, MCSA, GMRES"},
-               {op_radiosity, "OBJ reader, tracer, form factors, patch walks"}};
+#ifdef ULAM_RADIOSITY
+               {op_radiosity, "OBJ reader, tracer, form factors, patch walks"},
+#endif
+    };
     for (size_t k = 0; k < sizeof ops / sizeof *ops; k++) {
         long optional, n = countdown(ops[k].op, ops[k].name, &optional);
         print_message("%-48s %4ld allocations failed in turn: %ld ENOMEM, %ld optional\n", ops[k].name, n,

@@ -2,6 +2,7 @@
  * Howell's exact values, the furnace test, and every walk mode against LAPACK on the cube and
  * the Cornell box.  Fixed seeds; tolerances from the reported standard errors. */
 #include "testutil.h"
+#include "ulam_radiosity.h"
 
 #include <string.h>
 

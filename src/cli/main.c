@@ -35,7 +35,15 @@ static int dispatch(int argc, char **argv)
     if (!strcmp(argv[1], "direct")) return cli_direct(argc - 1, argv + 1);
     if (!strcmp(argv[1], "solve")) return cli_solve(argc - 1, argv + 1);
     if (!strcmp(argv[1], "study")) return cli_study(argc - 1, argv + 1);
+#ifdef ULAM_RADIOSITY
     if (!strcmp(argv[1], "radiosity")) return cli_radiosity(argc - 1, argv + 1);
+#else
+    if (!strcmp(argv[1], "radiosity")) {
+        fprintf(stderr, "ulam: radiosity: this ulam was built without the radiosity front end (meson "
+                        "-Dradiosity=enabled needs Embree 3 and libpng: libembree-dev, libpng-dev)\n");
+        return EXIT_USAGE;
+    }
+#endif
     if (!strcmp(argv[1], "prepare")) return cli_prepare(argc - 1, argv + 1);
     fprintf(stderr, "ulam: unknown command '%s'\n%s", argv[1], usage);
     return EXIT_USAGE;

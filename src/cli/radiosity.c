@@ -1,6 +1,7 @@
 /* ulam radiosity: a patch scene's radiosity by walks that sample F by ray casting, checked
  * against the LAPACK solve of the assembled system. */
 #include "cli.h"
+#include "ulam_radiosity.h"
 
 #include <getopt.h>
 #include <math.h>

@@ -3,6 +3,7 @@
 #define ULAM_RAD_H
 
 #include "../internal.h"
+#include "ulam_radiosity.h"
 
 #include <math.h>
 

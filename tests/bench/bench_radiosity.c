@@ -15,7 +15,7 @@
  *    projected to the particles that bring every seen patch to 1%: P (worst rel. error / 1%)^2)
  *    and against the direct route (what it would need).
  * Usage: bench_radiosity [scene.obj [WxH [P]]] (run from the source root). */
-#include "ulam.h"
+#include "ulam_radiosity.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,7 +1,7 @@
 /* libFuzzer target: the OBJ/MTL reader.  The input is an OBJ file, optionally followed by a
  * line "%%MTL" and the MTL file that "mtllib f.mtl" names; both are written to a private
  * temporary folder and read back.  A scene that parses is also subdivided. */
-#include "ulam.h"
+#include "ulam_radiosity.h"
 
 #include <math.h>
 #include <stdio.h>

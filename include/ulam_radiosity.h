@@ -1,0 +1,266 @@
+/* ulam_radiosity.h: the radiosity front end of ulam, B = E + diag(rho) F B for a scene of
+ * diffuse patches: OBJ + MTL scenes, Embree 3 ray casting, form factors, the LAPACK solve,
+ * patch walks that sample F by rays (gathering, shooting, next-event), view gathering and PNG
+ * images.  Built with meson's 'radiosity' feature (Embree 3 and libpng); the conventions of
+ * ulam.h apply (status codes, ulam_error, const inputs, _free accepts NULL). */
+#ifndef ULAM_RADIOSITY_H
+#define ULAM_RADIOSITY_H
+
+#include "ulam.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- radiosity */
+
+/* A scene of planar convex patches with diffuse RGB reflectance and emission: the radiosity
+ * equation B = E + diag(rho) F B per colour channel.  Plain data; arrays of 3 hold RGB or
+ * xyz per patch, patch p's polygon is vidx[start[p] .. start[p+1]) (counter-clockwise seen
+ * from the side its normal points to, the side that emits and reflects). */
+typedef struct ulam_scene {
+    int64_t npatches, nverts;
+    double *vert;    /* 3 * nverts coordinates */
+    int64_t *start;  /* npatches + 1 */
+    int32_t *vidx;   /* start[npatches] vertex indices */
+    double *normal;  /* 3 * npatches unit normals */
+    double *area;    /* npatches */
+    double *rho;     /* 3 * npatches reflectances in [0, 1) */
+    double *emit;    /* 3 * npatches emissions (radiosity units) */
+    int64_t *face;   /* npatches: the face of the OBJ file a patch came from (0-based) */
+    int64_t nfaces;
+    int32_t *group;  /* npatches: index into groups (the o / g name in force), -1 for none */
+    int64_t ngroups;
+    char **groups;
+} ulam_scene;
+
+/* Read a Wavefront OBJ file (v; f with 3 or more vertices, v, v/t, v/t/n or v//n, negative
+ * indices relative; o, g; usemtl; mtllib, relative to the OBJ's folder) and its MTL files
+ * (newmtl; Kd = reflectance in [0, 1), Ke = emission >= 0).  One patch per face.  Errors
+ * carry the line, and err->file names the MTL file when the error is in one. */
+int ulam_scene_read_obj(const char *path, ulam_scene **out, ulam_error *err);
+
+/* Split every patch into patches no longer than max_side on a side (quads into a grid,
+ * triangles into m^2 similar triangles, larger polygons through a fan); face and group
+ * are kept. */
+int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out);
+
+/* Free a scene; accepts and returns NULL. */
+ulam_scene *ulam_scene_free(ulam_scene *s);
+
+/* The patch a label names: the patch of group label that contains the group's area centroid
+ * (the lowest-numbered one when the centroid is on a shared edge); when none contains it (a
+ * label that is not flat, like a block, whose centroid is inside it), the patch of that label
+ * whose area centroid is nearest.  Does not depend on the subdivision but through the patch
+ * sizes.  ULAM_ENOTFOUND when no patch has that label. */
+int ulam_scene_find(const ulam_scene *s, const char *label, int64_t *patch);
+
+/* The area centroid of patch p. */
+void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3]);
+
+/* The area centroid of the patches labelled label; ULAM_ENOTFOUND when there are none. */
+int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3]);
+
+/* A ray caster over a scene (Embree 3): opaque. */
+typedef struct ulam_tracer ulam_tracer;
+
+/* Build the ray-casting structure for s (which must outlive it). */
+int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err);
+
+/* Free a tracer; accepts and returns NULL. */
+ulam_tracer *ulam_tracer_free(ulam_tracer *t);
+
+/* How finely ray casting resolves the scene: Embree works in float (relative to the scene's
+ * centre), so a patch far from the centre and small is resolved only to the float step there;
+ * the largest (float step at the patch) / sqrt(its area) over the patches, that patch in
+ * *patch (may be NULL).  Above 10^-3 the geometry that rays see is off by more than 0.1% of a
+ * patch. */
+double ulam_tracer_resolution(const ulam_tracer *t, int64_t *patch);
+
+/* The patch the ray org + t dir (t > 0, dir unit) first hits, or -1 when it leaves the
+ * scene; *front (may be NULL) is 1 when it hits the patch's front side. */
+int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3],
+                         int *front);
+
+/* A cosine-distributed ray leaving a uniform point of patch p: the patch it reaches
+ * (front side) is j with probability exactly F_pj; -1 when it leaves the scene or hits a
+ * back side (the light is lost).  Draws from r. */
+int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
+
+/* Form factors F_ij estimated by casting `rays` cosine-distributed rays from uniform points of
+ * each patch i (the share that reaches j); stream (seed, i) for patch i, so F does not
+ * depend on the number of threads (0: all cores). */
+int ulam_form_factors(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads,
+                      ulam_csr **F, ulam_error *err);
+
+/* How well an estimated F obeys the laws of form factors. */
+typedef struct ulam_ff_report {
+    double reciprocity; /* sum |A_i F_ij - A_j F_ji| / sum A_i F_ij over pairs i < j, j < i */
+    double rowsum_min, rowsum_max, rowsum_mean; /* 1 in a closed scene */
+    int64_t nnz;
+} ulam_ff_report;
+
+/* Fill *r for F on s. */
+int ulam_form_factor_report(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r);
+
+/* Exact form factor between directly opposed parallel a x b rectangles at distance c
+ * (Howell's catalogue, C-11). */
+double ulam_ff_parallel_rectangles(double a, double b, double c);
+
+/* Exact form factor from a w x l rectangle to an h x l rectangle perpendicular to it that
+ * shares its edge of length l (Howell's catalogue, C-14). */
+double ulam_ff_perpendicular_rectangles(double w, double h, double l);
+
+/* The radiosity system of channel c: M = diag(rho_c) F (new *M) and b = E_c (npatches). */
+int ulam_radiosity_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
+                          double *b);
+
+/* Solve the three channels' systems with LAPACKE_dgesv into B (3 * npatches, RGB per patch);
+ * refuses with ULAM_EMEMLIMIT like ulam_direct_solve.  info (may be NULL) sums the three. */
+int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
+                          ulam_direct_info *info, ulam_error *err);
+
+/* The standard error of the direct solution B (from ulam_radiosity_direct on an F estimated
+ * with `rays` rays a patch) at patch p, per channel: the first-order propagation of the
+ * multinomial noise of each row of F, se^2 = sum_k (G_pk rho_k)^2 v_k / rays with
+ * G = (I - M)^-1 (one transposed LAPACK solve a channel) and v_k = sum_j F_kj B_j^2 -
+ * (sum_j F_kj B_j)^2. */
+int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                                int64_t p, size_t max_bytes, double se[3], ulam_error *err);
+
+/* The same at every patch (se: 3 * npatches): G = (I - M)^-1 whole by one LAPACKE_dgesv with
+ * npatches right-hand sides a channel, so two dense matrices (ULAM_EMEMLIMIT past max_bytes). */
+int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                                 size_t max_bytes, double *se, ulam_error *err);
+
+/* Gathering's next-event estimators (opts->estimator of ulam_rad_solver_alloc, gathering only).
+ * At every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in
+ * proportion to its power A_l sum_c E_lc, y uniform on it) and a uniform point x on p; one
+ * shadow ray scores W rho_p E_l cos cos_l A_l / (pi r^2 P_l) (P_l: l's share of the power)
+ * when y is visible from x and both face each other.  The walk's own cosine rays that reach an
+ * emitter are combined with it by multiple importance sampling (Veach's power heuristic,
+ * exponent 2, or the balance heuristic), or not counted at all (light sampling alone, which
+ * has infinite variance at a patch that shares an edge with a light). */
+enum ulam_rad_estimator {
+    ULAM_NEXT_EVENT = 3,         /* light sampling + the walk's hits, power heuristic (default) */
+    ULAM_NEXT_EVENT_BALANCE = 4, /* the same, balance heuristic */
+    ULAM_NEXT_EVENT_LIGHT = 5    /* light sampling alone */
+};
+
+/* What a patch walk run has found: RGB radiosity of the patch opts->index. */
+typedef struct ulam_rad_result {
+    double radiosity[3];
+    double std_error[3];
+    int64_t walks;    /* histories (gathering walks or shot particles) */
+    int64_t rays;     /* rays cast */
+    int64_t cut;      /* walks cut at max_steps */
+    double max_share; /* the largest single score^2 / sum of scores^2 (channel sum) */
+    double seconds;
+    int threads, interrupted;
+    int zero; /* rel_err could never be met: every channel exactly 0 with zero variance after
+               * the first round (no walk scored); the run stopped there */
+    double min_walks;          /* gathering with rel_err: the walks the rule's range term needs at
+                                  this estimate (largest over channels; 0 when unbounded) */
+    double variance_rel_error; /* gathering with rel_err: the largest relative standard error of
+                                  a channel's variance (fourth moment); the rule wants <= 0.25 */
+    int rel_err_met;           /* the run stopped because the rel_err rule holds */
+} ulam_rad_result;
+
+/* An opaque patch-walk solver: walks that sample F by ray casting, never forming it. */
+typedef struct ulam_rad_solver ulam_rad_solver;
+
+/* Prepare walks on scene t (the tracer's): opts->mode ULAM_ADJOINT gathers at patch
+ * opts->index (continuation max_c rho_c of the patch, weights rho_c / q), ULAM_FORWARD
+ * shoots particles from the emitters in proportion to power and tallies every patch;
+ * estimator ULAM_COLLISION or ULAM_ABSORPTION, or for gathering one of ulam_rad_estimator
+ * (rays then counts the shadow rays too); the stopping rules, seed, threads and
+ * interrupt of ulam_walk_opts (continue_q, roulette and split must be 0). */
+int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
+                          ulam_error *err);
+
+/* Run one round of walks; ULAM_OK or ULAM_ENONFINITE. */
+int ulam_rad_solver_iterate(ulam_rad_solver *s);
+
+/* Nonzero once a stopping rule is met (rel_err: every nonzero channel; or every channel is
+ * exactly 0 with zero variance, when the result's zero is set). */
+int ulam_rad_solver_done(const ulam_rad_solver *s);
+
+/* The result so far. */
+void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r);
+
+/* Shooting: every patch's RGB radiosity and standard error (3 * npatches each; either may be
+ * NULL).  Gathering: ULAM_EINVAL. */
+int ulam_rad_solver_vectors(const ulam_rad_solver *s, double *B, double *std_error);
+
+/* Free; accepts and returns NULL. */
+ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s);
+
+/* A pinhole camera. */
+typedef struct ulam_camera {
+    double eye[3], dir[3], up[3];
+    double focal, film; /* focal length and film width, same unit (mm) */
+} ulam_camera;
+
+/* The Cornell box camera: eye (278, 273, -800), looking along +z, 35 mm lens, 25 mm film. */
+ulam_camera ulam_camera_cornell(void);
+
+/* A camera framing the scene's bounding box for a width x height picture: looking along +z at
+ * its centre from the -z side, up +y, the Cornell lens, as near as lets the box's near face
+ * fill the picture (3% margin).  On the Cornell box: eye (278, 274.4, -802). */
+ulam_camera ulam_camera_frame(const ulam_scene *s, int width, int height);
+
+/* What a render saw. */
+typedef struct ulam_render_info {
+    double exposure;        /* the exposure used */
+    int exposure_set;       /* given, or set from the pixels (0: nothing lit in view, 1 used) */
+    int64_t pixels_hit;     /* pixels that see a patch's front */
+    int64_t pixels_emitter; /* of them, pixels that see an emitter (0: no emitter in view) */
+} ulam_render_info;
+
+/* Render B (3 * npatches) as width x height 8-bit sRGB (3 bytes a pixel, rows top first):
+ * one ray per pixel centre, the radiosity of the first patch whose front it meets (back sides
+ * are seen through, so a camera outside a closed room sees in) times exposure, clamped,
+ * sRGB-encoded (flat shading).  exposure <= 0 picks 1 / (the 99th percentile of the largest
+ * channel over the pixels of patches that do not emit; over all pixels when those are all
+ * black or absent); *info (may be NULL) says what was used
+ * and seen.  ULAM_ENONFINITE if any of B is not finite, ULAM_EOVERFLOW if the image cannot be
+ * sized. */
+int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width,
+                int height, double exposure, unsigned char *rgb, ulam_render_info *info);
+
+/* How many pixel centres of a width x height picture see each patch's front (pixels:
+ * npatches), with the rays of ulam_render. */
+int ulam_view_pixels(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t *pixels);
+
+/* What a view gather did. */
+typedef struct ulam_view_info {
+    int64_t npatches, seen; /* patches in the scene, and those some pixel sees */
+    int64_t pixels_hit;     /* pixels that see a patch */
+    int64_t camera_rays;    /* width * height */
+    int64_t walks, rays;    /* gathering walks and their rays (shadow rays included) */
+    int64_t unmet;          /* seen patches that stopped short of their target (budget, time) */
+    int64_t cut;            /* walks cut at max_steps */
+    double seconds;         /* all of it, camera rays included */
+    int threads, interrupted;
+} ulam_view_info;
+
+/* Images that solve only what is seen: cast the camera's primary rays (ulam_view_pixels), then
+ * gather every patch some pixel sees, and no other, each with its own solver run (opts: the
+ * gathering estimator, seed, threads, max_walks a patch, max_steps, interrupt; max_seconds
+ * for the whole) to relative error opts->rel_err (n_max / n_p)^coverage on every nonzero
+ * channel, n_p its pixels and n_max the most any patch has: coverage 0 holds every seen
+ * patch to rel_err; 0.25 minimises the walks for a given pixel-summed squared error
+ * (sum_p n_p se_p^2 at cost sum_p 1 / se_p^2: se_p ~ n_p^-1/4).  Patch p's walks use the seed
+ * drawn from stream (opts->seed, p), so the result does not depend on threads.  B and se
+ * (3 * npatches) get the seen patches' answers; unseen patches get B 0 and se NaN. */
+int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, int height, double coverage,
+                     const ulam_walk_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err);
+
+/* Write an 8-bit RGB image as PNG (libpng), atomically. */
+int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* ULAM_RADIOSITY_H */
