@@ -145,4 +145,13 @@ int cli_prepare(int argc, char **argv);
  * 0 or an exit code (reported). */
 int cli_check_output(const char *path);
 
+/* A progress line on stderr for a terminal (nothing on a pipe, with --json, or off rank 0). */
+typedef struct cli_progress {
+    int on, shown;
+    double t0, last;
+} cli_progress;
+void cli_progress_start(cli_progress *p, int json);
+void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double se, double rel_err);
+void cli_progress_end(cli_progress *p);
+
 #endif

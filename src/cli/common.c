@@ -338,3 +338,31 @@ int cli_check_output(const char *path)
                                                "directory)"};
     return cli_report(path, &err);
 }
+
+/* Start a progress line: only on a terminal, never with --json, only on rank 0. */
+void cli_progress_start(cli_progress *p, int json)
+{
+    p->on = !json && cli_rank == 0 && isatty(2);
+    p->t0 = p->last = ulam_now();
+    p->shown = 0;
+}
+
+/* Show walks, the estimate +- its standard error, the time elapsed and, with a relative-error
+ * target, the time left at this rate (the error falls as 1 / sqrt(walks)); at most 4 a second. */
+void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double se, double rel_err)
+{
+    double now = ulam_now(), el = now - p->t0;
+    if (!p->on || now - p->last < 0.25) return;
+    p->last = now, p->shown = 1;
+    fprintf(stderr, "\rulam: %lld walks, %.6g +- %.2g, %.1f s", (long long)walks, estimate, se, el);
+    double want = rel_err * fabs(estimate);
+    if (rel_err > 0 && want > 0 && se > want) fprintf(stderr, ", about %.0f s left", el * ((se / want) * (se / want) - 1));
+    fputs("      ", stderr);
+}
+
+/* End the progress line (a newline if anything was shown). */
+void cli_progress_end(cli_progress *p)
+{
+    if (p->on && p->shown) fputc('\n', stderr);
+    p->shown = 0;
+}

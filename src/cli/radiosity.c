@@ -261,10 +261,16 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     int status = ulam_rad_solver_alloc(t, &a->o, &sv, &err);
     if (status) return cli_report(a->scene, &err);
     cli_catch_sigint();
+    cli_progress pg;
+    cli_progress_start(&pg, a->json);
     for (int round = 0; !status && !ulam_rad_solver_done(sv); round++) {
         status = ulam_rad_solver_iterate(sv);
         if (round == 0) rel_err_warning(a, sv);
+        ulam_rad_result pr;
+        ulam_rad_solver_result(sv, &pr);
+        cli_progress_show(&pg, pr.walks, pr.radiosity[0], pr.std_error[0], a->o.rel_err); /* the red channel */
     }
+    cli_progress_end(&pg);
     cli_release_sigint();
     ulam_rad_result r;
     ulam_rad_solver_result(sv, &r);

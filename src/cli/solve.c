@@ -37,7 +37,8 @@ static const char *const usage =
     "                     is not certified finite, unless --walks or --time bounds the run\n"
     "  --time S           stop after S seconds; the first rule reached wins\n"
     "  --seed S           block q of walks uses stream (S, q): identical results for any --threads\n"
-    "  --threads T        threads (default: all cores)\n"
+    "  --threads T        threads (default: all cores)\n";
+static const char *const usage2 = /* the help in two strings: C99 promises 4095 characters a literal */
     "  --continue Q       continue with probability Q in every state (default: analog,\n"
     "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased\n"
     "  --roulette W       Russian roulette below weight W (survive with |w|/W, weight W)\n"
@@ -341,7 +342,7 @@ int cli_solve(int argc, char **argv)
         case 'A': ro.assume_finite = 1; break;
         case 'o': out = optarg; break;
         case 'E': errors = optarg; break;
-        case 'h': fputs(usage, stdout); return 0;
+        case 'h': fputs(usage, stdout), fputs(usage2, stdout); return 0;
         default: return cli_usage_error("solve", "unknown option");
         }
     }
@@ -408,11 +409,15 @@ int cli_solve(int argc, char **argv)
     }
     cli_catch_sigint();
     ulam_walk_result r;
+    cli_progress pg;
+    cli_progress_start(&pg, ro.json);
     for (int first = 1; !status && !ulam_solver_done(sv); first = 0) {
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, &r);
         if (first && !status) rel_err_warning(&s, &o, &r);
+        cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o.rel_err);
     }
+    cli_progress_end(&pg);
     ulam_solver_result(sv, &r);
     rc = 0;
     if (status == ULAM_ENOMEM) {
