@@ -5,8 +5,6 @@
 #include <stdio.h>
 #include <string.h>
 
-static const char *const mode_names[] = {"adjoint", "forward"};
-static const char *const est_names[] = {"collision", "absorption", "expected"};
 
 /* Nonzero when argv names option opt (as "--opt" or "--opt=..."). */
 static int has_option(int argc, char **argv, const char *opt)
@@ -35,7 +33,7 @@ int cli_auto_choose(const cli_system *s, int argc, char **argv, ulam_walk_opts *
     if (res->chosen < 0) {
         fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance; the closest is "
                         "%s %s (continuation %s%.3g) with rho(M^) = %.6g (upper bound %.6g)%s\n",
-                s->matrix_path, o->rel_err > 0 ? "error" : "warning", mode_names[c->mode], est_names[c->estimator],
+                s->matrix_path, o->rel_err > 0 ? "error" : "warning", cli_mode_names[c->mode], cli_estimator_names[c->estimator],
                 c->continue_q > 0 ? "" : "analog, ", c->continue_q > 0 ? c->continue_q : 0.0, c->hat.rho, c->hat.upper,
                 o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it");
         if (o->rel_err > 0) return EXIT_DIVERGE;
@@ -59,7 +57,7 @@ void cli_auto_print_text(const ulam_auto_result *res)
            res->ncand, res->seconds);
     for (int k = 0; k < res->ncand; k++) {
         const ulam_auto_candidate *c = &res->cand[k];
-        printf("  %c %-8s %-10s ", k == res->chosen ? '*' : ' ', mode_names[c->mode], est_names[c->estimator]);
+        printf("  %c %-8s %-10s ", k == res->chosen ? '*' : ' ', cli_mode_names[c->mode], cli_estimator_names[c->estimator]);
         print_q(c->continue_q);
         printf(" rho(M^) %-9.4g ", c->hat.rho);
         if (!c->certified) printf("not certified finite (upper bound %.4g)\n", c->hat.upper);
@@ -78,8 +76,8 @@ void cli_auto_print_json(const ulam_auto_result *res)
     for (int k = 0; k < res->ncand; k++) {
         const ulam_auto_candidate *c = &res->cand[k];
         printf("%s{", k ? ", " : "");
-        cli_json_string("mode", mode_names[c->mode], 0);
-        cli_json_string("estimator", est_names[c->estimator], 0);
+        cli_json_string("mode", cli_mode_names[c->mode], 0);
+        cli_json_string("estimator", cli_estimator_names[c->estimator], 0);
         cli_json_number("continue", c->continue_q > 0 ? c->continue_q : NAN, 0);
         cli_json_number("rho_hat", c->hat.rho, 0);
         cli_json_number("rho_hat_upper", c->hat.upper, 0);

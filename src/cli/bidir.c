@@ -151,7 +151,7 @@ static int prepare(cli_system *s, int64_t source, int force, double continue_q, 
     rp->guard_seconds = rp->g.abs.seconds + rp->g.hat[0].seconds + rp->g.hat[1].seconds;
     if (rp->check) {
         double *x;
-        if ((rc = cli_direct_solve(s, (size_t)4 << 30, &x, NULL))) return rc;
+        if ((rc = cli_direct_solve(s, CLI_MAX_MEM, &x, NULL))) return rc;
         rp->direct = x[s->index - 1];
         free(x);
     }
@@ -199,8 +199,7 @@ int cli_bidir(int argc, char **argv)
         {"check", no_argument, 0, 'c'},           {"json", no_argument, 0, 'J'},
         {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
         {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
-    static const char *const est_names[] = {"collision", "absorption", "expected"};
-    cli_system s = {.command = "solve", .omega = 1.0};
+        cli_system s = {.command = "solve", .omega = 1.0};
     ulam_bidir_opts o = ulam_bidir_defaults();
     report rp = {0};
     int64_t v, source = 0;
@@ -219,7 +218,7 @@ int cli_bidir(int argc, char **argv)
         case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &o.rmax))) return rc; break;
         case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &o.min_value))) return rc; break;
         case 'e':
-            if ((o.walk.estimator = cli_lookup(optarg, est_names, 3)) < 0)
+            if ((o.walk.estimator = cli_lookup(optarg, cli_estimator_names, 3)) < 0)
                 return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
             break;
         case 'n': if ((rc = cli_parse_int("solve", "--walks", optarg, 1, INT64_MAX / 2, &o.walk.max_walks))) return rc; any_rule = 1; break;

@@ -154,4 +154,11 @@ void cli_progress_start(cli_progress *p, int json);
 void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double se, double rel_err);
 void cli_progress_end(cli_progress *p);
 
+/* The walk modes and estimators by name, indexed by enum ulam_mode and enum ulam_estimator. */
+extern const char *const cli_mode_names[2];
+extern const char *const cli_estimator_names[3];
+
+/* The memory a dense reference solve may take unless --max-mem says otherwise: 4 GiB. */
+#define CLI_MAX_MEM ((size_t)4 << 30)
+
 #endif

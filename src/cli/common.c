@@ -11,6 +11,9 @@
 #include <unistd.h>
 #include <sys/stat.h>
 
+const char *const cli_mode_names[2] = {"adjoint", "forward"};
+const char *const cli_estimator_names[3] = {"collision", "absorption", "expected"};
+
 volatile int cli_interrupted;
 const ulam_share *cli_share;
 int cli_rank;

@@ -66,7 +66,7 @@ int cli_direct(int argc, char **argv)
         {0, 0, 0, 0}};
     cli_system s = {.command = "direct", .omega = 1.0};
     const char *out = NULL;
-    size_t max_mem = (size_t)4 << 30;
+    size_t max_mem = CLI_MAX_MEM;
     int json = 0, c, rc;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {

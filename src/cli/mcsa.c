@@ -44,7 +44,6 @@ static const char *const usage =
 
 static const char *const method_names[] = {"richardson", "gauss-seidel", "sequential", "mcsa", "cg", "gmres"};
 enum { KRYLOV_CG = 4, KRYLOV_GMRES = 5 }; /* the Krylov peers: not outer iterations */
-static const char *const est_names[] = {"collision", "absorption", "expected"};
 
 /* Nonzero when argv (after the subcommand) asks for an outer iteration. */
 int cli_solve_wants_method(int argc, char **argv)
@@ -115,7 +114,7 @@ static void print_text(const report *p)
     double walk_s;
     totals(p, &hist, &walk_s);
     printf("method          %s%s%s, tol %g%s\n", method_names[p->method], walks ? ", " : "",
-           walks ? est_names[p->o->walk.estimator] : "", p->o->tol, walks ? "" : " (no walks)");
+           walks ? cli_estimator_names[p->o->walk.estimator] : "", p->o->tol, walks ? "" : " (no walks)");
     if (p->method == KRYLOV_GMRES) printf("restart         %d\n", p->restart);
     printf("outcome         %s after %d iterations%s, residual %.4e\n", outcome(p), p->iterations,
            p->method >= KRYLOV_CG ? " (matrix-vector products)" : "", p->residual);
@@ -140,7 +139,7 @@ static void print_json(const report *p)
     totals(p, &hist, &walk_s);
     printf("{");
     cli_json_string("method", method_names[p->method], 0);
-    if (walking(p->method)) cli_json_string("estimator", est_names[p->o->walk.estimator], 0);
+    if (walking(p->method)) cli_json_string("estimator", cli_estimator_names[p->o->walk.estimator], 0);
     cli_json_string("outcome", outcome(p), 0);
     printf("\"converged\": %s, \"iterations\": %d, ", p->converged ? "true" : "false", p->iterations);
     if (p->method == KRYLOV_GMRES) printf("\"restart\": %d, ", p->restart);
@@ -180,7 +179,7 @@ static int direct_error(const cli_system *s, const double *x, report *p)
 {
     double *xd, num = 0, den = 0;
     ulam_direct_info info;
-    int rc = cli_direct_solve(s, (size_t)4 << 30, &xd, &info);
+    int rc = cli_direct_solve(s, CLI_MAX_MEM, &xd, &info);
     if (rc) return rc;
     for (int64_t i = 0; i < s->M->nrows; i++) num += (x[i] - xd[i]) * (x[i] - xd[i]), den += xd[i] * xd[i];
     p->err_direct = den > 0 ? sqrt(num / den) : sqrt(num);
@@ -324,7 +323,7 @@ int cli_solve_method(int argc, char **argv)
         case 'H': if ((rc = cli_parse_int("solve", "--max-histories", optarg, 1, INT64_MAX / 2, &o.max_histories))) return rc; break;
         case 'a': if ((rc = cli_parse_int("solve", "--stall", optarg, 1, 1000000, &v))) return rc; o.stall = (int)v; break;
         case 'e':
-            if ((o.walk.estimator = cli_lookup(optarg, est_names, 3)) < 0)
+            if ((o.walk.estimator = cli_lookup(optarg, cli_estimator_names, 3)) < 0)
                 return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
             break;
         case 's': if ((rc = cli_parse_int("solve", "--seed", optarg, 0, INT64_MAX, &v))) return rc; o.walk.seed = (uint64_t)v; break;

@@ -743,7 +743,7 @@ static patch_values every_patch(const args *a, const report *r, const walked *w,
 /* ulam radiosity. */
 int cli_radiosity(int argc, char **argv)
 {
-    args a = {.est = -1, .mis = -1, .coverage = 0.25, .ff_rays = 1000, .width = 512, .height = 512, .max_mem = (size_t)4 << 30, .o = ulam_walk_defaults()};
+    args a = {.est = -1, .mis = -1, .coverage = 0.25, .ff_rays = 1000, .width = 512, .height = 512, .max_mem = CLI_MAX_MEM, .o = ulam_walk_defaults()};
     a.o.max_walks = 0;
     a.o.interrupt = &cli_interrupted, a.o.share = cli_share;
     int rc = parse(argc, argv, &a);

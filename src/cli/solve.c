@@ -73,8 +73,6 @@ static const char *const usage2 = /* the help in two strings: C99 promises 4095 
     "Every unknown to a residual tolerance (MCSA, sequential MC, Krylov): see\n"
     "'ulam solve --method mcsa --help'.\n";
 
-static const char *const mode_names[] = {"adjoint", "forward"};
-static const char *const est_names[] = {"collision", "absorption", "expected"};
 
 typedef struct {
     int check, json;
@@ -111,7 +109,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
                "means nothing)%s\n", (long long)o->index + 1, o->index < 9 ? 10 : 9, "", r->estimate,
                r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
                r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
-    printf("method          %s walks, %s estimator\n", mode_names[o->mode], est_names[o->estimator]);
+    printf("method          %s walks, %s estimator\n", cli_mode_names[o->mode], cli_estimator_names[o->estimator]);
     printf("walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
            (long long)o->max_steps, r->cut ? ": the estimate is biased by the cut" : "");
     printf("steps           %lld (mean walk length %.4g; kernel rows built %lld)\n", (long long)r->steps, mean_len,
@@ -187,8 +185,8 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     cli_json_number("seconds", r->seconds, 0);
     cli_json_number("steps_per_second", r->seconds > 0 ? (double)r->steps / r->seconds : 0.0, 0);
     cli_json_number("figure_of_merit", r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : NAN, 0);
-    cli_json_string("mode", mode_names[o->mode], 0);
-    cli_json_string("estimator", est_names[o->estimator], 0);
+    cli_json_string("mode", cli_mode_names[o->mode], 0);
+    cli_json_string("estimator", cli_estimator_names[o->estimator], 0);
     printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)ro->seed, r->threads,
            cli_share ? cli_share->nranks : 1);
     cli_json_number("load_seconds", ro->load_seconds, 0);
@@ -210,7 +208,7 @@ static int direct_check(const cli_system *s, int64_t index, report_opts *ro)
 {
     double *x;
     ulam_direct_info info;
-    int rc = cli_direct_solve(s, (size_t)4 << 30, &x, &info);
+    int rc = cli_direct_solve(s, CLI_MAX_MEM, &x, &info);
     if (rc) return rc;
     ro->direct = x[index];
     ro->direct_seconds = info.seconds;
@@ -311,11 +309,11 @@ int cli_solve(int argc, char **argv)
         case 'b': s.rhs_path = optarg; break;
         case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
         case 'm':
-            if ((o.mode = cli_lookup(optarg, mode_names, 2)) < 0)
+            if ((o.mode = cli_lookup(optarg, cli_mode_names, 2)) < 0)
                 return cli_usage_error("solve", "--mode expects adjoint or forward, got '%s'", optarg);
             break;
         case 'e':
-            if ((o.estimator = cli_lookup(optarg, est_names, 3)) < 0)
+            if ((o.estimator = cli_lookup(optarg, cli_estimator_names, 3)) < 0)
                 return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
             break;
         case 'n': if ((rc = cli_parse_int("solve", "--walks", optarg, 1, INT64_MAX / 2, &o.max_walks))) return rc; any_rule = 1; break;

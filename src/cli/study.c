@@ -46,8 +46,6 @@ static const char *const usage =
     "every finished row and writes the summary (exit 130); a second Ctrl-C exits at once.\n";
 
 enum { NMETHOD = 18, MAXBUDGET = 16, MAXREPEAT = 4096 };
-static const char *const mode_names[] = {"adjoint", "forward"};
-static const char *const est_names[] = {"collision", "absorption", "expected"};
 static const char *const window_names[] = {"plain", "roulette", "split"};
 
 typedef struct {
@@ -85,7 +83,7 @@ static void methods_init(method *m)
 {
     for (int k = 0; k < NMETHOD; k++) {
         m[k] = (method){.mode = k / 9, .est = k / 3 % 3, .window = k % 3, .on = 1};
-        snprintf(m[k].name, sizeof m[k].name, "%s-%s-%s", mode_names[m[k].mode], est_names[m[k].est],
+        snprintf(m[k].name, sizeof m[k].name, "%s-%s-%s", cli_mode_names[m[k].mode], cli_estimator_names[m[k].est],
                  window_names[m[k].window]);
     }
 }
