@@ -815,6 +815,12 @@ int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *b
 /* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
 void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
 
+/* The reference of a study: Gauss-Seidel sweeps on x (in place, from what it holds) until, after
+ * at least min_sweeps, one sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps
+ * are made; returns the sweeps made. */
+int ulam_gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
+                             int min_sweeps, int max_sweeps);
+
 /* What R runs of one method at one budget say, against the exact value. */
 typedef struct ulam_cell {
     int runs;

@@ -108,29 +108,6 @@ static int push(ulam_push *w, const ulam_bidir_opts *o, double visits, int64_t c
     }
 }
 
-/* 1 when every walk from s on Mt must score the same value, so a zero sample variance is exact:
- * no state with r != 0 is reachable from s in one step or more, and r_s = 0 or s has no moves
- * (every estimator then scores 0, or r_s at s alone); 0 when some walk could score differently;
- * -1 out of memory.  A search over the states reachable from s. */
-static int deterministic(const ulam_csr *Mt, const double *r, int64_t s)
-{
-    int64_t n = Mt->nrows, head = 0, len = 0;
-    unsigned char *seen = ulam__calloc((size_t)n, 1);
-    int32_t *queue = ulam__malloc((size_t)n, sizeof *queue);
-    int found = !seen || !queue ? -1 : r[s] != 0 && Mt->rowptr[s + 1] > Mt->rowptr[s];
-    if (found == 0) queue[len++] = (int32_t)s;
-    while (found == 0 && head < len) {
-        int64_t i = queue[head++];
-        for (int64_t k = Mt->rowptr[i]; k < Mt->rowptr[i + 1] && !found; k++) {
-            int64_t j = Mt->colidx[k];
-            if (r[j] != 0) found = 1;
-            if (!seen[j]) seen[j] = 1, queue[len++] = (int32_t)j;
-        }
-    }
-    free(seen), free(queue);
-    return found < 0 ? -1 : !found;
-}
-
 /* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr.  The solver's
  * rel_err rule (the one of ulam_solve) applies to the whole estimate push_part + <r, x>. */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,

@@ -15,6 +15,20 @@ void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x)
     }
 }
 
+/* Gauss-Seidel sweeps on x until x_index settles; the sweeps made. */
+int ulam_gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
+                             int min_sweeps, int max_sweeps)
+{
+    int k = 0;
+    while (k < max_sweeps) {
+        double old = x[index];
+        ulam_gauss_seidel_sweep(M, b, x);
+        k++;
+        if (k >= min_sweeps && fabs(x[index] - old) <= rel_tol * fabs(x[index])) break;
+    }
+    return k;
+}
+
 /* Summarise n runs against the exact value. */
 void ulam_cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
                        double exact, ulam_cell *out)

@@ -404,11 +404,7 @@ static int references(study *st)
     int64_t n = st->s.M->nrows, I = st->s.index - 1;
     double *x = calloc((size_t)n, sizeof *x), *xd = NULL;
     if (!x) return cli_exit_code(ULAM_ENOMEM);
-    for (int k = 0; k < 100000; k++) { /* the converged reference */
-        double old = x[I];
-        ulam_gauss_seidel_sweep(st->s.M, st->s.b, x);
-        if (k > 10 && fabs(x[I] - old) <= 1e-16 * fabs(x[I])) break;
-    }
+    ulam_gauss_seidel_settle(st->s.M, st->s.b, x, I, 1e-16, 12, 100000); /* the converged reference */
     st->exact = x[I];
     char path[4096], v[2][32];
     snprintf(path, sizeof path, "%s/reference.csv", st->out);
