@@ -73,6 +73,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
         for (int t = 0; t < s->threads; t++) {
             free(s->scratch[t].stack_s), free(s->scratch[t].stack_w);
             free(s->scratch[t].hist), free(s->scratch[t].touched), free(s->scratch[t].mark);
+            free(s->scratch[t].bsum), free(s->scratch[t].bsq), free(s->scratch[t].btouched), free(s->scratch[t].bmark);
         }
     if (s->ks)
         for (int t = 0; t < s->threads; t++) ulam__kscratch_free(&s->ks[t]);
@@ -263,7 +264,12 @@ static int alloc_work(ulam_solver *s)
             sc->hist = ulam__calloc((size_t)s->n, sizeof *sc->hist);
             sc->touched = ulam__malloc((size_t)s->n, sizeof *sc->touched);
             sc->mark = ulam__calloc((size_t)s->n, 1);
-            if (!sc->hist || !sc->touched || !sc->mark) return ULAM_ENOMEM;
+            sc->bsum = ulam__calloc((size_t)s->n, sizeof *sc->bsum);
+            sc->bsq = ulam__calloc((size_t)s->n, sizeof *sc->bsq);
+            sc->btouched = ulam__malloc((size_t)s->n, sizeof *sc->btouched);
+            sc->bmark = ulam__calloc((size_t)s->n, 1);
+            if (!sc->hist || !sc->touched || !sc->mark || !sc->bsum || !sc->bsq || !sc->btouched || !sc->bmark)
+                return ULAM_ENOMEM;
         }
     }
     if (s->o.mode == ULAM_FORWARD) {
@@ -334,6 +340,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     if (o.mode == ULAM_ADJOINT) s->w.start = ulam__kernel_unit(s->k, o.index, &s->ks[0]);
     if (o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED) s->w.score0 = s->b[o.index];
     if (o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED) s->w.expected = 1;
+    s->w.watch = o.mode == ULAM_FORWARD ? o.index : -1;
     if ((status = kernel_failure(s->k, err))) {
         ulam_solver_free(s);
         return status;
@@ -522,12 +529,10 @@ static void merge_block(ulam_solver *s, const ulam__block *br)
 {
     ulam__moments_merge(&s->adj, &br->m);
     s->maxsq = fmax(s->maxsq, br->maxsq);
-    ulam__moments w = {0};
+    ulam__moments w = br->watched;
     for (int64_t q = 0; q < br->t.len; q++) {
-        double v = br->t.t[q].value;
-        s->sum[br->t.t[q].state] += v;
-        s->sumsq[br->t.t[q].state] += v * v;
-        if (br->t.t[q].state == s->o.index) s->maxsq = fmax(s->maxsq, v * v), ulam__moments_add(&w, v);
+        s->sum[br->t.t[q].state] += br->t.t[q].value;
+        s->sumsq[br->t.t[q].state] += br->t.t[q].square;
     }
     if (s->o.mode == ULAM_FORWARD) {
         ulam__moments zeros = {.n = br->walks - w.n};

@@ -204,18 +204,37 @@ static void tally(ulam__scratch *sc, int32_t s, double v)
     sc->hist[s] += v;
 }
 
-/* Move this history's tallies to out and clear them. */
-static int emit(ulam__scratch *sc, ulam__tallies *out)
+/* Add this history's tallies to the block's sums (and the watched component's moments) and
+ * clear them. */
+static void emit(const ulam__walker *w, ulam__scratch *sc, ulam__block *out)
 {
-    if (ulam__grow(&out->t, &out->cap, out->len + sc->ntouched, sizeof *out->t)) return ULAM_ENOMEM;
     for (int64_t q = 0; q < sc->ntouched; q++) {
         int64_t s = sc->touched[q];
-        out->t[out->len++] = (ulam__tally){(int32_t)s, sc->hist[s]};
+        double v = sc->hist[s];
+        if (!sc->bmark[s]) {
+            sc->bmark[s] = 1;
+            sc->btouched[sc->nbtouched++] = s;
+        }
+        sc->bsum[s] += v, sc->bsq[s] += v * v;
+        if (s == w->watch) ulam__moments_add(&out->watched, v), out->maxsq = fmax(out->maxsq, v * v);
         sc->hist[s] = 0.0;
         sc->mark[s] = 0;
     }
     sc->ntouched = 0;
-    return ULAM_OK;
+}
+
+/* Move the block's sums to its tally list (one per state reached) and clear them. */
+static int flush(ulam__scratch *sc, ulam__tallies *out)
+{
+    int st = ulam__grow(&out->t, &out->cap, out->len + sc->nbtouched, sizeof *out->t) ? ULAM_ENOMEM : ULAM_OK;
+    for (int64_t q = 0; q < sc->nbtouched; q++) {
+        int64_t s = sc->btouched[q];
+        if (!st) out->t[out->len++] = (ulam__tally){(int32_t)s, sc->bsum[s], sc->bsq[s]};
+        sc->bsum[s] = sc->bsq[s] = 0.0;
+        sc->bmark[s] = 0;
+    }
+    sc->nbtouched = 0;
+    return st;
 }
 
 /* Tally a visit to row h with weight wt. */
@@ -263,7 +282,8 @@ static int forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc
         }
     }
     out->walks++;
-    return emit(sc, &out->t);
+    emit(w, sc, out);
+    return ULAM_OK;
 }
 
 /* Run count forward histories, one at a time, counting into a local block. */
@@ -274,12 +294,10 @@ void ulam__forward_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam
     acc.t.len = 0;
     int64_t c = 0;
     for (; c < count; c++) {
-        if (forward_history(w, r, sc, &acc)) { /* out of memory: the run must fail, not stop short */
-            acc.nomem = 1;
-            break;
-        }
+        forward_history(w, r, sc, &acc);
         if ((c & 63) == 63 && w->interrupt && *w->interrupt) break;
     }
-    acc.complete = c == count;
+    acc.nomem = flush(sc, &acc.t) != ULAM_OK; /* out of memory: the run must fail, not stop short */
+    acc.complete = c == count && !acc.nomem;
     *out = acc;
 }

@@ -5,10 +5,11 @@
 #include "kernel.h"
 #include "stats.h"
 
-/* A (state, tally) pair a forward history emits when it ends. */
+/* A state's tallies over a block of forward histories: their sum and their sum of squares
+ * (the block adds its histories in order; the solver adds blocks in order). */
 typedef struct {
     int32_t state;
-    double value;
+    double value, square;
 } ulam__tally;
 
 /* Growable list of tallies (one per block). */
@@ -27,6 +28,7 @@ typedef struct {
     ulam__slot *src;       /* forward: alias table of |b| over n outcomes (encoded states) */
     double bnorm1;         /* forward: ||b||_1 */
     int expected;          /* forward: scatter expected tallies */
+    int64_t watch;         /* forward: the component whose per-history moments a block keeps */
     double roulette, split;
     int64_t max_steps;
     int lanes; /* adjoint histories interleaved (1 to 32) */
@@ -44,14 +46,20 @@ typedef struct {
     int64_t *touched;    /* forward: states with a tally in this history */
     unsigned char *mark; /* forward: mark[s] != 0 when s is in touched[] */
     int64_t ntouched;
+    double *bsum, *bsq;   /* forward: this block's sums of history tallies and of their squares */
+    int64_t *btouched;    /* forward: states with a tally in this block, in first-tally order */
+    unsigned char *bmark; /* forward: bmark[s] != 0 when s is in btouched[] */
+    int64_t nbtouched;
 } ulam__scratch;
 
 /* What a block of histories produced. */
 typedef struct {
     ulam__moments m; /* adjoint scores */
-    ulam__tallies t; /* forward tallies */
+    ulam__tallies t; /* forward: one tally per state the block reached */
+    ulam__moments watched; /* forward: the watched component's history tallies (histories that
+                              tallied it; the others count as zeros when merged) */
     int64_t walks, steps, cut, nonfinite;
-    double maxsq; /* adjoint: the largest score^2 */
+    double maxsq; /* the largest score^2 (forward: of the watched component) */
     int complete; /* 0 when interrupted or out of memory */
     int nomem;    /* a tally list could not grow: the run fails with ULAM_ENOMEM */
 } ulam__block;
