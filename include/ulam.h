@@ -424,6 +424,12 @@ typedef struct ulam_walk_result {
                             (0: no bound) */
     double variance_rel_error; /* relative standard error of `variance` (fourth moment) */
     int rel_err_met;     /* 1: stopped by the rel_err rule */
+    double cut_bound;    /* the most the walks cut at max_steps can have moved the mean (0: none
+                            cut; INFINITY: no bound); the rel_err rule needs it <= 0.1 E |m| */
+    int cut_stop;        /* 1: stopped because the cuts' bias may exceed the rel_err target
+                            (raise max_steps) */
+    int out_of_reach;    /* 1: rel_err alone, stopped after a round because the rule's minimum
+                            walk count exceeds ULAM_REL_ERR_CAP (rel_err_met 0) */
     int64_t unreached;   /* forward: components no walk has tallied (no estimate at all) */
     double seconds;    /* wall time spent walking */
     int threads;       /* threads used */

@@ -438,7 +438,7 @@ static void merge_block(ulam_rad_solver *s, const rad_block *br)
 static double channel_min_walks(const ulam_rad_solver *s, int c, double E)
 {
     double m = fabs(s->m[c].mean);
-    return ulam__rel_min_walks(ulam__score_range(s->range[c], s->per_step[c], s->qmax, 0, m, E), E, m);
+    return ulam__rel_min_walks(ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, m, E), E, m);
 }
 
 /* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
