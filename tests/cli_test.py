@@ -285,6 +285,33 @@ def check_json(ulam):
     assert o["index"] == 1 and abs(o["value"] - 2.9329173166926679) < 1e-12 and o["residual"] < 1e-14
 
 
+def check_info_neumann(ulam):
+    """ulam info never gives the Neumann verdict from an unconverged estimate: a 2000-cycle of
+    random weights whose geometric mean is exactly 0.999 or 1.001 (rho(M) = that mean; Arnoldi
+    does not converge on it, and the old verdict was 'diverges' for 0.999, 'converges' for 1.001)
+    is 'unknown', JSON null; certified verdicts stay (chain4 by rho(|M|) < 1)."""
+    import math
+    import random
+    rnd = random.Random(7)
+    with tempfile.TemporaryDirectory() as d:
+        for rho in (0.999, 1.001):
+            a = [rnd.uniform(-0.5, 0.5) for _ in range(2000)]
+            mean = sum(a) / len(a)
+            p = os.path.join(d, "cyc.mtx")
+            with open(p, "w") as f:
+                f.write("%%MatrixMarket matrix coordinate real general\n2000 2000 2000\n")
+                for i in range(2000):
+                    f.write(f"{i + 1} {(i + 1) % 2000 + 1} {rho * math.exp(a[i] - mean):.17g}\n")
+            rc, out, _ = run(ulam, ["info", p, "--json"])
+            o = json.loads(out)
+            assert rc == 0 and o["neumann_converges"] is None and o["neumann_certified"] is False, (rho, o)
+            rc, out, _ = run(ulam, ["info", p])
+            assert rc == 0 and "Neumann series   unknown" in out, out
+    rc, out, _ = run(ulam, ["info", M + "chain4.mtx", "--json"])
+    o = json.loads(out)
+    assert o["neumann_converges"] is True and o["neumann_certified"] is True, o
+
+
 def check_solve_json(ulam):
     """solve --json has the documented keys; --check adds direct and z; threads do not matter."""
     base = SOLVE + ["--index", "3", "--walks", "50000", "--seed", "5", "--json", "--check"]
@@ -833,7 +860,7 @@ def check_genmat(genmat):
 def main():
     ulam, genmat = sys.argv[1], sys.argv[2]
     failures, n = check_table(ulam)
-    extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
              (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
