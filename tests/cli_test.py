@@ -92,6 +92,8 @@ CASES += [
     (SOLVE + ["--index", "1", "--estimator", "psychic"], 2, r"--estimator expects", ""),
     (SOLVE + ["--index", "1", "--continue", "1"], 2, r"--continue expects a number", ""),
     (SOLVE + ["--index", "1", "--roulette", "2", "--split", "1"], 2, r"--split W must exceed", ""),
+    # a split weight below the start weight (1, adjoint) split every walk into 1e7 copies (11 s)
+    (SOLVE + ["--index", "1", "--walks", "1000", "--split", "1e-7"], 2, r"split weight of at least the start weight 1", ""),
     (SOLVE + ["--index", "9"], 2, r"--index 9 is out of range 1..4", ""),
     (SOLVE, 2, r"adjoint walks need --index", ""),
     (SOLVE + ["--index", "1", "--out", "/tmp/x.mtx"], 2, r"--out and --errors need --mode forward", ""),

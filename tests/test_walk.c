@@ -216,8 +216,10 @@ static void test_roulette_and_splitting(void **state)
         o.continue_q = 0.5;
         o.max_walks = 200000;
         ulam_walk_result plain = run(&s, o);
-        o.split = 2.0;
-        o.roulette = 0.25;
+        double w0 = mode == ULAM_ADJOINT ? 1.0 : 0.0; /* the start weight: 1 adjoint, ||b||_1 forward (a split weight below it is refused) */
+        for (int64_t i = 0; mode == ULAM_FORWARD && i < s.n; i++) w0 += fabs(s.b[i]);
+        o.split = 2.0 * w0;
+        o.roulette = 0.25 * w0;
         ulam_walk_result ws = run(&s, o);
         assert_agrees(&s, &ws, 3);
         assert_true(ws.steps > plain.steps); /* splitting did make copies */
@@ -538,8 +540,17 @@ static void test_rel_err_cuts(void **state)
     o.max_steps = 1000000, o.max_walks = 2048, o.rel_err = 0; /* no cuts: no cut bias */
     assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(r.cut == 0 && r.cut_bound == 0.0 && !r.cut_stop);
-    /* splitting leaves no bound on a single score: --rel-err alone is refused at the start */
     ulam_error err;
+    /* a split weight below the start weight (1 adjoint, ||b||_1 = 1000 forward) is refused */
+    o = ulam_walk_defaults();
+    o.split = 1e-7;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    assert_non_null(strstr(err.msg, "split weight"));
+    o.mode = ULAM_FORWARD, o.split = 999;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    o.split = 1000, o.max_walks = 1024;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    /* splitting leaves no bound on a single score: --rel-err alone is refused at the start */
     o = ulam_walk_defaults();
     o.max_walks = 0, o.rel_err = 0.1, o.split = 2.0;
     assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);

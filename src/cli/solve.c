@@ -391,6 +391,10 @@ int cli_solve(int argc, char **argv)
     o.assume_finite = ro.assume_finite;
     t0 = ulam_now();
     int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err); /* refuses what the guards refuse */
+    if (status == ULAM_EINVAL && o.split > 0 && strstr(err.msg, "split weight")) {
+        cli_system_free(&s);
+        return cli_usage_error("solve", "--split W: %s", err.msg);
+    }
     ro.kernel_seconds = ulam_now() - t0;
     int64_t n = s.M->nrows;
     if (status == ULAM_EDIVERGE) {
