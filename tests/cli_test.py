@@ -314,6 +314,34 @@ def check_info_neumann(ulam):
     assert o["neumann_converges"] is True and o["neumann_certified"] is True, o
 
 
+def check_rel_err_stops(ulam):
+    """--rel-err never claims 'met' without a certificate: walks cut at --max-steps whose bias
+    bound exceeds a tenth of the target stop the run at once (JSON rel_err_stop "cuts"; the old
+    rule printed 1813 +- 1.8 as met on this 1000-cycle of weights 0.9999, x = 10^4); a run with no
+    bound on a single score (splitting) is refused with rel-err alone (exit 4, the reason named)
+    and, bounded by --walks, reports rel_err_stop "no_bound"."""
+    with tempfile.TemporaryDirectory() as d:
+        p, pb = os.path.join(d, "cyc.mtx"), os.path.join(d, "cyc_b.mtx")
+        with open(p, "w") as f:
+            f.write("%%MatrixMarket matrix coordinate real general\n1000 1000 1000\n")
+            f.writelines(f"{i + 1} {(i + 1) % 1000 + 1} 0.9999\n" for i in range(1000))
+        with open(pb, "w") as f:
+            f.write("%%MatrixMarket matrix array real general\n1000 1\n" + "1\n" * 1000)
+        args = ["solve", p, "--rhs", pb, "--index", "1", "--rel-err", "0.01"]
+        rc, out, err = run(ulam, args + ["--max-steps", "2000", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["rel_err_met"] is False and o["rel_err_stop"] == "cuts" and o["walks"] == 1024, o
+        assert o["cut_bound"] > 1000 and "raise --max-steps" in err, (o, err)
+        rc, out, err = run(ulam, args + ["--max-steps", "2000"])
+        assert rc == 0 and re.search(r"^rel-err +NOT met .*raise --max-steps", out, re.M), out
+    rc, out, err = run(ulam, SOLVE + ["--index", "1", "--rel-err", "0.1", "--split", "2"])
+    assert rc == 4 and "splitting leaves the weights without a bound" in err, (rc, err)
+    rc, out, err = run(ulam, SOLVE + ["--index", "1", "--rel-err", "0.1", "--split", "2", "--walks", "5000", "--json"])
+    o = json.loads(out)
+    assert rc == 0 and o["rel_err_met"] is False and o["rel_err_stop"] == "no_bound" and o["walks"] == 5000, o
+    assert "no bound on a single walk's score" in err, err
+
+
 def check_solve_json(ulam):
     """solve --json has the documented keys; --check adds direct and z; threads do not matter."""
     base = SOLVE + ["--index", "3", "--walks", "50000", "--seed", "5", "--json", "--check"]
@@ -862,7 +890,7 @@ def check_genmat(genmat):
 def main():
     ulam, genmat = sys.argv[1], sys.argv[2]
     failures, n = check_table(ulam)
-    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam),
              (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
