@@ -297,7 +297,6 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         w0 = 0.0;
         for (int64_t i = 0; i < s->n; i++) w0 += fabs(s->b[i]);
     }
-    if (adj && expected) vmax += fabs(s->b[s->o.index]); /* the start's own b_i */
     double Wmax = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
     s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
     if (s->o.rel_err > 0 && vmax > 0 && (!(qmax < 1.0) || !isfinite(Wmax)))
