@@ -139,7 +139,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
         printf("rel-err         NOT met (target %.3g): %lld walks were cut at %lld steps and the cut's bias may be "
                "%.3g, more than a tenth of the target error: unreachable by more walks (raise --max-steps)\n",
                o->rel_err, (long long)r->cut, (long long)o->max_steps, r->cut_bound);
-    else if (o->rel_err > 0 && !isfinite(r->tail_bound))
+    else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
         printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
                o->rel_err);
     else if (o->rel_err > 0 && r->min_walks > 0)
@@ -184,7 +184,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         printf("\"rel_err_met\": %s, ", r->rel_err_met ? "true" : "false");
         cli_json_number("cut_bound", r->cut_bound, 0);
         printf("\"rel_err_stop\": %s, ", r->cut_stop ? "\"cuts\"" : r->out_of_reach ? "\"out_of_reach\""
-                                       : !isfinite(r->tail_bound) ? "\"no_bound\"" : "null");
+                                       : !isfinite(r->tail_bound) && r->estimate != 0 ? "\"no_bound\"" : "null");
     }
     if (o->mode == ULAM_FORWARD) printf("\"unreached\": %lld, ", (long long)r->unreached);
     cli_json_number("variance", r->variance, 0);
@@ -272,7 +272,7 @@ static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const 
 {
     double limit = o->max_walks > 0 ? (double)o->max_walks : 1e8;
     if (!(o->rel_err > 0)) return;
-    if (!isfinite(r->tail_bound) && r->walks > 0) {
+    if (!isfinite(r->tail_bound) && r->walks > 0 && r->estimate != 0) { /* (at 0 the tail is infinite too) */
         fprintf(stderr, "ulam: %s: warning: --rel-err %g: no bound on a single walk's score holds (weights can grow "
                         "without bound, or the walk's length tail is not certified): the rule cannot be met; the "
                         "run ends by --walks or --time\n", s->matrix_path, o->rel_err);
