@@ -528,6 +528,12 @@ typedef struct ulam_walk_result {
                             (0: no bound) */
     double variance_rel_error; /* relative standard error of `variance` (fourth moment) */
     int rel_err_met;     /* 1: stopped by the rel_err rule */
+    double cut_bound;    /* the most the walks cut at max_steps can have moved the mean (0: none
+                            cut; INFINITY: no bound); the rel_err rule needs it <= 0.1 E |m| */
+    int cut_stop;        /* 1: stopped because the cuts' bias may exceed the rel_err target
+                            (raise max_steps) */
+    int out_of_reach;    /* 1: rel_err alone, stopped after a round because the rule's minimum
+                            walk count exceeds ULAM_REL_ERR_CAP (rel_err_met 0) */
     int64_t unreached;   /* forward: components no walk has tallied (no estimate at all) */
     double seconds;    /* wall time spent walking */
     int threads;       /* threads used */
@@ -588,10 +594,18 @@ ulam_solver *ulam_solver_free(ulam_solver *s);
  * stops when all of these hold (N walks, estimate m, standard error se):
  *   N >= 1000, m != 0 and, forward, the watched component opts->index has been tallied;
  *   se <= E |m|;
- *   N >= 3 ln(3 / 0.05) R / (E |m|) when a single score is bounded (R = score_bound, twice it
- *     when scores take both signs): the empirical-Bernstein range term at 95%, so any class
- *     of scores worth E of the answer has been seen about 12 times before a stop;
- *   the variance's own relative standard error (fourth moment) <= 0.25. */
+ *   N >= 3 ln(3 / 0.05) R / (E |m|), R the range of a single score (score_bound; for collision
+ *     and expected the range of walks short enough to matter, from the continuation or a
+ *     Collatz-Wielandt certificate of the length tail; with weights growing on cycles, from a
+ *     certified second moment; twice it when scores take both signs): the empirical-Bernstein
+ *     range term at 95%, so any class of scores worth E of the answer has been seen about 12
+ *     times before a stop.  No such R (splitting, forward expected, no certificate): never
+ *     met, and rel_err alone is refused with ULAM_EINFVAR (err->msg names the reason);
+ *   with walks cut at max_steps, cut_bound <= 0.1 E |m|, else the run stops (cut_stop);
+ *   the variance's own relative standard error (fourth moment) <= 0.25.
+ * With rel_err alone, a run whose minimum walk count exceeds ULAM_REL_ERR_CAP stops after the
+ * round (out_of_reach).  A split weight below the start weight (1 adjoint, ||b||_1 forward)
+ * is refused with ULAM_EINVAL. */
 int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                ulam_walk_result *result, ulam_error *err);
 

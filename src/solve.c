@@ -48,11 +48,15 @@ struct ulam_solver {
     double bound, range; /* the largest |score| a walk can make; the scores' range (INFINITY: none) */
     double per_step, qmax; /* collision, expected: the largest |score| of one visit, the largest
                               continuation over reachable states (walk length tail q^l) */
+    double tail_u, kappa;  /* the length tail (Collatz-Wielandt): |K| v <= tail_u v over reachable
+                              states, kappa = max v / min v (tail_u 1: none) */
+    double visit;          /* the start weight times the largest |score| of one visit */
+    double v2;             /* a certified bound on E[score^2] (INFINITY: none) */
     int signs;             /* scores may take both signs */
     int64_t walks, steps, cut, nonfinite, next_walk;
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
     double seconds, t0;
-    int done, interrupted, status, met;
+    int done, interrupted, status, met, cut_stop, out_of_reach;
 };
 
 /* The defaults. */
@@ -106,6 +110,21 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
     return ULAM_OK;
 }
 
+/* Refuse a split weight below the start weight (1 adjoint, ||b||_1 forward): every walk would
+ * split at once into ceil(w0 / W) copies (a split weight of 1e-7 on chain4: 1e7 copies a walk,
+ * 11 s for 1000 walks), which is unbiased but no longer the run asked for. */
+static int check_split(const ulam_csr *M, const double *b, const ulam_walk_opts *o, ulam_error *err)
+{
+    if (!(o->split > 0)) return ULAM_OK;
+    double w0 = o->mode == ULAM_ADJOINT ? 1.0 : 0.0;
+    for (int64_t i = 0; o->mode == ULAM_FORWARD && i < M->nrows; i++) w0 += fabs(b[i]);
+    if (o->split >= w0) return ULAM_OK;
+    return ulam__fail(err, ULAM_EINVAL, 0, -1,
+                      "a split weight of at least the start weight %.6g (%s), not %g: below it every walk splits "
+                      "into ceil(%.6g / W) copies at its first step",
+                      w0, o->mode == ULAM_ADJOINT ? "1 in adjoint mode" : "||b||_1 in forward mode", o->split, w0);
+}
+
 /* The sum of |K| over row i. */
 static double row_sum(const ulam_csr *K, int64_t i)
 {
@@ -114,11 +133,129 @@ static double row_sum(const ulam_csr *K, int64_t i)
     return S;
 }
 
+/* The largest product of weight factors S / q along any path among the seen states (the
+ * weight a walk can reach, as a multiple of the weight it had anywhere on its way): a longest
+ * path fixpoint, 1 when no factor exceeds 1; INFINITY when it does not settle within SWEEPS
+ * passes (a cycle that grows weights, or paths too long to follow).  Growth below a relative
+ * 1e-12 a pass is ignored (rounding of factors of exactly 1). */
+static double weight_growth(const ulam_csr *K, double continue_q, const char *seen)
+{
+    enum { SWEEPS = 64 };
+    int64_t n = K->nrows;
+    double *A = ulam__malloc((size_t)n, sizeof *A), best = 1.0;
+    if (!A) return INFINITY;
+    for (int64_t i = 0; i < n; i++) A[i] = 1.0;
+    int changed = 1;
+    for (int sweep = 0; sweep < SWEEPS && changed; sweep++) {
+        changed = 0;
+        for (int64_t i = 0; i < n; i++) {
+            if (!seen[i]) continue;
+            double a = A[i] * ulam__factor(row_sum(K, i), continue_q);
+            for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++)
+                if (K->val[k] != 0.0 && a > A[K->colidx[k]] * (1.0 + 1e-12)) A[K->colidx[k]] = a, changed = 1;
+        }
+    }
+    for (int64_t i = 0; i < n; i++) best = fmax(best, seen[i] ? A[i] : 1.0);
+    free(A);
+    return changed ? INFINITY : best;
+}
+
+/* A Collatz-Wielandt certificate of the walk's length tail over the seen states (closed under
+ * K's moves): a positive v with |K| v <= u v there, so a walk's expected remaining |weight|
+ * after k steps, w0 (|K|^k 1)_i, is at most w0 kappa u^k, kappa = max v / min v.  v is a
+ * power iterate of I + |K| from 1 (the shift converges on periodic chains, a cycle of two
+ * states, where iterates of |K| alone oscillate), floored at floor times its largest entry
+ * (so kappa <= 1 / floor); the smallest u over ITER iterations is kept.  *u = 1
+ * (no certificate) when none is below 1 or memory runs out.  second: the same for the
+ * walk's second-moment matrix M^ = diag(S / q) |K| (E[w_k^2] = w0^2 (M^^k 1)_i, no roulette). */
+static void length_tail(const ulam_csr *K, const char *seen, double continue_q, int second, double floor,
+                        double *u, double *kappa)
+{
+    enum { ITER = 300 };
+    int64_t n = K->nrows;
+    double *v = ulam__malloc((size_t)n, sizeof *v), *y = ulam__malloc((size_t)n, sizeof *y);
+    *u = 1.0, *kappa = INFINITY;
+    for (int64_t i = 0; v && y && i < n; i++) v[i] = 1.0;
+    for (int it = 0; v && y && it < ITER; it++) {
+        double ratio = 0.0, ymax = 0.0, vmin = INFINITY, vmax = 0.0;
+        for (int64_t i = 0; i < n; i++) {
+            if (!seen[i]) continue;
+            double t = 0.0;
+            for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) t += fabs(K->val[k]) * v[K->colidx[k]];
+            y[i] = t = second ? t * ulam__factor(row_sum(K, i), continue_q) : t;
+            ratio = fmax(ratio, t / v[i]), ymax = fmax(ymax, t + v[i]);
+            vmin = fmin(vmin, v[i]), vmax = fmax(vmax, v[i]);
+        }
+        if (ratio < *u) *u = ratio, *kappa = vmax / vmin;
+        else if (*u < 1.0 && ratio >= *u * (1.0 - 1e-6)) break; /* no longer improving */
+        if (!(ymax > 0)) break;
+        for (int64_t i = 0; i < n; i++)
+            if (seen[i]) v[i] = fmax((y[i] + v[i]) / ymax, floor);
+    }
+    free(v), free(y);
+}
+
+/* A certified bound on E[X^2] of a walk's score X (collision, expected, absorption; no roulette,
+ * no splitting) from the second-moment matrix M^ = diag(S / q) |K| over the seen states:
+ * E[w_k^2 at j] = w0^2 (M^^k)_{start j}, so with g_j what a visit at j can add squared (b_j^2,
+ * (|(M b)_j| + |b_start|)^2, forward 1 at the index; absorption b_j^2 / p*_j), a positive z
+ * with M^ z <= u z and g <= c z gives (M^^k g)_start <= c u^k z_start, and by Cauchy-Schwarz
+ * with weights u^(k/2), E[X^2] <= w0^2 c z_start / (1 - sqrt u)^2 (absorption, one score a
+ * walk: w0^2 c z_start / (1 - u)).  z: iterates of I + M^ from g (so it fits the states that
+ * score), floored at a few shares of its largest entry, the best bound kept; INFINITY when none
+ * has u < 1. */
+static double second_moment(const ulam_solver *s, const ulam_csr *K, const char *seen, double w0)
+{
+    enum { ITER = 300 };
+    int64_t n = K->nrows;
+    int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION;
+    double *g = ulam__malloc((size_t)n, sizeof *g), *v = ulam__malloc((size_t)n, sizeof *v);
+    double *y = ulam__malloc((size_t)n, sizeof *y), *f = ulam__malloc((size_t)n, sizeof *f), best = INFINITY;
+    double b0 = adj && s->o.estimator == ULAM_EXPECTED ? fabs(s->b[s->o.index]) : 0.0, gmax = 0.0;
+    for (int64_t i = 0; g && v && y && f && i < n; i++) {
+        g[i] = 0.0;
+        if (!seen[i]) continue;
+        double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
+        f[i] = ulam__factor(S, s->o.continue_q);
+        for (int64_t k = K->rowptr[i]; adj && s->o.estimator == ULAM_EXPECTED && k < K->rowptr[i + 1]; k++)
+            c += K->val[k] * s->b[K->colidx[k]];
+        double a = adj ? (s->o.estimator == ULAM_EXPECTED ? fabs(c) + b0 : fabs(s->b[i])) : i == s->o.index;
+        g[i] = absorb ? (a != 0.0 ? a * a / (1.0 - q) : 0.0) : a * a;
+        gmax = fmax(gmax, g[i]);
+    }
+    static const double floors[] = {1e-30, 1e-6, 1e-3, 1e-2, 0.1};
+    for (int fl = 0; g && v && y && f && gmax > 0 && isfinite(gmax) && fl < 5; fl++) {
+        for (int64_t i = 0; i < n; i++) v[i] = seen[i] ? fmax(g[i] / gmax, floors[fl]) : 1.0;
+        for (int it = 0, last = 0; it < ITER && it - last < 30; it++) { /* until 30 iterations bring nothing */
+            double u = 0.0, c = 0.0, z0 = 0.0, ymax = 0.0;
+            for (int64_t i = 0; i < n; i++) {
+                if (!seen[i]) continue;
+                double t = 0.0;
+                for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) t += fabs(K->val[k]) * v[K->colidx[k]];
+                y[i] = t * f[i];
+                u = fmax(u, y[i] / v[i]), c = fmax(c, g[i] / v[i]), ymax = fmax(ymax, y[i] + v[i]);
+                z0 += adj ? (i == s->o.index ? v[i] : 0.0) : fabs(s->b[i]) / w0 * v[i];
+            }
+            if (u < 1.0) {
+                double d = absorb ? 1.0 - u : (1.0 - sqrt(u)) * (1.0 - sqrt(u)), bound = w0 * w0 * c * z0 / d;
+                if (bound < best * (1.0 - 1e-3)) last = it;
+                best = fmin(best, bound);
+            }
+            for (int64_t i = 0; i < n; i++)
+                if (seen[i]) v[i] = fmax((y[i] + v[i]) / ymax, floors[fl]);
+        }
+    }
+    free(g), free(v), free(y), free(f);
+    return best;
+}
+
 /* Over the states walks can reach (seen): absorption's p* > 0 wherever it scores (else
  * ULAM_EUNDEFINED naming the state), and the bound on a single score and the scores' range
  * (s->bound, s->range): 0 when nothing that scores is reachable; for absorption W |g_i| / p*_i,
- * W the weight bound (the start weight, or the roulette weight when larger, as long as no
- * reachable state's factor S / q exceeds 1); otherwise unbounded. */
+ * W the weight bound (the start weight, or the roulette weight when larger, times the
+ * largest product of factors S / q along a path, weight_growth; unbounded with splitting);
+ * the per-visit score and continuation tail for collision and expected (s->per_step, s->qmax,
+ * and past qmax = 1 the certificate of length_tail). */
 static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
     char *seen = ulam__calloc((size_t)s->n, 1);
@@ -136,7 +273,7 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = 0;
     int64_t bad = -1;
     int expected = s->o.estimator == ULAM_EXPECTED;
-    double w0 = 1.0, fbig = 0.0, gmax = 0.0, vmax = 0.0, qmax = 0.0;
+    double w0 = 1.0, fbig = 0.0, gmax = 0.0, g2max = 0.0, vmax = 0.0, qmax = 0.0;
     for (int64_t i = 0; i < s->n; i++) {
         if (!seen[i]) continue;
         double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
@@ -154,13 +291,23 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         if (!scores) continue;
         double g = adj ? fabs(s->b[i]) : 1.0;
         gmax = fmax(gmax, absorb ? (q < 1.0 ? g / (1.0 - q) : INFINITY) : INFINITY);
+        g2max = fmax(g2max, absorb && q < 1.0 ? g * g / (1.0 - q) : INFINITY);
         if (adj) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
     }
     if (!adj)
         for (int64_t i = 0; i < s->n; i++) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
+    double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, seen) : 1.0;
     if (!adj) {
         w0 = 0.0;
         for (int64_t i = 0; i < s->n; i++) w0 += fabs(s->b[i]);
+    }
+    double Wmax = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
+    s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
+    if (s->o.rel_err > 0 && vmax > 0 && (!(qmax < 1.0) || !isfinite(Wmax)))
+        length_tail(K, seen, s->o.continue_q, 0, 1e-30, &s->tail_u, &s->kappa); /* kappa enters by its log */
+    if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
+        (absorb ? isfinite(g2max) : isfinite(vmax))) {
+        s->v2 = second_moment(s, K, seen, w0);
     }
     free(seen);
     if (bad >= 0)
@@ -169,13 +316,34 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
                           "reachable and never terminates (its row sum of |%s| is >= 1): use the "
                           "collision estimator or --continue Q",
                           (long long)bad + 1, adj ? "M" : "M' (column of M)");
-    double W = fbig <= 1.0 && !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) : INFINITY;
+    double W = Wmax;
     s->signs = pos && neg;
     s->bound = gmax > 0 ? W * gmax : 0.0;
     s->range = s->bound * (s->signs ? 2.0 : 1.0);
     s->per_step = vmax > 0 ? W * vmax : 0.0;
     s->qmax = qmax;
     return ULAM_OK;
+}
+
+/* Refuse a rel_err target no bound on a single score can certify (nothing else ends the run):
+ * absorption with weights that can grow without bound (a cycle of factors S / q > 1, or
+ * splitting); collision and expected with such weights, or a continuation of 1 (qmax = 1) and
+ * no Collatz-Wielandt certificate below 1, or the forward expected estimator (unbounded
+ * per-visit tallies). */
+static int check_bounded(const ulam_solver *s, ulam_error *err)
+{
+    if (s->bound == 0.0 || s->per_step == 0.0) return ULAM_OK;
+    int absorb = s->o.estimator == ULAM_ABSORPTION;
+    double t = s->qmax < 1.0 ? s->qmax : s->tail_u;
+    if (isfinite(s->v2) || (absorb ? isfinite(s->range) : isfinite(s->per_step) && t < 1.0)) return ULAM_OK;
+    const char *why = !isfinite(s->per_step) && !absorb && s->o.mode == ULAM_FORWARD && s->o.estimator == ULAM_EXPECTED
+                          ? "the forward expected estimator's tallies have no per-visit bound"
+                      : s->o.split > 0 ? "splitting leaves the weights without a bound"
+                      : !isfinite(s->per_step) ? "a reachable cycle of weight factors S/q > 1 lets weights grow without "
+                                                 "bound, and no second-moment certificate holds"
+                                               : "a reachable row of |M| sums to 1 or more and no Collatz-Wielandt vector "
+                                                 "certifies the walk's length tail below 1";
+    return ulam__fail(err, ULAM_EINFVAR, 0, -1, "a bound on a single walk's score (%s)", why);
 }
 
 /* The guards' verdicts for this run: opts->guard when it holds them, else computed (rho(|M|)
@@ -302,6 +470,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     ulam_walk_opts o = opts ? *opts : ulam_walk_defaults();
     int status = check_opts(M, &o, err);
     if (status) return status;
+    if ((status = check_split(M, b, &o, err))) return status;
     double bnorm1 = 0.0;
     ulam_solver *s = calloc(1, sizeof *s);
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
@@ -325,9 +494,13 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
-    s->bound = s->range = s->per_step = INFINITY;
-    s->qmax = 1.0;
+    s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = INFINITY;
+    s->qmax = s->tail_u = 1.0;
     if ((o.estimator == ULAM_ABSORPTION || o.rel_err > 0) && (status = check_reach(s, K, err))) {
+        ulam_solver_free(s);
+        return status;
+    }
+    if (o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0 && (status = check_bounded(s, err))) {
         ulam_solver_free(s);
         return status;
     }
@@ -555,6 +728,8 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
     if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
     if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.index] == 0))
         return 0;
+    if (!isfinite(r->tail_bound)) return 0; /* no bound on a single score: no certificate */
+    if (!(r->cut_bound <= ULAM__CUT_SHARE * E * m)) return 0;
     return ulam__rel_err_holds(r->walks, m, r->std_error, r->min_walks, r->variance_rel_error, E);
 }
 
@@ -590,6 +765,12 @@ int ulam_solver_iterate(ulam_solver *s)
     result(s, &r, 0);
     if (ulam__budget_spent(&s->o, stop, s->next_walk)) s->done = 1;
     if (rel_err_met(s, &r)) s->done = s->met = 1;
+    else if (s->o.rel_err > 0 && s->walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.rel_err_offset) > 0 &&
+             !(r.cut_bound <= ULAM__CUT_SHARE * s->o.rel_err * fabs(r.estimate + s->o.rel_err_offset)))
+        s->done = s->cut_stop = 1; /* the cuts' bias may exceed the target: more walks cannot help */
+    else if (s->o.rel_err > 0 && s->walks >= ULAM__REL_MIN && s->o.max_walks == ULAM_REL_ERR_CAP &&
+             !(s->o.max_seconds > 0) && r.min_walks > (double)ULAM_REL_ERR_CAP)
+        s->done = s->out_of_reach = 1; /* rel_err alone, and the cap cannot reach the minimum */
     return s->status;
 }
 
@@ -621,7 +802,17 @@ static void forward_component(const ulam_solver *s, int64_t i, double *est, doub
 static double score_range(const ulam_solver *s, double m, double E)
 {
     if (s->bound == 0.0) return s->range;
-    return ulam__score_range(s->range, s->per_step, s->qmax, s->signs, m, E);
+    int q = s->qmax < 1.0;
+    double R = ulam__score_range(s->range, s->per_step, q ? s->qmax : s->tail_u, q ? 1.0 : s->kappa, s->signs, m, E);
+    return isfinite(R) ? R : ulam__moment_range(s->v2, s->signs, m, E);
+}
+
+/* The most the walks cut at max_steps can have moved the mean (0 without cuts). */
+static double cut_bound(const ulam_solver *s)
+{
+    if (s->cut == 0) return 0.0;
+    return fmin(ulam__cut_bound(s->per_step, s->qmax, 1.0, s->o.max_steps),
+                ulam__cut_bound(s->visit, s->tail_u, s->kappa, s->o.max_steps));
 }
 
 /* The result so far; the forward count of unreached components (O(n)) when asked. */
@@ -650,6 +841,9 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->score_bound = s->bound;
     r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
     r->min_walks = ulam__rel_min_walks(R, s->o.rel_err, m);
+    r->cut_bound = cut_bound(s);
+    r->cut_stop = s->cut_stop;
+    r->out_of_reach = s->out_of_reach;
     r->rel_err_met = s->met;
     double half = s->var_finite == 1 ? ULAM_Z95 * r->std_error : NAN;
     r->ci95[0] = r->estimate - half;
@@ -742,6 +936,6 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     s->walks = s->steps = s->cut = s->nonfinite = s->next_walk = 0;
     s->maxsq = s->seconds = 0.0;
     s->t0 = -1;
-    s->done = s->interrupted = s->status = s->met = 0;
+    s->done = s->interrupted = s->status = s->met = s->cut_stop = s->out_of_reach = 0;
     return ULAM_OK;
 }

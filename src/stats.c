@@ -52,13 +52,28 @@ double ulam__moments_variance_rel_error(const ulam__moments *m)
 }
 
 /* The range of a single score the rel_err rule uses. */
-double ulam__score_range(double range, double per_step, double qmax, int signs, double m, double E)
+double ulam__score_range(double range, double per_step, double qmax, double kappa, int signs, double m, double E)
 {
     if (isfinite(range) || range == 0.0) return range;
     if (per_step == 0.0) return 0.0;
-    if (!isfinite(per_step) || !(qmax < 1.0) || !(m > 0) || !(E > 0)) return INFINITY;
-    double steps = qmax > 0 ? ceil(log(per_step / (E * m * (1.0 - qmax))) / log(1.0 / qmax)) : 0.0;
+    if (!isfinite(per_step) || !(qmax < 1.0) || !isfinite(kappa) || !(m > 0) || !(E > 0)) return INFINITY;
+    double steps = qmax > 0 ? ceil(log(kappa * per_step / (E * m * (1.0 - qmax))) / log(1.0 / qmax)) : 0.0;
     return per_step * fmax(1.0, steps + 1.0) * (signs ? 2.0 : 1.0);
+}
+
+/* The range the rule uses from a bound on the second moment. */
+double ulam__moment_range(double v2, int signs, double m, double E)
+{
+    if (!isfinite(v2) || !(m > 0) || !(E > 0)) return INFINITY;
+    return v2 / (E * m) * (signs ? 2.0 : 1.0);
+}
+
+/* The most the walks cut after max_steps steps can move the mean. */
+double ulam__cut_bound(double per_step, double qmax, double kappa, int64_t max_steps)
+{
+    if (per_step == 0.0) return 0.0;
+    if (!isfinite(per_step) || !(qmax < 1.0) || !isfinite(kappa)) return INFINITY;
+    return kappa * per_step * pow(qmax, (double)max_steps) / (1.0 - qmax);
 }
 
 /* The walks the range term needs. */

@@ -36,12 +36,28 @@ double ulam__moments_variance_rel_error(const ulam__moments *m);
 #define ULAM__VAR_REL_MAX 0.25
 
 /* The range R of a single walk's score the rule uses: range when finite (a bounded score);
- * else, for scores that add per_step at most at each visit of walks that survive a step with
- * probability at most qmax, the range of walks of at most l steps, l chosen so that longer walks
- * add at most E m to the mean (per_step qmax^(l+1) / (1 - qmax) <= E m), doubled when scores
- * take both signs; INFINITY when no bound holds (qmax = 1, per_step infinite); 0 when nothing
- * scores (range 0 or per_step 0). */
-double ulam__score_range(double range, double per_step, double qmax, int signs, double m, double E);
+ * else, for scores that add per_step at most at each visit (weights bounded), with the walk's
+ * expected remaining weight after k steps at most kappa qmax^k (kappa 1 and qmax the largest
+ * continuation; or a Collatz-Wielandt certificate of |K|: kappa = max v / min v, qmax = u with
+ * |K| v <= u v), the range of walks of at most l steps, l chosen so that longer walks add at
+ * most E m to the mean (kappa per_step qmax^(l+1) / (1 - qmax) <= E m), doubled when scores
+ * take both signs; INFINITY when no bound holds (qmax >= 1, per_step or kappa infinite); 0
+ * when nothing scores (range 0 or per_step 0). */
+double ulam__score_range(double range, double per_step, double qmax, double kappa, int signs, double m, double E);
+
+/* The range R from a certified bound v2 on a single score's second moment, when no bound on
+ * the score itself holds (weights that can grow along cycles): scores above T = v2 / (E m)
+ * add at most E[|X| 1{|X| > T}] <= v2 / T = E m to the mean (Markov's inequality on X^2), so the
+ * rule takes the range of the scores up to T, doubled when they take both signs; INFINITY
+ * without a bound. */
+double ulam__moment_range(double v2, int signs, double m, double E);
+
+/* The bound on the bias of walks cut after max_steps steps, from the same length tail:
+ * kappa per_step qmax^max_steps / (1 - qmax); INFINITY without a tail bound, 0 when nothing
+ * scores.  The rel_err rule holds with cut walks only when this is at most ULAM__CUT_SHARE of
+ * E |m|. */
+double ulam__cut_bound(double per_step, double qmax, double kappa, int64_t max_steps);
+#define ULAM__CUT_SHARE 0.1
 
 /* The walks the range term needs at estimate m (> 0): ceil(ULAM__EB_RANGE R / (E m)); 0 when
  * there is no target or no finite nonzero R, INFINITY when m = 0. */

@@ -105,6 +105,8 @@ CASES += [
     (SOLVE + ["--index", "1", "--estimator", "psychic"], 2, r"--estimator expects", ""),
     (SOLVE + ["--index", "1", "--continue", "1"], 2, r"--continue expects a number", ""),
     (SOLVE + ["--index", "1", "--roulette", "2", "--split", "1"], 2, r"--split W must exceed", ""),
+    # a split weight below the start weight (1, adjoint) split every walk into 1e7 copies (11 s)
+    (SOLVE + ["--index", "1", "--walks", "1000", "--split", "1e-7"], 2, r"split weight of at least the start weight 1", ""),
     (SOLVE + ["--index", "9"], 2, r"--index 9 is out of range 1..4", ""),
     (SOLVE, 2, r"adjoint walks need --index", ""),
     (SOLVE + ["--index", "1", "--out", "/tmp/x.mtx"], 2, r"--out and --errors need --mode forward", ""),
@@ -329,6 +331,61 @@ def check_json(ulam):
     for k in ["n", "index", "value", "rcond", "residual", "seconds"]:
         assert k in o, k
     assert o["index"] == 1 and abs(o["value"] - 2.9329173166926679) < 1e-12 and o["residual"] < 1e-14
+
+
+def check_info_neumann(ulam):
+    """ulam info never gives the Neumann verdict from an unconverged estimate: a 2000-cycle of
+    random weights whose geometric mean is exactly 0.999 or 1.001 (rho(M) = that mean; Arnoldi
+    does not converge on it, and the old verdict was 'diverges' for 0.999, 'converges' for 1.001)
+    is 'unknown', JSON null; certified verdicts stay (chain4 by rho(|M|) < 1)."""
+    import math
+    import random
+    rnd = random.Random(7)
+    with tempfile.TemporaryDirectory() as d:
+        for rho in (0.999, 1.001):
+            a = [rnd.uniform(-0.5, 0.5) for _ in range(2000)]
+            mean = sum(a) / len(a)
+            p = os.path.join(d, "cyc.mtx")
+            with open(p, "w") as f:
+                f.write("%%MatrixMarket matrix coordinate real general\n2000 2000 2000\n")
+                for i in range(2000):
+                    f.write(f"{i + 1} {(i + 1) % 2000 + 1} {rho * math.exp(a[i] - mean):.17g}\n")
+            rc, out, _ = run(ulam, ["info", p, "--json"])
+            o = json.loads(out)
+            assert rc == 0 and o["neumann_converges"] is None and o["neumann_certified"] is False, (rho, o)
+            rc, out, _ = run(ulam, ["info", p])
+            assert rc == 0 and "Neumann series   unknown" in out, out
+    rc, out, _ = run(ulam, ["info", M + "chain4.mtx", "--json"])
+    o = json.loads(out)
+    assert o["neumann_converges"] is True and o["neumann_certified"] is True, o
+
+
+def check_rel_err_stops(ulam):
+    """--rel-err never claims 'met' without a certificate: walks cut at --max-steps whose bias
+    bound exceeds a tenth of the target stop the run at once (JSON rel_err_stop "cuts"; the old
+    rule printed 1813 +- 1.8 as met on this 1000-cycle of weights 0.9999, x = 10^4); a run with no
+    bound on a single score (splitting) is refused with rel-err alone (exit 4, the reason named)
+    and, bounded by --walks, reports rel_err_stop "no_bound"."""
+    with tempfile.TemporaryDirectory() as d:
+        p, pb = os.path.join(d, "cyc.mtx"), os.path.join(d, "cyc_b.mtx")
+        with open(p, "w") as f:
+            f.write("%%MatrixMarket matrix coordinate real general\n1000 1000 1000\n")
+            f.writelines(f"{i + 1} {(i + 1) % 1000 + 1} 0.9999\n" for i in range(1000))
+        with open(pb, "w") as f:
+            f.write("%%MatrixMarket matrix array real general\n1000 1\n" + "1\n" * 1000)
+        args = ["solve", p, "--rhs", pb, "--index", "1", "--rel-err", "0.01"]
+        rc, out, err = run(ulam, args + ["--max-steps", "2000", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["rel_err_met"] is False and o["rel_err_stop"] == "cuts" and o["walks"] == 1024, o
+        assert o["cut_bound"] > 1000 and "raise --max-steps" in err, (o, err)
+        rc, out, err = run(ulam, args + ["--max-steps", "2000"])
+        assert rc == 0 and re.search(r"^rel-err +NOT met .*raise --max-steps", out, re.M), out
+    rc, out, err = run(ulam, SOLVE + ["--index", "1", "--rel-err", "0.1", "--split", "2"])
+    assert rc == 4 and "splitting leaves the weights without a bound" in err, (rc, err)
+    rc, out, err = run(ulam, SOLVE + ["--index", "1", "--rel-err", "0.1", "--split", "2", "--walks", "5000", "--json"])
+    o = json.loads(out)
+    assert rc == 0 and o["rel_err_met"] is False and o["rel_err_stop"] == "no_bound" and o["walks"] == 5000, o
+    assert "no bound on a single walk's score" in err, err
 
 
 def check_solve_json(ulam):
@@ -954,7 +1011,7 @@ def main():
         rc, out, err = run(ulam, ["radiosity", "x.obj"])
         assert rc == 2 and "built without the radiosity front end" in err, err
     failures, n = check_table(ulam)
-    extra = [(check_json, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_interrupt, ulam),

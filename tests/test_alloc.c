@@ -152,7 +152,9 @@ static int walk_run(int mode, int est)
     int s = ulam_mm_read_matrix("matrices/chain4.mtx", &M, NULL);
     if (!s) s = ulam_mm_read_vector("matrices/chain4_b.mtx", &b, &n, NULL);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = mode, o.estimator = est, o.max_walks = 3000, o.threads = 2, o.roulette = 0.1, o.split = 2;
+    double w0 = mode == ULAM_ADJOINT ? 1.0 : 0.0; /* the start weight: 1 adjoint, ||b||_1 forward (a split weight below it is refused) */
+    for (int64_t i = 0; !s && mode == ULAM_FORWARD && i < n; i++) w0 += fabs(b[i]);
+    o.mode = mode, o.estimator = est, o.max_walks = 3000, o.threads = 2, o.roulette = 0.1 * w0, o.split = 2 * w0;
     ulam_walk_result r;
     if (!s) s = ulam_solve(M, b, &o, &r, NULL);
     ulam_csr_free(M), free(b);

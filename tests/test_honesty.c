@@ -60,8 +60,61 @@ static void test_rel_err_rare_scores(void **state)
     ulam_csr_free(M), free(b);
 }
 
+/* Load tests/data/NAME.mtx and NAME_b.mtx and solve with LAPACK. */
+static void load(const char *name, ulam_csr **M, double **b, double **x)
+{
+    char mp[256], bp[256];
+    int64_t n;
+    snprintf(mp, sizeof mp, "tests/data/%s.mtx", name);
+    snprintf(bp, sizeof bp, "tests/data/%s_b.mtx", name);
+    assert_int_equal(ulam_mm_read_matrix(mp, M, NULL), ULAM_OK);
+    assert_int_equal(ulam_mm_read_vector(bp, b, &n, NULL), ULAM_OK);
+    *x = malloc((size_t)n * sizeof **x);
+    assert_int_equal(ulam_direct_solve(*M, *b, *x, 0, NULL, NULL), ULAM_OK);
+}
+
+/* --rel-err where the old rule had no bound on a single score and fell back to the standard
+ * error and the fourth-moment check: (a) grow12, absorption, a reachable state whose weight
+ * factor S/q is 1.2 (row sum 1.2) ahead of rare scores of 20 000 (old: 2.000 +- 6e-6 at seed 2
+ * against 5.2013, coverage 7/100); (b) sticky1, collision, a reachable row sum of exactly 1
+ * (qmax = 1) in a sticky pair (old: coverage 8/100, 33% low).  Now the weight growth along
+ * paths bounds the first, a Collatz-Wielandt certificate of the length tail the second:
+ * coverage >= 0.9 R - 2 sqrt(0.09 R) and every stop at or past the range-term minimum. */
+static void test_rel_err_no_score_bound(void **state)
+{
+    (void)state;
+    static const struct { const char *name; int est, seeds; } cases[] = {
+        {"grow12", ULAM_ABSORPTION, 100}, {"sticky1", ULAM_COLLISION, 50}};
+    for (int k = 0; k < 2; k++) {
+        ulam_csr *M;
+        double *b, *x;
+        load(cases[k].name, &M, &b, &x);
+        int covered = 0, R = cases[k].seeds;
+        double walks = 0, bias = 0;
+        for (int s = 0; s < R; s++) { /* case (k, s) */
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.estimator = cases[k].est, o.index = 0, o.max_walks = 0, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
+            ulam_walk_result r;
+            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            if (!(r.rel_err_met && isfinite(r.tail_bound) && r.walks >= r.min_walks))
+                print_error("case (%d, %d): met %d, tail %g, %lld walks, min %g\n", k, s, r.rel_err_met, r.tail_bound,
+                            (long long)r.walks, r.min_walks);
+            assert_true(r.rel_err_met && isfinite(r.tail_bound) && r.walks >= r.min_walks);
+            covered += fabs(r.estimate - x[0]) <= ULAM_Z95 * r.std_error;
+            walks += (double)r.walks, bias += r.estimate - x[0];
+        }
+        int lower = (int)floor(0.9 * R - 2 * sqrt(0.09 * R));
+        print_message("%s: covered %d / %d (at least %d), mean bias %.2f%%, mean walks %.3g\n", cases[k].name, covered,
+                      R, lower, 100 * bias / R / x[0], walks / R);
+        if (covered < lower) print_error("case %d fails\n", k);
+        assert_true(covered >= lower);
+        ulam_csr_free(M), free(b), free(x);
+    }
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_rel_err_rare_scores)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_rel_err_rare_scores),
+                                       cmocka_unit_test(test_rel_err_no_score_bound)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -404,6 +404,36 @@ static void test_next_event_hidden(void **state)
     ulam_scene_free(s);
 }
 
+/* --rel-err in gathering with a channel still at 0: a box whose walls glow red and blue, lit in
+ * green only by a tiny lamp (10^-4 of the floor's area, Ke 10^4) that walks from the floor hit
+ * about once in 2 * 10^4.  The old rule skipped the zero channel and stopped absorption
+ * gathering after 1792 walks at 'G 0 +- 0'; now a zero channel some emitter emits in blocks
+ * the stop until the range term's minimum at the brightest channel's estimate, so the run
+ * ends with G lit and in agreement with next-event (which samples the lamp) within 4 sigma. */
+static void test_rel_err_zero_channel(void **state)
+{
+    (void)state;
+    ulam_scene *s = must_scene("tests/data/rad/green_lamp.obj");
+    ulam_tracer *t = must_tracer(s);
+    ulam_rad_result ne = rad_walk(t, ULAM_ADJOINT, ULAM_NEXT_EVENT, 0, 100000, 5, NULL);
+    assert_true(ne.radiosity[1] > 0);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.estimator = ULAM_ABSORPTION, o.index = 0, o.max_walks = 0, o.rel_err = 0.05, o.seed = 1, o.threads = 2;
+    ulam_rad_solver *sv = NULL;
+    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
+    while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
+    ulam_rad_result r;
+    ulam_rad_solver_result(sv, &r);
+    double sd = sqrt(ne.std_error[1] * ne.std_error[1] + r.std_error[1] * r.std_error[1]);
+    print_message("green lamp: G %.5f +- %.2g after %lld walks (min %.3g), next-event %.5f +- %.2g\n", r.radiosity[1],
+                  r.std_error[1], (long long)r.walks, r.min_walks, ne.radiosity[1], ne.std_error[1]);
+    assert_true(r.rel_err_met && r.radiosity[1] > 0 && (double)r.walks >= r.min_walks);
+    assert_close(r.radiosity[1], ne.radiosity[1], 4 * sd);
+    ulam_rad_solver_free(sv);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
 /* --view-gather solves what the camera sees and nothing else: inside the furnace cube (B = 2
  * everywhere) a wide camera looking at one face sees five faces, each gathered to its target
  * (within 4 sigma of 2), the face behind it untouched (se NaN, no walks spent on it); on the
@@ -1011,7 +1041,7 @@ int main(void)
         cmocka_unit_test(test_rel_err_zero),       cmocka_unit_test(test_shoot_coverage),
         cmocka_unit_test(test_render_framing),     cmocka_unit_test(test_next_event_coverage),
         cmocka_unit_test(test_next_event_back_sides), cmocka_unit_test(test_next_event_edge),
-        cmocka_unit_test(test_next_event_hidden),  cmocka_unit_test(test_view_gather),
+        cmocka_unit_test(test_next_event_hidden), cmocka_unit_test(test_rel_err_zero_channel),  cmocka_unit_test(test_view_gather),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

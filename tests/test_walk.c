@@ -216,8 +216,10 @@ static void test_roulette_and_splitting(void **state)
         o.continue_q = 0.5;
         o.max_walks = 200000;
         ulam_walk_result plain = run(&s, o);
-        o.split = 2.0;
-        o.roulette = 0.25;
+        double w0 = mode == ULAM_ADJOINT ? 1.0 : 0.0; /* the start weight: 1 adjoint, ||b||_1 forward (a split weight below it is refused) */
+        for (int64_t i = 0; mode == ULAM_FORWARD && i < s.n; i++) w0 += fabs(s.b[i]);
+        o.split = 2.0 * w0;
+        o.roulette = 0.25 * w0;
         ulam_walk_result ws = run(&s, o);
         assert_agrees(&s, &ws, 3);
         assert_true(ws.steps > plain.steps); /* splitting did make copies */
@@ -510,6 +512,55 @@ static void test_rel_err_infinite_refused(void **state)
     ulam_csr_free(M);
 }
 
+/* --max-steps cuts under --rel-err: a 1000-cycle of weights 0.9999 (x = 10^4, walks of 10^4
+ * steps) cut at 2000 steps.  The old rule stopped with 1813.19 +- 1.84 (z = -4444); now the
+ * cuts' bias bound (qmax^K / (1 - qmax) per unit score, 8187 here) exceeds a tenth of E |m|, so
+ * the run stops after its first round, not met, saying why (cut_stop), with no interval claimed
+ * as met; the same walks with a bound run on (--walks) also never meet it. */
+static void test_rel_err_cuts(void **state)
+{
+    (void)state;
+    enum { N = 1000 };
+    int32_t ti[N], tj[N];
+    double tx[N], b[N];
+    for (int i = 0; i < N; i++) ti[i] = i, tj[i] = (i + 1) % N, tx[i] = 0.9999, b[i] = 1.0;
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(N, N, N, ti, tj, tx, &M), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.max_walks = 0, o.rel_err = 0.01, o.max_steps = 2000, o.seed = 1;
+    ulam_walk_result r;
+    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    print_message("cut at 2000 steps: %lld of %lld walks cut, cut bound %.4g, met %d, cut_stop %d\n", (long long)r.cut,
+                  (long long)r.walks, r.cut_bound, r.rel_err_met, r.cut_stop);
+    assert_true(r.cut > 0 && !r.rel_err_met && r.cut_stop && r.walks <= 2048);
+    assert_true(r.cut_bound > 0.1 * 0.01 * r.estimate);
+    o.max_walks = 8192;
+    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_true(!r.rel_err_met && r.cut_stop);
+    o.max_steps = 1000000, o.max_walks = 2048, o.rel_err = 0; /* no cuts: no cut bias */
+    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_true(r.cut == 0 && r.cut_bound == 0.0 && !r.cut_stop);
+    ulam_error err;
+    /* a split weight below the start weight (1 adjoint, ||b||_1 = 1000 forward) is refused */
+    o = ulam_walk_defaults();
+    o.split = 1e-7;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    assert_non_null(strstr(err.msg, "split weight"));
+    o.mode = ULAM_FORWARD, o.split = 999;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    o.split = 1000, o.max_walks = 1024;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    /* splitting leaves no bound on a single score: --rel-err alone is refused at the start */
+    o = ulam_walk_defaults();
+    o.max_walks = 0, o.rel_err = 0.1, o.split = 2.0;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
+    assert_non_null(strstr(err.msg, "bound on a single walk's score"));
+    o.max_walks = 4096; /* bounded by walks: runs, never met */
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_true(r.walks == 4096 && !r.rel_err_met && !isfinite(r.tail_bound));
+    ulam_csr_free(M);
+}
+
 /* Forward mode at 1000 walks: a component no walk tallied has no estimate (NaN error, counted),
  * never 0 +- 0 (states 1-3 of rare_system here have rows summing to 1e-4 and b = 0: forward
  * walks reach each about once in 7000 walks, and x there is about 2.5e-4, which came out as
@@ -543,7 +594,13 @@ static void test_forward_unreached(void **state)
     ulam_solver_free(sv);
     o.index = first, o.max_walks = 0, o.rel_err = 0.2; /* an unreached component, watched */
     assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
-    assert_true(r.rel_err_met && isfinite(r.std_error) && r.std_error <= 0.2 * fabs(r.estimate));
+    print_message("rel_err 0.2 on an unreached component: %lld walks, met %d, out of reach %d, min walks %.3g\n",
+                  (long long)r.walks, r.rel_err_met, r.out_of_reach, r.min_walks);
+    /* M' has column sums above 1 on cycles, so weights grow without a bound and the rule's
+     * minimum comes from the certified second moment: far out of reach.  The run keeps going
+     * while the component is unreached, then ends, not met, instead of running to the cap. */
+    assert_true(!r.rel_err_met && r.out_of_reach && r.min_walks > ULAM_REL_ERR_CAP && r.walks < ULAM_REL_ERR_CAP);
+    assert_true(isfinite(r.std_error) && r.std_error > 0);
     assert_true(fabs(r.estimate - s.x[first]) < 4 * r.std_error);
     free(x), free(e);
     unload(&s);
@@ -585,7 +642,7 @@ int main(void)
         cmocka_unit_test(test_rel_err_stop),      cmocka_unit_test(test_jacobi_poisson),
         cmocka_unit_test(test_collision_absorption_law),
         cmocka_unit_test(test_solver_guards),     cmocka_unit_test(test_rel_err_infinite_refused),
-        cmocka_unit_test(test_forward_unreached), cmocka_unit_test(test_rel_err_collision_tail),
+        cmocka_unit_test(test_forward_unreached), cmocka_unit_test(test_rel_err_cuts), cmocka_unit_test(test_rel_err_collision_tail),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -24,7 +24,21 @@ static const char *const usage =
     "  --tol T      relative residual tolerance of the rho(M) estimate\n"
     "  --json       print one JSON object\n";
 
-static const char *const unsure = " [estimate not converged: verdict uncertain]";
+static const char *const unsure = " [the estimate did not converge]";
+
+/* The Neumann verdict on rho(M) < 1: 1 converges, 0 diverges, -1 unknown; *certified says
+ * whether bounds decide it (rho(M) <= rho(|M|) < 1 certified; a nonnegative M with rho(|M|)
+ * certified >= 1), else a converged Arnoldi estimate at least 1% away from 1 decides it, never
+ * an unconverged one. */
+static int neumann_verdict(const ulam_csr_stats *st, const ulam_radius *r, const ulam_guard *g, int *certified)
+{
+    *certified = 1;
+    if (g->abs.upper < 1) return 1;
+    if (st->nonnegative && g->abs.lower >= 1) return 0;
+    *certified = 0;
+    if (r->converged && fabs(r->rho - 1) >= 0.01) return r->rho < 1;
+    return -1;
+}
 
 /* Print the human-readable report. */
 static void print_text(const cli_system *s, const ulam_csr_stats *st, const ulam_radius *r,
@@ -46,8 +60,12 @@ static void print_text(const cli_system *s, const ulam_csr_stats *st, const ulam
     cli_print_power(&g->hat[ULAM_ADJOINT]);
     printf("\nrho(M^) forward  ");
     cli_print_power(&g->hat[ULAM_FORWARD]);
-    printf("\nNeumann series   %s%s\n", r->rho < 1 ? "converges (rho(M) < 1)" : "diverges (rho(M) >= 1)",
-           r->converged ? "" : unsure);
+    int cert, nv = neumann_verdict(st, r, g, &cert);
+    printf("\nNeumann series   %s%s\n",
+           nv == 1 ? "converges (rho(M) < 1)" : nv == 0 ? "diverges (rho(M) >= 1)" : "unknown (rho(M) not certified on either side of 1)",
+           nv < 0 ? (r->converged ? " [the estimate is within 1% of 1]" : unsure)
+           : cert ? (nv ? " [certified: rho(M) <= rho(|M|) < 1]" : " [certified: M >= 0 and rho(|M|) >= 1]")
+                  : " [converged estimate, not certified]");
     printf("walks            %s (rho(|M|) %s)\n",
            g->verdict_abs == ULAM_VERDICT_FAIL ? "diverge: use 'ulam direct'"
            : g->verdict_abs == ULAM_VERDICT_UNKNOWN ? "unknown: refused unless --force" : "converge",
@@ -82,7 +100,9 @@ static void print_json(const cli_system *s, const ulam_csr_stats *st, const ulam
     cli_json_radius("rho_abs", &g->abs);
     cli_json_radius("rho_hat_adjoint", &g->hat[ULAM_ADJOINT]);
     cli_json_radius("rho_hat_forward", &g->hat[ULAM_FORWARD]);
-    printf("\"neumann_converges\": %s, ", r->rho < 1 ? "true" : "false");
+    int cert, nv = neumann_verdict(st, r, g, &cert);
+    printf("\"neumann_converges\": %s, \"neumann_certified\": %s, ", nv < 0 ? "null" : nv ? "true" : "false",
+           cert ? "true" : "false");
     cli_json_variance("walks_converge", g->verdict_abs <= ULAM_VERDICT_EDGE ? 1 : g->verdict_abs == ULAM_VERDICT_FAIL ? 0 : -1);
     cli_json_variance("variance_finite_adjoint", ulam_guard_variance(g, ULAM_ADJOINT));
     cli_json_variance("variance_finite_forward", ulam_guard_variance(g, ULAM_FORWARD));
@@ -112,7 +132,8 @@ static int print_omegas(const cli_system *base, const ulam_spectral_opts *so)
         ulam_csr_free(M);
         if (!status)
             printf("                 %5.2f   %-9.6f  %-9.6f  %-9s  %s\n", omega, r.rho, pa.rho,
-                   r.rho < 1 ? "converges" : "diverges", ulam_verdict_of(&pa) <= ULAM_VERDICT_EDGE ? "converge" : ulam_verdict_of(&pa) == ULAM_VERDICT_FAIL ? "diverge" : "unknown");
+                   pa.upper < 1 ? "converges" : !r.converged || fabs(r.rho - 1) < 0.01 ? "unknown"
+                   : r.rho < 1 ? "converges" : "diverges", ulam_verdict_of(&pa) <= ULAM_VERDICT_EDGE ? "converge" : ulam_verdict_of(&pa) == ULAM_VERDICT_FAIL ? "diverge" : "unknown");
     }
     ulam_csr_free(A);
     free(b), free(bp);

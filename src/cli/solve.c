@@ -136,12 +136,19 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (o->mode == ULAM_FORWARD)
         printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
                (long long)r->unreached, (long long)ro->n);
-    if (o->rel_err > 0 && r->min_walks > 0)
-        printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate)\n",
-               r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks);
+    if (o->rel_err > 0 && r->cut_stop)
+        printf("rel-err         NOT met (target %.3g): %lld walks were cut at %lld steps and the cut's bias may be "
+               "%.3g, more than a tenth of the target error: unreachable by more walks (raise --max-steps)\n",
+               o->rel_err, (long long)r->cut, (long long)o->max_steps, r->cut_bound);
+    else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
+        printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
+               o->rel_err);
+    else if (o->rel_err > 0 && r->min_walks > 0)
+        printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate%s)\n",
+               r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
+               r->out_of_reach ? ", beyond the 1e9 cap: stopped" : "");
     else if (o->rel_err > 0)
-        printf("rel-err         %s (target %.3g; no score bound: the standard error and the fourth-moment check "
-               "decide)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
+        printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
     if (ro->au) cli_auto_print_text(ro->au);
@@ -176,6 +183,9 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (o->rel_err > 0) {
         cli_json_number("min_walks", r->min_walks, 0);
         printf("\"rel_err_met\": %s, ", r->rel_err_met ? "true" : "false");
+        cli_json_number("cut_bound", r->cut_bound, 0);
+        printf("\"rel_err_stop\": %s, ", r->cut_stop ? "\"cuts\"" : r->out_of_reach ? "\"out_of_reach\""
+                                       : !isfinite(r->tail_bound) && r->estimate != 0 ? "\"no_bound\"" : "null");
     }
     if (o->mode == ULAM_FORWARD) printf("\"unreached\": %lld, ", (long long)r->unreached);
     cli_json_number("variance", r->variance, 0);
@@ -262,7 +272,14 @@ static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, cons
 static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const ulam_walk_result *r)
 {
     double limit = o->max_walks > 0 ? (double)o->max_walks : 1e8;
-    if (!(o->rel_err > 0) || !(r->min_walks > limit)) return;
+    if (!(o->rel_err > 0)) return;
+    if (!isfinite(r->tail_bound) && r->walks > 0 && r->estimate != 0) { /* (at 0 the tail is infinite too) */
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g: no bound on a single walk's score holds (weights can grow "
+                        "without bound, or the walk's length tail is not certified): the rule cannot be met; the "
+                        "run ends by --walks or --time\n", s->matrix_path, o->rel_err);
+        return;
+    }
+    if (!(r->min_walks > limit)) return;
     if (isfinite(r->score_bound))
         fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %s score can reach %.4g, so the rule needs about "
                         "%.3g walks at this estimate before it may stop (%s)%s\n", s->matrix_path, o->rel_err,
@@ -381,6 +398,10 @@ int cli_solve(int argc, char **argv)
     o.assume_finite = ro.assume_finite;
     t0 = ulam_now();
     int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err); /* refuses what the guards refuse */
+    if (status == ULAM_EINVAL && o.split > 0 && strstr(err.msg, "split weight")) {
+        cli_system_free(&s);
+        return cli_usage_error("solve", "--split W: %s", err.msg);
+    }
     ro.kernel_seconds = ulam_now() - t0;
     int64_t n = s.M->nrows;
     if (status == ULAM_EDIVERGE) {
@@ -417,6 +438,11 @@ int cli_solve(int argc, char **argv)
     }
     cli_progress_end(&pg);
     ulam_solver_result(sv, &r);
+    if (r.cut_stop)
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g is unreachable: %lld walks were cut at --max-steps %lld and "
+                        "the cut's bias may be up to %.3g, more than a tenth of the target error; stopped after %lld "
+                        "walks (raise --max-steps)\n", s.matrix_path, o.rel_err, (long long)r.cut,
+                (long long)o.max_steps, r.cut_bound, (long long)r.walks);
     rc = 0;
     if (status == ULAM_ENOMEM) {
         fprintf(stderr, "ulam: %s: error: %s: expected memory to build the walk kernel's rows\n", s.matrix_path,

@@ -434,11 +434,11 @@ static void merge_block(ulam_rad_solver *s, const rad_block *br)
     s->nonfinite += br->nonfinite;
 }
 
-/* Gathering: the walks the rel_err rule's range term needs in channel c at its estimate. */
-static double channel_min_walks(const ulam_rad_solver *s, int c, double E)
+/* Gathering: the walks the rel_err rule's range term needs in channel c at estimate m. */
+static double channel_min_walks(const ulam_rad_solver *s, int c, double m, double E)
 {
-    double m = fabs(s->m[c].mean);
-    return ulam__rel_min_walks(ulam__score_range(s->range[c], s->per_step[c], s->qmax, 0, m, E), E, m);
+    m = fabs(m);
+    return ulam__rel_min_walks(ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, m, E), E, m);
 }
 
 /* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
@@ -447,11 +447,19 @@ static double channel_min_walks(const ulam_rad_solver *s, int c, double E)
 static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, double rel_err)
 {
     int any = 0;
+    double bright = 0.0; /* the brightest nonzero channel's estimate */
+    for (int c = 0; c < 3; c++) bright = fmax(bright, fabs(r->radiosity[c]));
     for (int c = 0; c < 3; c++) {
+        /* a channel still at 0 in which some emitter emits: no walk has scored it yet, so it
+         * blocks the stop until enough walks ran to have seen any of its scores worth E times
+         * the brightest channel (the range term at that estimate); gathering only */
+        if (r->radiosity[c] == 0.0 && s->o.mode != ULAM_FORWARD && s->per_step[c] > 0 && bright > 0 &&
+            (double)r->walks < channel_min_walks(s, c, bright, rel_err))
+            return 0;
         if (r->radiosity[c] == 0.0) continue;
         if (s->o.mode == ULAM_FORWARD ? !(r->std_error[c] <= rel_err * fabs(r->radiosity[c]))
                                       : !ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c],
-                                                             channel_min_walks(s, c, rel_err),
+                                                             channel_min_walks(s, c, s->m[c].mean, rel_err),
                                                              ulam__moments_variance_rel_error(&s->m[c]), rel_err))
             return 0;
         any = 1;
@@ -543,10 +551,14 @@ void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
         }
     }
     r->max_share = s->sq > 0 ? fmin(1.0, s->maxsq / s->sq) : 0.0;
+    double bright = 0.0;
+    for (int c = 0; c < 3; c++) bright = fmax(bright, fabs(s->m[c].mean));
     for (int c = 0; c < 3 && s->o.mode == ULAM_ADJOINT && s->o.rel_err > 0; c++)
         if (s->m[c].mean != 0.0) {
-            r->min_walks = fmax(r->min_walks, channel_min_walks(s, c, s->o.rel_err));
+            r->min_walks = fmax(r->min_walks, channel_min_walks(s, c, s->m[c].mean, s->o.rel_err));
             r->variance_rel_error = fmax(r->variance_rel_error, ulam__moments_variance_rel_error(&s->m[c]));
+        } else if (s->per_step[c] > 0 && bright > 0) { /* an emitting channel not yet scored (precise_enough) */
+            r->min_walks = fmax(r->min_walks, channel_min_walks(s, c, bright, s->o.rel_err));
         }
     r->walks = s->walks;
     r->rays = s->rays;
