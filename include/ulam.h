@@ -529,7 +529,8 @@ typedef struct ulam_walk_result {
     double variance_rel_error; /* relative standard error of `variance` (fourth moment) */
     int rel_err_met;     /* 1: stopped by the rel_err rule */
     double cut_bound;    /* the most the walks cut at max_steps can have moved the mean (0: none
-                            cut; INFINITY: no bound); the rel_err rule needs it <= 0.1 E |m| */
+                            cut; INFINITY: no bound); the rel_err rule needs it <= 0.1 E |m|, and
+                            ci95 is NaN (no interval) while it exceeds std_error */
     int cut_stop;        /* 1: stopped because the cuts' bias may exceed the rel_err target
                             (raise max_steps) */
     int out_of_reach;    /* 1: rel_err alone, stopped after a round because the rule's minimum

@@ -845,7 +845,9 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->cut_stop = s->cut_stop;
     r->out_of_reach = s->out_of_reach;
     r->rel_err_met = s->met;
-    double half = s->var_finite == 1 ? ULAM_Z95 * r->std_error : NAN;
+    /* no interval when the variance is not certified finite, or when walks cut at max_steps may
+       have moved the mean by more than the standard error (the interval would hide the bias) */
+    double half = s->var_finite == 1 && !(r->cut_bound > r->std_error) ? ULAM_Z95 * r->std_error : NAN;
     r->ci95[0] = r->estimate - half;
     r->ci95[1] = r->estimate + half;
     r->walks = s->walks;

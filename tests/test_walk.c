@@ -470,6 +470,7 @@ static void test_solver_guards(void **state)
     assert_true(isnan(r.ci95[0]));
     ulam_solver_free(sv);
     o.assume_finite = 1; /* the user's word that unknown is finite: an interval again */
+    o.max_steps = 1000000; /* and no cut walks, whose unbounded bias would withhold it */
     assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
     assert_int_equal(r.variance_finite, 1);
     assert_true(isfinite(r.ci95[0]));
@@ -534,6 +535,9 @@ static void test_rel_err_cuts(void **state)
                   (long long)r.walks, r.cut_bound, r.rel_err_met, r.cut_stop);
     assert_true(r.cut > 0 && !r.rel_err_met && r.cut_stop && r.walks <= 2048);
     assert_true(r.cut_bound > 0.1 * 0.01 * r.estimate);
+    /* and no interval: the cuts may have moved the mean (exact 10^4, estimate ~1.8e3) by more than
+       the standard error, so a 95% interval would hide the bias */
+    assert_true(r.cut_bound > r.std_error && isnan(r.ci95[0]) && isnan(r.ci95[1]));
     o.max_walks = 8192;
     assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(!r.rel_err_met && r.cut_stop);

@@ -100,6 +100,10 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (o->mode == ULAM_FORWARD && isnan(r->std_error))
         printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->index + 1,
                o->index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
+    else if (r->variance_finite == 1 && isnan(r->ci95[0]))
+        printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: walks cut at --max-steps may have moved it by up "
+               "to %.3g, more than its standard error)%s\n", (long long)o->index + 1, o->index < 9 ? 10 : 9, "",
+               r->estimate, r->std_error, r->cut_bound, r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1)
         printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->index + 1,
                o->index < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
