@@ -267,37 +267,43 @@ def check_radiosity_rare_lamp(ulam):
     assert covered >= 88, f"next-event on the rare lamp: {covered} of 100 intervals cover"
 
 
-def check_progress(ulam):
-    """solve and radiosity show a progress line when stderr is a terminal (walks, estimate +-
-    error, elapsed, time left for --rel-err), and nothing with --json; on a pipe the table's
-    empty-stderr cases show there is none."""
+def on_tty(ulam, args):
+    """Run ulam with stderr on a pseudo-terminal: (exit code, what it wrote there)."""
     import pty
+    master, slave = pty.openpty()
+    p = subprocess.Popen([ulam] + args, stdout=subprocess.PIPE, stderr=slave)
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 4096)
+        except OSError:
+            break
+        if not data:
+            break
+        chunks.append(data)
+    p.communicate(timeout=120)
+    os.close(master)
+    return p.returncode, b"".join(chunks).decode(errors="replace")
 
-    def on_tty(args):
-        master, slave = pty.openpty()
-        p = subprocess.Popen([ulam] + args, stdout=subprocess.PIPE, stderr=slave)
-        os.close(slave)
-        chunks = []
-        while True:
-            try:
-                data = os.read(master, 4096)
-            except OSError:
-                break
-            if not data:
-                break
-            chunks.append(data)
-        p.communicate(timeout=120)
-        os.close(master)
-        return p.returncode, b"".join(chunks).decode(errors="replace")
+
+def check_radiosity_progress(ulam):
+    """radiosity shows its progress line on a terminal too."""
+    rc, err = on_tty(ulam, ["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.001",
+                            "--threads", "1", "--estimator", "next-event"])
+    assert rc == 0 and re.search(r"\rulam: \d+ walks, ", err), err
+
+
+def check_progress(ulam):
+    """solve shows a progress line when stderr is a terminal (walks, estimate +- error, elapsed,
+    time left for --rel-err), and nothing with --json; on a pipe the table's empty-stderr cases
+    show there is none."""
     solve = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "7", "--threads", "1",
              "--rel-err", "0.0003"]
-    rc, err = on_tty(solve)
+    rc, err = on_tty(ulam, solve)
     assert rc == 0 and re.search(r"\rulam: \d+ walks, [-\d.e+]+ \+- [\d.e+-]+, [\d.]+ s, about \d+ s left", err), err
-    rc, err = on_tty(solve + ["--json"])
+    rc, err = on_tty(ulam, solve + ["--json"])
     assert rc == 0 and "walks," not in err, err
-    rc, err = on_tty(["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.001", "--threads", "1",
-                      "--estimator", "next-event"])
-    assert rc == 0 and re.search(r"\rulam: \d+ walks, ", err), err
 
 
 def run(ulam, args):
@@ -1018,7 +1024,8 @@ def main():
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
-             (check_bidir, ulam), (check_auto, ulam), (check_progress, ulam)]
+             (check_bidir, ulam), (check_auto, ulam), (check_progress, ulam),
+             (check_radiosity_progress, ulam)]
     for f, arg in extra if radiosity else [e for e in extra if "radiosity" not in e[0].__name__]:
         try:
             f(arg)
