@@ -1,0 +1,143 @@
+/* The round driver shared by matrix walks (solve.c) and patch walks (radiosity/patchwalk.c):
+ * rounds of blocks of walks spread over threads and, through ulam_share, over processes, whose
+ * results every process then holds in block order (so any thread or rank count gives the same
+ * totals); and the budget and time tests a round stops on. */
+#include "internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Nonzero when a block starting at walk first may start. */
+int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first)
+{
+    if (o->interrupt && *o->interrupt) return 0;
+    return first == 0 || !(o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds);
+}
+
+/* Nonzero when this process runs block q. */
+int ulam__mine(const ulam_share *sh, int64_t q)
+{
+    return !sh || sh->nranks <= 1 || q % sh->nranks == sh->rank;
+}
+
+/* This process's stop flags: 1 time is up, 2 interrupted. */
+static int local_stop(const ulam_walk_opts *o, double t0)
+{
+    int f = o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds ? 1 : 0;
+    return f | (o->interrupt && *o->interrupt ? 2 : 0);
+}
+
+/* Append n bytes to the buffer *buf of length *len and capacity *cap. */
+static int put(unsigned char **buf, int64_t *len, int64_t *cap, const void *p, size_t n)
+{
+    if (ulam__grow(buf, cap, *len + (int64_t)n, 1)) return ULAM_ENOMEM;
+    if (n) memcpy(*buf + *len, p, n);
+    *len += (int64_t)n;
+    return ULAM_OK;
+}
+
+/* This process's message: its length and stop flags, then for each block it ran, its index,
+ * struct and tallies. */
+static int pack(const void *blocks, const ulam__blocks *L, int nb, int64_t q0, const ulam_share *sh,
+                int stop, unsigned char **buf, int64_t *len)
+{
+    int64_t cap = 0, tlen, head[2] = {0, stop};
+    int status = put(buf, len, &cap, head, sizeof head);
+    for (int64_t k = 0; k < nb && !status; k++) {
+        if (!ulam__mine(sh, q0 + k)) continue;
+        const unsigned char *b = (const unsigned char *)blocks + (size_t)k * L->size;
+        void *t;
+        memcpy(&t, b + L->off_ptr, sizeof t);
+        memcpy(&tlen, b + L->off_len, sizeof tlen);
+        if (!(status = put(buf, len, &cap, &k, sizeof k)) && !(status = put(buf, len, &cap, b, L->size)))
+            status = put(buf, len, &cap, t, (size_t)tlen * L->tally_size);
+    }
+    if (!status) memcpy(*buf, len, sizeof *len);
+    return status;
+}
+
+/* Read one process's message (n bytes at p) into blocks[], each block keeping its own tally
+ * storage; *stop |= its flags. */
+static int unpack(const unsigned char *p, size_t n, void *blocks, const ulam__blocks *L, int nb, int *stop)
+{
+    int64_t head[2];
+    memcpy(head, p, sizeof head);
+    *stop |= (int)head[1];
+    for (size_t at = sizeof head; at < n;) {
+        int64_t k, tlen, cap;
+        if (n - at < sizeof k + L->size) return ULAM_EIO;
+        memcpy(&k, p + at, sizeof k);
+        if (k < 0 || k >= nb) return ULAM_EIO;
+        unsigned char *b = (unsigned char *)blocks + (size_t)k * L->size;
+        void *t;
+        memcpy(&t, b + L->off_ptr, sizeof t);
+        memcpy(&cap, b + L->off_cap, sizeof cap);
+        memcpy(b, p + at + sizeof k, L->size);
+        at += sizeof k + L->size;
+        memcpy(&tlen, b + L->off_len, sizeof tlen);
+        memcpy(b + L->off_ptr, &t, sizeof t);
+        memcpy(b + L->off_cap, &cap, sizeof cap);
+        if (tlen < 0 || (uint64_t)tlen > (n - at) / L->tally_size) return ULAM_EIO;
+        if (ulam__grow(b + L->off_ptr, &cap, tlen, L->tally_size)) return ULAM_ENOMEM;
+        memcpy(b + L->off_cap, &cap, sizeof cap);
+        memcpy(&t, b + L->off_ptr, sizeof t);
+        if (tlen) memcpy(t, p + at, (size_t)tlen * L->tally_size);
+        at += (size_t)tlen * L->tally_size;
+    }
+    return ULAM_OK;
+}
+
+/* Exchange a round's nb blocks (from block q0) between the processes of o->share; *stop gets
+ * the stop flags or'ed over them (this process's alone without a share). */
+static int exchange(const ulam_walk_opts *o, double t0, void *blocks, const ulam__blocks *L, int nb, int64_t q0,
+                    int *stop)
+{
+    const ulam_share *sh = o->share;
+    *stop = local_stop(o, t0);
+    if (!sh || sh->nranks <= 1) return ULAM_OK;
+    unsigned char *mine = NULL;
+    int64_t len = 0, head[2] = {sizeof head, *stop | 4}; /* 4: this process failed */
+    int status = pack(blocks, L, nb, q0, sh, *stop, &mine, &len);
+    void *all = NULL;
+    size_t total = 0; /* every process takes part, even one that failed to pack */
+    if (sh->allgather(sh->ctx, status ? (void *)head : mine, status ? sizeof head : (size_t)len, &all, &total))
+        status = ULAM_EIO;
+    free(mine);
+    for (size_t at = 0; !status && at < total;) {
+        int64_t n;
+        if (total - at < 2 * sizeof n) status = ULAM_EIO;
+        else memcpy(&n, (const unsigned char *)all + at, sizeof n);
+        if (!status && (n < (int64_t)(2 * sizeof n) || (uint64_t)n > total - at)) status = ULAM_EIO;
+        if (!status) status = unpack((const unsigned char *)all + at, (size_t)n, blocks, L, nb, stop);
+        at += status ? 0 : (size_t)n;
+    }
+    if (!status && (*stop & 4)) status = ULAM_ENOMEM; /* another process could not pack */
+    free(all);
+    return status;
+}
+
+/* One round of blocks, in parallel, then the exchange between processes.  Rounds grow 1, 2,
+ * 4, ... blocks up to B->round (a round is as long as all before it), so a --rel-err or time
+ * rule is checked often while little has run, and the schedule depends on walks done only,
+ * never on the thread count. */
+int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int threads, void *ctx,
+                void *results, int *nb, int *stop)
+{
+    int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX, done = next / B->block;
+    int round = done + 1 < B->round ? (int)(done + 1) : B->round, n = 0;
+    while (n < round && left > (int64_t)n * B->block) n++;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int k = 0; k < n; k++) {
+        int64_t rest = left - (int64_t)k * B->block;
+        B->run(ctx, k, next + (int64_t)k * B->block, rest < B->block ? rest : B->block, ulam__thread_num());
+    }
+    int status = exchange(o, t0, results, B, n, done, stop);
+    *nb = status ? 0 : n;
+    return status;
+}
+
+/* Nonzero when the walk budget is spent or the stop flags say time is up. */
+int ulam__budget_spent(const ulam_walk_opts *o, int stop, int64_t walks)
+{
+    return (stop & 1) || (o->max_walks > 0 && walks >= o->max_walks);
+}
