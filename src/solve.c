@@ -625,9 +625,8 @@ int ulam_solver_done(const ulam_solver *s)
  * walk has tallied it (unreached: 0 +- 0 would claim certainty). */
 static void forward_component(const ulam_solver *s, int64_t i, double *est, double *se, double *var)
 {
-    double N = (double)s->walks;
-    double mean = N > 0 ? s->sum[i] / N : 0.0;
-    double v = N > 1 ? fmax(0.0, (s->sumsq[i] - N * mean * mean) / (N - 1)) : 0.0;
+    double N = (double)s->walks, mean, v;
+    ulam__sums_moments(N, s->sum[i], s->sumsq[i], &mean, &v);
     *est = mean + (s->o.estimator == ULAM_EXPECTED ? s->b[i] : 0.0);
     *var = v;
     *se = N > 0 ? sqrt(v / N) : INFINITY;

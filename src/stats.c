@@ -90,3 +90,11 @@ int ulam__rel_err_holds(int64_t n, double m, double se, double min_walks, double
     return E > 0 && n >= ULAM__REL_MIN && m > 0 && se <= E * m && (double)n >= min_walks &&
            var_rel_error <= ULAM__VAR_REL_MAX;
 }
+
+/* Mean and sample variance from a sum and a sum of squares. */
+void ulam__sums_moments(double n, double sum, double sumsq, double *mean, double *variance)
+{
+    double m = n > 0 ? sum / n : 0.0;
+    *mean = m;
+    *variance = n > 1 ? fmax(0.0, (sumsq - n * m * m) / (n - 1)) : 0.0;
+}

@@ -27,6 +27,12 @@ double ulam__moments_variance(const ulam__moments *m);
  * when every observation is alike. */
 double ulam__moments_variance_rel_error(const ulam__moments *m);
 
+/* The mean and sample variance (n - 1 denominator, never negative) of n observations given by
+ * their sum and sum of squares (forward tallies, shooting tallies: components that most
+ * observations leave at 0 are kept as sums, not moments); mean 0 and variance 0 below n = 1
+ * and n = 2. */
+void ulam__sums_moments(double n, double sum, double sumsq, double *mean, double *variance);
+
 /* The rel_err stopping rule, shared by matrix and patch walks (derived in README.md, "When to
  * trust the error bar"): at least ULAM__REL_MIN walks; stderr <= E |m|; the empirical-Bernstein
  * range term 3 ln(3 / delta) R / N at delta = 0.05 within E |m|, so N >= ULAM__EB_RANGE R /

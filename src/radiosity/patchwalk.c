@@ -530,9 +530,8 @@ int ulam_rad_solver_done(const ulam_rad_solver *s)
 /* Shooting estimate and standard error of patch p's radiosity in channel c. */
 static void shot_component(const ulam_rad_solver *s, int64_t p, int c, double *est, double *se)
 {
-    double N = (double)s->walks, A = s->s->area[p];
-    double mean = N > 0 ? s->sum[3 * p + c] / N : 0.0;
-    double v = N > 1 ? fmax(0.0, (s->sumsq[3 * p + c] - N * mean * mean) / (N - 1)) : 0.0;
+    double N = (double)s->walks, A = s->s->area[p], mean, v;
+    ulam__sums_moments(N, s->sum[3 * p + c], s->sumsq[3 * p + c], &mean, &v);
     *est = s->s->emit[3 * p + c] + mean / A; /* the emission exactly, the reflected light by the walks */
     *se = N > 0 ? sqrt(v / N) / A : INFINITY;
 }
