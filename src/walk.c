@@ -246,8 +246,8 @@ static void forward_visit(const ulam__walker *w, ulam__scratch *sc, const ulam__
             tally(sc, w->mt->colidx[q], wt * w->mt->val[q]);
 }
 
-/* One forward history: its (state, tally) pairs go to out->t. */
-static int forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc, ulam__block *out)
+/* One forward history: its tallies go to the block's sums (emit). */
+static void forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc, ulam__block *out)
 {
     ulam_kernel *k = w->k;
     uint64_t frac;
@@ -283,7 +283,6 @@ static int forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc
     }
     out->walks++;
     emit(w, sc, out);
-    return ULAM_OK;
 }
 
 /* Run count forward histories, one at a time, counting into a local block. */

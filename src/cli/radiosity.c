@@ -241,16 +241,14 @@ static int find_patch(const ulam_scene *s, const char *arg, int64_t *p)
 
 /* After the first round: say so when the rel-err rule's minimum walk count (the bound on one
  * walk's score: a bright emitter a walk rarely hits) is out of reach, and name next-event. */
-static void rel_err_warning(const args *a, const ulam_rad_solver *sv)
+static void rel_err_warning(const args *a, const ulam_rad_result *r)
 {
-    ulam_rad_result r;
-    ulam_rad_solver_result(sv, &r);
     double limit = a->o.max_walks > 0 && a->o.max_walks < ULAM_REL_ERR_CAP ? (double)a->o.max_walks : 1e8;
-    if (!(a->o.rel_err > 0) || !(r.min_walks > limit)) return;
+    if (!(a->o.rel_err > 0) || !(r->min_walks > limit)) return;
     fprintf(stderr, "ulam: %s: warning: --rel-err %g: one walk can score up to a bright emitter's radiosity at every "
                     "bounce, so the rule needs about %.3g walks at this estimate before it may stop (%s): "
                     "--estimator next-event samples the emitters directly and has no such tail\n",
-            a->scene, a->o.rel_err, r.min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
+            a->scene, a->o.rel_err, r->min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
 }
 
 /* Ray walks (gathering or shooting); 0 or an exit code. */
@@ -263,16 +261,15 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     cli_catch_sigint();
     cli_progress pg;
     cli_progress_start(&pg, a->json);
+    ulam_rad_result r;
     for (int round = 0; !status && !ulam_rad_solver_done(sv); round++) {
         status = ulam_rad_solver_iterate(sv);
-        if (round == 0) rel_err_warning(a, sv);
-        ulam_rad_result pr;
-        ulam_rad_solver_result(sv, &pr);
-        cli_progress_show(&pg, pr.walks, pr.radiosity[0], pr.std_error[0], a->o.rel_err); /* the red channel */
+        ulam_rad_solver_result(sv, &r);
+        if (round == 0) rel_err_warning(a, &r);
+        cli_progress_show(&pg, r.walks, r.radiosity[0], r.std_error[0], a->o.rel_err); /* the red channel */
     }
     cli_progress_end(&pg);
     cli_release_sigint();
-    ulam_rad_result r;
     ulam_rad_solver_result(sv, &r);
     memcpy(w->B, r.radiosity, sizeof w->B);
     memcpy(w->se, r.std_error, sizeof w->se);
