@@ -306,22 +306,28 @@ typedef struct ulam_guard_opts {
     int tight; /* nonzero: iterate every radius to the tolerance (ulam info); 0: stop as soon
                   as the bounds certify the verdict (one O(nnz) pass when row or column sums do) */
     ulam_power_opts power; /* the iteration (certify is set by tight) */
+    double kernel_alpha;   /* the kernel exponent of the walks whose rho(M^) is computed (see
+                              ulam_walk_opts; default 1) */
 } ulam_guard_opts;
 
-/* The defaults: all three radii, stopped once certified. */
+/* The defaults: all three radii, stopped once certified, kernel exponent 1. */
 ulam_guard_opts ulam_guard_defaults(void);
 
-/* The guards of a walk on M with continuation continue_q (<= 0: analog), a plain struct (a
- * certificate a prepared-system file can store and reload):
- *   abs:    rho(|M|) (= rho(|M'|)): the walk's expectation is a convergent series iff < 1;
+/* The guards of a walk on M with continuation continue_q (<= 0: analog) and kernel exponent
+ * alpha, a plain struct (a certificate a prepared-system file can store and reload):
+ *   abs:    rho(|M|) (= rho(|M'|)): the walk's expectation is a convergent series iff < 1 (for
+ *           every alpha);
  *   hat[m]: rho(M^) of the mode m kernel's second-moment matrix M^_ij = K_ij^2 / (q_i p_ij),
- *           K = M (adjoint) or M' (forward): the estimators' variance is finite iff < 1.
+ *           K = M (adjoint) or M' (forward), p_ij = q_i |K_ij|^alpha / sum_k |K_ik|^alpha:
+ *           diag(S / q) |K| at alpha = 1, |K_ij|^(2 - alpha) sum_k |K_ik|^alpha / q_i in
+ *           general; the estimators' variance is finite iff < 1.
  * Each radius carries its one-pass row/column-sum bounds, its certified bounds (the tighter of
  * those and the power iteration's), its estimate and whether it converged; verdicts come from
  * the bounds only.  A radius not computed has verdict ULAM_VERDICT_UNKNOWN and bounds
  * [0, INFINITY]. */
 typedef struct ulam_guard {
-    double continue_q; /* the kernel the radii describe */
+    double continue_q; /* the kernel the radii describe: its continuation */
+    double kernel_alpha; /* and its exponent (rho(M^) depends on it, rho(|M|) does not) */
     int computed;      /* ULAM_GUARD_* bits of the radii computed */
     ulam_power abs, hat[2];
     int verdict_abs, verdict_hat[2];
@@ -329,7 +335,9 @@ typedef struct ulam_guard {
 
 /* Compute the radii opts->need asks for (opts may be NULL: ulam_guard_defaults()): one pass over
  * M gives every row and column sum bound; power iteration runs only for a radius those do not
- * certify (or for every radius when opts->tight). */
+ * certify (or for every radius when opts->tight).  At opts->kernel_alpha != 1, rho(M^) is that
+ * of M^ formed entry by entry (nnz doubles; forward: on M', a transpose); a kernel_alpha that
+ * is negative or not finite is ULAM_EINVAL. */
 int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
                      ulam_guard *g, ulam_error *err);
 
@@ -349,7 +357,8 @@ int ulam_guard_variance(const ulam_guard *g, int mode);
 typedef struct ulam_system ulam_system;
 
 /* What the guards certified for a prepared system, so a query needs no pass over M: the
- * radii of ulam_guard_check for the kernel of continuation continue_q under power-iteration
+ * radii of ulam_guard_check for the kernel of continuation continue_q and exponent 1 (a
+ * query at another kernel exponent computes its own) under power-iteration
  * options (tol, max_iter), and the row- and column-sum bounds of |M| (the largest of either
  * bounds rho(|M|) from above).  Stored in a versioned section of the header (version 1 holds
  * these fields; a reader ignores a version it does not know and the guards run as usual). */
@@ -374,7 +383,7 @@ typedef struct ulam_system_desc {
 } ulam_system_desc;
 
 /* Write a prepared system to f (positioned at 0; the caller closes it): ULAM_OK, ULAM_EINVAL
- * or ULAM_EIO. */
+ * (also for a certificate whose guards are not of kernel exponent 1) or ULAM_EIO. */
 int ulam_system_write_file(FILE *f, const ulam_system_desc *d);
 
 /* Write a prepared system to path atomically (through ulam_outfile). */
@@ -420,12 +429,14 @@ double ulam_system_omega(const ulam_system *s);
 ulam_system *ulam_system_free(ulam_system *s);
 
 /* The certificate of M: the guards of ulam_guard_check(M, continue_q, opts) and the row and
- * column sums of |M| (one more pass). */
+ * column sums of |M| (one more pass); ULAM_EINVAL for opts->kernel_alpha != 1 (the file's
+ * certificate holds the guards of exponent 1). */
 int ulam_certificate_compute(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
                              ulam_certificate *c, ulam_error *err);
 
 /* The guards a query would compute, taken from certificate c when it was made for the same
- * continuation and power-iteration options and holds the radii opts->need asks for (opts NULL:
+ * continuation, kernel exponent and power-iteration options and holds the radii opts->need
+ * asks for (opts NULL:
  * the defaults, all three; never for opts->tight): ULAM_OK with *g
  * filled (its seconds 0: no pass was made), or ULAM_ENOTFOUND when c is NULL or does not
  * apply (the caller then runs ulam_guard_check). */
@@ -497,10 +508,16 @@ typedef struct ulam_walk_opts {
                                 the solver computes them */
     double rel_err_offset; /* a known exact part c of the answer c + estimate (bidirectional's push
                               part): rel_err is then relative to |c + estimate| (0: none) */
+    double kernel_alpha;   /* the kernel exponent alpha, finite and >= 0: a walk that continues from
+                              i moves to j with probability |K_ij|^alpha / sum_k |K_ik|^alpha over
+                              the row's nonzeros (K = M adjoint, M' forward), its weight times
+                              K_ij / (q_i p_ij); 1 (the default): the "almost optimal" |K_ij| / S_i,
+                              0 uniform, 2 Alea's transition factor.  rho(M^) is that kernel's, so
+                              opts->guard is used only when computed for the same alpha */
 } ulam_walk_opts;
 
-/* The defaults: adjoint collision walks, index 0, analog kernel, seed 1, all cores,
- * 10^5 walks, walk cap 10^6 steps. */
+/* The defaults: adjoint collision walks, index 0, analog kernel (kernel_alpha 1), seed 1, all
+ * cores, 10^5 walks, walk cap 10^6 steps. */
 ulam_walk_opts ulam_walk_defaults(void);
 
 /* What a run has found so far. */
@@ -563,7 +580,8 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
 /* Run one round of walks (rounds grow 1, 2, 4 ... 64 blocks of 1024 walks as walks accumulate,
  * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
  * ULAM_ENOMEM, ULAM_EIO (the share's allgather), ULAM_ESYNTAX (a corrupt row of a mapped
- * file); ulam_solver_error says why. */
+ * file), ULAM_ERANGE (at kernel_alpha != 1, a reached row whose entries are so uneven that a
+ * move's probability is below 2^-40 / the row's length); ulam_solver_error says why. */
 int ulam_solver_iterate(ulam_solver *s);
 
 /* Why the run failed (the status ulam_solver_iterate returned), with err filled: the row of a

@@ -60,7 +60,7 @@ struct ulam_solver {
 ulam_walk_opts ulam_walk_defaults(void)
 {
     return (ulam_walk_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_COLLISION, .seed = 1,
-                            .max_walks = 100000, .max_steps = 1000000};
+                            .max_walks = 100000, .max_steps = 1000000, .kernel_alpha = 1.0};
 }
 
 /* Free a solver; accepts and returns NULL. */
@@ -98,6 +98,9 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
         return ulam__fail(err, ULAM_EINVAL, 0, o->index, "an index from 0 to %lld", (long long)M->nrows - 1);
     if (o->continue_q > 0 && !(o->continue_q < 1))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a continuation probability below 1");
+    if (!(o->kernel_alpha >= 0) || !isfinite(o->kernel_alpha))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a kernel exponent alpha that is finite and >= 0 (got %g)",
+                          o->kernel_alpha);
     if (o->roulette < 0 || o->split < 0 || (o->split > 0 && o->roulette > 0 && o->split <= o->roulette))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "0 < roulette W < split W (or either off)");
     if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
@@ -130,12 +133,13 @@ static double row_sum(const ulam_csr *K, int64_t i)
     return S;
 }
 
-/* The largest product of weight factors S / q along any path among the seen states (the
- * weight a walk can reach, as a multiple of the weight it had anywhere on its way): a longest
- * path fixpoint, 1 when no factor exceeds 1; INFINITY when it does not settle within SWEEPS
- * passes (a cycle that grows weights, or paths too long to follow).  Growth below a relative
- * 1e-12 a pass is ignored (rounding of factors of exactly 1). */
-static double weight_growth(const ulam_csr *K, double continue_q, const char *seen)
+/* The largest product of weight factors S / q (fac: each move's own, kernel exponent != 1)
+ * along any path among the seen states (the weight a walk can reach, as a multiple of the
+ * weight it had anywhere on its way): a longest path fixpoint, 1 when no factor exceeds 1;
+ * INFINITY when it does not settle within SWEEPS passes (a cycle that grows weights, or paths
+ * too long to follow).  Growth below a relative 1e-12 a pass is ignored (rounding of factors
+ * of exactly 1). */
+static double weight_growth(const ulam_csr *K, double continue_q, const double *fac, const char *seen)
 {
     enum { SWEEPS = 64 };
     int64_t n = K->nrows;
@@ -147,9 +151,11 @@ static double weight_growth(const ulam_csr *K, double continue_q, const char *se
         changed = 0;
         for (int64_t i = 0; i < n; i++) {
             if (!seen[i]) continue;
-            double a = A[i] * ulam__factor(row_sum(K, i), continue_q);
-            for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++)
+            double a = fac ? 0.0 : A[i] * ulam__factor(row_sum(K, i), continue_q);
+            for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
+                if (fac) a = A[i] * fac[k];
                 if (K->val[k] != 0.0 && a > A[K->colidx[k]] * (1.0 + 1e-12)) A[K->colidx[k]] = a, changed = 1;
+            }
         }
     }
     for (int64_t i = 0; i < n; i++) best = fmax(best, seen[i] ? A[i] : 1.0);
@@ -200,8 +206,8 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
  * with weights u^(k/2), E[X^2] <= w0^2 c z_start / (1 - sqrt u)^2 (absorption, one score a
  * walk: w0^2 c z_start / (1 - u)).  z: iterates of I + M^ from g (so it fits the states that
  * score), floored at a few shares of its largest entry, the best bound kept; INFINITY when none
- * has u < 1. */
-static double second_moment(const ulam_solver *s, const ulam_csr *K, const char *seen, double w0)
+ * has u < 1.  At kernel exponent != 1, M^_ij = |K_ij| fac_ij, fac the moves' own factors. */
+static double second_moment(const ulam_solver *s, const ulam_csr *K, const double *fac, const char *seen, double w0)
 {
     enum { ITER = 300 };
     int64_t n = K->nrows;
@@ -228,8 +234,9 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const char 
             for (int64_t i = 0; i < n; i++) {
                 if (!seen[i]) continue;
                 double t = 0.0;
-                for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) t += fabs(K->val[k]) * v[K->colidx[k]];
-                y[i] = t * f[i];
+                for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++)
+                    t += fabs(K->val[k]) * (fac ? fac[k] : 1.0) * v[K->colidx[k]];
+                y[i] = fac ? t : t * f[i];
                 u = fmax(u, y[i] / v[i]), c = fmax(c, g[i] / v[i]), ymax = fmax(ymax, y[i] + v[i]);
                 z0 += adj ? (i == s->o.index ? v[i] : 0.0) : fabs(s->b[i]) / w0 * v[i];
             }
@@ -244,6 +251,22 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const char 
     }
     free(g), free(v), free(y), free(f);
     return best;
+}
+
+/* The weight factors |K_ij| / (q_i p_ij) of the moves of the seen rows of K at kernel exponent
+ * alpha != 1, one per entry (0 in the other rows; infinite where a probability underflows);
+ * NULL when out of memory. */
+static double *move_factors(const ulam_csr *K, const char *seen, double continue_q, double alpha)
+{
+    int64_t nnz = K->rowptr[K->nrows];
+    double *f = ulam__calloc((size_t)nnz, sizeof *f), *pm = ulam__malloc((size_t)nnz, sizeof *pm);
+    for (int64_t i = 0; f && pm && i < K->nrows; i++) {
+        double q = seen[i] ? ulam__kernel_q(K, i, continue_q) : 0.0;
+        if (q > 0) (void)ulam__kernel_moves(K, i, q, alpha, pm + K->rowptr[i], f + K->rowptr[i]);
+    }
+    if (!pm) free(f), f = NULL;
+    free(pm);
+    return f;
 }
 
 /* Over the states walks can reach (seen): absorption's p* > 0 wherever it scores (else
@@ -267,6 +290,11 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
                                      : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, "
                                                   "nonzero values (the matrix is corrupt)");
     }
+    double *fac = NULL; /* kernel exponent != 1: each move's own weight factor */
+    if (s->o.kernel_alpha != 1.0 && !(fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha))) {
+        free(seen);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
+    }
     int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = 0;
     int64_t bad = -1;
     int expected = s->o.estimator == ULAM_EXPECTED;
@@ -274,10 +302,11 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     for (int64_t i = 0; i < s->n; i++) {
         if (!seen[i]) continue;
         double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
-        fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
+        if (!fac) fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
         qmax = fmax(qmax, q);
         for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
             neg |= K->val[k] < 0;
+            if (fac) fbig = fmax(fbig, fac[k]);
             if (adj && expected) c += K->val[k] * s->b[K->colidx[k]];
         }
         if (absorb && (adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
@@ -293,7 +322,7 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     }
     if (!adj)
         for (int64_t i = 0; i < s->n; i++) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
-    double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, seen) : 1.0;
+    double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
     if (!adj) {
         w0 = 0.0;
         for (int64_t i = 0; i < s->n; i++) w0 += fabs(s->b[i]);
@@ -304,9 +333,9 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         length_tail(K, seen, s->o.continue_q, 0, 1e-30, &s->tail_u, &s->kappa); /* kappa enters by its log */
     if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
         (absorb ? isfinite(g2max) : isfinite(vmax))) {
-        s->v2 = second_moment(s, K, seen, w0);
+        s->v2 = second_moment(s, K, fac, seen, w0);
     }
-    free(seen);
+    free(seen), free(fac);
     if (bad >= 0)
         return ulam__fail(err, ULAM_EUNDEFINED, 0, bad,
                           "p* > 0 wherever the absorption estimator scores; state %lld (1-based) is "
@@ -349,12 +378,14 @@ static int take_guard(const ulam_csr *M, const ulam_walk_opts *o, ulam_guard *g,
 {
     int need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(o->mode);
     double q = o->continue_q > 0 ? o->continue_q : 0.0;
-    if (o->guard && (o->guard->continue_q > 0 ? o->guard->continue_q : 0.0) == q && (o->guard->computed & need) == need) {
+    if (o->guard && (o->guard->continue_q > 0 ? o->guard->continue_q : 0.0) == q &&
+        o->guard->kernel_alpha == o->kernel_alpha && (o->guard->computed & need) == need) {
         *g = *o->guard;
         return ULAM_OK;
     }
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = need;
+    go.kernel_alpha = o->kernel_alpha;
     return ulam_guard_check(M, o->continue_q, &go, g, err);
 }
 
@@ -376,14 +407,17 @@ static int check_verdicts(const ulam_csr *M, ulam_solver *s, ulam_error *err)
     ulam_guard og = s->g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_HAT(other);
+    go.kernel_alpha = o->kernel_alpha;
     if (!(og.computed & go.need) && ulam_guard_check(M, o->continue_q, &go, &og, NULL)) og.verdict_hat[other] = ULAM_VERDICT_UNKNOWN;
     char also[96] = "; the other mode's is not certified finite either";
     if (ulam_guard_variance(&og, other) == 1)
         snprintf(also, sizeof also, "; the %s mode's is finite, %.4g < 1", other == ULAM_ADJOINT ? "adjoint" : "forward",
                  og.hat[other].upper);
+    char alpha[48] = "";
+    if (o->kernel_alpha != 1.0) snprintf(alpha, sizeof alpha, " at kernel exponent alpha = %g", o->kernel_alpha);
     return ulam__fail(err, ULAM_EINFVAR, 0, -1,
-                      "a finite variance for a relative-error target: rho(M^) of the %s kernel is in [%.4g, %.4g] (%s)%s",
-                      o->mode == ULAM_ADJOINT ? "adjoint" : "forward", h->lower, h->upper,
+                      "a finite variance for a relative-error target: rho(M^) of the %s kernel%s is in [%.4g, %.4g] (%s)%s",
+                      o->mode == ULAM_ADJOINT ? "adjoint" : "forward", alpha, h->lower, h->upper,
                       s->var_finite == 0 ? ">= 1: infinite" : "straddles 1: unknown", also);
 }
 
@@ -453,6 +487,10 @@ static int kernel_failure(const ulam_kernel *k, ulam_error *err)
     if (!status) return ULAM_OK;
     int64_t i = atomic_load(&k->bad);
     if (status == ULAM_ENOMEM) return ulam__fail(err, status, 0, i, "memory to build a walk kernel row");
+    if (status == ULAM_ERANGE)
+        return ulam__fail(err, status, 0, i, "row %lld (1-based) with every move's probability |K_ij|^alpha / "
+                          "sum_k |K_ik|^alpha at least 2^-40 / its length at kernel exponent alpha = %g (its entries "
+                          "are too uneven for this alpha: a lower one samples them)", (long long)i + 1, k->alpha);
     return ulam__fail(err, status, 0, i, "row %lld (1-based) with its range in rowptr, columns in range and "
                       "finite, nonzero values and score (the matrix is corrupt)", (long long)i + 1);
 }
@@ -486,7 +524,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         K = s->mt;
     }
     ulam__scores sc = {o.mode == ULAM_ADJOINT ? b : NULL, o.estimator};
-    if ((status = ulam__kernel_alloc(K, o.continue_q, sc, &s->k)) == ULAM_EOVERFLOW) {
+    if ((status = ulam__kernel_alloc(K, o.continue_q, o.kernel_alpha, sc, &s->k)) == ULAM_EOVERFLOW) {
         ulam_solver_free(s);
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }

@@ -78,6 +78,52 @@ static inline void assert_csr_same(const ulam_csr *A, const ulam_csr *B)
     assert_memory_equal(A->val, B->val, (size_t)ulam_csr_nnz(A) * sizeof *A->val);
 }
 
+/* A system (I - M) x = b and its LAPACK solution x. */
+typedef struct {
+    ulam_csr *M;
+    double *b, *x;
+    int64_t n;
+} test_sys;
+
+/* Solve s with LAPACK into a new s->x. */
+static inline void test_sys_solve(test_sys *s)
+{
+    s->x = malloc((size_t)s->n * sizeof *s->x);
+    assert_int_equal(ulam_direct_solve(s->M, s->b, s->x, 0, NULL, NULL), ULAM_OK);
+}
+
+/* Load matrices/NAME.mtx and its b (matrices/NAME_b.mtx), solved with LAPACK. */
+static inline test_sys test_sys_load(const char *name)
+{
+    char mp[256], bp[256];
+    snprintf(mp, sizeof mp, "matrices/%s.mtx", name);
+    snprintf(bp, sizeof bp, "matrices/%s_b.mtx", name);
+    test_sys s;
+    s.M = must_read(mp);
+    s.b = must_read_vector(bp, &s.n);
+    test_sys_solve(&s);
+    return s;
+}
+
+/* Free a loaded system. */
+static inline void test_sys_free(test_sys *s)
+{
+    ulam_csr_free(s->M);
+    free(s->b), free(s->x);
+}
+
+/* Run walks on s; they must succeed with the walks asked for. */
+static inline ulam_walk_result test_run(const test_sys *s, ulam_walk_opts o)
+{
+    ulam_walk_result r;
+    ulam_error err;
+    int st = ulam_solve(s->M, s->b, &o, &r, &err);
+    if (st) print_error("ulam_solve: %s: %s\n", ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    assert_true(r.walks == o.max_walks);
+    return r;
+}
+
 /* A nonnegative n x n matrix whose Perron root is exactly rho but whose row and column sums
  * vary (so no one-pass bound is tight) and whose spectral gap is ~1/n^2 (so power iteration
  * converges slowly): rho / cos(pi / (n + 1)) D^-1 T D, T the path graph's tridiagonal (1/2

@@ -104,9 +104,10 @@ static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, ulam_error 
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision or absorption (next-event: gathering only)");
     if (o->index < 0 || o->index >= sc->npatches)
         return ulam__fail(err, ULAM_EINVAL, 0, o->index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
-    if (o->continue_q != 0 || o->roulette != 0 || o->split != 0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette or split (patch walks continue "
-                                                   "with the patch's largest reflectance)");
+    if (o->continue_q != 0 || o->roulette != 0 || o->split != 0 || o->kernel_alpha != 1.0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette, split or kernel exponent other "
+                                                   "than 1 (patch walks continue with the patch's largest "
+                                                   "reflectance and follow the form factors)");
     if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
     if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
