@@ -127,6 +127,17 @@ int ulam__mine(const ulam_share *sh, int64_t q);
  * tallies, counts and stopping state are reset (src/solve.c; used by the outer iterations). */
 int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_error *err);
 
+/* Nonzero when [lower, upper] decides a radius' verdict and its warning: wholly below 0.99,
+ * wholly at or above 1, or wholly in [0.99, 1) (src/spectral.c; the guards use it). */
+int ulam__power_certain(double lower, double upper);
+
+/* Power iteration on diag(left) |A| diag(right) (left, right may be NULL) from the bounds
+ * already in *out (the guards' one-pass sums), with out->iterations and out->seconds added
+ * to; out keeps the tighter bounds of both (src/spectral.c; ulam_spectral_power starts it
+ * from [0, INFINITY]). */
+int ulam__power_from(const ulam_csr *A, const double *left, const double *right, const ulam_power_opts *o,
+                     ulam_power *out, ulam_error *err);
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)
