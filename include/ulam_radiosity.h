@@ -90,7 +90,7 @@ int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
 /* Form factors F_ij estimated by casting `rays` cosine-distributed rays from uniform points of
  * each patch i (the share that reaches j); stream (seed, i) for patch i, so F does not
  * depend on the number of threads (0: all cores). */
-int ulam_form_factors(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads,
+int ulam_ff_estimate(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads,
                       ulam_csr **F, ulam_error *err);
 
 /* How well an estimated F obeys the laws of form factors. */
@@ -101,7 +101,7 @@ typedef struct ulam_ff_report {
 } ulam_ff_report;
 
 /* Fill *r for F on s. */
-int ulam_form_factor_report(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r);
+int ulam_ff_report_compute(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r);
 
 /* Exact form factor between directly opposed parallel a x b rectangles at distance c
  * (Howell's catalogue, C-11). */
@@ -112,25 +112,25 @@ double ulam_ff_parallel_rectangles(double a, double b, double c);
 double ulam_ff_perpendicular_rectangles(double w, double h, double l);
 
 /* The radiosity system of channel c: M = diag(rho_c) F (new *M) and b = E_c (npatches). */
-int ulam_radiosity_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
+int ulam_rad_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
                           double *b);
 
 /* Solve the three channels' systems with LAPACKE_dgesv into B (3 * npatches, RGB per patch);
  * refuses with ULAM_EMEMLIMIT like ulam_direct_solve.  info (may be NULL) sums the three. */
-int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
+int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
                           ulam_direct_info *info, ulam_error *err);
 
-/* The standard error of the direct solution B (from ulam_radiosity_direct on an F estimated
+/* The standard error of the direct solution B (from ulam_rad_direct on an F estimated
  * with `rays` rays a patch) at patch p, per channel: the first-order propagation of the
  * multinomial noise of each row of F, se^2 = sum_k (G_pk rho_k)^2 v_k / rays with
  * G = (I - M)^-1 (one transposed LAPACK solve a channel) and v_k = sum_j F_kj B_j^2 -
  * (sum_j F_kj B_j)^2. */
-int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                                 int64_t p, size_t max_bytes, double se[3], ulam_error *err);
 
 /* The same at every patch (se: 3 * npatches): G = (I - M)^-1 whole by one LAPACKE_dgesv with
  * npatches right-hand sides a channel, so two dense matrices (ULAM_EMEMLIMIT past max_bytes). */
-int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                                  size_t max_bytes, double *se, ulam_error *err);
 
 /* Gathering's next-event estimators (opts->estimator of ulam_rad_solver_alloc, gathering only).
