@@ -91,7 +91,7 @@ int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
  * each patch i (the share that reaches j); stream (seed, i) for patch i, so F does not
  * depend on the number of threads (0: all cores). */
 int ulam_ff_estimate(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads,
-                      ulam_csr **F, ulam_error *err);
+                     ulam_csr **F, ulam_error *err);
 
 /* How well an estimated F obeys the laws of form factors. */
 typedef struct ulam_ff_report {
@@ -113,12 +113,12 @@ double ulam_ff_perpendicular_rectangles(double w, double h, double l);
 
 /* The radiosity system of channel c: M = diag(rho_c) F (new *M) and b = E_c (npatches). */
 int ulam_rad_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
-                          double *b);
+                    double *b);
 
 /* Solve the three channels' systems with LAPACKE_dgesv into B (3 * npatches, RGB per patch);
  * refuses with ULAM_EMEMLIMIT like ulam_direct_solve.  info (may be NULL) sums the three. */
 int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
-                          ulam_direct_info *info, ulam_error *err);
+                    ulam_direct_info *info, ulam_error *err);
 
 /* The standard error of the direct solution B (from ulam_rad_direct on an F estimated
  * with `rays` rays a patch) at patch p, per channel: the first-order propagation of the
@@ -126,12 +126,12 @@ int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, do
  * G = (I - M)^-1 (one transposed LAPACK solve a channel) and v_k = sum_j F_kj B_j^2 -
  * (sum_j F_kj B_j)^2. */
 int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                int64_t p, size_t max_bytes, double se[3], ulam_error *err);
+                          int64_t p, size_t max_bytes, double se[3], ulam_error *err);
 
 /* The same at every patch (se: 3 * npatches): G = (I - M)^-1 whole by one LAPACKE_dgesv with
  * npatches right-hand sides a channel, so two dense matrices (ULAM_EMEMLIMIT past max_bytes). */
 int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                 size_t max_bytes, double *se, ulam_error *err);
+                           size_t max_bytes, double *se, ulam_error *err);
 
 /* Gathering's next-event estimators (opts->estimator of ulam_rad_solver_alloc, gathering only).
  * At every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in

@@ -37,7 +37,7 @@ static int64_t ff_row(const ulam_tracer *t, int64_t i, int64_t rays, uint64_t se
 
 /* F by ray casting, rows in parallel. */
 int ulam_ff_estimate(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads, ulam_csr **F,
-                      ulam_error *err)
+                     ulam_error *err)
 {
     ulam__clear(err);
     if (!t || !F || rays < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer and rays >= 1");
@@ -160,7 +160,7 @@ int ulam_rad_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_cs
 
 /* The three channels by LAPACK. */
 int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
-                          ulam_direct_info *info, ulam_error *err)
+                    ulam_direct_info *info, ulam_error *err)
 {
     ulam__clear(err);
     if (!s || !F || !B) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a scene, F and an output");
@@ -205,7 +205,7 @@ static double row_noise(const ulam_scene *s, const ulam_csr *F, int64_t rays, co
 
 /* Standard error of the direct B at patch p from the noise of F. */
 int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                int64_t p, size_t max_bytes, double se[3], ulam_error *err)
+                          int64_t p, size_t max_bytes, double se[3], ulam_error *err)
 {
     ulam__clear(err);
     if (!s || !F || !B || !se || rays < 1 || p < 0 || p >= s->npatches)
@@ -234,7 +234,7 @@ int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, 
 /* Standard errors of the direct B at every patch from the noise of F: G = (I - M)^-1 whole
  * (LAPACKE_dgesv of (I - M)' with the identity: X = G'), se_p^2 = sum_k G_pk^2 noise_k. */
 int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                 size_t max_bytes, double *se, ulam_error *err)
+                           size_t max_bytes, double *se, ulam_error *err)
 {
     ulam__clear(err);
     if (!s || !F || !B || !se || rays < 1 || F->nrows != s->npatches || F->ncols != s->npatches)
