@@ -2,7 +2,8 @@
  * diffuse patches: OBJ + MTL scenes, Embree 3 ray casting, form factors, the LAPACK solve,
  * patch walks that sample F by rays (gathering, shooting, next-event), view gathering and PNG
  * images.  Built with meson's 'radiosity' feature (Embree 3 and libpng); the conventions of
- * ulam.h apply (status codes, ulam_error, const inputs, _free accepts NULL). */
+ * ulam.h apply (status codes, ulam_error, const inputs, _free accepts NULL, the ABI habit:
+ * structs the caller fills start from their defaults function, handles are opaque). */
 #ifndef ULAM_RADIOSITY_H
 #define ULAM_RADIOSITY_H
 
@@ -195,7 +196,8 @@ int ulam_rad_solver_vectors(const ulam_rad_solver *s, double *B, double *std_err
 /* Free; accepts and returns NULL. */
 ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s);
 
-/* A pinhole camera. */
+/* A pinhole camera.  Start from ulam_camera_cornell() or ulam_camera_frame() (ulam.h's ABI
+ * habit). */
 typedef struct ulam_camera {
     double eye[3], dir[3], up[3];
     double focal, film; /* focal length and film width, same unit (mm) */

@@ -845,6 +845,28 @@ static void test_furnace(void **state)
     ulam_scene_free(s);
 }
 
+/* The camera's starting functions (ulam.h's ABI habit) return what the header documents: the
+ * Cornell camera eye (278, 273, -800) along +z, up +y, 35 mm lens on 25 mm film; the frame of
+ * the Cornell box eye (278, 274.4, -802) (rounded there), the same direction, lens and film. */
+static void test_camera_defaults(void **state)
+{
+    (void)state;
+    ulam_camera c = ulam_camera_cornell();
+    static const double eye[3] = {278, 273, -800}, dir[3] = {0, 0, 1}, up[3] = {0, 1, 0};
+    for (int d = 0; d < 3; d++)
+        assert_close(c.eye[d], eye[d], 0), assert_close(c.dir[d], dir[d], 0), assert_close(c.up[d], up[d], 0);
+    assert_close(c.focal, 35, 0);
+    assert_close(c.film, 25, 0);
+    ulam_scene *s = must_scene("examples/scenes/cornell_box.obj");
+    ulam_camera f = ulam_camera_frame(s, 512, 512);
+    static const double framed[3] = {278, 274.4, -802};
+    for (int d = 0; d < 3; d++)
+        assert_close(f.eye[d], framed[d], 0.5), assert_close(f.dir[d], dir[d], 0), assert_close(f.up[d], up[d], 0);
+    assert_close(f.focal, 35, 0);
+    assert_close(f.film, 25, 0);
+    ulam_scene_free(s);
+}
+
 /* Pictures of scenes that are not the Cornell box: the camera frames the bounding box (the
  * Cornell camera, 1000 units from a unit cube, saw its front face's back: a black picture), back
  * sides are seen through (a closed room is seen into), and the render says when no emitter is
@@ -1039,7 +1061,7 @@ int main(void)
         cmocka_unit_test(test_black_emitters),     cmocka_unit_test(test_far_and_gap),
         cmocka_unit_test(test_cornell_black_light),
         cmocka_unit_test(test_rel_err_zero),       cmocka_unit_test(test_shoot_coverage),
-        cmocka_unit_test(test_render_framing),     cmocka_unit_test(test_next_event_coverage),
+        cmocka_unit_test(test_render_framing),     cmocka_unit_test(test_camera_defaults),     cmocka_unit_test(test_next_event_coverage),
         cmocka_unit_test(test_next_event_back_sides), cmocka_unit_test(test_next_event_edge),
         cmocka_unit_test(test_next_event_hidden), cmocka_unit_test(test_rel_err_zero_channel),  cmocka_unit_test(test_view_gather),
     };
