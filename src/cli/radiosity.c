@@ -299,7 +299,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
     for (int c = 0; c < 3 && !status && !cli_interrupted; c++) {
         ulam_csr *M = NULL;
         ulam_solver *sv = NULL;
-        if ((status = ulam_radiosity_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
+        if ((status = ulam_rad_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
             ulam_csr_free(M);
             break;
         }
@@ -686,9 +686,9 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
 {
     ulam_error err;
     double t0 = ulam_now();
-    if (ulam_form_factors(t, a->ff_rays, a->o.seed, a->o.threads, F, &err)) return cli_report(a->scene, &err);
+    if (ulam_ff_estimate(t, a->ff_rays, a->o.seed, a->o.threads, F, &err)) return cli_report(a->scene, &err);
     r->ff_seconds = ulam_now() - t0;
-    ulam_form_factor_report(s, *F, &r->ff);
+    ulam_ff_report_compute(s, *F, &r->ff);
     r->F = *F;
     int need = a->direct || a->check, every = a->out || a->all;
     int for_error = a->matrix_walk && (r->patch >= 0 || (every && a->o.mode == ULAM_FORWARD));
@@ -699,11 +699,11 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
         return cli_report(a->scene, &err);
     }
     ulam_direct_info info;
-    if (ulam_radiosity_direct(s, *F, a->max_mem, *Bd, &info, &err)) return cli_report(a->scene, &err);
+    if (ulam_rad_direct(s, *F, a->max_mem, *Bd, &info, &err)) return cli_report(a->scene, &err);
     r->direct_seconds = info.seconds;
     if (need) r->Bdirect = *Bd;
     if (r->patch >= 0) {
-        if (ulam_radiosity_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
+        if (ulam_rad_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
             return cli_report(a->scene, &err);
         r->ff_se_known = 1;
     }
@@ -712,7 +712,7 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
             err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the standard errors"};
             return cli_report(a->scene, &err);
         }
-        int st = ulam_radiosity_direct_errors(s, *F, a->ff_rays, *Bd, a->max_mem, r->direct_se_all, &err);
+        int st = ulam_rad_direct_errors(s, *F, a->ff_rays, *Bd, a->max_mem, r->direct_se_all, &err);
         if (st == ULAM_EMEMLIMIT) free(r->direct_se_all), r->direct_se_all = NULL; /* the rows say unknown */
         else if (st) return cli_report(a->scene, &err);
     }
