@@ -92,6 +92,7 @@ typedef struct {
 typedef struct {
     double B[3], se[3], se_walk[3]; /* se: with --matrix-walk, the walk's and F's noise combined */
     int64_t walks, steps, cut; /* cut: walks stopped at --max-steps */
+    int64_t channel_walks[3]; /* --matrix-walk: each channel's walks (walks is their sum) */
     double seconds;
     int threads, interrupted;
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
@@ -131,10 +132,10 @@ static int parse(int argc, char **argv, args *a)
 {
     static const struct option longopts[] = {
         {"patch", required_argument, 0, 'p'},     {"mode", required_argument, 0, 'm'},
-        {"estimator", required_argument, 0, 'e'}, {"walks", required_argument, 0, 'n'},
-        {"rel-err", required_argument, 0, 'r'},   {"time", required_argument, 0, 't'},
-        {"seed", required_argument, 0, 's'},      {"threads", required_argument, 0, 'T'},
-        {"max-steps", required_argument, 0, 'K'}, {"subdivide", required_argument, 0, 'L'},
+        {"estimator", required_argument, 0, 'e'}, CLI_WALK_OPTION("walks"),
+        CLI_WALK_OPTION("rel-err"),               CLI_WALK_OPTION("time"),
+        CLI_WALK_OPTION("seed"),                  CLI_WALK_OPTION("threads"),
+        CLI_WALK_OPTION("max-steps"),             {"subdivide", required_argument, 0, 'L'},
         {"ff-rays", required_argument, 0, 'f'},   {"direct", no_argument, 0, 'd'},
         {"check", no_argument, 0, 'c'},           {"matrix-walk", no_argument, 0, 'M'},
         {"max-mem", required_argument, 0, 'x'},   {"image", required_argument, 0, 'i'},
@@ -146,11 +147,11 @@ static int parse(int argc, char **argv, args *a)
         {"coverage", required_argument, 0, 'G'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
-    int64_t v;
-    int c, rc, any_rule = 0;
+    int c, rc, idx;
     optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
+        case CLI_WALK: if ((rc = cli_walk_option(cmd, longopts[idx].name, optarg, &a->o))) return rc; break;
         case 'p': a->patch = optarg; break;
         case 'm':
             if ((a->o.mode = cli_lookup(optarg, mode_names, 2)) < 0)
@@ -164,12 +165,6 @@ static int parse(int argc, char **argv, args *a)
             if ((a->mis = cli_lookup(optarg, mis_names, 3)) < 0)
                 return cli_usage_error(cmd, "--mis expects power, balance or none, got '%s'", optarg);
             break;
-        case 'n': if ((rc = cli_parse_int(cmd, "--walks", optarg, 1, INT64_MAX / 2, &a->o.max_walks))) return rc; any_rule = 1; break;
-        case 'r': if ((rc = cli_parse_real(cmd, "--rel-err", optarg, 1e-12, 1.0, &a->o.rel_err))) return rc; any_rule = 1; break;
-        case 't': if ((rc = cli_parse_real(cmd, "--time", optarg, 1e-6, 1e9, &a->o.max_seconds))) return rc; any_rule = 1; break;
-        case 's': if ((rc = cli_parse_int(cmd, "--seed", optarg, 0, INT64_MAX, &v))) return rc; a->o.seed = (uint64_t)v; break;
-        case 'T': if ((rc = cli_parse_int(cmd, "--threads", optarg, 1, 1024, &v))) return rc; a->o.threads = (int)v; break;
-        case 'K': if ((rc = cli_parse_int(cmd, "--max-steps", optarg, 1, INT64_MAX / 2, &a->o.max_steps))) return rc; break;
         case 'L': if ((rc = cli_parse_real(cmd, "--subdivide", optarg, 1e-9, 1e300, &a->subdivide))) return rc; break;
         case 'f': if ((rc = cli_parse_int(cmd, "--ff-rays", optarg, 1, INT32_MAX, &a->ff_rays))) return rc; break;
         case 'd': a->direct = 1; break;
@@ -217,7 +212,7 @@ static int parse(int argc, char **argv, args *a)
     if (a->image && a->o.mode == ULAM_ADJOINT && !a->direct && !a->view)
         return cli_usage_error(cmd, "--image needs --mode shoot, --direct or --view-gather (gathering answers one "
                                     "patch)");
-    if (!any_rule) a->o.max_walks = 100000;
+    cli_walk_budget(&a->o);
     return 0;
 }
 
@@ -304,7 +299,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
     for (int c = 0; c < 3 && !status && !cli_interrupted; c++) {
         ulam_csr *M = NULL;
         ulam_solver *sv = NULL;
-        if ((status = ulam_radiosity_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
+        if ((status = ulam_rad_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
             ulam_csr_free(M);
             break;
         }
@@ -312,6 +307,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
         ulam_walk_result r;
         ulam_solver_result(sv, &r);
         w->B[c] = r.estimate, w->se[c] = w->se_walk[c] = r.std_error;
+        w->channel_walks[c] = r.walks;
         w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds, w->cut += r.cut;
         w->threads = r.threads, w->interrupted |= r.interrupted;
         if (!status && w->all) {
@@ -452,7 +448,9 @@ typedef struct {
 static double zscore(const args *a, const report *r, int c)
 {
     double d = r->Bdirect[3 * r->patch + c], sw = r->w->se_walk[c], sf = a->matrix_walk ? 0.0 : r->direct_se[c];
-    return (r->w->B[c] - d) / sqrt(sw * sw + sf * sf);
+    double diff = r->w->B[c] - d, se = sqrt(sw * sw + sf * sf);
+    if (se == 0) return diff == 0 ? 0.0 : copysign(INFINITY, diff); /* both exact: agree, or not at all */
+    return diff / se;
 }
 
 /* Print the text report. */
@@ -494,6 +492,9 @@ static void print_text(const args *a, const report *r)
                a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
+    if (w && a->matrix_walk)
+        printf("             (one walk a channel: %lld R + %lld G + %lld B)\n", (long long)w->channel_walks[0],
+               (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
     if (a->view)
         printf("view         %lld of %lld patches seen (%lld of %lld pixels), each to %.3g (n_max / n)^%.3g: "
                "%lld camera rays + %lld walk rays, %.4f s%s\n", (long long)r->view.seen, (long long)r->view.npatches,
@@ -554,6 +555,9 @@ static void print_json(const args *a, const report *r)
         printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, \"cut\": %lld, \"max_steps\": %lld, ",
                a->matrix_walk ? "true" : "false", (long long)w->walks, a->matrix_walk ? "steps" : "rays",
                (long long)w->steps, (long long)w->cut, (long long)a->o.max_steps);
+        if (a->matrix_walk) /* walks is their sum: a matrix walk carries one channel */
+            printf("\"channel_walks\": [%lld, %lld, %lld], ", (long long)w->channel_walks[0],
+                   (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
         cli_json_number("seconds", w->seconds, 0);
         printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
         if (a->o.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT) {
@@ -682,9 +686,9 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
 {
     ulam_error err;
     double t0 = ulam_now();
-    if (ulam_form_factors(t, a->ff_rays, a->o.seed, a->o.threads, F, &err)) return cli_report(a->scene, &err);
+    if (ulam_ff_estimate(t, a->ff_rays, a->o.seed, a->o.threads, F, &err)) return cli_report(a->scene, &err);
     r->ff_seconds = ulam_now() - t0;
-    ulam_form_factor_report(s, *F, &r->ff);
+    ulam_ff_report_compute(s, *F, &r->ff);
     r->F = *F;
     int need = a->direct || a->check, every = a->out || a->all;
     int for_error = a->matrix_walk && (r->patch >= 0 || (every && a->o.mode == ULAM_FORWARD));
@@ -695,11 +699,11 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
         return cli_report(a->scene, &err);
     }
     ulam_direct_info info;
-    if (ulam_radiosity_direct(s, *F, a->max_mem, *Bd, &info, &err)) return cli_report(a->scene, &err);
+    if (ulam_rad_direct(s, *F, a->max_mem, *Bd, &info, &err)) return cli_report(a->scene, &err);
     r->direct_seconds = info.seconds;
     if (need) r->Bdirect = *Bd;
     if (r->patch >= 0) {
-        if (ulam_radiosity_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
+        if (ulam_rad_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
             return cli_report(a->scene, &err);
         r->ff_se_known = 1;
     }
@@ -708,7 +712,7 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
             err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the standard errors"};
             return cli_report(a->scene, &err);
         }
-        int st = ulam_radiosity_direct_errors(s, *F, a->ff_rays, *Bd, a->max_mem, r->direct_se_all, &err);
+        int st = ulam_rad_direct_errors(s, *F, a->ff_rays, *Bd, a->max_mem, r->direct_se_all, &err);
         if (st == ULAM_EMEMLIMIT) free(r->direct_se_all), r->direct_se_all = NULL; /* the rows say unknown */
         else if (st) return cli_report(a->scene, &err);
     }
