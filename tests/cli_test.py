@@ -75,6 +75,24 @@ CASES += [  # counts written as whole numbers in exponent form are counts; fract
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--out", "/nonexistent/dir/x.mtx"], 13,
      r"/nonexistent/dir/x\.mtx: error: .*writable output file", r"^$"),
 ]
+CASES += [  # the kernel exponent: finite and >= 0; it changes rho(M^) (chain4: 0.68..0.9 at 0, >= 1 at 3)
+    (["info", M + "signed200.mtx"], 0, r"^$", r"variance forward finite"),
+    (["info", M + "signed200.mtx", "--alpha", "2"], 0, r"^$",
+     r"rho\(M\^\) forward  1\.04\d+ .* at kernel exponent alpha = 2\n(.*\n)*variance forward infinite"),
+    (["info", M + "signed200.mtx", "--alpha", "-0.5"], 2, r"--alpha expects a number from 0 to 1000", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "-1"], 2, r"--alpha expects a number from 0 to 1000, got '-1'", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "nan"], 2, r"--alpha expects a number from 0 to 1000, got 'nan'", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "inf"], 2, r"--alpha expects a number from 0 to 1000, got 'inf'", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "two"], 2, r"--alpha expects a number from 0 to 1000, got 'two'", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", ""], 2, r"--alpha expects a number", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "0", "--walks", "20000"], 0, r"^$",
+     r"95% CI[^\n]*\n(.*\n)*guards .*rho\(M\^\) in \[0\.68\d*, 0\.9\] \(below 1\) at kernel exponent alpha = 0\n"),
+    (SOLVE + ["--index", "1", "--alpha", "3", "--walks", "20000"], 0,
+     r"warning: rho\(M\^\) >= 1 .* for the adjoint kernel of exponent alpha = 3: the estimator's variance is infinite",
+     r"no confidence interval|not certified|infinite"),
+    (SOLVE + ["--index", "1", "--alpha", "3", "--rel-err", "0.01"], 4,
+     r"--rel-err 0\.01 can never be met: .*rho\(M\^\) of the adjoint kernel at kernel exponent alpha = 3 is in", r"^$"),
+]
 DIV = ["solve", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1"]
 RS = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1"]
 CASES += [
@@ -432,6 +450,32 @@ def check_solve_json(ulam):
     o = json.loads(out)
     assert rc == 0 and o["variance_finite"] is False and o["ci95"] is None, o
     assert abs(o["rho_hat"] - 1.62) < 1e-6 and o["rho_hat_lower"] >= 1, o
+
+
+def check_alpha(ulam):
+    """--alpha walks the kernel of that exponent: --json reports it beside rho_hat (1 by default);
+    a prepared system's certificate (exponent 1) serves the default but not --alpha 2, whose
+    guards are computed and match the text input's; the estimate agrees with LAPACK."""
+    with tempfile.TemporaryDirectory() as d:
+        sysf = d + "/s.ulam"
+        rc, out, err = run(ulam, ["prepare", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "-o", sysf])
+        assert rc == 0, err
+        common = ["--index", "5", "--walks", "20000", "--json", "--check"]
+        runs = {}
+        for name, args in [("text1", [M + "signed200.mtx", "--rhs", M + "signed200_b.mtx"]), ("prep1", [sysf]),
+                           ("text2", [M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "--alpha", "2"]),
+                           ("prep2", [sysf, "--alpha", "2"])]:
+            rc, out, err = run(ulam, ["solve"] + args + common)
+            assert rc == 0, (name, err)
+            runs[name] = json.loads(out)
+        t1, p1, t2, p2 = runs["text1"], runs["prep1"], runs["text2"], runs["prep2"]
+        assert t1["kernel_alpha"] == 1 and t2["kernel_alpha"] == 2 and p2["kernel_alpha"] == 2, (t1, t2)
+        assert p1["guard_seconds"] == 0 and p1["rho_hat"] == t1["rho_hat"], p1  # the certificate served
+        assert p2["rho_hat_upper"] == t2["rho_hat_upper"] and p2["rho_hat"] != p1["rho_hat"], (p1, p2)
+        assert t2["rho_hat_lower"] <= 0.974368 <= t2["rho_hat_upper"], t2  # adjoint rho(M^) at alpha 2 (test_kernel)
+        assert p2["estimate"] == t2["estimate"] and t2["estimate"] != t1["estimate"], (t1, t2)
+        for o in (t1, t2):
+            assert abs(o["z"]) < 4 and o["variance_finite"] is True, o
 
 
 def check_forward_files(ulam):
@@ -1031,7 +1075,7 @@ def main():
         rc, out, err = run(ulam, ["radiosity", "x.obj"])
         assert rc == 2 and "built without the radiosity front end" in err, err
     failures, n = check_table(ulam)
-    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_interrupt, ulam),

@@ -301,7 +301,7 @@ static void test_verdict(void **state)
 
 /* Over 200 seeds the 95% interval of adjoint collision walks at alpha = 2 on the uneven signed
  * system (2000 walks each) covers the LAPACK value 180 to 198 times: Bin(200, 0.95) falls
- * outside that range with probability about 0.006 (a kernel with the wrong weights would be
+ * outside that range with probability 0.0016 (a kernel with the wrong weights would be
  * biased and cover far less often). */
 static void test_coverage(void **state)
 {

@@ -142,7 +142,7 @@ static int prepare(cli_system *s, int64_t source, int force, double continue_q, 
     }
     s->own_b[source - 1] = 1.0;
     s->b = s->own_b; /* freed by cli_system_free */
-    if ((rc = cli_guard(s, continue_q, ULAM_FORWARD, &rp->g))) return rc;
+    if ((rc = cli_guard(s, continue_q, 1.0, ULAM_FORWARD, &rp->g))) return rc;
     if (rp->g.verdict_abs >= ULAM_VERDICT_FAIL) {
         cli_guard_diverge(s, &rp->g, force);
         if (!force) return EXIT_DIVERGE;
