@@ -803,22 +803,62 @@ typedef struct ulam_bidir_opts {
  * (the default cap), walk ulam_walk_defaults(). */
 ulam_bidir_opts ulam_bidir_defaults(void);
 
+/* A bidirectional estimate's plan (ulam_bidir_plan): the push it runs and what the walks after it
+ * are predicted to cost, in a deterministic unit of work (push operations; a walk's visits, its
+ * steps + 1, count step_cost operations each), so a comparison of methods on it gives the same
+ * answer on every run, thread count and MPI rank. */
+typedef struct ulam_bidir_plan_info {
+    int64_t target;         /* 0-based t */
+    double rmax;            /* the push threshold: the balance's choice, or ulam_bidir_opts.rmax */
+    int balanced;           /* 1: rmax chosen by the balance */
+    ulam_push_info push;    /* the push as run to rmax (its ops are counted, not predicted) */
+    double push_part;       /* <p, b>: the exact part of x_t */
+    int64_t pilot_walks;    /* walks of the pilot that measured mean_visits (0: rmax given) */
+    int64_t pilot_steps;    /* their steps */
+    double mean_visits;     /* V: states a walk from b visits on average (pilot; 1 without one) */
+    double predicted_walks; /* walks the stopping rule is predicted to need (0: no residual left,
+                               the value is exact; max_walks when that is the only rule; NaN
+                               when rmax is given and rel_err is set: no pilot measured V) */
+    double predicted_work;  /* push.ops + step_cost (pilot visits + predicted_walks V): the whole
+                               estimate's work in push operations */
+    double step_cost;       /* push operations a walk visit counts as */
+    double seconds;         /* wall time of the plan: pilot and push */
+} ulam_bidir_plan_info;
+
+/* Plan a bidirectional estimate without its walks: start the push at o->target and, when o->rmax
+ * <= 0, run a pilot of 256 walks on a seed of its own (o->walk.seed mixed) and halve rmax from 1,
+ * pushing down to it, while the push's operations are below the walks' predicted work (walks
+ * predicted by the stopping rule's terms: its 1000-walk floor, the variance rmax V / (E^2 x^),
+ * and for a rel_err target E the range term the walk solver's own bounds (the pilot's solver,
+ * over the states the walks reach) give for scores of at most rmax a visit, when they give one;
+ * x^ = max(min_value, |<p, b>|); E = 0.1 for a run stopped by time alone); with o->rmax > 0
+ * push to it.  w is left
+ * pushed, and remembers the plan: ulam_bidir_solve with the same options (target, b, rmax,
+ * min_value, max_push_ops and the walk options the pilot and prediction read) uses that push and
+ * pilot as they are, until ulam_push_start or ulam_push_run changes the workspace.  The push's
+ * operations are exact; the walks are a prediction (the solver stops after whole rounds, so it
+ * runs at least the predicted walks rounded up to its rounds, and more when the variance is
+ * larger than modelled).  Statuses as ulam_bidir_solve. */
+int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
+                    ulam_error *err);
+
 /* What a bidirectional estimate found. */
 typedef struct ulam_bidir_result {
-    double estimate, std_error, ci95[2]; /* of x_t: p_s plus the walks' estimate of <r, x> */
-    double push_part;      /* p_s, exact given the push */
+    double estimate, std_error, ci95[2]; /* of x_t: <p, b> plus the walks' estimate of <r, x> */
+    double push_part;      /* <p, b>, exact given the push */
     ulam_push_info push;   /* the push (its seconds are push_seconds) */
     ulam_walk_result walks; /* the walks' estimate of <r, x> (0 walks when r = 0: exact) */
-    int64_t pilot_walks;   /* walks that measured the mean walk length for the balance */
-    double mean_visits;    /* states a walk visits on average (pilot) */
-    double predicted_walks; /* walks the balance predicted for the target at its rmax (NaN: rmax given) */
-    double seconds;        /* the whole estimate: pilot, push, walk set-up and walks */
+    ulam_bidir_plan_info plan; /* the plan the estimate followed */
+    int plan_reused;       /* 1: the workspace held this plan (ulam_bidir_plan), not redone */
+    double seconds;        /* the whole estimate: the plan's seconds (pilot and push, also when
+                              reused) plus the walks' set-up and walks */
 } ulam_bidir_result;
 
 /* Estimate x_t of (I - M) x = e_s with push workspace w (on M) and Mt, the transpose of M (borrowed;
- * computing it is one O(nnz) pass the caller makes once for any number of queries).  ULAM_OK,
- * ULAM_EINVAL (bad options, index out of range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap),
- * the walk solver's statuses. */
+ * computing it is one O(nnz) pass the caller makes once for any number of queries): the plan of
+ * ulam_bidir_plan (reused when w holds it for these options), then walks from s on Mt scoring the
+ * residual until o->walk's stopping rules hold.  ULAM_OK, ULAM_EINVAL (bad options, index out of
+ * range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap), the walk solver's statuses. */
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err);
 
