@@ -203,7 +203,9 @@ typedef struct ulam_rad_solver ulam_rad_solver;
 int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
                           ulam_error *err);
 
-/* Run one round of walks; ULAM_OK or ULAM_ENONFINITE. */
+/* Run one round of walks (rounds grow 1, 2, 4 ... 32 blocks of 256 walks as walks accumulate,
+ * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
+ * ULAM_ENOMEM (shooting's tallies), ULAM_EIO (the share's allgather). */
 int ulam_rad_solver_iterate(ulam_rad_solver *s);
 
 /* Nonzero once a stopping rule is met (rel_err: every nonzero channel; or every channel is
