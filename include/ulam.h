@@ -18,6 +18,25 @@
  *     are opaque, reached only through their functions; what the library fills (results,
  *     reports, ulam_guard, ulam_certificate, ulam_csr and ulam_scene from their allocators and
  *     readers) is plain data to read.
+ *
+ * The API by rank, as CSparse's header ranks its own (each section banner below names the
+ * ranks it holds; sections follow the data flow, file -> matrix -> guards -> walks -> output):
+ *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
+ *     ulam_guard_check, ulam_walk_defaults, ulam_solver_alloc, ulam_solver_iterate,
+ *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
+ *     ulam_solver_free, ulam_solve, ulam_direct_solve, ulam_mm_write_vector, ulam_strerror;
+ *   secondary, more control and the other methods: building and transforming matrices
+ *     (ulam_csr_alloc, _from_triplets, _check, _transpose, ulam_jacobi), reader options and
+ *     files (ulam_mm_read_matrix_opts, _file, ulam_mm_write_matrix), verdicts
+ *     (ulam_guard_variance, ulam_verdict_of, ulam_solver_guard), spectral radii
+ *     (ulam_spectral_power, ulam_spectral_radius), prepared systems (ulam_system_*,
+ *     ulam_certificate_*), processes (ulam_share), outer iterations (ulam_outer_*), Krylov
+ *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_solve), the method
+ *     choice (ulam_auto_choose), ulam_direct_bytes;
+ *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
+ *     ulam_strtod, ulam_outfile_*, ulam_spectral_radius_op, ulam_gauss_seidel_*, the studies'
+ *     ulam_cell_summary, ulam_law_*, ulam_gnuplot, random numbers (ulam_rng_*), ulam_now.
+ * The radiosity front end ranks its own in ulam_radiosity.h.
  */
 #ifndef ULAM_H
 #define ULAM_H
@@ -36,6 +55,7 @@ extern "C" {
 #define ULAM_Z95 1.959963984540054
 
 /* ---------------------------------------------------------------- status codes */
+/* All primary. */
 
 enum ulam_status {
     ULAM_OK = 0,
@@ -84,6 +104,8 @@ typedef struct ulam_error {
 } ulam_error;
 
 /* ---------------------------------------------------------------- sparse matrices */
+/* Primary: the struct, ulam_csr_free.  Secondary: building, checking, transposing, ulam_jacobi.
+ * Tertiary: nnz, copy, matvec, dense, stats. */
 
 /* Compressed sparse row matrix.  Plain data: rowptr has nrows+1 entries (64-bit, so
  * nnz may exceed 2^31), colidx and val have rowptr[nrows] entries; columns are sorted
@@ -149,14 +171,16 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
                 ulam_error *err);
 
 /* ---------------------------------------------------------------- Matrix Market */
+/* Primary: ulam_mm_read_matrix, _read_vector, _write_vector.  Secondary: options, FILE readers,
+ * _write_matrix.  Tertiary: ulam_strtod, ulam_outfile. */
 
-/* Read a sparse matrix ("coordinate" real/integer/pattern, general/symmetric/
+/* Read a sparse matrix from path ("coordinate" real/integer/pattern, general/symmetric/
  * skew-symmetric; duplicates summed, explicit zeros dropped; symmetric files are
- * expanded).  name is used only in error details. */
-int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
-
-/* As ulam_mm_read_matrix_file, opening path. */
+ * expanded). */
 int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err);
+
+/* As ulam_mm_read_matrix, from an open file; name is used only in error details. */
+int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
 
 /* Options of the matrix reader.  Start from ulam_mm_defaults(). */
 typedef struct ulam_mm_opts {
@@ -175,12 +199,12 @@ ulam_mm_opts ulam_mm_defaults(void);
 /* As ulam_mm_read_matrix_file with options (o NULL: ulam_mm_defaults()). */
 int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
 
-/* Read a dense vector: "array" m x 1, or "coordinate" m x 1 (missing entries are 0).
- * *x is malloc'd with *n entries. */
-int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
-
-/* As ulam_mm_read_vector_file, opening path. */
+/* Read a dense vector from path: "array" m x 1, or "coordinate" m x 1 (missing entries are
+ * 0).  *x is malloc'd with *n entries. */
 int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *err);
+
+/* As ulam_mm_read_vector, from an open file; name is used only in error details. */
+int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
 
 /* strtod(s, end) exactly (the same double and end for every input, C locale), faster for
  * decimals of up to 19 significant digits with normal results (Clinger's fast path, else the
@@ -215,6 +239,7 @@ int ulam_outfile_commit(ulam_outfile *o);
 void ulam_outfile_abort(ulam_outfile *o);
 
 /* ---------------------------------------------------------------- direct solve */
+/* Primary: ulam_direct_solve.  Secondary: ulam_direct_bytes. */
 
 /* What a LAPACK direct solve reports besides the solution. */
 typedef struct ulam_direct_info {
@@ -234,6 +259,7 @@ int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_
                       ulam_direct_info *info, ulam_error *err);
 
 /* ---------------------------------------------------------------- spectral radius */
+/* Secondary, except tertiary: ulam_spectral_radius_op. */
 
 /* Options of the spectral radius estimate: ARPACK's implicitly restarted Arnoldi
  * (dense dgeev for n <= 128), stopped when the dominant Ritz pair reaches
@@ -301,6 +327,7 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
                         const ulam_power_opts *opts, ulam_power *out, ulam_error *err);
 
 /* ---------------------------------------------------------------- stability guards */
+/* Primary: ulam_guard_check and its options.  Secondary: ulam_verdict_of, ulam_guard_variance. */
 
 /* A radius against 1, from its certified bounds alone (never from an unconverged estimate):
  * OK when upper < 0.99; EDGE (finite, within 1% of 1) when upper < 1; FAIL when lower >= 1;
@@ -361,6 +388,7 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
 int ulam_guard_variance(const ulam_guard *g, int mode);
 
 /* ---------------------------------------------------------------- prepared systems */
+/* Secondary, except tertiary: ulam_system_from_memory, _is_file, _omega, _certificate, _write_file. */
 
 /* A prepared system: M (and b) of (I - M) x = b as one binary file that is mapped read-only
  * and used in place, so a query reads only the pages of the rows its walks reach (the layout
@@ -462,27 +490,8 @@ int ulam_certificate_compute(const ulam_csr *M, double continue_q, const ulam_gu
 int ulam_certificate_guard(const ulam_certificate *c, double continue_q, const ulam_guard_opts *opts,
                            ulam_guard *g);
 
-/* ---------------------------------------------------------------- random numbers */
-
-/* xoshiro256** 1.0 (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
- * ACM TOMS 2021; https://prng.di.unimi.it), seeded through splitmix64.  Caller-owned. */
-typedef struct ulam_rng {
-    uint64_t s[4];
-} ulam_rng;
-
-/* Seed from a 64-bit seed and a stream number (e.g. a walk or block index). */
-void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream);
-
-/* Next 64 random bits. */
-uint64_t ulam_rng_next(ulam_rng *r);
-
-/* Uniform double in [0, 1) with 53 random bits. */
-double ulam_rng_uniform(ulam_rng *r);
-
-/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
-uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
-
 /* ---------------------------------------------------------------- random walks */
+/* Primary, except secondary: ulam_share, ulam_solver_guard. */
 
 enum ulam_mode { ULAM_ADJOINT = 0, ULAM_FORWARD = 1 };
 enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2 };
@@ -654,6 +663,7 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
 #define ULAM_REL_ERR_CAP 1000000000
 
 /* ---------------------------------------------------------------- outer iterations */
+/* All secondary. */
 
 /* Iterations on (I - M) x = b from x = 0 that stop on the exact residual
  * ||b - (I - M) x||_2 / ||b||_2 <= tol:
@@ -730,6 +740,7 @@ int ulam_outer_solve(const ulam_csr *M, const double *b, const ulam_outer_opts *
                      ulam_outer_step *steps, int max_steps, int *nsteps, ulam_error *err);
 
 /* ---------------------------------------------------------------- Krylov peers */
+/* Secondary, except tertiary: ulam_csr_symmetric. */
 
 /* Krylov solvers for (I - M) x = b from x = 0, stopped when ||b - (I - M) x||_2 / ||b||_2 <=
  * tol (the true residual, recomputed at the end): conjugate gradients for symmetric positive
@@ -745,6 +756,7 @@ int ulam_gmres(const ulam_csr *M, const double *b, int restart, double tol, int 
 int ulam_csr_symmetric(const ulam_csr *M);
 
 /* ---------------------------------------------------------------- point sources: push and bidirectional */
+/* All secondary. */
 
 /* Reverse local push from a target t on the adjoint equation (src/push.c): estimates p and
  * residuals r with x_t = <p, b> + <r, x> for every b, where (I - M) x = b.  Pushing j moves r_j
@@ -863,6 +875,7 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
                      ulam_error *err);
 
 /* ---------------------------------------------------------------- choosing the method */
+/* All secondary. */
 
 /* One candidate of ulam_auto_choose: a mode, an estimator and a continuation. */
 typedef struct ulam_auto_candidate {
@@ -909,6 +922,7 @@ int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *b
                      ulam_auto_result *res, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
+/* All tertiary. */
 
 /* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
 void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
@@ -950,7 +964,29 @@ int ulam_law_noreturn(const ulam_csr *M, int64_t j, double *s, double *pstar, ul
  * or fails (nothing is left behind). */
 int ulam_gnuplot(const char *dir, const char *name, int width, int height, const char *script);
 
+/* ---------------------------------------------------------------- random numbers */
+/* All tertiary. */
+
+/* xoshiro256** 1.0 (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
+ * ACM TOMS 2021; https://prng.di.unimi.it), seeded through splitmix64.  Caller-owned. */
+typedef struct ulam_rng {
+    uint64_t s[4];
+} ulam_rng;
+
+/* Seed from a 64-bit seed and a stream number (e.g. a walk or block index). */
+void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream);
+
+/* Next 64 random bits. */
+uint64_t ulam_rng_next(ulam_rng *r);
+
+/* Uniform double in [0, 1) with 53 random bits. */
+double ulam_rng_uniform(ulam_rng *r);
+
+/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
+uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
+
 /* ---------------------------------------------------------------- utilities */
+/* All tertiary. */
 
 /* Monotonic wall clock in seconds. */
 double ulam_now(void);

@@ -897,6 +897,27 @@ def check_radiosity(ulam):
         assert sorted(os.listdir(d)) == ["box.png"], os.listdir(d)
 
 
+def check_radiosity_json_paths(ulam):
+    """A scene path with a quote, a backslash and a tab stays valid JSON in every radiosity object
+    (gathering, shooting, --list): the main object printed the path unescaped."""
+    import shutil
+    with tempfile.TemporaryDirectory() as d:
+        sub = os.path.join(d, 'a "quoted"\\dir\t')
+        os.mkdir(sub)
+        for f in ("cube.obj", "cube.mtl"):
+            shutil.copy(SC + f, os.path.join(sub, f))
+        scene = os.path.join(sub, "cube.obj")
+        for extra in (["--patch", "1", "--walks", "1000"], ["--mode", "shoot", "--walks", "1000", "--patch", "2"],
+                      ["--list"]):
+            rc, out, err = run(ulam, ["radiosity", scene, "--json"] + extra)
+            assert rc == 0, (extra, err)
+            try:
+                j = json.loads(out)
+            except ValueError as e:
+                raise AssertionError(f"{extra}: not JSON ({e}): {out[:200]}")
+            assert j["scene"] == scene, (extra, j["scene"])
+
+
 def check_radiosity_interrupt(ulam):
     """An interrupted image run says [INTERRUPTED], writes no picture and does not claim one
     ('image int.png (exposure 0)' was printed); output paths are checked before any work (a run
@@ -1078,7 +1099,7 @@ def main():
     extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
-             (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
+             (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
