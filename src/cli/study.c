@@ -3,6 +3,7 @@
  * resumes; then summary.csv and charts.  No output file is ever seen half written, and no
  * non-finite number is written: an undefined statistic is an empty field. */
 #include "cli.h"
+#include "gnuplot.h"
 
 #include <errno.h>
 #include <getopt.h>
@@ -45,12 +46,11 @@ static const char *const usage =
     "Windows: roulette W = 0.5 w0, split W = 2 w0 (w0 the starting weight).  Ctrl-C keeps\n"
     "every finished row and writes the summary (exit 130); a second Ctrl-C exits at once.\n";
 
-enum { NMETHOD = 18, MAXBUDGET = 16, MAXREPEAT = 4096 };
-static const char *const window_names[] = {"plain", "roulette", "split"};
+enum { NMETHOD = ULAM_STUDY_METHODS, MAXBUDGET = 16, MAXREPEAT = 4096 };
 
 typedef struct {
-    char name[40];
-    int mode, est, window, on;
+    const char *name; /* the library's method grid: ulam_study_method_get */
+    int mode, on;
     char why[320]; /* non-empty: refused */
     int infinite;  /* rho(M^) not certified below 1: runs, flagged */
 } method;
@@ -82,9 +82,8 @@ static size_t at(const study *st, int m, int b, int r)
 static void methods_init(method *m)
 {
     for (int k = 0; k < NMETHOD; k++) {
-        m[k] = (method){.mode = k / 9, .est = k / 3 % 3, .window = k % 3, .on = 1};
-        snprintf(m[k].name, sizeof m[k].name, "%s-%s-%s", cli_mode_names[m[k].mode], cli_estimator_names[m[k].est],
-                 window_names[m[k].window]);
+        const ulam_study_method *g = ulam_study_method_get(k);
+        m[k] = (method){.name = g->name, .mode = g->mode, .on = 1};
     }
 }
 
@@ -95,9 +94,8 @@ static int methods_select(method *m, const char *list)
     char buf[1024];
     snprintf(buf, sizeof buf, "%s", list);
     for (char *save, *w = strtok_r(buf, ",", &save); w; w = strtok_r(NULL, ",", &save)) {
-        int k = 0;
-        while (k < NMETHOD && strcmp(m[k].name, w)) k++;
-        if (k == NMETHOD)
+        int k = ulam_study_method_find(w);
+        if (k < 0)
             return cli_usage_error("study", "--methods: unknown method '%s' (names like adjoint-collision-plain)", w);
         m[k].on = 1;
     }
@@ -140,7 +138,8 @@ static int screen_methods(study *st)
                      g->abs.lower, g->abs.upper);
         } else {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.mode = m->mode, o.estimator = m->est, o.index = st->s.index - 1, o.max_walks = 1, o.guard = g;
+            ulam_study_method_opts(k, st->s.b, st->s.M->nrows, &o);
+            o.roulette = o.split = 0, o.index = st->s.index - 1, o.max_walks = 1, o.guard = g; /* screened unwindowed */
             ulam_solver *sv = NULL;
             if (ulam_solver_alloc(st->s.M, st->s.b, &o, &sv, &err))
                 snprintf(m->why, sizeof m->why, "%s: expected %s", ulam_strerror(err.status), err.msg);
@@ -216,16 +215,12 @@ static int one_run(study *st, int m, int b, int r)
 {
     const method *me = &st->m[m];
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = me->mode, o.estimator = me->est, o.index = st->s.index - 1, o.threads = st->threads;
+    ulam_study_method_opts(m, st->s.b, st->s.M->nrows, &o);
+    o.index = st->s.index - 1, o.threads = st->threads;
     o.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
     o.interrupt = &cli_interrupted, o.share = cli_share, o.guard = &st->g, o.force = 1;
     if (st->time_budgets) o.max_walks = 0, o.max_seconds = st->budget[b];
     else o.max_walks = (int64_t)st->budget[b];
-    double w0 = me->mode == ULAM_FORWARD ? 0.0 : 1.0; /* forward particles start at ||b||_1 */
-    if (me->mode == ULAM_FORWARD)
-        for (int64_t i = 0; i < st->s.M->nrows; i++) w0 += fabs(st->s.b[i]);
-    if (me->window >= 1) o.roulette = 0.5 * w0;
-    if (me->window == 2) o.split = 2.0 * w0;
     ulam_walk_result res;
     if (ulam_solve(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted || res.walks < 2 || !isfinite(res.std_error))
         return 1; /* nothing non-finite reaches runs.csv */
@@ -396,16 +391,18 @@ static void outer_references(const study *st, FILE *f)
     free(x);
 }
 
-/* The exact x_I and the reference lines: LAPACK (n <= 8000: its time and its error against
- * Gauss-Seidel run to convergence) and Gauss-Seidel from x = 0 (time against its error on
- * x_I), into reference.csv.  0 or an exit code. */
+/* The exact x_I (ulam_study_reference) and the reference lines: LAPACK (n <= 8000: its time and
+ * its error against Gauss-Seidel run to convergence) and Gauss-Seidel from x = 0 (time against
+ * its error on x_I), into reference.csv.  0 or an exit code. */
 static int references(study *st)
 {
     int64_t n = st->s.M->nrows, I = st->s.index - 1;
-    double *x = calloc((size_t)n, sizeof *x), *xd = NULL;
+    ulam_study_ref ref;
+    ulam_error err;
+    if (ulam_study_reference(st->s.M, st->s.b, I, &ref, &err)) return cli_report(st->s.matrix_path, &err);
+    st->exact = ref.exact;
+    double *x = calloc((size_t)n, sizeof *x);
     if (!x) return cli_exit_code(ULAM_ENOMEM);
-    ulam_gauss_seidel_settle(st->s.M, st->s.b, x, I, 1e-16, 12, 100000); /* the converged reference */
-    st->exact = x[I];
     char path[4096], v[2][32];
     snprintf(path, sizeof path, "%s/reference.csv", st->out);
     ulam_outfile o = {0};
@@ -421,14 +418,9 @@ static int references(study *st)
         return cli_exit_code(ULAM_EIO);
     }
     fprintf(f, "kind,seconds,error\n");
-    ulam_direct_info info;
-    if (n <= 8000 && (xd = malloc((size_t)n * sizeof *xd)) && !ulam_direct_solve(st->s.M, st->s.b, xd, 0, &info, NULL)) {
-        fprintf(f, "lapack,%s,%s\n", num(v[0], info.seconds), num(v[1], fabs(xd[I] - st->exact) + 1e-300));
-        st->exact = xd[I];
-    }
-    free(xd);
+    if (ref.direct)
+        fprintf(f, "lapack,%s,%s\n", num(v[0], ref.direct_seconds), num(v[1], fabs(ref.exact - ref.settled) + 1e-300));
     double t = 0;
-    for (int64_t i = 0; i < n; i++) x[i] = 0;
     for (int k = 1; k <= 100000; k++) {
         double t0 = ulam_now();
         ulam_gauss_seidel_sweep(st->s.M, st->s.b, x);
@@ -443,6 +435,34 @@ static int references(study *st)
     if (!o.f) return fclose(f), 0;
     ulam_error e = {.status = ulam_outfile_commit(&o), .msg = "a writable output directory"};
     return e.status ? cli_report(path, &e) : 0;
+}
+
+/* What R runs of one method at one budget say, against the exact value. */
+typedef struct {
+    int runs;
+    double rmse;        /* sqrt(mean (estimate - exact)^2) */
+    double mean_stderr; /* the mean reported standard error */
+    double honesty;     /* rmse / mean_stderr: 1 when the error bars are honest */
+    double coverage;    /* share of runs whose 95% interval holds the exact value */
+    double seconds;     /* mean seconds per run */
+    double work;        /* work-normalised variance rmse^2 x seconds (lower is better) */
+} cell;
+
+/* Summarise n runs (arrays of n) against the exact value into *out. */
+static void cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
+                         double exact, cell *out)
+{
+    double se2 = 0, se = 0, t = 0;
+    int covered = 0;
+    for (int k = 0; k < n; k++) {
+        double e = estimate[k] - exact;
+        se2 += e * e, se += std_error[k], t += seconds[k];
+        covered += fabs(e) <= ULAM_Z95 * std_error[k];
+    }
+    double N = n > 0 ? n : 1;
+    *out = (cell){.runs = n, .rmse = sqrt(se2 / N), .mean_stderr = se / N, .coverage = covered / N, .seconds = t / N};
+    out->honesty = out->mean_stderr > 0 ? out->rmse / out->mean_stderr : INFINITY;
+    out->work = out->rmse * out->rmse * out->seconds;
 }
 
 /* summary.csv (a row per cell) and bars.csv (per method, at the largest budget). */
@@ -465,7 +485,7 @@ static int summarise(study *st)
     double *e = malloc((size_t)st->repeats * 3 * sizeof *e);
     for (int m = 0; m < NMETHOD && e; m++) {
         if (!st->m[m].on || st->m[m].why[0]) continue;
-        ulam_cell last = {0};
+        cell last = {0};
         for (int b = 0; b < st->nbudget; b++) {
             int k = 0;
             for (int r = 0; r < st->repeats; r++) {
@@ -473,8 +493,8 @@ static int summarise(study *st)
                 if (st->done[i]) e[k] = st->est[i], e[st->repeats + k] = st->se[i], e[2 * st->repeats + k++] = st->sec[i];
             }
             if (!k) continue;
-            ulam_cell c;
-            ulam_cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, &c);
+            cell c;
+            cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, &c);
             fprintf(f, "%s,%.17g,%d,%s,%s,%s,%s,%s,%s,%s\n", st->m[m].name, st->budget[b], c.runs,
                     num(v[0], c.rmse), num(v[1], c.mean_stderr), num(v[2], c.honesty), num(v[3], c.coverage),
                     num(v[4], c.seconds), num(v[5], c.work), st->m[m].infinite ? "false" : "true");
@@ -514,15 +534,15 @@ static int charts(const study *st)
              "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 2 pt 3 t 'Krylov (CG or GMRES(30))', "
              "f(x) dt 2 lc 'black' t '1/sqrt(t) slope'\n",
              (long long)st->s.index, st->exact != 0 ? 1e-9 * fabs(st->exact) : 1e-12, names);
-    if (ulam_gnuplot(st->out, "rmse", 1200, 700, script)) {
+    if (gnuplot_draw(st->out, "rmse", 1200, 700, script)) {
         fprintf(stderr, "ulam: study: gnuplot failed (install gnuplot-nox): charts not drawn, CSVs written\n");
         return 1;
     }
-    ulam_gnuplot(st->out, "work", 1000, 500,
+    gnuplot_draw(st->out, "work", 1000, 500,
                  "set title 'work-normalised variance RMSE^2 x seconds at the largest budget (lower wins)'\n"
                  "set style data histograms\nset style fill solid 0.6\nset logscale y\nset format y '10^{%L}'\n"
                  "set xtics rotate by -40 font ',8'\nset bmargin 7\nset key off\nplot 'bars.csv' u 2:xtic(1)\n");
-    ulam_gnuplot(st->out, "coverage", 1000, 500,
+    gnuplot_draw(st->out, "coverage", 1000, 500,
                  "set title 'coverage of the 95% interval at the largest budget'\nset style data histograms\n"
                  "set style fill solid 0.6\nset yrange [0:1]\nset xtics rotate by -40 font ',8'\nset bmargin 7\nset key off\n"
                  "plot 'bars.csv' u 3:xtic(1), 0.95 dt 2 lc 'black'\n");
