@@ -64,6 +64,7 @@ typedef struct {
     const char *out;
     ulam_guard g; /* the verdicts, computed once for every run */
     double exact;
+    int direct; double direct_seconds, direct_error; /* LAPACK's point on the chart (n <= 8000) */
     int forward_walks; /* rho(|M|) < 1 and the forward rho(M^) < 1: the outer iterations can walk */
     double *est, *se, *sec; /* [m][b][r] */
     unsigned char *done;
@@ -401,6 +402,7 @@ static int references(study *st)
     ulam_error err;
     if (ulam_study_reference(st->s.M, st->s.b, I, &ref, &err)) return cli_report(st->s.matrix_path, &err);
     st->exact = ref.exact;
+    st->direct = ref.direct, st->direct_seconds = ref.direct_seconds, st->direct_error = fabs(ref.exact - ref.settled) + 1e-300;
     double *x = calloc((size_t)n, sizeof *x);
     if (!x) return cli_exit_code(ULAM_ENOMEM);
     char path[4096], v[2][32];
@@ -419,7 +421,7 @@ static int references(study *st)
     }
     fprintf(f, "kind,seconds,error\n");
     if (ref.direct)
-        fprintf(f, "lapack,%s,%s\n", num(v[0], ref.direct_seconds), num(v[1], fabs(ref.exact - ref.settled) + 1e-300));
+        fprintf(f, "lapack,%s,%s\n", num(v[0], st->direct_seconds), num(v[1], st->direct_error));
     double t = 0;
     for (int k = 1; k <= 100000; k++) {
         double t0 = ulam_now();
@@ -512,28 +514,70 @@ static int summarise(study *st)
     return status ? cli_report(path[k ? k - 1 : 0], &err) : 0;
 }
 
+/* LAPACK's point on the RMSE chart, kept inside the axes the other lines set: marked at the edge
+ * it would stretch past, with its values and an arrow toward them (gnuplot, after X0, X1, Y0). */
+static void lapack_mark(const study *st, char *buf, size_t len)
+{
+    if (!st->direct) {
+        snprintf(buf, len, "lx = 1/0\nly = 1/0\n");
+        return;
+    }
+    char err[32]; /* the error as a label: 0 when LAPACK and Gauss-Seidel agree to the last bit */
+    if (st->direct_error > 1e-299) snprintf(err, sizeof err, "%.2g", st->direct_error);
+    else snprintf(err, sizeof err, "0");
+    snprintf(buf, len,
+             "LX = %.17g\nLY = %.17g\n"
+             "lx = LX < X0 ? X0 : LX > X1 ? X1 : LX\nly = LY < Y0 ? 2 * Y0 : LY\n"
+             "lt = 'LAPACK: error %s in %.3g s '.(LY < Y0 ? '\342\206\223' : '').(LX > X1 ? '\342\206\222' : "
+             "LX < X0 ? '\342\206\220' : '')\n"
+             "if (lx != LX || ly != LY) {\n"
+             "  if (lx > sqrt(X0 * X1)) {\n"
+             "    set label 1 lt at lx, ly right offset character -1.5, 0 font ',9'\n"
+             "  } else {\n"
+             "    set label 1 lt at lx, ly left offset character 1.5, 0 font ',9'\n"
+             "  }\n"
+             "}\n",
+             st->direct_seconds, st->direct_error, err, st->direct_seconds);
+}
+
 /* The three charts; nonzero when gnuplot failed. */
 static int charts(const study *st)
 {
-    char names[NMETHOD * 40] = "", script[8192];
+    char names[NMETHOD * 40] = "", budgets[MAXBUDGET * 32] = "", lapack[1024], script[12288];
     for (int m = 0; m < NMETHOD; m++)
         if (st->m[m].on && !st->m[m].why[0]) strcat(strcat(names, st->m[m].name), " ");
+    for (int b = 0; b < st->nbudget; b++)
+        snprintf(budgets + strlen(budgets), sizeof budgets - strlen(budgets), "%.17g ", st->budget[b]);
+    double y0 = st->exact != 0 ? 1e-9 * fabs(st->exact) : 1e-12;
+    lapack_mark(st, lapack, sizeof lapack);
     snprintf(script, sizeof script,
              "set title 'ulam study: RMSE of x_{%lld} against seconds per run'\n"
              "set logscale xy\nset format x '10^{%%L}'\nset format y '10^{%%L}'\nset xlabel 'seconds per run'\n"
              "set ylabel 'RMSE (reference lines: the error of one run)'\nset key outside right font ',8'\n"
-             "set yrange [%g:*]\n"
+             "Y0 = %g\nset yrange [Y0:*]\n"
              "set fit quiet\nset fit logfile '/dev/null'\nf(x) = a / sqrt(x)\na = 0\nfit f(x) 'summary.csv' u 8:4 via a\n"
              "M = \"%s\"\n" /* one colour and dash per method: 8 colours, then the next dash pattern */
-             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) ? $8 : 1/0):4 w lp "
-             "linecolor i dashtype 1 + (i - 1) / 8 pointtype i title word(M, i), "
-             "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 t 'Gauss-Seidel, whole vector', "
-             "'' u (strcol(1) eq 'lapack' ? $2 : 1/0):3 w p pt 9 ps 2 t 'LAPACK dgesv (error vs refined)', "
-             "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 2 pt 5 t 'sequential MC, every unknown (one run)', "
-             "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 2 pt 7 t 'MCSA, every unknown (one run)', "
-             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 2 pt 3 t 'Krylov (CG or GMRES(30))', "
+             "B = \"%s\"\n" /* one point shape per budget, in the method's colour */
+             "P = \"7 5 9 11 13 6 4 8 10 12 1 2 3 14 15 16\"\n"
+             /* the x axis spans the walks and the reference lines but LAPACK's point */
+             "stats 'summary.csv' u ($8 > 0 ? $8 : 1/0) nooutput\nX0 = STATS_min\nX1 = STATS_max\n"
+             "stats 'reference.csv' u (strcol(1) ne 'lapack' && $2 > 0 ? $2 : 1/0) nooutput\n"
+             "X0 = 10**floor(log10(STATS_min < X0 ? STATS_min : X0))\nX1 = 10**ceil(log10(STATS_max > X1 ? STATS_max : X1))\n"
+             "set xrange [X0:X1]\n"
+             "%s"
+             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) ? $8 : 1/0):4 w l "
+             "linecolor i dashtype 1 + (i - 1) / 8 title word(M, i), "
+             "for [i=1:words(M)] for [j=1:words(B)] 'summary.csv' u (strcol(1) eq word(M, i) && $2 == word(B, j) + 0 ? "
+             "$8 : 1/0):4 w p linecolor i pointtype (word(P, j) + 0) notitle, "
+             "for [j=1:words(B)] NaN w p lc 'black' pointtype (word(P, j) + 0) title sprintf('%s', word(B, j) + 0), "
+             "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 lc 3 t 'Gauss-Seidel, whole vector', "
+             "'' u (strcol(1) eq 'lapack' ? lx : 1/0):(ly) w p pt 9 ps 2 lc 4 t 'LAPACK dgesv (error vs refined)', "
+             "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 2 pt 5 lc 5 t 'sequential MC, every unknown (one run)', "
+             "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 2 pt 7 lc 6 t 'MCSA, every unknown (one run)', "
+             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 2 pt 3 lc 7 t 'Krylov (CG or GMRES(30))', "
              "f(x) dt 2 lc 'black' t '1/sqrt(t) slope'\n",
-             (long long)st->s.index, st->exact != 0 ? 1e-9 * fabs(st->exact) : 1e-12, names);
+             (long long)st->s.index, y0, names, budgets, lapack,
+             st->time_budgets ? "budget %g s a run" : "budget %.0f walks");
     if (gnuplot_draw(st->out, "rmse", 1200, 700, script)) {
         fprintf(stderr, "ulam: study: gnuplot failed (install gnuplot-nox): charts not drawn, CSVs written\n");
         return 1;
