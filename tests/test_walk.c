@@ -77,6 +77,7 @@ static void test_agreement(void **state)
         sys s = load(systems[k].name);
         for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++)
             for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
+                if (!test_case(1000 * (long)k + 3 * mode + est)) continue; /* system k, mode, estimator */
                 ulam_walk_opts o = ulam_walk_defaults();
                 o.mode = mode;
                 o.estimator = est;
@@ -97,6 +98,7 @@ static void test_agreement(void **state)
             }
         unload(&s);
     }
+    test_case_done();
 }
 
 /* Over 200 seeds the 95% interval covers the LAPACK value 90% to 99% of the time. */
@@ -106,7 +108,8 @@ static void test_coverage(void **state)
     sys s = load("chain4");
     for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
         int covered = 0;
-        for (int seed = 0; seed < 200; seed++) { /* case seed: reruns exactly */
+        for (int seed = 0; seed < 200; seed++) { /* case 1000 est + seed: reruns exactly */
+            if (!test_case(1000L * est + seed)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = est;
             o.index = 0;
@@ -115,6 +118,8 @@ static void test_coverage(void **state)
             ulam_walk_result r = run(&s, o);
             covered += r.ci95[0] <= s.x[0] && s.x[0] <= r.ci95[1];
         }
+        test_case_done();
+        if (!test_case_all()) continue; /* one case alone: no count over seeds */
         print_message("estimator %d: 95%% interval covered the LAPACK value %d / 200 times\n", est, covered);
         assert_in_range(covered, 180, 198);
     }
@@ -172,6 +177,7 @@ static void test_exact_variance(void **state)
     for (size_t k = 0; k < 3; k++) {
         sys s = load(cases[k].name);
         for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
+            if (!test_case(1000 * (long)k + est)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = est;
             o.index = cases[k].index;
@@ -188,6 +194,7 @@ static void test_exact_variance(void **state)
         }
         unload(&s);
     }
+    test_case_done();
 }
 
 /* Roulette (weights shrinking under --continue 0.95 on the chain) and splitting (weights
@@ -236,6 +243,7 @@ static void test_jacobi_poisson(void **state)
     ulam_csr *A = s.M;
     double *bp = malloc((size_t)s.n * sizeof *bp);
     for (int k = 0; k < 2; k++) {
+        if (!test_case(k)) continue;
         double omega = k ? 0.8 : 1.0;
         assert_int_equal(ulam_jacobi(A, s.b, omega, &s.M, bp, NULL), ULAM_OK);
         double *b = s.b;
@@ -252,6 +260,7 @@ static void test_jacobi_poisson(void **state)
         s.b = b;
         ulam_csr_free(s.M);
     }
+    test_case_done();
     s.M = A;
     free(bp);
     unload(&s);
@@ -281,6 +290,7 @@ static void test_collision_absorption_law(void **state)
         law_variances(ps[k], s, &v[0], &v[1]);
         sys sy = {.M = M, .b = b, .n = 4};
         for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+            if (!test_case(1000L * k + est)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.mode = ULAM_FORWARD, o.estimator = est, o.max_walks = 1000000, o.seed = 40 + (uint64_t)k;
             ulam_walk_result r = run(&sy, o);
@@ -291,6 +301,7 @@ static void test_collision_absorption_law(void **state)
         assert_true(k == 1 || (v[0] < v[1]) == (ps[k] < s / (2 - s)));
         ulam_csr_free(M);
     }
+    test_case_done();
 }
 
 /* Two runs gave the same result bit for bit. */
@@ -331,6 +342,7 @@ static void test_lazy_kernel(void **state)
     static const int64_t budgets[2] = {16, 50000};
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++)
         for (int k = 0; k < 2; k++) {
+            if (!test_case(1000L * mode + k)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.mode = mode, o.index = 5, o.max_walks = budgets[k], o.seed = 7 + (uint64_t)k, o.threads = 2;
             ulam_walk_result lazy = run(&s, o);
@@ -341,6 +353,7 @@ static void test_lazy_kernel(void **state)
             if (k == 0) assert_true(lazy.rows <= lazy.steps + lazy.walks && lazy.rows < s.n / 4);
             else assert_true(lazy.rows == s.n);
         }
+    test_case_done();
     unload(&s);
 }
 
@@ -649,5 +662,5 @@ int main(void)
         cmocka_unit_test(test_solver_guards),     cmocka_unit_test(test_rel_err_infinite_refused),
         cmocka_unit_test(test_forward_unreached), cmocka_unit_test(test_rel_err_cuts), cmocka_unit_test(test_rel_err_collision_tail),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return test_run(tests);
 }
