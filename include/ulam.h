@@ -7,7 +7,17 @@
  *     sentence saying what was expected;
  *   - indices are 0-based in this API (the command line and Matrix Market files are 1-based);
  *   - inputs are const, outputs are caller-owned, every _free accepts and returns NULL;
- *   - the library never prints and never exits.
+ *   - the library never prints and never exits;
+ *   - ABI habit: a struct the caller fills starts from its defaults function, which sets every
+ *     field, and the caller then sets what it needs (ulam_walk_defaults, ulam_mm_defaults,
+ *     ulam_spectral_defaults, ulam_power_defaults, ulam_guard_defaults, ulam_outer_defaults,
+ *     ulam_bidir_defaults, ulam_auto_defaults, ulam_share_defaults, ulam_system_desc_defaults;
+ *     in ulam_radiosity.h ulam_camera_cornell or ulam_camera_frame): a field a later version
+ *     adds then takes its default there, so such a program keeps its meaning when rebuilt.
+ *     Handles (ulam_solver, ulam_outer, ulam_push, ulam_system; ulam_tracer, ulam_rad_solver)
+ *     are opaque, reached only through their functions; what the library fills (results,
+ *     reports, ulam_guard, ulam_certificate, ulam_csr and ulam_scene from their allocators and
+ *     readers) is plain data to read.
  */
 #ifndef ULAM_H
 #define ULAM_H
@@ -148,7 +158,7 @@ int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error
 /* As ulam_mm_read_matrix_file, opening path. */
 int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err);
 
-/* Options of the matrix reader. */
+/* Options of the matrix reader.  Start from ulam_mm_defaults(). */
 typedef struct ulam_mm_opts {
     int threads;     /* 0: all cores; 1: the sequential streaming reader.  A regular file of
                         coordinate general kind is read by `threads` threads in chunks split at
@@ -159,7 +169,10 @@ typedef struct ulam_mm_opts {
                         as it was, for comparisons) */
 } ulam_mm_opts;
 
-/* As ulam_mm_read_matrix_file with options (o NULL: all cores, ulam_strtod). */
+/* The defaults: all cores (threads 0), reals by ulam_strtod (libc_strtod 0). */
+ulam_mm_opts ulam_mm_defaults(void);
+
+/* As ulam_mm_read_matrix_file with options (o NULL: ulam_mm_defaults()). */
 int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
 
 /* Read a dense vector: "array" m x 1, or "coordinate" m x 1 (missing entries are 0).
@@ -224,15 +237,15 @@ int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_
 
 /* Options of the spectral radius estimate: ARPACK's implicitly restarted Arnoldi
  * (dense dgeev for n <= 128), stopped when the dominant Ritz pair reaches
- * ||A u - lambda u|| <= tol |lambda|. */
+ * ||A u - lambda u|| <= tol |lambda|.  Start from ulam_spectral_defaults(). */
 typedef struct ulam_spectral_opts {
     double tol;       /* relative residual tolerance (default 1e-6) */
     int max_restarts; /* cap on implicit restarts (default 300) */
     int krylov_dim;   /* Arnoldi basis size, ARPACK's ncv (default 20) */
-    uint64_t seed;    /* start vector seed for signed matrices */
+    uint64_t seed;    /* start vector seed for signed matrices (default 1) */
 } ulam_spectral_opts;
 
-/* The default options. */
+/* The defaults: tol 1e-6, max_restarts 300, krylov_dim 20, seed 1. */
 ulam_spectral_opts ulam_spectral_defaults(void);
 
 /* Result of a spectral radius estimate. */
@@ -254,9 +267,8 @@ int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double 
                             const void *ctx, int positive_start, const ulam_spectral_opts *opts,
                             ulam_radius *out);
 
-/* ---------------------------------------------------------------- stability guards */
-
-/* Options of the power iteration for nonnegative operators. */
+/* Options of the power iteration for nonnegative operators (the guards' radii).  Start from
+ * ulam_power_defaults(). */
 typedef struct ulam_power_opts {
     double tol;   /* stop when (upper - lower) <= tol * upper, or when for 5 iterations the
                      changes, extrapolated as a geometric series, add up to <= tol * rho,
@@ -267,7 +279,7 @@ typedef struct ulam_power_opts {
                      upper < 1 (default 0: iterate to the tolerance) */
 } ulam_power_opts;
 
-/* The default options. */
+/* The defaults: tol 1e-4, max_iter 1000, certify 0. */
 ulam_power_opts ulam_power_defaults(void);
 
 /* Spectral radius of a nonnegative operator by power iteration, with Collatz-Wielandt bounds
@@ -288,6 +300,8 @@ typedef struct ulam_power {
 int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
                         const ulam_power_opts *opts, ulam_power *out, ulam_error *err);
 
+/* ---------------------------------------------------------------- stability guards */
+
 /* A radius against 1, from its certified bounds alone (never from an unconverged estimate):
  * OK when upper < 0.99; EDGE (finite, within 1% of 1) when upper < 1; FAIL when lower >= 1;
  * UNKNOWN when the bounds straddle 1, which callers treat as FAIL unless told otherwise. */
@@ -300,7 +314,7 @@ enum { ULAM_GUARD_ABS = 1, ULAM_GUARD_ADJOINT = 2, ULAM_GUARD_FORWARD = 4, ULAM_
 /* The bit of ULAM_GUARD_* for the rho(M^) of walks in mode (ULAM_ADJOINT, ULAM_FORWARD). */
 #define ULAM_GUARD_HAT(mode) ((mode) == 1 ? ULAM_GUARD_FORWARD : ULAM_GUARD_ADJOINT)
 
-/* What a guard check computes and how far. */
+/* What a guard check computes and how far.  Start from ulam_guard_defaults(). */
 typedef struct ulam_guard_opts {
     int need;  /* ULAM_GUARD_* bits (0: all three) */
     int tight; /* nonzero: iterate every radius to the tolerance (ulam info); 0: stop as soon
@@ -308,7 +322,8 @@ typedef struct ulam_guard_opts {
     ulam_power_opts power; /* the iteration (certify is set by tight) */
 } ulam_guard_opts;
 
-/* The defaults: all three radii, stopped once certified. */
+/* The defaults: all three radii (need ULAM_GUARD_ALL), tight 0 (stopped once certified), power
+ * ulam_power_defaults(). */
 ulam_guard_opts ulam_guard_defaults(void);
 
 /* The guards of a walk on M with continuation continue_q (<= 0: analog), a plain struct (a
@@ -363,7 +378,7 @@ typedef struct ulam_certificate {
 
 /* What to write: M and/or b (n entries; with M, n = M->nrows), an optional source tag (the
  * CLI's cache: size and mtime), the Jacobi damping omega that made M (0: M as read) and an
- * optional certificate. */
+ * optional certificate.  Start from ulam_system_desc_defaults(). */
 typedef struct ulam_system_desc {
     const ulam_csr *M;
     const double *b;
@@ -372,6 +387,10 @@ typedef struct ulam_system_desc {
     double omega;
     const ulam_certificate *cert;
 } ulam_system_desc;
+
+/* The defaults: nothing to write yet (M, b and cert NULL, n 0, tag {0, 0}, omega 0); set M
+ * and/or b and n. */
+ulam_system_desc ulam_system_desc_defaults(void);
 
 /* Write a prepared system to f (positioned at 0; the caller closes it): ULAM_OK, ULAM_EINVAL
  * or ULAM_EIO. */
@@ -463,12 +482,15 @@ enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2
  * order and reaches the same totals, bit for bit, and the same stopping decisions as one
  * process running them all with the same seed.  allgather must concatenate every process's
  * `bytes` bytes at `mine` in rank order into a new malloc'd *all of *total bytes, returning 0,
- * or nonzero on failure (the run then stops with ULAM_EIO). */
+ * or nonzero on failure (the run then stops with ULAM_EIO).  Start from ulam_share_defaults(). */
 typedef struct ulam_share {
     int rank, nranks;
     int (*allgather)(void *ctx, const void *mine, size_t bytes, void **all, size_t *total);
     void *ctx;
 } ulam_share;
+
+/* The defaults: one process (rank 0 of 1; allgather and ctx NULL, never called). */
+ulam_share ulam_share_defaults(void);
 
 /* How to walk and when to stop.  Start from ulam_walk_defaults(). */
 typedef struct ulam_walk_opts {
@@ -633,7 +655,7 @@ enum ulam_method { ULAM_RICHARDSON = 0, ULAM_GAUSS_SEIDEL = 1, ULAM_SEQUENTIAL =
 typedef struct ulam_outer_opts {
     int method;            /* enum ulam_method (default ULAM_MCSA) */
     double tol;            /* residual reduction, in (0, 1) (default 1e-8) */
-    int max_iter;          /* iteration cap, >= 1 (default 1000; 100000 for the deterministic) */
+    int max_iter;          /* iteration cap (default 0: 1000 with walks, 100000 for the deterministic) */
     int stall;             /* end with ULAM_ESTALL after this many iterations without a new
                               smallest residual (0: 5 with walks, 100 without) */
     double eps1;           /* adaptive threshold on ||stderr||_1 / ||delta||_1, in (0, 1)
@@ -644,7 +666,8 @@ typedef struct ulam_outer_opts {
                               seed of iteration l is drawn from the stream (seed, l)) */
 } ulam_outer_opts;
 
-/* The defaults: MCSA, tol 1e-8, eps1 0.1, expected-value forward walks, seed 1. */
+/* The defaults: MCSA, tol 1e-8, max_iter 0, stall 0, eps1 0.1, max_histories 10^8, walk
+ * ulam_walk_defaults() but forward expected-value walks (seed 1). */
 ulam_outer_opts ulam_outer_defaults(void);
 
 /* What one iteration did. */
@@ -747,7 +770,8 @@ void ulam_push_report(const ulam_push *w, ulam_push_info *info);
  * PageRank estimation and search: a bidirectional approach", WSDM 2016): a reverse push from t gives
  * x_t = p_s + <r, x>, and <r, x> = e_s' (I - M')^-1 r is the unknown s of the system (M', r),
  * estimated by the adjoint walk solver on M' from s scoring r (walks forward from the source).
- * Each score is at most rmax x the walk's weight sum, so the variance falls with rmax. */
+ * Each score is at most rmax x the walk's weight sum, so the variance falls with rmax.  Start from
+ * ulam_bidir_defaults(). */
 typedef struct ulam_bidir_opts {
     int64_t target, source; /* 0-based t and s */
     double rmax;       /* push threshold; <= 0: balance the push's work against the walks' predicted work */
@@ -757,7 +781,8 @@ typedef struct ulam_bidir_opts {
                              set here); rel_err applies to the whole estimate p_s + <r, x> */
 } ulam_bidir_opts;
 
-/* The defaults: balanced rmax, min_value 1 / n, ulam_walk_defaults() walks. */
+/* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
+ * (the default cap), walk ulam_walk_defaults(). */
 ulam_bidir_opts ulam_bidir_defaults(void);
 
 /* What a bidirectional estimate found. */
@@ -797,7 +822,7 @@ typedef struct ulam_auto_candidate {
 /* At most 2 modes x 3 estimators x 2 continuations. */
 #define ULAM_AUTO_MAX 12
 
-/* What the choice may vary: a pinned part keeps base's value. */
+/* What the choice may vary: a pinned part keeps base's value.  Start from ulam_auto_defaults(). */
 typedef struct ulam_auto_opts {
     int pin_mode, pin_estimator, pin_continue;
     double continue_q;   /* the fixed continuation tried beside analog (default 0.9) */
@@ -805,7 +830,7 @@ typedef struct ulam_auto_opts {
     double pilot_seconds; /* and at most this long, its first block of 1024 walks whole (default 0.02; 0 off) */
 } ulam_auto_opts;
 
-/* The default options: nothing pinned, Q = 0.9, pilots of 2048 walks or 0.02 s. */
+/* The defaults: nothing pinned, continue_q 0.9, pilot_walks 2048, pilot_seconds 0.02. */
 ulam_auto_opts ulam_auto_defaults(void);
 
 /* The candidates and the choice. */

@@ -2,7 +2,8 @@
  * diffuse patches: OBJ + MTL scenes, Embree 3 ray casting, form factors, the LAPACK solve,
  * patch walks that sample F by rays (gathering, shooting, next-event), view gathering and PNG
  * images.  Built with meson's 'radiosity' feature (Embree 3 and libpng); the conventions of
- * ulam.h apply (status codes, ulam_error, const inputs, _free accepts NULL). */
+ * ulam.h apply (status codes, ulam_error, const inputs, _free accepts NULL, the ABI habit:
+ * structs the caller fills start from their defaults function, handles are opaque). */
 #ifndef ULAM_RADIOSITY_H
 #define ULAM_RADIOSITY_H
 
@@ -90,8 +91,8 @@ int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
 /* Form factors F_ij estimated by casting `rays` cosine-distributed rays from uniform points of
  * each patch i (the share that reaches j); stream (seed, i) for patch i, so F does not
  * depend on the number of threads (0: all cores). */
-int ulam_form_factors(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads,
-                      ulam_csr **F, ulam_error *err);
+int ulam_ff_estimate(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads,
+                     ulam_csr **F, ulam_error *err);
 
 /* How well an estimated F obeys the laws of form factors. */
 typedef struct ulam_ff_report {
@@ -101,7 +102,7 @@ typedef struct ulam_ff_report {
 } ulam_ff_report;
 
 /* Fill *r for F on s. */
-int ulam_form_factor_report(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r);
+int ulam_ff_report_compute(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r);
 
 /* Exact form factor between directly opposed parallel a x b rectangles at distance c
  * (Howell's catalogue, C-11). */
@@ -112,26 +113,26 @@ double ulam_ff_parallel_rectangles(double a, double b, double c);
 double ulam_ff_perpendicular_rectangles(double w, double h, double l);
 
 /* The radiosity system of channel c: M = diag(rho_c) F (new *M) and b = E_c (npatches). */
-int ulam_radiosity_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
-                          double *b);
+int ulam_rad_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
+                    double *b);
 
 /* Solve the three channels' systems with LAPACKE_dgesv into B (3 * npatches, RGB per patch);
  * refuses with ULAM_EMEMLIMIT like ulam_direct_solve.  info (may be NULL) sums the three. */
-int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
-                          ulam_direct_info *info, ulam_error *err);
+int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
+                    ulam_direct_info *info, ulam_error *err);
 
-/* The standard error of the direct solution B (from ulam_radiosity_direct on an F estimated
+/* The standard error of the direct solution B (from ulam_rad_direct on an F estimated
  * with `rays` rays a patch) at patch p, per channel: the first-order propagation of the
  * multinomial noise of each row of F, se^2 = sum_k (G_pk rho_k)^2 v_k / rays with
  * G = (I - M)^-1 (one transposed LAPACK solve a channel) and v_k = sum_j F_kj B_j^2 -
  * (sum_j F_kj B_j)^2. */
-int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                int64_t p, size_t max_bytes, double se[3], ulam_error *err);
+int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                          int64_t p, size_t max_bytes, double se[3], ulam_error *err);
 
 /* The same at every patch (se: 3 * npatches): G = (I - M)^-1 whole by one LAPACKE_dgesv with
  * npatches right-hand sides a channel, so two dense matrices (ULAM_EMEMLIMIT past max_bytes). */
-int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                 size_t max_bytes, double *se, ulam_error *err);
+int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                           size_t max_bytes, double *se, ulam_error *err);
 
 /* Gathering's next-event estimators (opts->estimator of ulam_rad_solver_alloc, gathering only).
  * At every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in
@@ -195,7 +196,8 @@ int ulam_rad_solver_vectors(const ulam_rad_solver *s, double *B, double *std_err
 /* Free; accepts and returns NULL. */
 ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s);
 
-/* A pinhole camera. */
+/* A pinhole camera.  Start from ulam_camera_cornell() or ulam_camera_frame() (ulam.h's ABI
+ * habit). */
 typedef struct ulam_camera {
     double eye[3], dir[3], up[3];
     double focal, film; /* focal length and film width, same unit (mm) */

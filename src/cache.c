@@ -141,6 +141,12 @@ static int put_part(FILE *f, const void *p, size_t n, uint64_t *at)
     return !pad || fwrite(zeros, 1, pad, f) == pad;
 }
 
+/* An empty description. */
+ulam_system_desc ulam_system_desc_defaults(void)
+{
+    return (ulam_system_desc){.M = NULL, .b = NULL, .n = 0, .tag = {0, 0}, .omega = 0.0, .cert = NULL};
+}
+
 /* Write a prepared system to f. */
 int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
 {

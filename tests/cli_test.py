@@ -160,6 +160,11 @@ BAD_SCENES = [  # file, status, the file:line the message must name
     ("no_usemtl.obj", "ENOTFOUND", O + "no_usemtl.obj:6"), ("bad_vertex.obj", "ESYNTAX", O + "bad_vertex.obj:3"),
     ("unknown_statement.obj", "ESYNTAX", O + "unknown_statement.obj:7"), ("empty.obj", "EEMPTY", O + "empty.obj:2"),
     ("repeated_newmtl.obj", "ESYNTAX", O + "repeated_newmtl.mtl:7"), ("kd_spectral.obj", "EUNSUPPORTED", O + "kd_spectral.mtl:2"),
+    # the review's findings: a second Ke overrode the first silently; mtllib twice blamed the MTL's line 1;
+    # w = 0 was accepted; 1e200 said "degenerate"; a face before any vertex asked for "1 to 0"
+    ("repeated_ke.obj", "ESYNTAX", O + "repeated_ke.mtl:4"), ("mtllib_twice.obj", "ESYNTAX", O + "mtllib_twice.obj:3"),
+    ("vertex_w0.obj", "ERANGE", O + "vertex_w0.obj:4"), ("huge_coord.obj", "ERANGE", O + "huge_coord.obj:4"),
+    ("face_before_vertex.obj", "EINDEX", O + "face_before_vertex.obj:3"),
 ]
 for f, status, where in BAD_SCENES:
     CASES.append((["radiosity", O + f, "--patch", "1"], code(status), rf"^ulam: {re.escape(where)}: error: .*expected ", ""))
@@ -182,6 +187,15 @@ CASES += [
     (["radiosity", O + "kd_spectral.obj", "--patch", "1"], code("EUNSUPPORTED"),
      r"kd_spectral.mtl:2: error: unsupported kind of data: expected Kd r g b \(RGB only\): this file gives a spectral curve", ""),
     (["radiosity", O + "unknown_statement.obj", "--patch", "1"], code("ESYNTAX"), r"vt, vn, vp, s, l, p, mg, lod, .* ignored", ""),
+    (["radiosity", O + "repeated_ke.obj", "--patch", "1"], code("ESYNTAX"), r"one Ke per material: 'lamp' has one at line 3", ""),
+    (["radiosity", O + "mtllib_twice.obj", "--patch", "1"], code("ESYNTAX"), r"ok.mtl was read at line 1", ""),
+    (["radiosity", O + "vertex_w0.obj", "--patch", "1"], code("ERANGE"), r"w = 1 .*got w = 0", ""),
+    (["radiosity", O + "huge_coord.obj", "--patch", "1"], code("ERANGE"), r"within \+-1e\+30 .*got 1e\+200", ""),
+    (["radiosity", O + "face_before_vertex.obj", "--patch", "1"], code("EINDEX"), r"a 'v' line before the first face", ""),
+    # an unlit scene: direct and walks both exactly 0 printed z = -nan
+    (["radiosity", O + "unlit.obj", "--patch", "1", "--direct", "--walks", "1000"], 0, r"^$", r"direct R +0 \+- 0 \(form-factor noise\)  z = 0\.000"),
+    (["radiosity", O + "unlit.obj", "--patch", "1", "--matrix-walk", "--walks", "1000"], 0, r"^$",
+     r"walks +3000 matrix gather walks.*\n +\(one walk a channel: 1000 R \+ 1000 G \+ 1000 B\)"),
 ]
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends --rel-err (it spun forever)
     CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0,

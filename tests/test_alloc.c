@@ -208,7 +208,7 @@ static int op_radiosity(void)
     int st = ulam_scene_read_obj("examples/scenes/cube.obj", &s0, NULL);
     if (!st) st = ulam_scene_subdivide(s0, 0.5, &s);
     if (!st) st = ulam_tracer_alloc(s, &t, NULL);
-    if (!st) st = ulam_form_factors(t, 50, 1, 2, &F, NULL);
+    if (!st) st = ulam_ff_estimate(t, 50, 1, 2, &F, NULL);
     for (int mode = 0; mode < 2 && !st; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = mode, o.max_walks = 600, o.threads = 2;
