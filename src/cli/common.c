@@ -176,8 +176,9 @@ static int read_input(const char *path, int cache, ulam_system **sys, ulam_csr *
     int status = vec ? ulam_mm_read_vector(path, vec, n, err) : ulam_mm_read_matrix(path, A, err);
     if (status || !use) return status;
     double parsed = ulam_now() - t0;
-    ulam_system_desc d = {.M = vec ? NULL : *A, .b = vec ? *vec : NULL, .n = vec ? *n : (*A)->nrows,
-                          .tag = {tag[0], tag[1]}};
+    ulam_system_desc d = ulam_system_desc_defaults();
+    d.M = vec ? NULL : *A, d.b = vec ? *vec : NULL, d.n = vec ? *n : (*A)->nrows;
+    d.tag[0] = tag[0], d.tag[1] = tag[1];
     int st = ulam_system_write(cpath, &d);
     if (st) fprintf(stderr, "ulam: %s: warning: cache not written: %s\n", cpath, ulam_strerror(st));
     else fprintf(stderr, "ulam: %s: parsed in %.3f s, cache written to %s\n", path, parsed, cpath);
