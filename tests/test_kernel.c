@@ -325,7 +325,8 @@ static void test_coverage(void **state)
  * probability 0.8 / 2 and factor 0.6 / 0.4 = 1.5 (the row factor S / q is 1), so a score is
  * 1.5 and the bound must say 1.5, not 1; at alpha = 1 every factor is 1; at alpha = 3 the move
  * 0 -> 2 has probability 0.8 (1/27) / (28/27) and factor 0.2 * 28 / 0.8 = 7.  --rel-err meets
- * its target and agrees with x_0 = 0.2 + 0.6 * 0.5 = 0.5. */
+ * its target and agrees with x_0 = 0.2 + 0.6 * 0.5 = 0.5, with the absorption and the collision
+ * estimator (whose range term asks for at least 12.28 R / (E x) walks, R >= that largest score). */
 static void test_weight_bound(void **state)
 {
     (void)state;
@@ -343,6 +344,10 @@ static void test_weight_bound(void **state)
                       (long long)r.walks, r.estimate, r.std_error);
         assert_close(r.score_bound, bounds[a], 1e-12);
         assert_true(r.rel_err_met && fabs(r.estimate - 0.5) < 4 * r.std_error);
+        o.estimator = ULAM_COLLISION; /* per visit at most the weight bound times max |b|: the range term holds too */
+        assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+        assert_true(r.rel_err_met && isfinite(r.tail_bound) && fabs(r.estimate - 0.5) < 4 * r.std_error);
+        assert_true(r.min_walks >= 12.28 * bounds[a] / (0.01 * r.estimate)); /* R >= the largest score */
     }
     ulam_csr_free(s.M);
 }
@@ -373,7 +378,8 @@ static void test_identical(void **state)
  * (computing or writing another is refused, a query at another exponent does not take one);
  * stored zeros weigh nothing at alpha = 0 (the guards' radius is the matrix's without them,
  * and walks refuse the row as corrupt rather than dividing by zero); a row whose entries are
- * too uneven for the exponent's probabilities is refused when a walk reaches it. */
+ * too uneven for the exponent's probabilities is refused when a walk reaches it, and where a
+ * probability underflows the guards certify nothing. */
 static void test_options(void **state)
 {
     (void)state;
@@ -449,6 +455,10 @@ static void test_options(void **state)
     assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_ERANGE);
     assert_int_equal(err.index, 0);
     assert_non_null(strstr(err.msg, "alpha = 2"));
+    go = ulam_guard_defaults(); /* at alpha = 20 the probability (2e-30)^20 underflows: rho(M^) unknown, not certified */
+    go.kernel_alpha = 20.0;
+    assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
+    assert_true(g.verdict_hat[ULAM_ADJOINT] == ULAM_VERDICT_UNKNOWN && g.hat[ULAM_ADJOINT].lower == 0.0);
     o.kernel_alpha = 1.0; /* the analog kernel samples it (probability 2e-30) */
     assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
     ulam_csr_free(M);
