@@ -18,6 +18,25 @@
  *     are opaque, reached only through their functions; what the library fills (results,
  *     reports, ulam_guard, ulam_certificate, ulam_csr and ulam_scene from their allocators and
  *     readers) is plain data to read.
+ *
+ * The API by rank, as CSparse's header ranks its own (each section banner below names the
+ * ranks it holds; sections follow the data flow, file -> matrix -> guards -> walks -> output):
+ *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
+ *     ulam_guard_check, ulam_walk_defaults, ulam_solver_alloc, ulam_solver_iterate,
+ *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
+ *     ulam_solver_free, ulam_solve, ulam_direct_solve, ulam_mm_write_vector, ulam_strerror;
+ *   secondary, more control and the other methods: building and transforming matrices
+ *     (ulam_csr_alloc, _from_triplets, _check, _transpose, ulam_jacobi), reader options and
+ *     files (ulam_mm_read_matrix_opts, _file, ulam_mm_write_matrix), verdicts
+ *     (ulam_guard_variance, ulam_verdict_of, ulam_solver_guard), spectral radii
+ *     (ulam_spectral_power, ulam_spectral_radius), prepared systems (ulam_system_*,
+ *     ulam_certificate_*), processes (ulam_share), outer iterations (ulam_outer_*), Krylov
+ *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_solve), the method
+ *     choice (ulam_auto_choose), ulam_direct_bytes;
+ *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
+ *     ulam_strtod, ulam_outfile_*, ulam_spectral_radius_op, ulam_gauss_seidel_*, the studies'
+ *     method grid and exact value (ulam_study_*), random numbers (ulam_rng_*), ulam_now.
+ * The radiosity front end ranks its own in ulam_radiosity.h.
  */
 #ifndef ULAM_H
 #define ULAM_H
@@ -36,6 +55,7 @@ extern "C" {
 #define ULAM_Z95 1.959963984540054
 
 /* ---------------------------------------------------------------- status codes */
+/* All primary. */
 
 enum ulam_status {
     ULAM_OK = 0,
@@ -84,6 +104,8 @@ typedef struct ulam_error {
 } ulam_error;
 
 /* ---------------------------------------------------------------- sparse matrices */
+/* Primary: the struct, ulam_csr_free.  Secondary: building, checking, transposing, ulam_jacobi.
+ * Tertiary: nnz, copy, matvec, dense, stats. */
 
 /* Compressed sparse row matrix.  Plain data: rowptr has nrows+1 entries (64-bit, so
  * nnz may exceed 2^31), colidx and val have rowptr[nrows] entries; columns are sorted
@@ -149,14 +171,16 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
                 ulam_error *err);
 
 /* ---------------------------------------------------------------- Matrix Market */
+/* Primary: ulam_mm_read_matrix, _read_vector, _write_vector.  Secondary: options, FILE readers,
+ * _write_matrix.  Tertiary: ulam_strtod, ulam_outfile. */
 
-/* Read a sparse matrix ("coordinate" real/integer/pattern, general/symmetric/
+/* Read a sparse matrix from path ("coordinate" real/integer/pattern, general/symmetric/
  * skew-symmetric; duplicates summed, explicit zeros dropped; symmetric files are
- * expanded).  name is used only in error details. */
-int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
-
-/* As ulam_mm_read_matrix_file, opening path. */
+ * expanded). */
 int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err);
+
+/* As ulam_mm_read_matrix, from an open file; name is used only in error details. */
+int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
 
 /* Options of the matrix reader.  Start from ulam_mm_defaults(). */
 typedef struct ulam_mm_opts {
@@ -175,12 +199,12 @@ ulam_mm_opts ulam_mm_defaults(void);
 /* As ulam_mm_read_matrix_file with options (o NULL: ulam_mm_defaults()). */
 int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
 
-/* Read a dense vector: "array" m x 1, or "coordinate" m x 1 (missing entries are 0).
- * *x is malloc'd with *n entries. */
-int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
-
-/* As ulam_mm_read_vector_file, opening path. */
+/* Read a dense vector from path: "array" m x 1, or "coordinate" m x 1 (missing entries are
+ * 0).  *x is malloc'd with *n entries. */
 int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *err);
+
+/* As ulam_mm_read_vector, from an open file; name is used only in error details. */
+int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
 
 /* strtod(s, end) exactly (the same double and end for every input, C locale), faster for
  * decimals of up to 19 significant digits with normal results (Clinger's fast path, else the
@@ -215,6 +239,7 @@ int ulam_outfile_commit(ulam_outfile *o);
 void ulam_outfile_abort(ulam_outfile *o);
 
 /* ---------------------------------------------------------------- direct solve */
+/* Primary: ulam_direct_solve.  Secondary: ulam_direct_bytes. */
 
 /* What a LAPACK direct solve reports besides the solution. */
 typedef struct ulam_direct_info {
@@ -234,6 +259,7 @@ int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_
                       ulam_direct_info *info, ulam_error *err);
 
 /* ---------------------------------------------------------------- spectral radius */
+/* Secondary, except tertiary: ulam_spectral_radius_op. */
 
 /* Options of the spectral radius estimate: ARPACK's implicitly restarted Arnoldi
  * (dense dgeev for n <= 128), stopped when the dominant Ritz pair reaches
@@ -301,6 +327,7 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
                         const ulam_power_opts *opts, ulam_power *out, ulam_error *err);
 
 /* ---------------------------------------------------------------- stability guards */
+/* Primary: ulam_guard_check and its options.  Secondary: ulam_verdict_of, ulam_guard_variance. */
 
 /* A radius against 1, from its certified bounds alone (never from an unconverged estimate):
  * OK when upper < 0.99; EDGE (finite, within 1% of 1) when upper < 1; FAIL when lower >= 1;
@@ -361,6 +388,7 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
 int ulam_guard_variance(const ulam_guard *g, int mode);
 
 /* ---------------------------------------------------------------- prepared systems */
+/* Secondary, except tertiary: ulam_system_from_memory, _is_file, _omega, _certificate, _write_file. */
 
 /* A prepared system: M (and b) of (I - M) x = b as one binary file that is mapped read-only
  * and used in place, so a query reads only the pages of the rows its walks reach (the layout
@@ -462,27 +490,8 @@ int ulam_certificate_compute(const ulam_csr *M, double continue_q, const ulam_gu
 int ulam_certificate_guard(const ulam_certificate *c, double continue_q, const ulam_guard_opts *opts,
                            ulam_guard *g);
 
-/* ---------------------------------------------------------------- random numbers */
-
-/* xoshiro256** 1.0 (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
- * ACM TOMS 2021; https://prng.di.unimi.it), seeded through splitmix64.  Caller-owned. */
-typedef struct ulam_rng {
-    uint64_t s[4];
-} ulam_rng;
-
-/* Seed from a 64-bit seed and a stream number (e.g. a walk or block index). */
-void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream);
-
-/* Next 64 random bits. */
-uint64_t ulam_rng_next(ulam_rng *r);
-
-/* Uniform double in [0, 1) with 53 random bits. */
-double ulam_rng_uniform(ulam_rng *r);
-
-/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
-uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
-
 /* ---------------------------------------------------------------- random walks */
+/* Primary, except secondary: ulam_share, ulam_solver_guard. */
 
 enum ulam_mode { ULAM_ADJOINT = 0, ULAM_FORWARD = 1 };
 enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2 };
@@ -654,6 +663,7 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
 #define ULAM_REL_ERR_CAP 1000000000
 
 /* ---------------------------------------------------------------- outer iterations */
+/* All secondary. */
 
 /* Iterations on (I - M) x = b from x = 0 that stop on the exact residual
  * ||b - (I - M) x||_2 / ||b||_2 <= tol:
@@ -730,6 +740,7 @@ int ulam_outer_solve(const ulam_csr *M, const double *b, const ulam_outer_opts *
                      ulam_outer_step *steps, int max_steps, int *nsteps, ulam_error *err);
 
 /* ---------------------------------------------------------------- Krylov peers */
+/* Secondary, except tertiary: ulam_csr_symmetric. */
 
 /* Krylov solvers for (I - M) x = b from x = 0, stopped when ||b - (I - M) x||_2 / ||b||_2 <=
  * tol (the true residual, recomputed at the end): conjugate gradients for symmetric positive
@@ -745,6 +756,7 @@ int ulam_gmres(const ulam_csr *M, const double *b, int restart, double tol, int 
 int ulam_csr_symmetric(const ulam_csr *M);
 
 /* ---------------------------------------------------------------- point sources: push and bidirectional */
+/* All secondary. */
 
 /* Reverse local push from a target t on the adjoint equation (src/push.c): estimates p and
  * residuals r with x_t = <p, b> + <r, x> for every b, where (I - M) x = b.  Pushing j moves r_j
@@ -803,26 +815,67 @@ typedef struct ulam_bidir_opts {
  * (the default cap), walk ulam_walk_defaults(). */
 ulam_bidir_opts ulam_bidir_defaults(void);
 
+/* A bidirectional estimate's plan (ulam_bidir_plan): the push it runs and what the walks after it
+ * are predicted to cost, in a deterministic unit of work (push operations; a walk's visits, its
+ * steps + 1, count step_cost operations each), so a comparison of methods on it gives the same
+ * answer on every run, thread count and MPI rank. */
+typedef struct ulam_bidir_plan_info {
+    int64_t target;         /* 0-based t */
+    double rmax;            /* the push threshold: the balance's choice, or ulam_bidir_opts.rmax */
+    int balanced;           /* 1: rmax chosen by the balance */
+    ulam_push_info push;    /* the push as run to rmax (its ops are counted, not predicted) */
+    double push_part;       /* <p, b>: the exact part of x_t */
+    int64_t pilot_walks;    /* walks of the pilot that measured mean_visits (0: rmax given) */
+    int64_t pilot_steps;    /* their steps */
+    double mean_visits;     /* V: states a walk from b visits on average (pilot; 1 without one) */
+    double predicted_walks; /* walks the stopping rule is predicted to need (0: no residual left,
+                               the value is exact; max_walks when that is the only rule; NaN
+                               when rmax is given and rel_err is set: no pilot measured V) */
+    double predicted_work;  /* push.ops + step_cost (pilot visits + predicted_walks V): the whole
+                               estimate's work in push operations */
+    double step_cost;       /* push operations a walk visit counts as */
+    double seconds;         /* wall time of the plan: pilot and push */
+} ulam_bidir_plan_info;
+
+/* Plan a bidirectional estimate without its walks: start the push at o->target and, when o->rmax
+ * <= 0, run a pilot of 256 walks on a seed of its own (o->walk.seed mixed) and halve rmax from 1,
+ * pushing down to it, while the push's operations are below the walks' predicted work (walks
+ * predicted by the stopping rule's terms: its 1000-walk floor, the variance rmax V / (E^2 x^),
+ * and for a rel_err target E the range term the walk solver's own bounds (the pilot's solver,
+ * over the states the walks reach) give for scores of at most rmax a visit, when they give one;
+ * x^ = max(min_value, |<p, b>|); E = 0.1 for a run stopped by time alone); with o->rmax > 0
+ * push to it.  w is left
+ * pushed, and remembers the plan: ulam_bidir_solve with the same options (target, b, rmax,
+ * min_value, max_push_ops and the walk options the pilot and prediction read) uses that push and
+ * pilot as they are, until ulam_push_start or ulam_push_run changes the workspace.  The push's
+ * operations are exact; the walks are a prediction (the solver stops after whole rounds, so it
+ * runs at least the predicted walks rounded up to its rounds, and more when the variance is
+ * larger than modelled).  Statuses as ulam_bidir_solve. */
+int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
+                    ulam_error *err);
+
 /* What a bidirectional estimate found. */
 typedef struct ulam_bidir_result {
-    double estimate, std_error, ci95[2]; /* of x_t: p_s plus the walks' estimate of <r, x> */
-    double push_part;      /* p_s, exact given the push */
+    double estimate, std_error, ci95[2]; /* of x_t: <p, b> plus the walks' estimate of <r, x> */
+    double push_part;      /* <p, b>, exact given the push */
     ulam_push_info push;   /* the push (its seconds are push_seconds) */
     ulam_walk_result walks; /* the walks' estimate of <r, x> (0 walks when r = 0: exact) */
-    int64_t pilot_walks;   /* walks that measured the mean walk length for the balance */
-    double mean_visits;    /* states a walk visits on average (pilot) */
-    double predicted_walks; /* walks the balance predicted for the target at its rmax (NaN: rmax given) */
-    double seconds;        /* the whole estimate: pilot, push, walk set-up and walks */
+    ulam_bidir_plan_info plan; /* the plan the estimate followed */
+    int plan_reused;       /* 1: the workspace held this plan (ulam_bidir_plan), not redone */
+    double seconds;        /* the whole estimate: the plan's seconds (pilot and push, also when
+                              reused) plus the walks' set-up and walks */
 } ulam_bidir_result;
 
 /* Estimate x_t of (I - M) x = e_s with push workspace w (on M) and Mt, the transpose of M (borrowed;
- * computing it is one O(nnz) pass the caller makes once for any number of queries).  ULAM_OK,
- * ULAM_EINVAL (bad options, index out of range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap),
- * the walk solver's statuses. */
+ * computing it is one O(nnz) pass the caller makes once for any number of queries): the plan of
+ * ulam_bidir_plan (reused when w holds it for these options), then walks from s on Mt scoring the
+ * residual until o->walk's stopping rules hold.  ULAM_OK, ULAM_EINVAL (bad options, index out of
+ * range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap), the walk solver's statuses. */
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err);
 
 /* ---------------------------------------------------------------- choosing the method */
+/* All secondary. */
 
 /* One candidate of ulam_auto_choose: a mode, an estimator and a continuation. */
 typedef struct ulam_auto_candidate {
@@ -869,48 +922,82 @@ int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *b
                      ulam_auto_result *res, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
+/* All tertiary. */
+
+/* The weight windows of a study's methods: none, Russian roulette below 0.5 w0, or roulette and
+ * splitting above 2 w0 (w0 the starting weight: 1 adjoint, ||b||_1 forward). */
+enum ulam_window { ULAM_WINDOW_PLAIN, ULAM_WINDOW_ROULETTE, ULAM_WINDOW_SPLIT };
+
+/* A study's method grid: mode x estimator x window, 18 methods. */
+enum { ULAM_STUDY_METHODS = 18 };
+
+/* One method of the grid. */
+typedef struct ulam_study_method {
+    const char *name; /* "mode-estimator-window", e.g. "adjoint-collision-plain" */
+    int mode;         /* ULAM_ADJOINT or ULAM_FORWARD */
+    int estimator;    /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */
+    int window;       /* enum ulam_window */
+} ulam_study_method;
+
+/* Method k (0 <= k < ULAM_STUDY_METHODS; k = 9 mode + 3 estimator + window), or NULL. */
+const ulam_study_method *ulam_study_method_get(int k);
+
+/* The index of the method named name, or -1. */
+int ulam_study_method_find(const char *name);
+
+/* Set o's mode, estimator, roulette and split to method k's on b (n entries; read only in
+ * forward mode, for w0 = ||b||_1).  ULAM_OK or ULAM_EINVAL. */
+int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o);
 
 /* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
 void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
 
-/* The reference of a study: Gauss-Seidel sweeps on x (in place, from what it holds) until, after
- * at least min_sweeps, one sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps
- * are made; returns the sweeps made. */
+/* Gauss-Seidel sweeps on x (in place, from what it holds) until, after at least min_sweeps, one
+ * sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps are made; returns the
+ * sweeps made. */
 int ulam_gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
                              int min_sweeps, int max_sweeps);
 
-/* What R runs of one method at one budget say, against the exact value. */
-typedef struct ulam_cell {
-    int runs;
-    double rmse;        /* sqrt(mean (estimate - exact)^2) */
-    double mean_stderr; /* the mean reported standard error */
-    double honesty;     /* rmse / mean_stderr: 1 when the error bars are honest */
-    double coverage;    /* share of runs whose 95% interval holds the exact value */
-    double seconds;     /* mean seconds per run */
-    double work;        /* work-normalised variance rmse^2 x seconds (lower is better) */
-} ulam_cell;
+/* Up to this n a study's exact value is LAPACK's. */
+#define ULAM_STUDY_DIRECT_MAX 8000
 
-/* Summarise n runs (arrays of n) into *out. */
-void ulam_cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
-                       double exact, ulam_cell *out);
+/* The exact value a study scores its runs against. */
+typedef struct ulam_study_ref {
+    double exact;          /* x_index: LAPACK's when direct, else settled */
+    double settled;        /* Gauss-Seidel from x = 0 until x_index settles (1e-16 relative, after
+                              at least 12 sweeps, at most 10^5) */
+    int sweeps;            /* the sweeps it made */
+    int direct;            /* 1: n <= ULAM_STUDY_DIRECT_MAX and the LAPACK solve succeeded */
+    double direct_seconds; /* that solve's time */
+} ulam_study_ref;
 
-/* The collision-absorption law for a forward analog walk started at state j and counting
- * particles at j, with termination probability p*_j = pstar and no-return probability s:
- * visits are geometric, so Var(collision) = (1 - s) / s^2 and Var(absorption) = 1 / (p* s) -
- * 1 / s^2; collision is no worse iff p* <= s / (2 - s).  Writes the two variances. */
-void ulam_law_variances(double pstar, double s, double *var_collision, double *var_absorption);
+/* The exact x_index of (I - M) x = b for a study (index 0-based).  ULAM_OK, ULAM_EINVAL or
+ * ULAM_ENOMEM. */
+int ulam_study_reference(const ulam_csr *M, const double *b, int64_t index, ulam_study_ref *ref, ulam_error *err);
 
-/* The no-return probability s of state j of the forward kernel of M (walks on the rows of
- * M', analog q): 1 - sum_k P_jk h_k with h the hitting probabilities of j (a linear solve).
- * ULAM_OK, ULAM_ENOMEM or ULAM_ESINGULAR. */
-int ulam_law_noreturn(const ulam_csr *M, int64_t j, double *s, double *pstar, ulam_error *err);
+/* ---------------------------------------------------------------- random numbers */
+/* All tertiary. */
 
-/* Draw DIR/NAME.png with gnuplot (pngcairo, width x height pixels) from script, run in DIR;
- * written under a temporary name and renamed into place.  ULAM_EIO when gnuplot is missing
- * or fails (nothing is left behind). */
-int ulam_gnuplot(const char *dir, const char *name, int width, int height, const char *script);
+/* xoshiro256** 1.0 (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
+ * ACM TOMS 2021; https://prng.di.unimi.it), seeded through splitmix64.  Caller-owned. */
+typedef struct ulam_rng {
+    uint64_t s[4];
+} ulam_rng;
+
+/* Seed from a 64-bit seed and a stream number (e.g. a walk or block index). */
+void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream);
+
+/* Next 64 random bits. */
+uint64_t ulam_rng_next(ulam_rng *r);
+
+/* Uniform double in [0, 1) with 53 random bits. */
+double ulam_rng_uniform(ulam_rng *r);
+
+/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
+uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
 
 /* ---------------------------------------------------------------- utilities */
+/* All tertiary. */
 
 /* Monotonic wall clock in seconds. */
 double ulam_now(void);

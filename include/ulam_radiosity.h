@@ -3,7 +3,18 @@
  * patch walks that sample F by rays (gathering, shooting, next-event), view gathering and PNG
  * images.  Built with meson's 'radiosity' feature (Embree 3 and libpng); the conventions of
  * ulam.h apply (status codes, ulam_error, const inputs, _free accepts NULL, the ABI habit:
- * structs the caller fills start from their defaults function, handles are opaque). */
+ * structs the caller fills start from their defaults function, handles are opaque).
+ *
+ * The API by rank (as in ulam.h; each section banner below names the ranks it holds):
+ *   primary: ulam_scene_read_obj, ulam_scene_find, ulam_scene_free, ulam_tracer_alloc,
+ *     ulam_tracer_free, ulam_rad_solver_alloc, _iterate, _done, _result, _vectors, _free,
+ *     ulam_ff_estimate, ulam_rad_direct, ulam_camera_cornell, ulam_camera_frame,
+ *     ulam_render, ulam_png_write;
+ *   secondary: ulam_scene_subdivide, ulam_scene_centroid, ulam_scene_label_centroid,
+ *     ulam_tracer_cast, ulam_tracer_shoot, ulam_ff_report_compute, ulam_rad_system,
+ *     ulam_rad_direct_error, ulam_rad_direct_errors, ulam_view_gather, ulam_view_pixels;
+ *   tertiary: ulam_tracer_resolution, ulam_ff_parallel_rectangles,
+ *     ulam_ff_perpendicular_rectangles (exact references for tests). */
 #ifndef ULAM_RADIOSITY_H
 #define ULAM_RADIOSITY_H
 
@@ -13,7 +24,9 @@
 extern "C" {
 #endif
 
-/* ---------------------------------------------------------------- radiosity */
+/* ---------------------------------------------------------------- scenes */
+/* Primary: ulam_scene, ulam_scene_read_obj, ulam_scene_find, ulam_scene_free.  Secondary:
+ * ulam_scene_subdivide, ulam_scene_centroid, ulam_scene_label_centroid. */
 
 /* A scene of planar convex patches with diffuse RGB reflectance and emission: the radiosity
  * equation B = E + diag(rho) F B per colour channel.  Plain data; arrays of 3 hold RGB or
@@ -62,6 +75,10 @@ void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3]);
 /* The area centroid of the patches labelled label; ULAM_ENOTFOUND when there are none. */
 int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3]);
 
+/* ---------------------------------------------------------------- rays */
+/* Primary: ulam_tracer_alloc, ulam_tracer_free.  Secondary: ulam_tracer_cast, ulam_tracer_shoot.
+ * Tertiary: ulam_tracer_resolution. */
+
 /* A ray caster over a scene (Embree 3): opaque. */
 typedef struct ulam_tracer ulam_tracer;
 
@@ -87,6 +104,10 @@ int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double
  * (front side) is j with probability exactly F_pj; -1 when it leaves the scene or hits a
  * back side (the light is lost).  Draws from r. */
 int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
+
+/* ---------------------------------------------------------------- form factors and the direct solve */
+/* Primary: ulam_ff_estimate, ulam_rad_direct.  Secondary: ulam_ff_report_compute, ulam_rad_system,
+ * ulam_rad_direct_error, ulam_rad_direct_errors.  Tertiary: the exact ulam_ff_*_rectangles. */
 
 /* Form factors F_ij estimated by casting `rays` cosine-distributed rays from uniform points of
  * each patch i (the share that reaches j); stream (seed, i) for patch i, so F does not
@@ -134,6 +155,9 @@ int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, 
 int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                            size_t max_bytes, double *se, ulam_error *err);
 
+/* ---------------------------------------------------------------- patch walks */
+/* All primary. */
+
 /* Gathering's next-event estimators (opts->estimator of ulam_rad_solver_alloc, gathering only).
  * At every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in
  * proportion to its power A_l sum_c E_lc, y uniform on it) and a uniform point x on p; one
@@ -179,7 +203,9 @@ typedef struct ulam_rad_solver ulam_rad_solver;
 int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
                           ulam_error *err);
 
-/* Run one round of walks; ULAM_OK or ULAM_ENONFINITE. */
+/* Run one round of walks (rounds grow 1, 2, 4 ... 32 blocks of 256 walks as walks accumulate,
+ * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
+ * ULAM_ENOMEM (shooting's tallies), ULAM_EIO (the share's allgather). */
 int ulam_rad_solver_iterate(ulam_rad_solver *s);
 
 /* Nonzero once a stopping rule is met (rel_err: every nonzero channel; or every channel is
@@ -195,6 +221,10 @@ int ulam_rad_solver_vectors(const ulam_rad_solver *s, double *B, double *std_err
 
 /* Free; accepts and returns NULL. */
 ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s);
+
+/* ---------------------------------------------------------------- images */
+/* Primary: ulam_camera_cornell, ulam_camera_frame, ulam_render, ulam_png_write.  Secondary:
+ * ulam_view_pixels, ulam_view_gather. */
 
 /* A pinhole camera.  Start from ulam_camera_cornell() or ulam_camera_frame() (ulam.h's ABI
  * habit). */

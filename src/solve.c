@@ -48,6 +48,7 @@ struct ulam_solver {
     double tail_u, kappa;  /* the length tail (Collatz-Wielandt): |K| v <= tail_u v over reachable
                               states, kappa = max v / min v (tail_u 1: none) */
     double visit;          /* the start weight times the largest |score| of one visit */
+    double weight;         /* the weight bound W over reachable states (INFINITY with splitting) */
     double v2;             /* a certified bound on E[score^2] (INFINITY: none) */
     int signs;             /* scores may take both signs */
     ulam__run run;      /* walks, time, ending (round.c) */
@@ -343,6 +344,7 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
                           "collision estimator or --continue Q",
                           (long long)bad + 1, adj ? "M" : "M' (column of M)");
     double W = Wmax;
+    s->weight = W;
     s->signs = pos && neg;
     s->bound = gmax > 0 ? W * gmax : 0.0;
     s->range = s->bound * (s->signs ? 2.0 : 1.0);
@@ -529,7 +531,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
-    s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = INFINITY;
+    s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = s->weight = INFINITY;
     s->qmax = s->tail_u = 1.0;
     if ((o.estimator == ULAM_ABSORPTION || o.rel_err > 0) && (status = check_reach(s, K, err))) {
         ulam_solver_free(s);
@@ -682,6 +684,25 @@ static double score_range(const ulam_solver *s, double m, double E)
     int q = s->qmax < 1.0;
     double R = ulam__score_range(s->range, s->per_step, q ? s->qmax : s->tail_u, q ? 1.0 : s->kappa, s->signs, m, E);
     return isfinite(R) ? R : ulam__moment_range(s->v2, s->signs, m, E);
+}
+
+/* The walks the rel_err rule's range term would need at estimate m and target E if a visit
+ * scored at most per_visit times the walk's weight (absorption: a termination per_visit / p*),
+ * both signs when signs, under this solver's reachability bounds, which must have been made for
+ * scores of at most 1 a visit (b = 1; check_reach runs for rel_err > 0 or absorption): the
+ * per-visit route of score_range, or the second moment's scaled by per_visit^2; INFINITY when
+ * neither gives a bound.  For a planner that knows the scores only after these walks' set-up
+ * (src/bidir.c: the push's residual). */
+double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E)
+{
+    if (!(per_visit > 0)) return 0.0;
+    signs = signs || s->signs;
+    int q = s->qmax < 1.0, absorb = s->o.estimator == ULAM_ABSORPTION;
+    double R = absorb ? (q ? s->weight * per_visit / (1.0 - s->qmax) * (signs ? 2.0 : 1.0) : INFINITY)
+                      : ulam__score_range(INFINITY, s->weight * per_visit, q ? s->qmax : s->tail_u, q ? 1.0 : s->kappa,
+                                          signs, m, E);
+    if (!isfinite(R) && !absorb) R = ulam__moment_range(s->v2 * per_visit * per_visit, signs, m, E);
+    return isfinite(R) ? ulam__rel_min_walks(R, E, m) : INFINITY;
 }
 
 /* The most the walks cut at max_steps can have moved the mean (0 without cuts). */
