@@ -64,7 +64,7 @@ void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assu
                         "walks may be long (mean length about 1 / (1 - rho))\n", s->matrix_path, g->abs.lower,
                 g->abs.upper);
     const ulam_power *h = &g->hat[mode];
-    const char *kernel = mode == ULAM_ADJOINT ? "adjoint" : "forward";
+    const char *kernel = cli_mode_names[mode];
     if (g->verdict_hat[mode] == ULAM_VERDICT_FAIL)
         fprintf(stderr, "ulam: %s: warning: rho(M^) >= 1 (bounds [%.6g, %.6g]) for the %s kernel: the estimator's "
                         "variance is infinite, so no error bar it reports can be trusted\n",
