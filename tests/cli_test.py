@@ -321,6 +321,25 @@ def on_tty(ulam, args):
     return p.returncode, b"".join(chunks).decode(errors="replace")
 
 
+def check_radiosity_json_path(ulam):
+    """The JSON names the scene by a valid JSON string whatever its path holds (a quote, a
+    backslash): it was printed unescaped, and the output did not parse."""
+    import shutil
+    with tempfile.TemporaryDirectory() as tmp:
+        d = os.path.join(tmp, 'q"uote\\d')
+        os.mkdir(d)
+        for f in ("cube.obj", "cube.mtl"):
+            shutil.copy("examples/scenes/" + f, d)
+        scene = os.path.join(d, "cube.obj")
+        rc, out, err = run(ulam, ["radiosity", scene, "--patch", "1", "--walks", "1000", "--json"])
+        assert rc == 0, err
+        try:
+            got = json.loads(out)["scene"]
+        except ValueError:
+            raise AssertionError(f"not JSON: {out[:200]}")
+        assert got == scene, out
+
+
 def check_radiosity_progress(ulam):
     """radiosity shows its progress line on a terminal too."""
     rc, err = on_tty(ulam, ["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.001",
@@ -1116,7 +1135,7 @@ def main():
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_progress, ulam),
-             (check_radiosity_progress, ulam)]
+             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]
     if cases:

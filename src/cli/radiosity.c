@@ -531,7 +531,7 @@ static void print_text(const args *a, const report *r)
 static void print_json(const args *a, const report *r)
 {
     printf("{");
-    cli_json_string("scene", a->scene, 0);
+    cli_json_string("scene", a->scene, 0); /* a path may hold quotes and backslashes */
     printf("\"npatches\": %lld, ", (long long)r->s->npatches);
     if (r->patch >= 0) {
         int32_t g = r->s->group[r->patch];
