@@ -587,6 +587,14 @@ typedef struct ulam_walk_result {
     double seconds;    /* wall time spent walking */
     int threads;       /* threads used */
     int interrupted;   /* stopped by *interrupt */
+    ulam_power rho4;   /* rel_err > 0: rho(M4), M4_ij = |K_ij|^4 / (q_i p_ij)^3 (the walk's fourth
+                          moment is finite when it is below 1), certified bounds; [0, INFINITY]
+                          when not computed (rel_err 0) */
+    int fourth_finite; /* rel_err > 0: 1 the score's fourth moment is finite (rho4 certified
+                          below 1, or a single score is bounded: every moment finite), 0 infinite,
+                          -1 unknown (also rel_err 0: not asked).  Unless 1, variance_rel_error may
+                          be far too small and the rel_err rule is never met (rel_err alone is
+                          refused: ULAM_EINFVAR) */
 } ulam_walk_result;
 
 /* An opaque walk solver: the kernel, the statistics and the stopping state. */
@@ -652,7 +660,10 @@ ulam_solver *ulam_solver_free(ulam_solver *s);
  *     times before a stop.  No such R (splitting, forward expected, no certificate): never
  *     met, and rel_err alone is refused with ULAM_EINFVAR (err->msg names the reason);
  *   with walks cut at max_steps, cut_bound <= 0.1 E |m|, else the run stops (cut_stop);
- *   the variance's own relative standard error (fourth moment) <= 0.25.
+ *   the variance's own relative standard error (fourth moment) <= 0.25, trusted only when
+ *     the fourth moment is finite (fourth_finite 1: a bounded score, or rho4 certified below
+ *     1); else never met, and rel_err alone is refused with ULAM_EINFVAR (err->msg names
+ *     rho4 and a mode or alpha = 1 whose rho4 is below 1, when one is).
  * With rel_err alone, a run whose minimum walk count exceeds ULAM_REL_ERR_CAP stops after the
  * round (out_of_reach).  A split weight below the start weight (1 adjoint, ||b||_1 forward)
  * is refused with ULAM_EINVAL. */

@@ -16,6 +16,17 @@
  * M^_ij = |K_ij| |K_ij| T_i / (q_i |K_ij|^alpha), so M^ is formed entry by entry (on M' for
  * forward walks) and its radius bounded the same way; rho(|M|) does not depend on alpha.
  *
+ * The fourth moment (what the rel_err rule's check on the variance's own error bar needs) is
+ * the same with fourth powers: E[|w_k|^4 at j] = w0^4 (M4^k)_{start j}, M4_ij = |K_ij|^4 /
+ * (q_i p_ij)^3, and a score sum_k w_k g_k (collision g = b, expected g = M b plus the start's
+ * b; absorption one score w_k b_j / p*_j, i.e. g_j^4 = b_j^4 / p*_j^3 against M4^k) has, by
+ * Minkowski, ||X||_4 <= sum_k ((M4^k |g|^4)_start)^(1/4) w0: finite when rho(M4) < 1.  The
+ * entries of the moment matrices of order r are P_ij f_ij^r (P_ij = q_i p_ij), log-linear in
+ * r, so log rho is convex in r (Kingman): with rho(P) <= 1 at r = 0, rho(M4) < 1 gives rho(M^)
+ * < 1 and rho(|M|) < 1 too, and rho(M4) >= rho(M^)^2 / rho(P) >= rho(M^)^2.
+ * The solver computes it for rel_err runs (ulam__guard_fourth); it matters only where no
+ * bound on a single score holds (a bounded score has every moment finite).
+ *
  * The radii of these nonnegative matrices come from power iteration with Collatz-Wielandt
  * bounds (spectral.c), which certify a verdict whenever the bracket lies on one side of 1. */
 #include "kernel.h"
@@ -244,27 +255,31 @@ static sums matrix_sums(const ulam_csr *A, double *col)
     return s;
 }
 
-/* rho(M^) of the kernel of K (M adjoint, M' forward) at exponent alpha != 1: M^_ij = |K_ij| f_ij,
- * f the moves' weight factors (ulam__kernel_moves), formed in K's pattern.  An entry whose
- * probability underflows (the walk kernel refuses its row) leaves the radius unknown: bounds
- * [0, INFINITY], nothing certified. */
-static int hat_alpha(const ulam_csr *K, double continue_q, double alpha, const ulam_guard_opts *o, ulam_power *out,
-                     ulam_error *err)
+/* The radius of the walk's moment matrix of order power + 1 on K (M adjoint, M' forward):
+ * entries |K_ij| f_ij^power, f_ij = |K_ij| / (q_i p_ij) the moves' weight factors (S_i / q_i
+ * at alpha = 1, else ulam__kernel_moves), formed in K's pattern: power 1 is M^, power 3 the
+ * fourth-moment matrix M4_ij = |K_ij|^4 / (q_i p_ij)^3.  An entry whose probability underflows
+ * (the walk kernel refuses its row) leaves the radius unknown: bounds [0, INFINITY], nothing
+ * certified. */
+static int moment_radius(const ulam_csr *K, double continue_q, double alpha, int power, const ulam_guard_opts *o,
+                         ulam_power *out, ulam_error *err)
 {
     int64_t n = K->nrows, nnz = K->rowptr[n];
     double *val = ulam__malloc((size_t)nnz, sizeof *val), *f = ulam__malloc((size_t)nnz, sizeof *f);
     double *col = ulam__malloc((size_t)n, sizeof *col);
     if (!val || !f || !col) {
         free(val), free(f), free(col);
-        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the second-moment matrix");
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a moment matrix");
     }
     int finite = 1;
     for (int64_t i = 0; i < n; i++) {
-        double q = ulam__kernel_q(K, i, continue_q);
+        double q = ulam__kernel_q(K, i, continue_q), S = 0.0;
         int64_t a = K->rowptr[i];
-        if (q > 0) (void)ulam__kernel_moves(K, i, q, alpha, val + a, f + a);
+        for (int64_t k = a; alpha == 1.0 && k < K->rowptr[i + 1]; k++) S += fabs(K->val[k]);
+        if (q > 0 && alpha != 1.0) (void)ulam__kernel_moves(K, i, q, alpha, val + a, f + a);
         for (int64_t k = a; k < K->rowptr[i + 1]; k++) {
-            val[k] = q > 0 ? fabs(K->val[k]) * f[k] : 0.0;
+            double fk = alpha == 1.0 ? ulam__factor(S, continue_q) : f[k];
+            val[k] = q > 0 ? fabs(K->val[k]) * pow(fk, power) : 0.0;
             finite &= isfinite(val[k]);
         }
     }
@@ -281,6 +296,28 @@ static int hat_alpha(const ulam_csr *K, double continue_q, double alpha, const u
     return status;
 }
 
+/* rho(M4) of the walk kernel of K (internal.h).  Every factor 1 (alpha = 1, no row of |K|
+ * above 1, analog continuation q_i = S_i): then q_i p_ij = |K_ij|, M4_ij = |K_ij|^4 / |K_ij|^3
+ * = |K_ij|, M4 = |K| itself and rho(M4) = rho(|M|), taken from abs when given (the guards'
+ * radius, which the solver has certified below 1 or refused). */
+int ulam__guard_fourth(const ulam_csr *K, double continue_q, double alpha, const ulam_power *abs, ulam_power *out,
+                       ulam_error *err)
+{
+    int ones = alpha == 1.0 && abs;
+    for (int64_t i = 0; ones && i < K->nrows; i++) {
+        double S = 0.0;
+        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) S += fabs(K->val[k]);
+        ones = S == 0.0 || ulam__factor(S, continue_q) == 1.0;
+    }
+    if (ones) {
+        *out = *abs;
+        out->seconds = 0.0;
+        return ULAM_OK;
+    }
+    ulam_guard_opts o = ulam_guard_defaults();
+    return moment_radius(K, continue_q, alpha, 3, &o, out, err);
+}
+
 /* The radii asked for and their verdicts. */
 int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
                      ulam_guard *g, ulam_error *err)
@@ -294,7 +331,7 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a kernel exponent alpha that is finite and >= 0 (got %g)",
                           o.kernel_alpha);
     int64_t n = M->nrows;
-    int alpha1 = o.kernel_alpha == 1.0; /* else rho(M^) comes from hat_alpha */
+    int alpha1 = o.kernel_alpha == 1.0; /* else rho(M^) comes from moment_radius */
     double t0 = ulam_now();
     ulam_power none = {.upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
     *g = (ulam_guard){.continue_q = continue_q, .kernel_alpha = o.kernel_alpha, .abs = none, .hat = {none, none}};
@@ -333,7 +370,7 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
         if (!alpha1) {
             ulam_csr *T = NULL;
             if (m == ULAM_FORWARD && ulam_csr_transpose(M, &T)) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for M'");
-            else status = hat_alpha(T ? T : M, continue_q, o.kernel_alpha, &o, &g->hat[m], err);
+            else status = moment_radius(T ? T : M, continue_q, o.kernel_alpha, 1, &o, &g->hat[m], err);
             ulam_csr_free(T);
             continue;
         }

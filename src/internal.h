@@ -138,6 +138,14 @@ int ulam__power_certain(double lower, double upper);
 int ulam__power_from(const ulam_csr *A, const double *left, const double *right, const ulam_power_opts *o,
                      ulam_power *out, ulam_error *err);
 
+/* rho(M4), M4_ij = |K_ij|^4 / (q_i p_ij)^3, of the walk kernel of K (M adjoint, M' forward) at
+ * continuation continue_q and exponent alpha, with certified bounds (stopped once they decide
+ * against 1 like the guards' radii): the walk's score has a finite fourth moment when it is
+ * below 1.  abs: rho(|M|) when known (NULL: not), which it is when every weight factor is 1
+ * (src/guard.c). */
+int ulam__guard_fourth(const ulam_csr *K, double continue_q, double alpha, const ulam_power *abs, ulam_power *out,
+                       ulam_error *err);
+
 /* The walks the rel_err rule's range term would need at estimate m and target E were every visit
  * to score at most per_visit (times the walk's weight), both signs when signs, under the
  * reachability bounds of a solver made with rel_err > 0 and b = 1 (src/solve.c; INFINITY
