@@ -94,6 +94,17 @@ CASES += [  # the kernel exponent: finite and >= 0; it changes rho(M^) (chain4: 
      r"no confidence interval|not certified|infinite"),
     (SOLVE + ["--index", "1", "--alpha", "3", "--rel-err", "0.01"], 4,
      r"--rel-err 0\.01 can never be met: .*rho\(M\^\) of the adjoint kernel at kernel exponent alpha = 3 is in", r"^$"),
+    # alpha 2 on chain4: the variance finite (rho(M^) 0.9) but weights grow on cycles and the fourth
+    # moment is infinite (rho(M4) >= 1.157): --rel-err alone refused naming alpha 1 (rho(M4) 0.8);
+    # with --walks the run keeps its interval and the rule is never met, the reason printed
+    (SOLVE + ["--index", "1", "--alpha", "2", "--rel-err", "0.05"], 4,
+     r"--rel-err 0\.05 can never be met: it needs a finite fourth moment .*rho\(M4\) of the adjoint kernel at alpha 2 "
+     r"in \[1\.157, 1\.519\] \(>= 1: infinite\).*adjoint at alpha 1 has it finite, 0\.8 < 1.*the rule is then never met",
+     r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "2", "--rel-err", "0.05", "--walks", "5000"], 0, r"",
+     r"95% CI(.*\n)*rel-err +NOT met \(target 0\.05\): scores are unbounded and rho\(M4\) is in \[1\.157, 1\.519\], so "
+     r"the fourth moment is infinite"),
+    (SOLVE + ["--index", "1", "--alpha", "0.5", "--rel-err", "0.05"], 0, r"^$", r"rel-err +met"),
 ]
 DIV = ["solve", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1"]
 RS = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1"]

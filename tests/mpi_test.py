@@ -28,8 +28,12 @@ def main():
         cases = [
             ("solve adjoint", ["solve", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx", "--index", "7",
                                "--walks", "50000", "--seed", "9", "--json"], None),
-            ("solve adjoint alpha", ["solve", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx", "--index",
-                                     "7", "--alpha", "0.5", "--rel-err", "0.02", "--json"], None),
+            # signed200 at alpha 0.5 has rho(M4) >= 1: --rel-err alone is refused there, so chain4 (rho(M4) < 0.96)
+            ("solve adjoint alpha", ["solve", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx", "--index",
+                                     "2", "--alpha", "0.5", "--rel-err", "0.02", "--json"], None),
+            ("solve adjoint alpha walks", ["solve", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx",
+                                           "--index", "7", "--alpha", "0.5", "--rel-err", "0.02", "--walks", "100000",
+                                           "--json"], None),
             ("solve forward alpha", ["solve", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
                                      "1", "--mode", "forward", "--alpha", "2", "--walks", "30000", "--json", "--out",
                                      "{d}/xa.mtx"], "xa.mtx"),

@@ -153,6 +153,10 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
         printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
                o->rel_err);
+    else if (o->rel_err > 0 && r->fourth_finite != 1)
+        printf("rel-err         NOT met (target %.3g): scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth "
+               "moment is %s and the variance's own error bar cannot be trusted\n", o->rel_err, r->rho4.lower,
+               r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
     else if (o->rel_err > 0 && r->min_walks > 0)
         printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate%s)\n",
                r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
@@ -196,7 +200,10 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         printf("\"rel_err_met\": %s, ", r->rel_err_met ? "true" : "false");
         cli_json_number("cut_bound", r->cut_bound, 0);
         printf("\"rel_err_stop\": %s, ", r->cut_stop ? "\"cuts\"" : r->out_of_reach ? "\"out_of_reach\""
-                                       : !isfinite(r->tail_bound) && r->estimate != 0 ? "\"no_bound\"" : "null");
+                                       : !isfinite(r->tail_bound) && r->estimate != 0 ? "\"no_bound\""
+                                       : r->fourth_finite != 1 ? "\"fourth_moment\"" : "null");
+        cli_json_variance("fourth_finite", r->fourth_finite);
+        cli_json_radius("rho4", &r->rho4);
     }
     if (o->mode == ULAM_FORWARD) printf("\"unreached\": %lld, ", (long long)r->unreached);
     cli_json_number("variance", r->variance, 0);
@@ -415,7 +422,8 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solv
         rc = EXIT_DIVERGE;
     } else if (status == ULAM_EINFVAR) {
         fprintf(stderr, "ulam: %s: error: --rel-err %g can never be met: it needs %s. Bound the run with --walks N "
-                        "or --time S (no confidence interval is then printed)\n", s->matrix_path, o->rel_err, err.msg);
+                        "or --time S (%s)\n", s->matrix_path, o->rel_err, err.msg,
+                strstr(err.msg, "rho(M^)") ? "no confidence interval is then printed" : "the rule is then never met");
         rc = EXIT_INFVAR;
     } else if (status) {
         rc = cli_report(s->matrix_path, &err);
