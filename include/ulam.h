@@ -589,7 +589,7 @@ typedef struct ulam_walk_result {
     int interrupted;   /* stopped by *interrupt */
     ulam_power rho4;   /* rel_err > 0: rho(M4), M4_ij = |K_ij|^4 / (q_i p_ij)^3 (the walk's fourth
                           moment is finite when it is below 1), certified bounds; [0, INFINITY]
-                          when not computed (rel_err 0) */
+                          when not computed (rel_err 0, or a bounded score: not needed) */
     int fourth_finite; /* rel_err > 0: 1 the score's fourth moment is finite (rho4 certified
                           below 1, or a single score is bounded: every moment finite), 0 infinite,
                           -1 unknown (also rel_err 0: not asked).  Unless 1, variance_rel_error may

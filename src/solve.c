@@ -53,7 +53,7 @@ struct ulam_solver {
     int signs;             /* scores may take both signs */
     ulam_power rho4;       /* rho(M4) of the walk kernel ([0, INFINITY] until computed) */
     int rho4_done;         /* rho4 computed */
-    int fourth;            /* the fourth moment: 1 finite, 0 infinite, -1 unknown (fourth_verdict) */
+    int fourth;            /* the fourth moment: 1 finite, 0 infinite, -1 unknown (take_fourth) */
     ulam__run run;      /* walks, time, ending (round.c) */
     int64_t steps, cut;
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
@@ -409,11 +409,11 @@ static int take_fourth(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     return ULAM_OK;
 }
 
-/* Refuse a rel_err target (asked alone: the caller checks) whose score has no bound and no certified finite fourth
- * moment: the rule's check on the variance's own relative error trusts a sample fourth
- * moment, which then underestimates it (measured -3.3% actual against +-0.9% reported), and
- * nothing else would end the run.  The message names a mode or exponent 1 whose rho(M4) is
- * below 1 when one is. */
+/* Refuse a rel_err target (asked alone: the caller checks) whose score has no bound and no
+ * certified finite fourth moment: the rule's check on the variance's own relative error
+ * trusts a sample fourth moment, which then errs low (tests/test_kernel.c: the variance's
+ * spread over seeds 1.7 times what the runs report), and nothing else would end the run.
+ * The message names a mode or exponent 1 whose rho(M4) is below 1 when one is. */
 static int check_fourth(const ulam_csr *M, const ulam_solver *s, ulam_error *err)
 {
     const ulam_walk_opts *o = &s->o;
@@ -437,7 +437,7 @@ static int check_fourth(const ulam_csr *M, const ulam_solver *s, ulam_error *err
     return ulam__fail(err, ULAM_EINFVAR, 0, -1,
                       "a finite fourth moment for a relative-error target: scores unbounded (%s), rho(M4) of the %s "
                       "kernel at alpha %g in [%.4g, %.4g] (%s): variance_rel_error errs low%s",
-                      isfinite(s->per_step) && isfinite(s->range) ? "no length tail" : "weights grow on cycles",
+                      isfinite(s->weight) ? "no certified length tail" : "weights grow on cycles",
                       o->mode == ULAM_ADJOINT ? "adjoint" : "forward", o->kernel_alpha, s->rho4.lower, s->rho4.upper,
                       s->fourth == 0 ? ">= 1: infinite" : "straddles 1: unknown", also);
 }
