@@ -545,6 +545,12 @@ typedef struct ulam_walk_opts {
                               K_ij / (q_i p_ij); 1 (the default): the "almost optimal" |K_ij| / S_i,
                               0 uniform, 2 Alea's transition factor.  rho(M^) is that kernel's, so
                               opts->guard is used only when computed for the same alpha */
+    int64_t nstarts;     /* adjoint: 0 starts every walk at index; k > 0 starts it at starts[j]
+                            with probability |start_weights[j]| / S (S their sum of |.|) and
+                            weight sign(start_weights[j]) S, so the estimate is of
+                            sum_j start_weights[j] x_{starts[j]} (index only labels it) */
+    const int64_t *starts;       /* k states (0-based), borrowed like b */
+    const double *start_weights; /* k finite weights, not all 0 */
 } ulam_walk_opts;
 
 /* The defaults: adjoint collision walks, index 0, analog kernel (kernel_alpha 1), seed 1, all
@@ -796,19 +802,24 @@ const double *ulam_push_residuals(const ulam_push *w);
 /* Fill *info about the pushes since the last start. */
 void ulam_push_report(const ulam_push *w, ulam_push_info *info);
 
-/* Bidirectional estimate of x_t of (I - M) x = e_s (src/bidir.c; Lofgren, Banerjee, Goel, "Personalized
- * PageRank estimation and search: a bidirectional approach", WSDM 2016): a reverse push from t gives
- * x_t = p_s + <r, x>, and <r, x> = e_s' (I - M')^-1 r is the unknown s of the system (M', r),
- * estimated by the adjoint walk solver on M' from s scoring r (walks forward from the source).
- * Each score is at most rmax x the walk's weight sum, so the variance falls with rmax.  Start from
+/* Bidirectional estimate of x_t of (I - M) x = b for b = e_s or a sparse b (src/bidir.c; Lofgren,
+ * Banerjee, Goel, "Personalized PageRank estimation and search: a bidirectional approach", WSDM
+ * 2016): a reverse push from t gives x_t = <p, b> + <r, x>, and <r, x> = b' (I - M')^-1 r is
+ * estimated by the adjoint walk solver on M' scoring r from walks that start at s (or at b's
+ * state j with probability |b_j| / ||b||_1 and weight sign(b_j) ||b||_1: walks forward from the
+ * sources).  Each score is at most rmax x the walk's weight sum, so the variance falls with rmax.  Start from
  * ulam_bidir_defaults(). */
 typedef struct ulam_bidir_opts {
-    int64_t target, source; /* 0-based t and s */
+    int64_t target, source; /* 0-based t and s (b = e_s when nb is 0) */
+    int64_t nb;               /* > 0: a sparse b instead of e_s, nb entries (indices may repeat) */
+    const int64_t *b_index;   /* their 0-based states (borrowed) */
+    const double *b_value;    /* their finite values, not all 0 */
     double rmax;       /* push threshold; <= 0: balance the push's work against the walks' predicted work */
     double min_value;  /* the smallest |x_t| the balance plans for (<= 0: 1 / n) */
     int64_t max_push_ops; /* cap on the push's work (0: 100 nnz(M) + 10^6); past it ULAM_ENOCONV */
-    ulam_walk_opts walk;  /* the walks' kernel, seed, threads and stopping rules (mode and index are
-                             set here); rel_err applies to the whole estimate p_s + <r, x> */
+    ulam_walk_opts walk;  /* the walks' kernel, seed, threads and stopping rules (mode, index and
+                             starts are set here); rel_err applies to the whole estimate
+                             <p, b> + <r, x> */
 } ulam_bidir_opts;
 
 /* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
@@ -866,10 +877,11 @@ typedef struct ulam_bidir_result {
                               reused) plus the walks' set-up and walks */
 } ulam_bidir_result;
 
-/* Estimate x_t of (I - M) x = e_s with push workspace w (on M) and Mt, the transpose of M (borrowed;
+/* Estimate x_t of (I - M) x = b (e_s, or o's sparse b) with push workspace w (on M) and Mt, the
+ * transpose of M (borrowed;
  * computing it is one O(nnz) pass the caller makes once for any number of queries): the plan of
  * ulam_bidir_plan (reused when w holds it for these options), then walks from s on Mt scoring the
- * residual until o->walk's stopping rules hold.  ULAM_OK, ULAM_EINVAL (bad options, index out of
+ * residual (from b's states, in proportion to |b_j|) until o->walk's stopping rules hold.  ULAM_OK, ULAM_EINVAL (bad options, index out of
  * range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap), the walk solver's statuses. */
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err);

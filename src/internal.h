@@ -144,6 +144,15 @@ int ulam__power_from(const ulam_csr *A, const double *left, const double *right,
  * without a bound). */
 double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E);
 
+/* As ulam_solver_alloc, with seen (n flags, borrowed until the solver is freed) the states walks
+ * can reach, as an earlier solver on the same M, start states and continuation found them
+ * (ulam__solver_reached): its rows were checked then, and the search is not made again. */
+int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
+                               ulam_solver **out, ulam_error *err);
+
+/* The states a solver's walks can reach (n flags; NULL unless its reachability check ran). */
+const char *ulam__solver_reached(const ulam_solver *s);
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)

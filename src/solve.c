@@ -32,6 +32,11 @@ struct ulam_solver {
     const double *b; /* the caller's, borrowed like M */
     ulam_csr *mt;
     ulam__slot *src;
+    ulam__slot *start_src; /* adjoint with nstarts: the start distribution (walker.start_*) */
+    int32_t *start_units;
+    double *start_b;
+    char *seen;             /* the states walks can reach (check_reach; NULL before) */
+    const char *given_seen; /* the same computed by an earlier solver (ulam__solver_alloc_reached) */
     int threads;
     ulam__scratch *scratch; /* one per thread */
     ulam__kscratch *ks;     /* one per thread: room to build a kernel row */
@@ -70,6 +75,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
     if (!s) return NULL;
     ulam__kernel_free(s->k);
     free(s->src), free(s->sum), free(s->sumsq);
+    free(s->start_src), free(s->start_units), free(s->start_b), free(s->seen);
     ulam_csr_free(s->mt);
     if (s->scratch)
         for (int t = 0; t < s->threads; t++) {
@@ -97,6 +103,18 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision, absorption or expected");
     if (o->index < 0 || o->index >= M->nrows)
         return ulam__fail(err, ULAM_EINVAL, 0, o->index, "an index from 0 to %lld", (long long)M->nrows - 1);
+    if (o->nstarts < 0 || (o->nstarts > 0 && (o->mode != ULAM_ADJOINT || !o->starts || !o->start_weights ||
+                                              o->nstarts > INT32_MAX)))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "start states and weights in adjoint mode");
+    double S = 0.0;
+    for (int64_t j = 0; j < o->nstarts; j++) {
+        if (o->starts[j] < 0 || o->starts[j] >= M->nrows || !isfinite(o->start_weights[j]))
+            return ulam__fail(err, ULAM_EINVAL, 0, j, "start states from 0 to %lld with finite weights",
+                              (long long)M->nrows - 1);
+        S += fabs(o->start_weights[j]);
+    }
+    if (o->nstarts > 0 && !(S > 0 && isfinite(S)))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "start weights with a finite nonzero sum of |weights|");
     if (o->continue_q > 0 && !(o->continue_q < 1))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a continuation probability below 1");
     if (!(o->kernel_alpha >= 0) || !isfinite(o->kernel_alpha))
@@ -111,14 +129,25 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
     return ULAM_OK;
 }
 
+/* The size of a walk's start weight: 1 adjoint (the sum of |start weights| with a start
+ * distribution), ||b||_1 forward. */
+static double start_weight(const ulam_walk_opts *o, const double *b, int64_t n)
+{
+    double w0 = 0.0;
+    if (o->mode == ULAM_FORWARD)
+        for (int64_t i = 0; i < n; i++) w0 += fabs(b[i]);
+    else
+        for (int64_t j = 0; j < o->nstarts; j++) w0 += fabs(o->start_weights[j]);
+    return o->mode == ULAM_ADJOINT && o->nstarts == 0 ? 1.0 : w0;
+}
+
 /* Refuse a split weight below the start weight (1 adjoint, ||b||_1 forward): every walk would
  * split at once into ceil(w0 / W) copies (a split weight of 1e-7 on chain4: 1e7 copies a walk,
  * 11 s for 1000 walks), which is unbiased but no longer the run asked for. */
 static int check_split(const ulam_csr *M, const double *b, const ulam_walk_opts *o, ulam_error *err)
 {
     if (!(o->split > 0)) return ULAM_OK;
-    double w0 = o->mode == ULAM_ADJOINT ? 1.0 : 0.0;
-    for (int64_t i = 0; o->mode == ULAM_FORWARD && i < M->nrows; i++) w0 += fabs(b[i]);
+    double w0 = start_weight(o, b, M->nrows);
     if (o->split >= w0) return ULAM_OK;
     return ulam__fail(err, ULAM_EINVAL, 0, -1,
                       "a split weight of at least the start weight %.6g (%s), not %g: below it every walk splits "
@@ -215,7 +244,9 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const doubl
     int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION;
     double *g = ulam__malloc((size_t)n, sizeof *g), *v = ulam__malloc((size_t)n, sizeof *v);
     double *y = ulam__malloc((size_t)n, sizeof *y), *f = ulam__malloc((size_t)n, sizeof *f), best = INFINITY;
-    double b0 = adj && s->o.estimator == ULAM_EXPECTED ? fabs(s->b[s->o.index]) : 0.0, gmax = 0.0;
+    double b0 = 0.0, gmax = 0.0;
+    for (int64_t j = 0; adj && s->o.estimator == ULAM_EXPECTED && j < (s->o.nstarts ? s->o.nstarts : 1); j++)
+        b0 = fmax(b0, fabs(s->b[s->o.nstarts ? s->o.starts[j] : s->o.index]));
     for (int64_t i = 0; g && v && y && f && i < n; i++) {
         g[i] = 0.0;
         if (!seen[i]) continue;
@@ -239,8 +270,9 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const doubl
                     t += fabs(K->val[k]) * (fac ? fac[k] : 1.0) * v[K->colidx[k]];
                 y[i] = fac ? t : t * f[i];
                 u = fmax(u, y[i] / v[i]), c = fmax(c, g[i] / v[i]), ymax = fmax(ymax, y[i] + v[i]);
-                z0 += adj ? (i == s->o.index ? v[i] : 0.0) : fabs(s->b[i]) / w0 * v[i];
+                z0 += adj ? (i == s->o.index && !s->o.nstarts ? v[i] : 0.0) : fabs(s->b[i]) / w0 * v[i];
             }
+            for (int64_t j = 0; adj && j < s->o.nstarts; j++) z0 += fabs(s->o.start_weights[j]) / w0 * v[s->o.starts[j]];
             if (u < 1.0) {
                 double d = absorb ? 1.0 - u : (1.0 - sqrt(u)) * (1.0 - sqrt(u)), bound = w0 * w0 * c * z0 / d;
                 if (bound < best * (1.0 - 1e-3)) last = it;
@@ -279,23 +311,27 @@ static double *move_factors(const ulam_csr *K, const char *seen, double continue
  * and past qmax = 1 the certificate of length_tail). */
 static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
-    char *seen = ulam__calloc((size_t)s->n, 1);
-    if (!seen) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
-    if (s->o.mode == ULAM_ADJOINT) seen[s->o.index] = 1;
-    else
-        for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
-    int status = ulam__kernel_reach(K, s->o.continue_q, seen);
-    if (status) {
-        free(seen);
-        return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for a reachability check")
-                                     : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, "
-                                                  "nonzero values (the matrix is corrupt)");
+    if (!s->given_seen) {
+        char *mark = ulam__calloc((size_t)s->n, 1);
+        if (!mark) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
+        if (s->o.mode == ULAM_ADJOINT && !s->o.nstarts) mark[s->o.index] = 1;
+        for (int64_t j = 0; s->o.mode == ULAM_ADJOINT && j < s->o.nstarts; j++) mark[s->o.starts[j]] = 1;
+        if (s->o.mode == ULAM_FORWARD)
+            for (int64_t i = 0; i < s->n; i++) mark[i] = s->b[i] != 0.0;
+        int status = ulam__kernel_reach(K, s->o.continue_q, mark);
+        if (status) {
+            free(mark);
+            return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for a reachability check")
+                                         : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, "
+                                                      "nonzero values (the matrix is corrupt)");
+        }
+        free(s->seen);
+        s->seen = mark;
     }
+    const char *seen = s->given_seen ? s->given_seen : s->seen;
     double *fac = NULL; /* kernel exponent != 1: each move's own weight factor */
-    if (s->o.kernel_alpha != 1.0 && !(fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha))) {
-        free(seen);
+    if (s->o.kernel_alpha != 1.0 && !(fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
-    }
     int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = 0;
     int64_t bad = -1;
     int expected = s->o.estimator == ULAM_EXPECTED;
@@ -323,11 +359,10 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     }
     if (!adj)
         for (int64_t i = 0; i < s->n; i++) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
+    for (int64_t j = 0; adj && j < s->o.nstarts; j++) /* signed start weights (conservative: both may show) */
+        pos |= s->o.start_weights[j] > 0, neg |= s->o.start_weights[j] < 0;
     double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
-    if (!adj) {
-        w0 = 0.0;
-        for (int64_t i = 0; i < s->n; i++) w0 += fabs(s->b[i]);
-    }
+    w0 = start_weight(&s->o, s->b, s->n);
     double Wmax = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
     s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
     if (s->o.rel_err > 0 && vmax > 0 && (!(qmax < 1.0) || !isfinite(Wmax)))
@@ -336,7 +371,7 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         (absorb ? isfinite(g2max) : isfinite(vmax))) {
         s->v2 = second_moment(s, K, fac, seen, w0);
     }
-    free(seen), free(fac);
+    free(fac);
     if (bad >= 0)
         return ulam__fail(err, ULAM_EUNDEFINED, 0, bad,
                           "p* > 0 wherever the absorption estimator scores; state %lld (1-based) is "
@@ -447,6 +482,35 @@ static int build_source(ulam_solver *s, double *bnorm1)
     return status;
 }
 
+/* The adjoint start distribution |c_j| / ||c||_1 over the nstarts start states as an alias table,
+ * their rows' units and (expected estimator) their b. */
+static int build_starts(ulam_solver *s)
+{
+    int64_t k = s->o.nstarts;
+    double *p = ulam__malloc((size_t)k, sizeof *p), *scaled = ulam__malloc((size_t)k, sizeof *scaled);
+    int32_t *out = ulam__malloc((size_t)k, sizeof *out);
+    int64_t *small = ulam__malloc((size_t)k, sizeof *small), *large = ulam__malloc((size_t)k, sizeof *large);
+    s->start_src = ulam__malloc((size_t)k, sizeof *s->start_src);
+    s->start_units = ulam__malloc((size_t)k, sizeof *s->start_units);
+    s->start_b = ulam__malloc((size_t)k, sizeof *s->start_b);
+    int status = ULAM_ENOMEM;
+    if (p && scaled && out && small && large && s->start_src && s->start_units && s->start_b) {
+        double norm = start_weight(&s->o, s->b, s->n);
+        for (int64_t j = 0; j < k; j++) {
+            p[j] = fabs(s->o.start_weights[j]) / norm;
+            out[j] = s->o.start_weights[j] < 0 ? ~(int32_t)j : (int32_t)j;
+            s->start_units[j] = ulam__kernel_unit(s->k, s->o.starts[j], &s->ks[0]);
+            s->start_b[j] = s->o.estimator == ULAM_EXPECTED ? s->b[s->o.starts[j]] : 0.0;
+        }
+        ulam__alias_build(p, out, k, s->start_src, scaled, small, large);
+        s->w.nstarts = k, s->w.start_src = s->start_src, s->w.start_units = s->start_units;
+        s->w.start_b = s->start_b, s->w.start_norm = norm;
+        status = ULAM_OK;
+    }
+    free(p), free(scaled), free(out), free(small), free(large);
+    return status;
+}
+
 /* Allocate per-thread scratch and per-block results. */
 static int alloc_work(ulam_solver *s)
 {
@@ -497,9 +561,9 @@ static int kernel_failure(const ulam_kernel *k, ulam_error *err)
                       "finite, nonzero values and score (the matrix is corrupt)", (long long)i + 1);
 }
 
-/* Prepare walks on (I - M) x = b. */
-int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-                      ulam_solver **out, ulam_error *err)
+/* Prepare walks on (I - M) x = b; seen: the states they can reach, computed before (NULL: search). */
+static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
+                        ulam_solver **out, ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !b || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
@@ -514,6 +578,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     s->o = o;
     s->b = b;
     s->n = M->nrows;
+    s->given_seen = seen;
     if ((status = take_guard(M, &o, &s->g, err)) || (status = check_verdicts(M, s, err))) {
         ulam_solver_free(s);
         return status;
@@ -548,6 +613,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
                           .max_steps = o.max_steps, .interrupt = o.interrupt,
                           .lanes = s->k->cap * (int64_t)sizeof(ulam__slot) <= CACHED ? 16 : 32};
     if (o.mode == ULAM_ADJOINT) s->w.start = ulam__kernel_unit(s->k, o.index, &s->ks[0]);
+    if (o.nstarts > 0 && build_starts(s)) goto nomem;
     if (o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED) s->w.score0 = s->b[o.index];
     if (o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED) s->w.expected = 1;
     s->w.watch = o.mode == ULAM_FORWARD ? o.index : -1;
@@ -561,6 +627,26 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
 nomem:
     ulam_solver_free(s);
     return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walk kernel and workspace");
+}
+
+/* Prepare walks on (I - M) x = b. */
+int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                      ulam_solver **out, ulam_error *err)
+{
+    return solver_alloc(M, b, opts, NULL, out, err);
+}
+
+/* As ulam_solver_alloc with the reachable states seen (borrowed). */
+int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
+                               ulam_solver **out, ulam_error *err)
+{
+    return solver_alloc(M, b, opts, seen, out, err);
+}
+
+/* The states the solver's walks can reach (NULL unless its reachability check ran). */
+const char *ulam__solver_reached(const ulam_solver *s)
+{
+    return s->given_seen ? s->given_seen : s->seen;
 }
 
 /* Run walks [first, first + count) as block q on thread t (ctx: the solver). */
