@@ -35,7 +35,7 @@
  *     choice (ulam_auto_choose), ulam_direct_bytes;
  *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
  *     ulam_strtod, ulam_outfile_*, ulam_spectral_radius_op, ulam_gauss_seidel_*, the studies'
- *     ulam_cell_summary, ulam_law_*, ulam_gnuplot, random numbers (ulam_rng_*), ulam_now.
+ *     method grid and exact value (ulam_study_*), random numbers (ulam_rng_*), ulam_now.
  * The radiosity front end ranks its own in ulam_radiosity.h.
  */
 #ifndef ULAM_H
@@ -936,45 +936,56 @@ int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *b
 /* ---------------------------------------------------------------- studies */
 /* All tertiary. */
 
+/* The weight windows of a study's methods: none, Russian roulette below 0.5 w0, or roulette and
+ * splitting above 2 w0 (w0 the starting weight: 1 adjoint, ||b||_1 forward). */
+enum ulam_window { ULAM_WINDOW_PLAIN, ULAM_WINDOW_ROULETTE, ULAM_WINDOW_SPLIT };
+
+/* A study's method grid: mode x estimator x window, 18 methods. */
+enum { ULAM_STUDY_METHODS = 18 };
+
+/* One method of the grid. */
+typedef struct ulam_study_method {
+    const char *name; /* "mode-estimator-window", e.g. "adjoint-collision-plain" */
+    int mode;         /* ULAM_ADJOINT or ULAM_FORWARD */
+    int estimator;    /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */
+    int window;       /* enum ulam_window */
+} ulam_study_method;
+
+/* Method k (0 <= k < ULAM_STUDY_METHODS; k = 9 mode + 3 estimator + window), or NULL. */
+const ulam_study_method *ulam_study_method_get(int k);
+
+/* The index of the method named name, or -1. */
+int ulam_study_method_find(const char *name);
+
+/* Set o's mode, estimator, roulette and split to method k's on b (n entries; read only in
+ * forward mode, for w0 = ||b||_1).  ULAM_OK or ULAM_EINVAL. */
+int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o);
+
 /* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
 void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
 
-/* The reference of a study: Gauss-Seidel sweeps on x (in place, from what it holds) until, after
- * at least min_sweeps, one sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps
- * are made; returns the sweeps made. */
+/* Gauss-Seidel sweeps on x (in place, from what it holds) until, after at least min_sweeps, one
+ * sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps are made; returns the
+ * sweeps made. */
 int ulam_gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
                              int min_sweeps, int max_sweeps);
 
-/* What R runs of one method at one budget say, against the exact value. */
-typedef struct ulam_cell {
-    int runs;
-    double rmse;        /* sqrt(mean (estimate - exact)^2) */
-    double mean_stderr; /* the mean reported standard error */
-    double honesty;     /* rmse / mean_stderr: 1 when the error bars are honest */
-    double coverage;    /* share of runs whose 95% interval holds the exact value */
-    double seconds;     /* mean seconds per run */
-    double work;        /* work-normalised variance rmse^2 x seconds (lower is better) */
-} ulam_cell;
+/* Up to this n a study's exact value is LAPACK's. */
+#define ULAM_STUDY_DIRECT_MAX 8000
 
-/* Summarise n runs (arrays of n) into *out. */
-void ulam_cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
-                       double exact, ulam_cell *out);
+/* The exact value a study scores its runs against. */
+typedef struct ulam_study_ref {
+    double exact;          /* x_index: LAPACK's when direct, else settled */
+    double settled;        /* Gauss-Seidel from x = 0 until x_index settles (1e-16 relative, after
+                              at least 12 sweeps, at most 10^5) */
+    int sweeps;            /* the sweeps it made */
+    int direct;            /* 1: n <= ULAM_STUDY_DIRECT_MAX and the LAPACK solve succeeded */
+    double direct_seconds; /* that solve's time */
+} ulam_study_ref;
 
-/* The collision-absorption law for a forward analog walk started at state j and counting
- * particles at j, with termination probability p*_j = pstar and no-return probability s:
- * visits are geometric, so Var(collision) = (1 - s) / s^2 and Var(absorption) = 1 / (p* s) -
- * 1 / s^2; collision is no worse iff p* <= s / (2 - s).  Writes the two variances. */
-void ulam_law_variances(double pstar, double s, double *var_collision, double *var_absorption);
-
-/* The no-return probability s of state j of the forward kernel of M (walks on the rows of
- * M', analog q): 1 - sum_k P_jk h_k with h the hitting probabilities of j (a linear solve).
- * ULAM_OK, ULAM_ENOMEM or ULAM_ESINGULAR. */
-int ulam_law_noreturn(const ulam_csr *M, int64_t j, double *s, double *pstar, ulam_error *err);
-
-/* Draw DIR/NAME.png with gnuplot (pngcairo, width x height pixels) from script, run in DIR;
- * written under a temporary name and renamed into place.  ULAM_EIO when gnuplot is missing
- * or fails (nothing is left behind). */
-int ulam_gnuplot(const char *dir, const char *name, int width, int height, const char *script);
+/* The exact x_index of (I - M) x = b for a study (index 0-based).  ULAM_OK, ULAM_EINVAL or
+ * ULAM_ENOMEM. */
+int ulam_study_reference(const ulam_csr *M, const double *b, int64_t index, ulam_study_ref *ref, ulam_error *err);
 
 /* ---------------------------------------------------------------- random numbers */
 /* All tertiary. */

@@ -3,7 +3,9 @@
 
 A table of cases, each (arguments, expected exit code, regex the stderr must match,
 regex the stdout must match).  Exit codes are 10 + the library status (see README).
-Run from the source root: cli_test.py path/to/ulam
+Run from the source root: cli_test.py path/to/ulam path/to/genmat [--no-radiosity] [--case NAME]...
+A failing case prints its name: `table:K` (K-th row of CASES, from 0) or a check function
+(`check_study`); `--case NAME` (repeatable) runs only those, e.g. --case table:12 --case check_study.
 """
 import json
 import os
@@ -343,15 +345,19 @@ def run(ulam, args):
     return p.returncode, p.stdout, p.stderr
 
 
-def check_table(ulam):
+def check_table(ulam, only=None):
+    """Run the rows of CASES (those in `only`, a set of indices, when given); (failures, rows run)."""
     failures = 0
-    for args, want_rc, err_re, out_re in CASES:
+    rows = [k for k in range(len(CASES)) if only is None or k in only]
+    for k in rows:
+        args, want_rc, err_re, out_re = CASES[k]
         rc, out, err = run(ulam, args)
         ok = rc == want_rc and re.search(err_re, err, re.M) and re.search(out_re, out, re.M)
         if not ok:
             failures += 1
-            print(f"FAIL ulam {' '.join(args)}: rc {rc} (want {want_rc})\n  stderr: {err.strip()}\n  stdout: {out.strip()[:300]}")
-    return failures, len(CASES)
+            print(f"FAIL table:{k} ulam {' '.join(args)}: rc {rc} (want {want_rc})\n  stderr: {err.strip()}\n"
+                  f"  stdout: {out.strip()[:300]}\n  (rerun it alone: --case table:{k})")
+    return failures, len(rows)
 
 
 def check_json(ulam):
@@ -1090,12 +1096,18 @@ def check_genmat(genmat):
 
 def main():
     ulam, genmat = sys.argv[1], sys.argv[2]
-    radiosity = "--no-radiosity" not in sys.argv[3:]  # a build without Embree and libpng
+    flags = sys.argv[3:]
+    radiosity = "--no-radiosity" not in flags  # a build without Embree and libpng
+    cases = [flags[k + 1] for k in range(len(flags) - 1) if flags[k] == "--case"]  # --case NAME: those alone
     if not radiosity:
         CASES[:] = [c for c in CASES if not c[0] or c[0][0] != "radiosity"]
         rc, out, err = run(ulam, ["radiosity", "x.obj"])
         assert rc == 2 and "built without the radiosity front end" in err, err
-    failures, n = check_table(ulam)
+    rows = {int(c[6:]) for c in cases if re.fullmatch(r"table:\d+", c)}
+    if any(k >= len(CASES) for k in rows):
+        print(f"--case table:K: K runs from 0 to {len(CASES) - 1}")
+        return 2
+    failures, n = check_table(ulam, rows if cases else None)
     extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
@@ -1105,12 +1117,21 @@ def main():
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam)]
-    for f, arg in extra if radiosity else [e for e in extra if "radiosity" not in e[0].__name__]:
+    if not radiosity:
+        extra = [e for e in extra if "radiosity" not in e[0].__name__]
+    if cases:
+        names = {f.__name__ for f, _ in extra}
+        unknown = [c for c in cases if not re.fullmatch(r"table:\d+", c) and c not in names and "check_" + c not in names]
+        if unknown:
+            print(f"unknown --case {', '.join(unknown)}: table:0 .. table:{len(CASES) - 1} or one of {', '.join(sorted(names))}")
+            return 2
+        extra = [e for e in extra if e[0].__name__ in cases or e[0].__name__[6:] in cases]
+    for f, arg in extra:
         try:
             f(arg)
         except AssertionError as e:
             failures += 1
-            print(f"FAIL {f.__name__}: {e}")
+            print(f"FAIL {f.__name__}: {e}\n  (rerun it alone: --case {f.__name__})")
     total = n + len(extra)
     print(f"{total - failures} passed, {failures} failed")
     return 1 if failures else 0

@@ -224,5 +224,5 @@ int main(void)
         cmocka_unit_test(test_outer),      cmocka_unit_test(test_bidir_and_auto), cmocka_unit_test(test_share),
         cmocka_unit_test(test_system_desc),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return test_run(tests);
 }

@@ -159,7 +159,7 @@ static void test_agreement(void **state)
                         assert_true(est == ULAM_ABSORPTION && mode == ULAM_FORWARD && k > 0);
                         o.continue_q = 0.8;
                     }
-                    ulam_walk_result r = test_run(&sy[k], o);
+                    ulam_walk_result r = test_sys_run(&sy[k], o);
                     if (r.variance_finite != 1) { /* no 4 sigma claim: and no interval either */
                         assert_true(k == 1 && alphas[a] != 0.5 && mode == ULAM_FORWARD);
                         assert_true(r.variance_finite == 0 && isnan(r.ci95[0]));
@@ -225,7 +225,7 @@ static void test_exact_variance(void **state)
         for (int a = 0; a < 4; a++) {
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = est, o.index = 5, o.kernel_alpha = alphas[a], o.max_walks = 400000, o.seed = 11;
-            ulam_walk_result r = test_run(&s, o);
+            ulam_walk_result r = test_sys_run(&s, o);
             ex[a] = exact_variance(&s, est, o.index, alphas[a]);
             double *D4 = dense_moment(s.M, ULAM_ADJOINT, alphas[a], 0.0, 4), r4 = dense_radius(D4, s.n);
             free(D4);
@@ -311,7 +311,7 @@ static void test_coverage(void **state)
     for (int seed = 0; seed < 200; seed++) { /* case seed: reruns exactly */
         ulam_walk_opts o = ulam_walk_defaults();
         o.index = 5, o.kernel_alpha = 2.0, o.max_walks = 2000, o.seed = (uint64_t)seed;
-        ulam_walk_result r = test_run(&s, o);
+        ulam_walk_result r = test_sys_run(&s, o);
         assert_int_equal(r.variance_finite, 1);
         covered += r.ci95[0] <= s.x[5] && s.x[5] <= r.ci95[1];
     }
@@ -356,11 +356,11 @@ static void test_identical(void **state)
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = mode, o.index = 5, o.max_walks = 50000, o.seed = 9, o.kernel_alpha = 0.5, o.threads = 1;
-        ulam_walk_result a = test_run(&s, o);
+        ulam_walk_result a = test_sys_run(&s, o);
         o.threads = 2;
-        ulam_walk_result b = test_run(&s, o);
+        ulam_walk_result b = test_sys_run(&s, o);
         o.whole_kernel = 1;
-        ulam_walk_result c = test_run(&s, o);
+        ulam_walk_result c = test_sys_run(&s, o);
         assert_memory_equal(&a.estimate, &b.estimate, sizeof a.estimate);
         assert_memory_equal(&a.variance, &c.variance, sizeof a.variance);
         assert_true(a.steps == b.steps && a.steps == c.steps && c.rows == s.n);

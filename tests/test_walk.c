@@ -11,6 +11,7 @@
  * and Var X_i = v_i - x_i^2 in the first two.  For the analog kernel p_ij = |M_ij| / S_i,
  * M^_ij = |M_ij| S_i / q_i. */
 #include "testutil.h"
+#include "law.h" /* examples/law.h: the law the test checks the walks against */
 
 #include <string.h>
 
@@ -37,6 +38,7 @@ static void test_agreement(void **state)
         test_sys s = test_sys_load(systems[k].name);
         for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++)
             for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
+                if (!test_case(1000 * (long)k + 3 * mode + est)) continue; /* system k, mode, estimator */
                 ulam_walk_opts o = ulam_walk_defaults();
                 o.mode = mode;
                 o.estimator = est;
@@ -52,11 +54,12 @@ static void test_agreement(void **state)
                     o.continue_q = 0.8;
                     o.max_walks = 1600000;
                 }
-                ulam_walk_result r = test_run(&s, o);
+                ulam_walk_result r = test_sys_run(&s, o);
                 assert_agrees(&s, &r, o.index);
             }
         test_sys_free(&s);
     }
+    test_case_done();
 }
 
 /* Over 200 seeds the 95% interval covers the LAPACK value 90% to 99% of the time. */
@@ -66,15 +69,18 @@ static void test_coverage(void **state)
     test_sys s = test_sys_load("chain4");
     for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
         int covered = 0;
-        for (int seed = 0; seed < 200; seed++) { /* case seed: reruns exactly */
+        for (int seed = 0; seed < 200; seed++) { /* case 1000 est + seed: reruns exactly */
+            if (!test_case(1000L * est + seed)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = est;
             o.index = 0;
             o.max_walks = 2000;
             o.seed = (uint64_t)seed;
-            ulam_walk_result r = test_run(&s, o);
+            ulam_walk_result r = test_sys_run(&s, o);
             covered += r.ci95[0] <= s.x[0] && s.x[0] <= r.ci95[1];
         }
+        test_case_done();
+        if (!test_case_all()) continue; /* one case alone: no count over seeds */
         print_message("estimator %d: 95%% interval covered the LAPACK value %d / 200 times\n", est, covered);
         assert_in_range(covered, 180, 198);
     }
@@ -132,13 +138,14 @@ static void test_exact_variance(void **state)
     for (size_t k = 0; k < 3; k++) {
         test_sys s = test_sys_load(cases[k].name);
         for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
+            if (!test_case(1000 * (long)k + est)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = est;
             o.index = cases[k].index;
             o.continue_q = cases[k].q;
             o.max_walks = 1000000;
             o.seed = 7;
-            ulam_walk_result r = test_run(&s, o);
+            ulam_walk_result r = test_sys_run(&s, o);
             double exact = exact_variance(&s, est, o.index, cases[k].q);
             print_message("%s x[%lld] q=%g %-10s variance: measured %.6g, exact %.6g (%+.2f%%)\n",
                           cases[k].name, (long long)o.index + 1, cases[k].q, names[est], r.variance,
@@ -148,6 +155,7 @@ static void test_exact_variance(void **state)
         }
         test_sys_free(&s);
     }
+    test_case_done();
 }
 
 /* Roulette (weights shrinking under --continue 0.95 on the chain) and splitting (weights
@@ -162,9 +170,9 @@ static void test_roulette_and_splitting(void **state)
         o.index = 2;
         o.continue_q = 0.95;
         o.max_walks = 200000;
-        ulam_walk_result plain = test_run(&s, o);
+        ulam_walk_result plain = test_sys_run(&s, o);
         o.roulette = 0.5;
-        ulam_walk_result rr = test_run(&s, o);
+        ulam_walk_result rr = test_sys_run(&s, o);
         assert_agrees(&s, &rr, 2);
         assert_true(rr.steps < plain.steps); /* roulette did cut walks short */
     }
@@ -176,12 +184,12 @@ static void test_roulette_and_splitting(void **state)
         o.index = 3;
         o.continue_q = 0.5;
         o.max_walks = 200000;
-        ulam_walk_result plain = test_run(&s, o);
+        ulam_walk_result plain = test_sys_run(&s, o);
         double w0 = mode == ULAM_ADJOINT ? 1.0 : 0.0; /* the start weight: 1 adjoint, ||b||_1 forward (a split weight below it is refused) */
         for (int64_t i = 0; mode == ULAM_FORWARD && i < s.n; i++) w0 += fabs(s.b[i]);
         o.split = 2.0 * w0;
         o.roulette = 0.25 * w0;
-        ulam_walk_result ws = test_run(&s, o);
+        ulam_walk_result ws = test_sys_run(&s, o);
         assert_agrees(&s, &ws, 3);
         assert_true(ws.steps > plain.steps); /* splitting did make copies */
     }
@@ -196,6 +204,7 @@ static void test_jacobi_poisson(void **state)
     ulam_csr *A = s.M;
     double *bp = malloc((size_t)s.n * sizeof *bp);
     for (int k = 0; k < 2; k++) {
+        if (!test_case(k)) continue;
         double omega = k ? 0.8 : 1.0;
         assert_int_equal(ulam_jacobi(A, s.b, omega, &s.M, bp, NULL), ULAM_OK);
         double *b = s.b;
@@ -205,13 +214,14 @@ static void test_jacobi_poisson(void **state)
         o.index = 210;
         o.max_walks = 20000;
         o.seed = 7 + (uint64_t)k;
-        ulam_walk_result r = test_run(&s, o);
+        ulam_walk_result r = test_sys_run(&s, o);
         print_message("poisson20 --jacobi --omega %.1f: x[211] = %.6g +- %.2g, LAPACK %.6g\n", omega,
                       r.estimate, r.std_error, s.x[210]);
         assert_agrees(&s, &r, 210);
         s.b = b;
         ulam_csr_free(s.M);
     }
+    test_case_done();
     s.M = A;
     free(bp);
     test_sys_free(&s);
@@ -226,7 +236,7 @@ static void test_collision_absorption_law(void **state)
     (void)state;
     const double ps[3] = {0.2, 0.32, 0.45}, s = 0.5;
     for (int k = 0; k < 3; k++) {
-        double c = 1 - (s - ps[k]) / (1 - ps[k]), b[4] = {1, 0, 0, 0}, v[2], s2, p2;
+        double c = 1 - (s - ps[k]) / (1 - ps[k]), b[4] = {1, 0, 0, 0}, v[2], s2 = NAN, p2 = NAN;
         int32_t ti[6], tj[6];
         double tx[6];
         for (int q = 0; q < 3; q++) {
@@ -235,15 +245,16 @@ static void test_collision_absorption_law(void **state)
         }
         ulam_csr *M = NULL;
         assert_int_equal(ulam_csr_from_triplets(4, 4, 6, ti, tj, tx, &M), ULAM_OK);
-        assert_int_equal(ulam_law_noreturn(M, 0, &s2, &p2, NULL), ULAM_OK);
+        assert_int_equal(law_noreturn(M, 0, &s2, &p2), ULAM_OK);
         assert_close(s2, s, 1e-12);
         assert_close(p2, ps[k], 1e-12);
-        ulam_law_variances(ps[k], s, &v[0], &v[1]);
+        law_variances(ps[k], s, &v[0], &v[1]);
         test_sys sy = {.M = M, .b = b, .n = 4};
         for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+            if (!test_case(1000L * k + est)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.mode = ULAM_FORWARD, o.estimator = est, o.max_walks = 1000000, o.seed = 40 + (uint64_t)k;
-            ulam_walk_result r = test_run(&sy, o);
+            ulam_walk_result r = test_sys_run(&sy, o);
             print_message("law p* = %.2f (boundary 0.333) %-10s variance measured %.5g, exact %.5g (%+.2f%%)\n",
                           ps[k], est ? "absorption" : "collision", r.variance, v[est], 100 * (r.variance / v[est] - 1));
             assert_close(r.variance, v[est], 0.05 * v[est]);
@@ -251,6 +262,7 @@ static void test_collision_absorption_law(void **state)
         assert_true(k == 1 || (v[0] < v[1]) == (ps[k] < s / (2 - s)));
         ulam_csr_free(M);
     }
+    test_case_done();
 }
 
 /* Two runs gave the same result bit for bit. */
@@ -273,9 +285,9 @@ static void test_threads_identical(void **state)
         o.max_walks = 50000;
         o.seed = 99;
         o.threads = 1;
-        ulam_walk_result a = test_run(&s, o);
+        ulam_walk_result a = test_sys_run(&s, o);
         o.threads = 2;
-        ulam_walk_result b = test_run(&s, o);
+        ulam_walk_result b = test_sys_run(&s, o);
         assert_same_run(&a, &b);
     }
     test_sys_free(&s);
@@ -291,16 +303,18 @@ static void test_lazy_kernel(void **state)
     static const int64_t budgets[2] = {16, 50000};
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++)
         for (int k = 0; k < 2; k++) {
+            if (!test_case(1000L * mode + k)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.mode = mode, o.index = 5, o.max_walks = budgets[k], o.seed = 7 + (uint64_t)k, o.threads = 2;
-            ulam_walk_result lazy = test_run(&s, o);
+            ulam_walk_result lazy = test_sys_run(&s, o);
             o.whole_kernel = 1;
-            ulam_walk_result whole = test_run(&s, o);
+            ulam_walk_result whole = test_sys_run(&s, o);
             assert_same_run(&lazy, &whole);
             assert_true(whole.rows == s.n);
             if (k == 0) assert_true(lazy.rows <= lazy.steps + lazy.walks && lazy.rows < s.n / 4);
             else assert_true(lazy.rows == s.n);
         }
+    test_case_done();
     test_sys_free(&s);
 }
 
@@ -609,5 +623,5 @@ int main(void)
         cmocka_unit_test(test_solver_guards),     cmocka_unit_test(test_rel_err_infinite_refused),
         cmocka_unit_test(test_forward_unreached), cmocka_unit_test(test_rel_err_cuts), cmocka_unit_test(test_rel_err_collision_tail),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return test_run(tests);
 }
