@@ -843,7 +843,8 @@ typedef struct ulam_bidir_plan_info {
                                the value is exact; max_walks when that is the only rule; NaN
                                when rmax is given and rel_err is set: no pilot measured V) */
     double predicted_work;  /* push.ops + step_cost (pilot visits + predicted_walks V): the whole
-                               estimate's work in push operations */
+                               estimate's work in push operations (NaN when rmax is given and
+                               walks remain: no pilot measured V) */
     double step_cost;       /* push operations a walk visit counts as */
     double seconds;         /* wall time of the plan: pilot and push */
 } ulam_bidir_plan_info;

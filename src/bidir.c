@@ -10,7 +10,7 @@
  *
  * Plan and balance (as BiPPR balances times, here on work counts so the result is
  * reproducible): a collision walk scores at most rmax at each of its V visits, so its variance
- * is about rmax E[V] x, and the walk solver's rel_err rule needs at least the walks of its
+ * is about ||b||_1 rmax E[V] x, and the walk solver's rel_err rule needs at least the walks of its
  * range term for scores of rmax a visit (the solver's own bounds over the states the walks
  * reach, taken from the pilot's solver); the walks needed are the largest of those and the
  * rule's floor, each costing E[V] visits.  rmax halves, pushing down to it, while the push's
@@ -217,7 +217,9 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
     if (status == ULAM_ENOCONV)
         return ulam__fail(err, status, 0, -1, "a push within %lld operations (is rho(|M|) < 1?)", (long long)cap);
     double pilot_visits = (double)(plan->pilot_walks + plan->pilot_steps);
-    plan->predicted_work = (double)plan->push.ops + STEP_COST * (pilot_visits + plan->predicted_walks * plan->mean_visits);
+    plan->predicted_work = plan->balanced || plan->predicted_walks == 0.0
+                               ? (double)plan->push.ops + STEP_COST * (pilot_visits + plan->predicted_walks * plan->mean_visits)
+                               : NAN; /* rmax given: no pilot measured V */
     plan->seconds = ulam_now() - t0;
     if (o->nb > memo->cap) { /* keep b's entries: the options point at the caller's */
         int64_t *idx = realloc(memo->idx, (size_t)o->nb * sizeof *idx);

@@ -147,7 +147,10 @@ CASES += [
     (PS + ["--source", "3", "--rmax", "-0.1"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--source", "3", "--rmax", "nan"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
-    (["solve", M + "randsub1000.mtx", "--source", "3"], 2, r"--source S needs --index I", r"^$"),
+    (["solve", M + "randsub1000.mtx", "--source", "3"], 2, r"--method bidirectional needs --index I", r"^$"),
+    (PS + ["--rhs", M + "randsub1000_b.mtx", "--method", "bidirectional"], 2,
+     r"is for a sparse b, and this b has 1000 nonzeros of 1000 \(more than max\(16, n/10\) = 100\)", r"^$"),
+    (PS + ["--rhs", D + "sparse3_b.mtx", "--rmax", "0.1"], 2, r"say --method bidirectional", r"^$"),
     (PS + ["--source", "3", "--method", "forward"], 2, r"go with --method bidirectional, got 'forward'", r"^$"),
     (PS + ["--source", "3", "--out", "x.mtx"], 2, r"unknown option for a --source solve", r"^$"),
     (["solve", M + "divergent200.mtx", "--index", "1", "--source", "2"], 3, r"rho\(\|M\|\) is >= 1 \(certified: bounds \[1\.1, 1\.1\]\)", r"^$"),
@@ -1056,6 +1059,11 @@ def check_bidir(ulam):
     o = json.loads(out)
     assert rc == 0 and o["rmax_balanced"] is True and o["pilot_walks"] == 256, o
     assert o["stderr"] <= 0.02 * abs(o["estimate"]) and o["walks"] >= 1000, o
+    rc, out, err = run(ulam, PS + ["--rhs", D + "sparse3_b.mtx", "--method", "bidirectional", "--rmax", "0.01",
+                                   "--walks", "30000", "--json", "--check"])
+    o = json.loads(out)  # a sparse b of 3 nonzeros, mixed signs
+    assert rc == 0 and o["source"] is None and o["b_nonzeros"] == 3 and o["walks"] == 30000, o
+    assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
     rc, out, err = run(ulam, ["solve", D + "dag5.mtx", "--index", "1", "--source", "5", "--rmax", "1e-3", "--json",
                               "--check"])
     o = json.loads(out)

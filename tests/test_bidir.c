@@ -255,6 +255,7 @@ static void test_bidir_plan(void **state)
     o.rmax = 0.01, o.walk.rel_err = 0, o.walk.max_walks = 5000; /* given rmax: no pilot, walks known */
     assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
     assert_true(!plan.balanced && plan.pilot_walks == 0 && plan.rmax == 0.01 && plan.predicted_walks == 5000);
+    assert_true(isnan(plan.predicted_work)); /* V unknown */
     o.walk.rel_err = 0.05, o.walk.max_walks = 0;
     assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
     assert_true(isnan(plan.predicted_walks) && isnan(plan.predicted_work)); /* no pilot measured V */
