@@ -453,7 +453,7 @@ static int run(solve_args *a)
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, &r);
         if (first && !status) rel_err_warning(s, o, &r);
-        cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o->rel_err);
+        cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o);
     }
     cli_progress_end(&pg);
     ulam_solver_result(sv, &r);
