@@ -144,7 +144,7 @@ CASES += [
     (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--method", "auto",
       "--rel-err", "0.01"], 3, r"error: --method auto: no candidate has a certified finite variance; the closest is .*"
      r"a --rel-err target cannot be met honestly", r"^$"),
-    (RS + ["--method", "auto", "--walks", "20000"], 0, r"^$", r"auto\s+chose the least variance x seconds a walk from 12 candidates"),
+    (RS + ["--method", "auto", "--walks", "20000"], 0, r"^$", r"auto\s+chose the least predicted variance x work a walk of 12 candidates"),
 ]
 
 
@@ -987,8 +987,9 @@ def check_auto(ulam):
     a = o["auto"]
     assert len(a["candidates"]) == 12 and 0 <= a["chosen"] < 12, a
     for c in a["candidates"]:
-        assert c["certified"] == (c["rho_hat_upper"] < 1), c
-        assert (c["pilot_walks"] > 0) == (c["certified"] and c["status"] == "ok"), c
+        if c["state"] != "skipped":
+            assert c["certified"] == (c["rho_hat_upper"] < 1), c
+        assert (c["pilot_walks"] > 0) == (c["state"] in ("dropped", "finalist", "chosen")), c
     ch = a["candidates"][a["chosen"]]
     assert ch["mode"] == o["mode"] and ch["estimator"] == o["estimator"], (ch, o)
     assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"] and o["stderr"] <= 0.02 * abs(o["estimate"]), o

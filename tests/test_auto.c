@@ -26,22 +26,21 @@ static void test_choice(void **state)
         double *x = malloc((size_t)M->nrows * sizeof *x);
         assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 1, o.max_walks = 40000, o.seed = 11;
+        o.index = 1, o.rel_err = 0.02, o.seed = 11;
         ulam_auto_result res;
         ulam_auto_opts ao = ulam_auto_defaults();
-        ao.pilot_seconds = 0; /* pilots of exactly 2048 walks, whatever the machine's load */
+
         assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_OK);
         assert_int_equal(res.ncand, 12);
         assert_true(res.chosen >= 0);
         for (int c = 0; c < res.ncand; c++) {
             const ulam_auto_candidate *a = &res.cand[c];
-            assert_int_equal(a->certified, res.abs.upper < 1 && a->hat.upper < 1);
+            if (a->state != ULAM_AUTO_SKIPPED) assert_int_equal(a->certified, res.abs.upper < 1 && a->hat.upper < 1);
             assert_true(a->certified || a->pilot_walks == 0);
-            if (a->pilot_walks) assert_int_equal(a->pilot_walks, 2048);
-            if (isfinite(a->cost)) assert_true(res.cand[res.chosen].cost <= a->cost);
+            if (a->state == ULAM_AUTO_FINALIST) assert_true(res.cand[res.chosen].predicted_work <= a->predicted_work);
         }
         const ulam_auto_candidate *ch = &res.cand[res.chosen];
-        assert_true(ch->certified && ch->status == ULAM_OK && isfinite(ch->cost));
+        assert_true(ch->certified && ch->status == ULAM_OK && ch->state == ULAM_AUTO_CHOSEN);
         o.mode = ch->mode, o.estimator = ch->estimator, o.continue_q = ch->continue_q;
         ulam_walk_result r;
         assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
@@ -80,7 +79,7 @@ static void test_pins_and_none(void **state)
     assert_int_equal(ulam_auto_choose(M, b, &o, NULL, &res, NULL), ULAM_OK);
     assert_true(res.chosen == -1 && res.closest >= 0 && res.abs.lower >= 1);
     for (int c = 0; c < res.ncand; c++) {
-        assert_true(!res.cand[c].certified && res.cand[c].pilot_walks == 0);
+        assert_true(!res.cand[c].certified && res.cand[c].pilot_walks == 0 && res.cand[c].state == ULAM_AUTO_UNCERTIFIED);
         assert_true(res.cand[res.closest].hat.rho <= res.cand[c].hat.rho);
     }
     free(b);
