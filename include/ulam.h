@@ -254,9 +254,7 @@ int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double 
                             const void *ctx, int positive_start, const ulam_spectral_opts *opts,
                             ulam_radius *out);
 
-/* ---------------------------------------------------------------- stability guards */
-
-/* Options of the power iteration for nonnegative operators. */
+/* Options of the power iteration for nonnegative operators (the guards' radii). */
 typedef struct ulam_power_opts {
     double tol;   /* stop when (upper - lower) <= tol * upper, or when for 5 iterations the
                      changes, extrapolated as a geometric series, add up to <= tol * rho,
@@ -287,6 +285,8 @@ typedef struct ulam_power {
 /* rho(diag(left) |A| diag(right)); left and right may be NULL (all ones).  opts may be NULL. */
 int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
                         const ulam_power_opts *opts, ulam_power *out, ulam_error *err);
+
+/* ---------------------------------------------------------------- stability guards */
 
 /* A radius against 1, from its certified bounds alone (never from an unconverged estimate):
  * OK when upper < 0.99; EDGE (finite, within 1% of 1) when upper < 1; FAIL when lower >= 1;

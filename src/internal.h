@@ -70,13 +70,36 @@ int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first);
  * `round` a round; block k runs as run(ctx, k, its first walk, its walk count, thread) and
  * leaves its result in the k-th struct of the caller's array, `size` bytes each, whose tallies
  * (tally_size bytes each) sit behind a pointer, a length and a capacity (int64) at the offsets
- * given, so results can be sent between processes. */
+ * given, so results can be sent between processes.  Every block struct also holds its walks
+ * and non-finite scores (int64) and its complete and nomem flags (int) at the offsets given;
+ * merge(ctx, k) adds the k-th completed block to the solver's own totals; begin(ctx), when
+ * given, runs before each round inside its time (the matrix solver completes its kernel
+ * there); failure(ctx), when given, is a status that fails the whole run once a round ran (a
+ * corrupt matrix row), or ULAM_OK. */
 typedef struct {
     int block, round;
     void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread);
     size_t size, tally_size;
     size_t off_ptr, off_len, off_cap;
+    size_t off_walks, off_nonfinite, off_complete, off_nomem;
+    void (*merge)(void *ctx, int k);
+    void (*begin)(void *ctx);
+    int (*failure)(void *ctx);
 } ulam__blocks;
+
+/* Where a walk run stands between rounds, the part of a solver the round driver keeps: walks
+ * merged (the next round starts there), of them non-finite scores, when the run started (t0,
+ * -1 before its first round), seconds spent in rounds, and its ending: done once a stopping
+ * rule is met or the run failed (status), interrupted by o->interrupt.  Zeroed, with t0 = -1,
+ * it is a run not yet started (ulam__run_reset). */
+typedef struct {
+    int64_t walks, nonfinite;
+    double t0, seconds;
+    int done, interrupted, status;
+} ulam__run;
+
+/* A run not yet started. */
+void ulam__run_reset(ulam__run *run);
 
 /* One round from walk `next` (no further than o->max_walks), shared dynamically among
  * `threads`, its *nb block results left in results[].  With o->share, every process's blocks
@@ -86,8 +109,16 @@ typedef struct {
 int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int threads, void *ctx,
                 void *results, int *nb, int *stop);
 
-/* Nonzero when the walk budget is spent after `walks` walks or the stop flags say time is up. */
-int ulam__budget_spent(const ulam_walk_opts *o, int stop, int64_t walks);
+/* The step a solver's iterate takes, shared by matrix and patch walks so each stopping rule
+ * but the relative error is written once: one round (ulam__round) after B->begin, then its
+ * completed blocks merged in block order (B->merge; the first incomplete block, interrupted or
+ * out of time, ends the run with what came before it), and run's ending updated: a failed
+ * exchange, a block out of memory, B->failure or a non-finite score fail the run
+ * (ULAM_ENONFINITE only when nothing else did); an interrupt, the walk budget (o->max_walks)
+ * or the time limit (o->max_seconds) end it.  The solver then applies its own rel_err rule.
+ * Returns run->status. */
+int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads, void *ctx, void *results,
+                     ulam__run *run);
 
 /* Nonzero when this process runs block q (always, without a share). */
 int ulam__mine(const ulam_share *sh, int64_t q);
@@ -109,6 +140,17 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *o, ulam_error *err)
  * row's nonzeros + 3) and matrix entries read by reachability checks and score-bound passes
  * (*reads). */
 void ulam__solver_setup(const ulam_solver *s, int64_t *units, int64_t *reads);
+
+/* Nonzero when [lower, upper] decides a radius' verdict and its warning: wholly below 0.99,
+ * wholly at or above 1, or wholly in [0.99, 1) (src/spectral.c; the guards use it). */
+int ulam__power_certain(double lower, double upper);
+
+/* Power iteration on diag(left) |A| diag(right) (left, right may be NULL) from the bounds
+ * already in *out (the guards' one-pass sums), with out->iterations and out->seconds added
+ * to; out keeps the tighter bounds of both (src/spectral.c; ulam_spectral_power starts it
+ * from [0, INFINITY]). */
+int ulam__power_from(const ulam_csr *A, const double *left, const double *right, const ulam_power_opts *o,
+                     ulam_power *out, ulam_error *err);
 
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)

@@ -1,7 +1,8 @@
 /* The round driver shared by matrix walks (solve.c) and patch walks (radiosity/patchwalk.c):
  * rounds of blocks of walks spread over threads and, through ulam_share, over processes, whose
  * results every process then holds in block order (so any thread or rank count gives the same
- * totals); and the budget and time tests a round stops on. */
+ * totals); and the after-round step both solvers take (ulam__round_step: merge in block order,
+ * failures, interrupt, budget and time), so those stopping rules are written once. */
 #include "internal.h"
 
 #include <stdlib.h>
@@ -18,6 +19,12 @@ int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first)
 int ulam__mine(const ulam_share *sh, int64_t q)
 {
     return !sh || sh->nranks <= 1 || q % sh->nranks == sh->rank;
+}
+
+/* Nonzero when the walk budget is spent after `walks` walks or the stop flags say time is up. */
+static int budget_spent(const ulam_walk_opts *o, int stop, int64_t walks)
+{
+    return (stop & 1) || (o->max_walks > 0 && walks >= o->max_walks);
 }
 
 /* This process's stop flags: 1 time is up, 2 interrupted. */
@@ -136,8 +143,53 @@ int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64
     return status;
 }
 
-/* Nonzero when the walk budget is spent or the stop flags say time is up. */
-int ulam__budget_spent(const ulam_walk_opts *o, int stop, int64_t walks)
+
+/* A run not yet started. */
+void ulam__run_reset(ulam__run *run)
 {
-    return (stop & 1) || (o->max_walks > 0 && walks >= o->max_walks);
+    *run = (ulam__run){.t0 = -1};
+}
+
+/* The int64 at offset off of block k in results. */
+static int64_t block_i64(const ulam__blocks *B, const void *results, int k, size_t off)
+{
+    int64_t v;
+    memcpy(&v, (const unsigned char *)results + (size_t)k * B->size + off, sizeof v);
+    return v;
+}
+
+/* The int at offset off of block k in results. */
+static int block_int(const ulam__blocks *B, const void *results, int k, size_t off)
+{
+    int v;
+    memcpy(&v, (const unsigned char *)results + (size_t)k * B->size + off, sizeof v);
+    return v;
+}
+
+/* One round, its merge and the stopping rules but the relative error. */
+int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads, void *ctx, void *results,
+                     ulam__run *run)
+{
+    double start = ulam_now();
+    if (run->t0 < 0) run->t0 = start;
+    if (B->begin) B->begin(ctx);
+    int nb, stop, st = ulam__round(B, o, run->t0, run->walks, threads, ctx, results, &nb, &stop);
+    if (st) run->status = st;
+    for (int k = 0; k < nb; k++) {
+        if (block_int(B, results, k, B->off_nomem)) run->status = ULAM_ENOMEM;
+        if (!block_int(B, results, k, B->off_complete)) { /* interrupted or out of time: keep what came before */
+            run->done = 1;
+            break;
+        }
+        B->merge(ctx, k);
+        run->walks += block_i64(B, results, k, B->off_walks);
+        run->nonfinite += block_i64(B, results, k, B->off_nonfinite);
+    }
+    run->seconds += ulam_now() - start;
+    if (stop & 2) run->interrupted = run->done = 1;
+    if (B->failure && (st = B->failure(ctx))) run->status = st, run->done = 1;
+    if (run->nonfinite && !run->status) run->status = ULAM_ENONFINITE;
+    if (run->status) run->done = 1;
+    if (budget_spent(o, stop, run->walks)) run->done = 1;
+    return run->status;
 }

@@ -63,10 +63,10 @@ struct ulam_solver {
     int tail_done, v2_done[3]; /* length_tail's and second_moment's results kept: */
     double tail_uc, tail_kc, v2c[3];
     const ulam_csr *M;     /* borrowed */
-    int64_t walks, steps, cut, nonfinite, next_walk;
+    ulam__run run;      /* walks, time, ending (round.c) */
+    int64_t steps, cut;
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
-    double seconds, t0;
-    int done, interrupted, status, met, cut_stop, out_of_reach;
+    int met, cut_stop, out_of_reach;
 };
 
 /* The defaults. */
@@ -579,7 +579,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         ulam_solver_free(s);
         return status;
     }
-    s->t0 = -1;
+    ulam__run_reset(&s->run);
     *out = s;
     return ULAM_OK;
 nomem:
@@ -594,17 +594,20 @@ static void run_block(void *ctx, int q, int64_t first, int64_t count, int t)
     ulam__block *br = &s->blocks[q];
     br->complete = 0;
     br->walks = 0;
-    if (!ulam__mine(s->o.share, first / BLOCK) || !ulam__block_may_start(&s->o, s->t0, first)) return;
+    if (!ulam__mine(s->o.share, first / BLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
     ulam_rng r;
     ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / BLOCK));
     if (s->o.mode == ULAM_ADJOINT) ulam__adjoint_block(&s->w, count, &r, &s->scratch[t], br);
     else ulam__forward_block(&s->w, count, &r, &s->scratch[t], br);
 }
 
-/* Merge a completed block into the totals (forward: the watched component's moments count
- * the block's histories that did not tally it as zeros). */
-static void merge_block(ulam_solver *s, const ulam__block *br)
+/* Merge completed block q into the totals (ctx: the solver; forward: the watched component's
+ * moments count the block's histories that did not tally it as zeros; the walk and non-finite
+ * counts are the round driver's). */
+static void merge_block(void *ctx, int q)
 {
+    ulam_solver *s = ctx;
+    const ulam__block *br = &s->blocks[q];
     ulam__moments_merge(&s->adj, &br->m);
     s->maxsq = fmax(s->maxsq, br->maxsq);
     ulam__moments w = br->watched;
@@ -617,10 +620,24 @@ static void merge_block(ulam_solver *s, const ulam__block *br)
         ulam__moments_merge(&w, &zeros);
         ulam__moments_merge(&s->watched, &w);
     }
-    s->walks += br->walks;
     s->steps += br->steps;
     s->cut += br->cut;
-    s->nonfinite += br->nonfinite;
+}
+
+/* Before a round (ctx: the solver): once walks have built 1 / COMPLETE of the kernel, build the
+ * rest at once. */
+static void begin_round(void *ctx)
+{
+    ulam_solver *s = ctx;
+    if (atomic_load(&s->k->built) < s->n && atomic_load(&s->k->top) * COMPLETE > s->k->cap)
+        ulam__kernel_complete(s->k, s->threads, s->ks);
+}
+
+/* A corrupt row a walk found fails the run (ctx: the solver). */
+static int kernel_status(void *ctx)
+{
+    const ulam_solver *s = ctx;
+    return atomic_load(&s->k->status);
 }
 
 static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached);
@@ -642,54 +659,36 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
 int ulam_solver_iterate(ulam_solver *s)
 {
     if (!s) return ULAM_EINVAL;
-    if (s->done) return s->status;
-    double start = ulam_now();
-    if (s->t0 < 0) s->t0 = start;
-    if (atomic_load(&s->k->built) < s->n && atomic_load(&s->k->top) * COMPLETE > s->k->cap)
-        ulam__kernel_complete(s->k, s->threads, s->ks);
+    if (s->run.done) return s->run.status;
     static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally),
                                    offsetof(ulam__block, t.t), offsetof(ulam__block, t.len),
-                                   offsetof(ulam__block, t.cap)};
-    int nb, stop, st = ulam__round(&B, &s->o, s->t0, s->next_walk, s->threads, s, s->blocks, &nb, &stop);
-    if (st) s->status = st;
-    for (int q = 0; q < nb; q++) {
-        if (s->blocks[q].nomem) s->status = ULAM_ENOMEM;
-        if (!s->blocks[q].complete) { /* interrupted or out of time: keep what came before */
-            s->done = 1;
-            break;
-        }
-        merge_block(s, &s->blocks[q]);
-        s->next_walk += s->blocks[q].walks;
-    }
-    s->seconds += ulam_now() - start;
-    if (stop & 2) s->interrupted = s->done = 1;
-    if ((st = atomic_load(&s->k->status))) s->status = st, s->done = 1; /* a corrupt row: the run fails */
-    if (s->nonfinite && !s->status) s->status = ULAM_ENONFINITE;
-    if (s->status) s->done = 1;
+                                   offsetof(ulam__block, t.cap), offsetof(ulam__block, walks),
+                                   offsetof(ulam__block, nonfinite), offsetof(ulam__block, complete),
+                                   offsetof(ulam__block, nomem), merge_block, begin_round, kernel_status};
+    ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
     result(s, &r, 0);
-    if (ulam__budget_spent(&s->o, stop, s->next_walk)) s->done = 1;
-    if (rel_err_met(s, &r)) s->done = s->met = 1;
-    else if (s->o.rel_err > 0 && s->walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.rel_err_offset) > 0 &&
+    if (rel_err_met(s, &r)) s->run.done = s->met = 1;
+    else if (s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.rel_err_offset) > 0 &&
              !(r.cut_bound <= ULAM__CUT_SHARE * s->o.rel_err * fabs(r.estimate + s->o.rel_err_offset)))
-        s->done = s->cut_stop = 1; /* the cuts' bias may exceed the target: more walks cannot help */
-    else if (s->o.rel_err > 0 && s->walks >= ULAM__REL_MIN && s->o.max_walks == ULAM_REL_ERR_CAP &&
+        s->run.done = s->cut_stop = 1; /* the cuts' bias may exceed the target: more walks cannot help */
+    else if (s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && s->o.max_walks == ULAM_REL_ERR_CAP &&
              !(s->o.max_seconds > 0) && r.min_walks > (double)ULAM_REL_ERR_CAP)
-        s->done = s->out_of_reach = 1; /* rel_err alone, and the cap cannot reach the minimum */
-    return s->status;
+        s->run.done = s->out_of_reach = 1; /* rel_err alone, and the cap cannot reach the minimum */
+    return s->run.status;
 }
 
 /* Nonzero once a stopping rule is met. */
 int ulam_solver_done(const ulam_solver *s)
 {
-    return !s || s->done;
+    return !s || s->run.done;
 }
 
 /* Forward estimate and standard error of component i from the sums; the error is NaN when no
  * walk has tallied it (unreached: 0 +- 0 would claim certainty). */
 static void forward_component(const ulam_solver *s, int64_t i, double *est, double *se, double *var)
 {
-    double N = (double)s->walks, mean, v;
+    double N = (double)s->run.walks, mean, v;
     ulam__sums_moments(N, s->sum[i], s->sumsq[i], &mean, &v);
     *est = mean + (s->o.estimator == ULAM_EXPECTED ? s->b[i] : 0.0);
     *var = v;
@@ -739,7 +738,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->max_share = sumsq > 0 ? fmin(1.0, s->maxsq / sumsq) : 0.0;
     r->variance_finite = s->var_finite;
     r->variance_rel_error = ulam__moments_variance_rel_error(mom);
-    double m = fabs(r->estimate + s->o.rel_err_offset), N = (double)s->walks;
+    double m = fabs(r->estimate + s->o.rel_err_offset), N = (double)s->run.walks;
     double E = s->o.rel_err > 0 ? s->o.rel_err : TAIL_E;
     double R = score_range(s, m, E);
     r->score_bound = s->bound;
@@ -754,13 +753,13 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     double half = s->var_finite == 1 && !(r->cut_bound > r->std_error) ? ULAM_Z95 * r->std_error : NAN;
     r->ci95[0] = r->estimate - half;
     r->ci95[1] = r->estimate + half;
-    r->walks = s->walks;
+    r->walks = s->run.walks;
     r->steps = s->steps;
     r->cut = s->cut;
     r->rows = atomic_load(&s->k->built);
-    r->seconds = s->seconds;
+    r->seconds = s->run.seconds;
     r->threads = s->threads;
-    r->interrupted = s->interrupted;
+    r->interrupted = s->run.interrupted;
 }
 
 /* The result so far. */
@@ -806,14 +805,15 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
 int ulam_solver_error(const ulam_solver *s, ulam_error *err)
 {
     ulam__clear(err);
-    if (!s || !s->status) return ULAM_OK;
+    if (!s || !s->run.status) return ULAM_OK;
     int status = kernel_failure(s->k, err);
     if (status) return status;
-    switch (s->status) {
-    case ULAM_ENONFINITE: return ulam__fail(err, s->status, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
-    case ULAM_ENOMEM: return ulam__fail(err, s->status, 0, -1, "memory for the walks' tallies");
-    case ULAM_EIO: return ulam__fail(err, s->status, 0, -1, "an exchange of walk results between processes (allgather failed)");
-    default: return ulam__fail(err, s->status, 0, -1, "walks that run to their end");
+    int st = s->run.status;
+    switch (st) {
+    case ULAM_ENONFINITE: return ulam__fail(err, st, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
+    case ULAM_ENOMEM: return ulam__fail(err, st, 0, -1, "memory for the walks' tallies");
+    case ULAM_EIO: return ulam__fail(err, st, 0, -1, "an exchange of walk results between processes (allgather failed)");
+    default: return ulam__fail(err, st, 0, -1, "walks that run to their end");
     }
 }
 
@@ -823,10 +823,10 @@ static void reset(ulam_solver *s)
     if (s->sum) memset(s->sum, 0, (size_t)s->n * sizeof *s->sum);
     if (s->sumsq) memset(s->sumsq, 0, (size_t)s->n * sizeof *s->sumsq);
     s->adj = s->watched = (ulam__moments){0};
-    s->walks = s->steps = s->cut = s->nonfinite = s->next_walk = 0;
-    s->maxsq = s->seconds = 0.0;
-    s->t0 = -1;
-    s->done = s->interrupted = s->status = s->met = s->cut_stop = s->out_of_reach = 0;
+    s->steps = s->cut = 0;
+    s->maxsq = 0.0;
+    ulam__run_reset(&s->run);
+    s->met = s->cut_stop = s->out_of_reach = 0;
 }
 
 /* Restart a forward solver on a new right-hand side b (borrowed like the first) with a new

@@ -5,7 +5,12 @@
  * So: ARPACK-NG's implicitly restarted Arnoldi (dnaupd/dneupd, which = "LM"), stopped when
  * the dominant Ritz pair has ||A u - lambda u|| <= tol |lambda|; the residual reported is
  * recomputed from the returned eigenvector.  Small operators (n <= DENSE_MAX, where ARPACK's
- * nev < n - 1 constraint bites) are formed densely from n products and solved by dgeev. */
+ * nev < n - 1 constraint bites) are formed densely from n products and solved by dgeev.
+ *
+ * The radius of a nonnegative operator diag(left) |A| diag(right) (ulam_spectral_power, which
+ * the guards use) comes instead from shifted power iteration with Collatz-Wielandt bounds: for
+ * any positive x, min_i (Ax)_i / x_i <= rho <= max_i (Ax)_i / x_i, so each iterate certifies a
+ * bracket. */
 #include "internal.h"
 
 #include <arpack.h>
@@ -204,4 +209,130 @@ int ulam_spectral_radius(const ulam_csr *A, int use_abs, const ulam_spectral_opt
     if (A->nrows != A->ncols) return ULAM_ENOTSQUARE;
     csr_op_ctx ctx = {A, use_abs};
     return ulam_spectral_radius_op(A->nrows, csr_op, &ctx, use_abs, opts, out);
+}
+
+/* ---- power iteration on nonnegative operators, with Collatz-Wielandt bounds (the guards' radii) */
+
+/* Iterations spent, once a radius is certified below 1, on settling whether it is below 0.99
+ * (the warning's margin). */
+enum { MARGIN_TRIES = 20, SUPPORT_EVERY = 10 };
+#define SUPPORT_CUT 1e-10 /* the support of an iterate for support_lower */
+
+/* The default power-iteration options. */
+ulam_power_opts ulam_power_defaults(void)
+{
+    return (ulam_power_opts){.tol = 1e-4, .max_iter = 1000};
+}
+
+/* y = diag(left) |A| xr (threaded only where the product is big enough to pay for it). */
+static void apply(const ulam_csr *A, const double *left, const double *xr, double *y)
+{
+#pragma omp parallel for schedule(static) if (ulam_csr_nnz(A) > 200000)
+    for (int64_t i = 0; i < A->nrows; i++) {
+        double s = 0.0;
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += fabs(A->val[q]) * xr[A->colidx[q]];
+        y[i] = left ? left[i] * s : s;
+    }
+}
+
+/* One power step's bookkeeping: the bounds and estimate from x and y = A x, then x <- the
+ * shifted, normalised iterate y + rho x (the shift damps eigenvalues on the circle |z| = rho
+ * other than rho itself, such as the -rho of bipartite matrices). */
+static double step(int64_t n, double *x, const double *y, double *lo, double *hi)
+{
+    double sx = 0.0, sy = 0.0, mx = 0.0;
+    *lo = INFINITY, *hi = 0.0;
+    for (int64_t i = 0; i < n; i++) {
+        double r = y[i] / x[i];
+        *lo = fmin(*lo, r), *hi = fmax(*hi, r);
+        sx += x[i], sy += y[i];
+    }
+    double est = sy / sx;
+    for (int64_t i = 0; i < n; i++) mx = fmax(mx, x[i] = y[i] + est * x[i]);
+    for (int64_t i = 0; i < n; i++) x[i] = mx > 0 ? fmax(x[i] / mx, 1e-200) : 1.0;
+    return est;
+}
+
+/* Nonzero when [lower, upper] decides a verdict and its warning (internal.h). */
+int ulam__power_certain(double lower, double upper)
+{
+    return upper < 0.99 || lower >= 1.0 || (lower >= 0.99 && upper < 1.0);
+}
+
+/* A lower bound on the radius from the iterate x restricted to its support (entries below
+ * SUPPORT_CUT of the largest set to 0): for nonnegative A, x >= 0, x != 0 and A x >= lambda x
+ * give rho(A) >= lambda (Collatz-Wielandt), and outside the support A x >= 0 = lambda x holds
+ * anyway, so states that cannot reach the dominant class (a dangling row, say, whose ratio is 0)
+ * no longer pin the bound at 0.  xt and yt are scratch of n. */
+static double support_lower(const ulam_csr *A, const double *left, const double *right, const double *x, double *xt,
+                            double *yt)
+{
+    int64_t n = A->nrows;
+    double mx = 0.0, lam = INFINITY;
+    for (int64_t i = 0; i < n; i++) mx = fmax(mx, x[i]);
+    for (int64_t i = 0; i < n; i++) xt[i] = x[i] >= SUPPORT_CUT * mx ? x[i] * (right ? right[i] : 1.0) : 0.0;
+    apply(A, left, xt, yt);
+    for (int64_t i = 0; i < n; i++)
+        if (xt[i] > 0) lam = fmin(lam, yt[i] / (xt[i] / (right ? right[i] : 1.0)));
+    return isfinite(lam) ? lam : 0.0;
+}
+
+/* Power iteration from bounds already known (internal.h). */
+int ulam__power_from(const ulam_csr *A, const double *left, const double *right, const ulam_power_opts *o,
+                     ulam_power *out, ulam_error *err)
+{
+    int64_t n = A->nrows;
+    double t0 = ulam_now();
+    double *x = ulam__malloc((size_t)n, sizeof *x), *y = ulam__malloc((size_t)n, sizeof *y);
+    double *xr = right ? ulam__malloc((size_t)n, sizeof *xr) : x;
+    double *xt = ulam__malloc((size_t)n, sizeof *xt), *yt = ulam__malloc((size_t)n, sizeof *yt);
+    if (!x || !y || !xr || !xt || !yt) {
+        free(x), free(y), free(xt), free(yt);
+        if (right) free(xr);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for five vectors of %lld", (long long)n);
+    }
+    for (int64_t i = 0; i < n; i++) x[i] = 1.0;
+    int stable = 0;
+    double prev = -1.0, change = INFINITY;
+    /* an estimate that has converged while the bounds still straddle a threshold goes on (the
+     * bounds close in later); certifying, once the radius is certified below 1, at most
+     * MARGIN_TRIES more iterations try to settle the warning's 0.99 */
+    int extra = 0;
+    while (out->iterations < o->max_iter && n > 0 &&
+           !(ulam__power_certain(out->lower, out->upper) && (o->certify || out->converged)) &&
+           !(o->certify && out->upper < 1.0 && extra++ >= MARGIN_TRIES)) {
+        if (right)
+            for (int64_t i = 0; i < n; i++) xr[i] = right[i] * x[i];
+        apply(A, left, xr, y);
+        double lo, hi;
+        out->rho = step(n, x, y, &lo, &hi);
+        out->iterations++;
+        out->lower = fmax(out->lower, lo), out->upper = fmin(out->upper, hi);
+        /* the changes shrink geometrically at about `ratio`: the ones still to come add up to ahead */
+        double c = fabs(out->rho - prev), ratio = c / change;
+        double ahead = prev >= 0 && isfinite(change) && ratio < 1 ? c * ratio / (1 - ratio) : INFINITY;
+        stable = ahead <= o->tol * out->rho ? stable + 1 : 0;
+        prev = out->rho, change = c;
+        out->converged = out->upper - out->lower <= o->tol * out->upper || stable >= 5 || out->upper <= o->tol;
+        if ((out->converged || out->iterations % SUPPORT_EVERY == 0) && out->lower < out->upper)
+            out->lower = fmin(fmax(out->lower, support_lower(A, left, right, x, xt, yt)), out->upper);
+    }
+    if (n == 0) out->lower = out->upper = 0.0, out->converged = 1;
+    out->rho = fmin(fmax(out->rho, out->lower), out->upper);
+    out->seconds += ulam_now() - t0;
+    free(x), free(y), free(xt), free(yt);
+    if (right) free(xr);
+    return ULAM_OK;
+}
+
+/* rho(diag(left) |A| diag(right)) by shifted power iteration with Collatz-Wielandt bounds. */
+int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
+                        const ulam_power_opts *opts, ulam_power *out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!A || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
+    if (A->nrows != A->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix");
+    ulam_power_opts o = opts ? *opts : ulam_power_defaults();
+    *out = (ulam_power){.lower = 0.0, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
+    return ulam__power_from(A, left, right, &o, out, err);
 }

@@ -192,22 +192,23 @@ int cli_bidir(int argc, char **argv)
         {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
         {"source", required_argument, 0, 'u'},    {"method", required_argument, 0, 'M'},
         {"rmax", required_argument, 0, 'x'},      {"min-value", required_argument, 0, 'v'},
-        {"estimator", required_argument, 0, 'e'}, {"walks", required_argument, 0, 'n'},
-        {"rel-err", required_argument, 0, 'r'},   {"time", required_argument, 0, 't'},
-        {"seed", required_argument, 0, 's'},      {"threads", required_argument, 0, 'T'},
-        {"continue", required_argument, 0, 'q'},  {"max-steps", required_argument, 0, 'K'},
+        CLI_WALK_OPTION("estimator"),             CLI_WALK_OPTION("walks"),
+        CLI_WALK_OPTION("rel-err"),               CLI_WALK_OPTION("time"),
+        CLI_WALK_OPTION("seed"),                  CLI_WALK_OPTION("threads"),
+        CLI_WALK_OPTION("continue"),              CLI_WALK_OPTION("max-steps"),
         {"check", no_argument, 0, 'c'},           {"json", no_argument, 0, 'J'},
         {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
         {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
-        cli_system s = {.command = "solve", .omega = 1.0};
+    cli_system s = {.command = "solve", .omega = 1.0};
     ulam_bidir_opts o = ulam_bidir_defaults();
     report rp = {0};
-    int64_t v, source = 0;
-    int c, rc, any_rule = 0, force = 0;
+    int64_t source = 0;
+    int c, rc, idx, force = 0;
     o.walk.max_walks = 0;
     optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
+        case CLI_WALK: if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &o.walk))) return rc; break;
         case 'b': s.rhs_path = optarg; break;
         case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
         case 'u': if ((rc = cli_parse_int("solve", "--source", optarg, 1, ULAM_MAX_DIM, &source))) return rc; break;
@@ -217,17 +218,6 @@ int cli_bidir(int argc, char **argv)
             break;
         case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &o.rmax))) return rc; break;
         case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &o.min_value))) return rc; break;
-        case 'e':
-            if ((o.walk.estimator = cli_lookup(optarg, cli_estimator_names, 3)) < 0)
-                return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
-            break;
-        case 'n': if ((rc = cli_parse_int("solve", "--walks", optarg, 1, INT64_MAX / 2, &o.walk.max_walks))) return rc; any_rule = 1; break;
-        case 'r': if ((rc = cli_parse_real("solve", "--rel-err", optarg, 1e-12, 1.0, &o.walk.rel_err))) return rc; any_rule = 1; break;
-        case 't': if ((rc = cli_parse_real("solve", "--time", optarg, 1e-6, 1e9, &o.walk.max_seconds))) return rc; any_rule = 1; break;
-        case 's': if ((rc = cli_parse_int("solve", "--seed", optarg, 0, INT64_MAX, &v))) return rc; o.walk.seed = (uint64_t)v; break;
-        case 'T': if ((rc = cli_parse_int("solve", "--threads", optarg, 1, 1024, &v))) return rc; o.walk.threads = (int)v; break;
-        case 'q': if ((rc = cli_parse_real("solve", "--continue", optarg, 1e-9, 1 - 1e-12, &o.walk.continue_q))) return rc; break;
-        case 'K': if ((rc = cli_parse_int("solve", "--max-steps", optarg, 1, INT64_MAX / 2, &o.walk.max_steps))) return rc; break;
         case 'c': rp.check = 1; break;
         case 'J': rp.json = 1; break;
         case 'F': force = 1; break;
@@ -240,7 +230,7 @@ int cli_bidir(int argc, char **argv)
     if (s.rhs_path) return cli_usage_error("solve", "--source S sets b = e_S: it cannot go with --rhs");
     if (!source) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
     if (!s.index) return cli_usage_error("solve", "--source S needs --index I");
-    if (!any_rule) o.walk.max_walks = 100000;
+    cli_walk_budget(&o.walk);
     o.walk.force = force;
     s.matrix_path = argv[optind];
     if (!(rc = prepare(&s, source, force, o.walk.continue_q, &rp))) {

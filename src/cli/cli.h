@@ -32,6 +32,19 @@ int cli_parse_real(const char *command, const char *opt, const char *s, double l
 /* Parse a byte count with an optional K, M, G or T suffix (powers of 1024). */
 int cli_parse_bytes(const char *command, const char *opt, const char *s, size_t *out);
 
+/* A walk option shared by the walking commands (src/cli/walkopts.c): in a command's longopts as
+ * CLI_WALK_OPTION("walks"), getopt_long returns CLI_WALK for it and the command hands it on with
+ * cli_walk_option(command, longopts[idx].name, optarg, &o).  Short letters differ per command. */
+enum { CLI_WALK = 0x100 };
+#define CLI_WALK_OPTION(name) {name, required_argument, 0, CLI_WALK}
+
+/* Parse walk option --name (walks, rel-err, time, seed, threads, continue, roulette, split,
+ * max-steps, estimator, mode) into o: 0 handled, 1 not a walk option, else an exit code (reported). */
+int cli_walk_option(const char *command, const char *name, const char *value, ulam_walk_opts *o);
+
+/* After parsing: 100000 walks when no stopping rule (--walks, --rel-err, --time) was given. */
+void cli_walk_budget(ulam_walk_opts *o);
+
 /* What a subcommand needs to know about the system it solves. */
 typedef struct cli_system {
     const char *command;  /* subcommand name, for messages */

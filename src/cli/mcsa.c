@@ -271,9 +271,9 @@ int cli_solve_method(int argc, char **argv)
         {"rhs", required_argument, 0, 'b'},     {"method", required_argument, 0, 'M'},
         {"tol", required_argument, 0, 'l'},     {"max-iter", required_argument, 0, 'k'},
         {"eps1", required_argument, 0, 'p'},    {"max-histories", required_argument, 0, 'H'},
-        {"stall", required_argument, 0, 'a'},   {"estimator", required_argument, 0, 'e'},
-        {"seed", required_argument, 0, 's'},    {"threads", required_argument, 0, 'T'},
-        {"continue", required_argument, 0, 'q'}, {"max-steps", required_argument, 0, 'K'},
+        {"stall", required_argument, 0, 'a'},   CLI_WALK_OPTION("estimator"),
+        CLI_WALK_OPTION("seed"),                CLI_WALK_OPTION("threads"),
+        CLI_WALK_OPTION("continue"),            CLI_WALK_OPTION("max-steps"),
         {"jacobi", no_argument, 0, 'j'},        {"omega", required_argument, 0, 'w'},
         {"json", no_argument, 0, 'J'},          {"out", required_argument, 0, 'o'},
         {"index", required_argument, 0, 'i'},   {"check", no_argument, 0, 'c'},
@@ -285,10 +285,11 @@ int cli_solve_method(int argc, char **argv)
     report p = {.o = &o, .s = &s, .method = ULAM_MCSA, .restart = 30};
     const char *out = NULL;
     int64_t v;
-    int c, rc, force = 0;
+    int c, rc, idx, force = 0;
     optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
+        case CLI_WALK: if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &o.walk))) return rc; break;
         case 'b': s.rhs_path = optarg; break;
         case 'M':
             if ((p.method = cli_lookup(optarg, method_names, 6)) < 0)
@@ -322,14 +323,6 @@ int cli_solve_method(int argc, char **argv)
         }
         case 'H': if ((rc = cli_parse_int("solve", "--max-histories", optarg, 1, INT64_MAX / 2, &o.max_histories))) return rc; break;
         case 'a': if ((rc = cli_parse_int("solve", "--stall", optarg, 1, 1000000, &v))) return rc; o.stall = (int)v; break;
-        case 'e':
-            if ((o.walk.estimator = cli_lookup(optarg, cli_estimator_names, 3)) < 0)
-                return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
-            break;
-        case 's': if ((rc = cli_parse_int("solve", "--seed", optarg, 0, INT64_MAX, &v))) return rc; o.walk.seed = (uint64_t)v; break;
-        case 'T': if ((rc = cli_parse_int("solve", "--threads", optarg, 1, 1024, &v))) return rc; o.walk.threads = (int)v; break;
-        case 'q': if ((rc = cli_parse_real("solve", "--continue", optarg, 1e-9, 1 - 1e-12, &o.walk.continue_q))) return rc; break;
-        case 'K': if ((rc = cli_parse_int("solve", "--max-steps", optarg, 1, INT64_MAX / 2, &o.walk.max_steps))) return rc; break;
         case 'j': s.jacobi = 1; break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'J': p.json = 1; break;

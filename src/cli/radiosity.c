@@ -131,10 +131,10 @@ static int parse(int argc, char **argv, args *a)
 {
     static const struct option longopts[] = {
         {"patch", required_argument, 0, 'p'},     {"mode", required_argument, 0, 'm'},
-        {"estimator", required_argument, 0, 'e'}, {"walks", required_argument, 0, 'n'},
-        {"rel-err", required_argument, 0, 'r'},   {"time", required_argument, 0, 't'},
-        {"seed", required_argument, 0, 's'},      {"threads", required_argument, 0, 'T'},
-        {"max-steps", required_argument, 0, 'K'}, {"subdivide", required_argument, 0, 'L'},
+        {"estimator", required_argument, 0, 'e'}, CLI_WALK_OPTION("walks"),
+        CLI_WALK_OPTION("rel-err"),               CLI_WALK_OPTION("time"),
+        CLI_WALK_OPTION("seed"),                  CLI_WALK_OPTION("threads"),
+        CLI_WALK_OPTION("max-steps"),             {"subdivide", required_argument, 0, 'L'},
         {"ff-rays", required_argument, 0, 'f'},   {"direct", no_argument, 0, 'd'},
         {"check", no_argument, 0, 'c'},           {"matrix-walk", no_argument, 0, 'M'},
         {"max-mem", required_argument, 0, 'x'},   {"image", required_argument, 0, 'i'},
@@ -146,11 +146,11 @@ static int parse(int argc, char **argv, args *a)
         {"coverage", required_argument, 0, 'G'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
-    int64_t v;
-    int c, rc, any_rule = 0;
+    int c, rc, idx;
     optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
+        case CLI_WALK: if ((rc = cli_walk_option(cmd, longopts[idx].name, optarg, &a->o))) return rc; break;
         case 'p': a->patch = optarg; break;
         case 'm':
             if ((a->o.mode = cli_lookup(optarg, mode_names, 2)) < 0)
@@ -164,12 +164,6 @@ static int parse(int argc, char **argv, args *a)
             if ((a->mis = cli_lookup(optarg, mis_names, 3)) < 0)
                 return cli_usage_error(cmd, "--mis expects power, balance or none, got '%s'", optarg);
             break;
-        case 'n': if ((rc = cli_parse_int(cmd, "--walks", optarg, 1, INT64_MAX / 2, &a->o.max_walks))) return rc; any_rule = 1; break;
-        case 'r': if ((rc = cli_parse_real(cmd, "--rel-err", optarg, 1e-12, 1.0, &a->o.rel_err))) return rc; any_rule = 1; break;
-        case 't': if ((rc = cli_parse_real(cmd, "--time", optarg, 1e-6, 1e9, &a->o.max_seconds))) return rc; any_rule = 1; break;
-        case 's': if ((rc = cli_parse_int(cmd, "--seed", optarg, 0, INT64_MAX, &v))) return rc; a->o.seed = (uint64_t)v; break;
-        case 'T': if ((rc = cli_parse_int(cmd, "--threads", optarg, 1, 1024, &v))) return rc; a->o.threads = (int)v; break;
-        case 'K': if ((rc = cli_parse_int(cmd, "--max-steps", optarg, 1, INT64_MAX / 2, &a->o.max_steps))) return rc; break;
         case 'L': if ((rc = cli_parse_real(cmd, "--subdivide", optarg, 1e-9, 1e300, &a->subdivide))) return rc; break;
         case 'f': if ((rc = cli_parse_int(cmd, "--ff-rays", optarg, 1, INT32_MAX, &a->ff_rays))) return rc; break;
         case 'd': a->direct = 1; break;
@@ -217,7 +211,7 @@ static int parse(int argc, char **argv, args *a)
     if (a->image && a->o.mode == ULAM_ADJOINT && !a->direct && !a->view)
         return cli_usage_error(cmd, "--image needs --mode shoot, --direct or --view-gather (gathering answers one "
                                     "patch)");
-    if (!any_rule) a->o.max_walks = 100000;
+    cli_walk_budget(&a->o);
     return 0;
 }
 

@@ -77,7 +77,6 @@ static const char *const usage2 = /* the help in two strings: C99 promises 4095 
 typedef struct {
     int check, json;
     double direct, direct_seconds;
-    uint64_t seed;
     ulam_guard g;
     int assume_finite;
     int64_t n;
@@ -121,7 +120,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     printf("variance        %.6g per walk (relative error %.3g)\n", r->variance, rel);
     printf("seconds         %.4f (%.3g M steps/s, %d threads, seed %llu)\n", r->seconds,
            r->seconds > 0 ? (double)r->steps / r->seconds / 1e6 : 0.0, r->threads,
-           (unsigned long long)ro->seed);
+           (unsigned long long)o->seed);
     printf("figure of merit %.4g (1 / (relative variance x seconds))\n",
            r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : INFINITY);
     printf("guards          rho(|M|) in [%.6g, %.6g] (%s), rho(M^) in [%.6g, %.6g] (%s)\n", ro->g.abs.lower,
@@ -201,7 +200,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     cli_json_number("figure_of_merit", r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : NAN, 0);
     cli_json_string("mode", cli_mode_names[o->mode], 0);
     cli_json_string("estimator", cli_estimator_names[o->estimator], 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)ro->seed, r->threads,
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->seed, r->threads,
            cli_share ? cli_share->nranks : 1);
     cli_json_number("load_seconds", ro->load_seconds, 0);
     cli_json_number("guard_seconds", ro->guard_seconds, 0);
@@ -297,139 +296,146 @@ static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const 
                 o->max_walks > 0 ? "more than --walks" : "out of reach in practice");
 }
 
-/* ulam solve. */
-int cli_solve(int argc, char **argv)
+/* Everything ulam solve was asked: parse fills it from argv, run does it. */
+typedef struct {
+    cli_system s;         /* the files (rhs_path, index, jacobi, omega, cache, matrix_path) */
+    ulam_walk_opts o;     /* how to walk and when to stop */
+    const char *out, *errors; /* --out, --errors (NULL: none) */
+    int check, json, force, assume_finite;
+    int autom;            /* --method auto */
+    int argc;             /* argv, for what --method auto leaves pinned */
+    char **argv;
+} solve_args;
+
+/* Parse argv into a; 0, or an exit code (-1: --help printed). */
+static int parse(int argc, char **argv, solve_args *a)
 {
     static const struct option longopts[] = {
-        {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
-        {"mode", required_argument, 0, 'm'},      {"estimator", required_argument, 0, 'e'},
-        {"walks", required_argument, 0, 'n'},     {"rel-err", required_argument, 0, 'r'},
-        {"time", required_argument, 0, 't'},      {"seed", required_argument, 0, 's'},
-        {"threads", required_argument, 0, 'T'},   {"continue", required_argument, 0, 'q'},
-        {"roulette", required_argument, 0, 'R'},  {"split", required_argument, 0, 'S'},
-        {"max-steps", required_argument, 0, 'K'}, {"jacobi", no_argument, 0, 'j'},
-        {"omega", required_argument, 0, 'w'},     {"check", no_argument, 0, 'c'},
-        {"json", no_argument, 0, 'J'},            {"out", required_argument, 0, 'o'},
-        {"errors", required_argument, 0, 'E'},    {"help", no_argument, 0, 'h'},
-        {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
-        {"whole-kernel", no_argument, 0, 'W'},    {"assume-finite-variance", no_argument, 0, 'A'},
-        {"method", required_argument, 0, 'U'},  {0, 0, 0, 0}};
-    if (cli_bidir_claims(argc, argv)) return cli_bidir(argc, argv); /* --source S: src/cli/bidir.c */
-    if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv); /* src/cli/mcsa.c */
-    cli_system s = {.command = "solve", .omega = 1.0};
-    ulam_walk_opts o = ulam_walk_defaults();
-    report_opts ro = {.seed = 1};
-    const char *out = NULL, *errors = NULL;
-    int64_t v;
-    int c, rc, any_rule = 0, force = 0, autom = 0;
-    ulam_auto_result au;
-    o.max_walks = 0;
+        {"rhs", required_argument, 0, 'b'},      {"index", required_argument, 0, 'i'},
+        CLI_WALK_OPTION("mode"),                 CLI_WALK_OPTION("estimator"),
+        CLI_WALK_OPTION("walks"),                CLI_WALK_OPTION("rel-err"),
+        CLI_WALK_OPTION("time"),                 CLI_WALK_OPTION("seed"),
+        CLI_WALK_OPTION("threads"),              CLI_WALK_OPTION("continue"),
+        CLI_WALK_OPTION("roulette"),             CLI_WALK_OPTION("split"),
+        CLI_WALK_OPTION("max-steps"),            {"jacobi", no_argument, 0, 'j'},
+        {"omega", required_argument, 0, 'w'},    {"check", no_argument, 0, 'c'},
+        {"json", no_argument, 0, 'J'},           {"out", required_argument, 0, 'o'},
+        {"errors", required_argument, 0, 'E'},   {"help", no_argument, 0, 'h'},
+        {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
+        {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
+        {"method", required_argument, 0, 'U'},   {0, 0, 0, 0}};
+    *a = (solve_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_walk_defaults(), .argc = argc, .argv = argv};
+    a->o.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
+    int c, rc, idx;
     optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
-        case 'b': s.rhs_path = optarg; break;
-        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
-        case 'm':
-            if ((o.mode = cli_lookup(optarg, cli_mode_names, 2)) < 0)
-                return cli_usage_error("solve", "--mode expects adjoint or forward, got '%s'", optarg);
-            break;
-        case 'e':
-            if ((o.estimator = cli_lookup(optarg, cli_estimator_names, 3)) < 0)
-                return cli_usage_error("solve", "--estimator expects collision, absorption or expected, got '%s'", optarg);
-            break;
-        case 'n': if ((rc = cli_parse_int("solve", "--walks", optarg, 1, INT64_MAX / 2, &o.max_walks))) return rc; any_rule = 1; break;
-        case 'r': if ((rc = cli_parse_real("solve", "--rel-err", optarg, 1e-12, 1.0, &o.rel_err))) return rc; any_rule = 1; break;
-        case 't': if ((rc = cli_parse_real("solve", "--time", optarg, 1e-6, 1e9, &o.max_seconds))) return rc; any_rule = 1; break;
-        case 's': if ((rc = cli_parse_int("solve", "--seed", optarg, 0, INT64_MAX, &v))) return rc; o.seed = ro.seed = (uint64_t)v; break;
-        case 'T': if ((rc = cli_parse_int("solve", "--threads", optarg, 1, 1024, &v))) return rc; o.threads = (int)v; break;
-        case 'q': if ((rc = cli_parse_real("solve", "--continue", optarg, 1e-9, 1 - 1e-12, &o.continue_q))) return rc; break;
-        case 'R': if ((rc = cli_parse_real("solve", "--roulette", optarg, 1e-300, 1e300, &o.roulette))) return rc; break;
-        case 'S': if ((rc = cli_parse_real("solve", "--split", optarg, 1e-300, 1e300, &o.split))) return rc; break;
-        case 'K': if ((rc = cli_parse_int("solve", "--max-steps", optarg, 1, INT64_MAX / 2, &o.max_steps))) return rc; break;
-        case 'j': s.jacobi = 1; break;
-        case 'C': s.cache = 1; break;
-        case 'W': o.whole_kernel = 1; break;
+        case CLI_WALK: if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &a->o))) return rc; break;
+        case 'b': a->s.rhs_path = optarg; break;
+        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
+        case 'j': a->s.jacobi = 1; break;
+        case 'C': a->s.cache = 1; break;
+        case 'W': a->o.whole_kernel = 1; break;
         case 'U':
             if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
             if (strcmp(optarg, "auto")) return cli_usage_error("solve", "--method expects auto, bidirectional (with --source), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
-            autom = 1;
+            a->autom = 1;
             break;
-        case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
-        case 'c': ro.check = 1; break;
-        case 'J': ro.json = 1; break;
-        case 'F': force = 1; break;
-        case 'A': ro.assume_finite = 1; break;
-        case 'o': out = optarg; break;
-        case 'E': errors = optarg; break;
-        case 'h': fputs(usage, stdout), fputs(usage2, stdout); return 0;
+        case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
+        case 'c': a->check = 1; break;
+        case 'J': a->json = 1; break;
+        case 'F': a->force = 1; break;
+        case 'A': a->assume_finite = 1; break;
+        case 'o': a->out = optarg; break;
+        case 'E': a->errors = optarg; break;
+        case 'h': fputs(usage, stdout), fputs(usage2, stdout); return -1;
         default: return cli_usage_error("solve", "unknown option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (!s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("solve", "needs --rhs b.mtx");
-    if (!s.index && o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
-    if ((out || errors) && o.mode != ULAM_FORWARD)
+    if (!a->s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("solve", "needs --rhs b.mtx");
+    if (!a->s.index && a->o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
+    if ((a->out || a->errors) && a->o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
-    if (o.roulette > 0 && o.split > 0 && o.split <= o.roulette)
+    if (a->o.roulette > 0 && a->o.split > 0 && a->o.split <= a->o.roulette)
         return cli_usage_error("solve", "--split W must exceed --roulette W");
-    if (!any_rule) o.max_walks = 100000;
-    s.matrix_path = argv[optind];
-    s.lazy = o.mode == ULAM_ADJOINT && !ro.check && !cli_share; /* read only the rows walks reach */
-    if ((out && (rc = cli_check_output(out))) || (errors && (rc = cli_check_output(errors)))) return rc;
+    cli_walk_budget(&a->o);
+    a->s.matrix_path = argv[optind];
+    return 0;
+}
+
+/* Load the system, choose (--method auto), guard, and make the solver *sv; print the refusals
+ * and the warnings, then run --check; 0 or an exit code (nothing kept on failure). */
+static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solver **sv)
+{
+    cli_system *s = &a->s;
+    ulam_walk_opts *o = &a->o;
+    int rc;
+    s->lazy = o->mode == ULAM_ADJOINT && !a->check && !cli_share; /* read only the rows walks reach */
+    if ((a->out && (rc = cli_check_output(a->out))) || (a->errors && (rc = cli_check_output(a->errors)))) return rc;
     double t0 = ulam_now();
-    if ((rc = cli_load_system(&s))) return rc;
-    if (!s.b) {
-        cli_system_free(&s);
-        return cli_usage_error("solve", "needs --rhs b.mtx (%s holds no b)", s.matrix_path);
+    if ((rc = cli_load_system(s))) return rc;
+    if (!s->b) {
+        cli_system_free(s);
+        return cli_usage_error("solve", "needs --rhs b.mtx (%s holds no b)", s->matrix_path);
     }
-    ro.load_seconds = ulam_now() - t0;
-    o.index = s.index ? s.index - 1 : 0;
-    o.share = cli_share;
-    if (autom && (rc = cli_auto_choose(&s, argc, argv, &o, &au))) {
-        cli_system_free(&s);
+    ro->load_seconds = ulam_now() - t0;
+    o->index = s->index ? s->index - 1 : 0;
+    o->share = cli_share;
+    if (a->autom && (rc = cli_auto_choose(s, a->argc, a->argv, o, au))) {
+        cli_system_free(s);
         return rc;
     }
-    ro.au = autom ? &au : NULL;
-    if ((rc = cli_guard(&s, o.continue_q, o.mode, &ro.g))) {
-        cli_system_free(&s);
+    ro->au = a->autom ? au : NULL;
+    if ((rc = cli_guard(s, o->continue_q, o->mode, &ro->g))) {
+        cli_system_free(s);
         return rc;
     }
-    ro.guard_seconds = ro.g.abs.seconds + ro.g.hat[0].seconds + ro.g.hat[1].seconds;
-    ro.n = s.M->nrows;
-    ulam_solver *sv = NULL;
+    ro->guard_seconds = ro->g.abs.seconds + ro->g.hat[0].seconds + ro->g.hat[1].seconds;
+    ro->n = s->M->nrows;
     ulam_error err;
-    o.interrupt = &cli_interrupted, o.share = cli_share, o.guard = &ro.g, o.force = force;
-    o.assume_finite = ro.assume_finite;
+    o->interrupt = &cli_interrupted, o->share = cli_share, o->guard = &ro->g, o->force = a->force;
+    o->assume_finite = ro->assume_finite;
     t0 = ulam_now();
-    int status = ulam_solver_alloc(s.M, s.b, &o, &sv, &err); /* refuses what the guards refuse */
-    if (status == ULAM_EINVAL && o.split > 0 && strstr(err.msg, "split weight")) {
-        cli_system_free(&s);
-        return cli_usage_error("solve", "--split W: %s", err.msg);
-    }
-    ro.kernel_seconds = ulam_now() - t0;
-    int64_t n = s.M->nrows;
-    if (status == ULAM_EDIVERGE) {
-        cli_guard_diverge(&s, &ro.g, 0);
-        cli_system_free(&s);
-        return EXIT_DIVERGE;
-    }
-    if (status == ULAM_EINFVAR) {
+    int status = ulam_solver_alloc(s->M, s->b, o, sv, &err); /* refuses what the guards refuse */
+    ro->kernel_seconds = ulam_now() - t0;
+    if (status == ULAM_EINVAL && o->split > 0 && strstr(err.msg, "split weight")) {
+        rc = cli_usage_error("solve", "--split W: %s", err.msg);
+    } else if (status == ULAM_EDIVERGE) {
+        cli_guard_diverge(s, &ro->g, 0);
+        rc = EXIT_DIVERGE;
+    } else if (status == ULAM_EINFVAR) {
         fprintf(stderr, "ulam: %s: error: --rel-err %g can never be met: it needs %s. Bound the run with --walks N "
-                        "or --time S (no confidence interval is then printed)\n", s.matrix_path, o.rel_err, err.msg);
-        cli_system_free(&s);
-        return EXIT_INFVAR;
+                        "or --time S (no confidence interval is then printed)\n", s->matrix_path, o->rel_err, err.msg);
+        rc = EXIT_INFVAR;
+    } else if (status) {
+        rc = cli_report(s->matrix_path, &err);
     }
     if (status) {
-        cli_system_free(&s);
-        return cli_report(s.matrix_path, &err);
-    }
-    if (ro.g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(&s, &ro.g, 1);
-    cli_guard_warn(&s, &ro.g, o.mode, ro.assume_finite);
-    if (ro.check && (rc = direct_check(&s, o.index, &ro))) {
-        ulam_solver_free(sv);
-        cli_system_free(&s);
+        cli_system_free(s);
         return rc;
     }
+    if (ro->g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(s, &ro->g, 1);
+    cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
+    if (ro->check && (rc = direct_check(s, o->index, ro))) {
+        *sv = ulam_solver_free(*sv);
+        cli_system_free(s);
+        return rc;
+    }
+    return 0;
+}
+
+/* Walk until a stopping rule holds (a progress line on a terminal), then write and print the
+ * results; 0 or an exit code. */
+static int run(solve_args *a)
+{
+    const cli_system *s = &a->s;
+    const ulam_walk_opts *o = &a->o;
+    report_opts ro = {.check = a->check, .json = a->json, .assume_finite = a->assume_finite};
+    ulam_auto_result au;
+    ulam_solver *sv = NULL;
+    int rc = start(a, &ro, &au, &sv), status = ULAM_OK;
+    if (rc) return rc;
     cli_catch_sigint();
     ulam_walk_result r;
     cli_progress pg;
@@ -437,41 +443,50 @@ int cli_solve(int argc, char **argv)
     for (int first = 1; !status && !ulam_solver_done(sv); first = 0) {
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, &r);
-        if (first && !status) rel_err_warning(&s, &o, &r);
-        cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o.rel_err);
+        if (first && !status) rel_err_warning(s, o, &r);
+        cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o->rel_err);
     }
     cli_progress_end(&pg);
     ulam_solver_result(sv, &r);
     if (r.cut_stop)
         fprintf(stderr, "ulam: %s: warning: --rel-err %g is unreachable: %lld walks were cut at --max-steps %lld and "
                         "the cut's bias may be up to %.3g, more than a tenth of the target error; stopped after %lld "
-                        "walks (raise --max-steps)\n", s.matrix_path, o.rel_err, (long long)r.cut,
-                (long long)o.max_steps, r.cut_bound, (long long)r.walks);
-    rc = 0;
+                        "walks (raise --max-steps)\n", s->matrix_path, o->rel_err, (long long)r.cut,
+                (long long)o->max_steps, r.cut_bound, (long long)r.walks);
     if (status == ULAM_ENOMEM) {
-        fprintf(stderr, "ulam: %s: error: %s: expected memory to build the walk kernel's rows\n", s.matrix_path,
+        fprintf(stderr, "ulam: %s: error: %s: expected memory to build the walk kernel's rows\n", s->matrix_path,
                 ulam_strerror(status));
         rc = cli_exit_code(status);
     } else if (status && status != ULAM_ENONFINITE) {
         fprintf(stderr, "ulam: %s: error: %s: expected rows the walks reach to be consistent (row data of "
-                        "the mapped file is corrupt: prepare it again)\n", s.matrix_path, ulam_strerror(status));
+                        "the mapped file is corrupt: prepare it again)\n", s->matrix_path, ulam_strerror(status));
         rc = cli_exit_code(status);
     } else if (status) {
         fprintf(stderr, "ulam: %s: error: %s: a walk produced a non-finite weight or score after %lld "
                         "walks; nothing was averaged in from it (is rho(|M|) < 1? see 'ulam info')\n",
-                s.matrix_path, ulam_strerror(status), (long long)r.walks);
+                s->matrix_path, ulam_strerror(status), (long long)r.walks);
         rc = cli_exit_code(status);
-    } else if (o.mode == ULAM_FORWARD && (out || errors) && !r.interrupted && cli_rank == 0) {
-        rc = write_vectors(sv, n, out, errors, &r);
+    } else if (o->mode == ULAM_FORWARD && (a->out || a->errors) && !r.interrupted && cli_rank == 0) {
+        rc = write_vectors(sv, ro.n, a->out, a->errors, &r);
     }
     if (!status && !rc) {
-        if (ro.json) print_json(&o, &r, &ro);
-        else print_text(&o, &r, &ro);
+        if (ro.json) print_json(o, &r, &ro);
+        else print_text(o, &r, &ro);
         if (r.interrupted) rc = EXIT_INTERRUPTED;
     }
     fflush(stdout); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
     cli_release_sigint();
     ulam_solver_free(sv);
-    cli_system_free(&s);
+    cli_system_free(&a->s);
     return rc;
+}
+
+/* ulam solve. */
+int cli_solve(int argc, char **argv)
+{
+    if (cli_bidir_claims(argc, argv)) return cli_bidir(argc, argv); /* --source S: src/cli/bidir.c */
+    if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv); /* src/cli/mcsa.c */
+    solve_args a;
+    int rc = parse(argc, argv, &a);
+    return rc < 0 ? 0 : rc ? rc : run(&a);
 }

@@ -74,9 +74,9 @@ struct ulam_rad_solver {
     ulam__moments m[3];
     double *sum, *sumsq; /* shooting: per patch and channel, of history tallies */
     double sq, maxsq;
-    int64_t walks, rays, cut, nonfinite, next_walk;
-    double seconds, t0;
-    int done, interrupted, zero, status, met;
+    ulam__run run; /* walks, time, ending (round.c) */
+    int64_t rays, cut;
+    int zero, met;
 };
 
 /* Free; accepts and returns NULL. */
@@ -201,7 +201,7 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam
     s->t = t;
     s->s = ulam__tracer_scene(t);
     s->threads = ulam__threads(o.threads);
-    s->t0 = -1;
+    ulam__run_reset(&s->run);
     if (o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0) s->o.max_walks = ULAM_REL_ERR_CAP;
     if ((o.mode == ULAM_FORWARD || o.estimator >= ULAM_NEXT_EVENT) && (status = build_source(s, err))) {
         ulam_rad_solver_free(s);
@@ -383,7 +383,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     br->sq = br->maxsq = 0.0;
     br->len = br->walks = br->rays = br->cut = br->nonfinite = 0;
     br->complete = br->nomem = 0;
-    if (!ulam__mine(s->o.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->t0, first)) return;
+    if (!ulam__mine(s->o.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
     ulam_rng r;
     ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / RBLOCK));
     for (int64_t w = 0; w < count; w++) {
@@ -410,9 +410,12 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     br->complete = 1;
 }
 
-/* Merge a completed block into the totals. */
-static void merge_block(ulam_rad_solver *s, const rad_block *br)
+/* Merge completed block k into the totals (ctx: the solver; the walk and non-finite counts are
+ * the round driver's). */
+static void merge_block(void *ctx, int k)
 {
+    ulam_rad_solver *s = ctx;
+    const rad_block *br = &s->blocks[k];
     for (int c = 0; c < 3; c++) ulam__moments_merge(&s->m[c], &br->m[c]);
     s->sq += br->sq;
     s->maxsq = fmax(s->maxsq, br->maxsq);
@@ -428,10 +431,8 @@ static void merge_block(ulam_rad_solver *s, const rad_block *br)
             s->maxsq = fmax(s->maxsq, x * x);
         }
     }
-    s->walks += br->walks;
     s->rays += br->rays;
     s->cut += br->cut;
-    s->nonfinite += br->nonfinite;
 }
 
 /* Gathering: the walks the rel_err rule's range term needs in channel c at estimate m. */
@@ -480,32 +481,18 @@ static int all_zero(const ulam_rad_result *r)
 int ulam_rad_solver_iterate(ulam_rad_solver *s)
 {
     if (!s) return ULAM_EINVAL;
-    if (s->done) return s->status;
-    double start = ulam_now();
-    if (s->t0 < 0) s->t0 = start;
+    if (s->run.done) return s->run.status;
     static const ulam__blocks B = {RBLOCK, RROUND, run_block, sizeof(rad_block), sizeof(rad_tally),
-                                   offsetof(rad_block, t), offsetof(rad_block, len), offsetof(rad_block, cap)};
-    int nb, stop, st = ulam__round(&B, &s->o, s->t0, s->next_walk, s->threads, s, s->blocks, &nb, &stop);
-    if (st) s->status = st;
-    for (int k = 0; k < nb; k++) {
-        if (s->blocks[k].nomem) s->status = ULAM_ENOMEM;
-        if (!s->blocks[k].complete) {
-            s->done = 1;
-            break;
-        }
-        merge_block(s, &s->blocks[k]);
-        s->next_walk += s->blocks[k].walks;
-    }
-    s->seconds += ulam_now() - start;
-    if (stop & 2) s->interrupted = s->done = 1;
-    if (s->nonfinite && !s->status) s->status = ULAM_ENONFINITE;
-    if (s->status) s->done = 1;
+                                   offsetof(rad_block, t), offsetof(rad_block, len), offsetof(rad_block, cap),
+                                   offsetof(rad_block, walks), offsetof(rad_block, nonfinite),
+                                   offsetof(rad_block, complete), offsetof(rad_block, nomem), merge_block,
+                                   NULL, NULL};
+    ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_rad_result r;
     ulam_rad_solver_result(s, &r);
-    if (ulam__budget_spent(&s->o, stop, s->next_walk)) s->done = 1;
-    if (s->o.rel_err > 0 && r.walks >= 1000 && precise_enough(s, &r, s->o.rel_err)) s->done = s->met = 1;
-    if (s->o.rel_err > 0 && r.walks >= 1000 && all_zero(&r)) s->done = s->zero = 1; /* can never be met */
-    return s->status;
+    if (s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, s->o.rel_err)) s->run.done = s->met = 1;
+    if (s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && all_zero(&r)) s->run.done = s->zero = 1; /* can never be met */
+    return s->run.status;
 }
 
 /* Restart a gathering solver at patch p with relative target rel_err and seed: the statistics
@@ -515,22 +502,22 @@ void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uin
     ulam__moments zero = {0};
     s->o.index = p, s->o.rel_err = rel_err, s->o.seed = seed, s->o.max_seconds = max_seconds;
     s->m[0] = s->m[1] = s->m[2] = zero;
-    s->sq = s->maxsq = s->seconds = 0.0;
-    s->walks = s->rays = s->cut = s->nonfinite = s->next_walk = 0;
-    s->t0 = -1;
-    s->done = s->interrupted = s->zero = s->status = s->met = 0;
+    s->sq = s->maxsq = 0.0;
+    s->rays = s->cut = 0;
+    ulam__run_reset(&s->run);
+    s->zero = s->met = 0;
 }
 
 /* Nonzero once a stopping rule is met. */
 int ulam_rad_solver_done(const ulam_rad_solver *s)
 {
-    return !s || s->done;
+    return !s || s->run.done;
 }
 
 /* Shooting estimate and standard error of patch p's radiosity in channel c. */
 static void shot_component(const ulam_rad_solver *s, int64_t p, int c, double *est, double *se)
 {
-    double N = (double)s->walks, A = s->s->area[p], mean, v;
+    double N = (double)s->run.walks, A = s->s->area[p], mean, v;
     ulam__sums_moments(N, s->sum[3 * p + c], s->sumsq[3 * p + c], &mean, &v);
     *est = s->s->emit[3 * p + c] + mean / A; /* the emission exactly, the reflected light by the walks */
     *se = N > 0 ? sqrt(v / N) / A : INFINITY;
@@ -559,12 +546,12 @@ void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
         } else if (s->per_step[c] > 0 && bright > 0) { /* an emitting channel not yet scored (precise_enough) */
             r->min_walks = fmax(r->min_walks, channel_min_walks(s, c, bright, s->o.rel_err));
         }
-    r->walks = s->walks;
+    r->walks = s->run.walks;
     r->rays = s->rays;
     r->cut = s->cut;
-    r->seconds = s->seconds;
+    r->seconds = s->run.seconds;
     r->threads = s->threads;
-    r->interrupted = s->interrupted;
+    r->interrupted = s->run.interrupted;
     r->zero = s->zero;
     r->rel_err_met = s->met;
 }

@@ -1,0 +1,47 @@
+/* The walk options the walking commands share (solve, solve --source, solve --method, radiosity),
+ * parsed in one place by their long name: a command lists the ones it takes in its longopts as
+ * CLI_WALK_OPTION("name") and hands each to cli_walk_option. */
+#include "cli.h"
+
+#include <stdio.h>
+#include <string.h>
+
+/* Parse walk option --name's value into o: 0 handled, 1 not a walk option, else an exit code
+ * (the bad value reported as command's usage error).  Adding a walk option is one line here. */
+int cli_walk_option(const char *command, const char *name, const char *value, ulam_walk_opts *o)
+{
+    const char *cmd = command;
+    int64_t v;
+    int rc;
+    if (!strcmp(name, "walks")) return cli_parse_int(cmd, "--walks", value, 1, INT64_MAX / 2, &o->max_walks);
+    if (!strcmp(name, "rel-err")) return cli_parse_real(cmd, "--rel-err", value, 1e-12, 1.0, &o->rel_err);
+    if (!strcmp(name, "time")) return cli_parse_real(cmd, "--time", value, 1e-6, 1e9, &o->max_seconds);
+    if (!strcmp(name, "continue")) return cli_parse_real(cmd, "--continue", value, 1e-9, 1 - 1e-12, &o->continue_q);
+    if (!strcmp(name, "roulette")) return cli_parse_real(cmd, "--roulette", value, 1e-300, 1e300, &o->roulette);
+    if (!strcmp(name, "split")) return cli_parse_real(cmd, "--split", value, 1e-300, 1e300, &o->split);
+    if (!strcmp(name, "max-steps")) return cli_parse_int(cmd, "--max-steps", value, 1, INT64_MAX / 2, &o->max_steps);
+    if (!strcmp(name, "seed")) {
+        if (!(rc = cli_parse_int(cmd, "--seed", value, 0, INT64_MAX, &v))) o->seed = (uint64_t)v;
+        return rc;
+    }
+    if (!strcmp(name, "threads")) {
+        if (!(rc = cli_parse_int(cmd, "--threads", value, 1, 1024, &v))) o->threads = (int)v;
+        return rc;
+    }
+    if (!strcmp(name, "estimator")) {
+        if ((o->estimator = cli_lookup(value, cli_estimator_names, 3)) >= 0) return 0;
+        return cli_usage_error(cmd, "--estimator expects collision, absorption or expected, got '%s'", value);
+    }
+    if (!strcmp(name, "mode")) {
+        if ((o->mode = cli_lookup(value, cli_mode_names, 2)) >= 0) return 0;
+        return cli_usage_error(cmd, "--mode expects adjoint or forward, got '%s'", value);
+    }
+    return 1;
+}
+
+/* The default budget once the options are parsed: 100000 walks when no stopping rule (--walks,
+ * --rel-err, --time) was given (the command cleared o->max_walks before parsing). */
+void cli_walk_budget(ulam_walk_opts *o)
+{
+    if (!o->max_walks && !(o->rel_err > 0) && !(o->max_seconds > 0)) o->max_walks = 100000;
+}
