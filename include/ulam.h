@@ -847,6 +847,7 @@ typedef struct ulam_auto_result {
                        is certified */
     int closest;    /* the candidate of least rho(M^) among those screened (named when none is certified) */
     ulam_power abs; /* rho(|M|) */
+    ulam_guard guard; /* the guards of the chosen (or closest) candidate's continuation */
     int by_work;    /* 1: compared by predicted work (a rel_err target); 0: by cost */
     int stages;     /* pilot stages run */
     double pilot_work;  /* units the guards and pilots spent */

@@ -88,12 +88,10 @@ static int guard_need(chooser *c, int iq, int need, ulam_error *err)
  * 1, 2, 4 ... 64 blocks of 1024 (totals 1, 3, 7 ... 127 blocks, then 64 more a round). */
 static double rounded_walks(double n)
 {
-    double blocks = 0;
-    for (int r = 1; blocks * 1024 < n; r = r < 64 ? 2 * r : 64) {
-        blocks += r;
-        if (blocks > 1e12) return INFINITY;
-    }
-    return blocks * 1024;
+    double b = ceil(n / 1024), t = 1;
+    if (!(b < 1e15)) return INFINITY;
+    while (t < b && t < 127) t = 2 * t + 1;
+    return 1024 * (t >= b ? t : 127 + 64 * ceil((b - 127) / 64));
 }
 
 /* The work units of one walk of candidate k with the pilots' mean steps (forward: tallies per
@@ -432,6 +430,7 @@ int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *b
     if (!status && res->chosen >= 0) res->cand[res->chosen].state = ULAM_AUTO_CHOSEN;
     res->pilot_work = spent(c);
     res->reused_work = res->chosen >= 0 ? reused(c, res->chosen) : 0.0;
+    if (k >= 0) res->guard = c->guard[c->gi[k] % 2];
     if (!status && out && k >= 0) {
         ulam_walk_opts o = *base;
         o.mode = res->cand[k].mode, o.estimator = res->cand[k].estimator, o.continue_q = res->cand[k].continue_q;

@@ -26,13 +26,15 @@ def main():
     failures = 0
     with tempfile.TemporaryDirectory() as d:
         cases = [
-            ("solve adjoint", ["solve", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx", "--index", "7",
+            ("solve adjoint", ["solve", "--method", "walks", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx", "--index", "7",
                                "--walks", "50000", "--seed", "9", "--json"], None),
-            ("solve adjoint rel-err", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
+            ("solve adjoint rel-err", ["solve", "--method", "walks", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
                                        "--index", "3", "--rel-err", "0.005", "--json"], None),
             ("solve bidirectional", ["solve", "matrices/randsub1000.mtx", "--index", "7", "--source", "3",
                                      "--rel-err", "0.01", "--json"], None),
-            ("solve forward", ["solve", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
+            ("solve auto", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
+                            "--index", "3", "--rel-err", "0.01", "--json"], None),
+            ("solve forward", ["solve", "--method", "walks", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
                                "1", "--mode", "forward", "--walks", "30000", "--json", "--out", "{d}/x.mtx"], "x.mtx"),
             ("solve mcsa", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx", "--method",
                             "mcsa", "--tol", "1e-6", "--json", "--out", "{d}/m.mtx"], "m.mtx"),

@@ -6,37 +6,29 @@
 #include <string.h>
 
 
-/* Nonzero when argv names option opt (as "--opt" or "--opt=..."). */
-static int has_option(int argc, char **argv, const char *opt)
+/* Choose for s (loaded) under o (what ao pins stays), make the solver *sv and set o's mode,
+ * estimator and continuation to the choice; *status gets the solver's refusal (err filled) for the
+ * caller to report as a plain run's.  0, or an exit code (message printed) when the library fails
+ * or when no candidate is certified and o asks for a --rel-err target (the closest is named). */
+int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, ulam_auto_result *res,
+                    ulam_solver **sv, int *status, ulam_error *err)
 {
-    size_t n = strlen(opt);
-    for (int k = 1; k < argc; k++)
-        if (!strncmp(argv[k], opt, n) && (argv[k][n] == '\0' || argv[k][n] == '=')) return 1;
-    return 0;
-}
-
-/* Choose for s (loaded) and set o's mode, estimator and continuation; what the command line names
- * (--mode, --estimator, --continue) is pinned.  0, or an exit code (message printed) when the library
- * fails or when no candidate is certified and o asks for a --rel-err target. */
-int cli_auto_choose(const cli_system *s, int argc, char **argv, ulam_walk_opts *o, ulam_auto_result *res)
-{
-    ulam_auto_opts ao = ulam_auto_defaults();
-    ao.pin_mode = has_option(argc, argv, "--mode");
-    ao.pin_estimator = has_option(argc, argv, "--estimator");
-    ao.pin_continue = has_option(argc, argv, "--continue");
-    ulam_error err;
-    int status = ulam_auto_choose(s->M, s->b, o, &ao, res, &err);
-    if (status) return cli_report(s->matrix_path, &err);
+    *status = ulam_auto_solver(s->M, s->b, o, ao, res, sv, err);
     int k = res->chosen >= 0 ? res->chosen : res->closest;
-    if (k < 0) return cli_usage_error("solve", "--method auto has no candidate left once --mode, --estimator and --continue are pinned");
+    if (k < 0) return cli_report(s->matrix_path, err);
     const ulam_auto_candidate *c = &res->cand[k];
     if (res->chosen < 0) {
-        fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance; the closest is "
+        int diverge = !(res->abs.upper < 1);
+        fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance%s; the closest is "
                         "%s %s (continuation %s%.3g) with rho(M^) = %.6g (upper bound %.6g)%s\n",
-                s->matrix_path, o->rel_err > 0 ? "error" : "warning", cli_mode_names[c->mode], cli_estimator_names[c->estimator],
-                c->continue_q > 0 ? "" : "analog, ", c->continue_q > 0 ? c->continue_q : 0.0, c->hat.rho, c->hat.upper,
+                s->matrix_path, o->rel_err > 0 ? "error" : "warning", diverge ? " (rho(|M|) is not certified below 1)" : "",
+                cli_mode_names[c->mode], cli_estimator_names[c->estimator], c->continue_q > 0 ? "" : "analog, ",
+                c->continue_q > 0 ? c->continue_q : 0.0, c->hat.rho, c->hat.upper,
                 o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it");
-        if (o->rel_err > 0) return EXIT_DIVERGE;
+        if (o->rel_err > 0) {
+            *sv = ulam_solver_free(*sv);
+            return diverge ? EXIT_DIVERGE : EXIT_INFVAR;
+        }
     }
     o->mode = c->mode, o->estimator = c->estimator, o->continue_q = c->continue_q;
     return 0;
