@@ -804,7 +804,10 @@ typedef struct ulam_auto_candidate {
     double estimate, variance, variance_rel_error; /* pooled over its pilots (never used in the answer) */
     double steps_per_walk; /* the pilots' mean steps a walk */
     double work_per_walk;  /* the work model's units a walk (see ulam_auto_choose) */
-    double cost;           /* variance x work_per_walk (INFINITY when not piloted) */
+    double cost;           /* variance x work_per_walk (INFINITY when not piloted); the variance
+                              compared is at least what puts the pilot's mean within 2 standard
+                              errors of the most precise other pilot's (a pilot that missed a
+                              skewed score's rare large values looks cheap otherwise) */
     double predicted_walks; /* walks the run would make (rel_err: the rule's variance, range and
                                variance-error terms at the pilots' values, rounded up to the rounds
                                the rule is checked at; else max_walks; NaN for time alone) */

@@ -135,11 +135,29 @@ static double predict(const chooser *c, int k, double var, double *walks)
     return N * work_per_walk(c, k) + ULAM_AUTO_BUILD * fmax(0.0, reach - u);
 }
 
-/* The key candidates are compared by: predicted work with rel_err, else the cost. */
-static double key(const chooser *c, int k, double scale)
+/* Candidate k's variance for the comparisons: every candidate estimates the same x_i, so a pilot
+ * mean further than 2 of its standard errors from the most precise other pilot's has missed part
+ * of its scores' spread (a skewed score, rare large values, otherwise looks cheapest exactly when
+ * its pilot missed them): its variance is raised to what puts the difference at 2 standard errors. */
+static double variance_of(const chooser *c, int k)
 {
     const ulam_auto_candidate *a = &c->res->cand[k];
-    double var = a->variance * scale, walks;
+    double best = INFINITY, m = NAN;
+    for (int j = 0; j < c->res->ncand; j++) {
+        const ulam_auto_candidate *o = &c->res->cand[j];
+        if (j == k || !o->pilot_walks || !isfinite(o->estimate) || !(o->variance > 0)) continue;
+        double se2 = o->variance / (double)o->pilot_walks;
+        if (se2 < best) best = se2, m = o->estimate;
+    }
+    double d = a->estimate - m, n = (double)a->pilot_walks;
+    return isnan(m) ? a->variance : fmax(a->variance, n * d * d / 4.0);
+}
+
+/* The key candidates are compared by: predicted work with rel_err, else the cost (at the
+ * variance scaled by `scale`). */
+static double key(const chooser *c, int k, double scale)
+{
+    double var = variance_of(c, k) * scale, walks;
     if (c->base.rel_err > 0) return predict(c, k, var, &walks);
     return var * work_per_walk(c, k);
 }
@@ -182,8 +200,8 @@ static void refresh(chooser *c, int k)
     a->variance = ulam__moments_variance(&c->mom[k]);
     a->steps_per_walk = a->pilot_walks ? c->steps[k] / (double)a->pilot_walks : 0.0;
     a->work_per_walk = work_per_walk(c, k);
-    a->cost = a->variance * a->work_per_walk;
-    a->predicted_work = predict(c, k, a->variance, &a->predicted_walks);
+    a->cost = variance_of(c, k) * a->work_per_walk;
+    a->predicted_work = predict(c, k, variance_of(c, k), &a->predicted_walks);
     a->predicted_seconds = a->predicted_work * ULAM_AUTO_UNIT_SECONDS;
 }
 
@@ -423,6 +441,8 @@ int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *b
     c->nq = a.pin_continue ? 1 : 2;
     list(c);
     if (!(status = first_stage(c, err)) && !(status = race(c, err))) {
+        for (int j = 0; j < res->ncand; j++)
+            if (res->cand[j].pilot_walks) refresh(c, j); /* at every pilot's final figures */
         res->chosen = c->leader;
         status = closest(c, err);
     }

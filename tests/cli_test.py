@@ -505,6 +505,14 @@ def check_honest_verdicts(ulam):
         rc, out, err = run(ulam, ["solve", "--method", "walks", f"{d}/tref.mtx", "--rhs", f"{d}/b500.mtx", "--index", "1", "--jacobi",
                                   "--rel-err", "0.01"])
         assert rc == 4 and "the forward mode's is finite, 0.9" in err, (rc, err)
+        # by default (auto) the same query ends with a finite, honest interval: forward mode, whose
+        # variance is certified finite, within 4 sigma of LAPACK
+        rc, out, err = run(ulam, ["solve", f"{d}/tref.mtx", "--rhs", f"{d}/b500.mtx", "--index", "1", "--jacobi",
+                                  "--rel-err", "0.25", "--check", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["mode"] == "forward" and o["variance_finite"] is True and o["ci95"] is not None, (rc, err, o)
+        assert o["rel_err_met"] is True and abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
+        assert all(not c["certified"] for c in o["auto"]["candidates"] if c["mode"] == "adjoint"), o["auto"]
         # forward: state 4 is reached once in ~10^5 walks, state 3 never
         write_mtx(f"{d}/thin.mtx", 4, [(1, 2, 0.5), (2, 1, 0.5), (4, 1, 1e-5)])
         write_vec(f"{d}/b4.mtx", [1.0, 1.0, 0.0, 0.0])
