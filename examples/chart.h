@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "gnuplot.h"
 #include "ulam.h"
 
 /* An output file being written: its final path and the temporary one. */
@@ -37,7 +38,7 @@ static inline void out_commit(out_file *o)
     fprintf(stderr, "wrote %s\n", o->path);
 }
 
-/* Draw DIR/NAME.png with ulam_gnuplot from a printf-style script (data files relative to
+/* Draw DIR/NAME.png with gnuplot_draw (src/cli/gnuplot.h) from a printf-style script (data files relative to
  * DIR).  Returns 0, or 1 with a message when gnuplot is missing or fails. */
 static inline int chart_draw(const char *dir, const char *name, int width, int height, const char *fmt, ...)
 {
@@ -46,7 +47,7 @@ static inline int chart_draw(const char *dir, const char *name, int width, int h
     va_start(ap, fmt);
     int len = vsnprintf(script, sizeof script, fmt, ap);
     va_end(ap);
-    if (len < 0 || (size_t)len >= sizeof script || ulam_gnuplot(dir, name, width, height, script)) {
+    if (len < 0 || (size_t)len >= sizeof script || gnuplot_draw(dir, name, width, height, script)) {
         fprintf(stderr, "gnuplot failed for %s/%s.png (install gnuplot-nox); the CSV is written\n", dir, name);
         return 1;
     }

@@ -5,10 +5,10 @@
  * The chains: j = state 1 is the source (b = e_1); from j a walk ends with probability p*,
  * else moves to one of 3 other states, each of which returns to j with probability c and
  * ends otherwise, so s = p* + (1 - p*)(1 - c).  Visits to j are geometric, hence the exact
- * variances (ulam_law_variances)
+ * variances (law_variances in law.h)
  *     Var(collision) = (1 - s) / s^2,      Var(absorption) = 1 / (p* s) - 1 / s^2,
  * and s itself is also computed from hitting probabilities by a linear solve
- * (ulam_law_noreturn) as a check.  For s = 0.2, 0.5, 0.8, p* sweeps (0, s) across the
+ * (law_noreturn) as a check.  For s = 0.2, 0.5, 0.8, p* sweeps (0, s) across the
  * boundary; each point is measured with 2 10^5 forward walks of each estimator.
  *
  *   law [OUTDIR]    writes OUTDIR/law.csv and OUTDIR/law.png */
@@ -16,6 +16,7 @@
 #include <stdio.h>
 
 #include "chart.h"
+#include "law.h"
 #include "systems.h"
 
 /* M = P' for the chain above (forward walks step on the rows of M' = P). */
@@ -44,10 +45,10 @@ int main(int argc, char **argv)
         for (size_t k = 0; k < sizeof fr / sizeof *fr; k++) {
             double s = ss[a], bnd = s / (2 - s), ps = fr[k] * bnd;
             if (ps >= s) continue;
-            double c = 1 - (s - ps) / (1 - ps), vc, va, s2, ps2, v[2];
+            double c = 1 - (s - ps) / (1 - ps), vc, va, s2 = NAN, ps2 = NAN, v[2];
             ulam_csr *M = law_chain(ps, c);
-            ulam_law_variances(ps, s, &vc, &va);
-            ulam_law_noreturn(M, 0, &s2, &ps2, NULL);
+            law_variances(ps, s, &vc, &va);
+            law_noreturn(M, 0, &s2, &ps2);
             for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
                 ulam_walk_opts wo = ulam_walk_defaults();
                 wo.mode = ULAM_FORWARD, wo.estimator = est, wo.max_walks = 200000, wo.seed = 17 + k;

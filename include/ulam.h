@@ -7,7 +7,36 @@
  *     sentence saying what was expected;
  *   - indices are 0-based in this API (the command line and Matrix Market files are 1-based);
  *   - inputs are const, outputs are caller-owned, every _free accepts and returns NULL;
- *   - the library never prints and never exits.
+ *   - the library never prints and never exits;
+ *   - ABI habit: a struct the caller fills starts from its defaults function, which sets every
+ *     field, and the caller then sets what it needs (ulam_walk_defaults, ulam_mm_defaults,
+ *     ulam_spectral_defaults, ulam_power_defaults, ulam_guard_defaults, ulam_outer_defaults,
+ *     ulam_bidir_defaults, ulam_auto_defaults, ulam_share_defaults, ulam_system_desc_defaults;
+ *     in ulam_radiosity.h ulam_camera_cornell or ulam_camera_frame): a field a later version
+ *     adds then takes its default there, so such a program keeps its meaning when rebuilt.
+ *     Handles (ulam_solver, ulam_outer, ulam_push, ulam_system; ulam_tracer, ulam_rad_solver)
+ *     are opaque, reached only through their functions; what the library fills (results,
+ *     reports, ulam_guard, ulam_certificate, ulam_csr and ulam_scene from their allocators and
+ *     readers) is plain data to read.
+ *
+ * The API by rank, as CSparse's header ranks its own (each section banner below names the
+ * ranks it holds; sections follow the data flow, file -> matrix -> guards -> walks -> output):
+ *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
+ *     ulam_guard_check, ulam_walk_defaults, ulam_solver_alloc, ulam_solver_iterate,
+ *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
+ *     ulam_solver_free, ulam_solve, ulam_direct_solve, ulam_mm_write_vector, ulam_strerror;
+ *   secondary, more control and the other methods: building and transforming matrices
+ *     (ulam_csr_alloc, _from_triplets, _check, _transpose, ulam_jacobi), reader options and
+ *     files (ulam_mm_read_matrix_opts, _file, ulam_mm_write_matrix), verdicts
+ *     (ulam_guard_variance, ulam_verdict_of, ulam_solver_guard), spectral radii
+ *     (ulam_spectral_power, ulam_spectral_radius), prepared systems (ulam_system_*,
+ *     ulam_certificate_*), processes (ulam_share), outer iterations (ulam_outer_*), Krylov
+ *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_solve), the method
+ *     choice (ulam_auto_choose), ulam_direct_bytes;
+ *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
+ *     ulam_strtod, ulam_outfile_*, ulam_spectral_radius_op, ulam_gauss_seidel_*, the studies'
+ *     method grid and exact value (ulam_study_*), random numbers (ulam_rng_*), ulam_now.
+ * The radiosity front end ranks its own in ulam_radiosity.h.
  */
 #ifndef ULAM_H
 #define ULAM_H
@@ -26,6 +55,7 @@ extern "C" {
 #define ULAM_Z95 1.959963984540054
 
 /* ---------------------------------------------------------------- status codes */
+/* All primary. */
 
 enum ulam_status {
     ULAM_OK = 0,
@@ -74,6 +104,8 @@ typedef struct ulam_error {
 } ulam_error;
 
 /* ---------------------------------------------------------------- sparse matrices */
+/* Primary: the struct, ulam_csr_free.  Secondary: building, checking, transposing, ulam_jacobi.
+ * Tertiary: nnz, copy, matvec, dense, stats. */
 
 /* Compressed sparse row matrix.  Plain data: rowptr has nrows+1 entries (64-bit, so
  * nnz may exceed 2^31), colidx and val have rowptr[nrows] entries; columns are sorted
@@ -139,16 +171,18 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
                 ulam_error *err);
 
 /* ---------------------------------------------------------------- Matrix Market */
+/* Primary: ulam_mm_read_matrix, _read_vector, _write_vector.  Secondary: options, FILE readers,
+ * _write_matrix.  Tertiary: ulam_strtod, ulam_outfile. */
 
-/* Read a sparse matrix ("coordinate" real/integer/pattern, general/symmetric/
+/* Read a sparse matrix from path ("coordinate" real/integer/pattern, general/symmetric/
  * skew-symmetric; duplicates summed, explicit zeros dropped; symmetric files are
- * expanded).  name is used only in error details. */
-int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
-
-/* As ulam_mm_read_matrix_file, opening path. */
+ * expanded). */
 int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err);
 
-/* Options of the matrix reader. */
+/* As ulam_mm_read_matrix, from an open file; name is used only in error details. */
+int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
+
+/* Options of the matrix reader.  Start from ulam_mm_defaults(). */
 typedef struct ulam_mm_opts {
     int threads;     /* 0: all cores; 1: the sequential streaming reader.  A regular file of
                         coordinate general kind is read by `threads` threads in chunks split at
@@ -159,15 +193,18 @@ typedef struct ulam_mm_opts {
                         as it was, for comparisons) */
 } ulam_mm_opts;
 
-/* As ulam_mm_read_matrix_file with options (o NULL: all cores, ulam_strtod). */
+/* The defaults: all cores (threads 0), reals by ulam_strtod (libc_strtod 0). */
+ulam_mm_opts ulam_mm_defaults(void);
+
+/* As ulam_mm_read_matrix_file with options (o NULL: ulam_mm_defaults()). */
 int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
 
-/* Read a dense vector: "array" m x 1, or "coordinate" m x 1 (missing entries are 0).
- * *x is malloc'd with *n entries. */
-int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
-
-/* As ulam_mm_read_vector_file, opening path. */
+/* Read a dense vector from path: "array" m x 1, or "coordinate" m x 1 (missing entries are
+ * 0).  *x is malloc'd with *n entries. */
 int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *err);
+
+/* As ulam_mm_read_vector, from an open file; name is used only in error details. */
+int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
 
 /* strtod(s, end) exactly (the same double and end for every input, C locale), faster for
  * decimals of up to 19 significant digits with normal results (Clinger's fast path, else the
@@ -202,6 +239,7 @@ int ulam_outfile_commit(ulam_outfile *o);
 void ulam_outfile_abort(ulam_outfile *o);
 
 /* ---------------------------------------------------------------- direct solve */
+/* Primary: ulam_direct_solve.  Secondary: ulam_direct_bytes. */
 
 /* What a LAPACK direct solve reports besides the solution. */
 typedef struct ulam_direct_info {
@@ -221,18 +259,19 @@ int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_
                       ulam_direct_info *info, ulam_error *err);
 
 /* ---------------------------------------------------------------- spectral radius */
+/* Secondary, except tertiary: ulam_spectral_radius_op. */
 
 /* Options of the spectral radius estimate: ARPACK's implicitly restarted Arnoldi
  * (dense dgeev for n <= 128), stopped when the dominant Ritz pair reaches
- * ||A u - lambda u|| <= tol |lambda|. */
+ * ||A u - lambda u|| <= tol |lambda|.  Start from ulam_spectral_defaults(). */
 typedef struct ulam_spectral_opts {
     double tol;       /* relative residual tolerance (default 1e-6) */
     int max_restarts; /* cap on implicit restarts (default 300) */
     int krylov_dim;   /* Arnoldi basis size, ARPACK's ncv (default 20) */
-    uint64_t seed;    /* start vector seed for signed matrices */
+    uint64_t seed;    /* start vector seed for signed matrices (default 1) */
 } ulam_spectral_opts;
 
-/* The default options. */
+/* The defaults: tol 1e-6, max_restarts 300, krylov_dim 20, seed 1. */
 ulam_spectral_opts ulam_spectral_defaults(void);
 
 /* Result of a spectral radius estimate. */
@@ -254,7 +293,8 @@ int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double 
                             const void *ctx, int positive_start, const ulam_spectral_opts *opts,
                             ulam_radius *out);
 
-/* Options of the power iteration for nonnegative operators (the guards' radii). */
+/* Options of the power iteration for nonnegative operators (the guards' radii).  Start from
+ * ulam_power_defaults(). */
 typedef struct ulam_power_opts {
     double tol;   /* stop when (upper - lower) <= tol * upper, or when for 5 iterations the
                      changes, extrapolated as a geometric series, add up to <= tol * rho,
@@ -265,7 +305,7 @@ typedef struct ulam_power_opts {
                      upper < 1 (default 0: iterate to the tolerance) */
 } ulam_power_opts;
 
-/* The default options. */
+/* The defaults: tol 1e-4, max_iter 1000, certify 0. */
 ulam_power_opts ulam_power_defaults(void);
 
 /* Spectral radius of a nonnegative operator by power iteration, with Collatz-Wielandt bounds
@@ -287,6 +327,7 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
                         const ulam_power_opts *opts, ulam_power *out, ulam_error *err);
 
 /* ---------------------------------------------------------------- stability guards */
+/* Primary: ulam_guard_check and its options.  Secondary: ulam_verdict_of, ulam_guard_variance. */
 
 /* A radius against 1, from its certified bounds alone (never from an unconverged estimate):
  * OK when upper < 0.99; EDGE (finite, within 1% of 1) when upper < 1; FAIL when lower >= 1;
@@ -300,28 +341,35 @@ enum { ULAM_GUARD_ABS = 1, ULAM_GUARD_ADJOINT = 2, ULAM_GUARD_FORWARD = 4, ULAM_
 /* The bit of ULAM_GUARD_* for the rho(M^) of walks in mode (ULAM_ADJOINT, ULAM_FORWARD). */
 #define ULAM_GUARD_HAT(mode) ((mode) == 1 ? ULAM_GUARD_FORWARD : ULAM_GUARD_ADJOINT)
 
-/* What a guard check computes and how far. */
+/* What a guard check computes and how far.  Start from ulam_guard_defaults(). */
 typedef struct ulam_guard_opts {
     int need;  /* ULAM_GUARD_* bits (0: all three) */
     int tight; /* nonzero: iterate every radius to the tolerance (ulam info); 0: stop as soon
                   as the bounds certify the verdict (one O(nnz) pass when row or column sums do) */
     ulam_power_opts power; /* the iteration (certify is set by tight) */
+    double kernel_alpha;   /* the kernel exponent of the walks whose rho(M^) is computed (see
+                              ulam_walk_opts; default 1) */
 } ulam_guard_opts;
 
-/* The defaults: all three radii, stopped once certified. */
+/* The defaults: all three radii (need ULAM_GUARD_ALL), tight 0 (stopped once certified), power
+ * ulam_power_defaults(), kernel_alpha 1. */
 ulam_guard_opts ulam_guard_defaults(void);
 
-/* The guards of a walk on M with continuation continue_q (<= 0: analog), a plain struct (a
- * certificate a prepared-system file can store and reload):
- *   abs:    rho(|M|) (= rho(|M'|)): the walk's expectation is a convergent series iff < 1;
+/* The guards of a walk on M with continuation continue_q (<= 0: analog) and kernel exponent
+ * alpha, a plain struct (a certificate a prepared-system file can store and reload):
+ *   abs:    rho(|M|) (= rho(|M'|)): the walk's expectation is a convergent series iff < 1 (for
+ *           every alpha);
  *   hat[m]: rho(M^) of the mode m kernel's second-moment matrix M^_ij = K_ij^2 / (q_i p_ij),
- *           K = M (adjoint) or M' (forward): the estimators' variance is finite iff < 1.
+ *           K = M (adjoint) or M' (forward), p_ij = q_i |K_ij|^alpha / sum_k |K_ik|^alpha:
+ *           diag(S / q) |K| at alpha = 1, |K_ij|^(2 - alpha) sum_k |K_ik|^alpha / q_i in
+ *           general; the estimators' variance is finite iff < 1.
  * Each radius carries its one-pass row/column-sum bounds, its certified bounds (the tighter of
  * those and the power iteration's), its estimate and whether it converged; verdicts come from
  * the bounds only.  A radius not computed has verdict ULAM_VERDICT_UNKNOWN and bounds
  * [0, INFINITY]. */
 typedef struct ulam_guard {
-    double continue_q; /* the kernel the radii describe */
+    double continue_q; /* the kernel the radii describe: its continuation */
+    double kernel_alpha; /* and its exponent (rho(M^) depends on it, rho(|M|) does not) */
     int computed;      /* ULAM_GUARD_* bits of the radii computed */
     ulam_power abs, hat[2];
     int verdict_abs, verdict_hat[2];
@@ -329,7 +377,9 @@ typedef struct ulam_guard {
 
 /* Compute the radii opts->need asks for (opts may be NULL: ulam_guard_defaults()): one pass over
  * M gives every row and column sum bound; power iteration runs only for a radius those do not
- * certify (or for every radius when opts->tight). */
+ * certify (or for every radius when opts->tight).  At opts->kernel_alpha != 1, rho(M^) is that
+ * of M^ formed entry by entry (nnz doubles; forward: on M', a transpose); a kernel_alpha that
+ * is negative or not finite is ULAM_EINVAL. */
 int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
                      ulam_guard *g, ulam_error *err);
 
@@ -338,6 +388,7 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
 int ulam_guard_variance(const ulam_guard *g, int mode);
 
 /* ---------------------------------------------------------------- prepared systems */
+/* Secondary, except tertiary: ulam_system_from_memory, _is_file, _omega, _certificate, _write_file. */
 
 /* A prepared system: M (and b) of (I - M) x = b as one binary file that is mapped read-only
  * and used in place, so a query reads only the pages of the rows its walks reach (the layout
@@ -349,7 +400,8 @@ int ulam_guard_variance(const ulam_guard *g, int mode);
 typedef struct ulam_system ulam_system;
 
 /* What the guards certified for a prepared system, so a query needs no pass over M: the
- * radii of ulam_guard_check for the kernel of continuation continue_q under power-iteration
+ * radii of ulam_guard_check for the kernel of continuation continue_q and exponent 1 (a
+ * query at another kernel exponent computes its own) under power-iteration
  * options (tol, max_iter), and the row- and column-sum bounds of |M| (the largest of either
  * bounds rho(|M|) from above).  Stored in a versioned section of the header (version 1 holds
  * these fields; a reader ignores a version it does not know and the guards run as usual). */
@@ -363,7 +415,7 @@ typedef struct ulam_certificate {
 
 /* What to write: M and/or b (n entries; with M, n = M->nrows), an optional source tag (the
  * CLI's cache: size and mtime), the Jacobi damping omega that made M (0: M as read) and an
- * optional certificate. */
+ * optional certificate.  Start from ulam_system_desc_defaults(). */
 typedef struct ulam_system_desc {
     const ulam_csr *M;
     const double *b;
@@ -373,8 +425,12 @@ typedef struct ulam_system_desc {
     const ulam_certificate *cert;
 } ulam_system_desc;
 
+/* The defaults: nothing to write yet (M, b and cert NULL, n 0, tag {0, 0}, omega 0); set M
+ * and/or b and n. */
+ulam_system_desc ulam_system_desc_defaults(void);
+
 /* Write a prepared system to f (positioned at 0; the caller closes it): ULAM_OK, ULAM_EINVAL
- * or ULAM_EIO. */
+ * (also for a certificate whose guards are not of kernel exponent 1) or ULAM_EIO. */
 int ulam_system_write_file(FILE *f, const ulam_system_desc *d);
 
 /* Write a prepared system to path atomically (through ulam_outfile). */
@@ -420,39 +476,22 @@ double ulam_system_omega(const ulam_system *s);
 ulam_system *ulam_system_free(ulam_system *s);
 
 /* The certificate of M: the guards of ulam_guard_check(M, continue_q, opts) and the row and
- * column sums of |M| (one more pass). */
+ * column sums of |M| (one more pass); ULAM_EINVAL for opts->kernel_alpha != 1 (the file's
+ * certificate holds the guards of exponent 1). */
 int ulam_certificate_compute(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
                              ulam_certificate *c, ulam_error *err);
 
 /* The guards a query would compute, taken from certificate c when it was made for the same
- * continuation and power-iteration options and holds the radii opts->need asks for (opts NULL:
+ * continuation, kernel exponent and power-iteration options and holds the radii opts->need
+ * asks for (opts NULL:
  * the defaults, all three; never for opts->tight): ULAM_OK with *g
  * filled (its seconds 0: no pass was made), or ULAM_ENOTFOUND when c is NULL or does not
  * apply (the caller then runs ulam_guard_check). */
 int ulam_certificate_guard(const ulam_certificate *c, double continue_q, const ulam_guard_opts *opts,
                            ulam_guard *g);
 
-/* ---------------------------------------------------------------- random numbers */
-
-/* xoshiro256** 1.0 (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
- * ACM TOMS 2021; https://prng.di.unimi.it), seeded through splitmix64.  Caller-owned. */
-typedef struct ulam_rng {
-    uint64_t s[4];
-} ulam_rng;
-
-/* Seed from a 64-bit seed and a stream number (e.g. a walk or block index). */
-void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream);
-
-/* Next 64 random bits. */
-uint64_t ulam_rng_next(ulam_rng *r);
-
-/* Uniform double in [0, 1) with 53 random bits. */
-double ulam_rng_uniform(ulam_rng *r);
-
-/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
-uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
-
 /* ---------------------------------------------------------------- random walks */
+/* Primary, except secondary: ulam_share, ulam_solver_guard. */
 
 enum ulam_mode { ULAM_ADJOINT = 0, ULAM_FORWARD = 1 };
 enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2 };
@@ -463,12 +502,15 @@ enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2
  * order and reaches the same totals, bit for bit, and the same stopping decisions as one
  * process running them all with the same seed.  allgather must concatenate every process's
  * `bytes` bytes at `mine` in rank order into a new malloc'd *all of *total bytes, returning 0,
- * or nonzero on failure (the run then stops with ULAM_EIO). */
+ * or nonzero on failure (the run then stops with ULAM_EIO).  Start from ulam_share_defaults(). */
 typedef struct ulam_share {
     int rank, nranks;
     int (*allgather)(void *ctx, const void *mine, size_t bytes, void **all, size_t *total);
     void *ctx;
 } ulam_share;
+
+/* The defaults: one process (rank 0 of 1; allgather and ctx NULL, never called). */
+ulam_share ulam_share_defaults(void);
 
 /* How to walk and when to stop.  Start from ulam_walk_defaults(). */
 typedef struct ulam_walk_opts {
@@ -497,10 +539,16 @@ typedef struct ulam_walk_opts {
                                 the solver computes them */
     double rel_err_offset; /* a known exact part c of the answer c + estimate (bidirectional's push
                               part): rel_err is then relative to |c + estimate| (0: none) */
+    double kernel_alpha;   /* the kernel exponent alpha, finite and >= 0: a walk that continues from
+                              i moves to j with probability |K_ij|^alpha / sum_k |K_ik|^alpha over
+                              the row's nonzeros (K = M adjoint, M' forward), its weight times
+                              K_ij / (q_i p_ij); 1 (the default): the "almost optimal" |K_ij| / S_i,
+                              0 uniform, 2 Alea's transition factor.  rho(M^) is that kernel's, so
+                              opts->guard is used only when computed for the same alpha */
 } ulam_walk_opts;
 
-/* The defaults: adjoint collision walks, index 0, analog kernel, seed 1, all cores,
- * 10^5 walks, walk cap 10^6 steps. */
+/* The defaults: adjoint collision walks, index 0, analog kernel (kernel_alpha 1), seed 1, all
+ * cores, 10^5 walks, walk cap 10^6 steps. */
 ulam_walk_opts ulam_walk_defaults(void);
 
 /* What a run has found so far. */
@@ -563,7 +611,8 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
 /* Run one round of walks (rounds grow 1, 2, 4 ... 64 blocks of 1024 walks as walks accumulate,
  * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
  * ULAM_ENOMEM, ULAM_EIO (the share's allgather), ULAM_ESYNTAX (a corrupt row of a mapped
- * file); ulam_solver_error says why. */
+ * file), ULAM_ERANGE (at kernel_alpha != 1, a reached row whose entries are so uneven that a
+ * move's probability is below 2^-40 / the row's length); ulam_solver_error says why. */
 int ulam_solver_iterate(ulam_solver *s);
 
 /* Why the run failed (the status ulam_solver_iterate returned), with err filled: the row of a
@@ -614,6 +663,7 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
 #define ULAM_REL_ERR_CAP 1000000000
 
 /* ---------------------------------------------------------------- outer iterations */
+/* All secondary. */
 
 /* Iterations on (I - M) x = b from x = 0 that stop on the exact residual
  * ||b - (I - M) x||_2 / ||b||_2 <= tol:
@@ -633,7 +683,7 @@ enum ulam_method { ULAM_RICHARDSON = 0, ULAM_GAUSS_SEIDEL = 1, ULAM_SEQUENTIAL =
 typedef struct ulam_outer_opts {
     int method;            /* enum ulam_method (default ULAM_MCSA) */
     double tol;            /* residual reduction, in (0, 1) (default 1e-8) */
-    int max_iter;          /* iteration cap, >= 1 (default 1000; 100000 for the deterministic) */
+    int max_iter;          /* iteration cap (default 0: 1000 with walks, 100000 for the deterministic) */
     int stall;             /* end with ULAM_ESTALL after this many iterations without a new
                               smallest residual (0: 5 with walks, 100 without) */
     double eps1;           /* adaptive threshold on ||stderr||_1 / ||delta||_1, in (0, 1)
@@ -644,7 +694,8 @@ typedef struct ulam_outer_opts {
                               seed of iteration l is drawn from the stream (seed, l)) */
 } ulam_outer_opts;
 
-/* The defaults: MCSA, tol 1e-8, eps1 0.1, expected-value forward walks, seed 1. */
+/* The defaults: MCSA, tol 1e-8, max_iter 0, stall 0, eps1 0.1, max_histories 10^8, walk
+ * ulam_walk_defaults() but forward expected-value walks (seed 1). */
 ulam_outer_opts ulam_outer_defaults(void);
 
 /* What one iteration did. */
@@ -689,6 +740,7 @@ int ulam_outer_solve(const ulam_csr *M, const double *b, const ulam_outer_opts *
                      ulam_outer_step *steps, int max_steps, int *nsteps, ulam_error *err);
 
 /* ---------------------------------------------------------------- Krylov peers */
+/* Secondary, except tertiary: ulam_csr_symmetric. */
 
 /* Krylov solvers for (I - M) x = b from x = 0, stopped when ||b - (I - M) x||_2 / ||b||_2 <=
  * tol (the true residual, recomputed at the end): conjugate gradients for symmetric positive
@@ -704,6 +756,7 @@ int ulam_gmres(const ulam_csr *M, const double *b, int restart, double tol, int 
 int ulam_csr_symmetric(const ulam_csr *M);
 
 /* ---------------------------------------------------------------- point sources: push and bidirectional */
+/* All secondary. */
 
 /* Reverse local push from a target t on the adjoint equation (src/push.c): estimates p and
  * residuals r with x_t = <p, b> + <r, x> for every b, where (I - M) x = b.  Pushing j moves r_j
@@ -747,7 +800,8 @@ void ulam_push_report(const ulam_push *w, ulam_push_info *info);
  * PageRank estimation and search: a bidirectional approach", WSDM 2016): a reverse push from t gives
  * x_t = p_s + <r, x>, and <r, x> = e_s' (I - M')^-1 r is the unknown s of the system (M', r),
  * estimated by the adjoint walk solver on M' from s scoring r (walks forward from the source).
- * Each score is at most rmax x the walk's weight sum, so the variance falls with rmax. */
+ * Each score is at most rmax x the walk's weight sum, so the variance falls with rmax.  Start from
+ * ulam_bidir_defaults(). */
 typedef struct ulam_bidir_opts {
     int64_t target, source; /* 0-based t and s */
     double rmax;       /* push threshold; <= 0: balance the push's work against the walks' predicted work */
@@ -757,29 +811,71 @@ typedef struct ulam_bidir_opts {
                              set here); rel_err applies to the whole estimate p_s + <r, x> */
 } ulam_bidir_opts;
 
-/* The defaults: balanced rmax, min_value 1 / n, ulam_walk_defaults() walks. */
+/* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
+ * (the default cap), walk ulam_walk_defaults(). */
 ulam_bidir_opts ulam_bidir_defaults(void);
+
+/* A bidirectional estimate's plan (ulam_bidir_plan): the push it runs and what the walks after it
+ * are predicted to cost, in a deterministic unit of work (push operations; a walk's visits, its
+ * steps + 1, count step_cost operations each), so a comparison of methods on it gives the same
+ * answer on every run, thread count and MPI rank. */
+typedef struct ulam_bidir_plan_info {
+    int64_t target;         /* 0-based t */
+    double rmax;            /* the push threshold: the balance's choice, or ulam_bidir_opts.rmax */
+    int balanced;           /* 1: rmax chosen by the balance */
+    ulam_push_info push;    /* the push as run to rmax (its ops are counted, not predicted) */
+    double push_part;       /* <p, b>: the exact part of x_t */
+    int64_t pilot_walks;    /* walks of the pilot that measured mean_visits (0: rmax given) */
+    int64_t pilot_steps;    /* their steps */
+    double mean_visits;     /* V: states a walk from b visits on average (pilot; 1 without one) */
+    double predicted_walks; /* walks the stopping rule is predicted to need (0: no residual left,
+                               the value is exact; max_walks when that is the only rule; NaN
+                               when rmax is given and rel_err is set: no pilot measured V) */
+    double predicted_work;  /* push.ops + step_cost (pilot visits + predicted_walks V): the whole
+                               estimate's work in push operations */
+    double step_cost;       /* push operations a walk visit counts as */
+    double seconds;         /* wall time of the plan: pilot and push */
+} ulam_bidir_plan_info;
+
+/* Plan a bidirectional estimate without its walks: start the push at o->target and, when o->rmax
+ * <= 0, run a pilot of 256 walks on a seed of its own (o->walk.seed mixed) and halve rmax from 1,
+ * pushing down to it, while the push's operations are below the walks' predicted work (walks
+ * predicted by the stopping rule's terms: its 1000-walk floor, the variance rmax V / (E^2 x^),
+ * and for a rel_err target E the range term the walk solver's own bounds (the pilot's solver,
+ * over the states the walks reach) give for scores of at most rmax a visit, when they give one;
+ * x^ = max(min_value, |<p, b>|); E = 0.1 for a run stopped by time alone); with o->rmax > 0
+ * push to it.  w is left
+ * pushed, and remembers the plan: ulam_bidir_solve with the same options (target, b, rmax,
+ * min_value, max_push_ops and the walk options the pilot and prediction read) uses that push and
+ * pilot as they are, until ulam_push_start or ulam_push_run changes the workspace.  The push's
+ * operations are exact; the walks are a prediction (the solver stops after whole rounds, so it
+ * runs at least the predicted walks rounded up to its rounds, and more when the variance is
+ * larger than modelled).  Statuses as ulam_bidir_solve. */
+int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
+                    ulam_error *err);
 
 /* What a bidirectional estimate found. */
 typedef struct ulam_bidir_result {
-    double estimate, std_error, ci95[2]; /* of x_t: p_s plus the walks' estimate of <r, x> */
-    double push_part;      /* p_s, exact given the push */
+    double estimate, std_error, ci95[2]; /* of x_t: <p, b> plus the walks' estimate of <r, x> */
+    double push_part;      /* <p, b>, exact given the push */
     ulam_push_info push;   /* the push (its seconds are push_seconds) */
     ulam_walk_result walks; /* the walks' estimate of <r, x> (0 walks when r = 0: exact) */
-    int64_t pilot_walks;   /* walks that measured the mean walk length for the balance */
-    double mean_visits;    /* states a walk visits on average (pilot) */
-    double predicted_walks; /* walks the balance predicted for the target at its rmax (NaN: rmax given) */
-    double seconds;        /* the whole estimate: pilot, push, walk set-up and walks */
+    ulam_bidir_plan_info plan; /* the plan the estimate followed */
+    int plan_reused;       /* 1: the workspace held this plan (ulam_bidir_plan), not redone */
+    double seconds;        /* the whole estimate: the plan's seconds (pilot and push, also when
+                              reused) plus the walks' set-up and walks */
 } ulam_bidir_result;
 
 /* Estimate x_t of (I - M) x = e_s with push workspace w (on M) and Mt, the transpose of M (borrowed;
- * computing it is one O(nnz) pass the caller makes once for any number of queries).  ULAM_OK,
- * ULAM_EINVAL (bad options, index out of range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap),
- * the walk solver's statuses. */
+ * computing it is one O(nnz) pass the caller makes once for any number of queries): the plan of
+ * ulam_bidir_plan (reused when w holds it for these options), then walks from s on Mt scoring the
+ * residual until o->walk's stopping rules hold.  ULAM_OK, ULAM_EINVAL (bad options, index out of
+ * range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap), the walk solver's statuses. */
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err);
 
 /* ---------------------------------------------------------------- choosing the method */
+/* All secondary. */
 
 /* What became of a candidate of ulam_auto_choose. */
 enum ulam_auto_state {
@@ -828,7 +924,8 @@ typedef struct ulam_auto_candidate {
 #define ULAM_AUTO_READ 1.0
 #define ULAM_AUTO_UNIT_SECONDS 3e-8
 
-/* What the choice may vary and how it pilots: a pinned part keeps base's value. */
+/* What the choice may vary and how it pilots: a pinned part keeps base's value.  Start from
+ * ulam_auto_defaults(). */
 typedef struct ulam_auto_opts {
     int pin_mode, pin_estimator, pin_continue;
     double continue_q;    /* the fixed continuation tried beside analog (default 0.9) */
@@ -887,48 +984,82 @@ int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *b
                      ulam_auto_result *res, ulam_solver **out, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
+/* All tertiary. */
+
+/* The weight windows of a study's methods: none, Russian roulette below 0.5 w0, or roulette and
+ * splitting above 2 w0 (w0 the starting weight: 1 adjoint, ||b||_1 forward). */
+enum ulam_window { ULAM_WINDOW_PLAIN, ULAM_WINDOW_ROULETTE, ULAM_WINDOW_SPLIT };
+
+/* A study's method grid: mode x estimator x window, 18 methods. */
+enum { ULAM_STUDY_METHODS = 18 };
+
+/* One method of the grid. */
+typedef struct ulam_study_method {
+    const char *name; /* "mode-estimator-window", e.g. "adjoint-collision-plain" */
+    int mode;         /* ULAM_ADJOINT or ULAM_FORWARD */
+    int estimator;    /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */
+    int window;       /* enum ulam_window */
+} ulam_study_method;
+
+/* Method k (0 <= k < ULAM_STUDY_METHODS; k = 9 mode + 3 estimator + window), or NULL. */
+const ulam_study_method *ulam_study_method_get(int k);
+
+/* The index of the method named name, or -1. */
+int ulam_study_method_find(const char *name);
+
+/* Set o's mode, estimator, roulette and split to method k's on b (n entries; read only in
+ * forward mode, for w0 = ||b||_1).  ULAM_OK or ULAM_EINVAL. */
+int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o);
 
 /* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
 void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
 
-/* The reference of a study: Gauss-Seidel sweeps on x (in place, from what it holds) until, after
- * at least min_sweeps, one sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps
- * are made; returns the sweeps made. */
+/* Gauss-Seidel sweeps on x (in place, from what it holds) until, after at least min_sweeps, one
+ * sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps are made; returns the
+ * sweeps made. */
 int ulam_gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
                              int min_sweeps, int max_sweeps);
 
-/* What R runs of one method at one budget say, against the exact value. */
-typedef struct ulam_cell {
-    int runs;
-    double rmse;        /* sqrt(mean (estimate - exact)^2) */
-    double mean_stderr; /* the mean reported standard error */
-    double honesty;     /* rmse / mean_stderr: 1 when the error bars are honest */
-    double coverage;    /* share of runs whose 95% interval holds the exact value */
-    double seconds;     /* mean seconds per run */
-    double work;        /* work-normalised variance rmse^2 x seconds (lower is better) */
-} ulam_cell;
+/* Up to this n a study's exact value is LAPACK's. */
+#define ULAM_STUDY_DIRECT_MAX 8000
 
-/* Summarise n runs (arrays of n) into *out. */
-void ulam_cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
-                       double exact, ulam_cell *out);
+/* The exact value a study scores its runs against. */
+typedef struct ulam_study_ref {
+    double exact;          /* x_index: LAPACK's when direct, else settled */
+    double settled;        /* Gauss-Seidel from x = 0 until x_index settles (1e-16 relative, after
+                              at least 12 sweeps, at most 10^5) */
+    int sweeps;            /* the sweeps it made */
+    int direct;            /* 1: n <= ULAM_STUDY_DIRECT_MAX and the LAPACK solve succeeded */
+    double direct_seconds; /* that solve's time */
+} ulam_study_ref;
 
-/* The collision-absorption law for a forward analog walk started at state j and counting
- * particles at j, with termination probability p*_j = pstar and no-return probability s:
- * visits are geometric, so Var(collision) = (1 - s) / s^2 and Var(absorption) = 1 / (p* s) -
- * 1 / s^2; collision is no worse iff p* <= s / (2 - s).  Writes the two variances. */
-void ulam_law_variances(double pstar, double s, double *var_collision, double *var_absorption);
+/* The exact x_index of (I - M) x = b for a study (index 0-based).  ULAM_OK, ULAM_EINVAL or
+ * ULAM_ENOMEM. */
+int ulam_study_reference(const ulam_csr *M, const double *b, int64_t index, ulam_study_ref *ref, ulam_error *err);
 
-/* The no-return probability s of state j of the forward kernel of M (walks on the rows of
- * M', analog q): 1 - sum_k P_jk h_k with h the hitting probabilities of j (a linear solve).
- * ULAM_OK, ULAM_ENOMEM or ULAM_ESINGULAR. */
-int ulam_law_noreturn(const ulam_csr *M, int64_t j, double *s, double *pstar, ulam_error *err);
+/* ---------------------------------------------------------------- random numbers */
+/* All tertiary. */
 
-/* Draw DIR/NAME.png with gnuplot (pngcairo, width x height pixels) from script, run in DIR;
- * written under a temporary name and renamed into place.  ULAM_EIO when gnuplot is missing
- * or fails (nothing is left behind). */
-int ulam_gnuplot(const char *dir, const char *name, int width, int height, const char *script);
+/* xoshiro256** 1.0 (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
+ * ACM TOMS 2021; https://prng.di.unimi.it), seeded through splitmix64.  Caller-owned. */
+typedef struct ulam_rng {
+    uint64_t s[4];
+} ulam_rng;
+
+/* Seed from a 64-bit seed and a stream number (e.g. a walk or block index). */
+void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream);
+
+/* Next 64 random bits. */
+uint64_t ulam_rng_next(ulam_rng *r);
+
+/* Uniform double in [0, 1) with 53 random bits. */
+double ulam_rng_uniform(ulam_rng *r);
+
+/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
+uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
 
 /* ---------------------------------------------------------------- utilities */
+/* All tertiary. */
 
 /* Monotonic wall clock in seconds. */
 double ulam_now(void);

@@ -2,7 +2,19 @@
  * diffuse patches: OBJ + MTL scenes, Embree 3 ray casting, form factors, the LAPACK solve,
  * patch walks that sample F by rays (gathering, shooting, next-event), view gathering and PNG
  * images.  Built with meson's 'radiosity' feature (Embree 3 and libpng); the conventions of
- * ulam.h apply (status codes, ulam_error, const inputs, _free accepts NULL). */
+ * ulam.h apply (status codes, ulam_error, const inputs, _free accepts NULL, the ABI habit:
+ * structs the caller fills start from their defaults function, handles are opaque).
+ *
+ * The API by rank (as in ulam.h; each section banner below names the ranks it holds):
+ *   primary: ulam_scene_read_obj, ulam_scene_find, ulam_scene_free, ulam_tracer_alloc,
+ *     ulam_tracer_free, ulam_rad_solver_alloc, _iterate, _done, _result, _vectors, _free,
+ *     ulam_ff_estimate, ulam_rad_direct, ulam_camera_cornell, ulam_camera_frame,
+ *     ulam_render, ulam_png_write;
+ *   secondary: ulam_scene_subdivide, ulam_scene_centroid, ulam_scene_label_centroid,
+ *     ulam_tracer_cast, ulam_tracer_shoot, ulam_ff_report_compute, ulam_rad_system,
+ *     ulam_rad_direct_error, ulam_rad_direct_errors, ulam_view_gather, ulam_view_pixels;
+ *   tertiary: ulam_tracer_resolution, ulam_ff_parallel_rectangles,
+ *     ulam_ff_perpendicular_rectangles (exact references for tests). */
 #ifndef ULAM_RADIOSITY_H
 #define ULAM_RADIOSITY_H
 
@@ -12,7 +24,9 @@
 extern "C" {
 #endif
 
-/* ---------------------------------------------------------------- radiosity */
+/* ---------------------------------------------------------------- scenes */
+/* Primary: ulam_scene, ulam_scene_read_obj, ulam_scene_find, ulam_scene_free.  Secondary:
+ * ulam_scene_subdivide, ulam_scene_centroid, ulam_scene_label_centroid. */
 
 /* A scene of planar convex patches with diffuse RGB reflectance and emission: the radiosity
  * equation B = E + diag(rho) F B per colour channel.  Plain data; arrays of 3 hold RGB or
@@ -61,6 +75,10 @@ void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3]);
 /* The area centroid of the patches labelled label; ULAM_ENOTFOUND when there are none. */
 int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3]);
 
+/* ---------------------------------------------------------------- rays */
+/* Primary: ulam_tracer_alloc, ulam_tracer_free.  Secondary: ulam_tracer_cast, ulam_tracer_shoot.
+ * Tertiary: ulam_tracer_resolution. */
+
 /* A ray caster over a scene (Embree 3): opaque. */
 typedef struct ulam_tracer ulam_tracer;
 
@@ -87,11 +105,15 @@ int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double
  * back side (the light is lost).  Draws from r. */
 int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
 
+/* ---------------------------------------------------------------- form factors and the direct solve */
+/* Primary: ulam_ff_estimate, ulam_rad_direct.  Secondary: ulam_ff_report_compute, ulam_rad_system,
+ * ulam_rad_direct_error, ulam_rad_direct_errors.  Tertiary: the exact ulam_ff_*_rectangles. */
+
 /* Form factors F_ij estimated by casting `rays` cosine-distributed rays from uniform points of
  * each patch i (the share that reaches j); stream (seed, i) for patch i, so F does not
  * depend on the number of threads (0: all cores). */
-int ulam_form_factors(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads,
-                      ulam_csr **F, ulam_error *err);
+int ulam_ff_estimate(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads,
+                     ulam_csr **F, ulam_error *err);
 
 /* How well an estimated F obeys the laws of form factors. */
 typedef struct ulam_ff_report {
@@ -101,7 +123,7 @@ typedef struct ulam_ff_report {
 } ulam_ff_report;
 
 /* Fill *r for F on s. */
-int ulam_form_factor_report(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r);
+int ulam_ff_report_compute(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r);
 
 /* Exact form factor between directly opposed parallel a x b rectangles at distance c
  * (Howell's catalogue, C-11). */
@@ -112,26 +134,29 @@ double ulam_ff_parallel_rectangles(double a, double b, double c);
 double ulam_ff_perpendicular_rectangles(double w, double h, double l);
 
 /* The radiosity system of channel c: M = diag(rho_c) F (new *M) and b = E_c (npatches). */
-int ulam_radiosity_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
-                          double *b);
+int ulam_rad_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
+                    double *b);
 
 /* Solve the three channels' systems with LAPACKE_dgesv into B (3 * npatches, RGB per patch);
  * refuses with ULAM_EMEMLIMIT like ulam_direct_solve.  info (may be NULL) sums the three. */
-int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
-                          ulam_direct_info *info, ulam_error *err);
+int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
+                    ulam_direct_info *info, ulam_error *err);
 
-/* The standard error of the direct solution B (from ulam_radiosity_direct on an F estimated
+/* The standard error of the direct solution B (from ulam_rad_direct on an F estimated
  * with `rays` rays a patch) at patch p, per channel: the first-order propagation of the
  * multinomial noise of each row of F, se^2 = sum_k (G_pk rho_k)^2 v_k / rays with
  * G = (I - M)^-1 (one transposed LAPACK solve a channel) and v_k = sum_j F_kj B_j^2 -
  * (sum_j F_kj B_j)^2. */
-int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                int64_t p, size_t max_bytes, double se[3], ulam_error *err);
+int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                          int64_t p, size_t max_bytes, double se[3], ulam_error *err);
 
 /* The same at every patch (se: 3 * npatches): G = (I - M)^-1 whole by one LAPACKE_dgesv with
  * npatches right-hand sides a channel, so two dense matrices (ULAM_EMEMLIMIT past max_bytes). */
-int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                 size_t max_bytes, double *se, ulam_error *err);
+int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                           size_t max_bytes, double *se, ulam_error *err);
+
+/* ---------------------------------------------------------------- patch walks */
+/* All primary. */
 
 /* Gathering's next-event estimators (opts->estimator of ulam_rad_solver_alloc, gathering only).
  * At every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in
@@ -178,7 +203,9 @@ typedef struct ulam_rad_solver ulam_rad_solver;
 int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
                           ulam_error *err);
 
-/* Run one round of walks; ULAM_OK or ULAM_ENONFINITE. */
+/* Run one round of walks (rounds grow 1, 2, 4 ... 32 blocks of 256 walks as walks accumulate,
+ * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
+ * ULAM_ENOMEM (shooting's tallies), ULAM_EIO (the share's allgather). */
 int ulam_rad_solver_iterate(ulam_rad_solver *s);
 
 /* Nonzero once a stopping rule is met (rel_err: every nonzero channel; or every channel is
@@ -195,7 +222,12 @@ int ulam_rad_solver_vectors(const ulam_rad_solver *s, double *B, double *std_err
 /* Free; accepts and returns NULL. */
 ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s);
 
-/* A pinhole camera. */
+/* ---------------------------------------------------------------- images */
+/* Primary: ulam_camera_cornell, ulam_camera_frame, ulam_render, ulam_png_write.  Secondary:
+ * ulam_view_pixels, ulam_view_gather. */
+
+/* A pinhole camera.  Start from ulam_camera_cornell() or ulam_camera_frame() (ulam.h's ABI
+ * habit). */
 typedef struct ulam_camera {
     double eye[3], dir[3], up[3];
     double focal, film; /* focal length and film width, same unit (mm) */

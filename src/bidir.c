@@ -7,25 +7,28 @@
  * stopping rules.  r is fixed before any of those walks runs (the balance below looks only at
  * the push's work and a pilot on its own seed), so p_s + estimate is unbiased for x_t.
  *
- * Balance (as BiPPR balances times, here on work counts so the result is reproducible): a
- * collision walk scores at most rmax at each of its V visits, so its variance is about
- * rmax E[V] x; the walks needed for relative error e are N = rmax E[V] / (e^2 xhat) with
- * xhat = max(min_value, |p_s|), each costing E[V] steps.  rmax halves, pushing down to it,
- * while the push's work so far is below the walks' predicted work. */
+ * Plan and balance (as BiPPR balances times, here on work counts so the result is
+ * reproducible): a collision walk scores at most rmax at each of its V visits, so its variance
+ * is about rmax E[V] x, and the walk solver's rel_err rule needs at least the walks of its
+ * range term for scores of rmax a visit (the solver's own bounds over the states the walks
+ * reach, taken from the pilot's solver); the walks needed are the largest of those and the
+ * rule's floor, each costing E[V] visits.  rmax halves, pushing down to it, while the push's
+ * work so far is below the walks' predicted work.  ulam_bidir_plan does this and leaves the
+ * pushed workspace with a memo of the plan (push.h), which ulam_bidir_solve reuses for the same
+ * options instead of pushing again. */
 #include "internal.h"
 #include "push.h"
+#include "stats.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Pilot walks that measure E[V]; a walk step's cost in push operations (a push operation reads
+/* Pilot walks that measure E[V]; a walk visit's cost in push operations (a push operation reads
  * one nonzero and updates one residual, a step on a built row draws from its alias table; on the
- * 10^6 R-MAT graph of bench_bidir a step that builds rows cost about 150 operations, while the
- * variance model predicted 3 to 80 times the walks needed: the two errors lean opposite ways and
- * the 1000-walk floor bound every query there, README); the walks before a relative-error rule
- * may stop (as the solver's). */
-enum { PILOT = 256, MIN_WALKS = 1000 };
+ * 10^6 R-MAT graph of bench_bidir a step that builds rows cost about 150 operations, README); the
+ * target a run stopped by time alone is planned for. */
+enum { PILOT = 256 };
 static const double STEP_COST = 1.0, DEFAULT_REL_ERR = 0.1;
 
 /* The defaults. */
@@ -51,6 +54,14 @@ static int check_opts(const ulam_csr *M, const ulam_csr *Mt, const ulam_bidir_op
     return ULAM_OK;
 }
 
+/* Check a call's arguments (out: where its answer goes); err cleared first. */
+static int check_call(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, const void *out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!w || !o || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a push workspace, options and a place for the answer");
+    return check_opts(ulam__push_matrix(w), Mt, o, err);
+}
+
 /* The walks' options: adjoint on M' from s, scoring r. */
 static ulam_walk_opts walk_opts(const ulam_bidir_opts *o)
 {
@@ -60,61 +71,129 @@ static ulam_walk_opts walk_opts(const ulam_bidir_opts *o)
     return wo;
 }
 
-/* Mean visits per walk from s on Mt, by PILOT walks on a seed of their own. */
-static int pilot(const ulam_csr *Mt, const double *scores, const ulam_bidir_opts *o, double *visits,
-                 int64_t *walks, ulam_error *err)
+/* Nonzero when a plan made for (Mt, a) is the plan of (Mt2, b): every option it read agrees. */
+static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_bidir_opts *b)
+{
+    const ulam_bidir_opts *a = &m->o;
+    const ulam_walk_opts *x = &a->walk, *y = &b->walk;
+    return m->Mt == Mt && a->target == b->target && a->source == b->source && a->rmax == b->rmax &&
+           a->min_value == b->min_value && a->max_push_ops == b->max_push_ops && x->seed == y->seed &&
+           x->rel_err == y->rel_err && x->max_walks == y->max_walks && x->continue_q == y->continue_q &&
+           x->roulette == y->roulette && x->split == y->split && x->max_steps == y->max_steps &&
+           x->force == y->force && x->assume_finite == y->assume_finite && x->guard == y->guard;
+}
+
+/* The pilot's solver: PILOT collision walks from s on Mt on a seed of their own, scoring 1 at
+ * every visit (ones: n of them), with rel_err when the walks have one so that the solver
+ * computes its reachability bounds for scores of at most 1 a visit (the balance scales them to
+ * rmax). */
+static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *o, ulam_solver **out, ulam_error *err)
 {
     ulam_walk_opts po = walk_opts(o);
     po.estimator = ULAM_COLLISION;
     po.max_walks = PILOT, po.max_seconds = 0, po.share = NULL, po.whole_kernel = 0;
     po.threads = 1; /* one partial block: a thread team would only be woken (same result for any count) */
     po.seed = o->walk.seed ^ UINT64_C(0x9e3779b97f4a7c15);
-    ulam_walk_result r;
-    int status = ulam_solve(Mt, scores, &po, &r, err);
-    if (status) return status;
-    *walks = r.walks;
-    *visits = r.walks > 0 ? 1.0 + (double)r.steps / (double)r.walks : 1.0;
-    return ULAM_OK;
+    po.interrupt = NULL;
+    int status = ulam_solver_alloc(Mt, ones, &po, out, err);
+    while (!status && !ulam_solver_done(*out)) status = ulam_solver_iterate(*out);
+    if (status && *out) ulam_solver_error(*out, err);
+    return status;
 }
 
-/* Walks needed at threshold rmax for the target (the balance's model). */
-static double predicted_walks(const ulam_bidir_opts *o, double rmax, double visits, double xhat)
+/* Walks the stopping rule is predicted to need at threshold rmax for |x| about xhat (the
+ * balance's model, ulam_bidir_plan in ulam.h); pilot: its solver (NULL: none). */
+static double predicted_walks(const ulam_bidir_opts *o, const ulam_solver *pilot, double rmax, double visits,
+                              double xhat)
 {
-    if (o->walk.rel_err <= 0 && o->walk.max_walks > 0) return (double)o->walk.max_walks;
-    double e = o->walk.rel_err > 0 ? o->walk.rel_err : DEFAULT_REL_ERR;
-    return rmax * visits / (e * e * xhat);
+    const ulam_walk_opts *wo = &o->walk;
+    if (wo->rel_err <= 0 && wo->max_walks > 0) return (double)wo->max_walks;
+    double E = wo->rel_err > 0 ? wo->rel_err : DEFAULT_REL_ERR;
+    double n = fmax((double)ULAM__REL_MIN, rmax * visits / (E * E * xhat));
+    double range = wo->rel_err > 0 && pilot ? ulam__solver_range_walks(pilot, rmax, 0, xhat, E) : 0.0;
+    if (isfinite(range)) n = fmax(n, range); /* else the rule bounds the score through its second moment, which
+                                               depends on r: not predicted */
+    return wo->max_walks > 0 ? fmin(n, (double)wo->max_walks) : n;
 }
 
-/* Push from t: to o->rmax, or halving rmax while the push's work is below the walks' predicted work. */
-static int push(ulam_push *w, const ulam_bidir_opts *o, double visits, int64_t cap, double *walks)
+/* Push from t: to o->rmax, or halving rmax while the push's work is below the walks' predicted
+ * work; the plan's rmax, push and predicted walks filled in. */
+static int push(ulam_push *w, const ulam_bidir_opts *o, const ulam_solver *pl, int64_t cap, ulam_bidir_plan_info *plan)
 {
-    if (o->rmax > 0) {
-        *walks = NAN; /* no balance, no prediction */
-        return ulam_push_run(w, o->rmax, cap);
-    }
     const double *p = ulam_push_estimates(w);
     int64_t n = ulam__push_matrix(w)->nrows;
-    double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n;
-    double rmax = 1.0;
-    int status = ulam_push_run(w, rmax, cap); /* r = e_t: nothing to push yet */
+    double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n, V = plan->mean_visits;
+    double rmax = o->rmax > 0 ? o->rmax : 1.0, walks;
+    int status = ulam_push_run(w, rmax, cap); /* balanced: r = e_t, nothing to push yet */
     for (;;) {
-        ulam_push_info pi;
-        ulam_push_report(w, &pi);
-        *walks = predicted_walks(o, rmax, visits, fmax(delta, fabs(p[o->source])));
-        if (status || pi.support == 0 || *walks <= MIN_WALKS || (double)pi.ops >= *walks * visits * STEP_COST)
-            return status; /* below MIN_WALKS more pushing saves no walks */
+        ulam_push_report(w, &plan->push);
+        walks = predicted_walks(o, pl, rmax, V, fmax(delta, fabs(p[o->source])));
+        if (o->rmax > 0 || status || plan->push.support == 0 || walks <= ULAM__REL_MIN ||
+            (double)plan->push.ops >= walks * V * STEP_COST)
+            break; /* at the floor more pushing saves no walks */
         rmax /= 2;
         status = ulam_push_run(w, rmax, cap);
     }
+    plan->rmax = rmax;
+    plan->push_part = p[o->source];
+    int fixed = o->walk.rel_err <= 0 && o->walk.max_walks > 0; /* walks known without V */
+    plan->predicted_walks = plan->push.support == 0 ? 0.0 : o->rmax > 0 && !fixed ? NAN : walks;
+    return status;
+}
+
+/* Plan x_t's estimate: the push and the walks' predicted cost (see ulam.h). */
+int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
+                    ulam_error *err)
+{
+    int status = check_call(w, Mt, o, plan, err);
+    if (status) return status;
+    memset(plan, 0, sizeof *plan);
+    const ulam_csr *M = ulam__push_matrix(w);
+    double t0 = ulam_now();
+    int64_t cap = o->max_push_ops > 0 ? o->max_push_ops : 100 * ulam_csr_nnz(M) + 1000000;
+    ulam_push_start(w, o->target);
+    ulam__bidir_memo *memo = ulam__push_memo(w);
+    ulam_solver *pl = NULL;
+    plan->target = o->target, plan->balanced = !(o->rmax > 0), plan->mean_visits = 1.0, plan->step_cost = STEP_COST;
+    memo->have_guard = 0;
+    if (plan->balanced && !memo->ones) {
+        if (!(memo->ones = ulam__malloc((size_t)M->nrows, sizeof *memo->ones)))
+            return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the pilot's scores");
+        for (int64_t i = 0; i < M->nrows; i++) memo->ones[i] = 1.0;
+    }
+    if (plan->balanced) {
+        status = pilot(Mt, memo->ones, o, &pl, err);
+        if (status) {
+            ulam_solver_free(pl);
+            return status;
+        }
+        ulam_walk_result r;
+        ulam_solver_result(pl, &r);
+        plan->pilot_walks = r.walks, plan->pilot_steps = r.steps;
+        plan->mean_visits = r.walks > 0 ? 1.0 + (double)r.steps / (double)r.walks : 1.0;
+        ulam_solver_guard(pl, &memo->guard);
+        memo->have_guard = 1;
+    }
+    status = push(w, o, pl, cap, plan);
+    ulam_solver_free(pl);
+    if (status == ULAM_ENOCONV)
+        return ulam__fail(err, status, 0, -1, "a push within %lld operations (is rho(|M|) < 1?)", (long long)cap);
+    double pilot_visits = (double)(plan->pilot_walks + plan->pilot_steps);
+    plan->predicted_work = (double)plan->push.ops + STEP_COST * (pilot_visits + plan->predicted_walks * plan->mean_visits);
+    plan->seconds = ulam_now() - t0;
+    memo->o = *o, memo->Mt = Mt, memo->plan = *plan, memo->valid = 1;
+    return ULAM_OK;
 }
 
 /* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr.  The solver's
- * rel_err rule (the one of ulam_solve) applies to the whole estimate push_part + <r, x>. */
+ * rel_err rule (the one of ulam_solve) applies to the whole estimate push_part + <r, x>;
+ * guard: verdicts on Mt computed before (NULL: the solver computes them). */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
-                ulam_walk_result *wr, ulam_error *err)
+                const ulam_guard *guard, ulam_walk_result *wr, ulam_error *err)
 {
     ulam_walk_opts wo = walk_opts(o);
     wo.rel_err_offset = push_part;
+    if (!wo.guard) wo.guard = guard;
     ulam_solver *sv = NULL;
     int status = ulam_solver_alloc(Mt, r, &wo, &sv, err);
     if (status) return status;
@@ -129,29 +208,22 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err)
 {
-    ulam__clear(err);
-    if (!w || !o || !res) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a push workspace, options and a result");
-    memset(res, 0, sizeof *res);
-    const ulam_csr *M = ulam__push_matrix(w);
-    int status = check_opts(M, Mt, o, err);
+    int status = check_call(w, Mt, o, res, err);
     if (status) return status;
+    memset(res, 0, sizeof *res);
+    ulam__bidir_memo *memo = ulam__push_memo(w);
+    if (memo->valid && same_plan(memo, Mt, o)) res->plan = memo->plan, res->plan_reused = 1;
+    else if ((status = ulam_bidir_plan(w, Mt, o, &res->plan, err))) return status;
     double t0 = ulam_now();
-    int64_t cap = o->max_push_ops > 0 ? o->max_push_ops : 100 * ulam_csr_nnz(M) + 1000000;
-    ulam_push_start(w, o->target);
-    if (o->rmax <= 0 && (status = pilot(Mt, ulam_push_residuals(w), o, &res->mean_visits, &res->pilot_walks, err)))
-        return status;
-    status = push(w, o, res->mean_visits, cap, &res->predicted_walks);
     ulam_push_report(w, &res->push);
-    if (status == ULAM_ENOCONV)
-        return ulam__fail(err, status, 0, -1, "a push within %lld operations (is rho(|M|) < 1?)", (long long)cap);
-    res->push_part = ulam_push_estimates(w)[o->source];
-    if (res->push.support > 0 &&
-        (status = walk(Mt, ulam_push_residuals(w), o, res->push_part, &res->walks, err)))
+    res->push_part = res->plan.push_part;
+    if (res->push.support > 0 && (status = walk(Mt, ulam_push_residuals(w), o, res->push_part,
+                                                memo->have_guard ? &memo->guard : NULL, &res->walks, err)))
         return status;
     res->estimate = res->push_part + res->walks.estimate;
     res->std_error = res->walks.std_error;
     res->ci95[0] = res->push_part + res->walks.ci95[0];
     res->ci95[1] = res->push_part + res->walks.ci95[1];
-    res->seconds = ulam_now() - t0;
+    res->seconds = res->plan.seconds + (ulam_now() - t0);
     return ULAM_OK;
 }

@@ -122,6 +122,7 @@ static int get_cert(const uint64_t *w, ulam_certificate *c)
     c->guard.verdict_abs = (int)w[32], c->guard.verdict_hat[0] = (int)w[33], c->guard.verdict_hat[1] = (int)w[34];
     c->guard.computed = (int)w[35];
     c->guard.continue_q = c->continue_q;
+    c->guard.kernel_alpha = 1.0; /* certificates are made at kernel exponent 1 (ulam_certificate_compute) */
     return 1;
 }
 
@@ -141,6 +142,12 @@ static int put_part(FILE *f, const void *p, size_t n, uint64_t *at)
     return !pad || fwrite(zeros, 1, pad, f) == pad;
 }
 
+/* An empty description. */
+ulam_system_desc ulam_system_desc_defaults(void)
+{
+    return (ulam_system_desc){.M = NULL, .b = NULL, .n = 0, .tag = {0, 0}, .omega = 0.0, .cert = NULL};
+}
+
 /* Write a prepared system to f. */
 int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
 {
@@ -148,6 +155,7 @@ int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
     const ulam_csr *M = d->M;
     int64_t n = M ? M->nrows : d->n, nnz = M ? M->rowptr[M->nrows] : 0;
     if (n < 0 || (M && d->n != M->nrows && d->b)) return ULAM_EINVAL;
+    if (d->cert && d->cert->guard.kernel_alpha != 1.0) return ULAM_EINVAL; /* the section holds exponent 1's guards */
     uint64_t w[WORDS] = {0}, at = HEADER;
     size_t part[4] = {M ? ((size_t)n + 1) * 8 : 0, (size_t)nnz * 4, (size_t)nnz * 8, d->b ? (size_t)n * 8 : 0};
     memcpy(&w[0], MAGIC, 8);

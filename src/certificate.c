@@ -12,6 +12,9 @@ int ulam_certificate_compute(const ulam_csr *M, double continue_q, const ulam_gu
     ulam__clear(err);
     if (!M || !c) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
     ulam_guard_opts o = opts ? *opts : ulam_guard_defaults();
+    if (o.kernel_alpha != 1.0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the kernel exponent 1 (a certificate holds its guards; got %g)",
+                          o.kernel_alpha);
     *c = (ulam_certificate){.continue_q = continue_q > 0 ? continue_q : 0.0, .tol = o.power.tol,
                             .max_iter = o.power.max_iter};
     int status = ulam_guard_check(M, continue_q, &o, &c->guard, err);
@@ -29,8 +32,8 @@ int ulam_certificate_compute(const ulam_csr *M, double continue_q, const ulam_gu
     return ULAM_OK;
 }
 
-/* The guards from certificate c when it was made for this continuation and these options and
- * holds the radii they need. */
+/* The guards from certificate c when it was made for this continuation, kernel exponent and
+ * these options and holds the radii they need. */
 int ulam_certificate_guard(const ulam_certificate *c, double continue_q, const ulam_guard_opts *opts,
                            ulam_guard *g)
 {
@@ -38,7 +41,8 @@ int ulam_certificate_guard(const ulam_certificate *c, double continue_q, const u
     ulam_guard_opts o = opts ? *opts : ulam_guard_defaults();
     int need = o.need ? o.need : ULAM_GUARD_ALL;
     if (c->continue_q != (continue_q > 0 ? continue_q : 0.0) || c->tol != o.power.tol ||
-        c->max_iter != o.power.max_iter || (c->guard.computed & need) != need || o.tight)
+        c->max_iter != o.power.max_iter || c->guard.kernel_alpha != o.kernel_alpha || (c->guard.computed & need) != need ||
+        o.tight)
         return ULAM_ENOTFOUND;
     *g = c->guard;
     g->abs.seconds = g->hat[0].seconds = g->hat[1].seconds = 0.0;

@@ -11,11 +11,14 @@
  * (o: elementwise; derived in tests/test_walk.c), so every estimator's variance is finite iff
  * the series sum_k M^^k r converges: rho(M^) < 1.  For the analog kernel (p_ij = |K_ij| / S_i)
  * M^ = diag(S / q) |K|; a fixed q = Q gives diag(S / Q) |K|.  With K = M', rho(diag(c) |M'|)
- * = rho(|M| diag(c)), c the column factors, so no transpose is formed.
+ * = rho(|M| diag(c)), c the column factors, so no transpose is formed.  At a kernel exponent
+ * alpha != 1 (p_ij = |K_ij|^alpha / T_i given a move) the factor differs from entry to entry,
+ * M^_ij = |K_ij| |K_ij| T_i / (q_i |K_ij|^alpha), so M^ is formed entry by entry (on M' for
+ * forward walks) and its radius bounded the same way; rho(|M|) does not depend on alpha.
  *
  * The radii of these nonnegative matrices come from power iteration with Collatz-Wielandt
  * bounds (spectral.c), which certify a verdict whenever the bracket lies on one side of 1. */
-#include "internal.h"
+#include "kernel.h"
 
 #include <float.h>
 #include <math.h>
@@ -24,7 +27,7 @@
 /* The default guard options: all three radii, stopped once certified. */
 ulam_guard_opts ulam_guard_defaults(void)
 {
-    return (ulam_guard_opts){.need = ULAM_GUARD_ALL, .power = ulam_power_defaults()};
+    return (ulam_guard_opts){.need = ULAM_GUARD_ALL, .power = ulam_power_defaults(), .kernel_alpha = 1.0};
 }
 
 /* Certified bounds alone decide: below 0.99 fine, below 1 near the edge, from 1 up failing,
@@ -226,6 +229,57 @@ static int radius(const ulam_csr *M, const double *left, const double *right, co
     return status;
 }
 
+/* The one-pass sums of the nonnegative matrix A (its entries as they are). */
+static sums matrix_sums(const ulam_csr *A, double *col)
+{
+    int64_t n = A->nrows;
+    sums s = {.rmin = n ? INFINITY : 0.0, .cmin = n ? INFINITY : 0.0};
+    for (int64_t j = 0; j < n; j++) col[j] = 0.0;
+    for (int64_t i = 0; i < n; i++) {
+        double r = 0.0;
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) r += A->val[q], col[A->colidx[q]] += A->val[q];
+        s.rmin = fmin(s.rmin, r), s.rmax = fmax(s.rmax, r), s.total += r;
+    }
+    range(col, n, &s.cmin, &s.cmax);
+    return s;
+}
+
+/* rho(M^) of the kernel of K (M adjoint, M' forward) at exponent alpha != 1: M^_ij = |K_ij| f_ij,
+ * f the moves' weight factors (ulam__kernel_moves), formed in K's pattern.  An entry whose
+ * probability underflows makes M^ infinite: radius INFINITY, certified. */
+static int hat_alpha(const ulam_csr *K, double continue_q, double alpha, const ulam_guard_opts *o, ulam_power *out,
+                     ulam_error *err)
+{
+    int64_t n = K->nrows, nnz = K->rowptr[n];
+    double *val = ulam__malloc((size_t)nnz, sizeof *val), *f = ulam__malloc((size_t)nnz, sizeof *f);
+    double *col = ulam__malloc((size_t)n, sizeof *col);
+    if (!val || !f || !col) {
+        free(val), free(f), free(col);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the second-moment matrix");
+    }
+    int finite = 1;
+    for (int64_t i = 0; i < n; i++) {
+        double q = ulam__kernel_q(K, i, continue_q);
+        int64_t a = K->rowptr[i];
+        if (q > 0) (void)ulam__kernel_moves(K, i, q, alpha, val + a, f + a);
+        for (int64_t k = a; k < K->rowptr[i + 1]; k++) {
+            val[k] = q > 0 ? fabs(K->val[k]) * f[k] : 0.0;
+            finite &= isfinite(val[k]);
+        }
+    }
+    ulam_csr H = {.nrows = n, .ncols = n, .rowptr = K->rowptr, .colidx = K->colidx, .val = val};
+    int status = ULAM_OK;
+    if (finite) {
+        sums sm = matrix_sums(&H, col);
+        status = radius(&H, NULL, NULL, &sm, NULL, NULL, 0, o, out, err);
+    } else {
+        *out = (ulam_power){.rho = INFINITY, .lower = INFINITY, .upper = INFINITY, .rowsum_max = INFINITY,
+                            .colsum_max = INFINITY, .converged = 1};
+    }
+    free(val), free(f), free(col);
+    return status;
+}
+
 /* The radii asked for and their verdicts. */
 int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts *opts,
                      ulam_guard *g, ulam_error *err)
@@ -235,23 +289,27 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
     if (M->nrows != M->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
     ulam_guard_opts o = opts ? *opts : ulam_guard_defaults();
     if (!o.need) o.need = ULAM_GUARD_ALL;
+    if (!(o.kernel_alpha >= 0) || !isfinite(o.kernel_alpha))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a kernel exponent alpha that is finite and >= 0 (got %g)",
+                          o.kernel_alpha);
     int64_t n = M->nrows;
+    int alpha1 = o.kernel_alpha == 1.0; /* else rho(M^) comes from hat_alpha */
     double t0 = ulam_now();
     ulam_power none = {.upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
-    *g = (ulam_guard){.continue_q = continue_q, .abs = none, .hat = {none, none}};
+    *g = (ulam_guard){.continue_q = continue_q, .kernel_alpha = o.kernel_alpha, .abs = none, .hat = {none, none}};
     guard_work w = {0};
-    int status = sum_pass(M, continue_q, 0, &w), cols = o.tight || (o.need & ULAM_GUARD_FORWARD);
+    int status = sum_pass(M, continue_q, 0, &w), cols = o.tight || (alpha1 && (o.need & ULAM_GUARD_FORWARD));
     if (!status && !cols) { /* the column sums only when the row sums do not certify */
         double lo, hi;
         range(w.S, n, &lo, &hi);
         cols = !ulam__power_certain(lo, hi);
-        if ((o.need & ULAM_GUARD_ADJOINT) && !all_ones(w.fr, n)) {
+        if (alpha1 && (o.need & ULAM_GUARD_ADJOINT) && !all_ones(w.fr, n)) {
             sums h = hat_sums(&w, n, 0);
             cols |= !ulam__power_certain(h.rmin, h.rmax);
         }
     }
     if (!status && cols) status = sum_pass(M, continue_q, 1, &w);
-    if (!status && (o.need & ULAM_GUARD_FORWARD)) { /* the second pass only when the column sums do not certify */
+    if (!status && alpha1 && (o.need & ULAM_GUARD_FORWARD)) { /* the second pass only when the column sums do not certify */
         sums f = hat_sums(&w, n, 1);
         if (o.tight || !ulam__power_certain(fmax(f.cmin, 0.0), f.cmax)) status = forward_rows(M, &w);
     }
@@ -264,13 +322,20 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
     range(w.S, n, &a.rmin, &a.rmax);
     if (w.C) range(w.C, n, &a.cmin, &a.cmax);
     for (int64_t i = 0; i < n; i++) a.total += w.S[i];
-    int ones[2] = {all_ones(w.fr, n), w.fc && all_ones(w.fc, n)}, need = o.need;
+    int ones[2] = {alpha1 && all_ones(w.fr, n), alpha1 && w.fc && all_ones(w.fc, n)}, need = o.need;
     for (int m = 0; m < 2; m++)
         if ((o.need & ULAM_GUARD_HAT(m)) && ones[m]) need |= ULAM_GUARD_ABS; /* M^ is |M| itself */
     int reach = (need & ULAM_GUARD_ADJOINT ? 1 : 0) | (need & ULAM_GUARD_FORWARD ? 2 : 0);
     if (need & ULAM_GUARD_ABS) status = radius(M, NULL, NULL, &a, w.S, w.C, reach ? reach : 3, &o, &g->abs, err);
     for (int m = 0; m < 2 && !status; m++) {
         if (!(need & ULAM_GUARD_HAT(m))) continue;
+        if (!alpha1) {
+            ulam_csr *T = NULL;
+            if (m == ULAM_FORWARD && ulam_csr_transpose(M, &T)) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for M'");
+            else status = hat_alpha(T ? T : M, continue_q, o.kernel_alpha, &o, &g->hat[m], err);
+            ulam_csr_free(T);
+            continue;
+        }
         if (ones[m]) {
             g->hat[m] = g->abs;
             g->hat[m].seconds = 0.0;

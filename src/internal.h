@@ -152,6 +152,12 @@ int ulam__power_certain(double lower, double upper);
 int ulam__power_from(const ulam_csr *A, const double *left, const double *right, const ulam_power_opts *o,
                      ulam_power *out, ulam_error *err);
 
+/* The walks the rel_err rule's range term would need at estimate m and target E were every visit
+ * to score at most per_visit (times the walk's weight), both signs when signs, under the
+ * reachability bounds of a solver made with rel_err > 0 and b = 1 (src/solve.c; INFINITY
+ * without a bound). */
+double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E);
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -10,6 +10,12 @@
  * (factor, scores, length) sits just before its slots, and outcomes name the target row's
  * position, so a step touches one row's memory and nothing else.
  *
+ * The kernel exponent alpha generalises the move probabilities to p_ij = |K_ij|^alpha / T_i,
+ * T_i = sum_k |K_ik|^alpha (0: uniform over the row's nonzeros, 2: Alea's transition factor);
+ * the weight factor K_ij / (q_i p_ij) then differs from move to move, so each slot's two
+ * outcomes get their own factor in a table beside the arena (fac, at the slot's unit), read
+ * only at alpha != 1: at alpha = 1 the rows are built by exactly the code they always were.
+ *
  * Rows are built lazily.  The first walk to reach state j builds its row from the borrowed K at
  * the next free place of an arena (so rows a run visits are packed densely, and the rest of
  * the reservation is never touched), its moves naming target states not yet placed.  The first
@@ -35,6 +41,7 @@ ulam_kernel *ulam__kernel_free(ulam_kernel *k)
 {
     if (!k) return NULL;
     free(k->mem);
+    free(k->fac);
     free((void *)k->where);
     free(k);
     return NULL;
@@ -97,7 +104,7 @@ static int64_t row_outcomes(const ulam_csr *K, int64_t i)
 }
 
 /* The kernel of K: its size is reserved (not touched) and no row is built. */
-int ulam__kernel_alloc(const ulam_csr *K, double continue_q, ulam__scores scores, ulam_kernel **out)
+int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam__scores scores, ulam_kernel **out)
 {
     *out = NULL;
     int64_t n = K->nrows, nnz = K->rowptr[n];
@@ -105,7 +112,7 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, ulam__scores scores
     ulam_kernel *k = calloc(1, sizeof *k);
     if (!k) return ULAM_ENOMEM;
     k->n = n, k->cap = nnz + (ULAM__HEAD + 1) * n;
-    k->K = K, k->continue_q = continue_q, k->scores = scores;
+    k->K = K, k->continue_q = continue_q, k->alpha = alpha, k->scores = scores;
     atomic_init(&k->top, 0);
     atomic_init(&k->built, 0);
     atomic_init(&k->status, ULAM_OK);
@@ -113,7 +120,8 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, ulam__scores scores
     k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built; the pages of
                                                               states never reached stay untouched */
     k->mem = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->mem);
-    if (!k->where || !k->mem) {
+    if (alpha != 1.0) k->fac = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->fac);
+    if (!k->where || !k->mem || (alpha != 1.0 && !k->fac)) {
         ulam__kernel_free(k);
         return ULAM_ENOMEM;
     }
@@ -130,6 +138,8 @@ static int kscratch_fit(ulam__kscratch *w, int64_t m)
     if (ulam__grow(&w->p, &c, m, sizeof *w->p)) return ULAM_ENOMEM;
     c = w->cap;
     if (ulam__grow(&w->scaled, &c, m, sizeof *w->scaled)) return ULAM_ENOMEM;
+    c = w->cap;
+    if (ulam__grow(&w->f, &c, m, sizeof *w->f)) return ULAM_ENOMEM;
     c = w->cap;
     if (ulam__grow(&w->o, &c, m, sizeof *w->o)) return ULAM_ENOMEM;
     c = w->cap;
@@ -151,7 +161,7 @@ int ulam__kscratch_alloc(const ulam_kernel *k, ulam__kscratch *w)
 /* Free scratch. */
 void ulam__kscratch_free(ulam__kscratch *w)
 {
-    free(w->p), free(w->scaled), free(w->o), free(w->small), free(w->large);
+    free(w->p), free(w->scaled), free(w->f), free(w->o), free(w->small), free(w->large);
     *w = (ulam__kscratch){0};
 }
 
@@ -167,6 +177,23 @@ static double row_sum(const ulam_csr *K, int64_t i)
 double ulam__kernel_q(const ulam_csr *K, int64_t i, double continue_q)
 {
     return ulam__continuation(row_sum(K, i), continue_q);
+}
+
+/* The moves of row i at kernel exponent alpha != 1 (see kernel.h). */
+int ulam__kernel_moves(const ulam_csr *K, int64_t i, double q, double alpha, double *pm, double *f)
+{
+    int64_t a = K->rowptr[i], len = K->rowptr[i + 1] - a;
+    double m = 0.0, T = 0.0;
+    for (int64_t k = 0; k < len; k++) m = fmax(m, fabs(K->val[a + k]));
+    for (int64_t k = 0; k < len; k++) T += pm[k] = K->val[a + k] != 0.0 ? pow(fabs(K->val[a + k]) / m, alpha) : 0.0;
+    int status = ULAM_OK;
+    for (int64_t k = 0; k < len; k++) {
+        double v = fabs(K->val[a + k]);
+        f[k] = v != 0.0 ? v * T / (q * pm[k]) : 0.0; /* |K_ij| / (q p_ij), with p_ij = pm T: no division by p */
+        pm[k] /= T;
+        if (v != 0.0 && !(pm[k] * (double)len >= 0x1p-40)) status = ULAM_ERANGE;
+    }
+    return status;
 }
 
 /* What a visit to and a termination at row i score (see ulam__scores). */
@@ -234,6 +261,49 @@ static void prefetch_state(const ulam_kernel *k, int64_t j)
 #endif
 }
 
+/* The outcome of a move to state j along an entry of sign given by v: the target row's unit when
+ * placed, else the state to resolve; negative (flipping the weight) for v < 0. */
+static int32_t move_outcome(ulam_kernel *k, int64_t j, double v, int placed)
+{
+    if (!placed) prefetch_state(k, j); /* a walk here moves to one of these next */
+    int32_t t = placed ? atomic_load_explicit(&k->where[j], memory_order_relaxed) - 1 : ULAM__UNRESOLVED + (int32_t)j;
+    return v < 0 ? ~t : t;
+}
+
+/* The alias table of row i (header h built, continuation qi) at kernel exponent alpha != 1:
+ * the table is built on the outcomes' numbers, then each slot gets its two outcomes and their
+ * weight factors.  A probability too small for the table records ULAM_ERANGE (the dead row
+ * instead); a factor that is not finite, ULAM_ENONFINITE. */
+static void build_moves(ulam_kernel *k, int64_t i, ulam__row *h, double qi, int placed, ulam__kscratch *w)
+{
+    const ulam_csr *K = k->K;
+    int64_t b = K->rowptr[i], len = h->len - 1;
+    int status = len > 0 ? ulam__kernel_moves(K, i, qi, k->alpha, w->p, w->f) : ULAM_OK;
+    for (int64_t q = 0; !status && q < len; q++)
+        if (!isfinite(w->f[q])) status = ULAM_ENONFINITE;
+    if (status) {
+        dead_row(h, i);
+        fail(k, status, i);
+        return;
+    }
+    for (int64_t q = 0; q <= len; q++) {
+        if (q < len) w->p[q] *= qi;
+        w->o[q] = (int32_t)q;
+    }
+    w->p[len] = 1.0 - qi;
+    w->f[len] = 0.0; /* termination: never read */
+    ulam__slot *s = (ulam__slot *)(void *)h + ULAM__HEAD;
+    ulam__alias_build(w->p, w->o, len + 1, s, w->scaled, w->small, w->large);
+    for (int64_t q = 0; q < len; q++) w->large[q] = move_outcome(k, K->colidx[b + q], K->val[b + q], placed);
+    w->large[len] = ULAM__TERMINATE; /* the table is built: large is free scratch again */
+    int64_t u = s - k->mem;
+    for (int64_t q = 0; q <= len; q++) {
+        int32_t a = atomic_load_explicit(&s[q].a, memory_order_relaxed), c = atomic_load_explicit(&s[q].b, memory_order_relaxed);
+        k->fac[u + q][0] = w->f[a], k->fac[u + q][1] = w->f[c];
+        set_slot(&s[q], s[q].thresh, (int32_t)w->large[a], (int32_t)w->large[c]);
+    }
+}
+
 /* Build row i at header h: factor, scores and the alias table of its moves and termination.
  * Moves name their target rows' units when `placed` (every row has its place), else target
  * states still to be resolved.  A corrupt row (or no memory for its scratch) builds the dead
@@ -253,19 +323,20 @@ static void build_row(ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam_
         return;
     }
     double S = row_sum(K, i), qi = ulam__continuation(S, k->continue_q);
-    *h = (ulam__row){.factor = qi > 0 ? S / qi : 0.0, .len = (int32_t)(len + 1), .state = (int32_t)i};
+    *h = (ulam__row){.factor = qi > 0 && !k->fac ? S / qi : 0.0, .len = (int32_t)(len + 1), .state = (int32_t)i};
     row_scores(k, i, 1.0 - qi, &h->visit, &h->end);
     if (!isfinite(h->factor) || !isfinite(h->visit) || !isfinite(h->end)) {
         dead_row(h, i);
         fail(k, ULAM_ENONFINITE, i);
         return;
     }
+    if (k->fac) {
+        build_moves(k, i, h, qi, placed, w);
+        return;
+    }
     for (int64_t q = 0; q < len; q++) {
-        int64_t j = K->colidx[b + q];
-        if (!placed) prefetch_state(k, j); /* a walk here moves to one of these next */
-        int32_t t = placed ? atomic_load_explicit(&k->where[j], memory_order_relaxed) - 1 : ULAM__UNRESOLVED + (int32_t)j;
         w->p[q] = qi * fabs(K->val[b + q]) / S;
-        w->o[q] = K->val[b + q] < 0 ? ~t : t;
+        w->o[q] = move_outcome(k, K->colidx[b + q], K->val[b + q], placed);
     }
     w->p[len] = 1.0 - qi;
     w->o[len] = ULAM__TERMINATE;

@@ -26,7 +26,8 @@ typedef struct {
 /* A row's header, two units long, followed by its len alias slots: everything a step from
  * this state reads sits in one contiguous run of memory. */
 typedef struct {
-    double factor; /* S_i / q_i: the weight's factor on every move */
+    double factor; /* S_i / q_i: the weight's factor on every move (kernel exponent 1; else 0,
+                      each move's own factor sitting in the kernel's fac) */
     double visit;  /* scored (times the weight) on every visit */
     double end;    /* scored (times the weight) when the walk terminates here */
     int32_t len;   /* alias slots (nonzeros + 1 for termination) */
@@ -57,12 +58,15 @@ typedef struct ulam_kernel {
     _Atomic int32_t *where;
     const ulam_csr *K;
     double continue_q;
+    double alpha;       /* the kernel exponent: p_ij = q_i |K_ij|^alpha / sum_k |K_ik|^alpha */
+    double (*fac)[2];   /* alpha != 1: the weight factors |K_ij| / (q_i p_ij) of the two outcomes
+                           of the slot at each unit (a, b); NULL at alpha = 1 (the row's factor) */
     ulam__scores scores;
 } ulam_kernel;
 
 /* Per-thread scratch for building rows of up to cap outcomes (grown as rows need). */
 typedef struct {
-    double *p, *scaled;
+    double *p, *scaled, *f; /* f: the moves' factors (kernel exponent != 1) */
     int32_t *o;
     int64_t *small, *large;
     int64_t cap;
@@ -73,9 +77,18 @@ typedef struct {
 void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slot *s, double *scaled,
                        int64_t *small, int64_t *large);
 
-/* The kernel of K (which must outlive it; continue_q <= 0: analog), no row built yet: O(n)
- * time and 4 bytes a state.  ULAM_OK, ULAM_ENOMEM, or ULAM_EOVERFLOW past 2^30 units. */
-int ulam__kernel_alloc(const ulam_csr *K, double continue_q, ulam__scores scores, ulam_kernel **out);
+/* The kernel of K (which must outlive it; continue_q <= 0: analog) with exponent alpha, no row
+ * built yet: O(n) time and 4 bytes a state (alpha != 1: room for two factors a slot, reserved
+ * like the slots).  ULAM_OK, ULAM_ENOMEM, or ULAM_EOVERFLOW past 2^30 units. */
+int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam__scores scores, ulam_kernel **out);
+
+/* The moves of row i of K at kernel exponent alpha != 1 with continuation q > 0: pm[k] the
+ * probability of the move along the row's k-th entry given that the walk moves,
+ * (|K_ij| / m)^alpha / sum (m the row's largest |entry|, a stored zero weighing nothing), and
+ * f[k] its weight factor |K_ij| / (q pm[k]) (the sign is the entry's).  ULAM_OK, or ULAM_ERANGE
+ * when a probability is below 2^-40 / len (the alias table's 64-bit thresholds would bias it;
+ * such an f may be infinite). */
+int ulam__kernel_moves(const ulam_csr *K, int64_t i, double q, double alpha, double *pm, double *f);
 
 /* Free a kernel; accepts NULL. */
 ulam_kernel *ulam__kernel_free(ulam_kernel *k);
@@ -137,6 +150,14 @@ static inline int32_t ulam__slot_outcome(ulam__slot *s, uint64_t frac)
     int32_t a = atomic_load_explicit(&s->a, memory_order_acquire);
     int32_t b = atomic_load_explicit(&s->b, memory_order_acquire);
     return frac < s->thresh ? a : b;
+}
+
+/* The weight factor (without sign) of the move that fraction frac takes from slot s of row h:
+ * the row's at kernel exponent 1 (fac NULL), else the move's own (mem: the arena). */
+static inline double ulam__move_weight(double (*fac)[2], const ulam__slot *mem, const ulam__row *h,
+                                       const ulam__slot *s, uint64_t frac)
+{
+    return fac ? fac[s - mem][!(frac < s->thresh)] : h->factor;
 }
 
 /* The row unit a move with outcome o (taken by frac from slot s) reaches. */

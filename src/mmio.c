@@ -649,13 +649,19 @@ static int read_entries_parallel(int fd, int64_t data, int64_t end, const mm_hea
     return ULAM_OK;
 }
 
+/* The reader's defaults. */
+ulam_mm_opts ulam_mm_defaults(void)
+{
+    return (ulam_mm_opts){.threads = 0, .libc_strtod = 0};
+}
+
 /* Read a sparse matrix from f with options o (NULL: the defaults). */
 int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err)
 {
     ulam__clear(err);
     if (!f || !A) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a file and an output pointer");
     *A = NULL;
-    ulam_mm_opts opts = o ? *o : (ulam_mm_opts){0};
+    ulam_mm_opts opts = o ? *o : ulam_mm_defaults();
     name = name ? name : "input";
     int threads = ulam__threads(opts.threads), fd = fileno(f);
     long start = ftell(f);

@@ -24,6 +24,7 @@ struct ulam_push {
     double rmax;
     int64_t pushes, ops;
     double seconds;
+    ulam__bidir_memo memo; /* the last bidirectional plan on this push (src/bidir.c) */
 };
 
 /* Free a push workspace; accepts and returns NULL. */
@@ -31,6 +32,7 @@ ulam_push *ulam_push_free(ulam_push *w)
 {
     if (!w) return NULL;
     free(w->p), free(w->r), free(w->touched), free(w->mark), free(w->queue);
+    free(w->memo.idx), free(w->memo.val), free(w->memo.ones);
     free(w);
     return NULL;
 }
@@ -84,6 +86,7 @@ int ulam_push_start(ulam_push *w, int64_t target)
         w->mark[j] = 0;
     }
     w->ntouched = w->head = w->len = w->pushes = w->ops = 0;
+    w->memo.valid = 0;
     w->seconds = 0.0;
     w->target = target;
     w->rmax = INFINITY;
@@ -101,6 +104,7 @@ int ulam_push_run(ulam_push *w, double rmax, int64_t max_ops)
     double t0 = ulam_now();
     const ulam_csr *M = w->M;
     w->rmax = rmax;
+    w->memo.valid = 0;
     for (int64_t q = 0; q < w->ntouched; q++) enqueue(w, w->touched[q]);
     int status = ULAM_OK;
     while (w->len > 0) {
@@ -163,4 +167,10 @@ void ulam_push_report(const ulam_push *w, ulam_push_info *info)
 const ulam_csr *ulam__push_matrix(const ulam_push *w)
 {
     return w->M;
+}
+
+/* The workspace's memo of the last bidirectional plan. */
+ulam__bidir_memo *ulam__push_memo(ulam_push *w)
+{
+    return &w->memo;
 }

@@ -7,4 +7,24 @@
 /* The matrix a workspace pushes on. */
 const ulam_csr *ulam__push_matrix(const ulam_push *w);
 
+/* The last bidirectional plan made on a workspace (src/bidir.c fills it): the transpose and
+ * options it was made for, b's entries copied (idx, val: cap entries of room), what it found
+ * and the guards its pilot computed.  valid is
+ * cleared by ulam_push_start and ulam_push_run, so a valid memo describes the push in place. */
+typedef struct {
+    int valid;
+    const ulam_csr *Mt; /* the transpose it was made with */
+    ulam_bidir_opts o;
+    int64_t *idx;
+    double *val;
+    int64_t cap;
+    ulam_bidir_plan_info plan;
+    ulam_guard guard; /* the pilot's guards on Mt, for the walks (have_guard 0: none) */
+    int have_guard;
+    double *ones; /* n ones (NULL until a pilot needs them): the pilot's scores */
+} ulam__bidir_memo;
+
+/* The workspace's memo (owned by it, freed with it). */
+ulam__bidir_memo *ulam__push_memo(ulam_push *w);
+
 #endif

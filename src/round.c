@@ -8,6 +8,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* One process. */
+ulam_share ulam_share_defaults(void)
+{
+    return (ulam_share){.rank = 0, .nranks = 1, .allgather = NULL, .ctx = NULL};
+}
+
 /* Nonzero when a block starting at walk first may start. */
 int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first)
 {

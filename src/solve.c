@@ -48,9 +48,11 @@ struct ulam_solver {
     double tail_u, kappa;  /* the length tail (Collatz-Wielandt): |K| v <= tail_u v over reachable
                               states, kappa = max v / min v (tail_u 1: none) */
     double visit;          /* the start weight times the largest |score| of one visit */
+    double weight;         /* the weight bound W over reachable states (INFINITY with splitting) */
     double v2;             /* a certified bound on E[score^2] (INFINITY: none) */
     int signs;             /* scores may take both signs */
     char *seen;            /* the states walks can reach (kept for a rerun; NULL until needed) */
+    double *fac;           /* kernel exponent != 1: each move's weight factor over them (kept) */
     int64_t reach_nnz;     /* entries of M over the reachable rows (0 until computed) */
     int64_t setup_work;    /* entries read by reachability checks and score-bound passes so far */
     int passed;            /* the bounds pass over the reachable rows is done (kept for a rerun): */
@@ -73,7 +75,7 @@ struct ulam_solver {
 ulam_walk_opts ulam_walk_defaults(void)
 {
     return (ulam_walk_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_COLLISION, .seed = 1,
-                            .max_walks = 100000, .max_steps = 1000000};
+                            .max_walks = 100000, .max_steps = 1000000, .kernel_alpha = 1.0};
 }
 
 /* Free a solver; accepts and returns NULL. */
@@ -81,7 +83,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
 {
     if (!s) return NULL;
     ulam__kernel_free(s->k);
-    free(s->src), free(s->sum), free(s->sumsq), free(s->seen);
+    free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac);
     ulam_csr_free(s->mt);
     if (s->scratch)
         for (int t = 0; t < s->threads; t++) {
@@ -111,6 +113,9 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
         return ulam__fail(err, ULAM_EINVAL, 0, o->index, "an index from 0 to %lld", (long long)M->nrows - 1);
     if (o->continue_q > 0 && !(o->continue_q < 1))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a continuation probability below 1");
+    if (!(o->kernel_alpha >= 0) || !isfinite(o->kernel_alpha))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a kernel exponent alpha that is finite and >= 0 (got %g)",
+                          o->kernel_alpha);
     if (o->roulette < 0 || o->split < 0 || (o->split > 0 && o->roulette > 0 && o->split <= o->roulette))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "0 < roulette W < split W (or either off)");
     if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
@@ -143,12 +148,13 @@ static double row_sum(const ulam_csr *K, int64_t i)
     return S;
 }
 
-/* The largest product of weight factors S / q along any path among the seen states (the
- * weight a walk can reach, as a multiple of the weight it had anywhere on its way): a longest
- * path fixpoint, 1 when no factor exceeds 1; INFINITY when it does not settle within SWEEPS
- * passes (a cycle that grows weights, or paths too long to follow).  Growth below a relative
- * 1e-12 a pass is ignored (rounding of factors of exactly 1). */
-static double weight_growth(const ulam_csr *K, double continue_q, const char *seen)
+/* The largest product of weight factors S / q (fac: each move's own, kernel exponent != 1)
+ * along any path among the seen states (the weight a walk can reach, as a multiple of the
+ * weight it had anywhere on its way): a longest path fixpoint, 1 when no factor exceeds 1;
+ * INFINITY when it does not settle within SWEEPS passes (a cycle that grows weights, or paths
+ * too long to follow).  Growth below a relative 1e-12 a pass is ignored (rounding of factors
+ * of exactly 1). */
+static double weight_growth(const ulam_csr *K, double continue_q, const double *fac, const char *seen)
 {
     enum { SWEEPS = 64 };
     int64_t n = K->nrows;
@@ -160,9 +166,11 @@ static double weight_growth(const ulam_csr *K, double continue_q, const char *se
         changed = 0;
         for (int64_t i = 0; i < n; i++) {
             if (!seen[i]) continue;
-            double a = A[i] * ulam__factor(row_sum(K, i), continue_q);
-            for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++)
+            double a = fac ? 0.0 : A[i] * ulam__factor(row_sum(K, i), continue_q);
+            for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
+                if (fac) a = A[i] * fac[k];
                 if (K->val[k] != 0.0 && a > A[K->colidx[k]] * (1.0 + 1e-12)) A[K->colidx[k]] = a, changed = 1;
+            }
         }
     }
     for (int64_t i = 0; i < n; i++) best = fmax(best, seen[i] ? A[i] : 1.0);
@@ -214,8 +222,9 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
  * with weights u^(k/2), E[X^2] <= w0^2 c z_start / (1 - sqrt u)^2 (absorption, one score a
  * walk: w0^2 c z_start / (1 - u)).  z: iterates of I + M^ from g (so it fits the states that
  * score), floored at a few shares of its largest entry, the best bound kept; INFINITY when none
- * has u < 1. */
-static double second_moment(const ulam_solver *s, const ulam_csr *K, const char *seen, double w0, int *iterations)
+ * has u < 1.  At kernel exponent != 1, M^_ij = |K_ij| fac_ij, fac the moves' own factors. */
+static double second_moment(const ulam_solver *s, const ulam_csr *K, const double *fac, const char *seen, double w0,
+                            int *iterations)
 {
     enum { ITER = 300 };
     int64_t n = K->nrows;
@@ -243,8 +252,9 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const char 
             for (int64_t i = 0; i < n; i++) {
                 if (!seen[i]) continue;
                 double t = 0.0;
-                for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) t += fabs(K->val[k]) * v[K->colidx[k]];
-                y[i] = t * f[i];
+                for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++)
+                    t += fabs(K->val[k]) * (fac ? fac[k] : 1.0) * v[K->colidx[k]];
+                y[i] = fac ? t : t * f[i];
                 u = fmax(u, y[i] / v[i]), c = fmax(c, g[i] / v[i]), ymax = fmax(ymax, y[i] + v[i]);
                 z0 += adj ? (i == s->o.index ? v[i] : 0.0) : fabs(s->b[i]) / w0 * v[i];
             }
@@ -259,6 +269,22 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const char 
     }
     free(g), free(v), free(y), free(f);
     return best;
+}
+
+/* The weight factors |K_ij| / (q_i p_ij) of the moves of the seen rows of K at kernel exponent
+ * alpha != 1, one per entry (0 in the other rows; infinite where a probability underflows);
+ * NULL when out of memory. */
+static double *move_factors(const ulam_csr *K, const char *seen, double continue_q, double alpha)
+{
+    int64_t nnz = K->rowptr[K->nrows];
+    double *f = ulam__calloc((size_t)nnz, sizeof *f), *pm = ulam__malloc((size_t)nnz, sizeof *pm);
+    for (int64_t i = 0; f && pm && i < K->nrows; i++) {
+        double q = seen[i] ? ulam__kernel_q(K, i, continue_q) : 0.0;
+        if (q > 0) (void)ulam__kernel_moves(K, i, q, alpha, pm + K->rowptr[i], f + K->rowptr[i]);
+    }
+    if (!pm) free(f), f = NULL;
+    free(pm);
+    return f;
 }
 
 /* The states walks can reach (s->seen, computed once and kept) and their entries (s->reach_nnz). */
@@ -288,19 +314,23 @@ static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 /* The one pass over the reachable rows that every estimator's score bounds come from (kept):
  * for each estimator the largest visit score, single score and g^2 / p*, and absorption's first
  * scoring state with p* = 0; the weight bound and the scores' signs. */
-static void bounds_pass(ulam_solver *s, const ulam_csr *K)
+static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
     const char *seen = s->seen;
+    double *fac = NULL; /* kernel exponent != 1: each move's own weight factor (kept: s->fac) */
+    if (s->o.kernel_alpha != 1.0 && !(fac = s->fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
     int adj = s->o.mode == ULAM_ADJOINT, pos = 0, neg = 0, any = 0;
     int64_t bad = -1;
     double w0 = 1.0, fbig = 0.0, gabs = 0.0, g2abs = 0.0, vb = 0.0, vexp = 0.0, qmax = 0.0;
     for (int64_t i = 0; i < s->n; i++) {
         if (!seen[i]) continue;
         double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
-        fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
+        if (!fac) fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
         qmax = fmax(qmax, q);
         for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
             neg |= K->val[k] < 0;
+            if (fac) fbig = fmax(fbig, fac[k]);
             if (adj) c += K->val[k] * s->b[K->colidx[k]];
         }
         if ((adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
@@ -317,7 +347,7 @@ static void bounds_pass(ulam_solver *s, const ulam_csr *K)
     }
     if (!adj)
         for (int64_t i = 0; i < s->n; i++) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
-    double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, seen) : 1.0;
+    double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
     if (!adj) {
         w0 = 0.0;
         for (int64_t i = 0; i < s->n; i++) w0 += fabs(s->b[i]);
@@ -335,6 +365,7 @@ static void bounds_pass(ulam_solver *s, const ulam_csr *K)
     s->pass_signs = pos && neg;
     s->passed = 1;
     s->setup_work += s->reach_nnz;
+    return ULAM_OK;
 }
 
 /* Over the states walks can reach: absorption's p* > 0 wherever it scores (else ULAM_EUNDEFINED
@@ -349,7 +380,7 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
     int status = reach(s, K, err);
     if (status) return status;
-    if (!s->passed) bounds_pass(s, K);
+    if (!s->passed && (status = bounds_pass(s, K, err))) return status;
     int e = s->o.estimator, absorb = e == ULAM_ABSORPTION, adj = s->o.mode == ULAM_ADJOINT, it = 0;
     double vmax = s->pass[e].vmax, Wmax = s->pass_W, w0 = s->pass_w0;
     if (s->pass[e].bad >= 0)
@@ -366,11 +397,12 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     }
     if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
         (absorb ? isfinite(s->pass[e].g2max) : isfinite(vmax))) {
-        if (!s->v2_done[e]) s->v2c[e] = second_moment(s, K, s->seen, w0, &it), s->v2_done[e] = 1;
+        if (!s->v2_done[e]) s->v2c[e] = second_moment(s, K, s->fac, s->seen, w0, &it), s->v2_done[e] = 1;
         s->v2 = s->v2c[e];
     }
     s->setup_work += (int64_t)it * s->reach_nnz;
     double W = Wmax, gmax = s->pass[e].gmax;
+    s->weight = W;
     s->signs = s->pass_signs;
     s->bound = gmax > 0 ? W * gmax : 0.0;
     s->range = s->bound * (s->signs ? 2.0 : 1.0);
@@ -405,7 +437,7 @@ static int check_bounded(const ulam_solver *s, ulam_error *err)
  * target no bound certifies (check_bounded). */
 static int take_bounds(ulam_solver *s, const ulam_csr *K, int rel_alone, ulam_error *err)
 {
-    s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = INFINITY;
+    s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = s->weight = INFINITY;
     s->qmax = s->tail_u = 1.0;
     s->signs = 0;
     int status = s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0 ? check_reach(s, K, err) : ULAM_OK;
@@ -418,12 +450,14 @@ static int take_guard(const ulam_csr *M, const ulam_walk_opts *o, ulam_guard *g,
 {
     int need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(o->mode);
     double q = o->continue_q > 0 ? o->continue_q : 0.0;
-    if (o->guard && (o->guard->continue_q > 0 ? o->guard->continue_q : 0.0) == q && (o->guard->computed & need) == need) {
+    if (o->guard && (o->guard->continue_q > 0 ? o->guard->continue_q : 0.0) == q &&
+        o->guard->kernel_alpha == o->kernel_alpha && (o->guard->computed & need) == need) {
         *g = *o->guard;
         return ULAM_OK;
     }
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = need;
+    go.kernel_alpha = o->kernel_alpha;
     return ulam_guard_check(M, o->continue_q, &go, g, err);
 }
 
@@ -445,14 +479,17 @@ static int check_verdicts(const ulam_csr *M, ulam_solver *s, ulam_error *err)
     ulam_guard og = s->g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_HAT(other);
+    go.kernel_alpha = o->kernel_alpha;
     if (!(og.computed & go.need) && ulam_guard_check(M, o->continue_q, &go, &og, NULL)) og.verdict_hat[other] = ULAM_VERDICT_UNKNOWN;
     char also[96] = "; the other mode's is not certified finite either";
     if (ulam_guard_variance(&og, other) == 1)
         snprintf(also, sizeof also, "; the %s mode's is finite, %.4g < 1", other == ULAM_ADJOINT ? "adjoint" : "forward",
                  og.hat[other].upper);
+    char alpha[48] = "";
+    if (o->kernel_alpha != 1.0) snprintf(alpha, sizeof alpha, " at kernel exponent alpha = %g", o->kernel_alpha);
     return ulam__fail(err, ULAM_EINFVAR, 0, -1,
-                      "a finite variance for a relative-error target: rho(M^) of the %s kernel is in [%.4g, %.4g] (%s)%s",
-                      o->mode == ULAM_ADJOINT ? "adjoint" : "forward", h->lower, h->upper,
+                      "a finite variance for a relative-error target: rho(M^) of the %s kernel%s is in [%.4g, %.4g] (%s)%s",
+                      o->mode == ULAM_ADJOINT ? "adjoint" : "forward", alpha, h->lower, h->upper,
                       s->var_finite == 0 ? ">= 1: infinite" : "straddles 1: unknown", also);
 }
 
@@ -522,6 +559,10 @@ static int kernel_failure(const ulam_kernel *k, ulam_error *err)
     if (!status) return ULAM_OK;
     int64_t i = atomic_load(&k->bad);
     if (status == ULAM_ENOMEM) return ulam__fail(err, status, 0, i, "memory to build a walk kernel row");
+    if (status == ULAM_ERANGE)
+        return ulam__fail(err, status, 0, i, "row %lld (1-based) with every move's probability |K_ij|^alpha / "
+                          "sum_k |K_ik|^alpha at least 2^-40 / its length at kernel exponent alpha = %g (its entries "
+                          "are too uneven for this alpha: a lower one samples them)", (long long)i + 1, k->alpha);
     return ulam__fail(err, status, 0, i, "row %lld (1-based) with its range in rowptr, columns in range and "
                       "finite, nonzero values and score (the matrix is corrupt)", (long long)i + 1);
 }
@@ -556,7 +597,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         K = s->mt;
     }
     ulam__scores sc = {o.mode == ULAM_ADJOINT ? b : NULL, o.estimator};
-    if ((status = ulam__kernel_alloc(K, o.continue_q, sc, &s->k)) == ULAM_EOVERFLOW) {
+    if ((status = ulam__kernel_alloc(K, o.continue_q, o.kernel_alpha, sc, &s->k)) == ULAM_EOVERFLOW) {
         ulam_solver_free(s);
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
@@ -710,6 +751,25 @@ static double score_range(const ulam_solver *s, double m, double E)
     return isfinite(R) ? R : ulam__moment_range(s->v2, s->signs, m, E);
 }
 
+/* The walks the rel_err rule's range term would need at estimate m and target E if a visit
+ * scored at most per_visit times the walk's weight (absorption: a termination per_visit / p*),
+ * both signs when signs, under this solver's reachability bounds, which must have been made for
+ * scores of at most 1 a visit (b = 1; check_reach runs for rel_err > 0 or absorption): the
+ * per-visit route of score_range, or the second moment's scaled by per_visit^2; INFINITY when
+ * neither gives a bound.  For a planner that knows the scores only after these walks' set-up
+ * (src/bidir.c: the push's residual). */
+double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E)
+{
+    if (!(per_visit > 0)) return 0.0;
+    signs = signs || s->signs;
+    int q = s->qmax < 1.0, absorb = s->o.estimator == ULAM_ABSORPTION;
+    double R = absorb ? (q ? s->weight * per_visit / (1.0 - s->qmax) * (signs ? 2.0 : 1.0) : INFINITY)
+                      : ulam__score_range(INFINITY, s->weight * per_visit, q ? s->qmax : s->tail_u, q ? 1.0 : s->kappa,
+                                          signs, m, E);
+    if (!isfinite(R) && !absorb) R = ulam__moment_range(s->v2 * per_visit * per_visit, signs, m, E);
+    return isfinite(R) ? ulam__rel_min_walks(R, E, m) : INFINITY;
+}
+
 /* The most the walks cut at max_steps can have moved the mean (0 without cuts). */
 static double cut_bound(const ulam_solver *s)
 {
@@ -842,8 +902,8 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     s->o.seed = seed;
     double bnorm1 = 0.0;
     if (build_source(s, &bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");
-    free(s->seen); /* the reachable set and the score bounds depend on b */
-    s->seen = NULL;
+    free(s->seen), free(s->fac); /* the reachable set and the score bounds depend on b */
+    s->seen = NULL, s->fac = NULL;
     s->passed = s->tail_done = 0;
     memset(s->v2_done, 0, sizeof s->v2_done);
     if (s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0) {
@@ -865,9 +925,10 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *e
     ulam_walk_opts o = *opts;
     double q0 = s->o.continue_q > 0 ? s->o.continue_q : 0.0, q1 = o.continue_q > 0 ? o.continue_q : 0.0;
     if (o.mode != s->o.mode || o.index != s->o.index || q0 != q1 || o.roulette != s->o.roulette ||
-        o.split != s->o.split || o.max_steps != s->o.max_steps || ulam__threads(o.threads) != s->threads)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the solver's mode, index, continuation, weight window, max_steps "
-                                                   "and threads");
+        o.split != s->o.split || o.max_steps != s->o.max_steps || o.kernel_alpha != s->o.kernel_alpha ||
+        ulam__threads(o.threads) != s->threads)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the solver's mode, index, continuation, kernel exponent, weight "
+                                                   "window, max_steps and threads");
     int status = check_opts(s->M, &o, err);
     if (status) return status;
     if (atomic_load(&s->k->status)) return kernel_failure(s->k, err);

@@ -1,9 +1,61 @@
-/* Pieces of variance studies: the Gauss-Seidel reference, cell summaries, and the
- * collision-absorption law of the lecture notes with its exact variances. */
+/* Pieces of variance studies an embedding program needs to repeat one: the method grid (what
+ * each of the study's method names means as walk options) and the exact value a study scores
+ * against (LAPACK, or Gauss-Seidel run until x_I settles). */
 #include "internal.h"
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
+
+/* The grid, k = 9 mode + 3 estimator + window. */
+static const ulam_study_method methods[ULAM_STUDY_METHODS] = {
+    {"adjoint-collision-plain", ULAM_ADJOINT, ULAM_COLLISION, ULAM_WINDOW_PLAIN},
+    {"adjoint-collision-roulette", ULAM_ADJOINT, ULAM_COLLISION, ULAM_WINDOW_ROULETTE},
+    {"adjoint-collision-split", ULAM_ADJOINT, ULAM_COLLISION, ULAM_WINDOW_SPLIT},
+    {"adjoint-absorption-plain", ULAM_ADJOINT, ULAM_ABSORPTION, ULAM_WINDOW_PLAIN},
+    {"adjoint-absorption-roulette", ULAM_ADJOINT, ULAM_ABSORPTION, ULAM_WINDOW_ROULETTE},
+    {"adjoint-absorption-split", ULAM_ADJOINT, ULAM_ABSORPTION, ULAM_WINDOW_SPLIT},
+    {"adjoint-expected-plain", ULAM_ADJOINT, ULAM_EXPECTED, ULAM_WINDOW_PLAIN},
+    {"adjoint-expected-roulette", ULAM_ADJOINT, ULAM_EXPECTED, ULAM_WINDOW_ROULETTE},
+    {"adjoint-expected-split", ULAM_ADJOINT, ULAM_EXPECTED, ULAM_WINDOW_SPLIT},
+    {"forward-collision-plain", ULAM_FORWARD, ULAM_COLLISION, ULAM_WINDOW_PLAIN},
+    {"forward-collision-roulette", ULAM_FORWARD, ULAM_COLLISION, ULAM_WINDOW_ROULETTE},
+    {"forward-collision-split", ULAM_FORWARD, ULAM_COLLISION, ULAM_WINDOW_SPLIT},
+    {"forward-absorption-plain", ULAM_FORWARD, ULAM_ABSORPTION, ULAM_WINDOW_PLAIN},
+    {"forward-absorption-roulette", ULAM_FORWARD, ULAM_ABSORPTION, ULAM_WINDOW_ROULETTE},
+    {"forward-absorption-split", ULAM_FORWARD, ULAM_ABSORPTION, ULAM_WINDOW_SPLIT},
+    {"forward-expected-plain", ULAM_FORWARD, ULAM_EXPECTED, ULAM_WINDOW_PLAIN},
+    {"forward-expected-roulette", ULAM_FORWARD, ULAM_EXPECTED, ULAM_WINDOW_ROULETTE},
+    {"forward-expected-split", ULAM_FORWARD, ULAM_EXPECTED, ULAM_WINDOW_SPLIT},
+};
+
+/* Method k of the grid, or NULL out of range. */
+const ulam_study_method *ulam_study_method_get(int k)
+{
+    return k >= 0 && k < ULAM_STUDY_METHODS ? &methods[k] : NULL;
+}
+
+/* The index of the method named name, or -1. */
+int ulam_study_method_find(const char *name)
+{
+    for (int k = 0; name && k < ULAM_STUDY_METHODS; k++)
+        if (!strcmp(name, methods[k].name)) return k;
+    return -1;
+}
+
+/* Set o's mode, estimator and weight window for method k on b. */
+int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o)
+{
+    const ulam_study_method *m = ulam_study_method_get(k);
+    if (!m || !o || (m->mode == ULAM_FORWARD && (!b || n < 0))) return ULAM_EINVAL;
+    double w0 = m->mode == ULAM_FORWARD ? 0.0 : 1.0; /* forward particles start at ||b||_1 */
+    if (m->mode == ULAM_FORWARD)
+        for (int64_t i = 0; i < n; i++) w0 += fabs(b[i]);
+    o->mode = m->mode, o->estimator = m->estimator;
+    o->roulette = m->window >= ULAM_WINDOW_ROULETTE ? 0.5 * w0 : 0.0;
+    o->split = m->window == ULAM_WINDOW_SPLIT ? 2.0 * w0 : 0.0;
+    return ULAM_OK;
+}
 
 /* One Gauss-Seidel sweep on x = M x + b. */
 void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x)
@@ -29,77 +81,23 @@ int ulam_gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int6
     return k;
 }
 
-/* Summarise n runs against the exact value. */
-void ulam_cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
-                       double exact, ulam_cell *out)
-{
-    double se2 = 0, se = 0, t = 0;
-    int covered = 0;
-    for (int k = 0; k < n; k++) {
-        double e = estimate[k] - exact;
-        se2 += e * e, se += std_error[k], t += seconds[k];
-        covered += fabs(e) <= ULAM_Z95 * std_error[k];
-    }
-    double N = n > 0 ? n : 1;
-    *out = (ulam_cell){.runs = n, .rmse = sqrt(se2 / N), .mean_stderr = se / N, .coverage = covered / N,
-                       .seconds = t / N};
-    out->honesty = out->mean_stderr > 0 ? out->rmse / out->mean_stderr : INFINITY;
-    out->work = out->rmse * out->rmse * out->seconds;
-}
-
-/* Exact variances of the two forward estimators at the start state (h = 1). */
-void ulam_law_variances(double pstar, double s, double *var_collision, double *var_absorption)
-{
-    *var_collision = (1 - s) / (s * s);
-    *var_absorption = pstar > 0 ? 1 / (pstar * s) - 1 / (s * s) : INFINITY;
-}
-
-/* The forward kernel's transition matrix P (P_jk = q_j |M_kj| / S_j) with row j zeroed, and
- * its column j in c; the row sum S_j in *Sj. */
-static int kernel_without(const ulam_csr *M, int64_t j, ulam_csr **Q, double *c, double *pj, double *Sj)
-{
-    ulam_csr *K = NULL;
-    int status = ulam_csr_transpose(M, &K);
-    if (status) return status;
-    for (int64_t i = 0; i < K->nrows; i++) {
-        double S = 0;
-        for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++) S += fabs(K->val[q]);
-        double qi = ulam__continuation(S, 0.0);
-        if (i == j) *Sj = S;
-        c[i] = 0;
-        for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++) {
-            double p = S > 0 ? qi * fabs(K->val[q]) / S : 0.0;
-            if (i == j) pj[K->colidx[q]] += p;
-            if (i == j || K->colidx[q] == j) {
-                if (i != j) c[i] += p;
-                p = 0.0;
-            }
-            K->val[q] = p;
-        }
-    }
-    *Q = K;
-    return ULAM_OK;
-}
-
-/* s = 1 - sum_k P_jk h_k, h the probabilities of hitting j (h_j = 1). */
-int ulam_law_noreturn(const ulam_csr *M, int64_t j, double *s, double *pstar, ulam_error *err)
+/* The exact x_index a study scores against. */
+int ulam_study_reference(const ulam_csr *M, const double *b, int64_t index, ulam_study_ref *ref, ulam_error *err)
 {
     ulam__clear(err);
-    if (!M || !s || !pstar || M->nrows != M->ncols || j < 0 || j >= M->nrows)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a square matrix and a state in range");
+    if (!M || !b || !ref || M->nrows != M->ncols || index < 0 || index >= M->nrows)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a square matrix, b and an index in range");
     int64_t n = M->nrows;
-    double *c = ulam__calloc((size_t)n, sizeof *c), *pj = ulam__calloc((size_t)n, sizeof *pj);
-    double *h = ulam__malloc((size_t)n, sizeof *h), Sj = 0;
-    ulam_csr *Q = NULL;
-    int status = c && pj && h ? kernel_without(M, j, &Q, c, pj, &Sj) : ULAM_ENOMEM;
-    if (!status) status = ulam_direct_solve(Q, c, h, 0, NULL, err);
-    if (!status) {
-        double back = 0;
-        for (int64_t k = 0; k < n; k++) back += pj[k] * (k == j ? 1.0 : h[k]);
-        *s = 1 - back;
-        *pstar = 1 - ulam__continuation(Sj, 0.0);
+    double *x = ulam__calloc((size_t)n, sizeof *x), *xd = NULL;
+    if (!x) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the reference solve");
+    *ref = (ulam_study_ref){0};
+    ref->sweeps = ulam_gauss_seidel_settle(M, b, x, index, 1e-16, 12, 100000);
+    ref->exact = ref->settled = x[index];
+    ulam_direct_info info;
+    if (n <= ULAM_STUDY_DIRECT_MAX && (xd = ulam__malloc((size_t)n, sizeof *xd)) &&
+        !ulam_direct_solve(M, b, xd, 0, &info, NULL)) { /* LAPACK failing leaves Gauss-Seidel's */
+        ref->direct = 1, ref->direct_seconds = info.seconds, ref->exact = xd[index];
     }
-    ulam_csr_free(Q);
-    free(c), free(pj), free(h);
-    return status ? ulam__fail(err, status, 0, j, "a chain whose hitting probabilities are defined") : ULAM_OK;
+    free(x), free(xd);
+    return ULAM_OK;
 }

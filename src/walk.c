@@ -24,6 +24,14 @@
 
 enum { LANES = 32 }; /* at most; the solver picks 16 for kernels that fit in cache */
 
+/* The walk loops are compiled twice, for the kernel's per-row factor (exponent 1, fac NULL) and
+ * for per-move factors, so the common case pays nothing for the other. */
+#if defined(__GNUC__)
+#define WALK_INLINE __attribute__((always_inline)) inline
+#else
+#define WALK_INLINE inline
+#endif
+
 /* Ask for the cache line at p ahead of its use. */
 static inline void prefetch(const void *p)
 {
@@ -63,7 +71,7 @@ static int window(const ulam__walker *w, int32_t u, double *wt, ulam_rng *r, sta
     return 1;
 }
 
-/* Take the move to outcome o (read from the alias slot s) of a row with factor f: the weight gets the
+/* Take the move to outcome o (read from the alias slot s) with weight factor f: the weight gets the
  * factor and the move's sign; returns the target row's unit. */
 static inline int32_t target(ulam_kernel *k, ulam__slot *s, uint64_t frac, int32_t o, double f, double *wt,
                              ulam__kscratch *ks)
@@ -109,12 +117,13 @@ static int lane_pop(const ulam__walker *w, lane *x)
  * the walker would reload them on every step. */
 typedef struct {
     ulam__slot *mem;
+    double (*fac)[2]; /* the moves' own factors (kernel exponent != 1), or NULL */
     int64_t max_steps;
     int window; /* roulette or splitting in force */
 } step_consts;
 
 /* Lane x's step: 1 while its particle lives on. */
-static inline int lane_move(const ulam__walker *w, step_consts c, lane *x, ulam_rng *r, ulam__kscratch *ks,
+static WALK_INLINE int lane_move(const ulam__walker *w, step_consts c, lane *x, ulam_rng *r, ulam__kscratch *ks,
                             ulam__block *out)
 {
     int32_t o = ulam__slot_outcome(x->s, x->frac);
@@ -122,7 +131,7 @@ static inline int lane_move(const ulam__walker *w, step_consts c, lane *x, ulam_
         x->score += x->w * x->h->end;
         return 0;
     }
-    int32_t u = target(w->k, x->s, x->frac, o, x->h->factor, &x->w, ks);
+    int32_t u = target(w->k, x->s, x->frac, o, ulam__move_weight(c.fac, c.mem, x->h, x->s, x->frac), &x->w, ks);
     x->h = (ulam__row *)(void *)(c.mem + u);
     prefetch(x->h);
     out->steps++;
@@ -148,9 +157,9 @@ static void record(ulam__block *out, double score)
 
 /* Run count adjoint histories, w->lanes at a time, counting into a local block (the caller's
  * blocks sit side by side in memory, and writing them on every step would share cache lines
- * between threads). */
-void ulam__adjoint_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam__scratch *sc,
-                         ulam__block *out)
+ * between threads); fac: the kernel's per-move factors or NULL. */
+static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam_rng *r, ulam__scratch *sc,
+                                      ulam__block *out, double (*fac)[2])
 {
     ulam__block acc = {.t = out->t};
     acc.t.len = 0;
@@ -158,7 +167,7 @@ void ulam__adjoint_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam
     int lanes = w->lanes < 1 ? 1 : w->lanes > LANES ? LANES : w->lanes;
     int64_t cap = sc->stack_cap / lanes, started = 0;
     int act = 0;
-    const step_consts c = {w->k->mem, w->max_steps, w->roulette > 0 || w->split > 0};
+    const step_consts c = {w->k->mem, fac, w->max_steps, w->roulette > 0 || w->split > 0};
     for (; act < lanes && started < count; act++, started++) {
         L[act].st = (stack){sc->stack_s + act * cap, sc->stack_w + act * cap, 0, cap};
         lane_start(w, &L[act]);
@@ -194,8 +203,16 @@ void ulam__adjoint_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam
     *out = acc;
 }
 
+/* Run count adjoint histories (see adjoint_lanes). */
+void ulam__adjoint_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam__scratch *sc,
+                         ulam__block *out)
+{
+    if (w->k->fac) adjoint_lanes(w, count, r, sc, out, w->k->fac);
+    else adjoint_lanes(w, count, r, sc, out, NULL);
+}
+
 /* Add v to state s's tally for this history. */
-static void tally(ulam__scratch *sc, int32_t s, double v)
+static WALK_INLINE void tally(ulam__scratch *sc, int32_t s, double v)
 {
     if (!sc->mark[s]) {
         sc->mark[s] = 1;
@@ -206,7 +223,7 @@ static void tally(ulam__scratch *sc, int32_t s, double v)
 
 /* Add this history's tallies to the block's sums (and the watched component's moments) and
  * clear them. */
-static void emit(const ulam__walker *w, ulam__scratch *sc, ulam__block *out)
+static WALK_INLINE void emit(const ulam__walker *w, ulam__scratch *sc, ulam__block *out)
 {
     for (int64_t q = 0; q < sc->ntouched; q++) {
         int64_t s = sc->touched[q];
@@ -238,7 +255,7 @@ static int flush(ulam__scratch *sc, ulam__tallies *out)
 }
 
 /* Tally a visit to row h with weight wt. */
-static void forward_visit(const ulam__walker *w, ulam__scratch *sc, const ulam__row *h, double wt)
+static WALK_INLINE void forward_visit(const ulam__walker *w, ulam__scratch *sc, const ulam__row *h, double wt)
 {
     if (h->visit != 0.0) tally(sc, h->state, wt * h->visit);
     if (w->expected)
@@ -246,10 +263,13 @@ static void forward_visit(const ulam__walker *w, ulam__scratch *sc, const ulam__
             tally(sc, w->mt->colidx[q], wt * w->mt->val[q]);
 }
 
-/* One forward history: its tallies go to the block's sums (emit). */
-static void forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc, ulam__block *out)
+/* One forward history: its tallies go to the block's sums (emit); fac: the kernel's per-move
+ * factors or NULL. */
+static WALK_INLINE void forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *sc, ulam__block *out,
+                                   double (*fac)[2])
 {
     ulam_kernel *k = w->k;
+    ulam__slot *mem = k->mem; /* a local: see step_consts */
     uint64_t frac;
     ulam__slot *src = w->src + ulam__rng_index(r, (uint64_t)k->n, &frac);
     int32_t o = ulam__slot_outcome(src, frac);
@@ -269,7 +289,7 @@ static void forward_history(const ulam__walker *w, ulam_rng *r, ulam__scratch *s
                 if (h->end != 0.0) tally(sc, h->state, wt * h->end);
                 break;
             }
-            int32_t u = target(k, sl, frac, o, h->factor, &wt, sc->ks);
+            int32_t u = target(k, sl, frac, o, ulam__move_weight(fac, mem, h, sl, frac), &wt, sc->ks);
             h = ulam__kernel_row(k, u);
             out->steps++;
             if (++len > w->max_steps || !isfinite(wt)) {
@@ -293,7 +313,8 @@ void ulam__forward_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam
     acc.t.len = 0;
     int64_t c = 0;
     for (; c < count; c++) {
-        forward_history(w, r, sc, &acc);
+        if (w->k->fac) forward_history(w, r, sc, &acc, w->k->fac);
+        else forward_history(w, r, sc, &acc, NULL);
         if ((c & 63) == 63 && w->interrupt && *w->interrupt) break;
     }
     acc.nomem = flush(sc, &acc.t) != ULAM_OK; /* out of memory: the run must fail, not stop short */

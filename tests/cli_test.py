@@ -3,7 +3,9 @@
 
 A table of cases, each (arguments, expected exit code, regex the stderr must match,
 regex the stdout must match).  Exit codes are 10 + the library status (see README).
-Run from the source root: cli_test.py path/to/ulam
+Run from the source root: cli_test.py path/to/ulam path/to/genmat [--no-radiosity] [--case NAME]...
+A failing case prints its name: `table:K` (K-th row of CASES, from 0) or a check function
+(`check_study`); `--case NAME` (repeatable) runs only those, e.g. --case table:12 --case check_study.
 """
 import json
 import os
@@ -74,6 +76,24 @@ CASES += [  # counts written as whole numbers in exponent form are counts; fract
               "/nonexistent/dir/e.mtx"], 13, r"/nonexistent/dir/e\.mtx: error: .*writable output file", r"^$"),
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--out", "/nonexistent/dir/x.mtx"], 13,
      r"/nonexistent/dir/x\.mtx: error: .*writable output file", r"^$"),
+]
+CASES += [  # the kernel exponent: finite and >= 0; it changes rho(M^) (chain4: 0.68..0.9 at 0, >= 1 at 3)
+    (["info", M + "signed200.mtx"], 0, r"^$", r"variance forward finite"),
+    (["info", M + "signed200.mtx", "--alpha", "2"], 0, r"^$",
+     r"rho\(M\^\) forward  1\.04\d+ .* at kernel exponent alpha = 2\n(.*\n)*variance forward infinite"),
+    (["info", M + "signed200.mtx", "--alpha", "-0.5"], 2, r"--alpha expects a number from 0 to 1000", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "-1"], 2, r"--alpha expects a number from 0 to 1000, got '-1'", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "nan"], 2, r"--alpha expects a number from 0 to 1000, got 'nan'", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "inf"], 2, r"--alpha expects a number from 0 to 1000, got 'inf'", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "two"], 2, r"--alpha expects a number from 0 to 1000, got 'two'", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", ""], 2, r"--alpha expects a number", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "0", "--walks", "20000"], 0, r"^$",
+     r"95% CI[^\n]*\n(.*\n)*guards .*rho\(M\^\) in \[0\.68\d*, 0\.9\] \(below 1\) at kernel exponent alpha = 0\n"),
+    (SOLVE + ["--index", "1", "--alpha", "3", "--walks", "20000"], 0,
+     r"warning: rho\(M\^\) >= 1 .* for the adjoint kernel of exponent alpha = 3: the estimator's variance is infinite",
+     r"no confidence interval|not certified|infinite"),
+    (SOLVE + ["--index", "1", "--alpha", "3", "--rel-err", "0.01"], 4,
+     r"--rel-err 0\.01 can never be met: .*rho\(M\^\) of the adjoint kernel at kernel exponent alpha = 3 is in", r"^$"),
 ]
 DIV = ["solve", "--method", "walks", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1"]
 RS0 = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1"]
@@ -162,6 +182,11 @@ BAD_SCENES = [  # file, status, the file:line the message must name
     ("no_usemtl.obj", "ENOTFOUND", O + "no_usemtl.obj:6"), ("bad_vertex.obj", "ESYNTAX", O + "bad_vertex.obj:3"),
     ("unknown_statement.obj", "ESYNTAX", O + "unknown_statement.obj:7"), ("empty.obj", "EEMPTY", O + "empty.obj:2"),
     ("repeated_newmtl.obj", "ESYNTAX", O + "repeated_newmtl.mtl:7"), ("kd_spectral.obj", "EUNSUPPORTED", O + "kd_spectral.mtl:2"),
+    # the review's findings: a second Ke overrode the first silently; mtllib twice blamed the MTL's line 1;
+    # w = 0 was accepted; 1e200 said "degenerate"; a face before any vertex asked for "1 to 0"
+    ("repeated_ke.obj", "ESYNTAX", O + "repeated_ke.mtl:4"), ("mtllib_twice.obj", "ESYNTAX", O + "mtllib_twice.obj:3"),
+    ("vertex_w0.obj", "ERANGE", O + "vertex_w0.obj:4"), ("huge_coord.obj", "ERANGE", O + "huge_coord.obj:4"),
+    ("face_before_vertex.obj", "EINDEX", O + "face_before_vertex.obj:3"),
 ]
 for f, status, where in BAD_SCENES:
     CASES.append((["radiosity", O + f, "--patch", "1"], code(status), rf"^ulam: {re.escape(where)}: error: .*expected ", ""))
@@ -184,6 +209,15 @@ CASES += [
     (["radiosity", O + "kd_spectral.obj", "--patch", "1"], code("EUNSUPPORTED"),
      r"kd_spectral.mtl:2: error: unsupported kind of data: expected Kd r g b \(RGB only\): this file gives a spectral curve", ""),
     (["radiosity", O + "unknown_statement.obj", "--patch", "1"], code("ESYNTAX"), r"vt, vn, vp, s, l, p, mg, lod, .* ignored", ""),
+    (["radiosity", O + "repeated_ke.obj", "--patch", "1"], code("ESYNTAX"), r"one Ke per material: 'lamp' has one at line 3", ""),
+    (["radiosity", O + "mtllib_twice.obj", "--patch", "1"], code("ESYNTAX"), r"ok.mtl was read at line 1", ""),
+    (["radiosity", O + "vertex_w0.obj", "--patch", "1"], code("ERANGE"), r"w = 1 .*got w = 0", ""),
+    (["radiosity", O + "huge_coord.obj", "--patch", "1"], code("ERANGE"), r"within \+-1e\+30 .*got 1e\+200", ""),
+    (["radiosity", O + "face_before_vertex.obj", "--patch", "1"], code("EINDEX"), r"a 'v' line before the first face", ""),
+    # an unlit scene: direct and walks both exactly 0 printed z = -nan
+    (["radiosity", O + "unlit.obj", "--patch", "1", "--direct", "--walks", "1000"], 0, r"^$", r"direct R +0 \+- 0 \(form-factor noise\)  z = 0\.000"),
+    (["radiosity", O + "unlit.obj", "--patch", "1", "--matrix-walk", "--walks", "1000"], 0, r"^$",
+     r"walks +3000 matrix gather walks.*\n +\(one walk a channel: 1000 R \+ 1000 G \+ 1000 B\)"),
 ]
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends --rel-err (it spun forever)
     CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0,
@@ -315,15 +349,19 @@ def run(ulam, args):
     return p.returncode, p.stdout, p.stderr
 
 
-def check_table(ulam):
+def check_table(ulam, only=None):
+    """Run the rows of CASES (those in `only`, a set of indices, when given); (failures, rows run)."""
     failures = 0
-    for args, want_rc, err_re, out_re in CASES:
+    rows = [k for k in range(len(CASES)) if only is None or k in only]
+    for k in rows:
+        args, want_rc, err_re, out_re = CASES[k]
         rc, out, err = run(ulam, args)
         ok = rc == want_rc and re.search(err_re, err, re.M) and re.search(out_re, out, re.M)
         if not ok:
             failures += 1
-            print(f"FAIL ulam {' '.join(args)}: rc {rc} (want {want_rc})\n  stderr: {err.strip()}\n  stdout: {out.strip()[:300]}")
-    return failures, len(CASES)
+            print(f"FAIL table:{k} ulam {' '.join(args)}: rc {rc} (want {want_rc})\n  stderr: {err.strip()}\n"
+                  f"  stdout: {out.strip()[:300]}\n  (rerun it alone: --case table:{k})")
+    return failures, len(rows)
 
 
 def check_json(ulam):
@@ -422,6 +460,32 @@ def check_solve_json(ulam):
     o = json.loads(out)
     assert rc == 0 and o["variance_finite"] is False and o["ci95"] is None, o
     assert abs(o["rho_hat"] - 1.62) < 1e-6 and o["rho_hat_lower"] >= 1, o
+
+
+def check_alpha(ulam):
+    """--alpha walks the kernel of that exponent: --json reports it beside rho_hat (1 by default);
+    a prepared system's certificate (exponent 1) serves the default but not --alpha 2, whose
+    guards are computed and match the text input's; the estimate agrees with LAPACK."""
+    with tempfile.TemporaryDirectory() as d:
+        sysf = d + "/s.ulam"
+        rc, out, err = run(ulam, ["prepare", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "-o", sysf])
+        assert rc == 0, err
+        common = ["--index", "5", "--walks", "20000", "--json", "--check"]
+        runs = {}
+        for name, args in [("text1", [M + "signed200.mtx", "--rhs", M + "signed200_b.mtx"]), ("prep1", [sysf]),
+                           ("text2", [M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "--alpha", "2"]),
+                           ("prep2", [sysf, "--alpha", "2"])]:
+            rc, out, err = run(ulam, ["solve", "--method", "walks"] + args + common)
+            assert rc == 0, (name, err)
+            runs[name] = json.loads(out)
+        t1, p1, t2, p2 = runs["text1"], runs["prep1"], runs["text2"], runs["prep2"]
+        assert t1["kernel_alpha"] == 1 and t2["kernel_alpha"] == 2 and p2["kernel_alpha"] == 2, (t1, t2)
+        assert p1["guard_seconds"] == 0 and p1["rho_hat"] == t1["rho_hat"], p1  # the certificate served
+        assert p2["rho_hat_upper"] == t2["rho_hat_upper"] and p2["rho_hat"] != p1["rho_hat"], (p1, p2)
+        assert t2["rho_hat_lower"] <= 0.974368 <= t2["rho_hat_upper"], t2  # adjoint rho(M^) at alpha 2 (test_kernel)
+        assert p2["estimate"] == t2["estimate"] and t2["estimate"] != t1["estimate"], (t1, t2)
+        for o in (t1, t2):
+            assert abs(o["z"]) < 4 and o["variance_finite"] is True, o
 
 
 def check_forward_files(ulam):
@@ -851,6 +915,27 @@ def check_radiosity(ulam):
         assert sorted(os.listdir(d)) == ["box.png"], os.listdir(d)
 
 
+def check_radiosity_json_paths(ulam):
+    """A scene path with a quote, a backslash and a tab stays valid JSON in every radiosity object
+    (gathering, shooting, --list): the main object printed the path unescaped."""
+    import shutil
+    with tempfile.TemporaryDirectory() as d:
+        sub = os.path.join(d, 'a "quoted"\\dir\t')
+        os.mkdir(sub)
+        for f in ("cube.obj", "cube.mtl"):
+            shutil.copy(SC + f, os.path.join(sub, f))
+        scene = os.path.join(sub, "cube.obj")
+        for extra in (["--patch", "1", "--walks", "1000"], ["--mode", "shoot", "--walks", "1000", "--patch", "2"],
+                      ["--list"]):
+            rc, out, err = run(ulam, ["radiosity", scene, "--json"] + extra)
+            assert rc == 0, (extra, err)
+            try:
+                j = json.loads(out)
+            except ValueError as e:
+                raise AssertionError(f"{extra}: not JSON ({e}): {out[:200]}")
+            assert j["scene"] == scene, (extra, j["scene"])
+
+
 def check_radiosity_interrupt(ulam):
     """An interrupted image run says [INTERRUPTED], writes no picture and does not claim one
     ('image int.png (exposure 0)' was printed); output paths are checked before any work (a run
@@ -1024,27 +1109,42 @@ def check_genmat(genmat):
 
 def main():
     ulam, genmat = sys.argv[1], sys.argv[2]
-    radiosity = "--no-radiosity" not in sys.argv[3:]  # a build without Embree and libpng
+    flags = sys.argv[3:]
+    radiosity = "--no-radiosity" not in flags  # a build without Embree and libpng
+    cases = [flags[k + 1] for k in range(len(flags) - 1) if flags[k] == "--case"]  # --case NAME: those alone
     if not radiosity:
         CASES[:] = [c for c in CASES if not c[0] or c[0][0] != "radiosity"]
         rc, out, err = run(ulam, ["radiosity", "x.obj"])
         assert rc == 2 and "built without the radiosity front end" in err, err
-    failures, n = check_table(ulam)
-    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam),
+    rows = {int(c[6:]) for c in cases if re.fullmatch(r"table:\d+", c)}
+    if any(k >= len(CASES) for k in rows):
+        print(f"--case table:K: K runs from 0 to {len(CASES) - 1}")
+        return 2
+    failures, n = check_table(ulam, rows if cases else None)
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
-             (check_radiosity, ulam), (check_radiosity_interrupt, ulam),
+             (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam)]
-    for f, arg in extra if radiosity else [e for e in extra if "radiosity" not in e[0].__name__]:
+    if not radiosity:
+        extra = [e for e in extra if "radiosity" not in e[0].__name__]
+    if cases:
+        names = {f.__name__ for f, _ in extra}
+        unknown = [c for c in cases if not re.fullmatch(r"table:\d+", c) and c not in names and "check_" + c not in names]
+        if unknown:
+            print(f"unknown --case {', '.join(unknown)}: table:0 .. table:{len(CASES) - 1} or one of {', '.join(sorted(names))}")
+            return 2
+        extra = [e for e in extra if e[0].__name__ in cases or e[0].__name__[6:] in cases]
+    for f, arg in extra:
         try:
             f(arg)
         except AssertionError as e:
             failures += 1
-            print(f"FAIL {f.__name__}: {e}")
+            print(f"FAIL {f.__name__}: {e}\n  (rerun it alone: --case {f.__name__})")
     total = n + len(extra)
     print(f"{total - failures} passed, {failures} failed")
     return 1 if failures else 0

@@ -75,6 +75,7 @@ static void test_push_invariant(void **state)
 {
     (void)state;
     for (int k = 0; k < NSYS; k++) {
+        if (!test_case(k)) continue;
         ulam_csr *M = random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k);
         int64_t n = M->nrows;
         ulam_rng rg;
@@ -109,6 +110,7 @@ static void test_push_invariant(void **state)
         ulam_push_free(w);
         ulam_csr_free(M);
     }
+    test_case_done();
 }
 
 /* Bad arguments are refused. */
@@ -173,6 +175,7 @@ static void test_bidir_unbiased(void **state)
         double *x = exact_column(M, s);
         for (int q = 0; q < 3; q++)
             for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est += 2) {
+                if (!test_case(1000L * k + 10 * q + est)) continue;
                 ulam_bidir_opts o = ulam_bidir_defaults();
                 o.source = s, o.target = t, o.rmax = rmaxes[q];
                 o.walk.max_walks = 20000, o.walk.estimator = est, o.walk.seed = (uint64_t)(k * 10 + q);
@@ -191,11 +194,75 @@ static void test_bidir_unbiased(void **state)
                 assert_close(res.estimate - res.push_part, res.walks.estimate, 1e-15 * (fabs(res.estimate) + 1));
                 assert_close(res.ci95[1] - res.ci95[0], 2 * 1.959963984540054 * res.std_error, 1e-12);
                 assert_true(res.seconds >= res.push.seconds);
-                if (q == 2) assert_true(res.pilot_walks == 256 && res.mean_visits >= 1);
+                if (q == 2) assert_true(res.plan.pilot_walks == 256 && res.plan.mean_visits >= 1);
             }
         free(x);
         ulam_csr_free(M), ulam_csr_free(Mt);
     }
+    test_case_done();
+}
+
+/* The plan: the balance's rmax and push, the pilot, the predicted walks and work; a solve with
+ * the same options reuses it (no push again, the same answer as a solve on a fresh workspace);
+ * other options, or a push since, make the solve plan again; the plan is the same for any
+ * thread count. */
+static void test_bidir_plan(void **state)
+{
+    (void)state;
+    ulam_csr *M = random_system(150, 5, 0, 0.85, 4), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    o.source = 3, o.target = 10, o.walk.max_walks = 0, o.walk.rel_err = 0.05, o.walk.threads = 1;
+    ulam_push *w = NULL, *fresh = NULL;
+    assert_int_equal(ulam_push_alloc(M, &w), ULAM_OK);
+    assert_int_equal(ulam_push_alloc(M, &fresh), ULAM_OK);
+    ulam_bidir_plan_info plan, again;
+    ulam_error err;
+    assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
+    ulam_push_info pi;
+    ulam_push_report(w, &pi);
+    assert_true(plan.balanced && plan.target == 10 && plan.rmax == pi.rmax && plan.push.ops == pi.ops && pi.ops > 0);
+    assert_true(pi.r_max <= plan.rmax && plan.push_part == ulam_push_estimates(w)[3]);
+    assert_true(plan.pilot_walks == 256 && plan.mean_visits == 1.0 + (double)plan.pilot_steps / 256.0);
+    assert_true(plan.predicted_walks >= 1000 && isfinite(plan.predicted_walks));
+    assert_close(plan.predicted_work, (double)plan.push.ops + plan.step_cost * ((double)(256 + plan.pilot_steps) +
+                                      plan.predicted_walks * plan.mean_visits), 1e-9 * plan.predicted_work);
+    ulam_bidir_result res, ref;
+    assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
+    print_message("plan: rmax %g, %lld push operations, %g walks predicted; the solve ran %lld\n", plan.rmax,
+                  (long long)plan.push.ops, plan.predicted_walks, (long long)res.walks.walks);
+    assert_true(res.plan_reused && res.push.ops == plan.push.ops && res.push.pushes == plan.push.pushes);
+    assert_memory_equal(&res.plan.predicted_work, &plan.predicted_work, sizeof plan.predicted_work);
+    assert_int_equal(ulam_bidir_solve(fresh, Mt, &o, &ref, &err), ULAM_OK); /* plans inside */
+    assert_false(ref.plan_reused);
+    assert_memory_equal(&res.estimate, &ref.estimate, sizeof res.estimate);
+    assert_memory_equal(&res.std_error, &ref.std_error, sizeof res.std_error);
+    assert_true(ref.plan.rmax == plan.rmax && ref.plan.push.ops == plan.push.ops && ref.walks.walks == res.walks.walks);
+    assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK); /* still the plan in place */
+    assert_true(res.plan_reused);
+    o.walk.seed = 2; /* another pilot: plan again */
+    assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
+    assert_false(res.plan_reused);
+    assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
+    assert_int_equal(ulam_push_run(w, plan.rmax / 2, 0), ULAM_OK); /* the push moved on: plan again */
+    assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
+    assert_false(res.plan_reused);
+    assert_true(res.push.rmax == plan.rmax && res.push.ops == plan.push.ops);
+    o.walk.threads = 2;
+    assert_int_equal(ulam_bidir_plan(w, Mt, &o, &again, &err), ULAM_OK);
+    assert_true(again.rmax == plan.rmax && again.push.ops == plan.push.ops && again.pilot_steps == plan.pilot_steps);
+    assert_memory_equal(&again.predicted_work, &plan.predicted_work, sizeof plan.predicted_work);
+    o.rmax = 0.01, o.walk.rel_err = 0, o.walk.max_walks = 5000; /* given rmax: no pilot, walks known */
+    assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
+    assert_true(!plan.balanced && plan.pilot_walks == 0 && plan.rmax == 0.01 && plan.predicted_walks == 5000);
+    o.walk.rel_err = 0.05, o.walk.max_walks = 0;
+    assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
+    assert_true(isnan(plan.predicted_walks) && isnan(plan.predicted_work)); /* no pilot measured V */
+    o.source = 150;
+    assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_bidir_plan(NULL, Mt, &o, &plan, &err), ULAM_EINVAL);
+    ulam_push_free(w), ulam_push_free(fresh);
+    ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
 /* Over 200 seeds the 95% interval covers the LAPACK value 180 to 198 times (Bin(200, 0.95) falls
@@ -209,6 +276,7 @@ static void test_bidir_coverage(void **state)
     int covered = 0;
     double push_part = 0;
     for (int seed = 0; seed < 200; seed++) { /* case seed: reruns exactly */
+        if (!test_case(seed)) continue;
         ulam_bidir_opts o = ulam_bidir_defaults();
         o.source = 5, o.target = 17, o.rmax = 0.2;
         o.walk.max_walks = 2000, o.walk.seed = (uint64_t)seed;
@@ -216,10 +284,13 @@ static void test_bidir_coverage(void **state)
         covered += res.ci95[0] <= x[17] && x[17] <= res.ci95[1];
         push_part = res.push_part;
     }
-    print_message("95%% interval covered the LAPACK value %d / 200 times (x = %.6g, push part %.6g)\n", covered,
-                  x[17], push_part);
-    assert_true(fabs(push_part - x[17]) > 0.1 * fabs(x[17]));
-    assert_in_range(covered, 180, 198);
+    test_case_done();
+    if (test_case_all()) { /* the count over seeds (one case alone: none) */
+        print_message("95%% interval covered the LAPACK value %d / 200 times (x = %.6g, push part %.6g)\n", covered,
+                      x[17], push_part);
+        assert_true(fabs(push_part - x[17]) > 0.1 * fabs(x[17]));
+        assert_in_range(covered, 180, 198);
+    }
     free(x);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
@@ -291,6 +362,7 @@ static void test_bidir_deterministic_walks(void **state)
         {0, 0, 2, ULAM_COLLISION}, /* walks from 0 on N' have no moves and score r_0 = 1: x = 1 */
     };
     for (int k = 0; k < 4; k++) { /* case k */
+        if (!test_case(k)) continue;
         double *x = exact_column(N, cases[k].s);
         ulam_bidir_opts o = ulam_bidir_defaults();
         o.source = cases[k].s, o.target = cases[k].t, o.rmax = cases[k].rmax, o.walk.estimator = cases[k].est;
@@ -301,6 +373,7 @@ static void test_bidir_deterministic_walks(void **state)
         assert_true(res.std_error == 0 && res.estimate == x[cases[k].t] && res.walks.walks >= 1000);
         free(x);
     }
+    test_case_done();
     ulam_csr_free(N), ulam_csr_free(Nt);
 }
 
@@ -318,11 +391,13 @@ static void test_bidir_small_budgets(void **state)
     assert_true(res.walks.walks >= 1 && res.walks.walks <= 1024 && isfinite(res.estimate));
     assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
     for (int64_t walks = 1; walks <= 16; walks *= 4) {
+        if (!test_case(walks)) continue;
         o.walk.max_seconds = 0, o.walk.max_walks = walks;
         res = bidir(M, Mt, &o);
         assert_true(res.walks.walks == walks && isfinite(res.estimate));
         if (walks > 1 && res.std_error > 0) assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
     }
+    test_case_done();
     free(x);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
@@ -339,6 +414,7 @@ static void test_bidir_rare_score(void **state)
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     double *x = exact_column(M, 1);
     for (int seed = 0; seed < 10; seed++) { /* case seed */
+        if (!test_case(seed)) continue;
         ulam_bidir_opts o = ulam_bidir_defaults();
         o.source = 1, o.target = 0, o.rmax = 2; /* no push: every score is a walk's */
         o.walk.max_walks = 0, o.walk.rel_err = 0.1, o.walk.seed = (uint64_t)seed;
@@ -349,6 +425,7 @@ static void test_bidir_rare_score(void **state)
         assert_true(res.std_error > 0 && res.std_error <= 0.1 * res.estimate);
         assert_true(fabs(res.estimate - x[0]) < 4 * res.std_error);
     }
+    test_case_done();
     free(x);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
@@ -357,9 +434,9 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_push_invariant), cmocka_unit_test(test_push_bad_input),
-        cmocka_unit_test(test_bidir_unbiased), cmocka_unit_test(test_bidir_coverage),
+        cmocka_unit_test(test_bidir_unbiased), cmocka_unit_test(test_bidir_plan), cmocka_unit_test(test_bidir_coverage),
         cmocka_unit_test(test_bidir_rules),    cmocka_unit_test(test_bidir_rare_score),
         cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return test_run(tests);
 }

@@ -75,5 +75,5 @@ int main(void)
         cmocka_unit_test(test_reference_output), cmocka_unit_test(test_streams),
         cmocka_unit_test(test_uniform), cmocka_unit_test(test_bounded),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return test_run(tests);
 }

@@ -11,50 +11,12 @@
  * and Var X_i = v_i - x_i^2 in the first two.  For the analog kernel p_ij = |M_ij| / S_i,
  * M^_ij = |M_ij| S_i / q_i. */
 #include "testutil.h"
+#include "law.h" /* examples/law.h: the law the test checks the walks against */
 
 #include <string.h>
 
-typedef struct {
-    ulam_csr *M;
-    double *b, *x; /* x: LAPACK solution */
-    int64_t n;
-} sys;
-
-/* Load matrices/NAME.mtx and its b, and solve it with LAPACK. */
-static sys load(const char *name)
-{
-    char mp[256], bp[256];
-    snprintf(mp, sizeof mp, "matrices/%s.mtx", name);
-    snprintf(bp, sizeof bp, "matrices/%s_b.mtx", name);
-    sys s;
-    s.M = must_read(mp);
-    s.b = must_read_vector(bp, &s.n);
-    s.x = malloc((size_t)s.n * sizeof *s.x);
-    assert_int_equal(ulam_direct_solve(s.M, s.b, s.x, 0, NULL, NULL), ULAM_OK);
-    return s;
-}
-
-/* Free a loaded system. */
-static void unload(sys *s)
-{
-    ulam_csr_free(s->M);
-    free(s->b), free(s->x);
-}
-
-/* Run walks; must succeed. */
-static ulam_walk_result run(const sys *s, ulam_walk_opts o)
-{
-    ulam_walk_result r;
-    ulam_error err;
-    int st = ulam_solve(s->M, s->b, &o, &r, &err);
-    if (st) print_error("ulam_solve: %s: %s\n", ulam_strerror(st), err.msg);
-    assert_int_equal(st, ULAM_OK);
-    assert_true(r.walks == o.max_walks);
-    return r;
-}
-
 /* |estimate - LAPACK| < 4 sigma. */
-static void assert_agrees(const sys *s, const ulam_walk_result *r, int64_t index)
+static void assert_agrees(const test_sys *s, const ulam_walk_result *r, int64_t index)
 {
     if (!(fabs(r->estimate - s->x[index]) < 4 * r->std_error))
         print_error("estimate %.10g, LAPACK %.10g, stderr %.3g (z = %.2f)\n", r->estimate, s->x[index],
@@ -73,9 +35,10 @@ static void test_agreement(void **state)
     static const struct { const char *name; int64_t index; } systems[] = {
         {"chain4", 1}, {"randsub1000", 7}, {"signed200", 3}};
     for (size_t k = 0; k < 3; k++) {
-        sys s = load(systems[k].name);
+        test_sys s = test_sys_load(systems[k].name);
         for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++)
             for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
+                if (!test_case(1000 * (long)k + 3 * mode + est)) continue; /* system k, mode, estimator */
                 ulam_walk_opts o = ulam_walk_defaults();
                 o.mode = mode;
                 o.estimator = est;
@@ -91,33 +54,37 @@ static void test_agreement(void **state)
                     o.continue_q = 0.8;
                     o.max_walks = 1600000;
                 }
-                ulam_walk_result r = run(&s, o);
+                ulam_walk_result r = test_sys_run(&s, o);
                 assert_agrees(&s, &r, o.index);
             }
-        unload(&s);
+        test_sys_free(&s);
     }
+    test_case_done();
 }
 
 /* Over 200 seeds the 95% interval covers the LAPACK value 90% to 99% of the time. */
 static void test_coverage(void **state)
 {
     (void)state;
-    sys s = load("chain4");
+    test_sys s = test_sys_load("chain4");
     for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
         int covered = 0;
-        for (int seed = 0; seed < 200; seed++) { /* case seed: reruns exactly */
+        for (int seed = 0; seed < 200; seed++) { /* case 1000 est + seed: reruns exactly */
+            if (!test_case(1000L * est + seed)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = est;
             o.index = 0;
             o.max_walks = 2000;
             o.seed = (uint64_t)seed;
-            ulam_walk_result r = run(&s, o);
+            ulam_walk_result r = test_sys_run(&s, o);
             covered += r.ci95[0] <= s.x[0] && s.x[0] <= r.ci95[1];
         }
+        test_case_done();
+        if (!test_case_all()) continue; /* one case alone: no count over seeds */
         print_message("estimator %d: 95%% interval covered the LAPACK value %d / 200 times\n", est, covered);
         assert_in_range(covered, 180, 198);
     }
-    unload(&s);
+    test_sys_free(&s);
 }
 
 /* The second-moment matrix M^ of the kernel (analog or fixed q). */
@@ -135,7 +102,7 @@ static ulam_csr *second_moment(const ulam_csr *M, double q_fixed)
 }
 
 /* Exact per-walk variance of the adjoint estimator at index (formulas at the top). */
-static double exact_variance(const sys *s, int est, int64_t index, double q_fixed)
+static double exact_variance(const test_sys *s, int est, int64_t index, double q_fixed)
 {
     int64_t n = s->n;
     ulam_csr *H = second_moment(s->M, q_fixed);
@@ -169,15 +136,16 @@ static void test_exact_variance(void **state)
         {"chain4", 1, 0}, {"signed200", 3, 0}, {"signed200", 3, 0.75}};
     static const char *const names[] = {"collision", "absorption", "expected"};
     for (size_t k = 0; k < 3; k++) {
-        sys s = load(cases[k].name);
+        test_sys s = test_sys_load(cases[k].name);
         for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
+            if (!test_case(1000 * (long)k + est)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = est;
             o.index = cases[k].index;
             o.continue_q = cases[k].q;
             o.max_walks = 1000000;
             o.seed = 7;
-            ulam_walk_result r = run(&s, o);
+            ulam_walk_result r = test_sys_run(&s, o);
             double exact = exact_variance(&s, est, o.index, cases[k].q);
             print_message("%s x[%lld] q=%g %-10s variance: measured %.6g, exact %.6g (%+.2f%%)\n",
                           cases[k].name, (long long)o.index + 1, cases[k].q, names[est], r.variance,
@@ -185,8 +153,9 @@ static void test_exact_variance(void **state)
             assert_true(exact > 0);
             assert_close(r.variance, exact, 0.05 * exact);
         }
-        unload(&s);
+        test_sys_free(&s);
     }
+    test_case_done();
 }
 
 /* Roulette (weights shrinking under --continue 0.95 on the chain) and splitting (weights
@@ -194,47 +163,48 @@ static void test_exact_variance(void **state)
 static void test_roulette_and_splitting(void **state)
 {
     (void)state;
-    sys s = load("chain4");
+    test_sys s = test_sys_load("chain4");
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = mode;
         o.index = 2;
         o.continue_q = 0.95;
         o.max_walks = 200000;
-        ulam_walk_result plain = run(&s, o);
+        ulam_walk_result plain = test_sys_run(&s, o);
         o.roulette = 0.5;
-        ulam_walk_result rr = run(&s, o);
+        ulam_walk_result rr = test_sys_run(&s, o);
         assert_agrees(&s, &rr, 2);
         assert_true(rr.steps < plain.steps); /* roulette did cut walks short */
     }
-    unload(&s);
-    s = load("signed200");
+    test_sys_free(&s);
+    s = test_sys_load("signed200");
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = mode;
         o.index = 3;
         o.continue_q = 0.5;
         o.max_walks = 200000;
-        ulam_walk_result plain = run(&s, o);
+        ulam_walk_result plain = test_sys_run(&s, o);
         double w0 = mode == ULAM_ADJOINT ? 1.0 : 0.0; /* the start weight: 1 adjoint, ||b||_1 forward (a split weight below it is refused) */
         for (int64_t i = 0; mode == ULAM_FORWARD && i < s.n; i++) w0 += fabs(s.b[i]);
         o.split = 2.0 * w0;
         o.roulette = 0.25 * w0;
-        ulam_walk_result ws = run(&s, o);
+        ulam_walk_result ws = test_sys_run(&s, o);
         assert_agrees(&s, &ws, 3);
         assert_true(ws.steps > plain.steps); /* splitting did make copies */
     }
-    unload(&s);
+    test_sys_free(&s);
 }
 
 /* --jacobi and --omega: walks on M = I - w D^-1 A for Poisson's A agree with LAPACK. */
 static void test_jacobi_poisson(void **state)
 {
     (void)state;
-    sys s = load("poisson20"); /* s.M holds A here; replaced by its splitting below */
+    test_sys s = test_sys_load("poisson20"); /* s.M holds A here; replaced by its splitting below */
     ulam_csr *A = s.M;
     double *bp = malloc((size_t)s.n * sizeof *bp);
     for (int k = 0; k < 2; k++) {
+        if (!test_case(k)) continue;
         double omega = k ? 0.8 : 1.0;
         assert_int_equal(ulam_jacobi(A, s.b, omega, &s.M, bp, NULL), ULAM_OK);
         double *b = s.b;
@@ -244,16 +214,17 @@ static void test_jacobi_poisson(void **state)
         o.index = 210;
         o.max_walks = 20000;
         o.seed = 7 + (uint64_t)k;
-        ulam_walk_result r = run(&s, o);
+        ulam_walk_result r = test_sys_run(&s, o);
         print_message("poisson20 --jacobi --omega %.1f: x[211] = %.6g +- %.2g, LAPACK %.6g\n", omega,
                       r.estimate, r.std_error, s.x[210]);
         assert_agrees(&s, &r, 210);
         s.b = b;
         ulam_csr_free(s.M);
     }
+    test_case_done();
     s.M = A;
     free(bp);
-    unload(&s);
+    test_sys_free(&s);
 }
 
 /* The collision-absorption law (lecture notes): the chain of examples/law.c with s = 0.5,
@@ -265,7 +236,7 @@ static void test_collision_absorption_law(void **state)
     (void)state;
     const double ps[3] = {0.2, 0.32, 0.45}, s = 0.5;
     for (int k = 0; k < 3; k++) {
-        double c = 1 - (s - ps[k]) / (1 - ps[k]), b[4] = {1, 0, 0, 0}, v[2], s2, p2;
+        double c = 1 - (s - ps[k]) / (1 - ps[k]), b[4] = {1, 0, 0, 0}, v[2], s2 = NAN, p2 = NAN;
         int32_t ti[6], tj[6];
         double tx[6];
         for (int q = 0; q < 3; q++) {
@@ -274,15 +245,16 @@ static void test_collision_absorption_law(void **state)
         }
         ulam_csr *M = NULL;
         assert_int_equal(ulam_csr_from_triplets(4, 4, 6, ti, tj, tx, &M), ULAM_OK);
-        assert_int_equal(ulam_law_noreturn(M, 0, &s2, &p2, NULL), ULAM_OK);
+        assert_int_equal(law_noreturn(M, 0, &s2, &p2), ULAM_OK);
         assert_close(s2, s, 1e-12);
         assert_close(p2, ps[k], 1e-12);
-        ulam_law_variances(ps[k], s, &v[0], &v[1]);
-        sys sy = {.M = M, .b = b, .n = 4};
+        law_variances(ps[k], s, &v[0], &v[1]);
+        test_sys sy = {.M = M, .b = b, .n = 4};
         for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+            if (!test_case(1000L * k + est)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.mode = ULAM_FORWARD, o.estimator = est, o.max_walks = 1000000, o.seed = 40 + (uint64_t)k;
-            ulam_walk_result r = run(&sy, o);
+            ulam_walk_result r = test_sys_run(&sy, o);
             print_message("law p* = %.2f (boundary 0.333) %-10s variance measured %.5g, exact %.5g (%+.2f%%)\n",
                           ps[k], est ? "absorption" : "collision", r.variance, v[est], 100 * (r.variance / v[est] - 1));
             assert_close(r.variance, v[est], 0.05 * v[est]);
@@ -290,6 +262,7 @@ static void test_collision_absorption_law(void **state)
         assert_true(k == 1 || (v[0] < v[1]) == (ps[k] < s / (2 - s)));
         ulam_csr_free(M);
     }
+    test_case_done();
 }
 
 /* Two runs gave the same result bit for bit. */
@@ -304,7 +277,7 @@ static void assert_same_run(const ulam_walk_result *a, const ulam_walk_result *b
 static void test_threads_identical(void **state)
 {
     (void)state;
-    sys s = load("randsub1000");
+    test_sys s = test_sys_load("randsub1000");
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = mode;
@@ -312,12 +285,12 @@ static void test_threads_identical(void **state)
         o.max_walks = 50000;
         o.seed = 99;
         o.threads = 1;
-        ulam_walk_result a = run(&s, o);
+        ulam_walk_result a = test_sys_run(&s, o);
         o.threads = 2;
-        ulam_walk_result b = run(&s, o);
+        ulam_walk_result b = test_sys_run(&s, o);
         assert_same_run(&a, &b);
     }
-    unload(&s);
+    test_sys_free(&s);
 }
 
 /* The walk kernel is built as walks reach its rows: a short run builds at most one row per
@@ -326,28 +299,30 @@ static void test_threads_identical(void **state)
 static void test_lazy_kernel(void **state)
 {
     (void)state;
-    sys s = load("randsub1000");
+    test_sys s = test_sys_load("randsub1000");
     static const int64_t budgets[2] = {16, 50000};
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++)
         for (int k = 0; k < 2; k++) {
+            if (!test_case(1000L * mode + k)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.mode = mode, o.index = 5, o.max_walks = budgets[k], o.seed = 7 + (uint64_t)k, o.threads = 2;
-            ulam_walk_result lazy = run(&s, o);
+            ulam_walk_result lazy = test_sys_run(&s, o);
             o.whole_kernel = 1;
-            ulam_walk_result whole = run(&s, o);
+            ulam_walk_result whole = test_sys_run(&s, o);
             assert_same_run(&lazy, &whole);
             assert_true(whole.rows == s.n);
             if (k == 0) assert_true(lazy.rows <= lazy.steps + lazy.walks && lazy.rows < s.n / 4);
             else assert_true(lazy.rows == s.n);
         }
-    unload(&s);
+    test_case_done();
+    test_sys_free(&s);
 }
 
 /* Forward mode estimates every component with its own error bar. */
 static void test_forward_vectors(void **state)
 {
     (void)state;
-    sys s = load("radiosity100");
+    test_sys s = test_sys_load("radiosity100");
     ulam_walk_opts o = ulam_walk_defaults();
     o.mode = ULAM_FORWARD;
     o.max_walks = 200000;
@@ -366,7 +341,7 @@ static void test_forward_vectors(void **state)
     assert_in_range(within, 85, 100);
     free(x), free(e);
     ulam_solver_free(sv);
-    unload(&s);
+    test_sys_free(&s);
 }
 
 /* Absorption is refused, naming the state, where a reachable state with b != 0 never ends. */
@@ -395,7 +370,7 @@ static void test_absorption_refused(void **state)
 static void test_bad_options(void **state)
 {
     (void)state;
-    sys s = load("chain4");
+    test_sys s = test_sys_load("chain4");
     ulam_walk_opts o = ulam_walk_defaults();
     ulam_solver *sv = NULL;
     o.index = 4;
@@ -408,7 +383,7 @@ static void test_bad_options(void **state)
     assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_EINVAL);
     assert_null(sv);
     assert_null(ulam_solver_free(NULL));
-    unload(&s);
+    test_sys_free(&s);
 }
 
 /* --rel-err stops once the relative standard error is reached, after at least 1000 walks; with
@@ -416,7 +391,7 @@ static void test_bad_options(void **state)
 static void test_rel_err_stop(void **state)
 {
     (void)state;
-    sys s = load("randsub1000");
+    test_sys s = test_sys_load("randsub1000");
     ulam_walk_opts o = ulam_walk_defaults();
     o.max_walks = 0;
     o.rel_err = 0.005;
@@ -429,7 +404,7 @@ static void test_rel_err_stop(void **state)
     for (int64_t i = 0; i < s.n; i++) s.b[i] = 0.0; /* x = 0 exactly: the rule ends at once, never spins */
     assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
     assert_true(r.rel_err_met && r.estimate == 0.0 && r.walks < 2048);
-    unload(&s);
+    test_sys_free(&s);
 }
 
 /* The solver takes the guards' verdicts before walking and refuses what the CLI refuses: a
@@ -439,7 +414,7 @@ static void test_rel_err_stop(void **state)
 static void test_solver_guards(void **state)
 {
     (void)state;
-    sys s = load("divergent200");
+    test_sys s = test_sys_load("divergent200");
     ulam_walk_opts o = ulam_walk_defaults();
     ulam_walk_result r;
     ulam_error err;
@@ -449,7 +424,7 @@ static void test_solver_guards(void **state)
     assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK);
     assert_int_equal(r.variance_finite, 0);
     assert_true(isnan(r.ci95[0]) && isnan(r.ci95[1]));
-    unload(&s);
+    test_sys_free(&s);
     ulam_csr *M = near_one_matrix(300, 1.0005);
     double *b = malloc(300 * sizeof *b);
     for (int k = 0; k < 300; k++) b[k] = 1.0;
@@ -572,7 +547,7 @@ static void test_rel_err_cuts(void **state)
 static void test_forward_unreached(void **state)
 {
     (void)state;
-    sys s;
+    test_sys s;
     s.n = 200;
     s.M = rare_system(200, 0.9999, 0, 0.0, 1, &s.b);
     s.x = malloc(200 * sizeof *s.x);
@@ -607,7 +582,7 @@ static void test_forward_unreached(void **state)
     assert_true(isfinite(r.std_error) && r.std_error > 0);
     assert_true(fabs(r.estimate - s.x[first]) < 4 * r.std_error);
     free(x), free(e);
-    unload(&s);
+    test_sys_free(&s);
 }
 
 /* Collision on a sticky rare cluster (rare_system with the three rare states' rows pointing at
@@ -648,5 +623,5 @@ int main(void)
         cmocka_unit_test(test_solver_guards),     cmocka_unit_test(test_rel_err_infinite_refused),
         cmocka_unit_test(test_forward_unreached), cmocka_unit_test(test_rel_err_cuts), cmocka_unit_test(test_rel_err_collision_tail),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return test_run(tests);
 }

@@ -13,7 +13,85 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include <string.h>
+
 #include "ulam.h"
+
+/* Seeded test tables (pixman style).  A loop over a table of cases or over seeds calls
+ * test_case(k) first in each iteration and test_case_done() after the loop; a test that fails
+ * inside case k then says so (test_case_report, the teardown test_run gives every test), and
+ *     ULAM_TEST_CASE=k build/tests/test_walk
+ * runs case k alone in every table (the other cases are skipped, and so are the checks over the
+ * whole table: a coverage count over seeds means nothing for one seed); ULAM_TEST=NAME runs only
+ * the tests whose name matches NAME (* and ? wildcards), e.g.
+ *     ULAM_TEST=test_adjoint_coverage ULAM_TEST_CASE=17 build/tests/test_walk
+ * A case of a nested loop is numbered outer * 1000 + inner. */
+static struct {
+    long k;     /* the case being run */
+    int active; /* inside a table's loop */
+} test_case_state;
+
+/* The case ULAM_TEST_CASE names, or -1 (every case). */
+static inline long test_case_only(void)
+{
+    const char *s = getenv("ULAM_TEST_CASE");
+    char *end;
+    long k = s && *s ? strtol(s, &end, 10) : -1;
+    return s && *s && !*end && k >= 0 ? k : -1;
+}
+
+/* Nonzero when every case of the tables runs (no ULAM_TEST_CASE): checks over a whole table. */
+static inline int test_case_all(void)
+{
+    return test_case_only() < 0;
+}
+
+/* Enter case k of a table; 0 when ULAM_TEST_CASE names another (skip it). */
+static inline int test_case(long k)
+{
+    long only = test_case_only();
+    if (only >= 0 && k != only) return 0;
+    test_case_state.k = k, test_case_state.active = 1;
+    return 1;
+}
+
+/* Leave a table's loop (every case run passed). */
+static inline void test_case_done(void)
+{
+    test_case_state.active = 0;
+}
+
+/* Teardown of every test: name the case a test stopped in (it failed inside a table's loop) and
+ * how to rerun it; *state is the test's name (test_run), the tests that loop over cases having
+ * no state of their own. */
+static inline int test_case_report(void **state)
+{
+    if (test_case_state.active)
+        print_error("[  CASE    ] failed in case %ld: rerun it alone with ULAM_TEST=%s ULAM_TEST_CASE=%ld\n",
+                    test_case_state.k, state && *state ? (const char *)*state : "NAME", test_case_state.k);
+    test_case_state.active = 0;
+    return 0;
+}
+
+/* Run a program's tests (as cmocka_run_group_tests), each with test_case_report as teardown (and
+ * its name as state where it has none) and filtered by ULAM_TEST. */
+#define test_run(tests) test_run_(#tests, (tests), sizeof(tests) / sizeof *(tests))
+
+static inline int test_run_(const char *group, const struct CMUnitTest *tests, size_t n)
+{
+    struct CMUnitTest *t = malloc(n * sizeof *t);
+    if (!t) return 1;
+    memcpy(t, tests, n * sizeof *t);
+    for (size_t k = 0; k < n; k++) {
+        if (!t[k].teardown_func) t[k].teardown_func = test_case_report;
+        if (!t[k].initial_state) t[k].initial_state = (void *)(uintptr_t)t[k].name;
+    }
+    const char *only = getenv("ULAM_TEST");
+    if (only && *only) cmocka_set_test_filter(only);
+    int rc = _cmocka_run_group_tests(group, t, n, NULL, NULL);
+    free(t);
+    return rc;
+}
 
 /* Fail unless |a - b| <= tol (cmocka 1.1 has no assert_double_equal). */
 #define assert_close(a, b, tol) assert_close_((a), (b), (tol), #a, __FILE__, __LINE__)
@@ -76,6 +154,52 @@ static inline void assert_csr_same(const ulam_csr *A, const ulam_csr *B)
     assert_memory_equal(A->rowptr, B->rowptr, (size_t)(A->nrows + 1) * sizeof *A->rowptr);
     assert_memory_equal(A->colidx, B->colidx, (size_t)ulam_csr_nnz(A) * sizeof *A->colidx);
     assert_memory_equal(A->val, B->val, (size_t)ulam_csr_nnz(A) * sizeof *A->val);
+}
+
+/* A system (I - M) x = b and its LAPACK solution x. */
+typedef struct {
+    ulam_csr *M;
+    double *b, *x;
+    int64_t n;
+} test_sys;
+
+/* Solve s with LAPACK into a new s->x. */
+static inline void test_sys_solve(test_sys *s)
+{
+    s->x = malloc((size_t)s->n * sizeof *s->x);
+    assert_int_equal(ulam_direct_solve(s->M, s->b, s->x, 0, NULL, NULL), ULAM_OK);
+}
+
+/* Load matrices/NAME.mtx and its b (matrices/NAME_b.mtx), solved with LAPACK. */
+static inline test_sys test_sys_load(const char *name)
+{
+    char mp[256], bp[256];
+    snprintf(mp, sizeof mp, "matrices/%s.mtx", name);
+    snprintf(bp, sizeof bp, "matrices/%s_b.mtx", name);
+    test_sys s;
+    s.M = must_read(mp);
+    s.b = must_read_vector(bp, &s.n);
+    test_sys_solve(&s);
+    return s;
+}
+
+/* Free a loaded system. */
+static inline void test_sys_free(test_sys *s)
+{
+    ulam_csr_free(s->M);
+    free(s->b), free(s->x);
+}
+
+/* Run walks on s; they must succeed with the walks asked for. */
+static inline ulam_walk_result test_sys_run(const test_sys *s, ulam_walk_opts o)
+{
+    ulam_walk_result r;
+    ulam_error err;
+    int st = ulam_solve(s->M, s->b, &o, &r, &err);
+    if (st) print_error("ulam_solve: %s: %s\n", ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    assert_true(r.walks == o.max_walks);
+    return r;
 }
 
 /* A nonnegative n x n matrix whose Perron root is exactly rho but whose row and column sums

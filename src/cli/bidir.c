@@ -64,8 +64,9 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         printf("walks           %lld (%lld cut, %lld steps, %d threads)\n", (long long)w->walks, (long long)w->cut,
                (long long)w->steps, w->threads);
     if (o->rmax <= 0)
-        printf("balance         pilot %lld walks, %.3g visits a walk; %.3g walks predicted at this rmax\n",
-               (long long)r->pilot_walks, r->mean_visits, r->predicted_walks);
+        printf("balance         pilot %lld walks, %.3g visits a walk; %.3g walks predicted at this rmax, "
+               "work %.3g operations predicted in all\n", (long long)r->plan.pilot_walks, r->plan.mean_visits,
+               r->plan.predicted_walks, r->plan.predicted_work);
     printf("seconds         %.4f (push %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
            r->push.seconds, w->seconds, (unsigned long long)o->walk.seed, rp->transpose_seconds);
     printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
@@ -106,10 +107,11 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     cli_json_number("residual_sum", r->push.r_sum, 0);
     cli_json_number("push_seconds", r->push.seconds, 0);
     printf("\"walks\": %lld, \"steps\": %lld, \"cut\": %lld, \"pilot_walks\": %lld, ", (long long)w->walks,
-           (long long)w->steps, (long long)w->cut, (long long)r->pilot_walks);
+           (long long)w->steps, (long long)w->cut, (long long)r->plan.pilot_walks);
     cli_json_number("variance", w->variance, 0);
-    cli_json_number("mean_visits", r->mean_visits, 0);
-    cli_json_number("predicted_walks", r->predicted_walks, 0);
+    cli_json_number("mean_visits", r->plan.mean_visits, 0);
+    cli_json_number("predicted_walks", r->plan.predicted_walks, 0);
+    cli_json_number("predicted_work", r->plan.predicted_work, 0);
     cli_json_number("walk_seconds", w->seconds, 0);
     cli_json_number("seconds", r->seconds, 0);
     cli_json_number("transpose_seconds", rp->transpose_seconds, 0);
@@ -142,7 +144,7 @@ static int prepare(cli_system *s, int64_t source, int force, double continue_q, 
     }
     s->own_b[source - 1] = 1.0;
     s->b = s->own_b; /* freed by cli_system_free */
-    if ((rc = cli_guard(s, continue_q, ULAM_FORWARD, &rp->g))) return rc;
+    if ((rc = cli_guard(s, continue_q, 1.0, ULAM_FORWARD, &rp->g))) return rc;
     if (rp->g.verdict_abs >= ULAM_VERDICT_FAIL) {
         cli_guard_diverge(s, &rp->g, force);
         if (!force) return EXIT_DIVERGE;

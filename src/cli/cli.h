@@ -114,11 +114,12 @@ const char *cli_verdict_word(int verdict);
 /* Print a power-iteration radius with its bounds (no newline). */
 void cli_print_power(const ulam_power *p);
 
-/* The guards' radii for a walk in mode on s (rho(|M|) and that mode's rho(M^), stopped once
- * certified): a prepared file's certificate made for this continuation serves instead of a pass
+/* The guards' radii for a walk in mode on s with kernel exponent alpha (rho(|M|) and that mode's
+ * rho(M^), stopped once certified): a prepared file's certificate made for this continuation
+ * (and exponent: a certificate holds alpha = 1's) serves instead of a pass
  * over M (ulam_certificate_guard), else a mapped M is verified whole first; 0 or an exit code
  * (error reported).  The solver takes them (ulam_walk_opts.guard) and refuses what they refuse. */
-int cli_guard(cli_system *s, double continue_q, int mode, ulam_guard *g);
+int cli_guard(cli_system *s, double continue_q, double alpha, int mode, ulam_guard *g);
 
 /* Print why walks whose rho(|M|) is not certified below 1 are refused (a warning under force). */
 void cli_guard_diverge(const cli_system *s, const ulam_guard *g, int force);

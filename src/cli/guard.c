@@ -25,11 +25,12 @@ void cli_print_power(const ulam_power *p)
 
 /* The guards' radii for a walk in mode on s (rho(|M|) and that mode's rho(M^), stopped once
  * certified); 0 or an exit code (error reported). */
-int cli_guard(cli_system *s, double continue_q, int mode, ulam_guard *g)
+int cli_guard(cli_system *s, double continue_q, double alpha, int mode, ulam_guard *g)
 {
     ulam_error err;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(mode);
+    go.kernel_alpha = alpha;
     if (!ulam_certificate_guard(s->cert, continue_q, &go, g)) return 0;
     int rc = cli_system_verify(s);
     if (rc) return rc;
@@ -64,13 +65,15 @@ void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assu
                         "walks may be long (mean length about 1 / (1 - rho))\n", s->matrix_path, g->abs.lower,
                 g->abs.upper);
     const ulam_power *h = &g->hat[mode];
-    const char *kernel = mode == ULAM_ADJOINT ? "adjoint" : "forward";
+    char kernel[96] = "", alpha[48] = ""; /* the kernel named by mode, and by its exponent when not 1 */
+    if (g->kernel_alpha != 1.0) snprintf(alpha, sizeof alpha, " of exponent alpha = %g", g->kernel_alpha);
+    snprintf(kernel, sizeof kernel, "%s kernel%s", mode == ULAM_ADJOINT ? "adjoint" : "forward", alpha);
     if (g->verdict_hat[mode] == ULAM_VERDICT_FAIL)
-        fprintf(stderr, "ulam: %s: warning: rho(M^) >= 1 (bounds [%.6g, %.6g]) for the %s kernel: the estimator's "
+        fprintf(stderr, "ulam: %s: warning: rho(M^) >= 1 (bounds [%.6g, %.6g]) for the %s: the estimator's "
                         "variance is infinite, so no error bar it reports can be trusted\n",
                 s->matrix_path, h->lower, h->upper, kernel);
     else if (g->verdict_hat[mode] == ULAM_VERDICT_UNKNOWN)
-        fprintf(stderr, "ulam: %s: warning: rho(M^) of the %s kernel is in [%.6g, %.6g] after %d iterations: "
+        fprintf(stderr, "ulam: %s: warning: rho(M^) of the %s is in [%.6g, %.6g] after %d iterations: "
                         "whether the variance is finite is unknown%s\n", s->matrix_path, kernel, h->lower,
                 h->upper, h->iterations,
                 assume_finite ? "; --assume-finite-variance: the interval is printed anyway"

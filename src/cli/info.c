@@ -8,7 +8,7 @@
 #include <string.h>
 
 static const char *const usage =
-    "usage: ulam info M.mtx [--jacobi [--omega W]] [--continue Q] [--tol T] [--json]\n"
+    "usage: ulam info M.mtx [--jacobi [--omega W]] [--continue Q] [--alpha A] [--tol T] [--json]\n"
     "\n"
     "Describe the iteration matrix M of (I - M) x = b: size, nonzeros per row, signs,\n"
     "row sums of |M| (the continuation probabilities of an analog walk), and the guards:\n"
@@ -22,6 +22,8 @@ static const char *const usage =
     "               rho(M) and rho(|M|) for omega = 1, 0.9, ..., 0.5 (n <= 100000)\n"
     "  --omega W    damping of the Jacobi splitting (default 1)\n"
     "  --continue Q the kernel's fixed continuation probability (default: analog)\n"
+    "  --alpha A    the kernel's exponent, p_ij proportional to |M_ij|^A (default 1): the\n"
+    "               rho(M^) are that kernel's\n"
     "  --tol T      relative residual tolerance of the rho(M) estimate\n"
     "  --json       print one JSON object\n";
 
@@ -59,8 +61,10 @@ static void print_text(const cli_system *s, const ulam_csr_stats *st, const ulam
     cli_print_power(&g->abs);
     printf("\nrho(M^) adjoint  ");
     cli_print_power(&g->hat[ULAM_ADJOINT]);
+    if (g->kernel_alpha != 1.0) printf(" at kernel exponent alpha = %g", g->kernel_alpha);
     printf("\nrho(M^) forward  ");
     cli_print_power(&g->hat[ULAM_FORWARD]);
+    if (g->kernel_alpha != 1.0) printf(" at kernel exponent alpha = %g", g->kernel_alpha);
     int cert, nv = neumann_verdict(st, r, g, &cert);
     printf("\nNeumann series   %s%s\n",
            nv == 1 ? "converges (rho(M) < 1)" : nv == 0 ? "diverges (rho(M) >= 1)" : "unknown (rho(M) not certified on either side of 1)",
@@ -101,6 +105,7 @@ static void print_json(const cli_system *s, const ulam_csr_stats *st, const ulam
     cli_json_radius("rho_abs", &g->abs);
     cli_json_radius("rho_hat_adjoint", &g->hat[ULAM_ADJOINT]);
     cli_json_radius("rho_hat_forward", &g->hat[ULAM_FORWARD]);
+    cli_json_number("kernel_alpha", g->kernel_alpha, 0);
     int cert, nv = neumann_verdict(st, r, g, &cert);
     printf("\"neumann_converges\": %s, \"neumann_certified\": %s, ", nv < 0 ? "null" : nv ? "true" : "false",
            cert ? "true" : "false");
@@ -152,10 +157,11 @@ int cli_info(int argc, char **argv)
         {"jacobi", no_argument, 0, 'j'}, {"omega", required_argument, 0, 'w'},
         {"tol", required_argument, 0, 't'}, {"json", no_argument, 0, 'J'},
         {"continue", required_argument, 0, 'q'}, {"help", no_argument, 0, 'h'},
+        {"alpha", required_argument, 0, 'a'},
         {0, 0, 0, 0}};
     cli_system s = {.command = "info", .omega = 1.0};
     ulam_spectral_opts so = ulam_spectral_defaults();
-    double continue_q = 0.0;
+    double continue_q = 0.0, alpha = 1.0;
     int json = 0, c, rc;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
@@ -164,6 +170,7 @@ int cli_info(int argc, char **argv)
         case 'w': if ((rc = cli_parse_real("info", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 't': if ((rc = cli_parse_real("info", "--tol", optarg, 1e-14, 0.5, &so.tol))) return rc; break;
         case 'q': if ((rc = cli_parse_real("info", "--continue", optarg, 1e-9, 1 - 1e-12, &continue_q))) return rc; break;
+        case 'a': if ((rc = cli_parse_real("info", "--alpha", optarg, 0.0, 1000.0, &alpha))) return rc; break;
         case 'J': json = 1; break;
         case 'h': fputs(usage, stdout); return 0;
         default: return cli_usage_error("info", "unknown option");
@@ -182,6 +189,7 @@ int cli_info(int argc, char **argv)
     else {
         ulam_guard_opts go = ulam_guard_defaults();
         go.tight = 1; /* info reports the radii themselves, not only the verdicts */
+        go.kernel_alpha = alpha;
         status = ulam_guard_check(s.M, continue_q, &go, &g, &err);
     }
     if (status) {

@@ -346,7 +346,7 @@ int cli_solve_method(int argc, char **argv)
     if ((rc = cli_load_system(&s))) return rc;
     p.index = s.index;
     o.walk.share = cli_share, o.walk.interrupt = &cli_interrupted;
-    if (walking(p.method) && (rc = cli_guard(&s, o.walk.continue_q, ULAM_FORWARD, &p.g))) {
+    if (walking(p.method) && (rc = cli_guard(&s, o.walk.continue_q, o.walk.kernel_alpha, ULAM_FORWARD, &p.g))) {
         cli_system_free(&s);
         return rc;
     }

@@ -92,6 +92,7 @@ typedef struct {
 typedef struct {
     double B[3], se[3], se_walk[3]; /* se: with --matrix-walk, the walk's and F's noise combined */
     int64_t walks, steps, cut; /* cut: walks stopped at --max-steps */
+    int64_t channel_walks[3]; /* --matrix-walk: each channel's walks (walks is their sum) */
     double seconds;
     int threads, interrupted;
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
@@ -298,7 +299,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
     for (int c = 0; c < 3 && !status && !cli_interrupted; c++) {
         ulam_csr *M = NULL;
         ulam_solver *sv = NULL;
-        if ((status = ulam_radiosity_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
+        if ((status = ulam_rad_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
             ulam_csr_free(M);
             break;
         }
@@ -306,6 +307,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
         ulam_walk_result r;
         ulam_solver_result(sv, &r);
         w->B[c] = r.estimate, w->se[c] = w->se_walk[c] = r.std_error;
+        w->channel_walks[c] = r.walks;
         w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds, w->cut += r.cut;
         w->threads = r.threads, w->interrupted |= r.interrupted;
         if (!status && w->all) {
@@ -446,7 +448,9 @@ typedef struct {
 static double zscore(const args *a, const report *r, int c)
 {
     double d = r->Bdirect[3 * r->patch + c], sw = r->w->se_walk[c], sf = a->matrix_walk ? 0.0 : r->direct_se[c];
-    return (r->w->B[c] - d) / sqrt(sw * sw + sf * sf);
+    double diff = r->w->B[c] - d, se = sqrt(sw * sw + sf * sf);
+    if (se == 0) return diff == 0 ? 0.0 : copysign(INFINITY, diff); /* both exact: agree, or not at all */
+    return diff / se;
 }
 
 /* Print the text report. */
@@ -488,6 +492,9 @@ static void print_text(const args *a, const report *r)
                a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
+    if (w && a->matrix_walk)
+        printf("             (one walk a channel: %lld R + %lld G + %lld B)\n", (long long)w->channel_walks[0],
+               (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
     if (a->view)
         printf("view         %lld of %lld patches seen (%lld of %lld pixels), each to %.3g (n_max / n)^%.3g: "
                "%lld camera rays + %lld walk rays, %.4f s%s\n", (long long)r->view.seen, (long long)r->view.npatches,
@@ -523,7 +530,9 @@ static void print_text(const args *a, const report *r)
 /* Print the JSON object. */
 static void print_json(const args *a, const report *r)
 {
-    printf("{\"scene\": \"%s\", \"npatches\": %lld, ", a->scene, (long long)r->s->npatches);
+    printf("{");
+    cli_json_string("scene", a->scene, 0);
+    printf("\"npatches\": %lld, ", (long long)r->s->npatches);
     if (r->patch >= 0) {
         int32_t g = r->s->group[r->patch];
         double c[3];
@@ -548,6 +557,9 @@ static void print_json(const args *a, const report *r)
         printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, \"cut\": %lld, \"max_steps\": %lld, ",
                a->matrix_walk ? "true" : "false", (long long)w->walks, a->matrix_walk ? "steps" : "rays",
                (long long)w->steps, (long long)w->cut, (long long)a->o.max_steps);
+        if (a->matrix_walk) /* walks is their sum: a matrix walk carries one channel */
+            printf("\"channel_walks\": [%lld, %lld, %lld], ", (long long)w->channel_walks[0],
+                   (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
         cli_json_number("seconds", w->seconds, 0);
         printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
         if (a->o.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT) {
@@ -676,9 +688,9 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
 {
     ulam_error err;
     double t0 = ulam_now();
-    if (ulam_form_factors(t, a->ff_rays, a->o.seed, a->o.threads, F, &err)) return cli_report(a->scene, &err);
+    if (ulam_ff_estimate(t, a->ff_rays, a->o.seed, a->o.threads, F, &err)) return cli_report(a->scene, &err);
     r->ff_seconds = ulam_now() - t0;
-    ulam_form_factor_report(s, *F, &r->ff);
+    ulam_ff_report_compute(s, *F, &r->ff);
     r->F = *F;
     int need = a->direct || a->check, every = a->out || a->all;
     int for_error = a->matrix_walk && (r->patch >= 0 || (every && a->o.mode == ULAM_FORWARD));
@@ -689,11 +701,11 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
         return cli_report(a->scene, &err);
     }
     ulam_direct_info info;
-    if (ulam_radiosity_direct(s, *F, a->max_mem, *Bd, &info, &err)) return cli_report(a->scene, &err);
+    if (ulam_rad_direct(s, *F, a->max_mem, *Bd, &info, &err)) return cli_report(a->scene, &err);
     r->direct_seconds = info.seconds;
     if (need) r->Bdirect = *Bd;
     if (r->patch >= 0) {
-        if (ulam_radiosity_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
+        if (ulam_rad_direct_error(s, *F, a->ff_rays, *Bd, r->patch, a->max_mem, r->direct_se, &err))
             return cli_report(a->scene, &err);
         r->ff_se_known = 1;
     }
@@ -702,7 +714,7 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
             err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the standard errors"};
             return cli_report(a->scene, &err);
         }
-        int st = ulam_radiosity_direct_errors(s, *F, a->ff_rays, *Bd, a->max_mem, r->direct_se_all, &err);
+        int st = ulam_rad_direct_errors(s, *F, a->ff_rays, *Bd, a->max_mem, r->direct_se_all, &err);
         if (st == ULAM_EMEMLIMIT) free(r->direct_se_all), r->direct_se_all = NULL; /* the rows say unknown */
         else if (st) return cli_report(a->scene, &err);
     }

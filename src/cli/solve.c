@@ -11,8 +11,9 @@
 static const char *const usage =
     "usage: ulam solve M.mtx --rhs b.mtx --index I [--mode adjoint|forward]\n"
     "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"
-    "                  [--time S] [--seed S] [--threads T] [--continue Q] [--roulette W]\n"
-    "                  [--split W] [--max-steps K] [--jacobi [--omega W]] [--check] [--json]\n"
+    "                  [--time S] [--seed S] [--threads T] [--continue Q] [--alpha A]\n"
+    "                  [--roulette W] [--split W] [--max-steps K] [--jacobi [--omega W]] [--check]\n"
+    "                  [--json]\n"
     "                  [--out x.mtx] [--errors e.mtx] [--force] [--assume-finite-variance]\n"
     "                  [--cache] [--whole-kernel]\n"
     "                  [--method auto]\n"
@@ -41,6 +42,9 @@ static const char *const usage =
 static const char *const usage2 = /* the help in two strings: C99 promises 4095 characters a literal */
     "  --continue Q       continue with probability Q in every state (default: analog,\n"
     "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased\n"
+    "  --alpha A          kernel exponent: move to j with probability proportional to\n"
+    "                     |M_ij|^A over the row's nonzeros (default 1, |M_ij| / S_i; 0 uniform,\n"
+    "                     2 Alea's); rho(M^) and the error bar are this kernel's\n"
     "  --roulette W       Russian roulette below weight W (survive with |w|/W, weight W)\n"
     "  --split W          split particles above weight W into ceil(|w|/W) copies\n"
     "  --max-steps K      cut walks longer than K steps and count them (default 1000000)\n"
@@ -123,9 +127,11 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
            (unsigned long long)o->seed);
     printf("figure of merit %.4g (1 / (relative variance x seconds))\n",
            r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : INFINITY);
-    printf("guards          rho(|M|) in [%.6g, %.6g] (%s), rho(M^) in [%.6g, %.6g] (%s)\n", ro->g.abs.lower,
+    printf("guards          rho(|M|) in [%.6g, %.6g] (%s), rho(M^) in [%.6g, %.6g] (%s)", ro->g.abs.lower,
            ro->g.abs.upper, cli_verdict_word(ro->g.verdict_abs), ro->g.hat[o->mode].lower, ro->g.hat[o->mode].upper,
            cli_verdict_word(ro->g.verdict_hat[o->mode]));
+    if (o->kernel_alpha != 1.0) printf(" at kernel exponent alpha = %g", o->kernel_alpha);
+    printf("\n");
     if (isfinite(r->score_bound))
         printf("tail            a single score is at most %.4g: one more walk could move the estimate by at "
                "most %.3g%%\n", r->score_bound, 100 * r->tail_bound);
@@ -179,6 +185,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     cli_json_variance("variance_finite", r->variance_finite);
     cli_json_radius("rho_abs", &ro->g.abs);
     cli_json_radius("rho_hat", &ro->g.hat[o->mode]);
+    cli_json_number("kernel_alpha", o->kernel_alpha, 0);
     cli_json_number("max_share", r->max_share, 0);
     cli_json_number("score_bound", r->score_bound, 0);
     cli_json_number("tail_bound", r->tail_bound, 0);
@@ -316,7 +323,8 @@ static int parse(int argc, char **argv, solve_args *a)
         CLI_WALK_OPTION("time"),                 CLI_WALK_OPTION("seed"),
         CLI_WALK_OPTION("threads"),              CLI_WALK_OPTION("continue"),
         CLI_WALK_OPTION("roulette"),             CLI_WALK_OPTION("split"),
-        CLI_WALK_OPTION("max-steps"),            {"jacobi", no_argument, 0, 'j'},
+        CLI_WALK_OPTION("max-steps"),            CLI_WALK_OPTION("alpha"),
+        {"jacobi", no_argument, 0, 'j'},
         {"omega", required_argument, 0, 'w'},    {"check", no_argument, 0, 'c'},
         {"json", no_argument, 0, 'J'},           {"out", required_argument, 0, 'o'},
         {"errors", required_argument, 0, 'E'},   {"help", no_argument, 0, 'h'},
@@ -403,7 +411,7 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solv
         ro->g = au->guard;
         ro->kernel_seconds = ulam_now() - t0 - au->seconds;
     } else {
-        if ((rc = cli_guard(s, o->continue_q, o->mode, &ro->g))) {
+        if ((rc = cli_guard(s, o->continue_q, o->kernel_alpha, o->mode, &ro->g))) {
             cli_system_free(s);
             return rc;
         }

@@ -3,6 +3,7 @@
  * resumes; then summary.csv and charts.  No output file is ever seen half written, and no
  * non-finite number is written: an undefined statistic is an empty field. */
 #include "cli.h"
+#include "gnuplot.h"
 
 #include <errno.h>
 #include <getopt.h>
@@ -45,12 +46,11 @@ static const char *const usage =
     "Windows: roulette W = 0.5 w0, split W = 2 w0 (w0 the starting weight).  Ctrl-C keeps\n"
     "every finished row and writes the summary (exit 130); a second Ctrl-C exits at once.\n";
 
-enum { NMETHOD = 18, MAXBUDGET = 16, MAXREPEAT = 4096 };
-static const char *const window_names[] = {"plain", "roulette", "split"};
+enum { NMETHOD = ULAM_STUDY_METHODS, MAXBUDGET = 16, MAXREPEAT = 4096 };
 
 typedef struct {
-    char name[40];
-    int mode, est, window, on;
+    const char *name; /* the library's method grid: ulam_study_method_get */
+    int mode, on;
     char why[320]; /* non-empty: refused */
     int infinite;  /* rho(M^) not certified below 1: runs, flagged */
 } method;
@@ -64,6 +64,7 @@ typedef struct {
     const char *out;
     ulam_guard g; /* the verdicts, computed once for every run */
     double exact;
+    int direct; double direct_seconds, direct_error; /* LAPACK's point on the chart (n <= 8000) */
     int forward_walks; /* rho(|M|) < 1 and the forward rho(M^) < 1: the outer iterations can walk */
     double *est, *se, *sec; /* [m][b][r] */
     unsigned char *done;
@@ -82,9 +83,8 @@ static size_t at(const study *st, int m, int b, int r)
 static void methods_init(method *m)
 {
     for (int k = 0; k < NMETHOD; k++) {
-        m[k] = (method){.mode = k / 9, .est = k / 3 % 3, .window = k % 3, .on = 1};
-        snprintf(m[k].name, sizeof m[k].name, "%s-%s-%s", cli_mode_names[m[k].mode], cli_estimator_names[m[k].est],
-                 window_names[m[k].window]);
+        const ulam_study_method *g = ulam_study_method_get(k);
+        m[k] = (method){.name = g->name, .mode = g->mode, .on = 1};
     }
 }
 
@@ -95,9 +95,8 @@ static int methods_select(method *m, const char *list)
     char buf[1024];
     snprintf(buf, sizeof buf, "%s", list);
     for (char *save, *w = strtok_r(buf, ",", &save); w; w = strtok_r(NULL, ",", &save)) {
-        int k = 0;
-        while (k < NMETHOD && strcmp(m[k].name, w)) k++;
-        if (k == NMETHOD)
+        int k = ulam_study_method_find(w);
+        if (k < 0)
             return cli_usage_error("study", "--methods: unknown method '%s' (names like adjoint-collision-plain)", w);
         m[k].on = 1;
     }
@@ -140,7 +139,8 @@ static int screen_methods(study *st)
                      g->abs.lower, g->abs.upper);
         } else {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.mode = m->mode, o.estimator = m->est, o.index = st->s.index - 1, o.max_walks = 1, o.guard = g;
+            ulam_study_method_opts(k, st->s.b, st->s.M->nrows, &o);
+            o.roulette = o.split = 0, o.index = st->s.index - 1, o.max_walks = 1, o.guard = g; /* screened unwindowed */
             ulam_solver *sv = NULL;
             if (ulam_solver_alloc(st->s.M, st->s.b, &o, &sv, &err))
                 snprintf(m->why, sizeof m->why, "%s: expected %s", ulam_strerror(err.status), err.msg);
@@ -216,16 +216,12 @@ static int one_run(study *st, int m, int b, int r)
 {
     const method *me = &st->m[m];
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = me->mode, o.estimator = me->est, o.index = st->s.index - 1, o.threads = st->threads;
+    ulam_study_method_opts(m, st->s.b, st->s.M->nrows, &o);
+    o.index = st->s.index - 1, o.threads = st->threads;
     o.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
     o.interrupt = &cli_interrupted, o.share = cli_share, o.guard = &st->g, o.force = 1;
     if (st->time_budgets) o.max_walks = 0, o.max_seconds = st->budget[b];
     else o.max_walks = (int64_t)st->budget[b];
-    double w0 = me->mode == ULAM_FORWARD ? 0.0 : 1.0; /* forward particles start at ||b||_1 */
-    if (me->mode == ULAM_FORWARD)
-        for (int64_t i = 0; i < st->s.M->nrows; i++) w0 += fabs(st->s.b[i]);
-    if (me->window >= 1) o.roulette = 0.5 * w0;
-    if (me->window == 2) o.split = 2.0 * w0;
     ulam_walk_result res;
     if (ulam_solve(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted || res.walks < 2 || !isfinite(res.std_error))
         return 1; /* nothing non-finite reaches runs.csv */
@@ -396,16 +392,19 @@ static void outer_references(const study *st, FILE *f)
     free(x);
 }
 
-/* The exact x_I and the reference lines: LAPACK (n <= 8000: its time and its error against
- * Gauss-Seidel run to convergence) and Gauss-Seidel from x = 0 (time against its error on
- * x_I), into reference.csv.  0 or an exit code. */
+/* The exact x_I (ulam_study_reference) and the reference lines: LAPACK (n <= 8000: its time and
+ * its error against Gauss-Seidel run to convergence) and Gauss-Seidel from x = 0 (time against
+ * its error on x_I), into reference.csv.  0 or an exit code. */
 static int references(study *st)
 {
     int64_t n = st->s.M->nrows, I = st->s.index - 1;
-    double *x = calloc((size_t)n, sizeof *x), *xd = NULL;
+    ulam_study_ref ref;
+    ulam_error err;
+    if (ulam_study_reference(st->s.M, st->s.b, I, &ref, &err)) return cli_report(st->s.matrix_path, &err);
+    st->exact = ref.exact;
+    st->direct = ref.direct, st->direct_seconds = ref.direct_seconds, st->direct_error = fabs(ref.exact - ref.settled) + 1e-300;
+    double *x = calloc((size_t)n, sizeof *x);
     if (!x) return cli_exit_code(ULAM_ENOMEM);
-    ulam_gauss_seidel_settle(st->s.M, st->s.b, x, I, 1e-16, 12, 100000); /* the converged reference */
-    st->exact = x[I];
     char path[4096], v[2][32];
     snprintf(path, sizeof path, "%s/reference.csv", st->out);
     ulam_outfile o = {0};
@@ -421,14 +420,9 @@ static int references(study *st)
         return cli_exit_code(ULAM_EIO);
     }
     fprintf(f, "kind,seconds,error\n");
-    ulam_direct_info info;
-    if (n <= 8000 && (xd = malloc((size_t)n * sizeof *xd)) && !ulam_direct_solve(st->s.M, st->s.b, xd, 0, &info, NULL)) {
-        fprintf(f, "lapack,%s,%s\n", num(v[0], info.seconds), num(v[1], fabs(xd[I] - st->exact) + 1e-300));
-        st->exact = xd[I];
-    }
-    free(xd);
+    if (ref.direct)
+        fprintf(f, "lapack,%s,%s\n", num(v[0], st->direct_seconds), num(v[1], st->direct_error));
     double t = 0;
-    for (int64_t i = 0; i < n; i++) x[i] = 0;
     for (int k = 1; k <= 100000; k++) {
         double t0 = ulam_now();
         ulam_gauss_seidel_sweep(st->s.M, st->s.b, x);
@@ -443,6 +437,34 @@ static int references(study *st)
     if (!o.f) return fclose(f), 0;
     ulam_error e = {.status = ulam_outfile_commit(&o), .msg = "a writable output directory"};
     return e.status ? cli_report(path, &e) : 0;
+}
+
+/* What R runs of one method at one budget say, against the exact value. */
+typedef struct {
+    int runs;
+    double rmse;        /* sqrt(mean (estimate - exact)^2) */
+    double mean_stderr; /* the mean reported standard error */
+    double honesty;     /* rmse / mean_stderr: 1 when the error bars are honest */
+    double coverage;    /* share of runs whose 95% interval holds the exact value */
+    double seconds;     /* mean seconds per run */
+    double work;        /* work-normalised variance rmse^2 x seconds (lower is better) */
+} cell;
+
+/* Summarise n runs (arrays of n) against the exact value into *out. */
+static void cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
+                         double exact, cell *out)
+{
+    double se2 = 0, se = 0, t = 0;
+    int covered = 0;
+    for (int k = 0; k < n; k++) {
+        double e = estimate[k] - exact;
+        se2 += e * e, se += std_error[k], t += seconds[k];
+        covered += fabs(e) <= ULAM_Z95 * std_error[k];
+    }
+    double N = n > 0 ? n : 1;
+    *out = (cell){.runs = n, .rmse = sqrt(se2 / N), .mean_stderr = se / N, .coverage = covered / N, .seconds = t / N};
+    out->honesty = out->mean_stderr > 0 ? out->rmse / out->mean_stderr : INFINITY;
+    out->work = out->rmse * out->rmse * out->seconds;
 }
 
 /* summary.csv (a row per cell) and bars.csv (per method, at the largest budget). */
@@ -465,7 +487,7 @@ static int summarise(study *st)
     double *e = malloc((size_t)st->repeats * 3 * sizeof *e);
     for (int m = 0; m < NMETHOD && e; m++) {
         if (!st->m[m].on || st->m[m].why[0]) continue;
-        ulam_cell last = {0};
+        cell last = {0};
         for (int b = 0; b < st->nbudget; b++) {
             int k = 0;
             for (int r = 0; r < st->repeats; r++) {
@@ -473,8 +495,8 @@ static int summarise(study *st)
                 if (st->done[i]) e[k] = st->est[i], e[st->repeats + k] = st->se[i], e[2 * st->repeats + k++] = st->sec[i];
             }
             if (!k) continue;
-            ulam_cell c;
-            ulam_cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, &c);
+            cell c;
+            cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, &c);
             fprintf(f, "%s,%.17g,%d,%s,%s,%s,%s,%s,%s,%s\n", st->m[m].name, st->budget[b], c.runs,
                     num(v[0], c.rmse), num(v[1], c.mean_stderr), num(v[2], c.honesty), num(v[3], c.coverage),
                     num(v[4], c.seconds), num(v[5], c.work), st->m[m].infinite ? "false" : "true");
@@ -492,37 +514,79 @@ static int summarise(study *st)
     return status ? cli_report(path[k ? k - 1 : 0], &err) : 0;
 }
 
+/* LAPACK's point on the RMSE chart, kept inside the axes the other lines set: marked at the edge
+ * it would stretch past, with its values and an arrow toward them (gnuplot, after X0, X1, Y0). */
+static void lapack_mark(const study *st, char *buf, size_t len)
+{
+    if (!st->direct) {
+        snprintf(buf, len, "lx = 1/0\nly = 1/0\n");
+        return;
+    }
+    char err[32]; /* the error as a label: 0 when LAPACK and Gauss-Seidel agree to the last bit */
+    if (st->direct_error > 1e-299) snprintf(err, sizeof err, "%.2g", st->direct_error);
+    else snprintf(err, sizeof err, "0");
+    snprintf(buf, len,
+             "LX = %.17g\nLY = %.17g\n"
+             "lx = LX < X0 ? X0 : LX > X1 ? X1 : LX\nly = LY < Y0 ? 2 * Y0 : LY\n"
+             "lt = 'LAPACK: error %s in %.3g s '.(LY < Y0 ? '\342\206\223' : '').(LX > X1 ? '\342\206\222' : "
+             "LX < X0 ? '\342\206\220' : '')\n"
+             "if (lx != LX || ly != LY) {\n"
+             "  if (lx > sqrt(X0 * X1)) {\n"
+             "    set label 1 lt at lx, ly right offset character -1.5, 0 font ',9'\n"
+             "  } else {\n"
+             "    set label 1 lt at lx, ly left offset character 1.5, 0 font ',9'\n"
+             "  }\n"
+             "}\n",
+             st->direct_seconds, st->direct_error, err, st->direct_seconds);
+}
+
 /* The three charts; nonzero when gnuplot failed. */
 static int charts(const study *st)
 {
-    char names[NMETHOD * 40] = "", script[8192];
+    char names[NMETHOD * 40] = "", budgets[MAXBUDGET * 32] = "", lapack[1024], script[12288];
     for (int m = 0; m < NMETHOD; m++)
         if (st->m[m].on && !st->m[m].why[0]) strcat(strcat(names, st->m[m].name), " ");
+    for (int b = 0; b < st->nbudget; b++)
+        snprintf(budgets + strlen(budgets), sizeof budgets - strlen(budgets), "%.17g ", st->budget[b]);
+    double y0 = st->exact != 0 ? 1e-9 * fabs(st->exact) : 1e-12;
+    lapack_mark(st, lapack, sizeof lapack);
     snprintf(script, sizeof script,
              "set title 'ulam study: RMSE of x_{%lld} against seconds per run'\n"
              "set logscale xy\nset format x '10^{%%L}'\nset format y '10^{%%L}'\nset xlabel 'seconds per run'\n"
              "set ylabel 'RMSE (reference lines: the error of one run)'\nset key outside right font ',8'\n"
-             "set yrange [%g:*]\n"
+             "Y0 = %g\nset yrange [Y0:*]\n"
              "set fit quiet\nset fit logfile '/dev/null'\nf(x) = a / sqrt(x)\na = 0\nfit f(x) 'summary.csv' u 8:4 via a\n"
              "M = \"%s\"\n" /* one colour and dash per method: 8 colours, then the next dash pattern */
-             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) ? $8 : 1/0):4 w lp "
-             "linecolor i dashtype 1 + (i - 1) / 8 pointtype i title word(M, i), "
-             "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 t 'Gauss-Seidel, whole vector', "
-             "'' u (strcol(1) eq 'lapack' ? $2 : 1/0):3 w p pt 9 ps 2 t 'LAPACK dgesv (error vs refined)', "
-             "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 2 pt 5 t 'sequential MC, every unknown (one run)', "
-             "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 2 pt 7 t 'MCSA, every unknown (one run)', "
-             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 2 pt 3 t 'Krylov (CG or GMRES(30))', "
+             "B = \"%s\"\n" /* one point shape per budget, in the method's colour */
+             "P = \"7 5 9 11 13 6 4 8 10 12 1 2 3 14 15 16\"\n"
+             /* the x axis spans the walks and the reference lines but LAPACK's point */
+             "stats 'summary.csv' u ($8 > 0 ? $8 : 1/0) nooutput\nX0 = STATS_min\nX1 = STATS_max\n"
+             "stats 'reference.csv' u (strcol(1) ne 'lapack' && $2 > 0 ? $2 : 1/0) nooutput\n"
+             "X0 = 10**floor(log10(STATS_min < X0 ? STATS_min : X0))\nX1 = 10**ceil(log10(STATS_max > X1 ? STATS_max : X1))\n"
+             "set xrange [X0:X1]\n"
+             "%s"
+             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) ? $8 : 1/0):4 w l "
+             "linecolor i dashtype 1 + (i - 1) / 8 title word(M, i), "
+             "for [i=1:words(M)] for [j=1:words(B)] 'summary.csv' u (strcol(1) eq word(M, i) && $2 == word(B, j) + 0 ? "
+             "$8 : 1/0):4 w p linecolor i pointtype (word(P, j) + 0) notitle, "
+             "for [j=1:words(B)] NaN w p lc 'black' pointtype (word(P, j) + 0) title sprintf('%s', word(B, j) + 0), "
+             "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 lc 3 t 'Gauss-Seidel, whole vector', "
+             "'' u (strcol(1) eq 'lapack' ? lx : 1/0):(ly) w p pt 9 ps 2 lc 4 t 'LAPACK dgesv (error vs refined)', "
+             "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 2 pt 5 lc 5 t 'sequential MC, every unknown (one run)', "
+             "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 2 pt 7 lc 6 t 'MCSA, every unknown (one run)', "
+             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 2 pt 3 lc 7 t 'Krylov (CG or GMRES(30))', "
              "f(x) dt 2 lc 'black' t '1/sqrt(t) slope'\n",
-             (long long)st->s.index, st->exact != 0 ? 1e-9 * fabs(st->exact) : 1e-12, names);
-    if (ulam_gnuplot(st->out, "rmse", 1200, 700, script)) {
+             (long long)st->s.index, y0, names, budgets, lapack,
+             st->time_budgets ? "budget %g s a run" : "budget %.0f walks");
+    if (gnuplot_draw(st->out, "rmse", 1200, 700, script)) {
         fprintf(stderr, "ulam: study: gnuplot failed (install gnuplot-nox): charts not drawn, CSVs written\n");
         return 1;
     }
-    ulam_gnuplot(st->out, "work", 1000, 500,
+    gnuplot_draw(st->out, "work", 1000, 500,
                  "set title 'work-normalised variance RMSE^2 x seconds at the largest budget (lower wins)'\n"
                  "set style data histograms\nset style fill solid 0.6\nset logscale y\nset format y '10^{%L}'\n"
                  "set xtics rotate by -40 font ',8'\nset bmargin 7\nset key off\nplot 'bars.csv' u 2:xtic(1)\n");
-    ulam_gnuplot(st->out, "coverage", 1000, 500,
+    gnuplot_draw(st->out, "coverage", 1000, 500,
                  "set title 'coverage of the 95% interval at the largest budget'\nset style data histograms\n"
                  "set style fill solid 0.6\nset yrange [0:1]\nset xtics rotate by -40 font ',8'\nset bmargin 7\nset key off\n"
                  "plot 'bars.csv' u 3:xtic(1), 0.95 dt 2 lc 'black'\n");

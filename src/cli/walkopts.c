@@ -21,6 +21,7 @@ int cli_walk_option(const char *command, const char *name, const char *value, ul
     if (!strcmp(name, "roulette")) return cli_parse_real(cmd, "--roulette", value, 1e-300, 1e300, &o->roulette);
     if (!strcmp(name, "split")) return cli_parse_real(cmd, "--split", value, 1e-300, 1e300, &o->split);
     if (!strcmp(name, "max-steps")) return cli_parse_int(cmd, "--max-steps", value, 1, INT64_MAX / 2, &o->max_steps);
+    if (!strcmp(name, "alpha")) return cli_parse_real(cmd, "--alpha", value, 0.0, 1000.0, &o->kernel_alpha);
     if (!strcmp(name, "seed")) {
         if (!(rc = cli_parse_int(cmd, "--seed", value, 0, INT64_MAX, &v))) o->seed = (uint64_t)v;
         return rc;

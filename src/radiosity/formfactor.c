@@ -36,8 +36,8 @@ static int64_t ff_row(const ulam_tracer *t, int64_t i, int64_t rays, uint64_t se
 }
 
 /* F by ray casting, rows in parallel. */
-int ulam_form_factors(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads, ulam_csr **F,
-                      ulam_error *err)
+int ulam_ff_estimate(const ulam_tracer *t, int64_t rays, uint64_t seed, int threads, ulam_csr **F,
+                     ulam_error *err)
 {
     ulam__clear(err);
     if (!t || !F || rays < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer and rays >= 1");
@@ -76,7 +76,7 @@ int ulam_form_factors(const ulam_tracer *t, int64_t rays, uint64_t seed, int thr
 }
 
 /* Reciprocity and row sums of F. */
-int ulam_form_factor_report(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r)
+int ulam_ff_report_compute(const ulam_scene *s, const ulam_csr *F, ulam_ff_report *r)
 {
     if (!s || !F || !r || F->nrows != s->npatches || F->ncols != s->npatches) return ULAM_EINVAL;
     ulam_csr *G = NULL, *Gt = NULL;
@@ -135,7 +135,7 @@ double ulam_ff_perpendicular_rectangles(double w, double h, double l)
 }
 
 /* M = diag(rho_c) F and b = E_c. */
-int ulam_radiosity_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M, double *b)
+int ulam_rad_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M, double *b)
 {
     if (!s || !F || !M || !b || channel < 0 || channel > 2 || F->nrows != s->npatches) return ULAM_EINVAL;
     ulam_csr *A = NULL;
@@ -159,8 +159,8 @@ int ulam_radiosity_system(const ulam_scene *s, const ulam_csr *F, int channel, u
 }
 
 /* The three channels by LAPACK. */
-int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
-                          ulam_direct_info *info, ulam_error *err)
+int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
+                    ulam_direct_info *info, ulam_error *err)
 {
     ulam__clear(err);
     if (!s || !F || !B) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a scene, F and an output");
@@ -171,7 +171,7 @@ int ulam_radiosity_direct(const ulam_scene *s, const ulam_csr *F, size_t max_byt
     for (int c = 0; c < 3 && !status; c++) {
         ulam_csr *M = NULL;
         ulam_direct_info one;
-        if ((status = ulam_radiosity_system(s, F, c, &M, b))) {
+        if ((status = ulam_rad_system(s, F, c, &M, b))) {
             ulam__fail(err, status, 0, -1, "memory for the radiosity system");
             break;
         }
@@ -204,8 +204,8 @@ static double row_noise(const ulam_scene *s, const ulam_csr *F, int64_t rays, co
 }
 
 /* Standard error of the direct B at patch p from the noise of F. */
-int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                int64_t p, size_t max_bytes, double se[3], ulam_error *err)
+int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                          int64_t p, size_t max_bytes, double se[3], ulam_error *err)
 {
     ulam__clear(err);
     if (!s || !F || !B || !se || rays < 1 || p < 0 || p >= s->npatches)
@@ -216,8 +216,8 @@ int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t 
     if (!status) e[p] = 1.0;
     for (int c = 0; c < 3 && !status; c++) {
         ulam_csr *M = NULL, *Mt = NULL;
-        double *b = g; /* ulam_radiosity_system writes E_c here; overwritten by the solve */
-        if ((status = ulam_radiosity_system(s, F, c, &M, b)) || (status = ulam_csr_transpose(M, &Mt))) {
+        double *b = g; /* ulam_rad_system writes E_c here; overwritten by the solve */
+        if ((status = ulam_rad_system(s, F, c, &M, b)) || (status = ulam_csr_transpose(M, &Mt))) {
             ulam__fail(err, status, 0, -1, "memory for the transposed system");
         } else if (!(status = ulam_direct_solve(Mt, e, g, max_bytes, NULL, err))) {
             double var = 0.0; /* g = row p of (I - M)^-1 */
@@ -233,8 +233,8 @@ int ulam_radiosity_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t 
 
 /* Standard errors of the direct B at every patch from the noise of F: G = (I - M)^-1 whole
  * (LAPACKE_dgesv of (I - M)' with the identity: X = G'), se_p^2 = sum_k G_pk^2 noise_k. */
-int ulam_radiosity_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
-                                 size_t max_bytes, double *se, ulam_error *err)
+int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
+                           size_t max_bytes, double *se, ulam_error *err)
 {
     ulam__clear(err);
     if (!s || !F || !B || !se || rays < 1 || F->nrows != s->npatches || F->ncols != s->npatches)

@@ -6,10 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The largest vertex coordinate read: Embree traces in float (the scene centred first), and a
+ * face's area, the square of its size, must stay finite in double. */
+#define ULAM__OBJ_MAX_COORD 1e30
+
 /* A material: its name and the two colours ulam uses. */
 typedef struct {
     char *name, *file; /* file and line of its newmtl */
     long line;
+    long kd_line, ke_line; /* where its Kd and Ke were given (0: not yet) */
     double kd[3], ke[3];
 } mtl;
 
@@ -32,6 +37,9 @@ typedef struct {
     char **groups;
     int64_t ngroups, cap_groups;
     int32_t cur_mat, cur_group;
+    char **mtl_names; /* the mtllib files read, as written, and the OBJ lines that read them */
+    long *mtl_lines;
+    int64_t nmtl, cap_mtl, cap_mtl_lines;
     char *dir; /* the OBJ file's folder, with a trailing slash, or "" */
     ulam_error *err;
 } objr;
@@ -50,6 +58,8 @@ static void objr_free(objr *o)
 {
     for (int64_t i = 0; i < o->nmats; i++) free(o->mats[i].name), free(o->mats[i].file);
     for (int64_t i = 0; i < o->ngroups; i++) free(o->groups[i]);
+    for (int64_t i = 0; i < o->nmtl; i++) free(o->mtl_names[i]);
+    free(o->mtl_names), free(o->mtl_lines);
     free(o->v), free(o->idx), free(o->faces);
     free(o->mats), free(o->groups), free(o->dir);
 }
@@ -204,9 +214,16 @@ static int read_mtl(objr *o, const char *name, long obj_line)
                 break;
             }
             int kd = s[1] == 'd';
+            long *given = kd ? &cur->kd_line : &cur->ke_line;
+            if (*given) { /* a second one would silently override the first */
+                char what[400];
+                snprintf(what, sizeof what, "one %s per material: '%.100s' has one at line %ld", s, cur->name, *given);
+                status = mtl_fail(o, path, ULAM_ESYNTAX, line, "%s", what);
+                break;
+            }
             double c[3];
             status = mtl_colour(o, path, line, args, kd, c);
-            if (!status) memcpy(kd ? cur->kd : cur->ke, c, sizeof c);
+            if (!status) memcpy(kd ? cur->kd : cur->ke, c, sizeof c), *given = line;
         } /* every other MTL statement (Ka, Ks, Ns, d, illum, map_*, ...) is not ulam's business */
     }
     if (!status && ferror(f)) status = mtl_fail(o, path, ULAM_EIO, line, "%s", "a readable file");
@@ -216,13 +233,37 @@ static int read_mtl(objr *o, const char *name, long obj_line)
     return status;
 }
 
+/* The index of the mtllib file name read before, or -1. */
+static int64_t mtl_read_before(const objr *o, const char *name)
+{
+    for (int64_t i = 0; i < o->nmtl; i++)
+        if (!strcmp(o->mtl_names[i], name)) return i;
+    return -1;
+}
+
+/* Remember that the OBJ's line read the MTL file name. */
+static int mtl_remember(objr *o, const char *name, long line)
+{
+    if (ulam__grow(&o->mtl_names, &o->cap_mtl, o->nmtl + 1, sizeof(char *)) ||
+        ulam__grow(&o->mtl_lines, &o->cap_mtl_lines, o->nmtl + 1, sizeof(long)) ||
+        !(o->mtl_names[o->nmtl] = dup_str(name)))
+        return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for an MTL file name");
+    o->mtl_lines[o->nmtl++] = line;
+    return ULAM_OK;
+}
+
 /* mtllib: one or more MTL files. */
 static int do_mtllib(objr *o, char *args, long line)
 {
     char *tok, *save = NULL;
     int any = 0;
     for (tok = strtok_r(args, " \t", &save); tok; tok = strtok_r(NULL, " \t", &save)) {
+        int64_t seen = mtl_read_before(o, tok);
+        if (seen >= 0)
+            return ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "an MTL file not read before; %.200s was read at line %ld",
+                              tok, o->mtl_lines[seen]);
         int status = read_mtl(o, tok, line);
+        if (!status) status = mtl_remember(o, tok, line);
         if (status) return status;
         any = 1;
     }
@@ -269,6 +310,13 @@ static int do_vertex(objr *o, char *args, long line)
     if (k == -2) return ulam__fail(o->err, ULAM_ENONFINITE, line, -1, "finite vertex coordinates");
     if (k != 3 && k != 4 && k != 6)
         return ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "v x y z (three numbers, optionally w or r g b)");
+    if (k == 4 && x[3] != 1.0) /* w weighs rational curves; a polygon's vertex is the point x y z */
+        return ulam__fail(o->err, ULAM_ERANGE, line, -1, "v x y z [w] with w = 1 (polygon vertices are not "
+                          "weighted); got w = %.6g", x[3]);
+    for (int d = 0; d < 3; d++)
+        if (fabs(x[d]) > ULAM__OBJ_MAX_COORD)
+            return ulam__fail(o->err, ULAM_ERANGE, line, -1, "vertex coordinates within +-%g (rays are traced in "
+                              "single precision); got %.6g", ULAM__OBJ_MAX_COORD, x[d]);
     if (o->nv >= INT32_MAX || ulam__grow(&o->v, &o->cap_v, 3 * (o->nv + 1), sizeof(double)))
         return ulam__fail(o->err, ULAM_ENOMEM, line, -1, "memory for the vertices");
     memcpy(o->v + 3 * o->nv++, x, 3 * sizeof(double));
@@ -291,6 +339,10 @@ static int64_t face_index(objr *o, const char *tok, long line)
             return -1;
         }
     long long k = i > 0 ? i - 1 : i < 0 ? o->nv + i : -1;
+    if (o->nv == 0) {
+        ulam__fail(o->err, ULAM_EINDEX, line, -1, "a 'v' line before the first face (no vertex is defined yet)");
+        return -1;
+    }
     if (k < 0 || k >= o->nv) {
         ulam__fail(o->err, ULAM_EINDEX, line, -1,
                     "a vertex index from 1 to %lld or -1 to -%lld (vertices defined so far); got %lld",

@@ -104,9 +104,10 @@ static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, ulam_error 
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision or absorption (next-event: gathering only)");
     if (o->index < 0 || o->index >= sc->npatches)
         return ulam__fail(err, ULAM_EINVAL, 0, o->index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
-    if (o->continue_q != 0 || o->roulette != 0 || o->split != 0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette or split (patch walks continue "
-                                                   "with the patch's largest reflectance)");
+    if (o->continue_q != 0 || o->roulette != 0 || o->split != 0 || o->kernel_alpha != 1.0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette, split or kernel exponent other "
+                                                   "than 1 (patch walks continue with the patch's largest "
+                                                   "reflectance and follow the form factors)");
     if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
     if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
@@ -435,6 +436,8 @@ static void merge_block(void *ctx, int k)
     s->cut += br->cut;
 }
 
+static void result(const ulam_rad_solver *s, const double mins[3], ulam_rad_result *r);
+
 /* Gathering: the walks the rel_err rule's range term needs in channel c at estimate m. */
 static double channel_min_walks(const ulam_rad_solver *s, int c, double m, double E)
 {
@@ -442,10 +445,25 @@ static double channel_min_walks(const ulam_rad_solver *s, int c, double m, doubl
     return ulam__rel_min_walks(ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, m, E), E, m);
 }
 
+/* Gathering with rel_err: the walks the rule's range term needs in each channel, at its
+ * estimate, or for an emitting channel still at 0 at the brightest channel's (precise_enough);
+ * 0 otherwise (shooting, no rel_err, a channel nothing emits in). */
+static void channel_mins(const ulam_rad_solver *s, double mins[3])
+{
+    double bright = 0.0;
+    for (int c = 0; c < 3; c++) bright = fmax(bright, fabs(s->m[c].mean));
+    for (int c = 0; c < 3; c++) {
+        mins[c] = 0.0;
+        if (s->o.mode != ULAM_ADJOINT || !(s->o.rel_err > 0)) continue;
+        if (s->m[c].mean != 0.0) mins[c] = channel_min_walks(s, c, s->m[c].mean, s->o.rel_err);
+        else if (s->per_step[c] > 0 && bright > 0) mins[c] = channel_min_walks(s, c, bright, s->o.rel_err);
+    }
+}
+
 /* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
- * takes the whole rule (ulam__rel_err_holds); shooting, whose tallies keep no fourth moment,
- * the standard error alone. */
-static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, double rel_err)
+ * takes the whole rule (ulam__rel_err_holds, with the channels' range-term minimums mins from
+ * channel_mins); shooting, whose tallies keep no fourth moment, the standard error alone. */
+static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, const double mins[3], double rel_err)
 {
     int any = 0;
     double bright = 0.0; /* the brightest nonzero channel's estimate */
@@ -455,12 +473,11 @@ static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, do
          * blocks the stop until enough walks ran to have seen any of its scores worth E times
          * the brightest channel (the range term at that estimate); gathering only */
         if (r->radiosity[c] == 0.0 && s->o.mode != ULAM_FORWARD && s->per_step[c] > 0 && bright > 0 &&
-            (double)r->walks < channel_min_walks(s, c, bright, rel_err))
+            (double)r->walks < mins[c])
             return 0;
         if (r->radiosity[c] == 0.0) continue;
         if (s->o.mode == ULAM_FORWARD ? !(r->std_error[c] <= rel_err * fabs(r->radiosity[c]))
-                                      : !ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c],
-                                                             channel_min_walks(s, c, s->m[c].mean, rel_err),
+                                      : !ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c], mins[c],
                                                              ulam__moments_variance_rel_error(&s->m[c]), rel_err))
             return 0;
         any = 1;
@@ -489,8 +506,10 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
                                    NULL, NULL};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_rad_result r;
-    ulam_rad_solver_result(s, &r);
-    if (s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, s->o.rel_err)) s->run.done = s->met = 1;
+    double mins[3];
+    channel_mins(s, mins);
+    result(s, mins, &r);
+    if (s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, mins, s->o.rel_err)) s->run.done = s->met = 1;
     if (s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && all_zero(&r)) s->run.done = s->zero = 1; /* can never be met */
     return s->run.status;
 }
@@ -523,11 +542,10 @@ static void shot_component(const ulam_rad_solver *s, int64_t p, int c, double *e
     *se = N > 0 ? sqrt(v / N) / A : INFINITY;
 }
 
-/* The result so far. */
-void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
+/* The result so far, with the channels' range-term minimums mins (channel_mins). */
+static void result(const ulam_rad_solver *s, const double mins[3], ulam_rad_result *r)
 {
     memset(r, 0, sizeof *r);
-    if (!s) return;
     for (int c = 0; c < 3; c++) {
         if (s->o.mode == ULAM_ADJOINT) {
             r->radiosity[c] = s->m[c].mean;
@@ -537,15 +555,11 @@ void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
         }
     }
     r->max_share = s->sq > 0 ? fmin(1.0, s->maxsq / s->sq) : 0.0;
-    double bright = 0.0;
-    for (int c = 0; c < 3; c++) bright = fmax(bright, fabs(s->m[c].mean));
-    for (int c = 0; c < 3 && s->o.mode == ULAM_ADJOINT && s->o.rel_err > 0; c++)
-        if (s->m[c].mean != 0.0) {
-            r->min_walks = fmax(r->min_walks, channel_min_walks(s, c, s->m[c].mean, s->o.rel_err));
+    for (int c = 0; c < 3 && s->o.mode == ULAM_ADJOINT && s->o.rel_err > 0; c++) {
+        r->min_walks = fmax(r->min_walks, mins[c]); /* 0 in a channel where no minimum applies */
+        if (s->m[c].mean != 0.0)
             r->variance_rel_error = fmax(r->variance_rel_error, ulam__moments_variance_rel_error(&s->m[c]));
-        } else if (s->per_step[c] > 0 && bright > 0) { /* an emitting channel not yet scored (precise_enough) */
-            r->min_walks = fmax(r->min_walks, channel_min_walks(s, c, bright, s->o.rel_err));
-        }
+    }
     r->walks = s->run.walks;
     r->rays = s->rays;
     r->cut = s->cut;
@@ -554,6 +568,18 @@ void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
     r->interrupted = s->run.interrupted;
     r->zero = s->zero;
     r->rel_err_met = s->met;
+}
+
+/* The result so far. */
+void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
+{
+    double mins[3];
+    if (!s) {
+        memset(r, 0, sizeof *r);
+        return;
+    }
+    channel_mins(s, mins);
+    result(s, mins, r);
 }
 
 /* Shooting: every patch. */

@@ -22,7 +22,8 @@
  *   push           push alone with rmax halving from 1 until |p_s - x_t| <= 10% x_t, checked
  *                  against the exact value (an oracle stop: a lower bound on what push alone
  *                  needs without knowing x_t); capped at PUSH_CAP seconds (a lower bound, marked).
- * The transpose M' is built once (its time is printed apart): a query never repeats it.
+ * The transpose M' and the walks' guards on it are computed once (their times are printed apart)
+ * and given to every query of both walk methods: a query never repeats them.
  * Usage: bench_bidir [L [SOURCES]] (default 20 and 20: n = 1048576, 100 pairs). */
 #include "gen.h"
 
@@ -116,10 +117,11 @@ static double quantile(const double *v, int n, double q)
 }
 
 /* A bidirectional query (rmax 0: balanced). */
-static int query(ulam_push *w, const ulam_csr *Mt, int64_t s, int64_t t, double rmax, double cap, uint64_t seed,
-                 ulam_bidir_result *res)
+static int query(ulam_push *w, const ulam_csr *Mt, const ulam_guard *g, int64_t s, int64_t t, double rmax, double cap,
+                 uint64_t seed, ulam_bidir_result *res)
 {
     ulam_bidir_opts o = ulam_bidir_defaults();
+    o.walk.guard = g;
     o.source = s, o.target = t, o.rmax = rmax;
     o.walk.max_walks = 0, o.walk.rel_err = REL, o.walk.max_seconds = cap, o.walk.threads = 1, o.walk.seed = seed;
     o.walk.max_steps = INT64_MAX / 4;
@@ -131,10 +133,11 @@ static int query(ulam_push *w, const ulam_csr *Mt, int64_t s, int64_t t, double 
 
 /* Pure walks from s counting visits to t (e: zeros, n entries); seconds (projected when capped: *mark
  * 1, or 2 for a lower bound) and whether the 95% interval covers exact (-1: no interval). */
-static double walks_alone(const ulam_csr *Mt, double *e, int64_t s, int64_t t, double exact, uint64_t seed, int *mark,
-                          int *covers)
+static double walks_alone(const ulam_csr *Mt, const ulam_guard *g, double *e, int64_t s, int64_t t, double exact,
+                          uint64_t seed, int *mark, int *covers)
 {
     ulam_walk_opts o = ulam_walk_defaults();
+    o.guard = g;
     o.index = s, o.threads = 1, o.seed = seed, o.max_walks = 0, o.max_seconds = WALK_CAP, o.max_steps = INT64_MAX / 4;
     e[t] = 1.0;
     ulam_solver *sv = NULL;
@@ -218,6 +221,12 @@ int main(int argc, char **argv)
     ulam_push *w = NULL;
     if (ulam_csr_transpose(M, &Mt) || ulam_push_alloc(M, &w)) return fprintf(stderr, "bidir: out of memory\n"), 1;
     printf("transpose M' (once, for every query): %.3f s\n", ulam_now() - t0);
+    ulam_guard g; /* the walks' guards on M' (adjoint kernel), once for every query of either method */
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(ULAM_ADJOINT);
+    t0 = ulam_now();
+    if (ulam_guard_check(Mt, 0.0, &go, &g, NULL)) return fprintf(stderr, "bidir: guards failed\n"), 1;
+    printf("guards on M' (once, for every query of both walk methods): %.3f s\n", ulam_now() - t0);
     double *x = malloc((size_t)n * sizeof *x), *old = malloc((size_t)n * sizeof *old), *b = malloc((size_t)n * sizeof *b);
     double *e = calloc((size_t)n, sizeof *e);
     int64_t *cand = malloc((size_t)n * sizeof *cand);
@@ -244,19 +253,19 @@ int main(int argc, char **argv)
             int64_t t = cand[j];
             cand[j] = cand[q], cand[q] = t;
             ulam_bidir_result rb;
-            if (query(w, Mt, s, t, 0, 0, (uint64_t)k + 1, &rb)) return 1;
+            if (query(w, Mt, &g, s, t, 0, 0, (uint64_t)k + 1, &rb)) return 1;
             bi.seconds[k] = rb.seconds, bi.other[k] = rb.push.seconds, bi.walk[k] = rb.walks.seconds;
             bi.covered += rb.ci95[0] <= x[t] && x[t] <= rb.ci95[1], bi.intervals++;
             sum_push_ops += (double)rb.push.ops, sum_steps += (double)rb.walks.steps;
             sum_push_s += rb.push.seconds, sum_walk_s += rb.walks.seconds;
             int covers;
-            wk.seconds[k] = walks_alone(Mt, e, s, t, x[t], (uint64_t)k + 1, &wk.marked[k], &covers);
+            wk.seconds[k] = walks_alone(Mt, &g, e, s, t, x[t], (uint64_t)k + 1, &wk.marked[k], &covers);
             if (covers >= 0) wk.covered += covers, wk.intervals++;
             double prmax;
             pu.seconds[k] = push_alone(w, s, t, x[t], &pu.marked[k], &prmax);
             printf("%4d %8lld %8lld %12.5g %10.5f %9.5f %9.5f %9.2g %10lld %10.3g %7.2f %9.4f%s %9.4f%s %9.2g\n", k + 1,
                    (long long)s + 1, (long long)t + 1, x[t], rb.seconds, rb.push.seconds, rb.walks.seconds, rb.push.rmax,
-                   (long long)rb.walks.walks, rb.predicted_walks, (rb.estimate - x[t]) / rb.std_error, wk.seconds[k],
+                   (long long)rb.walks.walks, rb.plan.predicted_walks, (rb.estimate - x[t]) / rb.std_error, wk.seconds[k],
                    wk.marked[k] == 2 ? "!" : wk.marked[k] ? "*" : " ", pu.seconds[k], pu.marked[k] ? ">" : " ", prmax);
             fflush(stdout);
         }

@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "gen.h"
+#include "gnuplot.h"
 
 enum { NTOL = 7, STEPS = 100000 };
 static const double BUDGET = 120.0; /* seconds of MCSA per random system (checked between iterations) */
@@ -234,7 +235,7 @@ static void scale(int64_t n, ulam_outer_step *st)
 /* The chart from docs/mcsa.csv: seconds against tolerance, one panel a problem. */
 static int chart(void)
 {
-    return ulam_gnuplot("docs", "mcsa", 1500, 480,
+    return gnuplot_draw("docs", "mcsa", 1500, 480,
                         "set multiplot layout 1,3\nset logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\n"
                         "set xrange [1:5e-9] reverse\nset xlabel 'smallest residual ||r||/||b|| reached'\n"
                         "set ylabel 'seconds'\nset key top left font ',9'\nset grid\nset datafile separator ','\n"

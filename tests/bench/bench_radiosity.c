@@ -146,11 +146,11 @@ int main(int argc, char **argv)
         } else {
             ulam_csr *F = NULL;
             double t0 = ulam_now();
-            if (ulam_form_factors(t, ff_rays, 1, 0, &F, &err)) return 1;
+            if (ulam_ff_estimate(t, ff_rays, 1, 0, &F, &err)) return 1;
             double tf = ulam_now() - t0;
             double *B = malloc((size_t)(3 * s->npatches) * sizeof *B);
             ulam_direct_info info;
-            if (ulam_radiosity_direct(s, F, 0, B, &info, &err)) return 1;
+            if (ulam_rad_direct(s, F, 0, B, &info, &err)) return 1;
             double total = tf + info.seconds;
             f_per_patch = tf / (double)s->npatches, lapack_n = (double)s->npatches, lapack_s = info.seconds;
             printf(" %.2f | %.2f | %.2f | %.0fx | %.0fx |\n", tf, info.seconds, total, total / c.seconds,

@@ -24,6 +24,7 @@
 #include <sys/wait.h>
 
 #include "gen.h"
+#include "gnuplot.h"
 
 #ifdef HAVE_UMFPACK
 #include <suitesparse/umfpack.h>
@@ -242,7 +243,7 @@ static outcome walk_run(const ulam_csr *M, const double *b, int64_t I, int whole
  * the rows of other series do not break its line), projections as open circles. */
 static int chart(void)
 {
-    return ulam_gnuplot("docs", "scale", 1100, 520,
+    return gnuplot_draw("docs", "scale", 1100, 520,
                         "set multiplot layout 1,2\nset logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\n"
                         "set xlabel 'n'\nset ylabel 'seconds to x_I at 1%'\nset key top left font ',9'\nset grid\n"
                         "set datafile separator ','\nset xrange [500:2e7]\n"

@@ -1,16 +1,24 @@
-/* Charts: gnuplot (pngcairo) fed a script on a pipe, the PNG renamed into place when done. */
-#include "internal.h"
+/* Charts for the programs around the library (ulam study, examples/, tests/bench/): gnuplot
+ * (pngcairo) fed a script on a pipe, the PNG renamed into place when done.  An application
+ * helper, not library code: it starts a process. */
+#ifndef ULAM_GNUPLOT_H
+#define ULAM_GNUPLOT_H
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Draw DIR/NAME.png from script. */
-int ulam_gnuplot(const char *dir, const char *name, int width, int height, const char *script)
+#include "ulam.h"
+
+/* Draw DIR/NAME.png (width x height pixels) from script, gnuplot run in DIR with the data files'
+ * separator ',' and a grid; written under a temporary name and renamed into place.  ULAM_OK,
+ * ULAM_EINVAL (a quote in dir or name), ULAM_ENOMEM, or ULAM_EIO when gnuplot is missing or
+ * fails (nothing is left behind). */
+static inline int gnuplot_draw(const char *dir, const char *name, int width, int height, const char *script)
 {
     if (!dir || !name || !script || strchr(dir, '\'') || strchr(name, '\'')) return ULAM_EINVAL;
     size_t len = strlen(dir) + strlen(name) + 64;
-    char *png = ulam__malloc(len, 1), *tmp = ulam__malloc(len, 1), *cmd = ulam__malloc(len, 1);
+    char *png = malloc(len), *tmp = malloc(len), *cmd = malloc(len);
     int status = ULAM_ENOMEM;
     if (png && tmp && cmd) {
         snprintf(png, len, "%s/%s.png", dir, name);
@@ -30,3 +38,5 @@ int ulam_gnuplot(const char *dir, const char *name, int width, int height, const
     free(png), free(tmp), free(cmd);
     return status;
 }
+
+#endif

@@ -1,0 +1,229 @@
+/* The ABI habit (ulam.h): every struct a caller fills starts from its defaults function, which
+ * must return what the header documents, field by field; and starting from one must behave as
+ * the NULL options it stands for. */
+#include "testutil.h"
+
+#include <string.h>
+
+/* Fail unless walk options a and b agree field by field (a memcmp would compare padding). */
+static void assert_walk_equal(const ulam_walk_opts *a, const ulam_walk_opts *b)
+{
+    assert_int_equal(a->mode, b->mode);
+    assert_int_equal(a->estimator, b->estimator);
+    assert_int_equal(a->index, b->index);
+    assert_close(a->continue_q, b->continue_q, 0);
+    assert_int_equal(a->whole_kernel, b->whole_kernel);
+    assert_close(a->roulette, b->roulette, 0);
+    assert_close(a->split, b->split, 0);
+    assert_int_equal(a->seed, b->seed);
+    assert_int_equal(a->threads, b->threads);
+    assert_int_equal(a->max_walks, b->max_walks);
+    assert_close(a->rel_err, b->rel_err, 0);
+    assert_close(a->max_seconds, b->max_seconds, 0);
+    assert_int_equal(a->max_steps, b->max_steps);
+    assert_ptr_equal(a->interrupt, b->interrupt);
+    assert_ptr_equal(a->share, b->share);
+    assert_int_equal(a->force, b->force);
+    assert_int_equal(a->assume_finite, b->assume_finite);
+    assert_ptr_equal(a->guard, b->guard);
+    assert_close(a->rel_err_offset, b->rel_err_offset, 0);
+}
+
+/* ulam_walk_defaults: adjoint collision walks at index 0, analog kernel, seed 1, all cores,
+ * 10^5 walks, 10^6 steps, every other rule off. */
+static void test_walk(void **state)
+{
+    (void)state;
+    ulam_walk_opts o = ulam_walk_defaults();
+    assert_int_equal(o.mode, ULAM_ADJOINT);
+    assert_int_equal(o.estimator, ULAM_COLLISION);
+    assert_int_equal(o.index, 0);
+    assert_close(o.continue_q, 0.0, 0);
+    assert_int_equal(o.whole_kernel, 0);
+    assert_close(o.roulette, 0.0, 0);
+    assert_close(o.split, 0.0, 0);
+    assert_int_equal(o.seed, 1);
+    assert_int_equal(o.threads, 0);
+    assert_int_equal(o.max_walks, 100000);
+    assert_close(o.rel_err, 0.0, 0);
+    assert_close(o.max_seconds, 0.0, 0);
+    assert_int_equal(o.max_steps, 1000000);
+    assert_null(o.interrupt);
+    assert_null(o.share);
+    assert_int_equal(o.force, 0);
+    assert_int_equal(o.assume_finite, 0);
+    assert_null(o.guard);
+    assert_close(o.rel_err_offset, 0.0, 0);
+}
+
+/* ulam_mm_defaults: all cores, ulam_strtod; and reading with them is reading with NULL options. */
+static void test_mm(void **state)
+{
+    (void)state;
+    ulam_mm_opts o = ulam_mm_defaults();
+    assert_int_equal(o.threads, 0);
+    assert_int_equal(o.libc_strtod, 0);
+    ulam_csr *A = NULL, *B = NULL;
+    FILE *f = fopen(src_path("matrices/signed200.mtx"), "rb");
+    assert_non_null(f);
+    assert_int_equal(ulam_mm_read_matrix_opts(f, "signed200", &o, &A, NULL), ULAM_OK);
+    rewind(f);
+    assert_int_equal(ulam_mm_read_matrix_opts(f, "signed200", NULL, &B, NULL), ULAM_OK);
+    fclose(f);
+    assert_int_equal(ulam_csr_nnz(A), ulam_csr_nnz(B));
+    assert_memory_equal(A->rowptr, B->rowptr, (size_t)(A->nrows + 1) * sizeof *A->rowptr);
+    assert_memory_equal(A->colidx, B->colidx, (size_t)ulam_csr_nnz(A) * sizeof *A->colidx);
+    assert_memory_equal(A->val, B->val, (size_t)ulam_csr_nnz(A) * sizeof *A->val);
+    ulam_csr_free(A), ulam_csr_free(B);
+}
+
+/* ulam_spectral_defaults, ulam_power_defaults, ulam_guard_defaults. */
+static void test_spectral_and_guards(void **state)
+{
+    (void)state;
+    ulam_spectral_opts s = ulam_spectral_defaults();
+    assert_close(s.tol, 1e-6, 0);
+    assert_int_equal(s.max_restarts, 300);
+    assert_int_equal(s.krylov_dim, 20);
+    assert_int_equal(s.seed, 1);
+    ulam_power_opts p = ulam_power_defaults();
+    assert_close(p.tol, 1e-4, 0);
+    assert_int_equal(p.max_iter, 1000);
+    assert_int_equal(p.certify, 0);
+    ulam_guard_opts g = ulam_guard_defaults();
+    assert_int_equal(g.need, ULAM_GUARD_ALL);
+    assert_int_equal(g.tight, 0);
+    assert_close(g.power.tol, p.tol, 0);
+    assert_int_equal(g.power.max_iter, p.max_iter);
+    assert_int_equal(g.power.certify, p.certify);
+}
+
+/* ulam_outer_defaults: MCSA, tol 1e-8, caps by method (0), eps1 0.1, 10^8 histories, the walk
+ * defaults but forward expected-value walks. */
+static void test_outer(void **state)
+{
+    (void)state;
+    ulam_outer_opts o = ulam_outer_defaults();
+    ulam_walk_opts w = ulam_walk_defaults();
+    assert_int_equal(o.method, ULAM_MCSA);
+    assert_close(o.tol, 1e-8, 0);
+    assert_int_equal(o.max_iter, 0);
+    assert_int_equal(o.stall, 0);
+    assert_close(o.eps1, 0.1, 0);
+    assert_int_equal(o.max_histories, 100000000);
+    assert_int_equal(o.walk.mode, ULAM_FORWARD);
+    assert_int_equal(o.walk.estimator, ULAM_EXPECTED);
+    w.mode = ULAM_FORWARD, w.estimator = ULAM_EXPECTED;
+    assert_walk_equal(&o.walk, &w);
+}
+
+/* ulam_bidir_defaults and ulam_auto_defaults. */
+static void test_bidir_and_auto(void **state)
+{
+    (void)state;
+    ulam_bidir_opts b = ulam_bidir_defaults();
+    ulam_walk_opts w = ulam_walk_defaults();
+    assert_int_equal(b.target, 0);
+    assert_int_equal(b.source, 0);
+    assert_close(b.rmax, 0.0, 0);
+    assert_close(b.min_value, 0.0, 0);
+    assert_int_equal(b.max_push_ops, 0);
+    assert_walk_equal(&b.walk, &w);
+    ulam_auto_opts a = ulam_auto_defaults();
+    assert_int_equal(a.pin_mode, 0);
+    assert_int_equal(a.pin_estimator, 0);
+    assert_int_equal(a.pin_continue, 0);
+    assert_close(a.continue_q, 0.9, 0);
+    assert_int_equal(a.pilot_walks, 128);
+    assert_int_equal(a.pilot_max, 1024);
+    assert_close(a.pilot_share, 0.2, 0);
+}
+
+/* Concatenate one process's bytes (the allgather of a share of one). */
+static int gather_one(void *ctx, const void *mine, size_t bytes, void **all, size_t *total)
+{
+    (void)ctx;
+    *all = malloc(bytes ? bytes : 1);
+    if (!*all) return 1;
+    memcpy(*all, mine, bytes);
+    *total = bytes;
+    return 0;
+}
+
+/* ulam_share_defaults: one process; walking with it, or with it given an allgather, is
+ * walking with no share, bit for bit. */
+static void test_share(void **state)
+{
+    (void)state;
+    ulam_share sh = ulam_share_defaults();
+    assert_int_equal(sh.rank, 0);
+    assert_int_equal(sh.nranks, 1);
+    assert_null(sh.allgather);
+    assert_null(sh.ctx);
+    ulam_csr *M = must_read("matrices/signed200.mtx");
+    int64_t n;
+    double *b = must_read_vector("matrices/signed200_b.mtx", &n);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.max_walks = 5000, o.index = 3, o.threads = 2;
+    ulam_walk_result r0, r1, r2;
+    assert_int_equal(ulam_solve(M, b, &o, &r0, NULL), ULAM_OK);
+    o.share = &sh;
+    assert_int_equal(ulam_solve(M, b, &o, &r1, NULL), ULAM_OK);
+    sh.allgather = gather_one;
+    assert_int_equal(ulam_solve(M, b, &o, &r2, NULL), ULAM_OK);
+    assert_memory_equal(&r0.estimate, &r1.estimate, sizeof r0.estimate);
+    assert_memory_equal(&r0.std_error, &r1.std_error, sizeof r0.std_error);
+    assert_memory_equal(&r0.estimate, &r2.estimate, sizeof r0.estimate);
+    assert_int_equal(r0.walks, r1.walks);
+    assert_int_equal(r0.steps, r2.steps);
+    free(b);
+    ulam_csr_free(M);
+}
+
+/* ulam_system_desc_defaults: nothing to write (refused), then with M and b set the same file
+ * as a description written out by hand. */
+static void test_system_desc(void **state)
+{
+    (void)state;
+    ulam_system_desc d = ulam_system_desc_defaults();
+    assert_null(d.M);
+    assert_null(d.b);
+    assert_int_equal(d.n, 0);
+    assert_int_equal(d.tag[0], 0);
+    assert_int_equal(d.tag[1], 0);
+    assert_close(d.omega, 0.0, 0);
+    assert_null(d.cert);
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    assert_int_equal(ulam_system_write_file(f, &d), ULAM_EINVAL);
+    ulam_csr *M = must_read("matrices/chain4.mtx");
+    int64_t n;
+    double *b = must_read_vector("matrices/chain4_b.mtx", &n);
+    d.M = M, d.b = b, d.n = n;
+    ulam_system_desc hand = {.M = M, .b = b, .n = n};
+    FILE *g = tmpfile();
+    assert_non_null(g);
+    assert_int_equal(ulam_system_write_file(f, &d), ULAM_OK);
+    assert_int_equal(ulam_system_write_file(g, &hand), ULAM_OK);
+    long lf = (fseek(f, 0, SEEK_END), ftell(f)), lg = (fseek(g, 0, SEEK_END), ftell(g));
+    assert_true(lf > 0);
+    assert_int_equal(lf, lg);
+    char *bf = malloc((size_t)lf), *bg = malloc((size_t)lg);
+    rewind(f), rewind(g);
+    assert_int_equal(fread(bf, 1, (size_t)lf, f), (size_t)lf);
+    assert_int_equal(fread(bg, 1, (size_t)lg, g), (size_t)lg);
+    assert_memory_equal(bf, bg, (size_t)lf);
+    free(bf), free(bg), free(b);
+    fclose(f), fclose(g);
+    ulam_csr_free(M);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_walk),       cmocka_unit_test(test_mm),    cmocka_unit_test(test_spectral_and_guards),
+        cmocka_unit_test(test_outer),      cmocka_unit_test(test_bidir_and_auto), cmocka_unit_test(test_share),
+        cmocka_unit_test(test_system_desc),
+    };
+    return test_run(tests);
+}
