@@ -891,6 +891,7 @@ enum ulam_auto_state {
 typedef struct ulam_auto_candidate {
     int mode, estimator;
     double continue_q;    /* <= 0: analog */
+    double kernel_alpha;  /* the kernel exponent: p_ij proportional to |K_ij|^alpha */
     ulam_power hat;       /* rho(M^) of this candidate's kernel (bounds [0, INFINITY]: not computed) */
     int certified;        /* hat.upper < 1 and rho(|M|)'s upper bound < 1: variance certified finite */
     int status;           /* ULAM_OK, or why the solver refused it (ULAM_EUNDEFINED: absorption with p* = 0) */
@@ -927,8 +928,9 @@ typedef struct ulam_auto_candidate {
 /* What the choice may vary and how it pilots: a pinned part keeps base's value.  Start from
  * ulam_auto_defaults(). */
 typedef struct ulam_auto_opts {
-    int pin_mode, pin_estimator, pin_continue;
-    double continue_q;    /* the fixed continuation tried beside analog (default 0.9) */
+    int pin_mode, pin_estimator, pin_continue, pin_alpha;
+    double continue_q;    /* the fixed continuation tried beside analog (default 0.9); kernel
+                             exponents tried: 1, 0 and 2 */
     int64_t pilot_walks;  /* a candidate's first pilot (default 128 walks); survivors double */
     int64_t pilot_max;    /* the largest pilot of a stage (default 1024) */
     double pilot_share;   /* stop piloting once the pilots' overhead (their work less what the
@@ -957,8 +959,9 @@ typedef struct ulam_auto_result {
 
 /* Choose the walk method for (I - M) x = b under base's options, deterministically: the same
  * choice for any thread count, process count and machine load (no clock is read for it).
- *   - candidates: mode x estimator x continuation (analog, ao->continue_q), less what is pinned,
- *     adjoint before forward; a guard per continuation (rho(|M|), rho(M^) of each mode's kernel;
+ *   - candidates: mode x estimator x continuation (analog, ao->continue_q) x kernel exponent
+ *     (1, 0, 2), less what is pinned, adjoint before forward; a guard per continuation and
+ *     exponent (rho(|M|), rho(M^) of each mode's kernel;
  *     the forward one only when forward candidates are started or none is certified) screens
  *     them: only certified-finite ones are piloted;
  *   - pilots race: every candidate ao->pilot_walks walks, on seeds of its own, candidates of one

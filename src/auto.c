@@ -20,7 +20,7 @@
 
 static const uint64_t PILOT_SEED = UINT64_C(0x5851f42d4c957f2d);
 
-enum { GROUPS = 4 }; /* kernels: 2 modes x 2 continuations */
+enum { KERNELS = 6, GROUPS = 12 }; /* guards: 2 continuations x 3 exponents; kernels: x 2 modes */
 
 /* One kernel's solver and the work it has done (guards excluded). */
 typedef struct {
@@ -42,10 +42,10 @@ typedef struct {
     ulam__moments mom[ULAM_AUTO_MAX]; /* pooled pilot scores */
     double steps[ULAM_AUTO_MAX], min_walks[ULAM_AUTO_MAX];
     int tail_ok[ULAM_AUTO_MAX];
-    double guard_reads[2];          /* per continuation */
-    ulam_guard guard[2];
-    int nq;
-    double qs[2];
+    double guard_reads[KERNELS];    /* per continuation and exponent: iq * 3 + ia */
+    ulam_guard guard[KERNELS];
+    int nq, na;
+    double qs[2], as[3];
     int leader;
 } chooser;
 
@@ -65,22 +65,23 @@ static double guard_reads(const ulam_csr *M, const ulam_guard *g)
     return it * (double)ulam_csr_nnz(M);
 }
 
-/* Compute the guard radii `need` of continuation iq not yet computed. */
-static int guard_need(chooser *c, int iq, int need, ulam_error *err)
+/* Compute the guard radii `need` of continuation and exponent kk (iq * 3 + ia) not yet computed. */
+static int guard_need(chooser *c, int kk, int need, ulam_error *err)
 {
-    ulam_guard *g = &c->guard[iq];
+    ulam_guard *g = &c->guard[kk];
     if ((g->computed & need) == need) return ULAM_OK;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = need & ~g->computed;
+    go.kernel_alpha = c->as[kk % 3];
     ulam_guard h;
-    int status = ulam_guard_check(c->M, c->qs[iq], &go, &h, err);
+    int status = ulam_guard_check(c->M, c->qs[kk / 3], &go, &h, err);
     if (status) return status;
     if (!g->computed) *g = h;
     else
         for (int m = 0; m < 2; m++)
             if (h.computed & ULAM_GUARD_HAT(m)) g->hat[m] = h.hat[m], g->verdict_hat[m] = h.verdict_hat[m];
     g->computed |= h.computed;
-    c->guard_reads[iq] += guard_reads(c->M, &h);
+    c->guard_reads[kk] += guard_reads(c->M, &h);
     return ULAM_OK;
 }
 
@@ -167,14 +168,14 @@ static double key(const chooser *c, int k, double scale)
 static double reused(const chooser *c, int k)
 {
     const group *g = &c->g[c->gi[k]];
-    int iq = c->gi[k] % 2;
-    return c->guard_reads[iq] + ULAM_AUTO_READ * (double)g->reads + ULAM_AUTO_BUILD * (double)g->units;
+    return c->guard_reads[c->gi[k] % KERNELS] + ULAM_AUTO_READ * (double)g->reads + ULAM_AUTO_BUILD * (double)g->units;
 }
 
 /* Everything spent so far: guards, kernels' set-up, pilot walks. */
 static double spent(const chooser *c)
 {
-    double w = c->guard_reads[0] + c->guard_reads[1];
+    double w = 0.0;
+    for (int kk = 0; kk < KERNELS; kk++) w += c->guard_reads[kk];
     for (int i = 0; i < GROUPS; i++) w += ULAM_AUTO_READ * (double)c->g[i].reads + ULAM_AUTO_BUILD * (double)c->g[i].units;
     for (int k = 0; k < c->res->ncand; k++) {
         const ulam_auto_candidate *a = &c->res->cand[k];
@@ -213,7 +214,8 @@ static ulam_walk_opts pilot_opts(const chooser *c, int k, int stage, int64_t n)
     o.mode = a->mode, o.estimator = a->estimator, o.continue_q = a->continue_q;
     o.max_walks = n, o.max_seconds = 0, o.interrupt = NULL, o.share = NULL, o.whole_kernel = 0;
     o.seed = c->base.seed ^ (PILOT_SEED + (uint64_t)(64 * k + stage));
-    o.guard = &c->guard[c->gi[k] % 2];
+    o.kernel_alpha = a->kernel_alpha;
+    o.guard = &c->guard[c->gi[k] % KERNELS];
     return o;
 }
 
@@ -277,38 +279,40 @@ static double start_cost(const chooser *c, int gi)
     double w = 0.0;
     for (int i = 0; i < GROUPS; i++)
         if (c->g[i].started) w = fmax(w, ULAM_AUTO_READ * (double)c->g[i].reads + ULAM_AUTO_BUILD * (double)c->g[i].units);
-    if (gi >= 2) w += 2.0 * ULAM_AUTO_READ * (double)ulam_csr_nnz(c->M);
-    if (gi >= 2 && !(c->guard[gi % 2].computed & ULAM_GUARD_FORWARD)) w += c->guard_reads[gi % 2];
+    if (gi >= KERNELS) w += 2.0 * ULAM_AUTO_READ * (double)ulam_csr_nnz(c->M);
+    if (gi >= KERNELS && !(c->guard[gi % KERNELS].computed & ULAM_GUARD_FORWARD)) w += c->guard_reads[gi % KERNELS];
     return w;
 }
 
 /* The candidates, less what is pinned: adjoint before forward, analog before the fixed
- * continuation, collision, absorption, expected. */
+ * continuation, kernel exponent 1 before 0 and 2, then collision, absorption, expected. */
 static void list(chooser *c)
 {
     ulam_auto_result *res = c->res;
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++)
         for (int iq = 0; iq < c->nq; iq++)
-            for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
-                if ((c->a.pin_mode && mode != c->base.mode) || (c->a.pin_estimator && est != c->base.estimator)) continue;
-                int k = res->ncand++;
-                res->cand[k] = (ulam_auto_candidate){.mode = mode, .estimator = est, .continue_q = c->qs[iq],
-                                                     .hat = {.upper = INFINITY}, .cost = INFINITY,
-                                                     .predicted_walks = NAN, .predicted_work = INFINITY,
-                                                     .predicted_seconds = NAN};
-                c->gi[k] = 2 * mode + iq;
-            }
+            for (int ia = 0; ia < c->na; ia++)
+                for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++) {
+                    if ((c->a.pin_mode && mode != c->base.mode) || (c->a.pin_estimator && est != c->base.estimator))
+                        continue;
+                    int k = res->ncand++;
+                    res->cand[k] = (ulam_auto_candidate){.mode = mode, .estimator = est, .continue_q = c->qs[iq],
+                                                         .kernel_alpha = c->as[ia], .hat = {.upper = INFINITY},
+                                                         .cost = INFINITY, .predicted_walks = NAN,
+                                                         .predicted_work = INFINITY, .predicted_seconds = NAN};
+                    c->gi[k] = mode * KERNELS + iq * 3 + ia;
+                }
 }
 
 /* Screen candidate k with its continuation's guard (computing its mode's radius if needed). */
 static int screen(chooser *c, int k, ulam_error *err)
 {
     ulam_auto_candidate *a = &c->res->cand[k];
-    int iq = c->gi[k] % 2, status = guard_need(c, iq, ULAM_GUARD_ABS | ULAM_GUARD_HAT(a->mode), err);
+    int kk = c->gi[k] % KERNELS, status = guard_need(c, kk, ULAM_GUARD_ABS | ULAM_GUARD_HAT(a->mode), err);
     if (status) return status;
-    a->hat = c->guard[iq].hat[a->mode];
-    c->res->abs = c->guard[iq].abs;
-    a->certified = c->guard[iq].abs.upper < 1 && a->hat.upper < 1;
+    a->hat = c->guard[kk].hat[a->mode];
+    c->res->abs = c->guard[kk].abs;
+    a->certified = c->guard[kk].abs.upper < 1 && a->hat.upper < 1;
     return ULAM_OK;
 }
 
@@ -323,10 +327,10 @@ static int first_stage(chooser *c, ulam_error *err)
             overhead_share(c) + start_cost(c, c->gi[k]) / (res->cand[c->leader].predicted_work + reused(c, c->leader)) >
                 c->a.pilot_share) {
             a->state = ULAM_AUTO_SKIPPED; /* screened only when its guard is known already */
-            int iq = c->gi[k] % 2;
-            if (c->guard[iq].computed & ULAM_GUARD_HAT(a->mode)) {
-                a->hat = c->guard[iq].hat[a->mode];
-                a->certified = c->guard[iq].abs.upper < 1 && a->hat.upper < 1;
+            int kk = c->gi[k] % KERNELS;
+            if (c->guard[kk].computed & ULAM_GUARD_HAT(a->mode)) {
+                a->hat = c->guard[kk].hat[a->mode];
+                a->certified = c->guard[kk].abs.upper < 1 && a->hat.upper < 1;
             }
             continue;
         }
@@ -439,6 +443,8 @@ int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *b
     c->M = M, c->b = b, c->base = *base, c->a = a, c->res = res, c->leader = -1;
     c->qs[0] = a.pin_continue ? base->continue_q : 0.0, c->qs[1] = a.continue_q;
     c->nq = a.pin_continue ? 1 : 2;
+    c->as[0] = a.pin_alpha ? base->kernel_alpha : 1.0, c->as[1] = 0.0, c->as[2] = 2.0;
+    c->na = a.pin_alpha ? 1 : 3;
     list(c);
     if (!(status = first_stage(c, err)) && !(status = race(c, err))) {
         for (int j = 0; j < res->ncand; j++)
@@ -450,11 +456,12 @@ int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *b
     if (!status && res->chosen >= 0) res->cand[res->chosen].state = ULAM_AUTO_CHOSEN;
     res->pilot_work = spent(c);
     res->reused_work = res->chosen >= 0 ? reused(c, res->chosen) : 0.0;
-    if (k >= 0) res->guard = c->guard[c->gi[k] % 2];
+    if (k >= 0) res->guard = c->guard[c->gi[k] % KERNELS];
     if (!status && out && k >= 0) {
         ulam_walk_opts o = *base;
         o.mode = res->cand[k].mode, o.estimator = res->cand[k].estimator, o.continue_q = res->cand[k].continue_q;
-        o.guard = &c->guard[c->gi[k] % 2];
+        o.kernel_alpha = res->cand[k].kernel_alpha;
+        o.guard = &c->guard[c->gi[k] % KERNELS];
         group *g = &c->g[c->gi[k]];
         if (g->sv) {
             status = ulam__solver_rerun(g->sv, &o, err);

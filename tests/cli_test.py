@@ -168,7 +168,7 @@ CASES += [
     # the default is auto: the same refusal without --method
     (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--rel-err", "0.01"], 3,
      r"error: --method auto: no candidate has a certified finite variance", r"^$"),
-    (RS0 + ["--method", "auto", "--walks", "20000"], 0, r"^$", r"auto\s+chose the least predicted variance x work a walk of 12 candidates"),
+    (RS0 + ["--method", "auto", "--walks", "20000"], 0, r"^$", r"auto\s+chose the least predicted variance x work a walk of 36 candidates"),
 ]
 
 
@@ -1082,19 +1082,34 @@ def check_auto(ulam):
     assert rc == 0, err
     o = json.loads(out)
     a = o["auto"]
-    assert len(a["candidates"]) == 12 and 0 <= a["chosen"] < 12, a
+    assert len(a["candidates"]) == 36 and 0 <= a["chosen"] < 36, a
     for c in a["candidates"]:
         if c["state"] != "skipped":
             assert c["certified"] == (c["rho_hat_upper"] < 1), c
         assert (c["pilot_walks"] > 0) == (c["state"] in ("dropped", "finalist", "chosen")), c
+        assert c["kernel_alpha"] in (0, 1, 2) and c["state"] in ("uncertified", "refused", "skipped", "dropped",
+                                                                 "finalist", "chosen"), c
     ch = a["candidates"][a["chosen"]]
-    assert ch["mode"] == o["mode"] and ch["estimator"] == o["estimator"], (ch, o)
+    assert ch["state"] == "chosen" and [c["state"] for c in a["candidates"]].count("chosen") == 1, a
+    assert ch["mode"] == o["mode"] and ch["estimator"] == o["estimator"] and ch["kernel_alpha"] == o["kernel_alpha"], (ch, o)
+    assert ch["predicted_walks"] >= 1000 and ch["predicted_work"] > 0 and 0 <= a["pilot_share"] < 0.5, a
+    assert a["pilot_work"] >= a["reused_work"] > 0 and a["stages"] >= 1, a
     assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"] and o["stderr"] <= 0.02 * abs(o["estimate"]), o
+    # the default is auto, and the same run (same seed) gives the same answer
+    rc, out2, err = run(ulam, RS0 + ["--rel-err", "0.02", "--json", "--check"])
+    o2 = json.loads(out2)
+    assert rc == 0 and o2["estimate"] == o["estimate"] and o2["auto"]["chosen"] == a["chosen"], (o, o2)
     rc, out, err = run(ulam, RS0 + ["--method", "auto", "--mode", "forward", "--continue", "0.8", "--walks", "5000", "--json"])
     assert rc == 0, err
     o = json.loads(out)
-    assert len(o["auto"]["candidates"]) == 3 and o["mode"] == "forward", o
+    assert len(o["auto"]["candidates"]) == 9 and o["mode"] == "forward", o
     assert all(c["mode"] == "forward" and c["continue"] == 0.8 for c in o["auto"]["candidates"]), o
+    # everything pinned (or --method walks): today's run, output for output but the timings
+    pinned = RS0 + ["--mode", "adjoint", "--estimator", "collision", "--continue", "analog", "--alpha", "1", "--walks", "3000"]
+    outs = [run(ulam, args) for args in (pinned, RS0 + ["--method", "walks", "--walks", "3000"])]
+    strip = lambda t: [l for l in t.splitlines() if not l.startswith(("seconds", "figure", "load"))]
+    assert outs[0][0] == outs[1][0] == 0 and strip(outs[0][1]) == strip(outs[1][1]), outs
+    assert "auto " not in outs[0][1], outs[0][1]
 
 
 def check_genmat(genmat):

@@ -20,17 +20,17 @@ int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts
     if (res->chosen < 0) {
         int diverge = !(res->abs.upper < 1);
         fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance%s; the closest is "
-                        "%s %s (continuation %s%.3g) with rho(M^) = %.6g (upper bound %.6g)%s\n",
+                        "%s %s (continuation %s%.3g, kernel exponent %g) with rho(M^) = %.6g (upper bound %.6g)%s\n",
                 s->matrix_path, o->rel_err > 0 ? "error" : "warning", diverge ? " (rho(|M|) is not certified below 1)" : "",
                 cli_mode_names[c->mode], cli_estimator_names[c->estimator], c->continue_q > 0 ? "" : "analog, ",
-                c->continue_q > 0 ? c->continue_q : 0.0, c->hat.rho, c->hat.upper,
+                c->continue_q > 0 ? c->continue_q : 0.0, c->kernel_alpha, c->hat.rho, c->hat.upper,
                 o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it");
         if (o->rel_err > 0) {
             *sv = ulam_solver_free(*sv);
             return diverge ? EXIT_DIVERGE : EXIT_INFVAR;
         }
     }
-    o->mode = c->mode, o->estimator = c->estimator, o->continue_q = c->continue_q;
+    o->mode = c->mode, o->estimator = c->estimator, o->continue_q = c->continue_q, o->kernel_alpha = c->kernel_alpha;
     return 0;
 }
 
@@ -66,6 +66,7 @@ void cli_auto_print_text(const ulam_auto_result *res)
         const ulam_auto_candidate *c = &res->cand[k];
         printf("  %c %-8s %-10s ", k == res->chosen ? '*' : ' ', cli_mode_names[c->mode], cli_estimator_names[c->estimator]);
         print_q(c->continue_q);
+        printf(" alpha %-3.3g", c->kernel_alpha);
         if (isfinite(c->hat.upper)) printf(" rho(M^) %-9.4g ", c->hat.rho);
         else printf(" rho(M^) %-9s ", "-");
         if (c->state == ULAM_AUTO_SKIPPED) printf("not piloted: starting its kernel would pass the pilot budget\n");
@@ -94,6 +95,7 @@ void cli_auto_print_json(const ulam_auto_result *res)
         cli_json_string("mode", cli_mode_names[c->mode], 0);
         cli_json_string("estimator", cli_estimator_names[c->estimator], 0);
         cli_json_number("continue", c->continue_q > 0 ? c->continue_q : NAN, 0);
+        cli_json_number("kernel_alpha", c->kernel_alpha, 0);
         cli_json_number("rho_hat", isfinite(c->hat.upper) ? c->hat.rho : NAN, 0);
         cli_json_number("rho_hat_upper", c->hat.upper, 0);
         printf("\"certified\": %s, ", c->certified ? "true" : "false");

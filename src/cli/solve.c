@@ -343,6 +343,7 @@ static int parse(int argc, char **argv, solve_args *a)
             a->ao.pin_mode |= !strcmp(longopts[idx].name, "mode");
             a->ao.pin_estimator |= !strcmp(longopts[idx].name, "estimator");
             a->ao.pin_continue |= !strcmp(longopts[idx].name, "continue");
+            a->ao.pin_alpha |= !strcmp(longopts[idx].name, "alpha");
             break;
         case 'b': a->s.rhs_path = optarg; break;
         case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
@@ -374,7 +375,7 @@ static int parse(int argc, char **argv, solve_args *a)
         return cli_usage_error("solve", "--split W must exceed --roulette W");
     cli_walk_budget(&a->o);
     a->s.matrix_path = argv[optind];
-    if (a->ao.pin_mode && a->ao.pin_estimator && a->ao.pin_continue) a->autom = 0; /* nothing to choose */
+    if (a->ao.pin_mode && a->ao.pin_estimator && a->ao.pin_continue && a->ao.pin_alpha) a->autom = 0; /* nothing to choose */
     return 0;
 }
 
