@@ -403,7 +403,8 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
         }
     atomic_store(&k->top, u);
     atomic_store(&k->built, k->n);
-#pragma omp parallel for schedule(static, 4096) num_threads(threads)
+    /* static chunks of 4096 rows: a kernel of fewer rows is one thread's work, so no team */
+#pragma omp parallel for schedule(static, 4096) num_threads(threads) if (k->n > 4096)
     for (int64_t i = 0; i < k->n; i++) {
         int64_t at = atomic_load_explicit(&k->where[i], memory_order_relaxed) - 1;
         prefetch_targets(k, i + 16);
