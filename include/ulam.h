@@ -936,6 +936,9 @@ typedef struct ulam_auto_opts {
     double pilot_share;   /* stop piloting once the pilots' overhead (their work less what the
                              leader's run reuses) reaches this share of the leader's predicted
                              run (default 0.2) */
+    const ulam_guard *guard; /* radii computed before (a prepared system's certificate): they serve
+                                the candidates of their continuation and exponent instead of a pass
+                                over M (NULL: none) */
 } ulam_auto_opts;
 
 /* The default options: nothing pinned, Q = 0.9, pilots of 128 walks doubling up to 1024, 0.2. */

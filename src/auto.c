@@ -70,6 +70,12 @@ static int guard_need(chooser *c, int kk, int need, ulam_error *err)
 {
     ulam_guard *g = &c->guard[kk];
     if ((g->computed & need) == need) return ULAM_OK;
+    const ulam_guard *given = c->a.guard;
+    if (!g->computed && given && (given->continue_q > 0 ? given->continue_q : 0.0) == c->qs[kk / 3] &&
+        given->kernel_alpha == c->as[kk % 3] && (given->computed & need) == need) {
+        *g = *given; /* no pass over M */
+        return ULAM_OK;
+    }
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = need & ~g->computed;
     go.kernel_alpha = c->as[kk % 3];

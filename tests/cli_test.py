@@ -1110,6 +1110,19 @@ def check_auto(ulam):
     strip = lambda t: [l for l in t.splitlines() if not l.startswith(("seconds", "figure", "load"))]
     assert outs[0][0] == outs[1][0] == 0 and strip(outs[0][1]) == strip(outs[1][1]), outs
     assert "auto " not in outs[0][1], outs[0][1]
+    # a prepared system with a certificate: auto chooses the estimator on the certificate's kernel
+    # (its guards need no pass over M), and answers as --method walks with that estimator
+    with tempfile.TemporaryDirectory() as d:
+        sysf = d + "/rs.ulam"
+        rc, _, err = run(ulam, ["prepare", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "-o", sysf])
+        assert rc == 0, err
+        rc, out, err = run(ulam, ["solve", sysf, "--index", "7", "--rel-err", "0.02", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and len(o["auto"]["candidates"]) == 3 and o["guard_seconds"] == 0, (err, o)
+        assert all(c["mode"] == "adjoint" and c["continue"] is None for c in o["auto"]["candidates"]), o
+        rc, out, err = run(ulam, ["solve", sysf, "--index", "7", "--rel-err", "0.02", "--json", "--method", "walks",
+                                  "--estimator", o["estimator"]])
+        assert rc == 0 and json.loads(out)["estimate"] == o["estimate"], (err, out, o)
 
 
 def check_genmat(genmat):

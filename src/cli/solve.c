@@ -382,6 +382,27 @@ static int parse(int argc, char **argv, solve_args *a)
     return 0;
 }
 
+/* A lazily read prepared system under auto: with a certificate that serves the adjoint guards,
+ * auto chooses the estimator on the certificate's kernel (continuation, exponent 1, adjoint: what
+ * is not pinned is set so), whose guards need no pass over M, so the query still reads only the
+ * rows its walks reach; otherwise the file is verified whole first (the guards read all of M). */
+static int certified_auto(solve_args *a, ulam_guard *g)
+{
+    cli_system *s = &a->s;
+    if (!s->lazy) return 0;
+    ulam_walk_opts *o = &a->o;
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_ADJOINT;
+    double q = a->ao.pin_continue ? o->continue_q : s->cert ? s->cert->continue_q : 0.0;
+    if ((a->ao.pin_alpha && o->kernel_alpha != 1.0) || (a->ao.pin_mode && o->mode != ULAM_ADJOINT) ||
+        ulam_certificate_guard(s->cert, q, &go, g))
+        return cli_system_verify(s);
+    o->continue_q = q, o->kernel_alpha = 1.0, o->mode = ULAM_ADJOINT;
+    a->ao.pin_continue = a->ao.pin_alpha = a->ao.pin_mode = 1;
+    a->ao.guard = g;
+    return 0;
+}
+
 /* Load the system, choose (--method auto), guard, and make the solver *sv; print the refusals
  * and the warnings, then run --check; 0 or an exit code (nothing kept on failure). */
 static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solver **sv)
@@ -389,8 +410,8 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solv
     cli_system *s = &a->s;
     ulam_walk_opts *o = &a->o;
     int rc;
-    /* read only the rows walks reach (the choice's guards read all of M) */
-    s->lazy = o->mode == ULAM_ADJOINT && !a->check && !cli_share && !a->autom;
+    /* read only the rows walks reach; auto does on a prepared system (see certified_auto) */
+    s->lazy = o->mode == ULAM_ADJOINT && !a->check && !cli_share && (!a->autom || ulam_system_is_file(s->matrix_path));
     if ((a->out && (rc = cli_check_output(a->out))) || (a->errors && (rc = cli_check_output(a->errors)))) return rc;
     double t0 = ulam_now();
     if ((rc = cli_load_system(s))) return rc;
@@ -407,7 +428,8 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solv
     int status;
     if (a->autom) { /* guards, pilots and the solver, its set-up kept from the chosen pilot */
         t0 = ulam_now();
-        if ((rc = cli_auto_choose(s, o, &a->ao, au, sv, &status, &err))) {
+        ulam_guard cg;
+        if ((rc = certified_auto(a, &cg)) || (rc = cli_auto_choose(s, o, &a->ao, au, sv, &status, &err))) {
             cli_system_free(s);
             return rc;
         }
