@@ -41,7 +41,8 @@ static const char *const usage =
     "  --threads T        threads (default: all cores)\n";
 static const char *const usage2 = /* the help in two strings: C99 promises 4095 characters a literal */
     "  --continue Q       continue with probability Q in every state (analog, the default:\n"
-    "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased\n"
+    "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased;\n"
+    "                     --continue analog names the default (pins it for --method auto)\n"
     "  --alpha A          kernel exponent: move to j with probability proportional to\n"
     "                     |M_ij|^A over the row's nonzeros (default 1, |M_ij| / S_i; 0 uniform,\n"
     "                     2 Alea's); rho(M^) and the error bar are this kernel's\n"
