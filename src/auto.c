@@ -164,6 +164,9 @@ static double variance_of(const chooser *c, int k)
  * variance scaled by `scale`). */
 static double key(const chooser *c, int k, double scale)
 {
+    const ulam_auto_candidate *a = &c->res->cand[k];
+    if (a->mode == ULAM_FORWARD && a->estimate == 0 && a->variance == 0)
+        return INFINITY; /* no forward pilot walk has tallied the component yet: nothing is known */
     double var = variance_of(c, k) * scale, walks;
     if (c->base.rel_err > 0) return predict(c, k, var, &walks);
     return var * work_per_walk(c, k);

@@ -6,7 +6,8 @@
  * single method (adjoint / forward x collision / absorption / expected x analog / Q = 0.9, kernel
  * exponent 1) times its whole estimate as `ulam solve --method walks` makes it: the guards, the
  * solver's set-up and the walks; auto times ulam_auto_solver (guards, pilots, the chosen solver)
- * and its walks.  Median of 5 repetitions; the ratio is to the best single method's median.
+ * and its walks.  Median of 5 repetitions, each running every method once (so a busy spell of
+ * the machine slows them alike); the ratio is to the best single method's median.
  *
  *   bench_auto [REPS]    prints the table */
 #include <math.h>
@@ -100,15 +101,14 @@ static void name(char *buf, size_t n, int mode, int est, double q)
 /* Time every method on one system and print its rows; 1 when auto meets 1.5x. */
 static int bench(const char *sys, const ulam_csr *M, const double *b, int reps)
 {
-    double med[SINGLE + 1], t[REPS_MAX];
+    double med[SINGLE + 1], t[SINGLE + 1][REPS_MAX];
     run last[SINGLE + 1];
-    for (int k = 0; k <= SINGLE; k++) {
-        for (int r = 0; r < reps; r++) {
+    for (int r = 0; r < reps; r++) /* every method once a repetition: a busy spell slows them all */
+        for (int k = 0; k <= SINGLE; k++) {
             last[k] = k < SINGLE ? single(M, b, k) : automatic(M, b);
-            t[r] = last[k].seconds;
+            t[k][r] = last[k].seconds;
         }
-        med[k] = last[k].status ? NAN : median(t, reps);
-    }
+    for (int k = 0; k <= SINGLE; k++) med[k] = last[k].status ? NAN : median(t[k], reps);
     int best = -1;
     for (int k = 0; k < SINGLE; k++)
         if (!isnan(med[k]) && (best < 0 || med[k] < med[best])) best = k;
