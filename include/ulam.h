@@ -31,7 +31,7 @@
  *     (ulam_guard_variance, ulam_verdict_of, ulam_solver_guard), spectral radii
  *     (ulam_spectral_power, ulam_spectral_radius), prepared systems (ulam_system_*,
  *     ulam_certificate_*), processes (ulam_share), outer iterations (ulam_outer_*), Krylov
- *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_solve), the method
+ *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_plan, ulam_bidir_solve), the method
  *     choice (ulam_auto_choose), ulam_direct_bytes;
  *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
  *     ulam_strtod, ulam_outfile_*, ulam_spectral_radius_op, ulam_gauss_seidel_*, the studies'

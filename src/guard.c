@@ -246,7 +246,8 @@ static sums matrix_sums(const ulam_csr *A, double *col)
 
 /* rho(M^) of the kernel of K (M adjoint, M' forward) at exponent alpha != 1: M^_ij = |K_ij| f_ij,
  * f the moves' weight factors (ulam__kernel_moves), formed in K's pattern.  An entry whose
- * probability underflows makes M^ infinite: radius INFINITY, certified. */
+ * probability underflows (the walk kernel refuses its row) leaves the radius unknown: bounds
+ * [0, INFINITY], nothing certified. */
 static int hat_alpha(const ulam_csr *K, double continue_q, double alpha, const ulam_guard_opts *o, ulam_power *out,
                      ulam_error *err)
 {
@@ -273,8 +274,8 @@ static int hat_alpha(const ulam_csr *K, double continue_q, double alpha, const u
         sums sm = matrix_sums(&H, col);
         status = radius(&H, NULL, NULL, &sm, NULL, NULL, 0, o, out, err);
     } else {
-        *out = (ulam_power){.rho = INFINITY, .lower = INFINITY, .upper = INFINITY, .rowsum_max = INFINITY,
-                            .colsum_max = INFINITY, .converged = 1};
+        *out = (ulam_power){.rho = INFINITY, .lower = 0.0, .upper = INFINITY, .rowsum_max = INFINITY,
+                            .colsum_max = INFINITY};
     }
     free(val), free(f), free(col);
     return status;

@@ -6,6 +6,7 @@
  * (Chan's formula for the adjoint score, per-state sums for forward tallies), so the result is
  * bit-for-bit the same for any number of threads.  Stopping rules are checked between rounds; an interrupt or the time limit
  * also stops blocks that have not started. */
+#include "round.h"
 #include "stats.h"
 #include "walk.h"
 
@@ -118,11 +119,7 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
                           o->kernel_alpha);
     if (o->roulette < 0 || o->split < 0 || (o->split > 0 && o->roulette > 0 && o->split <= o->roulette))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "0 < roulette W < split W (or either off)");
-    if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
-    if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a stopping rule: walks, rel_err or time");
-    return ULAM_OK;
+    return ulam__budgets_check(o, err);
 }
 
 /* Refuse a split weight below the start weight (1 adjoint, ||b||_1 forward): every walk would
@@ -589,7 +586,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         ulam_solver_free(s);
         return status;
     }
-    if (o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0) s->o.max_walks = ULAM_REL_ERR_CAP;
+    s->o.max_walks = ulam__walk_cap(&o);
     s->threads = ulam__threads(o.threads);
     const ulam_csr *K = M;
     if (o.mode == ULAM_FORWARD) {

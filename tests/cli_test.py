@@ -14,7 +14,7 @@ import subprocess
 import sys
 import tempfile
 
-from ulam_status import STATUS, code  # noqa: E402  (the enum of include/ulam.h)
+from ulam_status import STATUS, Z95, code  # noqa: E402  (the enum of include/ulam.h)
 
 
 D = "tests/data/"
@@ -300,7 +300,7 @@ def check_radiosity_rare_lamp(ulam):
         assert rc == 0, err
         j = json.loads(out)
         assert j["rel_err_met"] is True, (seed, j)
-        covered += abs(j["radiosity"][0] - exact) <= 1.959964 * j["stderr"][0]
+        covered += abs(j["radiosity"][0] - exact) <= Z95 * j["stderr"][0]
     # binomial(100, 0.95): P(X < 88) = 0.0015
     assert covered >= 88, f"next-event on the rare lamp: {covered} of 100 intervals cover"
 
@@ -325,6 +325,25 @@ def on_tty(ulam, args):
     return p.returncode, b"".join(chunks).decode(errors="replace")
 
 
+def check_radiosity_json_path(ulam):
+    """The JSON names the scene by a valid JSON string whatever its path holds (a quote, a
+    backslash): it was printed unescaped, and the output did not parse."""
+    import shutil
+    with tempfile.TemporaryDirectory() as tmp:
+        d = os.path.join(tmp, 'q"uote\\d')
+        os.mkdir(d)
+        for f in ("cube.obj", "cube.mtl"):
+            shutil.copy("examples/scenes/" + f, d)
+        scene = os.path.join(d, "cube.obj")
+        rc, out, err = run(ulam, ["radiosity", scene, "--patch", "1", "--walks", "1000", "--json"])
+        assert rc == 0, err
+        try:
+            got = json.loads(out)["scene"]
+        except ValueError:
+            raise AssertionError(f"not JSON: {out[:200]}")
+        assert got == scene, out
+
+
 def check_radiosity_progress(ulam):
     """radiosity shows its progress line on a terminal too."""
     rc, err = on_tty(ulam, ["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.001",
@@ -339,7 +358,10 @@ def check_progress(ulam):
     solve = ["solve", "--method", "walks", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "7", "--threads", "1",
              "--rel-err", "0.0003"]
     rc, err = on_tty(ulam, solve)
-    assert rc == 0 and re.search(r"\rulam: \d+ walks, [-\d.e+]+ \+- [\d.e+-]+, [\d.]+ s, about \d+ s left", err), err
+    assert rc == 0 and re.search(r"\rulam: \d+ walks, [-\d.e+]+ \+- [\d.e+-]+, [\d.]+ s, (about \d+|under 1) s left", err), err
+    # the time left counts --time too (radiosity --time 3 said "about 26 s left"): under 1 s of 1 s
+    rc, err = on_tty(ulam, solve[:-2] + ["--walks", "1e12", "--time", "1"])
+    assert rc == 0 and "under 1 s left" in err and not re.search(r"about \d+ s left", err), err
     rc, err = on_tty(ulam, solve + ["--json"])
     assert rc == 0 and "walks," not in err, err
 
@@ -502,7 +524,7 @@ def check_forward_files(ulam):
         xs, es, rs = read(x), read(e), read(ref)
         assert len(xs) == len(es) == len(rs) == 1000
         assert all(abs(a - b) < 5 * s for a, b, s in zip(xs, rs, es))
-        covered = sum(abs(a - b) < 1.959964 * s for a, b, s in zip(xs, rs, es))
+        covered = sum(abs(a - b) < Z95 * s for a, b, s in zip(xs, rs, es))
         assert 922 <= covered <= 978, covered
 
 
@@ -1157,7 +1179,7 @@ def main():
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_progress, ulam),
-             (check_radiosity_progress, ulam)]
+             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]
     if cases:

@@ -28,6 +28,11 @@ def main():
         cases = [
             ("solve adjoint", ["solve", "--method", "walks", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx", "--index", "7",
                                "--walks", "50000", "--seed", "9", "--json"], None),
+            ("solve adjoint alpha", ["solve", "--method", "walks", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx", "--index",
+                                     "7", "--alpha", "0.5", "--rel-err", "0.02", "--json"], None),
+            ("solve forward alpha", ["solve", "--method", "walks", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
+                                     "1", "--mode", "forward", "--alpha", "2", "--walks", "30000", "--json", "--out",
+                                     "{d}/xa.mtx"], "xa.mtx"),
             ("solve adjoint rel-err", ["solve", "--method", "walks", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
                                        "--index", "3", "--rel-err", "0.005", "--json"], None),
             ("solve bidirectional", ["solve", "matrices/randsub1000.mtx", "--index", "7", "--source", "3",

@@ -192,7 +192,7 @@ static void test_bidir_unbiased(void **state)
                 assert_true(res.walks.walks == 20000);
                 assert_true(fabs(z) < 4);
                 assert_close(res.estimate - res.push_part, res.walks.estimate, 1e-15 * (fabs(res.estimate) + 1));
-                assert_close(res.ci95[1] - res.ci95[0], 2 * 1.959963984540054 * res.std_error, 1e-12);
+                assert_close(res.ci95[1] - res.ci95[0], 2 * ULAM_Z95 * res.std_error, 1e-12);
                 assert_true(res.seconds >= res.push.seconds);
                 if (q == 2) assert_true(res.plan.pilot_walks == 256 && res.plan.mean_visits >= 1);
             }

@@ -334,7 +334,7 @@ static void test_forward_vectors(void **state)
     int within = 0;
     for (int64_t i = 0; i < s.n; i++) {
         assert_true(e[i] > 0);
-        within += fabs(x[i] - s.x[i]) < 1.959964 * e[i];
+        within += fabs(x[i] - s.x[i]) < ULAM_Z95 * e[i];
         assert_true(fabs(x[i] - s.x[i]) < 5 * e[i]);
     }
     print_message("forward: %d / 100 components within their 95%% interval\n", within);

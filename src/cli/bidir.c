@@ -117,8 +117,7 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     cli_json_number("transpose_seconds", rp->transpose_seconds, 0);
     cli_json_number("load_seconds", rp->load_seconds, 0);
     cli_json_number("guard_seconds", rp->guard_seconds, 0);
-    cli_json_string("estimator", o->walk.estimator == ULAM_COLLISION ? "collision"
-                                 : o->walk.estimator == ULAM_ABSORPTION ? "absorption" : "expected", 0);
+    cli_json_string("estimator", cli_estimator_names[o->walk.estimator], 0);
     printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->walk.seed, w->threads,
            cli_share ? cli_share->nranks : 1);
     if (rp->check) {

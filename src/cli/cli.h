@@ -167,7 +167,7 @@ typedef struct cli_progress {
     double t0, last;
 } cli_progress;
 void cli_progress_start(cli_progress *p, int json);
-void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double se, double rel_err);
+void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double se, const ulam_walk_opts *o);
 void cli_progress_end(cli_progress *p);
 
 /* The walk modes and estimators by name, indexed by enum ulam_mode and enum ulam_estimator. */

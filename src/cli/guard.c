@@ -67,7 +67,7 @@ void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assu
     const ulam_power *h = &g->hat[mode];
     char kernel[96] = "", alpha[48] = ""; /* the kernel named by mode, and by its exponent when not 1 */
     if (g->kernel_alpha != 1.0) snprintf(alpha, sizeof alpha, " of exponent alpha = %g", g->kernel_alpha);
-    snprintf(kernel, sizeof kernel, "%s kernel%s", mode == ULAM_ADJOINT ? "adjoint" : "forward", alpha);
+    snprintf(kernel, sizeof kernel, "%s kernel%s", cli_mode_names[mode], alpha);
     if (g->verdict_hat[mode] == ULAM_VERDICT_FAIL)
         fprintf(stderr, "ulam: %s: warning: rho(M^) >= 1 (bounds [%.6g, %.6g]) for the %s: the estimator's "
                         "variance is infinite, so no error bar it reports can be trusted\n",

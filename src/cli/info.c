@@ -77,7 +77,7 @@ static void print_text(const cli_system *s, const ulam_csr_stats *st, const ulam
            cli_verdict_word(g->verdict_abs));
     for (int m = 0; m < 2; m++) {
         int v = ulam_guard_variance(g, m);
-        printf("variance %s %s (rho(M^) %s)\n", m == ULAM_ADJOINT ? "adjoint" : "forward",
+        printf("variance %s %s (rho(M^) %s)\n", cli_mode_names[m],
                v == 0 ? "infinite: no error bar can be trusted"
                : v < 0 ? "unknown: treated as infinite (no interval) unless --assume-finite-variance" : "finite",
                cli_verdict_word(g->verdict_hat[m]));

@@ -43,6 +43,7 @@ void cli_mpi_init(int *argc, char ***argv)
     if (!getenv("OMPI_COMM_WORLD_SIZE") && !getenv("PMIX_RANK") && !getenv("PMI_SIZE")) return;
     if (MPI_Init(argc, argv) != MPI_SUCCESS) return;
     started = 1;
+    share = ulam_share_defaults();
     MPI_Comm_rank(MPI_COMM_WORLD, &share.rank);
     MPI_Comm_size(MPI_COMM_WORLD, &share.nranks);
     share.allgather = allgather;

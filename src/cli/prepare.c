@@ -20,7 +20,7 @@ static const char *const usage =
     "  --omega W     damping of the Jacobi splitting (default 1)\n"
     "  --continue Q  certify the kernel of fixed continuation Q (default: analog); a query with\n"
     "                another continuation runs its own guards\n"
-    "  -o PATH       the output file (required)\n";
+    "  -o, --output PATH  the output file (required)\n";
 
 /* ulam prepare. */
 int cli_prepare(int argc, char **argv)
@@ -72,7 +72,8 @@ int cli_prepare(int argc, char **argv)
         cli_system_free(&s);
         return rc;
     }
-    ulam_system_desc d = {.M = s.M, .b = s.b, .n = s.M->nrows, .omega = s.jacobi ? s.omega : 0.0, .cert = &cert};
+    ulam_system_desc d = ulam_system_desc_defaults();
+    d.M = s.M, d.b = s.b, d.n = s.M->nrows, d.omega = s.jacobi ? s.omega : 0.0, d.cert = &cert;
     status = ulam_system_write_file(o.f, &d);
     if (status) ulam_outfile_abort(&o);
     else status = ulam_outfile_commit(&o);

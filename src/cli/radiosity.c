@@ -261,7 +261,7 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
         status = ulam_rad_solver_iterate(sv);
         ulam_rad_solver_result(sv, &r);
         if (round == 0) rel_err_warning(a, &r);
-        cli_progress_show(&pg, r.walks, r.radiosity[0], r.std_error[0], a->o.rel_err); /* the red channel */
+        cli_progress_show(&pg, r.walks, r.radiosity[0], r.std_error[0], &a->o); /* the red channel */
     }
     cli_progress_end(&pg);
     cli_release_sigint();
@@ -531,7 +531,7 @@ static void print_text(const args *a, const report *r)
 static void print_json(const args *a, const report *r)
 {
     printf("{");
-    cli_json_string("scene", a->scene, 0);
+    cli_json_string("scene", a->scene, 0); /* a path may hold quotes and backslashes */
     printf("\"npatches\": %lld, ", (long long)r->s->npatches);
     if (r->patch >= 0) {
         int32_t g = r->s->group[r->patch];

@@ -37,7 +37,8 @@ static const char *const usage =
     "                     stops while no walk has reached it; refused (exit 4) when the variance\n"
     "                     is not certified finite, unless --walks or --time bounds the run\n"
     "  --time S           stop after S seconds; the first rule reached wins\n"
-    "  --seed S           block q of walks uses stream (S, q): identical results for any --threads\n"
+    "  --seed S           block q of walks uses stream (S, q) (default 1): identical results for\n"
+    "                     any --threads\n"
     "  --threads T        threads (default: all cores)\n";
 static const char *const usage2 = /* the help in two strings: C99 promises 4095 characters a literal */
     "  --continue Q       continue with probability Q in every state (analog, the default:\n"
@@ -46,8 +47,8 @@ static const char *const usage2 = /* the help in two strings: C99 promises 4095 
     "  --alpha A          kernel exponent: move to j with probability proportional to\n"
     "                     |M_ij|^A over the row's nonzeros (default 1, |M_ij| / S_i; 0 uniform,\n"
     "                     2 Alea's); rho(M^) and the error bar are this kernel's\n"
-    "  --roulette W       Russian roulette below weight W (survive with |w|/W, weight W)\n"
-    "  --split W          split particles above weight W into ceil(|w|/W) copies\n"
+    "  --roulette W       Russian roulette below weight W (survive with |w|/W, weight W; default off)\n"
+    "  --split W          split particles above weight W into ceil(|w|/W) copies (default off)\n"
     "  --max-steps K      cut walks longer than K steps and count them (default 1000000)\n"
     "  --jacobi           the file holds A of A x = b; walk on M = I - omega D^-1 A\n"
     "  --omega W          damping of the Jacobi splitting (default 1)\n"
@@ -493,7 +494,7 @@ static int run(solve_args *a)
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, &r);
         if (first && !status) rel_err_warning(s, o, &r);
-        cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o->rel_err);
+        cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o);
     }
     cli_progress_end(&pg);
     ulam_solver_result(sv, &r);
