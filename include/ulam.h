@@ -890,49 +890,117 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
 /* ---------------------------------------------------------------- choosing the method */
 /* All secondary. */
 
+/* What became of a candidate of ulam_auto_choose. */
+enum ulam_auto_state {
+    ULAM_AUTO_UNCERTIFIED = 0, /* its variance is not certified finite (or its guard was not computed) */
+    ULAM_AUTO_REFUSED,         /* the solver refused it (status: absorption with p* = 0) */
+    ULAM_AUTO_SKIPPED,         /* not piloted: starting its kernel would pass the pilot budget */
+    ULAM_AUTO_DROPPED,         /* piloted, then dropped: its predicted work clearly the leader's worse */
+    ULAM_AUTO_FINALIST,        /* piloted to the end, not chosen */
+    ULAM_AUTO_CHOSEN
+};
+
 /* One candidate of ulam_auto_choose: a mode, an estimator and a continuation. */
 typedef struct ulam_auto_candidate {
     int mode, estimator;
     double continue_q;    /* <= 0: analog */
-    ulam_power hat;       /* rho(M^) of this candidate's kernel, with Collatz-Wielandt bounds */
+    double kernel_alpha;  /* the kernel exponent: p_ij proportional to |K_ij|^alpha */
+    ulam_power hat;       /* rho(M^) of this candidate's kernel (bounds [0, INFINITY]: not computed) */
     int certified;        /* hat.upper < 1 and rho(|M|)'s upper bound < 1: variance certified finite */
     int status;           /* ULAM_OK, or why the solver refused it (ULAM_EUNDEFINED: absorption with p* = 0) */
-    int64_t pilot_walks;  /* 0: not piloted (not certified, or refused) */
-    double estimate, variance, seconds_per_walk; /* the pilot's (its estimate is not used) */
-    double cost;          /* variance x seconds per walk; INFINITY when not piloted */
-    double predicted_seconds; /* walks for base rel_err x seconds a walk (NaN without rel_err) */
+    int state;            /* enum ulam_auto_state */
+    int stages;           /* pilot stages it ran (its pilots: pilot_walks, then doubling) */
+    int64_t pilot_walks;  /* walks of its pilots, all stages (0: not piloted) */
+    double estimate, variance, variance_rel_error; /* pooled over its pilots (never used in the answer) */
+    double steps_per_walk; /* the pilots' mean steps a walk */
+    double work_per_walk;  /* the work model's units a walk (see ulam_auto_choose) */
+    double cost;           /* variance x work_per_walk (INFINITY when not piloted); the variance
+                              compared is at least what puts the pilot's mean within 2 standard
+                              errors of the most precise other pilot's (a pilot that missed a
+                              skewed score's rare large values looks cheap otherwise) */
+    double predicted_walks; /* walks the run would make (rel_err: the rule's variance, range and
+                               variance-error terms at the pilots' values, rounded up to the rounds
+                               the rule is checked at; else max_walks; NaN for time alone) */
+    double predicted_work;  /* units: predicted_walks x work_per_walk + the kernel still to build */
+    double predicted_seconds; /* predicted_work x ULAM_AUTO_UNIT_SECONDS (for the report only) */
 } ulam_auto_candidate;
 
-/* At most 2 modes x 3 estimators x 2 continuations. */
-#define ULAM_AUTO_MAX 12
+/* At most 2 modes x 3 estimators x 2 continuations (x 3 kernel exponents). */
+#define ULAM_AUTO_MAX 36
 
-/* What the choice may vary: a pinned part keeps base's value.  Start from ulam_auto_defaults(). */
+/* The work model's units (one unit: one step of a walk), measured once (README, "Choosing for the
+ * user"): a walk's start and record, a forward tally, a kernel unit built (16 bytes of a row), a
+ * matrix entry read by a guard, reachability check or score-bound pass; and the seconds a unit
+ * took on the machine they were measured on (the report's predicted seconds only). */
+#define ULAM_AUTO_WALK 3.0
+#define ULAM_AUTO_TALLY 1.0
+#define ULAM_AUTO_BUILD 2.0
+#define ULAM_AUTO_READ 1.0
+#define ULAM_AUTO_UNIT_SECONDS 3e-8
+
+/* What the choice may vary and how it pilots: a pinned part keeps base's value.  Start from
+ * ulam_auto_defaults(). */
 typedef struct ulam_auto_opts {
-    int pin_mode, pin_estimator, pin_continue;
-    double continue_q;   /* the fixed continuation tried beside analog (default 0.9) */
-    int64_t pilot_walks; /* walks a pilot (default 2048) */
-    double pilot_seconds; /* and at most this long, its first block of 1024 walks whole (default 0.02; 0 off) */
+    int pin_mode, pin_estimator, pin_continue, pin_alpha;
+    double continue_q;    /* the fixed continuation tried beside analog (default 0.9); kernel
+                             exponents tried: 1, 0 and 2 */
+    int64_t pilot_walks;  /* a candidate's first pilot (default 128 walks); survivors double */
+    int64_t pilot_max;    /* the largest pilot of a stage (default 1024) */
+    double pilot_share;   /* stop piloting once the pilots' overhead (their work less what the
+                             leader's run reuses) reaches this share of the leader's predicted
+                             run (default 0.2) */
+    const ulam_guard *guard; /* radii computed before (a prepared system's certificate): they serve
+                                the candidates of their continuation and exponent instead of a pass
+                                over M (NULL: none) */
 } ulam_auto_opts;
 
-/* The defaults: nothing pinned, continue_q 0.9, pilot_walks 2048, pilot_seconds 0.02. */
+/* The default options: nothing pinned, Q = 0.9, pilots of 128 walks doubling up to 1024, 0.2. */
 ulam_auto_opts ulam_auto_defaults(void);
 
 /* The candidates and the choice. */
 typedef struct ulam_auto_result {
     int ncand;
     ulam_auto_candidate cand[ULAM_AUTO_MAX];
-    int chosen;     /* the certified, piloted candidate of least cost; -1 when none is certified */
-    int closest;    /* the candidate of least rho(M^) (named when none is certified) */
+    int chosen;     /* the piloted candidate of least predicted work (rel_err) or cost; -1 when none
+                       is certified */
+    int closest;    /* the candidate of least rho(M^) among those screened (named when none is certified) */
     ulam_power abs; /* rho(|M|) */
-    double seconds; /* guards and pilots */
+    ulam_guard guard; /* the guards of the chosen (or closest) candidate's continuation */
+    int by_work;    /* 1: compared by predicted work (a rel_err target); 0: by cost */
+    int stages;     /* pilot stages run */
+    double pilot_work;  /* units the guards and pilots spent */
+    double reused_work; /* of which the chosen run reuses (its guards, reachable set, score bounds, kernel rows) */
+    double seconds; /* wall time of guards and pilots (reported; the choice never looks at a clock) */
 } ulam_auto_result;
 
-/* Screen mode x estimator x continuation (less what is pinned) with the guards, keep the candidates
- * whose variance is certified finite, run a pilot of each (seeds of their own, so the walks that then
- * estimate with the chosen method are fresh and the choice does not bias them) and choose the least
- * variance x seconds per walk.  Walks across processes (base->share) agree on rank 0's choice. */
+/* Choose the walk method for (I - M) x = b under base's options, deterministically: the same
+ * choice for any thread count, process count and machine load (no clock is read for it).
+ *   - candidates: mode x estimator x continuation (analog, ao->continue_q) x kernel exponent
+ *     (1, 0, 2), less what is pinned, adjoint before forward; a guard per continuation and
+ *     exponent (rho(|M|), rho(M^) of each mode's kernel;
+ *     the forward one only when forward candidates are started or none is certified) screens
+ *     them: only certified-finite ones are piloted;
+ *   - pilots race: every candidate ao->pilot_walks walks, on seeds of its own, candidates of one
+ *     kernel (mode, continuation) sharing one solver (its rows, reachable set and score bounds;
+ *     rescored per estimator), then the survivors' walks double; a candidate is dropped when even
+ *     at its variance's lower bound (2 relative errors) its predicted work exceeds the leader's at
+ *     its upper; piloting stops when one is left, at ao->pilot_max, or when the overhead reaches
+ *     ao->pilot_share of the leader's predicted run (then no new kernel is started either);
+ *   - predicted work: units of the work model (ULAM_AUTO_*): walks x (steps + ULAM_AUTO_WALK +
+ *     forward tallies) + the kernel units still to build; with rel_err the walks are the rule's:
+ *     variance, range (min_walks) and variance-error terms.
+ * The pilots' walks are not used in the answer: it comes from fresh walks on base's seed
+ * (ulam_auto_solver), which the choice, a function of the pilots alone, cannot bias. */
 int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
                      ulam_auto_result *res, ulam_error *err);
+
+/* As ulam_auto_choose, and *out gets the solver to run: the chosen candidate's (or, when none is
+ * certified, the closest's) on base's options with that mode, estimator and continuation, its
+ * kernel rows, reachable set, score bounds and guards kept from the pilots, no walk made yet:
+ * iterating it gives, bit for bit, what a solver allocated with those options would (NULL with
+ * a status when none is left).  Its refusals are ulam_solver_alloc's. */
+int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                     ulam_auto_result *res, ulam_solver **out, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
 /* All tertiary. */

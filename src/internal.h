@@ -65,6 +65,20 @@ int ulam__thread_num(void);
  * tallies, counts and stopping state are reset (src/solve.c; used by the outer iterations). */
 int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_error *err);
 
+/* Walk again with options o that differ from the solver's only in the estimator, the seed, the
+ * stopping rules (max_walks, rel_err, max_seconds), interrupt, share, force, assume_finite and
+ * rel_err_offset (else ULAM_EINVAL): the kernel rows built (rescored for a new estimator), the
+ * reachable set, the score bounds met before, the guards and the workspace are kept; every tally,
+ * count and stopping state is reset, so the walks that follow are those of a solver allocated with
+ * o, bit for bit (src/solve.c; used by the method choice, src/auto.c).  Refusals as
+ * ulam_solver_alloc's. */
+int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *o, ulam_error *err);
+
+/* The deterministic set-up work of a solver so far: kernel units built (*units, 16 bytes each: a
+ * row's nonzeros + 3) and matrix entries read by reachability checks and score-bound passes
+ * (*reads). */
+void ulam__solver_setup(const ulam_solver *s, int64_t *units, int64_t *reads);
+
 /* Nonzero when [lower, upper] decides a radius' verdict and its warning: wholly below 0.99,
  * wholly at or above 1, or wholly in [0.99, 1) (src/spectral.c; the guards use it). */
 int ulam__power_certain(double lower, double upper);

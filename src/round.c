@@ -139,7 +139,8 @@ int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64
     int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX, done = next / B->block;
     int round = done + 1 < B->round ? (int)(done + 1) : B->round, n = 0;
     while (n < round && left > (int64_t)n * B->block) n++;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    int team = threads < n ? threads : n; /* a round of one block runs on the calling thread */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(team) if (team > 1)
     for (int k = 0; k < n; k++) {
         int64_t rest = left - (int64_t)k * B->block;
         B->run(ctx, k, next + (int64_t)k * B->block, rest < B->block ? rest : B->block, ulam__thread_num());

@@ -36,7 +36,6 @@ struct ulam_solver {
     ulam__slot *start_src; /* adjoint with nstarts: the start distribution (walker.start_*) */
     int32_t *start_units;
     double *start_b;
-    char *seen;             /* the states walks can reach (check_reach; NULL before) */
     const char *given_seen; /* the same computed by an earlier solver (ulam__solver_alloc_reached) */
     int threads;
     ulam__scratch *scratch; /* one per thread */
@@ -57,6 +56,20 @@ struct ulam_solver {
     double weight;         /* the weight bound W over reachable states (INFINITY with splitting) */
     double v2;             /* a certified bound on E[score^2] (INFINITY: none) */
     int signs;             /* scores may take both signs */
+    char *seen;            /* the states walks can reach (kept for a rerun; NULL until needed) */
+    double *fac;           /* kernel exponent != 1: each move's weight factor over them (kept) */
+    int64_t reach_nnz;     /* entries of M over the reachable rows (0 until computed) */
+    int64_t setup_work;    /* entries read by reachability checks and score-bound passes so far */
+    int passed;            /* the bounds pass over the reachable rows is done (kept for a rerun): */
+    struct {
+        double vmax, gmax, g2max; /* the largest |score| of one visit, of a single score, of g^2 / p* */
+        int64_t bad;              /* absorption: a reachable scoring state with p* = 0 (-1: none) */
+    } pass[3];             /* per estimator */
+    double pass_w0, pass_W, pass_qmax; /* the start weight, the weight bound, the largest q */
+    int pass_signs;
+    int tail_done, v2_done[3]; /* length_tail's and second_moment's results kept: */
+    double tail_uc, tail_kc, v2c[3];
+    const ulam_csr *M;     /* borrowed */
     ulam__run run;      /* walks, time, ending (round.c) */
     int64_t steps, cut;
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
@@ -75,8 +88,8 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
 {
     if (!s) return NULL;
     ulam__kernel_free(s->k);
-    free(s->src), free(s->sum), free(s->sumsq);
-    free(s->start_src), free(s->start_units), free(s->start_b), free(s->seen);
+    free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac);
+    free(s->start_src), free(s->start_units), free(s->start_b);
     ulam_csr_free(s->mt);
     if (s->scratch)
         for (int t = 0; t < s->threads; t++) {
@@ -199,7 +212,7 @@ static double weight_growth(const ulam_csr *K, double continue_q, const double *
  * (no certificate) when none is below 1 or memory runs out.  second: the same for the
  * walk's second-moment matrix M^ = diag(S / q) |K| (E[w_k^2] = w0^2 (M^^k 1)_i, no roulette). */
 static void length_tail(const ulam_csr *K, const char *seen, double continue_q, int second, double floor,
-                        double *u, double *kappa)
+                        double *u, double *kappa, int *iterations)
 {
     enum { ITER = 300 };
     int64_t n = K->nrows;
@@ -216,6 +229,7 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
             ratio = fmax(ratio, t / v[i]), ymax = fmax(ymax, t + v[i]);
             vmin = fmin(vmin, v[i]), vmax = fmax(vmax, v[i]);
         }
+        ++*iterations;
         if (ratio < *u) *u = ratio, *kappa = vmax / vmin;
         else if (*u < 1.0 && ratio >= *u * (1.0 - 1e-6)) break; /* no longer improving */
         if (!(ymax > 0)) break;
@@ -234,7 +248,8 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
  * walk: w0^2 c z_start / (1 - u)).  z: iterates of I + M^ from g (so it fits the states that
  * score), floored at a few shares of its largest entry, the best bound kept; INFINITY when none
  * has u < 1.  At kernel exponent != 1, M^_ij = |K_ij| fac_ij, fac the moves' own factors. */
-static double second_moment(const ulam_solver *s, const ulam_csr *K, const double *fac, const char *seen, double w0)
+static double second_moment(const ulam_solver *s, const ulam_csr *K, const double *fac, const char *seen, double w0,
+                            int *iterations)
 {
     enum { ITER = 300 };
     int64_t n = K->nrows;
@@ -260,6 +275,7 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const doubl
         for (int64_t i = 0; i < n; i++) v[i] = seen[i] ? fmax(g[i] / gmax, floors[fl]) : 1.0;
         for (int it = 0, last = 0; it < ITER && it - last < 30; it++) { /* until 30 iterations bring nothing */
             double u = 0.0, c = 0.0, z0 = 0.0, ymax = 0.0;
+            ++*iterations;
             for (int64_t i = 0; i < n; i++) {
                 if (!seen[i]) continue;
                 double t = 0.0;
@@ -299,40 +315,45 @@ static double *move_factors(const ulam_csr *K, const char *seen, double continue
     return f;
 }
 
-/* Over the states walks can reach (seen): absorption's p* > 0 wherever it scores (else
- * ULAM_EUNDEFINED naming the state), and the bound on a single score and the scores' range
- * (s->bound, s->range): 0 when nothing that scores is reachable; for absorption W |g_i| / p*_i,
- * W the weight bound (the start weight, or the roulette weight when larger, times the
- * largest product of factors S / q along a path, weight_growth; unbounded with splitting);
- * the per-visit score and continuation tail for collision and expected (s->per_step, s->qmax,
- * and past qmax = 1 the certificate of length_tail). */
-static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
+/* The states walks can reach (s->seen, computed once and kept) and their entries (s->reach_nnz). */
+static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
-    if (!s->given_seen) {
-        char *mark = ulam__calloc((size_t)s->n, 1);
-        if (!mark) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
-        if (s->o.mode == ULAM_ADJOINT && !s->o.nstarts) mark[s->o.index] = 1;
-        for (int64_t j = 0; s->o.mode == ULAM_ADJOINT && j < s->o.nstarts; j++) mark[s->o.starts[j]] = 1;
-        if (s->o.mode == ULAM_FORWARD)
-            for (int64_t i = 0; i < s->n; i++) mark[i] = s->b[i] != 0.0;
-        int status = ulam__kernel_reach(K, s->o.continue_q, mark);
-        if (status) {
-            free(mark);
-            return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for a reachability check")
-                                         : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, "
-                                                      "nonzero values (the matrix is corrupt)");
-        }
-        free(s->seen);
-        s->seen = mark;
+    if (s->seen) return ULAM_OK;
+    char *seen = ulam__calloc((size_t)s->n, 1);
+    if (!seen) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
+    if (s->o.mode == ULAM_ADJOINT && !s->o.nstarts) seen[s->o.index] = 1;
+    for (int64_t j = 0; s->o.mode == ULAM_ADJOINT && j < s->o.nstarts; j++) seen[s->o.starts[j]] = 1;
+    if (s->o.mode == ULAM_FORWARD)
+        for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
+    /* an earlier solver's search (ulam__solver_alloc_reached) is copied, not repeated */
+    int status = s->given_seen ? (memcpy(seen, s->given_seen, (size_t)s->n), ULAM_OK)
+                               : ulam__kernel_reach(K, s->o.continue_q, seen);
+    if (status) {
+        free(seen);
+        return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for a reachability check")
+                                     : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, "
+                                                  "nonzero values (the matrix is corrupt)");
     }
-    const char *seen = s->given_seen ? s->given_seen : s->seen;
-    double *fac = NULL; /* kernel exponent != 1: each move's own weight factor */
-    if (s->o.kernel_alpha != 1.0 && !(fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
+    s->seen = seen;
+    s->reach_nnz = 0;
+    for (int64_t i = 0; i < s->n; i++)
+        if (seen[i]) s->reach_nnz += K->rowptr[i + 1] - K->rowptr[i];
+    s->setup_work += s->reach_nnz;
+    return ULAM_OK;
+}
+
+/* The one pass over the reachable rows that every estimator's score bounds come from (kept):
+ * for each estimator the largest visit score, single score and g^2 / p*, and absorption's first
+ * scoring state with p* = 0; the weight bound and the scores' signs. */
+static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
+{
+    const char *seen = s->seen;
+    double *fac = NULL; /* kernel exponent != 1: each move's own weight factor (kept: s->fac) */
+    if (s->o.kernel_alpha != 1.0 && !(fac = s->fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
-    int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = 0;
+    int adj = s->o.mode == ULAM_ADJOINT, pos = 0, neg = 0, any = 0;
     int64_t bad = -1;
-    int expected = s->o.estimator == ULAM_EXPECTED;
-    double w0 = 1.0, fbig = 0.0, gmax = 0.0, g2max = 0.0, vmax = 0.0, qmax = 0.0;
+    double w0 = 1.0, fbig = 0.0, gabs = 0.0, g2abs = 0.0, vb = 0.0, vexp = 0.0, qmax = 0.0;
     for (int64_t i = 0; i < s->n; i++) {
         if (!seen[i]) continue;
         double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
@@ -341,17 +362,18 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
             neg |= K->val[k] < 0;
             if (fac) fbig = fmax(fbig, fac[k]);
-            if (adj && expected) c += K->val[k] * s->b[K->colidx[k]];
+            if (adj) c += K->val[k] * s->b[K->colidx[k]];
         }
-        if (absorb && (adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
+        if ((adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
         /* what one visit scores: b_i (collision), (M b)_i (expected), forward 1 at the index */
-        double v = adj ? fabs(expected ? c : s->b[i]) : i == s->o.index ? (expected ? INFINITY : 1.0) : 0.0;
-        vmax = fmax(vmax, v);
+        vb = fmax(vb, adj ? fabs(s->b[i]) : i == s->o.index ? 1.0 : 0.0);
+        vexp = fmax(vexp, adj ? fabs(c) : i == s->o.index ? INFINITY : 0.0);
         int scores = adj ? s->b[i] != 0.0 : i == s->o.index;
         if (!scores) continue;
         double g = adj ? fabs(s->b[i]) : 1.0;
-        gmax = fmax(gmax, absorb ? (q < 1.0 ? g / (1.0 - q) : INFINITY) : INFINITY);
-        g2max = fmax(g2max, absorb && q < 1.0 ? g * g / (1.0 - q) : INFINITY);
+        any = 1;
+        gabs = fmax(gabs, q < 1.0 ? g / (1.0 - q) : INFINITY);
+        g2abs = fmax(g2abs, q < 1.0 ? g * g / (1.0 - q) : INFINITY);
         if (adj) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
     }
     if (!adj)
@@ -360,28 +382,62 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         pos |= s->o.start_weights[j] > 0, neg |= s->o.start_weights[j] < 0;
     double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
     w0 = start_weight(&s->o, s->b, s->n);
-    double Wmax = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
-    s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
-    if (s->o.rel_err > 0 && vmax > 0 && (!(qmax < 1.0) || !isfinite(Wmax)))
-        length_tail(K, seen, s->o.continue_q, 0, 1e-30, &s->tail_u, &s->kappa); /* kappa enters by its log */
-    if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
-        (absorb ? isfinite(g2max) : isfinite(vmax))) {
-        s->v2 = second_moment(s, K, fac, seen, w0);
+    for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++) {
+        int absorb = e == ULAM_ABSORPTION;
+        s->pass[e].vmax = e == ULAM_EXPECTED ? vexp : vb;
+        s->pass[e].gmax = absorb ? gabs : any ? INFINITY : 0.0;
+        s->pass[e].g2max = absorb ? g2abs : any ? INFINITY : 0.0;
+        s->pass[e].bad = absorb ? bad : -1;
     }
-    free(fac);
-    if (bad >= 0)
-        return ulam__fail(err, ULAM_EUNDEFINED, 0, bad,
+    s->pass_w0 = w0;
+    s->pass_W = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
+    s->pass_qmax = qmax;
+    s->pass_signs = pos && neg;
+    s->passed = 1;
+    s->setup_work += s->reach_nnz;
+    return ULAM_OK;
+}
+
+/* Over the states walks can reach: absorption's p* > 0 wherever it scores (else ULAM_EUNDEFINED
+ * naming the state), and the bound on a single score and the scores' range (s->bound, s->range):
+ * 0 when nothing that scores is reachable; for absorption W |g_i| / p*_i, W the weight bound
+ * (the start weight, or the roulette weight when larger, times the largest product of factors
+ * S / q along a path, weight_growth; unbounded with splitting); the per-visit score and
+ * continuation tail for collision and expected (s->per_step, s->qmax, and past qmax = 1 the
+ * certificate of length_tail).  The reachable set, the pass and the certificates are kept, so a
+ * rerun with another estimator reads M again only for what it has not computed. */
+static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
+{
+    int status = reach(s, K, err);
+    if (status) return status;
+    if (!s->passed && (status = bounds_pass(s, K, err))) return status;
+    int e = s->o.estimator, absorb = e == ULAM_ABSORPTION, adj = s->o.mode == ULAM_ADJOINT, it = 0;
+    double vmax = s->pass[e].vmax, Wmax = s->pass_W, w0 = s->pass_w0;
+    if (s->pass[e].bad >= 0)
+        return ulam__fail(err, ULAM_EUNDEFINED, 0, s->pass[e].bad,
                           "p* > 0 wherever the absorption estimator scores; state %lld (1-based) is "
                           "reachable and never terminates (its row sum of |%s| is >= 1): use the "
                           "collision estimator or --continue Q",
-                          (long long)bad + 1, adj ? "M" : "M' (column of M)");
-    double W = Wmax;
+                          (long long)s->pass[e].bad + 1, adj ? "M" : "M' (column of M)");
+    s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
+    if (s->o.rel_err > 0 && vmax > 0 && (!(s->pass_qmax < 1.0) || !isfinite(Wmax))) {
+        if (!s->tail_done) /* kappa enters by its log */
+            length_tail(K, s->seen, s->o.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
+        s->tail_u = s->tail_uc, s->kappa = s->tail_kc;
+    }
+    if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
+        (absorb ? isfinite(s->pass[e].g2max) : isfinite(vmax))) {
+        if (!s->v2_done[e]) s->v2c[e] = second_moment(s, K, s->fac, s->seen, w0, &it), s->v2_done[e] = 1;
+        s->v2 = s->v2c[e];
+    }
+    s->setup_work += (int64_t)it * s->reach_nnz;
+    double W = Wmax, gmax = s->pass[e].gmax;
     s->weight = W;
-    s->signs = pos && neg;
+    s->signs = s->pass_signs;
     s->bound = gmax > 0 ? W * gmax : 0.0;
     s->range = s->bound * (s->signs ? 2.0 : 1.0);
     s->per_step = vmax > 0 ? W * vmax : 0.0;
-    s->qmax = qmax;
+    s->qmax = s->pass_qmax;
     return ULAM_OK;
 }
 
@@ -404,6 +460,18 @@ static int check_bounded(const ulam_solver *s, ulam_error *err)
                                                : "a reachable row of |M| sums to 1 or more and no Collatz-Wielandt vector "
                                                  "certifies the walk's length tail below 1";
     return ulam__fail(err, ULAM_EINFVAR, 0, -1, "a bound on a single walk's score (%s)", why);
+}
+
+/* The score bounds of this run's estimator (check_reach, when absorption or a rel_err target needs
+ * them), and with rel_err alone the refusal of a
+ * target no bound certifies (check_bounded). */
+static int take_bounds(ulam_solver *s, const ulam_csr *K, int rel_alone, ulam_error *err)
+{
+    s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = s->weight = INFINITY;
+    s->qmax = s->tail_u = 1.0;
+    s->signs = 0;
+    int status = s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0 ? check_reach(s, K, err) : ULAM_OK;
+    return !status && rel_alone ? check_bounded(s, err) : status;
 }
 
 /* The guards' verdicts for this run: opts->guard when it holds them, else computed (rho(|M|)
@@ -576,6 +644,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     s->b = b;
     s->n = M->nrows;
     s->given_seen = seen;
+    s->M = M;
     if ((status = take_guard(M, &o, &s->g, err)) || (status = check_verdicts(M, s, err))) {
         ulam_solver_free(s);
         return status;
@@ -593,13 +662,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
-    s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = s->weight = INFINITY;
-    s->qmax = s->tail_u = 1.0;
-    if ((o.estimator == ULAM_ABSORPTION || o.rel_err > 0) && (status = check_reach(s, K, err))) {
-        ulam_solver_free(s);
-        return status;
-    }
-    if (o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0 && (status = check_bounded(s, err))) {
+    if ((status = take_bounds(s, K, o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0, err))) {
         ulam_solver_free(s);
         return status;
     }
@@ -895,6 +958,18 @@ int ulam_solver_error(const ulam_solver *s, ulam_error *err)
     }
 }
 
+/* Reset every tally, count and stopping state (the kernel, the bounds and the workspace stay). */
+static void reset(ulam_solver *s)
+{
+    if (s->sum) memset(s->sum, 0, (size_t)s->n * sizeof *s->sum);
+    if (s->sumsq) memset(s->sumsq, 0, (size_t)s->n * sizeof *s->sumsq);
+    s->adj = s->watched = (ulam__moments){0};
+    s->steps = s->cut = 0;
+    s->maxsq = 0.0;
+    ulam__run_reset(&s->run);
+    s->met = s->cut_stop = s->out_of_reach = 0;
+}
+
 /* Restart a forward solver on a new right-hand side b (borrowed like the first) with a new
  * seed: the kernel and workspace are kept (the kernel of a forward walk does not depend on b),
  * the source table is rebuilt and every tally, count and stopping state is reset. */
@@ -908,18 +983,55 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     s->o.seed = seed;
     double bnorm1 = 0.0;
     if (build_source(s, &bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");
+    free(s->seen), free(s->fac); /* the reachable set and the score bounds depend on b */
+    s->seen = NULL, s->fac = NULL;
+    s->passed = s->tail_done = 0;
+    memset(s->v2_done, 0, sizeof s->v2_done);
     if (s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0) {
-        int status = check_reach(s, s->mt, err); /* the score bounds depend on b */
+        int status = check_reach(s, s->mt, err);
         if (status) return status;
     }
     s->w.src = s->src;
     s->w.bnorm1 = bnorm1;
-    memset(s->sum, 0, (size_t)s->n * sizeof *s->sum);
-    memset(s->sumsq, 0, (size_t)s->n * sizeof *s->sumsq);
-    s->adj = s->watched = (ulam__moments){0};
-    s->steps = s->cut = 0;
-    s->maxsq = 0.0;
-    ulam__run_reset(&s->run);
-    s->met = s->cut_stop = s->out_of_reach = 0;
+    reset(s);
     return ULAM_OK;
+}
+
+/* Walk again with options o that differ from the solver's only in the estimator, the seed, the
+ * stopping rules, interrupt, share, force, assume_finite and rel_err_offset. */
+int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s || !opts) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a solver and options");
+    ulam_walk_opts o = *opts;
+    double q0 = s->o.continue_q > 0 ? s->o.continue_q : 0.0, q1 = o.continue_q > 0 ? o.continue_q : 0.0;
+    if (o.mode != s->o.mode || o.index != s->o.index || q0 != q1 || o.roulette != s->o.roulette ||
+        o.split != s->o.split || o.max_steps != s->o.max_steps || o.kernel_alpha != s->o.kernel_alpha ||
+        ulam__threads(o.threads) != s->threads || o.nstarts || s->o.nstarts)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the solver's mode, index, continuation, kernel exponent, weight "
+                                                   "window, max_steps and threads (and one start state)");
+    int status = check_opts(s->M, &o, err);
+    if (status) return status;
+    if (atomic_load(&s->k->status)) return kernel_failure(s->k, err);
+    int rescore = o.estimator != s->o.estimator;
+    s->o = o;
+    if ((status = check_verdicts(s->M, s, err))) return status;
+    s->o.max_walks = ulam__walk_cap(&o);
+    if (rescore && (status = ulam__kernel_rescore(s->k, o.estimator))) return kernel_failure(s->k, err);
+    s->w.interrupt = o.interrupt;
+    s->w.score0 = o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED ? s->b[o.index] : 0.0;
+    s->w.expected = o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED;
+    if ((status = take_bounds(s, o.mode == ULAM_FORWARD ? s->mt : s->M, o.rel_err > 0 && o.max_walks == 0 &&
+                              o.max_seconds == 0, err)))
+        return status;
+    reset(s);
+    return ULAM_OK;
+}
+
+/* The deterministic work a solver has done on set-up: kernel units built, and entries read by
+ * reachability checks and score-bound passes. */
+void ulam__solver_setup(const ulam_solver *s, int64_t *units, int64_t *reads)
+{
+    *units = atomic_load(&s->k->top);
+    *reads = s->setup_work;
 }
