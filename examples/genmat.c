@@ -47,37 +47,6 @@ static ulam_csr *poisson2d(int g)
     return build(n, k, ti, tj, tx);
 }
 
-/* A radiosity-like dense M = diag(rho) F: n patches on a circle's two arcs, F_ij
- * proportional to 1 / (1 + d_ij^2) with unit row sums, reflectances in [0.3, 0.8]. */
-static ulam_csr *radiosity_like(int64_t n, uint64_t seed)
-{
-    int64_t nz = n * (n - 1), k = 0;
-    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
-    double *tx = malloc((size_t)nz * sizeof *tx);
-    ulam_rng r;
-    ulam_rng_seed(&r, seed, 2);
-    for (int64_t i = 0; i < n; i++) {
-        double rho = 0.3 + 0.5 * ulam_rng_uniform(&r), sum = 0;
-        int64_t base = k;
-        for (int64_t j = 0; j < n; j++) {
-            if (j == i) continue;
-            double d = (double)(i - j) / (double)n * 8.0;
-            ti[k] = (int32_t)i, tj[k] = (int32_t)j, tx[k] = 1.0 / (1.0 + d * d);
-            sum += tx[k++];
-        }
-        for (int64_t q = base; q < k; q++) tx[q] *= rho / sum;
-    }
-    return build(n, k, ti, tj, tx);
-}
-
-/* Emission: a few bright patches, the rest dark. */
-static double *emitters(int64_t n)
-{
-    double *b = calloc((size_t)n, sizeof *b);
-    for (int64_t i = 0; i < n; i += n / 5) b[i] = 10.0;
-    return b;
-}
-
 /* Write every system of matrices/ that is generated rather than written by hand. */
 static void all(const char *dir)
 {

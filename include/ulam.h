@@ -31,7 +31,7 @@
  *     (ulam_guard_variance, ulam_verdict_of, ulam_solver_guard), spectral radii
  *     (ulam_spectral_power, ulam_spectral_radius), prepared systems (ulam_system_*,
  *     ulam_certificate_*), processes (ulam_share), outer iterations (ulam_outer_*), Krylov
- *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_solve), the method
+ *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_plan, ulam_bidir_solve), the method
  *     choice (ulam_auto_choose), ulam_direct_bytes;
  *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
  *     ulam_strtod, ulam_outfile_*, ulam_spectral_radius_op, ulam_gauss_seidel_*, the studies'
@@ -545,6 +545,12 @@ typedef struct ulam_walk_opts {
                               K_ij / (q_i p_ij); 1 (the default): the "almost optimal" |K_ij| / S_i,
                               0 uniform, 2 Alea's transition factor.  rho(M^) is that kernel's, so
                               opts->guard is used only when computed for the same alpha */
+    int64_t nstarts;     /* adjoint: 0 starts every walk at index; k > 0 starts it at starts[j]
+                            with probability |start_weights[j]| / S (S their sum of |.|) and
+                            weight sign(start_weights[j]) S, so the estimate is of
+                            sum_j start_weights[j] x_{starts[j]} (index only labels it) */
+    const int64_t *starts;       /* k states (0-based), borrowed like b */
+    const double *start_weights; /* k finite weights, not all 0 */
 } ulam_walk_opts;
 
 /* The defaults: adjoint collision walks, index 0, analog kernel (kernel_alpha 1), seed 1, all
@@ -807,19 +813,24 @@ const double *ulam_push_residuals(const ulam_push *w);
 /* Fill *info about the pushes since the last start. */
 void ulam_push_report(const ulam_push *w, ulam_push_info *info);
 
-/* Bidirectional estimate of x_t of (I - M) x = e_s (src/bidir.c; Lofgren, Banerjee, Goel, "Personalized
- * PageRank estimation and search: a bidirectional approach", WSDM 2016): a reverse push from t gives
- * x_t = p_s + <r, x>, and <r, x> = e_s' (I - M')^-1 r is the unknown s of the system (M', r),
- * estimated by the adjoint walk solver on M' from s scoring r (walks forward from the source).
- * Each score is at most rmax x the walk's weight sum, so the variance falls with rmax.  Start from
+/* Bidirectional estimate of x_t of (I - M) x = b for b = e_s or a sparse b (src/bidir.c; Lofgren,
+ * Banerjee, Goel, "Personalized PageRank estimation and search: a bidirectional approach", WSDM
+ * 2016): a reverse push from t gives x_t = <p, b> + <r, x>, and <r, x> = b' (I - M')^-1 r is
+ * estimated by the adjoint walk solver on M' scoring r from walks that start at s (or at b's
+ * state j with probability |b_j| / ||b||_1 and weight sign(b_j) ||b||_1: walks forward from the
+ * sources).  Each score is at most rmax x the walk's weight sum, so the variance falls with rmax.  Start from
  * ulam_bidir_defaults(). */
 typedef struct ulam_bidir_opts {
-    int64_t target, source; /* 0-based t and s */
+    int64_t target, source; /* 0-based t and s (b = e_s when nb is 0) */
+    int64_t nb;               /* > 0: a sparse b instead of e_s, nb entries (indices may repeat) */
+    const int64_t *b_index;   /* their 0-based states (borrowed) */
+    const double *b_value;    /* their finite values, not all 0 */
     double rmax;       /* push threshold; <= 0: balance the push's work against the walks' predicted work */
     double min_value;  /* the smallest |x_t| the balance plans for (<= 0: 1 / n) */
     int64_t max_push_ops; /* cap on the push's work (0: 100 nnz(M) + 10^6); past it ULAM_ENOCONV */
-    ulam_walk_opts walk;  /* the walks' kernel, seed, threads and stopping rules (mode and index are
-                             set here); rel_err applies to the whole estimate p_s + <r, x> */
+    ulam_walk_opts walk;  /* the walks' kernel, seed, threads and stopping rules (mode, index and
+                             starts are set here); rel_err applies to the whole estimate
+                             <p, b> + <r, x> */
 } ulam_bidir_opts;
 
 /* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
@@ -843,7 +854,8 @@ typedef struct ulam_bidir_plan_info {
                                the value is exact; max_walks when that is the only rule; NaN
                                when rmax is given and rel_err is set: no pilot measured V) */
     double predicted_work;  /* push.ops + step_cost (pilot visits + predicted_walks V): the whole
-                               estimate's work in push operations */
+                               estimate's work in push operations (NaN when rmax is given and
+                               walks remain: no pilot measured V) */
     double step_cost;       /* push operations a walk visit counts as */
     double seconds;         /* wall time of the plan: pilot and push */
 } ulam_bidir_plan_info;
@@ -851,17 +863,17 @@ typedef struct ulam_bidir_plan_info {
 /* Plan a bidirectional estimate without its walks: start the push at o->target and, when o->rmax
  * <= 0, run a pilot of 256 walks on a seed of its own (o->walk.seed mixed) and halve rmax from 1,
  * pushing down to it, while the push's operations are below the walks' predicted work (walks
- * predicted by the stopping rule's terms: its 1000-walk floor, the variance rmax V / (E^2 x^),
- * and for a rel_err target E the range term the walk solver's own bounds (the pilot's solver,
- * over the states the walks reach) give for scores of at most rmax a visit, when they give one;
- * x^ = max(min_value, |<p, b>|); E = 0.1 for a run stopped by time alone); with o->rmax > 0
- * push to it.  w is left
- * pushed, and remembers the plan: ulam_bidir_solve with the same options (target, b, rmax,
- * min_value, max_push_ops and the walk options the pilot and prediction read) uses that push and
- * pilot as they are, until ulam_push_start or ulam_push_run changes the workspace.  The push's
- * operations are exact; the walks are a prediction (the solver stops after whole rounds, so it
- * runs at least the predicted walks rounded up to its rounds, and more when the variance is
- * larger than modelled).  Statuses as ulam_bidir_solve. */
+ * predicted by the stopping rule's terms: its 1000-walk floor, the variance ||b||_1 rmax V /
+ * (E^2 x^), and for a rel_err target E the range term the walk solver's own bounds (the pilot's
+ * solver, over the states the walks reach) give for scores of at most rmax a visit, when they
+ * give one; x^ = max(min_value, |<p, b>|); E = 0.1 for a run stopped by time alone); with
+ * o->rmax > 0 push to it.  w is left pushed, and remembers the plan: ulam_bidir_solve with the
+ * same options (target, b, rmax, min_value, max_push_ops and the walk options the pilot and
+ * prediction read) uses that push and pilot as they are, until ulam_push_start or ulam_push_run
+ * changes the workspace.  The push's operations are exact; the walks are a model's prediction:
+ * the solver runs what its rule needs, in whole rounds, fewer or more (on the R-MAT benchmark the
+ * median prediction was 1.8e4 walks where 7168 ran; x^ far above |x| predicts too few).
+ * Statuses as ulam_bidir_solve. */
 int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
                     ulam_error *err);
 
@@ -877,10 +889,11 @@ typedef struct ulam_bidir_result {
                               reused) plus the walks' set-up and walks */
 } ulam_bidir_result;
 
-/* Estimate x_t of (I - M) x = e_s with push workspace w (on M) and Mt, the transpose of M (borrowed;
+/* Estimate x_t of (I - M) x = b (e_s, or o's sparse b) with push workspace w (on M) and Mt, the
+ * transpose of M (borrowed;
  * computing it is one O(nnz) pass the caller makes once for any number of queries): the plan of
  * ulam_bidir_plan (reused when w holds it for these options), then walks from s on Mt scoring the
- * residual until o->walk's stopping rules hold.  ULAM_OK, ULAM_EINVAL (bad options, index out of
+ * residual (from b's states, in proportion to |b_j|) until o->walk's stopping rules hold.  ULAM_OK, ULAM_EINVAL (bad options, index out of
  * range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap), the walk solver's statuses. */
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err);
@@ -888,49 +901,117 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
 /* ---------------------------------------------------------------- choosing the method */
 /* All secondary. */
 
+/* What became of a candidate of ulam_auto_choose. */
+enum ulam_auto_state {
+    ULAM_AUTO_UNCERTIFIED = 0, /* its variance is not certified finite (or its guard was not computed) */
+    ULAM_AUTO_REFUSED,         /* the solver refused it (status: absorption with p* = 0) */
+    ULAM_AUTO_SKIPPED,         /* not piloted: starting its kernel would pass the pilot budget */
+    ULAM_AUTO_DROPPED,         /* piloted, then dropped: its predicted work clearly the leader's worse */
+    ULAM_AUTO_FINALIST,        /* piloted to the end, not chosen */
+    ULAM_AUTO_CHOSEN
+};
+
 /* One candidate of ulam_auto_choose: a mode, an estimator and a continuation. */
 typedef struct ulam_auto_candidate {
     int mode, estimator;
     double continue_q;    /* <= 0: analog */
-    ulam_power hat;       /* rho(M^) of this candidate's kernel, with Collatz-Wielandt bounds */
+    double kernel_alpha;  /* the kernel exponent: p_ij proportional to |K_ij|^alpha */
+    ulam_power hat;       /* rho(M^) of this candidate's kernel (bounds [0, INFINITY]: not computed) */
     int certified;        /* hat.upper < 1 and rho(|M|)'s upper bound < 1: variance certified finite */
     int status;           /* ULAM_OK, or why the solver refused it (ULAM_EUNDEFINED: absorption with p* = 0) */
-    int64_t pilot_walks;  /* 0: not piloted (not certified, or refused) */
-    double estimate, variance, seconds_per_walk; /* the pilot's (its estimate is not used) */
-    double cost;          /* variance x seconds per walk; INFINITY when not piloted */
-    double predicted_seconds; /* walks for base rel_err x seconds a walk (NaN without rel_err) */
+    int state;            /* enum ulam_auto_state */
+    int stages;           /* pilot stages it ran (its pilots: pilot_walks, then doubling) */
+    int64_t pilot_walks;  /* walks of its pilots, all stages (0: not piloted) */
+    double estimate, variance, variance_rel_error; /* pooled over its pilots (never used in the answer) */
+    double steps_per_walk; /* the pilots' mean steps a walk */
+    double work_per_walk;  /* the work model's units a walk (see ulam_auto_choose) */
+    double cost;           /* variance x work_per_walk (INFINITY when not piloted); the variance
+                              compared is at least what puts the pilot's mean within 2 standard
+                              errors of the most precise other pilot's (a pilot that missed a
+                              skewed score's rare large values looks cheap otherwise) */
+    double predicted_walks; /* walks the run would make (rel_err: the rule's variance, range and
+                               variance-error terms at the pilots' values, rounded up to the rounds
+                               the rule is checked at; else max_walks; NaN for time alone) */
+    double predicted_work;  /* units: predicted_walks x work_per_walk + the kernel still to build */
+    double predicted_seconds; /* predicted_work x ULAM_AUTO_UNIT_SECONDS (for the report only) */
 } ulam_auto_candidate;
 
-/* At most 2 modes x 3 estimators x 2 continuations. */
-#define ULAM_AUTO_MAX 12
+/* At most 2 modes x 3 estimators x 2 continuations (x 3 kernel exponents). */
+#define ULAM_AUTO_MAX 36
 
-/* What the choice may vary: a pinned part keeps base's value.  Start from ulam_auto_defaults(). */
+/* The work model's units (one unit: one step of a walk), measured once (README, "Choosing for the
+ * user"): a walk's start and record, a forward tally, a kernel unit built (16 bytes of a row), a
+ * matrix entry read by a guard, reachability check or score-bound pass; and the seconds a unit
+ * took on the machine they were measured on (the report's predicted seconds only). */
+#define ULAM_AUTO_WALK 3.0
+#define ULAM_AUTO_TALLY 1.0
+#define ULAM_AUTO_BUILD 2.0
+#define ULAM_AUTO_READ 1.0
+#define ULAM_AUTO_UNIT_SECONDS 3e-8
+
+/* What the choice may vary and how it pilots: a pinned part keeps base's value.  Start from
+ * ulam_auto_defaults(). */
 typedef struct ulam_auto_opts {
-    int pin_mode, pin_estimator, pin_continue;
-    double continue_q;   /* the fixed continuation tried beside analog (default 0.9) */
-    int64_t pilot_walks; /* walks a pilot (default 2048) */
-    double pilot_seconds; /* and at most this long, its first block of 1024 walks whole (default 0.02; 0 off) */
+    int pin_mode, pin_estimator, pin_continue, pin_alpha;
+    double continue_q;    /* the fixed continuation tried beside analog (default 0.9); kernel
+                             exponents tried: 1, 0 and 2 */
+    int64_t pilot_walks;  /* a candidate's first pilot (default 128 walks); survivors double */
+    int64_t pilot_max;    /* the largest pilot of a stage (default 1024) */
+    double pilot_share;   /* stop piloting once the pilots' overhead (their work less what the
+                             leader's run reuses) reaches this share of the leader's predicted
+                             run (default 0.2) */
+    const ulam_guard *guard; /* radii computed before (a prepared system's certificate): they serve
+                                the candidates of their continuation and exponent instead of a pass
+                                over M (NULL: none) */
 } ulam_auto_opts;
 
-/* The defaults: nothing pinned, continue_q 0.9, pilot_walks 2048, pilot_seconds 0.02. */
+/* The default options: nothing pinned, Q = 0.9, pilots of 128 walks doubling up to 1024, 0.2. */
 ulam_auto_opts ulam_auto_defaults(void);
 
 /* The candidates and the choice. */
 typedef struct ulam_auto_result {
     int ncand;
     ulam_auto_candidate cand[ULAM_AUTO_MAX];
-    int chosen;     /* the certified, piloted candidate of least cost; -1 when none is certified */
-    int closest;    /* the candidate of least rho(M^) (named when none is certified) */
+    int chosen;     /* the piloted candidate of least predicted work (rel_err) or cost; -1 when none
+                       is certified */
+    int closest;    /* the candidate of least rho(M^) among those screened (named when none is certified) */
     ulam_power abs; /* rho(|M|) */
-    double seconds; /* guards and pilots */
+    ulam_guard guard; /* the guards of the chosen (or closest) candidate's continuation */
+    int by_work;    /* 1: compared by predicted work (a rel_err target); 0: by cost */
+    int stages;     /* pilot stages run */
+    double pilot_work;  /* units the guards and pilots spent */
+    double reused_work; /* of which the chosen run reuses (its guards, reachable set, score bounds, kernel rows) */
+    double seconds; /* wall time of guards and pilots (reported; the choice never looks at a clock) */
 } ulam_auto_result;
 
-/* Screen mode x estimator x continuation (less what is pinned) with the guards, keep the candidates
- * whose variance is certified finite, run a pilot of each (seeds of their own, so the walks that then
- * estimate with the chosen method are fresh and the choice does not bias them) and choose the least
- * variance x seconds per walk.  Walks across processes (base->share) agree on rank 0's choice. */
+/* Choose the walk method for (I - M) x = b under base's options, deterministically: the same
+ * choice for any thread count, process count and machine load (no clock is read for it).
+ *   - candidates: mode x estimator x continuation (analog, ao->continue_q) x kernel exponent
+ *     (1, 0, 2), less what is pinned, adjoint before forward; a guard per continuation and
+ *     exponent (rho(|M|), rho(M^) of each mode's kernel;
+ *     the forward one only when forward candidates are started or none is certified) screens
+ *     them: only certified-finite ones are piloted;
+ *   - pilots race: every candidate ao->pilot_walks walks, on seeds of its own, candidates of one
+ *     kernel (mode, continuation) sharing one solver (its rows, reachable set and score bounds;
+ *     rescored per estimator), then the survivors' walks double; a candidate is dropped when even
+ *     at its variance's lower bound (2 relative errors) its predicted work exceeds the leader's at
+ *     its upper; piloting stops when one is left, at ao->pilot_max, or when the overhead reaches
+ *     ao->pilot_share of the leader's predicted run (then no new kernel is started either);
+ *   - predicted work: units of the work model (ULAM_AUTO_*): walks x (steps + ULAM_AUTO_WALK +
+ *     forward tallies) + the kernel units still to build; with rel_err the walks are the rule's:
+ *     variance, range (min_walks) and variance-error terms.
+ * The pilots' walks are not used in the answer: it comes from fresh walks on base's seed
+ * (ulam_auto_solver), which the choice, a function of the pilots alone, cannot bias. */
 int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
                      ulam_auto_result *res, ulam_error *err);
+
+/* As ulam_auto_choose, and *out gets the solver to run: the chosen candidate's (or, when none is
+ * certified, the closest's) on base's options with that mode, estimator and continuation, its
+ * kernel rows, reachable set, score bounds and guards kept from the pilots, no walk made yet:
+ * iterating it gives, bit for bit, what a solver allocated with those options would (NULL with
+ * a status when none is left).  Its refusals are ulam_solver_alloc's. */
+int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                     ulam_auto_result *res, ulam_solver **out, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
 /* All tertiary. */

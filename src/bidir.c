@@ -1,15 +1,16 @@
-/* Bidirectional estimate of one entry x_t of (I - M) x = e_s: a reverse push from t, then walks
- * from s that score the push's residual.
+/* Bidirectional estimate of one entry x_t of (I - M) x = b for b = e_s or a sparse b: a reverse
+ * push from t, then walks from b's states that score the push's residual.
  *
- * The push leaves x_t = p_s + <r, x> (src/push.c), and <r, x> = r' (I - M)^-1 e_s
- * = e_s' (I - M')^-1 r is the unknown s of the system (M', r): the adjoint walk solver on M'
- * started at s with right-hand side r estimates it, unbiased, with its error bar, threads and
- * stopping rules.  r is fixed before any of those walks runs (the balance below looks only at
- * the push's work and a pilot on its own seed), so p_s + estimate is unbiased for x_t.
+ * The push leaves x_t = <p, b> + <r, x> (src/push.c), and <r, x> = r' (I - M)^-1 b
+ * = b' (I - M')^-1 r: the adjoint walk solver on M' with right-hand side r, started at s (or at
+ * b's state j with probability |b_j| / ||b||_1 and weight sign(b_j) ||b||_1, its start
+ * distribution) estimates it, unbiased, with its error bar, threads and stopping rules.  r is
+ * fixed before any of those walks runs (the balance below looks only at the push's work and a
+ * pilot on its own seed), so <p, b> + estimate is unbiased for x_t.
  *
  * Plan and balance (as BiPPR balances times, here on work counts so the result is
  * reproducible): a collision walk scores at most rmax at each of its V visits, so its variance
- * is about rmax E[V] x, and the walk solver's rel_err rule needs at least the walks of its
+ * is about ||b||_1 rmax E[V] x, and the walk solver's rel_err rule needs at least the walks of its
  * range term for scores of rmax a visit (the solver's own bounds over the states the walks
  * reach, taken from the pilot's solver); the walks needed are the largest of those and the
  * rule's floor, each costing E[V] visits.  rmax halves, pushing down to it, while the push's
@@ -46,8 +47,19 @@ static int check_opts(const ulam_csr *M, const ulam_csr *Mt, const ulam_bidir_op
                           (long long)n);
     if (o->target < 0 || o->target >= n)
         return ulam__fail(err, ULAM_EINVAL, 0, o->target, "a target from 0 to %lld", (long long)n - 1);
-    if (o->source < 0 || o->source >= n)
+    if (o->nb == 0 && (o->source < 0 || o->source >= n))
         return ulam__fail(err, ULAM_EINVAL, 0, o->source, "a source from 0 to %lld", (long long)n - 1);
+    if (o->nb < 0 || (o->nb > 0 && (!o->b_index || !o->b_value)))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "nb >= 0 entries of b with their indices and values");
+    double norm = 0.0;
+    for (int64_t j = 0; j < o->nb; j++) {
+        if (o->b_index[j] < 0 || o->b_index[j] >= n || !isfinite(o->b_value[j]))
+            return ulam__fail(err, ULAM_EINVAL, 0, j, "entries of b at states 0 to %lld with finite values",
+                              (long long)n - 1);
+        norm += fabs(o->b_value[j]);
+    }
+    if (o->nb > 0 && !(norm > 0 && isfinite(norm)))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a sparse b with a finite nonzero ||b||_1");
     if (!(o->rmax <= 0 || isfinite(o->rmax)) || !(o->min_value <= 0 || isfinite(o->min_value)) ||
         o->max_push_ops < 0 || isnan(o->rmax) || isnan(o->min_value))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a finite rmax, a finite min_value and max_push_ops >= 0");
@@ -62,13 +74,31 @@ static int check_call(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o
     return check_opts(ulam__push_matrix(w), Mt, o, err);
 }
 
-/* The walks' options: adjoint on M' from s, scoring r. */
+/* The walks' options: adjoint on M' from s (or from b's entries), scoring r. */
 static ulam_walk_opts walk_opts(const ulam_bidir_opts *o)
 {
     ulam_walk_opts wo = o->walk;
     wo.mode = ULAM_ADJOINT;
-    wo.index = o->source;
+    wo.index = o->nb > 0 ? o->b_index[0] : o->source;
+    wo.nstarts = o->nb, wo.starts = o->b_index, wo.start_weights = o->b_value;
     return wo;
+}
+
+/* <v, b> for the dense v (v_s for b = e_s). */
+static double dot_b(const double *v, const ulam_bidir_opts *o)
+{
+    if (o->nb == 0) return v[o->source];
+    double sum = 0.0;
+    for (int64_t j = 0; j < o->nb; j++) sum += o->b_value[j] * v[o->b_index[j]];
+    return sum;
+}
+
+/* ||b||_1 (1 for e_s). */
+static double norm_b(const ulam_bidir_opts *o)
+{
+    double sum = o->nb == 0 ? 1.0 : 0.0;
+    for (int64_t j = 0; j < o->nb; j++) sum += fabs(o->b_value[j]);
+    return sum;
 }
 
 /* Nonzero when a plan made for (Mt, a) is the plan of (Mt2, b): every option it read agrees. */
@@ -76,7 +106,10 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
 {
     const ulam_bidir_opts *a = &m->o;
     const ulam_walk_opts *x = &a->walk, *y = &b->walk;
-    return m->Mt == Mt && a->target == b->target && a->source == b->source && a->rmax == b->rmax &&
+    if (a->nb != b->nb || (b->nb > 0 && (memcmp(m->idx, b->b_index, (size_t)b->nb * sizeof *m->idx) ||
+                                         memcmp(m->val, b->b_value, (size_t)b->nb * sizeof *m->val))))
+        return 0;
+    return m->Mt == Mt && a->target == b->target && (b->nb > 0 || a->source == b->source) && a->rmax == b->rmax &&
            a->min_value == b->min_value && a->max_push_ops == b->max_push_ops && x->seed == y->seed &&
            x->rel_err == y->rel_err && x->max_walks == y->max_walks && x->continue_q == y->continue_q &&
            x->roulette == y->roulette && x->split == y->split && x->max_steps == y->max_steps &&
@@ -109,7 +142,7 @@ static double predicted_walks(const ulam_bidir_opts *o, const ulam_solver *pilot
     const ulam_walk_opts *wo = &o->walk;
     if (wo->rel_err <= 0 && wo->max_walks > 0) return (double)wo->max_walks;
     double E = wo->rel_err > 0 ? wo->rel_err : DEFAULT_REL_ERR;
-    double n = fmax((double)ULAM__REL_MIN, rmax * visits / (E * E * xhat));
+    double n = fmax((double)ULAM__REL_MIN, norm_b(o) * rmax * visits / (E * E * xhat));
     double range = wo->rel_err > 0 && pilot ? ulam__solver_range_walks(pilot, rmax, 0, xhat, E) : 0.0;
     if (isfinite(range)) n = fmax(n, range); /* else the rule bounds the score through its second moment, which
                                                depends on r: not predicted */
@@ -127,7 +160,7 @@ static int push(ulam_push *w, const ulam_bidir_opts *o, const ulam_solver *pl, i
     int status = ulam_push_run(w, rmax, cap); /* balanced: r = e_t, nothing to push yet */
     for (;;) {
         ulam_push_report(w, &plan->push);
-        walks = predicted_walks(o, pl, rmax, V, fmax(delta, fabs(p[o->source])));
+        walks = predicted_walks(o, pl, rmax, V, fmax(delta, fabs(dot_b(p, o))));
         if (o->rmax > 0 || status || plan->push.support == 0 || walks <= ULAM__REL_MIN ||
             (double)plan->push.ops >= walks * V * STEP_COST)
             break; /* at the floor more pushing saves no walks */
@@ -135,7 +168,7 @@ static int push(ulam_push *w, const ulam_bidir_opts *o, const ulam_solver *pl, i
         status = ulam_push_run(w, rmax, cap);
     }
     plan->rmax = rmax;
-    plan->push_part = p[o->source];
+    plan->push_part = dot_b(p, o);
     int fixed = o->walk.rel_err <= 0 && o->walk.max_walks > 0; /* walks known without V */
     plan->predicted_walks = plan->push.support == 0 ? 0.0 : o->rmax > 0 && !fixed ? NAN : walks;
     return status;
@@ -155,7 +188,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
     ulam__bidir_memo *memo = ulam__push_memo(w);
     ulam_solver *pl = NULL;
     plan->target = o->target, plan->balanced = !(o->rmax > 0), plan->mean_visits = 1.0, plan->step_cost = STEP_COST;
-    memo->have_guard = 0;
+    memo->have_guard = memo->have_seen = 0;
     if (plan->balanced && !memo->ones) {
         if (!(memo->ones = ulam__malloc((size_t)M->nrows, sizeof *memo->ones)))
             return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the pilot's scores");
@@ -173,29 +206,47 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
         plan->mean_visits = r.walks > 0 ? 1.0 + (double)r.steps / (double)r.walks : 1.0;
         ulam_solver_guard(pl, &memo->guard);
         memo->have_guard = 1;
+        const char *seen = ulam__solver_reached(pl); /* the walks' reach: the estimate's solver need not search again */
+        if (seen && (memo->seen || (memo->seen = ulam__malloc((size_t)M->nrows, 1)))) {
+            memcpy(memo->seen, seen, (size_t)M->nrows);
+            memo->have_seen = 1;
+        }
     }
     status = push(w, o, pl, cap, plan);
     ulam_solver_free(pl);
     if (status == ULAM_ENOCONV)
         return ulam__fail(err, status, 0, -1, "a push within %lld operations (is rho(|M|) < 1?)", (long long)cap);
     double pilot_visits = (double)(plan->pilot_walks + plan->pilot_steps);
-    plan->predicted_work = (double)plan->push.ops + STEP_COST * (pilot_visits + plan->predicted_walks * plan->mean_visits);
+    plan->predicted_work = plan->balanced || plan->predicted_walks == 0.0
+                               ? (double)plan->push.ops + STEP_COST * (pilot_visits + plan->predicted_walks * plan->mean_visits)
+                               : NAN; /* rmax given: no pilot measured V */
     plan->seconds = ulam_now() - t0;
+    if (o->nb > memo->cap) { /* keep b's entries: the options point at the caller's */
+        int64_t *idx = realloc(memo->idx, (size_t)o->nb * sizeof *idx);
+        if (idx) memo->idx = idx;
+        double *val = idx ? realloc(memo->val, (size_t)o->nb * sizeof *val) : NULL;
+        if (val) memo->val = val, memo->cap = o->nb;
+    }
+    if (o->nb > memo->cap) return ULAM_OK; /* no room to remember b: a solve plans again */
+    if (o->nb > 0) {
+        memcpy(memo->idx, o->b_index, (size_t)o->nb * sizeof *memo->idx);
+        memcpy(memo->val, o->b_value, (size_t)o->nb * sizeof *memo->val);
+    }
     memo->o = *o, memo->Mt = Mt, memo->plan = *plan, memo->valid = 1;
     return ULAM_OK;
 }
 
 /* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr.  The solver's
  * rel_err rule (the one of ulam_solve) applies to the whole estimate push_part + <r, x>;
- * guard: verdicts on Mt computed before (NULL: the solver computes them). */
+ * memo: the pilot's guards on Mt and the states it found the walks reach, when it has them. */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
-                const ulam_guard *guard, ulam_walk_result *wr, ulam_error *err)
+                const ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_error *err)
 {
     ulam_walk_opts wo = walk_opts(o);
     wo.rel_err_offset = push_part;
-    if (!wo.guard) wo.guard = guard;
+    if (!wo.guard && memo->have_guard) wo.guard = &memo->guard;
     ulam_solver *sv = NULL;
-    int status = ulam_solver_alloc(Mt, r, &wo, &sv, err);
+    int status = ulam__solver_alloc_reached(Mt, r, &wo, memo->have_seen ? memo->seen : NULL, &sv, err);
     if (status) return status;
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     ulam_solver_result(sv, wr);
@@ -204,7 +255,7 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     return status;
 }
 
-/* Estimate x_t of (I - M) x = e_s. */
+/* Estimate x_t of (I - M) x = b (e_s or a sparse b). */
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err)
 {
@@ -217,8 +268,7 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
     double t0 = ulam_now();
     ulam_push_report(w, &res->push);
     res->push_part = res->plan.push_part;
-    if (res->push.support > 0 && (status = walk(Mt, ulam_push_residuals(w), o, res->push_part,
-                                                memo->have_guard ? &memo->guard : NULL, &res->walks, err)))
+    if (res->push.support > 0 && (status = walk(Mt, ulam_push_residuals(w), o, res->push_part, memo, &res->walks, err)))
         return status;
     res->estimate = res->push_part + res->walks.estimate;
     res->std_error = res->walks.std_error;

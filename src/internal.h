@@ -61,71 +61,23 @@ int ulam__threads(int requested);
 /* The calling thread's number in the enclosing OpenMP team (0 outside one or without OpenMP). */
 int ulam__thread_num(void);
 
-/* Nonzero when a block whose first walk is `first` may start: not interrupted and, unless it is
- * the run's first block (which always runs, so a time limit still yields an estimate), not out
- * of time (t0: when the run started). */
-int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first);
-
-/* A block-parallel walk run as the round driver sees it: blocks of `block` walks, at most
- * `round` a round; block k runs as run(ctx, k, its first walk, its walk count, thread) and
- * leaves its result in the k-th struct of the caller's array, `size` bytes each, whose tallies
- * (tally_size bytes each) sit behind a pointer, a length and a capacity (int64) at the offsets
- * given, so results can be sent between processes.  Every block struct also holds its walks
- * and non-finite scores (int64) and its complete and nomem flags (int) at the offsets given;
- * merge(ctx, k) adds the k-th completed block to the solver's own totals; begin(ctx), when
- * given, runs before each round inside its time (the matrix solver completes its kernel
- * there); failure(ctx), when given, is a status that fails the whole run once a round ran (a
- * corrupt matrix row), or ULAM_OK. */
-typedef struct {
-    int block, round;
-    void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread);
-    size_t size, tally_size;
-    size_t off_ptr, off_len, off_cap;
-    size_t off_walks, off_nonfinite, off_complete, off_nomem;
-    void (*merge)(void *ctx, int k);
-    void (*begin)(void *ctx);
-    int (*failure)(void *ctx);
-} ulam__blocks;
-
-/* Where a walk run stands between rounds, the part of a solver the round driver keeps: walks
- * merged (the next round starts there), of them non-finite scores, when the run started (t0,
- * -1 before its first round), seconds spent in rounds, and its ending: done once a stopping
- * rule is met or the run failed (status), interrupted by o->interrupt.  Zeroed, with t0 = -1,
- * it is a run not yet started (ulam__run_reset). */
-typedef struct {
-    int64_t walks, nonfinite;
-    double t0, seconds;
-    int done, interrupted, status;
-} ulam__run;
-
-/* A run not yet started. */
-void ulam__run_reset(ulam__run *run);
-
-/* One round from walk `next` (no further than o->max_walks), shared dynamically among
- * `threads`, its *nb block results left in results[].  With o->share, every process's blocks
- * are then exchanged so all hold all of them.  *stop gets the stop flags (1: time is up,
- * 2: interrupted), or'ed over the processes.  ULAM_OK, ULAM_ENOMEM or ULAM_EIO (the exchange
- * failed; *nb is then 0). */
-int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int threads, void *ctx,
-                void *results, int *nb, int *stop);
-
-/* The step a solver's iterate takes, shared by matrix and patch walks so each stopping rule
- * but the relative error is written once: one round (ulam__round) after B->begin, then its
- * completed blocks merged in block order (B->merge; the first incomplete block, interrupted or
- * out of time, ends the run with what came before it), and run's ending updated: a failed
- * exchange, a block out of memory, B->failure or a non-finite score fail the run
- * (ULAM_ENONFINITE only when nothing else did); an interrupt, the walk budget (o->max_walks)
- * or the time limit (o->max_seconds) end it.  The solver then applies its own rel_err rule.
- * Returns run->status. */
-int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads, void *ctx, void *results,
-                     ulam__run *run);
-
-/* Nonzero when this process runs block q (always, without a share). */
-int ulam__mine(const ulam_share *sh, int64_t q);
-
 /* Restart a forward solver on right-hand side b (borrowed) with seed: the kernel is kept,
  * tallies, counts and stopping state are reset (src/solve.c; used by the outer iterations). */
 int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_error *err);
+
+/* Walk again with options o that differ from the solver's only in the estimator, the seed, the
+ * stopping rules (max_walks, rel_err, max_seconds), interrupt, share, force, assume_finite and
+ * rel_err_offset (else ULAM_EINVAL): the kernel rows built (rescored for a new estimator), the
+ * reachable set, the score bounds met before, the guards and the workspace are kept; every tally,
+ * count and stopping state is reset, so the walks that follow are those of a solver allocated with
+ * o, bit for bit (src/solve.c; used by the method choice, src/auto.c).  Refusals as
+ * ulam_solver_alloc's. */
+int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *o, ulam_error *err);
+
+/* The deterministic set-up work of a solver so far: kernel units built (*units, 16 bytes each: a
+ * row's nonzeros + 3) and matrix entries read by reachability checks and score-bound passes
+ * (*reads). */
+void ulam__solver_setup(const ulam_solver *s, int64_t *units, int64_t *reads);
 
 /* Nonzero when [lower, upper] decides a radius' verdict and its warning: wholly below 0.99,
  * wholly at or above 1, or wholly in [0.99, 1) (src/spectral.c; the guards use it). */
@@ -151,6 +103,15 @@ int ulam__guard_fourth(const ulam_csr *K, double continue_q, double alpha, const
  * reachability bounds of a solver made with rel_err > 0 and b = 1 (src/solve.c; INFINITY
  * without a bound). */
 double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E);
+
+/* As ulam_solver_alloc, with seen (n flags, borrowed until the solver is freed) the states walks
+ * can reach, as an earlier solver on the same M, start states and continuation found them
+ * (ulam__solver_reached): its rows were checked then, and the search is not made again. */
+int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
+                               ulam_solver **out, ulam_error *err);
+
+/* The states a solver's walks can reach (n flags; NULL unless its reachability check ran). */
+const char *ulam__solver_reached(const ulam_solver *s);
 
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)

@@ -214,6 +214,25 @@ static void fail(ulam_kernel *k, int status, int64_t i)
     if (atomic_compare_exchange_strong(&k->status, &ok, status)) atomic_store(&k->bad, i);
 }
 
+/* Rescore every built row for another estimator. */
+int ulam__kernel_rescore(ulam_kernel *k, int estimator)
+{
+    int status = atomic_load(&k->status);
+    if (status) return status;
+    k->scores.estimator = estimator;
+    for (int64_t i = 0; i < k->n; i++) {
+        int32_t v = atomic_load_explicit(&k->where[i], memory_order_relaxed);
+        if (v <= 0 || v - 1 >= k->cap) continue; /* not built (or the dead row) */
+        ulam__row *h = ulam__kernel_row(k, v - 1);
+        row_scores(k, i, 1.0 - ulam__continuation(row_sum(k->K, i), k->continue_q), &h->visit, &h->end);
+        if (!isfinite(h->visit) || !isfinite(h->end)) {
+            fail(k, ULAM_ENONFINITE, i);
+            return ULAM_ENONFINITE;
+        }
+    }
+    return ULAM_OK;
+}
+
 /* Nonzero when row i's range in rowptr lies within K's entries (a prepared file is trusted no
  * further than its header). */
 static int range_ok(const ulam_csr *K, int64_t i)
@@ -384,7 +403,8 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
         }
     atomic_store(&k->top, u);
     atomic_store(&k->built, k->n);
-#pragma omp parallel for schedule(static, 4096) num_threads(threads)
+    /* static chunks of 4096 rows: a kernel of fewer rows is one thread's work, so no team */
+#pragma omp parallel for schedule(static, 4096) num_threads(threads) if (k->n > 4096)
     for (int64_t i = 0; i < k->n; i++) {
         int64_t at = atomic_load_explicit(&k->where[i], memory_order_relaxed) - 1;
         prefetch_targets(k, i + 16);

@@ -111,6 +111,11 @@ int32_t ulam__kernel_resolve(ulam_kernel *k, ulam__slot *s, uint64_t frac, int32
  * by row at first visits (random reads). */
 void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w);
 
+/* Rewrite the scores (visit, end) of every built row for estimator `estimator` (the moves and
+ * factors do not depend on it), while no walk runs; ULAM_OK, the kernel's failure, or
+ * ULAM_ENONFINITE when a new score is not finite (the kernel is then failed). */
+int ulam__kernel_rescore(ulam_kernel *k, int estimator);
+
 /* The continuation probability q_i of row i of K. */
 double ulam__kernel_q(const ulam_csr *K, int64_t i, double continue_q);
 

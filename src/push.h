@@ -22,6 +22,8 @@ typedef struct {
     ulam_guard guard; /* the pilot's guards on Mt, for the walks (have_guard 0: none) */
     int have_guard;
     double *ones; /* n ones (NULL until a pilot needs them): the pilot's scores */
+    char *seen;   /* n flags: the states the pilot found its walks can reach (have_seen 0: none) */
+    int have_seen;
 } ulam__bidir_memo;
 
 /* The workspace's memo (owned by it, freed with it). */

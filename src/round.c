@@ -3,7 +3,7 @@
  * results every process then holds in block order (so any thread or rank count gives the same
  * totals); and the after-round step both solvers take (ulam__round_step: merge in block order,
  * failures, interrupt, budget and time), so those stopping rules are written once. */
-#include "internal.h"
+#include "round.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -139,7 +139,8 @@ int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64
     int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX, done = next / B->block;
     int round = done + 1 < B->round ? (int)(done + 1) : B->round, n = 0;
     while (n < round && left > (int64_t)n * B->block) n++;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    int team = threads < n ? threads : n; /* a round of one block runs on the calling thread */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(team) if (team > 1)
     for (int k = 0; k < n; k++) {
         int64_t rest = left - (int64_t)k * B->block;
         B->run(ctx, k, next + (int64_t)k * B->block, rest < B->block ? rest : B->block, ulam__thread_num());
@@ -198,4 +199,20 @@ int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads
     if (run->status) run->done = 1;
     if (budget_spent(o, stop, run->walks)) run->done = 1;
     return run->status;
+}
+
+/* The budgets both solvers check first. */
+int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err)
+{
+    if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
+    if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a stopping rule: walks, rel_err or time");
+    return ULAM_OK;
+}
+
+/* The walk cap: ULAM_REL_ERR_CAP with rel_err alone, else max_walks. */
+int64_t ulam__walk_cap(const ulam_walk_opts *o)
+{
+    return o->rel_err > 0 && o->max_walks == 0 && o->max_seconds == 0 ? ULAM_REL_ERR_CAP : o->max_walks;
 }

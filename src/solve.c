@@ -6,6 +6,7 @@
  * (Chan's formula for the adjoint score, per-state sums for forward tallies), so the result is
  * bit-for-bit the same for any number of threads.  Stopping rules are checked between rounds; an interrupt or the time limit
  * also stops blocks that have not started. */
+#include "round.h"
 #include "stats.h"
 #include "walk.h"
 
@@ -32,6 +33,10 @@ struct ulam_solver {
     const double *b; /* the caller's, borrowed like M */
     ulam_csr *mt;
     ulam__slot *src;
+    ulam__slot *start_src; /* adjoint with nstarts: the start distribution (walker.start_*) */
+    int32_t *start_units;
+    double *start_b;
+    const char *given_seen; /* the same computed by an earlier solver (ulam__solver_alloc_reached) */
     int threads;
     ulam__scratch *scratch; /* one per thread */
     ulam__kscratch *ks;     /* one per thread: room to build a kernel row */
@@ -54,6 +59,20 @@ struct ulam_solver {
     ulam_power rho4;       /* rho(M4) of the walk kernel ([0, INFINITY] until computed) */
     int rho4_done;         /* rho4 computed */
     int fourth;            /* the fourth moment: 1 finite, 0 infinite, -1 unknown (take_fourth) */
+    char *seen;            /* the states walks can reach (kept for a rerun; NULL until needed) */
+    double *fac;           /* kernel exponent != 1: each move's weight factor over them (kept) */
+    int64_t reach_nnz;     /* entries of M over the reachable rows (0 until computed) */
+    int64_t setup_work;    /* entries read by reachability checks and score-bound passes so far */
+    int passed;            /* the bounds pass over the reachable rows is done (kept for a rerun): */
+    struct {
+        double vmax, gmax, g2max; /* the largest |score| of one visit, of a single score, of g^2 / p* */
+        int64_t bad;              /* absorption: a reachable scoring state with p* = 0 (-1: none) */
+    } pass[3];             /* per estimator */
+    double pass_w0, pass_W, pass_qmax; /* the start weight, the weight bound, the largest q */
+    int pass_signs;
+    int tail_done, v2_done[3]; /* length_tail's and second_moment's results kept: */
+    double tail_uc, tail_kc, v2c[3];
+    const ulam_csr *M;     /* borrowed */
     ulam__run run;      /* walks, time, ending (round.c) */
     int64_t steps, cut;
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
@@ -72,7 +91,8 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
 {
     if (!s) return NULL;
     ulam__kernel_free(s->k);
-    free(s->src), free(s->sum), free(s->sumsq);
+    free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac);
+    free(s->start_src), free(s->start_units), free(s->start_b);
     ulam_csr_free(s->mt);
     if (s->scratch)
         for (int t = 0; t < s->threads; t++) {
@@ -100,6 +120,18 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision, absorption or expected");
     if (o->index < 0 || o->index >= M->nrows)
         return ulam__fail(err, ULAM_EINVAL, 0, o->index, "an index from 0 to %lld", (long long)M->nrows - 1);
+    if (o->nstarts < 0 || (o->nstarts > 0 && (o->mode != ULAM_ADJOINT || !o->starts || !o->start_weights ||
+                                              o->nstarts > INT32_MAX)))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "start states and weights in adjoint mode");
+    double S = 0.0;
+    for (int64_t j = 0; j < o->nstarts; j++) {
+        if (o->starts[j] < 0 || o->starts[j] >= M->nrows || !isfinite(o->start_weights[j]))
+            return ulam__fail(err, ULAM_EINVAL, 0, j, "start states from 0 to %lld with finite weights",
+                              (long long)M->nrows - 1);
+        S += fabs(o->start_weights[j]);
+    }
+    if (o->nstarts > 0 && !(S > 0 && isfinite(S)))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "start weights with a finite nonzero sum of |weights|");
     if (o->continue_q > 0 && !(o->continue_q < 1))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a continuation probability below 1");
     if (!(o->kernel_alpha >= 0) || !isfinite(o->kernel_alpha))
@@ -107,11 +139,19 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
                           o->kernel_alpha);
     if (o->roulette < 0 || o->split < 0 || (o->split > 0 && o->roulette > 0 && o->split <= o->roulette))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "0 < roulette W < split W (or either off)");
-    if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
-    if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a stopping rule: walks, rel_err or time");
-    return ULAM_OK;
+    return ulam__budgets_check(o, err);
+}
+
+/* The size of a walk's start weight: 1 adjoint (the sum of |start weights| with a start
+ * distribution), ||b||_1 forward. */
+static double start_weight(const ulam_walk_opts *o, const double *b, int64_t n)
+{
+    double w0 = 0.0;
+    if (o->mode == ULAM_FORWARD)
+        for (int64_t i = 0; i < n; i++) w0 += fabs(b[i]);
+    else
+        for (int64_t j = 0; j < o->nstarts; j++) w0 += fabs(o->start_weights[j]);
+    return o->mode == ULAM_ADJOINT && o->nstarts == 0 ? 1.0 : w0;
 }
 
 /* Refuse a split weight below the start weight (1 adjoint, ||b||_1 forward): every walk would
@@ -120,8 +160,7 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
 static int check_split(const ulam_csr *M, const double *b, const ulam_walk_opts *o, ulam_error *err)
 {
     if (!(o->split > 0)) return ULAM_OK;
-    double w0 = o->mode == ULAM_ADJOINT ? 1.0 : 0.0;
-    for (int64_t i = 0; o->mode == ULAM_FORWARD && i < M->nrows; i++) w0 += fabs(b[i]);
+    double w0 = start_weight(o, b, M->nrows);
     if (o->split >= w0) return ULAM_OK;
     return ulam__fail(err, ULAM_EINVAL, 0, -1,
                       "a split weight of at least the start weight %.6g (%s), not %g: below it every walk splits "
@@ -176,7 +215,7 @@ static double weight_growth(const ulam_csr *K, double continue_q, const double *
  * (no certificate) when none is below 1 or memory runs out.  second: the same for the
  * walk's second-moment matrix M^ = diag(S / q) |K| (E[w_k^2] = w0^2 (M^^k 1)_i, no roulette). */
 static void length_tail(const ulam_csr *K, const char *seen, double continue_q, int second, double floor,
-                        double *u, double *kappa)
+                        double *u, double *kappa, int *iterations)
 {
     enum { ITER = 300 };
     int64_t n = K->nrows;
@@ -193,6 +232,7 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
             ratio = fmax(ratio, t / v[i]), ymax = fmax(ymax, t + v[i]);
             vmin = fmin(vmin, v[i]), vmax = fmax(vmax, v[i]);
         }
+        ++*iterations;
         if (ratio < *u) *u = ratio, *kappa = vmax / vmin;
         else if (*u < 1.0 && ratio >= *u * (1.0 - 1e-6)) break; /* no longer improving */
         if (!(ymax > 0)) break;
@@ -211,14 +251,17 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
  * walk: w0^2 c z_start / (1 - u)).  z: iterates of I + M^ from g (so it fits the states that
  * score), floored at a few shares of its largest entry, the best bound kept; INFINITY when none
  * has u < 1.  At kernel exponent != 1, M^_ij = |K_ij| fac_ij, fac the moves' own factors. */
-static double second_moment(const ulam_solver *s, const ulam_csr *K, const double *fac, const char *seen, double w0)
+static double second_moment(const ulam_solver *s, const ulam_csr *K, const double *fac, const char *seen, double w0,
+                            int *iterations)
 {
     enum { ITER = 300 };
     int64_t n = K->nrows;
     int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION;
     double *g = ulam__malloc((size_t)n, sizeof *g), *v = ulam__malloc((size_t)n, sizeof *v);
     double *y = ulam__malloc((size_t)n, sizeof *y), *f = ulam__malloc((size_t)n, sizeof *f), best = INFINITY;
-    double b0 = adj && s->o.estimator == ULAM_EXPECTED ? fabs(s->b[s->o.index]) : 0.0, gmax = 0.0;
+    double b0 = 0.0, gmax = 0.0;
+    for (int64_t j = 0; adj && s->o.estimator == ULAM_EXPECTED && j < (s->o.nstarts ? s->o.nstarts : 1); j++)
+        b0 = fmax(b0, fabs(s->b[s->o.nstarts ? s->o.starts[j] : s->o.index]));
     for (int64_t i = 0; g && v && y && f && i < n; i++) {
         g[i] = 0.0;
         if (!seen[i]) continue;
@@ -235,6 +278,7 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const doubl
         for (int64_t i = 0; i < n; i++) v[i] = seen[i] ? fmax(g[i] / gmax, floors[fl]) : 1.0;
         for (int it = 0, last = 0; it < ITER && it - last < 30; it++) { /* until 30 iterations bring nothing */
             double u = 0.0, c = 0.0, z0 = 0.0, ymax = 0.0;
+            ++*iterations;
             for (int64_t i = 0; i < n; i++) {
                 if (!seen[i]) continue;
                 double t = 0.0;
@@ -242,8 +286,9 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const doubl
                     t += fabs(K->val[k]) * (fac ? fac[k] : 1.0) * v[K->colidx[k]];
                 y[i] = fac ? t : t * f[i];
                 u = fmax(u, y[i] / v[i]), c = fmax(c, g[i] / v[i]), ymax = fmax(ymax, y[i] + v[i]);
-                z0 += adj ? (i == s->o.index ? v[i] : 0.0) : fabs(s->b[i]) / w0 * v[i];
+                z0 += adj ? (i == s->o.index && !s->o.nstarts ? v[i] : 0.0) : fabs(s->b[i]) / w0 * v[i];
             }
+            for (int64_t j = 0; adj && j < s->o.nstarts; j++) z0 += fabs(s->o.start_weights[j]) / w0 * v[s->o.starts[j]];
             if (u < 1.0) {
                 double d = absorb ? 1.0 - u : (1.0 - sqrt(u)) * (1.0 - sqrt(u)), bound = w0 * w0 * c * z0 / d;
                 if (bound < best * (1.0 - 1e-3)) last = it;
@@ -273,36 +318,45 @@ static double *move_factors(const ulam_csr *K, const char *seen, double continue
     return f;
 }
 
-/* Over the states walks can reach (seen): absorption's p* > 0 wherever it scores (else
- * ULAM_EUNDEFINED naming the state), and the bound on a single score and the scores' range
- * (s->bound, s->range): 0 when nothing that scores is reachable; for absorption W |g_i| / p*_i,
- * W the weight bound (the start weight, or the roulette weight when larger, times the
- * largest product of factors S / q along a path, weight_growth; unbounded with splitting);
- * the per-visit score and continuation tail for collision and expected (s->per_step, s->qmax,
- * and past qmax = 1 the certificate of length_tail). */
-static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
+/* The states walks can reach (s->seen, computed once and kept) and their entries (s->reach_nnz). */
+static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
+    if (s->seen) return ULAM_OK;
     char *seen = ulam__calloc((size_t)s->n, 1);
     if (!seen) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
-    if (s->o.mode == ULAM_ADJOINT) seen[s->o.index] = 1;
-    else
+    if (s->o.mode == ULAM_ADJOINT && !s->o.nstarts) seen[s->o.index] = 1;
+    for (int64_t j = 0; s->o.mode == ULAM_ADJOINT && j < s->o.nstarts; j++) seen[s->o.starts[j]] = 1;
+    if (s->o.mode == ULAM_FORWARD)
         for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
-    int status = ulam__kernel_reach(K, s->o.continue_q, seen);
+    /* an earlier solver's search (ulam__solver_alloc_reached) is copied, not repeated */
+    int status = s->given_seen ? (memcpy(seen, s->given_seen, (size_t)s->n), ULAM_OK)
+                               : ulam__kernel_reach(K, s->o.continue_q, seen);
     if (status) {
         free(seen);
         return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for a reachability check")
                                      : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, "
                                                   "nonzero values (the matrix is corrupt)");
     }
-    double *fac = NULL; /* kernel exponent != 1: each move's own weight factor */
-    if (s->o.kernel_alpha != 1.0 && !(fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha))) {
-        free(seen);
+    s->seen = seen;
+    s->reach_nnz = 0;
+    for (int64_t i = 0; i < s->n; i++)
+        if (seen[i]) s->reach_nnz += K->rowptr[i + 1] - K->rowptr[i];
+    s->setup_work += s->reach_nnz;
+    return ULAM_OK;
+}
+
+/* The one pass over the reachable rows that every estimator's score bounds come from (kept):
+ * for each estimator the largest visit score, single score and g^2 / p*, and absorption's first
+ * scoring state with p* = 0; the weight bound and the scores' signs. */
+static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
+{
+    const char *seen = s->seen;
+    double *fac = NULL; /* kernel exponent != 1: each move's own weight factor (kept: s->fac) */
+    if (s->o.kernel_alpha != 1.0 && !(fac = s->fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
-    }
-    int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = 0;
+    int adj = s->o.mode == ULAM_ADJOINT, pos = 0, neg = 0, any = 0;
     int64_t bad = -1;
-    int expected = s->o.estimator == ULAM_EXPECTED;
-    double w0 = 1.0, fbig = 0.0, gmax = 0.0, g2max = 0.0, vmax = 0.0, qmax = 0.0;
+    double w0 = 1.0, fbig = 0.0, gabs = 0.0, g2abs = 0.0, vb = 0.0, vexp = 0.0, qmax = 0.0;
     for (int64_t i = 0; i < s->n; i++) {
         if (!seen[i]) continue;
         double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
@@ -311,48 +365,82 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
             neg |= K->val[k] < 0;
             if (fac) fbig = fmax(fbig, fac[k]);
-            if (adj && expected) c += K->val[k] * s->b[K->colidx[k]];
+            if (adj) c += K->val[k] * s->b[K->colidx[k]];
         }
-        if (absorb && (adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
+        if ((adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
         /* what one visit scores: b_i (collision), (M b)_i (expected), forward 1 at the index */
-        double v = adj ? fabs(expected ? c : s->b[i]) : i == s->o.index ? (expected ? INFINITY : 1.0) : 0.0;
-        vmax = fmax(vmax, v);
+        vb = fmax(vb, adj ? fabs(s->b[i]) : i == s->o.index ? 1.0 : 0.0);
+        vexp = fmax(vexp, adj ? fabs(c) : i == s->o.index ? INFINITY : 0.0);
         int scores = adj ? s->b[i] != 0.0 : i == s->o.index;
         if (!scores) continue;
         double g = adj ? fabs(s->b[i]) : 1.0;
-        gmax = fmax(gmax, absorb ? (q < 1.0 ? g / (1.0 - q) : INFINITY) : INFINITY);
-        g2max = fmax(g2max, absorb && q < 1.0 ? g * g / (1.0 - q) : INFINITY);
+        any = 1;
+        gabs = fmax(gabs, q < 1.0 ? g / (1.0 - q) : INFINITY);
+        g2abs = fmax(g2abs, q < 1.0 ? g * g / (1.0 - q) : INFINITY);
         if (adj) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
     }
     if (!adj)
         for (int64_t i = 0; i < s->n; i++) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
+    for (int64_t j = 0; adj && j < s->o.nstarts; j++) /* signed start weights (conservative: both may show) */
+        pos |= s->o.start_weights[j] > 0, neg |= s->o.start_weights[j] < 0;
     double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
-    if (!adj) {
-        w0 = 0.0;
-        for (int64_t i = 0; i < s->n; i++) w0 += fabs(s->b[i]);
+    w0 = start_weight(&s->o, s->b, s->n);
+    for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++) {
+        int absorb = e == ULAM_ABSORPTION;
+        s->pass[e].vmax = e == ULAM_EXPECTED ? vexp : vb;
+        s->pass[e].gmax = absorb ? gabs : any ? INFINITY : 0.0;
+        s->pass[e].g2max = absorb ? g2abs : any ? INFINITY : 0.0;
+        s->pass[e].bad = absorb ? bad : -1;
     }
-    double Wmax = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
-    s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
-    if (s->o.rel_err > 0 && vmax > 0 && (!(qmax < 1.0) || !isfinite(Wmax)))
-        length_tail(K, seen, s->o.continue_q, 0, 1e-30, &s->tail_u, &s->kappa); /* kappa enters by its log */
-    if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
-        (absorb ? isfinite(g2max) : isfinite(vmax))) {
-        s->v2 = second_moment(s, K, fac, seen, w0);
-    }
-    free(seen), free(fac);
-    if (bad >= 0)
-        return ulam__fail(err, ULAM_EUNDEFINED, 0, bad,
+    s->pass_w0 = w0;
+    s->pass_W = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
+    s->pass_qmax = qmax;
+    s->pass_signs = pos && neg;
+    s->passed = 1;
+    s->setup_work += s->reach_nnz;
+    return ULAM_OK;
+}
+
+/* Over the states walks can reach: absorption's p* > 0 wherever it scores (else ULAM_EUNDEFINED
+ * naming the state), and the bound on a single score and the scores' range (s->bound, s->range):
+ * 0 when nothing that scores is reachable; for absorption W |g_i| / p*_i, W the weight bound
+ * (the start weight, or the roulette weight when larger, times the largest product of factors
+ * S / q along a path, weight_growth; unbounded with splitting); the per-visit score and
+ * continuation tail for collision and expected (s->per_step, s->qmax, and past qmax = 1 the
+ * certificate of length_tail).  The reachable set, the pass and the certificates are kept, so a
+ * rerun with another estimator reads M again only for what it has not computed. */
+static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
+{
+    int status = reach(s, K, err);
+    if (status) return status;
+    if (!s->passed && (status = bounds_pass(s, K, err))) return status;
+    int e = s->o.estimator, absorb = e == ULAM_ABSORPTION, adj = s->o.mode == ULAM_ADJOINT, it = 0;
+    double vmax = s->pass[e].vmax, Wmax = s->pass_W, w0 = s->pass_w0;
+    if (s->pass[e].bad >= 0)
+        return ulam__fail(err, ULAM_EUNDEFINED, 0, s->pass[e].bad,
                           "p* > 0 wherever the absorption estimator scores; state %lld (1-based) is "
                           "reachable and never terminates (its row sum of |%s| is >= 1): use the "
                           "collision estimator or --continue Q",
-                          (long long)bad + 1, adj ? "M" : "M' (column of M)");
-    double W = Wmax;
+                          (long long)s->pass[e].bad + 1, adj ? "M" : "M' (column of M)");
+    s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
+    if (s->o.rel_err > 0 && vmax > 0 && (!(s->pass_qmax < 1.0) || !isfinite(Wmax))) {
+        if (!s->tail_done) /* kappa enters by its log */
+            length_tail(K, s->seen, s->o.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
+        s->tail_u = s->tail_uc, s->kappa = s->tail_kc;
+    }
+    if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
+        (absorb ? isfinite(s->pass[e].g2max) : isfinite(vmax))) {
+        if (!s->v2_done[e]) s->v2c[e] = second_moment(s, K, s->fac, s->seen, w0, &it), s->v2_done[e] = 1;
+        s->v2 = s->v2c[e];
+    }
+    s->setup_work += (int64_t)it * s->reach_nnz;
+    double W = Wmax, gmax = s->pass[e].gmax;
     s->weight = W;
-    s->signs = pos && neg;
+    s->signs = s->pass_signs;
     s->bound = gmax > 0 ? W * gmax : 0.0;
     s->range = s->bound * (s->signs ? 2.0 : 1.0);
     s->per_step = vmax > 0 ? W * vmax : 0.0;
-    s->qmax = qmax;
+    s->qmax = s->pass_qmax;
     return ULAM_OK;
 }
 
@@ -409,15 +497,16 @@ static int take_fourth(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     return ULAM_OK;
 }
 
-/* Refuse a rel_err target (asked alone: the caller checks) whose score has no bound and no
- * certified finite fourth moment: the rule's check on the variance's own relative error
- * trusts a sample fourth moment, which then errs low (tests/test_kernel.c: the variance's
- * spread over seeds 1.7 times what the runs report), and nothing else would end the run.
+/* Refuse a rel_err target (asked alone: the caller checks) whose score has no bound, no
+ * certified finite fourth moment and no certified second moment: the rule's check on the
+ * variance's own relative error trusts a sample fourth moment, which then errs low
+ * (tests/test_kernel.c: the variance's spread over seeds 1.7 times what the runs report), and
+ * nothing else would end the run (with v2 the rule stands on v2 and skips that check).
  * The message names a mode or exponent 1 whose rho(M4) is below 1 when one is. */
 static int check_fourth(const ulam_csr *M, const ulam_solver *s, ulam_error *err)
 {
     const ulam_walk_opts *o = &s->o;
-    if (s->fourth == 1 || !(o->rel_err > 0)) return ULAM_OK;
+    if (s->fourth == 1 || isfinite(s->v2) || !(o->rel_err > 0)) return ULAM_OK; /* v2: the rule stands on it */
     char also[96] = "; no other mode or alpha 1 has it below 1";
     ulam_csr *T = NULL;
     if (!ulam_csr_transpose(M, &T)) {
@@ -440,6 +529,20 @@ static int check_fourth(const ulam_csr *M, const ulam_solver *s, ulam_error *err
                       isfinite(s->weight) ? "no certified length tail" : "weights grow on cycles",
                       o->mode == ULAM_ADJOINT ? "adjoint" : "forward", o->kernel_alpha, s->rho4.lower, s->rho4.upper,
                       s->fourth == 0 ? ">= 1: infinite" : "straddles 1: unknown", also);
+}
+
+/* The score bounds of this run's estimator (check_reach, when absorption or a rel_err target needs
+ * them), and with rel_err alone the refusal of a
+ * target no bound certifies (check_bounded). */
+static int take_bounds(ulam_solver *s, const ulam_csr *K, int rel_alone, ulam_error *err)
+{
+    s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = s->weight = INFINITY;
+    s->qmax = s->tail_u = 1.0;
+    s->signs = 0;
+    int status = s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0 ? check_reach(s, K, err) : ULAM_OK;
+    if (!status) status = take_fourth(s, K, err);
+    if (!status && rel_alone) status = check_bounded(s, err);
+    return !status && rel_alone ? check_fourth(s->M, s, err) : status;
 }
 
 /* The guards' verdicts for this run: opts->guard when it holds them, else computed (rho(|M|)
@@ -515,6 +618,35 @@ static int build_source(ulam_solver *s, double *bnorm1)
     return status;
 }
 
+/* The adjoint start distribution |c_j| / ||c||_1 over the nstarts start states as an alias table,
+ * their rows' units and (expected estimator) their b. */
+static int build_starts(ulam_solver *s)
+{
+    int64_t k = s->o.nstarts;
+    double *p = ulam__malloc((size_t)k, sizeof *p), *scaled = ulam__malloc((size_t)k, sizeof *scaled);
+    int32_t *out = ulam__malloc((size_t)k, sizeof *out);
+    int64_t *small = ulam__malloc((size_t)k, sizeof *small), *large = ulam__malloc((size_t)k, sizeof *large);
+    s->start_src = ulam__malloc((size_t)k, sizeof *s->start_src);
+    s->start_units = ulam__malloc((size_t)k, sizeof *s->start_units);
+    s->start_b = ulam__malloc((size_t)k, sizeof *s->start_b);
+    int status = ULAM_ENOMEM;
+    if (p && scaled && out && small && large && s->start_src && s->start_units && s->start_b) {
+        double norm = start_weight(&s->o, s->b, s->n);
+        for (int64_t j = 0; j < k; j++) {
+            p[j] = fabs(s->o.start_weights[j]) / norm;
+            out[j] = s->o.start_weights[j] < 0 ? ~(int32_t)j : (int32_t)j;
+            s->start_units[j] = ulam__kernel_unit(s->k, s->o.starts[j], &s->ks[0]);
+            s->start_b[j] = s->o.estimator == ULAM_EXPECTED ? s->b[s->o.starts[j]] : 0.0;
+        }
+        ulam__alias_build(p, out, k, s->start_src, scaled, small, large);
+        s->w.nstarts = k, s->w.start_src = s->start_src, s->w.start_units = s->start_units;
+        s->w.start_b = s->start_b, s->w.start_norm = norm;
+        status = ULAM_OK;
+    }
+    free(p), free(scaled), free(out), free(small), free(large);
+    return status;
+}
+
 /* Allocate per-thread scratch and per-block results. */
 static int alloc_work(ulam_solver *s)
 {
@@ -565,9 +697,9 @@ static int kernel_failure(const ulam_kernel *k, ulam_error *err)
                       "finite, nonzero values and score (the matrix is corrupt)", (long long)i + 1);
 }
 
-/* Prepare walks on (I - M) x = b. */
-int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-                      ulam_solver **out, ulam_error *err)
+/* Prepare walks on (I - M) x = b; seen: the states they can reach, computed before (NULL: search). */
+static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
+                        ulam_solver **out, ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !b || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
@@ -582,11 +714,13 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     s->o = o;
     s->b = b;
     s->n = M->nrows;
+    s->given_seen = seen;
+    s->M = M;
     if ((status = take_guard(M, &o, &s->g, err)) || (status = check_verdicts(M, s, err))) {
         ulam_solver_free(s);
         return status;
     }
-    if (o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0) s->o.max_walks = ULAM_REL_ERR_CAP;
+    s->o.max_walks = ulam__walk_cap(&o);
     s->threads = ulam__threads(o.threads);
     const ulam_csr *K = M;
     if (o.mode == ULAM_FORWARD) {
@@ -599,14 +733,8 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
-    s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = s->weight = INFINITY;
     s->rho4 = (ulam_power){.rho = NAN, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
-    s->qmax = s->tail_u = 1.0;
-    if ((o.estimator == ULAM_ABSORPTION || o.rel_err > 0) && (status = check_reach(s, K, err))) {
-        ulam_solver_free(s);
-        return status;
-    }
-    if (o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0 && (status = check_bounded(s, err))) {
+    if ((status = take_bounds(s, K, o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0, err))) {
         ulam_solver_free(s);
         return status;
     }
@@ -622,6 +750,7 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
                           .max_steps = o.max_steps, .interrupt = o.interrupt,
                           .lanes = s->k->cap * (int64_t)sizeof(ulam__slot) <= CACHED ? 16 : 32};
     if (o.mode == ULAM_ADJOINT) s->w.start = ulam__kernel_unit(s->k, o.index, &s->ks[0]);
+    if (o.nstarts > 0 && build_starts(s)) goto nomem;
     if (o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED) s->w.score0 = s->b[o.index];
     if (o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED) s->w.expected = 1;
     s->w.watch = o.mode == ULAM_FORWARD ? o.index : -1;
@@ -635,6 +764,26 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
 nomem:
     ulam_solver_free(s);
     return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walk kernel and workspace");
+}
+
+/* Prepare walks on (I - M) x = b. */
+int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                      ulam_solver **out, ulam_error *err)
+{
+    return solver_alloc(M, b, opts, NULL, out, err);
+}
+
+/* As ulam_solver_alloc with the reachable states seen (borrowed). */
+int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
+                               ulam_solver **out, ulam_error *err)
+{
+    return solver_alloc(M, b, opts, seen, out, err);
+}
+
+/* The states the solver's walks can reach (NULL unless its reachability check ran). */
+const char *ulam__solver_reached(const ulam_solver *s)
+{
+    return s->given_seen ? s->given_seen : s->seen;
 }
 
 /* Run walks [first, first + count) as block q on thread t (ctx: the solver). */
@@ -698,12 +847,17 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
     double E = s->o.rel_err, m = fabs(r->estimate + s->o.rel_err_offset);
     if (!(E > 0) || s->var_finite != 1 || r->walks < ULAM__REL_MIN) return 0;
     if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
-    if (s->fourth != 1) return 0; /* variance_rel_error is not to be trusted */
+    /* The fourth moment not certified finite: variance_rel_error errs low, so the rule does not
+     * use it and stands on the certified second moment v2 alone (its range term asks for
+     * 12.28 v2 / (E m)^2 walks, which bounds the true standard error by 0.29 E |m|); without
+     * v2 it is never met. */
+    if (s->fourth != 1 && !isfinite(s->v2)) return 0;
     if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.index] == 0))
         return 0;
     if (!isfinite(r->tail_bound)) return 0; /* no bound on a single score: no certificate */
     if (!(r->cut_bound <= ULAM__CUT_SHARE * E * m)) return 0;
-    return ulam__rel_err_holds(r->walks, m, r->std_error, r->min_walks, r->variance_rel_error, E);
+    return ulam__rel_err_holds(r->walks, m, r->std_error, r->min_walks, s->fourth == 1 ? r->variance_rel_error : 0.0,
+                               E);
 }
 
 /* Run one round of walks. */
@@ -889,6 +1043,18 @@ int ulam_solver_error(const ulam_solver *s, ulam_error *err)
     }
 }
 
+/* Reset every tally, count and stopping state (the kernel, the bounds and the workspace stay). */
+static void reset(ulam_solver *s)
+{
+    if (s->sum) memset(s->sum, 0, (size_t)s->n * sizeof *s->sum);
+    if (s->sumsq) memset(s->sumsq, 0, (size_t)s->n * sizeof *s->sumsq);
+    s->adj = s->watched = (ulam__moments){0};
+    s->steps = s->cut = 0;
+    s->maxsq = 0.0;
+    ulam__run_reset(&s->run);
+    s->met = s->cut_stop = s->out_of_reach = 0;
+}
+
 /* Restart a forward solver on a new right-hand side b (borrowed like the first) with a new
  * seed: the kernel and workspace are kept (the kernel of a forward walk does not depend on b),
  * the source table is rebuilt and every tally, count and stopping state is reset. */
@@ -902,6 +1068,10 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     s->o.seed = seed;
     double bnorm1 = 0.0;
     if (build_source(s, &bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");
+    free(s->seen), free(s->fac); /* the reachable set and the score bounds depend on b */
+    s->seen = NULL, s->fac = NULL;
+    s->passed = s->tail_done = 0;
+    memset(s->v2_done, 0, sizeof s->v2_done);
     if (s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0) {
         int status = check_reach(s, s->mt, err); /* the score bounds depend on b */
         if (!status) status = take_fourth(s, s->mt, err); /* and so may whether they are bounded */
@@ -909,12 +1079,45 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     }
     s->w.src = s->src;
     s->w.bnorm1 = bnorm1;
-    memset(s->sum, 0, (size_t)s->n * sizeof *s->sum);
-    memset(s->sumsq, 0, (size_t)s->n * sizeof *s->sumsq);
-    s->adj = s->watched = (ulam__moments){0};
-    s->steps = s->cut = 0;
-    s->maxsq = 0.0;
-    ulam__run_reset(&s->run);
-    s->met = s->cut_stop = s->out_of_reach = 0;
+    reset(s);
     return ULAM_OK;
+}
+
+/* Walk again with options o that differ from the solver's only in the estimator, the seed, the
+ * stopping rules, interrupt, share, force, assume_finite and rel_err_offset. */
+int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s || !opts) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a solver and options");
+    ulam_walk_opts o = *opts;
+    double q0 = s->o.continue_q > 0 ? s->o.continue_q : 0.0, q1 = o.continue_q > 0 ? o.continue_q : 0.0;
+    if (o.mode != s->o.mode || o.index != s->o.index || q0 != q1 || o.roulette != s->o.roulette ||
+        o.split != s->o.split || o.max_steps != s->o.max_steps || o.kernel_alpha != s->o.kernel_alpha ||
+        ulam__threads(o.threads) != s->threads || o.nstarts || s->o.nstarts)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the solver's mode, index, continuation, kernel exponent, weight "
+                                                   "window, max_steps and threads (and one start state)");
+    int status = check_opts(s->M, &o, err);
+    if (status) return status;
+    if (atomic_load(&s->k->status)) return kernel_failure(s->k, err);
+    int rescore = o.estimator != s->o.estimator;
+    s->o = o;
+    if ((status = check_verdicts(s->M, s, err))) return status;
+    s->o.max_walks = ulam__walk_cap(&o);
+    if (rescore && (status = ulam__kernel_rescore(s->k, o.estimator))) return kernel_failure(s->k, err);
+    s->w.interrupt = o.interrupt;
+    s->w.score0 = o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED ? s->b[o.index] : 0.0;
+    s->w.expected = o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED;
+    if ((status = take_bounds(s, o.mode == ULAM_FORWARD ? s->mt : s->M, o.rel_err > 0 && o.max_walks == 0 &&
+                              o.max_seconds == 0, err)))
+        return status;
+    reset(s);
+    return ULAM_OK;
+}
+
+/* The deterministic work a solver has done on set-up: kernel units built, and entries read by
+ * reachability checks and score-bound passes. */
+void ulam__solver_setup(const ulam_solver *s, int64_t *units, int64_t *reads)
+{
+    *units = atomic_load(&s->k->top);
+    *reads = s->setup_work;
 }

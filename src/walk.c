@@ -1,6 +1,7 @@
 /* Adjoint and forward random walks, their estimators, Russian roulette and splitting.
  *
- * Adjoint (one x_i): start at i with weight 1.  Collision scores sum_m w_m b_{i_m} over every
+ * Adjoint (one x_i): start at i with weight 1 (or at j ~ |c_j| / ||c||_1 with weight
+ * sign(c_j) ||c||_1 for <c, x>).  Collision scores sum_m w_m b_{i_m} over every
  * visited state; absorption scores w_k b_{i_k} / p*_{i_k} where the walk ends; expected scores
  * b_i + sum_m w_m (M b)_{i_m}, the exact expectation of the next step's score.  The kernel
  * keeps these per-state scores in its row headers (visit and end), so one loop serves all
@@ -90,12 +91,22 @@ typedef struct {
     stack st;
 } lane;
 
-/* Start a new history in lane x. */
-static void lane_start(const ulam__walker *w, lane *x)
+/* Start a new history in lane x: at the start, or at one drawn from the start distribution
+ * (with its signed weight). */
+static void lane_start(const ulam__walker *w, lane *x, ulam_rng *r)
 {
     x->h = ulam__kernel_row(w->k, w->start);
     x->w = 1.0;
     x->score = w->score0;
+    if (w->nstarts > 0) {
+        uint64_t frac;
+        ulam__slot *sl = w->start_src + ulam__rng_index(r, (uint64_t)w->nstarts, &frac); /* sets frac first */
+        int32_t o = ulam__slot_outcome(sl, frac);
+        int32_t j = ulam__outcome_target(o);
+        x->h = ulam__kernel_row(w->k, w->start_units[j]);
+        x->w = o < 0 ? -w->start_norm : w->start_norm;
+        x->score = x->w * w->start_b[j];
+    }
     x->len = 0;
     x->st.top = 0;
 }
@@ -170,7 +181,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
     const step_consts c = {w->k->mem, fac, w->max_steps, w->roulette > 0 || w->split > 0};
     for (; act < lanes && started < count; act++, started++) {
         L[act].st = (stack){sc->stack_s + act * cap, sc->stack_w + act * cap, 0, cap};
-        lane_start(w, &L[act]);
+        lane_start(w, &L[act], r);
     }
     while (act > 0) {
         for (int l = 0; l < act; l++) {
@@ -188,7 +199,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
             record(&acc, x->score);
             if (started < count) {
                 if ((started & 63) == 0 && w->interrupt && *w->interrupt) break;
-                lane_start(w, x);
+                lane_start(w, x, r);
                 started++;
                 l++;
             } else {

@@ -24,6 +24,11 @@ typedef struct {
     ulam_kernel *k;        /* its rows are built as walks reach them */
     int64_t start;         /* adjoint: the start row's unit */
     double score0;         /* adjoint: added to every history (b_i for the expected estimator) */
+    int64_t nstarts;       /* adjoint with a start distribution: its states (0: start at start) */
+    ulam__slot *start_src; /* their alias table: outcome j (~j: negative weight) */
+    int32_t *start_units;  /* their rows' units */
+    double *start_b;       /* their b (expected: added times the weight), else 0 */
+    double start_norm;     /* the start weight's size, sum of |start_weights| */
     const ulam_csr *mt;    /* forward expected estimator: M' (column s of M is row s) */
     ulam__slot *src;       /* forward: alias table of |b| over n outcomes (encoded states) */
     double bnorm1;         /* forward: ||b||_1 */

@@ -14,7 +14,7 @@ import subprocess
 import sys
 import tempfile
 
-from ulam_status import STATUS, code  # noqa: E402  (the enum of include/ulam.h)
+from ulam_status import STATUS, Z95, code  # noqa: E402  (the enum of include/ulam.h)
 
 
 D = "tests/data/"
@@ -64,7 +64,7 @@ CASES += [
     (["info", M + "signed_edge200.mtx"], 0, r"^$", r"walks\s+diverge"),
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "4"], 0, r"^$", r"x\[4\]\s+3\.68174"),
 ]
-SOLVE = ["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx"]
+SOLVE = ["solve", "--method", "walks", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx"]
 CASES += [  # counts written as whole numbers in exponent form are counts; fractions are not
     (SOLVE + ["--index", "1", "--walks", "2e4"], 0, r"^$", r"walks\s+20000 "),
     (SOLVE + ["--index", "1", "--walks", "1.5"], 2, r"--walks expects an integer from 1 to \d+, got '1\.5'", ""),
@@ -95,30 +95,31 @@ CASES += [  # the kernel exponent: finite and >= 0; it changes rho(M^) (chain4: 
     (SOLVE + ["--index", "1", "--alpha", "3", "--rel-err", "0.01"], 4,
      r"--rel-err 0\.01 can never be met: .*rho\(M\^\) of the adjoint kernel at kernel exponent alpha = 3 is in", r"^$"),
     # alpha 2 on chain4: the variance finite (rho(M^) 0.9) but weights grow on cycles and the fourth
-    # moment is infinite (rho(M4) >= 1.157): --rel-err alone refused naming alpha 1 (rho(M4) 0.8);
-    # with --walks the run keeps its interval and the rule is never met, the reason printed
-    (SOLVE + ["--index", "1", "--alpha", "2", "--rel-err", "0.05"], 4,
-     r"--rel-err 0\.05 can never be met: it needs a finite fourth moment .*rho\(M4\) of the adjoint kernel at alpha 2 "
-     r"in \[1\.157, 1\.519\] \(>= 1: infinite\).*adjoint at alpha 1 has it finite, 0\.8 < 1.*the rule is then never met",
-     r"^$"),
+    # moment is infinite (rho(M4) >= 1.157): the variance's own error (variance_rel_error) errs low, so
+    # the rule does not use it and stands on the certified second moment (its walk count, 3.2e5 here,
+    # bounds the true standard error by 0.29 E |x|); with --walks 5000 it is not met, the reason printed
+    (SOLVE + ["--index", "1", "--alpha", "2", "--rel-err", "0.05"], 0, r"^$",
+     r"rel-err +met \(target 0\.05; the certified second moment asks for [\d.e+]+ walks at this estimate\): scores are "
+     r"unbounded and rho\(M4\) is in \[1\.157, 1\.519\], so the fourth moment is infinite and the rule does not use"),
     (SOLVE + ["--index", "1", "--alpha", "2", "--rel-err", "0.05", "--walks", "5000"], 0, r"",
-     r"95% CI(.*\n)*rel-err +NOT met \(target 0\.05\): scores are unbounded and rho\(M4\) is in \[1\.157, 1\.519\], so "
-     r"the fourth moment is infinite"),
+     r"95% CI(.*\n)*rel-err +NOT met \(target 0\.05; the certified second moment asks for [\d.e+]+ walks.*rho\(M4\) is in "
+     r"\[1\.157, 1\.519\], so the fourth moment is infinite"),
     (SOLVE + ["--index", "1", "--alpha", "0.5", "--rel-err", "0.05"], 0, r"^$", r"rel-err +met"),
 ]
-DIV = ["solve", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1"]
-RS = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1"]
+DIV = ["solve", "--method", "walks", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1"]
+RS0 = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1"]
+RS = RS0 + ["--method", "walks"]
 CASES += [
     # the guards: refusal, --force, the walk cap, the non-finite stop, infinite variance, the edge
     (DIV, 3, r"rho\(\|M\|\) is >= 1 \(certified: bounds \[1\.1, 1\.1\]\).*divergent series.*ulam direct.*--jacobi.*--force", r"^$"),
-    (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1"], 3,
+    (["solve", "--method", "walks", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1"], 3,
      r"rho\(\|M\|\) is >= 1 \(certified: bounds \[1\.3, 1\.3\]", r"^$"),
     (DIV + ["--force", "--max-steps", "50", "--walks", "1000"], 0, r"Running anyway \(--force\)",
      r"1000 cut at 50 steps: the estimate is biased by the cut"),
     (DIV + ["--force", "--walks", "100"], code("ENONFINITE"), r"non-finite weight or score", r"^$"),
     (RS + ["--continue", "0.5"], 0, r"rho\(M\^\) >= 1 \(bounds \[1\.62, 1\.62\]\) .* variance is infinite",
      r"no confidence interval: the variance is infinite"),
-    (["solve", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--index", "1", "--jacobi", "--omega", "0.5",
+    (["solve", "--method", "walks", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--index", "1", "--jacobi", "--omega", "0.5",
       "--walks", "2000"], 0, r"rho\(\|M\|\) is certified below 1 but not below 0\.99 \(bounds \[0\.\d+, 1\)\)", r"\+-"),
     (SOLVE + ["--index", "1", "--walks", "-5"], 2, r"--walks expects an integer", ""),
     # the score-bound minimum out of reach: said after the first round, collision/expected named
@@ -141,7 +142,7 @@ CASES += [
     (SOLVE + ["--index", "9"], 2, r"--index 9 is out of range 1..4", ""),
     (SOLVE, 2, r"adjoint walks need --index", ""),
     (SOLVE + ["--index", "1", "--out", "/tmp/x.mtx"], 2, r"--out and --errors need --mode forward", ""),
-    (["solve", D + "absorb_undefined.mtx", "--rhs", D + "ones3.mtx", "--index", "1", "--estimator", "absorption"],
+    (["solve", "--method", "walks", D + "absorb_undefined.mtx", "--rhs", D + "ones3.mtx", "--index", "1", "--estimator", "absorption"],
      code("EUNDEFINED"), r"state 2 \(1-based\) is reachable and never terminates", ""),
     (SOLVE + ["--index", "2", "--walks", "20000", "--check"], 0, r"^$", r"direct\s+2\.34009.*z = "),
     (SOLVE + ["--index", "2", "--walks", "20000", "--mode", "forward", "--estimator", "expected"], 0, r"^$",
@@ -158,7 +159,10 @@ CASES += [
     (PS + ["--source", "3", "--rmax", "-0.1"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--source", "3", "--rmax", "nan"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
-    (["solve", M + "randsub1000.mtx", "--source", "3"], 2, r"--source S needs --index I", r"^$"),
+    (["solve", M + "randsub1000.mtx", "--source", "3"], 2, r"--method bidirectional needs --index I", r"^$"),
+    (PS + ["--rhs", M + "randsub1000_b.mtx", "--method", "bidirectional"], 2,
+     r"is for a sparse b, and this b has 1000 nonzeros of 1000 \(more than max\(16, n/10\) = 100\)", r"^$"),
+    (PS + ["--rhs", D + "sparse3_b.mtx", "--rmax", "0.1"], 2, r"say --method bidirectional", r"^$"),
     (PS + ["--source", "3", "--method", "forward"], 2, r"go with --method bidirectional, got 'forward'", r"^$"),
     (PS + ["--source", "3", "--out", "x.mtx"], 2, r"unknown option for a --source solve", r"^$"),
     (["solve", M + "divergent200.mtx", "--index", "1", "--source", "2"], 3, r"rho\(\|M\|\) is >= 1 \(certified: bounds \[1\.1, 1\.1\]\)", r"^$"),
@@ -171,11 +175,14 @@ CASES += [
 
 CASES += [
     # --method auto (src/cli/auto.c)
-    (RS + ["--method", "sideways"], 2, r"--method expects auto, bidirectional \(with --source\), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got 'sideways'", r"^$"),
+    (RS0 + ["--method", "sideways"], 2, r"--method expects auto, walks, bidirectional \(with --source\), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got 'sideways'", r"^$"),
     (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--method", "auto",
-      "--rel-err", "0.01"], 3, r"error: --method auto: no candidate has a certified finite variance; the closest is .*"
-     r"a --rel-err target cannot be met honestly", r"^$"),
-    (RS + ["--method", "auto", "--walks", "20000"], 0, r"^$", r"auto\s+chose the least variance x seconds a walk from 12 candidates"),
+      "--rel-err", "0.01"], 3, r"error: --method auto: no candidate has a certified finite variance \(rho\(\|M\|\) is not "
+     r"certified below 1\); the closest is .*a --rel-err target cannot be met honestly", r"^$"),
+    # the default is auto: the same refusal without --method
+    (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--rel-err", "0.01"], 3,
+     r"error: --method auto: no candidate has a certified finite variance", r"^$"),
+    (RS0 + ["--method", "auto", "--walks", "20000"], 0, r"^$", r"auto\s+chose the least predicted variance x work a walk of 36 candidates"),
 ]
 
 
@@ -307,7 +314,7 @@ def check_radiosity_rare_lamp(ulam):
         assert rc == 0, err
         j = json.loads(out)
         assert j["rel_err_met"] is True, (seed, j)
-        covered += abs(j["radiosity"][0] - exact) <= 1.959964 * j["stderr"][0]
+        covered += abs(j["radiosity"][0] - exact) <= Z95 * j["stderr"][0]
     # binomial(100, 0.95): P(X < 88) = 0.0015
     assert covered >= 88, f"next-event on the rare lamp: {covered} of 100 intervals cover"
 
@@ -362,10 +369,13 @@ def check_progress(ulam):
     """solve shows a progress line when stderr is a terminal (walks, estimate +- error, elapsed,
     time left for --rel-err), and nothing with --json; on a pipe the table's empty-stderr cases
     show there is none."""
-    solve = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "7", "--threads", "1",
+    solve = ["solve", "--method", "walks", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "7", "--threads", "1",
              "--rel-err", "0.0003"]
     rc, err = on_tty(ulam, solve)
-    assert rc == 0 and re.search(r"\rulam: \d+ walks, [-\d.e+]+ \+- [\d.e+-]+, [\d.]+ s, about \d+ s left", err), err
+    assert rc == 0 and re.search(r"\rulam: \d+ walks, [-\d.e+]+ \+- [\d.e+-]+, [\d.]+ s, (about \d+|under 1) s left", err), err
+    # the time left counts --time too (radiosity --time 3 said "about 26 s left"): under 1 s of 1 s
+    rc, err = on_tty(ulam, solve[:-2] + ["--walks", "1e12", "--time", "1"])
+    assert rc == 0 and "under 1 s left" in err and not re.search(r"about \d+ s left", err), err
     rc, err = on_tty(ulam, solve + ["--json"])
     assert rc == 0 and "walks," not in err, err
 
@@ -447,7 +457,7 @@ def check_rel_err_stops(ulam):
             f.writelines(f"{i + 1} {(i + 1) % 1000 + 1} 0.9999\n" for i in range(1000))
         with open(pb, "w") as f:
             f.write("%%MatrixMarket matrix array real general\n1000 1\n" + "1\n" * 1000)
-        args = ["solve", p, "--rhs", pb, "--index", "1", "--rel-err", "0.01"]
+        args = ["solve", "--method", "walks", p, "--rhs", pb, "--index", "1", "--rel-err", "0.01"]
         rc, out, err = run(ulam, args + ["--max-steps", "2000", "--json"])
         o = json.loads(out)
         assert rc == 0 and o["rel_err_met"] is False and o["rel_err_stop"] == "cuts" and o["walks"] == 1024, o
@@ -501,7 +511,7 @@ def check_alpha(ulam):
         for name, args in [("text1", [M + "signed200.mtx", "--rhs", M + "signed200_b.mtx"]), ("prep1", [sysf]),
                            ("text2", [M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "--alpha", "2"]),
                            ("prep2", [sysf, "--alpha", "2"])]:
-            rc, out, err = run(ulam, ["solve"] + args + common)
+            rc, out, err = run(ulam, ["solve", "--method", "walks"] + args + common)
             assert rc == 0, (name, err)
             runs[name] = json.loads(out)
         t1, p1, t2, p2 = runs["text1"], runs["prep1"], runs["text2"], runs["prep2"]
@@ -519,7 +529,7 @@ def check_forward_files(ulam):
     about 95% within their 95% interval (binomial: 1000 components, 4 sigma band)."""
     with tempfile.TemporaryDirectory() as d:
         x, e, ref = (os.path.join(d, f) for f in ("x.mtx", "e.mtx", "ref.mtx"))
-        rc, _, err = run(ulam, ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx",
+        rc, _, err = run(ulam, ["solve", "--method", "walks", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx",
                                 "--mode", "forward", "--walks", "200000", "--out", x, "--errors", e])
         assert rc == 0, err
         rc, _, _ = run(ulam, ["direct", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--out", ref])
@@ -528,7 +538,7 @@ def check_forward_files(ulam):
         xs, es, rs = read(x), read(e), read(ref)
         assert len(xs) == len(es) == len(rs) == 1000
         assert all(abs(a - b) < 5 * s for a, b, s in zip(xs, rs, es))
-        covered = sum(abs(a - b) < 1.959964 * s for a, b, s in zip(xs, rs, es))
+        covered = sum(abs(a - b) < Z95 * s for a, b, s in zip(xs, rs, es))
         assert 922 <= covered <= 978, covered
 
 
@@ -558,7 +568,7 @@ def check_honest_verdicts(ulam):
             ent += [(k + 1, k + 2, c * 0.5 * dd[k + 1] / dd[k]), (k + 2, k + 1, c * 0.5 * dd[k] / dd[k + 1])]
         write_mtx(f"{d}/near.mtx", n, ent)
         write_vec(f"{d}/ones.mtx", [1.0] * n)
-        near = ["solve", f"{d}/near.mtx", "--rhs", f"{d}/ones.mtx", "--index", "150"]
+        near = ["solve", "--method", "walks", f"{d}/near.mtx", "--rhs", f"{d}/ones.mtx", "--index", "150"]
         rc, out, err = run(ulam, near)
         assert rc == 3 and "the bounds straddle 1" in err and out == "", (rc, err)
         rc, out, err = run(ulam, near + ["--force", "--walks", "200", "--max-steps", "10000", "--json"])
@@ -571,7 +581,7 @@ def check_honest_verdicts(ulam):
         # the star: adjoint rho(M^) = sqrt(1.25) (row 1 sums to 5), forward 0.5
         write_mtx(f"{d}/star.mtx", 11, [(1, k, 0.5) for k in range(2, 12)] + [(k, 1, 0.05) for k in range(2, 12)])
         write_vec(f"{d}/b11.mtx", [1.0] * 11)
-        star = ["solve", f"{d}/star.mtx", "--rhs", f"{d}/b11.mtx", "--index", "1"]
+        star = ["solve", "--method", "walks", f"{d}/star.mtx", "--rhs", f"{d}/b11.mtx", "--index", "1"]
         rc, out, err = run(ulam, star + ["--rel-err", "0.01"])
         assert rc == 4 and "rho(M^) of the adjoint kernel" in err and "forward mode's is finite" in err, (rc, err)
         assert out == ""
@@ -592,19 +602,27 @@ def check_honest_verdicts(ulam):
         ent += [(i + 1, j + 1, 1.0) for i in range(500) for j in range(500) if i != j and (abs(i - j) & (abs(i - j) - 1)) == 0]
         write_mtx(f"{d}/tref.mtx", 500, ent)
         write_vec(f"{d}/b500.mtx", [1.0] * 500)
-        rc, out, err = run(ulam, ["solve", f"{d}/tref.mtx", "--rhs", f"{d}/b500.mtx", "--index", "1", "--jacobi",
+        rc, out, err = run(ulam, ["solve", "--method", "walks", f"{d}/tref.mtx", "--rhs", f"{d}/b500.mtx", "--index", "1", "--jacobi",
                                   "--rel-err", "0.01"])
         assert rc == 4 and "the forward mode's is finite, 0.9" in err, (rc, err)
+        # by default (auto) the same query ends with a finite, honest interval: forward mode, whose
+        # variance is certified finite, within 4 sigma of LAPACK
+        rc, out, err = run(ulam, ["solve", f"{d}/tref.mtx", "--rhs", f"{d}/b500.mtx", "--index", "1", "--jacobi",
+                                  "--rel-err", "0.25", "--check", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["mode"] == "forward" and o["variance_finite"] is True and o["ci95"] is not None, (rc, err, o)
+        assert o["rel_err_met"] is True and abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
+        assert all(not c["certified"] for c in o["auto"]["candidates"] if c["mode"] == "adjoint"), o["auto"]
         # forward: state 4 is reached once in ~10^5 walks, state 3 never
         write_mtx(f"{d}/thin.mtx", 4, [(1, 2, 0.5), (2, 1, 0.5), (4, 1, 1e-5)])
         write_vec(f"{d}/b4.mtx", [1.0, 1.0, 0.0, 0.0])
-        rc, out, err = run(ulam, ["solve", f"{d}/thin.mtx", "--rhs", f"{d}/b4.mtx", "--mode", "forward", "--walks", "1000",
+        rc, out, err = run(ulam, ["solve", "--method", "walks", f"{d}/thin.mtx", "--rhs", f"{d}/b4.mtx", "--mode", "forward", "--walks", "1000",
                                   "--errors", f"{d}/e.mtx", "--json"])
         o = json.loads(out)
         assert rc == 0 and o["unreached"] == 2, (rc, err, o)
         lines = open(f"{d}/e.mtx").read().splitlines()
         assert "% 2 components unreached" in "\n".join(lines) and lines[-2:] == ["nan", "nan"], lines
-        rc, out, err = run(ulam, ["solve", f"{d}/star.mtx", "--rhs", f"{d}/b11.mtx", "--mode", "forward", "--walks", "1000",
+        rc, out, err = run(ulam, ["solve", "--method", "walks", f"{d}/star.mtx", "--rhs", f"{d}/b11.mtx", "--mode", "forward", "--walks", "1000",
                                   "--continue", "0.1", "--errors", f"{d}/e2.mtx", "--json"])
         o = json.loads(out)
         assert rc == 0 and o["variance_finite"] is False, (rc, err, o)
@@ -720,7 +738,7 @@ def check_cache(ulam):
     with tempfile.TemporaryDirectory() as d:
         for f in ("signed200.mtx", "signed200_b.mtx"):
             shutil.copy(M + f, d)
-        args = ["solve", d + "/signed200.mtx", "--rhs", d + "/signed200_b.mtx", "--index", "5", "--walks", "20000",
+        args = ["solve", "--method", "walks", d + "/signed200.mtx", "--rhs", d + "/signed200_b.mtx", "--index", "5", "--walks", "20000",
                 "--json", "--cache"]
         rc, out1, err = run(ulam, args)
         assert rc == 0 and err.count("cache written") == 2, err
@@ -745,14 +763,14 @@ def check_prepare(ulam):
         rc, out, err = run(ulam, ["prepare", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "-o", sysf])
         assert rc == 0 and "prepared" in out and os.listdir(d) == ["s.ulam"], (rc, out, err, os.listdir(d))
         common = ["--index", "5", "--walks", "20000", "--json", "--threads", "2"]
-        rc, text, err = run(ulam, ["solve", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx"] + common)
+        rc, text, err = run(ulam, ["solve", "--method", "walks", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx"] + common)
         assert rc == 0, err
-        rc, prep, err = run(ulam, ["solve", sysf] + common)
+        rc, prep, err = run(ulam, ["solve", "--method", "walks", sysf] + common)
         assert rc == 0, err
         a, b = json.loads(text), json.loads(prep)
         assert a["estimate"] == b["estimate"] and a["stderr"] == b["stderr"], (a, b)
         assert b["guard_seconds"] == 0 and b["rho_abs"] == a["rho_abs"], b
-        rc, fwd, err = run(ulam, ["solve", sysf, "--mode", "forward", "--walks", "2000", "--json"])
+        rc, fwd, err = run(ulam, ["solve", "--method", "walks", sysf, "--mode", "forward", "--walks", "2000", "--json"])
         assert rc == 0, err
         rc, info, err = run(ulam, ["info", sysf, "--json"])
         assert rc == 0 and json.loads(info)["n"] == 200, err
@@ -761,16 +779,16 @@ def check_prepare(ulam):
         assert rc == 0 and os.path.exists(d + "/study/runs.csv"), err
         import shutil
         shutil.rmtree(d + "/study")
-        rc, _, err = run(ulam, ["solve", sysf, "--index", "5", "--jacobi"])
+        rc, _, err = run(ulam, ["solve", "--method", "walks", sysf, "--index", "5", "--jacobi"])
         assert rc == 2 and "prepared system" in err, err
         # Jacobi splitting stored, no b: solve needs --rhs
         rc, _, err = run(ulam, ["prepare", M + "poisson20.mtx", "--jacobi", "-o", d + "/p.ulam"])
         assert rc == 0, err
-        rc, _, err = run(ulam, ["solve", d + "/p.ulam", "--index", "3"])
+        rc, _, err = run(ulam, ["solve", "--method", "walks", d + "/p.ulam", "--index", "3"])
         assert rc == 2 and "holds no b" in err, err
-        rc, _, err = run(ulam, ["solve", M + "poisson20.mtx", "--jacobi", "--rhs", M + "poisson20_b.mtx", "--index",
+        rc, _, err = run(ulam, ["solve", "--method", "walks", M + "poisson20.mtx", "--jacobi", "--rhs", M + "poisson20_b.mtx", "--index",
                                 "3", "--walks", "5000", "--json"])
-        rc2, out2, err2 = run(ulam, ["solve", d + "/p.ulam", "--rhs", M + "poisson20_b.mtx", "--index", "3",
+        rc2, out2, err2 = run(ulam, ["solve", "--method", "walks", d + "/p.ulam", "--rhs", M + "poisson20_b.mtx", "--index", "3",
                                      "--walks", "5000", "--json"])
         assert rc == 0 and rc2 == 0, err2
         raw = open(sysf, "rb").read()
@@ -781,7 +799,7 @@ def check_prepare(ulam):
             bad = d + f"/bad{k}.ulam"
             with open(bad, "wb") as fh:
                 fh.write(data)
-            rc, out, err = run(ulam, ["solve", bad, "--index", "5", "--walks", "100"])
+            rc, out, err = run(ulam, ["solve", "--method", "walks", bad, "--index", "5", "--walks", "100"])
             if status == "EBANNER":  # no longer a prepared file: parsed as Matrix Market
                 assert rc != 0 and out == "", (k, rc, err)
             else:
@@ -793,7 +811,7 @@ def check_prepare(ulam):
         data[colidx:colidx + 4] = (999).to_bytes(4, "little")
         with open(d + "/rows.ulam", "wb") as fh:
             fh.write(bytes(data))
-        rc, out, err = run(ulam, ["solve", d + "/rows.ulam", "--index", "1", "--walks", "1000"])
+        rc, out, err = run(ulam, ["solve", "--method", "walks", d + "/rows.ulam", "--index", "1", "--walks", "1000"])
         assert rc == code("ESYNTAX") and "corrupt" in err and out == "", (rc, err)
         rc, out, err = run(ulam, ["info", d + "/rows.ulam"])
         assert rc != 0 and "corrupt" in err and out == "", (rc, err)
@@ -1086,6 +1104,11 @@ def check_bidir(ulam):
     o = json.loads(out)
     assert rc == 0 and o["rmax_balanced"] is True and o["pilot_walks"] == 256, o
     assert o["stderr"] <= 0.02 * abs(o["estimate"]) and o["walks"] >= 1000, o
+    rc, out, err = run(ulam, PS + ["--rhs", D + "sparse3_b.mtx", "--method", "bidirectional", "--rmax", "0.01",
+                                   "--walks", "30000", "--json", "--check"])
+    o = json.loads(out)  # a sparse b of 3 nonzeros, mixed signs
+    assert rc == 0 and o["source"] is None and o["b_nonzeros"] == 3 and o["walks"] == 30000, o
+    assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
     rc, out, err = run(ulam, ["solve", D + "dag5.mtx", "--index", "1", "--source", "5", "--rmax", "1e-3", "--json",
                               "--check"])
     o = json.loads(out)
@@ -1096,22 +1119,51 @@ def check_bidir(ulam):
 def check_auto(ulam):
     """solve --method auto --json: the candidates (certified iff the upper bound of rho(M^) is below 1),
     the chosen one is what ran, the estimate agrees with LAPACK; pins leave only what they allow."""
-    rc, out, err = run(ulam, RS + ["--method", "auto", "--rel-err", "0.02", "--json", "--check"])
+    rc, out, err = run(ulam, RS0 + ["--method", "auto", "--rel-err", "0.02", "--json", "--check"])
     assert rc == 0, err
     o = json.loads(out)
     a = o["auto"]
-    assert len(a["candidates"]) == 12 and 0 <= a["chosen"] < 12, a
+    assert len(a["candidates"]) == 36 and 0 <= a["chosen"] < 36, a
     for c in a["candidates"]:
-        assert c["certified"] == (c["rho_hat_upper"] < 1), c
-        assert (c["pilot_walks"] > 0) == (c["certified"] and c["status"] == "ok"), c
+        if c["state"] != "skipped":
+            assert c["certified"] == (c["rho_hat_upper"] < 1), c
+        assert (c["pilot_walks"] > 0) == (c["state"] in ("dropped", "finalist", "chosen")), c
+        assert c["kernel_alpha"] in (0, 1, 2) and c["state"] in ("uncertified", "refused", "skipped", "dropped",
+                                                                 "finalist", "chosen"), c
     ch = a["candidates"][a["chosen"]]
-    assert ch["mode"] == o["mode"] and ch["estimator"] == o["estimator"], (ch, o)
+    assert ch["state"] == "chosen" and [c["state"] for c in a["candidates"]].count("chosen") == 1, a
+    assert ch["mode"] == o["mode"] and ch["estimator"] == o["estimator"] and ch["kernel_alpha"] == o["kernel_alpha"], (ch, o)
+    assert ch["predicted_walks"] >= 1000 and ch["predicted_work"] > 0 and 0 <= a["pilot_share"] < 0.5, a
+    assert a["pilot_work"] >= a["reused_work"] > 0 and a["stages"] >= 1, a
     assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"] and o["stderr"] <= 0.02 * abs(o["estimate"]), o
-    rc, out, err = run(ulam, RS + ["--method", "auto", "--mode", "forward", "--continue", "0.8", "--walks", "5000", "--json"])
+    # the default is auto, and the same run (same seed) gives the same answer
+    rc, out2, err = run(ulam, RS0 + ["--rel-err", "0.02", "--json", "--check"])
+    o2 = json.loads(out2)
+    assert rc == 0 and o2["estimate"] == o["estimate"] and o2["auto"]["chosen"] == a["chosen"], (o, o2)
+    rc, out, err = run(ulam, RS0 + ["--method", "auto", "--mode", "forward", "--continue", "0.8", "--walks", "5000", "--json"])
     assert rc == 0, err
     o = json.loads(out)
-    assert len(o["auto"]["candidates"]) == 3 and o["mode"] == "forward", o
+    assert len(o["auto"]["candidates"]) == 9 and o["mode"] == "forward", o
     assert all(c["mode"] == "forward" and c["continue"] == 0.8 for c in o["auto"]["candidates"]), o
+    # everything pinned (or --method walks): today's run, output for output but the timings
+    pinned = RS0 + ["--mode", "adjoint", "--estimator", "collision", "--continue", "analog", "--alpha", "1", "--walks", "3000"]
+    outs = [run(ulam, args) for args in (pinned, RS0 + ["--method", "walks", "--walks", "3000"])]
+    strip = lambda t: [l for l in t.splitlines() if not l.startswith(("seconds", "figure", "load"))]
+    assert outs[0][0] == outs[1][0] == 0 and strip(outs[0][1]) == strip(outs[1][1]), outs
+    assert "auto " not in outs[0][1], outs[0][1]
+    # a prepared system with a certificate: auto chooses the estimator on the certificate's kernel
+    # (its guards need no pass over M), and answers as --method walks with that estimator
+    with tempfile.TemporaryDirectory() as d:
+        sysf = d + "/rs.ulam"
+        rc, _, err = run(ulam, ["prepare", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "-o", sysf])
+        assert rc == 0, err
+        rc, out, err = run(ulam, ["solve", sysf, "--index", "7", "--rel-err", "0.02", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and len(o["auto"]["candidates"]) == 3 and o["guard_seconds"] == 0, (err, o)
+        assert all(c["mode"] == "adjoint" and c["continue"] is None for c in o["auto"]["candidates"]), o
+        rc, out, err = run(ulam, ["solve", sysf, "--index", "7", "--rel-err", "0.02", "--json", "--method", "walks",
+                                  "--estimator", o["estimator"]])
+        assert rc == 0 and json.loads(out)["estimate"] == o["estimate"], (err, out, o)
 
 
 def check_genmat(genmat):

@@ -26,22 +26,28 @@ def main():
     failures = 0
     with tempfile.TemporaryDirectory() as d:
         cases = [
-            ("solve adjoint", ["solve", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx", "--index", "7",
+            ("solve adjoint", ["solve", "--method", "walks", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx", "--index", "7",
                                "--walks", "50000", "--seed", "9", "--json"], None),
-            # signed200 at alpha 0.5 has rho(M4) >= 1: --rel-err alone is refused there, so chain4 (rho(M4) < 0.96)
-            ("solve adjoint alpha", ["solve", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx", "--index",
-                                     "2", "--alpha", "0.5", "--rel-err", "0.02", "--json"], None),
-            ("solve adjoint alpha walks", ["solve", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx",
+            # chain4 at alpha 0.5: rho(M4) < 0.96, a quick rel-err stop (signed200's certified second
+            # moment asks for 1.7e7 walks at this target)
+            ("solve adjoint alpha", ["solve", "--method", "walks", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx",
+                                     "--index", "2", "--alpha", "0.5", "--rel-err", "0.02", "--json"], None),
+            ("solve adjoint alpha walks", ["solve", "--method", "walks", "matrices/signed200.mtx", "--rhs", "matrices/signed200_b.mtx",
                                            "--index", "7", "--alpha", "0.5", "--rel-err", "0.02", "--walks", "100000",
                                            "--json"], None),
-            ("solve forward alpha", ["solve", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
+            ("solve forward alpha", ["solve", "--method", "walks", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
                                      "1", "--mode", "forward", "--alpha", "2", "--walks", "30000", "--json", "--out",
                                      "{d}/xa.mtx"], "xa.mtx"),
-            ("solve adjoint rel-err", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
+            ("solve adjoint rel-err", ["solve", "--method", "walks", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
                                        "--index", "3", "--rel-err", "0.005", "--json"], None),
             ("solve bidirectional", ["solve", "matrices/randsub1000.mtx", "--index", "7", "--source", "3",
                                      "--rel-err", "0.01", "--json"], None),
-            ("solve forward", ["solve", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
+            ("solve bidirectional sparse b", ["solve", "matrices/randsub1000.mtx", "--index", "7", "--rhs",
+                                              "tests/data/sparse3_b.mtx", "--method", "bidirectional",
+                                              "--rel-err", "0.02", "--json"], None),
+            ("solve auto", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
+                            "--index", "3", "--rel-err", "0.01", "--json"], None),
+            ("solve forward", ["solve", "--method", "walks", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
                                "1", "--mode", "forward", "--walks", "30000", "--json", "--out", "{d}/x.mtx"], "x.mtx"),
             ("solve mcsa", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx", "--method",
                             "mcsa", "--tol", "1e-6", "--json", "--out", "{d}/m.mtx"], "m.mtx"),

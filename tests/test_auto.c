@@ -1,5 +1,6 @@
-/* --method auto's choice (ulam_auto_choose): screening by certified guards, pins, pilots, and an
- * unbiased estimate from fresh walks with the chosen method. */
+/* --method auto's choice (ulam_auto_choose, ulam_auto_solver): screening by certified guards, pins,
+ * deterministic racing, and an unbiased estimate from fresh walks with the chosen method on the
+ * pilots' solver. */
 #include "testutil.h"
 
 /* Load matrices/NAME.mtx and its b. */
@@ -13,79 +14,189 @@ static ulam_csr *load(const char *name, double **b)
     return must_read(mp);
 }
 
-/* Every candidate's certification follows its bounds, only certified ones are piloted, the
- * choice is the least finite cost, and walks with the chosen method on the caller's seed agree
- * with LAPACK within 4 sigma. */
+/* Iterate s until done into *r; its status. */
+static int walk_out(ulam_solver *s, ulam_walk_result *r)
+{
+    int status = ULAM_OK;
+    while (!status && !ulam_solver_done(s)) status = ulam_solver_iterate(s);
+    ulam_solver_result(s, r);
+    return status;
+}
+
+/* Nonzero when two results agree bit for bit in what the walks decide. */
+static int same_result(const ulam_walk_result *a, const ulam_walk_result *b)
+{
+    return a->estimate == b->estimate && a->std_error == b->std_error && a->variance == b->variance &&
+           a->walks == b->walks && a->steps == b->steps && a->cut == b->cut && a->min_walks == b->min_walks &&
+           a->rel_err_met == b->rel_err_met;
+}
+
+/* On three systems (a rel_err target, then a walk budget): every screened candidate's certification
+ * follows its bounds, only certified ones are piloted, the chosen one is the finalist of least
+ * predicted work; the solver handed out walks exactly as a fresh solver with the chosen options
+ * (its kernel rows, reachable set and bounds come from the pilots: the walks do not), and its
+ * answer agrees with LAPACK within 4 sigma. */
 static void test_choice(void **state)
 {
     (void)state;
     static const char *const names[] = {"randsub1000", "signed200", "chain4"};
-    for (int k = 0; k < 3; k++) { /* case k */
-        if (!test_case(k)) continue;
+    for (int k = 0; k < 6; k++) { /* case k: system k % 3, rel_err for k < 3 */
         double *b;
-        ulam_csr *M = load(names[k], &b);
+        ulam_csr *M = load(names[k % 3], &b);
         double *x = malloc((size_t)M->nrows * sizeof *x);
         assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 1, o.max_walks = 40000, o.seed = 11;
+        o.index = 1, o.seed = 11 + (uint64_t)k, o.max_walks = 0;
+        if (k < 3) o.rel_err = 0.02;
+        else o.max_walks = 20000;
         ulam_auto_result res;
-        ulam_auto_opts ao = ulam_auto_defaults();
-        ao.pilot_seconds = 0; /* pilots of exactly 2048 walks, whatever the machine's load */
-        assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_OK);
-        assert_int_equal(res.ncand, 12);
-        assert_true(res.chosen >= 0);
+        ulam_solver *sv = NULL;
+        assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
+        assert_int_equal(res.ncand, 36);
+        assert_true(res.chosen >= 0 && sv);
+        assert_int_equal(res.by_work, k < 3);
+        const ulam_auto_candidate *ch = &res.cand[res.chosen];
         for (int c = 0; c < res.ncand; c++) {
             const ulam_auto_candidate *a = &res.cand[c];
-            assert_int_equal(a->certified, res.abs.upper < 1 && a->hat.upper < 1);
+            if (isfinite(a->hat.upper)) assert_int_equal(a->certified, res.abs.upper < 1 && a->hat.upper < 1);
             assert_true(a->certified || a->pilot_walks == 0);
-            if (a->pilot_walks) assert_int_equal(a->pilot_walks, 2048);
-            if (isfinite(a->cost)) assert_true(res.cand[res.chosen].cost <= a->cost);
+            assert_int_equal(a->pilot_walks > 0, a->state >= ULAM_AUTO_DROPPED);
+            if (a->state == ULAM_AUTO_FINALIST) {
+                if (k < 3) assert_true(ch->predicted_work <= a->predicted_work);
+                else assert_true(ch->cost <= a->cost);
+            }
         }
-        const ulam_auto_candidate *ch = &res.cand[res.chosen];
-        assert_true(ch->certified && ch->status == ULAM_OK && isfinite(ch->cost));
-        o.mode = ch->mode, o.estimator = ch->estimator, o.continue_q = ch->continue_q;
-        ulam_walk_result r;
-        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
-        if (!(fabs(r.estimate - x[1]) < 4 * r.std_error))
-            print_error("case %d: %.10g +- %.3g, LAPACK %.10g\n", k, r.estimate, r.std_error, x[1]);
+        assert_true(ch->certified && ch->status == ULAM_OK && ch->state == ULAM_AUTO_CHOSEN);
+        assert_true(res.pilot_work >= res.reused_work && res.reused_work > 0);
+        ulam_walk_result r, plain;
+        assert_int_equal(walk_out(sv, &r), ULAM_OK);
+        ulam_solver_free(sv);
+        o.mode = ch->mode, o.estimator = ch->estimator, o.continue_q = ch->continue_q, o.kernel_alpha = ch->kernel_alpha;
+        assert_int_equal(ulam_solve(M, b, &o, &plain, NULL), ULAM_OK);
+        if (!same_result(&r, &plain) || !(fabs(r.estimate - x[1]) < 4 * r.std_error))
+            print_error("case %d: %.17g +- %.3g (plain %.17g, %lld walks / %lld), LAPACK %.10g\n", k, r.estimate,
+                        r.std_error, plain.estimate, (long long)r.walks, (long long)plain.walks, x[1]);
+        assert_true(same_result(&r, &plain));
         assert_true(fabs(r.estimate - x[1]) < 4 * r.std_error);
+        if (k < 3) assert_true(r.rel_err_met);
         free(x), free(b);
         ulam_csr_free(M);
     }
-    test_case_done();
 }
 
-/* Pins keep the caller's values; with rho(|M|) >= 1 nothing is certified and the closest
- * candidate is named; bad options are refused. */
-static void test_pins_and_none(void **state)
+/* The choice is a function of (M, b, options, seed) alone: with 1 or 2 threads every candidate's
+ * pilots, predictions and state, the choice and the answer are the same, bit for bit. */
+static void test_threads(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"randsub1000", "signed200"};
+    for (int k = 0; k < 2; k++) { /* case k */
+        double *b;
+        ulam_csr *M = load(names[k], &b);
+        ulam_auto_result res[2];
+        ulam_walk_result r[2];
+        for (int t = 0; t < 2; t++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.index = 3, o.rel_err = 0.01, o.max_walks = 0, o.threads = t + 1, o.seed = 5;
+            ulam_solver *sv = NULL;
+            assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res[t], &sv, NULL), ULAM_OK);
+            assert_int_equal(walk_out(sv, &r[t]), ULAM_OK);
+            ulam_solver_free(sv);
+        }
+        if (res[0].chosen != res[1].chosen || !same_result(&r[0], &r[1]))
+            print_error("case %d: chosen %d / %d, %.17g / %.17g\n", k, res[0].chosen, res[1].chosen, r[0].estimate,
+                        r[1].estimate);
+        assert_int_equal(res[0].chosen, res[1].chosen);
+        assert_int_equal(res[0].stages, res[1].stages);
+        assert_true(res[0].pilot_work == res[1].pilot_work && res[0].reused_work == res[1].reused_work);
+        for (int c = 0; c < res[0].ncand; c++) {
+            const ulam_auto_candidate *a = &res[0].cand[c], *z = &res[1].cand[c];
+            assert_int_equal(a->state, z->state);
+            assert_int_equal(a->pilot_walks, z->pilot_walks);
+            assert_true(a->estimate == z->estimate || (isnan(a->estimate) && isnan(z->estimate)));
+            assert_true(a->variance == z->variance || (isnan(a->variance) && isnan(z->variance)));
+            assert_true(a->predicted_work == z->predicted_work || (isnan(a->predicted_work) && isnan(z->predicted_work)));
+        }
+        assert_true(same_result(&r[0], &r[1]));
+        free(b);
+        ulam_csr_free(M);
+    }
+}
+
+/* Pins keep the caller's values and auto chooses among the rest; with everything pinned there is
+ * one candidate and its solver walks as a plain ulam_solve would, bit for bit; bad options are
+ * refused. */
+static void test_pins(void **state)
 {
     (void)state;
     double *b;
     ulam_csr *M = load("randsub1000", &b);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = ULAM_FORWARD, o.estimator = ULAM_EXPECTED, o.continue_q = 0.5;
+    o.mode = ULAM_FORWARD, o.estimator = ULAM_EXPECTED, o.continue_q = 0.5, o.kernel_alpha = 2, o.max_walks = 3000;
     ulam_auto_opts ao = ulam_auto_defaults();
     ao.pin_mode = ao.pin_continue = 1;
     ulam_auto_result res;
     assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_OK);
-    assert_int_equal(res.ncand, 3);
-    for (int c = 0; c < 3; c++) assert_true(res.cand[c].mode == ULAM_FORWARD && res.cand[c].continue_q == 0.5);
-    ao.pin_estimator = 1;
-    assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_OK);
-    assert_true(res.ncand == 1 && res.cand[0].estimator == ULAM_EXPECTED);
+    assert_int_equal(res.ncand, 9);
+    for (int c = 0; c < 9; c++) assert_true(res.cand[c].mode == ULAM_FORWARD && res.cand[c].continue_q == 0.5);
+    ao.pin_estimator = ao.pin_alpha = 1;
+    for (int k = 0; k < 2; k++) { /* case k: forward expected, Q 0.5, alpha 2 (not certified); adjoint absorption */
+        if (k) o = ulam_walk_defaults(), o.estimator = ULAM_ABSORPTION, o.index = 4, o.rel_err = 0.02, o.max_walks = 0;
+        ulam_solver *sv = NULL;
+        assert_int_equal(ulam_auto_solver(M, b, &o, &ao, &res, &sv, NULL), ULAM_OK);
+        assert_true(res.ncand == 1 && (k ? res.chosen : res.closest) == 0);
+        assert_true(res.cand[0].estimator == o.estimator && res.cand[0].kernel_alpha == o.kernel_alpha);
+        ulam_walk_result r, plain;
+        assert_int_equal(walk_out(sv, &r), ULAM_OK);
+        ulam_solver_free(sv);
+        assert_int_equal(ulam_solve(M, b, &o, &plain, NULL), ULAM_OK);
+        if (!same_result(&r, &plain)) print_error("case %d: %.17g / %.17g\n", k, r.estimate, plain.estimate);
+        assert_true(same_result(&r, &plain) && (k ? r.rel_err_met : r.walks == 3000));
+    }
     ao.continue_q = 1.0;
     assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_EINVAL);
+    ao = ulam_auto_defaults();
+    ao.pilot_max = ao.pilot_walks - 1;
+    assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_EINVAL);
+    o.index = M->nrows;
+    assert_int_equal(ulam_auto_choose(M, b, &o, NULL, &res, NULL), ULAM_EINVAL);
     free(b);
     ulam_csr_free(M);
-    M = load("signed_edge200", &b);
-    o = ulam_walk_defaults();
-    assert_int_equal(ulam_auto_choose(M, b, &o, NULL, &res, NULL), ULAM_OK);
-    assert_true(res.chosen == -1 && res.closest >= 0 && res.abs.lower >= 1);
+}
+
+/* No candidate certified: rho(|M|) >= 1 (signed_edge200) or, with rho(|M|) = 0.98 < 1, every
+ * kernel's rho(M^) >= 1 (M = [0 3; 0.32 0]): the closest (least rho(M^)) is named, nothing is
+ * piloted, and the closest's solver refuses a rel_err target as a plain run does (ULAM_EDIVERGE,
+ * ULAM_EINFVAR), while a walk budget runs it. */
+static void test_none(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M = load("signed_edge200", &b);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.rel_err = 0.01, o.max_walks = 0;
+    ulam_auto_result res;
+    ulam_solver *sv = NULL;
+    assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_EDIVERGE);
+    assert_true(sv == NULL && res.chosen == -1 && res.closest >= 0 && res.abs.lower >= 1);
     for (int c = 0; c < res.ncand; c++) {
-        assert_true(!res.cand[c].certified && res.cand[c].pilot_walks == 0);
+        assert_true(!res.cand[c].certified && res.cand[c].pilot_walks == 0 && res.cand[c].state == ULAM_AUTO_UNCERTIFIED);
         assert_true(res.cand[res.closest].hat.rho <= res.cand[c].hat.rho);
     }
     free(b);
+    ulam_csr_free(M);
+    int32_t ti[] = {0, 1}, tj[] = {1, 0};
+    double tx[] = {3.0, 0.32}, b2[] = {1.0, 1.0};
+    assert_int_equal(ulam_csr_from_triplets(2, 2, 2, ti, tj, tx, &M), ULAM_OK);
+    assert_int_equal(ulam_auto_solver(M, b2, &o, NULL, &res, &sv, NULL), ULAM_EINFVAR);
+    assert_true(sv == NULL && res.chosen == -1 && res.closest >= 0 && res.abs.upper < 1);
+    for (int c = 0; c < res.ncand; c++) assert_true(!res.cand[c].certified && res.cand[c].hat.upper >= 1);
+    o.rel_err = 0, o.max_walks = 1000;
+    assert_int_equal(ulam_auto_solver(M, b2, &o, NULL, &res, &sv, NULL), ULAM_OK);
+    ulam_walk_result r;
+    assert_int_equal(walk_out(sv, &r), ULAM_OK);
+    assert_true(r.walks == 1000 && r.variance_finite != 1 && isnan(r.ci95[0]));
+    ulam_solver_free(sv);
     ulam_csr_free(M);
 }
 
@@ -93,7 +204,9 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_choice),
-        cmocka_unit_test(test_pins_and_none),
+        cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_pins),
+        cmocka_unit_test(test_none),
     };
-    return test_run(tests);
+    return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -192,7 +192,7 @@ static void test_bidir_unbiased(void **state)
                 assert_true(res.walks.walks == 20000);
                 assert_true(fabs(z) < 4);
                 assert_close(res.estimate - res.push_part, res.walks.estimate, 1e-15 * (fabs(res.estimate) + 1));
-                assert_close(res.ci95[1] - res.ci95[0], 2 * 1.959963984540054 * res.std_error, 1e-12);
+                assert_close(res.ci95[1] - res.ci95[0], 2 * ULAM_Z95 * res.std_error, 1e-12);
                 assert_true(res.seconds >= res.push.seconds);
                 if (q == 2) assert_true(res.plan.pilot_walks == 256 && res.plan.mean_visits >= 1);
             }
@@ -255,6 +255,7 @@ static void test_bidir_plan(void **state)
     o.rmax = 0.01, o.walk.rel_err = 0, o.walk.max_walks = 5000; /* given rmax: no pilot, walks known */
     assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
     assert_true(!plan.balanced && plan.pilot_walks == 0 && plan.rmax == 0.01 && plan.predicted_walks == 5000);
+    assert_true(isnan(plan.predicted_work)); /* V unknown */
     o.walk.rel_err = 0.05, o.walk.max_walks = 0;
     assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
     assert_true(isnan(plan.predicted_walks) && isnan(plan.predicted_work)); /* no pilot measured V */
@@ -263,6 +264,112 @@ static void test_bidir_plan(void **state)
     assert_int_equal(ulam_bidir_plan(NULL, Mt, &o, &plan, &err), ULAM_EINVAL);
     ulam_push_free(w), ulam_push_free(fresh);
     ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
+/* The walk solver's start distribution (ulam_walk_opts.starts, what the sparse-b walks use):
+ * <c, x> within 4 sigma of LAPACK for the three estimators and under a rel_err rule (which
+ * must stop), and refused in forward mode, with a state out of range or all-zero weights. */
+static void test_solver_starts(void **state)
+{
+    (void)state;
+    ulam_csr *M = random_system(60, 4, 1, 0.85, 7);
+    int64_t n = M->nrows, st[3] = {5, 17, 5};
+    double c[3] = {0.5, -2.0, 0.25}, *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
+    for (int64_t i = 0; i < n; i++) b[i] = 1.0 + (double)(i % 5) / 4.0;
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    double exact = 0.75 * x[5] - 2.0 * x[17];
+    for (int k = 0; k < 4; k++) { /* case k: estimators 0..2, then collision with rel_err 0.02 */
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.nstarts = 3, o.starts = st, o.start_weights = c, o.seed = (uint64_t)k + 1;
+        o.estimator = k < 3 ? k : ULAM_COLLISION, o.max_walks = k < 3 ? 40000 : 0, o.rel_err = k < 3 ? 0 : 0.02;
+        ulam_walk_result r;
+        ulam_error err;
+        int st_ = ulam_solve(M, b, &o, &r, &err);
+        if (st_ || !(fabs(r.estimate - exact) < 4 * r.std_error))
+            print_error("case %d: %s, %.8g +- %.3g, exact %.8g\n", k, ulam_strerror(st_), r.estimate, r.std_error, exact);
+        assert_int_equal(st_, ULAM_OK);
+        assert_true(fabs(r.estimate - exact) < 4 * r.std_error);
+        if (k == 3) assert_true(r.rel_err_met && r.std_error <= 0.02 * fabs(r.estimate));
+    }
+    ulam_walk_opts o = ulam_walk_defaults();
+    ulam_walk_result r;
+    ulam_error err;
+    double zeros[3] = {0, 0, 0};
+    int64_t bad[3] = {5, 60, 1};
+    o.nstarts = 3, o.starts = st, o.start_weights = c, o.mode = ULAM_FORWARD;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    o.mode = ULAM_ADJOINT, o.starts = bad;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    o.starts = st, o.start_weights = zeros;
+    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    free(b), free(x);
+    ulam_csr_free(M);
+}
+
+/* A sparse b of 3 entries with mixed signs: x_t = <p, b> + <r, x> with walks started at b's
+ * states in proportion to |b_j|, signed weights ||b||_1: within 4 sigma of LAPACK on systems of
+ * the table (fixed and balanced rmax, collision and expected), the push's invariant exact for
+ * that b, the result the same for any thread count, bad entries refused. */
+static void test_bidir_sparse_b(void **state)
+{
+    (void)state;
+    static const double rmaxes[] = {0.05, 0};
+    for (int k = 0; k < NSYS - 1; k++) { /* the long walks of the last system: test_bidir_unbiased */
+        ulam_csr *M = random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k), *Mt = NULL;
+        assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+        int64_t n = M->nrows, t = (k * 3 + 2) % n;
+        int64_t idx[3] = {(k * 7 + 1) % n, (k * 5 + 4) % n, (k * 11 + 6) % n};
+        double val[3] = {0.7, -1.3, 0.4};
+        double *b = calloc((size_t)n, sizeof *b), *x = malloc((size_t)n * sizeof *x);
+        for (int j = 0; j < 3; j++) b[idx[j]] += val[j];
+        assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+        ulam_push *w = NULL;
+        assert_int_equal(ulam_push_alloc(M, &w), ULAM_OK);
+        for (int q = 0; q < 2; q++)
+            for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est += 2) {
+                ulam_bidir_opts o = ulam_bidir_defaults();
+                o.target = t, o.nb = 3, o.b_index = idx, o.b_value = val, o.rmax = rmaxes[q];
+                o.walk.max_walks = 20000, o.walk.estimator = est, o.walk.seed = (uint64_t)(k * 10 + q + 100);
+                ulam_bidir_result res;
+                ulam_error err;
+                int st = ulam_bidir_solve(w, Mt, &o, &res, &err);
+                if (st) print_error("case %d: %s: %s\n", k, ulam_strerror(st), err.msg);
+                assert_int_equal(st, ULAM_OK);
+                assert_invariant(w, M, t, b, x, k);
+                assert_close(res.push_part, 0.7 * ulam_push_estimates(w)[idx[0]] - 1.3 * ulam_push_estimates(w)[idx[1]] +
+                             0.4 * ulam_push_estimates(w)[idx[2]], 1e-15);
+                if (res.std_error == 0) { /* no residual the walks reach: exact */
+                    assert_close(res.estimate, x[t], 1e-12 * fabs(x[t]) + 1e-300);
+                    continue;
+                }
+                double z = (res.estimate - x[t]) / (res.std_error + 1e-13 * fabs(x[t]));
+                if (!(fabs(z) < 4))
+                    print_error("case %d rmax %g est %d: estimate %.10g, LAPACK %.10g, stderr %.3g (z = %.2f)\n", k,
+                                rmaxes[q], est, res.estimate, x[t], res.std_error, z);
+                assert_true(fabs(z) < 4 && res.walks.walks == 20000);
+                if (k == 1 && q == 1 && est == ULAM_COLLISION) { /* any thread count, the same answer */
+                    ulam_bidir_result two;
+                    o.walk.threads = 2;
+                    assert_int_equal(ulam_bidir_solve(w, Mt, &o, &two, &err), ULAM_OK);
+                    assert_memory_equal(&two.estimate, &res.estimate, sizeof res.estimate);
+                    assert_memory_equal(&two.std_error, &res.std_error, sizeof res.std_error);
+                }
+            }
+        ulam_bidir_opts o = ulam_bidir_defaults();
+        ulam_bidir_result res;
+        ulam_error err;
+        int64_t bad_idx[2] = {0, n};
+        double zeros[2] = {0, 0}, nan_val[2] = {1, NAN};
+        o.target = t, o.nb = 2, o.b_index = bad_idx, o.b_value = val;
+        assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL); /* index n */
+        o.b_index = idx, o.b_value = zeros;
+        assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL); /* ||b||_1 = 0 */
+        o.b_value = nan_val;
+        assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL);
+        ulam_push_free(w);
+        free(b), free(x);
+        ulam_csr_free(M), ulam_csr_free(Mt);
+    }
 }
 
 /* Over 200 seeds the 95% interval covers the LAPACK value 180 to 198 times (Bin(200, 0.95) falls
@@ -434,7 +541,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_push_invariant), cmocka_unit_test(test_push_bad_input),
-        cmocka_unit_test(test_bidir_unbiased), cmocka_unit_test(test_bidir_plan), cmocka_unit_test(test_bidir_coverage),
+        cmocka_unit_test(test_bidir_unbiased), cmocka_unit_test(test_bidir_plan),
+        cmocka_unit_test(test_solver_starts), cmocka_unit_test(test_bidir_sparse_b),  cmocka_unit_test(test_bidir_coverage),
         cmocka_unit_test(test_bidir_rules),    cmocka_unit_test(test_bidir_rare_score),
         cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
     };

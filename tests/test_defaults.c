@@ -134,8 +134,9 @@ static void test_bidir_and_auto(void **state)
     assert_int_equal(a.pin_estimator, 0);
     assert_int_equal(a.pin_continue, 0);
     assert_close(a.continue_q, 0.9, 0);
-    assert_int_equal(a.pilot_walks, 2048);
-    assert_close(a.pilot_seconds, 0.02, 0);
+    assert_int_equal(a.pilot_walks, 128);
+    assert_int_equal(a.pilot_max, 1024);
+    assert_close(a.pilot_share, 0.2, 0);
 }
 
 /* Concatenate one process's bytes (the allgather of a share of one). */

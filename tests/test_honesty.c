@@ -47,7 +47,7 @@ static void test_rel_err_rare_scores(void **state)
             assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
             assert_true(r.rel_err_met && r.variance_finite == 1);
             assert_true(r.std_error <= cases[k].E * fabs(r.estimate) && r.walks >= r.min_walks);
-            covered += fabs(r.estimate - x) <= 1.959963984540054 * r.std_error;
+            covered += fabs(r.estimate - x) <= ULAM_Z95 * r.std_error;
             bias += r.estimate - x, se += r.std_error, walks += (double)r.walks;
         }
         test_case_done();

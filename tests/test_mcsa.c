@@ -5,31 +5,12 @@
 
 #include <string.h>
 
-typedef struct {
-    ulam_csr *M;
-    double *b, *x; /* x: LAPACK solution */
-    int64_t n;
-} sys;
+typedef test_sys sys;
 
-/* Load matrices/NAME.mtx and its b (with the Jacobi splitting when jacobi), and solve it with
- * LAPACK. */
+/* Load matrices/NAME.mtx and its b (with the Jacobi splitting when jacobi), solved with LAPACK. */
 static sys load(const char *name, int jacobi)
 {
-    char mp[256], bp[256];
-    snprintf(mp, sizeof mp, "matrices/%s.mtx", name);
-    snprintf(bp, sizeof bp, "matrices/%s_b.mtx", name);
-    sys s;
-    s.M = must_read(mp);
-    s.b = must_read_vector(bp, &s.n);
-    if (jacobi) {
-        ulam_csr *M = NULL;
-        assert_int_equal(ulam_jacobi(s.M, s.b, 1.0, &M, s.b, NULL), ULAM_OK);
-        ulam_csr_free(s.M);
-        s.M = M;
-    }
-    s.x = malloc((size_t)s.n * sizeof *s.x);
-    assert_int_equal(ulam_direct_solve(s.M, s.b, s.x, 0, NULL, NULL), ULAM_OK);
-    return s;
+    return test_sys_load_split(name, jacobi);
 }
 
 /* The rho = 0.9 random system scaled to row and column sums 0.5 (short walks: cheap enough for
@@ -45,8 +26,7 @@ static sys load_half(void)
 /* Free a loaded system. */
 static void unload(sys *s)
 {
-    ulam_csr_free(s->M);
-    free(s->b), free(s->x);
+    test_sys_free(s);
 }
 
 /* ||x - x_LAPACK||_2 / ||x_LAPACK||_2. */

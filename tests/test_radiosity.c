@@ -296,7 +296,7 @@ static void test_shoot_coverage(void **state)
     for (uint64_t seed = 0; seed < 200; seed++) {
         if (!test_case((long)seed)) continue;
         ulam_rad_result r = rad_walk(t, ULAM_FORWARD, ULAM_COLLISION, 1, 2000, 5000 + seed, NULL);
-        for (int c = 0; c < 3; c++) inside[c] += fabs(r.radiosity[c] - Bx[3 + c]) <= 1.96 * r.std_error[c];
+        for (int c = 0; c < 3; c++) inside[c] += fabs(r.radiosity[c] - Bx[3 + c]) <= ULAM_Z95 * r.std_error[c];
     }
     test_case_done();
     print_message("shooting coverage of the 95%% interval over 200 seeds: R %d G %d B %d\n", inside[0], inside[1], inside[2]);
@@ -322,7 +322,7 @@ static void test_next_event_coverage(void **state)
             if (!test_case(1000L * est + (long)seed)) continue;
             ulam_rad_result r = rad_walk(t, ULAM_ADJOINT, est, 1, 2000, 7000 + seed, NULL);
             double z = (r.radiosity[0] - x) / r.std_error[0];
-            inside += fabs(z) <= 1.96, zsum += z, zsq += z * z;
+            inside += fabs(z) <= ULAM_Z95, zsum += z, zsq += z * z;
         }
         test_case_done();
         print_message("next-event %s: %d of 200 inside 1.96 sigma, mean z %+.3f, var z %.3f\n",

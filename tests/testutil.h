@@ -29,6 +29,7 @@
 static struct {
     long k;     /* the case being run */
     int active; /* inside a table's loop */
+    long ran;   /* cases entered (a ULAM_TEST_CASE that no table has is an error, not a pass) */
 } test_case_state;
 
 /* The case ULAM_TEST_CASE names, or -1 (every case). */
@@ -51,7 +52,7 @@ static inline int test_case(long k)
 {
     long only = test_case_only();
     if (only >= 0 && k != only) return 0;
-    test_case_state.k = k, test_case_state.active = 1;
+    test_case_state.k = k, test_case_state.active = 1, test_case_state.ran++;
     return 1;
 }
 
@@ -90,6 +91,10 @@ static inline int test_run_(const char *group, const struct CMUnitTest *tests, s
     if (only && *only) cmocka_set_test_filter(only);
     int rc = _cmocka_run_group_tests(group, t, n, NULL, NULL);
     free(t);
+    if (test_case_only() >= 0 && test_case_state.ran == 0) {
+        print_error("[  CASE    ] no table of the tests run has case %ld (ULAM_TEST_CASE)\n", test_case_only());
+        return 1;
+    }
     return rc;
 }
 
@@ -170,8 +175,9 @@ static inline void test_sys_solve(test_sys *s)
     assert_int_equal(ulam_direct_solve(s->M, s->b, s->x, 0, NULL, NULL), ULAM_OK);
 }
 
-/* Load matrices/NAME.mtx and its b (matrices/NAME_b.mtx), solved with LAPACK. */
-static inline test_sys test_sys_load(const char *name)
+/* Load matrices/NAME.mtx and its b (matrices/NAME_b.mtx), with the Jacobi splitting
+ * M = I - D^-1 A when jacobi (the file then holds A), solved with LAPACK. */
+static inline test_sys test_sys_load_split(const char *name, int jacobi)
 {
     char mp[256], bp[256];
     snprintf(mp, sizeof mp, "matrices/%s.mtx", name);
@@ -179,8 +185,20 @@ static inline test_sys test_sys_load(const char *name)
     test_sys s;
     s.M = must_read(mp);
     s.b = must_read_vector(bp, &s.n);
+    if (jacobi) {
+        ulam_csr *M = NULL;
+        assert_int_equal(ulam_jacobi(s.M, s.b, 1.0, &M, s.b, NULL), ULAM_OK);
+        ulam_csr_free(s.M);
+        s.M = M;
+    }
     test_sys_solve(&s);
     return s;
+}
+
+/* Load matrices/NAME.mtx and its b (matrices/NAME_b.mtx), solved with LAPACK. */
+static inline test_sys test_sys_load(const char *name)
+{
+    return test_sys_load_split(name, 0);
 }
 
 /* Free a loaded system. */

@@ -15,6 +15,9 @@ def _statuses():
 
 STATUS = _statuses()
 
+# The 95% normal quantile, the library's ULAM_Z95 (one home).
+Z95 = float(re.search(r"#define ULAM_Z95 ([0-9.]+)", open(_HEADER).read()).group(1))
+
 
 def code(name):
     """The exit code of a run that failed with status ULAM_<name>."""

@@ -6,39 +6,31 @@
 #include <string.h>
 
 
-/* Nonzero when argv names option opt (as "--opt" or "--opt=..."). */
-static int has_option(int argc, char **argv, const char *opt)
+/* Choose for s (loaded) under o (what ao pins stays), make the solver *sv and set o's mode,
+ * estimator and continuation to the choice; *status gets the solver's refusal (err filled) for the
+ * caller to report as a plain run's.  0, or an exit code (message printed) when the library fails
+ * or when no candidate is certified and o asks for a --rel-err target (the closest is named). */
+int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, ulam_auto_result *res,
+                    ulam_solver **sv, int *status, ulam_error *err)
 {
-    size_t n = strlen(opt);
-    for (int k = 1; k < argc; k++)
-        if (!strncmp(argv[k], opt, n) && (argv[k][n] == '\0' || argv[k][n] == '=')) return 1;
-    return 0;
-}
-
-/* Choose for s (loaded) and set o's mode, estimator and continuation; what the command line names
- * (--mode, --estimator, --continue) is pinned.  0, or an exit code (message printed) when the library
- * fails or when no candidate is certified and o asks for a --rel-err target. */
-int cli_auto_choose(const cli_system *s, int argc, char **argv, ulam_walk_opts *o, ulam_auto_result *res)
-{
-    ulam_auto_opts ao = ulam_auto_defaults();
-    ao.pin_mode = has_option(argc, argv, "--mode");
-    ao.pin_estimator = has_option(argc, argv, "--estimator");
-    ao.pin_continue = has_option(argc, argv, "--continue");
-    ulam_error err;
-    int status = ulam_auto_choose(s->M, s->b, o, &ao, res, &err);
-    if (status) return cli_report(s->matrix_path, &err);
+    *status = ulam_auto_solver(s->M, s->b, o, ao, res, sv, err);
     int k = res->chosen >= 0 ? res->chosen : res->closest;
-    if (k < 0) return cli_usage_error("solve", "--method auto has no candidate left once --mode, --estimator and --continue are pinned");
+    if (k < 0) return cli_report(s->matrix_path, err);
     const ulam_auto_candidate *c = &res->cand[k];
     if (res->chosen < 0) {
-        fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance; the closest is "
-                        "%s %s (continuation %s%.3g) with rho(M^) = %.6g (upper bound %.6g)%s\n",
-                s->matrix_path, o->rel_err > 0 ? "error" : "warning", cli_mode_names[c->mode], cli_estimator_names[c->estimator],
-                c->continue_q > 0 ? "" : "analog, ", c->continue_q > 0 ? c->continue_q : 0.0, c->hat.rho, c->hat.upper,
+        int diverge = !(res->abs.upper < 1);
+        fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance%s; the closest is "
+                        "%s %s (continuation %s%.3g, kernel exponent %g) with rho(M^) = %.6g (upper bound %.6g)%s\n",
+                s->matrix_path, o->rel_err > 0 ? "error" : "warning", diverge ? " (rho(|M|) is not certified below 1)" : "",
+                cli_mode_names[c->mode], cli_estimator_names[c->estimator], c->continue_q > 0 ? "" : "analog, ",
+                c->continue_q > 0 ? c->continue_q : 0.0, c->kernel_alpha, c->hat.rho, c->hat.upper,
                 o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it");
-        if (o->rel_err > 0) return EXIT_DIVERGE;
+        if (o->rel_err > 0) {
+            *sv = ulam_solver_free(*sv);
+            return diverge ? EXIT_DIVERGE : EXIT_INFVAR;
+        }
     }
-    o->mode = c->mode, o->estimator = c->estimator, o->continue_q = c->continue_q;
+    o->mode = c->mode, o->estimator = c->estimator, o->continue_q = c->continue_q, o->kernel_alpha = c->kernel_alpha;
     return 0;
 }
 
@@ -49,29 +41,53 @@ static void print_q(double q)
     else printf("analog    ");
 }
 
+/* What became of a candidate, in words (JSON "state"). */
+static const char *const state_names[] = {"uncertified", "refused", "skipped", "dropped", "finalist", "chosen"};
+
+/* The pilots' share of the whole estimate's predicted work (NaN when not predicted). */
+static double pilot_share(const ulam_auto_result *res)
+{
+    if (res->chosen < 0) return NAN;
+    double run = res->cand[res->chosen].predicted_work, over = res->pilot_work - res->reused_work;
+    return isfinite(run) ? over / (over + res->reused_work + run) : NAN;
+}
+
 /* The candidates and the choice, as text. */
 void cli_auto_print_text(const ulam_auto_result *res)
 {
-    printf("auto            %s from %d candidates (guards and pilots %.3f s); the estimate is from fresh walks\n",
-           res->chosen >= 0 ? "chose the least variance x seconds a walk" : "no certified candidate: ran the closest",
-           res->ncand, res->seconds);
+    if (res->chosen >= 0)
+        printf("auto            chose the least predicted %s of %d candidates after %d pilot stages; the pilots' "
+               "overhead is %.3g%% of the predicted work (guards and pilots %.3f s); the estimate is from fresh walks\n",
+               res->by_work ? "work" : "variance x work a walk",
+               res->ncand, res->stages, 100 * pilot_share(res), res->seconds);
+    else
+        printf("auto            no certified candidate among %d: ran the closest\n", res->ncand);
     for (int k = 0; k < res->ncand; k++) {
         const ulam_auto_candidate *c = &res->cand[k];
         printf("  %c %-8s %-10s ", k == res->chosen ? '*' : ' ', cli_mode_names[c->mode], cli_estimator_names[c->estimator]);
         print_q(c->continue_q);
-        printf(" rho(M^) %-9.4g ", c->hat.rho);
-        if (!c->certified) printf("not certified finite (upper bound %.4g)\n", c->hat.upper);
-        else if (c->status) printf("refused: %s\n", ulam_strerror(c->status));
-        else printf("variance %-10.4g %.3g s/walk  cost %-10.4g predicted %.3g s\n", c->variance, c->seconds_per_walk,
-                    c->cost, c->predicted_seconds);
+        printf(" alpha %-3.3g", c->kernel_alpha);
+        if (isfinite(c->hat.upper)) printf(" rho(M^) %-9.4g ", c->hat.rho);
+        else printf(" rho(M^) %-9s ", "-");
+        if (c->state == ULAM_AUTO_SKIPPED) printf("not piloted: starting its kernel would pass the pilot budget\n");
+        else if (!c->certified) printf("not certified finite (upper bound %.4g)\n", c->hat.upper);
+        else if (c->state == ULAM_AUTO_REFUSED) printf("refused: %s\n", ulam_strerror(c->status));
+        else
+            printf("pilots %lld walks  variance %-9.4g (+-%.0f%%) %.3g steps/walk  predicted %.4g walks, %.3g units "
+                   "(%.2g s)%s\n", (long long)c->pilot_walks, c->variance, 100 * fmin(c->variance_rel_error, 99.99),
+                   c->steps_per_walk, c->predicted_walks, c->predicted_work, c->predicted_seconds,
+                   c->state == ULAM_AUTO_DROPPED ? "  dropped" : "");
     }
 }
 
 /* The candidates and the choice, as the JSON key "auto" (followed by a comma). */
 void cli_auto_print_json(const ulam_auto_result *res)
 {
-    printf("\"auto\": {\"chosen\": %d, \"closest\": %d, ", res->chosen, res->closest);
+    printf("\"auto\": {\"chosen\": %d, \"closest\": %d, \"stages\": %d, ", res->chosen, res->closest, res->stages);
     cli_json_number("seconds", res->seconds, 0);
+    cli_json_number("pilot_work", res->pilot_work, 0);
+    cli_json_number("reused_work", res->reused_work, 0);
+    cli_json_number("pilot_share", pilot_share(res), 0);
     printf("\"candidates\": [");
     for (int k = 0; k < res->ncand; k++) {
         const ulam_auto_candidate *c = &res->cand[k];
@@ -79,14 +95,20 @@ void cli_auto_print_json(const ulam_auto_result *res)
         cli_json_string("mode", cli_mode_names[c->mode], 0);
         cli_json_string("estimator", cli_estimator_names[c->estimator], 0);
         cli_json_number("continue", c->continue_q > 0 ? c->continue_q : NAN, 0);
-        cli_json_number("rho_hat", c->hat.rho, 0);
+        cli_json_number("kernel_alpha", c->kernel_alpha, 0);
+        cli_json_number("rho_hat", isfinite(c->hat.upper) ? c->hat.rho : NAN, 0);
         cli_json_number("rho_hat_upper", c->hat.upper, 0);
         printf("\"certified\": %s, ", c->certified ? "true" : "false");
+        cli_json_string("state", state_names[c->state], 0);
         cli_json_string("status", c->status ? ulam_strerror(c->status) : "ok", 0);
         printf("\"pilot_walks\": %lld, ", (long long)c->pilot_walks);
         cli_json_number("variance", c->pilot_walks ? c->variance : NAN, 0);
-        cli_json_number("seconds_per_walk", c->pilot_walks ? c->seconds_per_walk : NAN, 0);
+        cli_json_number("variance_rel_error", c->pilot_walks ? c->variance_rel_error : NAN, 0);
+        cli_json_number("steps_per_walk", c->pilot_walks ? c->steps_per_walk : NAN, 0);
+        cli_json_number("work_per_walk", c->pilot_walks ? c->work_per_walk : NAN, 0);
         cli_json_number("cost", c->cost, 0);
+        cli_json_number("predicted_walks", c->predicted_walks, 0);
+        cli_json_number("predicted_work", c->predicted_work, 0);
         cli_json_number("predicted_seconds", c->predicted_seconds, 1);
         printf("}");
     }

@@ -1,5 +1,6 @@
-/* ulam solve --source S: one entry x_I of (I - M) x = e_S, by a reverse push from I and walks
- * from S (--method bidirectional).  Reached from cli_solve through cli_bidir_claims. */
+/* ulam solve --source S or --rhs b --method bidirectional: one entry x_I of (I - M) x = b for
+ * b = e_S or a sparse b, by a reverse push from I and walks from b's states.  Reached from
+ * cli_solve through cli_bidir_claims. */
 #include "cli.h"
 
 #include <getopt.h>
@@ -10,21 +11,29 @@
 
 static const char *const usage =
     "usage: ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R]\n"
+    "       ulam solve M.mtx --index I --rhs b.mtx --method bidirectional [--rmax R]\n"
     "                  [--min-value V] [--estimator collision|absorption|expected] [--walks N]\n"
     "                  [--rel-err E] [--time S] [--seed S] [--threads T] [--continue Q]\n"
     "                  [--max-steps K] [--check] [--json] [--force] [--cache]\n"
     "\n"
-    "Estimate x_I of (I - M) x = e_S (a point source at S; no --rhs file) with an error bar:\n"
-    "a reverse push from I on the adjoint equation leaves x_I = p_S + <r, x> with every\n"
-    "|r_j| <= R, then walks from S (on the columns of M) score the residual r.\n"
-    "Indices are 1-based.\n"
+    "Estimate x_I of (I - M) x = b with an error bar, for a point source b = e_S (no --rhs\n"
+    "file) or a sparse b (at most max(16, n/10) nonzeros; a denser b is refused):\n"
+    "a reverse push from I on the adjoint equation leaves x_I = <p, b> + <r, x> with every\n"
+    "|r_j| <= R, then walks from b's states (S, or state j with probability |b_j| / ||b||_1;\n"
+    "on the columns of M) score the residual r.  Indices are 1-based.\n"
     "\n"
     "  --rmax R           push threshold (default: balance the push's work against the work\n"
     "                     the walks are predicted to need for the target)\n"
     "  --min-value V      the smallest x_I the balance plans for (default 1 / n)\n"
     "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
-    "  the other options are those of 'ulam solve'; the walks are walks on M' from S, so the\n"
+    "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
     "  guards reported are those of the forward kernel\n";
+
+/* The densest b the bidirectional path takes: nonzeros at most max(16, n / 10). */
+static int64_t sparse_limit(int64_t n)
+{
+    return n / 10 > 16 ? n / 10 : 16;
+}
 
 /* Nonzero when argv asks for a point-source solve (--source, --rmax or --method bidirectional). */
 int cli_bidir_claims(int argc, char **argv)
@@ -53,9 +62,13 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->target + 1,
            o->target < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
            w->interrupted ? "  [INTERRUPTED]" : "");
-    printf("method          bidirectional: reverse push from %lld, walks from source %lld (%s rmax)\n",
-           (long long)o->target + 1, (long long)o->source + 1, o->rmax > 0 ? "given" : "balanced");
-    printf("push            rmax %.3g: %lld pushes, %lld operations, %.4f s; p_S = %.10g; residual on %lld "
+    if (o->nb > 0)
+        printf("method          bidirectional: reverse push from %lld, walks from b's %lld nonzeros (%s rmax)\n",
+               (long long)o->target + 1, (long long)o->nb, o->rmax > 0 ? "given" : "balanced");
+    else
+        printf("method          bidirectional: reverse push from %lld, walks from source %lld (%s rmax)\n",
+               (long long)o->target + 1, (long long)o->source + 1, o->rmax > 0 ? "given" : "balanced");
+    printf("push            rmax %.3g: %lld pushes, %lld operations, %.4f s; <p, b> = %.10g; residual on %lld "
            "states, sum %.3g\n", r->push.rmax, (long long)r->push.pushes, (long long)r->push.ops, r->push.seconds,
            r->push_part, (long long)r->push.support, r->push.r_sum);
     if (r->push.support == 0)
@@ -82,7 +95,9 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
 {
     const ulam_walk_result *w = &r->walks;
     int finite = rp->g.verdict_hat[ULAM_FORWARD] != ULAM_VERDICT_FAIL;
-    printf("{\"index\": %lld, \"source\": %lld, ", (long long)o->target + 1, (long long)o->source + 1);
+    printf("{\"index\": %lld, ", (long long)o->target + 1);
+    if (o->nb > 0) printf("\"source\": null, \"b_nonzeros\": %lld, ", (long long)o->nb);
+    else printf("\"source\": %lld, \"b_nonzeros\": 1, ", (long long)o->source + 1);
     cli_json_string("method", "bidirectional", 0);
     cli_json_number("estimate", r->estimate, 0);
     cli_json_number("stderr", r->std_error, 0);
@@ -127,8 +142,32 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     printf("\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
 }
 
-/* Load the system with b = e_S, check S, run the guards and --check; 0 or an exit code. */
-static int prepare(cli_system *s, int64_t source, int force, double continue_q, report *rp)
+/* b's nonzeros as entries of o (new arrays in *idx, *val); 0 or an exit code (refused when b is
+ * zero or denser than sparse_limit). */
+static int sparse_b(const cli_system *s, ulam_bidir_opts *o, int64_t **idx, double **val)
+{
+    int64_t n = s->M->nrows, k = 0;
+    for (int64_t i = 0; i < n; i++) k += s->b[i] != 0.0;
+    if (k == 0) return cli_usage_error("solve", "%s: b is zero, so x is 0: nothing to estimate", s->rhs_path);
+    if (k > sparse_limit(n))
+        return cli_usage_error("solve", "%s: --method bidirectional is for a sparse b, and this b has %lld nonzeros of "
+                               "%lld (more than max(16, n/10) = %lld): use the walks (--method auto)", s->rhs_path,
+                               (long long)k, (long long)n, (long long)sparse_limit(n));
+    *idx = malloc((size_t)k * sizeof **idx), *val = malloc((size_t)k * sizeof **val);
+    if (!*idx || !*val) {
+        fprintf(stderr, "ulam: %s: error: %s\n", s->rhs_path, ulam_strerror(ULAM_ENOMEM));
+        return cli_exit_code(ULAM_ENOMEM);
+    }
+    for (int64_t i = 0, j = 0; i < n; i++)
+        if (s->b[i] != 0.0) (*idx)[j] = i, (*val)[j++] = s->b[i];
+    o->nb = k, o->b_index = *idx, o->b_value = *val;
+    return 0;
+}
+
+/* Load the system with b from --rhs (sparse) or b = e_S, check S, run the guards and --check;
+ * 0 or an exit code. */
+static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o, int64_t **idx, double **val,
+                   report *rp)
 {
     double t0 = ulam_now();
     int rc = cli_load_system(s);
@@ -137,12 +176,17 @@ static int prepare(cli_system *s, int64_t source, int force, double continue_q, 
     int64_t n = s->M->nrows;
     if (source > n)
         return cli_usage_error("solve", "--source %lld is out of range 1..%lld", (long long)source, (long long)n);
-    if (!(s->own_b = calloc((size_t)n, sizeof *s->own_b))) {
-        fprintf(stderr, "ulam: %s: error: %s\n", s->matrix_path, ulam_strerror(ULAM_ENOMEM));
-        return cli_exit_code(ULAM_ENOMEM);
+    if (s->rhs_path) {
+        if ((rc = sparse_b(s, o, idx, val))) return rc;
+    } else {
+        if (!(s->own_b = calloc((size_t)n, sizeof *s->own_b))) {
+            fprintf(stderr, "ulam: %s: error: %s\n", s->matrix_path, ulam_strerror(ULAM_ENOMEM));
+            return cli_exit_code(ULAM_ENOMEM);
+        }
+        s->own_b[source - 1] = 1.0;
+        s->b = s->own_b; /* freed by cli_system_free */
     }
-    s->own_b[source - 1] = 1.0;
-    s->b = s->own_b; /* freed by cli_system_free */
+    double continue_q = o->walk.continue_q;
     if ((rc = cli_guard(s, continue_q, 1.0, ULAM_FORWARD, &rp->g))) return rc;
     if (rp->g.verdict_abs >= ULAM_VERDICT_FAIL) {
         cli_guard_diverge(s, &rp->g, force);
@@ -186,7 +230,7 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     return rc;
 }
 
-/* ulam solve --source S. */
+/* ulam solve --source S, or --rhs b --method bidirectional. */
 int cli_bidir(int argc, char **argv)
 {
     static const struct option longopts[] = {
@@ -204,7 +248,9 @@ int cli_bidir(int argc, char **argv)
     ulam_bidir_opts o = ulam_bidir_defaults();
     report rp = {0};
     int64_t source = 0;
-    int c, rc, idx, force = 0;
+    int c, rc, idx, force = 0, method = 0;
+    int64_t *bidx = NULL;
+    double *bval = NULL;
     o.walk.max_walks = 0;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
@@ -216,6 +262,7 @@ int cli_bidir(int argc, char **argv)
         case 'M':
             if (strcmp(optarg, "bidirectional"))
                 return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
+            method = 1;
             break;
         case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &o.rmax))) return rc; break;
         case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &o.min_value))) return rc; break;
@@ -228,16 +275,20 @@ int cli_bidir(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (s.rhs_path) return cli_usage_error("solve", "--source S sets b = e_S: it cannot go with --rhs");
-    if (!source) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
-    if (!s.index) return cli_usage_error("solve", "--source S needs --index I");
+    if (s.rhs_path && source) return cli_usage_error("solve", "--source S sets b = e_S: it cannot go with --rhs");
+    if (s.rhs_path && !method)
+        return cli_usage_error("solve", "--rhs b with --rmax is a bidirectional solve: say --method bidirectional");
+    if (!source && !s.rhs_path)
+        return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S) or a sparse --rhs b.mtx");
+    if (!s.index) return cli_usage_error("solve", "--method bidirectional needs --index I");
     cli_walk_budget(&o.walk);
     o.walk.force = force;
     s.matrix_path = argv[optind];
-    if (!(rc = prepare(&s, source, force, o.walk.continue_q, &rp))) {
-        o.target = s.index - 1, o.source = source - 1;
+    if (!(rc = prepare(&s, source, force, &o, &bidx, &bval, &rp))) {
+        o.target = s.index - 1, o.source = source ? source - 1 : 0;
         rc = run(&s, &o, &rp);
     }
+    free(bidx), free(bval);
     cli_system_free(&s);
     return rc;
 }

@@ -142,9 +142,11 @@ int cli_solve(int argc, char **argv);
 int cli_bidir_claims(int argc, char **argv);
 int cli_bidir(int argc, char **argv);
 
-/* solve --method auto (src/cli/auto.c): choose the method for the loaded s and set o (what argv pins
- * stays); 0 or an exit code.  Then print the candidates as text, or as the JSON key "auto". */
-int cli_auto_choose(const cli_system *s, int argc, char **argv, ulam_walk_opts *o, ulam_auto_result *res);
+/* solve --method auto (src/cli/auto.c): choose the method for the loaded s under o (what ao pins
+ * stays), make the solver *sv and set o to the choice; *status and err get the solver's refusal.
+ * 0 or an exit code.  Then print the candidates as text, or as the JSON key "auto". */
+int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, ulam_auto_result *res,
+                    ulam_solver **sv, int *status, ulam_error *err);
 void cli_auto_print_text(const ulam_auto_result *res);
 void cli_auto_print_json(const ulam_auto_result *res);
 int cli_study(int argc, char **argv);
@@ -165,7 +167,7 @@ typedef struct cli_progress {
     double t0, last;
 } cli_progress;
 void cli_progress_start(cli_progress *p, int json);
-void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double se, double rel_err);
+void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double se, const ulam_walk_opts *o);
 void cli_progress_end(cli_progress *p);
 
 /* The walk modes and estimators by name, indexed by enum ulam_mode and enum ulam_estimator. */

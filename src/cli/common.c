@@ -351,16 +351,20 @@ void cli_progress_start(cli_progress *p, int json)
     p->shown = 0;
 }
 
-/* Show walks, the estimate +- its standard error, the time elapsed and, with a relative-error
- * target, the time left at this rate (the error falls as 1 / sqrt(walks)); at most 4 a second. */
-void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double se, double rel_err)
+/* Show walks, the estimate +- its standard error, the time elapsed and the time left at this
+ * rate: the least of what the relative-error target (the error falls as 1 / sqrt(walks)), the
+ * walk budget and the time limit of o leave; at most 4 a second. */
+void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double se, const ulam_walk_opts *o)
 {
     double now = ulam_now(), el = now - p->t0;
     if (!p->on || now - p->last < 0.25) return;
     p->last = now, p->shown = 1;
     fprintf(stderr, "\rulam: %lld walks, %.6g +- %.2g, %.1f s", (long long)walks, estimate, se, el);
-    double want = rel_err * fabs(estimate);
-    if (rel_err > 0 && want > 0 && se > want) fprintf(stderr, ", about %.0f s left", el * ((se / want) * (se / want) - 1));
+    double want = o->rel_err * fabs(estimate), left = INFINITY;
+    if (o->rel_err > 0 && want > 0 && se > want) left = el * ((se / want) * (se / want) - 1);
+    if (o->max_walks > 0 && walks > 0) left = fmin(left, el * ((double)o->max_walks / (double)walks - 1));
+    if (o->max_seconds > 0) left = fmin(left, o->max_seconds - el);
+    if (isfinite(left)) left < 1 ? fputs(", under 1 s left", stderr) : fprintf(stderr, ", about %.0f s left", left);
     fputs("      ", stderr);
 }
 

@@ -52,7 +52,8 @@ int cli_solve_wants_method(int argc, char **argv)
         const char *v = !strncmp(argv[k], "--method=", 9) ? argv[k] + 9
                         : !strcmp(argv[k], "--method") && k + 1 < argc ? argv[k + 1] : NULL;
         if (!strcmp(argv[k], "--method") && !v) return 1; /* its parser reports the missing value */
-        if (v && strcmp(v, "auto") && strcmp(v, "bidirectional")) return 1; /* those two: cli_solve, cli_bidir */
+        if (v && strcmp(v, "auto") && strcmp(v, "walks") && strcmp(v, "bidirectional"))
+            return 1; /* those three: cli_solve, cli_bidir */
     }
     return 0;
 }
@@ -293,7 +294,7 @@ int cli_solve_method(int argc, char **argv)
         case 'b': s.rhs_path = optarg; break;
         case 'M':
             if ((p.method = cli_lookup(optarg, method_names, 6)) < 0)
-                return cli_usage_error("solve", "--method expects auto, bidirectional (with --source), mcsa, "
+                return cli_usage_error("solve", "--method expects auto, walks, bidirectional (with --source), mcsa, "
                                                 "sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
             if (p.method < KRYLOV_CG) o.method = p.method;
             break;

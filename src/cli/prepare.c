@@ -20,7 +20,7 @@ static const char *const usage =
     "  --omega W     damping of the Jacobi splitting (default 1)\n"
     "  --continue Q  certify the kernel of fixed continuation Q (default: analog); a query with\n"
     "                another continuation runs its own guards\n"
-    "  -o PATH       the output file (required)\n";
+    "  -o, --output PATH  the output file (required)\n";
 
 /* ulam prepare. */
 int cli_prepare(int argc, char **argv)

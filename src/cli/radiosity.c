@@ -261,7 +261,7 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
         status = ulam_rad_solver_iterate(sv);
         ulam_rad_solver_result(sv, &r);
         if (round == 0) rel_err_warning(a, &r);
-        cli_progress_show(&pg, r.walks, r.radiosity[0], r.std_error[0], a->o.rel_err); /* the red channel */
+        cli_progress_show(&pg, r.walks, r.radiosity[0], r.std_error[0], &a->o); /* the red channel */
     }
     cli_progress_end(&pg);
     cli_release_sigint();

@@ -41,8 +41,9 @@ static const char *const usage =
     "                     any --threads\n"
     "  --threads T        threads (default: all cores)\n";
 static const char *const usage2 = /* the help in two strings: C99 promises 4095 characters a literal */
-    "  --continue Q       continue with probability Q in every state (default: analog,\n"
-    "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased\n"
+    "  --continue Q       continue with probability Q in every state (analog, the default:\n"
+    "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased;\n"
+    "                     --continue analog names the default (pins it for --method auto)\n"
     "  --alpha A          kernel exponent: move to j with probability proportional to\n"
     "                     |M_ij|^A over the row's nonzeros (default 1, |M_ij| / S_i; 0 uniform,\n"
     "                     2 Alea's); rho(M^) and the error bar are this kernel's\n"
@@ -60,9 +61,12 @@ static const char *const usage2 = /* the help in two strings: C99 promises 4095 
     "                     whether rho(M^) < 1 (unknown is otherwise treated as infinite)\n"
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
     "                     that instead of parsing while the file is unchanged (size, mtime)\n"
-    "  --method auto      choose mode, estimator and continuation (those given stay pinned)\n"
-    "                     among candidates the guards certify, by short pilots; fresh walks\n"
-    "                     then estimate with the choice\n"
+    "  --method auto      (default) choose mode, estimator, continuation and --alpha among\n"
+    "                     the candidates the guards certify, by pilots compared on a fixed\n"
+    "                     work model (the same choice on every run); what is given stays\n"
+    "                     pinned; fresh walks then estimate with the choice\n"
+    "  --method walks     the single method the options name, defaults for the rest (adjoint,\n"
+    "                     collision, --continue analog, --alpha 1): the run before auto\n"
     "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
     "                     is built when a walk first reaches it, so one unknown of a large\n"
     "                     system reads and keeps only the rows its walks visit)\n"
@@ -154,9 +158,10 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
         printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
                o->rel_err);
     else if (o->rel_err > 0 && r->fourth_finite != 1)
-        printf("rel-err         NOT met (target %.3g): scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth "
-               "moment is %s and the variance's own error bar cannot be trusted\n", o->rel_err, r->rho4.lower,
-               r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
+        printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
+               "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
+               "not use the variance's own error bar\n", r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
+               r->rho4.lower, r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
     else if (o->rel_err > 0 && r->min_walks > 0)
         printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate%s)\n",
                r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
@@ -201,7 +206,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         cli_json_number("cut_bound", r->cut_bound, 0);
         printf("\"rel_err_stop\": %s, ", r->cut_stop ? "\"cuts\"" : r->out_of_reach ? "\"out_of_reach\""
                                        : !isfinite(r->tail_bound) && r->estimate != 0 ? "\"no_bound\""
-                                       : r->fourth_finite != 1 ? "\"fourth_moment\"" : "null");
+                                       : !r->rel_err_met && r->fourth_finite != 1 ? "\"fourth_moment\"" : "null");
         cli_json_variance("fourth_finite", r->fourth_finite);
         cli_json_radius("rho4", &r->rho4);
     }
@@ -317,9 +322,8 @@ typedef struct {
     ulam_walk_opts o;     /* how to walk and when to stop */
     const char *out, *errors; /* --out, --errors (NULL: none) */
     int check, json, force, assume_finite;
-    int autom;            /* --method auto */
-    int argc;             /* argv, for what --method auto leaves pinned */
-    char **argv;
+    int autom;            /* --method auto (the default): choose what is not pinned */
+    ulam_auto_opts ao;    /* what the command line pins (--mode, --estimator, --continue) */
 } solve_args;
 
 /* Parse argv into a; 0, or an exit code (-1: --help printed). */
@@ -340,13 +344,20 @@ static int parse(int argc, char **argv, solve_args *a)
         {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
         {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
         {"method", required_argument, 0, 'U'},   {0, 0, 0, 0}};
-    *a = (solve_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_walk_defaults(), .argc = argc, .argv = argv};
+    *a = (solve_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_walk_defaults(), .autom = 1,
+                      .ao = ulam_auto_defaults()};
     a->o.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
     int c, rc, idx;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
-        case CLI_WALK: if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &a->o))) return rc; break;
+        case CLI_WALK:
+            if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &a->o))) return rc;
+            a->ao.pin_mode |= !strcmp(longopts[idx].name, "mode");
+            a->ao.pin_estimator |= !strcmp(longopts[idx].name, "estimator");
+            a->ao.pin_continue |= !strcmp(longopts[idx].name, "continue");
+            a->ao.pin_alpha |= !strcmp(longopts[idx].name, "alpha");
+            break;
         case 'b': a->s.rhs_path = optarg; break;
         case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
         case 'j': a->s.jacobi = 1; break;
@@ -354,8 +365,8 @@ static int parse(int argc, char **argv, solve_args *a)
         case 'W': a->o.whole_kernel = 1; break;
         case 'U':
             if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
-            if (strcmp(optarg, "auto")) return cli_usage_error("solve", "--method expects auto, bidirectional (with --source), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
-            a->autom = 1;
+            if (strcmp(optarg, "auto") && strcmp(optarg, "walks")) return cli_usage_error("solve", "--method expects auto, walks, bidirectional (with --source), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
+            a->autom = !strcmp(optarg, "auto");
             break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
         case 'c': a->check = 1; break;
@@ -377,6 +388,28 @@ static int parse(int argc, char **argv, solve_args *a)
         return cli_usage_error("solve", "--split W must exceed --roulette W");
     cli_walk_budget(&a->o);
     a->s.matrix_path = argv[optind];
+    if (a->ao.pin_mode && a->ao.pin_estimator && a->ao.pin_continue && a->ao.pin_alpha) a->autom = 0; /* nothing to choose */
+    return 0;
+}
+
+/* A lazily read prepared system under auto: with a certificate that serves the adjoint guards,
+ * auto chooses the estimator on the certificate's kernel (continuation, exponent 1, adjoint: what
+ * is not pinned is set so), whose guards need no pass over M, so the query still reads only the
+ * rows its walks reach; otherwise the file is verified whole first (the guards read all of M). */
+static int certified_auto(solve_args *a, ulam_guard *g)
+{
+    cli_system *s = &a->s;
+    if (!s->lazy) return 0;
+    ulam_walk_opts *o = &a->o;
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_ADJOINT;
+    double q = a->ao.pin_continue ? o->continue_q : s->cert ? s->cert->continue_q : 0.0;
+    if ((a->ao.pin_alpha && o->kernel_alpha != 1.0) || (a->ao.pin_mode && o->mode != ULAM_ADJOINT) ||
+        ulam_certificate_guard(s->cert, q, &go, g))
+        return cli_system_verify(s);
+    o->continue_q = q, o->kernel_alpha = 1.0, o->mode = ULAM_ADJOINT;
+    a->ao.pin_continue = a->ao.pin_alpha = a->ao.pin_mode = 1;
+    a->ao.guard = g;
     return 0;
 }
 
@@ -387,7 +420,8 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solv
     cli_system *s = &a->s;
     ulam_walk_opts *o = &a->o;
     int rc;
-    s->lazy = o->mode == ULAM_ADJOINT && !a->check && !cli_share; /* read only the rows walks reach */
+    /* read only the rows walks reach; auto does on a prepared system (see certified_auto) */
+    s->lazy = o->mode == ULAM_ADJOINT && !a->check && !cli_share && (!a->autom || ulam_system_is_file(s->matrix_path));
     if ((a->out && (rc = cli_check_output(a->out))) || (a->errors && (rc = cli_check_output(a->errors)))) return rc;
     double t0 = ulam_now();
     if ((rc = cli_load_system(s))) return rc;
@@ -397,24 +431,32 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solv
     }
     ro->load_seconds = ulam_now() - t0;
     o->index = s->index ? s->index - 1 : 0;
-    o->share = cli_share;
-    if (a->autom && (rc = cli_auto_choose(s, a->argc, a->argv, o, au))) {
-        cli_system_free(s);
-        return rc;
-    }
-    ro->au = a->autom ? au : NULL;
-    if ((rc = cli_guard(s, o->continue_q, o->kernel_alpha, o->mode, &ro->g))) {
-        cli_system_free(s);
-        return rc;
-    }
-    ro->guard_seconds = ro->g.abs.seconds + ro->g.hat[0].seconds + ro->g.hat[1].seconds;
+    o->interrupt = &cli_interrupted, o->share = cli_share, o->force = a->force;
+    o->assume_finite = ro->assume_finite;
     ro->n = s->M->nrows;
     ulam_error err;
-    o->interrupt = &cli_interrupted, o->share = cli_share, o->guard = &ro->g, o->force = a->force;
-    o->assume_finite = ro->assume_finite;
-    t0 = ulam_now();
-    int status = ulam_solver_alloc(s->M, s->b, o, sv, &err); /* refuses what the guards refuse */
-    ro->kernel_seconds = ulam_now() - t0;
+    int status;
+    if (a->autom) { /* guards, pilots and the solver, its set-up kept from the chosen pilot */
+        t0 = ulam_now();
+        ulam_guard cg;
+        if ((rc = certified_auto(a, &cg)) || (rc = cli_auto_choose(s, o, &a->ao, au, sv, &status, &err))) {
+            cli_system_free(s);
+            return rc;
+        }
+        ro->au = au;
+        ro->g = au->guard;
+        ro->kernel_seconds = ulam_now() - t0 - au->seconds;
+    } else {
+        if ((rc = cli_guard(s, o->continue_q, o->kernel_alpha, o->mode, &ro->g))) {
+            cli_system_free(s);
+            return rc;
+        }
+        o->guard = &ro->g;
+        t0 = ulam_now();
+        status = ulam_solver_alloc(s->M, s->b, o, sv, &err); /* refuses what the guards refuse */
+        ro->kernel_seconds = ulam_now() - t0;
+    }
+    ro->guard_seconds = ro->g.abs.seconds + ro->g.hat[0].seconds + ro->g.hat[1].seconds;
     if (status == ULAM_EINVAL && o->split > 0 && strstr(err.msg, "split weight")) {
         rc = cli_usage_error("solve", "--split W: %s", err.msg);
     } else if (status == ULAM_EDIVERGE) {
@@ -461,7 +503,7 @@ static int run(solve_args *a)
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, &r);
         if (first && !status) rel_err_warning(s, o, &r);
-        cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o->rel_err);
+        cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o);
     }
     cli_progress_end(&pg);
     ulam_solver_result(sv, &r);

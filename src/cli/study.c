@@ -556,7 +556,8 @@ static int charts(const study *st)
              "set ylabel 'RMSE (reference lines: the error of one run)'\nset key outside right font ',8'\n"
              "Y0 = %g\nset yrange [Y0:*]\n"
              "set fit quiet\nset fit logfile '/dev/null'\nf(x) = a / sqrt(x)\na = 0\nfit f(x) 'summary.csv' u 8:4 via a\n"
-             "M = \"%s\"\n" /* one colour and dash per method: 8 colours, then the next dash pattern */
+             "M = \"%s\"\n" /* one colour and dash per method: 8 colours, then the next dash pattern (dashes 1-3;
+                                   the reference lines take colours and dash 4 of their own) */
              "B = \"%s\"\n" /* one point shape per budget, in the method's colour */
              "P = \"7 5 9 11 13 6 4 8 10 12 1 2 3 14 15 16\"\n"
              /* the x axis spans the walks and the reference lines but LAPACK's point */
@@ -570,12 +571,12 @@ static int charts(const study *st)
              "for [i=1:words(M)] for [j=1:words(B)] 'summary.csv' u (strcol(1) eq word(M, i) && $2 == word(B, j) + 0 ? "
              "$8 : 1/0):4 w p linecolor i pointtype (word(P, j) + 0) notitle, "
              "for [j=1:words(B)] NaN w p lc 'black' pointtype (word(P, j) + 0) title sprintf('%s', word(B, j) + 0), "
-             "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 lc 3 t 'Gauss-Seidel, whole vector', "
-             "'' u (strcol(1) eq 'lapack' ? lx : 1/0):(ly) w p pt 9 ps 2 lc 4 t 'LAPACK dgesv (error vs refined)', "
-             "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 2 pt 5 lc 5 t 'sequential MC, every unknown (one run)', "
-             "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 2 pt 7 lc 6 t 'MCSA, every unknown (one run)', "
-             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 2 pt 3 lc 7 t 'Krylov (CG or GMRES(30))', "
-             "f(x) dt 2 lc 'black' t '1/sqrt(t) slope'\n",
+             "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 lc 'gray50' t 'Gauss-Seidel, whole vector', "
+             "'' u (strcol(1) eq 'lapack' ? lx : 1/0):(ly) w p pt 9 ps 2 lc 'web-green' t 'LAPACK dgesv (error vs refined)', "
+             "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 2 pt 5 lc 'brown' t 'sequential MC, every unknown (one run)', "
+             "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 2 pt 7 lc 'dark-magenta' t 'MCSA, every unknown (one run)', "
+             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 2 pt 3 lc 'dark-cyan' t 'Krylov (CG or GMRES(30))', "
+             "f(x) dt 4 lc 'gray30' t '1/sqrt(t) slope'\n",
              (long long)st->s.index, y0, names, budgets, lapack,
              st->time_budgets ? "budget %g s a run" : "budget %.0f walks");
     if (gnuplot_draw(st->out, "rmse", 1200, 700, script)) {

@@ -16,6 +16,7 @@ int cli_walk_option(const char *command, const char *name, const char *value, ul
     if (!strcmp(name, "walks")) return cli_parse_int(cmd, "--walks", value, 1, INT64_MAX / 2, &o->max_walks);
     if (!strcmp(name, "rel-err")) return cli_parse_real(cmd, "--rel-err", value, 1e-12, 1.0, &o->rel_err);
     if (!strcmp(name, "time")) return cli_parse_real(cmd, "--time", value, 1e-6, 1e9, &o->max_seconds);
+    if (!strcmp(name, "continue") && !strcmp(value, "analog")) return o->continue_q = 0.0, 0; /* min(1, S_i) */
     if (!strcmp(name, "continue")) return cli_parse_real(cmd, "--continue", value, 1e-9, 1 - 1e-12, &o->continue_q);
     if (!strcmp(name, "roulette")) return cli_parse_real(cmd, "--roulette", value, 1e-300, 1e300, &o->roulette);
     if (!strcmp(name, "split")) return cli_parse_real(cmd, "--split", value, 1e-300, 1e300, &o->split);

@@ -28,6 +28,7 @@
  * As in ulam_solve, block k of walks draws from the stream (seed, k) and blocks merge in
  * index order: the result does not depend on the number of threads. */
 #include "rad.h"
+#include "../round.h"
 
 #include "../stats.h"
 
@@ -108,11 +109,7 @@ static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, ulam_error 
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette, split or kernel exponent other "
                                                    "than 1 (patch walks continue with the patch's largest "
                                                    "reflectance and follow the form factors)");
-    if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
-    if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a stopping rule: walks, rel_err or time");
-    return ULAM_OK;
+    return ulam__budgets_check(o, err);
 }
 
 /* The shooting source: emitters and their cumulative power (channel sums). */
@@ -203,7 +200,7 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam
     s->s = ulam__tracer_scene(t);
     s->threads = ulam__threads(o.threads);
     ulam__run_reset(&s->run);
-    if (o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0) s->o.max_walks = ULAM_REL_ERR_CAP;
+    s->o.max_walks = ulam__walk_cap(&o);
     if ((o.mode == ULAM_FORWARD || o.estimator >= ULAM_NEXT_EVENT) && (status = build_source(s, err))) {
         ulam_rad_solver_free(s);
         return status;

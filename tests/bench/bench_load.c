@@ -33,8 +33,8 @@ int main(int argc, char **argv)
            (long long)ulam_csr_nnz(M), ulam_now() - t0, csr_mib);
     ulam_csr_free(M);
     free(b);
-    char *args[] = {argv[1], "solve", mpath, "--rhs", bpath, "--index", idx, "--rel-err", "0.01", "--threads", "2",
-                    "--json", "--cache", NULL};
+    char *args[] = {argv[1], "solve", mpath, "--method", "walks", "--rhs", bpath, "--index", idx, "--rel-err", "0.01",
+                    "--threads", "2", "--json", "--cache", NULL};
     static char out[1 << 16];
     printf("%-16s %9s %9s %9s %9s %10s %10s %9s %9s\n", "run", "load s", "guards s", "set-up s", "walk s",
            "load/walk", "rows", "peak MiB", "peak/CSR");

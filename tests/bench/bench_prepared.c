@@ -177,7 +177,8 @@ int main(int argc, char **argv)
                                 "--threads", "2", "--json", "--cache", NULL};
                 before = median_run(args);
             }
-            char *args[] = {argv[1], "solve", sysf, "--index", idx, "--rel-err", "0.01", "--threads", "2", "--json", NULL};
+            char *args[] = {argv[1], "solve", sysf, "--method", "walks", "--index", idx, "--rel-err", "0.01", "--threads",
+                            "2", "--json", NULL};
             figures after = median_run(args);
             double sp_s = NAN, xI = NAN;
             if (py && scipy_run(py, dir, sysf, fam, n / 2, &sp_s, &xI)) sp_s = NAN;
