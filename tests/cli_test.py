@@ -1166,12 +1166,13 @@ def check_auto(ulam):
         assert rc == 0 and json.loads(out)["estimate"] == o["estimate"], (err, out, o)
 
 
-def check_auto_bidir(ulam):
-    """solve --method auto with a sparse b: bidirectional is a candidate (an adjoint query with a
+def check_auto_bidir(progs):
+    """(progs: ulam and genmat) solve --method auto with a sparse b: bidirectional is a candidate (an adjoint query with a
     --rel-err target, nothing pinned it cannot honour, the walk leader's predicted work W above
     nnz/4); chosen when its predicted work is below W, then its answer is --method
     bidirectional's (the same plan and walks) and within 4 sigma of LAPACK; the report says why
     it lost or was not considered."""
+    ulam, genmat = progs
     sp3 = PS + ["--rhs", D + "sparse3_b.mtx", "--rel-err", "0.02"]
     rc, out, err = run(ulam, sp3 + ["--json", "--check"])
     assert rc == 0, err
@@ -1205,6 +1206,15 @@ def check_auto_bidir(ulam):
         assert o["auto"]["bidirectional"].startswith("not considered: " + why), (extra, o["auto"]["bidirectional"])
         rc, out, err = run(ulam, PS + extra)
         assert rc == 0 and re.search(r"^    bidirectional .*not considered: " + re.escape(why), out, re.M), (extra, out)
+    # rent or buy: the study's r500 (b has 6 nonzeros) has walks cheaper than nnz/4 = 62 400
+    with tempfile.TemporaryDirectory() as d:
+        assert subprocess.run([genmat, "--radiosity", "500", d + "/r.mtx", d + "/r_b.mtx"], timeout=120).returncode == 0
+        rc, out, err = run(ulam, ["solve", d + "/r.mtx", "--rhs", d + "/r_b.mtx", "--index", "1", "--rel-err", "0.01",
+                                  "--json"])
+        o = json.loads(out)
+        w = o["auto"]["candidates"][o["auto"]["chosen"]]["predicted_work"]
+        assert rc == 0 and o["mode"] == "adjoint" and w < 62400, o["auto"]
+        assert o["auto"]["bidirectional"].startswith("not considered: the walks' predicted work"), o["auto"]
 
 
 def check_genmat(genmat):
@@ -1238,7 +1248,7 @@ def main():
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
-             (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, ulam), (check_progress, ulam),
+             (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]
