@@ -357,7 +357,7 @@ int cli_bidir_consider(cli_system *s, const ulam_walk_opts *user, const char *pi
     bc->o.walk.estimator = ULAM_COLLISION, bc->o.walk.kernel_alpha = 1.0;
     bc->o.walk.guard = NULL, bc->o.walk.interrupt = NULL, bc->o.walk.share = NULL;
     bc->o.target = user->index;
-    bc->o.max_push_ops = W / 2 >= 1 ? (int64_t)(W / 2) : 1;
+    bc->o.max_push_ops = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : 0; /* W infinite: the default cap */
     bc->idx = malloc((size_t)k * sizeof *bc->idx), bc->val = malloc((size_t)k * sizeof *bc->val);
     double t0 = ulam_now();
     int status = bc->idx && bc->val ? ulam_csr_transpose(M, &bc->Mt) : ULAM_ENOMEM;
