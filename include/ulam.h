@@ -857,6 +857,8 @@ typedef struct ulam_bidir_plan_info {
                                estimate's work in push operations (NaN when rmax is given and
                                walks remain: no pilot measured V) */
     double step_cost;       /* push operations a walk visit counts as */
+    int64_t pilot_units;    /* kernel units (16 bytes of a row) the pilot's solver built on Mt */
+    int64_t pilot_reads;    /* entries its reachability checks and score-bound passes read */
     double seconds;         /* wall time of the plan: pilot and push */
 } ulam_bidir_plan_info;
 

@@ -213,6 +213,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
         }
     }
     status = push(w, o, pl, cap, plan);
+    if (pl) ulam__solver_setup(pl, &plan->pilot_units, &plan->pilot_reads);
     ulam_solver_free(pl);
     if (status == ULAM_ENOCONV)
         return ulam__fail(err, status, 0, -1, "a push within %lld operations (is rho(|M|) < 1?)", (long long)cap);

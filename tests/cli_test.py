@@ -1166,6 +1166,57 @@ def check_auto(ulam):
         assert rc == 0 and json.loads(out)["estimate"] == o["estimate"], (err, out, o)
 
 
+def check_auto_bidir(progs):
+    """(progs: ulam and genmat) solve --method auto with a sparse b: bidirectional is a candidate (an adjoint query with a
+    --rel-err target, nothing pinned it cannot honour, the walk leader's predicted work W above
+    nnz/4); chosen when its predicted work is below W, then its answer is --method
+    bidirectional's (the same plan and walks) and within 4 sigma of LAPACK; the report says why
+    it lost or was not considered."""
+    ulam, genmat = progs
+    sp3 = PS + ["--rhs", D + "sparse3_b.mtx", "--rel-err", "0.02"]
+    rc, out, err = run(ulam, sp3 + ["--json", "--check"])
+    assert rc == 0, err
+    o = json.loads(out)
+    a = o["auto"]
+    b = a["candidates"][-1]
+    assert o["method"] == "bidirectional" and a["bidirectional"] is None and a["chosen"] == len(a["candidates"]) - 1, o
+    assert b["mode"] == "bidirectional" and b["state"] == "chosen" and b["push_ops"] > 0 and b["pilot_walks"] == 256, b
+    assert 0 < b["predicted_work"] < b["leader_work"] and b["push_ops"] <= b["leader_work"] / 2, b
+    assert [c["state"] for c in a["candidates"]].count("chosen") == 1, a
+    assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"] and o["stderr"] <= 0.02 * abs(o["estimate"]), o
+    rc, out, err = run(ulam, sp3 + ["--method", "bidirectional", "--json"])
+    assert rc == 0 and json.loads(out)["estimate"] == o["estimate"], (err, out, o)
+    rc, out, err = run(ulam, sp3)
+    assert rc == 0 and re.search(r"^auto +chose bidirectional: its predicted work", out, re.M), out
+    assert re.search(r"^  \* bidirectional .*rmax .* push \d+ ops .*predicted", out, re.M), out
+    # considered, and it loses: at --rel-err 0.1 the walks need their 1000-walk floor
+    rc, out, err = run(ulam, PS + ["--rhs", D + "sparse16_b.mtx", "--rel-err", "0.1", "--json", "--check"])
+    o = json.loads(out)
+    b = o["auto"]["candidates"][-1]
+    assert rc == 0 and o["mode"] == "adjoint" and b["mode"] == "bidirectional" and b["state"] == "planned", o
+    assert b["predicted_work"] >= b["leader_work"] and o["auto"]["bidirectional"].startswith("lost: "), b
+    assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
+    # not considered: a dense b, a pinned estimator, no --rel-err target (one line each)
+    for extra, why in ((["--rhs", M + "randsub1000_b.mtx", "--rel-err", "0.02"], "b is dense"),
+                       (["--rhs", D + "sparse3_b.mtx", "--rel-err", "0.02", "--estimator", "expected"], "--estimator is pinned"),
+                       (["--rhs", D + "sparse3_b.mtx", "--walks", "2000"], "no --rel-err target")):
+        rc, out, err = run(ulam, PS + extra + ["--json"])
+        o = json.loads(out)
+        assert rc == 0 and all(c["mode"] != "bidirectional" for c in o["auto"]["candidates"]), (extra, o)
+        assert o["auto"]["bidirectional"].startswith("not considered: " + why), (extra, o["auto"]["bidirectional"])
+        rc, out, err = run(ulam, PS + extra)
+        assert rc == 0 and re.search(r"^    bidirectional .*not considered: " + re.escape(why), out, re.M), (extra, out)
+    # rent or buy: the study's r500 (b has 6 nonzeros) has walks cheaper than nnz/4 = 62 400
+    with tempfile.TemporaryDirectory() as d:
+        assert subprocess.run([genmat, "--radiosity", "500", d + "/r.mtx", d + "/r_b.mtx"], timeout=120).returncode == 0
+        rc, out, err = run(ulam, ["solve", d + "/r.mtx", "--rhs", d + "/r_b.mtx", "--index", "1", "--rel-err", "0.01",
+                                  "--json"])
+        o = json.loads(out)
+        w = o["auto"]["candidates"][o["auto"]["chosen"]]["predicted_work"]
+        assert rc == 0 and o["mode"] == "adjoint" and w < 62400, o["auto"]
+        assert o["auto"]["bidirectional"].startswith("not considered: the walks' predicted work"), o["auto"]
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -1197,7 +1248,7 @@ def main():
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
-             (check_bidir, ulam), (check_auto, ulam), (check_progress, ulam),
+             (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]

@@ -47,6 +47,9 @@ def main():
                                               "--rel-err", "0.02", "--json"], None),
             ("solve auto", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx",
                             "--index", "3", "--rel-err", "0.01", "--json"], None),
+            # auto with a sparse b on which it chooses bidirectional (its plan seeded, not timed)
+            ("solve auto bidirectional", ["solve", "matrices/randsub1000.mtx", "--index", "7", "--rhs",
+                                          "tests/data/sparse3_b.mtx", "--rel-err", "0.02", "--json"], None),
             ("solve forward", ["solve", "--method", "walks", "matrices/radiosity100.mtx", "--rhs", "matrices/radiosity100_b.mtx", "--index",
                                "1", "--mode", "forward", "--walks", "30000", "--json", "--out", "{d}/x.mtx"], "x.mtx"),
             ("solve mcsa", ["solve", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx", "--method",
@@ -86,6 +89,9 @@ def main():
                         a, b = (one[0] if outfile else one)[k], (two[0] if outfile else two)[k]
                         assert a == b, (name, k, a, b)
                     assert (two[0] if outfile else two)["ranks"] == 2, "not distributed"
+                    if name == "solve auto bidirectional":
+                        assert one["method"] == two["method"] == "bidirectional", (one, two)
+                        assert one["auto"] == dict(two["auto"], seconds=one["auto"]["seconds"]), (one, two)
                     if outfile:
                         assert one[1] == two[1], "forward --out files differ"
                 elif name in ("radiosity", "radiosity next-event"):

@@ -53,9 +53,13 @@ static double pilot_share(const ulam_auto_result *res)
 }
 
 /* The candidates and the choice, as text. */
-void cli_auto_print_text(const ulam_auto_result *res)
+void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc)
 {
-    if (res->chosen >= 0)
+    if (bc && bc->state == 2)
+        printf("auto            chose bidirectional: its predicted work %.3g units is below the walk leader's %.3g "
+               "(%d walk candidates after %d pilot stages; guards and pilots %.3f s)\n", bc->work, bc->leader_work,
+               res->ncand, res->stages, res->seconds);
+    else if (res->chosen >= 0)
         printf("auto            chose the least predicted %s of %d candidates after %d pilot stages; the pilots' "
                "overhead is %.3g%% of the predicted work (guards and pilots %.3f s); the estimate is from fresh walks\n",
                res->by_work ? "work" : "variance x work a walk",
@@ -64,7 +68,7 @@ void cli_auto_print_text(const ulam_auto_result *res)
         printf("auto            no certified candidate among %d: ran the closest\n", res->ncand);
     for (int k = 0; k < res->ncand; k++) {
         const ulam_auto_candidate *c = &res->cand[k];
-        printf("  %c %-8s %-10s ", k == res->chosen ? '*' : ' ', cli_mode_names[c->mode], cli_estimator_names[c->estimator]);
+        printf("  %c %-8s %-10s ", k == res->chosen && !(bc && bc->state == 2) ? '*' : ' ', cli_mode_names[c->mode], cli_estimator_names[c->estimator]);
         print_q(c->continue_q);
         printf(" alpha %-3.3g", c->kernel_alpha);
         if (isfinite(c->hat.upper)) printf(" rho(M^) %-9.4g ", c->hat.rho);
@@ -78,12 +82,21 @@ void cli_auto_print_text(const ulam_auto_result *res)
                    c->steps_per_walk, c->predicted_walks, c->predicted_work, c->predicted_seconds,
                    c->state == ULAM_AUTO_DROPPED ? "  dropped" : "");
     }
+    if (!bc) return;
+    printf("  %c bidirectional (reverse push, walks from b) ", bc->state == 2 ? '*' : ' ');
+    if (bc->state)
+        printf("rmax %.3g  push %lld ops  pilot %lld walks  predicted %.4g walks, %.3g units%s%s\n", bc->plan.rmax,
+               (long long)bc->plan.push.ops, (long long)bc->plan.pilot_walks, bc->plan.predicted_walks, bc->work,
+               bc->state == 2 ? "" : "  ", bc->state == 2 ? "" : bc->why);
+    else
+        printf("%s\n", bc->why);
 }
 
 /* The candidates and the choice, as the JSON key "auto" (followed by a comma). */
-void cli_auto_print_json(const ulam_auto_result *res)
+void cli_auto_print_json(const ulam_auto_result *res, const cli_bidir_cand *bc)
 {
-    printf("\"auto\": {\"chosen\": %d, \"closest\": %d, \"stages\": %d, ", res->chosen, res->closest, res->stages);
+    printf("\"auto\": {\"chosen\": %d, \"closest\": %d, \"stages\": %d, ", bc && bc->state == 2 ? res->ncand : res->chosen,
+           res->closest, res->stages);
     cli_json_number("seconds", res->seconds, 0);
     cli_json_number("pilot_work", res->pilot_work, 0);
     cli_json_number("reused_work", res->reused_work, 0);
@@ -99,7 +112,7 @@ void cli_auto_print_json(const ulam_auto_result *res)
         cli_json_number("rho_hat", isfinite(c->hat.upper) ? c->hat.rho : NAN, 0);
         cli_json_number("rho_hat_upper", c->hat.upper, 0);
         printf("\"certified\": %s, ", c->certified ? "true" : "false");
-        cli_json_string("state", state_names[c->state], 0);
+        cli_json_string("state", state_names[c->state == ULAM_AUTO_CHOSEN && bc && bc->state == 2 ? ULAM_AUTO_FINALIST : c->state], 0);
         cli_json_string("status", c->status ? ulam_strerror(c->status) : "ok", 0);
         printf("\"pilot_walks\": %lld, ", (long long)c->pilot_walks);
         cli_json_number("variance", c->pilot_walks ? c->variance : NAN, 0);
@@ -112,5 +125,23 @@ void cli_auto_print_json(const ulam_auto_result *res)
         cli_json_number("predicted_seconds", c->predicted_seconds, 1);
         printf("}");
     }
-    printf("]}, ");
+    if (bc && bc->state) { /* planned: the last entry (chosen: index ncand) */
+        printf("%s{", res->ncand ? ", " : "");
+        cli_json_string("mode", "bidirectional", 0);
+        cli_json_string("state", bc->state == 2 ? "chosen" : bc->state == 1 ? "planned" : "not_considered", 0);
+        cli_json_number("rmax", bc->state ? bc->plan.rmax : NAN, 0);
+        printf("\"push_ops\": %lld, \"pilot_walks\": %lld, ", (long long)(bc->state ? bc->plan.push.ops : 0),
+               (long long)(bc->state ? bc->plan.pilot_walks : 0));
+        cli_json_number("predicted_walks", bc->state ? bc->plan.predicted_walks : NAN, 0);
+        cli_json_number("predicted_work", bc->work, 0);
+        cli_json_number("leader_work", bc->leader_work, 1);
+        printf("}");
+    }
+    printf("]");
+    if (bc) { /* why bidirectional was not chosen, in one line (null: it was) */
+        printf(", ");
+        if (bc->state == 2) printf("\"bidirectional\": null");
+        else cli_json_string("bidirectional", bc->why, 1);
+    }
+    printf("}, ");
 }

@@ -64,7 +64,9 @@ static const char *const usage2 = /* the help in two strings: C99 promises 4095 
     "  --method auto      (default) choose mode, estimator, continuation and --alpha among\n"
     "                     the candidates the guards certify, by pilots compared on a fixed\n"
     "                     work model (the same choice on every run); what is given stays\n"
-    "                     pinned; fresh walks then estimate with the choice\n"
+    "                     pinned; fresh walks then estimate with the choice; with a sparse b\n"
+    "                     and --rel-err, also bidirectional (push + walks) when the best walks\n"
+    "                     are predicted to cost more than nnz(M)/4\n"
     "  --method walks     the single method the options name, defaults for the rest (adjoint,\n"
     "                     collision, --continue analog, --alpha 1): the run before auto\n"
     "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
@@ -91,6 +93,7 @@ typedef struct {
     int64_t n;
     double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the solver set-up */
     const ulam_auto_result *au; /* --method auto: the candidates and the choice (else NULL) */
+    const cli_bidir_cand *bc;   /* --method auto: bidirectional as a candidate (else NULL) */
 } report_opts;
 
 /* Peak resident memory of this process so far, in MiB. */
@@ -170,7 +173,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
         printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
-    if (ro->au) cli_auto_print_text(ro->au);
+    if (ro->au) cli_auto_print_text(ro->au, ro->bc);
     if (ro->check)
         printf("direct          %.10g (LAPACK, %.4f s), z = %.3f\n", ro->direct, ro->direct_seconds,
                (r->estimate - ro->direct) / r->std_error);
@@ -232,7 +235,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         cli_json_number("direct_seconds", ro->direct_seconds, 0);
         cli_json_number("z", (r->estimate - ro->direct) / r->std_error, 0);
     }
-    if (ro->au) cli_auto_print_json(ro->au);
+    if (ro->au) cli_auto_print_json(ro->au, ro->bc);
     printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
 }
 
@@ -413,9 +416,22 @@ static int certified_auto(solve_args *a, ulam_guard *g)
     return 0;
 }
 
-/* Load the system, choose (--method auto), guard, and make the solver *sv; print the refusals
- * and the warnings, then run --check; 0 or an exit code (nothing kept on failure). */
-static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solver **sv)
+/* What the command line pins that bidirectional cannot honour, in words (NULL: nothing). */
+static const char *bidir_pinned(const solve_args *a)
+{
+    if (a->o.mode == ULAM_FORWARD) return "forward mode (--mode forward, --out, --errors)";
+    if (a->ao.pin_estimator) return "--estimator is pinned";
+    if (a->ao.pin_alpha && a->o.kernel_alpha != 1.0) return "--alpha other than 1";
+    if (a->o.roulette > 0 || a->o.split > 0) return "--roulette or --split (bidirectional takes neither)";
+    if (a->s.jacobi) return "--jacobi";
+    if (a->s.lazy) return "a prepared system read only where walks go (bidirectional transposes all of M)";
+    return NULL;
+}
+
+/* Load the system, choose (--method auto, bidirectional among the candidates: bc), guard, and
+ * make the solver *sv (none when bidirectional is chosen); print the refusals and the warnings,
+ * then run --check; 0 or an exit code (nothing kept on failure). */
+static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir_cand *bc, ulam_solver **sv)
 {
     cli_system *s = &a->s;
     ulam_walk_opts *o = &a->o;
@@ -439,6 +455,8 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solv
     if (a->autom) { /* guards, pilots and the solver, its set-up kept from the chosen pilot */
         t0 = ulam_now();
         ulam_guard cg;
+        ulam_walk_opts user = *o;
+        const char *pinned = bidir_pinned(a);
         if ((rc = certified_auto(a, &cg)) || (rc = cli_auto_choose(s, o, &a->ao, au, sv, &status, &err))) {
             cli_system_free(s);
             return rc;
@@ -446,6 +464,17 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solv
         ro->au = au;
         ro->g = au->guard;
         ro->kernel_seconds = ulam_now() - t0 - au->seconds;
+        if (!status) {
+            ro->bc = bc;
+            if ((rc = cli_bidir_consider(s, &user, pinned, au, bc))) {
+                *sv = ulam_solver_free(*sv);
+                cli_bidir_cand_free(bc);
+                cli_system_free(s);
+                return rc;
+            }
+            if (bc->state == 2) *sv = ulam_solver_free(*sv);
+            else cli_bidir_cand_free(bc); /* its transpose and push: only its plan's figures are reported */
+        }
     } else {
         if ((rc = cli_guard(s, o->continue_q, o->kernel_alpha, o->mode, &ro->g))) {
             cli_system_free(s);
@@ -474,10 +503,12 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, ulam_solv
         cli_system_free(s);
         return rc;
     }
-    if (ro->g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(s, &ro->g, 1);
-    cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
+    int walks = !(ro->bc && ro->bc->state == 2);
+    if (walks && ro->g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(s, &ro->g, 1);
+    if (walks) cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
     if (ro->check && (rc = direct_check(s, o->index, ro))) {
         *sv = ulam_solver_free(*sv);
+        cli_bidir_cand_free(bc);
         cli_system_free(s);
         return rc;
     }
@@ -492,9 +523,16 @@ static int run(solve_args *a)
     const ulam_walk_opts *o = &a->o;
     report_opts ro = {.check = a->check, .json = a->json, .assume_finite = a->assume_finite};
     ulam_auto_result au;
+    cli_bidir_cand bc = {0};
     ulam_solver *sv = NULL;
-    int rc = start(a, &ro, &au, &sv), status = ULAM_OK;
+    int rc = start(a, &ro, &au, &bc, &sv), status = ULAM_OK;
     if (rc) return rc;
+    if (bc.state == 2) { /* auto chose bidirectional: its own report, with the choice */
+        rc = cli_bidir_auto_run(&a->s, &bc, &au, ro.json, ro.check, ro.direct, ro.load_seconds);
+        cli_bidir_cand_free(&bc);
+        cli_system_free(&a->s);
+        return rc;
+    }
     cli_catch_sigint();
     ulam_walk_result r;
     cli_progress pg;
@@ -536,6 +574,7 @@ static int run(solve_args *a)
     fflush(stdout); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
     cli_release_sigint();
     ulam_solver_free(sv);
+    cli_bidir_cand_free(&bc);
     cli_system_free(&a->s);
     return rc;
 }
