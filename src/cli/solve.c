@@ -40,7 +40,7 @@ static const char *const usage =
     "  --seed S           block q of walks uses stream (S, q) (default 1): identical results for\n"
     "                     any --threads\n"
     "  --threads T        threads (default: all cores)\n";
-static const char *const usage2 = /* the help in two strings: C99 promises 4095 characters a literal */
+static const char *const usage2 = /* the help in three strings: C99 promises 4095 characters a literal */
     "  --continue Q       continue with probability Q in every state (analog, the default:\n"
     "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased;\n"
     "                     --continue analog names the default (pins it for --method auto)\n"
@@ -60,7 +60,8 @@ static const char *const usage2 = /* the help in two strings: C99 promises 4095 
     "  --assume-finite-variance  print a confidence interval when the guards cannot tell\n"
     "                     whether rho(M^) < 1 (unknown is otherwise treated as infinite)\n"
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
-    "                     that instead of parsing while the file is unchanged (size, mtime)\n"
+    "                     that instead of parsing while the file is unchanged (size, mtime)\n";
+static const char *const usage3 =
     "  --method auto      (default) choose mode, estimator, continuation and --alpha among\n"
     "                     the candidates the guards certify, by pilots compared on a fixed\n"
     "                     work model (the same choice on every run); what is given stays\n"
@@ -378,7 +379,7 @@ static int parse(int argc, char **argv, solve_args *a)
         case 'A': a->assume_finite = 1; break;
         case 'o': a->out = optarg; break;
         case 'E': a->errors = optarg; break;
-        case 'h': fputs(usage, stdout), fputs(usage2, stdout); return -1;
+        case 'h': fputs(usage, stdout), fputs(usage2, stdout), fputs(usage3, stdout); return -1;
         default: return cli_usage_error("solve", "unknown option");
         }
     }
