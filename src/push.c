@@ -32,7 +32,7 @@ ulam_push *ulam_push_free(ulam_push *w)
 {
     if (!w) return NULL;
     free(w->p), free(w->r), free(w->touched), free(w->mark), free(w->queue);
-    free(w->memo.idx), free(w->memo.val), free(w->memo.ones), free(w->memo.seen);
+    free(w->memo.idx), free(w->memo.val), free(w->memo.ones), free(w->memo.seen), free(w->memo.all);
     free(w);
     return NULL;
 }

@@ -36,8 +36,8 @@ struct ulam_solver {
     ulam__slot *start_src; /* adjoint with nstarts: the start distribution (walker.start_*) */
     int32_t *start_units;
     double *start_b;
-    char *seen;             /* the states walks can reach (check_reach; NULL before) */
-    const char *given_seen; /* the same computed by an earlier solver (ulam__solver_alloc_reached) */
+    char *seen;               /* the states walks can reach (check_reach; NULL before) */
+    const ulam__reach *given; /* the same given by the caller (ulam__solver_alloc_reached; NULL: none) */
     int threads;
     ulam__scratch *scratch; /* one per thread */
     ulam__kscratch *ks;     /* one per thread: room to build a kernel row */
@@ -299,6 +299,25 @@ static double *move_factors(const ulam_csr *K, const char *seen, double continue
     return f;
 }
 
+/* Over the seen states of K: the largest weight factor S / q (fac: each move's own, kernel
+ * exponent != 1) and continuation, and whether K has a negative entry (R->fbig, qmax, neg). */
+static void kernel_bounds(const ulam_csr *K, const char *seen, double continue_q, const double *fac, ulam__reach *R)
+{
+    double fbig = 0.0, qmax = 0.0;
+    int neg = 0;
+    for (int64_t i = 0; i < K->nrows; i++) {
+        if (!seen[i]) continue;
+        double S = row_sum(K, i);
+        if (!fac) fbig = fmax(fbig, ulam__factor(S, continue_q));
+        qmax = fmax(qmax, ulam__continuation(S, continue_q));
+        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
+            neg |= K->val[k] < 0;
+            if (fac) fbig = fmax(fbig, fac[k]);
+        }
+    }
+    R->fbig = fbig, R->qmax = qmax, R->neg = neg;
+}
+
 /* Over the states walks can reach (seen): absorption's p* > 0 wherever it scores (else
  * ULAM_EUNDEFINED naming the state), and the bound on a single score and the scores' range
  * (s->bound, s->range): 0 when nothing that scores is reachable; for absorption W |g_i| / p*_i,
@@ -308,7 +327,7 @@ static double *move_factors(const ulam_csr *K, const char *seen, double continue
  * and past qmax = 1 the certificate of length_tail). */
 static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
-    if (!s->given_seen) {
+    if (!s->given) {
         char *mark = ulam__calloc((size_t)s->n, 1);
         if (!mark) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
         if (s->o.mode == ULAM_ADJOINT && !s->o.nstarts) mark[s->o.index] = 1;
@@ -325,29 +344,31 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         free(s->seen);
         s->seen = mark;
     }
-    const char *seen = s->given_seen ? s->given_seen : s->seen;
+    const char *seen = s->given ? s->given->seen : s->seen;
+    const ulam__reach *given = s->given && s->given->bounds && s->given->K == K &&
+                                       s->given->continue_q == fmax(s->o.continue_q, 0.0) &&
+                                       s->given->alpha == s->o.kernel_alpha
+                                   ? s->given
+                                   : NULL; /* K's own bounds over seen, computed before */
+    ulam__reach kb = given ? *given : (ulam__reach){.seen = seen};
     double *fac = NULL; /* kernel exponent != 1: each move's own weight factor */
-    if (s->o.kernel_alpha != 1.0 && !(fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
+    if (!given && s->o.kernel_alpha != 1.0 && !(fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
-    int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = 0;
+    if (!given) kernel_bounds(K, seen, s->o.continue_q, fac, &kb);
+    int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, pos = 0, neg = kb.neg;
     int64_t bad = -1;
     int expected = s->o.estimator == ULAM_EXPECTED;
-    double w0 = 1.0, fbig = 0.0, gmax = 0.0, g2max = 0.0, vmax = 0.0, qmax = 0.0;
+    double w0 = 1.0, gmax = 0.0, g2max = 0.0, vmax = 0.0, qmax = kb.qmax;
     for (int64_t i = 0; i < s->n; i++) {
         if (!seen[i]) continue;
-        double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
-        if (!fac) fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
-        qmax = fmax(qmax, q);
-        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
-            neg |= K->val[k] < 0;
-            if (fac) fbig = fmax(fbig, fac[k]);
-            if (adj && expected) c += K->val[k] * s->b[K->colidx[k]];
-        }
-        if (absorb && (adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
+        int scores = adj ? s->b[i] != 0.0 : i == s->o.index, ends = absorb && (adj ? s->b[i] != 0.0 : 1);
+        if (!scores && !ends && !(adj && expected)) continue; /* a visit here scores nothing */
+        double q = absorb ? ulam__continuation(row_sum(K, i), s->o.continue_q) : 0.0, c = 0.0;
+        for (int64_t k = K->rowptr[i]; adj && expected && k < K->rowptr[i + 1]; k++) c += K->val[k] * s->b[K->colidx[k]];
+        if (ends && q >= 1.0 && bad < 0) bad = i;
         /* what one visit scores: b_i (collision), (M b)_i (expected), forward 1 at the index */
         double v = adj ? fabs(expected ? c : s->b[i]) : i == s->o.index ? (expected ? INFINITY : 1.0) : 0.0;
         vmax = fmax(vmax, v);
-        int scores = adj ? s->b[i] != 0.0 : i == s->o.index;
         if (!scores) continue;
         double g = adj ? fabs(s->b[i]) : 1.0;
         gmax = fmax(gmax, absorb ? (q < 1.0 ? g / (1.0 - q) : INFINITY) : INFINITY);
@@ -358,14 +379,18 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         for (int64_t i = 0; i < s->n; i++) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
     for (int64_t j = 0; adj && j < s->o.nstarts; j++) /* signed start weights (conservative: both may show) */
         pos |= s->o.start_weights[j] > 0, neg |= s->o.start_weights[j] < 0;
-    double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
+    double G = given ? given->growth : kb.fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
     w0 = start_weight(&s->o, s->b, s->n);
     double Wmax = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
     s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
-    if (s->o.rel_err > 0 && vmax > 0 && (!(qmax < 1.0) || !isfinite(Wmax)))
-        length_tail(K, seen, s->o.continue_q, 0, 1e-30, &s->tail_u, &s->kappa); /* kappa enters by its log */
+    if (s->o.rel_err > 0 && vmax > 0 && (!(qmax < 1.0) || !isfinite(Wmax))) {
+        if (given && given->tail) s->tail_u = given->tail_u, s->kappa = given->kappa;
+        else length_tail(K, seen, s->o.continue_q, 0, 1e-30, &s->tail_u, &s->kappa); /* kappa enters by its log */
+    }
     if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
         (absorb ? isfinite(g2max) : isfinite(vmax))) {
+        if (s->o.kernel_alpha != 1.0 && !fac && !(fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
+            return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
         s->v2 = second_moment(s, K, fac, seen, w0);
     }
     free(fac);
@@ -382,6 +407,26 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     s->range = s->bound * (s->signs ? 2.0 : 1.0);
     s->per_step = vmax > 0 ? W * vmax : 0.0;
     s->qmax = qmax;
+    return ULAM_OK;
+}
+
+/* The reach of every state of K, with K's own bounds over it (see internal.h). */
+int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *seen, ulam__reach *R)
+{
+    memset(seen, 1, (size_t)K->nrows);
+    *R = (ulam__reach){.seen = seen, .bounds = 1, .K = K, .continue_q = fmax(continue_q, 0.0), .alpha = alpha,
+                       .tail_u = 1.0, .kappa = INFINITY};
+    int status = ulam__kernel_reach(K, continue_q, seen); /* every row checked */
+    if (status) return status;
+    double *fac = NULL;
+    if (alpha != 1.0 && !(fac = move_factors(K, seen, continue_q, alpha))) return ULAM_ENOMEM;
+    kernel_bounds(K, seen, continue_q, fac, R);
+    R->growth = R->fbig > 1.0 ? weight_growth(K, continue_q, fac, seen) : 1.0;
+    if (!(R->qmax < 1.0) || !isfinite(R->growth)) { /* the tail certificate check_reach would need */
+        length_tail(K, seen, continue_q, 0, 1e-30, &R->tail_u, &R->kappa);
+        R->tail = 1;
+    }
+    free(fac);
     return ULAM_OK;
 }
 
@@ -558,8 +603,8 @@ static int kernel_failure(const ulam_kernel *k, ulam_error *err)
                       "finite, nonzero values and score (the matrix is corrupt)", (long long)i + 1);
 }
 
-/* Prepare walks on (I - M) x = b; seen: the states they can reach, computed before (NULL: search). */
-static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
+/* Prepare walks on (I - M) x = b; reach: the states they can reach, computed before (NULL: search). */
+static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
                         ulam_solver **out, ulam_error *err)
 {
     ulam__clear(err);
@@ -575,7 +620,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     s->o = o;
     s->b = b;
     s->n = M->nrows;
-    s->given_seen = seen;
+    s->given = o.mode == ULAM_ADJOINT ? reach : NULL;
     if ((status = take_guard(M, &o, &s->g, err)) || (status = check_verdicts(M, s, err))) {
         ulam_solver_free(s);
         return status;
@@ -633,17 +678,17 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
     return solver_alloc(M, b, opts, NULL, out, err);
 }
 
-/* As ulam_solver_alloc with the reachable states seen (borrowed). */
-int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
-                               ulam_solver **out, ulam_error *err)
+/* As ulam_solver_alloc with the reachable states (borrowed). */
+int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                               const ulam__reach *reach, ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, seen, out, err);
+    return solver_alloc(M, b, opts, reach, out, err);
 }
 
 /* The states the solver's walks can reach (NULL unless its reachability check ran). */
 const char *ulam__solver_reached(const ulam_solver *s)
 {
-    return s->given_seen ? s->given_seen : s->seen;
+    return s->given ? s->given->seen : s->seen;
 }
 
 /* Run walks [first, first + count) as block q on thread t (ctx: the solver). */
