@@ -279,9 +279,7 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     ulam_solver *sv = NULL;
     ulam__reach seen = {.seen = memo->seen};
     int status = ULAM_OK;
-    /* <p, b> = 0: x_t may be exactly 0, which only the source's own reach can certify (nothing that
-       scores reachable); every state's bounds would leave the rule unmet to the walk cap */
-    const ulam__reach *all = push_part != 0.0 ? reach_all(memo, Mt, o, &status, err) : NULL;
+    const ulam__reach *all = reach_all(memo, Mt, o, &status, err); /* the solver searches should x_t be 0 */
     const ulam__reach *reach = all ? all : memo->have_seen ? &seen : NULL;
     if (status) return status;
     status = ulam__solver_alloc_reached(Mt, r, &wo, reach, &sv, err);

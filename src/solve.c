@@ -759,6 +759,24 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
     return ulam__rel_err_holds(r->walks, m, r->std_error, r->min_walks, r->variance_rel_error, E);
 }
 
+/* Under bounds over every state (ulam__reach_all), an estimate still exactly 0 once the rule
+ * could hold: search the starts' own reach, whose bounds are what a solver without given bounds
+ * has from the start (nothing that scores reachable certifies x = 0; looser bounds would leave
+ * the rule unmet to the walk cap).  The search's bounds hold for the run as the others did, and
+ * are at least as tight, so the rule may only stop it sooner from here on.  1 when it searched
+ * (a failure ends the run with its status). */
+static int search_reach(ulam_solver *s, const ulam_walk_result *r)
+{
+    if (!s->given || !s->given->bounds || !(s->o.rel_err > 0) || s->run.walks < ULAM__REL_MIN ||
+        r->estimate + s->o.rel_err_offset != 0.0 || s->o.mode != ULAM_ADJOINT)
+        return 0;
+    s->given = NULL;
+    ulam_error err;
+    int status = check_reach(s, s->k->K, &err);
+    if (status) s->run.done = 1, s->run.status = status;
+    return 1;
+}
+
 /* Run one round of walks. */
 int ulam_solver_iterate(ulam_solver *s)
 {
@@ -772,6 +790,10 @@ int ulam_solver_iterate(ulam_solver *s)
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
     result(s, &r, 0);
+    if (!s->run.status && search_reach(s, &r)) {
+        if (s->run.status) return s->run.status; /* the search failed */
+        result(s, &r, 0);
+    }
     if (rel_err_met(s, &r)) s->run.done = s->met = 1;
     else if (s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.rel_err_offset) > 0 &&
              !(r.cut_bound <= ULAM__CUT_SHARE * s->o.rel_err * fabs(r.estimate + s->o.rel_err_offset)))

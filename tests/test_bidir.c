@@ -542,7 +542,8 @@ static void test_bidir_rare_score(void **state)
  * one shared workspace
  * are within 4 sigma of LAPACK, and where the bounds over the source's reach equal those over
  * every state (the table's systems: random rows reach every state) they are bit for bit the
- * run with a search a query on a fresh workspace; on a block-diagonal M (the source's block reaches half of
+ * run with a search a query on a fresh workspace (case 202 too, where x_t = 0 and the push finds
+ * nothing: the solver searches once its estimate is still 0, and stops at once, certified); on a block-diagonal M (the source's block reaches half of
  * the states, the other block's rows sum higher, so the bounds are looser and the balance may
  * choose another rmax) still within 4 sigma and the rule met. */
 static void test_bidir_reach_all(void **state)
