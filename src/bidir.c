@@ -18,6 +18,7 @@
  * pushed workspace with a memo of the plan (push.h), which ulam_bidir_solve reuses for the same
  * options instead of pushing again. */
 #include "internal.h"
+#include "kernel.h"
 #include "push.h"
 #include "stats.h"
 
@@ -119,9 +120,10 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
 /* The pilot's solver: PILOT collision walks from s on Mt on a seed of their own, scoring 1 at
  * every visit (ones: n of them), with rel_err when the walks have one so that the solver
  * computes its reachability bounds for scores of at most 1 a visit (the balance scales them to
- * rmax); reach: every state's bounds (reach_all), or NULL to search. */
+ * rmax); reach: every state's bounds (reach_all), or NULL to search; with keep_kernel the pilot's
+ * kernel (scoring ones) is kept in memo for later pilots. */
 static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *o, const ulam__reach *reach,
-                 ulam_solver **out, ulam_error *err)
+                 ulam__bidir_memo *memo, ulam_solver **out, ulam_error *err)
 {
     ulam_walk_opts po = walk_opts(o);
     po.estimator = ULAM_COLLISION;
@@ -129,9 +131,15 @@ static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *
     po.threads = 1; /* one partial block: a thread team would only be woken (same result for any count) */
     po.seed = o->walk.seed ^ UINT64_C(0x9e3779b97f4a7c15);
     po.interrupt = NULL;
-    int status = ulam__solver_alloc_reached(Mt, ones, &po, reach, out, err);
+    ulam_kernel *k = memo->pilot;
+    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != po.continue_q || k->alpha != po.kernel_alpha ||
+              k->scores.b != ones))
+        memo->pilot = k = ulam__kernel_free(k);
+    int status = ulam__solver_alloc_reached(Mt, ones, &po, reach, k, out, err);
     while (!status && !ulam_solver_done(*out)) status = ulam_solver_iterate(*out);
     if (status && *out) ulam_solver_error(*out, err);
+    if (!k && o->keep_kernel && !status) memo->pilot = ulam__solver_keep_kernel_fixed(*out);
+    if (k && status) memo->pilot = ulam__kernel_free(k); /* freed after the solver (ulam_bidir_plan) */
     return status;
 }
 
@@ -224,7 +232,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
     const ulam__reach *all = reach_all(memo, Mt, o, &status, err);
     if (status) return status;
     if (plan->balanced) {
-        status = pilot(Mt, memo->ones, o, all, &pl, err);
+        status = pilot(Mt, memo->ones, o, all, memo, &pl, err);
         if (status) {
             ulam_solver_free(pl);
             return status;
@@ -282,12 +290,21 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     const ulam__reach *all = reach_all(memo, Mt, o, &status, err); /* the solver searches should x_t be 0 */
     const ulam__reach *reach = all ? all : memo->have_seen ? &seen : NULL;
     if (status) return status;
-    status = ulam__solver_alloc_reached(Mt, r, &wo, reach, &sv, err);
-    if (status) return status;
+    ulam_kernel *k = memo->kernel; /* keep_kernel: the rows earlier queries built, if made for these walks */
+    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != wo.continue_q || k->alpha != wo.kernel_alpha ||
+              k->scores.estimator != wo.estimator))
+        memo->kernel = k = ulam__kernel_free(k);
+    status = ulam__solver_alloc_reached(Mt, r, &wo, reach, k, &sv, err);
+    if (status) {
+        if (k) memo->kernel = ulam__kernel_free(k); /* a failed kernel is not kept */
+        return status;
+    }
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     ulam_solver_result(sv, wr);
     if (status) ulam_solver_error(sv, err);
+    if (!k && o->keep_kernel && !status && wo.estimator != ULAM_EXPECTED) memo->kernel = ulam__solver_keep_kernel(sv);
     ulam_solver_free(sv);
+    if (k && status) memo->kernel = ulam__kernel_free(k);
     return status;
 }
 

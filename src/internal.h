@@ -82,6 +82,8 @@ int ulam__power_from(const ulam_csr *A, const double *left, const double *right,
  * without a bound). */
 double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E);
 
+struct ulam_kernel; /* src/kernel.h */
+
 /* A set of states adjoint walks on K can reach (seen: n flags, closed under the walk's moves,
  * rows checked) and, when bounds is set, what check_reach computes over it from K alone
  * (src/solve.c): the largest weight factor S / q (fbig), continuation (qmax), whether K has a
@@ -104,12 +106,25 @@ typedef struct ulam__reach {
 int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *seen, ulam__reach *R);
 
 /* As ulam_solver_alloc (adjoint) with reach (borrowed until the solver is freed; NULL: search)
+ * and kernel (NULL, or one of ulam__solver_keep_kernel, borrowed likewise)
  * the states walks can reach, from an earlier solver on the same M, start states and
  * continuation (ulam__solver_reached) or from ulam__reach_all: its rows were checked then, the
  * search is not made again, and with reach->bounds (for this M, continuation and exponent)
  * neither are the bounds of M alone. */
 int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-                               const ulam__reach *reach, ulam_solver **out, ulam_error *err);
+                               const ulam__reach *reach, struct ulam_kernel *kernel, ulam_solver **out,
+                               ulam_error *err);
+
+/* The kernel of an adjoint collision or absorption solver, kept for later solvers on the same M,
+ * continuation, exponent and estimator with any b (ulam__solver_alloc_reached's kernel, rescored
+ * to its b: rows already built are not built again, and walks take exactly the moves a new
+ * kernel's would); the caller owns it from here (ulam__kernel_free, after this solver is freed).
+ * NULL when it cannot be kept (forward, expected, a failed kernel, no memory, a borrowed one). */
+struct ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s);
+
+/* As ulam__solver_keep_kernel for a b whose values the caller keeps as they are, passed again to
+ * every later solver on the kernel: rescoring is then nothing at all. */
+struct ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s);
 
 /* The states a solver's walks can reach (n flags; NULL unless its reachability check ran). */
 const char *ulam__solver_reached(const ulam_solver *s);

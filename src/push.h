@@ -27,6 +27,8 @@ typedef struct {
     char *all;          /* n ones: every state (reach_all; NULL until a query asks) */
     ulam__reach reach;  /* what the walks reach: over seen (have_seen) or all (have_all) */
     int have_all;       /* 1: reach holds ulam__reach_all's bounds over all, for reach.K and continuation */
+    struct ulam_kernel *kernel; /* keep_kernel: the last walks' kernel (ulam__solver_keep_kernel; NULL: none) */
+    struct ulam_kernel *pilot;  /* keep_kernel: the pilot's, scoring ones (fixed; NULL: none) */
 } ulam__bidir_memo;
 
 /* The workspace's memo (owned by it, freed with it). */

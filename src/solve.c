@@ -29,6 +29,7 @@ struct ulam_solver {
     ulam_walk_opts o;
     int64_t n;
     ulam_kernel *k;
+    int k_borrowed; /* k is the caller's (ulam__solver_alloc_reached) or was kept (ulam__solver_keep_kernel) */
     ulam__walker w;
     const double *b; /* the caller's, borrowed like M */
     ulam_csr *mt;
@@ -74,7 +75,7 @@ ulam_walk_opts ulam_walk_defaults(void)
 ulam_solver *ulam_solver_free(ulam_solver *s)
 {
     if (!s) return NULL;
-    ulam__kernel_free(s->k);
+    if (!s->k_borrowed) ulam__kernel_free(s->k);
     free(s->src), free(s->sum), free(s->sumsq);
     free(s->start_src), free(s->start_units), free(s->start_b), free(s->seen);
     ulam_csr_free(s->mt);
@@ -603,9 +604,10 @@ static int kernel_failure(const ulam_kernel *k, ulam_error *err)
                       "finite, nonzero values and score (the matrix is corrupt)", (long long)i + 1);
 }
 
-/* Prepare walks on (I - M) x = b; reach: the states they can reach, computed before (NULL: search). */
+/* Prepare walks on (I - M) x = b; reach: the states they can reach, computed before (NULL: search);
+ * kernel: a kept kernel to walk on, rescored to b (NULL: a new one). */
 static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
-                        ulam_solver **out, ulam_error *err)
+                        ulam_kernel *kernel, ulam_solver **out, ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !b || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
@@ -633,7 +635,19 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         K = s->mt;
     }
     ulam__scores sc = {o.mode == ULAM_ADJOINT ? b : NULL, o.estimator};
-    if ((status = ulam__kernel_alloc(K, o.continue_q, o.kernel_alpha, sc, &s->k)) == ULAM_EOVERFLOW) {
+    if (kernel && (o.mode != ULAM_ADJOINT || kernel->K != K || kernel->continue_q != o.continue_q ||
+                   kernel->alpha != o.kernel_alpha || kernel->scores.estimator != o.estimator)) {
+        ulam_solver_free(s);
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a kept kernel made for this M, mode, continuation and estimator");
+    }
+    if (kernel) {
+        s->k = kernel, s->k_borrowed = 1;
+        if ((status = ulam__kernel_rescore(kernel, b))) {
+            status = kernel_failure(kernel, err);
+            ulam_solver_free(s);
+            return status ? status : ulam__fail(err, ULAM_EINVAL, 0, -1, "a kept kernel (ulam__solver_keep_kernel)");
+        }
+    } else if ((status = ulam__kernel_alloc(K, o.continue_q, o.kernel_alpha, sc, &s->k)) == ULAM_EOVERFLOW) {
         ulam_solver_free(s);
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
@@ -675,14 +689,30 @@ nomem:
 int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                       ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, NULL, out, err);
+    return solver_alloc(M, b, opts, NULL, NULL, out, err);
 }
 
-/* As ulam_solver_alloc with the reachable states (borrowed). */
+/* As ulam_solver_alloc with the reachable states and a kept kernel (both borrowed). */
 int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-                               const ulam__reach *reach, ulam_solver **out, ulam_error *err)
+                               const ulam__reach *reach, ulam_kernel *kernel, ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, reach, out, err);
+    return solver_alloc(M, b, opts, reach, kernel, out, err);
+}
+
+/* The solver's kernel, kept for later solvers (see internal.h). */
+ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s)
+{
+    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || ulam__kernel_keep(s->k)) return NULL;
+    s->k_borrowed = 1;
+    return s->k;
+}
+
+/* The solver's kernel, kept for later solvers with the same b, unchanged (see internal.h). */
+ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s)
+{
+    ulam_kernel *k = ulam__solver_keep_kernel(s);
+    if (k) k->fixed = 1;
+    return k;
 }
 
 /* The states the solver's walks can reach (NULL unless its reachability check ran). */

@@ -537,8 +537,10 @@ static void test_bidir_rare_score(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
-/* reach_all: bounds over every state, made once in the workspace and shared by later queries.
- * Queries (several targets and sources, balanced rmax, rel_err 0.1, collision and expected) on
+/* reach_all: bounds over every state, made once in the workspace and shared by later queries;
+ * keep_kernel: the walks' kernel rows kept there and rescored to each query's residual (the
+ * expected estimator keeps none).
+ * Queries (several targets and sources, balanced rmax, rel_err 0.1, the three estimators) on
  * one shared workspace
  * are within 4 sigma of LAPACK, and where the bounds over the source's reach equal those over
  * every state (the table's systems: random rows reach every state) they are bit for bit the
@@ -572,15 +574,16 @@ static void test_bidir_reach_all(void **state)
         int64_t n = M->nrows;
         ulam_push *shared = NULL;
         assert_int_equal(ulam_push_alloc(M, &shared), ULAM_OK);
-        for (int qe = 0; qe < 8; qe++) {
-            int q = qe / 2, est = qe % 2 ? ULAM_EXPECTED : ULAM_COLLISION;
+        for (int qe = 0; qe < 12; qe++) { /* collision, absorption, expected: 4 queries each (a kernel kept 4) */
+            int q = qe % 4, est = qe < 4 ? ULAM_COLLISION : qe < 8 ? ULAM_ABSORPTION : ULAM_EXPECTED;
             if (!test_case(100L * k + qe)) continue;
             int64_t s = (k * 7 + 5 * q + 1) % (block ? 30 : n), t = (k * 3 + 11 * q + 2) % (block ? 30 : n);
             double *x = exact_column(M, s);
             ulam_bidir_opts o = ulam_bidir_defaults();
             o.source = s, o.target = t;
             o.walk.max_walks = 0, o.walk.rel_err = 0.1, o.walk.seed = (uint64_t)(k * 10 + q + 1);
-            o.walk.estimator = est, o.reach_all = 1;
+            o.walk.estimator = est, o.reach_all = 1, o.keep_kernel = 1;
+            if (est == ULAM_ABSORPTION) o.walk.continue_q = 0.9; /* rows of M' may sum past 1: p* = 0.1 */
             ulam_bidir_result res;
             ulam_error err;
             int st = ulam_bidir_solve(shared, Mt, &o, &res, &err);
@@ -596,7 +599,7 @@ static void test_bidir_reach_all(void **state)
                             100 * k + qe, (long long)res.walks.walks, res.std_error, res.estimate, res.walks.out_of_reach,
                             res.walks.cut_stop);
             assert_true(res.push.support == 0 || res.walks.rel_err_met);
-            o.reach_all = 0;
+            o.reach_all = o.keep_kernel = 0;
             ulam_bidir_result one = bidir(M, Mt, &o); /* a search a query, fresh workspace */
             if (!block) {
                 if (res.estimate != one.estimate || res.walks.walks != one.walks.walks)
