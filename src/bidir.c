@@ -110,8 +110,9 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
     if (a->nb != b->nb || (b->nb > 0 && (memcmp(m->idx, b->b_index, (size_t)b->nb * sizeof *m->idx) ||
                                          memcmp(m->val, b->b_value, (size_t)b->nb * sizeof *m->val))))
         return 0;
-    return m->Mt == Mt && a->reach_all == b->reach_all && a->target == b->target && (b->nb > 0 || a->source == b->source) && a->rmax == b->rmax &&
-           a->min_value == b->min_value && a->max_push_ops == b->max_push_ops && x->seed == y->seed &&
+    return m->Mt == Mt && a->reach_all == b->reach_all && a->target == b->target &&
+           (b->nb > 0 || a->source == b->source) && a->rmax == b->rmax && a->min_value == b->min_value &&
+           a->max_push_ops == b->max_push_ops && x->seed == y->seed &&
            x->rel_err == y->rel_err && x->max_walks == y->max_walks && x->continue_q == y->continue_q &&
            x->roulette == y->roulette && x->split == y->split && x->max_steps == y->max_steps &&
            x->force == y->force && x->assume_finite == y->assume_finite && x->guard == y->guard;
@@ -139,7 +140,7 @@ static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *
     while (!status && !ulam_solver_done(*out)) status = ulam_solver_iterate(*out);
     if (status && *out) ulam_solver_error(*out, err);
     if (!k && o->keep_kernel && !status) memo->pilot = ulam__solver_keep_kernel_fixed(*out);
-    if (k && status) memo->pilot = ulam__kernel_free(k); /* freed after the solver (ulam_bidir_plan) */
+    if (k && status) memo->pilot = ulam__kernel_free(k); /* not kept; *out never reads a borrowed kernel again */
     return status;
 }
 
