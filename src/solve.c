@@ -61,7 +61,8 @@ struct ulam_solver {
     ulam_power rho4;       /* rho(M4) of the walk kernel ([0, INFINITY] until computed) */
     int rho4_done;         /* rho4 computed */
     int fourth;            /* the fourth moment: 1 finite, 0 infinite, -1 unknown (take_fourth) */
-    char *seen;            /* the states walks can reach (kept for a rerun; NULL until needed) */
+    char *seen;            /* the states walks can reach as searched here (kept for a rerun; NULL until needed) */
+    const char *reached;   /* seen, or the caller's given->seen (NULL until needed) */
     double *fac;           /* kernel exponent != 1: each move's weight factor over them (kept) */
     int64_t reach_nnz;     /* entries of M over the reachable rows (0 until computed) */
     int64_t setup_work;    /* entries read by reachability checks and score-bound passes so far */
@@ -350,30 +351,41 @@ static const ulam__reach *given_bounds(const ulam_solver *s, const ulam_csr *K)
                : NULL;
 }
 
-/* The states walks can reach (s->seen, computed once and kept) and their entries (s->reach_nnz). */
+/* The entries of K over the reachable rows (s->reach_nnz). */
+static void count_reached(ulam_solver *s, const ulam_csr *K)
+{
+    s->reach_nnz = 0;
+    for (int64_t i = 0; i < s->n; i++)
+        if (s->reached[i]) s->reach_nnz += K->rowptr[i + 1] - K->rowptr[i];
+}
+
+/* The states walks can reach (s->reached: searched once and kept in s->seen, or the caller's)
+ * and their entries (s->reach_nnz). */
 static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
-    if (s->seen) return ULAM_OK;
+    if (s->reached) return ULAM_OK;
+    if (s->given) { /* the caller's reach (an earlier solver's search, or ulam__reach_all), read where it is */
+        s->reached = s->given->seen;
+        if (given_bounds(s, K)) s->reach_nnz = K->rowptr[K->nrows]; /* every state's (ulam__reach_all): not counted */
+        else count_reached(s, K);
+        return ULAM_OK;
+    }
     char *seen = ulam__calloc((size_t)s->n, 1);
     if (!seen) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
     if (s->o.mode == ULAM_ADJOINT && !s->o.nstarts) seen[s->o.index] = 1;
     for (int64_t j = 0; s->o.mode == ULAM_ADJOINT && j < s->o.nstarts; j++) seen[s->o.starts[j]] = 1;
     if (s->o.mode == ULAM_FORWARD)
         for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
-    /* the caller's reach (an earlier solver's search, or ulam__reach_all) is copied, not repeated */
-    int status = s->given ? (memcpy(seen, s->given->seen, (size_t)s->n), ULAM_OK)
-                          : ulam__kernel_reach(K, s->o.continue_q, seen);
+    int status = ulam__kernel_reach(K, s->o.continue_q, seen);
     if (status) {
         free(seen);
         return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for a reachability check")
                                      : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, "
                                                   "nonzero values (the matrix is corrupt)");
     }
-    s->seen = seen;
-    s->reach_nnz = 0;
-    for (int64_t i = 0; i < s->n; i++)
-        if (seen[i]) s->reach_nnz += K->rowptr[i + 1] - K->rowptr[i];
-    s->setup_work += s->given ? 0 : s->reach_nnz;
+    s->reached = s->seen = seen;
+    count_reached(s, K);
+    s->setup_work += s->reach_nnz;
     return ULAM_OK;
 }
 
@@ -387,7 +399,7 @@ static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
  * one of them run. */
 static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
-    const char *seen = s->seen;
+    const char *seen = s->reached;
     const ulam__reach *given = given_bounds(s, K);
     int adj = s->o.mode == ULAM_ADJOINT, only = given ? s->o.estimator : -1;
     double *fac = NULL; /* kernel exponent != 1: each move's own weight factor (kept: s->fac) */
@@ -476,15 +488,15 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         if (!s->tail_done && given && given->tail) /* the caller's certificate over the same states */
             s->tail_uc = given->tail_u, s->tail_kc = given->kappa, s->tail_done = 1;
         if (!s->tail_done) /* kappa enters by its log */
-            length_tail(K, s->seen, s->o.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
+            length_tail(K, s->reached, s->o.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
         s->tail_u = s->tail_uc, s->kappa = s->tail_kc;
     }
     if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
         (absorb ? isfinite(s->pass[e].g2max) : isfinite(vmax))) {
         if (!s->v2_done[e] && s->o.kernel_alpha != 1.0 && !s->fac &&
-            !(s->fac = move_factors(K, s->seen, s->o.continue_q, s->o.kernel_alpha))) /* given bounds: not made */
+            !(s->fac = move_factors(K, s->reached, s->o.continue_q, s->o.kernel_alpha))) /* given bounds: not made */
             return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
-        if (!s->v2_done[e]) s->v2c[e] = second_moment(s, K, s->fac, s->seen, w0, &it), s->v2_done[e] = 1;
+        if (!s->v2_done[e]) s->v2c[e] = second_moment(s, K, s->fac, s->reached, w0, &it), s->v2_done[e] = 1;
         s->v2 = s->v2c[e];
     }
     s->setup_work += (int64_t)it * s->reach_nnz;
@@ -977,7 +989,7 @@ static int search_reach(ulam_solver *s, const ulam_walk_result *r)
         return 0;
     s->given = NULL;
     free(s->seen), free(s->fac); /* the given reach and what was kept over it (as ulam__solver_restart) */
-    s->seen = NULL, s->fac = NULL;
+    s->seen = NULL, s->reached = NULL, s->fac = NULL;
     s->passed = s->tail_done = 0;
     memset(s->v2_done, 0, sizeof s->v2_done);
     ulam_error err;
@@ -1200,7 +1212,7 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     double bnorm1 = 0.0;
     if (build_source(s, &bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");
     free(s->seen), free(s->fac); /* the reachable set and the score bounds depend on b */
-    s->seen = NULL, s->fac = NULL;
+    s->seen = NULL, s->reached = NULL, s->fac = NULL;
     s->passed = s->tail_done = 0;
     memset(s->v2_done, 0, sizeof s->v2_done);
     if (s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0) {
