@@ -831,6 +831,15 @@ typedef struct ulam_bidir_opts {
     ulam_walk_opts walk;  /* the walks' kernel, seed, threads and stopping rules (mode, index and
                              starts are set here); rel_err applies to the whole estimate
                              <p, b> + <r, x> */
+    int reach_all;        /* 1: the walks' reachability bounds (rel_err, absorption) taken over
+                             every state of Mt, a superset of what any source reaches, so they
+                             hold for every query (looser where a source reaches less); computed
+                             once and kept in the push workspace for later queries on the same
+                             Mt and continuation; 0: a search from the source each query */
+    int keep_kernel;      /* 1 (collision or absorption): the walks' kernel rows of Mt kept in the
+                             push workspace and rescored to the next query's residual, so a query
+                             builds only the rows no earlier one reached (its walks are those a new
+                             kernel gives, bit for bit; walks.rows counts every row kept) */
 } ulam_bidir_opts;
 
 /* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0

@@ -18,6 +18,7 @@
  * pushed workspace with a memo of the plan (push.h), which ulam_bidir_solve reuses for the same
  * options instead of pushing again. */
 #include "internal.h"
+#include "kernel.h"
 #include "push.h"
 #include "stats.h"
 
@@ -109,8 +110,9 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
     if (a->nb != b->nb || (b->nb > 0 && (memcmp(m->idx, b->b_index, (size_t)b->nb * sizeof *m->idx) ||
                                          memcmp(m->val, b->b_value, (size_t)b->nb * sizeof *m->val))))
         return 0;
-    return m->Mt == Mt && a->target == b->target && (b->nb > 0 || a->source == b->source) && a->rmax == b->rmax &&
-           a->min_value == b->min_value && a->max_push_ops == b->max_push_ops && x->seed == y->seed &&
+    return m->Mt == Mt && a->reach_all == b->reach_all && a->target == b->target &&
+           (b->nb > 0 || a->source == b->source) && a->rmax == b->rmax && a->min_value == b->min_value &&
+           a->max_push_ops == b->max_push_ops && x->seed == y->seed &&
            x->rel_err == y->rel_err && x->max_walks == y->max_walks && x->continue_q == y->continue_q &&
            x->roulette == y->roulette && x->split == y->split && x->max_steps == y->max_steps &&
            x->force == y->force && x->assume_finite == y->assume_finite && x->guard == y->guard;
@@ -119,8 +121,10 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
 /* The pilot's solver: PILOT collision walks from s on Mt on a seed of their own, scoring 1 at
  * every visit (ones: n of them), with rel_err when the walks have one so that the solver
  * computes its reachability bounds for scores of at most 1 a visit (the balance scales them to
- * rmax). */
-static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *o, ulam_solver **out, ulam_error *err)
+ * rmax); reach: every state's bounds (reach_all), or NULL to search; with keep_kernel the pilot's
+ * kernel (scoring ones) is kept in memo for later pilots. */
+static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *o, const ulam__reach *reach,
+                 ulam__bidir_memo *memo, ulam_solver **out, ulam_error *err)
 {
     ulam_walk_opts po = walk_opts(o);
     po.estimator = ULAM_COLLISION;
@@ -128,9 +132,15 @@ static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *
     po.threads = 1; /* one partial block: a thread team would only be woken (same result for any count) */
     po.seed = o->walk.seed ^ UINT64_C(0x9e3779b97f4a7c15);
     po.interrupt = NULL;
-    int status = ulam_solver_alloc(Mt, ones, &po, out, err);
+    ulam_kernel *k = memo->pilot;
+    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != po.continue_q || k->alpha != po.kernel_alpha ||
+              k->scores.b != ones))
+        memo->pilot = k = ulam__kernel_free(k);
+    int status = ulam__solver_alloc_reached(Mt, ones, &po, reach, k, out, err);
     while (!status && !ulam_solver_done(*out)) status = ulam_solver_iterate(*out);
     if (status && *out) ulam_solver_error(*out, err);
+    if (!k && o->keep_kernel && !status) memo->pilot = ulam__solver_keep_kernel_fixed(*out);
+    if (k && status) memo->pilot = ulam__kernel_free(k); /* not kept; *out never reads a borrowed kernel again */
     return status;
 }
 
@@ -174,6 +184,32 @@ static int push(ulam_push *w, const ulam_bidir_opts *o, const ulam_solver *pl, i
     return status;
 }
 
+/* The memo's reach of every state of Mt for o's continuation and exponent, made once (reach_all);
+ * NULL without reach_all. */
+static const ulam__reach *reach_all(ulam__bidir_memo *memo, const ulam_csr *Mt, const ulam_bidir_opts *o, int *status,
+                                    ulam_error *err)
+{
+    const ulam_walk_opts *wo = &o->walk;
+    ulam__reach *R = &memo->reach;
+    *status = ULAM_OK;
+    if (!o->reach_all) return NULL;
+    if (memo->have_all && R->K == Mt && R->continue_q == fmax(wo->continue_q, 0.0) && R->alpha == wo->kernel_alpha)
+        return R;
+    memo->have_all = 0;
+    if (!memo->all && !(memo->all = ulam__malloc((size_t)Mt->nrows, 1))) {
+        *status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' reach");
+        return NULL;
+    }
+    if ((*status = ulam__reach_all(Mt, wo->continue_q, wo->kernel_alpha, memo->all, R))) {
+        *status = *status == ULAM_ENOMEM ? ulam__fail(err, *status, 0, -1, "memory for the walks' reach")
+                                         : ulam__fail(err, *status, 0, -1, "rows of Mt with columns in range and "
+                                                      "finite, nonzero values (the matrix is corrupt)");
+        return NULL;
+    }
+    memo->have_all = 1;
+    return R;
+}
+
 /* Plan x_t's estimate: the push and the walks' predicted cost (see ulam.h). */
 int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
                     ulam_error *err)
@@ -194,8 +230,10 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
             return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the pilot's scores");
         for (int64_t i = 0; i < M->nrows; i++) memo->ones[i] = 1.0;
     }
+    const ulam__reach *all = reach_all(memo, Mt, o, &status, err);
+    if (status) return status;
     if (plan->balanced) {
-        status = pilot(Mt, memo->ones, o, &pl, err);
+        status = pilot(Mt, memo->ones, o, all, memo, &pl, err);
         if (status) {
             ulam_solver_free(pl);
             return status;
@@ -206,7 +244,8 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
         plan->mean_visits = r.walks > 0 ? 1.0 + (double)r.steps / (double)r.walks : 1.0;
         ulam_solver_guard(pl, &memo->guard);
         memo->have_guard = 1;
-        const char *seen = ulam__solver_reached(pl); /* the walks' reach: the estimate's solver need not search again */
+        const char *seen = all ? NULL : ulam__solver_reached(pl); /* the walks' reach: the estimate's solver need
+                                                                     not search again */
         if (seen && (memo->seen || (memo->seen = ulam__malloc((size_t)M->nrows, 1)))) {
             memcpy(memo->seen, seen, (size_t)M->nrows);
             memo->have_seen = 1;
@@ -239,20 +278,35 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
 
 /* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr.  The solver's
  * rel_err rule (the one of ulam_solve) applies to the whole estimate push_part + <r, x>;
- * memo: the pilot's guards on Mt and the states it found the walks reach, when it has them. */
+ * memo: the pilot's guards on Mt and the states it found the walks reach, when it has them, or
+ * (reach_all) every state's bounds. */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
-                const ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_error *err)
+                ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_error *err)
 {
     ulam_walk_opts wo = walk_opts(o);
     wo.rel_err_offset = push_part;
     if (!wo.guard && memo->have_guard) wo.guard = &memo->guard;
     ulam_solver *sv = NULL;
-    int status = ulam__solver_alloc_reached(Mt, r, &wo, memo->have_seen ? memo->seen : NULL, &sv, err);
+    ulam__reach seen = {.seen = memo->seen};
+    int status = ULAM_OK;
+    const ulam__reach *all = reach_all(memo, Mt, o, &status, err); /* the solver searches should x_t be 0 */
+    const ulam__reach *reach = all ? all : memo->have_seen ? &seen : NULL;
     if (status) return status;
+    ulam_kernel *k = memo->kernel; /* keep_kernel: the rows earlier queries built, if made for these walks */
+    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != wo.continue_q || k->alpha != wo.kernel_alpha ||
+              k->scores.estimator != wo.estimator))
+        memo->kernel = k = ulam__kernel_free(k);
+    status = ulam__solver_alloc_reached(Mt, r, &wo, reach, k, &sv, err);
+    if (status) {
+        if (k) memo->kernel = ulam__kernel_free(k); /* a failed kernel is not kept */
+        return status;
+    }
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     ulam_solver_result(sv, wr);
     if (status) ulam_solver_error(sv, err);
+    if (!k && o->keep_kernel && !status && wo.estimator != ULAM_EXPECTED) memo->kernel = ulam__solver_keep_kernel(sv);
     ulam_solver_free(sv);
+    if (k && status) memo->kernel = ulam__kernel_free(k);
     return status;
 }
 

@@ -104,11 +104,49 @@ int ulam__guard_fourth(const ulam_csr *K, double continue_q, double alpha, const
  * without a bound). */
 double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E);
 
-/* As ulam_solver_alloc, with seen (n flags, borrowed until the solver is freed) the states walks
- * can reach, as an earlier solver on the same M, start states and continuation found them
- * (ulam__solver_reached): its rows were checked then, and the search is not made again. */
-int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
-                               ulam_solver **out, ulam_error *err);
+struct ulam_kernel; /* src/kernel.h */
+
+/* A set of states adjoint walks on K can reach (seen: n flags, closed under the walk's moves,
+ * rows checked) and, when bounds is set, what check_reach computes over it from K alone
+ * (src/solve.c): the largest weight factor S / q (fbig), continuation (qmax), whether K has a
+ * negative entry (neg), the weight growth along paths, and (tail) the length tail's
+ * certificate.  ulam__reach_all makes it over every state: a superset of any start's reach, so
+ * its bounds hold for every start and b (looser where a start reaches less), computed once. */
+typedef struct ulam__reach {
+    const char *seen;
+    int bounds;
+    const ulam_csr *K;
+    double continue_q, alpha;
+    double fbig, qmax, growth;
+    int neg, tail;
+    double tail_u, kappa;
+} ulam__reach;
+
+/* The reach of every state of K at continuation continue_q and exponent alpha with its bounds;
+ * seen: n bytes of room, set to all ones (borrowed by R).  ULAM_OK, ULAM_ENOMEM, ULAM_ESYNTAX
+ * (a corrupt row), ULAM_ERANGE (alpha's probabilities underflow). */
+int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *seen, ulam__reach *R);
+
+/* As ulam_solver_alloc (adjoint) with reach (borrowed until the solver is freed; NULL: search)
+ * and kernel (NULL, or one of ulam__solver_keep_kernel, borrowed likewise)
+ * the states walks can reach, from an earlier solver on the same M, start states and
+ * continuation (ulam__solver_reached) or from ulam__reach_all: its rows were checked then, the
+ * search is not made again, and with reach->bounds (for this M, continuation and exponent)
+ * neither are the bounds of M alone. */
+int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                               const ulam__reach *reach, struct ulam_kernel *kernel, ulam_solver **out,
+                               ulam_error *err);
+
+/* The kernel of an adjoint collision or absorption solver, kept for later solvers on the same M,
+ * continuation, exponent and estimator with any b (ulam__solver_alloc_reached's kernel, rescored
+ * to its b: rows already built are not built again, and walks take exactly the moves a new
+ * kernel's would); the caller owns it from here (ulam__kernel_free, after this solver is freed).
+ * NULL when it cannot be kept (forward, expected, a failed kernel, no memory, a borrowed one). */
+struct ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s);
+
+/* As ulam__solver_keep_kernel for a b whose values the caller keeps as they are, passed again to
+ * every later solver on the kernel: rescoring is then nothing at all. */
+struct ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s);
 
 /* The states a solver's walks can reach (n flags; NULL unless its reachability check ran). */
 const char *ulam__solver_reached(const ulam_solver *s);

@@ -42,6 +42,7 @@ ulam_kernel *ulam__kernel_free(ulam_kernel *k)
     if (!k) return NULL;
     free(k->mem);
     free(k->fac);
+    free(k->scored);
     free((void *)k->where);
     free(k);
     return NULL;
@@ -436,4 +437,39 @@ int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen)
     }
     free(stack);
     return ULAM_OK;
+}
+
+/* Rescore row i, when built, from k's scores. */
+static void rescore_row(ulam_kernel *k, int64_t i)
+{
+    int32_t u = atomic_load_explicit(&k->where[i], memory_order_relaxed);
+    if (u <= 0) return;
+    ulam__row *h = ulam__kernel_row(k, u - 1);
+    double pstar = k->scores.estimator == ULAM_ABSORPTION ? 1.0 - ulam__continuation(row_sum(k->K, i), k->continue_q) : 0.0;
+    row_scores(k, i, pstar, &h->visit, &h->end); /* p* is read by absorption alone */
+    if (!isfinite(h->visit) || !isfinite(h->end)) h->visit = h->end = 0.0, fail(k, ULAM_ENONFINITE, i);
+}
+
+/* Keep k for later right-hand sides (see kernel.h). */
+int ulam__kernel_keep(ulam_kernel *k)
+{
+    if (k->scores.estimator == ULAM_EXPECTED || !k->scores.b || atomic_load(&k->status)) return ULAM_EINVAL;
+    if (!k->scored && !(k->scored = ulam__malloc((size_t)k->n, sizeof *k->scored))) return ULAM_ENOMEM;
+    k->nscored = 0;
+    for (int64_t i = 0; i < k->n; i++)
+        if (k->scores.b[i] != 0.0) k->scored[k->nscored++] = i;
+    return ULAM_OK;
+}
+
+/* Give a kept kernel's rows the scores of b (see kernel.h). */
+int ulam__kernel_rescore_b(ulam_kernel *k, const double *b)
+{
+    if (!k->scored || atomic_load(&k->status)) return ULAM_EINVAL;
+    if (b == k->scores.b && k->fixed) return ULAM_OK; /* the same scores: nothing to do */
+    if (k->fixed) return ULAM_EINVAL;
+    k->scores.b = b;
+    for (int64_t j = 0; j < k->nscored; j++) rescore_row(k, k->scored[j]); /* now b's (0 off its support) */
+    int status = atomic_load(&k->status) ? atomic_load(&k->status) : ulam__kernel_keep(k);
+    for (int64_t j = 0; !status && j < k->nscored; j++) rescore_row(k, k->scored[j]);
+    return status ? status : atomic_load(&k->status);
 }

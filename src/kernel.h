@@ -62,6 +62,8 @@ typedef struct ulam_kernel {
     double (*fac)[2];   /* alpha != 1: the weight factors |K_ij| / (q_i p_ij) of the two outcomes
                            of the slot at each unit (a, b); NULL at alpha = 1 (the row's factor) */
     ulam__scores scores;
+    int64_t *scored, nscored; /* kept (ulam__kernel_keep): the states b scores at */
+    int fixed;                /* kept with b's values fixed: only the same b rescores, as a no-op */
 } ulam_kernel;
 
 /* Per-thread scratch for building rows of up to cap outcomes (grown as rows need). */
@@ -89,6 +91,19 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam_
  * when a probability is below 2^-40 / len (the alias table's 64-bit thresholds would bias it;
  * such an f may be infinite). */
 int ulam__kernel_moves(const ulam_csr *K, int64_t i, double q, double alpha, double *pm, double *f);
+
+/* Keep k for later right-hand sides: record the states its b scores at (b still as the rows were
+ * built with it).  Collision or absorption only (a row's scores are its own b_i's; expected
+ * reads its neighbours').  ULAM_OK, ULAM_EINVAL (expected, no b, or a failed kernel),
+ * ULAM_ENOMEM. */
+int ulam__kernel_keep(ulam_kernel *k);
+
+/* Give a kept kernel's rows the scores of b (n entries, borrowed like the first; with k->fixed
+ * only the b it was kept with, whose values its owner keeps unchanged: nothing to do): the rows that
+ * scored and those b scores at are rescored, as a row built now would be, the rest score 0 as
+ * before, and rows built later read b; the alias tables are unchanged (they do not depend on b).
+ * ULAM_OK, ULAM_EINVAL (not kept), ULAM_ENONFINITE (a non-finite score, recorded). */
+int ulam__kernel_rescore_b(ulam_kernel *k, const double *b);
 
 /* Free a kernel; accepts NULL. */
 ulam_kernel *ulam__kernel_free(ulam_kernel *k);

@@ -7,6 +7,7 @@
  * wait in a FIFO queue, each at most once; p and r are dense arrays of n, zero outside a list
  * of touched states, so a new target costs the states the last one touched, not n. */
 #include "internal.h"
+#include "kernel.h"
 #include "push.h"
 
 #include <math.h>
@@ -32,7 +33,8 @@ ulam_push *ulam_push_free(ulam_push *w)
 {
     if (!w) return NULL;
     free(w->p), free(w->r), free(w->touched), free(w->mark), free(w->queue);
-    free(w->memo.idx), free(w->memo.val), free(w->memo.ones), free(w->memo.seen);
+    free(w->memo.idx), free(w->memo.val), free(w->memo.ones), free(w->memo.seen), free(w->memo.all);
+    ulam__kernel_free(w->memo.kernel), ulam__kernel_free(w->memo.pilot);
     free(w);
     return NULL;
 }

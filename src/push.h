@@ -2,7 +2,7 @@
 #ifndef ULAM_PUSH_H
 #define ULAM_PUSH_H
 
-#include "ulam.h"
+#include "internal.h"
 
 /* The matrix a workspace pushes on. */
 const ulam_csr *ulam__push_matrix(const ulam_push *w);
@@ -24,6 +24,11 @@ typedef struct {
     double *ones; /* n ones (NULL until a pilot needs them): the pilot's scores */
     char *seen;   /* n flags: the states the pilot found its walks can reach (have_seen 0: none) */
     int have_seen;
+    char *all;          /* n ones: every state (reach_all; NULL until a query asks) */
+    ulam__reach reach;  /* what the walks reach: over seen (have_seen) or all (have_all) */
+    int have_all;       /* 1: reach holds ulam__reach_all's bounds over all, for reach.K and continuation */
+    struct ulam_kernel *kernel; /* keep_kernel: the last walks' kernel (ulam__solver_keep_kernel; NULL: none) */
+    struct ulam_kernel *pilot;  /* keep_kernel: the pilot's, scoring ones (fixed; NULL: none) */
 } ulam__bidir_memo;
 
 /* The workspace's memo (owned by it, freed with it). */

@@ -29,6 +29,7 @@ struct ulam_solver {
     ulam_walk_opts o;
     int64_t n;
     ulam_kernel *k;
+    int k_borrowed; /* k is the caller's (ulam__solver_alloc_reached) or was kept (ulam__solver_keep_kernel) */
     ulam__walker w;
     const double *b; /* the caller's, borrowed like M */
     ulam_csr *mt;
@@ -36,7 +37,8 @@ struct ulam_solver {
     ulam__slot *start_src; /* adjoint with nstarts: the start distribution (walker.start_*) */
     int32_t *start_units;
     double *start_b;
-    const char *given_seen; /* the same computed by an earlier solver (ulam__solver_alloc_reached) */
+    const ulam__reach *given; /* the states walks can reach given by the caller (ulam__solver_alloc_reached;
+                                 NULL: none), with K's own bounds over them when given->bounds */
     int threads;
     ulam__scratch *scratch; /* one per thread */
     ulam__kscratch *ks;     /* one per thread: room to build a kernel row */
@@ -59,7 +61,8 @@ struct ulam_solver {
     ulam_power rho4;       /* rho(M4) of the walk kernel ([0, INFINITY] until computed) */
     int rho4_done;         /* rho4 computed */
     int fourth;            /* the fourth moment: 1 finite, 0 infinite, -1 unknown (take_fourth) */
-    char *seen;            /* the states walks can reach (kept for a rerun; NULL until needed) */
+    char *seen;            /* the states walks can reach as searched here (kept for a rerun; NULL until needed) */
+    const char *reached;   /* seen, or the caller's given->seen (NULL until needed) */
     double *fac;           /* kernel exponent != 1: each move's weight factor over them (kept) */
     int64_t reach_nnz;     /* entries of M over the reachable rows (0 until computed) */
     int64_t setup_work;    /* entries read by reachability checks and score-bound passes so far */
@@ -70,6 +73,7 @@ struct ulam_solver {
     } pass[3];             /* per estimator */
     double pass_w0, pass_W, pass_qmax; /* the start weight, the weight bound, the largest q */
     int pass_signs;
+    int pass_only;         /* given bounds: the one estimator the pass read K for (-1: every one) */
     int tail_done, v2_done[3]; /* length_tail's and second_moment's results kept: */
     double tail_uc, tail_kc, v2c[3];
     const ulam_csr *M;     /* borrowed */
@@ -90,7 +94,7 @@ ulam_walk_opts ulam_walk_defaults(void)
 ulam_solver *ulam_solver_free(ulam_solver *s)
 {
     if (!s) return NULL;
-    ulam__kernel_free(s->k);
+    if (!s->k_borrowed) ulam__kernel_free(s->k);
     free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac);
     free(s->start_src), free(s->start_units), free(s->start_b);
     ulam_csr_free(s->mt);
@@ -318,54 +322,107 @@ static double *move_factors(const ulam_csr *K, const char *seen, double continue
     return f;
 }
 
-/* The states walks can reach (s->seen, computed once and kept) and their entries (s->reach_nnz). */
+/* Over the seen states of K: the largest weight factor S / q (fac: each move's own, kernel
+ * exponent != 1) and continuation, and whether K has a negative entry (R->fbig, qmax, neg). */
+static void kernel_bounds(const ulam_csr *K, const char *seen, double continue_q, const double *fac, ulam__reach *R)
+{
+    double fbig = 0.0, qmax = 0.0;
+    int neg = 0;
+    for (int64_t i = 0; i < K->nrows; i++) {
+        if (!seen[i]) continue;
+        double S = row_sum(K, i);
+        if (!fac) fbig = fmax(fbig, ulam__factor(S, continue_q));
+        qmax = fmax(qmax, ulam__continuation(S, continue_q));
+        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
+            neg |= K->val[k] < 0;
+            if (fac) fbig = fmax(fbig, fac[k]);
+        }
+    }
+    R->fbig = fbig, R->qmax = qmax, R->neg = neg;
+}
+
+/* The caller's bounds of K alone over the given states (ulam__reach_all), when they were made
+ * for this K, continuation and exponent; NULL otherwise. */
+static const ulam__reach *given_bounds(const ulam_solver *s, const ulam_csr *K)
+{
+    const ulam__reach *g = s->given;
+    return g && g->bounds && g->K == K && g->continue_q == fmax(s->o.continue_q, 0.0) && g->alpha == s->o.kernel_alpha
+               ? g
+               : NULL;
+}
+
+/* The entries of K over the reachable rows (s->reach_nnz). */
+static void count_reached(ulam_solver *s, const ulam_csr *K)
+{
+    s->reach_nnz = 0;
+    for (int64_t i = 0; i < s->n; i++)
+        if (s->reached[i]) s->reach_nnz += K->rowptr[i + 1] - K->rowptr[i];
+}
+
+/* The states walks can reach (s->reached: searched once and kept in s->seen, or the caller's)
+ * and their entries (s->reach_nnz). */
 static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
-    if (s->seen) return ULAM_OK;
+    if (s->reached) return ULAM_OK;
+    if (s->given) { /* the caller's reach (an earlier solver's search, or ulam__reach_all), read where it is */
+        s->reached = s->given->seen;
+        if (given_bounds(s, K)) s->reach_nnz = K->rowptr[K->nrows]; /* every state's (ulam__reach_all): not counted */
+        else count_reached(s, K);
+        return ULAM_OK;
+    }
     char *seen = ulam__calloc((size_t)s->n, 1);
     if (!seen) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
     if (s->o.mode == ULAM_ADJOINT && !s->o.nstarts) seen[s->o.index] = 1;
     for (int64_t j = 0; s->o.mode == ULAM_ADJOINT && j < s->o.nstarts; j++) seen[s->o.starts[j]] = 1;
     if (s->o.mode == ULAM_FORWARD)
         for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
-    /* an earlier solver's search (ulam__solver_alloc_reached) is copied, not repeated */
-    int status = s->given_seen ? (memcpy(seen, s->given_seen, (size_t)s->n), ULAM_OK)
-                               : ulam__kernel_reach(K, s->o.continue_q, seen);
+    int status = ulam__kernel_reach(K, s->o.continue_q, seen);
     if (status) {
         free(seen);
         return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for a reachability check")
                                      : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, "
                                                   "nonzero values (the matrix is corrupt)");
     }
-    s->seen = seen;
-    s->reach_nnz = 0;
-    for (int64_t i = 0; i < s->n; i++)
-        if (seen[i]) s->reach_nnz += K->rowptr[i + 1] - K->rowptr[i];
+    s->reached = s->seen = seen;
+    count_reached(s, K);
     s->setup_work += s->reach_nnz;
     return ULAM_OK;
 }
 
 /* The one pass over the reachable rows that every estimator's score bounds come from (kept):
  * for each estimator the largest visit score, single score and g^2 / p*, and absorption's first
- * scoring state with p* = 0; the weight bound and the scores' signs. */
+ * scoring state with p* = 0; the weight bound and the scores' signs.  With the caller's bounds
+ * of K (given_bounds) the weight factor, continuation, sign and growth of K are theirs, and the
+ * pass reads only what this run's estimator needs (s->pass_only): the rows where b scores
+ * (absorption: their p*; collision: nothing of K), or for the expected estimator every row's
+ * (M b)_i; the other estimators' bounds are left INFINITY and check_reach passes again should
+ * one of them run. */
 static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
-    const char *seen = s->seen;
+    const char *seen = s->reached;
+    const ulam__reach *given = given_bounds(s, K);
+    int adj = s->o.mode == ULAM_ADJOINT, only = given ? s->o.estimator : -1;
     double *fac = NULL; /* kernel exponent != 1: each move's own weight factor (kept: s->fac) */
-    if (s->o.kernel_alpha != 1.0 && !(fac = s->fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
+    if (!given && s->o.kernel_alpha != 1.0 &&
+        !(fac = s->fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
-    int adj = s->o.mode == ULAM_ADJOINT, pos = 0, neg = 0, any = 0;
-    int64_t bad = -1;
-    double w0 = 1.0, fbig = 0.0, gabs = 0.0, g2abs = 0.0, vb = 0.0, vexp = 0.0, qmax = 0.0;
+    int pos = 0, neg = given ? given->neg : 0, any = 0;
+    int need_q = !given || only == ULAM_ABSORPTION, need_c = adj && (!given || only == ULAM_EXPECTED);
+    int64_t bad = -1, reads = 0;
+    double w0 = 1.0, fbig = given ? given->fbig : 0.0, gabs = 0.0, g2abs = 0.0, vb = 0.0, vexp = 0.0;
+    double qmax = given ? given->qmax : 0.0;
     for (int64_t i = 0; i < s->n; i++) {
-        if (!seen[i]) continue;
-        double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
-        if (!fac) fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
-        qmax = fmax(qmax, q);
-        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
+        if (!seen[i] || (given && only != ULAM_EXPECTED && s->b[i] == 0.0)) continue; /* scores nothing here */
+        double S = need_q ? row_sum(K, i) : 0.0, q = need_q ? ulam__continuation(S, s->o.continue_q) : 0.0, c = 0.0;
+        if (need_q || need_c) reads += K->rowptr[i + 1] - K->rowptr[i];
+        if (!given) {
+            if (!fac) fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
+            qmax = fmax(qmax, q);
+        }
+        for (int64_t k = K->rowptr[i]; (!given || need_c) && k < K->rowptr[i + 1]; k++) {
             neg |= K->val[k] < 0;
             if (fac) fbig = fmax(fbig, fac[k]);
-            if (adj) c += K->val[k] * s->b[K->colidx[k]];
+            if (need_c) c += K->val[k] * s->b[K->colidx[k]];
         }
         if ((adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
         /* what one visit scores: b_i (collision), (M b)_i (expected), forward 1 at the index */
@@ -383,7 +440,7 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         for (int64_t i = 0; i < s->n; i++) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
     for (int64_t j = 0; adj && j < s->o.nstarts; j++) /* signed start weights (conservative: both may show) */
         pos |= s->o.start_weights[j] > 0, neg |= s->o.start_weights[j] < 0;
-    double G = fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
+    double G = given ? given->growth : fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
     w0 = start_weight(&s->o, s->b, s->n);
     for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++) {
         int absorb = e == ULAM_ABSORPTION;
@@ -391,13 +448,15 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         s->pass[e].gmax = absorb ? gabs : any ? INFINITY : 0.0;
         s->pass[e].g2max = absorb ? g2abs : any ? INFINITY : 0.0;
         s->pass[e].bad = absorb ? bad : -1;
+        if (only >= 0 && e != only) /* not read: never an optimistic bound (check_reach passes again) */
+            s->pass[e].vmax = s->pass[e].gmax = s->pass[e].g2max = INFINITY;
     }
     s->pass_w0 = w0;
     s->pass_W = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
     s->pass_qmax = qmax;
     s->pass_signs = pos && neg;
-    s->passed = 1;
-    s->setup_work += s->reach_nnz;
+    s->passed = 1, s->pass_only = only;
+    s->setup_work += given ? reads : s->reach_nnz;
     return ULAM_OK;
 }
 
@@ -413,7 +472,9 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
     int status = reach(s, K, err);
     if (status) return status;
+    if (s->passed && s->pass_only >= 0 && s->pass_only != s->o.estimator) s->passed = 0; /* made for another */
     if (!s->passed && (status = bounds_pass(s, K, err))) return status;
+    const ulam__reach *given = given_bounds(s, K);
     int e = s->o.estimator, absorb = e == ULAM_ABSORPTION, adj = s->o.mode == ULAM_ADJOINT, it = 0;
     double vmax = s->pass[e].vmax, Wmax = s->pass_W, w0 = s->pass_w0;
     if (s->pass[e].bad >= 0)
@@ -424,13 +485,18 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
                           (long long)s->pass[e].bad + 1, adj ? "M" : "M' (column of M)");
     s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
     if (s->o.rel_err > 0 && vmax > 0 && (!(s->pass_qmax < 1.0) || !isfinite(Wmax))) {
+        if (!s->tail_done && given && given->tail) /* the caller's certificate over the same states */
+            s->tail_uc = given->tail_u, s->tail_kc = given->kappa, s->tail_done = 1;
         if (!s->tail_done) /* kappa enters by its log */
-            length_tail(K, s->seen, s->o.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
+            length_tail(K, s->reached, s->o.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
         s->tail_u = s->tail_uc, s->kappa = s->tail_kc;
     }
     if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
         (absorb ? isfinite(s->pass[e].g2max) : isfinite(vmax))) {
-        if (!s->v2_done[e]) s->v2c[e] = second_moment(s, K, s->fac, s->seen, w0, &it), s->v2_done[e] = 1;
+        if (!s->v2_done[e] && s->o.kernel_alpha != 1.0 && !s->fac &&
+            !(s->fac = move_factors(K, s->reached, s->o.continue_q, s->o.kernel_alpha))) /* given bounds: not made */
+            return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
+        if (!s->v2_done[e]) s->v2c[e] = second_moment(s, K, s->fac, s->reached, w0, &it), s->v2_done[e] = 1;
         s->v2 = s->v2c[e];
     }
     s->setup_work += (int64_t)it * s->reach_nnz;
@@ -441,6 +507,27 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     s->range = s->bound * (s->signs ? 2.0 : 1.0);
     s->per_step = vmax > 0 ? W * vmax : 0.0;
     s->qmax = s->pass_qmax;
+    return ULAM_OK;
+}
+
+/* The reach of every state of K, with K's own bounds over it (see internal.h). */
+int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *seen, ulam__reach *R)
+{
+    memset(seen, 1, (size_t)K->nrows);
+    *R = (ulam__reach){.seen = seen, .bounds = 1, .K = K, .continue_q = fmax(continue_q, 0.0), .alpha = alpha,
+                       .tail_u = 1.0, .kappa = INFINITY};
+    int status = ulam__kernel_reach(K, continue_q, seen); /* every row checked */
+    if (status) return status;
+    double *fac = NULL;
+    if (alpha != 1.0 && !(fac = move_factors(K, seen, continue_q, alpha))) return ULAM_ENOMEM;
+    kernel_bounds(K, seen, continue_q, fac, R);
+    R->growth = R->fbig > 1.0 ? weight_growth(K, continue_q, fac, seen) : 1.0;
+    if (!(R->qmax < 1.0) || !isfinite(R->growth)) { /* the tail certificate check_reach would need */
+        int it = 0;
+        length_tail(K, seen, continue_q, 0, 1e-30, &R->tail_u, &R->kappa, &it);
+        R->tail = 1;
+    }
+    free(fac);
     return ULAM_OK;
 }
 
@@ -697,9 +784,10 @@ static int kernel_failure(const ulam_kernel *k, ulam_error *err)
                       "finite, nonzero values and score (the matrix is corrupt)", (long long)i + 1);
 }
 
-/* Prepare walks on (I - M) x = b; seen: the states they can reach, computed before (NULL: search). */
-static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
-                        ulam_solver **out, ulam_error *err)
+/* Prepare walks on (I - M) x = b; reach: the states they can reach, computed before (NULL: search);
+ * kernel: a kept kernel to walk on, rescored to b (NULL: a new one). */
+static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
+                        ulam_kernel *kernel, ulam_solver **out, ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !b || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
@@ -714,7 +802,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     s->o = o;
     s->b = b;
     s->n = M->nrows;
-    s->given_seen = seen;
+    s->given = o.mode == ULAM_ADJOINT ? reach : NULL;
     s->M = M;
     if ((status = take_guard(M, &o, &s->g, err)) || (status = check_verdicts(M, s, err))) {
         ulam_solver_free(s);
@@ -728,7 +816,19 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         K = s->mt;
     }
     ulam__scores sc = {o.mode == ULAM_ADJOINT ? b : NULL, o.estimator};
-    if ((status = ulam__kernel_alloc(K, o.continue_q, o.kernel_alpha, sc, &s->k)) == ULAM_EOVERFLOW) {
+    if (kernel && (o.mode != ULAM_ADJOINT || kernel->K != K || kernel->continue_q != o.continue_q ||
+                   kernel->alpha != o.kernel_alpha || kernel->scores.estimator != o.estimator)) {
+        ulam_solver_free(s);
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a kept kernel made for this M, mode, continuation and estimator");
+    }
+    if (kernel) {
+        s->k = kernel, s->k_borrowed = 1;
+        if ((status = ulam__kernel_rescore_b(kernel, b))) {
+            status = kernel_failure(kernel, err);
+            ulam_solver_free(s);
+            return status ? status : ulam__fail(err, ULAM_EINVAL, 0, -1, "a kept kernel (ulam__solver_keep_kernel)");
+        }
+    } else if ((status = ulam__kernel_alloc(K, o.continue_q, o.kernel_alpha, sc, &s->k)) == ULAM_EOVERFLOW) {
         ulam_solver_free(s);
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
@@ -770,20 +870,36 @@ nomem:
 int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                       ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, NULL, out, err);
+    return solver_alloc(M, b, opts, NULL, NULL, out, err);
 }
 
-/* As ulam_solver_alloc with the reachable states seen (borrowed). */
-int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const char *seen,
-                               ulam_solver **out, ulam_error *err)
+/* As ulam_solver_alloc with the reachable states and a kept kernel (both borrowed). */
+int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                               const ulam__reach *reach, ulam_kernel *kernel, ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, seen, out, err);
+    return solver_alloc(M, b, opts, reach, kernel, out, err);
+}
+
+/* The solver's kernel, kept for later solvers (see internal.h). */
+ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s)
+{
+    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || ulam__kernel_keep(s->k)) return NULL;
+    s->k_borrowed = 1;
+    return s->k;
+}
+
+/* The solver's kernel, kept for later solvers with the same b, unchanged (see internal.h). */
+ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s)
+{
+    ulam_kernel *k = ulam__solver_keep_kernel(s);
+    if (k) k->fixed = 1;
+    return k;
 }
 
 /* The states the solver's walks can reach (NULL unless its reachability check ran). */
 const char *ulam__solver_reached(const ulam_solver *s)
 {
-    return s->given_seen ? s->given_seen : s->seen;
+    return s->given ? s->given->seen : s->seen;
 }
 
 /* Run walks [first, first + count) as block q on thread t (ctx: the solver). */
@@ -860,6 +976,29 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
                                E);
 }
 
+/* Under bounds over every state (ulam__reach_all), an estimate still exactly 0 once the rule
+ * could hold: search the starts' own reach, whose bounds are what a solver without given bounds
+ * has from the start (nothing that scores reachable certifies x = 0; looser bounds would leave
+ * the rule unmet to the walk cap).  The search's bounds hold for the run as the others did, and
+ * are at least as tight, so the rule may only stop it sooner from here on.  1 when it searched
+ * (a failure ends the run with its status). */
+static int search_reach(ulam_solver *s, const ulam_walk_result *r)
+{
+    if (!s->given || !s->given->bounds || !(s->o.rel_err > 0) || s->run.walks < ULAM__REL_MIN ||
+        r->estimate + s->o.rel_err_offset != 0.0 || s->o.mode != ULAM_ADJOINT)
+        return 0;
+    s->given = NULL;
+    free(s->seen), free(s->fac); /* the given reach and what was kept over it (as ulam__solver_restart) */
+    s->seen = NULL, s->reached = NULL, s->fac = NULL;
+    s->passed = s->tail_done = 0;
+    memset(s->v2_done, 0, sizeof s->v2_done);
+    ulam_error err;
+    int status = check_reach(s, s->k->K, &err);
+    if (!status) status = take_fourth(s, s->k->K, &err); /* as take_bounds: the bounds may now be bounded */
+    if (status) s->run.done = 1, s->run.status = status;
+    return 1;
+}
+
 /* Run one round of walks. */
 int ulam_solver_iterate(ulam_solver *s)
 {
@@ -873,6 +1012,10 @@ int ulam_solver_iterate(ulam_solver *s)
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
     result(s, &r, 0);
+    if (!s->run.status && search_reach(s, &r)) {
+        if (s->run.status) return s->run.status; /* the search failed */
+        result(s, &r, 0);
+    }
     if (rel_err_met(s, &r)) s->run.done = s->met = 1;
     else if (s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.rel_err_offset) > 0 &&
              !(r.cut_bound <= ULAM__CUT_SHARE * s->o.rel_err * fabs(r.estimate + s->o.rel_err_offset)))
@@ -1069,7 +1212,7 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     double bnorm1 = 0.0;
     if (build_source(s, &bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");
     free(s->seen), free(s->fac); /* the reachable set and the score bounds depend on b */
-    s->seen = NULL, s->fac = NULL;
+    s->seen = NULL, s->reached = NULL, s->fac = NULL;
     s->passed = s->tail_done = 0;
     memset(s->v2_done, 0, sizeof s->v2_done);
     if (s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0) {
@@ -1100,6 +1243,8 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *e
     if (status) return status;
     if (atomic_load(&s->k->status)) return kernel_failure(s->k, err);
     int rescore = o.estimator != s->o.estimator;
+    if (rescore && s->k_borrowed) /* a kept kernel is its keeper's, for its estimator */
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a solver that owns its kernel to change the estimator");
     s->o = o;
     if ((status = check_verdicts(s->M, s, err))) return status;
     s->o.max_walks = ulam__walk_cap(&o);

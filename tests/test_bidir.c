@@ -537,6 +537,85 @@ static void test_bidir_rare_score(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* reach_all: bounds over every state, made once in the workspace and shared by later queries;
+ * keep_kernel: the walks' kernel rows kept there and rescored to each query's residual (the
+ * expected estimator keeps none).
+ * Queries (several targets and sources, balanced rmax, rel_err 0.1, the three estimators) on
+ * one shared workspace
+ * are within 4 sigma of LAPACK, and where the bounds over the source's reach equal those over
+ * every state (the table's systems: random rows reach every state) they are bit for bit the
+ * run with a search a query on a fresh workspace (case 202 too, where x_t = 0 and the push finds
+ * nothing: the solver searches once its estimate is still 0, and stops at once, certified); on a block-diagonal M (the source's block reaches half of
+ * the states, the other block's rows sum higher, so the bounds are looser and the balance may
+ * choose another rmax) still within 4 sigma and the rule met. */
+static void test_bidir_reach_all(void **state)
+{
+    (void)state;
+    for (int k = 0; k < NSYS + 1; k++) {
+        ulam_csr *M = NULL, *Mt = NULL;
+        int block = k == NSYS;
+        if (!block) M = random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k);
+        else { /* two random blocks of 30 states, the second's rows summing up to 0.95 */
+            ulam_csr *A = random_system(30, 4, 0, 0.6, 7), *B = random_system(30, 4, 0, 0.95, 8);
+            int64_t nz = ulam_csr_nnz(A) + ulam_csr_nnz(B), e = 0;
+            int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
+            double *tx = malloc((size_t)nz * sizeof *tx);
+            for (int h = 0; h < 2; h++)
+                for (int64_t i = 0; i < 30; i++) {
+                    const ulam_csr *C = h ? B : A;
+                    for (int64_t q = C->rowptr[i]; q < C->rowptr[i + 1]; q++, e++)
+                        ti[e] = (int32_t)(i + 30 * h), tj[e] = C->colidx[q] + 30 * h, tx[e] = C->val[q];
+                }
+            assert_int_equal(ulam_csr_from_triplets(60, 60, nz, ti, tj, tx, &M), ULAM_OK);
+            free(ti), free(tj), free(tx);
+            ulam_csr_free(A), ulam_csr_free(B);
+        }
+        assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+        int64_t n = M->nrows;
+        ulam_push *shared = NULL;
+        assert_int_equal(ulam_push_alloc(M, &shared), ULAM_OK);
+        for (int qe = 0; qe < 12; qe++) { /* collision, absorption, expected: 4 queries each (a kernel kept 4) */
+            int q = qe % 4, est = qe < 4 ? ULAM_COLLISION : qe < 8 ? ULAM_ABSORPTION : ULAM_EXPECTED;
+            if (!test_case(100L * k + qe)) continue;
+            int64_t s = (k * 7 + 5 * q + 1) % (block ? 30 : n), t = (k * 3 + 11 * q + 2) % (block ? 30 : n);
+            double *x = exact_column(M, s);
+            ulam_bidir_opts o = ulam_bidir_defaults();
+            o.source = s, o.target = t;
+            o.walk.max_walks = 0, o.walk.rel_err = 0.1, o.walk.seed = (uint64_t)(k * 10 + q + 1);
+            o.walk.estimator = est, o.reach_all = 1, o.keep_kernel = 1;
+            if (est == ULAM_ABSORPTION) o.walk.continue_q = 0.9; /* rows of M' may sum past 1: p* = 0.1 */
+            ulam_bidir_result res;
+            ulam_error err;
+            int st = ulam_bidir_solve(shared, Mt, &o, &res, &err);
+            if (st) print_error("case %d: %s: %s\n", 100 * k + qe, ulam_strerror(st), err.msg);
+            assert_int_equal(st, ULAM_OK);
+            double z = (res.estimate - x[t]) / (res.std_error + 1e-13 * fabs(x[t]) + 1e-300);
+            if (!(fabs(z) < 4))
+                print_error("case %d: estimate %.10g, LAPACK %.10g, stderr %.3g (z = %.2f)\n", 100 * k + qe, res.estimate,
+                            x[t], res.std_error, z);
+            assert_true(fabs(z) < 4);
+            if (!(res.push.support == 0 || res.walks.rel_err_met))
+                print_error("case %d: %lld walks, stderr %.3g, estimate %.6g, out of reach %d, cut stop %d\n",
+                            100 * k + qe, (long long)res.walks.walks, res.std_error, res.estimate, res.walks.out_of_reach,
+                            res.walks.cut_stop);
+            assert_true(res.push.support == 0 || res.walks.rel_err_met);
+            o.reach_all = o.keep_kernel = 0;
+            ulam_bidir_result one = bidir(M, Mt, &o); /* a search a query, fresh workspace */
+            if (!block) {
+                if (res.estimate != one.estimate || res.walks.walks != one.walks.walks)
+                    print_error("case %d: shared %.17g (%lld walks), one query %.17g (%lld)\n", 100 * k + qe,
+                                res.estimate, (long long)res.walks.walks, one.estimate, (long long)one.walks.walks);
+                assert_true(res.estimate == one.estimate && res.std_error == one.std_error);
+                assert_true(res.walks.walks == one.walks.walks);
+            }
+            free(x);
+        }
+        ulam_push_free(shared);
+        ulam_csr_free(M), ulam_csr_free(Mt);
+    }
+    test_case_done();
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -545,6 +624,7 @@ int main(void)
         cmocka_unit_test(test_solver_starts), cmocka_unit_test(test_bidir_sparse_b),  cmocka_unit_test(test_bidir_coverage),
         cmocka_unit_test(test_bidir_rules),    cmocka_unit_test(test_bidir_rare_score),
         cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
+        cmocka_unit_test(test_bidir_reach_all),
     };
     return test_run(tests);
 }
