@@ -239,7 +239,8 @@ int ulam_outfile_commit(ulam_outfile *o);
 void ulam_outfile_abort(ulam_outfile *o);
 
 /* ---------------------------------------------------------------- direct solve */
-/* Primary: ulam_direct_solve.  Secondary: ulam_direct_bytes. */
+/* Primary: ulam_direct_solve, ulam_direct_sparse.  Secondary: ulam_direct_bytes,
+ * ulam_direct_sparse_available. */
 
 /* What a LAPACK direct solve reports besides the solution. */
 typedef struct ulam_direct_info {
@@ -257,6 +258,17 @@ size_t ulam_direct_bytes(int64_t n);
  * ULAM_ESINGULAR (err->index is the zero pivot).  info may be NULL. */
 int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
                       ulam_direct_info *info, ulam_error *err);
+
+/* Solve (I - M) x = b by a sparse LU factorisation (UMFPACK, SuiteSparse): memory about that of
+ * the factors, not n^2.  UMFPACK's own estimate of the factorisation's peak memory is checked
+ * against max_bytes (0: no limit) before it starts (ULAM_EMEMLIMIT); ULAM_ESINGULAR for a
+ * singular I - M; ULAM_EUNSUPPORTED when libulam was built without UMFPACK.  info may be NULL
+ * (its rcond is UMFPACK's estimate, its bytes the peak memory). */
+int ulam_direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
+                       ulam_direct_info *info, ulam_error *err);
+
+/* Nonzero when libulam was built with UMFPACK (ulam_direct_sparse works). */
+int ulam_direct_sparse_available(void);
 
 /* ---------------------------------------------------------------- spectral radius */
 /* Secondary, except tertiary: ulam_spectral_radius_op. */

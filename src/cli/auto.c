@@ -55,6 +55,16 @@ static double pilot_share(const ulam_auto_result *res)
 /* The candidates and the choice, as text. */
 void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc)
 {
+    if (cli_verbosity < 1) { /* one line: what was chosen among how many; --verbose lists them */
+        if (bc && bc->state == 2)
+            printf("auto            chose bidirectional over %d walk candidates (--verbose lists them)\n", res->ncand);
+        else if (res->chosen >= 0)
+            printf("auto            chose it among %d candidates by predicted cost (--verbose lists them)\n", res->ncand);
+        else
+            printf("auto            no certified candidate among %d: ran the closest (--verbose lists them)\n",
+                   res->ncand);
+        return;
+    }
     if (bc && bc->state == 2)
         printf("auto            chose bidirectional: its predicted work %.3g units is below the walk leader's %.3g "
                "(%d walk candidates after %d pilot stages; guards and pilots %.3f s)\n", bc->work, bc->leader_work,
@@ -95,8 +105,9 @@ void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc)
 /* The candidates and the choice, as the JSON key "auto" (followed by a comma). */
 void cli_auto_print_json(const ulam_auto_result *res, const cli_bidir_cand *bc)
 {
-    printf("\"auto\": {\"chosen\": %d, \"closest\": %d, \"stages\": %d, ", bc && bc->state == 2 ? res->ncand : res->chosen,
-           res->closest, res->stages);
+    /* 1-based positions in "candidates", as every index a user sees (0: none) */
+    printf("\"auto\": {\"chosen\": %d, \"closest\": %d, \"stages\": %d, ",
+           (bc && bc->state == 2 ? res->ncand : res->chosen) + 1, res->closest + 1, res->stages);
     cli_json_number("seconds", res->seconds, 0);
     cli_json_number("pilot_work", res->pilot_work, 0);
     cli_json_number("reused_work", res->reused_work, 0);

@@ -256,6 +256,7 @@ int cli_bidir(int argc, char **argv)
     int64_t *bidx = NULL;
     double *bval = NULL;
     o.walk.max_walks = 0;
+    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {

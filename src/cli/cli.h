@@ -4,6 +4,8 @@
 
 #include "ulam.h"
 
+#include <getopt.h>
+
 /* Exit codes (documented in README.md): 0 success, 1 internal failure, 2 usage error,
  * 3 walks would diverge, 4 a --rel-err target with a variance not certified finite, 10 + status for a library status, 130 interrupted. */
 enum { EXIT_USAGE = 2, EXIT_DIVERGE = 3, EXIT_INFVAR = 4, EXIT_STATUS_BASE = 10, EXIT_INTERRUPTED = 130 };
@@ -75,7 +77,16 @@ int cli_system_verify(cli_system *s);
 /* Free what cli_load_system loaded. */
 void cli_system_free(cli_system *s);
 
-/* Solve the loaded system densely into a new *x; 0 or an exit code (error reported). */
+/* The reference solve (src/cli/direct.c): sparse LU when cli_direct_sparse_wanted(M) (--lu of
+ * ulam direct sets cli_direct_force: -1 auto, 0 dense, 1 sparse), else dense. */
+extern int cli_direct_force;
+int cli_direct_sparse_wanted(const ulam_csr *M);
+
+/* x_index of the reference solve for --check, interruptible by Ctrl-C (EXIT_INTERRUPTED: its thread
+ * still reads s); *method "sparse LU" or "dense LU"; 0 or an exit code. */
+int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method);
+
+/* Solve the loaded system (sparse or dense LU) into a new *x; 0 or an exit code (error reported). */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info);
 
 /* Set by the first Ctrl-C while cli_catch_sigint is in force (walks stop at their next block). */
@@ -133,6 +144,28 @@ void cli_json_variance(const char *key, int finite);
 /* Print a radius as JSON keys prefix (the estimate when converged, else the upper bound),
  * prefix_is ("estimate" or "upper bound"), prefix_lower, prefix_upper, prefix_converged. */
 void cli_json_radius(const char *prefix, const ulam_power *p);
+
+/* Output (src/cli/output.c).  cli_verbosity: -1 --quiet (the answer line), 0 default (a few lines),
+ * 1 --verbose (everything); cli_json_mode: --json was given; cli_json_done: a JSON object was
+ * printed (set by cli_json_number and cli_json_string). */
+extern int cli_verbosity, cli_json_mode, cli_json_done;
+
+/* Strip --verbose/-v and --quiet/-q from argv, note --json (then stderr keeps its last error). */
+void cli_output_begin(int *argc, char **argv);
+
+/* Under --json, a failure that printed no JSON prints {"error": message, "exit": rc}; returns rc. */
+int cli_output_finish(int rc);
+
+/* The name among names[0..n) closest to word, or NULL. */
+const char *cli_suggest(const char *word, const char *const *names, int n);
+
+/* Refuse an unknown --name in argv (no abbreviations), naming the closest of longopts; 0 or EXIT_USAGE. */
+int cli_check_options(const char *command, int argc, char **argv, const struct option *longopts);
+
+/* value's index among names[0..n) for option opt, or -1 after a usage error (what: the names in
+ * words) with a "did you mean". */
+int cli_choose(const char *command, const char *opt, const char *value, const char *const *names, int n,
+               const char *what);
 
 /* Subcommands: each takes the argv that starts at its own name. */
 int cli_info(int argc, char **argv);

@@ -295,7 +295,8 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
 {
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
     *x = malloc((size_t)s->M->nrows * sizeof **x);
-    int status = *x ? ulam_direct_solve(s->M, s->b, *x, max_mem, info, &err) : ULAM_ENOMEM;
+    int status = !*x ? ULAM_ENOMEM : cli_direct_sparse_wanted(s->M) ? ulam_direct_sparse(s->M, s->b, *x, max_mem, info, &err)
+                                                                  : ulam_direct_solve(s->M, s->b, *x, max_mem, info, &err);
     if (!status) return 0;
     free(*x);
     *x = NULL;
@@ -312,6 +313,7 @@ void cli_json_value(double v)
 /* Print a JSON number (null when not finite). */
 void cli_json_number(const char *key, double v, int last)
 {
+    cli_json_done = 1;
     printf("\"%s\": ", key);
     cli_json_value(v);
     printf("%s", last ? "" : ", ");
@@ -320,6 +322,7 @@ void cli_json_number(const char *key, double v, int last)
 /* Print a JSON string (escaped). */
 void cli_json_string(const char *key, const char *v, int last)
 {
+    cli_json_done = 1;
     printf("\"%s\": \"", key);
     for (const unsigned char *c = (const unsigned char *)v; *c; c++) {
         if (*c == '"' || *c == '\\') printf("\\%c", *c);

@@ -60,7 +60,7 @@ void cli_guard_diverge(const cli_system *s, const ulam_guard *g, int force)
 /* Warnings for radii near or past 1 that do not stop the run. */
 void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assume_finite)
 {
-    if (g->verdict_abs == ULAM_VERDICT_EDGE)
+    if (g->verdict_abs == ULAM_VERDICT_EDGE && cli_verbosity > 0) /* nothing to do about it: --verbose */
         fprintf(stderr, "ulam: %s: warning: rho(|M|) is certified below 1 but not below 0.99 (bounds [%.6g, %.6g)): "
                         "walks may be long (mean length about 1 / (1 - rho))\n", s->matrix_path, g->abs.lower,
                 g->abs.upper);
@@ -79,7 +79,7 @@ void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assu
                 assume_finite ? "; --assume-finite-variance: the interval is printed anyway"
                               : ", so it is treated as infinite: no confidence interval (--assume-finite-variance "
                                 "prints one anyway)");
-    else if (g->verdict_hat[mode] == ULAM_VERDICT_EDGE)
+    else if (g->verdict_hat[mode] == ULAM_VERDICT_EDGE && cli_verbosity > 0)
         fprintf(stderr, "ulam: %s: warning: rho(M^) is certified below 1 but not below 0.99 (bounds [%.6g, %.6g)): "
                         "the variance is finite but may be huge, and the error bar converges slowly\n",
                 s->matrix_path, h->lower, h->upper);

@@ -163,6 +163,7 @@ int cli_info(int argc, char **argv)
     ulam_spectral_opts so = ulam_spectral_defaults();
     double continue_q = 0.0, alpha = 1.0;
     int json = 0, c, rc;
+    if (cli_check_options("info", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
         switch (c) {

@@ -54,7 +54,8 @@ int main(int argc, char **argv)
 #ifdef ULAM_MPI
     cli_mpi_init(&argc, &argv);
 #endif
-    int rc = dispatch(argc, argv);
+    cli_output_begin(&argc, argv);
+    int rc = cli_output_finish(dispatch(argc, argv));
 #ifdef ULAM_MPI
     fflush(stdout);
     cli_mpi_finalize();

@@ -287,6 +287,7 @@ int cli_solve_method(int argc, char **argv)
     const char *out = NULL;
     int64_t v;
     int c, rc, idx, force = 0;
+    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {

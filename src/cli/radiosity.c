@@ -148,6 +148,7 @@ static int parse(int argc, char **argv, args *a)
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int c, rc, idx;
+    if (cli_check_options("radiosity", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {

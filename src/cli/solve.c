@@ -95,6 +95,8 @@ typedef struct {
     double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the solver set-up */
     const ulam_auto_result *au; /* --method auto: the candidates and the choice (else NULL) */
     const cli_bidir_cand *bc;   /* --method auto: bidirectional as a candidate (else NULL) */
+    double t_start;             /* when the command started (ulam_now) */
+    const char *direct_method;  /* --check: "dense LU", "sparse LU" or "interrupted" */
 } report_opts;
 
 /* Peak resident memory of this process so far, in MiB. */
@@ -104,11 +106,9 @@ static double peak_rss_mib(void)
     return getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
 }
 
-/* Print the human-readable block. */
-static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
+/* Print the answer line: x[I] with its interval, or why there is none. */
+static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 {
-    double mean_len = r->walks ? (double)r->steps / (double)r->walks : 0.0;
-    double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
     if (o->mode == ULAM_FORWARD && isnan(r->std_error))
         printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->index + 1,
                o->index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
@@ -125,6 +125,64 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
                "means nothing)%s\n", (long long)o->index + 1, o->index < 9 ? 10 : 9, "", r->estimate,
                r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
                r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
+}
+
+/* Print whether the --rel-err target was met, and when not why (one line; nothing without a target). */
+static void print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int verbose)
+{
+    if (o->rel_err > 0 && r->cut_stop)
+        printf("rel-err         NOT met (target %.3g): %lld walks were cut at %lld steps and the cut's bias may be "
+               "%.3g, more than a tenth of the target error: unreachable by more walks (raise --max-steps)\n",
+               o->rel_err, (long long)r->cut, (long long)o->max_steps, r->cut_bound);
+    else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
+        printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
+               o->rel_err);
+    else if (o->rel_err > 0 && r->fourth_finite != 1 && (verbose || !r->rel_err_met))
+        printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
+               "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
+               "not use the variance's own error bar\n", r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
+               r->rho4.lower, r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
+    else if (o->rel_err > 0 && r->min_walks > 0 && (verbose || !r->rel_err_met))
+        printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate%s)\n",
+               r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
+               r->out_of_reach ? ", beyond the 1e9 cap: stopped" : "");
+    else if (o->rel_err > 0)
+        printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
+}
+
+/* Print the default block: the answer, the method in words, the cost, the target (about 5 lines). */
+static void print_brief(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
+{
+    print_answer(o, r);
+    if (cli_verbosity < 0) return;
+    printf("method          %s random walks, %s estimator%s\n", cli_mode_names[o->mode],
+           cli_estimator_names[o->estimator], o->mode == ULAM_ADJOINT ? " (walks start at the unknown)"
+                                                                     : " (walks start from b: every unknown at once)");
+    if (ro->au) cli_auto_print_text(ro->au, ro->bc);
+    if (r->cut)
+        printf("walks           %lld (%lld cut at %lld steps: the estimate is biased by the cut)\n",
+               (long long)r->walks, (long long)r->cut, (long long)o->max_steps);
+    else
+        printf("walks           %lld (mean length %.3g steps)\n", (long long)r->walks,
+               r->walks ? (double)r->steps / (double)r->walks : 0.0);
+    printf("seconds         %.3g walking on %d threads; %.3g in all (inputs, guards, set-up)\n", r->seconds,
+           r->threads, ulam_now() - ro->t_start);
+    print_rel_err(o, r, 0);
+    if (o->mode == ULAM_FORWARD && r->unreached)
+        printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
+               (long long)r->unreached, (long long)ro->n);
+}
+
+/* Print the whole human-readable block (--verbose). */
+static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
+{
+    double mean_len = r->walks ? (double)r->steps / (double)r->walks : 0.0;
+    double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
+    if (cli_verbosity < 1) {
+        print_brief(o, r, ro);
+        return;
+    }
+    print_answer(o, r);
     printf("method          %s walks, %s estimator\n", cli_mode_names[o->mode], cli_estimator_names[o->estimator]);
     printf("walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
            (long long)o->max_steps, r->cut ? ": the estimate is biased by the cut" : "");
@@ -154,30 +212,10 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (o->mode == ULAM_FORWARD)
         printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
                (long long)r->unreached, (long long)ro->n);
-    if (o->rel_err > 0 && r->cut_stop)
-        printf("rel-err         NOT met (target %.3g): %lld walks were cut at %lld steps and the cut's bias may be "
-               "%.3g, more than a tenth of the target error: unreachable by more walks (raise --max-steps)\n",
-               o->rel_err, (long long)r->cut, (long long)o->max_steps, r->cut_bound);
-    else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
-        printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
-               o->rel_err);
-    else if (o->rel_err > 0 && r->fourth_finite != 1)
-        printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
-               "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
-               "not use the variance's own error bar\n", r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
-               r->rho4.lower, r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
-    else if (o->rel_err > 0 && r->min_walks > 0)
-        printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate%s)\n",
-               r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
-               r->out_of_reach ? ", beyond the 1e9 cap: stopped" : "");
-    else if (o->rel_err > 0)
-        printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
+    print_rel_err(o, r, 1);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
     if (ro->au) cli_auto_print_text(ro->au, ro->bc);
-    if (ro->check)
-        printf("direct          %.10g (LAPACK, %.4f s), z = %.3f\n", ro->direct, ro->direct_seconds,
-               (r->estimate - ro->direct) / r->std_error);
 }
 
 /* Print the JSON object. */
@@ -234,23 +272,21 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (ro->check) {
         cli_json_number("direct", ro->direct, 0);
         cli_json_number("direct_seconds", ro->direct_seconds, 0);
+        cli_json_string("direct_method", ro->direct_method, 0);
         cli_json_number("z", (r->estimate - ro->direct) / r->std_error, 0);
     }
     if (ro->au) cli_auto_print_json(ro->au, ro->bc);
     printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
 }
 
-/* LAPACK value of x_index for --check; 0 or an exit code. */
+/* The reference value of x_index for --check (sparse or dense LU, src/cli/direct.c), interruptible:
+ * 0, EXIT_INTERRUPTED (the solve still runs: the caller must leave s alone) or an exit code. */
 static int direct_check(const cli_system *s, int64_t index, report_opts *ro)
 {
-    double *x;
-    ulam_direct_info info;
-    int rc = cli_direct_solve(s, CLI_MAX_MEM, &x, &info);
-    if (rc) return rc;
-    ro->direct = x[index];
-    ro->direct_seconds = info.seconds;
-    free(x);
-    return 0;
+    double value = NAN, seconds = NAN;
+    int rc = cli_direct_check(s, index, &value, &seconds, &ro->direct_method);
+    ro->direct = value, ro->direct_seconds = seconds;
+    return rc;
 }
 
 /* The standard errors as a Matrix Market array, atomically: NaN for a component no walk reached
@@ -352,6 +388,7 @@ static int parse(int argc, char **argv, solve_args *a)
                       .ao = ulam_auto_defaults()};
     a->o.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
     int c, rc, idx;
+    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
@@ -438,7 +475,7 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
     ulam_walk_opts *o = &a->o;
     int rc;
     /* read only the rows walks reach; auto does on a prepared system (see certified_auto) */
-    s->lazy = o->mode == ULAM_ADJOINT && !a->check && !cli_share && (!a->autom || ulam_system_is_file(s->matrix_path));
+    s->lazy = o->mode == ULAM_ADJOINT && !cli_share && (!a->autom || ulam_system_is_file(s->matrix_path));
     if ((a->out && (rc = cli_check_output(a->out))) || (a->errors && (rc = cli_check_output(a->errors)))) return rc;
     double t0 = ulam_now();
     if ((rc = cli_load_system(s))) return rc;
@@ -507,7 +544,7 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
     int walks = !(ro->bc && ro->bc->state == 2);
     if (walks && ro->g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(s, &ro->g, 1);
     if (walks) cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
-    if (ro->check && (rc = direct_check(s, o->index, ro))) {
+    if (ro->check && !walks && (rc = direct_check(s, o->index, ro))) { /* bidirectional: checked first */
         *sv = ulam_solver_free(*sv);
         cli_bidir_cand_free(bc);
         cli_system_free(s);
@@ -522,7 +559,7 @@ static int run(solve_args *a)
 {
     const cli_system *s = &a->s;
     const ulam_walk_opts *o = &a->o;
-    report_opts ro = {.check = a->check, .json = a->json, .assume_finite = a->assume_finite};
+    report_opts ro = {.check = a->check, .json = a->json, .assume_finite = a->assume_finite, .t_start = ulam_now()};
     ulam_auto_result au;
     cli_bidir_cand bc = {0};
     ulam_solver *sv = NULL;
@@ -567,12 +604,23 @@ static int run(solve_args *a)
     } else if (o->mode == ULAM_FORWARD && (a->out || a->errors) && !r.interrupted && cli_rank == 0) {
         rc = write_vectors(sv, ro.n, a->out, a->errors, &r);
     }
+    int left = 0; /* a check still running when Ctrl-C came: leave the system to it */
     if (!status && !rc) {
-        if (ro.json) print_json(o, &r, &ro);
-        else print_text(o, &r, &ro);
+        if (!ro.json) print_text(o, &r, &ro);
+        fflush(stdout); /* the estimate first: a check may take long, and Ctrl-C keeps what is printed */
+        if (ro.check && !r.interrupted && cli_rank == 0) {
+            rc = cli_system_verify(&a->s);
+            rc = rc ? rc : direct_check(s, o->index, &ro);
+            left = rc == EXIT_INTERRUPTED;
+            if (!ro.json && !rc) printf("direct          %.10g (%s, %.3g s), z = %.3f\n", ro.direct, ro.direct_method,
+                                        ro.direct_seconds, (r.estimate - ro.direct) / r.std_error);
+            if (left && !ro.json) fprintf(stderr, "ulam: --check interrupted: the estimate above stands unchecked\n");
+        }
+        if (ro.json && (!rc || left)) print_json(o, &r, &ro);
         if (r.interrupted) rc = EXIT_INTERRUPTED;
     }
     fflush(stdout); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
+    if (left) return rc; /* the reference solve's thread still reads the system: exit without freeing it */
     cli_release_sigint();
     ulam_solver_free(sv);
     cli_bidir_cand_free(&bc);

@@ -616,6 +616,7 @@ int cli_study(int argc, char **argv)
     parse_budgets(&st, "--budgets", "100,1000,10000,100000,1000000", 1);
     int64_t v;
     int c, rc;
+    if (cli_check_options("study", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
         switch (c) {
