@@ -79,32 +79,35 @@ CASES += [  # counts written as whole numbers in exponent form are counts; fract
 ]
 CASES += [  # the kernel exponent: finite and >= 0; it changes rho(M^) (chain4: 0.68..0.9 at 0, >= 1 at 3)
     (["info", M + "signed200.mtx"], 0, r"^$", r"variance forward finite"),
-    (["info", M + "signed200.mtx", "--alpha", "2"], 0, r"^$",
+    (["info", M + "signed200.mtx", "--kernel-exponent", "2"], 0, r"^$",
      r"rho\(M\^\) forward  1\.04\d+ .* at kernel exponent alpha = 2\n(.*\n)*variance forward infinite"),
     (["info", M + "signed200.mtx", "--alpha", "-0.5"], 2, r"--alpha expects a number from 0 to 1000", r"^$"),
+    (SOLVE + ["--index", "1", "--alpha", "1", "--walks", "100"], 0, r"^ulam solve: note: --alpha is deprecated: the kernel "
+     r"exponent is --kernel-exponent \(PageRank's damping is --pagerank\)\n$", r"95% CI"),
+    (SOLVE + ["--index", "1", "--kernel-exponent", "-1"], 2, r"--kernel-exponent expects a number from 0 to 1000", r"^$"),
     (SOLVE + ["--index", "1", "--alpha", "-1"], 2, r"--alpha expects a number from 0 to 1000, got '-1'", r"^$"),
     (SOLVE + ["--index", "1", "--alpha", "nan"], 2, r"--alpha expects a number from 0 to 1000, got 'nan'", r"^$"),
     (SOLVE + ["--index", "1", "--alpha", "inf"], 2, r"--alpha expects a number from 0 to 1000, got 'inf'", r"^$"),
     (SOLVE + ["--index", "1", "--alpha", "two"], 2, r"--alpha expects a number from 0 to 1000, got 'two'", r"^$"),
     (SOLVE + ["--index", "1", "--alpha", ""], 2, r"--alpha expects a number", r"^$"),
-    (SOLVE + ["--index", "1", "--alpha", "0", "--walks", "20000", "--verbose"], 0, r"^$",
+    (SOLVE + ["--index", "1", "--kernel-exponent", "0", "--walks", "20000", "--verbose"], 0, r"^$",
      r"95% CI[^\n]*\n(.*\n)*guards .*rho\(M\^\) in \[0\.68\d*, 0\.9\] \(below 1\) at kernel exponent alpha = 0\n"),
-    (SOLVE + ["--index", "1", "--alpha", "3", "--walks", "20000"], 0,
+    (SOLVE + ["--index", "1", "--kernel-exponent", "3", "--walks", "20000"], 0,
      r"warning: rho\(M\^\) >= 1 .* for the adjoint kernel of exponent alpha = 3: the estimator's variance is infinite",
      r"no confidence interval|not certified|infinite"),
-    (SOLVE + ["--index", "1", "--alpha", "3", "--rel-err", "0.01"], 4,
+    (SOLVE + ["--index", "1", "--kernel-exponent", "3", "--rel-err", "0.01"], 4,
      r"--rel-err 0\.01 can never be met: .*rho\(M\^\) of the adjoint kernel at kernel exponent alpha = 3 is in", r"^$"),
     # alpha 2 on chain4: the variance finite (rho(M^) 0.9) but weights grow on cycles and the fourth
     # moment is infinite (rho(M4) >= 1.157): the variance's own error (variance_rel_error) errs low, so
     # the rule does not use it and stands on the certified second moment (its walk count, 3.2e5 here,
     # bounds the true standard error by 0.29 E |x|); with --walks 5000 it is not met, the reason printed
-    (SOLVE + ["--index", "1", "--alpha", "2", "--rel-err", "0.05", "--verbose"], 0, r"^$",
+    (SOLVE + ["--index", "1", "--kernel-exponent", "2", "--rel-err", "0.05", "--verbose"], 0, r"^$",
      r"rel-err +met \(target 0\.05; the certified second moment asks for [\d.e+]+ walks at this estimate\): scores are "
      r"unbounded and rho\(M4\) is in \[1\.157, 1\.519\], so the fourth moment is infinite and the rule does not use"),
-    (SOLVE + ["--index", "1", "--alpha", "2", "--rel-err", "0.05", "--walks", "5000"], 0, r"",
+    (SOLVE + ["--index", "1", "--kernel-exponent", "2", "--rel-err", "0.05", "--walks", "5000"], 0, r"",
      r"95% CI(.*\n)*rel-err +NOT met \(target 0\.05; the certified second moment asks for [\d.e+]+ walks.*rho\(M4\) is in "
      r"\[1\.157, 1\.519\], so the fourth moment is infinite"),
-    (SOLVE + ["--index", "1", "--alpha", "0.5", "--rel-err", "0.05"], 0, r"^$", r"rel-err +met"),
+    (SOLVE + ["--index", "1", "--kernel-exponent", "0.5", "--rel-err", "0.05"], 0, r"^$", r"rel-err +met"),
 ]
 DIV = ["solve", "--method", "walks", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1"]
 RS0 = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1"]
@@ -120,7 +123,10 @@ CASES += [
     (RS + ["--continue", "0.5"], 0, r"rho\(M\^\) >= 1 \(bounds \[1\.62, 1\.62\]\) .* variance is infinite",
      r"no confidence interval: the variance is infinite"),
     (["solve", "--method", "walks", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--index", "1", "--jacobi", "--omega", "0.5",
-      "--walks", "2000"], 0, r"rho\(\|M\|\) is certified below 1 but not below 0\.99 \(bounds \[0\.\d+, 1\)\)", r"\+-"),
+      "--walks", "2000", "--verbose"], 0, r"rho\(\|M\|\) is certified below 1 but not below 0\.99 \(bounds \[0\.\d+, 1\)\)", r"\+-"),
+    # by default a radius near 1 that changes nothing the user should do is not warned about
+    (["solve", "--method", "walks", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--index", "1", "--jacobi", "--omega", "0.5",
+      "--walks", "2000"], 0, r"^$", r"\+-"),
     (SOLVE + ["--index", "1", "--walks", "-5"], 2, r"--walks expects an integer", ""),
     # the score-bound minimum out of reach: said after the first round, collision/expected named
     (SOLVE + ["--index", "2", "--estimator", "absorption", "--rel-err", "0.0001", "--walks", "2000"], 0,
@@ -380,6 +386,125 @@ def check_progress(ulam):
     assert rc == 0 and "walks," not in err, err
 
 
+CASES += [  # one vocabulary: no abbreviations, "did you mean" for options and their values
+    (RS0 + ["--meth", "mcsa"], 2, r"unknown option '--meth' \(did you mean '--method'\?\)", r"^$"),
+    (RS0 + ["--method", "mcsx"], 2, r"--method expects auto, walks, .* got 'mcsx' \(did you mean 'mcsa'\?\)", r"^$"),
+    (RS0 + ["--method", "walks", "--estimator", "colision"], 2, r"got 'colision' \(did you mean 'collision'\?\)", r"^$"),
+    (RS0 + ["--method", "mcsa", "--max-iters", "5"], 2, r"unknown option '--max-iters' \(did you mean '--max-iter'\?\)", r"^$"),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--lu", "sparce"], 2, r"did you mean 'sparse'", r"^$"),
+    # the iterations take --rel-err (their --tol) and print x_I without --out; the walks take --tol
+    (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "cg", "--index", "4", "--rel-err", "1e-10"], 0,
+     r"^$", r"x\[4\]\s+3\.68174"),
+    (SOLVE + ["--index", "1", "--tol", "0.05"], 0, r"^$", r"rel-err\s+met \(target 0\.05"),
+]
+
+
+def write_grid(path, bpath, m, c):
+    """M of the 2D grid m x m, c on each neighbour (rho(|M|) < 4c), and b_i = 1 + i mod 7."""
+    n = m * m
+    lines = []
+    for i in range(m):
+        for j in range(m):
+            k = i * m + j + 1
+            for di, dj in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+                if 0 <= i + di < m and 0 <= j + dj < m:
+                    lines.append(f"{k} {(i + di) * m + j + dj + 1} {c}")
+    with open(path, "w") as f:
+        f.write(f"%%MatrixMarket matrix coordinate real general\n{n} {n} {len(lines)}\n" + "\n".join(lines) + "\n")
+    write_vec(bpath, [1.0 + i % 7 for i in range(n)])
+
+
+def check_default_output(ulam):
+    """Golden length: the default solve prints the answer, the method in words, the choice, walks,
+    seconds and the target, one line each (6 lines); --quiet the answer line alone; --verbose the
+    candidates, radii and tail; no warning for radii near 1 that change nothing."""
+    args = RS0 + ["--rel-err", "0.02"]
+    rc, out, err = run(ulam, args)
+    labels = [ln.split()[0] for ln in out.splitlines()]
+    assert rc == 0 and err == "" and labels == ["x[1]", "method", "auto", "walks", "seconds", "rel-err"], (out, err)
+    assert re.match(r"x\[1\]\s+[\d.]+ \+- [\d.e-]+ \(95% CI [\d.]+ \.\. [\d.]+\)$", out.splitlines()[0]), out
+    rc, out, err = run(ulam, args + ["--quiet"])
+    assert rc == 0 and len(out.splitlines()) == 1 and out.startswith("x[1] "), out
+    rc, out, err = run(ulam, args + ["--verbose"])
+    assert rc == 0 and len(out.splitlines()) > 30 and re.search(r"^guards ", out, re.M) and re.search(r"^tail ", out, re.M), out
+    rc, out, err = run(ulam, args + ["--check"])
+    assert rc == 0 and len(out.splitlines()) == 7 and re.search(r"^direct\s+[\d.]+ \(dense LU, ", out, re.M), out
+
+
+def check_sparse_check(ulam):
+    """--check on a 10^5-unknown sparse system is a sparse LU (UMFPACK) after the printed estimate:
+    it agrees within 4 standard errors; ulam direct takes the same path."""
+    with tempfile.TemporaryDirectory() as d:
+        write_grid(d + "/g.mtx", d + "/g_b.mtx", 317, 0.24)  # n = 100489, rho(|M|) = 0.96 cos(pi/318)
+        rc, out, err = run(ulam, ["solve", d + "/g.mtx", "--rhs", d + "/g_b.mtx", "--index", "50000", "--walks", "4000",
+                                  "--check", "--json"])
+        o = json.loads(out)
+        assert rc == 0 and o["direct_method"] == "sparse LU" and abs(o["z"]) < 4, (o, err)
+        rc, out, err = run(ulam, ["direct", d + "/g.mtx", "--rhs", d + "/g_b.mtx", "--index", "50000", "--json"])
+        o2 = json.loads(out)
+        assert rc == 0 and o2["method"] == "sparse LU" and abs(o2["estimate"] - o["direct"]) < 1e-12 * abs(o["direct"]), o2
+        assert o2["residual"] < 1e-12, o2
+
+
+# A hand-written schema: key -> type (a tuple: any of them; None: null allowed), for each command's
+# JSON, success and failure.
+NUM, STR, BOOL, INT = (int, float), str, bool, int
+SCHEMAS = {
+    "solve": {"index": INT, "estimate": NUM, "stderr": NUM, "ci95": (list, type(None)), "method": STR, "mode": STR,
+              "estimator": STR, "walks": INT, "seconds": NUM, "variance_finite": (bool, type(None)), "interrupted": BOOL},
+    "solve_auto": {"estimate": NUM, "auto": dict},
+    "solve_check": {"estimate": NUM, "direct": NUM, "direct_method": STR, "z": NUM},
+    "bidir": {"index": INT, "estimate": NUM, "stderr": NUM, "method": STR},
+    "iterations": {"method": STR, "outcome": STR, "residual": NUM, "index": INT, "estimate": NUM},
+    "direct": {"n": INT, "index": INT, "estimate": NUM, "method": STR, "rcond": NUM, "residual": NUM, "seconds": NUM},
+    "info": {"n": INT, "nnz": INT, "rho_abs": NUM, "walks_converge": BOOL},
+    "error": {"error": STR, "exit": INT},
+}
+
+
+def schema_ok(obj, schema):
+    """The keys schema names are present with their types (bool is not a number here); a message or ''."""
+    for k, t in schema.items():
+        if k not in obj:
+            return f"missing key {k!r}"
+        ts = t if isinstance(t, tuple) else (t,)
+        v = obj[k]
+        if isinstance(v, bool) and bool not in ts:
+            return f"{k!r} is a bool"
+        if not isinstance(v, ts):
+            return f"{k!r} is {type(v).__name__}"
+    return ""
+
+
+def check_json_schemas(ulam):
+    """Every command's --json success and failure against SCHEMAS: the answer is "estimate" in every
+    command, indices 1-based (auto.chosen too), a failure prints {"error": ..., "exit": N} and exits N."""
+    ok = [("solve", SOLVE + ["--index", "2", "--walks", "2000"]),
+          ("solve_auto", RS0 + ["--walks", "2000"]),
+          ("solve_check", SOLVE + ["--index", "2", "--walks", "2000", "--check"]),
+          ("bidir", ["solve", M + "randsub1000.mtx", "--index", "7", "--source", "3", "--walks", "2000"]),
+          ("iterations", ["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "gmres", "--index", "2"]),
+          ("direct", ["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "2"]),
+          ("info", ["info", M + "chain4.mtx"])]
+    for name, args in ok:
+        rc, out, err = run(ulam, args + ["--json"])
+        o = json.loads(out)
+        assert rc == 0 and not schema_ok(o, SCHEMAS[name]), (name, schema_ok(o, SCHEMAS[name]), out)
+        if name == "solve_auto":
+            a = o["auto"]
+            assert 1 <= a["chosen"] <= len(a["candidates"]) and a["candidates"][a["chosen"] - 1]["state"] == "chosen", a
+    bad = [(SOLVE + ["--index", "9"], 2), (SOLVE + ["--index", "1", "--meth", "walks"], 2),
+           (["direct", D + "singular.mtx", "--rhs", D + "ones3.mtx"], code("ESINGULAR")),
+           (["info", D + "nan.mtx"], code("ENONFINITE")), (DIV, 3),
+           (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "cg", "--restart", "x"], 2),
+           (["solve", M + "randsub1000.mtx", "--index", "7", "--source", "3000"], 2)]
+    for args, want in bad:
+        rc, out, err = run(ulam, args + ["--json"])
+        o = json.loads(out)
+        assert rc == want and not schema_ok(o, SCHEMAS["error"]) and o["exit"] == rc and o["error"], (args, rc, out, err)
+        assert o["error"] in err, (o, err)  # the same message as on stderr
+
+
 def run(ulam, args):
     p = subprocess.run([ulam] + args, capture_output=True, text=True, timeout=120)
     return p.returncode, p.stdout, p.stderr
@@ -509,8 +634,8 @@ def check_alpha(ulam):
         common = ["--index", "5", "--walks", "20000", "--json", "--check"]
         runs = {}
         for name, args in [("text1", [M + "signed200.mtx", "--rhs", M + "signed200_b.mtx"]), ("prep1", [sysf]),
-                           ("text2", [M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "--alpha", "2"]),
-                           ("prep2", [sysf, "--alpha", "2"])]:
+                           ("text2", [M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "--kernel-exponent", "2"]),
+                           ("prep2", [sysf, "--kernel-exponent", "2"])]:
             rc, out, err = run(ulam, ["solve", "--method", "walks"] + args + common)
             assert rc == 0, (name, err)
             runs[name] = json.loads(out)
@@ -1123,14 +1248,14 @@ def check_auto(ulam):
     assert rc == 0, err
     o = json.loads(out)
     a = o["auto"]
-    assert len(a["candidates"]) == 36 and 0 <= a["chosen"] < 36, a
+    assert len(a["candidates"]) == 36 and 1 <= a["chosen"] <= 36, a
     for c in a["candidates"]:
         if c["state"] != "skipped":
             assert c["certified"] == (c["rho_hat_upper"] < 1), c
         assert (c["pilot_walks"] > 0) == (c["state"] in ("dropped", "finalist", "chosen")), c
         assert c["kernel_alpha"] in (0, 1, 2) and c["state"] in ("uncertified", "refused", "skipped", "dropped",
                                                                  "finalist", "chosen"), c
-    ch = a["candidates"][a["chosen"]]
+    ch = a["candidates"][a["chosen"] - 1]
     assert ch["state"] == "chosen" and [c["state"] for c in a["candidates"]].count("chosen") == 1, a
     assert ch["mode"] == o["mode"] and ch["estimator"] == o["estimator"] and ch["kernel_alpha"] == o["kernel_alpha"], (ch, o)
     assert ch["predicted_walks"] >= 1000 and ch["predicted_work"] > 0 and 0 <= a["pilot_share"] < 0.5, a
@@ -1146,7 +1271,7 @@ def check_auto(ulam):
     assert len(o["auto"]["candidates"]) == 9 and o["mode"] == "forward", o
     assert all(c["mode"] == "forward" and c["continue"] == 0.8 for c in o["auto"]["candidates"]), o
     # everything pinned (or --method walks): today's run, output for output but the timings
-    pinned = RS0 + ["--mode", "adjoint", "--estimator", "collision", "--continue", "analog", "--alpha", "1", "--walks", "3000"]
+    pinned = RS0 + ["--mode", "adjoint", "--estimator", "collision", "--continue", "analog", "--kernel-exponent", "1", "--walks", "3000"]
     outs = [run(ulam, args) for args in (pinned, RS0 + ["--method", "walks", "--walks", "3000"])]
     strip = lambda t: [l for l in t.splitlines() if not l.startswith(("seconds", "figure", "load"))]
     assert outs[0][0] == outs[1][0] == 0 and strip(outs[0][1]) == strip(outs[1][1]), outs
@@ -1179,7 +1304,7 @@ def check_auto_bidir(progs):
     o = json.loads(out)
     a = o["auto"]
     b = a["candidates"][-1]
-    assert o["method"] == "bidirectional" and a["bidirectional"] is None and a["chosen"] == len(a["candidates"]) - 1, o
+    assert o["method"] == "bidirectional" and a["bidirectional"] is None and a["chosen"] == len(a["candidates"]), o
     assert b["mode"] == "bidirectional" and b["state"] == "chosen" and b["push_ops"] > 0 and b["pilot_walks"] == 256, b
     assert 0 < b["predicted_work"] < b["leader_work"] and b["push_ops"] <= b["leader_work"] / 2, b
     assert [c["state"] for c in a["candidates"]].count("chosen") == 1, a
@@ -1212,7 +1337,7 @@ def check_auto_bidir(progs):
         rc, out, err = run(ulam, ["solve", d + "/r.mtx", "--rhs", d + "/r_b.mtx", "--index", "1", "--rel-err", "0.01",
                                   "--json"])
         o = json.loads(out)
-        w = o["auto"]["candidates"][o["auto"]["chosen"]]["predicted_work"]
+        w = o["auto"]["candidates"][o["auto"]["chosen"] - 1]["predicted_work"]
         assert rc == 0 and o["mode"] == "adjoint" and w < 62400, o["auto"]
         assert o["auto"]["bidirectional"].startswith("not considered: the walks' predicted work"), o["auto"]
 
@@ -1249,7 +1374,8 @@ def main():
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),
-             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam)]
+             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
+             (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]
     if cases:

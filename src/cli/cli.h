@@ -156,6 +156,11 @@ void cli_output_begin(int *argc, char **argv);
 /* Under --json, a failure that printed no JSON prints {"error": message, "exit": rc}; returns rc. */
 int cli_output_finish(int rc);
 
+/* Every value of solve --method (src/cli/output.c), and them in words for messages. */
+enum { CLI_NMETHODS = 9 };
+extern const char *const cli_method_names[CLI_NMETHODS];
+extern const char *const cli_method_words;
+
 /* The name among names[0..n) closest to word, or NULL. */
 const char *cli_suggest(const char *word, const char *const *names, int n);
 

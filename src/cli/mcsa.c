@@ -35,7 +35,8 @@ static const char *const usage =
     "  --estimator E         of the forward walks (default expected)\n"
     "  --seed S              iteration l walks with a seed drawn from stream (S, l) (default 1):\n"
     "                        identical results for any --threads\n"
-    "  --out x.mtx           write the solution; --index I also prints x_I\n"
+    "  --out x.mtx           write the solution\n"
+    "  --index I             print x_I (with or without --out)\n"
     "  --check               also solve with LAPACK and report the relative error of x\n"
     "  --json                one JSON object with the history of every iteration\n"
     "  --jacobi, --omega, --continue, --max-steps, --threads, --force, --cache: as for walks\n"
@@ -270,7 +271,7 @@ int cli_solve_method(int argc, char **argv)
 {
     static const struct option longopts[] = {
         {"rhs", required_argument, 0, 'b'},     {"method", required_argument, 0, 'M'},
-        {"tol", required_argument, 0, 'l'},     {"max-iter", required_argument, 0, 'k'},
+        {"tol", required_argument, 0, 'l'},     {"rel-err", required_argument, 0, 'l'},     {"max-iter", required_argument, 0, 'k'},
         {"eps1", required_argument, 0, 'p'},    {"max-histories", required_argument, 0, 'H'},
         {"stall", required_argument, 0, 'a'},   CLI_WALK_OPTION("estimator"),
         CLI_WALK_OPTION("seed"),                CLI_WALK_OPTION("threads"),
@@ -295,8 +296,7 @@ int cli_solve_method(int argc, char **argv)
         case 'b': s.rhs_path = optarg; break;
         case 'M':
             if ((p.method = cli_lookup(optarg, method_names, 6)) < 0)
-                return cli_usage_error("solve", "--method expects auto, walks, bidirectional (with --source), mcsa, "
-                                                "sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
+                return cli_choose("solve", "--method", optarg, cli_method_names, CLI_NMETHODS, cli_method_words), EXIT_USAGE;
             if (p.method < KRYLOV_CG) o.method = p.method;
             break;
         case 'r':
@@ -339,9 +339,6 @@ int cli_solve_method(int argc, char **argv)
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
     if (!s.rhs_path) return cli_usage_error("solve", "needs --rhs b.mtx");
-    if (s.index && !out)
-        return cli_usage_error("solve", "--method solves for every unknown: --index I needs --out x.mtx "
-                                        "(the solution file) beside it");
     s.matrix_path = argv[optind];
     if (out && (rc = cli_check_output(out))) return rc;
     if ((rc = cli_load_system(&s))) return rc;

@@ -11,7 +11,7 @@
 static const char *const usage =
     "usage: ulam solve M.mtx --rhs b.mtx --index I [--mode adjoint|forward]\n"
     "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"
-    "                  [--time S] [--seed S] [--threads T] [--continue Q] [--alpha A]\n"
+    "                  [--time S] [--seed S] [--threads T] [--continue Q] [--kernel-exponent A]\n"
     "                  [--roulette W] [--split W] [--max-steps K] [--jacobi [--omega W]] [--check]\n"
     "                  [--json]\n"
     "                  [--out x.mtx] [--errors e.mtx] [--force] [--assume-finite-variance]\n"
@@ -31,7 +31,7 @@ static const char *const usage =
     "  --estimator E      collision (score at every visit, default), absorption (score where\n"
     "                     the walk ends, / p*), expected (score the exact next-step expectation)\n"
     "  --walks N          stop after N walks (default 100000 when no rule is given)\n"
-    "  --rel-err E        stop once stderr / |estimate| <= E, and only once enough walks have run\n"
+    "  --rel-err E        (or --tol E) stop once stderr / |estimate| <= E, and only once enough walks have run\n"
     "                     for the error bar to be trusted (README: 'When to trust the error\n"
     "                     bar'); it watches x_I (--index, default 1 in forward mode) and never\n"
     "                     stops while no walk has reached it; refused (exit 4) when the variance\n"
@@ -44,7 +44,7 @@ static const char *const usage2 = /* the help in three strings: C99 promises 409
     "  --continue Q       continue with probability Q in every state (analog, the default:\n"
     "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased;\n"
     "                     --continue analog names the default (pins it for --method auto)\n"
-    "  --alpha A          kernel exponent: move to j with probability proportional to\n"
+    "  --kernel-exponent A  (was --alpha) move to j with probability proportional to\n"
     "                     |M_ij|^A over the row's nonzeros (default 1, |M_ij| / S_i; 0 uniform,\n"
     "                     2 Alea's); rho(M^) and the error bar are this kernel's\n"
     "  --roulette W       Russian roulette below weight W (survive with |w|/W, weight W; default off)\n"
@@ -260,6 +260,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     cli_json_number("seconds", r->seconds, 0);
     cli_json_number("steps_per_second", r->seconds > 0 ? (double)r->steps / r->seconds : 0.0, 0);
     cli_json_number("figure_of_merit", r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : NAN, 0);
+    cli_json_string("method", "walks", 0);
     cli_json_string("mode", cli_mode_names[o->mode], 0);
     cli_json_string("estimator", cli_estimator_names[o->estimator], 0);
     printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->seed, r->threads,
@@ -377,6 +378,7 @@ static int parse(int argc, char **argv, solve_args *a)
         CLI_WALK_OPTION("threads"),              CLI_WALK_OPTION("continue"),
         CLI_WALK_OPTION("roulette"),             CLI_WALK_OPTION("split"),
         CLI_WALK_OPTION("max-steps"),            CLI_WALK_OPTION("alpha"),
+        CLI_WALK_OPTION("kernel-exponent"),      CLI_WALK_OPTION("tol"),
         {"jacobi", no_argument, 0, 'j'},
         {"omega", required_argument, 0, 'w'},    {"check", no_argument, 0, 'c'},
         {"json", no_argument, 0, 'J'},           {"out", required_argument, 0, 'o'},
@@ -397,7 +399,7 @@ static int parse(int argc, char **argv, solve_args *a)
             a->ao.pin_mode |= !strcmp(longopts[idx].name, "mode");
             a->ao.pin_estimator |= !strcmp(longopts[idx].name, "estimator");
             a->ao.pin_continue |= !strcmp(longopts[idx].name, "continue");
-            a->ao.pin_alpha |= !strcmp(longopts[idx].name, "alpha");
+            a->ao.pin_alpha |= !strcmp(longopts[idx].name, "alpha") || !strcmp(longopts[idx].name, "kernel-exponent");
             break;
         case 'b': a->s.rhs_path = optarg; break;
         case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
@@ -406,7 +408,7 @@ static int parse(int argc, char **argv, solve_args *a)
         case 'W': a->o.whole_kernel = 1; break;
         case 'U':
             if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
-            if (strcmp(optarg, "auto") && strcmp(optarg, "walks")) return cli_usage_error("solve", "--method expects auto, walks, bidirectional (with --source), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
+            if (cli_choose("solve", "--method", optarg, cli_method_names, CLI_NMETHODS, cli_method_words) < 0) return EXIT_USAGE;
             a->autom = !strcmp(optarg, "auto");
             break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
