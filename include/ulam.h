@@ -170,6 +170,11 @@ int ulam_csr_stats_compute(const ulam_csr *A, ulam_csr_stats *st);
 int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, double *bp,
                 ulam_error *err);
 
+/* PageRank as a system: M = alpha P^T for the adjacency matrix A (edge i -> j of weight A_ij >= 0,
+ * P = D^-1 A row-stochastic; a dangling row stays zero), so that (I - M) x = (1 - alpha) / n
+ * gives PageRank x.  alpha in (0, 1) is the damping; *M is new (ulam_csr_free). */
+int ulam_pagerank_matrix(const ulam_csr *A, double alpha, ulam_csr **M, ulam_error *err);
+
 /* ---------------------------------------------------------------- Matrix Market */
 /* Primary: ulam_mm_read_matrix, _read_vector, _write_vector.  Secondary: options, FILE readers,
  * _write_matrix.  Tertiary: ulam_strtod, ulam_outfile. */

@@ -505,6 +505,29 @@ def check_json_schemas(ulam):
         assert o["error"] in err, (o, err)  # the same message as on stderr
 
 
+def check_systems_as_held(ulam):
+    """A matrix that looks like A (poisson20: diagonal 4) is refused naming --jacobi, by auto and by
+    --method walks; an adjacency matrix is refused naming --pagerank, and --pagerank 0.85 (alias
+    --damping) walks on 0.85 P^T: node ranks within 4 sigma of ulam direct --pagerank."""
+    for extra in ([], ["--method", "walks"]):
+        rc, out, err = run(ulam, ["solve", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--index", "3",
+                                  "--rel-err", "0.01"] + extra)
+        assert rc == 3 and "add --jacobi" in err and out == "", (extra, rc, err)
+    with tempfile.TemporaryDirectory() as d:
+        edges = [(1, 2), (2, 3), (3, 1), (3, 4), (4, 1), (1, 3), (4, 5), (5, 1), (2, 5)]
+        write_mtx(d + "/g.mtx", 5, [(i, j, 1) for i, j in edges])
+        write_vec(d + "/b.mtx", [1.0] * 5)
+        rc, out, err = run(ulam, ["solve", d + "/g.mtx", "--rhs", d + "/b.mtx", "--index", "1", "--method", "walks"])
+        assert rc == 3 and "--pagerank 0.85" in err, err
+        rc, out, err = run(ulam, ["direct", d + "/g.mtx", "--pagerank", "0.85", "--json", "--index", "3"])
+        ref = json.loads(out)["estimate"]
+        for opt in ("--pagerank", "--damping"):
+            rc, out, err = run(ulam, ["solve", d + "/g.mtx", opt, "0.85", "--index", "3", "--walks", "20000", "--json",
+                                      "--method", "walks"])
+            o = json.loads(out)
+            assert rc == 0 and abs(o["estimate"] - ref) < 4 * o["stderr"] and 0.1 < ref < 0.5, (o, ref)
+
+
 def run(ulam, args):
     p = subprocess.run([ulam] + args, capture_output=True, text=True, timeout=120)
     return p.returncode, p.stdout, p.stderr
@@ -1375,7 +1398,8 @@ def main():
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
-             (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam)]
+             (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
+             (check_systems_as_held, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]
     if cases:

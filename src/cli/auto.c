@@ -19,12 +19,13 @@ int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts
     const ulam_auto_candidate *c = &res->cand[k];
     if (res->chosen < 0) {
         int diverge = !(res->abs.upper < 1);
+        const char *hint = s->jacobi || s->pagerank > 0 ? "" : cli_system_hint(s->M);
         fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance%s; the closest is "
-                        "%s %s (continuation %s%.3g, kernel exponent %g) with rho(M^) = %.6g (upper bound %.6g)%s\n",
+                        "%s %s (continuation %s%.3g, kernel exponent %g) with rho(M^) = %.6g (upper bound %.6g)%s.%s\n",
                 s->matrix_path, o->rel_err > 0 ? "error" : "warning", diverge ? " (rho(|M|) is not certified below 1)" : "",
                 cli_mode_names[c->mode], cli_estimator_names[c->estimator], c->continue_q > 0 ? "" : "analog, ",
                 c->continue_q > 0 ? c->continue_q : 0.0, c->kernel_alpha, c->hat.rho, c->hat.upper,
-                o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it");
+                o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it", hint);
         if (o->rel_err > 0) {
             *sv = ulam_solver_free(*sv);
             return diverge ? EXIT_DIVERGE : EXIT_INFVAR;

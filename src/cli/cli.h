@@ -54,6 +54,7 @@ typedef struct cli_system {
     int64_t index;        /* 1-based --index to check against n once loaded (0: none) */
     int jacobi;   /* the file holds A of A x = b: use M = I - omega D^-1 A */
     double omega; /* damping of the Jacobi splitting (1 = plain Jacobi) */
+    double pagerank; /* > 0: the file is an adjacency matrix; solve PageRank at this damping */
     int cache;    /* read and write binary caches beside the files (--cache) */
     int lazy;     /* the command reads M only where walks reach (adjoint solve): a mapped
                      file is then verified only if its certificate does not serve the guards */
@@ -73,6 +74,14 @@ int cli_load_system(cli_system *s);
 
 /* Check a mapped M and b whole (ulam_system_check) if not yet done; 0 or an exit code. */
 int cli_system_verify(cli_system *s);
+
+/* --pagerank: replace the loaded adjacency matrix by alpha P^T and a missing b by (1 - alpha) / n
+ * (src/cli/graph.c); 0 or an exit code. */
+int cli_load_pagerank(cli_system *s);
+
+/* A hint naming the option that fits how M looks (--jacobi for a large diagonal, --pagerank for an
+ * adjacency matrix), or "" (src/cli/guard.c). */
+const char *cli_system_hint(const ulam_csr *M);
 
 /* Free what cli_load_system loaded. */
 void cli_system_free(cli_system *s);

@@ -234,7 +234,7 @@ int cli_load_system(cli_system *s)
 {
     ulam_error err;
     int prepared = ulam_system_is_file(s->matrix_path);
-    if (prepared && s->jacobi)
+    if (prepared && (s->jacobi || s->pagerank > 0))
         return cli_usage_error(s->command, "%s is a prepared system: it holds M already (prepare it with --jacobi)",
                                s->matrix_path);
     int status = read_input(s->matrix_path, s->cache, &s->sys_M, &s->own_M, NULL, NULL, &err);
@@ -268,6 +268,7 @@ int cli_load_system(cli_system *s)
     }
     s->verified = !s->sys_M && !s->sys_b;
     int rc = s->jacobi ? load_jacobi(s) : 0;
+    if (!rc && s->pagerank > 0) rc = cli_load_pagerank(s);
     if (!rc && !s->lazy) rc = cli_system_verify(s);
     if (rc) return rc;
     if (s->index > s->M->nrows) {

@@ -116,6 +116,7 @@ static const char *const usage =
     "                  UMFPACK is there), sparse or dense\n"
     "  --jacobi        the file holds A of A x = b; solve with M = I - omega D^-1 A\n"
     "  --omega W       damping of the Jacobi splitting (default 1)\n"
+    "  --pagerank A    (or --damping) the file is an adjacency matrix: solve PageRank at damping A\n"
     "  --json          print one JSON object\n";
 
 /* Print the human-readable report. */
@@ -163,7 +164,8 @@ int cli_direct(int argc, char **argv)
         {"out", required_argument, 0, 'o'},     {"max-mem", required_argument, 0, 'm'},
         {"jacobi", no_argument, 0, 'j'},        {"omega", required_argument, 0, 'w'},
         {"json", no_argument, 0, 'J'},          {"help", no_argument, 0, 'h'},
-        {"lu", required_argument, 0, 'L'},      {0, 0, 0, 0}};
+        {"lu", required_argument, 0, 'L'},      {"pagerank", required_argument, 0, 'P'},
+        {"damping", required_argument, 0, 'P'}, {0, 0, 0, 0}};
     static const char *const lu_names[] = {"dense", "sparse", "auto"};
     cli_system s = {.command = "direct", .omega = 1.0};
     const char *out = NULL;
@@ -180,6 +182,7 @@ int cli_direct(int argc, char **argv)
         case 'j': s.jacobi = 1; break;
         case 'w': if ((rc = cli_parse_real("direct", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'J': json = 1; break;
+        case 'P': if ((rc = cli_parse_real("direct", "--pagerank", optarg, 1e-6, 1 - 1e-9, &s.pagerank))) return rc; break;
         case 'L':
             if ((cli_direct_force = cli_choose("direct", "--lu", optarg, lu_names, 3, "auto, sparse or dense")) < 0)
                 return EXIT_USAGE;
@@ -192,7 +195,8 @@ int cli_direct(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("direct", "expects exactly one matrix file");
-    if (!s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("direct", "needs --rhs b.mtx");
+    if (!s.rhs_path && !s.pagerank && !ulam_system_is_file(argv[optind]))
+        return cli_usage_error("direct", "needs --rhs b.mtx (or --pagerank ALPHA for a graph's adjacency matrix)");
     s.matrix_path = argv[optind];
     if (out && (rc = cli_check_output(out))) return rc;
     if ((rc = cli_load_system(&s))) return rc;

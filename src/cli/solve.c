@@ -51,6 +51,9 @@ static const char *const usage2 = /* the help in three strings: C99 promises 409
     "  --split W          split particles above weight W into ceil(|w|/W) copies (default off)\n"
     "  --max-steps K      cut walks longer than K steps and count them (default 1000000)\n"
     "  --jacobi           the file holds A of A x = b; walk on M = I - omega D^-1 A\n"
+    "  --pagerank ALPHA   (or --damping) the file is a graph's adjacency matrix (edge i -> j);\n"
+    "                     walk on M = ALPHA P^T, P = D^-1 adjacency: x_I is node I's PageRank\n"
+    "                     (b = (1 - ALPHA) / n unless --rhs; a dangling node's rank leaks)\n"
     "  --omega W          damping of the Jacobi splitting (default 1)\n"
     "  --check            also solve with LAPACK: adds direct, direct_seconds and\n"
     "                     z = (estimate - direct) / stderr\n"
@@ -385,7 +388,8 @@ static int parse(int argc, char **argv, solve_args *a)
         {"errors", required_argument, 0, 'E'},   {"help", no_argument, 0, 'h'},
         {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
         {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
-        {"method", required_argument, 0, 'U'},   {0, 0, 0, 0}};
+        {"method", required_argument, 0, 'U'},   {"pagerank", required_argument, 0, 'P'},
+        {"damping", required_argument, 0, 'P'},  {0, 0, 0, 0}};
     *a = (solve_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_walk_defaults(), .autom = 1,
                       .ao = ulam_auto_defaults()};
     a->o.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
@@ -412,6 +416,7 @@ static int parse(int argc, char **argv, solve_args *a)
             a->autom = !strcmp(optarg, "auto");
             break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
+        case 'P': if ((rc = cli_parse_real("solve", "--pagerank", optarg, 1e-6, 1 - 1e-9, &a->s.pagerank))) return rc; break;
         case 'c': a->check = 1; break;
         case 'J': a->json = 1; break;
         case 'F': a->force = 1; break;
@@ -423,7 +428,9 @@ static int parse(int argc, char **argv, solve_args *a)
         }
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (!a->s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("solve", "needs --rhs b.mtx");
+    if (!a->s.rhs_path && !a->s.pagerank && !ulam_system_is_file(argv[optind]))
+        return cli_usage_error("solve", "needs --rhs b.mtx (or --pagerank ALPHA for a graph's adjacency matrix)");
+    if (a->s.pagerank > 0 && a->s.jacobi) return cli_usage_error("solve", "--pagerank and --jacobi exclude each other");
     if (!a->s.index && a->o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
     if ((a->out || a->errors) && a->o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
