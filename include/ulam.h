@@ -1065,6 +1065,10 @@ const ulam_study_method *ulam_study_method_get(int k);
 /* The index of the method named name, or -1. */
 int ulam_study_method_find(const char *name);
 
+/* The 95% Wilson score interval [*lo, *hi] of a coverage: covered of runs intervals held the exact
+ * value (runs > 0; else [0, 1]). */
+void ulam_study_coverage_interval(int covered, int runs, double *lo, double *hi);
+
 /* Set o's mode, estimator, roulette and split to method k's on b (n entries; read only in
  * forward mode, for w0 = ||b||_1).  ULAM_OK or ULAM_EINVAL. */
 int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o);

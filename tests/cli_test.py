@@ -393,7 +393,7 @@ CASES += [  # one vocabulary: no abbreviations, "did you mean" for options and t
     (RS0 + ["--method", "mcsa", "--max-iters", "5"], 2, r"unknown option '--max-iters' \(did you mean '--max-iter'\?\)", r"^$"),
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--lu", "sparce"], 2, r"did you mean 'sparse'", r"^$"),
     # the iterations take --rel-err (their --tol) and print x_I without --out; the walks take --tol
-    (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "cg", "--index", "4", "--rel-err", "1e-10"], 0,
+    (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "gmres", "--index", "4", "--rel-err", "1e-10"], 0,
      r"^$", r"x\[4\]\s+3\.68174"),
     (SOLVE + ["--index", "1", "--tol", "0.05"], 0, r"^$", r"rel-err\s+met \(target 0\.05"),
 ]
@@ -1032,6 +1032,29 @@ def check_study(ulam):
     p.communicate(timeout=60)
     assert p.returncode == 130, p.returncode
     assert open(f"{d}/i/runs.csv").read() == "method,budget,repeat,seed,estimate,stderr,abs_error,walks,steps,seconds,covered\n"
+    assert "PARTIAL" in open(f"{d}/i/rmse-collision.gp").read(), os.listdir(d + "/i")
+
+
+def check_study_summary(ulam):
+    """study tells the result on stdout: the winner at each budget with its coverage k/N and the
+    Wilson interval, the refused methods; one RMSE chart per estimator (<= 6 lines), each chart's
+    gnuplot script kept beside it; SVG on request; --reference-time 0 leaves out the references."""
+    with tempfile.TemporaryDirectory() as d:
+        rc, out, err = run(ulam, ["study", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "--index", "3", "--methods",
+                                  "forward-absorption-plain,adjoint-collision-plain,adjoint-expected-split", "--budgets",
+                                  "100,1000", "--repeats", "4", "--out", d, "--reference-time", "0", "--format", "svg"])
+        assert rc == 0, err
+        rows = re.findall(r"^(100|1000) +(\S+) +\S+ +\S+ +(\d+)/4 \((\d\.\d\d) \.\. (\d\.\d\d)\)$", out, re.M)
+        assert len(rows) == 2 and all(w in ("adjoint-collision-plain", "adjoint-expected-split") for _, w, *_ in rows), out
+        for _, _, k, lo, hi in rows:
+            assert float(lo) <= int(k) / 4 <= float(hi), rows
+        assert re.search(r"^refused: forward-absorption-plain: ", out, re.M), out
+        files = set(os.listdir(d))
+        assert {"rmse-collision.svg", "rmse-collision.gp", "rmse-expected.svg", "coverage.svg", "coverage.gp"} <= files, files
+        assert "rmse-absorption.svg" not in files and not any(f.endswith(".png") for f in files), files
+        assert not any(l.startswith(("sequential", "mcsa")) for l in open(d + "/reference.csv")), "references ran"
+        bars = open(d + "/bars.csv").read().splitlines()
+        assert bars[0] == "method,work,coverage,honesty,coverage_lo,coverage_hi,covered,runs", bars
 
 
 def check_outputs(ulam):
@@ -1334,7 +1357,7 @@ def check_auto_bidir(progs):
     assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"] and o["stderr"] <= 0.02 * abs(o["estimate"]), o
     rc, out, err = run(ulam, sp3 + ["--method", "bidirectional", "--json"])
     assert rc == 0 and json.loads(out)["estimate"] == o["estimate"], (err, out, o)
-    rc, out, err = run(ulam, sp3)
+    rc, out, err = run(ulam, sp3 + ["--verbose"])
     assert rc == 0 and re.search(r"^auto +chose bidirectional: its predicted work", out, re.M), out
     assert re.search(r"^  \* bidirectional .*rmax .* push \d+ ops .*predicted", out, re.M), out
     # considered, and it loses: at --rel-err 0.1 the walks need their 1000-walk floor
@@ -1352,7 +1375,7 @@ def check_auto_bidir(progs):
         o = json.loads(out)
         assert rc == 0 and all(c["mode"] != "bidirectional" for c in o["auto"]["candidates"]), (extra, o)
         assert o["auto"]["bidirectional"].startswith("not considered: " + why), (extra, o["auto"]["bidirectional"])
-        rc, out, err = run(ulam, PS + extra)
+        rc, out, err = run(ulam, PS + extra + ["--verbose"])
         assert rc == 0 and re.search(r"^    bidirectional .*not considered: " + re.escape(why), out, re.M), (extra, out)
     # rent or buy: the study's r500 (b has 6 nonzeros) has walks cheaper than nnz/4 = 62 400
     with tempfile.TemporaryDirectory() as d:
@@ -1391,7 +1414,7 @@ def main():
     failures, n = check_table(ulam, rows if cases else None)
     extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
-             (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
+             (check_study, ulam), (check_study_summary, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
