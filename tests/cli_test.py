@@ -444,6 +444,12 @@ def check_sparse_check(ulam):
         o2 = json.loads(out)
         assert rc == 0 and o2["method"] == "sparse LU" and abs(o2["estimate"] - o["direct"]) < 1e-12 * abs(o["direct"]), o2
         assert o2["residual"] < 1e-12, o2
+        # a prepared system: the walks read it in place, then the check verifies and solves it whole
+        rc, out, err = run(ulam, ["prepare", d + "/g.mtx", "--rhs", d + "/g_b.mtx", "-o", d + "/g.ulam"])
+        assert rc == 0, err
+        rc, out, err = run(ulam, ["solve", d + "/g.ulam", "--index", "50000", "--walks", "4000", "--check", "--json"])
+        o3 = json.loads(out)
+        assert rc == 0 and o3["direct_method"] == "sparse LU" and o3["direct"] == o["direct"] and abs(o3["z"]) < 4, o3
 
 
 # A hand-written schema: key -> type (a tuple: any of them; None: null allowed), for each command's

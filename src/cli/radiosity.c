@@ -545,6 +545,7 @@ static void print_json(const args *a, const report *r)
     const walked *w = r->w;
     if (w) {
         if (r->patch >= 0) {
+            json_triple("estimate", w->B); /* the answer's key in every command */
             json_triple("radiosity", w->B);
             json_triple("stderr", w->se);
             if (a->matrix_walk) {
