@@ -272,6 +272,11 @@ int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_
 int ulam_direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
                        ulam_direct_info *info, ulam_error *err);
 
+/* What ulam_direct_sparse will need, before it starts: UMFPACK's estimates of the factorisation's
+ * peak memory (*bytes) and floating-point operations (*flops), from its symbolic analysis (a
+ * fraction of the factorisation's time).  ULAM_EUNSUPPORTED without UMFPACK. */
+int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err);
+
 /* Nonzero when libulam was built with UMFPACK (ulam_direct_sparse works). */
 int ulam_direct_sparse_available(void);
 

@@ -82,7 +82,47 @@ static int factor_solve(int64_t n, const SuiteSparse_long *p, const SuiteSparse_
     if (info) info->rcond = rcond, info->bytes = (size_t)peak;
     return ULAM_OK;
 }
+
+/* UMFPACK's symbolic analysis of I - M alone: its estimates of the factorisation's peak memory
+ * (bytes) and floating-point operations; a status. */
+static int estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err)
+{
+    SuiteSparse_long *p = NULL, *c = NULL;
+    double *v = NULL, control[UMFPACK_CONTROL], stat[UMFPACK_INFO];
+    void *symbolic = NULL;
+    int status = assemble(M, &p, &c, &v);
+    if (status) {
+        ulam__fail(err, status, 0, -1, "memory for I - M");
+    } else {
+        umfpack_dl_defaults(control);
+        SuiteSparse_long sn = (SuiteSparse_long)M->nrows;
+        int st = (int)umfpack_dl_symbolic(sn, sn, p, c, v, &symbolic, control, stat);
+        if (st == UMFPACK_OK) {
+            *bytes = stat[UMFPACK_PEAK_MEMORY_ESTIMATE] * stat[UMFPACK_SIZE_OF_UNIT];
+            *flops = stat[UMFPACK_FLOPS_ESTIMATE];
+        } else {
+            status = ulam__fail(err, st == UMFPACK_ERROR_out_of_memory ? ULAM_ENOMEM : ULAM_EINVAL, 0, -1,
+                                "a matrix UMFPACK can analyse (status %d)", st);
+        }
+        umfpack_dl_free_symbolic(&symbolic);
+    }
+    free(p), free(c), free(v);
+    return status;
+}
 #endif
+
+/* What the sparse LU of I - M will need, before it starts. */
+int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!M || !bytes || !flops || M->nrows != M->ncols)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a square matrix and places for the estimates");
+#ifndef ULAM_UMFPACK
+    return ulam__fail(err, ULAM_EUNSUPPORTED, 0, -1, "a libulam built with UMFPACK (libsuitesparse-dev) for a sparse LU");
+#else
+    return estimate(M, bytes, flops, err);
+#endif
+}
 
 /* Nonzero when libulam was built with UMFPACK. */
 int ulam_direct_sparse_available(void)

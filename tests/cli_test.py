@@ -464,6 +464,7 @@ SCHEMAS = {
     "iterations": {"method": STR, "outcome": STR, "residual": NUM, "index": INT, "estimate": NUM},
     "direct": {"n": INT, "index": INT, "estimate": NUM, "method": STR, "rcond": NUM, "residual": NUM, "seconds": NUM},
     "info": {"n": INT, "nnz": INT, "rho_abs": NUM, "walks_converge": BOOL},
+    "radiosity": {"patch": INT, "estimate": list, "stderr": list, "mode": STR, "walks": INT},
     "error": {"error": STR, "exit": INT},
 }
 
@@ -492,6 +493,11 @@ def check_json_schemas(ulam):
           ("iterations", ["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "gmres", "--index", "2"]),
           ("direct", ["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "2"]),
           ("info", ["info", M + "chain4.mtx"])]
+    bad = []
+    if run(ulam, ["radiosity", "--help"])[0] == 0:  # built with the radiosity front end
+        scene = "examples/scenes/cornell_box.obj"
+        ok.append(("radiosity", ["radiosity", scene, "--subdivide", "100", "--patch", "floor", "--walks", "2000"]))
+        bad.append((["radiosity", scene, "--patch", "99999"], 2))
     for name, args in ok:
         rc, out, err = run(ulam, args + ["--json"])
         o = json.loads(out)
@@ -499,7 +505,7 @@ def check_json_schemas(ulam):
         if name == "solve_auto":
             a = o["auto"]
             assert 1 <= a["chosen"] <= len(a["candidates"]) and a["candidates"][a["chosen"] - 1]["state"] == "chosen", a
-    bad = [(SOLVE + ["--index", "9"], 2), (SOLVE + ["--index", "1", "--meth", "walks"], 2),
+    bad += [(SOLVE + ["--index", "9"], 2), (SOLVE + ["--index", "1", "--meth", "walks"], 2),
            (["direct", D + "singular.mtx", "--rhs", D + "ones3.mtx"], code("ESINGULAR")),
            (["info", D + "nan.mtx"], code("ENONFINITE")), (DIV, 3),
            (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "cg", "--restart", "x"], 2),

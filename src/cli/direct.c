@@ -26,9 +26,13 @@ static void announce(const cli_system *s, int sparse)
 {
     int64_t n = s->M->nrows, nnz = s->M->rowptr[n];
     double flops = 2.0 / 3.0 * (double)n * (double)n * (double)n, gib = (double)ulam_direct_bytes(n) / 1073741824.0;
-    if (sparse && nnz + n > 2000000)
-        fprintf(stderr, "ulam: --check: sparse LU (UMFPACK) of I - M: n = %lld, %lld nonzeros (the memory is that of "
-                        "its factors, checked before it starts); Ctrl-C keeps the estimate\n", (long long)n, (long long)nnz);
+    double bytes, lu_flops;
+    ulam_error err;
+    if (sparse && nnz + n > 200000 && !ulam_direct_sparse_estimate(s->M, &bytes, &lu_flops, &err))
+        fprintf(stderr, "ulam: --check: sparse LU (UMFPACK) of n = %lld, %lld nonzeros: at most %.3g GiB and %.2g flops "
+                        "(UMFPACK's bounds; at most about %.0f s at 10 Gflop/s)%s; Ctrl-C keeps the estimate\n",
+                (long long)n, (long long)nnz, bytes / 1073741824.0, lu_flops, lu_flops / 1e10,
+                bytes > (double)CLI_MAX_MEM ? ": over 4 GiB, so GMRES to a 1e-12 residual instead" : "");
     else if (!sparse && flops > 2e10)
         fprintf(stderr, "ulam: --check: dense LU (LAPACK) of n = %lld: %.3g GiB and 2/3 n^3 = %.2g flops (about %.0f s "
                         "at 10 Gflop/s)%s; Ctrl-C keeps the estimate\n", (long long)n, gib, flops, flops / 1e10,
