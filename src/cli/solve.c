@@ -449,6 +449,7 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
     ro->load_seconds = ulam_now() - t0;
     o->index = s->index ? s->index - 1 : 0;
     o->interrupt = &cli_interrupted, o->share = cli_share, o->force = a->force;
+    o->system = s->lazy ? s->sys_M : NULL; /* a mapped M read lazily: its blocks verified as walks reach them */
     o->assume_finite = ro->assume_finite;
     ro->n = s->M->nrows;
     ulam_error err;
