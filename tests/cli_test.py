@@ -785,6 +785,14 @@ def check_prepare(ulam):
         a, b = json.loads(text), json.loads(prep)
         assert a["estimate"] == b["estimate"] and a["stderr"] == b["stderr"], (a, b)
         assert b["guard_seconds"] == 0 and b["rho_abs"] == a["rho_abs"], b
+        # --transpose stores M^T beside M: the same answers, a file holding both
+        rc, out, err = run(ulam, ["prepare", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "--transpose", "-o",
+                                  d + "/t.ulam"])
+        assert rc == 0 and "with M^T" in out, (rc, out, err)
+        rc, tprep, err = run(ulam, ["solve", "--method", "walks", d + "/t.ulam"] + common)
+        assert rc == 0 and json.loads(tprep)["estimate"] == b["estimate"], err
+        assert os.path.getsize(d + "/t.ulam") > os.path.getsize(sysf)
+        os.remove(d + "/t.ulam")
         rc, fwd, err = run(ulam, ["solve", "--method", "walks", sysf, "--mode", "forward", "--walks", "2000", "--json"])
         assert rc == 0, err
         rc, info, err = run(ulam, ["info", sysf, "--json"])
