@@ -63,7 +63,7 @@ enum ulam_status {
     ULAM_ENOMEM,       /* out of memory */
     ULAM_EIO,          /* file cannot be opened, read or written */
     ULAM_EEMPTY,       /* input file is empty */
-    ULAM_EBANNER,      /* missing or malformed %%MatrixMarket banner */
+    ULAM_EBANNER,      /* not the kind of file expected: a missing or malformed banner or magic */
     ULAM_EUNSUPPORTED, /* valid Matrix Market, but a kind ulam does not handle (complex, ...) */
     ULAM_ESIZELINE,    /* missing or malformed size line */
     ULAM_EOVERFLOW,    /* sizes too large to represent or allocate */
@@ -173,6 +173,11 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
 /* ---------------------------------------------------------------- Matrix Market */
 /* Primary: ulam_mm_read_matrix, _read_vector, _write_vector.  Secondary: options, FILE readers,
  * _write_matrix.  Tertiary: ulam_strtod, ulam_outfile. */
+
+/* The most rows (and columns) a Matrix Market matrix declaring nnz entries may have: every row
+ * costs memory and time in each pass over M, so a short file may not declare millions of empty
+ * ones (ULAM_EOVERFLOW at the size line).  A vector (n x 1), held dense anyway: 2^24 + 64 nnz. */
+#define ULAM_MM_DIM_CAP(nnz) (((int64_t)1 << 16) + 64 * (int64_t)(nnz))
 
 /* Read a sparse matrix from path ("coordinate" real/integer/pattern, general/symmetric/
  * skew-symmetric; duplicates summed, explicit zeros dropped; symmetric files are

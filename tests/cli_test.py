@@ -28,6 +28,7 @@ BAD_FILES = [
     ("not_a_number.mtx", "ESYNTAX", 4), ("nan.mtx", "ENONFINITE", 3), ("inf.mtx", "ENONFINITE", 4),
     ("missing_value.mtx", "ESYNTAX", 4), ("huge_dims.mtx", "EOVERFLOW", 2),
     ("huge_nnz.mtx", "ETOOFEW", 2), ("skew_diagonal.mtx", "EINDEX", 4),
+    ("sparse_dims.mtx", "EOVERFLOW", 2), ("nul_after_value.mtx", "ESYNTAX", 4),
 ]
 
 CASES = []
@@ -35,6 +36,10 @@ for f, status, line in BAD_FILES:
     CASES.append((["info", D + f], code(status), rf"^ulam: {re.escape(D + f)}:{line}: error: .*expected ", ""))
 CASES += [
     (["info", D + "does_not_exist.mtx"], code("EIO"), r"does_not_exist.mtx: error: .*No such file", ""),
+    (["info", D + "truncated.mtx.gz"], code("ESYNTAX"), r"truncated.mtx.gz: error: .*gzip", ""),
+    (["info", D + "duplicates_beyond.mtx"], 0, "", r"nnz +4"),
+    (["solve", "--method", "walks", D + "dag5.mtx.gz", "--rhs", D + "ones5.mtx.gz", "--index", "1", "--walks", "1000"], 0,
+     "", r"x\[1\]"),
     (["info", D + "nonsquare.mtx"], code("ENOTSQUARE"), r"nonsquare.mtx: error: .*square", ""),
     (["direct", M + "chain4.mtx", "--rhs", D + "ones3.mtx"], code("EDIM"),
      r"ones3.mtx: error: .*expected 4 entries", ""),
@@ -858,6 +863,13 @@ def check_prepare(ulam):
             else:
                 assert out == "" and re.search(r"^ulam: .*flip.ulam: error: .*(damaged|checksum|certificate)", err), (at, rc, err)
         os.remove(d + "/flip.ulam")
+        # an empty or foreign file named .ulam says what it is, not "needs --rhs"
+        for name, data in (("empty.ulam", b""), ("foreign.ulam", b"ulamSYS9" + bytes(100))):
+            with open(d + "/" + name, "wb") as fh:
+                fh.write(data)
+            rc, out, err = run(ulam, ["solve", d + "/" + name, "--index", "1"])
+            assert rc == code("EBANNER") and "prepared system" in err and "--rhs" not in err and out == "", (rc, err)
+            os.remove(d + "/" + name)
         # the output is checked before the work, and a failed prepare leaves nothing
         rc, _, err = run(ulam, ["prepare", M + "signed200.mtx", "-o", d + "/no/such/dir/s.ulam"])
         assert rc == code("EIO"), err

@@ -228,6 +228,20 @@ static int load_jacobi(cli_system *s)
     return 0;
 }
 
+/* See cli.h. */
+int cli_need_rhs(const char *command, const char *path)
+{
+    size_t len = strlen(path);
+    if ((len > 5 && !strcmp(path + len - 5, ".ulam")) || (len > 10 && !strcmp(path + len - 10, ".ulamcache"))) {
+        ulam_system *sys = NULL;
+        ulam_error err;
+        int status = ulam_system_open(path, NULL, &sys, &err); /* says why it is not one */
+        ulam_system_free(sys);
+        if (status) return cli_report(path, &err);
+    }
+    return cli_usage_error(command, "needs --rhs b.mtx");
+}
+
 /* Load M (and b); 0 or an exit code. */
 int cli_load_system(cli_system *s)
 {

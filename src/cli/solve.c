@@ -384,7 +384,7 @@ static int parse(int argc, char **argv, solve_args *a)
         }
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (!a->s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("solve", "needs --rhs b.mtx");
+    if (!a->s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_need_rhs("solve", argv[optind]);
     if (!a->s.index && a->o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
     if ((a->out || a->errors) && a->o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
