@@ -797,6 +797,12 @@ def check_prepare(ulam):
         rc, tprep, err = run(ulam, ["solve", "--method", "walks", d + "/t.ulam"] + common)
         assert rc == 0 and json.loads(tprep)["estimate"] == b["estimate"], err
         assert os.path.getsize(d + "/t.ulam") > os.path.getsize(sysf)
+        # a point-source query pushes on the stored M^T: the answer of the one it builds
+        pair = ["--source", "3", "--index", "5", "--walks", "2000", "--json", "--threads", "1"]
+        rc, built, err = run(ulam, ["solve", sysf] + pair)
+        assert rc == 0, err
+        rc, kept, err = run(ulam, ["solve", d + "/t.ulam"] + pair)
+        assert rc == 0 and json.loads(kept)["estimate"] == json.loads(built)["estimate"], (err, kept, built)
         os.remove(d + "/t.ulam")
         rc, fwd, err = run(ulam, ["solve", "--method", "walks", sysf, "--mode", "forward", "--walks", "2000", "--json"])
         assert rc == 0, err
