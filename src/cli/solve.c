@@ -60,7 +60,7 @@ static const char *const usage2 = /* the help in three strings: C99 promises 409
     "  --assume-finite-variance  print a confidence interval when the guards cannot tell\n"
     "                     whether rho(M^) < 1 (unknown is otherwise treated as infinite)\n"
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
-    "                     that instead of parsing while the file is unchanged (size, mtime)\n";
+    "                     that instead of parsing while the file is unchanged (its XXH3 hash)\n";
 static const char *const usage3 =
     "  --method auto      (default) choose mode, estimator, continuation and --alpha among\n"
     "                     the candidates the guards certify, by pilots compared on a fixed\n"
