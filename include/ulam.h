@@ -440,8 +440,8 @@ typedef struct ulam_system_desc {
 ulam_system_desc ulam_system_desc_defaults(void);
 
 /* Write a prepared system to f (positioned at 0; the caller closes it): ULAM_OK, ULAM_EINVAL
- * (also for a certificate without M or whose guards are not of kernel exponent 1), ULAM_ENOMEM
- * or ULAM_EIO. */
+ * (also for an M that fails ulam_csr_check, a b not finite, a certificate without M or whose
+ * guards are not of kernel exponent 1), ULAM_ENOMEM or ULAM_EIO. */
 int ulam_system_write_file(FILE *f, const ulam_system_desc *d);
 
 /* Write a prepared system to path atomically (through ulam_outfile). */

@@ -238,6 +238,9 @@ int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
     int64_t n = M ? M->nrows : d->n, nnz = M ? M->rowptr[M->nrows] : 0;
     if (n < 0 || (M && d->n != M->nrows && d->b)) return ULAM_EINVAL;
     if (d->cert && (d->cert->guard.kernel_alpha != 1.0 || !M)) return ULAM_EINVAL; /* exponent 1's guards, of M */
+    if (M && ulam_csr_check(M)) return ULAM_EINVAL; /* never a file that fails its own verification */
+    for (int64_t i = 0; d->b && i < n; i++)
+        if (!isfinite(d->b[i])) return ULAM_EINVAL;
     ulam_csr *T = NULL;
     if (d->transpose && ulam_csr_transpose(M, &T)) return ULAM_ENOMEM;
     int shift = block_shift(n, nnz);
