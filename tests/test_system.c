@@ -493,6 +493,24 @@ static void test_flip_table(void **state)
     free(b);
 }
 
+/* The prepared file of mixed(n), b_i = i mod 5 - 1.5 and its certificate (*c), in aligned
+ * memory of *len bytes (free() it). */
+static void *mixed_file(int64_t n, size_t *len, ulam_certificate *c)
+{
+    ulam_csr *M = mixed(n);
+    double *b = malloc((size_t)n * sizeof *b);
+    for (int64_t i = 0; i < n; i++) b[i] = (double)(i % 5) - 1.5;
+    assert_int_equal(ulam_certificate_compute(M, 0.0, NULL, c, NULL), ULAM_OK);
+    ulam_system_desc d = {.M = M, .b = b, .n = n, .cert = c};
+    unsigned char *bytes = file_bytes(&d, len);
+    void *q = NULL;
+    assert_int_equal(posix_memalign(&q, 4096, *len), 0);
+    memcpy(q, bytes, *len);
+    free(bytes), free(b);
+    ulam_csr_free(M);
+    return q;
+}
+
 /* Two solvers in two threads (each with two threads of walks) on one system opened fresh, its
  * blocks verified by whichever thread reaches them first: both answer as one solver alone does. */
 typedef struct {
@@ -521,18 +539,9 @@ static void *run_job(void *arg)
 static void test_threads(void **state)
 {
     (void)state;
-    const int64_t n = 5000;
-    ulam_csr *M = mixed(n);
-    double *b = malloc((size_t)n * sizeof *b);
-    for (int64_t i = 0; i < n; i++) b[i] = (double)(i % 5) - 1.5;
-    ulam_certificate c;
-    assert_int_equal(ulam_certificate_compute(M, 0.0, NULL, &c, NULL), ULAM_OK);
-    ulam_system_desc d = {.M = M, .b = b, .n = n, .cert = &c};
     size_t len;
-    unsigned char *bytes = file_bytes(&d, &len);
-    void *q = NULL;
-    assert_int_equal(posix_memalign(&q, 4096, len), 0);
-    memcpy(q, bytes, len);
+    ulam_certificate c;
+    void *q = mixed_file(5000, &len, &c);
     ulam_guard g;
     assert_int_equal(ulam_certificate_guard(&c, 0.0, NULL, &g), ULAM_OK);
     double alone[2];
@@ -557,8 +566,7 @@ static void test_threads(void **state)
     }
     assert_int_equal(ulam_system_check(s, NULL), ULAM_OK);
     ulam_system_free(s);
-    free(q), free(bytes), free(b);
-    ulam_csr_free(M);
+    free(q);
 }
 
 /* Recompute the checksums of M's blocks of the file at p (its arrays F, changed in place), the
@@ -600,17 +608,9 @@ static void test_sound_sums_bad_arrays(void **state)
     const int64_t n = 300;
     for (int k = 0; k < 3; k++) {
         if (!test_case(k)) continue;
-        ulam_csr *M = mixed(n);
-        double *b = malloc((size_t)n * sizeof *b);
-        for (int64_t i = 0; i < n; i++) b[i] = 1.0;
-        ulam_certificate c;
-        assert_int_equal(ulam_certificate_compute(M, 0.0, NULL, &c, NULL), ULAM_OK);
-        ulam_system_desc d = {.M = M, .b = b, .n = n, .cert = &c};
         size_t len;
-        unsigned char *bytes = file_bytes(&d, &len);
-        void *q = NULL;
-        assert_int_equal(posix_memalign(&q, 4096, len), 0);
-        memcpy(q, bytes, len);
+        ulam_certificate c;
+        void *q = mixed_file(n, &len, &c);
         ulam_csr F = {.nrows = n, .ncols = n, .rowptr = (int64_t *)(void *)((unsigned char *)q + word(q, 6)),
                       .colidx = (int32_t *)(void *)((unsigned char *)q + word(q, 7)),
                       .val = (double *)(void *)((unsigned char *)q + word(q, 8))};
@@ -639,8 +639,7 @@ static void test_sound_sums_bad_arrays(void **state)
                 fail_msg("case %d, run %d: status %d, '%s'", k, run, st, err.msg);
         }
         ulam_system_free(s);
-        free(q), free(bytes), free(b);
-        ulam_csr_free(M);
+        free(q);
     }
     test_case_done();
 }
