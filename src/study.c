@@ -111,5 +111,5 @@ void ulam_study_coverage_interval(int covered, int runs, double *lo, double *hi)
     }
     double n = runs, p = covered / n, z = ULAM_Z95, z2 = z * z;
     double mid = (p + z2 / (2 * n)) / (1 + z2 / n), half = z * sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / (1 + z2 / n);
-    *lo = fmax(0.0, mid - half), *hi = fmin(1.0, mid + half);
+    *lo = covered <= 0 ? 0.0 : fmax(0.0, mid - half), *hi = covered >= runs ? 1.0 : fmin(1.0, mid + half); /* exact ends */
 }

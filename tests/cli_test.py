@@ -1028,7 +1028,8 @@ def check_prepare(ulam):
             if rc == 0:
                 assert json.loads(out)["estimate"] == json.loads(intact)["estimate"], (at, out, intact)
             else:
-                assert out == "" and re.search(r"^ulam: .*flip.ulam: error: .*(damaged|checksum|certificate)", err), (at, rc, err)
+                assert re.search(r"^ulam: .*flip.ulam: error: .*(damaged|checksum|certificate)", err), (at, rc, err)
+                assert json.loads(out) == {"error": err.strip()[6:], "exit": rc}, (at, out)  # --json: the error as JSON
         os.remove(d + "/flip.ulam")
         # an empty or foreign file named .ulam says what it is, not "needs --rhs"
         for name, data in (("empty.ulam", b""), ("foreign.ulam", b"ulamSYS9" + bytes(100))):
