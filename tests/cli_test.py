@@ -11,6 +11,7 @@ A failing case prints its name: `table:K` (K-th row of CASES, from 0) or a check
 import json
 import os
 import re
+import signal
 import subprocess
 import sys
 import tempfile
@@ -450,6 +451,20 @@ def check_sparse_check(ulam):
         o2 = json.loads(out)
         assert rc == 0 and o2["method"] == "sparse LU" and abs(o2["estimate"] - o["direct"]) < 1e-12 * abs(o["direct"]), o2
         assert o2["residual"] < 1e-12, o2
+        # Ctrl-C once the check has said what it needs: the estimate printed stays, exit 130
+        for extra in ([], ["--json"]):
+            p = subprocess.Popen([ulam, "solve", d + "/g.mtx", "--rhs", d + "/g_b.mtx", "--index", "50000", "--walks",
+                                  "4000", "--check"] + extra, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            said = p.stderr.readline()
+            p.send_signal(signal.SIGINT)
+            out, err = p.communicate(timeout=120)
+            assert "--check: sparse LU (UMFPACK) of n = 100489" in said and p.returncode == 130, (said, p.returncode, err)
+            if extra:
+                o4 = json.loads(out)
+                assert o4["estimate"] == o["estimate"] and o4["direct"] is None and o4["direct_method"] == "interrupted", o4
+            else:
+                assert re.match(r"x\[50000\]\s+[\d.]+ \+- ", out) and "direct" not in out, out
+                assert "--check interrupted: the estimate above stands unchecked" in err, err
         # a prepared system: the walks read it in place, then the check verifies and solves it whole
         rc, out, err = run(ulam, ["prepare", d + "/g.mtx", "--rhs", d + "/g_b.mtx", "-o", d + "/g.ulam"])
         assert rc == 0, err

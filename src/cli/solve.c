@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char *const usage =
     "usage: ulam solve M.mtx --rhs b.mtx --index I [--mode adjoint|forward]\n"
@@ -632,7 +633,11 @@ static int run(solve_args *a)
         if (r.interrupted) rc = EXIT_INTERRUPTED;
     }
     fflush(stdout); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
-    if (left) return rc; /* the reference solve's thread still reads the system: exit without freeing it */
+    if (left && !cli_share) { /* the reference solve's thread still reads the system: end here */
+        fflush(stderr);
+        _exit(rc);
+    }
+    if (left) return rc; /* under MPI the ranks end together (main); the system stays to the thread */
     cli_release_sigint();
     ulam_solver_free(sv);
     cli_bidir_cand_free(&bc);
