@@ -730,11 +730,18 @@ typedef struct ulam_outer_step {
 typedef struct ulam_outer ulam_outer;
 
 /* Prepare the iteration on (I - M) x = b (M and b borrowed until freed).  Refuses options
- * out of range (ULAM_EINVAL), a non-square M, and b = 0 (ULAM_EINVAL: nothing to reduce). */
+ * out of range (ULAM_EINVAL), a non-square M, and b = 0 (ULAM_EINVAL: nothing to reduce); with
+ * walks, also a forward rho(M^) not certified below 1 (ULAM_EINFVAR, before any walk: an
+ * unknown one walks when walk.assume_finite).  The guards come from walk.guard when it holds
+ * rho(|M|) and the forward rho(M^) of this kernel, else they are computed here. */
 int ulam_outer_alloc(const ulam_csr *M, const double *b, const ulam_outer_opts *opts, ulam_outer **out,
                      ulam_error *err);
 
-/* One iteration; fills *step (may be NULL).  ULAM_OK while it may go on or once converged;
+/* One iteration; fills *step (may be NULL).  A walk correction is applied only when it lowers
+ * the residual it was fed; otherwise its walks go on to about N (ratio / 0.5)^2 histories (at
+ * least 4 N) and it is tried again, and when that count exceeds 100 times what the eps1 rule
+ * asked for or max_histories, the run ends with ULAM_ESTALL (step->histories counts every
+ * walk, rejected ones too).  ULAM_OK while it may go on or once converged;
  * then ULAM_ENOCONV at the iteration cap, ULAM_ESTALL when the residual stopped decreasing,
  * ULAM_ENONFINITE for a non-finite residual or walk, ULAM_ENOMEM; each also ends the run. */
 int ulam_outer_iterate(ulam_outer *s, ulam_outer_step *step);
@@ -750,6 +757,14 @@ const double *ulam_outer_x(const ulam_outer *s);
 
 /* Free; accepts and returns NULL. */
 ulam_outer *ulam_outer_free(ulam_outer *s);
+
+/* Why the run ended, as a sentence in err (may be NULL); returns its status (ULAM_OK while it
+ * goes on or once converged). */
+int ulam_outer_error(const ulam_outer *s, ulam_error *err);
+
+/* Corrections rejected so far: a walk correction that did not lower the residual is never
+ * applied; its walks go on to more histories (see ulam_outer_iterate). */
+int ulam_outer_rejected(const ulam_outer *s);
 
 /* Iterate until done into x (n entries); steps (may be NULL) gets up to max_steps records,
  * *nsteps (may be NULL) the iterations run.  Returns the last iterate's status. */
