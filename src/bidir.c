@@ -31,7 +31,7 @@
  * 10^6 R-MAT graph of bench_bidir a step that builds rows cost about 150 operations, README); the
  * target a run stopped by time alone is planned for. */
 enum { PILOT = 256 };
-static const double STEP_COST = 1.0, DEFAULT_REL_ERR = 0.1;
+static const double STEP_COST = 3.0, DEFAULT_REL_ERR = 0.1;
 
 /* The defaults. */
 ulam_bidir_opts ulam_bidir_defaults(void)
@@ -167,19 +167,20 @@ static int push(ulam_push *w, const ulam_bidir_opts *o, const ulam_solver *pl, i
     int64_t n = ulam__push_matrix(w)->nrows;
     double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n, V = plan->mean_visits;
     double rmax = o->rmax > 0 ? o->rmax : 1.0, walks;
+    int fixed = o->walk.rel_err <= 0 && o->walk.max_walks > 0; /* walks known without V */
     int status = ulam_push_run(w, rmax, cap); /* balanced: r = e_t, nothing to push yet */
     for (;;) {
         ulam_push_report(w, &plan->push);
         walks = predicted_walks(o, pl, rmax, V, fmax(delta, fabs(dot_b(p, o))));
-        if (o->rmax > 0 || status || plan->push.support == 0 || walks <= ULAM__REL_MIN ||
+        if (o->rmax > 0 || status || plan->push.support == 0 || (!fixed && walks <= ULAM__REL_MIN) ||
             (double)plan->push.ops >= walks * V * STEP_COST)
-            break; /* at the floor more pushing saves no walks */
+            break; /* at the rule's floor more pushing saves no walks; at a fixed walk count it
+                      lowers their variance instead, and the push may spend what they do */
         rmax /= 2;
         status = ulam_push_run(w, rmax, cap);
     }
     plan->rmax = rmax;
     plan->push_part = dot_b(p, o);
-    int fixed = o->walk.rel_err <= 0 && o->walk.max_walks > 0; /* walks known without V */
     plan->predicted_walks = plan->push.support == 0 ? 0.0 : o->rmax > 0 && !fixed ? NAN : walks;
     return status;
 }
@@ -281,7 +282,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
  * memo: the pilot's guards on Mt and the states it found the walks reach, when it has them, or
  * (reach_all) every state's bounds. */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
-                ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_error *err)
+                ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err)
 {
     ulam_walk_opts wo = walk_opts(o);
     wo.rel_err_offset = push_part;
@@ -303,11 +304,59 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     }
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     ulam_solver_result(sv, wr);
+    ulam_solver_guard(sv, g); /* the walks' guards on Mt: the walk part's certified bound */
     if (status) ulam_solver_error(sv, err);
     if (!k && o->keep_kernel && !status && wo.estimator != ULAM_EXPECTED) memo->kernel = ulam__solver_keep_kernel(sv);
     ulam_solver_free(sv);
     if (k && status) memo->kernel = ulam__kernel_free(k);
     return status;
+}
+
+/* The 95% interval of a mean of n scores with sample mean `mean`, sample variance var and a
+ * certified range R (every score within an interval of width R): the empirical-Bernstein bound
+ * of Maurer and Pontil (COLT 2009, thm 4), two-sided (delta = 0.05 split between the sides):
+ * mean -+ (sqrt(2 var ln(4 / delta) / n) + 7 R ln(4 / delta) / (3 (n - 1))).  Valid at any n,
+ * and never zero-width while R > 0: a sample that saw one value still leaves the range's term.
+ * R not finite (or n < 2): NaN (no interval).  The one home of this interval for the point-source
+ * path: src/stop.c's anytime-valid construction replaces it when merged. */
+static void ulam__bidir_interval(int64_t n, double mean, double var, double R, double out[2])
+{
+    static const double L = 4.382026634673881; /* ln(4 / 0.05) */
+    if (!(n >= 2 && isfinite(R) && R >= 0)) {
+        out[0] = out[1] = NAN;
+        return;
+    }
+    double half = sqrt(2.0 * fmax(var, 0.0) * L / (double)n) + 7.0 * R * L / (3.0 * (double)(n - 1));
+    out[0] = mean - half, out[1] = mean + half;
+}
+
+/* The certified bound D on the walk part: |<r, x>| <= max|r| ||x||_1 <= max|r| ||b||_1 /
+ * (1 - ||M||_1), ||M||_1 the largest row sum of |Mt| (the guards' one-pass bound); INFINITY when
+ * that is not below 1 or was not computed. */
+static double walk_part_bound(const ulam_push_info *push, const ulam_guard *g, const ulam_bidir_opts *o)
+{
+    double c = g ? g->abs.rowsum_max : INFINITY;
+    return g && (g->computed & ULAM_GUARD_ABS) && c < 1.0 ? push->r_max * norm_b(o) / (1.0 - c) : INFINITY;
+}
+
+/* The interval of x_t: with a certified range of one walk's score (the solver's score_bound,
+ * absorption) the empirical-Bernstein interval; without one the normal interval, except that a
+ * sample of one repeated score (the walks saw nothing else: its variance says nothing about what
+ * they missed) gets the certified bound D of the walk part instead; either is clipped to
+ * push_part -+ D.  Never zero-width while a residual is left unless D = 0. */
+static void honest_interval(ulam_bidir_result *res, double D)
+{
+    const ulam_walk_result *w = &res->walks;
+    double lo = res->push_part + w->ci95[0], hi = res->push_part + w->ci95[1];
+    if (w->walks > 0 && isfinite(w->score_bound)) {
+        double ci[2];
+        ulam__bidir_interval(w->walks, w->estimate, w->variance, 2.0 * w->score_bound, ci);
+        lo = res->push_part + ci[0], hi = res->push_part + ci[1];
+    } else if (w->walks > 0 && !(w->variance > 0))
+        lo = res->push_part - D, hi = res->push_part + D; /* NaN-free: D may be INFINITY (no bound) */
+    if (isfinite(D)) lo = fmax(lo, res->push_part - D), hi = fmin(hi, res->push_part + D);
+    if (!isfinite(lo) || !isfinite(hi)) lo = hi = NAN; /* withheld: nothing certifies one */
+    res->ci95[0] = lo, res->ci95[1] = hi;
 }
 
 /* Estimate x_t of (I - M) x = b (e_s or a sparse b). */
@@ -323,12 +372,14 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
     double t0 = ulam_now();
     ulam_push_report(w, &res->push);
     res->push_part = res->plan.push_part;
-    if (res->push.support > 0 && (status = walk(Mt, ulam_push_residuals(w), o, res->push_part, memo, &res->walks, err)))
+    ulam_guard g = {0};
+    if (res->push.support > 0 && (status = walk(Mt, ulam_push_residuals(w), o, res->push_part, memo, &res->walks, &g, err)))
         return status;
     res->estimate = res->push_part + res->walks.estimate;
     res->std_error = res->walks.std_error;
     res->ci95[0] = res->push_part + res->walks.ci95[0];
     res->ci95[1] = res->push_part + res->walks.ci95[1];
+    if (res->push.support > 0) honest_interval(res, walk_part_bound(&res->push, &g, o));
     res->seconds = res->plan.seconds + (ulam_now() - t0);
     return ULAM_OK;
 }
