@@ -855,10 +855,18 @@ typedef struct ulam_bidir_opts {
                              push workspace and rescored to the next query's residual, so a query
                              builds only the rows no earlier one reached (its walks are those a new
                              kernel gives, bit for bit; walks.rows counts every row kept) */
+    double step_cost;     /* push operations one walk visit costs, for the balance (<= 0: the
+                             default ULAM_BIDIR_STEP_COST); measure it on the machine and graph at
+                             hand with bench_bidir, which prints push operations/s over walk
+                             visits/s (docs/bidirectional.md) */
 } ulam_bidir_opts;
 
+/* The balance's default cost of one walk visit in push operations: bench_bidir measured 2.6 to
+ * 3.4 on R-MAT 2^20 and the Zipf family (one thread, 2026-12-02, docs/bidirectional.md). */
+#define ULAM_BIDIR_STEP_COST 3.0
+
 /* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
- * (the default cap), walk ulam_walk_defaults(). */
+ * (the default cap), walk ulam_walk_defaults(), step_cost 0 (ULAM_BIDIR_STEP_COST). */
 ulam_bidir_opts ulam_bidir_defaults(void);
 
 /* A bidirectional estimate's plan (ulam_bidir_plan): the push it runs and what the walks after it
@@ -884,6 +892,8 @@ typedef struct ulam_bidir_plan_info {
     int64_t pilot_units;    /* kernel units (16 bytes of a row) the pilot's solver built on Mt */
     int64_t pilot_reads;    /* entries its reachability checks and score-bound passes read */
     double seconds;         /* wall time of the plan: pilot and push */
+    double probe;           /* a lower bound on |x_t| from 1024 walks scoring the residual midway
+                               (0: no probe ran, or it saw nothing), which the balance plans for */
 } ulam_bidir_plan_info;
 
 /* Plan a bidirectional estimate without its walks: start the push at o->target and, when o->rmax

@@ -26,12 +26,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Pilot walks that measure E[V]; a walk visit's cost in push operations (a push operation reads
- * one nonzero and updates one residual, a step on a built row draws from its alias table; on the
- * 10^6 R-MAT graph of bench_bidir a step that builds rows cost about 150 operations, README); the
- * target a run stopped by time alone is planned for. */
-enum { PILOT = 256 };
-static const double STEP_COST = 3.0, DEFAULT_REL_ERR = 0.1;
+/* Pilot walks that measure E[V]; the target a run stopped by time alone is planned for.  A walk
+ * visit's cost in push operations is ulam_bidir_opts.step_cost (a push operation reads one
+ * nonzero and updates one residual, a step draws from a row's alias table and scores it). */
+enum { PILOT = 256, PROBE = 1024 };
+static const double DEFAULT_REL_ERR = 0.1;
+
+/* The balance's cost of a walk visit in push operations. */
+static double step_cost(const ulam_bidir_opts *o)
+{
+    return o->step_cost > 0 && isfinite(o->step_cost) ? o->step_cost : ULAM_BIDIR_STEP_COST;
+}
 
 /* The defaults. */
 ulam_bidir_opts ulam_bidir_defaults(void)
@@ -112,7 +117,7 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
         return 0;
     return m->Mt == Mt && a->reach_all == b->reach_all && a->target == b->target &&
            (b->nb > 0 || a->source == b->source) && a->rmax == b->rmax && a->min_value == b->min_value &&
-           a->max_push_ops == b->max_push_ops && x->seed == y->seed &&
+           a->max_push_ops == b->max_push_ops && step_cost(a) == step_cost(b) && x->seed == y->seed &&
            x->rel_err == y->rel_err && x->max_walks == y->max_walks && x->continue_q == y->continue_q &&
            x->roulette == y->roulette && x->split == y->split && x->max_steps == y->max_steps &&
            x->force == y->force && x->assume_finite == y->assume_finite && x->guard == y->guard;
@@ -159,21 +164,49 @@ static double predicted_walks(const ulam_bidir_opts *o, const ulam_solver *pilot
     return wo->max_walks > 0 ? fmin(n, (double)wo->max_walks) : n;
 }
 
+static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
+                ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err);
+
+/* A lower bound on |x_t| from a probe: PROBE walks on a seed of their own scoring the residual
+ * as it stands (p_s + their estimate, less two standard errors; 0 when they say nothing).  The
+ * final walks run after the push ends on their own seed, so x_t's estimate stays unbiased. */
+static double probe(const ulam_csr *Mt, ulam_push *w, const ulam_bidir_opts *o, ulam__bidir_memo *memo)
+{
+    ulam_bidir_opts po = *o;
+    po.walk.rel_err = 0, po.walk.max_walks = PROBE, po.walk.max_seconds = 0, po.walk.interrupt = NULL;
+    po.walk.share = NULL, po.walk.threads = 1, po.walk.seed = o->walk.seed ^ UINT64_C(0x3c6ef372fe94f82b);
+    ulam_walk_result wr;
+    ulam_guard g;
+    double part = dot_b(ulam_push_estimates(w), o);
+    if (walk(Mt, ulam_push_residuals(w), &po, part, memo, &wr, &g, NULL) || !(wr.variance > 0)) return 0.0;
+    return fmax(0.0, fabs(part + wr.estimate) - 2.0 * wr.std_error);
+}
+
 /* Push from t: to o->rmax, or halving rmax while the push's work is below the walks' predicted
- * work; the plan's rmax, push and predicted walks filled in. */
-static int push(ulam_push *w, const ulam_bidir_opts *o, const ulam_solver *pl, int64_t cap, ulam_bidir_plan_info *plan)
+ * work; the plan's rmax, push and predicted walks filled in.  The walks are predicted for |x_t|
+ * about xhat = the largest of min_value (1 / n), |p_s| and, once the push has spent what the
+ * rule's floor of walks costs, a probe's lower bound: planning for 1 / n alone over-predicted the
+ * walks a median 2.2x (p90 12x) on the Zipf family of bench_bidir, and the push went on. */
+static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir_memo *memo, const ulam_bidir_opts *o,
+                const ulam_solver *pl, int64_t cap, ulam_bidir_plan_info *plan)
 {
     const double *p = ulam_push_estimates(w);
     int64_t n = ulam__push_matrix(w)->nrows;
-    double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n, V = plan->mean_visits;
-    double rmax = o->rmax > 0 ? o->rmax : 1.0, walks;
+    double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n, V = plan->mean_visits, cost = step_cost(o);
+    double rmax = o->rmax > 0 ? o->rmax : 1.0, walks, seen = 0.0;
     int fixed = o->walk.rel_err <= 0 && o->walk.max_walks > 0; /* walks known without V */
+    int probed = fixed || !(o->walk.rel_err > 0) || o->min_value > 0; /* a given min_value is the plan's */
     int status = ulam_push_run(w, rmax, cap); /* balanced: r = e_t, nothing to push yet */
     for (;;) {
         ulam_push_report(w, &plan->push);
-        walks = predicted_walks(o, pl, rmax, V, fmax(delta, fabs(dot_b(p, o))));
+        walks = predicted_walks(o, pl, rmax, V, fmax(fmax(delta, seen), fabs(dot_b(p, o))));
+        if (!probed && o->rmax <= 0 && !status && plan->push.support > 0 && walks > ULAM__REL_MIN &&
+            (double)plan->push.ops >= ULAM__REL_MIN * V * cost) {
+            probed = 1, seen = probe(Mt, w, o, memo), plan->probe = seen;
+            continue;
+        }
         if (o->rmax > 0 || status || plan->push.support == 0 || (!fixed && walks <= ULAM__REL_MIN) ||
-            (double)plan->push.ops >= walks * V * STEP_COST)
+            (double)plan->push.ops >= walks * V * cost)
             break; /* at the rule's floor more pushing saves no walks; at a fixed walk count it
                       lowers their variance instead, and the push may spend what they do */
         rmax /= 2;
@@ -224,7 +257,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
     ulam_push_start(w, o->target);
     ulam__bidir_memo *memo = ulam__push_memo(w);
     ulam_solver *pl = NULL;
-    plan->target = o->target, plan->balanced = !(o->rmax > 0), plan->mean_visits = 1.0, plan->step_cost = STEP_COST;
+    plan->target = o->target, plan->balanced = !(o->rmax > 0), plan->mean_visits = 1.0, plan->step_cost = step_cost(o);
     memo->have_guard = memo->have_seen = 0;
     if (plan->balanced && !memo->ones) {
         if (!(memo->ones = ulam__malloc((size_t)M->nrows, sizeof *memo->ones)))
@@ -252,14 +285,14 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
             memo->have_seen = 1;
         }
     }
-    status = push(w, o, pl, cap, plan);
+    status = push(w, Mt, memo, o, pl, cap, plan);
     if (pl) ulam__solver_setup(pl, &plan->pilot_units, &plan->pilot_reads);
     ulam_solver_free(pl);
     if (status == ULAM_ENOCONV)
         return ulam__fail(err, status, 0, -1, "a push within %lld operations (is rho(|M|) < 1?)", (long long)cap);
     double pilot_visits = (double)(plan->pilot_walks + plan->pilot_steps);
     plan->predicted_work = plan->balanced || plan->predicted_walks == 0.0
-                               ? (double)plan->push.ops + STEP_COST * (pilot_visits + plan->predicted_walks * plan->mean_visits)
+                               ? (double)plan->push.ops + plan->step_cost * (pilot_visits + plan->predicted_walks * plan->mean_visits)
                                : NAN; /* rmax given: no pilot measured V */
     plan->seconds = ulam_now() - t0;
     if (o->nb > memo->cap) { /* keep b's entries: the options point at the caller's */
@@ -284,6 +317,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
                 ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err)
 {
+    memset(wr, 0, sizeof *wr);
     ulam_walk_opts wo = walk_opts(o);
     wo.rel_err_offset = push_part;
     if (!wo.guard && memo->have_guard) wo.guard = &memo->guard;

@@ -12,7 +12,7 @@
 static const char *const usage =
     "usage: ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R]\n"
     "       ulam solve M.mtx --index I --rhs b.mtx --method bidirectional [--rmax R]\n"
-    "                  [--min-value V] [--estimator collision|absorption|expected] [--walks N]\n"
+    "                  [--min-value V] [--step-cost C] [--estimator collision|absorption|expected] [--walks N]\n"
     "                  [--rel-err E] [--time S] [--seed S] [--threads T] [--continue Q]\n"
     "                  [--max-steps K] [--check] [--json] [--force] [--cache]\n"
     "\n"
@@ -24,7 +24,10 @@ static const char *const usage =
     "\n"
     "  --rmax R           push threshold (default: balance the push's work against the work\n"
     "                     the walks are predicted to need for the target)\n"
-    "  --min-value V      the smallest x_I the balance plans for (default 1 / n)\n"
+    "  --min-value V      the smallest x_I the balance plans for (default 1 / n, raised by a probe\n"
+    "                     of 1024 walks once the push has spent what they cost)\n"
+    "  --step-cost C      push operations one walk visit costs, for the balance (default 3;\n"
+    "                     bench_bidir measures it: docs/bidirectional.md)\n"
     "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
     "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
     "  guards reported are those of the forward kernel\n";
@@ -80,8 +83,9 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
                (long long)w->steps, w->threads);
     if (o->rmax <= 0)
         printf("balance         pilot %lld walks, %.3g visits a walk; %.3g walks predicted at this rmax, "
-               "work %.3g operations predicted in all\n", (long long)r->plan.pilot_walks, r->plan.mean_visits,
-               r->plan.predicted_walks, r->plan.predicted_work);
+               "work %.3g operations predicted in all (a visit %.3g operations; probe's |x| >= %.3g)\n",
+               (long long)r->plan.pilot_walks, r->plan.mean_visits, r->plan.predicted_walks, r->plan.predicted_work,
+               r->plan.step_cost, r->plan.probe);
     printf("seconds         %.4f (push %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
            r->push.seconds, w->seconds, (unsigned long long)o->walk.seed, rp->transpose_seconds);
     printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
@@ -241,6 +245,7 @@ int cli_bidir(int argc, char **argv)
         {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
         {"source", required_argument, 0, 'u'},    {"method", required_argument, 0, 'M'},
         {"rmax", required_argument, 0, 'x'},      {"min-value", required_argument, 0, 'v'},
+        {"step-cost", required_argument, 0, 'k'},
         CLI_WALK_OPTION("estimator"),             CLI_WALK_OPTION("walks"),
         CLI_WALK_OPTION("rel-err"),               CLI_WALK_OPTION("time"),
         CLI_WALK_OPTION("seed"),                  CLI_WALK_OPTION("threads"),
@@ -270,6 +275,7 @@ int cli_bidir(int argc, char **argv)
             break;
         case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &o.rmax))) return rc; break;
         case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &o.min_value))) return rc; break;
+        case 'k': if ((rc = cli_parse_real("solve", "--step-cost", optarg, 1e-3, 1e6, &o.step_cost))) return rc; break;
         case 'c': rp.check = 1; break;
         case 'J': rp.json = 1; break;
         case 'F': force = 1; break;
