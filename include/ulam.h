@@ -861,9 +861,10 @@ typedef struct ulam_bidir_opts {
                              visits/s (docs/bidirectional.md) */
 } ulam_bidir_opts;
 
-/* The balance's default cost of one walk visit in push operations: bench_bidir measured 2.6 to
- * 3.4 on R-MAT 2^20 and the Zipf family (one thread, 2026-12-02, docs/bidirectional.md). */
-#define ULAM_BIDIR_STEP_COST 3.0
+/* The balance's default cost of one walk visit in push operations: the median of bench_bidir's
+ * measurements, 0.74 and 1.29 on the Zipf family and 1.82 on R-MAT 2^18 (one thread, a 2-core
+ * machine at load ~20, 2026-12-02, docs/bidirectional.md); not the 3 issue 29 supposed. */
+#define ULAM_BIDIR_STEP_COST 1.3
 
 /* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
  * (the default cap), walk ulam_walk_defaults(), step_cost 0 (ULAM_BIDIR_STEP_COST). */

@@ -5,16 +5,18 @@
  * = b' (I - M')^-1 r: the adjoint walk solver on M' with right-hand side r, started at s (or at
  * b's state j with probability |b_j| / ||b||_1 and weight sign(b_j) ||b||_1, its start
  * distribution) estimates it, unbiased, with its error bar, threads and stopping rules.  r is
- * fixed before any of those walks runs (the balance below looks only at the push's work and a
- * pilot on its own seed), so <p, b> + estimate is unbiased for x_t.
+ * fixed before any of those walks runs (the balance below looks only at the push's work, a
+ * pilot and a probe on seeds of their own), so <p, b> + estimate is unbiased for x_t.
  *
  * Plan and balance (as BiPPR balances times, here on work counts so the result is
  * reproducible): a collision walk scores at most rmax at each of its V visits, so its variance
  * is about ||b||_1 rmax E[V] x, and the walk solver's rel_err rule needs at least the walks of its
  * range term for scores of rmax a visit (the solver's own bounds over the states the walks
  * reach, taken from the pilot's solver); the walks needed are the largest of those and the
- * rule's floor, each costing E[V] visits.  rmax halves, pushing down to it, while the push's
- * work so far is below the walks' predicted work.  ulam_bidir_plan does this and leaves the
+ * rule's floor, each costing E[V] visits of step_cost push operations.  rmax halves, pushing
+ * down to it, while the push's work so far is below the walks' predicted work (at a fixed walk
+ * count: below what those walks cost), for |x_t| about the largest of min_value, p_s and a
+ * probe's lower bound (see push()).  The interval: honest_interval.  ulam_bidir_plan does this and leaves the
  * pushed workspace with a memo of the plan (push.h), which ulam_bidir_solve reuses for the same
  * options instead of pushing again. */
 #include "internal.h"

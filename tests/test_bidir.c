@@ -621,8 +621,8 @@ static void test_bidir_reach_all(void **state)
  * target whose x_t is nearest 0.0028, 100 walks.  The balance used to stop at rmax = 1 (no push:
  * the 1000-walk floor of the rel_err rule, which a fixed walk count does not have), and a run
  * whose walks missed the target printed 0 +- 0: 18/100 covered.  Now the push spends what the
- * walks do (rmax < 0.01), and over 200 seeds at least 180 collision intervals cover (Bin(200,
- * 0.95) falls below 180 with probability ~0.01; we measured 188), none zero-width; the
+ * walks do (rmax 1/64), and over 200 seeds at least 180 collision intervals cover (Bin(200,
+ * 0.95) falls below 180 with probability about 0.002; we measured 184), none zero-width; the
  * absorption walks' scores have a certified range (score_bound), so theirs is the
  * empirical-Bernstein interval (valid at any n): at least 95 of 100 cover.  With the push
  * forbidden (rmax 2), a sample that saw nothing gets the certified bound of the walk part, never
@@ -662,7 +662,7 @@ static void test_bidir_fixed_walks_honest(void **state)
                       covered, cases[c].seeds, zero, blind);
         assert_int_equal(zero, 0);
         assert_true(covered >= cases[c].need);
-        if (cases[c].rmax == 0) assert_true(rmax < 0.01);
+        if (cases[c].rmax == 0) assert_true(rmax < 0.05); /* pushed: 1/64 at step_cost 1.3 */
         else assert_true(blind > 0); /* some samples saw nothing: the case the bound is for */
     }
     test_case_done();

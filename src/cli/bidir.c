@@ -26,7 +26,7 @@ static const char *const usage =
     "                     the walks are predicted to need for the target)\n"
     "  --min-value V      the smallest x_I the balance plans for (default 1 / n, raised by a probe\n"
     "                     of 1024 walks once the push has spent what they cost)\n"
-    "  --step-cost C      push operations one walk visit costs, for the balance (default 3;\n"
+    "  --step-cost C      push operations one walk visit costs, for the balance (default 1.3;\n"
     "                     bench_bidir measures it: docs/bidirectional.md)\n"
     "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
     "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
