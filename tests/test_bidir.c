@@ -671,6 +671,45 @@ static void test_bidir_fixed_walks_honest(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* Single source, every target (src/fpush.c, issue 29 point 4): on the 5000-node Zipf graph from
+ * source 2 at rel_err 0.1, every component with pi = 0.15 x >= 1/n: the 95% intervals cover the
+ * exact value for at least 90% of them, and the estimates are within 10% for at least 90%; no
+ * interval is zero-width.  Two seeds. */
+static void test_fpush_all_targets(void **state)
+{
+    (void)state;
+    int64_t n = 5000;
+    ulam_csr *M = zipf_graph(n, 2.1, 0.75, 0.85, 1), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = zipf_graph_column(M, 2), *est = malloc((size_t)n * sizeof *est), *se = malloc((size_t)n * sizeof *se);
+    double *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi);
+    for (int seed = 1; seed <= 2; seed++) {
+        if (!test_case(seed)) continue;
+        ulam_fpush_opts o = ulam_fpush_defaults();
+        o.source = 2, o.walk.seed = (uint64_t)seed;
+        ulam_fpush_info info;
+        ulam_error err;
+        assert_int_equal(ulam_fpush_solve(M, Mt, &o, est, se, lo, hi, &info, &err), ULAM_OK);
+        int big = 0, covered = 0, close = 0, zero = 0;
+        for (int64_t i = 0; i < n; i++) {
+            zero += !(hi[i] > lo[i]);
+            if (0.15 * x[i] < 1.0 / (double)n) continue;
+            big++;
+            covered += lo[i] <= x[i] && x[i] <= hi[i];
+            close += fabs(est[i] - x[i]) <= 0.1 * x[i];
+        }
+        print_message("seed %d: rmax %.3g, %lld push ops, %lld walks: %d components with pi >= 1/n, %d covered, %d "
+                      "within 10%%, %d zero-width\n", seed, info.rmax, (long long)info.push.ops, (long long)info.walks, big,
+                      covered, close, zero);
+        assert_true(big >= 20);
+        assert_true(covered >= 0.9 * big && close >= 0.9 * big);
+        assert_int_equal(zero, 0);
+    }
+    test_case_done();
+    free(x), free(est), free(se), free(lo), free(hi);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -680,6 +719,7 @@ int main(void)
         cmocka_unit_test(test_bidir_rules),    cmocka_unit_test(test_bidir_rare_score),
         cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
         cmocka_unit_test(test_bidir_reach_all),  cmocka_unit_test(test_bidir_fixed_walks_honest),
+        cmocka_unit_test(test_fpush_all_targets),
     };
     return test_run(tests);
 }
