@@ -315,13 +315,13 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
                    info.push.r_sum, info.residual_bound);
             printf("walks           %lld (%lld steps)\n", (long long)info.walks, (long long)info.steps);
             printf("seconds         %.4f (push %.4f, walks %.4f)\n", info.seconds, info.push_seconds, info.walk_seconds);
-            printf("%-6s %-10s %-14s %-11s %-25s%s\n", "rank", "index", "estimate", "stderr", "95% CI",
-                   xd ? " direct" : "");
+            printf("%-6s %-10s %-14s %-11s %s\n", "rank", "index", "estimate", "stderr",
+                   xd ? "95% CI                    direct" : "95% CI");
             for (int64_t k = 0; k < top; k++) {
                 int64_t i = order[k];
-                printf("%-6lld %-10lld %-14.8g %-11.3g %-12.6g %-12.6g", (long long)k + 1, (long long)i + 1, x[i], se[i],
+                printf("%-6lld %-10lld %-14.8g %-11.3g %-12.6g %.6g", (long long)k + 1, (long long)i + 1, x[i], se[i],
                        lo[i], hi[i]);
-                if (xd) printf(" %.8g", xd[i]);
+                if (xd) printf("%*s%.8g", 13 - (int)snprintf(NULL, 0, "%.6g", hi[i]), "", xd[i]);
                 printf("\n");
             }
         }
