@@ -245,7 +245,19 @@ for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # cuts at --max-step
 
 
 CASES += [
-    (["radiosity", SC + "cube.obj", "--patch", "1", "--mis", "power"], 2, r"--mis needs --estimator next-event", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "collision", "--mis", "power"], 2,
+     r"--mis needs --estimator next-event", ""),
+    # next-event with MIS is gathering's default: --mis alone applies to it
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--mis", "balance", "--walks", "1000", "--json"], 0, "",
+     r'"estimator": "next-event", "mis": "balance"'),
+    # point queries: the bad forms are refused before any work
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0"], 2, r"--at expects x,y,z or x,y,z,nx,ny,nz", r"^$"),
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0.5,0.5,0,0,0"], 2, r"a nonzero normal", r"^$"),
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0.5,0.5"], 2, r"--at 0.5,0.5,0.5: .*a normal for a sensor", r"^$"),
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0,0.5", "--patch", "1"], 2, r"--at and --grid are point queries", r"^$"),
+    (["radiosity", SC + "cube.obj", "--grid", "0,0.5,0:1,0.6,1:0.1"], 2, r"equal in exactly one coordinate", r"^$"),
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0,0.5", "--walks", "2000"], 0, "",
+     r"point 1 +0.5 0 0.5, normal 0 1 0 \(patch 1, floor\)"),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "next-event", "--mis", "heavy"], 2,
      r"--mis expects power, balance or none", ""),
     (["radiosity", SC + "cube.obj", "--mode", "shoot", "--estimator", "next-event"], 2,
@@ -302,7 +314,7 @@ def check_radiosity_rare_lamp(ulam):
     exact, scene = 0.21981, R + "rare_lamp.obj"
     for seed in range(1, 11):
         rc, out, err = run(ulam, ["radiosity", scene, "--patch", "floor", "--rel-err", "0.05", "--walks", "20000",
-                                  "--json", "--seed", str(seed)])
+                                  "--estimator", "collision", "--json", "--seed", str(seed)])
         assert rc == 0, err
         j = json.loads(out)
         assert j["rel_err_met"] is False and j["min_walks"] > 1e8 and j["walks"] == 20000, (seed, j)

@@ -19,6 +19,7 @@ static const char *const usage =
     "                      [--image out.png] [--size WxH] [--exposure X] [--camera C]\n"
     "                      [--view-gather] [--coverage X]\n"
     "                      [--out patches.csv] [--all] [--list] [--json]\n"
+    "       ulam radiosity SCENE.obj --at x,y,z[,nx,ny,nz] ... [--grid C0:C1:S[:n]] [walk options]\n"
     "\n"
     "Radiosity B = E + diag(rho) F B of a scene of diffuse patches (Wavefront OBJ + MTL: Kd is\n"
     "the reflectance, Ke the emission), per RGB channel.\n"
@@ -30,9 +31,10 @@ static const char *const usage =
     "  --mode gather     walks from the patch that gather emission (default; needs --patch):\n"
     "                    one patch without forming F\n"
     "  --mode shoot      particles from the emitters, tallied on every patch (for --image)\n"
-    "  --estimator E     collision (score at every patch, default) or absorption (where it stops);\n"
-    "                    next-event (gathering by rays): at every patch a walk visits, one shadow\n"
-    "                    ray to a point on an emitter (drawn by power and area)\n"
+    "  --estimator E     next-event (gathering by rays and points, the default there): at every\n"
+    "                    patch or point a walk visits, one shadow ray to a point on an emitter\n"
+    "                    (drawn by power and area); collision (score at every patch; the default\n"
+    "                    for --mode shoot and --matrix-walk) or absorption (where it stops)\n"
     "  --mis H           next-event with the walk's own emitter hits by multiple importance\n"
     "                    sampling: power (default) or balance heuristic; none: light sampling\n"
     "                    alone (infinite variance at a patch sharing an edge with a light)\n"
@@ -51,7 +53,7 @@ static const char *const usage =
     "  --image out.png   render the shooting (or else direct) solution\n"
     "  --view-gather     with --image and --rel-err E: gather only the patches the camera sees,\n"
     "                    each to E (n_max / n)^X on every channel, n its pixels, n_max the most\n"
-    "                    any patch has (--estimator: next-event unless given; --walks: a cap\n"
+    "                    any patch has (--walks: a cap\n"
     "                    per patch, --time: for all)\n"
     "  --coverage X      that exponent, in [0, 1] (default 0.25, the fewest walks for a given\n"
     "                    pixel-summed squared error; 0: every seen patch to E)\n"
@@ -63,7 +65,20 @@ static const char *const usage =
     "  --out FILE.csv    every patch: number, label, face, centroid, area, R G B and standard\n"
     "                    errors (and the direct values with --check or --direct); needs --mode\n"
     "                    shoot or --direct\n"
-    "  --all             print every patch too (a table; with --json a patches array)\n"
+    "  --all             print every patch too (a table; with --json a patches array)\n";
+
+/* The usage's second half (a literal each stays within C99's 4095 characters). */
+static const char *const usage_points =
+    "  --at x,y,z        a point query on the continuous surfaces (no mesh in the answer): the\n"
+    "                    irradiance H arriving there and the radiosity B = E + rho H of the\n"
+    "                    surface it lies on, by walks from the point itself (next-event with MIS\n"
+    "                    at every vertex, Russian roulette); repeat for more points\n"
+    "  --at x,y,z,nx,ny,nz  a sensor facing (nx, ny, nz) anywhere (irradiance only off the surfaces)\n"
+    "  --grid x0,y0,z0:x1,y1,z1:S[:nx,ny,nz]  a sensor grid on a work plane: the rectangle with\n"
+    "                    opposite corners C0 and C1 (equal in one coordinate: the plane), cells\n"
+    "                    of about S (the sensors at their centres), facing + that axis or n;\n"
+    "                    irradiance per point with its error to --out CSV, a false-colour PNG with\n"
+    "                    a scale bar to --image; --walks and --rel-err per point, --time for all\n"
     "  --json            print one JSON object\n"
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
@@ -73,6 +88,12 @@ static const char *const est_names[] = {"collision", "absorption", "next-event"}
 static const char *const mis_names[] = {"power", "balance", "none"};
 static const char *const chan = "RGB";
 
+/* The JSON key of the answer (the radiosity), in one place so that it can be renamed. */
+static const char *const answer_key = "radiosity";
+
+/* Luminance weights of linear Rec. 709 RGB: the illuminance column of a grid. */
+static const double luma[3] = {0.2126, 0.7152, 0.0722};
+
 /* Everything the command was asked. */
 typedef struct {
     const char *scene, *patch, *image, *out;
@@ -81,6 +102,10 @@ typedef struct {
     int direct, check, matrix_walk, json, width, height, all, list;
     int est, mis; /* indices into est_names and mis_names (-1: not given) */
     int view;     /* --view-gather */
+    double *at;   /* --at: 6 per point (the normal NaN when not given) */
+    int nat;
+    int grid;     /* --grid given: g holds it */
+    ulam_rad_grid g;
     double coverage;
     int camera_given; /* --camera: cam holds it */
     ulam_camera cam;
@@ -127,6 +152,69 @@ static int parse_camera(const char *cmd, const char *arg, ulam_camera *cam)
                                 "apart from it, an up not along the view, fov in (0, 180) degrees), got '%s'", arg);
 }
 
+/* Parse n comma-separated finite numbers of s (n of them exactly); 0 or -1. */
+static int parse_numbers(const char *s, int n, double *x)
+{
+    for (int k = 0; k < n; k++) {
+        char *end;
+        x[k] = strtod(s, &end);
+        if (end == s || !isfinite(x[k]) || (k < n - 1 ? *end != ',' : *end != 0)) return -1;
+        s = end + (k < n - 1);
+    }
+    return 0;
+}
+
+/* Parse --at x,y,z[,nx,ny,nz] onto a's list. */
+static int parse_at(const char *cmd, const char *arg, args *a)
+{
+    double x[6];
+    int n = parse_numbers(arg, 6, x) == 0 ? 6 : parse_numbers(arg, 3, x) == 0 ? 3 : 0;
+    if (!n || (n == 6 && !(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] > 0)))
+        return cli_usage_error(cmd, "--at expects x,y,z or x,y,z,nx,ny,nz (finite, a nonzero normal), got '%s'", arg);
+    double *m = realloc(a->at, (size_t)(a->nat + 1) * 6 * sizeof *m);
+    if (!m) return cli_usage_error(cmd, "no memory for --at %s", arg);
+    a->at = m;
+    for (int k = 0; k < 6; k++) m[6 * a->nat + k] = k < n ? x[k] : NAN;
+    a->nat++;
+    return 0;
+}
+
+/* Parse --grid x0,y0,z0:x1,y1,z1:S[:nx,ny,nz]: corners equal in exactly one coordinate. */
+static int parse_grid(const char *cmd, const char *arg, ulam_rad_grid *g)
+{
+    char buf[512];
+    double c0[3], c1[3], S, n[3];
+    char *part[4] = {0};
+    int np = 0;
+    if (strlen(arg) < sizeof buf) {
+        strcpy(buf, arg);
+        for (char *t = strtok(buf, ":"); t && np < 4; t = strtok(NULL, ":")) part[np++] = t;
+    }
+    int ok = (np == 3 || np == 4) && !parse_numbers(part[0], 3, c0) && !parse_numbers(part[1], 3, c1) &&
+             !parse_numbers(part[2], 1, &S) && S > 0 && (np == 3 || !parse_numbers(part[3], 3, n));
+    int flat = -1, eq = 0;
+    for (int k = 0; ok && k < 3; k++)
+        if (c0[k] == c1[k]) flat = k, eq++;
+    if (!ok || eq != 1)
+        return cli_usage_error(cmd, "--grid expects x0,y0,z0:x1,y1,z1:S[:nx,ny,nz], opposite corners of a rectangle "
+                                    "equal in exactly one coordinate (its plane) and a spacing S > 0, got '%s'", arg);
+    int ax[2], m = 0;
+    for (int k = 0; k < 3; k++)
+        if (k != flat) ax[m++] = k;
+    memset(g, 0, sizeof *g);
+    for (int k = 0; k < 3; k++) g->origin[k] = c0[k];
+    g->u[ax[0]] = c1[ax[0]] - c0[ax[0]], g->v[ax[1]] = c1[ax[1]] - c0[ax[1]];
+    double nu = fmax(1.0, round(fabs(g->u[ax[0]]) / S)), nv = fmax(1.0, round(fabs(g->v[ax[1]]) / S));
+    if (nu * nv > ULAM_RAD_GRID_MAX)
+        return cli_usage_error(cmd, "--grid %s makes %.0f x %.0f points, more than %d", arg, nu, nv, ULAM_RAD_GRID_MAX);
+    g->nu = (int)nu, g->nv = (int)nv;
+    double len = 0.0;
+    for (int k = 0; k < 3; k++) g->normal[k] = np == 4 ? n[k] : k == flat, len += g->normal[k] * g->normal[k];
+    if (!(len > 0)) return cli_usage_error(cmd, "--grid: the normal must not be zero, got '%s'", arg);
+    for (int k = 0; k < 3; k++) g->normal[k] /= sqrt(len);
+    return 0;
+}
+
 /* Parse the options into a; 0, or an exit code (with -1 meaning: --help printed). */
 static int parse(int argc, char **argv, args *a)
 {
@@ -144,7 +232,8 @@ static int parse(int argc, char **argv, args *a)
         {"out", required_argument, 0, 'o'},       {"all", no_argument, 0, 'A'},
         {"list", no_argument, 0, 'l'},            {"camera", required_argument, 0, 'C'},
         {"mis", required_argument, 0, 'H'},       {"view-gather", no_argument, 0, 'V'},
-        {"coverage", required_argument, 0, 'G'},
+        {"coverage", required_argument, 0, 'G'},  {"at", required_argument, 0, 'P'},
+        {"grid", required_argument, 0, 'R'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int c, rc, idx;
@@ -185,15 +274,27 @@ static int parse(int argc, char **argv, args *a)
         case 'A': a->all = 1; break;
         case 'l': a->list = 1; break;
         case 'C': if ((rc = parse_camera(cmd, optarg, &a->cam))) return rc; a->camera_given = 1; break;
-        case 'h': fputs(usage, stdout); return -1;
+        case 'P': if ((rc = parse_at(cmd, optarg, a))) return rc; break;
+        case 'R': if ((rc = parse_grid(cmd, optarg, &a->g))) return rc; a->grid = 1; break;
+        case 'h': fputs(usage, stdout), fputs(usage_points, stdout); return -1;
         default: return cli_usage_error(cmd, "unknown option");
         }
     }
     if (optind != argc - 1) return cli_usage_error(cmd, "expects exactly one scene file");
     a->scene = argv[optind];
     if (a->list) return 0;
-    if (a->view && a->est < 0) a->est = 2; /* --view-gather: next-event unless told */
-    if (a->est < 0) a->est = 0;
+    if (a->nat || a->grid) {
+        if (a->patch || a->o.mode != ULAM_ADJOINT || a->direct || a->check || a->matrix_walk || a->view || a->all ||
+            (a->est >= 0 && a->est != 2 && a->est != 0) || ((a->out || a->image) && !a->grid))
+            return cli_usage_error(cmd, "--at and --grid are point queries by gathering walks (no --patch, --mode "
+                                        "shoot, --direct, --check, --matrix-walk, --view-gather, --all, --estimator "
+                                        "absorption; --out and --image with --grid)");
+        a->o.estimator = a->est == 0 ? ULAM_RAD_COLLISION : ULAM_RAD_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
+        if (a->mis >= 0 && a->est == 0) return cli_usage_error(cmd, "--mis needs --estimator next-event");
+        cli_walk_budget(&a->o);
+        return 0;
+    }
+    if (a->est < 0) a->est = a->o.mode == ULAM_FORWARD || a->matrix_walk ? 0 : 2; /* next-event where it applies */
     if (a->view && (!a->image || !(a->o.rel_err > 0) || a->o.mode != ULAM_ADJOINT || a->direct || a->matrix_walk ||
                     a->patch || a->check || a->out || a->all))
         return cli_usage_error(cmd, "--view-gather needs --image and --rel-err, and gathers by rays only (no --mode "
@@ -202,7 +303,9 @@ static int parse(int argc, char **argv, args *a)
     if (a->est == 2 && (a->o.mode != ULAM_ADJOINT || a->matrix_walk))
         return cli_usage_error(cmd, "--estimator next-event is for gathering by rays (not --mode shoot or "
                                     "--matrix-walk)");
-    a->o.estimator = a->est < 2 ? a->est : ULAM_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
+    /* matrix walks take ulam.h's enum, ray walks enum ulam_rad_estimator */
+    a->o.estimator = a->matrix_walk ? a->est : a->est == 0 ? ULAM_RAD_COLLISION : a->est == 1 ? ULAM_RAD_ABSORPTION
+                                                             : ULAM_RAD_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
     if ((a->out || a->all) && a->o.mode == ULAM_ADJOINT && !a->direct)
         return cli_usage_error(cmd, "%s needs --mode shoot or --direct (gathering answers one patch)",
                                a->out ? "--out" : "--all");
@@ -544,7 +647,7 @@ static void print_json(const args *a, const report *r)
     const walked *w = r->w;
     if (w) {
         if (r->patch >= 0) {
-            json_triple("radiosity", w->B);
+            json_triple(answer_key, w->B);
             json_triple("stderr", w->se);
             if (a->matrix_walk) {
                 json_triple("walk_stderr", w->se_walk);
@@ -609,6 +712,195 @@ static void print_json(const args *a, const report *r)
         printf("], ");
     }
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
+}
+
+/* One point's answer as text. */
+static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int interrupted)
+{
+    printf("point %-6d %.6g %.6g %.6g, normal %.4g %.4g %.4g", k + 1, r->x[0], r->x[1], r->x[2], r->n[0], r->n[1],
+           r->n[2]);
+    if (r->patch >= 0) {
+        int32_t g = s->group[r->patch];
+        printf(" (patch %lld, %s)\n", (long long)r->patch + 1, g >= 0 ? s->groups[g] : "unlabelled");
+    } else {
+        printf(" (a sensor on no surface)\n");
+    }
+    for (int c = 0; c < 3; c++) {
+        printf("  irradiance %c %.8g +- %.3g", chan[c], r->irradiance[c], r->irradiance_se[c]);
+        if (r->patch >= 0) printf("   radiosity %c %.8g +- %.3g", chan[c], r->radiosity[c], r->radiosity_se[c]);
+        printf("%s\n", interrupted ? "  [INTERRUPTED]" : "");
+    }
+    printf("  walks      %lld, %lld rays, %.4f s%s\n", (long long)r->run.walks, (long long)r->run.rays, r->run.seconds,
+           r->run.cut ? " (some walks cut at --max-steps: biased low)" : "");
+}
+
+/* One point's answer as a JSON object. */
+static void point_json(const ulam_rad_point *r)
+{
+    printf("{");
+    json_triple("x", r->x);
+    json_triple("normal", r->n);
+    printf("\"patch\": ");
+    if (r->patch >= 0) printf("%lld, ", (long long)r->patch + 1);
+    else printf("null, ");
+    json_triple("irradiance", r->irradiance);
+    json_triple("irradiance_stderr", r->irradiance_se);
+    json_triple(answer_key, r->radiosity); /* null off the surfaces */
+    json_triple("stderr", r->radiosity_se);
+    printf("\"walks\": %lld, \"rays\": %lld, \"cut\": %lld, ", (long long)r->run.walks, (long long)r->run.rays,
+           (long long)r->run.cut);
+    cli_json_number("seconds", r->run.seconds, 1);
+    printf("}");
+}
+
+/* The luminance-weighted irradiance (illuminance in the scene's units) of a point, and a bound
+ * on its standard error (the channels' added: they come from the same walks). */
+static void illuminance(const ulam_rad_point *r, double *Y, double *se)
+{
+    *Y = *se = 0.0;
+    for (int c = 0; c < 3; c++) *Y += luma[c] * r->irradiance[c], *se += luma[c] * r->irradiance_se[c];
+}
+
+/* --grid: the CSV (one row a sensor), atomically; 0 or an exit code. */
+static int write_grid_csv(const char *path, const ulam_rad_grid *g, const ulam_rad_point *pts)
+{
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (!status) {
+        fprintf(o.f, "i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks\n");
+        for (int j = 0; j < g->nv; j++)
+            for (int i = 0; i < g->nu; i++) {
+                const ulam_rad_point *r = &pts[(size_t)j * (size_t)g->nu + (size_t)i];
+                double Y, se;
+                illuminance(r, &Y, &se);
+                fprintf(o.f, "%d,%d,%.17g,%.17g,%.17g", i + 1, j + 1, r->x[0], r->x[1], r->x[2]);
+                for (int c = 0; c < 3; c++) fprintf(o.f, ",%.17g", r->irradiance[c]);
+                for (int c = 0; c < 3; c++) fprintf(o.f, ",%.17g", r->irradiance_se[c]);
+                fprintf(o.f, ",%.17g,%.17g,%lld\n", Y, se, (long long)r->run.walks);
+            }
+        status = ulam_outfile_commit(&o);
+    }
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable output file"};
+    return cli_report(path, &err);
+}
+
+/* --grid --image: the false-colour picture of the illuminance, 0 to the largest; 0 or an exit code. */
+static int write_grid_png(const char *path, const ulam_rad_grid *g, const ulam_rad_point *pts, double *hi)
+{
+    size_t n = (size_t)g->nu * (size_t)g->nv;
+    double *Y = malloc(n * sizeof *Y), se;
+    int cell = g->nu > g->nv ? 480 / g->nu : 480 / g->nv, w, h, status = Y ? ULAM_OK : ULAM_ENOMEM;
+    cell = cell < 2 ? 2 : cell;
+    *hi = 0.0;
+    for (size_t k = 0; Y && k < n; k++) {
+        illuminance(&pts[k], &Y[k], &se);
+        *hi = fmax(*hi, Y[k]);
+    }
+    if (!(*hi > 0)) *hi = 1.0;
+    ulam_falsecolour_size(g->nu, g->nv, cell, &w, &h);
+    unsigned char *rgb = Y ? malloc((size_t)w * (size_t)h * 3) : NULL;
+    if (!status) status = rgb ? ulam_falsecolour(Y, g->nu, g->nv, cell, 0.0, *hi, rgb) : ULAM_ENOMEM;
+    if (!status) status = ulam_png_write(path, w, h, rgb);
+    free(Y), free(rgb);
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable PNG file"};
+    return cli_report(path, &err);
+}
+
+/* --at and --grid: point queries; 0 or an exit code. */
+static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
+{
+    int64_t ngrid = a->grid ? (int64_t)a->g.nu * a->g.nv : 0, n = a->nat + ngrid;
+    ulam_rad_point *pts = calloc((size_t)n, sizeof *pts);
+    ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the points"};
+    if (!pts) return cli_report(a->scene, &err);
+    int rc = 0, interrupted = 0;
+    double t0 = ulam_now();
+    cli_catch_sigint();
+    for (int k = 0; k < a->nat && !interrupted; k++) {
+        ulam_walk_opts o = a->o;
+        o.seed = a->o.seed + (uint64_t)k; /* each point its own walks */
+        const double *x = a->at + 6 * k;
+        if (ulam_rad_point_query(t, &o, x, isnan(x[3]) ? NULL : x + 3, &pts[k], &err)) {
+            fprintf(stderr, "ulam radiosity: --at %g,%g,%g: %s: %s\n", x[0], x[1], x[2], ulam_strerror(err.status),
+                    err.msg);
+            rc = err.status == ULAM_EINVAL ? EXIT_USAGE : cli_exit_code(err.status); /* the point itself */
+            goto done;
+        }
+        interrupted = pts[k].run.interrupted;
+    }
+    if (ngrid && !interrupted) {
+        if (ulam_rad_grid_solve(t, &a->o, &a->g, pts + a->nat, &err)) {
+            rc = cli_report(a->scene, &err);
+            goto done;
+        }
+        for (int64_t k = a->nat; k < n; k++) interrupted |= pts[k].run.interrupted || !pts[k].run.walks;
+    }
+    double seconds = ulam_now() - t0, hi = 0.0;
+    cli_release_sigint();
+    if (ngrid && !interrupted && a->out && (rc = write_grid_csv(a->out, &a->g, pts + a->nat))) goto done;
+    if (ngrid && !interrupted && a->image && (rc = write_grid_png(a->image, &a->g, pts + a->nat, &hi))) goto done;
+    double Ymin = INFINITY, Ysum = 0.0, worst = 0.0;
+    int64_t walks = 0, rays = 0;
+    for (int64_t k = 0; k < n; k++) {
+        walks += pts[k].run.walks, rays += pts[k].run.rays;
+        if (k < a->nat) continue;
+        double Y, se;
+        illuminance(&pts[k], &Y, &se);
+        Ymin = fmin(Ymin, Y), Ysum += Y;
+        if (Y > 0) worst = fmax(worst, se / Y);
+    }
+    if (a->json) {
+        printf("{");
+        cli_json_string("scene", a->scene, 0);
+        printf("\"points\": [");
+        for (int k = 0; k < a->nat; k++) {
+            if (k) printf(", ");
+            point_json(&pts[k]);
+        }
+        printf("], ");
+        if (ngrid) {
+            printf("\"grid\": {\"nu\": %d, \"nv\": %d, ", a->g.nu, a->g.nv);
+            json_triple("origin", a->g.origin), json_triple("u", a->g.u), json_triple("v", a->g.v);
+            json_triple("normal", a->g.normal);
+            cli_json_number("illuminance_min", Ymin, 0);
+            cli_json_number("illuminance_mean", Ysum / (double)ngrid, 0);
+            cli_json_number("uniformity", Ysum > 0 ? Ymin / (Ysum / (double)ngrid) : NAN, 0);
+            cli_json_number("worst_rel_stderr_bound", worst, 0);
+            if (a->out) cli_json_string("out", interrupted ? "" : a->out, 0);
+            if (a->image) cli_json_string("image", interrupted ? "" : a->image, 0);
+            printf("\"points\": [");
+            for (int64_t k = a->nat; k < n; k++) {
+                if (k > a->nat) printf(", ");
+                point_json(&pts[k]);
+            }
+            printf("]}, ");
+        }
+        cli_json_string("estimator", a->o.estimator == ULAM_RAD_COLLISION ? "collision" : "next-event", 0);
+        printf("\"walks\": %lld, \"rays\": %lld, \"interrupted\": %s, ", (long long)walks, (long long)rays,
+               interrupted ? "true" : "false");
+        cli_json_number("seconds", seconds, 0);
+        printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
+    } else {
+        printf("scene        %s: %lld patches\n", a->scene, (long long)s->npatches);
+        for (int k = 0; k < a->nat; k++) point_text(s, k, &pts[k], pts[k].run.interrupted);
+        if (ngrid)
+            printf("grid         %d x %d sensors facing %.4g %.4g %.4g: illuminance (0.2126 R + 0.7152 G + 0.0722 B)\n"
+                   "             min %.6g, mean %.6g, uniformity min/mean %.4f; worst relative error <= %.3g\n",
+                   a->g.nu, a->g.nv, a->g.normal[0], a->g.normal[1], a->g.normal[2], Ymin, Ysum / (double)ngrid,
+                   Ysum > 0 ? Ymin / (Ysum / (double)ngrid) : NAN, worst);
+        if (ngrid && a->out && !interrupted) printf("grid csv     %s\n", a->out);
+        if (ngrid && a->image && !interrupted) printf("grid image   %s (false colour, 0 .. %.4g)\n", a->image, hi);
+        printf("walks        %lld point walks (%s), %lld rays, %.4f s%s\n", (long long)walks,
+               a->o.estimator == ULAM_RAD_COLLISION ? "collision" : "next-event with MIS", (long long)rays, seconds,
+               interrupted ? "  [INTERRUPTED]" : "");
+    }
+    if (interrupted) rc = EXIT_INTERRUPTED;
+done:
+    cli_release_sigint();
+    free(pts);
+    return rc;
 }
 
 /* The camera asked for, or the one framing the scene. */
@@ -750,7 +1042,10 @@ int cli_radiosity(int argc, char **argv)
     a.o.max_walks = 0;
     a.o.interrupt = &cli_interrupted, a.o.share = cli_share;
     int rc = parse(argc, argv, &a);
-    if (rc) return rc < 0 ? 0 : rc;
+    if (rc) {
+        free(a.at);
+        return rc < 0 ? 0 : rc;
+    }
     ulam_scene *s = NULL;
     ulam_tracer *t = NULL;
     ulam_csr *F = NULL;
@@ -782,6 +1077,10 @@ int cli_radiosity(int argc, char **argv)
         fprintf(stderr, "ulam radiosity: warning: %s: patch %lld is only %.0f float steps across where it lies: ray "
                         "casting resolves it to %.2g of its size (move the scene's parts closer together)\n",
                 a.scene, (long long)coarse + 1, 1.0 / res, res);
+    if (a.nat || a.grid) {
+        rc = run_points(&a, t, s);
+        goto done;
+    }
     if ((a.direct || a.check || a.matrix_walk) && (rc = form_and_solve(&a, t, s, &r, &F, &Bd))) goto done;
     if (a.view) {
         if ((rc = view_walks(&a, t, s, &w, &r.view))) goto done;
@@ -805,7 +1104,7 @@ int cli_radiosity(int argc, char **argv)
     else print_text(&a, &r);
     if (w.interrupted) rc = EXIT_INTERRUPTED;
 done:
-    free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all);
+    free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all), free(a.at);
     ulam_csr_free(F);
     ulam_tracer_free(t);
     ulam_scene_free(s);

@@ -223,14 +223,29 @@ void ulam__tracer_point(const ulam_tracer *t, int64_t p, ulam_rng *r, double pt[
  * front and meets no other patch first; *h gets the distance and the two cosines either way. */
 int ulam__tracer_sees(const ulam_tracer *t, int64_t p, const double x[3], int64_t l, const double y[3], ulam__hit *h)
 {
+    return ulam__tracer_sees_from(t, x, t->s->normal + 3 * p, p, l, y, h);
+}
+
+/* The same from a point x with unit normal n on patch self (-1: a point on no patch). */
+int ulam__tracer_sees_from(const ulam_tracer *t, const double x[3], const double n[3], int64_t self, int64_t l,
+                           const double y[3], ulam__hit *h)
+{
     double d[3];
     ulam__sub3(y, x, d);
     double r = sqrt(ulam__dot3(d, d));
     h->dist = r, h->cos_from = h->cos_to = 0.0;
     if (!(r > 0)) return 0;
     for (int k = 0; k < 3; k++) d[k] /= r;
-    h->cos_from = ulam__dot3(d, t->s->normal + 3 * p);
+    h->cos_from = ulam__dot3(d, n);
     h->cos_to = -ulam__dot3(d, t->s->normal + 3 * l);
-    if (!(h->cos_from > 0) || !(h->cos_to > 0) || p == l) return 0; /* from a back side, or at a light's back */
-    return cast_from(t, x, d, p, 0, NULL, NULL) == l;
+    if (!(h->cos_from > 0) || !(h->cos_to > 0) || self == l) return 0; /* from a back side, or at a light's back */
+    return cast_from(t, x, d, self, 0, NULL, NULL) == l;
+}
+
+/* The ray org + t dir (dir unit) from a point on patch self (-1: none): the first other patch it
+ * hits (-1: none), *front 1 when on its front, *dist the distance. */
+int64_t ulam__tracer_ray(const ulam_tracer *t, const double org[3], const double dir[3], int64_t self, int *front,
+                         double *dist)
+{
+    return cast_from(t, org, dir, self, 0, front, dist);
 }

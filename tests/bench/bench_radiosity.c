@@ -89,7 +89,7 @@ static int64_t beside_light(const ulam_scene *s)
     return best;
 }
 
-static const int ests[4] = {ULAM_COLLISION, ULAM_NEXT_EVENT, ULAM_NEXT_EVENT_BALANCE, ULAM_NEXT_EVENT_LIGHT};
+static const int ests[4] = {ULAM_RAD_COLLISION, ULAM_RAD_NEXT_EVENT, ULAM_RAD_NEXT_EVENT_BALANCE, ULAM_RAD_NEXT_EVENT_LIGHT};
 static const char *const est_name[4] = {"collision", "next-event MIS power", "next-event MIS balance",
                                         "next-event light only"};
 
@@ -135,7 +135,7 @@ int main(int argc, char **argv)
         ulam_tracer *t = NULL;
         int64_t p = 0;
         if (!s || ulam_tracer_alloc(s, &t, &err) || ulam_scene_find(s, "floor", &p)) return 1;
-        ulam_rad_result c = gather(t, ULAM_COLLISION, p, 0.01, 0), e = gather(t, ULAM_NEXT_EVENT, p, 0.01, 0);
+        ulam_rad_result c = gather(t, ULAM_RAD_COLLISION, p, 0.01, 0), e = gather(t, ULAM_RAD_NEXT_EVENT, p, 0.01, 0);
         printf("| %lld | %.3f | %lld | %.4f | %lld | %.1f | %.1f |", (long long)s->npatches, c.seconds,
                (long long)c.rays, e.seconds, (long long)e.rays, (double)c.rays / (double)e.rays, c.seconds / e.seconds);
         size_t bytes = ulam_direct_bytes(s->npatches);
@@ -183,7 +183,7 @@ int main(int argc, char **argv)
     double *B = malloc((size_t)(3 * n) * sizeof *B), *se = malloc((size_t)(3 * n) * sizeof *se);
     double *Bs = malloc((size_t)(3 * n) * sizeof *Bs), *ses = malloc((size_t)(3 * n) * sizeof *ses);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_NEXT_EVENT, o.max_walks = 0, o.rel_err = 0.01, o.seed = 1;
+    o.estimator = ULAM_RAD_NEXT_EVENT, o.max_walks = 0, o.rel_err = 0.01, o.seed = 1;
     ulam_view_info vi;
     if (!B || !se || !Bs || !ses || ulam_view_gather(t, &cam, W, H, 0.0, &o, B, se, &vi, &err)) return 1;
     ulam_walk_opts so = ulam_walk_defaults();

@@ -1,0 +1,271 @@
+/* Point queries on the continuous surfaces (src/radiosity/point.c) and sensor grids: the
+ * irradiance at a point against Howell's closed forms (a differential planar element to a
+ * parallel rectangle and to a rectangle in a perpendicular plane, signed corner sums for
+ * points beside the emitter), the furnace (B = E / (1 - rho) at every point and every sensor),
+ * 95% intervals counted over 100 seeds with a binomial bound, the options refused, and the
+ * grid's points and picture.  Fixed seeds; tolerances from the reported standard errors. */
+#include "testutil.h"
+#include "ulam_radiosity.h"
+
+#include <string.h>
+
+/* Howell: element whose normal passes through a corner of a parallel a x b rectangle at c. */
+static double howell_parallel(double a, double b, double c)
+{
+    double A = a / c, B = b / c, sa = sqrt(1 + A * A), sb = sqrt(1 + B * B);
+    return (A / sa * atan(B / sa) + B / sb * atan(A / sb)) / (2 * M_PI);
+}
+
+/* Howell: element at distance c from the edge of an a (height) x b rectangle in a perpendicular
+ * plane, in front of its corner. */
+static double howell_perpendicular(double a, double b, double c)
+{
+    double X = a / b, Y = c / b, r = sqrt(X * X + Y * Y);
+    return (atan(1 / Y) - Y / r * atan(1 / r)) / (2 * M_PI);
+}
+
+/* The signed corner term of a parallel rectangle reaching u, v from the foot of the normal. */
+static double par_corner(double u, double v, double c)
+{
+    if (u == 0 || v == 0) return 0.0;
+    return copysign(1.0, u) * copysign(1.0, v) * howell_parallel(fabs(u), fabs(v), c);
+}
+
+/* Form factor from (px, py) facing up to the lamp [x0, x1] x [y0, y1] at height c facing down. */
+static double parallel_at(double px, double py, double x0, double x1, double y0, double y1, double c)
+{
+    return par_corner(x1 - px, y1 - py, c) - par_corner(x0 - px, y1 - py, c) - par_corner(x1 - px, y0 - py, c) +
+           par_corner(x0 - px, y0 - py, c);
+}
+
+/* Form factor from floor point (px, py) to the unit lamp x in [0, 1], z in [0, 1] at y = 0. */
+static double perpendicular_at(double px, double py)
+{
+    double u1 = 1 - px, u0 = -px;
+    double f1 = u1 == 0 ? 0 : copysign(howell_perpendicular(1, fabs(u1), py), u1);
+    double f0 = u0 == 0 ? 0 : copysign(howell_perpendicular(1, fabs(u0), py), u0);
+    return f1 - f0;
+}
+
+/* A scene and its tracer that must build. */
+static ulam_tracer *must_load(const char *path, ulam_scene **s)
+{
+    ulam_error err;
+    int st = ulam_scene_read_obj(path, s, &err);
+    if (st) print_error("%s:%ld: %s\n", path, err.line, err.msg);
+    assert_int_equal(st, ULAM_OK);
+    ulam_tracer *t = NULL;
+    assert_int_equal(ulam_tracer_alloc(*s, &t, NULL), ULAM_OK);
+    return t;
+}
+
+/* A point query that must run: walks walks (or rel_err), estimator est. */
+static ulam_rad_point query(const ulam_tracer *t, const double x[3], const double *n, int est, int64_t walks,
+                            double rel_err, uint64_t seed)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.estimator = est, o.max_walks = walks, o.rel_err = rel_err, o.seed = seed, o.threads = 2;
+    ulam_rad_point r;
+    ulam_error err;
+    int st = ulam_rad_point_query(t, &o, x, n, &r, &err);
+    if (st) print_error("%s: %s\n", ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    return r;
+}
+
+/* Every channel of r's irradiance against exact within 4 standard errors (and the error bar
+ * small enough for the check to mean something); the radiosity B = E + rho H on a grey floor. */
+static void check_point(const ulam_rad_point *r, double exact, double rho, const char *what)
+{
+    print_message("%s: H %.6f +- %.2g, exact %.6f, z %+.2f (%lld walks, %lld rays)\n", what, r->irradiance[0],
+                  r->irradiance_se[0], exact, (r->irradiance[0] - exact) / r->irradiance_se[0],
+                  (long long)r->run.walks, (long long)r->run.rays);
+    for (int c = 0; c < 3; c++) {
+        assert_true(r->irradiance_se[c] > 0 && r->irradiance_se[c] < 0.02 * exact);
+        assert_close(r->irradiance[c], exact, 4 * r->irradiance_se[c]);
+        if (r->patch >= 0) assert_close(r->radiosity[c], rho * r->irradiance[c], 1e-12);
+    }
+}
+
+/* Floor points under, inside and beside a parallel lamp, and a sensor in the air. */
+static void test_point_parallel(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
+    const double pts[6][2] = {{0, 0}, {0.5, 1}, {0.9, 0.1}, {-0.5, 1}, {1.5, -0.5}, {0.5, 2.02}}; /* last: beside an edge */
+    for (int k = 0; k < 6; k++) {
+        double x[3] = {pts[k][0], pts[k][1], 0}, exact = parallel_at(x[0], x[1], 0, 1, 0, 2, 1);
+        for (int est = ULAM_RAD_NEXT_EVENT; est <= ULAM_RAD_COLLISION; est += est == ULAM_RAD_NEXT_EVENT ? 3 : 1) {
+            ulam_rad_point r = query(t, x, NULL, est, est == ULAM_RAD_COLLISION ? 200000 : 40000, 0, 10 + (uint64_t)k);
+            assert_int_equal(r.patch, 1);
+            check_point(&r, exact, 0.5, est == ULAM_RAD_COLLISION ? "parallel, collision" : "parallel, next-event");
+        }
+    }
+    /* a sensor off the surfaces, half way up, facing the lamp: the same law at c = 0.5 */
+    double x[3] = {0.25, 0.5, 0.5}, n[3] = {0, 0, 2};
+    ulam_rad_point r = query(t, x, n, ULAM_RAD_NEXT_EVENT, 40000, 0, 3);
+    assert_int_equal(r.patch, -1);
+    assert_true(isnan(r.radiosity[0]));
+    check_point(&r, parallel_at(0.25, 0.5, 0, 1, 0, 2, 0.5), 0, "parallel, sensor in the air");
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* Floor points in front of a perpendicular lamp, at its corner, beside it, and 0.02 from the
+ * edge it stands on (where G / p_L ~ 1 / r^2 and only MIS keeps the variance finite). */
+static void test_point_perpendicular(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_perpendicular.obj", &s);
+    const double pts[5][2] = {{0, 0.5}, {0.5, 0.5}, {-0.5, 0.3}, {1.2, 1.5}, {0.5, 0.02}};
+    for (int k = 0; k < 5; k++) {
+        double x[3] = {pts[k][0], pts[k][1], 0};
+        ulam_rad_point r = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, 40000, 0, 20 + (uint64_t)k);
+        check_point(&r, perpendicular_at(x[0], x[1]), 0.5, "perpendicular, next-event");
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* The furnace: H = B = E / (1 - rho) at points on faces, near an edge and a corner, and for a
+ * tilted sensor in the air; walks of several bounces. */
+static void test_point_furnace(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/furnace_half.obj", &s);
+    const double B[3] = {2.0, 1.5, 0.4 / 0.3};
+    const double pts[4][3] = {{0.5, 0.5, 0}, {0.01, 0.99, 0}, {1, 0.3, 0.999}, {0.3, 0.2, 0.7}};
+    for (int k = 0; k < 4; k++) {
+        double n[3] = {1, 2, 3};
+        ulam_rad_point r = query(t, pts[k], k == 3 ? n : NULL, ULAM_RAD_NEXT_EVENT, 20000, 0, 40 + (uint64_t)k);
+        assert_true(r.run.rays > 3 * r.run.walks); /* several bounces */
+        for (int c = 0; c < 3; c++) {
+            print_message("furnace point %d %c: H %.5f +- %.2g (exact %.5f)\n", k, "RGB"[c], r.irradiance[c],
+                          r.irradiance_se[c], B[c]);
+            assert_true(r.irradiance_se[c] < 0.01 * B[c]);
+            assert_close(r.irradiance[c], B[c], 4 * r.irradiance_se[c]);
+            if (k < 3) assert_close(r.radiosity[c], B[c], 4 * r.radiosity_se[c]);
+        }
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* 95% intervals over 100 seeds, 200 walks each (small: the variance estimate itself is noisy),
+ * at the hard point 0.02 from the perpendicular lamp's edge, and at rel_err 0.05 (a stopping
+ * rule) on the parallel lamp: at least 88 of 100 cover (P(Binomial(100, 0.95) < 88) < 0.002). */
+static void test_point_coverage(void **state)
+{
+    (void)state;
+    const char *scene[2] = {"tests/data/rad/point_perpendicular.obj", "tests/data/rad/point_parallel.obj"};
+    for (int m = 0; m < 2; m++) {
+        ulam_scene *s = NULL;
+        ulam_tracer *t = must_load(scene[m], &s);
+        double x[3] = {0.5, m ? 1.0 : 0.02, 0}, exact = m ? parallel_at(0.5, 1, 0, 1, 0, 2, 1) : perpendicular_at(0.5, 0.02);
+        int inside = 0;
+        for (uint64_t seed = 0; seed < 100; seed++) {
+            ulam_rad_point r = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, m ? 0 : 200, m ? 0.05 : 0, 1000 + seed);
+            inside += fabs(r.irradiance[0] - exact) <= 1.96 * r.irradiance_se[0];
+        }
+        print_message("%s: %d of 100 intervals cover (%s)\n", scene[m], inside, m ? "rel_err 0.05" : "200 walks");
+        assert_true(inside >= 88);
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
+}
+
+/* Bad points and options are refused with ULAM_EINVAL and a message. */
+static void test_point_refused(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.max_walks = 100;
+    ulam_rad_solver *sv = NULL;
+    ulam_error err;
+    double air[3] = {0.5, 0.5, 0.5}, floor_pt[3] = {0.5, 0.5, 0}, down[3] = {0, 0, -1}, zero[3] = {0, 0, 0};
+    double bad[3] = {NAN, 0, 0};
+    assert_int_equal(ulam_rad_point_alloc(t, &o, air, NULL, &sv, &err), ULAM_EINVAL); /* on no patch, no normal */
+    assert_non_null(strstr(err.msg, "normal"));
+    assert_int_equal(ulam_rad_point_alloc(t, &o, floor_pt, down, &sv, &err), ULAM_EINVAL); /* not the floor's */
+    assert_int_equal(ulam_rad_point_alloc(t, &o, air, zero, &sv, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_rad_point_alloc(t, &o, bad, NULL, &sv, &err), ULAM_EINVAL);
+    o.estimator = ULAM_RAD_ABSORPTION;
+    assert_int_equal(ulam_rad_point_alloc(t, &o, floor_pt, NULL, &sv, &err), ULAM_EINVAL);
+    o.estimator = ULAM_RAD_NEXT_EVENT, o.mode = ULAM_FORWARD;
+    assert_int_equal(ulam_rad_point_alloc(t, &o, floor_pt, NULL, &sv, &err), ULAM_EINVAL);
+    assert_null(sv);
+    o.mode = ULAM_ADJOINT;
+    assert_int_equal(ulam_rad_point_alloc(t, &o, floor_pt, NULL, &sv, &err), ULAM_OK);
+    ulam_rad_point r;
+    assert_int_equal(ulam_rad_point_result(sv, &r), ULAM_OK);
+    assert_int_equal(r.run.walks, 0);
+    sv = ulam_rad_solver_free(sv);
+    o.index = 1; /* a patch solver has no point result */
+    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_OK);
+    assert_int_equal(ulam_rad_point_result(sv, &r), ULAM_EINVAL);
+    ulam_rad_solver_free(sv);
+    /* the default estimator of a patch walk is next-event now, and shooting refuses it */
+    assert_int_equal(ulam_walk_defaults().estimator, ULAM_RAD_NEXT_EVENT);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* A 4 x 3 grid on the floor under the parallel lamp: every sensor against Howell, each with its
+ * own seed (a point's answer does not depend on the grid), and the false-colour picture. */
+static void test_grid(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
+    ulam_rad_grid g = {.origin = {-1, -0.5, 0}, .u = {3, 0, 0}, .v = {0, 3, 0}, .normal = {0, 0, 1}, .nu = 4, .nv = 3};
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.rel_err = 0.02, o.max_walks = 0, o.seed = 5, o.threads = 2;
+    ulam_rad_point pts[12];
+    ulam_error err;
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &g, pts, &err), ULAM_OK);
+    double Y[12];
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 4; i++) {
+            const ulam_rad_point *r = &pts[j * 4 + i];
+            double x[3];
+            ulam_rad_grid_point(&g, i, j, x);
+            assert_close(x[0], -1 + 0.75 * (2 * i + 1) / 2.0 * 1.0, 1e-12);
+            assert_close(r->x[1], -0.5 + (j + 0.5), 1e-12);
+            check_point(r, parallel_at(x[0], x[1], 0, 1, 0, 2, 1), 0.5, "grid");
+            assert_true(r->irradiance_se[0] <= 0.02 * r->irradiance[0]);
+            Y[j * 4 + i] = r->irradiance[1];
+        }
+    g.nu = 0;
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &g, pts, &err), ULAM_EINVAL);
+    g.nu = 4, g.normal[2] = 2;
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &g, pts, &err), ULAM_EINVAL);
+    int w, h;
+    ulam_falsecolour_size(4, 3, 10, &w, &h);
+    unsigned char *rgb = malloc((size_t)w * (size_t)h * 3);
+    assert_int_equal(ulam_falsecolour(Y, 4, 3, 10, 0, 0.4, rgb), ULAM_OK);
+    /* the brightest cell is red-ish, the darkest blue-ish; cell (i, j) at rows from the top */
+    int hi = 0, lo = 0;
+    for (int k = 1; k < 12; k++) hi = Y[k] > Y[hi] ? k : hi, lo = Y[k] < Y[lo] ? k : lo;
+    const unsigned char *ph = rgb + 3 * ((size_t)((2 - hi / 4) * 10 + 5) * (size_t)w + (size_t)(hi % 4) * 10 + 5);
+    const unsigned char *pl = rgb + 3 * ((size_t)((2 - lo / 4) * 10 + 5) * (size_t)w + (size_t)(lo % 4) * 10 + 5);
+    assert_true(ph[0] > ph[2] && pl[2] > pl[0]);
+    assert_int_equal(ulam_falsecolour(Y, 4, 3, 10, 1, 1, rgb), ULAM_EINVAL);
+    free(rgb);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_point_parallel), cmocka_unit_test(test_point_perpendicular),
+        cmocka_unit_test(test_point_furnace),  cmocka_unit_test(test_point_coverage),
+        cmocka_unit_test(test_point_refused),  cmocka_unit_test(test_grid),
+    };
+    return test_run(tests);
+}
