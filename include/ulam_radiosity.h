@@ -351,14 +351,14 @@ typedef struct ulam_view_info {
 int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, int height, double coverage,
                      const ulam_walk_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err);
 
-/* The size of ulam_falsecolour's picture of an nu x nv grid of cell-pixel squares (the scale
- * bar and its labels to the right). */
-void ulam_falsecolour_size(int nu, int nv, int cell, int *width, int *height);
+/* The size of ulam_falsecolour's picture of an nu x nv grid of cells of cw x ch pixels (the
+ * scale bar and its labels to the right). */
+void ulam_falsecolour_size(int nu, int nv, int cw, int ch, int *width, int *height);
 
 /* A false-colour picture of grid values v (v[j nu + i], row j = 0 at the bottom; NaN: grey)
- * from lo (blue) to hi (red), with a labelled scale bar, into rgb (3 bytes a pixel of
+ * from lo (blue) to hi (red) in cells of cw x ch pixels, with a labelled scale bar, into rgb (3 bytes a pixel of
  * ulam_falsecolour_size, rows top first); ULAM_EINVAL unless lo < hi are finite. */
-int ulam_falsecolour(const double *v, int nu, int nv, int cell, double lo, double hi, unsigned char *rgb);
+int ulam_falsecolour(const double *v, int nu, int nv, int cw, int ch, double lo, double hi, unsigned char *rgb);
 
 /* Write an 8-bit RGB image as PNG (libpng), atomically. */
 int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb);

@@ -245,16 +245,16 @@ static void test_grid(void **state)
     g.nu = 4, g.normal[2] = 2;
     assert_int_equal(ulam_rad_grid_solve(t, &o, &g, pts, &err), ULAM_EINVAL);
     int w, h;
-    ulam_falsecolour_size(4, 3, 10, &w, &h);
+    ulam_falsecolour_size(4, 3, 10, 10, &w, &h);
     unsigned char *rgb = malloc((size_t)w * (size_t)h * 3);
-    assert_int_equal(ulam_falsecolour(Y, 4, 3, 10, 0, 0.4, rgb), ULAM_OK);
+    assert_int_equal(ulam_falsecolour(Y, 4, 3, 10, 10, 0, 0.4, rgb), ULAM_OK);
     /* the brightest cell is red-ish, the darkest blue-ish; cell (i, j) at rows from the top */
     int hi = 0, lo = 0;
     for (int k = 1; k < 12; k++) hi = Y[k] > Y[hi] ? k : hi, lo = Y[k] < Y[lo] ? k : lo;
     const unsigned char *ph = rgb + 3 * ((size_t)((2 - hi / 4) * 10 + 5) * (size_t)w + (size_t)(hi % 4) * 10 + 5);
     const unsigned char *pl = rgb + 3 * ((size_t)((2 - lo / 4) * 10 + 5) * (size_t)w + (size_t)(lo % 4) * 10 + 5);
     assert_true(ph[0] > ph[2] && pl[2] > pl[0]);
-    assert_int_equal(ulam_falsecolour(Y, 4, 3, 10, 1, 1, rgb), ULAM_EINVAL);
+    assert_int_equal(ulam_falsecolour(Y, 4, 3, 10, 10, 1, 1, rgb), ULAM_EINVAL);
     free(rgb);
     ulam_tracer_free(t);
     ulam_scene_free(s);

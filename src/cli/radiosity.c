@@ -76,7 +76,8 @@ static const char *const usage_points =
     "  --at x,y,z,nx,ny,nz  a sensor facing (nx, ny, nz) anywhere (irradiance only off the surfaces)\n"
     "  --grid x0,y0,z0:x1,y1,z1:S[:nx,ny,nz]  a sensor grid on a work plane: the rectangle with\n"
     "                    opposite corners C0 and C1 (equal in one coordinate: the plane), cells\n"
-    "                    of about S (the sensors at their centres), facing + that axis or n;\n"
+    "                    of about S, or S = NUxNV cells (the sensors at their centres), facing\n"
+    "                    + that axis or n;\n"
     "                    irradiance per point with its error to --out CSV, a false-colour PNG with\n"
     "                    a scale bar to --image; --walks and --rel-err per point, --time for all\n"
     "  --json            print one JSON object\n"
@@ -183,28 +184,33 @@ static int parse_at(const char *cmd, const char *arg, args *a)
 static int parse_grid(const char *cmd, const char *arg, ulam_rad_grid *g)
 {
     char buf[512];
-    double c0[3], c1[3], S, n[3];
+    double c0[3], c1[3], S = 1.0, n[3];
     char *part[4] = {0};
     int np = 0;
     if (strlen(arg) < sizeof buf) {
         strcpy(buf, arg);
         for (char *t = strtok(buf, ":"); t && np < 4; t = strtok(NULL, ":")) part[np++] = t;
     }
+    int cu = 0, cv = 0, used = 0; /* S may be counts NUxNV instead of a spacing */
+    int counts = np >= 3 && sscanf(part[2], "%dx%d%n", &cu, &cv, &used) == 2 && !part[2][used];
     int ok = (np == 3 || np == 4) && !parse_numbers(part[0], 3, c0) && !parse_numbers(part[1], 3, c1) &&
-             !parse_numbers(part[2], 1, &S) && S > 0 && (np == 3 || !parse_numbers(part[3], 3, n));
+             (counts ? cu >= 1 && cv >= 1 : !parse_numbers(part[2], 1, &S) && S > 0) &&
+             (np == 3 || !parse_numbers(part[3], 3, n));
     int flat = -1, eq = 0;
     for (int k = 0; ok && k < 3; k++)
         if (c0[k] == c1[k]) flat = k, eq++;
     if (!ok || eq != 1)
         return cli_usage_error(cmd, "--grid expects x0,y0,z0:x1,y1,z1:S[:nx,ny,nz], opposite corners of a rectangle "
-                                    "equal in exactly one coordinate (its plane) and a spacing S > 0, got '%s'", arg);
+                                    "equal in exactly one coordinate (its plane) and a spacing S > 0 or counts NUxNV, "
+                                    "got '%s'", arg);
     int ax[2], m = 0;
     for (int k = 0; k < 3; k++)
         if (k != flat) ax[m++] = k;
     memset(g, 0, sizeof *g);
     for (int k = 0; k < 3; k++) g->origin[k] = c0[k];
     g->u[ax[0]] = c1[ax[0]] - c0[ax[0]], g->v[ax[1]] = c1[ax[1]] - c0[ax[1]];
-    double nu = fmax(1.0, round(fabs(g->u[ax[0]]) / S)), nv = fmax(1.0, round(fabs(g->v[ax[1]]) / S));
+    double nu = counts ? cu : fmax(1.0, round(fabs(g->u[ax[0]]) / S));
+    double nv = counts ? cv : fmax(1.0, round(fabs(g->v[ax[1]]) / S));
     if (nu * nv > ULAM_RAD_GRID_MAX)
         return cli_usage_error(cmd, "--grid %s makes %.0f x %.0f points, more than %d", arg, nu, nv, ULAM_RAD_GRID_MAX);
     g->nu = (int)nu, g->nv = (int)nv;
@@ -790,17 +796,21 @@ static int write_grid_png(const char *path, const ulam_rad_grid *g, const ulam_r
 {
     size_t n = (size_t)g->nu * (size_t)g->nv;
     double *Y = malloc(n * sizeof *Y), se;
-    int cell = g->nu > g->nv ? 480 / g->nu : 480 / g->nv, w, h, status = Y ? ULAM_OK : ULAM_ENOMEM;
-    cell = cell < 2 ? 2 : cell;
+    /* cells in the grid's proportions, the longer side of the picture 480 pixels */
+    double lu = sqrt(g->u[0] * g->u[0] + g->u[1] * g->u[1] + g->u[2] * g->u[2]) / g->nu;
+    double lv = sqrt(g->v[0] * g->v[0] + g->v[1] * g->v[1] + g->v[2] * g->v[2]) / g->nv;
+    double scale = 480.0 / fmax(lu * g->nu, lv * g->nv);
+    int cw = (int)fmax(2.0, round(lu * scale)), ch = (int)fmax(2.0, round(lv * scale)), w, h;
+    int status = Y ? ULAM_OK : ULAM_ENOMEM;
     *hi = 0.0;
     for (size_t k = 0; Y && k < n; k++) {
         illuminance(&pts[k], &Y[k], &se);
         *hi = fmax(*hi, Y[k]);
     }
     if (!(*hi > 0)) *hi = 1.0;
-    ulam_falsecolour_size(g->nu, g->nv, cell, &w, &h);
+    ulam_falsecolour_size(g->nu, g->nv, cw, ch, &w, &h);
     unsigned char *rgb = Y ? malloc((size_t)w * (size_t)h * 3) : NULL;
-    if (!status) status = rgb ? ulam_falsecolour(Y, g->nu, g->nv, cell, 0.0, *hi, rgb) : ULAM_ENOMEM;
+    if (!status) status = rgb ? ulam_falsecolour(Y, g->nu, g->nv, cw, ch, 0.0, *hi, rgb) : ULAM_ENOMEM;
     if (!status) status = ulam_png_write(path, w, h, rgb);
     free(Y), free(rgb);
     if (!status) return 0;

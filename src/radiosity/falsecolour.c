@@ -43,19 +43,21 @@ static void text(unsigned char *img, int w, int h, int x, int y, const char *s)
     }
 }
 
-/* The picture's size for a grid of nu x nv cells of cell pixels. */
-void ulam_falsecolour_size(int nu, int nv, int cell, int *width, int *height)
+/* The picture's size for a grid of nu x nv cells of cw x ch pixels. */
+void ulam_falsecolour_size(int nu, int nv, int cw, int ch, int *width, int *height)
 {
-    *width = nu * cell + GAP + BAR + GAP + TEXT;
-    *height = nv * cell > 5 * FONT * 8 ? nv * cell : 5 * FONT * 8;
+    *width = nu * cw + GAP + BAR + GAP + TEXT;
+    *height = nv * ch > 5 * FONT * 8 ? nv * ch : 5 * FONT * 8;
 }
 
-/* Paint the grid v (nu x nv, v[j nu + i], j = 0 at the bottom) and its scale bar into rgb. */
-int ulam_falsecolour(const double *v, int nu, int nv, int cell, double lo, double hi, unsigned char *rgb)
+/* Paint the grid v (nu x nv, v[j nu + i], j = 0 at the bottom; cells cw x ch pixels) and its
+ * scale bar into rgb. */
+int ulam_falsecolour(const double *v, int nu, int nv, int cw, int ch, double lo, double hi, unsigned char *rgb)
 {
-    if (!v || !rgb || nu < 1 || nv < 1 || cell < 1 || !isfinite(lo) || !isfinite(hi) || !(hi > lo)) return ULAM_EINVAL;
+    if (!v || !rgb || nu < 1 || nv < 1 || cw < 1 || ch < 1 || !isfinite(lo) || !isfinite(hi) || !(hi > lo))
+        return ULAM_EINVAL;
     int w, h;
-    ulam_falsecolour_size(nu, nv, cell, &w, &h);
+    ulam_falsecolour_size(nu, nv, cw, ch, &w, &h);
     memset(rgb, 255, (size_t)w * (size_t)h * 3);
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++) {
@@ -63,10 +65,10 @@ int ulam_falsecolour(const double *v, int nu, int nv, int cell, double lo, doubl
             double x = v[(size_t)j * (size_t)nu + (size_t)i];
             if (isfinite(x)) ramp((x - lo) / (hi - lo), c);
             else c[0] = c[1] = c[2] = 128; /* no value: grey */
-            for (int y = (nv - 1 - j) * cell; y < (nv - j) * cell; y++)
-                for (int k = i * cell; k < (i + 1) * cell; k++) memcpy(rgb + 3 * ((size_t)y * (size_t)w + (size_t)k), c, 3);
+            for (int y = (nv - 1 - j) * ch; y < (nv - j) * ch; y++)
+                for (int k = i * cw; k < (i + 1) * cw; k++) memcpy(rgb + 3 * ((size_t)y * (size_t)w + (size_t)k), c, 3);
         }
-    int x0 = nu * cell + GAP, top = 5 * FONT, bottom = h - 5 * FONT - 1;
+    int x0 = nu * cw + GAP, top = 5 * FONT, bottom = h - 5 * FONT - 1;
     for (int y = top; y <= bottom; y++) {
         unsigned char c[3];
         ramp((double)(bottom - y) / (double)(bottom - top), c);
