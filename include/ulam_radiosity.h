@@ -266,6 +266,29 @@ void ulam_rad_grid_point(const ulam_rad_grid *g, int i, int j, double x[3]);
 int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_walk_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
                         ulam_error *err);
 
+/* The most quadrature points of a mesh-error estimate: the centroid and up to 8 vertex halves. */
+#define ULAM_RAD_MESH_POINTS 9
+
+/* The mesh's error of a patch query (ulam_rad_mesh_error). */
+typedef struct ulam_rad_mesh {
+    int npoints;                                    /* quadrature points used, the centroid first */
+    double point[ULAM_RAD_MESH_POINTS][3];          /* the surface's radiosity B(x_k) there */
+    double point_se[ULAM_RAD_MESH_POINTS][3];
+    double mean[3], mean_se[3];                     /* their mean (a quadrature of the patch's mean) */
+    double error[3];    /* max_k |B_patch - B(x_k)|: the mesh error beside the Monte Carlo error */
+    double error_se[3]; /* the standard error of that point's B(x_k) */
+    int64_t walks, rays;
+    double seconds;
+    int interrupted;
+} ulam_rad_mesh;
+
+/* The mesh error of the patch query of patch opts->index that answered B (RGB): point queries
+ * (ulam_rad_point_query with opts, each its seed from stream (opts->seed, k + 1)) on the
+ * continuous surfaces at the patch's area centroid and half way from it to each of its first 8
+ * vertices, against B. */
+int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_walk_opts *opts, const double B[3], ulam_rad_mesh *out,
+                        ulam_error *err);
+
 /* Run one round of walks (rounds grow 1, 2, 4 ... 32 blocks of 256 walks as walks accumulate,
  * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
  * ULAM_ENOMEM (shooting's tallies), ULAM_EIO (the share's allgather). */

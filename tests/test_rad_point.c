@@ -59,6 +59,14 @@ static ulam_tracer *must_load(const char *path, ulam_scene **s)
     return t;
 }
 
+/* A tracer on a scene already read. */
+static ulam_tracer *must_tracer_of(const ulam_scene *s)
+{
+    ulam_tracer *t = NULL;
+    assert_int_equal(ulam_tracer_alloc(s, &t, NULL), ULAM_OK);
+    return t;
+}
+
 /* A point query that must run: walks walks (or rel_err), estimator est. */
 static ulam_rad_point query(const ulam_tracer *t, const double x[3], const double *n, int est, int64_t walks,
                             double rel_err, uint64_t seed)
@@ -260,12 +268,124 @@ static void test_grid(void **state)
     ulam_scene_free(s);
 }
 
+/* A patch query to rel_err 0.01 (next-event) at patch p. */
+static ulam_rad_result patch_query(const ulam_tracer *t, int64_t p, double rel_err, int64_t walks, uint64_t seed)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = p, o.rel_err = rel_err, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    ulam_rad_solver *sv = NULL;
+    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
+    while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
+    ulam_rad_result r;
+    ulam_rad_solver_result(sv, &r);
+    ulam_rad_solver_free(sv);
+    return r;
+}
+
+/* The mesh error flags the Cornell floor asked for at its centre with no subdivision (the
+ * patch's one value, the floor's mean, is far from the surface's radiosity at the centroid),
+ * and not a patch of a fine mesh away from the blocks' edges. */
+static void test_mesh_error_flags(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL, *fine = NULL;
+    ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
+    int64_t p;
+    assert_int_equal(ulam_scene_find(s, "floor", &p), ULAM_OK);
+    ulam_rad_result pr = patch_query(t, p, 0.01, 0, 1);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = p, o.rel_err = 0.02, o.max_walks = 0, o.seed = 2, o.threads = 2;
+    ulam_rad_mesh m;
+    assert_int_equal(ulam_rad_mesh_error(t, &o, pr.radiosity, &m, NULL), ULAM_OK);
+    assert_int_equal(m.npoints, 5);
+    for (int c = 0; c < 3; c++) {
+        double se = sqrt(pr.std_error[c] * pr.std_error[c] + m.point_se[0][c] * m.point_se[0][c]);
+        print_message("Cornell floor %c: patch %.5f +- %.2g, surface at the centroid %.5f +- %.2g, mesh error %.4f\n",
+                      "RGB"[c], pr.radiosity[c], pr.std_error[c], m.point[0][c], m.point_se[0][c], m.error[c]);
+        assert_true(m.point[0][c] - pr.radiosity[c] > 10 * se); /* the centre is brighter than the floor's mean */
+        assert_true(m.error[c] > 10 * pr.std_error[c]);         /* dominates */
+    }
+    /* a back-wall patch of a fine mesh (20 mm: the wall's radiosity varies by about 0.8% across
+     * it, less than the points' 2%): the surface agrees with the patch within its errors */
+    assert_int_equal(ulam_scene_subdivide(s, 20.0, &fine), ULAM_OK);
+    ulam_tracer *tf = must_tracer_of(fine);
+    assert_int_equal(ulam_scene_find(fine, "back_wall", &p), ULAM_OK);
+    pr = patch_query(tf, p, 0.01, 0, 3);
+    o.index = p;
+    assert_int_equal(ulam_rad_mesh_error(tf, &o, pr.radiosity, &m, NULL), ULAM_OK);
+    for (int c = 0; c < 3; c++) {
+        double se = sqrt(pr.std_error[c] * pr.std_error[c] + m.error_se[c] * m.error_se[c]);
+        print_message("fine back wall %c: patch %.5f +- %.2g, mesh error %.4f +- %.2g\n", "RGB"[c], pr.radiosity[c],
+                      pr.std_error[c], m.error[c], m.error_se[c]);
+        assert_true(m.error[c] < 4 * se);
+    }
+    ulam_tracer_free(tf), ulam_tracer_free(t);
+    ulam_scene_free(fine), ulam_scene_free(s);
+}
+
+/* Patch averages from a fine uniform mesh converge to the mean of the surface over the coarse
+ * patch: the Cornell back wall, its children's patch queries area-weighted at about 8 x 8, against
+ * the mean of point queries at 20 x 20 jittered points of the wall (stratified; its variance from
+ * neighbouring strata collapsed in pairs, which errs high); the unsubdivided wall's one value
+ * is off by many standard errors. */
+static void test_mesh_converges(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL, *fine = NULL;
+    ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
+    int64_t P;
+    assert_int_equal(ulam_scene_find(s, "back_wall", &P), ULAM_OK);
+    /* the surface's mean over P: 400 uniform points, 200 walks each */
+    ulam_rng r;
+    ulam_rng_seed(&r, 77, 0);
+    const double *v = s->vert;
+    const int32_t *ix = s->vidx + s->start[P];
+    assert_int_equal(s->start[P + 1] - s->start[P], 4);
+    double sum = 0, pairs = 0, prev = 0;
+    for (int k = 0; k < 400; k++) { /* a jittered point of stratum (k % 20, k / 20) of the (parallelogram) wall */
+        double a = (k % 20 + ulam_rng_uniform(&r)) / 20, b = (k / 20 + ulam_rng_uniform(&r)) / 20, x[3];
+        for (int d = 0; d < 3; d++)
+            x[d] = v[3 * ix[0] + d] + a * (v[3 * ix[1] + d] - v[3 * ix[0] + d]) + b * (v[3 * ix[3] + d] - v[3 * ix[0] + d]);
+        ulam_rad_point pt = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, 200, 0, 500 + (uint64_t)k);
+        sum += pt.radiosity[0];
+        if (k % 2) pairs += (pt.radiosity[0] - prev) * (pt.radiosity[0] - prev);
+        prev = pt.radiosity[0];
+    }
+    double mean = sum / 400, se_mean = sqrt(pairs) / 400;
+    ulam_rad_result coarse = patch_query(t, P, 0.005, 0, 9);
+    /* the fine mesh: every child of the wall (face of P) */
+    double side = 0;
+    for (int d = 0; d < 3; d++) side += (v[3 * ix[1] + d] - v[3 * ix[0] + d]) * (v[3 * ix[1] + d] - v[3 * ix[0] + d]);
+    assert_int_equal(ulam_scene_subdivide(s, sqrt(side) / 8 * 1.0001, &fine), ULAM_OK);
+    ulam_tracer *tf = must_tracer_of(fine);
+    double A = 0, BA = 0, var = 0;
+    int children = 0;
+    for (int64_t q = 0; q < fine->npatches; q++) {
+        if (fine->face[q] != s->face[P]) continue;
+        ulam_rad_result c = patch_query(tf, q, 0, 1500, 1000 + (uint64_t)q);
+        A += fine->area[q], BA += fine->area[q] * c.radiosity[0];
+        var += fine->area[q] * fine->area[q] * c.std_error[0] * c.std_error[0];
+        children++;
+    }
+    double Bf = BA / A, se_f = sqrt(var) / A, zf = (Bf - mean) / sqrt(se_f * se_f + se_mean * se_mean);
+    double zc = (coarse.radiosity[0] - mean) / sqrt(coarse.std_error[0] * coarse.std_error[0] + se_mean * se_mean);
+    print_message("back wall R: surface mean %.5f +- %.2g; %d children %.5f +- %.2g (z %+.2f); one patch %.5f +- %.2g "
+                  "(z %+.2f)\n", mean, se_mean, children, Bf, se_f, zf, coarse.radiosity[0], coarse.std_error[0], zc);
+    assert_true(children >= 64);
+    assert_true(se_f < 0.01 * Bf && se_mean < 0.01 * mean);
+    assert_true(fabs(zf) < 4);
+    assert_true(fabs(zc) > 4);
+    ulam_tracer_free(tf), ulam_tracer_free(t);
+    ulam_scene_free(fine), ulam_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_parallel), cmocka_unit_test(test_point_perpendicular),
         cmocka_unit_test(test_point_furnace),  cmocka_unit_test(test_point_coverage),
         cmocka_unit_test(test_point_refused),  cmocka_unit_test(test_grid),
+        cmocka_unit_test(test_mesh_error_flags), cmocka_unit_test(test_mesh_converges),
     };
     return test_run(tests);
 }

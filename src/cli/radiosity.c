@@ -65,7 +65,16 @@ static const char *const usage =
     "  --out FILE.csv    every patch: number, label, face, centroid, area, R G B and standard\n"
     "                    errors (and the direct values with --check or --direct); needs --mode\n"
     "                    shoot or --direct\n"
-    "  --all             print every patch too (a table; with --json a patches array)\n";
+    "  --all             print every patch too (a table; with --json a patches array)\n"
+    ;
+
+/* The usage's third part. */
+static const char *const usage_mesh =
+    "  --no-mesh-error   --patch: skip the mesh error (by default point queries on the continuous\n"
+    "                    surfaces at the patch's centroid and half way to each vertex, each to\n"
+    "                    twice --rel-err or with a quarter of --walks, print how far the patch's one value is\n"
+    "                    from the surface's, beside the Monte Carlo error, and warn when it\n"
+    "                    dominates)\n";
 
 /* The usage's second half (a literal each stays within C99's 4095 characters). */
 static const char *const usage_points =
@@ -103,6 +112,7 @@ typedef struct {
     int direct, check, matrix_walk, json, width, height, all, list;
     int est, mis; /* indices into est_names and mis_names (-1: not given) */
     int view;     /* --view-gather */
+    int no_mesh;  /* --no-mesh-error */
     double *at;   /* --at: 6 per point (the normal NaN when not given) */
     int nat;
     int grid;     /* --grid given: g holds it */
@@ -239,7 +249,7 @@ static int parse(int argc, char **argv, args *a)
         {"list", no_argument, 0, 'l'},            {"camera", required_argument, 0, 'C'},
         {"mis", required_argument, 0, 'H'},       {"view-gather", no_argument, 0, 'V'},
         {"coverage", required_argument, 0, 'G'},  {"at", required_argument, 0, 'P'},
-        {"grid", required_argument, 0, 'R'},
+        {"grid", required_argument, 0, 'R'},     {"no-mesh-error", no_argument, 0, 'N'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int c, rc, idx;
@@ -280,9 +290,10 @@ static int parse(int argc, char **argv, args *a)
         case 'A': a->all = 1; break;
         case 'l': a->list = 1; break;
         case 'C': if ((rc = parse_camera(cmd, optarg, &a->cam))) return rc; a->camera_given = 1; break;
+        case 'N': a->no_mesh = 1; break;
         case 'P': if ((rc = parse_at(cmd, optarg, a))) return rc; break;
         case 'R': if ((rc = parse_grid(cmd, optarg, &a->g))) return rc; a->grid = 1; break;
-        case 'h': fputs(usage, stdout), fputs(usage_points, stdout); return -1;
+        case 'h': fputs(usage, stdout), fputs(usage_mesh, stdout), fputs(usage_points, stdout); return -1;
         default: return cli_usage_error(cmd, "unknown option");
         }
     }
@@ -550,6 +561,8 @@ typedef struct {
     const double *w_all_se_conditional; /* matrix forward walks whose se lack F's noise, or NULL */
     const walked *w;
     ulam_view_info view; /* --view-gather */
+    int mesh_known;      /* mesh holds the patch's mesh error (ray gathering at --patch) */
+    ulam_rad_mesh mesh;
 } report;
 
 /* (walk - direct) / the standard error of the difference at the patch, channel c: matrix walks
@@ -560,6 +573,32 @@ static double zscore(const args *a, const report *r, int c)
     double diff = r->w->B[c] - d, se = sqrt(sw * sw + sf * sf);
     if (se == 0) return diff == 0 ? 0.0 : copysign(INFINITY, diff); /* both exact: agree, or not at all */
     return diff / se;
+}
+
+/* Nonzero when the mesh error of channel c dominates the Monte Carlo error: larger than twice
+ * it, and real (more than 4 standard errors of the difference: the largest of up to 9). */
+static int mesh_dominates(const report *r, const walked *w, int c)
+{
+    double e = r->mesh.error[c], se = sqrt(w->se[c] * w->se[c] + r->mesh.error_se[c] * r->mesh.error_se[c]);
+    return e > 2 * w->se[c] && e > 4 * se;
+}
+
+/* The mesh error lines of the text report. */
+static void print_mesh(const report *r, const walked *w)
+{
+    int any = 0;
+    for (int c = 0; c < 3; c++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (int k = 0; k < r->mesh.npoints; k++) lo = fmin(lo, r->mesh.point[k][c]), hi = fmax(hi, r->mesh.point[k][c]);
+        printf("mesh error %c %.3g (Monte Carlo %.3g): the surface reads %.8g +- %.3g at the patch's centroid, "
+               "%.6g .. %.6g at its %d quadrature points\n", chan[c], r->mesh.error[c], w->se[c], r->mesh.point[0][c],
+               r->mesh.point_se[0][c], lo, hi, r->mesh.npoints);
+        any |= mesh_dominates(r, w, c);
+    }
+    if (any)
+        printf("warning      the mesh error dominates the Monte Carlo error: this patch's one value stands for a\n"
+               "             surface whose radiosity differs from it by more; ask --at a point (no mesh), or\n"
+               "             --subdivide finer\n");
 }
 
 /* Print the text report. */
@@ -587,6 +626,7 @@ static void print_text(const args *a, const report *r)
             else if (a->matrix_walk) printf(" (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
             printf("%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
         }
+        if (r->mesh_known) print_mesh(r, w);
         if (a->o.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT && !w->zero)
             printf("rel-err      %s (%g; the rule's range term wants %.3g walks)\n", w->rel_err_met ? "met" : "NOT met",
                    a->o.rel_err, w->min_walks);
@@ -655,6 +695,15 @@ static void print_json(const args *a, const report *r)
         if (r->patch >= 0) {
             json_triple(answer_key, w->B);
             json_triple("stderr", w->se);
+            if (r->mesh_known) {
+                int dom = 0;
+                for (int c = 0; c < 3; c++) dom |= mesh_dominates(r, w, c);
+                json_triple("mesh_error", r->mesh.error);
+                json_triple("mesh_error_stderr", r->mesh.error_se);
+                json_triple("surface_at_centroid", r->mesh.point[0]);
+                json_triple("surface_at_centroid_stderr", r->mesh.point_se[0]);
+                printf("\"mesh_error_dominates\": %s, ", dom ? "true" : "false");
+            }
             if (a->matrix_walk) {
                 json_triple("walk_stderr", w->se_walk);
                 if (r->ff_se_known) json_triple("ff_stderr", r->direct_se);
@@ -1098,6 +1147,19 @@ int cli_radiosity(int argc, char **argv)
     } else if (a.patch || a.o.mode == ULAM_FORWARD) {
         rc = a.matrix_walk ? matrix_walks(&a, s, F, &w) : ray_walks(&a, t, s->npatches, &w);
         if (rc) goto done;
+        if (a.patch && a.o.mode == ULAM_ADJOINT && !w.interrupted && !a.no_mesh) { /* the mesh's error beside */
+            ulam_walk_opts mo = a.o; /* each point to twice the patch's relative error or 1/4 its walks (>= 256) */
+            mo.index = r.patch, mo.estimator = ULAM_RAD_NEXT_EVENT, mo.rel_err = 2 * a.o.rel_err;
+            if (a.o.max_walks > 0) mo.max_walks = a.o.max_walks / 4 > 256 ? a.o.max_walks / 4 : 256;
+            cli_catch_sigint();
+            int st = ulam_rad_mesh_error(t, &mo, w.B, &r.mesh, &err);
+            cli_release_sigint();
+            if (st) {
+                rc = cli_report(a.scene, &err);
+                goto done;
+            }
+            r.mesh_known = !r.mesh.interrupted;
+        }
         if (a.matrix_walk) combine_errors(&r, &w);
         r.w = &w;
     }
