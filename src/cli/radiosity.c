@@ -74,7 +74,10 @@ static const char *const usage_mesh =
     "                    surfaces at the patch's centroid and half way to each vertex, each to\n"
     "                    twice --rel-err or with a quarter of --walks, print how far the patch's one value is\n"
     "                    from the surface's, beside the Monte Carlo error, and warn when it\n"
-    "                    dominates)\n";
+    "                    dominates)\n"
+    "  --mesh-error N    with --out or --all (--mode shoot or --direct): every patch's mesh error as\n"
+    "                    R_mesh G_mesh B_mesh columns, point queries of N walks each at the\n"
+    "                    patch's quadrature points (cost: up to 5 N walks a patch)\n";
 
 /* The usage's second half (a literal each stays within C99's 4095 characters). */
 static const char *const usage_points =
@@ -113,6 +116,7 @@ typedef struct {
     int est, mis; /* indices into est_names and mis_names (-1: not given) */
     int view;     /* --view-gather */
     int no_mesh;  /* --no-mesh-error */
+    int64_t mesh_walks; /* --mesh-error N: every patch's mesh error in --out / --all, N walks a point */
     double *at;   /* --at: 6 per point (the normal NaN when not given) */
     int nat;
     int grid;     /* --grid given: g holds it */
@@ -250,6 +254,7 @@ static int parse(int argc, char **argv, args *a)
         {"mis", required_argument, 0, 'H'},       {"view-gather", no_argument, 0, 'V'},
         {"coverage", required_argument, 0, 'G'},  {"at", required_argument, 0, 'P'},
         {"grid", required_argument, 0, 'R'},     {"no-mesh-error", no_argument, 0, 'N'},
+        {"mesh-error", required_argument, 0, 'W'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int c, rc, idx;
@@ -291,6 +296,7 @@ static int parse(int argc, char **argv, args *a)
         case 'l': a->list = 1; break;
         case 'C': if ((rc = parse_camera(cmd, optarg, &a->cam))) return rc; a->camera_given = 1; break;
         case 'N': a->no_mesh = 1; break;
+        case 'W': if ((rc = cli_parse_int(cmd, "--mesh-error", optarg, 1, INT32_MAX, &a->mesh_walks))) return rc; break;
         case 'P': if ((rc = parse_at(cmd, optarg, a))) return rc; break;
         case 'R': if ((rc = parse_grid(cmd, optarg, &a->g))) return rc; a->grid = 1; break;
         case 'h': fputs(usage, stdout), fputs(usage_mesh, stdout), fputs(usage_points, stdout); return -1;
@@ -329,6 +335,7 @@ static int parse(int argc, char **argv, args *a)
     if (!a->patch && a->o.mode == ULAM_ADJOINT && !a->direct && !a->view)
         return cli_usage_error(cmd, "needs --patch K (gathering answers one patch), --mode shoot or --direct");
     if (a->check && !a->patch) return cli_usage_error(cmd, "--check needs --patch K");
+    if (a->mesh_walks && !a->out && !a->all) return cli_usage_error(cmd, "--mesh-error N needs --out or --all");
     if (a->image && a->o.mode == ULAM_ADJOINT && !a->direct && !a->view)
         return cli_usage_error(cmd, "--image needs --mode shoot, --direct or --view-gather (gathering answers one "
                                     "patch)");
@@ -461,6 +468,7 @@ static void json_triple(const char *key, const double *v)
  * answer beside walks. */
 typedef struct {
     const double *B, *se, *Bd, *sed;
+    const double *mesh; /* --mesh-error: every patch's mesh error (3 each), or NULL */
 } patch_values;
 
 enum { ROW_TEXT, ROW_CSV, ROW_JSON };
@@ -473,6 +481,7 @@ static void row_header(FILE *f, int fmt, const patch_values *v)
     for (int k = 0; k < 4; k++) fprintf(f, fmt == ROW_CSV ? ",%s" : " %12s", geo[k]);
     for (int k = 0; v && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",%s" : " %12s", val[k]);
     for (int k = 0; v && v->Bd && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",direct_%s" : " direct_%-5s", val[k]);
+    for (int k = 0; v && v->mesh && k < 3; k++) fprintf(f, fmt == ROW_CSV ? ",%s_mesh" : " %7s_mesh", val[k]);
     fputc('\n', f);
 }
 
@@ -481,21 +490,25 @@ static void row_header(FILE *f, int fmt, const patch_values *v)
 static void row(FILE *f, int fmt, const ulam_scene *s, int64_t p, const patch_values *v)
 {
     static const char *const keys[] = {"x", "y", "z", "area", "R", "G", "B", "R_se", "G_se", "B_se",
-                                       "direct_R", "direct_G", "direct_B", "direct_R_se", "direct_G_se", "direct_B_se"};
-    double x[16];
+                                       "direct_R", "direct_G", "direct_B", "direct_R_se", "direct_G_se", "direct_B_se",
+                                       "R_mesh", "G_mesh", "B_mesh"};
+    double x[19];
+    const char *key[19];
     int n = 4;
     ulam_scene_centroid(s, p, x);
     x[3] = s->area[p];
     const double *cols[4] = {v ? v->B : NULL, v ? v->se : NULL, v ? v->Bd : NULL, v ? v->sed : NULL};
+    for (int k = 0; k < 4; k++) key[k] = keys[k];
     for (int k = 0; v && k < (v->Bd ? 4 : 2); k++)
-        for (int c = 0; c < 3; c++) x[n++] = cols[k] ? cols[k][3 * p + c] : NAN;
+        for (int c = 0; c < 3; c++) key[n] = keys[n], x[n++] = cols[k] ? cols[k][3 * p + c] : NAN;
+    for (int c = 0; v && v->mesh && c < 3; c++) key[n] = keys[16 + c], x[n++] = v->mesh[3 * p + c];
     int32_t g = s->group[p];
     const char *label = g >= 0 ? s->groups[g] : "";
     if (fmt == ROW_JSON) {
         printf("{\"patch\": %lld, ", (long long)p + 1);
         cli_json_string("label", label, 0);
         printf("\"face\": %lld, ", (long long)s->face[p] + 1);
-        for (int k = 0; k < n; k++) cli_json_number(keys[k], x[k], k == n - 1);
+        for (int k = 0; k < n; k++) cli_json_number(key[k], x[k], k == n - 1);
         printf("}");
         return;
     }
@@ -1090,8 +1103,32 @@ static void combine_errors(report *r, walked *w)
 /* The values of every patch for --out and --all. */
 static patch_values every_patch(const args *a, const report *r, const walked *w, const double *Bd)
 {
-    if (w->all) return (patch_values){w->all, w->all_se, (a->direct || a->check) ? Bd : NULL, r->direct_se_all};
-    return (patch_values){Bd, r->direct_se_all, NULL, NULL};
+    if (w->all) return (patch_values){w->all, w->all_se, (a->direct || a->check) ? Bd : NULL, r->direct_se_all, NULL};
+    return (patch_values){Bd, r->direct_se_all, NULL, NULL, NULL};
+}
+
+/* --mesh-error N: every patch's mesh error against pv->B into a new *out (3 a patch); 0 or an
+ * exit code. */
+static int every_mesh_error(const args *a, const ulam_tracer *t, const ulam_scene *s, patch_values *pv, double **out)
+{
+    ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the mesh errors"};
+    if (!(*out = malloc((size_t)s->npatches * 3 * sizeof **out))) return cli_report(a->scene, &err);
+    ulam_walk_opts o = a->o;
+    o.mode = ULAM_ADJOINT, o.estimator = ULAM_RAD_NEXT_EVENT, o.rel_err = 0, o.max_seconds = 0;
+    o.max_walks = a->mesh_walks;
+    cli_catch_sigint();
+    for (int64_t p = 0; p < s->npatches; p++) {
+        ulam_rad_mesh m;
+        o.index = p, o.seed = a->o.seed + (uint64_t)p;
+        if (ulam_rad_mesh_error(t, &o, pv->B + 3 * p, &m, &err)) {
+            cli_release_sigint();
+            return cli_report(a->scene, &err);
+        }
+        for (int c = 0; c < 3; c++) (*out)[3 * p + c] = m.interrupted ? NAN : m.error[c];
+    }
+    cli_release_sigint();
+    pv->mesh = *out;
+    return 0;
 }
 
 /* ulam radiosity. */
@@ -1111,6 +1148,7 @@ int cli_radiosity(int argc, char **argv)
     double *Bd = NULL;
     walked w = {0};
     report r = {.patch = -1, .w = NULL};
+    double *mesh_all = NULL;
     ulam_error err;
     if (a.est == 2 && a.mis == 2 && cli_rank == 0)
         fprintf(stderr, "ulam radiosity: warning: --mis none (light sampling alone) has infinite variance at a patch "
@@ -1164,6 +1202,7 @@ int cli_radiosity(int argc, char **argv)
         r.w = &w;
     }
     r.pv = every_patch(&a, &r, &w, Bd);
+    if (a.mesh_walks && r.pv.B && !w.interrupted && (rc = every_mesh_error(&a, t, s, &r.pv, &mesh_all))) goto done;
     if (a.out && !w.interrupted && cli_rank == 0) {
         if ((rc = write_csv(a.out, s, &r.pv))) goto done;
         r.out_written = 1;
@@ -1176,7 +1215,7 @@ int cli_radiosity(int argc, char **argv)
     else print_text(&a, &r);
     if (w.interrupted) rc = EXIT_INTERRUPTED;
 done:
-    free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all), free(a.at);
+    free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all), free(a.at), free(mesh_all);
     ulam_csr_free(F);
     ulam_tracer_free(t);
     ulam_scene_free(s);
