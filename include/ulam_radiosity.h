@@ -54,6 +54,24 @@ typedef struct ulam_scene {
  * carry the line, and err->file names the MTL file when the error is in one. */
 int ulam_scene_read_obj(const char *path, ulam_scene **out, ulam_error *err);
 
+/* A non-diffuse MTL statement ulam_scene_read_obj_notes ignored: the first of its keyword in a
+ * material (Ks not 0, Ns, d not 1, Tr not 0, illum above 2, Tf not 1, map_*, bump, Pr, ...;
+ * the material is rendered matte with its Kd and Ke). */
+typedef struct ulam_mtl_note {
+    char *file;     /* the MTL file */
+    long line;
+    char keyword[16];
+    char *material;
+} ulam_mtl_note;
+
+/* ulam_scene_read_obj, and the non-diffuse MTL statements ignored (*notes: a new array of
+ * *nnotes, in file order; NULL and 0 when none or on failure; free with ulam_mtl_notes_free). */
+int ulam_scene_read_obj_notes(const char *path, ulam_scene **out, ulam_mtl_note **notes, int64_t *nnotes,
+                              ulam_error *err);
+
+/* Free notes (n of them); accepts NULL. */
+void ulam_mtl_notes_free(ulam_mtl_note *notes, int64_t n);
+
 /* Split every patch into patches no longer than max_side on a side (quads into a grid,
  * triangles into m^2 similar triangles, larger polygons through a fan); face and group
  * are kept. */

@@ -237,8 +237,16 @@ for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends
     CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0,
                   r"^ulam radiosity: warning: .*small_gap.obj: patch 3 is only 168 float steps across where it lies",
                   r"radiosity R  0 \+- 0.*\n.*\n.*\nnote .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))
-CASES.append((["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--max-mem", "10"], 0, r"^$",
+# --max-mem that holds F but not the dense solve of F's noise: the matrix walk runs, its error bar labelled
+CASES.append((["radiosity", SC + "cube.obj", "--subdivide", "0.04", "--ff-rays", "100", "--patch", "1", "--matrix-walk",
+               "--max-mem", "50M", "--walks", "20000", "--no-mesh-error"], 0, r"^$",
               r"radiosity R  \S+ \+- \S+ \(walk noise only, CONDITIONAL on the sampled F"))
+# --max-mem is an estimate made before any ray (the 110k-patch --direct cast rays 641 s, then refused)
+CASES.append((["radiosity", SC + "cornell_box.obj", "--subdivide", "2", "--direct"], code("EMEMLIMIT"),
+              r"this run needs about 3.74 TiB, more than --max-mem 4 GiB \(ray tracer .*dense matrices 3.74 TiB.*"
+              r"refused before any work", r"^$"))
+CASES.append((["radiosity", SC + "cornell_box.obj", "--subdivide", "5", "--patch", "floor", "--matrix-walk",
+               "--max-mem", "100M"], code("EMEMLIMIT"), r"needs about 3.9 GiB, more than --max-mem 100 MiB", r"^$"))
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # cuts at --max-steps were silent (96 for 1000)
     CASES.append((["radiosity", R + "furnace999.obj", "--patch", "1", "--max-steps", "100", "--walks", "2000"] + extra,
                   0, r"^$", r"^warning +\d+ of \d+ walks cut at --max-steps 100: the estimate is biased low"))
@@ -256,6 +264,10 @@ CASES += [
     (["radiosity", SC + "cube.obj", "--at", "0.5,0.5,0.5"], 2, r"--at 0.5,0.5,0.5: .*a normal for a sensor", r"^$"),
     (["radiosity", SC + "cube.obj", "--at", "0.5,0,0.5", "--patch", "1"], 2, r"--at and --grid are point queries", r"^$"),
     (["radiosity", SC + "cube.obj", "--grid", "0,0.5,0:1,0.6,1:0.1"], 2, r"equal in exactly one coordinate", r"^$"),
+    # non-diffuse MTL statements: one warning a material, each statement with file:line
+    (["radiosity", R + "shiny.obj", "--at", "1,0.5,0.5", "--walks", "500"], 0,
+     r"^ulam radiosity: warning: .*shiny.mtl: material 'glass' is rendered matte \(Kd, Ke\): ignored Ks "
+     r"\(.*shiny.mtl:12\), Ns \(.*:13\), d \(.*:14\), illum \(.*:15\), map_Kd \(.*:16\)\n$", r"point 1"),
     (["radiosity", SC + "cube.obj", "--at", "0.5,0,0.5", "--walks", "2000"], 0, "",
      r"point 1 +0.5 0 0.5, normal 0 1 0 \(patch 1, floor\)"),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "next-event", "--mis", "heavy"], 2,

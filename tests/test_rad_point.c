@@ -379,6 +379,31 @@ static void test_mesh_converges(void **state)
     ulam_scene_free(fine), ulam_scene_free(s);
 }
 
+/* The non-diffuse MTL statements are noted once a keyword a material, with file and line; the
+ * matte defaults (Ka, Ni, Ks 0, Ns 0, d 1, illum 2) are not. */
+static void test_mtl_notes(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_mtl_note *notes = NULL;
+    int64_t n = 0;
+    assert_int_equal(ulam_scene_read_obj_notes("tests/data/rad/shiny.obj", &s, &notes, &n, NULL), ULAM_OK);
+    const char *kw[5] = {"Ks", "Ns", "d", "illum", "map_Kd"};
+    assert_int_equal(n, 5);
+    for (int k = 0; k < 5; k++) {
+        assert_string_equal(notes[k].keyword, kw[k]);
+        assert_string_equal(notes[k].material, "glass");
+        assert_int_equal(notes[k].line, 12 + k);
+        assert_non_null(strstr(notes[k].file, "shiny.mtl"));
+    }
+    ulam_mtl_notes_free(notes, n);
+    ulam_scene_free(s);
+    assert_int_equal(ulam_scene_read_obj_notes("tests/data/rad/edge_lamp.obj", &s, &notes, &n, NULL), ULAM_OK);
+    assert_int_equal(n, 0);
+    assert_null(notes);
+    ulam_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -386,6 +411,7 @@ int main(void)
         cmocka_unit_test(test_point_furnace),  cmocka_unit_test(test_point_coverage),
         cmocka_unit_test(test_point_refused),  cmocka_unit_test(test_grid),
         cmocka_unit_test(test_mesh_error_flags), cmocka_unit_test(test_mesh_converges),
+        cmocka_unit_test(test_mtl_notes),
     };
     return test_run(tests);
 }

@@ -49,7 +49,8 @@ static const char *const usage =
     "  --check           with --patch: also the direct solve, and z = (walk - direct) / stderr\n"
     "  --matrix-walk     walk on the assembled M (ulam solve's engine) instead of casting rays:\n"
     "                    walks and LAPACK then share the very same F\n"
-    "  --max-mem SIZE    refuse a direct solve needing more (default 4G)\n"
+    "  --max-mem SIZE    refuse, before any ray, a run whose estimate (ray tracer, F, dense\n"
+    "                    matrices, tallies, pictures) is more (default 4G)\n"
     "  --image out.png   render the shooting (or else direct) solution\n"
     "  --view-gather     with --image and --rel-err E: gather only the patches the camera sees,\n"
     "                    each to E (n_max / n)^X on every channel, n its pixels, n_max the most\n"
@@ -65,11 +66,11 @@ static const char *const usage =
     "  --out FILE.csv    every patch: number, label, face, centroid, area, R G B and standard\n"
     "                    errors (and the direct values with --check or --direct); needs --mode\n"
     "                    shoot or --direct\n"
-    "  --all             print every patch too (a table; with --json a patches array)\n"
     ;
 
 /* The usage's third part. */
 static const char *const usage_mesh =
+    "  --all             print every patch too (a table; with --json a patches array)\n"
     "  --no-mesh-error   --patch: skip the mesh error (by default point queries on the continuous\n"
     "                    surfaces at the patch's centroid and half way to each vertex, each to\n"
     "                    twice --rel-err or with a quarter of --walks, print how far the patch's one value is\n"
@@ -1030,7 +1031,21 @@ static int load_scene(const args *a, ulam_scene **out, int64_t *faces)
 {
     ulam_error err;
     ulam_scene *s = NULL;
-    if (ulam_scene_read_obj(a->scene, &s, &err)) return cli_report(a->scene, &err);
+    ulam_mtl_note *notes = NULL;
+    int64_t nnotes = 0;
+    if (ulam_scene_read_obj_notes(a->scene, &s, &notes, &nnotes, &err)) return cli_report(a->scene, &err);
+    for (int64_t i = 0; i < nnotes && cli_rank == 0; i++) { /* one warning a material */
+        int first = 1;
+        for (int64_t k = 0; k < i && first; k++) first = strcmp(notes[k].material, notes[i].material) != 0;
+        if (!first) continue;
+        fprintf(stderr, "ulam radiosity: warning: %s: material '%s' is rendered matte (Kd, Ke): ignored", notes[i].file,
+                notes[i].material);
+        for (int64_t k = i; k < nnotes; k++)
+            if (!strcmp(notes[k].material, notes[i].material))
+                fprintf(stderr, "%s %s (%s:%ld)", k == i ? "" : ",", notes[k].keyword, notes[k].file, notes[k].line);
+        fprintf(stderr, "\n");
+    }
+    ulam_mtl_notes_free(notes, nnotes);
     *faces = s->nfaces;
     if (a->subdivide > 0) {
         ulam_scene *d = NULL;
@@ -1107,6 +1122,40 @@ static patch_values every_patch(const args *a, const report *r, const walked *w,
     return (patch_values){Bd, r->direct_se_all, NULL, NULL, NULL};
 }
 
+/* Bytes as GiB, MiB or KiB for a message. */
+static void human(double b, char *out, size_t len)
+{
+    const char *u[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+    int k = 0;
+    while (b >= 1024 && k < 4) b /= 1024, k++;
+    snprintf(out, len, k ? "%.3g %s" : "%.0f %s", b, u[k]);
+}
+
+/* What the run will hold at once, estimated from the scene and the options before any ray is
+ * cast: the ray tracer (Embree's structure, about 200 bytes a triangle), F (12 bytes a nonzero,
+ * at most npatches x min(ff rays, npatches); a matrix walk adds each channel's M and kernel),
+ * the dense LAPACK solve (ulam_direct_bytes; twice for every patch's error bar), shooting's
+ * tallies, pictures and grids.  *what gets the breakdown. */
+static double need_bytes(const args *a, const ulam_scene *s, char *what, size_t len)
+{
+    double n = (double)s->npatches, tri = (double)(s->start[s->npatches] - 2 * s->npatches);
+    double tracer = 208.0 * tri + 16.0 * (double)s->nverts, ff = 0, dense = 0, walks = 0, pic = 0;
+    int threads = a->o.threads > 0 ? a->o.threads : 2;
+    int forms = (a->direct || a->check || a->matrix_walk) && !a->nat && !a->grid;
+    if (forms) ff = 12.0 * n * fmin((double)a->ff_rays, n) + 8.0 * (n + 1);
+    if (forms && a->matrix_walk) ff *= 3; /* F, one channel's M and the walk's kernel rows */
+    if (forms && (a->direct || a->check)) dense = (double)ulam_direct_bytes(s->npatches);
+    if (forms && (a->direct || a->check) && (a->out || a->all)) dense *= 2; /* every patch's error: G whole */
+    if (a->o.mode == ULAM_FORWARD) walks = n * (48.0 + 29.0 * threads) + 32.0 * 256 * 32 * 64;
+    if (a->image) pic = (double)a->width * a->height * 11.0 + (a->view ? 8.0 * n : 0.0);
+    if (a->nat || a->grid) walks = (double)(a->nat + (a->grid ? (int64_t)a->g.nu * a->g.nv : 0)) * sizeof(ulam_rad_point);
+    char h[5][32];
+    human(tracer, h[0], 32), human(ff, h[1], 32), human(dense, h[2], 32), human(walks, h[3], 32), human(pic, h[4], 32);
+    snprintf(what, len, "ray tracer %s (%.0f triangles), form factors %s (%.0f patches x %lld rays), dense "
+                        "matrices %s, walks %s, pictures %s", h[0], tri, h[1], n, (long long)a->ff_rays, h[2], h[3], h[4]);
+    return tracer + ff + dense + walks + pic;
+}
+
 /* --mesh-error N: every patch's mesh error against pv->B into a new *out (3 a patch); 0 or an
  * exit code. */
 static int every_mesh_error(const args *a, const ulam_tracer *t, const ulam_scene *s, patch_values *pv, double **out)
@@ -1163,6 +1212,18 @@ int cli_radiosity(int argc, char **argv)
         goto done;
     }
     if (a.patch && (rc = find_patch(s, a.patch, &r.patch))) goto done;
+    {
+        char what[512], h[2][32];
+        double need = need_bytes(&a, s, what, sizeof what);
+        if (need > (double)a.max_mem) { /* refused before the first ray */
+            human(need, h[0], 32), human((double)a.max_mem, h[1], 32);
+            fprintf(stderr, "ulam radiosity: %s: memory limit: this run needs about %s, more than --max-mem %s (%s); refused before "
+                            "any work: raise --max-mem, or ask less (--patch or --at walks need no F)\n",
+                    a.scene, h[0], h[1], what);
+            rc = cli_exit_code(ULAM_EMEMLIMIT);
+            goto done;
+        }
+    }
     a.o.index = r.patch >= 0 ? r.patch : 0;
     if (ulam_tracer_alloc(s, &t, &err)) {
         rc = cli_report(a.scene, &err);
