@@ -364,6 +364,19 @@ typedef struct ulam_render_info {
 int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width,
                 int height, double exposure, unsigned char *rgb, ulam_render_info *info);
 
+/* Render B (3 * npatches) with `samples` jittered rays a pixel (1: the pixel centre; each pixel's
+ * jitter from stream (seed, pixel)) and, when smooth, the radiosity interpolated across each
+ * hit patch from its corners (a corner's value: the area-weighted mean of B over the patches of
+ * the same OBJ face sharing that vertex, so subdivision is smoothed and creases between faces
+ * kept): linear RGB floats in hdr (3 a pixel, rows top first) and, when rgb is not NULL, the
+ * 8-bit sRGB picture with ulam_render's exposure rule.  Errors as ulam_render's. */
+int ulam_render_hdr(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width, int height, int samples,
+                    int smooth, uint64_t seed, double exposure, float *hdr, unsigned char *rgb, ulam_render_info *info);
+
+/* Write linear float RGB (3 a pixel, rows top first) as a PFM file (Portable Float Map,
+ * little-endian), atomically. */
+int ulam_pfm_write(const char *path, int width, int height, const float *rgb);
+
 /* How many pixel centres of a width x height picture see each patch's front (pixels:
  * npatches), with the rays of ulam_render. */
 int ulam_view_pixels(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t *pixels);

@@ -640,7 +640,6 @@ static void print_text(const args *a, const report *r)
             else if (a->matrix_walk) printf(" (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
             printf("%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
         }
-        if (r->mesh_known) print_mesh(r, w);
         if (a->o.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT && !w->zero)
             printf("rel-err      %s (%g; the rule's range term wants %.3g walks)\n", w->rel_err_met ? "met" : "NOT met",
                    a->o.rel_err, w->min_walks);
@@ -649,6 +648,7 @@ static void print_text(const args *a, const report *r)
                    "             --rel-err can never be met by a zero estimate, so the walks stopped there; if the\n"
                    "             answer is not exactly 0, a walk scores with probability below 3/%lld = %.2g (95%%)\n",
                    (long long)w->walks, (long long)w->walks, 3.0 / (double)w->walks);
+        if (r->mesh_known) print_mesh(r, w);
     }
     if (w)
         printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)%s\n", (long long)w->walks,

@@ -50,6 +50,11 @@ void ulam__cosine_dir(const double n[3], ulam_rng *r, double d[3]);
  * outside a closed room sees into it), or -1. */
 int64_t ulam__tracer_cast_front(const ulam_tracer *t, const double org[3], const double dir[3]);
 
+/* ulam__tracer_cast_front, and where on the patch: fan triangle k (vertices 0, k, k + 1) and the
+ * barycentric u, v of its vertices k and k + 1. */
+int64_t ulam__tracer_cast_front_uv(const ulam_tracer *t, const double org[3], const double dir[3], int64_t *k, double *u,
+                                   double *v);
+
 /* Where a ray landed: its length and the cosines at its two ends (at the patch it left, and
  * at the patch it reached, positive on its front). */
 typedef struct {
