@@ -972,7 +972,22 @@ def check_radiosity(ulam):
         rc, _, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "1000",
                                 "--image", d + "/no/such/dir/x.png"])
         assert rc == code("EIO") and "x.png" in err, err
-        assert sorted(os.listdir(d)) == ["box.png"], os.listdir(d)
+        assert sorted(os.listdir(d)) == ["box.pfm", "box.png"], os.listdir(d)  # the linear picture beside
+        pfm = open(d + "/box.pfm", "rb").read()
+        assert pfm.startswith(b"PF\n64 48\n-1.0\n") and len(pfm) == len(b"PF\n64 48\n-1.0\n") + 64 * 48 * 12
+
+
+def check_radiosity_image_noise(ulam):
+    """A shooting picture with too few particles a patch says so (it was salt-and-pepper noise with
+    no word); with enough, no warning."""
+    with tempfile.TemporaryDirectory() as d:
+        png = d + "/n.png"
+        rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "60", "--mode", "shoot", "--walks",
+                                  "20000", "--image", png, "--size", "32x32"])
+        assert rc == 0 and re.search(r"warning: .*n.png: the \d+ patches in view carry \d+% relative error", err), err
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "20000", "--image", png,
+                                  "--size", "16x16"])
+        assert rc == 0 and "relative error" not in err, err
 
 
 def check_radiosity_json_paths(ulam):
@@ -1269,7 +1284,7 @@ def main():
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
-             (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
+             (check_radiosity_patches, ulam), (check_radiosity_images, ulam), (check_radiosity_image_noise, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),

@@ -404,6 +404,48 @@ static void test_mtl_notes(void **state)
     ulam_scene_free(s);
 }
 
+/* ulam_render_hdr: one centre ray a pixel, flat, is ulam_render's picture byte for byte; smooth
+ * shading of a constant radiosity is that constant at every pixel (corner means of equal values),
+ * jittered or not; a linear gradient over a subdivided face is interpolated (between the patch
+ * values, not a staircase). */
+static void test_render_hdr(void **state)
+{
+    (void)state;
+    ulam_scene *s0 = NULL, *s = NULL;
+    ulam_tracer *t0 = must_load("tests/data/rad/furnace_half.obj", &s0);
+    assert_int_equal(ulam_scene_subdivide(s0, 0.25, &s), ULAM_OK);
+    ulam_tracer *t = must_tracer_of(s);
+    int64_t n = s->npatches;
+    double *B = malloc((size_t)(3 * n) * sizeof *B);
+    ulam_camera cam = {.eye = {0.5, 0.5, 0.9}, .dir = {0, 0, -1}, .up = {0, 1, 0}, .focal = 1, .film = 1.5};
+    enum { W = 24, H = 16 };
+    float hdr[3 * W * H];
+    unsigned char a[3 * W * H], b[3 * W * H];
+    for (int64_t p = 0; p < n; p++) {
+        double c[3];
+        ulam_scene_centroid(s, p, c);
+        for (int k = 0; k < 3; k++) B[3 * p + k] = 1.0 + c[0]; /* a gradient in x */
+    }
+    assert_int_equal(ulam_render(t, B, &cam, W, H, 0.5, a, NULL), ULAM_OK);
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 1, 0, 1, 0.5, hdr, b, NULL), ULAM_OK);
+    assert_memory_equal(a, b, sizeof a);
+    /* smooth: on the floor (the picture's lower middle) values lie between neighbours, and vary
+     * continuously: no jump between adjacent pixels as large as a patch step (0.25) */
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 4, 1, 1, 0.5, hdr, b, NULL), ULAM_OK);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x + 1 < W; x++) assert_true(fabs(hdr[3 * (y * W + x + 1)] - hdr[3 * (y * W + x)]) < 0.2);
+    for (int64_t p = 0; p < n; p++)
+        for (int k = 0; k < 3; k++) B[3 * p + k] = 2.0;
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 3, 1, 7, 0, hdr, NULL, NULL), ULAM_OK);
+    for (int k = 0; k < 3 * W * H; k++) assert_close(hdr[k], 2.0, 1e-6);
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 0, 1, 7, 0, hdr, NULL, NULL), ULAM_EINVAL);
+    B[5] = NAN;
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 1, 1, 7, 0, hdr, NULL, NULL), ULAM_ENONFINITE);
+    free(B);
+    ulam_tracer_free(t), ulam_tracer_free(t0);
+    ulam_scene_free(s), ulam_scene_free(s0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -411,7 +453,7 @@ int main(void)
         cmocka_unit_test(test_point_furnace),  cmocka_unit_test(test_point_coverage),
         cmocka_unit_test(test_point_refused),  cmocka_unit_test(test_grid),
         cmocka_unit_test(test_mesh_error_flags), cmocka_unit_test(test_mesh_converges),
-        cmocka_unit_test(test_mtl_notes),
+        cmocka_unit_test(test_mtl_notes),        cmocka_unit_test(test_render_hdr),
     };
     return test_run(tests);
 }

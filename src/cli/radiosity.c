@@ -70,6 +70,10 @@ static const char *const usage =
 
 /* The usage's third part. */
 static const char *const usage_mesh =
+    "  --samples N       jittered rays a pixel (default 4); the linear picture is written as PFM\n"
+    "                    beside the PNG (out.png -> out.pfm)\n"
+    "  --flat            one colour a patch (default: radiosity interpolated from the patch corners\n"
+    "                    across each face's patches, creases between faces kept)\n"
     "  --all             print every patch too (a table; with --json a patches array)\n"
     "  --no-mesh-error   --patch: skip the mesh error (by default point queries on the continuous\n"
     "                    surfaces at the patch's centroid and half way to each vertex, each to\n"
@@ -117,6 +121,8 @@ typedef struct {
     int est, mis; /* indices into est_names and mis_names (-1: not given) */
     int view;     /* --view-gather */
     int no_mesh;  /* --no-mesh-error */
+    int samples, flat; /* --samples N jittered rays a pixel, --flat: one colour a patch */
+    char hdr[4096];    /* the PFM beside --image */
     int64_t mesh_walks; /* --mesh-error N: every patch's mesh error in --out / --all, N walks a point */
     double *at;   /* --at: 6 per point (the normal NaN when not given) */
     int nat;
@@ -255,7 +261,8 @@ static int parse(int argc, char **argv, args *a)
         {"mis", required_argument, 0, 'H'},       {"view-gather", no_argument, 0, 'V'},
         {"coverage", required_argument, 0, 'G'},  {"at", required_argument, 0, 'P'},
         {"grid", required_argument, 0, 'R'},     {"no-mesh-error", no_argument, 0, 'N'},
-        {"mesh-error", required_argument, 0, 'W'},
+        {"mesh-error", required_argument, 0, 'W'},  {"samples", required_argument, 0, 'S'},
+        {"flat", no_argument, 0, 'F'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int c, rc, idx;
@@ -297,6 +304,13 @@ static int parse(int argc, char **argv, args *a)
         case 'l': a->list = 1; break;
         case 'C': if ((rc = parse_camera(cmd, optarg, &a->cam))) return rc; a->camera_given = 1; break;
         case 'N': a->no_mesh = 1; break;
+        case 'F': a->flat = 1; break;
+        case 'S': {
+            int64_t v;
+            if ((rc = cli_parse_int(cmd, "--samples", optarg, 1, 1024, &v))) return rc;
+            a->samples = (int)v;
+            break;
+        }
         case 'W': if ((rc = cli_parse_int(cmd, "--mesh-error", optarg, 1, INT32_MAX, &a->mesh_walks))) return rc; break;
         case 'P': if ((rc = parse_at(cmd, optarg, a))) return rc; break;
         case 'R': if ((rc = parse_grid(cmd, optarg, &a->g))) return rc; a->grid = 1; break;
@@ -1002,20 +1016,56 @@ static int view_walks(const args *a, const ulam_tracer *t, const ulam_scene *s, 
     return 0;
 }
 
-/* Render B into a->image, warning when the picture cannot show the light; 0 or an exit code. */
-static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s, const double *B, double *used)
+/* Warn when the picture's patches are noisy: the pixel-weighted mean, over the pixels that see a
+ * patch, of its largest relative standard error over the lit channels, above 5%. */
+static void noise_warning(const args *a, const ulam_tracer *t, const ulam_scene *s, const ulam_camera *cam,
+                          const double *B, const double *se)
 {
-    unsigned char *rgb = malloc((size_t)a->width * (size_t)a->height * 3);
+    int64_t *pix = malloc((size_t)s->npatches * sizeof *pix), seen = 0;
+    if (!pix || ulam_view_pixels(t, cam, a->width, a->height, pix)) {
+        free(pix);
+        return;
+    }
+    double sum = 0.0, n = 0.0;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        if (!pix[p]) continue;
+        double rel = 0.0;
+        for (int c = 0; c < 3; c++)
+            if (B[3 * p + c] > 0) rel = fmax(rel, se[3 * p + c] / B[3 * p + c]);
+        sum += (double)pix[p] * rel, n += (double)pix[p], seen++;
+    }
+    free(pix);
+    if (n > 0 && sum / n > 0.05 && cli_rank == 0)
+        fprintf(stderr, "ulam radiosity: warning: %s: the %lld patches in view carry %.0f%% relative error (pixel-weighted "
+                        "mean): the picture will be salt-and-pepper noise; more --walks (the error falls as "
+                        "1/sqrt(walks)), or --view-gather --rel-err\n", a->image, (long long)seen, 100.0 * sum / n);
+}
+
+/* Render B into a->image, warning when the picture cannot show the light; 0 or an exit code. */
+static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s, const double *B, const double *se,
+                       double *used)
+{
+    size_t np = (size_t)a->width * (size_t)a->height;
+    unsigned char *rgb = malloc(np * 3);
+    float *hdr = malloc(np * 3 * sizeof *hdr);
     ulam_camera cam = camera_of(a, s);
     ulam_render_info info;
-    int status = rgb ? ulam_render(t, B, &cam, a->width, a->height, a->exposure, rgb, &info) : ULAM_ENOMEM;
+    int status = rgb && hdr ? ulam_render_hdr(t, B, &cam, a->width, a->height, a->samples, !a->flat, a->o.seed,
+                                              a->exposure, hdr, rgb, &info)
+                            : ULAM_ENOMEM;
     if (!status) status = ulam_png_write(a->image, a->width, a->height, rgb);
-    free(rgb);
+    if (!status && (status = ulam_pfm_write(a->hdr, a->width, a->height, hdr))) {
+        free(rgb), free(hdr);
+        ulam_error err = {.status = status, .msg = "a writable PFM file"};
+        return cli_report(a->hdr, &err);
+    }
+    free(rgb), free(hdr);
     if (status) {
         ulam_error err = {.status = status, .msg = "a writable PNG file"};
         return cli_report(a->image, &err);
     }
     *used = info.exposure;
+    if (se) noise_warning(a, t, s, &cam, B, se);
     if (!info.pixels_hit)
         fprintf(stderr, "ulam radiosity: warning: %s: the camera sees no patch's front (try --camera)\n", a->image);
     else if (!info.pixels_emitter)
@@ -1183,7 +1233,7 @@ static int every_mesh_error(const args *a, const ulam_tracer *t, const ulam_scen
 /* ulam radiosity. */
 int cli_radiosity(int argc, char **argv)
 {
-    args a = {.est = -1, .mis = -1, .coverage = 0.25, .ff_rays = 1000, .width = 512, .height = 512, .max_mem = CLI_MAX_MEM, .o = ulam_walk_defaults()};
+    args a = {.est = -1, .mis = -1, .samples = 4, .coverage = 0.25, .ff_rays = 1000, .width = 512, .height = 512, .max_mem = CLI_MAX_MEM, .o = ulam_walk_defaults()};
     a.o.max_walks = 0;
     a.o.interrupt = &cli_interrupted, a.o.share = cli_share;
     int rc = parse(argc, argv, &a);
@@ -1203,7 +1253,14 @@ int cli_radiosity(int argc, char **argv)
         fprintf(stderr, "ulam radiosity: warning: --mis none (light sampling alone) has infinite variance at a patch "
                         "that shares an edge with a light or nearly touches one: there the error bar can be far too "
                         "small (the edge-lamp scene: z = -4.6); the MIS default is bounded\n");
+    if (a.image) { /* the PFM beside the PNG: out.png -> out.pfm */
+        size_t len = strlen(a.image);
+        int png = len > 4 && !strcmp(a.image + len - 4, ".png");
+        if (len + 5 > sizeof a.hdr) return cli_usage_error("radiosity", "--image: a path shorter than 4 KiB");
+        snprintf(a.hdr, sizeof a.hdr, "%.*s.pfm", (int)(png ? len - 4 : len), a.image);
+    }
     if (a.image && (rc = cli_check_output(a.image))) return rc;
+    if (a.image && !a.grid && (rc = cli_check_output(a.hdr))) return rc;
     if (a.out && (rc = cli_check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
     r.s = s;
@@ -1269,7 +1326,7 @@ int cli_radiosity(int argc, char **argv)
         r.out_written = 1;
     }
     if (a.image && !w.interrupted && cli_rank == 0) {
-        if ((rc = write_image(&a, t, s, w.all ? w.all : Bd, &r.exposure))) goto done;
+        if ((rc = write_image(&a, t, s, w.all ? w.all : Bd, w.all ? w.all_se : NULL, &r.exposure))) goto done;
         r.image_written = 1;
     }
     if (a.json) print_json(&a, &r);
