@@ -977,6 +977,20 @@ def check_radiosity(ulam):
         assert pfm.startswith(b"PF\n64 48\n-1.0\n") and len(pfm) == len(b"PF\n64 48\n-1.0\n") + 64 * 48 * 12
 
 
+def check_radiosity_matrix_rel_err(ulam):
+    """--matrix-walk --rel-err stops on the answer's whole error, the walks' and F's combined
+    (it held the walks' alone to E, and the error bar printed was larger than E); where F's error
+    alone is past E it says more --ff-rays, not more walks, can meet it."""
+    rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--rel-err", "0.05",
+                              "--ff-rays", "100000", "--no-mesh-error", "--json"])
+    j = json.loads(out)
+    assert rc == 0 and all(s <= 0.05 * b for s, b in zip(j["stderr"], j["radiosity"])), j
+    assert all(abs(s * s - w * w - f * f) < 1e-12 for s, w, f in zip(j["stderr"], j["walk_stderr"], j["ff_stderr"])), j
+    rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--rel-err", "0.05",
+                              "--ff-rays", "20", "--no-mesh-error"])
+    assert rc == 0 and re.search(r"rel-err +NOT met in R: the form factors' error alone is \S+, past --rel-err 0.05", out), out
+
+
 def check_radiosity_image_noise(ulam):
     """A shooting picture with too few particles a patch says so (it was salt-and-pepper noise with
     no word); with enough, no warning."""
@@ -1285,6 +1299,7 @@ def main():
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam), (check_radiosity_image_noise, ulam),
+             (check_radiosity_matrix_rel_err, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),

@@ -446,6 +446,38 @@ static void test_render_hdr(void **state)
     ulam_scene_free(s), ulam_scene_free(s0);
 }
 
+/* Shooting's --rel-err takes the whole rule now (its variance's own error from the fourth moment
+ * of the patch's per-particle tallies, at least 1000 particles), not the standard error alone:
+ * 50 seeds at rel_err 0.03 on the edge lamp's wall (exact 0.5 F(C-14)), every run met with its
+ * variance known to 25%, at least 43 of 50 intervals (95%) covering (P(Binomial(50, 0.95) < 43)
+ * < 0.01). */
+static void test_shoot_rel_err(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/edge_lamp.obj", &s);
+    double exact = 0.5 * ulam_ff_perpendicular_rectangles(1, 1, 1);
+    int inside = 0;
+    for (uint64_t seed = 0; seed < 50; seed++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = ULAM_FORWARD, o.estimator = ULAM_RAD_COLLISION, o.index = 1, o.rel_err = 0.03, o.max_walks = 0;
+        o.seed = 300 + seed, o.threads = 2;
+        ulam_rad_solver *sv = NULL;
+        assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
+        while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
+        ulam_rad_result r;
+        ulam_rad_solver_result(sv, &r);
+        ulam_rad_solver_free(sv);
+        assert_true(r.rel_err_met && r.walks >= 1000 && r.variance_rel_error <= 0.25);
+        assert_true(r.std_error[0] <= 0.03 * r.radiosity[0]);
+        inside += fabs(r.radiosity[0] - exact) <= 1.96 * r.std_error[0];
+    }
+    print_message("shooting at rel_err 0.03: %d of 50 intervals cover\n", inside);
+    assert_true(inside >= 43);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -454,6 +486,7 @@ int main(void)
         cmocka_unit_test(test_point_refused),  cmocka_unit_test(test_grid),
         cmocka_unit_test(test_mesh_error_flags), cmocka_unit_test(test_mesh_converges),
         cmocka_unit_test(test_mtl_notes),        cmocka_unit_test(test_render_hdr),
+        cmocka_unit_test(test_shoot_rel_err),
     };
     return test_run(tests);
 }

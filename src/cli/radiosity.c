@@ -140,6 +140,7 @@ typedef struct {
     double B[3], se[3], se_walk[3]; /* se: with --matrix-walk, the walk's and F's noise combined */
     int64_t walks, steps, cut; /* cut: walks stopped at --max-steps */
     int64_t channel_walks[3]; /* --matrix-walk: each channel's walks (walks is their sum) */
+    int ff_limited[3];        /* --matrix-walk --rel-err: F's error alone is past the target */
     double seconds;
     int threads, interrupted;
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
@@ -426,8 +427,23 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     return cli_exit_code(status);
 }
 
-/* Walks on the assembled M, one channel at a time; 0 or an exit code. */
-static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, walked *w)
+/* The stopping rule of --matrix-walk --rel-err E at a patch, in one place: the answer's error
+ * is the walks' and F's combined, so the walks stop at E' = sqrt(E^2 - (ff / |B|)^2) of the
+ * estimate, ff being F's standard error at the patch and B the direct solution there; 0 when
+ * F's error alone reaches E (more walks cannot meet it: more --ff-rays can); E when F's error
+ * is unknown (the error bar is then labelled conditional on F). */
+static double matrix_walk_rel_err(double E, double ff, double B, int ff_known)
+{
+    if (!(E > 0) || !ff_known) return E;
+    double f = B != 0 ? ff / fabs(B) : (ff > 0 ? INFINITY : 0.0);
+    return f < E ? sqrt(E * E - f * f) : 0.0;
+}
+
+/* Walks on the assembled M, one channel at a time (at a patch with --rel-err: to the combined
+ * rule of matrix_walk_rel_err, given F's error ff and the direct solution Bd there); 0 or an
+ * exit code. */
+static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, const double *ff, const double *Bd,
+                        walked *w)
 {
     int64_t n = s->npatches;
     double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x), *e = malloc((size_t)n * sizeof *e);
@@ -441,7 +457,15 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
     for (int c = 0; c < 3 && !status && !cli_interrupted; c++) {
         ulam_csr *M = NULL;
         ulam_solver *sv = NULL;
-        if ((status = ulam_rad_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
+        ulam_walk_opts o = a->o;
+        if (a->o.rel_err > 0 && a->o.mode == ULAM_ADJOINT) {
+            o.rel_err = matrix_walk_rel_err(a->o.rel_err, ff ? ff[c] : 0, Bd ? Bd[c] : 0, ff && Bd);
+            if (!(o.rel_err > 0)) { /* F's noise alone is past the target: walk to it, say it is not met */
+                w->ff_limited[c] = 1;
+                o.rel_err = a->o.rel_err;
+            }
+        }
+        if ((status = ulam_rad_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &o, &sv, &err))) {
             ulam_csr_free(M);
             break;
         }
@@ -669,6 +693,11 @@ static void print_text(const args *a, const report *r)
                a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
+    for (int c = 0; w && a->matrix_walk && c < 3; c++)
+        if (w->ff_limited[c])
+            printf("rel-err      NOT met in %c: the form factors' error alone is %.3g, past --rel-err %g of the "
+                   "answer; more walks cannot meet it, more --ff-rays can (F's error falls as 1/sqrt(rays))\n",
+                   chan[c], r->direct_se[c], a->o.rel_err);
     if (w && a->matrix_walk)
         printf("             (one walk a channel: %lld R + %lld G + %lld B)\n", (long long)w->channel_walks[0],
                (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
@@ -1301,7 +1330,9 @@ int cli_radiosity(int argc, char **argv)
         if ((rc = view_walks(&a, t, s, &w, &r.view))) goto done;
         r.w = &w;
     } else if (a.patch || a.o.mode == ULAM_FORWARD) {
-        rc = a.matrix_walk ? matrix_walks(&a, s, F, &w) : ray_walks(&a, t, s->npatches, &w);
+        rc = a.matrix_walk ? matrix_walks(&a, s, F, r.ff_se_known ? r.direct_se : NULL,
+                                          Bd && r.patch >= 0 ? Bd + 3 * r.patch : NULL, &w)
+                           : ray_walks(&a, t, s->npatches, &w);
         if (rc) goto done;
         if (a.patch && a.o.mode == ULAM_ADJOINT && !w.interrupted && !a.no_mesh) { /* the mesh's error beside */
             ulam_walk_opts mo = a.o; /* each point to twice the patch's relative error or 1/4 its walks (>= 256) */

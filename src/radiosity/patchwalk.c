@@ -457,6 +457,8 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             br->maxsq = fmax(br->maxsq, x * x);
         } else {
             shoot(s, &r, &s->scratch[th], br);
+            for (int c = 0; c < 3; c++) /* the patch's tally, 0 when untouched: its moments for rel_err */
+                ulam__moments_add(&br->m[c], s->scratch[th].hist[3 * s->o.index + c]);
             if (flush_history(&s->scratch[th], br)) {
                 br->nomem = 1;
                 return;
@@ -516,9 +518,11 @@ static void channel_mins(const ulam_rad_solver *s, double mins[3])
     }
 }
 
-/* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
- * takes the whole rule (ulam__rel_err_holds, with the channels' range-term minimums mins from
- * channel_mins); shooting, whose tallies keep no fourth moment, the standard error alone. */
+/* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): the whole
+ * rule (ulam__rel_err_holds) with the channels' range-term minimums mins from channel_mins;
+ * shooting at patch opts->index with the moments of that patch's per-particle tallies (its
+ * variance's own error from their fourth moment) and no range term (a particle may return to
+ * the patch any number of times: no bound on its tally). */
 static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, const double mins[3], double rel_err)
 {
     int any = 0;
@@ -532,9 +536,8 @@ static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, co
             (double)r->walks < mins[c])
             return 0;
         if (r->radiosity[c] == 0.0) continue;
-        if (s->o.mode == ULAM_FORWARD ? !(r->std_error[c] <= rel_err * fabs(r->radiosity[c]))
-                                      : !ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c], mins[c],
-                                                             ulam__moments_variance_rel_error(&s->m[c]), rel_err))
+        if (!ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c], mins[c],
+                                 ulam__moments_variance_rel_error(&s->m[c]), rel_err))
             return 0;
         any = 1;
     }
@@ -611,7 +614,7 @@ static void result(const ulam_rad_solver *s, const double mins[3], ulam_rad_resu
         }
     }
     r->max_share = s->sq > 0 ? fmin(1.0, s->maxsq / s->sq) : 0.0;
-    for (int c = 0; c < 3 && s->o.mode == ULAM_ADJOINT && s->o.rel_err > 0; c++) {
+    for (int c = 0; c < 3 && s->o.rel_err > 0; c++) {
         r->min_walks = fmax(r->min_walks, mins[c]); /* 0 in a channel where no minimum applies */
         if (s->m[c].mean != 0.0)
             r->variance_rel_error = fmax(r->variance_rel_error, ulam__moments_variance_rel_error(&s->m[c]));
