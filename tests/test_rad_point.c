@@ -268,18 +268,24 @@ static void test_grid(void **state)
     ulam_scene_free(s);
 }
 
-/* A patch query to rel_err 0.01 (next-event) at patch p. */
-static ulam_rad_result patch_query(const ulam_tracer *t, int64_t p, double rel_err, int64_t walks, uint64_t seed)
+/* A patch solver run to its end with options o. */
+static ulam_rad_result run_solver(const ulam_tracer *t, const ulam_walk_opts *o)
 {
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.index = p, o.rel_err = rel_err, o.max_walks = walks, o.seed = seed, o.threads = 2;
     ulam_rad_solver *sv = NULL;
-    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
+    assert_int_equal(ulam_rad_solver_alloc(t, o, &sv, NULL), ULAM_OK);
     while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
     ulam_rad_result r;
     ulam_rad_solver_result(sv, &r);
     ulam_rad_solver_free(sv);
     return r;
+}
+
+/* A patch query (next-event) at patch p to rel_err or walks. */
+static ulam_rad_result patch_query(const ulam_tracer *t, int64_t p, double rel_err, int64_t walks, uint64_t seed)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = p, o.rel_err = rel_err, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    return run_solver(t, &o);
 }
 
 /* The mesh error flags the Cornell floor asked for at its centre with no subdivision (the
@@ -462,12 +468,7 @@ static void test_shoot_rel_err(void **state)
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = ULAM_FORWARD, o.estimator = ULAM_RAD_COLLISION, o.index = 1, o.rel_err = 0.03, o.max_walks = 0;
         o.seed = 300 + seed, o.threads = 2;
-        ulam_rad_solver *sv = NULL;
-        assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
-        while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
-        ulam_rad_result r;
-        ulam_rad_solver_result(sv, &r);
-        ulam_rad_solver_free(sv);
+        ulam_rad_result r = run_solver(t, &o);
         assert_true(r.rel_err_met && r.walks >= 1000 && r.variance_rel_error <= 0.25);
         assert_true(r.std_error[0] <= 0.03 * r.radiosity[0]);
         inside += fabs(r.radiosity[0] - exact) <= 1.96 * r.std_error[0];
