@@ -991,6 +991,25 @@ def check_radiosity_matrix_rel_err(ulam):
     assert rc == 0 and re.search(r"rel-err +NOT met in R: the form factors' error alone is \S+, past --rel-err 0.05", out), out
 
 
+def check_radiosity_grid(ulam):
+    """--grid: a 3 x 2 sensor grid on the cube's floor (the furnace-like cube: every sensor reads
+    H = 2 within its error) to CSV and a false-colour PNG; JSON has the grid's points."""
+    with tempfile.TemporaryDirectory() as d:
+        csv, png = d + "/g.csv", d + "/g.png"
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--grid", "0,0.5,0:1,0.5,1:3x2", "--walks", "4000",
+                                  "--out", csv, "--image", png, "--json"])
+        assert rc == 0 and err == "", (rc, err)
+        j = json.loads(out)
+        pts = j["grid"]["points"]
+        assert j["grid"]["nu"] == 3 and j["grid"]["nv"] == 2 and len(pts) == 6, j["grid"]
+        for p in pts:
+            assert p["patch"] is None and abs(p["irradiance"][0] - 2) <= 4 * p["irradiance_stderr"][0], p
+        rows = open(csv).read().splitlines()
+        assert rows[0].startswith("i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks") and len(rows) == 7, rows
+        assert open(png, "rb").read()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert sorted(os.listdir(d)) == ["g.csv", "g.png"], os.listdir(d)
+
+
 def check_radiosity_image_noise(ulam):
     """A shooting picture with too few particles a patch says so (it was salt-and-pepper noise with
     no word); with enough, no warning."""
@@ -1299,7 +1318,7 @@ def main():
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam), (check_radiosity_image_noise, ulam),
-             (check_radiosity_matrix_rel_err, ulam),
+             (check_radiosity_matrix_rel_err, ulam), (check_radiosity_grid, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),
