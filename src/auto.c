@@ -52,7 +52,7 @@ typedef struct {
 /* The default options. */
 ulam_auto_opts ulam_auto_defaults(void)
 {
-    return (ulam_auto_opts){.continue_q = 0.9, .pilot_walks = 128, .pilot_max = 1024, .pilot_share = 0.2};
+    return (ulam_auto_opts){.continue_q = 0.9, .pilot_walks = 128, .pilot_max = 1024, .pilot_share = 0.2, .method = -1};
 }
 
 /* Matrix entries a guard's radii read: one pass for the sums, one per power iteration. */
@@ -138,7 +138,7 @@ static double predict(const chooser *c, int k, double var, double *walks)
     *walks = N;
     double cap = (double)ulam_csr_nnz(c->M) + 3.0 * (double)c->M->nrows, u = (double)g->units;
     double reach = g->walks > 0 ? fmin(cap, u * N / (double)g->walks) : cap;
-    if (reach * 4 > cap) reach = cap; /* the solver then builds the rest at once */
+    if (reach * ULAM__COMPLETE > cap) reach = cap; /* the solver then builds the rest at once */
     return N * work_per_walk(c, k) + ULAM_AUTO_BUILD * fmax(0.0, reach - u);
 }
 

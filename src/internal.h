@@ -151,6 +151,10 @@ struct ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s);
 /* The states a solver's walks can reach (n flags; NULL unless its reachability check ran). */
 const char *ulam__solver_reached(const ulam_solver *s);
 
+/* The walk solver builds the rest of its kernel at once when walks have built 1 / ULAM__COMPLETE
+ * of it row by row (src/solve.c: the rent-or-buy rule); the choice's work models predict it. */
+enum { ULAM__COMPLETE = 4 };
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)
