@@ -36,10 +36,10 @@ static int pin(ulam__query *q, int k, ulam_error *err)
     return ulam_solver_alloc(q->M, q->b, q->o, &q->run->sv, err);
 }
 
-/* Iterate until done. */
+/* Iterate until done (a solver that has failed stays failed: its status). */
 static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
 {
-    int status = ULAM_OK;
+    int status = ulam_solver_error(r->sv, NULL);
     while (!status && !ulam_solver_done(r->sv)) status = ulam_solver_iterate(r->sv);
     ulam_solver_result(r->sv, &a->walks);
     ulam_solver_guard(r->sv, &a->guard);
