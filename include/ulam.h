@@ -975,14 +975,9 @@ typedef struct ulam_auto_opts {
     const ulam_guard *guard; /* radii computed before (a prepared system's certificate): they serve
                                 the candidates of their continuation and exponent instead of a pass
                                 over M (NULL: none) */
-    int method;           /* ulam_auto_start: the row pinned (enum ulam_method_row), -1 (the default):
-                             choose among the rows */
-    unsigned exclude;     /* ulam_auto_start: bit k set: row k is not considered (its why says
-                             "not considered: excluded"; a caller may write its own reason) */
 } ulam_auto_opts;
 
-/* The default options: nothing pinned, Q = 0.9, pilots of 128 walks doubling up to 1024, 0.2;
- * no row pinned (method -1) or excluded. */
+/* The default options: nothing pinned, Q = 0.9, pilots of 128 walks doubling up to 1024, 0.2. */
 ulam_auto_opts ulam_auto_defaults(void);
 
 /* The candidates and the choice. */
@@ -1067,6 +1062,16 @@ int ulam_method_answers(int k);
 /* The densest b the bidirectional row takes: nonzeros at most max(16, n / 10). */
 int64_t ulam_method_sparse_limit(int64_t n);
 
+/* Which rows a choice may take.  Start from ulam_method_defaults(). */
+typedef struct ulam_method_opts {
+    int method;       /* the row pinned (enum ulam_method_row); -1: choose among the rows */
+    unsigned exclude; /* bit k set: row k (not the walks) is not considered (its why says "not
+                         considered: excluded"; a caller may write its own reason there) */
+} ulam_method_opts;
+
+/* The defaults: no row pinned (method -1), none excluded. */
+ulam_method_opts ulam_method_defaults(void);
+
 /* What became of a row in a choice. */
 enum ulam_method_state {
     ULAM_METHOD_NOT_CONSIDERED = 0, /* its applicability test failed (why says which) */
@@ -1085,7 +1090,7 @@ typedef struct ulam_method_verdict {
 /* The choice among the rows for one query (ulam_auto_start). */
 typedef struct ulam_choice {
     int chosen;                   /* the row that runs (enum ulam_method_row; -1: none) */
-    int pinned;                   /* 1: the row was pinned (ulam_auto_opts.method), not chosen */
+    int pinned;                   /* 1: the row was pinned (ulam_method_opts.method), not chosen */
     ulam_method_verdict method[ULAM_NMETHODS];
     ulam_auto_result walks;       /* the walks row's race (ulam_auto_choose): its candidates */
     double leader_work;           /* the walks' chosen candidate's predicted work (NaN: none) */
@@ -1114,9 +1119,9 @@ typedef struct ulam_answer {
     int status;                  /* the run's status (ULAM_OK; ENOCONV, ESTALL for the outer rows) */
 } ulam_answer;
 
-/* Choose the method for x_{o->index} of (I - M) x = b under o's options and ao's pins (ao NULL:
- * ulam_auto_defaults(), nothing pinned, every row considered): with ao->method >= 0 that row
- * alone, as o says (walks: ulam_solver_alloc on o, no pilots: bit for bit what ulam_solve does);
+/* Choose the method for x_{o->index} of (I - M) x = b under o's options, ao's pins of the walks'
+ * candidates (ao NULL: ulam_auto_defaults()) and mo's of the rows (mo NULL:
+ * ulam_method_defaults(), every row considered): with mo->method >= 0 that row alone, as o says (walks: ulam_solver_alloc on o, no pilots: bit for bit what ulam_solve does);
  * else every row of the table in order: the walks row races its candidates (ulam_auto_solver),
  * then each other row's applicability test and cost prediction, a row replacing the leader when
  * its predicted work is below the leader's.  Bidirectional applies to an adjoint query with a
@@ -1127,7 +1132,7 @@ typedef struct ulam_answer {
  * verdict; *out the run (NULL on failure).  Statuses: ulam_auto_solver's (the walks' refusal:
  * ch->walks says which candidate), ULAM_ENOMEM. */
 int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                    ulam_choice *ch, ulam_run **out, ulam_error *err);
+                    const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err);
 
 /* The walk solver of a run of the walks row (borrowed: iterate it, read it; freed by
  * ulam_run_free), or NULL for another row. */
@@ -1141,11 +1146,11 @@ int ulam_run_finish(ulam_run *r, ulam_answer *a, ulam_error *err);
 ulam_run *ulam_run_free(ulam_run *r);
 
 /* The library's `ulam solve`: ulam_auto_start, ulam_run_finish, ulam_run_free in one call
- * (ch may be NULL).  With ao NULL or ulam_auto_defaults() it chooses as `ulam solve` does by
- * default (the same choice and, on the same seed, the same estimate); pin a row with
- * ao->method (ULAM_METHOD_WALKS: ulam_solve's run). */
+ * (ch may be NULL).  With ao and mo NULL it chooses as `ulam solve` does by default (the same
+ * choice and, on the same seed, the same estimate); pin a row with mo->method
+ * (ULAM_METHOD_WALKS: ulam_solve's run, bit for bit). */
 int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-              ulam_choice *ch, ulam_answer *a, ulam_error *err);
+              const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
 /* All tertiary. */

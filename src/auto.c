@@ -52,7 +52,7 @@ typedef struct {
 /* The default options. */
 ulam_auto_opts ulam_auto_defaults(void)
 {
-    return (ulam_auto_opts){.continue_q = 0.9, .pilot_walks = 128, .pilot_max = 1024, .pilot_share = 0.2, .method = -1};
+    return (ulam_auto_opts){.continue_q = 0.9, .pilot_walks = 128, .pilot_max = 1024, .pilot_share = 0.2};
 }
 
 /* Matrix entries a guard's radii read: one pass for the sums, one per power iteration. */

@@ -37,7 +37,7 @@ int ulam_method_answers(int k)
 /* 1 when row k is excluded by q's options. */
 int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len)
 {
-    if (!(q->ao->exclude & (1u << k))) return 0;
+    if (!(q->mo->exclude & (1u << k))) return 0;
     snprintf(why, len, "not considered: excluded");
     return 1;
 }
@@ -50,12 +50,18 @@ void ulam__answer_interval(ulam_answer *a)
     a->ci95[1] = ok ? a->estimate + ULAM_Z95 * a->std_error : NAN;
 }
 
+/* The default row options: none pinned, none excluded. */
+ulam_method_opts ulam_method_defaults(void)
+{
+    return (ulam_method_opts){.method = -1, .exclude = 0};
+}
+
 /* Check the inputs. */
-static int check(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+static int check(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_method_opts *mo,
                  const ulam_choice *ch, ulam_run **out, ulam_error *err)
 {
     if (!M || !b || !o || !ch || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b, options, a choice and a run");
-    if (ao->method < -1 || ao->method >= ULAM_NMETHODS)
+    if (mo->method < -1 || mo->method >= ULAM_NMETHODS)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a pinned method from -1 (none) to %d", ULAM_NMETHODS - 1);
     return ULAM_OK;
 }
@@ -98,12 +104,13 @@ static int choose(ulam__query *q, ulam_error *err)
 
 /* Choose (or start the pinned row) and hand out the run. */
 int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                    ulam_choice *ch, ulam_run **out, ulam_error *err)
+                    const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
 {
     ulam__clear(err);
     if (out) *out = NULL;
     ulam_auto_opts a = ao ? *ao : ulam_auto_defaults();
-    int status = check(M, b, o, &a, ch, out, err);
+    ulam_method_opts m = mo ? *mo : ulam_method_defaults();
+    int status = check(M, b, o, &m, ch, out, err);
     if (status) return status;
     memset(ch, 0, sizeof *ch);
     ch->chosen = -1, ch->leader_work = NAN;
@@ -112,11 +119,11 @@ int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o,
     ulam_run *r = calloc(1, sizeof *r);
     if (!r) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the run");
     r->method = -1, r->M = M, r->b = b, r->o = *o;
-    ulam__query q = {.M = M, .b = b, .o = o, .ao = &a, .ch = ch, .run = r};
-    if (a.method >= 0) {
+    ulam__query q = {.M = M, .b = b, .o = o, .ao = &a, .mo = &m, .ch = ch, .run = r};
+    if (m.method >= 0) {
         ch->pinned = 1;
-        status = table[a.method]->pin(&q, a.method, err);
-        if (!status) ch->chosen = a.method;
+        status = table[m.method]->pin(&q, m.method, err);
+        if (!status) ch->chosen = m.method;
     } else {
         status = choose(&q, err);
     }
@@ -163,12 +170,12 @@ ulam_run *ulam_run_free(ulam_run *r)
 
 /* Choose, run and free in one call. */
 int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-              ulam_choice *ch, ulam_answer *a, ulam_error *err)
+              const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err)
 {
     ulam_choice *own = ch ? NULL : malloc(sizeof *own);
     if (!ch && !own) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the choice");
     ulam_run *r = NULL;
-    int status = ulam_auto_start(M, b, o, ao, ch ? ch : own, &r, err);
+    int status = ulam_auto_start(M, b, o, ao, mo, ch ? ch : own, &r, err);
     if (!status) status = ulam_run_finish(r, a, err);
     ulam_run_free(r);
     free(own);

@@ -23,7 +23,8 @@ typedef struct ulam__query {
     const ulam_csr *M;
     const double *b;
     const ulam_walk_opts *o;  /* as the caller gave them */
-    const ulam_auto_opts *ao; /* pins, exclusions */
+    const ulam_auto_opts *ao; /* the walks' pins */
+    const ulam_method_opts *mo; /* the rows' pin and exclusions */
     ulam_choice *ch;
     ulam_run *run;
 } ulam__query;

@@ -233,13 +233,13 @@ static void test_table(void **state)
     assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
     o.index = 3, o.seed = 5, o.max_walks = 20000, o.threads = 2;
-    ulam_auto_opts ao = ulam_auto_defaults();
+    ulam_method_opts ao = ulam_method_defaults();
     assert_int_equal(ao.method, -1);
     ulam_choice *ch = malloc(sizeof *ch);
     ulam_answer a;
     for (int k = 0; k < ULAM_NMETHODS; k++) {
         ao.method = k;
-        assert_int_equal(ulam_auto(M, b, &o, &ao, ch, &a, NULL), ULAM_OK);
+        assert_int_equal(ulam_auto(M, b, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
         assert_int_equal(ch->chosen, k);
         assert_int_equal(a.method, k);
         assert_true(ch->pinned && ch->method[k].state == ULAM_METHOD_CHOSEN);
@@ -259,7 +259,7 @@ static void test_table(void **state)
     }
     /* unpinned: the walks (no rel_err target: bidirectional has no figure to compare) */
     ao.method = -1;
-    assert_int_equal(ulam_auto(M, b, &o, &ao, ch, &a, NULL), ULAM_OK);
+    assert_int_equal(ulam_auto(M, b, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
     assert_int_equal(ch->chosen, ULAM_METHOD_WALKS);
     assert_false(ch->pinned);
     assert_int_equal(ch->method[ULAM_METHOD_BIDIRECTIONAL].state, ULAM_METHOD_NOT_CONSIDERED);
@@ -281,7 +281,7 @@ static void test_table(void **state)
     /* an excluded row says so */
     ao.exclude = 1u << ULAM_METHOD_BIDIRECTIONAL;
     o.rel_err = 0.05, o.max_walks = 0;
-    assert_int_equal(ulam_auto(M, b, &o, &ao, ch, &a, NULL), ULAM_OK);
+    assert_int_equal(ulam_auto(M, b, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
     assert_string_equal(ch->method[ULAM_METHOD_BIDIRECTIONAL].why, "not considered: excluded");
     ulam_csr_free(M);
     /* bidirectional chosen: randsub1000's x_7 for a 3-nonzero b at rel_err 0.02 (the CLI's case) */
@@ -291,8 +291,8 @@ static void test_table(void **state)
     assert_int_equal(ulam_direct_solve(M, bs, x2, 0, NULL, NULL), ULAM_OK);
     o = ulam_walk_defaults();
     o.index = 6, o.rel_err = 0.02, o.max_walks = 0;
-    ao = ulam_auto_defaults();
-    assert_int_equal(ulam_auto(M, bs, &o, &ao, ch, &a, NULL), ULAM_OK);
+    ao = ulam_method_defaults();
+    assert_int_equal(ulam_auto(M, bs, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
     assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
     assert_int_equal(a.method, ULAM_METHOD_BIDIRECTIONAL);
     assert_int_equal(ch->method[ULAM_METHOD_WALKS].state, ULAM_METHOD_PLANNED);

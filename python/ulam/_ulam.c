@@ -131,7 +131,8 @@ static int get_int(PyObject *d, const char *key, int *v)
 }
 
 /* The walk and choice options from the Python half's dict (its keys: the fields' names). */
-static int read_opts(PyObject *d, ulam_walk_opts *o, ulam_auto_opts *ao, int *reuse, int *catch_sigint)
+static int read_opts(PyObject *d, ulam_walk_opts *o, ulam_auto_opts *ao, ulam_method_opts *mo, int *reuse,
+                     int *catch_sigint)
 {
     int64_t seed = (int64_t)o->seed;
     if (get_int(d, "mode", &o->mode) || get_int(d, "estimator", &o->estimator) ||
@@ -141,7 +142,7 @@ static int read_opts(PyObject *d, ulam_walk_opts *o, ulam_auto_opts *ao, int *re
         get_double(d, "roulette", &o->roulette) || get_double(d, "split", &o->split) || get_int64(d, "seed", &seed) ||
         get_int(d, "threads", &o->threads) || get_int(d, "force", &o->force) ||
         get_int(d, "assume_finite", &o->assume_finite) || get_int(d, "whole_kernel", &o->whole_kernel) ||
-        get_int(d, "method", &ao->method) || get_int(d, "pin_mode", &ao->pin_mode) ||
+        get_int(d, "method", &mo->method) || get_int(d, "pin_mode", &ao->pin_mode) ||
         get_int(d, "pin_estimator", &ao->pin_estimator) || get_int(d, "pin_continue", &ao->pin_continue) ||
         get_int(d, "pin_alpha", &ao->pin_alpha) || get_int(d, "reuse", reuse) ||
         get_int(d, "catch_sigint", catch_sigint))
@@ -149,7 +150,7 @@ static int read_opts(PyObject *d, ulam_walk_opts *o, ulam_auto_opts *ao, int *re
     o->seed = (uint64_t)seed;
     int exclude = 0;
     if (get_int(d, "exclude", &exclude)) return -1;
-    ao->exclude = (unsigned)exclude;
+    mo->exclude = (unsigned)exclude;
     return 0;
 }
 
@@ -327,8 +328,9 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
     }
     ulam_walk_opts o = ulam_walk_defaults();
     ulam_auto_opts ao = ulam_auto_defaults();
+    ulam_method_opts mo = ulam_method_defaults();
     int reuse = 0, catch = 0;
-    if (read_opts(od, &o, &ao, &reuse, &catch)) {
+    if (read_opts(od, &o, &ao, &mo, &reuse, &catch)) {
         Py_DECREF(barr);
         return NULL;
     }
@@ -349,7 +351,7 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
     if (catch) catch_sigint(&flag, &old);
     if (!status) {
         Py_BEGIN_ALLOW_THREADS
-        status = ulam_auto_start(&self->M, b, &o, &ao, ch, &run, &err);
+        status = ulam_auto_start(&self->M, b, &o, &ao, &mo, ch, &run, &err);
         Py_END_ALLOW_THREADS
         started = 1;
     }

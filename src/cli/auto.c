@@ -14,10 +14,10 @@
 int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, const char *excluded_why,
                     ulam_choice *ch, ulam_run **run, int *status, ulam_error *err)
 {
-    ulam_auto_opts a = *ao;
-    if (excluded_why) a.exclude |= 1u << ULAM_METHOD_BIDIRECTIONAL;
+    ulam_method_opts mo = ulam_method_defaults();
+    if (excluded_why) mo.exclude |= 1u << ULAM_METHOD_BIDIRECTIONAL;
     ch->walks.chosen = ch->walks.closest = -1;
-    *status = ulam_auto_start(s->M, s->b, o, &a, ch, run, err);
+    *status = ulam_auto_start(s->M, s->b, o, ao, &mo, ch, run, err);
     ulam_method_verdict *v = &ch->method[ULAM_METHOD_BIDIRECTIONAL];
     if (excluded_why && v->state == ULAM_METHOD_NOT_CONSIDERED && !strcmp(v->why, "not considered: excluded"))
         snprintf(v->why, sizeof v->why, "not considered: %s", excluded_why);
