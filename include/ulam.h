@@ -1127,7 +1127,8 @@ typedef struct ulam_answer {
  * its predicted work is below the leader's.  Bidirectional applies to an adjoint query with a
  * rel_err target, nothing pinned it cannot honour (forward mode, the estimator, alpha other than
  * 1, roulette or split), a sparse b (ulam_method_sparse_limit) and a walk leader W above nnz(M)/4
- * (it needs M's transpose); its push is capped at W / 2.  The rows that answer every unknown do
+ * (it needs M's transpose); its push is capped at W / 2 (pinned, a b equal to e_S runs as the
+ * point source S, as `ulam solve --source S` does).  The rows that answer every unknown do
  * not apply to a query for one entry with an error bar (they give none).  ch gets every row's
  * verdict; *out the run (NULL on failure).  Statuses: ulam_auto_solver's (the walks' refusal:
  * ch->walks says which candidate), ULAM_ENOMEM. */

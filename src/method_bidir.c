@@ -138,7 +138,8 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     return ULAM_OK;
 }
 
-/* Pinned: the options as given, b's nonzeros as the sparse b (no plan yet: the solve makes it). */
+/* Pinned: the options as given, b's nonzeros as the sparse b, or b = e_S as the point source S (no
+ * plan yet: the solve makes it). */
 static int pin(ulam__query *q, int k, ulam_error *err)
 {
     (void)k;
@@ -148,6 +149,8 @@ static int pin(ulam__query *q, int k, ulam_error *err)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a sparse b for bidirectional: at most max(16, n/10) = %lld nonzeros, "
                           "not %lld", (long long)ulam_method_sparse_limit(n), (long long)nb);
     int status = setup(q, q->o, err);
+    if (!status && nb == 1 && q->b[q->run->idx[0]] == 1.0) /* b = e_S: a point source, as `ulam solve --source S` */
+        q->run->bo.source = q->run->idx[0], q->run->bo.nb = 0;
     q->ch->bidir_opts = q->run->bo;
     return status;
 }

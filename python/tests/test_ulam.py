@@ -108,6 +108,16 @@ def test_same_as_cli(case):
         assert r.report[k] == o[k], k
 
 
+def test_source_same_as_cli():
+    """source=S is `ulam solve --source S`: the same push, walks and estimate on the same seed."""
+    M = scipy.io.mmread(os.path.join(ROOT, "matrices/randsub1000.mtx")).tocsr()
+    o = cli_json(["solve", os.path.join(ROOT, "matrices/randsub1000.mtx"), "--index", "7", "--source", "3",
+                  "--rel-err", "0.05", "--seed", "5"])
+    r = ulam.solve(M, index=6, source=2, rel_err=0.05, seed=5)
+    assert (r.estimate, r.stderr, r.walks, r.report["rmax"]) == (o["estimate"], o["stderr"], o["walks"], o["rmax"]), o
+    assert r.report["source"] == o["source"] == 3 and r.method == o["method"] == "bidirectional"
+
+
 def test_refusals():
     """The CLI's refusals raise the library's status as ulam.Error subclasses; the interpreter lives."""
     M, b = random_system(50, 4, 0.9, 5)
