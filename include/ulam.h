@@ -1129,8 +1129,10 @@ typedef struct ulam_answer {
  * 1, roulette or split), a sparse b (ulam_method_sparse_limit) and a walk leader W above nnz(M)/4
  * (it needs M's transpose); its push is capped at W / 2 (pinned, a b equal to e_S runs as the
  * point source S, as `ulam solve --source S` does).  The rows that answer every unknown do
- * not apply to a query for one entry with an error bar (they give none).  ch gets every row's
- * verdict; *out the run (NULL on failure).  Statuses: ulam_auto_solver's (the walks' refusal:
+ * not apply to a query for one entry with an error bar (they give none); pinned, they run from
+ * ulam_outer_defaults() and the Krylov peers to its tolerance, with o's seed, threads,
+ * continuation, cut, interrupt and force, and o->max_walks (when set) capping one correction.
+ * ch gets every row's verdict; *out the run (NULL on failure).  Statuses: ulam_auto_solver's (the walks' refusal:
  * ch->walks says which candidate), ULAM_ENOMEM. */
 int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
                     const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err);

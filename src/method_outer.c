@@ -31,7 +31,8 @@ static int pin(ulam__query *q, int k, ulam_error *err)
 }
 
 /* The outer iteration's options from the walk options: its defaults (MCSA's forward expected
- * walks), with the caller's seed, threads, continuation, cut, interrupt, share and force. */
+ * walks), with the caller's seed, threads, continuation, cut, interrupt, share and force, and
+ * max_walks (when set) as the cap on one correction's histories. */
 static ulam_outer_opts outer_opts(const ulam_walk_opts *w, int method)
 {
     ulam_outer_opts o = ulam_outer_defaults();
@@ -39,6 +40,7 @@ static ulam_outer_opts outer_opts(const ulam_walk_opts *w, int method)
     o.walk.seed = w->seed, o.walk.threads = w->threads, o.walk.continue_q = w->continue_q;
     o.walk.max_steps = w->max_steps, o.walk.interrupt = w->interrupt, o.walk.share = w->share;
     o.walk.force = w->force;
+    if (w->max_walks > 0) o.max_histories = w->max_walks;
     return o;
 }
 
