@@ -64,7 +64,7 @@ enum ulam_status {
     ULAM_ENOMEM,       /* out of memory */
     ULAM_EIO,          /* file cannot be opened, read or written */
     ULAM_EEMPTY,       /* input file is empty */
-    ULAM_EBANNER,      /* missing or malformed %%MatrixMarket banner */
+    ULAM_EBANNER,      /* not the kind of file expected: a missing or malformed banner or magic */
     ULAM_EUNSUPPORTED, /* valid Matrix Market, but a kind ulam does not handle (complex, ...) */
     ULAM_ESIZELINE,    /* missing or malformed size line */
     ULAM_EOVERFLOW,    /* sizes too large to represent or allocate */
@@ -174,6 +174,11 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
 /* ---------------------------------------------------------------- Matrix Market */
 /* Primary: ulam_mm_read_matrix, _read_vector, _write_vector.  Secondary: options, FILE readers,
  * _write_matrix.  Tertiary: ulam_strtod, ulam_outfile. */
+
+/* The most rows (and columns) a Matrix Market matrix declaring nnz entries may have: every row
+ * costs memory and time in each pass over M, so a short file may not declare millions of empty
+ * ones (ULAM_EOVERFLOW at the size line).  A vector (n x 1), held dense anyway: 2^24 + 64 nnz. */
+#define ULAM_MM_DIM_CAP(nnz) (((int64_t)1 << 16) + 64 * (int64_t)(nnz))
 
 /* Read a sparse matrix from path ("coordinate" real/integer/pattern, general/symmetric/
  * skew-symmetric; duplicates summed, explicit zeros dropped; symmetric files are
@@ -391,21 +396,24 @@ int ulam_guard_variance(const ulam_guard *g, int mode);
 /* ---------------------------------------------------------------- prepared systems */
 /* Secondary, except tertiary: ulam_system_from_memory, _is_file, _omega, _certificate, _write_file. */
 
-/* A prepared system: M (and b) of (I - M) x = b as one binary file that is mapped read-only
- * and used in place, so a query reads only the pages of the rows its walks reach (the layout
- * is documented in docs/prepared.md: a 1024-byte little-endian header with the sizes, the
- * array offsets, the file length, a certificate section and an FNV-1a checksum of the header,
- * then rowptr int64[nrows + 1], colidx int32[nnz], val double[nnz] and b double[nrows], each
- * at a 4096-byte boundary).  `ulam prepare` writes one; `--cache` keeps one beside each input
- * (a vector's holds only b), tagged with the source's size and modification time. */
+/* A prepared system: M (and b, and optionally M^T) of (I - M) x = b as one binary file that is
+ * mapped read-only and used in place, so a query reads only the pages of the rows its walks
+ * reach.  The layout is documented in docs/prepared.md (format version 2): a 1024-byte
+ * little-endian header (sizes, array offsets, the file length, a certificate section, its own
+ * XXH3 checksum), the arrays at 4096-byte boundaries and a table of XXH3-64 checksums, one for
+ * each block of rows of M, b and M^T.  Every block is verified (checksum and CSR invariants) the
+ * first time anything reads it, once.  `ulam prepare` writes one; `--cache` keeps one beside
+ * each input (a vector's holds only b), tagged with the XXH3-128 hash of the source's bytes. */
 typedef struct ulam_system ulam_system;
 
 /* What the guards certified for a prepared system, so a query needs no pass over M: the
  * radii of ulam_guard_check for the kernel of continuation continue_q and exponent 1 (a
  * query at another kernel exponent computes its own) under power-iteration
  * options (tol, max_iter), and the row- and column-sum bounds of |M| (the largest of either
- * bounds rho(|M|) from above).  Stored in a versioned section of the header (version 1 holds
- * these fields; a reader ignores a version it does not know and the guards run as usual). */
+ * bounds rho(|M|) from above).  Stored in a versioned section of the header (version 3 holds
+ * these fields and the content hash of M's blocks, which binds it to the arrays it certifies; a
+ * later version appends fields and a version-3 reader reads the ones it knows; an earlier one is
+ * ignored and the guards run as usual). */
 typedef struct ulam_certificate {
     double continue_q; /* <= 0: the analog kernel */
     double tol;
@@ -415,8 +423,9 @@ typedef struct ulam_certificate {
 } ulam_certificate;
 
 /* What to write: M and/or b (n entries; with M, n = M->nrows), an optional source tag (the
- * CLI's cache: size and mtime), the Jacobi damping omega that made M (0: M as read) and an
- * optional certificate.  Start from ulam_system_desc_defaults(). */
+ * CLI's cache: ulam_file_tag of the source), the Jacobi damping omega that made M (0: M as
+ * read), an optional certificate of M, and whether to store M^T too (transpose 1: the writer
+ * builds it; ulam_system_transpose then serves it).  Start from ulam_system_desc_defaults(). */
 typedef struct ulam_system_desc {
     const ulam_csr *M;
     const double *b;
@@ -424,26 +433,27 @@ typedef struct ulam_system_desc {
     uint64_t tag[2];
     double omega;
     const ulam_certificate *cert;
+    int transpose;
 } ulam_system_desc;
 
-/* The defaults: nothing to write yet (M, b and cert NULL, n 0, tag {0, 0}, omega 0); set M
- * and/or b and n. */
+/* The defaults: nothing to write yet (M, b and cert NULL, n 0, tag {0, 0}, omega 0, no
+ * transpose); set M and/or b and n. */
 ulam_system_desc ulam_system_desc_defaults(void);
 
 /* Write a prepared system to f (positioned at 0; the caller closes it): ULAM_OK, ULAM_EINVAL
- * (also for a certificate whose guards are not of kernel exponent 1) or ULAM_EIO. */
+ * (also for an M that fails ulam_csr_check, a b not finite, a certificate without M or whose
+ * guards are not of kernel exponent 1), ULAM_ENOMEM or ULAM_EIO. */
 int ulam_system_write_file(FILE *f, const ulam_system_desc *d);
 
 /* Write a prepared system to path atomically (through ulam_outfile). */
 int ulam_system_write(const char *path, const ulam_system_desc *d);
 
-/* Map the prepared system at path read-only.  The header is checked whole: magic
- * (ULAM_EBANNER), version and byte order (ULAM_EUNSUPPORTED), checksum, sizes, offsets and
- * the file's length against them, rowptr[0] = 0 and rowptr[nrows] = nnz (ULAM_ESYNTAX; a
- * truncated file fails here); tag, when not NULL, must match the stored one (ULAM_ENOTFOUND).
- * The arrays are NOT read: ulam_system_check verifies them, and the walk kernel checks each
- * row it builds (ulam_solver_iterate fails with ULAM_ESYNTAX on a corrupt one), so a query
- * that uses the certificate reads only the rows it walks. */
+/* Map the prepared system at path read-only.  Checked at once, in O(blocks): magic and an empty
+ * file (ULAM_EBANNER), version and byte order (ULAM_EUNSUPPORTED), the header's checksum, sizes,
+ * offsets and the file's length against them, the checksum table against its checksum, the
+ * certificate's content hash against the table, rowptr[0] = 0 and rowptr[nrows] = nnz
+ * (ULAM_ESYNTAX; a truncated file fails here); tag, when not NULL, must match the stored one
+ * (ULAM_ENOTFOUND).  The arrays are verified block by block when first read (below). */
 int ulam_system_open(const char *path, const uint64_t tag[2], ulam_system **out, ulam_error *err);
 
 /* As ulam_system_open on bytes already in memory (borrowed: they must outlive the system). */
@@ -453,19 +463,34 @@ int ulam_system_from_memory(const void *data, size_t bytes, const uint64_t tag[2
 /* 1 when path starts with the prepared-system magic, 0 otherwise (unreadable included). */
 int ulam_system_is_file(const char *path);
 
-/* Verify the arrays as a parse would: the CSR invariants (ulam_csr_check) and a finite b;
- * one pass over the file.  ULAM_OK or ULAM_ESYNTAX / ULAM_EINDEX / ULAM_ENONFINITE. */
+/* Verify every block of M, b and M^T (checksums and the CSR invariants of ulam_csr_check, a
+ * finite b): one pass over the file, and none again (each block's verdict is kept).  ULAM_OK or
+ * ULAM_ESYNTAX with err naming the damaged block (err->index its first row) and the fault. */
 int ulam_system_check(const ulam_system *s, ulam_error *err);
 
-/* The mapped matrix (NULL when the file holds only b): read-only, owned by s (never pass it
- * to ulam_csr_free), valid until ulam_system_free.  Not verified: a walk checks each row it
- * builds, but anything that reads all of M (the guards ulam_solver_alloc runs unless
- * ulam_walk_opts.guard holds them, a direct solve) needs ulam_system_check first; a query
- * passes the certificate's guards instead (ulam_certificate_guard). */
+/* Verify the blocks of M and b that hold rows [first, last) (clipped to 0 .. n), as
+ * ulam_system_check does; thread-safe. */
+int ulam_system_verify(const ulam_system *s, int64_t first, int64_t last, ulam_error *err);
+
+/* The mapped matrix, verified whole on the first call (NULL when the file holds none or it is
+ * damaged: ulam_system_check says where): read-only, owned by s (never pass it to
+ * ulam_csr_free), valid until ulam_system_free. */
 const ulam_csr *ulam_system_matrix(const ulam_system *s);
 
-/* The mapped b (NULL when the file holds none); *n (may be NULL) gets its length. */
+/* The mapped b, verified whole (NULL when the file holds none or it is damaged); *n (may be
+ * NULL) gets its length. */
 const double *ulam_system_rhs(const ulam_system *s, int64_t *n);
+
+/* The stored M^T (`ulam prepare --transpose`), verified whole, NULL when the file holds none
+ * or it is damaged: what a bidirectional or point-source query pushes on, with no transpose to
+ * build. */
+const ulam_csr *ulam_system_transpose(const ulam_system *s);
+
+/* The mapped M and b (either may be NULL) as they are, NOT verified: for a solver given
+ * ulam_walk_opts.system = s (and this M), which verifies each block before its walks, its
+ * reachability search or a pass over all of M first read it, so a query for one x_i reads only
+ * the blocks of the rows it reaches.  ULAM_OK, or ULAM_EINVAL for s NULL. */
+int ulam_system_lazy(const ulam_system *s, const ulam_csr **M, const double **b);
 
 /* The stored certificate, or NULL when there is none (or of a version this reader does not know). */
 const ulam_certificate *ulam_system_certificate(const ulam_system *s);
@@ -475,6 +500,11 @@ double ulam_system_omega(const ulam_system *s);
 
 /* Unmap and free; accepts and returns NULL. */
 ulam_system *ulam_system_free(ulam_system *s);
+
+/* The content tag of a source file for a cache (ulam_system_desc.tag, ulam_system_open's tag):
+ * the XXH3-128 hash of its bytes (low, high), so an edit that keeps the size and the modification
+ * time still changes it.  ULAM_OK, ULAM_EIO or ULAM_ENOMEM. */
+int ulam_file_tag(const char *path, uint64_t tag[2], ulam_error *err);
 
 /* The certificate of M: the guards of ulam_guard_check(M, continue_q, opts) and the row and
  * column sums of |M| (one more pass); ULAM_EINVAL for opts->kernel_alpha != 1 (the file's
@@ -552,6 +582,11 @@ typedef struct ulam_walk_opts {
                             sum_j start_weights[j] x_{starts[j]} (index only labels it) */
     const int64_t *starts;       /* k states (0-based), borrowed like b */
     const double *start_weights; /* k finite weights, not all 0 */
+    const ulam_system *system; /* the prepared system M (and b, when it is the system's) come from
+                                  (ulam_system_lazy), or NULL: its blocks are verified as they are
+                                  first read (each row before a walk builds it; every row before a
+                                  pass over all of M), and a damaged one fails the run with
+                                  ULAM_ESYNTAX naming it */
 } ulam_walk_opts;
 
 /* The defaults: adjoint collision walks, index 0, analog kernel (kernel_alpha 1), seed 1, all
@@ -731,11 +766,18 @@ typedef struct ulam_outer_step {
 typedef struct ulam_outer ulam_outer;
 
 /* Prepare the iteration on (I - M) x = b (M and b borrowed until freed).  Refuses options
- * out of range (ULAM_EINVAL), a non-square M, and b = 0 (ULAM_EINVAL: nothing to reduce). */
+ * out of range (ULAM_EINVAL), a non-square M, and b = 0 (ULAM_EINVAL: nothing to reduce); with
+ * walks, also a forward rho(M^) not certified below 1 (ULAM_EINFVAR, before any walk: an
+ * unknown one walks when walk.assume_finite).  The guards come from walk.guard when it holds
+ * rho(|M|) and the forward rho(M^) of this kernel, else they are computed here. */
 int ulam_outer_alloc(const ulam_csr *M, const double *b, const ulam_outer_opts *opts, ulam_outer **out,
                      ulam_error *err);
 
-/* One iteration; fills *step (may be NULL).  ULAM_OK while it may go on or once converged;
+/* One iteration; fills *step (may be NULL).  A walk correction is applied only when it lowers
+ * the residual it was fed; otherwise its walks go on to about N (ratio / 0.5)^2 histories (at
+ * least 4 N) and it is tried again, and when that count exceeds 100 times what the eps1 rule
+ * asked for or max_histories, the run ends with ULAM_ESTALL (step->histories counts every
+ * walk, rejected ones too).  ULAM_OK while it may go on or once converged;
  * then ULAM_ENOCONV at the iteration cap, ULAM_ESTALL when the residual stopped decreasing,
  * ULAM_ENONFINITE for a non-finite residual or walk, ULAM_ENOMEM; each also ends the run. */
 int ulam_outer_iterate(ulam_outer *s, ulam_outer_step *step);
@@ -751,6 +793,14 @@ const double *ulam_outer_x(const ulam_outer *s);
 
 /* Free; accepts and returns NULL. */
 ulam_outer *ulam_outer_free(ulam_outer *s);
+
+/* Why the run ended, as a sentence in err (may be NULL); returns its status (ULAM_OK while it
+ * goes on or once converged). */
+int ulam_outer_error(const ulam_outer *s, ulam_error *err);
+
+/* Corrections rejected so far: a walk correction that did not lower the residual is never
+ * applied; its walks go on to more histories (see ulam_outer_iterate). */
+int ulam_outer_rejected(const ulam_outer *s);
 
 /* Iterate until done into x (n entries); steps (may be NULL) gets up to max_steps records,
  * *nsteps (may be NULL) the iterations run.  Returns the last iterate's status. */
@@ -841,10 +891,19 @@ typedef struct ulam_bidir_opts {
                              push workspace and rescored to the next query's residual, so a query
                              builds only the rows no earlier one reached (its walks are those a new
                              kernel gives, bit for bit; walks.rows counts every row kept) */
+    double step_cost;     /* push operations one walk visit costs, for the balance (<= 0: the
+                             default ULAM_BIDIR_STEP_COST); measure it on the machine and graph at
+                             hand with bench_bidir, which prints push operations/s over walk
+                             visits/s (docs/bidirectional.md) */
 } ulam_bidir_opts;
 
+/* The balance's default cost of one walk visit in push operations: the median of bench_bidir's
+ * measurements, 0.74 and 1.29 on the Zipf family and 1.82 on R-MAT 2^18 (one thread, a 2-core
+ * machine at load ~20, 2026-12-02, docs/bidirectional.md); not the 3 issue 29 supposed. */
+#define ULAM_BIDIR_STEP_COST 1.3
+
 /* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
- * (the default cap), walk ulam_walk_defaults(). */
+ * (the default cap), walk ulam_walk_defaults(), step_cost 0 (ULAM_BIDIR_STEP_COST). */
 ulam_bidir_opts ulam_bidir_defaults(void);
 
 /* A bidirectional estimate's plan (ulam_bidir_plan): the push it runs and what the walks after it
@@ -870,6 +929,8 @@ typedef struct ulam_bidir_plan_info {
     int64_t pilot_units;    /* kernel units (16 bytes of a row) the pilot's solver built on Mt */
     int64_t pilot_reads;    /* entries its reachability checks and score-bound passes read */
     double seconds;         /* wall time of the plan: pilot and push */
+    double probe;           /* a lower bound on |x_t| from 1024 walks scoring the residual midway
+                               (0: no probe ran, or it saw nothing), which the balance plans for */
 } ulam_bidir_plan_info;
 
 /* Plan a bidirectional estimate without its walks: start the push at o->target and, when o->rmax
@@ -909,6 +970,46 @@ typedef struct ulam_bidir_result {
  * range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap), the walk solver's statuses. */
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err);
+
+/* Single source, every target (src/fpush.c; FORA, Wang et al., KDD 2017): x = (I - M)^-1 e_s by
+ * a forward push from s (the reverse push of ulam_push on M'), leaving x = p + (I - M)^-1 r, and
+ * forward walks on M from r that estimate every component of the rest.  Start from
+ * ulam_fpush_defaults(). */
+typedef struct ulam_fpush_opts {
+    int64_t source;      /* 0-based s */
+    double rel_err;      /* FORA's target: relative error E on every x_i >= min_value (default 0.1) */
+    double min_value;    /* delta (<= 0: 1 / n) */
+    int64_t walks;       /* > 0: this many walks (the balance pushes to what they cost); 0: FORA's
+                            count ||r||_1 (2E/3 + 2) ln(2n) / (E^2 delta) */
+    double rmax;         /* > 0: push threshold; <= 0: halve from 1 while the push's operations are
+                            below the walks' work (walks x visits x step_cost) */
+    double step_cost;    /* push operations a walk visit costs (<= 0: ULAM_BIDIR_STEP_COST) */
+    ulam_walk_opts walk; /* seed, threads, estimator, continue_q, guard (mode forced forward) */
+} ulam_fpush_opts;
+
+/* The defaults: source 0, rel_err 0.1, min_value 0, walks 0, rmax 0, step_cost 0, walk
+ * ulam_walk_defaults() in forward mode. */
+ulam_fpush_opts ulam_fpush_defaults(void);
+
+/* What a single-source estimate did. */
+typedef struct ulam_fpush_info {
+    double rmax;           /* the push threshold */
+    ulam_push_info push;   /* the push */
+    double mean_visits;    /* V the balance took: 1 / (1 - ||M||_1) */
+    double residual_bound; /* ||r||_1 / (1 - ||M||_1): the most the walks' part of any x_i can be
+                              (INFINITY: ||M||_1 >= 1, no bound) */
+    int64_t walks, steps;  /* the walks and their transitions */
+    int interrupted;
+    double seconds, push_seconds, walk_seconds;
+} ulam_fpush_info;
+
+/* Estimate every x_i of (I - M) x = e_source into x (n entries); std_error, lo and hi (each may
+ * be NULL) get each component's standard error and 95% interval: p_i + the walks' normal
+ * interval where the walks scored two values at i, else p_i -+ residual_bound (NaN when there is
+ * none), always clipped to p_i -+ residual_bound.  Mt is M's transpose.  ULAM_OK, ULAM_EINVAL,
+ * ULAM_ENOCONV (push cap 100 nnz + 10^6), ULAM_ENOMEM, the walk solver's statuses. */
+int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, double *x, double *std_error,
+                     double *lo, double *hi, ulam_fpush_info *info, ulam_error *err);
 
 /* ---------------------------------------------------------------- choosing the method */
 /* All secondary. */
