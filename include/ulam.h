@@ -24,7 +24,8 @@
  *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
  *     ulam_guard_check, ulam_walk_defaults, ulam_solver_alloc, ulam_solver_iterate,
  *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
- *     ulam_solver_free, ulam_solve, ulam_direct_solve, ulam_mm_write_vector, ulam_strerror;
+ *     ulam_solver_free, ulam_solve, ulam_auto (the method table's choice: what `ulam solve` runs),
+ *     ulam_direct_solve, ulam_mm_write_vector, ulam_strerror;
  *   secondary, more control and the other methods: building and transforming matrices
  *     (ulam_csr_alloc, _from_triplets, _check, _transpose, ulam_jacobi), reader options and
  *     files (ulam_mm_read_matrix_opts, _file, ulam_mm_write_matrix), verdicts
@@ -32,7 +33,7 @@
  *     (ulam_spectral_power, ulam_spectral_radius), prepared systems (ulam_system_*,
  *     ulam_certificate_*), processes (ulam_share), outer iterations (ulam_outer_*), Krylov
  *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_plan, ulam_bidir_solve), the method
- *     choice (ulam_auto_choose), ulam_direct_bytes;
+ *     table and its choice (ulam_method_*, ulam_auto_start, ulam_run_*, ulam_auto_choose), ulam_direct_bytes;
  *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
  *     ulam_strtod, ulam_outfile_*, ulam_spectral_radius_op, ulam_gauss_seidel_*, the studies'
  *     method grid and exact value (ulam_study_*), random numbers (ulam_rng_*), ulam_now.
@@ -1146,6 +1147,136 @@ int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *b
  * a status when none is left).  Its refusals are ulam_solver_alloc's. */
 int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
                      ulam_auto_result *res, ulam_solver **out, ulam_error *err);
+
+/* ---------------------------------------------------------------- the method table */
+/* All secondary, except primary: ulam_auto. */
+
+/* The methods, rows of one table (src/method.c; GSL's gsl_root_fsolver_type): each has a name,
+ * an applicability test, a cost prediction in the work model's units (ULAM_AUTO_*) and a run.
+ * Rows answer one of two questions: one entry x_i with an error bar (walks, bidirectional) or
+ * every unknown to a residual tolerance (the outer iterations and the Krylov peers; asked for
+ * one entry they answer x_i without an error bar).  Row k's number is stable: */
+enum ulam_method_row {
+    ULAM_METHOD_WALKS = 0,         /* adjoint or forward walks: mode x estimator x continuation x
+                                      kernel exponent, raced by ulam_auto_choose */
+    ULAM_METHOD_BIDIRECTIONAL = 1, /* reverse push from the index, walks from a sparse b */
+    ULAM_METHOD_RICHARDSON = 2,    /* then ULAM_METHOD_RICHARDSON + enum ulam_method: richardson, */
+    ULAM_METHOD_GAUSS_SEIDEL = 3,  /* gauss-seidel, */
+    ULAM_METHOD_SEQUENTIAL = 4,    /* sequential, */
+    ULAM_METHOD_MCSA = 5,          /* mcsa (ulam_outer_*), */
+    ULAM_METHOD_CG = 6,            /* then the Krylov peers cg */
+    ULAM_METHOD_GMRES = 7,         /* and gmres */
+    ULAM_NMETHODS = 8
+};
+
+/* What a row answers. */
+enum { ULAM_ANSWERS_ENTRY = 1, ULAM_ANSWERS_ALL = 2 };
+
+/* Row k's name ("walks", "bidirectional", "richardson", "gauss-seidel", "sequential", "mcsa", "cg",
+ * "gmres"), or NULL when k is out of range. */
+const char *ulam_method_name(int k);
+
+/* The row named name, or -1. */
+int ulam_method_find(const char *name);
+
+/* What row k answers: ULAM_ANSWERS_ENTRY or ULAM_ANSWERS_ALL (0 out of range). */
+int ulam_method_answers(int k);
+
+/* The densest b the bidirectional row takes: nonzeros at most max(16, n / 10). */
+int64_t ulam_method_sparse_limit(int64_t n);
+
+/* Which rows a choice may take.  Start from ulam_method_defaults(). */
+typedef struct ulam_method_opts {
+    int method;       /* the row pinned (enum ulam_method_row); -1: choose among the rows */
+    unsigned exclude; /* bit k set: row k (not the walks) is not considered (its why says "not
+                         considered: excluded"; a caller may write its own reason there) */
+} ulam_method_opts;
+
+/* The defaults: no row pinned (method -1), none excluded. */
+ulam_method_opts ulam_method_defaults(void);
+
+/* What became of a row in a choice. */
+enum ulam_method_state {
+    ULAM_METHOD_NOT_CONSIDERED = 0, /* its applicability test failed (why says which) */
+    ULAM_METHOD_PLANNED = 1,        /* applicable and its cost predicted (or refused, or dropped while
+                                       predicting: why says), not chosen */
+    ULAM_METHOD_CHOSEN = 2          /* the row that runs */
+};
+
+/* One row's verdict. */
+typedef struct ulam_method_verdict {
+    int state;             /* enum ulam_method_state */
+    double predicted_work; /* its predicted work in the work model's units (NaN: not predicted) */
+    char why[320];         /* states 0 and 1: why not, in one line (empty when chosen) */
+} ulam_method_verdict;
+
+/* The choice among the rows for one query (ulam_auto_start). */
+typedef struct ulam_choice {
+    int chosen;                   /* the row that runs (enum ulam_method_row; -1: none) */
+    int pinned;                   /* 1: the row was pinned (ulam_method_opts.method), not chosen */
+    ulam_method_verdict method[ULAM_NMETHODS];
+    ulam_auto_result walks;       /* the walks row's race (ulam_auto_choose): its candidates */
+    double leader_work;           /* the walks' chosen candidate's predicted work (NaN: none) */
+    ulam_bidir_plan_info bidir;   /* the bidirectional row's plan (state PLANNED or CHOSEN) */
+    ulam_bidir_opts bidir_opts;   /* the options it was planned with and runs with (its b arrays
+                                     are owned by the run: valid until ulam_run_free) */
+    double transpose_seconds;     /* the bidirectional row's transpose of M */
+} ulam_choice;
+
+/* A chosen method ready to run (opaque): the walk solver, the bidirectional plan, or the outer
+ * iteration's options. */
+typedef struct ulam_run ulam_run;
+
+/* What a run answered: x_index with an error bar (NaN without one: the rows that answer every
+ * unknown to a residual), the row that ran, the options its walks ran with (the choice's mode,
+ * estimator, continuation and exponent; borrowed pointers as given) and the row's own result. */
+typedef struct ulam_answer {
+    int method;                  /* enum ulam_method_row */
+    double estimate, std_error, ci95[2];
+    ulam_walk_opts opts;         /* walks: the options of the run (the choice's); else as given */
+    ulam_walk_result walks;      /* walks: the run; bidirectional: its walks (on <r, x>) */
+    ulam_bidir_result bidir;     /* bidirectional only */
+    ulam_guard guard;            /* walks: the guards the run walked under */
+    int iterations;              /* outer or Krylov rows: iterations (matrix-vector products for Krylov) */
+    double residual;             /* outer or Krylov rows: the final relative residual */
+    int status;                  /* the run's status (ULAM_OK; ENOCONV, ESTALL for the outer rows) */
+} ulam_answer;
+
+/* Choose the method for x_{o->index} of (I - M) x = b under o's options, ao's pins of the walks'
+ * candidates (ao NULL: ulam_auto_defaults()) and mo's of the rows (mo NULL:
+ * ulam_method_defaults(), every row considered): with mo->method >= 0 that row alone, as o says (walks: ulam_solver_alloc on o, no pilots: bit for bit what ulam_solve does);
+ * else every row of the table in order: the walks row races its candidates (ulam_auto_solver),
+ * then each other row's applicability test and cost prediction, a row replacing the leader when
+ * its predicted work is below the leader's.  Bidirectional applies to an adjoint query with a
+ * rel_err target, nothing pinned it cannot honour (forward mode, the estimator, alpha other than
+ * 1, roulette or split), a sparse b (ulam_method_sparse_limit) and a walk leader W above nnz(M)/4
+ * (it needs M's transpose); its push is capped at W / 2 (pinned, a b equal to e_S runs as the
+ * point source S, as `ulam solve --source S` does).  The rows that answer every unknown do
+ * not apply to a query for one entry with an error bar (they give none); pinned, they run from
+ * ulam_outer_defaults() and the Krylov peers to its tolerance, with o's seed, threads,
+ * continuation, cut, interrupt and force, and o->max_walks (when set) capping one correction.
+ * ch gets every row's verdict; *out the run (NULL on failure).  Statuses: ulam_auto_solver's (the walks' refusal:
+ * ch->walks says which candidate), ULAM_ENOMEM. */
+int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                    const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err);
+
+/* The walk solver of a run of the walks row (borrowed: iterate it, read it; freed by
+ * ulam_run_free), or NULL for another row. */
+ulam_solver *ulam_run_solver(ulam_run *r);
+
+/* Run to the end (walks: iterate the solver until done) and fill *a.  The walks' statuses, the
+ * bidirectional and outer rows' (ULAM_ENOCONV, ULAM_ESTALL with a filled; a->status holds it). */
+int ulam_run_finish(ulam_run *r, ulam_answer *a, ulam_error *err);
+
+/* Free a run; accepts and returns NULL. */
+ulam_run *ulam_run_free(ulam_run *r);
+
+/* The library's `ulam solve`: ulam_auto_start, ulam_run_finish, ulam_run_free in one call
+ * (ch may be NULL).  With ao and mo NULL it chooses as `ulam solve` does by default (the same
+ * choice and, on the same seed, the same estimate); pin a row with mo->method
+ * (ULAM_METHOD_WALKS: ulam_solve's run, bit for bit). */
+int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+              const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
 /* All tertiary. */

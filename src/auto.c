@@ -139,7 +139,7 @@ static double predict(const chooser *c, int k, double var, double *walks)
     *walks = N;
     double cap = (double)ulam_csr_nnz(c->M) + 3.0 * (double)c->M->nrows, u = (double)g->units;
     double reach = g->walks > 0 ? fmin(cap, u * N / (double)g->walks) : cap;
-    if (reach * 4 > cap) reach = cap; /* the solver then builds the rest at once */
+    if (reach * ULAM__COMPLETE > cap) reach = cap; /* the solver then builds the rest at once */
     return N * work_per_walk(c, k) + ULAM_AUTO_BUILD * fmax(0.0, reach - u);
 }
 

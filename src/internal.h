@@ -151,6 +151,10 @@ struct ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s);
 /* The states a solver's walks can reach (n flags; NULL unless its reachability check ran). */
 const char *ulam__solver_reached(const ulam_solver *s);
 
+/* The walk solver builds the rest of its kernel at once when walks have built 1 / ULAM__COMPLETE
+ * of it row by row (src/solve.c: the rent-or-buy rule); the choice's work models predict it. */
+enum { ULAM__COMPLETE = 4 };
+
 /* A check of rows [first, last) of a borrowed matrix (and, with with_b, of b at those rows) made
  * before anything reads them: ULAM_OK, or ULAM_ESYNTAX with *bad (may be NULL) the first row of the
  * damaged block.  Thread-safe.  fn NULL: nothing to check.  A prepared system's (src/cache.c): a

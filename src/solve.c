@@ -21,7 +21,7 @@
  * row built at a first visit costs about 3 times one built in the whole streaming pass
  * (measured, n = 10^6 .. 10^7), so by then the run has spent on row-by-row building about
  * what the pass costs (the rent-or-buy rule), and a run that far will likely reach the rest. */
-enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = 4 };
+enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = ULAM__COMPLETE };
 
 #define TAIL_E 0.01 /* the target a run without rel_err reports its tail_bound at */
 

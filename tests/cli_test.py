@@ -193,7 +193,7 @@ CASES += [
 
 CASES += [
     # --method auto (src/cli/auto.c)
-    (RS0 + ["--method", "sideways"], 2, r"--method expects auto, walks, bidirectional \(with --source\), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got 'sideways'", r"^$"),
+    (RS0 + ["--method", "sideways"], 2, r"--method expects auto, walks, bidirectional \(with --source or a sparse b\), richardson, gauss-seidel, sequential, mcsa, cg or gmres, got 'sideways'", r"^$"),
     (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--method", "auto",
       "--rel-err", "0.01"], 3, r"error: --method auto: no candidate has a certified finite variance \(rho\(\|M\|\) is not "
      r"certified below 1\); the closest is .*a --rel-err target cannot be met honestly", r"^$"),
@@ -1554,6 +1554,27 @@ def check_auto_bidir(progs):
         assert o["auto"]["bidirectional"].startswith("not considered: the walks' predicted work"), o["auto"]
 
 
+def check_method_table(ulam):
+    """Every row of the library's method table (the names --method's usage error lists, from the
+    table) is reachable from the CLI by name: each runs, and its --json names it."""
+    rc, out, err = run(ulam, RS0 + ["--method", "sideways"])
+    names = re.search(r"--method expects auto, (.*), got", err).group(1)
+    names = [w for w in re.split(r", | or ", re.sub(r" \([^)]*\)", "", names))]
+    assert names[:2] == ["walks", "bidirectional"] and len(names) == 8, names
+    p20 = ["solve", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--jacobi", "--json", "--index", "3"]
+    for name in names:
+        args = (RS0 + ["--walks", "2000", "--json"] if name == "walks"
+                else PS + ["--rhs", D + "sparse3_b.mtx", "--walks", "2000", "--json"] if name == "bidirectional"
+                else p20 + ["--tol", "1e-6", "--out", os.devnull])
+        rc, out, err = run(ulam, args + ["--method", name])
+        assert rc == 0, (name, err)
+        o = json.loads(out)
+        if name == "walks":  # the walks' JSON names their mode and estimator, and no choice ran
+            assert o["mode"] == "adjoint" and o["estimator"] == "collision" and "auto" not in o, o
+        else:
+            assert o["method"] == name, (name, o)
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -1587,7 +1608,7 @@ def main():
              (check_radiosity_matrix_rel_err, ulam), (check_radiosity_grid, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
-             (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),
+             (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
              (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
              (check_systems_as_held, ulam)]

@@ -28,7 +28,7 @@ CASES = [  # arguments, exit code, stderr regex, stdout regex
     (P20 + ["--method", "mcsa", "--max-iter", "0"], 2, r"--max-iter expects an integer from 1", r"^$"),
     (P20 + ["--method", "gauss-seidel", "--index", "3"], 0, r"^$", r"^x\[3\]\s+[\d.]+$"),  # x_I without --out
     (P20 + ["--method", "mcsa", "--eps1", "0"], 2, r"--eps1 expects .*strictly between 0 and 1", r"^$"),
-    (P20 + ["--method", "newton"], 2, r"--method expects auto, walks, bidirectional \(with --source\), mcsa, sequential, richardson, gauss-seidel, cg or gmres", r"^$"),
+    (P20 + ["--method", "newton"], 2, r"--method expects auto, walks, bidirectional \(with --source or a sparse b\), richardson, gauss-seidel, sequential, mcsa, cg or gmres, got .newton.", r"^$"),
     (P20 + ["--method", "mcsa", "--walks", "10"], 2, r"unknown option '--walks'", r"^$"),
     (["solve", M + "poisson20.mtx", "--method", "mcsa"], 2, r"needs --rhs", r"^$"),
     (P20 + ["--method", "mcsa", "--out", "/nonexistent/dir/x.mtx"], 13, r"x\.mtx.*writable output file", r"^$"),

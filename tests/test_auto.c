@@ -200,6 +200,110 @@ static void test_none(void **state)
     ulam_csr_free(M);
 }
 
+/* The method table: every row has a name that finds it, answers one of the two questions, and is
+ * reachable from ulam_auto pinned by its number; unpinned, the rows that answer every unknown are
+ * not considered for an entry query (each says why), and the walks and bidirectional rows are
+ * each chosen on a system where they are cheaper.  Pinned walks are ulam_solve's run bit for bit;
+ * every pinned answer agrees with LAPACK (walks and bidirectional within 4 sigma, the rest to
+ * their residual tolerance). */
+static void test_table(void **state)
+{
+    (void)state;
+    assert_null(ulam_method_name(-1));
+    assert_null(ulam_method_name(ULAM_NMETHODS));
+    assert_int_equal(ulam_method_find("sideways"), -1);
+    assert_int_equal(ulam_method_find(NULL), -1);
+    for (int k = 0; k < ULAM_NMETHODS; k++) {
+        assert_non_null(ulam_method_name(k));
+        assert_int_equal(ulam_method_find(ulam_method_name(k)), k);
+        assert_int_equal(ulam_method_answers(k), k <= ULAM_METHOD_BIDIRECTIONAL ? ULAM_ANSWERS_ENTRY : ULAM_ANSWERS_ALL);
+    }
+    /* a symmetric tridiagonal M (0.3 off the diagonal: rho(|M|) < 0.6) with b = e_1 + e_30 */
+    enum { N = 60 };
+    int32_t ti[2 * N], tj[2 * N];
+    double tx[2 * N], b[N] = {0}, x[N];
+    int64_t nz = 0;
+    for (int i = 0; i + 1 < N; i++) {
+        ti[nz] = i, tj[nz] = i + 1, tx[nz++] = 0.3;
+        ti[nz] = i + 1, tj[nz] = i, tx[nz++] = 0.3;
+    }
+    b[1] = 1.0, b[30] = 0.5;
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(N, N, nz, ti, tj, tx, &M), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 3, o.seed = 5, o.max_walks = 20000, o.threads = 2;
+    ulam_method_opts ao = ulam_method_defaults();
+    assert_int_equal(ao.method, -1);
+    ulam_choice *ch = malloc(sizeof *ch);
+    ulam_answer a;
+    for (int k = 0; k < ULAM_NMETHODS; k++) {
+        ao.method = k;
+        assert_int_equal(ulam_auto(M, b, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
+        assert_int_equal(ch->chosen, k);
+        assert_int_equal(a.method, k);
+        assert_true(ch->pinned && ch->method[k].state == ULAM_METHOD_CHOSEN);
+        if (k <= ULAM_METHOD_BIDIRECTIONAL) {
+            /* (bidirectional may push this small system whole: exact to rounding, stderr 0) */
+            assert_true(a.std_error >= 0 && fabs(a.estimate - x[3]) <= 4 * a.std_error + 1e-12 * fabs(x[3]));
+            assert_true(a.std_error > 0 || k == ULAM_METHOD_BIDIRECTIONAL);
+            assert_true(a.ci95[0] <= a.estimate && a.estimate <= a.ci95[1]);
+        } else {
+            assert_true(isnan(a.std_error) && isnan(a.ci95[0]) && a.residual <= 1e-8);
+            assert_true(fabs(a.estimate - x[3]) <= 1e-6 * fabs(x[3]));
+        }
+        if (k == ULAM_METHOD_WALKS) { /* ulam_solve's run */
+            ulam_walk_result r;
+            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            assert_true(same_result(&r, &a.walks));
+        }
+    }
+    /* unpinned: the walks (no rel_err target: bidirectional has no figure to compare) */
+    ao.method = -1;
+    assert_int_equal(ulam_auto(M, b, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
+    assert_int_equal(ch->chosen, ULAM_METHOD_WALKS);
+    assert_false(ch->pinned);
+    assert_int_equal(ch->method[ULAM_METHOD_BIDIRECTIONAL].state, ULAM_METHOD_NOT_CONSIDERED);
+    assert_non_null(strstr(ch->method[ULAM_METHOD_BIDIRECTIONAL].why, "no --rel-err target"));
+    for (int k = ULAM_METHOD_RICHARDSON; k < ULAM_NMETHODS; k++) {
+        assert_int_equal(ch->method[k].state, ULAM_METHOD_NOT_CONSIDERED);
+        assert_non_null(strstr(ch->method[k].why, "every unknown"));
+    }
+    assert_true(fabs(a.estimate - x[3]) < 4 * a.std_error);
+    /* the same choice and estimate as ulam_auto_solver's solver iterated (what ulam solve runs) */
+    ulam_auto_result *res = malloc(sizeof *res);
+    ulam_solver *sv = NULL;
+    ulam_walk_result r;
+    assert_int_equal(ulam_auto_solver(M, b, &o, NULL, res, &sv, NULL), ULAM_OK);
+    assert_int_equal(walk_out(sv, &r), ULAM_OK);
+    assert_int_equal(res->chosen, ch->walks.chosen);
+    assert_true(same_result(&r, &a.walks));
+    ulam_solver_free(sv);
+    /* an excluded row says so */
+    ao.exclude = 1u << ULAM_METHOD_BIDIRECTIONAL;
+    o.rel_err = 0.05, o.max_walks = 0;
+    assert_int_equal(ulam_auto(M, b, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
+    assert_string_equal(ch->method[ULAM_METHOD_BIDIRECTIONAL].why, "not considered: excluded");
+    ulam_csr_free(M);
+    /* bidirectional chosen: randsub1000's x_7 for a 3-nonzero b at rel_err 0.02 (the CLI's case) */
+    int64_t n;
+    double *bs = must_read_vector("tests/data/sparse3_b.mtx", &n), *b2, *x2 = malloc(1000 * sizeof *x2);
+    M = load("randsub1000", &b2);
+    assert_int_equal(ulam_direct_solve(M, bs, x2, 0, NULL, NULL), ULAM_OK);
+    o = ulam_walk_defaults();
+    o.index = 6, o.rel_err = 0.02, o.max_walks = 0;
+    ao = ulam_method_defaults();
+    assert_int_equal(ulam_auto(M, bs, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
+    assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
+    assert_int_equal(a.method, ULAM_METHOD_BIDIRECTIONAL);
+    assert_int_equal(ch->method[ULAM_METHOD_WALKS].state, ULAM_METHOD_PLANNED);
+    assert_true(ch->method[ULAM_METHOD_BIDIRECTIONAL].predicted_work < ch->leader_work);
+    assert_non_null(strstr(ch->method[ULAM_METHOD_WALKS].why, "lost: "));
+    assert_true(fabs(a.estimate - x2[6]) < 4 * a.std_error && a.std_error <= 0.02 * fabs(a.estimate));
+    free(bs), free(b2), free(x2), free(res), free(ch);
+    ulam_csr_free(M);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -207,6 +311,7 @@ int main(void)
         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_pins),
         cmocka_unit_test(test_none),
+        cmocka_unit_test(test_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -6,14 +6,22 @@
 #include <string.h>
 
 
-/* Choose for s (loaded) under o (what ao pins stays), make the solver *sv and set o's mode,
- * estimator and continuation to the choice; *status gets the solver's refusal (err filled) for the
- * caller to report as a plain run's.  0, or an exit code (message printed) when the library fails
- * or when no candidate is certified and o asks for a --rel-err target (the closest is named). */
-int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, ulam_auto_result *res,
-                    ulam_solver **sv, int *status, ulam_error *err)
+/* Choose for s (loaded) under o (what ao pins stays) through the library's method table, make
+ * the run *run and set o's mode, estimator and continuation to the walks' choice; *status gets the
+ * refusal (err filled) for the caller to report as a plain run's.  0, or an exit code (message
+ * printed) when the library fails or when no candidate is certified and o asks for a --rel-err
+ * target (the closest is named). */
+int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, const char *excluded_why,
+                    ulam_choice *ch, ulam_run **run, int *status, ulam_error *err)
 {
-    *status = ulam_auto_solver(s->M, s->b, o, ao, res, sv, err);
+    ulam_method_opts mo = ulam_method_defaults();
+    if (excluded_why) mo.exclude |= 1u << ULAM_METHOD_BIDIRECTIONAL;
+    ch->walks.chosen = ch->walks.closest = -1;
+    *status = ulam_auto_start(s->M, s->b, o, ao, &mo, ch, run, err);
+    ulam_method_verdict *v = &ch->method[ULAM_METHOD_BIDIRECTIONAL];
+    if (excluded_why && v->state == ULAM_METHOD_NOT_CONSIDERED && !strcmp(v->why, "not considered: excluded"))
+        snprintf(v->why, sizeof v->why, "not considered: %s", excluded_why);
+    const ulam_auto_result *res = &ch->walks;
     int k = res->chosen >= 0 ? res->chosen : res->closest;
     if (k < 0) return cli_report(s->matrix_path, err);
     const ulam_auto_candidate *c = &res->cand[k];
@@ -27,7 +35,7 @@ int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts
                 c->continue_q > 0 ? c->continue_q : 0.0, c->kernel_alpha, c->hat.rho, c->hat.upper,
                 o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it", hint);
         if (o->rel_err > 0) {
-            *sv = ulam_solver_free(*sv);
+            *run = ulam_run_free(*run);
             return diverge ? EXIT_DIVERGE : EXIT_INFVAR;
         }
     }
@@ -54,10 +62,13 @@ static double pilot_share(const ulam_auto_result *res)
 }
 
 /* The candidates and the choice, as text. */
-void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc)
+void cli_auto_print_text(const ulam_choice *ch, int bidir)
 {
+    const ulam_auto_result *res = &ch->walks;
+    const ulam_method_verdict *v = &ch->method[ULAM_METHOD_BIDIRECTIONAL];
+    int bstate = bidir ? v->state : 0;
     if (cli_verbosity < 1) { /* one line: what was chosen among how many; --verbose lists them */
-        if (bc && bc->state == 2)
+        if (bstate == ULAM_METHOD_CHOSEN)
             printf("auto            chose bidirectional over %d walk candidates (--verbose lists them)\n", res->ncand);
         else if (res->chosen >= 0)
             printf("auto            chose it among %d candidates by predicted cost (--verbose lists them)\n", res->ncand);
@@ -66,9 +77,9 @@ void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc)
                    res->ncand);
         return;
     }
-    if (bc && bc->state == 2)
+    if (bstate == ULAM_METHOD_CHOSEN)
         printf("auto            chose bidirectional: its predicted work %.3g units is below the walk leader's %.3g "
-               "(%d walk candidates after %d pilot stages; guards and pilots %.3f s)\n", bc->work, bc->leader_work,
+               "(%d walk candidates after %d pilot stages; guards and pilots %.3f s)\n", v->predicted_work, ch->leader_work,
                res->ncand, res->stages, res->seconds);
     else if (res->chosen >= 0)
         printf("auto            chose the least predicted %s of %d candidates after %d pilot stages; the pilots' "
@@ -79,7 +90,7 @@ void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc)
         printf("auto            no certified candidate among %d: ran the closest\n", res->ncand);
     for (int k = 0; k < res->ncand; k++) {
         const ulam_auto_candidate *c = &res->cand[k];
-        printf("  %c %-8s %-10s ", k == res->chosen && !(bc && bc->state == 2) ? '*' : ' ', cli_mode_names[c->mode], cli_estimator_names[c->estimator]);
+        printf("  %c %-8s %-10s ", k == res->chosen && !(bstate == ULAM_METHOD_CHOSEN) ? '*' : ' ', cli_mode_names[c->mode], cli_estimator_names[c->estimator]);
         print_q(c->continue_q);
         printf(" alpha %-3.3g", c->kernel_alpha);
         if (isfinite(c->hat.upper)) printf(" rho(M^) %-9.4g ", c->hat.rho);
@@ -93,22 +104,25 @@ void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc)
                    c->steps_per_walk, c->predicted_walks, c->predicted_work, c->predicted_seconds,
                    c->state == ULAM_AUTO_DROPPED ? "  dropped" : "");
     }
-    if (!bc) return;
-    printf("  %c bidirectional (reverse push, walks from b) ", bc->state == 2 ? '*' : ' ');
-    if (bc->state)
-        printf("rmax %.3g  push %lld ops  pilot %lld walks  predicted %.4g walks, %.3g units%s%s\n", bc->plan.rmax,
-               (long long)bc->plan.push.ops, (long long)bc->plan.pilot_walks, bc->plan.predicted_walks, bc->work,
-               bc->state == 2 ? "" : "  ", bc->state == 2 ? "" : bc->why);
+    if (!bidir) return;
+    printf("  %c bidirectional (reverse push, walks from b) ", bstate == ULAM_METHOD_CHOSEN ? '*' : ' ');
+    if (bstate)
+        printf("rmax %.3g  push %lld ops  pilot %lld walks  predicted %.4g walks, %.3g units%s%s\n", ch->bidir.rmax,
+               (long long)ch->bidir.push.ops, (long long)ch->bidir.pilot_walks, ch->bidir.predicted_walks, v->predicted_work,
+               bstate == ULAM_METHOD_CHOSEN ? "" : "  ", bstate == ULAM_METHOD_CHOSEN ? "" : v->why);
     else
-        printf("%s\n", bc->why);
+        printf("%s\n", v->why);
 }
 
 /* The candidates and the choice, as the JSON key "auto" (followed by a comma). */
-void cli_auto_print_json(const ulam_auto_result *res, const cli_bidir_cand *bc)
+void cli_auto_print_json(const ulam_choice *ch, int bidir)
 {
+    const ulam_auto_result *res = &ch->walks;
+    const ulam_method_verdict *v = &ch->method[ULAM_METHOD_BIDIRECTIONAL];
+    int bstate = bidir ? v->state : 0;
     /* 1-based positions in "candidates", as every index a user sees (0: none) */
     printf("\"auto\": {\"chosen\": %d, \"closest\": %d, \"stages\": %d, ",
-           (bc && bc->state == 2 ? res->ncand : res->chosen) + 1, res->closest + 1, res->stages);
+           (bstate == ULAM_METHOD_CHOSEN ? res->ncand : res->chosen) + 1, res->closest + 1, res->stages);
     cli_json_number("seconds", res->seconds, 0);
     cli_json_number("pilot_work", res->pilot_work, 0);
     cli_json_number("reused_work", res->reused_work, 0);
@@ -124,7 +138,7 @@ void cli_auto_print_json(const ulam_auto_result *res, const cli_bidir_cand *bc)
         cli_json_number("rho_hat", isfinite(c->hat.upper) ? c->hat.rho : NAN, 0);
         cli_json_number("rho_hat_upper", c->hat.upper, 0);
         printf("\"certified\": %s, ", c->certified ? "true" : "false");
-        cli_json_string("state", state_names[c->state == ULAM_AUTO_CHOSEN && bc && bc->state == 2 ? ULAM_AUTO_FINALIST : c->state], 0);
+        cli_json_string("state", state_names[c->state == ULAM_AUTO_CHOSEN && bstate == ULAM_METHOD_CHOSEN ? ULAM_AUTO_FINALIST : c->state], 0);
         cli_json_string("status", c->status ? ulam_strerror(c->status) : "ok", 0);
         printf("\"pilot_walks\": %lld, ", (long long)c->pilot_walks);
         cli_json_number("variance", c->pilot_walks ? c->variance : NAN, 0);
@@ -137,23 +151,23 @@ void cli_auto_print_json(const ulam_auto_result *res, const cli_bidir_cand *bc)
         cli_json_number("predicted_seconds", c->predicted_seconds, 1);
         printf("}");
     }
-    if (bc && bc->state) { /* planned: the last entry (chosen: index ncand) */
+    if (bstate) { /* planned: the last entry (chosen: index ncand) */
         printf("%s{", res->ncand ? ", " : "");
         cli_json_string("mode", "bidirectional", 0);
-        cli_json_string("state", bc->state == 2 ? "chosen" : bc->state == 1 ? "planned" : "not_considered", 0);
-        cli_json_number("rmax", bc->state ? bc->plan.rmax : NAN, 0);
-        printf("\"push_ops\": %lld, \"pilot_walks\": %lld, ", (long long)(bc->state ? bc->plan.push.ops : 0),
-               (long long)(bc->state ? bc->plan.pilot_walks : 0));
-        cli_json_number("predicted_walks", bc->state ? bc->plan.predicted_walks : NAN, 0);
-        cli_json_number("predicted_work", bc->work, 0);
-        cli_json_number("leader_work", bc->leader_work, 1);
+        cli_json_string("state", bstate == ULAM_METHOD_CHOSEN ? "chosen" : bstate == 1 ? "planned" : "not_considered", 0);
+        cli_json_number("rmax", bstate ? ch->bidir.rmax : NAN, 0);
+        printf("\"push_ops\": %lld, \"pilot_walks\": %lld, ", (long long)(bstate ? ch->bidir.push.ops : 0),
+               (long long)(bstate ? ch->bidir.pilot_walks : 0));
+        cli_json_number("predicted_walks", bstate ? ch->bidir.predicted_walks : NAN, 0);
+        cli_json_number("predicted_work", v->predicted_work, 0);
+        cli_json_number("leader_work", ch->leader_work, 1);
         printf("}");
     }
     printf("]");
-    if (bc) { /* why bidirectional was not chosen, in one line (null: it was) */
+    if (bidir) { /* why bidirectional was not chosen, in one line (null: it was) */
         printf(", ");
-        if (bc->state == 2) printf("\"bidirectional\": null");
-        else cli_json_string("bidirectional", bc->why, 1);
+        if (bstate == ULAM_METHOD_CHOSEN) printf("\"bidirectional\": null");
+        else cli_json_string("bidirectional", v->why, 1);
     }
     printf("}, ");
 }

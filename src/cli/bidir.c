@@ -36,12 +36,6 @@ static const char *const usage =
     "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
     "  guards reported are those of the forward kernel\n";
 
-/* The densest b the bidirectional path takes: nonzeros at most max(16, n / 10). */
-static int64_t sparse_limit(int64_t n)
-{
-    return n / 10 > 16 ? n / 10 : 16;
-}
-
 /* Nonzero when argv asks for a point-source solve (--source, --rmax or --method bidirectional). */
 int cli_bidir_claims(int argc, char **argv)
 {
@@ -50,8 +44,8 @@ int cli_bidir_claims(int argc, char **argv)
         if (!strcmp(a, "--")) break;
         if (!strcmp(a, "--source") || !strncmp(a, "--source=", 9) || !strcmp(a, "--rmax") || !strncmp(a, "--rmax=", 7))
             return 1;
-        if (!strcmp(a, "--method=bidirectional") || (!strcmp(a, "--method") && k + 1 < argc && !strcmp(argv[k + 1], "bidirectional")))
-            return 1;
+        const char *v = !strncmp(a, "--method=", 9) ? a + 9 : !strcmp(a, "--method") && k + 1 < argc ? argv[k + 1] : NULL;
+        if (v && ulam_method_find(v) == ULAM_METHOD_BIDIRECTIONAL) return 1;
     }
     return 0;
 }
@@ -60,8 +54,7 @@ typedef struct {
     int json, check;
     double direct, transpose_seconds, load_seconds, guard_seconds;
     ulam_guard g;
-    const ulam_auto_result *au; /* chosen by --method auto: the walks' candidates (else NULL) */
-    const cli_bidir_cand *bc;
+    const ulam_choice *ch; /* chosen by --method auto: the choice (else NULL) */
 } report;
 
 /* Print the human-readable block. */
@@ -95,7 +88,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
            cli_verdict_word(rp->g.verdict_abs), rp->g.hat[ULAM_FORWARD].rho, cli_verdict_word(rp->g.verdict_hat[ULAM_FORWARD]));
     printf("load            %.3f s inputs, %.3f s guards\n", rp->load_seconds, rp->guard_seconds);
-    if (rp->au) cli_auto_print_text(rp->au, rp->bc);
+    if (rp->ch) cli_auto_print_text(rp->ch, 1);
     if (rp->check)
         printf("direct          %.10g (LAPACK), z = %.3f\n", rp->direct,
                r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN);
@@ -150,7 +143,7 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         cli_json_number("direct", rp->direct, 0);
         cli_json_number("z", r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN, 0);
     }
-    if (rp->au) cli_auto_print_json(rp->au, rp->bc);
+    if (rp->ch) cli_auto_print_json(rp->ch, 1);
     printf("\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
 }
 
@@ -161,10 +154,10 @@ static int sparse_b(const cli_system *s, ulam_bidir_opts *o, int64_t **idx, doub
     int64_t n = s->M->nrows, k = 0;
     for (int64_t i = 0; i < n; i++) k += s->b[i] != 0.0;
     if (k == 0) return cli_usage_error("solve", "%s: b is zero, so x is 0: nothing to estimate", s->rhs_path);
-    if (k > sparse_limit(n))
+    if (k > ulam_method_sparse_limit(n))
         return cli_usage_error("solve", "%s: --method bidirectional is for a sparse b, and this b has %lld nonzeros of "
                                "%lld (more than max(16, n/10) = %lld): use the walks (--method auto)", s->rhs_path,
-                               (long long)k, (long long)n, (long long)sparse_limit(n));
+                               (long long)k, (long long)n, (long long)ulam_method_sparse_limit(n));
     *idx = malloc((size_t)k * sizeof **idx), *val = malloc((size_t)k * sizeof **val);
     if (!*idx || !*val) {
         fprintf(stderr, "ulam: %s: error: %s\n", s->rhs_path, ulam_strerror(ULAM_ENOMEM));
@@ -364,7 +357,7 @@ int cli_bidir(int argc, char **argv)
         case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
         case 'u': if ((rc = cli_parse_int("solve", "--source", optarg, 1, ULAM_MAX_DIM, &source))) return rc; break;
         case 'M':
-            if (strcmp(optarg, "bidirectional"))
+            if (ulam_method_find(optarg) != ULAM_METHOD_BIDIRECTIONAL)
                 return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
             method = 1;
             break;
@@ -406,130 +399,29 @@ int cli_bidir(int argc, char **argv)
     return rc;
 }
 
-/* The plan's predicted work in the units of --method auto's work model (ULAM_AUTO_*, one walk
- * step), so that it compares with the walk leader's: the plan counts a push operation (one
- * nonzero of M read, one residual updated) and a walk visit as one operation each; here a push
- * operation counts as a matrix entry read (ULAM_AUTO_READ), a walk as its steps (V - 1) plus
- * its start and record (ULAM_AUTO_WALK), the kernel rows on M' the pilot built and those the
- * estimate's walks would build (as many a walk; the whole kernel once they pass a quarter of it,
- * as the solver does) ULAM_AUTO_BUILD each, its reachability and bound reads twice (pilot and
- * estimate), and the transpose (2 nnz reads) and the guards on M' (twice: the pilot's and the
- * report's, as many reads as guard g's) that the walks do not need. */
-static double auto_work(const ulam_csr *M, const ulam_bidir_plan_info *p, const ulam_guard *g)
-{
-    double nnz = (double)ulam_csr_nnz(M), walks = (double)p->pilot_walks + p->predicted_walks;
-    double cap = nnz + 3.0 * (double)M->nrows, u = (double)p->pilot_units;
-    double est = p->pilot_walks > 0 ? fmin(cap, u * p->predicted_walks / (double)p->pilot_walks) : cap;
-    if (est * 4 > cap) est = cap;
-    double guard = (1.0 + g->abs.iterations + g->hat[ULAM_ADJOINT].iterations) * nnz;
-    return ULAM_AUTO_READ * ((double)p->push.ops + 2.0 * (double)p->pilot_reads + 2.0 * nnz + 2.0 * guard) +
-           walks * (p->mean_visits - 1.0 + ULAM_AUTO_WALK) + ULAM_AUTO_BUILD * (u + est);
-}
-
-/* Consider bidirectional as a candidate of --method auto (cli.h). */
-int cli_bidir_consider(cli_system *s, const ulam_walk_opts *user, const char *pinned, const ulam_auto_result *au,
-                       cli_bidir_cand *bc)
-{
-    memset(bc, 0, sizeof *bc);
-    bc->work = bc->leader_work = NAN;
-    const ulam_csr *M = s->M;
-    int64_t n = M->nrows, k = 0;
-    for (int64_t i = 0; i < n; i++) k += s->b[i] != 0.0;
-    double nnz = (double)ulam_csr_nnz(M);
-    if (au->chosen >= 0) bc->leader_work = au->cand[au->chosen].predicted_work;
-    double W = bc->leader_work;
-    if (pinned) {
-        snprintf(bc->why, sizeof bc->why, "not considered: %s", pinned);
-        return 0;
-    }
-    if (!(user->rel_err > 0)) {
-        snprintf(bc->why, sizeof bc->why, "not considered: no --rel-err target (without one auto compares variance x "
-                                          "work a walk, which bidirectional has no figure for)");
-        return 0;
-    }
-    if (au->chosen < 0) {
-        snprintf(bc->why, sizeof bc->why, "not considered: no certified walk method to compare with");
-        return 0;
-    }
-    if (k == 0 || k > sparse_limit(n)) {
-        snprintf(bc->why, sizeof bc->why, "not considered: b is %s (%lld nonzeros; sparse is at most max(16, n/10) = %lld)",
-                 k ? "dense" : "zero", (long long)k, (long long)sparse_limit(n));
-        return 0;
-    }
-    if (!(W > nnz / 4)) {
-        snprintf(bc->why, sizeof bc->why, "not considered: the walks' predicted work %.3g is below nnz(M)/4 = %.3g "
-                                          "(the transpose alone would cost more)", W, nnz / 4);
-        return 0;
-    }
-    bc->o = ulam_bidir_defaults();
-    bc->o.walk = *user;
-    bc->o.walk.estimator = ULAM_COLLISION, bc->o.walk.kernel_alpha = 1.0;
-    bc->o.walk.guard = NULL, bc->o.walk.interrupt = NULL, bc->o.walk.share = NULL;
-    bc->o.target = user->index;
-    bc->o.max_push_ops = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : 0; /* W infinite: the default cap */
-    bc->idx = malloc((size_t)k * sizeof *bc->idx), bc->val = malloc((size_t)k * sizeof *bc->val);
-    double t0 = ulam_now();
-    int status = bc->idx && bc->val ? ulam_csr_transpose(M, &bc->Mt) : ULAM_ENOMEM;
-    bc->transpose_seconds = ulam_now() - t0;
-    if (!status) status = ulam_push_alloc(M, &bc->w);
-    if (status) {
-        fprintf(stderr, "ulam: %s: error: %s: expected memory for the transpose and the push\n", s->matrix_path,
-                ulam_strerror(status));
-        return cli_exit_code(status);
-    }
-    for (int64_t i = 0, j = 0; i < n; i++)
-        if (s->b[i] != 0.0) bc->idx[j] = i, bc->val[j++] = s->b[i];
-    bc->o.nb = k, bc->o.b_index = bc->idx, bc->o.b_value = bc->val;
-    ulam_error err;
-    status = ulam_bidir_plan(bc->w, bc->Mt, &bc->o, &bc->plan, &err);
-    bc->state = 1;
-    if (status == ULAM_ENOCONV) {
-        snprintf(bc->why, sizeof bc->why, "dropped: its push passed W/2 = %lld operations", (long long)bc->o.max_push_ops);
-        return 0;
-    }
-    if (status == ULAM_ENOMEM) return cli_report(s->matrix_path, &err);
-    if (status) {
-        snprintf(bc->why, sizeof bc->why, "refused: %.250s", err.msg);
-        return 0;
-    }
-    bc->work = auto_work(M, &bc->plan, &au->guard);
-    if (bc->work < W) bc->state = 2;
-    else snprintf(bc->why, sizeof bc->why, "lost: predicted work %.3g units, the walks' %.3g", bc->work, W);
-    return 0;
-}
-
-/* Run the chosen candidate (cli.h). */
-int cli_bidir_auto_run(cli_system *s, cli_bidir_cand *bc, const ulam_auto_result *au, int json, int check,
-                       double direct, double load_seconds)
+/* Run the chosen bidirectional (cli.h). */
+int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int json, int check, double direct,
+                       double load_seconds)
 {
     report rp = {.json = json, .check = check, .direct = direct, .load_seconds = load_seconds,
-                 .transpose_seconds = bc->transpose_seconds, .au = au, .bc = bc};
-    int rc = cli_guard(s, bc->o.walk.continue_q, 1.0, ULAM_FORWARD, &rp.g);
+                 .transpose_seconds = ch->transpose_seconds, .ch = ch};
+    int rc = cli_guard(s, ch->bidir_opts.walk.continue_q, 1.0, ULAM_FORWARD, &rp.g);
     if (rc) return rc;
     rp.guard_seconds = rp.g.abs.seconds + rp.g.hat[0].seconds + rp.g.hat[1].seconds;
     cli_guard_warn(s, &rp.g, ULAM_FORWARD, 0);
-    ulam_bidir_result r;
+    ulam_answer a;
     ulam_error err;
-    bc->o.walk.interrupt = &cli_interrupted, bc->o.walk.share = cli_share;
     cli_catch_sigint();
-    int status = ulam_bidir_solve(bc->w, bc->Mt, &bc->o, &r, &err);
+    int status = ulam_run_finish(run, &a, &err);
     rc = status ? cli_report(s->matrix_path, &err) : 0;
     if (!status) {
-        if (json) print_json(&bc->o, &r, &rp);
-        else print_text(&bc->o, &r, &rp);
-        if (r.walks.interrupted) rc = EXIT_INTERRUPTED;
+        ulam_bidir_opts o = ch->bidir_opts;
+        o.walk = a.opts;
+        if (json) print_json(&o, &a.bidir, &rp);
+        else print_text(&o, &a.bidir, &rp);
+        if (a.bidir.walks.interrupted) rc = EXIT_INTERRUPTED;
     }
     fflush(stdout);
     cli_release_sigint();
     return rc;
-}
-
-/* Free what bc owns (cli.h). */
-void cli_bidir_cand_free(cli_bidir_cand *bc)
-{
-    if (!bc) return;
-    free(bc->idx), free(bc->val);
-    ulam_push_free(bc->w);
-    ulam_csr_free(bc->Mt);
-    bc->idx = NULL, bc->val = NULL, bc->w = NULL, bc->Mt = NULL;
 }

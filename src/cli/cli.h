@@ -123,6 +123,9 @@ void cli_release_sigint(void);
 /* Index of word in names[0..n), or -1. */
 int cli_lookup(const char *word, const char *const *names, int n);
 
+/* The usage error for an unknown --method: auto and the rows of the library's table; EXIT_USAGE. */
+int cli_method_error(const char *got);
+
 /* Print a bare JSON number (null when not finite). */
 void cli_json_value(double v);
 
@@ -170,9 +173,6 @@ void cli_output_begin(int *argc, char **argv);
 int cli_output_finish(int rc);
 
 /* Every value of solve --method (src/cli/output.c), and them in words for messages. */
-enum { CLI_NMETHODS = 9 };
-extern const char *const cli_method_names[CLI_NMETHODS];
-extern const char *const cli_method_words;
 
 /* The name among names[0..n) closest to word, or NULL. */
 const char *cli_suggest(const char *word, const char *const *names, int n);
@@ -193,44 +193,20 @@ int cli_solve(int argc, char **argv);
 int cli_bidir_claims(int argc, char **argv);
 int cli_bidir(int argc, char **argv);
 
-/* Bidirectional as a candidate of solve --method auto (src/cli/bidir.c): considered for an adjoint
- * query with a --rel-err target and a sparse b when the walk leader's predicted work W exceeds
- * nnz(M) / 4 (rent or buy: it needs M's transpose), planned with its push capped at W / 2, chosen
- * when its predicted work (the auto work model's units) is below W. */
-typedef struct cli_bidir_cand {
-    int state;          /* 0 not considered, 1 planned and not chosen, 2 chosen */
-    char why[320];      /* states 0 and 1: why not, in one line */
-    double leader_work; /* W: the walk leader's predicted work */
-    double work;        /* its predicted work in the auto units (NaN: not planned) */
-    ulam_bidir_plan_info plan;
-    ulam_bidir_opts o;  /* the options it was planned (and runs) with */
-    int64_t *idx;       /* b's nonzeros (owned) */
-    double *val;
-    ulam_csr *Mt;       /* M's transpose (owned) */
-    ulam_push *w;       /* the pushed workspace holding the plan (owned) */
-    double transpose_seconds;
-} cli_bidir_cand;
-
-/* Consider bidirectional for s (loaded) after the walks' choice au under user (the options as the
- * command line gave them, index set); pinned: what the command line pins that it cannot honour
- * (NULL: nothing).  0 or an exit code (bc filled either way; free it with cli_bidir_cand_free). */
-int cli_bidir_consider(cli_system *s, const ulam_walk_opts *user, const char *pinned, const ulam_auto_result *au,
-                       cli_bidir_cand *bc);
-
-/* Run the chosen bidirectional candidate and print its report with the choice; 0 or an exit code. */
-int cli_bidir_auto_run(cli_system *s, cli_bidir_cand *bc, const ulam_auto_result *au, int json, int check,
-                       double direct, double load_seconds);
-
-/* Free what bc owns (accepts NULL). */
-void cli_bidir_cand_free(cli_bidir_cand *bc);
+/* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print
+ * its report with the choice; 0 or an exit code. */
+int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int json, int check, double direct,
+                       double load_seconds);
 
 /* solve --method auto (src/cli/auto.c): choose the method for the loaded s under o (what ao pins
- * stays), make the solver *sv and set o to the choice; *status and err get the solver's refusal.
- * 0 or an exit code.  Then print the candidates as text, or as the JSON key "auto". */
-int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, ulam_auto_result *res,
-                    ulam_solver **sv, int *status, ulam_error *err);
-void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc);
-void cli_auto_print_json(const ulam_auto_result *res, const cli_bidir_cand *bc);
+ * stays; ao->exclude: rows the command line rules out, their reason excluded_why) through the
+ * library's table (ulam_auto_start), make the run *run and set o to the walks' choice; *status and
+ * err get the refusal.  0 or an exit code.  Then print the candidates as text, or as the JSON key
+ * "auto" (bidir: with the bidirectional row's line). */
+int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, const char *excluded_why,
+                    ulam_choice *ch, ulam_run **run, int *status, ulam_error *err);
+void cli_auto_print_text(const ulam_choice *ch, int bidir);
+void cli_auto_print_json(const ulam_choice *ch, int bidir);
 int cli_study(int argc, char **argv);
 
 /* ulam solve --method (src/cli/mcsa.c): nonzero when argv asks for it, and the command. */

@@ -67,6 +67,21 @@ int cli_report(const char *file, const ulam_error *err)
     return cli_exit_code(err->status);
 }
 
+/* The usage error for an unknown --method, its names from the library's table (cli.h). */
+int cli_method_error(const char *got)
+{
+    char list[512] = "auto";
+    for (int k = 0; k < ULAM_NMETHODS; k++) {
+        size_t n = strlen(list);
+        snprintf(list + n, sizeof list - n, "%s%s%s", k == ULAM_NMETHODS - 1 ? " or " : ", ", ulam_method_name(k),
+                 k == ULAM_METHOD_BIDIRECTIONAL ? " (with --source or a sparse b)" : "");
+    }
+    const char *names[ULAM_NMETHODS + 1] = {"auto"};
+    for (int k = 0; k < ULAM_NMETHODS; k++) names[k + 1] = ulam_method_name(k);
+    cli_choose("solve", "--method", got, names, ULAM_NMETHODS + 1, list); /* prints the error, did you mean */
+    return EXIT_USAGE;
+}
+
 /* Print a usage error and return EXIT_USAGE. */
 int cli_usage_error(const char *command, const char *fmt, ...)
 {

@@ -47,8 +47,9 @@ static const char *const usage =
     "certified finite (rho(M^) >= 1) are refused before any walk (exit 10 + EINFVAR).\n"
     "Each iteration prints its residual, its walks (histories, rejected ones too) and its seconds.\n";
 
-static const char *const method_names[] = {"richardson", "gauss-seidel", "sequential", "mcsa", "cg", "gmres"};
-enum { KRYLOV_CG = 4, KRYLOV_GMRES = 5 }; /* the Krylov peers: not outer iterations */
+/* The method's name: its row of the library's table (p->method counts from ULAM_METHOD_RICHARDSON). */
+#define method_name(m) ulam_method_name(ULAM_METHOD_RICHARDSON + (m))
+enum { KRYLOV_CG = ULAM_METHOD_CG - ULAM_METHOD_RICHARDSON, KRYLOV_GMRES = ULAM_METHOD_GMRES - ULAM_METHOD_RICHARDSON };
 
 /* Nonzero when argv (after the subcommand) asks for an outer iteration. */
 int cli_solve_wants_method(int argc, char **argv)
@@ -57,8 +58,8 @@ int cli_solve_wants_method(int argc, char **argv)
         const char *v = !strncmp(argv[k], "--method=", 9) ? argv[k] + 9
                         : !strcmp(argv[k], "--method") && k + 1 < argc ? argv[k + 1] : NULL;
         if (!strcmp(argv[k], "--method") && !v) return 1; /* its parser reports the missing value */
-        if (v && strcmp(v, "auto") && strcmp(v, "walks") && strcmp(v, "bidirectional"))
-            return 1; /* those three: cli_solve, cli_bidir */
+        if (v && strcmp(v, "auto") && ulam_method_answers(ulam_method_find(v)) != ULAM_ANSWERS_ENTRY)
+            return 1; /* auto and the entry rows (walks, bidirectional): cli_solve, cli_bidir */
     }
     return 0;
 }
@@ -121,7 +122,7 @@ static void print_text(const report *p)
     int64_t hist;
     double walk_s;
     totals(p, &hist, &walk_s);
-    printf("method          %s%s%s, tol %g%s\n", method_names[p->method], walks ? ", " : "",
+    printf("method          %s%s%s, tol %g%s\n", method_name(p->method), walks ? ", " : "",
            walks ? cli_estimator_names[p->o->walk.estimator] : "", p->o->tol, walks ? "" : " (no walks)");
     if (p->method == KRYLOV_GMRES) printf("restart         %d\n", p->restart);
     printf("outcome         %s after %d iterations%s, residual %.4e\n", outcome(p), p->iterations,
@@ -146,7 +147,7 @@ static void print_json(const report *p)
     double walk_s;
     totals(p, &hist, &walk_s);
     printf("{");
-    cli_json_string("method", method_names[p->method], 0);
+    cli_json_string("method", method_name(p->method), 0);
     if (walking(p->method)) cli_json_string("estimator", cli_estimator_names[p->o->walk.estimator], 0);
     cli_json_string("outcome", outcome(p), 0);
     printf("\"converged\": %s, \"iterations\": %d, ", p->converged ? "true" : "false", p->iterations);
@@ -306,8 +307,9 @@ int cli_solve_method(int argc, char **argv)
         case CLI_WALK: if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &o.walk))) return rc; break;
         case 'b': s.rhs_path = optarg; break;
         case 'M':
-            if ((p.method = cli_lookup(optarg, method_names, 6)) < 0)
-                return cli_choose("solve", "--method", optarg, cli_method_names, CLI_NMETHODS, cli_method_words), EXIT_USAGE;
+            if (ulam_method_answers(ulam_method_find(optarg)) != ULAM_ANSWERS_ALL)
+                return cli_method_error(optarg);
+            p.method = ulam_method_find(optarg) - ULAM_METHOD_RICHARDSON;
             if (p.method < KRYLOV_CG) o.method = p.method;
             break;
         case 'r':

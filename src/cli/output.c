@@ -77,12 +77,6 @@ int cli_output_finish(int rc)
     return rc;
 }
 
-/* Every value of solve --method, and them in words. */
-const char *const cli_method_names[CLI_NMETHODS] = {"auto", "walks", "bidirectional", "mcsa", "sequential",
-                                                    "richardson", "gauss-seidel", "cg", "gmres"};
-const char *const cli_method_words = "auto, walks, bidirectional (with --source), mcsa, sequential, richardson, "
-                                     "gauss-seidel, cg or gmres";
-
 /* Levenshtein distance of a and b (both short), capped at 99. */
 static int distance(const char *a, const char *b)
 {

@@ -100,8 +100,7 @@ typedef struct {
     int assume_finite;
     int64_t n;
     double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the solver set-up */
-    const ulam_auto_result *au; /* --method auto: the candidates and the choice (else NULL) */
-    const cli_bidir_cand *bc;   /* --method auto: bidirectional as a candidate (else NULL) */
+    const ulam_choice *ch;      /* --method auto: the rows, the candidates and the choice (else NULL) */
     double t_start;             /* when the command started (ulam_now) */
     const char *direct_method;  /* --check: "dense LU", "sparse LU" or "interrupted" */
 } report_opts;
@@ -165,7 +164,7 @@ static void print_brief(const ulam_walk_opts *o, const ulam_walk_result *r, cons
     printf("method          %s random walks, %s estimator%s\n", cli_mode_names[o->mode],
            cli_estimator_names[o->estimator], o->mode == ULAM_ADJOINT ? " (walks start at the unknown)"
                                                                      : " (walks start from b: every unknown at once)");
-    if (ro->au) cli_auto_print_text(ro->au, ro->bc);
+    if (ro->ch) cli_auto_print_text(ro->ch, 1);
     if (r->cut)
         printf("walks           %lld (%lld cut at %lld steps: the estimate is biased by the cut)\n",
                (long long)r->walks, (long long)r->cut, (long long)o->max_steps);
@@ -222,7 +221,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     print_rel_err(o, r, 1);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
-    if (ro->au) cli_auto_print_text(ro->au, ro->bc);
+    if (ro->ch) cli_auto_print_text(ro->ch, 1);
 }
 
 /* Print the JSON object. */
@@ -283,7 +282,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         cli_json_string("direct_method", ro->direct_method, 0);
         cli_json_number("z", (r->estimate - ro->direct) / r->std_error, 0);
     }
-    if (ro->au) cli_auto_print_json(ro->au, ro->bc);
+    if (ro->ch) cli_auto_print_json(ro->ch, 1);
     printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
 }
 
@@ -416,7 +415,7 @@ static int parse(int argc, char **argv, solve_args *a)
         case 'W': a->o.whole_kernel = 1; break;
         case 'U':
             if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
-            if (cli_choose("solve", "--method", optarg, cli_method_names, CLI_NMETHODS, cli_method_words) < 0) return EXIT_USAGE;
+            if (strcmp(optarg, "auto") && ulam_method_find(optarg) != ULAM_METHOD_WALKS) return cli_method_error(optarg);
             a->autom = !strcmp(optarg, "auto");
             break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
@@ -466,22 +465,19 @@ static int certified_auto(solve_args *a, ulam_guard *g)
     return 0;
 }
 
-/* What the command line pins that bidirectional cannot honour, in words (NULL: nothing). */
-static const char *bidir_pinned(const solve_args *a)
+/* What the command line rules out for bidirectional beyond what the library tests (the options it
+ * cannot honour), in words (NULL: nothing). */
+static const char *bidir_excluded(const solve_args *a)
 {
-    if (a->o.mode == ULAM_FORWARD) return "forward mode (--mode forward, --out, --errors)";
-    if (a->ao.pin_estimator) return "--estimator is pinned";
-    if (a->ao.pin_alpha && a->o.kernel_alpha != 1.0) return "--alpha other than 1";
-    if (a->o.roulette > 0 || a->o.split > 0) return "--roulette or --split (bidirectional takes neither)";
     if (a->s.jacobi) return "--jacobi";
     if (a->s.lazy) return "a prepared system read only where walks go (bidirectional transposes all of M)";
     return NULL;
 }
 
-/* Load the system, choose (--method auto, bidirectional among the candidates: bc), guard, and
- * make the solver *sv (none when bidirectional is chosen); print the refusals and the warnings,
- * then run --check; 0 or an exit code (nothing kept on failure). */
-static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir_cand *bc, ulam_solver **sv)
+/* Load the system, choose (--method auto: the library's table, ch) or guard, and make the run
+ * *run (walks: *sv, borrowed from it; none when bidirectional is chosen); print the refusals and
+ * the warnings, then run --check; 0 or an exit code (nothing kept on failure). */
+static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run, ulam_solver **sv)
 {
     cli_system *s = &a->s;
     ulam_walk_opts *o = &a->o;
@@ -503,29 +499,18 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
     ro->n = s->M->nrows;
     ulam_error err;
     int status;
-    if (a->autom) { /* guards, pilots and the solver, its set-up kept from the chosen pilot */
+    if (a->autom) { /* guards, pilots, the rows of the table and the run, its set-up kept from the choice */
         t0 = ulam_now();
         ulam_guard cg;
-        ulam_walk_opts user = *o;
-        const char *pinned = bidir_pinned(a);
-        if ((rc = certified_auto(a, &cg)) || (rc = cli_auto_choose(s, o, &a->ao, au, sv, &status, &err))) {
+        const char *excluded = bidir_excluded(a);
+        if ((rc = certified_auto(a, &cg)) || (rc = cli_auto_choose(s, o, &a->ao, excluded, ch, run, &status, &err))) {
             cli_system_free(s);
             return rc;
         }
-        ro->au = au;
-        ro->g = au->guard;
-        ro->kernel_seconds = ulam_now() - t0 - au->seconds;
-        if (!status) {
-            ro->bc = bc;
-            if ((rc = cli_bidir_consider(s, &user, pinned, au, bc))) {
-                *sv = ulam_solver_free(*sv);
-                cli_bidir_cand_free(bc);
-                cli_system_free(s);
-                return rc;
-            }
-            if (bc->state == 2) *sv = ulam_solver_free(*sv);
-            else cli_bidir_cand_free(bc); /* its transpose and push: only its plan's figures are reported */
-        }
+        ro->ch = ch;
+        ro->g = ch->walks.guard;
+        ro->kernel_seconds = ulam_now() - t0 - ch->walks.seconds;
+        *sv = ulam_run_solver(*run);
     } else {
         if ((rc = cli_guard(s, o->continue_q, o->kernel_alpha, o->mode, &ro->g))) {
             cli_system_free(s);
@@ -551,15 +536,15 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
         rc = cli_report(s->matrix_path, &err);
     }
     if (status) {
+        *run = ulam_run_free(*run);
         cli_system_free(s);
         return rc;
     }
-    int walks = !(ro->bc && ro->bc->state == 2);
+    int walks = *sv != NULL;
     if (walks && ro->g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(s, &ro->g, 1);
     if (walks) cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
     if (ro->check && !walks && (rc = direct_check(s, o->index, ro))) { /* bidirectional: checked first */
-        *sv = ulam_solver_free(*sv);
-        cli_bidir_cand_free(bc);
+        *run = ulam_run_free(*run);
         cli_system_free(s);
         return rc;
     }
@@ -573,14 +558,14 @@ static int run(solve_args *a)
     const cli_system *s = &a->s;
     const ulam_walk_opts *o = &a->o;
     report_opts ro = {.check = a->check, .json = a->json, .assume_finite = a->assume_finite, .t_start = ulam_now()};
-    ulam_auto_result au;
-    cli_bidir_cand bc = {0};
+    ulam_choice ch;
+    ulam_run *rn = NULL;
     ulam_solver *sv = NULL;
-    int rc = start(a, &ro, &au, &bc, &sv), status = ULAM_OK;
+    int rc = start(a, &ro, &ch, &rn, &sv), status = ULAM_OK;
     if (rc) return rc;
-    if (bc.state == 2) { /* auto chose bidirectional: its own report, with the choice */
-        rc = cli_bidir_auto_run(&a->s, &bc, &au, ro.json, ro.check, ro.direct, ro.load_seconds);
-        cli_bidir_cand_free(&bc);
+    if (!sv) { /* auto chose bidirectional: its own report, with the choice */
+        rc = cli_bidir_auto_run(&a->s, rn, &ch, ro.json, ro.check, ro.direct, ro.load_seconds);
+        ulam_run_free(rn);
         cli_system_free(&a->s);
         return rc;
     }
@@ -639,8 +624,8 @@ static int run(solve_args *a)
     }
     if (left) return rc; /* under MPI the ranks end together (main); the system stays to the thread */
     cli_release_sigint();
-    ulam_solver_free(sv);
-    cli_bidir_cand_free(&bc);
+    if (rn) ulam_run_free(rn); /* its solver with it */
+    else ulam_solver_free(sv);
     cli_system_free(&a->s);
     return rc;
 }

@@ -1,0 +1,276 @@
+"""The Python binding (import ulam): answers within 4 sigma of scipy's spsolve, coverage counted
+over seeds against a binomial bound, the CLI's choice and estimate on the same seed, the CLI's
+refusals as exceptions, many queries of one System, Ctrl-C as KeyboardInterrupt with the estimate
+so far, M taken without a copy.  Run by meson test (python): PYTHONPATH=<build>/python and
+ULAM_EXE=<build>/ulam; from the source root."""
+import inspect
+import json
+import os
+import signal
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+import scipy.io
+import scipy.sparse as sp
+import scipy.sparse.linalg as sla
+from scipy.stats import binom
+
+import ulam
+
+ULAM = os.environ.get("ULAM_EXE", "build/ulam")
+ROOT = os.environ.get("ULAM_ROOT", ".")
+
+
+def random_system(n, nnz_row, radius, seed, signed=False):
+    """A random sparse M with every |row| sum = radius (so rho(|M|) <= radius) and a dense b."""
+    rng = np.random.default_rng(seed)
+    rows = np.repeat(np.arange(n), nnz_row)
+    cols = np.concatenate([rng.choice(n, nnz_row, replace=False) for _ in range(n)])
+    vals = rng.random(n * nnz_row) + 0.1
+    if signed:
+        vals *= rng.choice([-1.0, 1.0], n * nnz_row)
+    M = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    M = sp.diags(radius / np.asarray(abs(M).sum(axis=1)).reshape(-1)) @ M
+    return M.tocsr(), rng.random(n) + 0.5
+
+
+def exact(M, b):
+    return sla.spsolve((sp.identity(M.shape[0], format="csc") - M).tocsc(), b)
+
+
+def test_spsolve_4sigma():
+    """Every answer is within 4 of its standard errors of spsolve's, on three systems, with the
+    default choice (auto) and a rel_err target met."""
+    for seed, signed, radius in ((1, False, 0.9), (2, True, 0.8), (3, False, 0.99)):
+        M, b = random_system(300, 6, radius, seed, signed)
+        x = exact(M, b)
+        for i in (7, 123):
+            r = ulam.solve(M, b, index=i, rel_err=0.02, seed=seed, threads=2)
+            assert r.ci95 is not None and r.variance_finite, r
+            assert abs(r.estimate - x[i]) < 4 * r.stderr, (seed, i, r, x[i])
+            assert r.stderr <= 0.02 * abs(r.estimate) and r.report["rel_err_met"], r.report
+            assert r.ci95[0] < r.estimate < r.ci95[1] and r.walks >= 1000
+
+
+def coverage_bound(n):
+    """The least number of covering 95% intervals of n that is not rejected at 1e-6."""
+    return int(binom.ppf(1e-6, n, 0.95))
+
+
+@pytest.mark.parametrize("rule", ["walks", "rel_err"])
+def test_coverage(rule):
+    """95% intervals over 100 seeds on a hard small system (signed; radius 0.97 and a small budget of
+    1000 walks, or radius 0.9 under the rel_err 0.1 rule) cover x_i at least the binomial bound's count (the walks
+    row pinned: auto's choice, made from pilots independent of the walks, is tested above)."""
+    M, b = random_system(40, 3, 0.97 if rule == "walks" else 0.9, 11, signed=True)
+    x = exact(M, b)
+    covered, n = 0, 100
+    for seed in range(1, n + 1):
+        kw = {"walks": 1000} if rule == "walks" else {"rel_err": 0.1}
+        r = ulam.solve(M, b, index=5, seed=seed, threads=1, method="walks", **kw)
+        assert r.ci95 is not None, r
+        covered += r.ci95[0] <= x[5] <= r.ci95[1]
+    assert covered >= coverage_bound(n), (covered, coverage_bound(n))
+
+
+def cli_json(args):
+    p = subprocess.run([ULAM] + args + ["--json"], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    return json.loads(p.stdout)
+
+
+@pytest.mark.parametrize("case", ["dense_b", "sparse_b"])
+def test_same_as_cli(case):
+    """ulam.solve with defaults gives `ulam solve`'s choice and estimate on the same seed (the
+    library's table: walks for a dense b, bidirectional for a sparse one), and its report holds
+    the CLI's keys (less the process's)."""
+    M = scipy.io.mmread(os.path.join(ROOT, "matrices/randsub1000.mtx")).tocsr()
+    if case == "dense_b":
+        bpath = os.path.join(ROOT, "matrices/randsub1000_b.mtx")
+        index = 0
+    else:
+        bpath = os.path.join(ROOT, "tests/data/sparse3_b.mtx")
+        index = 6
+    b = np.asarray(scipy.io.mmread(bpath).todense() if sp.issparse(scipy.io.mmread(bpath))
+                   else scipy.io.mmread(bpath)).reshape(-1)
+    o = cli_json(["solve", os.path.join(ROOT, "matrices/randsub1000.mtx"), "--rhs", bpath, "--index", str(index + 1),
+                  "--rel-err", "0.02", "--seed", "3"])
+    r = ulam.solve(M, b, index=index, rel_err=0.02, seed=3)
+    assert r.estimate == o["estimate"] and r.stderr == o["stderr"] and r.walks == o["walks"], (r.report, o)
+    assert r.method == ("bidirectional" if case == "sparse_b" else "walks") == o.get("method", "walks"), o
+    assert r.report["auto"]["chosen"] == o["auto"]["chosen"], (r.report["auto"], o["auto"])
+    assert r.report["auto"]["bidirectional"] == o["auto"]["bidirectional"]
+    process = {"load_seconds", "guard_seconds", "kernel_seconds", "peak_rss_mib", "transpose_seconds"}
+    assert set(o) - process <= set(r.report), set(o) - process - set(r.report)
+    for k in ("estimate", "stderr", "ci95", "walks", "steps", "variance_finite", "seed"):
+        assert r.report[k] == o[k], k
+
+
+def test_source_same_as_cli():
+    """source=S is `ulam solve --source S`: the same push, walks and estimate on the same seed."""
+    M = scipy.io.mmread(os.path.join(ROOT, "matrices/randsub1000.mtx")).tocsr()
+    o = cli_json(["solve", os.path.join(ROOT, "matrices/randsub1000.mtx"), "--index", "7", "--source", "3",
+                  "--rel-err", "0.05", "--seed", "5"])
+    r = ulam.solve(M, index=6, source=2, rel_err=0.05, seed=5)
+    assert (r.estimate, r.stderr, r.walks, r.report["rmax"]) == (o["estimate"], o["stderr"], o["walks"], o["rmax"]), o
+    assert r.report["source"] == o["source"] == 3 and r.method == o["method"] == "bidirectional"
+
+
+def test_refusals():
+    """The CLI's refusals raise the library's status as ulam.Error subclasses; the interpreter lives."""
+    M, b = random_system(50, 4, 0.9, 5)
+    with pytest.raises(ulam.InputError):
+        ulam.solve(sp.random(5, 6, density=0.5, format="csr"), np.ones(5), index=0)
+    with pytest.raises(ulam.InputError):
+        ulam.solve(M, np.ones(49), index=0)
+    with pytest.raises(ulam.InputError):
+        ulam.solve(M, b, index=50)
+    with pytest.raises(ulam.InputError):
+        ulam.solve(M, b)  # adjoint walks need an index
+    with pytest.raises(ulam.InputError):
+        ulam.solve(M, b, index=0, method="sideways")
+    with pytest.raises(ulam.InputError):
+        ulam.solve(M, b, index=0, rel_err=2.0)
+    with pytest.raises(ulam.InputError):
+        ulam.solve(M, b, index=0, source=3)  # source= sets b
+    with pytest.raises(ulam.InputError):
+        ulam.solve(A=M, b=b, index=0)  # A= goes with jacobi=True
+    with pytest.raises(ulam.InputError):
+        ulam.solve(M, b, index=0, roulette=0.5, split=0.4)
+    with pytest.raises(TypeError):
+        ulam.solve(M, b, index=0, sideways=1)
+    bad = M.copy()
+    bad.data[3] = np.nan
+    with pytest.raises(ulam.InputError) as e:
+        ulam.solve(bad, b, index=0)
+    assert e.value.status == ulam._ulam.ENONFINITE
+    A = sp.identity(50, format="csr") - M
+    A = A.tolil()
+    A[7, 7] = 0.0
+    with pytest.raises(ulam.InputError) as e:
+        ulam.solve(A=A.tocsr(), b=b, jacobi=True, index=0)
+    assert e.value.status == ulam._ulam.EZERODIAG and e.value.index == 7
+    # rho(|M|) above 1: refused unless force=True (the CLI's exit 3)
+    with pytest.raises(ulam.DivergenceError) as e:
+        ulam.solve(1.5 * M, b, index=0, method="walks")
+    assert e.value.status == ulam._ulam.EDIVERGE and "rho" in str(e.value)
+    with pytest.raises(ulam.DivergenceError):
+        ulam.solve(1.5 * M, b, index=0, rel_err=0.01)  # auto: no candidate certified
+    # the variance not certified finite and a rel_err target alone: no walk count meets it
+    S, c = random_system(40, 3, 0.995, 8, signed=True)
+    with pytest.raises(ulam.InfiniteVarianceError) as e:
+        ulam.solve(S, c, index=0, rel_err=0.01, method="walks", estimator="absorption", continue_q=0.05)
+    assert e.value.status == ulam._ulam.EINFVAR
+
+
+def test_many_queries():
+    """A System answers 12 queries, each within 4 sigma of spsolve, paying the guards once: its
+    queries' choices spend less set-up work than a fresh solve's."""
+    M, b = random_system(400, 5, 0.9, 21)
+    x = exact(M, b)
+    system = ulam.System(M)
+    fresh = ulam.solve(M, b, index=0, rel_err=0.05, seed=4)
+    for i in range(12):
+        r = system.solve(b, index=31 * i, rel_err=0.05, seed=4 + i)
+        assert abs(r.estimate - x[31 * i]) < 4 * r.stderr, (i, r, x[31 * i])
+    again = system.solve(b, index=0, rel_err=0.05, seed=4)
+    assert again.report["auto"]["pilot_work"] < fresh.report["auto"]["pilot_work"], (again.report["auto"],
+                                                                                     fresh.report["auto"])
+
+
+def test_no_copy():
+    """Canonical float64 CSR with int32 indices is taken without a copy (an int32 indptr is converted)."""
+    M0, _ = random_system(100, 4, 0.9, 2)
+    M0.sum_duplicates()
+    M = M0.copy()  # canonical: sorted columns, no duplicates (else a canonical copy is made)
+    M.indices = M.indices.astype(np.int32)
+    s = ulam.System(M)
+    assert np.shares_memory(s._arrays[1], M.indices) and np.shares_memory(s._arrays[2], M.data)
+    M.indptr = M.indptr.astype(np.int64)
+    s = ulam.System(M)
+    assert all(np.shares_memory(a, m) for a, m in zip(s._arrays[:3], (M.indptr, M.indices, M.data)))
+    # other formats and dense arrays are converted, and answer the same
+    b = np.ones(100)
+    r1 = ulam.solve(M, b, index=3, walks=5000, method="walks")
+    for other in (M0.tocoo(), M0.tocsc(), M0.toarray(), sp.csr_array(M0), M0.astype(np.float32).astype(np.float64)):
+        r2 = ulam.solve(other, b, index=3, walks=5000, method="walks")
+        assert r2.estimate == r1.estimate
+
+
+def test_interrupt():
+    """Ctrl-C (SIGINT sent by the progress callback after the first round: deterministic) stops the
+    walks at the next block and raises ulam.Interrupted, a KeyboardInterrupt, with the estimate so far."""
+    M, b = random_system(200, 4, 0.9, 6)
+    x = exact(M, b)
+    rounds = []
+
+    def progress(walks, estimate, stderr):
+        rounds.append(walks)
+        if len(rounds) == 1:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt) as e:
+        ulam.solve(M, b, index=2, walks=10**9, method="walks", progress=progress)
+    r = e.value.result
+    assert isinstance(e.value, ulam.Interrupted) and r.interrupted and r.report["interrupted"]
+    assert 0 < r.walks < 10**9 and abs(r.estimate - x[2]) < 4 * r.stderr, r
+    # Python's own handler is back: the next SIGINT is Python's KeyboardInterrupt
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_progress_exception():
+    """An exception raised by progress stops the walks and propagates."""
+    M, b = random_system(50, 4, 0.9, 6)
+
+    def progress(walks, estimate, stderr):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        ulam.solve(M, b, index=2, walks=10**8, method="walks", progress=progress)
+
+
+def test_rows_and_sources():
+    """Pinned rows of the library's table: bidirectional for a point source, the outer iterations
+    and Krylov peers to their residual (no error bar), Jacobi from A."""
+    M, b = random_system(120, 4, 0.8, 9)
+    Ms = ((M + M.T) / 2).tocsr()
+    x = exact(Ms, b)
+    for name, kind in ulam.methods():
+        if kind == "all":
+            r = ulam.solve(Ms, b, index=4, method=name, seed=2)
+            assert r.method == name and np.isnan(r.stderr) and r.ci95 is None and abs(r.estimate - x[4]) < 1e-6 * abs(x[4])
+    e = np.zeros(120)
+    e[17] = 1.0
+    xs = exact(M, e)
+    r = ulam.solve(M, index=3, source=17, walks=20000)
+    assert r.method == "bidirectional" and abs(r.estimate - xs[3]) < 4 * r.stderr + 1e-12, r
+    A = (sp.identity(120) - M).tocsr() * 3.0
+    r = ulam.solve(A=A, b=b, jacobi=True, index=5, rel_err=0.02)
+    assert abs(r.estimate - sla.spsolve(A.tocsc(), b)[5]) < 4 * r.stderr
+    assert r.report["auto"]["bidirectional"] == "not considered: --jacobi"
+
+
+def test_pagerank():
+    """Personalized PageRank pi_s(t) within 4 sigma of (1 - alpha) (I - alpha P')^-1 e_s."""
+    rng = np.random.default_rng(3)
+    n = 300
+    adj = sp.random(n, n, density=0.02, format="csr", random_state=4)
+    adj.data[:] = 1.0
+    out = np.asarray(adj.sum(axis=1)).reshape(-1)
+    P = sp.diags(np.divide(1.0, out, out=np.zeros(n), where=out > 0)) @ adj
+    alpha, s = 0.85, int(rng.integers(n))
+    e = np.zeros(n)
+    e[s] = 1.0
+    pi = (1 - alpha) * sla.spsolve((sp.identity(n) - alpha * P.T).tocsc(), e)
+    t = int(np.argsort(pi)[-3])  # a node the walks from s reach
+    r = ulam.pagerank(adj, alpha, s, t, rel_err=0.05)
+    assert r.method == "bidirectional" and abs(r.estimate - pi[t]) < 4 * r.stderr, (r, pi[t])
+
+
+def test_help_documents_every_argument():
+    """help(ulam.solve) names every argument."""
+    doc = ulam.solve.__doc__
+    for name in inspect.signature(ulam.solve).parameters:
+        assert f"  {name} " in doc or f"  {name}," in doc or f", {name} " in doc or f" {name}  " in doc, name

@@ -1,0 +1,571 @@
+"""ulam: one entry of (I - M) x = b by von Neumann-Ulam random walks, with an honest error bar.
+
+    import ulam
+    r = ulam.solve(M, b, index=3, rel_err=0.01)
+    print(r.estimate, "+-", r.stderr, r.ci95, r.walks, r.method)
+
+M is any scipy.sparse matrix or array, or a dense NumPy array (square); b a NumPy vector; indices
+are 0-based.  The answer comes from the C library's method table, as `ulam solve` gives it: the
+walks' candidates raced by pilots, bidirectional (push + walks) for a sparse b when cheaper
+(ulam_auto).  ulam.System(M) answers many queries of one matrix, reusing its set-up;
+ulam.pagerank(adj, alpha, source, target) is personalized PageRank.  Errors raise ulam.Error
+subclasses carrying the library's status and message; Ctrl-C raises ulam.Interrupted (a
+KeyboardInterrupt) with the estimate so far in its .result.
+"""
+import math
+import threading
+import warnings
+
+import numpy as np
+
+from . import _ulam
+
+__all__ = ["solve", "pagerank", "System", "Result", "methods", "Error", "InputError", "DivergenceError",
+           "InfiniteVarianceError", "ConvergenceError", "OutOfMemoryError", "Interrupted"]
+__version__ = _ulam.version
+
+MODES = ("adjoint", "forward")
+ESTIMATORS = ("collision", "absorption", "expected")
+_ROWS = [name for name, _ in _ulam.methods()]
+_METHOD_WALKS, _METHOD_BIDIR = _ROWS.index("walks"), _ROWS.index("bidirectional")
+_STATES = ("uncertified", "refused", "skipped", "dropped", "finalist", "chosen")
+_ROW_STATES = ("not_considered", "planned", "chosen")
+
+
+class Error(Exception):
+    """A refusal or failure of the library: .status (the library's ULAM_E* code), .message (the
+    sentence saying what was expected), .index (the row or index it concerns, or None)."""
+
+    def __init__(self, status, message, index=None):
+        self.status, self.message, self.index = status, message, index
+        text = _ulam.strerror(status) + (": expected " + message if message else "")
+        super().__init__(text if index is None or index < 0 else f"{text} (index {index})")
+
+
+class InputError(Error, ValueError):
+    """Bad input: an option out of range, a non-square M, a b of the wrong length, an index out
+    of range, NaN or infinite entries, a zero diagonal for jacobi, ..."""
+
+
+class DivergenceError(Error):
+    """rho(|M|) is not certified below 1: the walks may diverge (pass force=True to walk anyway)."""
+
+
+class InfiniteVarianceError(Error):
+    """A rel_err target with a variance not certified finite: no walk count can meet it honestly
+    (bound the run with walks= or time= instead)."""
+
+
+class ConvergenceError(Error):
+    """An iteration did not converge within its cap, or its residual stalled."""
+
+
+class OutOfMemoryError(Error, MemoryError):
+    """The library ran out of memory."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during a solve: .result is the Result so far (its estimate from the walks made)."""
+
+    def __init__(self, result):
+        self.result = result
+        super().__init__(f"interrupted after {result.walks} walks: estimate so far {result.estimate:.10g} "
+                         f"+- {result.stderr:.3g}")
+
+
+_INPUT = {"EINVAL", "EZERODIAG", "ENONFINITE", "EUNDEFINED"}
+
+
+def _raise(status, message, index=-1):
+    """Raise the exception of a library status."""
+    names = {getattr(_ulam, k): k for k in ("EINVAL", "ENOMEM", "EDIVERGE", "EINFVAR", "ENOCONV", "ESTALL",
+                                            "EUNDEFINED", "EZERODIAG", "ENONFINITE")}
+    name = names.get(status, "")
+    cls = (DivergenceError if name == "EDIVERGE" else InfiniteVarianceError if name == "EINFVAR"
+           else ConvergenceError if name in ("ENOCONV", "ESTALL") else OutOfMemoryError if name == "ENOMEM"
+           else InputError if name in _INPUT or 11 <= status <= 16 else Error)
+    raise cls(status, message, index if index is not None and index >= 0 else None)
+
+
+def _input(message):
+    """Raise an InputError (ULAM_EINVAL) with message (what was expected)."""
+    raise InputError(_ulam.EINVAL, message)
+
+
+def methods():
+    """The library's method table: a list of (name, what it answers), what answers is "entry"
+    (one x_i with an error bar: walks, bidirectional) or "all" (every unknown to a residual
+    tolerance: richardson, gauss-seidel, sequential, mcsa, cg, gmres).  solve(method=NAME) pins a
+    row; method="auto" (the default) chooses among them."""
+    return [(name, "entry" if answers == 1 else "all") for name, answers in _ulam.methods()]
+
+
+def _csr(M, what="M"):
+    """M as the library's CSR arrays (indptr int64, indices int32, data float64, n): taken without
+    a copy where they already are of those types and canonical (sorted, no duplicates, no stored
+    zeros); converted otherwise (scipy's own int32 indptr: its n + 1 entries)."""
+    import scipy.sparse as sp
+    if sp.issparse(M):
+        if M.format != "csr":
+            M = M.tocsr()
+    else:
+        a = np.asarray(M)
+        if a.ndim != 2:
+            _input(f"{what}: a 2-d matrix (scipy.sparse or NumPy), got {a.ndim} dimensions")
+        M = sp.csr_matrix(a)
+    if M.shape[0] != M.shape[1]:
+        raise InputError(14, f"{what}: a square matrix, got {M.shape[0]} x {M.shape[1]}")
+    if M.shape[0] < 1 or M.shape[0] > 2**31 - 1:
+        _input(f"{what}: between 1 and 2^31 - 1 rows, got {M.shape[0]}")
+    if np.iscomplexobj(M.data):
+        _input(f"{what}: real entries (complex systems are not supported)")
+    if not M.has_canonical_format:
+        M = M.copy()
+        M.sum_duplicates()
+    data = M.data if M.data.dtype == np.float64 else M.data.astype(np.float64)
+    if not np.isfinite(data).all():
+        k = int(np.flatnonzero(~np.isfinite(data))[0])
+        row = int(np.searchsorted(M.indptr, k, side="right") - 1)
+        raise InputError(_ulam.ENONFINITE, f"{what}: finite entries (row {row} holds a NaN or infinity)", row)
+    indices, indptr = M.indices, M.indptr
+    if (data == 0).any():
+        keep = data != 0
+        counts = np.add.reduceat(keep.astype(np.int64), indptr[:-1]) if len(data) else np.zeros(M.shape[0], np.int64)
+        counts[np.diff(indptr) == 0] = 0
+        indptr = np.concatenate(([0], np.cumsum(counts)))
+        data, indices = data[keep], indices[keep]
+    indices = indices if indices.dtype == np.int32 else indices.astype(np.int32)
+    indptr = indptr if indptr.dtype == np.int64 else indptr.astype(np.int64)
+    return (np.ascontiguousarray(indptr), np.ascontiguousarray(indices), np.ascontiguousarray(data), M.shape[0])
+
+
+def _vector(b, n, what="b"):
+    """b as a float64 C-contiguous vector of n entries."""
+    import scipy.sparse as sp
+    if sp.issparse(b):
+        b = b.toarray()
+    v = np.ascontiguousarray(np.asarray(b, dtype=np.float64).reshape(-1) if np.ndim(b) == 2 and 1 in np.shape(b)
+                             else np.asarray(b, dtype=np.float64))
+    if v.ndim != 1 or v.shape[0] != n:
+        raise InputError(15, f"{what}: a vector of {n} entries (M's size), got shape {np.shape(b)}")
+    if not np.isfinite(v).all():
+        raise InputError(_ulam.ENONFINITE, f"{what}: finite entries (entry {int(np.flatnonzero(~np.isfinite(v))[0])} "
+                         "is NaN or infinite)")
+    return v
+
+
+def _number(name, v, lo, hi, integer=False):
+    """v checked to lie in [lo, hi] (the CLI's ranges), as int or float."""
+    try:
+        x = int(v) if integer else float(v)
+    except (TypeError, ValueError):
+        _input(f"{name}: a number from {lo} to {hi}, got {v!r}")
+    if integer and x != v:
+        _input(f"{name}: an integer from {lo} to {hi}, got {v!r}")
+    if not (lo <= x <= hi):
+        _input(f"{name}: a number from {lo:g} to {hi:g}, got {v!r}")
+    return x
+
+
+class Result:
+    """One answer.  Attributes:
+      estimate   the estimate of x_index
+      stderr     its standard error (NaN for the rows without an error bar)
+      ci95       (low, high): the 95% confidence interval, or None when the variance is not
+                 certified finite (or cut walks may have moved it more than its standard error)
+      walks      walks made (for the outer iterations: their walk histories)
+      method     the table row that ran: "walks", "bidirectional", "mcsa", ...
+      mode, estimator, continue_q, kernel_alpha   the walks' kernel (walks row)
+      variance_finite  True, False or None (unknown)
+      interrupted  True when Ctrl-C stopped it
+      report     the JSON object `ulam solve --json` prints for this run, as a dict (the CLI's keys;
+                 its "index" is 1-based there, as on the command line; the process keys load_seconds,
+                 guard_seconds, kernel_seconds, transpose_seconds and peak_rss_mib are absent, and a
+                 bidirectional run's rho_abs and rho_hat are None: the CLI computes them beside it)
+      choice     the library's choice: every row's verdict and the walks' candidates (raw)
+    """
+
+    def __init__(self, d, index, b_nonzeros, source, scale=1.0):
+        w = d["walk"]
+        self.method = d["method"]
+        self.estimate = d["estimate"] * scale
+        self.stderr = d["std_error"] * scale
+        lo, hi = d["ci95"]
+        self.ci95 = (lo * scale, hi * scale) if math.isfinite(lo) and math.isfinite(hi) else None
+        if scale < 0 and self.ci95:
+            self.ci95 = (self.ci95[1], self.ci95[0])
+        self.walks = w["walks"]
+        o = d["opts"]
+        self.mode, self.estimator = MODES[o["mode"]], ESTIMATORS[o["estimator"]]
+        self.continue_q = o["continue_q"] if o["continue_q"] > 0 else "analog"
+        self.kernel_alpha = o["kernel_alpha"]
+        self.seed = o["seed"]
+        self.index = index
+        fin = w["variance_finite"]
+        self.variance_finite = True if fin == 1 else False if fin == 0 else None
+        if self.method == "bidirectional":
+            self.variance_finite = self.ci95 is not None
+        self.interrupted = bool(d["interrupted"] or w["interrupted"])
+        self.choice = d.get("choice")
+        self.iterations, self.residual = d["iterations"], d["residual"]
+        self.report = _report(d, index, b_nonzeros, source, scale)
+
+    def __repr__(self):
+        ci = f"95% CI {self.ci95[0]:.10g} .. {self.ci95[1]:.10g}" if self.ci95 else "no confidence interval"
+        return (f"<ulam.Result x[{self.index}] = {self.estimate:.10g} +- {self.stderr:.3g} ({ci}), "
+                f"{self.walks} walks, method {self.method}>")
+
+
+def _num(v):
+    """A JSON number as the CLI prints it: None when not finite."""
+    return v if isinstance(v, (int, bool)) or (v is not None and math.isfinite(v)) else None
+
+
+def _radius(rep, prefix, p):
+    """The CLI's radius keys (cli_json_radius)."""
+    rep[prefix] = _num(p["rho"] if p["converged"] else p["upper"])
+    rep[prefix + "_is"] = "estimate" if p["converged"] else "upper bound"
+    rep[prefix + "_lower"], rep[prefix + "_upper"] = _num(p["lower"]), _num(p["upper"])
+    rep[prefix + "_converged"] = bool(p["converged"])
+
+
+def _auto(ch):
+    """The CLI's "auto" key (cli_auto_print_json) from the library's choice."""
+    w, rows = ch["walks"], ch["rows"]
+    bid = rows[_METHOD_BIDIR]
+    chosen_bidir = ch["chosen"] == _METHOD_BIDIR
+    cands = w["candidates"]
+    run = cands[w["chosen"]]["predicted_work"] if w["chosen"] >= 0 else float("nan")
+    over = w["pilot_work"] - w["reused_work"]
+    share = over / (over + w["reused_work"] + run) if w["chosen"] >= 0 and math.isfinite(run) else float("nan")
+    out = {"chosen": (len(cands) if chosen_bidir else w["chosen"]) + 1, "closest": w["closest"] + 1, "stages": w["stages"],
+           "seconds": w["seconds"], "pilot_work": w["pilot_work"], "reused_work": w["reused_work"],
+           "pilot_share": _num(share), "candidates": []}
+    for k, c in enumerate(cands):
+        piloted = c["pilot_walks"] > 0
+        state = _STATES[c["state"]]
+        if state == "chosen" and chosen_bidir:
+            state = "finalist"
+        out["candidates"].append({
+            "mode": MODES[c["mode"]], "estimator": ESTIMATORS[c["estimator"]],
+            "continue": _num(c["continue_q"]) if c["continue_q"] > 0 else None, "kernel_alpha": c["kernel_alpha"],
+            "rho_hat": _num(c["rho_hat"]) if math.isfinite(c["rho_hat_upper"]) else None,
+            "rho_hat_upper": _num(c["rho_hat_upper"]), "certified": c["certified"], "state": state,
+            "status": "ok" if not c["status"] else _ulam.strerror(c["status"]), "pilot_walks": c["pilot_walks"],
+            "variance": _num(c["variance"]) if piloted else None,
+            "variance_rel_error": _num(c["variance_rel_error"]) if piloted else None,
+            "steps_per_walk": _num(c["steps_per_walk"]) if piloted else None,
+            "work_per_walk": _num(c["work_per_walk"]) if piloted else None, "cost": _num(c["cost"]),
+            "predicted_walks": _num(c["predicted_walks"]), "predicted_work": _num(c["predicted_work"]),
+            "predicted_seconds": _num(c["predicted_seconds"])})
+    if bid["state"]:
+        p = ch["bidirectional"]
+        out["candidates"].append({"mode": "bidirectional", "state": _ROW_STATES[bid["state"]], "rmax": _num(p["rmax"]),
+                                  "push_ops": p["push_ops"], "pilot_walks": p["pilot_walks"],
+                                  "predicted_walks": _num(p["predicted_walks"]),
+                                  "predicted_work": _num(bid["predicted_work"]), "leader_work": _num(ch["leader_work"])})
+    out["bidirectional"] = None if chosen_bidir else bid["why"]
+    out["rows"] = [{"name": r["name"], "state": _ROW_STATES[r["state"]], "predicted_work": _num(r["predicted_work"]),
+                    "why": r["why"] or None} for r in rows]
+    return out
+
+
+def _report(d, index, b_nonzeros, source, scale):
+    """The JSON object `ulam solve --json` prints, from the library's answer (the CLI's keys)."""
+    w, o = d["walk"], d["opts"]
+    ch = d.get("choice")
+    auto = ch is not None and not ch["pinned"]
+    rep = {"index": index + 1}
+    if d["method"] == "bidirectional":
+        b = d["bidirectional"]
+        rep.update({"source": source + 1 if source is not None else None, "b_nonzeros": b_nonzeros,
+                    "method": "bidirectional", "estimate": d["estimate"] * scale, "stderr": d["std_error"] * scale})
+        lo, hi = d["ci95"]
+        rep["ci95"] = [lo * scale, hi * scale] if math.isfinite(lo) else None
+        rep["variance_finite"] = rep["ci95"] is not None
+        # the guards of the forward kernel the CLI prints beside: not computed by the library's run
+        rep.update({"rho_abs": None, "rho_hat": None, "rmax": b["rmax"], "rmax_balanced": bool(b["rmax_balanced"]),
+                    "push_part": b["push_part"] * scale, "pushes": b["pushes"],
+                    "push_ops": b["push_ops"], "residual_support": b["residual_support"],
+                    "residual_sum": b["residual_sum"], "walks": w["walks"], "steps": w["steps"], "cut": w["cut"],
+                    "pilot_walks": b["pilot_walks"], "variance": _num(w["variance"]),
+                    "mean_visits": _num(b["mean_visits"]), "predicted_walks": _num(b["predicted_walks"]),
+                    "predicted_work": _num(b["predicted_work"]), "push_seconds": b["push_seconds"], "walk_seconds": w["seconds"], "seconds": b["seconds"], "estimator": ESTIMATORS[o["estimator"]],
+                    "seed": o["seed"], "threads": w["threads"], "ranks": 1})
+    elif d["method"] != "walks":
+        rep.update({"method": d["method"], "estimate": d["estimate"] * scale, "iterations": d["iterations"],
+                    "residual": _num(d["residual"]), "histories": w["walks"], "seed": o["seed"]})
+    else:
+        rep.update({"method": "walks", "estimate": w["estimate"] * scale, "stderr": w["std_error"] * abs(scale)})
+        lo, hi = d["ci95"]
+        rep["ci95"] = [lo * scale, hi * scale] if w["variance_finite"] == 1 and math.isfinite(lo) else None
+        fin = w["variance_finite"]
+        rep["variance_finite"] = True if fin == 1 else False if fin == 0 else None
+        _radius(rep, "rho_abs", d["rho_abs"])
+        _radius(rep, "rho_hat", d["rho_hat"])
+        rep.update({"kernel_alpha": o["kernel_alpha"], "max_share": _num(w["max_share"]),
+                    "score_bound": _num(w["score_bound"]), "tail_bound": _num(w["tail_bound"]),
+                    "variance_rel_error": _num(w["variance_rel_error"])})
+        if d.get("rel_err"):
+            r = w
+            stop = ("cuts" if r["cut_stop"] else "out_of_reach" if r["out_of_reach"]
+                    else "no_bound" if not math.isfinite(r["tail_bound"]) and r["estimate"] != 0
+                    else "fourth_moment" if not r["rel_err_met"] and r["fourth_finite"] != 1 else None)
+            rep.update({"min_walks": _num(r["min_walks"]), "rel_err_met": bool(r["rel_err_met"]),
+                        "cut_bound": _num(r["cut_bound"]), "rel_err_stop": stop,
+                        "fourth_finite": True if r["fourth_finite"] == 1 else False if r["fourth_finite"] == 0 else None})
+            _radius(rep, "rho4", r["rho4"])
+        if o["mode"] == 1:
+            rep["unreached"] = w["unreached"]
+        rel = w["std_error"] / abs(w["estimate"]) if w["estimate"] != 0 else float("inf")
+        rep.update({"variance": _num(w["variance"]), "walks": w["walks"], "steps": w["steps"], "cut": w["cut"],
+                    "mean_length": w["steps"] / w["walks"] if w["walks"] else 0.0, "seconds": w["seconds"],
+                    "steps_per_second": w["steps"] / w["seconds"] if w["seconds"] > 0 else 0.0,
+                    "figure_of_merit": _num(1.0 / (rel * rel * w["seconds"])) if w["seconds"] > 0 and rel > 0 else None,
+                    "mode": MODES[o["mode"]], "estimator": ESTIMATORS[o["estimator"]], "seed": o["seed"],
+                    "threads": w["threads"], "ranks": 1, "kernel_rows": w["rows"]})
+    if auto:
+        rep["auto"] = _auto(ch)
+    rep["interrupted"] = bool(d["interrupted"] or w["interrupted"])
+    return rep
+
+
+# The numeric options: the library's field, and the CLI's range (integer or real).
+_RANGES = {"walks": ("max_walks", 1, 2**62, True), "rel_err": ("rel_err", 1e-12, 1.0, False),
+           "time": ("max_seconds", 1e-6, 1e9, False), "threads": ("threads", 1, 1024, True),
+           "max_steps": ("max_steps", 1, 2**62, True), "roulette": ("roulette", 1e-300, 1e300, False),
+           "split": ("split", 1e-300, 1e300, False)}
+
+
+def _method_error(name):
+    """The CLI's usage error for an unknown method."""
+    names = ["walks", "bidirectional (with source= or a sparse b)"] + _ROWS[2:]
+    _input(f"method: one of auto, {', '.join(names[:-1])} or {names[-1]}, got {name!r}")
+
+
+class System:
+    """A matrix M of (I - M) x = b to answer many queries of: System(M).solve(b, index=i, ...) as
+    many times as needed (keyword arguments: those of ulam.solve).  The set-up the queries share
+    (the guards of the analog kernel, computed by the first query) is paid once; each query's
+    answer is as honest as a fresh solve's, though its choice may differ where the pilots'
+    budget counted a fresh solve's guard pass.  With jacobi=True, M holds A of A x = b and the
+    walks run on I - omega D^-1 A (b is scaled per query).  M's arrays are taken without a copy
+    where they are float64 CSR with int32 indices (an int32 indptr is converted: n + 1 entries):
+    do not change M while the System lives."""
+
+    def __init__(self, M, *, jacobi=False, omega=1.0):
+        self._jacobi, self._omega = bool(jacobi), _number("omega", omega, 1e-6, 2.0)
+        arrays = _csr(M, "A" if jacobi else "M")
+        self.n = arrays[3]
+        if jacobi:
+            self._A = arrays
+            st, msg, idx, *rest = _ulam.jacobi(*arrays, np.zeros(self.n), self._omega)
+            if st:
+                _raise(st, msg, idx)
+            arrays = (rest[0], rest[1], rest[2], self.n)
+        self._arrays = arrays
+        try:
+            self._sys = _ulam.System(*arrays)
+        except ValueError as e:
+            st = int(str(e).split(":")[0])
+            raise InputError(st, "a valid CSR matrix (sorted unique columns, finite nonzero values)") from None
+
+    def _rhs(self, b):
+        """b of the walks: omega D^-1 b under jacobi."""
+        if not self._jacobi:
+            return b
+        st, msg, idx, *rest = _ulam.jacobi(*self._A, b, self._omega)
+        if st:
+            _raise(st, msg, idx)
+        return rest[3]
+
+    def solve(self, b=None, index=None, **kw):
+        """As ulam.solve(M, b, index=..., ...) on this system's M (see help(ulam.solve))."""
+        return _solve(self, b, index, reuse=True, **kw)
+
+
+def _solve(system, b, index, *, source=None, method="auto", mode=None, estimator=None, walks=None, rel_err=None,
+           time=None, seed=1, threads=None, continue_q=None, alpha=None, roulette=None, split=None, max_steps=None,
+           force=False, assume_finite_variance=False, whole_kernel=False, progress=None, reuse=False, _scale=1.0):
+    """The query behind solve, System.solve and pagerank."""
+    n = system.n
+    if method != "auto" and method not in _ROWS:
+        _method_error(method)
+    if source is not None:
+        source = _number("source", source, 0, n - 1, integer=True)
+        if b is not None:
+            _input("source=S sets b = e_S: it cannot go with b")
+        if method not in ("auto", "bidirectional"):
+            _input(f"source=S goes with method='bidirectional', got {method!r}")
+        method = "bidirectional"
+        b = np.zeros(n)
+        b[source] = 1.0
+    if b is None:
+        _input("b (or source= for b = e_S)")
+    b = _vector(b, n)
+    b = system._rhs(b)
+    opts = {"seed": _number("seed", seed, 0, 2**63 - 1, integer=True)}
+    if mode is not None:
+        if mode not in MODES:
+            _input(f"mode: adjoint or forward, got {mode!r}")
+        opts["mode"], opts["pin_mode"] = MODES.index(mode), 1
+    if estimator is not None:
+        if estimator not in ESTIMATORS:
+            _input(f"estimator: collision, absorption or expected, got {estimator!r}")
+        opts["estimator"], opts["pin_estimator"] = ESTIMATORS.index(estimator), 1
+    if continue_q is not None:
+        opts["continue_q"] = 0.0 if continue_q == "analog" else _number("continue_q", continue_q, 1e-9, 1 - 1e-12)
+        opts["pin_continue"] = 1
+    if alpha is not None:
+        opts["kernel_alpha"], opts["pin_alpha"] = _number("alpha", alpha, 0.0, 1000.0), 1
+    given = {"walks": walks, "rel_err": rel_err, "time": time, "threads": threads, "max_steps": max_steps,
+             "roulette": roulette, "split": split}
+    for name, (field, lo, hi, integer) in _RANGES.items():
+        if given[name] is not None:
+            opts[field] = _number(name, given[name], lo, hi, integer)
+    if walks is None:
+        opts["max_walks"] = 100000 if rel_err is None and time is None else 0  # the CLI's default budget
+    if roulette is not None and split is not None and split <= roulette:
+        _input("split: a weight above roulette's")
+    mode_forward = opts.get("mode") == 1
+    if index is None:
+        if not mode_forward:
+            _input("index (adjoint walks and bidirectional answer x_index)")
+        index = 0
+    index = _number("index", index, 0, n - 1, integer=True)
+    opts.update({"force": int(bool(force)), "assume_finite": int(bool(assume_finite_variance)),
+                 "whole_kernel": int(bool(whole_kernel)), "reuse": int(bool(reuse)),
+                 "catch_sigint": int(threading.current_thread() is threading.main_thread())})
+    if all(opts.get(k) for k in ("pin_mode", "pin_estimator", "pin_continue", "pin_alpha")) and method == "auto":
+        method = "walks"  # nothing to choose: the CLI's pinned run
+    opts["method"] = -1 if method == "auto" else _ROWS.index(method)
+    if method == "auto" and system._jacobi:
+        opts["exclude"] = 1 << _METHOD_BIDIR  # as the CLI: not with --jacobi
+    if progress is not None and not callable(progress):
+        _input("progress: a callable (walks, estimate, stderr) or None")
+    d = system._sys.query(b, index, opts, progress)
+    if "choice" in d and method == "auto" and system._jacobi:
+        d["choice"]["rows"][_METHOD_BIDIR]["why"] = "not considered: --jacobi"
+    d["rel_err"] = rel_err
+    if d["status"]:
+        _raise(d["status"], d["message"], d["error_index"])
+    ch = d.get("choice")
+    if method == "auto" and ch and ch["walks"]["chosen"] < 0:
+        w = ch["walks"]
+        c = w["candidates"][w["closest"]]
+        diverge = not (w["abs_upper"] < 1)
+        text = (f"no walk candidate has a certified finite variance"
+                f"{' (rho(|M|) is not certified below 1)' if diverge else ''}; the closest is "
+                f"{MODES[c['mode']]} {ESTIMATORS[c['estimator']]} (continuation "
+                f"{'' if c['continue_q'] > 0 else 'analog, '}{max(c['continue_q'], 0):.3g}, kernel exponent "
+                f"{c['kernel_alpha']:g}) with rho(M^) = {c['rho_hat']:.6g} (upper bound {c['rho_hat_upper']:.6g})")
+        if rel_err is not None:
+            raise (DivergenceError if diverge else InfiniteVarianceError)(
+                _ulam.EDIVERGE if diverge else _ulam.EINFVAR, text + ": a rel_err target cannot be met honestly")
+        warnings.warn("ulam: " + text + "; running it", RuntimeWarning, stacklevel=3)
+    nb = int(np.count_nonzero(b))
+    r = Result(d, index, nb, source, _scale)
+    if d["interrupted"]:  # Ctrl-C (the walks' interrupt flag): the estimate so far rides on the exception
+        raise Interrupted(r)
+    return r
+
+
+def solve(M=None, b=None, *, index=None, A=None, jacobi=False, omega=1.0, source=None, method="auto", mode=None,
+          estimator=None, walks=None, rel_err=None, time=None, seed=1, threads=None, continue_q=None, alpha=None,
+          roulette=None, split=None, max_steps=None, force=False, assume_finite_variance=False, whole_kernel=False,
+          progress=None):
+    """Estimate x_index of (I - M) x = b with an error bar: `ulam solve` from Python.
+
+    Returns a ulam.Result (r.estimate, r.stderr, r.ci95, r.walks, r.method, r.report).
+
+    Arguments (the keyword ones mirror `ulam solve`'s long options):
+      M           the matrix: any scipy.sparse matrix or array, or a dense NumPy array, square.
+                  Float64 CSR with int32 indices is used without a copy (scipy's int32 indptr,
+                  n + 1 entries, is converted); other formats and types are converted.
+      b           the right-hand side, a NumPy vector of M's size (or source= instead).
+      index       0-based: the unknown x_index to estimate (needed unless mode="forward").
+      A, jacobi   A=A with jacobi=True: the system is A x = b, walked as M = I - omega D^-1 A with
+                  b' = omega D^-1 b (--jacobi); solve(A, b, jacobi=True) says the same.
+      omega       the Jacobi damping, in [1e-6, 2] (--omega, default 1).
+      source      0-based S: b = e_S, a point source (--source): a bidirectional solve, a reverse
+                  push from index and walks from S.
+      method      "auto" (the default: the library's choice among the table's rows, as the CLI's
+                  --method auto: the walks' candidates raced by pilots, and bidirectional for a
+                  sparse b with a rel_err target when predicted cheaper), or a row of the table
+                  pinned: "walks" (the walks the options name, defaults for the rest),
+                  "bidirectional", or "richardson", "gauss-seidel", "sequential", "mcsa", "cg",
+                  "gmres" (every unknown to a residual of 1e-8; r.estimate is x_index, with no
+                  error bar).  ulam.methods() lists the rows.
+      mode        "adjoint" (walks start at index) or "forward" (walks from b); pins it for auto.
+      estimator   "collision", "absorption" or "expected"; pins it for auto.
+      walks       stop after this many walks (--walks; default 100000 when no rule is given).
+      rel_err     stop once stderr / |estimate| <= rel_err, and only once enough walks have run
+                  for the error bar to be trusted (--rel-err, in [1e-12, 1]); refused
+                  (InfiniteVarianceError) when the variance is not certified finite, unless
+                  walks= or time= bounds the run.
+      time        stop after this many seconds (--time); the first rule reached wins.
+      seed        block q of walks uses stream (seed, q) (--seed, default 1): the same answer for
+                  any thread count, and the CLI's answer for the same seed and options.
+      threads     threads (--threads, default all cores).
+      continue_q  --continue: "analog" (min(1, row sum), the default) or a fixed continuation
+                  probability in (0, 1); pins it for auto.
+      alpha       the kernel exponent (--alpha, in [0, 1000], default 1); pins it for auto.
+      roulette    Russian roulette below this weight (--roulette).
+      split       split particles above this weight (--split; above roulette's).
+      max_steps   cut walks longer than this (--max-steps, default 10^6).
+      force       walk even when rho(|M|) is not certified below 1 (--force; else DivergenceError).
+      assume_finite_variance  treat a variance the guards cannot decide as finite
+                  (--assume-finite-variance).
+      whole_kernel  build every row of the walk kernel first (--whole-kernel).
+      progress    None, or a callable progress(walks, estimate, stderr) called after each round of
+                  walks (an exception it raises stops the walks and propagates).
+
+    Raises ulam.InputError (bad arguments: the CLI's refusals), ulam.DivergenceError,
+    ulam.InfiniteVarianceError, ulam.ConvergenceError, ulam.OutOfMemoryError (all ulam.Error:
+    .status, .message), and ulam.Interrupted (a KeyboardInterrupt; .result holds the estimate so
+    far) on Ctrl-C.  The GIL is released while the library works.
+    """
+    if A is not None:
+        if M is not None:
+            _input("M or A=, not both")
+        if not jacobi:
+            _input("A= goes with jacobi=True (the walks run on M = I - omega D^-1 A)")
+        M = A
+    if M is None:
+        _input("a matrix M (or A= with jacobi=True)")
+    system = System(M, jacobi=jacobi, omega=omega)
+    return _solve(system, b, index, source=source, method=method, mode=mode, estimator=estimator, walks=walks,
+                  rel_err=rel_err, time=time, seed=seed, threads=threads, continue_q=continue_q, alpha=alpha,
+                  roulette=roulette, split=split, max_steps=max_steps, force=force,
+                  assume_finite_variance=assume_finite_variance, whole_kernel=whole_kernel, progress=progress)
+
+
+def pagerank(adj, alpha=0.85, source=0, target=0, **kw):
+    """Personalized PageRank pi_source(target) with an error bar: the probability that a surfer
+    who restarts at source with probability 1 - alpha each step (following out-links in
+    proportion to adj's weights otherwise) is at target.  pi_s(t) = (1 - alpha) x_t with
+    (I - alpha P') x = e_s, P = D^-1 adj the out-link transition matrix; a node without out-links
+    ends the walk (its mass is lost: the substochastic convention).  Solved bidirectionally (a
+    reverse push from target, walks from source), as `ulam solve --index t --source s`.
+
+      adj      the adjacency (weights >= 0), any scipy.sparse or dense square matrix; adj[i, j] is
+               the link i -> j.
+      alpha    the damping (continuation) in (0, 1), default 0.85.
+      source, target  0-based nodes.
+      **kw     as ulam.solve (rel_err=, walks=, seed=, threads=, ...).
+    Returns a ulam.Result whose estimate, stderr and ci95 are of pi_source(target)."""
+    import scipy.sparse as sp
+    alpha = _number("alpha", alpha, 1e-12, 1 - 1e-12)
+    G = sp.csr_matrix(adj, dtype=np.float64) if not sp.issparse(adj) else adj.tocsr().astype(np.float64)
+    if G.shape[0] != G.shape[1]:
+        raise InputError(14, f"adj: a square adjacency, got {G.shape[0]} x {G.shape[1]}")
+    if (G.data < 0).any():
+        _input("adj: nonnegative link weights")
+    out = np.asarray(G.sum(axis=1)).reshape(-1)
+    inv = np.divide(alpha, out, out=np.zeros_like(out), where=out > 0)
+    M = (sp.diags(inv) @ G).T.tocsr()
+    system = System(M)
+    n = system.n
+    source = _number("source", source, 0, n - 1, integer=True)
+    target = _number("target", target, 0, n - 1, integer=True)
+    return _solve(system, None, target, source=source, _scale=1.0 - alpha, **kw)

@@ -1,0 +1,183 @@
+/* The method table (GSL's gsl_root_fsolver_type, Lua's luaL_Reg): every way ulam answers
+ * (I - M) x = b is a row with its name, its applicability test, its cost prediction and its run;
+ * ulam_auto_start chooses among the rows, or starts the one pinned.  A new method is a row here
+ * and its own file (src/method_*.c). */
+#include "method.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The rows, in enum ulam_method_row's order (the walks first: the others compare with its leader). */
+static const ulam__method_type *const table[ULAM_NMETHODS] = {
+    &ulam__method_walks, &ulam__method_bidir,      &ulam__method_richardson, &ulam__method_gauss_seidel,
+    &ulam__method_sequential, &ulam__method_mcsa, &ulam__method_cg,          &ulam__method_gmres};
+
+/* Row k's name, or NULL. */
+const char *ulam_method_name(int k)
+{
+    return k >= 0 && k < ULAM_NMETHODS ? table[k]->name : NULL;
+}
+
+/* The row named name, or -1. */
+int ulam_method_find(const char *name)
+{
+    for (int k = 0; name && k < ULAM_NMETHODS; k++)
+        if (!strcmp(name, table[k]->name)) return k;
+    return -1;
+}
+
+/* What row k answers (0 out of range). */
+int ulam_method_answers(int k)
+{
+    return k >= 0 && k < ULAM_NMETHODS ? table[k]->answers : 0;
+}
+
+/* 1 when row k is excluded by q's options. */
+int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len)
+{
+    if (!(q->mo->exclude & (1u << k))) return 0;
+    snprintf(why, len, "not considered: excluded");
+    return 1;
+}
+
+/* Fill a's interval from its estimate and standard error. */
+void ulam__answer_interval(ulam_answer *a)
+{
+    int ok = isfinite(a->std_error);
+    a->ci95[0] = ok ? a->estimate - ULAM_Z95 * a->std_error : NAN;
+    a->ci95[1] = ok ? a->estimate + ULAM_Z95 * a->std_error : NAN;
+}
+
+/* The default row options: none pinned, none excluded. */
+ulam_method_opts ulam_method_defaults(void)
+{
+    return (ulam_method_opts){.method = -1, .exclude = 0};
+}
+
+/* Check the inputs. */
+static int check(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_method_opts *mo,
+                 const ulam_choice *ch, ulam_run **out, ulam_error *err)
+{
+    if (!M || !b || !o || !ch || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b, options, a choice and a run");
+    if (mo->method < -1 || mo->method >= ULAM_NMETHODS)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a pinned method from -1 (none) to %d", ULAM_NMETHODS - 1);
+    return ULAM_OK;
+}
+
+/* "lost" to the row named by: its predicted work and the winner's ("the walks' ", "mcsa's "). */
+static void lost(char *why, size_t len, double work, const char *by, double by_work)
+{
+    size_t n = strlen(by);
+    snprintf(why, len, "lost: predicted work %.3g units, %s%s%s %.3g", work, by[n - 1] == 's' ? "the " : "", by,
+             by[n - 1] == 's' ? "'" : "'s", by_work);
+}
+
+/* Every row in order: the applicability test, the prediction, the leader kept (ties to the earlier). */
+static int choose(ulam__query *q, ulam_error *err)
+{
+    ulam_choice *ch = q->ch;
+    int leader = -1;
+    for (int k = 0; k < ULAM_NMETHODS; k++) {
+        ulam_method_verdict *v = &ch->method[k];
+        if (!table[k]->applies(q, k, v->why, sizeof v->why)) continue;
+        int status = table[k]->predict(q, k, err);
+        if (status) return status;
+        v->state = ULAM_METHOD_PLANNED;
+        if (leader < 0) {
+            leader = k;
+        } else if (v->predicted_work < ch->method[leader].predicted_work) {
+            table[leader]->release(q->run);
+            lost(ch->method[leader].why, sizeof ch->method[leader].why, ch->method[leader].predicted_work, table[k]->name,
+                 v->predicted_work);
+            leader = k;
+        } else {
+            table[k]->release(q->run);
+            if (!v->why[0])
+                lost(v->why, sizeof v->why, v->predicted_work, table[leader]->name, ch->method[leader].predicted_work);
+        }
+    }
+    ch->chosen = leader;
+    return ULAM_OK;
+}
+
+/* Choose (or start the pinned row) and hand out the run. */
+int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                    const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (out) *out = NULL;
+    ulam_auto_opts a = ao ? *ao : ulam_auto_defaults();
+    ulam_method_opts m = mo ? *mo : ulam_method_defaults();
+    int status = check(M, b, o, &m, ch, out, err);
+    if (status) return status;
+    memset(ch, 0, sizeof *ch);
+    ch->chosen = -1, ch->leader_work = NAN;
+    ch->walks.chosen = ch->walks.closest = -1;
+    for (int k = 0; k < ULAM_NMETHODS; k++) ch->method[k].predicted_work = NAN;
+    ulam_run *r = calloc(1, sizeof *r);
+    if (!r) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the run");
+    r->method = -1, r->M = M, r->b = b, r->o = *o;
+    ulam__query q = {.M = M, .b = b, .o = o, .ao = &a, .mo = &m, .ch = ch, .run = r};
+    if (m.method >= 0) {
+        ch->pinned = 1;
+        status = table[m.method]->pin(&q, m.method, err);
+        if (!status) ch->chosen = m.method;
+    } else {
+        status = choose(&q, err);
+    }
+    if (!status && ch->chosen < 0) status = ulam__fail(err, ULAM_EINVAL, 0, -1, "a method that applies to this query");
+    if (status) {
+        ulam_run_free(r);
+        return status;
+    }
+    ch->method[ch->chosen].state = ULAM_METHOD_CHOSEN;
+    ch->method[ch->chosen].why[0] = 0;
+    r->method = ch->chosen;
+    *out = r;
+    return ULAM_OK;
+}
+
+/* The walk solver of a walks run (borrowed), or NULL. */
+ulam_solver *ulam_run_solver(ulam_run *r)
+{
+    return r && r->method == ULAM_METHOD_WALKS ? r->sv : NULL;
+}
+
+/* Run to the end and fill *a. */
+int ulam_run_finish(ulam_run *r, ulam_answer *a, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!r || !a || r->method < 0) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a started run and an answer");
+    memset(a, 0, sizeof *a);
+    a->method = r->method, a->opts = r->o;
+    a->estimate = a->std_error = a->residual = NAN;
+    a->ci95[0] = a->ci95[1] = NAN;
+    int status = table[r->method]->finish(r, a, err);
+    a->status = status;
+    return status;
+}
+
+/* Free a run. */
+ulam_run *ulam_run_free(ulam_run *r)
+{
+    if (!r) return NULL;
+    for (int k = 0; k < ULAM_NMETHODS; k++) table[k]->release(r);
+    free(r);
+    return NULL;
+}
+
+/* Choose, run and free in one call. */
+int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+              const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err)
+{
+    ulam_choice *own = ch ? NULL : malloc(sizeof *own);
+    if (!ch && !own) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the choice");
+    ulam_run *r = NULL;
+    int status = ulam_auto_start(M, b, o, ao, mo, ch ? ch : own, &r, err);
+    if (!status) status = ulam_run_finish(r, a, err);
+    ulam_run_free(r);
+    free(own);
+    return status;
+}

@@ -1,0 +1,60 @@
+/* The method table's rows (src/method.c): what a row is and the state a choice builds.  Internal. */
+#ifndef ULAM_METHOD_H
+#define ULAM_METHOD_H
+
+#include "internal.h"
+
+/* A chosen method ready to run: what the rows keep between their prediction and their run. */
+struct ulam_run {
+    int method;           /* enum ulam_method_row; -1 before a row is chosen or pinned */
+    const ulam_csr *M;
+    const double *b;
+    ulam_walk_opts o;     /* the options as given (the walks row's run: the choice's) */
+    ulam_solver *sv;      /* walks */
+    ulam_bidir_opts bo;   /* bidirectional: its options (b's nonzeros in idx, val) */
+    int64_t *idx;
+    double *val;
+    ulam_csr *Mt;
+    ulam_push *w;
+};
+
+/* One query's choice in progress. */
+typedef struct ulam__query {
+    const ulam_csr *M;
+    const double *b;
+    const ulam_walk_opts *o;  /* as the caller gave them */
+    const ulam_auto_opts *ao; /* the walks' pins */
+    const ulam_method_opts *mo; /* the rows' pin and exclusions */
+    ulam_choice *ch;
+    ulam_run *run;
+} ulam__query;
+
+/* A row of the table (GSL's gsl_root_fsolver_type): its name, what it answers, its applicability
+ * test, its cost prediction, its pinned start, its run and its release. */
+typedef struct ulam__method_type {
+    const char *name;
+    int answers; /* ULAM_ANSWERS_ENTRY or ULAM_ANSWERS_ALL */
+    /* 1 when the row applies to q (the rows before it decided); else 0 with why filled */
+    int (*applies)(const ulam__query *q, int k, char *why, size_t len);
+    /* Predict the row's work (q->ch->method[k]; its why says a refusal or a drop), keeping in
+     * q->run what its run needs; ULAM_OK or a status that ends the choice */
+    int (*predict)(ulam__query *q, int k, ulam_error *err);
+    /* Start the row as pinned, from the options alone (no prediction) */
+    int (*pin)(ulam__query *q, int k, ulam_error *err);
+    /* Run to the end and fill a */
+    int (*finish)(ulam_run *r, ulam_answer *a, ulam_error *err);
+    /* Free what the run keeps for this row (it lost) */
+    void (*release)(ulam_run *r);
+} ulam__method_type;
+
+/* The rows (src/method_walks.c, src/method_bidir.c, src/method_outer.c). */
+extern const ulam__method_type ulam__method_walks, ulam__method_bidir, ulam__method_richardson,
+    ulam__method_gauss_seidel, ulam__method_sequential, ulam__method_mcsa, ulam__method_cg, ulam__method_gmres;
+
+/* 1 when row k is excluded by q's options (why filled: "not considered: excluded"). */
+int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len);
+
+/* Fill a's interval from its estimate and standard error (NaN standard error: no interval). */
+void ulam__answer_interval(ulam_answer *a);
+
+#endif

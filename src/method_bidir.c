@@ -1,0 +1,171 @@
+/* The method table's bidirectional row: a reverse push from the index and walks from a sparse b
+ * (src/bidir.c), considered by the choice against the walks' leader (rent or buy: it needs M's
+ * transpose) with its push capped at half the leader's predicted work, chosen when its own
+ * predicted work is below the leader's. */
+#include "method.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+/* The densest b the bidirectional row takes: nonzeros at most max(16, n / 10). */
+int64_t ulam_method_sparse_limit(int64_t n)
+{
+    return n / 10 > 16 ? n / 10 : 16;
+}
+
+/* The nonzeros of b (n entries). */
+static int64_t nonzeros(const double *b, int64_t n)
+{
+    int64_t k = 0;
+    for (int64_t i = 0; i < n; i++) k += b[i] != 0.0;
+    return k;
+}
+
+/* An adjoint query with a rel_err target, nothing pinned it cannot honour, a walk leader to
+ * compare with whose predicted work W exceeds nnz(M)/4, and a sparse b. */
+static int applies(const ulam__query *q, int k, char *why, size_t len)
+{
+    const ulam_walk_opts *o = q->o;
+    const ulam_auto_opts *ao = q->ao;
+    const ulam_auto_result *au = &q->ch->walks;
+    const char *pinned = o->mode == ULAM_FORWARD ? "forward mode (--mode forward, --out, --errors)"
+                         : ao->pin_estimator ? "--estimator is pinned"
+                         : ao->pin_alpha && o->kernel_alpha != 1.0 ? "--alpha other than 1"
+                         : o->roulette > 0 || o->split > 0 ? "--roulette or --split (bidirectional takes neither)"
+                                                           : NULL;
+    int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
+    double nnz = (double)ulam_csr_nnz(q->M), W = q->ch->leader_work;
+    if (pinned) snprintf(why, len, "not considered: %s", pinned);
+    else if (ulam__method_excluded(q, k, why, len)) return 0;
+    else if (!(o->rel_err > 0))
+        snprintf(why, len, "not considered: no --rel-err target (without one auto compares variance x work a walk, "
+                           "which bidirectional has no figure for)");
+    else if (au->chosen < 0) snprintf(why, len, "not considered: no certified walk method to compare with");
+    else if (nb == 0 || nb > ulam_method_sparse_limit(n))
+        snprintf(why, len, "not considered: b is %s (%lld nonzeros; sparse is at most max(16, n/10) = %lld)",
+                 nb ? "dense" : "zero", (long long)nb, (long long)ulam_method_sparse_limit(n));
+    else if (!(W > nnz / 4))
+        snprintf(why, len, "not considered: the walks' predicted work %.3g is below nnz(M)/4 = %.3g (the transpose "
+                           "alone would cost more)", W, nnz / 4);
+    else return 1;
+    return 0;
+}
+
+/* The plan's predicted work in the units of the walks' work model (ULAM_AUTO_*, one walk step),
+ * so that it compares with the walk leader's: the plan counts a push operation (one nonzero of M
+ * read, one residual updated) and a walk visit as one operation each; here a push operation
+ * counts as a matrix entry read (ULAM_AUTO_READ), a walk as its steps (V - 1) plus its start and
+ * record (ULAM_AUTO_WALK), the kernel rows on M' the pilot built and those the estimate's walks
+ * would build (as many a walk; the whole kernel once they pass 1 / ULAM__COMPLETE of it,
+ * as the solver does) ULAM_AUTO_BUILD each, its reachability and bound reads twice (pilot and
+ * estimate), and the transpose (2 nnz reads) and the guards on M' (twice: the pilot's and the
+ * report's, as many reads as guard g's) that the walks do not need. */
+static double work(const ulam_csr *M, const ulam_bidir_plan_info *p, const ulam_guard *g)
+{
+    double nnz = (double)ulam_csr_nnz(M), walks = (double)p->pilot_walks + p->predicted_walks;
+    double cap = nnz + 3.0 * (double)M->nrows, u = (double)p->pilot_units;
+    double est = p->pilot_walks > 0 ? fmin(cap, u * p->predicted_walks / (double)p->pilot_walks) : cap;
+    if (est * ULAM__COMPLETE > cap) est = cap;
+    double guard = (1.0 + g->abs.iterations + g->hat[ULAM_ADJOINT].iterations) * nnz;
+    return ULAM_AUTO_READ * ((double)p->push.ops + 2.0 * (double)p->pilot_reads + 2.0 * nnz + 2.0 * guard) +
+           walks * (p->mean_visits - 1.0 + ULAM_AUTO_WALK) + ULAM_AUTO_BUILD * (u + est);
+}
+
+/* Free what the run keeps for bidirectional. */
+static void release(ulam_run *r)
+{
+    free(r->idx), free(r->val);
+    ulam_push_free(r->w);
+    ulam_csr_free(r->Mt);
+    r->idx = NULL, r->val = NULL, r->w = NULL, r->Mt = NULL;
+    r->bo.b_index = NULL, r->bo.b_value = NULL;
+}
+
+/* The options, b's nonzeros, the transpose and the push workspace (walk: the walks' options). */
+static int setup(ulam__query *q, const ulam_walk_opts *walk, ulam_error *err)
+{
+    ulam_run *r = q->run;
+    int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
+    r->bo = ulam_bidir_defaults();
+    r->bo.walk = *walk;
+    r->bo.target = walk->index;
+    r->idx = malloc((size_t)(nb ? nb : 1) * sizeof *r->idx), r->val = malloc((size_t)(nb ? nb : 1) * sizeof *r->val);
+    double t0 = ulam_now();
+    int status = r->idx && r->val ? ulam_csr_transpose(q->M, &r->Mt) : ULAM_ENOMEM;
+    q->ch->transpose_seconds = ulam_now() - t0;
+    if (!status) status = ulam_push_alloc(q->M, &r->w);
+    if (status) {
+        release(r);
+        return ulam__fail(err, status, 0, -1, "memory for the transpose and the push");
+    }
+    for (int64_t i = 0, j = 0; i < n; i++)
+        if (q->b[i] != 0.0) r->idx[j] = i, r->val[j++] = q->b[i];
+    r->bo.nb = nb, r->bo.b_index = r->idx, r->bo.b_value = r->val;
+    return ULAM_OK;
+}
+
+/* Plan with the push capped at W / 2 and predict the work; kept in the run. */
+static int predict(ulam__query *q, int k, ulam_error *err)
+{
+    ulam_choice *ch = q->ch;
+    ulam_run *r = q->run;
+    double W = ch->leader_work;
+    ulam_walk_opts walk = *q->o;
+    walk.estimator = ULAM_COLLISION, walk.kernel_alpha = 1.0;
+    walk.guard = NULL, walk.interrupt = NULL, walk.share = NULL;
+    int status = setup(q, &walk, err);
+    if (status) return status;
+    r->bo.max_push_ops = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : 0; /* W infinite: the default cap */
+    ulam_error e;
+    ulam_method_verdict *v = &ch->method[k];
+    status = ulam_bidir_plan(r->w, r->Mt, &r->bo, &ch->bidir, &e);
+    ch->bidir_opts = r->bo;
+    if (status == ULAM_ENOCONV) {
+        snprintf(v->why, sizeof v->why, "dropped: its push passed W/2 = %lld operations", (long long)r->bo.max_push_ops);
+        return ULAM_OK;
+    }
+    if (status == ULAM_ENOMEM) {
+        release(r);
+        *err = e;
+        return status;
+    }
+    if (status) {
+        snprintf(v->why, sizeof v->why, "refused: %.250s", e.msg);
+        return ULAM_OK;
+    }
+    v->predicted_work = work(q->M, &ch->bidir, &ch->walks.guard);
+    return ULAM_OK;
+}
+
+/* Pinned: the options as given, b's nonzeros as the sparse b, or b = e_S as the point source S (no
+ * plan yet: the solve makes it). */
+static int pin(ulam__query *q, int k, ulam_error *err)
+{
+    (void)k;
+    int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
+    if (nb == 0) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero b (b is zero, so x is 0)");
+    if (nb > ulam_method_sparse_limit(n))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a sparse b for bidirectional: at most max(16, n/10) = %lld nonzeros, "
+                          "not %lld", (long long)ulam_method_sparse_limit(n), (long long)nb);
+    int status = setup(q, q->o, err);
+    if (!status && nb == 1 && q->b[q->run->idx[0]] == 1.0) /* b = e_S: a point source, as `ulam solve --source S` */
+        q->run->bo.source = q->run->idx[0], q->run->bo.nb = 0;
+    q->ch->bidir_opts = q->run->bo;
+    return status;
+}
+
+/* The push and the walks (the plan reused when predicted). */
+static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
+{
+    r->bo.walk.interrupt = r->o.interrupt, r->bo.walk.share = r->o.share;
+    int status = ulam_bidir_solve(r->w, r->Mt, &r->bo, &a->bidir, err);
+    if (status) return status;
+    a->walks = a->bidir.walks;
+    a->opts = r->bo.walk;
+    a->estimate = a->bidir.estimate, a->std_error = a->bidir.std_error;
+    a->ci95[0] = a->bidir.ci95[0], a->ci95[1] = a->bidir.ci95[1];
+    return ULAM_OK;
+}
+
+const ulam__method_type ulam__method_bidir = {"bidirectional", ULAM_ANSWERS_ENTRY, applies, predict, pin, finish, release};

@@ -1,0 +1,60 @@
+/* The method table's walks row: adjoint or forward von Neumann-Ulam walks, the candidate (mode,
+ * estimator, continuation, kernel exponent) chosen by the pilots' race (src/auto.c), run by the
+ * walk solver (src/solve.c). */
+#include "method.h"
+
+#include <math.h>
+
+/* Walks answer every entry query (their own guards refuse what they cannot do). */
+static int applies(const ulam__query *q, int k, char *why, size_t len)
+{
+    (void)q, (void)k, (void)why, (void)len;
+    return 1;
+}
+
+/* The race (ulam_auto_solver): its chosen candidate's predicted work, its solver kept. */
+static int predict(ulam__query *q, int k, ulam_error *err)
+{
+    ulam_choice *ch = q->ch;
+    int status = ulam_auto_solver(q->M, q->b, q->o, q->ao, &ch->walks, &q->run->sv, err);
+    const ulam_auto_result *au = &ch->walks;
+    if (au->chosen >= 0) ch->leader_work = ch->method[k].predicted_work = au->cand[au->chosen].predicted_work;
+    int c = au->chosen >= 0 ? au->chosen : au->closest;
+    if (c >= 0) {
+        ulam_walk_opts *o = &q->run->o;
+        o->mode = au->cand[c].mode, o->estimator = au->cand[c].estimator;
+        o->continue_q = au->cand[c].continue_q, o->kernel_alpha = au->cand[c].kernel_alpha;
+        o->guard = NULL; /* the solver holds its own copy */
+    }
+    return status;
+}
+
+/* Pinned: a solver on the options as given (ulam_solve's run). */
+static int pin(ulam__query *q, int k, ulam_error *err)
+{
+    (void)k;
+    return ulam_solver_alloc(q->M, q->b, q->o, &q->run->sv, err);
+}
+
+/* Iterate until done (a solver that has failed stays failed: its status). */
+static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
+{
+    int status = ulam_solver_error(r->sv, NULL);
+    while (!status && !ulam_solver_done(r->sv)) status = ulam_solver_iterate(r->sv);
+    ulam_solver_result(r->sv, &a->walks);
+    ulam_solver_guard(r->sv, &a->guard);
+    if (status) ulam_solver_error(r->sv, err);
+    a->estimate = a->walks.estimate;
+    a->std_error = a->walks.std_error;
+    a->ci95[0] = a->walks.ci95[0], a->ci95[1] = a->walks.ci95[1]; /* NaN unless the variance is certified finite */
+    a->opts.guard = NULL;
+    return status;
+}
+
+/* Free the solver. */
+static void release(ulam_run *r)
+{
+    r->sv = ulam_solver_free(r->sv);
+}
+
+const ulam__method_type ulam__method_walks = {"walks", ULAM_ANSWERS_ENTRY, applies, predict, pin, finish, release};
