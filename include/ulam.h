@@ -676,6 +676,17 @@ ulam_solver *ulam_solver_free(ulam_solver *s);
 int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                ulam_walk_result *result, ulam_error *err);
 
+/* As ulam_solve, ulam_solver_alloc and ulam_jacobi with b's length nb: b must have one entry a
+ * row of M (A), else ULAM_EDIM (ULAM_EINVAL for a NULL b), so a short b is refused, never read
+ * past its end (the functions without a length read M->nrows entries of b and trust that they
+ * are there).  ulam_jacobi_n writes nb entries of bp. */
+int ulam_solve_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
+                 ulam_walk_result *result, ulam_error *err);
+int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
+                        ulam_solver **out, ulam_error *err);
+int ulam_jacobi_n(const ulam_csr *A, const double *b, int64_t nb, double omega, ulam_csr **M, double *bp,
+                  ulam_error *err);
+
 /* The walk cap of a run whose only rule is rel_err. */
 #define ULAM_REL_ERR_CAP 1000000000
 

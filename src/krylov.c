@@ -54,7 +54,8 @@ int ulam_csr_symmetric(const ulam_csr *M)
 int ulam_cg(const ulam_csr *M, const double *b, double tol, int max_iter, double *x, int *iterations,
             double *residual)
 {
-    if (!M || !b || !x || M->nrows != M->ncols || !(tol > 0) || max_iter < 1) return ULAM_EINVAL;
+    if (!M || !b || !x || M->nrows != M->ncols || !(tol > 0) || !isfinite(tol) || max_iter < 1) return ULAM_EINVAL;
+    if (ulam__csr_check_structure(M, NULL)) return ULAM_EINVAL; /* src/check.c */
     int64_t n = M->nrows;
     double *r = ulam__malloc((size_t)n, sizeof *r), *p = ulam__malloc((size_t)n, sizeof *p);
     double *q = ulam__malloc((size_t)n, sizeof *q);
@@ -99,7 +100,9 @@ static void rotate(double c, double s, double *a, double *b)
 int ulam_gmres(const ulam_csr *M, const double *b, int m, double tol, int max_iter, double *x, int *iterations,
                double *residual)
 {
-    if (!M || !b || !x || M->nrows != M->ncols || !(tol > 0) || max_iter < 1 || m < 1) return ULAM_EINVAL;
+    if (!M || !b || !x || M->nrows != M->ncols || !(tol > 0) || !isfinite(tol) || max_iter < 1 || m < 1)
+        return ULAM_EINVAL;
+    if (ulam__csr_check_structure(M, NULL)) return ULAM_EINVAL; /* src/check.c */
     int64_t n = M->nrows;
     double *V = ulam__malloc((size_t)n * (size_t)(m + 1), sizeof *V), *w = ulam__malloc((size_t)n, sizeof *w);
     double *H = ulam__calloc((size_t)(m + 1) * (size_t)m, sizeof *H); /* column-major, (m+1) x m */

@@ -118,6 +118,8 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
 {
     if (M->nrows != M->ncols)
         return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
+    int bad = ulam__walk_opts_check(o, err); /* src/check.c: every finite-valued option first */
+    if (bad) return bad;
     if (o->mode != ULAM_ADJOINT && o->mode != ULAM_FORWARD)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "mode adjoint or forward");
     if (o->estimator < ULAM_COLLISION || o->estimator > ULAM_EXPECTED)
@@ -796,6 +798,8 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     int status = check_opts(M, &o, err);
     if (status) return status;
     if ((status = check_split(M, b, &o, err))) return status;
+    if (o.mode == ULAM_FORWARD && (status = ulam__csr_check_structure(M, err))) /* src/check.c: M' is made */
+        return status; /* (adjoint: the guards' pass checks M, or the kernel each row it builds) */
     double bnorm1 = 0.0;
     ulam_solver *s = calloc(1, sizeof *s);
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
