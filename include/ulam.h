@@ -623,7 +623,10 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
                       ulam_solver **out, ulam_error *err);
 
 /* Run one round of walks (rounds grow 1, 2, 4 ... 64 blocks of 1024 walks as walks accumulate,
- * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
+ * whatever the thread count).  A b whose largest |entry| lies outside [2^-256, 2^256] is walked
+ * on scaled by a power of 2 (exact) and the results scaled back, so an answer a double can hold
+ * is answered; one it cannot (or a non-finite score) ends the run with ULAM_ENONFINITE.  ULAM_OK,
+ * or the status that ends the run: ULAM_ENONFINITE,
  * ULAM_ENOMEM, ULAM_EIO (the share's allgather), ULAM_ESYNTAX (a corrupt row of a mapped
  * file), ULAM_ERANGE (at kernel_alpha != 1, a reached row whose entries are so uneven that a
  * move's probability is below 2^-40 / the row's length); ulam_solver_error says why. */
@@ -645,7 +648,8 @@ void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r);
 
 /* Forward mode: every component's estimate and standard error (arrays of n; either may be
  * NULL); a component no walk has tallied has no estimate: x 0 (expected: b_i) and standard
- * error NaN.  Adjoint mode: ULAM_EINVAL. */
+ * error NaN.  Adjoint mode: ULAM_EINVAL.  ULAM_ENONFINITE (the arrays filled) when an estimate
+ * exceeds the largest double. */
 int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error);
 
 /* Free a solver; accepts and returns NULL. */
@@ -774,7 +778,9 @@ int ulam_outer_solve(const ulam_csr *M, const double *b, const ulam_outer_opts *
  * tol (the true residual, recomputed at the end): conjugate gradients for symmetric positive
  * definite I - M (ulam_cg), restarted GMRES(restart) with modified Gram-Schmidt and Givens
  * rotations otherwise (ulam_gmres).  *iterations gets the matrix-vector products spent on
- * Krylov vectors, *residual the final relative residual.  ULAM_OK or ULAM_ENOCONV at max_iter. */
+ * Krylov vectors, *residual the final relative residual.  ULAM_OK or ULAM_ENOCONV at max_iter;
+ * ULAM_ENONFINITE when x or the residual is not finite (b far from 1 is scaled by a power of 2
+ * first, exactly, so an x up to the largest double is answered). */
 int ulam_cg(const ulam_csr *M, const double *b, double tol, int max_iter, double *x, int *iterations,
             double *residual);
 int ulam_gmres(const ulam_csr *M, const double *b, int restart, double tol, int max_iter, double *x,

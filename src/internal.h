@@ -206,4 +206,11 @@ int ulam__csr_check_structure(const ulam_csr *A, ulam_error *err);
 /* As ulam__csr_check_structure for rows [lo, hi) of A only (A's sizes and rowptr[nrows] trusted). */
 int ulam__csr_check_rows(const ulam_csr *A, int64_t lo, int64_t hi, ulam_error *err);
 
+/* Scaling of b (src/util.c): a solver works on b 2^-e when b's largest |entry| is far from 1, so
+ * that scores, sums and squares neither overflow nor underflow, and multiplies what it finds by
+ * 2^e (both exact: powers of 2).  ulam__b_exponent gives e (0: no scaling; b's largest |entry|
+ * outside [2^-256, 2^256] is brought into [0.5, 1)); ulam__b_scaled a malloc'd copy of b 2^-e. */
+int ulam__b_exponent(const double *b, int64_t n);
+double *ulam__b_scaled(const double *b, int64_t n, int e);
+
 #endif

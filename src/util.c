@@ -2,6 +2,7 @@
 #include "internal.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -207,4 +208,24 @@ int ulam__thread_num(void)
 #else
     return 0;
 #endif
+}
+
+/* The power of 2 that brings b's largest |entry| into [0.5, 1) when it lies outside
+ * [2^-256, 2^256], else 0. */
+int ulam__b_exponent(const double *b, int64_t n)
+{
+    double m = 0.0;
+    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(b[i]));
+    if (!(m > 0) || !isfinite(m) || (m <= 0x1p256 && m >= 0x1p-256)) return 0;
+    int e;
+    frexp(m, &e);
+    return e;
+}
+
+/* A copy of b times 2^-e (NULL on failure). */
+double *ulam__b_scaled(const double *b, int64_t n, int e)
+{
+    double *c = ulam__malloc((size_t)n, sizeof *c);
+    for (int64_t i = 0; c && i < n; i++) c[i] = ldexp(b[i], -e);
+    return c;
 }

@@ -234,9 +234,9 @@ static ulam_csr *damaged(int kind)
     case 0: M->rowptr[0] = 1; break;
     case 1: M->rowptr[2] = (int64_t)1 << 40; break;
     case 2: M->rowptr[2] = 0, M->rowptr[1] = 2; break;
-    case 3: M->rowptr[1] = -(int64_t)1 << 40; break;
+    case 3: M->rowptr[1] = INT64_MIN / 2; break;
     case 4: M->colidx[1] = 1 << 30; break;
-    case 5: M->colidx[0] = -(1 << 30); break;
+    case 5: M->colidx[0] = INT32_MIN; break;
     case 6: M->rowptr[4] = -5; break;
     }
     return M;
@@ -296,12 +296,86 @@ static void test_damaged_matrix(void **state)
     test_case_done();
 }
 
+/* The 3-state path M_{12} = M_{21} = M_{23} = M_{32} = a. */
+static ulam_csr *path3(double a)
+{
+    int32_t ti[4] = {0, 1, 1, 2}, tj[4] = {1, 0, 2, 1};
+    double tx[4] = {a, a, a, a};
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(3, 3, 4, ti, tj, tx, &M), ULAM_OK);
+    return M;
+}
+
+/* Point 5: b = (1, 1e308, 1).  With a = 0.25 x_2 = 1.1428e308 is a double: walks (both modes,
+ * every estimator) and Krylov answer it (walks within 4 standard errors of LAPACK's, finite
+ * errors); with a = 0.49 x_2 = 1.92e308 is not: ULAM_ENONFINITE with a message, never inf +- 0. */
+static void test_overflow(void **state)
+{
+    (void)state;
+    const double b[3] = {1, 1e308, 1};
+    ulam_csr *M = path3(0.25), *H = path3(0.49);
+    double exact[3], x[3];
+    ulam_error err;
+    assert_int_equal(ulam_direct_solve(M, b, exact, 0, NULL, &err), ULAM_OK);
+    for (int mode = 0; mode < 2; mode++)
+        for (int est = 0; est < 3; est++) {
+            test_case(mode * 3 + est);
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.mode = mode, o.estimator = est, o.index = 1, o.max_walks = 20000, o.threads = 1;
+            ulam_walk_result r;
+            assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+            assert_true(isfinite(r.estimate) && isfinite(r.std_error) && r.std_error > 0);
+            assert_true(fabs(r.estimate - exact[1]) < 4 * r.std_error);
+            int st = ulam_solve(H, b, &o, &r, &err);
+            assert_int_equal(st, ULAM_ENONFINITE);
+            assert_non_null(strstr(err.msg, "double"));
+        }
+    test_case_done();
+    int it;
+    double res;
+    assert_int_equal(ulam_gmres(M, b, 10, 1e-10, 100, x, &it, &res), ULAM_OK);
+    assert_close(x[1] / exact[1], 1.0, 1e-9);
+    assert_int_equal(ulam_cg(M, b, 1e-10, 100, x, &it, &res), ULAM_OK);
+    assert_close(x[1] / exact[1], 1.0, 1e-9);
+    assert_int_equal(ulam_gmres(H, b, 10, 1e-10, 100, x, &it, &res), ULAM_ENONFINITE);
+    assert_int_equal(ulam_cg(H, b, 1e-10, 100, x, &it, &res), ULAM_ENONFINITE);
+    ulam_csr_free(M);
+    ulam_csr_free(H);
+}
+
+/* The scaling is exact: b 2^600 and b 2^-600 give the estimates of b times 2^600 and 2^-600, bit
+ * for bit (and the same walks). */
+static void test_scaling_exact(void **state)
+{
+    (void)state;
+    ulam_csr *M = path3(0.3);
+    const double b[3] = {1, -0.5, 2};
+    for (int mode = 0; mode < 2; mode++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = mode, o.index = 1, o.max_walks = 5000, o.threads = 1;
+        ulam_walk_result r0, r1;
+        ulam_error err;
+        assert_int_equal(ulam_solve(M, b, &o, &r0, &err), ULAM_OK);
+        for (int k = -1; k <= 1; k += 2) {
+            double bb[3];
+            for (int i = 0; i < 3; i++) bb[i] = ldexp(b[i], 600 * k);
+            assert_int_equal(ulam_solve(M, bb, &o, &r1, &err), ULAM_OK);
+            assert_true(r1.estimate == ldexp(r0.estimate, 600 * k));
+            assert_true(r1.std_error == ldexp(r0.std_error, 600 * k));
+            assert_int_equal(r1.walks, r0.walks);
+            assert_int_equal(r1.steps, r0.steps);
+        }
+    }
+    ulam_csr_free(M);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_walk_options),   cmocka_unit_test(test_nested_walk_options),
         cmocka_unit_test(test_other_options),  cmocka_unit_test(test_lengths),
-        cmocka_unit_test(test_damaged_matrix),
+        cmocka_unit_test(test_damaged_matrix), cmocka_unit_test(test_overflow),
+        cmocka_unit_test(test_scaling_exact),
     };
     return test_run(tests);
 }

@@ -202,6 +202,10 @@ static void print_failure(const report *p)
     else if (p->status == ULAM_ENOCONV)
         fprintf(stderr, "ulam: %s: error: %s: residual %.3g after --max-iter %d iterations (tolerance %g)\n",
                 p->s->matrix_path, ulam_strerror(p->status), res, p->iterations, p->o->tol);
+    else if (p->status == ULAM_ENONFINITE && p->method >= KRYLOV_CG)
+        fprintf(stderr, "ulam: %s: error: %s: expected a solution a double can hold: x (or its residual, %.3g) "
+                        "exceeds 1.8e308 after %d iterations; no output written\n",
+                p->s->matrix_path, ulam_strerror(p->status), res, p->iterations);
     else
         fprintf(stderr, "ulam: %s: error: %s after %d iterations (is rho(|M|) < 1? see 'ulam info')\n",
                 p->s->matrix_path, ulam_strerror(p->status), p->nsteps);

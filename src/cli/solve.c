@@ -545,6 +545,7 @@ static int run(solve_args *a)
         cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o);
     }
     cli_progress_end(&pg);
+    ulam_error ferr;
     ulam_solver_result(sv, &r);
     if (r.cut_stop)
         fprintf(stderr, "ulam: %s: warning: --rel-err %g is unreachable: %lld walks were cut at --max-steps %lld and "
@@ -558,6 +559,10 @@ static int run(solve_args *a)
     } else if (status && status != ULAM_ENONFINITE) {
         fprintf(stderr, "ulam: %s: error: %s: expected rows the walks reach to be consistent (row data of "
                         "the mapped file is corrupt: prepare it again)\n", s->matrix_path, ulam_strerror(status));
+        rc = cli_exit_code(status);
+    } else if (status && ulam_solver_error(sv, &ferr) && ferr.index >= 0) { /* the estimate overflowed */
+        fprintf(stderr, "ulam: %s: error: %s: expected %s; no estimate after %lld walks\n", s->matrix_path,
+                ulam_strerror(status), ferr.msg, (long long)r.walks);
         rc = cli_exit_code(status);
     } else if (status) {
         fprintf(stderr, "ulam: %s: error: %s: a walk produced a non-finite weight or score after %lld "
