@@ -216,8 +216,12 @@ double ulam_strtod(const char *s, char **end);
  * written to a temporary name and renamed into place only when complete. */
 int ulam_mm_write_matrix(const char *path, const ulam_csr *A, const char *comment);
 
-/* Write x as "array real general" n x 1, atomically like ulam_mm_write_matrix. */
+/* Write x as "array real general" n x 1, atomically like ulam_mm_write_matrix (ULAM_ENONFINITE
+ * for a non-finite value, nothing written; ULAM_EIO with errno saying why). */
 int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const char *comment);
+
+/* As ulam_mm_write_vector, to an open file f (an ulam_outfile's, say, to commit with others). */
+int ulam_mm_write_vector_file(FILE *f, const double *x, int64_t n, const char *comment);
 
 /* An output file written under a temporary name in the same directory and renamed into place
  * by ulam_outfile_commit: a reader sees the old file or the complete new one, never a part.
@@ -232,8 +236,14 @@ typedef struct ulam_outfile {
 /* Open a temporary file beside path; ULAM_OK, ULAM_ENOMEM or ULAM_EIO (o is then empty). */
 int ulam_outfile_open(ulam_outfile *o, const char *path);
 
-/* Flush, close and rename into place; ULAM_OK, or ULAM_EIO with the temporary file removed. */
+/* Flush, close and rename into place; ULAM_OK, or ULAM_EIO with the temporary file removed and
+ * errno saying why (ENOSPC: "No space left on device"). */
 int ulam_outfile_commit(ulam_outfile *o);
+
+/* Commit k files together (an answer and its errors): flush and close every one, and only when
+ * all were written whole rename each into place; else remove every temporary file, so no file
+ * is replaced (ULAM_EIO, errno saying why).  Every o[j] is left empty (aborted) either way. */
+int ulam_outfile_commit_all(ulam_outfile *o, int k);
 
 /* Close and remove the temporary file; accepts an empty (zeroed or aborted) o. */
 void ulam_outfile_abort(ulam_outfile *o);

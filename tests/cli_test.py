@@ -1217,6 +1217,42 @@ def check_auto_bidir(progs):
         assert o["auto"]["bidirectional"].startswith("not considered: the walks' predicted work"), o["auto"]
 
 
+def check_disk_full(ulam):
+    """Disk full (issue 26, point 7): the answer reaches stdout before any output file is written
+    and survives its failure; the message names errno's reason ("No space left on device"); --out
+    and --errors are committed together or neither (the previous run's pair stays intact, no
+    temporary file is left).  stdout on /dev/full; the files on a 64 KiB tmpfs, mounted when the
+    test can (root), else that part is skipped with a message."""
+    import subprocess as sp
+    args = ["solve", "--method", "walks", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--mode", "forward",
+            "--walks", "2000"]
+    with open("/dev/full", "w") as full:
+        p = sp.run([ulam] + args, stdout=full, stderr=sp.PIPE, text=True, timeout=120)
+    assert p.returncode == code("EIO") and "No space left on device" in p.stderr, (p.returncode, p.stderr)
+    with tempfile.TemporaryDirectory() as d:
+        if os.geteuid() != 0 or sp.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", d],
+                                       capture_output=True).returncode != 0:
+            print("check_disk_full: skipped the full-disk files (cannot mount a tmpfs: not root)")
+            return
+        try:
+            x, e = os.path.join(d, "x.mtx"), os.path.join(d, "e.mtx")
+            rc, _, err = run(ulam, args + ["--out", x, "--errors", e])
+            assert rc == 0, err
+            old = open(x, "rb").read(), open(e, "rb").read()
+            pages = lambda b: -(-len(b) // 4096)
+            free = 16 - pages(old[0]) - pages(old[1])
+            with open(os.path.join(d, "pad"), "wb") as f:  # room for a new x.mtx, not for both
+                f.write(b"\0" * 4096 * (free - pages(old[0])))
+            rc, out, err = run(ulam, args + ["--seed", "2", "--out", x, "--errors", e])
+            assert rc == code("EIO"), (rc, err)
+            assert re.search(r"^x\[1\]\s+\S+ \+- ", out), out  # the answer, though the files failed
+            assert "No space left on device" in err, err
+            assert (open(x, "rb").read(), open(e, "rb").read()) == old, "a file of the pair was replaced"
+            assert sorted(os.listdir(d)) == ["e.mtx", "pad", "x.mtx"], os.listdir(d)
+        finally:
+            sp.run(["umount", d])
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -1249,7 +1285,7 @@ def main():
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),
-             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam)]
+             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam), (check_disk_full, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]
     if cases:

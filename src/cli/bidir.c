@@ -227,7 +227,7 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
         else print_text(o, &r, rp);
         if (r.walks.interrupted) rc = EXIT_INTERRUPTED;
     }
-    fflush(stdout);
+    cli_flush();
     cli_release_sigint();
     ulam_push_free(w);
     ulam_csr_free(Mt);
@@ -410,7 +410,7 @@ int cli_bidir_auto_run(cli_system *s, cli_bidir_cand *bc, const ulam_auto_result
         else print_text(&bc->o, &r, &rp);
         if (r.walks.interrupted) rc = EXIT_INTERRUPTED;
     }
-    fflush(stdout);
+    cli_flush();
     cli_release_sigint();
     return rc;
 }

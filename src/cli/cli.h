@@ -14,6 +14,14 @@ int cli_exit_code(int status);
 /* Print "ulam: file:line: error: <status>: expected <msg>" and return the exit code. */
 int cli_report(const char *file, const ulam_error *err);
 
+/* Report a failed write of path (status ULAM_EIO: errno's message errnum, "No space left on
+ * device"; ULAM_ENONFINITE: values that cannot be written) and return the exit code. */
+int cli_report_write(const char *path, int status, int errnum);
+
+/* fflush(stdout), remembering errno's value at the first failure (main reports it at exit: "No
+ * space left on device"); 0 or that errno value. */
+int cli_flush(void);
+
 /* Print "ulam: <command>: <message>" for a usage error and return EXIT_USAGE. */
 int cli_usage_error(const char *command, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -67,6 +67,29 @@ int cli_report(const char *file, const ulam_error *err)
     return cli_exit_code(err->status);
 }
 
+/* Report a failed write of path with errno's message. */
+int cli_report_write(const char *path, int status, int errnum)
+{
+    ulam_error err = {.status = status, .line = 0, .index = -1};
+    if (status == ULAM_EIO && errnum)
+        snprintf(err.msg, sizeof err.msg, "a writable output file (%s)", strerror(errnum));
+    else if (status == ULAM_ENONFINITE)
+        snprintf(err.msg, sizeof err.msg, "finite values to write (nothing was written)");
+    else
+        snprintf(err.msg, sizeof err.msg, "a writable output file");
+    return cli_report(path, &err);
+}
+
+static int stdout_errno; /* errno's value when a flush of stdout first failed */
+
+/* Flush stdout, remembering why it first failed. */
+int cli_flush(void)
+{
+    errno = 0;
+    if ((fflush(stdout) != 0 || ferror(stdout)) && !stdout_errno) stdout_errno = errno ? errno : EIO;
+    return stdout_errno;
+}
+
 /* Print a usage error and return EXIT_USAGE. */
 int cli_usage_error(const char *command, const char *fmt, ...)
 {

@@ -2,6 +2,7 @@
 #include "cli.h"
 
 #include <getopt.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -37,7 +38,6 @@ static void print_text(const cli_system *s, const double *x, int64_t index,
     printf("rcond      %.3e\n", info->rcond);
     printf("residual   %.3e\n", info->residual);
     printf("seconds    %.6f\n", info->seconds);
-    if (out) printf("written    %s\n", out);
 }
 
 /* Print the JSON object. */
@@ -96,13 +96,13 @@ int cli_direct(int argc, char **argv)
     int status;
     if ((rc = cli_direct_solve(&s, max_mem, &x, &info))) {
         /* reported */
-    } else if (out && (status = ulam_mm_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct"))) {
-        ulam_error err = {.status = status, .msg = "a writable output file"};
-        rc = cli_report(out, &err);
-    } else if (json) {
-        print_json(&s, x, s.index, &info);
-    } else {
-        print_text(&s, x, s.index, &info, out);
+    } else { /* the answer first: a failed write of --out below cannot lose it */
+        if (json) print_json(&s, x, s.index, &info);
+        else print_text(&s, x, s.index, &info, out);
+        cli_flush();
+        if (out && (status = ulam_mm_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct")))
+            rc = cli_report_write(out, status, errno);
+        else if (out && !json) printf("written    %s\n", out);
     }
     free(x);
     cli_system_free(&s);

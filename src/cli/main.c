@@ -1,6 +1,7 @@
 /* ulam: the command-line entry point; dispatches to one file per subcommand. */
 #include "cli.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -55,8 +56,12 @@ int main(int argc, char **argv)
     cli_mpi_init(&argc, &argv);
 #endif
     int rc = dispatch(argc, argv);
+    int e = cli_flush();
+    if (e && cli_rank == 0) { /* a full disk or a closed pipe: say so */
+        fprintf(stderr, "ulam: error: cannot write the answer to standard output (%s)\n", strerror(e));
+        if (!rc) rc = cli_exit_code(ULAM_EIO);
+    }
 #ifdef ULAM_MPI
-    fflush(stdout);
     cli_mpi_finalize();
 #endif
     return rc;
