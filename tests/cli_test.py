@@ -1253,6 +1253,69 @@ def check_disk_full(ulam):
             sp.run(["umount", d])
 
 
+def stopped(p):
+    """Wait until process p has stopped itself (SIGSTOP: state T in /proc) or ended; True if stopped.
+    Polls /proc, no clock: the ULAM_TEST_STOP_AT_TMP hook stops it with its temporary file open."""
+    while p.poll() is None:
+        try:
+            state = [l for l in open(f"/proc/{p.pid}/status") if l.startswith("State:")][0].split()[1]
+        except (OSError, IndexError):
+            continue
+        if state == "T":
+            return True
+    return False
+
+
+def check_signals(ulam):
+    """Signals (issue 26, point 8): SIGTERM or SIGINT in any phase that has an output's temporary
+    file (NAME.tmp.XXXXXX) open removes it: prepare -o, study's output while its reference runs,
+    solve's --out/--errors, a --cache write, radiosity's --out.  Each process stops itself once its
+    k-th temporary file exists (ULAM_TEST_STOP_AT_TMP=k), is sent the signal and SIGCONT, and must
+    end by the signal with no temporary file left and no output in place."""
+    import signal
+    import shutil
+    with tempfile.TemporaryDirectory() as d:
+        shutil.copy(M + "chain4.mtx", os.path.join(d, "c.mtx"))
+        shutil.copy(M + "chain4_b.mtx", os.path.join(d, "c_b.mtx"))
+        c, cb = os.path.join(d, "c.mtx"), os.path.join(d, "c_b.mtx")
+        out = os.path.join(d, "out")
+        phases = [
+            ("prepare -o", ["prepare", c, "--rhs", cb, "-o", out + ".ulam"], 1),
+            ("study", ["study", c, "--rhs", cb, "--index", "2", "--methods", "adjoint-collision-plain",
+                       "--budgets", "100", "--repeats", "2", "--out", out], 1),
+            ("solve --out --errors", ["solve", "--method", "walks", c, "--rhs", cb, "--mode", "forward",
+                                      "--walks", "2000", "--out", out + "x.mtx", "--errors", out + "e.mtx"], 2),
+            ("--cache", ["solve", "--method", "walks", c, "--rhs", cb, "--index", "2", "--walks", "1000", "--cache"], 1),
+        ]
+        if os.path.exists(R + "cube_black_lamp.obj") and "radiosity" in run(ulam, ["--help"])[2] + run(ulam, ["--help"])[1]:
+            phases.append(("radiosity --out", ["radiosity", R + "cube_black_lamp.obj", "--direct", "--out",
+                                                out + ".csv"], 1))
+        for name, args, k in phases:
+            for sig in (signal.SIGTERM, signal.SIGINT):
+                env = dict(os.environ, ULAM_TEST_STOP_AT_TMP=str(k))
+                p = subprocess.Popen([ulam] + args, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+                try:
+                    assert stopped(p), f"{name}: ended without reaching temporary file {k}: {p.stderr.read()}"
+                    tmps = [f for _, _, fs in os.walk(d) for f in fs if ".tmp." in f]
+                    assert tmps, f"{name}: stopped with no temporary file"
+                    p.send_signal(sig)
+                    p.send_signal(signal.SIGCONT)
+                    p.wait(timeout=60)
+                finally:
+                    if p.poll() is None:
+                        p.kill()
+                        p.wait()
+                left = [f for _, _, fs in os.walk(d) for f in fs if ".tmp." in f]
+                assert not left, f"{name}: {sig.name} left {left}"
+                if sig == signal.SIGTERM or name != "solve --out --errors":
+                    assert p.returncode == -sig, f"{name}: {sig.name}: exit {p.returncode}"
+                    assert not [f for r, _, fs in os.walk(d) for f in fs if r != d or f.startswith("out")], \
+                        f"{name}: output in place after {sig.name}"
+                for f in os.listdir(d):  # fresh for the next run
+                    if f.startswith("out") or f.endswith(".ulamcache"):
+                        shutil.rmtree(os.path.join(d, f)) if os.path.isdir(os.path.join(d, f)) else os.remove(os.path.join(d, f))
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -1285,7 +1348,7 @@ def main():
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),
-             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam), (check_disk_full, ulam)]
+             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam), (check_disk_full, ulam), (check_signals, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]
     if cases:

@@ -100,7 +100,7 @@ int cli_direct(int argc, char **argv)
         if (json) print_json(&s, x, s.index, &info);
         else print_text(&s, x, s.index, &info, out);
         cli_flush();
-        if (out && (status = ulam_mm_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct")))
+        if (out && (status = cli_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct")))
             rc = cli_report_write(out, status, errno);
         else if (out && !json) printf("written    %s\n", out);
     }

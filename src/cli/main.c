@@ -55,6 +55,7 @@ int main(int argc, char **argv)
 #ifdef ULAM_MPI
     cli_mpi_init(&argc, &argv);
 #endif
+    cli_signals_init(); /* temporary files removed on SIGINT, SIGTERM, SIGHUP */
     int rc = dispatch(argc, argv);
     int e = cli_flush();
     if (e && cli_rank == 0) { /* a full disk or a closed pipe: say so */

@@ -380,7 +380,7 @@ int cli_solve_method(int argc, char **argv)
         }
         int ws;
         if (!rc && out && cli_rank == 0 && p.converged &&
-            (ws = ulam_mm_write_vector(out, x, s.M->nrows, "outer-iteration solution x")))
+            (ws = cli_write_vector(out, x, s.M->nrows, "outer-iteration solution x")))
             rc = cli_report_write(out, ws, errno);
         if (!rc && p.status) {
             print_failure(&p);

@@ -414,11 +414,11 @@ static void print_list(const args *a, const ulam_scene *s)
 static int write_csv(const char *path, const ulam_scene *s, const patch_values *v)
 {
     ulam_outfile o;
-    int status = ulam_outfile_open(&o, path);
+    int status = cli_outfile_open(&o, path);
     if (!status) {
         row_header(o.f, ROW_CSV, v);
         for (int64_t p = 0; p < s->npatches; p++) row(o.f, ROW_CSV, s, p, v);
-        status = ulam_outfile_commit(&o);
+        status = cli_outfile_commit(&o);
     }
     if (!status) return 0;
     ulam_error err = {.status = status, .msg = "a writable output file"};
@@ -644,7 +644,11 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
     ulam_camera cam = camera_of(a, s);
     ulam_render_info info;
     int status = rgb ? ulam_render(t, B, &cam, a->width, a->height, a->exposure, rgb, &info) : ULAM_ENOMEM;
-    if (!status) status = ulam_png_write(a->image, a->width, a->height, rgb);
+    if (!status) {
+        cli_hold_signals(1); /* its temporary file is the library's: a signal waits until it is gone */
+        status = ulam_png_write(a->image, a->width, a->height, rgb);
+        cli_hold_signals(0);
+    }
     free(rgb);
     if (status) {
         ulam_error err = {.status = status, .msg = "a writable PNG file"};

@@ -283,7 +283,7 @@ static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, cons
     char both[1100];
     const char *fail = NULL;
     if (!status && out) {
-        if ((status = ulam_outfile_open(&o[k], out)) ||
+        if ((status = cli_outfile_open(&o[k], out)) ||
             (status = ulam_mm_write_vector_file(o[k].f, x, n, r->unreached ? "forward random-walk estimates of x "
                                                 "(unreached components: 0, no estimate; see the errors)"
                                                 : "forward random-walk estimates of x")))
@@ -291,16 +291,16 @@ static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, cons
         k++;
     }
     if (!status && errors) {
-        if ((status = ulam_outfile_open(&o[k], errors))) fail = errors, errnum = errno;
+        if ((status = cli_outfile_open(&o[k], errors))) fail = errors, errnum = errno;
         else write_errors(o[k].f, e, n, r);
         k++;
     }
     if (!status) {
-        status = ulam_outfile_commit_all(o, k);
+        status = cli_outfile_commit_all(o, k);
         errnum = errno;
         if (out && errors) snprintf(both, sizeof both, "%s and %s", out, errors), fail = both;
     }
-    ulam_outfile_abort(&o[0]), ulam_outfile_abort(&o[1]); /* whatever is left: nothing is replaced */
+    cli_outfile_abort(&o[0]), cli_outfile_abort(&o[1]); /* whatever is left: nothing is replaced */
     free(x), free(e);
     if (!fail) fail = out ? out : errors;
     return status ? cli_report_write(fail, status, errnum) : 0;
