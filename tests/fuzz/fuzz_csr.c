@@ -34,7 +34,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (int64_t i = 0; i <= n; i++) {
         int16_t v;
         take(data, size, &at, &v, sizeof v);
-        A.rowptr[i] = flags & 64 ? (int64_t)v << 20 : v; /* sometimes far out of range */
+        A.rowptr[i] = flags & 64 ? (int64_t)v * (1 << 20) : v; /* sometimes far out of range */
     }
     for (int64_t p = 0; p < nnz; p++) {
         int16_t v;
