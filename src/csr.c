@@ -44,7 +44,8 @@ int ulam_csr_check(const ulam_csr *A)
 {
     if (!A || !A->rowptr || A->nrows < 0 || A->ncols < 0 || A->nrows > ULAM_MAX_DIM || A->ncols > ULAM_MAX_DIM)
         return ULAM_EINVAL;
-    if (A->rowptr[0] != 0) return ULAM_ESYNTAX;
+    int bad = ulam__csr_check_structure(A, NULL); /* src/check.c: rows in bounds before they are read */
+    if (bad) return bad;
     for (int64_t i = 0; i < A->nrows; i++) {
         if (A->rowptr[i + 1] < A->rowptr[i]) return ULAM_ESYNTAX;
         for (int64_t p = A->rowptr[i]; p < A->rowptr[i + 1]; p++) {

@@ -263,6 +263,18 @@ static void test_damaged_matrix(void **state)
                 assert_int_equal(err.status, st);
             }
         ulam_guard g;
+        ulam_csr *good = chain(); /* the guards given (a certificate): the walks read rows lazily */
+        assert_int_equal(ulam_guard_check(good, 0.0, NULL, &g, &err), ULAM_OK);
+        ulam_csr_free(good);
+        for (int est = 0; est < 3; est++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.estimator = est, o.max_walks = 1000, o.threads = 1, o.guard = &g;
+            for (o.index = 0; o.index < 4; o.index++) {
+                ulam_walk_result r;
+                int st = ulam_solve(M, ones, &o, &r, &err); /* refused or answered, never out of bounds */
+                assert_true(st == ULAM_OK || st == ULAM_ESYNTAX || st == ULAM_EINDEX);
+            }
+        }
         assert_int_not_equal(ulam_guard_check(M, 0.0, NULL, &g, &err), ULAM_OK);
         ulam_power p;
         assert_int_not_equal(ulam_spectral_power(M, NULL, NULL, NULL, &p, &err), ULAM_OK);
