@@ -808,8 +808,10 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
     s->o = o;
     s->b = b;
-    /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered */
-    s->bexp = !kernel && !reach && o.rel_err_offset == 0.0 && (o.mode == ULAM_ADJOINT || !(o.roulette > 0 || o.split > 0))
+    /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered;
+       not on the lazy path (adjoint with the guards given reads only the b_i its walks reach) */
+    s->bexp = !kernel && !reach && o.rel_err_offset == 0.0 && (o.mode == ULAM_ADJOINT ? !o.guard
+                                                                 : !(o.roulette > 0 || o.split > 0))
                   ? ulam__b_exponent(b, M->nrows) : 0;
     if (s->bexp && !(s->b = b = s->bs = ulam__b_scaled(b, M->nrows, s->bexp))) goto nomem;
     s->n = M->nrows;
