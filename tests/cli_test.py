@@ -655,19 +655,20 @@ def check_study_question(ulam):
         assert rc == 2 and "no question.txt" in err, (rc, err)
 
 
+def popen_walks(*args, **kwargs):
+    """subprocess.Popen with the test hook ULAM_TEST_STOP_AT_WALKS=1: the process stops itself
+    (SIGSTOP) once the walks' Ctrl-C handler is in force (SIGINT is caught in every phase, to
+    remove temporary files, so a caught SIGINT no longer says the walks are ready)."""
+    return subprocess.Popen(*args, env=dict(os.environ, ULAM_TEST_STOP_AT_WALKS="1"), **kwargs)
+
+
 def interrupt_when_ready(p):
-    """Send SIGINT once process p has installed its handler (polled in /proc, no sleeps)."""
+    """Send SIGINT once process p (started by popen_walks) has stopped itself with the walks' handler
+    installed, then SIGCONT (polled in /proc, no sleeps)."""
     import signal
-    import time
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        try:
-            caught = [l for l in open(f"/proc/{p.pid}/status") if l.startswith("SigCgt:")]
-        except OSError:
-            break
-        if caught and int(caught[0].split()[1], 16) & (1 << (signal.SIGINT - 1)):
-            break
+    stopped(p)
     p.send_signal(signal.SIGINT)
+    p.send_signal(signal.SIGCONT)
 
 
 def check_interrupt(ulam):
@@ -675,7 +676,7 @@ def check_interrupt(ulam):
     wait until the process has installed its SIGINT handler, then send it)."""
     import signal
     import time
-    p = subprocess.Popen([ulam] + SOLVE + ["--index", "1", "--walks", "100000000000", "--json"],
+    p = popen_walks([ulam] + SOLVE + ["--index", "1", "--walks", "100000000000", "--json"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     interrupt_when_ready(p)
     out, _ = p.communicate(timeout=60)
@@ -702,7 +703,7 @@ def check_second_interrupt(ulam):
         except BlockingIOError:
             pass
     os.set_blocking(w, True)  # O_NONBLOCK belongs to the shared file description: undo it
-    p = subprocess.Popen([ulam] + SOLVE + ["--index", "1", "--walks", "100000", "--json"], stdout=w,
+    p = popen_walks([ulam] + SOLVE + ["--index", "1", "--walks", "100000", "--json"], stdout=w,
                          stderr=subprocess.DEVNULL)
     os.close(w)
     interrupt_when_ready(p)
@@ -937,7 +938,7 @@ def check_study(ulam):
     rc, _, err = run(ulam, ["study", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1",
                             "--out", d + "/x"])
     assert rc == 3 and "rho(|M|) in [1.1, 1.1] is not certified below 1" in err, (rc, err)
-    p = subprocess.Popen([ulam] + args[:6] + ["--methods", "adjoint-collision-plain", "--budgets", "100000000000",
+    p = popen_walks([ulam] + args[:6] + ["--methods", "adjoint-collision-plain", "--budgets", "100000000000",
                                               "--repeats", "3", "--out", d + "/i"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     interrupt_when_ready(p)
@@ -1038,14 +1039,14 @@ def check_radiosity_interrupt(ulam):
     of 10^11 particles into a missing directory must fail at once, not after the walks)."""
     with tempfile.TemporaryDirectory() as d:
         png = d + "/int.png"
-        p = subprocess.Popen([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+        p = popen_walks([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
                               "--image", png], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         interrupt_when_ready(p)
         out, err = p.communicate(timeout=60)
         assert p.returncode == 130, (p.returncode, err)
         assert "[INTERRUPTED]" in out and re.search(r"^image +not written: the run was interrupted", out, re.M), out
         assert "exposure" not in out and os.listdir(d) == [], (out, os.listdir(d))
-        p = subprocess.Popen([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+        p = popen_walks([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
                               "--json", "--image", png, "--out", d + "/p.csv"], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
         interrupt_when_ready(p)

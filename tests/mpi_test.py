@@ -23,21 +23,22 @@ def run(cmd):
 def check_interrupt(ulam, mpirun):
     """Ctrl-C under mpirun (issue 26, point 8): mpirun sends every rank SIGTERM, which the walks take
     as their first Ctrl-C: every rank stops at the same round and rank 0 prints the estimate so far,
-    marked interrupted.  No clock: the signal is sent once both ranks have installed the handler
-    (polled in /proc)."""
+    marked interrupted.  No clock: the signal is sent once both ranks have stopped themselves with the
+    walks' handler installed (the ULAM_TEST_STOP_AT_WALKS hook; mpirun sends SIGCONT before SIGTERM)."""
     import signal
     p = subprocess.Popen([mpirun, "--oversubscribe", "-np", "2", ulam, "solve", "--method", "walks", "matrices/chain4.mtx",
                           "--rhs", "matrices/chain4_b.mtx", "--index", "2", "--walks", "100000000000", "--json"],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV)
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env=dict(ENV, ULAM_TEST_STOP_AT_WALKS="1"))
     try:
         ready = 0
-        while ready < 2 and p.poll() is None:
+        while ready < 2 and p.poll() is None:  # both ranks stopped themselves with the walks' handler set
             ready = 0
             kids = subprocess.run(["pgrep", "-P", str(p.pid)], capture_output=True, text=True).stdout.split()
             for k in kids:
                 try:
-                    cgt = [l for l in open(f"/proc/{k}/status") if l.startswith("SigCgt:")][0].split()[1]
-                    ready += int(cgt, 16) >> (signal.SIGTERM - 1) & 1 and open(f"/proc/{k}/comm").read().startswith("ulam")
+                    state = [l for l in open(f"/proc/{k}/status") if l.startswith("State:")][0].split()[1]
+                    ready += state == "T" and open(f"/proc/{k}/comm").read().startswith("ulam")
                 except (OSError, IndexError):
                     pass
         p.send_signal(signal.SIGINT)

@@ -73,6 +73,10 @@ void cli_catch_sigint(void)
 {
     catch(SIGINT, on_sigint);
     if (cli_share) catch(SIGTERM, on_sigint);
+    /* test hook (tests/cli_test.py, interrupt_when_ready): ULAM_TEST_STOP_AT_WALKS=1 stops the
+       process with SIGSTOP the first time the walks' handler is in force */
+    static int armed;
+    if (getenv("ULAM_TEST_STOP_AT_WALKS") && !armed++) raise(SIGSTOP);
 }
 
 /* Back to the handlers of cli_signals_init. */
