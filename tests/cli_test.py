@@ -164,7 +164,12 @@ CASES += [
     (PS + ["--source", "3", "--rmax", "-0.1"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--source", "3", "--rmax", "nan"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
-    (["solve", M + "randsub1000.mtx", "--source", "3"], 2, r"--method bidirectional needs --index I", r"^$"),
+    (["solve", M + "randsub1000.mtx", "--source", "3", "--top", "2"], 0, r"^$",  # every target (src/fpush.c)
+     r"single source: forward push from 3.*\n(.*\n)*rank .*95% CI\n1 +3 +1\.00\d+ .*\n2 +143 +0\.195"),
+    (["solve", M + "randsub1000.mtx", "--source", "3", "--index", "4", "--top", "2"], 2, r"--top K .* not with --index",
+     r"^$"),
+    (["solve", M + "randsub1000.mtx", "--rhs", D + "sparse3_b.mtx", "--method", "bidirectional"], 2,
+     r"--method bidirectional needs --index I", r"^$"),
     (PS + ["--rhs", M + "randsub1000_b.mtx", "--method", "bidirectional"], 2,
      r"is for a sparse b, and this b has 1000 nonzeros of 1000 \(more than max\(16, n/10\) = 100\)", r"^$"),
     (PS + ["--rhs", D + "sparse3_b.mtx", "--rmax", "0.1"], 2, r"say --method bidirectional", r"^$"),

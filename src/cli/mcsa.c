@@ -41,7 +41,11 @@ static const char *const usage =
     "  --json                one JSON object with the history of every iteration\n"
     "  --jacobi, --omega, --continue, --max-steps, --threads, --force, --cache: as for walks\n"
     "\n"
-    "Each iteration prints its residual, its walks (histories) and its seconds.\n";
+    "A walk correction that does not lower the residual is rejected and its walks go on to more\n"
+    "histories; when the count its variance predicts is beyond 100x what --eps1 asked for (or\n"
+    "--max-histories), the run stops (exit 10 + ESTALL) saying so.  Walks whose variance is not\n"
+    "certified finite (rho(M^) >= 1) are refused before any walk (exit 10 + EINFVAR).\n"
+    "Each iteration prints its residual, its walks (histories, rejected ones too) and its seconds.\n";
 
 static const char *const method_names[] = {"richardson", "gauss-seidel", "sequential", "mcsa", "cg", "gmres"};
 enum { KRYLOV_CG = 4, KRYLOV_GMRES = 5 }; /* the Krylov peers: not outer iterations */
@@ -70,6 +74,8 @@ typedef struct {
     const double *x;
     double err_direct, direct_seconds, seconds;
     ulam_guard g;
+    ulam_error why; /* the library's sentence on how the run ended */
+    int rejected;   /* corrections rejected and redone with more histories */
 } report;
 
 /* Sum of the steps' histories and walk seconds. */
@@ -121,8 +127,8 @@ static void print_text(const report *p)
     printf("outcome         %s after %d iterations%s, residual %.4e\n", outcome(p), p->iterations,
            p->method >= KRYLOV_CG ? " (matrix-vector products)" : "", p->residual);
     if (walks)
-        printf("histories       %lld (%.4g per iteration), eps1 %g\n", (long long)hist,
-               p->nsteps ? (double)hist / p->nsteps : 0.0, p->o->eps1);
+        printf("histories       %lld (%.4g per iteration), eps1 %g, corrections rejected %d\n", (long long)hist,
+               p->nsteps ? (double)hist / p->nsteps : 0.0, p->o->eps1, p->rejected);
     printf("seconds         %.4f (walks %.4f)\n", p->seconds, walk_s);
     if (walks)
         printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", p->g.abs.rho,
@@ -149,6 +155,7 @@ static void print_json(const report *p)
     cli_json_number("eps1", p->o->eps1, 0);
     cli_json_number("residual", p->residual, 0);
     printf("\"histories\": %lld, ", (long long)hist);
+    if (walking(p->method)) printf("\"rejected\": %d, ", p->rejected);
     cli_json_number("seconds", p->seconds, 0);
     cli_json_number("walk_seconds", walk_s, 0);
     if (walking(p->method)) {
@@ -194,7 +201,9 @@ static int direct_error(const cli_system *s, const double *x, report *p)
 static void print_failure(const report *p)
 {
     double res = p->residual;
-    if (p->status == ULAM_ESTALL)
+    if (p->status == ULAM_ESTALL && strstr(p->why.msg, "lowers the residual"))
+        fprintf(stderr, "ulam: %s: error: %s: expected %s\n", p->s->matrix_path, ulam_strerror(p->status), p->why.msg);
+    else if (p->status == ULAM_ESTALL)
         fprintf(stderr, "ulam: %s: error: %s: the residual made no new low in the last %s iterations (now "
                         "%.3g after %d, tolerance %g): the corrections no longer reduce it (is rho(M^) < 1? a "
                         "smaller --eps1 walks more a correction)\n",
@@ -244,6 +253,8 @@ static int run(const cli_system *s, const ulam_outer_opts *o, report *p, ulam_ou
     p->iterations = p->nsteps;
     p->converged = ulam_outer_converged(it);
     p->residual = p->nsteps ? (*steps)[p->nsteps - 1].residual : 1.0;
+    ulam_outer_error(it, &p->why);
+    p->rejected = ulam_outer_rejected(it);
     *x = malloc((size_t)s->M->nrows * sizeof **x);
     if (*x) memcpy(*x, ulam_outer_x(it), (size_t)s->M->nrows * sizeof **x);
     ulam_outer_free(it);
