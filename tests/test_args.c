@@ -105,6 +105,11 @@ static void test_nested_walk_options(void **state)
         ulam_bidir_result br;
         assert_int_equal(ulam_bidir_solve(w, Mt, &bo, &br, &err), ULAM_EINVAL);
         assert_names(&err, walk_table[k].field);
+        ulam_fpush_opts fo = ulam_fpush_defaults();
+        fo.walk = bad_opts(k, ULAM_FORWARD), fo.source = 0;
+        ulam_fpush_info fi;
+        assert_int_equal(ulam_fpush_solve(M, Mt, &fo, x, NULL, NULL, NULL, &fi, &err), ULAM_EINVAL);
+        assert_names(&err, walk_table[k].field);
         ulam_walk_opts base = bad_opts(k, ULAM_ADJOINT);
         ulam_auto_opts ao = ulam_auto_defaults();
         ulam_auto_result *ar = malloc(sizeof *ar);
@@ -181,6 +186,14 @@ static void test_other_options(void **state)
         ulam_bidir_result br;
         assert_int_equal(ulam_bidir_solve(w, Mt, &bo, &br, &err), ULAM_EINVAL);
         ulam_push_free(w);
+        ulam_fpush_opts fo = ulam_fpush_defaults();
+        ulam_fpush_info fi;
+        fo.min_value = v;
+        assert_int_equal(ulam_fpush_solve(M, Mt, &fo, x, NULL, NULL, NULL, &fi, &err), ULAM_EINVAL);
+        fo = ulam_fpush_defaults(), fo.rmax = v;
+        assert_int_equal(ulam_fpush_solve(M, Mt, &fo, x, NULL, NULL, NULL, &fi, &err), ULAM_EINVAL);
+        fo = ulam_fpush_defaults(), fo.step_cost = v;
+        assert_int_equal(ulam_fpush_solve(M, Mt, &fo, x, NULL, NULL, NULL, &fi, &err), ULAM_EINVAL);
     }
     test_case_done();
     ulam_csr_free(Mt);
