@@ -247,15 +247,39 @@ for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends
     CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0,
                   r"^ulam radiosity: warning: .*small_gap.obj: patch 3 is only 168 float steps across where it lies",
                   r"radiosity R  0 \+- 0.*\n.*\n.*\nnote .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))
-CASES.append((["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--max-mem", "10"], 0, r"^$",
+# --max-mem that holds F but not the dense solve of F's noise: the matrix walk runs, its error bar labelled
+CASES.append((["radiosity", SC + "cube.obj", "--subdivide", "0.04", "--ff-rays", "100", "--patch", "1", "--matrix-walk",
+               "--max-mem", "50M", "--walks", "20000", "--no-mesh-error"], 0, r"^$",
               r"radiosity R  \S+ \+- \S+ \(walk noise only, CONDITIONAL on the sampled F"))
+# --max-mem is an estimate made before any ray (the 110k-patch --direct cast rays 641 s, then refused)
+CASES.append((["radiosity", SC + "cornell_box.obj", "--subdivide", "2", "--direct"], code("EMEMLIMIT"),
+              r"this run needs about 3.74 TiB, more than --max-mem 4 GiB \(ray tracer .*dense matrices 3.74 TiB.*"
+              r"refused before any work", r"^$"))
+CASES.append((["radiosity", SC + "cornell_box.obj", "--subdivide", "5", "--patch", "floor", "--matrix-walk",
+               "--max-mem", "100M"], code("EMEMLIMIT"), r"needs about 3.9 GiB, more than --max-mem 100 MiB", r"^$"))
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # cuts at --max-steps were silent (96 for 1000)
     CASES.append((["radiosity", R + "furnace999.obj", "--patch", "1", "--max-steps", "100", "--walks", "2000"] + extra,
                   0, r"^$", r"^warning +\d+ of \d+ walks cut at --max-steps 100: the estimate is biased low"))
 
 
 CASES += [
-    (["radiosity", SC + "cube.obj", "--patch", "1", "--mis", "power"], 2, r"--mis needs --estimator next-event", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "collision", "--mis", "power"], 2,
+     r"--mis needs --estimator next-event", ""),
+    # next-event with MIS is gathering's default: --mis alone applies to it
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--mis", "balance", "--walks", "1000", "--json"], 0, "",
+     r'"estimator": "next-event", "mis": "balance"'),
+    # point queries: the bad forms are refused before any work
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0"], 2, r"--at expects x,y,z or x,y,z,nx,ny,nz", r"^$"),
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0.5,0.5,0,0,0"], 2, r"a nonzero normal", r"^$"),
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0.5,0.5"], 2, r"--at 0.5,0.5,0.5: .*a normal for a sensor", r"^$"),
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0,0.5", "--patch", "1"], 2, r"--at and --grid are point queries", r"^$"),
+    (["radiosity", SC + "cube.obj", "--grid", "0,0.5,0:1,0.6,1:0.1"], 2, r"equal in exactly one coordinate", r"^$"),
+    # non-diffuse MTL statements: one warning a material, each statement with file:line
+    (["radiosity", R + "shiny.obj", "--at", "1,0.5,0.5", "--walks", "500"], 0,
+     r"^ulam radiosity: warning: .*shiny.mtl: material 'glass' is rendered matte \(Kd, Ke\): ignored Ks "
+     r"\(.*shiny.mtl:12\), Ns \(.*:13\), d \(.*:14\), illum \(.*:15\), map_Kd \(.*:16\)\n$", r"point 1"),
+    (["radiosity", SC + "cube.obj", "--at", "0.5,0,0.5", "--walks", "2000"], 0, "",
+     r"point 1 +0.5 0 0.5, normal 0 1 0 \(patch 1, floor\)"),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "next-event", "--mis", "heavy"], 2,
      r"--mis expects power, balance or none", ""),
     (["radiosity", SC + "cube.obj", "--mode", "shoot", "--estimator", "next-event"], 2,
@@ -312,7 +336,7 @@ def check_radiosity_rare_lamp(ulam):
     exact, scene = 0.21981, R + "rare_lamp.obj"
     for seed in range(1, 11):
         rc, out, err = run(ulam, ["radiosity", scene, "--patch", "floor", "--rel-err", "0.05", "--walks", "20000",
-                                  "--json", "--seed", str(seed)])
+                                  "--estimator", "collision", "--json", "--seed", str(seed)])
         assert rc == 0, err
         j = json.loads(out)
         assert j["rel_err_met"] is False and j["min_walks"] > 1e8 and j["walks"] == 20000, (seed, j)
@@ -1014,7 +1038,55 @@ def check_radiosity(ulam):
         rc, _, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "1000",
                                 "--image", d + "/no/such/dir/x.png"])
         assert rc == code("EIO") and "x.png" in err, err
-        assert sorted(os.listdir(d)) == ["box.png"], os.listdir(d)
+        assert sorted(os.listdir(d)) == ["box.pfm", "box.png"], os.listdir(d)  # the linear picture beside
+        pfm = open(d + "/box.pfm", "rb").read()
+        assert pfm.startswith(b"PF\n64 48\n-1.0\n") and len(pfm) == len(b"PF\n64 48\n-1.0\n") + 64 * 48 * 12
+
+
+def check_radiosity_matrix_rel_err(ulam):
+    """--matrix-walk --rel-err stops on the answer's whole error, the walks' and F's combined
+    (it held the walks' alone to E, and the error bar printed was larger than E); where F's error
+    alone is past E it says more --ff-rays, not more walks, can meet it."""
+    rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--rel-err", "0.05",
+                              "--ff-rays", "100000", "--no-mesh-error", "--json"])
+    j = json.loads(out)
+    assert rc == 0 and all(s <= 0.05 * b for s, b in zip(j["stderr"], j["radiosity"])), j
+    assert all(abs(s * s - w * w - f * f) < 1e-12 for s, w, f in zip(j["stderr"], j["walk_stderr"], j["ff_stderr"])), j
+    rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--rel-err", "0.05",
+                              "--ff-rays", "20", "--no-mesh-error"])
+    assert rc == 0 and re.search(r"rel-err +NOT met in R: the form factors' error alone is \S+, past --rel-err 0.05", out), out
+
+
+def check_radiosity_grid(ulam):
+    """--grid: a 3 x 2 sensor grid on the cube's floor (the furnace-like cube: every sensor reads
+    H = 2 within its error) to CSV and a false-colour PNG; JSON has the grid's points."""
+    with tempfile.TemporaryDirectory() as d:
+        csv, png = d + "/g.csv", d + "/g.png"
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--grid", "0,0.5,0:1,0.5,1:3x2", "--walks", "4000",
+                                  "--out", csv, "--image", png, "--json"])
+        assert rc == 0 and err == "", (rc, err)
+        j = json.loads(out)
+        pts = j["grid"]["points"]
+        assert j["grid"]["nu"] == 3 and j["grid"]["nv"] == 2 and len(pts) == 6, j["grid"]
+        for p in pts:
+            assert p["patch"] is None and abs(p["irradiance"][0] - 2) <= 4 * p["irradiance_stderr"][0], p
+        rows = open(csv).read().splitlines()
+        assert rows[0].startswith("i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks") and len(rows) == 7, rows
+        assert open(png, "rb").read()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert sorted(os.listdir(d)) == ["g.csv", "g.png"], os.listdir(d)
+
+
+def check_radiosity_image_noise(ulam):
+    """A shooting picture with too few particles a patch says so (it was salt-and-pepper noise with
+    no word); with enough, no warning."""
+    with tempfile.TemporaryDirectory() as d:
+        png = d + "/n.png"
+        rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "60", "--mode", "shoot", "--walks",
+                                  "20000", "--image", png, "--size", "32x32"])
+        assert rc == 0 and re.search(r"warning: .*n.png: the \d+ patches in view carry \d+% relative error", err), err
+        rc, out, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "20000", "--image", png,
+                                  "--size", "16x16"])
+        assert rc == 0 and "relative error" not in err, err
 
 
 def check_radiosity_json_paths(ulam):
@@ -1410,7 +1482,8 @@ def main():
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
-             (check_radiosity_patches, ulam), (check_radiosity_images, ulam),
+             (check_radiosity_patches, ulam), (check_radiosity_images, ulam), (check_radiosity_image_noise, ulam),
+             (check_radiosity_matrix_rel_err, ulam), (check_radiosity_grid, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
              (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_progress, ulam),
