@@ -227,8 +227,12 @@ double ulam_strtod(const char *s, char **end);
  * written to a temporary name and renamed into place only when complete. */
 int ulam_mm_write_matrix(const char *path, const ulam_csr *A, const char *comment);
 
-/* Write x as "array real general" n x 1, atomically like ulam_mm_write_matrix. */
+/* Write x as "array real general" n x 1, atomically like ulam_mm_write_matrix (ULAM_ENONFINITE
+ * for a non-finite value, nothing written; ULAM_EIO with errno saying why). */
 int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const char *comment);
+
+/* As ulam_mm_write_vector, to an open file f (an ulam_outfile's, say, to commit with others). */
+int ulam_mm_write_vector_file(FILE *f, const double *x, int64_t n, const char *comment);
 
 /* An output file written under a temporary name in the same directory and renamed into place
  * by ulam_outfile_commit: a reader sees the old file or the complete new one, never a part.
@@ -243,8 +247,14 @@ typedef struct ulam_outfile {
 /* Open a temporary file beside path; ULAM_OK, ULAM_ENOMEM or ULAM_EIO (o is then empty). */
 int ulam_outfile_open(ulam_outfile *o, const char *path);
 
-/* Flush, close and rename into place; ULAM_OK, or ULAM_EIO with the temporary file removed. */
+/* Flush, close and rename into place; ULAM_OK, or ULAM_EIO with the temporary file removed and
+ * errno saying why (ENOSPC: "No space left on device"). */
 int ulam_outfile_commit(ulam_outfile *o);
+
+/* Commit k files together (an answer and its errors): flush and close every one, and only when
+ * all were written whole rename each into place; else remove every temporary file, so no file
+ * is replaced (ULAM_EIO, errno saying why).  Every o[j] is left empty (aborted) either way. */
+int ulam_outfile_commit_all(ulam_outfile *o, int k);
 
 /* Close and remove the temporary file; accepts an empty (zeroed or aborted) o. */
 void ulam_outfile_abort(ulam_outfile *o);
@@ -681,7 +691,10 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
                       ulam_solver **out, ulam_error *err);
 
 /* Run one round of walks (rounds grow 1, 2, 4 ... 64 blocks of 1024 walks as walks accumulate,
- * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
+ * whatever the thread count).  A b whose largest |entry| lies outside [2^-256, 2^256] is walked
+ * on scaled by a power of 2 (exact) and the results scaled back, so an answer a double can hold
+ * is answered; one it cannot (or a non-finite score) ends the run with ULAM_ENONFINITE.  ULAM_OK,
+ * or the status that ends the run: ULAM_ENONFINITE,
  * ULAM_ENOMEM, ULAM_EIO (the share's allgather), ULAM_ESYNTAX (a corrupt row of a mapped
  * file), ULAM_ERANGE (at kernel_alpha != 1, a reached row whose entries are so uneven that a
  * move's probability is below 2^-40 / the row's length); ulam_solver_error says why. */
@@ -703,7 +716,8 @@ void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r);
 
 /* Forward mode: every component's estimate and standard error (arrays of n; either may be
  * NULL); a component no walk has tallied has no estimate: x 0 (expected: b_i) and standard
- * error NaN.  Adjoint mode: ULAM_EINVAL. */
+ * error NaN.  Adjoint mode: ULAM_EINVAL.  ULAM_ENONFINITE (the arrays filled) when an estimate
+ * exceeds the largest double. */
 int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error);
 
 /* Free a solver; accepts and returns NULL. */
@@ -733,6 +747,17 @@ ulam_solver *ulam_solver_free(ulam_solver *s);
  * is refused with ULAM_EINVAL. */
 int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                ulam_walk_result *result, ulam_error *err);
+
+/* As ulam_solve, ulam_solver_alloc and ulam_jacobi with b's length nb: b must have one entry a
+ * row of M (A), else ULAM_EDIM (ULAM_EINVAL for a NULL b), so a short b is refused, never read
+ * past its end (the functions without a length read M->nrows entries of b and trust that they
+ * are there).  ulam_jacobi_n writes nb entries of bp. */
+int ulam_solve_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
+                 ulam_walk_result *result, ulam_error *err);
+int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
+                        ulam_solver **out, ulam_error *err);
+int ulam_jacobi_n(const ulam_csr *A, const double *b, int64_t nb, double omega, ulam_csr **M, double *bp,
+                  ulam_error *err);
 
 /* The walk cap of a run whose only rule is rel_err. */
 #define ULAM_REL_ERR_CAP 1000000000
@@ -836,7 +861,9 @@ int ulam_outer_solve(const ulam_csr *M, const double *b, const ulam_outer_opts *
  * tol (the true residual, recomputed at the end): conjugate gradients for symmetric positive
  * definite I - M (ulam_cg), restarted GMRES(restart) with modified Gram-Schmidt and Givens
  * rotations otherwise (ulam_gmres).  *iterations gets the matrix-vector products spent on
- * Krylov vectors, *residual the final relative residual.  ULAM_OK or ULAM_ENOCONV at max_iter. */
+ * Krylov vectors, *residual the final relative residual.  ULAM_OK or ULAM_ENOCONV at max_iter;
+ * ULAM_ENONFINITE when x or the residual is not finite (b far from 1 is scaled by a power of 2
+ * first, exactly, so an x up to the largest double is answered). */
 int ulam_cg(const ulam_csr *M, const double *b, double tol, int max_iter, double *x, int *iterations,
             double *residual);
 int ulam_gmres(const ulam_csr *M, const double *b, int restart, double tol, int max_iter, double *x,

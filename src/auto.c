@@ -419,10 +419,12 @@ static int check(const ulam_csr *M, const double *b, const ulam_walk_opts *base,
 {
     if (!M || !b || !base || !res) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b, options and a result");
     if (!(a->continue_q > 0 && a->continue_q < 1) || a->pilot_walks < 1 || a->pilot_max < a->pilot_walks ||
-        !(a->pilot_share > 0))
+        !(a->pilot_share > 0) || !isfinite(a->pilot_share))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a fixed continuation in (0, 1), pilot walks >= 1, pilot_max >= "
                                                    "pilot walks and a pilot share > 0");
     if (M->nrows != M->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
+    int bad = ulam__walk_opts_check(base, err); /* src/check.c: the options, then M's structure */
+    if (bad || (bad = ulam__csr_check_structure(M, err))) return bad;
     if (base->index < 0 || base->index >= M->nrows)
         return ulam__fail(err, ULAM_EINVAL, 0, base->index, "an index from 0 to %lld", (long long)M->nrows - 1);
     return ULAM_OK;

@@ -68,10 +68,9 @@ static int check_opts(const ulam_csr *M, const ulam_csr *Mt, const ulam_bidir_op
     }
     if (o->nb > 0 && !(norm > 0 && isfinite(norm)))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a sparse b with a finite nonzero ||b||_1");
-    if (!(o->rmax <= 0 || isfinite(o->rmax)) || !(o->min_value <= 0 || isfinite(o->min_value)) ||
-        o->max_push_ops < 0 || isnan(o->rmax) || isnan(o->min_value))
+    if (!isfinite(o->rmax) || !isfinite(o->min_value) || o->max_push_ops < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a finite rmax, a finite min_value and max_push_ops >= 0");
-    return ULAM_OK;
+    return ulam__walk_opts_check(&o->walk, err); /* src/check.c */
 }
 
 /* Check a call's arguments (out: where its answer goes); err cleared first. */

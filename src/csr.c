@@ -44,7 +44,8 @@ int ulam_csr_check(const ulam_csr *A)
 {
     if (!A || !A->rowptr || A->nrows < 0 || A->ncols < 0 || A->nrows > ULAM_MAX_DIM || A->ncols > ULAM_MAX_DIM)
         return ULAM_EINVAL;
-    if (A->rowptr[0] != 0) return ULAM_ESYNTAX;
+    int bad = ulam__csr_check_structure(A, NULL); /* src/check.c: rows in bounds before they are read */
+    if (bad) return bad;
     for (int64_t i = 0; i < A->nrows; i++) {
         if (A->rowptr[i + 1] < A->rowptr[i]) return ULAM_ESYNTAX;
         for (int64_t p = A->rowptr[i]; p < A->rowptr[i + 1]; p++) {
@@ -168,6 +169,8 @@ int ulam_csr_from_triplets(int64_t nrows, int64_t ncols, int64_t nz, const int32
 int ulam_csr_transpose(const ulam_csr *A, ulam_csr **out)
 {
     if (!A || !out) return ULAM_EINVAL;
+    int bad = ulam__csr_check_structure(A, NULL); /* src/check.c */
+    if (bad) return bad;
     *out = NULL;
     int64_t nz = ulam_csr_nnz(A);
     ulam_csr *T = ulam_csr_alloc(A->ncols, A->nrows, nz);
@@ -196,6 +199,8 @@ int ulam_csr_transpose(const ulam_csr *A, ulam_csr **out)
 int ulam_csr_copy(const ulam_csr *A, ulam_csr **out)
 {
     if (!A || !out) return ULAM_EINVAL;
+    int bad = ulam__csr_check_structure(A, NULL); /* src/check.c */
+    if (bad) return bad;
     int64_t nz = ulam_csr_nnz(A);
     ulam_csr *C = ulam_csr_alloc(A->nrows, A->ncols, nz);
     if (!C) return ULAM_ENOMEM;
@@ -223,6 +228,8 @@ int ulam_csr_matvec(const ulam_csr *A, int use_abs, const double *x, double *y)
 int ulam_csr_to_dense(const ulam_csr *A, double *dense)
 {
     if (!A || !dense) return ULAM_EINVAL;
+    int bad = ulam__csr_check_structure(A, NULL); /* src/check.c */
+    if (bad) return bad;
     memset(dense, 0, (size_t)A->nrows * (size_t)A->ncols * sizeof *dense);
     for (int64_t i = 0; i < A->nrows; i++)
         for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
@@ -234,6 +241,8 @@ int ulam_csr_to_dense(const ulam_csr *A, double *dense)
 int ulam_csr_stats_compute(const ulam_csr *A, ulam_csr_stats *st)
 {
     if (!A || !st) return ULAM_EINVAL;
+    int bad = ulam__csr_check_structure(A, NULL); /* src/check.c */
+    if (bad) return bad;
     memset(st, 0, sizeof *st);
     st->n = A->nrows;
     st->nnz = ulam_csr_nnz(A);
@@ -277,6 +286,8 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
     if (!A || !b || !M || !bp || !(omega > 0.0) || !isfinite(omega))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, a right-hand side and omega > 0");
     *M = NULL;
+    int bad = ulam__csr_check_structure(A, err); /* src/check.c */
+    if (bad) return bad;
     if (A->nrows != A->ncols)
         return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1,
                           "a square matrix A for the Jacobi splitting, got %lld x %lld",

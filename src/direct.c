@@ -49,6 +49,8 @@ int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_
     if (M->nrows != M->ncols)
         return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M, got %lld x %lld",
                           (long long)M->nrows, (long long)M->ncols);
+    int bad = ulam__csr_check_structure(M, err); /* src/check.c */
+    if (bad) return bad;
     double t0 = ulam_now();
     int64_t n = M->nrows;
     size_t bytes = ulam_direct_bytes(n);

@@ -38,10 +38,11 @@ static int check(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "Mt, the transpose of M (%lld x %lld)", (long long)n, (long long)n);
     if (o->source < 0 || o->source >= n)
         return ulam__fail(err, ULAM_EINVAL, 0, o->source, "a source from 0 to %lld", (long long)n - 1);
-    if (!(o->rel_err > 0 && o->rel_err < 1) || o->walks < 0 || isnan(o->rmax) || isnan(o->min_value) ||
-        !(o->rmax <= 0 || isfinite(o->rmax)) || !(o->min_value <= 0 || o->min_value < INFINITY))
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "rel_err in (0, 1), walks >= 0, a finite rmax and min_value");
-    return ULAM_OK;
+    if (!(o->rel_err > 0 && o->rel_err < 1) || o->walks < 0 || !isfinite(o->rmax) || !isfinite(o->min_value) ||
+        !isfinite(o->step_cost))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "rel_err in (0, 1), walks >= 0, a finite rmax, min_value and "
+                                                   "step_cost");
+    return ulam__walk_opts_check(&o->walk, err); /* src/check.c */
 }
 
 /* FORA's walk count for the residual mass rsum (or the fixed count). */

@@ -327,9 +327,10 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
     if (M->nrows != M->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
     ulam_guard_opts o = opts ? *opts : ulam_guard_defaults();
     if (!o.need) o.need = ULAM_GUARD_ALL;
-    if (!(o.kernel_alpha >= 0) || !isfinite(o.kernel_alpha))
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a kernel exponent alpha that is finite and >= 0 (got %g)",
-                          o.kernel_alpha);
+    int bad = ulam__guard_opts_check(&o, err); /* src/check.c: the options, then M's structure */
+    if (!bad) bad = ulam__real_check(continue_q, -DBL_MAX, nextafter(1.0, 0.0), "continue_q",
+                                     "finite and below 1 (<= 0: analog)", err);
+    if (bad || (bad = ulam__csr_check_structure(M, err))) return bad;
     int64_t n = M->nrows;
     int alpha1 = o.kernel_alpha == 1.0; /* else rho(M^) comes from moment_radius */
     double t0 = ulam_now();

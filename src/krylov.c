@@ -50,11 +50,12 @@ int ulam_csr_symmetric(const ulam_csr *M)
     return 1;
 }
 
-/* Conjugate gradients. */
-int ulam_cg(const ulam_csr *M, const double *b, double tol, int max_iter, double *x, int *iterations,
-            double *residual)
+/* Conjugate gradients (b scaled by the caller: see ulam_cg). */
+static int cg(const ulam_csr *M, const double *b, double tol, int max_iter, double *x, int *iterations,
+              double *residual)
 {
-    if (!M || !b || !x || M->nrows != M->ncols || !(tol > 0) || max_iter < 1) return ULAM_EINVAL;
+    if (!M || !b || !x || M->nrows != M->ncols || !(tol > 0) || !isfinite(tol) || max_iter < 1) return ULAM_EINVAL;
+    if (ulam__csr_check_structure(M, NULL)) return ULAM_EINVAL; /* src/check.c */
     int64_t n = M->nrows;
     double *r = ulam__malloc((size_t)n, sizeof *r), *p = ulam__malloc((size_t)n, sizeof *p);
     double *q = ulam__malloc((size_t)n, sizeof *q);
@@ -95,11 +96,13 @@ static void rotate(double c, double s, double *a, double *b)
     *a = t;
 }
 
-/* Restarted GMRES(m). */
-int ulam_gmres(const ulam_csr *M, const double *b, int m, double tol, int max_iter, double *x, int *iterations,
-               double *residual)
+/* Restarted GMRES(m) (b scaled by the caller: see ulam_gmres). */
+static int gmres(const ulam_csr *M, const double *b, int m, double tol, int max_iter, double *x, int *iterations,
+                 double *residual)
 {
-    if (!M || !b || !x || M->nrows != M->ncols || !(tol > 0) || max_iter < 1 || m < 1) return ULAM_EINVAL;
+    if (!M || !b || !x || M->nrows != M->ncols || !(tol > 0) || !isfinite(tol) || max_iter < 1 || m < 1)
+        return ULAM_EINVAL;
+    if (ulam__csr_check_structure(M, NULL)) return ULAM_EINVAL; /* src/check.c */
     int64_t n = M->nrows;
     double *V = ulam__malloc((size_t)n * (size_t)(m + 1), sizeof *V), *w = ulam__malloc((size_t)n, sizeof *w);
     double *H = ulam__calloc((size_t)(m + 1) * (size_t)m, sizeof *H); /* column-major, (m+1) x m */
@@ -160,4 +163,39 @@ int ulam_gmres(const ulam_csr *M, const double *b, int m, double tol, int max_it
     if (iterations) *iterations = k;
     if (residual) *residual = tr;
     return tr <= tol ? ULAM_OK : ULAM_ENOCONV;
+}
+
+/* Run cg (restart 0) or gmres on b 2^-e when b is far from 1 (its norms would overflow or
+ * underflow), then x 2^e (both exact); ULAM_ENONFINITE when x or the residual is not finite. */
+static int scaled(const ulam_csr *M, const double *b, int restart, double tol, int max_iter, double *x,
+                  int *iterations, double *residual)
+{
+    int64_t n = M->nrows;
+    int e = ulam__b_exponent(b, n);
+    double *bs = e ? ulam__b_scaled(b, n, e) : NULL, res = NAN;
+    if (e && !bs) return ULAM_ENOMEM;
+    int status = restart ? gmres(M, bs ? bs : b, restart, tol, max_iter, x, iterations, &res)
+                         : cg(M, bs ? bs : b, tol, max_iter, x, iterations, &res);
+    free(bs);
+    if (status == ULAM_ENOMEM || status == ULAM_EINVAL) return status; /* x not written */
+    if (residual) *residual = res;
+    int bad = !isfinite(res);
+    for (int64_t i = 0; i < n; i++) bad |= !isfinite(x[i] = ldexp(x[i], e));
+    return bad ? ULAM_ENONFINITE : status;
+}
+
+/* Conjugate gradients on b scaled. */
+int ulam_cg(const ulam_csr *M, const double *b, double tol, int max_iter, double *x, int *iterations,
+            double *residual)
+{
+    if (!M || !b || !x || M->nrows != M->ncols) return ULAM_EINVAL;
+    return scaled(M, b, 0, tol, max_iter, x, iterations, residual);
+}
+
+/* Restarted GMRES(m) on b scaled. */
+int ulam_gmres(const ulam_csr *M, const double *b, int m, double tol, int max_iter, double *x, int *iterations,
+               double *residual)
+{
+    if (!M || !b || !x || M->nrows != M->ncols || m < 1) return ULAM_EINVAL;
+    return scaled(M, b, m, tol, max_iter, x, iterations, residual);
 }

@@ -94,6 +94,8 @@ static double residual(ulam_outer *s)
 static int check(const ulam_csr *M, const double *b, const ulam_outer_opts *o, ulam_error *err)
 {
     if (M->nrows != M->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
+    int bad = ulam__csr_check_structure(M, err); /* src/check.c: M, and the walks' options */
+    if (bad || (walks(o->method) && (bad = ulam__walk_opts_check(&o->walk, err)))) return bad;
     if (o->method < ULAM_RICHARDSON || o->method > ULAM_MCSA)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "method richardson, gauss-seidel, sequential or mcsa");
     if (!(o->tol > 0 && o->tol < 1)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tolerance in (0, 1)");

@@ -846,6 +846,19 @@ int ulam_mm_write_matrix(const char *path, const ulam_csr *A, const char *commen
     return ulam_outfile_commit(&o);
 }
 
+/* Write x as array real general n x 1 to f; non-finite values are refused. */
+int ulam_mm_write_vector_file(FILE *f, const double *x, int64_t n, const char *comment)
+{
+    if (!f || !x || n < 1) return ULAM_EINVAL;
+    for (int64_t k = 0; k < n; k++)
+        if (!isfinite(x[k])) return ULAM_ENONFINITE;
+    fprintf(f, "%%%%MatrixMarket matrix array real general\n");
+    write_comment(f, comment);
+    fprintf(f, "%lld 1\n", (long long)n);
+    for (int64_t k = 0; k < n; k++) fprintf(f, "%.17g\n", x[k]);
+    return ferror(f) ? ULAM_EIO : ULAM_OK;
+}
+
 /* Write x as array real general n x 1, atomically; non-finite values are refused. */
 int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const char *comment)
 {
@@ -855,9 +868,6 @@ int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const cha
     ulam_outfile o;
     int status = ulam_outfile_open(&o, path);
     if (status) return status;
-    fprintf(o.f, "%%%%MatrixMarket matrix array real general\n");
-    write_comment(o.f, comment);
-    fprintf(o.f, "%lld 1\n", (long long)n);
-    for (int64_t k = 0; k < n; k++) fprintf(o.f, "%.17g\n", x[k]);
+    ulam_mm_write_vector_file(o.f, x, n, comment);
     return ulam_outfile_commit(&o);
 }

@@ -45,6 +45,8 @@ int ulam_push_alloc(const ulam_csr *M, ulam_push **out)
     if (!M || !out) return ULAM_EINVAL;
     *out = NULL;
     if (M->nrows != M->ncols) return ULAM_ENOTSQUARE;
+    int bad = ulam__csr_check_structure(M, NULL); /* src/check.c */
+    if (bad) return bad;
     ulam_push *w = calloc(1, sizeof *w);
     if (!w) return ULAM_ENOMEM;
     w->M = M, w->n = M->nrows, w->target = -1;
@@ -102,7 +104,7 @@ int ulam_push_start(ulam_push *w, int64_t target)
  * are whole) and the queue kept, so a later call goes on from there. */
 int ulam_push_run(ulam_push *w, double rmax, int64_t max_ops)
 {
-    if (!w || w->target < 0 || !(rmax > 0) || max_ops < 0) return ULAM_EINVAL;
+    if (!w || w->target < 0 || !(rmax > 0) || !isfinite(rmax) || max_ops < 0) return ULAM_EINVAL;
     double t0 = ulam_now();
     const ulam_csr *M = w->M;
     w->rmax = rmax;

@@ -204,6 +204,8 @@ int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads
 /* The budgets both solvers check first. */
 int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err)
 {
+    int status = ulam__walk_opts_check(o, err); /* src/check.c: NaN, +-inf, out of range */
+    if (status) return status;
     if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
     if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)

@@ -31,7 +31,10 @@ struct ulam_solver {
     ulam_kernel *k;
     int k_borrowed; /* k is the caller's (ulam__solver_alloc_reached) or was kept (ulam__solver_keep_kernel) */
     ulam__walker w;
-    const double *b; /* the caller's, borrowed like M */
+    const double *b; /* the caller's, borrowed like M (or bs) */
+    double *bs;      /* b 2^-bexp when b is far from 1 (ulam__b_exponent; owned), else NULL */
+    int bexp;        /* the estimates found on bs are times 2^bexp */
+    int overflow;    /* the run ended because its estimate was not finite */
     ulam_csr *mt;
     ulam__slot *src;
     ulam__slot *start_src; /* adjoint with nstarts: the start distribution (walker.start_*) */
@@ -96,7 +99,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
 {
     if (!s) return NULL;
     if (!s->k_borrowed) ulam__kernel_free(s->k);
-    free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac);
+    free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac), free(s->bs);
     free(s->start_src), free(s->start_units), free(s->start_b);
     ulam_csr_free(s->mt);
     if (s->scratch)
@@ -119,6 +122,8 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
 {
     if (M->nrows != M->ncols)
         return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
+    int bad = ulam__walk_opts_check(o, err); /* src/check.c: every finite-valued option first */
+    if (bad) return bad;
     if (o->mode != ULAM_ADJOINT && o->mode != ULAM_FORWARD)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "mode adjoint or forward");
     if (o->estimator < ULAM_COLLISION || o->estimator > ULAM_EXPECTED)
@@ -821,11 +826,19 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     if ((o.mode == ULAM_FORWARD || o.whole_kernel || reach) && (status = verify_all(M, &o, &rc, err)))
         return status; /* these read all of M (and forward, all of b) */
     if ((status = check_split(M, b, &o, err))) return status;
+    if (o.mode == ULAM_FORWARD && (status = ulam__csr_check_structure(M, err))) /* src/check.c: M' is made */
+        return status; /* (adjoint: the guards' pass checks M, or the kernel each row it builds) */
     double bnorm1 = 0.0;
     ulam_solver *s = calloc(1, sizeof *s);
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
     s->o = o;
     s->b = b;
+    /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered;
+       not on the lazy path (adjoint with the guards given reads only the b_i its walks reach) */
+    s->bexp = !kernel && !reach && o.rel_err_offset == 0.0 && (o.mode == ULAM_ADJOINT ? !o.guard
+                                                                 : !(o.roulette > 0 || o.split > 0))
+                  ? ulam__b_exponent(b, M->nrows) : 0;
+    if (s->bexp && !(s->b = b = s->bs = ulam__b_scaled(b, M->nrows, s->bexp))) goto nomem;
     s->n = M->nrows;
     s->given = o.mode == ULAM_ADJOINT ? reach : NULL;
     s->M = M;
@@ -1039,6 +1052,8 @@ int ulam_solver_iterate(ulam_solver *s)
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
     result(s, &r, 0);
+    if (!s->run.status && !isfinite(r.estimate) && s->run.walks > 0) /* beyond the largest double */
+        s->run.status = ULAM_ENONFINITE, s->run.done = s->overflow = 1;
     if (!s->run.status && search_reach(s, &r)) {
         if (s->run.status) return s->run.status; /* the search failed */
         result(s, &r, 0);
@@ -1156,6 +1171,13 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->interrupted = s->run.interrupted;
     r->rho4 = s->rho4;
     r->fourth_finite = s->fourth;
+    if (s->bexp) { /* walked on b 2^-bexp: back to b's scale (exact) */
+        int e = s->bexp;
+        r->estimate = ldexp(r->estimate, e), r->std_error = ldexp(r->std_error, e);
+        r->ci95[0] = ldexp(r->ci95[0], e), r->ci95[1] = ldexp(r->ci95[1], e);
+        r->variance = ldexp(r->variance, 2 * e);
+        r->score_bound = ldexp(r->score_bound, e), r->cut_bound = ldexp(r->cut_bound, e);
+    }
 }
 
 /* The result so far. */
@@ -1174,13 +1196,16 @@ void ulam_solver_guard(const ulam_solver *s, ulam_guard *g)
 int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error)
 {
     if (!s || s->o.mode != ULAM_FORWARD) return ULAM_EINVAL;
+    int bad = 0;
     for (int64_t i = 0; i < s->n; i++) {
         double e, se, v;
         forward_component(s, i, &e, &se, &v);
+        e = ldexp(e, s->bexp), se = ldexp(se, s->bexp); /* walked on b 2^-bexp */
         if (x) x[i] = e;
         if (std_error) std_error[i] = se;
+        if (!isfinite(e)) bad = 1;
     }
-    return ULAM_OK;
+    return bad ? ULAM_ENONFINITE : ULAM_OK; /* an estimate beyond the largest double */
 }
 
 /* The whole run in one call. */
@@ -1206,7 +1231,12 @@ int ulam_solver_error(const ulam_solver *s, ulam_error *err)
     if (status) return status;
     int st = s->run.status;
     switch (st) {
-    case ULAM_ENONFINITE: return ulam__fail(err, st, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
+    case ULAM_ENONFINITE:
+        if (s->overflow)
+            return ulam__fail(err, st, 0, s->o.index, "an estimate a double can hold: x[%lld] (1-based) exceeds "
+                              "1.8e308 (the walks' mean of scores overflows; b's scale is 2^%d)",
+                              (long long)s->o.index + 1, s->bexp);
+        return ulam__fail(err, st, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
     case ULAM_ENOMEM: return ulam__fail(err, st, 0, -1, "memory for the walks' tallies");
     case ULAM_EIO: return ulam__fail(err, st, 0, -1, "an exchange of walk results between processes (allgather failed)");
     default: return ulam__fail(err, st, 0, -1, "walks that run to their end");
@@ -1235,6 +1265,8 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     free(s->src);
     s->src = NULL;
     s->b = b;
+    for (int64_t i = 0; s->bexp && i < s->n; i++) s->bs[i] = ldexp(b[i], -s->bexp); /* as the first b */
+    if (s->bexp) s->b = s->bs;
     s->o.seed = seed;
     double bnorm1 = 0.0;
     if (build_source(s, &bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");

@@ -172,7 +172,7 @@ int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double 
 {
     if (n < 1 || !op || !out) return ULAM_EINVAL;
     ulam_spectral_opts o = opts ? *opts : ulam_spectral_defaults();
-    if (!(o.tol > 0) || o.max_restarts < 1 || o.krylov_dim < 1) return ULAM_EINVAL;
+    if (ulam__spectral_opts_check(&o, NULL)) return ULAM_EINVAL; /* src/check.c */
     memset(out, 0, sizeof *out);
     if (n <= DENSE_MAX) return radius_dense(n, op, ctx, out);
     if (n > INT32_MAX) return ULAM_EOVERFLOW;
@@ -207,6 +207,8 @@ int ulam_spectral_radius(const ulam_csr *A, int use_abs, const ulam_spectral_opt
 {
     if (!A || !out) return ULAM_EINVAL;
     if (A->nrows != A->ncols) return ULAM_ENOTSQUARE;
+    int bad = ulam__csr_check_structure(A, NULL); /* src/check.c */
+    if (bad) return bad;
     csr_op_ctx ctx = {A, use_abs};
     return ulam_spectral_radius_op(A->nrows, csr_op, &ctx, use_abs, opts, out);
 }
@@ -333,6 +335,8 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
     if (!A || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
     if (A->nrows != A->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix");
     ulam_power_opts o = opts ? *opts : ulam_power_defaults();
+    int bad = ulam__power_opts_check(&o, err); /* src/check.c: the options, then A's structure */
+    if (bad || (bad = ulam__csr_check_structure(A, err))) return bad;
     *out = (ulam_power){.lower = 0.0, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
     return ulam__power_from(A, left, right, &o, out, err);
 }

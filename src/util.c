@@ -2,6 +2,7 @@
 #include "internal.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -162,20 +163,42 @@ int ulam_outfile_open(ulam_outfile *o, const char *path)
     return ULAM_OK;
 }
 
-/* Flush, close and rename into place. */
+/* Flush and close o's temporary file; 0, or errno's value for the failure (EIO when a buffered
+ * write failed earlier and the retry did not say why). */
+static int outfile_close(ulam_outfile *o)
+{
+    int e0 = errno; /* a failed fprintf's reason, when nothing has set errno since */
+    errno = 0;
+    int e = fflush(o->f) != 0 ? errno : 0;
+    if (!e && ferror(o->f)) e = e0 ? e0 : EIO;
+    if (fclose(o->f) != 0 && !e) e = errno ? errno : EIO;
+    o->f = NULL;
+    return e;
+}
+
+/* Flush, close and rename into place; errno says why on ULAM_EIO. */
 int ulam_outfile_commit(ulam_outfile *o)
 {
-    if (!o || !o->f) return ULAM_EINVAL;
-    int bad = ferror(o->f) || fflush(o->f) != 0;
-    bad |= fclose(o->f) != 0;
-    o->f = NULL;
-    if (!bad && rename(o->tmp, o->path) == 0) {
-        o->tmp[0] = '\0';
-        ulam_outfile_abort(o);
-        return ULAM_OK;
+    return ulam_outfile_commit_all(o, 1);
+}
+
+/* Flush and close all k files, then rename each into place only when every one closed cleanly;
+ * else remove every temporary file.  errno says why on ULAM_EIO. */
+int ulam_outfile_commit_all(ulam_outfile *o, int k)
+{
+    if (!o || k < 1) return ULAM_EINVAL;
+    int e = 0;
+    for (int j = 0; j < k; j++) {
+        if (!o[j].f) e = e ? e : EINVAL;
+        else if (!e) e = outfile_close(&o[j]);
     }
-    ulam_outfile_abort(o);
-    return ULAM_EIO;
+    for (int j = 0; j < k && !e; j++) {
+        if (rename(o[j].tmp, o[j].path) != 0) e = errno;
+        else o[j].tmp[0] = '\0';
+    }
+    for (int j = 0; j < k; j++) ulam_outfile_abort(&o[j]); /* closes and removes what is left */
+    errno = e;
+    return e == EINVAL ? ULAM_EINVAL : e ? ULAM_EIO : ULAM_OK;
 }
 
 /* Close and remove the temporary file. */
@@ -207,4 +230,24 @@ int ulam__thread_num(void)
 #else
     return 0;
 #endif
+}
+
+/* The power of 2 that brings b's largest |entry| into [0.5, 1) when it lies outside
+ * [2^-256, 2^256], else 0. */
+int ulam__b_exponent(const double *b, int64_t n)
+{
+    double m = 0.0;
+    for (int64_t i = 0; i < n; i++) m = fmax(m, fabs(b[i]));
+    if (!(m > 0) || !isfinite(m) || (m <= 0x1p256 && m >= 0x1p-256)) return 0;
+    int e;
+    frexp(m, &e);
+    return e;
+}
+
+/* A copy of b times 2^-e (NULL on failure). */
+double *ulam__b_scaled(const double *b, int64_t n, int e)
+{
+    double *c = ulam__malloc((size_t)n, sizeof *c);
+    for (int64_t i = 0; c && i < n; i++) c[i] = ldexp(b[i], -e);
+    return c;
 }

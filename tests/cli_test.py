@@ -860,19 +860,20 @@ def check_study_question(ulam):
         assert rc == 2 and "no question.txt" in err, (rc, err)
 
 
+def popen_walks(*args, **kwargs):
+    """subprocess.Popen with the test hook ULAM_TEST_STOP_AT_WALKS=1: the process stops itself
+    (SIGSTOP) once the walks' Ctrl-C handler is in force (SIGINT is caught in every phase, to
+    remove temporary files, so a caught SIGINT no longer says the walks are ready)."""
+    return subprocess.Popen(*args, env=dict(os.environ, ULAM_TEST_STOP_AT_WALKS="1"), **kwargs)
+
+
 def interrupt_when_ready(p):
-    """Send SIGINT once process p has installed its handler (polled in /proc, no sleeps)."""
+    """Send SIGINT once process p (started by popen_walks) has stopped itself with the walks' handler
+    installed, then SIGCONT (polled in /proc, no sleeps)."""
     import signal
-    import time
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        try:
-            caught = [l for l in open(f"/proc/{p.pid}/status") if l.startswith("SigCgt:")]
-        except OSError:
-            break
-        if caught and int(caught[0].split()[1], 16) & (1 << (signal.SIGINT - 1)):
-            break
+    stopped(p)
     p.send_signal(signal.SIGINT)
+    p.send_signal(signal.SIGCONT)
 
 
 def check_interrupt(ulam):
@@ -880,7 +881,7 @@ def check_interrupt(ulam):
     wait until the process has installed its SIGINT handler, then send it)."""
     import signal
     import time
-    p = subprocess.Popen([ulam] + SOLVE + ["--index", "1", "--walks", "100000000000", "--json"],
+    p = popen_walks([ulam] + SOLVE + ["--index", "1", "--walks", "100000000000", "--json"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     interrupt_when_ready(p)
     out, _ = p.communicate(timeout=60)
@@ -907,7 +908,7 @@ def check_second_interrupt(ulam):
         except BlockingIOError:
             pass
     os.set_blocking(w, True)  # O_NONBLOCK belongs to the shared file description: undo it
-    p = subprocess.Popen([ulam] + SOLVE + ["--index", "1", "--walks", "100000", "--json"], stdout=w,
+    p = popen_walks([ulam] + SOLVE + ["--index", "1", "--walks", "100000", "--json"], stdout=w,
                          stderr=subprocess.DEVNULL)
     os.close(w)
     interrupt_when_ready(p)
@@ -1143,7 +1144,7 @@ def check_study(ulam):
     rc, _, err = run(ulam, ["study", M + "divergent200.mtx", "--rhs", M + "divergent200_b.mtx", "--index", "1",
                             "--out", d + "/x"])
     assert rc == 3 and "rho(|M|) in [1.1, 1.1] is not certified below 1" in err, (rc, err)
-    p = subprocess.Popen([ulam] + args[:6] + ["--methods", "adjoint-collision-plain", "--budgets", "100000000000",
+    p = popen_walks([ulam] + args[:6] + ["--methods", "adjoint-collision-plain", "--budgets", "100000000000",
                                               "--repeats", "3", "--out", d + "/i"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     interrupt_when_ready(p)
@@ -1315,14 +1316,14 @@ def check_radiosity_interrupt(ulam):
     of 10^11 particles into a missing directory must fail at once, not after the walks)."""
     with tempfile.TemporaryDirectory() as d:
         png = d + "/int.png"
-        p = subprocess.Popen([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+        p = popen_walks([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
                               "--image", png], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         interrupt_when_ready(p)
         out, err = p.communicate(timeout=60)
         assert p.returncode == 130, (p.returncode, err)
         assert "[INTERRUPTED]" in out and re.search(r"^image +not written: the run was interrupted", out, re.M), out
         assert "exposure" not in out and os.listdir(d) == [], (out, os.listdir(d))
-        p = subprocess.Popen([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
+        p = popen_walks([ulam, "radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100000000000",
                               "--json", "--image", png, "--out", d + "/p.csv"], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
         interrupt_when_ready(p)
@@ -1575,6 +1576,105 @@ def check_method_table(ulam):
             assert o["method"] == name, (name, o)
 
 
+def check_disk_full(ulam):
+    """Disk full (issue 26, point 7): the answer reaches stdout before any output file is written
+    and survives its failure; the message names errno's reason ("No space left on device"); --out
+    and --errors are committed together or neither (the previous run's pair stays intact, no
+    temporary file is left).  stdout on /dev/full; the files on a 64 KiB tmpfs, mounted when the
+    test can (root), else that part is skipped with a message."""
+    import subprocess as sp
+    args = ["solve", "--method", "walks", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--mode", "forward",
+            "--walks", "2000"]
+    with open("/dev/full", "w") as full:
+        p = sp.run([ulam] + args, stdout=full, stderr=sp.PIPE, text=True, timeout=120)
+    assert p.returncode == code("EIO") and "No space left on device" in p.stderr, (p.returncode, p.stderr)
+    with tempfile.TemporaryDirectory() as d:
+        if os.geteuid() != 0 or sp.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", d],
+                                       capture_output=True).returncode != 0:
+            print("check_disk_full: skipped the full-disk files (cannot mount a tmpfs: not root)")
+            return
+        try:
+            x, e = os.path.join(d, "x.mtx"), os.path.join(d, "e.mtx")
+            rc, _, err = run(ulam, args + ["--out", x, "--errors", e])
+            assert rc == 0, err
+            old = open(x, "rb").read(), open(e, "rb").read()
+            pages = lambda b: -(-len(b) // 4096)
+            free = 16 - pages(old[0]) - pages(old[1])
+            with open(os.path.join(d, "pad"), "wb") as f:  # room for a new x.mtx, not for both
+                f.write(b"\0" * 4096 * (free - pages(old[0])))
+            rc, out, err = run(ulam, args + ["--seed", "2", "--out", x, "--errors", e])
+            assert rc == code("EIO"), (rc, err)
+            assert re.search(r"^x\[1\]\s+\S+ \+- ", out), out  # the answer, though the files failed
+            assert "No space left on device" in err, err
+            assert (open(x, "rb").read(), open(e, "rb").read()) == old, "a file of the pair was replaced"
+            assert sorted(os.listdir(d)) == ["e.mtx", "pad", "x.mtx"], os.listdir(d)
+        finally:
+            sp.run(["umount", d])
+
+
+def stopped(p):
+    """Wait until process p has stopped itself (SIGSTOP: state T in /proc) or ended; True if stopped.
+    Polls /proc, no clock: the ULAM_TEST_STOP_AT_TMP hook stops it with its temporary file open."""
+    while p.poll() is None:
+        try:
+            state = [l for l in open(f"/proc/{p.pid}/status") if l.startswith("State:")][0].split()[1]
+        except (OSError, IndexError):
+            continue
+        if state == "T":
+            return True
+    return False
+
+
+def check_signals(ulam):
+    """Signals (issue 26, point 8): SIGTERM or SIGINT in any phase that has an output's temporary
+    file (NAME.tmp.XXXXXX) open removes it: prepare -o, study's output while its reference runs,
+    solve's --out/--errors, a --cache write, radiosity's --out.  Each process stops itself once its
+    k-th temporary file exists (ULAM_TEST_STOP_AT_TMP=k), is sent the signal and SIGCONT, and must
+    end by the signal with no temporary file left and no output in place."""
+    import signal
+    import shutil
+    with tempfile.TemporaryDirectory() as d:
+        shutil.copy(M + "chain4.mtx", os.path.join(d, "c.mtx"))
+        shutil.copy(M + "chain4_b.mtx", os.path.join(d, "c_b.mtx"))
+        c, cb = os.path.join(d, "c.mtx"), os.path.join(d, "c_b.mtx")
+        out = os.path.join(d, "out")
+        phases = [
+            ("prepare -o", ["prepare", c, "--rhs", cb, "-o", out + ".ulam"], 1),
+            ("study", ["study", c, "--rhs", cb, "--index", "2", "--methods", "adjoint-collision-plain",
+                       "--budgets", "100", "--repeats", "2", "--out", out], 1),
+            ("solve --out --errors", ["solve", "--method", "walks", c, "--rhs", cb, "--mode", "forward",
+                                      "--walks", "2000", "--out", out + "x.mtx", "--errors", out + "e.mtx"], 2),
+            ("--cache", ["solve", "--method", "walks", c, "--rhs", cb, "--index", "2", "--walks", "1000", "--cache"], 1),
+        ]
+        if os.path.exists(R + "cube_black_lamp.obj") and "radiosity" in run(ulam, ["--help"])[2] + run(ulam, ["--help"])[1]:
+            phases.append(("radiosity --out", ["radiosity", R + "cube_black_lamp.obj", "--direct", "--out",
+                                                out + ".csv"], 1))
+        for name, args, k in phases:
+            for sig in (signal.SIGTERM, signal.SIGINT):
+                env = dict(os.environ, ULAM_TEST_STOP_AT_TMP=str(k))
+                p = subprocess.Popen([ulam] + args, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+                try:
+                    assert stopped(p), f"{name}: ended without reaching temporary file {k}: {p.stderr.read()}"
+                    tmps = [f for _, _, fs in os.walk(d) for f in fs if ".tmp." in f]
+                    assert tmps, f"{name}: stopped with no temporary file"
+                    p.send_signal(sig)
+                    p.send_signal(signal.SIGCONT)
+                    p.wait(timeout=60)
+                finally:
+                    if p.poll() is None:
+                        p.kill()
+                        p.wait()
+                left = [f for _, _, fs in os.walk(d) for f in fs if ".tmp." in f]
+                assert not left, f"{name}: {sig.name} left {left}"
+                if sig == signal.SIGTERM or name != "solve --out --errors":
+                    assert p.returncode == -sig, f"{name}: {sig.name}: exit {p.returncode}"
+                    assert not [f for r, _, fs in os.walk(d) for f in fs if r != d or f.startswith("out")], \
+                        f"{name}: output in place after {sig.name}"
+                for f in os.listdir(d):  # fresh for the next run
+                    if f.startswith("out") or f.endswith(".ulamcache"):
+                        shutil.rmtree(os.path.join(d, f)) if os.path.isdir(os.path.join(d, f)) else os.remove(os.path.join(d, f))
+
+
 def check_genmat(genmat):
     """examples/genmat reproduces every generated file in matrices/ byte for byte."""
     with tempfile.TemporaryDirectory() as d:
@@ -1611,7 +1711,8 @@ def main():
              (check_bidir, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
              (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
-             (check_systems_as_held, ulam)]
+             (check_systems_as_held, ulam),
+             (check_disk_full, ulam), (check_signals, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]
     if cases:

@@ -99,10 +99,10 @@ def check_json_out(ulam):
 def check_interrupt(ulam):
     """Ctrl-C during the walks ends the run after the current correction: exit 130, outcome
     'interrupted', no --out file (the solution has not converged)."""
-    from cli_test import interrupt_when_ready  # beside this file
+    from cli_test import interrupt_when_ready, popen_walks  # beside this file
     with tempfile.TemporaryDirectory() as d:
         x = os.path.join(d, "x.mtx")
-        p = subprocess.Popen([ulam, "solve", M + "poisson900.mtx", "--rhs", M + "poisson900_b.mtx", "--jacobi",
+        p = popen_walks([ulam, "solve", M + "poisson900.mtx", "--rhs", M + "poisson900_b.mtx", "--jacobi",
                               "--method", "mcsa", "--json", "--out", x], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
         interrupt_when_ready(p)

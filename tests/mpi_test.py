@@ -20,6 +20,36 @@ def run(cmd):
     return p.stdout
 
 
+def check_interrupt(ulam, mpirun):
+    """Ctrl-C under mpirun (issue 26, point 8): mpirun sends every rank SIGTERM, which the walks take
+    as their first Ctrl-C: every rank stops at the same round and rank 0 prints the estimate so far,
+    marked interrupted.  No clock: the signal is sent once both ranks have stopped themselves with the
+    walks' handler installed (the ULAM_TEST_STOP_AT_WALKS hook; mpirun sends SIGCONT before SIGTERM)."""
+    import signal
+    p = subprocess.Popen([mpirun, "--oversubscribe", "-np", "2", ulam, "solve", "--method", "walks", "matrices/chain4.mtx",
+                          "--rhs", "matrices/chain4_b.mtx", "--index", "2", "--walks", "100000000000", "--json"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env=dict(ENV, ULAM_TEST_STOP_AT_WALKS="1"))
+    try:
+        ready = 0
+        while ready < 2 and p.poll() is None:  # both ranks stopped themselves with the walks' handler set
+            ready = 0
+            kids = subprocess.run(["pgrep", "-P", str(p.pid)], capture_output=True, text=True).stdout.split()
+            for k in kids:
+                try:
+                    state = [l for l in open(f"/proc/{k}/status") if l.startswith("State:")][0].split()[1]
+                    ready += state == "T" and open(f"/proc/{k}/comm").read().startswith("ulam")
+                except (OSError, IndexError):
+                    pass
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=120)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    o = json.loads(out)
+    assert o["interrupted"] is True and o["walks"] >= 0 and o["ranks"] == 2, (out, err)
+
+
 def main():
     ulam, mpirun = sys.argv[1], sys.argv[2]
     par = [mpirun, "--oversubscribe", "-np", "2", ulam]
@@ -107,7 +137,13 @@ def main():
             except AssertionError as e:
                 failures += 1
                 print(f"FAIL {name}: {e}")
-    print(f"{len(cases) - failures} passed, {failures} failed")
+    try:
+        check_interrupt(ulam, mpirun)
+        print("ok interrupt")
+    except AssertionError as e:
+        failures += 1
+        print(f"FAIL interrupt: {e}")
+    print(f"{len(cases) + 1 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 

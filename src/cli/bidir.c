@@ -229,7 +229,7 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
         else print_text(o, &r, rp);
         if (r.walks.interrupted) rc = EXIT_INTERRUPTED;
     }
-    fflush(stdout);
+    cli_flush();
     cli_release_sigint();
     ulam_push_free(w);
     ulam_csr_free(Mt);
@@ -421,7 +421,7 @@ int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int 
         else print_text(&o, &a.bidir, &rp);
         if (a.bidir.walks.interrupted) rc = EXIT_INTERRUPTED;
     }
-    fflush(stdout);
+    cli_flush();
     cli_release_sigint();
     return rc;
 }

@@ -16,6 +16,14 @@ int cli_exit_code(int status);
 /* Print "ulam: file:line: error: <status>: expected <msg>" and return the exit code. */
 int cli_report(const char *file, const ulam_error *err);
 
+/* Report a failed write of path (status ULAM_EIO: errno's message errnum, "No space left on
+ * device"; ULAM_ENONFINITE: values that cannot be written) and return the exit code. */
+int cli_report_write(const char *path, int status, int errnum);
+
+/* fflush(stdout), remembering errno's value at the first failure (main reports it at exit: "No
+ * space left on device"); 0 or that errno value. */
+int cli_flush(void);
+
 /* Print "ulam: <command>: <message>" for a usage error and return EXIT_USAGE. */
 int cli_usage_error(const char *command, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -114,11 +122,30 @@ extern int cli_rank;
 void cli_mpi_init(int *argc, char ***argv);
 void cli_mpi_finalize(void);
 
-/* Catch SIGINT: the first sets cli_interrupted, a second exits at once with EXIT_INTERRUPTED. */
+/* Signals and temporary files: every output is written to a temporary file (NAME.tmp.XXXXXX)
+ * opened by cli_outfile_open, which registers it, and renamed into place by cli_outfile_commit
+ * (or removed by cli_outfile_abort), which forget it; SIGINT, SIGTERM and SIGHUP remove every
+ * registered file in every phase (cli_signals_init, from main), then end the process as the
+ * signal would.  During walks cli_catch_sigint takes SIGINT (and, under MPI, SIGTERM: mpirun's
+ * Ctrl-C) instead: the first sets cli_interrupted (the estimate so far is printed), a second
+ * removes the temporary files and exits at once with EXIT_INTERRUPTED; cli_release_sigint
+ * restores the handlers of cli_signals_init. */
+void cli_signals_init(void);
 void cli_catch_sigint(void);
-
-/* Restore the default SIGINT. */
 void cli_release_sigint(void);
+int cli_outfile_open(ulam_outfile *o, const char *path);
+int cli_outfile_commit(ulam_outfile *o);
+int cli_outfile_commit_all(ulam_outfile *o, int k);
+void cli_outfile_abort(ulam_outfile *o);
+
+/* ulam_mm_write_vector and ulam_system_write through cli_outfile_open: ULAM_OK or a status (errno
+ * says why for EIO). */
+int cli_write_vector(const char *path, const double *x, int64_t n, const char *comment);
+int cli_system_write(const char *path, const ulam_system_desc *d);
+
+/* Hold (on 1) SIGINT, SIGTERM and SIGHUP until released (on 0), around a short write whose
+ * temporary file the library makes itself (ulam_png_write). */
+void cli_hold_signals(int on);
 
 /* Index of word in names[0..n), or -1. */
 int cli_lookup(const char *word, const char *const *names, int n);

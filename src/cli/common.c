@@ -18,26 +18,167 @@ volatile int cli_interrupted;
 const ulam_share *cli_share;
 int cli_rank;
 
-/* SIGINT: the first asks the walks to stop, the second exits at once. */
+/* The temporary files of the outputs being written (ulam_outfile's NAME.tmp.XXXXXX), removed by
+ * the signal handlers: one registry for every command.  Entries are set and cleared with the
+ * signals blocked, so a handler sees each whole. */
+enum { CLI_TMP_MAX = 8 };
+static const char *volatile cli_tmps[CLI_TMP_MAX];
+
+/* Remove every registered temporary file (async-signal-safe: unlink only). */
+static void remove_tmps(void)
+{
+    for (int k = 0; k < CLI_TMP_MAX; k++)
+        if (cli_tmps[k]) unlink(cli_tmps[k]);
+}
+
+/* SIGINT, SIGTERM, SIGHUP outside the walks: remove the temporary files, then die of the signal
+ * as the default action would (the exit status says which). */
+static void on_fatal(int sig)
+{
+    remove_tmps();
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* Install sig's handler h (SA_RESTART: a write blocked on a full pipe is restarted). */
+static void catch(int sig, void (*h)(int))
+{
+    struct sigaction sa = {.sa_handler = h, .sa_flags = SA_RESTART};
+    sigemptyset(&sa.sa_mask);
+    sigaction(sig, &sa, NULL);
+}
+
+/* Remove the temporary files on SIGINT, SIGTERM and SIGHUP, in every phase. */
+void cli_signals_init(void)
+{
+    catch(SIGINT, on_fatal), catch(SIGTERM, on_fatal), catch(SIGHUP, on_fatal);
+}
+
+/* SIGINT (and SIGTERM under MPI, which mpirun sends every rank on Ctrl-C): the first asks the
+ * walks to stop (every rank stops at the same round), the second removes the temporary files and
+ * exits at once. */
 static void on_sigint(int sig)
 {
     (void)sig;
-    if (cli_interrupted) _exit(EXIT_INTERRUPTED);
+    if (cli_interrupted) {
+        remove_tmps();
+        _exit(EXIT_INTERRUPTED);
+    }
     cli_interrupted = 1;
 }
 
-/* Catch SIGINT; a write blocked on a full pipe is restarted after the first. */
+/* Catch SIGINT (and SIGTERM under MPI) for the walks; a write blocked on a full pipe is restarted
+ * after the first. */
 void cli_catch_sigint(void)
 {
-    struct sigaction sa = {.sa_handler = on_sigint, .sa_flags = SA_RESTART};
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
+    catch(SIGINT, on_sigint);
+    if (cli_share) catch(SIGTERM, on_sigint);
+    /* test hook (tests/cli_test.py, interrupt_when_ready): ULAM_TEST_STOP_AT_WALKS=1 stops the
+       process with SIGSTOP the first time the walks' handler is in force */
+    static int armed;
+    if (getenv("ULAM_TEST_STOP_AT_WALKS") && !armed++) raise(SIGSTOP);
 }
 
-/* Restore the default SIGINT. */
+/* Back to the handlers of cli_signals_init. */
 void cli_release_sigint(void)
 {
-    signal(SIGINT, SIG_DFL);
+    catch(SIGINT, on_fatal), catch(SIGTERM, on_fatal);
+}
+
+/* Block (how SIG_BLOCK) or restore the signals whose handlers read the registry. */
+static void block_signals(sigset_t *old)
+{
+    sigset_t s;
+    sigemptyset(&s);
+    sigaddset(&s, SIGINT), sigaddset(&s, SIGTERM), sigaddset(&s, SIGHUP);
+    sigprocmask(SIG_BLOCK, &s, old);
+}
+
+/* Register (on 1) or forget (on 0) the temporary name tmp. */
+static void registry(const char *tmp, int on)
+{
+    for (int k = 0; tmp && k < CLI_TMP_MAX; k++)
+        if (on ? !cli_tmps[k] : cli_tmps[k] == tmp) {
+            cli_tmps[k] = on ? tmp : NULL;
+            return;
+        }
+}
+
+/* ulam_outfile_open, its temporary file registered for removal on a signal. */
+int cli_outfile_open(ulam_outfile *o, const char *path)
+{
+    sigset_t old;
+    block_signals(&old);
+    int status = ulam_outfile_open(o, path);
+    if (!status) registry(o->tmp, 1);
+    sigprocmask(SIG_SETMASK, &old, NULL);
+    /* test hook (tests/cli_test.py, check_signals): ULAM_TEST_STOP_AT_TMP=k stops the process with
+       SIGSTOP once its k-th temporary file exists, so a test signals it in that phase without
+       waiting on a clock */
+    static int opened;
+    const char *stop = getenv("ULAM_TEST_STOP_AT_TMP");
+    if (!status && stop && atoi(stop) == ++opened) raise(SIGSTOP);
+    return status;
+}
+
+/* ulam_outfile_commit_all of k files, their temporary files forgotten (errno kept). */
+int cli_outfile_commit_all(ulam_outfile *o, int k)
+{
+    sigset_t old;
+    block_signals(&old);
+    for (int j = 0; j < k; j++) registry(o[j].tmp, 0);
+    int status = ulam_outfile_commit_all(o, k), e = errno;
+    sigprocmask(SIG_SETMASK, &old, NULL);
+    errno = e;
+    return status;
+}
+
+/* ulam_outfile_commit, its temporary file forgotten (errno kept). */
+int cli_outfile_commit(ulam_outfile *o)
+{
+    return cli_outfile_commit_all(o, 1);
+}
+
+/* ulam_outfile_abort, its temporary file forgotten. */
+void cli_outfile_abort(ulam_outfile *o)
+{
+    sigset_t old;
+    block_signals(&old);
+    registry(o->tmp, 0);
+    ulam_outfile_abort(o);
+    sigprocmask(SIG_SETMASK, &old, NULL);
+}
+
+/* Hold (on 1) SIGINT, SIGTERM and SIGHUP until released (on 0): around a short write whose
+ * temporary file the library makes itself (a PNG), so a signal ends the process after it. */
+void cli_hold_signals(int on)
+{
+    static sigset_t old;
+    if (on) block_signals(&old);
+    else sigprocmask(SIG_SETMASK, &old, NULL);
+}
+
+/* ulam_system_write through a registered temporary file; a status. */
+int cli_system_write(const char *path, const ulam_system_desc *d)
+{
+    ulam_outfile o;
+    int status = cli_outfile_open(&o, path);
+    if (!status && (status = ulam_system_write_file(o.f, d))) cli_outfile_abort(&o);
+    return status ? status : cli_outfile_commit(&o);
+}
+
+/* ulam_mm_write_vector through a registered temporary file; a status (errno says why for EIO). */
+int cli_write_vector(const char *path, const double *x, int64_t n, const char *comment)
+{
+    ulam_outfile o;
+    int status = cli_outfile_open(&o, path);
+    if (!status && (status = ulam_mm_write_vector_file(o.f, x, n, comment))) {
+        int e = errno;
+        cli_outfile_abort(&o);
+        errno = e;
+        return status;
+    }
+    return status ? status : cli_outfile_commit(&o);
 }
 
 /* Index of word in names[0..n), or -1. */
@@ -80,6 +221,29 @@ int cli_method_error(const char *got)
     for (int k = 0; k < ULAM_NMETHODS; k++) names[k + 1] = ulam_method_name(k);
     cli_choose("solve", "--method", got, names, ULAM_NMETHODS + 1, list); /* prints the error, did you mean */
     return EXIT_USAGE;
+}
+
+/* Report a failed write of path with errno's message. */
+int cli_report_write(const char *path, int status, int errnum)
+{
+    ulam_error err = {.status = status, .line = 0, .index = -1};
+    if (status == ULAM_EIO && errnum)
+        snprintf(err.msg, sizeof err.msg, "a writable output file (%s)", strerror(errnum));
+    else if (status == ULAM_ENONFINITE)
+        snprintf(err.msg, sizeof err.msg, "finite values to write (nothing was written)");
+    else
+        snprintf(err.msg, sizeof err.msg, "a writable output file");
+    return cli_report(path, &err);
+}
+
+static int stdout_errno; /* errno's value when a flush of stdout first failed */
+
+/* Flush stdout, remembering why it first failed. */
+int cli_flush(void)
+{
+    errno = 0;
+    if ((fflush(stdout) != 0 || ferror(stdout)) && !stdout_errno) stdout_errno = errno ? errno : EIO;
+    return stdout_errno;
 }
 
 /* Print a usage error and return EXIT_USAGE. */
@@ -193,7 +357,7 @@ static int read_input(const char *path, int cache, ulam_system **sys, ulam_csr *
     ulam_system_desc d = ulam_system_desc_defaults();
     d.M = vec ? NULL : *A, d.b = vec ? *vec : NULL, d.n = vec ? *n : (*A)->nrows;
     d.tag[0] = tag[0], d.tag[1] = tag[1];
-    int st = ulam_system_write(cpath, &d);
+    int st = cli_system_write(cpath, &d);
     if (st) fprintf(stderr, "ulam: %s: warning: cache not written: %s\n", cpath, ulam_strerror(st));
     else fprintf(stderr, "ulam: %s: parsed in %.3f s, cache written to %s\n", path, parsed, cpath);
     return ULAM_OK;
@@ -377,8 +541,8 @@ int cli_check_output(const char *path)
 {
     struct stat st;
     ulam_outfile o;
-    int status = stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? ULAM_EIO : ulam_outfile_open(&o, path);
-    if (!status) ulam_outfile_abort(&o);
+    int status = stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? ULAM_EIO : cli_outfile_open(&o, path);
+    if (!status) cli_outfile_abort(&o);
     if (!status) return 0;
     ulam_error err = {.status = status, .msg = "a writable output file (in an existing, writable directory; not a "
                                                "directory)"};

@@ -5,6 +5,7 @@
 #include <getopt.h>
 #include <pthread.h>
 #include <stdatomic.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
@@ -140,7 +141,6 @@ static void print_text(const cli_system *s, const double *x, int64_t index,
     printf("rcond      %.3e\n", info->rcond);
     printf("residual   %.3e\n", info->residual);
     printf("seconds    %.6f\n", info->seconds);
-    if (out) printf("written    %s\n", out);
 }
 
 /* Print the JSON object. */
@@ -212,13 +212,13 @@ int cli_direct(int argc, char **argv)
     int status;
     if ((rc = cli_direct_solve(&s, max_mem, &x, &info))) {
         /* reported */
-    } else if (out && (status = ulam_mm_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct"))) {
-        ulam_error err = {.status = status, .msg = "a writable output file"};
-        rc = cli_report(out, &err);
-    } else if (json) {
-        print_json(&s, x, s.index, &info);
-    } else {
-        print_text(&s, x, s.index, &info, out);
+    } else { /* the answer first: a failed write of --out below cannot lose it */
+        if (json) print_json(&s, x, s.index, &info);
+        else print_text(&s, x, s.index, &info, out);
+        cli_flush();
+        if (out && (status = cli_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct")))
+            rc = cli_report_write(out, status, errno);
+        else if (out && !json) printf("written    %s\n", out);
     }
     free(x);
     cli_system_free(&s);

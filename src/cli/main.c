@@ -1,6 +1,7 @@
 /* ulam: the command-line entry point; dispatches to one file per subcommand. */
 #include "cli.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -56,10 +57,15 @@ int main(int argc, char **argv)
 #ifdef ULAM_MPI
     cli_mpi_init(&argc, &argv);
 #endif
+    cli_signals_init(); /* temporary files removed on SIGINT, SIGTERM, SIGHUP */
     cli_output_begin(&argc, argv);
     int rc = cli_output_finish(dispatch(argc, argv));
+    int e = cli_flush();
+    if (e && cli_rank == 0) { /* a full disk or a closed pipe: say so */
+        fprintf(stderr, "ulam: error: cannot write the answer to standard output (%s)\n", strerror(e));
+        if (!rc) rc = cli_exit_code(ULAM_EIO);
+    }
 #ifdef ULAM_MPI
-    fflush(stdout);
     cli_mpi_finalize();
 #endif
     return rc;

@@ -4,6 +4,7 @@
 
 #include <getopt.h>
 #include <math.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -105,7 +106,7 @@ static void print_step(const ulam_outer_step *s, int walks)
     if (s->iteration == 1) printf("%-5s %-12s %-12s %-10s %-10s\n", "iter", "residual", "histories", "rel_sd", "seconds");
     printf("%-5d %-12.4e %-12lld %-10.3g %-10.4f\n", s->iteration, s->residual, (long long)s->histories,
            walks ? s->rel_sd : 0.0, s->seconds);
-    fflush(stdout);
+    cli_flush();
 }
 
 /* Nonzero when iteration k's line is printed as it ends: the first 10, then every 500th (the
@@ -213,6 +214,10 @@ static void print_failure(const report *p)
     else if (p->status == ULAM_ENOCONV)
         fprintf(stderr, "ulam: %s: error: %s: residual %.3g after --max-iter %d iterations (tolerance %g)\n",
                 p->s->matrix_path, ulam_strerror(p->status), res, p->iterations, p->o->tol);
+    else if (p->status == ULAM_ENONFINITE && p->method >= KRYLOV_CG)
+        fprintf(stderr, "ulam: %s: error: %s: expected a solution a double can hold: x (or its residual, %.3g) "
+                        "exceeds 1.8e308 after %d iterations; no output written\n",
+                p->s->matrix_path, ulam_strerror(p->status), res, p->iterations);
     else
         fprintf(stderr, "ulam: %s: error: %s after %d iterations (is rho(|M|) < 1? see 'ulam info')\n",
                 p->s->matrix_path, ulam_strerror(p->status), p->nsteps);
@@ -379,22 +384,22 @@ int cli_solve_method(int argc, char **argv)
         rc = cli_exit_code(p.status);
     } else if (!rc) {
         if (p.check) rc = direct_error(&s, x, &p);
-        if (!rc && out && cli_rank == 0 && p.converged &&
-            ulam_mm_write_vector(out, x, s.M->nrows, "outer-iteration solution x")) {
-            ulam_error err = {.status = ULAM_EIO, .msg = "a writable output file"};
-            rc = cli_report(out, &err);
-        }
-        if (!rc && cli_rank == 0) {
+        if (!rc && cli_rank == 0) { /* the answer first: a failed write of --out below cannot lose it */
             if (p.json) print_json(&p);
             else print_text(&p);
+            cli_flush();
         }
+        int ws;
+        if (!rc && out && cli_rank == 0 && p.converged &&
+            (ws = cli_write_vector(out, x, s.M->nrows, "outer-iteration solution x")))
+            rc = cli_report_write(out, ws, errno);
         if (!rc && p.status) {
             print_failure(&p);
             rc = cli_exit_code(p.status);
         }
         if (!rc && cli_interrupted) rc = EXIT_INTERRUPTED;
     }
-    fflush(stdout);
+    cli_flush();
     free(steps), free(x);
     cli_system_free(&s);
     return rc;

@@ -57,14 +57,14 @@ int cli_prepare(int argc, char **argv)
     s.matrix_path = argv[optind];
     ulam_outfile o;
     ulam_error err = {.msg = "a writable output file"};
-    int status = ulam_outfile_open(&o, out); /* checked before the work */
+    int status = cli_outfile_open(&o, out); /* checked before the work */
     if (status) {
         err.status = status;
         return cli_report(out, &err);
     }
     double t0 = ulam_now();
     if ((rc = cli_load_system(&s))) {
-        ulam_outfile_abort(&o);
+        cli_outfile_abort(&o);
         return rc;
     }
     double load = ulam_now() - t0;
@@ -73,7 +73,7 @@ int cli_prepare(int argc, char **argv)
     status = ulam_certificate_compute(s.M, continue_q, NULL, &cert, &err);
     double guards = ulam_now() - t0;
     if (status) {
-        ulam_outfile_abort(&o);
+        cli_outfile_abort(&o);
         rc = cli_report(s.matrix_path, &err);
         cli_system_free(&s);
         return rc;
@@ -82,8 +82,8 @@ int cli_prepare(int argc, char **argv)
     d.M = s.M, d.b = s.b, d.n = s.M->nrows, d.omega = s.jacobi ? s.omega : 0.0, d.cert = &cert;
     d.transpose = transpose;
     status = ulam_system_write_file(o.f, &d);
-    if (status) ulam_outfile_abort(&o);
-    else status = ulam_outfile_commit(&o);
+    if (status) cli_outfile_abort(&o);
+    else status = cli_outfile_commit(&o);
     if (status) {
         err = (ulam_error){.status = status, .msg = "a writable output file"};
         rc = cli_report(out, &err);

@@ -587,11 +587,11 @@ static void print_list(const args *a, const ulam_scene *s)
 static int write_csv(const char *path, const ulam_scene *s, const patch_values *v)
 {
     ulam_outfile o;
-    int status = ulam_outfile_open(&o, path);
+    int status = cli_outfile_open(&o, path);
     if (!status) {
         row_header(o.f, ROW_CSV, v);
         for (int64_t p = 0; p < s->npatches; p++) row(o.f, ROW_CSV, s, p, v);
-        status = ulam_outfile_commit(&o);
+        status = cli_outfile_commit(&o);
     }
     if (!status) return 0;
     ulam_error err = {.status = status, .msg = "a writable output file"};
@@ -879,7 +879,7 @@ static void illuminance(const ulam_rad_point *r, double *Y, double *se)
 static int write_grid_csv(const char *path, const ulam_rad_grid *g, const ulam_rad_point *pts)
 {
     ulam_outfile o;
-    int status = ulam_outfile_open(&o, path);
+    int status = cli_outfile_open(&o, path);
     if (!status) {
         fprintf(o.f, "i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks\n");
         for (int j = 0; j < g->nv; j++)
@@ -892,7 +892,7 @@ static int write_grid_csv(const char *path, const ulam_rad_grid *g, const ulam_r
                 for (int c = 0; c < 3; c++) fprintf(o.f, ",%.17g", r->irradiance_se[c]);
                 fprintf(o.f, ",%.17g,%.17g,%lld\n", Y, se, (long long)r->run.walks);
             }
-        status = ulam_outfile_commit(&o);
+        status = cli_outfile_commit(&o);
     }
     if (!status) return 0;
     ulam_error err = {.status = status, .msg = "a writable output file"};
@@ -919,7 +919,11 @@ static int write_grid_png(const char *path, const ulam_rad_grid *g, const ulam_r
     ulam_falsecolour_size(g->nu, g->nv, cw, ch, &w, &h);
     unsigned char *rgb = Y ? malloc((size_t)w * (size_t)h * 3) : NULL;
     if (!status) status = rgb ? ulam_falsecolour(Y, g->nu, g->nv, cw, ch, 0.0, *hi, rgb) : ULAM_ENOMEM;
-    if (!status) status = ulam_png_write(path, w, h, rgb);
+    if (!status) {
+        cli_hold_signals(1); /* its temporary file is the library's: a signal waits until it is gone */
+        status = ulam_png_write(path, w, h, rgb);
+        cli_hold_signals(0);
+    }
     free(Y), free(rgb);
     if (!status) return 0;
     ulam_error err = {.status = status, .msg = "a writable PNG file"};
@@ -1084,11 +1088,20 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
     int status = rgb && hdr ? ulam_render_hdr(t, B, &cam, a->width, a->height, a->samples, !a->flat, a->o.seed,
                                               a->exposure, hdr, rgb, &info)
                             : ULAM_ENOMEM;
-    if (!status) status = ulam_png_write(a->image, a->width, a->height, rgb);
-    if (!status && (status = ulam_pfm_write(a->hdr, a->width, a->height, hdr))) {
-        free(rgb), free(hdr);
-        ulam_error err = {.status = status, .msg = "a writable PFM file"};
-        return cli_report(a->hdr, &err);
+    if (!status) { /* its temporary file is the library's: a signal waits until it is gone */
+        cli_hold_signals(1);
+        status = ulam_png_write(a->image, a->width, a->height, rgb);
+        cli_hold_signals(0);
+    }
+    if (!status) {
+        cli_hold_signals(1);
+        status = ulam_pfm_write(a->hdr, a->width, a->height, hdr);
+        cli_hold_signals(0);
+        if (status) {
+            free(rgb), free(hdr);
+            ulam_error err = {.status = status, .msg = "a writable PFM file"};
+            return cli_report(a->hdr, &err);
+        }
     }
     free(rgb), free(hdr);
     if (status) {

@@ -1,6 +1,8 @@
 /* ulam solve: one unknown (adjoint) or every unknown (forward) by random walks. */
 #include "cli.h"
 
+#include <errno.h>
+
 #include <getopt.h>
 #include <sys/resource.h>
 #include <math.h>
@@ -296,45 +298,55 @@ static int direct_check(const cli_system *s, int64_t index, report_opts *ro)
     return rc;
 }
 
-/* The standard errors as a Matrix Market array, atomically: NaN for a component no walk reached
+/* The standard errors as a Matrix Market array to f: NaN for a component no walk reached
  * (ulam_mm_write_vector refuses non-finite values), with the comments saying so and whether the
- * variance is finite.  ULAM_OK or a status. */
-static int write_errors(const char *path, const double *e, int64_t n, const ulam_walk_result *r)
+ * variance is finite. */
+static void write_errors(FILE *f, const double *e, int64_t n, const ulam_walk_result *r)
 {
-    ulam_outfile o;
-    int status = ulam_outfile_open(&o, path);
-    if (status) return status;
-    fprintf(o.f, "%%%%MatrixMarket matrix array real general\n%% standard errors of the forward estimates\n");
+    fprintf(f, "%%%%MatrixMarket matrix array real general\n%% standard errors of the forward estimates\n");
     if (r->variance_finite != 1)
-        fprintf(o.f, "%% VARIANCE %s (rho(M^) of the forward kernel %s): these standard errors mean nothing\n",
+        fprintf(f, "%% VARIANCE %s (rho(M^) of the forward kernel %s): these standard errors mean nothing\n",
                 r->variance_finite == 0 ? "INFINITE" : "NOT CERTIFIED FINITE",
                 r->variance_finite == 0 ? ">= 1" : "straddles 1");
     if (r->unreached)
-        fprintf(o.f, "%% %lld components unreached (no walk tallied them): their error is nan, they have no estimate\n",
+        fprintf(f, "%% %lld components unreached (no walk tallied them): their error is nan, they have no estimate\n",
                 (long long)r->unreached);
-    fprintf(o.f, "%lld 1\n", (long long)n);
-    for (int64_t k = 0; k < n; k++) fprintf(o.f, isnan(e[k]) ? "nan\n" : "%.17g\n", e[k]);
-    return ulam_outfile_commit(&o);
+    fprintf(f, "%lld 1\n", (long long)n);
+    for (int64_t k = 0; k < n; k++) fprintf(f, isnan(e[k]) ? "nan\n" : "%.17g\n", e[k]);
 }
 
-/* Write the forward vectors; 0 or an exit code. */
+/* Write the forward vectors, --out and --errors committed together or neither (both written to
+ * temporary files, renamed into place only when both are whole); 0 or an exit code. */
 static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, const char *errors,
                          const ulam_walk_result *r)
 {
     double *x = malloc((size_t)n * sizeof *x), *e = malloc((size_t)n * sizeof *e);
-    int status = x && e ? ulam_solver_vectors(sv, x, e) : ULAM_ENOMEM;
-    const char *path = out;
-    if (!status && out) status = ulam_mm_write_vector(out, x, n, r->unreached ? "forward random-walk estimates of x "
-                                                                 "(unreached components: 0, no estimate; see the errors)"
-                                                               : "forward random-walk estimates of x");
-    if (!status && errors) {
-        path = errors;
-        status = write_errors(errors, e, n, r);
+    int status = x && e ? ulam_solver_vectors(sv, x, e) : ULAM_ENOMEM, k = 0, errnum = 0;
+    ulam_outfile o[2] = {{0}};
+    char both[1100];
+    const char *fail = NULL;
+    if (!status && out) {
+        if ((status = cli_outfile_open(&o[k], out)) ||
+            (status = ulam_mm_write_vector_file(o[k].f, x, n, r->unreached ? "forward random-walk estimates of x "
+                                                "(unreached components: 0, no estimate; see the errors)"
+                                                : "forward random-walk estimates of x")))
+            fail = out, errnum = errno;
+        k++;
     }
+    if (!status && errors) {
+        if ((status = cli_outfile_open(&o[k], errors))) fail = errors, errnum = errno;
+        else write_errors(o[k].f, e, n, r);
+        k++;
+    }
+    if (!status) {
+        status = cli_outfile_commit_all(o, k);
+        errnum = errno;
+        if (out && errors) snprintf(both, sizeof both, "%s and %s", out, errors), fail = both;
+    }
+    cli_outfile_abort(&o[0]), cli_outfile_abort(&o[1]); /* whatever is left: nothing is replaced */
     free(x), free(e);
-    if (!status) return 0;
-    ulam_error err = {.status = status, .msg = "a writable output file and finite values"};
-    return cli_report(path, &err);
+    if (!fail) fail = out ? out : errors;
+    return status ? cli_report_write(fail, status, errnum) : 0;
 }
 
 /* After the first round: say so when the rel-err rule's minimum walk count (from the bound on a
@@ -580,6 +592,7 @@ static int run(solve_args *a)
         cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o);
     }
     cli_progress_end(&pg);
+    ulam_error ferr;
     ulam_solver_result(sv, &r);
     if (r.cut_stop)
         fprintf(stderr, "ulam: %s: warning: --rel-err %g is unreachable: %lld walks were cut at --max-steps %lld and "
@@ -594,18 +607,20 @@ static int run(solve_args *a)
         fprintf(stderr, "ulam: %s: error: %s: expected rows the walks reach to be consistent (row data of "
                         "the mapped file is corrupt: prepare it again)\n", s->matrix_path, ulam_strerror(status));
         rc = cli_exit_code(status);
+    } else if (status && ulam_solver_error(sv, &ferr) && ferr.index >= 0) { /* the estimate overflowed */
+        fprintf(stderr, "ulam: %s: error: %s: expected %s; no estimate after %lld walks\n", s->matrix_path,
+                ulam_strerror(status), ferr.msg, (long long)r.walks);
+        rc = cli_exit_code(status);
     } else if (status) {
         fprintf(stderr, "ulam: %s: error: %s: a walk produced a non-finite weight or score after %lld "
                         "walks; nothing was averaged in from it (is rho(|M|) < 1? see 'ulam info')\n",
                 s->matrix_path, ulam_strerror(status), (long long)r.walks);
         rc = cli_exit_code(status);
-    } else if (o->mode == ULAM_FORWARD && (a->out || a->errors) && !r.interrupted && cli_rank == 0) {
-        rc = write_vectors(sv, ro.n, a->out, a->errors, &r);
     }
     int left = 0; /* a check still running when Ctrl-C came: leave the system to it */
     if (!status && !rc) {
         if (!ro.json) print_text(o, &r, &ro);
-        fflush(stdout); /* the estimate first: a check may take long, and Ctrl-C keeps what is printed */
+        cli_flush(); /* the estimate first: a check may take long, a failed write of the files below cannot lose it, and Ctrl-C keeps what is printed */
         if (ro.check && !r.interrupted && cli_rank == 0) {
             rc = cli_system_verify(&a->s);
             rc = rc ? rc : direct_check(s, o->index, &ro);
@@ -616,8 +631,10 @@ static int run(solve_args *a)
         }
         if (ro.json && (!rc || left)) print_json(o, &r, &ro);
         if (r.interrupted) rc = EXIT_INTERRUPTED;
+        else if (o->mode == ULAM_FORWARD && (a->out || a->errors) && cli_rank == 0)
+            rc = write_vectors(sv, ro.n, a->out, a->errors, &r);
     }
-    fflush(stdout); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
+    cli_flush(); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
     if (left && !cli_share) { /* the reference solve's thread still reads the system: end here */
         fflush(stderr);
         _exit(rc);

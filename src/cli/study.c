@@ -212,12 +212,12 @@ static int save_runs(const study *st)
     char path[4096];
     snprintf(path, sizeof path, "%s/runs.csv", st->out);
     ulam_outfile o;
-    int status = ulam_outfile_open(&o, path);
+    int status = cli_outfile_open(&o, path);
     if (!status) {
         fputs(runs_header, o.f);
         for (size_t i = 0, n = at(st, NMETHOD, 0, 0); i < n; i++)
             if (st->done[i]) fputs(st->row[i], o.f);
-        status = ulam_outfile_commit(&o);
+        status = cli_outfile_commit(&o);
     }
     ulam_error e = {.status = status, .msg = "a writable output directory"};
     return status ? cli_report(path, &e) : 0;
@@ -327,8 +327,8 @@ static int check_question(study *st)
     if (mismatch) fprintf(stderr, "ulam: study: --force: the old runs in %s are discarded\n", st->out);
     if (cli_rank) return 0;
     ulam_outfile o;
-    int status = ulam_outfile_open(&o, path);
-    if (!status) fputs(mine, o.f), status = ulam_outfile_commit(&o);
+    int status = cli_outfile_open(&o, path);
+    if (!status) fputs(mine, o.f), status = cli_outfile_commit(&o);
     ulam_error e = {.status = status, .msg = "a writable output directory"};
     return status ? cli_report(path, &e) : 0;
 }
@@ -442,7 +442,7 @@ static int references(study *st)
     char path[4096], v[2][32];
     snprintf(path, sizeof path, "%s/reference.csv", st->out);
     ulam_outfile o = {0};
-    int status = cli_rank ? ULAM_OK : ulam_outfile_open(&o, path); /* under MPI, rank 0 writes */
+    int status = cli_rank ? ULAM_OK : cli_outfile_open(&o, path); /* under MPI, rank 0 writes */
     if (status) {
         free(x);
         ulam_error e = {.status = status, .msg = "a writable output directory"};
@@ -469,7 +469,7 @@ static int references(study *st)
     free(x);
     outer_references(st, f);
     if (!o.f) return fclose(f), 0;
-    ulam_error e = {.status = ulam_outfile_commit(&o), .msg = "a writable output directory"};
+    ulam_error e = {.status = cli_outfile_commit(&o), .msg = "a writable output directory"};
     return e.status ? cli_report(path, &e) : 0;
 }
 
@@ -509,9 +509,9 @@ static int summarise(study *st)
     snprintf(path[1], sizeof path[1], "%s/bars.csv", st->out);
     ulam_outfile o[2] = {{0}};
     int k = 0, status = ULAM_OK;
-    for (; k < 2 && !status; k++) status = ulam_outfile_open(&o[k], path[k]);
+    for (; k < 2 && !status; k++) status = cli_outfile_open(&o[k], path[k]);
     if (status) {
-        ulam_outfile_abort(&o[0]);
+        cli_outfile_abort(&o[0]);
         ulam_error err = {.status = status, .msg = "a writable output directory"};
         return cli_report(path[k - 1], &err);
     }
@@ -546,8 +546,8 @@ static int summarise(study *st)
     }
     status = e ? ULAM_OK : ULAM_ENOMEM;
     free(e);
-    for (k = 0; k < 2 && !status; k++) status = ulam_outfile_commit(&o[k]);
-    ulam_outfile_abort(&o[0]), ulam_outfile_abort(&o[1]); /* whatever was not committed */
+    for (k = 0; k < 2 && !status; k++) status = cli_outfile_commit(&o[k]);
+    cli_outfile_abort(&o[0]), cli_outfile_abort(&o[1]); /* whatever was not committed */
     ulam_error err = {.status = status, .msg = "a writable output directory"};
     return status ? cli_report(path[k ? k - 1 : 0], &err) : 0;
 }
