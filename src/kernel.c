@@ -464,7 +464,7 @@ int ulam__kernel_keep(ulam_kernel *k)
 /* Give a kept kernel's rows the scores of b (see kernel.h). */
 int ulam__kernel_rescore_b(ulam_kernel *k, const double *b)
 {
-    if (!k->scored || atomic_load(&k->status)) return ULAM_EINVAL;
+    if ((!k->scored && !k->fixed) || atomic_load(&k->status)) return ULAM_EINVAL;
     if (b == k->scores.b && k->fixed) return ULAM_OK; /* the same scores: nothing to do */
     if (k->fixed) return ULAM_EINVAL;
     k->scores.b = b;

@@ -328,6 +328,7 @@ typedef struct {
     int check, json, force, assume_finite;
     int autom;            /* --method auto (the default): choose what is not pinned */
     ulam_auto_opts ao;    /* what the command line pins (--mode, --estimator, --continue) */
+    ulam_analysis *an;    /* what queries on M share (a prepared system read lazily; NULL: none) */
 } solve_args;
 
 /* Parse argv into a; 0, or an exit code (-1: --help printed). */
@@ -483,7 +484,15 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
         }
         o->guard = &ro->g;
         t0 = ulam_now();
-        status = ulam_solver_alloc(s->M, s->b, o, sv, &err); /* refuses what the guards refuse */
+        if (s->lazy && s->sys_M) { /* the file's stored bounds: no pass over what the start can reach */
+            ulam_analysis_opts ao = ulam_analysis_defaults();
+            ao.continue_q = o->continue_q, ao.kernel_alpha = o->kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
+            status = ulam_analysis_alloc(s->M, &ao, &a->an, &err);
+            if (!status) status = ulam_analysis_solver(a->an, s->b, o, sv, &err);
+            if (status) a->an = ulam_analysis_free(a->an);
+        } else {
+            status = ulam_solver_alloc(s->M, s->b, o, sv, &err); /* refuses what the guards refuse */
+        }
         ro->kernel_seconds = ulam_now() - t0;
     }
     ro->guard_seconds = ro->g.abs.seconds + ro->g.hat[0].seconds + ro->g.hat[1].seconds;
@@ -509,6 +518,7 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
     if (walks) cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
     if (ro->check && (rc = direct_check(s, o->index, ro))) {
         *sv = ulam_solver_free(*sv);
+        a->an = ulam_analysis_free(a->an);
         cli_bidir_cand_free(bc);
         cli_system_free(s);
         return rc;
@@ -575,6 +585,7 @@ static int run(solve_args *a)
     fflush(stdout); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
     cli_release_sigint();
     ulam_solver_free(sv);
+    a->an = ulam_analysis_free(a->an);
     cli_bidir_cand_free(&bc);
     cli_system_free(&a->s);
     return rc;
