@@ -86,6 +86,19 @@ extern volatile int cli_interrupted;
 extern const ulam_share *cli_share;
 extern int cli_rank;
 
+/* When the process started (ulam_now()), set first thing in main: --time counts from here. */
+extern double cli_started;
+
+/* The walks' share of a --time budget of `budget` seconds (0: none) once what ran since the
+ * process started (reading, guards, set-up) is taken off; at least one block of walks still
+ * runs when nothing is left (a tiny positive budget). */
+double cli_time_left(double budget);
+
+/* Make OpenMP threads wait passively (sleep, not spin) unless the user chose a policy: libgomp
+ * reads OMP_WAIT_POLICY when it loads, before main, so the process runs itself again once with
+ * it set (argv as given).  Returns only when no re-run happened (set already, or exec failed). */
+void cli_passive_threads(char **argv);
+
 /* With -Dmpi=enabled: start MPI when launched by mpirun, and end it (src/cli/mpi.c). */
 void cli_mpi_init(int *argc, char ***argv);
 void cli_mpi_finalize(void);

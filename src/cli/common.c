@@ -17,6 +17,22 @@ const char *const cli_estimator_names[3] = {"collision", "absorption", "expected
 volatile int cli_interrupted;
 const ulam_share *cli_share;
 int cli_rank;
+double cli_started;
+
+/* The walks' share of a --time budget. */
+double cli_time_left(double budget)
+{
+    if (!(budget > 0)) return budget;
+    double left = budget - (ulam_now() - cli_started);
+    return left > 1e-6 ? left : 1e-6;
+}
+
+/* Passive OpenMP waiting unless the user chose (see cli.h). */
+void cli_passive_threads(char **argv)
+{
+    if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT") || setenv("OMP_WAIT_POLICY", "PASSIVE", 1)) return;
+    execv("/proc/self/exe", argv); /* returns only on failure: run on as we are */
+}
 
 /* SIGINT: the first asks the walks to stop, the second exits at once. */
 static void on_sigint(int sig)

@@ -36,7 +36,8 @@ static const char *const usage =
     "                     bar'); it watches x_I (--index, default 1 in forward mode) and never\n"
     "                     stops while no walk has reached it; refused (exit 4) when the variance\n"
     "                     is not certified finite, unless --walks or --time bounds the run\n"
-    "  --time S           stop after S seconds; the first rule reached wins\n"
+    "  --time S           stop S seconds after ulam started (reading, guards and set-up\n"
+    "                     count); the first rule reached wins\n"
     "  --seed S           block q of walks uses stream (S, q) (default 1): identical results for\n"
     "                     any --threads\n"
     "  --threads T        threads (default: all cores)\n";
@@ -329,6 +330,7 @@ typedef struct {
     int autom;            /* --method auto (the default): choose what is not pinned */
     ulam_auto_opts ao;    /* what the command line pins (--mode, --estimator, --continue) */
     ulam_analysis *an;    /* what queries on M share (a prepared system read lazily; NULL: none) */
+    double max_seconds;   /* --time as given (o.max_seconds: what is left of it for the walks) */
 } solve_args;
 
 /* Parse argv into a; 0, or an exit code (-1: --help printed). */
@@ -454,6 +456,8 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
     ro->n = s->M->nrows;
     ulam_error err;
     int status;
+    a->max_seconds = o->max_seconds;
+    o->max_seconds = cli_time_left(a->max_seconds); /* --time counts the reading before it too */
     if (a->autom) { /* guards, pilots and the solver, its set-up kept from the chosen pilot */
         t0 = ulam_now();
         ulam_guard cg;
@@ -483,6 +487,7 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
             return rc;
         }
         o->guard = &ro->g;
+        o->max_seconds = cli_time_left(a->max_seconds); /* and the guards */
         t0 = ulam_now();
         if (s->lazy && s->sys_M) { /* the file's stored bounds: no pass over what the start can reach */
             ulam_analysis_opts ao = ulam_analysis_defaults();
