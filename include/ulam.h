@@ -1090,6 +1090,20 @@ int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *b
 int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
                      ulam_auto_result *res, ulam_solver **out, ulam_error *err);
 
+/* As ulam_auto_solver for M = a's M, its candidates of a's kernel (adjoint, a's continuation and
+ * exponent) walking under a's bounds over every state (a prepared file's, or one pass over M)
+ * rather than each searching its start's reach; ao->guard, when NULL and ao pins a's
+ * continuation, exponent and adjoint mode, is a's.  The same choice as ulam_auto_solver where
+ * those bounds equal the start's (a start that reaches every state). */
+int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                       ulam_auto_result *res, ulam_solver **out, ulam_error *err);
+
+/* A's push workspace on M for point-source queries (ulam_bidir_solve with
+ * ulam_analysis_transpose(a)), made at the first call and kept, so that the walks' bounds and
+ * kernel rows later queries reuse (ulam_bidir_opts.reach_all, keep_kernel) stay with the
+ * analysis; NULL: no memory (err filled). */
+ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err);
+
 /* ---------------------------------------------------------------- studies */
 /* All tertiary. */
 

@@ -22,6 +22,7 @@ struct ulam_analysis {
     int bounds_from, b_from;
     ulam_kernel *k[3];    /* per estimator: the kept kernel of adjoint queries on b */
     ulam_csr *T;          /* the transpose (NULL until asked) */
+    ulam_push *push;      /* the push workspace on M (NULL until asked) */
     double seconds;
 };
 
@@ -58,6 +59,7 @@ ulam_analysis *ulam_analysis_free(ulam_analysis *a)
 {
     if (!a) return NULL;
     for (int e = 0; e < 3; e++) ulam__kernel_free(a->k[e]);
+    ulam_push_free(a->push);
     ulam_csr_free(a->T);
     free(a->seen);
     free(a);
@@ -141,6 +143,23 @@ int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts 
     return status ? status : ulam__solver_finish(s, result, err);
 }
 
+/* The method choice on a's bounds. */
+int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                       ulam_auto_result *res, ulam_solver **out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!a || !base) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis and options");
+    ulam_auto_opts o = ao ? *ao : ulam_auto_defaults();
+    int mine = o.pin_continue && o.pin_alpha && o.pin_mode && base->mode == ULAM_ADJOINT &&
+               (base->continue_q > 0 ? base->continue_q : 0.0) == a->continue_q && base->kernel_alpha == a->alpha;
+    if (mine && !o.guard) {
+        int status = take_guard(a, ULAM_ADJOINT, err);
+        if (status) return status;
+        o.guard = &a->g;
+    }
+    return ulam__auto_solver_reach(a->M, b, base, &o, take_bounds(a), res, out, err);
+}
+
 /* M's transpose, made once. */
 const ulam_csr *ulam_analysis_transpose(ulam_analysis *a, ulam_error *err)
 {
@@ -151,6 +170,16 @@ const ulam_csr *ulam_analysis_transpose(ulam_analysis *a, ulam_error *err)
     if (ulam_csr_transpose(a->M, &a->T)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose"), NULL;
     a->seconds += ulam_now() - t0;
     return a->T;
+}
+
+/* The push workspace on M, made once. */
+ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis"), NULL;
+    if (!a->push && ulam_push_alloc(a->M, &a->push))
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a push workspace"), NULL;
+    return a->push;
 }
 
 /* What a holds so far. */

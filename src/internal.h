@@ -170,6 +170,13 @@ const char *ulam__solver_reached(const ulam_solver *s);
  * (R->K its matrix, R->seen NULL: the caller gives n flags of ones), else 0 (src/cache.c). */
 int ulam__system_bounds(const ulam_system *s, double continue_q, double alpha, ulam__reach *R);
 
+/* As ulam_auto_solver, with reach (NULL: none; borrowed until the solver is freed) the bounds
+ * over every state of M (ulam__reach_all's, with b's scores when they are this b's) that the
+ * candidates of its kernel (adjoint, its continuation and exponent) walk under instead of each
+ * searching its start's reach (src/auto.c; ulam_analysis_auto). */
+int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                            const ulam__reach *reach, ulam_auto_result *res, ulam_solver **out, ulam_error *err);
+
 /* Iterate s until a stopping rule holds, fill result (may be NULL) and, on failure, err; free s.
  * The status (src/solve.c: the rest of ulam_solve). */
 int ulam__solver_finish(ulam_solver *s, ulam_walk_result *result, ulam_error *err);

@@ -6,14 +6,14 @@
 #include <string.h>
 
 
-/* Choose for s (loaded) under o (what ao pins stays), make the solver *sv and set o's mode,
+/* Choose for s (loaded) under o (what ao pins stays; an: on its bounds), make the solver *sv and set o's mode,
  * estimator and continuation to the choice; *status gets the solver's refusal (err filled) for the
  * caller to report as a plain run's.  0, or an exit code (message printed) when the library fails
  * or when no candidate is certified and o asks for a --rel-err target (the closest is named). */
-int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, ulam_auto_result *res,
-                    ulam_solver **sv, int *status, ulam_error *err)
+int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, const ulam_auto_opts *ao,
+                    ulam_auto_result *res, ulam_solver **sv, int *status, ulam_error *err)
 {
-    *status = ulam_auto_solver(s->M, s->b, o, ao, res, sv, err);
+    *status = an ? ulam_analysis_auto(an, s->b, o, ao, res, sv, err) : ulam_auto_solver(s->M, s->b, o, ao, res, sv, err);
     int k = res->chosen >= 0 ? res->chosen : res->closest;
     if (k < 0) return cli_report(s->matrix_path, err);
     const ulam_auto_candidate *c = &res->cand[k];

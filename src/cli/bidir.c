@@ -325,7 +325,6 @@ int cli_bidir_consider(cli_system *s, const ulam_walk_opts *user, const char *pi
     bc->work = bc->leader_work = NAN;
     const ulam_csr *M = s->M;
     int64_t n = M->nrows, k = 0;
-    for (int64_t i = 0; i < n; i++) k += s->b[i] != 0.0;
     double nnz = (double)ulam_csr_nnz(M);
     if (au->chosen >= 0) bc->leader_work = au->cand[au->chosen].predicted_work;
     double W = bc->leader_work;
@@ -342,6 +341,7 @@ int cli_bidir_consider(cli_system *s, const ulam_walk_opts *user, const char *pi
         snprintf(bc->why, sizeof bc->why, "not considered: no certified walk method to compare with");
         return 0;
     }
+    for (int64_t i = 0; i < n; i++) k += s->b[i] != 0.0; /* after the refusals: a lazy query reads no more of b */
     if (k == 0 || k > sparse_limit(n)) {
         snprintf(bc->why, sizeof bc->why, "not considered: b is %s (%lld nonzeros; sparse is at most max(16, n/10) = %lld)",
                  k ? "dense" : "zero", (long long)k, (long long)sparse_limit(n));

@@ -186,11 +186,16 @@ int cli_bidir_auto_run(cli_system *s, cli_bidir_cand *bc, const ulam_auto_result
 /* Free what bc owns (accepts NULL). */
 void cli_bidir_cand_free(cli_bidir_cand *bc);
 
+/* ulam solve --queries FILE (src/cli/queries.c): s (not loaded) and o from the command line
+ * (adjoint), json, walks_given (--walks or --time given); 0 or an exit code. */
+int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int json, int walks_given);
+
 /* solve --method auto (src/cli/auto.c): choose the method for the loaded s under o (what ao pins
- * stays), make the solver *sv and set o to the choice; *status and err get the solver's refusal.
+ * stays), make the solver *sv and set o to the choice (an: on its bounds, NULL: none); *status and
+ * err get the solver's refusal.
  * 0 or an exit code.  Then print the candidates as text, or as the JSON key "auto". */
-int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, ulam_auto_result *res,
-                    ulam_solver **sv, int *status, ulam_error *err);
+int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, const ulam_auto_opts *ao,
+                    ulam_auto_result *res, ulam_solver **sv, int *status, ulam_error *err);
 void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc);
 void cli_auto_print_json(const ulam_auto_result *res, const cli_bidir_cand *bc);
 int cli_study(int argc, char **argv);

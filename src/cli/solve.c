@@ -69,6 +69,11 @@ static const char *const usage3 =
     "                     pinned; fresh walks then estimate with the choice; with a sparse b\n"
     "                     and --rel-err, also bidirectional (push + walks) when the best walks\n"
     "                     are predicted to cost more than nnz(M)/4\n"
+    "  --queries FILE     many queries in one process ('-': stdin), one a line: 'I' (x_I), or\n"
+    "                     'S I' (x_I with b = e_S, bidirectional), either optionally followed\n"
+    "                     by a target like 0.01 for that line's --rel-err; one answer a line\n"
+    "                     (--json: JSON lines); query k walks with seed --seed + k - 1; the\n"
+    "                     guards, bounds and kernel rows are kept across them (docs/queries.md)\n"
     "  --method walks     the single method the options name, defaults for the rest (adjoint,\n"
     "                     collision, --continue analog, --alpha 1): the run before auto\n"
     "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
@@ -173,8 +178,9 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
                r->out_of_reach ? ", beyond the 1e9 cap: stopped" : "");
     else if (o->rel_err > 0)
         printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
-    printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
-           ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
+    printf("load            %.3f s inputs, %.3f s guards, %.3f s %s; peak memory %.0f MiB\n",
+           ro->load_seconds, ro->guard_seconds, ro->kernel_seconds,
+           ro->au ? "choice and solver set-up (auto's guards, pilots, set-up)" : "solver set-up", peak_rss_mib());
     if (ro->au) cli_auto_print_text(ro->au, ro->bc);
     if (ro->check)
         printf("direct          %.10g (LAPACK, %.4f s), z = %.3f\n", ro->direct, ro->direct_seconds,
@@ -331,6 +337,8 @@ typedef struct {
     ulam_auto_opts ao;    /* what the command line pins (--mode, --estimator, --continue) */
     ulam_analysis *an;    /* what queries on M share (a prepared system read lazily; NULL: none) */
     double max_seconds;   /* --time as given (o.max_seconds: what is left of it for the walks) */
+    const char *queries;  /* --queries FILE ("-": stdin; NULL: one query) */
+    int walks_given;      /* --walks or --time given */
 } solve_args;
 
 /* Parse argv into a; 0, or an exit code (-1: --help printed). */
@@ -350,7 +358,8 @@ static int parse(int argc, char **argv, solve_args *a)
         {"errors", required_argument, 0, 'E'},   {"help", no_argument, 0, 'h'},
         {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
         {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
-        {"method", required_argument, 0, 'U'},   {0, 0, 0, 0}};
+        {"method", required_argument, 0, 'U'},   {"queries", required_argument, 0, 'Q'},
+        {0, 0, 0, 0}};
     *a = (solve_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_walk_defaults(), .autom = 1,
                       .ao = ulam_auto_defaults()};
     a->o.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
@@ -382,13 +391,19 @@ static int parse(int argc, char **argv, solve_args *a)
         case 'A': a->assume_finite = 1; break;
         case 'o': a->out = optarg; break;
         case 'E': a->errors = optarg; break;
+        case 'Q': a->queries = optarg; break;
         case 'h': fputs(usage, stdout), fputs(usage2, stdout), fputs(usage3, stdout); return -1;
         default: return cli_usage_error("solve", "unknown option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (!a->s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("solve", "needs --rhs b.mtx");
-    if (!a->s.index && a->o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
+    if (a->queries && (a->s.index || a->o.mode != ULAM_ADJOINT || a->out || a->errors || a->check || a->s.jacobi))
+        return cli_usage_error("solve", "--queries takes the indices from its file, in adjoint mode (no --index, "
+                                        "--mode forward, --out, --errors, --check or --jacobi)");
+    a->walks_given = a->o.max_walks > 0 || a->o.max_seconds > 0;
+    if (!a->queries && !a->s.rhs_path && !ulam_system_is_file(argv[optind]))
+        return cli_usage_error("solve", "needs --rhs b.mtx");
+    if (!a->s.index && a->o.mode == ULAM_ADJOINT && !a->queries) return cli_usage_error("solve", "adjoint walks need --index I");
     if ((a->out || a->errors) && a->o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
     if (a->o.roulette > 0 && a->o.split > 0 && a->o.split <= a->o.roulette)
@@ -418,6 +433,19 @@ static int certified_auto(solve_args *a, ulam_guard *g)
     a->ao.pin_continue = a->ao.pin_alpha = a->ao.pin_mode = 1;
     a->ao.guard = g;
     return 0;
+}
+
+/* For a prepared system read only where walks go (s->lazy): the analysis its queries share
+ * (a->an), at the options' continuation and exponent, on the file's stored bounds and b; 0 or
+ * an exit code (no memory). */
+static int lazy_analysis(solve_args *a)
+{
+    cli_system *s = &a->s;
+    if (!s->lazy || !s->sys_M || a->an) return 0;
+    ulam_analysis_opts ao = ulam_analysis_defaults();
+    ao.continue_q = a->o.continue_q, ao.kernel_alpha = a->o.kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
+    ulam_error err;
+    return ulam_analysis_alloc(s->M, &ao, &a->an, &err) ? cli_report(s->matrix_path, &err) : 0;
 }
 
 /* What the command line pins that bidirectional cannot honour, in words (NULL: nothing). */
@@ -463,13 +491,14 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
         ulam_guard cg;
         ulam_walk_opts user = *o;
         const char *pinned = bidir_pinned(a);
-        if ((rc = certified_auto(a, &cg)) || (rc = cli_auto_choose(s, o, &a->ao, au, sv, &status, &err))) {
+        if ((rc = certified_auto(a, &cg)) || (rc = lazy_analysis(a)) ||
+            (rc = cli_auto_choose(s, a->an, o, &a->ao, au, sv, &status, &err))) {
             cli_system_free(s);
             return rc;
         }
         ro->au = au;
         ro->g = au->guard;
-        ro->kernel_seconds = ulam_now() - t0 - au->seconds;
+        ro->kernel_seconds = ulam_now() - t0; /* the choice's guards, pilots and set-up: all of it */
         if (!status) {
             ro->bc = bc;
             if ((rc = cli_bidir_consider(s, &user, pinned, au, bc))) {
@@ -489,11 +518,12 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
         o->guard = &ro->g;
         o->max_seconds = cli_time_left(a->max_seconds); /* and the guards */
         t0 = ulam_now();
-        if (s->lazy && s->sys_M) { /* the file's stored bounds: no pass over what the start can reach */
-            ulam_analysis_opts ao = ulam_analysis_defaults();
-            ao.continue_q = o->continue_q, ao.kernel_alpha = o->kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
-            status = ulam_analysis_alloc(s->M, &ao, &a->an, &err);
-            if (!status) status = ulam_analysis_solver(a->an, s->b, o, sv, &err);
+        if ((rc = lazy_analysis(a))) {
+            cli_system_free(s);
+            return rc;
+        }
+        if (a->an) { /* the file's stored bounds: no pass over what the start can reach */
+            status = ulam_analysis_solver(a->an, s->b, o, sv, &err);
             if (status) a->an = ulam_analysis_free(a->an);
         } else {
             status = ulam_solver_alloc(s->M, s->b, o, sv, &err); /* refuses what the guards refuse */
@@ -542,7 +572,10 @@ static int run(solve_args *a)
     cli_bidir_cand bc = {0};
     ulam_solver *sv = NULL;
     int rc = start(a, &ro, &au, &bc, &sv), status = ULAM_OK;
-    if (rc) return rc;
+    if (rc) {
+        a->an = ulam_analysis_free(a->an);
+        return rc;
+    }
     if (bc.state == 2) { /* auto chose bidirectional: its own report, with the choice */
         rc = cli_bidir_auto_run(&a->s, &bc, &au, ro.json, ro.check, ro.direct, ro.load_seconds);
         cli_bidir_cand_free(&bc);
@@ -603,5 +636,6 @@ int cli_solve(int argc, char **argv)
     if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv); /* src/cli/mcsa.c */
     solve_args a;
     int rc = parse(argc, argv, &a);
+    if (!rc && a.queries) return cli_queries(&a.s, &a.o, a.queries, a.json, a.walks_given); /* src/cli/queries.c */
     return rc < 0 ? 0 : rc ? rc : run(&a);
 }
