@@ -49,7 +49,9 @@ int ulam_analysis_alloc(const ulam_csr *M, const ulam_analysis_opts *opts, ulam_
     ulam_analysis *a = calloc(1, sizeof *a);
     if (!a) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for an analysis");
     a->M = M, a->continue_q = o.continue_q > 0 ? o.continue_q : 0.0, a->alpha = o.kernel_alpha;
-    a->b = o.b, a->sys = ulam_system_matrix(o.system) == M ? o.system : NULL;
+    const ulam_csr *mapped = NULL;
+    if (o.system) ulam_system_lazy(o.system, &mapped, NULL);
+    a->b = o.b, a->sys = mapped == M ? o.system : NULL;
     *out = a;
     return ULAM_OK;
 }
@@ -93,8 +95,8 @@ static const ulam__reach *take_bounds(ulam_analysis *a)
             a->bounds_from = 1;
             if (a->R.b && a->R.b == a->b) a->b_from = 1;
             else a->R.b = NULL;
-        } else if (!(a->seen = ulam__malloc((size_t)a->M->nrows, 1))) {
-            return NULL;
+        } else if ((a->sys && !ulam_system_matrix(a->sys)) || !(a->seen = ulam__malloc((size_t)a->M->nrows, 1))) {
+            return NULL; /* a damaged file (the pass would read all of it) or no memory: the solver searches */
         } else if (!ulam__reach_all(a->M, a->continue_q, a->alpha, a->seen, &a->R)) {
             a->bounds_from = 2;
         } else {
@@ -102,7 +104,10 @@ static const ulam__reach *take_bounds(ulam_analysis *a)
             return NULL;
         }
     }
-    if (a->b && !a->R.b && !ulam__reach_b(a->M, a->b, &a->R)) a->b_from = 2;
+    const double *sb = NULL;
+    if (a->sys) ulam_system_lazy(a->sys, NULL, &sb);
+    if (a->b && !a->R.b && (a->b != sb || ulam_system_rhs(a->sys, NULL)) && !ulam__reach_b(a->M, a->b, &a->R))
+        a->b_from = 2; /* (a file's b verified whole first: the pass reads all of it) */
     a->seconds += ulam_now() - t0;
     return &a->R;
 }
@@ -119,6 +124,7 @@ int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "the analysis' continuation %g and kernel exponent %g",
                           a->continue_q, a->alpha);
     o.continue_q = a->continue_q;
+    if (!o.system && a->sys) o.system = a->sys; /* the file's blocks verified as the walks reach them */
     int status;
     if (!o.guard) {
         if (o.mode != ULAM_ADJOINT && o.mode != ULAM_FORWARD) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a mode");
