@@ -40,6 +40,7 @@ static figures median_run(char *const argv[])
         f[k].setup = bench_json_number(out, "kernel_seconds"), f[k].walks = bench_json_number(out, "seconds");
         f[k].rows = bench_json_number(out, "kernel_rows"), f[k].estimate = bench_json_number(out, "estimate");
         f[k].stderr_ = bench_json_number(out, "stderr");
+        f[k].rss = bench_json_number(out, "peak_rss_mib"); /* the run's own (VmHWM): rusage's counts this process */
     }
     for (int a = 0; a < 3; a++)
         for (int b = a + 1; b < 3; b++)
