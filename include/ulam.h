@@ -762,6 +762,72 @@ int ulam_jacobi_n(const ulam_csr *A, const double *b, int64_t nb, double omega, 
 /* The walk cap of a run whose only rule is rel_err. */
 #define ULAM_REL_ERR_CAP 1000000000
 
+/* ---------------------------------------------------------------- analysis: many queries on one M */
+/* Secondary.  An analysis is what queries on one M share, built once for (M, continuation,
+ * kernel exponent) and held by the caller across queries, as CSparse's cs_sqr is across cs_lu
+ * calls: the guards' verdicts (a prepared system's certificate, else computed at the first
+ * query), the bounds the rel_err rule and absorption need over every state (a prepared file
+ * stores them, `ulam prepare`; else one pass over M at the first query that needs them), the
+ * scores of the b the queries share (opts.b), each estimator's walk kernel (the rows any earlier
+ * query built, kept while queries use that b), and M's transpose (made when first asked).  A
+ * query then reads only the rows its walks reach.  The bounds hold for every start, so they are
+ * at most as tight as a search of one start's reach would give (the rule may ask for more
+ * walks); an estimate still exactly 0 searches its start's reach as ulam_solver_alloc would. */
+typedef struct ulam_analysis ulam_analysis;
+
+/* What an analysis is made for.  Start from ulam_analysis_defaults(). */
+typedef struct ulam_analysis_opts {
+    size_t size;             /* sizeof (ulam_analysis_opts), set by ulam_analysis_defaults: a
+                                later version reads only the fields a caller's size holds */
+    double continue_q;       /* the walks' continuation (<= 0: analog) */
+    double kernel_alpha;     /* the kernel exponent (1) */
+    const double *b;         /* the right-hand side queries share (NULL: none); borrowed, and its
+                                values unchanged while the analysis lives */
+    const ulam_system *system; /* the prepared system M is mapped from (NULL: none): its
+                                certificate and stored bounds serve when made for this
+                                continuation and exponent */
+} ulam_analysis_opts;
+
+/* The defaults: analog continuation, exponent 1, no b, no system. */
+ulam_analysis_opts ulam_analysis_defaults(void);
+
+/* An analysis of square M (borrowed: it must outlive the analysis) under opts (NULL: the
+ * defaults).  O(1) work and memory here; what the queries need is made at the first that needs
+ * it.  ULAM_OK, ULAM_EINVAL, ULAM_ENOTSQUARE, ULAM_ENOMEM. */
+int ulam_analysis_alloc(const ulam_csr *M, const ulam_analysis_opts *opts, ulam_analysis **out, ulam_error *err);
+
+/* Free an analysis and everything it made; accepts and returns NULL.  Free every solver made on
+ * it first. */
+ulam_analysis *ulam_analysis_free(ulam_analysis *a);
+
+/* A solver for one query on a's M (as ulam_solver_alloc, whose refusals it shares), using what
+ * a holds: opts->continue_q and kernel_alpha must be a's (ULAM_EINVAL otherwise); opts->guard,
+ * when NULL, is a's.  Adjoint queries with b = a's b walk on a's kept kernel for their estimator
+ * (one solver on it at a time: free it before the next); other b and forward mode get a kernel
+ * of their own.  The same seed gives the same walks as ulam_solver_alloc (the bounds, and so a
+ * rel_err run's length, may differ). */
+int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_solver **out,
+                         ulam_error *err);
+
+/* One query to its end (ulam_analysis_solver, iterate, report, free): as ulam_solve. */
+int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_walk_result *result,
+                        ulam_error *err);
+
+/* M's transpose, made at the first call and kept (NULL: no memory, err filled). */
+const ulam_csr *ulam_analysis_transpose(ulam_analysis *a, ulam_error *err);
+
+/* What an analysis holds so far. */
+typedef struct ulam_analysis_info {
+    int bounds;          /* 0 none yet, 1 read from a prepared file, 2 computed by a pass over M */
+    int b_scores;        /* the shared b's scores: 0 none, 1 stored, 2 computed */
+    int guard;           /* the guards: 0 none yet, 1 from a certificate, 2 computed */
+    int64_t kernel_rows; /* rows built in the kept kernels */
+    double seconds;      /* spent making the bounds, b's scores, guards and transpose */
+} ulam_analysis_info;
+
+/* Fill info (see ulam_analysis_info). */
+void ulam_analysis_get_info(const ulam_analysis *a, ulam_analysis_info *info);
+
 /* ---------------------------------------------------------------- outer iterations */
 /* All secondary. */
 
@@ -1304,6 +1370,26 @@ ulam_run *ulam_run_free(ulam_run *r);
  * (ULAM_METHOD_WALKS: ulam_solve's run, bit for bit). */
 int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
               const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err);
+
+/* As ulam_auto_solver for M = a's M, its candidates of a's kernel (adjoint, a's continuation and
+ * exponent) walking under a's bounds over every state (a prepared file's, or one pass over M)
+ * rather than each searching its start's reach; ao->guard, when NULL and ao pins a's
+ * continuation, exponent and adjoint mode, is a's.  The same choice as ulam_auto_solver where
+ * those bounds equal the start's (a start that reaches every state). */
+int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                       ulam_auto_result *res, ulam_solver **out, ulam_error *err);
+
+/* A's push workspace on M for point-source queries (ulam_bidir_solve with
+ * ulam_analysis_transpose(a)), made at the first call and kept, so that the walks' bounds and
+ * kernel rows later queries reuse (ulam_bidir_opts.reach_all, keep_kernel) stay with the
+ * analysis; NULL: no memory (err filled). */
+ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err);
+
+/* As ulam_auto_start for M = a's M: the walks row's candidates of a's kernel walk under a's bounds
+ * over every state (as ulam_analysis_auto), the other rows as ulam_auto_start; the run borrows a
+ * (free the run first). */
+int ulam_analysis_auto_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                             const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
 /* All tertiary. */

@@ -47,7 +47,18 @@ typedef struct {
     int nq, na;
     double qs[2], as[3];
     int leader;
+    const ulam__reach *reach;       /* bounds over every state for one kernel (an analysis'; NULL: none) */
 } chooser;
+
+/* A solver for o, on the caller's bounds when they were made for its kernel (adjoint, this
+ * continuation and exponent): its set-up then reads no more than its walks do. */
+static int alloc_solver(const chooser *c, const ulam_walk_opts *o, ulam_solver **out, ulam_error *err)
+{
+    const ulam__reach *R = c->reach;
+    int fits = R && o->mode == ULAM_ADJOINT && (o->continue_q > 0 ? o->continue_q : 0.0) == R->continue_q &&
+               o->kernel_alpha == R->alpha;
+    return ulam__solver_alloc_reached(c->M, c->b, o, fits ? R : NULL, NULL, out, err);
+}
 
 /* The default options. */
 ulam_auto_opts ulam_auto_defaults(void)
@@ -236,7 +247,7 @@ static int pilot(chooser *c, int k, int stage, int64_t n)
     ulam_auto_candidate *a = &c->res->cand[k];
     group *g = &c->g[c->gi[k]];
     ulam_walk_opts o = pilot_opts(c, k, stage, n);
-    int status = g->sv ? ulam__solver_rerun(g->sv, &o, NULL) : ulam_solver_alloc(c->M, c->b, &o, &g->sv, NULL);
+    int status = g->sv ? ulam__solver_rerun(g->sv, &o, NULL) : alloc_solver(c, &o, &g->sv, NULL);
     g->started = g->sv != NULL;
     if (g->sv) ulam__solver_setup(g->sv, &g->units, &g->reads);
     if (status == ULAM_ENOMEM) return status;
@@ -441,6 +452,13 @@ static void free_groups(chooser *c, int kept)
 int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
                      ulam_auto_result *res, ulam_solver **out, ulam_error *err)
 {
+    return ulam__auto_solver_reach(M, b, base, ao, NULL, res, out, err);
+}
+
+/* As ulam_auto_solver on the caller's bounds over every state for one kernel (see internal.h). */
+int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                            const ulam__reach *reach, ulam_auto_result *res, ulam_solver **out, ulam_error *err)
+{
     ulam__clear(err);
     if (out) *out = NULL;
     ulam_auto_opts a = ao ? *ao : ulam_auto_defaults();
@@ -452,7 +470,7 @@ int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *b
     double t0 = ulam_now();
     chooser *c = calloc(1, sizeof *c);
     if (!c) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the choice");
-    c->M = M, c->b = b, c->base = *base, c->a = a, c->res = res, c->leader = -1;
+    c->M = M, c->b = b, c->base = *base, c->a = a, c->res = res, c->leader = -1, c->reach = reach;
     c->qs[0] = a.pin_continue ? base->continue_q : 0.0, c->qs[1] = a.continue_q;
     c->nq = a.pin_continue ? 1 : 2;
     c->as[0] = a.pin_alpha ? base->kernel_alpha : 1.0, c->as[1] = 0.0, c->as[2] = 2.0;
@@ -479,7 +497,7 @@ int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *b
             status = ulam__solver_rerun(g->sv, &o, err);
             if (!status) *out = g->sv, g->sv = NULL;
         } else {
-            status = ulam_solver_alloc(M, b, &o, out, err);
+            status = alloc_solver(c, &o, out, err);
         }
     }
     free_groups(c, -1);

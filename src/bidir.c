@@ -120,6 +120,7 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
            (b->nb > 0 || a->source == b->source) && a->rmax == b->rmax && a->min_value == b->min_value &&
            a->max_push_ops == b->max_push_ops && step_cost(a) == step_cost(b) && x->seed == y->seed &&
            x->rel_err == y->rel_err && x->max_walks == y->max_walks && x->continue_q == y->continue_q &&
+           x->kernel_alpha == y->kernel_alpha && x->estimator == y->estimator &&
            x->roulette == y->roulette && x->split == y->split && x->max_steps == y->max_steps &&
            x->force == y->force && x->assume_finite == y->assume_finite && x->guard == y->guard;
 }

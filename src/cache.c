@@ -14,8 +14,13 @@
  *   word  15     byte offset of the checksum table (XXH3-64 of each block: M's, b's, M^T's)
  *   word  16     XXH3-64 of the checksum table
  *   words 17-19  byte offsets of M^T's rowptr int64[ncols + 1], colidx int32[nnz], val double[nnz]
- *   words 32-126 the certificate section: word 32 its version (3) | its bytes << 32, then
+ *   words 32-95  the certificate section: word 32 its version (3) | its bytes << 32, then
  *                version 3's fields (see put_cert), the first the content hash of M's blocks
+ *   words 96-126 the bounds extension (a section of its own, versioned apart, written and
+ *                trusted only with the certificate, which binds M): word 96 its version (1) |
+ *                its bytes << 32, then the walk kernel's bounds over every state and b's scores
+ *                (see put_bounds); 0 when absent, and a reader that does not know its version
+ *                ignores it
  *   word  127    XXH3-64 of bytes 0 .. 1015
  *
  * Opening checks the header, the checksum table and the certificate's binding, and reads no
@@ -45,6 +50,7 @@ enum {
     W_FLAGS = 2, W_DIMS = 3, W_OFF = 6, W_LEN = 10, W_TAG = 11, W_OMEGA = 13, W_SHIFT = 14, W_SUMS = 15,
     W_SUMS_HASH = 16, W_TOFF = 17,
     W_CERT = 32, W_SUM = WORDS - 1, CERT_VERSION = 3, CERT_WORDS = 37,
+    W_BOUNDS = 96, BOUNDS_VERSION = 1, BOUNDS_WORDS = 16,
     BLOCK_ENTRIES = 1024 /* entries a block aims at: a few pages of colidx and val */
 };
 static const char MAGIC[8] = {'u', 'l', 'a', 'm', 'S', 'Y', 'S', '1'};
@@ -68,6 +74,8 @@ struct ulam_system {
     int64_t first[3];      /* each part's first entry in sums[] and state[] */
     const uint64_t *sums;  /* the checksum table */
     _Atomic unsigned char *state; /* one a block, as sums[] */
+    int has_bounds;
+    ulam__reach bounds;    /* the bounds extension (seen and K unset) */
     void *map;             /* the mapping (NULL: borrowed memory) */
     size_t map_bytes;
 };
@@ -155,6 +163,47 @@ static int get_cert(const uint64_t *w, ulam_certificate *c, uint64_t *content)
     c->guard.continue_q = c->continue_q;
     c->guard.kernel_alpha = 1.0; /* certificates are made at kernel exponent 1 (ulam_certificate_compute) */
     return 1;
+}
+
+/* The bounds extension, version 1, from word 96: the continuation and exponent they were made
+ * for, the largest weight factor, continuation and weight growth, the length tail's u and kappa,
+ * flags (1 K has a negative entry, 2 tail certified, 4 b's scores present, 8 b has a positive
+ * entry, 16 a negative one), then b's bmax, kbmax, gabs, g2abs and bad (ulam__reach's fields). */
+static void put_bounds(uint64_t *w, const ulam__reach *R)
+{
+    w[0] = (uint64_t)BOUNDS_VERSION | (uint64_t)(BOUNDS_WORDS * 8) << 32;
+    w[1] = bits(R->continue_q), w[2] = bits(R->alpha), w[3] = bits(R->fbig), w[4] = bits(R->qmax);
+    w[5] = bits(R->growth), w[6] = bits(R->tail_u), w[7] = bits(R->kappa);
+    w[8] = (uint64_t)(R->neg ? 1 : 0) | (R->tail ? 2 : 0) | (R->b ? 4 : 0) | (R->bpos ? 8 : 0) | (R->bneg ? 16 : 0);
+    w[9] = bits(R->bmax), w[10] = bits(R->kbmax), w[11] = bits(R->gabs), w[12] = bits(R->g2abs);
+    w[13] = (uint64_t)R->bad;
+}
+
+/* Read the bounds extension into R (b: the file's b, which its scores are of); 0 when absent, of
+ * another version or inconsistent. */
+static int get_bounds(const uint64_t *w, const double *b, int64_t n, ulam__reach *R)
+{
+    if (w[0] != ((uint64_t)BOUNDS_VERSION | (uint64_t)(BOUNDS_WORDS * 8) << 32) || w[8] > 31) return 0;
+    *R = (ulam__reach){.bounds = 1, .continue_q = real(w[1]), .alpha = real(w[2]), .fbig = real(w[3]),
+                       .qmax = real(w[4]), .growth = real(w[5]), .tail_u = real(w[6]), .kappa = real(w[7]),
+                       .neg = (w[8] & 1) != 0, .tail = (w[8] & 2) != 0, .bpos = (w[8] & 8) != 0,
+                       .bneg = (w[8] & 16) != 0, .bmax = real(w[9]), .kbmax = real(w[10]), .gabs = real(w[11]),
+                       .g2abs = real(w[12]), .bad = (int64_t)w[13]};
+    if ((w[8] & 4) && b) R->b = b;
+    else R->bmax = R->kbmax = R->gabs = R->g2abs = INFINITY, R->bad = -1;
+    return R->continue_q >= 0 && R->qmax >= 0 && R->fbig >= 0 && R->growth >= 1 && R->bad >= -1 && R->bad < n;
+}
+
+/* The bounds of d's M (and scores of its b) at its certificate's continuation and exponent 1,
+ * into the header words w; nothing when they cannot be made (a corrupt row, no memory). */
+static void make_bounds(const ulam_system_desc *d, uint64_t *w)
+{
+    char *seen = ulam__malloc((size_t)d->M->nrows, 1);
+    ulam__reach R;
+    if (seen && !ulam__reach_all(d->M, d->cert->continue_q, 1.0, seen, &R) &&
+        (!d->b || !ulam__reach_b(d->M, d->b, &R)))
+        put_bounds(w, &R);
+    free(seen);
 }
 
 /* Round x up to the alignment. */
@@ -278,6 +327,7 @@ int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
     w[W_SHIFT] = (uint64_t)shift;
     w[W_SUMS_HASH] = hash(sums, nsums * 8);
     if (d->cert) put_cert(w + W_CERT, d->cert, hash(sums, (size_t)nb[0] * 8));
+    if (d->cert && M && M->nrows == M->ncols) make_bounds(d, w + W_BOUNDS);
     w[W_SUM] = hash(w, (size_t)W_SUM * 8);
     uint64_t pos = 0;
     int ok = put_part(f, w, HEADER, &pos);
@@ -380,6 +430,7 @@ static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam
     if (s->has_cert && content != hash(sums, (size_t)nb[0] * 8))
         return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a certificate bound to the file's matrix (its content hash "
                           "differs: the arrays were replaced)");
+    s->has_bounds = s->has_cert && m && nc == n && get_bounds(w + W_BOUNDS, s->b, (int64_t)n, &s->bounds);
     return ULAM_OK;
 }
 
@@ -593,6 +644,16 @@ const ulam_csr *ulam_system_transpose(const ulam_system *s)
 const ulam_certificate *ulam_system_certificate(const ulam_system *s)
 {
     return s && s->has_cert ? &s->cert : NULL;
+}
+
+/* The bounds extension of s for its matrix at continuation continue_q and kernel exponent alpha
+ * (R->seen unset: every state): 1 when the file holds them, else 0 (see internal.h). */
+int ulam__system_bounds(const ulam_system *s, double continue_q, double alpha, ulam__reach *R)
+{
+    if (!s || !s->has_bounds || s->bounds.continue_q != fmax(continue_q, 0.0) || s->bounds.alpha != alpha) return 0;
+    *R = s->bounds;
+    R->K = &s->csr;
+    return 1;
 }
 
 /* The Jacobi damping of the stored M. */

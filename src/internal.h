@@ -120,12 +120,25 @@ typedef struct ulam__reach {
     double fbig, qmax, growth;
     int neg, tail;
     double tail_u, kappa;
+    /* the scores of one b over every state (ulam__reach_b; b NULL: none): the largest |b_i|
+       (bmax), |(K b)_i| (kbmax), absorption's |b_i| / p*_i and b_i^2 / p*_i where b_i != 0
+       (gabs, g2abs; INFINITY where p*_i = 0), its first such state with p*_i = 0 (bad, -1:
+       none), and b's signs (bpos, bneg) */
+    const double *b;
+    double bmax, kbmax, gabs, g2abs;
+    int64_t bad;
+    int bpos, bneg;
 } ulam__reach;
 
 /* The reach of every state of K at continuation continue_q and exponent alpha with its bounds;
  * seen: n bytes of room, set to all ones (borrowed by R).  ULAM_OK, ULAM_ENOMEM, ULAM_ESYNTAX
  * (a corrupt row), ULAM_ERANGE (alpha's probabilities underflow). */
 int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *seen, ulam__reach *R);
+
+/* Add to R (made by ulam__reach_all for K, or read from a prepared file) the scores of b (n
+ * entries, borrowed by R) over every state, so that a solver given R and this b reads neither K
+ * nor b before walking: one pass over K and b.  ULAM_OK, or ULAM_EINVAL when R is not K's. */
+int ulam__reach_b(const ulam_csr *K, const double *b, ulam__reach *R);
 
 /* As ulam_solver_alloc (adjoint) with reach (borrowed until the solver is freed; NULL: search)
  * and kernel (NULL, or one of ulam__solver_keep_kernel, borrowed likewise)
@@ -145,7 +158,8 @@ int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_wa
 struct ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s);
 
 /* As ulam__solver_keep_kernel for a b whose values the caller keeps as they are, passed again to
- * every later solver on the kernel: rescoring is then nothing at all. */
+ * every later solver on the kernel: rescoring is then nothing at all, nothing is recorded (O(1)),
+ * and the expected estimator's kernel keeps too. */
 struct ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s);
 
 /* The states a solver's walks can reach (n flags; NULL unless its reachability check ran). */
@@ -154,6 +168,29 @@ const char *ulam__solver_reached(const ulam_solver *s);
 /* The walk solver builds the rest of its kernel at once when walks have built 1 / ULAM__COMPLETE
  * of it row by row (src/solve.c: the rent-or-buy rule); the choice's work models predict it. */
 enum { ULAM__COMPLETE = 4 };
+
+/* The bounds a prepared system stores for its matrix (ulam__reach_all's, with b's scores when
+ * the file holds b) when made for continuation continue_q and exponent alpha: 1 and R filled
+ * (R->K its matrix, R->seen NULL: the caller gives n flags of ones), else 0 (src/cache.c). */
+int ulam__system_bounds(const ulam_system *s, double continue_q, double alpha, ulam__reach *R);
+
+/* As ulam_auto_solver, with reach (NULL: none; borrowed until the solver is freed) the bounds
+ * over every state of M (ulam__reach_all's, with b's scores when they are this b's) that the
+ * candidates of its kernel (adjoint, its continuation and exponent) walk under instead of each
+ * searching its start's reach (src/auto.c; ulam_analysis_auto). */
+int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                            const ulam__reach *reach, ulam_auto_result *res, ulam_solver **out, ulam_error *err);
+
+/* Iterate s until a stopping rule holds, fill result (may be NULL) and, on failure, err; free s.
+ * The status (src/solve.c: the rest of ulam_solve). */
+int ulam__solver_finish(ulam_solver *s, ulam_walk_result *result, ulam_error *err);
+
+/* As ulam_auto_start, with reach (NULL: none; borrowed until the run is freed) the bounds over
+ * every state the walks row's candidates of its kernel walk under (ulam__auto_solver_reach; src/method.c,
+ * ulam_analysis_auto_start). */
+int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                           const ulam_method_opts *mo, const ulam__reach *reach, ulam_choice *ch, ulam_run **out,
+                           ulam_error *err);
 
 /* A check of rows [first, last) of a borrowed matrix (and, with with_b, of b at those rows) made
  * before anything reads them: ULAM_OK, or ULAM_ESYNTAX with *bad (may be NULL) the first row of the

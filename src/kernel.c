@@ -225,10 +225,12 @@ int ulam__kernel_rescore(ulam_kernel *k, int estimator)
     int status = atomic_load(&k->status);
     if (status) return status;
     k->scores.estimator = estimator;
-    for (int64_t i = 0; i < k->n; i++) {
-        int32_t v = atomic_load_explicit(&k->where[i], memory_order_relaxed);
-        if (v <= 0 || v - 1 >= k->cap) continue; /* not built (or the dead row) */
-        ulam__row *h = ulam__kernel_row(k, v - 1);
+    int64_t top = atomic_load(&k->top);
+    for (int64_t u = 0; u < top; u += ULAM__HEAD + row_outcomes(k->K, ulam__kernel_row(k, u)->state)) {
+        /* the built rows one after another in the arena (not where[]: its n entries, untouched pages
+           too, would cost a query O(n)); a failed build ended the loop above through k->status */
+        ulam__row *h = ulam__kernel_row(k, u);
+        int64_t i = h->state;
         row_scores(k, i, 1.0 - ulam__continuation(row_sum(k->K, i), k->continue_q), &h->visit, &h->end);
         if (!isfinite(h->visit) || !isfinite(h->end)) {
             fail(k, ULAM_ENONFINITE, i);
@@ -478,7 +480,7 @@ int ulam__kernel_keep(ulam_kernel *k)
 /* Give a kept kernel's rows the scores of b (see kernel.h). */
 int ulam__kernel_rescore_b(ulam_kernel *k, const double *b)
 {
-    if (!k->scored || atomic_load(&k->status)) return ULAM_EINVAL;
+    if ((!k->scored && !k->fixed) || atomic_load(&k->status)) return ULAM_EINVAL;
     if (b == k->scores.b && k->fixed) return ULAM_OK; /* the same scores: nothing to do */
     if (k->fixed) return ULAM_EINVAL;
     k->scores.b = b;

@@ -27,6 +27,7 @@ typedef struct ulam__query {
     const ulam_method_opts *mo; /* the rows' pin and exclusions */
     ulam_choice *ch;
     ulam_run *run;
+    const ulam__reach *reach; /* the walks' bounds over every state (an analysis's), or NULL */
 } ulam__query;
 
 /* A row of the table (GSL's gsl_root_fsolver_type): its name, what it answers, its applicability

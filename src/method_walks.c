@@ -16,7 +16,7 @@ static int applies(const ulam__query *q, int k, char *why, size_t len)
 static int predict(ulam__query *q, int k, ulam_error *err)
 {
     ulam_choice *ch = q->ch;
-    int status = ulam_auto_solver(q->M, q->b, q->o, q->ao, &ch->walks, &q->run->sv, err);
+    int status = ulam__auto_solver_reach(q->M, q->b, q->o, q->ao, q->reach, &ch->walks, &q->run->sv, err);
     const ulam_auto_result *au = &ch->walks;
     if (au->chosen >= 0) ch->leader_work = ch->method[k].predicted_work = au->cand[au->chosen].predicted_work;
     int c = au->chosen >= 0 ? au->chosen : au->closest;

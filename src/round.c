@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+enum { TEAM_BLOCKS = 4 }; /* blocks a thread a round must have before a round takes a team */
+
 /* One process. */
 ulam_share ulam_share_defaults(void)
 {
@@ -139,7 +141,11 @@ int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64
     int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX, done = next / B->block;
     int round = done + 1 < B->round ? (int)(done + 1) : B->round, n = 0;
     while (n < round && left > (int64_t)n * B->block) n++;
-    int team = threads < n ? threads : n; /* a round of one block runs on the calling thread */
+    /* A team only for rounds of at least TEAM_BLOCKS blocks a thread: a small round (the first
+       ones, a small query) runs on the calling thread, which would otherwise wait at the round's
+       end for a worker to be scheduled: on a busy machine a time slice or more, 40-100x the walks
+       of a 4096-walk query (issue 29 point 5; the results do not depend on the team) */
+    int team = n >= TEAM_BLOCKS * threads ? threads : 1;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(team) if (team > 1)
     for (int k = 0; k < n; k++) {
         int64_t rest = left - (int64_t)k * B->block;

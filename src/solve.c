@@ -375,14 +375,30 @@ static void count_reached(ulam_solver *s, const ulam_csr *K)
         if (s->reached[i]) s->reach_nnz += K->rowptr[i + 1] - K->rowptr[i];
 }
 
+/* The reachable states as flags: the caller's every-state bounds may come without them (a
+ * prepared file's, R->seen NULL), made here (n ones, kept in s->seen) only for a pass that reads
+ * them; ULAM_OK or ULAM_ENOMEM. */
+static int reached_flags(ulam_solver *s, ulam_error *err)
+{
+    if (s->reached) return ULAM_OK;
+    int status = verify_all(s->M, &s->o, &s->rc, err); /* the pass that wants them reads every row */
+    if (status) return status;
+    if (!(s->seen = ulam__malloc((size_t)s->n, 1))) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
+    memset(s->seen, 1, (size_t)s->n);
+    s->reached = s->seen;
+    return ULAM_OK;
+}
+
 /* The states walks can reach (s->reached: searched once and kept in s->seen, or the caller's)
  * and their entries (s->reach_nnz). */
 static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
     if (s->reached) return ULAM_OK;
-    if (s->given) { /* the caller's reach (an earlier solver's search, or ulam__reach_all), read where it is */
+    if (s->given) { /* the caller's reach (an earlier solver's search, or ulam__reach_all), read where it is;
+                       NULL with every-state bounds: every state (reached_flags makes the flags if needed) */
         s->reached = s->given->seen;
         if (given_bounds(s, K)) s->reach_nnz = K->rowptr[K->nrows]; /* every state's (ulam__reach_all): not counted */
+        else if (!s->reached) return reached_flags(s, err);
         else count_reached(s, K);
         return ULAM_OK;
     }
@@ -420,9 +436,12 @@ static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
  * one of them run. */
 static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
-    const char *seen = s->reached;
     const ulam__reach *given = given_bounds(s, K);
     int adj = s->o.mode == ULAM_ADJOINT, only = given ? s->o.estimator : -1;
+    int summary = given && adj && given->b && given->b == s->b; /* b's scores over every state: read nothing */
+    int status = summary ? ULAM_OK : reached_flags(s, err);
+    if (status) return status;
+    const char *seen = s->reached;
     double *fac = NULL; /* kernel exponent != 1: each move's own weight factor (kept: s->fac) */
     if (!given && s->o.kernel_alpha != 1.0 &&
         !(fac = s->fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
@@ -432,7 +451,11 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     int64_t bad = -1, reads = 0;
     double w0 = 1.0, fbig = given ? given->fbig : 0.0, gabs = 0.0, g2abs = 0.0, vb = 0.0, vexp = 0.0;
     double qmax = given ? given->qmax : 0.0;
-    for (int64_t i = 0; i < s->n; i++) {
+    if (summary) {
+        only = -1, vb = given->bmax, vexp = given->kbmax, gabs = given->gabs, g2abs = given->g2abs;
+        bad = given->bad, any = given->bmax > 0, pos = given->bpos, neg |= given->bneg;
+    }
+    for (int64_t i = 0; !summary && i < s->n; i++) {
         if (!seen[i] || (given && only != ULAM_EXPECTED && s->b[i] == 0.0)) continue; /* scores nothing here */
         double S = need_q ? row_sum(K, i) : 0.0, q = need_q ? ulam__continuation(S, s->o.continue_q) : 0.0, c = 0.0;
         if (need_q || need_c) reads += K->rowptr[i + 1] - K->rowptr[i];
@@ -508,12 +531,14 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     if (s->o.rel_err > 0 && vmax > 0 && (!(s->pass_qmax < 1.0) || !isfinite(Wmax))) {
         if (!s->tail_done && given && given->tail) /* the caller's certificate over the same states */
             s->tail_uc = given->tail_u, s->tail_kc = given->kappa, s->tail_done = 1;
+        if (!s->tail_done && (status = reached_flags(s, err))) return status;
         if (!s->tail_done) /* kappa enters by its log */
             length_tail(K, s->reached, s->o.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
         s->tail_u = s->tail_uc, s->kappa = s->tail_kc;
     }
     if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
         (absorb ? isfinite(s->pass[e].g2max) : isfinite(vmax))) {
+        if (!s->v2_done[e] && (status = reached_flags(s, err))) return status;
         if (!s->v2_done[e] && s->o.kernel_alpha != 1.0 && !s->fac &&
             !(s->fac = move_factors(K, s->reached, s->o.continue_q, s->o.kernel_alpha))) /* given bounds: not made */
             return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
@@ -536,7 +561,7 @@ int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *se
 {
     memset(seen, 1, (size_t)K->nrows);
     *R = (ulam__reach){.seen = seen, .bounds = 1, .K = K, .continue_q = fmax(continue_q, 0.0), .alpha = alpha,
-                       .tail_u = 1.0, .kappa = INFINITY};
+                       .tail_u = 1.0, .kappa = INFINITY, .bad = -1};
     int status = ulam__kernel_reach(K, continue_q, seen, NULL, NULL); /* every row checked */
     if (status) return status;
     double *fac = NULL;
@@ -549,6 +574,30 @@ int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *se
         R->tail = 1;
     }
     free(fac);
+    return ULAM_OK;
+}
+
+/* The scores of b over every state of K (see internal.h): bounds_pass's per-state quantities at
+ * every state, as a pass over a reach of every state would find them. */
+int ulam__reach_b(const ulam_csr *K, const double *b, ulam__reach *R)
+{
+    if (!K || !b || !R || !R->bounds || R->K != K) return ULAM_EINVAL;
+    double bmax = 0.0, kbmax = 0.0, gabs = 0.0, g2abs = 0.0;
+    int64_t bad = -1;
+    int pos = 0, neg = 0;
+    for (int64_t i = 0; i < K->nrows; i++) {
+        double S = 0.0, c = 0.0, g = fabs(b[i]);
+        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) S += fabs(K->val[k]), c += K->val[k] * b[K->colidx[k]];
+        double q = ulam__continuation(S, R->continue_q);
+        bmax = fmax(bmax, g), kbmax = fmax(kbmax, fabs(c));
+        pos |= b[i] > 0, neg |= b[i] < 0;
+        if (g == 0.0) continue;
+        if (q >= 1.0 && bad < 0) bad = i;
+        gabs = fmax(gabs, q < 1.0 ? g / (1.0 - q) : INFINITY);
+        g2abs = fmax(g2abs, q < 1.0 ? g * g / (1.0 - q) : INFINITY);
+    }
+    R->b = b, R->bmax = bmax, R->kbmax = kbmax, R->gabs = gabs, R->g2abs = g2abs, R->bad = bad;
+    R->bpos = pos, R->bneg = neg;
     return ULAM_OK;
 }
 
@@ -823,7 +872,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     if (status) return status;
     ulam__rows_check rc = {0};
     if (o.system && (status = ulam__system_rows_check(o.system, M, b, &rc, err))) return status;
-    if ((o.mode == ULAM_FORWARD || o.whole_kernel || reach) && (status = verify_all(M, &o, &rc, err)))
+    if ((o.mode == ULAM_FORWARD || o.whole_kernel || (reach && reach->seen)) && (status = verify_all(M, &o, &rc, err)))
         return status; /* these read all of M (and forward, all of b) */
     if ((status = check_split(M, b, &o, err))) return status;
     if (o.mode == ULAM_FORWARD && (status = ulam__csr_check_structure(M, err))) /* src/check.c: M' is made */
@@ -931,9 +980,9 @@ ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s)
 /* The solver's kernel, kept for later solvers with the same b, unchanged (see internal.h). */
 ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s)
 {
-    ulam_kernel *k = ulam__solver_keep_kernel(s);
-    if (k) k->fixed = 1;
-    return k;
+    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || atomic_load(&s->k->status)) return NULL;
+    s->k_borrowed = 1, s->k->fixed = 1; /* nothing recorded: only this b, unchanged, rescores (a no-op) */
+    return s->k;
 }
 
 /* The states the solver's walks can reach (NULL unless its reachability check ran). */
@@ -1214,7 +1263,13 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
 {
     ulam_solver *s = NULL;
     int status = ulam_solver_alloc(M, b, opts, &s, err);
-    if (status) return status;
+    return status ? status : ulam__solver_finish(s, result, err);
+}
+
+/* Iterate s until done, report into result (may be NULL) and err, free s; the status. */
+int ulam__solver_finish(ulam_solver *s, ulam_walk_result *result, ulam_error *err)
+{
+    int status = ULAM_OK;
     while (!status && !ulam_solver_done(s)) status = ulam_solver_iterate(s);
     if (result) ulam_solver_result(s, result);
     if (status) ulam_solver_error(s, err);

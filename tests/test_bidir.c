@@ -241,6 +241,10 @@ static void test_bidir_plan(void **state)
     assert_true(ref.plan.rmax == plan.rmax && ref.plan.push.ops == plan.push.ops && ref.walks.walks == res.walks.walks);
     assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK); /* still the plan in place */
     assert_true(res.plan_reused);
+    o.walk.kernel_alpha = 2.0; /* another kernel exponent: its walks' plan is another (issue 29) */
+    int st = ulam_bidir_solve(w, Mt, &o, &res, &err);
+    assert_true(st != ULAM_OK || !res.plan_reused);
+    o.walk.kernel_alpha = 1.0;
     o.walk.seed = 2; /* another pilot: plan again */
     assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
     assert_false(res.plan_reused);

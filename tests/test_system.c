@@ -3,6 +3,7 @@
  * when a walk reaches them, and a query that reads no page of rows its walks do not reach. */
 #include "testutil.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <string.h>
 #include <sys/mman.h>
@@ -233,6 +234,17 @@ static void protect(unsigned char *p, size_t lo, size_t hi)
     if (hi > lo) assert_int_equal(mprotect(p + lo, hi - lo, PROT_NONE), 0);
 }
 
+/* The bytes of a prepared file of d in page-aligned memory (munmap it), *len bytes. */
+static unsigned char *mapped_bytes(const ulam_system_desc *d, size_t *len)
+{
+    unsigned char *bytes = file_bytes(d, len);
+    unsigned char *p = mmap(NULL, *len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    assert_true(p != MAP_FAILED);
+    memcpy(p, bytes, *len);
+    free(bytes);
+    return p;
+}
+
 /* A query on a mapped file reads no page of the rows its walks cannot reach: those pages are
  * made unreadable, and an adjoint run from block 0 still completes (a read would fault).  Its
  * estimate is that of the parsed matrix, bit for bit. */
@@ -245,11 +257,7 @@ static void test_lazy_pages(void **state)
     for (int64_t i = 0; i < n; i++) b[i] = 1.0 + (double)(i % 7);
     ulam_system_desc d = {.M = M, .b = b, .n = n};
     size_t len;
-    unsigned char *bytes = file_bytes(&d, &len);
-    unsigned char *p = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    assert_true(p != MAP_FAILED);
-    memcpy(p, bytes, len);
-    free(bytes);
+    unsigned char *p = mapped_bytes(&d, &len);
     size_t off[4] = {word(p, 6), word(p, 7), word(p, 8), word(p, 9)}, sz[4] = {8, 16, 32, 8};
     for (int k = 0; k < 4; k++) /* rows far .. n-1, keeping rowptr[n] */
         protect(p, off[k] + (size_t)far * sz[k], off[k] + (size_t)(n - (k == 0)) * sz[k]);
@@ -351,6 +359,97 @@ static void test_corrupt_rows(void **state)
     free(good);
     ulam_csr_free(M);
     free(b);
+}
+
+/* A chain of n states, M_{i,i-1} = M_{i,i+1} = 0.25 (ends: one neighbour): every state reaches
+ * every other, while a walk (mean length under 2) rarely goes 30 states from its start. */
+static ulam_csr *chain(int64_t n)
+{
+    ulam_csr *M = ulam_csr_alloc(n, n, 2 * n);
+    int64_t q = 0;
+    for (int64_t i = 0; i < n; i++) {
+        if (i > 0) M->colidx[q] = (int32_t)(i - 1), M->val[q++] = 0.25;
+        if (i + 1 < n) M->colidx[q] = (int32_t)(i + 1), M->val[q++] = 0.25;
+        M->rowptr[i + 1] = q;
+    }
+    return M;
+}
+
+/* Issue 29, point 1: a rel_err query (and absorption's) from a prepared file reads only the rows
+ * its walks reach, though the start reaches every state: the file's stored bounds serve the rule
+ * (rows far from the start made unreadable: a pass over the reach would fault).  Through an
+ * analysis on the file, the same seed gives the same walks as one on the parsed system (whose
+ * bounds a pass computes: the stored ones round-trip), the estimate is within 4 standard errors
+ * of the exact one, and later queries reuse the kept kernel, bit for bit a fresh analysis' answer. */
+static void test_analysis_local(void **state)
+{
+    (void)state;
+    const int64_t n = 8192, far = 2048;
+    ulam_csr *M = chain(n);
+    double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
+    for (int64_t i = 0; i < n; i++) b[i] = 1.0 + (double)(i % 7);
+    ulam_certificate cert;
+    assert_int_equal(ulam_certificate_compute(M, 0.0, NULL, &cert, NULL), ULAM_OK);
+    ulam_system_desc d = {.M = M, .b = b, .n = n, .cert = &cert};
+    size_t len;
+    unsigned char *p = mapped_bytes(&d, &len);
+    size_t off[4] = {word(p, 6), word(p, 7), word(p, 8), word(p, 9)}, sz[4] = {8, 8, 16, 8};
+    for (int k = 0; k < 4; k++) /* rows far .. n-1 (entries 2 a row), keeping rowptr[n] */
+        protect(p, off[k] + (size_t)far * sz[k], off[k] + (size_t)(n - (k == 0)) * sz[k]);
+    ulam_system *s = NULL;
+    assert_int_equal(ulam_system_from_memory(p, len, NULL, &s, NULL), ULAM_OK);
+    const ulam_csr *Ms = NULL; /* unverified: the walks verify the blocks they reach */
+    const double *bs = NULL;
+    ulam_system_lazy(s, &Ms, &bs);
+    for (int64_t i = 0; i < n; i++) x[i] = b[i];
+    for (int it = 0; it < 80; it++) /* x = b + M x: rows sum to at most 0.5, so 0.5^80 of the answer is left */
+        for (int64_t i = 0; i < n; i++) {
+            double t = b[i];
+            for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) t += M->val[q] * x[M->colidx[q]];
+            x[i] = t;
+        }
+    ulam_analysis_opts ao = ulam_analysis_defaults();
+    ao.b = bs, ao.system = s;
+    ulam_analysis *af = NULL, *ap = NULL;
+    assert_int_equal(ulam_analysis_alloc(Ms, &ao, &af, NULL), ULAM_OK);
+    ao.b = b, ao.system = NULL;
+    assert_int_equal(ulam_analysis_alloc(M, &ao, &ap, NULL), ULAM_OK);
+    for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++)
+        for (int64_t idx = 3; idx < 40; idx += 17) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.index = idx, o.estimator = e, o.max_walks = 0, o.rel_err = 0.02, o.threads = 2, o.seed = (uint64_t)idx;
+            ulam_walk_result r1, r2;
+            ulam_error err;
+            assert_int_equal(ulam_analysis_solve(af, bs, &o, &r1, &err), ULAM_OK);
+            assert_int_equal(ulam_analysis_solve(ap, b, &o, &r2, &err), ULAM_OK);
+            assert_true(r1.rel_err_met);
+            assert_int_equal(r1.walks, r2.walks);
+            assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
+            if (!(fabs(r1.estimate - x[idx]) < 4 * r1.std_error))
+                fail_msg("estimator %d, x[%lld] = %.8g +- %.3g, exact %.8g", e, (long long)idx, r1.estimate,
+                         r1.std_error, x[idx]);
+        }
+    ulam_analysis_info info;
+    ulam_analysis_get_info(af, &info);
+    assert_int_equal(info.bounds, 1), assert_int_equal(info.b_scores, 1), assert_int_equal(info.guard, 1);
+    assert_true(info.kernel_rows > 0 && info.kernel_rows < far);
+    ulam_analysis_get_info(ap, &info);
+    assert_int_equal(info.bounds, 2), assert_int_equal(info.b_scores, 2), assert_int_equal(info.guard, 2);
+    ulam_analysis *fresh = NULL; /* a kept kernel walks as a new one: a late query, alone */
+    ao.b = bs, ao.system = s;
+    assert_int_equal(ulam_analysis_alloc(Ms, &ao, &fresh, NULL), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 37, o.max_walks = 0, o.rel_err = 0.02, o.threads = 1, o.seed = 37;
+    ulam_walk_result r1, r2;
+    assert_int_equal(ulam_analysis_solve(fresh, bs, &o, &r1, NULL), ULAM_OK);
+    assert_int_equal(ulam_analysis_solve(af, bs, &o, &r2, NULL), ULAM_OK);
+    assert_int_equal(r1.walks, r2.walks);
+    assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
+    ulam_analysis_free(fresh), ulam_analysis_free(af), ulam_analysis_free(ap);
+    ulam_system_free(s);
+    munmap(p, len);
+    ulam_csr_free(M);
+    free(b), free(x);
 }
 
 /* A system with a certificate and M^T, rows of 3 to 6 entries of both signs (row sums of |M|
@@ -654,6 +753,7 @@ int main(void)
         cmocka_unit_test(test_flip_table),
         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_sound_sums_bad_arrays),
+        cmocka_unit_test(test_analysis_local),
     };
     return test_run(tests);
 }

@@ -6,18 +6,19 @@
 #include <string.h>
 
 
-/* Choose for s (loaded) under o (what ao pins stays) through the library's method table, make
- * the run *run and set o's mode, estimator and continuation to the walks' choice; *status gets the
- * refusal (err filled) for the caller to report as a plain run's.  0, or an exit code (message
- * printed) when the library fails or when no candidate is certified and o asks for a --rel-err
- * target (the closest is named). */
-int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, const char *excluded_why,
-                    ulam_choice *ch, ulam_run **run, int *status, ulam_error *err)
+/* Choose for s (loaded) under o (what ao pins stays; an: the walks on its bounds, NULL: none)
+ * through the library's method table, make the run *run and set o's mode, estimator and
+ * continuation to the walks' choice; *status gets the refusal (err filled) for the caller to
+ * report as a plain run's.  0, or an exit code (message printed) when the library fails or when
+ * no candidate is certified and o asks for a --rel-err target (the closest is named). */
+int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, const ulam_auto_opts *ao,
+                    const char *excluded_why, ulam_choice *ch, ulam_run **run, int *status, ulam_error *err)
 {
     ulam_method_opts mo = ulam_method_defaults();
     if (excluded_why) mo.exclude |= 1u << ULAM_METHOD_BIDIRECTIONAL;
     ch->walks.chosen = ch->walks.closest = -1;
-    *status = ulam_auto_start(s->M, s->b, o, ao, &mo, ch, run, err);
+    *status = an ? ulam_analysis_auto_start(an, s->b, o, ao, &mo, ch, run, err)
+                 : ulam_auto_start(s->M, s->b, o, ao, &mo, ch, run, err);
     ulam_method_verdict *v = &ch->method[ULAM_METHOD_BIDIRECTIONAL];
     if (excluded_why && v->state == ULAM_METHOD_NOT_CONSIDERED && !strcmp(v->why, "not considered: excluded"))
         snprintf(v->why, sizeof v->why, "not considered: %s", excluded_why);

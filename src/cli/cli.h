@@ -118,6 +118,19 @@ extern volatile int cli_interrupted;
 extern const ulam_share *cli_share;
 extern int cli_rank;
 
+/* When the process started (ulam_now()), set first thing in main: --time counts from here. */
+extern double cli_started;
+
+/* The walks' share of a --time budget of `budget` seconds (0: none) once what ran since the
+ * process started (reading, guards, set-up) is taken off; at least one block of walks still
+ * runs when nothing is left (a tiny positive budget). */
+double cli_time_left(double budget);
+
+/* Make OpenMP threads wait passively (sleep, not spin) unless the user chose a policy: libgomp
+ * reads OMP_WAIT_POLICY when it loads, before main, so the process runs itself again once with
+ * it set (argv as given).  Returns only when no re-run happened (set already, or exec failed). */
+void cli_passive_threads(char **argv);
+
 /* With -Dmpi=enabled: start MPI when launched by mpirun, and end it (src/cli/mpi.c). */
 void cli_mpi_init(int *argc, char ***argv);
 void cli_mpi_finalize(void);
@@ -225,13 +238,18 @@ int cli_bidir(int argc, char **argv);
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int json, int check, double direct,
                        double load_seconds);
 
+/* ulam solve --queries FILE (src/cli/queries.c): s (not loaded) and o from the command line
+ * (adjoint), json, walks_given (--walks or --time given); 0 or an exit code. */
+int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int json, int walks_given);
+
 /* solve --method auto (src/cli/auto.c): choose the method for the loaded s under o (what ao pins
  * stays; ao->exclude: rows the command line rules out, their reason excluded_why) through the
- * library's table (ulam_auto_start), make the run *run and set o to the walks' choice; *status and
- * err get the refusal.  0 or an exit code.  Then print the candidates as text, or as the JSON key
- * "auto" (bidir: with the bidirectional row's line). */
-int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts *ao, const char *excluded_why,
-                    ulam_choice *ch, ulam_run **run, int *status, ulam_error *err);
+ * library's table (ulam_auto_start; an: ulam_analysis_auto_start, the walks on its bounds), make
+ * the run *run and set o to the walks' choice; *status and err get the refusal.  0 or an exit
+ * code.  Then print the candidates as text, or as the JSON key "auto" (bidir: with the
+ * bidirectional row's line). */
+int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, const ulam_auto_opts *ao,
+                    const char *excluded_why, ulam_choice *ch, ulam_run **run, int *status, ulam_error *err);
 void cli_auto_print_text(const ulam_choice *ch, int bidir);
 void cli_auto_print_json(const ulam_choice *ch, int bidir);
 int cli_study(int argc, char **argv);

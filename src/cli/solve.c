@@ -39,7 +39,8 @@ static const char *const usage =
     "                     bar'); it watches x_I (--index, default 1 in forward mode) and never\n"
     "                     stops while no walk has reached it; refused (exit 4) when the variance\n"
     "                     is not certified finite, unless --walks or --time bounds the run\n"
-    "  --time S           stop after S seconds; the first rule reached wins\n"
+    "  --time S           stop S seconds after ulam started (reading, guards and set-up\n"
+    "                     count); the first rule reached wins\n"
     "  --seed S           block q of walks uses stream (S, q) (default 1): identical results for\n"
     "                     any --threads\n"
     "  --threads T        threads (default: all cores)\n";
@@ -77,6 +78,11 @@ static const char *const usage3 =
     "                     pinned; fresh walks then estimate with the choice; with a sparse b\n"
     "                     and --rel-err, also bidirectional (push + walks) when the best walks\n"
     "                     are predicted to cost more than nnz(M)/4\n"
+    "  --queries FILE     many queries in one process ('-': stdin), one a line: 'I' (x_I), or\n"
+    "                     'S I' (x_I with b = e_S, bidirectional), either optionally followed\n"
+    "                     by a target like 0.01 for that line's --rel-err; one answer a line\n"
+    "                     (--json: JSON lines); query k walks with seed --seed + k - 1; the\n"
+    "                     guards, bounds and kernel rows are kept across them (docs/queries.md)\n"
     "  --method walks     the single method the options name, defaults for the rest (adjoint,\n"
     "                     collision, --continue analog, --alpha 1): the run before auto\n"
     "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
@@ -107,11 +113,19 @@ typedef struct {
     const char *direct_method;  /* --check: "dense LU", "sparse LU" or "interrupted" */
 } report_opts;
 
-/* Peak resident memory of this process so far, in MiB. */
+/* Peak resident memory of this process so far, in MiB: VmHWM of /proc/self/status, the high-water
+ * mark of this program's own memory (getrusage's ru_maxrss keeps, across the exec, that of the
+ * process it was forked from: a benchmark's 119 MiB showed as this query's peak), else ru_maxrss. */
 static double peak_rss_mib(void)
 {
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    double kb = -1;
+    while (f && kb < 0 && fgets(line, sizeof line, f))
+        if (sscanf(line, "VmHWM: %lf", &kb) != 1) kb = -1;
+    if (f) fclose(f);
     struct rusage ru;
-    return getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
+    return kb >= 0 ? kb / 1024.0 : getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
 }
 
 /* Print the answer line: x[I] with its interval, or why there is none. */
@@ -221,8 +235,9 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
         printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
                (long long)r->unreached, (long long)ro->n);
     print_rel_err(o, r, 1);
-    printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
-           ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
+    printf("load            %.3f s inputs, %.3f s guards, %.3f s %s; peak memory %.0f MiB\n",
+           ro->load_seconds, ro->guard_seconds, ro->kernel_seconds,
+           ro->ch ? "choice and solver set-up (auto's guards, pilots, set-up)" : "solver set-up", peak_rss_mib());
     if (ro->ch) cli_auto_print_text(ro->ch, 1);
 }
 
@@ -383,6 +398,10 @@ typedef struct {
     int check, json, force, assume_finite;
     int autom;            /* --method auto (the default): choose what is not pinned */
     ulam_auto_opts ao;    /* what the command line pins (--mode, --estimator, --continue) */
+    ulam_analysis *an;    /* what queries on M share (a prepared system read lazily; NULL: none) */
+    double max_seconds;   /* --time as given (o.max_seconds: what is left of it for the walks) */
+    const char *queries;  /* --queries FILE ("-": stdin; NULL: one query) */
+    int walks_given;      /* --walks or --time given */
 } solve_args;
 
 /* Parse argv into a; 0, or an exit code (-1: --help printed). */
@@ -404,7 +423,8 @@ static int parse(int argc, char **argv, solve_args *a)
         {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
         {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
         {"method", required_argument, 0, 'U'},   {"pagerank", required_argument, 0, 'P'},
-        {"damping", required_argument, 0, 'P'},  {0, 0, 0, 0}};
+        {"damping", required_argument, 0, 'P'},  {"queries", required_argument, 0, 'Q'},
+        {0, 0, 0, 0}};
     *a = (solve_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_walk_defaults(), .autom = 1,
                       .ao = ulam_auto_defaults()};
     a->o.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
@@ -438,14 +458,20 @@ static int parse(int argc, char **argv, solve_args *a)
         case 'A': a->assume_finite = 1; break;
         case 'o': a->out = optarg; break;
         case 'E': a->errors = optarg; break;
+        case 'Q': a->queries = optarg; break;
         case 'h': fputs(usage, stdout), fputs(usage2, stdout), fputs(usage3, stdout); return -1;
         default: return cli_usage_error("solve", "unknown option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (!a->s.rhs_path && !a->s.pagerank && !ulam_system_is_file(argv[optind])) return cli_need_rhs("solve", argv[optind]);
+    if (a->queries && (a->s.index || a->o.mode != ULAM_ADJOINT || a->out || a->errors || a->check || a->s.jacobi))
+        return cli_usage_error("solve", "--queries takes the indices from its file, in adjoint mode (no --index, "
+                                        "--mode forward, --out, --errors, --check or --jacobi)");
+    a->walks_given = a->o.max_walks > 0 || a->o.max_seconds > 0;
+    if (!a->queries && !a->s.rhs_path && !a->s.pagerank && !ulam_system_is_file(argv[optind]))
+        return cli_need_rhs("solve", argv[optind]);
     if (a->s.pagerank > 0 && a->s.jacobi) return cli_usage_error("solve", "--pagerank and --jacobi exclude each other");
-    if (!a->s.index && a->o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
+    if (!a->s.index && a->o.mode == ULAM_ADJOINT && !a->queries) return cli_usage_error("solve", "adjoint walks need --index I");
     if ((a->out || a->errors) && a->o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
     if (a->o.roulette > 0 && a->o.split > 0 && a->o.split <= a->o.roulette)
@@ -475,6 +501,19 @@ static int certified_auto(solve_args *a, ulam_guard *g)
     a->ao.pin_continue = a->ao.pin_alpha = a->ao.pin_mode = 1;
     a->ao.guard = g;
     return 0;
+}
+
+/* For a prepared system read only where walks go (s->lazy): the analysis its queries share
+ * (a->an), at the options' continuation and exponent, on the file's stored bounds and b; 0 or
+ * an exit code (no memory). */
+static int lazy_analysis(solve_args *a)
+{
+    cli_system *s = &a->s;
+    if (!s->lazy || !s->sys_M || a->an) return 0;
+    ulam_analysis_opts ao = ulam_analysis_defaults();
+    ao.continue_q = a->o.continue_q, ao.kernel_alpha = a->o.kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
+    ulam_error err;
+    return ulam_analysis_alloc(s->M, &ao, &a->an, &err) ? cli_report(s->matrix_path, &err) : 0;
 }
 
 /* What the command line rules out for bidirectional beyond what the library tests (the options it
@@ -511,17 +550,20 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
     ro->n = s->M->nrows;
     ulam_error err;
     int status;
+    a->max_seconds = o->max_seconds;
+    o->max_seconds = cli_time_left(a->max_seconds); /* --time counts the reading before it too */
     if (a->autom) { /* guards, pilots, the rows of the table and the run, its set-up kept from the choice */
         t0 = ulam_now();
         ulam_guard cg;
         const char *excluded = bidir_excluded(a);
-        if ((rc = certified_auto(a, &cg)) || (rc = cli_auto_choose(s, o, &a->ao, excluded, ch, run, &status, &err))) {
+        if ((rc = certified_auto(a, &cg)) || (rc = lazy_analysis(a)) ||
+            (rc = cli_auto_choose(s, a->an, o, &a->ao, excluded, ch, run, &status, &err))) {
             cli_system_free(s);
             return rc;
         }
         ro->ch = ch;
         ro->g = ch->walks.guard;
-        ro->kernel_seconds = ulam_now() - t0 - ch->walks.seconds;
+        ro->kernel_seconds = ulam_now() - t0; /* the choice's guards, pilots and set-up: all of it */
         *sv = ulam_run_solver(*run);
     } else {
         if ((rc = cli_guard(s, o->continue_q, o->kernel_alpha, o->mode, &ro->g))) {
@@ -529,8 +571,18 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
             return rc;
         }
         o->guard = &ro->g;
+        o->max_seconds = cli_time_left(a->max_seconds); /* and the guards */
         t0 = ulam_now();
-        status = ulam_solver_alloc(s->M, s->b, o, sv, &err); /* refuses what the guards refuse */
+        if ((rc = lazy_analysis(a))) {
+            cli_system_free(s);
+            return rc;
+        }
+        if (a->an) { /* the file's stored bounds: no pass over what the start can reach */
+            status = ulam_analysis_solver(a->an, s->b, o, sv, &err);
+            if (status) a->an = ulam_analysis_free(a->an);
+        } else {
+            status = ulam_solver_alloc(s->M, s->b, o, sv, &err); /* refuses what the guards refuse */
+        }
         ro->kernel_seconds = ulam_now() - t0;
     }
     ro->guard_seconds = ro->g.abs.seconds + ro->g.hat[0].seconds + ro->g.hat[1].seconds;
@@ -557,6 +609,7 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
     if (walks) cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
     if (ro->check && !walks && (rc = direct_check(s, o->index, ro))) { /* bidirectional: checked first */
         *run = ulam_run_free(*run);
+        a->an = ulam_analysis_free(a->an);
         cli_system_free(s);
         return rc;
     }
@@ -574,10 +627,14 @@ static int run(solve_args *a)
     ulam_run *rn = NULL;
     ulam_solver *sv = NULL;
     int rc = start(a, &ro, &ch, &rn, &sv), status = ULAM_OK;
-    if (rc) return rc;
+    if (rc) {
+        a->an = ulam_analysis_free(a->an);
+        return rc;
+    }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
         rc = cli_bidir_auto_run(&a->s, rn, &ch, ro.json, ro.check, ro.direct, ro.load_seconds);
         ulam_run_free(rn);
+        a->an = ulam_analysis_free(a->an);
         cli_system_free(&a->s);
         return rc;
     }
@@ -641,8 +698,9 @@ static int run(solve_args *a)
     }
     if (left) return rc; /* under MPI the ranks end together (main); the system stays to the thread */
     cli_release_sigint();
-    if (rn) ulam_run_free(rn); /* its solver with it */
+    if (rn) ulam_run_free(rn); /* its solver with it (before the analysis it may borrow) */
     else ulam_solver_free(sv);
+    a->an = ulam_analysis_free(a->an);
     cli_system_free(&a->s);
     return rc;
 }
@@ -654,5 +712,6 @@ int cli_solve(int argc, char **argv)
     if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv); /* src/cli/mcsa.c */
     solve_args a;
     int rc = parse(argc, argv, &a);
+    if (!rc && a.queries) return cli_queries(&a.s, &a.o, a.queries, a.json, a.walks_given); /* src/cli/queries.c */
     return rc < 0 ? 0 : rc ? rc : run(&a);
 }

@@ -46,65 +46,6 @@
 enum { SOURCES = 20, TARGETS = 5, PAIRS = SOURCES * TARGETS };
 static const double WALK_CAP = 2.0, PUSH_CAP = 5.0, REL = 0.1, ALPHA = 0.85;
 
-/* The R-MAT graph's M = ALPHA P' (n = 2^L, 8 n edges); *dangling counts states without out-edges. */
-static ulam_csr *rmat(int L, int64_t *dangling, int64_t *maxin, int64_t *maxout)
-{
-    int64_t n = (int64_t)1 << L, m = 8 * n;
-    ulam_rng r;
-    ulam_rng_seed(&r, (uint64_t)L, 0);
-    int32_t *perm = malloc((size_t)n * sizeof *perm), *src = malloc((size_t)m * sizeof *src);
-    int32_t *dst = malloc((size_t)m * sizeof *dst);
-    int64_t *outdeg = calloc((size_t)n, sizeof *outdeg), *indeg = calloc((size_t)n, sizeof *indeg);
-    double *val = malloc((size_t)m * sizeof *val);
-    ulam_csr *M = NULL;
-    if (!perm || !src || !dst || !outdeg || !indeg || !val) goto done;
-    for (int64_t i = 0; i < n; i++) perm[i] = (int32_t)i;
-    for (int64_t i = n - 1; i > 0; i--) { /* Fisher-Yates */
-        int64_t j = (int64_t)ulam_rng_bounded(&r, (uint64_t)i + 1);
-        int32_t t = perm[i];
-        perm[i] = perm[j], perm[j] = t;
-    }
-    for (int64_t e = 0; e < m; e++) {
-        int64_t u = 0, v = 0;
-        for (int l = 0; l < L; l++) {
-            double q = ulam_rng_uniform(&r);
-            int down = q >= 0.57 + 0.19, right = (q >= 0.57 && q < 0.76) || q >= 0.95;
-            u = 2 * u + down, v = 2 * v + right;
-        }
-        src[e] = perm[u], dst[e] = perm[v];
-        outdeg[perm[u]]++, indeg[perm[v]]++;
-    }
-    *dangling = *maxin = *maxout = 0;
-    for (int64_t i = 0; i < n; i++) {
-        *dangling += outdeg[i] == 0;
-        if (indeg[i] > *maxin) *maxin = indeg[i];
-        if (outdeg[i] > *maxout) *maxout = outdeg[i];
-    }
-    for (int64_t e = 0; e < m; e++) val[e] = ALPHA / (double)outdeg[src[e]];
-    /* M_vu = ALPHA P_uv: row v of M holds v's in-neighbours u */
-    if (ulam_csr_from_triplets(n, n, m, dst, src, val, &M)) M = NULL;
-done:
-    free(perm), free(src), free(dst), free(outdeg), free(indeg), free(val);
-    return M;
-}
-
-/* x = (I - M)^-1 e_s by Gauss-Seidel until no entry moves by more than 1e-15; the sweeps done. */
-static int exact_column(const ulam_csr *M, int64_t s, double *x, double *old, double *b)
-{
-    int64_t n = M->nrows;
-    memset(x, 0, (size_t)n * sizeof *x);
-    memset(b, 0, (size_t)n * sizeof *b);
-    b[s] = 1.0;
-    int sweeps = 0;
-    for (double change = INFINITY; change > 1e-15 && sweeps < 2000; sweeps++) {
-        memcpy(old, x, (size_t)n * sizeof *x);
-        ulam_gauss_seidel_sweep(M, b, x);
-        change = 0;
-        for (int64_t i = 0; i < n; i++) change = fmax(change, fabs(x[i] - old[i]));
-    }
-    return sweeps;
-}
-
 /* One method's per-pair outcome. */
 typedef struct {
     double seconds[PAIRS];
@@ -239,7 +180,7 @@ int main(int argc, char **argv)
     }
     double t0 = ulam_now();
     int64_t dangling = 0, maxin = 0, maxout = 0;
-    ulam_csr *M = zipf ? zipf_graph(L, 2.1, 0.75, ALPHA, 1) : rmat(L, &dangling, &maxin, &maxout), *Mt = NULL;
+    ulam_csr *M = zipf ? zipf_graph(L, 2.1, 0.75, ALPHA, 1) : bench_rmat(L, ALPHA, &dangling, &maxin, &maxout), *Mt = NULL;
     int64_t n = zipf ? L : (int64_t)1 << L;
     if (!M) return fprintf(stderr, "bidir: out of memory\n"), 1;
     if (zipf)
@@ -276,7 +217,7 @@ int main(int argc, char **argv)
     for (int src = 0; src < nsrc;) {
         int64_t s = (int64_t)ulam_rng_bounded(&r, (uint64_t)n);
         double g0 = ulam_now();
-        int sweeps = exact_column(M, s, x, old, b);
+        int sweeps = bench_exact_column(M, s, x, old, b);
         gs_seconds += ulam_now() - g0;
         gs_max_sweeps = fmax(gs_max_sweeps, sweeps);
         int64_t nc = 0;

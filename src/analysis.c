@@ -1,0 +1,218 @@
+/* The analysis: what queries on one M share, made once and held across them (CSparse's cs_sqr
+ * before cs_lu): the guards, the bounds over every state the rel_err rule and absorption need
+ * (ulam__reach_all, or the prepared file's stored copy), the shared b's scores, a kept walk
+ * kernel per estimator and the transpose.  Each is made at the first query that needs it, so a
+ * single query from a prepared file reads only the rows its walks reach. */
+#include "kernel.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct ulam_analysis {
+    const ulam_csr *M;    /* borrowed */
+    double continue_q;    /* normalised: 0 analog */
+    double alpha;
+    const double *b;      /* the shared b (borrowed; NULL: none) */
+    const ulam_system *sys;
+    ulam_guard g;         /* the guards so far (g.computed: which radii) */
+    int guard_from;       /* 0 none, 1 certificate, 2 computed */
+    ulam__reach R;        /* the bounds over every state (R.bounds 0: not yet) */
+    char *seen;           /* n ones: R.seen */
+    int bounds_from, b_from;
+    ulam_kernel *k[3];    /* per estimator: the kept kernel of adjoint queries on b */
+    ulam_csr *T;          /* the transpose (NULL until asked) */
+    ulam_push *push;      /* the push workspace on M (NULL until asked) */
+    double seconds;
+};
+
+/* The defaults. */
+ulam_analysis_opts ulam_analysis_defaults(void)
+{
+    return (ulam_analysis_opts){.size = sizeof(ulam_analysis_opts), .continue_q = 0.0, .kernel_alpha = 1.0};
+}
+
+/* An analysis of M under opts. */
+int ulam_analysis_alloc(const ulam_csr *M, const ulam_analysis_opts *opts, ulam_analysis **out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!M || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix and an output");
+    *out = NULL;
+    ulam_analysis_opts o = ulam_analysis_defaults();
+    if (opts) { /* the fields the caller's size holds */
+        size_t sz = opts->size && opts->size < sizeof o ? opts->size : sizeof o;
+        memcpy(&o, opts, sz);
+    }
+    if (M->nrows != M->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
+    if ((o.continue_q > 0 && !(o.continue_q < 1)) || !(o.kernel_alpha >= 0) || !isfinite(o.kernel_alpha))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a continuation below 1 and a finite kernel exponent >= 0");
+    ulam_analysis *a = calloc(1, sizeof *a);
+    if (!a) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for an analysis");
+    a->M = M, a->continue_q = o.continue_q > 0 ? o.continue_q : 0.0, a->alpha = o.kernel_alpha;
+    const ulam_csr *mapped = NULL;
+    if (o.system) ulam_system_lazy(o.system, &mapped, NULL);
+    a->b = o.b, a->sys = mapped == M ? o.system : NULL;
+    *out = a;
+    return ULAM_OK;
+}
+
+/* Free an analysis. */
+ulam_analysis *ulam_analysis_free(ulam_analysis *a)
+{
+    if (!a) return NULL;
+    for (int e = 0; e < 3; e++) ulam__kernel_free(a->k[e]);
+    ulam_push_free(a->push);
+    ulam_csr_free(a->T);
+    free(a->seen);
+    free(a);
+    return NULL;
+}
+
+/* The guards a query in mode `mode` needs, from the certificate or computed (kept). */
+static int take_guard(ulam_analysis *a, int mode, ulam_error *err)
+{
+    int need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(mode);
+    if ((a->g.computed & need) == need) return ULAM_OK;
+    double t0 = ulam_now();
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = need | a->g.computed;
+    go.kernel_alpha = a->alpha;
+    int status = ULAM_OK;
+    if (a->sys && !ulam_certificate_guard(ulam_system_certificate(a->sys), a->continue_q, &go, &a->g)) a->guard_from = 1;
+    else if (!(status = ulam_guard_check(a->M, a->continue_q, &go, &a->g, err))) a->guard_from = 2;
+    a->seconds += ulam_now() - t0;
+    return status;
+}
+
+/* The bounds over every state, with b's scores when b is the shared one: the prepared file's,
+ * else one pass over M (kept); NULL when memory runs out or a row is corrupt (the solver then
+ * searches the start's reach itself, and reports what it finds). */
+static const ulam__reach *take_bounds(ulam_analysis *a)
+{
+    double t0 = ulam_now();
+    if (!a->R.bounds) {
+        if (a->sys && ulam__system_bounds(a->sys, a->continue_q, a->alpha, &a->R)) { /* seen NULL: every state */
+            a->bounds_from = 1;
+            if (a->R.b && a->R.b == a->b) a->b_from = 1;
+            else a->R.b = NULL;
+        } else if ((a->sys && !ulam_system_matrix(a->sys)) || !(a->seen = ulam__malloc((size_t)a->M->nrows, 1))) {
+            return NULL; /* a damaged file (the pass would read all of it) or no memory: the solver searches */
+        } else if (!ulam__reach_all(a->M, a->continue_q, a->alpha, a->seen, &a->R)) {
+            a->bounds_from = 2;
+        } else {
+            a->R.bounds = 0;
+            return NULL;
+        }
+    }
+    const double *sb = NULL;
+    if (a->sys) ulam_system_lazy(a->sys, NULL, &sb);
+    if (a->b && !a->R.b && (a->b != sb || ulam_system_rhs(a->sys, NULL)) && !ulam__reach_b(a->M, a->b, &a->R))
+        a->b_from = 2; /* (a file's b verified whole first: the pass reads all of it) */
+    a->seconds += ulam_now() - t0;
+    return &a->R;
+}
+
+/* A solver for one query using what a holds. */
+int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_solver **out,
+                         ulam_error *err)
+{
+    ulam__clear(err);
+    if (!a || !b || !opts || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis, b, options and an output");
+    *out = NULL;
+    ulam_walk_opts o = *opts;
+    if ((o.continue_q > 0 ? o.continue_q : 0.0) != a->continue_q || o.kernel_alpha != a->alpha)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the analysis' continuation %g and kernel exponent %g",
+                          a->continue_q, a->alpha);
+    o.continue_q = a->continue_q;
+    if (!o.system && a->sys) o.system = a->sys; /* the file's blocks verified as the walks reach them */
+    int status;
+    if (!o.guard) {
+        if (o.mode != ULAM_ADJOINT && o.mode != ULAM_FORWARD) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a mode");
+        if ((status = take_guard(a, o.mode, err))) return status;
+        o.guard = &a->g;
+    }
+    int adj = o.mode == ULAM_ADJOINT, shared = adj && a->b && b == a->b && !o.nstarts;
+    int e = o.estimator >= ULAM_COLLISION && o.estimator <= ULAM_EXPECTED ? o.estimator : -1;
+    const ulam__reach *R = adj && (o.estimator == ULAM_ABSORPTION || o.rel_err > 0) ? take_bounds(a) : NULL;
+    ulam_kernel *k = shared && e >= 0 ? a->k[e] : NULL;
+    status = ulam__solver_alloc_reached(a->M, b, &o, R, k, out, err);
+    if (!status && shared && e >= 0 && !k) a->k[e] = ulam__solver_keep_kernel_fixed(*out);
+    return status;
+}
+
+/* One query to its end. */
+int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_walk_result *result,
+                        ulam_error *err)
+{
+    ulam_solver *s = NULL;
+    int status = ulam_analysis_solver(a, b, opts, &s, err);
+    return status ? status : ulam__solver_finish(s, result, err);
+}
+
+/* The walks' pins o (from ao, or the defaults) with a's guards when they pin a's own kernel. */
+static int auto_pins(ulam_analysis *a, const ulam_walk_opts *base, const ulam_auto_opts *ao, ulam_auto_opts *o,
+                     ulam_error *err)
+{
+    ulam__clear(err);
+    if (!a || !base) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis and options");
+    *o = ao ? *ao : ulam_auto_defaults();
+    int mine = o->pin_continue && o->pin_alpha && o->pin_mode && base->mode == ULAM_ADJOINT &&
+               (base->continue_q > 0 ? base->continue_q : 0.0) == a->continue_q && base->kernel_alpha == a->alpha;
+    if (mine && !o->guard) {
+        int status = take_guard(a, ULAM_ADJOINT, err);
+        if (status) return status;
+        o->guard = &a->g;
+    }
+    return ULAM_OK;
+}
+
+/* The walks' choice on a's bounds. */
+int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                       ulam_auto_result *res, ulam_solver **out, ulam_error *err)
+{
+    ulam_auto_opts o;
+    int status = auto_pins(a, base, ao, &o, err);
+    return status ? status : ulam__auto_solver_reach(a->M, b, base, &o, take_bounds(a), res, out, err);
+}
+
+/* The method table's choice, its walks row on a's bounds. */
+int ulam_analysis_auto_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                             const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
+{
+    ulam_auto_opts p;
+    int status = auto_pins(a, o, ao, &p, err);
+    return status ? status : ulam__auto_start_reach(a->M, b, o, &p, mo, take_bounds(a), ch, out, err);
+}
+
+/* M's transpose, made once. */
+const ulam_csr *ulam_analysis_transpose(ulam_analysis *a, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis"), NULL;
+    if (a->T) return a->T;
+    double t0 = ulam_now();
+    if (ulam_csr_transpose(a->M, &a->T)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose"), NULL;
+    a->seconds += ulam_now() - t0;
+    return a->T;
+}
+
+/* The push workspace on M, made once. */
+ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis"), NULL;
+    if (!a->push && ulam_push_alloc(a->M, &a->push))
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a push workspace"), NULL;
+    return a->push;
+}
+
+/* What a holds so far. */
+void ulam_analysis_get_info(const ulam_analysis *a, ulam_analysis_info *info)
+{
+    if (!info) return;
+    memset(info, 0, sizeof *info);
+    if (!a) return;
+    info->bounds = a->R.bounds ? a->bounds_from : 0;
+    info->b_scores = a->b_from, info->guard = a->guard_from, info->seconds = a->seconds;
+    for (int e = 0; e < 3; e++) info->kernel_rows += a->k[e] ? atomic_load(&a->k[e]->built) : 0;
+}

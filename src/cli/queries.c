@@ -1,0 +1,243 @@
+/* ulam solve SYSTEM --queries FILE: many queries on one system in one process, the analysis
+ * (guards, bounds, kept kernels, transpose, push workspace) made once and kept across them.
+ *
+ * A line is `I` (x_I of (I - M) x = b, b the system's or --rhs), or `S I` (x_I with b = e_S: a
+ * point source, by the bidirectional method), then optionally a relative-error target for that
+ * line alone written as a real with a point or an exponent (0.01, 1e-3); indices are 1-based
+ * integers; '#' starts a comment; blank lines are skipped.  Query k (1-based, in file order)
+ * walks with seed --seed + k - 1, so it answers exactly what `ulam solve --method walks --index
+ * I --seed S+k-1` answers on a prepared file (and on a Matrix Market file at fixed --walks; a
+ * --rel-err run there walks under bounds over every state, which may ask for more walks than a
+ * lone run's search of its start's reach).  One result a line, flushed as it is made: Ctrl-C
+ * stops the query under way and keeps the answered lines (exit 130).  The whole file is read
+ * and checked before the first query runs: a bad line is an error (file:line) with no output. */
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* One query: source (0-based; -1: b), index (0-based), target (0: the command line's), line. */
+typedef struct {
+    int64_t source, index;
+    double target;
+    long line;
+} query;
+
+/* Nonzero when token t is written as a real (a point or an exponent), not an index. */
+static int real_token(const char *t)
+{
+    return strpbrk(t, ".eE") != NULL;
+}
+
+/* Parse one line into q: 1 a query, 0 nothing (blank or comment), -1 malformed (why set). */
+static int parse_line(char *text, query *q, const char **why)
+{
+    char *hash = strchr(text, '#');
+    if (hash) *hash = '\0';
+    char *tok[4];
+    int n = 0;
+    for (char *t = strtok(text, " \t\r\n"); t; t = strtok(NULL, " \t\r\n")) {
+        if (n == 3) return *why = "at most 'SOURCE INDEX TARGET'", -1;
+        tok[n++] = t;
+    }
+    if (n == 0) return 0;
+    int ints = n - (n > 1 && real_token(tok[n - 1]));
+    if (ints < 1 || ints > 2) return *why = "'INDEX', 'SOURCE INDEX', either followed by a target like 0.01", -1;
+    int64_t v[2];
+    for (int k = 0; k < ints; k++) {
+        char *end;
+        errno = 0;
+        long long x = strtoll(tok[k], &end, 10);
+        if (*end || errno || x < 1 || x > ULAM_MAX_DIM) return *why = "1-based integer indices", -1;
+        v[k] = x - 1;
+    }
+    q->source = ints == 2 ? v[0] : -1, q->index = v[ints - 1], q->target = 0.0;
+    if (ints < n) {
+        char *end;
+        q->target = strtod(tok[n - 1], &end);
+        if (*end || !(q->target > 0 && q->target < 1)) return *why = "a target between 0 and 1 (exclusive)", -1;
+    }
+    return 1;
+}
+
+/* Read every query of path ("-": stdin) into *out (*nq of them); 0 or an exit code. */
+static int read_queries(const char *path, query **out, int64_t *nq)
+{
+    FILE *f = strcmp(path, "-") ? fopen(path, "r") : stdin;
+    if (!f) {
+        fprintf(stderr, "ulam: %s: error: expected a readable query file (%s)\n", path, strerror(errno));
+        return EXIT_USAGE;
+    }
+    query *q = NULL;
+    int64_t cap = 0, n = 0;
+    char buf[4096];
+    int rc = 0;
+    for (long line = 1; !rc && fgets(buf, sizeof buf, f); line++) {
+        const char *why = NULL;
+        query one = {.line = line};
+        int got = strchr(buf, '\n') || feof(f) ? parse_line(buf, &one, &why) : (why = "lines under 4096 bytes", -1);
+        if (got < 0) {
+            fprintf(stderr, "ulam: %s:%ld: error: expected %s\n", path, line, why);
+            rc = EXIT_USAGE;
+        } else if (got && n == cap) {
+            cap = cap ? 2 * cap : 64;
+            query *g = realloc(q, (size_t)cap * sizeof *q);
+            if (!g) rc = cli_exit_code(ULAM_ENOMEM);
+            else q = g;
+        }
+        if (!rc && got > 0) q[n++] = one;
+    }
+    if (!rc && ferror(f)) {
+        fprintf(stderr, "ulam: %s: error: expected a readable query file (read failed)\n", path);
+        rc = EXIT_USAGE;
+    }
+    if (f != stdin) fclose(f);
+    if (rc) free(q), q = NULL, n = 0;
+    *out = q, *nq = n;
+    return rc;
+}
+
+/* Everything the queries share. */
+typedef struct {
+    cli_system *s;
+    ulam_analysis *an;
+    const char *path;
+    ulam_guard g, gt; /* the guards of M and (point sources) of its transpose */
+    int have_gt;
+} shared;
+
+/* The guards of M's transpose from M's (rho(|M^T|) = rho(|M|); the adjoint kernel of M^T is M's
+ * forward one), computed when M's lack the forward radius; 0 or an exit code. */
+static int transpose_guard(shared *w, const ulam_csr *Mt, double q)
+{
+    if (w->have_gt) return 0;
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_ADJOINT;
+    ulam_error err;
+    int fwd = (w->g.computed & ULAM_GUARD_FORWARD) && w->g.kernel_alpha == 1.0;
+    if (fwd) {
+        w->gt = w->g;
+        w->gt.hat[ULAM_ADJOINT] = w->g.hat[ULAM_FORWARD], w->gt.hat[ULAM_FORWARD] = w->g.hat[ULAM_ADJOINT];
+        w->gt.verdict_hat[ULAM_ADJOINT] = w->g.verdict_hat[ULAM_FORWARD];
+        w->gt.verdict_hat[ULAM_FORWARD] = w->g.verdict_hat[ULAM_ADJOINT];
+        w->gt.computed = ULAM_GUARD_ABS | ULAM_GUARD_ADJOINT | ((w->g.computed & ULAM_GUARD_ADJOINT) ? ULAM_GUARD_FORWARD : 0);
+    } else if (ulam_guard_check(Mt, q, &go, &w->gt, &err)) {
+        return cli_report(w->s->matrix_path, &err);
+    }
+    w->have_gt = 1;
+    return 0;
+}
+
+/* Print one answer (text or a JSON line) and flush. */
+static void print_answer(const query *q, int64_t k, uint64_t seed, double est, double se, const double ci[2],
+                         int met, int64_t walks, double seconds, int json)
+{
+    if (json) {
+        printf("{\"query\": %lld, \"line\": %ld, \"source\": ", (long long)k + 1, q->line);
+        if (q->source >= 0) printf("%lld, ", (long long)q->source + 1);
+        else printf("null, ");
+        printf("\"index\": %lld, ", (long long)q->index + 1);
+        cli_json_number("estimate", est, 0);
+        cli_json_number("stderr", se, 0);
+        printf("\"ci95\": ");
+        if (isnan(ci[0])) printf("null, ");
+        else printf("[%.17g, %.17g], ", ci[0], ci[1]);
+        printf("\"rel_err_met\": %s, \"walks\": %lld, \"seed\": %llu, ", met ? "true" : "false", (long long)walks,
+               (unsigned long long)seed);
+        cli_json_number("seconds", seconds, 1);
+        printf("}\n");
+    } else {
+        char src[32] = "";
+        if (q->source >= 0) snprintf(src, sizeof src, " (source %lld)", (long long)q->source + 1);
+        printf("x[%lld]%s %.10g +- %.3g", (long long)q->index + 1, src, est, se);
+        if (!isnan(ci[0])) printf(" (95%% CI %.10g .. %.10g)", ci[0], ci[1]);
+        printf("  walks %lld, %.4f s, seed %llu\n", (long long)walks, seconds, (unsigned long long)seed);
+    }
+    fflush(stdout);
+}
+
+/* Run query k with options o (its seed and target set); 0, an exit code, or EXIT_INTERRUPTED. */
+static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int json)
+{
+    ulam_error err;
+    double t0 = ulam_now();
+    int status, interrupted;
+    double est, se, ci[2];
+    int met;
+    int64_t walks;
+    if (q->source < 0) {
+        o.index = q->index;
+        ulam_walk_result r;
+        status = ulam_analysis_solve(w->an, w->s->b, &o, &r, &err);
+        est = r.estimate, se = r.std_error, ci[0] = r.ci95[0], ci[1] = r.ci95[1], met = r.rel_err_met;
+        walks = r.walks, interrupted = r.interrupted;
+    } else {
+        const ulam_csr *Mt = ulam_analysis_transpose(w->an, &err);
+        ulam_push *p = Mt ? ulam_analysis_push(w->an, &err) : NULL;
+        if (!p) return cli_report(w->s->matrix_path, &err);
+        int rc = transpose_guard(w, Mt, o.continue_q);
+        if (rc) return rc;
+        ulam_bidir_opts bo = ulam_bidir_defaults();
+        bo.walk = o;
+        bo.walk.guard = &w->gt;
+        bo.source = q->source, bo.target = q->index, bo.reach_all = 1, bo.keep_kernel = 1;
+        ulam_bidir_result r;
+        status = ulam_bidir_solve(p, Mt, &bo, &r, &err);
+        est = r.estimate, se = r.std_error, ci[0] = r.ci95[0], ci[1] = r.ci95[1];
+        met = r.walks.rel_err_met || r.walks.walks == 0, walks = r.walks.walks, interrupted = r.walks.interrupted;
+    }
+    if (status) {
+        fprintf(stderr, "ulam: %s: query %lld (line %ld): ", w->path, (long long)k + 1, q->line);
+        return cli_report(w->s->matrix_path, &err);
+    }
+    if (interrupted) return EXIT_INTERRUPTED; /* the answered lines stay; this one is not an answer */
+    print_answer(q, k, o.seed, est, se, ci, met, walks, ulam_now() - t0, json);
+    return 0;
+}
+
+/* ulam solve --queries (see the top of this file); s not loaded yet, o the command line's walk
+ * options (adjoint), walks_given: --walks or --time was given. */
+int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int json, int walks_given)
+{
+    query *q = NULL;
+    int64_t nq = 0;
+    int rc = read_queries(path, &q, &nq), need_b = 0;
+    for (int64_t k = 0; k < nq; k++) need_b |= q[k].source < 0;
+    s->lazy = 1;
+    if (!rc) rc = cli_load_system(s);
+    if (rc) {
+        free(q);
+        return rc;
+    }
+    shared w = {.s = s, .path = path};
+    const int64_t n = s->M->nrows;
+    for (int64_t k = 0; !rc && k < nq; k++)
+        if (q[k].index >= n || q[k].source >= n) {
+            fprintf(stderr, "ulam: %s:%ld: error: expected indices from 1 to %lld\n", path, q[k].line, (long long)n);
+            rc = EXIT_USAGE;
+        }
+    if (!rc && need_b && !s->b) rc = cli_usage_error("solve", "--queries with 'INDEX' lines needs b (--rhs b.mtx)");
+    if (!rc) rc = cli_guard(s, o->continue_q, o->kernel_alpha, ULAM_ADJOINT, &w.g);
+    ulam_analysis_opts ao = ulam_analysis_defaults();
+    ao.continue_q = o->continue_q, ao.kernel_alpha = o->kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
+    ulam_error err;
+    if (!rc && ulam_analysis_alloc(s->M, &ao, &w.an, &err)) rc = cli_report(s->matrix_path, &err);
+    ulam_walk_opts base = *o;
+    base.guard = &w.g, base.interrupt = &cli_interrupted, base.mode = ULAM_ADJOINT;
+    cli_catch_sigint();
+    for (int64_t k = 0; !rc && k < nq; k++) {
+        ulam_walk_opts ok = base;
+        ok.seed = o->seed + (uint64_t)k; /* query k's seed: --seed + k - 1 (1-based k) */
+        if (q[k].target > 0) ok.rel_err = q[k].target, ok.max_walks = walks_given ? ok.max_walks : 0;
+        rc = run_query(&w, &q[k], k, ok, json);
+    }
+    fflush(stdout);
+    cli_release_sigint();
+    ulam_analysis_free(w.an);
+    cli_system_free(s);
+    free(q);
+    return rc;
+}
