@@ -489,7 +489,7 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
                           "collision estimator or --continue Q",
                           (long long)s->pass[e].bad + 1, adj ? "M" : "M' (column of M)");
     s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
-    if (vmax > 0 && (!(s->pass_qmax < TAIL_Q) || !isfinite(Wmax))) {
+    if (vmax > 0 && (!(s->pass_qmax < TAIL_Q) || (!isfinite(Wmax) && s->o.rel_err > 0))) {
         if (!s->tail_done && given && given->tail) /* the caller's certificate over the same states */
             s->tail_uc = given->tail_u, s->tail_kc = given->kappa, s->tail_done = 1;
         if (!s->tail_done) /* kappa enters by its log */
@@ -965,7 +965,8 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci);
 
 /* Nonzero when the rel_err rule holds for r (see ulam_solve in ulam.h): the run's 95% interval
- * (stop.h) at most sqrt(2 L) E |m| wide on each side, after ULAM__REL_MIN walks, forward with
+ * (stop.h) meeting ulam__stop_rel_met (stderr <= E |m|, range and bias terms within the
+ * same width sqrt(2 L) E |m|), after ULAM__REL_MIN walks, forward with
  * the watched component tallied, and walks cut at max_steps moving it by at most
  * ULAM__CUT_SHARE E |m|; x certified 0 (nothing that scores is reachable) meets it at once. */
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)

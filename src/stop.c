@@ -46,8 +46,8 @@ int ulam__stop_rel_met(const ulam__stop_ci *ci, double m, double E)
 {
     if (!(E > 0)) return 0;
     if (ci->kind == ULAM__STOP_EXACT) return 1;
-    m = fabs(m);
-    return ci->kind == ULAM__STOP_EB && m > 0 && ci->half <= sqrt(2.0 * ci->L) * E * m;
+    double w = sqrt(2.0 * ci->L) * E * fabs(m);
+    return ci->kind == ULAM__STOP_EB && w > 0 && ci->var_term <= w && ci->range_term + ci->bias <= w;
 }
 
 /* The walk count that would meet target E. */
@@ -55,9 +55,8 @@ double ulam__stop_walks_needed(double m, double var, double R, double bias, doub
 {
     if (!(E > 0)) return 0.0;
     if (R == 0.0) return 0.0;
-    double L = ulam__stop_log(k), c = sqrt(2.0 * L) * E * fabs(m) - bias;
+    double L = ulam__stop_log(k), w = sqrt(2.0 * L) * E * fabs(m), c = w - bias;
     if (!(fabs(m) > 0) || !isfinite(R) || !(c > 0)) return INFINITY;
-    double a = 7.0 * R * L / 3.0, b = sqrt(2.0 * fmax(var, 0.0) * L);
-    double u = a > 0 ? (-b + sqrt(b * b + 4.0 * a * c)) / (2.0 * a) : c / b; /* u = 1 / sqrt(n) */
-    return u > 0 ? ceil(1.0 / (u * u)) + 1.0 : INFINITY;
+    double nv = fmax(var, 0.0) / (E * m * E * m), nr = 7.0 * R * L / (3.0 * c) + 1.0;
+    return ceil(fmax(nv, nr));
 }

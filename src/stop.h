@@ -59,16 +59,17 @@ double ulam__stop_log(int k);
 void ulam__stop_interval(int64_t n, double mean, double var, double R, double bias, double maxabs, double limit, int k,
                          ulam__stop_ci *ci);
 
-/* Whether an interval meets a relative-error target E at estimate m: its half-width is at most
- * sqrt(2 L) E |m|, the width the variance term alone has when the standard error is E |m|
- * (so at a rich sample the rule asks stderr <= E |m|, plus room for the range and bias
- * terms); never at m = 0 unless exact. */
+/* Whether an interval meets a relative-error target E at estimate m: its variance term at most
+ * w = sqrt(2 L) E |m|, the width it has when the standard error is E |m| (so the rule asks
+ * stderr <= E |m|, as a CLT rule would), and its range and bias terms together at most w too
+ * (so the sample has seen what could still matter): the half-width is then at most 2 w; never
+ * at m = 0 unless exact. */
 int ulam__stop_rel_met(const ulam__stop_ci *ci, double m, double E);
 
 /* The walk count at which a run of sample variance var, range R and bias at estimate m would
- * meet target E at epoch k (the variance term solved with the range term, as a quadratic in
- * 1 / sqrt(n)); 0 with no target, INFINITY when the bias alone exceeds what the target
- * allows, m = 0 or R infinite. */
+ * meet target E at epoch k (the larger of the variance term's and the range term's); 0 with
+ * no target, INFINITY when the bias alone exceeds what the target allows, m = 0 or R
+ * infinite. */
 double ulam__stop_walks_needed(double m, double var, double R, double bias, double E, int k);
 
 #endif /* ULAM_STOP_H */

@@ -474,7 +474,7 @@ static void channel_mins(const ulam_rad_solver *s, double mins[3])
 }
 
 /* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
- * takes the rule of src/stop.h (each channel's 95% interval within sqrt(2 L) E |m|; mins from
+ * takes the rule of src/stop.h (ulam__stop_rel_met on each channel's 95% interval; mins from
  * channel_mins hold a channel still at 0); shooting, the standard error alone. */
 static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, const double mins[3], double rel_err)
 {
