@@ -63,7 +63,7 @@ enum ulam_status {
     ULAM_ENOMEM,       /* out of memory */
     ULAM_EIO,          /* file cannot be opened, read or written */
     ULAM_EEMPTY,       /* input file is empty */
-    ULAM_EBANNER,      /* missing or malformed %%MatrixMarket banner */
+    ULAM_EBANNER,      /* not the kind of file expected: a missing or malformed banner or magic */
     ULAM_EUNSUPPORTED, /* valid Matrix Market, but a kind ulam does not handle (complex, ...) */
     ULAM_ESIZELINE,    /* missing or malformed size line */
     ULAM_EOVERFLOW,    /* sizes too large to represent or allocate */
@@ -173,6 +173,11 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
 /* ---------------------------------------------------------------- Matrix Market */
 /* Primary: ulam_mm_read_matrix, _read_vector, _write_vector.  Secondary: options, FILE readers,
  * _write_matrix.  Tertiary: ulam_strtod, ulam_outfile. */
+
+/* The most rows (and columns) a Matrix Market matrix declaring nnz entries may have: every row
+ * costs memory and time in each pass over M, so a short file may not declare millions of empty
+ * ones (ULAM_EOVERFLOW at the size line).  A vector (n x 1), held dense anyway: 2^24 + 64 nnz. */
+#define ULAM_MM_DIM_CAP(nnz) (((int64_t)1 << 16) + 64 * (int64_t)(nnz))
 
 /* Read a sparse matrix from path ("coordinate" real/integer/pattern, general/symmetric/
  * skew-symmetric; duplicates summed, explicit zeros dropped; symmetric files are
@@ -390,21 +395,24 @@ int ulam_guard_variance(const ulam_guard *g, int mode);
 /* ---------------------------------------------------------------- prepared systems */
 /* Secondary, except tertiary: ulam_system_from_memory, _is_file, _omega, _certificate, _write_file. */
 
-/* A prepared system: M (and b) of (I - M) x = b as one binary file that is mapped read-only
- * and used in place, so a query reads only the pages of the rows its walks reach (the layout
- * is documented in docs/prepared.md: a 1024-byte little-endian header with the sizes, the
- * array offsets, the file length, a certificate section and an FNV-1a checksum of the header,
- * then rowptr int64[nrows + 1], colidx int32[nnz], val double[nnz] and b double[nrows], each
- * at a 4096-byte boundary).  `ulam prepare` writes one; `--cache` keeps one beside each input
- * (a vector's holds only b), tagged with the source's size and modification time. */
+/* A prepared system: M (and b, and optionally M^T) of (I - M) x = b as one binary file that is
+ * mapped read-only and used in place, so a query reads only the pages of the rows its walks
+ * reach.  The layout is documented in docs/prepared.md (format version 2): a 1024-byte
+ * little-endian header (sizes, array offsets, the file length, a certificate section, its own
+ * XXH3 checksum), the arrays at 4096-byte boundaries and a table of XXH3-64 checksums, one for
+ * each block of rows of M, b and M^T.  Every block is verified (checksum and CSR invariants) the
+ * first time anything reads it, once.  `ulam prepare` writes one; `--cache` keeps one beside
+ * each input (a vector's holds only b), tagged with the XXH3-128 hash of the source's bytes. */
 typedef struct ulam_system ulam_system;
 
 /* What the guards certified for a prepared system, so a query needs no pass over M: the
  * radii of ulam_guard_check for the kernel of continuation continue_q and exponent 1 (a
  * query at another kernel exponent computes its own) under power-iteration
  * options (tol, max_iter), and the row- and column-sum bounds of |M| (the largest of either
- * bounds rho(|M|) from above).  Stored in a versioned section of the header (version 1 holds
- * these fields; a reader ignores a version it does not know and the guards run as usual). */
+ * bounds rho(|M|) from above).  Stored in a versioned section of the header (version 3 holds
+ * these fields and the content hash of M's blocks, which binds it to the arrays it certifies; a
+ * later version appends fields and a version-3 reader reads the ones it knows; an earlier one is
+ * ignored and the guards run as usual). */
 typedef struct ulam_certificate {
     double continue_q; /* <= 0: the analog kernel */
     double tol;
@@ -414,8 +422,9 @@ typedef struct ulam_certificate {
 } ulam_certificate;
 
 /* What to write: M and/or b (n entries; with M, n = M->nrows), an optional source tag (the
- * CLI's cache: size and mtime), the Jacobi damping omega that made M (0: M as read) and an
- * optional certificate.  Start from ulam_system_desc_defaults(). */
+ * CLI's cache: ulam_file_tag of the source), the Jacobi damping omega that made M (0: M as
+ * read), an optional certificate of M, and whether to store M^T too (transpose 1: the writer
+ * builds it; ulam_system_transpose then serves it).  Start from ulam_system_desc_defaults(). */
 typedef struct ulam_system_desc {
     const ulam_csr *M;
     const double *b;
@@ -423,26 +432,27 @@ typedef struct ulam_system_desc {
     uint64_t tag[2];
     double omega;
     const ulam_certificate *cert;
+    int transpose;
 } ulam_system_desc;
 
-/* The defaults: nothing to write yet (M, b and cert NULL, n 0, tag {0, 0}, omega 0); set M
- * and/or b and n. */
+/* The defaults: nothing to write yet (M, b and cert NULL, n 0, tag {0, 0}, omega 0, no
+ * transpose); set M and/or b and n. */
 ulam_system_desc ulam_system_desc_defaults(void);
 
 /* Write a prepared system to f (positioned at 0; the caller closes it): ULAM_OK, ULAM_EINVAL
- * (also for a certificate whose guards are not of kernel exponent 1) or ULAM_EIO. */
+ * (also for an M that fails ulam_csr_check, a b not finite, a certificate without M or whose
+ * guards are not of kernel exponent 1), ULAM_ENOMEM or ULAM_EIO. */
 int ulam_system_write_file(FILE *f, const ulam_system_desc *d);
 
 /* Write a prepared system to path atomically (through ulam_outfile). */
 int ulam_system_write(const char *path, const ulam_system_desc *d);
 
-/* Map the prepared system at path read-only.  The header is checked whole: magic
- * (ULAM_EBANNER), version and byte order (ULAM_EUNSUPPORTED), checksum, sizes, offsets and
- * the file's length against them, rowptr[0] = 0 and rowptr[nrows] = nnz (ULAM_ESYNTAX; a
- * truncated file fails here); tag, when not NULL, must match the stored one (ULAM_ENOTFOUND).
- * The arrays are NOT read: ulam_system_check verifies them, and the walk kernel checks each
- * row it builds (ulam_solver_iterate fails with ULAM_ESYNTAX on a corrupt one), so a query
- * that uses the certificate reads only the rows it walks. */
+/* Map the prepared system at path read-only.  Checked at once, in O(blocks): magic and an empty
+ * file (ULAM_EBANNER), version and byte order (ULAM_EUNSUPPORTED), the header's checksum, sizes,
+ * offsets and the file's length against them, the checksum table against its checksum, the
+ * certificate's content hash against the table, rowptr[0] = 0 and rowptr[nrows] = nnz
+ * (ULAM_ESYNTAX; a truncated file fails here); tag, when not NULL, must match the stored one
+ * (ULAM_ENOTFOUND).  The arrays are verified block by block when first read (below). */
 int ulam_system_open(const char *path, const uint64_t tag[2], ulam_system **out, ulam_error *err);
 
 /* As ulam_system_open on bytes already in memory (borrowed: they must outlive the system). */
@@ -452,19 +462,34 @@ int ulam_system_from_memory(const void *data, size_t bytes, const uint64_t tag[2
 /* 1 when path starts with the prepared-system magic, 0 otherwise (unreadable included). */
 int ulam_system_is_file(const char *path);
 
-/* Verify the arrays as a parse would: the CSR invariants (ulam_csr_check) and a finite b;
- * one pass over the file.  ULAM_OK or ULAM_ESYNTAX / ULAM_EINDEX / ULAM_ENONFINITE. */
+/* Verify every block of M, b and M^T (checksums and the CSR invariants of ulam_csr_check, a
+ * finite b): one pass over the file, and none again (each block's verdict is kept).  ULAM_OK or
+ * ULAM_ESYNTAX with err naming the damaged block (err->index its first row) and the fault. */
 int ulam_system_check(const ulam_system *s, ulam_error *err);
 
-/* The mapped matrix (NULL when the file holds only b): read-only, owned by s (never pass it
- * to ulam_csr_free), valid until ulam_system_free.  Not verified: a walk checks each row it
- * builds, but anything that reads all of M (the guards ulam_solver_alloc runs unless
- * ulam_walk_opts.guard holds them, a direct solve) needs ulam_system_check first; a query
- * passes the certificate's guards instead (ulam_certificate_guard). */
+/* Verify the blocks of M and b that hold rows [first, last) (clipped to 0 .. n), as
+ * ulam_system_check does; thread-safe. */
+int ulam_system_verify(const ulam_system *s, int64_t first, int64_t last, ulam_error *err);
+
+/* The mapped matrix, verified whole on the first call (NULL when the file holds none or it is
+ * damaged: ulam_system_check says where): read-only, owned by s (never pass it to
+ * ulam_csr_free), valid until ulam_system_free. */
 const ulam_csr *ulam_system_matrix(const ulam_system *s);
 
-/* The mapped b (NULL when the file holds none); *n (may be NULL) gets its length. */
+/* The mapped b, verified whole (NULL when the file holds none or it is damaged); *n (may be
+ * NULL) gets its length. */
 const double *ulam_system_rhs(const ulam_system *s, int64_t *n);
+
+/* The stored M^T (`ulam prepare --transpose`), verified whole, NULL when the file holds none
+ * or it is damaged: what a bidirectional or point-source query pushes on, with no transpose to
+ * build. */
+const ulam_csr *ulam_system_transpose(const ulam_system *s);
+
+/* The mapped M and b (either may be NULL) as they are, NOT verified: for a solver given
+ * ulam_walk_opts.system = s (and this M), which verifies each block before its walks, its
+ * reachability search or a pass over all of M first read it, so a query for one x_i reads only
+ * the blocks of the rows it reaches.  ULAM_OK, or ULAM_EINVAL for s NULL. */
+int ulam_system_lazy(const ulam_system *s, const ulam_csr **M, const double **b);
 
 /* The stored certificate, or NULL when there is none (or of a version this reader does not know). */
 const ulam_certificate *ulam_system_certificate(const ulam_system *s);
@@ -474,6 +499,11 @@ double ulam_system_omega(const ulam_system *s);
 
 /* Unmap and free; accepts and returns NULL. */
 ulam_system *ulam_system_free(ulam_system *s);
+
+/* The content tag of a source file for a cache (ulam_system_desc.tag, ulam_system_open's tag):
+ * the XXH3-128 hash of its bytes (low, high), so an edit that keeps the size and the modification
+ * time still changes it.  ULAM_OK, ULAM_EIO or ULAM_ENOMEM. */
+int ulam_file_tag(const char *path, uint64_t tag[2], ulam_error *err);
 
 /* The certificate of M: the guards of ulam_guard_check(M, continue_q, opts) and the row and
  * column sums of |M| (one more pass); ULAM_EINVAL for opts->kernel_alpha != 1 (the file's
@@ -551,6 +581,11 @@ typedef struct ulam_walk_opts {
                             sum_j start_weights[j] x_{starts[j]} (index only labels it) */
     const int64_t *starts;       /* k states (0-based), borrowed like b */
     const double *start_weights; /* k finite weights, not all 0 */
+    const ulam_system *system; /* the prepared system M (and b, when it is the system's) come from
+                                  (ulam_system_lazy), or NULL: its blocks are verified as they are
+                                  first read (each row before a walk builds it; every row before a
+                                  pass over all of M), and a damaged one fails the run with
+                                  ULAM_ESYNTAX naming it */
 } ulam_walk_opts;
 
 /* The defaults: adjoint collision walks, index 0, analog kernel (kernel_alpha 1), seed 1, all

@@ -81,7 +81,8 @@ static int guard_need(chooser *c, int kk, int need, ulam_error *err)
     go.need = need & ~g->computed;
     go.kernel_alpha = c->as[kk % 3];
     ulam_guard h;
-    int status = ulam_guard_check(c->M, c->qs[kk / 3], &go, &h, err);
+    int status = c->base.system ? ulam_system_check(c->base.system, err) : ULAM_OK; /* a lazily read file: whole now */
+    if (!status) status = ulam_guard_check(c->M, c->qs[kk / 3], &go, &h, err);
     if (status) return status;
     if (!g->computed) *g = h;
     else

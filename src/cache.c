@@ -2,55 +2,80 @@
  * (docs/prepared.md).  The header is 1024 bytes of little-endian 64-bit words:
  *
  *   word  0      magic "ulamSYS1"
- *   word  1      version (1) | header bytes (1024) << 32
- *   word  2      flags: 1 matrix, 2 b, 4 certificate
+ *   word  1      format version (2) | header bytes (1024) << 32
+ *   word  2      flags: 1 matrix, 2 b, 4 certificate, 8 transpose
  *   words 3-5    nrows, ncols, nnz
  *   words 6-9    byte offsets of rowptr int64[nrows + 1], colidx int32[nnz], val double[nnz],
  *                b double[nrows] (0 when absent), each a multiple of 4096
  *   word  10     the file's length in bytes
- *   words 11-12  the source's tag (the CLI's cache: size and mtime; 0 from `ulam prepare`)
+ *   words 11-12  the source's tag (the CLI's cache: XXH3-128 of the source file; 0 from `ulam prepare`)
  *   word  13     the Jacobi damping omega that made M (double; 0: M as read)
- *   words 32-126 the certificate section: word 32 its version (1) | its bytes << 32, then
- *                version 1's fields (see put_cert)
- *   word  127    FNV-1a 64 of bytes 0 .. 1015
+ *   word  14     log2 of the rows in a block (the unit of verification)
+ *   word  15     byte offset of the checksum table (XXH3-64 of each block: M's, b's, M^T's)
+ *   word  16     XXH3-64 of the checksum table
+ *   words 17-19  byte offsets of M^T's rowptr int64[ncols + 1], colidx int32[nnz], val double[nnz]
+ *   words 32-126 the certificate section: word 32 its version (3) | its bytes << 32, then
+ *                version 3's fields (see put_cert), the first the content hash of M's blocks
+ *   word  127    XXH3-64 of bytes 0 .. 1015
  *
- * Opening checks the header whole but reads no array beyond rowptr[0] and rowptr[nrows]:
- * ulam_system_check verifies them, and the walk kernel checks each row it builds. */
+ * Opening checks the header, the checksum table and the certificate's binding, and reads no
+ * array beyond rowptr[0] and rowptr[nrows].  Each block of rows is verified the first time
+ * anything reads it (its checksum, its rowptr rising within the entries, its columns in range,
+ * sorted and unique, its values finite and nonzero; b's block hashed and finite), once: an atomic
+ * state a block, so the two walk threads may race to verify one and agree.  ulam_system_matrix,
+ * _rhs and _transpose verify their arrays whole; ulam_system_lazy hands the arrays out unverified
+ * for a solver given ulam_walk_opts.system, whose kernel verifies each row's block before it
+ * builds the row (so a one-row query reads a few blocks). */
 #include "internal.h"
 
 #include <fcntl.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#define XXH_STATIC_LINKING_ONLY /* XXH3_state_t on the stack */
+#include <xxhash.h>
 
 enum {
-    HEADER = 1024, WORDS = HEADER / 8, ALIGN = 4096, VERSION = 1,
-    F_MATRIX = 1, F_RHS = 2, F_CERT = 4,
-    W_FLAGS = 2, W_DIMS = 3, W_OFF = 6, W_LEN = 10, W_TAG = 11, W_OMEGA = 13,
-    W_CERT = 32, W_SUM = WORDS - 1, CERT_VERSION = 2, CERT_WORDS = 36
+    HEADER = 1024, WORDS = HEADER / 8, ALIGN = 4096, VERSION = 2,
+    F_MATRIX = 1, F_RHS = 2, F_CERT = 4, F_TRANSPOSE = 8,
+    W_FLAGS = 2, W_DIMS = 3, W_OFF = 6, W_LEN = 10, W_TAG = 11, W_OMEGA = 13, W_SHIFT = 14, W_SUMS = 15,
+    W_SUMS_HASH = 16, W_TOFF = 17,
+    W_CERT = 32, W_SUM = WORDS - 1, CERT_VERSION = 3, CERT_WORDS = 37,
+    BLOCK_ENTRIES = 1024 /* entries a block aims at: a few pages of colidx and val */
 };
 static const char MAGIC[8] = {'u', 'l', 'a', 'm', 'S', 'Y', 'S', '1'};
 
+/* Which arrays a block belongs to. */
+enum { PART_M = 0, PART_B = 1, PART_T = 2 };
+
+/* The verification state of a block. */
+enum { UNCHECKED = 0, GOOD = 1, BAD = 2 };
+
 struct ulam_system {
     ulam_csr csr;          /* pointers into the mapping */
+    ulam_csr tr;           /* M^T (prepare --transpose), or nrows 0 */
     const double *b;
     int64_t n;
-    int has_matrix, has_cert;
+    int has_matrix, has_cert, has_tr;
     double omega;
     ulam_certificate cert;
+    int shift;             /* a block holds 2^shift rows */
+    int64_t nblocks[3];    /* blocks of M, b, M^T (0: absent) */
+    int64_t first[3];      /* each part's first entry in sums[] and state[] */
+    const uint64_t *sums;  /* the checksum table */
+    _Atomic unsigned char *state; /* one a block, as sums[] */
     void *map;             /* the mapping (NULL: borrowed memory) */
     size_t map_bytes;
 };
 
-/* FNV-1a 64 of bytes p[0 .. n). */
-static uint64_t fnv1a(const unsigned char *p, size_t n)
+/* XXH3-64 of bytes p[0 .. n). */
+static uint64_t hash(const void *p, size_t n)
 {
-    uint64_t h = 0xcbf29ce484222325u;
-    for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 0x100000001b3u;
-    return h;
+    return (uint64_t)XXH3_64bits(p, n);
 }
 
 /* Nonzero on a little-endian machine (the only one that can use the file in place). */
@@ -91,36 +116,42 @@ static void get_power(const uint64_t *w, ulam_power *p)
                       .seconds = real(w[7])};
 }
 
-/* Certificate version 2 from word 33: continue_q, tol, max_iter, rowsum min and max, colsum min
+/* Certificate version 3 from word 33: the content hash of M's blocks (XXH3-64 of their
+ * checksums: the arrays it certifies), continue_q, tol, max_iter, rowsum min and max, colsum min
  * and max, then |M|, M^ adjoint, M^ forward (8 words each), the three verdicts and the guard's
- * computed bits. */
-static void put_cert(uint64_t *w, const ulam_certificate *c)
+ * computed bits.  A later version appends fields: the section's bytes say how many there are. */
+static void put_cert(uint64_t *w, const ulam_certificate *c, uint64_t content)
 {
     w[0] = (uint64_t)CERT_VERSION | (uint64_t)(CERT_WORDS * 8) << 32;
-    w[1] = bits(c->continue_q), w[2] = bits(c->tol), w[3] = (uint64_t)(int64_t)c->max_iter;
-    w[4] = bits(c->rowsum_min), w[5] = bits(c->rowsum_max), w[6] = bits(c->colsum_min), w[7] = bits(c->colsum_max);
-    put_power(w + 8, &c->guard.abs);
-    put_power(w + 16, &c->guard.hat[0]);
-    put_power(w + 24, &c->guard.hat[1]);
-    w[32] = (uint64_t)c->guard.verdict_abs, w[33] = (uint64_t)c->guard.verdict_hat[0];
-    w[34] = (uint64_t)c->guard.verdict_hat[1], w[35] = (uint64_t)c->guard.computed;
+    w[1] = content;
+    w[2] = bits(c->continue_q), w[3] = bits(c->tol), w[4] = (uint64_t)(int64_t)c->max_iter;
+    w[5] = bits(c->rowsum_min), w[6] = bits(c->rowsum_max), w[7] = bits(c->colsum_min), w[8] = bits(c->colsum_max);
+    put_power(w + 9, &c->guard.abs);
+    put_power(w + 17, &c->guard.hat[0]);
+    put_power(w + 25, &c->guard.hat[1]);
+    w[33] = (uint64_t)c->guard.verdict_abs, w[34] = (uint64_t)c->guard.verdict_hat[0];
+    w[35] = (uint64_t)c->guard.verdict_hat[1], w[36] = (uint64_t)c->guard.computed;
 }
 
-/* Read certificate version 2; 0 when the section is of another version or inconsistent. */
-static int get_cert(const uint64_t *w, ulam_certificate *c)
+/* Read a certificate of version 3 or later (the fields version 3 has): 1, with *content its
+ * content hash; 0 when the section is of an earlier version, too short for its version, or
+ * inconsistent. */
+static int get_cert(const uint64_t *w, ulam_certificate *c, uint64_t *content)
 {
-    if (w[0] != ((uint64_t)CERT_VERSION | (uint64_t)(CERT_WORDS * 8) << 32)) return 0;
-    *c = (ulam_certificate){.continue_q = real(w[1]), .tol = real(w[2]), .max_iter = (int)(int64_t)w[3],
-                            .rowsum_min = real(w[4]), .rowsum_max = real(w[5]), .colsum_min = real(w[6]),
-                            .colsum_max = real(w[7])};
-    get_power(w + 8, &c->guard.abs);
-    get_power(w + 16, &c->guard.hat[0]);
-    get_power(w + 24, &c->guard.hat[1]);
+    uint64_t version = w[0] & 0xffffffffu, bytes = w[0] >> 32;
+    if (version < CERT_VERSION || bytes < CERT_WORDS * 8 || bytes > (uint64_t)(W_SUM - W_CERT) * 8) return 0;
+    *content = w[1];
+    *c = (ulam_certificate){.continue_q = real(w[2]), .tol = real(w[3]), .max_iter = (int)(int64_t)w[4],
+                            .rowsum_min = real(w[5]), .rowsum_max = real(w[6]), .colsum_min = real(w[7]),
+                            .colsum_max = real(w[8])};
+    get_power(w + 9, &c->guard.abs);
+    get_power(w + 17, &c->guard.hat[0]);
+    get_power(w + 25, &c->guard.hat[1]);
     for (int k = 0; k < 3; k++)
-        if (w[32 + k] > ULAM_VERDICT_UNKNOWN) return 0;
-    if (w[35] > (uint64_t)ULAM_GUARD_ALL) return 0;
-    c->guard.verdict_abs = (int)w[32], c->guard.verdict_hat[0] = (int)w[33], c->guard.verdict_hat[1] = (int)w[34];
-    c->guard.computed = (int)w[35];
+        if (w[33 + k] > ULAM_VERDICT_UNKNOWN) return 0;
+    if (w[36] > (uint64_t)ULAM_GUARD_ALL) return 0;
+    c->guard.verdict_abs = (int)w[33], c->guard.verdict_hat[0] = (int)w[34], c->guard.verdict_hat[1] = (int)w[35];
+    c->guard.computed = (int)w[36];
     c->guard.continue_q = c->continue_q;
     c->guard.kernel_alpha = 1.0; /* certificates are made at kernel exponent 1 (ulam_certificate_compute) */
     return 1;
@@ -142,42 +173,118 @@ static int put_part(FILE *f, const void *p, size_t n, uint64_t *at)
     return !pad || fwrite(zeros, 1, pad, f) == pad;
 }
 
+/* log2 of the rows of a block: about BLOCK_ENTRIES entries of the matrix (b alone: 1024 rows),
+ * from 16 to 65536 rows. */
+static int block_shift(int64_t n, int64_t nnz)
+{
+    double want = nnz > 0 ? (double)BLOCK_ENTRIES * (double)n / (double)nnz : 1024.0;
+    int s = 4;
+    while (s < 16 && (double)((int64_t)1 << s) < want) s++;
+    return s;
+}
+
+/* Blocks of 2^shift rows covering n rows. */
+static int64_t block_count(int64_t n, int shift)
+{
+    return (n + ((int64_t)1 << shift) - 1) >> shift;
+}
+
+/* The checksum of rows r0 .. r1 - 1 of A (its rowptr checked): rowptr[r0 .. r1], then the
+ * columns and values of those rows. */
+static uint64_t csr_block_hash(const ulam_csr *A, int64_t r0, int64_t r1)
+{
+    XXH3_state_t st;
+    XXH3_64bits_reset(&st);
+    int64_t a = A->rowptr[r0], e = A->rowptr[r1];
+    XXH3_64bits_update(&st, A->rowptr + r0, (size_t)(r1 - r0 + 1) * sizeof *A->rowptr);
+    if (e > a) {
+        XXH3_64bits_update(&st, A->colidx + a, (size_t)(e - a) * sizeof *A->colidx);
+        XXH3_64bits_update(&st, A->val + a, (size_t)(e - a) * sizeof *A->val);
+    }
+    return (uint64_t)XXH3_64bits_digest(&st);
+}
+
+/* The checksums of A's blocks into sums[0 .. blocks). */
+static void csr_sums(const ulam_csr *A, int shift, uint64_t *sums)
+{
+    int64_t nb = block_count(A->nrows, shift);
+    for (int64_t k = 0; k < nb; k++) {
+        int64_t r0 = k << shift, r1 = r0 + ((int64_t)1 << shift) < A->nrows ? r0 + ((int64_t)1 << shift) : A->nrows;
+        sums[k] = csr_block_hash(A, r0, r1);
+    }
+}
+
+/* The checksums of b's blocks into sums[0 .. blocks). */
+static void vec_sums(const double *b, int64_t n, int shift, uint64_t *sums)
+{
+    int64_t nb = block_count(n, shift);
+    for (int64_t k = 0; k < nb; k++) {
+        int64_t r0 = k << shift, r1 = r0 + ((int64_t)1 << shift) < n ? r0 + ((int64_t)1 << shift) : n;
+        sums[k] = hash(b + r0, (size_t)(r1 - r0) * sizeof *b);
+    }
+}
+
 /* An empty description. */
 ulam_system_desc ulam_system_desc_defaults(void)
 {
-    return (ulam_system_desc){.M = NULL, .b = NULL, .n = 0, .tag = {0, 0}, .omega = 0.0, .cert = NULL};
+    return (ulam_system_desc){.M = NULL, .b = NULL, .n = 0, .tag = {0, 0}, .omega = 0.0, .cert = NULL, .transpose = 0};
 }
 
 /* Write a prepared system to f. */
 int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
 {
-    if (!f || !d || (!d->M && !d->b) || !little_endian()) return ULAM_EINVAL;
+    if (!f || !d || (!d->M && !d->b) || !little_endian() || (d->transpose && !d->M)) return ULAM_EINVAL;
     const ulam_csr *M = d->M;
     int64_t n = M ? M->nrows : d->n, nnz = M ? M->rowptr[M->nrows] : 0;
     if (n < 0 || (M && d->n != M->nrows && d->b)) return ULAM_EINVAL;
-    if (d->cert && d->cert->guard.kernel_alpha != 1.0) return ULAM_EINVAL; /* the section holds exponent 1's guards */
-    uint64_t w[WORDS] = {0}, at = HEADER;
-    size_t part[4] = {M ? ((size_t)n + 1) * 8 : 0, (size_t)nnz * 4, (size_t)nnz * 8, d->b ? (size_t)n * 8 : 0};
+    if (d->cert && (d->cert->guard.kernel_alpha != 1.0 || !M)) return ULAM_EINVAL; /* exponent 1's guards, of M */
+    if (M && ulam_csr_check(M)) return ULAM_EINVAL; /* never a file that fails its own verification */
+    for (int64_t i = 0; d->b && i < n; i++)
+        if (!isfinite(d->b[i])) return ULAM_EINVAL;
+    ulam_csr *T = NULL;
+    if (d->transpose && ulam_csr_transpose(M, &T)) return ULAM_ENOMEM;
+    int shift = block_shift(n, nnz);
+    int64_t nb[3] = {M ? block_count(n, shift) : 0, d->b ? block_count(n, shift) : 0, T ? block_count(T->nrows, shift) : 0};
+    size_t nsums = (size_t)(nb[0] + nb[1] + nb[2]);
+    uint64_t *sums = malloc((nsums ? nsums : 1) * sizeof *sums);
+    if (!sums) {
+        ulam_csr_free(T);
+        return ULAM_ENOMEM;
+    }
+    if (M) csr_sums(M, shift, sums);
+    if (d->b) vec_sums(d->b, n, shift, sums + nb[0]);
+    if (T) csr_sums(T, shift, sums + nb[0] + nb[1]);
+    uint64_t w[WORDS] = {0}, at = aligned(HEADER);
+    enum { PARTS = 8 };
+    size_t part[PARTS] = {M ? ((size_t)n + 1) * 8 : 0, (size_t)nnz * 4, (size_t)nnz * 8, d->b ? (size_t)n * 8 : 0,
+                          T ? ((size_t)T->nrows + 1) * 8 : 0, T ? (size_t)nnz * 4 : 0, T ? (size_t)nnz * 8 : 0,
+                          nsums * 8};
+    const void *src[PARTS] = {M ? (const void *)M->rowptr : NULL, M ? (const void *)M->colidx : NULL,
+                              M ? (const void *)M->val : NULL, d->b, T ? (const void *)T->rowptr : NULL,
+                              T ? (const void *)T->colidx : NULL, T ? (const void *)T->val : NULL, sums};
+    int present[PARTS] = {M != NULL, M != NULL, M != NULL, d->b != NULL, T != NULL, T != NULL, T != NULL, 1};
+    const int word[PARTS] = {W_OFF, W_OFF + 1, W_OFF + 2, W_OFF + 3, W_TOFF, W_TOFF + 1, W_TOFF + 2, W_SUMS};
     memcpy(&w[0], MAGIC, 8);
     w[1] = (uint64_t)VERSION | (uint64_t)HEADER << 32;
-    w[W_FLAGS] = (M ? F_MATRIX : 0) | (d->b ? F_RHS : 0) | (d->cert ? F_CERT : 0);
+    w[W_FLAGS] = (M ? F_MATRIX : 0) | (d->b ? F_RHS : 0) | (d->cert ? F_CERT : 0) | (T ? F_TRANSPOSE : 0);
     w[W_DIMS] = (uint64_t)n, w[W_DIMS + 1] = (uint64_t)(M ? M->ncols : 1), w[W_DIMS + 2] = (uint64_t)nnz;
-    at = aligned(at);
-    for (int k = 0; k < 4; k++) {
-        w[W_OFF + k] = part[k] || (k < 3 && M) || (k == 3 && d->b) ? at : 0;
+    for (int k = 0; k < PARTS; k++) {
+        w[word[k]] = present[k] ? at : 0;
         at = aligned(at + part[k]);
     }
     w[W_LEN] = at;
     w[W_TAG] = d->tag[0], w[W_TAG + 1] = d->tag[1];
     w[W_OMEGA] = bits(d->omega);
-    if (d->cert) put_cert(w + W_CERT, d->cert);
-    w[W_SUM] = fnv1a((const unsigned char *)w, (size_t)W_SUM * 8);
-    const void *src[4] = {M ? (const void *)M->rowptr : NULL, M ? (const void *)M->colidx : NULL,
-                          M ? (const void *)M->val : NULL, d->b};
+    w[W_SHIFT] = (uint64_t)shift;
+    w[W_SUMS_HASH] = hash(sums, nsums * 8);
+    if (d->cert) put_cert(w + W_CERT, d->cert, hash(sums, (size_t)nb[0] * 8));
+    w[W_SUM] = hash(w, (size_t)W_SUM * 8);
     uint64_t pos = 0;
     int ok = put_part(f, w, HEADER, &pos);
-    for (int k = 0; k < 4 && ok; k++)
-        if (w[W_OFF + k]) ok = put_part(f, src[k], part[k], &pos);
+    for (int k = 0; k < PARTS && ok; k++)
+        if (present[k]) ok = put_part(f, src[k], part[k], &pos);
+    free(sums);
+    ulam_csr_free(T);
     return ok && pos == at ? ULAM_OK : ULAM_EIO;
 }
 
@@ -202,48 +309,77 @@ static int inside(uint64_t off, uint64_t bytes, uint64_t len)
     return off >= HEADER && off % ALIGN == 0 && off <= len && bytes <= len - off;
 }
 
+/* The CSR view of arrays at offsets off[0 .. 2] of p. */
+static ulam_csr csr_at(const unsigned char *p, const uint64_t *off, uint64_t nrows, uint64_t ncols)
+{
+    return (ulam_csr){.nrows = (int64_t)nrows, .ncols = (int64_t)ncols, .rowptr = (int64_t *)(uintptr_t)(p + off[0]),
+                      .colidx = (int32_t *)(uintptr_t)(p + off[1]), .val = (double *)(uintptr_t)(p + off[2])};
+}
+
 /* Check the header of the len bytes at p and fill s (its arrays point into p). */
 static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam_system *s, ulam_error *err)
 {
     uint64_t w[WORDS];
+    if (len == 0) return ulam__fail(err, ULAM_EBANNER, 0, -1, "an ulam prepared system (the file is empty)");
     if (len < 8 || memcmp(p, MAGIC, 8))
         return ulam__fail(err, ULAM_EBANNER, 0, -1, "an ulam prepared system (magic 'ulamSYS1')");
     if (!little_endian()) return ulam__fail(err, ULAM_EUNSUPPORTED, 0, -1, "a little-endian machine");
     if (len < HEADER)
         return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a header of %d bytes (the file has %zu: truncated)", HEADER, len);
     memcpy(w, p, HEADER);
+    if (hash(p, (size_t)W_SUM * 8) != w[W_SUM])
+        return ulam__fail(err, ULAM_ESYNTAX, 0, -1,
+                          "a header matching its checksum (the header is damaged, or of a format before version 2)");
     if (w[1] != ((uint64_t)VERSION | (uint64_t)HEADER << 32))
-        return ulam__fail(err, ULAM_EUNSUPPORTED, 0, -1, "format version 1 (got %llu)", (unsigned long long)(w[1] & 0xffffffffu));
-    if (fnv1a(p, (size_t)W_SUM * 8) != w[W_SUM])
-        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a header matching its checksum (the header is corrupt)");
+        return ulam__fail(err, ULAM_EUNSUPPORTED, 0, -1, "format version %d (got %llu: prepare the file again)", VERSION,
+                          (unsigned long long)(w[1] & 0xffffffffu));
     if (w[W_LEN] != len)
         return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a file of %llu bytes as its header states, got %zu (truncated?)",
                           (unsigned long long)w[W_LEN], len);
-    uint64_t flags = w[W_FLAGS], n = w[W_DIMS], nc = w[W_DIMS + 1], nnz = w[W_DIMS + 2];
-    int m = (flags & F_MATRIX) != 0, r = (flags & F_RHS) != 0;
-    if ((flags & ~(uint64_t)(F_MATRIX | F_RHS | F_CERT)) || (!m && !r) || n > ULAM_MAX_DIM || nc > ULAM_MAX_DIM ||
-        nnz > (uint64_t)INT64_MAX / 32 || (!m && (nnz || nc != 1)))
-        return ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "sizes that fit (got %llu x %llu, %llu entries)",
-                          (unsigned long long)n, (unsigned long long)nc, (unsigned long long)nnz);
-    uint64_t bytes[4] = {m ? (n + 1) * 8 : 0, m ? nnz * 4 : 0, m ? nnz * 8 : 0, r ? n * 8 : 0};
-    for (int k = 0; k < 4; k++) {
-        int present = k < 3 ? m : r;
-        if (present ? !inside(w[W_OFF + k], bytes[k], len) : w[W_OFF + k] != 0)
-            return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "arrays inside the file at 4096-byte boundaries (array %d is not)", k);
-    }
+    uint64_t flags = w[W_FLAGS], n = w[W_DIMS], nc = w[W_DIMS + 1], nnz = w[W_DIMS + 2], shift = w[W_SHIFT];
+    int m = (flags & F_MATRIX) != 0, r = (flags & F_RHS) != 0, t = (flags & F_TRANSPOSE) != 0;
+    if ((flags & ~(uint64_t)(F_MATRIX | F_RHS | F_CERT | F_TRANSPOSE)) || (!m && !r) || (t && !m) || (!m && (flags & F_CERT)) ||
+        n > ULAM_MAX_DIM || nc > ULAM_MAX_DIM || nnz > (uint64_t)INT64_MAX / 32 || (!m && (nnz || nc != 1)) || shift < 4 ||
+        shift > 30)
+        return ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "sizes that fit (got %llu x %llu, %llu entries, blocks of 2^%llu rows)",
+                          (unsigned long long)n, (unsigned long long)nc, (unsigned long long)nnz, (unsigned long long)shift);
+    int64_t nb[3] = {m ? block_count((int64_t)n, (int)shift) : 0, r ? block_count((int64_t)n, (int)shift) : 0,
+                     t ? block_count((int64_t)nc, (int)shift) : 0};
+    uint64_t nsums = (uint64_t)(nb[0] + nb[1] + nb[2]);
+    const int word[8] = {W_OFF, W_OFF + 1, W_OFF + 2, W_OFF + 3, W_TOFF, W_TOFF + 1, W_TOFF + 2, W_SUMS};
+    const char *name[8] = {"rowptr", "colidx", "val", "b", "rowptr of M^T", "colidx of M^T", "val of M^T", "checksums"};
+    uint64_t bytes[8] = {m ? (n + 1) * 8 : 0, m ? nnz * 4 : 0, m ? nnz * 8 : 0, r ? n * 8 : 0,
+                         t ? (nc + 1) * 8 : 0, t ? nnz * 4 : 0, t ? nnz * 8 : 0, nsums * 8};
+    int present[8] = {m, m, m, r, t, t, t, 1};
+    for (int k = 0; k < 8; k++)
+        if (present[k] ? !inside(w[word[k]], bytes[k], len) : w[word[k]] != 0)
+            return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "arrays inside the file at 4096-byte boundaries (%s is not)", name[k]);
+    const uint64_t *sums = (const uint64_t *)(const void *)(p + w[W_SUMS]);
+    if (hash(sums, (size_t)nsums * 8) != w[W_SUMS_HASH])
+        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a checksum table matching its checksum (the table is damaged)");
     if (tag && (w[W_TAG] != tag[0] || w[W_TAG + 1] != tag[1]))
         return ulam__fail(err, ULAM_ENOTFOUND, 0, -1, "a cache of the current source file (it changed)");
-    *s = (ulam_system){.n = (int64_t)n, .has_matrix = m, .omega = real(w[W_OMEGA])};
+    *s = (ulam_system){.n = (int64_t)n, .has_matrix = m, .has_tr = t, .omega = real(w[W_OMEGA]), .shift = (int)shift,
+                       .sums = sums};
+    for (int k = 0; k < 3; k++) s->nblocks[k] = nb[k], s->first[k] = k ? s->first[k - 1] + nb[k - 1] : 0;
     if (m) {
-        s->csr = (ulam_csr){.nrows = (int64_t)n, .ncols = (int64_t)nc, .rowptr = (int64_t *)(uintptr_t)(p + w[W_OFF]),
-                            .colidx = (int32_t *)(uintptr_t)(p + w[W_OFF + 1]),
-                            .val = (double *)(uintptr_t)(p + w[W_OFF + 2])};
+        s->csr = csr_at(p, w + W_OFF, n, nc);
         if (s->csr.rowptr[0] != 0 || s->csr.rowptr[n] != (int64_t)nnz)
             return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "rowptr from 0 to the %llu entries the header states",
                               (unsigned long long)nnz);
     }
+    if (t) {
+        s->tr = csr_at(p, w + W_TOFF, nc, n);
+        if (s->tr.rowptr[0] != 0 || s->tr.rowptr[nc] != (int64_t)nnz)
+            return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "rowptr of M^T from 0 to the %llu entries the header states",
+                              (unsigned long long)nnz);
+    }
     if (r) s->b = (const double *)(const void *)(p + w[W_OFF + 3]);
-    s->has_cert = (flags & F_CERT) && get_cert(w + W_CERT, &s->cert);
+    uint64_t content = 0;
+    s->has_cert = (flags & F_CERT) && get_cert(w + W_CERT, &s->cert, &content);
+    if (s->has_cert && content != hash(sums, (size_t)nb[0] * 8))
+        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a certificate bound to the file's matrix (its content hash "
+                          "differs: the arrays were replaced)");
     return ULAM_OK;
 }
 
@@ -257,6 +393,9 @@ int ulam_system_from_memory(const void *data, size_t bytes, const uint64_t tag[2
     ulam_system *s = malloc(sizeof *s);
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a system");
     int status = parse(data, bytes, tag, s, err);
+    int64_t total = status ? 0 : s->nblocks[0] + s->nblocks[1] + s->nblocks[2];
+    if (!status && !(s->state = calloc((size_t)(total ? total : 1), sizeof *s->state)))
+        status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the blocks' states");
     if (status) {
         free(s);
         return status;
@@ -303,29 +442,151 @@ int ulam_system_is_file(const char *path)
     return yes;
 }
 
-/* Verify the arrays as a parse would. */
+/* Why a block failed, as the state it is left in. */
+enum { BAD_SUM = 2, BAD_ROWPTR = 3, BAD_COLUMN = 4, BAD_VALUE = 5 };
+
+/* The rows [*r0, *r1) of block k of a part of rows rows. */
+static void block_rows(const ulam_system *s, int64_t k, int64_t rows, int64_t *r0, int64_t *r1)
+{
+    *r0 = k << s->shift;
+    *r1 = *r0 + ((int64_t)1 << s->shift) < rows ? *r0 + ((int64_t)1 << s->shift) : rows;
+}
+
+/* The state block rows r0 .. r1 - 1 of A (nnz entries) verify to against checksum want. */
+static int csr_block_state(const ulam_csr *A, int64_t r0, int64_t r1, uint64_t want)
+{
+    const int64_t *rp = A->rowptr, nnz = A->rowptr[A->nrows]; /* rowptr[nrows] was checked at open */
+    for (int64_t i = r0; i < r1; i++)
+        if (!(rp[i] >= 0 && rp[i] <= rp[i + 1] && rp[i + 1] <= nnz)) return BAD_ROWPTR;
+    if (csr_block_hash(A, r0, r1) != want) return BAD_SUM;
+    for (int64_t i = r0; i < r1; i++)
+        for (int64_t q = rp[i]; q < rp[i + 1]; q++) {
+            if (A->colidx[q] < 0 || A->colidx[q] >= A->ncols || (q > rp[i] && A->colidx[q] <= A->colidx[q - 1]))
+                return BAD_COLUMN;
+            if (!isfinite(A->val[q]) || A->val[q] == 0.0) return BAD_VALUE;
+        }
+    return GOOD;
+}
+
+/* Verify block k of a part once (any thread; racing threads compute the same state). */
+static int verify_block(const ulam_system *s, int part, int64_t k)
+{
+    _Atomic unsigned char *st = &s->state[s->first[part] + k];
+    unsigned char v = atomic_load_explicit(st, memory_order_acquire);
+    if (v == UNCHECKED) {
+        uint64_t want = s->sums[s->first[part] + k];
+        int64_t r0, r1;
+        block_rows(s, k, part == PART_T ? s->tr.nrows : s->n, &r0, &r1);
+        if (part == PART_B) {
+            v = hash(s->b + r0, (size_t)(r1 - r0) * sizeof *s->b) != want ? BAD_SUM : GOOD;
+            for (int64_t i = r0; v == GOOD && i < r1; i++)
+                if (!isfinite(s->b[i])) v = BAD_VALUE;
+        } else {
+            v = (unsigned char)csr_block_state(part == PART_M ? &s->csr : &s->tr, r0, r1, want);
+        }
+        atomic_store_explicit(st, v, memory_order_release);
+    }
+    return v == GOOD ? ULAM_OK : ULAM_ESYNTAX;
+}
+
+/* The message of a failed block k of a part. */
+static int block_error(const ulam_system *s, int part, int64_t k, ulam_error *err)
+{
+    static const char *const parts[3] = {"M", "b", "M^T"};
+    static const char *const why[6] = {"", "", "its checksum does not match", "its row pointers do not rise within the entries",
+                                       "a column out of range or out of order", "a value that is not finite and nonzero"};
+    int64_t r0, r1;
+    block_rows(s, k, part == PART_T ? s->tr.nrows : s->n, &r0, &r1);
+    unsigned char v = atomic_load(&s->state[s->first[part] + k]);
+    return ulam__fail(err, ULAM_ESYNTAX, 0, r0, "an intact prepared file: block %lld of %s (rows %lld..%lld, 1-based) "
+                      "is damaged: %s", (long long)k, parts[part], (long long)r0 + 1, (long long)r1,
+                      v < 6 ? why[v] : "?");
+}
+
+/* Verify blocks of a part covering rows [first, last); the first failure with err filled. */
+static int verify_part(const ulam_system *s, int part, int64_t first, int64_t last, ulam_error *err)
+{
+    int64_t rows = part == PART_T ? s->tr.nrows : s->n;
+    if (!s->nblocks[part]) return ULAM_OK;
+    first = first < 0 ? 0 : first, last = last > rows ? rows : last;
+    for (int64_t k = first >> s->shift; first < last && k <= (last - 1) >> s->shift; k++)
+        if (verify_block(s, part, k)) return block_error(s, part, k, err);
+    return ULAM_OK;
+}
+
+/* Verify the blocks of M and b holding rows [first, last). */
+int ulam_system_verify(const ulam_system *s, int64_t first, int64_t last, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a system");
+    int status = verify_part(s, PART_M, first, last, err);
+    return status ? status : verify_part(s, PART_B, first, last, err);
+}
+
+/* Verify every block. */
 int ulam_system_check(const ulam_system *s, ulam_error *err)
 {
     ulam__clear(err);
     if (!s) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a system");
-    int status = s->has_matrix ? ulam_csr_check(&s->csr) : ULAM_OK;
-    if (status) return ulam__fail(err, status, 0, -1, "a consistent matrix (the prepared file is corrupt)");
-    for (int64_t i = 0; s->b && i < s->n; i++)
-        if (!isfinite(s->b[i])) return ulam__fail(err, ULAM_ENONFINITE, 0, i, "finite b (the prepared file is corrupt)");
+    int status = ULAM_OK;
+    for (int part = 0; part < 3 && !status; part++) status = verify_part(s, part, 0, INT64_MAX, err);
+    return status;
+}
+
+/* The lazy check of a solver's rows (ulam__rows_check). */
+static int rows_check(const void *ctx, int64_t first, int64_t last, int with_b, int64_t *bad)
+{
+    const ulam_system *s = ctx;
+    ulam_error err;
+    int status = verify_part(s, PART_M, first, last, &err);
+    if (!status && with_b) status = verify_part(s, PART_B, first, last, &err);
+    if (status && bad) *bad = err.index;
+    return status;
+}
+
+/* The check a solver given opts->system makes before it reads rows (see internal.h). */
+int ulam__system_rows_check(const ulam_system *s, const ulam_csr *M, const double *b, ulam__rows_check *rc,
+                            ulam_error *err)
+{
+    if (!s->has_matrix || M != &s->csr)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the matrix of opts->system (ulam_system_lazy's) as M");
+    *rc = (ulam__rows_check){.fn = rows_check, .ctx = s, .with_b = b && b == s->b};
     return ULAM_OK;
 }
 
-/* The mapped matrix, or NULL. */
-const ulam_csr *ulam_system_matrix(const ulam_system *s)
+/* Why row i's block failed (see internal.h). */
+int ulam__system_row_error(const ulam_system *s, int64_t i, ulam_error *err)
 {
-    return s && s->has_matrix ? &s->csr : NULL;
+    int status = verify_part(s, PART_M, i, i + 1, err);
+    return status ? status : verify_part(s, PART_B, i, i + 1, err);
 }
 
-/* The mapped b, or NULL. */
+/* The mapped arrays, unverified, for a solver given opts->system. */
+int ulam_system_lazy(const ulam_system *s, const ulam_csr **M, const double **b)
+{
+    if (!s) return ULAM_EINVAL;
+    if (M) *M = s->has_matrix ? &s->csr : NULL;
+    if (b) *b = s->b;
+    return ULAM_OK;
+}
+
+/* The mapped matrix, verified whole, or NULL. */
+const ulam_csr *ulam_system_matrix(const ulam_system *s)
+{
+    return s && s->has_matrix && !verify_part(s, PART_M, 0, s->n, NULL) ? &s->csr : NULL;
+}
+
+/* The mapped b, verified whole, or NULL. */
 const double *ulam_system_rhs(const ulam_system *s, int64_t *n)
 {
     if (n) *n = s ? s->n : 0;
-    return s ? s->b : NULL;
+    return s && s->b && !verify_part(s, PART_B, 0, s->n, NULL) ? s->b : NULL;
+}
+
+/* The stored M^T, verified whole, or NULL. */
+const ulam_csr *ulam_system_transpose(const ulam_system *s)
+{
+    return s && s->has_tr && !verify_part(s, PART_T, 0, s->tr.nrows, NULL) ? &s->tr : NULL;
 }
 
 /* The stored certificate, or NULL. */
@@ -345,6 +606,34 @@ ulam_system *ulam_system_free(ulam_system *s)
 {
     if (!s) return NULL;
     if (s->map) munmap(s->map, s->map_bytes);
+    free((void *)s->state);
     free(s);
     return NULL;
+}
+
+/* The content tag of a source file: XXH3-128 of its bytes. */
+int ulam_file_tag(const char *path, uint64_t tag[2], ulam_error *err)
+{
+    ulam__clear(err);
+    if (!path || !tag) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path and a tag");
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return ulam__fail(err, ULAM_EIO, 0, -1, "a readable file");
+    XXH3_state_t *st = XXH3_createState();
+    enum { CHUNK = 1 << 20 };
+    unsigned char *buf = malloc(CHUNK);
+    int status = st && buf ? ULAM_OK : ULAM_ENOMEM;
+    if (!status) XXH3_128bits_reset(st);
+    for (ssize_t got; !status && (got = read(fd, buf, CHUNK)) != 0;) {
+        if (got < 0) status = ULAM_EIO;
+        else XXH3_128bits_update(st, buf, (size_t)got);
+    }
+    if (!status) {
+        XXH128_hash_t h = XXH3_128bits_digest(st);
+        tag[0] = h.low64, tag[1] = h.high64;
+    }
+    close(fd);
+    free(buf);
+    XXH3_freeState(st);
+    return status ? ulam__fail(err, status, 0, -1, status == ULAM_EIO ? "a readable file" : "memory to hash the file")
+                  : ULAM_OK;
 }

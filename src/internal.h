@@ -151,6 +151,31 @@ struct ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s);
 /* The states a solver's walks can reach (n flags; NULL unless its reachability check ran). */
 const char *ulam__solver_reached(const ulam_solver *s);
 
+/* A check of rows [first, last) of a borrowed matrix (and, with with_b, of b at those rows) made
+ * before anything reads them: ULAM_OK, or ULAM_ESYNTAX with *bad (may be NULL) the first row of the
+ * damaged block.  Thread-safe.  fn NULL: nothing to check.  A prepared system's (src/cache.c): a
+ * solver given ulam_walk_opts.system calls it on each row before building it, on every row
+ * reached by a reachability search, and on all of them before a pass over all of M. */
+typedef struct ulam__rows_check {
+    int (*fn)(const void *ctx, int64_t first, int64_t last, int with_b, int64_t *bad);
+    const void *ctx;
+    int with_b;
+} ulam__rows_check;
+
+/* Run rc on rows [first, last) (ULAM_OK when rc or its fn is NULL). */
+static inline int ulam__rows_verify(const ulam__rows_check *rc, int64_t first, int64_t last, int64_t *bad)
+{
+    return rc && rc->fn ? rc->fn(rc->ctx, first, last, rc->with_b, bad) : 0;
+}
+
+/* The check of a solver given opts->system: *rc, when M is that system's matrix (b is checked
+ * with it when it is the system's b; another b was verified by whoever gave it); else ULAM_EINVAL. */
+int ulam__system_rows_check(const ulam_system *s, const ulam_csr *M, const double *b, ulam__rows_check *rc,
+                            ulam_error *err);
+
+/* Why the block holding row i of s failed: ULAM_ESYNTAX with err naming the block and the fault. */
+int ulam__system_row_error(const ulam_system *s, int64_t i, ulam_error *err);
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)

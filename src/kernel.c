@@ -29,7 +29,11 @@
  * row, or a row that would overflow the arena, is replaced by the dead row at the arena's end
  * (which terminates at once and scores nothing) and recorded in k->status, which the solver
  * turns into a failed run.  The per-thread scratch grows to the longest row built, so nothing
- * reads all of K before the walks. */
+ * reads all of K before the walks.
+ *
+ * With k->rc (a prepared file's verification, src/cache.c) every row's block is verified before
+ * the row is first read, and all of K before the kernel is completed; a damaged block fails the
+ * kernel as a corrupt row does. */
 #include "kernel.h"
 
 #include <math.h>
@@ -312,7 +316,11 @@ static void build_moves(ulam_kernel *k, int64_t i, ulam__row *h, double qi, int 
 static void build_row(ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam__kscratch *w)
 {
     const ulam_csr *K = k->K;
-    if (!entries_ok(K, i)) {
+    int ok = entries_ok(K, i);
+    if (ok && k->rc.with_b && k->scores.estimator == ULAM_EXPECTED) /* its score reads b at its columns */
+        for (int64_t q = K->rowptr[i]; ok && q < K->rowptr[i + 1]; q++)
+            ok = !ulam__rows_verify(&k->rc, K->colidx[q], K->colidx[q] + 1, NULL);
+    if (!ok) {
         dead_row(h, i);
         fail(k, ULAM_ESYNTAX, i);
         return;
@@ -352,7 +360,8 @@ int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
     if (v > 0) return v - 1;
     if (atomic_compare_exchange_strong_explicit(&k->where[j], &expect, -1, memory_order_acquire,
                                                 memory_order_acquire)) {
-        int64_t len = range_ok(k->K, j) ? ULAM__HEAD + row_outcomes(k->K, j) : 0;
+        int ok = !ulam__rows_verify(&k->rc, j, j + 1, NULL) && range_ok(k->K, j);
+        int64_t len = ok ? ULAM__HEAD + row_outcomes(k->K, j) : 0;
         int64_t u = len ? atomic_fetch_add_explicit(&k->top, len, memory_order_relaxed) : k->cap;
         if (len && u + len > k->cap) u = k->cap; /* rowptr's ranges overlap: the file is corrupt */
         if (u < k->cap) build_row(k, j, ulam__kernel_row(k, u), 0, w);
@@ -391,7 +400,11 @@ static void prefetch_targets(const ulam_kernel *k, int64_t i)
 void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
 {
     const ulam_csr *K = k->K;
-    int64_t from = atomic_load(&k->top), u = from;
+    int64_t from = atomic_load(&k->top), u = from, bad = -1;
+    if (ulam__rows_verify(&k->rc, 0, k->n, &bad)) { /* every row is read below: every block verified first */
+        fail(k, ULAM_ESYNTAX, bad);
+        return;
+    }
     for (int64_t i = 0; i < k->n; i++)
         if (atomic_load_explicit(&k->where[i], memory_order_relaxed) == 0) {
             int64_t len = range_ok(K, i) ? ULAM__HEAD + row_outcomes(K, i) : 0;
@@ -414,7 +427,7 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
 }
 
 /* States reachable from the start set (marked in seen[]) along the walk's moves. */
-int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen)
+int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen, const ulam__rows_check *rc, int64_t *bad)
 {
     int64_t n = K->nrows, *stack = ulam__malloc((size_t)n, sizeof *stack), top = 0;
     if (!stack) return ULAM_ENOMEM;
@@ -422,8 +435,9 @@ int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen)
         if (seen[i]) stack[top++] = i;
     while (top > 0) {
         int64_t i = stack[--top];
-        if (!range_ok(K, i) || !entries_ok(K, i)) {
+        if (ulam__rows_verify(rc, i, i + 1, NULL) || !range_ok(K, i) || !entries_ok(K, i)) {
             free(stack);
+            if (bad) *bad = i;
             return ULAM_ESYNTAX;
         }
         if (ulam__kernel_q(K, i, continue_q) <= 0) continue;

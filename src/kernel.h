@@ -64,6 +64,8 @@ typedef struct ulam_kernel {
     ulam__scores scores;
     int64_t *scored, nscored; /* kept (ulam__kernel_keep): the states b scores at */
     int fixed;                /* kept with b's values fixed: only the same b rescores, as a no-op */
+    ulam__rows_check rc;      /* made before a row of K (and of b) is first read (a prepared file's
+                                 verification; fn NULL: none) */
 } ulam_kernel;
 
 /* Per-thread scratch for building rows of up to cap outcomes (grown as rows need). */
@@ -136,8 +138,9 @@ double ulam__kernel_q(const ulam_csr *K, int64_t i, double continue_q);
 
 /* Mark in seen[] every state of K reachable from those already marked by the walk's moves
  * (the nonzeros of rows with q_i > 0); ULAM_OK, ULAM_ENOMEM, or ULAM_ESYNTAX when a row it
- * reaches is corrupt (rows are checked as the kernel checks them). */
-int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen);
+ * reaches is corrupt (rows are checked as the kernel checks them, after rc, which may be NULL),
+ * *bad (may be NULL) that row. */
+int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen, const ulam__rows_check *rc, int64_t *bad);
 
 /* The header of the row at unit u. */
 static inline ulam__row *ulam__kernel_row(const ulam_kernel *k, int64_t u)

@@ -1,8 +1,11 @@
 /* Matrix Market input and output (https://math.nist.gov/MatrixMarket/formats.html).
  *
  * Reading is streamed through a growing buffer; integers are scanned by hand and reals
- * with strtod, so a file parses at hundreds of MB/s.  Duplicated coordinates are summed,
- * explicit zeros dropped, symmetric and skew-symmetric files expanded to full storage. */
+ * with strtod, so a file parses at hundreds of MB/s.  Duplicated coordinates are summed (a
+ * file may hold more entries than rows x columns, as SciPy reads it), explicit zeros dropped,
+ * symmetric and skew-symmetric files expanded to full storage.  A comment line may be indented;
+ * a NUL byte in a line is refused (a binary or damaged file).  A gzip-compressed file is read
+ * through zlib when opened by its path, and named as such when given as an open FILE. */
 #include "internal.h"
 
 #include <errno.h>
@@ -12,6 +15,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 enum { FMT_COORD, FMT_ARRAY };
 enum { FLD_REAL, FLD_INTEGER, FLD_PATTERN };
@@ -95,15 +99,28 @@ static char *reader_next(reader *r, int *status)
         char *nl = memchr(start, '\n', r->len - r->pos);
         if (nl || (r->eof && r->pos < r->len)) {
             char *end = nl ? nl : r->buf + r->len;
+            int nul = memchr(start, '\0', (size_t)(end - start)) != NULL;
             *end = '\0';
             if (end > start && end[-1] == '\r') end[-1] = '\0';
             r->pos = (size_t)(end - r->buf) + (nl ? 1 : 0);
             r->line++;
+            if (nul) { /* the text would end at the NUL: a value cut short is not read as another */
+                *status = ULAM_ESYNTAX;
+                return NULL;
+            }
             return start;
         }
         if (r->eof) return NULL;
         if ((*status = reader_fill(r)) != ULAM_OK) return NULL;
     }
+}
+
+/* A failure of reader_next (status) at the reader's line, with err filled. */
+static int read_failure(const reader *r, int status, ulam_error *err)
+{
+    if (status == ULAM_ESYNTAX)
+        return ulam__fail(err, status, r->line, -1, "a text line with no NUL byte (the file is binary or damaged)");
+    return read_failure(r, status, err);
 }
 
 /* Bytes of input not yet handed out as lines, or -1 when unknown (a pipe). */
@@ -244,22 +261,26 @@ static char *next_data_line(reader *r, int *status)
 {
     char *line;
     while ((line = reader_next(r, status)) != NULL)
-        if (line[0] != '%' && !at_end(line)) return line;
+        if (*skip_ws(line) != '%' && !at_end(line)) return line; /* a comment may be indented */
     return NULL;
 }
 
 /* Read the banner, comments and size line; check the sizes before anything is allocated. */
 static int read_header(reader *r, const char *name, mm_header *h, ulam_error *err)
 {
-    int status;
-    char *line = reader_next(r, &status);
-    if (status) return ulam__fail(err, status, r->line, -1, "a readable file");
+    int status = r->len < 2 ? reader_fill(r) : ULAM_OK;
+    if (!status && r->len < 2 && !r->eof) status = reader_fill(r);
+    if (!status && r->len >= 2 && (unsigned char)r->buf[0] == 0x1f && (unsigned char)r->buf[1] == 0x8b)
+        return ulam__fail(err, ULAM_EUNSUPPORTED, 1, -1, "a Matrix Market text file: %s is gzip-compressed (open it "
+                          "by its path, which reads it through zlib, or gunzip it)", name);
+    char *line = status ? NULL : reader_next(r, &status);
+    if (status) return read_failure(r, status, err);
     if (!line)
         return ulam__fail(err, ULAM_EEMPTY, 1, -1,
                           "a '%%%%MatrixMarket' banner, found an empty file");
     if ((status = parse_banner(r, name, line, h, err)) != ULAM_OK) return status;
     line = next_data_line(r, &status);
-    if (status) return ulam__fail(err, status, r->line, -1, "a readable file");
+    if (status) return read_failure(r, status, err);
     if (!line)
         return ulam__fail(err, ULAM_ESIZELINE, r->line + 1, -1,
                           "a size line after the banner, found end of file");
@@ -290,16 +311,16 @@ static int read_header(reader *r, const char *name, mm_header *h, ulam_error *er
         return ulam__fail(err, ULAM_ENOTSQUARE, r->line, -1,
                           "a square matrix for a symmetric file, got %lld x %lld",
                           (long long)h->m, (long long)h->n);
-    int64_t dim_cap = ((int64_t)1 << 24) + 64 * h->nnz; /* nnz <= INT64_MAX / 32: no overflow */
+    /* Dimensions the entries justify (ULAM_MM_DIM_CAP): every row and column costs memory and
+     * time in whatever reads M next (a pass, a radius, a transpose), so a short file must not
+     * declare millions of them.  A vector (n = 1) is held dense anyway: its cap is higher. */
+    int64_t dim_cap = h->n == 1 ? ((int64_t)1 << 24) + 64 * h->nnz : ULAM_MM_DIM_CAP(h->nnz); /* no overflow */
     if (h->format == FMT_COORD && (h->m > dim_cap || h->n > dim_cap))
         return ulam__fail(err, ULAM_EOVERFLOW, r->line, -1,
-                          "dimensions at most 2^24 + 64 x entries = %lld (a size line of %lld x %lld with "
-                          "%lld entries would only allocate empty rows)",
-                          (long long)dim_cap, (long long)h->m, (long long)h->n, (long long)h->nnz);
-    if ((double)h->nnz > (double)h->m * (double)h->n)
-        return ulam__fail(err, ULAM_EOVERFLOW, r->line, -1,
-                          "at most rows*columns = %.0f entries, the size line says %lld",
-                          (double)h->m * (double)h->n, (long long)h->nnz);
+                          "dimensions at most %s + 64 x entries = %lld (a size line of %lld x %lld with "
+                          "%lld entries declares mostly empty rows, which cost memory and time in every pass)",
+                          h->n == 1 ? "2^24" : "2^16", (long long)dim_cap, (long long)h->m, (long long)h->n,
+                          (long long)h->nnz);
     int64_t left = reader_bytes_left(r);
     int min_bytes = h->format == FMT_ARRAY ? 2 : (h->field == FLD_PATTERN ? 4 : 6);
     if (left >= 0 && h->nnz > left / min_bytes + 1)
@@ -441,7 +462,7 @@ static int read_entries(reader *r, const mm_header *h, triplets *t, ulam_error *
         if ((status = add_entry(t, h, i, j, x)))
             return ulam__fail(err, status, r->line, -1, "memory for the entries");
     }
-    if (status) return ulam__fail(err, status, r->line, -1, "a readable file");
+    if (status) return read_failure(r, status, err);
     if (k < h->nnz)
         return ulam__fail(err, ULAM_ETOOFEW, r->line, -1,
                           "%lld entries as the size line says, found %lld before the end of file",
@@ -484,6 +505,7 @@ static char *span_next(span *s)
         char *nl = memchr(start, '\n', s->len - s->at);
         if (nl || (s->pos == s->end && s->at < s->len)) {
             char *e = nl ? nl : s->buf + s->len;
+            if (memchr(start, '\0', (size_t)(e - start))) return s->failed = 1, NULL; /* the sequential reader locates it */
             *e = '\0';
             if (e > start && e[-1] == '\r') e[-1] = '\0';
             s->at = (size_t)(e - s->buf) + (nl ? 1 : 0);
@@ -563,7 +585,7 @@ static void parse_chunk(int fd, const mm_header *h, chunk *c)
     int32_t prev = -1;
     char *line;
     while (s.buf && !c->bad && (line = span_next(&s)) != NULL) {
-        if (line[0] == '%' || at_end(line)) continue;
+        if (*skip_ws(line) == '%' || at_end(line)) continue;
         int64_t i, j;
         double x;
         if (parse_coord(0, line, h, &i, &j, &x, NULL)) {
@@ -706,6 +728,41 @@ static FILE *open_input(const char *path, ulam_error *err)
     return f;
 }
 
+/* *f itself, or when it starts with the gzip magic, a temporary file holding its bytes
+ * decompressed through zlib (the original closed): ULAM_OK, or the status with err filled
+ * (*f NULL). */
+static int gunzipped(FILE **f, const char *path, ulam_error *err)
+{
+    unsigned char m[2];
+    size_t got = fread(m, 1, 2, *f);
+    rewind(*f);
+    if (got < 2 || m[0] != 0x1f || m[1] != 0x8b) return ULAM_OK;
+    int fd = dup(fileno(*f));
+    fclose(*f);
+    *f = NULL;
+    gzFile z = fd >= 0 ? gzdopen(fd, "rb") : NULL;
+    FILE *t = z ? tmpfile() : NULL;
+    enum { CHUNK = 1 << 18 };
+    char *buf = t ? malloc(CHUNK) : NULL, why[96] = "";
+    int n = 0, ok = buf != NULL, zerr = 0;
+    while (ok && (n = gzread(z, buf, CHUNK)) > 0) ok = fwrite(buf, 1, (size_t)n, t) == (size_t)n;
+    if (z) {
+        const char *msg = gzerror(z, &zerr); /* a stream cut short ends with Z_BUF_ERROR, not n < 0 */
+        if (n < 0 || zerr == Z_BUF_ERROR || zerr == Z_DATA_ERROR) n = -1, snprintf(why, sizeof why, "%s", msg);
+    }
+    free(buf);
+    if (z) gzclose(z);
+    else if (fd >= 0) close(fd);
+    if (!ok || n < 0 || !t || fflush(t)) {
+        if (t) fclose(t);
+        return n < 0 ? ulam__fail(err, ULAM_ESYNTAX, 0, -1, "an intact gzip stream (%s is gzip-compressed: %s)", path, why)
+                     : ulam__fail(err, ULAM_EIO, 0, -1, "room to decompress %s (gzip-compressed)", path);
+    }
+    rewind(t);
+    *f = t;
+    return ULAM_OK;
+}
+
 /* Read a sparse matrix from path. */
 int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err)
 {
@@ -713,6 +770,8 @@ int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err)
     if (A) *A = NULL;
     FILE *f = open_input(path, err);
     if (!f) return ULAM_EIO;
+    int gz = gunzipped(&f, path, err);
+    if (gz) return gz;
     int status = ulam_mm_read_matrix_file(f, path, A, err);
     fclose(f);
     return status;
@@ -753,6 +812,8 @@ int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *er
     if (x) *x = NULL;
     FILE *f = open_input(path, err);
     if (!f) return ULAM_EIO;
+    int gz = gunzipped(&f, path, err);
+    if (gz) return gz;
     int status = ulam_mm_read_vector_file(f, path, x, n, err);
     fclose(f);
     return status;

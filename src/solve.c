@@ -41,6 +41,7 @@ struct ulam_solver {
     ulam__slot *start_src; /* adjoint with nstarts: the start distribution (walker.start_*) */
     int32_t *start_units;
     double *start_b;
+    ulam__rows_check rc; /* opts->system's verification, made before rows are first read (fn NULL: none) */
     const ulam__reach *given; /* the states walks can reach given by the caller (ulam__solver_alloc_reached;
                                  NULL: none), with K's own bounds over them when given->bounds */
     int threads;
@@ -346,6 +347,16 @@ static void kernel_bounds(const ulam_csr *K, const char *seen, double continue_q
     R->fbig = fbig, R->qmax = qmax, R->neg = neg;
 }
 
+/* Verify every row of a prepared system before a pass over all of M reads them (ULAM_OK without
+ * one; blocks verified before are not read again). */
+static int verify_all(const ulam_csr *M, const ulam_walk_opts *o, const ulam__rows_check *rc, ulam_error *err)
+{
+    int64_t bad = -1;
+    if (!ulam__rows_verify(rc, 0, M->nrows, &bad)) return ULAM_OK;
+    return o->system && ulam__system_row_error(o->system, bad, err) ? ULAM_ESYNTAX
+                                                                    : ulam__fail(err, ULAM_ESYNTAX, 0, bad, "an intact prepared file");
+}
+
 /* The caller's bounds of K alone over the given states (ulam__reach_all), when they were made
  * for this K, continuation and exponent; NULL otherwise. */
 static const ulam__reach *given_bounds(const ulam_solver *s, const ulam_csr *K)
@@ -381,7 +392,12 @@ static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     for (int64_t j = 0; s->o.mode == ULAM_ADJOINT && j < s->o.nstarts; j++) seen[s->o.starts[j]] = 1;
     if (s->o.mode == ULAM_FORWARD)
         for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
-    int status = ulam__kernel_reach(K, s->o.continue_q, seen);
+    int64_t bad = -1;
+    int status = ulam__kernel_reach(K, s->o.continue_q, seen, &s->rc, &bad);
+    if (status == ULAM_ESYNTAX && s->o.system && ulam__system_row_error(s->o.system, bad, err)) {
+        free(seen);
+        return ULAM_ESYNTAX; /* a damaged block of the prepared file, named */
+    }
     if (status) {
         free(seen);
         return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for a reachability check")
@@ -521,7 +537,7 @@ int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *se
     memset(seen, 1, (size_t)K->nrows);
     *R = (ulam__reach){.seen = seen, .bounds = 1, .K = K, .continue_q = fmax(continue_q, 0.0), .alpha = alpha,
                        .tail_u = 1.0, .kappa = INFINITY};
-    int status = ulam__kernel_reach(K, continue_q, seen); /* every row checked */
+    int status = ulam__kernel_reach(K, continue_q, seen, NULL, NULL); /* every row checked */
     if (status) return status;
     double *fac = NULL;
     if (alpha != 1.0 && !(fac = move_factors(K, seen, continue_q, alpha))) return ULAM_ENOMEM;
@@ -580,7 +596,9 @@ static int take_fourth(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     if (!(s->o.rel_err > 0)) return ULAM_OK;
     if (score_bounded(s)) return s->fourth = 1, ULAM_OK;
     if (!s->rho4_done) {
-        int status = ulam__guard_fourth(K, s->o.continue_q, s->o.kernel_alpha,
+        int status = s->o.mode == ULAM_ADJOINT ? verify_all(s->M, &s->o, &s->rc, err) : ULAM_OK; /* it reads all of K */
+        if (status) return status;
+        status = ulam__guard_fourth(K, s->o.continue_q, s->o.kernel_alpha,
                                         s->g.computed & ULAM_GUARD_ABS ? &s->g.abs : NULL, &s->rho4, err);
         if (status) return status;
         s->rho4_done = 1;
@@ -601,7 +619,7 @@ static int check_fourth(const ulam_csr *M, const ulam_solver *s, ulam_error *err
     if (s->fourth == 1 || isfinite(s->v2) || !(o->rel_err > 0)) return ULAM_OK; /* v2: the rule stands on it */
     char also[96] = "; no other mode or alpha 1 has it below 1";
     ulam_csr *T = NULL;
-    if (!ulam_csr_transpose(M, &T)) {
+    if (!verify_all(M, o, &s->rc, NULL) && !ulam_csr_transpose(M, &T)) {
         const int modes[3] = {1 - o->mode, o->mode, 1 - o->mode};
         const double alphas[3] = {o->kernel_alpha, 1.0, 1.0};
         for (int c = 0; c < (o->kernel_alpha != 1.0 ? 3 : 1); c++) {
@@ -639,7 +657,8 @@ static int take_bounds(ulam_solver *s, const ulam_csr *K, int rel_alone, ulam_er
 
 /* The guards' verdicts for this run: opts->guard when it holds them, else computed (rho(|M|)
  * and this mode's rho(M^), stopped once certified). */
-static int take_guard(const ulam_csr *M, const ulam_walk_opts *o, ulam_guard *g, ulam_error *err)
+static int take_guard(const ulam_csr *M, const ulam_walk_opts *o, const ulam__rows_check *rc, ulam_guard *g,
+                      ulam_error *err)
 {
     int need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(o->mode);
     double q = o->continue_q > 0 ? o->continue_q : 0.0;
@@ -651,7 +670,8 @@ static int take_guard(const ulam_csr *M, const ulam_walk_opts *o, ulam_guard *g,
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = need;
     go.kernel_alpha = o->kernel_alpha;
-    return ulam_guard_check(M, o->continue_q, &go, g, err);
+    int status = verify_all(M, o, rc, err); /* the guards read all of M */
+    return status ? status : ulam_guard_check(M, o->continue_q, &go, g, err);
 }
 
 /* Refuse what the verdicts refuse: walks not certified to converge (unless force), a
@@ -775,11 +795,12 @@ static int alloc_work(ulam_solver *s)
 
 /* The kernel's failure (a corrupt row of a mapped file, a non-finite score or no memory to
  * build a row) as a status with err filled; ULAM_OK when it has none. */
-static int kernel_failure(const ulam_kernel *k, ulam_error *err)
+static int kernel_failure(const ulam_kernel *k, const ulam_system *sys, ulam_error *err)
 {
     int status = atomic_load(&k->status);
     if (!status) return ULAM_OK;
     int64_t i = atomic_load(&k->bad);
+    if (status == ULAM_ESYNTAX && sys && i >= 0 && ulam__system_row_error(sys, i, err)) return status; /* named */
     if (status == ULAM_ENOMEM) return ulam__fail(err, status, 0, i, "memory to build a walk kernel row");
     if (status == ULAM_ERANGE)
         return ulam__fail(err, status, 0, i, "row %lld (1-based) with every move's probability |K_ij|^alpha / "
@@ -800,6 +821,10 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     ulam_walk_opts o = opts ? *opts : ulam_walk_defaults();
     int status = check_opts(M, &o, err);
     if (status) return status;
+    ulam__rows_check rc = {0};
+    if (o.system && (status = ulam__system_rows_check(o.system, M, b, &rc, err))) return status;
+    if ((o.mode == ULAM_FORWARD || o.whole_kernel || reach) && (status = verify_all(M, &o, &rc, err)))
+        return status; /* these read all of M (and forward, all of b) */
     if ((status = check_split(M, b, &o, err))) return status;
     double bnorm1 = 0.0;
     ulam_solver *s = calloc(1, sizeof *s);
@@ -809,7 +834,8 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     s->n = M->nrows;
     s->given = o.mode == ULAM_ADJOINT ? reach : NULL;
     s->M = M;
-    if ((status = take_guard(M, &o, &s->g, err)) || (status = check_verdicts(M, s, err))) {
+    s->rc = rc;
+    if ((status = take_guard(M, &o, &rc, &s->g, err)) || (status = check_verdicts(M, s, err))) {
         ulam_solver_free(s);
         return status;
     }
@@ -829,7 +855,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     if (kernel) {
         s->k = kernel, s->k_borrowed = 1;
         if ((status = ulam__kernel_rescore_b(kernel, b))) {
-            status = kernel_failure(kernel, err);
+            status = kernel_failure(kernel, o.system, err);
             ulam_solver_free(s);
             return status ? status : ulam__fail(err, ULAM_EINVAL, 0, -1, "a kept kernel (ulam__solver_keep_kernel)");
         }
@@ -838,6 +864,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
+    if (!kernel) s->k->rc = rc;
     s->rho4 = (ulam_power){.rho = NAN, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
     if ((status = take_bounds(s, K, o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0, err))) {
         ulam_solver_free(s);
@@ -859,7 +886,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     if (o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED) s->w.score0 = s->b[o.index];
     if (o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED) s->w.expected = 1;
     s->w.watch = o.mode == ULAM_FORWARD ? o.index : -1;
-    if ((status = kernel_failure(s->k, err))) {
+    if ((status = kernel_failure(s->k, s->o.system, err))) {
         ulam_solver_free(s);
         return status;
     }
@@ -1217,7 +1244,7 @@ int ulam_solver_error(const ulam_solver *s, ulam_error *err)
 {
     ulam__clear(err);
     if (!s || !s->run.status) return ULAM_OK;
-    int status = kernel_failure(s->k, err);
+    int status = kernel_failure(s->k, s->o.system, err);
     if (status) return status;
     int st = s->run.status;
     switch (st) {
@@ -1283,14 +1310,14 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *e
                                                    "window, max_steps and threads (and one start state)");
     int status = check_opts(s->M, &o, err);
     if (status) return status;
-    if (atomic_load(&s->k->status)) return kernel_failure(s->k, err);
+    if (atomic_load(&s->k->status)) return kernel_failure(s->k, s->o.system, err);
     int rescore = o.estimator != s->o.estimator;
     if (rescore && s->k_borrowed) /* a kept kernel is its keeper's, for its estimator */
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a solver that owns its kernel to change the estimator");
     s->o = o;
     if ((status = check_verdicts(s->M, s, err))) return status;
     s->o.max_walks = ulam__walk_cap(&o);
-    if (rescore && (status = ulam__kernel_rescore(s->k, o.estimator))) return kernel_failure(s->k, err);
+    if (rescore && (status = ulam__kernel_rescore(s->k, o.estimator))) return kernel_failure(s->k, s->o.system, err);
     s->w.interrupt = o.interrupt;
     s->w.score0 = o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED ? s->b[o.index] : 0.0;
     s->w.expected = o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED;

@@ -28,6 +28,7 @@ BAD_FILES = [
     ("not_a_number.mtx", "ESYNTAX", 4), ("nan.mtx", "ENONFINITE", 3), ("inf.mtx", "ENONFINITE", 4),
     ("missing_value.mtx", "ESYNTAX", 4), ("huge_dims.mtx", "EOVERFLOW", 2),
     ("huge_nnz.mtx", "ETOOFEW", 2), ("skew_diagonal.mtx", "EINDEX", 4),
+    ("sparse_dims.mtx", "EOVERFLOW", 2), ("nul_after_value.mtx", "ESYNTAX", 4),
 ]
 
 CASES = []
@@ -35,6 +36,10 @@ for f, status, line in BAD_FILES:
     CASES.append((["info", D + f], code(status), rf"^ulam: {re.escape(D + f)}:{line}: error: .*expected ", ""))
 CASES += [
     (["info", D + "does_not_exist.mtx"], code("EIO"), r"does_not_exist.mtx: error: .*No such file", ""),
+    (["info", D + "truncated.mtx.gz"], code("ESYNTAX"), r"truncated.mtx.gz: error: .*gzip", ""),
+    (["info", D + "duplicates_beyond.mtx"], 0, "", r"nnz +4"),
+    (["solve", "--method", "walks", D + "dag5.mtx.gz", "--rhs", D + "ones5.mtx.gz", "--index", "1", "--walks", "1000"], 0,
+     "", r"x\[1\]"),
     (["info", D + "nonsquare.mtx"], code("ENOTSQUARE"), r"nonsquare.mtx: error: .*square", ""),
     (["direct", M + "chain4.mtx", "--rhs", D + "ones3.mtx"], code("EDIM"),
      r"ones3.mtx: error: .*expected 4 entries", ""),
@@ -752,6 +757,21 @@ def check_cache(ulam):
             fh.write("% changed\n")
         rc, _, err = run(ulam, args)
         assert rc == 0 and err.count("loaded from its cache") == 1 and err.count("cache written") == 1, err
+        # an edit that keeps the size and the modification time (cp -p, tar, rsync -t, touch -r):
+        # the cache is keyed by the content, so it is parsed again and the new answer given
+        src = d + "/signed200_b.mtx"
+        st = os.stat(src)
+        text = open(src).read()
+        lines = text.split("\n")
+        k = next(i for i, l in enumerate(lines) if l and not l.startswith("%") and len(l.split()) == 1 and i > 2)
+        old = lines[k]
+        lines[k] = ("9" if old[0] != "9" else "8") + old[1:]  # same length, another value
+        with open(src, "w") as fh:
+            fh.write("\n".join(lines))
+        os.utime(src, ns=(st.st_atime_ns, st.st_mtime_ns))
+        assert os.stat(src).st_size == st.st_size and os.stat(src).st_mtime_ns == st.st_mtime_ns
+        rc, out3, err = run(ulam, args)
+        assert rc == 0 and err.count("loaded from its cache") == 1 and err.count("cache written") == 1, err
 
 
 def check_prepare(ulam):
@@ -771,6 +791,20 @@ def check_prepare(ulam):
         a, b = json.loads(text), json.loads(prep)
         assert a["estimate"] == b["estimate"] and a["stderr"] == b["stderr"], (a, b)
         assert b["guard_seconds"] == 0 and b["rho_abs"] == a["rho_abs"], b
+        # --transpose stores M^T beside M: the same answers, a file holding both
+        rc, out, err = run(ulam, ["prepare", M + "signed200.mtx", "--rhs", M + "signed200_b.mtx", "--transpose", "-o",
+                                  d + "/t.ulam"])
+        assert rc == 0 and "with M^T" in out, (rc, out, err)
+        rc, tprep, err = run(ulam, ["solve", "--method", "walks", d + "/t.ulam"] + common)
+        assert rc == 0 and json.loads(tprep)["estimate"] == b["estimate"], err
+        assert os.path.getsize(d + "/t.ulam") > os.path.getsize(sysf)
+        # a point-source query pushes on the stored M^T: the answer of the one it builds
+        pair = ["--source", "3", "--index", "5", "--walks", "2000", "--json", "--threads", "1"]
+        rc, built, err = run(ulam, ["solve", sysf] + pair)
+        assert rc == 0, err
+        rc, kept, err = run(ulam, ["solve", d + "/t.ulam"] + pair)
+        assert rc == 0 and json.loads(kept)["estimate"] == json.loads(built)["estimate"], (err, kept, built)
+        os.remove(d + "/t.ulam")
         rc, fwd, err = run(ulam, ["solve", "--method", "walks", sysf, "--mode", "forward", "--walks", "2000", "--json"])
         assert rc == 0, err
         rc, info, err = run(ulam, ["info", sysf, "--json"])
@@ -813,10 +847,36 @@ def check_prepare(ulam):
         with open(d + "/rows.ulam", "wb") as fh:
             fh.write(bytes(data))
         rc, out, err = run(ulam, ["solve", "--method", "walks", d + "/rows.ulam", "--index", "1", "--walks", "1000"])
-        assert rc == code("ESYNTAX") and "corrupt" in err and out == "", (rc, err)
+        assert rc == code("ESYNTAX") and "block 0 of M" in err and "damaged" in err and out == "", (rc, err)
         rc, out, err = run(ulam, ["info", d + "/rows.ulam"])
-        assert rc != 0 and "corrupt" in err and out == "", (rc, err)
+        assert rc != 0 and "damaged" in err and out == "", (rc, err)
         os.remove(d + "/rows.ulam")
+        # one byte flipped in each part of the file (header, certificate, rowptr, colidx, val, b,
+        # the checksum table): refused with a message, or the intact file's answer; never another
+        # answer with exit 0
+        words = [int.from_bytes(raw[8 * k:8 * k + 8], "little") for k in range(128)]
+        args = ["--index", "8", "--walks", "2000", "--json", "--threads", "1", "--method", "walks"]
+        rc, intact, err = run(ulam, ["solve", sysf] + args)
+        assert rc == 0, err
+        for at in (8 * 3, 8 * 34, words[6] + 8 * 9, words[7] + 4 * 70, words[8] + 8 * 70 + 6, words[9] + 8 * 8 + 7,
+                   words[15] + 3):
+            data = bytearray(raw)
+            data[at] ^= 0x10
+            with open(d + "/flip.ulam", "wb") as fh:
+                fh.write(bytes(data))
+            rc, out, err = run(ulam, ["solve", d + "/flip.ulam"] + args)
+            if rc == 0:
+                assert json.loads(out)["estimate"] == json.loads(intact)["estimate"], (at, out, intact)
+            else:
+                assert out == "" and re.search(r"^ulam: .*flip.ulam: error: .*(damaged|checksum|certificate)", err), (at, rc, err)
+        os.remove(d + "/flip.ulam")
+        # an empty or foreign file named .ulam says what it is, not "needs --rhs"
+        for name, data in (("empty.ulam", b""), ("foreign.ulam", b"ulamSYS9" + bytes(100))):
+            with open(d + "/" + name, "wb") as fh:
+                fh.write(data)
+            rc, out, err = run(ulam, ["solve", d + "/" + name, "--index", "1"])
+            assert rc == code("EBANNER") and "prepared system" in err and "--rhs" not in err and out == "", (rc, err)
+            os.remove(d + "/" + name)
         # the output is checked before the work, and a failed prepare leaves nothing
         rc, _, err = run(ulam, ["prepare", M + "signed200.mtx", "-o", d + "/no/such/dir/s.ulam"])
         assert rc == code("EIO"), err

@@ -193,6 +193,7 @@ static void test_system_desc(void **state)
     assert_int_equal(d.tag[1], 0);
     assert_close(d.omega, 0.0, 0);
     assert_null(d.cert);
+    assert_int_equal(d.transpose, 0);
     FILE *f = tmpfile();
     assert_non_null(f);
     assert_int_equal(ulam_system_write_file(f, &d), ULAM_EINVAL);

@@ -34,7 +34,10 @@ static const bad_case bad_cases[] = {
     {"tests/data/extra_field.mtx", ULAM_ESYNTAX, 4, 0},
     {"tests/data/huge_dims.mtx", ULAM_EOVERFLOW, 2, 0},
     {"tests/data/huge_nnz.mtx", ULAM_ETOOFEW, 2, 0},
-    {"tests/data/nnz_exceeds_size.mtx", ULAM_EOVERFLOW, 2, 0},
+    {"tests/data/nnz_exceeds_size.mtx", ULAM_ETOOFEW, 2, 0}, /* more than rows x columns is allowed (duplicates); not more than the file holds */
+    {"tests/data/sparse_dims.mtx", ULAM_EOVERFLOW, 2, 0},   /* 74 bytes declaring 16,777,280 rows and one entry */
+    {"tests/data/nul_after_value.mtx", ULAM_ESYNTAX, 4, 0}, /* "0.25\0junk": not read as 0.25 */
+    {"tests/data/truncated.mtx.gz", ULAM_ESYNTAX, 0, 0},    /* a gzip stream cut short */
     {"tests/data/skew_diagonal.mtx", ULAM_EINDEX, 4, 0},
     {"tests/data/integer_not_integer.mtx", ULAM_ESYNTAX, 3, 0},
     {"tests/data/vector_not_column.mtx", ULAM_EDIM, 0, 1},
@@ -116,6 +119,61 @@ static void test_duplicates(void **state)
     assert_int_equal(ulam_csr_nnz(A), 1);
     assert_close(csr_get(A, 0, 0), 0.5, 0);
     ulam_csr_free(A);
+}
+
+/* More entries than rows x columns (duplicates, summed) are read as SciPy reads them. */
+static void test_duplicates_beyond(void **state)
+{
+    (void)state;
+    ulam_csr *A = must_read("tests/data/duplicates_beyond.mtx");
+    assert_int_equal(ulam_csr_nnz(A), 4);
+    assert_close(csr_get(A, 0, 0), 0.5, 0);
+    assert_close(csr_get(A, 1, 0), 0.5, 0);
+    assert_close(csr_get(A, 0, 1), 2.0, 0);
+    assert_close(csr_get(A, 1, 1), 3.0, 0);
+    ulam_csr_free(A);
+    ulam_mm_opts o = ulam_mm_defaults(); /* the parallel reader too */
+    o.threads = 2;
+    FILE *f = fopen("tests/data/duplicates_beyond.mtx", "rb");
+    assert_non_null(f);
+    assert_int_equal(ulam_mm_read_matrix_opts(f, "d", &o, &A, NULL), ULAM_OK);
+    fclose(f);
+    assert_close(csr_get(A, 1, 1), 3.0, 0);
+    ulam_csr_free(A);
+}
+
+/* Comment lines may be indented (blanks or tabs before the '%'), before the size line too. */
+static void test_indented_comment(void **state)
+{
+    (void)state;
+    ulam_csr *A = must_read("tests/data/indented_comment.mtx");
+    assert_int_equal(ulam_csr_nnz(A), 2);
+    assert_close(csr_get(A, 1, 0), 0.25, 0);
+    ulam_csr_free(A);
+}
+
+/* A gzip-compressed file is read through zlib by its path (the same matrix and vector); from an
+ * open FILE it is named as gzip-compressed. */
+static void test_gzip(void **state)
+{
+    (void)state;
+    ulam_csr *A = must_read("tests/data/dag5.mtx"), *Z = must_read("tests/data/dag5.mtx.gz");
+    assert_csr_same(Z, A);
+    double *x = NULL, *y = NULL;
+    int64_t n = 0, m = 0;
+    assert_int_equal(ulam_mm_read_vector("tests/data/ones3.mtx", &x, &n, NULL), ULAM_OK);
+    assert_int_equal(ulam_mm_read_vector("tests/data/ones3.mtx.gz", &y, &m, NULL), ULAM_OK);
+    assert_int_equal(n, m);
+    assert_memory_equal(x, y, (size_t)n * sizeof *x);
+    FILE *f = fopen("tests/data/dag5.mtx.gz", "rb");
+    assert_non_null(f);
+    ulam_csr *B = NULL;
+    ulam_error err;
+    assert_int_equal(ulam_mm_read_matrix_file(f, "dag5.mtx.gz", &B, &err), ULAM_EUNSUPPORTED);
+    assert_non_null(strstr(err.msg, "gzip"));
+    fclose(f);
+    ulam_csr_free(A), ulam_csr_free(Z);
+    free(x), free(y);
 }
 
 /* CR LF line ends, blank lines, upper-case banners and a missing final newline are read. */
@@ -376,7 +434,7 @@ static void test_parallel_read(void **state)
 int main(void)
 {
     enum { NBAD = sizeof bad_cases / sizeof bad_cases[0] };
-    struct CMUnitTest tests[NBAD + 13];
+    struct CMUnitTest tests[NBAD + 16];
     size_t k = 0;
     for (size_t i = 0; i < NBAD; i++)
         tests[k++] = (struct CMUnitTest){bad_cases[i].file, test_bad, NULL, NULL, (void *)&bad_cases[i]};
@@ -387,7 +445,8 @@ int main(void)
         cmocka_unit_test(test_vectors),         cmocka_unit_test(test_roundtrip),
         cmocka_unit_test(test_write_refuses_nonfinite), cmocka_unit_test(test_write_unwritable),
         cmocka_unit_test(test_read_from_stream), cmocka_unit_test(test_strtod),
-        cmocka_unit_test(test_parallel_read),
+        cmocka_unit_test(test_parallel_read),   cmocka_unit_test(test_duplicates_beyond),
+        cmocka_unit_test(test_indented_comment), cmocka_unit_test(test_gzip),
     };
     for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) tests[k++] = good[i];
     return test_run_("mmio", tests, k);

@@ -3,9 +3,11 @@
  * when a walk reaches them, and a query that reads no page of rows its walks do not reach. */
 #include "testutil.h"
 
+#include <pthread.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <unistd.h>
+#include <xxhash.h>
 
 /* The bytes of a prepared file of M and b in *len, malloc'd (via a temporary file). */
 static unsigned char *file_bytes(const ulam_system_desc *d, size_t *len)
@@ -31,13 +33,12 @@ static uint64_t word(const unsigned char *p, int k)
     return w;
 }
 
-/* Set header word k and recompute the checksum (FNV-1a 64 of bytes 0 .. 1015), as a writer
+/* Set header word k and recompute the checksum (XXH3-64 of bytes 0 .. 1015), as a writer
  * with other intentions would. */
 static void set_word(unsigned char *p, int k, uint64_t w)
 {
     memcpy(p + 8 * k, &w, 8);
-    uint64_t h = 0xcbf29ce484222325u;
-    for (int i = 0; i < 1016; i++) h = (h ^ p[i]) * 0x100000001b3u;
+    uint64_t h = XXH3_64bits(p, 1016);
     memcpy(p + 1016, &h, 8);
 }
 
@@ -148,10 +149,11 @@ static void test_damaged(void **state)
     ulam_system_desc d = {.M = A, .b = b, .n = n, .cert = &c};
     size_t len;
     unsigned char *good = file_bytes(&d, &len);
-    enum { NCASE = 13 };
+    enum { NCASE = 18 };
     static const int want[NCASE] = {ULAM_EBANNER, ULAM_ESYNTAX, ULAM_ESYNTAX, ULAM_ESYNTAX, ULAM_ESYNTAX,
                                     ULAM_EUNSUPPORTED, ULAM_EOVERFLOW, ULAM_ESYNTAX, ULAM_ESYNTAX, ULAM_ESYNTAX,
-                                    ULAM_EOVERFLOW, ULAM_ESYNTAX, ULAM_EBANNER};
+                                    ULAM_EOVERFLOW, ULAM_ESYNTAX, ULAM_EBANNER, ULAM_ESYNTAX, ULAM_ESYNTAX,
+                                    ULAM_EOVERFLOW, ULAM_EBANNER, ULAM_ESYNTAX};
     for (int k = 0; k < NCASE; k++) {
         if (!test_case(k)) continue;
         unsigned char *p = malloc(len + 8);
@@ -163,7 +165,7 @@ static void test_damaged(void **state)
         case 2: l = 600; break;                                /* truncated inside the header */
         case 3: p[len] = 0, l = len + 1; break;                /* a byte appended */
         case 4: p[8 * 5] ^= 1; break;                          /* nnz changed: the checksum disagrees */
-        case 5: set_word(p, 1, 2 | (uint64_t)1024 << 32); break; /* a version this reader does not know */
+        case 5: set_word(p, 1, 1 | (uint64_t)1024 << 32); break; /* format version 1 (no block checksums) */
         case 6: set_word(p, 3, (uint64_t)1 << 40); break;      /* n past 2^31 */
         case 7: set_word(p, 7, word(p, 7) + 8); break;         /* colidx off its boundary */
         case 8: set_word(p, 8, word(p, 10)); break;            /* val past the end of the file */
@@ -171,6 +173,11 @@ static void test_damaged(void **state)
         case 10: set_word(p, 2, word(p, 2) | 64); break;       /* an unknown flag */
         case 11: set_word(p, 10, word(p, 10) + 4096); break;   /* stated length past the file */
         case 12: l = 4; break;                                 /* shorter than the magic */
+        case 13: p[word(p, 15) + 3] ^= 4; break;               /* the checksum table damaged */
+        case 14: set_word(p, 33, word(p, 33) ^ 1); break;      /* a certificate of other arrays */
+        case 15: set_word(p, 14, 3); break;                    /* blocks of 8 rows: not a size written */
+        case 16: l = 0; break;                                 /* empty */
+        case 17: set_word(p, 16, word(p, 16) + 1); break;      /* the table's checksum disagrees */
         }
         ulam_system *s = NULL;
         int st = open_copy(p, l, NULL, &s);
@@ -178,18 +185,23 @@ static void test_damaged(void **state)
         free(p);
     }
     test_case_done();
-    /* a certificate section of a later version is ignored, not trusted */
-    unsigned char *p = malloc(len);
-    memcpy(p, good, len);
-    set_word(p, 32, 3 | word(p, 32) >> 32 << 32);
-    void *q = NULL;
-    assert_int_equal(posix_memalign(&q, 4096, len), 0);
-    memcpy(q, p, len);
-    ulam_system *s = NULL;
-    assert_int_equal(ulam_system_from_memory(q, len, NULL, &s, NULL), ULAM_OK);
-    assert_null(ulam_system_certificate(s));
-    ulam_system_free(s);
-    free(q), free(p), free(good);
+    /* a certificate section of an earlier version is ignored, not trusted; one of a later version
+     * (longer, its extra fields appended) is read for the fields this reader knows */
+    for (int v = 2; v <= 4; v += 2) {
+        unsigned char *p = malloc(len);
+        memcpy(p, good, len);
+        set_word(p, 32, (uint64_t)v | ((word(p, 32) >> 32) + 8 * (v == 4)) << 32);
+        void *q = NULL;
+        assert_int_equal(posix_memalign(&q, 4096, len), 0);
+        memcpy(q, p, len);
+        ulam_system *s = NULL;
+        assert_int_equal(ulam_system_from_memory(q, len, NULL, &s, NULL), ULAM_OK);
+        if (v == 2) assert_null(ulam_system_certificate(s));
+        else assert_memory_equal(&ulam_system_certificate(s)->guard.abs, &c.guard.abs, sizeof c.guard.abs);
+        ulam_system_free(s);
+        free(q), free(p);
+    }
+    free(good);
     ulam_csr_free(A);
     free(b);
 }
@@ -249,12 +261,26 @@ static void test_lazy_pages(void **state)
     o.index = 3, o.max_walks = 20000, o.threads = 2, o.guard = &g;
     ulam_walk_result r1, r2;
     ulam_error err;
-    assert_int_equal(ulam_solve(ulam_system_matrix(s), ulam_system_rhs(s, NULL), &o, &r1, &err), ULAM_OK);
+    const ulam_csr *lm;
+    const double *lb;
+    assert_int_equal(ulam_system_lazy(s, &lm, &lb), ULAM_OK);
+    o.system = s; /* each block verified as the walks reach it: blocks 0 .. far hold what they read */
+    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_OK);
+    o.system = NULL;
     assert_int_equal(ulam_solve(M, b, &o, &r2, &err), ULAM_OK);
     assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
     assert_int_equal(r1.rows, B);
+    o.system = s;
     o.estimator = ULAM_ABSORPTION; /* the reachability check too reads only what it reaches */
-    assert_int_equal(ulam_solve(ulam_system_matrix(s), ulam_system_rhs(s, NULL), &o, &r1, &err), ULAM_OK);
+    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_OK);
+    o.estimator = ULAM_EXPECTED; /* and the expected estimator's b at the rows' columns */
+    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_OK);
+    o.system = NULL; /* the arrays of another system's solver: refused */
+    ulam_system *t = NULL;
+    assert_int_equal(ulam_system_from_memory(p, len, NULL, &t, NULL), ULAM_OK);
+    o.system = t;
+    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_EINVAL);
+    ulam_system_free(t);
     ulam_system_free(s);
     munmap(p, len);
     ulam_csr_free(M);
@@ -267,7 +293,7 @@ static void test_lazy_pages(void **state)
 static void test_corrupt_rows(void **state)
 {
     (void)state;
-    const int64_t n = 256, B = 16;
+    const int64_t n = 1024, B = 256; /* blocks of 256 rows: the walks from 3 read block 0 alone */
     ulam_csr *M = two_blocks(n, B);
     double *b = malloc((size_t)n * sizeof *b);
     for (int64_t i = 0; i < n; i++) b[i] = 1.0;
@@ -299,16 +325,25 @@ static void test_corrupt_rows(void **state)
         ulam_system *s = NULL;
         ulam_error err;
         assert_int_equal(ulam_system_from_memory(p, len, NULL, &s, &err), ULAM_OK);
-        if (ulam_system_check(s, &err) == ULAM_OK) fail_msg("corrupt case %d: passed the check", k);
+        const ulam_csr *lm;
+        const double *lb;
+        ulam_system_lazy(s, &lm, &lb);
         for (int start = 0; start < 3; start++) {
             ulam_walk_opts o = ulam_walk_defaults();
             o.index = start == 0 ? B : start == 1 ? row : 3, o.max_walks = 5000, o.threads = 1, o.guard = &g;
+            o.system = s;
             ulam_walk_result r;
-            int st = ulam_solve(ulam_system_matrix(s), ulam_system_rhs(s, NULL), &o, &r, &err);
-            int bad = st == ULAM_ESYNTAX || st == ULAM_ENONFINITE;
-            if (start < 2 && !bad) fail_msg("corrupt case %d, start %lld: status %d", k, (long long)o.index, st);
+            int st = ulam_solve(lm, lb, &o, &r, &err);
+            if (start < 2 && (st != ULAM_ESYNTAX || !strstr(err.msg, "block 1 of")))
+                fail_msg("corrupt case %d, start %lld: status %d (%s)", k, (long long)o.index, st, err.msg);
             if (start == 2 && st != ULAM_OK) fail_msg("corrupt case %d: the other block failed (%d)", k, st);
         }
+        assert_int_equal(ulam_system_verify(s, 0, B, &err), ULAM_OK); /* block 0 is intact */
+        assert_int_equal(ulam_system_verify(s, row, row + 1, &err), ULAM_ESYNTAX);
+        if (ulam_system_check(s, &err) == ULAM_OK) fail_msg("corrupt case %d: passed the check", k);
+        assert_int_equal(err.index, B);
+        if (k < 6) assert_null(ulam_system_matrix(s));
+        else assert_null(ulam_system_rhs(s, NULL));
         ulam_system_free(s);
         free(q);
     }
@@ -318,6 +353,297 @@ static void test_corrupt_rows(void **state)
     free(b);
 }
 
+/* A system with a certificate and M^T, rows of 3 to 6 entries of both signs (row sums of |M|
+ * 0.75), b of varied entries: n rows in reach of one another. */
+static ulam_csr *mixed(int64_t n)
+{
+    ulam_csr *M = ulam_csr_alloc(n, n, 6 * n);
+    int64_t q = 0;
+    for (int64_t i = 0; i < n; i++) {
+        int len = 3 + (int)(i % 4);
+        for (int k = 0; k < len; k++) {
+            M->colidx[q] = (int32_t)((i * 7 + 13 * k * k + k) % n);
+            int dup = 0;
+            for (int64_t z = M->rowptr[i]; z < q; z++) dup |= M->colidx[z] == M->colidx[q];
+            if (dup) continue;
+            M->val[q++] = (k % 2 ? -0.75 : 0.75) / len;
+        }
+        M->rowptr[i + 1] = q;
+        for (int64_t a = M->rowptr[i]; a < q; a++) /* sort the row */
+            for (int64_t z = a + 1; z < q; z++)
+                if (M->colidx[z] < M->colidx[a]) {
+                    int32_t c = M->colidx[a];
+                    double v = M->val[a];
+                    M->colidx[a] = M->colidx[z], M->val[a] = M->val[z], M->colidx[z] = c, M->val[z] = v;
+                }
+    }
+    for (int64_t i = 0; i < n; i++) /* rescale each row to |sum| 0.75 */
+        for (int64_t z = M->rowptr[i]; z < M->rowptr[i + 1]; z++) M->val[z] *= (double)(3 + i % 4) / (double)(M->rowptr[i + 1] - M->rowptr[i]);
+    return M;
+}
+
+/* One query of a damaged copy: lazily (o.system), through the verified accessors, and M^T: each
+ * refused with a message, or answered as the intact file answers, bit for bit.  *refused counts
+ * the refusals. */
+static void query_copy(const unsigned char *p, size_t len, const double want[3], const ulam_csr *T, int label,
+                       int *refused)
+{
+    void *q = NULL;
+    assert_int_equal(posix_memalign(&q, 4096, len), 0);
+    memcpy(q, p, len);
+    ulam_system *s = NULL;
+    ulam_error err;
+    int st = ulam_system_from_memory(q, len, NULL, &s, &err);
+    if (st) {
+        if (!err.msg[0]) fail_msg("case %d: refused at open with no message", label);
+        ++*refused;
+        free(q);
+        return;
+    }
+    const ulam_certificate *c = ulam_system_certificate(s);
+    if (!c) fail_msg("case %d: opened without its certificate", label);
+    ulam_guard g;
+    assert_int_equal(ulam_certificate_guard(c, 0.0, NULL, &g), ULAM_OK);
+    const ulam_csr *lm;
+    const double *lb;
+    ulam_system_lazy(s, &lm, &lb);
+    for (int e = 0; e < 3; e++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.index = 3, o.max_walks = 2000, o.threads = 1, o.guard = &g, o.system = s, o.estimator = e;
+        ulam_walk_result r;
+        st = ulam_solve(lm, lb, &o, &r, &err);
+        if (st == ULAM_OK && memcmp(&r.estimate, &want[e], sizeof r.estimate))
+            fail_msg("case %d, estimator %d: a wrong answer %.17g (intact %.17g) with ULAM_OK", label, e, r.estimate, want[e]);
+        if (st && (!err.msg[0] || st != ULAM_ESYNTAX)) fail_msg("case %d: status %d, '%s'", label, st, err.msg);
+        *refused += st != ULAM_OK;
+    }
+    const ulam_csr *M = ulam_system_matrix(s); /* verified whole: NULL, or the intact answer */
+    const double *b = ulam_system_rhs(s, NULL);
+    if (M && b) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.index = 3, o.max_walks = 2000, o.threads = 1;
+        ulam_walk_result r;
+        st = ulam_solve(M, b, &o, &r, &err);
+        if (st || memcmp(&r.estimate, &want[0], sizeof r.estimate)) fail_msg("case %d: verified M answered %d", label, st);
+    } else if (ulam_system_check(s, &err) != ULAM_ESYNTAX || !strstr(err.msg, "block")) {
+        fail_msg("case %d: an accessor refused what the check passes", label);
+    }
+    const ulam_csr *t = ulam_system_transpose(s);
+    if (t) assert_csr_same(t, T);
+    else if (ulam_system_check(s, &err) != ULAM_ESYNTAX || !strstr(err.msg, "M^T")) fail_msg("case %d: M^T refused", label);
+    *refused += !t;
+    ulam_system_free(s);
+    free(q);
+}
+
+/* The corrupted-file table: in every byte class of a small prepared file (header words, the
+ * certificate, the header's checksum, padding, rowptr, colidx, val, b, M^T's arrays, the checksum
+ * table) bytes are flipped one at a time, spread over the class; every copy is refused with a
+ * message or answers as the intact file does, never a wrong answer with ULAM_OK. */
+static void test_flip_table(void **state)
+{
+    (void)state;
+    const int64_t n = 700;
+    ulam_csr *M = mixed(n), *T = NULL;
+    assert_int_equal(ulam_csr_check(M), ULAM_OK);
+    assert_int_equal(ulam_csr_transpose(M, &T), ULAM_OK);
+    double *b = malloc((size_t)n * sizeof *b);
+    for (int64_t i = 0; i < n; i++) b[i] = (double)(i % 5) - 1.5;
+    ulam_certificate c;
+    assert_int_equal(ulam_certificate_compute(M, 0.0, NULL, &c, NULL), ULAM_OK);
+    ulam_system_desc d = {.M = M, .b = b, .n = n, .cert = &c, .transpose = 1};
+    size_t len;
+    unsigned char *good = file_bytes(&d, &len);
+    double want[3];
+    for (int e = 0; e < 3; e++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.index = 3, o.max_walks = 2000, o.threads = 1, o.estimator = e;
+        ulam_walk_result r;
+        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        want[e] = r.estimate;
+    }
+    int refused = 0, dummy = 0;
+    query_copy(good, len, want, T, -1, &dummy);
+    assert_int_equal(dummy, 0);
+    enum { CLASSES = 13, PER = 24 };
+    uint64_t lo[CLASSES] = {0, 8 * 32, 8 * 69, 1016, 1024, word(good, 6), word(good, 7), word(good, 8), word(good, 9),
+                            word(good, 17), word(good, 18), word(good, 19), word(good, 15)};
+    uint64_t hi[CLASSES] = {8 * 32, 8 * 69, 1016, 1024, word(good, 6), lo[5] + 8 * (uint64_t)(n + 1),
+                            lo[6] + 4 * (uint64_t)M->rowptr[n], lo[7] + 8 * (uint64_t)M->rowptr[n], lo[8] + 8 * (uint64_t)n,
+                            lo[9] + 8 * (uint64_t)(n + 1), lo[10] + 4 * (uint64_t)M->rowptr[n],
+                            lo[11] + 8 * (uint64_t)M->rowptr[n], len};
+    unsigned char *p = malloc(len);
+    for (int k = 0; k < CLASSES; k++) {
+        if (!test_case(k)) continue;
+        int before = refused;
+        for (int j = 0; j < PER; j++) {
+            uint64_t at = lo[k] + (hi[k] - lo[k]) * (uint64_t)j / PER + (uint64_t)j % 3;
+            if (at >= hi[k]) continue;
+            memcpy(p, good, len);
+            p[at] ^= (unsigned char)(1u << (j % 8));
+            query_copy(p, len, want, T, k * 100 + j, &refused);
+        }
+        if (k != 4 && refused == before) fail_msg("byte class %d: no flip was noticed", k); /* 4: padding */
+    }
+    test_case_done();
+    free(p);
+    free(good);
+    ulam_csr_free(M);
+    ulam_csr_free(T);
+    free(b);
+}
+
+/* The prepared file of mixed(n), b_i = i mod 5 - 1.5 and its certificate (*c), in aligned
+ * memory of *len bytes (free() it). */
+static void *mixed_file(int64_t n, size_t *len, ulam_certificate *c)
+{
+    ulam_csr *M = mixed(n);
+    double *b = malloc((size_t)n * sizeof *b);
+    for (int64_t i = 0; i < n; i++) b[i] = (double)(i % 5) - 1.5;
+    assert_int_equal(ulam_certificate_compute(M, 0.0, NULL, c, NULL), ULAM_OK);
+    ulam_system_desc d = {.M = M, .b = b, .n = n, .cert = c};
+    unsigned char *bytes = file_bytes(&d, len);
+    void *q = NULL;
+    assert_int_equal(posix_memalign(&q, 4096, *len), 0);
+    memcpy(q, bytes, *len);
+    free(bytes), free(b);
+    ulam_csr_free(M);
+    return q;
+}
+
+/* Two solvers in two threads (each with two threads of walks) on one system opened fresh, its
+ * blocks verified by whichever thread reaches them first: both answer as one solver alone does. */
+typedef struct {
+    const ulam_system *s;
+    const ulam_guard *g;
+    int index, status;
+    double estimate;
+} solve_job;
+
+/* Run one job. */
+static void *run_job(void *arg)
+{
+    solve_job *j = arg;
+    const ulam_csr *M;
+    const double *b;
+    ulam_system_lazy(j->s, &M, &b);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = j->index, o.max_walks = 20000, o.threads = 2, o.guard = j->g, o.system = j->s, o.whole_kernel = j->index == 5;
+    ulam_walk_result r;
+    j->status = ulam_solve(M, b, &o, &r, NULL);
+    j->estimate = r.estimate;
+    return NULL;
+}
+
+/* See solve_job. */
+static void test_threads(void **state)
+{
+    (void)state;
+    size_t len;
+    ulam_certificate c;
+    void *q = mixed_file(5000, &len, &c);
+    ulam_guard g;
+    assert_int_equal(ulam_certificate_guard(&c, 0.0, NULL, &g), ULAM_OK);
+    double alone[2];
+    for (int k = 0; k < 2; k++) {
+        ulam_system *s = NULL;
+        assert_int_equal(ulam_system_from_memory(q, len, NULL, &s, NULL), ULAM_OK);
+        solve_job j = {.s = s, .g = &g, .index = k ? 5 : 3};
+        run_job(&j);
+        assert_int_equal(j.status, ULAM_OK);
+        alone[k] = j.estimate;
+        ulam_system_free(s);
+    }
+    ulam_system *s = NULL;
+    assert_int_equal(ulam_system_from_memory(q, len, NULL, &s, NULL), ULAM_OK);
+    solve_job jobs[2] = {{.s = s, .g = &g, .index = 3}, {.s = s, .g = &g, .index = 5}};
+    pthread_t th[2];
+    for (int k = 0; k < 2; k++) assert_int_equal(pthread_create(&th[k], NULL, run_job, &jobs[k]), 0);
+    for (int k = 0; k < 2; k++) assert_int_equal(pthread_join(th[k], NULL), 0);
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(jobs[k].status, ULAM_OK);
+        assert_memory_equal(&jobs[k].estimate, &alone[k], sizeof alone[k]);
+    }
+    assert_int_equal(ulam_system_check(s, NULL), ULAM_OK);
+    ulam_system_free(s);
+    free(q);
+}
+
+/* Recompute the checksums of M's blocks of the file at p (its arrays F, changed in place), the
+ * table's, the certificate's content hash and the header's, as a forger would (rows of block k:
+ * rowptr[k B .. min(n, (k+1) B)], then their colidx and val; a row range past the entries is
+ * hashed up to nnz, what a forger's tool would do). */
+static void reseal(void *p, const ulam_csr *F)
+{
+    unsigned char *u = p;
+    int64_t B = (int64_t)1 << word(u, 14), n = F->nrows, nnz = (int64_t)word(u, 5), nb = (n + B - 1) / B;
+    uint64_t *sums = (uint64_t *)(void *)(u + word(u, 15));
+    for (int64_t k = 0; k < nb; k++) {
+        int64_t r0 = k * B, r1 = r0 + B < n ? r0 + B : n;
+        int64_t a = F->rowptr[r0] < nnz ? F->rowptr[r0] : nnz, e = F->rowptr[r1] < nnz ? F->rowptr[r1] : nnz;
+        XXH3_state_t *st = XXH3_createState();
+        XXH3_64bits_reset(st);
+        XXH3_64bits_update(st, F->rowptr + r0, (size_t)(r1 - r0 + 1) * 8);
+        if (e > a) {
+            XXH3_64bits_update(st, F->colidx + a, (size_t)(e - a) * 4);
+            XXH3_64bits_update(st, F->val + a, (size_t)(e - a) * 8);
+        }
+        sums[k] = XXH3_64bits_digest(st);
+        XXH3_freeState(st);
+    }
+    int64_t total = nb * ((word(u, 2) & 2) ? 2 : 1);
+    uint64_t th = XXH3_64bits(sums, (size_t)total * 8), content = XXH3_64bits(sums, (size_t)nb * 8);
+    memcpy(u + 8 * 16, &th, 8);
+    set_word(u, 33, content);
+}
+
+/* Arrays written with their checksums right but a column out of range, a row range running past
+ * the entries, or a NaN (a writer's bug, or a forger): open, then what a user does with no check
+ * of their own (the verified matrix; the lazy arrays with opts.system, guards computed or given,
+ * adjoint and forward) is refused with ULAM_ESYNTAX naming the fault, never read out of bounds
+ * (the guards' sum pass once read colidx[q] = 10^6 here). */
+static void test_sound_sums_bad_arrays(void **state)
+{
+    (void)state;
+    const int64_t n = 300;
+    for (int k = 0; k < 3; k++) {
+        if (!test_case(k)) continue;
+        size_t len;
+        ulam_certificate c;
+        void *q = mixed_file(n, &len, &c);
+        ulam_csr F = {.nrows = n, .ncols = n, .rowptr = (int64_t *)(void *)((unsigned char *)q + word(q, 6)),
+                      .colidx = (int32_t *)(void *)((unsigned char *)q + word(q, 7)),
+                      .val = (double *)(void *)((unsigned char *)q + word(q, 8))};
+        if (k == 0) F.colidx[F.rowptr[7] + 1] = 1000000;
+        if (k == 1) F.rowptr[9] = F.rowptr[n] + 50;
+        if (k == 2) F.val[F.rowptr[11]] = NAN;
+        reseal(q, &F);
+        ulam_system *s = NULL;
+        ulam_error err;
+        assert_int_equal(ulam_system_from_memory(q, len, NULL, &s, &err), ULAM_OK);
+        assert_null(ulam_system_matrix(s));
+        const ulam_csr *lm;
+        const double *lb;
+        ulam_system_lazy(s, &lm, &lb);
+        ulam_guard g;
+        assert_int_equal(ulam_certificate_guard(ulam_system_certificate(s), 0.0, NULL, &g), ULAM_OK);
+        static const char *const why[3] = {"column", "row pointers", "value"};
+        for (int run = 0; run < 3; run++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.index = 3, o.max_walks = 2000, o.threads = 1, o.system = s;
+            o.guard = run == 1 ? &g : NULL;
+            o.mode = run == 2 ? ULAM_FORWARD : ULAM_ADJOINT;
+            ulam_walk_result r;
+            int st = ulam_solve(lm, lb, &o, &r, &err);
+            if (st != ULAM_ESYNTAX || !strstr(err.msg, why[k]))
+                fail_msg("case %d, run %d: status %d, '%s'", k, run, st, err.msg);
+        }
+        ulam_system_free(s);
+        free(q);
+    }
+    test_case_done();
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -325,6 +651,9 @@ int main(void)
         cmocka_unit_test(test_damaged),
         cmocka_unit_test(test_lazy_pages),
         cmocka_unit_test(test_corrupt_rows),
+        cmocka_unit_test(test_flip_table),
+        cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_sound_sums_bad_arrays),
     };
     return test_run(tests);
 }

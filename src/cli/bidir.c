@@ -213,14 +213,15 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     ulam_csr *Mt = NULL;
     ulam_push *w = NULL;
     double t0 = ulam_now();
-    int status = ulam_csr_transpose(s->M, &Mt);
+    const ulam_csr *stored = s->sys_M ? ulam_system_transpose(s->sys_M) : NULL; /* prepare --transpose: none to build */
+    int status = stored ? ULAM_OK : ulam_csr_transpose(s->M, &Mt);
     rp->transpose_seconds = ulam_now() - t0;
     if (!status) status = ulam_push_alloc(s->M, &w);
     ulam_error err = {.status = status, .msg = "memory for the transpose and the push"};
     ulam_bidir_result r;
     o->walk.interrupt = &cli_interrupted, o->walk.share = cli_share;
     cli_catch_sigint();
-    if (!status) status = ulam_bidir_solve(w, Mt, o, &r, &err);
+    if (!status) status = ulam_bidir_solve(w, stored ? stored : Mt, o, &r, &err);
     int rc = status ? cli_report(s->matrix_path, &err) : 0;
     if (!status) {
         if (rp->json) print_json(o, &r, rp);

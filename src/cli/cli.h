@@ -69,6 +69,10 @@ typedef struct cli_system {
  * whole unless s->lazy; 0 or an exit code (nothing stays loaded on failure). */
 int cli_load_system(cli_system *s);
 
+/* The refusal of a command given no --rhs for path: a file named .ulam or .ulamcache that is
+ * not a prepared system (empty, another magic) says so; anything else needs --rhs.  An exit code. */
+int cli_need_rhs(const char *command, const char *path);
+
 /* Check a mapped M and b whole (ulam_system_check) if not yet done; 0 or an exit code. */
 int cli_system_verify(cli_system *s);
 

@@ -133,14 +133,13 @@ int cli_parse_bytes(const char *command, const char *opt, const char *s, size_t 
     return 0;
 }
 
-/* The identity of a source file for its cache: size and modification time (ns). */
-static int file_tag(const char *path, uint64_t tag[2])
+/* The matrix (vec == NULL) or b a prepared system holds, unverified (NULL: none). */
+static const void *held(const ulam_system *sys, const double **vec)
 {
-    struct stat st;
-    if (stat(path, &st)) return -1;
-    tag[0] = (uint64_t)st.st_size;
-    tag[1] = (uint64_t)st.st_mtim.tv_sec * 1000000000u + (uint64_t)st.st_mtim.tv_nsec;
-    return 0;
+    const ulam_csr *M = NULL;
+    const double *b = NULL;
+    ulam_system_lazy(sys, &M, &b);
+    return vec ? (const void *)b : (const void *)M;
 }
 
 /* Read a matrix (vec == NULL) or vector.  A prepared file is mapped (*sys); with cache, its
@@ -155,7 +154,7 @@ static int read_input(const char *path, int cache, ulam_system **sys, ulam_csr *
     double t0 = ulam_now();
     if (ulam_system_is_file(path)) {
         int status = ulam_system_open(path, NULL, sys, err);
-        if (!status && (vec ? !ulam_system_rhs(*sys, NULL) : !ulam_system_matrix(*sys))) {
+        if (!status && !held(*sys, (const double **)vec)) {
             *sys = ulam_system_free(*sys);
             *err = (ulam_error){.status = ULAM_ENOTFOUND, .index = -1};
             snprintf(err->msg, sizeof err->msg, "%s", vec ? "a prepared system holding b (prepare it with --rhs)"
@@ -164,10 +163,10 @@ static int read_input(const char *path, int cache, ulam_system **sys, ulam_csr *
         }
         return status;
     }
-    int use = cache && strlen(path) < 4096 && !file_tag(path, tag);
+    int use = cache && strlen(path) < 4096 && !ulam_file_tag(path, tag, NULL); /* the source's content hash */
     if (use) {
         snprintf(cpath, sizeof cpath, "%s.ulamcache", path);
-        if (!ulam_system_open(cpath, tag, sys, err) && (vec ? ulam_system_rhs(*sys, NULL) != NULL : ulam_system_matrix(*sys) != NULL)) {
+        if (!ulam_system_open(cpath, tag, sys, err) && held(*sys, (const double **)vec)) {
             fprintf(stderr, "ulam: %s: loaded from its cache in %.3f s\n", path, ulam_now() - t0);
             return ULAM_OK;
         }
@@ -229,6 +228,20 @@ static int load_jacobi(cli_system *s)
     return 0;
 }
 
+/* See cli.h. */
+int cli_need_rhs(const char *command, const char *path)
+{
+    size_t len = strlen(path);
+    if ((len > 5 && !strcmp(path + len - 5, ".ulam")) || (len > 10 && !strcmp(path + len - 10, ".ulamcache"))) {
+        ulam_system *sys = NULL;
+        ulam_error err;
+        int status = ulam_system_open(path, NULL, &sys, &err); /* says why it is not one */
+        ulam_system_free(sys);
+        if (status) return cli_report(path, &err);
+    }
+    return cli_usage_error(command, "needs --rhs b.mtx");
+}
+
 /* Load M (and b); 0 or an exit code. */
 int cli_load_system(cli_system *s)
 {
@@ -239,7 +252,10 @@ int cli_load_system(cli_system *s)
                                s->matrix_path);
     int status = read_input(s->matrix_path, s->cache, &s->sys_M, &s->own_M, NULL, NULL, &err);
     if (status) return cli_report(s->matrix_path, &err);
-    s->M = s->own_M ? s->own_M : ulam_system_matrix(s->sys_M);
+    const ulam_csr *mapped = NULL;
+    const double *mapped_b = NULL;
+    ulam_system_lazy(s->sys_M, &mapped, &mapped_b); /* verified below, or as walks read it (lazy) */
+    s->M = s->own_M ? s->own_M : mapped;
     if (prepared) s->cert = ulam_system_certificate(s->sys_M);
     if (s->M->nrows != s->M->ncols) {
         fprintf(stderr, "ulam: %s: error: %s: expected a square matrix, got %lld x %lld\n",
@@ -255,7 +271,10 @@ int cli_load_system(cli_system *s)
             cli_system_free(s);
             return cli_report(s->rhs_path, &err);
         }
-        s->b = s->own_b ? s->own_b : ulam_system_rhs(s->sys_b, &nb);
+        const double *vb = NULL;
+        ulam_system_lazy(s->sys_b, NULL, &vb);
+        if (s->sys_b) ulam_system_rhs(s->sys_b, &nb);
+        s->b = s->own_b ? s->own_b : vb;
         if (nb != n) {
             fprintf(stderr, "ulam: %s: error: %s: expected %lld entries to match %s, got %lld\n",
                     s->rhs_path, ulam_strerror(ULAM_EDIM), (long long)n, s->matrix_path,
@@ -264,11 +283,15 @@ int cli_load_system(cli_system *s)
             return cli_exit_code(ULAM_EDIM);
         }
     } else if (prepared) {
-        s->b = ulam_system_rhs(s->sys_M, NULL);
+        s->b = mapped_b;
     }
     s->verified = !s->sys_M && !s->sys_b;
     int rc = s->jacobi ? load_jacobi(s) : 0;
     if (!rc && !s->lazy) rc = cli_system_verify(s);
+    if (!rc && s->lazy && s->sys_b && ulam_system_check(s->sys_b, &err)) { /* a b of its own file: whole */
+        cli_system_free(s);
+        return cli_report(s->rhs_path, &err);
+    }
     if (rc) return rc;
     if (s->index > s->M->nrows) {
         rc = cli_usage_error(s->command, "--index %lld is out of range 1..%lld",

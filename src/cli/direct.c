@@ -83,7 +83,7 @@ int cli_direct(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("direct", "expects exactly one matrix file");
-    if (!s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("direct", "needs --rhs b.mtx");
+    if (!s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_need_rhs("direct", argv[optind]);
     s.matrix_path = argv[optind];
     if (out && (rc = cli_check_output(out))) return rc;
     if ((rc = cli_load_system(&s))) return rc;

@@ -7,12 +7,13 @@
 #include <string.h>
 
 static const char *const usage =
-    "usage: ulam prepare M.mtx [--rhs b.mtx] [--jacobi [--omega W]] [--continue Q] -o SYSTEM.ulam\n"
+    "usage: ulam prepare M.mtx [--rhs b.mtx] [--jacobi [--omega W]] [--continue Q] [--transpose] -o SYSTEM.ulam\n"
     "\n"
     "Write M (and b) of (I - M) x = b as a prepared system: the CSR arrays and b as they sit in\n"
     "memory (little-endian, 4096-byte aligned) behind a checksummed header that also holds the\n"
     "guards' certificate (rho(|M|), rho(M^) of both kernels with their bounds, the row and\n"
-    "column sums of |M|).  'ulam solve SYSTEM.ulam --index I' then maps the file and reads only\n"
+    "column sums of |M|), with an XXH3 checksum for each block of rows, verified when first\n"
+    "read.  'ulam solve SYSTEM.ulam --index I' then maps the file and reads only the blocks of\n"
     "the rows its walks reach: no parse, no guard pass.  The file is written atomically.\n"
     "\n"
     "  --rhs b.mtx   store b too (solve then needs no --rhs)\n"
@@ -20,6 +21,8 @@ static const char *const usage =
     "  --omega W     damping of the Jacobi splitting (default 1)\n"
     "  --continue Q  certify the kernel of fixed continuation Q (default: analog); a query with\n"
     "                another continuation runs its own guards\n"
+    "  --transpose   store M^T too (CSR of the transpose): bidirectional and point-source\n"
+    "                queries push on it instead of transposing M each run\n"
     "  -o, --output PATH  the output file (required)\n";
 
 /* ulam prepare. */
@@ -29,11 +32,12 @@ int cli_prepare(int argc, char **argv)
         {"rhs", required_argument, 0, 'b'},      {"jacobi", no_argument, 0, 'j'},
         {"omega", required_argument, 0, 'w'},    {"continue", required_argument, 0, 'q'},
         {"output", required_argument, 0, 'o'},   {"help", no_argument, 0, 'h'},
+        {"transpose", no_argument, 0, 't'},
         {0, 0, 0, 0}};
     cli_system s = {.command = "prepare", .omega = 1.0};
     const char *out = NULL;
     double continue_q = 0.0;
-    int c, rc;
+    int c, rc, transpose = 0;
     optind = 0;
     while ((c = getopt_long(argc, argv, "ho:", longopts, NULL)) != -1) {
         switch (c) {
@@ -42,6 +46,7 @@ int cli_prepare(int argc, char **argv)
         case 'w': if ((rc = cli_parse_real("prepare", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'q': if ((rc = cli_parse_real("prepare", "--continue", optarg, 1e-9, 1 - 1e-12, &continue_q))) return rc; break;
         case 'o': out = optarg; break;
+        case 't': transpose = 1; break;
         case 'h': fputs(usage, stdout); return 0;
         default: return cli_usage_error("prepare", "unknown option");
         }
@@ -74,6 +79,7 @@ int cli_prepare(int argc, char **argv)
     }
     ulam_system_desc d = ulam_system_desc_defaults();
     d.M = s.M, d.b = s.b, d.n = s.M->nrows, d.omega = s.jacobi ? s.omega : 0.0, d.cert = &cert;
+    d.transpose = transpose;
     status = ulam_system_write_file(o.f, &d);
     if (status) ulam_outfile_abort(&o);
     else status = ulam_outfile_commit(&o);
@@ -81,8 +87,8 @@ int cli_prepare(int argc, char **argv)
         err = (ulam_error){.status = status, .msg = "a writable output file"};
         rc = cli_report(out, &err);
     } else {
-        printf("prepared       %s: n %lld, nnz %lld%s%s\n", out, (long long)s.M->nrows, (long long)ulam_csr_nnz(s.M),
-               s.b ? ", with b" : ", no b", s.jacobi ? ", Jacobi splitting" : "");
+        printf("prepared       %s: n %lld, nnz %lld%s%s%s\n", out, (long long)s.M->nrows, (long long)ulam_csr_nnz(s.M),
+               s.b ? ", with b" : ", no b", s.jacobi ? ", Jacobi splitting" : "", transpose ? ", with M^T" : "");
         printf("rho(|M|)       ");
         cli_print_power(&cert.guard.abs);
         printf("  (%s)\nrow sums |M|   %.6g .. %.6g; column sums %.6g .. %.6g\n",

@@ -60,7 +60,7 @@ static const char *const usage2 = /* the help in three strings: C99 promises 409
     "  --assume-finite-variance  print a confidence interval when the guards cannot tell\n"
     "                     whether rho(M^) < 1 (unknown is otherwise treated as infinite)\n"
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
-    "                     that instead of parsing while the file is unchanged (size, mtime)\n";
+    "                     that instead of parsing while the file is unchanged (its XXH3 hash)\n";
 static const char *const usage3 =
     "  --method auto      (default) choose mode, estimator, continuation and --alpha among\n"
     "                     the candidates the guards certify, by pilots compared on a fixed\n"
@@ -386,7 +386,7 @@ static int parse(int argc, char **argv, solve_args *a)
         }
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (!a->s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("solve", "needs --rhs b.mtx");
+    if (!a->s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_need_rhs("solve", argv[optind]);
     if (!a->s.index && a->o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
     if ((a->out || a->errors) && a->o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
@@ -451,6 +451,7 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
     ro->load_seconds = ulam_now() - t0;
     o->index = s->index ? s->index - 1 : 0;
     o->interrupt = &cli_interrupted, o->share = cli_share, o->force = a->force;
+    o->system = s->lazy ? s->sys_M : NULL; /* a mapped M read lazily: its blocks verified as walks reach them */
     o->assume_finite = ro->assume_finite;
     ro->n = s->M->nrows;
     ulam_error err;

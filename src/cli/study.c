@@ -637,7 +637,7 @@ int cli_study(int argc, char **argv)
         }
     }
     if (optind != argc - 1) return cli_usage_error("study", "expects exactly one matrix file");
-    if (!st.s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_usage_error("study", "needs --rhs b.mtx");
+    if (!st.s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_need_rhs("study", argv[optind]);
     if (!st.s.index) return cli_usage_error("study", "needs --index I");
     st.s.matrix_path = argv[optind];
     if (mkdir(st.out, 0777) && access(st.out, W_OK)) {
