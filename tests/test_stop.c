@@ -116,6 +116,32 @@ static void test_metastable_fixed(void **state)
     ulam_csr_free(M), free(b);
 }
 
+/* Case 1 under the method auto chooses (pilots, then the chosen solver) at 1000 walks, where a
+ * pilot that never reached B has variance 0 and the old choice preferred it (13/100). */
+static void test_metastable_auto(void **state)
+{
+    (void)state;
+    double *b, x;
+    ulam_csr *M = metastable(1e-4, &b, &x);
+    int v[3] = {0, 0, 0};
+    for (int s = 0; s < 100; s++) {
+        if (!test_case(s)) continue;
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.max_walks = 1000, o.seed = 300 + (uint64_t)s;
+        ulam_auto_result res;
+        ulam_solver *sv = NULL;
+        assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
+        while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+        ulam_walk_result r;
+        ulam_solver_result(sv, &r);
+        v[verdict(&r, x)]++;
+        ulam_solver_free(sv);
+    }
+    test_case_done();
+    count("metastable auto, 1000 walks:", v[1], v[2], 100);
+    ulam_csr_free(M), free(b);
+}
+
 /* Case 1 stopped after a number of rounds the test picks per seed (1 to 6: 1024 to 64512 walks),
  * as a clock would stop it, with max_seconds set so the run knows its stop is not fixed. */
 static void test_metastable_rounds(void **state)
@@ -232,7 +258,7 @@ static void test_never_zero_width(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_never_zero_width), cmocka_unit_test(test_metastable_fixed),
-                                       cmocka_unit_test(test_metastable_rounds),
+                                       cmocka_unit_test(test_metastable_rounds), cmocka_unit_test(test_metastable_auto),
                                        cmocka_unit_test(test_metastable_rel_err), cmocka_unit_test(test_laplace_corner)};
     return test_run(tests);
 }
