@@ -1108,7 +1108,9 @@ double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int sign
                       : ulam__score_range(INFINITY, s->weight * per_visit, q ? s->qmax : s->tail_u, q ? 1.0 : s->kappa,
                                           signs, m, E);
     if (!isfinite(R) && !absorb) R = ulam__moment_range(s->v2 * per_visit * per_visit, signs, m, E);
-    return isfinite(R) ? ulam__rel_min_walks(R, E, m) : INFINITY;
+    if (!isfinite(R)) return INFINITY;
+    double n = ulam__stop_walks_needed(m, 0.0, R, 0.0, E, 1); /* the rule's range term, at the epoch it lands in */
+    return isfinite(n) ? ulam__stop_walks_needed(m, 0.0, R, 0.0, E, ulam__stop_epoch((int64_t)n)) : n;
 }
 
 /* The most the walks cut at max_steps can have moved the mean (0 without cuts). */

@@ -455,7 +455,7 @@ static double channel_min_walks(const ulam_rad_solver *s, int c, double m, doubl
     ulam__stop_ci ci;
     channel_interval(s, c, m, E, &ci);
     double R = ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, fabs(m), E / 4.0);
-    return ulam__stop_walks_needed(m, ulam__moments_variance(&s->m[c]), R, ci.bias, E, ci.k);
+    return isfinite(R) ? ulam__stop_walks_needed(m, ulam__moments_variance(&s->m[c]), R, ci.bias, E, ci.k) : 0.0;
 }
 
 /* Gathering with rel_err: the walks the rule's range term needs in each channel, at its
@@ -475,7 +475,8 @@ static void channel_mins(const ulam_rad_solver *s, double mins[3])
 
 /* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
  * takes the rule of src/stop.h (ulam__stop_rel_met on each channel's 95% interval; mins from
- * channel_mins hold a channel still at 0); shooting, the standard error alone. */
+ * channel_mins hold a channel still at 0); shooting, and gathering without a certified range, the
+ * standard error alone. */
 static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, const double mins[3], double rel_err)
 {
     int any = 0;
@@ -491,8 +492,11 @@ static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, co
         if (r->radiosity[c] == 0.0) continue;
         ulam__stop_ci ci;
         if (s->o.mode != ULAM_FORWARD) channel_interval(s, c, r->radiosity[c], rel_err, &ci);
-        if (s->o.mode == ULAM_FORWARD ? !(r->std_error[c] <= rel_err * fabs(r->radiosity[c]))
-                                      : !ulam__stop_rel_met(&ci, r->radiosity[c], rel_err))
+        /* no certified range (next-event estimation: unbounded per-visit scores): the standard
+           error alone, as shooting (a known gap: such a stop has no range term) */
+        if (s->o.mode == ULAM_FORWARD || ci.kind == ULAM__STOP_NONE
+                ? !(r->std_error[c] <= rel_err * fabs(r->radiosity[c]))
+                : !ulam__stop_rel_met(&ci, r->radiosity[c], rel_err))
             return 0;
         any = 1;
     }
