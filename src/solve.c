@@ -1187,7 +1187,13 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     ulam__stop_ci ci;
     interval(s, r, &R, &ci);
     r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
-    r->min_walks = ulam__stop_walks_needed(m, r->variance, R, ci.bias, s->o.rel_err, ci.k);
+    if (s->o.rel_err > 0) { /* at this interval's truncation or at the one a stop would have (bias E |m| / 4) */
+        double E = s->o.rel_err, Rs = m > 0 ? score_range(s, m, E / 4.0) : INFINITY;
+        int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
+        r->min_walks = fmin(ulam__stop_walks_needed(m, r->variance, R, ci.bias, E, ci.k),
+                            ulam__stop_walks_needed(m, r->variance, Rs, (truncated ? E * m / 4.0 : 0.0) + r->cut_bound,
+                                                    E, ci.k));
+    }
     r->cut_stop = s->cut_stop;
     r->out_of_reach = s->out_of_reach;
     r->rel_err_met = s->met;
