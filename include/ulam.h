@@ -170,6 +170,11 @@ int ulam_csr_stats_compute(const ulam_csr *A, ulam_csr_stats *st);
 int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, double *bp,
                 ulam_error *err);
 
+/* PageRank as a system: M = alpha P^T for the adjacency matrix A (edge i -> j of weight A_ij >= 0,
+ * P = D^-1 A row-stochastic; a dangling row stays zero), so that (I - M) x = (1 - alpha) / n
+ * gives PageRank x.  alpha in (0, 1) is the damping; *M is new (ulam_csr_free). */
+int ulam_pagerank_matrix(const ulam_csr *A, double alpha, ulam_csr **M, ulam_error *err);
+
 /* ---------------------------------------------------------------- Matrix Market */
 /* Primary: ulam_mm_read_matrix, _read_vector, _write_vector.  Secondary: options, FILE readers,
  * _write_matrix.  Tertiary: ulam_strtod, ulam_outfile. */
@@ -244,7 +249,8 @@ int ulam_outfile_commit(ulam_outfile *o);
 void ulam_outfile_abort(ulam_outfile *o);
 
 /* ---------------------------------------------------------------- direct solve */
-/* Primary: ulam_direct_solve.  Secondary: ulam_direct_bytes. */
+/* Primary: ulam_direct_solve, ulam_direct_sparse.  Secondary: ulam_direct_bytes,
+ * ulam_direct_sparse_available. */
 
 /* What a LAPACK direct solve reports besides the solution. */
 typedef struct ulam_direct_info {
@@ -262,6 +268,22 @@ size_t ulam_direct_bytes(int64_t n);
  * ULAM_ESINGULAR (err->index is the zero pivot).  info may be NULL. */
 int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
                       ulam_direct_info *info, ulam_error *err);
+
+/* Solve (I - M) x = b by a sparse LU factorisation (UMFPACK, SuiteSparse): memory about that of
+ * the factors, not n^2.  UMFPACK's own estimate of the factorisation's peak memory is checked
+ * against max_bytes (0: no limit) before it starts (ULAM_EMEMLIMIT); ULAM_ESINGULAR for a
+ * singular I - M; ULAM_EUNSUPPORTED when libulam was built without UMFPACK.  info may be NULL
+ * (its rcond is UMFPACK's estimate, its bytes the peak memory). */
+int ulam_direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
+                       ulam_direct_info *info, ulam_error *err);
+
+/* What ulam_direct_sparse will need, before it starts: UMFPACK's estimates of the factorisation's
+ * peak memory (*bytes) and floating-point operations (*flops), from its symbolic analysis (a
+ * fraction of the factorisation's time).  ULAM_EUNSUPPORTED without UMFPACK. */
+int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err);
+
+/* Nonzero when libulam was built with UMFPACK (ulam_direct_sparse works). */
+int ulam_direct_sparse_available(void);
 
 /* ---------------------------------------------------------------- spectral radius */
 /* Secondary, except tertiary: ulam_spectral_radius_op. */
@@ -769,11 +791,18 @@ typedef struct ulam_outer_step {
 typedef struct ulam_outer ulam_outer;
 
 /* Prepare the iteration on (I - M) x = b (M and b borrowed until freed).  Refuses options
- * out of range (ULAM_EINVAL), a non-square M, and b = 0 (ULAM_EINVAL: nothing to reduce). */
+ * out of range (ULAM_EINVAL), a non-square M, and b = 0 (ULAM_EINVAL: nothing to reduce); with
+ * walks, also a forward rho(M^) not certified below 1 (ULAM_EINFVAR, before any walk: an
+ * unknown one walks when walk.assume_finite).  The guards come from walk.guard when it holds
+ * rho(|M|) and the forward rho(M^) of this kernel, else they are computed here. */
 int ulam_outer_alloc(const ulam_csr *M, const double *b, const ulam_outer_opts *opts, ulam_outer **out,
                      ulam_error *err);
 
-/* One iteration; fills *step (may be NULL).  ULAM_OK while it may go on or once converged;
+/* One iteration; fills *step (may be NULL).  A walk correction is applied only when it lowers
+ * the residual it was fed; otherwise its walks go on to about N (ratio / 0.5)^2 histories (at
+ * least 4 N) and it is tried again, and when that count exceeds 100 times what the eps1 rule
+ * asked for or max_histories, the run ends with ULAM_ESTALL (step->histories counts every
+ * walk, rejected ones too).  ULAM_OK while it may go on or once converged;
  * then ULAM_ENOCONV at the iteration cap, ULAM_ESTALL when the residual stopped decreasing,
  * ULAM_ENONFINITE for a non-finite residual or walk, ULAM_ENOMEM; each also ends the run. */
 int ulam_outer_iterate(ulam_outer *s, ulam_outer_step *step);
@@ -789,6 +818,14 @@ const double *ulam_outer_x(const ulam_outer *s);
 
 /* Free; accepts and returns NULL. */
 ulam_outer *ulam_outer_free(ulam_outer *s);
+
+/* Why the run ended, as a sentence in err (may be NULL); returns its status (ULAM_OK while it
+ * goes on or once converged). */
+int ulam_outer_error(const ulam_outer *s, ulam_error *err);
+
+/* Corrections rejected so far: a walk correction that did not lower the residual is never
+ * applied; its walks go on to more histories (see ulam_outer_iterate). */
+int ulam_outer_rejected(const ulam_outer *s);
 
 /* Iterate until done into x (n entries); steps (may be NULL) gets up to max_steps records,
  * *nsteps (may be NULL) the iterations run.  Returns the last iterate's status. */
@@ -879,10 +916,19 @@ typedef struct ulam_bidir_opts {
                              push workspace and rescored to the next query's residual, so a query
                              builds only the rows no earlier one reached (its walks are those a new
                              kernel gives, bit for bit; walks.rows counts every row kept) */
+    double step_cost;     /* push operations one walk visit costs, for the balance (<= 0: the
+                             default ULAM_BIDIR_STEP_COST); measure it on the machine and graph at
+                             hand with bench_bidir, which prints push operations/s over walk
+                             visits/s (docs/bidirectional.md) */
 } ulam_bidir_opts;
 
+/* The balance's default cost of one walk visit in push operations: the median of bench_bidir's
+ * measurements, 0.74 and 1.29 on the Zipf family and 1.82 on R-MAT 2^18 (one thread, a 2-core
+ * machine at load ~20, 2026-12-02, docs/bidirectional.md); not the 3 issue 29 supposed. */
+#define ULAM_BIDIR_STEP_COST 1.3
+
 /* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
- * (the default cap), walk ulam_walk_defaults(). */
+ * (the default cap), walk ulam_walk_defaults(), step_cost 0 (ULAM_BIDIR_STEP_COST). */
 ulam_bidir_opts ulam_bidir_defaults(void);
 
 /* A bidirectional estimate's plan (ulam_bidir_plan): the push it runs and what the walks after it
@@ -908,6 +954,8 @@ typedef struct ulam_bidir_plan_info {
     int64_t pilot_units;    /* kernel units (16 bytes of a row) the pilot's solver built on Mt */
     int64_t pilot_reads;    /* entries its reachability checks and score-bound passes read */
     double seconds;         /* wall time of the plan: pilot and push */
+    double probe;           /* a lower bound on |x_t| from 1024 walks scoring the residual midway
+                               (0: no probe ran, or it saw nothing), which the balance plans for */
 } ulam_bidir_plan_info;
 
 /* Plan a bidirectional estimate without its walks: start the push at o->target and, when o->rmax
@@ -947,6 +995,46 @@ typedef struct ulam_bidir_result {
  * range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap), the walk solver's statuses. */
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err);
+
+/* Single source, every target (src/fpush.c; FORA, Wang et al., KDD 2017): x = (I - M)^-1 e_s by
+ * a forward push from s (the reverse push of ulam_push on M'), leaving x = p + (I - M)^-1 r, and
+ * forward walks on M from r that estimate every component of the rest.  Start from
+ * ulam_fpush_defaults(). */
+typedef struct ulam_fpush_opts {
+    int64_t source;      /* 0-based s */
+    double rel_err;      /* FORA's target: relative error E on every x_i >= min_value (default 0.1) */
+    double min_value;    /* delta (<= 0: 1 / n) */
+    int64_t walks;       /* > 0: this many walks (the balance pushes to what they cost); 0: FORA's
+                            count ||r||_1 (2E/3 + 2) ln(2n) / (E^2 delta) */
+    double rmax;         /* > 0: push threshold; <= 0: halve from 1 while the push's operations are
+                            below the walks' work (walks x visits x step_cost) */
+    double step_cost;    /* push operations a walk visit costs (<= 0: ULAM_BIDIR_STEP_COST) */
+    ulam_walk_opts walk; /* seed, threads, estimator, continue_q, guard (mode forced forward) */
+} ulam_fpush_opts;
+
+/* The defaults: source 0, rel_err 0.1, min_value 0, walks 0, rmax 0, step_cost 0, walk
+ * ulam_walk_defaults() in forward mode. */
+ulam_fpush_opts ulam_fpush_defaults(void);
+
+/* What a single-source estimate did. */
+typedef struct ulam_fpush_info {
+    double rmax;           /* the push threshold */
+    ulam_push_info push;   /* the push */
+    double mean_visits;    /* V the balance took: 1 / (1 - ||M||_1) */
+    double residual_bound; /* ||r||_1 / (1 - ||M||_1): the most the walks' part of any x_i can be
+                              (INFINITY: ||M||_1 >= 1, no bound) */
+    int64_t walks, steps;  /* the walks and their transitions */
+    int interrupted;
+    double seconds, push_seconds, walk_seconds;
+} ulam_fpush_info;
+
+/* Estimate every x_i of (I - M) x = e_source into x (n entries); std_error, lo and hi (each may
+ * be NULL) get each component's standard error and 95% interval: p_i + the walks' normal
+ * interval where the walks scored two values at i, else p_i -+ residual_bound (NaN when there is
+ * none), always clipped to p_i -+ residual_bound.  Mt is M's transpose.  ULAM_OK, ULAM_EINVAL,
+ * ULAM_ENOCONV (push cap 100 nnz + 10^6), ULAM_ENOMEM, the walk solver's statuses. */
+int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, double *x, double *std_error,
+                     double *lo, double *hi, ulam_fpush_info *info, ulam_error *err);
 
 /* ---------------------------------------------------------------- choosing the method */
 /* All secondary. */
@@ -1086,6 +1174,10 @@ const ulam_study_method *ulam_study_method_get(int k);
 
 /* The index of the method named name, or -1. */
 int ulam_study_method_find(const char *name);
+
+/* The 95% Wilson score interval [*lo, *hi] of a coverage: covered of runs intervals held the exact
+ * value (runs > 0; else [0, 1]). */
+void ulam_study_coverage_interval(int covered, int runs, double *lo, double *hi);
 
 /* Set o's mode, estimator, roulette and split to method k's on b (n entries; read only in
  * forward mode, for w0 = ||b||_1).  ULAM_OK or ULAM_EINVAL. */

@@ -54,6 +54,24 @@ typedef struct ulam_scene {
  * carry the line, and err->file names the MTL file when the error is in one. */
 int ulam_scene_read_obj(const char *path, ulam_scene **out, ulam_error *err);
 
+/* A non-diffuse MTL statement ulam_scene_read_obj_notes ignored: the first of its keyword in a
+ * material (Ks not 0, Ns, d not 1, Tr not 0, illum above 2, Tf not 1, map_*, bump, Pr, ...;
+ * the material is rendered matte with its Kd and Ke). */
+typedef struct ulam_mtl_note {
+    char *file;     /* the MTL file */
+    long line;
+    char keyword[16];
+    char *material;
+} ulam_mtl_note;
+
+/* ulam_scene_read_obj, and the non-diffuse MTL statements ignored (*notes: a new array of
+ * *nnotes, in file order; NULL and 0 when none or on failure; free with ulam_mtl_notes_free). */
+int ulam_scene_read_obj_notes(const char *path, ulam_scene **out, ulam_mtl_note **notes, int64_t *nnotes,
+                              ulam_error *err);
+
+/* Free notes (n of them); accepts NULL. */
+void ulam_mtl_notes_free(ulam_mtl_note *notes, int64_t n);
+
 /* Split every patch into patches no longer than max_side on a side (quads into a grid,
  * triangles into m^2 similar triangles, larger polygons through a fan); face and group
  * are kept. */
@@ -68,6 +86,10 @@ ulam_scene *ulam_scene_free(ulam_scene *s);
  * whose area centroid is nearest.  Does not depend on the subdivision but through the patch
  * sizes.  ULAM_ENOTFOUND when no patch has that label. */
 int ulam_scene_find(const ulam_scene *s, const char *label, int64_t *patch);
+
+/* The lowest-numbered patch that point x lies in (within rel times the patch's size of its
+ * plane and of every edge), or -1 (a point on no patch, or s NULL). */
+int64_t ulam_scene_locate(const ulam_scene *s, const double x[3], double rel);
 
 /* The area centroid of patch p. */
 void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3]);
@@ -158,8 +180,11 @@ int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays,
 /* ---------------------------------------------------------------- patch walks */
 /* All primary. */
 
-/* Gathering's next-event estimators (opts->estimator of ulam_rad_solver_alloc, gathering only).
- * At every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in
+/* The radiosity estimators: opts->estimator of ulam_rad_solver_alloc and ulam_rad_point_alloc
+ * is one of these (its own enum, not ulam.h's ulam_estimator; 0, ulam_walk_defaults()'s, is
+ * next-event with MIS).
+ *
+ * Next-event (gathering and point walks): at every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in
  * proportion to its power A_l sum_c E_lc, y uniform on it) and a uniform point x on p; one
  * shadow ray scores W rho_p E_l cos cos_l A_l / (pi r^2 P_l) (P_l: l's share of the power)
  * when y is visible from x and both face each other.  The walk's own cosine rays that reach an
@@ -167,10 +192,17 @@ int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays,
  * exponent 2, or the balance heuristic), or not counted at all (light sampling alone, which
  * has infinite variance at a patch that shares an edge with a light). */
 enum ulam_rad_estimator {
-    ULAM_NEXT_EVENT = 3,         /* light sampling + the walk's hits, power heuristic (default) */
-    ULAM_NEXT_EVENT_BALANCE = 4, /* the same, balance heuristic */
-    ULAM_NEXT_EVENT_LIGHT = 5    /* light sampling alone */
+    ULAM_RAD_NEXT_EVENT = 0,         /* light sampling + the walk's hits, power heuristic (default) */
+    ULAM_RAD_NEXT_EVENT_BALANCE = 1, /* the same, balance heuristic */
+    ULAM_RAD_NEXT_EVENT_LIGHT = 2,   /* light sampling alone */
+    ULAM_RAD_COLLISION = 3,          /* score emission at every patch reached (shooting: tally every
+                                        reflection); point walks: the walk's emitter hits alone */
+    ULAM_RAD_ABSORPTION = 4          /* score where the walk stops (patch walks only) */
 };
+
+/* Points within this share of a patch's size of it lie on it (ulam_scene_locate's rel for
+ * point walks). */
+#define ULAM_RAD_LOCATE_REL 1e-6
 
 /* What a patch walk run has found: RGB radiosity of the patch opts->index. */
 typedef struct ulam_rad_result {
@@ -197,11 +229,83 @@ typedef struct ulam_rad_solver ulam_rad_solver;
 /* Prepare walks on scene t (the tracer's): opts->mode ULAM_ADJOINT gathers at patch
  * opts->index (continuation max_c rho_c of the patch, weights rho_c / q), ULAM_FORWARD
  * shoots particles from the emitters in proportion to power and tallies every patch;
- * estimator ULAM_COLLISION or ULAM_ABSORPTION, or for gathering one of ulam_rad_estimator
- * (rays then counts the shadow rays too); the stopping rules, seed, threads and
- * interrupt of ulam_walk_opts (continue_q, roulette and split must be 0). */
+ * opts->estimator one of enum ulam_rad_estimator (shooting: ULAM_RAD_COLLISION or
+ * ULAM_RAD_ABSORPTION; next-event's rays count the shadow rays too); the stopping rules, seed,
+ * threads and interrupt of ulam_walk_opts (continue_q, roulette and split must be 0). */
 int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
                           ulam_error *err);
+
+/* A point query's answer (ulam_rad_point_result). */
+typedef struct ulam_rad_point {
+    double x[3], n[3];        /* the point (on its patch's plane) and the unit normal used */
+    int64_t patch;            /* the patch the point lies on (0-based), or -1: a sensor off the surfaces */
+    double irradiance[3];     /* H = int B G V dA: the light arriving per unit area (radiosity units) */
+    double irradiance_se[3];
+    double radiosity[3];      /* B = E + rho H of the patch's material; NaN off the surfaces */
+    double radiosity_se[3];   /* rho times H's */
+    ulam_rad_result run;      /* walks, rays, cut, seconds, rel_err ...; its radiosity[] and
+                                 std_error[] are H's */
+} ulam_rad_point;
+
+/* Prepare point walks (point.c) from x, on the continuous surfaces (no mesh in the answer): the
+ * light sample and the cosine ray at every vertex are taken from the vertex itself, not a
+ * uniform point of its patch.  n NULL: x must lie on a patch (ulam_scene_locate with
+ * ULAM_RAD_LOCATE_REL), whose normal it takes; n given: a sensor facing n anywhere (on a patch,
+ * n must be the patch's).  opts as ulam_rad_solver_alloc's, gathering, estimator next-event (any
+ * of the three) or ULAM_RAD_COLLISION; opts->index is not read; rel_err is held on the
+ * irradiance.  Iterate, done and free as for patch walks; ulam_rad_solver_result gives H. */
+int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+                         ulam_rad_solver **out, ulam_error *err);
+
+/* A point solver's answer so far; ULAM_EINVAL for a patch solver. */
+int ulam_rad_point_result(const ulam_rad_solver *s, ulam_rad_point *r);
+
+/* One point query run to its end: ulam_rad_point_alloc, iterate until done, the result. */
+int ulam_rad_point_query(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+                         ulam_rad_point *r, ulam_error *err);
+
+/* A sensor grid: the centres of nu x nv cells of the rectangle origin + a u + b v (a, b in
+ * [0, 1]), every sensor facing the unit normal (a work plane: the lighting designer's grid). */
+typedef struct ulam_rad_grid {
+    double origin[3], u[3], v[3], normal[3];
+    int nu, nv;
+} ulam_rad_grid;
+
+/* The most points a grid may have. */
+#define ULAM_RAD_GRID_MAX 1000000
+
+/* The centre of cell (i, j): origin + (i + 1/2) / nu u + (j + 1/2) / nv v. */
+void ulam_rad_grid_point(const ulam_rad_grid *g, int i, int j, double x[3]);
+
+/* Point queries (ulam_rad_point_query) at every sensor of g, out[j nu + i] for cell (i, j), each
+ * with opts (rel_err, max_walks per point; max_seconds for the whole grid) and the seed drawn
+ * from stream (opts->seed, j nu + i).  Interrupted: the points not reached are zeroed (their
+ * run.walks 0).  ULAM_EINVAL for a grid without points, not finite or with a normal not unit. */
+int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_walk_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
+                        ulam_error *err);
+
+/* The most quadrature points of a mesh-error estimate: the centroid and up to 8 vertex halves. */
+#define ULAM_RAD_MESH_POINTS 9
+
+/* The mesh's error of a patch query (ulam_rad_mesh_error). */
+typedef struct ulam_rad_mesh {
+    int npoints;                                    /* quadrature points used, the centroid first */
+    double point[ULAM_RAD_MESH_POINTS][3];          /* the surface's radiosity B(x_k) there */
+    double point_se[ULAM_RAD_MESH_POINTS][3];
+    double mean[3], mean_se[3];                     /* their mean (a quadrature of the patch's mean) */
+    double error[3];    /* max_k |B_patch - B(x_k)|: the mesh error beside the Monte Carlo error */
+    double error_se[3]; /* the standard error of that point's B(x_k) */
+    int64_t walks, rays;
+    double seconds;
+    int interrupted;
+} ulam_rad_mesh;
+
+/* The mesh error of the patch query of patch opts->index that answered B (RGB): point queries
+ * (ulam_rad_point_query with opts, each its seed from stream (opts->seed, k + 1)) on the
+ * continuous surfaces at the patch's area centroid and half way from it to each of its first 8
+ * vertices, against B. */
+int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_walk_opts *opts, const double B[3], ulam_rad_mesh *out,
+                        ulam_error *err);
 
 /* Run one round of walks (rounds grow 1, 2, 4 ... 32 blocks of 256 walks as walks accumulate,
  * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
@@ -260,6 +364,19 @@ typedef struct ulam_render_info {
 int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width,
                 int height, double exposure, unsigned char *rgb, ulam_render_info *info);
 
+/* Render B (3 * npatches) with `samples` jittered rays a pixel (1: the pixel centre; each pixel's
+ * jitter from stream (seed, pixel)) and, when smooth, the radiosity interpolated across each
+ * hit patch from its corners (a corner's value: the area-weighted mean of B over the patches of
+ * the same OBJ face sharing that vertex, so subdivision is smoothed and creases between faces
+ * kept): linear RGB floats in hdr (3 a pixel, rows top first) and, when rgb is not NULL, the
+ * 8-bit sRGB picture with ulam_render's exposure rule.  Errors as ulam_render's. */
+int ulam_render_hdr(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width, int height, int samples,
+                    int smooth, uint64_t seed, double exposure, float *hdr, unsigned char *rgb, ulam_render_info *info);
+
+/* Write linear float RGB (3 a pixel, rows top first) as a PFM file (Portable Float Map,
+ * little-endian), atomically. */
+int ulam_pfm_write(const char *path, int width, int height, const float *rgb);
+
 /* How many pixel centres of a width x height picture see each patch's front (pixels:
  * npatches), with the rays of ulam_render. */
 int ulam_view_pixels(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t *pixels);
@@ -287,6 +404,15 @@ typedef struct ulam_view_info {
  * (3 * npatches) get the seen patches' answers; unseen patches get B 0 and se NaN. */
 int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, int height, double coverage,
                      const ulam_walk_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err);
+
+/* The size of ulam_falsecolour's picture of an nu x nv grid of cells of cw x ch pixels (the
+ * scale bar and its labels to the right). */
+void ulam_falsecolour_size(int nu, int nv, int cw, int ch, int *width, int *height);
+
+/* A false-colour picture of grid values v (v[j nu + i], row j = 0 at the bottom; NaN: grey)
+ * from lo (blue) to hi (red) in cells of cw x ch pixels, with a labelled scale bar, into rgb (3 bytes a pixel of
+ * ulam_falsecolour_size, rows top first); ULAM_EINVAL unless lo < hi are finite. */
+int ulam_falsecolour(const double *v, int nu, int nv, int cw, int ch, double lo, double hi, unsigned char *rgb);
 
 /* Write an 8-bit RGB image as PNG (libpng), atomically. */
 int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb);

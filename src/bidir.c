@@ -5,16 +5,18 @@
  * = b' (I - M')^-1 r: the adjoint walk solver on M' with right-hand side r, started at s (or at
  * b's state j with probability |b_j| / ||b||_1 and weight sign(b_j) ||b||_1, its start
  * distribution) estimates it, unbiased, with its error bar, threads and stopping rules.  r is
- * fixed before any of those walks runs (the balance below looks only at the push's work and a
- * pilot on its own seed), so <p, b> + estimate is unbiased for x_t.
+ * fixed before any of those walks runs (the balance below looks only at the push's work, a
+ * pilot and a probe on seeds of their own), so <p, b> + estimate is unbiased for x_t.
  *
  * Plan and balance (as BiPPR balances times, here on work counts so the result is
  * reproducible): a collision walk scores at most rmax at each of its V visits, so its variance
  * is about ||b||_1 rmax E[V] x, and the walk solver's rel_err rule needs at least the walks of its
  * range term for scores of rmax a visit (the solver's own bounds over the states the walks
  * reach, taken from the pilot's solver); the walks needed are the largest of those and the
- * rule's floor, each costing E[V] visits.  rmax halves, pushing down to it, while the push's
- * work so far is below the walks' predicted work.  ulam_bidir_plan does this and leaves the
+ * rule's floor, each costing E[V] visits of step_cost push operations.  rmax halves, pushing
+ * down to it, while the push's work so far is below the walks' predicted work (at a fixed walk
+ * count: below what those walks cost), for |x_t| about the largest of min_value, p_s and a
+ * probe's lower bound (see push()).  The interval: honest_interval.  ulam_bidir_plan does this and leaves the
  * pushed workspace with a memo of the plan (push.h), which ulam_bidir_solve reuses for the same
  * options instead of pushing again. */
 #include "internal.h"
@@ -26,12 +28,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Pilot walks that measure E[V]; a walk visit's cost in push operations (a push operation reads
- * one nonzero and updates one residual, a step on a built row draws from its alias table; on the
- * 10^6 R-MAT graph of bench_bidir a step that builds rows cost about 150 operations, README); the
- * target a run stopped by time alone is planned for. */
-enum { PILOT = 256 };
-static const double STEP_COST = 1.0, DEFAULT_REL_ERR = 0.1;
+/* Pilot walks that measure E[V]; the target a run stopped by time alone is planned for.  A walk
+ * visit's cost in push operations is ulam_bidir_opts.step_cost (a push operation reads one
+ * nonzero and updates one residual, a step draws from a row's alias table and scores it). */
+enum { PILOT = 256, PROBE = 1024 };
+static const double DEFAULT_REL_ERR = 0.1;
+
+/* The balance's cost of a walk visit in push operations. */
+static double step_cost(const ulam_bidir_opts *o)
+{
+    return o->step_cost > 0 && isfinite(o->step_cost) ? o->step_cost : ULAM_BIDIR_STEP_COST;
+}
 
 /* The defaults. */
 ulam_bidir_opts ulam_bidir_defaults(void)
@@ -112,7 +119,7 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
         return 0;
     return m->Mt == Mt && a->reach_all == b->reach_all && a->target == b->target &&
            (b->nb > 0 || a->source == b->source) && a->rmax == b->rmax && a->min_value == b->min_value &&
-           a->max_push_ops == b->max_push_ops && x->seed == y->seed &&
+           a->max_push_ops == b->max_push_ops && step_cost(a) == step_cost(b) && x->seed == y->seed &&
            x->rel_err == y->rel_err && x->max_walks == y->max_walks && x->continue_q == y->continue_q &&
            x->roulette == y->roulette && x->split == y->split && x->max_steps == y->max_steps &&
            x->force == y->force && x->assume_finite == y->assume_finite && x->guard == y->guard;
@@ -159,27 +166,56 @@ static double predicted_walks(const ulam_bidir_opts *o, const ulam_solver *pilot
     return wo->max_walks > 0 ? fmin(n, (double)wo->max_walks) : n;
 }
 
+static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
+                ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err);
+
+/* A lower bound on |x_t| from a probe: PROBE walks on a seed of their own scoring the residual
+ * as it stands (p_s + their estimate, less two standard errors; 0 when they say nothing).  The
+ * final walks run after the push ends on their own seed, so x_t's estimate stays unbiased. */
+static double probe(const ulam_csr *Mt, ulam_push *w, const ulam_bidir_opts *o, ulam__bidir_memo *memo)
+{
+    ulam_bidir_opts po = *o;
+    po.walk.rel_err = 0, po.walk.max_walks = PROBE, po.walk.max_seconds = 0, po.walk.interrupt = NULL;
+    po.walk.share = NULL, po.walk.threads = 1, po.walk.seed = o->walk.seed ^ UINT64_C(0x3c6ef372fe94f82b);
+    ulam_walk_result wr;
+    ulam_guard g;
+    double part = dot_b(ulam_push_estimates(w), o);
+    if (walk(Mt, ulam_push_residuals(w), &po, part, memo, &wr, &g, NULL) || !(wr.variance > 0)) return 0.0;
+    return fmax(0.0, fabs(part + wr.estimate) - 2.0 * wr.std_error);
+}
+
 /* Push from t: to o->rmax, or halving rmax while the push's work is below the walks' predicted
- * work; the plan's rmax, push and predicted walks filled in. */
-static int push(ulam_push *w, const ulam_bidir_opts *o, const ulam_solver *pl, int64_t cap, ulam_bidir_plan_info *plan)
+ * work; the plan's rmax, push and predicted walks filled in.  The walks are predicted for |x_t|
+ * about xhat = the largest of min_value (1 / n), |p_s| and, once the push has spent what the
+ * rule's floor of walks costs, a probe's lower bound: planning for 1 / n alone over-predicted the
+ * walks a median 2.2x (p90 12x) on the Zipf family of bench_bidir, and the push went on. */
+static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir_memo *memo, const ulam_bidir_opts *o,
+                const ulam_solver *pl, int64_t cap, ulam_bidir_plan_info *plan)
 {
     const double *p = ulam_push_estimates(w);
     int64_t n = ulam__push_matrix(w)->nrows;
-    double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n, V = plan->mean_visits;
-    double rmax = o->rmax > 0 ? o->rmax : 1.0, walks;
+    double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n, V = plan->mean_visits, cost = step_cost(o);
+    double rmax = o->rmax > 0 ? o->rmax : 1.0, walks, seen = 0.0;
+    int fixed = o->walk.rel_err <= 0 && o->walk.max_walks > 0; /* walks known without V */
+    int probed = fixed || !(o->walk.rel_err > 0) || o->min_value > 0; /* a given min_value is the plan's */
     int status = ulam_push_run(w, rmax, cap); /* balanced: r = e_t, nothing to push yet */
     for (;;) {
         ulam_push_report(w, &plan->push);
-        walks = predicted_walks(o, pl, rmax, V, fmax(delta, fabs(dot_b(p, o))));
-        if (o->rmax > 0 || status || plan->push.support == 0 || walks <= ULAM__REL_MIN ||
-            (double)plan->push.ops >= walks * V * STEP_COST)
-            break; /* at the floor more pushing saves no walks */
+        walks = predicted_walks(o, pl, rmax, V, fmax(fmax(delta, seen), fabs(dot_b(p, o))));
+        if (!probed && o->rmax <= 0 && !status && plan->push.support > 0 && walks > ULAM__REL_MIN &&
+            (double)plan->push.ops >= ULAM__REL_MIN * V * cost) {
+            probed = 1, seen = probe(Mt, w, o, memo), plan->probe = seen;
+            continue;
+        }
+        if (o->rmax > 0 || status || plan->push.support == 0 || (!fixed && walks <= ULAM__REL_MIN) ||
+            (double)plan->push.ops >= walks * V * cost)
+            break; /* at the rule's floor more pushing saves no walks; at a fixed walk count it
+                      lowers their variance instead, and the push may spend what they do */
         rmax /= 2;
         status = ulam_push_run(w, rmax, cap);
     }
     plan->rmax = rmax;
     plan->push_part = dot_b(p, o);
-    int fixed = o->walk.rel_err <= 0 && o->walk.max_walks > 0; /* walks known without V */
     plan->predicted_walks = plan->push.support == 0 ? 0.0 : o->rmax > 0 && !fixed ? NAN : walks;
     return status;
 }
@@ -223,7 +259,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
     ulam_push_start(w, o->target);
     ulam__bidir_memo *memo = ulam__push_memo(w);
     ulam_solver *pl = NULL;
-    plan->target = o->target, plan->balanced = !(o->rmax > 0), plan->mean_visits = 1.0, plan->step_cost = STEP_COST;
+    plan->target = o->target, plan->balanced = !(o->rmax > 0), plan->mean_visits = 1.0, plan->step_cost = step_cost(o);
     memo->have_guard = memo->have_seen = 0;
     if (plan->balanced && !memo->ones) {
         if (!(memo->ones = ulam__malloc((size_t)M->nrows, sizeof *memo->ones)))
@@ -251,14 +287,14 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
             memo->have_seen = 1;
         }
     }
-    status = push(w, o, pl, cap, plan);
+    status = push(w, Mt, memo, o, pl, cap, plan);
     if (pl) ulam__solver_setup(pl, &plan->pilot_units, &plan->pilot_reads);
     ulam_solver_free(pl);
     if (status == ULAM_ENOCONV)
         return ulam__fail(err, status, 0, -1, "a push within %lld operations (is rho(|M|) < 1?)", (long long)cap);
     double pilot_visits = (double)(plan->pilot_walks + plan->pilot_steps);
     plan->predicted_work = plan->balanced || plan->predicted_walks == 0.0
-                               ? (double)plan->push.ops + STEP_COST * (pilot_visits + plan->predicted_walks * plan->mean_visits)
+                               ? (double)plan->push.ops + plan->step_cost * (pilot_visits + plan->predicted_walks * plan->mean_visits)
                                : NAN; /* rmax given: no pilot measured V */
     plan->seconds = ulam_now() - t0;
     if (o->nb > memo->cap) { /* keep b's entries: the options point at the caller's */
@@ -281,8 +317,9 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
  * memo: the pilot's guards on Mt and the states it found the walks reach, when it has them, or
  * (reach_all) every state's bounds. */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
-                ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_error *err)
+                ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err)
 {
+    memset(wr, 0, sizeof *wr);
     ulam_walk_opts wo = walk_opts(o);
     wo.rel_err_offset = push_part;
     if (!wo.guard && memo->have_guard) wo.guard = &memo->guard;
@@ -303,11 +340,59 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     }
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     ulam_solver_result(sv, wr);
+    ulam_solver_guard(sv, g); /* the walks' guards on Mt: the walk part's certified bound */
     if (status) ulam_solver_error(sv, err);
     if (!k && o->keep_kernel && !status && wo.estimator != ULAM_EXPECTED) memo->kernel = ulam__solver_keep_kernel(sv);
     ulam_solver_free(sv);
     if (k && status) memo->kernel = ulam__kernel_free(k);
     return status;
+}
+
+/* The 95% interval of a mean of n scores with sample mean `mean`, sample variance var and a
+ * certified range R (every score within an interval of width R): the empirical-Bernstein bound
+ * of Maurer and Pontil (COLT 2009, thm 4), two-sided (delta = 0.05 split between the sides):
+ * mean -+ (sqrt(2 var ln(4 / delta) / n) + 7 R ln(4 / delta) / (3 (n - 1))).  Valid at any n,
+ * and never zero-width while R > 0: a sample that saw one value still leaves the range's term.
+ * R not finite (or n < 2): NaN (no interval).  The one home of this interval for the point-source
+ * path: src/stop.c's anytime-valid construction replaces it when merged. */
+static void ulam__bidir_interval(int64_t n, double mean, double var, double R, double out[2])
+{
+    static const double L = 4.382026634673881; /* ln(4 / 0.05) */
+    if (!(n >= 2 && isfinite(R) && R >= 0)) {
+        out[0] = out[1] = NAN;
+        return;
+    }
+    double half = sqrt(2.0 * fmax(var, 0.0) * L / (double)n) + 7.0 * R * L / (3.0 * (double)(n - 1));
+    out[0] = mean - half, out[1] = mean + half;
+}
+
+/* The certified bound D on the walk part: |<r, x>| <= max|r| ||x||_1 <= max|r| ||b||_1 /
+ * (1 - ||M||_1), ||M||_1 the largest row sum of |Mt| (the guards' one-pass bound); INFINITY when
+ * that is not below 1 or was not computed. */
+static double walk_part_bound(const ulam_push_info *push, const ulam_guard *g, const ulam_bidir_opts *o)
+{
+    double c = g ? g->abs.rowsum_max : INFINITY;
+    return g && (g->computed & ULAM_GUARD_ABS) && c < 1.0 ? push->r_max * norm_b(o) / (1.0 - c) : INFINITY;
+}
+
+/* The interval of x_t: with a certified range of one walk's score (the solver's score_bound,
+ * absorption) the empirical-Bernstein interval; without one the normal interval, except that a
+ * sample of one repeated score (the walks saw nothing else: its variance says nothing about what
+ * they missed) gets the certified bound D of the walk part instead; either is clipped to
+ * push_part -+ D.  Never zero-width while a residual is left unless D = 0. */
+static void honest_interval(ulam_bidir_result *res, double D)
+{
+    const ulam_walk_result *w = &res->walks;
+    double lo = res->push_part + w->ci95[0], hi = res->push_part + w->ci95[1];
+    if (w->walks > 0 && isfinite(w->score_bound)) {
+        double ci[2];
+        ulam__bidir_interval(w->walks, w->estimate, w->variance, 2.0 * w->score_bound, ci);
+        lo = res->push_part + ci[0], hi = res->push_part + ci[1];
+    } else if (w->walks > 0 && !(w->variance > 0))
+        lo = res->push_part - D, hi = res->push_part + D; /* NaN-free: D may be INFINITY (no bound) */
+    if (isfinite(D)) lo = fmax(lo, res->push_part - D), hi = fmin(hi, res->push_part + D);
+    if (!isfinite(lo) || !isfinite(hi)) lo = hi = NAN; /* withheld: nothing certifies one */
+    res->ci95[0] = lo, res->ci95[1] = hi;
 }
 
 /* Estimate x_t of (I - M) x = b (e_s or a sparse b). */
@@ -323,12 +408,14 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
     double t0 = ulam_now();
     ulam_push_report(w, &res->push);
     res->push_part = res->plan.push_part;
-    if (res->push.support > 0 && (status = walk(Mt, ulam_push_residuals(w), o, res->push_part, memo, &res->walks, err)))
+    ulam_guard g = {0};
+    if (res->push.support > 0 && (status = walk(Mt, ulam_push_residuals(w), o, res->push_part, memo, &res->walks, &g, err)))
         return status;
     res->estimate = res->push_part + res->walks.estimate;
     res->std_error = res->walks.std_error;
     res->ci95[0] = res->push_part + res->walks.ci95[0];
     res->ci95[1] = res->push_part + res->walks.ci95[1];
+    if (res->push.support > 0) honest_interval(res, walk_part_bound(&res->push, &g, o));
     res->seconds = res->plan.seconds + (ulam_now() - t0);
     return ULAM_OK;
 }

@@ -27,8 +27,8 @@ static void assemble(const ulam_csr *M, double *a)
     }
 }
 
-/* ||b - (I - M) x||_inf / ||b||_inf, computed from the sparse M. */
-static double residual(const ulam_csr *M, const double *b, const double *x)
+/* ||b - (I - M) x||_inf / ||b||_inf, computed from the sparse M (the dense and sparse solves). */
+double ulam__direct_residual(const ulam_csr *M, const double *b, const double *x)
 {
     double rmax = 0.0, bmax = 0.0;
     for (int64_t i = 0; i < M->nrows; i++) {
@@ -85,7 +85,7 @@ int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_
             return ulam__fail(err, ULAM_ESINGULAR, 0, i, "a finite solution: I - M is numerically singular");
     if (info) {
         info->rcond = rcond;
-        info->residual = residual(M, b, x);
+        info->residual = ulam__direct_residual(M, b, x);
         info->bytes = bytes;
         info->seconds = ulam_now() - t0;
     }

@@ -206,4 +206,7 @@ void *ulam__alloc_big(size_t n, size_t sz);
  * compacting A in place. */
 int ulam__csr_canonicalize(ulam_csr *A, int threads);
 
+/* ||b - (I - M) x||_inf / ||b||_inf from the sparse M (src/direct.c). */
+double ulam__direct_residual(const ulam_csr *M, const double *b, const double *x);
+
 #endif

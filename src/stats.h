@@ -36,6 +36,12 @@ void ulam__sums_moments(double n, double sum, double sumsq, double *mean, double
 /* The fewest walks a --rel-err run makes (the rule itself is src/stop.h's). */
 #define ULAM__REL_MIN 1000
 
+/* The rule as it was, kept for radiosity shooting and gathering without a certified range
+ * (src/radiosity/patchwalk.c): at least ULAM__REL_MIN walks, stderr <= E |m|, n >= min_walks
+ * and the variance's own relative standard error at most ULAM__VAR_REL_MAX. */
+#define ULAM__VAR_REL_MAX 0.25
+int ulam__rel_err_holds(int64_t n, double m, double se, double min_walks, double var_rel_error, double E);
+
 /* The range R of a single walk's score the rule uses: range when finite (a bounded score);
  * else, for scores that add per_step at most at each visit (weights bounded), with the walk's
  * expected remaining weight after k steps at most kappa qmax^k (kappa 1 and qmax the largest

@@ -101,3 +101,15 @@ int ulam_study_reference(const ulam_csr *M, const double *b, int64_t index, ulam
     free(x), free(xd);
     return ULAM_OK;
 }
+
+/* The 95% Wilson score interval of covered / runs. */
+void ulam_study_coverage_interval(int covered, int runs, double *lo, double *hi)
+{
+    if (runs <= 0) {
+        *lo = 0.0, *hi = 1.0;
+        return;
+    }
+    double n = runs, p = covered / n, z = ULAM_Z95, z2 = z * z;
+    double mid = (p + z2 / (2 * n)) / (1 + z2 / n), half = z * sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / (1 + z2 / n);
+    *lo = covered <= 0 ? 0.0 : fmax(0.0, mid - half), *hi = covered >= runs ? 1.0 : fmin(1.0, mid + half); /* exact ends */
+}

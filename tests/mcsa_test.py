@@ -15,7 +15,7 @@ import tempfile
 M = "matrices/"
 from ulam_status import code  # noqa: E402
 
-ENOCONV, ESTALL = code("ENOCONV"), code("ESTALL")
+ENOCONV, ESTALL, EINFVAR = code("ENOCONV"), code("ESTALL"), code("EINFVAR")
 P20 = ["solve", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--jacobi"]
 RS = ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx"]
 
@@ -26,10 +26,10 @@ CASES = [  # arguments, exit code, stderr regex, stdout regex
     (P20 + ["--method", "mcsa", "--tol", "-1e-8"], 2, r"--tol expects", r"^$"),
     (P20 + ["--method", "mcsa", "--tol", "tiny"], 2, r"--tol expects", r"^$"),
     (P20 + ["--method", "mcsa", "--max-iter", "0"], 2, r"--max-iter expects an integer from 1", r"^$"),
-    (P20 + ["--method", "mcsa", "--index", "3"], 2, r"--index I needs --out x\.mtx", r"^$"),
+    (P20 + ["--method", "gauss-seidel", "--index", "3"], 0, r"^$", r"^x\[3\]\s+[\d.]+$"),  # x_I without --out
     (P20 + ["--method", "mcsa", "--eps1", "0"], 2, r"--eps1 expects .*strictly between 0 and 1", r"^$"),
     (P20 + ["--method", "newton"], 2, r"--method expects auto, walks, bidirectional \(with --source\), mcsa, sequential, richardson, gauss-seidel, cg or gmres", r"^$"),
-    (P20 + ["--method", "mcsa", "--walks", "10"], 2, r"unrecognized option '--walks'", r"^$"),
+    (P20 + ["--method", "mcsa", "--walks", "10"], 2, r"unknown option '--walks'", r"^$"),
     (["solve", M + "poisson20.mtx", "--method", "mcsa"], 2, r"needs --rhs", r"^$"),
     (P20 + ["--method", "mcsa", "--out", "/nonexistent/dir/x.mtx"], 13, r"x\.mtx.*writable output file", r"^$"),
     (RS + ["--method", "cg"], 2, r"--method cg needs a symmetric M.*gmres", r"^$"),
@@ -37,8 +37,13 @@ CASES = [  # arguments, exit code, stderr regex, stdout regex
      r"rho\(\|M\|\) is >= 1 \(certified: bounds \[1\.1, 1\.1\]\)", r"^$"),
     (P20 + ["--method", "richardson", "--max-iter", "5"], ENOCONV, r"residual 0\.86\d+ after --max-iter 5 iterations",
      r"capped after 5 iterations"),
-    (RS + ["--method", "mcsa", "--continue", "0.3", "--estimator", "collision", "--max-histories", "20000"], ESTALL,
-     r"variance is infinite.*\n.*the residual stopped decreasing: .*no new low", r"stalled after \d+ iterations"),
+    (RS + ["--method", "mcsa", "--continue", "0.3", "--estimator", "collision", "--max-histories", "20000"], EINFVAR,
+     r"variance is infinite.*\n.*error: .*a finite variance for the correction walks: rho\(M\^\) .*\[2\.7, 2\.7\] "
+     r"\(>= 1: infinite\)", r"^$"),
+    (["solve", M + "poisson900.mtx", "--rhs", M + "poisson900_b.mtx", "--jacobi", "--method", "sequential",
+      "--max-histories", "1000"], ESTALL, r"the residual stopped decreasing: expected a correction that lowers the "
+     r"residual: iteration 1's made it \S+x with 1000 histories; its variance asks ~\S+ .*cannot make it contract",
+     r"(?s)stalled after 1 iterations, residual 1\.0000e\+00.*corrections rejected 1"),
     (P20 + ["--method", "gauss-seidel", "--tol", "1e-6"], 0, r"^$", r"converged after \d+ iterations"),
     (RS + ["--method", "sequential", "--tol", "1e-4", "--seed", "3"], 0, r"^$",
      r"(?s)iter\s+residual\s+histories\s+rel_sd\s+seconds\s*\n1\s+\S+\s+\d+.*converged after \d+ iterations"),
@@ -153,16 +158,58 @@ def check_krylov(ulam):
         assert abs(o["iterations"] - k) <= 1 and o["residual"] <= 1e-8, (name, method, m, o["iterations"], k)
 
 
+def check_issue25_case8(ulam):
+    """Issue 25 case 8, with generators of our own: a 100-state nonsymmetric system with rho(M) = 0.99
+    and an infinite forward variance is refused before any walk (it used to walk its first correction
+    for minutes); 2-D Poisson with Jacobi at n = 10^4 (b = 1) ends in one iteration, the residual
+    never above 1 (it was 1 -> 22 -> 24), with the count the correction would need."""
+    import random
+    with tempfile.TemporaryDirectory() as d:
+        rng, n = random.Random(8), 100
+        rows = [(i, j, rng.random() ** 3) for i in range(n) for j in rng.sample(range(n), 10)]
+        v = [1.0] * n
+        for _ in range(3000):  # Perron root by power iteration
+            w = [0.0] * n
+            for i, j, a in rows:
+                w[i] += a * v[j]
+            lam, v = sum(w) / sum(v), [x * n / sum(w) for x in w]
+        a_path, b_path = os.path.join(d, "a.mtx"), os.path.join(d, "a_b.mtx")
+        with open(a_path, "w") as f:
+            f.write(f"%%MatrixMarket matrix coordinate real general\n{n} {n} {len(rows)}\n")
+            f.writelines(f"{i + 1} {j + 1} {a * 0.99 / lam:.17g}\n" for i, j, a in rows)
+        with open(b_path, "w") as f:
+            f.write(f"%%MatrixMarket matrix array real general\n{n} 1\n" + "".join(f"{rng.random()}\n" for _ in range(n)))
+        for m in ("mcsa", "sequential"):
+            rc, out, err = run(ulam, ["solve", a_path, "--rhs", b_path, "--method", m])
+            assert rc == EINFVAR and out == "" and "a finite variance for the correction walks" in err, (m, rc, err)
+        L = 100
+        p_path, pb_path = os.path.join(d, "p.mtx"), os.path.join(d, "p_b.mtx")
+        ent = [(i * L + j, (i + di) * L + j + dj, -1) for i in range(L) for j in range(L)
+               for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1)) if 0 <= i + di < L and 0 <= j + dj < L]
+        ent += [(k, k, 4) for k in range(L * L)]
+        with open(p_path, "w") as f:
+            f.write(f"%%MatrixMarket matrix coordinate real general\n{L * L} {L * L} {len(ent)}\n")
+            f.writelines(f"{i + 1} {j + 1} {a}\n" for i, j, a in ent)
+        with open(pb_path, "w") as f:
+            f.write(f"%%MatrixMarket matrix array real general\n{L * L} 1\n" + "1\n" * (L * L))
+        for m in ("mcsa", "sequential"):
+            rc, out, err = run(ulam, ["solve", p_path, "--rhs", pb_path, "--jacobi", "--method", m, "--json"])
+            o = json.loads(out)
+            assert rc == ESTALL and o["outcome"] == "stalled" and o["iterations"] == 1, (m, rc, o)
+            assert o["rejected"] == 1 and all(h["residual"] <= 1 for h in o["history"]), o
+            assert "cannot make it contract" in err, err
+
+
 def main():
     ulam = sys.argv[1]
     failures = check_table(ulam)
-    for f in (check_json_out, check_interrupt, check_krylov):
+    for f in (check_json_out, check_interrupt, check_krylov, check_issue25_case8):
         try:
             f(ulam)
         except AssertionError as e:
             failures += 1
             print(f"FAIL {f.__name__}: {e}")
-    print(f"{len(CASES) + 3 - failures} passed, {failures} failed")
+    print(f"{len(CASES) + 4 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 

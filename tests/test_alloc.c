@@ -198,7 +198,7 @@ static int op_guard_direct(void)
 }
 
 #ifdef ULAM_RADIOSITY
-/* The OBJ reader, subdivision, tracer, form factors and both patch walks. */
+/* The OBJ reader, subdivision, tracer, form factors, both patch walks and a point query. */
 static int op_radiosity(void)
 {
     ulam_scene *s0 = NULL, *s = NULL;
@@ -212,9 +212,16 @@ static int op_radiosity(void)
     for (int mode = 0; mode < 2 && !st; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = mode, o.max_walks = 600, o.threads = 2;
+        o.estimator = mode ? ULAM_RAD_COLLISION : ULAM_RAD_NEXT_EVENT; /* shooting has no next event */
         if (!(st = ulam_rad_solver_alloc(t, &o, &sv, NULL)))
             while (!st && !ulam_rad_solver_done(sv)) st = ulam_rad_solver_iterate(sv);
         sv = ulam_rad_solver_free(sv);
+    }
+    if (!st) { /* a point query on the continuous surfaces */
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.max_walks = 600, o.threads = 2;
+        ulam_rad_point pt;
+        st = ulam_rad_point_query(t, &o, (const double[3]){0.5, 0, 0.5}, NULL, &pt, NULL);
     }
     ulam_csr_free(F);
     ulam_tracer_free(t);

@@ -1,7 +1,9 @@
-/* The LAPACK reference solve: a hand-checked system, residuals, and every refusal; the study's
- * reference (LAPACK or Gauss-Seidel) and its method grid. */
+/* The LAPACK reference solve: a hand-checked system, residuals, and every refusal; the sparse
+ * (UMFPACK) one against it; PageRank's matrix; the study's reference (LAPACK or Gauss-Seidel), its
+ * method grid and its coverage interval. */
 #include "testutil.h"
 
+#include <math.h>
 #include <string.h>
 
 /* M = [0 .5 0; .25 0 .25; 0 .5 0], b = (1, 2, 3): x = (3, 4, 5) and rcond_1 = 3/16 by hand. */
@@ -95,6 +97,94 @@ static void test_memory_limit(void **state)
     ulam_csr_free(M);
 }
 
+/* The sparse LU agrees with the dense one on every committed system (unsorted, duplicate-free CSR
+ * with the diagonal merged), refuses a singular I - M and a too-small memory limit, and its
+ * estimate bounds what it needs; without UMFPACK every call says so. */
+static void test_sparse(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"chain4", "randsub1000", "radiosity100", "signed200", "poisson900"};
+    char mp[256], bpath[256];
+    ulam_error err;
+    if (!ulam_direct_sparse_available()) {
+        ulam_csr *M = must_read("matrices/chain4.mtx");
+        double b[4] = {1, 1, 1, 1}, x[4], by, fl;
+        assert_int_equal(ulam_direct_sparse(M, b, x, 0, NULL, &err), ULAM_EUNSUPPORTED);
+        assert_int_equal(ulam_direct_sparse_estimate(M, &by, &fl, &err), ULAM_EUNSUPPORTED);
+        ulam_csr_free(M);
+        return;
+    }
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
+        snprintf(mp, sizeof mp, "matrices/%s.mtx", names[k]);
+        snprintf(bpath, sizeof bpath, "matrices/%s_b.mtx", names[k]);
+        ulam_csr *M = must_read(mp);
+        int64_t n;
+        double *b = must_read_vector(bpath, &n);
+        double *x = malloc((size_t)n * sizeof *x), *xs = malloc((size_t)n * sizeof *xs), bytes, flops;
+        ulam_direct_info info;
+        assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+        assert_int_equal(ulam_direct_sparse(M, b, xs, 0, &info, NULL), ULAM_OK);
+        for (int64_t i = 0; i < n; i++) assert_close(xs[i], x[i], 1e-10 * (1 + fabs(x[i])));
+        assert_true(info.residual < 1e-12 && info.seconds >= 0);
+        assert_int_equal(ulam_direct_sparse_estimate(M, &bytes, &flops, NULL), ULAM_OK);
+        assert_true(bytes >= (double)info.bytes && bytes > 0 && flops >= 0);
+        assert_int_equal(ulam_direct_sparse(M, b, xs, 16, NULL, &err), ULAM_EMEMLIMIT);
+        free(x), free(xs), free(b);
+        ulam_csr_free(M);
+    }
+    ulam_csr *S = must_read("tests/data/singular.mtx");
+    double b3[3] = {1, 1, 1}, x3[3];
+    assert_int_equal(ulam_direct_sparse(S, b3, x3, 0, NULL, &err), ULAM_ESINGULAR);
+    ulam_csr_free(S);
+}
+
+/* PageRank's M = alpha P^T: column j of M is alpha times node j's out-edges normalised (a dangling
+ * node's column is zero), and a negative weight is refused naming its row. */
+static void test_pagerank_matrix(void **state)
+{
+    (void)state;
+    int32_t i[5] = {0, 0, 1, 2, 2}, j[5] = {1, 2, 2, 0, 3};
+    double v[5] = {1, 3, 2, 1, 1};
+    ulam_csr *A = NULL, *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(4, 4, 5, i, j, v, &A), ULAM_OK);
+    assert_int_equal(ulam_pagerank_matrix(A, 0.85, &M, NULL), ULAM_OK);
+    double dense[4][4] = {{0}};
+    for (int64_t r = 0; r < 4; r++)
+        for (int64_t k = M->rowptr[r]; k < M->rowptr[r + 1]; k++) dense[r][M->colidx[k]] += M->val[k];
+    assert_close(dense[1][0], 0.85 * 0.25, 1e-15); /* 0 -> 1 of weight 1 among 4 */
+    assert_close(dense[2][0], 0.85 * 0.75, 1e-15);
+    assert_close(dense[2][1], 0.85, 1e-15);
+    assert_close(dense[0][2], 0.85 * 0.5, 1e-15);
+    assert_close(dense[3][2], 0.85 * 0.5, 1e-15);
+    for (int r = 0; r < 4; r++) assert_close(dense[r][3], 0.0, 0.0); /* node 4 dangles */
+    ulam_csr_free(M);
+    A->val[3] = -1;
+    ulam_error err;
+    assert_int_equal(ulam_pagerank_matrix(A, 0.85, &M, &err), ULAM_EINVAL);
+    assert_int_equal(err.index, 2);
+    assert_int_equal(ulam_pagerank_matrix(A, 1.0, &M, NULL), ULAM_EINVAL);
+    ulam_csr_free(A);
+}
+
+/* The Wilson interval: 19/20 is [0.764, 0.991] (the textbook value), 0/10 starts at 0 and 10/10
+ * ends at 1, and it always holds k / n. */
+static void test_coverage_interval(void **state)
+{
+    (void)state;
+    double lo, hi;
+    ulam_study_coverage_interval(19, 20, &lo, &hi);
+    assert_close(lo, 0.7639, 1e-4);
+    assert_close(hi, 0.9911, 1e-4);
+    ulam_study_coverage_interval(0, 10, &lo, &hi);
+    assert_true(lo == 0.0 && hi > 0.2 && hi < 0.35);
+    ulam_study_coverage_interval(10, 10, &lo, &hi);
+    assert_true(hi == 1.0 && lo > 0.65 && lo < 0.8);
+    for (int k = 0; k <= 30; k++) {
+        ulam_study_coverage_interval(k, 30, &lo, &hi);
+        assert_true(lo <= k / 30.0 && k / 30.0 <= hi);
+    }
+}
+
 /* A rectangular matrix is refused. */
 static void test_not_square(void **state)
 {
@@ -166,6 +256,8 @@ int main(void)
         cmocka_unit_test(test_jacobi_poisson), cmocka_unit_test(test_singular),
         cmocka_unit_test(test_memory_limit), cmocka_unit_test(test_not_square),
         cmocka_unit_test(test_study_reference), cmocka_unit_test(test_study_methods),
+        cmocka_unit_test(test_sparse), cmocka_unit_test(test_pagerank_matrix),
+        cmocka_unit_test(test_coverage_interval),
     };
     return test_run(tests);
 }

@@ -144,8 +144,10 @@ static void test_threads_identical(void **state)
 }
 
 /* Infinite variance (a fixed continuation q = 0.3 with row sums 0.9: rho(M^) = 0.81 / 0.3 =
- * 2.7): the corrections are noise that no history count tames, the residual stops falling,
- * and the run ends with ULAM_ESTALL after the stall window, never looping. */
+ * 2.7) is refused before any walk (ULAM_EINFVAR).  A correction that the history cap keeps
+ * from lowering the residual (poisson900 at 1000 histories) ends the run with ULAM_ESTALL
+ * at once; the stall window ends a run whose residual makes no new low (Richardson on the
+ * rho = 1.1 system: its last low plus the window), never looping. */
 static void test_stall(void **state)
 {
     (void)state;
@@ -157,18 +159,211 @@ static void test_stall(void **state)
     o.max_histories = 20000;
     o.walk.threads = 2;
     ulam_outer_step st[64];
-    int k;
-    assert_int_equal(run(&s, &o, x, st, 64, &k), ULAM_ESTALL);
-    print_message("stalled after %d iterations at residual %.3g\n", k, st[k - 1].residual);
-    assert_true(k <= 40);
-    assert_true(st[k - 1].residual > 1e-8);
+    int k = -1;
+    ulam_error err;
+    assert_int_equal(ulam_outer_solve(s.M, s.b, &o, x, st, 64, &k, &err), ULAM_EINFVAR);
+    assert_int_equal(k, -1); /* refused before any iteration */
+    unload(&s);
     assert_string_equal(ulam_strerror(ULAM_ESTALL), "the residual stopped decreasing");
-    /* the stall window is the option: 2 iterations without a new low end it sooner */
-    o.stall = 2;
-    int k2;
-    assert_int_equal(run(&s, &o, x, st, 64, &k2), ULAM_ESTALL);
-    assert_true(k2 <= k);
+    s = load("poisson900", 1);
+    o = ulam_outer_defaults();
+    o.max_histories = 1000;
+    o.walk.threads = 2;
+    assert_int_equal(ulam_outer_solve(s.M, s.b, &o, x, st, 64, &k, &err), ULAM_ESTALL);
+    print_message("poisson900 at 1000 histories: %d iterations, residual %.3g: %s\n", k, st[k - 1].residual, err.msg);
+    assert_true(k <= 3 && st[k - 1].residual < 1);
+    assert_non_null(strstr(err.msg, "lowers the residual"));
+    unload(&s);
+    s = load("divergent200", 0);
+    o = ulam_outer_defaults();
+    o.method = ULAM_RICHARDSON;
+    int kw[2];
+    for (int w = 0; w < 2; w++) { /* the residual's last low is at the same iteration m: m + window */
+        o.stall = 2 + 3 * w;
+        assert_int_equal(ulam_outer_solve(s.M, s.b, &o, x, st, 64, &kw[w], &err), ULAM_ESTALL);
+        assert_true(kw[w] <= 40);
+    }
+    assert_int_equal(kw[1] - kw[0], 3);
     free(x);
+    unload(&s);
+}
+
+/* A nonsymmetric n-state system with rho(M) = rho exactly (power iteration to 1e-13): d entries
+ * a row at distinct random columns, weights u^3 (so column sums vary widely and the forward
+ * kernel's second moment rho(M^) exceeds 1); b_i ~ U(0, 1).  *b is malloc'd. */
+static ulam_csr *skewed_system(int32_t n, int d, double rho, uint64_t seed, double **b)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 25);
+    int32_t *ti = malloc((size_t)n * d * sizeof *ti), *tj = malloc((size_t)n * d * sizeof *tj);
+    double *tx = malloc((size_t)n * d * sizeof *tx);
+    int64_t nz = 0;
+    for (int32_t i = 0; i < n; i++)
+        for (int k = 0; k < d; k++) {
+            int32_t j;
+            int again;
+            do { /* distinct columns in the row */
+                j = (int32_t)ulam_rng_bounded(&r, (uint64_t)n), again = 0;
+                for (int64_t q = nz - k; q < nz; q++) again |= tj[q] == j;
+            } while (again);
+            double u = ulam_rng_uniform(&r);
+            ti[nz] = i, tj[nz] = j, tx[nz++] = u * u * u;
+        }
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M), ULAM_OK);
+    double *v = malloc((size_t)n * sizeof *v), *w = malloc((size_t)n * sizeof *w), lam = 0;
+    for (int32_t i = 0; i < n; i++) v[i] = 1.0;
+    for (int it = 0; it < 5000; it++) { /* Perron root: M irreducible with d = 10 */
+        ulam_csr_matvec(M, 0, v, w);
+        double s1 = 0, s0 = 0;
+        for (int32_t i = 0; i < n; i++) s1 += w[i], s0 += v[i];
+        double l = s1 / s0;
+        for (int32_t i = 0; i < n; i++) v[i] = w[i] / s1 * n;
+        if (fabs(l - lam) < 1e-13 * l) break;
+        lam = l;
+    }
+    for (int64_t q = 0; q < nz; q++) M->val[q] *= rho / lam;
+    *b = malloc((size_t)n * sizeof **b);
+    for (int32_t i = 0; i < n; i++) (*b)[i] = ulam_rng_uniform(&r);
+    free(ti), free(tj), free(tx), free(v), free(w);
+    return M;
+}
+
+/* Issue 25 case 8: on a 100-state nonsymmetric system with rho(M) = 0.99 whose forward
+ * variance is infinite, both walk methods are refused up front (ULAM_EINFVAR, before any
+ * walk; they used to warn and walk the first correction for minutes), assume_finite does not
+ * override a certified infinite variance, and the deterministic methods still run. */
+static void test_infinite_variance_refused(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M = skewed_system(100, 10, 0.99, 8, &b);
+    ulam_guard g;
+    assert_int_equal(ulam_guard_check(M, 0.0, NULL, &g, NULL), ULAM_OK);
+    print_message("rho(|M|) in [%.4g, %.4g], forward rho(M^) in [%.4g, %.4g]\n", g.abs.lower, g.abs.upper,
+                  g.hat[ULAM_FORWARD].lower, g.hat[ULAM_FORWARD].upper);
+    assert_true(g.abs.upper < 1 && g.abs.lower > 0.98);
+    assert_int_equal(ulam_guard_variance(&g, ULAM_FORWARD), 0);
+    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA; m++)
+        for (int assume = 0; assume < 2; assume++) {
+            ulam_outer_opts o = ulam_outer_defaults();
+            o.method = m;
+            o.walk.assume_finite = assume;
+            o.walk.guard = assume ? &g : NULL; /* given or computed: the same verdict */
+            ulam_outer *it = (ulam_outer *)M;
+            ulam_error err;
+            assert_int_equal(ulam_outer_alloc(M, b, &o, &it, &err), ULAM_EINFVAR);
+            assert_null(it);
+            assert_non_null(strstr(err.msg, "rho(M^) of the forward kernel"));
+            assert_non_null(strstr(err.msg, "infinite"));
+        }
+    ulam_outer_opts o = ulam_outer_defaults();
+    o.method = ULAM_GAUSS_SEIDEL;
+    o.tol = 1e-6;
+    int k;
+    ulam_error err;
+    assert_int_equal(ulam_outer_solve(M, b, &o, NULL, NULL, 0, &k, &err), ULAM_OK);
+    ulam_csr_free(M);
+    free(b);
+}
+
+/* The Jacobi splitting of the L x L five-point Laplacian (M_ij = 1/4 between neighbours), b = 1/4. */
+static ulam_csr *poisson_jacobi(int32_t L, double **b)
+{
+    int64_t n = (int64_t)L * L, nz = 0;
+    int32_t *ti = malloc(4 * (size_t)n * sizeof *ti), *tj = malloc(4 * (size_t)n * sizeof *tj);
+    double *tx = malloc(4 * (size_t)n * sizeof *tx);
+    for (int32_t i = 0; i < L; i++)
+        for (int32_t j = 0; j < L; j++) {
+            static const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+            for (int k = 0; k < 4; k++)
+                if (i + di[k] >= 0 && i + di[k] < L && j + dj[k] >= 0 && j + dj[k] < L)
+                    ti[nz] = i * L + j, tj[nz] = (i + di[k]) * L + j + dj[k], tx[nz++] = 0.25;
+        }
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M), ULAM_OK);
+    *b = malloc((size_t)n * sizeof **b);
+    for (int64_t i = 0; i < n; i++) (*b)[i] = 0.25;
+    free(ti), free(tj), free(tx);
+    return M;
+}
+
+/* Issue 25 case 8: on 2-D Poisson with Jacobi at n = 10^4 the first correction of 3072
+ * histories made the residual 22x worse and was kept (1 -> 22 -> 24).  Now no iteration
+ * raises the residual: a correction that would is rejected, and when the count its variance
+ * predicts is beyond 100x what the eps1 rule took, the run stops at once with ULAM_ESTALL and
+ * a sentence saying so (bounded time: one correction's walks). */
+static void test_poisson_never_worse(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M = poisson_jacobi(100, &b);
+    double *x = malloc(10000 * sizeof *x);
+    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA; m++) {
+        if (!test_case(m)) continue;
+        ulam_outer_opts o = ulam_outer_defaults();
+        o.method = m;
+        o.walk.threads = 2;
+        ulam_outer *it = NULL;
+        ulam_error err;
+        assert_int_equal(ulam_outer_alloc(M, b, &o, &it, &err), ULAM_OK);
+        double prev = 1.0;
+        int k = 0, status = ULAM_OK;
+        ulam_outer_step st;
+        while (!ulam_outer_done(it)) {
+            status = ulam_outer_iterate(it, &st);
+            k++;
+            print_message("method %d iteration %d: residual %.4g, %lld histories, rejected %d\n", m, k, st.residual,
+                          (long long)st.histories, ulam_outer_rejected(it));
+            assert_true(st.residual <= prev); /* never worse than before the iteration */
+            prev = st.residual;
+        }
+        assert_int_equal(ulam_outer_error(it, &err), status);
+        print_message("  %s: %s\n", ulam_strerror(status), err.msg);
+        assert_true(status == ULAM_OK || status == ULAM_ESTALL);
+        if (status == ULAM_ESTALL) {
+            assert_true(ulam_outer_rejected(it) >= 1);
+            assert_non_null(strstr(err.msg, "lowers the residual"));
+            assert_true(k <= 3);
+        }
+        ulam_outer_free(it);
+    }
+    test_case_done();
+    free(x), free(b);
+    ulam_csr_free(M);
+}
+
+/* A correction rejected on the way is redone with more histories and the run still converges:
+ * the 20 x 20 Poisson problem at a loose eps1 = 0.9, each iteration's residual below the last. */
+static void test_rejected_redone(void **state)
+{
+    (void)state;
+    sys s = load("poisson20", 1);
+    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA; m++) {
+        if (!test_case(m)) continue;
+        ulam_outer_opts o = ulam_outer_defaults();
+        o.method = m;
+        o.eps1 = 0.9;
+        o.tol = 1e-4;
+        o.walk.threads = 2;
+        ulam_outer *it = NULL;
+        assert_int_equal(ulam_outer_alloc(s.M, s.b, &o, &it, NULL), ULAM_OK);
+        double prev = 1.0;
+        int status = ULAM_OK;
+        ulam_outer_step st;
+        while (!ulam_outer_done(it)) {
+            status = ulam_outer_iterate(it, &st);
+            assert_true(st.residual < prev);
+            prev = st.residual;
+        }
+        print_message("method %d: %s after %d iterations, residual %.3g, %d rejected\n", m, ulam_strerror(status),
+                      st.iteration, st.residual, ulam_outer_rejected(it));
+        assert_int_equal(status, ULAM_OK);
+        assert_true(ulam_outer_converged(it));
+        assert_true(ulam_outer_rejected(it) >= 1);
+        ulam_outer_free(it);
+    }
+    test_case_done();
     unload(&s);
 }
 
@@ -260,7 +455,8 @@ int main(void)
         cmocka_unit_test(test_richardson_paper), cmocka_unit_test(test_methods_converge),
         cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_stall),
         cmocka_unit_test(test_max_iter),          cmocka_unit_test(test_bad_options),
-        cmocka_unit_test(test_krylov),
+        cmocka_unit_test(test_krylov),            cmocka_unit_test(test_infinite_variance_refused),
+        cmocka_unit_test(test_poisson_never_worse), cmocka_unit_test(test_rejected_redone),
     };
     return test_run(tests);
 }

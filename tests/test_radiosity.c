@@ -129,11 +129,11 @@ static void check_all_modes(const exact_scene *e, int64_t walks, uint64_t seed)
     for (int m = 0; m < 10; m++) {
         double est[3], se[3];
         if (m >= 7) {
-            ulam_rad_result r = rad_walk(t, ULAM_ADJOINT, ULAM_NEXT_EVENT + (m - 7), p, walks, seed + 20 + (uint64_t)m, NULL);
+            ulam_rad_result r = rad_walk(t, ULAM_ADJOINT, ULAM_RAD_NEXT_EVENT + (m - 7), p, walks, seed + 20 + (uint64_t)m, NULL);
             assert_int_equal(r.cut, 0);
             memcpy(est, r.radiosity, sizeof est), memcpy(se, r.std_error, sizeof se);
         } else if (m < 4) {
-            ulam_rad_result r = rad_walk(t, m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, m % 2 ? ULAM_ABSORPTION : ULAM_COLLISION,
+            ulam_rad_result r = rad_walk(t, m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, m % 2 ? ULAM_RAD_ABSORPTION : ULAM_RAD_COLLISION,
                                          p, walks, seed + (uint64_t)m, NULL);
             assert_int_equal(r.cut, 0);
             memcpy(est, r.radiosity, sizeof est), memcpy(se, r.std_error, sizeof se);
@@ -191,7 +191,7 @@ static void test_black_emitters(void **state)
      * one of the single bounce, not 30 times it (1 / sqrt(0.001) when survival was the lamp's Kd) */
     ulam_scene *s = must_scene("tests/data/rad/tiny_kd_emitter.obj");
     ulam_tracer *t = must_tracer(s);
-    ulam_rad_result r = rad_walk(t, ULAM_FORWARD, ULAM_COLLISION, 1, 20000, 3, NULL);
+    ulam_rad_result r = rad_walk(t, ULAM_FORWARD, ULAM_RAD_COLLISION, 1, 20000, 3, NULL);
     double F = ulam_ff_parallel_rectangles(1, 1.5, 0.5), se1 = 0.5 * sqrt(F * (1 - F) / 20000);
     print_message("tiny Kd lamp: shooting stderr %.3g, single-bounce binomial %.3g\n", r.std_error[0], se1);
     assert_true(r.std_error[0] < 1.2 * se1);
@@ -211,7 +211,7 @@ static void test_cornell_black_light(void **state)
     ulam_scene_free(s0);
     ulam_tracer *t = must_tracer(s);
     const char *labels[3] = {"floor", "back_wall", "tall_block"};
-    for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+    for (int est = ULAM_RAD_COLLISION; est <= ULAM_RAD_ABSORPTION; est++) {
         ulam_rad_solver *sv = NULL;
         rad_walk(t, ULAM_FORWARD, est, 0, 100000, 31 + (uint64_t)est, &sv);
         double *all = malloc((size_t)(3 * s->npatches) * sizeof *all), *se = malloc((size_t)(3 * s->npatches) * sizeof *se);
@@ -223,14 +223,14 @@ static void test_cornell_black_light(void **state)
             for (int c = 0; c < 3; c++) {
                 double sd = sqrt(se[3 * p + c] * se[3 * p + c] + g.std_error[c] * g.std_error[c]);
                 print_message("black light, %s, %s %c: shoot %.5g +- %.2g, gather %.5g +- %.2g, z %+.2f\n",
-                              est ? "absorption" : "collision", labels[k], "RGB"[c], all[3 * p + c], se[3 * p + c],
+                              est == ULAM_RAD_ABSORPTION ? "absorption" : "collision", labels[k], "RGB"[c], all[3 * p + c], se[3 * p + c],
                               g.radiosity[c], g.std_error[c], (all[3 * p + c] - g.radiosity[c]) / sd);
                 assert_true(all[3 * p + c] > 0 && sd < 0.2 * g.radiosity[c]); /* lit, and a test that can fail */
                 assert_close(all[3 * p + c], g.radiosity[c], 4 * sd);
             }
-            if (est == ULAM_ABSORPTION) continue;
+            if (est == ULAM_RAD_ABSORPTION) continue;
             /* next-event (MIS power): light samples on a lamp that reflects nothing */
-            ulam_rad_result ne = rad_walk(t, ULAM_ADJOINT, ULAM_NEXT_EVENT, p, 20000, 51 + (uint64_t)k, NULL);
+            ulam_rad_result ne = rad_walk(t, ULAM_ADJOINT, ULAM_RAD_NEXT_EVENT, p, 20000, 51 + (uint64_t)k, NULL);
             for (int c = 0; c < 3; c++) {
                 double sd = sqrt(se[3 * p + c] * se[3 * p + c] + ne.std_error[c] * ne.std_error[c]);
                 print_message("black light, %s %c: shoot %.5g, next-event %.5g +- %.2g, z %+.2f\n", labels[k], "RGB"[c],
@@ -295,7 +295,7 @@ static void test_shoot_coverage(void **state)
     int inside[3] = {0, 0, 0};
     for (uint64_t seed = 0; seed < 200; seed++) {
         if (!test_case((long)seed)) continue;
-        ulam_rad_result r = rad_walk(t, ULAM_FORWARD, ULAM_COLLISION, 1, 2000, 5000 + seed, NULL);
+        ulam_rad_result r = rad_walk(t, ULAM_FORWARD, ULAM_RAD_COLLISION, 1, 2000, 5000 + seed, NULL);
         for (int c = 0; c < 3; c++) inside[c] += fabs(r.radiosity[c] - Bx[3 + c]) <= ULAM_Z95 * r.std_error[c];
     }
     test_case_done();
@@ -315,7 +315,7 @@ static void test_next_event_coverage(void **state)
     ulam_scene *s = must_scene("tests/data/rad/black_emitter.obj");
     ulam_tracer *t = must_tracer(s);
     double x = 0.5 * ulam_ff_parallel_rectangles(1, 1.5, 0.5);
-    for (int est = ULAM_NEXT_EVENT; est <= ULAM_NEXT_EVENT_LIGHT; est += 2) {
+    for (int est = ULAM_RAD_NEXT_EVENT; est <= ULAM_RAD_NEXT_EVENT_LIGHT; est += 2) {
         int inside = 0;
         double zsum = 0, zsq = 0;
         for (uint64_t seed = 0; seed < 200; seed++) {
@@ -326,7 +326,7 @@ static void test_next_event_coverage(void **state)
         }
         test_case_done();
         print_message("next-event %s: %d of 200 inside 1.96 sigma, mean z %+.3f, var z %.3f\n",
-                      est == ULAM_NEXT_EVENT ? "MIS power" : "light only", inside, zsum / 200,
+                      est == ULAM_RAD_NEXT_EVENT ? "MIS power" : "light only", inside, zsum / 200,
                       zsq / 200 - zsum * zsum / 40000);
         assert_true(!test_case_all() || (inside >= 180 && inside <= 197)); /* over seeds: not for one alone */
     }
@@ -344,10 +344,10 @@ static void test_next_event_back_sides(void **state)
     ulam_scene *s = must_scene("tests/data/rad/back_faces.obj");
     ulam_tracer *t = must_tracer(s);
     for (int64_t p = 1; p <= 2; p++)
-        for (int est = ULAM_COLLISION; est <= ULAM_NEXT_EVENT_LIGHT; est += est == ULAM_COLLISION ? ULAM_NEXT_EVENT : 1) {
+        for (int est = ULAM_RAD_NEXT_EVENT; est <= ULAM_RAD_COLLISION; est++) {
             ulam_rad_result r = rad_walk(t, ULAM_ADJOINT, est, p, 5000, 3 + (uint64_t)est, NULL);
             for (int c = 0; c < 3; c++) assert_true(r.radiosity[c] == 0 && r.std_error[c] == 0);
-            if (est != ULAM_COLLISION) assert_true(r.rays <= r.walks); /* no shadow ray was cast */
+            if (est != ULAM_RAD_COLLISION) assert_true(r.rays <= r.walks); /* no shadow ray was cast */
         }
     ulam_tracer_free(t);
     ulam_scene_free(s);
@@ -364,7 +364,7 @@ static void test_next_event_edge(void **state)
     ulam_scene *s = must_scene("tests/data/rad/edge_lamp.obj");
     ulam_tracer *t = must_tracer(s);
     double x = 0.5 * ulam_ff_perpendicular_rectangles(1, 1, 1);
-    const int ests[4] = {ULAM_COLLISION, ULAM_NEXT_EVENT, ULAM_NEXT_EVENT_BALANCE, ULAM_NEXT_EVENT_LIGHT};
+    const int ests[4] = {ULAM_RAD_COLLISION, ULAM_RAD_NEXT_EVENT, ULAM_RAD_NEXT_EVENT_BALANCE, ULAM_RAD_NEXT_EVENT_LIGHT};
     double var[4], share[4];
     for (int k = 0; k < 4; k++) {
         ulam_rad_result r = rad_walk(t, ULAM_ADJOINT, ests[k], 1, 40000, 90 + (uint64_t)k, NULL);
@@ -372,7 +372,7 @@ static void test_next_event_edge(void **state)
         print_message("edge lamp, estimator %d: %.5f +- %.2g (exact %.5f, z %+.2f), variance a walk %.4g, "
                       "largest score's share %.3g\n", ests[k], r.radiosity[0], r.std_error[0], x,
                       (r.radiosity[0] - x) / r.std_error[0], var[k], r.max_share);
-        if (ests[k] != ULAM_NEXT_EVENT_LIGHT) {
+        if (ests[k] != ULAM_RAD_NEXT_EVENT_LIGHT) {
             assert_close(r.radiosity[0], x, 4 * r.std_error[0]);
             assert_true(r.std_error[0] < 0.02 * x);
         }
@@ -396,9 +396,9 @@ static void test_next_event_hidden(void **state)
     (void)state;
     ulam_scene *s = must_scene("tests/data/rad/hidden_lamp.obj");
     ulam_tracer *t = must_tracer(s);
-    ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, ULAM_COLLISION, 2, 400000, 61, NULL);
+    ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, ULAM_RAD_COLLISION, 2, 400000, 61, NULL);
     assert_true(g.radiosity[0] > 0 && g.std_error[0] < 0.05 * g.radiosity[0]);
-    for (int est = ULAM_NEXT_EVENT; est <= ULAM_NEXT_EVENT_LIGHT; est++) {
+    for (int est = ULAM_RAD_NEXT_EVENT; est <= ULAM_RAD_NEXT_EVENT_LIGHT; est++) {
         ulam_rad_result r = rad_walk(t, ULAM_ADJOINT, est, 2, 40000, 62 + (uint64_t)est, NULL);
         double sd = sqrt(g.std_error[0] * g.std_error[0] + r.std_error[0] * r.std_error[0]);
         print_message("hidden lamp, estimator %d: %.5f +- %.2g, collision %.5f +- %.2g, z %+.2f\n", est,
@@ -421,10 +421,10 @@ static void test_rel_err_zero_channel(void **state)
     (void)state;
     ulam_scene *s = must_scene("tests/data/rad/green_lamp.obj");
     ulam_tracer *t = must_tracer(s);
-    ulam_rad_result ne = rad_walk(t, ULAM_ADJOINT, ULAM_NEXT_EVENT, 0, 100000, 5, NULL);
+    ulam_rad_result ne = rad_walk(t, ULAM_ADJOINT, ULAM_RAD_NEXT_EVENT, 0, 100000, 5, NULL);
     assert_true(ne.radiosity[1] > 0);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_ABSORPTION, o.index = 0, o.max_walks = 0, o.rel_err = 0.05, o.seed = 1, o.threads = 2;
+    o.estimator = ULAM_RAD_ABSORPTION, o.index = 0, o.max_walks = 0, o.rel_err = 0.05, o.seed = 1, o.threads = 2;
     ulam_rad_solver *sv = NULL;
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
     while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
@@ -451,7 +451,7 @@ static void test_view_gather(void **state)
     ulam_tracer *t = must_tracer(s);
     ulam_camera cam = {.eye = {0.5, 0.5, 0.5}, .dir = {0, 0, -1}, .up = {0, 1, 0}, .focal = 1.0, .film = 4.0};
     ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_NEXT_EVENT, o.max_walks = 0, o.rel_err = 0.02, o.seed = 8, o.threads = 2;
+    o.estimator = ULAM_RAD_NEXT_EVENT, o.max_walks = 0, o.rel_err = 0.02, o.seed = 8, o.threads = 2;
     double B[18], se[18];
     int64_t pix[6];
     ulam_view_info vi;
@@ -513,7 +513,7 @@ static void test_rel_err_zero(void **state)
     ulam_tracer *t = must_tracer(s);
     for (int m = 0; m < 4; m++) {
         ulam_walk_opts o = ulam_walk_defaults();
-        o.mode = m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, o.estimator = m % 2 ? ULAM_ABSORPTION : ULAM_COLLISION;
+        o.mode = m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, o.estimator = m % 2 ? ULAM_RAD_ABSORPTION : ULAM_RAD_COLLISION;
         o.index = 2, o.rel_err = 0.01, o.max_walks = 0, o.seed = 5, o.threads = 2; /* the far patch, facing away */
         ulam_rad_solver *sv = NULL;
         assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
@@ -825,7 +825,7 @@ static void test_furnace(void **state)
     assert_int_equal(ulam_render(t, two, &cam, INT32_MAX, INT32_MAX, 1.0, rgb, NULL), ULAM_EOVERFLOW);
     two[7] = NAN;
     assert_int_equal(ulam_render(t, two, &cam, 4, 4, 0.25, rgb, NULL), ULAM_ENONFINITE);
-    for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+    for (int est = ULAM_RAD_COLLISION; est <= ULAM_RAD_ABSORPTION; est++) {
         for (int64_t p = 0; p < 6; p += 5) {
             ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, est, p, 20000, 11 + (uint64_t)p, NULL);
             for (int c = 0; c < 3; c++) assert_close(g.radiosity[c], 2.0, 4 * g.std_error[c] + 1e-12);
@@ -843,9 +843,9 @@ static void test_furnace(void **state)
         ulam_rad_solver_free(sv);
         /* matrix walks on the assembled M, both modes */
         double x[6], xse[6];
-        ulam_walk_result m = matrix_walk(s, F, 1, ULAM_ADJOINT, est, 2, 20000, 3, NULL, NULL);
+        ulam_walk_result m = matrix_walk(s, F, 1, ULAM_ADJOINT, est - ULAM_RAD_COLLISION, 2, 20000, 3, NULL, NULL);
         assert_close(m.estimate, 2.0, 4 * m.std_error + 1e-12);
-        matrix_walk(s, F, 2, ULAM_FORWARD, est, 0, 50000, 4, x, xse);
+        matrix_walk(s, F, 2, ULAM_FORWARD, est - ULAM_RAD_COLLISION, 0, 50000, 4, x, xse);
         for (int k = 0; k < 6; k++) assert_close(x[k], 2.0, 4 * xse[k] + 1e-12);
     }
     ulam_csr_free(F);
@@ -956,8 +956,8 @@ static void test_cornell_against_direct(void **state)
         assert_int_equal(ulam_scene_find(s, labels[k], &p), ULAM_OK);
         double sf[3];
         assert_int_equal(ulam_rad_direct_error(s, F, rays, B, p, 0, sf, NULL), ULAM_OK);
-        for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
-            ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, est, p, est == ULAM_ABSORPTION ? 1200000 : 300000, 100 + (uint64_t)(2 * k + est), NULL);
+        for (int est = ULAM_RAD_COLLISION; est <= ULAM_RAD_ABSORPTION; est++) {
+            ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, est, p, est == ULAM_RAD_ABSORPTION ? 1200000 : 300000, 100 + (uint64_t)(2 * k + est), NULL);
             for (int c = 0; c < 3; c++) {
                 double tol = 4 * sqrt(g.std_error[c] * g.std_error[c] + sf[c] * sf[c]);
                 assert_true(tol < 0.25 * B[3 * p + c]); /* a test that can fail */
@@ -965,7 +965,7 @@ static void test_cornell_against_direct(void **state)
             }
             /* the matrix walk on the same F, one channel at a time */
             for (int c = 0; c < 3; c++) {
-                ulam_walk_result w = matrix_walk(s, F, c, ULAM_ADJOINT, est, p, 200000, 7 + (uint64_t)c, NULL, NULL);
+                ulam_walk_result w = matrix_walk(s, F, c, ULAM_ADJOINT, est - ULAM_RAD_COLLISION, p, 200000, 7 + (uint64_t)c, NULL, NULL);
                 assert_close(w.estimate, B[3 * p + c], 4 * w.std_error);
             }
         }
@@ -995,7 +995,7 @@ static void test_cornell_against_direct(void **state)
         free(x), free(xse);
     }
     /* shooting: every patch at once, against the direct solution */
-    for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+    for (int est = ULAM_RAD_COLLISION; est <= ULAM_RAD_ABSORPTION; est++) {
         ulam_rad_solver *sv = NULL;
         rad_walk(t, ULAM_FORWARD, est, 0, 200000, 9 + (uint64_t)est, &sv);
         double *all = malloc((size_t)(3 * n) * sizeof *all), *se = malloc((size_t)(3 * n) * sizeof *se);
@@ -1025,7 +1025,7 @@ static void test_threads_and_options(void **state)
     ulam_tracer *t = must_tracer(s);
     ulam_walk_opts o = ulam_walk_defaults();
     o.index = 0, o.max_walks = 30000, o.seed = 42;
-    for (int est = ULAM_COLLISION; est <= ULAM_NEXT_EVENT_LIGHT; est += est == ULAM_COLLISION ? ULAM_NEXT_EVENT : 1) {
+    for (int est = ULAM_RAD_NEXT_EVENT; est <= ULAM_RAD_COLLISION; est++) {
         ulam_rad_result r[2];
         o.estimator = est;
         for (int k = 0; k < 2; k++) {
@@ -1043,16 +1043,16 @@ static void test_threads_and_options(void **state)
     }
     ulam_rad_solver *sv = NULL;
     ulam_error err;
-    o.estimator = ULAM_COLLISION, o.index = s->npatches;
+    o.estimator = ULAM_RAD_COLLISION, o.index = s->npatches;
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
-    o.index = 0, o.estimator = ULAM_EXPECTED;
+    o.index = 0, o.estimator = ULAM_RAD_ABSORPTION + 1;
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
-    o.estimator = ULAM_NEXT_EVENT_LIGHT + 1;
+    o.estimator = -1;
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
-    o.estimator = ULAM_NEXT_EVENT, o.mode = ULAM_FORWARD; /* next-event gathers */
+    o.estimator = ULAM_RAD_NEXT_EVENT, o.mode = ULAM_FORWARD; /* next-event gathers (and is the default) */
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
     o.mode = ULAM_ADJOINT;
-    o.estimator = ULAM_COLLISION, o.roulette = 0.5;
+    o.estimator = ULAM_RAD_COLLISION, o.roulette = 0.5;
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
     assert_null(sv);
     assert_int_equal(ulam_rad_solver_vectors(NULL, NULL, NULL), ULAM_EINVAL);

@@ -19,12 +19,13 @@ int cli_auto_choose(const cli_system *s, ulam_walk_opts *o, const ulam_auto_opts
     const ulam_auto_candidate *c = &res->cand[k];
     if (res->chosen < 0) {
         int diverge = !(res->abs.upper < 1);
+        const char *hint = s->jacobi || s->pagerank > 0 ? "" : cli_system_hint(s->M);
         fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance%s; the closest is "
-                        "%s %s (continuation %s%.3g, kernel exponent %g) with rho(M^) = %.6g (upper bound %.6g)%s\n",
+                        "%s %s (continuation %s%.3g, kernel exponent %g) with rho(M^) = %.6g (upper bound %.6g)%s.%s\n",
                 s->matrix_path, o->rel_err > 0 ? "error" : "warning", diverge ? " (rho(|M|) is not certified below 1)" : "",
                 cli_mode_names[c->mode], cli_estimator_names[c->estimator], c->continue_q > 0 ? "" : "analog, ",
                 c->continue_q > 0 ? c->continue_q : 0.0, c->kernel_alpha, c->hat.rho, c->hat.upper,
-                o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it");
+                o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it", hint);
         if (o->rel_err > 0) {
             *sv = ulam_solver_free(*sv);
             return diverge ? EXIT_DIVERGE : EXIT_INFVAR;
@@ -55,6 +56,16 @@ static double pilot_share(const ulam_auto_result *res)
 /* The candidates and the choice, as text. */
 void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc)
 {
+    if (cli_verbosity < 1) { /* one line: what was chosen among how many; --verbose lists them */
+        if (bc && bc->state == 2)
+            printf("auto            chose bidirectional over %d walk candidates (--verbose lists them)\n", res->ncand);
+        else if (res->chosen >= 0)
+            printf("auto            chose it among %d candidates by predicted cost (--verbose lists them)\n", res->ncand);
+        else
+            printf("auto            no certified candidate among %d: ran the closest (--verbose lists them)\n",
+                   res->ncand);
+        return;
+    }
     if (bc && bc->state == 2)
         printf("auto            chose bidirectional: its predicted work %.3g units is below the walk leader's %.3g "
                "(%d walk candidates after %d pilot stages; guards and pilots %.3f s)\n", bc->work, bc->leader_work,
@@ -95,8 +106,9 @@ void cli_auto_print_text(const ulam_auto_result *res, const cli_bidir_cand *bc)
 /* The candidates and the choice, as the JSON key "auto" (followed by a comma). */
 void cli_auto_print_json(const ulam_auto_result *res, const cli_bidir_cand *bc)
 {
-    printf("\"auto\": {\"chosen\": %d, \"closest\": %d, \"stages\": %d, ", bc && bc->state == 2 ? res->ncand : res->chosen,
-           res->closest, res->stages);
+    /* 1-based positions in "candidates", as every index a user sees (0: none) */
+    printf("\"auto\": {\"chosen\": %d, \"closest\": %d, \"stages\": %d, ",
+           (bc && bc->state == 2 ? res->ncand : res->chosen) + 1, res->closest + 1, res->stages);
     cli_json_number("seconds", res->seconds, 0);
     cli_json_number("pilot_work", res->pilot_work, 0);
     cli_json_number("reused_work", res->reused_work, 0);

@@ -12,7 +12,7 @@
 static const char *const usage =
     "usage: ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R]\n"
     "       ulam solve M.mtx --index I --rhs b.mtx --method bidirectional [--rmax R]\n"
-    "                  [--min-value V] [--estimator collision|absorption|expected] [--walks N]\n"
+    "                  [--min-value V] [--step-cost C] [--estimator collision|absorption|expected] [--walks N]\n"
     "                  [--rel-err E] [--time S] [--seed S] [--threads T] [--continue Q]\n"
     "                  [--max-steps K] [--check] [--json] [--force] [--cache]\n"
     "\n"
@@ -24,7 +24,14 @@ static const char *const usage =
     "\n"
     "  --rmax R           push threshold (default: balance the push's work against the work\n"
     "                     the walks are predicted to need for the target)\n"
-    "  --min-value V      the smallest x_I the balance plans for (default 1 / n)\n"
+    "  --min-value V      the smallest x_I the balance plans for (default 1 / n, raised by a probe\n"
+    "                     of 1024 walks once the push has spent what they cost)\n"
+    "  --top K            with --source S and no --index: every component of x = (I - M)^-1 e_S by\n"
+    "                     forward push and walks (FORA; --rel-err E for every x_i >= --min-value,\n"
+    "                     default 0.1 and 1 / n; or --walks N), the K largest printed with their\n"
+    "                     intervals (default 10)\n"
+    "  --step-cost C      push operations one walk visit costs, for the balance (default 1.3;\n"
+    "                     bench_bidir measures it: docs/bidirectional.md)\n"
     "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
     "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
     "  guards reported are those of the forward kernel\n";
@@ -80,8 +87,9 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
                (long long)w->steps, w->threads);
     if (o->rmax <= 0)
         printf("balance         pilot %lld walks, %.3g visits a walk; %.3g walks predicted at this rmax, "
-               "work %.3g operations predicted in all\n", (long long)r->plan.pilot_walks, r->plan.mean_visits,
-               r->plan.predicted_walks, r->plan.predicted_work);
+               "work %.3g operations predicted in all (a visit %.3g operations; probe's |x| >= %.3g)\n",
+               (long long)r->plan.pilot_walks, r->plan.mean_visits, r->plan.predicted_walks, r->plan.predicted_work,
+               r->plan.step_cost, r->plan.probe);
     printf("seconds         %.4f (push %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
            r->push.seconds, w->seconds, (unsigned long long)o->walk.seed, rp->transpose_seconds);
     printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
@@ -235,6 +243,95 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     return rc;
 }
 
+/* Components by decreasing estimate (qsort on indices into cli_fpush_x). */
+static const double *cli_fpush_x;
+static int by_estimate(const void *a, const void *b)
+{
+    double x = cli_fpush_x[*(const int64_t *)a], y = cli_fpush_x[*(const int64_t *)b];
+    return (x < y) - (x > y);
+}
+
+/* --source S without --index: every component by forward push and walks (src/fpush.c), the
+ * largest K printed with their intervals; 0 or an exit code. */
+static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_opts *bo, int64_t top, report *rp)
+{
+    ulam_fpush_opts o = ulam_fpush_defaults();
+    o.walk = bo->walk;
+    o.walk.mode = ULAM_FORWARD;
+    o.walk.max_walks = bo->walk.max_walks > 0 ? bo->walk.max_walks : 0;
+    o.walks = o.walk.max_walks;
+    if (bo->walk.rel_err > 0) o.rel_err = bo->walk.rel_err;
+    o.rmax = bo->rmax, o.min_value = bo->min_value, o.step_cost = bo->step_cost, o.source = source - 1;
+    int check = rp->check;
+    rp->check = 0; /* prepare's direct value is for one index */
+    int rc = prepare(s, source, force, (ulam_bidir_opts *)bo, NULL, NULL, rp);
+    if (rc) return rc;
+    int64_t n = s->M->nrows, *order = malloc((size_t)n * sizeof *order);
+    double *x = malloc((size_t)n * sizeof *x), *se = malloc((size_t)n * sizeof *se);
+    double *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi), *xd = NULL;
+    ulam_csr *Mt = NULL;
+    ulam_fpush_info info;
+    ulam_error err;
+    int status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : ulam_csr_transpose(s->M, &Mt);
+    o.walk.guard = &rp->g, o.walk.interrupt = &cli_interrupted;
+    if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
+    else status = ulam_fpush_solve(s->M, Mt, &o, x, se, lo, hi, &info, &err);
+    if (status) rc = cli_report(s->matrix_path, &err);
+    if (!rc && check) rc = cli_direct_solve(s, CLI_MAX_MEM, &xd, NULL);
+    if (!rc && cli_rank == 0) {
+        for (int64_t i = 0; i < n; i++) order[i] = i;
+        cli_fpush_x = x;
+        qsort(order, (size_t)n, sizeof *order, by_estimate);
+        if (top > n) top = n;
+        if (rp->json) {
+            printf("{");
+            cli_json_string("method", "single-source", 0);
+            printf("\"source\": %lld, \"n\": %lld, ", (long long)source, (long long)n);
+            cli_json_number("rmax", info.rmax, 0);
+            printf("\"push_ops\": %lld, \"walks\": %lld, \"steps\": %lld, ", (long long)info.push.ops,
+                   (long long)info.walks, (long long)info.steps);
+            cli_json_number("residual_bound", info.residual_bound, 0);
+            cli_json_number("seconds", info.seconds, 0);
+            printf("\"top\": [");
+            for (int64_t k = 0; k < top; k++) {
+                int64_t i = order[k];
+                printf("%s{\"index\": %lld, ", k ? ", " : "", (long long)i + 1);
+                cli_json_number("estimate", x[i], 0);
+                cli_json_number("stderr", se[i], 0);
+                printf("\"ci95\": [");
+                cli_json_value(lo[i]);
+                printf(", ");
+                cli_json_value(hi[i]);
+                printf("]%s", xd ? ", " : "");
+                if (xd) cli_json_number("direct", xd[i], 1);
+                printf("}");
+            }
+            printf("]}\n");
+        } else {
+            printf("method          single source: forward push from %lld, forward walks on its residual (FORA)\n",
+                   (long long)source);
+            printf("push            rmax %.3g: %lld operations, residual on %lld states, sum %.3g (walk part of any "
+                   "x_i at most %.3g)\n", info.rmax, (long long)info.push.ops, (long long)info.push.support,
+                   info.push.r_sum, info.residual_bound);
+            printf("walks           %lld (%lld steps)\n", (long long)info.walks, (long long)info.steps);
+            printf("seconds         %.4f (push %.4f, walks %.4f)\n", info.seconds, info.push_seconds, info.walk_seconds);
+            printf("%-6s %-10s %-14s %-11s %s\n", "rank", "index", "estimate", "stderr",
+                   xd ? "95% CI                    direct" : "95% CI");
+            for (int64_t k = 0; k < top; k++) {
+                int64_t i = order[k];
+                printf("%-6lld %-10lld %-14.8g %-11.3g %-12.6g %.6g", (long long)k + 1, (long long)i + 1, x[i], se[i],
+                       lo[i], hi[i]);
+                if (xd) printf("%*s%.8g", 13 - (int)snprintf(NULL, 0, "%.6g", hi[i]), "", xd[i]);
+                printf("\n");
+            }
+        }
+    }
+    if (!rc && cli_interrupted) rc = EXIT_INTERRUPTED;
+    free(order), free(x), free(se), free(lo), free(hi), free(xd);
+    ulam_csr_free(Mt);
+    return rc;
+}
+
 /* ulam solve --source S, or --rhs b --method bidirectional. */
 int cli_bidir(int argc, char **argv)
 {
@@ -242,6 +339,7 @@ int cli_bidir(int argc, char **argv)
         {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
         {"source", required_argument, 0, 'u'},    {"method", required_argument, 0, 'M'},
         {"rmax", required_argument, 0, 'x'},      {"min-value", required_argument, 0, 'v'},
+        {"step-cost", required_argument, 0, 'k'}, {"top", required_argument, 0, 'T'},
         CLI_WALK_OPTION("estimator"),             CLI_WALK_OPTION("walks"),
         CLI_WALK_OPTION("rel-err"),               CLI_WALK_OPTION("time"),
         CLI_WALK_OPTION("seed"),                  CLI_WALK_OPTION("threads"),
@@ -254,9 +352,10 @@ int cli_bidir(int argc, char **argv)
     report rp = {0};
     int64_t source = 0;
     int c, rc, idx, force = 0, method = 0;
-    int64_t *bidx = NULL;
+    int64_t *bidx = NULL, top = 0;
     double *bval = NULL;
     o.walk.max_walks = 0;
+    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
@@ -271,6 +370,8 @@ int cli_bidir(int argc, char **argv)
             break;
         case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &o.rmax))) return rc; break;
         case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &o.min_value))) return rc; break;
+        case 'k': if ((rc = cli_parse_real("solve", "--step-cost", optarg, 1e-3, 1e6, &o.step_cost))) return rc; break;
+        case 'T': if ((rc = cli_parse_int("solve", "--top", optarg, 1, ULAM_MAX_DIM, &top))) return rc; break;
         case 'c': rp.check = 1; break;
         case 'J': rp.json = 1; break;
         case 'F': force = 1; break;
@@ -285,7 +386,14 @@ int cli_bidir(int argc, char **argv)
         return cli_usage_error("solve", "--rhs b with --rmax is a bidirectional solve: say --method bidirectional");
     if (!source && !s.rhs_path)
         return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S) or a sparse --rhs b.mtx");
-    if (!s.index) return cli_usage_error("solve", "--method bidirectional needs --index I");
+    if (top && s.index) return cli_usage_error("solve", "--top K lists the largest of every component: not with --index");
+    if (!s.index && s.rhs_path) return cli_usage_error("solve", "--method bidirectional needs --index I");
+    if (!s.index) { /* single source, every target */
+        s.matrix_path = argv[optind];
+        rc = run_all(&s, source, force, &o, top ? top : 10, &rp);
+        cli_system_free(&s);
+        return rc;
+    }
     cli_walk_budget(&o.walk);
     o.walk.force = force;
     s.matrix_path = argv[optind];

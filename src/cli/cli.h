@@ -4,6 +4,8 @@
 
 #include "ulam.h"
 
+#include <getopt.h>
+
 /* Exit codes (documented in README.md): 0 success, 1 internal failure, 2 usage error,
  * 3 walks would diverge, 4 a --rel-err target with a variance not certified finite, 10 + status for a library status, 130 interrupted. */
 enum { EXIT_USAGE = 2, EXIT_DIVERGE = 3, EXIT_INFVAR = 4, EXIT_STATUS_BASE = 10, EXIT_INTERRUPTED = 130 };
@@ -52,6 +54,7 @@ typedef struct cli_system {
     int64_t index;        /* 1-based --index to check against n once loaded (0: none) */
     int jacobi;   /* the file holds A of A x = b: use M = I - omega D^-1 A */
     double omega; /* damping of the Jacobi splitting (1 = plain Jacobi) */
+    double pagerank; /* > 0: the file is an adjacency matrix; solve PageRank at this damping */
     int cache;    /* read and write binary caches beside the files (--cache) */
     int lazy;     /* the command reads M only where walks reach (adjoint solve): a mapped
                      file is then verified only if its certificate does not serve the guards */
@@ -76,10 +79,27 @@ int cli_need_rhs(const char *command, const char *path);
 /* Check a mapped M and b whole (ulam_system_check) if not yet done; 0 or an exit code. */
 int cli_system_verify(cli_system *s);
 
+/* --pagerank: replace the loaded adjacency matrix by alpha P^T and a missing b by (1 - alpha) / n
+ * (src/cli/graph.c); 0 or an exit code. */
+int cli_load_pagerank(cli_system *s);
+
+/* A hint naming the option that fits how M looks (--jacobi for a large diagonal, --pagerank for an
+ * adjacency matrix), or "" (src/cli/guard.c). */
+const char *cli_system_hint(const ulam_csr *M);
+
 /* Free what cli_load_system loaded. */
 void cli_system_free(cli_system *s);
 
-/* Solve the loaded system densely into a new *x; 0 or an exit code (error reported). */
+/* The reference solve (src/cli/direct.c): sparse LU when cli_direct_sparse_wanted(M) (--lu of
+ * ulam direct sets cli_direct_force: -1 auto, 0 dense, 1 sparse), else dense. */
+extern int cli_direct_force;
+int cli_direct_sparse_wanted(const ulam_csr *M);
+
+/* x_index of the reference solve for --check, interruptible by Ctrl-C (EXIT_INTERRUPTED: its thread
+ * still reads s); *method "sparse LU" or "dense LU"; 0 or an exit code. */
+int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method);
+
+/* Solve the loaded system (sparse or dense LU) into a new *x; 0 or an exit code (error reported). */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info);
 
 /* Set by the first Ctrl-C while cli_catch_sigint is in force (walks stop at their next block). */
@@ -137,6 +157,33 @@ void cli_json_variance(const char *key, int finite);
 /* Print a radius as JSON keys prefix (the estimate when converged, else the upper bound),
  * prefix_is ("estimate" or "upper bound"), prefix_lower, prefix_upper, prefix_converged. */
 void cli_json_radius(const char *prefix, const ulam_power *p);
+
+/* Output (src/cli/output.c).  cli_verbosity: -1 --quiet (the answer line), 0 default (a few lines),
+ * 1 --verbose (everything); cli_json_mode: --json was given; cli_json_done: a JSON object was
+ * printed (set by cli_json_number and cli_json_string). */
+extern int cli_verbosity, cli_json_mode, cli_json_done;
+
+/* Strip --verbose/-v and --quiet/-q from argv, note --json (then stderr keeps its last error). */
+void cli_output_begin(int *argc, char **argv);
+
+/* Under --json, a failure that printed no JSON prints {"error": message, "exit": rc}; returns rc. */
+int cli_output_finish(int rc);
+
+/* Every value of solve --method (src/cli/output.c), and them in words for messages. */
+enum { CLI_NMETHODS = 9 };
+extern const char *const cli_method_names[CLI_NMETHODS];
+extern const char *const cli_method_words;
+
+/* The name among names[0..n) closest to word, or NULL. */
+const char *cli_suggest(const char *word, const char *const *names, int n);
+
+/* Refuse an unknown --name in argv (no abbreviations), naming the closest of longopts; 0 or EXIT_USAGE. */
+int cli_check_options(const char *command, int argc, char **argv, const struct option *longopts);
+
+/* value's index among names[0..n) for option opt, or -1 after a usage error (what: the names in
+ * words) with a "did you mean". */
+int cli_choose(const char *command, const char *opt, const char *value, const char *const *names, int n,
+               const char *what);
 
 /* Subcommands: each takes the argv that starts at its own name. */
 int cli_info(int argc, char **argv);

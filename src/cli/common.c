@@ -247,7 +247,7 @@ int cli_load_system(cli_system *s)
 {
     ulam_error err;
     int prepared = ulam_system_is_file(s->matrix_path);
-    if (prepared && s->jacobi)
+    if (prepared && (s->jacobi || s->pagerank > 0))
         return cli_usage_error(s->command, "%s is a prepared system: it holds M already (prepare it with --jacobi)",
                                s->matrix_path);
     int status = read_input(s->matrix_path, s->cache, &s->sys_M, &s->own_M, NULL, NULL, &err);
@@ -287,6 +287,7 @@ int cli_load_system(cli_system *s)
     }
     s->verified = !s->sys_M && !s->sys_b;
     int rc = s->jacobi ? load_jacobi(s) : 0;
+    if (!rc && s->pagerank > 0) rc = cli_load_pagerank(s);
     if (!rc && !s->lazy) rc = cli_system_verify(s);
     if (!rc && s->lazy && s->sys_b && ulam_system_check(s->sys_b, &err)) { /* a b of its own file: whole */
         cli_system_free(s);
@@ -318,7 +319,8 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
 {
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
     *x = malloc((size_t)s->M->nrows * sizeof **x);
-    int status = *x ? ulam_direct_solve(s->M, s->b, *x, max_mem, info, &err) : ULAM_ENOMEM;
+    int status = !*x ? ULAM_ENOMEM : cli_direct_sparse_wanted(s->M) ? ulam_direct_sparse(s->M, s->b, *x, max_mem, info, &err)
+                                                                  : ulam_direct_solve(s->M, s->b, *x, max_mem, info, &err);
     if (!status) return 0;
     free(*x);
     *x = NULL;
@@ -335,6 +337,7 @@ void cli_json_value(double v)
 /* Print a JSON number (null when not finite). */
 void cli_json_number(const char *key, double v, int last)
 {
+    cli_json_done = 1;
     printf("\"%s\": ", key);
     cli_json_value(v);
     printf("%s", last ? "" : ", ");
@@ -343,6 +346,7 @@ void cli_json_number(const char *key, double v, int last)
 /* Print a JSON string (escaped). */
 void cli_json_string(const char *key, const char *v, int last)
 {
+    cli_json_done = 1;
     printf("\"%s\": \"", key);
     for (const unsigned char *c = (const unsigned char *)v; *c; c++) {
         if (*c == '"' || *c == '\\') printf("\\%c", *c);

@@ -1,24 +1,126 @@
-/* ulam direct: the LAPACK reference solve of (I - M) x = b. */
+/* ulam direct: the reference solve of (I - M) x = b, sparse (UMFPACK) or dense (LAPACK); and the
+ * interruptible reference of solve --check. */
 #include "cli.h"
 
 #include <getopt.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <time.h>
+
+int cli_direct_force = -1;
+
+/* Nonzero when the reference solve of M should be the sparse LU: --lu sparse, or (auto) UMFPACK is
+ * there and M is large (n > 1000: dense LU takes over a second from n of a few thousand) and sparse
+ * (under 5% nonzeros). */
+int cli_direct_sparse_wanted(const ulam_csr *M)
+{
+    int64_t n = M->nrows;
+    if (cli_direct_force >= 0) return cli_direct_force;
+    return ulam_direct_sparse_available() && n > 1000 && (double)M->rowptr[n] < 0.05 * (double)n * (double)n;
+}
+
+/* Before a reference solve that may take long: what it needs, on stderr (nothing when it is quick). */
+static void announce(const cli_system *s, int sparse)
+{
+    int64_t n = s->M->nrows, nnz = s->M->rowptr[n];
+    double flops = 2.0 / 3.0 * (double)n * (double)n * (double)n, gib = (double)ulam_direct_bytes(n) / 1073741824.0;
+    double bytes, lu_flops;
+    ulam_error err;
+    if (sparse && nnz + n > 200000 && !ulam_direct_sparse_estimate(s->M, &bytes, &lu_flops, &err))
+        fprintf(stderr, "ulam: --check: sparse LU (UMFPACK) of n = %lld, %lld nonzeros: at most %.3g GiB and %.2g flops "
+                        "(UMFPACK's bounds; at most about %.0f s at 10 Gflop/s)%s; Ctrl-C keeps the estimate\n",
+                (long long)n, (long long)nnz, bytes / 1073741824.0, lu_flops, lu_flops / 1e10,
+                bytes > (double)CLI_MAX_MEM ? ": over 4 GiB, so GMRES to a 1e-12 residual instead" : "");
+    else if (!sparse && flops > 2e10)
+        fprintf(stderr, "ulam: --check: dense LU (LAPACK) of n = %lld: %.3g GiB and 2/3 n^3 = %.2g flops (about %.0f s "
+                        "at 10 Gflop/s)%s; Ctrl-C keeps the estimate\n", (long long)n, gib, flops, flops / 1e10,
+                ulam_direct_sparse_available() ? "" : " (this ulam has no UMFPACK for a sparse LU)");
+}
+
+/* The reference solve in a thread, so that Ctrl-C can leave it. */
+typedef struct {
+    const cli_system *s;
+    int sparse;   /* sparse LU first (else dense) */
+    int krylov;   /* the LU would pass the memory limit: GMRES to a 1e-12 residual instead */
+    double *x;
+    ulam_direct_info info;
+    int rc;
+    atomic_int done;
+} check_job;
+
+/* Run the job (thread body): the LU, or GMRES when the LU's memory passes the limit. */
+static void *check_run(void *p)
+{
+    check_job *j = p;
+    const ulam_csr *M = j->s->M;
+    ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
+    int status = ULAM_ENOMEM, it;
+    if ((j->x = malloc((size_t)M->nrows * sizeof *j->x)))
+        status = j->sparse ? ulam_direct_sparse(M, j->s->b, j->x, CLI_MAX_MEM, &j->info, &err)
+                           : ulam_direct_solve(M, j->s->b, j->x, CLI_MAX_MEM, &j->info, &err);
+    if (status == ULAM_EMEMLIMIT) {
+        double t0 = ulam_now();
+        j->krylov = 1;
+        status = ulam_gmres(M, j->s->b, 50, 1e-12, 10000000, j->x, &it, &j->info.residual);
+        j->info.seconds = ulam_now() - t0;
+        if (status) err = (ulam_error){.status = status, .msg = "GMRES to converge (the LU would pass the memory limit)"};
+    }
+    j->rc = status ? cli_report(j->s->matrix_path, &err) : 0;
+    atomic_store(&j->done, 1);
+    return NULL;
+}
+
+/* x_index of the reference solve of s for --check, *method "sparse LU", "dense LU" or "GMRES" (when
+ * the LU would pass the memory limit); the needs announced first when large; 0, an exit code, or
+ * EXIT_INTERRUPTED on Ctrl-C (cli_interrupted) while the solve still runs in its thread (s must
+ * then stay loaded until exit). */
+int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method)
+{
+    check_job *j = calloc(1, sizeof *j);
+    if (!j) return cli_exit_code(ULAM_ENOMEM);
+    j->s = s, j->sparse = cli_direct_sparse_wanted(s->M);
+    announce(s, j->sparse);
+    pthread_t t;
+    if (pthread_create(&t, NULL, check_run, j)) {
+        check_run(j);
+    } else {
+        while (!atomic_load(&j->done) && !cli_interrupted) nanosleep(&(struct timespec){0, 20000000}, NULL);
+        if (!atomic_load(&j->done)) {
+            pthread_detach(t);
+            *method = "interrupted";
+            return EXIT_INTERRUPTED;
+        }
+        pthread_join(t, NULL);
+    }
+    *method = j->krylov ? "GMRES to residual 1e-12: the LU would pass 4 GiB" : j->sparse ? "sparse LU" : "dense LU";
+    int rc = j->rc;
+    if (!rc) *value = j->x[index], *seconds = j->info.seconds;
+    free(j->x);
+    free(j);
+    return rc;
+}
+
 
 static const char *const usage =
     "usage: ulam direct M.mtx --rhs b.mtx [--index I] [--out x.mtx] [--max-mem SIZE]\n"
-    "                   [--jacobi [--omega W]] [--json]\n"
+    "                   [--lu auto|sparse|dense] [--jacobi [--omega W]] [--json]\n"
     "\n"
-    "Solve (I - M) x = b with a dense LU factorisation (LAPACKE_dgesv, OpenBLAS) and report\n"
-    "the reciprocal condition number (LAPACKE_dgecon, 1-norm), the relative residual\n"
+    "Solve (I - M) x = b with a sparse LU factorisation (UMFPACK) for a large sparse M, else\n"
+    "a dense one (LAPACKE_dgesv, OpenBLAS), and report the reciprocal condition number (dense:\n"
+    "LAPACKE_dgecon, 1-norm; sparse: UMFPACK's estimate), the relative residual\n"
     "||b - (I - M) x||_inf / ||b||_inf and the time.\n"
     "\n"
     "  --rhs b.mtx     right-hand side, a Matrix Market n x 1 vector (required)\n"
     "  --index I       report x_I; indices are 1-based, as in Matrix Market files\n"
     "  --out x.mtx     write the whole solution (array format)\n"
-    "  --max-mem SIZE  refuse when the dense matrix needs more (default 4G)\n"
+    "  --max-mem SIZE  refuse when the dense matrix or the sparse factors need more (default 4G)\n"
+    "  --lu L          auto (default: sparse when n > 1000 and under 5% of M is nonzero and\n"
+    "                  UMFPACK is there), sparse or dense\n"
     "  --jacobi        the file holds A of A x = b; solve with M = I - omega D^-1 A\n"
     "  --omega W       damping of the Jacobi splitting (default 1)\n"
+    "  --pagerank A    (or --damping) the file is an adjacency matrix: solve PageRank at damping A\n"
     "  --json          print one JSON object\n";
 
 /* Print the human-readable report. */
@@ -34,6 +136,7 @@ static void print_text(const cli_system *s, const double *x, int64_t index,
         for (int64_t i = 0; i < n && i < 10; i++) printf("x[%lld]%*s%.17g\n", (long long)i + 1, i < 9 ? 6 : 5, "", x[i]);
         if (n > 10) printf("...        (%lld more: use --out or --index)\n", (long long)(n - 10));
     }
+    printf("method     %s\n", cli_direct_sparse_wanted(s->M) ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");
     printf("rcond      %.3e\n", info->rcond);
     printf("residual   %.3e\n", info->residual);
     printf("seconds    %.6f\n", info->seconds);
@@ -47,8 +150,10 @@ static void print_json(const cli_system *s, const double *x, int64_t index,
     printf("{\"n\": %lld, ", (long long)s->M->nrows);
     if (index > 0) {
         printf("\"index\": %lld, ", (long long)index);
-        cli_json_number("value", x[index - 1], 0);
+        cli_json_number("estimate", x[index - 1], 0);
+        cli_json_number("value", x[index - 1], 0); /* deprecated: "estimate", as in every command */
     }
+    cli_json_string("method", cli_direct_sparse_wanted(s->M) ? "sparse LU" : "dense LU", 0);
     cli_json_number("rcond", info->rcond, 0);
     cli_json_number("residual", info->residual, 0);
     cli_json_number("seconds", info->seconds, 1);
@@ -63,11 +168,14 @@ int cli_direct(int argc, char **argv)
         {"out", required_argument, 0, 'o'},     {"max-mem", required_argument, 0, 'm'},
         {"jacobi", no_argument, 0, 'j'},        {"omega", required_argument, 0, 'w'},
         {"json", no_argument, 0, 'J'},          {"help", no_argument, 0, 'h'},
-        {0, 0, 0, 0}};
+        {"lu", required_argument, 0, 'L'},      {"pagerank", required_argument, 0, 'P'},
+        {"damping", required_argument, 0, 'P'}, {0, 0, 0, 0}};
+    static const char *const lu_names[] = {"dense", "sparse", "auto"};
     cli_system s = {.command = "direct", .omega = 1.0};
     const char *out = NULL;
     size_t max_mem = CLI_MAX_MEM;
     int json = 0, c, rc;
+    if (cli_check_options("direct", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
         switch (c) {
@@ -78,12 +186,20 @@ int cli_direct(int argc, char **argv)
         case 'j': s.jacobi = 1; break;
         case 'w': if ((rc = cli_parse_real("direct", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'J': json = 1; break;
+        case 'P': if ((rc = cli_parse_real("direct", "--pagerank", optarg, 1e-6, 1 - 1e-9, &s.pagerank))) return rc; break;
+        case 'L':
+            if ((cli_direct_force = cli_choose("direct", "--lu", optarg, lu_names, 3, "auto, sparse or dense")) < 0)
+                return EXIT_USAGE;
+            if (cli_direct_force == 2) cli_direct_force = -1;
+            if (cli_direct_force == 1 && !ulam_direct_sparse_available())
+                return cli_usage_error("direct", "--lu sparse: this ulam was built without UMFPACK (libsuitesparse-dev)");
+            break;
         case 'h': fputs(usage, stdout); return 0;
         default: return cli_usage_error("direct", "unknown option");
         }
     }
     if (optind != argc - 1) return cli_usage_error("direct", "expects exactly one matrix file");
-    if (!s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_need_rhs("direct", argv[optind]);
+    if (!s.rhs_path && !s.pagerank && !ulam_system_is_file(argv[optind])) return cli_need_rhs("direct", argv[optind]);
     s.matrix_path = argv[optind];
     if (out && (rc = cli_check_output(out))) return rc;
     if ((rc = cli_load_system(&s))) return rc;

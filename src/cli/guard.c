@@ -1,6 +1,7 @@
 /* The stability guards as the commands report them: refusal messages, warnings, verdict words. */
 #include "cli.h"
 
+#include <math.h>
 #include <stdio.h>
 
 /* A verdict in words. */
@@ -12,6 +13,32 @@ const char *cli_verdict_word(int verdict)
     case ULAM_VERDICT_FAIL: return "at or above 1";
     default: return "unknown: the bounds straddle 1";
     }
+}
+
+/* A hint naming the option that fits how M looks: a diagonal of magnitude >= 1 in at least half
+ * the rows is A of A x = b (--jacobi); nonnegative whole-number weights off an empty diagonal with
+ * some row sum above 1 are a graph's adjacency matrix (--pagerank); else "". */
+const char *cli_system_hint(const ulam_csr *M)
+{
+    int64_t n = M->nrows, big_diag = 0, diag = 0, heavy = 0;
+    int whole = 1;
+    for (int64_t i = 0; i < n; i++) {
+        double sum = 0.0;
+        for (int64_t k = M->rowptr[i]; k < M->rowptr[i + 1]; k++) {
+            double v = M->val[k];
+            if (M->colidx[k] == i) diag += v != 0.0, big_diag += fabs(v) >= 1.0;
+            whole &= v >= 0.0 && v == floor(v);
+            sum += fabs(v);
+        }
+        heavy += sum > 1.0;
+    }
+    if (n > 0 && 2 * big_diag >= n)
+        return " The diagonal is large (|M_ii| >= 1 in most rows): if the file holds A of A x = b, add --jacobi to "
+               "walk on M = I - D^-1 A.";
+    if (whole && !diag && heavy)
+        return " It looks like a graph's adjacency matrix (whole-number weights, empty diagonal): for PageRank add "
+               "--pagerank 0.85 (M = 0.85 P^T).";
+    return "";
 }
 
 /* Print a radius as "0.900000 (bounds [lo, hi], k iterations, s, converged or a bound)". */
@@ -51,7 +78,9 @@ void cli_guard_diverge(const cli_system *s, const ulam_guard *g, int force)
         fprintf(stderr, "ulam: %s: %s: rho(|M|) is in [%.6g, %.6g] after %d iterations: the bounds straddle 1, so "
                         "whether the walks converge is unknown, and unknown is treated as divergent. ",
                 s->matrix_path, kind, a->lower, a->upper, a->iterations);
-    fprintf(stderr, "Solve it with 'ulam direct'%s.%s\n",
+    const char *hint = s->jacobi || s->pagerank > 0 ? "" : cli_system_hint(s->M);
+    fprintf(stderr, "%s%s with 'ulam direct'%s.%s\n", hint[0] ? hint + 1 : "", hint[0] ? " Or solve M as it is" : "Solve it",
+            hint[0] ? "" :
             s->jacobi ? " (damping with --omega cannot help: rho(|I - w D^-1 A|) = 1 - w + w rho(|J|))"
                       : ", or if the file holds A of A x = b, try --jacobi",
             force ? " Running anyway (--force)." : " --force runs the walks anyway.");
@@ -60,7 +89,7 @@ void cli_guard_diverge(const cli_system *s, const ulam_guard *g, int force)
 /* Warnings for radii near or past 1 that do not stop the run. */
 void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assume_finite)
 {
-    if (g->verdict_abs == ULAM_VERDICT_EDGE)
+    if (g->verdict_abs == ULAM_VERDICT_EDGE && cli_verbosity > 0) /* nothing to do about it: --verbose */
         fprintf(stderr, "ulam: %s: warning: rho(|M|) is certified below 1 but not below 0.99 (bounds [%.6g, %.6g)): "
                         "walks may be long (mean length about 1 / (1 - rho))\n", s->matrix_path, g->abs.lower,
                 g->abs.upper);
@@ -79,7 +108,7 @@ void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assu
                 assume_finite ? "; --assume-finite-variance: the interval is printed anyway"
                               : ", so it is treated as infinite: no confidence interval (--assume-finite-variance "
                                 "prints one anyway)");
-    else if (g->verdict_hat[mode] == ULAM_VERDICT_EDGE)
+    else if (g->verdict_hat[mode] == ULAM_VERDICT_EDGE && cli_verbosity > 0)
         fprintf(stderr, "ulam: %s: warning: rho(M^) is certified below 1 but not below 0.99 (bounds [%.6g, %.6g)): "
                         "the variance is finite but may be huge, and the error bar converges slowly\n",
                 s->matrix_path, h->lower, h->upper);

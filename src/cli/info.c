@@ -8,7 +8,7 @@
 #include <string.h>
 
 static const char *const usage =
-    "usage: ulam info M.mtx [--jacobi [--omega W]] [--continue Q] [--alpha A] [--tol T] [--json]\n"
+    "usage: ulam info M.mtx [--jacobi [--omega W]] [--continue Q] [--kernel-exponent A] [--tol T] [--json]\n"
     "\n"
     "Describe the iteration matrix M of (I - M) x = b: size, nonzeros per row, signs,\n"
     "row sums of |M| (the continuation probabilities of an analog walk), and the guards:\n"
@@ -22,7 +22,7 @@ static const char *const usage =
     "               rho(M) and rho(|M|) for omega = 1, 0.9, ..., 0.5 (n <= 100000)\n"
     "  --omega W    damping of the Jacobi splitting (default 1)\n"
     "  --continue Q the kernel's fixed continuation probability (default: analog)\n"
-    "  --alpha A    the kernel's exponent, p_ij proportional to |M_ij|^A (default 1): the\n"
+    "  --kernel-exponent A  (was --alpha) the kernel's exponent, p_ij proportional to |M_ij|^A (default 1): the\n"
     "               rho(M^) are that kernel's\n"
     "  --tol T      relative residual tolerance of the rho(M) estimate\n"
     "  --json       print one JSON object\n";
@@ -157,12 +157,13 @@ int cli_info(int argc, char **argv)
         {"jacobi", no_argument, 0, 'j'}, {"omega", required_argument, 0, 'w'},
         {"tol", required_argument, 0, 't'}, {"json", no_argument, 0, 'J'},
         {"continue", required_argument, 0, 'q'}, {"help", no_argument, 0, 'h'},
-        {"alpha", required_argument, 0, 'a'},
+        {"alpha", required_argument, 0, 'a'},   {"kernel-exponent", required_argument, 0, 'K'},
         {0, 0, 0, 0}};
     cli_system s = {.command = "info", .omega = 1.0};
     ulam_spectral_opts so = ulam_spectral_defaults();
     double continue_q = 0.0, alpha = 1.0;
     int json = 0, c, rc;
+    if (cli_check_options("info", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
         switch (c) {
@@ -170,7 +171,11 @@ int cli_info(int argc, char **argv)
         case 'w': if ((rc = cli_parse_real("info", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 't': if ((rc = cli_parse_real("info", "--tol", optarg, 1e-14, 0.5, &so.tol))) return rc; break;
         case 'q': if ((rc = cli_parse_real("info", "--continue", optarg, 1e-9, 1 - 1e-12, &continue_q))) return rc; break;
-        case 'a': if ((rc = cli_parse_real("info", "--alpha", optarg, 0.0, 1000.0, &alpha))) return rc; break;
+        case 'a': /* fall through: the deprecated spelling */
+        case 'K':
+            if (c == 'a') fprintf(stderr, "ulam info: note: --alpha is deprecated: the kernel exponent is --kernel-exponent\n");
+            if ((rc = cli_parse_real("info", c == 'a' ? "--alpha" : "--kernel-exponent", optarg, 0.0, 1000.0, &alpha))) return rc;
+            break;
         case 'J': json = 1; break;
         case 'h': fputs(usage, stdout); return 0;
         default: return cli_usage_error("info", "unknown option");

@@ -7,18 +7,20 @@
 static const char *const usage =
     "usage: ulam <command> [options]   (ulam <command> --help for details)\n"
     "\n"
-    "Solve (I - M) x = b by von Neumann-Ulam random walks, checked against LAPACK.\n"
+    "Solve (I - M) x = b by von Neumann-Ulam random walks, with an error bar, checked by a direct solve.\n"
     "\n"
     "commands:\n"
     "  info     describe M: sizes, signs, spectral radii, convergence verdicts\n"
     "  solve    one unknown (adjoint) or all (forward) by random walks, with error bars\n"
-    "  direct   LAPACK dense reference solve\n"
+    "  direct   the reference solve: sparse LU (UMFPACK) or dense LU (LAPACK)\n"
     "  study    every method at every budget, repeated: accuracy against time, charts\n"
     "  radiosity  a patch scene (OBJ + MTL): one patch by ray-cast walks, or all, or LAPACK\n"
     "  prepare  write M, b and the guards' certificate as a file that queries map in place\n"
     "\n"
     "Matrices and vectors are Matrix Market files (or prepared systems).  Indices on the command line are\n"
-    "1-based, as in Matrix Market files (the C API is 0-based).\n";
+    "1-based, as in Matrix Market files (the C API is 0-based).  solve, direct, info and radiosity take\n"
+    "--json (one JSON object; {\"error\": ..., \"exit\": N} on failure); every command --quiet (-q) and\n"
+    "--verbose (-v).\n";
 
 /* Run the subcommand. */
 static int dispatch(int argc, char **argv)
@@ -54,7 +56,8 @@ int main(int argc, char **argv)
 #ifdef ULAM_MPI
     cli_mpi_init(&argc, &argv);
 #endif
-    int rc = dispatch(argc, argv);
+    cli_output_begin(&argc, argv);
+    int rc = cli_output_finish(dispatch(argc, argv));
 #ifdef ULAM_MPI
     fflush(stdout);
     cli_mpi_finalize();

@@ -35,12 +35,17 @@ static const char *const usage =
     "  --estimator E         of the forward walks (default expected)\n"
     "  --seed S              iteration l walks with a seed drawn from stream (S, l) (default 1):\n"
     "                        identical results for any --threads\n"
-    "  --out x.mtx           write the solution; --index I also prints x_I\n"
+    "  --out x.mtx           write the solution\n"
+    "  --index I             print x_I (with or without --out)\n"
     "  --check               also solve with LAPACK and report the relative error of x\n"
     "  --json                one JSON object with the history of every iteration\n"
     "  --jacobi, --omega, --continue, --max-steps, --threads, --force, --cache: as for walks\n"
     "\n"
-    "Each iteration prints its residual, its walks (histories) and its seconds.\n";
+    "A walk correction that does not lower the residual is rejected and its walks go on to more\n"
+    "histories; when the count its variance predicts is beyond 100x what --eps1 asked for (or\n"
+    "--max-histories), the run stops (exit 10 + ESTALL) saying so.  Walks whose variance is not\n"
+    "certified finite (rho(M^) >= 1) are refused before any walk (exit 10 + EINFVAR).\n"
+    "Each iteration prints its residual, its walks (histories, rejected ones too) and its seconds.\n";
 
 static const char *const method_names[] = {"richardson", "gauss-seidel", "sequential", "mcsa", "cg", "gmres"};
 enum { KRYLOV_CG = 4, KRYLOV_GMRES = 5 }; /* the Krylov peers: not outer iterations */
@@ -69,6 +74,8 @@ typedef struct {
     const double *x;
     double err_direct, direct_seconds, seconds;
     ulam_guard g;
+    ulam_error why; /* the library's sentence on how the run ended */
+    int rejected;   /* corrections rejected and redone with more histories */
 } report;
 
 /* Sum of the steps' histories and walk seconds. */
@@ -120,8 +127,8 @@ static void print_text(const report *p)
     printf("outcome         %s after %d iterations%s, residual %.4e\n", outcome(p), p->iterations,
            p->method >= KRYLOV_CG ? " (matrix-vector products)" : "", p->residual);
     if (walks)
-        printf("histories       %lld (%.4g per iteration), eps1 %g\n", (long long)hist,
-               p->nsteps ? (double)hist / p->nsteps : 0.0, p->o->eps1);
+        printf("histories       %lld (%.4g per iteration), eps1 %g, corrections rejected %d\n", (long long)hist,
+               p->nsteps ? (double)hist / p->nsteps : 0.0, p->o->eps1, p->rejected);
     printf("seconds         %.4f (walks %.4f)\n", p->seconds, walk_s);
     if (walks)
         printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", p->g.abs.rho,
@@ -148,6 +155,7 @@ static void print_json(const report *p)
     cli_json_number("eps1", p->o->eps1, 0);
     cli_json_number("residual", p->residual, 0);
     printf("\"histories\": %lld, ", (long long)hist);
+    if (walking(p->method)) printf("\"rejected\": %d, ", p->rejected);
     cli_json_number("seconds", p->seconds, 0);
     cli_json_number("walk_seconds", walk_s, 0);
     if (walking(p->method)) {
@@ -193,7 +201,9 @@ static int direct_error(const cli_system *s, const double *x, report *p)
 static void print_failure(const report *p)
 {
     double res = p->residual;
-    if (p->status == ULAM_ESTALL)
+    if (p->status == ULAM_ESTALL && strstr(p->why.msg, "lowers the residual"))
+        fprintf(stderr, "ulam: %s: error: %s: expected %s\n", p->s->matrix_path, ulam_strerror(p->status), p->why.msg);
+    else if (p->status == ULAM_ESTALL)
         fprintf(stderr, "ulam: %s: error: %s: the residual made no new low in the last %s iterations (now "
                         "%.3g after %d, tolerance %g): the corrections no longer reduce it (is rho(M^) < 1? a "
                         "smaller --eps1 walks more a correction)\n",
@@ -239,6 +249,8 @@ static int run(const cli_system *s, const ulam_outer_opts *o, report *p, ulam_ou
     p->iterations = p->nsteps;
     p->converged = ulam_outer_converged(it);
     p->residual = p->nsteps ? (*steps)[p->nsteps - 1].residual : 1.0;
+    ulam_outer_error(it, &p->why);
+    p->rejected = ulam_outer_rejected(it);
     *x = malloc((size_t)s->M->nrows * sizeof **x);
     if (*x) memcpy(*x, ulam_outer_x(it), (size_t)s->M->nrows * sizeof **x);
     ulam_outer_free(it);
@@ -270,7 +282,7 @@ int cli_solve_method(int argc, char **argv)
 {
     static const struct option longopts[] = {
         {"rhs", required_argument, 0, 'b'},     {"method", required_argument, 0, 'M'},
-        {"tol", required_argument, 0, 'l'},     {"max-iter", required_argument, 0, 'k'},
+        {"tol", required_argument, 0, 'l'},     {"rel-err", required_argument, 0, 'l'},     {"max-iter", required_argument, 0, 'k'},
         {"eps1", required_argument, 0, 'p'},    {"max-histories", required_argument, 0, 'H'},
         {"stall", required_argument, 0, 'a'},   CLI_WALK_OPTION("estimator"),
         CLI_WALK_OPTION("seed"),                CLI_WALK_OPTION("threads"),
@@ -287,6 +299,7 @@ int cli_solve_method(int argc, char **argv)
     const char *out = NULL;
     int64_t v;
     int c, rc, idx, force = 0;
+    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
@@ -294,8 +307,7 @@ int cli_solve_method(int argc, char **argv)
         case 'b': s.rhs_path = optarg; break;
         case 'M':
             if ((p.method = cli_lookup(optarg, method_names, 6)) < 0)
-                return cli_usage_error("solve", "--method expects auto, walks, bidirectional (with --source), mcsa, "
-                                                "sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
+                return cli_choose("solve", "--method", optarg, cli_method_names, CLI_NMETHODS, cli_method_words), EXIT_USAGE;
             if (p.method < KRYLOV_CG) o.method = p.method;
             break;
         case 'r':
@@ -338,9 +350,6 @@ int cli_solve_method(int argc, char **argv)
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
     if (!s.rhs_path) return cli_usage_error("solve", "needs --rhs b.mtx");
-    if (s.index && !out)
-        return cli_usage_error("solve", "--method solves for every unknown: --index I needs --out x.mtx "
-                                        "(the solution file) beside it");
     s.matrix_path = argv[optind];
     if (out && (rc = cli_check_output(out))) return rc;
     if ((rc = cli_load_system(&s))) return rc;

@@ -38,6 +38,7 @@ int cli_prepare(int argc, char **argv)
     const char *out = NULL;
     double continue_q = 0.0;
     int c, rc, transpose = 0;
+    if (cli_check_options("prepare", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "ho:", longopts, NULL)) != -1) {
         switch (c) {

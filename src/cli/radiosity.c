@@ -19,6 +19,7 @@ static const char *const usage =
     "                      [--image out.png] [--size WxH] [--exposure X] [--camera C]\n"
     "                      [--view-gather] [--coverage X]\n"
     "                      [--out patches.csv] [--all] [--list] [--json]\n"
+    "       ulam radiosity SCENE.obj --at x,y,z[,nx,ny,nz] ... [--grid C0:C1:S[:n]] [walk options]\n"
     "\n"
     "Radiosity B = E + diag(rho) F B of a scene of diffuse patches (Wavefront OBJ + MTL: Kd is\n"
     "the reflectance, Ke the emission), per RGB channel.\n"
@@ -30,9 +31,10 @@ static const char *const usage =
     "  --mode gather     walks from the patch that gather emission (default; needs --patch):\n"
     "                    one patch without forming F\n"
     "  --mode shoot      particles from the emitters, tallied on every patch (for --image)\n"
-    "  --estimator E     collision (score at every patch, default) or absorption (where it stops);\n"
-    "                    next-event (gathering by rays): at every patch a walk visits, one shadow\n"
-    "                    ray to a point on an emitter (drawn by power and area)\n"
+    "  --estimator E     next-event (gathering by rays and points, the default there): at every\n"
+    "                    patch or point a walk visits, one shadow ray to a point on an emitter\n"
+    "                    (drawn by power and area); collision (score at every patch; the default\n"
+    "                    for --mode shoot and --matrix-walk) or absorption (where it stops)\n"
     "  --mis H           next-event with the walk's own emitter hits by multiple importance\n"
     "                    sampling: power (default) or balance heuristic; none: light sampling\n"
     "                    alone (infinite variance at a patch sharing an edge with a light)\n"
@@ -47,11 +49,12 @@ static const char *const usage =
     "  --check           with --patch: also the direct solve, and z = (walk - direct) / stderr\n"
     "  --matrix-walk     walk on the assembled M (ulam solve's engine) instead of casting rays:\n"
     "                    walks and LAPACK then share the very same F\n"
-    "  --max-mem SIZE    refuse a direct solve needing more (default 4G)\n"
+    "  --max-mem SIZE    refuse, before any ray, a run whose estimate (ray tracer, F, dense\n"
+    "                    matrices, tallies, pictures) is more (default 4G)\n"
     "  --image out.png   render the shooting (or else direct) solution\n"
     "  --view-gather     with --image and --rel-err E: gather only the patches the camera sees,\n"
     "                    each to E (n_max / n)^X on every channel, n its pixels, n_max the most\n"
-    "                    any patch has (--estimator: next-event unless given; --walks: a cap\n"
+    "                    any patch has (--walks: a cap\n"
     "                    per patch, --time: for all)\n"
     "  --coverage X      that exponent, in [0, 1] (default 0.25, the fewest walks for a given\n"
     "                    pixel-summed squared error; 0: every seen patch to E)\n"
@@ -63,7 +66,37 @@ static const char *const usage =
     "  --out FILE.csv    every patch: number, label, face, centroid, area, R G B and standard\n"
     "                    errors (and the direct values with --check or --direct); needs --mode\n"
     "                    shoot or --direct\n"
+    ;
+
+/* The usage's third part. */
+static const char *const usage_mesh =
+    "  --samples N       jittered rays a pixel (default 4); the linear picture is written as PFM\n"
+    "                    beside the PNG (out.png -> out.pfm)\n"
+    "  --flat            one colour a patch (default: radiosity interpolated from the patch corners\n"
+    "                    across each face's patches, creases between faces kept)\n"
     "  --all             print every patch too (a table; with --json a patches array)\n"
+    "  --no-mesh-error   --patch: skip the mesh error (by default point queries on the continuous\n"
+    "                    surfaces at the patch's centroid and half way to each vertex, each to\n"
+    "                    twice --rel-err or with a quarter of --walks, print how far the patch's one value is\n"
+    "                    from the surface's, beside the Monte Carlo error, and warn when it\n"
+    "                    dominates)\n"
+    "  --mesh-error N    with --out or --all (--mode shoot or --direct): every patch's mesh error as\n"
+    "                    R_mesh G_mesh B_mesh columns, point queries of N walks each at the\n"
+    "                    patch's quadrature points (cost: up to 5 N walks a patch)\n";
+
+/* The usage's second half (a literal each stays within C99's 4095 characters). */
+static const char *const usage_points =
+    "  --at x,y,z        a point query on the continuous surfaces (no mesh in the answer): the\n"
+    "                    irradiance H arriving there and the radiosity B = E + rho H of the\n"
+    "                    surface it lies on, by walks from the point itself (next-event with MIS\n"
+    "                    at every vertex, Russian roulette); repeat for more points\n"
+    "  --at x,y,z,nx,ny,nz  a sensor facing (nx, ny, nz) anywhere (irradiance only off the surfaces)\n"
+    "  --grid x0,y0,z0:x1,y1,z1:S[:nx,ny,nz]  a sensor grid on a work plane: the rectangle with\n"
+    "                    opposite corners C0 and C1 (equal in one coordinate: the plane), cells\n"
+    "                    of about S, or S = NUxNV cells (the sensors at their centres), facing\n"
+    "                    + that axis or n;\n"
+    "                    irradiance per point with its error to --out CSV, a false-colour PNG with\n"
+    "                    a scale bar to --image; --walks and --rel-err per point, --time for all\n"
     "  --json            print one JSON object\n"
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
@@ -73,6 +106,12 @@ static const char *const est_names[] = {"collision", "absorption", "next-event"}
 static const char *const mis_names[] = {"power", "balance", "none"};
 static const char *const chan = "RGB";
 
+/* The JSON key of the answer (the radiosity), in one place so that it can be renamed. */
+static const char *const answer_key = "radiosity";
+
+/* Luminance weights of linear Rec. 709 RGB: the illuminance column of a grid. */
+static const double luma[3] = {0.2126, 0.7152, 0.0722};
+
 /* Everything the command was asked. */
 typedef struct {
     const char *scene, *patch, *image, *out;
@@ -81,6 +120,14 @@ typedef struct {
     int direct, check, matrix_walk, json, width, height, all, list;
     int est, mis; /* indices into est_names and mis_names (-1: not given) */
     int view;     /* --view-gather */
+    int no_mesh;  /* --no-mesh-error */
+    int samples, flat; /* --samples N jittered rays a pixel, --flat: one colour a patch */
+    char hdr[4096];    /* the PFM beside --image */
+    int64_t mesh_walks; /* --mesh-error N: every patch's mesh error in --out / --all, N walks a point */
+    double *at;   /* --at: 6 per point (the normal NaN when not given) */
+    int nat;
+    int grid;     /* --grid given: g holds it */
+    ulam_rad_grid g;
     double coverage;
     int camera_given; /* --camera: cam holds it */
     ulam_camera cam;
@@ -93,6 +140,7 @@ typedef struct {
     double B[3], se[3], se_walk[3]; /* se: with --matrix-walk, the walk's and F's noise combined */
     int64_t walks, steps, cut; /* cut: walks stopped at --max-steps */
     int64_t channel_walks[3]; /* --matrix-walk: each channel's walks (walks is their sum) */
+    int ff_limited[3];        /* --matrix-walk --rel-err: F's error alone is past the target */
     double seconds;
     int threads, interrupted;
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
@@ -127,6 +175,74 @@ static int parse_camera(const char *cmd, const char *arg, ulam_camera *cam)
                                 "apart from it, an up not along the view, fov in (0, 180) degrees), got '%s'", arg);
 }
 
+/* Parse n comma-separated finite numbers of s (n of them exactly); 0 or -1. */
+static int parse_numbers(const char *s, int n, double *x)
+{
+    for (int k = 0; k < n; k++) {
+        char *end;
+        x[k] = strtod(s, &end);
+        if (end == s || !isfinite(x[k]) || (k < n - 1 ? *end != ',' : *end != 0)) return -1;
+        s = end + (k < n - 1);
+    }
+    return 0;
+}
+
+/* Parse --at x,y,z[,nx,ny,nz] onto a's list. */
+static int parse_at(const char *cmd, const char *arg, args *a)
+{
+    double x[6];
+    int n = parse_numbers(arg, 6, x) == 0 ? 6 : parse_numbers(arg, 3, x) == 0 ? 3 : 0;
+    if (!n || (n == 6 && !(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] > 0)))
+        return cli_usage_error(cmd, "--at expects x,y,z or x,y,z,nx,ny,nz (finite, a nonzero normal), got '%s'", arg);
+    double *m = realloc(a->at, (size_t)(a->nat + 1) * 6 * sizeof *m);
+    if (!m) return cli_usage_error(cmd, "no memory for --at %s", arg);
+    a->at = m;
+    for (int k = 0; k < 6; k++) m[6 * a->nat + k] = k < n ? x[k] : NAN;
+    a->nat++;
+    return 0;
+}
+
+/* Parse --grid x0,y0,z0:x1,y1,z1:S[:nx,ny,nz]: corners equal in exactly one coordinate. */
+static int parse_grid(const char *cmd, const char *arg, ulam_rad_grid *g)
+{
+    char buf[512];
+    double c0[3], c1[3], S = 1.0, n[3];
+    char *part[4] = {0};
+    int np = 0;
+    if (strlen(arg) < sizeof buf) {
+        strcpy(buf, arg);
+        for (char *t = strtok(buf, ":"); t && np < 4; t = strtok(NULL, ":")) part[np++] = t;
+    }
+    int cu = 0, cv = 0, used = 0; /* S may be counts NUxNV instead of a spacing */
+    int counts = np >= 3 && sscanf(part[2], "%dx%d%n", &cu, &cv, &used) == 2 && !part[2][used];
+    int ok = (np == 3 || np == 4) && !parse_numbers(part[0], 3, c0) && !parse_numbers(part[1], 3, c1) &&
+             (counts ? cu >= 1 && cv >= 1 : !parse_numbers(part[2], 1, &S) && S > 0) &&
+             (np == 3 || !parse_numbers(part[3], 3, n));
+    int flat = -1, eq = 0;
+    for (int k = 0; ok && k < 3; k++)
+        if (c0[k] == c1[k]) flat = k, eq++;
+    if (!ok || eq != 1)
+        return cli_usage_error(cmd, "--grid expects x0,y0,z0:x1,y1,z1:S[:nx,ny,nz], opposite corners of a rectangle "
+                                    "equal in exactly one coordinate (its plane) and a spacing S > 0 or counts NUxNV, "
+                                    "got '%s'", arg);
+    int ax[2], m = 0;
+    for (int k = 0; k < 3; k++)
+        if (k != flat) ax[m++] = k;
+    memset(g, 0, sizeof *g);
+    for (int k = 0; k < 3; k++) g->origin[k] = c0[k];
+    g->u[ax[0]] = c1[ax[0]] - c0[ax[0]], g->v[ax[1]] = c1[ax[1]] - c0[ax[1]];
+    double nu = counts ? cu : fmax(1.0, round(fabs(g->u[ax[0]]) / S));
+    double nv = counts ? cv : fmax(1.0, round(fabs(g->v[ax[1]]) / S));
+    if (nu * nv > ULAM_RAD_GRID_MAX)
+        return cli_usage_error(cmd, "--grid %s makes %.0f x %.0f points, more than %d", arg, nu, nv, ULAM_RAD_GRID_MAX);
+    g->nu = (int)nu, g->nv = (int)nv;
+    double len = 0.0;
+    for (int k = 0; k < 3; k++) g->normal[k] = np == 4 ? n[k] : k == flat, len += g->normal[k] * g->normal[k];
+    if (!(len > 0)) return cli_usage_error(cmd, "--grid: the normal must not be zero, got '%s'", arg);
+    for (int k = 0; k < 3; k++) g->normal[k] /= sqrt(len);
+    return 0;
+}
+
 /* Parse the options into a; 0, or an exit code (with -1 meaning: --help printed). */
 static int parse(int argc, char **argv, args *a)
 {
@@ -144,10 +260,14 @@ static int parse(int argc, char **argv, args *a)
         {"out", required_argument, 0, 'o'},       {"all", no_argument, 0, 'A'},
         {"list", no_argument, 0, 'l'},            {"camera", required_argument, 0, 'C'},
         {"mis", required_argument, 0, 'H'},       {"view-gather", no_argument, 0, 'V'},
-        {"coverage", required_argument, 0, 'G'},
+        {"coverage", required_argument, 0, 'G'},  {"at", required_argument, 0, 'P'},
+        {"grid", required_argument, 0, 'R'},     {"no-mesh-error", no_argument, 0, 'N'},
+        {"mesh-error", required_argument, 0, 'W'},  {"samples", required_argument, 0, 'S'},
+        {"flat", no_argument, 0, 'F'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int c, rc, idx;
+    if (cli_check_options("radiosity", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
@@ -185,15 +305,36 @@ static int parse(int argc, char **argv, args *a)
         case 'A': a->all = 1; break;
         case 'l': a->list = 1; break;
         case 'C': if ((rc = parse_camera(cmd, optarg, &a->cam))) return rc; a->camera_given = 1; break;
-        case 'h': fputs(usage, stdout); return -1;
+        case 'N': a->no_mesh = 1; break;
+        case 'F': a->flat = 1; break;
+        case 'S': {
+            int64_t v;
+            if ((rc = cli_parse_int(cmd, "--samples", optarg, 1, 1024, &v))) return rc;
+            a->samples = (int)v;
+            break;
+        }
+        case 'W': if ((rc = cli_parse_int(cmd, "--mesh-error", optarg, 1, INT32_MAX, &a->mesh_walks))) return rc; break;
+        case 'P': if ((rc = parse_at(cmd, optarg, a))) return rc; break;
+        case 'R': if ((rc = parse_grid(cmd, optarg, &a->g))) return rc; a->grid = 1; break;
+        case 'h': fputs(usage, stdout), fputs(usage_mesh, stdout), fputs(usage_points, stdout); return -1;
         default: return cli_usage_error(cmd, "unknown option");
         }
     }
     if (optind != argc - 1) return cli_usage_error(cmd, "expects exactly one scene file");
     a->scene = argv[optind];
     if (a->list) return 0;
-    if (a->view && a->est < 0) a->est = 2; /* --view-gather: next-event unless told */
-    if (a->est < 0) a->est = 0;
+    if (a->nat || a->grid) {
+        if (a->patch || a->o.mode != ULAM_ADJOINT || a->direct || a->check || a->matrix_walk || a->view || a->all ||
+            (a->est >= 0 && a->est != 2 && a->est != 0) || ((a->out || a->image) && !a->grid))
+            return cli_usage_error(cmd, "--at and --grid are point queries by gathering walks (no --patch, --mode "
+                                        "shoot, --direct, --check, --matrix-walk, --view-gather, --all, --estimator "
+                                        "absorption; --out and --image with --grid)");
+        a->o.estimator = a->est == 0 ? ULAM_RAD_COLLISION : ULAM_RAD_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
+        if (a->mis >= 0 && a->est == 0) return cli_usage_error(cmd, "--mis needs --estimator next-event");
+        cli_walk_budget(&a->o);
+        return 0;
+    }
+    if (a->est < 0) a->est = a->o.mode == ULAM_FORWARD || a->matrix_walk ? 0 : 2; /* next-event where it applies */
     if (a->view && (!a->image || !(a->o.rel_err > 0) || a->o.mode != ULAM_ADJOINT || a->direct || a->matrix_walk ||
                     a->patch || a->check || a->out || a->all))
         return cli_usage_error(cmd, "--view-gather needs --image and --rel-err, and gathers by rays only (no --mode "
@@ -202,13 +343,16 @@ static int parse(int argc, char **argv, args *a)
     if (a->est == 2 && (a->o.mode != ULAM_ADJOINT || a->matrix_walk))
         return cli_usage_error(cmd, "--estimator next-event is for gathering by rays (not --mode shoot or "
                                     "--matrix-walk)");
-    a->o.estimator = a->est < 2 ? a->est : ULAM_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
+    /* matrix walks take ulam.h's enum, ray walks enum ulam_rad_estimator */
+    a->o.estimator = a->matrix_walk ? a->est : a->est == 0 ? ULAM_RAD_COLLISION : a->est == 1 ? ULAM_RAD_ABSORPTION
+                                                             : ULAM_RAD_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
     if ((a->out || a->all) && a->o.mode == ULAM_ADJOINT && !a->direct)
         return cli_usage_error(cmd, "%s needs --mode shoot or --direct (gathering answers one patch)",
                                a->out ? "--out" : "--all");
     if (!a->patch && a->o.mode == ULAM_ADJOINT && !a->direct && !a->view)
         return cli_usage_error(cmd, "needs --patch K (gathering answers one patch), --mode shoot or --direct");
     if (a->check && !a->patch) return cli_usage_error(cmd, "--check needs --patch K");
+    if (a->mesh_walks && !a->out && !a->all) return cli_usage_error(cmd, "--mesh-error N needs --out or --all");
     if (a->image && a->o.mode == ULAM_ADJOINT && !a->direct && !a->view)
         return cli_usage_error(cmd, "--image needs --mode shoot, --direct or --view-gather (gathering answers one "
                                     "patch)");
@@ -284,8 +428,23 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     return cli_exit_code(status);
 }
 
-/* Walks on the assembled M, one channel at a time; 0 or an exit code. */
-static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, walked *w)
+/* The stopping rule of --matrix-walk --rel-err E at a patch, in one place: the answer's error
+ * is the walks' and F's combined, so the walks stop at E' = sqrt(E^2 - (ff / |B|)^2) of the
+ * estimate, ff being F's standard error at the patch and B the direct solution there; 0 when
+ * F's error alone reaches E (more walks cannot meet it: more --ff-rays can); E when F's error
+ * is unknown (the error bar is then labelled conditional on F). */
+static double matrix_walk_rel_err(double E, double ff, double B, int ff_known)
+{
+    if (!(E > 0) || !ff_known) return E;
+    double f = B != 0 ? ff / fabs(B) : (ff > 0 ? INFINITY : 0.0);
+    return f < E ? sqrt(E * E - f * f) : 0.0;
+}
+
+/* Walks on the assembled M, one channel at a time (at a patch with --rel-err: to the combined
+ * rule of matrix_walk_rel_err, given F's error ff and the direct solution Bd there); 0 or an
+ * exit code. */
+static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, const double *ff, const double *Bd,
+                        walked *w)
 {
     int64_t n = s->npatches;
     double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x), *e = malloc((size_t)n * sizeof *e);
@@ -299,7 +458,15 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, w
     for (int c = 0; c < 3 && !status && !cli_interrupted; c++) {
         ulam_csr *M = NULL;
         ulam_solver *sv = NULL;
-        if ((status = ulam_rad_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &a->o, &sv, &err))) {
+        ulam_walk_opts o = a->o;
+        if (a->o.rel_err > 0 && a->o.mode == ULAM_ADJOINT) {
+            o.rel_err = matrix_walk_rel_err(a->o.rel_err, ff ? ff[c] : 0, Bd ? Bd[c] : 0, ff && Bd);
+            if (!(o.rel_err > 0)) { /* F's noise alone is past the target: walk to it, say it is not met */
+                w->ff_limited[c] = 1;
+                o.rel_err = a->o.rel_err;
+            }
+        }
+        if ((status = ulam_rad_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &o, &sv, &err))) {
             ulam_csr_free(M);
             break;
         }
@@ -341,6 +508,7 @@ static void json_triple(const char *key, const double *v)
  * answer beside walks. */
 typedef struct {
     const double *B, *se, *Bd, *sed;
+    const double *mesh; /* --mesh-error: every patch's mesh error (3 each), or NULL */
 } patch_values;
 
 enum { ROW_TEXT, ROW_CSV, ROW_JSON };
@@ -353,6 +521,7 @@ static void row_header(FILE *f, int fmt, const patch_values *v)
     for (int k = 0; k < 4; k++) fprintf(f, fmt == ROW_CSV ? ",%s" : " %12s", geo[k]);
     for (int k = 0; v && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",%s" : " %12s", val[k]);
     for (int k = 0; v && v->Bd && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",direct_%s" : " direct_%-5s", val[k]);
+    for (int k = 0; v && v->mesh && k < 3; k++) fprintf(f, fmt == ROW_CSV ? ",%s_mesh" : " %7s_mesh", val[k]);
     fputc('\n', f);
 }
 
@@ -361,21 +530,25 @@ static void row_header(FILE *f, int fmt, const patch_values *v)
 static void row(FILE *f, int fmt, const ulam_scene *s, int64_t p, const patch_values *v)
 {
     static const char *const keys[] = {"x", "y", "z", "area", "R", "G", "B", "R_se", "G_se", "B_se",
-                                       "direct_R", "direct_G", "direct_B", "direct_R_se", "direct_G_se", "direct_B_se"};
-    double x[16];
+                                       "direct_R", "direct_G", "direct_B", "direct_R_se", "direct_G_se", "direct_B_se",
+                                       "R_mesh", "G_mesh", "B_mesh"};
+    double x[19];
+    const char *key[19];
     int n = 4;
     ulam_scene_centroid(s, p, x);
     x[3] = s->area[p];
     const double *cols[4] = {v ? v->B : NULL, v ? v->se : NULL, v ? v->Bd : NULL, v ? v->sed : NULL};
+    for (int k = 0; k < 4; k++) key[k] = keys[k];
     for (int k = 0; v && k < (v->Bd ? 4 : 2); k++)
-        for (int c = 0; c < 3; c++) x[n++] = cols[k] ? cols[k][3 * p + c] : NAN;
+        for (int c = 0; c < 3; c++) key[n] = keys[n], x[n++] = cols[k] ? cols[k][3 * p + c] : NAN;
+    for (int c = 0; v && v->mesh && c < 3; c++) key[n] = keys[16 + c], x[n++] = v->mesh[3 * p + c];
     int32_t g = s->group[p];
     const char *label = g >= 0 ? s->groups[g] : "";
     if (fmt == ROW_JSON) {
         printf("{\"patch\": %lld, ", (long long)p + 1);
         cli_json_string("label", label, 0);
         printf("\"face\": %lld, ", (long long)s->face[p] + 1);
-        for (int k = 0; k < n; k++) cli_json_number(keys[k], x[k], k == n - 1);
+        for (int k = 0; k < n; k++) cli_json_number(key[k], x[k], k == n - 1);
         printf("}");
         return;
     }
@@ -441,6 +614,8 @@ typedef struct {
     const double *w_all_se_conditional; /* matrix forward walks whose se lack F's noise, or NULL */
     const walked *w;
     ulam_view_info view; /* --view-gather */
+    int mesh_known;      /* mesh holds the patch's mesh error (ray gathering at --patch) */
+    ulam_rad_mesh mesh;
 } report;
 
 /* (walk - direct) / the standard error of the difference at the patch, channel c: matrix walks
@@ -451,6 +626,32 @@ static double zscore(const args *a, const report *r, int c)
     double diff = r->w->B[c] - d, se = sqrt(sw * sw + sf * sf);
     if (se == 0) return diff == 0 ? 0.0 : copysign(INFINITY, diff); /* both exact: agree, or not at all */
     return diff / se;
+}
+
+/* Nonzero when the mesh error of channel c dominates the Monte Carlo error: larger than twice
+ * it, and real (more than 4 standard errors of the difference: the largest of up to 9). */
+static int mesh_dominates(const report *r, const walked *w, int c)
+{
+    double e = r->mesh.error[c], se = sqrt(w->se[c] * w->se[c] + r->mesh.error_se[c] * r->mesh.error_se[c]);
+    return e > 2 * w->se[c] && e > 4 * se;
+}
+
+/* The mesh error lines of the text report. */
+static void print_mesh(const report *r, const walked *w)
+{
+    int any = 0;
+    for (int c = 0; c < 3; c++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (int k = 0; k < r->mesh.npoints; k++) lo = fmin(lo, r->mesh.point[k][c]), hi = fmax(hi, r->mesh.point[k][c]);
+        printf("mesh error %c %.3g (Monte Carlo %.3g): the surface reads %.8g +- %.3g at the patch's centroid, "
+               "%.6g .. %.6g at its %d quadrature points\n", chan[c], r->mesh.error[c], w->se[c], r->mesh.point[0][c],
+               r->mesh.point_se[0][c], lo, hi, r->mesh.npoints);
+        any |= mesh_dominates(r, w, c);
+    }
+    if (any)
+        printf("warning      the mesh error dominates the Monte Carlo error: this patch's one value stands for a\n"
+               "             surface whose radiosity differs from it by more; ask --at a point (no mesh), or\n"
+               "             --subdivide finer\n");
 }
 
 /* Print the text report. */
@@ -486,12 +687,18 @@ static void print_text(const args *a, const report *r)
                    "             --rel-err can never be met by a zero estimate, so the walks stopped there; if the\n"
                    "             answer is not exactly 0, a walk scores with probability below 3/%lld = %.2g (95%%)\n",
                    (long long)w->walks, (long long)w->walks, 3.0 / (double)w->walks);
+        if (r->mesh_known) print_mesh(r, w);
     }
     if (w)
         printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)%s\n", (long long)w->walks,
                a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
+    for (int c = 0; w && a->matrix_walk && c < 3; c++)
+        if (w->ff_limited[c])
+            printf("rel-err      NOT met in %c: the form factors' error alone is %.3g, past --rel-err %g of the "
+                   "answer; more walks cannot meet it, more --ff-rays can (F's error falls as 1/sqrt(rays))\n",
+                   chan[c], r->direct_se[c], a->o.rel_err);
     if (w && a->matrix_walk)
         printf("             (one walk a channel: %lld R + %lld G + %lld B)\n", (long long)w->channel_walks[0],
                (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
@@ -544,8 +751,18 @@ static void print_json(const args *a, const report *r)
     const walked *w = r->w;
     if (w) {
         if (r->patch >= 0) {
-            json_triple("radiosity", w->B);
+            json_triple("estimate", w->B); /* the answer's key in every command */
+            json_triple(answer_key, w->B);
             json_triple("stderr", w->se);
+            if (r->mesh_known) {
+                int dom = 0;
+                for (int c = 0; c < 3; c++) dom |= mesh_dominates(r, w, c);
+                json_triple("mesh_error", r->mesh.error);
+                json_triple("mesh_error_stderr", r->mesh.error_se);
+                json_triple("surface_at_centroid", r->mesh.point[0]);
+                json_triple("surface_at_centroid_stderr", r->mesh.point_se[0]);
+                printf("\"mesh_error_dominates\": %s, ", dom ? "true" : "false");
+            }
             if (a->matrix_walk) {
                 json_triple("walk_stderr", w->se_walk);
                 if (r->ff_se_known) json_triple("ff_stderr", r->direct_se);
@@ -611,6 +828,199 @@ static void print_json(const args *a, const report *r)
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
 }
 
+/* One point's answer as text. */
+static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int interrupted)
+{
+    printf("point %-6d %.6g %.6g %.6g, normal %.4g %.4g %.4g", k + 1, r->x[0], r->x[1], r->x[2], r->n[0], r->n[1],
+           r->n[2]);
+    if (r->patch >= 0) {
+        int32_t g = s->group[r->patch];
+        printf(" (patch %lld, %s)\n", (long long)r->patch + 1, g >= 0 ? s->groups[g] : "unlabelled");
+    } else {
+        printf(" (a sensor on no surface)\n");
+    }
+    for (int c = 0; c < 3; c++) {
+        printf("  irradiance %c %.8g +- %.3g", chan[c], r->irradiance[c], r->irradiance_se[c]);
+        if (r->patch >= 0) printf("   radiosity %c %.8g +- %.3g", chan[c], r->radiosity[c], r->radiosity_se[c]);
+        printf("%s\n", interrupted ? "  [INTERRUPTED]" : "");
+    }
+    printf("  walks      %lld, %lld rays, %.4f s%s\n", (long long)r->run.walks, (long long)r->run.rays, r->run.seconds,
+           r->run.cut ? " (some walks cut at --max-steps: biased low)" : "");
+}
+
+/* One point's answer as a JSON object. */
+static void point_json(const ulam_rad_point *r)
+{
+    printf("{");
+    json_triple("x", r->x);
+    json_triple("normal", r->n);
+    printf("\"patch\": ");
+    if (r->patch >= 0) printf("%lld, ", (long long)r->patch + 1);
+    else printf("null, ");
+    json_triple("irradiance", r->irradiance);
+    json_triple("irradiance_stderr", r->irradiance_se);
+    json_triple(answer_key, r->radiosity); /* null off the surfaces */
+    json_triple("stderr", r->radiosity_se);
+    printf("\"walks\": %lld, \"rays\": %lld, \"cut\": %lld, ", (long long)r->run.walks, (long long)r->run.rays,
+           (long long)r->run.cut);
+    cli_json_number("seconds", r->run.seconds, 1);
+    printf("}");
+}
+
+/* The luminance-weighted irradiance (illuminance in the scene's units) of a point, and a bound
+ * on its standard error (the channels' added: they come from the same walks). */
+static void illuminance(const ulam_rad_point *r, double *Y, double *se)
+{
+    *Y = *se = 0.0;
+    for (int c = 0; c < 3; c++) *Y += luma[c] * r->irradiance[c], *se += luma[c] * r->irradiance_se[c];
+}
+
+/* --grid: the CSV (one row a sensor), atomically; 0 or an exit code. */
+static int write_grid_csv(const char *path, const ulam_rad_grid *g, const ulam_rad_point *pts)
+{
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (!status) {
+        fprintf(o.f, "i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks\n");
+        for (int j = 0; j < g->nv; j++)
+            for (int i = 0; i < g->nu; i++) {
+                const ulam_rad_point *r = &pts[(size_t)j * (size_t)g->nu + (size_t)i];
+                double Y, se;
+                illuminance(r, &Y, &se);
+                fprintf(o.f, "%d,%d,%.17g,%.17g,%.17g", i + 1, j + 1, r->x[0], r->x[1], r->x[2]);
+                for (int c = 0; c < 3; c++) fprintf(o.f, ",%.17g", r->irradiance[c]);
+                for (int c = 0; c < 3; c++) fprintf(o.f, ",%.17g", r->irradiance_se[c]);
+                fprintf(o.f, ",%.17g,%.17g,%lld\n", Y, se, (long long)r->run.walks);
+            }
+        status = ulam_outfile_commit(&o);
+    }
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable output file"};
+    return cli_report(path, &err);
+}
+
+/* --grid --image: the false-colour picture of the illuminance, 0 to the largest; 0 or an exit code. */
+static int write_grid_png(const char *path, const ulam_rad_grid *g, const ulam_rad_point *pts, double *hi)
+{
+    size_t n = (size_t)g->nu * (size_t)g->nv;
+    double *Y = malloc(n * sizeof *Y), se;
+    /* cells in the grid's proportions, the longer side of the picture 480 pixels */
+    double lu = sqrt(g->u[0] * g->u[0] + g->u[1] * g->u[1] + g->u[2] * g->u[2]) / g->nu;
+    double lv = sqrt(g->v[0] * g->v[0] + g->v[1] * g->v[1] + g->v[2] * g->v[2]) / g->nv;
+    double scale = 480.0 / fmax(lu * g->nu, lv * g->nv);
+    int cw = (int)fmax(2.0, round(lu * scale)), ch = (int)fmax(2.0, round(lv * scale)), w, h;
+    int status = Y ? ULAM_OK : ULAM_ENOMEM;
+    *hi = 0.0;
+    for (size_t k = 0; Y && k < n; k++) {
+        illuminance(&pts[k], &Y[k], &se);
+        *hi = fmax(*hi, Y[k]);
+    }
+    if (!(*hi > 0)) *hi = 1.0;
+    ulam_falsecolour_size(g->nu, g->nv, cw, ch, &w, &h);
+    unsigned char *rgb = Y ? malloc((size_t)w * (size_t)h * 3) : NULL;
+    if (!status) status = rgb ? ulam_falsecolour(Y, g->nu, g->nv, cw, ch, 0.0, *hi, rgb) : ULAM_ENOMEM;
+    if (!status) status = ulam_png_write(path, w, h, rgb);
+    free(Y), free(rgb);
+    if (!status) return 0;
+    ulam_error err = {.status = status, .msg = "a writable PNG file"};
+    return cli_report(path, &err);
+}
+
+/* --at and --grid: point queries; 0 or an exit code. */
+static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
+{
+    int64_t ngrid = a->grid ? (int64_t)a->g.nu * a->g.nv : 0, n = a->nat + ngrid;
+    ulam_rad_point *pts = calloc((size_t)n, sizeof *pts);
+    ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the points"};
+    if (!pts) return cli_report(a->scene, &err);
+    int rc = 0, interrupted = 0;
+    double t0 = ulam_now();
+    cli_catch_sigint();
+    for (int k = 0; k < a->nat && !interrupted; k++) {
+        ulam_walk_opts o = a->o;
+        o.seed = a->o.seed + (uint64_t)k; /* each point its own walks */
+        const double *x = a->at + 6 * k;
+        if (ulam_rad_point_query(t, &o, x, isnan(x[3]) ? NULL : x + 3, &pts[k], &err)) {
+            fprintf(stderr, "ulam radiosity: --at %g,%g,%g: %s: %s\n", x[0], x[1], x[2], ulam_strerror(err.status),
+                    err.msg);
+            rc = err.status == ULAM_EINVAL ? EXIT_USAGE : cli_exit_code(err.status); /* the point itself */
+            goto done;
+        }
+        interrupted = pts[k].run.interrupted;
+    }
+    if (ngrid && !interrupted) {
+        if (ulam_rad_grid_solve(t, &a->o, &a->g, pts + a->nat, &err)) {
+            rc = cli_report(a->scene, &err);
+            goto done;
+        }
+        for (int64_t k = a->nat; k < n; k++) interrupted |= pts[k].run.interrupted || !pts[k].run.walks;
+    }
+    double seconds = ulam_now() - t0, hi = 0.0;
+    cli_release_sigint();
+    if (ngrid && !interrupted && a->out && (rc = write_grid_csv(a->out, &a->g, pts + a->nat))) goto done;
+    if (ngrid && !interrupted && a->image && (rc = write_grid_png(a->image, &a->g, pts + a->nat, &hi))) goto done;
+    double Ymin = INFINITY, Ysum = 0.0, worst = 0.0;
+    int64_t walks = 0, rays = 0;
+    for (int64_t k = 0; k < n; k++) {
+        walks += pts[k].run.walks, rays += pts[k].run.rays;
+        if (k < a->nat) continue;
+        double Y, se;
+        illuminance(&pts[k], &Y, &se);
+        Ymin = fmin(Ymin, Y), Ysum += Y;
+        if (Y > 0) worst = fmax(worst, se / Y);
+    }
+    if (a->json) {
+        printf("{");
+        cli_json_string("scene", a->scene, 0);
+        printf("\"points\": [");
+        for (int k = 0; k < a->nat; k++) {
+            if (k) printf(", ");
+            point_json(&pts[k]);
+        }
+        printf("], ");
+        if (ngrid) {
+            printf("\"grid\": {\"nu\": %d, \"nv\": %d, ", a->g.nu, a->g.nv);
+            json_triple("origin", a->g.origin), json_triple("u", a->g.u), json_triple("v", a->g.v);
+            json_triple("normal", a->g.normal);
+            cli_json_number("illuminance_min", Ymin, 0);
+            cli_json_number("illuminance_mean", Ysum / (double)ngrid, 0);
+            cli_json_number("uniformity", Ysum > 0 ? Ymin / (Ysum / (double)ngrid) : NAN, 0);
+            cli_json_number("worst_rel_stderr_bound", worst, 0);
+            if (a->out) cli_json_string("out", interrupted ? "" : a->out, 0);
+            if (a->image) cli_json_string("image", interrupted ? "" : a->image, 0);
+            printf("\"points\": [");
+            for (int64_t k = a->nat; k < n; k++) {
+                if (k > a->nat) printf(", ");
+                point_json(&pts[k]);
+            }
+            printf("]}, ");
+        }
+        cli_json_string("estimator", a->o.estimator == ULAM_RAD_COLLISION ? "collision" : "next-event", 0);
+        printf("\"walks\": %lld, \"rays\": %lld, \"interrupted\": %s, ", (long long)walks, (long long)rays,
+               interrupted ? "true" : "false");
+        cli_json_number("seconds", seconds, 0);
+        printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
+    } else {
+        printf("scene        %s: %lld patches\n", a->scene, (long long)s->npatches);
+        for (int k = 0; k < a->nat; k++) point_text(s, k, &pts[k], pts[k].run.interrupted);
+        if (ngrid)
+            printf("grid         %d x %d sensors facing %.4g %.4g %.4g: illuminance (0.2126 R + 0.7152 G + 0.0722 B)\n"
+                   "             min %.6g, mean %.6g, uniformity min/mean %.4f; worst relative error <= %.3g\n",
+                   a->g.nu, a->g.nv, a->g.normal[0], a->g.normal[1], a->g.normal[2], Ymin, Ysum / (double)ngrid,
+                   Ysum > 0 ? Ymin / (Ysum / (double)ngrid) : NAN, worst);
+        if (ngrid && a->out && !interrupted) printf("grid csv     %s\n", a->out);
+        if (ngrid && a->image && !interrupted) printf("grid image   %s (false colour, 0 .. %.4g)\n", a->image, hi);
+        printf("walks        %lld point walks (%s), %lld rays, %.4f s%s\n", (long long)walks,
+               a->o.estimator == ULAM_RAD_COLLISION ? "collision" : "next-event with MIS", (long long)rays, seconds,
+               interrupted ? "  [INTERRUPTED]" : "");
+    }
+    if (interrupted) rc = EXIT_INTERRUPTED;
+done:
+    cli_release_sigint();
+    free(pts);
+    return rc;
+}
+
 /* The camera asked for, or the one framing the scene. */
 static ulam_camera camera_of(const args *a, const ulam_scene *s)
 {
@@ -637,20 +1047,56 @@ static int view_walks(const args *a, const ulam_tracer *t, const ulam_scene *s, 
     return 0;
 }
 
-/* Render B into a->image, warning when the picture cannot show the light; 0 or an exit code. */
-static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s, const double *B, double *used)
+/* Warn when the picture's patches are noisy: the pixel-weighted mean, over the pixels that see a
+ * patch, of its largest relative standard error over the lit channels, above 5%. */
+static void noise_warning(const args *a, const ulam_tracer *t, const ulam_scene *s, const ulam_camera *cam,
+                          const double *B, const double *se)
 {
-    unsigned char *rgb = malloc((size_t)a->width * (size_t)a->height * 3);
+    int64_t *pix = malloc((size_t)s->npatches * sizeof *pix), seen = 0;
+    if (!pix || ulam_view_pixels(t, cam, a->width, a->height, pix)) {
+        free(pix);
+        return;
+    }
+    double sum = 0.0, n = 0.0;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        if (!pix[p]) continue;
+        double rel = 0.0;
+        for (int c = 0; c < 3; c++)
+            if (B[3 * p + c] > 0) rel = fmax(rel, se[3 * p + c] / B[3 * p + c]);
+        sum += (double)pix[p] * rel, n += (double)pix[p], seen++;
+    }
+    free(pix);
+    if (n > 0 && sum / n > 0.05 && cli_rank == 0)
+        fprintf(stderr, "ulam radiosity: warning: %s: the %lld patches in view carry %.0f%% relative error (pixel-weighted "
+                        "mean): the picture will be salt-and-pepper noise; more --walks (the error falls as "
+                        "1/sqrt(walks)), or --view-gather --rel-err\n", a->image, (long long)seen, 100.0 * sum / n);
+}
+
+/* Render B into a->image, warning when the picture cannot show the light; 0 or an exit code. */
+static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s, const double *B, const double *se,
+                       double *used)
+{
+    size_t np = (size_t)a->width * (size_t)a->height;
+    unsigned char *rgb = malloc(np * 3);
+    float *hdr = malloc(np * 3 * sizeof *hdr);
     ulam_camera cam = camera_of(a, s);
     ulam_render_info info;
-    int status = rgb ? ulam_render(t, B, &cam, a->width, a->height, a->exposure, rgb, &info) : ULAM_ENOMEM;
+    int status = rgb && hdr ? ulam_render_hdr(t, B, &cam, a->width, a->height, a->samples, !a->flat, a->o.seed,
+                                              a->exposure, hdr, rgb, &info)
+                            : ULAM_ENOMEM;
     if (!status) status = ulam_png_write(a->image, a->width, a->height, rgb);
-    free(rgb);
+    if (!status && (status = ulam_pfm_write(a->hdr, a->width, a->height, hdr))) {
+        free(rgb), free(hdr);
+        ulam_error err = {.status = status, .msg = "a writable PFM file"};
+        return cli_report(a->hdr, &err);
+    }
+    free(rgb), free(hdr);
     if (status) {
         ulam_error err = {.status = status, .msg = "a writable PNG file"};
         return cli_report(a->image, &err);
     }
     *used = info.exposure;
+    if (se) noise_warning(a, t, s, &cam, B, se);
     if (!info.pixels_hit)
         fprintf(stderr, "ulam radiosity: warning: %s: the camera sees no patch's front (try --camera)\n", a->image);
     else if (!info.pixels_emitter)
@@ -666,7 +1112,21 @@ static int load_scene(const args *a, ulam_scene **out, int64_t *faces)
 {
     ulam_error err;
     ulam_scene *s = NULL;
-    if (ulam_scene_read_obj(a->scene, &s, &err)) return cli_report(a->scene, &err);
+    ulam_mtl_note *notes = NULL;
+    int64_t nnotes = 0;
+    if (ulam_scene_read_obj_notes(a->scene, &s, &notes, &nnotes, &err)) return cli_report(a->scene, &err);
+    for (int64_t i = 0; i < nnotes && cli_rank == 0; i++) { /* one warning a material */
+        int first = 1;
+        for (int64_t k = 0; k < i && first; k++) first = strcmp(notes[k].material, notes[i].material) != 0;
+        if (!first) continue;
+        fprintf(stderr, "ulam radiosity: warning: %s: material '%s' is rendered matte (Kd, Ke): ignored", notes[i].file,
+                notes[i].material);
+        for (int64_t k = i; k < nnotes; k++)
+            if (!strcmp(notes[k].material, notes[i].material))
+                fprintf(stderr, "%s %s (%s:%ld)", k == i ? "" : ",", notes[k].keyword, notes[k].file, notes[k].line);
+        fprintf(stderr, "\n");
+    }
+    ulam_mtl_notes_free(notes, nnotes);
     *faces = s->nfaces;
     if (a->subdivide > 0) {
         ulam_scene *d = NULL;
@@ -739,30 +1199,99 @@ static void combine_errors(report *r, walked *w)
 /* The values of every patch for --out and --all. */
 static patch_values every_patch(const args *a, const report *r, const walked *w, const double *Bd)
 {
-    if (w->all) return (patch_values){w->all, w->all_se, (a->direct || a->check) ? Bd : NULL, r->direct_se_all};
-    return (patch_values){Bd, r->direct_se_all, NULL, NULL};
+    if (w->all) return (patch_values){w->all, w->all_se, (a->direct || a->check) ? Bd : NULL, r->direct_se_all, NULL};
+    return (patch_values){Bd, r->direct_se_all, NULL, NULL, NULL};
+}
+
+/* Bytes as GiB, MiB or KiB for a message. */
+static void human(double b, char *out, size_t len)
+{
+    const char *u[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+    int k = 0;
+    while (b >= 1024 && k < 4) b /= 1024, k++;
+    snprintf(out, len, k ? "%.3g %s" : "%.0f %s", b, u[k]);
+}
+
+/* What the run will hold at once, estimated from the scene and the options before any ray is
+ * cast: the ray tracer (Embree's structure, about 200 bytes a triangle), F (12 bytes a nonzero,
+ * at most npatches x min(ff rays, npatches); a matrix walk adds each channel's M and kernel),
+ * the dense LAPACK solve (ulam_direct_bytes; twice for every patch's error bar), shooting's
+ * tallies, pictures and grids.  *what gets the breakdown. */
+static double need_bytes(const args *a, const ulam_scene *s, char *what, size_t len)
+{
+    double n = (double)s->npatches, tri = (double)(s->start[s->npatches] - 2 * s->npatches);
+    double tracer = 208.0 * tri + 16.0 * (double)s->nverts, ff = 0, dense = 0, walks = 0, pic = 0;
+    int threads = a->o.threads > 0 ? a->o.threads : 2;
+    int forms = (a->direct || a->check || a->matrix_walk) && !a->nat && !a->grid;
+    if (forms) ff = 12.0 * n * fmin((double)a->ff_rays, n) + 8.0 * (n + 1);
+    if (forms && a->matrix_walk) ff *= 3; /* F, one channel's M and the walk's kernel rows */
+    if (forms && (a->direct || a->check)) dense = (double)ulam_direct_bytes(s->npatches);
+    if (forms && (a->direct || a->check) && (a->out || a->all)) dense *= 2; /* every patch's error: G whole */
+    if (a->o.mode == ULAM_FORWARD) walks = n * (48.0 + 29.0 * threads) + 32.0 * 256 * 32 * 64;
+    if (a->image) pic = (double)a->width * a->height * 11.0 + (a->view ? 8.0 * n : 0.0);
+    if (a->nat || a->grid) walks = (double)(a->nat + (a->grid ? (int64_t)a->g.nu * a->g.nv : 0)) * sizeof(ulam_rad_point);
+    char h[5][32];
+    human(tracer, h[0], 32), human(ff, h[1], 32), human(dense, h[2], 32), human(walks, h[3], 32), human(pic, h[4], 32);
+    snprintf(what, len, "ray tracer %s (%.0f triangles), form factors %s (%.0f patches x %lld rays), dense "
+                        "matrices %s, walks %s, pictures %s", h[0], tri, h[1], n, (long long)a->ff_rays, h[2], h[3], h[4]);
+    return tracer + ff + dense + walks + pic;
+}
+
+/* --mesh-error N: every patch's mesh error against pv->B into a new *out (3 a patch); 0 or an
+ * exit code. */
+static int every_mesh_error(const args *a, const ulam_tracer *t, const ulam_scene *s, patch_values *pv, double **out)
+{
+    ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the mesh errors"};
+    if (!(*out = malloc((size_t)s->npatches * 3 * sizeof **out))) return cli_report(a->scene, &err);
+    ulam_walk_opts o = a->o;
+    o.mode = ULAM_ADJOINT, o.estimator = ULAM_RAD_NEXT_EVENT, o.rel_err = 0, o.max_seconds = 0;
+    o.max_walks = a->mesh_walks;
+    cli_catch_sigint();
+    for (int64_t p = 0; p < s->npatches; p++) {
+        ulam_rad_mesh m;
+        o.index = p, o.seed = a->o.seed + (uint64_t)p;
+        if (ulam_rad_mesh_error(t, &o, pv->B + 3 * p, &m, &err)) {
+            cli_release_sigint();
+            return cli_report(a->scene, &err);
+        }
+        for (int c = 0; c < 3; c++) (*out)[3 * p + c] = m.interrupted ? NAN : m.error[c];
+    }
+    cli_release_sigint();
+    pv->mesh = *out;
+    return 0;
 }
 
 /* ulam radiosity. */
 int cli_radiosity(int argc, char **argv)
 {
-    args a = {.est = -1, .mis = -1, .coverage = 0.25, .ff_rays = 1000, .width = 512, .height = 512, .max_mem = CLI_MAX_MEM, .o = ulam_walk_defaults()};
+    args a = {.est = -1, .mis = -1, .samples = 4, .coverage = 0.25, .ff_rays = 1000, .width = 512, .height = 512, .max_mem = CLI_MAX_MEM, .o = ulam_walk_defaults()};
     a.o.max_walks = 0;
     a.o.interrupt = &cli_interrupted, a.o.share = cli_share;
     int rc = parse(argc, argv, &a);
-    if (rc) return rc < 0 ? 0 : rc;
+    if (rc) {
+        free(a.at);
+        return rc < 0 ? 0 : rc;
+    }
     ulam_scene *s = NULL;
     ulam_tracer *t = NULL;
     ulam_csr *F = NULL;
     double *Bd = NULL;
     walked w = {0};
     report r = {.patch = -1, .w = NULL};
+    double *mesh_all = NULL;
     ulam_error err;
     if (a.est == 2 && a.mis == 2 && cli_rank == 0)
         fprintf(stderr, "ulam radiosity: warning: --mis none (light sampling alone) has infinite variance at a patch "
                         "that shares an edge with a light or nearly touches one: there the error bar can be far too "
                         "small (the edge-lamp scene: z = -4.6); the MIS default is bounded\n");
+    if (a.image) { /* the PFM beside the PNG: out.png -> out.pfm */
+        size_t len = strlen(a.image);
+        int png = len > 4 && !strcmp(a.image + len - 4, ".png");
+        if (len + 5 > sizeof a.hdr) return cli_usage_error("radiosity", "--image: a path shorter than 4 KiB");
+        snprintf(a.hdr, sizeof a.hdr, "%.*s.pfm", (int)(png ? len - 4 : len), a.image);
+    }
     if (a.image && (rc = cli_check_output(a.image))) return rc;
+    if (a.image && !a.grid && (rc = cli_check_output(a.hdr))) return rc;
     if (a.out && (rc = cli_check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
     r.s = s;
@@ -771,6 +1300,18 @@ int cli_radiosity(int argc, char **argv)
         goto done;
     }
     if (a.patch && (rc = find_patch(s, a.patch, &r.patch))) goto done;
+    {
+        char what[512], h[2][32];
+        double need = need_bytes(&a, s, what, sizeof what);
+        if (need > (double)a.max_mem) { /* refused before the first ray */
+            human(need, h[0], 32), human((double)a.max_mem, h[1], 32);
+            fprintf(stderr, "ulam radiosity: %s: memory limit: this run needs about %s, more than --max-mem %s (%s); refused before "
+                            "any work: raise --max-mem, or ask less (--patch or --at walks need no F)\n",
+                    a.scene, h[0], h[1], what);
+            rc = cli_exit_code(ULAM_EMEMLIMIT);
+            goto done;
+        }
+    }
     a.o.index = r.patch >= 0 ? r.patch : 0;
     if (ulam_tracer_alloc(s, &t, &err)) {
         rc = cli_report(a.scene, &err);
@@ -782,30 +1323,50 @@ int cli_radiosity(int argc, char **argv)
         fprintf(stderr, "ulam radiosity: warning: %s: patch %lld is only %.0f float steps across where it lies: ray "
                         "casting resolves it to %.2g of its size (move the scene's parts closer together)\n",
                 a.scene, (long long)coarse + 1, 1.0 / res, res);
+    if (a.nat || a.grid) {
+        rc = run_points(&a, t, s);
+        goto done;
+    }
     if ((a.direct || a.check || a.matrix_walk) && (rc = form_and_solve(&a, t, s, &r, &F, &Bd))) goto done;
     if (a.view) {
         if ((rc = view_walks(&a, t, s, &w, &r.view))) goto done;
         r.w = &w;
     } else if (a.patch || a.o.mode == ULAM_FORWARD) {
-        rc = a.matrix_walk ? matrix_walks(&a, s, F, &w) : ray_walks(&a, t, s->npatches, &w);
+        rc = a.matrix_walk ? matrix_walks(&a, s, F, r.ff_se_known ? r.direct_se : NULL,
+                                          Bd && r.patch >= 0 ? Bd + 3 * r.patch : NULL, &w)
+                           : ray_walks(&a, t, s->npatches, &w);
         if (rc) goto done;
+        if (a.patch && a.o.mode == ULAM_ADJOINT && !w.interrupted && !a.no_mesh) { /* the mesh's error beside */
+            ulam_walk_opts mo = a.o; /* each point to twice the patch's relative error or 1/4 its walks (>= 256) */
+            mo.index = r.patch, mo.estimator = ULAM_RAD_NEXT_EVENT, mo.rel_err = 2 * a.o.rel_err;
+            if (a.o.max_walks > 0) mo.max_walks = a.o.max_walks / 4 > 256 ? a.o.max_walks / 4 : 256;
+            cli_catch_sigint();
+            int st = ulam_rad_mesh_error(t, &mo, w.B, &r.mesh, &err);
+            cli_release_sigint();
+            if (st) {
+                rc = cli_report(a.scene, &err);
+                goto done;
+            }
+            r.mesh_known = !r.mesh.interrupted;
+        }
         if (a.matrix_walk) combine_errors(&r, &w);
         r.w = &w;
     }
     r.pv = every_patch(&a, &r, &w, Bd);
+    if (a.mesh_walks && r.pv.B && !w.interrupted && (rc = every_mesh_error(&a, t, s, &r.pv, &mesh_all))) goto done;
     if (a.out && !w.interrupted && cli_rank == 0) {
         if ((rc = write_csv(a.out, s, &r.pv))) goto done;
         r.out_written = 1;
     }
     if (a.image && !w.interrupted && cli_rank == 0) {
-        if ((rc = write_image(&a, t, s, w.all ? w.all : Bd, &r.exposure))) goto done;
+        if ((rc = write_image(&a, t, s, w.all ? w.all : Bd, w.all ? w.all_se : NULL, &r.exposure))) goto done;
         r.image_written = 1;
     }
     if (a.json) print_json(&a, &r);
     else print_text(&a, &r);
     if (w.interrupted) rc = EXIT_INTERRUPTED;
 done:
-    free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all);
+    free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all), free(a.at), free(mesh_all);
     ulam_csr_free(F);
     ulam_tracer_free(t);
     ulam_scene_free(s);

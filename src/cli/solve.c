@@ -7,13 +7,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char *const usage =
     "usage: ulam solve M.mtx --rhs b.mtx --index I [--mode adjoint|forward]\n"
     "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"
-    "                  [--time S] [--seed S] [--threads T] [--continue Q] [--alpha A]\n"
+    "                  [--time S] [--seed S] [--threads T] [--continue Q] [--kernel-exponent A]\n"
     "                  [--roulette W] [--split W] [--max-steps K] [--jacobi [--omega W]] [--check]\n"
-    "                  [--json]\n"
+    "                  [--json] [--quiet | --verbose] [--pagerank ALPHA]\n"
     "                  [--out x.mtx] [--errors e.mtx] [--force] [--assume-finite-variance]\n"
     "                  [--cache] [--whole-kernel]\n"
     "                  [--method auto]\n"
@@ -31,7 +32,7 @@ static const char *const usage =
     "  --estimator E      collision (score at every visit, default), absorption (score where\n"
     "                     the walk ends, / p*), expected (score the exact next-step expectation)\n"
     "  --walks N          stop after N walks (default 100000 when no rule is given)\n"
-    "  --rel-err E        stop once stderr / |estimate| <= E, and only once enough walks have run\n"
+    "  --rel-err E        (or --tol E) stop once stderr / |estimate| <= E, and only once enough walks have run\n"
     "                     for the error bar to be trusted (README: 'When to trust the error\n"
     "                     bar'); it watches x_I (--index, default 1 in forward mode) and never\n"
     "                     stops while no walk has reached it; refused (exit 4) when the variance\n"
@@ -44,7 +45,7 @@ static const char *const usage2 = /* the help in three strings: C99 promises 409
     "  --continue Q       continue with probability Q in every state (analog, the default:\n"
     "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased;\n"
     "                     --continue analog names the default (pins it for --method auto)\n"
-    "  --alpha A          kernel exponent: move to j with probability proportional to\n"
+    "  --kernel-exponent A  (was --alpha) move to j with probability proportional to\n"
     "                     |M_ij|^A over the row's nonzeros (default 1, |M_ij| / S_i; 0 uniform,\n"
     "                     2 Alea's); rho(M^) and the error bar are this kernel's\n"
     "  --roulette W       Russian roulette below weight W (survive with |w|/W, weight W; default off)\n"
@@ -52,9 +53,10 @@ static const char *const usage2 = /* the help in three strings: C99 promises 409
     "  --max-steps K      cut walks longer than K steps and count them (default 1000000)\n"
     "  --jacobi           the file holds A of A x = b; walk on M = I - omega D^-1 A\n"
     "  --omega W          damping of the Jacobi splitting (default 1)\n"
-    "  --check            also solve with LAPACK: adds direct, direct_seconds and\n"
-    "                     z = (estimate - direct) / stderr\n"
-    "  --json             print one JSON object\n"
+    "  --check            after printing the estimate, solve directly (sparse LU above n = 1000,\n"
+    "                     dense below, GMRES past 4 GiB; its needs said first when large; Ctrl-C\n"
+    "                     keeps the estimate): adds direct and z = (estimate - direct) / stderr\n"
+    "  --json             print one JSON object ({\"error\": ..., \"exit\": N} on failure)\n"
     "  --force            walk even when rho(|M|) is not certified below 1 (otherwise refused\n"
     "                     with exit 3)\n"
     "  --assume-finite-variance  print a confidence interval when the guards cannot tell\n"
@@ -62,6 +64,11 @@ static const char *const usage2 = /* the help in three strings: C99 promises 409
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
     "                     that instead of parsing while the file is unchanged (its XXH3 hash)\n";
 static const char *const usage3 =
+    "  --pagerank ALPHA   (or --damping) the file is a graph's adjacency matrix (edge i -> j);\n"
+    "                     walk on M = ALPHA P^T, P = D^-1 adjacency: x_I is node I's PageRank\n"
+    "                     (b = (1 - ALPHA) / n unless --rhs; a dangling node's rank leaks)\n"
+    "  --quiet, -q        print the answer line alone\n"
+    "  --verbose, -v      print everything: the candidates, the radii, the tail bound, timings\n"
     "  --method auto      (default) choose mode, estimator, continuation and --alpha among\n"
     "                     the candidates the guards certify, by pilots compared on a fixed\n"
     "                     work model (the same choice on every run); what is given stays\n"
@@ -95,6 +102,8 @@ typedef struct {
     double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the solver set-up */
     const ulam_auto_result *au; /* --method auto: the candidates and the choice (else NULL) */
     const cli_bidir_cand *bc;   /* --method auto: bidirectional as a candidate (else NULL) */
+    double t_start;             /* when the command started (ulam_now) */
+    const char *direct_method;  /* --check: "dense LU", "sparse LU" or "interrupted" */
 } report_opts;
 
 /* Peak resident memory of this process so far, in MiB. */
@@ -104,11 +113,9 @@ static double peak_rss_mib(void)
     return getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
 }
 
-/* Print the human-readable block. */
-static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
+/* Print the answer line: x[I] with its interval, or why there is none. */
+static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 {
-    double mean_len = r->walks ? (double)r->steps / (double)r->walks : 0.0;
-    double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
     if (o->mode == ULAM_FORWARD && isnan(r->std_error))
         printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->index + 1,
                o->index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
@@ -127,6 +134,64 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
                "means nothing)%s\n", (long long)o->index + 1, o->index < 9 ? 10 : 9, "", r->estimate,
                r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
                r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
+}
+
+/* Print whether the --rel-err target was met, and when not why (one line; nothing without a target). */
+static void print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int verbose)
+{
+    if (o->rel_err > 0 && r->cut_stop)
+        printf("rel-err         NOT met (target %.3g): %lld walks were cut at %lld steps and the cut's bias may be "
+               "%.3g, more than a tenth of the target error: unreachable by more walks (raise --max-steps)\n",
+               o->rel_err, (long long)r->cut, (long long)o->max_steps, r->cut_bound);
+    else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
+        printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
+               o->rel_err);
+    else if (o->rel_err > 0 && r->fourth_finite != 1 && (verbose || !r->rel_err_met))
+        printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
+               "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
+               "not use the variance's own error bar\n", r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
+               r->rho4.lower, r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
+    else if (o->rel_err > 0 && r->min_walks > 0 && (verbose || !r->rel_err_met))
+        printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate%s)\n",
+               r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
+               r->out_of_reach ? ", beyond the 1e9 cap: stopped" : "");
+    else if (o->rel_err > 0)
+        printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
+}
+
+/* Print the default block: the answer, the method in words, the cost, the target (about 5 lines). */
+static void print_brief(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
+{
+    print_answer(o, r);
+    if (cli_verbosity < 0) return;
+    printf("method          %s random walks, %s estimator%s\n", cli_mode_names[o->mode],
+           cli_estimator_names[o->estimator], o->mode == ULAM_ADJOINT ? " (walks start at the unknown)"
+                                                                     : " (walks start from b: every unknown at once)");
+    if (ro->au) cli_auto_print_text(ro->au, ro->bc);
+    if (r->cut)
+        printf("walks           %lld (%lld cut at %lld steps: the estimate is biased by the cut)\n",
+               (long long)r->walks, (long long)r->cut, (long long)o->max_steps);
+    else
+        printf("walks           %lld (mean length %.3g steps)\n", (long long)r->walks,
+               r->walks ? (double)r->steps / (double)r->walks : 0.0);
+    printf("seconds         %.3g walking on %d threads; %.3g in all (inputs, guards, set-up)\n", r->seconds,
+           r->threads, ulam_now() - ro->t_start);
+    print_rel_err(o, r, 0);
+    if (o->mode == ULAM_FORWARD && r->unreached)
+        printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
+               (long long)r->unreached, (long long)ro->n);
+}
+
+/* Print the whole human-readable block (--verbose). */
+static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
+{
+    double mean_len = r->walks ? (double)r->steps / (double)r->walks : 0.0;
+    double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
+    if (cli_verbosity < 1) {
+        print_brief(o, r, ro);
+        return;
+    }
+    print_answer(o, r);
     printf("method          %s walks, %s estimator\n", cli_mode_names[o->mode], cli_estimator_names[o->estimator]);
     printf("walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
            (long long)o->max_steps, r->cut ? ": the estimate is biased by the cut" : "");
@@ -156,30 +221,10 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (o->mode == ULAM_FORWARD)
         printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
                (long long)r->unreached, (long long)ro->n);
-    if (o->rel_err > 0 && r->cut_stop)
-        printf("rel-err         NOT met (target %.3g): %lld walks were cut at %lld steps and the cut's bias may be "
-               "%.3g, more than a tenth of the target error: unreachable by more walks (raise --max-steps)\n",
-               o->rel_err, (long long)r->cut, (long long)o->max_steps, r->cut_bound);
-    else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
-        printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
-               o->rel_err);
-    else if (o->rel_err > 0 && r->fourth_finite != 1)
-        printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
-               "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
-               "not use the variance's own error bar\n", r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
-               r->rho4.lower, r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
-    else if (o->rel_err > 0 && r->min_walks > 0)
-        printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate%s)\n",
-               r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
-               r->out_of_reach ? ", beyond the 1e9 cap: stopped" : "");
-    else if (o->rel_err > 0)
-        printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
+    print_rel_err(o, r, 1);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s solver set-up; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds, peak_rss_mib());
     if (ro->au) cli_auto_print_text(ro->au, ro->bc);
-    if (ro->check)
-        printf("direct          %.10g (LAPACK, %.4f s), z = %.3f\n", ro->direct, ro->direct_seconds,
-               (r->estimate - ro->direct) / r->std_error);
 }
 
 /* Print the JSON object. */
@@ -224,6 +269,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     cli_json_number("seconds", r->seconds, 0);
     cli_json_number("steps_per_second", r->seconds > 0 ? (double)r->steps / r->seconds : 0.0, 0);
     cli_json_number("figure_of_merit", r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : NAN, 0);
+    cli_json_string("method", "walks", 0);
     cli_json_string("mode", cli_mode_names[o->mode], 0);
     cli_json_string("estimator", cli_estimator_names[o->estimator], 0);
     printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->seed, r->threads,
@@ -236,23 +282,21 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (ro->check) {
         cli_json_number("direct", ro->direct, 0);
         cli_json_number("direct_seconds", ro->direct_seconds, 0);
+        cli_json_string("direct_method", ro->direct_method, 0);
         cli_json_number("z", (r->estimate - ro->direct) / r->std_error, 0);
     }
     if (ro->au) cli_auto_print_json(ro->au, ro->bc);
     printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
 }
 
-/* LAPACK value of x_index for --check; 0 or an exit code. */
+/* The reference value of x_index for --check (sparse or dense LU, src/cli/direct.c), interruptible:
+ * 0, EXIT_INTERRUPTED (the solve still runs: the caller must leave s alone) or an exit code. */
 static int direct_check(const cli_system *s, int64_t index, report_opts *ro)
 {
-    double *x;
-    ulam_direct_info info;
-    int rc = cli_direct_solve(s, CLI_MAX_MEM, &x, &info);
-    if (rc) return rc;
-    ro->direct = x[index];
-    ro->direct_seconds = info.seconds;
-    free(x);
-    return 0;
+    double value = NAN, seconds = NAN;
+    int rc = cli_direct_check(s, index, &value, &seconds, &ro->direct_method);
+    ro->direct = value, ro->direct_seconds = seconds;
+    return rc;
 }
 
 /* The standard errors as a Matrix Market array, atomically: NaN for a component no walk reached
@@ -343,17 +387,20 @@ static int parse(int argc, char **argv, solve_args *a)
         CLI_WALK_OPTION("threads"),              CLI_WALK_OPTION("continue"),
         CLI_WALK_OPTION("roulette"),             CLI_WALK_OPTION("split"),
         CLI_WALK_OPTION("max-steps"),            CLI_WALK_OPTION("alpha"),
+        CLI_WALK_OPTION("kernel-exponent"),      CLI_WALK_OPTION("tol"),
         {"jacobi", no_argument, 0, 'j'},
         {"omega", required_argument, 0, 'w'},    {"check", no_argument, 0, 'c'},
         {"json", no_argument, 0, 'J'},           {"out", required_argument, 0, 'o'},
         {"errors", required_argument, 0, 'E'},   {"help", no_argument, 0, 'h'},
         {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
         {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
-        {"method", required_argument, 0, 'U'},   {0, 0, 0, 0}};
+        {"method", required_argument, 0, 'U'},   {"pagerank", required_argument, 0, 'P'},
+        {"damping", required_argument, 0, 'P'},  {0, 0, 0, 0}};
     *a = (solve_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_walk_defaults(), .autom = 1,
                       .ao = ulam_auto_defaults()};
     a->o.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
     int c, rc, idx;
+    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
         switch (c) {
@@ -362,7 +409,7 @@ static int parse(int argc, char **argv, solve_args *a)
             a->ao.pin_mode |= !strcmp(longopts[idx].name, "mode");
             a->ao.pin_estimator |= !strcmp(longopts[idx].name, "estimator");
             a->ao.pin_continue |= !strcmp(longopts[idx].name, "continue");
-            a->ao.pin_alpha |= !strcmp(longopts[idx].name, "alpha");
+            a->ao.pin_alpha |= !strcmp(longopts[idx].name, "alpha") || !strcmp(longopts[idx].name, "kernel-exponent");
             break;
         case 'b': a->s.rhs_path = optarg; break;
         case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
@@ -371,10 +418,11 @@ static int parse(int argc, char **argv, solve_args *a)
         case 'W': a->o.whole_kernel = 1; break;
         case 'U':
             if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
-            if (strcmp(optarg, "auto") && strcmp(optarg, "walks")) return cli_usage_error("solve", "--method expects auto, walks, bidirectional (with --source), mcsa, sequential, richardson, gauss-seidel, cg or gmres, got '%s'", optarg);
+            if (cli_choose("solve", "--method", optarg, cli_method_names, CLI_NMETHODS, cli_method_words) < 0) return EXIT_USAGE;
             a->autom = !strcmp(optarg, "auto");
             break;
         case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
+        case 'P': if ((rc = cli_parse_real("solve", "--pagerank", optarg, 1e-6, 1 - 1e-9, &a->s.pagerank))) return rc; break;
         case 'c': a->check = 1; break;
         case 'J': a->json = 1; break;
         case 'F': a->force = 1; break;
@@ -386,7 +434,8 @@ static int parse(int argc, char **argv, solve_args *a)
         }
     }
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (!a->s.rhs_path && !ulam_system_is_file(argv[optind])) return cli_need_rhs("solve", argv[optind]);
+    if (!a->s.rhs_path && !a->s.pagerank && !ulam_system_is_file(argv[optind])) return cli_need_rhs("solve", argv[optind]);
+    if (a->s.pagerank > 0 && a->s.jacobi) return cli_usage_error("solve", "--pagerank and --jacobi exclude each other");
     if (!a->s.index && a->o.mode == ULAM_ADJOINT) return cli_usage_error("solve", "adjoint walks need --index I");
     if ((a->out || a->errors) && a->o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
@@ -440,7 +489,7 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
     ulam_walk_opts *o = &a->o;
     int rc;
     /* read only the rows walks reach; auto does on a prepared system (see certified_auto) */
-    s->lazy = o->mode == ULAM_ADJOINT && !a->check && !cli_share && (!a->autom || ulam_system_is_file(s->matrix_path));
+    s->lazy = o->mode == ULAM_ADJOINT && !cli_share && (!a->autom || ulam_system_is_file(s->matrix_path));
     if ((a->out && (rc = cli_check_output(a->out))) || (a->errors && (rc = cli_check_output(a->errors)))) return rc;
     double t0 = ulam_now();
     if ((rc = cli_load_system(s))) return rc;
@@ -510,7 +559,7 @@ static int start(solve_args *a, report_opts *ro, ulam_auto_result *au, cli_bidir
     int walks = !(ro->bc && ro->bc->state == 2);
     if (walks && ro->g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(s, &ro->g, 1);
     if (walks) cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
-    if (ro->check && (rc = direct_check(s, o->index, ro))) {
+    if (ro->check && !walks && (rc = direct_check(s, o->index, ro))) { /* bidirectional: checked first */
         *sv = ulam_solver_free(*sv);
         cli_bidir_cand_free(bc);
         cli_system_free(s);
@@ -525,7 +574,7 @@ static int run(solve_args *a)
 {
     const cli_system *s = &a->s;
     const ulam_walk_opts *o = &a->o;
-    report_opts ro = {.check = a->check, .json = a->json, .assume_finite = a->assume_finite};
+    report_opts ro = {.check = a->check, .json = a->json, .assume_finite = a->assume_finite, .t_start = ulam_now()};
     ulam_auto_result au;
     cli_bidir_cand bc = {0};
     ulam_solver *sv = NULL;
@@ -570,12 +619,27 @@ static int run(solve_args *a)
     } else if (o->mode == ULAM_FORWARD && (a->out || a->errors) && !r.interrupted && cli_rank == 0) {
         rc = write_vectors(sv, ro.n, a->out, a->errors, &r);
     }
+    int left = 0; /* a check still running when Ctrl-C came: leave the system to it */
     if (!status && !rc) {
-        if (ro.json) print_json(o, &r, &ro);
-        else print_text(o, &r, &ro);
+        if (!ro.json) print_text(o, &r, &ro);
+        fflush(stdout); /* the estimate first: a check may take long, and Ctrl-C keeps what is printed */
+        if (ro.check && !r.interrupted && cli_rank == 0) {
+            rc = cli_system_verify(&a->s);
+            rc = rc ? rc : direct_check(s, o->index, &ro);
+            left = rc == EXIT_INTERRUPTED;
+            if (!ro.json && !rc) printf("direct          %.10g (%s, %.3g s), z = %.3f\n", ro.direct, ro.direct_method,
+                                        ro.direct_seconds, (r.estimate - ro.direct) / r.std_error);
+            if (left && !ro.json) fprintf(stderr, "ulam: --check interrupted: the estimate above stands unchecked\n");
+        }
+        if (ro.json && (!rc || left)) print_json(o, &r, &ro);
         if (r.interrupted) rc = EXIT_INTERRUPTED;
     }
     fflush(stdout); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
+    if (left && !cli_share) { /* the reference solve's thread still reads the system: end here */
+        fflush(stderr);
+        _exit(rc);
+    }
+    if (left) return rc; /* under MPI the ranks end together (main); the system stays to the thread */
     cli_release_sigint();
     ulam_solver_free(sv);
     cli_bidir_cand_free(&bc);

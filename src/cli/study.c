@@ -17,7 +17,8 @@
 static const char *const usage =
     "usage: ulam study M.mtx --rhs b.mtx --index I [--methods LIST] [--budgets LIST |\n"
     "                  --time-budgets LIST] [--repeats R] [--out DIR] [--seed S] [--threads T]\n"
-    "                  [--jacobi [--omega W]] [--cache] [--force]\n"
+    "                  [--jacobi [--omega W]] [--cache] [--force] [--reference-time S]\n"
+    "                  [--format png|svg|pdf]\n"
     "\n"
     "Run every method (mode-estimator-window: adjoint|forward, collision|absorption|expected,\n"
     "plain|roulette|split) at every budget R times with distinct seeds, and compare each run\n"
@@ -30,13 +31,21 @@ static const char *const usage =
     "  --repeats R          runs per method and budget (default 30)\n"
     "  --out DIR            output directory (default study): runs.csv (a row per run, saved\n"
     "                       after each method and budget; rerunning resumes), summary.csv,\n"
-    "                       reference.csv, rmse.png, work.png, coverage.png\n"
+    "                       reference.csv, rmse-*.png, work.png, coverage.png\n"
     "  --cache              binary copies of the inputs beside them, as in 'ulam solve'\n"
     "  --seed S             base seed (default 1); run r of method m at budget k has its own\n"
     "  --force              start afresh when --out holds runs of a different question\n"
     "  --threads T          threads per run (default: all cores)\n"
     "  --jacobi             the file holds A of A x = b: walk on M = I - w D^-1 A, b' = w D^-1 b\n"
     "  --omega W            the damping w of --jacobi, in (0, 2] (default 1)\n"
+    "  --reference-time S   seconds for each reference line of the methods that solve for every\n"
+    "                       unknown (sequential MC, MCSA; default 10); 0 leaves them out\n"
+    "  --format F           png (default), svg or pdf charts; each chart's gnuplot script is kept\n"
+    "                       beside it (NAME.gp: 'cd DIR && gnuplot NAME.gp' redraws it from the CSVs)\n"
+    "\n"
+    "On stdout: the winner at each budget (least RMSE^2 x seconds) with its coverage and the\n"
+    "coverage's 95% binomial (Wilson) interval, and the refused methods.  The RMSE charts are\n"
+    "one per estimator (rmse-collision, rmse-absorption, rmse-expected: at most 6 lines each).\n"
     "\n"
     "A rerun resumes only the same question: DIR/question.txt records a fingerprint of it (the\n"
     "contents of M and b, n, --index, --jacobi and --omega, --seed, the methods, walk or time\n"
@@ -60,6 +69,9 @@ typedef struct {
     method m[NMETHOD];
     double budget[MAXBUDGET];
     int nbudget, time_budgets, repeats, threads, force;
+    double reference_time; /* seconds for each of sequential MC's and MCSA's reference lines (0: none) */
+    const char *format;    /* png, svg or pdf */
+    int partial;           /* interrupted: charts and summary say so */
     uint64_t seed;
     const char *out;
     ulam_guard g; /* the verdicts, computed once for every run */
@@ -321,6 +333,29 @@ static int check_question(study *st)
     return status ? cli_report(path, &e) : 0;
 }
 
+/* The seconds the runs not yet done will take, from the measured cost: a time budget is its own
+ * cost; a walk budget costs the method's measured seconds per walk (over its finished runs; a
+ * method not yet measured takes the dearest measured), so the tenfold budgets still to come weigh
+ * tenfold. */
+static double seconds_left(const study *st)
+{
+    double spw[NMETHOD], dearest = 0.0, left = 0.0;
+    for (int m = 0; m < NMETHOD; m++) {
+        double s = 0.0, w = 0.0;
+        for (int b = 0; b < st->nbudget; b++)
+            for (int r = 0; r < st->repeats; r++)
+                if (st->m[m].on && st->done[at(st, m, b, r)]) s += st->sec[at(st, m, b, r)], w += st->budget[b];
+        spw[m] = w > 0 ? s / w : NAN;
+        if (spw[m] > dearest) dearest = spw[m];
+    }
+    for (int m = 0; m < NMETHOD; m++)
+        for (int b = 0; b < st->nbudget; b++)
+            for (int r = 0; r < st->repeats; r++)
+                if (st->m[m].on && !st->m[m].why[0] && !st->done[at(st, m, b, r)])
+                    left += st->time_budgets ? st->budget[b] : st->budget[b] * (isnan(spw[m]) ? dearest : spw[m]);
+    return left;
+}
+
 /* Run every missing run, saving runs.csv after each cell (and every 10 s within one) and on
  * Ctrl-C; 0, EXIT_INTERRUPTED, or an exit code when runs.csv cannot be written. */
 static int run_all(study *st)
@@ -345,7 +380,7 @@ static int run_all(study *st)
             double el = ulam_now() - t0;
             if (tty)
                 fprintf(stderr, "\rulam: study: cells %d/%d, %.1f s elapsed, about %.0f s left   ", cells, total,
-                        el, el / cells * (total - cells));
+                        el, seconds_left(st));
         }
     if (!rc) rc = save_runs(st); /* the rows finished before Ctrl-C */
     cli_release_sigint();
@@ -354,24 +389,23 @@ static int run_all(study *st)
 }
 
 /* Reference lines of the methods that solve for every unknown: sequential MC and MCSA (one
- * run each, seed --seed, 10^-10 or OUTER_SECONDS, only when forward walks have finite
+ * run each, seed --seed, 10^-10 or --reference-time seconds, only when forward walks have finite
  * variance) and the Krylov peer (CG when M is symmetric, else GMRES(30); a run a tolerance
  * 10^-1 .. 10^-10): error on x_I against seconds, into f. */
 static void outer_references(const study *st, FILE *f)
 {
-    enum { OUTER_SECONDS = 60 };
     int64_t n = st->s.M->nrows, I = st->s.index - 1;
     double *x = malloc((size_t)n * sizeof *x);
     char v[2][32];
     if (!x) return;
-    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA && st->forward_walks; m++) {
+    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA && st->forward_walks && st->reference_time > 0; m++) {
         ulam_outer_opts o = ulam_outer_defaults();
         o.method = m, o.tol = 1e-10, o.walk.seed = st->seed, o.walk.threads = st->threads;
         o.walk.interrupt = &cli_interrupted, o.max_histories = 20 * n > 1000000 ? 20 * n : 1000000;
         ulam_outer *it = NULL;
         if (ulam_outer_alloc(st->s.M, st->s.b, &o, &it, NULL)) continue;
         double t = 0;
-        while (!ulam_outer_done(it) && t < OUTER_SECONDS && !cli_interrupted) {
+        while (!ulam_outer_done(it) && t < st->reference_time && !cli_interrupted) {
             ulam_outer_step step;
             ulam_outer_iterate(it, &step);
             t += step.seconds;
@@ -483,7 +517,7 @@ static int summarise(study *st)
     }
     FILE *f = o[0].f, *g = o[1].f;
     fprintf(f, "method,budget,runs,rmse,mean_stderr,honesty,coverage,seconds,work,variance_finite\n");
-    fprintf(g, "method,work,coverage,honesty\n");
+    fprintf(g, "method,work,coverage,honesty,coverage_lo,coverage_hi,covered,runs\n");
     double *e = malloc((size_t)st->repeats * 3 * sizeof *e);
     for (int m = 0; m < NMETHOD && e; m++) {
         if (!st->m[m].on || st->m[m].why[0]) continue;
@@ -502,9 +536,13 @@ static int summarise(study *st)
                     num(v[4], c.seconds), num(v[5], c.work), st->m[m].infinite ? "false" : "true");
             last = c;
         }
-        if (last.runs)
-            fprintf(g, "%s,%s,%s,%s\n", st->m[m].name, num(v[0], last.work), num(v[1], last.coverage),
-                    num(v[2], last.honesty));
+        if (last.runs) {
+            double lo, hi;
+            int covered = (int)lround(last.coverage * last.runs);
+            ulam_study_coverage_interval(covered, last.runs, &lo, &hi);
+            fprintf(g, "%s,%s,%s,%s,%s,%s,%d,%d\n", st->m[m].name, num(v[0], last.work), num(v[1], last.coverage),
+                    num(v[2], last.honesty), num(v[3], lo), num(v[4], hi), covered, last.runs);
+        }
     }
     status = e ? ULAM_OK : ULAM_ENOMEM;
     free(e);
@@ -540,62 +578,155 @@ static void lapack_mark(const study *st, char *buf, size_t len)
              st->direct_seconds, st->direct_error, err, st->direct_seconds);
 }
 
-/* The three charts; nonzero when gnuplot failed. */
-static int charts(const study *st)
+/* Draw DIR/NAME.FORMAT from script, and keep the script beside it as DIR/NAME.gp ('cd DIR &&
+ * gnuplot NAME.gp' redraws it from the CSVs there); the chart is drawn under a temporary name and
+ * renamed into place.  ULAM_OK or ULAM_EIO (gnuplot missing or failed). */
+static int draw(const study *st, const char *name, int width, int height, const char *script)
 {
-    char names[NMETHOD * 40] = "", budgets[MAXBUDGET * 32] = "", lapack[1024], script[12288];
-    for (int m = 0; m < NMETHOD; m++)
-        if (st->m[m].on && !st->m[m].why[0]) strcat(strcat(names, st->m[m].name), " ");
+    char term[128], gp[4200], tmp[4200], out[4200], cmd[4200];
+    const char *fmt = st->format;
+    if (!strcmp(fmt, "pdf")) snprintf(term, sizeof term, "pdfcairo size %gin,%gin font 'sans,9'", width / 100.0, height / 100.0);
+    else if (!strcmp(fmt, "svg")) snprintf(term, sizeof term, "svg size %d,%d font 'sans,10' background 'white'", width, height);
+    else snprintf(term, sizeof term, "pngcairo size %d,%d font 'sans,10'", width, height);
+    snprintf(gp, sizeof gp, "%s/%s.gp", st->out, name);
+    snprintf(out, sizeof out, "%s/%s.%s", st->out, name, fmt);
+    snprintf(tmp, sizeof tmp, "%s/%s.tmp.%s", st->out, name, fmt);
+    const char *head = "set datafile separator ','\nset grid\n";
+    ulam_outfile o;
+    if (!ulam_outfile_open(&o, gp)) {
+        fprintf(o.f, "# ulam study: %s; redraw with: cd %s && gnuplot %s.gp\nset terminal %s\nset output '%s.%s'\n%s%s\n"
+                     "set output\n", name, st->out, name, term, name, fmt, head, script);
+        if (ulam_outfile_commit(&o)) return ULAM_EIO;
+    }
+    if (strchr(st->out, '\'')) return ULAM_EINVAL;
+    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot 2>/dev/null", st->out);
+    FILE *g = popen(cmd, "w");
+    if (!g) return ULAM_EIO;
+    fprintf(g, "set terminal %s\nset output '%s.tmp.%s'\n%s%s\nset output\n", term, name, fmt, head, script);
+    int ok = pclose(g) == 0 && rename(tmp, out) == 0;
+    if (!ok) remove(tmp);
+    return ok ? ULAM_OK : ULAM_EIO;
+}
+
+/* The RMSE chart of the methods in names (one estimator's: at most 6, each its own colour and dash)
+ * as NAME; nonzero when gnuplot failed. */
+static int rmse_chart(const study *st, const char *name, const char *names, const char *what)
+{
+    char budgets[MAXBUDGET * 32] = "", lapack[1024], script[12288];
     for (int b = 0; b < st->nbudget; b++)
         snprintf(budgets + strlen(budgets), sizeof budgets - strlen(budgets), "%.17g ", st->budget[b]);
     double y0 = st->exact != 0 ? 1e-9 * fabs(st->exact) : 1e-12;
     lapack_mark(st, lapack, sizeof lapack);
     snprintf(script, sizeof script,
-             "set title 'ulam study: RMSE of x_{%lld} against seconds per run'\n"
+             "set title 'ulam study: RMSE of x_{%lld} against seconds per run, %s estimator%s'\n"
              "set logscale xy\nset format x '10^{%%L}'\nset format y '10^{%%L}'\nset xlabel 'seconds per run'\n"
-             "set ylabel 'RMSE (reference lines: the error of one run)'\nset key outside right font ',8'\n"
+             "set ylabel 'RMSE (reference lines: the error of one run)'\nset key outside bottom center horizontal "
+             "maxrows 4 font ',8'\n"
              "Y0 = %g\nset yrange [Y0:*]\n"
              "set fit quiet\nset fit logfile '/dev/null'\nf(x) = a / sqrt(x)\na = 0\nfit f(x) 'summary.csv' u 8:4 via a\n"
-             "M = \"%s\"\n" /* one colour and dash per method: 8 colours, then the next dash pattern (dashes 1-3;
-                                   the reference lines take colours and dash 4 of their own) */
+             "M = \"%s\"\n" /* at most 6 methods: 6 colours, 6 dashes */
+             "C = \"#1b9e77 #d95f02 #7570b3 #e7298a #66a61e #a6761d\"\n"
              "B = \"%s\"\n" /* one point shape per budget, in the method's colour */
              "P = \"7 5 9 11 13 6 4 8 10 12 1 2 3 14 15 16\"\n"
-             /* the x axis spans the walks and the reference lines but LAPACK's point */
              "stats 'summary.csv' u ($8 > 0 ? $8 : 1/0) nooutput\nX0 = STATS_min\nX1 = STATS_max\n"
              "stats 'reference.csv' u (strcol(1) ne 'lapack' && $2 > 0 ? $2 : 1/0) nooutput\n"
              "X0 = 10**floor(log10(STATS_min < X0 ? STATS_min : X0))\nX1 = 10**ceil(log10(STATS_max > X1 ? STATS_max : X1))\n"
              "set xrange [X0:X1]\n"
              "%s"
-             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) ? $8 : 1/0):4 w l "
-             "linecolor i dashtype 1 + (i - 1) / 8 title word(M, i), "
+             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) ? $8 : 1/0):4 w l lw 2 "
+             "linecolor rgb word(C, i) dashtype i title word(M, i), "
              "for [i=1:words(M)] for [j=1:words(B)] 'summary.csv' u (strcol(1) eq word(M, i) && $2 == word(B, j) + 0 ? "
-             "$8 : 1/0):4 w p linecolor i pointtype (word(P, j) + 0) notitle, "
+             "$8 : 1/0):4 w p linecolor rgb word(C, i) pointtype (word(P, j) + 0) notitle, "
              "for [j=1:words(B)] NaN w p lc 'black' pointtype (word(P, j) + 0) title sprintf('%s', word(B, j) + 0), "
              "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 lc 'gray50' t 'Gauss-Seidel, whole vector', "
-             "'' u (strcol(1) eq 'lapack' ? lx : 1/0):(ly) w p pt 9 ps 2 lc 'web-green' t 'LAPACK dgesv (error vs refined)', "
-             "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 2 pt 5 lc 'brown' t 'sequential MC, every unknown (one run)', "
-             "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 2 pt 7 lc 'dark-magenta' t 'MCSA, every unknown (one run)', "
-             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 2 pt 3 lc 'dark-cyan' t 'Krylov (CG or GMRES(30))', "
-             "f(x) dt 4 lc 'gray30' t '1/sqrt(t) slope'\n",
-             (long long)st->s.index, y0, names, budgets, lapack,
-             st->time_budgets ? "budget %g s a run" : "budget %.0f walks");
-    if (gnuplot_draw(st->out, "rmse", 1200, 700, script)) {
-        fprintf(stderr, "ulam: study: gnuplot failed (install gnuplot-nox): charts not drawn, CSVs written\n");
-        return 1;
+             "'' u (strcol(1) eq 'lapack' ? lx : 1/0):(ly) w p pt 9 ps 2 lc 'web-green' t 'LAPACK dgesv', "
+             "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 1 pt 5 lc 'brown' t 'sequential MC (one run)', "
+             "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 1 pt 7 lc 'dark-magenta' t 'MCSA (one run)', "
+             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 1 pt 3 lc 'dark-cyan' t 'Krylov', "
+             "f(x) dt 4 lc 'gray30' t '1/sqrt(t)'\n",
+             (long long)st->s.index, what, st->partial ? " (PARTIAL: interrupted)" : "", y0, names, budgets, lapack,
+             st->time_budgets ? "%g s a run" : "%.0f walks");
+    return draw(st, name, 1100, 750, script);
+}
+
+/* The charts (an RMSE chart per estimator, work, coverage with its binomial interval); the names of
+ * those drawn into drawn[]; nonzero when gnuplot failed. */
+static int charts(const study *st, char *drawn, size_t len)
+{
+    static const char *const est[3] = {"collision", "absorption", "expected"};
+    char script[2048], key[32], chart[64];
+    drawn[0] = '\0';
+    for (int e = 0; e < 3; e++) {
+        char names[NMETHOD * 40] = "";
+        snprintf(key, sizeof key, "-%s-", est[e]);
+        for (int m = 0; m < NMETHOD; m++)
+            if (st->m[m].on && !st->m[m].why[0] && strstr(st->m[m].name, key)) strcat(strcat(names, st->m[m].name), " ");
+        if (!names[0]) continue;
+        snprintf(chart, sizeof chart, "rmse-%s", est[e]);
+        if (rmse_chart(st, chart, names, est[e])) {
+            fprintf(stderr, "ulam: study: gnuplot failed (install gnuplot-nox): charts not drawn, CSVs written\n");
+            return 1;
+        }
+        snprintf(drawn + strlen(drawn), len - strlen(drawn), ", %s.%s", chart, st->format);
     }
-    /* the bars: the header row skipped (it took a slot), labels ending under their bar, a y label */
-    gnuplot_draw(st->out, "work", 1000, 500,
-                 "set title 'work-normalised variance RMSE^2 x seconds at the largest budget (lower wins)'\n"
-                 "set style data histograms\nset style fill solid 0.6\nset logscale y\nset format y '10^{%L}'\n"
-                 "set ylabel 'RMSE^2 x seconds per run'\nset xtics rotate by 35 right font ',8'\nset bmargin 8\n"
-                 "set key off\nplot 'bars.csv' skip 1 u 2:xtic(1)\n");
-    gnuplot_draw(st->out, "coverage", 1000, 500,
-                 "set title 'coverage of the 95% interval at the largest budget'\nset style data histograms\n"
-                 "set style fill solid 0.6\nset yrange [0:1.05]\nset ylabel 'share of runs whose 95% interval holds x_I'\n"
-                 "set xtics rotate by 35 right font ',8'\nset bmargin 8\nset rmargin 7\nset key off\n"
-                 "set label 1 '0.95' at graph 1, first 0.95 offset 0.5, 0 left font ',8'\n"
-                 "plot 'bars.csv' skip 1 u 3:xtic(1), 0.95 dt 2 lc 'black'\n");
+    const char *partial = st->partial ? " (PARTIAL: interrupted)" : "";
+    snprintf(script, sizeof script,
+             "set title 'work-normalised variance RMSE^2 x seconds at the largest budget (lower wins)%s'\n"
+             "set style data histograms\nset style fill solid 0.6\nset logscale y\nset format y '10^{%%L}'\n"
+             "set ylabel 'RMSE^2 x seconds per run'\nset xtics rotate by 35 right font ',8'\nset bmargin 10\n"
+             "set key off\nplot 'bars.csv' skip 1 u 2:xtic(1)\n", partial);
+    draw(st, "work", 1000, 500, script);
+    snprintf(script, sizeof script,
+             "set title 'coverage of the 95%% interval at the largest budget, with its 95%% binomial interval%s'\n"
+             "set style data histograms\nset style histogram errorbars gap 1 lw 1\n"
+             "set style fill solid 0.6\nset yrange [0:1.05]\nset ylabel 'share of runs whose 95%% interval holds x_I'\n"
+             "set xtics rotate by 35 right font ',8'\nset bmargin 10\nset rmargin 7\nset key off\n"
+             "set label 1 '0.95' at graph 1, first 0.95 offset 0.5, 0 left font ',8'\n"
+             "plot 'bars.csv' skip 1 u 3:5:6:xtic(1), 0.95 dt 2 lc 'black'\n", partial);
+    draw(st, "coverage", 1000, 500, script);
+    snprintf(drawn + strlen(drawn), len - strlen(drawn), ", work.%s, coverage.%s (and their .gp scripts)", st->format,
+             st->format);
     return 0;
+}
+
+/* On stdout: the winner at each budget (least RMSE^2 x seconds among the methods with a certified
+ * finite variance) with its RMSE, seconds and coverage (k/N and the 95% Wilson interval), then the
+ * refused methods; "PARTIAL" when interrupted. */
+static void print_summary(const study *st)
+{
+    printf("study of x[%lld]: exact %.10g; %d runs a cell%s\n", (long long)st->s.index, st->exact, st->repeats,
+           st->partial ? "; PARTIAL (interrupted): the cells below hold the runs finished" : "");
+    printf("%-12s %-28s %-10s %-10s %s\n", st->time_budgets ? "seconds" : "walks", "winner (least RMSE^2 x s)", "RMSE",
+           "s a run", "coverage (95% interval)");
+    double *e = malloc((size_t)st->repeats * 3 * sizeof *e);
+    for (int b = 0; b < st->nbudget && e; b++) {
+        int best = -1;
+        cell bc = {0};
+        for (int m = 0; m < NMETHOD; m++) {
+            if (!st->m[m].on || st->m[m].why[0] || st->m[m].infinite) continue;
+            int k = 0;
+            for (int r = 0; r < st->repeats; r++) {
+                size_t i = at(st, m, b, r);
+                if (st->done[i]) e[k] = st->est[i], e[st->repeats + k] = st->se[i], e[2 * st->repeats + k++] = st->sec[i];
+            }
+            if (!k) continue;
+            cell c;
+            cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, &c);
+            if (best < 0 || c.work < bc.work) best = m, bc = c;
+        }
+        if (best < 0) {
+            printf("%-12g (no finished runs)\n", st->budget[b]);
+            continue;
+        }
+        double lo, hi;
+        int covered = (int)lround(bc.coverage * bc.runs);
+        ulam_study_coverage_interval(covered, bc.runs, &lo, &hi);
+        printf("%-12g %-28s %-10.3g %-10.3g %d/%d (%.2f .. %.2f)\n", st->budget[b], st->m[best].name, bc.rmse,
+               bc.seconds, covered, bc.runs, lo, hi);
+    }
+    free(e);
+    for (int m = 0; m < NMETHOD; m++)
+        if (st->m[m].on && st->m[m].why[0]) printf("refused: %s: %s\n", st->m[m].name, st->m[m].why);
 }
 
 /* ulam study. */
@@ -609,13 +740,17 @@ int cli_study(int argc, char **argv)
         {"threads", required_argument, 0, 'T'}, {"jacobi", no_argument, 0, 'j'},
         {"omega", required_argument, 0, 'w'},   {"help", no_argument, 0, 'h'},
         {"cache", no_argument, 0, 'C'},         {"force", no_argument, 0, 'F'},
+        {"reference-time", required_argument, 0, 'r'}, {"format", required_argument, 0, 'f'},
         {0, 0, 0, 0}};
+    static const char *const formats[] = {"png", "svg", "pdf"};
     static study st;
-    st = (study){.s = {.command = "study", .omega = 1.0}, .repeats = 30, .seed = 1, .out = "study"};
+    st = (study){.s = {.command = "study", .omega = 1.0}, .repeats = 30, .seed = 1, .out = "study",
+                 .reference_time = 10, .format = "png"};
     methods_init(st.m);
     parse_budgets(&st, "--budgets", "100,1000,10000,100000,1000000", 1);
     int64_t v;
     int c, rc;
+    if (cli_check_options("study", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
         switch (c) {
@@ -631,6 +766,11 @@ int cli_study(int argc, char **argv)
         case 'j': st.s.jacobi = 1; break;
         case 'C': st.s.cache = 1; break;
         case 'F': st.force = 1; break;
+        case 'r': if ((rc = cli_parse_real("study", "--reference-time", optarg, 0, 1e6, &st.reference_time))) return rc; break;
+        case 'f':
+            if ((rc = cli_choose("study", "--format", optarg, formats, 3, "png, svg or pdf")) < 0) return EXIT_USAGE;
+            st.format = formats[rc];
+            break;
         case 'w': if ((rc = cli_parse_real("study", "--omega", optarg, 1e-6, 2.0, &st.s.omega))) return rc; break;
         case 'h': fputs(usage, stdout); return 0;
         default: return cli_usage_error("study", "unknown option");
@@ -658,11 +798,14 @@ int cli_study(int argc, char **argv)
     if (!rc) rc = references(&st);
     if (!rc) rc = run_all(&st);
     if ((rc == 0 || rc == EXIT_INTERRUPTED) && cli_rank == 0) {
+        st.partial = rc == EXIT_INTERRUPTED;
         int rs = summarise(&st);
         if (!rs) {
-            int drawn = !charts(&st);
+            char drawn[512];
+            if (charts(&st, drawn, sizeof drawn)) drawn[0] = '\0';
+            print_summary(&st);
             fprintf(stderr, "ulam: study: wrote %s/: runs.csv, summary.csv, bars.csv, reference.csv, question.txt%s\n",
-                    st.out, drawn ? ", rmse.png, work.png, coverage.png" : "");
+                    st.out, drawn);
         } else {
             rc = rs;
         }

@@ -14,6 +14,10 @@ int cli_walk_option(const char *command, const char *name, const char *value, ul
     int64_t v;
     int rc;
     if (!strcmp(name, "walks")) return cli_parse_int(cmd, "--walks", value, 1, INT64_MAX / 2, &o->max_walks);
+    if (!strcmp(name, "tol")) name = "rel-err"; /* the iterations' spelling of the same target */
+    if (!strcmp(name, "alpha")) /* deprecated: read as PageRank's alpha, which is --pagerank */
+        fprintf(stderr, "ulam %s: note: --alpha is deprecated: the kernel exponent is --kernel-exponent (PageRank's "
+                        "damping is --pagerank)\n", cmd);
     if (!strcmp(name, "rel-err")) return cli_parse_real(cmd, "--rel-err", value, 1e-12, 1.0, &o->rel_err);
     if (!strcmp(name, "time")) return cli_parse_real(cmd, "--time", value, 1e-6, 1e9, &o->max_seconds);
     if (!strcmp(name, "continue") && !strcmp(value, "analog")) return o->continue_q = 0.0, 0; /* min(1, S_i) */
@@ -21,7 +25,8 @@ int cli_walk_option(const char *command, const char *name, const char *value, ul
     if (!strcmp(name, "roulette")) return cli_parse_real(cmd, "--roulette", value, 1e-300, 1e300, &o->roulette);
     if (!strcmp(name, "split")) return cli_parse_real(cmd, "--split", value, 1e-300, 1e300, &o->split);
     if (!strcmp(name, "max-steps")) return cli_parse_int(cmd, "--max-steps", value, 1, INT64_MAX / 2, &o->max_steps);
-    if (!strcmp(name, "alpha")) return cli_parse_real(cmd, "--alpha", value, 0.0, 1000.0, &o->kernel_alpha);
+    if (!strcmp(name, "alpha") || !strcmp(name, "kernel-exponent"))
+        return cli_parse_real(cmd, name[0] == 'a' ? "--alpha" : "--kernel-exponent", value, 0.0, 1000.0, &o->kernel_alpha);
     if (!strcmp(name, "seed")) {
         if (!(rc = cli_parse_int(cmd, "--seed", value, 0, INT64_MAX, &v))) o->seed = (uint64_t)v;
         return rc;
@@ -32,11 +37,11 @@ int cli_walk_option(const char *command, const char *name, const char *value, ul
     }
     if (!strcmp(name, "estimator")) {
         if ((o->estimator = cli_lookup(value, cli_estimator_names, 3)) >= 0) return 0;
-        return cli_usage_error(cmd, "--estimator expects collision, absorption or expected, got '%s'", value);
+        return cli_choose(cmd, "--estimator", value, cli_estimator_names, 3, "collision, absorption or expected"), EXIT_USAGE;
     }
     if (!strcmp(name, "mode")) {
         if ((o->mode = cli_lookup(value, cli_mode_names, 2)) >= 0) return 0;
-        return cli_usage_error(cmd, "--mode expects adjoint or forward, got '%s'", value);
+        return cli_choose(cmd, "--mode", value, cli_mode_names, 2, "adjoint or forward"), EXIT_USAGE;
     }
     return 1;
 }

@@ -132,6 +132,141 @@ int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, i
     return ULAM_OK;
 }
 
+/* A patch corner: its place in vidx, vertex and face, to group the corners that share a vertex
+ * on one face of the OBJ file. */
+typedef struct {
+    int64_t i, v, face;
+} corner;
+
+/* Order corners by vertex, then face. */
+static int cmp_corner(const void *a, const void *b)
+{
+    const corner *x = a, *y = b;
+    if (x->v != y->v) return (x->v > y->v) - (x->v < y->v);
+    return (x->face > y->face) - (x->face < y->face);
+}
+
+/* Radiosity at every patch corner (3 per vidx entry): the area-weighted mean of B over the
+ * patches of the same OBJ face sharing that vertex (a face's subdivision is smoothed, a crease
+ * between faces is kept); NULL when out of memory. */
+static double *corner_values(const ulam_scene *s, const double *B)
+{
+    int64_t n = s->start[s->npatches];
+    corner *c = ulam__malloc((size_t)n, sizeof *c);
+    double *val = ulam__malloc((size_t)n, 3 * sizeof *val);
+    int64_t *owner = ulam__malloc((size_t)n, sizeof *owner);
+    if (!c || !val || !owner) {
+        free(c), free(val), free(owner);
+        return NULL;
+    }
+    for (int64_t p = 0; p < s->npatches; p++)
+        for (int64_t i = s->start[p]; i < s->start[p + 1]; i++) owner[i] = p;
+    for (int64_t i = 0; i < n; i++) c[i] = (corner){i, s->vidx[i], s->face[owner[i]]};
+    qsort(c, (size_t)n, sizeof *c, cmp_corner);
+    for (int64_t a = 0, b; a < n; a = b) {
+        double sum[3] = {0, 0, 0}, A = 0;
+        for (b = a; b < n && c[b].v == c[a].v && c[b].face == c[a].face; b++) {
+            int64_t p = owner[c[b].i];
+            A += s->area[p];
+            for (int k = 0; k < 3; k++) sum[k] += s->area[p] * B[3 * p + k];
+        }
+        for (int64_t j = a; j < b; j++)
+            for (int k = 0; k < 3; k++) val[3 * c[j].i + k] = A > 0 ? sum[k] / A : 0.0;
+    }
+    free(c), free(owner);
+    return val;
+}
+
+/* Render B with jittered rays and, if smooth, radiosity interpolated from the patch corners. */
+int ulam_render_hdr(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width, int height, int samples,
+                    int smooth, uint64_t seed, double exposure, float *hdr, unsigned char *rgb, ulam_render_info *info)
+{
+    if (info) *info = (ulam_render_info){0};
+    if (!t || !B || !cam || !hdr || width < 1 || height < 1 || samples < 1 || !(cam->focal > 0) || !(cam->film > 0))
+        return ULAM_EINVAL;
+    const ulam_scene *s = ulam__tracer_scene(t);
+    for (int64_t k = 0; k < 3 * s->npatches; k++)
+        if (!isfinite(B[k])) return ULAM_ENONFINITE;
+    size_t np = (size_t)width * (size_t)height;
+    if (np > SIZE_MAX / 8 / 3) return ULAM_EOVERFLOW;
+    double *cv = smooth ? corner_values(s, B) : NULL, *lum = ulam__malloc(np, sizeof *lum);
+    unsigned char *lit = ulam__malloc(np, 2); /* per pixel: any sample hit a patch, and an emitter */
+    if ((smooth && !cv) || !lum || !lit) {
+        free(cv), free(lum), free(lit);
+        return ULAM_ENOMEM;
+    }
+    double f[3] = {cam->dir[0], cam->dir[1], cam->dir[2]}, up[3] = {cam->up[0], cam->up[1], cam->up[2]}, right[3];
+    normalise(f);
+    ulam__cross3(f, up, right);
+    normalise(right);
+    ulam__cross3(right, f, up);
+    double pitch = cam->film / (double)width;
+#pragma omp parallel for schedule(dynamic, 4)
+    for (int y = 0; y < height; y++)
+        for (int x = 0; x < width; x++) {
+            size_t k = (size_t)y * (size_t)width + (size_t)x;
+            ulam_rng r;
+            ulam_rng_seed(&r, seed, (uint64_t)k);
+            double acc[3] = {0, 0, 0};
+            lit[2 * k] = lit[2 * k + 1] = 0;
+            for (int m = 0; m < samples; m++) {
+                double jx = samples > 1 ? ulam__rng_uniform(&r) : 0.5, jy = samples > 1 ? ulam__rng_uniform(&r) : 0.5;
+                double sx = ((double)x + jx - 0.5 * width) * pitch, sy = (0.5 * height - (double)y - jy) * pitch, d[3];
+                for (int c = 0; c < 3; c++) d[c] = cam->focal * f[c] + sx * right[c] + sy * up[c];
+                normalise(d);
+                int64_t tri = 0;
+                double u = 0, v = 0;
+                int64_t p = ulam__tracer_cast_front_uv(t, cam->eye, d, &tri, &u, &v);
+                if (p < 0) continue;
+                lit[2 * k] = 1, lit[2 * k + 1] |= ulam__max3(s->emit + 3 * p) > 0;
+                for (int c = 0; c < 3; c++) {
+                    double val = B[3 * p + c];
+                    if (cv) {
+                        int64_t i0 = s->start[p], i1 = i0 + tri, i2 = i1 + 1;
+                        val = (1 - u - v) * cv[3 * i0 + c] + u * cv[3 * i1 + c] + v * cv[3 * i2 + c];
+                    }
+                    acc[c] += val;
+                }
+            }
+            for (int c = 0; c < 3; c++) hdr[3 * k + c] = (float)(acc[c] / samples);
+        }
+    ulam_render_info in = {.exposure = exposure, .exposure_set = exposure > 0};
+    for (int all = 0; all < 2 && !(in.exposure > 0); all++) { /* as ulam_render: 1 / the 99th percentile */
+        size_t m = 0;
+        for (size_t k = 0; k < np; k++)
+            if (lit[2 * k] && (all || !lit[2 * k + 1]))
+                lum[m++] = fmax(hdr[3 * k], fmax(hdr[3 * k + 1], hdr[3 * k + 2]));
+        qsort(lum, m, sizeof *lum, cmp_double);
+        double top = m ? lum[(size_t)(0.99 * (double)(m - 1))] : 0.0;
+        if (top > 0 && isfinite(top)) in.exposure = 1.0 / top, in.exposure_set = 1;
+    }
+    if (!(in.exposure > 0)) in.exposure = 1.0;
+    for (size_t k = 0; k < np; k++) {
+        in.pixels_hit += lit[2 * k], in.pixels_emitter += lit[2 * k + 1];
+        for (int c = 0; rgb && c < 3; c++) rgb[3 * k + c] = srgb_byte(in.exposure * hdr[3 * k + c]);
+    }
+    if (info) *info = in;
+    free(cv), free(lum), free(lit);
+    return ULAM_OK;
+}
+
+/* Write a float RGB image as PFM (little-endian, rows bottom first), atomically. */
+int ulam_pfm_write(const char *path, int width, int height, const float *rgb)
+{
+    if (!path || !rgb || width < 1 || height < 1) return ULAM_EINVAL;
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (status) return status;
+    int ok = fprintf(o.f, "PF\n%d %d\n-1.0\n", width, height) > 0;
+    for (int y = height - 1; ok && y >= 0; y--) /* floats are little-endian on every platform ulam builds on */
+        ok = fwrite(rgb + (size_t)y * (size_t)width * 3, sizeof(float), (size_t)width * 3, o.f) == (size_t)width * 3;
+    if (!ok) {
+        ulam_outfile_abort(&o);
+        return ULAM_EIO;
+    }
+    return ulam_outfile_commit(&o);
+}
+
 /* Write the PNG stream to f; 0 or ULAM_EIO (libpng reports by longjmp). */
 static int png_stream(FILE *f, int width, int height, const unsigned char *rgb)
 {

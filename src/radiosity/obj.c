@@ -37,6 +37,8 @@ typedef struct {
     char **groups;
     int64_t ngroups, cap_groups;
     int32_t cur_mat, cur_group;
+    ulam_mtl_note *notes; /* non-diffuse MTL statements ignored, the first of each keyword a material */
+    int64_t nnotes, cap_notes;
     char **mtl_names; /* the mtllib files read, as written, and the OBJ lines that read them */
     long *mtl_lines;
     int64_t nmtl, cap_mtl, cap_mtl_lines;
@@ -62,6 +64,14 @@ static void objr_free(objr *o)
     free(o->mtl_names), free(o->mtl_lines);
     free(o->v), free(o->idx), free(o->faces);
     free(o->mats), free(o->groups), free(o->dir);
+    ulam_mtl_notes_free(o->notes, o->nnotes);
+}
+
+/* Free notes; accepts NULL. */
+void ulam_mtl_notes_free(ulam_mtl_note *notes, int64_t n)
+{
+    for (int64_t i = 0; notes && i < n; i++) free(notes[i].file), free(notes[i].material);
+    free(notes);
 }
 
 /* Strip a comment and trailing white space (including a CR) in place. */
@@ -160,6 +170,38 @@ static int mtl_colour(objr *o, const char *path, long line, char *args, int is_k
     return ULAM_OK;
 }
 
+/* Nonzero when MTL statement s with args leaves a diffuse material as it is: Ka (ambient, not
+ * physical), Ni (matters only with transparency), and the matte values Ks 0 0 0, Ns 0, d 1,
+ * Tr 0, illum 0, 1 or 2, Tf 1 1 1. */
+static int matte_statement(const char *s, char *args)
+{
+    double x[3];
+    int n = parse_numbers(args, x, 3);
+    if (!strcmp(s, "Ka") || !strcmp(s, "Ni")) return 1;
+    if (!strcmp(s, "Ks")) return n >= 1 && x[0] == 0 && (n < 2 || x[1] == 0) && (n < 3 || x[2] == 0);
+    if (!strcmp(s, "d")) return n == 1 && x[0] == 1;
+    if (!strcmp(s, "Ns")) return n == 1 && x[0] == 0;
+    if (!strcmp(s, "Tr")) return n == 1 && x[0] == 0;
+    if (!strcmp(s, "illum")) return n == 1 && (x[0] == 0 || x[0] == 1 || x[0] == 2);
+    if (!strcmp(s, "Tf")) return n >= 1 && x[0] == 1 && (n < 2 || x[1] == 1) && (n < 3 || x[2] == 1);
+    return 0;
+}
+
+/* Note an ignored non-diffuse statement s of material cur at path:line (once a keyword a
+ * material); ULAM_OK or ULAM_ENOMEM. */
+static int note_ignored(objr *o, const mtl *cur, const char *path, long line, const char *s)
+{
+    for (int64_t i = 0; i < o->nnotes; i++)
+        if (!strcmp(o->notes[i].material, cur->name) && !strncmp(o->notes[i].keyword, s, sizeof o->notes[i].keyword - 1))
+            return ULAM_OK;
+    if (ulam__grow(&o->notes, &o->cap_notes, o->nnotes + 1, sizeof *o->notes)) return ULAM_ENOMEM;
+    ulam_mtl_note *n = &o->notes[o->nnotes];
+    *n = (ulam_mtl_note){.file = dup_str(path), .material = dup_str(cur->name), .line = line};
+    snprintf(n->keyword, sizeof n->keyword, "%s", s);
+    o->nnotes++;
+    return n->file && n->material ? ULAM_OK : ULAM_ENOMEM;
+}
+
 /* Read the MTL file name (relative to the OBJ's folder); obj_line is the mtllib line. */
 static int read_mtl(objr *o, const char *name, long obj_line)
 {
@@ -224,7 +266,10 @@ static int read_mtl(objr *o, const char *name, long obj_line)
             double c[3];
             status = mtl_colour(o, path, line, args, kd, c);
             if (!status) memcpy(kd ? cur->kd : cur->ke, c, sizeof c), *given = line;
-        } /* every other MTL statement (Ka, Ks, Ns, d, illum, map_*, ...) is not ulam's business */
+        } else if (cur && !matte_statement(s, args) && note_ignored(o, cur, path, line, s)) {
+            /* every other statement (Ks, Ns, d, illum, map_*, ...) is ignored: noted, unless matte */
+            status = mtl_fail(o, path, ULAM_ENOMEM, line, "%s", "memory for a note");
+        }
     }
     if (!status && ferror(f)) status = mtl_fail(o, path, ULAM_EIO, line, "%s", "a readable file");
     free(buf);
@@ -497,7 +542,16 @@ static int build_scene(objr *o, ulam_scene **out)
 /* Read an OBJ scene. */
 int ulam_scene_read_obj(const char *path, ulam_scene **out, ulam_error *err)
 {
+    return ulam_scene_read_obj_notes(path, out, NULL, NULL, err);
+}
+
+/* Read an OBJ scene and the MTL statements it ignored. */
+int ulam_scene_read_obj_notes(const char *path, ulam_scene **out, ulam_mtl_note **notes, int64_t *nnotes,
+                              ulam_error *err)
+{
     ulam__clear(err);
+    if (notes) *notes = NULL;
+    if (nnotes) *nnotes = 0;
     if (!path || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path and an output");
     *out = NULL;
     objr o = {.cur_mat = -1, .cur_group = -1, .err = err};
@@ -516,6 +570,7 @@ int ulam_scene_read_obj(const char *path, ulam_scene **out, ulam_error *err)
     fclose(f);
     if (!status && (status = build_scene(&o, out)))
         ulam__fail(err, status, 0, -1, "memory for the scene");
+    if (!status && notes && nnotes) *notes = o.notes, *nnotes = o.nnotes, o.notes = NULL, o.nnotes = 0;
     objr_free(&o);
     return status;
 }

@@ -15,7 +15,7 @@
  * particle stops), and the particle survives with q_j, its weights becoming rho_jc W_c / q_j.
  * Then B_j = E_j + R_j / A_j.
  *
- * Next-event gathering (ULAM_NEXT_EVENT*) scores E_i at the start and, at every patch p a
+ * Next-event gathering (ULAM_RAD_NEXT_EVENT*, the default) scores E_i at the start and, at every patch p a
  * walk visits, one light sample: a point y on an emitter l drawn with area density
  * p_L(y) = sum_c E_lc / P (P = sum_l A_l sum_c E_lc) and a uniform point x of p, scoring
  * W rho_p E_l G(x, y) / p_L(y) w_L with G = cos cos_l / (pi r^2) when the shadow ray sees y.
@@ -23,7 +23,11 @@
  * p_C(y) = G(x, y) is the area density of that landing point.  w_L + w_C = 1 (power or
  * balance heuristic of p_L and p_C; w_L = 1, w_C = 0 for light sampling alone), so each
  * patch's direct term rho_p sum_j F_pj E_j is counted once in expectation; x is uniform on p
- * in both strategies, so the expectation is the patch-averaged F_pj (README).
+ * in both strategies, so the expectation is the patch-averaged F_pj (README).  The light
+ * sampling and its weights are lights.c's.
+ *
+ * A point solver (ulam_rad_point_alloc) runs point.c's walks from one point of the continuous
+ * surfaces instead, with the same rounds, statistics and stopping rules.
  *
  * As in ulam_solve, block k of walks draws from the stream (seed, k) and blocks merge in
  * index order: the result does not depend on the number of threads. */
@@ -69,8 +73,10 @@ struct ulam_rad_solver {
     int threads;
     double *q;            /* continuation per patch: max_c rho */
     double per_step[3], range[3], qmax; /* gathering: the score bounds of the rel_err rule */
-    double *cdf, ptot;    /* shooting: cumulative power over emitters */
-    int64_t *emitter, nem;
+    ulam__lights L;       /* the emitters (shooting's source, next-event's lights) */
+    int at;               /* a point solver: walks from at_x (normal at_n, on patch at_self or -1) */
+    double at_x[3], at_n[3];
+    int64_t at_self;
     rad_scratch *scratch;
     rad_block *blocks;
     ulam__moments m[3];
@@ -91,21 +97,34 @@ ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s)
             free(s->scratch[k].hist), free(s->scratch[k].touched), free(s->scratch[k].mark);
     if (s->blocks)
         for (int k = 0; k < RROUND; k++) free(s->blocks[k].t);
-    free(s->q), free(s->cdf), free(s->emitter), free(s->scratch), free(s->blocks);
+    ulam__lights_free(&s->L);
+    free(s->q), free(s->scratch), free(s->blocks);
     free(s->sum), free(s->sumsq);
     free(s);
     return NULL;
 }
 
-/* Check the options for a patch walk. */
-static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, ulam_error *err)
+/* Nonzero for a next-event estimator. */
+static int next_event(int estimator)
+{
+    return estimator == ULAM_RAD_NEXT_EVENT || estimator == ULAM_RAD_NEXT_EVENT_BALANCE ||
+           estimator == ULAM_RAD_NEXT_EVENT_LIGHT;
+}
+
+/* Check the options for a patch walk (point: a point solver, whose index is not read). */
+static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, int point, ulam_error *err)
 {
     if (o->mode != ULAM_ADJOINT && o->mode != ULAM_FORWARD)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "mode gathering (adjoint) or shooting (forward)");
-    int nee = o->estimator >= ULAM_NEXT_EVENT && o->estimator <= ULAM_NEXT_EVENT_LIGHT;
-    if (o->estimator != ULAM_COLLISION && o->estimator != ULAM_ABSORPTION && !(nee && o->mode == ULAM_ADJOINT))
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision or absorption (next-event: gathering only)");
-    if (o->index < 0 || o->index >= sc->npatches)
+    if (o->mode == ULAM_FORWARD && o->estimator != ULAM_RAD_COLLISION && o->estimator != ULAM_RAD_ABSORPTION)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "shooting takes estimator ULAM_RAD_COLLISION or ULAM_RAD_ABSORPTION "
+                                                   "(next-event, the default, is for gathering)");
+    if (!next_event(o->estimator) && o->estimator != ULAM_RAD_COLLISION && (o->estimator != ULAM_RAD_ABSORPTION || point))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "an estimator of enum ulam_rad_estimator (point walks: next-event "
+                                                   "or collision)");
+    if (point && o->mode != ULAM_ADJOINT)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "point walks gather (mode adjoint)");
+    if (!point && (o->index < 0 || o->index >= sc->npatches))
         return ulam__fail(err, ULAM_EINVAL, 0, o->index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
     if (o->continue_q != 0 || o->roulette != 0 || o->split != 0 || o->kernel_alpha != 1.0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette, split or kernel exponent other "
@@ -114,24 +133,11 @@ static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, ulam_error 
     return ulam__budgets_check(o, err);
 }
 
-/* The shooting source: emitters and their cumulative power (channel sums). */
+/* The emitters: shooting's source and next-event's lights. */
 static int build_source(ulam_rad_solver *s, ulam_error *err)
 {
-    const ulam_scene *sc = s->s;
-    int64_t n = sc->npatches;
-    s->emitter = ulam__malloc((size_t)n, sizeof *s->emitter);
-    s->cdf = ulam__malloc((size_t)n, sizeof *s->cdf);
-    if (!s->emitter || !s->cdf) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the emitters");
-    for (int64_t p = 0; p < n; p++) {
-        const double *E = sc->emit + 3 * p;
-        double phi = sc->area[p] * (E[0] + E[1] + E[2]);
-        if (phi > 0) {
-            s->ptot += phi;
-            s->emitter[s->nem] = p;
-            s->cdf[s->nem++] = s->ptot;
-        }
-    }
-    if (s->nem == 0 && s->o.mode == ULAM_FORWARD)
+    if (ulam__lights_build(s->s, &s->L)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the emitters");
+    if (s->L.nem == 0 && s->o.mode == ULAM_FORWARD)
         return ulam__fail(err, ULAM_EUNDEFINED, 0, -1, "an emitting patch (Ke > 0) to shoot from");
     return ULAM_OK;
 }
@@ -143,7 +149,7 @@ static int build_source(ulam_rad_solver *s, ulam_error *err)
 static void score_bounds(ulam_rad_solver *s)
 {
     const ulam_scene *sc = s->s;
-    int nee = s->o.estimator >= ULAM_NEXT_EVENT;
+    int nee = next_event(s->o.estimator);
     s->qmax = 0.0;
     for (int c = 0; c < 3; c++) s->per_step[c] = s->range[c] = 0.0;
     for (int64_t p = 0; p < sc->npatches; p++) {
@@ -155,7 +161,7 @@ static void score_bounds(ulam_rad_solver *s)
         }
     }
     for (int c = 0; c < 3; c++) {
-        if (s->o.estimator != ULAM_ABSORPTION) s->range[c] = s->per_step[c] > 0 ? INFINITY : 0.0;
+        if (s->o.estimator != ULAM_RAD_ABSORPTION) s->range[c] = s->per_step[c] > 0 ? INFINITY : 0.0;
         if (nee && s->per_step[c] > 0) s->per_step[c] = INFINITY;
     }
 }
@@ -185,15 +191,15 @@ static int alloc_work(ulam_rad_solver *s)
     return s->sum && s->sumsq ? ULAM_OK : ULAM_ENOMEM;
 }
 
-/* Prepare patch walks. */
-int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
-                          ulam_error *err)
+/* Prepare walks from patch opts->index, or (point) from a point. */
+static int solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, int point, ulam_rad_solver **out,
+                        ulam_error *err)
 {
     ulam__clear(err);
     if (!t || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer and an output");
     *out = NULL;
     ulam_walk_opts o = opts ? *opts : ulam_walk_defaults();
-    int status = check_opts(ulam__tracer_scene(t), &o, err);
+    int status = check_opts(ulam__tracer_scene(t), &o, point, err);
     if (status) return status;
     ulam_rad_solver *s = calloc(1, sizeof *s);
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
@@ -203,7 +209,8 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam
     s->threads = ulam__threads(o.threads);
     ulam__run_reset(&s->run);
     s->o.max_walks = ulam__walk_cap(&o);
-    if ((o.mode == ULAM_FORWARD || o.estimator >= ULAM_NEXT_EVENT) && (status = build_source(s, err))) {
+    s->at = point;
+    if ((status = build_source(s, err))) {
         ulam_rad_solver_free(s);
         return status;
     }
@@ -215,11 +222,86 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam
     return ULAM_OK;
 }
 
+/* Prepare patch walks. */
+int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
+                          ulam_error *err)
+{
+    return solver_alloc(t, opts, 0, out, err);
+}
+
+/* Prepare walks from point x (normal n, or NULL: the patch's it lies on). */
+int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+                         ulam_rad_solver **out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!t || !x || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, a point and an output");
+    *out = NULL;
+    const ulam_scene *sc = ulam__tracer_scene(t);
+    double nn[3], len = n ? sqrt(ulam__dot3(n, n)) : 0.0;
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(x[k]) || (n && !isfinite(n[k]))) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a finite point and normal");
+    if (n && !(len > 0)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero normal");
+    int64_t p = ulam_scene_locate(sc, x, ULAM_RAD_LOCATE_REL);
+    if (!n && p < 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point on a patch (within %g of its size) or a normal for a "
+                                                   "sensor off the surfaces", ULAM_RAD_LOCATE_REL);
+    for (int k = 0; k < 3; k++) nn[k] = n ? n[k] / len : sc->normal[3 * p + k];
+    if (p >= 0 && ulam__dot3(nn, sc->normal + 3 * p) < 1.0 - 1e-9)
+        return ulam__fail(err, ULAM_EINVAL, 0, p, "the normal of patch %lld the point lies on (or no normal)",
+                          (long long)p + 1);
+    int status = solver_alloc(t, opts, 1, out, err);
+    if (status) return status;
+    ulam_rad_solver *s = *out;
+    for (int k = 0; k < 3; k++) s->at_x[k] = x[k], s->at_n[k] = nn[k];
+    s->at_self = p;
+    if (p >= 0) { /* onto the patch's plane exactly */
+        const double *v = sc->vert + 3 * sc->vidx[sc->start[p]], *pn = sc->normal + 3 * p;
+        double d[3];
+        ulam__sub3(x, v, d);
+        double h = ulam__dot3(d, pn);
+        for (int k = 0; k < 3; k++) s->at_x[k] -= h * pn[k];
+    }
+    return ULAM_OK;
+}
+
+/* A point solver's answer: irradiance, and radiosity on the patch the point lies on. */
+int ulam_rad_point_result(const ulam_rad_solver *s, ulam_rad_point *r)
+{
+    if (!s || !r || !s->at) return ULAM_EINVAL;
+    memset(r, 0, sizeof *r);
+    ulam_rad_solver_result(s, &r->run);
+    r->patch = s->at_self;
+    for (int c = 0; c < 3; c++) {
+        r->irradiance[c] = r->run.radiosity[c], r->irradiance_se[c] = r->run.std_error[c];
+        r->radiosity[c] = r->radiosity_se[c] = NAN;
+        if (r->patch < 0) continue;
+        double rho = s->s->rho[3 * r->patch + c];
+        r->radiosity[c] = s->s->emit[3 * r->patch + c] + rho * r->irradiance[c];
+        r->radiosity_se[c] = rho * r->irradiance_se[c];
+    }
+    for (int k = 0; k < 3; k++) r->x[k] = s->at_x[k], r->n[k] = s->at_n[k];
+    return ULAM_OK;
+}
+
+/* Run a point solver to the end (ulam_rad_point_alloc, iterate, result, free). */
+int ulam_rad_point_query(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+                         ulam_rad_point *r, ulam_error *err)
+{
+    ulam_rad_solver *s = NULL;
+    int status = ulam_rad_point_alloc(t, opts, x, n, &s, err);
+    if (status) return status;
+    while (!status && !ulam_rad_solver_done(s)) status = ulam_rad_solver_iterate(s);
+    if (!status) ulam_rad_point_result(s, r);
+    else ulam__fail(err, status, 0, -1, "finite scores");
+    ulam_rad_solver_free(s);
+    return status;
+}
+
 /* One gathering walk from the patch: its RGB score. */
 static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_block *br)
 {
     const ulam_scene *sc = s->s;
-    int absorb = s->o.estimator == ULAM_ABSORPTION;
+    int absorb = s->o.estimator == ULAM_RAD_ABSORPTION;
     int64_t p = s->o.index;
     double W[3] = {1, 1, 1};
     score[0] = score[1] = score[2] = 0.0;
@@ -244,46 +326,16 @@ static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_b
     }
 }
 
-/* The weight of a strategy of density a against the other's b: the power heuristic (exponent 2),
- * the balance heuristic, or 1 for light sampling alone (whose partner then gets 0).  In the
- * ratio form, a landing point at distance 0 (a = inf) gets weight 1, not NaN. */
-static double mis_weight(int estimator, double a, double b, int light)
-{
-    if (estimator == ULAM_NEXT_EVENT_LIGHT) return light ? 1.0 : 0.0;
-    double r = b / a;
-    return estimator == ULAM_NEXT_EVENT_BALANCE ? 1.0 / (1.0 + r) : 1.0 / (1.0 + r * r);
-}
-
-/* The emitter drawn in proportion to power from u in [0, ptot). */
-static int64_t pick_emitter(const ulam_rad_solver *s, double u)
-{
-    int64_t lo = 0, hi = s->nem - 1;
-    while (lo < hi) { /* the first emitter whose cumulative power exceeds u */
-        int64_t mid = lo + (hi - lo) / 2;
-        if (s->cdf[mid] > u) hi = mid;
-        else lo = mid + 1;
-    }
-    return s->emitter[lo];
-}
-
-/* Next event at patch p: one light sample's score, weighted, added to score (W before p's
- * reflection). */
+/* Next event at patch p: one light sample (lights.c) from a uniform point of p, weighted
+ * (W before p's reflection). */
 static void light_sample(const ulam_rad_solver *s, ulam_rng *r, int64_t p, const double W[3], double score[3],
                          rad_block *br)
 {
-    const ulam_scene *sc = s->s;
-    int64_t l = pick_emitter(s, ulam__rng_uniform(r) * s->ptot);
-    double x[3], y[3];
+    const double *rho = s->s->rho + 3 * p;
+    double x[3], Wr[3] = {W[0] * rho[0], W[1] * rho[1], W[2] * rho[2]};
+    int64_t l = ulam__lights_pick(&s->L, ulam__rng_uniform(r));
     ulam__tracer_point(s->t, p, r, x);
-    ulam__tracer_point(s->t, l, r, y);
-    ulam__hit h;
-    int seen = ulam__tracer_sees(s->t, p, x, l, y, &h);
-    br->rays += h.cos_from > 0 && h.cos_to > 0 && p != l; /* a shadow ray was cast */
-    if (!seen) return;
-    const double *E = sc->emit + 3 * l, *rho = sc->rho + 3 * p;
-    double pl = (E[0] + E[1] + E[2]) / s->ptot, G = h.cos_from * h.cos_to / (M_PI * h.dist * h.dist);
-    double f = G / pl * mis_weight(s->o.estimator, pl, G, 1);
-    for (int c = 0; c < 3; c++) score[c] += W[c] * rho[c] * E[c] * f;
+    br->rays += ulam__lights_score(s->t, &s->L, s->o.estimator, l, x, s->s->normal + 3 * p, p, Wr, r, score);
 }
 
 /* One next-event gathering walk from the patch: its RGB score. */
@@ -295,7 +347,7 @@ static void gather_next_event(const ulam_rad_solver *s, ulam_rng *r, double scor
     for (int c = 0; c < 3; c++) score[c] = sc->emit[3 * p + c];
     for (int64_t step = 0;; step++) {
         double q = s->q[p];
-        if (q > 0 && s->nem) light_sample(s, r, p, W, score, br);
+        if (q > 0 && s->L.nem) light_sample(s, r, p, W, score, br);
         if (ulam__rng_uniform(r) >= q) return;
         if (step >= s->o.max_steps) {
             br->cut++;
@@ -307,9 +359,8 @@ static void gather_next_event(const ulam_rad_solver *s, ulam_rng *r, double scor
         br->rays++;
         if (j < 0) return;
         const double *E = sc->emit + 3 * j;
-        double esum = E[0] + E[1] + E[2];
-        if (esum > 0) { /* the walk's own hit on an emitter, weighted against light sampling */
-            double pc = h.cos_from * h.cos_to / (M_PI * h.dist * h.dist), w = mis_weight(s->o.estimator, pc, esum / s->ptot, 0);
+        if (E[0] + E[1] + E[2] > 0) { /* the walk's own hit on an emitter, weighted against light sampling */
+            double w = ulam__lights_hit_weight(&s->L, sc, s->o.estimator, j, &h);
             for (int c = 0; c < 3; c++) score[c] += W[c] * E[c] * w;
         }
         p = j;
@@ -329,11 +380,11 @@ static void tally(rad_scratch *sc, int64_t p, const double w[3], double scale)
 static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_block *br)
 {
     const ulam_scene *scn = s->s;
-    int absorb = s->o.estimator == ULAM_ABSORPTION;
-    int64_t p = pick_emitter(s, ulam__rng_uniform(r) * s->ptot);
+    int absorb = s->o.estimator == ULAM_RAD_ABSORPTION;
+    int64_t p = ulam__lights_pick(&s->L, ulam__rng_uniform(r));
     const double *E0 = scn->emit + 3 * p;
     double W[3], esum = E0[0] + E0[1] + E0[2];
-    for (int c = 0; c < 3; c++) W[c] = s->ptot * E0[c] / esum;
+    for (int c = 0; c < 3; c++) W[c] = s->L.ptot * E0[c] / esum;
     for (int64_t step = 0;; step++) {
         if (step >= s->o.max_steps) {
             br->cut++;
@@ -389,8 +440,16 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     for (int64_t w = 0; w < count; w++) {
         if (s->o.mode == ULAM_ADJOINT) {
             double sc[3];
-            if (s->o.estimator >= ULAM_NEXT_EVENT) gather_next_event(s, &r, sc, br);
-            else gather(s, &r, sc, br);
+            if (s->at) {
+                int64_t cut = 0;
+                ulam__point_walk(s->t, &s->L, s->q, s->o.estimator, s->o.max_steps, s->at_x, s->at_n, s->at_self, &r,
+                                 sc, &br->rays, &cut);
+                br->cut += cut;
+            } else if (next_event(s->o.estimator)) {
+                gather_next_event(s, &r, sc, br);
+            } else {
+                gather(s, &r, sc, br);
+            }
             for (int c = 0; c < 3; c++) {
                 ulam__moments_add(&br->m[c], sc[c]);
                 if (!isfinite(sc[c])) br->nonfinite++;
@@ -400,6 +459,8 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             br->maxsq = fmax(br->maxsq, x * x);
         } else {
             shoot(s, &r, &s->scratch[th], br);
+            for (int c = 0; c < 3; c++) /* the patch's tally, 0 when untouched: its moments for rel_err */
+                ulam__moments_add(&br->m[c], s->scratch[th].hist[3 * s->o.index + c]);
             if (flush_history(&s->scratch[th], br)) {
                 br->nomem = 1;
                 return;
@@ -475,8 +536,11 @@ static void channel_mins(const ulam_rad_solver *s, double mins[3])
 
 /* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
  * takes the rule of src/stop.h (ulam__stop_rel_met on each channel's 95% interval; mins from
- * channel_mins hold a channel still at 0); shooting, and gathering without a certified range, the
- * standard error alone. */
+ * channel_mins hold a channel still at 0); shooting at patch opts->index, with the moments of
+ * that patch's per-particle tallies, and gathering without a certified range (next-event
+ * estimation), the rule as it was (ulam__rel_err_holds: the standard error and the variance's
+ * own error from the fourth moment, no range term: a particle may return to the patch any
+ * number of times, no bound on its tally; a known gap). */
 static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, const double mins[3], double rel_err)
 {
     int any = 0;
@@ -492,10 +556,9 @@ static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, co
         if (r->radiosity[c] == 0.0) continue;
         ulam__stop_ci ci;
         if (s->o.mode != ULAM_FORWARD) channel_interval(s, c, r->radiosity[c], rel_err, &ci);
-        /* no certified range (next-event estimation: unbounded per-visit scores): the standard
-           error alone, as shooting (a known gap: such a stop has no range term) */
         if (s->o.mode == ULAM_FORWARD || ci.kind == ULAM__STOP_NONE
-                ? !(r->std_error[c] <= rel_err * fabs(r->radiosity[c]))
+                ? !ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c], mins[c],
+                                       ulam__moments_variance_rel_error(&s->m[c]), rel_err)
                 : !ulam__stop_rel_met(&ci, r->radiosity[c], rel_err))
             return 0;
         any = 1;
@@ -576,7 +639,7 @@ static void result(const ulam_rad_solver *s, const double mins[3], ulam_rad_resu
         }
     }
     r->max_share = s->sq > 0 ? fmin(1.0, s->maxsq / s->sq) : 0.0;
-    for (int c = 0; c < 3 && s->o.mode == ULAM_ADJOINT && s->o.rel_err > 0; c++) {
+    for (int c = 0; c < 3 && s->o.rel_err > 0; c++) {
         r->min_walks = fmax(r->min_walks, mins[c]); /* 0 in a channel where no minimum applies */
         if (s->m[c].mean != 0.0)
             r->variance_rel_error = fmax(r->variance_rel_error, ulam__moments_variance_rel_error(&s->m[c]));

@@ -50,6 +50,11 @@ void ulam__cosine_dir(const double n[3], ulam_rng *r, double d[3]);
  * outside a closed room sees into it), or -1. */
 int64_t ulam__tracer_cast_front(const ulam_tracer *t, const double org[3], const double dir[3]);
 
+/* ulam__tracer_cast_front, and where on the patch: fan triangle k (vertices 0, k, k + 1) and the
+ * barycentric u, v of its vertices k and k + 1. */
+int64_t ulam__tracer_cast_front_uv(const ulam_tracer *t, const double org[3], const double dir[3], int64_t *k, double *u,
+                                   double *v);
+
 /* Where a ray landed: its length and the cosines at its two ends (at the patch it left, and
  * at the patch it reached, positive on its front). */
 typedef struct {
@@ -66,12 +71,57 @@ void ulam__tracer_point(const ulam_tracer *t, int64_t p, ulam_rng *r, double pt[
  * reaches l's front and meets no other patch on the way; *h gets its length and cosines. */
 int ulam__tracer_sees(const ulam_tracer *t, int64_t p, const double x[3], int64_t l, const double y[3], ulam__hit *h);
 
+/* ulam__tracer_sees from a point x with unit normal n on patch self (-1: on no patch). */
+int ulam__tracer_sees_from(const ulam_tracer *t, const double x[3], const double n[3], int64_t self, int64_t l,
+                           const double y[3], ulam__hit *h);
+
+/* The first patch other than self (-1: none) the ray org + t dir (dir unit, t > 0) hits, or -1;
+ * *front is 1 on its front side, *dist its distance. */
+int64_t ulam__tracer_ray(const ulam_tracer *t, const double org[3], const double dir[3], int64_t self, int *front,
+                         double *dist);
+
 /* The scene a tracer was built on. */
 const ulam_scene *ulam__tracer_scene(const ulam_tracer *t);
 
 /* Restart a gathering solver at patch p (rel_err, seed and max_seconds replaced), its
  * statistics cleared and its workspace kept. */
 void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds);
+
+/* The emitters as a light source for next-event estimation (lights.c). */
+typedef struct {
+    int64_t *emitter; /* the emitting patches */
+    double *cdf;      /* their cumulative power A sum_c E */
+    int64_t nem;
+    double ptot;      /* the total */
+} ulam__lights;
+
+/* The emitters of s; ULAM_OK or ULAM_ENOMEM. */
+int ulam__lights_build(const ulam_scene *s, ulam__lights *L);
+
+/* Free the table's arrays (the struct is the caller's). */
+void ulam__lights_free(ulam__lights *L);
+
+/* The emitter drawn in proportion to power from u in [0, 1). */
+int64_t ulam__lights_pick(const ulam__lights *L, double u);
+
+/* MIS weight of a strategy of density a against the other's b (light: the strategy is light
+ * sampling), for estimator (enum ulam_rad_estimator). */
+double ulam__mis_weight(int estimator, double a, double b, int light);
+
+/* A light sample at x (unit normal n, on patch self or -1) toward emitter l: a uniform point y of
+ * l and W E_l G / p_L w_L added to score when seen; the shadow rays cast (0 or 1). */
+int ulam__lights_score(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t l, const double x[3],
+                       const double n[3], int64_t self, const double W[3], ulam_rng *r, double score[3]);
+
+/* The MIS weight of a walk's cosine ray that landed (h) on emitter j. */
+double ulam__lights_hit_weight(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t j,
+                               const ulam__hit *h);
+
+/* A point walk (point.c): one walk from x (unit normal n, on patch self or -1) on the continuous
+ * surfaces: its RGB irradiance score; *rays gets the rays cast, *cut 1 when cut at max_steps. */
+void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, const double *q, int estimator, int64_t max_steps,
+                      const double x[3], const double n[3], int64_t self, ulam_rng *r, double score[3],
+                      int64_t *rays, int64_t *cut);
 
 /* Allocate an empty scene with room for the given counts (arrays uninitialised). */
 ulam_scene *ulam__scene_alloc(int64_t npatches, int64_t nverts, int64_t nidx, int64_t ngroups);

@@ -190,6 +190,28 @@ int64_t ulam__tracer_cast_front(const ulam_tracer *t, const double org[3], const
     return cast_from(t, org, dir, -1, 1, NULL, NULL);
 }
 
+/* The same, and where on the patch: its fan triangle k (vertices 0, k, k + 1 of the patch) and
+ * the barycentric u, v of vertices k and k + 1 there. */
+int64_t ulam__tracer_cast_front_uv(const ulam_tracer *t, const double org[3], const double dir[3], int64_t *k, double *u,
+                                   double *v)
+{
+    ray_context rc = {.t = t, .self = -1, .cull = dir};
+    rtcInitIntersectContext(&rc.ctx);
+    struct RTCRayHit rh;
+    rh.ray.org_x = (float)(org[0] - t->centre[0]), rh.ray.org_y = (float)(org[1] - t->centre[1]);
+    rh.ray.org_z = (float)(org[2] - t->centre[2]);
+    rh.ray.dir_x = (float)dir[0], rh.ray.dir_y = (float)dir[1], rh.ray.dir_z = (float)dir[2];
+    rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f, rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(t->scene, &rc.ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
+    int64_t p = t->prim_patch[rh.hit.primID];
+    *k = (int64_t)rh.hit.primID - (t->s->start[p] - 2 * p) + 1; /* a patch of m vertices has m - 2 triangles */
+    *u = rh.hit.u, *v = rh.hit.v;
+    return p;
+}
+
 /* A cosine-distributed ray from a uniform point of patch p: the patch reached, front side. */
 int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r)
 {
@@ -223,14 +245,29 @@ void ulam__tracer_point(const ulam_tracer *t, int64_t p, ulam_rng *r, double pt[
  * front and meets no other patch first; *h gets the distance and the two cosines either way. */
 int ulam__tracer_sees(const ulam_tracer *t, int64_t p, const double x[3], int64_t l, const double y[3], ulam__hit *h)
 {
+    return ulam__tracer_sees_from(t, x, t->s->normal + 3 * p, p, l, y, h);
+}
+
+/* The same from a point x with unit normal n on patch self (-1: a point on no patch). */
+int ulam__tracer_sees_from(const ulam_tracer *t, const double x[3], const double n[3], int64_t self, int64_t l,
+                           const double y[3], ulam__hit *h)
+{
     double d[3];
     ulam__sub3(y, x, d);
     double r = sqrt(ulam__dot3(d, d));
     h->dist = r, h->cos_from = h->cos_to = 0.0;
     if (!(r > 0)) return 0;
     for (int k = 0; k < 3; k++) d[k] /= r;
-    h->cos_from = ulam__dot3(d, t->s->normal + 3 * p);
+    h->cos_from = ulam__dot3(d, n);
     h->cos_to = -ulam__dot3(d, t->s->normal + 3 * l);
-    if (!(h->cos_from > 0) || !(h->cos_to > 0) || p == l) return 0; /* from a back side, or at a light's back */
-    return cast_from(t, x, d, p, 0, NULL, NULL) == l;
+    if (!(h->cos_from > 0) || !(h->cos_to > 0) || self == l) return 0; /* from a back side, or at a light's back */
+    return cast_from(t, x, d, self, 0, NULL, NULL) == l;
+}
+
+/* The ray org + t dir (dir unit) from a point on patch self (-1: none): the first other patch it
+ * hits (-1: none), *front 1 when on its front, *dist the distance. */
+int64_t ulam__tracer_ray(const ulam_tracer *t, const double org[3], const double dir[3], int64_t self, int *front,
+                         double *dist)
+{
+    return cast_from(t, org, dir, self, 0, front, dist);
 }

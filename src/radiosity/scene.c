@@ -299,13 +299,13 @@ int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3
 }
 
 /* Nonzero when x lies in patch p: within tol of its plane and inside every edge, tol being
- * 10^-9 of the patch's size (rounding, so that a point on a shared edge is in both). */
-static int contains(const ulam_scene *s, int64_t p, const double x[3])
+ * rel of the patch's size (rounding, so that a point on a shared edge is in both). */
+static int contains_within(const ulam_scene *s, int64_t p, const double x[3], double rel)
 {
     const double *n = s->normal + 3 * p;
     const int32_t *v = s->vidx + s->start[p];
     int64_t m = s->start[p + 1] - s->start[p];
-    double tol = 1e-9 * sqrt(s->area[p]), d[3];
+    double tol = rel * sqrt(s->area[p]), d[3];
     ulam__sub3(x, s->vert + 3 * v[0], d);
     if (fabs(ulam__dot3(d, n)) > tol) return 0;
     for (int64_t k = 0; k < m; k++) {
@@ -317,6 +317,20 @@ static int contains(const ulam_scene *s, int64_t p, const double x[3])
         if (ulam__dot3(c, n) < -tol * sqrt(ulam__dot3(e, e))) return 0;
     }
     return 1;
+}
+
+/* Nonzero when x lies in patch p to 10^-9 of its size. */
+static int contains(const ulam_scene *s, int64_t p, const double x[3])
+{
+    return contains_within(s, p, x, 1e-9);
+}
+
+/* The lowest-numbered patch that x lies in to rel of the patch's size, or -1. */
+int64_t ulam_scene_locate(const ulam_scene *s, const double x[3], double rel)
+{
+    for (int64_t p = 0; s && p < s->npatches; p++)
+        if (contains_within(s, p, x, rel)) return p;
+    return -1;
 }
 
 /* The patch of group label containing the group's area centroid, else the nearest by centroid. */

@@ -28,8 +28,18 @@
  * state, made by the first query, its time counted there) and keep_kernel (kernel rows built by
  * earlier queries' walks and pilots are kept and rescored, not built again): per-graph work is
  * paid once, inside the queries' times.  The walks-alone peer builds its rows afresh each pair.
+ * The cost of a walk visit in push operations, the balance's step_cost, is measured here: push
+ * operations per second over walk visits per second (walks plus steps), both summed over the
+ * bidirectional queries; and how far the plan's predicted work (push operations plus step_cost
+ * visits) is from the work done.
+ *
+ * A second family (issue 29 point 3), `bench_bidir --zipf [N [SOURCES]]`: the heavy-tailed digraph
+ * of tests/zipf_graph.h (N = 2 10^5 states, out-degrees 1 + Zipf(2.1), heads drawn with weight
+ * rank^-0.75, M = 0.85 P'), SOURCES (default 10) random sources with one target each, drawn among
+ * the states with 1/n <= pi_t <= 20/n, pi = 0.15 x the personalized PageRank; the same methods.
  * Usage: bench_bidir [L [SOURCES]] (default 20 and 20: n = 1048576, 100 pairs). */
 #include "gen.h"
+#include "../zipf_graph.h"
 
 #include <math.h>
 
@@ -208,21 +218,38 @@ static void row(const char *name, const series *S, const series *ref, int np)
     printf("   %d\n", marked);
 }
 
+/* The largest row length of A. */
+static int64_t max_row(const ulam_csr *A)
+{
+    int64_t m = 0;
+    for (int64_t i = 0; i < A->nrows; i++) m = A->rowptr[i + 1] - A->rowptr[i] > m ? A->rowptr[i + 1] - A->rowptr[i] : m;
+    return m;
+}
+
 int main(int argc, char **argv)
 {
-    int L = argc > 1 ? atoi(argv[1]) : 20, nsrc = argc > 2 ? atoi(argv[2]) : SOURCES, np = nsrc * TARGETS;
-    if (L < 8 || L > 24 || nsrc < 1 || nsrc > SOURCES) {
-        fprintf(stderr, "usage: bench_bidir [L [SOURCES]], 8 <= L <= 24, 1 <= SOURCES <= %d\n", SOURCES);
+    int zipf = argc > 1 && !strcmp(argv[1], "--zipf");
+    if (zipf) argc--, argv++;
+    int L = argc > 1 ? atoi(argv[1]) : zipf ? 200000 : 20, nsrc = argc > 2 ? atoi(argv[2]) : zipf ? 10 : SOURCES;
+    int tps = zipf ? 1 : TARGETS, np = nsrc * tps; /* targets per source, pairs */
+    if ((zipf ? L < 1000 : L < 8 || L > 24) || nsrc < 1 || nsrc > SOURCES) {
+        fprintf(stderr, "usage: bench_bidir [L [SOURCES]] or bench_bidir --zipf [N [SOURCES]], 8 <= L <= 24, "
+                        "N >= 1000, 1 <= SOURCES <= %d\n", SOURCES);
         return 2;
     }
     double t0 = ulam_now();
     int64_t dangling = 0, maxin = 0, maxout = 0;
-    ulam_csr *M = rmat(L, &dangling, &maxin, &maxout), *Mt = NULL;
-    int64_t n = (int64_t)1 << L;
+    ulam_csr *M = zipf ? zipf_graph(L, 2.1, 0.75, ALPHA, 1) : rmat(L, &dangling, &maxin, &maxout), *Mt = NULL;
+    int64_t n = zipf ? L : (int64_t)1 << L;
     if (!M) return fprintf(stderr, "bidir: out of memory\n"), 1;
-    printf("R-MAT 2^%d: n = %lld, nnz(M) = %lld (8n edges, multi-edges merged), %lld dangling, max in-degree %lld, "
-           "max out-degree %lld; built in %.1f s\n", L, (long long)n, (long long)ulam_csr_nnz(M), (long long)dangling,
-           (long long)maxin, (long long)maxout, ulam_now() - t0);
+    if (zipf)
+        printf("Zipf digraph: n = %lld, nnz(M) = %lld (out-degrees 1 + Zipf(2.1), heads by rank^-0.75, multi-edges "
+               "merged), max in-neighbours %lld; built in %.1f s\n", (long long)n, (long long)ulam_csr_nnz(M),
+               (long long)max_row(M), ulam_now() - t0);
+    else
+        printf("R-MAT 2^%d: n = %lld, nnz(M) = %lld (8n edges, multi-edges merged), %lld dangling, max in-degree %lld, "
+               "max out-degree %lld; built in %.1f s\n", L, (long long)n, (long long)ulam_csr_nnz(M),
+               (long long)dangling, (long long)maxin, (long long)maxout, ulam_now() - t0);
     t0 = ulam_now();
     ulam_push *w = NULL;
     if (ulam_csr_transpose(M, &Mt) || ulam_push_alloc(M, &w)) return fprintf(stderr, "bidir: out of memory\n"), 1;
@@ -241,6 +268,8 @@ int main(int argc, char **argv)
     ulam_rng r;
     ulam_rng_seed(&r, (uint64_t)L, 1);
     double gs_seconds = 0, sum_push_ops = 0, sum_steps = 0, sum_push_s = 0, sum_walk_s = 0, gs_max_sweeps = 0;
+    double work_ratio[PAIRS], walks_ratio[PAIRS], step_cost = 0; /* predicted / done */
+    double lo = zipf ? 1.0 / ((1 - ALPHA) * (double)n) : 1.0 / (double)n, hi = zipf ? 20 * lo : INFINITY;
     int k = 0;
     printf("\n%4s %8s %8s %12s %10s %9s %9s %9s %10s %10s %7s %9s %9s %9s\n", "pair", "s", "t", "exact", "bidir_s",
            "push_s", "walks_s", "rmax", "walks", "predicted", "z", "walk1_s", "push1_s", "push1_rmax");
@@ -252,9 +281,9 @@ int main(int argc, char **argv)
         gs_max_sweeps = fmax(gs_max_sweeps, sweeps);
         int64_t nc = 0;
         for (int64_t i = 0; i < n; i++)
-            if (i != s && x[i] >= 1.0 / (double)n) cand[nc++] = i;
-        if (nc < TARGETS) continue; /* a source reaching too little: draw another */
-        for (int q = 0; q < TARGETS; q++, k++) {
+            if (i != s && x[i] >= lo && x[i] <= hi) cand[nc++] = i;
+        if (nc < tps) continue; /* a source reaching too little: draw another */
+        for (int q = 0; q < tps; q++, k++) {
             int64_t j = q + (int64_t)ulam_rng_bounded(&r, (uint64_t)(nc - q)); /* without replacement */
             int64_t t = cand[j];
             cand[j] = cand[q], cand[q] = t;
@@ -262,7 +291,12 @@ int main(int argc, char **argv)
             if (query(w, Mt, &g, s, t, 0, 0, (uint64_t)k + 1, &rb)) return 1;
             bi.seconds[k] = rb.seconds, bi.other[k] = rb.push.seconds, bi.walk[k] = rb.walks.seconds;
             bi.covered += rb.ci95[0] <= x[t] && x[t] <= rb.ci95[1], bi.intervals++;
-            sum_push_ops += (double)rb.push.ops, sum_steps += (double)rb.walks.steps;
+            sum_push_ops += (double)rb.push.ops, sum_steps += (double)(rb.walks.steps + rb.walks.walks);
+            step_cost = rb.plan.step_cost;
+            double done = (double)rb.push.ops + rb.plan.step_cost * (double)(rb.plan.pilot_walks + rb.plan.pilot_steps +
+                                                                             rb.walks.walks + rb.walks.steps);
+            work_ratio[k] = rb.plan.predicted_work / done;
+            walks_ratio[k] = rb.plan.predicted_walks / fmax(1.0, (double)rb.walks.walks);
             sum_push_s += rb.push.seconds, sum_walk_s += rb.walks.seconds;
             int covers;
             wk.seconds[k] = walks_alone(Mt, &g, e, s, t, x[t], (uint64_t)k + 1, &wk.marked[k], &covers);
@@ -278,8 +312,12 @@ int main(int argc, char **argv)
         src++;
     }
     printf("\nexact values: Gauss-Seidel, %.1f s for %d sources (up to %.0f sweeps)\n", gs_seconds, nsrc, gs_max_sweeps);
-    printf("bidirectional work: push %.3g operations/s, walks %.3g steps/s (one thread; the balance takes a step "
-           "as 1 operation)\n", sum_push_ops / sum_push_s, sum_steps / sum_walk_s);
+    printf("bidirectional work: push %.3g operations/s, walks %.3g visits/s (one thread): a visit costs %.2f push "
+           "operations (the balance's step_cost: %.2f)\n", sum_push_ops / sum_push_s, sum_steps / sum_walk_s,
+           (sum_push_ops / sum_push_s) / (sum_steps / sum_walk_s), step_cost);
+    printf("the plan's prediction over what was done: work median %.2fx (p90 %.2fx), walks median %.2fx (p90 %.2fx)\n",
+           quantile(work_ratio, np, 0.5), quantile(work_ratio, np, 0.9), quantile(walks_ratio, np, 0.5),
+           quantile(walks_ratio, np, 0.9));
     printf("\n%d pairs at %.0f%% relative error, one thread; seconds per query (median, 90th percentile), ratios to "
            "bidirectional\n", np, 100 * REL);
     printf("%-22s %10s %10s %10s %10s %13s   %-7s   %s\n", "method", "median", "p90", "med/bidir", "p90/bidir",

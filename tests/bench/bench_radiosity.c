@@ -14,7 +14,14 @@
  *    seen patch (coverage 0), against shooting (a run of P particles, default 2,000,000,
  *    projected to the particles that bring every seen patch to 1%: P (worst rel. error / 1%)^2)
  *    and against the direct route (what it would need).
- * Usage: bench_radiosity [scene.obj [WxH [P]]] (run from the source root). */
+ * 4. (bench_radiosity points) A 10 x 10 sensor grid on the work plane (0.8 m) of an office of
+ *    about 10^4 triangles (6 x 4 x 3 m, six ceiling panels, four desks; written by this program),
+ *    every point to 2% (next-event point walks, 2 threads): seconds, walks, rays, worst point.
+ * 5. (bench_radiosity points) A point query to 1% against a next-event patch query to 1% on the
+ *    same scene (the patch holding the point): rays of each and their ratio (target <= 2), on the
+ *    Cornell box floor centre (unsubdivided and at ~2,000 patches) and the office floor.
+ * Usage: bench_radiosity [scene.obj [WxH [P]]] (run from the source root); bench_radiosity points;
+ * bench_radiosity office OUT.obj (write the office scene and its .mtl). */
 #include "ulam_radiosity.h"
 
 #include <math.h>
@@ -89,7 +96,7 @@ static int64_t beside_light(const ulam_scene *s)
     return best;
 }
 
-static const int ests[4] = {ULAM_COLLISION, ULAM_NEXT_EVENT, ULAM_NEXT_EVENT_BALANCE, ULAM_NEXT_EVENT_LIGHT};
+static const int ests[4] = {ULAM_RAD_COLLISION, ULAM_RAD_NEXT_EVENT, ULAM_RAD_NEXT_EVENT_BALANCE, ULAM_RAD_NEXT_EVENT_LIGHT};
 static const char *const est_name[4] = {"collision", "next-event MIS power", "next-event MIS balance",
                                         "next-event light only"};
 
@@ -112,8 +119,157 @@ static void near_light(const char *what, const ulam_tracer *t, int64_t p, int64_
     }
 }
 
+/* One rectangle p0 + a e1 + b e2 as cells no longer than h on a side, two triangles each, facing
+ * e1 x e2; vertices counted from *nv. */
+static void rect(FILE *f, const double p0[3], const double e1[3], const double e2[3], double h, long *nv)
+{
+    int m = (int)ceil(sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]) / h);
+    int n = (int)ceil(sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]) / h);
+    long base = *nv + 1;
+    for (int j = 0; j <= n; j++)
+        for (int i = 0; i <= m; i++) {
+            double a = (double)i / m, b = (double)j / n;
+            fprintf(f, "v %.6f %.6f %.6f\n", p0[0] + a * e1[0] + b * e2[0], p0[1] + a * e1[1] + b * e2[1],
+                    p0[2] + a * e1[2] + b * e2[2]);
+        }
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < m; i++) {
+            long v = base + (long)j * (m + 1) + i, w = v + m + 1;
+            fprintf(f, "f %ld %ld %ld\nf %ld %ld %ld\n", v, v + 1, w + 1, v, w + 1, w);
+        }
+    *nv += (long)(m + 1) * (n + 1);
+}
+
+/* An axis-aligned box [lo, hi] without its bottom, faces outward, as rect cells of h. */
+static void box(FILE *f, const double lo[3], const double hi[3], double h, long *nv)
+{
+    double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+    rect(f, (double[3]){lo[0], hi[1], lo[2]}, (double[3]){0, 0, dz}, (double[3]){dx, 0, 0}, h, nv); /* top, +y */
+    rect(f, lo, (double[3]){0, 0, dz}, (double[3]){0, dy, 0}, h, nv);                            /* -x */
+    rect(f, (double[3]){hi[0], lo[1], lo[2]}, (double[3]){0, dy, 0}, (double[3]){0, 0, dz}, h, nv); /* +x */
+    rect(f, lo, (double[3]){0, dy, 0}, (double[3]){dx, 0, 0}, h, nv);                            /* -z */
+    rect(f, (double[3]){lo[0], lo[1], hi[2]}, (double[3]){dx, 0, 0}, (double[3]){0, dy, 0}, h, nv); /* +z */
+}
+
+/* Write the office: a 6 x 4 x 3 m room (y up; floor Kd 0.2, walls 0.5, ceiling 0.7), six
+ * 0.6 x 0.6 m ceiling panels (Ke 20, Kd 0) 1 cm below it and four 1.4 x 0.7 m desks 0.72 m high
+ * (Kd 0.4), in cells of 0.15 m: about 10^4 triangles.  0 or -1. */
+static int write_office(const char *path)
+{
+    char mtl[4096];
+    snprintf(mtl, sizeof mtl, "%s", path);
+    char *dot = strrchr(mtl, '.');
+    if (!dot || strlen(mtl) + 4 >= sizeof mtl) return -1;
+    strcpy(dot, ".mtl");
+    FILE *f = fopen(path, "w"), *m = fopen(mtl, "w");
+    if (!f || !m) return -1;
+    fprintf(m, "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl wall\nKd 0.5 0.5 0.45\nnewmtl ceiling\nKd 0.7 0.7 0.7\n"
+               "newmtl panel\nKd 0 0 0\nKe 20 20 18\nnewmtl desk\nKd 0.4 0.3 0.2\n");
+    const char *base = strrchr(mtl, '/');
+    fprintf(f, "# The office of bench_radiosity (tests/bench/bench_radiosity.c)\nmtllib %s\n", base ? base + 1 : mtl);
+    const double W = 6, D = 4, H = 3, h = 0.15;
+    long nv = 0;
+    fprintf(f, "o floor\nusemtl floor\n");
+    rect(f, (double[3]){0, 0, 0}, (double[3]){0, 0, D}, (double[3]){W, 0, 0}, h, &nv);
+    fprintf(f, "o ceiling\nusemtl ceiling\n");
+    rect(f, (double[3]){0, H, 0}, (double[3]){W, 0, 0}, (double[3]){0, 0, D}, h, &nv);
+    fprintf(f, "o walls\nusemtl wall\n");
+    rect(f, (double[3]){0, 0, 0}, (double[3]){0, H, 0}, (double[3]){0, 0, D}, h, &nv);
+    rect(f, (double[3]){W, 0, 0}, (double[3]){0, 0, D}, (double[3]){0, H, 0}, h, &nv);
+    rect(f, (double[3]){0, 0, 0}, (double[3]){W, 0, 0}, (double[3]){0, H, 0}, h, &nv);
+    rect(f, (double[3]){0, 0, D}, (double[3]){0, H, 0}, (double[3]){W, 0, 0}, h, &nv);
+    fprintf(f, "o panels\nusemtl panel\n");
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 2; k++)
+            rect(f, (double[3]){1.2 + 1.8 * i, H - 0.01, 1.0 + 1.4 * k}, (double[3]){0.6, 0, 0}, (double[3]){0, 0, 0.6},
+                 0.3, &nv);
+    fprintf(f, "o desks\nusemtl desk\n");
+    for (int i = 0; i < 2; i++)
+        for (int k = 0; k < 2; k++)
+            box(f, (double[3]){1.0 + 2.6 * i, 0, 0.8 + 1.7 * k}, (double[3]){2.4 + 2.6 * i, 0.72, 1.5 + 1.7 * k}, h, &nv);
+    int bad = ferror(f) | ferror(m);
+    bad |= fclose(f) | fclose(m);
+    return bad ? -1 : 0;
+}
+
+/* The office's work-plane grid: 10 x 10 sensors at 0.8 m over x in [0.3, 5.7], z in [0.3, 3.7]. */
+static ulam_rad_grid office_grid(void)
+{
+    return (ulam_rad_grid){.origin = {0.3, 0.8, 0.3}, .u = {5.4, 0, 0}, .v = {0, 0, 3.4}, .normal = {0, 1, 0},
+                           .nu = 10, .nv = 10};
+}
+
+/* Part 5: a point query at x to 1% against the next-event patch query of the patch holding it. */
+static void point_vs_patch(const char *what, const ulam_scene *s, const ulam_tracer *t, const double x[3])
+{
+    int64_t p = ulam_scene_locate(s, x, ULAM_RAD_LOCATE_REL);
+    if (p < 0) return;
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.rel_err = 0.01, o.max_walks = 0, o.seed = 1, o.threads = 2;
+    ulam_rad_point pt;
+    if (ulam_rad_point_query(t, &o, x, NULL, &pt, NULL)) return;
+    ulam_rad_result pa = gather(t, ULAM_RAD_NEXT_EVENT, p, 0.01, 0);
+    printf("| %s | %lld | %.5g +- %.2g | %lld | %lld | %.4f | %.5g +- %.2g | %lld | %lld | %.4f | %.2f |\n", what,
+           (long long)s->npatches, pt.radiosity[0], pt.radiosity_se[0], (long long)pt.run.walks,
+           (long long)pt.run.rays, pt.run.seconds, pa.radiosity[0], pa.std_error[0], (long long)pa.walks,
+           (long long)pa.rays, pa.seconds, (double)pt.run.rays / (double)pa.rays);
+    fflush(stdout);
+}
+
+/* Parts 4 and 5. */
+static int points_bench(void)
+{
+    const char *office = "build/bench_office.obj";
+    ulam_scene *s = NULL, *c0 = NULL, *c1 = NULL;
+    ulam_tracer *t = NULL, *tc0 = NULL, *tc1 = NULL;
+    ulam_error err;
+    if (write_office(office) || ulam_scene_read_obj(office, &s, &err) || ulam_tracer_alloc(s, &t, &err)) {
+        fprintf(stderr, "%s: cannot write or read the office\n", office);
+        return 1;
+    }
+    int64_t tri = s->start[s->npatches] - 2 * s->npatches;
+    ulam_rad_grid g = office_grid();
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.rel_err = 0.02, o.max_walks = 0, o.seed = 1, o.threads = 2;
+    ulam_rad_point *pts = malloc(100 * sizeof *pts);
+    double t0 = ulam_now();
+    if (!pts || ulam_rad_grid_solve(t, &o, &g, pts, &err)) return 1;
+    double sec = ulam_now() - t0, worst = 0, lo = INFINITY, hi = 0;
+    int64_t walks = 0, rays = 0, met = 0;
+    for (int k = 0; k < 100; k++) {
+        walks += pts[k].run.walks, rays += pts[k].run.rays, met += pts[k].run.rel_err_met;
+        for (int c = 0; c < 3; c++)
+            if (pts[k].irradiance[c] > 0) worst = fmax(worst, pts[k].irradiance_se[c] / pts[k].irradiance[c]);
+        lo = fmin(lo, pts[k].irradiance[1]), hi = fmax(hi, pts[k].irradiance[1]);
+    }
+    printf("4. Office (%lld triangles, %lld patches), 10 x 10 work-plane grid at 0.8 m, every point to 2%%\n\n",
+           (long long)tri, (long long)s->npatches);
+    printf("| seconds (2 threads) | points met | walks | rays | worst relative error | H (G) min .. max |\n");
+    printf("|---:|---:|---:|---:|---:|---:|\n");
+    printf("| %.2f | %lld / 100 | %lld | %lld | %.4f | %.4g .. %.4g |\n\n", sec, (long long)met, (long long)walks,
+           (long long)rays, worst, lo, hi);
+    printf("5. A point query to 1%% against the next-event patch query (1%%) of the patch holding the point\n\n");
+    printf("| scene | patches | point B (R) | walks | rays | s | patch B (R) | walks | rays | s | rays ratio |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    fflush(stdout);
+    if (!ulam_scene_read_obj("examples/scenes/cornell_box.obj", &c0, &err) && !ulam_tracer_alloc(c0, &tc0, &err)) {
+        double fc[3];
+        ulam_scene_label_centroid(c0, "floor", fc);
+        point_vs_patch("Cornell floor centre, no subdivision", c0, tc0, fc);
+        if ((c1 = subdivided(c0, 2000)) && !ulam_tracer_alloc(c1, &tc1, &err))
+            point_vs_patch("Cornell floor centre, ~2,000 patches", c1, tc1, fc);
+    }
+    point_vs_patch("office floor (3, 0, 2)", s, t, (double[3]){3.0 + 1e-3, 0, 2.0 + 1e-3});
+    free(pts);
+    ulam_tracer_free(t), ulam_tracer_free(tc0), ulam_tracer_free(tc1);
+    ulam_scene_free(s), ulam_scene_free(c0), ulam_scene_free(c1);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && !strcmp(argv[1], "points")) return points_bench();
+    if (argc > 2 && !strcmp(argv[1], "office")) return write_office(argv[2]) ? 1 : 0;
     const char *path = argc > 1 ? argv[1] : "examples/scenes/cornell_box.obj";
     int W = 16, H = 16;
     if (argc > 2 && (sscanf(argv[2], "%dx%d", &W, &H) != 2 || W < 1 || H < 1)) return 2;
@@ -135,7 +291,7 @@ int main(int argc, char **argv)
         ulam_tracer *t = NULL;
         int64_t p = 0;
         if (!s || ulam_tracer_alloc(s, &t, &err) || ulam_scene_find(s, "floor", &p)) return 1;
-        ulam_rad_result c = gather(t, ULAM_COLLISION, p, 0.01, 0), e = gather(t, ULAM_NEXT_EVENT, p, 0.01, 0);
+        ulam_rad_result c = gather(t, ULAM_RAD_COLLISION, p, 0.01, 0), e = gather(t, ULAM_RAD_NEXT_EVENT, p, 0.01, 0);
         printf("| %lld | %.3f | %lld | %.4f | %lld | %.1f | %.1f |", (long long)s->npatches, c.seconds,
                (long long)c.rays, e.seconds, (long long)e.rays, (double)c.rays / (double)e.rays, c.seconds / e.seconds);
         size_t bytes = ulam_direct_bytes(s->npatches);
@@ -183,7 +339,7 @@ int main(int argc, char **argv)
     double *B = malloc((size_t)(3 * n) * sizeof *B), *se = malloc((size_t)(3 * n) * sizeof *se);
     double *Bs = malloc((size_t)(3 * n) * sizeof *Bs), *ses = malloc((size_t)(3 * n) * sizeof *ses);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_NEXT_EVENT, o.max_walks = 0, o.rel_err = 0.01, o.seed = 1;
+    o.estimator = ULAM_RAD_NEXT_EVENT, o.max_walks = 0, o.rel_err = 0.01, o.seed = 1;
     ulam_view_info vi;
     if (!B || !se || !Bs || !ses || ulam_view_gather(t, &cam, W, H, 0.0, &o, B, se, &vi, &err)) return 1;
     ulam_walk_opts so = ulam_walk_defaults();

@@ -1,0 +1,152 @@
+/* How every command talks to its user: verbosity (--quiet, --verbose), errors as JSON under --json,
+ * and "did you mean" for options and option values.  The commands print through these. */
+#define _GNU_SOURCE /* fopencookie: stderr is teed to keep the last error line for --json */
+#include "cli.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+int cli_verbosity;
+int cli_json_mode;
+int cli_json_done;
+
+/* The last line written to stderr that is not a warning or progress (for the JSON error). */
+static char last_error[1024], line_buf[1024];
+static size_t line_len;
+
+/* The stderr tee: write through to fd 2, and keep the last complete line that is an error. */
+static ssize_t tee_write(void *cookie, const char *buf, size_t size)
+{
+    (void)cookie;
+    size_t done = 0;
+    while (done < size) {
+        ssize_t w = write(2, buf + done, size - done);
+        if (w <= 0) break;
+        done += (size_t)w;
+    }
+    for (size_t k = 0; k < size; k++) {
+        char c = buf[k];
+        if (c == '\r') line_len = 0;
+        else if (c != '\n' && line_len + 1 < sizeof line_buf) line_buf[line_len++] = c;
+        else if (c == '\n') {
+            line_buf[line_len] = '\0';
+            if (line_len && !strstr(line_buf, ": warning: ") && !strstr(line_buf, "deprecated"))
+                memcpy(last_error, line_buf, line_len + 1);
+            line_len = 0;
+        }
+    }
+    return (ssize_t)size;
+}
+
+/* Strip --verbose (-v) and --quiet (-q) from argv (the options of every command), note --json, and
+ * under --json keep the last error line written to stderr for cli_output_finish. */
+void cli_output_begin(int *argc, char **argv)
+{
+    int k = 1, j = 1;
+    for (; k < *argc && strcmp(argv[k], "--"); k++) {
+        if (!strcmp(argv[k], "--verbose") || !strcmp(argv[k], "-v")) cli_verbosity = 1;
+        else if (!strcmp(argv[k], "--quiet") || !strcmp(argv[k], "-q")) cli_verbosity = -1;
+        else {
+            cli_json_mode |= !strcmp(argv[k], "--json");
+            argv[j++] = argv[k];
+        }
+    }
+    while (k < *argc) argv[j++] = argv[k++];
+    argv[j] = NULL;
+    *argc = j;
+    if (!cli_json_mode) return;
+    cookie_io_functions_t io = {.write = tee_write};
+    FILE *f = fopencookie(NULL, "w", io);
+    if (!f) return;
+    setvbuf(f, NULL, _IONBF, 0);
+    stderr = f;
+}
+
+/* Under --json, a failure that printed no JSON prints {"error": its last message, "exit": rc}. */
+int cli_output_finish(int rc)
+{
+    if (!cli_json_mode || !rc || rc == EXIT_INTERRUPTED || cli_json_done || cli_rank) return rc;
+    const char *msg = last_error[0] ? last_error : "failed (no message)";
+    if (!strncmp(msg, "ulam: ", 6)) msg += 6;
+    printf("{");
+    cli_json_string("error", msg, 0);
+    printf("\"exit\": %d}\n", rc);
+    fflush(stdout);
+    return rc;
+}
+
+/* Every value of solve --method, and them in words. */
+const char *const cli_method_names[CLI_NMETHODS] = {"auto", "walks", "bidirectional", "mcsa", "sequential",
+                                                    "richardson", "gauss-seidel", "cg", "gmres"};
+const char *const cli_method_words = "auto, walks, bidirectional (with --source), mcsa, sequential, richardson, "
+                                     "gauss-seidel, cg or gmres";
+
+/* Levenshtein distance of a and b (both short), capped at 99. */
+static int distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    if (la > 60 || lb > 60) return 99;
+    int d[61][61];
+    for (size_t i = 0; i <= la; i++) d[i][0] = (int)i;
+    for (size_t j = 0; j <= lb; j++) d[0][j] = (int)j;
+    for (size_t i = 1; i <= la; i++)
+        for (size_t j = 1; j <= lb; j++) {
+            int sub = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]), del = d[i - 1][j] + 1, ins = d[i][j - 1] + 1;
+            d[i][j] = sub < del ? (sub < ins ? sub : ins) : (del < ins ? del : ins);
+        }
+    return d[la][lb];
+}
+
+/* The name among names[0..n) closest to word (a prefix of it, or within a third of its length in
+ * edits), or NULL. */
+const char *cli_suggest(const char *word, const char *const *names, int n)
+{
+    const char *best = NULL;
+    int bd = 99, len = (int)strlen(word);
+    for (int k = 0; k < n; k++) {
+        int d = len >= 3 && !strncmp(names[k], word, (size_t)len) ? 0 : distance(word, names[k]);
+        if (d < bd) bd = d, best = names[k];
+    }
+    return best && bd <= (len + 2) / 3 ? best : NULL;
+}
+
+/* Check every --name in argv against longopts before getopt_long sees them (it would take an
+ * abbreviation silently): an unknown one is a usage error naming the closest option.  0 or
+ * EXIT_USAGE. */
+int cli_check_options(const char *command, int argc, char **argv, const struct option *longopts)
+{
+    const char *names[256];
+    int n = 0;
+    for (; longopts[n].name && n < 256; n++) names[n] = longopts[n].name;
+    for (int k = 1; k < argc && strcmp(argv[k], "--"); k++) {
+        if (strncmp(argv[k], "--", 2)) continue;
+        char name[128];
+        snprintf(name, sizeof name, "%s", argv[k] + 2);
+        char *eq = strchr(name, '=');
+        if (eq) *eq = '\0';
+        int i = cli_lookup(name, names, n);
+        if (i >= 0) {
+            k += longopts[i].has_arg == required_argument && !eq; /* its value may start with "--" */
+            continue;
+        }
+        const char *s = cli_suggest(name, names, n);
+        return s ? cli_usage_error(command, "unknown option '--%s' (did you mean '--%s'?)", name, s)
+                 : cli_usage_error(command, "unknown option '--%s'", name);
+    }
+    return 0;
+}
+
+/* Look value up among names[0..n) for option opt: its index, or -1 after a usage error that lists
+ * the names (what) and the closest. */
+int cli_choose(const char *command, const char *opt, const char *value, const char *const *names, int n,
+               const char *what)
+{
+    int k = cli_lookup(value, names, n);
+    if (k >= 0) return k;
+    const char *s = cli_suggest(value, names, n);
+    if (s) cli_usage_error(command, "%s expects %s, got '%s' (did you mean '%s'?)", opt, what, value, s);
+    else cli_usage_error(command, "%s expects %s, got '%s'", opt, what, value);
+    return -1;
+}

@@ -1,0 +1,59 @@
+/* Sensor grids: the lighting designer's standard output, irradiance at the centres of the cells
+ * of a rectangle on a work plane, each point a point query (point.c's walks) with its own seed
+ * stream, so a point's answer depends neither on the threads nor on the other points. */
+#include "rad.h"
+
+#include <string.h>
+
+/* The centre of cell (i, j) of grid g. */
+void ulam_rad_grid_point(const ulam_rad_grid *g, int i, int j, double x[3])
+{
+    double a = (i + 0.5) / g->nu, b = (j + 0.5) / g->nv;
+    for (int k = 0; k < 3; k++) x[k] = g->origin[k] + a * g->u[k] + b * g->v[k];
+}
+
+/* Check a grid: sizes >= 1, finite vectors, a unit normal. */
+static int check_grid(const ulam_rad_grid *g, ulam_error *err)
+{
+    if (g->nu < 1 || g->nv < 1 || (int64_t)g->nu * g->nv > ULAM_RAD_GRID_MAX)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a grid of 1 to %d points", ULAM_RAD_GRID_MAX);
+    double len = 0.0;
+    for (int k = 0; k < 3; k++) {
+        if (!isfinite(g->origin[k]) || !isfinite(g->u[k]) || !isfinite(g->v[k]) || !isfinite(g->normal[k]))
+            return ulam__fail(err, ULAM_EINVAL, 0, -1, "a grid with finite corners and normal");
+        len += g->normal[k] * g->normal[k];
+    }
+    if (!(fabs(len - 1.0) < 1e-9)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a grid with a unit normal");
+    return ULAM_OK;
+}
+
+/* Every point of grid g (out: nu * nv, row j = 0 first, i fastest). */
+int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_walk_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
+                        ulam_error *err)
+{
+    ulam__clear(err);
+    if (!t || !opts || !g || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, options, a grid and an output");
+    int status = check_grid(g, err);
+    if (status) return status;
+    double t0 = ulam_now();
+    for (int j = 0; j < g->nv; j++)
+        for (int i = 0; i < g->nu; i++) {
+            int64_t k = (int64_t)j * g->nu + i;
+            ulam_walk_opts o = *opts;
+            ulam_rng r;
+            ulam_rng_seed(&r, opts->seed, (uint64_t)k);
+            o.seed = ulam__rng_next(&r);
+            if (opts->max_seconds > 0) { /* the time limit is the whole grid's */
+                o.max_seconds = opts->max_seconds - (ulam_now() - t0);
+                if (!(o.max_seconds > 0)) o.max_seconds = 1e-9; /* one block still runs: an estimate */
+            }
+            double x[3];
+            ulam_rad_grid_point(g, i, j, x);
+            if ((status = ulam_rad_point_query(t, &o, x, g->normal, &out[k], err))) return status;
+            if (out[k].run.interrupted) {
+                for (int64_t m = k + 1; m < (int64_t)g->nu * g->nv; m++) memset(&out[m], 0, sizeof out[m]);
+                return ULAM_OK;
+            }
+        }
+    return ULAM_OK;
+}

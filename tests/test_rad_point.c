@@ -1,0 +1,493 @@
+/* Point queries on the continuous surfaces (src/radiosity/point.c) and sensor grids: the
+ * irradiance at a point against Howell's closed forms (a differential planar element to a
+ * parallel rectangle and to a rectangle in a perpendicular plane, signed corner sums for
+ * points beside the emitter), the furnace (B = E / (1 - rho) at every point and every sensor),
+ * 95% intervals counted over 100 seeds with a binomial bound, the options refused, and the
+ * grid's points and picture.  Fixed seeds; tolerances from the reported standard errors. */
+#include "testutil.h"
+#include "ulam_radiosity.h"
+
+#include <string.h>
+
+/* Howell: element whose normal passes through a corner of a parallel a x b rectangle at c. */
+static double howell_parallel(double a, double b, double c)
+{
+    double A = a / c, B = b / c, sa = sqrt(1 + A * A), sb = sqrt(1 + B * B);
+    return (A / sa * atan(B / sa) + B / sb * atan(A / sb)) / (2 * M_PI);
+}
+
+/* Howell: element at distance c from the edge of an a (height) x b rectangle in a perpendicular
+ * plane, in front of its corner. */
+static double howell_perpendicular(double a, double b, double c)
+{
+    double X = a / b, Y = c / b, r = sqrt(X * X + Y * Y);
+    return (atan(1 / Y) - Y / r * atan(1 / r)) / (2 * M_PI);
+}
+
+/* The signed corner term of a parallel rectangle reaching u, v from the foot of the normal. */
+static double par_corner(double u, double v, double c)
+{
+    if (u == 0 || v == 0) return 0.0;
+    return copysign(1.0, u) * copysign(1.0, v) * howell_parallel(fabs(u), fabs(v), c);
+}
+
+/* Form factor from (px, py) facing up to the lamp [x0, x1] x [y0, y1] at height c facing down. */
+static double parallel_at(double px, double py, double x0, double x1, double y0, double y1, double c)
+{
+    return par_corner(x1 - px, y1 - py, c) - par_corner(x0 - px, y1 - py, c) - par_corner(x1 - px, y0 - py, c) +
+           par_corner(x0 - px, y0 - py, c);
+}
+
+/* Form factor from floor point (px, py) to the unit lamp x in [0, 1], z in [0, 1] at y = 0. */
+static double perpendicular_at(double px, double py)
+{
+    double u1 = 1 - px, u0 = -px;
+    double f1 = u1 == 0 ? 0 : copysign(howell_perpendicular(1, fabs(u1), py), u1);
+    double f0 = u0 == 0 ? 0 : copysign(howell_perpendicular(1, fabs(u0), py), u0);
+    return f1 - f0;
+}
+
+/* A scene and its tracer that must build. */
+static ulam_tracer *must_load(const char *path, ulam_scene **s)
+{
+    ulam_error err;
+    int st = ulam_scene_read_obj(path, s, &err);
+    if (st) print_error("%s:%ld: %s\n", path, err.line, err.msg);
+    assert_int_equal(st, ULAM_OK);
+    ulam_tracer *t = NULL;
+    assert_int_equal(ulam_tracer_alloc(*s, &t, NULL), ULAM_OK);
+    return t;
+}
+
+/* A tracer on a scene already read. */
+static ulam_tracer *must_tracer_of(const ulam_scene *s)
+{
+    ulam_tracer *t = NULL;
+    assert_int_equal(ulam_tracer_alloc(s, &t, NULL), ULAM_OK);
+    return t;
+}
+
+/* A point query that must run: walks walks (or rel_err), estimator est. */
+static ulam_rad_point query(const ulam_tracer *t, const double x[3], const double *n, int est, int64_t walks,
+                            double rel_err, uint64_t seed)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.estimator = est, o.max_walks = walks, o.rel_err = rel_err, o.seed = seed, o.threads = 2;
+    ulam_rad_point r;
+    ulam_error err;
+    int st = ulam_rad_point_query(t, &o, x, n, &r, &err);
+    if (st) print_error("%s: %s\n", ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    return r;
+}
+
+/* Every channel of r's irradiance against exact within 4 standard errors (and the error bar
+ * small enough for the check to mean something); the radiosity B = E + rho H on a grey floor. */
+static void check_point(const ulam_rad_point *r, double exact, double rho, const char *what)
+{
+    print_message("%s: H %.6f +- %.2g, exact %.6f, z %+.2f (%lld walks, %lld rays)\n", what, r->irradiance[0],
+                  r->irradiance_se[0], exact, (r->irradiance[0] - exact) / r->irradiance_se[0],
+                  (long long)r->run.walks, (long long)r->run.rays);
+    for (int c = 0; c < 3; c++) {
+        assert_true(r->irradiance_se[c] > 0 && r->irradiance_se[c] < 0.02 * exact);
+        assert_close(r->irradiance[c], exact, 4 * r->irradiance_se[c]);
+        if (r->patch >= 0) assert_close(r->radiosity[c], rho * r->irradiance[c], 1e-12);
+    }
+}
+
+/* Floor points under, inside and beside a parallel lamp, and a sensor in the air. */
+static void test_point_parallel(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
+    const double pts[6][2] = {{0, 0}, {0.5, 1}, {0.9, 0.1}, {-0.5, 1}, {1.5, -0.5}, {0.5, 2.02}}; /* last: beside an edge */
+    for (int k = 0; k < 6; k++) {
+        double x[3] = {pts[k][0], pts[k][1], 0}, exact = parallel_at(x[0], x[1], 0, 1, 0, 2, 1);
+        for (int est = ULAM_RAD_NEXT_EVENT; est <= ULAM_RAD_COLLISION; est += est == ULAM_RAD_NEXT_EVENT ? 3 : 1) {
+            ulam_rad_point r = query(t, x, NULL, est, est == ULAM_RAD_COLLISION ? 200000 : 40000, 0, 10 + (uint64_t)k);
+            assert_int_equal(r.patch, 1);
+            check_point(&r, exact, 0.5, est == ULAM_RAD_COLLISION ? "parallel, collision" : "parallel, next-event");
+        }
+    }
+    /* a sensor off the surfaces, half way up, facing the lamp: the same law at c = 0.5 */
+    double x[3] = {0.25, 0.5, 0.5}, n[3] = {0, 0, 2};
+    ulam_rad_point r = query(t, x, n, ULAM_RAD_NEXT_EVENT, 40000, 0, 3);
+    assert_int_equal(r.patch, -1);
+    assert_true(isnan(r.radiosity[0]));
+    check_point(&r, parallel_at(0.25, 0.5, 0, 1, 0, 2, 0.5), 0, "parallel, sensor in the air");
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* Floor points in front of a perpendicular lamp, at its corner, beside it, and 0.02 from the
+ * edge it stands on (where G / p_L ~ 1 / r^2 and only MIS keeps the variance finite). */
+static void test_point_perpendicular(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_perpendicular.obj", &s);
+    const double pts[5][2] = {{0, 0.5}, {0.5, 0.5}, {-0.5, 0.3}, {1.2, 1.5}, {0.5, 0.02}};
+    for (int k = 0; k < 5; k++) {
+        double x[3] = {pts[k][0], pts[k][1], 0};
+        ulam_rad_point r = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, 40000, 0, 20 + (uint64_t)k);
+        check_point(&r, perpendicular_at(x[0], x[1]), 0.5, "perpendicular, next-event");
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* The furnace: H = B = E / (1 - rho) at points on faces, near an edge and a corner, and for a
+ * tilted sensor in the air; walks of several bounces. */
+static void test_point_furnace(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/furnace_half.obj", &s);
+    const double B[3] = {2.0, 1.5, 0.4 / 0.3};
+    const double pts[4][3] = {{0.5, 0.5, 0}, {0.01, 0.99, 0}, {1, 0.3, 0.999}, {0.3, 0.2, 0.7}};
+    for (int k = 0; k < 4; k++) {
+        double n[3] = {1, 2, 3};
+        ulam_rad_point r = query(t, pts[k], k == 3 ? n : NULL, ULAM_RAD_NEXT_EVENT, 20000, 0, 40 + (uint64_t)k);
+        assert_true(r.run.rays > 3 * r.run.walks); /* several bounces */
+        for (int c = 0; c < 3; c++) {
+            print_message("furnace point %d %c: H %.5f +- %.2g (exact %.5f)\n", k, "RGB"[c], r.irradiance[c],
+                          r.irradiance_se[c], B[c]);
+            assert_true(r.irradiance_se[c] < 0.01 * B[c]);
+            assert_close(r.irradiance[c], B[c], 4 * r.irradiance_se[c]);
+            if (k < 3) assert_close(r.radiosity[c], B[c], 4 * r.radiosity_se[c]);
+        }
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* 95% intervals over 100 seeds, 200 walks each (small: the variance estimate itself is noisy),
+ * at the hard point 0.02 from the perpendicular lamp's edge, and at rel_err 0.05 (a stopping
+ * rule) on the parallel lamp: at least 88 of 100 cover (P(Binomial(100, 0.95) < 88) < 0.002). */
+static void test_point_coverage(void **state)
+{
+    (void)state;
+    const char *scene[2] = {"tests/data/rad/point_perpendicular.obj", "tests/data/rad/point_parallel.obj"};
+    for (int m = 0; m < 2; m++) {
+        ulam_scene *s = NULL;
+        ulam_tracer *t = must_load(scene[m], &s);
+        double x[3] = {0.5, m ? 1.0 : 0.02, 0}, exact = m ? parallel_at(0.5, 1, 0, 1, 0, 2, 1) : perpendicular_at(0.5, 0.02);
+        int inside = 0;
+        for (uint64_t seed = 0; seed < 100; seed++) {
+            ulam_rad_point r = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, m ? 0 : 200, m ? 0.05 : 0, 1000 + seed);
+            inside += fabs(r.irradiance[0] - exact) <= 1.96 * r.irradiance_se[0];
+        }
+        print_message("%s: %d of 100 intervals cover (%s)\n", scene[m], inside, m ? "rel_err 0.05" : "200 walks");
+        assert_true(inside >= 88);
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
+}
+
+/* Bad points and options are refused with ULAM_EINVAL and a message. */
+static void test_point_refused(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.max_walks = 100;
+    ulam_rad_solver *sv = NULL;
+    ulam_error err;
+    double air[3] = {0.5, 0.5, 0.5}, floor_pt[3] = {0.5, 0.5, 0}, down[3] = {0, 0, -1}, zero[3] = {0, 0, 0};
+    double bad[3] = {NAN, 0, 0};
+    assert_int_equal(ulam_rad_point_alloc(t, &o, air, NULL, &sv, &err), ULAM_EINVAL); /* on no patch, no normal */
+    assert_non_null(strstr(err.msg, "normal"));
+    assert_int_equal(ulam_rad_point_alloc(t, &o, floor_pt, down, &sv, &err), ULAM_EINVAL); /* not the floor's */
+    assert_int_equal(ulam_rad_point_alloc(t, &o, air, zero, &sv, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_rad_point_alloc(t, &o, bad, NULL, &sv, &err), ULAM_EINVAL);
+    o.estimator = ULAM_RAD_ABSORPTION;
+    assert_int_equal(ulam_rad_point_alloc(t, &o, floor_pt, NULL, &sv, &err), ULAM_EINVAL);
+    o.estimator = ULAM_RAD_NEXT_EVENT, o.mode = ULAM_FORWARD;
+    assert_int_equal(ulam_rad_point_alloc(t, &o, floor_pt, NULL, &sv, &err), ULAM_EINVAL);
+    assert_null(sv);
+    o.mode = ULAM_ADJOINT;
+    assert_int_equal(ulam_rad_point_alloc(t, &o, floor_pt, NULL, &sv, &err), ULAM_OK);
+    ulam_rad_point r;
+    assert_int_equal(ulam_rad_point_result(sv, &r), ULAM_OK);
+    assert_int_equal(r.run.walks, 0);
+    sv = ulam_rad_solver_free(sv);
+    o.index = 1; /* a patch solver has no point result */
+    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_OK);
+    assert_int_equal(ulam_rad_point_result(sv, &r), ULAM_EINVAL);
+    ulam_rad_solver_free(sv);
+    /* the default estimator of a patch walk is next-event now, and shooting refuses it */
+    assert_int_equal(ulam_walk_defaults().estimator, ULAM_RAD_NEXT_EVENT);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* A 4 x 3 grid on the floor under the parallel lamp: every sensor against Howell, each with its
+ * own seed (a point's answer does not depend on the grid), and the false-colour picture. */
+static void test_grid(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
+    ulam_rad_grid g = {.origin = {-1, -0.5, 0}, .u = {3, 0, 0}, .v = {0, 3, 0}, .normal = {0, 0, 1}, .nu = 4, .nv = 3};
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.rel_err = 0.02, o.max_walks = 0, o.seed = 5, o.threads = 2;
+    ulam_rad_point pts[12];
+    ulam_error err;
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &g, pts, &err), ULAM_OK);
+    double Y[12];
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 4; i++) {
+            const ulam_rad_point *r = &pts[j * 4 + i];
+            double x[3];
+            ulam_rad_grid_point(&g, i, j, x);
+            assert_close(x[0], -1 + 0.75 * (2 * i + 1) / 2.0 * 1.0, 1e-12);
+            assert_close(r->x[1], -0.5 + (j + 0.5), 1e-12);
+            check_point(r, parallel_at(x[0], x[1], 0, 1, 0, 2, 1), 0.5, "grid");
+            assert_true(r->irradiance_se[0] <= 0.02 * r->irradiance[0]);
+            Y[j * 4 + i] = r->irradiance[1];
+        }
+    g.nu = 0;
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &g, pts, &err), ULAM_EINVAL);
+    g.nu = 4, g.normal[2] = 2;
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &g, pts, &err), ULAM_EINVAL);
+    int w, h;
+    ulam_falsecolour_size(4, 3, 10, 10, &w, &h);
+    unsigned char *rgb = malloc((size_t)w * (size_t)h * 3);
+    assert_int_equal(ulam_falsecolour(Y, 4, 3, 10, 10, 0, 0.4, rgb), ULAM_OK);
+    /* the brightest cell is red-ish, the darkest blue-ish; cell (i, j) at rows from the top */
+    int hi = 0, lo = 0;
+    for (int k = 1; k < 12; k++) hi = Y[k] > Y[hi] ? k : hi, lo = Y[k] < Y[lo] ? k : lo;
+    const unsigned char *ph = rgb + 3 * ((size_t)((2 - hi / 4) * 10 + 5) * (size_t)w + (size_t)(hi % 4) * 10 + 5);
+    const unsigned char *pl = rgb + 3 * ((size_t)((2 - lo / 4) * 10 + 5) * (size_t)w + (size_t)(lo % 4) * 10 + 5);
+    assert_true(ph[0] > ph[2] && pl[2] > pl[0]);
+    assert_int_equal(ulam_falsecolour(Y, 4, 3, 10, 10, 1, 1, rgb), ULAM_EINVAL);
+    free(rgb);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* A patch solver run to its end with options o. */
+static ulam_rad_result run_solver(const ulam_tracer *t, const ulam_walk_opts *o)
+{
+    ulam_rad_solver *sv = NULL;
+    assert_int_equal(ulam_rad_solver_alloc(t, o, &sv, NULL), ULAM_OK);
+    while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
+    ulam_rad_result r;
+    ulam_rad_solver_result(sv, &r);
+    ulam_rad_solver_free(sv);
+    return r;
+}
+
+/* A patch query (next-event) at patch p to rel_err or walks. */
+static ulam_rad_result patch_query(const ulam_tracer *t, int64_t p, double rel_err, int64_t walks, uint64_t seed)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = p, o.rel_err = rel_err, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    return run_solver(t, &o);
+}
+
+/* The mesh error flags the Cornell floor asked for at its centre with no subdivision (the
+ * patch's one value, the floor's mean, is far from the surface's radiosity at the centroid),
+ * and not a patch of a fine mesh away from the blocks' edges. */
+static void test_mesh_error_flags(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL, *fine = NULL;
+    ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
+    int64_t p;
+    assert_int_equal(ulam_scene_find(s, "floor", &p), ULAM_OK);
+    ulam_rad_result pr = patch_query(t, p, 0.01, 0, 1);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = p, o.rel_err = 0.02, o.max_walks = 0, o.seed = 2, o.threads = 2;
+    ulam_rad_mesh m;
+    assert_int_equal(ulam_rad_mesh_error(t, &o, pr.radiosity, &m, NULL), ULAM_OK);
+    assert_int_equal(m.npoints, 5);
+    for (int c = 0; c < 3; c++) {
+        double se = sqrt(pr.std_error[c] * pr.std_error[c] + m.point_se[0][c] * m.point_se[0][c]);
+        print_message("Cornell floor %c: patch %.5f +- %.2g, surface at the centroid %.5f +- %.2g, mesh error %.4f\n",
+                      "RGB"[c], pr.radiosity[c], pr.std_error[c], m.point[0][c], m.point_se[0][c], m.error[c]);
+        assert_true(m.point[0][c] - pr.radiosity[c] > 10 * se); /* the centre is brighter than the floor's mean */
+        assert_true(m.error[c] > 10 * pr.std_error[c]);         /* dominates */
+    }
+    /* a back-wall patch of a fine mesh (20 mm: the wall's radiosity varies by about 0.8% across
+     * it, less than the points' 2%): the surface agrees with the patch within its errors */
+    assert_int_equal(ulam_scene_subdivide(s, 20.0, &fine), ULAM_OK);
+    ulam_tracer *tf = must_tracer_of(fine);
+    assert_int_equal(ulam_scene_find(fine, "back_wall", &p), ULAM_OK);
+    pr = patch_query(tf, p, 0.01, 0, 3);
+    o.index = p;
+    assert_int_equal(ulam_rad_mesh_error(tf, &o, pr.radiosity, &m, NULL), ULAM_OK);
+    for (int c = 0; c < 3; c++) {
+        double se = sqrt(pr.std_error[c] * pr.std_error[c] + m.error_se[c] * m.error_se[c]);
+        print_message("fine back wall %c: patch %.5f +- %.2g, mesh error %.4f +- %.2g\n", "RGB"[c], pr.radiosity[c],
+                      pr.std_error[c], m.error[c], m.error_se[c]);
+        assert_true(m.error[c] < 4 * se);
+    }
+    ulam_tracer_free(tf), ulam_tracer_free(t);
+    ulam_scene_free(fine), ulam_scene_free(s);
+}
+
+/* Patch averages from a fine uniform mesh converge to the mean of the surface over the coarse
+ * patch: the Cornell back wall, its children's patch queries area-weighted at about 8 x 8, against
+ * the mean of point queries at 20 x 20 jittered points of the wall (stratified; its variance from
+ * neighbouring strata collapsed in pairs, which errs high); the unsubdivided wall's one value
+ * is off by many standard errors. */
+static void test_mesh_converges(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL, *fine = NULL;
+    ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
+    int64_t P;
+    assert_int_equal(ulam_scene_find(s, "back_wall", &P), ULAM_OK);
+    /* the surface's mean over P: 400 uniform points, 200 walks each */
+    ulam_rng r;
+    ulam_rng_seed(&r, 77, 0);
+    const double *v = s->vert;
+    const int32_t *ix = s->vidx + s->start[P];
+    assert_int_equal(s->start[P + 1] - s->start[P], 4);
+    double sum = 0, pairs = 0, prev = 0;
+    for (int k = 0; k < 400; k++) { /* a jittered point of stratum (k % 20, k / 20) of the (parallelogram) wall */
+        double a = (k % 20 + ulam_rng_uniform(&r)) / 20, b = (k / 20 + ulam_rng_uniform(&r)) / 20, x[3];
+        for (int d = 0; d < 3; d++)
+            x[d] = v[3 * ix[0] + d] + a * (v[3 * ix[1] + d] - v[3 * ix[0] + d]) + b * (v[3 * ix[3] + d] - v[3 * ix[0] + d]);
+        ulam_rad_point pt = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, 200, 0, 500 + (uint64_t)k);
+        sum += pt.radiosity[0];
+        if (k % 2) pairs += (pt.radiosity[0] - prev) * (pt.radiosity[0] - prev);
+        prev = pt.radiosity[0];
+    }
+    double mean = sum / 400, se_mean = sqrt(pairs) / 400;
+    ulam_rad_result coarse = patch_query(t, P, 0.005, 0, 9);
+    /* the fine mesh: every child of the wall (face of P) */
+    double side = 0;
+    for (int d = 0; d < 3; d++) side += (v[3 * ix[1] + d] - v[3 * ix[0] + d]) * (v[3 * ix[1] + d] - v[3 * ix[0] + d]);
+    assert_int_equal(ulam_scene_subdivide(s, sqrt(side) / 8 * 1.0001, &fine), ULAM_OK);
+    ulam_tracer *tf = must_tracer_of(fine);
+    double A = 0, BA = 0, var = 0;
+    int children = 0;
+    for (int64_t q = 0; q < fine->npatches; q++) {
+        if (fine->face[q] != s->face[P]) continue;
+        ulam_rad_result c = patch_query(tf, q, 0, 1500, 1000 + (uint64_t)q);
+        A += fine->area[q], BA += fine->area[q] * c.radiosity[0];
+        var += fine->area[q] * fine->area[q] * c.std_error[0] * c.std_error[0];
+        children++;
+    }
+    double Bf = BA / A, se_f = sqrt(var) / A, zf = (Bf - mean) / sqrt(se_f * se_f + se_mean * se_mean);
+    double zc = (coarse.radiosity[0] - mean) / sqrt(coarse.std_error[0] * coarse.std_error[0] + se_mean * se_mean);
+    print_message("back wall R: surface mean %.5f +- %.2g; %d children %.5f +- %.2g (z %+.2f); one patch %.5f +- %.2g "
+                  "(z %+.2f)\n", mean, se_mean, children, Bf, se_f, zf, coarse.radiosity[0], coarse.std_error[0], zc);
+    assert_true(children >= 64);
+    assert_true(se_f < 0.01 * Bf && se_mean < 0.01 * mean);
+    assert_true(fabs(zf) < 4);
+    assert_true(fabs(zc) > 4);
+    ulam_tracer_free(tf), ulam_tracer_free(t);
+    ulam_scene_free(fine), ulam_scene_free(s);
+}
+
+/* The non-diffuse MTL statements are noted once a keyword a material, with file and line; the
+ * matte defaults (Ka, Ni, Ks 0, Ns 0, d 1, illum 2) are not. */
+static void test_mtl_notes(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_mtl_note *notes = NULL;
+    int64_t n = 0;
+    assert_int_equal(ulam_scene_read_obj_notes("tests/data/rad/shiny.obj", &s, &notes, &n, NULL), ULAM_OK);
+    const char *kw[5] = {"Ks", "Ns", "d", "illum", "map_Kd"};
+    assert_int_equal(n, 5);
+    for (int k = 0; k < 5; k++) {
+        assert_string_equal(notes[k].keyword, kw[k]);
+        assert_string_equal(notes[k].material, "glass");
+        assert_int_equal(notes[k].line, 12 + k);
+        assert_non_null(strstr(notes[k].file, "shiny.mtl"));
+    }
+    ulam_mtl_notes_free(notes, n);
+    ulam_scene_free(s);
+    assert_int_equal(ulam_scene_read_obj_notes("tests/data/rad/edge_lamp.obj", &s, &notes, &n, NULL), ULAM_OK);
+    assert_int_equal(n, 0);
+    assert_null(notes);
+    ulam_scene_free(s);
+}
+
+/* ulam_render_hdr: one centre ray a pixel, flat, is ulam_render's picture byte for byte; smooth
+ * shading of a constant radiosity is that constant at every pixel (corner means of equal values),
+ * jittered or not; a linear gradient over a subdivided face is interpolated (between the patch
+ * values, not a staircase). */
+static void test_render_hdr(void **state)
+{
+    (void)state;
+    ulam_scene *s0 = NULL, *s = NULL;
+    ulam_tracer *t0 = must_load("tests/data/rad/furnace_half.obj", &s0);
+    assert_int_equal(ulam_scene_subdivide(s0, 0.25, &s), ULAM_OK);
+    ulam_tracer *t = must_tracer_of(s);
+    int64_t n = s->npatches;
+    double *B = malloc((size_t)(3 * n) * sizeof *B);
+    ulam_camera cam = {.eye = {0.5, 0.5, 0.9}, .dir = {0, 0, -1}, .up = {0, 1, 0}, .focal = 1, .film = 1.5};
+    enum { W = 24, H = 16 };
+    float hdr[3 * W * H];
+    unsigned char a[3 * W * H], b[3 * W * H];
+    for (int64_t p = 0; p < n; p++) {
+        double c[3];
+        ulam_scene_centroid(s, p, c);
+        for (int k = 0; k < 3; k++) B[3 * p + k] = 1.0 + c[0]; /* a gradient in x */
+    }
+    assert_int_equal(ulam_render(t, B, &cam, W, H, 0.5, a, NULL), ULAM_OK);
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 1, 0, 1, 0.5, hdr, b, NULL), ULAM_OK);
+    assert_memory_equal(a, b, sizeof a);
+    /* smooth: on the floor (the picture's lower middle) values lie between neighbours, and vary
+     * continuously: no jump between adjacent pixels as large as a patch step (0.25) */
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 4, 1, 1, 0.5, hdr, b, NULL), ULAM_OK);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x + 1 < W; x++) assert_true(fabs(hdr[3 * (y * W + x + 1)] - hdr[3 * (y * W + x)]) < 0.2);
+    for (int64_t p = 0; p < n; p++)
+        for (int k = 0; k < 3; k++) B[3 * p + k] = 2.0;
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 3, 1, 7, 0, hdr, NULL, NULL), ULAM_OK);
+    for (int k = 0; k < 3 * W * H; k++) assert_close(hdr[k], 2.0, 1e-6);
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 0, 1, 7, 0, hdr, NULL, NULL), ULAM_EINVAL);
+    B[5] = NAN;
+    assert_int_equal(ulam_render_hdr(t, B, &cam, W, H, 1, 1, 7, 0, hdr, NULL, NULL), ULAM_ENONFINITE);
+    free(B);
+    ulam_tracer_free(t), ulam_tracer_free(t0);
+    ulam_scene_free(s), ulam_scene_free(s0);
+}
+
+/* Shooting's --rel-err takes the whole rule now (its variance's own error from the fourth moment
+ * of the patch's per-particle tallies, at least 1000 particles), not the standard error alone:
+ * 50 seeds at rel_err 0.03 on the edge lamp's wall (exact 0.5 F(C-14)), every run met with its
+ * variance known to 25%, at least 43 of 50 intervals (95%) covering (P(Binomial(50, 0.95) < 43)
+ * < 0.01). */
+static void test_shoot_rel_err(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/edge_lamp.obj", &s);
+    double exact = 0.5 * ulam_ff_perpendicular_rectangles(1, 1, 1);
+    int inside = 0;
+    for (uint64_t seed = 0; seed < 50; seed++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = ULAM_FORWARD, o.estimator = ULAM_RAD_COLLISION, o.index = 1, o.rel_err = 0.03, o.max_walks = 0;
+        o.seed = 300 + seed, o.threads = 2;
+        ulam_rad_result r = run_solver(t, &o);
+        assert_true(r.rel_err_met && r.walks >= 1000 && r.variance_rel_error <= 0.25);
+        assert_true(r.std_error[0] <= 0.03 * r.radiosity[0]);
+        inside += fabs(r.radiosity[0] - exact) <= 1.96 * r.std_error[0];
+    }
+    print_message("shooting at rel_err 0.03: %d of 50 intervals cover\n", inside);
+    assert_true(inside >= 43);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_point_parallel), cmocka_unit_test(test_point_perpendicular),
+        cmocka_unit_test(test_point_furnace),  cmocka_unit_test(test_point_coverage),
+        cmocka_unit_test(test_point_refused),  cmocka_unit_test(test_grid),
+        cmocka_unit_test(test_mesh_error_flags), cmocka_unit_test(test_mesh_converges),
+        cmocka_unit_test(test_mtl_notes),        cmocka_unit_test(test_render_hdr),
+        cmocka_unit_test(test_shoot_rel_err),
+    };
+    return test_run(tests);
+}
