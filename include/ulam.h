@@ -629,7 +629,11 @@ ulam_walk_opts ulam_walk_defaults(void);
 typedef struct ulam_walk_result {
     double estimate;   /* of x_index */
     double std_error;  /* standard error of the estimate */
-    double ci95[2];    /* estimate -+ 1.959964 std_error */
+    double ci95[2];    /* the 95% interval (docs/error-bars.md): empirical Bernstein on the certified
+                          range R of a single score (tail_bound), stitched over the walk counts the
+                          run could stop at, widened by the truncation's and the cuts' bias; zero
+                          width only when x is certified 0; NaN when there is none (no certified
+                          range, variance not certified finite, or a score past R) */
     double variance;   /* per-walk (per-history) sample variance */
     int64_t walks;     /* histories completed */
     int64_t steps;     /* transitions made */
@@ -641,22 +645,24 @@ typedef struct ulam_walk_result {
                             assume_finite), 0 infinite, -1 unknown; ci95 is NaN unless 1 */
     double score_bound;  /* the largest |score| a walk can make (absorption: W max |b_j| / p*_j over
                             reachable scoring states, W the weight bound); INFINITY: unbounded */
-    double tail_bound;   /* R / (walks |estimate|), R the range the rel_err rule uses (score_bound,
-                            or for collision and expected the range of walks short enough to
-                            matter at the rel_err target, 1% without one): how far one more walk
-                            could move the estimate, relatively; luck-independent (INFINITY: no
-                            bound) */
-    double min_walks;    /* the walk count the rel_err rule's range term needs at this estimate
-                            (0: no bound) */
+    double tail_bound;   /* R / (walks |estimate|), R the range ci95 uses (score_bound, or for
+                            collision and expected the range of walks short enough to matter:
+                            longer ones add at most a share of the estimate, counted as bias):
+                            how far one more walk could move the estimate, relatively;
+                            luck-independent (INFINITY: no bound) */
+    double min_walks;    /* rel_err: the walks the rule predicts it needs at this estimate and
+                            variance (the larger of the variance term's and the range term's;
+                            INFINITY: none can, 0: no target) */
     double variance_rel_error; /* relative standard error of `variance` (fourth moment) */
     int rel_err_met;     /* 1: stopped by the rel_err rule */
     double cut_bound;    /* the most the walks cut at max_steps can have moved the mean (0: none
                             cut; INFINITY: no bound); the rel_err rule needs it <= 0.1 E |m|, and
-                            ci95 is NaN (no interval) while it exceeds std_error */
+                            ci95 is widened by it on both sides */
     int cut_stop;        /* 1: stopped because the cuts' bias may exceed the rel_err target
                             (raise max_steps) */
-    int out_of_reach;    /* 1: rel_err alone, stopped after a round because the rule's minimum
-                            walk count exceeds ULAM_REL_ERR_CAP (rel_err_met 0) */
+    int out_of_reach;    /* 1: stopped early, not met, because the walks the rule predicts
+                            (min_walks) exceed max_walks or ULAM_REL_ERR_CAP (a finite range,
+                            a nonzero estimate and a certified finite variance; rel_err_met 0) */
     int64_t unreached;   /* forward: components no walk has tallied (no estimate at all) */
     double seconds;    /* wall time spent walking */
     int threads;       /* threads used */
@@ -726,24 +732,22 @@ ulam_solver *ulam_solver_free(ulam_solver *s);
 /* Allocate, iterate until done, report, free: the whole run in one call, with the refusals of
  * ulam_solver_alloc (guards checked first).  It always ends: rel_err alone stops at 10^9
  * walks at most (ULAM_REL_ERR_CAP; rel_err_met 0).
- * The rel_err rule (opts->rel_err = E, variance certified finite), checked after each round,
- * stops when all of these hold (N walks, estimate m, standard error se):
- *   N >= 1000, m != 0 and, forward, the watched component opts->index has been tallied;
- *   se <= E |m|;
- *   N >= 3 ln(3 / 0.05) R / (E |m|), R the range of a single score (score_bound; for collision
- *     and expected the range of walks short enough to matter, from the continuation or a
- *     Collatz-Wielandt certificate of the length tail; with weights growing on cycles, from a
- *     certified second moment; twice it when scores take both signs): the empirical-Bernstein
- *     range term at 95%, so any class of scores worth E of the answer has been seen about 12
- *     times before a stop.  No such R (splitting, forward expected, no certificate): never
- *     met, and rel_err alone is refused with ULAM_EINFVAR (err->msg names the reason);
- *   with walks cut at max_steps, cut_bound <= 0.1 E |m|, else the run stops (cut_stop);
- *   the variance's own relative standard error (fourth moment) <= 0.25, trusted only when
- *     the fourth moment is finite (fourth_finite 1: a bounded score, or rho4 certified below
- *     1); else never met, and rel_err alone is refused with ULAM_EINFVAR (err->msg names
- *     rho4 and a mode or alpha = 1 whose rho4 is below 1, when one is).
- * With rel_err alone, a run whose minimum walk count exceeds ULAM_REL_ERR_CAP stops after the
- * round (out_of_reach).  A split weight below the start weight (1 adjoint, ||b||_1 forward)
+ * The rel_err rule (opts->rel_err = E, variance certified finite; docs/error-bars.md), checked
+ * once per epoch of walk counts (sqrt(2) apart from 1024), stops when all of these hold (N walks,
+ * estimate m, the 95% interval's terms of src/stop.h at L = ln(3 / delta_k)):
+ *   N >= 1000, m != 0 (unless nothing that scores is reachable: x = 0, certified) and,
+ *   forward, the watched component opts->index has been tallied;
+ *   the variance term sqrt(2 V L / N) <= w = sqrt(2 L) E |m|, i.e. se <= E |m|;
+ *   the range and bias terms 7 R L / (3 (N - 1)) + bias <= w, R the range of a single score
+ *     (score_bound; for collision and expected the range of walks short enough to matter,
+ *     from the continuation or a Collatz-Wielandt certificate of the length tail; with weights
+ *     growing on cycles, from a certified second moment; twice it when scores take both
+ *     signs): so any class of scores that could move the answer by E has been seen before a
+ *     stop.  No such R (splitting, forward expected, no certificate): never met, and rel_err
+ *     alone is refused with ULAM_EINFVAR (err->msg names the reason);
+ *   with walks cut at max_steps, cut_bound <= 0.1 E |m|, else the run stops (cut_stop).
+ * A run whose predicted walks (min_walks) exceed max_walks or ULAM_REL_ERR_CAP stops after
+ * the round, not met (out_of_reach), with the estimate so far; a zero estimate never does.  A split weight below the start weight (1 adjoint, ||b||_1 forward)
  * is refused with ULAM_EINVAL. */
 int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                ulam_walk_result *result, ulam_error *err);

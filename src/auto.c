@@ -41,6 +41,7 @@ typedef struct {
     int gi[ULAM_AUTO_MAX];          /* each candidate's group */
     ulam__moments mom[ULAM_AUTO_MAX]; /* pooled pilot scores */
     double steps[ULAM_AUTO_MAX], min_walks[ULAM_AUTO_MAX];
+    double range[ULAM_AUTO_MAX]; /* the range R of a single score its pilot's interval used (INFINITY: none known) */
     int tail_ok[ULAM_AUTO_MAX];
     double guard_reads[KERNELS];    /* per continuation and exponent: iq * 3 + ia */
     ulam_guard guard[KERNELS];
@@ -135,12 +136,11 @@ static double predict(const chooser *c, int k, double var, double *walks)
     if (E > 0) {
         double m = fabs(a->estimate + c->base.rel_err_offset), n = (double)a->pilot_walks;
         if (!c->tail_ok[k]) N = INFINITY; /* no bound on a single score: the rule cannot stop */
-        else if (m == 0) N = var == 0 ? (double)ULAM__REL_MIN : INFINITY;
+        else if (m == 0) N = INFINITY; /* a pilot that saw nothing predicts nothing */
         else {
-            double vre = a->variance_rel_error / ULAM__VAR_REL_MAX;
-            N = fmax((double)ULAM__REL_MIN, var / (E * m * E * m));
+            (void)n; /* the rule's own prediction (stop.h) holds its range term: a pilot without spread */
+            N = fmax((double)ULAM__REL_MIN, var / (E * m * E * m)); /* is no evidence of a small variance */
             N = fmax(N, c->min_walks[k]);
-            N = fmax(N, isfinite(vre) ? n * vre * vre : INFINITY);
         }
         N = rounded_walks(N);
         if (c->base.max_walks > 0) N = fmin(N, (double)c->base.max_walks);
@@ -172,6 +172,19 @@ static double variance_of(const chooser *c, int k)
     return isnan(m) ? a->variance : fmax(a->variance, n * d * d / 4.0);
 }
 
+/* An upper confidence bound on candidate k's variance from its pilot's sample variance var and
+ * the range R of its scores (Maurer and Pontil, COLT 2009, Theorem 10: sigma <= sqrt(var) +
+ * R sqrt(2 ln(1 / delta) / (n - 1)) with probability 1 - delta, here 0.05): a pilot without
+ * spread is no evidence of a small variance when unseen scores could still be large.  Without
+ * a known R, var itself, and a pilot without spread counts as nothing known (INFINITY). */
+static double honest_variance(const chooser *c, int k, double var)
+{
+    double n = (double)c->res->cand[k].pilot_walks, R = c->range[k];
+    if (!isfinite(R)) return var > 0 ? var : INFINITY;
+    double sd = sqrt(var) + (n > 1 ? R * sqrt(2.0 * log(20.0) / (n - 1.0)) : INFINITY);
+    return sd * sd;
+}
+
 /* The key candidates are compared by: predicted work with rel_err, else the cost (at the
  * variance scaled by `scale`). */
 static double key(const chooser *c, int k, double scale)
@@ -181,7 +194,7 @@ static double key(const chooser *c, int k, double scale)
         return INFINITY; /* no forward pilot walk has tallied the component yet: nothing is known */
     double var = variance_of(c, k) * scale, walks;
     if (c->base.rel_err > 0) return predict(c, k, var, &walks);
-    return var * work_per_walk(c, k);
+    return honest_variance(c, k, var) * work_per_walk(c, k);
 }
 
 /* The set-up work the run of candidate k reuses: its continuation's guards and its kernel's
@@ -274,6 +287,7 @@ static int pilot(chooser *c, int k, int stage, int64_t n)
     double mp = fabs(c->mom[k].mean + c->base.rel_err_offset), ms = fabs(r.estimate + c->base.rel_err_offset);
     c->min_walks[k] = r.min_walks > 0 && mp > 0 ? r.min_walks * ms / mp : r.min_walks;
     c->tail_ok[k] = isfinite(r.tail_bound) || r.estimate == 0;
+    c->range[k] = r.tail_bound == 0.0 ? 0.0 : isfinite(r.tail_bound) && ms > 0 ? r.tail_bound * (double)r.walks * ms : INFINITY;
     /* the variance's own error at the pooled count (it falls as 1 / sqrt(n)) */
     a->variance_rel_error = r.variance_rel_error * sqrt((double)r.walks / (double)a->pilot_walks);
     if (a->mode == ULAM_FORWARD && isnan(r.std_error)) c->tail_ok[k] = 0; /* never reached the component */

@@ -8,6 +8,7 @@
  * also stops blocks that have not started. */
 #include "round.h"
 #include "stats.h"
+#include "stop.h"
 #include "walk.h"
 
 #include <math.h>
@@ -21,9 +22,12 @@
  * row built at a first visit costs about 3 times one built in the whole streaming pass
  * (measured, n = 10^6 .. 10^7), so by then the run has spent on row-by-row building about
  * what the pass costs (the rent-or-buy rule), and a run that far will likely reach the rest. */
+/* A largest continuation past which the length tail's certificate is sought too (a row sum
+ * of 1 - 1e-16 bounds nothing useful). */
+#define TAIL_Q 0.99
+
 enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = ULAM__COMPLETE };
 
-#define TAIL_E 0.01 /* the target a run without rel_err reports its tail_bound at */
 
 struct ulam_solver {
     ulam_walk_opts o;
@@ -85,6 +89,7 @@ struct ulam_solver {
     int64_t steps, cut;
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
     int met, cut_stop, out_of_reach;
+    int epoch; /* the last epoch (stop.h) the rel_err rule was checked at */
 };
 
 /* The defaults. */
@@ -244,7 +249,7 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
         }
         ++*iterations;
         if (ratio < *u) *u = ratio, *kappa = vmax / vmin;
-        else if (*u < 1.0 && ratio >= *u * (1.0 - 1e-6)) break; /* no longer improving */
+        else if (it >= 100 && *u < 1.0 && ratio >= *u * (1.0 - 1e-6)) break; /* no longer improving */
         if (!(ymax > 0)) break;
         for (int64_t i = 0; i < n; i++)
             if (seen[i]) v[i] = fmax((y[i] + v[i]) / ymax, floor);
@@ -528,7 +533,7 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
                           "collision estimator or --continue Q",
                           (long long)s->pass[e].bad + 1, adj ? "M" : "M' (column of M)");
     s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
-    if (s->o.rel_err > 0 && vmax > 0 && (!(s->pass_qmax < 1.0) || !isfinite(Wmax))) {
+    if (vmax > 0 && (!(s->pass_qmax < TAIL_Q) || (!isfinite(Wmax) && s->o.rel_err > 0))) {
         if (!s->tail_done && given && given->tail) /* the caller's certificate over the same states */
             s->tail_uc = given->tail_u, s->tail_kc = given->kappa, s->tail_done = 1;
         if (!s->tail_done && (status = reached_flags(s, err))) return status;
@@ -536,7 +541,7 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
             length_tail(K, s->reached, s->o.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
         s->tail_u = s->tail_uc, s->kappa = s->tail_kc;
     }
-    if (s->o.rel_err > 0 && vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
+    if (vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
         (absorb ? isfinite(s->pass[e].g2max) : isfinite(vmax))) {
         if (!s->v2_done[e] && (status = reached_flags(s, err))) return status;
         if (!s->v2_done[e] && s->o.kernel_alpha != 1.0 && !s->fac &&
@@ -568,7 +573,7 @@ int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *se
     if (alpha != 1.0 && !(fac = move_factors(K, seen, continue_q, alpha))) return ULAM_ENOMEM;
     kernel_bounds(K, seen, continue_q, fac, R);
     R->growth = R->fbig > 1.0 ? weight_growth(K, continue_q, fac, seen) : 1.0;
-    if (!(R->qmax < 1.0) || !isfinite(R->growth)) { /* the tail certificate check_reach would need */
+    if (!(R->qmax < TAIL_Q) || !isfinite(R->growth)) { /* the tail certificate check_reach would need */
         int it = 0;
         length_tail(K, seen, continue_q, 0, 1e-30, &R->tail_u, &R->kappa, &it);
         R->tail = 1;
@@ -698,7 +703,7 @@ static int take_bounds(ulam_solver *s, const ulam_csr *K, int rel_alone, ulam_er
     s->bound = s->range = s->per_step = s->visit = s->v2 = s->kappa = s->weight = INFINITY;
     s->qmax = s->tail_u = 1.0;
     s->signs = 0;
-    int status = s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0 ? check_reach(s, K, err) : ULAM_OK;
+    int status = check_reach(s, K, err); /* every run: the printed interval needs the range (stop.h) */
     if (!status) status = take_fourth(s, K, err);
     if (!status && rel_alone) status = check_bounded(s, err);
     return !status && rel_alone ? check_fourth(s->M, s, err) : status;
@@ -1046,23 +1051,23 @@ static int kernel_status(void *ctx)
 
 static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached);
 
-/* Nonzero when the rel_err rule holds for r (see ulam_solve in ulam.h). */
+static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci);
+
+/* Nonzero when the rel_err rule holds for r (see ulam_solve in ulam.h): the run's 95% interval
+ * (stop.h) meeting ulam__stop_rel_met (stderr <= E |m|, range and bias terms within the
+ * same width sqrt(2 L) E |m|), after ULAM__REL_MIN walks, forward with
+ * the watched component tallied, and walks cut at max_steps moving it by at most
+ * ULAM__CUT_SHARE E |m|; x certified 0 (nothing that scores is reachable) meets it at once. */
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
 {
-    double E = s->o.rel_err, m = fabs(r->estimate + s->o.rel_err_offset);
+    double E = s->o.rel_err, m = fabs(r->estimate + s->o.rel_err_offset), R;
     if (!(E > 0) || s->var_finite != 1 || r->walks < ULAM__REL_MIN) return 0;
     if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
-    /* The fourth moment not certified finite: variance_rel_error errs low, so the rule does not
-     * use it and stands on the certified second moment v2 alone (its range term asks for
-     * 12.28 v2 / (E m)^2 walks, which bounds the true standard error by 0.29 E |m|); without
-     * v2 it is never met. */
-    if (s->fourth != 1 && !isfinite(s->v2)) return 0;
-    if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.index] == 0))
-        return 0;
-    if (!isfinite(r->tail_bound)) return 0; /* no bound on a single score: no certificate */
+    if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.index] == 0)) return 0;
     if (!(r->cut_bound <= ULAM__CUT_SHARE * E * m)) return 0;
-    return ulam__rel_err_holds(r->walks, m, r->std_error, r->min_walks, s->fourth == 1 ? r->variance_rel_error : 0.0,
-                               E);
+    ulam__stop_ci ci;
+    interval(s, r, &R, &ci);
+    return ulam__stop_rel_met(&ci, m, E);
 }
 
 /* Under bounds over every state (ulam__reach_all), an estimate still exactly 0 once the rule
@@ -1107,13 +1112,15 @@ int ulam_solver_iterate(ulam_solver *s)
         if (s->run.status) return s->run.status; /* the search failed */
         result(s, &r, 0);
     }
-    if (rel_err_met(s, &r)) s->run.done = s->met = 1;
+    int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
+    if (check && s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
+    if (check && rel_err_met(s, &r)) s->run.done = s->met = 1;
     else if (s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.rel_err_offset) > 0 &&
              !(r.cut_bound <= ULAM__CUT_SHARE * s->o.rel_err * fabs(r.estimate + s->o.rel_err_offset)))
         s->run.done = s->cut_stop = 1; /* the cuts' bias may exceed the target: more walks cannot help */
-    else if (s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && s->o.max_walks == ULAM_REL_ERR_CAP &&
-             !(s->o.max_seconds > 0) && r.min_walks > (double)ULAM_REL_ERR_CAP)
-        s->run.done = s->out_of_reach = 1; /* rel_err alone, and the cap cannot reach the minimum */
+    else if (s->o.rel_err > 0 && s->var_finite == 1 && s->run.walks >= ULAM__REL_MIN && !(s->o.max_seconds > 0) &&
+             fabs(r.estimate + s->o.rel_err_offset) > 0 && isfinite(r.tail_bound) && r.min_walks > (double)s->o.max_walks)
+        s->run.done = s->out_of_reach = 1; /* the walks the target needs are past the budget or the cap */
     return s->run.status;
 }
 
@@ -1144,8 +1151,8 @@ static void forward_component(const ulam_solver *s, int64_t i, double *est, doub
 static double score_range(const ulam_solver *s, double m, double E)
 {
     if (s->bound == 0.0) return s->range;
-    int q = s->qmax < 1.0;
-    double R = ulam__score_range(s->range, s->per_step, q ? s->qmax : s->tail_u, q ? 1.0 : s->kappa, s->signs, m, E);
+    double R = fmin(ulam__score_range(s->range, s->per_step, s->qmax, 1.0, s->signs, m, E),
+                    ulam__score_range(s->range, s->per_step, s->tail_u, s->kappa, s->signs, m, E));
     return isfinite(R) ? R : ulam__moment_range(s->v2, s->signs, m, E);
 }
 
@@ -1165,7 +1172,9 @@ double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int sign
                       : ulam__score_range(INFINITY, s->weight * per_visit, q ? s->qmax : s->tail_u, q ? 1.0 : s->kappa,
                                           signs, m, E);
     if (!isfinite(R) && !absorb) R = ulam__moment_range(s->v2 * per_visit * per_visit, signs, m, E);
-    return isfinite(R) ? ulam__rel_min_walks(R, E, m) : INFINITY;
+    if (!isfinite(R)) return INFINITY;
+    double n = ulam__stop_walks_needed(m, 0.0, R, 0.0, E, 1); /* the rule's range term, at the epoch it lands in */
+    return isfinite(n) ? ulam__stop_walks_needed(m, 0.0, R, 0.0, E, ulam__stop_epoch((int64_t)n)) : n;
 }
 
 /* The most the walks cut at max_steps can have moved the mean (0 without cuts). */
@@ -1174,6 +1183,45 @@ static double cut_bound(const ulam_solver *s)
     if (s->cut == 0) return 0.0;
     return fmin(ulam__cut_bound(s->per_step, s->qmax, 1.0, s->o.max_steps),
                 ulam__cut_bound(s->visit, s->tail_u, s->kappa, s->o.max_steps));
+}
+
+/* The scale the truncation's bias is measured against: |m|, or with an estimate of 0 the most
+ * |x| can be by the same bounds (a visit's score over the length tail; sqrt(v2)); INFINITY
+ * without one. */
+static double bias_scale(const ulam_solver *s, double m)
+{
+    if (m > 0) return m;
+    double X = fmin(s->qmax < 1.0 ? s->per_step / (1.0 - s->qmax) : INFINITY,
+                    s->tail_u < 1.0 ? s->per_step * s->kappa / (1.0 - s->tail_u) : INFINITY);
+    return isfinite(X) && X > 0 ? X : isfinite(s->v2) && s->v2 > 0 ? sqrt(s->v2) : INFINITY;
+}
+
+/* The run's 95% interval so far (stop.h) from r's estimate, variance and walks, and the range R
+ * it used: a single score's range (score_range), for scores without a bound at a truncation
+ * whose bias is at most a quarter of the standard error, kept between 1e-6 and
+ * max(ULAM__STOP_TAIL, E / 4) of |m| (the tighter the truncation, the wider the range; a
+ * sample without spread takes the tightest); the truncation's and the cuts' bias widen it.
+ * Stitched over epochs unless the run stops at a walk count fixed in advance (max_walks reached,
+ * no time limit, no rel_err).  None while the variance is not certified finite. */
+static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci)
+{
+    double E = s->o.rel_err > 0 ? s->o.rel_err : 0.0, m = bias_scale(s, fabs(r->estimate + s->o.rel_err_offset));
+    double cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m, se = r->std_error;
+    int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
+    int fixed = !(s->o.rel_err > 0) && !(s->o.max_seconds > 0) && r->walks == s->o.max_walks;
+    int k = fixed ? 1 : ulam__stop_epoch(r->walks);
+    /* the truncation: a quarter of the standard error, or the decade of |m| that gives the
+       narrowest interval (a longer truncation widens the range term, a shorter one the bias) */
+    double bt = isfinite(se) ? fmin(cap, fmax(se / 4.0, 1e-6 * m)) : cap, best = INFINITY;
+    for (int j = 0; j <= (truncated && isfinite(m) ? 6 : 0); j++) {
+        double t = j == 0 ? bt : fmin(cap, m * pow(10.0, -j)), Rt;
+        ulam__stop_ci c;
+        Rt = isfinite(m) ? score_range(s, m, t / m) : s->bound == 0.0 ? s->range : INFINITY;
+        ulam__stop_interval(r->walks, r->estimate, r->variance, Rt, (truncated ? t : 0.0) + r->cut_bound,
+                            sqrt(s->maxsq), s->signs ? Rt / 2.0 : Rt, k, &c);
+        if (j == 0 || c.half < best) best = c.half, *ci = c, *R = Rt;
+    }
+    if (s->var_finite != 1 && ci->kind != ULAM__STOP_EXACT) ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
 }
 
 /* The result so far; the forward count of unreached components (O(n)) when asked. */
@@ -1196,22 +1244,24 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->max_share = sumsq > 0 ? fmin(1.0, s->maxsq / sumsq) : 0.0;
     r->variance_finite = s->var_finite;
     r->variance_rel_error = ulam__moments_variance_rel_error(mom);
-    double m = fabs(r->estimate + s->o.rel_err_offset), N = (double)s->run.walks;
-    double E = s->o.rel_err > 0 ? s->o.rel_err : TAIL_E;
-    double R = score_range(s, m, E);
+    double m = fabs(r->estimate + s->o.rel_err_offset), N = (double)s->run.walks, R;
+    r->walks = s->run.walks;
     r->score_bound = s->bound;
-    r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
-    r->min_walks = ulam__rel_min_walks(R, s->o.rel_err, m);
     r->cut_bound = cut_bound(s);
+    ulam__stop_ci ci;
+    interval(s, r, &R, &ci);
+    r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
+    if (s->o.rel_err > 0) { /* at this interval's truncation or at the one a stop would have (bias E |m| / 4) */
+        double E = s->o.rel_err, Rs = m > 0 ? score_range(s, m, E / 4.0) : INFINITY;
+        int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
+        r->min_walks = fmin(ulam__stop_walks_needed(m, r->variance, R, ci.bias, E, ci.k),
+                            ulam__stop_walks_needed(m, r->variance, Rs, (truncated ? E * m / 4.0 : 0.0) + r->cut_bound,
+                                                    E, ci.k));
+    }
     r->cut_stop = s->cut_stop;
     r->out_of_reach = s->out_of_reach;
     r->rel_err_met = s->met;
-    /* no interval when the variance is not certified finite, or when walks cut at max_steps may
-       have moved the mean by more than the standard error (the interval would hide the bias) */
-    double half = s->var_finite == 1 && !(r->cut_bound > r->std_error) ? ULAM_Z95 * r->std_error : NAN;
-    r->ci95[0] = r->estimate - half;
-    r->ci95[1] = r->estimate + half;
-    r->walks = s->run.walks;
+    r->ci95[0] = ci.lo, r->ci95[1] = ci.hi; /* NaN: none (stop.h says why) */
     r->steps = s->steps;
     r->cut = s->cut;
     r->rows = atomic_load(&s->k->built);
@@ -1307,7 +1357,7 @@ static void reset(ulam_solver *s)
     s->steps = s->cut = 0;
     s->maxsq = 0.0;
     ulam__run_reset(&s->run);
-    s->met = s->cut_stop = s->out_of_reach = 0;
+    s->met = s->cut_stop = s->out_of_reach = s->epoch = 0;
 }
 
 /* Restart a forward solver on a new right-hand side b (borrowed like the first) with a new
@@ -1329,7 +1379,7 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     s->seen = NULL, s->reached = NULL, s->fac = NULL;
     s->passed = s->tail_done = 0;
     memset(s->v2_done, 0, sizeof s->v2_done);
-    if (s->o.estimator == ULAM_ABSORPTION || s->o.rel_err > 0) {
+    {
         int status = check_reach(s, s->mt, err); /* the score bounds depend on b */
         if (!status) status = take_fourth(s, s->mt, err); /* and so may whether they are bounded */
         if (status) return status;

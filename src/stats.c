@@ -76,14 +76,7 @@ double ulam__cut_bound(double per_step, double qmax, double kappa, int64_t max_s
     return kappa * per_step * pow(qmax, (double)max_steps) / (1.0 - qmax);
 }
 
-/* The walks the range term needs. */
-double ulam__rel_min_walks(double R, double E, double m)
-{
-    if (!(E > 0) || !isfinite(R) || R == 0.0) return 0.0;
-    return m > 0 ? ceil(ULAM__EB_RANGE * R / (E * m)) : INFINITY;
-}
-
-/* Whether the rel_err rule holds. */
+/* Whether the rule as it was holds. */
 int ulam__rel_err_holds(int64_t n, double m, double se, double min_walks, double var_rel_error, double E)
 {
     m = fabs(m);

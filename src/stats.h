@@ -33,13 +33,14 @@ double ulam__moments_variance_rel_error(const ulam__moments *m);
  * and n = 2. */
 void ulam__sums_moments(double n, double sum, double sumsq, double *mean, double *variance);
 
-/* The rel_err stopping rule, shared by matrix and patch walks (derived in README.md, "When to
- * trust the error bar"): at least ULAM__REL_MIN walks; stderr <= E |m|; the empirical-Bernstein
- * range term 3 ln(3 / delta) R / N at delta = 0.05 within E |m|, so N >= ULAM__EB_RANGE R /
- * (E |m|); the variance's own relative standard error at most ULAM__VAR_REL_MAX. */
+/* The fewest walks a --rel-err run makes (the rule itself is src/stop.h's). */
 #define ULAM__REL_MIN 1000
-#define ULAM__EB_RANGE 12.283413301 /* 3 ln(60) */
+
+/* The rule as it was, kept for radiosity shooting and gathering without a certified range
+ * (src/radiosity/patchwalk.c): at least ULAM__REL_MIN walks, stderr <= E |m|, n >= min_walks
+ * and the variance's own relative standard error at most ULAM__VAR_REL_MAX. */
 #define ULAM__VAR_REL_MAX 0.25
+int ulam__rel_err_holds(int64_t n, double m, double se, double min_walks, double var_rel_error, double E);
 
 /* The range R of a single walk's score the rule uses: range when finite (a bounded score);
  * else, for scores that add per_step at most at each visit (weights bounded), with the walk's
@@ -64,12 +65,5 @@ double ulam__moment_range(double v2, int signs, double m, double E);
  * E |m|. */
 double ulam__cut_bound(double per_step, double qmax, double kappa, int64_t max_steps);
 #define ULAM__CUT_SHARE 0.1
-
-/* The walks the range term needs at estimate m (> 0): ceil(ULAM__EB_RANGE R / (E m)); 0 when
- * there is no target or no finite nonzero R, INFINITY when m = 0. */
-double ulam__rel_min_walks(double R, double E, double m);
-
-/* Whether the rule holds for n walks at estimate m with standard error se. */
-int ulam__rel_err_holds(int64_t n, double m, double se, double min_walks, double var_rel_error, double E);
 
 #endif

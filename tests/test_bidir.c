@@ -193,7 +193,11 @@ static void test_bidir_unbiased(void **state)
                 assert_true(res.walks.walks == 20000);
                 assert_true(fabs(z) < 4);
                 assert_close(res.estimate - res.push_part, res.walks.estimate, 1e-15 * (fabs(res.estimate) + 1));
-                assert_close(res.ci95[1] - res.ci95[0], 2 * ULAM_Z95 * res.std_error, 1e-12);
+                /* the walks' interval (src/stop.h) about the estimate, never narrower than the CLT's, or
+                   withheld (NaN: no certified range for the residual's scores) */
+                assert_true(isnan(res.ci95[0]) ||
+                            (res.ci95[0] <= res.estimate && res.estimate <= res.ci95[1] &&
+                             res.ci95[1] - res.ci95[0] >= 2 * ULAM_Z95 * res.std_error * (1 - 1e-12)));
                 assert_true(res.seconds >= res.push.seconds);
                 if (q == 2) assert_true(res.plan.pilot_walks == 256 && res.plan.mean_visits >= 1);
             }
@@ -385,7 +389,7 @@ static void test_bidir_coverage(void **state)
     ulam_csr *M = random_system(40, 4, 1, 0.9, 1), *Mt = NULL;
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     double *x = exact_column(M, 5);
-    int covered = 0;
+    int covered = 0, printed = 0;
     double push_part = 0;
     for (int seed = 0; seed < 200; seed++) { /* case seed: reruns exactly */
         if (!test_case(seed)) continue;
@@ -393,15 +397,17 @@ static void test_bidir_coverage(void **state)
         o.source = 5, o.target = 17, o.rmax = 0.2;
         o.walk.max_walks = 2000, o.walk.seed = (uint64_t)seed;
         ulam_bidir_result res = bidir(M, Mt, &o);
-        covered += res.ci95[0] <= x[17] && x[17] <= res.ci95[1];
+        covered += fabs(res.estimate - x[17]) <= ULAM_Z95 * res.std_error; /* the walks' own check */
+        printed += res.ci95[0] <= x[17] && x[17] <= res.ci95[1]; /* src/stop.h's interval: conservative */
         push_part = res.push_part;
     }
     test_case_done();
     if (test_case_all()) { /* the count over seeds (one case alone: none) */
-        print_message("95%% interval covered the LAPACK value %d / 200 times (x = %.6g, push part %.6g)\n", covered,
-                      x[17], push_part);
+        print_message("-+ 1.96 stderr covered the LAPACK value %d / 200 times, the printed interval %d (x = %.6g, push "
+                      "part %.6g)\n", covered, printed, x[17], push_part);
         assert_true(fabs(push_part - x[17]) > 0.1 * fabs(x[17]));
         assert_in_range(covered, 180, 198);
+        assert_true(printed >= 180);
     }
     free(x);
     ulam_csr_free(M), ulam_csr_free(Mt);

@@ -36,7 +36,7 @@ static void test_rel_err_rare_scores(void **state)
     exact(M, b, 3, &x, &var);
     print_message("x_4 = %.6g, per-walk variance %.6g (absorption)\n", x, var);
     for (int k = 0; k < 3; k++) {
-        int covered = 0, R = cases[k].seeds;
+        int covered = 0, printed = 0, R = cases[k].seeds;
         double bias = 0, se = 0, walks = 0;
         for (int s = 0; s < R; s++) { /* case 1000 k + s reruns exactly */
             if (!test_case(1000L * k + s)) continue;
@@ -48,16 +48,18 @@ static void test_rel_err_rare_scores(void **state)
             assert_true(r.rel_err_met && r.variance_finite == 1);
             assert_true(r.std_error <= cases[k].E * fabs(r.estimate) && r.walks >= r.min_walks);
             covered += fabs(r.estimate - x) <= ULAM_Z95 * r.std_error;
+            printed += r.ci95[0] <= x && x <= r.ci95[1]; /* the printed interval (src/stop.h) */
             bias += r.estimate - x, se += r.std_error, walks += (double)r.walks;
         }
         test_case_done();
         if (!test_case_all()) continue; /* one case alone: no count over seeds */
         bias /= R, se /= R;
         int lower = (int)floor(0.9 * R - 2 * sqrt(0.09 * R));
-        print_message("E = %g: covered %d / %d (at least %d), mean bias %.3g (%.2f%%), mean stderr %.3g, mean walks %.3g\n",
-                      cases[k].E, covered, R, lower, bias, 100 * bias / x, se, walks / R);
+        print_message("E = %g: covered %d / %d (at least %d; the printed interval %d), mean bias %.3g (%.2f%%), mean "
+                      "stderr %.3g, mean walks %.3g\n", cases[k].E, covered, R, lower, printed, bias, 100 * bias / x, se,
+                      walks / R);
         if (covered < lower || !(fabs(bias) < se)) print_error("table row %d fails (its seeds: cases %d000 ..)\n", k, k);
-        assert_true(covered >= lower);
+        assert_true(covered >= lower && printed >= lower);
         assert_true(fabs(bias) < se);
     }
     ulam_csr_free(M), free(b);
@@ -92,7 +94,7 @@ static void test_rel_err_no_score_bound(void **state)
         ulam_csr *M;
         double *b, *x;
         load(cases[k].name, &M, &b, &x);
-        int covered = 0, R = cases[k].seeds;
+        int covered = 0, printed = 0, R = cases[k].seeds;
         double walks = 0, bias = 0;
         for (int s = 0; s < R; s++) { /* case 1000 k + s */
             if (!test_case(1000L * k + s)) continue;
@@ -105,17 +107,18 @@ static void test_rel_err_no_score_bound(void **state)
                             (long long)r.walks, r.min_walks);
             assert_true(r.rel_err_met && isfinite(r.tail_bound) && r.walks >= r.min_walks);
             covered += fabs(r.estimate - x[0]) <= ULAM_Z95 * r.std_error;
+            printed += r.ci95[0] <= x[0] && x[0] <= r.ci95[1];
             walks += (double)r.walks, bias += r.estimate - x[0];
         }
         test_case_done();
         int lower = (int)floor(0.9 * R - 2 * sqrt(0.09 * R));
         if (test_case_all()) { /* the count over seeds (one case alone: none) */
-            print_message("%s: covered %d / %d (at least %d), mean bias %.2f%%, mean walks %.3g\n", cases[k].name,
-                          covered, R, lower, 100 * bias / R / x[0], walks / R);
+            print_message("%s: covered %d / %d (at least %d; the printed interval %d), mean bias %.2f%%, mean walks "
+                          "%.3g\n", cases[k].name, covered, R, lower, printed, 100 * bias / R / x[0], walks / R);
             if (covered < lower) print_error("table row %d fails (its seeds: cases %d000 ..)\n", k, k);
         }
         ulam_csr_free(M), free(b), free(x);
-        assert_true(!test_case_all() || covered >= lower);
+        assert_true(!test_case_all() || (covered >= lower && printed >= lower));
     }
 }
 

@@ -62,13 +62,17 @@ static void test_agreement(void **state)
     test_case_done();
 }
 
-/* Over 200 seeds the 95% interval covers the LAPACK value 90% to 99% of the time. */
+/* Over 200 seeds estimate -+ 1.96 stderr covers the LAPACK value 90% to 99% of the time (the
+ * walks' own check: biased walks cover less), the printed 95% interval (src/stop.h, conservative
+ * by construction) at least 90%, at under 5 times that CLT width (measured: collision 4.1, its range
+ * term, walks of up to ~27 steps, still dominant at 2000 walks; 2.1 at 10^5 walks). */
 static void test_coverage(void **state)
 {
     (void)state;
     test_sys s = test_sys_load("chain4");
     for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
-        int covered = 0;
+        int covered = 0, printed = 0;
+        double ratio = 0;
         for (int seed = 0; seed < 200; seed++) { /* case 1000 est + seed: reruns exactly */
             if (!test_case(1000L * est + seed)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
@@ -77,12 +81,16 @@ static void test_coverage(void **state)
             o.max_walks = 2000;
             o.seed = (uint64_t)seed;
             ulam_walk_result r = test_sys_run(&s, o);
-            covered += r.ci95[0] <= s.x[0] && s.x[0] <= r.ci95[1];
+            covered += fabs(r.estimate - s.x[0]) <= ULAM_Z95 * r.std_error;
+            printed += r.ci95[0] <= s.x[0] && s.x[0] <= r.ci95[1];
+            ratio += (r.ci95[1] - r.ci95[0]) / (2 * ULAM_Z95 * r.std_error) / 200;
         }
         test_case_done();
         if (!test_case_all()) continue; /* one case alone: no count over seeds */
-        print_message("estimator %d: 95%% interval covered the LAPACK value %d / 200 times\n", est, covered);
+        print_message("estimator %d: -+ 1.96 stderr covered the LAPACK value %d / 200 times, the printed interval %d "
+                      "at %.3g times its width\n", est, covered, printed, ratio);
         assert_in_range(covered, 180, 198);
+        assert_true(printed >= 180 && ratio < 5.0);
     }
     test_sys_free(&s);
 }
@@ -444,11 +452,11 @@ static void test_solver_guards(void **state)
     assert_int_equal(r.variance_finite, -1);
     assert_true(isnan(r.ci95[0]));
     ulam_solver_free(sv);
-    o.assume_finite = 1; /* the user's word that unknown is finite: an interval again */
-    o.max_steps = 1000000; /* and no cut walks, whose unbounded bias would withhold it */
+    o.assume_finite = 1; /* the user's word that unknown is finite, but no interval: it needs a */
+    o.max_steps = 1000000; /* certified range of a score, and rho(|M|) straddling 1 certifies no length tail */
     assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
     assert_int_equal(r.variance_finite, 1);
-    assert_true(isfinite(r.ci95[0]));
+    assert_true(isnan(r.ci95[0]) && !isfinite(r.tail_bound));
     o.guard = &g, o.assume_finite = 0; /* verdicts handed in are used, not recomputed */
     g.verdict_hat[ULAM_ADJOINT] = ULAM_VERDICT_OK;
     assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
@@ -510,9 +518,9 @@ static void test_rel_err_cuts(void **state)
                   (long long)r.walks, r.cut_bound, r.rel_err_met, r.cut_stop);
     assert_true(r.cut > 0 && !r.rel_err_met && r.cut_stop && r.walks <= 2048);
     assert_true(r.cut_bound > 0.1 * 0.01 * r.estimate);
-    /* and no interval: the cuts may have moved the mean (exact 10^4, estimate ~1.8e3) by more than
-       the standard error, so a 95% interval would hide the bias */
-    assert_true(r.cut_bound > r.std_error && isnan(r.ci95[0]) && isnan(r.ci95[1]));
+    /* and an interval that holds the cuts' bias (exact 10^4, estimate ~1.8e3): widened by cut_bound
+       on both sides (src/stop.h), it reaches the exact value */
+    assert_true(r.cut_bound > r.std_error && r.ci95[0] <= 1e4 && 1e4 <= r.ci95[1]);
     o.max_walks = 8192;
     assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(!r.rel_err_met && r.cut_stop);
@@ -604,7 +612,7 @@ static void test_forward_unreached(void **state)
 /* Collision on a sticky rare cluster (rare_system with the three rare states' rows pointing at
  * each other: walks that reach them, once in about 10^4, stay about 500 steps scoring 40 each,
  * 45% of x): a single score has no bound, but walks longer than l add under E |m|, so the rule
- * asks for ~10^6 walks and does not stop at 2000 (the old rule stopped at 1024 walks in 95 of
+ * asks for ~10^6 walks: past the budget of 2000, it stops early, not met, saying so (the old rule stopped at 1024 walks in 95 of
  * 100 seeds, 45% low; with the score-bound minimum 18 of 20 seeds covered at E = 0.1). */
 static void test_rel_err_collision_tail(void **state)
 {
@@ -622,7 +630,7 @@ static void test_rel_err_collision_tail(void **state)
     print_message("sticky cluster, collision, 2000 walks: the rule needs %.3g walks (tail bound %.3g)\n", r.min_walks,
                   r.tail_bound);
     assert_true(!isfinite(r.score_bound) && isfinite(r.tail_bound));
-    assert_true(r.min_walks > 1e6 && !r.rel_err_met && r.walks == 2000);
+    assert_true(r.min_walks > 1e6 && !r.rel_err_met && r.out_of_reach && r.walks < 2000); /* said so early */
     ulam_csr_free(M0), ulam_csr_free(T), ulam_csr_free(M), free(b);
 }
 

@@ -135,9 +135,11 @@ static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
         printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->index + 1,
                o->index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1 && isnan(r->ci95[0]))
-        printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: walks cut at --max-steps may have moved it by up "
-               "to %.3g, more than its standard error)%s\n", (long long)o->index + 1, o->index < 9 ? 10 : 9, "",
-               r->estimate, r->std_error, r->cut_bound, r->interrupted ? "  [INTERRUPTED]" : "");
+        printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->index + 1,
+               o->index < 9 ? 10 : 9, "", r->estimate, r->std_error,
+               !isfinite(r->cut_bound) ? "walks cut at --max-steps may have moved it by any amount"
+               : !isfinite(r->tail_bound) && r->estimate != 0 ? "no certified range of a single walk's score"
+               : "no certified range yet, or a score past the certified one", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1)
         printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->index + 1,
                o->index < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],

@@ -35,6 +35,7 @@
 #include "../round.h"
 
 #include "../stats.h"
+#include "../stop.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -84,6 +85,7 @@ struct ulam_rad_solver {
     ulam__run run; /* walks, time, ending (round.c) */
     int64_t rays, cut;
     int zero, met;
+    int epoch; /* the last epoch (stop.h) the rel_err rule was checked at */
 };
 
 /* Free; accepts and returns NULL. */
@@ -496,11 +498,25 @@ static void merge_block(void *ctx, int k)
 
 static void result(const ulam_rad_solver *s, const double mins[3], ulam_rad_result *r);
 
-/* Gathering: the walks the rel_err rule's range term needs in channel c at estimate m. */
-static double channel_min_walks(const ulam_rad_solver *s, int c, double m, double E)
+/* Gathering: channel c's 95% interval (stop.h) at estimate m, its scores' range at a truncation
+ * whose bias is at most E |m| / 4 (the patch solver keeps no per-channel largest score: the
+ * range is taken as holding). */
+static void channel_interval(const ulam_rad_solver *s, int c, double m, double E, ulam__stop_ci *ci)
 {
     m = fabs(m);
-    return ulam__rel_min_walks(ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, m, E), E, m);
+    double R = ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, m, E / 4.0);
+    int64_t n = s->run.walks;
+    ulam__stop_interval(n, s->m[c].mean, ulam__moments_variance(&s->m[c]), R, isfinite(s->range[c]) ? 0.0 : E * m / 4.0,
+                        0.0, INFINITY, ulam__stop_epoch(n), ci);
+}
+
+/* Gathering: the walks the rel_err rule (stop.h) needs in channel c at estimate m. */
+static double channel_min_walks(const ulam_rad_solver *s, int c, double m, double E)
+{
+    ulam__stop_ci ci;
+    channel_interval(s, c, m, E, &ci);
+    double R = ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, fabs(m), E / 4.0);
+    return isfinite(R) ? ulam__stop_walks_needed(m, ulam__moments_variance(&s->m[c]), R, ci.bias, E, ci.k) : 0.0;
 }
 
 /* Gathering with rel_err: the walks the rule's range term needs in each channel, at its
@@ -518,11 +534,13 @@ static void channel_mins(const ulam_rad_solver *s, double mins[3])
     }
 }
 
-/* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): the whole
- * rule (ulam__rel_err_holds) with the channels' range-term minimums mins from channel_mins;
- * shooting at patch opts->index with the moments of that patch's per-particle tallies (its
- * variance's own error from their fourth moment) and no range term (a particle may return to
- * the patch any number of times: no bound on its tally). */
+/* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
+ * takes the rule of src/stop.h (ulam__stop_rel_met on each channel's 95% interval; mins from
+ * channel_mins hold a channel still at 0); shooting at patch opts->index, with the moments of
+ * that patch's per-particle tallies, and gathering without a certified range (next-event
+ * estimation), the rule as it was (ulam__rel_err_holds: the standard error and the variance's
+ * own error from the fourth moment, no range term: a particle may return to the patch any
+ * number of times, no bound on its tally; a known gap). */
 static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, const double mins[3], double rel_err)
 {
     int any = 0;
@@ -536,8 +554,12 @@ static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, co
             (double)r->walks < mins[c])
             return 0;
         if (r->radiosity[c] == 0.0) continue;
-        if (!ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c], mins[c],
-                                 ulam__moments_variance_rel_error(&s->m[c]), rel_err))
+        ulam__stop_ci ci;
+        if (s->o.mode != ULAM_FORWARD) channel_interval(s, c, r->radiosity[c], rel_err, &ci);
+        if (s->o.mode == ULAM_FORWARD || ci.kind == ULAM__STOP_NONE
+                ? !ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c], mins[c],
+                                       ulam__moments_variance_rel_error(&s->m[c]), rel_err)
+                : !ulam__stop_rel_met(&ci, r->radiosity[c], rel_err))
             return 0;
         any = 1;
     }
@@ -568,7 +590,10 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     double mins[3];
     channel_mins(s, mins);
     result(s, mins, &r);
-    if (s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, mins, s->o.rel_err)) s->run.done = s->met = 1;
+    int k = ulam__stop_epoch(r.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
+    if (check && s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN) s->epoch = k;
+    if (check && s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, mins, s->o.rel_err))
+        s->run.done = s->met = 1;
     if (s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && all_zero(&r)) s->run.done = s->zero = 1; /* can never be met */
     return s->run.status;
 }
@@ -583,7 +608,7 @@ void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uin
     s->sq = s->maxsq = 0.0;
     s->rays = s->cut = 0;
     ulam__run_reset(&s->run);
-    s->zero = s->met = 0;
+    s->zero = s->met = s->epoch = 0;
 }
 
 /* Nonzero once a stopping rule is met. */

@@ -1,0 +1,62 @@
+/* The stopping rule and the printed interval: the stitched empirical-Bernstein bound (see
+ * stop.h), one formula for every budget (walks, time, rel_err) and every solver. */
+#include "stop.h"
+
+#include <math.h>
+
+/* The epoch of n walks. */
+int ulam__stop_epoch(int64_t n)
+{
+    if (n <= ULAM__STOP_N0) return 1;
+    return 1 + (int)ceil(2.0 * log2((double)n / ULAM__STOP_N0) - 1e-12);
+}
+
+/* ln(3 / delta_k), delta_k = delta / (k (k + 1)). */
+double ulam__stop_log(int k)
+{
+    double kk = k < 1 ? 1.0 : (double)k;
+    return log(3.0 / ULAM__STOP_DELTA) + (k > 1 ? log(kk * (kk + 1.0)) : 0.0);
+}
+
+/* The interval of n scores. */
+void ulam__stop_interval(int64_t n, double mean, double var, double R, double bias, double maxabs, double limit, int k,
+                         ulam__stop_ci *ci)
+{
+    *ci = (ulam__stop_ci){.lo = NAN, .hi = NAN, .half = INFINITY, .var_term = INFINITY, .range_term = INFINITY,
+                          .bias = bias, .L = ulam__stop_log(k), .k = k, .kind = ULAM__STOP_NONE};
+    if (R == 0.0) { /* nothing that scores is reachable: x is 0, certified */
+        ci->lo = ci->hi = mean, ci->half = ci->var_term = ci->range_term = 0.0, ci->kind = ULAM__STOP_EXACT;
+        return;
+    }
+    if (n < 2 || !isfinite(R) || !(R > 0) || !isfinite(mean) || !(bias >= 0) || !isfinite(bias)) return;
+    if (maxabs > limit) { /* a score past the range: the sample is not the clipped one R describes */
+        ci->kind = ULAM__STOP_BEYOND;
+        return;
+    }
+    double N = (double)n, L = ci->L;
+    ci->var_term = sqrt(2.0 * fmax(var, 0.0) * L / N);
+    ci->range_term = 7.0 * R * L / (3.0 * (N - 1.0));
+    ci->half = ci->var_term + ci->range_term + bias;
+    ci->lo = mean - ci->half, ci->hi = mean + ci->half;
+    ci->kind = ULAM__STOP_EB;
+}
+
+/* Whether an interval meets a relative-error target. */
+int ulam__stop_rel_met(const ulam__stop_ci *ci, double m, double E)
+{
+    if (!(E > 0)) return 0;
+    if (ci->kind == ULAM__STOP_EXACT) return 1;
+    double w = sqrt(2.0 * ci->L) * E * fabs(m);
+    return ci->kind == ULAM__STOP_EB && w > 0 && ci->var_term <= w && ci->range_term + ci->bias <= w;
+}
+
+/* The walk count that would meet target E. */
+double ulam__stop_walks_needed(double m, double var, double R, double bias, double E, int k)
+{
+    if (!(E > 0)) return 0.0;
+    if (R == 0.0) return 0.0;
+    double L = ulam__stop_log(k), w = sqrt(2.0 * L) * E * fabs(m), c = w - bias;
+    if (!(fabs(m) > 0) || !isfinite(R) || !(c > 0)) return INFINITY;
+    double nv = fmax(var, 0.0) / (E * m * E * m), nr = 7.0 * R * L / (3.0 * c) + 1.0;
+    return ceil(fmax(nv, nr));
+}

@@ -1,0 +1,75 @@
+/* The stopping rule and the printed interval, in one place (internal): every walk solver (the
+ * matrix solver src/solve.c, the patch solver src/radiosity/patchwalk.c) asks here what 95%
+ * interval its scores give and whether a relative-error target is met.
+ *
+ * The construction: the empirical-Bernstein bound of Maurer and Pontil ("Empirical Bernstein
+ * bounds and sample variance penalization", COLT 2009, Theorem 4, both sides): for n
+ * independent scores in an interval of width R, with sample variance V (n - 1 denominator),
+ *     |mean - E score| <= sqrt(2 V L / n) + 7 R L / (3 (n - 1)),   L = ln(3 / delta_k),
+ * with probability at least 1 - delta_k (two Bernstein tails and the variance's own bound, a
+ * third each).  Stitched over the checkpoints a run can stop at: walk counts are grouped in
+ * epochs growing by sqrt(2) from ULAM__STOP_N0 (epoch k holds n in (N0 2^((k-2)/2),
+ * N0 2^((k-1)/2)]), epoch k gets delta_k = delta / (k (k + 1)), so the bounds hold at every
+ * epoch at once with probability 1 - delta (sum 1 / (k (k + 1)) = 1); the rel_err rule checks
+ * once per epoch.  A run with a fixed walk count and no other rule stops at one count known in
+ * advance: it takes delta itself (k = 1).
+ *
+ * R is certified by the caller (a bound on a single score, or the range of walks cut at a
+ * length past which they add at most `bias` to the mean, or a second-moment route), as is
+ * `bias`, the most the scores' mean can differ from x (truncation, walks cut at max_steps),
+ * which widens the interval on both sides.  R = 0 certifies x exactly (nothing that scores is
+ * reachable); R infinite gives no interval. */
+#ifndef ULAM_STOP_H
+#define ULAM_STOP_H
+
+#include <stdint.h>
+
+#define ULAM__STOP_DELTA 0.05 /* 1 - the confidence of every printed interval */
+#define ULAM__STOP_N0 1024    /* the first epoch's walks (one block) */
+#define ULAM__STOP_TAIL 0.01  /* the largest share of |x| the truncation bias may take (fixed budgets) */
+
+/* What the interval rests on. */
+enum {
+    ULAM__STOP_NONE = 0,  /* no interval: no certified range (or fewer than 2 walks) */
+    ULAM__STOP_EB = 1,    /* the stitched empirical-Bernstein interval */
+    ULAM__STOP_EXACT = 2, /* x certified exactly (nothing that scores is reachable): zero width */
+    ULAM__STOP_BEYOND = 3 /* no interval: a score beyond the certified range R was seen */
+};
+
+/* A 95% interval: [lo, hi], its half-width (half = INFINITY, lo = hi = NaN when none), the
+ * terms it is made of, the checkpoint it was taken at and its kind (ULAM__STOP_*). */
+typedef struct {
+    double lo, hi, half;
+    double var_term, range_term, bias;
+    double L; /* ln(3 / delta_k) */
+    int k, kind;
+} ulam__stop_ci;
+
+/* The epoch of n walks (1 for n <= ULAM__STOP_N0). */
+int ulam__stop_epoch(int64_t n);
+
+/* L = ln(3 / delta_k) of epoch k (k >= 1). */
+double ulam__stop_log(int k);
+
+/* The interval of n scores with mean `mean`, sample variance `var`, certified range R (the width
+ * of an interval holding every score; INFINITY none, 0 exact) and certified bias, at epoch k
+ * (1 for a run that stops at a count fixed in advance); maxabs: the largest |score| seen, with
+ * half: R / 2 when the scores may take both signs (else R) as the largest |score| the range
+ * allows (kind ULAM__STOP_BEYOND past it). */
+void ulam__stop_interval(int64_t n, double mean, double var, double R, double bias, double maxabs, double limit, int k,
+                         ulam__stop_ci *ci);
+
+/* Whether an interval meets a relative-error target E at estimate m: its variance term at most
+ * w = sqrt(2 L) E |m|, the width it has when the standard error is E |m| (so the rule asks
+ * stderr <= E |m|, as a CLT rule would), and its range and bias terms together at most w too
+ * (so the sample has seen what could still matter): the half-width is then at most 2 w; never
+ * at m = 0 unless exact. */
+int ulam__stop_rel_met(const ulam__stop_ci *ci, double m, double E);
+
+/* The walk count at which a run of sample variance var, range R and bias at estimate m would
+ * meet target E at epoch k (the larger of the variance term's and the range term's); 0 with
+ * no target, INFINITY when the bias alone exceeds what the target allows, m = 0 or R
+ * infinite. */
+double ulam__stop_walks_needed(double m, double var, double R, double bias, double E, int k);
+
+#endif /* ULAM_STOP_H */

@@ -1,0 +1,156 @@
+/* What --rel-err costs against what the variance asks (issue 25's cost target: at most 3x).
+ *
+ * For each system (the suite's benign matrices, and two hard ones generated here: the
+ * metastable chain of tests/test_stop.c and the 15^3 Laplacian's corner), x_1 (or the corner)
+ * by adjoint walks with each of the collision and absorption estimators:
+ *   oracle   walks the true variance needs for stderr = E x: var / (E x)^2, var the sample
+ *            variance of a rich fixed run (ORACLE walks), x by LAPACK;
+ *   walks    the mean walks of REPS --rel-err E runs (seeds 1..REPS), and how many met;
+ *   ratio    walks / oracle (the target: <= 3), and walks / max(oracle, 1024) (a run's first
+ *            round is 1024 walks: no run is shorter);
+ *   width    the mean printed 95% half-width over E |x| (1.96 is what a CLT interval at
+ *            stderr E |x| would show);
+ *   covered  how many of the runs' printed intervals hold x.
+ * A run is capped at CAP walks: one that predicts more stops early, not met (counted in walks).
+ *
+ *   bench_relerr [E [REPS]]    prints the table (defaults 0.1 and 5) */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ulam.h"
+
+enum { ORACLE = 1 << 20, CAP = 1 << 24 };
+
+/* A system: M, b, the unknown's index and x by LAPACK. */
+typedef struct {
+    const char *name;
+    ulam_csr *M;
+    double *b, x;
+    int64_t index;
+} sys;
+
+/* Read matrices/NAME.mtx and NAME_b.mtx (Jacobi splitting when jacobi). */
+static int load(sys *s, const char *name, int jacobi)
+{
+    char mp[256], bp[256];
+    int64_t n;
+    snprintf(mp, sizeof mp, "matrices/%s.mtx", name);
+    snprintf(bp, sizeof bp, "matrices/%s_b.mtx", name);
+    ulam_csr *A;
+    double *b;
+    if (ulam_mm_read_matrix(mp, &A, NULL) || ulam_mm_read_vector(bp, &b, &n, NULL)) return -1;
+    s->name = name, s->index = 0;
+    if (jacobi) {
+        s->b = malloc((size_t)n * sizeof *s->b);
+        if (ulam_jacobi(A, b, 1.0, &s->M, s->b, NULL)) return -1;
+        ulam_csr_free(A), free(b);
+    } else {
+        s->M = A, s->b = b;
+    }
+    return 0;
+}
+
+/* The metastable chain (tests/test_stop.c) at leak 1e-4. */
+static void metastable(sys *s)
+{
+    int32_t ti[200], tj[200];
+    double tx[200];
+    int nz = 0;
+    static const int hop[4] = {1, 3, 7, 12};
+    for (int c = 0; c < 2; c++)
+        for (int i = 0; i < 20; i++) {
+            double sum = c ? 0.9995 : 0.95 - (i == 0 ? 1e-4 : 0.0);
+            for (int h = 0; h < 4; h++) ti[nz] = 20 * c + i, tj[nz] = 20 * c + (i + hop[h]) % 20, tx[nz++] = sum / 4;
+        }
+    ti[nz] = 0, tj[nz] = 20, tx[nz++] = 1e-4;
+    ulam_csr_from_triplets(40, 40, nz, ti, tj, tx, &s->M);
+    s->b = malloc(40 * sizeof *s->b);
+    for (int i = 0; i < 40; i++) s->b[i] = i < 20 ? 1.0 : 10.0;
+    s->name = "metastable40", s->index = 0;
+}
+
+/* The m^3 Laplacian's Jacobi splitting, a point source at the centre, the corner unknown. */
+static void laplace(sys *s, int m)
+{
+    int64_t n = (int64_t)m * m * m, nz = 0;
+    int32_t *ti = malloc((size_t)(7 * n) * sizeof *ti), *tj = malloc((size_t)(7 * n) * sizeof *tj);
+    double *tx = malloc((size_t)(7 * n) * sizeof *tx), *b = calloc((size_t)n, sizeof *b);
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < m; j++)
+            for (int k = 0; k < m; k++) {
+                int32_t r = (int32_t)((i * m + j) * m + k);
+                ti[nz] = r, tj[nz] = r, tx[nz++] = 6.0;
+                const int d[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+                for (int q = 0; q < 6; q++) {
+                    int a = i + d[q][0], c = j + d[q][1], e = k + d[q][2];
+                    if (a < 0 || c < 0 || e < 0 || a >= m || c >= m || e >= m) continue;
+                    ti[nz] = r, tj[nz] = (int32_t)((a * m + c) * m + e), tx[nz++] = -1.0;
+                }
+            }
+    b[((m / 2) * m + m / 2) * m + m / 2] = 1.0;
+    ulam_csr *A;
+    ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &A);
+    s->b = malloc((size_t)n * sizeof *s->b);
+    ulam_jacobi(A, b, 1.0, &s->M, s->b, NULL);
+    ulam_csr_free(A), free(ti), free(tj), free(tx), free(b);
+    s->name = "laplace15^3 corner", s->index = 0;
+}
+
+/* x at the index by LAPACK. */
+static void exact(sys *s)
+{
+    double *x = malloc((size_t)s->M->nrows * sizeof *x);
+    s->x = ulam_direct_solve(s->M, s->b, x, 0, NULL, NULL) ? NAN : x[s->index];
+    free(x);
+}
+
+/* One row of the table. */
+static void row(const sys *s, int est, double E, int reps)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.estimator = est, o.index = s->index, o.max_walks = ORACLE, o.seed = 12345;
+    ulam_walk_result r;
+    if (ulam_solve(s->M, s->b, &o, &r, NULL)) {
+        printf("%-20s %-10s refused\n", s->name, est ? "absorption" : "collision");
+        return;
+    }
+    double oracle = r.variance / (E * s->x * E * s->x), walks = 0, width = 0, secs = 0;
+    int met = 0, covered = 0;
+    for (int k = 0; k < reps; k++) {
+        o.max_walks = CAP, o.rel_err = E, o.seed = 1 + (uint64_t)k; /* past CAP: stopped early, not met */
+        if (ulam_solve(s->M, s->b, &o, &r, NULL)) continue;
+        walks += (double)r.walks / reps, secs += r.seconds / reps, met += r.rel_err_met;
+        width += (r.ci95[1] - r.ci95[0]) / 2 / (E * fabs(s->x)) / reps;
+        covered += r.ci95[0] <= s->x && s->x <= r.ci95[1];
+    }
+    printf("%-20s %-10s %11.4g %11.4g %3d/%-3d %8.3g %8.3g %8.3g %3d/%-3d %8.3g\n", s->name,
+           est ? "absorption" : "collision", oracle, walks, met, reps, walks / oracle, walks / fmax(oracle, 1024.0), width,
+           covered, reps, secs);
+    fflush(stdout);
+}
+
+int main(int argc, char **argv)
+{
+    double E = argc > 1 ? atof(argv[1]) : 0.1;
+    int reps = argc > 2 ? atoi(argv[2]) : 5;
+    static const struct { const char *name; int jacobi; } files[] = {
+        {"chain4", 0}, {"radiosity100", 0}, {"randsub1000", 0}, {"signed200", 0}, {"poisson20", 1}};
+    printf("--rel-err %g, %d runs a row; oracle = var / (E x)^2 (var from %d walks)\n", E, reps, ORACLE);
+    printf("%-20s %-10s %11s %11s %7s %8s %8s %8s %7s %8s\n", "system", "estimator", "oracle", "walks", "met", "ratio",
+           "ratio1k", "width/Ex", "covered", "seconds");
+    for (int f = 0; f < 7; f++) {
+        sys s = {0};
+        if (f < 5 && load(&s, files[f].name, files[f].jacobi)) {
+            printf("%s: cannot read (run from the source root)\n", files[f].name);
+            continue;
+        }
+        if (f == 5) metastable(&s);
+        if (f == 6) laplace(&s, 15);
+        exact(&s);
+        for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) row(&s, est, E, reps);
+        ulam_csr_free(s.M), free(s.b);
+    }
+    return 0;
+}

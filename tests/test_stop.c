@@ -1,0 +1,264 @@
+/* Printed 95% intervals at every budget (issue 25): coverage over 100 seeds on systems with a
+ * rarely reached part, at fixed walk counts, at round counts the test picks (a clock's stop),
+ * and under --rel-err, with a binomial bound (at least 89 of 100: 95% coverage fails it with
+ * probability under 2%).  An interval withheld is honest and counted so; an answer missing is
+ * not.  Every system is generated here.
+ *
+ * metastable(leak): 40 states; cluster A (states 0..19, b = 1) has rows of M summing to exactly
+ * 0.95, so every absorption score in A is 20; state 0 leaks `leak` into cluster B (states
+ * 20..39, b = 10, rows summing to 0.9995), which a walk from state 0 reaches with probability
+ * about `leak` and where it then scores about 2e4.  At leak 1e-4, B holds 9% of x_0; a sample of
+ * 1000 walks has seen B with probability 0.1, and its sample variance is then 0 (absorption) or
+ * small: the old CLT interval covered 13/100 at 1000 walks.
+ *
+ * laplace(m): the m^3 Laplacian (7-point, Dirichlet) by its Jacobi splitting, b a point source
+ * at the centre, the unknown at a corner, which walks reach rarely (x_0 about 1e-3). */
+#include "testutil.h"
+
+/* The metastable chain, its b (40 entries, malloc'd) and x_0 by LAPACK. */
+static ulam_csr *metastable(double leak, double **b, double *x0)
+{
+    int32_t ti[200], tj[200];
+    double tx[200];
+    int nz = 0;
+    static const int hop[4] = {1, 3, 7, 12};
+    for (int c = 0; c < 2; c++)
+        for (int i = 0; i < 20; i++) {
+            double sum = c ? 0.9995 : 0.95 - (i == 0 ? leak : 0.0);
+            for (int h = 0; h < 4; h++) ti[nz] = 20 * c + i, tj[nz] = 20 * c + (i + hop[h]) % 20, tx[nz++] = sum / 4;
+        }
+    ti[nz] = 0, tj[nz] = 20, tx[nz++] = leak;
+    ulam_csr *M;
+    assert_int_equal(ulam_csr_from_triplets(40, 40, nz, ti, tj, tx, &M), ULAM_OK);
+    *b = malloc(40 * sizeof **b);
+    for (int i = 0; i < 40; i++) (*b)[i] = i < 20 ? 1.0 : 10.0;
+    double x[40];
+    assert_int_equal(ulam_direct_solve(M, *b, x, 0, NULL, NULL), ULAM_OK);
+    *x0 = x[0];
+    return M;
+}
+
+/* The m^3 Laplacian's Jacobi splitting M, bp (malloc'd) and x at the corner (state 0). */
+static ulam_csr *laplace(int m, double **bp, double *x0)
+{
+    int64_t n = (int64_t)m * m * m, cap = 7 * n, nz = 0;
+    int32_t *ti = malloc((size_t)cap * sizeof *ti), *tj = malloc((size_t)cap * sizeof *tj);
+    double *tx = malloc((size_t)cap * sizeof *tx), *b = calloc((size_t)n, sizeof *b);
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < m; j++)
+            for (int k = 0; k < m; k++) {
+                int32_t r = (int32_t)((i * m + j) * m + k);
+                ti[nz] = r, tj[nz] = r, tx[nz++] = 6.0;
+                const int d[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+                for (int q = 0; q < 6; q++) {
+                    int a = i + d[q][0], c = j + d[q][1], e = k + d[q][2];
+                    if (a < 0 || c < 0 || e < 0 || a >= m || c >= m || e >= m) continue;
+                    ti[nz] = r, tj[nz] = (int32_t)((a * m + c) * m + e), tx[nz++] = -1.0;
+                }
+            }
+    b[((m / 2) * m + m / 2) * m + m / 2] = 1.0;
+    ulam_csr *A, *M;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &A), ULAM_OK);
+    *bp = malloc((size_t)n * sizeof **bp);
+    assert_int_equal(ulam_jacobi(A, b, 1.0, &M, *bp, NULL), ULAM_OK);
+    double *x = malloc((size_t)n * sizeof *x);
+    assert_int_equal(ulam_direct_solve(M, *bp, x, 0, NULL, NULL), ULAM_OK);
+    *x0 = x[0];
+    free(ti), free(tj), free(tx), free(b), free(x);
+    ulam_csr_free(A);
+    return M;
+}
+
+/* A run's verdict on x: 1 its interval covers x, 0 it misses, 2 withheld (NaN).  A zero-width
+ * interval fails the test at once unless x is 0 exactly (certified). */
+static int verdict(const ulam_walk_result *r, double x)
+{
+    if (isnan(r->ci95[0]) || isnan(r->ci95[1])) return 2;
+    if (!(r->ci95[1] > r->ci95[0]) && x != 0.0)
+        print_error("zero-width interval %.17g .. %.17g at x = %.17g (%lld walks)\n", r->ci95[0], r->ci95[1], x,
+                    (long long)r->walks);
+    assert_true(r->ci95[1] > r->ci95[0] || x == 0.0);
+    return r->ci95[0] <= x && x <= r->ci95[1];
+}
+
+/* The count over 100 seeds: honest (covered or withheld) at least 89 (fail below). */
+static void count(const char *what, int covered, int withheld, int R)
+{
+    int lower = (int)ceil(0.95 * R - 3 * sqrt(0.0475 * R)); /* 89 of 100 */
+    print_message("%-44s covered %3d, withheld %3d of %d (honest at least %d)\n", what, covered, withheld, R, lower);
+    if (test_case_all()) assert_true(covered + withheld >= lower);
+}
+
+/* Case 1 at fixed budgets: collision at 100, 1000 and 10^4 walks, absorption at 1000. */
+static void test_metastable_fixed(void **state)
+{
+    (void)state;
+    double *b, x;
+    ulam_csr *M = metastable(1e-4, &b, &x);
+    static const struct { int est; int64_t walks; } cases[] = {
+        {ULAM_COLLISION, 100}, {ULAM_COLLISION, 1000}, {ULAM_COLLISION, 10000}, {ULAM_ABSORPTION, 1000}};
+    for (int c = 0; c < 4; c++) {
+        int v[3] = {0, 0, 0};
+        for (int s = 0; s < 100; s++) {
+            if (!test_case(1000L * c + s)) continue;
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.estimator = cases[c].est, o.max_walks = cases[c].walks, o.seed = 1 + (uint64_t)s;
+            ulam_walk_result r;
+            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            v[verdict(&r, x)]++;
+        }
+        test_case_done();
+        char what[64];
+        snprintf(what, sizeof what, "metastable %s, %lld walks:", cases[c].est ? "absorption" : "collision",
+                 (long long)cases[c].walks);
+        count(what, v[1], v[2], 100);
+    }
+    ulam_csr_free(M), free(b);
+}
+
+/* Case 1 under the method auto chooses (pilots, then the chosen solver) at 1000 walks, where a
+ * pilot that never reached B has variance 0 and the old choice preferred it (13/100). */
+static void test_metastable_auto(void **state)
+{
+    (void)state;
+    double *b, x;
+    ulam_csr *M = metastable(1e-4, &b, &x);
+    int v[3] = {0, 0, 0};
+    for (int s = 0; s < 100; s++) {
+        if (!test_case(s)) continue;
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.max_walks = 1000, o.seed = 300 + (uint64_t)s;
+        ulam_auto_result res;
+        ulam_solver *sv = NULL;
+        assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
+        while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+        ulam_walk_result r;
+        ulam_solver_result(sv, &r);
+        v[verdict(&r, x)]++;
+        ulam_solver_free(sv);
+    }
+    test_case_done();
+    count("metastable auto, 1000 walks:", v[1], v[2], 100);
+    ulam_csr_free(M), free(b);
+}
+
+/* Case 1 stopped after a number of rounds the test picks per seed (1 to 6: 1024 to 64512 walks),
+ * as a clock would stop it, with max_seconds set so the run knows its stop is not fixed. */
+static void test_metastable_rounds(void **state)
+{
+    (void)state;
+    double *b, x;
+    ulam_csr *M = metastable(1e-4, &b, &x);
+    int v[3] = {0, 0, 0};
+    for (int s = 0; s < 100; s++) {
+        if (!test_case(s)) continue;
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.max_walks = 0, o.max_seconds = 1e9, o.seed = 100 + (uint64_t)s;
+        ulam_solver *sv;
+        assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, NULL), ULAM_OK);
+        for (int k = 0; k < 1 + s % 6; k++) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+        ulam_walk_result r;
+        ulam_solver_result(sv, &r);
+        v[verdict(&r, x)]++;
+        ulam_solver_free(sv);
+    }
+    test_case_done();
+    count("metastable collision, 1 to 6 rounds:", v[1], v[2], 100);
+    ulam_csr_free(M), free(b);
+}
+
+/* Case 2: the leak at 1e-5 (B holds under 1% of x_0, less than the target) under rel_err 0.1:
+ * every run met, its interval covers. */
+static void test_metastable_rel_err(void **state)
+{
+    (void)state;
+    double *b, x;
+    ulam_csr *M = metastable(1e-5, &b, &x);
+    int v[3] = {0, 0, 0};
+    double walks = 0;
+    for (int s = 0; s < 100; s++) {
+        if (!test_case(s)) continue;
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.estimator = ULAM_ABSORPTION, o.max_walks = 0, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
+        ulam_walk_result r;
+        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        assert_true(r.rel_err_met);
+        v[verdict(&r, x)]++;
+        walks += (double)r.walks;
+    }
+    test_case_done();
+    print_message("mean walks %.3g\n", walks / 100);
+    count("metastable 1e-5, absorption, rel_err 0.1:", v[1], v[2], 100);
+    ulam_csr_free(M), free(b);
+}
+
+/* Cases 4 and 5: the 15^3 Laplacian's corner.  At 1000 walks (collision and absorption) the
+ * intervals are honest; under rel_err 0.1 with a budget of 2^17 walks, no run ends on a zero
+ * estimate with a zero-width interval or "out of reach". */
+static void test_laplace_corner(void **state)
+{
+    (void)state;
+    double *b, x;
+    ulam_csr *M = laplace(15, &b, &x);
+    print_message("x_corner = %.6g\n", x);
+    for (int c = 0; c < 2; c++) {
+        int v[3] = {0, 0, 0};
+        for (int s = 0; s < 100; s++) {
+            if (!test_case(1000L * c + s)) continue;
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.estimator = c ? ULAM_ABSORPTION : ULAM_COLLISION, o.max_walks = 1000, o.seed = 1 + (uint64_t)s;
+            ulam_walk_result r;
+            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            v[verdict(&r, x)]++;
+        }
+        test_case_done();
+        count(c ? "laplace corner absorption, 1000 walks:" : "laplace corner collision, 1000 walks:", v[1], v[2], 100);
+    }
+    for (int s = 0; s < 10; s++) {
+        if (!test_case(2000L + s)) continue;
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.max_walks = 1 << 17, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
+        ulam_walk_result r;
+        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        print_message("rel_err seed %d: %.4g [%.4g, %.4g] %lld walks, met %d, out of reach %d (needs %.3g)\n", s,
+                      r.estimate, r.ci95[0], r.ci95[1], (long long)r.walks, r.rel_err_met, r.out_of_reach, r.min_walks);
+        assert_true(!(r.estimate == 0 && r.out_of_reach));
+        assert_true(verdict(&r, x) != 0);
+    }
+    test_case_done();
+    ulam_csr_free(M), free(b);
+}
+
+/* A sample that has not seen a reachable class gets an interval that is not zero-width and
+ * still covers; an answer certified exact (nothing that scores reachable) gets [0, 0]. */
+static void test_never_zero_width(void **state)
+{
+    (void)state;
+    double *b, x;
+    ulam_csr *M = metastable(1e-4, &b, &x);
+    for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.estimator = est, o.max_walks = 100, o.seed = 3;
+        ulam_walk_result r;
+        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        print_message("100 walks, %s: %.6g [%.6g, %.6g], variance %g\n", est ? "absorption" : "collision", r.estimate,
+                      r.ci95[0], r.ci95[1], r.variance);
+        assert_true(r.ci95[1] - r.ci95[0] > 1.0 && r.ci95[0] <= x && x <= r.ci95[1]);
+    }
+    for (int i = 20; i < 40; i++) b[i] = 0.0; /* from B only B is reachable: x_20 = 0, certified */
+    for (int i = 0; i < 20; i++) b[i] = 0.0;
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 25, o.max_walks = 100;
+    ulam_walk_result r;
+    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_true(r.estimate == 0 && r.ci95[0] == 0 && r.ci95[1] == 0);
+    ulam_csr_free(M), free(b);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_never_zero_width), cmocka_unit_test(test_metastable_fixed),
+                                       cmocka_unit_test(test_metastable_rounds), cmocka_unit_test(test_metastable_auto),
+                                       cmocka_unit_test(test_metastable_rel_err), cmocka_unit_test(test_laplace_corner)};
+    return test_run(tests);
+}
