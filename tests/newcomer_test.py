@@ -20,6 +20,7 @@ SHAPES = {  # KIND: regexes the stdout must match, each on a line of its own
               rf"^\d+\s+\S+-\S+-\S+\s+{NUM}\s+{NUM}\s+\d+/\d+ \({NUM} \.\. {NUM}\)$"],
     "radiosity": [r"^scene\s+", r"^patch\s+\d+ \(floor", rf"^radiosity R\s+{NUM} \+- {NUM}$",
                   rf"^radiosity B\s+{NUM} \+- {NUM}$", r"^rel-err\s+met"],
+    "python": [rf"^{NUM} \+- {NUM} \({NUM}, {NUM}\) \d+ \w+$"],  # estimate +- stderr ci95 walks method
 }
 MAX_LINES = {"solve": 10}  # the default solve output is read in one glance
 
@@ -32,7 +33,7 @@ def blocks(readme):
         for line in body.splitlines():
             for part in line.split("&&"):
                 part = part.strip()
-                if part.startswith("build/ulam "):
+                if part.startswith("build/ulam ") or kind == "python":
                     cmds.append(part)
         yield kind, cmds
 
@@ -50,11 +51,19 @@ def main():
         for kind, cmds in found:
             assert cmds, f"a '{kind}' block without a build/ulam command"
             for cmd in cmds:
-                args = shlex.split(cmd)
-                if kind == "radiosity" and subprocess.run([ulam, "radiosity", "--help"], capture_output=True).returncode:
-                    print(f"skip (no radiosity front end): {cmd}")
-                    continue
-                p = subprocess.run([ulam] + args[1:], cwd=d, capture_output=True, text=True, timeout=600)
+                if kind == "python":  # a shell line run from the source root, build/ being ulam's build directory
+                    pydir = os.path.join(os.path.dirname(ulam), "python")
+                    if not os.path.isdir(os.path.join(pydir, "ulam")):
+                        print(f"skip (no Python binding built): {cmd}")
+                        continue
+                    line = cmd.replace("PYTHONPATH=build/python", "PYTHONPATH=" + shlex.quote(pydir))
+                    p = subprocess.run(["sh", "-c", line], cwd=root, capture_output=True, text=True, timeout=600)
+                else:
+                    args = shlex.split(cmd)
+                    if kind == "radiosity" and subprocess.run([ulam, "radiosity", "--help"], capture_output=True).returncode:
+                        print(f"skip (no radiosity front end): {cmd}")
+                        continue
+                    p = subprocess.run([ulam] + args[1:], cwd=d, capture_output=True, text=True, timeout=600)
                 bad = [rx for rx in SHAPES[kind] if not re.search(rx, p.stdout, re.M)]
                 lines = len(p.stdout.splitlines())
                 if p.returncode or bad or lines > MAX_LINES.get(kind, 1000):
