@@ -34,8 +34,10 @@ typedef struct {
     ulam_csr M;          /* over the arrays below (never freed by ulam_csr_free) */
     PyArrayObject *rowptr, *colidx, *val;
     ulam_guard guard;    /* the analog kernel's guards at exponent 1, computed by the first query
-                            that reuses them (the reusable analysis: see system_analysis) */
+                            that reuses them (see system_analysis) */
     int have_guard;
+    ulam_analysis *an;   /* the library's analysis of M (analog, exponent 1): bounds over every
+                            state, kept kernel rows, made by the first query that reuses them */
 } SystemObject;
 
 /* An int64 / int32 / float64 C-contiguous 1-d array from obj (a new reference), or NULL with a
@@ -54,6 +56,7 @@ static PyArrayObject *array_of(PyObject *obj, int type, const char *what)
 /* Free a system. */
 static void System_dealloc(SystemObject *self)
 {
+    ulam_analysis_free(self->an);
     Py_XDECREF(self->rowptr);
     Py_XDECREF(self->colidx);
     Py_XDECREF(self->val);
@@ -86,11 +89,15 @@ static int System_init(SystemObject *self, PyObject *args, PyObject *kw)
     return 0;
 }
 
-/* The reusable analysis a query of this system may take instead of its own passes over M: today
- * the guards of the analog kernel at exponent 1 (ulam_auto_opts.guard).  The one place the
- * binding uses it: swap in the library's analysis object here. */
+/* The reusable analysis a query of this system takes instead of its own passes over M: the
+ * library's analysis object (ulam_analysis_auto_start races the walks on its bounds over every
+ * state) and the guards of the analog kernel at exponent 1 (ulam_auto_opts.guard). */
 static int system_analysis(SystemObject *self, ulam_auto_opts *ao, ulam_error *err)
 {
+    if (!self->an) {
+        int status = ulam_analysis_alloc(&self->M, NULL, &self->an, err);
+        if (status) return status;
+    }
     if (!self->have_guard) {
         int status;
         Py_BEGIN_ALLOW_THREADS
@@ -351,7 +358,8 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
     if (catch) catch_sigint(&flag, &old);
     if (!status) {
         Py_BEGIN_ALLOW_THREADS
-        status = ulam_auto_start(&self->M, b, &o, &ao, &mo, ch, &run, &err);
+        status = reuse ? ulam_analysis_auto_start(self->an, b, &o, &ao, &mo, ch, &run, &err)
+                       : ulam_auto_start(&self->M, b, &o, &ao, &mo, ch, &run, &err);
         Py_END_ALLOW_THREADS
         started = 1;
     }
