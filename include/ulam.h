@@ -200,11 +200,9 @@ typedef struct ulam_mm_opts {
                         line starts, straight into the CSR arrays when its rows rise through the
                         file; any error is found and located (file:line) by the sequential
                         reader, which reads on from the size line */
-    int libc_strtod; /* 1: reals by the C library's strtod (the same doubles, slower: the reader
-                        as it was, for comparisons) */
 } ulam_mm_opts;
 
-/* The defaults: all cores (threads 0), reals by ulam_strtod (libc_strtod 0). */
+/* The defaults: all cores (threads 0). */
 ulam_mm_opts ulam_mm_defaults(void);
 
 /* As ulam_mm_read_matrix_file with options (o NULL: ulam_mm_defaults()). */

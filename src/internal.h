@@ -281,4 +281,8 @@ int ulam__csr_check_rows(const ulam_csr *A, int64_t lo, int64_t hi, ulam_error *
 int ulam__b_exponent(const double *b, int64_t n);
 double *ulam__b_scaled(const double *b, int64_t n, int e);
 
+/* As ulam_mm_read_matrix_opts with reals by the C library's strtod (the same doubles, slower: the
+ * reader as it was), for the reader's benchmark and tests to compare (src/mmio.c). */
+int ulam__mm_read_matrix_libc(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
+
 #endif

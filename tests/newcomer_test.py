@@ -53,7 +53,7 @@ def main():
             for cmd in cmds:
                 if kind == "python":  # a shell line run from the source root, build/ being ulam's build directory
                     pydir = os.path.join(os.path.dirname(ulam), "python")
-                    if not os.path.isdir(os.path.join(pydir, "ulam")):
+                    if not os.path.isfile(os.path.join(pydir, "ulam", "__init__.py")):
                         print(f"skip (no Python binding built): {cmd}")
                         continue
                     line = cmd.replace("PYTHONPATH=build/python", "PYTHONPATH=" + shlex.quote(pydir))

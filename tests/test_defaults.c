@@ -62,7 +62,6 @@ static void test_mm(void **state)
     (void)state;
     ulam_mm_opts o = ulam_mm_defaults();
     assert_int_equal(o.threads, 0);
-    assert_int_equal(o.libc_strtod, 0);
     ulam_csr *A = NULL, *B = NULL;
     FILE *f = fopen(src_path("matrices/signed200.mtx"), "rb");
     assert_non_null(f);

@@ -1,5 +1,6 @@
 /* Matrix Market reading and writing: every good kind, every malformed input class. */
 #include "testutil.h"
+#include "../src/internal.h" /* ulam__mm_read_matrix_libc: the libc reader compared */
 
 #include <string.h>
 #include <unistd.h>
@@ -375,8 +376,8 @@ static int read_with(const char *path, int threads, int libc, ulam_csr **A, ulam
 {
     FILE *f = fopen(path, "rb");
     assert_non_null(f);
-    ulam_mm_opts o = {.threads = threads, .libc_strtod = libc};
-    int st = ulam_mm_read_matrix_opts(f, path, &o, A, err);
+    ulam_mm_opts o = {.threads = threads};
+    int st = libc ? ulam__mm_read_matrix_libc(f, path, &o, A, err) : ulam_mm_read_matrix_opts(f, path, &o, A, err);
     fclose(f);
     return st;
 }

@@ -9,10 +9,11 @@
 #include <sys/wait.h>
 
 #include "gen.h"
+#include "../../src/internal.h" /* ulam__mm_read_matrix_libc: the reader as it was */
 
 /* Parse path with o in a child: seconds into *t, its CPU seconds (user + system, the whole
  * process) into *cpu, peak RSS (MiB) into *rss, CSR MiB into *csr. */
-static int parse_child(const char *path, ulam_mm_opts o, double *t, double *cpu, double *rss, double *csr)
+static int parse_child(const char *path, ulam_mm_opts o, int libc, double *t, double *cpu, double *rss, double *csr)
 {
     int fd[2];
     if (pipe(fd)) return -1;
@@ -23,7 +24,7 @@ static int parse_child(const char *path, ulam_mm_opts o, double *t, double *cpu,
         FILE *f = fopen(path, "rb");
         ulam_csr *A = NULL;
         double t0 = ulam_now();
-        if (f && ulam_mm_read_matrix_opts(f, path, &o, &A, NULL) == ULAM_OK)
+        if (f && (libc ? ulam__mm_read_matrix_libc(f, path, &o, &A, NULL) : ulam_mm_read_matrix_opts(f, path, &o, &A, NULL)) == ULAM_OK)
             r[0] = ulam_now() - t0, r[1] = bench_csr_bytes(A) / 1048576.0;
         if (write(fd[1], r, sizeof r) != (ssize_t)sizeof r) _exit(1);
         _exit(0);
@@ -61,14 +62,14 @@ int main(void)
     stat(path, &st);
     double mb = (double)st.st_size / 1e6;
     static const char *const names[3] = {"old (1 thread, strtod)", "new, 1 thread", "new, 2 threads"};
-    const ulam_mm_opts opts[3] = {{.threads = 1, .libc_strtod = 1}, {.threads = 1}, {.threads = 2}};
+    const ulam_mm_opts opts[3] = {{.threads = 1}, {.threads = 1}, {.threads = 2}}; /* the first with libc's strtod */
     double best[3] = {1e30, 1e30, 1e30}, bcpu[3] = {1e30, 1e30, 1e30}, peak[3] = {0}, csr = 0;
     printf("%.1f MB, %lld entries\n%-24s %4s %10s %10s %10s %10s %10s\n", mb, (long long)nnz, "reader", "run", "seconds",
            "MB/s", "CPU s", "peak MiB", "peak/CSR");
     for (int rep = 0; rep < 3; rep++)
         for (int m = 0; m < 3; m++) {
             double t, cpu, rss;
-            if (parse_child(path, opts[m], &t, &cpu, &rss, &csr)) {
+            if (parse_child(path, opts[m], m == 0, &t, &cpu, &rss, &csr)) {
                 fprintf(stderr, "read failed\n");
                 remove(path);
                 return 1;
