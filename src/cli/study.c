@@ -501,6 +501,19 @@ static void cell_summary(int n, const double *estimate, const double *std_error,
     out->work = out->rmse * out->rmse * out->seconds;
 }
 
+/* The summary c of method m's finished runs at budget b (e: scratch for 3 x repeats doubles);
+ * the number of runs it summarises (0: none, c untouched). */
+static int method_cell(const study *st, int m, int b, double *e, cell *c)
+{
+    int k = 0;
+    for (int r = 0; r < st->repeats; r++) {
+        size_t i = at(st, m, b, r);
+        if (st->done[i]) e[k] = st->est[i], e[st->repeats + k] = st->se[i], e[2 * st->repeats + k++] = st->sec[i];
+    }
+    if (k) cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, c);
+    return k;
+}
+
 /* summary.csv (a row per cell) and bars.csv (per method, at the largest budget). */
 static int summarise(study *st)
 {
@@ -523,14 +536,8 @@ static int summarise(study *st)
         if (!st->m[m].on || st->m[m].why[0]) continue;
         cell last = {0};
         for (int b = 0; b < st->nbudget; b++) {
-            int k = 0;
-            for (int r = 0; r < st->repeats; r++) {
-                size_t i = at(st, m, b, r);
-                if (st->done[i]) e[k] = st->est[i], e[st->repeats + k] = st->se[i], e[2 * st->repeats + k++] = st->sec[i];
-            }
-            if (!k) continue;
             cell c;
-            cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, &c);
+            if (!method_cell(st, m, b, e, &c)) continue;
             fprintf(f, "%s,%.17g,%d,%s,%s,%s,%s,%s,%s,%s\n", st->m[m].name, st->budget[b], c.runs,
                     num(v[0], c.rmse), num(v[1], c.mean_stderr), num(v[2], c.honesty), num(v[3], c.coverage),
                     num(v[4], c.seconds), num(v[5], c.work), st->m[m].infinite ? "false" : "true");
@@ -704,14 +711,8 @@ static void print_summary(const study *st)
         cell bc = {0};
         for (int m = 0; m < NMETHOD; m++) {
             if (!st->m[m].on || st->m[m].why[0] || st->m[m].infinite) continue;
-            int k = 0;
-            for (int r = 0; r < st->repeats; r++) {
-                size_t i = at(st, m, b, r);
-                if (st->done[i]) e[k] = st->est[i], e[st->repeats + k] = st->se[i], e[2 * st->repeats + k++] = st->sec[i];
-            }
-            if (!k) continue;
             cell c;
-            cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, &c);
+            if (!method_cell(st, m, b, e, &c)) continue;
             if (best < 0 || c.work < bc.work) best = m, bc = c;
         }
         if (best < 0) {
