@@ -51,7 +51,9 @@ static void remove_tmps(void)
 /* The thread that blocks the signals around the registry's updates (the main thread).  A signal
  * the kernel delivers to another thread (OpenMP's workers, --check's) is sent on to it, so a
  * handler never reads the registry while the main thread is between forgetting a temporary file
- * and renaming it (found by check_signals: a study left question.txt.tmp 1 run in 4). */
+ * and renaming it (found by check_signals: a study left question.txt.tmp 1 run in 4).  The
+ * walks' first SIGINT only sets a flag and is taken where it lands: sent on, it could merge
+ * with a second one pending on the main thread and be lost (check_second_interrupt hung). */
 static pthread_t cli_main_thread;
 
 /* 1 when sig was sent on to the main thread (the caller returns), 0 on the main thread. */
@@ -92,12 +94,13 @@ void cli_signals_init(void)
  * exits at once. */
 static void on_sigint(int sig)
 {
-    if (forwarded(sig)) return;
-    if (cli_interrupted) {
-        remove_tmps();
-        _exit(EXIT_INTERRUPTED);
+    if (!cli_interrupted) { /* the first, on whichever thread took it: only a flag */
+        cli_interrupted = 1;
+        return;
     }
-    cli_interrupted = 1;
+    if (forwarded(sig)) return; /* the second reads the registry: on the main thread */
+    remove_tmps();
+    _exit(EXIT_INTERRUPTED);
 }
 
 /* Catch SIGINT (and SIGTERM under MPI) for the walks; a write blocked on a full pipe is restarted
