@@ -1121,6 +1121,10 @@ int ulam_solver_iterate(ulam_solver *s)
     else if (s->o.rel_err > 0 && s->var_finite == 1 && s->run.walks >= ULAM__REL_MIN && !(s->o.max_seconds > 0) &&
              fabs(r.estimate + s->o.rel_err_offset) > 0 && isfinite(r.tail_bound) && r.min_walks > (double)s->o.max_walks)
         s->run.done = s->out_of_reach = 1; /* the walks the target needs are past the budget or the cap */
+    else if (s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && !isfinite(r.ci95[0]) && r.min_walks > 0 &&
+             isfinite(r.min_walks) && (double)s->run.walks > ULAM__NO_CI_SPAN * fmax(r.min_walks, ULAM__REL_MIN))
+        s->run.done = s->out_of_reach = 1; /* still no interval (a score past the certified range) long after
+                                               the walks the rule asked for: more walks would only spin */
     return s->run.status;
 }
 

@@ -35,6 +35,10 @@ void ulam__sums_moments(double n, double sum, double sumsq, double *mean, double
 
 /* The fewest walks a --rel-err run makes (the rule itself is src/stop.h's). */
 #define ULAM__REL_MIN 1000
+/* A --rel-err run that still has no interval (a score past the certified range: it stays past)
+ * when it has run this many times the walks the rule asks for stops, not met, instead of
+ * walking on to the 1e9 cap (r500's expected estimator at E = 0.01 spun 1e9 walks, 92 s). */
+#define ULAM__NO_CI_SPAN 1024.0
 
 /* The rule as it was, kept for radiosity shooting and gathering without a certified range
  * (src/radiosity/patchwalk.c): at least ULAM__REL_MIN walks, stderr <= E |m|, n >= min_walks

@@ -591,7 +591,9 @@ def check_systems_as_held(ulam):
 
 
 def run(ulam, args):
-    p = subprocess.run([ulam] + args, capture_output=True, text=True, timeout=120)
+    # 600 s: a guard against a hang, not a speed check (a quiet ASan run of check_auto_bidir's
+    # solve takes tens of seconds, and more than 120 s with the machine loaded)
+    p = subprocess.run([ulam] + args, capture_output=True, text=True, timeout=600)
     return p.returncode, p.stdout, p.stderr
 
 

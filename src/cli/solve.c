@@ -161,6 +161,10 @@ static void print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, in
     else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
         printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
                o->rel_err);
+    else if (o->rel_err > 0 && r->out_of_reach && !isfinite(r->ci95[0]))
+        printf("rel-err         NOT met (target %.3g): a score passed the certified range, so no interval can be "
+               "printed; stopped after %lld walks, over 1024 times the %.4g the rule asked for\n", o->rel_err,
+               (long long)r->walks, r->min_walks);
     else if (o->rel_err > 0 && r->fourth_finite != 1 && (verbose || !r->rel_err_met))
         printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
                "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
