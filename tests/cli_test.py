@@ -1689,7 +1689,7 @@ def check_signals(ulam):
                                       "--walks", "2000", "--out", out + "x.mtx", "--errors", out + "e.mtx"], 2),
             ("--cache", ["solve", "--method", "walks", c, "--rhs", cb, "--index", "2", "--walks", "1000", "--cache"], 1),
         ]
-        if os.path.exists(R + "cube_black_lamp.obj") and "radiosity" in run(ulam, ["--help"])[2] + run(ulam, ["--help"])[1]:
+        if os.path.exists(R + "cube_black_lamp.obj") and run(ulam, ["radiosity", "--help"])[0] == 0:  # not in -Dradiosity=disabled
             phases.append(("radiosity --out", ["radiosity", R + "cube_black_lamp.obj", "--direct", "--out",
                                                 out + ".csv"], 1))
         for name, args, k in phases:
