@@ -24,7 +24,8 @@
  *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
  *     ulam_guard_check, ulam_walk_defaults, ulam_solver_alloc, ulam_solver_iterate,
  *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
- *     ulam_solver_free, ulam_solve, ulam_auto (the method table's choice: what `ulam solve` runs),
+ *     ulam_solver_free, ulam_solve (the method table's choice: what `ulam solve` runs), ulam_solve_walks
+ *     (the walks pinned), ulam_auto (the choice with its verdicts),
  *     ulam_direct_solve, ulam_mm_write_vector, ulam_strerror;
  *   secondary, more control and the other methods: building and transforming matrices
  *     (ulam_csr_alloc, _from_triplets, _check, _transpose, ulam_jacobi), reader options and
@@ -587,7 +588,7 @@ typedef struct ulam_walk_opts {
     uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */
     int threads;         /* 0: all cores */
     int64_t max_walks;   /* stop after this many walks (0: no limit) */
-    double rel_err;      /* stop once the relative-error rule holds (see ulam_solve); 0 off */
+    double rel_err;      /* stop once the relative-error rule holds (see ulam_solve_walks); 0 off */
     double max_seconds;  /* stop after this much wall time (0 off); the first block always runs */
     int64_t max_steps;   /* a walk longer than this is cut and counted (default 10^6) */
     const volatile int *interrupt; /* stop at the next block when *interrupt != 0 (may be NULL) */
@@ -727,8 +728,20 @@ int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error);
 /* Free a solver; accepts and returns NULL. */
 ulam_solver *ulam_solver_free(ulam_solver *s);
 
-/* Allocate, iterate until done, report, free: the whole run in one call, with the refusals of
- * ulam_solver_alloc (guards checked first).  It always ends: rel_err alone stops at 10^9
+/* The library's `ulam solve`: x_{opts->index} by the method the table chooses (ulam_auto), so a
+ * caller with ulam_walk_defaults() gets what `ulam solve` gives by default: the same choice and,
+ * on the same seed, the same estimate.  As the command line pins what it is given, a walk option
+ * that differs from ulam_walk_defaults() pins that part of the walks' race (mode, estimator,
+ * continue_q, kernel_alpha; opts->guard serves as ulam_auto_opts.guard); all four differing, or
+ * nstarts > 0, pin the walks row: ulam_solve_walks's run.  The answer comes as a walk result:
+ * the chosen walks' run, or for bidirectional its walks on <r, x> with the whole answer's
+ * estimate, std_error and ci95.  Statuses: ulam_auto's.  To run exactly the walks opts name, call
+ * ulam_solve_walks (or ulam_auto with ulam_method_opts.method = ULAM_METHOD_WALKS). */
+int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+               ulam_walk_result *result, ulam_error *err);
+
+/* The walks opts name, pinned (no choice): allocate, iterate until done, report, free in one
+ * call, with the refusals of ulam_solver_alloc (guards checked first).  It always ends: rel_err alone stops at 10^9
  * walks at most (ULAM_REL_ERR_CAP; rel_err_met 0).
  * The rel_err rule (opts->rel_err = E, variance certified finite; docs/error-bars.md), checked
  * once per epoch of walk counts (sqrt(2) apart from 1024), stops when all of these hold (N walks,
@@ -747,8 +760,8 @@ ulam_solver *ulam_solver_free(ulam_solver *s);
  * A run whose predicted walks (min_walks) exceed max_walks or ULAM_REL_ERR_CAP stops after
  * the round, not met (out_of_reach), with the estimate so far; a zero estimate never does.  A split weight below the start weight (1 adjoint, ||b||_1 forward)
  * is refused with ULAM_EINVAL. */
-int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-               ulam_walk_result *result, ulam_error *err);
+int ulam_solve_walks(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                     ulam_walk_result *result, ulam_error *err);
 
 /* As ulam_solve, ulam_solver_alloc and ulam_jacobi with b's length nb: b must have one entry a
  * row of M (A), else ULAM_EDIM (ULAM_EINVAL for a NULL b), so a short b is refused, never read
@@ -811,7 +824,7 @@ ulam_analysis *ulam_analysis_free(ulam_analysis *a);
 int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_solver **out,
                          ulam_error *err);
 
-/* One query to its end (ulam_analysis_solver, iterate, report, free): as ulam_solve. */
+/* One query to its end (ulam_analysis_solver, iterate, report, free): as ulam_solve_walks. */
 int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_walk_result *result,
                         ulam_error *err);
 
@@ -1339,7 +1352,7 @@ typedef struct ulam_answer {
 
 /* Choose the method for x_{o->index} of (I - M) x = b under o's options, ao's pins of the walks'
  * candidates (ao NULL: ulam_auto_defaults()) and mo's of the rows (mo NULL:
- * ulam_method_defaults(), every row considered): with mo->method >= 0 that row alone, as o says (walks: ulam_solver_alloc on o, no pilots: bit for bit what ulam_solve does);
+ * ulam_method_defaults(), every row considered): with mo->method >= 0 that row alone, as o says (walks: ulam_solver_alloc on o, no pilots: bit for bit what ulam_solve_walks does);
  * else every row of the table in order: the walks row races its candidates (ulam_auto_solver),
  * then each other row's applicability test and cost prediction, a row replacing the leader when
  * its predicted work is below the leader's.  Bidirectional applies to an adjoint query with a
@@ -1369,7 +1382,8 @@ ulam_run *ulam_run_free(ulam_run *r);
 /* The library's `ulam solve`: ulam_auto_start, ulam_run_finish, ulam_run_free in one call
  * (ch may be NULL).  With ao and mo NULL it chooses as `ulam solve` does by default (the same
  * choice and, on the same seed, the same estimate); pin a row with mo->method
- * (ULAM_METHOD_WALKS: ulam_solve's run, bit for bit). */
+ * (ULAM_METHOD_WALKS: ulam_solve_walks's run, bit for bit); ulam_solve is this call with its
+ * answer as a walk result. */
 int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
               const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err);
 

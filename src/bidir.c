@@ -313,7 +313,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
 }
 
 /* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr.  The solver's
- * rel_err rule (the one of ulam_solve) applies to the whole estimate push_part + <r, x>;
+ * rel_err rule (the one of ulam_solve_walks) applies to the whole estimate push_part + <r, x>;
  * memo: the pilot's guards on Mt and the states it found the walks reach, when it has them, or
  * (reach_all) every state's bounds. */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,

@@ -145,16 +145,6 @@ int ulam__csr_check_structure(const ulam_csr *A, ulam_error *err)
     return status ? status : ulam__csr_check_rows(A, 0, A->nrows, err);
 }
 
-/* As ulam_solve with b's length checked. */
-int ulam_solve_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                 ulam_walk_result *result, ulam_error *err)
-{
-    ulam__clear(err);
-    if (!M) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
-    int status = ulam__length_check(b, nb, M->nrows, "b", err);
-    return status ? status : ulam_solve(M, b, opts, result, err);
-}
-
 /* As ulam_solver_alloc with b's length checked. */
 int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
                         ulam_solver **out, ulam_error *err)

@@ -182,7 +182,7 @@ int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_
                             const ulam__reach *reach, ulam_auto_result *res, ulam_solver **out, ulam_error *err);
 
 /* Iterate s until a stopping rule holds, fill result (may be NULL) and, on failure, err; free s.
- * The status (src/solve.c: the rest of ulam_solve). */
+ * The status (src/solve.c: the rest of ulam_solve_walks). */
 int ulam__solver_finish(ulam_solver *s, ulam_walk_result *result, ulam_error *err);
 
 /* As ulam_auto_start, with reach (NULL: none; borrowed until the run is freed) the bounds over

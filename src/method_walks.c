@@ -29,7 +29,7 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     return status;
 }
 
-/* Pinned: a solver on the options as given (ulam_solve's run). */
+/* Pinned: a solver on the options as given (ulam_solve_walks's run). */
 static int pin(ulam__query *q, int k, ulam_error *err)
 {
     (void)k;

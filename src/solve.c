@@ -1053,7 +1053,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
 
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci);
 
-/* Nonzero when the rel_err rule holds for r (see ulam_solve in ulam.h): the run's 95% interval
+/* Nonzero when the rel_err rule holds for r (see ulam_solve_walks in ulam.h): the run's 95% interval
  * (stop.h) meeting ulam__stop_rel_met (stderr <= E |m|, range and bias terms within the
  * same width sqrt(2 L) E |m|), after ULAM__REL_MIN walks, forward with
  * the watched component tallied, and walks cut at max_steps moving it by at most
@@ -1311,9 +1311,9 @@ int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error)
     return bad ? ULAM_ENONFINITE : ULAM_OK; /* an estimate beyond the largest double */
 }
 
-/* The whole run in one call. */
-int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-               ulam_walk_result *result, ulam_error *err)
+/* The walks the options name, in one call. */
+int ulam_solve_walks(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                     ulam_walk_result *result, ulam_error *err)
 {
     ulam_solver *s = NULL;
     int status = ulam_solver_alloc(M, b, opts, &s, err);

@@ -156,7 +156,7 @@ static int walk_run(int mode, int est)
     for (int64_t i = 0; !s && mode == ULAM_FORWARD && i < n; i++) w0 += fabs(b[i]);
     o.mode = mode, o.estimator = est, o.max_walks = 3000, o.threads = 2, o.roulette = 0.1 * w0, o.split = 2 * w0;
     ulam_walk_result r;
-    if (!s) s = ulam_solve(M, b, &o, &r, NULL);
+    if (!s) s = ulam_solve_walks(M, b, &o, &r, NULL);
     ulam_csr_free(M), free(b);
     return s;
 }

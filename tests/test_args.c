@@ -70,7 +70,7 @@ static void test_walk_options(void **state)
             ulam_walk_opts o = bad_opts(k, mode);
             ulam_walk_result r;
             ulam_error err;
-            assert_int_equal(ulam_solve(M, ones, &o, &r, &err), ULAM_EINVAL);
+            assert_int_equal(ulam_solve_walks(M, ones, &o, &r, &err), ULAM_EINVAL);
             assert_int_equal(err.status, ULAM_EINVAL);
             assert_names(&err, walk_table[k].field);
             ulam_solver *s = NULL;
@@ -271,7 +271,7 @@ static void test_damaged_matrix(void **state)
                 ulam_walk_opts o = ulam_walk_defaults();
                 o.mode = mode, o.estimator = est, o.max_walks = 1000, o.threads = 1;
                 ulam_walk_result r;
-                int st = ulam_solve(M, ones, &o, &r, &err);
+                int st = ulam_solve_walks(M, ones, &o, &r, &err);
                 assert_true(st == ULAM_ESYNTAX || st == ULAM_EINDEX);
                 assert_int_equal(err.status, st);
             }
@@ -284,7 +284,7 @@ static void test_damaged_matrix(void **state)
             o.estimator = est, o.max_walks = 1000, o.threads = 1, o.guard = &g;
             for (o.index = 0; o.index < 4; o.index++) {
                 ulam_walk_result r;
-                int st = ulam_solve(M, ones, &o, &r, &err); /* refused or answered, never out of bounds */
+                int st = ulam_solve_walks(M, ones, &o, &r, &err); /* refused or answered, never out of bounds */
                 assert_true(st == ULAM_OK || st == ULAM_ESYNTAX || st == ULAM_EINDEX);
             }
         }
@@ -348,10 +348,10 @@ static void test_overflow(void **state)
             ulam_walk_opts o = ulam_walk_defaults();
             o.mode = mode, o.estimator = est, o.index = 1, o.max_walks = 20000, o.threads = 1;
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
             assert_true(isfinite(r.estimate) && isfinite(r.std_error) && r.std_error > 0);
             assert_true(fabs(r.estimate - exact[1]) < 4 * r.std_error);
-            int st = ulam_solve(H, b, &o, &r, &err);
+            int st = ulam_solve_walks(H, b, &o, &r, &err);
             assert_int_equal(st, ULAM_ENONFINITE);
             assert_non_null(strstr(err.msg, "double"));
         }
@@ -380,11 +380,11 @@ static void test_scaling_exact(void **state)
         o.mode = mode, o.index = 1, o.max_walks = 5000, o.threads = 1;
         ulam_walk_result r0, r1;
         ulam_error err;
-        assert_int_equal(ulam_solve(M, b, &o, &r0, &err), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r0, &err), ULAM_OK);
         for (int k = -1; k <= 1; k += 2) {
             double bb[3];
             for (int i = 0; i < 3; i++) bb[i] = ldexp(b[i], 600 * k);
-            assert_int_equal(ulam_solve(M, bb, &o, &r1, &err), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, bb, &o, &r1, &err), ULAM_OK);
             assert_true(r1.estimate == ldexp(r0.estimate, 600 * k));
             assert_true(r1.std_error == ldexp(r0.std_error, 600 * k));
             assert_int_equal(r1.walks, r0.walks);

@@ -293,7 +293,7 @@ static void test_solver_starts(void **state)
         o.estimator = k < 3 ? k : ULAM_COLLISION, o.max_walks = k < 3 ? 40000 : 0, o.rel_err = k < 3 ? 0 : 0.02;
         ulam_walk_result r;
         ulam_error err;
-        int st_ = ulam_solve(M, b, &o, &r, &err);
+        int st_ = ulam_solve_walks(M, b, &o, &r, &err);
         if (st_ || !(fabs(r.estimate - exact) < 4 * r.std_error))
             print_error("case %d: %s, %.8g +- %.3g, exact %.8g\n", k, ulam_strerror(st_), r.estimate, r.std_error, exact);
         assert_int_equal(st_, ULAM_OK);
@@ -306,11 +306,11 @@ static void test_solver_starts(void **state)
     double zeros[3] = {0, 0, 0};
     int64_t bad[3] = {5, 60, 1};
     o.nstarts = 3, o.starts = st, o.start_weights = c, o.mode = ULAM_FORWARD;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
     o.mode = ULAM_ADJOINT, o.starts = bad;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
     o.starts = st, o.start_weights = zeros;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
     free(b), free(x);
     ulam_csr_free(M);
 }

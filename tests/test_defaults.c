@@ -165,11 +165,11 @@ static void test_share(void **state)
     ulam_walk_opts o = ulam_walk_defaults();
     o.max_walks = 5000, o.index = 3, o.threads = 2;
     ulam_walk_result r0, r1, r2;
-    assert_int_equal(ulam_solve(M, b, &o, &r0, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r0, NULL), ULAM_OK);
     o.share = &sh;
-    assert_int_equal(ulam_solve(M, b, &o, &r1, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r1, NULL), ULAM_OK);
     sh.allgather = gather_one;
-    assert_int_equal(ulam_solve(M, b, &o, &r2, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r2, NULL), ULAM_OK);
     assert_memory_equal(&r0.estimate, &r1.estimate, sizeof r0.estimate);
     assert_memory_equal(&r0.std_error, &r1.std_error, sizeof r0.std_error);
     assert_memory_equal(&r0.estimate, &r2.estimate, sizeof r0.estimate);

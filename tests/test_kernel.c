@@ -284,14 +284,14 @@ static void test_verdict(void **state)
     o.max_walks = 0, o.rel_err = 0.01, o.kernel_alpha = 1.0;
     ulam_walk_result r;
     ulam_error err;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_true(r.rel_err_met && r.variance_finite == 1);
     o.kernel_alpha = 0.0;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINFVAR);
     assert_non_null(strstr(err.msg, "alpha = 0"));
     assert_non_null(strstr(err.msg, ">= 1: infinite"));
     o.guard = &g[2]; /* the alpha = 1 verdicts handed in are not this kernel's: recomputed */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINFVAR);
     o.max_walks = 4000; /* bounded: runs, no interval, the rule never fires */
     ulam_solver *sv = NULL;
     assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, &err), ULAM_OK);
@@ -349,7 +349,7 @@ static void test_rel_err_fourth_coverage(void **state)
         ulam_walk_opts o = ulam_walk_defaults();
         o.index = 0, o.kernel_alpha = 2.0, o.max_walks = 0, o.rel_err = 0.05, o.seed = 500 + (uint64_t)seed;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
         assert_true(r.rel_err_met && r.fourth_finite == 0 && r.variance_finite == 1);
         assert_true(r.std_error <= 0.05 * fabs(r.estimate));
         covered += r.ci95[0] <= s.x[0] && s.x[0] <= r.ci95[1];
@@ -382,13 +382,13 @@ static void test_weight_bound(void **state)
         ulam_walk_opts o = ulam_walk_defaults();
         o.estimator = ULAM_ABSORPTION, o.kernel_alpha = alphas[a], o.max_walks = 0, o.rel_err = 0.01;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
         print_message("alpha %.0f: score bound %.6g, %lld walks to 1%%, x_1 = %.6g +- %.2g\n", alphas[a], r.score_bound,
                       (long long)r.walks, r.estimate, r.std_error);
         assert_close(r.score_bound, bounds[a], 1e-12);
         assert_true(r.rel_err_met && fabs(r.estimate - 0.5) < 4 * r.std_error);
         o.estimator = ULAM_COLLISION; /* per visit at most the weight bound times max |b|: the range term holds too */
-        assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
         assert_true(r.rel_err_met && isfinite(r.tail_bound) && fabs(r.estimate - 0.5) < 4 * r.std_error);
         assert_true(r.min_walks >= 12.28 * bounds[a] / (0.01 * r.estimate)); /* R >= the largest score */
     }
@@ -487,7 +487,7 @@ static void test_options(void **state)
     o = ulam_walk_defaults();
     o.kernel_alpha = 0.0, o.index = 3, o.max_walks = 1000;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(Z, u.b, &o, &r, &err), ULAM_ESYNTAX);
+    assert_int_equal(ulam_solve_walks(Z, u.b, &o, &r, &err), ULAM_ESYNTAX);
     ulam_csr_free(Z);
     test_sys_free(&u);
 
@@ -498,7 +498,7 @@ static void test_options(void **state)
     assert_int_equal(ulam_csr_from_triplets(3, 3, 3, ti, tj, tx, &M), ULAM_OK);
     o = ulam_walk_defaults();
     o.kernel_alpha = 2.0, o.max_walks = 1000, o.force = 1;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_ERANGE);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_ERANGE);
     assert_int_equal(err.index, 0);
     assert_non_null(strstr(err.msg, "alpha = 2"));
     go = ulam_guard_defaults(); /* at alpha = 20 the probability (2e-30)^20 underflows: rho(M^) unknown, not certified */
@@ -506,7 +506,7 @@ static void test_options(void **state)
     assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
     assert_true(g.verdict_hat[ULAM_ADJOINT] == ULAM_VERDICT_UNKNOWN && g.hat[ULAM_ADJOINT].lower == 0.0);
     o.kernel_alpha = 1.0; /* the analog kernel samples it (probability 2e-30) */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     ulam_csr_free(M);
 }
 
@@ -556,7 +556,7 @@ static void test_fourth_moment(void **state)
     ulam_error err;
     /* rho(M4) >= 1 but a certified second moment: the rule skips the variance's own error and
      * stands on v2 (its range term bounds the true standard error by 0.29 E |x|) */
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_OK);
     print_message("alpha 2 --rel-err 0.05 alone: %lld walks, met %d, %.6g +- %.3g (exact %.6g; dense rho(M4) %.6g, "
                   "fourth %d)\n", (long long)r.walks, r.rel_err_met, r.estimate, r.std_error, s.x[5], r4,
                   r.fourth_finite);
@@ -564,13 +564,13 @@ static void test_fourth_moment(void **state)
     assert_close(r.estimate, s.x[5], 4 * r.std_error);
     assert_true(r.std_error <= 0.05 * fabs(r.estimate));
     o.max_walks = 200000; /* with a budget too: the same verdicts, and the rule may stop it earlier, or */
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK); /* say early the budget is too small */
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_OK); /* say early the budget is too small */
     assert_true(r.walks == 200000 || r.rel_err_met || (r.out_of_reach && r.min_walks > 200000));
     assert_true(r.fourth_finite == 0 && r.variance_finite == 1);
     assert_true(r.rho4.lower <= r4 * (1 + 1e-9) && r4 <= r.rho4.upper * (1 + 1e-9) && r.rho4.lower >= 1.0);
     assert_close(r.estimate, s.x[5], 4 * r.std_error);
     o.kernel_alpha = 1.0, o.max_walks = 0; /* bounded scores: every moment finite, rho4 not needed */
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_OK);
     assert_true(r.rel_err_met && r.fourth_finite == 1);
     assert_close(r.estimate, s.x[5], 4 * r.std_error);
     test_sys_free(&s);
@@ -599,7 +599,7 @@ static void test_fourth_radius(void **state)
                 o.max_walks = 1000000, o.seed = 3;
                 ulam_walk_result r;
                 ulam_error err;
-                int st = ulam_solve(sy[k].M, sy[k].b, &o, &r, &err);
+                int st = ulam_solve_walks(sy[k].M, sy[k].b, &o, &r, &err);
                 print_message("system %d alpha %.1f Q %.1f %s: rho(M4) dense %.6g, certified [%.6g, %.6g], fourth %d, "
                               "met %d (%s)\n", k, alphas[a], q, m ? "forward" : "adjoint", exact, r.rho4.lower,
                               r.rho4.upper, r.fourth_finite, r.rel_err_met, st ? err.msg : "ran");

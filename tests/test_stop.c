@@ -104,7 +104,7 @@ static void test_metastable_fixed(void **state)
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = cases[c].est, o.max_walks = cases[c].walks, o.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             v[verdict(&r, x)]++;
         }
         test_case_done();
@@ -181,7 +181,7 @@ static void test_metastable_rel_err(void **state)
         ulam_walk_opts o = ulam_walk_defaults();
         o.estimator = ULAM_ABSORPTION, o.max_walks = 0, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         assert_true(r.rel_err_met);
         v[verdict(&r, x)]++;
         walks += (double)r.walks;
@@ -208,7 +208,7 @@ static void test_laplace_corner(void **state)
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = c ? ULAM_ABSORPTION : ULAM_COLLISION, o.max_walks = 1000, o.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             v[verdict(&r, x)]++;
         }
         test_case_done();
@@ -219,7 +219,7 @@ static void test_laplace_corner(void **state)
         ulam_walk_opts o = ulam_walk_defaults();
         o.max_walks = 1 << 17, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         print_message("rel_err seed %d: %.4g [%.4g, %.4g] %lld walks, met %d, out of reach %d (needs %.3g)\n", s,
                       r.estimate, r.ci95[0], r.ci95[1], (long long)r.walks, r.rel_err_met, r.out_of_reach, r.min_walks);
         assert_true(!(r.estimate == 0 && r.out_of_reach));
@@ -240,7 +240,7 @@ static void test_never_zero_width(void **state)
         ulam_walk_opts o = ulam_walk_defaults();
         o.estimator = est, o.max_walks = 100, o.seed = 3;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         print_message("100 walks, %s: %.6g [%.6g, %.6g], variance %g\n", est ? "absorption" : "collision", r.estimate,
                       r.ci95[0], r.ci95[1], r.variance);
         assert_true(r.ci95[1] - r.ci95[0] > 1.0 && r.ci95[0] <= x && x <= r.ci95[1]);
@@ -250,7 +250,7 @@ static void test_never_zero_width(void **state)
     ulam_walk_opts o = ulam_walk_defaults();
     o.index = 25, o.max_walks = 100;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(r.estimate == 0 && r.ci95[0] == 0 && r.ci95[1] == 0);
     ulam_csr_free(M), free(b);
 }

@@ -273,21 +273,21 @@ static void test_lazy_pages(void **state)
     const double *lb;
     assert_int_equal(ulam_system_lazy(s, &lm, &lb), ULAM_OK);
     o.system = s; /* each block verified as the walks reach it: blocks 0 .. far hold what they read */
-    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(lm, lb, &o, &r1, &err), ULAM_OK);
     o.system = NULL;
-    assert_int_equal(ulam_solve(M, b, &o, &r2, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r2, &err), ULAM_OK);
     assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
     assert_int_equal(r1.rows, B);
     o.system = s;
     o.estimator = ULAM_ABSORPTION; /* the reachability check too reads only what it reaches */
-    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(lm, lb, &o, &r1, &err), ULAM_OK);
     o.estimator = ULAM_EXPECTED; /* and the expected estimator's b at the rows' columns */
-    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(lm, lb, &o, &r1, &err), ULAM_OK);
     o.system = NULL; /* the arrays of another system's solver: refused */
     ulam_system *t = NULL;
     assert_int_equal(ulam_system_from_memory(p, len, NULL, &t, NULL), ULAM_OK);
     o.system = t;
-    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_solve_walks(lm, lb, &o, &r1, &err), ULAM_EINVAL);
     ulam_system_free(t);
     ulam_system_free(s);
     munmap(p, len);
@@ -341,7 +341,7 @@ static void test_corrupt_rows(void **state)
             o.index = start == 0 ? B : start == 1 ? row : 3, o.max_walks = 5000, o.threads = 1, o.guard = &g;
             o.system = s;
             ulam_walk_result r;
-            int st = ulam_solve(lm, lb, &o, &r, &err);
+            int st = ulam_solve_walks(lm, lb, &o, &r, &err);
             if (start < 2 && (st != ULAM_ESYNTAX || !strstr(err.msg, "block 1 of")))
                 fail_msg("corrupt case %d, start %lld: status %d (%s)", k, (long long)o.index, st, err.msg);
             if (start == 2 && st != ULAM_OK) fail_msg("corrupt case %d: the other block failed (%d)", k, st);
@@ -510,7 +510,7 @@ static void query_copy(const unsigned char *p, size_t len, const double want[3],
         ulam_walk_opts o = ulam_walk_defaults();
         o.index = 3, o.max_walks = 2000, o.threads = 1, o.guard = &g, o.system = s, o.estimator = e;
         ulam_walk_result r;
-        st = ulam_solve(lm, lb, &o, &r, &err);
+        st = ulam_solve_walks(lm, lb, &o, &r, &err);
         if (st == ULAM_OK && memcmp(&r.estimate, &want[e], sizeof r.estimate))
             fail_msg("case %d, estimator %d: a wrong answer %.17g (intact %.17g) with ULAM_OK", label, e, r.estimate, want[e]);
         if (st && (!err.msg[0] || st != ULAM_ESYNTAX)) fail_msg("case %d: status %d, '%s'", label, st, err.msg);
@@ -522,7 +522,7 @@ static void query_copy(const unsigned char *p, size_t len, const double want[3],
         ulam_walk_opts o = ulam_walk_defaults();
         o.index = 3, o.max_walks = 2000, o.threads = 1;
         ulam_walk_result r;
-        st = ulam_solve(M, b, &o, &r, &err);
+        st = ulam_solve_walks(M, b, &o, &r, &err);
         if (st || memcmp(&r.estimate, &want[0], sizeof r.estimate)) fail_msg("case %d: verified M answered %d", label, st);
     } else if (ulam_system_check(s, &err) != ULAM_ESYNTAX || !strstr(err.msg, "block")) {
         fail_msg("case %d: an accessor refused what the check passes", label);
@@ -558,7 +558,7 @@ static void test_flip_table(void **state)
         ulam_walk_opts o = ulam_walk_defaults();
         o.index = 3, o.max_walks = 2000, o.threads = 1, o.estimator = e;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         want[e] = r.estimate;
     }
     int refused = 0, dummy = 0;
@@ -629,7 +629,7 @@ static void *run_job(void *arg)
     ulam_walk_opts o = ulam_walk_defaults();
     o.index = j->index, o.max_walks = 20000, o.threads = 2, o.guard = j->g, o.system = j->s, o.whole_kernel = j->index == 5;
     ulam_walk_result r;
-    j->status = ulam_solve(M, b, &o, &r, NULL);
+    j->status = ulam_solve_walks(M, b, &o, &r, NULL);
     j->estimate = r.estimate;
     return NULL;
 }
@@ -733,7 +733,7 @@ static void test_sound_sums_bad_arrays(void **state)
             o.guard = run == 1 ? &g : NULL;
             o.mode = run == 2 ? ULAM_FORWARD : ULAM_ADJOINT;
             ulam_walk_result r;
-            int st = ulam_solve(lm, lb, &o, &r, &err);
+            int st = ulam_solve_walks(lm, lb, &o, &r, &err);
             if (st != ULAM_ESYNTAX || !strstr(err.msg, why[k]))
                 fail_msg("case %d, run %d: status %d, '%s'", k, run, st, err.msg);
         }

@@ -1,5 +1,5 @@
 /* Two solvers at once on one shared read-only system (issue 26, Checks): pthreads each running
- * ulam_solve on the same mapped prepared system (its matrix, b and certificate shared, nothing
+ * ulam_solve_walks on the same mapped prepared system (its matrix, b and certificate shared, nothing
  * copied) must give, bit for bit, what the same runs give one after the other; the library holds
  * no global state.  CI runs this test under ThreadSanitizer (.ci/run). */
 #include "testutil.h"
@@ -20,7 +20,7 @@ static void *run(void *p)
 {
     job *j = p;
     ulam_error err;
-    j->status = ulam_solve(j->M, j->b, &j->o, &j->r, &err);
+    j->status = ulam_solve_walks(j->M, j->b, &j->o, &j->r, &err);
     return NULL;
 }
 

@@ -405,12 +405,12 @@ static void test_rel_err_stop(void **state)
     o.rel_err = 0.005;
     o.index = 11;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
     assert_true(r.walks >= 1000);
     assert_true(r.std_error <= 0.005 * fabs(r.estimate));
     assert_true(fabs(r.estimate - s.x[11]) < 4 * r.std_error);
     for (int64_t i = 0; i < s.n; i++) s.b[i] = 0.0; /* x = 0 exactly: the rule ends at once, never spins */
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
     assert_true(r.rel_err_met && r.estimate == 0.0 && r.walks < 2048);
     test_sys_free(&s);
 }
@@ -426,10 +426,10 @@ static void test_solver_guards(void **state)
     ulam_walk_opts o = ulam_walk_defaults();
     ulam_walk_result r;
     ulam_error err;
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_EDIVERGE);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_EDIVERGE);
     assert_non_null(strstr(err.msg, "rho(|M|)"));
     o.force = 1, o.max_steps = 50, o.max_walks = 1000;
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_OK);
     assert_int_equal(r.variance_finite, 0);
     assert_true(isnan(r.ci95[0]) && isnan(r.ci95[1]));
     test_sys_free(&s);
@@ -438,7 +438,7 @@ static void test_solver_guards(void **state)
     for (int k = 0; k < 300; k++) b[k] = 1.0;
     o = ulam_walk_defaults();
     o.index = 150;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EDIVERGE);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EDIVERGE);
     assert_non_null(strstr(err.msg, "not certain"));
     o.force = 1, o.max_walks = 200, o.max_steps = 10000;
     ulam_solver *sv = NULL;
@@ -454,12 +454,12 @@ static void test_solver_guards(void **state)
     ulam_solver_free(sv);
     o.assume_finite = 1; /* the user's word that unknown is finite, but no interval: it needs a */
     o.max_steps = 1000000; /* certified range of a score, and rho(|M|) straddling 1 certifies no length tail */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_int_equal(r.variance_finite, 1);
     assert_true(isnan(r.ci95[0]) && !isfinite(r.tail_bound));
     o.guard = &g, o.assume_finite = 0; /* verdicts handed in are used, not recomputed */
     g.verdict_hat[ULAM_ADJOINT] = ULAM_VERDICT_OK;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_int_equal(r.variance_finite, 1);
     ulam_csr_free(M), free(b);
 }
@@ -484,14 +484,14 @@ static void test_rel_err_infinite_refused(void **state)
     o.max_walks = 0, o.rel_err = 0.01;
     ulam_walk_result r;
     ulam_error err;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINFVAR);
     assert_non_null(strstr(err.msg, "adjoint kernel"));
     assert_non_null(strstr(err.msg, "forward mode's is finite"));
     o.max_walks = 5000; /* bounded: runs, and the rule never fires */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_true(r.walks == 5000 && !r.rel_err_met && r.variance_finite == 0);
     o.max_walks = 0, o.mode = ULAM_FORWARD; /* the finite mode meets it */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_true(r.rel_err_met && r.std_error <= 0.01 * fabs(r.estimate));
     ulam_csr_free(M);
 }
@@ -513,7 +513,7 @@ static void test_rel_err_cuts(void **state)
     ulam_walk_opts o = ulam_walk_defaults();
     o.max_walks = 0, o.rel_err = 0.01, o.max_steps = 2000, o.seed = 1;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     print_message("cut at 2000 steps: %lld of %lld walks cut, cut bound %.4g, met %d, cut_stop %d\n", (long long)r.cut,
                   (long long)r.walks, r.cut_bound, r.rel_err_met, r.cut_stop);
     assert_true(r.cut > 0 && !r.rel_err_met && r.cut_stop && r.walks <= 2048);
@@ -522,28 +522,28 @@ static void test_rel_err_cuts(void **state)
        on both sides (src/stop.h), it reaches the exact value */
     assert_true(r.cut_bound > r.std_error && r.ci95[0] <= 1e4 && 1e4 <= r.ci95[1]);
     o.max_walks = 8192;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(!r.rel_err_met && r.cut_stop);
     o.max_steps = 1000000, o.max_walks = 2048, o.rel_err = 0; /* no cuts: no cut bias */
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(r.cut == 0 && r.cut_bound == 0.0 && !r.cut_stop);
     ulam_error err;
     /* a split weight below the start weight (1 adjoint, ||b||_1 = 1000 forward) is refused */
     o = ulam_walk_defaults();
     o.split = 1e-7;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
     assert_non_null(strstr(err.msg, "split weight"));
     o.mode = ULAM_FORWARD, o.split = 999;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
     o.split = 1000, o.max_walks = 1024;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     /* splitting leaves no bound on a single score: --rel-err alone is refused at the start */
     o = ulam_walk_defaults();
     o.max_walks = 0, o.rel_err = 0.1, o.split = 2.0;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINFVAR);
     assert_non_null(strstr(err.msg, "bound on a single walk's score"));
     o.max_walks = 4096; /* bounded by walks: runs, never met */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_true(r.walks == 4096 && !r.rel_err_met && !isfinite(r.tail_bound));
     ulam_csr_free(M);
 }
@@ -581,7 +581,7 @@ static void test_forward_unreached(void **state)
     ulam_solver_free(sv);
     o.index = first, o.max_walks = 0, o.rel_err = 0.2; /* an unreached component, watched */
     ulam_error err;
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
     print_message("rel_err 0.2 on an unreached component: %lld walks, met %d, out of reach %d, min walks %.3g, "
                   "fourth moment %d, rho4 [%.4g, %.4g]\n", (long long)r.walks, r.rel_err_met, r.out_of_reach,
                   r.min_walks, r.fourth_finite, r.rho4.lower, r.rho4.upper);
@@ -599,7 +599,7 @@ static void test_forward_unreached(void **state)
     test_sys c = test_sys_load("chain4");
     o = ulam_walk_defaults();
     o.max_walks = 0, o.rel_err = 1e-7;
-    assert_int_equal(ulam_solve(c.M, c.b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(c.M, c.b, &o, &r, &err), ULAM_OK);
     print_message("chain4 rel_err 1e-7: %lld walks, met %d, out of reach %d, min walks %.3g\n", (long long)r.walks,
                   r.rel_err_met, r.out_of_reach, r.min_walks);
     assert_true(!r.rel_err_met && r.out_of_reach && r.min_walks > ULAM_REL_ERR_CAP && r.walks < ULAM_REL_ERR_CAP);
@@ -626,7 +626,7 @@ static void test_rel_err_collision_tail(void **state)
     ulam_walk_opts o = ulam_walk_defaults();
     o.index = 3, o.rel_err = 0.1, o.max_walks = 2000;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     print_message("sticky cluster, collision, 2000 walks: the rule needs %.3g walks (tail bound %.3g)\n", r.min_walks,
                   r.tail_bound);
     assert_true(!isfinite(r.score_bound) && isfinite(r.tail_bound));

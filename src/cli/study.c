@@ -235,7 +235,7 @@ static int one_run(study *st, int m, int b, int r)
     if (st->time_budgets) o.max_walks = 0, o.max_seconds = st->budget[b];
     else o.max_walks = (int64_t)st->budget[b];
     ulam_walk_result res;
-    if (ulam_solve(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted || res.walks < 2 || !isfinite(res.std_error))
+    if (ulam_solve_walks(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted || res.walks < 2 || !isfinite(res.std_error))
         return 1; /* nothing non-finite reaches runs.csv */
     char line[512];
     snprintf(line, sizeof line, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", me->name, st->budget[b], r,

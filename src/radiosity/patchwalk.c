@@ -29,7 +29,7 @@
  * A point solver (ulam_rad_point_alloc) runs point.c's walks from one point of the continuous
  * surfaces instead, with the same rounds, statistics and stopping rules.
  *
- * As in ulam_solve, block k of walks draws from the stream (seed, k) and blocks merge in
+ * As in ulam_solve_walks, block k of walks draws from the stream (seed, k) and blocks merge in
  * index order: the result does not depend on the number of threads. */
 #include "rad.h"
 #include "../round.h"

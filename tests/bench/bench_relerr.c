@@ -112,7 +112,7 @@ static void row(const sys *s, int est, double E, int reps)
     ulam_walk_opts o = ulam_walk_defaults();
     o.estimator = est, o.index = s->index, o.max_walks = ORACLE, o.seed = 12345;
     ulam_walk_result r;
-    if (ulam_solve(s->M, s->b, &o, &r, NULL)) {
+    if (ulam_solve_walks(s->M, s->b, &o, &r, NULL)) {
         printf("%-20s %-10s refused\n", s->name, est ? "absorption" : "collision");
         return;
     }
@@ -120,7 +120,7 @@ static void row(const sys *s, int est, double E, int reps)
     int met = 0, covered = 0;
     for (int k = 0; k < reps; k++) {
         o.max_walks = CAP, o.rel_err = E, o.seed = 1 + (uint64_t)k; /* past CAP: stopped early, not met */
-        if (ulam_solve(s->M, s->b, &o, &r, NULL)) continue;
+        if (ulam_solve_walks(s->M, s->b, &o, &r, NULL)) continue;
         walks += (double)r.walks / reps, secs += r.seconds / reps, met += r.rel_err_met;
         width += (r.ci95[1] - r.ci95[0]) / 2 / (E * fabs(s->x)) / reps;
         covered += r.ci95[0] <= s->x && s->x <= r.ci95[1];

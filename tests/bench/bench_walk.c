@@ -33,7 +33,7 @@ int main(void)
                 o.index = sizes[s] / 2;
                 o.seed = (uint64_t)rep + 1;
                 ulam_walk_result r;
-                if (ulam_solve(M, b, &o, &r, NULL)) return 1;
+                if (ulam_solve_walks(M, b, &o, &r, NULL)) return 1;
                 if (rep == 0 || r.steps / r.seconds > best[t - 1].steps / best[t - 1].seconds) best[t - 1] = r;
             }
         for (int t = 1; t <= 2; t++)

@@ -25,11 +25,11 @@ static void walk(const ulam_csr *M, const double *b, const ulam_system *lazy, in
     ulam_walk_result r;
     for (int e = 0; e < 3; e++) {
         o.estimator = e;
-        ulam_solve(M, b ? b : ones, &o, &r, NULL);
+        ulam_solve_walks(M, b ? b : ones, &o, &r, NULL);
     }
     if (forward) {
         o.mode = ULAM_FORWARD, o.estimator = ULAM_COLLISION;
-        ulam_solve(M, b ? b : ones, &o, &r, NULL);
+        ulam_solve_walks(M, b ? b : ones, &o, &r, NULL);
     }
     free(ones);
 }
@@ -48,7 +48,7 @@ static void one(void *p, size_t size)
             M->nrows > 0 && M->nrows <= 100000) { /* a query on the certificate: lazily read */
             o.max_walks = 200, o.max_steps = 200, o.threads = 2, o.guard = &g, o.system = s;
             ulam_walk_result r;
-            ulam_solve(M, b, &o, &r, NULL);
+            ulam_solve_walks(M, b, &o, &r, NULL);
         }
         walk(M, b, s, 1);                                        /* lazily, with the guards' own pass */
         walk(ulam_system_matrix(s), ulam_system_rhs(s, NULL), NULL, 1); /* verified whole */
