@@ -1,6 +1,6 @@
 /* ulam solve --source S or --rhs b --method bidirectional: one entry x_I of (I - M) x = b for
  * b = e_S or a sparse b, by a reverse push from I and walks from b's states.  Reached from
- * cli_solve through cli_bidir_claims. */
+ * cli_solve's parser (src/cli/solve_rows.c) as the table's bidirectional row. */
 #include "cli.h"
 
 #include <getopt.h>
@@ -35,20 +35,6 @@ static const char *const usage =
     "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
     "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
     "  guards reported are those of the forward kernel\n";
-
-/* Nonzero when argv asks for a point-source solve (--source, --rmax or --method bidirectional). */
-int cli_bidir_claims(int argc, char **argv)
-{
-    for (int k = 1; k < argc; k++) {
-        const char *a = argv[k];
-        if (!strcmp(a, "--")) break;
-        if (!strcmp(a, "--source") || !strncmp(a, "--source=", 9) || !strcmp(a, "--rmax") || !strncmp(a, "--rmax=", 7))
-            return 1;
-        const char *v = !strncmp(a, "--method=", 9) ? a + 9 : !strcmp(a, "--method") && k + 1 < argc ? argv[k + 1] : NULL;
-        if (v && ulam_method_find(v) == ULAM_METHOD_BIDIRECTIONAL) return 1;
-    }
-    return 0;
-}
 
 typedef struct {
     int json, check;
@@ -325,54 +311,76 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     return rc;
 }
 
-/* ulam solve --source S, or --rhs b --method bidirectional. */
-int cli_bidir(int argc, char **argv)
+/* The bidirectional row's options (src/cli/solve_rows.c reads them). */
+static const struct option longopts[] = {
+    {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
+    {"source", required_argument, 0, 'u'},    {"method", required_argument, 0, 'M'},
+    {"rmax", required_argument, 0, 'x'},      {"min-value", required_argument, 0, 'v'},
+    {"step-cost", required_argument, 0, 'k'}, {"top", required_argument, 0, 'T'},
+    CLI_WALK_OPTION("estimator"),             CLI_WALK_OPTION("walks"),
+    CLI_WALK_OPTION("rel-err"),               CLI_WALK_OPTION("time"),
+    CLI_WALK_OPTION("seed"),                  CLI_WALK_OPTION("threads"),
+    CLI_WALK_OPTION("continue"),              CLI_WALK_OPTION("max-steps"),
+    {"check", no_argument, 0, 'c'},           {"json", no_argument, 0, 'J'},
+    {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
+    {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
+
+/* What the command line gives a bidirectional solve. */
+typedef struct {
+    cli_system s;
+    ulam_bidir_opts o;
+    report rp;
+    int64_t source, top;
+    int force, method;
+} bidir_args;
+
+/* The arguments before any option. */
+static void init(void *p)
 {
-    static const struct option longopts[] = {
-        {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
-        {"source", required_argument, 0, 'u'},    {"method", required_argument, 0, 'M'},
-        {"rmax", required_argument, 0, 'x'},      {"min-value", required_argument, 0, 'v'},
-        {"step-cost", required_argument, 0, 'k'}, {"top", required_argument, 0, 'T'},
-        CLI_WALK_OPTION("estimator"),             CLI_WALK_OPTION("walks"),
-        CLI_WALK_OPTION("rel-err"),               CLI_WALK_OPTION("time"),
-        CLI_WALK_OPTION("seed"),                  CLI_WALK_OPTION("threads"),
-        CLI_WALK_OPTION("continue"),              CLI_WALK_OPTION("max-steps"),
-        {"check", no_argument, 0, 'c'},           {"json", no_argument, 0, 'J'},
-        {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
-        {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
-    cli_system s = {.command = "solve", .omega = 1.0};
-    ulam_bidir_opts o = ulam_bidir_defaults();
-    report rp = {0};
-    int64_t source = 0;
-    int c, rc, idx, force = 0, method = 0;
-    int64_t *bidx = NULL, top = 0;
-    double *bval = NULL;
-    o.walk.max_walks = 0;
-    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
-    optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
-        switch (c) {
-        case CLI_WALK: if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &o.walk))) return rc; break;
-        case 'b': s.rhs_path = optarg; break;
-        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
-        case 'u': if ((rc = cli_parse_int("solve", "--source", optarg, 1, ULAM_MAX_DIM, &source))) return rc; break;
-        case 'M':
-            if (ulam_method_find(optarg) != ULAM_METHOD_BIDIRECTIONAL)
-                return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
-            method = 1;
-            break;
-        case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &o.rmax))) return rc; break;
-        case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &o.min_value))) return rc; break;
-        case 'k': if ((rc = cli_parse_real("solve", "--step-cost", optarg, 1e-3, 1e6, &o.step_cost))) return rc; break;
-        case 'T': if ((rc = cli_parse_int("solve", "--top", optarg, 1, ULAM_MAX_DIM, &top))) return rc; break;
-        case 'c': rp.check = 1; break;
-        case 'J': rp.json = 1; break;
-        case 'F': force = 1; break;
-        case 'C': s.cache = 1; break;
-        case 'h': fputs(usage, stdout); return 0;
-        default: return cli_usage_error("solve", "unknown option for a --source solve");
-        }
+    bidir_args *a = p;
+    *a = (bidir_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_bidir_defaults()};
+    a->o.walk.max_walks = 0;
+}
+
+/* One option (c its code in longopts) into the arguments; 0, or an exit code (-1: --help printed). */
+static int option(void *p, int c, const char *name, const char *optarg)
+{
+    bidir_args *a = p;
+    int rc;
+    switch (c) {
+    case CLI_WALK: if ((rc = cli_walk_option("solve", name, optarg, &a->o.walk))) return rc; break;
+    case 'b': a->s.rhs_path = optarg; break;
+    case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
+    case 'u': if ((rc = cli_parse_int("solve", "--source", optarg, 1, ULAM_MAX_DIM, &a->source))) return rc; break;
+    case 'M':
+        if (ulam_method_find(optarg) != ULAM_METHOD_BIDIRECTIONAL)
+            return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
+        a->method = 1;
+        break;
+    case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &a->o.rmax))) return rc; break;
+    case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &a->o.min_value))) return rc; break;
+    case 'k': if ((rc = cli_parse_real("solve", "--step-cost", optarg, 1e-3, 1e6, &a->o.step_cost))) return rc; break;
+    case 'T': if ((rc = cli_parse_int("solve", "--top", optarg, 1, ULAM_MAX_DIM, &a->top))) return rc; break;
+    case 'c': a->rp.check = 1; break;
+    case 'J': a->rp.json = 1; break;
+    case 'F': a->force = 1; break;
+    case 'C': a->s.cache = 1; break;
+    case 'h': fputs(usage, stdout); return -1;
+    default: return cli_usage_error("solve", "unknown option for a --source solve");
     }
+    return 0;
+}
+
+/* The options read (argv[optind..]: the operands): check them and run; 0 or an exit code. */
+static int start_run(void *p, int argc, char **argv, int optind)
+{
+    bidir_args *a = p;
+    cli_system s = a->s;
+    ulam_bidir_opts o = a->o;
+    report rp = a->rp;
+    int64_t source = a->source, top = a->top, *bidx = NULL;
+    int rc, force = a->force, method = a->method;
+    double *bval = NULL;
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
     if (s.rhs_path && source) return cli_usage_error("solve", "--source S sets b = e_S: it cannot go with --rhs");
     if (s.rhs_path && !method)
@@ -398,6 +406,18 @@ int cli_bidir(int argc, char **argv)
     cli_system_free(&s);
     return rc;
 }
+
+/* Bidirectional: --source S, --rmax or --method bidirectional. */
+static const char *const claims[] = {"source", "rmax", NULL};
+
+/* --method bidirectional is this row's. */
+static int serves(const char *method)
+{
+    return method && ulam_method_find(method) == ULAM_METHOD_BIDIRECTIONAL;
+}
+
+const cli_solve_row cli_solve_bidir_row = {"bidirectional", longopts, claims, serves, sizeof(bidir_args), init, option,
+                                           start_run};
 
 /* Run the chosen bidirectional (cli.h). */
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int json, int check, double direct,

@@ -410,65 +410,77 @@ typedef struct {
     int walks_given;      /* --walks or --time given */
 } solve_args;
 
-/* Parse argv into a; 0, or an exit code (-1: --help printed). */
-static int parse(int argc, char **argv, solve_args *a)
+/* The walks row's options (src/cli/solve_rows.c reads them; the walk options go to cli_walk_option). */
+static const struct option longopts[] = {
+    {"rhs", required_argument, 0, 'b'},      {"index", required_argument, 0, 'i'},
+    CLI_WALK_OPTION("mode"),                 CLI_WALK_OPTION("estimator"),
+    CLI_WALK_OPTION("walks"),                CLI_WALK_OPTION("rel-err"),
+    CLI_WALK_OPTION("time"),                 CLI_WALK_OPTION("seed"),
+    CLI_WALK_OPTION("threads"),              CLI_WALK_OPTION("continue"),
+    CLI_WALK_OPTION("roulette"),             CLI_WALK_OPTION("split"),
+    CLI_WALK_OPTION("max-steps"),            CLI_WALK_OPTION("alpha"),
+    CLI_WALK_OPTION("kernel-exponent"),      CLI_WALK_OPTION("tol"),
+    {"jacobi", no_argument, 0, 'j'},
+    {"omega", required_argument, 0, 'w'},    {"check", no_argument, 0, 'c'},
+    {"json", no_argument, 0, 'J'},           {"out", required_argument, 0, 'o'},
+    {"errors", required_argument, 0, 'E'},   {"help", no_argument, 0, 'h'},
+    {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
+    {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
+    {"method", required_argument, 0, 'U'},   {"pagerank", required_argument, 0, 'P'},
+    {"damping", required_argument, 0, 'P'},  {"queries", required_argument, 0, 'Q'},
+    {0, 0, 0, 0}};
+
+/* The arguments before any option. */
+static void init(void *p)
 {
-    static const struct option longopts[] = {
-        {"rhs", required_argument, 0, 'b'},      {"index", required_argument, 0, 'i'},
-        CLI_WALK_OPTION("mode"),                 CLI_WALK_OPTION("estimator"),
-        CLI_WALK_OPTION("walks"),                CLI_WALK_OPTION("rel-err"),
-        CLI_WALK_OPTION("time"),                 CLI_WALK_OPTION("seed"),
-        CLI_WALK_OPTION("threads"),              CLI_WALK_OPTION("continue"),
-        CLI_WALK_OPTION("roulette"),             CLI_WALK_OPTION("split"),
-        CLI_WALK_OPTION("max-steps"),            CLI_WALK_OPTION("alpha"),
-        CLI_WALK_OPTION("kernel-exponent"),      CLI_WALK_OPTION("tol"),
-        {"jacobi", no_argument, 0, 'j'},
-        {"omega", required_argument, 0, 'w'},    {"check", no_argument, 0, 'c'},
-        {"json", no_argument, 0, 'J'},           {"out", required_argument, 0, 'o'},
-        {"errors", required_argument, 0, 'E'},   {"help", no_argument, 0, 'h'},
-        {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
-        {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
-        {"method", required_argument, 0, 'U'},   {"pagerank", required_argument, 0, 'P'},
-        {"damping", required_argument, 0, 'P'},  {"queries", required_argument, 0, 'Q'},
-        {0, 0, 0, 0}};
+    solve_args *a = p;
     *a = (solve_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_walk_defaults(), .autom = 1,
                       .ao = ulam_auto_defaults()};
     a->o.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
-    int c, rc, idx;
-    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
-    optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
-        switch (c) {
-        case CLI_WALK:
-            if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &a->o))) return rc;
-            a->ao.pin_mode |= !strcmp(longopts[idx].name, "mode");
-            a->ao.pin_estimator |= !strcmp(longopts[idx].name, "estimator");
-            a->ao.pin_continue |= !strcmp(longopts[idx].name, "continue");
-            a->ao.pin_alpha |= !strcmp(longopts[idx].name, "alpha") || !strcmp(longopts[idx].name, "kernel-exponent");
-            break;
-        case 'b': a->s.rhs_path = optarg; break;
-        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
-        case 'j': a->s.jacobi = 1; break;
-        case 'C': a->s.cache = 1; break;
-        case 'W': a->o.whole_kernel = 1; break;
-        case 'U':
-            if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
-            if (strcmp(optarg, "auto") && ulam_method_find(optarg) != ULAM_METHOD_WALKS) return cli_method_error(optarg);
-            a->autom = !strcmp(optarg, "auto");
-            break;
-        case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
-        case 'P': if ((rc = cli_parse_real("solve", "--pagerank", optarg, 1e-6, 1 - 1e-9, &a->s.pagerank))) return rc; break;
-        case 'c': a->check = 1; break;
-        case 'J': a->json = 1; break;
-        case 'F': a->force = 1; break;
-        case 'A': a->assume_finite = 1; break;
-        case 'o': a->out = optarg; break;
-        case 'E': a->errors = optarg; break;
-        case 'Q': a->queries = optarg; break;
-        case 'h': fputs(usage, stdout), fputs(usage2, stdout), fputs(usage3, stdout); return -1;
-        default: return cli_usage_error("solve", "unknown option");
-        }
+}
+
+/* One option (c its code in longopts, name its long name) into the arguments; 0, or an exit code
+ * (-1: --help printed). */
+static int option(void *p, int c, const char *name, const char *optarg)
+{
+    solve_args *a = p;
+    int rc;
+    switch (c) {
+    case CLI_WALK:
+        if ((rc = cli_walk_option("solve", name, optarg, &a->o))) return rc;
+        a->ao.pin_mode |= !strcmp(name, "mode");
+        a->ao.pin_estimator |= !strcmp(name, "estimator");
+        a->ao.pin_continue |= !strcmp(name, "continue");
+        a->ao.pin_alpha |= !strcmp(name, "alpha") || !strcmp(name, "kernel-exponent");
+        break;
+    case 'b': a->s.rhs_path = optarg; break;
+    case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
+    case 'j': a->s.jacobi = 1; break;
+    case 'C': a->s.cache = 1; break;
+    case 'W': a->o.whole_kernel = 1; break;
+    case 'U':
+        if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
+        if (strcmp(optarg, "auto") && ulam_method_find(optarg) != ULAM_METHOD_WALKS) return cli_method_error(optarg);
+        a->autom = !strcmp(optarg, "auto");
+        break;
+    case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
+    case 'P': if ((rc = cli_parse_real("solve", "--pagerank", optarg, 1e-6, 1 - 1e-9, &a->s.pagerank))) return rc; break;
+    case 'c': a->check = 1; break;
+    case 'J': a->json = 1; break;
+    case 'F': a->force = 1; break;
+    case 'A': a->assume_finite = 1; break;
+    case 'o': a->out = optarg; break;
+    case 'E': a->errors = optarg; break;
+    case 'Q': a->queries = optarg; break;
+    case 'h': fputs(usage, stdout), fputs(usage2, stdout), fputs(usage3, stdout); return -1;
+    default: return cli_usage_error("solve", "unknown option");
     }
+    return 0;
+}
+
+/* The checks once every option is read (argv[first..]: the operands); 0 or an exit code. */
+static int finish_parse(solve_args *a, int argc, char **argv, int optind)
+{
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
     if (a->queries && (a->s.index || a->o.mode != ULAM_ADJOINT || a->out || a->errors || a->check || a->s.jacobi))
         return cli_usage_error("solve", "--queries takes the indices from its file, in adjoint mode (no --index, "
@@ -711,13 +723,20 @@ static int run(solve_args *a)
     return rc;
 }
 
-/* ulam solve. */
-int cli_solve(int argc, char **argv)
+/* The options read: check them and run (many queries: src/cli/queries.c); 0 or an exit code. */
+static int start_run(void *p, int argc, char **argv, int first)
 {
-    if (cli_bidir_claims(argc, argv)) return cli_bidir(argc, argv); /* --source S: src/cli/bidir.c */
-    if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv); /* src/cli/mcsa.c */
-    solve_args a;
-    int rc = parse(argc, argv, &a);
-    if (!rc && a.queries) return cli_queries(&a.s, &a.o, a.queries, a.json, a.walks_given); /* src/cli/queries.c */
-    return rc < 0 ? 0 : rc ? rc : run(&a);
+    solve_args *a = p;
+    int rc = finish_parse(a, argc, argv, first);
+    if (!rc && a->queries) return cli_queries(&a->s, &a->o, a->queries, a->json, a->walks_given);
+    return rc ? rc : run(a);
 }
+
+/* The walks row of ulam solve (auto, or --method walks): the default, the last row of the table. */
+static int serves(const char *method)
+{
+    (void)method;
+    return 1;
+}
+
+const cli_solve_row cli_solve_walks_row = {"walks", longopts, NULL, serves, sizeof(solve_args), init, option, start_run};
