@@ -1185,7 +1185,10 @@ typedef struct ulam_auto_candidate {
 /* The work model's units (one unit: one step of a walk), measured once (README, "Choosing for the
  * user"): a walk's start and record, a forward tally, a kernel unit built (16 bytes of a row), a
  * matrix entry read by a guard, reachability check or score-bound pass; and the seconds a unit
- * took on the machine they were measured on (the report's predicted seconds only). */
+ * took on the machine they were measured on.  ULAM_AUTO_UNIT_SECONDS is a tunable of the report
+ * alone (docs/tunables.md): it converts predicted work to the predicted_seconds printed, and
+ * nothing the choice or a run decides reads it, so the same seed gives the same answer on every
+ * machine whatever its speed. */
 #define ULAM_AUTO_WALK 3.0
 #define ULAM_AUTO_TALLY 1.0
 #define ULAM_AUTO_BUILD 2.0

@@ -11,13 +11,23 @@
  * of time (t0: when the run started). */
 int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first);
 
+/* What every block struct opens with, the part the round driver reads (Lua's CommonHeader): a
+ * block struct embeds it as its first member, so the driver reads any solver's blocks through
+ * it.  The tallies (tally_size bytes each, behind a pointer, a length and a capacity) are sent
+ * between processes after the struct; walks and non-finite scores are what the block ran;
+ * complete is 0 when it was interrupted, out of time or out of memory, and nomem 1 when a
+ * tally list could not grow (the run fails with ULAM_ENOMEM). */
+typedef struct {
+    void *tally;
+    int64_t len, cap;
+    int64_t walks, nonfinite;
+    int complete, nomem;
+} ulam__block_head;
+
 /* A block-parallel walk run as the round driver sees it: blocks of `block` walks, at most
  * `round` a round; block k runs as run(ctx, k, its first walk, its walk count, thread) and
- * leaves its result in the k-th struct of the caller's array, `size` bytes each, whose tallies
- * (tally_size bytes each) sit behind a pointer, a length and a capacity (int64) at the offsets
- * given, so results can be sent between processes.  Every block struct also holds its walks
- * and non-finite scores (int64) and its complete and nomem flags (int) at the offsets given;
- * merge(ctx, k) adds the k-th completed block to the solver's own totals; begin(ctx), when
+ * leaves its result in the k-th struct of the caller's array, `size` bytes each, which opens
+ * with a ulam__block_head; merge(ctx, k) adds the k-th completed block to the solver's own totals; begin(ctx), when
  * given, runs before each round inside its time (the matrix solver completes its kernel
  * there); failure(ctx), when given, is a status that fails the whole run once a round ran (a
  * corrupt matrix row), or ULAM_OK. */
@@ -25,8 +35,6 @@ typedef struct {
     int block, round;
     void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread);
     size_t size, tally_size;
-    size_t off_ptr, off_len, off_cap;
-    size_t off_walks, off_nonfinite, off_complete, off_nomem;
     void (*merge)(void *ctx, int k);
     void (*begin)(void *ctx);
     int (*failure)(void *ctx);

@@ -17,7 +17,11 @@
 #include <string.h>
 
 /* Walks per block, blocks per round, split-stack entries per thread; kernels up to CACHED
- * bytes (this machine's L2) walk 16 histories interleaved, larger ones 32 (measured best).
+ * bytes walk 16 histories interleaved, larger ones 32 (measured best on a machine with a 2 MiB
+ * L2).  CACHED is a fixed tunable (docs/tunables.md), not the running machine's L2: a block's
+ * interleaved histories draw from the block's one generator in lane order, so the lane count
+ * decides which numbers each history draws, and a threshold measured at start-up would give one
+ * seed different walks on machines with different caches.
  * Once walks have built 1 / COMPLETE of the kernel row by row, the rest is built at once: a
  * row built at a first visit costs about 3 times one built in the whole streaming pass
  * (measured, n = 10^6 .. 10^7), so by then the run has spent on row-by-row building about
@@ -116,7 +120,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
     if (s->ks)
         for (int t = 0; t < s->threads; t++) ulam__kscratch_free(&s->ks[t]);
     if (s->blocks)
-        for (int q = 0; q < ROUND; q++) free(s->blocks[q].t.t);
+        for (int q = 0; q < ROUND; q++) free(s->blocks[q].h.tally);
     free(s->scratch), free(s->ks), free(s->blocks);
     free(s);
     return NULL;
@@ -1001,8 +1005,8 @@ static void run_block(void *ctx, int q, int64_t first, int64_t count, int t)
 {
     ulam_solver *s = ctx;
     ulam__block *br = &s->blocks[q];
-    br->complete = 0;
-    br->walks = 0;
+    br->h.complete = 0;
+    br->h.walks = 0;
     if (!ulam__mine(s->o.share, first / BLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
     ulam_rng r;
     ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / BLOCK));
@@ -1020,12 +1024,13 @@ static void merge_block(void *ctx, int q)
     ulam__moments_merge(&s->adj, &br->m);
     s->maxsq = fmax(s->maxsq, br->maxsq);
     ulam__moments w = br->watched;
-    for (int64_t q = 0; q < br->t.len; q++) {
-        s->sum[br->t.t[q].state] += br->t.t[q].value;
-        s->sumsq[br->t.t[q].state] += br->t.t[q].square;
+    const ulam__tally *t = br->h.tally;
+    for (int64_t q = 0; q < br->h.len; q++) {
+        s->sum[t[q].state] += t[q].value;
+        s->sumsq[t[q].state] += t[q].square;
     }
     if (s->o.mode == ULAM_FORWARD) {
-        ulam__moments zeros = {.n = br->walks - w.n};
+        ulam__moments zeros = {.n = br->h.walks - w.n};
         ulam__moments_merge(&w, &zeros);
         ulam__moments_merge(&s->watched, &w);
     }
@@ -1098,11 +1103,8 @@ int ulam_solver_iterate(ulam_solver *s)
 {
     if (!s) return ULAM_EINVAL;
     if (s->run.done) return s->run.status;
-    static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally),
-                                   offsetof(ulam__block, t.t), offsetof(ulam__block, t.len),
-                                   offsetof(ulam__block, t.cap), offsetof(ulam__block, walks),
-                                   offsetof(ulam__block, nonfinite), offsetof(ulam__block, complete),
-                                   offsetof(ulam__block, nomem), merge_block, begin_round, kernel_status};
+    static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally), merge_block,
+                                   begin_round, kernel_status};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
     result(s, &r, 0);

@@ -50,12 +50,10 @@ typedef struct {
 
 /* What a block of walks produced. */
 typedef struct {
+    ulam__block_head h; /* the round driver's part: the shooting tallies (rad_tally), walks, ... */
     ulam__moments m[3]; /* gathering scores per channel */
     double sq, maxsq;   /* sum and largest square of the channel-summed score (of the patch) */
-    rad_tally *t;       /* shooting tallies */
-    int64_t len, cap;
-    int64_t walks, rays, cut, nonfinite;
-    int complete, nomem;
+    int64_t rays, cut;
 } rad_block;
 
 /* Per-thread scratch of a shooting history. */
@@ -96,7 +94,7 @@ ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s)
         for (int k = 0; k < s->threads; k++)
             free(s->scratch[k].hist), free(s->scratch[k].touched), free(s->scratch[k].mark);
     if (s->blocks)
-        for (int k = 0; k < RROUND; k++) free(s->blocks[k].t);
+        for (int k = 0; k < RROUND; k++) free(s->blocks[k].h.tally);
     ulam__lights_free(&s->L);
     free(s->q), free(s->scratch), free(s->blocks);
     free(s->sum), free(s->sumsq);
@@ -408,14 +406,15 @@ static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_bl
 /* Move a finished shooting history's tallies into the block; 0 or ULAM_ENOMEM. */
 static int flush_history(rad_scratch *sc, rad_block *br)
 {
-    if (ulam__grow(&br->t, &br->cap, br->len + sc->ntouched, sizeof *br->t)) return ULAM_ENOMEM;
+    ulam__block_head *h = &br->h;
+    if (ulam__grow(&h->tally, &h->cap, h->len + sc->ntouched, sizeof(rad_tally))) return ULAM_ENOMEM;
     for (int64_t k = 0; k < sc->ntouched; k++) {
         int32_t p = sc->touched[k];
-        rad_tally *e = &br->t[br->len++];
+        rad_tally *e = (rad_tally *)h->tally + h->len++;
         e->patch = p;
         for (int c = 0; c < 3; c++) {
             e->v[c] = sc->hist[3 * p + c];
-            if (!isfinite(e->v[c])) br->nonfinite++;
+            if (!isfinite(e->v[c])) h->nonfinite++;
             sc->hist[3 * p + c] = 0.0;
         }
         sc->mark[p] = 0;
@@ -432,8 +431,8 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     ulam__moments zero = {0};
     br->m[0] = br->m[1] = br->m[2] = zero;
     br->sq = br->maxsq = 0.0;
-    br->len = br->walks = br->rays = br->cut = br->nonfinite = 0;
-    br->complete = br->nomem = 0;
+    br->h.len = br->h.walks = br->rays = br->cut = br->h.nonfinite = 0;
+    br->h.complete = br->h.nomem = 0;
     if (!ulam__mine(s->o.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
     ulam_rng r;
     ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / RBLOCK));
@@ -452,7 +451,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             }
             for (int c = 0; c < 3; c++) {
                 ulam__moments_add(&br->m[c], sc[c]);
-                if (!isfinite(sc[c])) br->nonfinite++;
+                if (!isfinite(sc[c])) br->h.nonfinite++;
             }
             double x = sc[0] + sc[1] + sc[2];
             br->sq += x * x;
@@ -462,13 +461,13 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             for (int c = 0; c < 3; c++) /* the patch's tally, 0 when untouched: its moments for rel_err */
                 ulam__moments_add(&br->m[c], s->scratch[th].hist[3 * s->o.index + c]);
             if (flush_history(&s->scratch[th], br)) {
-                br->nomem = 1;
+                br->h.nomem = 1;
                 return;
             }
         }
-        br->walks++;
+        br->h.walks++;
     }
-    br->complete = 1;
+    br->h.complete = 1;
 }
 
 /* Merge completed block k into the totals (ctx: the solver; the walk and non-finite counts are
@@ -480,8 +479,8 @@ static void merge_block(void *ctx, int k)
     for (int c = 0; c < 3; c++) ulam__moments_merge(&s->m[c], &br->m[c]);
     s->sq += br->sq;
     s->maxsq = fmax(s->maxsq, br->maxsq);
-    for (int64_t k = 0; k < br->len; k++) {
-        const rad_tally *e = &br->t[k];
+    for (int64_t k = 0; k < br->h.len; k++) {
+        const rad_tally *e = (const rad_tally *)br->h.tally + k;
         for (int c = 0; c < 3; c++) {
             s->sum[3 * e->patch + c] += e->v[c];
             s->sumsq[3 * e->patch + c] += e->v[c] * e->v[c];
@@ -580,10 +579,7 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
 {
     if (!s) return ULAM_EINVAL;
     if (s->run.done) return s->run.status;
-    static const ulam__blocks B = {RBLOCK, RROUND, run_block, sizeof(rad_block), sizeof(rad_tally),
-                                   offsetof(rad_block, t), offsetof(rad_block, len), offsetof(rad_block, cap),
-                                   offsetof(rad_block, walks), offsetof(rad_block, nonfinite),
-                                   offsetof(rad_block, complete), offsetof(rad_block, nomem), merge_block,
+    static const ulam__blocks B = {RBLOCK, RROUND, run_block, sizeof(rad_block), sizeof(rad_tally), merge_block,
                                    NULL, NULL};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_rad_result r;
