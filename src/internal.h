@@ -249,6 +249,10 @@ int ulam__csr_canonicalize(ulam_csr *A, int threads);
 
 /* ||b - (I - M) x||_inf / ||b||_inf from the sparse M (src/direct.c). */
 double ulam__direct_residual(const ulam_csr *M, const double *b, const double *x);
+
+
+/* The arguments of a direct solve checked: M, b, x given, M square and a sound CSR (src/direct.c). */
+int ulam__direct_args(const ulam_csr *M, const double *b, const double *x, ulam_error *err);
 /* Argument checks (src/check.c): ULAM_OK, or ULAM_EINVAL with err naming the field and what was
  * expected.  Every finite-valued option must be finite and in its range; walk options also have
  * their counts checked (max_walks, max_steps, threads). */
