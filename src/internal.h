@@ -98,6 +98,11 @@ int ulam__power_from(const ulam_csr *A, const double *left, const double *right,
 int ulam__guard_fourth(const ulam_csr *K, double continue_q, double alpha, const ulam_power *abs, ulam_power *out,
                        ulam_error *err);
 
+/* Whether a caller's guard g (may be NULL) was computed for continuation q (<= 0: analog),
+ * kernel exponent alpha and holds every verdict in need (ULAM_GUARD_* bits), so a solver may
+ * take it instead of computing its own (src/guard.c). */
+int ulam__guard_fits(const ulam_guard *g, double continue_q, double alpha, int need);
+
 /* The walks the rel_err rule's range term would need at estimate m and target E were every visit
  * to score at most per_visit (times the walk's weight), both signs when signs, under the
  * reachability bounds of a solver made with rel_err > 0 and b = 1 (src/solve.c; INFINITY
