@@ -68,8 +68,8 @@ int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opt
     ulam_guard g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
-    if (o.walk.guard) g = *o.walk.guard;
-    else if ((status = ulam_guard_check(M, o.walk.continue_q, &go, &g, err))) return status;
+    if (o.walk.policy.guard) g = *o.walk.policy.guard;
+    else if ((status = ulam_guard_check(M, o.walk.kernel.continue_q, &go, &g, err))) return status;
     double c = g.abs.colsum_max; /* ||M||_1 */
     double D1 = c < 1.0 ? 1.0 / (1.0 - c) : INFINITY; /* ||(I - M)^-1||_1 */
     info->mean_visits = isfinite(D1) ? D1 : 1.0 / fmax(1e-3, 1.0 - fmin(g.abs.upper, 0.999));
@@ -100,8 +100,8 @@ int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opt
     info->residual_bound = info->push.r_sum * D1;
     if (!status && info->push.support > 0) {
         ulam_walk_opts wo = o.walk;
-        wo.mode = ULAM_FORWARD, wo.index = o.source, wo.rel_err = 0, wo.guard = &g;
-        wo.max_walks = (int64_t)fmin(fmax(W, 1.0), 4e18);
+        wo.mode = ULAM_FORWARD, wo.query.index = o.source, wo.stop.rel_err = 0, wo.policy.guard = &g;
+        wo.stop.max_walks = (int64_t)fmin(fmax(W, 1.0), 4e18);
         ulam_solver *sv = NULL;
         status = ulam_solver_alloc(M, r, &wo, &sv, err);
         while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);

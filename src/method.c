@@ -199,10 +199,10 @@ static void solve_pins(const ulam_walk_opts *o, ulam_auto_opts *ao, ulam_method_
     *ao = ulam_auto_defaults(), *mo = ulam_method_defaults();
     ao->pin_mode = o->mode != d.mode;
     ao->pin_estimator = o->estimator != d.estimator;
-    ao->pin_continue = o->continue_q != d.continue_q && (o->continue_q > 0 || d.continue_q > 0);
-    ao->pin_alpha = o->kernel_alpha != d.kernel_alpha;
-    ao->guard = o->guard;
-    if ((ao->pin_mode && ao->pin_estimator && ao->pin_continue && ao->pin_alpha) || o->nstarts > 0)
+    ao->pin_continue = o->kernel.continue_q != d.kernel.continue_q && (o->kernel.continue_q > 0 || d.kernel.continue_q > 0);
+    ao->pin_alpha = o->kernel.kernel_alpha != d.kernel.kernel_alpha;
+    ao->guard = o->policy.guard;
+    if ((ao->pin_mode && ao->pin_estimator && ao->pin_continue && ao->pin_alpha) || o->query.nstarts > 0)
         mo->method = ULAM_METHOD_WALKS;
 }
 

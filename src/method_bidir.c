@@ -31,14 +31,14 @@ static int applies(const ulam__query *q, int k, char *why, size_t len)
     const ulam_auto_result *au = &q->ch->walks;
     const char *pinned = o->mode == ULAM_FORWARD ? "forward mode (--mode forward, --out, --errors)"
                          : ao->pin_estimator ? "--estimator is pinned"
-                         : ao->pin_alpha && o->kernel_alpha != 1.0 ? "--alpha other than 1"
-                         : o->roulette > 0 || o->split > 0 ? "--roulette or --split (bidirectional takes neither)"
+                         : ao->pin_alpha && o->kernel.kernel_alpha != 1.0 ? "--alpha other than 1"
+                         : o->kernel.roulette > 0 || o->kernel.split > 0 ? "--roulette or --split (bidirectional takes neither)"
                                                            : NULL;
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     double nnz = (double)ulam_csr_nnz(q->M), W = q->ch->leader_work;
     if (pinned) snprintf(why, len, "not considered: %s", pinned);
     else if (ulam__method_excluded(q, k, why, len)) return 0;
-    else if (!(o->rel_err > 0))
+    else if (!(o->stop.rel_err > 0))
         snprintf(why, len, "not considered: no --rel-err target (without one auto compares variance x work a walk, "
                            "which bidirectional has no figure for)");
     else if (au->chosen < 0) snprintf(why, len, "not considered: no certified walk method to compare with");
@@ -89,7 +89,7 @@ static int setup(ulam__query *q, const ulam_walk_opts *walk, ulam_error *err)
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     r->bo = ulam_bidir_defaults();
     r->bo.walk = *walk;
-    r->bo.target = walk->index;
+    r->bo.target = walk->query.index;
     r->idx = malloc((size_t)(nb ? nb : 1) * sizeof *r->idx), r->val = malloc((size_t)(nb ? nb : 1) * sizeof *r->val);
     double t0 = ulam_now();
     int status = r->idx && r->val ? ulam_csr_transpose(q->M, &r->Mt) : ULAM_ENOMEM;
@@ -112,8 +112,8 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     ulam_run *r = q->run;
     double W = ch->leader_work;
     ulam_walk_opts walk = *q->o;
-    walk.estimator = ULAM_COLLISION, walk.kernel_alpha = 1.0;
-    walk.guard = NULL, walk.interrupt = NULL, walk.share = NULL;
+    walk.estimator = ULAM_COLLISION, walk.kernel.kernel_alpha = 1.0;
+    walk.policy.guard = NULL, walk.stop.interrupt = NULL, walk.exec.share = NULL;
     int status = setup(q, &walk, err);
     if (status) return status;
     r->bo.max_push_ops = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : 0; /* W infinite: the default cap */
@@ -158,7 +158,7 @@ static int pin(ulam__query *q, int k, ulam_error *err)
 /* The push and the walks (the plan reused when predicted). */
 static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
 {
-    r->bo.walk.interrupt = r->o.interrupt, r->bo.walk.share = r->o.share;
+    r->bo.walk.stop.interrupt = r->o.stop.interrupt, r->bo.walk.exec.share = r->o.exec.share;
     int status = ulam_bidir_solve(r->w, r->Mt, &r->bo, &a->bidir, err);
     if (status) return status;
     a->walks = a->bidir.walks;

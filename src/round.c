@@ -19,8 +19,8 @@ ulam_share ulam_share_defaults(void)
 /* Nonzero when a block starting at walk first may start. */
 int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first)
 {
-    if (o->interrupt && *o->interrupt) return 0;
-    return first == 0 || !(o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds);
+    if (o->stop.interrupt && *o->stop.interrupt) return 0;
+    return first == 0 || !(o->stop.max_seconds > 0 && ulam_now() - t0 >= o->stop.max_seconds);
 }
 
 /* Nonzero when this process runs block q. */
@@ -32,14 +32,14 @@ int ulam__mine(const ulam_share *sh, int64_t q)
 /* Nonzero when the walk budget is spent after `walks` walks or the stop flags say time is up. */
 static int budget_spent(const ulam_walk_opts *o, int stop, int64_t walks)
 {
-    return (stop & 1) || (o->max_walks > 0 && walks >= o->max_walks);
+    return (stop & 1) || (o->stop.max_walks > 0 && walks >= o->stop.max_walks);
 }
 
 /* This process's stop flags: 1 time is up, 2 interrupted. */
 static int local_stop(const ulam_walk_opts *o, double t0)
 {
-    int f = o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds ? 1 : 0;
-    return f | (o->interrupt && *o->interrupt ? 2 : 0);
+    int f = o->stop.max_seconds > 0 && ulam_now() - t0 >= o->stop.max_seconds ? 1 : 0;
+    return f | (o->stop.interrupt && *o->stop.interrupt ? 2 : 0);
 }
 
 /* Append n bytes to the buffer *buf of length *len and capacity *cap. */
@@ -103,7 +103,7 @@ static int unpack(const unsigned char *p, size_t n, void *blocks, const ulam__bl
 static int exchange(const ulam_walk_opts *o, double t0, void *blocks, const ulam__blocks *L, int nb, int64_t q0,
                     int *stop)
 {
-    const ulam_share *sh = o->share;
+    const ulam_share *sh = o->exec.share;
     *stop = local_stop(o, t0);
     if (!sh || sh->nranks <= 1) return ULAM_OK;
     unsigned char *mine = NULL;
@@ -134,7 +134,7 @@ static int exchange(const ulam_walk_opts *o, double t0, void *blocks, const ulam
 int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int threads, void *ctx,
                 void *results, int *nb, int *stop)
 {
-    int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX, done = next / B->block;
+    int64_t left = o->stop.max_walks > 0 ? o->stop.max_walks - next : INT64_MAX, done = next / B->block;
     int round = done + 1 < B->round ? (int)(done + 1) : B->round, n = 0;
     while (n < round && left > (int64_t)n * B->block) n++;
     /* A team only for rounds of at least TEAM_BLOCKS blocks a thread: a small round (the first
@@ -199,9 +199,9 @@ int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err)
 {
     int status = ulam__walk_opts_check(o, err); /* src/check.c: NaN, +-inf, out of range */
     if (status) return status;
-    if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
+    if (o->stop.max_walks < 0 || o->stop.rel_err < 0 || o->stop.max_seconds < 0 || o->stop.max_steps < 1 || o->exec.threads < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
-    if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
+    if (o->stop.max_walks == 0 && o->stop.rel_err == 0 && o->stop.max_seconds == 0 && !o->stop.interrupt)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a stopping rule: walks, rel_err or time");
     return ULAM_OK;
 }
@@ -209,5 +209,5 @@ int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err)
 /* The walk cap: ULAM_REL_ERR_CAP with rel_err alone, else max_walks. */
 int64_t ulam__walk_cap(const ulam_walk_opts *o)
 {
-    return o->rel_err > 0 && o->max_walks == 0 && o->max_seconds == 0 ? ULAM_REL_ERR_CAP : o->max_walks;
+    return o->stop.rel_err > 0 && o->stop.max_walks == 0 && o->stop.max_seconds == 0 ? ULAM_REL_ERR_CAP : o->stop.max_walks;
 }

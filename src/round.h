@@ -43,7 +43,7 @@ typedef struct {
 /* Where a walk run stands between rounds, the part of a solver the round driver keeps: walks
  * merged (the next round starts there), of them non-finite scores, when the run started (t0,
  * -1 before its first round), seconds spent in rounds, and its ending: done once a stopping
- * rule is met or the run failed (status), interrupted by o->interrupt.  Zeroed, with t0 = -1,
+ * rule is met or the run failed (status), interrupted by o->stop.interrupt.  Zeroed, with t0 = -1,
  * it is a run not yet started (ulam__run_reset). */
 typedef struct {
     int64_t walks, nonfinite;
@@ -54,8 +54,8 @@ typedef struct {
 /* A run not yet started. */
 void ulam__run_reset(ulam__run *run);
 
-/* One round from walk `next` (no further than o->max_walks), shared dynamically among
- * `threads`, its *nb block results left in results[].  With o->share, every process's blocks
+/* One round from walk `next` (no further than o->stop.max_walks), shared dynamically among
+ * `threads`, its *nb block results left in results[].  With o->exec.share, every process's blocks
  * are then exchanged so all hold all of them.  *stop gets the stop flags (1: time is up,
  * 2: interrupted), or'ed over the processes.  ULAM_OK, ULAM_ENOMEM or ULAM_EIO (the exchange
  * failed; *nb is then 0). */
@@ -67,8 +67,8 @@ int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64
  * completed blocks merged in block order (B->merge; the first incomplete block, interrupted or
  * out of time, ends the run with what came before it), and run's ending updated: a failed
  * exchange, a block out of memory, B->failure or a non-finite score fail the run
- * (ULAM_ENONFINITE only when nothing else did); an interrupt, the walk budget (o->max_walks)
- * or the time limit (o->max_seconds) end it.  The solver then applies its own rel_err rule.
+ * (ULAM_ENONFINITE only when nothing else did); an interrupt, the walk budget (o->stop.max_walks)
+ * or the time limit (o->stop.max_seconds) end it.  The solver then applies its own rel_err rule.
  * Returns run->status. */
 int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads, void *ctx, void *results,
                      ulam__run *run);
@@ -81,7 +81,7 @@ int ulam__mine(const ulam_share *sh, int64_t q);
 int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err);
 
 /* The walk cap of a run whose only stopping rule is rel_err: ULAM_REL_ERR_CAP (a target out of
- * reach still ends), else o->max_walks. */
+ * reach still ends), else o->stop.max_walks. */
 int64_t ulam__walk_cap(const ulam_walk_opts *o);
 
 #endif /* ULAM_ROUND_H */

@@ -46,9 +46,9 @@ static void test_choice(void **state)
         double *x = malloc((size_t)M->nrows * sizeof *x);
         assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 1, o.seed = 11 + (uint64_t)k, o.max_walks = 0;
-        if (k < 3) o.rel_err = 0.02;
-        else o.max_walks = 20000;
+        o.query.index = 1, o.exec.seed = 11 + (uint64_t)k, o.stop.max_walks = 0;
+        if (k < 3) o.stop.rel_err = 0.02;
+        else o.stop.max_walks = 20000;
         ulam_auto_result res;
         ulam_solver *sv = NULL;
         assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
@@ -71,7 +71,7 @@ static void test_choice(void **state)
         ulam_walk_result r, plain;
         assert_int_equal(walk_out(sv, &r), ULAM_OK);
         ulam_solver_free(sv);
-        o.mode = ch->mode, o.estimator = ch->estimator, o.continue_q = ch->continue_q, o.kernel_alpha = ch->kernel_alpha;
+        o.mode = ch->mode, o.estimator = ch->estimator, o.kernel.continue_q = ch->continue_q, o.kernel.kernel_alpha = ch->kernel_alpha;
         assert_int_equal(ulam_solve_walks(M, b, &o, &plain, NULL), ULAM_OK);
         if (!same_result(&r, &plain) || !(fabs(r.estimate - x[1]) < 4 * r.std_error))
             print_error("case %d: %.17g +- %.3g (plain %.17g, %lld walks / %lld), LAPACK %.10g\n", k, r.estimate,
@@ -97,7 +97,7 @@ static void test_threads(void **state)
         ulam_walk_result r[2];
         for (int t = 0; t < 2; t++) {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.index = 3, o.rel_err = 0.01, o.max_walks = 0, o.threads = t + 1, o.seed = 5;
+            o.query.index = 3, o.stop.rel_err = 0.01, o.stop.max_walks = 0, o.exec.threads = t + 1, o.exec.seed = 5;
             ulam_solver *sv = NULL;
             assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res[t], &sv, NULL), ULAM_OK);
             assert_int_equal(walk_out(sv, &r[t]), ULAM_OK);
@@ -132,7 +132,7 @@ static void test_pins(void **state)
     double *b;
     ulam_csr *M = load("randsub1000", &b);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = ULAM_FORWARD, o.estimator = ULAM_EXPECTED, o.continue_q = 0.5, o.kernel_alpha = 2, o.max_walks = 3000;
+    o.mode = ULAM_FORWARD, o.estimator = ULAM_EXPECTED, o.kernel.continue_q = 0.5, o.kernel.kernel_alpha = 2, o.stop.max_walks = 3000;
     ulam_auto_opts ao = ulam_auto_defaults();
     ao.pin_mode = ao.pin_continue = 1;
     ulam_auto_result res;
@@ -141,11 +141,11 @@ static void test_pins(void **state)
     for (int c = 0; c < 9; c++) assert_true(res.cand[c].mode == ULAM_FORWARD && res.cand[c].continue_q == 0.5);
     ao.pin_estimator = ao.pin_alpha = 1;
     for (int k = 0; k < 2; k++) { /* case k: forward expected, Q 0.5, alpha 2 (not certified); adjoint absorption */
-        if (k) o = ulam_walk_defaults(), o.estimator = ULAM_ABSORPTION, o.index = 4, o.rel_err = 0.02, o.max_walks = 0;
+        if (k) o = ulam_walk_defaults(), o.estimator = ULAM_ABSORPTION, o.query.index = 4, o.stop.rel_err = 0.02, o.stop.max_walks = 0;
         ulam_solver *sv = NULL;
         assert_int_equal(ulam_auto_solver(M, b, &o, &ao, &res, &sv, NULL), ULAM_OK);
         assert_true(res.ncand == 1 && (k ? res.chosen : res.closest) == 0);
-        assert_true(res.cand[0].estimator == o.estimator && res.cand[0].kernel_alpha == o.kernel_alpha);
+        assert_true(res.cand[0].estimator == o.estimator && res.cand[0].kernel_alpha == o.kernel.kernel_alpha);
         ulam_walk_result r, plain;
         assert_int_equal(walk_out(sv, &r), ULAM_OK);
         ulam_solver_free(sv);
@@ -158,7 +158,7 @@ static void test_pins(void **state)
     ao = ulam_auto_defaults();
     ao.pilot_max = ao.pilot_walks - 1;
     assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_EINVAL);
-    o.index = M->nrows;
+    o.query.index = M->nrows;
     assert_int_equal(ulam_auto_choose(M, b, &o, NULL, &res, NULL), ULAM_EINVAL);
     free(b);
     ulam_csr_free(M);
@@ -174,7 +174,7 @@ static void test_none(void **state)
     double *b;
     ulam_csr *M = load("signed_edge200", &b);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.rel_err = 0.01, o.max_walks = 0;
+    o.stop.rel_err = 0.01, o.stop.max_walks = 0;
     ulam_auto_result res;
     ulam_solver *sv = NULL;
     assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_EDIVERGE);
@@ -191,7 +191,7 @@ static void test_none(void **state)
     assert_int_equal(ulam_auto_solver(M, b2, &o, NULL, &res, &sv, NULL), ULAM_EINFVAR);
     assert_true(sv == NULL && res.chosen == -1 && res.closest >= 0 && res.abs.upper < 1);
     for (int c = 0; c < res.ncand; c++) assert_true(!res.cand[c].certified && res.cand[c].hat.upper >= 1);
-    o.rel_err = 0, o.max_walks = 1000;
+    o.stop.rel_err = 0, o.stop.max_walks = 1000;
     assert_int_equal(ulam_auto_solver(M, b2, &o, NULL, &res, &sv, NULL), ULAM_OK);
     ulam_walk_result r;
     assert_int_equal(walk_out(sv, &r), ULAM_OK);
@@ -232,7 +232,7 @@ static void test_table(void **state)
     assert_int_equal(ulam_csr_from_triplets(N, N, nz, ti, tj, tx, &M), ULAM_OK);
     assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 3, o.seed = 5, o.max_walks = 20000, o.threads = 2;
+    o.query.index = 3, o.exec.seed = 5, o.stop.max_walks = 20000, o.exec.threads = 2;
     ulam_method_opts ao = ulam_method_defaults();
     assert_int_equal(ao.method, -1);
     ulam_choice *ch = malloc(sizeof *ch);
@@ -281,7 +281,7 @@ static void test_table(void **state)
     ulam_solver_free(sv);
     /* an excluded row says so */
     ao.exclude = 1u << ULAM_METHOD_BIDIRECTIONAL;
-    o.rel_err = 0.05, o.max_walks = 0;
+    o.stop.rel_err = 0.05, o.stop.max_walks = 0;
     assert_int_equal(ulam_auto(M, b, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
     assert_string_equal(ch->method[ULAM_METHOD_BIDIRECTIONAL].why, "not considered: excluded");
     ulam_csr_free(M);
@@ -291,7 +291,7 @@ static void test_table(void **state)
     M = load("randsub1000", &b2);
     assert_int_equal(ulam_direct_solve(M, bs, x2, 0, NULL, NULL), ULAM_OK);
     o = ulam_walk_defaults();
-    o.index = 6, o.rel_err = 0.02, o.max_walks = 0;
+    o.query.index = 6, o.stop.rel_err = 0.02, o.stop.max_walks = 0;
     ao = ulam_method_defaults();
     assert_int_equal(ulam_auto(M, bs, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
     assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
@@ -356,8 +356,8 @@ static void test_solve_is_cli(void **state)
         double *b = must_read_vector(cases[t].b, &n);
         ulam_csr *M = must_read(cases[t].M);
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = cases[t].index, o.seed = strstr(cases[t].args, "--seed 7") ? 7 : 3, o.threads = 2;
-        if (cases[t].rel_err > 0) o.rel_err = cases[t].rel_err, o.max_walks = 0; /* as the CLI: no --walks */
+        o.query.index = cases[t].index, o.exec.seed = strstr(cases[t].args, "--seed 7") ? 7 : 3, o.exec.threads = 2;
+        if (cases[t].rel_err > 0) o.stop.rel_err = cases[t].rel_err, o.stop.max_walks = 0; /* as the CLI: no --walks */
         if (cases[t].estimator >= 0) o.estimator = cases[t].estimator;
         ulam_walk_result r;
         assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);

@@ -102,7 +102,7 @@ static void test_metastable_fixed(void **state)
         for (int s = 0; s < 100; s++) {
             if (!test_case(1000L * c + s)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = cases[c].est, o.max_walks = cases[c].walks, o.seed = 1 + (uint64_t)s;
+            o.estimator = cases[c].est, o.stop.max_walks = cases[c].walks, o.exec.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
             assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             v[verdict(&r, x)]++;
@@ -127,7 +127,7 @@ static void test_metastable_auto(void **state)
     for (int s = 0; s < 100; s++) {
         if (!test_case(s)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.max_walks = 1000, o.seed = 300 + (uint64_t)s;
+        o.stop.max_walks = 1000, o.exec.seed = 300 + (uint64_t)s;
         ulam_auto_result res;
         ulam_solver *sv = NULL;
         assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
@@ -153,7 +153,7 @@ static void test_metastable_rounds(void **state)
     for (int s = 0; s < 100; s++) {
         if (!test_case(s)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.max_walks = 0, o.max_seconds = 1e9, o.seed = 100 + (uint64_t)s;
+        o.stop.max_walks = 0, o.stop.max_seconds = 1e9, o.exec.seed = 100 + (uint64_t)s;
         ulam_solver *sv;
         assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, NULL), ULAM_OK);
         for (int k = 0; k < 1 + s % 6; k++) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
@@ -179,7 +179,7 @@ static void test_metastable_rel_err(void **state)
     for (int s = 0; s < 100; s++) {
         if (!test_case(s)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.estimator = ULAM_ABSORPTION, o.max_walks = 0, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
+        o.estimator = ULAM_ABSORPTION, o.stop.max_walks = 0, o.stop.rel_err = 0.1, o.exec.seed = 1 + (uint64_t)s;
         ulam_walk_result r;
         assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         assert_true(r.rel_err_met);
@@ -206,7 +206,7 @@ static void test_laplace_corner(void **state)
         for (int s = 0; s < 100; s++) {
             if (!test_case(1000L * c + s)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = c ? ULAM_ABSORPTION : ULAM_COLLISION, o.max_walks = 1000, o.seed = 1 + (uint64_t)s;
+            o.estimator = c ? ULAM_ABSORPTION : ULAM_COLLISION, o.stop.max_walks = 1000, o.exec.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
             assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             v[verdict(&r, x)]++;
@@ -217,7 +217,7 @@ static void test_laplace_corner(void **state)
     for (int s = 0; s < 10; s++) {
         if (!test_case(2000L + s)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.max_walks = 1 << 17, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
+        o.stop.max_walks = 1 << 17, o.stop.rel_err = 0.1, o.exec.seed = 1 + (uint64_t)s;
         ulam_walk_result r;
         assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         print_message("rel_err seed %d: %.4g [%.4g, %.4g] %lld walks, met %d, out of reach %d (needs %.3g)\n", s,
@@ -238,7 +238,7 @@ static void test_never_zero_width(void **state)
     ulam_csr *M = metastable(1e-4, &b, &x);
     for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
         ulam_walk_opts o = ulam_walk_defaults();
-        o.estimator = est, o.max_walks = 100, o.seed = 3;
+        o.estimator = est, o.stop.max_walks = 100, o.exec.seed = 3;
         ulam_walk_result r;
         assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         print_message("100 walks, %s: %.6g [%.6g, %.6g], variance %g\n", est ? "absorption" : "collision", r.estimate,
@@ -248,7 +248,7 @@ static void test_never_zero_width(void **state)
     for (int i = 20; i < 40; i++) b[i] = 0.0; /* from B only B is reachable: x_20 = 0, certified */
     for (int i = 0; i < 20; i++) b[i] = 0.0;
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 25, o.max_walks = 100;
+    o.query.index = 25, o.stop.max_walks = 100;
     ulam_walk_result r;
     assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(r.estimate == 0 && r.ci95[0] == 0 && r.ci95[1] == 0);

@@ -216,7 +216,7 @@ static inline ulam_walk_result test_sys_run(const test_sys *s, ulam_walk_opts o)
     int st = ulam_solve_walks(s->M, s->b, &o, &r, &err);
     if (st) print_error("ulam_solve_walks: %s: %s\n", ulam_strerror(st), err.msg);
     assert_int_equal(st, ULAM_OK);
-    assert_true(r.walks == o.max_walks);
+    assert_true(r.walks == o.stop.max_walks);
     return r;
 }
 

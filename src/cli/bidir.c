@@ -70,7 +70,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
                (long long)r->plan.pilot_walks, r->plan.mean_visits, r->plan.predicted_walks, r->plan.predicted_work,
                r->plan.step_cost, r->plan.probe);
     printf("seconds         %.4f (push %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
-           r->push.seconds, w->seconds, (unsigned long long)o->walk.seed, rp->transpose_seconds);
+           r->push.seconds, w->seconds, (unsigned long long)o->walk.exec.seed, rp->transpose_seconds);
     printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
            cli_verdict_word(rp->g.verdict_abs), rp->g.hat[ULAM_FORWARD].rho, cli_verdict_word(rp->g.verdict_hat[ULAM_FORWARD]));
     printf("load            %.3f s inputs, %.3f s guards\n", rp->load_seconds, rp->guard_seconds);
@@ -123,7 +123,7 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     cli_json_number("load_seconds", rp->load_seconds, 0);
     cli_json_number("guard_seconds", rp->guard_seconds, 0);
     cli_json_string("estimator", cli_estimator_names[o->walk.estimator], 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->walk.seed, w->threads,
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->walk.exec.seed, w->threads,
            cli_share ? cli_share->nranks : 1);
     if (rp->check) {
         cli_json_number("direct", rp->direct, 0);
@@ -177,7 +177,7 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
         s->own_b[source - 1] = 1.0;
         s->b = s->own_b; /* freed by cli_system_free */
     }
-    double continue_q = o->walk.continue_q;
+    double continue_q = o->walk.kernel.continue_q;
     if ((rc = cli_guard(s, continue_q, 1.0, ULAM_FORWARD, &rp->g))) return rc;
     if (rp->g.verdict_abs >= ULAM_VERDICT_FAIL) {
         cli_guard_diverge(s, &rp->g, force);
@@ -206,7 +206,7 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     if (!status) status = ulam_push_alloc(s->M, &w);
     ulam_error err = {.status = status, .msg = "memory for the transpose and the push"};
     ulam_bidir_result r;
-    o->walk.interrupt = &cli_interrupted, o->walk.share = cli_share;
+    o->walk.stop.interrupt = &cli_interrupted, o->walk.exec.share = cli_share;
     cli_catch_sigint();
     if (!status) status = ulam_bidir_solve(w, stored ? stored : Mt, o, &r, &err);
     int rc = status ? cli_report(s->matrix_path, &err) : 0;
@@ -237,9 +237,9 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     ulam_fpush_opts o = ulam_fpush_defaults();
     o.walk = bo->walk;
     o.walk.mode = ULAM_FORWARD;
-    o.walk.max_walks = bo->walk.max_walks > 0 ? bo->walk.max_walks : 0;
-    o.walks = o.walk.max_walks;
-    if (bo->walk.rel_err > 0) o.rel_err = bo->walk.rel_err;
+    o.walk.stop.max_walks = bo->walk.stop.max_walks > 0 ? bo->walk.stop.max_walks : 0;
+    o.walks = o.walk.stop.max_walks;
+    if (bo->walk.stop.rel_err > 0) o.rel_err = bo->walk.stop.rel_err;
     o.rmax = bo->rmax, o.min_value = bo->min_value, o.step_cost = bo->step_cost, o.source = source - 1;
     int check = rp->check;
     rp->check = 0; /* prepare's direct value is for one index */
@@ -252,7 +252,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     ulam_fpush_info info;
     ulam_error err;
     int status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : ulam_csr_transpose(s->M, &Mt);
-    o.walk.guard = &rp->g, o.walk.interrupt = &cli_interrupted;
+    o.walk.policy.guard = &rp->g, o.walk.stop.interrupt = &cli_interrupted;
     if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
     else status = ulam_fpush_solve(s->M, Mt, &o, x, se, lo, hi, &info, &err);
     if (status) rc = cli_report(s->matrix_path, &err);
@@ -339,7 +339,7 @@ static void init(void *p)
 {
     bidir_args *a = p;
     *a = (bidir_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_bidir_defaults()};
-    a->o.walk.max_walks = 0;
+    a->o.walk.stop.max_walks = 0;
 }
 
 /* One option (c its code in longopts) into the arguments; 0, or an exit code (-1: --help printed). */
@@ -396,7 +396,7 @@ static int start_run(void *p, int argc, char **argv, int optind)
         return rc;
     }
     cli_walk_budget(&o.walk);
-    o.walk.force = force;
+    o.walk.policy.force = force;
     s.matrix_path = argv[optind];
     if (!(rc = prepare(&s, source, force, &o, &bidx, &bval, &rp))) {
         o.target = s.index - 1, o.source = source ? source - 1 : 0;
@@ -425,7 +425,7 @@ int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int 
 {
     report rp = {.json = json, .check = check, .direct = direct, .load_seconds = load_seconds,
                  .transpose_seconds = ch->transpose_seconds, .ch = ch};
-    int rc = cli_guard(s, ch->bidir_opts.walk.continue_q, 1.0, ULAM_FORWARD, &rp.g);
+    int rc = cli_guard(s, ch->bidir_opts.walk.kernel.continue_q, 1.0, ULAM_FORWARD, &rp.g);
     if (rc) return rc;
     rp.guard_seconds = rp.g.abs.seconds + rp.g.hat[0].seconds + rp.g.hat[1].seconds;
     cli_guard_warn(s, &rp.g, ULAM_FORWARD, 0);

@@ -156,8 +156,8 @@ static void print_json(const report *p)
         cli_json_number("estimate", p->x[p->index - 1], 0);
     }
     if (p->check) cli_json_number("relative_error", p->err_direct, 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, \"history\": [", (unsigned long long)p->o->walk.seed,
-           p->o->walk.threads, cli_share ? cli_share->nranks : 1);
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, \"history\": [", (unsigned long long)p->o->walk.exec.seed,
+           p->o->walk.exec.threads, cli_share ? cli_share->nranks : 1);
     for (int k = 0; k < p->nsteps; k++) {
         const ulam_outer_step *s = &p->steps[k];
         printf("%s{\"iteration\": %d, ", k ? ", " : "", s->iteration);
@@ -374,8 +374,8 @@ static int start_run(void *q, int argc, char **argv, int optind)
     if (out && (rc = cli_check_output(out))) return rc;
     if ((rc = cli_load_system(&s))) return rc;
     p.index = s.index;
-    o.walk.share = cli_share, o.walk.interrupt = &cli_interrupted;
-    if (walking(p.method) && (rc = cli_guard(&s, o.walk.continue_q, o.walk.kernel_alpha, ULAM_FORWARD, &p.g))) {
+    o.walk.exec.share = cli_share, o.walk.stop.interrupt = &cli_interrupted;
+    if (walking(p.method) && (rc = cli_guard(&s, o.walk.kernel.continue_q, o.walk.kernel.kernel_alpha, ULAM_FORWARD, &p.g))) {
         cli_system_free(&s);
         return rc;
     }
@@ -387,7 +387,7 @@ static int start_run(void *q, int argc, char **argv, int optind)
         }
     }
     if (walking(p.method)) cli_guard_warn(&s, &p.g, ULAM_FORWARD, 0);
-    o.walk.guard = &p.g, o.walk.force = force; /* the walks' solver takes these verdicts */
+    o.walk.policy.guard = &p.g, o.walk.policy.force = force; /* the walks' solver takes these verdicts */
     ulam_outer_step *steps = NULL;
     double *x = NULL;
     rc = p.method >= KRYLOV_CG ? run_krylov(&s, &o, &p, &x) : run(&s, &o, &p, &steps, &x);

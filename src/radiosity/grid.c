@@ -41,11 +41,11 @@ int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_walk_opts *opts, const 
             int64_t k = (int64_t)j * g->nu + i;
             ulam_walk_opts o = *opts;
             ulam_rng r;
-            ulam_rng_seed(&r, opts->seed, (uint64_t)k);
-            o.seed = ulam__rng_next(&r);
-            if (opts->max_seconds > 0) { /* the time limit is the whole grid's */
-                o.max_seconds = opts->max_seconds - (ulam_now() - t0);
-                if (!(o.max_seconds > 0)) o.max_seconds = 1e-9; /* one block still runs: an estimate */
+            ulam_rng_seed(&r, opts->exec.seed, (uint64_t)k);
+            o.exec.seed = ulam__rng_next(&r);
+            if (opts->stop.max_seconds > 0) { /* the time limit is the whole grid's */
+                o.stop.max_seconds = opts->stop.max_seconds - (ulam_now() - t0);
+                if (!(o.stop.max_seconds > 0)) o.stop.max_seconds = 1e-9; /* one block still runs: an estimate */
             }
             double x[3];
             ulam_rad_grid_point(g, i, j, x);

@@ -24,7 +24,7 @@ int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_walk_opts *opts, const 
     ulam__clear(err);
     if (!t || !opts || !B || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, options, B and an output");
     const ulam_scene *s = ulam__tracer_scene(t);
-    int64_t p = opts->index;
+    int64_t p = opts->query.index;
     if (p < 0 || p >= s->npatches)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a patch from 0 to %lld", (long long)s->npatches - 1);
     memset(out, 0, sizeof *out);
@@ -34,8 +34,8 @@ int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_walk_opts *opts, const 
     for (int k = 0; k < out->npoints; k++) {
         ulam_walk_opts o = *opts;
         ulam_rng r;
-        ulam_rng_seed(&r, opts->seed, (uint64_t)k + 1);
-        o.seed = ulam__rng_next(&r);
+        ulam_rng_seed(&r, opts->exec.seed, (uint64_t)k + 1);
+        o.exec.seed = ulam__rng_next(&r);
         double x[3];
         quad_point(s, p, k, x);
         ulam_rad_point pt;

@@ -122,9 +122,9 @@ static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, int point, 
                                                    "or collision)");
     if (point && o->mode != ULAM_ADJOINT)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "point walks gather (mode adjoint)");
-    if (!point && (o->index < 0 || o->index >= sc->npatches))
-        return ulam__fail(err, ULAM_EINVAL, 0, o->index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
-    if (o->continue_q != 0 || o->roulette != 0 || o->split != 0 || o->kernel_alpha != 1.0)
+    if (!point && (o->query.index < 0 || o->query.index >= sc->npatches))
+        return ulam__fail(err, ULAM_EINVAL, 0, o->query.index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
+    if (o->kernel.continue_q != 0 || o->kernel.roulette != 0 || o->kernel.split != 0 || o->kernel.kernel_alpha != 1.0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette, split or kernel exponent other "
                                                    "than 1 (patch walks continue with the patch's largest "
                                                    "reflectance and follow the form factors)");
@@ -204,9 +204,9 @@ static int solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, int po
     s->o = o;
     s->t = t;
     s->s = ulam__tracer_scene(t);
-    s->threads = ulam__threads(o.threads);
+    s->threads = ulam__threads(o.exec.threads);
     ulam__run_reset(&s->run);
-    s->o.max_walks = ulam__walk_cap(&o);
+    s->o.stop.max_walks = ulam__walk_cap(&o);
     s->at = point;
     if ((status = build_source(s, err))) {
         ulam_rad_solver_free(s);
@@ -300,7 +300,7 @@ static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_b
 {
     const ulam_scene *sc = s->s;
     int absorb = s->o.estimator == ULAM_RAD_ABSORPTION;
-    int64_t p = s->o.index;
+    int64_t p = s->o.query.index;
     double W[3] = {1, 1, 1};
     score[0] = score[1] = score[2] = 0.0;
     for (int64_t step = 0;; step++) {
@@ -312,7 +312,7 @@ static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_b
                 for (int c = 0; c < 3; c++) score[c] += W[c] * E[c] / (1.0 - q);
             return;
         }
-        if (step >= s->o.max_steps) {
+        if (step >= s->o.stop.max_steps) {
             br->cut++;
             return;
         }
@@ -340,14 +340,14 @@ static void light_sample(const ulam_rad_solver *s, ulam_rng *r, int64_t p, const
 static void gather_next_event(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_block *br)
 {
     const ulam_scene *sc = s->s;
-    int64_t p = s->o.index;
+    int64_t p = s->o.query.index;
     double W[3] = {1, 1, 1};
     for (int c = 0; c < 3; c++) score[c] = sc->emit[3 * p + c];
     for (int64_t step = 0;; step++) {
         double q = s->q[p];
         if (q > 0 && s->L.nem) light_sample(s, r, p, W, score, br);
         if (ulam__rng_uniform(r) >= q) return;
-        if (step >= s->o.max_steps) {
+        if (step >= s->o.stop.max_steps) {
             br->cut++;
             return;
         }
@@ -384,7 +384,7 @@ static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_bl
     double W[3], esum = E0[0] + E0[1] + E0[2];
     for (int c = 0; c < 3; c++) W[c] = s->L.ptot * E0[c] / esum;
     for (int64_t step = 0;; step++) {
-        if (step >= s->o.max_steps) {
+        if (step >= s->o.stop.max_steps) {
             br->cut++;
             return;
         }
@@ -433,15 +433,15 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     br->sq = br->maxsq = 0.0;
     br->h.len = br->h.walks = br->rays = br->cut = br->h.nonfinite = 0;
     br->h.complete = br->h.nomem = 0;
-    if (!ulam__mine(s->o.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
+    if (!ulam__mine(s->o.exec.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
     ulam_rng r;
-    ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / RBLOCK));
+    ulam_rng_seed(&r, s->o.exec.seed, (uint64_t)(first / RBLOCK));
     for (int64_t w = 0; w < count; w++) {
         if (s->o.mode == ULAM_ADJOINT) {
             double sc[3];
             if (s->at) {
                 int64_t cut = 0;
-                ulam__point_walk(s->t, &s->L, s->q, s->o.estimator, s->o.max_steps, s->at_x, s->at_n, s->at_self, &r,
+                ulam__point_walk(s->t, &s->L, s->q, s->o.estimator, s->o.stop.max_steps, s->at_x, s->at_n, s->at_self, &r,
                                  sc, &br->rays, &cut);
                 br->cut += cut;
             } else if (next_event(s->o.estimator)) {
@@ -459,7 +459,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
         } else {
             shoot(s, &r, &s->scratch[th], br);
             for (int c = 0; c < 3; c++) /* the patch's tally, 0 when untouched: its moments for rel_err */
-                ulam__moments_add(&br->m[c], s->scratch[th].hist[3 * s->o.index + c]);
+                ulam__moments_add(&br->m[c], s->scratch[th].hist[3 * s->o.query.index + c]);
             if (flush_history(&s->scratch[th], br)) {
                 br->h.nomem = 1;
                 return;
@@ -485,7 +485,7 @@ static void merge_block(void *ctx, int k)
             s->sum[3 * e->patch + c] += e->v[c];
             s->sumsq[3 * e->patch + c] += e->v[c] * e->v[c];
         }
-        if (e->patch == s->o.index) {
+        if (e->patch == s->o.query.index) {
             double x = e->v[0] + e->v[1] + e->v[2];
             s->sq += x * x;
             s->maxsq = fmax(s->maxsq, x * x);
@@ -527,9 +527,9 @@ static void channel_mins(const ulam_rad_solver *s, double mins[3])
     for (int c = 0; c < 3; c++) bright = fmax(bright, fabs(s->m[c].mean));
     for (int c = 0; c < 3; c++) {
         mins[c] = 0.0;
-        if (s->o.mode != ULAM_ADJOINT || !(s->o.rel_err > 0)) continue;
-        if (s->m[c].mean != 0.0) mins[c] = channel_min_walks(s, c, s->m[c].mean, s->o.rel_err);
-        else if (s->per_step[c] > 0 && bright > 0) mins[c] = channel_min_walks(s, c, bright, s->o.rel_err);
+        if (s->o.mode != ULAM_ADJOINT || !(s->o.stop.rel_err > 0)) continue;
+        if (s->m[c].mean != 0.0) mins[c] = channel_min_walks(s, c, s->m[c].mean, s->o.stop.rel_err);
+        else if (s->per_step[c] > 0 && bright > 0) mins[c] = channel_min_walks(s, c, bright, s->o.stop.rel_err);
     }
 }
 
@@ -587,10 +587,10 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     channel_mins(s, mins);
     result(s, mins, &r);
     int k = ulam__stop_epoch(r.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
-    if (check && s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN) s->epoch = k;
-    if (check && s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, mins, s->o.rel_err))
+    if (check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN) s->epoch = k;
+    if (check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, mins, s->o.stop.rel_err))
         s->run.done = s->met = 1;
-    if (s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && all_zero(&r)) s->run.done = s->zero = 1; /* can never be met */
+    if (s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN && all_zero(&r)) s->run.done = s->zero = 1; /* can never be met */
     return s->run.status;
 }
 
@@ -599,7 +599,7 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
 void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds)
 {
     ulam__moments zero = {0};
-    s->o.index = p, s->o.rel_err = rel_err, s->o.seed = seed, s->o.max_seconds = max_seconds;
+    s->o.query.index = p, s->o.stop.rel_err = rel_err, s->o.exec.seed = seed, s->o.stop.max_seconds = max_seconds;
     s->m[0] = s->m[1] = s->m[2] = zero;
     s->sq = s->maxsq = 0.0;
     s->rays = s->cut = 0;
@@ -631,11 +631,11 @@ static void result(const ulam_rad_solver *s, const double mins[3], ulam_rad_resu
             r->radiosity[c] = s->m[c].mean;
             r->std_error[c] = s->m[c].n > 0 ? sqrt(ulam__moments_variance(&s->m[c]) / (double)s->m[c].n) : INFINITY;
         } else {
-            shot_component(s, s->o.index, c, &r->radiosity[c], &r->std_error[c]);
+            shot_component(s, s->o.query.index, c, &r->radiosity[c], &r->std_error[c]);
         }
     }
     r->max_share = s->sq > 0 ? fmin(1.0, s->maxsq / s->sq) : 0.0;
-    for (int c = 0; c < 3 && s->o.rel_err > 0; c++) {
+    for (int c = 0; c < 3 && s->o.stop.rel_err > 0; c++) {
         r->min_walks = fmax(r->min_walks, mins[c]); /* 0 in a channel where no minimum applies */
         if (s->m[c].mean != 0.0)
             r->variance_rel_error = fmax(r->variance_rel_error, ulam__moments_variance_rel_error(&s->m[c]));

@@ -110,7 +110,7 @@ static void exact(sys *s)
 static void row(const sys *s, int est, double E, int reps)
 {
     ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = est, o.index = s->index, o.max_walks = ORACLE, o.seed = 12345;
+    o.estimator = est, o.query.index = s->index, o.stop.max_walks = ORACLE, o.exec.seed = 12345;
     ulam_walk_result r;
     if (ulam_solve_walks(s->M, s->b, &o, &r, NULL)) {
         printf("%-20s %-10s refused\n", s->name, est ? "absorption" : "collision");
@@ -119,7 +119,7 @@ static void row(const sys *s, int est, double E, int reps)
     double oracle = r.variance / (E * s->x * E * s->x), walks = 0, width = 0, secs = 0;
     int met = 0, covered = 0;
     for (int k = 0; k < reps; k++) {
-        o.max_walks = CAP, o.rel_err = E, o.seed = 1 + (uint64_t)k; /* past CAP: stopped early, not met */
+        o.stop.max_walks = CAP, o.stop.rel_err = E, o.exec.seed = 1 + (uint64_t)k; /* past CAP: stopped early, not met */
         if (ulam_solve_walks(s->M, s->b, &o, &r, NULL)) continue;
         walks += (double)r.walks / reps, secs += r.seconds / reps, met += r.rel_err_met;
         width += (r.ci95[1] - r.ci95[0]) / 2 / (E * fabs(s->x)) / reps;

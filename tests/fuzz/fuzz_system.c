@@ -21,7 +21,7 @@ static void walk(const ulam_csr *M, const double *b, const ulam_system *lazy, in
     if (!b && !ones) return;
     for (int64_t i = 0; !b && i < n; i++) ones[i] = 1.0;
     ulam_walk_opts o = ulam_walk_defaults();
-    o.max_walks = 200, o.max_steps = 200, o.threads = 1, o.system = lazy;
+    o.stop.max_walks = 200, o.stop.max_steps = 200, o.exec.threads = 1, o.policy.system = lazy;
     ulam_walk_result r;
     for (int e = 0; e < 3; e++) {
         o.estimator = e;
@@ -46,7 +46,7 @@ static void one(void *p, size_t size)
         ulam_walk_opts o = ulam_walk_defaults();
         if (!ulam_certificate_guard(ulam_system_certificate(s), 0.0, NULL, &g) && M && M->nrows == M->ncols &&
             M->nrows > 0 && M->nrows <= 100000) { /* a query on the certificate: lazily read */
-            o.max_walks = 200, o.max_steps = 200, o.threads = 2, o.guard = &g, o.system = s;
+            o.stop.max_walks = 200, o.stop.max_steps = 200, o.exec.threads = 2, o.policy.guard = &g, o.policy.system = s;
             ulam_walk_result r;
             ulam_solve_walks(M, b, &o, &r, NULL);
         }
