@@ -24,7 +24,8 @@
  * The API by rank, as CSparse's header ranks its own (each section banner below names the
  * ranks it holds; sections follow the data flow, file -> matrix -> guards -> walks -> output):
  *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
- *     ulam_guard_check, ulam_walk_defaults, ulam_solver_alloc, ulam_solver_iterate,
+ *     ulam_guard_check, ulam_walk_defaults (its parts: ulam_kernel_defaults, ulam_stop_defaults,
+ *     ulam_exec_defaults, ulam_query_defaults, ulam_policy_defaults), ulam_solver_alloc, ulam_solver_iterate,
  *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
  *     ulam_solver_free, ulam_solve (the method table's choice: what `ulam solve` runs), ulam_solve_walks
  *     (the walks pinned), ulam_auto (the choice with its verdicts),

@@ -210,7 +210,7 @@ static int op_radiosity(void)
     if (!st) st = ulam_tracer_alloc(s, &t, NULL);
     if (!st) st = ulam_ff_estimate(t, 50, 1, 2, &F, NULL);
     for (int mode = 0; mode < 2 && !st; mode++) {
-        ulam_walk_opts o = ulam_walk_defaults();
+        ulam_rad_opts o = ulam_rad_defaults();
         o.mode = mode, o.stop.max_walks = 600, o.exec.threads = 2;
         o.estimator = mode ? ULAM_RAD_COLLISION : ULAM_RAD_NEXT_EVENT; /* shooting has no next event */
         if (!(st = ulam_rad_solver_alloc(t, &o, &sv, NULL)))
@@ -218,7 +218,7 @@ static int op_radiosity(void)
         sv = ulam_rad_solver_free(sv);
     }
     if (!st) { /* a point query on the continuous surfaces */
-        ulam_walk_opts o = ulam_walk_defaults();
+        ulam_rad_opts o = ulam_rad_defaults();
         o.stop.max_walks = 600, o.exec.threads = 2;
         ulam_rad_point pt;
         st = ulam_rad_point_query(t, &o, (const double[3]){0.5, 0, 0.5}, NULL, &pt, NULL);

@@ -135,6 +135,15 @@ typedef struct {
     ulam_walk_opts o;
 } args;
 
+/* The radiosity options of the walk options the command line gave (mode, estimator, patch,
+ * stopping rules, seed, threads, processes). */
+static ulam_rad_opts rad_opts(const ulam_walk_opts *o)
+{
+    ulam_rad_opts r = ulam_rad_defaults();
+    r.mode = o->mode, r.estimator = o->estimator, r.index = o->query.index, r.stop = o->stop, r.exec = o->exec;
+    return r;
+}
+
 /* What the walks found. */
 typedef struct {
     double B[3], se[3], se_walk[3]; /* se: with --matrix-walk, the walk's and F's noise combined */
@@ -395,7 +404,8 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
 {
     ulam_rad_solver *sv = NULL;
     ulam_error err;
-    int status = ulam_rad_solver_alloc(t, &a->o, &sv, &err);
+    ulam_rad_opts ro = rad_opts(&a->o);
+    int status = ulam_rad_solver_alloc(t, &ro, &sv, &err);
     if (status) return cli_report(a->scene, &err);
     cli_catch_sigint();
     cli_progress pg;
@@ -941,7 +951,7 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
     double t0 = ulam_now();
     cli_catch_sigint();
     for (int k = 0; k < a->nat && !interrupted; k++) {
-        ulam_walk_opts o = a->o;
+        ulam_rad_opts o = rad_opts(&a->o);
         o.exec.seed = a->o.exec.seed + (uint64_t)k; /* each point its own walks */
         const double *x = a->at + 6 * k;
         if (ulam_rad_point_query(t, &o, x, isnan(x[3]) ? NULL : x + 3, &pts[k], &err)) {
@@ -953,7 +963,8 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         interrupted = pts[k].run.interrupted;
     }
     if (ngrid && !interrupted) {
-        if (ulam_rad_grid_solve(t, &a->o, &a->g, pts + a->nat, &err)) {
+        ulam_rad_opts ro = rad_opts(&a->o);
+        if (ulam_rad_grid_solve(t, &ro, &a->g, pts + a->nat, &err)) {
             rc = cli_report(a->scene, &err);
             goto done;
         }
@@ -1043,7 +1054,8 @@ static int view_walks(const args *a, const ulam_tracer *t, const ulam_scene *s, 
         return cli_report(a->scene, &err);
     }
     cli_catch_sigint();
-    int status = ulam_view_gather(t, &cam, a->width, a->height, a->coverage, &a->o, w->all, w->all_se, vi, &err);
+    ulam_rad_opts ro = rad_opts(&a->o);
+    int status = ulam_view_gather(t, &cam, a->width, a->height, a->coverage, &ro, w->all, w->all_se, vi, &err);
     cli_release_sigint();
     if (status) return cli_report(a->scene, &err);
     w->walks = vi->walks, w->steps = vi->rays, w->seconds = vi->seconds, w->cut = vi->cut;
@@ -1256,13 +1268,13 @@ static int every_mesh_error(const args *a, const ulam_tracer *t, const ulam_scen
 {
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the mesh errors"};
     if (!(*out = malloc((size_t)s->npatches * 3 * sizeof **out))) return cli_report(a->scene, &err);
-    ulam_walk_opts o = a->o;
+    ulam_rad_opts o = rad_opts(&a->o);
     o.mode = ULAM_ADJOINT, o.estimator = ULAM_RAD_NEXT_EVENT, o.stop.rel_err = 0, o.stop.max_seconds = 0;
     o.stop.max_walks = a->mesh_walks;
     cli_catch_sigint();
     for (int64_t p = 0; p < s->npatches; p++) {
         ulam_rad_mesh m;
-        o.query.index = p, o.exec.seed = a->o.exec.seed + (uint64_t)p;
+        o.index = p, o.exec.seed = a->o.exec.seed + (uint64_t)p;
         if (ulam_rad_mesh_error(t, &o, pv->B + 3 * p, &m, &err)) {
             cli_release_sigint();
             return cli_report(a->scene, &err);
@@ -1350,8 +1362,8 @@ int cli_radiosity(int argc, char **argv)
                            : ray_walks(&a, t, s->npatches, &w);
         if (rc) goto done;
         if (a.patch && a.o.mode == ULAM_ADJOINT && !w.interrupted && !a.no_mesh) { /* the mesh's error beside */
-            ulam_walk_opts mo = a.o; /* each point to twice the patch's relative error or 1/4 its walks (>= 256) */
-            mo.query.index = r.patch, mo.estimator = ULAM_RAD_NEXT_EVENT, mo.stop.rel_err = 2 * a.o.stop.rel_err;
+            ulam_rad_opts mo = rad_opts(&a.o); /* each point to twice the patch's relative error or 1/4 its walks (>= 256) */
+            mo.index = r.patch, mo.estimator = ULAM_RAD_NEXT_EVENT, mo.stop.rel_err = 2 * a.o.stop.rel_err;
             if (a.o.stop.max_walks > 0) mo.stop.max_walks = a.o.stop.max_walks / 4 > 256 ? a.o.stop.max_walks / 4 : 256;
             cli_catch_sigint();
             int st = ulam_rad_mesh_error(t, &mo, w.B, &r.mesh, &err);

@@ -28,7 +28,7 @@ static int check_grid(const ulam_rad_grid *g, ulam_error *err)
 }
 
 /* Every point of grid g (out: nu * nv, row j = 0 first, i fastest). */
-int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_walk_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
+int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
                         ulam_error *err)
 {
     ulam__clear(err);
@@ -39,7 +39,7 @@ int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_walk_opts *opts, const 
     for (int j = 0; j < g->nv; j++)
         for (int i = 0; i < g->nu; i++) {
             int64_t k = (int64_t)j * g->nu + i;
-            ulam_walk_opts o = *opts;
+            ulam_rad_opts o = *opts;
             ulam_rng r;
             ulam_rng_seed(&r, opts->exec.seed, (uint64_t)k);
             o.exec.seed = ulam__rng_next(&r);

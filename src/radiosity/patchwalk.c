@@ -124,10 +124,6 @@ static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, int point, 
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "point walks gather (mode adjoint)");
     if (!point && (o->query.index < 0 || o->query.index >= sc->npatches))
         return ulam__fail(err, ULAM_EINVAL, 0, o->query.index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
-    if (o->kernel.continue_q != 0 || o->kernel.roulette != 0 || o->kernel.split != 0 || o->kernel.kernel_alpha != 1.0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette, split or kernel exponent other "
-                                                   "than 1 (patch walks continue with the patch's largest "
-                                                   "reflectance and follow the form factors)");
     return ulam__budgets_check(o, err);
 }
 
@@ -190,13 +186,15 @@ static int alloc_work(ulam_rad_solver *s)
 }
 
 /* Prepare walks from patch opts->index, or (point) from a point. */
-static int solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, int point, ulam_rad_solver **out,
+static int solver_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, int point, ulam_rad_solver **out,
                         ulam_error *err)
 {
     ulam__clear(err);
     if (!t || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer and an output");
     *out = NULL;
-    ulam_walk_opts o = opts ? *opts : ulam_walk_defaults();
+    ulam_rad_opts r = opts ? *opts : ulam_rad_defaults();
+    ulam_walk_opts o = ulam_walk_defaults(); /* the round driver's view: the kernel's defaults are never read */
+    o.mode = r.mode, o.estimator = r.estimator, o.query.index = r.index, o.stop = r.stop, o.exec = r.exec;
     int status = check_opts(ulam__tracer_scene(t), &o, point, err);
     if (status) return status;
     ulam_rad_solver *s = calloc(1, sizeof *s);
@@ -220,15 +218,22 @@ static int solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, int po
     return ULAM_OK;
 }
 
+/* The radiosity defaults: gather at patch 0 by next-event estimation. */
+ulam_rad_opts ulam_rad_defaults(void)
+{
+    return (ulam_rad_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_RAD_NEXT_EVENT, .stop = ulam_stop_defaults(),
+                           .exec = ulam_exec_defaults()};
+}
+
 /* Prepare patch walks. */
-int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
+int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, ulam_rad_solver **out,
                           ulam_error *err)
 {
     return solver_alloc(t, opts, 0, out, err);
 }
 
 /* Prepare walks from point x (normal n, or NULL: the patch's it lies on). */
-int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, const double x[3], const double n[3],
                          ulam_rad_solver **out, ulam_error *err)
 {
     ulam__clear(err);
@@ -282,7 +287,7 @@ int ulam_rad_point_result(const ulam_rad_solver *s, ulam_rad_point *r)
 }
 
 /* Run a point solver to the end (ulam_rad_point_alloc, iterate, result, free). */
-int ulam_rad_point_query(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+int ulam_rad_point_query(const ulam_tracer *t, const ulam_rad_opts *opts, const double x[3], const double n[3],
                          ulam_rad_point *r, ulam_error *err)
 {
     ulam_rad_solver *s = NULL;

@@ -8,7 +8,7 @@
 
 /* Check a view gather's arguments. */
 static int check_view(const ulam_tracer *t, const ulam_camera *cam, int w, int h, double coverage,
-                      const ulam_walk_opts *o, const double *B, const double *se, ulam_error *err)
+                      const ulam_rad_opts *o, const double *B, const double *se, ulam_error *err)
 {
     if (!t || !cam || !o || !B || !se) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, camera, options and outputs");
     if (w < 1 || h < 1 || !(cam->focal > 0) || !(cam->film > 0))
@@ -21,7 +21,7 @@ static int check_view(const ulam_tracer *t, const ulam_camera *cam, int w, int h
 
 /* Gather the patches a camera sees. */
 int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, int height, double coverage,
-                     const ulam_walk_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err)
+                     const ulam_rad_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err)
 {
     ulam__clear(err);
     int status = check_view(t, cam, width, height, coverage, opts, B, se, err);
@@ -43,8 +43,8 @@ int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, in
         most = pix[p] > most ? pix[p] : most;
         if (first < 0) first = p;
     }
-    ulam_walk_opts o = *opts;
-    o.query.index = first >= 0 ? first : 0;
+    ulam_rad_opts o = *opts;
+    o.index = first >= 0 ? first : 0;
     ulam_rad_solver *sv = NULL;
     if (first >= 0 && (status = ulam_rad_solver_alloc(t, &o, &sv, err))) {
         free(pix);
