@@ -385,6 +385,73 @@ static void test_mesh_converges(void **state)
     ulam_scene_free(fine), ulam_scene_free(s);
 }
 
+/* ulam_rad_adapt with points to rel_err each (walks a cap), area importance unless Y. */
+static ulam_rad_adapt_info adapt(const ulam_tracer *t, const double *Y, double target, double rel_err, int64_t walks,
+                                 int64_t cap, uint64_t seed, ulam_scene **out)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.rel_err = rel_err, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    ulam_rad_adapt_info in;
+    ulam_error err;
+    int st = ulam_rad_adapt(t, &o, Y, target, cap, out, &in, &err);
+    if (st) print_error("%s: %s\n", ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    print_message("adapt: %lld -> %lld patches, %lld splits in %lld rounds, mesh error %.4f -> %.4f (target %.3g), "
+                  "%lld points, %lld rays, %.2f s\n", (long long)in.patches_in, (long long)in.patches,
+                  (long long)in.splits, (long long)in.rounds, in.error0, in.error, target, (long long)in.points,
+                  (long long)in.rays, in.seconds);
+    return in;
+}
+
+/* The furnace: the radiosity is the same at every point, so any mesh is exact and adaptive
+ * subdivision splits nothing (its measured mesh error, the points' noise removed, is below the
+ * target from the start). */
+static void test_adapt_furnace(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL, *d = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/furnace_half.obj", &s);
+    ulam_rad_adapt_info in = adapt(t, NULL, 0.02, 0.01, 20000, 1000, 5, &d);
+    assert_true(in.met && !in.capped && !in.interrupted);
+    assert_int_equal(in.splits, 0);
+    assert_int_equal(d->npatches, s->npatches);
+    assert_true(in.error0 <= 0.02 && in.points == 30);
+    for (int64_t p = 0; p < s->npatches; p++) assert_close(d->area[p], s->area[p], 1e-12);
+    ulam_tracer_free(t);
+    ulam_scene_free(d), ulam_scene_free(s);
+}
+
+/* The Cornell box, whose floor and walls need a finer mesh near the blocks and the lamp: the
+ * adaptive mesh reaches the target with fewer patches than the coarsest uniform --subdivide
+ * that reaches it (each uniform mesh's error measured the same way, by ulam_rad_adapt with
+ * nothing to split). */
+static void test_adapt_cornell(void **state)
+{
+    (void)state;
+    const double target = 0.08;
+    ulam_scene *s = NULL, *d = NULL;
+    ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
+    ulam_rad_adapt_info in = adapt(t, NULL, target, 0, 1024, 100000, 7, &d);
+    assert_true(in.met && in.error <= target && in.error0 > target && in.splits > 0);
+    ulam_scene_free(d);
+    int64_t uniform = 0;
+    for (double L = 280; L > 30 && !uniform; L /= 2) {
+        ulam_scene *u = NULL;
+        assert_int_equal(ulam_scene_subdivide(s, L, &u), ULAM_OK);
+        ulam_tracer *tu = must_tracer_of(u);
+        ulam_rad_adapt_info iu = adapt(tu, NULL, 1e300, 0, 1024, u->npatches, 8, &d);
+        print_message("uniform --subdivide %g: %lld patches, mesh error %.4f\n", L, (long long)u->npatches, iu.error);
+        if (iu.error <= target) uniform = u->npatches;
+        ulam_tracer_free(tu);
+        ulam_scene_free(d), ulam_scene_free(u);
+    }
+    print_message("Cornell box to mesh error %.3g: adaptive %lld patches, uniform %lld\n", target,
+                  (long long)in.patches, (long long)uniform);
+    assert_true(uniform > 0 && in.patches < uniform);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
 /* The non-diffuse MTL statements are noted once a keyword a material, with file and line; the
  * matte defaults (Ka, Ni, Ks 0, Ns 0, d 1, illum 2) are not. */
 static void test_mtl_notes(void **state)
@@ -487,7 +554,8 @@ int main(void)
         cmocka_unit_test(test_point_refused),  cmocka_unit_test(test_grid),
         cmocka_unit_test(test_mesh_error_flags), cmocka_unit_test(test_mesh_converges),
         cmocka_unit_test(test_mtl_notes),        cmocka_unit_test(test_render_hdr),
-        cmocka_unit_test(test_shoot_rel_err),
+        cmocka_unit_test(test_shoot_rel_err),    cmocka_unit_test(test_adapt_furnace),
+        cmocka_unit_test(test_adapt_cornell),
     };
     return test_run(tests);
 }
