@@ -452,6 +452,60 @@ static void test_adapt_cornell(void **state)
     ulam_scene_free(s);
 }
 
+/* The view's importance in the furnace: every walk from the picture counts 1 at the patch seen
+ * and 1 at each landing, on with probability mean rho = 0.6, so sum_p Y_p = 1 / (1 - 0.6) = 2.5
+ * exactly (the landings are geometric: variance 0.6 / 0.4^2 a walk), and the picture's share S
+ * sums to 1. */
+static void test_importance_furnace(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/furnace_half.obj", &s);
+    ulam_camera cam = {{0.5, 0.5, 0.05}, {0, 0, 1}, {0, 1, 0}, 35, 25};
+    double Y[6], sum = 0.0;
+    const int64_t walks = 40000;
+    assert_int_equal(ulam_rad_importance(t, &cam, 32, 32, walks, 3, Y, NULL), ULAM_OK);
+    for (int p = 0; p < 6; p++) sum += Y[p];
+    double se = sqrt(0.6 / 0.16 / (double)walks);
+    print_message("furnace importance: sum %.5f +- %.2g, exact 2.5\n", sum, se);
+    assert_close(sum, 2.5, 4 * se);
+    assert_int_equal(ulam_rad_importance(t, &cam, 32, 32, 0, 3, Y, NULL), ULAM_OK);
+    sum = 0.0;
+    for (int p = 0; p < 6; p++) sum += Y[p];
+    assert_close(sum, 1.0, 1e-12);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* Importance drives the refinement: a camera looking down at the Cornell floor puts a larger
+ * share of the patches made on the floor than the area's importance does, at the same target,
+ * and makes fewer in all (the walls it does not see matter only through their light). */
+static void test_adapt_view(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL, *da = NULL, *dv = NULL;
+    ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
+    ulam_camera cam = {{278, 540, 280}, {0, -1, 0}, {0, 0, 1}, 35, 25};
+    double *Y = malloc((size_t)s->npatches * sizeof *Y);
+    assert_non_null(Y);
+    assert_int_equal(ulam_rad_importance(t, &cam, 64, 64, 20000, 4, Y, NULL), ULAM_OK);
+    ulam_rad_adapt_info ia = adapt(t, NULL, 0.06, 0, 1024, 100000, 9, &da);
+    ulam_rad_adapt_info iv = adapt(t, Y, 0.06, 0, 1024, 100000, 9, &dv);
+    assert_true(ia.met && iv.met);
+    int64_t floor_face = -1, fa = 0, fv = 0;
+    assert_int_equal(ulam_scene_find(s, "floor", &floor_face), ULAM_OK);
+    floor_face = s->face[floor_face];
+    for (int64_t p = 0; p < da->npatches; p++) fa += da->face[p] == floor_face;
+    for (int64_t p = 0; p < dv->npatches; p++) fv += dv->face[p] == floor_face;
+    print_message("floor patches: area importance %lld of %lld, the view's %lld of %lld\n", (long long)fa,
+                  (long long)da->npatches, (long long)fv, (long long)dv->npatches);
+    assert_true((double)fv / (double)dv->npatches > (double)fa / (double)da->npatches);
+    assert_true(dv->npatches < da->npatches); /* the unseen walls need less */
+    free(Y);
+    ulam_tracer_free(t);
+    ulam_scene_free(da), ulam_scene_free(dv), ulam_scene_free(s);
+}
+
 /* The non-diffuse MTL statements are noted once a keyword a material, with file and line; the
  * matte defaults (Ka, Ni, Ks 0, Ns 0, d 1, illum 2) are not. */
 static void test_mtl_notes(void **state)
@@ -555,7 +609,8 @@ int main(void)
         cmocka_unit_test(test_mesh_error_flags), cmocka_unit_test(test_mesh_converges),
         cmocka_unit_test(test_mtl_notes),        cmocka_unit_test(test_render_hdr),
         cmocka_unit_test(test_shoot_rel_err),    cmocka_unit_test(test_adapt_furnace),
-        cmocka_unit_test(test_adapt_cornell),
+        cmocka_unit_test(test_adapt_cornell),    cmocka_unit_test(test_importance_furnace),
+        cmocka_unit_test(test_adapt_view),
     };
     return test_run(tests);
 }
