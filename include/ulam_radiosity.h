@@ -377,6 +377,10 @@ int ulam_render_hdr(const ulam_tracer *t, const double *B, const ulam_camera *ca
  * little-endian), atomically. */
 int ulam_pfm_write(const char *path, int width, int height, const float *rgb);
 
+/* Write linear float RGB (3 a pixel, rows top first) as a Radiance .hdr file (RGBE, flat
+ * scanlines: 8 bits of mantissa a channel under a shared exponent), atomically. */
+int ulam_hdr_write(const char *path, int width, int height, const float *rgb);
+
 /* How many pixel centres of a width x height picture see each patch's front (pixels:
  * npatches), with the rays of ulam_render. */
 int ulam_view_pixels(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t *pixels);

@@ -1251,7 +1251,10 @@ def check_radiosity(ulam):
         rc, _, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "1000",
                                 "--image", d + "/no/such/dir/x.png"])
         assert rc == code("EIO") and "x.png" in err, err
-        assert sorted(os.listdir(d)) == ["box.pfm", "box.png"], os.listdir(d)  # the linear picture beside
+        assert sorted(os.listdir(d)) == ["box.hdr", "box.pfm", "box.png"], os.listdir(d)  # the linear picture beside
+        rgbe = open(d + "/box.hdr", "rb").read()
+        assert rgbe.startswith(b"#?RADIANCE\n") and b"\n\n-Y 48 +X 64\n" in rgbe, rgbe[:80]
+        assert len(rgbe) == rgbe.index(b"-Y 48 +X 64\n") + len(b"-Y 48 +X 64\n") + 64 * 48 * 4
         pfm = open(d + "/box.pfm", "rb").read()
         assert pfm.startswith(b"PF\n64 48\n-1.0\n") and len(pfm) == len(b"PF\n64 48\n-1.0\n") + 64 * 48 * 12
 

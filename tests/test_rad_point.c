@@ -8,6 +8,7 @@
 #include "ulam_radiosity.h"
 
 #include <string.h>
+#include <unistd.h>
 
 /* Howell: element whose normal passes through a corner of a parallel a x b rectangle at c. */
 static double howell_parallel(double a, double b, double c)
@@ -573,6 +574,45 @@ static void test_render_hdr(void **state)
     ulam_scene_free(s), ulam_scene_free(s0);
 }
 
+/* The Radiance .hdr beside the PFM: its header, and every pixel decoded from RGBE within the
+ * format's 8-bit mantissa (1/128 of the pixel's largest channel) of the linear value; black
+ * stays black. */
+static void test_hdr_write(void **state)
+{
+    (void)state;
+    enum { W = 5, H = 3 };
+    float rgb[3 * W * H];
+    for (int k = 0; k < 3 * W * H; k++) rgb[k] = (float)(k % 7 == 0 ? 0.0 : pow(10.0, (k % 11) - 5.0) * (1 + k % 3));
+    char path[] = "/tmp/ulam_hdr_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    assert_int_equal(ulam_hdr_write(path, W, H, rgb), ULAM_OK);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    char line[128];
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_string_equal(line, "#?RADIANCE\n");
+    int w = 0, h = 0, blank = 0;
+    while (fgets(line, sizeof line, f) && !(blank && sscanf(line, "-Y %d +X %d", &h, &w) == 2)) blank = line[0] == '\n';
+    assert_int_equal(w, W);
+    assert_int_equal(h, H);
+    for (int i = 0; i < W * H; i++) {
+        unsigned char b[4];
+        assert_int_equal(fread(b, 1, 4, f), 4);
+        float *c = rgb + 3 * i;
+        double big = fmax(c[0], fmax(c[1], c[2]));
+        for (int k = 0; k < 3; k++) {
+            double v = b[3] ? ldexp(b[k] + 0.5, b[3] - 136) : 0.0;
+            assert_close(v, c[k], big / 128 + 1e-300);
+        }
+    }
+    assert_int_equal(fgetc(f), EOF);
+    fclose(f);
+    remove(path);
+    assert_int_equal(ulam_hdr_write(path, 0, H, rgb), ULAM_EINVAL);
+}
+
 /* Shooting's --rel-err takes the whole rule now (its variance's own error from the fourth moment
  * of the patch's per-particle tallies, at least 1000 particles), not the standard error alone:
  * 50 seeds at rel_err 0.03 on the edge lamp's wall (exact 0.5 F(C-14)), every run met with its
@@ -610,7 +650,7 @@ int main(void)
         cmocka_unit_test(test_mtl_notes),        cmocka_unit_test(test_render_hdr),
         cmocka_unit_test(test_shoot_rel_err),    cmocka_unit_test(test_adapt_furnace),
         cmocka_unit_test(test_adapt_cornell),    cmocka_unit_test(test_importance_furnace),
-        cmocka_unit_test(test_adapt_view),
+        cmocka_unit_test(test_adapt_view),       cmocka_unit_test(test_hdr_write),
     };
     return test_run(tests);
 }

@@ -71,7 +71,7 @@ static const char *const usage =
 /* The usage's third part. */
 static const char *const usage_mesh =
     "  --samples N       jittered rays a pixel (default 4); the linear picture is written as PFM\n"
-    "                    beside the PNG (out.png -> out.pfm)\n"
+    "                    and Radiance RGBE beside the PNG (out.png -> out.pfm, out.hdr)\n"
     "  --flat            one colour a patch (default: radiosity interpolated from the patch corners\n"
     "                    across each face's patches, creases between faces kept)\n"
     "  --all             print every patch too (a table; with --json a patches array)\n"
@@ -129,6 +129,7 @@ typedef struct {
     int no_mesh;  /* --no-mesh-error */
     int samples, flat; /* --samples N jittered rays a pixel, --flat: one colour a patch */
     char hdr[4096];    /* the PFM beside --image */
+    char rgbe[4096];   /* the Radiance .hdr beside --image */
     int64_t mesh_walks; /* --mesh-error N: every patch's mesh error in --out / --all, N walks a point */
     double mesh_target;  /* --mesh-target E: adaptive subdivision to mesh error E (0: none) */
     int64_t max_patches; /* --max-patches N (0: not given) */
@@ -1140,6 +1141,14 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
             ulam_error err = {.status = status, .msg = "a writable PFM file"};
             return cli_report(a->hdr, &err);
         }
+        cli_hold_signals(1);
+        status = ulam_hdr_write(a->rgbe, a->width, a->height, hdr);
+        cli_hold_signals(0);
+        if (status) {
+            free(rgb), free(hdr);
+            ulam_error err = {.status = status, .msg = "a writable Radiance .hdr file"};
+            return cli_report(a->rgbe, &err);
+        }
     }
     free(rgb), free(hdr);
     if (status) {
@@ -1401,9 +1410,11 @@ int cli_radiosity(int argc, char **argv)
         int png = len > 4 && !strcmp(a.image + len - 4, ".png");
         if (len + 5 > sizeof a.hdr) return cli_usage_error("radiosity", "--image: a path shorter than 4 KiB");
         snprintf(a.hdr, sizeof a.hdr, "%.*s.pfm", (int)(png ? len - 4 : len), a.image);
+        snprintf(a.rgbe, sizeof a.rgbe, "%.*s.hdr", (int)(png ? len - 4 : len), a.image);
     }
     if (a.image && (rc = cli_check_output(a.image))) return rc;
     if (a.image && !a.grid && (rc = cli_check_output(a.hdr))) return rc;
+    if (a.image && !a.grid && (rc = cli_check_output(a.rgbe))) return rc;
     if (a.out && (rc = cli_check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
     if (a.mesh_target > 0 && (rc = adapt_scene(&a, &s, &r.adapt, &r.view_importance))) goto done;
