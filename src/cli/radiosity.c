@@ -636,6 +636,7 @@ typedef struct {
     ulam_rad_mesh mesh;
     int adapted, view_importance; /* --mesh-target: adapt holds what it did (by the view's importance) */
     ulam_rad_adapt_info adapt;
+    int64_t adapt_cap; /* the most patches it could make (--max-patches, or what --max-mem holds) */
 } report;
 
 /* (walk - direct) / the standard error of the difference at the patch, channel c: matrix walks
@@ -678,10 +679,14 @@ static void print_mesh(const report *r, const walked *w)
 static void print_adapt(const args *a, const report *r)
 {
     const ulam_rad_adapt_info *d = &r->adapt;
+    char why[96];
+    int64_t asked = a->max_patches ? a->max_patches : 100000;
+    if (asked > r->adapt_cap) snprintf(why, sizeof why, "NOT met (--max-mem holds %lld patches)", (long long)r->adapt_cap);
+    else snprintf(why, sizeof why, "NOT met (--max-patches %lld)", (long long)r->adapt_cap);
     printf("mesh         adaptive (%s importance): %lld -> %lld patches, %lld split in %lld rounds; mesh error "
            "%.3g -> %.3g, target %g %s; %lld point queries, %lld rays, %.3f s\n", r->view_importance ? "the view's" : "area",
            (long long)d->patches_in, (long long)d->patches, (long long)d->splits, (long long)d->rounds, d->error0,
-           d->error, a->mesh_target, d->met ? "met" : d->interrupted ? "NOT met (interrupted)" : "NOT met (--max-patches or --max-mem)",
+           d->error, a->mesh_target, d->met ? "met" : d->interrupted ? "NOT met (interrupted)" : why,
            (long long)d->points, (long long)d->rays, d->seconds);
 }
 
@@ -1323,7 +1328,7 @@ static int64_t patch_cap(const args *a, const ulam_scene *s)
 
 /* --mesh-target: the scene adaptively subdivided (importance from the camera with --image, else
  * the area), *s replaced; 0 or an exit code. */
-static int adapt_scene(const args *a, ulam_scene **s, ulam_rad_adapt_info *info, int *view_importance)
+static int adapt_scene(const args *a, ulam_scene **s, ulam_rad_adapt_info *info, int *view_importance, int64_t *cap_out)
 {
     ulam_error err;
     ulam_tracer *t = NULL;
@@ -1331,6 +1336,7 @@ static int adapt_scene(const args *a, ulam_scene **s, ulam_rad_adapt_info *info,
     double *Y = NULL;
     if (ulam_tracer_alloc(*s, &t, &err)) return cli_report(a->scene, &err);
     int64_t cap = patch_cap(a, *s), walks = 64 * (*s)->npatches > 65536 ? 64 * (*s)->npatches : 65536;
+    *cap_out = cap;
     int rc = 0;
     if (a->image) {
         ulam_camera cam = camera_of(a, *s);
@@ -1417,7 +1423,7 @@ int cli_radiosity(int argc, char **argv)
     if (a.image && !a.grid && (rc = cli_check_output(a.rgbe))) return rc;
     if (a.out && (rc = cli_check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
-    if (a.mesh_target > 0 && (rc = adapt_scene(&a, &s, &r.adapt, &r.view_importance))) goto done;
+    if (a.mesh_target > 0 && (rc = adapt_scene(&a, &s, &r.adapt, &r.view_importance, &r.adapt_cap))) goto done;
     r.adapted = a.mesh_target > 0;
     r.s = s;
     if (a.list) {
