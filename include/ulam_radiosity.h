@@ -427,7 +427,9 @@ typedef struct ulam_rad_adapt_info {
     int64_t patches_in, patches; /* the tracer's scene's patches, and the mesh made */
     int64_t splits, rounds;      /* patches split, rounds of splitting */
     int64_t points, walks, rays; /* point queries made, their walks and rays */
-    double error0, error;        /* the mesh error (below) of the tracer's mesh and of the mesh made */
+    double error0, error;        /* the mesh error (below) of the tracer's mesh and of the mesh made
+                                    (interrupted: of the last mesh measured whole, before the
+                                    round that was cut) */
     double target, seconds;
     int met;         /* error <= target */
     int capped;      /* stopped by max_patches (or no patch left large enough to split) */
