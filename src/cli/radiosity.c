@@ -428,20 +428,8 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     return cli_exit_code(status);
 }
 
-/* The stopping rule of --matrix-walk --rel-err E at a patch, in one place: the answer's error
- * is the walks' and F's combined, so the walks stop at E' = sqrt(E^2 - (ff / |B|)^2) of the
- * estimate, ff being F's standard error at the patch and B the direct solution there; 0 when
- * F's error alone reaches E (more walks cannot meet it: more --ff-rays can); E when F's error
- * is unknown (the error bar is then labelled conditional on F). */
-static double matrix_walk_rel_err(double E, double ff, double B, int ff_known)
-{
-    if (!(E > 0) || !ff_known) return E;
-    double f = B != 0 ? ff / fabs(B) : (ff > 0 ? INFINITY : 0.0);
-    return f < E ? sqrt(E * E - f * f) : 0.0;
-}
-
 /* Walks on the assembled M, one channel at a time (at a patch with --rel-err: to the combined
- * rule of matrix_walk_rel_err, given F's error ff and the direct solution Bd there); 0 or an
+ * rule of ulam_rad_walk_target, given F's error ff and the direct solution Bd there); 0 or an
  * exit code. */
 static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, const double *ff, const double *Bd,
                         walked *w)
@@ -460,7 +448,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, c
         ulam_solver *sv = NULL;
         ulam_walk_opts o = a->o;
         if (a->o.rel_err > 0 && a->o.mode == ULAM_ADJOINT) {
-            o.rel_err = matrix_walk_rel_err(a->o.rel_err, ff ? ff[c] : 0, Bd ? Bd[c] : 0, ff && Bd);
+            o.rel_err = ulam_rad_walk_target(a->o.rel_err, ff ? ff[c] : 0, Bd ? Bd[c] : 0, ff && Bd);
             if (!(o.rel_err > 0)) { /* F's noise alone is past the target: walk to it, say it is not met */
                 w->ff_limited[c] = 1;
                 o.rel_err = a->o.rel_err;
