@@ -223,10 +223,10 @@ typedef struct ulam_rad_result {
     int threads, interrupted;
     int zero; /* rel_err could never be met: every channel exactly 0 with zero variance after
                * the first round (no walk scored); the run stopped there */
-    double min_walks;          /* gathering with rel_err: the walks the rule's range term needs at
-                                  this estimate (largest over channels; 0 when unbounded) */
-    double variance_rel_error; /* gathering with rel_err: the largest relative standard error of
-                                  a channel's variance (fourth moment); the rule wants <= 0.25 */
+    double min_walks;          /* with rel_err: the walks the rule (src/stop.c) needs at this
+                                  estimate (largest over channels; gathering and shooting) */
+    double variance_rel_error; /* with rel_err: the largest relative standard error of a
+                                  channel's variance (fourth moment; reported, not a stop rule) */
     int rel_err_met;           /* the run stopped because the rel_err rule holds */
 } ulam_rad_result;
 

@@ -144,8 +144,8 @@ typedef struct {
     double seconds;
     int threads, interrupted;
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
-    int rel_err_met;  /* ray gathering: the run stopped because the --rel-err rule holds */
-    double min_walks; /* ray gathering: the walks the rule's range term needs (0: unbounded) */
+    int rel_err_met;  /* ray walks: the run stopped because the --rel-err rule holds */
+    double min_walks; /* ray walks: the walks the rule needs at this estimate */
     double *all, *all_se; /* shooting: 3 per patch each */
 } walked;
 
@@ -384,6 +384,12 @@ static void rel_err_warning(const args *a, const ulam_rad_result *r)
 {
     double limit = a->o.max_walks > 0 && a->o.max_walks < ULAM_REL_ERR_CAP ? (double)a->o.max_walks : 1e8;
     if (!(a->o.rel_err > 0) || !(r->min_walks > limit)) return;
+    if (a->o.mode == ULAM_FORWARD || a->o.estimator < ULAM_RAD_COLLISION) { /* next-event or shooting */
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g: the rule needs about %.3g walks at this estimate before it "
+                        "may stop (%s): one walk's certified score range is wide against the estimate\n",
+                a->scene, a->o.rel_err, r->min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
+        return;
+    }
     fprintf(stderr, "ulam: %s: warning: --rel-err %g: one walk can score up to a bright emitter's radiosity at every "
                     "bounce, so the rule needs about %.3g walks at this estimate before it may stop (%s): "
                     "--estimator next-event samples the emitters directly and has no such tail\n",
@@ -667,7 +673,7 @@ static void print_text(const args *a, const report *r)
             else if (a->matrix_walk) printf(" (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
             printf("%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
         }
-        if (a->o.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT && !w->zero)
+        if (a->o.rel_err > 0 && !a->matrix_walk && !w->zero)
             printf("rel-err      %s (%g; the rule's range term wants %.3g walks)\n", w->rel_err_met ? "met" : "NOT met",
                    a->o.rel_err, w->min_walks);
         if (w->zero)
