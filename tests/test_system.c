@@ -429,6 +429,15 @@ static void test_analysis_local(void **state)
                 fail_msg("estimator %d, x[%lld] = %.8g +- %.3g, exact %.8g", e, (long long)idx, r1.estimate,
                          r1.std_error, x[idx]);
         }
+    for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++) { /* a fixed budget reads no more (the file's bounds) */
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.index = 20, o.estimator = e, o.max_walks = 3000, o.threads = 2, o.seed = 20;
+        ulam_walk_result r1, r2;
+        assert_int_equal(ulam_analysis_solve(af, bs, &o, &r1, NULL), ULAM_OK);
+        assert_int_equal(ulam_analysis_solve(ap, b, &o, &r2, NULL), ULAM_OK);
+        assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
+        assert_true(isfinite(r1.ci95[0]) && fabs(r1.estimate - x[20]) < 4 * r1.std_error);
+    }
     ulam_analysis_info info;
     ulam_analysis_get_info(af, &info);
     assert_int_equal(info.bounds, 1), assert_int_equal(info.b_scores, 1), assert_int_equal(info.guard, 1);
