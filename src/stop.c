@@ -60,3 +60,10 @@ double ulam__stop_walks_needed(double m, double var, double R, double bias, doub
     double nv = fmax(var, 0.0) / (E * m * E * m), nr = 7.0 * R * L / (3.0 * c) + 1.0;
     return ceil(fmax(nv, nr));
 }
+
+/* The walks' share of a target E beside an independent relative error f. */
+double ulam__stop_combined_target(double E, double f)
+{
+    if (!(E > 0)) return E;
+    return f < E ? sqrt(E * E - f * f) : 0.0;
+}

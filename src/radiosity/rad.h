@@ -33,6 +33,9 @@ static inline double ulam__max3(const double *v)
 void ulam__polygon_normal(const double *vert, const int32_t *idx, int64_t n, double normal[3],
                           double *longest);
 
+/* The area centroid of polygon vert[idx[0..n)] (scene.c). */
+void ulam__polygon_centroid(const double *vert, const int32_t *idx, int64_t n, double c[3]);
+
 /* Area, unit normal of every patch (after the vertex lists are set). */
 void ulam__scene_geometry(ulam_scene *s);
 
@@ -116,6 +119,13 @@ int ulam__lights_score(const ulam_tracer *t, const ulam__lights *L, int estimato
 /* The MIS weight of a walk's cosine ray that landed (h) on emitter j. */
 double ulam__lights_hit_weight(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t j,
                                const ulam__hit *h);
+
+/* A certified bound per channel on one next-event vertex's score (weights <= 1) at patch p, or
+ * (p < 0) the point pt with unit normal n: rho_p (reflect, a patch) or 1 times the largest light
+ * sample plus the largest MIS-weighted landing on an emitter; INFINITY for light sampling alone
+ * near an emitter it may touch. */
+void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
+                               const double n[3], int reflect, double out[3]);
 
 /* A point walk (point.c): one walk from x (unit normal n, on patch self or -1) on the continuous
  * surfaces: its RGB irradiance score; *rays gets the rays cast, *cut 1 when cut at max_steps. */
