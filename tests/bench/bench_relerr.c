@@ -13,12 +13,14 @@
  *   covered  how many of the runs' printed intervals hold x.
  * A run is capped at CAP walks: one that predicts more stops early, not met (counted in walks).
  *
- *   bench_relerr [E [REPS]]    prints the table (defaults 0.1 and 5) */
+ *   bench_relerr [E [REPS [ONLY]]]    prints the table (defaults 0.1 and 5; ONLY: the rows whose
+ *                                     system name contains it) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "gen.h"
 #include "ulam.h"
 
 enum { ORACLE = 1 << 20, CAP = 1 << 24 };
@@ -52,22 +54,10 @@ static int load(sys *s, const char *name, int jacobi)
     return 0;
 }
 
-/* The metastable chain (tests/test_stop.c) at leak 1e-4. */
+/* The metastable chain (gen.h) at leak 1e-4. */
 static void metastable(sys *s)
 {
-    int32_t ti[200], tj[200];
-    double tx[200];
-    int nz = 0;
-    static const int hop[4] = {1, 3, 7, 12};
-    for (int c = 0; c < 2; c++)
-        for (int i = 0; i < 20; i++) {
-            double sum = c ? 0.9995 : 0.95 - (i == 0 ? 1e-4 : 0.0);
-            for (int h = 0; h < 4; h++) ti[nz] = 20 * c + i, tj[nz] = 20 * c + (i + hop[h]) % 20, tx[nz++] = sum / 4;
-        }
-    ti[nz] = 0, tj[nz] = 20, tx[nz++] = 1e-4;
-    ulam_csr_from_triplets(40, 40, nz, ti, tj, tx, &s->M);
-    s->b = malloc(40 * sizeof *s->b);
-    for (int i = 0; i < 40; i++) s->b[i] = i < 20 ? 1.0 : 10.0;
+    bench_metastable(1e-4, &s->M, &s->b);
     s->name = "metastable40", s->index = 0;
 }
 
@@ -135,6 +125,7 @@ int main(int argc, char **argv)
 {
     double E = argc > 1 ? atof(argv[1]) : 0.1;
     int reps = argc > 2 ? atoi(argv[2]) : 5;
+    const char *only = argc > 3 ? argv[3] : "";
     static const struct { const char *name; int jacobi; } files[] = {
         {"chain4", 0}, {"radiosity100", 0}, {"randsub1000", 0}, {"signed200", 0}, {"poisson20", 1}};
     printf("--rel-err %g, %d runs a row; oracle = var / (E x)^2 (var from %d walks)\n", E, reps, ORACLE);
@@ -148,6 +139,10 @@ int main(int argc, char **argv)
         }
         if (f == 5) metastable(&s);
         if (f == 6) laplace(&s, 15);
+        if (!strstr(s.name, only)) {
+            ulam_csr_free(s.M), free(s.b);
+            continue;
+        }
         exact(&s);
         for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) row(&s, est, E, reps);
         ulam_csr_free(s.M), free(s.b);

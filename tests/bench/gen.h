@@ -218,4 +218,26 @@ static inline int bench_exact_column(const ulam_csr *M, int64_t s, double *x, do
     return sweeps;
 }
 
+/* The metastable chain of issue 25 (tests/test_stop.c): 40 states; cluster A (states 0..19,
+ * b = 1) has rows of M summing to exactly 0.95, state 0 leaking `leak` into cluster B (states
+ * 20..39, b = 10, rows summing to 0.9995).  M and b (40 entries, malloc'd); nonzero when out of
+ * memory. */
+static inline int bench_metastable(double leak, ulam_csr **M, double **b)
+{
+    int32_t ti[200], tj[200];
+    double tx[200];
+    int nz = 0;
+    static const int hop[4] = {1, 3, 7, 12};
+    for (int c = 0; c < 2; c++)
+        for (int i = 0; i < 20; i++) {
+            double sum = c ? 0.9995 : 0.95 - (i == 0 ? leak : 0.0);
+            for (int h = 0; h < 4; h++) ti[nz] = 20 * c + i, tj[nz] = 20 * c + (i + hop[h]) % 20, tx[nz++] = sum / 4;
+        }
+    ti[nz] = 0, tj[nz] = 20, tx[nz++] = leak;
+    *b = malloc(40 * sizeof **b);
+    if (!*b || ulam_csr_from_triplets(40, 40, nz, ti, tj, tx, M)) return free(*b), *b = NULL, -1;
+    for (int i = 0; i < 40; i++) (*b)[i] = i < 20 ? 1.0 : 10.0;
+    return 0;
+}
+
 #endif
