@@ -29,7 +29,7 @@ void ulam__stop_interval(int64_t n, double mean, double var, double R, double bi
         return;
     }
     if (n < 2 || !isfinite(R) || !(R > 0) || !isfinite(mean) || !(bias >= 0) || !isfinite(bias)) return;
-    if (maxabs > limit) { /* a score past the range: the sample is not the clipped one R describes */
+    if (maxabs > limit * (1.0 + ULAM__STOP_ROUNDING)) { /* past the range: not the clipped sample R describes */
         ci->kind = ULAM__STOP_BEYOND;
         return;
     }
