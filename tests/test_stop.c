@@ -274,11 +274,60 @@ static void test_rel_err_cost(void **state)
     ulam_csr_free(M), free(b), free(x);
 }
 
+/* Cost case 6 (bench/gen.h, n = 2000): b = +-0.1 and one entry 1000 that walks from state 0
+ * reach with weight ~1e-15.  Absorption walks pay for it in their range (x1000 of the oracle
+ * var / (E x)^2 at E = 0.1 on the n = 2e4 system); the bidirectional row with a dense b pushes b
+ * first (src/bpush.c) and its walks score a residual of at most 0.1: within 3x of the oracle at
+ * seed 1, and its intervals cover over 100 seeds (at least 89).  The row refused a dense b before. */
+static void test_push_b(void **state)
+{
+    (void)state;
+    ulam_csr *M;
+    double *b = NULL, E = 0.1;
+    assert_int_equal(bench_case6(2000, 1e-6, 1000.0, 6, &M, &b), 0);
+    double *xs = bench_neumann(M, b), x = xs[0];
+    free(xs);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.estimator = ULAM_ABSORPTION, o.max_walks = 1 << 18, o.seed = 12345;
+    ulam_walk_result r;
+    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    double oracle = r.variance / (E * x * E * x);
+    ulam_method_opts mo = ulam_method_defaults();
+    mo.method = ULAM_METHOD_BIDIRECTIONAL;
+    ulam_auto_opts ao = ulam_auto_defaults();
+    ao.pin_estimator = 1;
+    int v[3] = {0, 0, 0};
+    for (int s = 0; s < 100; s++) {
+        if (!test_case(s)) continue;
+        o.max_walks = 0, o.rel_err = E, o.seed = 1 + (uint64_t)s;
+        ulam_answer a;
+        ulam_error err;
+        int status = ulam_auto(M, b, &o, &ao, &mo, NULL, &a, &err);
+        if (status) print_error("seed %d: %s\n", s + 1, err.msg);
+        assert_int_equal(status, ULAM_OK);
+        assert_int_equal(a.method, ULAM_METHOD_BIDIRECTIONAL);
+        assert_true(a.walks.rel_err_met);
+        if (s == 0) {
+            print_message("case 6, n = 2000, push on b + absorption: %lld walks, oracle %.4g (%.3gx), push %lld ops\n",
+                          (long long)a.walks.walks, oracle, (double)a.walks.walks / oracle,
+                          (long long)a.bidir.plan.push.ops);
+            assert_true((double)a.walks.walks <= 3.0 * fmax(oracle, 1024.0));
+        }
+        ulam_walk_result w = a.walks;
+        w.ci95[0] = a.ci95[0], w.ci95[1] = a.ci95[1];
+        v[verdict(&w, x)]++;
+    }
+    test_case_done();
+    count("case 6 n = 2000, push on b, rel_err 0.1:", v[1], v[2], 100);
+    ulam_csr_free(M), free(b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_never_zero_width), cmocka_unit_test(test_metastable_fixed),
                                        cmocka_unit_test(test_metastable_rounds), cmocka_unit_test(test_metastable_auto),
                                        cmocka_unit_test(test_metastable_rel_err), cmocka_unit_test(test_laplace_corner),
-                                       cmocka_unit_test(test_rel_err_cost)};
+                                       cmocka_unit_test(test_rel_err_cost),
+                                       cmocka_unit_test(test_push_b)};
     return test_run(tests);
 }
