@@ -1281,6 +1281,12 @@ int ulam_method_answers(int k);
  * max(16, n / 10) (a denser b: the push on b, see ulam_auto_start). */
 int64_t ulam_method_sparse_limit(int64_t n);
 
+/* Which route the bidirectional row takes for x of (I - M) x = b (n entries) under the walks'
+ * pins ao (NULL: none) and options o: 0 the reverse push from the index and collision walks from
+ * b (a sparse b, nothing pinned it cannot honour), 1 the push on b and walks from the index with
+ * the walks' own estimator and exponent (a dense b, or an estimator or exponent pinned). */
+int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o);
+
 /* Which rows a choice may take.  Start from ulam_method_defaults(). */
 typedef struct ulam_method_opts {
     int method;       /* the row pinned (enum ulam_method_row); -1: choose among the rows */

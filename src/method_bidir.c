@@ -25,17 +25,22 @@ static int64_t nonzeros(const double *b, int64_t n)
     return k;
 }
 
+/* The route: 1 the push on b (dense b, or an estimator or exponent pinned), 0 the reverse push. */
+int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o)
+{
+    if (!b || !o) return 0;
+    return nonzeros(b, n) > ulam_method_sparse_limit(n) ||
+           (ao && (ao->pin_estimator || (ao->pin_alpha && o->kernel_alpha != 1.0)));
+}
+
 /* An adjoint query with a rel_err target, nothing pinned it cannot honour, a walk leader to
  * compare with whose predicted work W exceeds nnz(M)/4, and a sparse b. */
 static int applies(const ulam__query *q, int k, char *why, size_t len)
 {
     const ulam_walk_opts *o = q->o;
-    const ulam_auto_opts *ao = q->ao;
     const ulam_auto_result *au = &q->ch->walks;
-    int64_t n = q->M->nrows, nb = nonzeros(q->b, n), dense = nb > ulam_method_sparse_limit(n);
+    int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     const char *pinned = o->mode == ULAM_FORWARD ? "forward mode (--mode forward, --out, --errors)"
-                         : ao->pin_estimator && !dense ? "--estimator is pinned"
-                         : ao->pin_alpha && o->kernel_alpha != 1.0 && !dense ? "--alpha other than 1"
                          : o->roulette > 0 || o->split > 0 ? "--roulette or --split (bidirectional takes neither)"
                                                            : NULL;
     double nnz = (double)ulam_csr_nnz(q->M), W = q->ch->leader_work;
@@ -175,7 +180,7 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     ulam_choice *ch = q->ch;
     ulam_run *r = q->run;
     double W = ch->leader_work;
-    if (nonzeros(q->b, q->M->nrows) > ulam_method_sparse_limit(q->M->nrows)) { /* dense b: the push on b */
+    if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o)) { /* the push on b */
         const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
         double m = fabs(c->estimate + q->o->rel_err_offset);
         int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
@@ -220,7 +225,7 @@ static int pin(ulam__query *q, int k, ulam_error *err)
     (void)k;
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     if (nb == 0) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero b (b is zero, so x is 0)");
-    if (nb > ulam_method_sparse_limit(n)) { /* dense b: the push on b, planned from a pilot round of walks on b */
+    if (ulam_method_bidir_route(q->b, n, q->ao, q->o)) { /* the push on b, planned from a pilot round on b */
         if (!(q->o->rel_err > 0))
             return ulam__fail(err, ULAM_EINVAL, 0, -1, "a --rel-err target for bidirectional with a dense b "
                                                        "(more than max(16, n/10) = %lld nonzeros)",

@@ -56,7 +56,7 @@ typedef struct {
     ulam_guard g;
     const ulam_choice *ch; /* chosen by --method auto: the choice (else NULL) */
     double bmax;           /* max |b| */
-    int dense;             /* b dense: the library pushed b and walked from the index (src/bpush.c) */
+    int dense;             /* the library pushed b and walked from the index (src/bpush.c) */
 } report;
 
 /* Print the human-readable block. */
@@ -67,7 +67,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
            o->target < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
            w->interrupted ? "  [INTERRUPTED]" : "");
     if (rp->dense) { /* the push on b: its own lines */
-        printf("method          bidirectional with a dense b: push on b, then %s walks from %lld scoring its "
+        printf("method          bidirectional, the push on b: then %s walks from %lld scoring its "
                "residual\n", cli_estimator_names[o->walk.estimator], (long long)o->target + 1);
         printf("push            rmax %.3g: %lld operations; q_%lld = %.10g exact; residual max %.3g (b's was %.3g)\n",
                r->push.rmax, (long long)r->push.ops, (long long)o->target + 1, r->push_part, r->push.r_max,
@@ -163,6 +163,7 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         cli_json_number("direct", rp->direct, 0);
         cli_json_number("z", r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN, 0);
     }
+    if (o->walk.rel_err > 0) printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
     if (rp->ch) cli_auto_print_json(rp->ch, 1);
     printf("\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
 }
@@ -420,14 +421,13 @@ int cli_bidir(int argc, char **argv)
 }
 
 /* Run the chosen bidirectional (cli.h). */
-int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int json, int check, double direct,
+int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
                        double load_seconds)
 {
     report rp = {.json = json, .check = check, .direct = direct, .load_seconds = load_seconds,
                  .transpose_seconds = ch->transpose_seconds, .ch = ch};
-    int64_t n = s->M->nrows, nb = 0;
-    for (int64_t i = 0; i < n; i++) nb += s->b[i] != 0.0, rp.bmax = fmax(rp.bmax, fabs(s->b[i]));
-    rp.dense = nb > ulam_method_sparse_limit(n);
+    for (int64_t i = 0; i < s->M->nrows; i++) rp.bmax = fmax(rp.bmax, fabs(s->b[i]));
+    rp.dense = route; /* ulam_method_bidir_route: the push on b */
     int rc = 0;
     if (!rp.dense) { /* the dense route's walks run on M under the walks' own guards */
         if ((rc = cli_guard(s, ch->bidir_opts.walk.continue_q, 1.0, ULAM_FORWARD, &rp.g))) return rc;
