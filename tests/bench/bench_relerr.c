@@ -13,8 +13,8 @@
  *   covered  how many of the runs' printed intervals hold x.
  * A run is capped at CAP walks: one that predicts more stops early, not met (counted in walks).
  *
- *   bench_relerr [E [REPS [ONLY]]]    prints the table (defaults 0.1 and 5; ONLY: the rows whose
- *                                     system name contains it) */
+ *   bench_relerr [E [REPS [ONLY]]]    prints the tables (defaults 0.1 and 5; ONLY: the rows whose
+ *                                     system name contains it, +ONLY: of case 6's table alone) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -221,12 +221,14 @@ int main(int argc, char **argv)
     double E = argc > 1 ? atof(argv[1]) : 0.1;
     int reps = argc > 2 ? atoi(argv[2]) : 5;
     const char *only = argc > 3 ? argv[3] : "";
+    int case6_only = only[0] == '+'; /* "+NAME": case 6's table alone */
+    only += case6_only;
     static const struct { const char *name; int jacobi; } files[] = {
         {"chain4", 0}, {"radiosity100", 0}, {"randsub1000", 0}, {"signed200", 0}, {"poisson20", 1}};
     printf("--rel-err %g, %d runs a row; oracle = var / (E x)^2 (var from %d walks)\n", E, reps, ORACLE);
     printf("%-20s %-10s %11s %11s %7s %8s %8s %8s %7s %8s\n", "system", "estimator", "oracle", "walks", "met", "ratio",
            "ratio1k", "width/Ex", "covered", "seconds");
-    for (int f = 0; f < 7; f++) {
+    for (int f = 0; f < (case6_only ? 0 : 7); f++) {
         sys s = {0};
         if (f < 5 && load(&s, files[f].name, files[f].jacobi)) {
             printf("%s: cannot read (run from the source root)\n", files[f].name);
