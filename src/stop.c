@@ -68,3 +68,10 @@ double ulam__stop_walks_needed(double m, double var, double R, double bias, doub
     }
     return ceil(hi);
 }
+
+/* The walks' share of a target E beside an independent relative error f. */
+double ulam__stop_combined_target(double E, double f)
+{
+    if (!(E > 0)) return E;
+    return f < E ? sqrt(E * E - f * f) : 0.0;
+}

@@ -75,4 +75,9 @@ int ulam__stop_rel_met(const ulam__stop_ci *ci, double m, double E);
  * reaches 2 w, m = 0 or R infinite. */
 double ulam__stop_walks_needed(double m, double var, double R, double bias, double E, int k);
 
+/* The relative target E' that walks must meet so that, with an independent error of relative
+ * size f beside theirs (a sampled matrix's), the two combined (in quadrature) meet E:
+ * sqrt(E^2 - f^2); 0 when f >= E (no walk count can meet E). */
+double ulam__stop_combined_target(double E, double f);
+
 #endif /* ULAM_STOP_H */

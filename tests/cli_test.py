@@ -1659,6 +1659,16 @@ def check_auto_bidir(progs):
         w = o["auto"]["candidates"][o["auto"]["chosen"] - 1]["predicted_work"]
         assert rc == 0 and o["mode"] == "adjoint" and w < 62400, o["auto"]
         assert o["auto"]["bidirectional"].startswith("not considered: the walks' predicted work"), o["auto"]
+        # the candidate auto picks can give an interval: the expected estimator's scores are b_1 plus a
+        # part of width R, and were once checked against R alone (every score 'past the range': no
+        # interval, 1 047 552 walks to a stop 'not met'); now 'met' with an interval covering LAPACK's
+        for seed in ("1", "2", "3"):
+            rc, out, err = run(ulam, ["solve", d + "/r.mtx", "--rhs", d + "/r_b.mtx", "--index", "1", "--rel-err", "0.01",
+                                      "--json", "--check", "--seed", seed])
+            o = json.loads(out)
+            lo, hi = o["ci95"]
+            assert rc == 0 and o["rel_err_met"] and lo <= o["direct"] <= hi and hi - lo > 0, o
+            assert o["walks"] <= 4 * o["auto"]["candidates"][o["auto"]["chosen"] - 1]["predicted_walks"], o
 
 
 def check_method_table(ulam):
