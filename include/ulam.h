@@ -522,6 +522,10 @@ const ulam_csr *ulam_system_transpose(const ulam_system *s);
  * the blocks of the rows it reaches.  ULAM_OK, or ULAM_EINVAL for s NULL. */
 int ulam_system_lazy(const ulam_system *s, const ulam_csr **M, const double **b);
 
+/* The blocks of M, b and M^T verified so far (each once), and in *rows (may be NULL) the rows of M
+ * they hold: what a query read of the file beyond its header and checksum table. */
+int64_t ulam_system_checked(const ulam_system *s, int64_t *rows);
+
 /* The stored certificate, or NULL when there is none (or of a version this reader does not know). */
 const ulam_certificate *ulam_system_certificate(const ulam_system *s);
 
