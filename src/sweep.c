@@ -93,9 +93,9 @@ int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cos
             break;
         }
         if (!cost) continue; /* rmax alone decides */
-        /* one more round like this one: the walks' work falls by (1 - rsum / before) of it */
+        /* one more round like this one takes the residual from rsum to rsum^2 / before */
         double rho = before > 0 ? rsum / before : 1.0, next_ops = sweeping ? (double)(nnz + 2 * n) : (double)round_ops;
-        if (!((1.0 - rho) * cost(rsum, ctx) > next_ops)) break;
+        if (!(cost(rsum, ctx) - cost(rho * rsum, ctx) > next_ops)) break;
     }
     info->ops = ops;
     info->r_sum = rsum;
