@@ -377,6 +377,10 @@ int ulam_render_hdr(const ulam_tracer *t, const double *B, const ulam_camera *ca
  * little-endian), atomically. */
 int ulam_pfm_write(const char *path, int width, int height, const float *rgb);
 
+/* Write linear float RGB (3 a pixel, rows top first) as a Radiance .hdr file (RGBE, flat
+ * scanlines: 8 bits of mantissa a channel under a shared exponent), atomically. */
+int ulam_hdr_write(const char *path, int width, int height, const float *rgb);
+
 /* How many pixel centres of a width x height picture see each patch's front (pixels:
  * npatches), with the rays of ulam_render. */
 int ulam_view_pixels(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t *pixels);
@@ -404,6 +408,49 @@ typedef struct ulam_view_info {
  * (3 * npatches) get the seen patches' answers; unseen patches get B 0 and se NaN. */
 int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, int height, double coverage,
                      const ulam_walk_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err);
+
+/* ---------------------------------------------------------------- adaptive subdivision */
+/* Secondary: ulam_rad_importance, ulam_rad_adapt. */
+
+/* The view's importance of every patch (Y: npatches), the adjoint of the radiosity system with
+ * the picture as its source: Y = S + (diag(rho) F)^T Y, S_p the share of the picture's hit
+ * pixels that see patch p (ulam_view_pixels' rays), so the mean hit pixel is sum_p Y_p E_p and
+ * an error d on patch p's radiosity moves it by Y_p d.  S exactly; the rest by `walks` walks
+ * from the seen patches (in proportion to S, continuing with the mean of rho, each landing
+ * counted: Hanrahan-Salzman-Aupperle 1991, Smits-Arvo-Salesin 1992), from stream (seed, 0).
+ * All 0 when the camera sees no patch. */
+int ulam_rad_importance(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t walks,
+                        uint64_t seed, double *Y, ulam_error *err);
+
+/* What adaptive subdivision did (ulam_rad_adapt). */
+typedef struct ulam_rad_adapt_info {
+    int64_t patches_in, patches; /* the tracer's scene's patches, and the mesh made */
+    int64_t splits, rounds;      /* patches split, rounds of splitting */
+    int64_t points, walks, rays; /* point queries made, their walks and rays */
+    double error0, error;        /* the mesh error (below) of the tracer's mesh and of the mesh made
+                                    (interrupted: of the last mesh measured whole, before the
+                                    round that was cut) */
+    double target, seconds;
+    int met;         /* error <= target */
+    int capped;      /* stopped by max_patches (or no patch left large enough to split) */
+    int interrupted; /* opts->interrupt or max_seconds */
+} ulam_rad_adapt_info;
+
+/* Adaptive, importance-driven subdivision of the tracer's scene: the mesh error of a patch p,
+ * e_p, is the RMS of the continuous surface's radiosity about its mean over the patch, from
+ * point queries (ulam_rad_point_query with opts, no mesh in their answers) at the patch's area
+ * centroid and half way to each vertex (the points' noise removed: d_k^2 - var d_k); the mesh's
+ * error is max over channels of sum_p Y_p e_p / sum_p Y_p mean_p, Y_p the importance of p
+ * (importance: one a patch of the tracer's scene, e.g. ulam_rad_importance's, a child getting
+ * its area's share; NULL: the area, every surface alike).  While it is above target, the
+ * patches of largest Y_p e_p are split (triangles and quads into 4 at their edge midpoints,
+ * shared by neighbours; larger polygons into their fan) and their children measured, until
+ * target is met, the mesh would pass max_patches, or opts->interrupt / max_seconds stops it.
+ * Point k of the i-th polygon measured draws its seed from stream (opts->seed, 16 i + k).
+ * *out gets the mesh made (faces, groups and materials kept; the tracer's scene when nothing
+ * was split is copied).  info may be NULL. */
+int ulam_rad_adapt(const ulam_tracer *t, const ulam_walk_opts *opts, const double *importance, double target,
+                   int64_t max_patches, ulam_scene **out, ulam_rad_adapt_info *info, ulam_error *err);
 
 /* The size of ulam_falsecolour's picture of an nu x nv grid of cells of cw x ch pixels (the
  * scale bar and its labels to the right). */

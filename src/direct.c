@@ -40,16 +40,23 @@ double ulam__direct_residual(const ulam_csr *M, const double *b, const double *x
     return bmax > 0.0 ? rmax / bmax : rmax;
 }
 
-/* Solve (I - M) x = b densely. */
-int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
-                      ulam_direct_info *info, ulam_error *err)
+/* Check the arguments of a direct solve (dense or sparse): M, b and x given, M square and a
+ * sound CSR; clears err first. */
+int ulam__direct_args(const ulam_csr *M, const double *b, const double *x, ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !b || !x) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and x");
     if (M->nrows != M->ncols)
         return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M, got %lld x %lld",
                           (long long)M->nrows, (long long)M->ncols);
-    int bad = ulam__csr_check_structure(M, err); /* src/check.c */
+    return ulam__csr_check_structure(M, err); /* src/check.c */
+}
+
+/* Solve (I - M) x = b densely. */
+int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
+                      ulam_direct_info *info, ulam_error *err)
+{
+    int bad = ulam__direct_args(M, b, x, err);
     if (bad) return bad;
     double t0 = ulam_now();
     int64_t n = M->nrows;

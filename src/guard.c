@@ -394,3 +394,11 @@ int ulam_guard_check(const ulam_csr *M, double continue_q, const ulam_guard_opts
         g->verdict_hat[m] = need & ULAM_GUARD_HAT(m) ? ulam_verdict_of(&g->hat[m]) : ULAM_VERDICT_UNKNOWN;
     return ULAM_OK;
 }
+
+/* Whether a caller's guard fits a solver's continuation, exponent and needs. */
+int ulam__guard_fits(const ulam_guard *g, double continue_q, double alpha, int need)
+{
+    double q = continue_q > 0 ? continue_q : 0.0;
+    return g && (g->continue_q > 0 ? g->continue_q : 0.0) == q && g->kernel_alpha == alpha &&
+           (g->computed & need) == need;
+}

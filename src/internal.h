@@ -98,6 +98,11 @@ int ulam__power_from(const ulam_csr *A, const double *left, const double *right,
 int ulam__guard_fourth(const ulam_csr *K, double continue_q, double alpha, const ulam_power *abs, ulam_power *out,
                        ulam_error *err);
 
+/* Whether a caller's guard g (may be NULL) was computed for continuation q (<= 0: analog),
+ * kernel exponent alpha and holds every verdict in need (ULAM_GUARD_* bits), so a solver may
+ * take it instead of computing its own (src/guard.c). */
+int ulam__guard_fits(const ulam_guard *g, double continue_q, double alpha, int need);
+
 /* The walks the rel_err rule's range term would need at estimate m and target E were every visit
  * to score at most per_visit (times the walk's weight), both signs when signs, under the
  * reachability bounds of a solver made with rel_err > 0 and b = 1 (src/solve.c; INFINITY
@@ -249,6 +254,10 @@ int ulam__csr_canonicalize(ulam_csr *A, int threads);
 
 /* ||b - (I - M) x||_inf / ||b||_inf from the sparse M (src/direct.c). */
 double ulam__direct_residual(const ulam_csr *M, const double *b, const double *x);
+
+
+/* The arguments of a direct solve checked: M, b, x given, M square and a sound CSR (src/direct.c). */
+int ulam__direct_args(const ulam_csr *M, const double *b, const double *x, ulam_error *err);
 /* Argument checks (src/check.c): ULAM_OK, or ULAM_EINVAL with err naming the field and what was
  * expected.  Every finite-valued option must be finite and in its range; walk options also have
  * their counts checked (max_walks, max_steps, threads). */

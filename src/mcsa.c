@@ -113,9 +113,7 @@ static int check(const ulam_csr *M, const double *b, const ulam_outer_opts *o, u
 static int take_guard(const ulam_csr *M, const ulam_walk_opts *w, ulam_guard *g, ulam_error *err)
 {
     int need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
-    double q = w->continue_q > 0 ? w->continue_q : 0.0;
-    if (w->guard && (w->guard->continue_q > 0 ? w->guard->continue_q : 0.0) == q &&
-        w->guard->kernel_alpha == w->kernel_alpha && (w->guard->computed & need) == need) {
+    if (ulam__guard_fits(w->guard, w->continue_q, w->kernel_alpha, need)) { /* src/guard.c */
         *g = *w->guard;
         return ULAM_OK;
     }

@@ -715,9 +715,7 @@ static int take_guard(const ulam_csr *M, const ulam_walk_opts *o, const ulam__ro
                       ulam_error *err)
 {
     int need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(o->mode);
-    double q = o->continue_q > 0 ? o->continue_q : 0.0;
-    if (o->guard && (o->guard->continue_q > 0 ? o->guard->continue_q : 0.0) == q &&
-        o->guard->kernel_alpha == o->kernel_alpha && (o->guard->computed & need) == need) {
+    if (ulam__guard_fits(o->guard, o->continue_q, o->kernel_alpha, need)) { /* src/guard.c */
         *g = *o->guard;
         return ULAM_OK;
     }

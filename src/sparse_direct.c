@@ -138,11 +138,8 @@ int ulam_direct_sparse_available(void)
 int ulam_direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
                        ulam_direct_info *info, ulam_error *err)
 {
-    ulam__clear(err);
-    if (!M || !b || !x) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and x");
-    if (M->nrows != M->ncols)
-        return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M, got %lld x %lld",
-                          (long long)M->nrows, (long long)M->ncols);
+    int bad = ulam__direct_args(M, b, x, err); /* src/direct.c */
+    if (bad) return bad;
 #ifndef ULAM_UMFPACK
     (void)max_bytes, (void)info;
     return ulam__fail(err, ULAM_EUNSUPPORTED, 0, -1, "a libulam built with UMFPACK (libsuitesparse-dev) for a sparse LU");

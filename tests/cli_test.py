@@ -294,6 +294,18 @@ CASES += [
      r"next-event is for gathering by rays", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "next-event", "--matrix-walk"], 2,
      r"next-event is for gathering by rays", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--mesh-target", "0.05"], 2, r"--mesh-target is for whole-scene", ""),
+    (["radiosity", SC + "cube.obj", "--direct", "--mesh-target", "0.05", "--subdivide", "0.5"], 2, r"not with --subdivide", ""),
+    (["radiosity", SC + "cube.obj", "--direct", "--max-patches", "50"], 2, r"--max-patches needs --mesh-target", ""),
+    (["radiosity", SC + "cube.obj", "--direct", "--mesh-target", "0"], 2, r"--mesh-target expects a number", ""),
+    # the furnace: any mesh is exact, nothing is split
+    (["radiosity", SC + "cube.obj", "--direct", "--mesh-target", "0.05", "--ff-rays", "100"], 0, r"^$",
+     r"mesh +adaptive \(area importance\): 6 -> 6 patches, 0 split in 0 rounds; mesh error \S+ -> \S+, target 0.05 met"),
+    # the Cornell floor under the blocks needs splitting; --max-patches stops it short, and says so
+    (["radiosity", SC + "cornell_box.obj", "--direct", "--mesh-target", "0.01", "--max-patches", "30", "--ff-rays", "100"],
+     0, r"^$", r"mesh +adaptive \(area importance\): 17 -> (2\d|30) patches, .*NOT met \(--max-patches 30\)"),
+    (["radiosity", SC + "cornell_box.obj", "--direct", "--mesh-target", "0.01", "--max-mem", "300K", "--ff-rays", "100"],
+     0, r"^$", r"mesh +adaptive \(area importance\): 17 -> \d+ patches, .*NOT met \(--max-mem holds \d+ patches\)"),
     (["radiosity", SC + "cube.obj", "--view-gather", "--rel-err", "0.1"], 2, r"--view-gather needs --image and --rel-err", ""),
     (["radiosity", SC + "cube.obj", "--view-gather", "--image", "x.png"], 2, r"--view-gather needs --image and --rel-err", ""),
     (["radiosity", SC + "cube.obj", "--view-gather", "--rel-err", "0.1", "--image", "x.png", "--coverage", "2"], 2,
@@ -1241,7 +1253,10 @@ def check_radiosity(ulam):
         rc, _, err = run(ulam, ["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "1000",
                                 "--image", d + "/no/such/dir/x.png"])
         assert rc == code("EIO") and "x.png" in err, err
-        assert sorted(os.listdir(d)) == ["box.pfm", "box.png"], os.listdir(d)  # the linear picture beside
+        assert sorted(os.listdir(d)) == ["box.hdr", "box.pfm", "box.png"], os.listdir(d)  # the linear picture beside
+        rgbe = open(d + "/box.hdr", "rb").read()
+        assert rgbe.startswith(b"#?RADIANCE\n") and b"\n\n-Y 48 +X 64\n" in rgbe, rgbe[:80]
+        assert len(rgbe) == rgbe.index(b"-Y 48 +X 64\n") + len(b"-Y 48 +X 64\n") + 64 * 48 * 4
         pfm = open(d + "/box.pfm", "rb").read()
         assert pfm.startswith(b"PF\n64 48\n-1.0\n") and len(pfm) == len(b"PF\n64 48\n-1.0\n") + 64 * 48 * 12
 

@@ -298,6 +298,7 @@ static void test_damaged_matrix(void **state)
         double x[4], bp[4], res;
         int it;
         assert_int_not_equal(ulam_direct_solve(M, ones, x, 0, NULL, &err), ULAM_OK);
+        assert_int_not_equal(ulam_direct_sparse(M, ones, x, 0, NULL, &err), ULAM_OK);
         assert_int_not_equal(ulam_cg(M, ones, 1e-8, 100, x, &it, &res), ULAM_OK);
         assert_int_not_equal(ulam_gmres(M, ones, 10, 1e-8, 100, x, &it, &res), ULAM_OK);
         assert_int_not_equal(ulam_jacobi(M, ones, 1.0, &J, bp, &err), ULAM_OK);

@@ -8,6 +8,7 @@
 #include "ulam_radiosity.h"
 
 #include <string.h>
+#include <unistd.h>
 
 /* Howell: element whose normal passes through a corner of a parallel a x b rectangle at c. */
 static double howell_parallel(double a, double b, double c)
@@ -385,6 +386,127 @@ static void test_mesh_converges(void **state)
     ulam_scene_free(fine), ulam_scene_free(s);
 }
 
+/* ulam_rad_adapt with points to rel_err each (walks a cap), area importance unless Y. */
+static ulam_rad_adapt_info adapt(const ulam_tracer *t, const double *Y, double target, double rel_err, int64_t walks,
+                                 int64_t cap, uint64_t seed, ulam_scene **out)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.rel_err = rel_err, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    ulam_rad_adapt_info in;
+    ulam_error err;
+    int st = ulam_rad_adapt(t, &o, Y, target, cap, out, &in, &err);
+    if (st) print_error("%s: %s\n", ulam_strerror(st), err.msg);
+    assert_int_equal(st, ULAM_OK);
+    print_message("adapt: %lld -> %lld patches, %lld splits in %lld rounds, mesh error %.4f -> %.4f (target %.3g), "
+                  "%lld points, %lld rays, %.2f s\n", (long long)in.patches_in, (long long)in.patches,
+                  (long long)in.splits, (long long)in.rounds, in.error0, in.error, target, (long long)in.points,
+                  (long long)in.rays, in.seconds);
+    return in;
+}
+
+/* The furnace: the radiosity is the same at every point, so any mesh is exact and adaptive
+ * subdivision splits nothing (its measured mesh error, the points' noise removed, is below the
+ * target from the start). */
+static void test_adapt_furnace(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL, *d = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/furnace_half.obj", &s);
+    ulam_rad_adapt_info in = adapt(t, NULL, 0.02, 0.01, 20000, 1000, 5, &d);
+    assert_true(in.met && !in.capped && !in.interrupted);
+    assert_int_equal(in.splits, 0);
+    assert_int_equal(d->npatches, s->npatches);
+    assert_true(in.error0 <= 0.02 && in.points == 30);
+    for (int64_t p = 0; p < s->npatches; p++) assert_close(d->area[p], s->area[p], 1e-12);
+    ulam_tracer_free(t);
+    ulam_scene_free(d), ulam_scene_free(s);
+}
+
+/* The Cornell box, whose floor and walls need a finer mesh near the blocks and the lamp: the
+ * adaptive mesh reaches the target with fewer patches than the coarsest uniform --subdivide
+ * that reaches it (each uniform mesh's error measured the same way, by ulam_rad_adapt with
+ * nothing to split). */
+static void test_adapt_cornell(void **state)
+{
+    (void)state;
+    const double target = 0.08;
+    ulam_scene *s = NULL, *d = NULL;
+    ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
+    ulam_rad_adapt_info in = adapt(t, NULL, target, 0, 1024, 100000, 7, &d);
+    assert_true(in.met && in.error <= target && in.error0 > target && in.splits > 0);
+    ulam_scene_free(d);
+    int64_t uniform = 0;
+    for (double L = 280; L > 30 && !uniform; L /= 2) {
+        ulam_scene *u = NULL;
+        assert_int_equal(ulam_scene_subdivide(s, L, &u), ULAM_OK);
+        ulam_tracer *tu = must_tracer_of(u);
+        ulam_rad_adapt_info iu = adapt(tu, NULL, 1e300, 0, 1024, u->npatches, 8, &d);
+        print_message("uniform --subdivide %g: %lld patches, mesh error %.4f\n", L, (long long)u->npatches, iu.error);
+        if (iu.error <= target) uniform = u->npatches;
+        ulam_tracer_free(tu);
+        ulam_scene_free(d), ulam_scene_free(u);
+    }
+    print_message("Cornell box to mesh error %.3g: adaptive %lld patches, uniform %lld\n", target,
+                  (long long)in.patches, (long long)uniform);
+    assert_true(uniform > 0 && in.patches < uniform);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* The view's importance in the furnace: every walk from the picture counts 1 at the patch seen
+ * and 1 at each landing, on with probability mean rho = 0.6, so sum_p Y_p = 1 / (1 - 0.6) = 2.5
+ * exactly (the landings are geometric: variance 0.6 / 0.4^2 a walk), and the picture's share S
+ * sums to 1. */
+static void test_importance_furnace(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/furnace_half.obj", &s);
+    ulam_camera cam = {{0.5, 0.5, 0.05}, {0, 0, 1}, {0, 1, 0}, 35, 25};
+    double Y[6], sum = 0.0;
+    const int64_t walks = 40000;
+    assert_int_equal(ulam_rad_importance(t, &cam, 32, 32, walks, 3, Y, NULL), ULAM_OK);
+    for (int p = 0; p < 6; p++) sum += Y[p];
+    double se = sqrt(0.6 / 0.16 / (double)walks);
+    print_message("furnace importance: sum %.5f +- %.2g, exact 2.5\n", sum, se);
+    assert_close(sum, 2.5, 4 * se);
+    assert_int_equal(ulam_rad_importance(t, &cam, 32, 32, 0, 3, Y, NULL), ULAM_OK);
+    sum = 0.0;
+    for (int p = 0; p < 6; p++) sum += Y[p];
+    assert_close(sum, 1.0, 1e-12);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
+/* Importance drives the refinement: a camera looking down at the Cornell floor puts a larger
+ * share of the patches made on the floor than the area's importance does, at the same target,
+ * and makes fewer in all (the walls it does not see matter only through their light). */
+static void test_adapt_view(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL, *da = NULL, *dv = NULL;
+    ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
+    ulam_camera cam = {{278, 540, 280}, {0, -1, 0}, {0, 0, 1}, 35, 25};
+    double *Y = malloc((size_t)s->npatches * sizeof *Y);
+    assert_non_null(Y);
+    assert_int_equal(ulam_rad_importance(t, &cam, 64, 64, 20000, 4, Y, NULL), ULAM_OK);
+    ulam_rad_adapt_info ia = adapt(t, NULL, 0.06, 0, 1024, 100000, 9, &da);
+    ulam_rad_adapt_info iv = adapt(t, Y, 0.06, 0, 1024, 100000, 9, &dv);
+    assert_true(ia.met && iv.met);
+    int64_t floor_face = -1, fa = 0, fv = 0;
+    assert_int_equal(ulam_scene_find(s, "floor", &floor_face), ULAM_OK);
+    floor_face = s->face[floor_face];
+    for (int64_t p = 0; p < da->npatches; p++) fa += da->face[p] == floor_face;
+    for (int64_t p = 0; p < dv->npatches; p++) fv += dv->face[p] == floor_face;
+    print_message("floor patches: area importance %lld of %lld, the view's %lld of %lld\n", (long long)fa,
+                  (long long)da->npatches, (long long)fv, (long long)dv->npatches);
+    assert_true((double)fv / (double)dv->npatches > (double)fa / (double)da->npatches);
+    assert_true(dv->npatches < da->npatches); /* the unseen walls need less */
+    free(Y);
+    ulam_tracer_free(t);
+    ulam_scene_free(da), ulam_scene_free(dv), ulam_scene_free(s);
+}
+
 /* The non-diffuse MTL statements are noted once a keyword a material, with file and line; the
  * matte defaults (Ka, Ni, Ks 0, Ns 0, d 1, illum 2) are not. */
 static void test_mtl_notes(void **state)
@@ -452,6 +574,45 @@ static void test_render_hdr(void **state)
     ulam_scene_free(s), ulam_scene_free(s0);
 }
 
+/* The Radiance .hdr beside the PFM: its header, and every pixel decoded from RGBE within the
+ * format's 8-bit mantissa (1/128 of the pixel's largest channel) of the linear value; black
+ * stays black. */
+static void test_hdr_write(void **state)
+{
+    (void)state;
+    enum { W = 5, H = 3 };
+    float rgb[3 * W * H];
+    for (int k = 0; k < 3 * W * H; k++) rgb[k] = (float)(k % 7 == 0 ? 0.0 : pow(10.0, (k % 11) - 5.0) * (1 + k % 3));
+    char path[] = "/tmp/ulam_hdr_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    assert_int_equal(ulam_hdr_write(path, W, H, rgb), ULAM_OK);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    char line[128];
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_string_equal(line, "#?RADIANCE\n");
+    int w = 0, h = 0, blank = 0;
+    while (fgets(line, sizeof line, f) && !(blank && sscanf(line, "-Y %d +X %d", &h, &w) == 2)) blank = line[0] == '\n';
+    assert_int_equal(w, W);
+    assert_int_equal(h, H);
+    for (int i = 0; i < W * H; i++) {
+        unsigned char b[4];
+        assert_int_equal(fread(b, 1, 4, f), 4);
+        float *c = rgb + 3 * i;
+        double big = fmax(c[0], fmax(c[1], c[2]));
+        for (int k = 0; k < 3; k++) {
+            double v = b[3] ? ldexp(b[k] + 0.5, b[3] - 136) : 0.0;
+            assert_close(v, c[k], big / 128 + 1e-300);
+        }
+    }
+    assert_int_equal(fgetc(f), EOF);
+    fclose(f);
+    remove(path);
+    assert_int_equal(ulam_hdr_write(path, 0, H, rgb), ULAM_EINVAL);
+}
+
 /* Shooting's --rel-err takes the whole rule now (its variance's own error from the fourth moment
  * of the patch's per-particle tallies, at least 1000 particles), not the standard error alone:
  * 50 seeds at rel_err 0.03 on the edge lamp's wall (exact 0.5 F(C-14)), every run met with its
@@ -487,7 +648,9 @@ int main(void)
         cmocka_unit_test(test_point_refused),  cmocka_unit_test(test_grid),
         cmocka_unit_test(test_mesh_error_flags), cmocka_unit_test(test_mesh_converges),
         cmocka_unit_test(test_mtl_notes),        cmocka_unit_test(test_render_hdr),
-        cmocka_unit_test(test_shoot_rel_err),
+        cmocka_unit_test(test_shoot_rel_err),    cmocka_unit_test(test_adapt_furnace),
+        cmocka_unit_test(test_adapt_cornell),    cmocka_unit_test(test_importance_furnace),
+        cmocka_unit_test(test_adapt_view),       cmocka_unit_test(test_hdr_write),
     };
     return test_run(tests);
 }

@@ -71,7 +71,7 @@ static const char *const usage =
 /* The usage's third part. */
 static const char *const usage_mesh =
     "  --samples N       jittered rays a pixel (default 4); the linear picture is written as PFM\n"
-    "                    beside the PNG (out.png -> out.pfm)\n"
+    "                    and Radiance RGBE beside the PNG (out.png -> out.pfm, out.hdr)\n"
     "  --flat            one colour a patch (default: radiosity interpolated from the patch corners\n"
     "                    across each face's patches, creases between faces kept)\n"
     "  --all             print every patch too (a table; with --json a patches array)\n"
@@ -82,7 +82,13 @@ static const char *const usage_mesh =
     "                    dominates)\n"
     "  --mesh-error N    with --out or --all (--mode shoot or --direct): every patch's mesh error as\n"
     "                    R_mesh G_mesh B_mesh columns, point queries of N walks each at the\n"
-    "                    patch's quadrature points (cost: up to 5 N walks a patch)\n";
+    "                    patch's quadrature points (cost: up to 5 N walks a patch)\n"
+    "  --mesh-target E   adaptive subdivision instead of --subdivide (--mode shoot, --direct or\n"
+    "                    --view-gather): split the patches where point queries show the surface's\n"
+    "                    radiosity varies and (with --image) the camera's importance is high, until\n"
+    "                    the importance-weighted mesh error is at most E (relative, e.g. 0.05)\n"
+    "  --max-patches N   stop splitting before the mesh passes N patches (default 100000, and what\n"
+    "                    --max-mem allows)\n";
 
 /* The usage's second half (a literal each stays within C99's 4095 characters). */
 static const char *const usage_points =
@@ -123,7 +129,10 @@ typedef struct {
     int no_mesh;  /* --no-mesh-error */
     int samples, flat; /* --samples N jittered rays a pixel, --flat: one colour a patch */
     char hdr[4096];    /* the PFM beside --image */
+    char rgbe[4096];   /* the Radiance .hdr beside --image */
     int64_t mesh_walks; /* --mesh-error N: every patch's mesh error in --out / --all, N walks a point */
+    double mesh_target;  /* --mesh-target E: adaptive subdivision to mesh error E (0: none) */
+    int64_t max_patches; /* --max-patches N (0: not given) */
     double *at;   /* --at: 6 per point (the normal NaN when not given) */
     int nat;
     int grid;     /* --grid given: g holds it */
@@ -263,7 +272,8 @@ static int parse(int argc, char **argv, args *a)
         {"coverage", required_argument, 0, 'G'},  {"at", required_argument, 0, 'P'},
         {"grid", required_argument, 0, 'R'},     {"no-mesh-error", no_argument, 0, 'N'},
         {"mesh-error", required_argument, 0, 'W'},  {"samples", required_argument, 0, 'S'},
-        {"flat", no_argument, 0, 'F'},
+        {"flat", no_argument, 0, 'F'},           {"mesh-target", required_argument, 0, 'T'},
+        {"max-patches", required_argument, 0, 'K'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int c, rc, idx;
@@ -313,6 +323,8 @@ static int parse(int argc, char **argv, args *a)
             a->samples = (int)v;
             break;
         }
+        case 'T': if ((rc = cli_parse_real(cmd, "--mesh-target", optarg, 1e-6, 10.0, &a->mesh_target))) return rc; break;
+        case 'K': if ((rc = cli_parse_int(cmd, "--max-patches", optarg, 1, INT32_MAX, &a->max_patches))) return rc; break;
         case 'W': if ((rc = cli_parse_int(cmd, "--mesh-error", optarg, 1, INT32_MAX, &a->mesh_walks))) return rc; break;
         case 'P': if ((rc = parse_at(cmd, optarg, a))) return rc; break;
         case 'R': if ((rc = parse_grid(cmd, optarg, &a->g))) return rc; a->grid = 1; break;
@@ -323,6 +335,12 @@ static int parse(int argc, char **argv, args *a)
     if (optind != argc - 1) return cli_usage_error(cmd, "expects exactly one scene file");
     a->scene = argv[optind];
     if (a->list) return 0;
+    if (a->max_patches && !(a->mesh_target > 0)) return cli_usage_error(cmd, "--max-patches needs --mesh-target E");
+    if (a->mesh_target > 0 && (a->subdivide > 0 || a->nat || a->grid || a->patch ||
+                               (a->o.mode != ULAM_FORWARD && !a->direct && !a->view)))
+        return cli_usage_error(cmd, "--mesh-target is for whole-scene and image runs (--mode shoot, --direct or "
+                                    "--view-gather; not with --subdivide, --patch, --at or --grid, whose point "
+                                    "queries have no mesh)");
     if (a->nat || a->grid) {
         if (a->patch || a->o.mode != ULAM_ADJOINT || a->direct || a->check || a->matrix_walk || a->view || a->all ||
             (a->est >= 0 && a->est != 2 && a->est != 0) || ((a->out || a->image) && !a->grid))
@@ -616,6 +634,9 @@ typedef struct {
     ulam_view_info view; /* --view-gather */
     int mesh_known;      /* mesh holds the patch's mesh error (ray gathering at --patch) */
     ulam_rad_mesh mesh;
+    int adapted, view_importance; /* --mesh-target: adapt holds what it did (by the view's importance) */
+    ulam_rad_adapt_info adapt;
+    int64_t adapt_cap; /* the most patches it could make (--max-patches, or what --max-mem holds) */
 } report;
 
 /* (walk - direct) / the standard error of the difference at the patch, channel c: matrix walks
@@ -654,10 +675,26 @@ static void print_mesh(const report *r, const walked *w)
                "             --subdivide finer\n");
 }
 
+/* The adaptive mesh's line of the text report. */
+static void print_adapt(const args *a, const report *r)
+{
+    const ulam_rad_adapt_info *d = &r->adapt;
+    char why[96];
+    int64_t asked = a->max_patches ? a->max_patches : 100000;
+    if (asked > r->adapt_cap) snprintf(why, sizeof why, "NOT met (--max-mem holds %lld patches)", (long long)r->adapt_cap);
+    else snprintf(why, sizeof why, "NOT met (--max-patches %lld)", (long long)r->adapt_cap);
+    printf("mesh         adaptive (%s importance): %lld -> %lld patches, %lld split in %lld rounds; mesh error "
+           "%.3g -> %.3g, target %g %s; %lld point queries, %lld rays, %.3f s\n", r->view_importance ? "the view's" : "area",
+           (long long)d->patches_in, (long long)d->patches, (long long)d->splits, (long long)d->rounds, d->error0,
+           d->error, a->mesh_target, d->met ? "met" : d->interrupted ? "NOT met (interrupted)" : why,
+           (long long)d->points, (long long)d->rays, d->seconds);
+}
+
 /* Print the text report. */
 static void print_text(const args *a, const report *r)
 {
     printf("scene        %s: %lld faces, %lld patches\n", a->scene, (long long)r->faces, (long long)r->s->npatches);
+    if (r->adapted) print_adapt(a, r);
     if (r->F)
         printf("form factors %lld rays a patch, %.3f s: reciprocity error %.3g, row sums %.4f .. %.4f "
                "(mean %.4f), %lld nonzeros\n", (long long)a->ff_rays, r->ff_seconds, r->ff.reciprocity,
@@ -740,6 +777,13 @@ static void print_json(const args *a, const report *r)
     printf("{");
     cli_json_string("scene", a->scene, 0); /* a path may hold quotes and backslashes */
     printf("\"npatches\": %lld, ", (long long)r->s->npatches);
+    if (r->adapted)
+        printf("\"adaptive\": {\"importance\": \"%s\", \"patches_in\": %lld, \"patches\": %lld, \"splits\": %lld, "
+               "\"rounds\": %lld, \"mesh_error_initial\": %.6g, \"mesh_error\": %.6g, \"target\": %g, \"met\": %s, "
+               "\"points\": %lld, \"rays\": %lld, \"seconds\": %.6g}, ", r->view_importance ? "view" : "area",
+               (long long)r->adapt.patches_in, (long long)r->adapt.patches, (long long)r->adapt.splits,
+               (long long)r->adapt.rounds, r->adapt.error0, r->adapt.error, a->mesh_target,
+               r->adapt.met ? "true" : "false", (long long)r->adapt.points, (long long)r->adapt.rays, r->adapt.seconds);
     if (r->patch >= 0) {
         int32_t g = r->s->group[r->patch];
         double c[3];
@@ -1102,6 +1146,14 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
             ulam_error err = {.status = status, .msg = "a writable PFM file"};
             return cli_report(a->hdr, &err);
         }
+        cli_hold_signals(1);
+        status = ulam_hdr_write(a->rgbe, a->width, a->height, hdr);
+        cli_hold_signals(0);
+        if (status) {
+            free(rgb), free(hdr);
+            ulam_error err = {.status = status, .msg = "a writable Radiance .hdr file"};
+            return cli_report(a->rgbe, &err);
+        }
     }
     free(rgb), free(hdr);
     if (status) {
@@ -1230,15 +1282,14 @@ static void human(double b, char *out, size_t len)
  * at most npatches x min(ff rays, npatches); a matrix walk adds each channel's M and kernel),
  * the dense LAPACK solve (ulam_direct_bytes; twice for every patch's error bar), shooting's
  * tallies, pictures and grids.  *what gets the breakdown. */
-static double need_bytes(const args *a, const ulam_scene *s, char *what, size_t len)
+static double need_counts(const args *a, double n, double tri, double nverts, char *what, size_t len)
 {
-    double n = (double)s->npatches, tri = (double)(s->start[s->npatches] - 2 * s->npatches);
-    double tracer = 208.0 * tri + 16.0 * (double)s->nverts, ff = 0, dense = 0, walks = 0, pic = 0;
+    double tracer = 208.0 * tri + 16.0 * nverts, ff = 0, dense = 0, walks = 0, pic = 0;
     int threads = a->o.threads > 0 ? a->o.threads : 2;
     int forms = (a->direct || a->check || a->matrix_walk) && !a->nat && !a->grid;
     if (forms) ff = 12.0 * n * fmin((double)a->ff_rays, n) + 8.0 * (n + 1);
     if (forms && a->matrix_walk) ff *= 3; /* F, one channel's M and the walk's kernel rows */
-    if (forms && (a->direct || a->check)) dense = (double)ulam_direct_bytes(s->npatches);
+    if (forms && (a->direct || a->check)) dense = (double)ulam_direct_bytes((int64_t)n);
     if (forms && (a->direct || a->check) && (a->out || a->all)) dense *= 2; /* every patch's error: G whole */
     if (a->o.mode == ULAM_FORWARD) walks = n * (48.0 + 29.0 * threads) + 32.0 * 256 * 32 * 64;
     if (a->image) pic = (double)a->width * a->height * 11.0 + (a->view ? 8.0 * n : 0.0);
@@ -1248,6 +1299,69 @@ static double need_bytes(const args *a, const ulam_scene *s, char *what, size_t 
     snprintf(what, len, "ray tracer %s (%.0f triangles), form factors %s (%.0f patches x %lld rays), dense "
                         "matrices %s, walks %s, pictures %s", h[0], tri, h[1], n, (long long)a->ff_rays, h[2], h[3], h[4]);
     return tracer + ff + dense + walks + pic;
+}
+
+/* need_counts for scene s. */
+static double need_bytes(const args *a, const ulam_scene *s, char *what, size_t len)
+{
+    return need_counts(a, (double)s->npatches, (double)(s->start[s->npatches] - 2 * s->npatches), (double)s->nverts,
+                       what, len);
+}
+
+/* The most patches --mesh-target may make: --max-patches (default 100000), and no more than
+ * --max-mem holds by need_counts (an adaptive mesh of quads: 2 triangles and about 2 vertices
+ * a patch). */
+static int64_t patch_cap(const args *a, const ulam_scene *s)
+{
+    int64_t lo = s->npatches, hi = a->max_patches ? a->max_patches : 100000;
+    char what[512];
+    if (hi < lo) return lo;
+    while (lo < hi) { /* the largest n in [lo, hi] that fits (lo when none does: the check below refuses) */
+        int64_t mid = lo + (hi - lo + 1) / 2;
+        if (need_counts(a, (double)mid, 2.0 * (double)mid, 2.0 * (double)mid, what, sizeof what) <= (double)a->max_mem)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
+}
+
+/* --mesh-target: the scene adaptively subdivided (importance from the camera with --image, else
+ * the area), *s replaced; 0 or an exit code. */
+static int adapt_scene(const args *a, ulam_scene **s, ulam_rad_adapt_info *info, int *view_importance, int64_t *cap_out)
+{
+    ulam_error err;
+    ulam_tracer *t = NULL;
+    ulam_scene *d = NULL;
+    double *Y = NULL;
+    if (ulam_tracer_alloc(*s, &t, &err)) return cli_report(a->scene, &err);
+    int64_t cap = patch_cap(a, *s), walks = 64 * (*s)->npatches > 65536 ? 64 * (*s)->npatches : 65536;
+    *cap_out = cap;
+    int rc = 0;
+    if (a->image) {
+        ulam_camera cam = camera_of(a, *s);
+        if (!(Y = malloc((size_t)(*s)->npatches * sizeof *Y))) {
+            err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the importance"};
+            rc = cli_report(a->scene, &err);
+        } else if (ulam_rad_importance(t, &cam, a->width, a->height, walks, a->o.seed, Y, &err)) {
+            rc = cli_report(a->scene, &err);
+        }
+        *view_importance = 1;
+    }
+    ulam_walk_opts o = a->o; /* the points: next-event, to half the target or 1024 walks each */
+    o.mode = ULAM_ADJOINT, o.estimator = ULAM_RAD_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
+    o.rel_err = a->mesh_target / 2, o.max_walks = 1024, o.max_seconds = 0;
+    if (!rc) {
+        cli_catch_sigint();
+        if (ulam_rad_adapt(t, &o, Y, a->mesh_target, cap, &d, info, &err)) rc = cli_report(a->scene, &err);
+        cli_release_sigint();
+    }
+    free(Y);
+    ulam_tracer_free(t);
+    if (rc) return rc;
+    ulam_scene_free(*s);
+    *s = d;
+    return 0;
 }
 
 /* --mesh-error N: every patch's mesh error against pv->B into a new *out (3 a patch); 0 or an
@@ -1302,11 +1416,15 @@ int cli_radiosity(int argc, char **argv)
         int png = len > 4 && !strcmp(a.image + len - 4, ".png");
         if (len + 5 > sizeof a.hdr) return cli_usage_error("radiosity", "--image: a path shorter than 4 KiB");
         snprintf(a.hdr, sizeof a.hdr, "%.*s.pfm", (int)(png ? len - 4 : len), a.image);
+        snprintf(a.rgbe, sizeof a.rgbe, "%.*s.hdr", (int)(png ? len - 4 : len), a.image);
     }
     if (a.image && (rc = cli_check_output(a.image))) return rc;
     if (a.image && !a.grid && (rc = cli_check_output(a.hdr))) return rc;
+    if (a.image && !a.grid && (rc = cli_check_output(a.rgbe))) return rc;
     if (a.out && (rc = cli_check_output(a.out))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
+    if (a.mesh_target > 0 && (rc = adapt_scene(&a, &s, &r.adapt, &r.view_importance, &r.adapt_cap))) goto done;
+    r.adapted = a.mesh_target > 0;
     r.s = s;
     if (a.list) {
         print_list(&a, s);

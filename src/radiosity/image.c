@@ -267,6 +267,41 @@ int ulam_pfm_write(const char *path, int width, int height, const float *rgb)
     return ulam_outfile_commit(&o);
 }
 
+/* The Radiance RGBE bytes of linear RGB c: a shared exponent e with the largest channel's
+ * mantissa in [0.5, 1) scaled to 256; all zero below 1e-32 (and for a negative or NaN value). */
+static void rgbe(const float *c, unsigned char out[4])
+{
+    double v = fmax(c[0], fmax(c[1], c[2]));
+    if (!(v >= 1e-32) || !isfinite(v)) {
+        out[0] = out[1] = out[2] = out[3] = 0;
+        return;
+    }
+    int e;
+    double f = frexp(v, &e) * 256.0 / v;
+    for (int k = 0; k < 3; k++) out[k] = (unsigned char)(c[k] > 0 ? c[k] * f : 0.0);
+    out[3] = (unsigned char)(e + 128 < 0 ? 0 : e + 128 > 255 ? 255 : e + 128);
+}
+
+/* Write a float RGB image as a Radiance .hdr file (flat RGBE scanlines, top first), atomically. */
+int ulam_hdr_write(const char *path, int width, int height, const float *rgb)
+{
+    if (!path || !rgb || width < 1 || height < 1) return ULAM_EINVAL;
+    ulam_outfile o;
+    int status = ulam_outfile_open(&o, path);
+    if (status) return status;
+    int ok = fprintf(o.f, "#?RADIANCE\n# ulam radiosity\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n", height, width) > 0;
+    for (size_t i = 0; ok && i < (size_t)width * (size_t)height; i++) {
+        unsigned char b[4];
+        rgbe(rgb + 3 * i, b);
+        ok = fwrite(b, 1, 4, o.f) == 4;
+    }
+    if (!ok) {
+        ulam_outfile_abort(&o);
+        return ULAM_EIO;
+    }
+    return ulam_outfile_commit(&o);
+}
+
 /* Write the PNG stream to f; 0 or ULAM_EIO (libpng reports by longjmp). */
 static int png_stream(FILE *f, int width, int height, const unsigned char *rgb)
 {

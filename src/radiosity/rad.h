@@ -33,6 +33,9 @@ static inline double ulam__max3(const double *v)
 void ulam__polygon_normal(const double *vert, const int32_t *idx, int64_t n, double normal[3],
                           double *longest);
 
+/* The area centroid of polygon vert[idx[0..n)] (scene.c). */
+void ulam__polygon_centroid(const double *vert, const int32_t *idx, int64_t n, double c[3]);
+
 /* Area, unit normal of every patch (after the vertex lists are set). */
 void ulam__scene_geometry(ulam_scene *s);
 

@@ -255,21 +255,26 @@ static double tri_area2(const double *a, const double *b, const double *c)
     return sqrt(ulam__dot3(x, x));
 }
 
-/* The area centroid of patch p (its fan triangles' centroids weighted by their areas). */
-void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3])
+/* The area centroid of polygon vert[idx[0..n)] (its fan triangles' centroids weighted by their
+ * areas; its first vertex when the area is 0). */
+void ulam__polygon_centroid(const double *vert, const int32_t *idx, int64_t n, double c[3])
 {
-    const int32_t *v = s->vidx + s->start[p];
-    int64_t n = s->start[p + 1] - s->start[p];
-    const double *A = s->vert + 3 * v[0];
+    const double *A = vert + 3 * idx[0];
     double w = 0.0;
     c[0] = c[1] = c[2] = 0.0;
     for (int64_t t = 1; t + 1 < n; t++) {
-        const double *B = s->vert + 3 * v[t], *C = s->vert + 3 * v[t + 1];
+        const double *B = vert + 3 * idx[t], *C = vert + 3 * idx[t + 1];
         double a = tri_area2(A, B, C);
         for (int d = 0; d < 3; d++) c[d] += a * (A[d] + B[d] + C[d]) / 3.0;
         w += a;
     }
     for (int d = 0; d < 3; d++) c[d] = w > 0 ? c[d] / w : A[d];
+}
+
+/* The area centroid of patch p. */
+void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3])
+{
+    ulam__polygon_centroid(s->vert, s->vidx + s->start[p], s->start[p + 1] - s->start[p], c);
 }
 
 /* The index of group label, or -1. */
