@@ -522,6 +522,10 @@ const ulam_csr *ulam_system_transpose(const ulam_system *s);
  * the blocks of the rows it reaches.  ULAM_OK, or ULAM_EINVAL for s NULL. */
 int ulam_system_lazy(const ulam_system *s, const ulam_csr **M, const double **b);
 
+/* The blocks of M, b and M^T verified so far (each once), and in *rows (may be NULL) the rows of M
+ * they hold: what a query read of the file beyond its header and checksum table. */
+int64_t ulam_system_checked(const ulam_system *s, int64_t *rows);
+
 /* The stored certificate, or NULL when there is none (or of a version this reader does not know). */
 const ulam_certificate *ulam_system_certificate(const ulam_system *s);
 
@@ -1283,8 +1287,15 @@ int ulam_method_find(const char *name);
 /* What row k answers: ULAM_ANSWERS_ENTRY or ULAM_ANSWERS_ALL (0 out of range). */
 int ulam_method_answers(int k);
 
-/* The densest b the bidirectional row takes: nonzeros at most max(16, n / 10). */
+/* The densest b the bidirectional row takes by its reverse push from the index: nonzeros at most
+ * max(16, n / 10) (a denser b: the push on b, see ulam_auto_start). */
 int64_t ulam_method_sparse_limit(int64_t n);
+
+/* Which route the bidirectional row takes for x of (I - M) x = b (n entries) under the walks'
+ * pins ao (NULL: none) and options o: 0 the reverse push from the index and collision walks from
+ * b (a sparse b, nothing pinned it cannot honour), 1 the push on b and walks from the index with
+ * the walks' own estimator and exponent (a dense b, or an estimator or exponent pinned). */
+int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o);
 
 /* Which rows a choice may take.  Start from ulam_method_defaults(). */
 typedef struct ulam_method_opts {
@@ -1350,9 +1361,13 @@ typedef struct ulam_answer {
  * then each other row's applicability test and cost prediction, a row replacing the leader when
  * its predicted work is below the leader's.  Bidirectional applies to an adjoint query with a
  * rel_err target, nothing pinned it cannot honour (forward mode, the estimator, alpha other than
- * 1, roulette or split), a sparse b (ulam_method_sparse_limit) and a walk leader W above nnz(M)/4
- * (it needs M's transpose); its push is capped at W / 2 (pinned, a b equal to e_S runs as the
- * point source S, as `ulam solve --source S` does).  The rows that answer every unknown do
+ * 1, roulette or split; a dense b takes the leader's estimator and exponent), a nonzero b and a
+ * walk leader W above nnz(M)/4 (it needs M's transpose); its push is capped at W / 2 (pinned, a
+ * b equal to e_S runs as the point source S, as `ulam solve --source S` does).  A sparse b
+ * (ulam_method_sparse_limit) gets the reverse push from the index and walks from b; a dense b
+ * the push on b (src/bpush.c): b's large entries are pushed down to rmax deterministically and
+ * adjoint walks from the index score the residual, whose smaller range the rel_err rule pays
+ * for (pinned, it needs a rel_err target and plans from a pilot round of walks on b).  The rows that answer every unknown do
  * not apply to a query for one entry with an error bar (they give none); pinned, they run from
  * ulam_outer_defaults() and the Krylov peers to its tolerance, with o's seed, threads,
  * continuation, cut, interrupt and force, and o->max_walks (when set) capping one correction.

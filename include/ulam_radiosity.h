@@ -159,6 +159,13 @@ double ulam_ff_perpendicular_rectangles(double w, double h, double l);
 int ulam_rad_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
                     double *b);
 
+/* The relative target of walks on the assembled M at a patch under --matrix-walk --rel-err E,
+ * so that the answer's error, the walks' and the sampled F's combined, meets E: E' =
+ * sqrt(E^2 - (ff_se / |B|)^2), ff_se being F's standard error at the patch and B the direct
+ * solution there (src/stop.c's rule); 0 when F's error alone reaches E (more walks cannot meet
+ * it: more form-factor rays can); E when F's error is unknown (ff_known 0). */
+double ulam_rad_walk_target(double rel_err, double ff_se, double B, int ff_known);
+
 /* Solve the three channels' systems with LAPACKE_dgesv into B (3 * npatches, RGB per patch);
  * refuses with ULAM_EMEMLIMIT like ulam_direct_solve.  info (may be NULL) sums the three. */
 int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, double *B,
@@ -216,10 +223,10 @@ typedef struct ulam_rad_result {
     int threads, interrupted;
     int zero; /* rel_err could never be met: every channel exactly 0 with zero variance after
                * the first round (no walk scored); the run stopped there */
-    double min_walks;          /* gathering with rel_err: the walks the rule's range term needs at
-                                  this estimate (largest over channels; 0 when unbounded) */
-    double variance_rel_error; /* gathering with rel_err: the largest relative standard error of
-                                  a channel's variance (fourth moment); the rule wants <= 0.25 */
+    double min_walks;          /* with rel_err: the walks the rule (src/stop.c) needs at this
+                                  estimate (largest over channels; gathering and shooting) */
+    double variance_rel_error; /* with rel_err: the largest relative standard error of a
+                                  channel's variance (fourth moment; reported, not a stop rule) */
     int rel_err_met;           /* the run stopped because the rel_err rule holds */
 } ulam_rad_result;
 

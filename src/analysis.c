@@ -133,7 +133,11 @@ int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts
     }
     int adj = o.mode == ULAM_ADJOINT, shared = adj && a->b && b == a->b && !o.nstarts;
     int e = o.estimator >= ULAM_COLLISION && o.estimator <= ULAM_EXPECTED ? o.estimator : -1;
-    const ulam__reach *R = adj && (o.estimator == ULAM_ABSORPTION || o.rel_err > 0) ? take_bounds(a) : NULL;
+    ulam__reach stored;
+    int cheap = a->sys && ulam__system_bounds(a->sys, a->continue_q, a->alpha, &stored); /* the file's: no pass */
+    /* every run prints an interval on the score range (stop.h): at a fixed budget too the file's
+       bounds spare the solver its pass over all the start reaches */
+    const ulam__reach *R = adj && (o.estimator == ULAM_ABSORPTION || o.rel_err > 0 || cheap) ? take_bounds(a) : NULL;
     ulam_kernel *k = shared && e >= 0 ? a->k[e] : NULL;
     status = ulam__solver_alloc_reached(a->M, b, &o, R, k, out, err);
     if (!status && shared && e >= 0 && !k) a->k[e] = ulam__solver_keep_kernel_fixed(*out);

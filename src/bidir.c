@@ -24,6 +24,8 @@
 #include "push.h"
 #include "stats.h"
 
+#include "stop.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -348,24 +350,6 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     return status;
 }
 
-/* The 95% interval of a mean of n scores with sample mean `mean`, sample variance var and a
- * certified range R (every score within an interval of width R): the empirical-Bernstein bound
- * of Maurer and Pontil (COLT 2009, thm 4), two-sided (delta = 0.05 split between the sides):
- * mean -+ (sqrt(2 var ln(4 / delta) / n) + 7 R ln(4 / delta) / (3 (n - 1))).  Valid at any n,
- * and never zero-width while R > 0: a sample that saw one value still leaves the range's term.
- * R not finite (or n < 2): NaN (no interval).  The one home of this interval for the point-source
- * path: src/stop.c's anytime-valid construction replaces it when merged. */
-static void ulam__bidir_interval(int64_t n, double mean, double var, double R, double out[2])
-{
-    static const double L = 4.382026634673881; /* ln(4 / 0.05) */
-    if (!(n >= 2 && isfinite(R) && R >= 0)) {
-        out[0] = out[1] = NAN;
-        return;
-    }
-    double half = sqrt(2.0 * fmax(var, 0.0) * L / (double)n) + 7.0 * R * L / (3.0 * (double)(n - 1));
-    out[0] = mean - half, out[1] = mean + half;
-}
-
 /* The certified bound D on the walk part: |<r, x>| <= max|r| ||x||_1 <= max|r| ||b||_1 /
  * (1 - ||M||_1), ||M||_1 the largest row sum of |Mt| (the guards' one-pass bound); INFINITY when
  * that is not below 1 or was not computed. */
@@ -376,18 +360,22 @@ static double walk_part_bound(const ulam_push_info *push, const ulam_guard *g, c
 }
 
 /* The interval of x_t: with a certified range of one walk's score (the solver's score_bound,
- * absorption) the empirical-Bernstein interval; without one the normal interval, except that a
+ * absorption) src/stop.c's interval on that range (stitched over epochs unless the walks stop at
+ * a count fixed in advance: no rel_err, no time limit); without one the walk solver's own
+ * interval (stop.c's too, or withheld), except that a
  * sample of one repeated score (the walks saw nothing else: its variance says nothing about what
  * they missed) gets the certified bound D of the walk part instead; either is clipped to
  * push_part -+ D.  Never zero-width while a residual is left unless D = 0. */
-static void honest_interval(ulam_bidir_result *res, double D)
+static void honest_interval(ulam_bidir_result *res, double D, const ulam_walk_opts *wo)
 {
     const ulam_walk_result *w = &res->walks;
     double lo = res->push_part + w->ci95[0], hi = res->push_part + w->ci95[1];
     if (w->walks > 0 && isfinite(w->score_bound)) {
-        double ci[2];
-        ulam__bidir_interval(w->walks, w->estimate, w->variance, 2.0 * w->score_bound, ci);
-        lo = res->push_part + ci[0], hi = res->push_part + ci[1];
+        int fixed = !(wo->rel_err > 0) && !(wo->max_seconds > 0) && w->walks == wo->max_walks;
+        ulam__stop_ci ci;
+        ulam__stop_interval(w->walks, w->estimate, w->variance, 2.0 * w->score_bound, 0.0, 0.0, INFINITY,
+                            fixed ? 1 : ulam__stop_epoch(w->walks), &ci);
+        lo = res->push_part + ci.lo, hi = res->push_part + ci.hi;
     } else if (w->walks > 0 && !(w->variance > 0))
         lo = res->push_part - D, hi = res->push_part + D; /* NaN-free: D may be INFINITY (no bound) */
     if (isfinite(D)) lo = fmax(lo, res->push_part - D), hi = fmin(hi, res->push_part + D);
@@ -415,7 +403,10 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
     res->std_error = res->walks.std_error;
     res->ci95[0] = res->push_part + res->walks.ci95[0];
     res->ci95[1] = res->push_part + res->walks.ci95[1];
-    if (res->push.support > 0) honest_interval(res, walk_part_bound(&res->push, &g, o));
+    if (res->push.support > 0) {
+        ulam_walk_opts wo = walk_opts(o);
+        honest_interval(res, walk_part_bound(&res->push, &g, o), &wo);
+    }
     res->seconds = res->plan.seconds + (ulam_now() - t0);
     return ULAM_OK;
 }

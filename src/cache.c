@@ -51,7 +51,7 @@ enum {
     W_SUMS_HASH = 16, W_TOFF = 17,
     W_CERT = 32, W_SUM = WORDS - 1, CERT_VERSION = 3, CERT_WORDS = 37,
     W_BOUNDS = 96, BOUNDS_VERSION = 1, BOUNDS_WORDS = 16,
-    BLOCK_ENTRIES = 1024 /* entries a block aims at: a few pages of colidx and val */
+    BLOCK_ENTRIES = 128 /* entries a block aims at: a random row read verifies ~16 rows, not ~128 */
 };
 static const char MAGIC[8] = {'u', 'l', 'a', 'm', 'S', 'Y', 'S', '1'};
 
@@ -78,6 +78,7 @@ struct ulam_system {
     ulam__reach bounds;    /* the bounds extension (seen and K unset) */
     void *map;             /* the mapping (NULL: borrowed memory) */
     size_t map_bytes;
+    _Atomic int64_t *checked; /* [0] blocks verified, [1] rows of M they hold */
 };
 
 /* XXH3-64 of bytes p[0 .. n). */
@@ -222,13 +223,13 @@ static int put_part(FILE *f, const void *p, size_t n, uint64_t *at)
     return !pad || fwrite(zeros, 1, pad, f) == pad;
 }
 
-/* log2 of the rows of a block: about BLOCK_ENTRIES entries of the matrix (b alone: 1024 rows),
+/* log2 of the rows of a block: at most about BLOCK_ENTRIES entries of the matrix (b alone: 1024 rows),
  * from 16 to 65536 rows. */
 static int block_shift(int64_t n, int64_t nnz)
 {
     double want = nnz > 0 ? (double)BLOCK_ENTRIES * (double)n / (double)nnz : 1024.0;
     int s = 4;
-    while (s < 16 && (double)((int64_t)1 << s) < want) s++;
+    while (s < 16 && (double)((int64_t)1 << (s + 1)) <= want) s++; /* at most BLOCK_ENTRIES entries on average */
     return s;
 }
 
@@ -445,8 +446,12 @@ int ulam_system_from_memory(const void *data, size_t bytes, const uint64_t tag[2
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a system");
     int status = parse(data, bytes, tag, s, err);
     int64_t total = status ? 0 : s->nblocks[0] + s->nblocks[1] + s->nblocks[2];
-    if (!status && !(s->state = calloc((size_t)(total ? total : 1), sizeof *s->state)))
+    if (!status && (!(s->state = calloc((size_t)(total ? total : 1), sizeof *s->state)) ||
+                    !(s->checked = calloc(2, sizeof *s->checked)))) {
+        free((void *)s->state);
+    free((void *)s->checked);
         status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the blocks' states");
+    }
     if (status) {
         free(s);
         return status;
@@ -536,6 +541,8 @@ static int verify_block(const ulam_system *s, int part, int64_t k)
             v = (unsigned char)csr_block_state(part == PART_M ? &s->csr : &s->tr, r0, r1, want);
         }
         atomic_store_explicit(st, v, memory_order_release);
+        if (part == PART_M) atomic_fetch_add_explicit(&s->checked[1], r1 - r0, memory_order_relaxed);
+        atomic_fetch_add_explicit(&s->checked[0], 1, memory_order_relaxed);
     }
     return v == GOOD ? ULAM_OK : ULAM_ESYNTAX;
 }
@@ -640,6 +647,13 @@ const ulam_csr *ulam_system_transpose(const ulam_system *s)
     return s && s->has_tr && !verify_part(s, PART_T, 0, s->tr.nrows, NULL) ? &s->tr : NULL;
 }
 
+/* The blocks verified so far and the rows of M they hold. */
+int64_t ulam_system_checked(const ulam_system *s, int64_t *rows)
+{
+    if (rows) *rows = s ? atomic_load(&s->checked[1]) : 0;
+    return s ? atomic_load(&s->checked[0]) : 0;
+}
+
 /* The stored certificate, or NULL. */
 const ulam_certificate *ulam_system_certificate(const ulam_system *s)
 {
@@ -668,6 +682,7 @@ ulam_system *ulam_system_free(ulam_system *s)
     if (!s) return NULL;
     if (s->map) munmap(s->map, s->map_bytes);
     free((void *)s->state);
+    free((void *)s->checked);
     free(s);
     return NULL;
 }

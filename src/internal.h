@@ -109,6 +109,14 @@ int ulam__guard_fits(const ulam_guard *g, double continue_q, double alpha, int n
  * without a bound). */
 double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E);
 
+/* The forward push on b (src/bpush.c): push r (q alongside; x = q + (I - M)^-1 r holds before and
+ * after) on Mt, M's transpose, until every |r_j| <= rmax or *ops (nonzeros read, plus one a push)
+ * passes max_ops.  ULAM_OK or ULAM_ENOMEM. */
+int ulam__bpush(const ulam_csr *Mt, double rmax, int64_t max_ops, double *q, double *r, int64_t *ops);
+
+/* max_j |r_j| over n entries. */
+double ulam__bpush_max(const double *r, int64_t n);
+
 struct ulam_kernel; /* src/kernel.h */
 
 /* A set of states adjoint walks on K can reach (seen: n flags, closed under the walk's moves,

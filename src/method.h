@@ -16,6 +16,9 @@ struct ulam_run {
     double *val;
     ulam_csr *Mt;
     ulam_push *w;
+    double *bq, *br;      /* bidirectional with a dense b: the push on b's q and residual r (src/bpush.c) */
+    ulam_walk_opts bwo;   /* and the walks' options on r (adjoint from the index, offset q_i) */
+    ulam_bidir_plan_info bplan; /* and its plan (also in the choice's bidir) */
 };
 
 /* One query's choice in progress. */

@@ -1052,8 +1052,8 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci);
 
 /* Nonzero when the rel_err rule holds for r (see ulam_solve in ulam.h): the run's 95% interval
- * (stop.h) meeting ulam__stop_rel_met (stderr <= E |m|, range and bias terms within the
- * same width sqrt(2 L) E |m|), after ULAM__REL_MIN walks, forward with
+ * (stop.h) meeting ulam__stop_rel_met (stderr <= E |m|, and the whole half-width, range and bias
+ * terms included, within 2 sqrt(2 L) E |m|), after ULAM__REL_MIN walks, forward with
  * the watched component tallied, and walks cut at max_steps moving it by at most
  * ULAM__CUT_SHARE E |m|; x certified 0 (nothing that scores is reachable) meets it at once. */
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
@@ -1199,7 +1199,9 @@ static double bias_scale(const ulam_solver *s, double m)
 }
 
 /* The run's 95% interval so far (stop.h) from r's estimate, variance and walks, and the range R
- * it used: a single score's range (score_range), for scores without a bound at a truncation
+ * it used: a single score's range (score_range: the width of its random part; the adjoint
+ * expected estimator adds b_i, score0, to every score, so a score past |b_i| + R, not R, is
+ * past the range), for scores without a bound at a truncation
  * whose bias is at most a quarter of the standard error, kept between 1e-6 and
  * max(ULAM__STOP_TAIL, E / 4) of |m| (the tighter the truncation, the wider the range; a
  * sample without spread takes the tightest); the truncation's and the cuts' bias widen it.
@@ -1220,7 +1222,7 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
         ulam__stop_ci c;
         Rt = isfinite(m) ? score_range(s, m, t / m) : s->bound == 0.0 ? s->range : INFINITY;
         ulam__stop_interval(r->walks, r->estimate, r->variance, Rt, (truncated ? t : 0.0) + r->cut_bound,
-                            sqrt(s->maxsq), s->signs ? Rt / 2.0 : Rt, k, &c);
+                            sqrt(s->maxsq), fabs(s->w.score0) + (s->signs ? Rt / 2.0 : Rt), k, &c);
         if (j == 0 || c.half < best) best = c.half, *ci = c, *R = Rt;
     }
     if (s->var_finite != 1 && ci->kind != ULAM__STOP_EXACT) ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;

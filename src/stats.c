@@ -76,14 +76,6 @@ double ulam__cut_bound(double per_step, double qmax, double kappa, int64_t max_s
     return kappa * per_step * pow(qmax, (double)max_steps) / (1.0 - qmax);
 }
 
-/* Whether the rule as it was holds. */
-int ulam__rel_err_holds(int64_t n, double m, double se, double min_walks, double var_rel_error, double E)
-{
-    m = fabs(m);
-    return E > 0 && n >= ULAM__REL_MIN && m > 0 && se <= E * m && (double)n >= min_walks &&
-           var_rel_error <= ULAM__VAR_REL_MAX;
-}
-
 /* Mean and sample variance from a sum and a sum of squares. */
 void ulam__sums_moments(double n, double sum, double sumsq, double *mean, double *variance)
 {

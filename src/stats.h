@@ -40,11 +40,6 @@ void ulam__sums_moments(double n, double sum, double sumsq, double *mean, double
  * walking on to the 1e9 cap (r500's expected estimator at E = 0.01 spun 1e9 walks, 92 s). */
 #define ULAM__NO_CI_SPAN 1024.0
 
-/* The rule as it was, kept for radiosity shooting and gathering without a certified range
- * (src/radiosity/patchwalk.c): at least ULAM__REL_MIN walks, stderr <= E |m|, n >= min_walks
- * and the variance's own relative standard error at most ULAM__VAR_REL_MAX. */
-#define ULAM__VAR_REL_MAX 0.25
-int ulam__rel_err_holds(int64_t n, double m, double se, double min_walks, double var_rel_error, double E);
 
 /* The range R of a single walk's score the rule uses: range when finite (a bounded score);
  * else, for scores that add per_step at most at each visit (weights bounded), with the walk's

@@ -312,8 +312,9 @@ static void test_mesh_error_flags(void **state)
         assert_true(m.point[0][c] - pr.radiosity[c] > 10 * se); /* the centre is brighter than the floor's mean */
         assert_true(m.error[c] > 10 * pr.std_error[c]);         /* dominates */
     }
-    /* a back-wall patch of a fine mesh (20 mm: the wall's radiosity varies by about 0.8% across
-     * it, less than the points' 2%): the surface agrees with the patch within its errors */
+    /* a back-wall patch of a fine mesh (20 mm): the surface agrees with the patch within its
+     * errors and the mesh's own, a few % of B (the points now run to their certified 2%, precise
+     * enough to resolve the 2.2% the wall varies across it) */
     assert_int_equal(ulam_scene_subdivide(s, 20.0, &fine), ULAM_OK);
     ulam_tracer *tf = must_tracer_of(fine);
     assert_int_equal(ulam_scene_find(fine, "back_wall", &p), ULAM_OK);
@@ -324,7 +325,7 @@ static void test_mesh_error_flags(void **state)
         double se = sqrt(pr.std_error[c] * pr.std_error[c] + m.error_se[c] * m.error_se[c]);
         print_message("fine back wall %c: patch %.5f +- %.2g, mesh error %.4f +- %.2g\n", "RGB"[c], pr.radiosity[c],
                       pr.std_error[c], m.error[c], m.error_se[c]);
-        assert_true(m.error[c] < 4 * se);
+        assert_true(m.error[c] < 4 * se + 0.03 * pr.radiosity[c]);
     }
     ulam_tracer_free(tf), ulam_tracer_free(t);
     ulam_scene_free(fine), ulam_scene_free(s);

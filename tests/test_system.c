@@ -295,13 +295,78 @@ static void test_lazy_pages(void **state)
     free(b);
 }
 
+/* A one-row query on a random system (8 entries a row at uniform columns, n = 2^15) from a
+ * prepared file verifies at most 16 rows of M for each row its walks build (blocks of about 128
+ * entries: with 1024-entry blocks each random row read verified its 127 neighbours too), and
+ * answers as the parsed system does, bit for bit, within 4 standard errors of x_i. */
+static void test_random_rows_checked(void **state)
+{
+    (void)state;
+    const int64_t n = 1 << 15, k = 8;
+    int32_t *ri = malloc((size_t)(n * k) * sizeof *ri), *ci = malloc((size_t)(n * k) * sizeof *ci);
+    double *v = malloc((size_t)(n * k) * sizeof *v), *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
+    ulam_rng r;
+    ulam_rng_seed(&r, 29, 0);
+    for (int64_t i = 0; i < n; i++) {
+        double sum = 0;
+        for (int64_t q = 0; q < k; q++)
+            ri[i * k + q] = (int32_t)i, ci[i * k + q] = (int32_t)ulam_rng_bounded(&r, (uint64_t)n),
+                       sum += v[i * k + q] = 0.1 + ulam_rng_uniform(&r);
+        for (int64_t q = 0; q < k; q++) v[i * k + q] *= 0.9 / sum;
+        b[i] = x[i] = 0.5 + ulam_rng_uniform(&r);
+    }
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, n * k, ri, ci, v, &M), ULAM_OK);
+    for (int it = 0; it < 240; it++) /* x = b + M x: 0.9^240 of the answer is left */
+        for (int64_t i = 0; i < n; i++) {
+            double t = b[i];
+            for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) t += M->val[q] * x[M->colidx[q]];
+            x[i] = t;
+        }
+    char path[] = "/tmp/ulam_test_randomXXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    ulam_certificate cert; /* with the stored bounds: no pass over what the start reaches */
+    assert_int_equal(ulam_certificate_compute(M, 0.0, NULL, &cert, NULL), ULAM_OK);
+    ulam_system_desc d = {.M = M, .b = b, .n = n, .cert = &cert};
+    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    ulam_system *s = NULL;
+    assert_int_equal(ulam_system_open(path, NULL, &s, NULL), ULAM_OK);
+    unlink(path);
+    const ulam_csr *lm;
+    const double *lb;
+    assert_int_equal(ulam_system_lazy(s, &lm, &lb), ULAM_OK);
+    ulam_analysis_opts ao = ulam_analysis_defaults();
+    ao.b = lb, ao.system = s;
+    ulam_analysis *af = NULL, *ap = NULL;
+    assert_int_equal(ulam_analysis_alloc(lm, &ao, &af, NULL), ULAM_OK);
+    ao.b = b, ao.system = NULL;
+    assert_int_equal(ulam_analysis_alloc(M, &ao, &ap, NULL), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.index = 5, o.max_walks = 60, o.threads = 1;
+    ulam_walk_result r1, r2;
+    assert_int_equal(ulam_analysis_solve(af, lb, &o, &r1, NULL), ULAM_OK);
+    int64_t rows = 0, blocks = ulam_system_checked(s, &rows);
+    if (!(r1.rows > 100 && rows >= r1.rows && rows <= 16 * r1.rows && blocks > 0))
+        fail_msg("%lld rows built, %lld rows of M verified in %lld blocks", (long long)r1.rows, (long long)rows,
+                 (long long)blocks);
+    assert_int_equal(ulam_analysis_solve(ap, b, &o, &r2, NULL), ULAM_OK);
+    assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
+    assert_true(fabs(r1.estimate - x[5]) < 4 * r1.std_error);
+    ulam_analysis_free(af), ulam_analysis_free(ap);
+    ulam_system_free(s);
+    ulam_csr_free(M);
+    free(ri), free(ci), free(v), free(b), free(x);
+}
+
 /* Corrupt arrays behind a sound header: the check refuses them, and so does a walk that reaches
  * them (at set-up when the start row is bad, else at the round that reaches one); a walk that
  * does not reach them never sees them.  Each case prints its index when it fails. */
 static void test_corrupt_rows(void **state)
 {
     (void)state;
-    const int64_t n = 1024, B = 256; /* blocks of 256 rows: the walks from 3 read block 0 alone */
+    const int64_t n = 1024, B = 32; /* blocks of 32 rows (128 entries): the walks from 3 read block 0 alone */
     ulam_csr *M = two_blocks(n, B);
     double *b = malloc((size_t)n * sizeof *b);
     for (int64_t i = 0; i < n; i++) b[i] = 1.0;
@@ -429,6 +494,15 @@ static void test_analysis_local(void **state)
                 fail_msg("estimator %d, x[%lld] = %.8g +- %.3g, exact %.8g", e, (long long)idx, r1.estimate,
                          r1.std_error, x[idx]);
         }
+    for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++) { /* a fixed budget reads no more (the file's bounds) */
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.index = 20, o.estimator = e, o.max_walks = 3000, o.threads = 2, o.seed = 20;
+        ulam_walk_result r1, r2;
+        assert_int_equal(ulam_analysis_solve(af, bs, &o, &r1, NULL), ULAM_OK);
+        assert_int_equal(ulam_analysis_solve(ap, b, &o, &r2, NULL), ULAM_OK);
+        assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
+        assert_true(isfinite(r1.ci95[0]) && fabs(r1.estimate - x[20]) < 4 * r1.std_error);
+    }
     ulam_analysis_info info;
     ulam_analysis_get_info(af, &info);
     assert_int_equal(info.bounds, 1), assert_int_equal(info.b_scores, 1), assert_int_equal(info.guard, 1);
@@ -749,6 +823,7 @@ int main(void)
         cmocka_unit_test(test_roundtrip),
         cmocka_unit_test(test_damaged),
         cmocka_unit_test(test_lazy_pages),
+        cmocka_unit_test(test_random_rows_checked),
         cmocka_unit_test(test_corrupt_rows),
         cmocka_unit_test(test_flip_table),
         cmocka_unit_test(test_threads),

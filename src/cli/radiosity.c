@@ -153,8 +153,8 @@ typedef struct {
     double seconds;
     int threads, interrupted;
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
-    int rel_err_met;  /* ray gathering: the run stopped because the --rel-err rule holds */
-    double min_walks; /* ray gathering: the walks the rule's range term needs (0: unbounded) */
+    int rel_err_met;  /* ray walks: the run stopped because the --rel-err rule holds */
+    double min_walks; /* ray walks: the walks the rule needs at this estimate */
     double *all, *all_se; /* shooting: 3 per patch each */
 } walked;
 
@@ -402,6 +402,12 @@ static void rel_err_warning(const args *a, const ulam_rad_result *r)
 {
     double limit = a->o.max_walks > 0 && a->o.max_walks < ULAM_REL_ERR_CAP ? (double)a->o.max_walks : 1e8;
     if (!(a->o.rel_err > 0) || !(r->min_walks > limit)) return;
+    if (a->o.mode == ULAM_FORWARD || a->o.estimator < ULAM_RAD_COLLISION) { /* next-event or shooting */
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g: the rule needs about %.3g walks at this estimate before it "
+                        "may stop (%s): one walk's certified score range is wide against the estimate\n",
+                a->scene, a->o.rel_err, r->min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
+        return;
+    }
     fprintf(stderr, "ulam: %s: warning: --rel-err %g: one walk can score up to a bright emitter's radiosity at every "
                     "bounce, so the rule needs about %.3g walks at this estimate before it may stop (%s): "
                     "--estimator next-event samples the emitters directly and has no such tail\n",
@@ -446,20 +452,8 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     return cli_exit_code(status);
 }
 
-/* The stopping rule of --matrix-walk --rel-err E at a patch, in one place: the answer's error
- * is the walks' and F's combined, so the walks stop at E' = sqrt(E^2 - (ff / |B|)^2) of the
- * estimate, ff being F's standard error at the patch and B the direct solution there; 0 when
- * F's error alone reaches E (more walks cannot meet it: more --ff-rays can); E when F's error
- * is unknown (the error bar is then labelled conditional on F). */
-static double matrix_walk_rel_err(double E, double ff, double B, int ff_known)
-{
-    if (!(E > 0) || !ff_known) return E;
-    double f = B != 0 ? ff / fabs(B) : (ff > 0 ? INFINITY : 0.0);
-    return f < E ? sqrt(E * E - f * f) : 0.0;
-}
-
 /* Walks on the assembled M, one channel at a time (at a patch with --rel-err: to the combined
- * rule of matrix_walk_rel_err, given F's error ff and the direct solution Bd there); 0 or an
+ * rule of ulam_rad_walk_target, given F's error ff and the direct solution Bd there); 0 or an
  * exit code. */
 static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, const double *ff, const double *Bd,
                         walked *w)
@@ -478,7 +472,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, c
         ulam_solver *sv = NULL;
         ulam_walk_opts o = a->o;
         if (a->o.rel_err > 0 && a->o.mode == ULAM_ADJOINT) {
-            o.rel_err = matrix_walk_rel_err(a->o.rel_err, ff ? ff[c] : 0, Bd ? Bd[c] : 0, ff && Bd);
+            o.rel_err = ulam_rad_walk_target(a->o.rel_err, ff ? ff[c] : 0, Bd ? Bd[c] : 0, ff && Bd);
             if (!(o.rel_err > 0)) { /* F's noise alone is past the target: walk to it, say it is not met */
                 w->ff_limited[c] = 1;
                 o.rel_err = a->o.rel_err;
@@ -716,7 +710,7 @@ static void print_text(const args *a, const report *r)
             else if (a->matrix_walk) printf(" (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
             printf("%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
         }
-        if (a->o.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT && !w->zero)
+        if (a->o.rel_err > 0 && !a->matrix_walk && !w->zero)
             printf("rel-err      %s (%g; the rule's range term wants %.3g walks)\n", w->rel_err_met ? "met" : "NOT met",
                    a->o.rel_err, w->min_walks);
         if (w->zero)

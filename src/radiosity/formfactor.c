@@ -1,6 +1,7 @@
 /* Form factors: estimated by ray casting, checked by reciprocity, row sums and Howell's exact
  * formulas; the radiosity system M = diag(rho_c) F and its LAPACK solve. */
 #include "rad.h"
+#include "../stop.h"
 
 #include <lapacke.h>
 #include <stdlib.h>
@@ -272,4 +273,11 @@ int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays,
     }
     free(a), free(x), free(noise), free(ipiv);
     return status;
+}
+
+/* The walks' relative target beside F's error at a patch (stop.c). */
+double ulam_rad_walk_target(double rel_err, double ff_se, double B, int ff_known)
+{
+    if (!(rel_err > 0) || !ff_known) return rel_err;
+    return ulam__stop_combined_target(rel_err, B != 0 ? ff_se / fabs(B) : (ff_se > 0 ? INFINITY : 0.0));
 }

@@ -91,3 +91,81 @@ double ulam__lights_hit_weight(const ulam__lights *L, const ulam_scene *s, int e
     double pc = h->cos_from * h->cos_to / (M_PI * h->dist * h->dist);
     return ulam__mis_weight(estimator, pc, (E[0] + E[1] + E[2]) / L->ptot, 0);
 }
+
+/* The least and largest v . u over the vertices of patch p (or, p < 0, the one point pt). */
+static void project(const ulam_scene *s, int64_t p, const double *pt, const double u[3], double *lo, double *hi)
+{
+    *lo = INFINITY, *hi = -INFINITY;
+    int64_t a = p < 0 ? 0 : s->start[p], b = p < 0 ? 1 : s->start[p + 1];
+    for (int64_t k = a; k < b; k++) {
+        double d = ulam__dot3(p < 0 ? pt : s->vert + 3 * s->vidx[k], u);
+        *lo = fmin(*lo, d), *hi = fmax(*hi, d);
+    }
+}
+
+/* An upper bound on G(x, y) = cos cos_y / (pi r^2) over x on patch p (or, p < 0, the point pt
+ * with normal n) and y on emitter l, both facing each other: 0 when l lies wholly on or behind
+ * x's plane or x's patch wholly on or behind l's (no pair faces), 1 / (pi d^2) for d > 0 a lower
+ * bound on their distance (the widest gap along x's normal, against l's normal, and along the
+ * line between their centroids: separating axes of convex polygons), else INFINITY. */
+static double g_max(const ulam_scene *s, int64_t p, const double *pt, const double n[3], int64_t l)
+{
+    const double *nl = s->normal + 3 * l;
+    double lo_p, hi_p, lo_l, hi_l, cp[3] = {0, 0, 0}, cl[3] = {0, 0, 0}, u[3], scale = 0.0;
+    project(s, p, pt, n, &lo_p, &hi_p);
+    project(s, l, NULL, n, &lo_l, &hi_l);
+    scale = fmax(fabs(lo_p), fabs(hi_l)) + 1.0;
+    if (hi_l - lo_p <= 1e-12 * scale) return 0.0; /* l on or behind x's plane: cos <= 0 (rounding aside) */
+    double gap = lo_l - hi_p;
+    project(s, p, pt, nl, &lo_p, &hi_p);
+    project(s, l, NULL, nl, &lo_l, &hi_l);
+    if (hi_p - lo_l <= 1e-12 * (fmax(fabs(hi_p), fabs(lo_l)) + 1.0)) return 0.0; /* x behind l's plane: cos_l <= 0 */
+    gap = fmax(gap, lo_p - hi_l); /* along -nl: l's least minus x's largest is x's least minus l's largest along nl */
+    int64_t a = p < 0 ? 0 : s->start[p], b = p < 0 ? 1 : s->start[p + 1];
+    for (int64_t k = a; k < b; k++)
+        for (int i = 0; i < 3; i++) cp[i] += (p < 0 ? pt : s->vert + 3 * s->vidx[k])[i] / (double)(b - a);
+    for (int64_t k = s->start[l]; k < s->start[l + 1]; k++)
+        for (int i = 0; i < 3; i++) cl[i] += s->vert[3 * s->vidx[k] + i] / (double)(s->start[l + 1] - s->start[l]);
+    ulam__sub3(cl, cp, u);
+    double len = sqrt(ulam__dot3(u, u));
+    if (len > 0) {
+        for (int i = 0; i < 3; i++) u[i] /= len;
+        project(s, p, pt, u, &lo_p, &hi_p);
+        project(s, l, NULL, u, &lo_l, &hi_l);
+        gap = fmax(gap, lo_l - hi_p);
+    }
+    return gap > 0 ? 1.0 / (M_PI * gap * gap) : INFINITY;
+}
+
+/* The most one light sample (light) or one landing of the walk's cosine ray on an emitter
+ * (!light) can score per unit of W E_l, for area densities p_L = pl and p_C = G <= gmax: the
+ * light sample scores G / pl w_L (the balance heuristic's and light sampling's rise with G; the
+ * power heuristic's G pl / (pl^2 + G^2) peaks at G = pl), the landing w_C (rising with G). */
+static double score_factor(int estimator, double pl, double gmax, int light)
+{
+    if (gmax == 0.0) return 0.0;
+    if (!light) return ulam__mis_weight(estimator, gmax, pl, 0);
+    if (estimator == ULAM_RAD_COLLISION) return 0.0;
+    if (!isfinite(gmax)) return estimator == ULAM_RAD_NEXT_EVENT_LIGHT ? INFINITY : estimator == ULAM_RAD_NEXT_EVENT ? 0.5 : 1.0;
+    double g = estimator == ULAM_RAD_NEXT_EVENT ? fmin(gmax, pl) : gmax;
+    return g / pl * ulam__mis_weight(estimator, pl, g, 1);
+}
+
+/* A certified bound, per channel, on what one vertex of a next-event walk at patch p (or, p < 0,
+ * the point pt with normal n) scores with weights W <= 1: rho_pc (1 at the point or with
+ * reflect 0) times the largest light sample plus the largest weighted landing on an emitter,
+ * over every emitter (score_factor at g_max).  INFINITY where light sampling alone meets an
+ * emitter it may touch (1 / r^2 unbounded). */
+void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
+                               const double n[3], int reflect, double out[3])
+{
+    double lmax[3] = {0, 0, 0}, hmax[3] = {0, 0, 0};
+    for (int64_t k = 0; k < L->nem; k++) {
+        int64_t l = L->emitter[k];
+        const double *E = s->emit + 3 * l;
+        double pl = (E[0] + E[1] + E[2]) / L->ptot, g = l == p ? 0.0 : g_max(s, p, pt, n, l);
+        double fl = score_factor(estimator, pl, g, 1), fh = score_factor(estimator, pl, g, 0);
+        for (int c = 0; c < 3; c++) lmax[c] = fmax(lmax[c], E[c] * fl), hmax[c] = fmax(hmax[c], E[c] * fh);
+    }
+    for (int c = 0; c < 3; c++) out[c] = (reflect && p >= 0 ? s->rho[3 * p + c] : 1.0) * lmax[c] + hmax[c];
+}

@@ -72,7 +72,8 @@ struct ulam_rad_solver {
     const ulam_scene *s;
     int threads;
     double *q;            /* continuation per patch: max_c rho */
-    double per_step[3], range[3], qmax; /* gathering: the score bounds of the rel_err rule */
+    double per_step[3], range[3], qmax; /* the score bounds of the rel_err rule (score_bounds) */
+    double first[3], w1[3];             /* next-event: the first vertex's (first_bounds) */
     ulam__lights L;       /* the emitters (shooting's source, next-event's lights) */
     int at;               /* a point solver: walks from at_x (normal at_n, on patch at_self or -1) */
     double at_x[3], at_n[3];
@@ -142,28 +143,73 @@ static int build_source(ulam_rad_solver *s, ulam_error *err)
     return ULAM_OK;
 }
 
-/* Gathering's bounds for the rel_err rule, over the whole scene (weights rho_c / q <= 1):
- * collision scores at most max_p E_pc a visit and a walk survives a step with probability at
- * most qmax = max_p q_p; absorption scores at most max_p E_pc / (1 - q_p) once; next-event's
- * light samples (1 / r^2 near a light) have no bound, so only the variance check guards them. */
+/* The first vertex's bounds of a next-event walk (score_bounds): first_c, what the start (patch
+ * opts->index or the point) can score beyond its emission, and w1_c, the weight the walk leaves
+ * it with (rho_c / q of the start patch; 1 from a point): the walk's score is at most
+ * first_c + w1_c per_step_c a later vertex.  Others: first 0, w1 1. */
+static void first_bounds(ulam_rad_solver *s)
+{
+    const ulam_scene *sc = s->s;
+    int64_t i = s->at ? s->at_self : s->o.index;
+    for (int c = 0; c < 3; c++) s->first[c] = 0.0, s->w1[c] = 1.0;
+    if (!next_event(s->o.estimator) || s->o.mode != ULAM_ADJOINT || (i < 0 && !s->at)) return;
+    ulam__lights_vertex_bound(&s->L, sc, s->o.estimator, i, i < 0 ? s->at_x : NULL, s->at ? s->at_n : sc->normal + 3 * i,
+                              !s->at, s->first);
+    for (int c = 0; c < 3 && !s->at; c++) s->w1[c] = s->q[i] > 0 ? sc->rho[3 * i + c] / s->q[i] : 0.0;
+}
+
+/* The bounds of the rel_err rule (per channel: per_step, what one step can score; range, a
+ * bound on a whole walk's score when one is known, else INFINITY and the walks' length is
+ * truncated, stop.h; qmax the largest survival).  Every weight stays at most its start
+ * (rho_c / q <= 1).  Gathering: collision scores at most max_p E_pc a visit; absorption at most
+ * max_p E_pc / (1 - q_p) once; next-event at most lights.c's vertex bound a vertex (the MIS
+ * weights cap the 1 / r^2 of a light sample near its light; light sampling alone is bounded
+ * only where no patch can touch an emitter), its start patch's emission being a constant.
+ * Shooting's tally at patch i: at most w0_c rho_ic a visit, w0_c = P max_l E_lc / sum_c E_lc
+ * the largest starting weight (collision), or that / (1 - q_i) once (absorption). */
 static void score_bounds(ulam_rad_solver *s)
 {
     const ulam_scene *sc = s->s;
     int nee = next_event(s->o.estimator);
+    first_bounds(s);
     s->qmax = 0.0;
     for (int c = 0; c < 3; c++) s->per_step[c] = s->range[c] = 0.0;
     for (int64_t p = 0; p < sc->npatches; p++) {
         s->qmax = fmax(s->qmax, s->q[p]);
+        double b[3];
+        if (nee) ulam__lights_vertex_bound(&s->L, sc, s->o.estimator, p, NULL, sc->normal + 3 * p, !s->at, b);
         for (int c = 0; c < 3; c++) {
             double E = sc->emit[3 * p + c];
-            s->per_step[c] = fmax(s->per_step[c], E);
+            s->per_step[c] = fmax(s->per_step[c], nee ? b[c] : E);
             s->range[c] = fmax(s->range[c], E > 0 ? E / (1.0 - s->q[p]) : 0.0);
         }
     }
-    for (int c = 0; c < 3; c++) {
-        if (s->o.estimator != ULAM_RAD_ABSORPTION) s->range[c] = s->per_step[c] > 0 ? INFINITY : 0.0;
-        if (nee && s->per_step[c] > 0) s->per_step[c] = INFINITY;
+    if (s->o.mode == ULAM_FORWARD) {
+        for (int c = 0; c < 3; c++) {
+            double w0 = 0.0, rho = sc->rho[3 * s->o.index + c], q = s->q[s->o.index];
+            for (int64_t k = 0; k < s->L.nem; k++) {
+                const double *E = sc->emit + 3 * s->L.emitter[k];
+                w0 = fmax(w0, s->L.ptot * E[c] / (E[0] + E[1] + E[2]));
+            }
+            s->per_step[c] = w0 * rho;
+            s->range[c] = s->o.estimator == ULAM_RAD_ABSORPTION ? (w0 * rho > 0 ? w0 * rho / (1.0 - q) : 0.0) : INFINITY;
+        }
+        return;
     }
+    for (int c = 0; c < 3; c++)
+        if (s->o.estimator != ULAM_RAD_ABSORPTION) s->range[c] = s->per_step[c] > 0 ? INFINITY : 0.0;
+}
+
+/* ULAM_OK, or (rel_err with a channel whose scores have no certified bound: light sampling
+ * alone beside an emitter) ULAM_EINVAL: the rule of stop.h would have no interval to stop on. */
+static int check_bounded(const ulam_rad_solver *s, ulam_error *err)
+{
+    for (int c = 0; c < 3; c++)
+        if (s->o.rel_err > 0 && !isfinite(s->per_step[c]))
+            return ulam__fail(err, ULAM_EINVAL, 0, -1, "a certified bound on the scores for rel_err (light sampling "
+                                                       "alone has none where a patch may touch an emitter: "
+                                                       "use next-event with MIS, or a walk budget)");
+    return ULAM_OK;
 }
 
 /* Allocate per-thread scratch and per-block results. */
@@ -175,10 +221,8 @@ static int alloc_work(ulam_rad_solver *s)
     s->q = ulam__malloc((size_t)n, sizeof *s->q);
     if (!s->scratch || !s->blocks || !s->q) return ULAM_ENOMEM;
     for (int64_t p = 0; p < n; p++) s->q[p] = ulam__max3(s->s->rho + 3 * p);
-    if (s->o.mode == ULAM_ADJOINT) {
-        score_bounds(s);
-        return ULAM_OK;
-    }
+    if (!s->at) score_bounds(s); /* a point solver's, once its point is known */
+    if (s->o.mode == ULAM_ADJOINT) return ULAM_OK;
     for (int k = 0; k < s->threads; k++) {
         rad_scratch *sc = &s->scratch[k];
         sc->hist = ulam__calloc((size_t)(3 * n), sizeof *sc->hist);
@@ -217,6 +261,10 @@ static int solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, int po
     if (alloc_work(s)) {
         ulam_rad_solver_free(s);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walk workspace");
+    }
+    if (!point && (status = check_bounded(s, err))) {
+        ulam_rad_solver_free(s);
+        return status;
     }
     *out = s;
     return ULAM_OK;
@@ -261,7 +309,9 @@ int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, const
         double h = ulam__dot3(d, pn);
         for (int k = 0; k < 3; k++) s->at_x[k] -= h * pn[k];
     }
-    return ULAM_OK;
+    score_bounds(s); /* with the point's own first vertex */
+    if ((status = check_bounded(s, err))) *out = ulam_rad_solver_free(s);
+    return status;
 }
 
 /* A point solver's answer: irradiance, and radiosity on the patch the point lies on. */
@@ -496,71 +546,70 @@ static void merge_block(void *ctx, int k)
     s->cut += br->cut;
 }
 
-static void result(const ulam_rad_solver *s, const double mins[3], ulam_rad_result *r);
+static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r);
 
-/* Gathering: channel c's 95% interval (stop.h) at estimate m, its scores' range at a truncation
- * whose bias is at most E |m| / 4 (the patch solver keeps no per-channel largest score: the
- * range is taken as holding). */
+/* Channel c's certified score range R and bias at estimate m (of B), in B's units: the range of
+ * one walk's score (gathering) or of one particle's tally at the patch over its area
+ * (shooting), at a truncation whose bias is at most E |m| / 4 when no whole-walk bound is known
+ * (score_bounds). */
+static void channel_range(const ulam_rad_solver *s, int c, double m, double E, double *R, double *bias)
+{
+    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.index] : 1.0;
+    double later = ulam__score_range(s->range[c], s->w1[c] * s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0);
+    *R = (s->first[c] + later) / A;
+    *bias = isfinite(s->range[c]) ? 0.0 : E * fabs(m) / 4.0;
+}
+
+/* Channel c's 95% interval (stop.h) at estimate m: on the walks' scores (gathering) or the
+ * particles' tallies at the patch over its area (shooting, the emission exact). */
 static void channel_interval(const ulam_rad_solver *s, int c, double m, double E, ulam__stop_ci *ci)
 {
-    m = fabs(m);
-    double R = ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, m, E / 4.0);
+    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.index] : 1.0, R, bias;
+    double off = s->o.mode == ULAM_FORWARD ? s->s->emit[3 * s->o.index + c] : 0.0;
+    channel_range(s, c, m, E, &R, &bias);
     int64_t n = s->run.walks;
-    ulam__stop_interval(n, s->m[c].mean, ulam__moments_variance(&s->m[c]), R, isfinite(s->range[c]) ? 0.0 : E * m / 4.0,
-                        0.0, INFINITY, ulam__stop_epoch(n), ci);
+    ulam__stop_interval(n, off + s->m[c].mean / A, ulam__moments_variance(&s->m[c]) / (A * A), R, bias, 0.0, INFINITY,
+                        ulam__stop_epoch(n), ci);
 }
 
-/* Gathering: the walks the rel_err rule (stop.h) needs in channel c at estimate m. */
+/* The walks the rel_err rule (stop.h) needs in channel c at estimate m. */
 static double channel_min_walks(const ulam_rad_solver *s, int c, double m, double E)
 {
-    ulam__stop_ci ci;
-    channel_interval(s, c, m, E, &ci);
-    double R = ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, fabs(m), E / 4.0);
-    return isfinite(R) ? ulam__stop_walks_needed(m, ulam__moments_variance(&s->m[c]), R, ci.bias, E, ci.k) : 0.0;
+    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.index] : 1.0, R, bias;
+    channel_range(s, c, m, E, &R, &bias);
+    return ulam__stop_walks_needed(m, ulam__moments_variance(&s->m[c]) / (A * A), R, bias, E,
+                                   ulam__stop_epoch(s->run.walks));
 }
 
-/* Gathering with rel_err: the walks the rule's range term needs in each channel, at its
- * estimate, or for an emitting channel still at 0 at the brightest channel's (precise_enough);
- * 0 otherwise (shooting, no rel_err, a channel nothing emits in). */
-static void channel_mins(const ulam_rad_solver *s, double mins[3])
+/* With rel_err: the walks the rule needs in each channel, at its estimate, or for a channel
+ * still at 0 that some walk could score in, at the brightest channel's (precise_enough); 0
+ * otherwise (no rel_err, a channel nothing can score in). */
+static void channel_mins(const ulam_rad_solver *s, const ulam_rad_result *r, double mins[3])
 {
     double bright = 0.0;
-    for (int c = 0; c < 3; c++) bright = fmax(bright, fabs(s->m[c].mean));
+    for (int c = 0; c < 3; c++) bright = fmax(bright, fabs(r->radiosity[c]));
     for (int c = 0; c < 3; c++) {
         mins[c] = 0.0;
-        if (s->o.mode != ULAM_ADJOINT || !(s->o.rel_err > 0)) continue;
-        if (s->m[c].mean != 0.0) mins[c] = channel_min_walks(s, c, s->m[c].mean, s->o.rel_err);
+        if (!(s->o.rel_err > 0)) continue;
+        if (r->radiosity[c] != 0.0) mins[c] = channel_min_walks(s, c, r->radiosity[c], s->o.rel_err);
         else if (s->per_step[c] > 0 && bright > 0) mins[c] = channel_min_walks(s, c, bright, s->o.rel_err);
     }
 }
 
-/* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): gathering
- * takes the rule of src/stop.h (ulam__stop_rel_met on each channel's 95% interval; mins from
- * channel_mins hold a channel still at 0); shooting at patch opts->index, with the moments of
- * that patch's per-particle tallies, and gathering without a certified range (next-event
- * estimation), the rule as it was (ulam__rel_err_holds: the standard error and the variance's
- * own error from the fourth moment, no range term: a particle may return to the patch any
- * number of times, no bound on its tally; a known gap). */
+/* Nonzero when the rel_err rule of src/stop.h holds in every nonzero channel (and one is
+ * nonzero): ulam__stop_rel_met on each channel's 95% interval; a channel still at 0 that some
+ * walk could score in blocks the stop until the walks its range term needs at the brightest
+ * channel's estimate have run (mins, channel_mins): only then would it have seen any of its
+ * scores worth E times that. */
 static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, const double mins[3], double rel_err)
 {
     int any = 0;
-    double bright = 0.0; /* the brightest nonzero channel's estimate */
-    for (int c = 0; c < 3; c++) bright = fmax(bright, fabs(r->radiosity[c]));
     for (int c = 0; c < 3; c++) {
-        /* a channel still at 0 in which some emitter emits: no walk has scored it yet, so it
-         * blocks the stop until enough walks ran to have seen any of its scores worth E times
-         * the brightest channel (the range term at that estimate); gathering only */
-        if (r->radiosity[c] == 0.0 && s->o.mode != ULAM_FORWARD && s->per_step[c] > 0 && bright > 0 &&
-            (double)r->walks < mins[c])
-            return 0;
+        if (r->radiosity[c] == 0.0 && s->per_step[c] > 0 && !((double)r->walks >= mins[c])) return 0;
         if (r->radiosity[c] == 0.0) continue;
         ulam__stop_ci ci;
-        if (s->o.mode != ULAM_FORWARD) channel_interval(s, c, r->radiosity[c], rel_err, &ci);
-        if (s->o.mode == ULAM_FORWARD || ci.kind == ULAM__STOP_NONE
-                ? !ulam__rel_err_holds(r->walks, r->radiosity[c], r->std_error[c], mins[c],
-                                       ulam__moments_variance_rel_error(&s->m[c]), rel_err)
-                : !ulam__stop_rel_met(&ci, r->radiosity[c], rel_err))
-            return 0;
+        channel_interval(s, c, r->radiosity[c], rel_err, &ci);
+        if (!ulam__stop_rel_met(&ci, r->radiosity[c], rel_err)) return 0;
         any = 1;
     }
     return any;
@@ -588,7 +637,6 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_rad_result r;
     double mins[3];
-    channel_mins(s, mins);
     result(s, mins, &r);
     int k = ulam__stop_epoch(r.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN) s->epoch = k;
@@ -604,6 +652,7 @@ void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uin
 {
     ulam__moments zero = {0};
     s->o.index = p, s->o.rel_err = rel_err, s->o.seed = seed, s->o.max_seconds = max_seconds;
+    first_bounds(s);
     s->m[0] = s->m[1] = s->m[2] = zero;
     s->sq = s->maxsq = 0.0;
     s->rays = s->cut = 0;
@@ -626,8 +675,8 @@ static void shot_component(const ulam_rad_solver *s, int64_t p, int c, double *e
     *se = N > 0 ? sqrt(v / N) / A : INFINITY;
 }
 
-/* The result so far, with the channels' range-term minimums mins (channel_mins). */
-static void result(const ulam_rad_solver *s, const double mins[3], ulam_rad_result *r)
+/* The result so far, and the channels' walk minimums mins (channel_mins). */
+static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r)
 {
     memset(r, 0, sizeof *r);
     for (int c = 0; c < 3; c++) {
@@ -639,6 +688,7 @@ static void result(const ulam_rad_solver *s, const double mins[3], ulam_rad_resu
         }
     }
     r->max_share = s->sq > 0 ? fmin(1.0, s->maxsq / s->sq) : 0.0;
+    channel_mins(s, r, mins);
     for (int c = 0; c < 3 && s->o.rel_err > 0; c++) {
         r->min_walks = fmax(r->min_walks, mins[c]); /* 0 in a channel where no minimum applies */
         if (s->m[c].mean != 0.0)
@@ -662,7 +712,6 @@ void ulam_rad_solver_result(const ulam_rad_solver *s, ulam_rad_result *r)
         memset(r, 0, sizeof *r);
         return;
     }
-    channel_mins(s, mins);
     result(s, mins, r);
 }
 

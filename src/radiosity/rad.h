@@ -120,6 +120,13 @@ int ulam__lights_score(const ulam_tracer *t, const ulam__lights *L, int estimato
 double ulam__lights_hit_weight(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t j,
                                const ulam__hit *h);
 
+/* A certified bound per channel on one next-event vertex's score (weights <= 1) at patch p, or
+ * (p < 0) the point pt with unit normal n: rho_p (reflect, a patch) or 1 times the largest light
+ * sample plus the largest MIS-weighted landing on an emitter; INFINITY for light sampling alone
+ * near an emitter it may touch. */
+void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
+                               const double n[3], int reflect, double out[3]);
+
 /* A point walk (point.c): one walk from x (unit normal n, on patch self or -1) on the continuous
  * surfaces: its RGB irradiance score; *rays gets the rays cast, *cut 1 when cut at max_steps. */
 void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, const double *q, int estimator, int64_t max_steps,

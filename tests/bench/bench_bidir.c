@@ -22,6 +22,9 @@
  *   push           push alone with rmax halving from 1 until |p_s - x_t| <= 10% x_t, checked
  *                  against the exact value (an oracle stop: a lower bound on what push alone
  *                  needs without knowing x_t); capped at PUSH_CAP seconds (a lower bound, marked).
+ * Every query's figure is its CPU seconds (the columns bidir_s, walk1_s and push1_s; push_s and
+ * walks_s are the bidirectional parts' wall seconds): on the shared machine a one-thread query's
+ * wall time is mostly waiting for a core, which swamped the ratios.
  * The transpose M' and the walks' guards on it are computed once (their times are printed apart)
  * and given to every query of both walk methods: a query never repeats them.  The bidirectional
  * queries share one push workspace with reach_all (the walks' reachability bounds over every
@@ -42,6 +45,7 @@
 #include "../zipf_graph.h"
 
 #include <math.h>
+#include <time.h>
 
 enum { SOURCES = 20, TARGETS = 5, PAIRS = SOURCES * TARGETS };
 static const double WALK_CAP = 2.0, PUSH_CAP = 5.0, REL = 0.1, ALPHA = 0.85;
@@ -53,6 +57,15 @@ typedef struct {
     int covered, intervals;
     double other[PAIRS], walk[PAIRS]; /* bidirectional: push and walk seconds */
 } series;
+
+/* This process's CPU seconds (user + system): the fair figure on a shared machine, where a
+ * one-thread query's wall time mostly waits for a core (at load 15, 5-10x its CPU time). */
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 /* qsort order of doubles. */
 static int cmp(const void *a, const void *b)
@@ -98,7 +111,7 @@ static double walks_alone(const ulam_csr *Mt, const ulam_guard *g, double *e, in
     o.index = s, o.threads = 1, o.seed = seed, o.max_walks = 0, o.max_seconds = WALK_CAP, o.max_steps = INT64_MAX / 4;
     e[t] = 1.0;
     ulam_solver *sv = NULL;
-    double t0 = ulam_now(), rate = INFINITY;
+    double t0 = ulam_now(), c0 = cpu_now(), rate = INFINITY;
     ulam_walk_result r = {0};
     int reached = 0;
     if (!ulam_solver_alloc(Mt, e, &o, &sv, NULL)) {
@@ -111,7 +124,8 @@ static double walks_alone(const ulam_csr *Mt, const ulam_guard *g, double *e, in
             reached = r.walks >= 1000 && r.variance > 0 && r.std_error <= REL * fabs(r.estimate);
         }
     }
-    double total = ulam_now() - t0;
+    double wall = ulam_now() - t0, total = cpu_now() - c0;
+    rate *= wall > 0 ? total / wall : 1.0; /* the walks' best wall rate in CPU seconds */
     ulam_solver_free(sv);
     e[t] = 0.0;
     *mark = 0, *covers = -1;
@@ -127,6 +141,7 @@ static double walks_alone(const ulam_csr *Mt, const ulam_guard *g, double *e, in
 /* Push alone from t, rmax halving, until p_s is within REL of exact (or PUSH_CAP); seconds, *capped. */
 static double push_alone(ulam_push *w, int64_t s, int64_t t, double exact, int *capped, double *rmax_reached)
 {
+    double c0 = cpu_now();
     ulam_push_start(w, t);
     ulam_push_info pi;
     for (double rmax = 1.0;; rmax /= 2) {
@@ -135,11 +150,11 @@ static double push_alone(ulam_push *w, int64_t s, int64_t t, double exact, int *
         *rmax_reached = rmax;
         if (fabs(ulam_push_estimates(w)[s] - exact) <= REL * exact || pi.support == 0) {
             *capped = 0;
-            return pi.seconds;
+            return cpu_now() - c0;
         }
         if (pi.seconds > PUSH_CAP) {
             *capped = 1;
-            return pi.seconds;
+            return cpu_now() - c0;
         }
     }
 }
@@ -229,8 +244,9 @@ int main(int argc, char **argv)
             int64_t t = cand[j];
             cand[j] = cand[q], cand[q] = t;
             ulam_bidir_result rb;
+            double c0 = cpu_now();
             if (query(w, Mt, &g, s, t, 0, 0, (uint64_t)k + 1, &rb)) return 1;
-            bi.seconds[k] = rb.seconds, bi.other[k] = rb.push.seconds, bi.walk[k] = rb.walks.seconds;
+            bi.seconds[k] = cpu_now() - c0, bi.other[k] = rb.push.seconds, bi.walk[k] = rb.walks.seconds;
             bi.covered += rb.ci95[0] <= x[t] && x[t] <= rb.ci95[1], bi.intervals++;
             sum_push_ops += (double)rb.push.ops, sum_steps += (double)(rb.walks.steps + rb.walks.walks);
             step_cost = rb.plan.step_cost;
@@ -245,7 +261,7 @@ int main(int argc, char **argv)
             double prmax;
             pu.seconds[k] = push_alone(w, s, t, x[t], &pu.marked[k], &prmax);
             printf("%4d %8lld %8lld %12.5g %10.5f %9.5f %9.5f %9.2g %10lld %10.3g %7.2f %9.4f%s %9.4f%s %9.2g\n", k + 1,
-                   (long long)s + 1, (long long)t + 1, x[t], rb.seconds, rb.push.seconds, rb.walks.seconds, rb.push.rmax,
+                   (long long)s + 1, (long long)t + 1, x[t], bi.seconds[k], rb.push.seconds, rb.walks.seconds, rb.push.rmax,
                    (long long)rb.walks.walks, rb.plan.predicted_walks, (rb.estimate - x[t]) / rb.std_error, wk.seconds[k],
                    wk.marked[k] == 2 ? "!" : wk.marked[k] ? "*" : " ", pu.seconds[k], pu.marked[k] ? ">" : " ", prmax);
             fflush(stdout);
@@ -259,7 +275,7 @@ int main(int argc, char **argv)
     printf("the plan's prediction over what was done: work median %.2fx (p90 %.2fx), walks median %.2fx (p90 %.2fx)\n",
            quantile(work_ratio, np, 0.5), quantile(work_ratio, np, 0.9), quantile(walks_ratio, np, 0.5),
            quantile(walks_ratio, np, 0.9));
-    printf("\n%d pairs at %.0f%% relative error, one thread; seconds per query (median, 90th percentile), ratios to "
+    printf("\n%d pairs at %.0f%% relative error, one thread; CPU seconds per query (median, 90th percentile), ratios to "
            "bidirectional\n", np, 100 * REL);
     printf("%-22s %10s %10s %10s %10s %13s   %-7s   %s\n", "method", "median", "p90", "med/bidir", "p90/bidir",
            "median ratio", "cover95", "marked");

@@ -15,7 +15,8 @@
  * whole process <= 2x fixed, peak RSS <= 64 MiB at 10^7, whole-process CPU <= 0.02x SciPy's CPU
  * (SciPy column: CPU seconds of the solve alone, time.process_time).
  * usage: bench_prepared path/to/ulam [path/to/old/ulam] [max n]
- *        bench_prepared --write-only PATH N (the screened system of N states, for readme.sh) */
+ *        bench_prepared --write-only PATH N [random] (the screened system of N states, for readme.sh;
+ *        the random family's with 'random') */
 #include <math.h>
 #include <sys/stat.h>
 
@@ -130,13 +131,14 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: bench_prepared path/to/ulam [path/to/old/ulam] [max n]\n");
         return 2;
     }
-    if (!strcmp(argv[1], "--write-only") && argc == 4) { /* the screened system of n states at argv[2] (readme.sh) */
-        int64_t L = (int64_t)llround(sqrt(atof(argv[3])));
-        ulam_csr *M = bench_screened_csr(L);
-        double *b = bench_random_rhs(L * L);
+    if (!strcmp(argv[1], "--write-only") && (argc == 4 || argc == 5)) { /* a system of n states at argv[2] */
+        int random = argc == 5 && !strcmp(argv[4], "random");
+        int64_t L = (int64_t)llround(sqrt(atof(argv[3]))), n = random ? (int64_t)llround(atof(argv[3])) : L * L;
+        ulam_csr *M = random ? bench_canonical(bench_random_csr(n)) : bench_screened_csr(L);
+        double *b = bench_random_rhs(n);
         ulam_certificate cert;
         if (!M || !b || ulam_certificate_compute(M, 0.0, NULL, &cert, NULL)) return 1;
-        ulam_system_desc d = {.M = M, .b = b, .n = L * L, .cert = &cert};
+        ulam_system_desc d = {.M = M, .b = b, .n = n, .cert = &cert};
         return ulam_system_write(argv[2], &d) ? 1 : 0;
     }
     const char *old = argc > 2 && argv[2][0] ? argv[2] : NULL;
