@@ -58,7 +58,4 @@ extern const ulam__method_type ulam__method_walks, ulam__method_bidir, ulam__met
 /* 1 when row k is excluded by q's options (why filled: "not considered: excluded"). */
 int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len);
 
-/* Fill a's interval from its estimate and standard error (NaN standard error: no interval). */
-void ulam__answer_interval(ulam_answer *a);
-
 #endif

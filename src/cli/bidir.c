@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 static const char *const usage =
     "usage: ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R]\n"
@@ -27,9 +28,10 @@ static const char *const usage =
     "  --min-value V      the smallest x_I the balance plans for (default 1 / n, raised by a probe\n"
     "                     of 1024 walks once the push has spent what they cost)\n"
     "  --top K            with --source S and no --index: every component of x = (I - M)^-1 e_S by\n"
-    "                     forward push and walks (FORA; --rel-err E for every x_i >= --min-value,\n"
-    "                     default 0.1 and 1 / n; or --walks N), the K largest printed with their\n"
-    "                     intervals (default 10)\n"
+    "                     forward push (sweeps once the residual spreads) and walks from its\n"
+    "                     residual (--rel-err E: every 95% interval of an x_i >= --min-value within\n"
+    "                     E of it, default 0.1 and 1 / n; or --walks N), the K largest printed\n"
+    "                     with their intervals (default 10)\n"
     "  --step-cost C      push operations one walk visit costs, for the balance (default 1.3;\n"
     "                     bench_bidir measures it: docs/bidirectional.md)\n"
     "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
@@ -275,7 +277,11 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     int status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : ulam_csr_transpose(s->M, &Mt);
     o.walk.policy.guard = &rp->g, o.walk.stop.interrupt = &cli_interrupted;
     if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
-    else status = ulam_fpush_solve(s->M, Mt, &o, x, se, lo, hi, &info, &err);
+    struct timespec c0, c1;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+    if (!status) status = ulam_fpush_solve(s->M, Mt, &o, x, se, lo, hi, &info, &err);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+    double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec); /* push and walks */
     if (status) rc = cli_report(s->matrix_path, &err);
     if (!rc && check) rc = cli_direct_solve(s, CLI_MAX_MEM, &xd, NULL);
     if (!rc && cli_rank == 0) {
@@ -292,6 +298,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
                    (long long)info.walks, (long long)info.steps);
             cli_json_number("residual_bound", info.residual_bound, 0);
             cli_json_number("seconds", info.seconds, 0);
+            cli_json_number("cpu_seconds", cpu, 0);
             printf("\"top\": [");
             for (int64_t k = 0; k < top; k++) {
                 int64_t i = order[k];
@@ -314,7 +321,8 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
                    "x_i at most %.3g)\n", info.rmax, (long long)info.push.ops, (long long)info.push.support,
                    info.push.r_sum, info.residual_bound);
             printf("walks           %lld (%lld steps)\n", (long long)info.walks, (long long)info.steps);
-            printf("seconds         %.4f (push %.4f, walks %.4f)\n", info.seconds, info.push_seconds, info.walk_seconds);
+            printf("seconds         %.4f (push %.4f, walks %.4f; CPU %.4f)\n", info.seconds, info.push_seconds,
+                   info.walk_seconds, cpu);
             printf("%-6s %-10s %-14s %-11s %s\n", "rank", "index", "estimate", "stderr",
                    xd ? "95% CI                    direct" : "95% CI");
             for (int64_t k = 0; k < top; k++) {
