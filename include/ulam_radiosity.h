@@ -228,6 +228,8 @@ typedef struct ulam_rad_result {
     double variance_rel_error; /* with rel_err: the largest relative standard error of a
                                   channel's variance (fourth moment; reported, not a stop rule) */
     int rel_err_met;           /* the run stopped because the rel_err rule holds */
+    double ci95[3][2];         /* each channel's 95% interval (src/stop.c's construction on the
+                                  certified score range); NaN .. NaN where none is certified */
 } ulam_rad_result;
 
 /* How patch walks run and when they stop: radiosity's own options (the matrix walks' kernel,

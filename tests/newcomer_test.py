@@ -18,8 +18,8 @@ SHAPES = {  # KIND: regexes the stdout must match, each on a line of its own
               r"^walks\s+\d+", r"^seconds\s+", rf"^direct\s+{NUM} \((dense|sparse) LU, {NUM} s\), z = {NUM}$"],
     "study": [r"^study of x\[\d+\]: exact ", r"^walks\s+winner",
               rf"^\d+\s+\S+-\S+-\S+\s+{NUM}\s+{NUM}\s+\d+/\d+ \({NUM} \.\. {NUM}\)$"],
-    "radiosity": [r"^scene\s+", r"^patch\s+\d+ \(floor", rf"^radiosity R\s+{NUM} \+- {NUM}$",
-                  rf"^radiosity B\s+{NUM} \+- {NUM}$", r"^rel-err\s+met"],
+    "radiosity": [r"^scene\s+", r"^patch\s+\d+ \(floor", rf"^radiosity R\s+{NUM} \+- {NUM} \(95% CI {NUM} \.\. {NUM}\)$",
+                  rf"^radiosity B\s+{NUM} \+- {NUM} \(95% CI {NUM} \.\. {NUM}\)$", r"^rel-err\s+met"],
     "python": [rf"^{NUM} \+- {NUM} \({NUM}, {NUM}\) \d+ \w+$"],  # estimate +- stderr ci95 walks method
 }
 MAX_LINES = {"solve": 10}  # the default solve output is read in one glance

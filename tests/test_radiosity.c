@@ -844,7 +844,11 @@ static void test_furnace(void **state)
     for (int est = ULAM_RAD_COLLISION; est <= ULAM_RAD_ABSORPTION; est++) {
         for (int64_t p = 0; p < 6; p += 5) {
             ulam_rad_result g = rad_walk(t, ULAM_ADJOINT, est, p, 20000, 11 + (uint64_t)p, NULL);
-            for (int c = 0; c < 3; c++) assert_close(g.radiosity[c], 2.0, 4 * g.std_error[c] + 1e-12);
+            for (int c = 0; c < 3; c++) {
+                assert_close(g.radiosity[c], 2.0, 4 * g.std_error[c] + 1e-12);
+                /* the printed 95% interval holds B and never reaches below 0 */
+                assert_true(g.ci95[c][0] >= 0.0 && g.ci95[c][0] <= 2.0 && 2.0 <= g.ci95[c][1]);
+            }
             assert_true(g.rays > 0);
         }
         ulam_rad_solver *sv = NULL;
@@ -856,6 +860,7 @@ static void test_furnace(void **state)
             assert_close(all[k], 2.0, 4 * se[k]);
         }
         assert_close(sh.radiosity[0], all[0], 0);
+        assert_true(sh.ci95[0][0] >= 0.0 && sh.ci95[0][0] <= 2.0 && 2.0 <= sh.ci95[0][1]);
         ulam_rad_solver_free(sv);
         /* matrix walks on the assembled M, both modes */
         double x[6], xse[6];

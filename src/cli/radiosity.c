@@ -164,6 +164,7 @@ typedef struct {
     int zero;    /* --rel-err could never be met: every channel exactly 0, zero variance */
     int rel_err_met;  /* ray walks: the run stopped because the --rel-err rule holds */
     double min_walks; /* ray walks: the walks the rule needs at this estimate */
+    double ci95[3][2]; /* ray walks: each channel's 95% interval (NaN: none certified) */
     double *all, *all_se; /* shooting: 3 per patch each */
 } walked;
 
@@ -450,6 +451,7 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     w->walks = r.walks, w->steps = r.rays, w->seconds = r.seconds, w->threads = r.threads;
     w->interrupted = r.interrupted, w->zero = r.zero, w->cut = r.cut;
     w->rel_err_met = r.rel_err_met, w->min_walks = r.min_walks;
+    memcpy(w->ci95, r.ci95, sizeof w->ci95);
     if (!status && a->o.mode == ULAM_FORWARD) {
         w->all = malloc((size_t)np * 3 * sizeof *w->all);
         w->all_se = malloc((size_t)np * 3 * sizeof *w->all_se);
@@ -718,6 +720,8 @@ static void print_text(const args *a, const report *r)
             printf("radiosity %c  %.8g +- %.3g", chan[c], w->B[c], w->se[c]);
             if (a->matrix_walk && r->ff_se_known) printf(" (walk %.3g, form factors %.3g)", w->se_walk[c], r->direct_se[c]);
             else if (a->matrix_walk) printf(" (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
+            else if (isfinite(w->ci95[c][0])) printf(" (95%% CI %.8g .. %.8g)", w->ci95[c][0], w->ci95[c][1]);
+            else printf(" (no 95%% interval: no score range certified)");
             printf("%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
         }
         if (a->o.stop.rel_err > 0 && !a->matrix_walk && !w->zero)
@@ -802,6 +806,12 @@ static void print_json(const args *a, const report *r)
             json_triple("estimate", w->B); /* the answer's key in every command */
             json_triple(answer_key, w->B);
             json_triple("stderr", w->se);
+            if (!a->matrix_walk) {
+                double lo[3] = {w->ci95[0][0], w->ci95[1][0], w->ci95[2][0]};
+                double hi[3] = {w->ci95[0][1], w->ci95[1][1], w->ci95[2][1]};
+                json_triple("ci95_lo", lo); /* each channel's 95% interval (null: none certified) */
+                json_triple("ci95_hi", hi);
+            }
             if (r->mesh_known) {
                 int dom = 0;
                 for (int c = 0; c < 3; c++) dom |= mesh_dominates(r, w, c);

@@ -703,6 +703,12 @@ static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r)
     r->interrupted = s->run.interrupted;
     r->zero = s->zero;
     r->rel_err_met = s->met;
+    for (int c = 0; c < 3; c++) {
+        ulam__stop_ci ci; /* a fixed budget's truncation takes at most ULAM__STOP_TAIL of |B| */
+        channel_interval(s, c, r->radiosity[c], s->o.stop.rel_err > 0 ? s->o.stop.rel_err : 4.0 * ULAM__STOP_TAIL, &ci);
+        /* every score is >= 0 (emission and reflectance are), so B >= 0 is certain */
+        r->ci95[c][0] = r->walks > 1 && !isnan(ci.lo) ? fmax(ci.lo, 0.0) : NAN, r->ci95[c][1] = r->walks > 1 ? ci.hi : NAN;
+    }
 }
 
 /* The result so far. */
