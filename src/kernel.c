@@ -48,8 +48,61 @@ ulam_kernel *ulam__kernel_free(ulam_kernel *k)
     free(k->fac);
     free(k->scored);
     free((void *)k->where);
+    free((void *)k->dir);
+    free((void *)k->leaves);
     free(k);
     return NULL;
+}
+
+/* Keep k's places in leaves (see kernel.h). */
+int ulam__kernel_sparse(ulam_kernel *k)
+{
+    if (atomic_load(&k->top) > 0) return ULAM_EINVAL;
+    int64_t groups = k->n / ULAM__LEAF + 1;
+    free((void *)k->where);
+    k->where = NULL;
+    /* calloc: zero pages never touched, so a leaf costs memory once it is handed out */
+    if (!k->dir && !(k->dir = ulam__calloc((size_t)groups, sizeof *k->dir))) return ULAM_ENOMEM;
+    if (!k->leaves && !(k->leaves = ulam__calloc((size_t)groups * ULAM__LEAF, sizeof *k->leaves))) return ULAM_ENOMEM;
+    return ULAM_OK;
+}
+
+/* The bytes of k's places touched so far. */
+int64_t ulam__kernel_index_bytes(const ulam_kernel *k)
+{
+    if (k->where) return k->n * (int64_t)sizeof *k->where;
+    return (k->n / ULAM__LEAF + 1) * (int64_t)sizeof *k->dir +
+           atomic_load(&k->nleaves) * ULAM__LEAF * (int64_t)sizeof *k->leaves;
+}
+
+/* A leaf being made (the directory's mark while one thread takes it). */
+#define LEAF_CLAIMED ((_Atomic int32_t *)(uintptr_t)1)
+
+/* State j's place (0: no row, -1: being built, else its unit + 1), or NULL when its leaf is not
+ * made and make is 0 (no row).  make: the leaf is made if need be (racing threads agree: the first
+ * claims the group, the others wait for its leaf). */
+static _Atomic int32_t *place(ulam_kernel *k, int64_t j, int make)
+{
+    if (k->where) return &k->where[j];
+    _Atomic(_Atomic int32_t *) *d = &k->dir[j / ULAM__LEAF];
+    _Atomic int32_t *leaf = atomic_load_explicit(d, memory_order_acquire), *none = NULL;
+    if (leaf && leaf != LEAF_CLAIMED) return leaf + j % ULAM__LEAF;
+    if (!make) return NULL;
+    if (!leaf && atomic_compare_exchange_strong_explicit(d, &none, LEAF_CLAIMED, memory_order_acq_rel,
+                                                         memory_order_acquire)) {
+        leaf = k->leaves + atomic_fetch_add_explicit(&k->nleaves, 1, memory_order_relaxed) * ULAM__LEAF;
+        atomic_store_explicit(d, leaf, memory_order_release);
+        return leaf + j % ULAM__LEAF;
+    }
+    while ((leaf = atomic_load_explicit(d, memory_order_acquire)) == LEAF_CLAIMED) continue;
+    return leaf + j % ULAM__LEAF;
+}
+
+/* State j's place value (0 when its leaf is not made). */
+static int32_t place_of(ulam_kernel *k, int64_t j, memory_order mo)
+{
+    _Atomic int32_t *p = place(k, j, 0);
+    return p ? atomic_load_explicit(p, mo) : 0;
 }
 
 /* The 64-bit threshold of an alias fraction f in [0, 1]. */
@@ -122,11 +175,12 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam_
     atomic_init(&k->built, 0);
     atomic_init(&k->status, ULAM_OK);
     atomic_init(&k->bad, -1);
-    k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built; the pages of
-                                                              states never reached stay untouched */
+    atomic_init(&k->nleaves, 0);
+    int dense = n <= ULAM__DENSE_MAX;
+    if (dense) k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built */
     k->mem = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->mem);
     if (alpha != 1.0) k->fac = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->fac);
-    if (!k->where || !k->mem || (alpha != 1.0 && !k->fac)) {
+    if ((dense ? !k->where : ulam__kernel_sparse(k) != ULAM_OK) || !k->mem || (alpha != 1.0 && !k->fac)) {
         ulam__kernel_free(k);
         return ULAM_ENOMEM;
     }
@@ -261,7 +315,8 @@ static int entries_ok(const ulam_csr *K, int64_t i)
 static void prefetch_state(const ulam_kernel *k, int64_t j)
 {
 #if defined(__GNUC__)
-    __builtin_prefetch((const void *)&k->where[j]);
+    if (k->where) __builtin_prefetch((const void *)&k->where[j]);
+    else __builtin_prefetch((const void *)&k->dir[j / ULAM__LEAF]);
     __builtin_prefetch((const void *)&k->K->rowptr[j]);
 #else
     (void)k, (void)j;
@@ -273,7 +328,7 @@ static void prefetch_state(const ulam_kernel *k, int64_t j)
 static int32_t move_outcome(ulam_kernel *k, int64_t j, double v, int placed)
 {
     if (!placed) prefetch_state(k, j); /* a walk here moves to one of these next */
-    int32_t t = placed ? atomic_load_explicit(&k->where[j], memory_order_relaxed) - 1 : ULAM__UNRESOLVED + (int32_t)j;
+    int32_t t = placed ? place_of(k, j, memory_order_relaxed) - 1 : ULAM__UNRESOLVED + (int32_t)j;
     return v < 0 ? ~t : t;
 }
 
@@ -358,9 +413,10 @@ static void build_row(ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam_
  * builds the row there and publishes its place; any other thread waits for that. */
 int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
 {
-    int32_t v = atomic_load_explicit(&k->where[j], memory_order_acquire), expect = 0;
+    _Atomic int32_t *at = place(k, j, 1);
+    int32_t v = atomic_load_explicit(at, memory_order_acquire), expect = 0;
     if (v > 0) return v - 1;
-    if (atomic_compare_exchange_strong_explicit(&k->where[j], &expect, -1, memory_order_acquire,
+    if (atomic_compare_exchange_strong_explicit(at, &expect, -1, memory_order_acquire,
                                                 memory_order_acquire)) {
         int ok = !ulam__rows_verify(&k->rc, j, j + 1, NULL) && range_ok(k->K, j);
         int64_t len = ok ? ULAM__HEAD + row_outcomes(k->K, j) : 0;
@@ -368,11 +424,11 @@ int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
         if (len && u + len > k->cap) u = k->cap; /* rowptr's ranges overlap: the file is corrupt */
         if (u < k->cap) build_row(k, j, ulam__kernel_row(k, u), 0, w);
         else fail(k, ULAM_ESYNTAX, j);
-        atomic_store_explicit(&k->where[j], (int32_t)u + 1, memory_order_release);
+        atomic_store_explicit(at, (int32_t)u + 1, memory_order_release);
         atomic_fetch_add_explicit(&k->built, 1, memory_order_relaxed);
         return (int32_t)u;
     }
-    while ((v = atomic_load_explicit(&k->where[j], memory_order_acquire)) < 0) continue;
+    while ((v = atomic_load_explicit(at, memory_order_acquire)) < 0) continue;
     return v - 1;
 }
 
@@ -391,7 +447,7 @@ static void prefetch_targets(const ulam_kernel *k, int64_t i)
 #if defined(__GNUC__)
     if (i < k->n)
         for (int64_t q = k->K->rowptr[i]; q < k->K->rowptr[i + 1]; q++)
-            __builtin_prefetch((const void *)&k->where[k->K->colidx[q]]);
+            if (k->where) __builtin_prefetch((const void *)&k->where[k->K->colidx[q]]);
 #else
     (void)k, (void)i;
 #endif
@@ -408,13 +464,13 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
         return;
     }
     for (int64_t i = 0; i < k->n; i++)
-        if (atomic_load_explicit(&k->where[i], memory_order_relaxed) == 0) {
+        if (atomic_load_explicit(place(k, i, 1), memory_order_relaxed) == 0) {
             int64_t len = range_ok(K, i) ? ULAM__HEAD + row_outcomes(K, i) : 0;
             if (!len || u + len > k->cap) {
                 fail(k, ULAM_ESYNTAX, i);
                 len = 0;
             }
-            atomic_store_explicit(&k->where[i], (int32_t)(len ? u : k->cap) + 1, memory_order_relaxed);
+            atomic_store_explicit(place(k, i, 1), (int32_t)(len ? u : k->cap) + 1, memory_order_relaxed);
             u += len;
         }
     atomic_store(&k->top, u);
@@ -422,7 +478,7 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
     /* static chunks of 4096 rows: a kernel of fewer rows is one thread's work, so no team */
 #pragma omp parallel for schedule(static, 4096) num_threads(threads) if (k->n > 4096)
     for (int64_t i = 0; i < k->n; i++) {
-        int64_t at = atomic_load_explicit(&k->where[i], memory_order_relaxed) - 1;
+        int64_t at = place_of(k, i, memory_order_relaxed) - 1;
         prefetch_targets(k, i + 16);
         if (at >= from && at < k->cap) build_row(k, i, ulam__kernel_row(k, at), 1, &w[ulam__thread_num()]);
     }
@@ -458,7 +514,7 @@ int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen, const u
 /* Rescore row i, when built, from k's scores. */
 static void rescore_row(ulam_kernel *k, int64_t i)
 {
-    int32_t u = atomic_load_explicit(&k->where[i], memory_order_relaxed);
+    int32_t u = place_of(k, i, memory_order_relaxed);
     if (u <= 0) return;
     ulam__row *h = ulam__kernel_row(k, u - 1);
     double pstar = k->scores.estimator == ULAM_ABSORPTION ? 1.0 - ulam__continuation(row_sum(k->K, i), k->continue_q) : 0.0;

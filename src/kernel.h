@@ -36,6 +36,13 @@ typedef struct {
 
 #define ULAM__HEAD 2 /* units in a header */
 
+/* A kernel of more states keeps its places (where) in leaves of ULAM__LEAF states made when a
+ * walk first reaches one of their states, so a query that builds rows scattered over a large
+ * system keeps 8 bytes a group of ULAM__LEAF states and a leaf a group reached, not 4 bytes a
+ * state (40 MB at 10^7, nearly all of it touched by 10^5 scattered rows). */
+#define ULAM__DENSE_MAX (INT64_C(1) << 20)
+#define ULAM__LEAF 16
+
 /* What visits and terminations score, with g_i = b[i] (1 when b is NULL): collision g_i per
  * visit, absorption g_i / p*_i per termination, expected (K b)_i per visit (0 without b). */
 typedef struct {
@@ -55,7 +62,11 @@ typedef struct ulam_kernel {
                                ULAM_ENONFINITE (a non-finite score) or ULAM_ENOMEM (scratch) */
     _Atomic int64_t bad;    /* the row of that failure (-1: none) */
     ulam__slot *mem;
-    _Atomic int32_t *where;
+    _Atomic int32_t *where;   /* the places, one a state (n <= ULAM__DENSE_MAX), else NULL and: */
+    _Atomic(_Atomic int32_t *) *dir; /* one leaf of ULAM__LEAF places a group of states, made
+                                        the first time a state of the group is placed */
+    _Atomic int32_t *leaves;  /* their storage, handed out in order (touched as they are made) */
+    _Atomic int64_t nleaves;  /* leaves handed out */
     const ulam_csr *K;
     double continue_q;
     double alpha;       /* the kernel exponent: p_ij = q_i |K_ij|^alpha / sum_k |K_ik|^alpha */
@@ -109,6 +120,14 @@ int ulam__kernel_rescore_b(ulam_kernel *k, const double *b);
 
 /* Free a kernel; accepts NULL. */
 ulam_kernel *ulam__kernel_free(ulam_kernel *k);
+
+/* Keep k's places in leaves whatever its size (k: no row built yet); ULAM_OK, ULAM_EINVAL when
+ * a row is built, ULAM_ENOMEM. */
+int ulam__kernel_sparse(ulam_kernel *k);
+
+/* The bytes of k's places touched so far (dense: 4 a state; leaves: the directory and the leaves
+ * made). */
+int64_t ulam__kernel_index_bytes(const ulam_kernel *k);
 
 /* Scratch for building k's rows; ULAM_OK or ULAM_ENOMEM (free it with ulam__kscratch_free). */
 int ulam__kscratch_alloc(const ulam_kernel *k, ulam__kscratch *w);
