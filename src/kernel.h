@@ -85,6 +85,7 @@ typedef struct {
     int32_t *o;
     int64_t *small, *large;
     int64_t cap;
+    ulam__rowbuf rb; /* the row being built, read from a file (k->rc.fetch) */
 } ulam__kscratch;
 
 /* Vose's alias table of m outcomes out[] with probabilities p[] (sum 1) into s[0..m-1];
