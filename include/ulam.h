@@ -1092,20 +1092,24 @@ typedef struct ulam_bidir_result {
 int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err);
 
-/* Single source, every target (src/fpush.c; FORA, Wang et al., KDD 2017): x = (I - M)^-1 e_s by
- * a forward push from s (the reverse push of ulam_push on M'), leaving x = p + (I - M)^-1 r, and
- * forward walks on M from r that estimate every component of the rest.  Start from
+/* Single source, every target (src/fpush.c, src/sweep.c; FORA, Wang et al., KDD 2017, with
+ * SpeedPPR's sweeps, Wu et al., 2021): x = (I - M)^-1 e_s by a forward push from s (rounds over
+ * the states holding residual, then whole sweeps in order once n/16 do), leaving
+ * x = p + (I - M)^-1 r, and terminal walks on M from r that estimate every component of the rest
+ * (||M||_1 >= 1: the queue push of ulam_push on M' and the forward walk solver).  Start from
  * ulam_fpush_defaults(). */
 typedef struct ulam_fpush_opts {
     int64_t source;      /* 0-based s */
-    double rel_err;      /* FORA's target: relative error E on every x_i >= min_value (default 0.1) */
+    double rel_err;      /* E: walk until every x_i whose interval reaches min_value has its 95%
+                            interval within -+ E x_i (default 0.1) */
     double min_value;    /* delta (<= 0: 1 / n) */
-    int64_t walks;       /* > 0: this many walks (the balance pushes to what they cost); 0: FORA's
-                            count ||r||_1 (2E/3 + 2) ln(2n) / (E^2 delta) */
-    double rmax;         /* > 0: push threshold; <= 0: halve from 1 while the push's operations are
-                            below the walks' work (walks x visits x step_cost) */
-    double step_cost;    /* push operations a walk visit costs (<= 0: ULAM_BIDIR_STEP_COST) */
-    ulam_walk_opts walk; /* seed, threads, estimator, continue_q, guard (mode forced forward) */
+    int64_t walks;       /* > 0: this many walks; 0: the rel_err rule */
+    double rmax;         /* > 0: push every |r_j| > rmax, no balance; <= 0: push while one more
+                            round saves more predicted walk work than it costs */
+    double step_cost;    /* push operations a walk step costs, for the balance (<= 0: 100; the
+                            queue path: ULAM_BIDIR_STEP_COST) */
+    ulam_walk_opts walk; /* seed, threads, estimator, continue_q, guard, max_walks, interrupt (mode
+                            forced forward) */
 } ulam_fpush_opts;
 
 /* The defaults: source 0, rel_err 0.1, min_value 0, walks 0, rmax 0, step_cost 0, walk
@@ -1114,7 +1118,7 @@ ulam_fpush_opts ulam_fpush_defaults(void);
 
 /* What a single-source estimate did. */
 typedef struct ulam_fpush_info {
-    double rmax;           /* the push threshold */
+    double rmax;           /* the push threshold (the sweep push balanced: the largest |r_j| left) */
     ulam_push_info push;   /* the push */
     double mean_visits;    /* V the balance took: 1 / (1 - ||M||_1) */
     double residual_bound; /* ||r||_1 / (1 - ||M||_1): the most the walks' part of any x_i can be
@@ -1125,10 +1129,12 @@ typedef struct ulam_fpush_info {
 } ulam_fpush_info;
 
 /* Estimate every x_i of (I - M) x = e_source into x (n entries); std_error, lo and hi (each may
- * be NULL) get each component's standard error and 95% interval: p_i + the walks' normal
- * interval where the walks scored two values at i, else p_i -+ residual_bound (NaN when there is
- * none), always clipped to p_i -+ residual_bound.  Mt is M's transpose.  ULAM_OK, ULAM_EINVAL,
- * ULAM_ENOCONV (push cap 100 nnz + 10^6), ULAM_ENOMEM, the walk solver's statuses. */
+ * be NULL) get each component's standard error and 95% interval: p_i + the walks' stitched
+ * empirical-Bernstein interval (src/stop.h; every walk score within -+ ||r||_1 / (1 - ||M||_1)),
+ * clipped to p_i -+ residual_bound (the queue path for ||M||_1 >= 1: the normal interval where the
+ * walks scored two values, else p_i -+ residual_bound, NaN when there is none).  Mt is M's
+ * transpose.  ULAM_OK, ULAM_EINVAL, ULAM_ENOCONV (queue push cap 100 nnz + 10^6), ULAM_ENOMEM,
+ * the walk solver's statuses. */
 int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, double *x, double *std_error,
                      double *lo, double *hi, ulam_fpush_info *info, ulam_error *err);
 
@@ -1281,8 +1287,15 @@ int ulam_method_find(const char *name);
 /* What row k answers: ULAM_ANSWERS_ENTRY or ULAM_ANSWERS_ALL (0 out of range). */
 int ulam_method_answers(int k);
 
-/* The densest b the bidirectional row takes: nonzeros at most max(16, n / 10). */
+/* The densest b the bidirectional row takes by its reverse push from the index: nonzeros at most
+ * max(16, n / 10) (a denser b: the push on b, see ulam_auto_start). */
 int64_t ulam_method_sparse_limit(int64_t n);
+
+/* Which route the bidirectional row takes for x of (I - M) x = b (n entries) under the walks'
+ * pins ao (NULL: none) and options o: 0 the reverse push from the index and collision walks from
+ * b (a sparse b, nothing pinned it cannot honour), 1 the push on b and walks from the index with
+ * the walks' own estimator and exponent (a dense b, or an estimator or exponent pinned). */
+int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o);
 
 /* Which rows a choice may take.  Start from ulam_method_defaults(). */
 typedef struct ulam_method_opts {
@@ -1348,9 +1361,13 @@ typedef struct ulam_answer {
  * then each other row's applicability test and cost prediction, a row replacing the leader when
  * its predicted work is below the leader's.  Bidirectional applies to an adjoint query with a
  * rel_err target, nothing pinned it cannot honour (forward mode, the estimator, alpha other than
- * 1, roulette or split), a sparse b (ulam_method_sparse_limit) and a walk leader W above nnz(M)/4
- * (it needs M's transpose); its push is capped at W / 2 (pinned, a b equal to e_S runs as the
- * point source S, as `ulam solve --source S` does).  The rows that answer every unknown do
+ * 1, roulette or split; a dense b takes the leader's estimator and exponent), a nonzero b and a
+ * walk leader W above nnz(M)/4 (it needs M's transpose); its push is capped at W / 2 (pinned, a
+ * b equal to e_S runs as the point source S, as `ulam solve --source S` does).  A sparse b
+ * (ulam_method_sparse_limit) gets the reverse push from the index and walks from b; a dense b
+ * the push on b (src/bpush.c): b's large entries are pushed down to rmax deterministically and
+ * adjoint walks from the index score the residual, whose smaller range the rel_err rule pays
+ * for (pinned, it needs a rel_err target and plans from a pilot round of walks on b).  The rows that answer every unknown do
  * not apply to a query for one entry with an error bar (they give none); pinned, they run from
  * ulam_outer_defaults() and the Krylov peers to its tolerance, with o's seed, threads,
  * continuation, cut, interrupt and force, and o->max_walks (when set) capping one correction.

@@ -13,6 +13,7 @@
  * those walks, so it cannot bias them (README: reusing the pilot's walks would). */
 #include "internal.h"
 #include "stats.h"
+#include "stop.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -140,7 +141,13 @@ static double predict(const chooser *c, int k, double var, double *walks)
         else {
             (void)n; /* the rule's own prediction (stop.h) holds its range term: a pilot without spread */
             N = fmax((double)ULAM__REL_MIN, var / (E * m * E * m)); /* is no evidence of a small variance */
-            N = fmax(N, c->min_walks[k]);
+            N = fmax(N, c->min_walks[k]); /* the pilot's own prediction (its variance, range and bias) */
+            if (isfinite(c->range[k])) { /* the rule's at this variance: the range term shares the half-width */
+                double r = ulam__stop_walks_needed(m, var, c->range[k], 0.0, E, 1);
+                N = fmax(N, isfinite(r) ? ulam__stop_walks_needed(m, var, c->range[k], 0.0, E,
+                                                                  ulam__stop_epoch((int64_t)fmin(r, 1e18)))
+                                        : r);
+            }
         }
         N = rounded_walks(N);
         if (c->base.max_walks > 0) N = fmin(N, (double)c->base.max_walks);

@@ -16,10 +16,15 @@
  * sample says nothing about what it missed), the certified bound of the walk part,
  * |(I - M)^-1 r|_i <= ||r||_1 / (1 - ||M||_1); every interval clipped to p_i -+ that bound. */
 #include "internal.h"
+#include "stop.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#define ULAM__FPUSH_STEP_COST 100.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM under load:
+                                      0.9 us a step, 6 ns a push operation; a step misses the cache, a sweep streams) */
+#define ULAM__FPUSH_RANGE_SHARE 0.8 /* the share of E delta the first checkpoint leaves the interval's range term */
 
 /* The defaults. */
 ulam_fpush_opts ulam_fpush_defaults(void)
@@ -53,23 +58,14 @@ static double walk_count(const ulam_fpush_opts *o, double rsum, int64_t n)
     return ceil(rsum * (2.0 * E / 3.0 + 2.0) * log(2.0 * (double)n) / (E * E * delta));
 }
 
-/* Estimate every component of x = (I - M)^-1 e_source. */
-int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, double *std_error,
-                     double *lo, double *hi, ulam_fpush_info *info, ulam_error *err)
+/* The queue push and the walk solver on its residual, for ||M||_1 >= 1 (no terminal walks). */
+static int solve_queue(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, ulam_guard g, double *x,
+                       double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam_error *err)
 {
-    ulam__clear(err);
-    if (!M || !opts || !x || !info) return ulam__fail(err, ULAM_EINVAL, 0, -1, "M, options, x and info");
-    int status = check(M, Mt, opts, err);
-    if (status) return status;
-    memset(info, 0, sizeof *info);
+    int status = ULAM_OK;
     ulam_fpush_opts o = *opts;
     int64_t n = M->nrows;
     double t0 = ulam_now();
-    ulam_guard g;
-    ulam_guard_opts go = ulam_guard_defaults();
-    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
-    if (o.walk.guard) g = *o.walk.guard;
-    else if ((status = ulam_guard_check(M, o.walk.continue_q, &go, &g, err))) return status;
     double c = g.abs.colsum_max; /* ||M||_1 */
     double D1 = c < 1.0 ? 1.0 / (1.0 - c) : INFINITY; /* ||(I - M)^-1||_1 */
     info->mean_visits = isfinite(D1) ? D1 : 1.0 / fmax(1e-3, 1.0 - fmin(g.abs.upper, 0.999));
@@ -132,4 +128,312 @@ int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opt
     ulam_push_free(w);
     info->seconds = ulam_now() - t0;
     return status;
+}
+
+/* The walks' plan: residual mass, kernel norm alpha = ||M||_1 < 1, target and costs. */
+typedef struct {
+    double alpha, E, delta, visits, step_cost;
+    int64_t fixed; /* > 0: this many walks */
+} plan;
+
+/* The checkpoints: the walks stop at the ends of src/stop.c's epochs from the first, k0, whose
+ * end leaves room for relative error E at x = delta (the interval's range term at most
+ * ULAM__FPUSH_RANGE_SHARE E delta at stitching index 1; the variance term, small where the push
+ * left little of x_i to the walks, is checked at each checkpoint).  k0 depends on the residual alone, known before any walk, so the
+ * checkpoints k0, k0 + 1, ... are fixed in advance and stitched among themselves: the one at
+ * epoch k0 + j - 1 takes stitching index j, delta_j = delta / (j (j + 1)). */
+static int64_t epoch_end(int k)
+{
+    int64_t m = (int64_t)floor(ULAM__STOP_N0 * pow(2.0, (k - 1) / 2.0));
+    while (ulam__stop_epoch(m + 1) == k) m++;
+    while (m > 2 && ulam__stop_epoch(m) > k) m--;
+    return m;
+}
+
+/* k0 for walk scores of range R. */
+static int first_epoch(double R, double E, double delta)
+{
+    double L = ulam__stop_log(1);
+    int k = 1;
+    while (k < 200 && !(7.0 * R * L / (3.0 * ((double)epoch_end(k) - 1.0)) <= ULAM__FPUSH_RANGE_SHARE * E * delta)) k++;
+    return k;
+}
+
+/* The walks' work (push operations) a residual of mass r_sum leaves (ulam__sweep_cost): the
+ * walk count whose range term is ULAM__FPUSH_RANGE_SHARE E delta at stitching index 1, at least
+ * one block (a fixed count: that count in proportion to r_sum, the accuracy it buys). */
+static double walk_work(double r_sum, void *ctx)
+{
+    const plan *pl = ctx;
+    double L = ulam__stop_log(1), R = r_sum / (1.0 - pl->alpha);
+    double N = pl->fixed > 0 ? (double)pl->fixed * r_sum
+                             : fmax(ULAM__STOP_N0, 7.0 * R * L / (3.0 * ULAM__FPUSH_RANGE_SHARE * pl->E * pl->delta) + 1.0);
+    return N * pl->visits * pl->step_cost;
+}
+
+/* Vose's alias table over the residual's support (k states: idx, prob, alias; work k slots). */
+static int64_t alias_build(const double *r, int64_t n, double r_sum, int32_t *idx, double *prob, int32_t *alias,
+                           int32_t *work)
+{
+    int64_t k = 0;
+    for (int64_t j = 0; j < n; j++)
+        if (r[j] != 0.0) idx[k++] = (int32_t)j;
+    int64_t ns = 0, nl = k; /* small ones in work[0, ns), large ones in work[nl, k) */
+    for (int64_t q = 0; q < k; q++) {
+        prob[q] = fabs(r[idx[q]]) * (double)k / r_sum, alias[q] = (int32_t)q;
+        if (prob[q] < 1.0) work[ns++] = (int32_t)q;
+        else work[--nl] = (int32_t)q;
+    }
+    while (ns > 0 && nl < k) {
+        int32_t a = work[--ns], b = work[nl++];
+        alias[a] = b;
+        prob[b] += prob[a] - 1.0;
+        if (prob[b] < 1.0) work[ns++] = b;
+        else work[--nl] = b;
+    }
+    while (ns > 0) prob[work[--ns]] = 1.0; /* rounding */
+    while (nl < k) prob[work[nl++]] = 1.0;
+    return k;
+}
+
+/* Row j of M' (column j of M) as a walk reads it: the sum and largest of its |entries| (known
+ * 1), and when drawing an entry by rejection would take more than two tries on average, the
+ * running sums of |entries| in cum (at the row's own offsets) for a binary search (known 2). */
+static void row_sums(const ulam_csr *Mt, int64_t j, double *cs, double *mx, unsigned char *known, double *cum)
+{
+    double s = 0.0, m = 0.0;
+    int64_t a = Mt->rowptr[j], b = Mt->rowptr[j + 1];
+    for (int64_t e = a; e < b; e++) {
+        double v = fabs(Mt->val[e]);
+        s += v, m = v > m ? v : m;
+    }
+    cs[j] = s, mx[j] = m, known[j] = 1;
+    if (m * (double)(b - a) > 2.0 * s) {
+        double c = 0.0;
+        for (int64_t e = a; e < b; e++) c += fabs(Mt->val[e]), cum[e] = c;
+        known[j] = 2;
+    }
+}
+
+/* The walk state: alias table of the start, per-row sums met so far, terminal counts. */
+typedef struct {
+    const ulam_csr *Mt;
+    const double *r;
+    const int32_t *idx, *alias;
+    const double *prob;
+    int64_t k;
+    double alpha;
+    double *cs, *mx, *cum;
+    unsigned char *known;
+    int32_t *hp, *hn; /* walks that ended at i with score +R0, -R0 */
+    int64_t steps;
+} walker;
+
+/* One terminal walk: from j drawn with probability |r_j| / ||r||_1, stop and score at the state
+ * it is at with probability 1 - alpha, else move along column j of M with probability |M_kj|
+ * (die, scoring 0, with the rest, alpha - sum_k |M_kj|); the score's sign is r_j's times the
+ * signs of the entries it crossed.  The chance to end at i is (1 - alpha) ((I - M)^-1 |r|)_i /
+ * ||r||_1 (for M, r >= 0; signed: the expectation), so score R0 = ||r||_1 / (1 - alpha) at the
+ * end estimates ((I - M)^-1 r)_i for every i at once, every score within [-R0, R0]. */
+static void walk_one(walker *w, ulam_rng *rng)
+{
+    const ulam_csr *Mt = w->Mt;
+    uint64_t frac;
+    int64_t q = (int64_t)ulam__rng_index(rng, (uint64_t)w->k, &frac);
+    int64_t j = w->idx[(double)frac * 0x1.0p-64 < w->prob[q] ? q : w->alias[q]];
+    int neg = w->r[j] < 0, steps = 0;
+    double stop = 1.0 - w->alpha;
+    for (;;) {
+        double u = ulam__rng_uniform(rng);
+        if (u < stop) {
+            if (neg) w->hn[j]++;
+            else w->hp[j]++;
+            break;
+        }
+        double v = u - stop;
+        if (!(v < w->cs[j])) break; /* the walk dies */
+        int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a;
+        if (w->known[j] == 2) { /* the first entry whose running sum exceeds v */
+            int64_t l = a, h = a + d - 1;
+            while (l < h) {
+                int64_t mid = l + (h - l) / 2;
+                if (w->cum[mid] > v) h = mid;
+                else l = mid + 1;
+            }
+            neg ^= Mt->val[l] < 0;
+            j = Mt->colidx[l];
+            steps++;
+            continue;
+        }
+        double t = v / w->cs[j] * (double)d;
+        int64_t e = (int64_t)t;
+        if (e >= d) e = d - 1;
+        double f = t - (double)e;
+        while (f * w->mx[j] > fabs(Mt->val[a + e])) { /* rejection: entry e with probability |M_ej| / sum */
+            e = (int64_t)ulam__rng_index(rng, (uint64_t)d, &frac);
+            f = (double)frac * 0x1.0p-64;
+        }
+        neg ^= Mt->val[a + e] < 0;
+        j = Mt->colidx[a + e];
+        steps++;
+    }
+    w->steps += steps;
+}
+
+/* Whether N walks at epoch k meet relative error E at every component whose interval reaches
+ * delta: its 95% interval (src/stop.c) within -+ E max(|x_i|, delta) (the interval itself, not
+ * the standard error, so every x_i >= delta is within E of the truth unless its interval misses
+ * it); p + the walks' terminal counts, scores of range R, largest R0. */
+static int rule_met(const walker *w, const double *p, int64_t n, int64_t N, int k, double R, double R0, double E,
+                    double delta)
+{
+    double L = ulam__stop_log(k), rt = 7.0 * R * L / (3.0 * ((double)N - 1.0)), Nd = (double)N;
+    if (!(rt <= E * delta)) return 0;
+    for (int64_t i = 0; i < n; i++) {
+        int64_t h = w->hp[i] + (w->hn ? w->hn[i] : 0);
+        if (h == 0) continue; /* its interval is p_i -+ rt: met above */
+        double s = (double)(w->hp[i] - (w->hn ? w->hn[i] : 0)), mean = R0 * s / Nd;
+        double up = fabs(p[i]) + fabs(mean) + R0 * sqrt(2.0 * (double)h * L / (Nd * (Nd - 1.0))) + rt;
+        if (up < delta) continue; /* cannot reach delta */
+        double var = fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0));
+        ulam__stop_ci ci;
+        ulam__stop_interval(N, mean, var, R, 0.0, R0, R0, k, &ci);
+        if (ci.lo + p[i] > delta || ci.hi + p[i] >= delta)
+            if (!(ci.kind == ULAM__STOP_EB && ci.half <= E * fmax(fabs(p[i] + mean), delta))) return 0;
+    }
+    return 1;
+}
+
+/* Sweep push and terminal walks on its residual, for ||M||_1 < 1. */
+static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, const ulam_guard *g, double *x,
+                       double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *swi,
+                       ulam_error *err)
+{
+    int64_t n = M->nrows;
+    double t0 = ulam_now(), alpha = g->abs.colsum_max, D1 = 1.0 / (1.0 - alpha);
+    plan pl = {.alpha = alpha, .E = o->rel_err, .delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n,
+               .visits = D1, .step_cost = o->step_cost > 0 ? o->step_cost : ULAM__FPUSH_STEP_COST, .fixed = o->walks};
+    info->mean_visits = D1;
+    memset(x, 0, (size_t)n * sizeof *x);
+    double *r = ulam__calloc((size_t)n, sizeof *r);
+    if (!r) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the residual");
+    int64_t cap = 100 * ulam_csr_nnz(M) + 1000000;
+    int status = ulam__sweep_push(Mt, o->source, o->rmax, o->rmax > 0 ? NULL : walk_work, &pl, cap, x, r, swi);
+    if (status == ULAM_ENOCONV) status = ULAM_OK; /* ||M||_1 < 1: the cap only ends the push; the walks take the rest */
+    if (status) {
+        free(r);
+        return ulam__fail(err, status, 0, -1, "a push within %lld operations", (long long)cap);
+    }
+    info->push = (ulam_push_info){.target = o->source, .pushes = swi->pushes, .ops = swi->ops,
+                                  .touched = n, .r_sum = swi->r_sum, .support = swi->support};
+    for (int64_t j = 0; j < n; j++) info->push.r_max = fmax(info->push.r_max, fabs(r[j]));
+    info->push.rmax = info->rmax = o->rmax > 0 ? o->rmax : info->push.r_max;
+    info->push_seconds = info->push.seconds = ulam_now() - t0;
+    double R0 = swi->r_sum / (1.0 - alpha), t1 = ulam_now();
+    info->residual_bound = swi->r_sum * D1;
+    walker w = {.Mt = Mt, .r = r, .k = swi->support, .alpha = alpha};
+    int32_t *idx = NULL, *alias = NULL, *work = NULL;
+    double *prob = NULL;
+    int sgn = 0;
+    for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn; e++) sgn = Mt->val[e] < 0;
+    for (int64_t j = 0; j < n && !sgn; j++) sgn = r[j] < 0;
+    double R = sgn ? 2.0 * R0 : R0; /* the scores' range */
+    int64_t N = 0;
+    int k = 1;
+    if (w.k > 0) {
+        idx = ulam__malloc((size_t)w.k, sizeof *idx), alias = ulam__malloc((size_t)w.k, sizeof *alias);
+        work = ulam__malloc((size_t)w.k, sizeof *work), prob = ulam__malloc((size_t)w.k, sizeof *prob);
+        w.cs = ulam__malloc((size_t)n, sizeof *w.cs), w.mx = ulam__malloc((size_t)n, sizeof *w.mx);
+        w.cum = ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum);
+        w.known = ulam__calloc((size_t)n, 1), w.hp = ulam__calloc((size_t)n, sizeof *w.hp);
+        if (sgn) w.hn = ulam__calloc((size_t)n, sizeof *w.hn);
+        if (!idx || !alias || !work || !prob || !w.cs || !w.mx || !w.cum || !w.known || !w.hp || (sgn && !w.hn))
+            status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
+    }
+    if (!status && w.k > 0) {
+        alias_build(r, n, swi->r_sum, idx, prob, alias, work);
+        for (int64_t j = 0; j < n; j++) row_sums(Mt, j, w.cs, w.mx, w.known, w.cum); /* one streaming pass */
+        w.idx = idx, w.prob = prob, w.alias = alias;
+        ulam_rng rng;
+        ulam_rng_seed(&rng, o->walk.seed, 0);
+        int64_t cap_w = o->walk.max_walks > 0 ? o->walk.max_walks : INT32_MAX;
+        if (cap_w > INT32_MAX) cap_w = INT32_MAX;
+        int k0 = first_epoch(R, pl.E, pl.delta), planned = 1;
+        for (;;) { /* checkpoint k (stitching index) at the end of epoch k0 + k - 1 */
+            int64_t target = o->walks > 0 ? o->walks : epoch_end(k0 + k - 1);
+            if (target > cap_w) target = cap_w, planned = o->walks > 0 && o->walks == cap_w;
+            while (N < target) {
+                walk_one(&w, &rng);
+                N++;
+                if ((N & 1023) == 0 && o->walk.interrupt && *o->walk.interrupt) {
+                    info->interrupted = 1, planned = 0;
+                    break;
+                }
+            }
+            if (!planned || o->walks > 0 || N >= cap_w) break;
+            if (rule_met(&w, x, n, N, k, R, R0, pl.E, pl.delta)) break;
+            k++;
+        }
+        if (!planned) /* stopped between checkpoints: the next index */
+            k = ulam__stop_epoch(N) > k0 ? ulam__stop_epoch(N) - k0 + 2 : k + 1;
+    }
+    if (!status) {
+        double Nd = (double)N, D = info->residual_bound;
+        ulam__stop_ci none;
+        if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &none);
+        else none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
+        for (int64_t i = 0; i < n; i++) {
+            int64_t h = N > 0 ? w.hp[i] + (w.hn ? w.hn[i] : 0) : 0;
+            double mean = 0.0, var = 0.0;
+            ulam__stop_ci ci = none;
+            if (h > 0) {
+                mean = R0 * (double)(w.hp[i] - (w.hn ? w.hn[i] : 0)) / Nd;
+                var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
+                ulam__stop_interval(N, mean, var, R, 0.0, R0, R0, k, &ci);
+            }
+            double p = x[i], a = p + ci.lo, b = p + ci.hi;
+            x[i] = p + mean;
+            if (std_error) std_error[i] = N > 1 ? sqrt(var / Nd) : (w.k > 0 ? NAN : 0.0);
+            if (isnan(a) && isfinite(D)) a = p - D, b = p + D; /* no interval from the walks */
+            if (isfinite(D)) a = fmax(a, p - D), b = fmin(b, p + D);
+            if (lo) lo[i] = a;
+            if (hi) hi[i] = b;
+        }
+        info->walks = N, info->steps = w.steps, info->walk_seconds = ulam_now() - t1;
+    }
+    free(idx), free(alias), free(work), free(prob), free(w.cs), free(w.mx), free(w.cum), free(w.known), free(w.hp), free(w.hn);
+    free(r);
+    info->seconds = ulam_now() - t0;
+    return status;
+}
+
+/* Estimate every component of x = (I - M)^-1 e_source; sw (may be NULL) gets the sweep push's
+ * counts (zero when the queue push ran). */
+int ulam__fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, double *std_error,
+                      double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!M || !opts || !x || !info) return ulam__fail(err, ULAM_EINVAL, 0, -1, "M, options, x and info");
+    int status = check(M, Mt, opts, err);
+    if (status) return status;
+    memset(info, 0, sizeof *info);
+    ulam__sweep_info swi = {0};
+    ulam_guard g;
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
+    if (opts->walk.guard) g = *opts->walk.guard;
+    else if ((status = ulam_guard_check(M, opts->walk.continue_q, &go, &g, err))) return status;
+    if (g.abs.colsum_max < 1.0)
+        status = solve_sweep(M, Mt, opts, &g, x, std_error, lo, hi, info, &swi, err);
+    else
+        status = solve_queue(M, Mt, opts, g, x, std_error, lo, hi, info, err);
+    if (sw) *sw = swi;
+    return status;
+}
+
+/* Estimate every component of x = (I - M)^-1 e_source. */
+int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, double *std_error,
+                     double *lo, double *hi, ulam_fpush_info *info, ulam_error *err)
+{
+    return ulam__fpush_solve(M, Mt, opts, x, std_error, lo, hi, info, NULL, err);
 }

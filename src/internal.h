@@ -109,6 +109,14 @@ int ulam__guard_fits(const ulam_guard *g, double continue_q, double alpha, int n
  * without a bound). */
 double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E);
 
+/* The forward push on b (src/bpush.c): push r (q alongside; x = q + (I - M)^-1 r holds before and
+ * after) on Mt, M's transpose, until every |r_j| <= rmax or *ops (nonzeros read, plus one a push)
+ * passes max_ops.  ULAM_OK or ULAM_ENOMEM. */
+int ulam__bpush(const ulam_csr *Mt, double rmax, int64_t max_ops, double *q, double *r, int64_t *ops);
+
+/* max_j |r_j| over n entries. */
+double ulam__bpush_max(const double *r, int64_t n);
+
 struct ulam_kernel; /* src/kernel.h */
 
 /* A set of states adjoint walks on K can reach (seen: n flags, closed under the walk's moves,
@@ -316,5 +324,34 @@ double *ulam__b_scaled(const double *b, int64_t n, int e);
 /* As ulam_mm_read_matrix_opts with reals by the C library's strtod (the same doubles, slower: the
  * reader as it was), for the reader's benchmark and tests to compare (src/mmio.c). */
 int ulam__mm_read_matrix_libc(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
+
+/* What a sweep push did (src/sweep.c): rounds over a list of states or whole sweeps (sweeps of
+ * them), pushes, operations (a push costs its row's entries + 1, a sweep n more), the residual's
+ * sum of |r| and the states it is on. */
+typedef struct {
+    int64_t rounds, sweeps, pushes, ops, support;
+    double r_sum;
+} ulam__sweep_info;
+
+/* The walks' work (push operations) a residual of mass r_sum would leave. */
+typedef double (*ulam__sweep_cost)(double r_sum, void *ctx);
+
+/* Forward push of x = (I - M)^-1 e_s on M given as its transpose Mt, into p and r (n entries
+ * each, zero on entry; x = p + (I - M)^-1 r after): rounds over the states holding residual, then
+ * whole sweeps in order once n / 16 hold it, pushing every |r_j| > rmax, until none is left or
+ * (cost given) one more round would save less walk work than it costs.  ULAM_OK, ULAM_ENOMEM,
+ * ULAM_ENOCONV past max_ops (> 0) operations (p and r still valid). */
+int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost, void *ctx, int64_t max_ops,
+                     double *p, double *r, ulam__sweep_info *info);
+
+/* ulam_fpush_solve with the sweep push's counts in sw (may be NULL; zero when ||M||_1 >= 1 and
+ * the queue push ran) (src/fpush.c). */
+int ulam__fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, double *std_error,
+                      double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw, ulam_error *err);
+
+/* ulam_fpush_solve with the sweep push's counts in sw (may be NULL; zero when ||M||_1 >= 1 and
+ * the queue push ran) (src/fpush.c). */
+int ulam__fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, double *std_error,
+                      double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw, ulam_error *err);
 
 #endif

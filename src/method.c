@@ -42,14 +42,6 @@ int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len)
     return 1;
 }
 
-/* Fill a's interval from its estimate and standard error. */
-void ulam__answer_interval(ulam_answer *a)
-{
-    int ok = isfinite(a->std_error);
-    a->ci95[0] = ok ? a->estimate - ULAM_Z95 * a->std_error : NAN;
-    a->ci95[1] = ok ? a->estimate + ULAM_Z95 * a->std_error : NAN;
-}
-
 /* The default row options: none pinned, none excluded. */
 ulam_method_opts ulam_method_defaults(void)
 {

@@ -16,6 +16,9 @@ struct ulam_run {
     double *val;
     ulam_csr *Mt;
     ulam_push *w;
+    double *bq, *br;      /* bidirectional with a dense b: the push on b's q and residual r (src/bpush.c) */
+    ulam_walk_opts bwo;   /* and the walks' options on r (adjoint from the index, offset q_i) */
+    ulam_bidir_plan_info bplan; /* and its plan (also in the choice's bidir) */
 };
 
 /* One query's choice in progress. */
@@ -54,8 +57,5 @@ extern const ulam__method_type ulam__method_walks, ulam__method_bidir, ulam__met
 
 /* 1 when row k is excluded by q's options (why filled: "not considered: excluded"). */
 int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len);
-
-/* Fill a's interval from its estimate and standard error (NaN standard error: no interval). */
-void ulam__answer_interval(ulam_answer *a);
 
 #endif

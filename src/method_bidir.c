@@ -1,14 +1,17 @@
 /* The method table's bidirectional row: a reverse push from the index and walks from a sparse b
- * (src/bidir.c), considered by the choice against the walks' leader (rent or buy: it needs M's
+ * (src/bidir.c), or with a dense b the push on b and walks from the index scoring its residual
+ * (src/bpush.c), considered by the choice against the walks' leader (rent or buy: it needs M's
  * transpose) with its push capped at half the leader's predicted work, chosen when its own
  * predicted work is below the leader's. */
 #include "method.h"
+#include "stats.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
-/* The densest b the bidirectional row takes: nonzeros at most max(16, n / 10). */
+/* The densest b the reverse-push route takes: nonzeros at most max(16, n / 10). */
 int64_t ulam_method_sparse_limit(int64_t n)
 {
     return n / 10 > 16 ? n / 10 : 16;
@@ -22,19 +25,24 @@ static int64_t nonzeros(const double *b, int64_t n)
     return k;
 }
 
+/* The route: 1 the push on b (dense b, or an estimator or exponent pinned), 0 the reverse push. */
+int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o)
+{
+    if (!b || !o) return 0;
+    return nonzeros(b, n) > ulam_method_sparse_limit(n) ||
+           (ao && (ao->pin_estimator || (ao->pin_alpha && o->kernel_alpha != 1.0)));
+}
+
 /* An adjoint query with a rel_err target, nothing pinned it cannot honour, a walk leader to
  * compare with whose predicted work W exceeds nnz(M)/4, and a sparse b. */
 static int applies(const ulam__query *q, int k, char *why, size_t len)
 {
     const ulam_walk_opts *o = q->o;
-    const ulam_auto_opts *ao = q->ao;
     const ulam_auto_result *au = &q->ch->walks;
+    int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     const char *pinned = o->mode == ULAM_FORWARD ? "forward mode (--mode forward, --out, --errors)"
-                         : ao->pin_estimator ? "--estimator is pinned"
-                         : ao->pin_alpha && o->kernel_alpha != 1.0 ? "--alpha other than 1"
                          : o->roulette > 0 || o->split > 0 ? "--roulette or --split (bidirectional takes neither)"
                                                            : NULL;
-    int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     double nnz = (double)ulam_csr_nnz(q->M), W = q->ch->leader_work;
     if (pinned) snprintf(why, len, "not considered: %s", pinned);
     else if (ulam__method_excluded(q, k, why, len)) return 0;
@@ -42,9 +50,7 @@ static int applies(const ulam__query *q, int k, char *why, size_t len)
         snprintf(why, len, "not considered: no --rel-err target (without one auto compares variance x work a walk, "
                            "which bidirectional has no figure for)");
     else if (au->chosen < 0) snprintf(why, len, "not considered: no certified walk method to compare with");
-    else if (nb == 0 || nb > ulam_method_sparse_limit(n))
-        snprintf(why, len, "not considered: b is %s (%lld nonzeros; sparse is at most max(16, n/10) = %lld)",
-                 nb ? "dense" : "zero", (long long)nb, (long long)ulam_method_sparse_limit(n));
+    else if (nb == 0) snprintf(why, len, "not considered: b is zero");
     else if (!(W > nnz / 4))
         snprintf(why, len, "not considered: the walks' predicted work %.3g is below nnz(M)/4 = %.3g (the transpose "
                            "alone would cost more)", W, nnz / 4);
@@ -75,7 +81,8 @@ static double work(const ulam_csr *M, const ulam_bidir_plan_info *p, const ulam_
 /* Free what the run keeps for bidirectional. */
 static void release(ulam_run *r)
 {
-    free(r->idx), free(r->val);
+    free(r->idx), free(r->val), free(r->bq), free(r->br);
+    r->bq = r->br = NULL;
     ulam_push_free(r->w);
     ulam_csr_free(r->Mt);
     r->idx = NULL, r->val = NULL, r->w = NULL, r->Mt = NULL;
@@ -105,12 +112,85 @@ static int setup(ulam__query *q, const ulam_walk_opts *walk, ulam_error *err)
     return ULAM_OK;
 }
 
+/* Pilot walks of the dense route: one round of the walk solver on the residual. */
+enum { DENSE_PILOT = 1024 };
+
+/* The dense route's walks' options: adjoint from the index with kernel c's estimator,
+ * continuation and exponent (c NULL: o's), the push part q_i as the rule's offset. */
+static ulam_walk_opts dense_walk_opts(const ulam_walk_opts *o, const ulam_auto_candidate *c, double qi)
+{
+    ulam_walk_opts wo = *o;
+    wo.mode = ULAM_ADJOINT, wo.nstarts = 0, wo.starts = NULL, wo.start_weights = NULL, wo.guard = NULL;
+    if (c) wo.estimator = c->estimator, wo.continue_q = c->continue_q, wo.kernel_alpha = c->kernel_alpha;
+    wo.rel_err_offset = o->rel_err_offset + qi;
+    return wo;
+}
+
+/* The dense route (b has more nonzeros than ulam_method_sparse_limit): the transpose, b pushed
+ * down to rmax = max|b| nv / N (N the walks the rule predicts on b, nv = var / (E m)^2 those the
+ * variance alone asks: the range term, linear in max|r|, then asks about what the variance
+ * does) within max_ops, and a pilot round of the walks on the residual, whose rule (src/stop.c,
+ * on the residual's own range) predicts the walks; the plan in ch->bidir.  c: the kernel the
+ * walks run with (NULL: o's). */
+static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_candidate *c, double var, double m,
+                      double N, int64_t max_ops, ulam_error *err)
+{
+    ulam_run *r = q->run;
+    ulam_bidir_plan_info *pl = &q->ch->bidir;
+    int64_t n = q->M->nrows, ops = 0, nnz = ulam_csr_nnz(q->M);
+    double E = o->rel_err, t0 = ulam_now();
+    memset(pl, 0, sizeof *pl);
+    r->bq = calloc((size_t)n, sizeof *r->bq), r->br = malloc((size_t)n * sizeof *r->br);
+    int status = r->bq && r->br ? ulam_csr_transpose(q->M, &r->Mt) : ULAM_ENOMEM;
+    q->ch->transpose_seconds = ulam_now() - t0;
+    if (status) return release(r), ulam__fail(err, status, 0, -1, "memory for the transpose and the push on b");
+    memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
+    double bmax = ulam__bpush_max(q->b, n), nv = var / (E * m * E * m);
+    double rmax = isfinite(N) && N > 0 && nv > 0 ? bmax * fmin(1.0, nv / N) : bmax;
+    if ((status = ulam__bpush(r->Mt, rmax, max_ops, r->bq, r->br, &ops)))
+        return release(r), ulam__fail(err, status, 0, -1, "memory for the push on b");
+    double qi = r->bq[o->index];
+    r->bwo = dense_walk_opts(o, c, qi);
+    ulam_walk_opts po = r->bwo;
+    po.max_walks = DENSE_PILOT, po.max_seconds = 0, po.interrupt = NULL, po.share = NULL;
+    po.seed = o->seed ^ UINT64_C(0x9e3779b97f4a7c15);
+    ulam_solver *sv = NULL;
+    ulam_walk_result wr;
+    status = ulam_solver_alloc(q->M, r->br, &po, &sv, err);
+    while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
+    if (!status) ulam_solver_result(sv, &wr);
+    ulam_solver_free(sv);
+    if (status) return status;
+    double mt = fabs(qi + wr.estimate + o->rel_err_offset), V = wr.walks ? (double)wr.steps / (double)wr.walks : 0.0;
+    double need = fmax((double)ULAM__REL_MIN, fmax(wr.min_walks, wr.variance / (E * mt * E * mt)));
+    pl->target = o->index, pl->rmax = rmax, pl->balanced = 1, pl->push_part = qi;
+    pl->push = (ulam_push_info){.target = o->index, .rmax = rmax, .ops = ops, .r_max = ulam__bpush_max(r->br, n)};
+    pl->pilot_walks = wr.walks, pl->pilot_steps = wr.steps, pl->mean_visits = V + 1.0;
+    pl->predicted_walks = mt > 0 ? need : INFINITY, pl->step_cost = 1.0;
+    pl->predicted_work = ULAM_AUTO_READ * ((double)ops + 2.0 * (double)nnz) +
+                         ((double)wr.walks + pl->predicted_walks) * (V + ULAM_AUTO_WALK);
+    pl->seconds = ulam_now() - t0;
+    r->bplan = *pl;
+    return ULAM_OK;
+}
+
 /* Plan with the push capped at W / 2 and predict the work; kept in the run. */
 static int predict(ulam__query *q, int k, ulam_error *err)
 {
     ulam_choice *ch = q->ch;
     ulam_run *r = q->run;
     double W = ch->leader_work;
+    if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o)) { /* the push on b */
+        const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
+        double m = fabs(c->estimate + q->o->rel_err_offset);
+        int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
+        int status = dense_plan(q, q->o, c, c->variance, m, c->predicted_walks, cap, err);
+        if (status == ULAM_ENOMEM) return status;
+        ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = r->bwo, ch->bidir_opts.target = q->o->index;
+        if (status) snprintf(ch->method[k].why, sizeof ch->method[k].why, "refused: %.250s", err->msg);
+        else ch->method[k].predicted_work = ch->bidir.predicted_work;
+        return ULAM_OK;
+    }
     ulam_walk_opts walk = *q->o;
     walk.estimator = ULAM_COLLISION, walk.kernel_alpha = 1.0;
     walk.guard = NULL, walk.interrupt = NULL, walk.share = NULL;
@@ -145,9 +225,26 @@ static int pin(ulam__query *q, int k, ulam_error *err)
     (void)k;
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     if (nb == 0) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero b (b is zero, so x is 0)");
-    if (nb > ulam_method_sparse_limit(n))
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a sparse b for bidirectional: at most max(16, n/10) = %lld nonzeros, "
-                          "not %lld", (long long)ulam_method_sparse_limit(n), (long long)nb);
+    if (ulam_method_bidir_route(q->b, n, q->ao, q->o)) { /* the push on b, planned from a pilot round on b */
+        if (!(q->o->rel_err > 0))
+            return ulam__fail(err, ULAM_EINVAL, 0, -1, "a --rel-err target for bidirectional with a dense b "
+                                                       "(more than max(16, n/10) = %lld nonzeros)",
+                              (long long)ulam_method_sparse_limit(n));
+        ulam_walk_opts po = dense_walk_opts(q->o, NULL, 0.0);
+        po.max_walks = DENSE_PILOT, po.max_seconds = 0, po.interrupt = NULL, po.share = NULL;
+        po.seed = q->o->seed ^ UINT64_C(0x7f4a7c159e3779b9);
+        ulam_solver *sv = NULL;
+        ulam_walk_result wr;
+        int status = ulam_solver_alloc(q->M, q->b, &po, &sv, err);
+        while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
+        if (!status) ulam_solver_result(sv, &wr);
+        ulam_solver_free(sv);
+        if (status) return status;
+        double m = fabs(wr.estimate + q->o->rel_err_offset);
+        status = dense_plan(q, q->o, NULL, wr.variance, m, wr.min_walks, 100 * ulam_csr_nnz(q->M) + 1000000, err);
+        q->ch->bidir_opts = ulam_bidir_defaults(), q->ch->bidir_opts.walk = q->run->bwo;
+        return status;
+    }
     int status = setup(q, q->o, err);
     if (!status && nb == 1 && q->b[q->run->idx[0]] == 1.0) /* b = e_S: a point source, as `ulam solve --source S` */
         q->run->bo.source = q->run->idx[0], q->run->bo.nb = 0;
@@ -158,6 +255,20 @@ static int pin(ulam__query *q, int k, ulam_error *err)
 /* The push and the walks (the plan reused when predicted). */
 static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
 {
+    if (r->br) { /* dense b: the walks from the index on the push's residual, q_i added */
+        ulam_bidir_result *br = &a->bidir;
+        r->bwo.interrupt = r->o.interrupt, r->bwo.share = r->o.share;
+        int status = ulam_solve(r->M, r->br, &r->bwo, &br->walks, err);
+        if (status) return status;
+        double qi = r->bq[r->bwo.index];
+        br->push_part = qi, br->estimate = qi + br->walks.estimate, br->std_error = br->walks.std_error;
+        br->ci95[0] = qi + br->walks.ci95[0], br->ci95[1] = qi + br->walks.ci95[1];
+        br->plan = r->bplan, br->push = r->bplan.push;
+        br->seconds = br->walks.seconds + r->bplan.seconds;
+        a->walks = br->walks, a->opts = r->bwo;
+        a->estimate = br->estimate, a->std_error = br->std_error, a->ci95[0] = br->ci95[0], a->ci95[1] = br->ci95[1];
+        return ULAM_OK;
+    }
     r->bo.walk.interrupt = r->o.interrupt, r->bo.walk.share = r->o.share;
     int status = ulam_bidir_solve(r->w, r->Mt, &r->bo, &a->bidir, err);
     if (status) return status;

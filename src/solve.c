@@ -1052,8 +1052,8 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci);
 
 /* Nonzero when the rel_err rule holds for r (see ulam_solve in ulam.h): the run's 95% interval
- * (stop.h) meeting ulam__stop_rel_met (stderr <= E |m|, range and bias terms within the
- * same width sqrt(2 L) E |m|), after ULAM__REL_MIN walks, forward with
+ * (stop.h) meeting ulam__stop_rel_met (stderr <= E |m|, and the whole half-width, range and bias
+ * terms included, within 2 sqrt(2 L) E |m|), after ULAM__REL_MIN walks, forward with
  * the watched component tallied, and walks cut at max_steps moving it by at most
  * ULAM__CUT_SHARE E |m|; x certified 0 (nothing that scores is reachable) meets it at once. */
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)

@@ -29,7 +29,7 @@ void ulam__stop_interval(int64_t n, double mean, double var, double R, double bi
         return;
     }
     if (n < 2 || !isfinite(R) || !(R > 0) || !isfinite(mean) || !(bias >= 0) || !isfinite(bias)) return;
-    if (maxabs > limit) { /* a score past the range: the sample is not the clipped one R describes */
+    if (maxabs > limit * (1.0 + ULAM__STOP_ROUNDING)) { /* past the range: not the clipped sample R describes */
         ci->kind = ULAM__STOP_BEYOND;
         return;
     }
@@ -47,7 +47,7 @@ int ulam__stop_rel_met(const ulam__stop_ci *ci, double m, double E)
     if (!(E > 0)) return 0;
     if (ci->kind == ULAM__STOP_EXACT) return 1;
     double w = sqrt(2.0 * ci->L) * E * fabs(m);
-    return ci->kind == ULAM__STOP_EB && w > 0 && ci->var_term <= w && ci->range_term + ci->bias <= w;
+    return ci->kind == ULAM__STOP_EB && w > 0 && ci->var_term <= w && ci->half <= 2.0 * w;
 }
 
 /* The walk count that would meet target E. */
@@ -55,10 +55,18 @@ double ulam__stop_walks_needed(double m, double var, double R, double bias, doub
 {
     if (!(E > 0)) return 0.0;
     if (R == 0.0) return 0.0;
-    double L = ulam__stop_log(k), w = sqrt(2.0 * L) * E * fabs(m), c = w - bias;
-    if (!(fabs(m) > 0) || !isfinite(R) || !(c > 0)) return INFINITY;
-    double nv = fmax(var, 0.0) / (E * m * E * m), nr = 7.0 * R * L / (3.0 * c) + 1.0;
-    return ceil(fmax(nv, nr));
+    double L = ulam__stop_log(k), w = sqrt(2.0 * L) * E * fabs(m), C = 2.0 * w - bias;
+    if (!(fabs(m) > 0) || !isfinite(R) || !(C > 0)) return INFINITY;
+    /* var_term(n) = a / sqrt(n) <= w, and a / sqrt(n) + c / (n - 1) <= C (both fall with n) */
+    double a = sqrt(2.0 * fmax(var, 0.0) * L), c = 7.0 * R * L / 3.0, nv = fmax(var, 0.0) / (E * m * E * m);
+    double lo = fmax(nv, 1.0), hi = fmax(lo, fmax(4.0 * a * a / (C * C), 2.0 * c / C + 1.0)) + 1.0;
+    if (a / sqrt(lo) + c / (lo - 1.0) <= C) return ceil(fmax(lo, 2.0));
+    for (int it = 0; it < 200 && hi - lo > 0.5; it++) { /* lo fails, hi holds */
+        double mid = 0.5 * (lo + hi);
+        if (a / sqrt(mid) + c / (mid - 1.0) <= C) hi = mid;
+        else lo = mid;
+    }
+    return ceil(hi);
 }
 
 /* The walks' share of a target E beside an independent relative error f. */

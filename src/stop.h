@@ -27,6 +27,9 @@
 #define ULAM__STOP_DELTA 0.05 /* 1 - the confidence of every printed interval */
 #define ULAM__STOP_N0 1024    /* the first epoch's walks (one block) */
 #define ULAM__STOP_TAIL 0.01  /* the largest share of |x| the truncation bias may take (fixed budgets) */
+#define ULAM__STOP_ROUNDING 1e-9 /* a score at the range's edge, up to the rounding of a walk's weight
+                                    products (S / q = 1 computed as 0.9 / 0.9 along many steps), is
+                                    inside it: only a score past limit (1 + this) is beyond */
 
 /* What the interval rests on. */
 enum {
@@ -61,15 +64,15 @@ void ulam__stop_interval(int64_t n, double mean, double var, double R, double bi
 
 /* Whether an interval meets a relative-error target E at estimate m: its variance term at most
  * w = sqrt(2 L) E |m|, the width it has when the standard error is E |m| (so the rule asks
- * stderr <= E |m|, as a CLT rule would), and its range and bias terms together at most w too
- * (so the sample has seen what could still matter): the half-width is then at most 2 w; never
- * at m = 0 unless exact. */
+ * stderr <= E |m|, as a CLT rule would), and its whole half-width (variance, range and bias
+ * terms) at most 2 w: the range and bias terms take the slack the variance term leaves (so the
+ * sample has seen what could still matter); never at m = 0 unless exact. */
 int ulam__stop_rel_met(const ulam__stop_ci *ci, double m, double E);
 
 /* The walk count at which a run of sample variance var, range R and bias at estimate m would
- * meet target E at epoch k (the larger of the variance term's and the range term's); 0 with
- * no target, INFINITY when the bias alone exceeds what the target allows, m = 0 or R
- * infinite. */
+ * meet target E at epoch k (the rule of ulam__stop_rel_met: the least n with the variance term
+ * at most w and the half-width at most 2 w); 0 with no target, INFINITY when the bias alone
+ * reaches 2 w, m = 0 or R infinite. */
 double ulam__stop_walks_needed(double m, double var, double R, double bias, double E, int k);
 
 /* The relative target E' that walks must meet so that, with an independent error of relative

@@ -292,6 +292,8 @@ def _report(d, index, b_nonzeros, source, scale):
                     "mean_visits": _num(b["mean_visits"]), "predicted_walks": _num(b["predicted_walks"]),
                     "predicted_work": _num(b["predicted_work"]), "push_seconds": b["push_seconds"], "walk_seconds": w["seconds"], "seconds": b["seconds"], "estimator": ESTIMATORS[o["estimator"]],
                     "seed": o["seed"], "threads": w["threads"], "ranks": 1})
+        if d.get("rel_err"):
+            rep["rel_err_met"] = bool(w["rel_err_met"])
     elif d["method"] != "walks":
         rep.update({"method": d["method"], "estimate": d["estimate"] * scale, "iterations": d["iterations"],
                     "residual": _num(d["residual"]), "histories": w["walks"], "seed": o["seed"]})

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 static const char *const usage =
     "usage: ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R]\n"
@@ -27,9 +28,10 @@ static const char *const usage =
     "  --min-value V      the smallest x_I the balance plans for (default 1 / n, raised by a probe\n"
     "                     of 1024 walks once the push has spent what they cost)\n"
     "  --top K            with --source S and no --index: every component of x = (I - M)^-1 e_S by\n"
-    "                     forward push and walks (FORA; --rel-err E for every x_i >= --min-value,\n"
-    "                     default 0.1 and 1 / n; or --walks N), the K largest printed with their\n"
-    "                     intervals (default 10)\n"
+    "                     forward push (sweeps once the residual spreads) and walks from its\n"
+    "                     residual (--rel-err E: every 95% interval of an x_i >= --min-value within\n"
+    "                     E of it, default 0.1 and 1 / n; or --walks N), the K largest printed\n"
+    "                     with their intervals (default 10)\n"
     "  --step-cost C      push operations one walk visit costs, for the balance (default 1.3;\n"
     "                     bench_bidir measures it: docs/bidirectional.md)\n"
     "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
@@ -55,6 +57,8 @@ typedef struct {
     double direct, transpose_seconds, load_seconds, guard_seconds;
     ulam_guard g;
     const ulam_choice *ch; /* chosen by --method auto: the choice (else NULL) */
+    double bmax;           /* max |b| */
+    int dense;             /* the library pushed b and walked from the index (src/bpush.c) */
 } report;
 
 /* Print the human-readable block. */
@@ -64,6 +68,24 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->target + 1,
            o->target < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
            w->interrupted ? "  [INTERRUPTED]" : "");
+    if (rp->dense) { /* the push on b: its own lines */
+        printf("method          bidirectional, the push on b: then %s walks from %lld scoring its "
+               "residual\n", cli_estimator_names[o->walk.estimator], (long long)o->target + 1);
+        printf("push            rmax %.3g: %lld operations; q_%lld = %.10g exact; residual max %.3g (b's was %.3g)\n",
+               r->push.rmax, (long long)r->push.ops, (long long)o->target + 1, r->push_part, r->push.r_max,
+               r->plan.rmax > 0 ? rp->bmax : NAN);
+        printf("walks           %lld (%lld cut, %lld steps, %d threads); a pilot of %lld walks predicted %.3g\n",
+               (long long)w->walks, (long long)w->cut, (long long)w->steps, w->threads, (long long)r->plan.pilot_walks,
+               r->plan.predicted_walks);
+        printf("seconds         %.4f (push and pilot %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
+               r->plan.seconds, w->seconds, (unsigned long long)o->walk.seed, rp->transpose_seconds);
+        printf("load            %.3f s inputs\n", rp->load_seconds);
+        if (rp->ch) cli_auto_print_text(rp->ch, 1);
+        if (rp->check)
+            printf("direct          %.10g (LAPACK), z = %.3f\n", rp->direct,
+                   r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN);
+        return;
+    }
     if (o->nb > 0)
         printf("method          bidirectional: reverse push from %lld, walks from b's %lld nonzeros (%s rmax)\n",
                (long long)o->target + 1, (long long)o->nb, o->rmax > 0 ? "given" : "balanced");
@@ -143,6 +165,7 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         cli_json_number("direct", rp->direct, 0);
         cli_json_number("z", r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN, 0);
     }
+    if (o->walk.rel_err > 0) printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
     if (rp->ch) cli_auto_print_json(rp->ch, 1);
     printf("\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
 }
@@ -268,7 +291,11 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     int status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : ulam_csr_transpose(s->M, &Mt);
     o.walk.guard = &rp->g, o.walk.interrupt = &cli_interrupted;
     if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
-    else status = ulam_fpush_solve(s->M, Mt, &o, x, se, lo, hi, &info, &err);
+    struct timespec c0, c1;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+    if (!status) status = ulam_fpush_solve(s->M, Mt, &o, x, se, lo, hi, &info, &err);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+    double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec); /* push and walks */
     if (status) rc = cli_report(s->matrix_path, &err);
     if (!rc && check) rc = cli_direct_solve(s, CLI_MAX_MEM, &xd, NULL);
     if (!rc && cli_rank == 0) {
@@ -285,6 +312,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
                    (long long)info.walks, (long long)info.steps);
             cli_json_number("residual_bound", info.residual_bound, 0);
             cli_json_number("seconds", info.seconds, 0);
+            cli_json_number("cpu_seconds", cpu, 0);
             printf("\"top\": [");
             for (int64_t k = 0; k < top; k++) {
                 int64_t i = order[k];
@@ -307,7 +335,8 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
                    "x_i at most %.3g)\n", info.rmax, (long long)info.push.ops, (long long)info.push.support,
                    info.push.r_sum, info.residual_bound);
             printf("walks           %lld (%lld steps)\n", (long long)info.walks, (long long)info.steps);
-            printf("seconds         %.4f (push %.4f, walks %.4f)\n", info.seconds, info.push_seconds, info.walk_seconds);
+            printf("seconds         %.4f (push %.4f, walks %.4f; CPU %.4f)\n", info.seconds, info.push_seconds,
+                   info.walk_seconds, cpu);
             printf("%-6s %-10s %-14s %-11s %s\n", "rank", "index", "estimate", "stderr",
                    xd ? "95% CI                    direct" : "95% CI");
             for (int64_t k = 0; k < top; k++) {
@@ -400,15 +429,19 @@ int cli_bidir(int argc, char **argv)
 }
 
 /* Run the chosen bidirectional (cli.h). */
-int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int json, int check, double direct,
+int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
                        double load_seconds)
 {
     report rp = {.json = json, .check = check, .direct = direct, .load_seconds = load_seconds,
                  .transpose_seconds = ch->transpose_seconds, .ch = ch};
-    int rc = cli_guard(s, ch->bidir_opts.walk.continue_q, 1.0, ULAM_FORWARD, &rp.g);
-    if (rc) return rc;
-    rp.guard_seconds = rp.g.abs.seconds + rp.g.hat[0].seconds + rp.g.hat[1].seconds;
-    cli_guard_warn(s, &rp.g, ULAM_FORWARD, 0);
+    for (int64_t i = 0; i < s->M->nrows; i++) rp.bmax = fmax(rp.bmax, fabs(s->b[i]));
+    rp.dense = route; /* ulam_method_bidir_route: the push on b */
+    int rc = 0;
+    if (!rp.dense) { /* the dense route's walks run on M under the walks' own guards */
+        if ((rc = cli_guard(s, ch->bidir_opts.walk.continue_q, 1.0, ULAM_FORWARD, &rp.g))) return rc;
+        rp.guard_seconds = rp.g.abs.seconds + rp.g.hat[0].seconds + rp.g.hat[1].seconds;
+        cli_guard_warn(s, &rp.g, ULAM_FORWARD, 0);
+    }
     ulam_answer a;
     ulam_error err;
     cli_catch_sigint();

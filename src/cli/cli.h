@@ -235,7 +235,7 @@ int cli_bidir(int argc, char **argv);
 
 /* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print
  * its report with the choice; 0 or an exit code. */
-int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int json, int check, double direct,
+int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
                        double load_seconds);
 
 /* ulam solve --queries FILE (src/cli/queries.c): s (not loaded) and o from the command line

@@ -161,7 +161,8 @@ static void print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, in
     else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
         printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
                o->rel_err);
-    else if (o->rel_err > 0 && r->out_of_reach && !isfinite(r->ci95[0]))
+    else if (o->rel_err > 0 && r->out_of_reach && !isfinite(r->ci95[0]) &&
+             !(r->min_walks > (o->max_walks > 0 ? (double)o->max_walks : (double)ULAM_REL_ERR_CAP)))
         printf("rel-err         NOT met (target %.3g): a score passed the certified range, so no interval can be "
                "printed; stopped after %lld walks, over 1024 times the %.4g the rule asked for\n", o->rel_err,
                (long long)r->walks, r->min_walks);
@@ -171,9 +172,10 @@ static void print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, in
                "not use the variance's own error bar\n", r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
                r->rho4.lower, r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
     else if (o->rel_err > 0 && r->min_walks > 0 && (verbose || !r->rel_err_met))
-        printf("rel-err         %s (target %.3g; the score bound asks for %.4g walks at this estimate%s)\n",
+        printf("rel-err         %s (target %.3g; the rule asks for %.4g walks at this estimate and variance%s)\n",
                r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
-               r->out_of_reach ? ", beyond the 1e9 cap: stopped" : "");
+               !r->out_of_reach ? "" : o->max_walks > 0 ? ", more than --walks: stopped early, the estimate so far above"
+                                                        : ", beyond the 1e9 cap: stopped early, the estimate so far above");
     else if (o->rel_err > 0)
         printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
 }
@@ -638,7 +640,7 @@ static int run(solve_args *a)
         return rc;
     }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
-        rc = cli_bidir_auto_run(&a->s, rn, &ch, ro.json, ro.check, ro.direct, ro.load_seconds);
+        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_method_bidir_route(a->s.b, a->s.M->nrows, &a->ao, &a->o), ro.json, ro.check, ro.direct, ro.load_seconds);
         ulam_run_free(rn);
         a->an = ulam_analysis_free(a->an);
         cli_system_free(&a->s);

@@ -12,8 +12,43 @@
 /* Free the table's arrays (the struct itself is the caller's). */
 void ulam__lights_free(ulam__lights *L)
 {
-    free(L->emitter), free(L->cdf);
-    L->emitter = NULL, L->cdf = NULL, L->nem = 0, L->ptot = 0.0;
+    free(L->emitter), free(L->cdf), free(L->group);
+    L->emitter = NULL, L->cdf = NULL, L->group = NULL, L->nem = 0, L->ngroups = 0, L->ptot = 0.0;
+}
+
+/* Group of emitter l in L (the one of its emission and normal), made when new; -1 no memory. */
+static int64_t group_of(const ulam_scene *s, ulam__lights *L, int64_t l)
+{
+    const double *E = s->emit + 3 * l, *n = s->normal + 3 * l;
+    int64_t g = 0;
+    while (g < L->ngroups && !(L->group[g].E[0] == E[0] && L->group[g].E[1] == E[1] && L->group[g].E[2] == E[2] &&
+                               fabs(L->group[g].n[0] - n[0]) + fabs(L->group[g].n[1] - n[1]) +
+                                       fabs(L->group[g].n[2] - n[2]) < 1e-9))
+        g++;
+    if (g < L->ngroups) return g;
+    ulam__light_group *G = realloc(L->group, (size_t)(g + 1) * sizeof *G);
+    if (!G) return -1;
+    L->group = G, L->ngroups = g + 1;
+    for (int c = 0; c < 3; c++) G[g].E[c] = E[c], G[g].n[c] = n[c], G[g].lo[c] = INFINITY, G[g].hi[c] = -INFINITY;
+    return g;
+}
+
+/* The emitters' groups (group_of) and their boxes; ULAM_OK or ULAM_ENOMEM. */
+static int group(const ulam_scene *s, ulam__lights *L)
+{
+    for (int64_t k = 0; k < L->nem; k++) {
+        int64_t l = L->emitter[k], g = group_of(s, L, l);
+        if (g < 0) {
+            ulam__lights_free(L);
+            return ULAM_ENOMEM;
+        }
+        for (int64_t j = s->start[l]; j < s->start[l + 1]; j++)
+            for (int c = 0; c < 3; c++) {
+                double v = s->vert[3 * s->vidx[j] + c];
+                L->group[g].lo[c] = fmin(L->group[g].lo[c], v), L->group[g].hi[c] = fmax(L->group[g].hi[c], v);
+            }
+    }
+    return ULAM_OK;
 }
 
 /* The emitters of s and their cumulative power (channel sums); ULAM_OK or ULAM_ENOMEM. */
@@ -36,7 +71,7 @@ int ulam__lights_build(const ulam_scene *s, ulam__lights *L)
             L->cdf[L->nem++] = L->ptot;
         }
     }
-    return ULAM_OK;
+    return group(s, L);
 }
 
 /* The emitter drawn in proportion to power from u in [0, 1). */
@@ -103,35 +138,40 @@ static void project(const ulam_scene *s, int64_t p, const double *pt, const doub
     }
 }
 
-/* An upper bound on G(x, y) = cos cos_y / (pi r^2) over x on patch p (or, p < 0, the point pt
- * with normal n) and y on emitter l, both facing each other: 0 when l lies wholly on or behind
- * x's plane or x's patch wholly on or behind l's (no pair faces), 1 / (pi d^2) for d > 0 a lower
- * bound on their distance (the widest gap along x's normal, against l's normal, and along the
- * line between their centroids: separating axes of convex polygons), else INFINITY. */
-static double g_max(const ulam_scene *s, int64_t p, const double *pt, const double n[3], int64_t l)
+/* The least and largest v . u over the box of group G. */
+static void project_box(const ulam__light_group *G, const double u[3], double *lo, double *hi)
 {
-    const double *nl = s->normal + 3 * l;
-    double lo_p, hi_p, lo_l, hi_l, cp[3] = {0, 0, 0}, cl[3] = {0, 0, 0}, u[3], scale = 0.0;
+    double c = 0.0, h = 0.0;
+    for (int i = 0; i < 3; i++) c += 0.5 * (G->lo[i] + G->hi[i]) * u[i], h += 0.5 * (G->hi[i] - G->lo[i]) * fabs(u[i]);
+    *lo = c - h, *hi = c + h;
+}
+
+/* An upper bound on G(x, y) = cos cos_y / (pi r^2) over x on patch p (or, p < 0, the point pt
+ * with normal n) and y on an emitter of group G (within its box, facing along its normal), both
+ * facing each other: 0 when the box lies wholly on or behind x's plane or x's patch wholly on or
+ * behind the emitters' plane (no pair faces), 1 / (pi d^2) for d > 0 a lower bound on their
+ * distance (the widest gap along x's normal, against the emitters' normal, and along the line
+ * between the centres: separating axes of convex sets), else INFINITY. */
+static double g_max(const ulam_scene *s, int64_t p, const double *pt, const double n[3], const ulam__light_group *G)
+{
+    double lo_p, hi_p, lo_l, hi_l, cp[3] = {0, 0, 0}, u[3];
     project(s, p, pt, n, &lo_p, &hi_p);
-    project(s, l, NULL, n, &lo_l, &hi_l);
-    scale = fmax(fabs(lo_p), fabs(hi_l)) + 1.0;
-    if (hi_l - lo_p <= 1e-12 * scale) return 0.0; /* l on or behind x's plane: cos <= 0 (rounding aside) */
+    project_box(G, n, &lo_l, &hi_l);
+    if (hi_l - lo_p <= 1e-12 * (fmax(fabs(lo_p), fabs(hi_l)) + 1.0)) return 0.0; /* on or behind x's plane */
     double gap = lo_l - hi_p;
-    project(s, p, pt, nl, &lo_p, &hi_p);
-    project(s, l, NULL, nl, &lo_l, &hi_l);
-    if (hi_p - lo_l <= 1e-12 * (fmax(fabs(hi_p), fabs(lo_l)) + 1.0)) return 0.0; /* x behind l's plane: cos_l <= 0 */
-    gap = fmax(gap, lo_p - hi_l); /* along -nl: l's least minus x's largest is x's least minus l's largest along nl */
+    project(s, p, pt, G->n, &lo_p, &hi_p);
+    project_box(G, G->n, &lo_l, &hi_l);
+    if (hi_p - lo_l <= 1e-12 * (fmax(fabs(hi_p), fabs(lo_l)) + 1.0)) return 0.0; /* x behind the emitters' plane */
+    gap = fmax(gap, lo_p - hi_l); /* along -n_l */
     int64_t a = p < 0 ? 0 : s->start[p], b = p < 0 ? 1 : s->start[p + 1];
     for (int64_t k = a; k < b; k++)
         for (int i = 0; i < 3; i++) cp[i] += (p < 0 ? pt : s->vert + 3 * s->vidx[k])[i] / (double)(b - a);
-    for (int64_t k = s->start[l]; k < s->start[l + 1]; k++)
-        for (int i = 0; i < 3; i++) cl[i] += s->vert[3 * s->vidx[k] + i] / (double)(s->start[l + 1] - s->start[l]);
-    ulam__sub3(cl, cp, u);
+    for (int i = 0; i < 3; i++) u[i] = 0.5 * (G->lo[i] + G->hi[i]) - cp[i];
     double len = sqrt(ulam__dot3(u, u));
     if (len > 0) {
         for (int i = 0; i < 3; i++) u[i] /= len;
         project(s, p, pt, u, &lo_p, &hi_p);
-        project(s, l, NULL, u, &lo_l, &hi_l);
+        project_box(G, u, &lo_l, &hi_l);
         gap = fmax(gap, lo_l - hi_p);
     }
     return gap > 0 ? 1.0 / (M_PI * gap * gap) : INFINITY;
@@ -154,16 +194,15 @@ static double score_factor(int estimator, double pl, double gmax, int light)
 /* A certified bound, per channel, on what one vertex of a next-event walk at patch p (or, p < 0,
  * the point pt with normal n) scores with weights W <= 1: rho_pc (1 at the point or with
  * reflect 0) times the largest light sample plus the largest weighted landing on an emitter,
- * over every emitter (score_factor at g_max).  INFINITY where light sampling alone meets an
+ * over every group of emitters (score_factor at g_max).  INFINITY where light sampling alone meets an
  * emitter it may touch (1 / r^2 unbounded). */
 void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
                                const double n[3], int reflect, double out[3])
 {
     double lmax[3] = {0, 0, 0}, hmax[3] = {0, 0, 0};
-    for (int64_t k = 0; k < L->nem; k++) {
-        int64_t l = L->emitter[k];
-        const double *E = s->emit + 3 * l;
-        double pl = (E[0] + E[1] + E[2]) / L->ptot, g = l == p ? 0.0 : g_max(s, p, pt, n, l);
+    for (int64_t k = 0; k < L->ngroups; k++) {
+        const double *E = L->group[k].E;
+        double pl = (E[0] + E[1] + E[2]) / L->ptot, g = g_max(s, p, pt, n, &L->group[k]);
         double fl = score_factor(estimator, pl, g, 1), fh = score_factor(estimator, pl, g, 0);
         for (int c = 0; c < 3; c++) lmax[c] = fmax(lmax[c], E[c] * fl), hmax[c] = fmax(hmax[c], E[c] * fh);
     }

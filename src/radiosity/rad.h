@@ -90,12 +90,20 @@ const ulam_scene *ulam__tracer_scene(const ulam_tracer *t);
  * statistics cleared and its workspace kept. */
 void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds);
 
+/* Emitters of one emission and one normal (a subdivided lamp), boxed: what the score bounds
+ * of ulam__lights_vertex_bound read. */
+typedef struct {
+    double E[3], n[3], lo[3], hi[3];
+} ulam__light_group;
+
 /* The emitters as a light source for next-event estimation (lights.c). */
 typedef struct {
     int64_t *emitter; /* the emitting patches */
     double *cdf;      /* their cumulative power A sum_c E */
     int64_t nem;
     double ptot;      /* the total */
+    ulam__light_group *group; /* the emitters grouped by emission and normal */
+    int64_t ngroups;
 } ulam__lights;
 
 /* The emitters of s; ULAM_OK or ULAM_ENOMEM. */

@@ -13,12 +13,14 @@
  *   covered  how many of the runs' printed intervals hold x.
  * A run is capped at CAP walks: one that predicts more stops early, not met (counted in walks).
  *
- *   bench_relerr [E [REPS]]    prints the table (defaults 0.1 and 5) */
+ *   bench_relerr [E [REPS [ONLY]]]    prints the tables (defaults 0.1 and 5; ONLY: the rows whose
+ *                                     system name contains it, +ONLY: of case 6's table alone) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "gen.h"
 #include "ulam.h"
 
 enum { ORACLE = 1 << 20, CAP = 1 << 24 };
@@ -52,22 +54,10 @@ static int load(sys *s, const char *name, int jacobi)
     return 0;
 }
 
-/* The metastable chain (tests/test_stop.c) at leak 1e-4. */
+/* The metastable chain (gen.h) at leak 1e-4. */
 static void metastable(sys *s)
 {
-    int32_t ti[200], tj[200];
-    double tx[200];
-    int nz = 0;
-    static const int hop[4] = {1, 3, 7, 12};
-    for (int c = 0; c < 2; c++)
-        for (int i = 0; i < 20; i++) {
-            double sum = c ? 0.9995 : 0.95 - (i == 0 ? 1e-4 : 0.0);
-            for (int h = 0; h < 4; h++) ti[nz] = 20 * c + i, tj[nz] = 20 * c + (i + hop[h]) % 20, tx[nz++] = sum / 4;
-        }
-    ti[nz] = 0, tj[nz] = 20, tx[nz++] = 1e-4;
-    ulam_csr_from_triplets(40, 40, nz, ti, tj, tx, &s->M);
-    s->b = malloc(40 * sizeof *s->b);
-    for (int i = 0; i < 40; i++) s->b[i] = i < 20 ? 1.0 : 10.0;
+    bench_metastable(1e-4, &s->M, &s->b);
     s->name = "metastable40", s->index = 0;
 }
 
@@ -131,16 +121,114 @@ static void row(const sys *s, int est, double E, int reps)
     fflush(stdout);
 }
 
+/* One row of the dense-b table: `label` runs est pinned as walks (push 0), pinned as the
+ * bidirectional row, which with a dense b pushes b (push 1), or auto (est < 0); oracle[est] as
+ * row()'s for each estimator (auto: the one its walks ran with). */
+static void row_push(const sys *s, const char *label, int est, int push, const double *oracle, double E, int reps)
+{
+    double walks = 0, width = 0, secs = 0, ops = 0, orc = NAN;
+    int met = 0, covered = 0, ran = 0;
+    for (int k = 0; k < reps; k++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.index = s->index, o.max_walks = CAP, o.rel_err = E, o.seed = 1 + (uint64_t)k;
+        if (est >= 0) o.estimator = est;
+        ulam_method_opts mo = ulam_method_defaults();
+        ulam_auto_opts ao = ulam_auto_defaults();
+        if (est >= 0) ao.pin_estimator = 1, mo.method = push ? ULAM_METHOD_BIDIRECTIONAL : ULAM_METHOD_WALKS;
+        ulam_choice ch;
+        ulam_answer a;
+        ulam_error err;
+        double t0 = ulam_now();
+        if (ulam_auto(s->M, s->b, &o, &ao, &mo, &ch, &a, &err)) {
+            printf("%-20s %-22s refused: %s\n", s->name, label, err.msg);
+            return;
+        }
+        secs += (ulam_now() - t0) / reps, ran++;
+        walks += (double)a.walks.walks / reps, met += a.walks.rel_err_met;
+        ops += a.method == ULAM_METHOD_BIDIRECTIONAL ? (double)a.bidir.plan.push.ops / reps : 0.0;
+        width += (a.ci95[1] - a.ci95[0]) / 2 / (E * fabs(s->x)) / reps;
+        covered += a.ci95[0] <= s->x && s->x <= a.ci95[1];
+        orc = oracle[a.opts.estimator == ULAM_ABSORPTION];
+        if (est < 0 && k == 0)
+            printf("  (auto chose %s, %s)\n", ulam_method_name(a.method),
+                   a.opts.estimator == ULAM_ABSORPTION ? "absorption" : a.opts.estimator ? "expected" : "collision");
+    }
+    printf("%-20s %-22s %11.4g %11.4g %3d/%-3d %8.3g %8.3g %3d/%-3d %10.3g %8.3g\n", s->name, label, orc, walks, met, ran,
+           walks / orc, width, covered, ran, ops, secs);
+    fflush(stdout);
+}
+
+/* Cost case 6's systems: the power law (n = 2e4, b = +-0.1 and one entry 1000 its walks from
+ * state 0 reach with weight ~1e-15; b dense: the bidirectional row pushes b) and upwind
+ * convection-diffusion 30 x 30 (--jacobi, a point source at the centre, the downstream corner
+ * unknown; b sparse: the bidirectional row's reverse push from the unknown, unless the estimator
+ * is pinned), and radiosity100 (b sparse, 5 emitters): walks as they are, the bidirectional row
+ * with the estimator pinned (the push on b), and auto. */
+static void dense_table(double E, int reps, const char *only)
+{
+    printf("\ncase 6: walks pinned, the bidirectional row pinned (dense b: the push on b), auto; E %g, %d runs a row\n", E, reps);
+    printf("%-20s %-22s %11s %11s %7s %8s %8s %7s %10s %8s\n", "system", "route", "oracle", "walks", "met", "ratio",
+           "width/Ex", "covered", "push ops", "seconds");
+    for (int f = 0; f < 3; f++) {
+        sys s = {0};
+        if (f == 2 && load(&s, "radiosity100", 0)) continue;
+        if (f == 0) {
+            bench_case6(20000, 1e-6, 1000.0, 6, &s.M, &s.b);
+            s.name = "case6 powerlaw2e4";
+        } else if (f == 1) {
+            ulam_csr *A = bench_convdiff(30, 1.0);
+            double *one = malloc(900 * sizeof *one);
+            for (int i = 0; i < 900; i++) one[i] = i == 15 * 30 + 15 ? 1.0 : 0.0;
+            s.b = malloc(900 * sizeof *s.b);
+            ulam_jacobi(A, one, 1.0, &s.M, s.b, NULL);
+            ulam_csr_free(A), free(one);
+            s.name = "convdiff30 jacobi", s.index = 899;
+        }
+        if (!strstr(s.name, only)) {
+            ulam_csr_free(s.M), free(s.b);
+            continue;
+        }
+        double *x = bench_neumann(s.M, s.b);
+        s.x = x[s.index];
+        free(x);
+        if (f == 0) { /* the adjoint weight of the large entry: ((I - M)^-1)_{0, n-1} = [(I - M')^-1 e_0]_{n-1} */
+            ulam_csr *Mt;
+            ulam_csr_transpose(s.M, &Mt);
+            double *e = calloc(20000, sizeof *e);
+            e[0] = 1.0;
+            double *y = bench_neumann(Mt, e);
+            printf("  (x_0 = %.6g; the entry b = 1000 at state %d has adjoint weight %.3g)\n", s.x, 20000, y[19999]);
+            free(y), free(e), ulam_csr_free(Mt);
+        }
+        double oracle[2];
+        for (int est = 0; est < 2; est++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.estimator = est ? ULAM_ABSORPTION : ULAM_COLLISION, o.index = s.index, o.max_walks = ORACLE, o.seed = 12345;
+            ulam_walk_result r;
+            oracle[est] = ulam_solve(s.M, s.b, &o, &r, NULL) ? NAN : r.variance / (E * s.x * E * s.x);
+        }
+        row_push(&s, "walks collision", ULAM_COLLISION, 0, oracle, E, reps);
+        row_push(&s, "walks absorption", ULAM_ABSORPTION, 0, oracle, E, reps);
+        row_push(&s, "push+walks collision", ULAM_COLLISION, 1, oracle, E, reps);
+        row_push(&s, "push+walks absorption", ULAM_ABSORPTION, 1, oracle, E, reps);
+        row_push(&s, "auto", -1, 0, oracle, E, reps);
+        ulam_csr_free(s.M), free(s.b);
+    }
+}
+
 int main(int argc, char **argv)
 {
     double E = argc > 1 ? atof(argv[1]) : 0.1;
     int reps = argc > 2 ? atoi(argv[2]) : 5;
+    const char *only = argc > 3 ? argv[3] : "";
+    int case6_only = only[0] == '+'; /* "+NAME": case 6's table alone */
+    only += case6_only;
     static const struct { const char *name; int jacobi; } files[] = {
         {"chain4", 0}, {"radiosity100", 0}, {"randsub1000", 0}, {"signed200", 0}, {"poisson20", 1}};
     printf("--rel-err %g, %d runs a row; oracle = var / (E x)^2 (var from %d walks)\n", E, reps, ORACLE);
     printf("%-20s %-10s %11s %11s %7s %8s %8s %8s %7s %8s\n", "system", "estimator", "oracle", "walks", "met", "ratio",
            "ratio1k", "width/Ex", "covered", "seconds");
-    for (int f = 0; f < 7; f++) {
+    for (int f = 0; f < (case6_only ? 0 : 7); f++) {
         sys s = {0};
         if (f < 5 && load(&s, files[f].name, files[f].jacobi)) {
             printf("%s: cannot read (run from the source root)\n", files[f].name);
@@ -148,9 +236,14 @@ int main(int argc, char **argv)
         }
         if (f == 5) metastable(&s);
         if (f == 6) laplace(&s, 15);
+        if (!strstr(s.name, only)) {
+            ulam_csr_free(s.M), free(s.b);
+            continue;
+        }
         exact(&s);
         for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) row(&s, est, E, reps);
         ulam_csr_free(s.M), free(s.b);
     }
+    dense_table(E, reps, only);
     return 0;
 }

@@ -218,4 +218,115 @@ static inline int bench_exact_column(const ulam_csr *M, int64_t s, double *x, do
     return sweeps;
 }
 
+/* The metastable chain of issue 25 (tests/test_stop.c): 40 states; cluster A (states 0..19,
+ * b = 1) has rows of M summing to exactly 0.95, state 0 leaking `leak` into cluster B (states
+ * 20..39, b = 10, rows summing to 0.9995).  M and b (40 entries, malloc'd); nonzero when out of
+ * memory. */
+static inline int bench_metastable(double leak, ulam_csr **M, double **b)
+{
+    int32_t ti[200], tj[200];
+    double tx[200];
+    int nz = 0;
+    static const int hop[4] = {1, 3, 7, 12};
+    for (int c = 0; c < 2; c++)
+        for (int i = 0; i < 20; i++) {
+            double sum = c ? 0.9995 : 0.95 - (i == 0 ? leak : 0.0);
+            for (int h = 0; h < 4; h++) ti[nz] = 20 * c + i, tj[nz] = 20 * c + (i + hop[h]) % 20, tx[nz++] = sum / 4;
+        }
+    ti[nz] = 0, tj[nz] = 20, tx[nz++] = leak;
+    *b = malloc(40 * sizeof **b);
+    if (!*b || ulam_csr_from_triplets(40, 40, nz, ti, tj, tx, M)) return free(*b), *b = NULL, -1;
+    for (int i = 0; i < 40; i++) (*b)[i] = i < 20 ? 1.0 : 10.0;
+    return 0;
+}
+
+/* Issue 25's cost case 6: a power-law system with one large, nearly unreachable entry of b.
+ * n states; row i of M has 1 + Zipf(2.1) entries (at most 1000) at uniform columns, signs
+ * random, |M| rows summing to 0.5; the column of state n - 1 is emptied but for one entry eps
+ * at a random row k, so walks from state 0 reach n - 1 with (adjoint) weight
+ * ((I - M)^-1)_{0k} eps; b = +-0.1 at random, b_{n-1} = big.  Stream (seed, 25).  Nonzero when
+ * out of memory. */
+static inline int bench_case6(int64_t n, double eps, double big, uint64_t seed, ulam_csr **M, double **b)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 25);
+    double cum[1000];
+    for (int k = 0; k < 1000; k++) cum[k] = (k ? cum[k - 1] : 0) + pow(k + 1.0, -2.1);
+    int64_t cap = 0, nz = 0;
+    int *d = malloc((size_t)n * sizeof *d);
+    if (!d) return -1;
+    for (int64_t i = 0; i < n; i++) {
+        double u = ulam_rng_uniform(&r) * cum[999];
+        int k = 0;
+        while (cum[k] <= u && k < 999) k++;
+        cap += d[i] = 1 + (k + 1 < 999 ? k + 1 : 999);
+    }
+    int32_t *ti = malloc((size_t)(cap + 1) * sizeof *ti), *tj = malloc((size_t)(cap + 1) * sizeof *tj);
+    double *tx = malloc((size_t)(cap + 1) * sizeof *tx);
+    *b = malloc((size_t)n * sizeof **b);
+    int status = -1;
+    if (ti && tj && tx && *b) {
+        for (int64_t i = 0; i < n; i++) {
+            int64_t at = nz;
+            double sum = 0;
+            for (int q = 0; q < d[i]; q++) {
+                int32_t j = (int32_t)ulam_rng_bounded(&r, (uint64_t)(n - 1)); /* never n - 1 */
+                double v = 0.2 + ulam_rng_uniform(&r);
+                ti[nz] = (int32_t)i, tj[nz] = j, tx[nz++] = ulam_rng_uniform(&r) < 0.5 ? -v : v, sum += v;
+            }
+            for (int64_t e = at; e < nz; e++) tx[e] *= 0.5 / sum;
+            (*b)[i] = ulam_rng_uniform(&r) < 0.5 ? -0.1 : 0.1;
+        }
+        ti[nz] = (int32_t)ulam_rng_bounded(&r, (uint64_t)(n - 1)), tj[nz] = (int32_t)(n - 1), tx[nz++] = eps;
+        (*b)[n - 1] = big;
+        status = ulam_csr_from_triplets(n, n, nz, ti, tj, tx, M) ? -1 : 0; /* repeated entries summed */
+    }
+    free(d), free(ti), free(tj), free(tx);
+    if (status) free(*b), *b = NULL;
+    return status;
+}
+
+/* Upwind convection-diffusion on an L x L grid (Dirichlet), h^2 times: 4 + 2 c on the diagonal,
+ * -1 - c to the west and south neighbours (upwind for a flow towards north-east at c = v h), -1 to
+ * the east and north; the A that --jacobi splits.  NULL when out of memory. */
+static inline ulam_csr *bench_convdiff(int64_t L, double c)
+{
+    int64_t n = L * L, nz = 0;
+    int32_t *ti = malloc((size_t)(5 * n) * sizeof *ti), *tj = malloc((size_t)(5 * n) * sizeof *tj);
+    double *tx = malloc((size_t)(5 * n) * sizeof *tx);
+    ulam_csr *A = NULL;
+    if (ti && tj && tx) {
+        for (int64_t i = 0; i < L; i++)
+            for (int64_t j = 0; j < L; j++) {
+                int32_t row = (int32_t)(i * L + j);
+                const int64_t at[4][2] = {{i - 1, j}, {i, j - 1}, {i + 1, j}, {i, j + 1}};
+                ti[nz] = row, tj[nz] = row, tx[nz++] = 4.0 + 2.0 * c;
+                for (int k = 0; k < 4; k++) {
+                    if (at[k][0] < 0 || at[k][0] >= L || at[k][1] < 0 || at[k][1] >= L) continue;
+                    ti[nz] = row, tj[nz] = (int32_t)(at[k][0] * L + at[k][1]), tx[nz++] = k < 2 ? -1.0 - c : -1.0;
+                }
+            }
+        if (ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &A)) A = NULL;
+    }
+    free(ti), free(tj), free(tx);
+    return A;
+}
+
+/* x = (I - M)^-1 b by x <- b + M x to a change below 1e-15 ||x||_1 or 10^5 products; a new array
+ * (NULL when out of memory). */
+static inline double *bench_neumann(const ulam_csr *M, const double *b)
+{
+    int64_t n = M->nrows;
+    double *x = calloc((size_t)n, sizeof *x), *y = malloc((size_t)n * sizeof *y);
+    for (int it = 0; x && y && it < 100000; it++) {
+        ulam_csr_matvec(M, 0, x, y);
+        double dif = 0, tot = 0;
+        for (int64_t i = 0; i < n; i++) y[i] += b[i], dif += fabs(y[i] - x[i]), tot += fabs(y[i]), x[i] = y[i];
+        if (dif <= 1e-15 * tot) break;
+    }
+    if (!y) free(x), x = NULL;
+    free(y);
+    return x;
+}
+
 #endif

@@ -1,0 +1,121 @@
+/* Single source, every target by sweep push + terminal walks (src/fpush.c, src/sweep.c; issue 29
+ * point 4).  Linked with the library's objects: it reads the sweep push's counts through the
+ * internal ulam__fpush_solve.
+ *
+ * Each case draws the heavy-tailed Zipf digraph of tests/zipf_graph.h (M = 0.85 P', so
+ * x = (I - M)^-1 e_s, pi = 0.15 x) and the exact column by a long power iteration, and counts,
+ * over seeds, the components whose printed 95% interval holds the exact value.  The claim is 95%
+ * per component; the test asks the pooled count k of N to pass 0.95 N - 4 sqrt(0.95 0.05 N) and
+ * 0.9 N (a binomial bound: a true coverage of 95% fails it with probability below 1e-4). */
+#include <math.h>
+#include <stdarg.h>
+#include <setjmp.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "../src/internal.h"
+#include "testutil.h"
+#include "zipf_graph.h"
+
+/* k of N covered passes the binomial bound of the header. */
+static int coverage_ok(int64_t k, int64_t N)
+{
+    double Nd = (double)N;
+    return (double)k >= 0.95 * Nd - 4.0 * sqrt(0.95 * 0.05 * Nd) && (double)k >= 0.9 * Nd;
+}
+
+/* The relative-error rule (E = 0.1 on every pi >= 1/n): the push goes round the active list and
+ * then sweeps (the counters say so), every component with pi >= 1/n is within 10% of the exact
+ * value, and the intervals cover at the claimed rate over 8 seeds. */
+static void test_fpush_rule(void **state)
+{
+    (void)state;
+    int64_t n = 3000, s = 2;
+    ulam_csr *M = zipf_graph(n, 2.1, 0.75, 0.85, 1), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = zipf_graph_column(M, s), *est = malloc((size_t)n * sizeof *est);
+    double *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi);
+    int64_t big = 0, covered = 0, close = 0;
+    for (int seed = 1; seed <= 8; seed++) {
+        if (!test_case(seed)) continue;
+        ulam_fpush_opts o = ulam_fpush_defaults();
+        o.source = s, o.walk.seed = (uint64_t)seed, o.min_value = 1.0 / (0.15 * (double)n), o.walk.max_walks = 0;
+        ulam_fpush_info info;
+        ulam__sweep_info sw;
+        ulam_error err;
+        assert_int_equal(ulam__fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, &sw, &err), ULAM_OK);
+        assert_true(sw.sweeps >= 1 && sw.rounds > sw.sweeps); /* list rounds first, then whole sweeps */
+        assert_true(info.walks > 0 && info.push.r_sum > 0);
+        int64_t b = 0, c = 0, w = 0;
+        for (int64_t i = 0; i < n; i++) {
+            assert_true(lo[i] <= est[i] && est[i] <= hi[i]);
+            if (0.15 * x[i] < 1.0 / (double)n) continue;
+            b++;
+            c += lo[i] <= x[i] && x[i] <= hi[i];
+            w += fabs(est[i] - x[i]) <= 0.1 * x[i];
+        }
+        print_message("seed %d: %lld rounds (%lld sweeps), %lld ops, r_sum %.3g, %lld walks: %lld of %lld covered, %lld "
+                      "within 10%%\n", seed, (long long)sw.rounds, (long long)sw.sweeps, (long long)sw.ops, sw.r_sum,
+                      (long long)info.walks, (long long)c, (long long)b, (long long)w);
+        assert_true(b >= 20);
+        assert_int_equal(w, b);
+        big += b, covered += c, close += w;
+    }
+    test_case_done();
+    if (test_case_all()) assert_true(coverage_ok(covered, big));
+    free(x), free(est), free(lo), free(hi);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
+/* Fixed small budgets on a large residual (rmax 0.02: a short push, then 64 or 256 walks, so most
+ * components see no walk or one): every component's interval, reachable or not, covers at the
+ * claimed rate over 16 seeds, and none is zero-width where the residual can reach. */
+static void test_fpush_small_budgets(void **state)
+{
+    (void)state;
+    int64_t n = 1500, s = 5;
+    ulam_csr *M = zipf_graph(n, 2.1, 0.75, 0.85, 3), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = zipf_graph_column(M, s), *est = malloc((size_t)n * sizeof *est);
+    double *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi);
+    int64_t walks[] = {64, 256};
+    for (int c = 0; c < 2; c++) {
+        int64_t N = 0, covered = 0;
+        double rsum = 0.0;
+        for (int seed = 1; seed <= 16; seed++) {
+            if (!test_case(100 * c + seed)) continue;
+            ulam_fpush_opts o = ulam_fpush_defaults();
+            o.source = s, o.walk.seed = (uint64_t)seed, o.walks = walks[c], o.rmax = 0.02;
+            ulam_fpush_info info;
+            ulam__sweep_info sw;
+            ulam_error err;
+            assert_int_equal(ulam__fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, &sw, &err), ULAM_OK);
+            assert_int_equal(info.walks, walks[c]);
+            rsum = info.push.r_sum;
+            for (int64_t i = 0; i < n; i++) {
+                if (x[i] == 0.0) continue;
+                N++;
+                covered += lo[i] <= x[i] && x[i] <= hi[i];
+                assert_true(hi[i] > lo[i]);
+            }
+        }
+        print_message("%lld walks: %lld of %lld intervals cover (r_sum after the push %.3g)\n", (long long)walks[c],
+                      (long long)covered, (long long)N, rsum);
+        if (test_case_all()) assert_true(coverage_ok(covered, N));
+    }
+    test_case_done();
+    free(x), free(est), free(lo), free(hi);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_fpush_rule),
+        cmocka_unit_test(test_fpush_small_budgets),
+    };
+    return test_run(tests);
+}
