@@ -40,7 +40,7 @@ typedef struct {
  * walk first reaches one of their states, so a query that builds rows scattered over a large
  * system keeps 8 bytes a group of ULAM__LEAF states and a leaf a group reached, not 4 bytes a
  * state (40 MB at 10^7, nearly all of it touched by 10^5 scattered rows). */
-#define ULAM__DENSE_MAX (INT64_C(1) << 20)
+#define ULAM__DENSE_MAX (INT64_C(1) << 16)
 #define ULAM__LEAF 16
 
 /* What visits and terminations score, with g_i = b[i] (1 when b is NULL): collision g_i per
