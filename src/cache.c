@@ -80,7 +80,7 @@ struct ulam_system {
     size_t map_bytes;
     int fd;                /* the file, for rows read by pread (-1: borrowed memory) */
     uint64_t off[4];       /* byte offsets of rowptr, colidx, val and b in the file */
-    _Atomic int64_t *checked; /* [0] blocks verified, [1] rows of M they hold, [2] bytes read by pread */
+    _Atomic int64_t *checked; /* [0] blocks verified, [1] rows of M they hold */
 };
 
 /* XXH3-64 of bytes p[0 .. n). */
@@ -457,7 +457,7 @@ int ulam_system_from_memory(const void *data, size_t bytes, const uint64_t tag[2
     int status = parse(data, bytes, tag, s, err);
     int64_t total = status ? 0 : s->nblocks[0] + s->nblocks[1] + s->nblocks[2];
     if (!status && (!(s->state = calloc((size_t)(total ? total : 1), sizeof *s->state)) ||
-                    !(s->checked = calloc(3, sizeof *s->checked)))) {
+                    !(s->checked = calloc(2, sizeof *s->checked)))) {
         free((void *)s->state);
     free((void *)s->checked);
         status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the blocks' states");
@@ -627,7 +627,7 @@ static int rows_check(const void *ctx, int64_t first, int64_t last, int with_b, 
     return status;
 }
 
-/* Read bytes [off, off + len) of s's file into p, counted; 0, or -1 on a short read or an error. */
+/* Read bytes [off, off + len) of s's file into p; 0, or -1 on a short read or an error. */
 static int read_at(const ulam_system *s, void *p, size_t len, uint64_t off)
 {
     for (size_t got = 0; got < len;) {
@@ -635,7 +635,6 @@ static int read_at(const ulam_system *s, void *p, size_t len, uint64_t off)
         if (r <= 0) return -1;
         got += (size_t)r;
     }
-    atomic_fetch_add_explicit(&s->checked[2], (int64_t)len, memory_order_relaxed);
     return 0;
 }
 
@@ -747,12 +746,6 @@ static int b_at(const void *ctx, int64_t j, double *v, int64_t *bad)
     int status = b_value(ctx, j, &r, v, bad);
     free(r.blk);
     return status;
-}
-
-/* Bytes read from s's file by pread so far (lazy queries' rows). */
-int64_t ulam__system_bytes_read(const ulam_system *s)
-{
-    return s ? atomic_load(&s->checked[2]) : 0;
 }
 
 /* The check a solver given opts->system makes before it reads rows (see internal.h). */

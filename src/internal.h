@@ -247,9 +247,6 @@ static inline int ulam__rows_verify(const ulam__rows_check *rc, int64_t first, i
 int ulam__system_rows_check(const ulam_system *s, const ulam_csr *M, const double *b, ulam__rows_check *rc,
                             ulam_error *err);
 
-/* Bytes read from s's file by pread so far (the rows lazy queries fetched). */
-int64_t ulam__system_bytes_read(const ulam_system *s);
-
 /* Why the block holding row i of s failed: ULAM_ESYNTAX with err naming the block and the fault. */
 int ulam__system_row_error(const ulam_system *s, int64_t i, ulam_error *err);
 

@@ -54,25 +54,14 @@ ulam_kernel *ulam__kernel_free(ulam_kernel *k)
     return NULL;
 }
 
-/* Keep k's places in leaves (see kernel.h). */
-int ulam__kernel_sparse(ulam_kernel *k)
+/* Keep a new kernel's places in leaves: the directory and the leaves' storage, zero and untouched. */
+static int make_sparse(ulam_kernel *k)
 {
-    if (atomic_load(&k->top) > 0) return ULAM_EINVAL;
     int64_t groups = k->n / ULAM__LEAF + 1;
-    free((void *)k->where);
-    k->where = NULL;
     /* calloc: zero pages never touched, so a leaf costs memory once it is handed out */
-    if (!k->dir && !(k->dir = ulam__calloc((size_t)groups, sizeof *k->dir))) return ULAM_ENOMEM;
-    if (!k->leaves && !(k->leaves = ulam__calloc((size_t)groups * ULAM__LEAF, sizeof *k->leaves))) return ULAM_ENOMEM;
-    return ULAM_OK;
-}
-
-/* The bytes of k's places touched so far. */
-int64_t ulam__kernel_index_bytes(const ulam_kernel *k)
-{
-    if (k->where) return k->n * (int64_t)sizeof *k->where;
-    return (k->n / ULAM__LEAF + 1) * (int64_t)sizeof *k->dir +
-           atomic_load(&k->nleaves) * ULAM__LEAF * (int64_t)sizeof *k->leaves;
+    k->dir = ulam__calloc((size_t)groups, sizeof *k->dir);
+    k->leaves = ulam__calloc((size_t)groups * ULAM__LEAF, sizeof *k->leaves);
+    return k->dir && k->leaves ? ULAM_OK : ULAM_ENOMEM;
 }
 
 /* A leaf being made (the directory's mark while one thread takes it). */
@@ -180,7 +169,7 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam_
     if (dense) k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built */
     k->mem = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->mem);
     if (alpha != 1.0) k->fac = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->fac);
-    if ((dense ? !k->where : ulam__kernel_sparse(k) != ULAM_OK) || !k->mem || (alpha != 1.0 && !k->fac)) {
+    if ((dense ? !k->where : make_sparse(k) != ULAM_OK) || !k->mem || (alpha != 1.0 && !k->fac)) {
         ulam__kernel_free(k);
         return ULAM_ENOMEM;
     }

@@ -94,7 +94,7 @@ void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slo
                        int64_t *small, int64_t *large);
 
 /* The kernel of K (which must outlive it; continue_q <= 0: analog) with exponent alpha, no row
- * built yet: O(n) time and 4 bytes a state (alpha != 1: room for two factors a slot, reserved
+ * built yet: O(n) time, 4 bytes a state up to ULAM__DENSE_MAX states, 0.5 beyond (alpha != 1: room for two factors a slot, reserved
  * like the slots).  ULAM_OK, ULAM_ENOMEM, or ULAM_EOVERFLOW past 2^30 units. */
 int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam__scores scores, ulam_kernel **out);
 
@@ -121,14 +121,6 @@ int ulam__kernel_rescore_b(ulam_kernel *k, const double *b);
 
 /* Free a kernel; accepts NULL. */
 ulam_kernel *ulam__kernel_free(ulam_kernel *k);
-
-/* Keep k's places in leaves whatever its size (k: no row built yet); ULAM_OK, ULAM_EINVAL when
- * a row is built, ULAM_ENOMEM. */
-int ulam__kernel_sparse(ulam_kernel *k);
-
-/* The bytes of k's places touched so far (dense: 4 a state; leaves: the directory and the leaves
- * made). */
-int64_t ulam__kernel_index_bytes(const ulam_kernel *k);
 
 /* Scratch for building k's rows; ULAM_OK or ULAM_ENOMEM (free it with ulam__kscratch_free). */
 int ulam__kscratch_alloc(const ulam_kernel *k, ulam__kscratch *w);
