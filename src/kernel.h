@@ -94,8 +94,8 @@ void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slo
                        int64_t *small, int64_t *large);
 
 /* The kernel of K (which must outlive it; continue_q <= 0: analog) with exponent alpha, no row
- * built yet: O(n) time, 4 bytes a state up to ULAM__DENSE_MAX states, 0.5 beyond (alpha != 1: room for two factors a slot, reserved
- * like the slots).  ULAM_OK, ULAM_ENOMEM, or ULAM_EOVERFLOW past 2^30 units. */
+ * built yet: O(n) time, 4 bytes a state up to ULAM__DENSE_MAX states and 0.5 beyond (alpha != 1:
+ * room for two factors a slot, reserved like the slots).  ULAM_OK, ULAM_ENOMEM, or ULAM_EOVERFLOW past 2^30 units. */
 int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam__scores scores, ulam_kernel **out);
 
 /* The moves of row i of K at kernel exponent alpha != 1 with continuation q > 0: pm[k] the
