@@ -60,9 +60,9 @@ static inline ulam_walk_result walk(const ulam_csr *M, const double *b, const ul
 {
     ulam_walk_result r;
     ulam_error err;
-    int s = ulam_solve(M, b, o, &r, &err);
+    int s = ulam_solve_walks(M, b, o, &r, &err);
     if (s) {
-        fprintf(stderr, "ulam_solve: %s: %s\n", ulam_strerror(s), err.msg);
+        fprintf(stderr, "ulam_solve_walks: %s: %s\n", ulam_strerror(s), err.msg);
         exit(1);
     }
     return r;
@@ -88,11 +88,11 @@ static inline void running(const ulam_csr *M, const double *b, ulam_walk_opts o,
                            FILE *f, int tag)
 {
     for (int k = 0; k <= kmax; k++) {
-        o.max_walks = (int64_t)1024 << k;
+        o.stop.max_walks = (int64_t)1024 << k;
         ulam_walk_result r;
-        int s = ulam_solve(M, b, &o, &r, NULL);
+        int s = ulam_solve_walks(M, b, &o, &r, NULL);
         if (s) {
-            fprintf(stderr, "case %d: %lld walks: %s\n", tag, (long long)o.max_walks, ulam_strerror(s));
+            fprintf(stderr, "case %d: %lld walks: %s\n", tag, (long long)o.stop.max_walks, ulam_strerror(s));
             return;
         }
         fprintf(f, "%d,%lld,%.10g,%.6g,%.10g\n", tag, (long long)r.walks, r.estimate, r.std_error, exact);

@@ -47,8 +47,8 @@ int main(int argc, char **argv)
         for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
             ulam_walk_opts wo = ulam_walk_defaults();
             wo.estimator = est;
-            wo.max_walks = 200000;
-            wo.seed = 11 + k;
+            wo.stop.max_walks = 200000;
+            wo.exec.seed = 11 + k;
             ulam_walk_result r = walk(M, b, &wo);
             double t1 = r.variance / pow(0.01 * x[0], 2) * r.seconds / (double)r.walks;
             fprintf(o.f, ",%g,%g,%g", (double)r.steps / (double)r.walks, r.variance, t1);

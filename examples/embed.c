@@ -16,7 +16,7 @@ int main(void)
     ulam_csr *M = NULL;
     int st = ulam_csr_from_triplets(3, 3, 5, ti, tj, tx, &M);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.seed = 7;
+    o.exec.seed = 7;
     ulam_walk_result r;
     ulam_error err;
     double x[3];

@@ -28,8 +28,8 @@ int main(int argc, char **argv)
         hat[c] = g.hat[ULAM_ADJOINT].rho;
         fprintf(stderr, "case %d: q = %s, rho(|M|) = %.3f, rho(M^) = %.3f\n", c, c ? "0.5" : "analog", g.abs.rho, hat[c]);
         ulam_walk_opts wo = ulam_walk_defaults();
-        wo.continue_q = qs[c];
-        wo.seed = 9;
+        wo.kernel.continue_q = qs[c];
+        wo.exec.seed = 9;
         running(M, b, wo, 12, x[0], o.f, c);
     }
     out_commit(&o);

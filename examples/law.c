@@ -51,7 +51,7 @@ int main(int argc, char **argv)
             law_noreturn(M, 0, &s2, &ps2);
             for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
                 ulam_walk_opts wo = ulam_walk_defaults();
-                wo.mode = ULAM_FORWARD, wo.estimator = est, wo.max_walks = 200000, wo.seed = 17 + k;
+                wo.mode = ULAM_FORWARD, wo.estimator = est, wo.stop.max_walks = 200000, wo.exec.seed = 17 + k;
                 v[est] = walk(M, b, &wo).variance;
             }
             fprintf(o.f, "%g,%g,%g,%g,%g,%g,%g,%g,%.15g\n", s, ps, bnd, fr[k], vc, va, v[0], v[1], s2);

@@ -31,9 +31,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "case %d: %s\n", c, title[c]);
         double *x = direct(Ms[c], b, NULL);
         ulam_walk_opts wo = ulam_walk_defaults();
-        wo.continue_q = 0.5;
-        wo.force = 1; /* the point is to watch what the guard refuses */
-        wo.seed = 5;
+        wo.kernel.continue_q = 0.5;
+        wo.policy.force = 1; /* the point is to watch what the guard refuses */
+        wo.exec.seed = 5;
         running(Ms[c], b, wo, 12, x[0], o.f, c);
         free(x);
     }

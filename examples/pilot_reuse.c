@@ -50,7 +50,7 @@ int main(int argc, char **argv)
     double *x = direct(M, b, NULL), exact = x[0], pilot = 0, chosen[3] = {0}, reused_by[3] = {0};
     for (int s = 0; s < R; s++) {
         ulam_walk_opts o = ulam_walk_defaults();
-        o.max_walks = N, o.seed = (uint64_t)s + 1, o.threads = 1;
+        o.stop.max_walks = N, o.exec.seed = (uint64_t)s + 1, o.exec.threads = 1;
         ulam_auto_opts ao = ulam_auto_defaults();
         ao.pin_mode = 1; /* adjoint */
         if (pin >= 0) o.estimator = pin, ao.pin_estimator = 1;

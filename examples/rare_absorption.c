@@ -32,8 +32,8 @@ int main(int argc, char **argv)
         for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
             ulam_walk_opts wo = ulam_walk_defaults();
             wo.estimator = est;
-            wo.max_walks = 1000000;
-            wo.seed = 3 + k;
+            wo.stop.max_walks = 1000000;
+            wo.exec.seed = 3 + k;
             r[est] = walk(M, b, &wo);
             fprintf(o.f, ",%g", r[est].variance);
         }

@@ -9,7 +9,9 @@
  *   - inputs are const, outputs are caller-owned, every _free accepts and returns NULL;
  *   - the library never prints and never exits;
  *   - ABI habit: a struct the caller fills starts from its defaults function, which sets every
- *     field, and the caller then sets what it needs (ulam_walk_defaults, ulam_mm_defaults,
+ *     field, and the caller then sets what it needs (ulam_walk_defaults with its parts by concern:
+ *     ulam_kernel_defaults, ulam_stop_defaults, ulam_exec_defaults, ulam_query_defaults,
+ *     ulam_policy_defaults; ulam_mm_defaults,
  *     ulam_spectral_defaults, ulam_power_defaults, ulam_guard_defaults, ulam_outer_defaults,
  *     ulam_bidir_defaults, ulam_auto_defaults, ulam_share_defaults, ulam_system_desc_defaults;
  *     in ulam_radiosity.h ulam_camera_cornell or ulam_camera_frame): a field a later version
@@ -22,9 +24,11 @@
  * The API by rank, as CSparse's header ranks its own (each section banner below names the
  * ranks it holds; sections follow the data flow, file -> matrix -> guards -> walks -> output):
  *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
- *     ulam_guard_check, ulam_walk_defaults, ulam_solver_alloc, ulam_solver_iterate,
+ *     ulam_guard_check, ulam_walk_defaults (its parts: ulam_kernel_defaults, ulam_stop_defaults,
+ *     ulam_exec_defaults, ulam_query_defaults, ulam_policy_defaults), ulam_solver_alloc, ulam_solver_iterate,
  *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
- *     ulam_solver_free, ulam_solve, ulam_auto (the method table's choice: what `ulam solve` runs),
+ *     ulam_solver_free, ulam_solve (the method table's choice: what `ulam solve` runs), ulam_solve_walks
+ *     (the walks pinned), ulam_auto (the choice with its verdicts),
  *     ulam_direct_solve, ulam_mm_write_vector, ulam_strerror;
  *   secondary, more control and the other methods: building and transforming matrices
  *     (ulam_csr_alloc, _from_triplets, _check, _transpose, ulam_jacobi), reader options and
@@ -517,7 +521,7 @@ const double *ulam_system_rhs(const ulam_system *s, int64_t *n);
 const ulam_csr *ulam_system_transpose(const ulam_system *s);
 
 /* The mapped M and b (either may be NULL) as they are, NOT verified: for a solver given
- * ulam_walk_opts.system = s (and this M), which verifies each block before its walks, its
+ * ulam_walk_opts.policy.system = s (and this M), which verifies each block before its walks, its
  * reachability search or a pass over all of M first read it, so a query for one x_i reads only
  * the blocks of the rows it reaches.  ULAM_OK, or ULAM_EINVAL for s NULL. */
 int ulam_system_lazy(const ulam_system *s, const ulam_csr **M, const double **b);
@@ -577,54 +581,97 @@ typedef struct ulam_share {
 /* The defaults: one process (rank 0 of 1; allgather and ctx NULL, never called). */
 ulam_share ulam_share_defaults(void);
 
-/* How to walk and when to stop.  Start from ulam_walk_defaults(). */
-typedef struct ulam_walk_opts {
-    int mode;            /* ULAM_ADJOINT (one x_i) or ULAM_FORWARD (every x_i) */
-    int estimator;       /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */
-    int64_t index;       /* 0-based component reported (the start state in adjoint mode) */
+/* The walk kernel: how a walk moves and how its weight is kept in a window.  Start from
+ * ulam_kernel_defaults(). */
+typedef struct ulam_kernel_opts {
     double continue_q;   /* fixed continuation probability in (0, 1); <= 0: analog min(1, S_i) */
+    double kernel_alpha; /* the kernel exponent alpha, finite and >= 0: a walk that continues from
+                            i moves to j with probability |K_ij|^alpha / sum_k |K_ik|^alpha over
+                            the row's nonzeros (K = M adjoint, M' forward), its weight times
+                            K_ij / (q_i p_ij); 1 (the default): the "almost optimal" |K_ij| / S_i,
+                            0 uniform, 2 Alea's transition factor.  rho(M^) is that kernel's, so
+                            policy.guard is used only when computed for the same alpha */
     int whole_kernel;    /* 1: build the walk kernel's every row before walking; 0: build each
                             row when a walk first reaches it, and the rest at once when walks
                             have reached 1/4 of them (a run that far will reach most) */
     double roulette;     /* weight window floor W: below it survive with |w|/W at weight W; 0 off */
     double split;        /* weight window ceiling: above it split into ceil(|w|/W) copies; 0 off */
-    uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */
-    int threads;         /* 0: all cores */
+} ulam_kernel_opts;
+
+/* The defaults: analog continuation, exponent 1, rows built as reached, no weight window. */
+ulam_kernel_opts ulam_kernel_defaults(void);
+
+/* When a run stops: the first rule met ends it.  Start from ulam_stop_defaults(). */
+typedef struct ulam_stop_opts {
     int64_t max_walks;   /* stop after this many walks (0: no limit) */
-    double rel_err;      /* stop once the relative-error rule holds (see ulam_solve); 0 off */
+    double rel_err;      /* stop once the relative-error rule holds (see ulam_solve_walks); 0 off */
     double max_seconds;  /* stop after this much wall time (0 off); the first block always runs */
     int64_t max_steps;   /* a walk longer than this is cut and counted (default 10^6) */
     const volatile int *interrupt; /* stop at the next block when *interrupt != 0 (may be NULL) */
-    const ulam_share *share; /* NULL: this process runs every block */
-    int force;           /* 1: walk even when rho(|M|) is not certified below 1 (else ULAM_EDIVERGE) */
-    int assume_finite;   /* 1: treat a variance the guards cannot certify either way as finite */
-    const ulam_guard *guard; /* the verdicts for this M and continue_q computed before (an earlier
-                                solver's ulam_solver_guard, a prepared system): used instead of
-                                computing them when they hold the radii this run needs; NULL:
-                                the solver computes them */
     double rel_err_offset; /* a known exact part c of the answer c + estimate (bidirectional's push
                               part): rel_err is then relative to |c + estimate| (0: none) */
-    double kernel_alpha;   /* the kernel exponent alpha, finite and >= 0: a walk that continues from
-                              i moves to j with probability |K_ij|^alpha / sum_k |K_ik|^alpha over
-                              the row's nonzeros (K = M adjoint, M' forward), its weight times
-                              K_ij / (q_i p_ij); 1 (the default): the "almost optimal" |K_ij| / S_i,
-                              0 uniform, 2 Alea's transition factor.  rho(M^) is that kernel's, so
-                              opts->guard is used only when computed for the same alpha */
+} ulam_stop_opts;
+
+/* The defaults: 10^5 walks, walk cap 10^6 steps, every other rule off. */
+ulam_stop_opts ulam_stop_defaults(void);
+
+/* Where and how the walks run.  Start from ulam_exec_defaults(). */
+typedef struct ulam_exec_opts {
+    uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */
+    int threads;         /* 0: all cores */
+    const ulam_share *share; /* NULL: this process runs every block */
+} ulam_exec_opts;
+
+/* The defaults: seed 1, all cores, one process. */
+ulam_exec_opts ulam_exec_defaults(void);
+
+/* What is asked: which x_i (or which weighted sum of them).  Start from ulam_query_defaults(). */
+typedef struct ulam_query_opts {
+    int64_t index;       /* 0-based component reported (the start state in adjoint mode) */
     int64_t nstarts;     /* adjoint: 0 starts every walk at index; k > 0 starts it at starts[j]
                             with probability |start_weights[j]| / S (S their sum of |.|) and
                             weight sign(start_weights[j]) S, so the estimate is of
                             sum_j start_weights[j] x_{starts[j]} (index only labels it) */
     const int64_t *starts;       /* k states (0-based), borrowed like b */
     const double *start_weights; /* k finite weights, not all 0 */
+} ulam_query_opts;
+
+/* The defaults: x_0, walks starting there. */
+ulam_query_opts ulam_query_defaults(void);
+
+/* What the run trusts: the guards' verdicts, computed before or to compute, and what to do when
+ * they do not certify.  Start from ulam_policy_defaults(). */
+typedef struct ulam_policy_opts {
+    int force;           /* 1: walk even when rho(|M|) is not certified below 1 (else ULAM_EDIVERGE) */
+    int assume_finite;   /* 1: treat a variance the guards cannot certify either way as finite */
+    const ulam_guard *guard; /* the verdicts for this M and continue_q computed before (an earlier
+                                solver's ulam_solver_guard, a prepared system): used instead of
+                                computing them when they hold the radii this run needs; NULL:
+                                the solver computes them */
     const ulam_system *system; /* the prepared system M (and b, when it is the system's) come from
                                   (ulam_system_lazy), or NULL: its blocks are verified as they are
                                   first read (each row before a walk builds it; every row before a
                                   pass over all of M), and a damaged one fails the run with
                                   ULAM_ESYNTAX naming it */
+} ulam_policy_opts;
+
+/* The defaults: refuse what is not certified, compute the guards, no prepared system. */
+ulam_policy_opts ulam_policy_defaults(void);
+
+/* How to walk and when to stop, by concern.  Start from ulam_walk_defaults() (each part from its
+ * own defaults function). */
+typedef struct ulam_walk_opts {
+    int mode;            /* ULAM_ADJOINT (one x_i) or ULAM_FORWARD (every x_i) */
+    int estimator;       /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */
+    ulam_kernel_opts kernel; /* continuation, exponent, weight window */
+    ulam_stop_opts stop;     /* walks, rel_err, time, cuts, interrupt */
+    ulam_exec_opts exec;     /* seed, threads, processes */
+    ulam_query_opts query;   /* index, weighted starts */
+    ulam_policy_opts policy; /* force, assume_finite, guards computed before, prepared system */
 } ulam_walk_opts;
 
-/* The defaults: adjoint collision walks, index 0, analog kernel (kernel_alpha 1), seed 1, all
- * cores, 10^5 walks, walk cap 10^6 steps. */
+/* The defaults: adjoint collision walks and each part's defaults (index 0, analog kernel with
+ * exponent 1, seed 1, all cores, 10^5 walks, walk cap 10^6 steps). */
 ulam_walk_opts ulam_walk_defaults(void);
 
 /* What a run has found so far. */
@@ -685,12 +732,12 @@ typedef struct ulam_solver ulam_solver;
 /* Prepare walks on (I - M) x = b.  M and b are borrowed: they must stay unchanged until the
  * solver is freed, for the walk kernel's rows are built from them when a walk first reaches
  * them (so a query for one x_i reads and keeps only the rows its walks visit).
- * Before any walk it takes the guards' verdicts (opts->guard, or ulam_guard_check on rho(|M|)
+ * Before any walk it takes the guards' verdicts (opts->policy.guard, or ulam_guard_check on rho(|M|)
  * and this mode's rho(M^), stopped once certified) and keeps them (ulam_solver_guard):
  *   - rho(|M|) not certified below 1 (>= 1, or bounds straddling 1): ULAM_EDIVERGE unless
- *     opts->force;
+ *     opts->policy.force;
  *   - rho(M^) not certified below 1: the variance counts as infinite (result variance_finite
- *     0 or -1, ci95 NaN; opts->assume_finite makes an unknown one finite), the rel_err rule
+ *     0 or -1, ci95 NaN; opts->policy.assume_finite makes an unknown one finite), the rel_err rule
  *     never fires, and a rel_err run with neither max_walks nor max_seconds is refused with
  *     ULAM_EINFVAR (err->msg names the radius, and the other mode when its variance is finite);
  *   - absorption where a reachable scoring state has p* = 0: ULAM_EUNDEFINED, err->index
@@ -731,14 +778,26 @@ int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error);
 /* Free a solver; accepts and returns NULL. */
 ulam_solver *ulam_solver_free(ulam_solver *s);
 
-/* Allocate, iterate until done, report, free: the whole run in one call, with the refusals of
- * ulam_solver_alloc (guards checked first).  It always ends: rel_err alone stops at 10^9
+/* The library's `ulam solve`: x_{opts->query.index} by the method the table chooses (ulam_auto), so a
+ * caller with ulam_walk_defaults() gets what `ulam solve` gives by default: the same choice and,
+ * on the same seed, the same estimate.  As the command line pins what it is given, a walk option
+ * that differs from ulam_walk_defaults() pins that part of the walks' race (mode, estimator,
+ * continue_q, kernel_alpha; opts->policy.guard serves as ulam_auto_opts.guard); all four differing, or
+ * nstarts > 0, pin the walks row: ulam_solve_walks's run.  The answer comes as a walk result:
+ * the chosen walks' run, or for bidirectional its walks on <r, x> with the whole answer's
+ * estimate, std_error and ci95.  Statuses: ulam_auto's.  To run exactly the walks opts name, call
+ * ulam_solve_walks (or ulam_auto with ulam_method_opts.method = ULAM_METHOD_WALKS). */
+int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+               ulam_walk_result *result, ulam_error *err);
+
+/* The walks opts name, pinned (no choice): allocate, iterate until done, report, free in one
+ * call, with the refusals of ulam_solver_alloc (guards checked first).  It always ends: rel_err alone stops at 10^9
  * walks at most (ULAM_REL_ERR_CAP; rel_err_met 0).
- * The rel_err rule (opts->rel_err = E, variance certified finite; docs/error-bars.md), checked
+ * The rel_err rule (opts->stop.rel_err = E, variance certified finite; docs/error-bars.md), checked
  * once per epoch of walk counts (sqrt(2) apart from 1024), stops when all of these hold (N walks,
  * estimate m, the 95% interval's terms of src/stop.h at L = ln(3 / delta_k)):
  *   N >= 1000, m != 0 (unless nothing that scores is reachable: x = 0, certified) and,
- *   forward, the watched component opts->index has been tallied;
+ *   forward, the watched component opts->query.index has been tallied;
  *   the variance term sqrt(2 V L / N) <= w = sqrt(2 L) E |m|, i.e. se <= E |m|;
  *   the range and bias terms 7 R L / (3 (N - 1)) + bias <= w, R the range of a single score
  *     (score_bound; for collision and expected the range of walks short enough to matter,
@@ -751,8 +810,8 @@ ulam_solver *ulam_solver_free(ulam_solver *s);
  * A run whose predicted walks (min_walks) exceed max_walks or ULAM_REL_ERR_CAP stops after
  * the round, not met (out_of_reach), with the estimate so far; a zero estimate never does.  A split weight below the start weight (1 adjoint, ||b||_1 forward)
  * is refused with ULAM_EINVAL. */
-int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-               ulam_walk_result *result, ulam_error *err);
+int ulam_solve_walks(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                     ulam_walk_result *result, ulam_error *err);
 
 /* As ulam_solve, ulam_solver_alloc and ulam_jacobi with b's length nb: b must have one entry a
  * row of M (A), else ULAM_EDIM (ULAM_EINVAL for a NULL b), so a short b is refused, never read
@@ -807,7 +866,7 @@ int ulam_analysis_alloc(const ulam_csr *M, const ulam_analysis_opts *opts, ulam_
 ulam_analysis *ulam_analysis_free(ulam_analysis *a);
 
 /* A solver for one query on a's M (as ulam_solver_alloc, whose refusals it shares), using what
- * a holds: opts->continue_q and kernel_alpha must be a's (ULAM_EINVAL otherwise); opts->guard,
+ * a holds: opts->kernel.continue_q and kernel_alpha must be a's (ULAM_EINVAL otherwise); opts->policy.guard,
  * when NULL, is a's.  Adjoint queries with b = a's b walk on a's kept kernel for their estimator
  * (one solver on it at a time: free it before the next); other b and forward mode get a kernel
  * of their own.  The same seed gives the same walks as ulam_solver_alloc (the bounds, and so a
@@ -815,7 +874,7 @@ ulam_analysis *ulam_analysis_free(ulam_analysis *a);
 int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_solver **out,
                          ulam_error *err);
 
-/* One query to its end (ulam_analysis_solver, iterate, report, free): as ulam_solve. */
+/* One query to its end (ulam_analysis_solver, iterate, report, free): as ulam_solve_walks. */
 int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_walk_result *result,
                         ulam_error *err);
 
@@ -1182,7 +1241,10 @@ typedef struct ulam_auto_candidate {
 /* The work model's units (one unit: one step of a walk), measured once (README, "Choosing for the
  * user"): a walk's start and record, a forward tally, a kernel unit built (16 bytes of a row), a
  * matrix entry read by a guard, reachability check or score-bound pass; and the seconds a unit
- * took on the machine they were measured on (the report's predicted seconds only). */
+ * took on the machine they were measured on.  ULAM_AUTO_UNIT_SECONDS is a tunable of the report
+ * alone (docs/tunables.md): it converts predicted work to the predicted_seconds printed, and
+ * nothing the choice or a run decides reads it, so the same seed gives the same answer on every
+ * machine whatever its speed. */
 #define ULAM_AUTO_WALK 3.0
 #define ULAM_AUTO_TALLY 1.0
 #define ULAM_AUTO_BUILD 2.0
@@ -1354,9 +1416,9 @@ typedef struct ulam_answer {
     int status;                  /* the run's status (ULAM_OK; ENOCONV, ESTALL for the outer rows) */
 } ulam_answer;
 
-/* Choose the method for x_{o->index} of (I - M) x = b under o's options, ao's pins of the walks'
+/* Choose the method for x_{o->query.index} of (I - M) x = b under o's options, ao's pins of the walks'
  * candidates (ao NULL: ulam_auto_defaults()) and mo's of the rows (mo NULL:
- * ulam_method_defaults(), every row considered): with mo->method >= 0 that row alone, as o says (walks: ulam_solver_alloc on o, no pilots: bit for bit what ulam_solve does);
+ * ulam_method_defaults(), every row considered): with mo->method >= 0 that row alone, as o says (walks: ulam_solver_alloc on o, no pilots: bit for bit what ulam_solve_walks does);
  * else every row of the table in order: the walks row races its candidates (ulam_auto_solver),
  * then each other row's applicability test and cost prediction, a row replacing the leader when
  * its predicted work is below the leader's.  Bidirectional applies to an adjoint query with a
@@ -1370,7 +1432,7 @@ typedef struct ulam_answer {
  * for (pinned, it needs a rel_err target and plans from a pilot round of walks on b).  The rows that answer every unknown do
  * not apply to a query for one entry with an error bar (they give none); pinned, they run from
  * ulam_outer_defaults() and the Krylov peers to its tolerance, with o's seed, threads,
- * continuation, cut, interrupt and force, and o->max_walks (when set) capping one correction.
+ * continuation, cut, interrupt and force, and o->stop.max_walks (when set) capping one correction.
  * ch gets every row's verdict; *out the run (NULL on failure).  Statuses: ulam_auto_solver's (the walks' refusal:
  * ch->walks says which candidate), ULAM_ENOMEM. */
 int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
@@ -1390,7 +1452,8 @@ ulam_run *ulam_run_free(ulam_run *r);
 /* The library's `ulam solve`: ulam_auto_start, ulam_run_finish, ulam_run_free in one call
  * (ch may be NULL).  With ao and mo NULL it chooses as `ulam solve` does by default (the same
  * choice and, on the same seed, the same estimate); pin a row with mo->method
- * (ULAM_METHOD_WALKS: ulam_solve's run, bit for bit). */
+ * (ULAM_METHOD_WALKS: ulam_solve_walks's run, bit for bit); ulam_solve is this call with its
+ * answer as a walk result. */
 int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
               const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err);
 

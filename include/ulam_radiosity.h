@@ -7,7 +7,7 @@
  *
  * The API by rank (as in ulam.h; each section banner below names the ranks it holds):
  *   primary: ulam_scene_read_obj, ulam_scene_find, ulam_scene_free, ulam_tracer_alloc,
- *     ulam_tracer_free, ulam_rad_solver_alloc, _iterate, _done, _result, _vectors, _free,
+ *     ulam_tracer_free, ulam_rad_defaults, ulam_rad_solver_alloc, _iterate, _done, _result, _vectors, _free,
  *     ulam_ff_estimate, ulam_rad_direct, ulam_camera_cornell, ulam_camera_frame,
  *     ulam_render, ulam_png_write;
  *   secondary: ulam_scene_subdivide, ulam_scene_centroid, ulam_scene_label_centroid,
@@ -188,7 +188,7 @@ int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays,
 /* All primary. */
 
 /* The radiosity estimators: opts->estimator of ulam_rad_solver_alloc and ulam_rad_point_alloc
- * is one of these (its own enum, not ulam.h's ulam_estimator; 0, ulam_walk_defaults()'s, is
+ * is one of these (its own enum, not ulam.h's ulam_estimator; 0, ulam_rad_defaults()'s, is
  * next-event with MIS).
  *
  * Next-event (gathering and point walks): at every patch p a walk visits with weights W, a point y is drawn on an emitter l (l in
@@ -230,6 +230,21 @@ typedef struct ulam_rad_result {
     int rel_err_met;           /* the run stopped because the rel_err rule holds */
 } ulam_rad_result;
 
+/* How patch walks run and when they stop: radiosity's own options (the matrix walks' kernel,
+ * query and guard parts do not apply: patch walks continue with the patch's largest reflectance
+ * and follow the form factors).  Start from ulam_rad_defaults(). */
+typedef struct ulam_rad_opts {
+    int mode;            /* ULAM_ADJOINT gathers at patch index, ULAM_FORWARD shoots */
+    int estimator;       /* enum ulam_rad_estimator */
+    int64_t index;       /* the patch (0-based); point walks do not read it */
+    ulam_stop_opts stop; /* walks, rel_err, time, walk cap, interrupt */
+    ulam_exec_opts exec; /* seed, threads, processes */
+} ulam_rad_opts;
+
+/* The defaults: gathering at patch 0 with next-event estimation, and ulam_stop_defaults() and
+ * ulam_exec_defaults() (10^5 walks, walk cap 10^6 steps, seed 1, all cores). */
+ulam_rad_opts ulam_rad_defaults(void);
+
 /* An opaque patch-walk solver: walks that sample F by ray casting, never forming it. */
 typedef struct ulam_rad_solver ulam_rad_solver;
 
@@ -238,8 +253,8 @@ typedef struct ulam_rad_solver ulam_rad_solver;
  * shoots particles from the emitters in proportion to power and tallies every patch;
  * opts->estimator one of enum ulam_rad_estimator (shooting: ULAM_RAD_COLLISION or
  * ULAM_RAD_ABSORPTION; next-event's rays count the shadow rays too); the stopping rules, seed,
- * threads and interrupt of ulam_walk_opts (continue_q, roulette and split must be 0). */
-int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
+ * threads and interrupt of opts->stop and opts->exec. */
+int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, ulam_rad_solver **out,
                           ulam_error *err);
 
 /* A point query's answer (ulam_rad_point_result). */
@@ -261,14 +276,14 @@ typedef struct ulam_rad_point {
  * n must be the patch's).  opts as ulam_rad_solver_alloc's, gathering, estimator next-event (any
  * of the three) or ULAM_RAD_COLLISION; opts->index is not read; rel_err is held on the
  * irradiance.  Iterate, done and free as for patch walks; ulam_rad_solver_result gives H. */
-int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, const double x[3], const double n[3],
                          ulam_rad_solver **out, ulam_error *err);
 
 /* A point solver's answer so far; ULAM_EINVAL for a patch solver. */
 int ulam_rad_point_result(const ulam_rad_solver *s, ulam_rad_point *r);
 
 /* One point query run to its end: ulam_rad_point_alloc, iterate until done, the result. */
-int ulam_rad_point_query(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+int ulam_rad_point_query(const ulam_tracer *t, const ulam_rad_opts *opts, const double x[3], const double n[3],
                          ulam_rad_point *r, ulam_error *err);
 
 /* A sensor grid: the centres of nu x nv cells of the rectangle origin + a u + b v (a, b in
@@ -286,9 +301,9 @@ void ulam_rad_grid_point(const ulam_rad_grid *g, int i, int j, double x[3]);
 
 /* Point queries (ulam_rad_point_query) at every sensor of g, out[j nu + i] for cell (i, j), each
  * with opts (rel_err, max_walks per point; max_seconds for the whole grid) and the seed drawn
- * from stream (opts->seed, j nu + i).  Interrupted: the points not reached are zeroed (their
+ * from stream (opts->exec.seed, j nu + i).  Interrupted: the points not reached are zeroed (their
  * run.walks 0).  ULAM_EINVAL for a grid without points, not finite or with a normal not unit. */
-int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_walk_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
+int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
                         ulam_error *err);
 
 /* The most quadrature points of a mesh-error estimate: the centroid and up to 8 vertex halves. */
@@ -308,10 +323,10 @@ typedef struct ulam_rad_mesh {
 } ulam_rad_mesh;
 
 /* The mesh error of the patch query of patch opts->index that answered B (RGB): point queries
- * (ulam_rad_point_query with opts, each its seed from stream (opts->seed, k + 1)) on the
+ * (ulam_rad_point_query with opts, each its seed from stream (opts->exec.seed, k + 1)) on the
  * continuous surfaces at the patch's area centroid and half way from it to each of its first 8
  * vertices, against B. */
-int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_walk_opts *opts, const double B[3], ulam_rad_mesh *out,
+int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_rad_opts *opts, const double B[3], ulam_rad_mesh *out,
                         ulam_error *err);
 
 /* Run one round of walks (rounds grow 1, 2, 4 ... 32 blocks of 256 walks as walks accumulate,
@@ -407,14 +422,14 @@ typedef struct ulam_view_info {
 /* Images that solve only what is seen: cast the camera's primary rays (ulam_view_pixels), then
  * gather every patch some pixel sees, and no other, each with its own solver run (opts: the
  * gathering estimator, seed, threads, max_walks a patch, max_steps, interrupt; max_seconds
- * for the whole) to relative error opts->rel_err (n_max / n_p)^coverage on every nonzero
+ * for the whole) to relative error opts->stop.rel_err (n_max / n_p)^coverage on every nonzero
  * channel, n_p its pixels and n_max the most any patch has: coverage 0 holds every seen
  * patch to rel_err; 0.25 minimises the walks for a given pixel-summed squared error
  * (sum_p n_p se_p^2 at cost sum_p 1 / se_p^2: se_p ~ n_p^-1/4).  Patch p's walks use the seed
- * drawn from stream (opts->seed, p), so the result does not depend on threads.  B and se
+ * drawn from stream (opts->exec.seed, p), so the result does not depend on threads.  B and se
  * (3 * npatches) get the seen patches' answers; unseen patches get B 0 and se NaN. */
 int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, int height, double coverage,
-                     const ulam_walk_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err);
+                     const ulam_rad_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err);
 
 /* ---------------------------------------------------------------- adaptive subdivision */
 /* Secondary: ulam_rad_importance, ulam_rad_adapt. */
@@ -456,7 +471,7 @@ typedef struct ulam_rad_adapt_info {
  * Point k of the i-th polygon measured draws its seed from stream (opts->seed, 16 i + k).
  * *out gets the mesh made (faces, groups and materials kept; the tracer's scene when nothing
  * was split is copied).  info may be NULL. */
-int ulam_rad_adapt(const ulam_tracer *t, const ulam_walk_opts *opts, const double *importance, double target,
+int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double *importance, double target,
                    int64_t max_patches, ulam_scene **out, ulam_rad_adapt_info *info, ulam_error *err);
 
 /* The size of ulam_falsecolour's picture of an nu x nv grid of cells of cw x ch pixels (the

@@ -120,24 +120,24 @@ int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts
     if (!a || !b || !opts || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis, b, options and an output");
     *out = NULL;
     ulam_walk_opts o = *opts;
-    if ((o.continue_q > 0 ? o.continue_q : 0.0) != a->continue_q || o.kernel_alpha != a->alpha)
+    if ((o.kernel.continue_q > 0 ? o.kernel.continue_q : 0.0) != a->continue_q || o.kernel.kernel_alpha != a->alpha)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "the analysis' continuation %g and kernel exponent %g",
                           a->continue_q, a->alpha);
-    o.continue_q = a->continue_q;
-    if (!o.system && a->sys) o.system = a->sys; /* the file's blocks verified as the walks reach them */
+    o.kernel.continue_q = a->continue_q;
+    if (!o.policy.system && a->sys) o.policy.system = a->sys; /* the file's blocks verified as the walks reach them */
     int status;
-    if (!o.guard) {
+    if (!o.policy.guard) {
         if (o.mode != ULAM_ADJOINT && o.mode != ULAM_FORWARD) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a mode");
         if ((status = take_guard(a, o.mode, err))) return status;
-        o.guard = &a->g;
+        o.policy.guard = &a->g;
     }
-    int adj = o.mode == ULAM_ADJOINT, shared = adj && a->b && b == a->b && !o.nstarts;
+    int adj = o.mode == ULAM_ADJOINT, shared = adj && a->b && b == a->b && !o.query.nstarts;
     int e = o.estimator >= ULAM_COLLISION && o.estimator <= ULAM_EXPECTED ? o.estimator : -1;
     ulam__reach stored;
     int cheap = a->sys && ulam__system_bounds(a->sys, a->continue_q, a->alpha, &stored); /* the file's: no pass */
     /* every run prints an interval on the score range (stop.h): at a fixed budget too the file's
        bounds spare the solver its pass over all the start reaches */
-    const ulam__reach *R = adj && (o.estimator == ULAM_ABSORPTION || o.rel_err > 0 || cheap) ? take_bounds(a) : NULL;
+    const ulam__reach *R = adj && (o.estimator == ULAM_ABSORPTION || o.stop.rel_err > 0 || cheap) ? take_bounds(a) : NULL;
     ulam_kernel *k = shared && e >= 0 ? a->k[e] : NULL;
     status = ulam__solver_alloc_reached(a->M, b, &o, R, k, out, err);
     if (!status && shared && e >= 0 && !k) a->k[e] = ulam__solver_keep_kernel_fixed(*out);
@@ -161,7 +161,7 @@ static int auto_pins(ulam_analysis *a, const ulam_walk_opts *base, const ulam_au
     if (!a || !base) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis and options");
     *o = ao ? *ao : ulam_auto_defaults();
     int mine = o->pin_continue && o->pin_alpha && o->pin_mode && base->mode == ULAM_ADJOINT &&
-               (base->continue_q > 0 ? base->continue_q : 0.0) == a->continue_q && base->kernel_alpha == a->alpha;
+               (base->kernel.continue_q > 0 ? base->kernel.continue_q : 0.0) == a->continue_q && base->kernel.kernel_alpha == a->alpha;
     if (mine && !o->guard) {
         int status = take_guard(a, ULAM_ADJOINT, err);
         if (status) return status;

@@ -57,8 +57,8 @@ typedef struct {
 static int alloc_solver(const chooser *c, const ulam_walk_opts *o, ulam_solver **out, ulam_error *err)
 {
     const ulam__reach *R = c->reach;
-    int fits = R && o->mode == ULAM_ADJOINT && (o->continue_q > 0 ? o->continue_q : 0.0) == R->continue_q &&
-               o->kernel_alpha == R->alpha;
+    int fits = R && o->mode == ULAM_ADJOINT && (o->kernel.continue_q > 0 ? o->kernel.continue_q : 0.0) == R->continue_q &&
+               o->kernel.kernel_alpha == R->alpha;
     return ulam__solver_alloc_reached(c->M, c->b, o, fits ? R : NULL, NULL, out, err);
 }
 
@@ -93,7 +93,7 @@ static int guard_need(chooser *c, int kk, int need, ulam_error *err)
     go.need = need & ~g->computed;
     go.kernel_alpha = c->as[kk % 3];
     ulam_guard h;
-    int status = c->base.system ? ulam_system_check(c->base.system, err) : ULAM_OK; /* a lazily read file: whole now */
+    int status = c->base.policy.system ? ulam_system_check(c->base.policy.system, err) : ULAM_OK; /* a lazily read file: whole now */
     if (!status) status = ulam_guard_check(c->M, c->qs[kk / 3], &go, &h, err);
     if (status) return status;
     if (!g->computed) *g = h;
@@ -133,9 +133,9 @@ static double predict(const chooser *c, int k, double var, double *walks)
 {
     const ulam_auto_candidate *a = &c->res->cand[k];
     const group *g = &c->g[c->gi[k]];
-    double E = c->base.rel_err, N;
+    double E = c->base.stop.rel_err, N;
     if (E > 0) {
-        double m = fabs(a->estimate + c->base.rel_err_offset), n = (double)a->pilot_walks;
+        double m = fabs(a->estimate + c->base.stop.rel_err_offset), n = (double)a->pilot_walks;
         if (!c->tail_ok[k]) N = INFINITY; /* no bound on a single score: the rule cannot stop */
         else if (m == 0) N = INFINITY; /* a pilot that saw nothing predicts nothing */
         else {
@@ -150,9 +150,9 @@ static double predict(const chooser *c, int k, double var, double *walks)
             }
         }
         N = rounded_walks(N);
-        if (c->base.max_walks > 0) N = fmin(N, (double)c->base.max_walks);
+        if (c->base.stop.max_walks > 0) N = fmin(N, (double)c->base.stop.max_walks);
     } else {
-        N = c->base.max_walks > 0 ? (double)c->base.max_walks : NAN;
+        N = c->base.stop.max_walks > 0 ? (double)c->base.stop.max_walks : NAN;
     }
     *walks = N;
     double cap = (double)ulam_csr_nnz(c->M) + 3.0 * (double)c->M->nrows, u = (double)g->units;
@@ -200,7 +200,7 @@ static double key(const chooser *c, int k, double scale)
     if (a->mode == ULAM_FORWARD && a->estimate == 0 && a->variance == 0)
         return INFINITY; /* no forward pilot walk has tallied the component yet: nothing is known */
     double var = variance_of(c, k) * scale, walks;
-    if (c->base.rel_err > 0) return predict(c, k, var, &walks);
+    if (c->base.stop.rel_err > 0) return predict(c, k, var, &walks);
     return honest_variance(c, k, var) * work_per_walk(c, k);
 }
 
@@ -252,11 +252,11 @@ static ulam_walk_opts pilot_opts(const chooser *c, int k, int stage, int64_t n)
 {
     const ulam_auto_candidate *a = &c->res->cand[k];
     ulam_walk_opts o = c->base;
-    o.mode = a->mode, o.estimator = a->estimator, o.continue_q = a->continue_q;
-    o.max_walks = n, o.max_seconds = 0, o.interrupt = NULL, o.share = NULL, o.whole_kernel = 0;
-    o.seed = c->base.seed ^ (PILOT_SEED + (uint64_t)(64 * k + stage));
-    o.kernel_alpha = a->kernel_alpha;
-    o.guard = &c->guard[c->gi[k] % KERNELS];
+    o.mode = a->mode, o.estimator = a->estimator, o.kernel.continue_q = a->continue_q;
+    o.stop.max_walks = n, o.stop.max_seconds = 0, o.stop.interrupt = NULL, o.exec.share = NULL, o.kernel.whole_kernel = 0;
+    o.exec.seed = c->base.exec.seed ^ (PILOT_SEED + (uint64_t)(64 * k + stage));
+    o.kernel.kernel_alpha = a->kernel_alpha;
+    o.policy.guard = &c->guard[c->gi[k] % KERNELS];
     return o;
 }
 
@@ -291,7 +291,7 @@ static int pilot(chooser *c, int k, int stage, int64_t n)
     c->steps[k] += (double)r.steps;
     a->stages = stage + 1;
     /* the range term scales as R / |m|: carry it to the pooled mean */
-    double mp = fabs(c->mom[k].mean + c->base.rel_err_offset), ms = fabs(r.estimate + c->base.rel_err_offset);
+    double mp = fabs(c->mom[k].mean + c->base.stop.rel_err_offset), ms = fabs(r.estimate + c->base.stop.rel_err_offset);
     c->min_walks[k] = r.min_walks > 0 && mp > 0 ? r.min_walks * ms / mp : r.min_walks;
     c->tail_ok[k] = isfinite(r.tail_bound) || r.estimate == 0;
     c->range[k] = r.tail_bound == 0.0 ? 0.0 : isfinite(r.tail_bound) && ms > 0 ? r.tail_bound * (double)r.walks * ms : INFINITY;
@@ -457,8 +457,8 @@ static int check(const ulam_csr *M, const double *b, const ulam_walk_opts *base,
     if (M->nrows != M->ncols) return ulam__fail(err, ULAM_ENOTSQUARE, 0, -1, "a square matrix M");
     int bad = ulam__walk_opts_check(base, err); /* src/check.c: the options, then M's structure */
     if (bad || (bad = ulam__csr_check_structure(M, err))) return bad;
-    if (base->index < 0 || base->index >= M->nrows)
-        return ulam__fail(err, ULAM_EINVAL, 0, base->index, "an index from 0 to %lld", (long long)M->nrows - 1);
+    if (base->query.index < 0 || base->query.index >= M->nrows)
+        return ulam__fail(err, ULAM_EINVAL, 0, base->query.index, "an index from 0 to %lld", (long long)M->nrows - 1);
     return ULAM_OK;
 }
 
@@ -487,14 +487,14 @@ int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_
     if (status) return status;
     memset(res, 0, sizeof *res);
     res->chosen = res->closest = -1;
-    res->by_work = base->rel_err > 0;
+    res->by_work = base->stop.rel_err > 0;
     double t0 = ulam_now();
     chooser *c = calloc(1, sizeof *c);
     if (!c) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the choice");
     c->M = M, c->b = b, c->base = *base, c->a = a, c->res = res, c->leader = -1, c->reach = reach;
-    c->qs[0] = a.pin_continue ? base->continue_q : 0.0, c->qs[1] = a.continue_q;
+    c->qs[0] = a.pin_continue ? base->kernel.continue_q : 0.0, c->qs[1] = a.continue_q;
     c->nq = a.pin_continue ? 1 : 2;
-    c->as[0] = a.pin_alpha ? base->kernel_alpha : 1.0, c->as[1] = 0.0, c->as[2] = 2.0;
+    c->as[0] = a.pin_alpha ? base->kernel.kernel_alpha : 1.0, c->as[1] = 0.0, c->as[2] = 2.0;
     c->na = a.pin_alpha ? 1 : 3;
     list(c);
     if (!(status = first_stage(c, err)) && !(status = race(c, err))) {
@@ -510,9 +510,9 @@ int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_
     if (k >= 0) res->guard = c->guard[c->gi[k] % KERNELS];
     if (!status && out && k >= 0) {
         ulam_walk_opts o = *base;
-        o.mode = res->cand[k].mode, o.estimator = res->cand[k].estimator, o.continue_q = res->cand[k].continue_q;
-        o.kernel_alpha = res->cand[k].kernel_alpha;
-        o.guard = &c->guard[c->gi[k] % KERNELS];
+        o.mode = res->cand[k].mode, o.estimator = res->cand[k].estimator, o.kernel.continue_q = res->cand[k].continue_q;
+        o.kernel.kernel_alpha = res->cand[k].kernel_alpha;
+        o.policy.guard = &c->guard[c->gi[k] % KERNELS];
         group *g = &c->g[c->gi[k]];
         if (g->sv) {
             status = ulam__solver_rerun(g->sv, &o, err);

@@ -88,8 +88,8 @@ static ulam_walk_opts walk_opts(const ulam_bidir_opts *o)
 {
     ulam_walk_opts wo = o->walk;
     wo.mode = ULAM_ADJOINT;
-    wo.index = o->nb > 0 ? o->b_index[0] : o->source;
-    wo.nstarts = o->nb, wo.starts = o->b_index, wo.start_weights = o->b_value;
+    wo.query.index = o->nb > 0 ? o->b_index[0] : o->source;
+    wo.query.nstarts = o->nb, wo.query.starts = o->b_index, wo.query.start_weights = o->b_value;
     return wo;
 }
 
@@ -120,11 +120,11 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
         return 0;
     return m->Mt == Mt && a->reach_all == b->reach_all && a->target == b->target &&
            (b->nb > 0 || a->source == b->source) && a->rmax == b->rmax && a->min_value == b->min_value &&
-           a->max_push_ops == b->max_push_ops && step_cost(a) == step_cost(b) && x->seed == y->seed &&
-           x->rel_err == y->rel_err && x->max_walks == y->max_walks && x->continue_q == y->continue_q &&
-           x->kernel_alpha == y->kernel_alpha && x->estimator == y->estimator &&
-           x->roulette == y->roulette && x->split == y->split && x->max_steps == y->max_steps &&
-           x->force == y->force && x->assume_finite == y->assume_finite && x->guard == y->guard;
+           a->max_push_ops == b->max_push_ops && step_cost(a) == step_cost(b) && x->exec.seed == y->exec.seed &&
+           x->stop.rel_err == y->stop.rel_err && x->stop.max_walks == y->stop.max_walks && x->kernel.continue_q == y->kernel.continue_q &&
+           x->kernel.kernel_alpha == y->kernel.kernel_alpha && x->estimator == y->estimator &&
+           x->kernel.roulette == y->kernel.roulette && x->kernel.split == y->kernel.split && x->stop.max_steps == y->stop.max_steps &&
+           x->policy.force == y->policy.force && x->policy.assume_finite == y->policy.assume_finite && x->policy.guard == y->policy.guard;
 }
 
 /* The pilot's solver: PILOT collision walks from s on Mt on a seed of their own, scoring 1 at
@@ -137,12 +137,12 @@ static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *
 {
     ulam_walk_opts po = walk_opts(o);
     po.estimator = ULAM_COLLISION;
-    po.max_walks = PILOT, po.max_seconds = 0, po.share = NULL, po.whole_kernel = 0;
-    po.threads = 1; /* one partial block: a thread team would only be woken (same result for any count) */
-    po.seed = o->walk.seed ^ UINT64_C(0x9e3779b97f4a7c15);
-    po.interrupt = NULL;
+    po.stop.max_walks = PILOT, po.stop.max_seconds = 0, po.exec.share = NULL, po.kernel.whole_kernel = 0;
+    po.exec.threads = 1; /* one partial block: a thread team would only be woken (same result for any count) */
+    po.exec.seed = o->walk.exec.seed ^ UINT64_C(0x9e3779b97f4a7c15);
+    po.stop.interrupt = NULL;
     ulam_kernel *k = memo->pilot;
-    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != po.continue_q || k->alpha != po.kernel_alpha ||
+    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != po.kernel.continue_q || k->alpha != po.kernel.kernel_alpha ||
               k->scores.b != ones))
         memo->pilot = k = ulam__kernel_free(k);
     int status = ulam__solver_alloc_reached(Mt, ones, &po, reach, k, out, err);
@@ -159,13 +159,13 @@ static double predicted_walks(const ulam_bidir_opts *o, const ulam_solver *pilot
                               double xhat)
 {
     const ulam_walk_opts *wo = &o->walk;
-    if (wo->rel_err <= 0 && wo->max_walks > 0) return (double)wo->max_walks;
-    double E = wo->rel_err > 0 ? wo->rel_err : DEFAULT_REL_ERR;
+    if (wo->stop.rel_err <= 0 && wo->stop.max_walks > 0) return (double)wo->stop.max_walks;
+    double E = wo->stop.rel_err > 0 ? wo->stop.rel_err : DEFAULT_REL_ERR;
     double n = fmax((double)ULAM__REL_MIN, norm_b(o) * rmax * visits / (E * E * xhat));
-    double range = wo->rel_err > 0 && pilot ? ulam__solver_range_walks(pilot, rmax, 0, xhat, E) : 0.0;
+    double range = wo->stop.rel_err > 0 && pilot ? ulam__solver_range_walks(pilot, rmax, 0, xhat, E) : 0.0;
     if (isfinite(range)) n = fmax(n, range); /* else the rule bounds the score through its second moment, which
                                                depends on r: not predicted */
-    return wo->max_walks > 0 ? fmin(n, (double)wo->max_walks) : n;
+    return wo->stop.max_walks > 0 ? fmin(n, (double)wo->stop.max_walks) : n;
 }
 
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
@@ -177,8 +177,8 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
 static double probe(const ulam_csr *Mt, ulam_push *w, const ulam_bidir_opts *o, ulam__bidir_memo *memo)
 {
     ulam_bidir_opts po = *o;
-    po.walk.rel_err = 0, po.walk.max_walks = PROBE, po.walk.max_seconds = 0, po.walk.interrupt = NULL;
-    po.walk.share = NULL, po.walk.threads = 1, po.walk.seed = o->walk.seed ^ UINT64_C(0x3c6ef372fe94f82b);
+    po.walk.stop.rel_err = 0, po.walk.stop.max_walks = PROBE, po.walk.stop.max_seconds = 0, po.walk.stop.interrupt = NULL;
+    po.walk.exec.share = NULL, po.walk.exec.threads = 1, po.walk.exec.seed = o->walk.exec.seed ^ UINT64_C(0x3c6ef372fe94f82b);
     ulam_walk_result wr;
     ulam_guard g;
     double part = dot_b(ulam_push_estimates(w), o);
@@ -198,8 +198,8 @@ static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir_memo *memo, const 
     int64_t n = ulam__push_matrix(w)->nrows;
     double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n, V = plan->mean_visits, cost = step_cost(o);
     double rmax = o->rmax > 0 ? o->rmax : 1.0, walks, seen = 0.0;
-    int fixed = o->walk.rel_err <= 0 && o->walk.max_walks > 0; /* walks known without V */
-    int probed = fixed || !(o->walk.rel_err > 0) || o->min_value > 0; /* a given min_value is the plan's */
+    int fixed = o->walk.stop.rel_err <= 0 && o->walk.stop.max_walks > 0; /* walks known without V */
+    int probed = fixed || !(o->walk.stop.rel_err > 0) || o->min_value > 0; /* a given min_value is the plan's */
     int status = ulam_push_run(w, rmax, cap); /* balanced: r = e_t, nothing to push yet */
     for (;;) {
         ulam_push_report(w, &plan->push);
@@ -231,14 +231,14 @@ static const ulam__reach *reach_all(ulam__bidir_memo *memo, const ulam_csr *Mt, 
     ulam__reach *R = &memo->reach;
     *status = ULAM_OK;
     if (!o->reach_all) return NULL;
-    if (memo->have_all && R->K == Mt && R->continue_q == fmax(wo->continue_q, 0.0) && R->alpha == wo->kernel_alpha)
+    if (memo->have_all && R->K == Mt && R->continue_q == fmax(wo->kernel.continue_q, 0.0) && R->alpha == wo->kernel.kernel_alpha)
         return R;
     memo->have_all = 0;
     if (!memo->all && !(memo->all = ulam__malloc((size_t)Mt->nrows, 1))) {
         *status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' reach");
         return NULL;
     }
-    if ((*status = ulam__reach_all(Mt, wo->continue_q, wo->kernel_alpha, memo->all, R))) {
+    if ((*status = ulam__reach_all(Mt, wo->kernel.continue_q, wo->kernel.kernel_alpha, memo->all, R))) {
         *status = *status == ULAM_ENOMEM ? ulam__fail(err, *status, 0, -1, "memory for the walks' reach")
                                          : ulam__fail(err, *status, 0, -1, "rows of Mt with columns in range and "
                                                       "finite, nonzero values (the matrix is corrupt)");
@@ -315,7 +315,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
 }
 
 /* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr.  The solver's
- * rel_err rule (the one of ulam_solve) applies to the whole estimate push_part + <r, x>;
+ * rel_err rule (the one of ulam_solve_walks) applies to the whole estimate push_part + <r, x>;
  * memo: the pilot's guards on Mt and the states it found the walks reach, when it has them, or
  * (reach_all) every state's bounds. */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
@@ -323,8 +323,8 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
 {
     memset(wr, 0, sizeof *wr);
     ulam_walk_opts wo = walk_opts(o);
-    wo.rel_err_offset = push_part;
-    if (!wo.guard && memo->have_guard) wo.guard = &memo->guard;
+    wo.stop.rel_err_offset = push_part;
+    if (!wo.policy.guard && memo->have_guard) wo.policy.guard = &memo->guard;
     ulam_solver *sv = NULL;
     ulam__reach seen = {.seen = memo->seen};
     int status = ULAM_OK;
@@ -332,7 +332,7 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     const ulam__reach *reach = all ? all : memo->have_seen ? &seen : NULL;
     if (status) return status;
     ulam_kernel *k = memo->kernel; /* keep_kernel: the rows earlier queries built, if made for these walks */
-    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != wo.continue_q || k->alpha != wo.kernel_alpha ||
+    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != wo.kernel.continue_q || k->alpha != wo.kernel.kernel_alpha ||
               k->scores.estimator != wo.estimator))
         memo->kernel = k = ulam__kernel_free(k);
     status = ulam__solver_alloc_reached(Mt, r, &wo, reach, k, &sv, err);
@@ -371,7 +371,7 @@ static void honest_interval(ulam_bidir_result *res, double D, const ulam_walk_op
     const ulam_walk_result *w = &res->walks;
     double lo = res->push_part + w->ci95[0], hi = res->push_part + w->ci95[1];
     if (w->walks > 0 && isfinite(w->score_bound)) {
-        int fixed = !(wo->rel_err > 0) && !(wo->max_seconds > 0) && w->walks == wo->max_walks;
+        int fixed = !(wo->stop.rel_err > 0) && !(wo->stop.max_seconds > 0) && w->walks == wo->stop.max_walks;
         ulam__stop_ci ci;
         ulam__stop_interval(w->walks, w->estimate, w->variance, 2.0 * w->score_bound, 0.0, 0.0, INFINITY,
                             fixed ? 1 : ulam__stop_epoch(w->walks), &ci);

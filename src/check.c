@@ -38,20 +38,20 @@ static int check_reals(const void *p, const real_opt *t, size_t k, const char *w
 int ulam__walk_opts_check(const ulam_walk_opts *o, ulam_error *err)
 {
     const real_opt t[] = {
-        {"continue_q", offsetof(ulam_walk_opts, continue_q), -DBL_MAX, BELOW(1.0), "finite and below 1 (<= 0: analog)"},
-        {"roulette", offsetof(ulam_walk_opts, roulette), 0.0, DBL_MAX, "finite and >= 0 (0: off)"},
-        {"split", offsetof(ulam_walk_opts, split), 0.0, DBL_MAX, "finite and >= 0 (0: off)"},
-        {"rel_err", offsetof(ulam_walk_opts, rel_err), 0.0, DBL_MAX, "finite and >= 0 (0: off)"},
-        {"max_seconds", offsetof(ulam_walk_opts, max_seconds), 0.0, DBL_MAX, "finite and >= 0 (0: off)"},
-        {"rel_err_offset", offsetof(ulam_walk_opts, rel_err_offset), -DBL_MAX, DBL_MAX, "finite"},
-        {"kernel_alpha", offsetof(ulam_walk_opts, kernel_alpha), 0.0, DBL_MAX, "(the kernel exponent) finite and >= 0"},
+        {"kernel.continue_q", offsetof(ulam_walk_opts, kernel.continue_q), -DBL_MAX, BELOW(1.0), "finite and below 1 (<= 0: analog)"},
+        {"kernel.roulette", offsetof(ulam_walk_opts, kernel.roulette), 0.0, DBL_MAX, "finite and >= 0 (0: off)"},
+        {"kernel.split", offsetof(ulam_walk_opts, kernel.split), 0.0, DBL_MAX, "finite and >= 0 (0: off)"},
+        {"stop.rel_err", offsetof(ulam_walk_opts, stop.rel_err), 0.0, DBL_MAX, "finite and >= 0 (0: off)"},
+        {"stop.max_seconds", offsetof(ulam_walk_opts, stop.max_seconds), 0.0, DBL_MAX, "finite and >= 0 (0: off)"},
+        {"stop.rel_err_offset", offsetof(ulam_walk_opts, stop.rel_err_offset), -DBL_MAX, DBL_MAX, "finite"},
+        {"kernel.kernel_alpha", offsetof(ulam_walk_opts, kernel.kernel_alpha), 0.0, DBL_MAX, "(the kernel exponent) finite and >= 0"},
     };
     if (!o) return ulam__fail(err, ULAM_EINVAL, 0, -1, "walk options");
     int status = check_reals(o, t, sizeof t / sizeof *t, "ulam_walk_opts", err);
     if (status) return status;
-    if (o->max_walks < 0 || o->max_steps < 1 || o->threads < 0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "ulam_walk_opts with max_walks >= 0, max_steps >= 1 and "
-                                                   "threads >= 0");
+    if (o->stop.max_walks < 0 || o->stop.max_steps < 1 || o->exec.threads < 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "ulam_walk_opts with stop.max_walks >= 0, stop.max_steps >= 1 "
+                                                   "and exec.threads >= 0");
     return ULAM_OK;
 }
 
@@ -143,16 +143,6 @@ int ulam__csr_check_structure(const ulam_csr *A, ulam_error *err)
 {
     int status = check_shape(A, err);
     return status ? status : ulam__csr_check_rows(A, 0, A->nrows, err);
-}
-
-/* As ulam_solve with b's length checked. */
-int ulam_solve_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                 ulam_walk_result *result, ulam_error *err)
-{
-    ulam__clear(err);
-    if (!M) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
-    int status = ulam__length_check(b, nb, M->nrows, "b", err);
-    return status ? status : ulam_solve(M, b, opts, result, err);
 }
 
 /* As ulam_solver_alloc with b's length checked. */

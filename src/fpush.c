@@ -96,8 +96,8 @@ static int solve_queue(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     info->residual_bound = info->push.r_sum * D1;
     if (!status && info->push.support > 0) {
         ulam_walk_opts wo = o.walk;
-        wo.mode = ULAM_FORWARD, wo.index = o.source, wo.rel_err = 0, wo.guard = &g;
-        wo.max_walks = (int64_t)fmin(fmax(W, 1.0), 4e18);
+        wo.mode = ULAM_FORWARD, wo.query.index = o.source, wo.stop.rel_err = 0, wo.policy.guard = &g;
+        wo.stop.max_walks = (int64_t)fmin(fmax(W, 1.0), 4e18);
         ulam_solver *sv = NULL;
         status = ulam_solver_alloc(M, r, &wo, &sv, err);
         while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
@@ -355,8 +355,8 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         for (int64_t j = 0; j < n; j++) row_sums(Mt, j, w.cs, w.mx, w.known, w.cum); /* one streaming pass */
         w.idx = idx, w.prob = prob, w.alias = alias;
         ulam_rng rng;
-        ulam_rng_seed(&rng, o->walk.seed, 0);
-        int64_t cap_w = o->walk.max_walks > 0 ? o->walk.max_walks : INT32_MAX;
+        ulam_rng_seed(&rng, o->walk.exec.seed, 0);
+        int64_t cap_w = o->walk.stop.max_walks > 0 ? o->walk.stop.max_walks : INT32_MAX;
         if (cap_w > INT32_MAX) cap_w = INT32_MAX;
         int k0 = first_epoch(R, pl.E, pl.delta), planned = 1;
         for (;;) { /* checkpoint k (stitching index) at the end of epoch k0 + k - 1 */
@@ -365,7 +365,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
             while (N < target) {
                 walk_one(&w, &rng);
                 N++;
-                if ((N & 1023) == 0 && o->walk.interrupt && *o->walk.interrupt) {
+                if ((N & 1023) == 0 && o->walk.stop.interrupt && *o->walk.stop.interrupt) {
                     info->interrupted = 1, planned = 0;
                     break;
                 }
@@ -421,8 +421,8 @@ int ulam__fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_op
     ulam_guard g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
-    if (opts->walk.guard) g = *opts->walk.guard;
-    else if ((status = ulam_guard_check(M, opts->walk.continue_q, &go, &g, err))) return status;
+    if (opts->walk.policy.guard) g = *opts->walk.policy.guard;
+    else if ((status = ulam_guard_check(M, opts->walk.kernel.continue_q, &go, &g, err))) return status;
     if (g.abs.colsum_max < 1.0)
         status = solve_sweep(M, Mt, opts, &g, x, std_error, lo, hi, info, &swi, err);
     else

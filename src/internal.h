@@ -195,7 +195,7 @@ int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_
                             const ulam__reach *reach, ulam_auto_result *res, ulam_solver **out, ulam_error *err);
 
 /* Iterate s until a stopping rule holds, fill result (may be NULL) and, on failure, err; free s.
- * The status (src/solve.c: the rest of ulam_solve). */
+ * The status (src/solve.c: the rest of ulam_solve_walks). */
 int ulam__solver_finish(ulam_solver *s, ulam_walk_result *result, ulam_error *err);
 
 /* As ulam_auto_start, with reach (NULL: none; borrowed until the run is freed) the bounds over
@@ -219,7 +219,7 @@ typedef struct ulam__rowbuf {
 /* A check of rows [first, last) of a borrowed matrix (and, with with_b, of b at those rows) made
  * before anything reads them: ULAM_OK, or ULAM_ESYNTAX with *bad (may be NULL) the first row of the
  * damaged block.  Thread-safe.  fn NULL: nothing to check.  A prepared system's (src/cache.c): a
- * solver given ulam_walk_opts.system calls it on each row before building it, on every row
+ * solver given ulam_walk_opts.policy.system calls it on each row before building it, on every row
  * reached by a reachability search, and on all of them before a pass over all of M. */
 typedef struct ulam__rows_check {
     int (*fn)(const void *ctx, int64_t first, int64_t last, int with_b, int64_t *bad);
@@ -242,7 +242,7 @@ static inline int ulam__rows_verify(const ulam__rows_check *rc, int64_t first, i
     return rc && rc->fn ? rc->fn(rc->ctx, first, last, rc->with_b, bad) : 0;
 }
 
-/* The check of a solver given opts->system: *rc, when M is that system's matrix (b is checked
+/* The check of a solver given opts->policy.system: *rc, when M is that system's matrix (b is checked
  * with it when it is the system's b; another b was verified by whoever gave it); else ULAM_EINVAL. */
 int ulam__system_rows_check(const ulam_system *s, const ulam_csr *M, const double *b, ulam__rows_check *rc,
                             ulam_error *err);

@@ -113,14 +113,14 @@ static int check(const ulam_csr *M, const double *b, const ulam_outer_opts *o, u
 static int take_guard(const ulam_csr *M, const ulam_walk_opts *w, ulam_guard *g, ulam_error *err)
 {
     int need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
-    if (ulam__guard_fits(w->guard, w->continue_q, w->kernel_alpha, need)) { /* src/guard.c */
-        *g = *w->guard;
+    if (ulam__guard_fits(w->policy.guard, w->kernel.continue_q, w->kernel.kernel_alpha, need)) { /* src/guard.c */
+        *g = *w->policy.guard;
         return ULAM_OK;
     }
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = need;
-    go.kernel_alpha = w->kernel_alpha;
-    return ulam_guard_check(M, w->continue_q, &go, g, err);
+    go.kernel_alpha = w->kernel.kernel_alpha;
+    return ulam_guard_check(M, w->kernel.continue_q, &go, g, err);
 }
 
 /* Refuse walks whose variance is not certified finite (unknown: unless assume_finite): no
@@ -128,7 +128,7 @@ static int take_guard(const ulam_csr *M, const ulam_walk_opts *w, ulam_guard *g,
 static int check_variance(const ulam_guard *g, const ulam_walk_opts *w, ulam_error *err)
 {
     int finite = ulam_guard_variance(g, ULAM_FORWARD);
-    if (finite == 1 || (finite < 0 && w->assume_finite)) return ULAM_OK;
+    if (finite == 1 || (finite < 0 && w->policy.assume_finite)) return ULAM_OK;
     const ulam_power *h = &g->hat[ULAM_FORWARD];
     return ulam__fail(err, ULAM_EINFVAR, 0, -1,
                       "a finite variance for the correction walks: rho(M^) of the forward kernel is in [%.4g, %.4g] "
@@ -155,7 +155,7 @@ int ulam_outer_alloc(const ulam_csr *M, const double *b, const ulam_outer_opts *
     size_t n = (size_t)M->nrows;
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the iteration");
     s->o = o, s->M = M, s->b = b, s->n = M->nrows, s->g = g;
-    if (walks(o.method)) s->o.walk.guard = &s->g; /* the walks' solver takes these verdicts */
+    if (walks(o.method)) s->o.walk.policy.guard = &s->g; /* the walks' solver takes these verdicts */
     s->x = ulam__calloc(n, sizeof *s->x), s->r = ulam__malloc(n, sizeof *s->r);
     s->y = ulam__malloc(n, sizeof *s->y);
     if (walks(o.method)) {
@@ -211,12 +211,12 @@ static int walk_until(ulam_outer *s, int64_t atleast, double *rsd)
 static int correct(ulam_outer *s, double fed, ulam_outer_step *st)
 {
     ulam_walk_opts w = s->o.walk;
-    w.mode = ULAM_FORWARD, w.index = 0;
-    w.max_walks = s->o.max_histories, w.rel_err = 0.0, w.max_seconds = 0.0;
-    w.seed = iteration_seed(s->o.walk.seed, s->iter);
+    w.mode = ULAM_FORWARD, w.query.index = 0;
+    w.stop.max_walks = s->o.max_histories, w.stop.rel_err = 0.0, w.stop.max_seconds = 0.0;
+    w.exec.seed = iteration_seed(s->o.walk.exec.seed, s->iter);
     memcpy(s->rf, s->r, (size_t)s->n * sizeof *s->rf); /* the walks' source: r is overwritten by trials */
     memcpy(s->x0, s->x, (size_t)s->n * sizeof *s->x0);
-    int status = s->sv ? ulam__solver_restart(s->sv, s->rf, w.seed, NULL)
+    int status = s->sv ? ulam__solver_restart(s->sv, s->rf, w.exec.seed, NULL)
                        : ulam_solver_alloc(s->M, s->rf, &w, &s->sv, NULL);
     if (status) return status;
     double rsd = INFINITY, first = 0;

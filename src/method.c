@@ -181,3 +181,52 @@ int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const
     free(own);
     return status;
 }
+
+/* The pins ulam_solve takes from o, as `ulam solve` pins what its command line gives: a walk
+ * option that differs from ulam_walk_defaults() (mode, estimator, continuation, exponent) pins
+ * that part of the walks' race; all four, or weighted starts, pin the walks row itself. */
+static void solve_pins(const ulam_walk_opts *o, ulam_auto_opts *ao, ulam_method_opts *mo)
+{
+    ulam_walk_opts d = ulam_walk_defaults();
+    *ao = ulam_auto_defaults(), *mo = ulam_method_defaults();
+    ao->pin_mode = o->mode != d.mode;
+    ao->pin_estimator = o->estimator != d.estimator;
+    ao->pin_continue = o->kernel.continue_q != d.kernel.continue_q && (o->kernel.continue_q > 0 || d.kernel.continue_q > 0);
+    ao->pin_alpha = o->kernel.kernel_alpha != d.kernel.kernel_alpha;
+    ao->guard = o->policy.guard;
+    if ((ao->pin_mode && ao->pin_estimator && ao->pin_continue && ao->pin_alpha) || o->query.nstarts > 0)
+        mo->method = ULAM_METHOD_WALKS;
+}
+
+/* The library's `ulam solve` with its answer as a walk result. */
+int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, ulam_walk_result *result,
+               ulam_error *err)
+{
+    ulam__clear(err);
+    if (!M || !b || !opts) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and options");
+    ulam_auto_opts ao;
+    ulam_method_opts mo;
+    solve_pins(opts, &ao, &mo);
+    ulam_answer *a = malloc(sizeof *a);
+    if (!a) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the answer");
+    memset(a, 0, sizeof *a);
+    a->method = -1; /* a run that never started leaves result as it was */
+    int status = ulam_auto(M, b, opts, &ao, &mo, NULL, a, err);
+    if (result && (!status || a->method >= 0)) {
+        *result = a->walks; /* bidirectional: its walks on <r, x>, with the whole answer's estimate */
+        result->estimate = a->estimate, result->std_error = a->std_error;
+        result->ci95[0] = a->ci95[0], result->ci95[1] = a->ci95[1];
+    }
+    free(a);
+    return status;
+}
+
+/* As ulam_solve with b's length checked. */
+int ulam_solve_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
+                 ulam_walk_result *result, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!M) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
+    int status = ulam__length_check(b, nb, M->nrows, "b", err);
+    return status ? status : ulam_solve(M, b, opts, result, err);
+}

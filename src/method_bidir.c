@@ -30,7 +30,7 @@ int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao
 {
     if (!b || !o) return 0;
     return nonzeros(b, n) > ulam_method_sparse_limit(n) ||
-           (ao && (ao->pin_estimator || (ao->pin_alpha && o->kernel_alpha != 1.0)));
+           (ao && (ao->pin_estimator || (ao->pin_alpha && o->kernel.kernel_alpha != 1.0)));
 }
 
 /* An adjoint query with a rel_err target, nothing pinned it cannot honour, a walk leader to
@@ -41,12 +41,12 @@ static int applies(const ulam__query *q, int k, char *why, size_t len)
     const ulam_auto_result *au = &q->ch->walks;
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     const char *pinned = o->mode == ULAM_FORWARD ? "forward mode (--mode forward, --out, --errors)"
-                         : o->roulette > 0 || o->split > 0 ? "--roulette or --split (bidirectional takes neither)"
+                         : o->kernel.roulette > 0 || o->kernel.split > 0 ? "--roulette or --split (bidirectional takes neither)"
                                                            : NULL;
     double nnz = (double)ulam_csr_nnz(q->M), W = q->ch->leader_work;
     if (pinned) snprintf(why, len, "not considered: %s", pinned);
     else if (ulam__method_excluded(q, k, why, len)) return 0;
-    else if (!(o->rel_err > 0))
+    else if (!(o->stop.rel_err > 0))
         snprintf(why, len, "not considered: no --rel-err target (without one auto compares variance x work a walk, "
                            "which bidirectional has no figure for)");
     else if (au->chosen < 0) snprintf(why, len, "not considered: no certified walk method to compare with");
@@ -96,7 +96,7 @@ static int setup(ulam__query *q, const ulam_walk_opts *walk, ulam_error *err)
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     r->bo = ulam_bidir_defaults();
     r->bo.walk = *walk;
-    r->bo.target = walk->index;
+    r->bo.target = walk->query.index;
     r->idx = malloc((size_t)(nb ? nb : 1) * sizeof *r->idx), r->val = malloc((size_t)(nb ? nb : 1) * sizeof *r->val);
     double t0 = ulam_now();
     int status = r->idx && r->val ? ulam_csr_transpose(q->M, &r->Mt) : ULAM_ENOMEM;
@@ -120,9 +120,9 @@ enum { DENSE_PILOT = 1024 };
 static ulam_walk_opts dense_walk_opts(const ulam_walk_opts *o, const ulam_auto_candidate *c, double qi)
 {
     ulam_walk_opts wo = *o;
-    wo.mode = ULAM_ADJOINT, wo.nstarts = 0, wo.starts = NULL, wo.start_weights = NULL, wo.guard = NULL;
-    if (c) wo.estimator = c->estimator, wo.continue_q = c->continue_q, wo.kernel_alpha = c->kernel_alpha;
-    wo.rel_err_offset = o->rel_err_offset + qi;
+    wo.mode = ULAM_ADJOINT, wo.query.nstarts = 0, wo.query.starts = NULL, wo.query.start_weights = NULL, wo.policy.guard = NULL;
+    if (c) wo.estimator = c->estimator, wo.kernel.continue_q = c->continue_q, wo.kernel.kernel_alpha = c->kernel_alpha;
+    wo.stop.rel_err_offset = o->stop.rel_err_offset + qi;
     return wo;
 }
 
@@ -138,7 +138,7 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     ulam_run *r = q->run;
     ulam_bidir_plan_info *pl = &q->ch->bidir;
     int64_t n = q->M->nrows, ops = 0, nnz = ulam_csr_nnz(q->M);
-    double E = o->rel_err, t0 = ulam_now();
+    double E = o->stop.rel_err, t0 = ulam_now();
     memset(pl, 0, sizeof *pl);
     r->bq = calloc((size_t)n, sizeof *r->bq), r->br = malloc((size_t)n * sizeof *r->br);
     int status = r->bq && r->br ? ulam_csr_transpose(q->M, &r->Mt) : ULAM_ENOMEM;
@@ -149,11 +149,11 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     double rmax = isfinite(N) && N > 0 && nv > 0 ? bmax * fmin(1.0, nv / N) : bmax;
     if ((status = ulam__bpush(r->Mt, rmax, max_ops, r->bq, r->br, &ops)))
         return release(r), ulam__fail(err, status, 0, -1, "memory for the push on b");
-    double qi = r->bq[o->index];
+    double qi = r->bq[o->query.index];
     r->bwo = dense_walk_opts(o, c, qi);
     ulam_walk_opts po = r->bwo;
-    po.max_walks = DENSE_PILOT, po.max_seconds = 0, po.interrupt = NULL, po.share = NULL;
-    po.seed = o->seed ^ UINT64_C(0x9e3779b97f4a7c15);
+    po.stop.max_walks = DENSE_PILOT, po.stop.max_seconds = 0, po.stop.interrupt = NULL, po.exec.share = NULL;
+    po.exec.seed = o->exec.seed ^ UINT64_C(0x9e3779b97f4a7c15);
     ulam_solver *sv = NULL;
     ulam_walk_result wr;
     status = ulam_solver_alloc(q->M, r->br, &po, &sv, err);
@@ -161,10 +161,10 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     if (!status) ulam_solver_result(sv, &wr);
     ulam_solver_free(sv);
     if (status) return status;
-    double mt = fabs(qi + wr.estimate + o->rel_err_offset), V = wr.walks ? (double)wr.steps / (double)wr.walks : 0.0;
+    double mt = fabs(qi + wr.estimate + o->stop.rel_err_offset), V = wr.walks ? (double)wr.steps / (double)wr.walks : 0.0;
     double need = fmax((double)ULAM__REL_MIN, fmax(wr.min_walks, wr.variance / (E * mt * E * mt)));
-    pl->target = o->index, pl->rmax = rmax, pl->balanced = 1, pl->push_part = qi;
-    pl->push = (ulam_push_info){.target = o->index, .rmax = rmax, .ops = ops, .r_max = ulam__bpush_max(r->br, n)};
+    pl->target = o->query.index, pl->rmax = rmax, pl->balanced = 1, pl->push_part = qi;
+    pl->push = (ulam_push_info){.target = o->query.index, .rmax = rmax, .ops = ops, .r_max = ulam__bpush_max(r->br, n)};
     pl->pilot_walks = wr.walks, pl->pilot_steps = wr.steps, pl->mean_visits = V + 1.0;
     pl->predicted_walks = mt > 0 ? need : INFINITY, pl->step_cost = 1.0;
     pl->predicted_work = ULAM_AUTO_READ * ((double)ops + 2.0 * (double)nnz) +
@@ -182,18 +182,18 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     double W = ch->leader_work;
     if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o)) { /* the push on b */
         const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
-        double m = fabs(c->estimate + q->o->rel_err_offset);
+        double m = fabs(c->estimate + q->o->stop.rel_err_offset);
         int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
         int status = dense_plan(q, q->o, c, c->variance, m, c->predicted_walks, cap, err);
         if (status == ULAM_ENOMEM) return status;
-        ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = r->bwo, ch->bidir_opts.target = q->o->index;
+        ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = r->bwo, ch->bidir_opts.target = q->o->query.index;
         if (status) snprintf(ch->method[k].why, sizeof ch->method[k].why, "refused: %.250s", err->msg);
         else ch->method[k].predicted_work = ch->bidir.predicted_work;
         return ULAM_OK;
     }
     ulam_walk_opts walk = *q->o;
-    walk.estimator = ULAM_COLLISION, walk.kernel_alpha = 1.0;
-    walk.guard = NULL, walk.interrupt = NULL, walk.share = NULL;
+    walk.estimator = ULAM_COLLISION, walk.kernel.kernel_alpha = 1.0;
+    walk.policy.guard = NULL, walk.stop.interrupt = NULL, walk.exec.share = NULL;
     int status = setup(q, &walk, err);
     if (status) return status;
     r->bo.max_push_ops = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : 0; /* W infinite: the default cap */
@@ -226,13 +226,13 @@ static int pin(ulam__query *q, int k, ulam_error *err)
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     if (nb == 0) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero b (b is zero, so x is 0)");
     if (ulam_method_bidir_route(q->b, n, q->ao, q->o)) { /* the push on b, planned from a pilot round on b */
-        if (!(q->o->rel_err > 0))
+        if (!(q->o->stop.rel_err > 0))
             return ulam__fail(err, ULAM_EINVAL, 0, -1, "a --rel-err target for bidirectional with a dense b "
                                                        "(more than max(16, n/10) = %lld nonzeros)",
                               (long long)ulam_method_sparse_limit(n));
         ulam_walk_opts po = dense_walk_opts(q->o, NULL, 0.0);
-        po.max_walks = DENSE_PILOT, po.max_seconds = 0, po.interrupt = NULL, po.share = NULL;
-        po.seed = q->o->seed ^ UINT64_C(0x7f4a7c159e3779b9);
+        po.stop.max_walks = DENSE_PILOT, po.stop.max_seconds = 0, po.stop.interrupt = NULL, po.exec.share = NULL;
+        po.exec.seed = q->o->exec.seed ^ UINT64_C(0x7f4a7c159e3779b9);
         ulam_solver *sv = NULL;
         ulam_walk_result wr;
         int status = ulam_solver_alloc(q->M, q->b, &po, &sv, err);
@@ -240,7 +240,7 @@ static int pin(ulam__query *q, int k, ulam_error *err)
         if (!status) ulam_solver_result(sv, &wr);
         ulam_solver_free(sv);
         if (status) return status;
-        double m = fabs(wr.estimate + q->o->rel_err_offset);
+        double m = fabs(wr.estimate + q->o->stop.rel_err_offset);
         status = dense_plan(q, q->o, NULL, wr.variance, m, wr.min_walks, 100 * ulam_csr_nnz(q->M) + 1000000, err);
         q->ch->bidir_opts = ulam_bidir_defaults(), q->ch->bidir_opts.walk = q->run->bwo;
         return status;
@@ -257,10 +257,10 @@ static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
 {
     if (r->br) { /* dense b: the walks from the index on the push's residual, q_i added */
         ulam_bidir_result *br = &a->bidir;
-        r->bwo.interrupt = r->o.interrupt, r->bwo.share = r->o.share;
-        int status = ulam_solve(r->M, r->br, &r->bwo, &br->walks, err);
+        r->bwo.stop.interrupt = r->o.stop.interrupt, r->bwo.exec.share = r->o.exec.share;
+        int status = ulam_solve_walks(r->M, r->br, &r->bwo, &br->walks, err);
         if (status) return status;
-        double qi = r->bq[r->bwo.index];
+        double qi = r->bq[r->bwo.query.index];
         br->push_part = qi, br->estimate = qi + br->walks.estimate, br->std_error = br->walks.std_error;
         br->ci95[0] = qi + br->walks.ci95[0], br->ci95[1] = qi + br->walks.ci95[1];
         br->plan = r->bplan, br->push = r->bplan.push;
@@ -269,7 +269,7 @@ static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
         a->estimate = br->estimate, a->std_error = br->std_error, a->ci95[0] = br->ci95[0], a->ci95[1] = br->ci95[1];
         return ULAM_OK;
     }
-    r->bo.walk.interrupt = r->o.interrupt, r->bo.walk.share = r->o.share;
+    r->bo.walk.stop.interrupt = r->o.stop.interrupt, r->bo.walk.exec.share = r->o.exec.share;
     int status = ulam_bidir_solve(r->w, r->Mt, &r->bo, &a->bidir, err);
     if (status) return status;
     a->walks = a->bidir.walks;

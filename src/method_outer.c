@@ -37,10 +37,10 @@ static ulam_outer_opts outer_opts(const ulam_walk_opts *w, int method)
 {
     ulam_outer_opts o = ulam_outer_defaults();
     o.method = method;
-    o.walk.seed = w->seed, o.walk.threads = w->threads, o.walk.continue_q = w->continue_q;
-    o.walk.max_steps = w->max_steps, o.walk.interrupt = w->interrupt, o.walk.share = w->share;
-    o.walk.force = w->force;
-    if (w->max_walks > 0) o.max_histories = w->max_walks;
+    o.walk.exec.seed = w->exec.seed, o.walk.exec.threads = w->exec.threads, o.walk.kernel.continue_q = w->kernel.continue_q;
+    o.walk.stop.max_steps = w->stop.max_steps, o.walk.stop.interrupt = w->stop.interrupt, o.walk.exec.share = w->exec.share;
+    o.walk.policy.force = w->policy.force;
+    if (w->stop.max_walks > 0) o.max_histories = w->stop.max_walks;
     return o;
 }
 
@@ -48,8 +48,8 @@ static ulam_outer_opts outer_opts(const ulam_walk_opts *w, int method)
 static int finish_outer(ulam_run *r, ulam_answer *a, ulam_error *err)
 {
     ulam_outer_opts o = outer_opts(&r->o, r->method - ULAM_METHOD_RICHARDSON);
-    if (r->o.index < 0 || r->o.index >= r->M->nrows)
-        return ulam__fail(err, ULAM_EINVAL, 0, r->o.index, "an index from 0 to %lld", (long long)r->M->nrows - 1);
+    if (r->o.query.index < 0 || r->o.query.index >= r->M->nrows)
+        return ulam__fail(err, ULAM_EINVAL, 0, r->o.query.index, "an index from 0 to %lld", (long long)r->M->nrows - 1);
     ulam_outer *s = NULL;
     int status = ulam_outer_alloc(r->M, r->b, &o, &s, err);
     int64_t histories = 0;
@@ -58,7 +58,7 @@ static int finish_outer(ulam_run *r, ulam_answer *a, ulam_error *err)
         status = ulam_outer_iterate(s, &st);
         a->iterations = st.iteration, a->residual = st.residual, histories += st.histories;
     }
-    if (s) a->estimate = ulam_outer_x(s)[r->o.index];
+    if (s) a->estimate = ulam_outer_x(s)[r->o.query.index];
     a->walks.walks = histories;
     ulam_outer_free(s);
     return status;
@@ -79,8 +79,8 @@ const ulam__method_type ulam__method_mcsa = {"mcsa", ULAM_ANSWERS_ALL, applies, 
 static int finish_krylov(ulam_run *r, ulam_answer *a, ulam_error *err)
 {
     ulam_outer_opts d = ulam_outer_defaults();
-    if (r->o.index < 0 || r->o.index >= r->M->nrows || r->M->nrows != r->M->ncols)
-        return ulam__fail(err, ULAM_EINVAL, 0, r->o.index, "a square M and an index from 0 to %lld",
+    if (r->o.query.index < 0 || r->o.query.index >= r->M->nrows || r->M->nrows != r->M->ncols)
+        return ulam__fail(err, ULAM_EINVAL, 0, r->o.query.index, "a square M and an index from 0 to %lld",
                           (long long)r->M->nrows - 1);
     if (r->method == ULAM_METHOD_CG && !ulam_csr_symmetric(r->M))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a symmetric M for cg (I - M symmetric positive definite): use gmres");
@@ -88,7 +88,7 @@ static int finish_krylov(ulam_run *r, ulam_answer *a, ulam_error *err)
     if (!x) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for x");
     int status = r->method == ULAM_METHOD_CG ? ulam_cg(r->M, r->b, d.tol, 100000, x, &a->iterations, &a->residual)
                                              : ulam_gmres(r->M, r->b, 30, d.tol, 100000, x, &a->iterations, &a->residual);
-    a->estimate = x[r->o.index];
+    a->estimate = x[r->o.query.index];
     free(x);
     if (status) ulam__fail(err, status, 0, -1, "a residual below %g within 100000 iterations", d.tol);
     return status;

@@ -23,13 +23,13 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     if (c >= 0) {
         ulam_walk_opts *o = &q->run->o;
         o->mode = au->cand[c].mode, o->estimator = au->cand[c].estimator;
-        o->continue_q = au->cand[c].continue_q, o->kernel_alpha = au->cand[c].kernel_alpha;
-        o->guard = NULL; /* the solver holds its own copy */
+        o->kernel.continue_q = au->cand[c].continue_q, o->kernel.kernel_alpha = au->cand[c].kernel_alpha;
+        o->policy.guard = NULL; /* the solver holds its own copy */
     }
     return status;
 }
 
-/* Pinned: a solver on the options as given (ulam_solve's run). */
+/* Pinned: a solver on the options as given (ulam_solve_walks's run). */
 static int pin(ulam__query *q, int k, ulam_error *err)
 {
     (void)k;
@@ -47,7 +47,7 @@ static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
     a->estimate = a->walks.estimate;
     a->std_error = a->walks.std_error;
     a->ci95[0] = a->walks.ci95[0], a->ci95[1] = a->walks.ci95[1]; /* NaN unless the variance is certified finite */
-    a->opts.guard = NULL;
+    a->opts.policy.guard = NULL;
     return status;
 }
 

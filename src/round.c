@@ -19,8 +19,8 @@ ulam_share ulam_share_defaults(void)
 /* Nonzero when a block starting at walk first may start. */
 int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first)
 {
-    if (o->interrupt && *o->interrupt) return 0;
-    return first == 0 || !(o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds);
+    if (o->stop.interrupt && *o->stop.interrupt) return 0;
+    return first == 0 || !(o->stop.max_seconds > 0 && ulam_now() - t0 >= o->stop.max_seconds);
 }
 
 /* Nonzero when this process runs block q. */
@@ -32,14 +32,14 @@ int ulam__mine(const ulam_share *sh, int64_t q)
 /* Nonzero when the walk budget is spent after `walks` walks or the stop flags say time is up. */
 static int budget_spent(const ulam_walk_opts *o, int stop, int64_t walks)
 {
-    return (stop & 1) || (o->max_walks > 0 && walks >= o->max_walks);
+    return (stop & 1) || (o->stop.max_walks > 0 && walks >= o->stop.max_walks);
 }
 
 /* This process's stop flags: 1 time is up, 2 interrupted. */
 static int local_stop(const ulam_walk_opts *o, double t0)
 {
-    int f = o->max_seconds > 0 && ulam_now() - t0 >= o->max_seconds ? 1 : 0;
-    return f | (o->interrupt && *o->interrupt ? 2 : 0);
+    int f = o->stop.max_seconds > 0 && ulam_now() - t0 >= o->stop.max_seconds ? 1 : 0;
+    return f | (o->stop.interrupt && *o->stop.interrupt ? 2 : 0);
 }
 
 /* Append n bytes to the buffer *buf of length *len and capacity *cap. */
@@ -61,11 +61,10 @@ static int pack(const void *blocks, const ulam__blocks *L, int nb, int64_t q0, c
     for (int64_t k = 0; k < nb && !status; k++) {
         if (!ulam__mine(sh, q0 + k)) continue;
         const unsigned char *b = (const unsigned char *)blocks + (size_t)k * L->size;
-        void *t;
-        memcpy(&t, b + L->off_ptr, sizeof t);
-        memcpy(&tlen, b + L->off_len, sizeof tlen);
+        const ulam__block_head *h = (const ulam__block_head *)b;
+        tlen = h->len;
         if (!(status = put(buf, len, &cap, &k, sizeof k)) && !(status = put(buf, len, &cap, b, L->size)))
-            status = put(buf, len, &cap, t, (size_t)tlen * L->tally_size);
+            status = put(buf, len, &cap, h->tally, (size_t)tlen * L->tally_size);
     }
     if (!status) memcpy(*buf, len, sizeof *len);
     return status;
@@ -79,24 +78,21 @@ static int unpack(const unsigned char *p, size_t n, void *blocks, const ulam__bl
     memcpy(head, p, sizeof head);
     *stop |= (int)head[1];
     for (size_t at = sizeof head; at < n;) {
-        int64_t k, tlen, cap;
+        int64_t k, tlen;
         if (n - at < sizeof k + L->size) return ULAM_EIO;
         memcpy(&k, p + at, sizeof k);
         if (k < 0 || k >= nb) return ULAM_EIO;
         unsigned char *b = (unsigned char *)blocks + (size_t)k * L->size;
-        void *t;
-        memcpy(&t, b + L->off_ptr, sizeof t);
-        memcpy(&cap, b + L->off_cap, sizeof cap);
+        ulam__block_head *h = (ulam__block_head *)b;
+        void *t = h->tally; /* the block keeps its own tally storage */
+        int64_t cap = h->cap;
         memcpy(b, p + at + sizeof k, L->size);
         at += sizeof k + L->size;
-        memcpy(&tlen, b + L->off_len, sizeof tlen);
-        memcpy(b + L->off_ptr, &t, sizeof t);
-        memcpy(b + L->off_cap, &cap, sizeof cap);
+        tlen = h->len;
+        h->tally = t, h->cap = cap;
         if (tlen < 0 || (uint64_t)tlen > (n - at) / L->tally_size) return ULAM_EIO;
-        if (ulam__grow(b + L->off_ptr, &cap, tlen, L->tally_size)) return ULAM_ENOMEM;
-        memcpy(b + L->off_cap, &cap, sizeof cap);
-        memcpy(&t, b + L->off_ptr, sizeof t);
-        if (tlen) memcpy(t, p + at, (size_t)tlen * L->tally_size);
+        if (ulam__grow(&h->tally, &h->cap, tlen, L->tally_size)) return ULAM_ENOMEM;
+        if (tlen) memcpy(h->tally, p + at, (size_t)tlen * L->tally_size);
         at += (size_t)tlen * L->tally_size;
     }
     return ULAM_OK;
@@ -107,7 +103,7 @@ static int unpack(const unsigned char *p, size_t n, void *blocks, const ulam__bl
 static int exchange(const ulam_walk_opts *o, double t0, void *blocks, const ulam__blocks *L, int nb, int64_t q0,
                     int *stop)
 {
-    const ulam_share *sh = o->share;
+    const ulam_share *sh = o->exec.share;
     *stop = local_stop(o, t0);
     if (!sh || sh->nranks <= 1) return ULAM_OK;
     unsigned char *mine = NULL;
@@ -138,7 +134,7 @@ static int exchange(const ulam_walk_opts *o, double t0, void *blocks, const ulam
 int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int threads, void *ctx,
                 void *results, int *nb, int *stop)
 {
-    int64_t left = o->max_walks > 0 ? o->max_walks - next : INT64_MAX, done = next / B->block;
+    int64_t left = o->stop.max_walks > 0 ? o->stop.max_walks - next : INT64_MAX, done = next / B->block;
     int round = done + 1 < B->round ? (int)(done + 1) : B->round, n = 0;
     while (n < round && left > (int64_t)n * B->block) n++;
     /* A team only for rounds of at least TEAM_BLOCKS blocks a thread: a small round (the first
@@ -163,20 +159,10 @@ void ulam__run_reset(ulam__run *run)
     *run = (ulam__run){.t0 = -1};
 }
 
-/* The int64 at offset off of block k in results. */
-static int64_t block_i64(const ulam__blocks *B, const void *results, int k, size_t off)
+/* Block k's head in results. */
+static const ulam__block_head *head(const ulam__blocks *B, const void *results, int k)
 {
-    int64_t v;
-    memcpy(&v, (const unsigned char *)results + (size_t)k * B->size + off, sizeof v);
-    return v;
-}
-
-/* The int at offset off of block k in results. */
-static int block_int(const ulam__blocks *B, const void *results, int k, size_t off)
-{
-    int v;
-    memcpy(&v, (const unsigned char *)results + (size_t)k * B->size + off, sizeof v);
-    return v;
+    return (const ulam__block_head *)((const unsigned char *)results + (size_t)k * B->size);
 }
 
 /* One round, its merge and the stopping rules but the relative error. */
@@ -189,14 +175,15 @@ int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads
     int nb, stop, st = ulam__round(B, o, run->t0, run->walks, threads, ctx, results, &nb, &stop);
     if (st) run->status = st;
     for (int k = 0; k < nb; k++) {
-        if (block_int(B, results, k, B->off_nomem)) run->status = ULAM_ENOMEM;
-        if (!block_int(B, results, k, B->off_complete)) { /* interrupted or out of time: keep what came before */
+        const ulam__block_head *h = head(B, results, k);
+        if (h->nomem) run->status = ULAM_ENOMEM;
+        if (!h->complete) { /* interrupted or out of time: keep what came before */
             run->done = 1;
             break;
         }
         B->merge(ctx, k);
-        run->walks += block_i64(B, results, k, B->off_walks);
-        run->nonfinite += block_i64(B, results, k, B->off_nonfinite);
+        run->walks += h->walks;
+        run->nonfinite += h->nonfinite;
     }
     run->seconds += ulam_now() - start;
     if (stop & 2) run->interrupted = run->done = 1;
@@ -212,9 +199,9 @@ int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err)
 {
     int status = ulam__walk_opts_check(o, err); /* src/check.c: NaN, +-inf, out of range */
     if (status) return status;
-    if (o->max_walks < 0 || o->rel_err < 0 || o->max_seconds < 0 || o->max_steps < 1 || o->threads < 0)
+    if (o->stop.max_walks < 0 || o->stop.rel_err < 0 || o->stop.max_seconds < 0 || o->stop.max_steps < 1 || o->exec.threads < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "nonnegative budgets and max_steps >= 1");
-    if (o->max_walks == 0 && o->rel_err == 0 && o->max_seconds == 0 && !o->interrupt)
+    if (o->stop.max_walks == 0 && o->stop.rel_err == 0 && o->stop.max_seconds == 0 && !o->stop.interrupt)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a stopping rule: walks, rel_err or time");
     return ULAM_OK;
 }
@@ -222,5 +209,5 @@ int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err)
 /* The walk cap: ULAM_REL_ERR_CAP with rel_err alone, else max_walks. */
 int64_t ulam__walk_cap(const ulam_walk_opts *o)
 {
-    return o->rel_err > 0 && o->max_walks == 0 && o->max_seconds == 0 ? ULAM_REL_ERR_CAP : o->max_walks;
+    return o->stop.rel_err > 0 && o->stop.max_walks == 0 && o->stop.max_seconds == 0 ? ULAM_REL_ERR_CAP : o->stop.max_walks;
 }

@@ -11,13 +11,23 @@
  * of time (t0: when the run started). */
 int ulam__block_may_start(const ulam_walk_opts *o, double t0, int64_t first);
 
+/* What every block struct opens with, the part the round driver reads (Lua's CommonHeader): a
+ * block struct embeds it as its first member, so the driver reads any solver's blocks through
+ * it.  The tallies (tally_size bytes each, behind a pointer, a length and a capacity) are sent
+ * between processes after the struct; walks and non-finite scores are what the block ran;
+ * complete is 0 when it was interrupted, out of time or out of memory, and nomem 1 when a
+ * tally list could not grow (the run fails with ULAM_ENOMEM). */
+typedef struct {
+    void *tally;
+    int64_t len, cap;
+    int64_t walks, nonfinite;
+    int complete, nomem;
+} ulam__block_head;
+
 /* A block-parallel walk run as the round driver sees it: blocks of `block` walks, at most
  * `round` a round; block k runs as run(ctx, k, its first walk, its walk count, thread) and
- * leaves its result in the k-th struct of the caller's array, `size` bytes each, whose tallies
- * (tally_size bytes each) sit behind a pointer, a length and a capacity (int64) at the offsets
- * given, so results can be sent between processes.  Every block struct also holds its walks
- * and non-finite scores (int64) and its complete and nomem flags (int) at the offsets given;
- * merge(ctx, k) adds the k-th completed block to the solver's own totals; begin(ctx), when
+ * leaves its result in the k-th struct of the caller's array, `size` bytes each, which opens
+ * with a ulam__block_head; merge(ctx, k) adds the k-th completed block to the solver's own totals; begin(ctx), when
  * given, runs before each round inside its time (the matrix solver completes its kernel
  * there); failure(ctx), when given, is a status that fails the whole run once a round ran (a
  * corrupt matrix row), or ULAM_OK. */
@@ -25,8 +35,6 @@ typedef struct {
     int block, round;
     void (*run)(void *ctx, int k, int64_t first, int64_t count, int thread);
     size_t size, tally_size;
-    size_t off_ptr, off_len, off_cap;
-    size_t off_walks, off_nonfinite, off_complete, off_nomem;
     void (*merge)(void *ctx, int k);
     void (*begin)(void *ctx);
     int (*failure)(void *ctx);
@@ -35,7 +43,7 @@ typedef struct {
 /* Where a walk run stands between rounds, the part of a solver the round driver keeps: walks
  * merged (the next round starts there), of them non-finite scores, when the run started (t0,
  * -1 before its first round), seconds spent in rounds, and its ending: done once a stopping
- * rule is met or the run failed (status), interrupted by o->interrupt.  Zeroed, with t0 = -1,
+ * rule is met or the run failed (status), interrupted by o->stop.interrupt.  Zeroed, with t0 = -1,
  * it is a run not yet started (ulam__run_reset). */
 typedef struct {
     int64_t walks, nonfinite;
@@ -46,8 +54,8 @@ typedef struct {
 /* A run not yet started. */
 void ulam__run_reset(ulam__run *run);
 
-/* One round from walk `next` (no further than o->max_walks), shared dynamically among
- * `threads`, its *nb block results left in results[].  With o->share, every process's blocks
+/* One round from walk `next` (no further than o->stop.max_walks), shared dynamically among
+ * `threads`, its *nb block results left in results[].  With o->exec.share, every process's blocks
  * are then exchanged so all hold all of them.  *stop gets the stop flags (1: time is up,
  * 2: interrupted), or'ed over the processes.  ULAM_OK, ULAM_ENOMEM or ULAM_EIO (the exchange
  * failed; *nb is then 0). */
@@ -59,8 +67,8 @@ int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64
  * completed blocks merged in block order (B->merge; the first incomplete block, interrupted or
  * out of time, ends the run with what came before it), and run's ending updated: a failed
  * exchange, a block out of memory, B->failure or a non-finite score fail the run
- * (ULAM_ENONFINITE only when nothing else did); an interrupt, the walk budget (o->max_walks)
- * or the time limit (o->max_seconds) end it.  The solver then applies its own rel_err rule.
+ * (ULAM_ENONFINITE only when nothing else did); an interrupt, the walk budget (o->stop.max_walks)
+ * or the time limit (o->stop.max_seconds) end it.  The solver then applies its own rel_err rule.
  * Returns run->status. */
 int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads, void *ctx, void *results,
                      ulam__run *run);
@@ -73,7 +81,7 @@ int ulam__mine(const ulam_share *sh, int64_t q);
 int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err);
 
 /* The walk cap of a run whose only stopping rule is rel_err: ULAM_REL_ERR_CAP (a target out of
- * reach still ends), else o->max_walks. */
+ * reach still ends), else o->stop.max_walks. */
 int64_t ulam__walk_cap(const ulam_walk_opts *o);
 
 #endif /* ULAM_ROUND_H */

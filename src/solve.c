@@ -17,7 +17,11 @@
 #include <string.h>
 
 /* Walks per block, blocks per round, split-stack entries per thread; kernels up to CACHED
- * bytes (this machine's L2) walk 16 histories interleaved, larger ones 32 (measured best).
+ * bytes walk 16 histories interleaved, larger ones 32 (measured best on a machine with a 2 MiB
+ * L2).  CACHED is a fixed tunable (docs/tunables.md), not the running machine's L2: a block's
+ * interleaved histories draw from the block's one generator in lane order, so the lane count
+ * decides which numbers each history draws, and a threshold measured at start-up would give one
+ * seed different walks on machines with different caches.
  * Once walks have built 1 / COMPLETE of the kernel row by row, the rest is built at once: a
  * row built at a first visit costs about 3 times one built in the whole streaming pass
  * (measured, n = 10^6 .. 10^7), so by then the run has spent on row-by-row building about
@@ -95,8 +99,39 @@ struct ulam_solver {
 /* The defaults. */
 ulam_walk_opts ulam_walk_defaults(void)
 {
-    return (ulam_walk_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_COLLISION, .seed = 1,
-                            .max_walks = 100000, .max_steps = 1000000, .kernel_alpha = 1.0};
+    return (ulam_walk_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_COLLISION, .kernel = ulam_kernel_defaults(),
+                            .stop = ulam_stop_defaults(), .exec = ulam_exec_defaults(),
+                            .query = ulam_query_defaults(), .policy = ulam_policy_defaults()};
+}
+
+/* The kernel's defaults: analog, exponent 1, rows built as reached, no window. */
+ulam_kernel_opts ulam_kernel_defaults(void)
+{
+    return (ulam_kernel_opts){.kernel_alpha = 1.0};
+}
+
+/* The stopping defaults: 10^5 walks, 10^6 steps a walk. */
+ulam_stop_opts ulam_stop_defaults(void)
+{
+    return (ulam_stop_opts){.max_walks = 100000, .max_steps = 1000000};
+}
+
+/* The execution defaults: seed 1, all cores, one process. */
+ulam_exec_opts ulam_exec_defaults(void)
+{
+    return (ulam_exec_opts){.seed = 1};
+}
+
+/* The query defaults: x_0. */
+ulam_query_opts ulam_query_defaults(void)
+{
+    return (ulam_query_opts){.index = 0};
+}
+
+/* The policy defaults: refuse the uncertified, compute the guards. */
+ulam_policy_opts ulam_policy_defaults(void)
+{
+    return (ulam_policy_opts){.force = 0};
 }
 
 /* Free a solver; accepts and returns NULL. */
@@ -116,7 +151,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
     if (s->ks)
         for (int t = 0; t < s->threads; t++) ulam__kscratch_free(&s->ks[t]);
     if (s->blocks)
-        for (int q = 0; q < ROUND; q++) free(s->blocks[q].t.t);
+        for (int q = 0; q < ROUND; q++) free(s->blocks[q].h.tally);
     free(s->scratch), free(s->ks), free(s->blocks);
     free(s);
     return NULL;
@@ -133,26 +168,26 @@ static int check_opts(const ulam_csr *M, const ulam_walk_opts *o, ulam_error *er
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "mode adjoint or forward");
     if (o->estimator < ULAM_COLLISION || o->estimator > ULAM_EXPECTED)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "estimator collision, absorption or expected");
-    if (o->index < 0 || o->index >= M->nrows)
-        return ulam__fail(err, ULAM_EINVAL, 0, o->index, "an index from 0 to %lld", (long long)M->nrows - 1);
-    if (o->nstarts < 0 || (o->nstarts > 0 && (o->mode != ULAM_ADJOINT || !o->starts || !o->start_weights ||
-                                              o->nstarts > INT32_MAX)))
+    if (o->query.index < 0 || o->query.index >= M->nrows)
+        return ulam__fail(err, ULAM_EINVAL, 0, o->query.index, "an index from 0 to %lld", (long long)M->nrows - 1);
+    if (o->query.nstarts < 0 || (o->query.nstarts > 0 && (o->mode != ULAM_ADJOINT || !o->query.starts || !o->query.start_weights ||
+                                              o->query.nstarts > INT32_MAX)))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "start states and weights in adjoint mode");
     double S = 0.0;
-    for (int64_t j = 0; j < o->nstarts; j++) {
-        if (o->starts[j] < 0 || o->starts[j] >= M->nrows || !isfinite(o->start_weights[j]))
+    for (int64_t j = 0; j < o->query.nstarts; j++) {
+        if (o->query.starts[j] < 0 || o->query.starts[j] >= M->nrows || !isfinite(o->query.start_weights[j]))
             return ulam__fail(err, ULAM_EINVAL, 0, j, "start states from 0 to %lld with finite weights",
                               (long long)M->nrows - 1);
-        S += fabs(o->start_weights[j]);
+        S += fabs(o->query.start_weights[j]);
     }
-    if (o->nstarts > 0 && !(S > 0 && isfinite(S)))
+    if (o->query.nstarts > 0 && !(S > 0 && isfinite(S)))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "start weights with a finite nonzero sum of |weights|");
-    if (o->continue_q > 0 && !(o->continue_q < 1))
+    if (o->kernel.continue_q > 0 && !(o->kernel.continue_q < 1))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a continuation probability below 1");
-    if (!(o->kernel_alpha >= 0) || !isfinite(o->kernel_alpha))
+    if (!(o->kernel.kernel_alpha >= 0) || !isfinite(o->kernel.kernel_alpha))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a kernel exponent alpha that is finite and >= 0 (got %g)",
-                          o->kernel_alpha);
-    if (o->roulette < 0 || o->split < 0 || (o->split > 0 && o->roulette > 0 && o->split <= o->roulette))
+                          o->kernel.kernel_alpha);
+    if (o->kernel.roulette < 0 || o->kernel.split < 0 || (o->kernel.split > 0 && o->kernel.roulette > 0 && o->kernel.split <= o->kernel.roulette))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "0 < roulette W < split W (or either off)");
     return ulam__budgets_check(o, err);
 }
@@ -165,8 +200,8 @@ static double start_weight(const ulam_walk_opts *o, const double *b, int64_t n)
     if (o->mode == ULAM_FORWARD)
         for (int64_t i = 0; i < n; i++) w0 += fabs(b[i]);
     else
-        for (int64_t j = 0; j < o->nstarts; j++) w0 += fabs(o->start_weights[j]);
-    return o->mode == ULAM_ADJOINT && o->nstarts == 0 ? 1.0 : w0;
+        for (int64_t j = 0; j < o->query.nstarts; j++) w0 += fabs(o->query.start_weights[j]);
+    return o->mode == ULAM_ADJOINT && o->query.nstarts == 0 ? 1.0 : w0;
 }
 
 /* Refuse a split weight below the start weight (1 adjoint, ||b||_1 forward): every walk would
@@ -174,13 +209,13 @@ static double start_weight(const ulam_walk_opts *o, const double *b, int64_t n)
  * 11 s for 1000 walks), which is unbiased but no longer the run asked for. */
 static int check_split(const ulam_csr *M, const double *b, const ulam_walk_opts *o, ulam_error *err)
 {
-    if (!(o->split > 0)) return ULAM_OK;
+    if (!(o->kernel.split > 0)) return ULAM_OK;
     double w0 = start_weight(o, b, M->nrows);
-    if (o->split >= w0) return ULAM_OK;
+    if (o->kernel.split >= w0) return ULAM_OK;
     return ulam__fail(err, ULAM_EINVAL, 0, -1,
                       "a split weight of at least the start weight %.6g (%s), not %g: below it every walk splits "
                       "into ceil(%.6g / W) copies at its first step",
-                      w0, o->mode == ULAM_ADJOINT ? "1 in adjoint mode" : "||b||_1 in forward mode", o->split, w0);
+                      w0, o->mode == ULAM_ADJOINT ? "1 in adjoint mode" : "||b||_1 in forward mode", o->kernel.split, w0);
 }
 
 /* The sum of |K| over row i. */
@@ -275,16 +310,16 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const doubl
     double *g = ulam__malloc((size_t)n, sizeof *g), *v = ulam__malloc((size_t)n, sizeof *v);
     double *y = ulam__malloc((size_t)n, sizeof *y), *f = ulam__malloc((size_t)n, sizeof *f), best = INFINITY;
     double b0 = 0.0, gmax = 0.0;
-    for (int64_t j = 0; adj && s->o.estimator == ULAM_EXPECTED && j < (s->o.nstarts ? s->o.nstarts : 1); j++)
-        b0 = fmax(b0, fabs(s->b[s->o.nstarts ? s->o.starts[j] : s->o.index]));
+    for (int64_t j = 0; adj && s->o.estimator == ULAM_EXPECTED && j < (s->o.query.nstarts ? s->o.query.nstarts : 1); j++)
+        b0 = fmax(b0, fabs(s->b[s->o.query.nstarts ? s->o.query.starts[j] : s->o.query.index]));
     for (int64_t i = 0; g && v && y && f && i < n; i++) {
         g[i] = 0.0;
         if (!seen[i]) continue;
-        double S = row_sum(K, i), q = ulam__continuation(S, s->o.continue_q), c = 0.0;
-        f[i] = ulam__factor(S, s->o.continue_q);
+        double S = row_sum(K, i), q = ulam__continuation(S, s->o.kernel.continue_q), c = 0.0;
+        f[i] = ulam__factor(S, s->o.kernel.continue_q);
         for (int64_t k = K->rowptr[i]; adj && s->o.estimator == ULAM_EXPECTED && k < K->rowptr[i + 1]; k++)
             c += K->val[k] * s->b[K->colidx[k]];
-        double a = adj ? (s->o.estimator == ULAM_EXPECTED ? fabs(c) + b0 : fabs(s->b[i])) : i == s->o.index;
+        double a = adj ? (s->o.estimator == ULAM_EXPECTED ? fabs(c) + b0 : fabs(s->b[i])) : i == s->o.query.index;
         g[i] = absorb ? (a != 0.0 ? a * a / (1.0 - q) : 0.0) : a * a;
         gmax = fmax(gmax, g[i]);
     }
@@ -301,9 +336,9 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const doubl
                     t += fabs(K->val[k]) * (fac ? fac[k] : 1.0) * v[K->colidx[k]];
                 y[i] = fac ? t : t * f[i];
                 u = fmax(u, y[i] / v[i]), c = fmax(c, g[i] / v[i]), ymax = fmax(ymax, y[i] + v[i]);
-                z0 += adj ? (i == s->o.index && !s->o.nstarts ? v[i] : 0.0) : fabs(s->b[i]) / w0 * v[i];
+                z0 += adj ? (i == s->o.query.index && !s->o.query.nstarts ? v[i] : 0.0) : fabs(s->b[i]) / w0 * v[i];
             }
-            for (int64_t j = 0; adj && j < s->o.nstarts; j++) z0 += fabs(s->o.start_weights[j]) / w0 * v[s->o.starts[j]];
+            for (int64_t j = 0; adj && j < s->o.query.nstarts; j++) z0 += fabs(s->o.query.start_weights[j]) / w0 * v[s->o.query.starts[j]];
             if (u < 1.0) {
                 double d = absorb ? 1.0 - u : (1.0 - sqrt(u)) * (1.0 - sqrt(u)), bound = w0 * w0 * c * z0 / d;
                 if (bound < best * (1.0 - 1e-3)) last = it;
@@ -358,7 +393,7 @@ static int verify_all(const ulam_csr *M, const ulam_walk_opts *o, const ulam__ro
 {
     int64_t bad = -1;
     if (!ulam__rows_verify(rc, 0, M->nrows, &bad)) return ULAM_OK;
-    return o->system && ulam__system_row_error(o->system, bad, err) ? ULAM_ESYNTAX
+    return o->policy.system && ulam__system_row_error(o->policy.system, bad, err) ? ULAM_ESYNTAX
                                                                     : ulam__fail(err, ULAM_ESYNTAX, 0, bad, "an intact prepared file");
 }
 
@@ -367,7 +402,7 @@ static int verify_all(const ulam_csr *M, const ulam_walk_opts *o, const ulam__ro
 static const ulam__reach *given_bounds(const ulam_solver *s, const ulam_csr *K)
 {
     const ulam__reach *g = s->given;
-    return g && g->bounds && g->K == K && g->continue_q == fmax(s->o.continue_q, 0.0) && g->alpha == s->o.kernel_alpha
+    return g && g->bounds && g->K == K && g->continue_q == fmax(s->o.kernel.continue_q, 0.0) && g->alpha == s->o.kernel.kernel_alpha
                ? g
                : NULL;
 }
@@ -409,13 +444,13 @@ static int reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     }
     char *seen = ulam__calloc((size_t)s->n, 1);
     if (!seen) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a reachability check");
-    if (s->o.mode == ULAM_ADJOINT && !s->o.nstarts) seen[s->o.index] = 1;
-    for (int64_t j = 0; s->o.mode == ULAM_ADJOINT && j < s->o.nstarts; j++) seen[s->o.starts[j]] = 1;
+    if (s->o.mode == ULAM_ADJOINT && !s->o.query.nstarts) seen[s->o.query.index] = 1;
+    for (int64_t j = 0; s->o.mode == ULAM_ADJOINT && j < s->o.query.nstarts; j++) seen[s->o.query.starts[j]] = 1;
     if (s->o.mode == ULAM_FORWARD)
         for (int64_t i = 0; i < s->n; i++) seen[i] = s->b[i] != 0.0;
     int64_t bad = -1;
-    int status = ulam__kernel_reach(K, s->o.continue_q, seen, &s->rc, &bad);
-    if (status == ULAM_ESYNTAX && s->o.system && ulam__system_row_error(s->o.system, bad, err)) {
+    int status = ulam__kernel_reach(K, s->o.kernel.continue_q, seen, &s->rc, &bad);
+    if (status == ULAM_ESYNTAX && s->o.policy.system && ulam__system_row_error(s->o.policy.system, bad, err)) {
         free(seen);
         return ULAM_ESYNTAX; /* a damaged block of the prepared file, named */
     }
@@ -448,8 +483,8 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     if (status) return status;
     const char *seen = s->reached;
     double *fac = NULL; /* kernel exponent != 1: each move's own weight factor (kept: s->fac) */
-    if (!given && s->o.kernel_alpha != 1.0 &&
-        !(fac = s->fac = move_factors(K, seen, s->o.continue_q, s->o.kernel_alpha)))
+    if (!given && s->o.kernel.kernel_alpha != 1.0 &&
+        !(fac = s->fac = move_factors(K, seen, s->o.kernel.continue_q, s->o.kernel.kernel_alpha)))
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
     int pos = 0, neg = given ? given->neg : 0, any = 0;
     int need_q = !given || only == ULAM_ABSORPTION, need_c = adj && (!given || only == ULAM_EXPECTED);
@@ -462,10 +497,10 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     }
     for (int64_t i = 0; !summary && i < s->n; i++) {
         if (!seen[i] || (given && only != ULAM_EXPECTED && s->b[i] == 0.0)) continue; /* scores nothing here */
-        double S = need_q ? row_sum(K, i) : 0.0, q = need_q ? ulam__continuation(S, s->o.continue_q) : 0.0, c = 0.0;
+        double S = need_q ? row_sum(K, i) : 0.0, q = need_q ? ulam__continuation(S, s->o.kernel.continue_q) : 0.0, c = 0.0;
         if (need_q || need_c) reads += K->rowptr[i + 1] - K->rowptr[i];
         if (!given) {
-            if (!fac) fbig = fmax(fbig, ulam__factor(S, s->o.continue_q));
+            if (!fac) fbig = fmax(fbig, ulam__factor(S, s->o.kernel.continue_q));
             qmax = fmax(qmax, q);
         }
         for (int64_t k = K->rowptr[i]; (!given || need_c) && k < K->rowptr[i + 1]; k++) {
@@ -475,9 +510,9 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
         }
         if ((adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
         /* what one visit scores: b_i (collision), (M b)_i (expected), forward 1 at the index */
-        vb = fmax(vb, adj ? fabs(s->b[i]) : i == s->o.index ? 1.0 : 0.0);
-        vexp = fmax(vexp, adj ? fabs(c) : i == s->o.index ? INFINITY : 0.0);
-        int scores = adj ? s->b[i] != 0.0 : i == s->o.index;
+        vb = fmax(vb, adj ? fabs(s->b[i]) : i == s->o.query.index ? 1.0 : 0.0);
+        vexp = fmax(vexp, adj ? fabs(c) : i == s->o.query.index ? INFINITY : 0.0);
+        int scores = adj ? s->b[i] != 0.0 : i == s->o.query.index;
         if (!scores) continue;
         double g = adj ? fabs(s->b[i]) : 1.0;
         any = 1;
@@ -487,9 +522,9 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     }
     if (!adj)
         for (int64_t i = 0; i < s->n; i++) pos |= s->b[i] > 0, neg |= s->b[i] < 0;
-    for (int64_t j = 0; adj && j < s->o.nstarts; j++) /* signed start weights (conservative: both may show) */
-        pos |= s->o.start_weights[j] > 0, neg |= s->o.start_weights[j] < 0;
-    double G = given ? given->growth : fbig > 1.0 ? weight_growth(K, s->o.continue_q, fac, seen) : 1.0;
+    for (int64_t j = 0; adj && j < s->o.query.nstarts; j++) /* signed start weights (conservative: both may show) */
+        pos |= s->o.query.start_weights[j] > 0, neg |= s->o.query.start_weights[j] < 0;
+    double G = given ? given->growth : fbig > 1.0 ? weight_growth(K, s->o.kernel.continue_q, fac, seen) : 1.0;
     w0 = start_weight(&s->o, s->b, s->n);
     for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++) {
         int absorb = e == ULAM_ABSORPTION;
@@ -501,7 +536,7 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
             s->pass[e].vmax = s->pass[e].gmax = s->pass[e].g2max = INFINITY;
     }
     s->pass_w0 = w0;
-    s->pass_W = !(s->o.split > 0) ? (s->o.roulette > w0 ? s->o.roulette : w0) * G : INFINITY;
+    s->pass_W = !(s->o.kernel.split > 0) ? (s->o.kernel.roulette > w0 ? s->o.kernel.roulette : w0) * G : INFINITY;
     s->pass_qmax = qmax;
     s->pass_signs = pos && neg;
     s->passed = 1, s->pass_only = only;
@@ -533,19 +568,19 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
                           "collision estimator or --continue Q",
                           (long long)s->pass[e].bad + 1, adj ? "M" : "M' (column of M)");
     s->tail_u = 1.0, s->kappa = INFINITY, s->visit = w0 * vmax, s->v2 = INFINITY;
-    if (vmax > 0 && (!(s->pass_qmax < TAIL_Q) || (!isfinite(Wmax) && s->o.rel_err > 0))) {
+    if (vmax > 0 && (!(s->pass_qmax < TAIL_Q) || (!isfinite(Wmax) && s->o.stop.rel_err > 0))) {
         if (!s->tail_done && given && given->tail) /* the caller's certificate over the same states */
             s->tail_uc = given->tail_u, s->tail_kc = given->kappa, s->tail_done = 1;
         if (!s->tail_done && (status = reached_flags(s, err))) return status;
         if (!s->tail_done) /* kappa enters by its log */
-            length_tail(K, s->reached, s->o.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
+            length_tail(K, s->reached, s->o.kernel.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
         s->tail_u = s->tail_uc, s->kappa = s->tail_kc;
     }
-    if (vmax > 0 && !isfinite(Wmax) && !(s->o.roulette > 0) && !(s->o.split > 0) &&
+    if (vmax > 0 && !isfinite(Wmax) && !(s->o.kernel.roulette > 0) && !(s->o.kernel.split > 0) &&
         (absorb ? isfinite(s->pass[e].g2max) : isfinite(vmax))) {
         if (!s->v2_done[e] && (status = reached_flags(s, err))) return status;
-        if (!s->v2_done[e] && s->o.kernel_alpha != 1.0 && !s->fac &&
-            !(s->fac = move_factors(K, s->reached, s->o.continue_q, s->o.kernel_alpha))) /* given bounds: not made */
+        if (!s->v2_done[e] && s->o.kernel.kernel_alpha != 1.0 && !s->fac &&
+            !(s->fac = move_factors(K, s->reached, s->o.kernel.continue_q, s->o.kernel.kernel_alpha))) /* given bounds: not made */
             return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
         if (!s->v2_done[e]) s->v2c[e] = second_moment(s, K, s->fac, s->reached, w0, &it), s->v2_done[e] = 1;
         s->v2 = s->v2c[e];
@@ -619,7 +654,7 @@ static int check_bounded(const ulam_solver *s, ulam_error *err)
     if (isfinite(s->v2) || (absorb ? isfinite(s->range) : isfinite(s->per_step) && t < 1.0)) return ULAM_OK;
     const char *why = !isfinite(s->per_step) && !absorb && s->o.mode == ULAM_FORWARD && s->o.estimator == ULAM_EXPECTED
                           ? "the forward expected estimator's tallies have no per-visit bound"
-                      : s->o.split > 0 ? "splitting leaves the weights without a bound"
+                      : s->o.kernel.split > 0 ? "splitting leaves the weights without a bound"
                       : !isfinite(s->per_step) ? "a reachable cycle of weight factors S/q > 1 lets weights grow without "
                                                  "bound, and no second-moment certificate holds"
                                                : "a reachable row of |M| sums to 1 or more and no Collatz-Wielandt vector "
@@ -638,7 +673,7 @@ static int score_bounded(const ulam_solver *s)
     if (s->bound == 0.0 || s->per_step == 0.0) return 1;
     if (s->o.estimator == ULAM_ABSORPTION) return isfinite(s->range);
     return isfinite(s->per_step) &&
-           (s->qmax < 1.0 || (s->o.kernel_alpha == 1.0 && s->tail_u < 1.0 && isfinite(s->kappa)));
+           (s->qmax < 1.0 || (s->o.kernel.kernel_alpha == 1.0 && s->tail_u < 1.0 && isfinite(s->kappa)));
 }
 
 /* The fourth-moment verdict of a rel_err run (after check_reach): 1 when the score is bounded,
@@ -647,12 +682,12 @@ static int score_bounded(const ulam_solver *s)
 static int take_fourth(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 {
     s->fourth = -1;
-    if (!(s->o.rel_err > 0)) return ULAM_OK;
+    if (!(s->o.stop.rel_err > 0)) return ULAM_OK;
     if (score_bounded(s)) return s->fourth = 1, ULAM_OK;
     if (!s->rho4_done) {
         int status = s->o.mode == ULAM_ADJOINT ? verify_all(s->M, &s->o, &s->rc, err) : ULAM_OK; /* it reads all of K */
         if (status) return status;
-        status = ulam__guard_fourth(K, s->o.continue_q, s->o.kernel_alpha,
+        status = ulam__guard_fourth(K, s->o.kernel.continue_q, s->o.kernel.kernel_alpha,
                                         s->g.computed & ULAM_GUARD_ABS ? &s->g.abs : NULL, &s->rho4, err);
         if (status) return status;
         s->rho4_done = 1;
@@ -670,15 +705,15 @@ static int take_fourth(ulam_solver *s, const ulam_csr *K, ulam_error *err)
 static int check_fourth(const ulam_csr *M, const ulam_solver *s, ulam_error *err)
 {
     const ulam_walk_opts *o = &s->o;
-    if (s->fourth == 1 || isfinite(s->v2) || !(o->rel_err > 0)) return ULAM_OK; /* v2: the rule stands on it */
+    if (s->fourth == 1 || isfinite(s->v2) || !(o->stop.rel_err > 0)) return ULAM_OK; /* v2: the rule stands on it */
     char also[96] = "; no other mode or alpha 1 has it below 1";
     ulam_csr *T = NULL;
     if (!verify_all(M, o, &s->rc, NULL) && !ulam_csr_transpose(M, &T)) {
         const int modes[3] = {1 - o->mode, o->mode, 1 - o->mode};
-        const double alphas[3] = {o->kernel_alpha, 1.0, 1.0};
-        for (int c = 0; c < (o->kernel_alpha != 1.0 ? 3 : 1); c++) {
+        const double alphas[3] = {o->kernel.kernel_alpha, 1.0, 1.0};
+        for (int c = 0; c < (o->kernel.kernel_alpha != 1.0 ? 3 : 1); c++) {
             ulam_power p;
-            if (!ulam__guard_fourth(modes[c] == ULAM_ADJOINT ? M : T, o->continue_q, alphas[c], NULL, &p, NULL) &&
+            if (!ulam__guard_fourth(modes[c] == ULAM_ADJOINT ? M : T, o->kernel.continue_q, alphas[c], NULL, &p, NULL) &&
                 p.upper < 1.0) {
                 snprintf(also, sizeof also, "; %s at alpha %g has it finite, %.3g < 1",
                          modes[c] == ULAM_ADJOINT ? "adjoint" : "forward", alphas[c], p.upper);
@@ -691,7 +726,7 @@ static int check_fourth(const ulam_csr *M, const ulam_solver *s, ulam_error *err
                       "a finite fourth moment for a relative-error target: scores unbounded (%s), rho(M4) of the %s "
                       "kernel at alpha %g in [%.4g, %.4g] (%s): variance_rel_error errs low%s",
                       isfinite(s->weight) ? "no certified length tail" : "weights grow on cycles",
-                      o->mode == ULAM_ADJOINT ? "adjoint" : "forward", o->kernel_alpha, s->rho4.lower, s->rho4.upper,
+                      o->mode == ULAM_ADJOINT ? "adjoint" : "forward", o->kernel.kernel_alpha, s->rho4.lower, s->rho4.upper,
                       s->fourth == 0 ? ">= 1: infinite" : "straddles 1: unknown", also);
 }
 
@@ -715,15 +750,15 @@ static int take_guard(const ulam_csr *M, const ulam_walk_opts *o, const ulam__ro
                       ulam_error *err)
 {
     int need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(o->mode);
-    if (ulam__guard_fits(o->guard, o->continue_q, o->kernel_alpha, need)) { /* src/guard.c */
-        *g = *o->guard;
+    if (ulam__guard_fits(o->policy.guard, o->kernel.continue_q, o->kernel.kernel_alpha, need)) { /* src/guard.c */
+        *g = *o->policy.guard;
         return ULAM_OK;
     }
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = need;
-    go.kernel_alpha = o->kernel_alpha;
+    go.kernel_alpha = o->kernel.kernel_alpha;
     int status = verify_all(M, o, rc, err); /* the guards read all of M */
-    return status ? status : ulam_guard_check(M, o->continue_q, &go, g, err);
+    return status ? status : ulam_guard_check(M, o->kernel.continue_q, &go, g, err);
 }
 
 /* Refuse what the verdicts refuse: walks not certified to converge (unless force), a
@@ -732,26 +767,26 @@ static int check_verdicts(const ulam_csr *M, ulam_solver *s, ulam_error *err)
 {
     const ulam_walk_opts *o = &s->o;
     const ulam_power *a = &s->g.abs, *h = &s->g.hat[o->mode];
-    if (s->g.verdict_abs >= ULAM_VERDICT_FAIL && !o->force)
+    if (s->g.verdict_abs >= ULAM_VERDICT_FAIL && !o->policy.force)
         return ulam__fail(err, ULAM_EDIVERGE, 0, -1,
                           "rho(|M|) certified below 1; its bounds are [%.6g, %.6g]%s: the walks' expected score "
                           "may be a divergent series (force walks anyway)", a->lower, a->upper,
                           s->g.verdict_abs == ULAM_VERDICT_FAIL ? "" : ", not certain either way");
     s->var_finite = ulam_guard_variance(&s->g, o->mode);
-    if (s->var_finite < 0 && o->assume_finite) s->var_finite = 1;
-    if (s->var_finite == 1 || !(o->rel_err > 0) || o->max_walks > 0 || o->max_seconds > 0) return ULAM_OK;
+    if (s->var_finite < 0 && o->policy.assume_finite) s->var_finite = 1;
+    if (s->var_finite == 1 || !(o->stop.rel_err > 0) || o->stop.max_walks > 0 || o->stop.max_seconds > 0) return ULAM_OK;
     int other = 1 - o->mode;
     ulam_guard og = s->g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_HAT(other);
-    go.kernel_alpha = o->kernel_alpha;
-    if (!(og.computed & go.need) && ulam_guard_check(M, o->continue_q, &go, &og, NULL)) og.verdict_hat[other] = ULAM_VERDICT_UNKNOWN;
+    go.kernel_alpha = o->kernel.kernel_alpha;
+    if (!(og.computed & go.need) && ulam_guard_check(M, o->kernel.continue_q, &go, &og, NULL)) og.verdict_hat[other] = ULAM_VERDICT_UNKNOWN;
     char also[96] = "; the other mode's is not certified finite either";
     if (ulam_guard_variance(&og, other) == 1)
         snprintf(also, sizeof also, "; the %s mode's is finite, %.4g < 1", other == ULAM_ADJOINT ? "adjoint" : "forward",
                  og.hat[other].upper);
     char alpha[48] = "";
-    if (o->kernel_alpha != 1.0) snprintf(alpha, sizeof alpha, " at kernel exponent alpha = %g", o->kernel_alpha);
+    if (o->kernel.kernel_alpha != 1.0) snprintf(alpha, sizeof alpha, " at kernel exponent alpha = %g", o->kernel.kernel_alpha);
     return ulam__fail(err, ULAM_EINFVAR, 0, -1,
                       "a finite variance for a relative-error target: rho(M^) of the %s kernel%s is in [%.4g, %.4g] (%s)%s",
                       o->mode == ULAM_ADJOINT ? "adjoint" : "forward", alpha, h->lower, h->upper,
@@ -786,7 +821,7 @@ static int build_source(ulam_solver *s, double *bnorm1)
  * their rows' units and (expected estimator) their b. */
 static int build_starts(ulam_solver *s)
 {
-    int64_t k = s->o.nstarts;
+    int64_t k = s->o.query.nstarts;
     double *p = ulam__malloc((size_t)k, sizeof *p), *scaled = ulam__malloc((size_t)k, sizeof *scaled);
     int32_t *out = ulam__malloc((size_t)k, sizeof *out);
     int64_t *small = ulam__malloc((size_t)k, sizeof *small), *large = ulam__malloc((size_t)k, sizeof *large);
@@ -797,10 +832,10 @@ static int build_starts(ulam_solver *s)
     if (p && scaled && out && small && large && s->start_src && s->start_units && s->start_b) {
         double norm = start_weight(&s->o, s->b, s->n);
         for (int64_t j = 0; j < k; j++) {
-            p[j] = fabs(s->o.start_weights[j]) / norm;
-            out[j] = s->o.start_weights[j] < 0 ? ~(int32_t)j : (int32_t)j;
-            s->start_units[j] = ulam__kernel_unit(s->k, s->o.starts[j], &s->ks[0]);
-            s->start_b[j] = s->o.estimator == ULAM_EXPECTED ? s->b[s->o.starts[j]] : 0.0;
+            p[j] = fabs(s->o.query.start_weights[j]) / norm;
+            out[j] = s->o.query.start_weights[j] < 0 ? ~(int32_t)j : (int32_t)j;
+            s->start_units[j] = ulam__kernel_unit(s->k, s->o.query.starts[j], &s->ks[0]);
+            s->start_b[j] = s->o.estimator == ULAM_EXPECTED ? s->b[s->o.query.starts[j]] : 0.0;
         }
         ulam__alias_build(p, out, k, s->start_src, scaled, small, large);
         s->w.nstarts = k, s->w.start_src = s->start_src, s->w.start_units = s->start_units;
@@ -874,8 +909,8 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     int status = check_opts(M, &o, err);
     if (status) return status;
     ulam__rows_check rc = {0};
-    if (o.system && (status = ulam__system_rows_check(o.system, M, b, &rc, err))) return status;
-    if ((o.mode == ULAM_FORWARD || o.whole_kernel || (reach && reach->seen)) && (status = verify_all(M, &o, &rc, err)))
+    if (o.policy.system && (status = ulam__system_rows_check(o.policy.system, M, b, &rc, err))) return status;
+    if ((o.mode == ULAM_FORWARD || o.kernel.whole_kernel || (reach && reach->seen)) && (status = verify_all(M, &o, &rc, err)))
         return status; /* these read all of M (and forward, all of b) */
     if ((status = check_split(M, b, &o, err))) return status;
     if (o.mode == ULAM_FORWARD && (status = ulam__csr_check_structure(M, err))) /* src/check.c: M' is made */
@@ -887,8 +922,8 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     s->b = b;
     /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered;
        not on the lazy path (adjoint with the guards given reads only the b_i its walks reach) */
-    s->bexp = !kernel && !reach && o.rel_err_offset == 0.0 && (o.mode == ULAM_ADJOINT ? !o.guard
-                                                                 : !(o.roulette > 0 || o.split > 0))
+    s->bexp = !kernel && !reach && o.stop.rel_err_offset == 0.0 && (o.mode == ULAM_ADJOINT ? !o.policy.guard
+                                                                 : !(o.kernel.roulette > 0 || o.kernel.split > 0))
                   ? ulam__b_exponent(b, M->nrows) : 0;
     if (s->bexp && !(s->b = b = s->bs = ulam__b_scaled(b, M->nrows, s->bexp))) goto nomem;
     s->n = M->nrows;
@@ -899,54 +934,54 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         ulam_solver_free(s);
         return status;
     }
-    s->o.max_walks = ulam__walk_cap(&o);
-    s->threads = ulam__threads(o.threads);
+    s->o.stop.max_walks = ulam__walk_cap(&o);
+    s->threads = ulam__threads(o.exec.threads);
     const ulam_csr *K = M;
     if (o.mode == ULAM_FORWARD) {
         if (ulam_csr_transpose(M, &s->mt) || build_source(s, &bnorm1)) goto nomem;
         K = s->mt;
     }
     ulam__scores sc = {o.mode == ULAM_ADJOINT ? b : NULL, o.estimator};
-    if (kernel && (o.mode != ULAM_ADJOINT || kernel->K != K || kernel->continue_q != o.continue_q ||
-                   kernel->alpha != o.kernel_alpha || kernel->scores.estimator != o.estimator)) {
+    if (kernel && (o.mode != ULAM_ADJOINT || kernel->K != K || kernel->continue_q != o.kernel.continue_q ||
+                   kernel->alpha != o.kernel.kernel_alpha || kernel->scores.estimator != o.estimator)) {
         ulam_solver_free(s);
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a kept kernel made for this M, mode, continuation and estimator");
     }
     if (kernel) {
         s->k = kernel, s->k_borrowed = 1;
         if ((status = ulam__kernel_rescore_b(kernel, b))) {
-            status = kernel_failure(kernel, o.system, err);
+            status = kernel_failure(kernel, o.policy.system, err);
             ulam_solver_free(s);
             return status ? status : ulam__fail(err, ULAM_EINVAL, 0, -1, "a kept kernel (ulam__solver_keep_kernel)");
         }
-    } else if ((status = ulam__kernel_alloc(K, o.continue_q, o.kernel_alpha, sc, &s->k)) == ULAM_EOVERFLOW) {
+    } else if ((status = ulam__kernel_alloc(K, o.kernel.continue_q, o.kernel.kernel_alpha, sc, &s->k)) == ULAM_EOVERFLOW) {
         ulam_solver_free(s);
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
     if (!kernel) s->k->rc = rc;
     s->rho4 = (ulam_power){.rho = NAN, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
-    if ((status = take_bounds(s, K, o.rel_err > 0 && o.max_walks == 0 && o.max_seconds == 0, err))) {
+    if ((status = take_bounds(s, K, o.stop.rel_err > 0 && o.stop.max_walks == 0 && o.stop.max_seconds == 0, err))) {
         ulam_solver_free(s);
         return status;
     }
     if ((status = take_fourth(s, K, err)) ||
-        (o.max_walks == 0 && o.max_seconds == 0 && (status = check_fourth(M, s, err)))) {
+        (o.stop.max_walks == 0 && o.stop.max_seconds == 0 && (status = check_fourth(M, s, err)))) {
         ulam_solver_free(s);
         return status;
     }
     if (alloc_work(s)) goto nomem;
-    if (o.whole_kernel) ulam__kernel_complete(s->k, s->threads, s->ks);
+    if (o.kernel.whole_kernel) ulam__kernel_complete(s->k, s->threads, s->ks);
     s->w = (ulam__walker){.k = s->k, .mt = s->mt, .src = s->src,
-                          .bnorm1 = bnorm1, .roulette = o.roulette, .split = o.split,
-                          .max_steps = o.max_steps, .interrupt = o.interrupt,
+                          .bnorm1 = bnorm1, .roulette = o.kernel.roulette, .split = o.kernel.split,
+                          .max_steps = o.stop.max_steps, .interrupt = o.stop.interrupt,
                           .lanes = s->k->cap * (int64_t)sizeof(ulam__slot) <= CACHED ? 16 : 32};
-    if (o.mode == ULAM_ADJOINT) s->w.start = ulam__kernel_unit(s->k, o.index, &s->ks[0]);
-    if (o.nstarts > 0 && build_starts(s)) goto nomem;
-    if (o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED) s->w.score0 = s->b[o.index];
+    if (o.mode == ULAM_ADJOINT) s->w.start = ulam__kernel_unit(s->k, o.query.index, &s->ks[0]);
+    if (o.query.nstarts > 0 && build_starts(s)) goto nomem;
+    if (o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED) s->w.score0 = s->b[o.query.index];
     if (o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED) s->w.expected = 1;
-    s->w.watch = o.mode == ULAM_FORWARD ? o.index : -1;
-    if ((status = kernel_failure(s->k, s->o.system, err))) {
+    s->w.watch = o.mode == ULAM_FORWARD ? o.query.index : -1;
+    if ((status = kernel_failure(s->k, s->o.policy.system, err))) {
         ulam_solver_free(s);
         return status;
     }
@@ -999,11 +1034,11 @@ static void run_block(void *ctx, int q, int64_t first, int64_t count, int t)
 {
     ulam_solver *s = ctx;
     ulam__block *br = &s->blocks[q];
-    br->complete = 0;
-    br->walks = 0;
-    if (!ulam__mine(s->o.share, first / BLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
+    br->h.complete = 0;
+    br->h.walks = 0;
+    if (!ulam__mine(s->o.exec.share, first / BLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
     ulam_rng r;
-    ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / BLOCK));
+    ulam_rng_seed(&r, s->o.exec.seed, (uint64_t)(first / BLOCK));
     if (s->o.mode == ULAM_ADJOINT) ulam__adjoint_block(&s->w, count, &r, &s->scratch[t], br);
     else ulam__forward_block(&s->w, count, &r, &s->scratch[t], br);
 }
@@ -1018,12 +1053,13 @@ static void merge_block(void *ctx, int q)
     ulam__moments_merge(&s->adj, &br->m);
     s->maxsq = fmax(s->maxsq, br->maxsq);
     ulam__moments w = br->watched;
-    for (int64_t q = 0; q < br->t.len; q++) {
-        s->sum[br->t.t[q].state] += br->t.t[q].value;
-        s->sumsq[br->t.t[q].state] += br->t.t[q].square;
+    const ulam__tally *t = br->h.tally;
+    for (int64_t q = 0; q < br->h.len; q++) {
+        s->sum[t[q].state] += t[q].value;
+        s->sumsq[t[q].state] += t[q].square;
     }
     if (s->o.mode == ULAM_FORWARD) {
-        ulam__moments zeros = {.n = br->walks - w.n};
+        ulam__moments zeros = {.n = br->h.walks - w.n};
         ulam__moments_merge(&w, &zeros);
         ulam__moments_merge(&s->watched, &w);
     }
@@ -1051,17 +1087,17 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
 
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci);
 
-/* Nonzero when the rel_err rule holds for r (see ulam_solve in ulam.h): the run's 95% interval
+/* Nonzero when the rel_err rule holds for r (see ulam_solve_walks in ulam.h): the run's 95% interval
  * (stop.h) meeting ulam__stop_rel_met (stderr <= E |m|, and the whole half-width, range and bias
  * terms included, within 2 sqrt(2 L) E |m|), after ULAM__REL_MIN walks, forward with
  * the watched component tallied, and walks cut at max_steps moving it by at most
  * ULAM__CUT_SHARE E |m|; x certified 0 (nothing that scores is reachable) meets it at once. */
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
 {
-    double E = s->o.rel_err, m = fabs(r->estimate + s->o.rel_err_offset), R;
+    double E = s->o.stop.rel_err, m = fabs(r->estimate + s->o.stop.rel_err_offset), R;
     if (!(E > 0) || s->var_finite != 1 || r->walks < ULAM__REL_MIN) return 0;
     if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
-    if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.index] == 0)) return 0;
+    if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.query.index] == 0)) return 0;
     if (!(r->cut_bound <= ULAM__CUT_SHARE * E * m)) return 0;
     ulam__stop_ci ci;
     interval(s, r, &R, &ci);
@@ -1076,8 +1112,8 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
  * (a failure ends the run with its status). */
 static int search_reach(ulam_solver *s, const ulam_walk_result *r)
 {
-    if (!s->given || !s->given->bounds || !(s->o.rel_err > 0) || s->run.walks < ULAM__REL_MIN ||
-        r->estimate + s->o.rel_err_offset != 0.0 || s->o.mode != ULAM_ADJOINT)
+    if (!s->given || !s->given->bounds || !(s->o.stop.rel_err > 0) || s->run.walks < ULAM__REL_MIN ||
+        r->estimate + s->o.stop.rel_err_offset != 0.0 || s->o.mode != ULAM_ADJOINT)
         return 0;
     s->given = NULL;
     free(s->seen), free(s->fac); /* the given reach and what was kept over it (as ulam__solver_restart) */
@@ -1096,11 +1132,8 @@ int ulam_solver_iterate(ulam_solver *s)
 {
     if (!s) return ULAM_EINVAL;
     if (s->run.done) return s->run.status;
-    static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally),
-                                   offsetof(ulam__block, t.t), offsetof(ulam__block, t.len),
-                                   offsetof(ulam__block, t.cap), offsetof(ulam__block, walks),
-                                   offsetof(ulam__block, nonfinite), offsetof(ulam__block, complete),
-                                   offsetof(ulam__block, nomem), merge_block, begin_round, kernel_status};
+    static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally), merge_block,
+                                   begin_round, kernel_status};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
     result(s, &r, 0);
@@ -1111,15 +1144,15 @@ int ulam_solver_iterate(ulam_solver *s)
         result(s, &r, 0);
     }
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
-    if (check && s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
+    if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
     if (check && rel_err_met(s, &r)) s->run.done = s->met = 1;
-    else if (s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.rel_err_offset) > 0 &&
-             !(r.cut_bound <= ULAM__CUT_SHARE * s->o.rel_err * fabs(r.estimate + s->o.rel_err_offset)))
+    else if (s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.stop.rel_err_offset) > 0 &&
+             !(r.cut_bound <= ULAM__CUT_SHARE * s->o.stop.rel_err * fabs(r.estimate + s->o.stop.rel_err_offset)))
         s->run.done = s->cut_stop = 1; /* the cuts' bias may exceed the target: more walks cannot help */
-    else if (s->o.rel_err > 0 && s->var_finite == 1 && s->run.walks >= ULAM__REL_MIN && !(s->o.max_seconds > 0) &&
-             fabs(r.estimate + s->o.rel_err_offset) > 0 && isfinite(r.tail_bound) && r.min_walks > (double)s->o.max_walks)
+    else if (s->o.stop.rel_err > 0 && s->var_finite == 1 && s->run.walks >= ULAM__REL_MIN && !(s->o.stop.max_seconds > 0) &&
+             fabs(r.estimate + s->o.stop.rel_err_offset) > 0 && isfinite(r.tail_bound) && r.min_walks > (double)s->o.stop.max_walks)
         s->run.done = s->out_of_reach = 1; /* the walks the target needs are past the budget or the cap */
-    else if (s->o.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && !isfinite(r.ci95[0]) && r.min_walks > 0 &&
+    else if (s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && !isfinite(r.ci95[0]) && r.min_walks > 0 &&
              isfinite(r.min_walks) && (double)s->run.walks > ULAM__NO_CI_SPAN * fmax(r.min_walks, ULAM__REL_MIN))
         s->run.done = s->out_of_reach = 1; /* still no interval (a score past the certified range) long after
                                                the walks the rule asked for: more walks would only spin */
@@ -1183,8 +1216,8 @@ double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int sign
 static double cut_bound(const ulam_solver *s)
 {
     if (s->cut == 0) return 0.0;
-    return fmin(ulam__cut_bound(s->per_step, s->qmax, 1.0, s->o.max_steps),
-                ulam__cut_bound(s->visit, s->tail_u, s->kappa, s->o.max_steps));
+    return fmin(ulam__cut_bound(s->per_step, s->qmax, 1.0, s->o.stop.max_steps),
+                ulam__cut_bound(s->visit, s->tail_u, s->kappa, s->o.stop.max_steps));
 }
 
 /* The scale the truncation's bias is measured against: |m|, or with an estimate of 0 the most
@@ -1209,10 +1242,10 @@ static double bias_scale(const ulam_solver *s, double m)
  * no time limit, no rel_err).  None while the variance is not certified finite. */
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci)
 {
-    double E = s->o.rel_err > 0 ? s->o.rel_err : 0.0, m = bias_scale(s, fabs(r->estimate + s->o.rel_err_offset));
+    double E = s->o.stop.rel_err > 0 ? s->o.stop.rel_err : 0.0, m = bias_scale(s, fabs(r->estimate + s->o.stop.rel_err_offset));
     double cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m, se = r->std_error;
     int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
-    int fixed = !(s->o.rel_err > 0) && !(s->o.max_seconds > 0) && r->walks == s->o.max_walks;
+    int fixed = !(s->o.stop.rel_err > 0) && !(s->o.stop.max_seconds > 0) && r->walks == s->o.stop.max_walks;
     int k = fixed ? 1 : ulam__stop_epoch(r->walks);
     /* the truncation: a quarter of the standard error, or the decade of |m| that gives the
        narrowest interval (a longer truncation widens the range term, a shorter one the bias) */
@@ -1241,22 +1274,22 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
         r->std_error = s->adj.n > 0 ? sqrt(r->variance / (double)s->adj.n) : INFINITY;
         sumsq = s->adj.m2 + (double)s->adj.n * s->adj.mean * s->adj.mean;
     } else {
-        forward_component(s, s->o.index, &r->estimate, &r->std_error, &r->variance);
-        sumsq = s->sumsq[s->o.index];
+        forward_component(s, s->o.query.index, &r->estimate, &r->std_error, &r->variance);
+        sumsq = s->sumsq[s->o.query.index];
         for (int64_t i = 0; count_unreached && i < s->n; i++) r->unreached += s->sum[i] == 0.0 && s->sumsq[i] == 0.0;
     }
     r->max_share = sumsq > 0 ? fmin(1.0, s->maxsq / sumsq) : 0.0;
     r->variance_finite = s->var_finite;
     r->variance_rel_error = ulam__moments_variance_rel_error(mom);
-    double m = fabs(r->estimate + s->o.rel_err_offset), N = (double)s->run.walks, R;
+    double m = fabs(r->estimate + s->o.stop.rel_err_offset), N = (double)s->run.walks, R;
     r->walks = s->run.walks;
     r->score_bound = s->bound;
     r->cut_bound = cut_bound(s);
     ulam__stop_ci ci;
     interval(s, r, &R, &ci);
     r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
-    if (s->o.rel_err > 0) { /* at this interval's truncation or at the one a stop would have (bias E |m| / 4) */
-        double E = s->o.rel_err, Rs = m > 0 ? score_range(s, m, E / 4.0) : INFINITY;
+    if (s->o.stop.rel_err > 0) { /* at this interval's truncation or at the one a stop would have (bias E |m| / 4) */
+        double E = s->o.stop.rel_err, Rs = m > 0 ? score_range(s, m, E / 4.0) : INFINITY;
         int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
         r->min_walks = fmin(ulam__stop_walks_needed(m, r->variance, R, ci.bias, E, ci.k),
                             ulam__stop_walks_needed(m, r->variance, Rs, (truncated ? E * m / 4.0 : 0.0) + r->cut_bound,
@@ -1311,9 +1344,9 @@ int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error)
     return bad ? ULAM_ENONFINITE : ULAM_OK; /* an estimate beyond the largest double */
 }
 
-/* The whole run in one call. */
-int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-               ulam_walk_result *result, ulam_error *err)
+/* The walks the options name, in one call. */
+int ulam_solve_walks(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
+                     ulam_walk_result *result, ulam_error *err)
 {
     ulam_solver *s = NULL;
     int status = ulam_solver_alloc(M, b, opts, &s, err);
@@ -1336,15 +1369,15 @@ int ulam_solver_error(const ulam_solver *s, ulam_error *err)
 {
     ulam__clear(err);
     if (!s || !s->run.status) return ULAM_OK;
-    int status = kernel_failure(s->k, s->o.system, err);
+    int status = kernel_failure(s->k, s->o.policy.system, err);
     if (status) return status;
     int st = s->run.status;
     switch (st) {
     case ULAM_ENONFINITE:
         if (s->overflow)
-            return ulam__fail(err, st, 0, s->o.index, "an estimate a double can hold: x[%lld] (1-based) exceeds "
+            return ulam__fail(err, st, 0, s->o.query.index, "an estimate a double can hold: x[%lld] (1-based) exceeds "
                               "1.8e308 (the walks' mean of scores overflows; b's scale is 2^%d)",
-                              (long long)s->o.index + 1, s->bexp);
+                              (long long)s->o.query.index + 1, s->bexp);
         return ulam__fail(err, st, 0, -1, "finite weights and scores (a walk produced NaN or Inf)");
     case ULAM_ENOMEM: return ulam__fail(err, st, 0, -1, "memory for the walks' tallies");
     case ULAM_EIO: return ulam__fail(err, st, 0, -1, "an exchange of walk results between processes (allgather failed)");
@@ -1376,7 +1409,7 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     s->b = b;
     for (int64_t i = 0; s->bexp && i < s->n; i++) s->bs[i] = ldexp(b[i], -s->bexp); /* as the first b */
     if (s->bexp) s->b = s->bs;
-    s->o.seed = seed;
+    s->o.exec.seed = seed;
     double bnorm1 = 0.0;
     if (build_source(s, &bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");
     free(s->seen), free(s->fac); /* the reachable set and the score bounds depend on b */
@@ -1401,27 +1434,27 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *e
     ulam__clear(err);
     if (!s || !opts) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a solver and options");
     ulam_walk_opts o = *opts;
-    double q0 = s->o.continue_q > 0 ? s->o.continue_q : 0.0, q1 = o.continue_q > 0 ? o.continue_q : 0.0;
-    if (o.mode != s->o.mode || o.index != s->o.index || q0 != q1 || o.roulette != s->o.roulette ||
-        o.split != s->o.split || o.max_steps != s->o.max_steps || o.kernel_alpha != s->o.kernel_alpha ||
-        ulam__threads(o.threads) != s->threads || o.nstarts || s->o.nstarts)
+    double q0 = s->o.kernel.continue_q > 0 ? s->o.kernel.continue_q : 0.0, q1 = o.kernel.continue_q > 0 ? o.kernel.continue_q : 0.0;
+    if (o.mode != s->o.mode || o.query.index != s->o.query.index || q0 != q1 || o.kernel.roulette != s->o.kernel.roulette ||
+        o.kernel.split != s->o.kernel.split || o.stop.max_steps != s->o.stop.max_steps || o.kernel.kernel_alpha != s->o.kernel.kernel_alpha ||
+        ulam__threads(o.exec.threads) != s->threads || o.query.nstarts || s->o.query.nstarts)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "the solver's mode, index, continuation, kernel exponent, weight "
                                                    "window, max_steps and threads (and one start state)");
     int status = check_opts(s->M, &o, err);
     if (status) return status;
-    if (atomic_load(&s->k->status)) return kernel_failure(s->k, s->o.system, err);
+    if (atomic_load(&s->k->status)) return kernel_failure(s->k, s->o.policy.system, err);
     int rescore = o.estimator != s->o.estimator;
     if (rescore && s->k_borrowed) /* a kept kernel is its keeper's, for its estimator */
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a solver that owns its kernel to change the estimator");
     s->o = o;
     if ((status = check_verdicts(s->M, s, err))) return status;
-    s->o.max_walks = ulam__walk_cap(&o);
-    if (rescore && (status = ulam__kernel_rescore(s->k, o.estimator))) return kernel_failure(s->k, s->o.system, err);
-    s->w.interrupt = o.interrupt;
-    s->w.score0 = o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED ? s->b[o.index] : 0.0;
+    s->o.stop.max_walks = ulam__walk_cap(&o);
+    if (rescore && (status = ulam__kernel_rescore(s->k, o.estimator))) return kernel_failure(s->k, s->o.policy.system, err);
+    s->w.interrupt = o.stop.interrupt;
+    s->w.score0 = o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED ? s->b[o.query.index] : 0.0;
     s->w.expected = o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED;
-    if ((status = take_bounds(s, o.mode == ULAM_FORWARD ? s->mt : s->M, o.rel_err > 0 && o.max_walks == 0 &&
-                              o.max_seconds == 0, err)))
+    if ((status = take_bounds(s, o.mode == ULAM_FORWARD ? s->mt : s->M, o.stop.rel_err > 0 && o.stop.max_walks == 0 &&
+                              o.stop.max_seconds == 0, err)))
         return status;
     reset(s);
     return ULAM_OK;

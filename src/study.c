@@ -52,8 +52,8 @@ int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o)
     if (m->mode == ULAM_FORWARD)
         for (int64_t i = 0; i < n; i++) w0 += fabs(b[i]);
     o->mode = m->mode, o->estimator = m->estimator;
-    o->roulette = m->window >= ULAM_WINDOW_ROULETTE ? 0.5 * w0 : 0.0;
-    o->split = m->window == ULAM_WINDOW_SPLIT ? 2.0 * w0 : 0.0;
+    o->kernel.roulette = m->window >= ULAM_WINDOW_ROULETTE ? 0.5 * w0 : 0.0;
+    o->kernel.split = m->window == ULAM_WINDOW_SPLIT ? 2.0 * w0 : 0.0;
     return ULAM_OK;
 }
 

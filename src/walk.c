@@ -161,9 +161,9 @@ static void record(ulam__block *out, double score)
         ulam__moments_add(&out->m, score);
         out->maxsq = fmax(out->maxsq, score * score);
     } else {
-        out->nonfinite++;
+        out->h.nonfinite++;
     }
-    out->walks++;
+    out->h.walks++;
 }
 
 /* Run count adjoint histories, w->lanes at a time, counting into a local block (the caller's
@@ -172,8 +172,7 @@ static void record(ulam__block *out, double score)
 static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam_rng *r, ulam__scratch *sc,
                                       ulam__block *out, double (*fac)[2])
 {
-    ulam__block acc = {.t = out->t};
-    acc.t.len = 0;
+    ulam__block acc = {.h = {.tally = out->h.tally, .cap = out->h.cap}};
     lane L[LANES];
     int lanes = w->lanes < 1 ? 1 : w->lanes > LANES ? LANES : w->lanes;
     int64_t cap = sc->stack_cap / lanes, started = 0;
@@ -210,7 +209,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
         }
         if (started < count && w->interrupt && *w->interrupt) break;
     }
-    acc.complete = act == 0;
+    acc.h.complete = act == 0;
     *out = acc;
 }
 
@@ -252,12 +251,13 @@ static WALK_INLINE void emit(const ulam__walker *w, ulam__scratch *sc, ulam__blo
 }
 
 /* Move the block's sums to its tally list (one per state reached) and clear them. */
-static int flush(ulam__scratch *sc, ulam__tallies *out)
+static int flush(ulam__scratch *sc, ulam__block_head *out)
 {
-    int st = ulam__grow(&out->t, &out->cap, out->len + sc->nbtouched, sizeof *out->t) ? ULAM_ENOMEM : ULAM_OK;
+    int st = ulam__grow(&out->tally, &out->cap, out->len + sc->nbtouched, sizeof(ulam__tally)) ? ULAM_ENOMEM : ULAM_OK;
+    ulam__tally *t = out->tally;
     for (int64_t q = 0; q < sc->nbtouched; q++) {
         int64_t s = sc->btouched[q];
-        if (!st) out->t[out->len++] = (ulam__tally){(int32_t)s, sc->bsum[s], sc->bsq[s]};
+        if (!st) t[out->len++] = (ulam__tally){(int32_t)s, sc->bsum[s], sc->bsq[s]};
         sc->bsum[s] = sc->bsq[s] = 0.0;
         sc->bmark[s] = 0;
     }
@@ -305,14 +305,14 @@ static WALK_INLINE void forward_history(const ulam__walker *w, ulam_rng *r, ulam
             out->steps++;
             if (++len > w->max_steps || !isfinite(wt)) {
                 out->cut += len > w->max_steps;
-                out->nonfinite += !isfinite(wt);
+                out->h.nonfinite += !isfinite(wt);
                 st.top = 0;
                 break;
             }
             if (!window(w, u, &wt, r, &st)) break;
         }
     }
-    out->walks++;
+    out->h.walks++;
     emit(w, sc, out);
 }
 
@@ -320,15 +320,14 @@ static WALK_INLINE void forward_history(const ulam__walker *w, ulam_rng *r, ulam
 void ulam__forward_block(const ulam__walker *w, int64_t count, ulam_rng *r, ulam__scratch *sc,
                          ulam__block *out)
 {
-    ulam__block acc = {.t = out->t};
-    acc.t.len = 0;
+    ulam__block acc = {.h = {.tally = out->h.tally, .cap = out->h.cap}};
     int64_t c = 0;
     for (; c < count; c++) {
         if (w->k->fac) forward_history(w, r, sc, &acc, w->k->fac);
         else forward_history(w, r, sc, &acc, NULL);
         if ((c & 63) == 63 && w->interrupt && *w->interrupt) break;
     }
-    acc.nomem = flush(sc, &acc.t) != ULAM_OK; /* out of memory: the run must fail, not stop short */
-    acc.complete = c == count && !acc.nomem;
+    acc.h.nomem = flush(sc, &acc.h) != ULAM_OK; /* out of memory: the run must fail, not stop short */
+    acc.h.complete = c == count && !acc.h.nomem;
     *out = acc;
 }

@@ -3,6 +3,7 @@
 #define ULAM_WALK_H
 
 #include "kernel.h"
+#include "round.h"
 #include "stats.h"
 
 /* A state's tallies over a block of forward histories: their sum and their sum of squares
@@ -11,12 +12,6 @@ typedef struct {
     int32_t state;
     double value, square;
 } ulam__tally;
-
-/* Growable list of tallies (one per block). */
-typedef struct {
-    ulam__tally *t;
-    int64_t len, cap;
-} ulam__tallies;
 
 /* Everything a walker reads: shared, read-only during a run.  What a visit or a termination
  * scores lives in the kernel's row headers (visit, end). */
@@ -59,14 +54,13 @@ typedef struct {
 
 /* What a block of histories produced. */
 typedef struct {
+    ulam__block_head h; /* the round driver's part (forward: one ulam__tally per state the block
+                           reached; the walks, complete and nomem) */
     ulam__moments m; /* adjoint scores */
-    ulam__tallies t; /* forward: one tally per state the block reached */
     ulam__moments watched; /* forward: the watched component's history tallies (histories that
                               tallied it; the others count as zeros when merged) */
-    int64_t walks, steps, cut, nonfinite;
+    int64_t steps, cut;
     double maxsq; /* the largest score^2 (forward: of the watched component) */
-    int complete; /* 0 when interrupted or out of memory */
-    int nomem;    /* a tally list could not grow: the run fails with ULAM_ENOMEM */
 } ulam__block;
 
 /* Run count adjoint histories drawing from r into out (reset first). */

@@ -154,9 +154,9 @@ static int walk_run(int mode, int est)
     ulam_walk_opts o = ulam_walk_defaults();
     double w0 = mode == ULAM_ADJOINT ? 1.0 : 0.0; /* the start weight: 1 adjoint, ||b||_1 forward (a split weight below it is refused) */
     for (int64_t i = 0; !s && mode == ULAM_FORWARD && i < n; i++) w0 += fabs(b[i]);
-    o.mode = mode, o.estimator = est, o.max_walks = 3000, o.threads = 2, o.roulette = 0.1 * w0, o.split = 2 * w0;
+    o.mode = mode, o.estimator = est, o.stop.max_walks = 3000, o.exec.threads = 2, o.kernel.roulette = 0.1 * w0, o.kernel.split = 2 * w0;
     ulam_walk_result r;
-    if (!s) s = ulam_solve(M, b, &o, &r, NULL);
+    if (!s) s = ulam_solve_walks(M, b, &o, &r, NULL);
     ulam_csr_free(M), free(b);
     return s;
 }
@@ -174,7 +174,7 @@ static int op_outer(void)
     if (!s) s = ulam_mm_read_vector("matrices/chain4_b.mtx", &b, &n, NULL);
     for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA && !s; m++) {
         ulam_outer_opts o = ulam_outer_defaults();
-        o.method = m, o.tol = 1e-3, o.walk.threads = 2;
+        o.method = m, o.tol = 1e-3, o.walk.exec.threads = 2;
         s = ulam_outer_solve(M, b, &o, x, NULL, 0, NULL, NULL);
     }
     int its;
@@ -210,16 +210,16 @@ static int op_radiosity(void)
     if (!st) st = ulam_tracer_alloc(s, &t, NULL);
     if (!st) st = ulam_ff_estimate(t, 50, 1, 2, &F, NULL);
     for (int mode = 0; mode < 2 && !st; mode++) {
-        ulam_walk_opts o = ulam_walk_defaults();
-        o.mode = mode, o.max_walks = 600, o.threads = 2;
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.mode = mode, o.stop.max_walks = 600, o.exec.threads = 2;
         o.estimator = mode ? ULAM_RAD_COLLISION : ULAM_RAD_NEXT_EVENT; /* shooting has no next event */
         if (!(st = ulam_rad_solver_alloc(t, &o, &sv, NULL)))
             while (!st && !ulam_rad_solver_done(sv)) st = ulam_rad_solver_iterate(sv);
         sv = ulam_rad_solver_free(sv);
     }
     if (!st) { /* a point query on the continuous surfaces */
-        ulam_walk_opts o = ulam_walk_defaults();
-        o.max_walks = 600, o.threads = 2;
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.stop.max_walks = 600, o.exec.threads = 2;
         ulam_rad_point pt;
         st = ulam_rad_point_query(t, &o, (const double[3]){0.5, 0, 0.5}, NULL, &pt, NULL);
     }

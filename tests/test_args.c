@@ -27,13 +27,13 @@ typedef struct bad_walk {
 
 #define W(f, v) {#f, offsetof(ulam_walk_opts, f), v}
 static const bad_walk walk_table[] = {
-    W(continue_q, NAN), W(continue_q, INFINITY), W(continue_q, 1.0), W(continue_q, -INFINITY),
-    W(roulette, NAN), W(roulette, INFINITY), W(roulette, -1.0),
-    W(split, NAN), W(split, INFINITY), W(split, -1.0),
-    W(rel_err, NAN), W(rel_err, INFINITY), W(rel_err, -0.1),
-    W(max_seconds, NAN), W(max_seconds, INFINITY), W(max_seconds, -1.0),
-    W(rel_err_offset, NAN), W(rel_err_offset, INFINITY),
-    W(kernel_alpha, NAN), W(kernel_alpha, INFINITY), W(kernel_alpha, -1.0),
+    W(kernel.continue_q, NAN), W(kernel.continue_q, INFINITY), W(kernel.continue_q, 1.0), W(kernel.continue_q, -INFINITY),
+    W(kernel.roulette, NAN), W(kernel.roulette, INFINITY), W(kernel.roulette, -1.0),
+    W(kernel.split, NAN), W(kernel.split, INFINITY), W(kernel.split, -1.0),
+    W(stop.rel_err, NAN), W(stop.rel_err, INFINITY), W(stop.rel_err, -0.1),
+    W(stop.max_seconds, NAN), W(stop.max_seconds, INFINITY), W(stop.max_seconds, -1.0),
+    W(stop.rel_err_offset, NAN), W(stop.rel_err_offset, INFINITY),
+    W(kernel.kernel_alpha, NAN), W(kernel.kernel_alpha, INFINITY), W(kernel.kernel_alpha, -1.0),
 };
 #undef W
 enum { NWALK = sizeof walk_table / sizeof *walk_table };
@@ -43,8 +43,8 @@ enum { NWALK = sizeof walk_table / sizeof *walk_table };
 static ulam_walk_opts bad_opts(int k, int mode)
 {
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = mode, o.max_walks = 1000, o.threads = 1;
-    if (!strcmp(walk_table[k].field, "max_seconds")) o.max_walks = 0;
+    o.mode = mode, o.stop.max_walks = 1000, o.exec.threads = 1;
+    if (!strcmp(walk_table[k].field, "stop.max_seconds")) o.stop.max_walks = 0;
     memcpy((char *)&o + walk_table[k].off, &walk_table[k].v, sizeof(double));
     return o;
 }
@@ -70,7 +70,7 @@ static void test_walk_options(void **state)
             ulam_walk_opts o = bad_opts(k, mode);
             ulam_walk_result r;
             ulam_error err;
-            assert_int_equal(ulam_solve(M, ones, &o, &r, &err), ULAM_EINVAL);
+            assert_int_equal(ulam_solve_walks(M, ones, &o, &r, &err), ULAM_EINVAL);
             assert_int_equal(err.status, ULAM_EINVAL);
             assert_names(&err, walk_table[k].field);
             ulam_solver *s = NULL;
@@ -181,7 +181,7 @@ static void test_other_options(void **state)
         assert_int_equal(ulam_push_run(w, v, 0), ULAM_EINVAL);
         ulam_push_free(w);
         ulam_bidir_opts bo = ulam_bidir_defaults();
-        bo.walk.max_walks = 1000, bo.target = 0, bo.source = 3, bo.min_value = v;
+        bo.walk.stop.max_walks = 1000, bo.target = 0, bo.source = 3, bo.min_value = v;
         assert_int_equal(ulam_push_alloc(M, &w), ULAM_OK);
         ulam_bidir_result br;
         assert_int_equal(ulam_bidir_solve(w, Mt, &bo, &br, &err), ULAM_EINVAL);
@@ -206,7 +206,7 @@ static void test_lengths(void **state)
     (void)state;
     ulam_csr *M = chain(), *J = NULL;
     ulam_walk_opts o = ulam_walk_defaults();
-    o.max_walks = 1000, o.threads = 1;
+    o.stop.max_walks = 1000, o.exec.threads = 1;
     ulam_walk_result r;
     ulam_error err;
     double *b3 = malloc(3 * sizeof *b3), bp[4];
@@ -269,9 +269,9 @@ static void test_damaged_matrix(void **state)
         for (int mode = 0; mode < 2; mode++)
             for (int est = 0; est < 3; est++) {
                 ulam_walk_opts o = ulam_walk_defaults();
-                o.mode = mode, o.estimator = est, o.max_walks = 1000, o.threads = 1;
+                o.mode = mode, o.estimator = est, o.stop.max_walks = 1000, o.exec.threads = 1;
                 ulam_walk_result r;
-                int st = ulam_solve(M, ones, &o, &r, &err);
+                int st = ulam_solve_walks(M, ones, &o, &r, &err);
                 assert_true(st == ULAM_ESYNTAX || st == ULAM_EINDEX);
                 assert_int_equal(err.status, st);
             }
@@ -281,10 +281,10 @@ static void test_damaged_matrix(void **state)
         ulam_csr_free(good);
         for (int est = 0; est < 3; est++) {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = est, o.max_walks = 1000, o.threads = 1, o.guard = &g;
-            for (o.index = 0; o.index < 4; o.index++) {
+            o.estimator = est, o.stop.max_walks = 1000, o.exec.threads = 1, o.policy.guard = &g;
+            for (o.query.index = 0; o.query.index < 4; o.query.index++) {
                 ulam_walk_result r;
-                int st = ulam_solve(M, ones, &o, &r, &err); /* refused or answered, never out of bounds */
+                int st = ulam_solve_walks(M, ones, &o, &r, &err); /* refused or answered, never out of bounds */
                 assert_true(st == ULAM_OK || st == ULAM_ESYNTAX || st == ULAM_EINDEX);
             }
         }
@@ -311,7 +311,7 @@ static void test_damaged_matrix(void **state)
         assert_int_not_equal(ulam_push_alloc(M, &w), ULAM_OK);
         assert_null(w);
         ulam_walk_opts base = ulam_walk_defaults();
-        base.max_walks = 1000;
+        base.stop.max_walks = 1000;
         ulam_auto_opts ao = ulam_auto_defaults();
         ulam_auto_result *ar = malloc(sizeof *ar);
         assert_non_null(ar);
@@ -347,12 +347,12 @@ static void test_overflow(void **state)
         for (int est = 0; est < 3; est++) {
             test_case(mode * 3 + est);
             ulam_walk_opts o = ulam_walk_defaults();
-            o.mode = mode, o.estimator = est, o.index = 1, o.max_walks = 20000, o.threads = 1;
+            o.mode = mode, o.estimator = est, o.query.index = 1, o.stop.max_walks = 20000, o.exec.threads = 1;
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
             assert_true(isfinite(r.estimate) && isfinite(r.std_error) && r.std_error > 0);
             assert_true(fabs(r.estimate - exact[1]) < 4 * r.std_error);
-            int st = ulam_solve(H, b, &o, &r, &err);
+            int st = ulam_solve_walks(H, b, &o, &r, &err);
             assert_int_equal(st, ULAM_ENONFINITE);
             assert_non_null(strstr(err.msg, "double"));
         }
@@ -378,14 +378,14 @@ static void test_scaling_exact(void **state)
     const double b[3] = {1, -0.5, 2};
     for (int mode = 0; mode < 2; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
-        o.mode = mode, o.index = 1, o.max_walks = 5000, o.threads = 1;
+        o.mode = mode, o.query.index = 1, o.stop.max_walks = 5000, o.exec.threads = 1;
         ulam_walk_result r0, r1;
         ulam_error err;
-        assert_int_equal(ulam_solve(M, b, &o, &r0, &err), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r0, &err), ULAM_OK);
         for (int k = -1; k <= 1; k += 2) {
             double bb[3];
             for (int i = 0; i < 3; i++) bb[i] = ldexp(b[i], 600 * k);
-            assert_int_equal(ulam_solve(M, bb, &o, &r1, &err), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, bb, &o, &r1, &err), ULAM_OK);
             assert_true(r1.estimate == ldexp(r0.estimate, 600 * k));
             assert_true(r1.std_error == ldexp(r0.std_error, 600 * k));
             assert_int_equal(r1.walks, r0.walks);

@@ -46,9 +46,9 @@ static void test_choice(void **state)
         double *x = malloc((size_t)M->nrows * sizeof *x);
         assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 1, o.seed = 11 + (uint64_t)k, o.max_walks = 0;
-        if (k < 3) o.rel_err = 0.02;
-        else o.max_walks = 20000;
+        o.query.index = 1, o.exec.seed = 11 + (uint64_t)k, o.stop.max_walks = 0;
+        if (k < 3) o.stop.rel_err = 0.02;
+        else o.stop.max_walks = 20000;
         ulam_auto_result res;
         ulam_solver *sv = NULL;
         assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
@@ -71,8 +71,8 @@ static void test_choice(void **state)
         ulam_walk_result r, plain;
         assert_int_equal(walk_out(sv, &r), ULAM_OK);
         ulam_solver_free(sv);
-        o.mode = ch->mode, o.estimator = ch->estimator, o.continue_q = ch->continue_q, o.kernel_alpha = ch->kernel_alpha;
-        assert_int_equal(ulam_solve(M, b, &o, &plain, NULL), ULAM_OK);
+        o.mode = ch->mode, o.estimator = ch->estimator, o.kernel.continue_q = ch->continue_q, o.kernel.kernel_alpha = ch->kernel_alpha;
+        assert_int_equal(ulam_solve_walks(M, b, &o, &plain, NULL), ULAM_OK);
         if (!same_result(&r, &plain) || !(fabs(r.estimate - x[1]) < 4 * r.std_error))
             print_error("case %d: %.17g +- %.3g (plain %.17g, %lld walks / %lld), LAPACK %.10g\n", k, r.estimate,
                         r.std_error, plain.estimate, (long long)r.walks, (long long)plain.walks, x[1]);
@@ -97,7 +97,7 @@ static void test_threads(void **state)
         ulam_walk_result r[2];
         for (int t = 0; t < 2; t++) {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.index = 3, o.rel_err = 0.01, o.max_walks = 0, o.threads = t + 1, o.seed = 5;
+            o.query.index = 3, o.stop.rel_err = 0.01, o.stop.max_walks = 0, o.exec.threads = t + 1, o.exec.seed = 5;
             ulam_solver *sv = NULL;
             assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res[t], &sv, NULL), ULAM_OK);
             assert_int_equal(walk_out(sv, &r[t]), ULAM_OK);
@@ -124,7 +124,7 @@ static void test_threads(void **state)
 }
 
 /* Pins keep the caller's values and auto chooses among the rest; with everything pinned there is
- * one candidate and its solver walks as a plain ulam_solve would, bit for bit; bad options are
+ * one candidate and its solver walks as a plain ulam_solve_walks would, bit for bit; bad options are
  * refused. */
 static void test_pins(void **state)
 {
@@ -132,7 +132,7 @@ static void test_pins(void **state)
     double *b;
     ulam_csr *M = load("randsub1000", &b);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = ULAM_FORWARD, o.estimator = ULAM_EXPECTED, o.continue_q = 0.5, o.kernel_alpha = 2, o.max_walks = 3000;
+    o.mode = ULAM_FORWARD, o.estimator = ULAM_EXPECTED, o.kernel.continue_q = 0.5, o.kernel.kernel_alpha = 2, o.stop.max_walks = 3000;
     ulam_auto_opts ao = ulam_auto_defaults();
     ao.pin_mode = ao.pin_continue = 1;
     ulam_auto_result res;
@@ -141,15 +141,15 @@ static void test_pins(void **state)
     for (int c = 0; c < 9; c++) assert_true(res.cand[c].mode == ULAM_FORWARD && res.cand[c].continue_q == 0.5);
     ao.pin_estimator = ao.pin_alpha = 1;
     for (int k = 0; k < 2; k++) { /* case k: forward expected, Q 0.5, alpha 2 (not certified); adjoint absorption */
-        if (k) o = ulam_walk_defaults(), o.estimator = ULAM_ABSORPTION, o.index = 4, o.rel_err = 0.02, o.max_walks = 0;
+        if (k) o = ulam_walk_defaults(), o.estimator = ULAM_ABSORPTION, o.query.index = 4, o.stop.rel_err = 0.02, o.stop.max_walks = 0;
         ulam_solver *sv = NULL;
         assert_int_equal(ulam_auto_solver(M, b, &o, &ao, &res, &sv, NULL), ULAM_OK);
         assert_true(res.ncand == 1 && (k ? res.chosen : res.closest) == 0);
-        assert_true(res.cand[0].estimator == o.estimator && res.cand[0].kernel_alpha == o.kernel_alpha);
+        assert_true(res.cand[0].estimator == o.estimator && res.cand[0].kernel_alpha == o.kernel.kernel_alpha);
         ulam_walk_result r, plain;
         assert_int_equal(walk_out(sv, &r), ULAM_OK);
         ulam_solver_free(sv);
-        assert_int_equal(ulam_solve(M, b, &o, &plain, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &plain, NULL), ULAM_OK);
         if (!same_result(&r, &plain)) print_error("case %d: %.17g / %.17g\n", k, r.estimate, plain.estimate);
         assert_true(same_result(&r, &plain) && (k ? r.rel_err_met : r.walks == 3000));
     }
@@ -158,7 +158,7 @@ static void test_pins(void **state)
     ao = ulam_auto_defaults();
     ao.pilot_max = ao.pilot_walks - 1;
     assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_EINVAL);
-    o.index = M->nrows;
+    o.query.index = M->nrows;
     assert_int_equal(ulam_auto_choose(M, b, &o, NULL, &res, NULL), ULAM_EINVAL);
     free(b);
     ulam_csr_free(M);
@@ -174,7 +174,7 @@ static void test_none(void **state)
     double *b;
     ulam_csr *M = load("signed_edge200", &b);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.rel_err = 0.01, o.max_walks = 0;
+    o.stop.rel_err = 0.01, o.stop.max_walks = 0;
     ulam_auto_result res;
     ulam_solver *sv = NULL;
     assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_EDIVERGE);
@@ -191,7 +191,7 @@ static void test_none(void **state)
     assert_int_equal(ulam_auto_solver(M, b2, &o, NULL, &res, &sv, NULL), ULAM_EINFVAR);
     assert_true(sv == NULL && res.chosen == -1 && res.closest >= 0 && res.abs.upper < 1);
     for (int c = 0; c < res.ncand; c++) assert_true(!res.cand[c].certified && res.cand[c].hat.upper >= 1);
-    o.rel_err = 0, o.max_walks = 1000;
+    o.stop.rel_err = 0, o.stop.max_walks = 1000;
     assert_int_equal(ulam_auto_solver(M, b2, &o, NULL, &res, &sv, NULL), ULAM_OK);
     ulam_walk_result r;
     assert_int_equal(walk_out(sv, &r), ULAM_OK);
@@ -203,7 +203,7 @@ static void test_none(void **state)
 /* The method table: every row has a name that finds it, answers one of the two questions, and is
  * reachable from ulam_auto pinned by its number; unpinned, the rows that answer every unknown are
  * not considered for an entry query (each says why), and the walks and bidirectional rows are
- * each chosen on a system where they are cheaper.  Pinned walks are ulam_solve's run bit for bit;
+ * each chosen on a system where they are cheaper.  Pinned walks are ulam_solve_walks's run bit for bit;
  * every pinned answer agrees with LAPACK (walks and bidirectional within 4 sigma, the rest to
  * their residual tolerance). */
 static void test_table(void **state)
@@ -232,7 +232,7 @@ static void test_table(void **state)
     assert_int_equal(ulam_csr_from_triplets(N, N, nz, ti, tj, tx, &M), ULAM_OK);
     assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 3, o.seed = 5, o.max_walks = 20000, o.threads = 2;
+    o.query.index = 3, o.exec.seed = 5, o.stop.max_walks = 20000, o.exec.threads = 2;
     ulam_method_opts ao = ulam_method_defaults();
     assert_int_equal(ao.method, -1);
     ulam_choice *ch = malloc(sizeof *ch);
@@ -252,9 +252,9 @@ static void test_table(void **state)
             assert_true(isnan(a.std_error) && isnan(a.ci95[0]) && a.residual <= 1e-8);
             assert_true(fabs(a.estimate - x[3]) <= 1e-6 * fabs(x[3]));
         }
-        if (k == ULAM_METHOD_WALKS) { /* ulam_solve's run */
+        if (k == ULAM_METHOD_WALKS) { /* ulam_solve_walks's run */
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             assert_true(same_result(&r, &a.walks));
         }
     }
@@ -281,7 +281,7 @@ static void test_table(void **state)
     ulam_solver_free(sv);
     /* an excluded row says so */
     ao.exclude = 1u << ULAM_METHOD_BIDIRECTIONAL;
-    o.rel_err = 0.05, o.max_walks = 0;
+    o.stop.rel_err = 0.05, o.stop.max_walks = 0;
     assert_int_equal(ulam_auto(M, b, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
     assert_string_equal(ch->method[ULAM_METHOD_BIDIRECTIONAL].why, "not considered: excluded");
     ulam_csr_free(M);
@@ -291,7 +291,7 @@ static void test_table(void **state)
     M = load("randsub1000", &b2);
     assert_int_equal(ulam_direct_solve(M, bs, x2, 0, NULL, NULL), ULAM_OK);
     o = ulam_walk_defaults();
-    o.index = 6, o.rel_err = 0.02, o.max_walks = 0;
+    o.query.index = 6, o.stop.rel_err = 0.02, o.stop.max_walks = 0;
     ao = ulam_method_defaults();
     assert_int_equal(ulam_auto(M, bs, &o, NULL, &ao, ch, &a, NULL), ULAM_OK);
     assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
@@ -304,6 +304,91 @@ static void test_table(void **state)
     ulam_csr_free(M);
 }
 
+/* The value after "key": in a JSON text (a number, or a string's first character), or NULL. */
+static const char *json_at(const char *json, const char *key)
+{
+    char k[64];
+    snprintf(k, sizeof k, "\"%s\": ", key);
+    const char *p = strstr(json, k);
+    return p ? p + strlen(k) : NULL;
+}
+
+/* Run `ulam solve ARGS --json` (the CLI named by ULAM_EXE) into out (NUL-terminated). */
+static void cli_json(const char *args, char *out, size_t len)
+{
+    const char *exe = getenv("ULAM_EXE");
+    assert_non_null(exe);
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "%s solve %s --json", exe, args);
+    FILE *f = popen(cmd, "r");
+    assert_non_null(f);
+    size_t n = fread(out, 1, len - 1, f);
+    out[n] = 0;
+    assert_int_equal(pclose(f), 0);
+}
+
+/* ulam_solve with the defaults is `ulam solve`: on the same seed the same row, the same walk
+ * candidate (mode, estimator) and the same estimate and standard error, bit for bit (JSON's %.17g
+ * reads back exactly): the walks on chain4 at the default budget, bidirectional on randsub1000's
+ * x_7 for a 3-nonzero b at --rel-err 0.02; a walk option set away from its default is pinned as
+ * the command line pins what it is given (--estimator absorption). */
+static void test_solve_is_cli(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *M, *b, *args;
+        int64_t index;
+        double rel_err;
+        int estimator; /* -1: the default */
+        const char *method;
+    } cases[] = {
+        {"matrices/chain4.mtx", "matrices/chain4_b.mtx", "--index 3 --seed 7", 2, 0, -1, "walks"},
+        {"matrices/chain4.mtx", "matrices/chain4_b.mtx", "--index 3 --seed 7 --estimator absorption", 2, 0,
+         ULAM_ABSORPTION, "walks"},
+        {"matrices/randsub1000.mtx", "tests/data/sparse3_b.mtx", "--index 7 --seed 3 --rel-err 0.02", 6, 0.02, -1,
+         "bidirectional"},
+    };
+    ulam_choice *ch = malloc(sizeof *ch);
+    ulam_answer *a = malloc(sizeof *a);
+    char *json = malloc(1 << 16);
+    for (size_t t = 0; t < sizeof cases / sizeof cases[0]; t++) {
+        int64_t n;
+        double *b = must_read_vector(cases[t].b, &n);
+        ulam_csr *M = must_read(cases[t].M);
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.query.index = cases[t].index, o.exec.seed = strstr(cases[t].args, "--seed 7") ? 7 : 3, o.exec.threads = 2;
+        if (cases[t].rel_err > 0) o.stop.rel_err = cases[t].rel_err, o.stop.max_walks = 0; /* as the CLI: no --walks */
+        if (cases[t].estimator >= 0) o.estimator = cases[t].estimator;
+        ulam_walk_result r;
+        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        char args[512];
+        snprintf(args, sizeof args, "%s --rhs %s %s --threads 2", cases[t].M, cases[t].b, cases[t].args);
+        cli_json(args, json, 1 << 16);
+        const char *method = json_at(json, "method"), *est = json_at(json, "estimate"), *se = json_at(json, "stderr");
+        assert_true(method && est && se);
+        assert_memory_equal(method + 1, cases[t].method, strlen(cases[t].method));
+        assert_true(strtod(est, NULL) == r.estimate);
+        assert_true(strtod(se, NULL) == r.std_error);
+        /* the row and the walk candidate ulam_solve ran: ulam_auto's (the same estimate) */
+        ulam_auto_opts ao = ulam_auto_defaults();
+        ao.pin_estimator = cases[t].estimator >= 0;
+        assert_int_equal(ulam_auto(M, b, &o, &ao, NULL, ch, a, NULL), ULAM_OK);
+        assert_string_equal(ulam_method_name(a->method), cases[t].method);
+        assert_true(a->estimate == r.estimate);
+        if (a->method == ULAM_METHOD_WALKS) {
+            const char *mode = json_at(json, "mode"), *estimator = json_at(json, "estimator");
+            assert_true(mode && estimator);
+            assert_int_equal(strncmp(mode + 1, "adjoint", 7) ? ULAM_FORWARD : ULAM_ADJOINT, a->opts.mode);
+            const char *names[] = {"collision", "absorption", "expected"};
+            assert_memory_equal(estimator + 1, names[a->opts.estimator], strlen(names[a->opts.estimator]));
+            if (cases[t].estimator >= 0) assert_int_equal(a->opts.estimator, cases[t].estimator);
+        }
+        free(b);
+        ulam_csr_free(M);
+    }
+    free(json), free(a), free(ch);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -312,6 +397,7 @@ int main(void)
         cmocka_unit_test(test_pins),
         cmocka_unit_test(test_none),
         cmocka_unit_test(test_table),
+        cmocka_unit_test(test_solve_is_cli),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

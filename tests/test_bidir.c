@@ -179,7 +179,7 @@ static void test_bidir_unbiased(void **state)
                 if (!test_case(1000L * k + 10 * q + est)) continue;
                 ulam_bidir_opts o = ulam_bidir_defaults();
                 o.source = s, o.target = t, o.rmax = rmaxes[q];
-                o.walk.max_walks = 20000, o.walk.estimator = est, o.walk.seed = (uint64_t)(k * 10 + q);
+                o.walk.stop.max_walks = 20000, o.walk.estimator = est, o.walk.exec.seed = (uint64_t)(k * 10 + q);
                 ulam_bidir_result res = bidir(M, Mt, &o);
                 if (res.std_error == 0) { /* no residual left, or none the walks reach: exact */
                     assert_true(q == 2 || res.push.support > 0);
@@ -217,7 +217,7 @@ static void test_bidir_plan(void **state)
     ulam_csr *M = random_system(150, 5, 0, 0.85, 4), *Mt = NULL;
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     ulam_bidir_opts o = ulam_bidir_defaults();
-    o.source = 3, o.target = 10, o.walk.max_walks = 0, o.walk.rel_err = 0.05, o.walk.threads = 1;
+    o.source = 3, o.target = 10, o.walk.stop.max_walks = 0, o.walk.stop.rel_err = 0.05, o.walk.exec.threads = 1;
     ulam_push *w = NULL, *fresh = NULL;
     assert_int_equal(ulam_push_alloc(M, &w), ULAM_OK);
     assert_int_equal(ulam_push_alloc(M, &fresh), ULAM_OK);
@@ -245,11 +245,11 @@ static void test_bidir_plan(void **state)
     assert_true(ref.plan.rmax == plan.rmax && ref.plan.push.ops == plan.push.ops && ref.walks.walks == res.walks.walks);
     assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK); /* still the plan in place */
     assert_true(res.plan_reused);
-    o.walk.kernel_alpha = 2.0; /* another kernel exponent: its walks' plan is another (issue 29) */
+    o.walk.kernel.kernel_alpha = 2.0; /* another kernel exponent: its walks' plan is another (issue 29) */
     int st = ulam_bidir_solve(w, Mt, &o, &res, &err);
     assert_true(st != ULAM_OK || !res.plan_reused);
-    o.walk.kernel_alpha = 1.0;
-    o.walk.seed = 2; /* another pilot: plan again */
+    o.walk.kernel.kernel_alpha = 1.0;
+    o.walk.exec.seed = 2; /* another pilot: plan again */
     assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
     assert_false(res.plan_reused);
     assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
@@ -257,15 +257,15 @@ static void test_bidir_plan(void **state)
     assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
     assert_false(res.plan_reused);
     assert_true(res.push.rmax == plan.rmax && res.push.ops == plan.push.ops);
-    o.walk.threads = 2;
+    o.walk.exec.threads = 2;
     assert_int_equal(ulam_bidir_plan(w, Mt, &o, &again, &err), ULAM_OK);
     assert_true(again.rmax == plan.rmax && again.push.ops == plan.push.ops && again.pilot_steps == plan.pilot_steps);
     assert_memory_equal(&again.predicted_work, &plan.predicted_work, sizeof plan.predicted_work);
-    o.rmax = 0.01, o.walk.rel_err = 0, o.walk.max_walks = 5000; /* given rmax: no pilot, walks known */
+    o.rmax = 0.01, o.walk.stop.rel_err = 0, o.walk.stop.max_walks = 5000; /* given rmax: no pilot, walks known */
     assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
     assert_true(!plan.balanced && plan.pilot_walks == 0 && plan.rmax == 0.01 && plan.predicted_walks == 5000);
     assert_true(isnan(plan.predicted_work)); /* V unknown */
-    o.walk.rel_err = 0.05, o.walk.max_walks = 0;
+    o.walk.stop.rel_err = 0.05, o.walk.stop.max_walks = 0;
     assert_int_equal(ulam_bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
     assert_true(isnan(plan.predicted_walks) && isnan(plan.predicted_work)); /* no pilot measured V */
     o.source = 150;
@@ -289,11 +289,11 @@ static void test_solver_starts(void **state)
     double exact = 0.75 * x[5] - 2.0 * x[17];
     for (int k = 0; k < 4; k++) { /* case k: estimators 0..2, then collision with rel_err 0.02 */
         ulam_walk_opts o = ulam_walk_defaults();
-        o.nstarts = 3, o.starts = st, o.start_weights = c, o.seed = (uint64_t)k + 1;
-        o.estimator = k < 3 ? k : ULAM_COLLISION, o.max_walks = k < 3 ? 40000 : 0, o.rel_err = k < 3 ? 0 : 0.02;
+        o.query.nstarts = 3, o.query.starts = st, o.query.start_weights = c, o.exec.seed = (uint64_t)k + 1;
+        o.estimator = k < 3 ? k : ULAM_COLLISION, o.stop.max_walks = k < 3 ? 40000 : 0, o.stop.rel_err = k < 3 ? 0 : 0.02;
         ulam_walk_result r;
         ulam_error err;
-        int st_ = ulam_solve(M, b, &o, &r, &err);
+        int st_ = ulam_solve_walks(M, b, &o, &r, &err);
         if (st_ || !(fabs(r.estimate - exact) < 4 * r.std_error))
             print_error("case %d: %s, %.8g +- %.3g, exact %.8g\n", k, ulam_strerror(st_), r.estimate, r.std_error, exact);
         assert_int_equal(st_, ULAM_OK);
@@ -305,12 +305,12 @@ static void test_solver_starts(void **state)
     ulam_error err;
     double zeros[3] = {0, 0, 0};
     int64_t bad[3] = {5, 60, 1};
-    o.nstarts = 3, o.starts = st, o.start_weights = c, o.mode = ULAM_FORWARD;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
-    o.mode = ULAM_ADJOINT, o.starts = bad;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
-    o.starts = st, o.start_weights = zeros;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    o.query.nstarts = 3, o.query.starts = st, o.query.start_weights = c, o.mode = ULAM_FORWARD;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
+    o.mode = ULAM_ADJOINT, o.query.starts = bad;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
+    o.query.starts = st, o.query.start_weights = zeros;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
     free(b), free(x);
     ulam_csr_free(M);
 }
@@ -338,7 +338,7 @@ static void test_bidir_sparse_b(void **state)
             for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est += 2) {
                 ulam_bidir_opts o = ulam_bidir_defaults();
                 o.target = t, o.nb = 3, o.b_index = idx, o.b_value = val, o.rmax = rmaxes[q];
-                o.walk.max_walks = 20000, o.walk.estimator = est, o.walk.seed = (uint64_t)(k * 10 + q + 100);
+                o.walk.stop.max_walks = 20000, o.walk.estimator = est, o.walk.exec.seed = (uint64_t)(k * 10 + q + 100);
                 ulam_bidir_result res;
                 ulam_error err;
                 int st = ulam_bidir_solve(w, Mt, &o, &res, &err);
@@ -358,7 +358,7 @@ static void test_bidir_sparse_b(void **state)
                 assert_true(fabs(z) < 4 && res.walks.walks == 20000);
                 if (k == 1 && q == 1 && est == ULAM_COLLISION) { /* any thread count, the same answer */
                     ulam_bidir_result two;
-                    o.walk.threads = 2;
+                    o.walk.exec.threads = 2;
                     assert_int_equal(ulam_bidir_solve(w, Mt, &o, &two, &err), ULAM_OK);
                     assert_memory_equal(&two.estimate, &res.estimate, sizeof res.estimate);
                     assert_memory_equal(&two.std_error, &res.std_error, sizeof res.std_error);
@@ -395,7 +395,7 @@ static void test_bidir_coverage(void **state)
         if (!test_case(seed)) continue;
         ulam_bidir_opts o = ulam_bidir_defaults();
         o.source = 5, o.target = 17, o.rmax = 0.2;
-        o.walk.max_walks = 2000, o.walk.seed = (uint64_t)seed;
+        o.walk.stop.max_walks = 2000, o.walk.exec.seed = (uint64_t)seed;
         ulam_bidir_result res = bidir(M, Mt, &o);
         covered += fabs(res.estimate - x[17]) <= ULAM_Z95 * res.std_error; /* the walks' own check */
         printed += res.ci95[0] <= x[17] && x[17] <= res.ci95[1]; /* src/stop.h's interval: conservative */
@@ -446,7 +446,7 @@ static void test_bidir_rules(void **state)
     assert_int_equal(ulam_csr_transpose(Mt, &M), ULAM_OK);
     double *x = exact_column(M, 3);
     o = ulam_bidir_defaults();
-    o.source = 3, o.target = 10, o.rmax = 0.05, o.walk.max_walks = 0, o.walk.rel_err = 0.01;
+    o.source = 3, o.target = 10, o.rmax = 0.05, o.walk.stop.max_walks = 0, o.walk.stop.rel_err = 0.01;
     res = bidir(M, Mt, &o);
     print_message("rel-err 0.01: %lld walks, relative error %.3g\n", (long long)res.walks.walks,
                   res.std_error / fabs(res.estimate));
@@ -454,9 +454,9 @@ static void test_bidir_rules(void **state)
     /* stopped by the rule: its range-term minimum (here above what the standard error needs) */
     assert_true(res.walks.rel_err_met && res.walks.walks >= res.walks.min_walks && res.walks.min_walks > 1024);
     assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
-    o.rmax = 0, o.walk.rel_err = 0, o.walk.max_walks = 5000, o.walk.threads = 1;
+    o.rmax = 0, o.walk.stop.rel_err = 0, o.walk.stop.max_walks = 5000, o.walk.exec.threads = 1;
     ulam_bidir_result one = bidir(M, Mt, &o);
-    o.walk.threads = 2;
+    o.walk.exec.threads = 2;
     ulam_bidir_result two = bidir(M, Mt, &o);
     assert_memory_equal(&one.estimate, &two.estimate, sizeof one.estimate);
     assert_memory_equal(&one.std_error, &two.std_error, sizeof one.std_error);
@@ -484,7 +484,7 @@ static void test_bidir_deterministic_walks(void **state)
         double *x = exact_column(N, cases[k].s);
         ulam_bidir_opts o = ulam_bidir_defaults();
         o.source = cases[k].s, o.target = cases[k].t, o.rmax = cases[k].rmax, o.walk.estimator = cases[k].est;
-        o.walk.max_walks = 0, o.walk.rel_err = 0.1;
+        o.walk.stop.max_walks = 0, o.walk.stop.rel_err = 0.1;
         ulam_bidir_result res = bidir(N, Nt, &o);
         if (!(res.std_error == 0 && res.estimate == x[cases[k].t]))
             print_error("case %d: %.6g +- %.3g, exact %.6g\n", k, res.estimate, res.std_error, x[cases[k].t]);
@@ -504,13 +504,13 @@ static void test_bidir_small_budgets(void **state)
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     double *x = exact_column(M, 3);
     ulam_bidir_opts o = ulam_bidir_defaults();
-    o.source = 3, o.target = 10, o.rmax = 0.05, o.walk.max_walks = 0, o.walk.max_seconds = 1e-6;
+    o.source = 3, o.target = 10, o.rmax = 0.05, o.walk.stop.max_walks = 0, o.walk.stop.max_seconds = 1e-6;
     ulam_bidir_result res = bidir(M, Mt, &o);
     assert_true(res.walks.walks >= 1 && res.walks.walks <= 1024 && isfinite(res.estimate));
     assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
     for (int64_t walks = 1; walks <= 16; walks *= 4) {
         if (!test_case(walks)) continue;
-        o.walk.max_seconds = 0, o.walk.max_walks = walks;
+        o.walk.stop.max_seconds = 0, o.walk.stop.max_walks = walks;
         res = bidir(M, Mt, &o);
         assert_true(res.walks.walks == walks && isfinite(res.estimate));
         if (walks > 1 && res.std_error > 0) assert_true(fabs(res.estimate - x[10]) < 4 * res.std_error);
@@ -535,7 +535,7 @@ static void test_bidir_rare_score(void **state)
         if (!test_case(seed)) continue;
         ulam_bidir_opts o = ulam_bidir_defaults();
         o.source = 1, o.target = 0, o.rmax = 2; /* no push: every score is a walk's */
-        o.walk.max_walks = 0, o.walk.rel_err = 0.1, o.walk.seed = (uint64_t)seed;
+        o.walk.stop.max_walks = 0, o.walk.stop.rel_err = 0.1, o.walk.exec.seed = (uint64_t)seed;
         ulam_bidir_result res = bidir(M, Mt, &o);
         if (!(res.std_error > 0 && fabs(res.estimate - x[0]) < 4 * res.std_error))
             print_error("seed %d: %.6g +- %.3g after %lld walks, exact %.6g\n", seed, res.estimate, res.std_error,
@@ -592,9 +592,9 @@ static void test_bidir_reach_all(void **state)
             double *x = exact_column(M, s);
             ulam_bidir_opts o = ulam_bidir_defaults();
             o.source = s, o.target = t;
-            o.walk.max_walks = 0, o.walk.rel_err = 0.1, o.walk.seed = (uint64_t)(k * 10 + q + 1);
+            o.walk.stop.max_walks = 0, o.walk.stop.rel_err = 0.1, o.walk.exec.seed = (uint64_t)(k * 10 + q + 1);
             o.walk.estimator = est, o.reach_all = 1, o.keep_kernel = 1;
-            if (est == ULAM_ABSORPTION) o.walk.continue_q = 0.9; /* rows of M' may sum past 1: p* = 0.1 */
+            if (est == ULAM_ABSORPTION) o.walk.kernel.continue_q = 0.9; /* rows of M' may sum past 1: p* = 0.1 */
             ulam_bidir_result res;
             ulam_error err;
             int st = ulam_bidir_solve(shared, Mt, &o, &res, &err);
@@ -659,7 +659,7 @@ static void test_bidir_fixed_walks_honest(void **state)
         for (int seed = 0; seed < cases[c].seeds; seed++) {
             ulam_bidir_opts o = ulam_bidir_defaults();
             o.source = 2, o.target = t, o.rmax = cases[c].rmax;
-            o.walk.max_walks = 100, o.walk.seed = (uint64_t)seed, o.walk.estimator = cases[c].est;
+            o.walk.stop.max_walks = 100, o.walk.exec.seed = (uint64_t)seed, o.walk.estimator = cases[c].est;
             ulam_bidir_result res;
             ulam_error err;
             assert_int_equal(ulam_bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
@@ -696,7 +696,7 @@ static void test_fpush_all_targets(void **state)
     for (int seed = 1; seed <= 2; seed++) {
         if (!test_case(seed)) continue;
         ulam_fpush_opts o = ulam_fpush_defaults();
-        o.source = 2, o.walk.seed = (uint64_t)seed;
+        o.source = 2, o.walk.exec.seed = (uint64_t)seed;
         ulam_fpush_info info;
         ulam_error err;
         assert_int_equal(ulam_fpush_solve(M, Mt, &o, est, se, lo, hi, &info, &err), ULAM_OK);

@@ -10,23 +10,23 @@ static void assert_walk_equal(const ulam_walk_opts *a, const ulam_walk_opts *b)
 {
     assert_int_equal(a->mode, b->mode);
     assert_int_equal(a->estimator, b->estimator);
-    assert_int_equal(a->index, b->index);
-    assert_close(a->continue_q, b->continue_q, 0);
-    assert_int_equal(a->whole_kernel, b->whole_kernel);
-    assert_close(a->roulette, b->roulette, 0);
-    assert_close(a->split, b->split, 0);
-    assert_int_equal(a->seed, b->seed);
-    assert_int_equal(a->threads, b->threads);
-    assert_int_equal(a->max_walks, b->max_walks);
-    assert_close(a->rel_err, b->rel_err, 0);
-    assert_close(a->max_seconds, b->max_seconds, 0);
-    assert_int_equal(a->max_steps, b->max_steps);
-    assert_ptr_equal(a->interrupt, b->interrupt);
-    assert_ptr_equal(a->share, b->share);
-    assert_int_equal(a->force, b->force);
-    assert_int_equal(a->assume_finite, b->assume_finite);
-    assert_ptr_equal(a->guard, b->guard);
-    assert_close(a->rel_err_offset, b->rel_err_offset, 0);
+    assert_int_equal(a->query.index, b->query.index);
+    assert_close(a->kernel.continue_q, b->kernel.continue_q, 0);
+    assert_int_equal(a->kernel.whole_kernel, b->kernel.whole_kernel);
+    assert_close(a->kernel.roulette, b->kernel.roulette, 0);
+    assert_close(a->kernel.split, b->kernel.split, 0);
+    assert_int_equal(a->exec.seed, b->exec.seed);
+    assert_int_equal(a->exec.threads, b->exec.threads);
+    assert_int_equal(a->stop.max_walks, b->stop.max_walks);
+    assert_close(a->stop.rel_err, b->stop.rel_err, 0);
+    assert_close(a->stop.max_seconds, b->stop.max_seconds, 0);
+    assert_int_equal(a->stop.max_steps, b->stop.max_steps);
+    assert_ptr_equal(a->stop.interrupt, b->stop.interrupt);
+    assert_ptr_equal(a->exec.share, b->exec.share);
+    assert_int_equal(a->policy.force, b->policy.force);
+    assert_int_equal(a->policy.assume_finite, b->policy.assume_finite);
+    assert_ptr_equal(a->policy.guard, b->policy.guard);
+    assert_close(a->stop.rel_err_offset, b->stop.rel_err_offset, 0);
 }
 
 /* ulam_walk_defaults: adjoint collision walks at index 0, analog kernel, seed 1, all cores,
@@ -37,23 +37,44 @@ static void test_walk(void **state)
     ulam_walk_opts o = ulam_walk_defaults();
     assert_int_equal(o.mode, ULAM_ADJOINT);
     assert_int_equal(o.estimator, ULAM_COLLISION);
-    assert_int_equal(o.index, 0);
-    assert_close(o.continue_q, 0.0, 0);
-    assert_int_equal(o.whole_kernel, 0);
-    assert_close(o.roulette, 0.0, 0);
-    assert_close(o.split, 0.0, 0);
-    assert_int_equal(o.seed, 1);
-    assert_int_equal(o.threads, 0);
-    assert_int_equal(o.max_walks, 100000);
-    assert_close(o.rel_err, 0.0, 0);
-    assert_close(o.max_seconds, 0.0, 0);
-    assert_int_equal(o.max_steps, 1000000);
-    assert_null(o.interrupt);
-    assert_null(o.share);
-    assert_int_equal(o.force, 0);
-    assert_int_equal(o.assume_finite, 0);
-    assert_null(o.guard);
-    assert_close(o.rel_err_offset, 0.0, 0);
+    assert_int_equal(o.query.index, 0);
+    assert_close(o.kernel.continue_q, 0.0, 0);
+    assert_int_equal(o.kernel.whole_kernel, 0);
+    assert_close(o.kernel.roulette, 0.0, 0);
+    assert_close(o.kernel.split, 0.0, 0);
+    assert_int_equal(o.exec.seed, 1);
+    assert_int_equal(o.exec.threads, 0);
+    assert_int_equal(o.stop.max_walks, 100000);
+    assert_close(o.stop.rel_err, 0.0, 0);
+    assert_close(o.stop.max_seconds, 0.0, 0);
+    assert_int_equal(o.stop.max_steps, 1000000);
+    assert_null(o.stop.interrupt);
+    assert_null(o.exec.share);
+    assert_int_equal(o.policy.force, 0);
+    assert_int_equal(o.policy.assume_finite, 0);
+    assert_null(o.policy.guard);
+    assert_close(o.stop.rel_err_offset, 0.0, 0);
+    assert_close(o.kernel.kernel_alpha, 1.0, 0);
+    assert_int_equal(o.query.nstarts, 0);
+    assert_null(o.query.starts);
+    assert_null(o.query.start_weights);
+    assert_null(o.policy.system);
+    /* each concern is its own defaults function's (the parts a caller may start from alone) */
+    ulam_kernel_opts k = ulam_kernel_defaults();
+    ulam_stop_opts st = ulam_stop_defaults();
+    ulam_exec_opts e = ulam_exec_defaults();
+    ulam_query_opts q = ulam_query_defaults();
+    ulam_policy_opts p = ulam_policy_defaults();
+    assert_true(k.continue_q == o.kernel.continue_q && k.kernel_alpha == o.kernel.kernel_alpha &&
+                k.whole_kernel == o.kernel.whole_kernel && k.roulette == o.kernel.roulette && k.split == o.kernel.split);
+    assert_true(st.max_walks == o.stop.max_walks && st.rel_err == o.stop.rel_err &&
+                st.max_seconds == o.stop.max_seconds && st.max_steps == o.stop.max_steps &&
+                st.interrupt == o.stop.interrupt && st.rel_err_offset == o.stop.rel_err_offset);
+    assert_true(e.seed == o.exec.seed && e.threads == o.exec.threads && e.share == o.exec.share);
+    assert_true(q.index == o.query.index && q.nstarts == o.query.nstarts && q.starts == o.query.starts &&
+                q.start_weights == o.query.start_weights);
+    assert_true(p.force == o.policy.force && p.assume_finite == o.policy.assume_finite && p.guard == o.policy.guard &&
+                p.system == o.policy.system);
 }
 
 /* ulam_mm_defaults: all cores, ulam_strtod; and reading with them is reading with NULL options. */
@@ -163,13 +184,13 @@ static void test_share(void **state)
     int64_t n;
     double *b = must_read_vector("matrices/signed200_b.mtx", &n);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.max_walks = 5000, o.index = 3, o.threads = 2;
+    o.stop.max_walks = 5000, o.query.index = 3, o.exec.threads = 2;
     ulam_walk_result r0, r1, r2;
-    assert_int_equal(ulam_solve(M, b, &o, &r0, NULL), ULAM_OK);
-    o.share = &sh;
-    assert_int_equal(ulam_solve(M, b, &o, &r1, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r0, NULL), ULAM_OK);
+    o.exec.share = &sh;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r1, NULL), ULAM_OK);
     sh.allgather = gather_one;
-    assert_int_equal(ulam_solve(M, b, &o, &r2, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r2, NULL), ULAM_OK);
     assert_memory_equal(&r0.estimate, &r1.estimate, sizeof r0.estimate);
     assert_memory_equal(&r0.std_error, &r1.std_error, sizeof r0.std_error);
     assert_memory_equal(&r0.estimate, &r2.estimate, sizeof r0.estimate);

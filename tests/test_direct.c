@@ -239,8 +239,8 @@ static void test_study_methods(void **state)
         double w0 = m->mode == ULAM_FORWARD ? 6.0 : 1.0;
         assert_int_equal(o.mode, m->mode);
         assert_int_equal(o.estimator, m->estimator);
-        assert_close(o.roulette, m->window ? 0.5 * w0 : 0.0, 0.0);
-        assert_close(o.split, m->window == ULAM_WINDOW_SPLIT ? 2.0 * w0 : 0.0, 0.0);
+        assert_close(o.kernel.roulette, m->window ? 0.5 * w0 : 0.0, 0.0);
+        assert_close(o.kernel.split, m->window == ULAM_WINDOW_SPLIT ? 2.0 * w0 : 0.0, 0.0);
     }
     assert_null(ulam_study_method_get(ULAM_STUDY_METHODS));
     assert_null(ulam_study_method_get(-1));

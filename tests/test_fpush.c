@@ -42,7 +42,7 @@ static void test_fpush_rule(void **state)
     for (int seed = 1; seed <= 8; seed++) {
         if (!test_case(seed)) continue;
         ulam_fpush_opts o = ulam_fpush_defaults();
-        o.source = s, o.walk.seed = (uint64_t)seed, o.min_value = 1.0 / (0.15 * (double)n), o.walk.max_walks = 0;
+        o.source = s, o.walk.exec.seed = (uint64_t)seed, o.min_value = 1.0 / (0.15 * (double)n), o.walk.stop.max_walks = 0;
         ulam_fpush_info info;
         ulam__sweep_info sw;
         ulam_error err;
@@ -88,7 +88,7 @@ static void test_fpush_small_budgets(void **state)
         for (int seed = 1; seed <= 16; seed++) {
             if (!test_case(100 * c + seed)) continue;
             ulam_fpush_opts o = ulam_fpush_defaults();
-            o.source = s, o.walk.seed = (uint64_t)seed, o.walks = walks[c], o.rmax = 0.02;
+            o.source = s, o.walk.exec.seed = (uint64_t)seed, o.walks = walks[c], o.rmax = 0.02;
             ulam_fpush_info info;
             ulam__sweep_info sw;
             ulam_error err;

@@ -41,10 +41,10 @@ static void test_rel_err_rare_scores(void **state)
         for (int s = 0; s < R; s++) { /* case 1000 k + s reruns exactly */
             if (!test_case(1000L * k + s)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = ULAM_ABSORPTION, o.index = 3, o.max_walks = 0, o.rel_err = cases[k].E;
-            o.seed = 1000 + (uint64_t)s;
+            o.estimator = ULAM_ABSORPTION, o.query.index = 3, o.stop.max_walks = 0, o.stop.rel_err = cases[k].E;
+            o.exec.seed = 1000 + (uint64_t)s;
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             assert_true(r.rel_err_met && r.variance_finite == 1);
             assert_true(r.std_error <= cases[k].E * fabs(r.estimate) && r.walks >= r.min_walks);
             covered += fabs(r.estimate - x) <= ULAM_Z95 * r.std_error;
@@ -99,9 +99,9 @@ static void test_rel_err_no_score_bound(void **state)
         for (int s = 0; s < R; s++) { /* case 1000 k + s */
             if (!test_case(1000L * k + s)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = cases[k].est, o.index = 0, o.max_walks = 0, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
+            o.estimator = cases[k].est, o.query.index = 0, o.stop.max_walks = 0, o.stop.rel_err = 0.1, o.exec.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             if (!(r.rel_err_met && isfinite(r.tail_bound) && r.walks >= r.min_walks))
                 print_error("case (%d, %d): met %d, tail %g, %lld walks, min %g\n", k, s, r.rel_err_met, r.tail_bound,
                             (long long)r.walks, r.min_walks);

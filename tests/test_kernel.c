@@ -152,15 +152,15 @@ static void test_agreement(void **state)
                 for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est++, c++) {
                     if (!test_case(c)) continue;
                     ulam_walk_opts o = ulam_walk_defaults();
-                    o.mode = mode, o.estimator = est, o.index = index[k], o.kernel_alpha = alphas[a];
-                    o.max_walks = mode == ULAM_FORWARD ? 100000 : 40000;
-                    o.seed = 300 + (uint64_t)c;
+                    o.mode = mode, o.estimator = est, o.query.index = index[k], o.kernel.kernel_alpha = alphas[a];
+                    o.stop.max_walks = mode == ULAM_FORWARD ? 100000 : 40000;
+                    o.exec.seed = 300 + (uint64_t)c;
                     ulam_solver *sv = NULL;
                     int st = ulam_solver_alloc(sy[k].M, sy[k].b, &o, &sv, NULL);
                     ulam_solver_free(sv);
                     if (st == ULAM_EUNDEFINED) {
                         assert_true(est == ULAM_ABSORPTION && mode == ULAM_FORWARD && k > 0);
-                        o.continue_q = 0.8;
+                        o.kernel.continue_q = 0.8;
                     }
                     ulam_walk_result r = test_sys_run(&sy[k], o);
                     if (r.variance_finite != 1) { /* no 4 sigma claim: and no interval either */
@@ -169,12 +169,12 @@ static void test_agreement(void **state)
                         skipped++;
                         continue;
                     }
-                    double z = (r.estimate - sy[k].x[o.index]) / r.std_error;
-                    if (!(fabs(z) < 4) || !(r.std_error < 0.25 * (fabs(sy[k].x[o.index]) + 1)))
+                    double z = (r.estimate - sy[k].x[o.query.index]) / r.std_error;
+                    if (!(fabs(z) < 4) || !(r.std_error < 0.25 * (fabs(sy[k].x[o.query.index]) + 1)))
                         print_error("case %d (system %d alpha %g mode %d est %d): %.10g +- %.3g, LAPACK %.10g (z = "
-                                    "%.2f)\n", c, k, alphas[a], mode, est, r.estimate, r.std_error, sy[k].x[o.index], z);
+                                    "%.2f)\n", c, k, alphas[a], mode, est, r.estimate, r.std_error, sy[k].x[o.query.index], z);
                     assert_true(fabs(z) < 4);
-                    assert_true(r.std_error > 0 && r.std_error < 0.25 * (fabs(sy[k].x[o.index]) + 1));
+                    assert_true(r.std_error > 0 && r.std_error < 0.25 * (fabs(sy[k].x[o.query.index]) + 1));
                 }
     test_case_done();
     print_message("%d of %d cases with rho(M^) >= 1 (signed200 forward at alpha 0 and 2): no interval\n", skipped, c);
@@ -230,7 +230,7 @@ static void test_exact_variance(void **state)
             ex[a] = exact_variance(&s, est, 5, alphas[a]);
             if (!test_case(1000L * est + a)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = est, o.index = 5, o.kernel_alpha = alphas[a], o.max_walks = 400000, o.seed = 11;
+            o.estimator = est, o.query.index = 5, o.kernel.kernel_alpha = alphas[a], o.stop.max_walks = 400000, o.exec.seed = 11;
             ulam_walk_result r = test_sys_run(&s, o);
             double *D4 = dense_moment(s.M, ULAM_ADJOINT, alphas[a], 0.0, 4), r4 = dense_radius(D4, s.n);
             free(D4);
@@ -281,18 +281,18 @@ static void test_verdict(void **state)
     assert_int_equal(g[3].verdict_hat[0], ULAM_VERDICT_FAIL);
     assert_true(g[1].hat[0].lower > g[2].hat[0].upper && g[1].hat[0].upper < g[0].hat[0].lower);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.max_walks = 0, o.rel_err = 0.01, o.kernel_alpha = 1.0;
+    o.stop.max_walks = 0, o.stop.rel_err = 0.01, o.kernel.kernel_alpha = 1.0;
     ulam_walk_result r;
     ulam_error err;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_true(r.rel_err_met && r.variance_finite == 1);
-    o.kernel_alpha = 0.0;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
+    o.kernel.kernel_alpha = 0.0;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINFVAR);
     assert_non_null(strstr(err.msg, "alpha = 0"));
     assert_non_null(strstr(err.msg, ">= 1: infinite"));
-    o.guard = &g[2]; /* the alpha = 1 verdicts handed in are not this kernel's: recomputed */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
-    o.max_walks = 4000; /* bounded: runs, no interval, the rule never fires */
+    o.policy.guard = &g[2]; /* the alpha = 1 verdicts handed in are not this kernel's: recomputed */
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINFVAR);
+    o.stop.max_walks = 4000; /* bounded: runs, no interval, the rule never fires */
     ulam_solver *sv = NULL;
     assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, &err), ULAM_OK);
     ulam_guard gs;
@@ -317,7 +317,7 @@ static void test_coverage(void **state)
     for (int seed = 0; seed < 200; seed++) { /* case seed: reruns exactly */
         if (!test_case(seed)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 5, o.kernel_alpha = 2.0, o.max_walks = 2000, o.seed = (uint64_t)seed;
+        o.query.index = 5, o.kernel.kernel_alpha = 2.0, o.stop.max_walks = 2000, o.exec.seed = (uint64_t)seed;
         ulam_walk_result r = test_sys_run(&s, o);
         assert_int_equal(r.variance_finite, 1);
         covered += fabs(r.estimate - s.x[5]) <= ULAM_Z95 * r.std_error;
@@ -347,9 +347,9 @@ static void test_rel_err_fourth_coverage(void **state)
     for (int seed = 0; seed < 100; seed++) { /* case seed: reruns exactly */
         if (!test_case(seed)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 0, o.kernel_alpha = 2.0, o.max_walks = 0, o.rel_err = 0.05, o.seed = 500 + (uint64_t)seed;
+        o.query.index = 0, o.kernel.kernel_alpha = 2.0, o.stop.max_walks = 0, o.stop.rel_err = 0.05, o.exec.seed = 500 + (uint64_t)seed;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
         assert_true(r.rel_err_met && r.fourth_finite == 0 && r.variance_finite == 1);
         assert_true(r.std_error <= 0.05 * fabs(r.estimate));
         covered += r.ci95[0] <= s.x[0] && s.x[0] <= r.ci95[1];
@@ -380,15 +380,15 @@ static void test_weight_bound(void **state)
     for (int a = 0; a < 3; a++) {
         if (!test_case(a)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.estimator = ULAM_ABSORPTION, o.kernel_alpha = alphas[a], o.max_walks = 0, o.rel_err = 0.01;
+        o.estimator = ULAM_ABSORPTION, o.kernel.kernel_alpha = alphas[a], o.stop.max_walks = 0, o.stop.rel_err = 0.01;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
         print_message("alpha %.0f: score bound %.6g, %lld walks to 1%%, x_1 = %.6g +- %.2g\n", alphas[a], r.score_bound,
                       (long long)r.walks, r.estimate, r.std_error);
         assert_close(r.score_bound, bounds[a], 1e-12);
         assert_true(r.rel_err_met && fabs(r.estimate - 0.5) < 4 * r.std_error);
         o.estimator = ULAM_COLLISION; /* per visit at most the weight bound times max |b|: the range term holds too */
-        assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
         assert_true(r.rel_err_met && isfinite(r.tail_bound) && fabs(r.estimate - 0.5) < 4 * r.std_error);
         assert_true(r.min_walks >= 12.28 * bounds[a] / (0.01 * r.estimate)); /* R >= the largest score */
     }
@@ -405,11 +405,11 @@ static void test_identical(void **state)
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
         if (!test_case(mode)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.mode = mode, o.index = 5, o.max_walks = 50000, o.seed = 9, o.kernel_alpha = 0.5, o.threads = 1;
+        o.mode = mode, o.query.index = 5, o.stop.max_walks = 50000, o.exec.seed = 9, o.kernel.kernel_alpha = 0.5, o.exec.threads = 1;
         ulam_walk_result a = test_sys_run(&s, o);
-        o.threads = 2;
+        o.exec.threads = 2;
         ulam_walk_result b = test_sys_run(&s, o);
-        o.whole_kernel = 1;
+        o.kernel.whole_kernel = 1;
         ulam_walk_result c = test_sys_run(&s, o);
         assert_memory_equal(&a.estimate, &b.estimate, sizeof a.estimate);
         assert_memory_equal(&a.variance, &c.variance, sizeof a.variance);
@@ -435,10 +435,10 @@ static void test_options(void **state)
     ulam_solver *sv = NULL;
     ulam_guard g;
     ulam_error err;
-    assert_true(o.kernel_alpha == 1.0 && go.kernel_alpha == 1.0);
+    assert_true(o.kernel.kernel_alpha == 1.0 && go.kernel_alpha == 1.0);
     static const double bad[] = {-1.0, -1e-300, NAN, INFINITY};
     for (int k = 0; k < 4; k++) {
-        o.kernel_alpha = go.kernel_alpha = bad[k];
+        o.kernel.kernel_alpha = go.kernel_alpha = bad[k];
         assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, &err), ULAM_EINVAL);
         assert_non_null(strstr(err.msg, "kernel exponent"));
         assert_null(sv);
@@ -485,9 +485,9 @@ static void test_options(void **state)
         assert_close(gz.hat[m].rho, gu.hat[m].rho, 1e-9 * gu.hat[m].rho);
     }
     o = ulam_walk_defaults();
-    o.kernel_alpha = 0.0, o.index = 3, o.max_walks = 1000;
+    o.kernel.kernel_alpha = 0.0, o.query.index = 3, o.stop.max_walks = 1000;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(Z, u.b, &o, &r, &err), ULAM_ESYNTAX);
+    assert_int_equal(ulam_solve_walks(Z, u.b, &o, &r, &err), ULAM_ESYNTAX);
     ulam_csr_free(Z);
     test_sys_free(&u);
 
@@ -497,16 +497,16 @@ static void test_options(void **state)
     ulam_csr *M = NULL;
     assert_int_equal(ulam_csr_from_triplets(3, 3, 3, ti, tj, tx, &M), ULAM_OK);
     o = ulam_walk_defaults();
-    o.kernel_alpha = 2.0, o.max_walks = 1000, o.force = 1;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_ERANGE);
+    o.kernel.kernel_alpha = 2.0, o.stop.max_walks = 1000, o.policy.force = 1;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_ERANGE);
     assert_int_equal(err.index, 0);
     assert_non_null(strstr(err.msg, "alpha = 2"));
     go = ulam_guard_defaults(); /* at alpha = 20 the probability (2e-30)^20 underflows: rho(M^) unknown, not certified */
     go.kernel_alpha = 20.0;
     assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
     assert_true(g.verdict_hat[ULAM_ADJOINT] == ULAM_VERDICT_UNKNOWN && g.hat[ULAM_ADJOINT].lower == 0.0);
-    o.kernel_alpha = 1.0; /* the analog kernel samples it (probability 2e-30) */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    o.kernel.kernel_alpha = 1.0; /* the analog kernel samples it (probability 2e-30) */
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     ulam_csr_free(M);
 }
 
@@ -533,7 +533,7 @@ static void test_fourth_moment(void **state)
         for (int k = 0; k < SEEDS; k++) {
             if (!test_case(1000L * a + k)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.index = 5, o.kernel_alpha = alphas[a], o.max_walks = 20000, o.seed = 100 + (uint64_t)k;
+            o.query.index = 5, o.kernel.kernel_alpha = alphas[a], o.stop.max_walks = 20000, o.exec.seed = 100 + (uint64_t)k;
             ulam_walk_result r = test_sys_run(&s, o);
             sv += r.variance, sv2 += r.variance * r.variance, vre += r.variance_rel_error;
         }
@@ -551,26 +551,26 @@ static void test_fourth_moment(void **state)
     double *D4 = dense_moment(s.M, ULAM_ADJOINT, 2.0, 0.0, 4), r4 = dense_radius(D4, s.n);
     free(D4);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 5, o.kernel_alpha = 2.0, o.max_walks = 0, o.rel_err = 0.05;
+    o.query.index = 5, o.kernel.kernel_alpha = 2.0, o.stop.max_walks = 0, o.stop.rel_err = 0.05;
     ulam_walk_result r;
     ulam_error err;
     /* rho(M4) >= 1 but a certified second moment: the rule skips the variance's own error and
      * stands on v2 (its range term bounds the true standard error by 0.29 E |x|) */
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_OK);
     print_message("alpha 2 --rel-err 0.05 alone: %lld walks, met %d, %.6g +- %.3g (exact %.6g; dense rho(M4) %.6g, "
                   "fourth %d)\n", (long long)r.walks, r.rel_err_met, r.estimate, r.std_error, s.x[5], r4,
                   r.fourth_finite);
     assert_true(r4 >= 1.0 && r.fourth_finite == 0 && r.rel_err_met);
     assert_close(r.estimate, s.x[5], 4 * r.std_error);
     assert_true(r.std_error <= 0.05 * fabs(r.estimate));
-    o.max_walks = 200000; /* with a budget too: the same verdicts, and the rule may stop it earlier, or */
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK); /* say early the budget is too small */
+    o.stop.max_walks = 200000; /* with a budget too: the same verdicts, and the rule may stop it earlier, or */
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_OK); /* say early the budget is too small */
     assert_true(r.walks == 200000 || r.rel_err_met || (r.out_of_reach && r.min_walks > 200000));
     assert_true(r.fourth_finite == 0 && r.variance_finite == 1);
     assert_true(r.rho4.lower <= r4 * (1 + 1e-9) && r4 <= r.rho4.upper * (1 + 1e-9) && r.rho4.lower >= 1.0);
     assert_close(r.estimate, s.x[5], 4 * r.std_error);
-    o.kernel_alpha = 1.0, o.max_walks = 0; /* bounded scores: every moment finite, rho4 not needed */
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK);
+    o.kernel.kernel_alpha = 1.0, o.stop.max_walks = 0; /* bounded scores: every moment finite, rho4 not needed */
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_OK);
     assert_true(r.rel_err_met && r.fourth_finite == 1);
     assert_close(r.estimate, s.x[5], 4 * r.std_error);
     test_sys_free(&s);
@@ -595,11 +595,11 @@ static void test_fourth_radius(void **state)
                 double *D = dense_moment(sy[k].M, m, alphas[a], q, 4), exact = dense_radius(D, sy[k].n);
                 free(D);
                 ulam_walk_opts o = ulam_walk_defaults();
-                o.mode = m, o.index = 5, o.kernel_alpha = alphas[a], o.continue_q = q, o.rel_err = 0.05;
-                o.max_walks = 1000000, o.seed = 3;
+                o.mode = m, o.query.index = 5, o.kernel.kernel_alpha = alphas[a], o.kernel.continue_q = q, o.stop.rel_err = 0.05;
+                o.stop.max_walks = 1000000, o.exec.seed = 3;
                 ulam_walk_result r;
                 ulam_error err;
-                int st = ulam_solve(sy[k].M, sy[k].b, &o, &r, &err);
+                int st = ulam_solve_walks(sy[k].M, sy[k].b, &o, &r, &err);
                 print_message("system %d alpha %.1f Q %.1f %s: rho(M4) dense %.6g, certified [%.6g, %.6g], fourth %d, "
                               "met %d (%s)\n", k, alphas[a], q, m ? "forward" : "adjoint", exact, r.rho4.lower,
                               r.rho4.upper, r.fourth_finite, r.rel_err_met, st ? err.msg : "ran");

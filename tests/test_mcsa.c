@@ -86,7 +86,7 @@ static void test_methods_converge(void **state)
         if (!test_case(c)) continue;
         ulam_outer_opts o = ulam_outer_defaults();
         o.method = methods[c];
-        o.walk.threads = 2;
+        o.walk.exec.threads = 2;
         ulam_outer_step st[256];
         int k;
         assert_int_equal(run(&s, &o, x, st, 256, &k), ULAM_OK);
@@ -124,9 +124,9 @@ static void test_threads_identical(void **state)
         o.tol = 1e-6;
         ulam_outer_step a[32], b[32];
         int ka, kb;
-        o.walk.threads = 1;
+        o.walk.exec.threads = 1;
         assert_int_equal(run(&s, &o, x1, a, 32, &ka), ULAM_OK);
-        o.walk.threads = 2;
+        o.walk.exec.threads = 2;
         assert_int_equal(run(&s, &o, x2, b, 32, &kb), ULAM_OK);
         assert_int_equal(ka, kb);
         assert_memory_equal(x1, x2, (size_t)s.n * sizeof *x1);
@@ -135,7 +135,7 @@ static void test_threads_identical(void **state)
             assert_int_equal(a[i].steps, b[i].steps);
             assert_memory_equal(&a[i].residual, &b[i].residual, sizeof a[i].residual);
         }
-        o.walk.seed = 2; /* another seed: other walks */
+        o.walk.exec.seed = 2; /* another seed: other walks */
         assert_int_equal(run(&s, &o, x2, b, 32, &kb), ULAM_OK);
         assert_true(memcmp(x1, x2, (size_t)s.n * sizeof *x1) != 0);
     }
@@ -154,10 +154,10 @@ static void test_stall(void **state)
     sys s = load("randsub1000", 0);
     double *x = malloc((size_t)s.n * sizeof *x);
     ulam_outer_opts o = ulam_outer_defaults();
-    o.walk.continue_q = 0.3;
+    o.walk.kernel.continue_q = 0.3;
     o.walk.estimator = ULAM_COLLISION;
     o.max_histories = 20000;
-    o.walk.threads = 2;
+    o.walk.exec.threads = 2;
     ulam_outer_step st[64];
     int k = -1;
     ulam_error err;
@@ -168,7 +168,7 @@ static void test_stall(void **state)
     s = load("poisson900", 1);
     o = ulam_outer_defaults();
     o.max_histories = 1000;
-    o.walk.threads = 2;
+    o.walk.exec.threads = 2;
     assert_int_equal(ulam_outer_solve(s.M, s.b, &o, x, st, 64, &k, &err), ULAM_ESTALL);
     print_message("poisson900 at 1000 histories: %d iterations, residual %.3g: %s\n", k, st[k - 1].residual, err.msg);
     assert_true(k <= 3 && st[k - 1].residual < 1);
@@ -248,8 +248,8 @@ static void test_infinite_variance_refused(void **state)
         for (int assume = 0; assume < 2; assume++) {
             ulam_outer_opts o = ulam_outer_defaults();
             o.method = m;
-            o.walk.assume_finite = assume;
-            o.walk.guard = assume ? &g : NULL; /* given or computed: the same verdict */
+            o.walk.policy.assume_finite = assume;
+            o.walk.policy.guard = assume ? &g : NULL; /* given or computed: the same verdict */
             ulam_outer *it = (ulam_outer *)M;
             ulam_error err;
             assert_int_equal(ulam_outer_alloc(M, b, &o, &it, &err), ULAM_EINFVAR);
@@ -303,7 +303,7 @@ static void test_poisson_never_worse(void **state)
         if (!test_case(m)) continue;
         ulam_outer_opts o = ulam_outer_defaults();
         o.method = m;
-        o.walk.threads = 2;
+        o.walk.exec.threads = 2;
         ulam_outer *it = NULL;
         ulam_error err;
         assert_int_equal(ulam_outer_alloc(M, b, &o, &it, &err), ULAM_OK);
@@ -345,7 +345,7 @@ static void test_rejected_redone(void **state)
         o.method = m;
         o.eps1 = 0.9;
         o.tol = 1e-4;
-        o.walk.threads = 2;
+        o.walk.exec.threads = 2;
         ulam_outer *it = NULL;
         assert_int_equal(ulam_outer_alloc(s.M, s.b, &o, &it, NULL), ULAM_OK);
         double prev = 1.0;

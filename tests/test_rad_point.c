@@ -72,8 +72,8 @@ static ulam_tracer *must_tracer_of(const ulam_scene *s)
 static ulam_rad_point query(const ulam_tracer *t, const double x[3], const double *n, int est, int64_t walks,
                             double rel_err, uint64_t seed)
 {
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = est, o.max_walks = walks, o.rel_err = rel_err, o.seed = seed, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.estimator = est, o.stop.max_walks = walks, o.stop.rel_err = rel_err, o.exec.seed = seed, o.exec.threads = 2;
     ulam_rad_point r;
     ulam_error err;
     int st = ulam_rad_point_query(t, &o, x, n, &r, &err);
@@ -192,8 +192,8 @@ static void test_point_refused(void **state)
     (void)state;
     ulam_scene *s = NULL;
     ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.max_walks = 100;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.max_walks = 100;
     ulam_rad_solver *sv = NULL;
     ulam_error err;
     double air[3] = {0.5, 0.5, 0.5}, floor_pt[3] = {0.5, 0.5, 0}, down[3] = {0, 0, -1}, zero[3] = {0, 0, 0};
@@ -219,7 +219,7 @@ static void test_point_refused(void **state)
     assert_int_equal(ulam_rad_point_result(sv, &r), ULAM_EINVAL);
     ulam_rad_solver_free(sv);
     /* the default estimator of a patch walk is next-event now, and shooting refuses it */
-    assert_int_equal(ulam_walk_defaults().estimator, ULAM_RAD_NEXT_EVENT);
+    assert_int_equal(ulam_rad_defaults().estimator, ULAM_RAD_NEXT_EVENT);
     ulam_tracer_free(t);
     ulam_scene_free(s);
 }
@@ -232,8 +232,8 @@ static void test_grid(void **state)
     ulam_scene *s = NULL;
     ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
     ulam_rad_grid g = {.origin = {-1, -0.5, 0}, .u = {3, 0, 0}, .v = {0, 3, 0}, .normal = {0, 0, 1}, .nu = 4, .nv = 3};
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.rel_err = 0.02, o.max_walks = 0, o.seed = 5, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.rel_err = 0.02, o.stop.max_walks = 0, o.exec.seed = 5, o.exec.threads = 2;
     ulam_rad_point pts[12];
     ulam_error err;
     assert_int_equal(ulam_rad_grid_solve(t, &o, &g, pts, &err), ULAM_OK);
@@ -270,7 +270,7 @@ static void test_grid(void **state)
 }
 
 /* A patch solver run to its end with options o. */
-static ulam_rad_result run_solver(const ulam_tracer *t, const ulam_walk_opts *o)
+static ulam_rad_result run_solver(const ulam_tracer *t, const ulam_rad_opts *o)
 {
     ulam_rad_solver *sv = NULL;
     assert_int_equal(ulam_rad_solver_alloc(t, o, &sv, NULL), ULAM_OK);
@@ -284,8 +284,8 @@ static ulam_rad_result run_solver(const ulam_tracer *t, const ulam_walk_opts *o)
 /* A patch query (next-event) at patch p to rel_err or walks. */
 static ulam_rad_result patch_query(const ulam_tracer *t, int64_t p, double rel_err, int64_t walks, uint64_t seed)
 {
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.index = p, o.rel_err = rel_err, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.index = p, o.stop.rel_err = rel_err, o.stop.max_walks = walks, o.exec.seed = seed, o.exec.threads = 2;
     return run_solver(t, &o);
 }
 
@@ -300,8 +300,8 @@ static void test_mesh_error_flags(void **state)
     int64_t p;
     assert_int_equal(ulam_scene_find(s, "floor", &p), ULAM_OK);
     ulam_rad_result pr = patch_query(t, p, 0.01, 0, 1);
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.index = p, o.rel_err = 0.02, o.max_walks = 0, o.seed = 2, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.index = p, o.stop.rel_err = 0.02, o.stop.max_walks = 0, o.exec.seed = 2, o.exec.threads = 2;
     ulam_rad_mesh m;
     assert_int_equal(ulam_rad_mesh_error(t, &o, pr.radiosity, &m, NULL), ULAM_OK);
     assert_int_equal(m.npoints, 5);
@@ -391,8 +391,8 @@ static void test_mesh_converges(void **state)
 static ulam_rad_adapt_info adapt(const ulam_tracer *t, const double *Y, double target, double rel_err, int64_t walks,
                                  int64_t cap, uint64_t seed, ulam_scene **out)
 {
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.rel_err = rel_err, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.rel_err = rel_err, o.stop.max_walks = walks, o.exec.seed = seed, o.exec.threads = 2;
     ulam_rad_adapt_info in;
     ulam_error err;
     int st = ulam_rad_adapt(t, &o, Y, target, cap, out, &in, &err);
@@ -627,9 +627,9 @@ static void test_shoot_rel_err(void **state)
     double exact = 0.5 * ulam_ff_perpendicular_rectangles(1, 1, 1);
     int inside = 0;
     for (uint64_t seed = 0; seed < 50; seed++) {
-        ulam_walk_opts o = ulam_walk_defaults();
-        o.mode = ULAM_FORWARD, o.estimator = ULAM_RAD_COLLISION, o.index = 1, o.rel_err = 0.03, o.max_walks = 0;
-        o.seed = 300 + seed, o.threads = 2;
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.mode = ULAM_FORWARD, o.estimator = ULAM_RAD_COLLISION, o.index = 1, o.stop.rel_err = 0.03, o.stop.max_walks = 0;
+        o.exec.seed = 300 + seed, o.exec.threads = 2;
         ulam_rad_result r = run_solver(t, &o);
         assert_true(r.rel_err_met && r.walks >= 1000 && (double)r.walks >= r.min_walks && r.min_walks > 1000);
         assert_true(r.std_error[0] <= 0.03 * r.radiosity[0]);
@@ -637,14 +637,14 @@ static void test_shoot_rel_err(void **state)
     }
     print_message("shooting at rel_err 0.03: %d of 50 intervals cover\n", inside);
     assert_true(inside >= 43);
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_RAD_NEXT_EVENT_LIGHT, o.index = 1, o.rel_err = 0.03;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.estimator = ULAM_RAD_NEXT_EVENT_LIGHT, o.index = 1, o.stop.rel_err = 0.03;
     ulam_rad_solver *sv = NULL;
     ulam_error err;
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
     assert_null(sv);
     assert_non_null(strstr(err.msg, "certified bound"));
-    o.rel_err = 0, o.max_walks = 1000; /* a walk budget still runs */
+    o.stop.rel_err = 0, o.stop.max_walks = 1000; /* a walk budget still runs */
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_OK);
     ulam_rad_solver_free(sv);
     ulam_tracer_free(t);

@@ -35,8 +35,8 @@ static ulam_tracer *must_tracer(const ulam_scene *s)
 static ulam_rad_result rad_walk(const ulam_tracer *t, int mode, int est, int64_t patch, int64_t walks,
                                 uint64_t seed, ulam_rad_solver **keep)
 {
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = mode, o.estimator = est, o.index = patch, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.mode = mode, o.estimator = est, o.index = patch, o.stop.max_walks = walks, o.exec.seed = seed, o.exec.threads = 2;
     ulam_rad_solver *sv = NULL;
     ulam_error err;
     int st = ulam_rad_solver_alloc(t, &o, &sv, &err);
@@ -59,7 +59,7 @@ static ulam_walk_result matrix_walk(const ulam_scene *s, const ulam_csr *F, int 
     double *b = malloc((size_t)s->npatches * sizeof *b);
     assert_int_equal(ulam_rad_system(s, F, c, &M, b), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = mode, o.index = p, o.estimator = est, o.max_walks = walks, o.seed = seed, o.threads = 2;
+    o.mode = mode, o.query.index = p, o.estimator = est, o.stop.max_walks = walks, o.exec.seed = seed, o.exec.threads = 2;
     ulam_solver *sv = NULL;
     assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, NULL), ULAM_OK);
     while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
@@ -166,6 +166,22 @@ static void check_all_modes(const exact_scene *e, int64_t walks, uint64_t seed)
     ulam_csr_free(F), ulam_csr_free(Fx);
     ulam_tracer_free(t);
     ulam_scene_free(s);
+}
+
+/* ulam_rad_defaults: gathering at patch 0 by next-event estimation, the stopping and execution
+ * parts their own defaults functions' (radiosity carries no matrix-walk field). */
+static void test_rad_defaults(void **state)
+{
+    (void)state;
+    ulam_rad_opts o = ulam_rad_defaults();
+    ulam_stop_opts st = ulam_stop_defaults();
+    ulam_exec_opts e = ulam_exec_defaults();
+    assert_int_equal(o.mode, ULAM_ADJOINT);
+    assert_int_equal(o.estimator, ULAM_RAD_NEXT_EVENT);
+    assert_int_equal(o.index, 0);
+    assert_true(o.stop.max_walks == st.max_walks && o.stop.max_walks == 100000 && o.stop.max_steps == st.max_steps &&
+                o.stop.rel_err == 0 && o.stop.max_seconds == 0 && !o.stop.interrupt && o.stop.rel_err_offset == 0);
+    assert_true(o.exec.seed == e.seed && o.exec.seed == 1 && o.exec.threads == 0 && !o.exec.share);
 }
 
 /* Black emitters (Kd 0) and emitters that reflect: every particle leaves its emitter.  Shooting
@@ -423,8 +439,8 @@ static void test_rel_err_zero_channel(void **state)
     ulam_tracer *t = must_tracer(s);
     ulam_rad_result ne = rad_walk(t, ULAM_ADJOINT, ULAM_RAD_NEXT_EVENT, 0, 100000, 5, NULL);
     assert_true(ne.radiosity[1] > 0);
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_RAD_ABSORPTION, o.index = 0, o.max_walks = 0, o.rel_err = 0.05, o.seed = 1, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.estimator = ULAM_RAD_ABSORPTION, o.index = 0, o.stop.max_walks = 0, o.stop.rel_err = 0.05, o.exec.seed = 1, o.exec.threads = 2;
     ulam_rad_solver *sv = NULL;
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
     while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
@@ -450,8 +466,8 @@ static void test_view_gather(void **state)
     ulam_scene *s = must_scene("examples/scenes/cube.obj");
     ulam_tracer *t = must_tracer(s);
     ulam_camera cam = {.eye = {0.5, 0.5, 0.5}, .dir = {0, 0, -1}, .up = {0, 1, 0}, .focal = 1.0, .film = 4.0};
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_RAD_NEXT_EVENT, o.max_walks = 0, o.rel_err = 0.02, o.seed = 8, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.estimator = ULAM_RAD_NEXT_EVENT, o.stop.max_walks = 0, o.stop.rel_err = 0.02, o.exec.seed = 8, o.exec.threads = 2;
     double B[18], se[18];
     int64_t pix[6];
     ulam_view_info vi;
@@ -473,9 +489,9 @@ static void test_view_gather(void **state)
             assert_true(se[3 * p + c] <= target * B[3 * p + c] && se[3 * p + c] > 0);
             assert_close(B[3 * p + c], 2.0, 4 * se[3 * p + c]);
         }
-    o.rel_err = 0;
+    o.stop.rel_err = 0;
     assert_int_equal(ulam_view_gather(t, &cam, 16, 16, 0.25, &o, B, se, &vi, NULL), ULAM_EINVAL);
-    o.rel_err = 0.02;
+    o.stop.rel_err = 0.02;
     assert_int_equal(ulam_view_gather(t, &cam, 16, 16, 1.5, &o, B, se, &vi, NULL), ULAM_EINVAL);
     ulam_tracer_free(t);
     ulam_scene_free(s);
@@ -487,10 +503,10 @@ static void test_view_gather(void **state)
     int64_t n = s->npatches;
     double *b[2], *e[2];
     ulam_view_info v[2];
-    o.rel_err = 0.1;
+    o.stop.rel_err = 0.1;
     for (int k = 0; k < 2; k++) {
         b[k] = malloc((size_t)(3 * n) * sizeof(double)), e[k] = malloc((size_t)(3 * n) * sizeof(double));
-        o.threads = k + 1;
+        o.exec.threads = k + 1;
         assert_int_equal(ulam_view_gather(t, &cam, 12, 12, 0.25, &o, b[k], e[k], &v[k], NULL), ULAM_OK);
     }
     print_message("view gather, Cornell box: %lld of %lld patches seen, %lld walks, %lld rays\n", (long long)v[0].seen,
@@ -512,9 +528,9 @@ static void test_rel_err_zero(void **state)
     ulam_scene *s = must_scene("tests/data/rad/small_gap.obj");
     ulam_tracer *t = must_tracer(s);
     for (int m = 0; m < 4; m++) {
-        ulam_walk_opts o = ulam_walk_defaults();
+        ulam_rad_opts o = ulam_rad_defaults();
         o.mode = m < 2 ? ULAM_ADJOINT : ULAM_FORWARD, o.estimator = m % 2 ? ULAM_RAD_ABSORPTION : ULAM_RAD_COLLISION;
-        o.index = 2, o.rel_err = 0.01, o.max_walks = 0, o.seed = 5, o.threads = 2; /* the far patch, facing away */
+        o.index = 2, o.stop.rel_err = 0.01, o.stop.max_walks = 0, o.exec.seed = 5, o.exec.threads = 2; /* the far patch, facing away */
         ulam_rad_solver *sv = NULL;
         assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
         int rounds = 0;
@@ -529,8 +545,8 @@ static void test_rel_err_zero(void **state)
         ulam_rad_solver_free(sv);
     }
     /* the receiver, with light: the rule is met as before and zero stays 0 */
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 1, o.rel_err = 0.02, o.max_walks = 0, o.seed = 5, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.index = 1, o.stop.rel_err = 0.02, o.stop.max_walks = 0, o.exec.seed = 5, o.exec.threads = 2;
     ulam_rad_solver *sv = NULL;
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
     while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
@@ -1023,13 +1039,13 @@ static void test_threads_and_options(void **state)
     (void)state;
     ulam_scene *s = must_scene("examples/scenes/cornell_box.obj");
     ulam_tracer *t = must_tracer(s);
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 0, o.max_walks = 30000, o.seed = 42;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.index = 0, o.stop.max_walks = 30000, o.exec.seed = 42;
     for (int est = ULAM_RAD_NEXT_EVENT; est <= ULAM_RAD_COLLISION; est++) {
         ulam_rad_result r[2];
         o.estimator = est;
         for (int k = 0; k < 2; k++) {
-            o.threads = k + 1;
+            o.exec.threads = k + 1;
             ulam_rad_solver *sv = NULL;
             assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, NULL), ULAM_OK);
             while (!ulam_rad_solver_done(sv)) ulam_rad_solver_iterate(sv);
@@ -1051,9 +1067,6 @@ static void test_threads_and_options(void **state)
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
     o.estimator = ULAM_RAD_NEXT_EVENT, o.mode = ULAM_FORWARD; /* next-event gathers (and is the default) */
     assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
-    o.mode = ULAM_ADJOINT;
-    o.estimator = ULAM_RAD_COLLISION, o.roulette = 0.5;
-    assert_int_equal(ulam_rad_solver_alloc(t, &o, &sv, &err), ULAM_EINVAL);
     assert_null(sv);
     assert_int_equal(ulam_rad_solver_vectors(NULL, NULL, NULL), ULAM_EINVAL);
     ulam_tracer_free(t);
@@ -1063,6 +1076,7 @@ static void test_threads_and_options(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rad_defaults),
         cmocka_unit_test(test_read_cube),          cmocka_unit_test(test_read_good),
         cmocka_unit_test(test_read_errors),        cmocka_unit_test(test_subdivide),
         cmocka_unit_test(test_read_messages),      cmocka_unit_test(test_find_rule),

@@ -92,9 +92,9 @@ static void test_metastable_fixed(void **state)
         for (int s = 0; s < 100; s++) {
             if (!test_case(1000L * c + s)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = cases[c].est, o.max_walks = cases[c].walks, o.seed = 1 + (uint64_t)s;
+            o.estimator = cases[c].est, o.stop.max_walks = cases[c].walks, o.exec.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             v[verdict(&r, x)]++;
         }
         test_case_done();
@@ -117,7 +117,7 @@ static void test_metastable_auto(void **state)
     for (int s = 0; s < 100; s++) {
         if (!test_case(s)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.max_walks = 1000, o.seed = 300 + (uint64_t)s;
+        o.stop.max_walks = 1000, o.exec.seed = 300 + (uint64_t)s;
         ulam_auto_result res;
         ulam_solver *sv = NULL;
         assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
@@ -143,7 +143,7 @@ static void test_metastable_rounds(void **state)
     for (int s = 0; s < 100; s++) {
         if (!test_case(s)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.max_walks = 0, o.max_seconds = 1e9, o.seed = 100 + (uint64_t)s;
+        o.stop.max_walks = 0, o.stop.max_seconds = 1e9, o.exec.seed = 100 + (uint64_t)s;
         ulam_solver *sv;
         assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, NULL), ULAM_OK);
         for (int k = 0; k < 1 + s % 6; k++) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
@@ -171,9 +171,9 @@ static void test_metastable_rel_err(void **state)
         for (int s = 0; s < 100; s++) {
             if (!test_case(1000L * est + s)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = est, o.max_walks = 0, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
+            o.estimator = est, o.stop.max_walks = 0, o.stop.rel_err = 0.1, o.exec.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             assert_true(r.rel_err_met);
             v[verdict(&r, x)]++;
             walks += (double)r.walks;
@@ -200,9 +200,9 @@ static void test_laplace_corner(void **state)
         for (int s = 0; s < 100; s++) {
             if (!test_case(1000L * c + s)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = c ? ULAM_ABSORPTION : ULAM_COLLISION, o.max_walks = 1000, o.seed = 1 + (uint64_t)s;
+            o.estimator = c ? ULAM_ABSORPTION : ULAM_COLLISION, o.stop.max_walks = 1000, o.exec.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
-            assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             v[verdict(&r, x)]++;
         }
         test_case_done();
@@ -211,9 +211,9 @@ static void test_laplace_corner(void **state)
     for (int s = 0; s < 10; s++) {
         if (!test_case(2000L + s)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.max_walks = 1 << 17, o.rel_err = 0.1, o.seed = 1 + (uint64_t)s;
+        o.stop.max_walks = 1 << 17, o.stop.rel_err = 0.1, o.exec.seed = 1 + (uint64_t)s;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         print_message("rel_err seed %d: %.4g [%.4g, %.4g] %lld walks, met %d, out of reach %d (needs %.3g)\n", s,
                       r.estimate, r.ci95[0], r.ci95[1], (long long)r.walks, r.rel_err_met, r.out_of_reach, r.min_walks);
         assert_true(!(r.estimate == 0 && r.out_of_reach));
@@ -232,9 +232,9 @@ static void test_never_zero_width(void **state)
     ulam_csr *M = metastable(1e-4, &b, &x);
     for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
         ulam_walk_opts o = ulam_walk_defaults();
-        o.estimator = est, o.max_walks = 100, o.seed = 3;
+        o.estimator = est, o.stop.max_walks = 100, o.exec.seed = 3;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         print_message("100 walks, %s: %.6g [%.6g, %.6g], variance %g\n", est ? "absorption" : "collision", r.estimate,
                       r.ci95[0], r.ci95[1], r.variance);
         assert_true(r.ci95[1] - r.ci95[0] > 1.0 && r.ci95[0] <= x && x <= r.ci95[1]);
@@ -242,9 +242,9 @@ static void test_never_zero_width(void **state)
     for (int i = 20; i < 40; i++) b[i] = 0.0; /* from B only B is reachable: x_20 = 0, certified */
     for (int i = 0; i < 20; i++) b[i] = 0.0;
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 25, o.max_walks = 100;
+    o.query.index = 25, o.stop.max_walks = 100;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(r.estimate == 0 && r.ci95[0] == 0 && r.ci95[1] == 0);
     ulam_csr_free(M), free(b);
 }
@@ -261,12 +261,12 @@ static void test_rel_err_cost(void **state)
     double *b = must_read_vector("matrices/signed200_b.mtx", &n), *x = malloc((size_t)n * sizeof *x), E = 0.01;
     assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_COLLISION, o.max_walks = 1 << 18, o.seed = 12345;
+    o.estimator = ULAM_COLLISION, o.stop.max_walks = 1 << 18, o.exec.seed = 12345;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     double oracle = r.variance / (E * x[0] * E * x[0]);
-    o.max_walks = 0, o.rel_err = E, o.seed = 1;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    o.stop.max_walks = 0, o.stop.rel_err = E, o.exec.seed = 1;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     print_message("signed200 collision, rel_err %g: %lld walks, oracle %.4g (%.3gx)\n", E, (long long)r.walks, oracle,
                   (double)r.walks / oracle);
     assert_true(r.rel_err_met && r.ci95[0] <= x[0] && x[0] <= r.ci95[1]);
@@ -288,9 +288,9 @@ static void test_push_b(void **state)
     double *xs = bench_neumann(M, b), x = xs[0];
     free(xs);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_ABSORPTION, o.max_walks = 1 << 18, o.seed = 12345;
+    o.estimator = ULAM_ABSORPTION, o.stop.max_walks = 1 << 18, o.exec.seed = 12345;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     double oracle = r.variance / (E * x * E * x);
     ulam_method_opts mo = ulam_method_defaults();
     mo.method = ULAM_METHOD_BIDIRECTIONAL;
@@ -299,7 +299,7 @@ static void test_push_b(void **state)
     int v[3] = {0, 0, 0};
     for (int s = 0; s < 100; s++) {
         if (!test_case(s)) continue;
-        o.max_walks = 0, o.rel_err = E, o.seed = 1 + (uint64_t)s;
+        o.stop.max_walks = 0, o.stop.rel_err = E, o.exec.seed = 1 + (uint64_t)s;
         ulam_answer a;
         ulam_error err;
         int status = ulam_auto(M, b, &o, &ao, &mo, NULL, &a, &err);
@@ -345,7 +345,7 @@ static void test_laplace_noisy_auto(void **state)
     for (int s = 0; s < 20; s++) {
         if (!test_case(3000L + s)) continue;
         ulam_walk_opts o = ulam_walk_defaults();
-        o.max_walks = 1 << 17, o.rel_err = 0.1, o.seed = 40 + (uint64_t)s;
+        o.stop.max_walks = 1 << 17, o.stop.rel_err = 0.1, o.exec.seed = 40 + (uint64_t)s;
         ulam_auto_result res;
         ulam_solver *sv = NULL;
         assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);

@@ -266,28 +266,28 @@ static void test_lazy_pages(void **state)
     ulam_guard g; /* the verdicts a prepared file's certificate would carry: no pass over M */
     assert_int_equal(ulam_guard_check(M, 0.0, NULL, &g, NULL), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 3, o.max_walks = 20000, o.threads = 2, o.guard = &g;
+    o.query.index = 3, o.stop.max_walks = 20000, o.exec.threads = 2, o.policy.guard = &g;
     ulam_walk_result r1, r2;
     ulam_error err;
     const ulam_csr *lm;
     const double *lb;
     assert_int_equal(ulam_system_lazy(s, &lm, &lb), ULAM_OK);
-    o.system = s; /* each block verified as the walks reach it: blocks 0 .. far hold what they read */
-    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_OK);
-    o.system = NULL;
-    assert_int_equal(ulam_solve(M, b, &o, &r2, &err), ULAM_OK);
+    o.policy.system = s; /* each block verified as the walks reach it: blocks 0 .. far hold what they read */
+    assert_int_equal(ulam_solve_walks(lm, lb, &o, &r1, &err), ULAM_OK);
+    o.policy.system = NULL;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r2, &err), ULAM_OK);
     assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
     assert_int_equal(r1.rows, B);
-    o.system = s;
+    o.policy.system = s;
     o.estimator = ULAM_ABSORPTION; /* the reachability check too reads only what it reaches */
-    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(lm, lb, &o, &r1, &err), ULAM_OK);
     o.estimator = ULAM_EXPECTED; /* and the expected estimator's b at the rows' columns */
-    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_OK);
-    o.system = NULL; /* the arrays of another system's solver: refused */
+    assert_int_equal(ulam_solve_walks(lm, lb, &o, &r1, &err), ULAM_OK);
+    o.policy.system = NULL; /* the arrays of another system's solver: refused */
     ulam_system *t = NULL;
     assert_int_equal(ulam_system_from_memory(p, len, NULL, &t, NULL), ULAM_OK);
-    o.system = t;
-    assert_int_equal(ulam_solve(lm, lb, &o, &r1, &err), ULAM_EINVAL);
+    o.policy.system = t;
+    assert_int_equal(ulam_solve_walks(lm, lb, &o, &r1, &err), ULAM_EINVAL);
     ulam_system_free(t);
     ulam_system_free(s);
     munmap(p, len);
@@ -365,10 +365,10 @@ static void test_random_rows_checked(void **state)
     ao.b = b, ao.system = NULL;
     assert_int_equal(ulam_analysis_alloc(M, &ao, &ap, NULL), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 5, o.max_walks = 60, o.threads = 2;
+    o.query.index = 5, o.stop.max_walks = 60, o.exec.threads = 2;
     ulam_walk_result r1, r2;
     assert_int_equal(ulam_analysis_solve(af, lb, &o, &r1, NULL), ULAM_OK);
-    o.threads = 1; /* the parsed system's run below: one thread, the same estimate */
+    o.exec.threads = 1; /* the parsed system's run below: one thread, the same estimate */
     int64_t rows = 0, blocks = ulam_system_checked(s, &rows);
     if (!(r1.rows > 100 && rows >= r1.rows && rows <= 16 * r1.rows && blocks > 0))
         fail_msg("%lld rows built, %lld rows of M verified in %lld blocks", (long long)r1.rows, (long long)rows,
@@ -428,12 +428,12 @@ static void test_corrupt_rows(void **state)
         ulam_system_lazy(s, &lm, &lb);
         for (int start = 0; start < 3; start++) {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.index = start == 0 ? B : start == 1 ? row : 3, o.max_walks = 5000, o.threads = 1, o.guard = &g;
-            o.system = s;
+            o.query.index = start == 0 ? B : start == 1 ? row : 3, o.stop.max_walks = 5000, o.exec.threads = 1, o.policy.guard = &g;
+            o.policy.system = s;
             ulam_walk_result r;
-            int st = ulam_solve(lm, lb, &o, &r, &err);
+            int st = ulam_solve_walks(lm, lb, &o, &r, &err);
             if (start < 2 && (st != ULAM_ESYNTAX || !strstr(err.msg, "block 1 of")))
-                fail_msg("corrupt case %d, start %lld: status %d (%s)", k, (long long)o.index, st, err.msg);
+                fail_msg("corrupt case %d, start %lld: status %d (%s)", k, (long long)o.query.index, st, err.msg);
             if (start == 2 && st != ULAM_OK) fail_msg("corrupt case %d: the other block failed (%d)", k, st);
         }
         assert_int_equal(ulam_system_verify(s, 0, B, &err), ULAM_OK); /* block 0 is intact */
@@ -507,7 +507,7 @@ static void test_analysis_local(void **state)
     for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++)
         for (int64_t idx = 3; idx < 40; idx += 17) {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.index = idx, o.estimator = e, o.max_walks = 0, o.rel_err = 0.02, o.threads = 2, o.seed = (uint64_t)idx;
+            o.query.index = idx, o.estimator = e, o.stop.max_walks = 0, o.stop.rel_err = 0.02, o.exec.threads = 2, o.exec.seed = (uint64_t)idx;
             ulam_walk_result r1, r2;
             ulam_error err;
             assert_int_equal(ulam_analysis_solve(af, bs, &o, &r1, &err), ULAM_OK);
@@ -521,7 +521,7 @@ static void test_analysis_local(void **state)
         }
     for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++) { /* a fixed budget reads no more (the file's bounds) */
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 20, o.estimator = e, o.max_walks = 3000, o.threads = 2, o.seed = 20;
+        o.query.index = 20, o.estimator = e, o.stop.max_walks = 3000, o.exec.threads = 2, o.exec.seed = 20;
         ulam_walk_result r1, r2;
         assert_int_equal(ulam_analysis_solve(af, bs, &o, &r1, NULL), ULAM_OK);
         assert_int_equal(ulam_analysis_solve(ap, b, &o, &r2, NULL), ULAM_OK);
@@ -538,7 +538,7 @@ static void test_analysis_local(void **state)
     ao.b = bs, ao.system = s;
     assert_int_equal(ulam_analysis_alloc(Ms, &ao, &fresh, NULL), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 37, o.max_walks = 0, o.rel_err = 0.02, o.threads = 1, o.seed = 37;
+    o.query.index = 37, o.stop.max_walks = 0, o.stop.rel_err = 0.02, o.exec.threads = 1, o.exec.seed = 37;
     ulam_walk_result r1, r2;
     assert_int_equal(ulam_analysis_solve(fresh, bs, &o, &r1, NULL), ULAM_OK);
     assert_int_equal(ulam_analysis_solve(af, bs, &o, &r2, NULL), ULAM_OK);
@@ -607,9 +607,9 @@ static void query_copy(const unsigned char *p, size_t len, const double want[3],
     ulam_system_lazy(s, &lm, &lb);
     for (int e = 0; e < 3; e++) {
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 3, o.max_walks = 2000, o.threads = 1, o.guard = &g, o.system = s, o.estimator = e;
+        o.query.index = 3, o.stop.max_walks = 2000, o.exec.threads = 1, o.policy.guard = &g, o.policy.system = s, o.estimator = e;
         ulam_walk_result r;
-        st = ulam_solve(lm, lb, &o, &r, &err);
+        st = ulam_solve_walks(lm, lb, &o, &r, &err);
         if (st == ULAM_OK && memcmp(&r.estimate, &want[e], sizeof r.estimate))
             fail_msg("case %d, estimator %d: a wrong answer %.17g (intact %.17g) with ULAM_OK", label, e, r.estimate, want[e]);
         if (st && (!err.msg[0] || st != ULAM_ESYNTAX)) fail_msg("case %d: status %d, '%s'", label, st, err.msg);
@@ -619,9 +619,9 @@ static void query_copy(const unsigned char *p, size_t len, const double want[3],
     const double *b = ulam_system_rhs(s, NULL);
     if (M && b) {
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 3, o.max_walks = 2000, o.threads = 1;
+        o.query.index = 3, o.stop.max_walks = 2000, o.exec.threads = 1;
         ulam_walk_result r;
-        st = ulam_solve(M, b, &o, &r, &err);
+        st = ulam_solve_walks(M, b, &o, &r, &err);
         if (st || memcmp(&r.estimate, &want[0], sizeof r.estimate)) fail_msg("case %d: verified M answered %d", label, st);
     } else if (ulam_system_check(s, &err) != ULAM_ESYNTAX || !strstr(err.msg, "block")) {
         fail_msg("case %d: an accessor refused what the check passes", label);
@@ -655,9 +655,9 @@ static void test_flip_table(void **state)
     double want[3];
     for (int e = 0; e < 3; e++) {
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 3, o.max_walks = 2000, o.threads = 1, o.estimator = e;
+        o.query.index = 3, o.stop.max_walks = 2000, o.exec.threads = 1, o.estimator = e;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
         want[e] = r.estimate;
     }
     int refused = 0, dummy = 0;
@@ -726,9 +726,9 @@ static void *run_job(void *arg)
     const double *b;
     ulam_system_lazy(j->s, &M, &b);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = j->index, o.max_walks = 20000, o.threads = 2, o.guard = j->g, o.system = j->s, o.whole_kernel = j->index == 5;
+    o.query.index = j->index, o.stop.max_walks = 20000, o.exec.threads = 2, o.policy.guard = j->g, o.policy.system = j->s, o.kernel.whole_kernel = j->index == 5;
     ulam_walk_result r;
-    j->status = ulam_solve(M, b, &o, &r, NULL);
+    j->status = ulam_solve_walks(M, b, &o, &r, NULL);
     j->estimate = r.estimate;
     return NULL;
 }
@@ -828,11 +828,11 @@ static void test_sound_sums_bad_arrays(void **state)
         static const char *const why[3] = {"column", "row pointers", "value"};
         for (int run = 0; run < 3; run++) {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.index = 3, o.max_walks = 2000, o.threads = 1, o.system = s;
-            o.guard = run == 1 ? &g : NULL;
+            o.query.index = 3, o.stop.max_walks = 2000, o.exec.threads = 1, o.policy.system = s;
+            o.policy.guard = run == 1 ? &g : NULL;
             o.mode = run == 2 ? ULAM_FORWARD : ULAM_ADJOINT;
             ulam_walk_result r;
-            int st = ulam_solve(lm, lb, &o, &r, &err);
+            int st = ulam_solve_walks(lm, lb, &o, &r, &err);
             if (st != ULAM_ESYNTAX || !strstr(err.msg, why[k]))
                 fail_msg("case %d, run %d: status %d, '%s'", k, run, st, err.msg);
         }

@@ -1,5 +1,5 @@
 /* Two solvers at once on one shared read-only system (issue 26, Checks): pthreads each running
- * ulam_solve on the same mapped prepared system (its matrix, b and certificate shared, nothing
+ * ulam_solve_walks on the same mapped prepared system (its matrix, b and certificate shared, nothing
  * copied) must give, bit for bit, what the same runs give one after the other; the library holds
  * no global state.  CI runs this test under ThreadSanitizer (.ci/run). */
 #include "testutil.h"
@@ -20,7 +20,7 @@ static void *run(void *p)
 {
     job *j = p;
     ulam_error err;
-    j->status = ulam_solve(j->M, j->b, &j->o, &j->r, &err);
+    j->status = ulam_solve_walks(j->M, j->b, &j->o, &j->r, &err);
     return NULL;
 }
 
@@ -81,12 +81,12 @@ static void test_two_solvers(void **state)
     job jobs[4];
     for (int k = 0; k < 4; k++) {
         jobs[k] = (job){.M = M, .b = mb, .o = ulam_walk_defaults()};
-        jobs[k].o.threads = 2, jobs[k].o.max_walks = 20000, jobs[k].o.seed = 11 + (uint64_t)k;
-        jobs[k].o.guard = k == 1 ? NULL : &g; /* one computes its own guards over the shared M */
+        jobs[k].o.exec.threads = 2, jobs[k].o.stop.max_walks = 20000, jobs[k].o.exec.seed = 11 + (uint64_t)k;
+        jobs[k].o.policy.guard = k == 1 ? NULL : &g; /* one computes its own guards over the shared M */
     }
-    jobs[0].o.index = 3, jobs[1].o.index = 250, jobs[1].o.estimator = ULAM_ABSORPTION;
-    jobs[2].o.mode = ULAM_FORWARD, jobs[2].o.index = 17;
-    jobs[3].o.index = 42, jobs[3].o.max_walks = 0, jobs[3].o.rel_err = 0.05;
+    jobs[0].o.query.index = 3, jobs[1].o.query.index = 250, jobs[1].o.estimator = ULAM_ABSORPTION;
+    jobs[2].o.mode = ULAM_FORWARD, jobs[2].o.query.index = 17;
+    jobs[3].o.query.index = 42, jobs[3].o.stop.max_walks = 0, jobs[3].o.stop.rel_err = 0.05;
     ulam_walk_result seq[4];
     for (int k = 0; k < 4; k++) {
         run(&jobs[k]);

@@ -42,20 +42,20 @@ static void test_agreement(void **state)
                 ulam_walk_opts o = ulam_walk_defaults();
                 o.mode = mode;
                 o.estimator = est;
-                o.index = systems[k].index;
-                o.max_walks = mode == ULAM_FORWARD && s.n > 100 ? 400000 : 100000;
-                o.seed = 100 + k;
+                o.query.index = systems[k].index;
+                o.stop.max_walks = mode == ULAM_FORWARD && s.n > 100 ? 400000 : 100000;
+                o.exec.seed = 100 + k;
                 ulam_solver *sv = NULL;
                 int st = ulam_solver_alloc(s.M, s.b, &o, &sv, NULL);
                 ulam_solver_free(sv);
                 if (st == ULAM_EUNDEFINED) {
                     assert_true(est == ULAM_ABSORPTION && mode == ULAM_FORWARD && k > 0);
                     if (k == 1) continue;
-                    o.continue_q = 0.8;
-                    o.max_walks = 1600000;
+                    o.kernel.continue_q = 0.8;
+                    o.stop.max_walks = 1600000;
                 }
                 ulam_walk_result r = test_sys_run(&s, o);
-                assert_agrees(&s, &r, o.index);
+                assert_agrees(&s, &r, o.query.index);
             }
         test_sys_free(&s);
     }
@@ -77,9 +77,9 @@ static void test_coverage(void **state)
             if (!test_case(1000L * est + seed)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = est;
-            o.index = 0;
-            o.max_walks = 2000;
-            o.seed = (uint64_t)seed;
+            o.query.index = 0;
+            o.stop.max_walks = 2000;
+            o.exec.seed = (uint64_t)seed;
             ulam_walk_result r = test_sys_run(&s, o);
             covered += fabs(r.estimate - s.x[0]) <= ULAM_Z95 * r.std_error;
             printed += r.ci95[0] <= s.x[0] && s.x[0] <= r.ci95[1];
@@ -149,14 +149,14 @@ static void test_exact_variance(void **state)
             if (!test_case(1000 * (long)k + est)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
             o.estimator = est;
-            o.index = cases[k].index;
-            o.continue_q = cases[k].q;
-            o.max_walks = 1000000;
-            o.seed = 7;
+            o.query.index = cases[k].index;
+            o.kernel.continue_q = cases[k].q;
+            o.stop.max_walks = 1000000;
+            o.exec.seed = 7;
             ulam_walk_result r = test_sys_run(&s, o);
-            double exact = exact_variance(&s, est, o.index, cases[k].q);
+            double exact = exact_variance(&s, est, o.query.index, cases[k].q);
             print_message("%s x[%lld] q=%g %-10s variance: measured %.6g, exact %.6g (%+.2f%%)\n",
-                          cases[k].name, (long long)o.index + 1, cases[k].q, names[est], r.variance,
+                          cases[k].name, (long long)o.query.index + 1, cases[k].q, names[est], r.variance,
                           exact, 100 * (r.variance / exact - 1));
             assert_true(exact > 0);
             assert_close(r.variance, exact, 0.05 * exact);
@@ -175,11 +175,11 @@ static void test_roulette_and_splitting(void **state)
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = mode;
-        o.index = 2;
-        o.continue_q = 0.95;
-        o.max_walks = 200000;
+        o.query.index = 2;
+        o.kernel.continue_q = 0.95;
+        o.stop.max_walks = 200000;
         ulam_walk_result plain = test_sys_run(&s, o);
-        o.roulette = 0.5;
+        o.kernel.roulette = 0.5;
         ulam_walk_result rr = test_sys_run(&s, o);
         assert_agrees(&s, &rr, 2);
         assert_true(rr.steps < plain.steps); /* roulette did cut walks short */
@@ -189,14 +189,14 @@ static void test_roulette_and_splitting(void **state)
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = mode;
-        o.index = 3;
-        o.continue_q = 0.5;
-        o.max_walks = 200000;
+        o.query.index = 3;
+        o.kernel.continue_q = 0.5;
+        o.stop.max_walks = 200000;
         ulam_walk_result plain = test_sys_run(&s, o);
         double w0 = mode == ULAM_ADJOINT ? 1.0 : 0.0; /* the start weight: 1 adjoint, ||b||_1 forward (a split weight below it is refused) */
         for (int64_t i = 0; mode == ULAM_FORWARD && i < s.n; i++) w0 += fabs(s.b[i]);
-        o.split = 2.0 * w0;
-        o.roulette = 0.25 * w0;
+        o.kernel.split = 2.0 * w0;
+        o.kernel.roulette = 0.25 * w0;
         ulam_walk_result ws = test_sys_run(&s, o);
         assert_agrees(&s, &ws, 3);
         assert_true(ws.steps > plain.steps); /* splitting did make copies */
@@ -219,9 +219,9 @@ static void test_jacobi_poisson(void **state)
         s.b = bp;
         assert_int_equal(ulam_direct_solve(s.M, s.b, s.x, 0, NULL, NULL), ULAM_OK);
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = 210;
-        o.max_walks = 20000;
-        o.seed = 7 + (uint64_t)k;
+        o.query.index = 210;
+        o.stop.max_walks = 20000;
+        o.exec.seed = 7 + (uint64_t)k;
         ulam_walk_result r = test_sys_run(&s, o);
         print_message("poisson20 --jacobi --omega %.1f: x[211] = %.6g +- %.2g, LAPACK %.6g\n", omega,
                       r.estimate, r.std_error, s.x[210]);
@@ -261,7 +261,7 @@ static void test_collision_absorption_law(void **state)
         for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
             if (!test_case(1000L * k + est)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.mode = ULAM_FORWARD, o.estimator = est, o.max_walks = 1000000, o.seed = 40 + (uint64_t)k;
+            o.mode = ULAM_FORWARD, o.estimator = est, o.stop.max_walks = 1000000, o.exec.seed = 40 + (uint64_t)k;
             ulam_walk_result r = test_sys_run(&sy, o);
             print_message("law p* = %.2f (boundary 0.333) %-10s variance measured %.5g, exact %.5g (%+.2f%%)\n",
                           ps[k], est ? "absorption" : "collision", r.variance, v[est], 100 * (r.variance / v[est] - 1));
@@ -289,12 +289,12 @@ static void test_threads_identical(void **state)
     for (int mode = ULAM_ADJOINT; mode <= ULAM_FORWARD; mode++) {
         ulam_walk_opts o = ulam_walk_defaults();
         o.mode = mode;
-        o.index = 5;
-        o.max_walks = 50000;
-        o.seed = 99;
-        o.threads = 1;
+        o.query.index = 5;
+        o.stop.max_walks = 50000;
+        o.exec.seed = 99;
+        o.exec.threads = 1;
         ulam_walk_result a = test_sys_run(&s, o);
-        o.threads = 2;
+        o.exec.threads = 2;
         ulam_walk_result b = test_sys_run(&s, o);
         assert_same_run(&a, &b);
     }
@@ -313,9 +313,9 @@ static void test_lazy_kernel(void **state)
         for (int k = 0; k < 2; k++) {
             if (!test_case(1000L * mode + k)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.mode = mode, o.index = 5, o.max_walks = budgets[k], o.seed = 7 + (uint64_t)k, o.threads = 2;
+            o.mode = mode, o.query.index = 5, o.stop.max_walks = budgets[k], o.exec.seed = 7 + (uint64_t)k, o.exec.threads = 2;
             ulam_walk_result lazy = test_sys_run(&s, o);
-            o.whole_kernel = 1;
+            o.kernel.whole_kernel = 1;
             ulam_walk_result whole = test_sys_run(&s, o);
             assert_same_run(&lazy, &whole);
             assert_true(whole.rows == s.n);
@@ -333,7 +333,7 @@ static void test_forward_vectors(void **state)
     test_sys s = test_sys_load("radiosity100");
     ulam_walk_opts o = ulam_walk_defaults();
     o.mode = ULAM_FORWARD;
-    o.max_walks = 200000;
+    o.stop.max_walks = 200000;
     ulam_solver *sv = NULL;
     assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_OK);
     while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
@@ -381,13 +381,13 @@ static void test_bad_options(void **state)
     test_sys s = test_sys_load("chain4");
     ulam_walk_opts o = ulam_walk_defaults();
     ulam_solver *sv = NULL;
-    o.index = 4;
+    o.query.index = 4;
     assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_EINVAL);
     o = ulam_walk_defaults();
-    o.continue_q = 1.0;
+    o.kernel.continue_q = 1.0;
     assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_EINVAL);
     o = ulam_walk_defaults();
-    o.max_walks = 0;
+    o.stop.max_walks = 0;
     assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_EINVAL);
     assert_null(sv);
     assert_null(ulam_solver_free(NULL));
@@ -401,16 +401,16 @@ static void test_rel_err_stop(void **state)
     (void)state;
     test_sys s = test_sys_load("randsub1000");
     ulam_walk_opts o = ulam_walk_defaults();
-    o.max_walks = 0;
-    o.rel_err = 0.005;
-    o.index = 11;
+    o.stop.max_walks = 0;
+    o.stop.rel_err = 0.005;
+    o.query.index = 11;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
     assert_true(r.walks >= 1000);
     assert_true(r.std_error <= 0.005 * fabs(r.estimate));
     assert_true(fabs(r.estimate - s.x[11]) < 4 * r.std_error);
     for (int64_t i = 0; i < s.n; i++) s.b[i] = 0.0; /* x = 0 exactly: the rule ends at once, never spins */
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
     assert_true(r.rel_err_met && r.estimate == 0.0 && r.walks < 2048);
     test_sys_free(&s);
 }
@@ -426,10 +426,10 @@ static void test_solver_guards(void **state)
     ulam_walk_opts o = ulam_walk_defaults();
     ulam_walk_result r;
     ulam_error err;
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_EDIVERGE);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_EDIVERGE);
     assert_non_null(strstr(err.msg, "rho(|M|)"));
-    o.force = 1, o.max_steps = 50, o.max_walks = 1000;
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, &err), ULAM_OK);
+    o.policy.force = 1, o.stop.max_steps = 50, o.stop.max_walks = 1000;
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, &err), ULAM_OK);
     assert_int_equal(r.variance_finite, 0);
     assert_true(isnan(r.ci95[0]) && isnan(r.ci95[1]));
     test_sys_free(&s);
@@ -437,10 +437,10 @@ static void test_solver_guards(void **state)
     double *b = malloc(300 * sizeof *b);
     for (int k = 0; k < 300; k++) b[k] = 1.0;
     o = ulam_walk_defaults();
-    o.index = 150;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EDIVERGE);
+    o.query.index = 150;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EDIVERGE);
     assert_non_null(strstr(err.msg, "not certain"));
-    o.force = 1, o.max_walks = 200, o.max_steps = 10000;
+    o.policy.force = 1, o.stop.max_walks = 200, o.stop.max_steps = 10000;
     ulam_solver *sv = NULL;
     assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, &err), ULAM_OK);
     ulam_guard g;
@@ -452,14 +452,14 @@ static void test_solver_guards(void **state)
     assert_int_equal(r.variance_finite, -1);
     assert_true(isnan(r.ci95[0]));
     ulam_solver_free(sv);
-    o.assume_finite = 1; /* the user's word that unknown is finite, but no interval: it needs a */
-    o.max_steps = 1000000; /* certified range of a score, and rho(|M|) straddling 1 certifies no length tail */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    o.policy.assume_finite = 1; /* the user's word that unknown is finite, but no interval: it needs a */
+    o.stop.max_steps = 1000000; /* certified range of a score, and rho(|M|) straddling 1 certifies no length tail */
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_int_equal(r.variance_finite, 1);
     assert_true(isnan(r.ci95[0]) && !isfinite(r.tail_bound));
-    o.guard = &g, o.assume_finite = 0; /* verdicts handed in are used, not recomputed */
+    o.policy.guard = &g, o.policy.assume_finite = 0; /* verdicts handed in are used, not recomputed */
     g.verdict_hat[ULAM_ADJOINT] = ULAM_VERDICT_OK;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_int_equal(r.variance_finite, 1);
     ulam_csr_free(M), free(b);
 }
@@ -481,17 +481,17 @@ static void test_rel_err_infinite_refused(void **state)
     ulam_csr *M = NULL;
     assert_int_equal(ulam_csr_from_triplets(11, 11, 20, i, j, v, &M), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.max_walks = 0, o.rel_err = 0.01;
+    o.stop.max_walks = 0, o.stop.rel_err = 0.01;
     ulam_walk_result r;
     ulam_error err;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINFVAR);
     assert_non_null(strstr(err.msg, "adjoint kernel"));
     assert_non_null(strstr(err.msg, "forward mode's is finite"));
-    o.max_walks = 5000; /* bounded: runs, and the rule never fires */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    o.stop.max_walks = 5000; /* bounded: runs, and the rule never fires */
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_true(r.walks == 5000 && !r.rel_err_met && r.variance_finite == 0);
-    o.max_walks = 0, o.mode = ULAM_FORWARD; /* the finite mode meets it */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    o.stop.max_walks = 0, o.mode = ULAM_FORWARD; /* the finite mode meets it */
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_true(r.rel_err_met && r.std_error <= 0.01 * fabs(r.estimate));
     ulam_csr_free(M);
 }
@@ -511,9 +511,9 @@ static void test_rel_err_cuts(void **state)
     ulam_csr *M = NULL;
     assert_int_equal(ulam_csr_from_triplets(N, N, N, ti, tj, tx, &M), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.max_walks = 0, o.rel_err = 0.01, o.max_steps = 2000, o.seed = 1;
+    o.stop.max_walks = 0, o.stop.rel_err = 0.01, o.stop.max_steps = 2000, o.exec.seed = 1;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     print_message("cut at 2000 steps: %lld of %lld walks cut, cut bound %.4g, met %d, cut_stop %d\n", (long long)r.cut,
                   (long long)r.walks, r.cut_bound, r.rel_err_met, r.cut_stop);
     assert_true(r.cut > 0 && !r.rel_err_met && r.cut_stop && r.walks <= 2048);
@@ -521,29 +521,29 @@ static void test_rel_err_cuts(void **state)
     /* and an interval that holds the cuts' bias (exact 10^4, estimate ~1.8e3): widened by cut_bound
        on both sides (src/stop.h), it reaches the exact value */
     assert_true(r.cut_bound > r.std_error && r.ci95[0] <= 1e4 && 1e4 <= r.ci95[1]);
-    o.max_walks = 8192;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    o.stop.max_walks = 8192;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(!r.rel_err_met && r.cut_stop);
-    o.max_steps = 1000000, o.max_walks = 2048, o.rel_err = 0; /* no cuts: no cut bias */
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    o.stop.max_steps = 1000000, o.stop.max_walks = 2048, o.stop.rel_err = 0; /* no cuts: no cut bias */
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     assert_true(r.cut == 0 && r.cut_bound == 0.0 && !r.cut_stop);
     ulam_error err;
     /* a split weight below the start weight (1 adjoint, ||b||_1 = 1000 forward) is refused */
     o = ulam_walk_defaults();
-    o.split = 1e-7;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
+    o.kernel.split = 1e-7;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
     assert_non_null(strstr(err.msg, "split weight"));
-    o.mode = ULAM_FORWARD, o.split = 999;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINVAL);
-    o.split = 1000, o.max_walks = 1024;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    o.mode = ULAM_FORWARD, o.kernel.split = 999;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINVAL);
+    o.kernel.split = 1000, o.stop.max_walks = 1024;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     /* splitting leaves no bound on a single score: --rel-err alone is refused at the start */
     o = ulam_walk_defaults();
-    o.max_walks = 0, o.rel_err = 0.1, o.split = 2.0;
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_EINFVAR);
+    o.stop.max_walks = 0, o.stop.rel_err = 0.1, o.kernel.split = 2.0;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_EINFVAR);
     assert_non_null(strstr(err.msg, "bound on a single walk's score"));
-    o.max_walks = 4096; /* bounded by walks: runs, never met */
-    assert_int_equal(ulam_solve(M, b, &o, &r, &err), ULAM_OK);
+    o.stop.max_walks = 4096; /* bounded by walks: runs, never met */
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, &err), ULAM_OK);
     assert_true(r.walks == 4096 && !r.rel_err_met && !isfinite(r.tail_bound));
     ulam_csr_free(M);
 }
@@ -561,7 +561,7 @@ static void test_forward_unreached(void **state)
     s.x = malloc(200 * sizeof *s.x);
     assert_int_equal(ulam_direct_solve(s.M, s.b, s.x, 0, NULL, NULL), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = ULAM_FORWARD, o.max_walks = 1000, o.seed = 4;
+    o.mode = ULAM_FORWARD, o.stop.max_walks = 1000, o.exec.seed = 4;
     ulam_solver *sv = NULL;
     assert_int_equal(ulam_solver_alloc(s.M, s.b, &o, &sv, NULL), ULAM_OK);
     while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
@@ -579,9 +579,9 @@ static void test_forward_unreached(void **state)
     assert_true(nan > 0 && nan == r.unreached);
     assert_int_equal(zero, 0);
     ulam_solver_free(sv);
-    o.index = first, o.max_walks = 0, o.rel_err = 0.2; /* an unreached component, watched */
+    o.query.index = first, o.stop.max_walks = 0, o.stop.rel_err = 0.2; /* an unreached component, watched */
     ulam_error err;
-    assert_int_equal(ulam_solve(s.M, s.b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(s.M, s.b, &o, &r, NULL), ULAM_OK);
     print_message("rel_err 0.2 on an unreached component: %lld walks, met %d, out of reach %d, min walks %.3g, "
                   "fourth moment %d, rho4 [%.4g, %.4g]\n", (long long)r.walks, r.rel_err_met, r.out_of_reach,
                   r.min_walks, r.fourth_finite, r.rho4.lower, r.rho4.upper);
@@ -598,8 +598,8 @@ static void test_forward_unreached(void **state)
      * scores, E = 1e-7) ends after a round, not met, instead of running to the cap */
     test_sys c = test_sys_load("chain4");
     o = ulam_walk_defaults();
-    o.max_walks = 0, o.rel_err = 1e-7;
-    assert_int_equal(ulam_solve(c.M, c.b, &o, &r, &err), ULAM_OK);
+    o.stop.max_walks = 0, o.stop.rel_err = 1e-7;
+    assert_int_equal(ulam_solve_walks(c.M, c.b, &o, &r, &err), ULAM_OK);
     print_message("chain4 rel_err 1e-7: %lld walks, met %d, out of reach %d, min walks %.3g\n", (long long)r.walks,
                   r.rel_err_met, r.out_of_reach, r.min_walks);
     assert_true(!r.rel_err_met && r.out_of_reach && r.min_walks > ULAM_REL_ERR_CAP && r.walks < ULAM_REL_ERR_CAP);
@@ -624,9 +624,9 @@ static void test_rel_err_collision_tail(void **state)
     assert_int_equal(ulam_csr_transpose(M0, &T), ULAM_OK); /* re-sort the rewired rows */
     assert_int_equal(ulam_csr_transpose(T, &M), ULAM_OK);
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 3, o.rel_err = 0.1, o.max_walks = 2000;
+    o.query.index = 3, o.stop.rel_err = 0.1, o.stop.max_walks = 2000;
     ulam_walk_result r;
-    assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
     print_message("sticky cluster, collision, 2000 walks: the rule needs %.3g walks (tail bound %.3g)\n", r.min_walks,
                   r.tail_bound);
     assert_true(!isfinite(r.score_bound) && isfinite(r.tail_bound));

@@ -213,10 +213,10 @@ static inline ulam_walk_result test_sys_run(const test_sys *s, ulam_walk_opts o)
 {
     ulam_walk_result r;
     ulam_error err;
-    int st = ulam_solve(s->M, s->b, &o, &r, &err);
-    if (st) print_error("ulam_solve: %s: %s\n", ulam_strerror(st), err.msg);
+    int st = ulam_solve_walks(s->M, s->b, &o, &r, &err);
+    if (st) print_error("ulam_solve_walks: %s: %s\n", ulam_strerror(st), err.msg);
     assert_int_equal(st, ULAM_OK);
-    assert_true(r.walks == o.max_walks);
+    assert_true(r.walks == o.stop.max_walks);
     return r;
 }
 

@@ -141,20 +141,20 @@ static int get_int(PyObject *d, const char *key, int *v)
 static int read_opts(PyObject *d, ulam_walk_opts *o, ulam_auto_opts *ao, ulam_method_opts *mo, int *reuse,
                      int *catch_sigint)
 {
-    int64_t seed = (int64_t)o->seed;
+    int64_t seed = (int64_t)o->exec.seed;
     if (get_int(d, "mode", &o->mode) || get_int(d, "estimator", &o->estimator) ||
-        get_double(d, "continue_q", &o->continue_q) || get_double(d, "kernel_alpha", &o->kernel_alpha) ||
-        get_int64(d, "max_walks", &o->max_walks) || get_double(d, "rel_err", &o->rel_err) ||
-        get_double(d, "max_seconds", &o->max_seconds) || get_int64(d, "max_steps", &o->max_steps) ||
-        get_double(d, "roulette", &o->roulette) || get_double(d, "split", &o->split) || get_int64(d, "seed", &seed) ||
-        get_int(d, "threads", &o->threads) || get_int(d, "force", &o->force) ||
-        get_int(d, "assume_finite", &o->assume_finite) || get_int(d, "whole_kernel", &o->whole_kernel) ||
+        get_double(d, "continue_q", &o->kernel.continue_q) || get_double(d, "kernel_alpha", &o->kernel.kernel_alpha) ||
+        get_int64(d, "max_walks", &o->stop.max_walks) || get_double(d, "rel_err", &o->stop.rel_err) ||
+        get_double(d, "max_seconds", &o->stop.max_seconds) || get_int64(d, "max_steps", &o->stop.max_steps) ||
+        get_double(d, "roulette", &o->kernel.roulette) || get_double(d, "split", &o->kernel.split) || get_int64(d, "seed", &seed) ||
+        get_int(d, "threads", &o->exec.threads) || get_int(d, "force", &o->policy.force) ||
+        get_int(d, "assume_finite", &o->policy.assume_finite) || get_int(d, "whole_kernel", &o->kernel.whole_kernel) ||
         get_int(d, "method", &mo->method) || get_int(d, "pin_mode", &ao->pin_mode) ||
         get_int(d, "pin_estimator", &ao->pin_estimator) || get_int(d, "pin_continue", &ao->pin_continue) ||
         get_int(d, "pin_alpha", &ao->pin_alpha) || get_int(d, "reuse", reuse) ||
         get_int(d, "catch_sigint", catch_sigint))
         return -1;
-    o->seed = (uint64_t)seed;
+    o->exec.seed = (uint64_t)seed;
     int exclude = 0;
     if (get_int(d, "exclude", &exclude)) return -1;
     mo->exclude = (unsigned)exclude;
@@ -258,8 +258,8 @@ static PyObject *answer(int status, const ulam_error *err, const ulam_choice *ch
         put(d, "estimate", PyFloat_FromDouble(a->estimate)) || put(d, "std_error", PyFloat_FromDouble(a->std_error)) ||
         put(d, "ci95", Py_BuildValue("(dd)", a->ci95[0], a->ci95[1])) || put(d, "walk", walk_result(&a->walks)) ||
         put(d, "opts", Py_BuildValue("{s:i,s:i,s:d,s:d,s:K,s:L}", "mode", o->mode, "estimator", o->estimator,
-                                     "continue_q", o->continue_q, "kernel_alpha", o->kernel_alpha, "seed",
-                                     (unsigned long long)o->seed, "index", (long long)o->index)) ||
+                                     "continue_q", o->kernel.continue_q, "kernel_alpha", o->kernel.kernel_alpha, "seed",
+                                     (unsigned long long)o->exec.seed, "index", (long long)o->query.index)) ||
         put(d, "rho_abs", radius(&a->guard.abs)) || put(d, "rho_hat", radius(&a->guard.hat[o->mode == 1])) ||
         put(d, "iterations", PyLong_FromLong(a->iterations)) || put(d, "residual", PyFloat_FromDouble(a->residual)))
         goto fail;
@@ -342,7 +342,7 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
         return NULL;
     }
     volatile int flag = 0;
-    o.index = index, o.interrupt = &flag;
+    o.query.index = index, o.stop.interrupt = &flag;
     ulam_choice *ch = malloc(sizeof *ch);
     ulam_answer *a = calloc(1, sizeof *a);
     if (!ch || !a) {

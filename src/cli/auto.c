@@ -31,16 +31,16 @@ int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, c
         const char *hint = s->jacobi || s->pagerank > 0 ? "" : cli_system_hint(s->M);
         fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance%s; the closest is "
                         "%s %s (continuation %s%.3g, kernel exponent %g) with rho(M^) = %.6g (upper bound %.6g)%s.%s\n",
-                s->matrix_path, o->rel_err > 0 ? "error" : "warning", diverge ? " (rho(|M|) is not certified below 1)" : "",
+                s->matrix_path, o->stop.rel_err > 0 ? "error" : "warning", diverge ? " (rho(|M|) is not certified below 1)" : "",
                 cli_mode_names[c->mode], cli_estimator_names[c->estimator], c->continue_q > 0 ? "" : "analog, ",
                 c->continue_q > 0 ? c->continue_q : 0.0, c->kernel_alpha, c->hat.rho, c->hat.upper,
-                o->rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it", hint);
-        if (o->rel_err > 0) {
+                o->stop.rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it", hint);
+        if (o->stop.rel_err > 0) {
             *run = ulam_run_free(*run);
             return diverge ? EXIT_DIVERGE : EXIT_INFVAR;
         }
     }
-    o->mode = c->mode, o->estimator = c->estimator, o->continue_q = c->continue_q, o->kernel_alpha = c->kernel_alpha;
+    o->mode = c->mode, o->estimator = c->estimator, o->kernel.continue_q = c->continue_q, o->kernel.kernel_alpha = c->kernel_alpha;
     return 0;
 }
 

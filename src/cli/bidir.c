@@ -1,6 +1,6 @@
 /* ulam solve --source S or --rhs b --method bidirectional: one entry x_I of (I - M) x = b for
  * b = e_S or a sparse b, by a reverse push from I and walks from b's states.  Reached from
- * cli_solve through cli_bidir_claims. */
+ * cli_solve's parser (src/cli/solve_rows.c) as the table's bidirectional row. */
 #include "cli.h"
 
 #include <getopt.h>
@@ -38,20 +38,6 @@ static const char *const usage =
     "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
     "  guards reported are those of the forward kernel\n";
 
-/* Nonzero when argv asks for a point-source solve (--source, --rmax or --method bidirectional). */
-int cli_bidir_claims(int argc, char **argv)
-{
-    for (int k = 1; k < argc; k++) {
-        const char *a = argv[k];
-        if (!strcmp(a, "--")) break;
-        if (!strcmp(a, "--source") || !strncmp(a, "--source=", 9) || !strcmp(a, "--rmax") || !strncmp(a, "--rmax=", 7))
-            return 1;
-        const char *v = !strncmp(a, "--method=", 9) ? a + 9 : !strcmp(a, "--method") && k + 1 < argc ? argv[k + 1] : NULL;
-        if (v && ulam_method_find(v) == ULAM_METHOD_BIDIRECTIONAL) return 1;
-    }
-    return 0;
-}
-
 typedef struct {
     int json, check;
     double direct, transpose_seconds, load_seconds, guard_seconds;
@@ -78,7 +64,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
                (long long)w->walks, (long long)w->cut, (long long)w->steps, w->threads, (long long)r->plan.pilot_walks,
                r->plan.predicted_walks);
         printf("seconds         %.4f (push and pilot %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
-               r->plan.seconds, w->seconds, (unsigned long long)o->walk.seed, rp->transpose_seconds);
+               r->plan.seconds, w->seconds, (unsigned long long)o->walk.exec.seed, rp->transpose_seconds);
         printf("load            %.3f s inputs\n", rp->load_seconds);
         if (rp->ch) cli_auto_print_text(rp->ch, 1);
         if (rp->check)
@@ -106,7 +92,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
                (long long)r->plan.pilot_walks, r->plan.mean_visits, r->plan.predicted_walks, r->plan.predicted_work,
                r->plan.step_cost, r->plan.probe);
     printf("seconds         %.4f (push %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
-           r->push.seconds, w->seconds, (unsigned long long)o->walk.seed, rp->transpose_seconds);
+           r->push.seconds, w->seconds, (unsigned long long)o->walk.exec.seed, rp->transpose_seconds);
     printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
            cli_verdict_word(rp->g.verdict_abs), rp->g.hat[ULAM_FORWARD].rho, cli_verdict_word(rp->g.verdict_hat[ULAM_FORWARD]));
     printf("load            %.3f s inputs, %.3f s guards\n", rp->load_seconds, rp->guard_seconds);
@@ -159,13 +145,13 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     cli_json_number("load_seconds", rp->load_seconds, 0);
     cli_json_number("guard_seconds", rp->guard_seconds, 0);
     cli_json_string("estimator", cli_estimator_names[o->walk.estimator], 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->walk.seed, w->threads,
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->walk.exec.seed, w->threads,
            cli_share ? cli_share->nranks : 1);
     if (rp->check) {
         cli_json_number("direct", rp->direct, 0);
         cli_json_number("z", r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN, 0);
     }
-    if (o->walk.rel_err > 0) printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
+    if (o->walk.stop.rel_err > 0) printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
     if (rp->ch) cli_auto_print_json(rp->ch, 1);
     printf("\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
 }
@@ -214,7 +200,7 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
         s->own_b[source - 1] = 1.0;
         s->b = s->own_b; /* freed by cli_system_free */
     }
-    double continue_q = o->walk.continue_q;
+    double continue_q = o->walk.kernel.continue_q;
     if ((rc = cli_guard(s, continue_q, 1.0, ULAM_FORWARD, &rp->g))) return rc;
     if (rp->g.verdict_abs >= ULAM_VERDICT_FAIL) {
         cli_guard_diverge(s, &rp->g, force);
@@ -243,7 +229,7 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     if (!status) status = ulam_push_alloc(s->M, &w);
     ulam_error err = {.status = status, .msg = "memory for the transpose and the push"};
     ulam_bidir_result r;
-    o->walk.interrupt = &cli_interrupted, o->walk.share = cli_share;
+    o->walk.stop.interrupt = &cli_interrupted, o->walk.exec.share = cli_share;
     cli_catch_sigint();
     if (!status) status = ulam_bidir_solve(w, stored ? stored : Mt, o, &r, &err);
     int rc = status ? cli_report(s->matrix_path, &err) : 0;
@@ -274,9 +260,9 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     ulam_fpush_opts o = ulam_fpush_defaults();
     o.walk = bo->walk;
     o.walk.mode = ULAM_FORWARD;
-    o.walk.max_walks = bo->walk.max_walks > 0 ? bo->walk.max_walks : 0;
-    o.walks = o.walk.max_walks;
-    if (bo->walk.rel_err > 0) o.rel_err = bo->walk.rel_err;
+    o.walk.stop.max_walks = bo->walk.stop.max_walks > 0 ? bo->walk.stop.max_walks : 0;
+    o.walks = o.walk.stop.max_walks;
+    if (bo->walk.stop.rel_err > 0) o.rel_err = bo->walk.stop.rel_err;
     o.rmax = bo->rmax, o.min_value = bo->min_value, o.step_cost = bo->step_cost, o.source = source - 1;
     int check = rp->check;
     rp->check = 0; /* prepare's direct value is for one index */
@@ -289,7 +275,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     ulam_fpush_info info;
     ulam_error err;
     int status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : ulam_csr_transpose(s->M, &Mt);
-    o.walk.guard = &rp->g, o.walk.interrupt = &cli_interrupted;
+    o.walk.policy.guard = &rp->g, o.walk.stop.interrupt = &cli_interrupted;
     if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
@@ -354,54 +340,76 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     return rc;
 }
 
-/* ulam solve --source S, or --rhs b --method bidirectional. */
-int cli_bidir(int argc, char **argv)
+/* The bidirectional row's options (src/cli/solve_rows.c reads them). */
+static const struct option longopts[] = {
+    {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
+    {"source", required_argument, 0, 'u'},    {"method", required_argument, 0, 'M'},
+    {"rmax", required_argument, 0, 'x'},      {"min-value", required_argument, 0, 'v'},
+    {"step-cost", required_argument, 0, 'k'}, {"top", required_argument, 0, 'T'},
+    CLI_WALK_OPTION("estimator"),             CLI_WALK_OPTION("walks"),
+    CLI_WALK_OPTION("rel-err"),               CLI_WALK_OPTION("time"),
+    CLI_WALK_OPTION("seed"),                  CLI_WALK_OPTION("threads"),
+    CLI_WALK_OPTION("continue"),              CLI_WALK_OPTION("max-steps"),
+    {"check", no_argument, 0, 'c'},           {"json", no_argument, 0, 'J'},
+    {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
+    {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
+
+/* What the command line gives a bidirectional solve. */
+typedef struct {
+    cli_system s;
+    ulam_bidir_opts o;
+    report rp;
+    int64_t source, top;
+    int force, method;
+} bidir_args;
+
+/* The arguments before any option. */
+static void init(void *p)
 {
-    static const struct option longopts[] = {
-        {"rhs", required_argument, 0, 'b'},       {"index", required_argument, 0, 'i'},
-        {"source", required_argument, 0, 'u'},    {"method", required_argument, 0, 'M'},
-        {"rmax", required_argument, 0, 'x'},      {"min-value", required_argument, 0, 'v'},
-        {"step-cost", required_argument, 0, 'k'}, {"top", required_argument, 0, 'T'},
-        CLI_WALK_OPTION("estimator"),             CLI_WALK_OPTION("walks"),
-        CLI_WALK_OPTION("rel-err"),               CLI_WALK_OPTION("time"),
-        CLI_WALK_OPTION("seed"),                  CLI_WALK_OPTION("threads"),
-        CLI_WALK_OPTION("continue"),              CLI_WALK_OPTION("max-steps"),
-        {"check", no_argument, 0, 'c'},           {"json", no_argument, 0, 'J'},
-        {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
-        {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
-    cli_system s = {.command = "solve", .omega = 1.0};
-    ulam_bidir_opts o = ulam_bidir_defaults();
-    report rp = {0};
-    int64_t source = 0;
-    int c, rc, idx, force = 0, method = 0;
-    int64_t *bidx = NULL, top = 0;
-    double *bval = NULL;
-    o.walk.max_walks = 0;
-    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
-    optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
-        switch (c) {
-        case CLI_WALK: if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &o.walk))) return rc; break;
-        case 'b': s.rhs_path = optarg; break;
-        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
-        case 'u': if ((rc = cli_parse_int("solve", "--source", optarg, 1, ULAM_MAX_DIM, &source))) return rc; break;
-        case 'M':
-            if (ulam_method_find(optarg) != ULAM_METHOD_BIDIRECTIONAL)
-                return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
-            method = 1;
-            break;
-        case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &o.rmax))) return rc; break;
-        case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &o.min_value))) return rc; break;
-        case 'k': if ((rc = cli_parse_real("solve", "--step-cost", optarg, 1e-3, 1e6, &o.step_cost))) return rc; break;
-        case 'T': if ((rc = cli_parse_int("solve", "--top", optarg, 1, ULAM_MAX_DIM, &top))) return rc; break;
-        case 'c': rp.check = 1; break;
-        case 'J': rp.json = 1; break;
-        case 'F': force = 1; break;
-        case 'C': s.cache = 1; break;
-        case 'h': fputs(usage, stdout); return 0;
-        default: return cli_usage_error("solve", "unknown option for a --source solve");
-        }
+    bidir_args *a = p;
+    *a = (bidir_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_bidir_defaults()};
+    a->o.walk.stop.max_walks = 0;
+}
+
+/* One option (c its code in longopts) into the arguments; 0, or an exit code (-1: --help printed). */
+static int option(void *p, int c, const char *name, const char *optarg)
+{
+    bidir_args *a = p;
+    int rc;
+    switch (c) {
+    case CLI_WALK: if ((rc = cli_walk_option("solve", name, optarg, &a->o.walk))) return rc; break;
+    case 'b': a->s.rhs_path = optarg; break;
+    case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
+    case 'u': if ((rc = cli_parse_int("solve", "--source", optarg, 1, ULAM_MAX_DIM, &a->source))) return rc; break;
+    case 'M':
+        if (ulam_method_find(optarg) != ULAM_METHOD_BIDIRECTIONAL)
+            return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
+        a->method = 1;
+        break;
+    case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &a->o.rmax))) return rc; break;
+    case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &a->o.min_value))) return rc; break;
+    case 'k': if ((rc = cli_parse_real("solve", "--step-cost", optarg, 1e-3, 1e6, &a->o.step_cost))) return rc; break;
+    case 'T': if ((rc = cli_parse_int("solve", "--top", optarg, 1, ULAM_MAX_DIM, &a->top))) return rc; break;
+    case 'c': a->rp.check = 1; break;
+    case 'J': a->rp.json = 1; break;
+    case 'F': a->force = 1; break;
+    case 'C': a->s.cache = 1; break;
+    case 'h': fputs(usage, stdout); return -1;
+    default: return cli_usage_error("solve", "unknown option for a --source solve");
     }
+    return 0;
+}
+
+/* The options read (argv[optind..]: the operands): check them and run; 0 or an exit code. */
+static int start_run(void *p, int argc, char **argv, int optind)
+{
+    bidir_args *a = p;
+    cli_system s = a->s;
+    ulam_bidir_opts o = a->o;
+    report rp = a->rp;
+    int64_t source = a->source, top = a->top, *bidx = NULL;
+    int rc, force = a->force, method = a->method;
+    double *bval = NULL;
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
     if (s.rhs_path && source) return cli_usage_error("solve", "--source S sets b = e_S: it cannot go with --rhs");
     if (s.rhs_path && !method)
@@ -417,7 +425,7 @@ int cli_bidir(int argc, char **argv)
         return rc;
     }
     cli_walk_budget(&o.walk);
-    o.walk.force = force;
+    o.walk.policy.force = force;
     s.matrix_path = argv[optind];
     if (!(rc = prepare(&s, source, force, &o, &bidx, &bval, &rp))) {
         o.target = s.index - 1, o.source = source ? source - 1 : 0;
@@ -427,6 +435,18 @@ int cli_bidir(int argc, char **argv)
     cli_system_free(&s);
     return rc;
 }
+
+/* Bidirectional: --source S, --rmax or --method bidirectional. */
+static const char *const claims[] = {"source", "rmax", NULL};
+
+/* --method bidirectional is this row's. */
+static int serves(const char *method)
+{
+    return method && ulam_method_find(method) == ULAM_METHOD_BIDIRECTIONAL;
+}
+
+const cli_solve_row cli_solve_bidir_row = {"bidirectional", longopts, claims, serves, sizeof(bidir_args), init, option,
+                                           start_run};
 
 /* Run the chosen bidirectional (cli.h). */
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
@@ -438,7 +458,7 @@ int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int 
     rp.dense = route; /* ulam_method_bidir_route: the push on b */
     int rc = 0;
     if (!rp.dense) { /* the dense route's walks run on M under the walks' own guards */
-        if ((rc = cli_guard(s, ch->bidir_opts.walk.continue_q, 1.0, ULAM_FORWARD, &rp.g))) return rc;
+        if ((rc = cli_guard(s, ch->bidir_opts.walk.kernel.continue_q, 1.0, ULAM_FORWARD, &rp.g))) return rc;
         rp.guard_seconds = rp.g.abs.seconds + rp.g.hat[0].seconds + rp.g.hat[1].seconds;
         cli_guard_warn(s, &rp.g, ULAM_FORWARD, 0);
     }

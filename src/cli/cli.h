@@ -229,9 +229,29 @@ int cli_choose(const char *command, const char *opt, const char *value, const ch
 int cli_info(int argc, char **argv);
 int cli_direct(int argc, char **argv);
 int cli_solve(int argc, char **argv);
-/* solve with a point source (--source S, src/cli/bidir.c): cli_solve hands argv over when claimed. */
-int cli_bidir_claims(int argc, char **argv);
-int cli_bidir(int argc, char **argv);
+
+/* A row of `ulam solve`'s table (src/cli/solve_rows.c): a group of the library's method rows that
+ * share a report, with the options it takes.  The one parser reads argv once against the union
+ * of every row's longopts, picks the first row that a --method value (serves) or an option of
+ * its own (claims) selects, the last row being the default, and hands it each option in order.
+ * Adding a method or an estimator touches the library's table and the row that reports it. */
+typedef struct cli_solve_row {
+    const char *name;
+    const struct option *longopts; /* the options it takes; val: its own codes */
+    const char *const *claims;     /* options that select it whatever --method says (NULL-ended), or NULL */
+    int (*serves)(const char *method); /* 1 when --method METHOD (NULL: given no value) is this row's */
+    size_t size;                   /* its arguments' struct */
+    void (*init)(void *args);
+    /* one option: val its code in longopts ('?': getopt refused it), name its long name; 0, an
+     * exit code, or -1 (--help printed: exit 0) */
+    int (*option)(void *args, int val, const char *name, const char *value);
+    /* the options read, argv[first..] the operands: check and run; 0 or an exit code */
+    int (*run)(void *args, int argc, char **argv, int first);
+} cli_solve_row;
+
+/* The rows: bidirectional (src/cli/bidir.c), the outer iterations and Krylov peers
+ * (src/cli/mcsa.c), the walks with auto (src/cli/solve.c). */
+extern const cli_solve_row cli_solve_bidir_row, cli_solve_outer_row, cli_solve_walks_row;
 
 /* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print
  * its report with the choice; 0 or an exit code. */
@@ -254,9 +274,6 @@ void cli_auto_print_text(const ulam_choice *ch, int bidir);
 void cli_auto_print_json(const ulam_choice *ch, int bidir);
 int cli_study(int argc, char **argv);
 
-/* ulam solve --method (src/cli/mcsa.c): nonzero when argv asks for it, and the command. */
-int cli_solve_wants_method(int argc, char **argv);
-int cli_solve_method(int argc, char **argv);
 int cli_radiosity(int argc, char **argv);
 int cli_prepare(int argc, char **argv);
 

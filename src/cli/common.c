@@ -602,10 +602,10 @@ void cli_progress_show(cli_progress *p, int64_t walks, double estimate, double s
     if (!p->on || now - p->last < 0.25) return;
     p->last = now, p->shown = 1;
     fprintf(stderr, "\rulam: %lld walks, %.6g +- %.2g, %.1f s", (long long)walks, estimate, se, el);
-    double want = o->rel_err * fabs(estimate), left = INFINITY;
-    if (o->rel_err > 0 && want > 0 && se > want) left = el * ((se / want) * (se / want) - 1);
-    if (o->max_walks > 0 && walks > 0) left = fmin(left, el * ((double)o->max_walks / (double)walks - 1));
-    if (o->max_seconds > 0) left = fmin(left, o->max_seconds - el);
+    double want = o->stop.rel_err * fabs(estimate), left = INFINITY;
+    if (o->stop.rel_err > 0 && want > 0 && se > want) left = el * ((se / want) * (se / want) - 1);
+    if (o->stop.max_walks > 0 && walks > 0) left = fmin(left, el * ((double)o->stop.max_walks / (double)walks - 1));
+    if (o->stop.max_seconds > 0) left = fmin(left, o->stop.max_seconds - el);
     if (isfinite(left)) left < 1 ? fputs(", under 1 s left", stderr) : fprintf(stderr, ", about %.0f s left", left);
     fputs("      ", stderr);
 }

@@ -52,19 +52,6 @@ static const char *const usage =
 #define method_name(m) ulam_method_name(ULAM_METHOD_RICHARDSON + (m))
 enum { KRYLOV_CG = ULAM_METHOD_CG - ULAM_METHOD_RICHARDSON, KRYLOV_GMRES = ULAM_METHOD_GMRES - ULAM_METHOD_RICHARDSON };
 
-/* Nonzero when argv (after the subcommand) asks for an outer iteration. */
-int cli_solve_wants_method(int argc, char **argv)
-{
-    for (int k = 1; k < argc; k++) {
-        const char *v = !strncmp(argv[k], "--method=", 9) ? argv[k] + 9
-                        : !strcmp(argv[k], "--method") && k + 1 < argc ? argv[k + 1] : NULL;
-        if (!strcmp(argv[k], "--method") && !v) return 1; /* its parser reports the missing value */
-        if (v && strcmp(v, "auto") && ulam_method_answers(ulam_method_find(v)) != ULAM_ANSWERS_ENTRY)
-            return 1; /* auto and the entry rows (walks, bidirectional): cli_solve, cli_bidir */
-    }
-    return 0;
-}
-
 /* What the report needs besides the steps. */
 typedef struct {
     const ulam_outer_opts *o;
@@ -169,8 +156,8 @@ static void print_json(const report *p)
         cli_json_number("estimate", p->x[p->index - 1], 0);
     }
     if (p->check) cli_json_number("relative_error", p->err_direct, 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, \"history\": [", (unsigned long long)p->o->walk.seed,
-           p->o->walk.threads, cli_share ? cli_share->nranks : 1);
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, \"history\": [", (unsigned long long)p->o->walk.exec.seed,
+           p->o->walk.exec.threads, cli_share ? cli_share->nranks : 1);
     for (int k = 0; k < p->nsteps; k++) {
         const ulam_outer_step *s = &p->steps[k];
         printf("%s{\"iteration\": %d, ", k ? ", " : "", s->iteration);
@@ -283,86 +270,112 @@ static int run_krylov(const cli_system *s, const ulam_outer_opts *o, report *p, 
     return 0;
 }
 
-/* ulam solve --method. */
-int cli_solve_method(int argc, char **argv)
+/* The outer rows' options (src/cli/solve_rows.c reads them). */
+static const struct option longopts[] = {
+    {"rhs", required_argument, 0, 'b'},     {"method", required_argument, 0, 'M'},
+    {"tol", required_argument, 0, 'l'},     {"rel-err", required_argument, 0, 'l'},     {"max-iter", required_argument, 0, 'k'},
+    {"eps1", required_argument, 0, 'p'},    {"max-histories", required_argument, 0, 'H'},
+    {"stall", required_argument, 0, 'a'},   CLI_WALK_OPTION("estimator"),
+    CLI_WALK_OPTION("seed"),                CLI_WALK_OPTION("threads"),
+    CLI_WALK_OPTION("continue"),            CLI_WALK_OPTION("max-steps"),
+    {"jacobi", no_argument, 0, 'j'},        {"omega", required_argument, 0, 'w'},
+    {"json", no_argument, 0, 'J'},          {"out", required_argument, 0, 'o'},
+    {"index", required_argument, 0, 'i'},   {"check", no_argument, 0, 'c'},
+    {"force", no_argument, 0, 'F'},         {"cache", no_argument, 0, 'C'},
+    {"restart", required_argument, 0, 'r'}, {"help", no_argument, 0, 'h'},
+    {0, 0, 0, 0}};
+
+/* What the command line gives an outer iteration (p points at o and s). */
+typedef struct {
+    cli_system s;
+    ulam_outer_opts o;
+    report p;
+    const char *out;
+    int force;
+} outer_args;
+
+/* The arguments before any option. */
+static void init(void *q)
 {
-    static const struct option longopts[] = {
-        {"rhs", required_argument, 0, 'b'},     {"method", required_argument, 0, 'M'},
-        {"tol", required_argument, 0, 'l'},     {"rel-err", required_argument, 0, 'l'},     {"max-iter", required_argument, 0, 'k'},
-        {"eps1", required_argument, 0, 'p'},    {"max-histories", required_argument, 0, 'H'},
-        {"stall", required_argument, 0, 'a'},   CLI_WALK_OPTION("estimator"),
-        CLI_WALK_OPTION("seed"),                CLI_WALK_OPTION("threads"),
-        CLI_WALK_OPTION("continue"),            CLI_WALK_OPTION("max-steps"),
-        {"jacobi", no_argument, 0, 'j'},        {"omega", required_argument, 0, 'w'},
-        {"json", no_argument, 0, 'J'},          {"out", required_argument, 0, 'o'},
-        {"index", required_argument, 0, 'i'},   {"check", no_argument, 0, 'c'},
-        {"force", no_argument, 0, 'F'},         {"cache", no_argument, 0, 'C'},
-        {"restart", required_argument, 0, 'r'}, {"help", no_argument, 0, 'h'},
-        {0, 0, 0, 0}};
-    cli_system s = {.command = "solve", .omega = 1.0};
-    ulam_outer_opts o = ulam_outer_defaults();
-    report p = {.o = &o, .s = &s, .method = ULAM_MCSA, .restart = 30};
-    const char *out = NULL;
+    outer_args *a = q;
+    *a = (outer_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_outer_defaults()};
+    a->p = (report){.o = &a->o, .s = &a->s, .method = ULAM_MCSA, .restart = 30};
+}
+
+/* One option (c its code in longopts) into the arguments; 0, or an exit code (-1: --help printed). */
+static int option(void *q, int c, const char *name, const char *optarg)
+{
+    outer_args *a = q;
+    ulam_outer_opts *o = &a->o;
     int64_t v;
-    int c, rc, idx, force = 0;
-    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
-    optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
-        switch (c) {
-        case CLI_WALK: if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &o.walk))) return rc; break;
-        case 'b': s.rhs_path = optarg; break;
-        case 'M':
-            if (ulam_method_answers(ulam_method_find(optarg)) != ULAM_ANSWERS_ALL)
-                return cli_method_error(optarg);
-            p.method = ulam_method_find(optarg) - ULAM_METHOD_RICHARDSON;
-            if (p.method < KRYLOV_CG) o.method = p.method;
-            break;
-        case 'r':
-            if ((rc = cli_parse_int("solve", "--restart", optarg, 1, 10000, &v))) return rc;
-            p.restart = (int)v;
-            break;
-        case 'l': {
-            char *end;
-            o.tol = strtod(optarg, &end);
-            if (end == optarg || *end || !(o.tol > 0 && o.tol < 1))
-                return cli_usage_error("solve", "--tol expects a residual reduction strictly between 0 and 1 "
-                                                "(such as 1e-8), got '%s'", optarg);
-            break;
-        }
-        case 'k':
-            if ((rc = cli_parse_int("solve", "--max-iter", optarg, 1, 100000000, &v))) return rc;
-            o.max_iter = (int)v;
-            break;
-        case 'p': {
-            char *end;
-            o.eps1 = strtod(optarg, &end);
-            if (end == optarg || *end || !(o.eps1 > 0 && o.eps1 < 1))
-                return cli_usage_error("solve", "--eps1 expects a relative standard deviation strictly between "
-                                                "0 and 1 (such as 0.1), got '%s'", optarg);
-            break;
-        }
-        case 'H': if ((rc = cli_parse_int("solve", "--max-histories", optarg, 1, INT64_MAX / 2, &o.max_histories))) return rc; break;
-        case 'a': if ((rc = cli_parse_int("solve", "--stall", optarg, 1, 1000000, &v))) return rc; o.stall = (int)v; break;
-        case 'j': s.jacobi = 1; break;
-        case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
-        case 'J': p.json = 1; break;
-        case 'o': out = optarg; break;
-        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
-        case 'c': p.check = 1; break;
-        case 'F': force = 1; break;
-        case 'C': s.cache = 1; break;
-        case 'h': fputs(usage, stdout); return 0;
-        default: return cli_usage_error("solve", "unknown option (for --method: see 'ulam solve --method mcsa --help')");
-        }
+    int rc;
+    switch (c) {
+    case CLI_WALK: if ((rc = cli_walk_option("solve", name, optarg, &o->walk))) return rc; break;
+    case 'b': a->s.rhs_path = optarg; break;
+    case 'M':
+        if (ulam_method_answers(ulam_method_find(optarg)) != ULAM_ANSWERS_ALL)
+            return cli_method_error(optarg);
+        a->p.method = ulam_method_find(optarg) - ULAM_METHOD_RICHARDSON;
+        if (a->p.method < KRYLOV_CG) o->method = a->p.method;
+        break;
+    case 'r':
+        if ((rc = cli_parse_int("solve", "--restart", optarg, 1, 10000, &v))) return rc;
+        a->p.restart = (int)v;
+        break;
+    case 'l': {
+        char *end;
+        o->tol = strtod(optarg, &end);
+        if (end == optarg || *end || !(o->tol > 0 && o->tol < 1))
+            return cli_usage_error("solve", "--tol expects a residual reduction strictly between 0 and 1 "
+                                            "(such as 1e-8), got '%s'", optarg);
+        break;
     }
+    case 'k':
+        if ((rc = cli_parse_int("solve", "--max-iter", optarg, 1, 100000000, &v))) return rc;
+        o->max_iter = (int)v;
+        break;
+    case 'p': {
+        char *end;
+        o->eps1 = strtod(optarg, &end);
+        if (end == optarg || *end || !(o->eps1 > 0 && o->eps1 < 1))
+            return cli_usage_error("solve", "--eps1 expects a relative standard deviation strictly between "
+                                            "0 and 1 (such as 0.1), got '%s'", optarg);
+        break;
+    }
+    case 'H': if ((rc = cli_parse_int("solve", "--max-histories", optarg, 1, INT64_MAX / 2, &o->max_histories))) return rc; break;
+    case 'a': if ((rc = cli_parse_int("solve", "--stall", optarg, 1, 1000000, &v))) return rc; o->stall = (int)v; break;
+    case 'j': a->s.jacobi = 1; break;
+    case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
+    case 'J': a->p.json = 1; break;
+    case 'o': a->out = optarg; break;
+    case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
+    case 'c': a->p.check = 1; break;
+    case 'F': a->force = 1; break;
+    case 'C': a->s.cache = 1; break;
+    case 'h': fputs(usage, stdout); return -1;
+    default: return cli_usage_error("solve", "unknown option (for --method: see 'ulam solve --method mcsa --help')");
+    }
+    return 0;
+}
+
+/* The options read (argv[optind..]: the operands): check them and run; 0 or an exit code. */
+static int start_run(void *q, int argc, char **argv, int optind)
+{
+    outer_args *a = q;
+    cli_system s = a->s;
+    ulam_outer_opts o = a->o;
+    report p = a->p;
+    p.o = &o, p.s = &s;
+    const char *out = a->out;
+    int rc, force = a->force;
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
     if (!s.rhs_path) return cli_usage_error("solve", "needs --rhs b.mtx");
     s.matrix_path = argv[optind];
     if (out && (rc = cli_check_output(out))) return rc;
     if ((rc = cli_load_system(&s))) return rc;
     p.index = s.index;
-    o.walk.share = cli_share, o.walk.interrupt = &cli_interrupted;
-    if (walking(p.method) && (rc = cli_guard(&s, o.walk.continue_q, o.walk.kernel_alpha, ULAM_FORWARD, &p.g))) {
+    o.walk.exec.share = cli_share, o.walk.stop.interrupt = &cli_interrupted;
+    if (walking(p.method) && (rc = cli_guard(&s, o.walk.kernel.continue_q, o.walk.kernel.kernel_alpha, ULAM_FORWARD, &p.g))) {
         cli_system_free(&s);
         return rc;
     }
@@ -374,7 +387,7 @@ int cli_solve_method(int argc, char **argv)
         }
     }
     if (walking(p.method)) cli_guard_warn(&s, &p.g, ULAM_FORWARD, 0);
-    o.walk.guard = &p.g, o.walk.force = force; /* the walks' solver takes these verdicts */
+    o.walk.policy.guard = &p.g, o.walk.policy.force = force; /* the walks' solver takes these verdicts */
     ulam_outer_step *steps = NULL;
     double *x = NULL;
     rc = p.method >= KRYLOV_CG ? run_krylov(&s, &o, &p, &x) : run(&s, &o, &p, &steps, &x);
@@ -404,3 +417,12 @@ int cli_solve_method(int argc, char **argv)
     cli_system_free(&s);
     return rc;
 }
+
+/* The rows that answer every unknown (--method richardson ... gmres); a --method without a value
+ * and an unknown name come here too, to be refused in this row's words. */
+static int serves(const char *method)
+{
+    return !method || (strcmp(method, "auto") && ulam_method_answers(ulam_method_find(method)) != ULAM_ANSWERS_ENTRY);
+}
+
+const cli_solve_row cli_solve_outer_row = {"outer", longopts, NULL, serves, sizeof(outer_args), init, option, start_run};

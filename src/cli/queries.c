@@ -169,7 +169,7 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
     int met;
     int64_t walks;
     if (q->source < 0) {
-        o.index = q->index;
+        o.query.index = q->index;
         ulam_walk_result r;
         status = ulam_analysis_solve(w->an, w->s->b, &o, &r, &err);
         est = r.estimate, se = r.std_error, ci[0] = r.ci95[0], ci[1] = r.ci95[1], met = r.rel_err_met;
@@ -178,11 +178,11 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
         const ulam_csr *Mt = ulam_analysis_transpose(w->an, &err);
         ulam_push *p = Mt ? ulam_analysis_push(w->an, &err) : NULL;
         if (!p) return cli_report(w->s->matrix_path, &err);
-        int rc = transpose_guard(w, Mt, o.continue_q);
+        int rc = transpose_guard(w, Mt, o.kernel.continue_q);
         if (rc) return rc;
         ulam_bidir_opts bo = ulam_bidir_defaults();
         bo.walk = o;
-        bo.walk.guard = &w->gt;
+        bo.walk.policy.guard = &w->gt;
         bo.source = q->source, bo.target = q->index, bo.reach_all = 1, bo.keep_kernel = 1;
         ulam_bidir_result r;
         status = ulam_bidir_solve(p, Mt, &bo, &r, &err);
@@ -194,7 +194,7 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
         return cli_report(w->s->matrix_path, &err);
     }
     if (interrupted) return EXIT_INTERRUPTED; /* the answered lines stay; this one is not an answer */
-    print_answer(q, k, o.seed, est, se, ci, met, walks, ulam_now() - t0, json);
+    print_answer(q, k, o.exec.seed, est, se, ci, met, walks, ulam_now() - t0, json);
     return 0;
 }
 
@@ -220,18 +220,18 @@ int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int js
             rc = EXIT_USAGE;
         }
     if (!rc && need_b && !s->b) rc = cli_usage_error("solve", "--queries with 'INDEX' lines needs b (--rhs b.mtx)");
-    if (!rc) rc = cli_guard(s, o->continue_q, o->kernel_alpha, ULAM_ADJOINT, &w.g);
+    if (!rc) rc = cli_guard(s, o->kernel.continue_q, o->kernel.kernel_alpha, ULAM_ADJOINT, &w.g);
     ulam_analysis_opts ao = ulam_analysis_defaults();
-    ao.continue_q = o->continue_q, ao.kernel_alpha = o->kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
+    ao.continue_q = o->kernel.continue_q, ao.kernel_alpha = o->kernel.kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
     ulam_error err;
     if (!rc && ulam_analysis_alloc(s->M, &ao, &w.an, &err)) rc = cli_report(s->matrix_path, &err);
     ulam_walk_opts base = *o;
-    base.guard = &w.g, base.interrupt = &cli_interrupted, base.mode = ULAM_ADJOINT;
+    base.policy.guard = &w.g, base.stop.interrupt = &cli_interrupted, base.mode = ULAM_ADJOINT;
     cli_catch_sigint();
     for (int64_t k = 0; !rc && k < nq; k++) {
         ulam_walk_opts ok = base;
-        ok.seed = o->seed + (uint64_t)k; /* query k's seed: --seed + k - 1 (1-based k) */
-        if (q[k].target > 0) ok.rel_err = q[k].target, ok.max_walks = walks_given ? ok.max_walks : 0;
+        ok.exec.seed = o->exec.seed + (uint64_t)k; /* query k's seed: --seed + k - 1 (1-based k) */
+        if (q[k].target > 0) ok.stop.rel_err = q[k].target, ok.stop.max_walks = walks_given ? ok.stop.max_walks : 0;
         rc = run_query(&w, &q[k], k, ok, json);
     }
     fflush(stdout);

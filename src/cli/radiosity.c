@@ -144,6 +144,15 @@ typedef struct {
     ulam_walk_opts o;
 } args;
 
+/* The radiosity options of the walk options the command line gave (mode, estimator, patch,
+ * stopping rules, seed, threads, processes). */
+static ulam_rad_opts rad_opts(const ulam_walk_opts *o)
+{
+    ulam_rad_opts r = ulam_rad_defaults();
+    r.mode = o->mode, r.estimator = o->estimator, r.index = o->query.index, r.stop = o->stop, r.exec = o->exec;
+    return r;
+}
+
 /* What the walks found. */
 typedef struct {
     double B[3], se[3], se_walk[3]; /* se: with --matrix-walk, the walk's and F's noise combined */
@@ -353,7 +362,7 @@ static int parse(int argc, char **argv, args *a)
         return 0;
     }
     if (a->est < 0) a->est = a->o.mode == ULAM_FORWARD || a->matrix_walk ? 0 : 2; /* next-event where it applies */
-    if (a->view && (!a->image || !(a->o.rel_err > 0) || a->o.mode != ULAM_ADJOINT || a->direct || a->matrix_walk ||
+    if (a->view && (!a->image || !(a->o.stop.rel_err > 0) || a->o.mode != ULAM_ADJOINT || a->direct || a->matrix_walk ||
                     a->patch || a->check || a->out || a->all))
         return cli_usage_error(cmd, "--view-gather needs --image and --rel-err, and gathers by rays only (no --mode "
                                     "shoot, --direct, --matrix-walk, --patch, --check, --out or --all)");
@@ -400,18 +409,18 @@ static int find_patch(const ulam_scene *s, const char *arg, int64_t *p)
  * walk's score: a bright emitter a walk rarely hits) is out of reach, and name next-event. */
 static void rel_err_warning(const args *a, const ulam_rad_result *r)
 {
-    double limit = a->o.max_walks > 0 && a->o.max_walks < ULAM_REL_ERR_CAP ? (double)a->o.max_walks : 1e8;
-    if (!(a->o.rel_err > 0) || !(r->min_walks > limit)) return;
+    double limit = a->o.stop.max_walks > 0 && a->o.stop.max_walks < ULAM_REL_ERR_CAP ? (double)a->o.stop.max_walks : 1e8;
+    if (!(a->o.stop.rel_err > 0) || !(r->min_walks > limit)) return;
     if (a->o.mode == ULAM_FORWARD || a->o.estimator < ULAM_RAD_COLLISION) { /* next-event or shooting */
         fprintf(stderr, "ulam: %s: warning: --rel-err %g: the rule needs about %.3g walks at this estimate before it "
                         "may stop (%s): one walk's certified score range is wide against the estimate\n",
-                a->scene, a->o.rel_err, r->min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
+                a->scene, a->o.stop.rel_err, r->min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
         return;
     }
     fprintf(stderr, "ulam: %s: warning: --rel-err %g: one walk can score up to a bright emitter's radiosity at every "
                     "bounce, so the rule needs about %.3g walks at this estimate before it may stop (%s): "
                     "--estimator next-event samples the emitters directly and has no such tail\n",
-            a->scene, a->o.rel_err, r->min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
+            a->scene, a->o.stop.rel_err, r->min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
 }
 
 /* Ray walks (gathering or shooting); 0 or an exit code. */
@@ -419,7 +428,8 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
 {
     ulam_rad_solver *sv = NULL;
     ulam_error err;
-    int status = ulam_rad_solver_alloc(t, &a->o, &sv, &err);
+    ulam_rad_opts ro = rad_opts(&a->o);
+    int status = ulam_rad_solver_alloc(t, &ro, &sv, &err);
     if (status) return cli_report(a->scene, &err);
     cli_catch_sigint();
     cli_progress pg;
@@ -471,11 +481,11 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, c
         ulam_csr *M = NULL;
         ulam_solver *sv = NULL;
         ulam_walk_opts o = a->o;
-        if (a->o.rel_err > 0 && a->o.mode == ULAM_ADJOINT) {
-            o.rel_err = ulam_rad_walk_target(a->o.rel_err, ff ? ff[c] : 0, Bd ? Bd[c] : 0, ff && Bd);
-            if (!(o.rel_err > 0)) { /* F's noise alone is past the target: walk to it, say it is not met */
+        if (a->o.stop.rel_err > 0 && a->o.mode == ULAM_ADJOINT) {
+            o.stop.rel_err = ulam_rad_walk_target(a->o.stop.rel_err, ff ? ff[c] : 0, Bd ? Bd[c] : 0, ff && Bd);
+            if (!(o.stop.rel_err > 0)) { /* F's noise alone is past the target: walk to it, say it is not met */
                 w->ff_limited[c] = 1;
-                o.rel_err = a->o.rel_err;
+                o.stop.rel_err = a->o.stop.rel_err;
             }
         }
         if ((status = ulam_rad_system(s, F, c, &M, b)) || (status = ulam_solver_alloc(M, b, &o, &sv, &err))) {
@@ -498,7 +508,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, c
     }
     cli_release_sigint();
     free(b), free(x), free(e);
-    w->zero = a->o.rel_err > 0;
+    w->zero = a->o.stop.rel_err > 0;
     for (int c = 0; c < 3; c++) w->zero &= w->B[c] == 0 && w->se[c] == 0;
     if (!status) return 0;
     err.status = status;
@@ -710,9 +720,9 @@ static void print_text(const args *a, const report *r)
             else if (a->matrix_walk) printf(" (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
             printf("%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
         }
-        if (a->o.rel_err > 0 && !a->matrix_walk && !w->zero)
+        if (a->o.stop.rel_err > 0 && !a->matrix_walk && !w->zero)
             printf("rel-err      %s (%g; the rule's range term wants %.3g walks)\n", w->rel_err_met ? "met" : "NOT met",
-                   a->o.rel_err, w->min_walks);
+                   a->o.stop.rel_err, w->min_walks);
         if (w->zero)
             printf("note         every channel is exactly 0 with zero variance after %lld walks (no walk scored):\n"
                    "             --rel-err can never be met by a zero estimate, so the walks stopped there; if the\n"
@@ -729,14 +739,14 @@ static void print_text(const args *a, const report *r)
         if (w->ff_limited[c])
             printf("rel-err      NOT met in %c: the form factors' error alone is %.3g, past --rel-err %g of the "
                    "answer; more walks cannot meet it, more --ff-rays can (F's error falls as 1/sqrt(rays))\n",
-                   chan[c], r->direct_se[c], a->o.rel_err);
+                   chan[c], r->direct_se[c], a->o.stop.rel_err);
     if (w && a->matrix_walk)
         printf("             (one walk a channel: %lld R + %lld G + %lld B)\n", (long long)w->channel_walks[0],
                (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
     if (a->view)
         printf("view         %lld of %lld patches seen (%lld of %lld pixels), each to %.3g (n_max / n)^%.3g: "
                "%lld camera rays + %lld walk rays, %.4f s%s\n", (long long)r->view.seen, (long long)r->view.npatches,
-               (long long)r->view.pixels_hit, (long long)r->view.camera_rays, a->o.rel_err, a->coverage,
+               (long long)r->view.pixels_hit, (long long)r->view.camera_rays, a->o.stop.rel_err, a->coverage,
                (long long)r->view.camera_rays, (long long)r->view.rays, r->view.seconds,
                r->view.unmet ? "" : ", every seen patch met its target");
     if (a->view && r->view.unmet)
@@ -745,7 +755,7 @@ static void print_text(const args *a, const report *r)
     if (w && w->cut)
         printf("warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
                "             beyond the cut is lost) and the error bar does not cover the bias\n",
-               (long long)w->cut, (long long)w->walks, (long long)a->o.max_steps);
+               (long long)w->cut, (long long)w->walks, (long long)a->o.stop.max_steps);
     if (r->Bdirect && r->patch >= 0)
         for (int c = 0; c < 3; c++) {
             printf("direct %c     %.8g", chan[c], r->Bdirect[3 * r->patch + c]);
@@ -811,13 +821,13 @@ static void print_json(const args *a, const report *r)
         if (a->est == 2) cli_json_string("mis", mis_names[a->mis > 0 ? a->mis : 0], 0);
         printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, \"cut\": %lld, \"max_steps\": %lld, ",
                a->matrix_walk ? "true" : "false", (long long)w->walks, a->matrix_walk ? "steps" : "rays",
-               (long long)w->steps, (long long)w->cut, (long long)a->o.max_steps);
+               (long long)w->steps, (long long)w->cut, (long long)a->o.stop.max_steps);
         if (a->matrix_walk) /* walks is their sum: a matrix walk carries one channel */
             printf("\"channel_walks\": [%lld, %lld, %lld], ", (long long)w->channel_walks[0],
                    (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
         cli_json_number("seconds", w->seconds, 0);
         printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
-        if (a->o.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT) {
+        if (a->o.stop.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT) {
             printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
             cli_json_number("min_walks", w->min_walks, 0);
         }
@@ -827,7 +837,7 @@ static void print_json(const args *a, const report *r)
                "\"walks\": %lld, \"rays\": %lld, \"unmet\": %lld, ", (long long)r->view.seen,
                (long long)r->view.npatches, (long long)r->view.pixels_hit, (long long)r->view.camera_rays,
                (long long)r->view.walks, (long long)r->view.rays, (long long)r->view.unmet);
-        cli_json_number("rel_err", a->o.rel_err, 0);
+        cli_json_number("rel_err", a->o.stop.rel_err, 0);
         cli_json_number("coverage", a->coverage, 0);
         cli_json_number("seconds", r->view.seconds, 1);
         printf("}, ");
@@ -863,7 +873,7 @@ static void print_json(const args *a, const report *r)
         }
         printf("], ");
     }
-    printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
+    printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
 }
 
 /* One point's answer as text. */
@@ -979,8 +989,8 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
     double t0 = ulam_now();
     cli_catch_sigint();
     for (int k = 0; k < a->nat && !interrupted; k++) {
-        ulam_walk_opts o = a->o;
-        o.seed = a->o.seed + (uint64_t)k; /* each point its own walks */
+        ulam_rad_opts o = rad_opts(&a->o);
+        o.exec.seed = a->o.exec.seed + (uint64_t)k; /* each point its own walks */
         const double *x = a->at + 6 * k;
         if (ulam_rad_point_query(t, &o, x, isnan(x[3]) ? NULL : x + 3, &pts[k], &err)) {
             fprintf(stderr, "ulam radiosity: --at %g,%g,%g: %s: %s\n", x[0], x[1], x[2], ulam_strerror(err.status),
@@ -991,7 +1001,8 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         interrupted = pts[k].run.interrupted;
     }
     if (ngrid && !interrupted) {
-        if (ulam_rad_grid_solve(t, &a->o, &a->g, pts + a->nat, &err)) {
+        ulam_rad_opts ro = rad_opts(&a->o);
+        if (ulam_rad_grid_solve(t, &ro, &a->g, pts + a->nat, &err)) {
             rc = cli_report(a->scene, &err);
             goto done;
         }
@@ -1041,7 +1052,7 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         printf("\"walks\": %lld, \"rays\": %lld, \"interrupted\": %s, ", (long long)walks, (long long)rays,
                interrupted ? "true" : "false");
         cli_json_number("seconds", seconds, 0);
-        printf("\"seed\": %llu}\n", (unsigned long long)a->o.seed);
+        printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
     } else {
         printf("scene        %s: %lld patches\n", a->scene, (long long)s->npatches);
         for (int k = 0; k < a->nat; k++) point_text(s, k, &pts[k], pts[k].run.interrupted);
@@ -1081,7 +1092,8 @@ static int view_walks(const args *a, const ulam_tracer *t, const ulam_scene *s, 
         return cli_report(a->scene, &err);
     }
     cli_catch_sigint();
-    int status = ulam_view_gather(t, &cam, a->width, a->height, a->coverage, &a->o, w->all, w->all_se, vi, &err);
+    ulam_rad_opts ro = rad_opts(&a->o);
+    int status = ulam_view_gather(t, &cam, a->width, a->height, a->coverage, &ro, w->all, w->all_se, vi, &err);
     cli_release_sigint();
     if (status) return cli_report(a->scene, &err);
     w->walks = vi->walks, w->steps = vi->rays, w->seconds = vi->seconds, w->cut = vi->cut;
@@ -1123,7 +1135,7 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
     float *hdr = malloc(np * 3 * sizeof *hdr);
     ulam_camera cam = camera_of(a, s);
     ulam_render_info info;
-    int status = rgb && hdr ? ulam_render_hdr(t, B, &cam, a->width, a->height, a->samples, !a->flat, a->o.seed,
+    int status = rgb && hdr ? ulam_render_hdr(t, B, &cam, a->width, a->height, a->samples, !a->flat, a->o.exec.seed,
                                               a->exposure, hdr, rgb, &info)
                             : ULAM_ENOMEM;
     if (!status) { /* its temporary file is the library's: a signal waits until it is gone */
@@ -1207,7 +1219,7 @@ static int form_and_solve(const args *a, const ulam_tracer *t, const ulam_scene 
 {
     ulam_error err;
     double t0 = ulam_now();
-    if (ulam_ff_estimate(t, a->ff_rays, a->o.seed, a->o.threads, F, &err)) return cli_report(a->scene, &err);
+    if (ulam_ff_estimate(t, a->ff_rays, a->o.exec.seed, a->o.exec.threads, F, &err)) return cli_report(a->scene, &err);
     r->ff_seconds = ulam_now() - t0;
     ulam_ff_report_compute(s, *F, &r->ff);
     r->F = *F;
@@ -1279,7 +1291,7 @@ static void human(double b, char *out, size_t len)
 static double need_counts(const args *a, double n, double tri, double nverts, char *what, size_t len)
 {
     double tracer = 208.0 * tri + 16.0 * nverts, ff = 0, dense = 0, walks = 0, pic = 0;
-    int threads = a->o.threads > 0 ? a->o.threads : 2;
+    int threads = a->o.exec.threads > 0 ? a->o.exec.threads : 2;
     int forms = (a->direct || a->check || a->matrix_walk) && !a->nat && !a->grid;
     if (forms) ff = 12.0 * n * fmin((double)a->ff_rays, n) + 8.0 * (n + 1);
     if (forms && a->matrix_walk) ff *= 3; /* F, one channel's M and the walk's kernel rows */
@@ -1337,14 +1349,14 @@ static int adapt_scene(const args *a, ulam_scene **s, ulam_rad_adapt_info *info,
         if (!(Y = malloc((size_t)(*s)->npatches * sizeof *Y))) {
             err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for the importance"};
             rc = cli_report(a->scene, &err);
-        } else if (ulam_rad_importance(t, &cam, a->width, a->height, walks, a->o.seed, Y, &err)) {
+        } else if (ulam_rad_importance(t, &cam, a->width, a->height, walks, a->o.exec.seed, Y, &err)) {
             rc = cli_report(a->scene, &err);
         }
         *view_importance = 1;
     }
-    ulam_walk_opts o = a->o; /* the points: next-event, to half the target or 1024 walks each */
+    ulam_rad_opts o = rad_opts(&a->o); /* the points: next-event, to half the target or 1024 walks each */
     o.mode = ULAM_ADJOINT, o.estimator = ULAM_RAD_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
-    o.rel_err = a->mesh_target / 2, o.max_walks = 1024, o.max_seconds = 0;
+    o.stop.rel_err = a->mesh_target / 2, o.stop.max_walks = 1024, o.stop.max_seconds = 0;
     if (!rc) {
         cli_catch_sigint();
         if (ulam_rad_adapt(t, &o, Y, a->mesh_target, cap, &d, info, &err)) rc = cli_report(a->scene, &err);
@@ -1364,13 +1376,13 @@ static int every_mesh_error(const args *a, const ulam_tracer *t, const ulam_scen
 {
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the mesh errors"};
     if (!(*out = malloc((size_t)s->npatches * 3 * sizeof **out))) return cli_report(a->scene, &err);
-    ulam_walk_opts o = a->o;
-    o.mode = ULAM_ADJOINT, o.estimator = ULAM_RAD_NEXT_EVENT, o.rel_err = 0, o.max_seconds = 0;
-    o.max_walks = a->mesh_walks;
+    ulam_rad_opts o = rad_opts(&a->o);
+    o.mode = ULAM_ADJOINT, o.estimator = ULAM_RAD_NEXT_EVENT, o.stop.rel_err = 0, o.stop.max_seconds = 0;
+    o.stop.max_walks = a->mesh_walks;
     cli_catch_sigint();
     for (int64_t p = 0; p < s->npatches; p++) {
         ulam_rad_mesh m;
-        o.index = p, o.seed = a->o.seed + (uint64_t)p;
+        o.index = p, o.exec.seed = a->o.exec.seed + (uint64_t)p;
         if (ulam_rad_mesh_error(t, &o, pv->B + 3 * p, &m, &err)) {
             cli_release_sigint();
             return cli_report(a->scene, &err);
@@ -1386,8 +1398,8 @@ static int every_mesh_error(const args *a, const ulam_tracer *t, const ulam_scen
 int cli_radiosity(int argc, char **argv)
 {
     args a = {.est = -1, .mis = -1, .samples = 4, .coverage = 0.25, .ff_rays = 1000, .width = 512, .height = 512, .max_mem = CLI_MAX_MEM, .o = ulam_walk_defaults()};
-    a.o.max_walks = 0;
-    a.o.interrupt = &cli_interrupted, a.o.share = cli_share;
+    a.o.stop.max_walks = 0;
+    a.o.stop.interrupt = &cli_interrupted, a.o.exec.share = cli_share;
     int rc = parse(argc, argv, &a);
     if (rc) {
         free(a.at);
@@ -1437,7 +1449,7 @@ int cli_radiosity(int argc, char **argv)
             goto done;
         }
     }
-    a.o.index = r.patch >= 0 ? r.patch : 0;
+    a.o.query.index = r.patch >= 0 ? r.patch : 0;
     if (ulam_tracer_alloc(s, &t, &err)) {
         rc = cli_report(a.scene, &err);
         goto done;
@@ -1462,9 +1474,9 @@ int cli_radiosity(int argc, char **argv)
                            : ray_walks(&a, t, s->npatches, &w);
         if (rc) goto done;
         if (a.patch && a.o.mode == ULAM_ADJOINT && !w.interrupted && !a.no_mesh) { /* the mesh's error beside */
-            ulam_walk_opts mo = a.o; /* each point to twice the patch's relative error or 1/4 its walks (>= 256) */
-            mo.index = r.patch, mo.estimator = ULAM_RAD_NEXT_EVENT, mo.rel_err = 2 * a.o.rel_err;
-            if (a.o.max_walks > 0) mo.max_walks = a.o.max_walks / 4 > 256 ? a.o.max_walks / 4 : 256;
+            ulam_rad_opts mo = rad_opts(&a.o); /* each point to twice the patch's relative error or 1/4 its walks (>= 256) */
+            mo.index = r.patch, mo.estimator = ULAM_RAD_NEXT_EVENT, mo.stop.rel_err = 2 * a.o.stop.rel_err;
+            if (a.o.stop.max_walks > 0) mo.stop.max_walks = a.o.stop.max_walks / 4 > 256 ? a.o.stop.max_walks / 4 : 256;
             cli_catch_sigint();
             int st = ulam_rad_mesh_error(t, &mo, w.B, &r.mesh, &err);
             cli_release_sigint();

@@ -132,21 +132,21 @@ static double peak_rss_mib(void)
 static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 {
     if (o->mode == ULAM_FORWARD && isnan(r->std_error))
-        printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->index + 1,
-               o->index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
+        printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->query.index + 1,
+               o->query.index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1 && isnan(r->ci95[0]))
-        printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->index + 1,
-               o->index < 9 ? 10 : 9, "", r->estimate, r->std_error,
+        printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->query.index + 1,
+               o->query.index < 9 ? 10 : 9, "", r->estimate, r->std_error,
                !isfinite(r->cut_bound) ? "walks cut at --max-steps may have moved it by any amount"
                : !isfinite(r->tail_bound) && r->estimate != 0 ? "no certified range of a single walk's score"
                : "no certified range yet, or a score past the certified one", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1)
-        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->index + 1,
-               o->index < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->query.index + 1,
+               o->query.index < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
                r->interrupted ? "  [INTERRUPTED]" : "");
     else
         printf("x[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
-               "means nothing)%s\n", (long long)o->index + 1, o->index < 9 ? 10 : 9, "", r->estimate,
+               "means nothing)%s\n", (long long)o->query.index + 1, o->query.index < 9 ? 10 : 9, "", r->estimate,
                r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
                r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
 }
@@ -154,30 +154,30 @@ static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 /* Print whether the --rel-err target was met, and when not why (one line; nothing without a target). */
 static void print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int verbose)
 {
-    if (o->rel_err > 0 && r->cut_stop)
+    if (o->stop.rel_err > 0 && r->cut_stop)
         printf("rel-err         NOT met (target %.3g): %lld walks were cut at %lld steps and the cut's bias may be "
                "%.3g, more than a tenth of the target error: unreachable by more walks (raise --max-steps)\n",
-               o->rel_err, (long long)r->cut, (long long)o->max_steps, r->cut_bound);
-    else if (o->rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
+               o->stop.rel_err, (long long)r->cut, (long long)o->stop.max_steps, r->cut_bound);
+    else if (o->stop.rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
         printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
-               o->rel_err);
-    else if (o->rel_err > 0 && r->out_of_reach && !isfinite(r->ci95[0]) &&
-             !(r->min_walks > (o->max_walks > 0 ? (double)o->max_walks : (double)ULAM_REL_ERR_CAP)))
+               o->stop.rel_err);
+    else if (o->stop.rel_err > 0 && r->out_of_reach && !isfinite(r->ci95[0]) &&
+             !(r->min_walks > (o->stop.max_walks > 0 ? (double)o->stop.max_walks : (double)ULAM_REL_ERR_CAP)))
         printf("rel-err         NOT met (target %.3g): a score passed the certified range, so no interval can be "
-               "printed; stopped after %lld walks, over 1024 times the %.4g the rule asked for\n", o->rel_err,
+               "printed; stopped after %lld walks, over 1024 times the %.4g the rule asked for\n", o->stop.rel_err,
                (long long)r->walks, r->min_walks);
-    else if (o->rel_err > 0 && r->fourth_finite != 1 && (verbose || !r->rel_err_met))
+    else if (o->stop.rel_err > 0 && r->fourth_finite != 1 && (verbose || !r->rel_err_met))
         printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
                "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
-               "not use the variance's own error bar\n", r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
+               "not use the variance's own error bar\n", r->rel_err_met ? "met" : "NOT met", o->stop.rel_err, r->min_walks,
                r->rho4.lower, r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
-    else if (o->rel_err > 0 && r->min_walks > 0 && (verbose || !r->rel_err_met))
+    else if (o->stop.rel_err > 0 && r->min_walks > 0 && (verbose || !r->rel_err_met))
         printf("rel-err         %s (target %.3g; the rule asks for %.4g walks at this estimate and variance%s)\n",
-               r->rel_err_met ? "met" : "NOT met", o->rel_err, r->min_walks,
-               !r->out_of_reach ? "" : o->max_walks > 0 ? ", more than --walks: stopped early, the estimate so far above"
+               r->rel_err_met ? "met" : "NOT met", o->stop.rel_err, r->min_walks,
+               !r->out_of_reach ? "" : o->stop.max_walks > 0 ? ", more than --walks: stopped early, the estimate so far above"
                                                         : ", beyond the 1e9 cap: stopped early, the estimate so far above");
-    else if (o->rel_err > 0)
-        printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->rel_err);
+    else if (o->stop.rel_err > 0)
+        printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->stop.rel_err);
 }
 
 /* Print the default block: the answer, the method in words, the cost, the target (about 5 lines). */
@@ -191,7 +191,7 @@ static void print_brief(const ulam_walk_opts *o, const ulam_walk_result *r, cons
     if (ro->ch) cli_auto_print_text(ro->ch, 1);
     if (r->cut)
         printf("walks           %lld (%lld cut at %lld steps: the estimate is biased by the cut)\n",
-               (long long)r->walks, (long long)r->cut, (long long)o->max_steps);
+               (long long)r->walks, (long long)r->cut, (long long)o->stop.max_steps);
     else
         printf("walks           %lld (mean length %.3g steps)\n", (long long)r->walks,
                r->walks ? (double)r->steps / (double)r->walks : 0.0);
@@ -215,26 +215,26 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     print_answer(o, r);
     printf("method          %s walks, %s estimator\n", cli_mode_names[o->mode], cli_estimator_names[o->estimator]);
     printf("walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
-           (long long)o->max_steps, r->cut ? ": the estimate is biased by the cut" : "");
+           (long long)o->stop.max_steps, r->cut ? ": the estimate is biased by the cut" : "");
     printf("steps           %lld (mean walk length %.4g; kernel rows built %lld)\n", (long long)r->steps, mean_len,
            (long long)r->rows);
     printf("variance        %.6g per walk (relative error %.3g)\n", r->variance, rel);
     printf("seconds         %.4f (%.3g M steps/s, %d threads, seed %llu)\n", r->seconds,
            r->seconds > 0 ? (double)r->steps / r->seconds / 1e6 : 0.0, r->threads,
-           (unsigned long long)o->seed);
+           (unsigned long long)o->exec.seed);
     printf("figure of merit %.4g (1 / (relative variance x seconds))\n",
            r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : INFINITY);
     printf("guards          rho(|M|) in [%.6g, %.6g] (%s), rho(M^) in [%.6g, %.6g] (%s)", ro->g.abs.lower,
            ro->g.abs.upper, cli_verdict_word(ro->g.verdict_abs), ro->g.hat[o->mode].lower, ro->g.hat[o->mode].upper,
            cli_verdict_word(ro->g.verdict_hat[o->mode]));
-    if (o->kernel_alpha != 1.0) printf(" at kernel exponent alpha = %g", o->kernel_alpha);
+    if (o->kernel.kernel_alpha != 1.0) printf(" at kernel exponent alpha = %g", o->kernel.kernel_alpha);
     printf("\n");
     if (isfinite(r->score_bound))
         printf("tail            a single score is at most %.4g: one more walk could move the estimate by at "
                "most %.3g%%\n", r->score_bound, 100 * r->tail_bound);
     else if (isfinite(r->tail_bound))
         printf("tail            scores grow with the walk's length; walks short enough to matter (the rest add under "
-               "%.3g%% of the answer) could move it by at most %.3g%% more\n", 100 * (o->rel_err > 0 ? o->rel_err : 0.01),
+               "%.3g%% of the answer) could move it by at most %.3g%% more\n", 100 * (o->stop.rel_err > 0 ? o->stop.rel_err : 0.01),
                100 * r->tail_bound);
     else
         printf("tail            scores are unbounded (walk length, weights): no walk count rules out an unseen "
@@ -253,7 +253,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
 static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
 {
     double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
-    printf("{\"index\": %lld, ", (long long)o->index + 1);
+    printf("{\"index\": %lld, ", (long long)o->query.index + 1);
     cli_json_number("estimate", r->estimate, 0);
     cli_json_number("stderr", r->std_error, 0);
     if (r->variance_finite == 1) {
@@ -268,12 +268,12 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     cli_json_variance("variance_finite", r->variance_finite);
     cli_json_radius("rho_abs", &ro->g.abs);
     cli_json_radius("rho_hat", &ro->g.hat[o->mode]);
-    cli_json_number("kernel_alpha", o->kernel_alpha, 0);
+    cli_json_number("kernel_alpha", o->kernel.kernel_alpha, 0);
     cli_json_number("max_share", r->max_share, 0);
     cli_json_number("score_bound", r->score_bound, 0);
     cli_json_number("tail_bound", r->tail_bound, 0);
     cli_json_number("variance_rel_error", r->variance_rel_error, 0);
-    if (o->rel_err > 0) {
+    if (o->stop.rel_err > 0) {
         cli_json_number("min_walks", r->min_walks, 0);
         printf("\"rel_err_met\": %s, ", r->rel_err_met ? "true" : "false");
         cli_json_number("cut_bound", r->cut_bound, 0);
@@ -294,7 +294,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
     cli_json_string("method", "walks", 0);
     cli_json_string("mode", cli_mode_names[o->mode], 0);
     cli_json_string("estimator", cli_estimator_names[o->estimator], 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->seed, r->threads,
+    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->exec.seed, r->threads,
            cli_share ? cli_share->nranks : 1);
     cli_json_number("load_seconds", ro->load_seconds, 0);
     cli_json_number("guard_seconds", ro->guard_seconds, 0);
@@ -376,26 +376,26 @@ static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, cons
  * single score) is out of reach, and name the estimators without that tail. */
 static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const ulam_walk_result *r)
 {
-    double limit = o->max_walks > 0 ? (double)o->max_walks : 1e8;
-    if (!(o->rel_err > 0)) return;
+    double limit = o->stop.max_walks > 0 ? (double)o->stop.max_walks : 1e8;
+    if (!(o->stop.rel_err > 0)) return;
     if (!isfinite(r->tail_bound) && r->walks > 0 && r->estimate != 0) { /* (at 0 the tail is infinite too) */
         fprintf(stderr, "ulam: %s: warning: --rel-err %g: no bound on a single walk's score holds (weights can grow "
                         "without bound, or the walk's length tail is not certified): the rule cannot be met; the "
-                        "run ends by --walks or --time\n", s->matrix_path, o->rel_err);
+                        "run ends by --walks or --time\n", s->matrix_path, o->stop.rel_err);
         return;
     }
     if (!(r->min_walks > limit)) return;
     if (isfinite(r->score_bound))
         fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %s score can reach %.4g, so the rule needs about "
-                        "%.3g walks at this estimate before it may stop (%s)%s\n", s->matrix_path, o->rel_err,
+                        "%.3g walks at this estimate before it may stop (%s)%s\n", s->matrix_path, o->stop.rel_err,
                 o->estimator == ULAM_ABSORPTION ? "absorption" : "", r->score_bound, r->min_walks,
-                o->max_walks > 0 ? "more than --walks" : "out of reach in practice",
+                o->stop.max_walks > 0 ? "more than --walks" : "out of reach in practice",
                 o->estimator == ULAM_ABSORPTION ? "; the collision and expected estimators score b directly and "
                                                   "have no such tail" : "");
     else
         fprintf(stderr, "ulam: %s: warning: --rel-err %g: scores grow with the walk's length, so the rule needs about "
-                        "%.3g walks at this estimate before it may stop (%s)\n", s->matrix_path, o->rel_err, r->min_walks,
-                o->max_walks > 0 ? "more than --walks" : "out of reach in practice");
+                        "%.3g walks at this estimate before it may stop (%s)\n", s->matrix_path, o->stop.rel_err, r->min_walks,
+                o->stop.max_walks > 0 ? "more than --walks" : "out of reach in practice");
 }
 
 /* Everything ulam solve was asked: parse fills it from argv, run does it. */
@@ -412,77 +412,89 @@ typedef struct {
     int walks_given;      /* --walks or --time given */
 } solve_args;
 
-/* Parse argv into a; 0, or an exit code (-1: --help printed). */
-static int parse(int argc, char **argv, solve_args *a)
+/* The walks row's options (src/cli/solve_rows.c reads them; the walk options go to cli_walk_option). */
+static const struct option longopts[] = {
+    {"rhs", required_argument, 0, 'b'},      {"index", required_argument, 0, 'i'},
+    CLI_WALK_OPTION("mode"),                 CLI_WALK_OPTION("estimator"),
+    CLI_WALK_OPTION("walks"),                CLI_WALK_OPTION("rel-err"),
+    CLI_WALK_OPTION("time"),                 CLI_WALK_OPTION("seed"),
+    CLI_WALK_OPTION("threads"),              CLI_WALK_OPTION("continue"),
+    CLI_WALK_OPTION("roulette"),             CLI_WALK_OPTION("split"),
+    CLI_WALK_OPTION("max-steps"),            CLI_WALK_OPTION("alpha"),
+    CLI_WALK_OPTION("kernel-exponent"),      CLI_WALK_OPTION("tol"),
+    {"jacobi", no_argument, 0, 'j'},
+    {"omega", required_argument, 0, 'w'},    {"check", no_argument, 0, 'c'},
+    {"json", no_argument, 0, 'J'},           {"out", required_argument, 0, 'o'},
+    {"errors", required_argument, 0, 'E'},   {"help", no_argument, 0, 'h'},
+    {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
+    {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
+    {"method", required_argument, 0, 'U'},   {"pagerank", required_argument, 0, 'P'},
+    {"damping", required_argument, 0, 'P'},  {"queries", required_argument, 0, 'Q'},
+    {0, 0, 0, 0}};
+
+/* The arguments before any option. */
+static void init(void *p)
 {
-    static const struct option longopts[] = {
-        {"rhs", required_argument, 0, 'b'},      {"index", required_argument, 0, 'i'},
-        CLI_WALK_OPTION("mode"),                 CLI_WALK_OPTION("estimator"),
-        CLI_WALK_OPTION("walks"),                CLI_WALK_OPTION("rel-err"),
-        CLI_WALK_OPTION("time"),                 CLI_WALK_OPTION("seed"),
-        CLI_WALK_OPTION("threads"),              CLI_WALK_OPTION("continue"),
-        CLI_WALK_OPTION("roulette"),             CLI_WALK_OPTION("split"),
-        CLI_WALK_OPTION("max-steps"),            CLI_WALK_OPTION("alpha"),
-        CLI_WALK_OPTION("kernel-exponent"),      CLI_WALK_OPTION("tol"),
-        {"jacobi", no_argument, 0, 'j'},
-        {"omega", required_argument, 0, 'w'},    {"check", no_argument, 0, 'c'},
-        {"json", no_argument, 0, 'J'},           {"out", required_argument, 0, 'o'},
-        {"errors", required_argument, 0, 'E'},   {"help", no_argument, 0, 'h'},
-        {"force", no_argument, 0, 'F'},          {"cache", no_argument, 0, 'C'},
-        {"whole-kernel", no_argument, 0, 'W'},   {"assume-finite-variance", no_argument, 0, 'A'},
-        {"method", required_argument, 0, 'U'},   {"pagerank", required_argument, 0, 'P'},
-        {"damping", required_argument, 0, 'P'},  {"queries", required_argument, 0, 'Q'},
-        {0, 0, 0, 0}};
+    solve_args *a = p;
     *a = (solve_args){.s = {.command = "solve", .omega = 1.0}, .o = ulam_walk_defaults(), .autom = 1,
                       .ao = ulam_auto_defaults()};
-    a->o.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
-    int c, rc, idx;
-    if (cli_check_options("solve", argc, argv, longopts)) return EXIT_USAGE;
-    optind = 0;
-    while ((c = getopt_long(argc, argv, "h", longopts, &idx)) != -1) {
-        switch (c) {
-        case CLI_WALK:
-            if ((rc = cli_walk_option("solve", longopts[idx].name, optarg, &a->o))) return rc;
-            a->ao.pin_mode |= !strcmp(longopts[idx].name, "mode");
-            a->ao.pin_estimator |= !strcmp(longopts[idx].name, "estimator");
-            a->ao.pin_continue |= !strcmp(longopts[idx].name, "continue");
-            a->ao.pin_alpha |= !strcmp(longopts[idx].name, "alpha") || !strcmp(longopts[idx].name, "kernel-exponent");
-            break;
-        case 'b': a->s.rhs_path = optarg; break;
-        case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
-        case 'j': a->s.jacobi = 1; break;
-        case 'C': a->s.cache = 1; break;
-        case 'W': a->o.whole_kernel = 1; break;
-        case 'U':
-            if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
-            if (strcmp(optarg, "auto") && ulam_method_find(optarg) != ULAM_METHOD_WALKS) return cli_method_error(optarg);
-            a->autom = !strcmp(optarg, "auto");
-            break;
-        case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
-        case 'P': if ((rc = cli_parse_real("solve", "--pagerank", optarg, 1e-6, 1 - 1e-9, &a->s.pagerank))) return rc; break;
-        case 'c': a->check = 1; break;
-        case 'J': a->json = 1; break;
-        case 'F': a->force = 1; break;
-        case 'A': a->assume_finite = 1; break;
-        case 'o': a->out = optarg; break;
-        case 'E': a->errors = optarg; break;
-        case 'Q': a->queries = optarg; break;
-        case 'h': fputs(usage, stdout), fputs(usage2, stdout), fputs(usage3, stdout); return -1;
-        default: return cli_usage_error("solve", "unknown option");
-        }
+    a->o.stop.max_walks = 0; /* set by cli_walk_budget unless a rule is given */
+}
+
+/* One option (c its code in longopts, name its long name) into the arguments; 0, or an exit code
+ * (-1: --help printed). */
+static int option(void *p, int c, const char *name, const char *optarg)
+{
+    solve_args *a = p;
+    int rc;
+    switch (c) {
+    case CLI_WALK:
+        if ((rc = cli_walk_option("solve", name, optarg, &a->o))) return rc;
+        a->ao.pin_mode |= !strcmp(name, "mode");
+        a->ao.pin_estimator |= !strcmp(name, "estimator");
+        a->ao.pin_continue |= !strcmp(name, "continue");
+        a->ao.pin_alpha |= !strcmp(name, "alpha") || !strcmp(name, "kernel-exponent");
+        break;
+    case 'b': a->s.rhs_path = optarg; break;
+    case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
+    case 'j': a->s.jacobi = 1; break;
+    case 'C': a->s.cache = 1; break;
+    case 'W': a->o.kernel.whole_kernel = 1; break;
+    case 'U':
+        if (!strcmp(optarg, "bidirectional")) return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S)");
+        if (strcmp(optarg, "auto") && ulam_method_find(optarg) != ULAM_METHOD_WALKS) return cli_method_error(optarg);
+        a->autom = !strcmp(optarg, "auto");
+        break;
+    case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
+    case 'P': if ((rc = cli_parse_real("solve", "--pagerank", optarg, 1e-6, 1 - 1e-9, &a->s.pagerank))) return rc; break;
+    case 'c': a->check = 1; break;
+    case 'J': a->json = 1; break;
+    case 'F': a->force = 1; break;
+    case 'A': a->assume_finite = 1; break;
+    case 'o': a->out = optarg; break;
+    case 'E': a->errors = optarg; break;
+    case 'Q': a->queries = optarg; break;
+    case 'h': fputs(usage, stdout), fputs(usage2, stdout), fputs(usage3, stdout); return -1;
+    default: return cli_usage_error("solve", "unknown option");
     }
+    return 0;
+}
+
+/* The checks once every option is read (argv[first..]: the operands); 0 or an exit code. */
+static int finish_parse(solve_args *a, int argc, char **argv, int optind)
+{
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
     if (a->queries && (a->s.index || a->o.mode != ULAM_ADJOINT || a->out || a->errors || a->check || a->s.jacobi))
         return cli_usage_error("solve", "--queries takes the indices from its file, in adjoint mode (no --index, "
                                         "--mode forward, --out, --errors, --check or --jacobi)");
-    a->walks_given = a->o.max_walks > 0 || a->o.max_seconds > 0;
+    a->walks_given = a->o.stop.max_walks > 0 || a->o.stop.max_seconds > 0;
     if (!a->queries && !a->s.rhs_path && !a->s.pagerank && !ulam_system_is_file(argv[optind]))
         return cli_need_rhs("solve", argv[optind]);
     if (a->s.pagerank > 0 && a->s.jacobi) return cli_usage_error("solve", "--pagerank and --jacobi exclude each other");
     if (!a->s.index && a->o.mode == ULAM_ADJOINT && !a->queries) return cli_usage_error("solve", "adjoint walks need --index I");
     if ((a->out || a->errors) && a->o.mode != ULAM_FORWARD)
         return cli_usage_error("solve", "--out and --errors need --mode forward");
-    if (a->o.roulette > 0 && a->o.split > 0 && a->o.split <= a->o.roulette)
+    if (a->o.kernel.roulette > 0 && a->o.kernel.split > 0 && a->o.kernel.split <= a->o.kernel.roulette)
         return cli_usage_error("solve", "--split W must exceed --roulette W");
     cli_walk_budget(&a->o);
     a->s.matrix_path = argv[optind];
@@ -501,11 +513,11 @@ static int certified_auto(solve_args *a, ulam_guard *g)
     ulam_walk_opts *o = &a->o;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_ADJOINT;
-    double q = a->ao.pin_continue ? o->continue_q : s->cert ? s->cert->continue_q : 0.0;
-    if ((a->ao.pin_alpha && o->kernel_alpha != 1.0) || (a->ao.pin_mode && o->mode != ULAM_ADJOINT) ||
+    double q = a->ao.pin_continue ? o->kernel.continue_q : s->cert ? s->cert->continue_q : 0.0;
+    if ((a->ao.pin_alpha && o->kernel.kernel_alpha != 1.0) || (a->ao.pin_mode && o->mode != ULAM_ADJOINT) ||
         ulam_certificate_guard(s->cert, q, &go, g))
         return cli_system_verify(s);
-    o->continue_q = q, o->kernel_alpha = 1.0, o->mode = ULAM_ADJOINT;
+    o->kernel.continue_q = q, o->kernel.kernel_alpha = 1.0, o->mode = ULAM_ADJOINT;
     a->ao.pin_continue = a->ao.pin_alpha = a->ao.pin_mode = 1;
     a->ao.guard = g;
     return 0;
@@ -519,7 +531,7 @@ static int lazy_analysis(solve_args *a)
     cli_system *s = &a->s;
     if (!s->lazy || !s->sys_M || a->an) return 0;
     ulam_analysis_opts ao = ulam_analysis_defaults();
-    ao.continue_q = a->o.continue_q, ao.kernel_alpha = a->o.kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
+    ao.continue_q = a->o.kernel.continue_q, ao.kernel_alpha = a->o.kernel.kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
     ulam_error err;
     return ulam_analysis_alloc(s->M, &ao, &a->an, &err) ? cli_report(s->matrix_path, &err) : 0;
 }
@@ -551,15 +563,15 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
         return cli_usage_error("solve", "needs --rhs b.mtx (%s holds no b)", s->matrix_path);
     }
     ro->load_seconds = ulam_now() - t0;
-    o->index = s->index ? s->index - 1 : 0;
-    o->interrupt = &cli_interrupted, o->share = cli_share, o->force = a->force;
-    o->system = s->lazy ? s->sys_M : NULL; /* a mapped M read lazily: its blocks verified as walks reach them */
-    o->assume_finite = ro->assume_finite;
+    o->query.index = s->index ? s->index - 1 : 0;
+    o->stop.interrupt = &cli_interrupted, o->exec.share = cli_share, o->policy.force = a->force;
+    o->policy.system = s->lazy ? s->sys_M : NULL; /* a mapped M read lazily: its blocks verified as walks reach them */
+    o->policy.assume_finite = ro->assume_finite;
     ro->n = s->M->nrows;
     ulam_error err;
     int status;
-    a->max_seconds = o->max_seconds;
-    o->max_seconds = cli_time_left(a->max_seconds); /* --time counts the reading before it too */
+    a->max_seconds = o->stop.max_seconds;
+    o->stop.max_seconds = cli_time_left(a->max_seconds); /* --time counts the reading before it too */
     if (a->autom) { /* guards, pilots, the rows of the table and the run, its set-up kept from the choice */
         t0 = ulam_now();
         ulam_guard cg;
@@ -574,12 +586,12 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
         ro->kernel_seconds = ulam_now() - t0; /* the choice's guards, pilots and set-up: all of it */
         *sv = ulam_run_solver(*run);
     } else {
-        if ((rc = cli_guard(s, o->continue_q, o->kernel_alpha, o->mode, &ro->g))) {
+        if ((rc = cli_guard(s, o->kernel.continue_q, o->kernel.kernel_alpha, o->mode, &ro->g))) {
             cli_system_free(s);
             return rc;
         }
-        o->guard = &ro->g;
-        o->max_seconds = cli_time_left(a->max_seconds); /* and the guards */
+        o->policy.guard = &ro->g;
+        o->stop.max_seconds = cli_time_left(a->max_seconds); /* and the guards */
         t0 = ulam_now();
         if ((rc = lazy_analysis(a))) {
             cli_system_free(s);
@@ -594,14 +606,14 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
         ro->kernel_seconds = ulam_now() - t0;
     }
     ro->guard_seconds = ro->g.abs.seconds + ro->g.hat[0].seconds + ro->g.hat[1].seconds;
-    if (status == ULAM_EINVAL && o->split > 0 && strstr(err.msg, "split weight")) {
+    if (status == ULAM_EINVAL && o->kernel.split > 0 && strstr(err.msg, "split weight")) {
         rc = cli_usage_error("solve", "--split W: %s", err.msg);
     } else if (status == ULAM_EDIVERGE) {
         cli_guard_diverge(s, &ro->g, 0);
         rc = EXIT_DIVERGE;
     } else if (status == ULAM_EINFVAR) {
         fprintf(stderr, "ulam: %s: error: --rel-err %g can never be met: it needs %s. Bound the run with --walks N "
-                        "or --time S (%s)\n", s->matrix_path, o->rel_err, err.msg,
+                        "or --time S (%s)\n", s->matrix_path, o->stop.rel_err, err.msg,
                 strstr(err.msg, "rho(M^)") ? "no confidence interval is then printed" : "the rule is then never met");
         rc = EXIT_INFVAR;
     } else if (status) {
@@ -615,7 +627,7 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
     int walks = *sv != NULL;
     if (walks && ro->g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(s, &ro->g, 1);
     if (walks) cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
-    if (ro->check && !walks && (rc = direct_check(s, o->index, ro))) { /* bidirectional: checked first */
+    if (ro->check && !walks && (rc = direct_check(s, o->query.index, ro))) { /* bidirectional: checked first */
         *run = ulam_run_free(*run);
         a->an = ulam_analysis_free(a->an);
         cli_system_free(s);
@@ -662,8 +674,8 @@ static int run(solve_args *a)
     if (r.cut_stop)
         fprintf(stderr, "ulam: %s: warning: --rel-err %g is unreachable: %lld walks were cut at --max-steps %lld and "
                         "the cut's bias may be up to %.3g, more than a tenth of the target error; stopped after %lld "
-                        "walks (raise --max-steps)\n", s->matrix_path, o->rel_err, (long long)r.cut,
-                (long long)o->max_steps, r.cut_bound, (long long)r.walks);
+                        "walks (raise --max-steps)\n", s->matrix_path, o->stop.rel_err, (long long)r.cut,
+                (long long)o->stop.max_steps, r.cut_bound, (long long)r.walks);
     if (status == ULAM_ENOMEM) {
         fprintf(stderr, "ulam: %s: error: %s: expected memory to build the walk kernel's rows\n", s->matrix_path,
                 ulam_strerror(status));
@@ -688,7 +700,7 @@ static int run(solve_args *a)
         cli_flush(); /* the estimate first: a check may take long, a failed write of the files below cannot lose it, and Ctrl-C keeps what is printed */
         if (ro.check && !r.interrupted && cli_rank == 0) {
             rc = cli_system_verify(&a->s);
-            rc = rc ? rc : direct_check(s, o->index, &ro);
+            rc = rc ? rc : direct_check(s, o->query.index, &ro);
             left = rc == EXIT_INTERRUPTED;
             if (!ro.json && !rc) printf("direct          %.10g (%s, %.3g s), z = %.3f\n", ro.direct, ro.direct_method,
                                         ro.direct_seconds, (r.estimate - ro.direct) / r.std_error);
@@ -713,13 +725,20 @@ static int run(solve_args *a)
     return rc;
 }
 
-/* ulam solve. */
-int cli_solve(int argc, char **argv)
+/* The options read: check them and run (many queries: src/cli/queries.c); 0 or an exit code. */
+static int start_run(void *p, int argc, char **argv, int first)
 {
-    if (cli_bidir_claims(argc, argv)) return cli_bidir(argc, argv); /* --source S: src/cli/bidir.c */
-    if (cli_solve_wants_method(argc, argv)) return cli_solve_method(argc, argv); /* src/cli/mcsa.c */
-    solve_args a;
-    int rc = parse(argc, argv, &a);
-    if (!rc && a.queries) return cli_queries(&a.s, &a.o, a.queries, a.json, a.walks_given); /* src/cli/queries.c */
-    return rc < 0 ? 0 : rc ? rc : run(&a);
+    solve_args *a = p;
+    int rc = finish_parse(a, argc, argv, first);
+    if (!rc && a->queries) return cli_queries(&a->s, &a->o, a->queries, a->json, a->walks_given);
+    return rc ? rc : run(a);
 }
+
+/* The walks row of ulam solve (auto, or --method walks): the default, the last row of the table. */
+static int serves(const char *method)
+{
+    (void)method;
+    return 1;
+}
+
+const cli_solve_row cli_solve_walks_row = {"walks", longopts, NULL, serves, sizeof(solve_args), init, option, start_run};

@@ -152,7 +152,7 @@ static int screen_methods(study *st)
         } else {
             ulam_walk_opts o = ulam_walk_defaults();
             ulam_study_method_opts(k, st->s.b, st->s.M->nrows, &o);
-            o.roulette = o.split = 0, o.index = st->s.index - 1, o.max_walks = 1, o.guard = g; /* screened unwindowed */
+            o.kernel.roulette = o.kernel.split = 0, o.query.index = st->s.index - 1, o.stop.max_walks = 1, o.policy.guard = g; /* screened unwindowed */
             ulam_solver *sv = NULL;
             if (ulam_solver_alloc(st->s.M, st->s.b, &o, &sv, &err))
                 snprintf(m->why, sizeof m->why, "%s: expected %s", ulam_strerror(err.status), err.msg);
@@ -229,17 +229,17 @@ static int one_run(study *st, int m, int b, int r)
     const method *me = &st->m[m];
     ulam_walk_opts o = ulam_walk_defaults();
     ulam_study_method_opts(m, st->s.b, st->s.M->nrows, &o);
-    o.index = st->s.index - 1, o.threads = st->threads;
-    o.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
-    o.interrupt = &cli_interrupted, o.share = cli_share, o.guard = &st->g, o.force = 1;
-    if (st->time_budgets) o.max_walks = 0, o.max_seconds = st->budget[b];
-    else o.max_walks = (int64_t)st->budget[b];
+    o.query.index = st->s.index - 1, o.exec.threads = st->threads;
+    o.exec.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
+    o.stop.interrupt = &cli_interrupted, o.exec.share = cli_share, o.policy.guard = &st->g, o.policy.force = 1;
+    if (st->time_budgets) o.stop.max_walks = 0, o.stop.max_seconds = st->budget[b];
+    else o.stop.max_walks = (int64_t)st->budget[b];
     ulam_walk_result res;
-    if (ulam_solve(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted || res.walks < 2 || !isfinite(res.std_error))
+    if (ulam_solve_walks(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted || res.walks < 2 || !isfinite(res.std_error))
         return 1; /* nothing non-finite reaches runs.csv */
     char line[512];
     snprintf(line, sizeof line, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", me->name, st->budget[b], r,
-             (unsigned long long)o.seed, res.estimate, res.std_error, fabs(res.estimate - st->exact),
+             (unsigned long long)o.exec.seed, res.estimate, res.std_error, fabs(res.estimate - st->exact),
              (long long)res.walks, (long long)res.steps, res.seconds,
              fabs(res.estimate - st->exact) <= ULAM_Z95 * res.std_error);
     size_t i = at(st, m, b, r);
@@ -400,8 +400,8 @@ static void outer_references(const study *st, FILE *f)
     if (!x) return;
     for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA && st->forward_walks && st->reference_time > 0; m++) {
         ulam_outer_opts o = ulam_outer_defaults();
-        o.method = m, o.tol = 1e-10, o.walk.seed = st->seed, o.walk.threads = st->threads;
-        o.walk.interrupt = &cli_interrupted, o.max_histories = 20 * n > 1000000 ? 20 * n : 1000000;
+        o.method = m, o.tol = 1e-10, o.walk.exec.seed = st->seed, o.walk.exec.threads = st->threads;
+        o.walk.stop.interrupt = &cli_interrupted, o.max_histories = 20 * n > 1000000 ? 20 * n : 1000000;
         ulam_outer *it = NULL;
         if (ulam_outer_alloc(st->s.M, st->s.b, &o, &it, NULL)) continue;
         double t = 0;

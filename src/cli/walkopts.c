@@ -13,26 +13,26 @@ int cli_walk_option(const char *command, const char *name, const char *value, ul
     const char *cmd = command;
     int64_t v;
     int rc;
-    if (!strcmp(name, "walks")) return cli_parse_int(cmd, "--walks", value, 1, INT64_MAX / 2, &o->max_walks);
+    if (!strcmp(name, "walks")) return cli_parse_int(cmd, "--walks", value, 1, INT64_MAX / 2, &o->stop.max_walks);
     if (!strcmp(name, "tol")) name = "rel-err"; /* the iterations' spelling of the same target */
     if (!strcmp(name, "alpha")) /* deprecated: read as PageRank's alpha, which is --pagerank */
         fprintf(stderr, "ulam %s: note: --alpha is deprecated: the kernel exponent is --kernel-exponent (PageRank's "
                         "damping is --pagerank)\n", cmd);
-    if (!strcmp(name, "rel-err")) return cli_parse_real(cmd, "--rel-err", value, 1e-12, 1.0, &o->rel_err);
-    if (!strcmp(name, "time")) return cli_parse_real(cmd, "--time", value, 1e-6, 1e9, &o->max_seconds);
-    if (!strcmp(name, "continue") && !strcmp(value, "analog")) return o->continue_q = 0.0, 0; /* min(1, S_i) */
-    if (!strcmp(name, "continue")) return cli_parse_real(cmd, "--continue", value, 1e-9, 1 - 1e-12, &o->continue_q);
-    if (!strcmp(name, "roulette")) return cli_parse_real(cmd, "--roulette", value, 1e-300, 1e300, &o->roulette);
-    if (!strcmp(name, "split")) return cli_parse_real(cmd, "--split", value, 1e-300, 1e300, &o->split);
-    if (!strcmp(name, "max-steps")) return cli_parse_int(cmd, "--max-steps", value, 1, INT64_MAX / 2, &o->max_steps);
+    if (!strcmp(name, "rel-err")) return cli_parse_real(cmd, "--rel-err", value, 1e-12, 1.0, &o->stop.rel_err);
+    if (!strcmp(name, "time")) return cli_parse_real(cmd, "--time", value, 1e-6, 1e9, &o->stop.max_seconds);
+    if (!strcmp(name, "continue") && !strcmp(value, "analog")) return o->kernel.continue_q = 0.0, 0; /* min(1, S_i) */
+    if (!strcmp(name, "continue")) return cli_parse_real(cmd, "--continue", value, 1e-9, 1 - 1e-12, &o->kernel.continue_q);
+    if (!strcmp(name, "roulette")) return cli_parse_real(cmd, "--roulette", value, 1e-300, 1e300, &o->kernel.roulette);
+    if (!strcmp(name, "split")) return cli_parse_real(cmd, "--split", value, 1e-300, 1e300, &o->kernel.split);
+    if (!strcmp(name, "max-steps")) return cli_parse_int(cmd, "--max-steps", value, 1, INT64_MAX / 2, &o->stop.max_steps);
     if (!strcmp(name, "alpha") || !strcmp(name, "kernel-exponent"))
-        return cli_parse_real(cmd, name[0] == 'a' ? "--alpha" : "--kernel-exponent", value, 0.0, 1000.0, &o->kernel_alpha);
+        return cli_parse_real(cmd, name[0] == 'a' ? "--alpha" : "--kernel-exponent", value, 0.0, 1000.0, &o->kernel.kernel_alpha);
     if (!strcmp(name, "seed")) {
-        if (!(rc = cli_parse_int(cmd, "--seed", value, 0, INT64_MAX, &v))) o->seed = (uint64_t)v;
+        if (!(rc = cli_parse_int(cmd, "--seed", value, 0, INT64_MAX, &v))) o->exec.seed = (uint64_t)v;
         return rc;
     }
     if (!strcmp(name, "threads")) {
-        if (!(rc = cli_parse_int(cmd, "--threads", value, 1, 1024, &v))) o->threads = (int)v;
+        if (!(rc = cli_parse_int(cmd, "--threads", value, 1, 1024, &v))) o->exec.threads = (int)v;
         return rc;
     }
     if (!strcmp(name, "estimator")) {
@@ -50,5 +50,5 @@ int cli_walk_option(const char *command, const char *name, const char *value, ul
  * --rel-err, --time) was given (the command cleared o->max_walks before parsing). */
 void cli_walk_budget(ulam_walk_opts *o)
 {
-    if (!o->max_walks && !(o->rel_err > 0) && !(o->max_seconds > 0)) o->max_walks = 100000;
+    if (!o->stop.max_walks && !(o->stop.rel_err > 0) && !(o->stop.max_seconds > 0)) o->stop.max_walks = 100000;
 }

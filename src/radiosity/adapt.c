@@ -190,7 +190,7 @@ static int split(mesh *m, int64_t i)
 }
 
 /* Measure polygon i by point queries at its quadrature points: its mean and mesh error. */
-static int measure(mesh *m, int64_t i, const ulam_tracer *t, const ulam_walk_opts *opts, double t0,
+static int measure(mesh *m, int64_t i, const ulam_tracer *t, const ulam_rad_opts *opts, double t0,
                    ulam_rad_adapt_info *info, ulam_error *err)
 {
     const int32_t *v = m->idx + m->first[i];
@@ -201,11 +201,11 @@ static int measure(mesh *m, int64_t i, const ulam_tracer *t, const ulam_walk_opt
     for (int k = 0; k < K; k++) {
         double x[3];
         for (int d = 0; d < 3; d++) x[d] = k ? 0.5 * (c[d] + m->vert[3 * v[k - 1] + d]) : c[d];
-        ulam_walk_opts o = *opts;
+        ulam_rad_opts o = *opts;
         ulam_rng r;
-        ulam_rng_seed(&r, opts->seed, 16 * (uint64_t)i + (uint64_t)k);
-        o.seed = ulam__rng_next(&r);
-        if (opts->max_seconds > 0 && !((o.max_seconds = opts->max_seconds - (ulam_now() - t0)) > 0)) {
+        ulam_rng_seed(&r, opts->exec.seed, 16 * (uint64_t)i + (uint64_t)k);
+        o.exec.seed = ulam__rng_next(&r);
+        if (opts->stop.max_seconds > 0 && !((o.stop.max_seconds = opts->stop.max_seconds - (ulam_now() - t0)) > 0)) {
             info->interrupted = 1;
             return ULAM_OK;
         }
@@ -315,7 +315,7 @@ static int mesh_init(mesh *m, const ulam_scene *s, const double *Y)
 }
 
 /* Refine the tracer's scene until its importance-weighted mesh error is at most target. */
-int ulam_rad_adapt(const ulam_tracer *t, const ulam_walk_opts *opts, const double *importance, double target,
+int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double *importance, double target,
                    int64_t max_patches, ulam_scene **out, ulam_rad_adapt_info *info, ulam_error *err)
 {
     ulam__clear(err);

@@ -28,7 +28,7 @@ static int check_grid(const ulam_rad_grid *g, ulam_error *err)
 }
 
 /* Every point of grid g (out: nu * nv, row j = 0 first, i fastest). */
-int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_walk_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
+int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
                         ulam_error *err)
 {
     ulam__clear(err);
@@ -39,13 +39,13 @@ int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_walk_opts *opts, const 
     for (int j = 0; j < g->nv; j++)
         for (int i = 0; i < g->nu; i++) {
             int64_t k = (int64_t)j * g->nu + i;
-            ulam_walk_opts o = *opts;
+            ulam_rad_opts o = *opts;
             ulam_rng r;
-            ulam_rng_seed(&r, opts->seed, (uint64_t)k);
-            o.seed = ulam__rng_next(&r);
-            if (opts->max_seconds > 0) { /* the time limit is the whole grid's */
-                o.max_seconds = opts->max_seconds - (ulam_now() - t0);
-                if (!(o.max_seconds > 0)) o.max_seconds = 1e-9; /* one block still runs: an estimate */
+            ulam_rng_seed(&r, opts->exec.seed, (uint64_t)k);
+            o.exec.seed = ulam__rng_next(&r);
+            if (opts->stop.max_seconds > 0) { /* the time limit is the whole grid's */
+                o.stop.max_seconds = opts->stop.max_seconds - (ulam_now() - t0);
+                if (!(o.stop.max_seconds > 0)) o.stop.max_seconds = 1e-9; /* one block still runs: an estimate */
             }
             double x[3];
             ulam_rad_grid_point(g, i, j, x);

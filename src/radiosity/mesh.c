@@ -18,7 +18,7 @@ static void quad_point(const ulam_scene *s, int64_t p, int k, double x[3])
 }
 
 /* The mesh error of patch opts->index whose patch query gave B (3 channels). */
-int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_walk_opts *opts, const double B[3], ulam_rad_mesh *out,
+int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_rad_opts *opts, const double B[3], ulam_rad_mesh *out,
                         ulam_error *err)
 {
     ulam__clear(err);
@@ -32,10 +32,10 @@ int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_walk_opts *opts, const 
     out->npoints = (int)(1 + (nv < ULAM_RAD_MESH_POINTS - 1 ? nv : ULAM_RAD_MESH_POINTS - 1));
     double t0 = ulam_now();
     for (int k = 0; k < out->npoints; k++) {
-        ulam_walk_opts o = *opts;
+        ulam_rad_opts o = *opts;
         ulam_rng r;
-        ulam_rng_seed(&r, opts->seed, (uint64_t)k + 1);
-        o.seed = ulam__rng_next(&r);
+        ulam_rng_seed(&r, opts->exec.seed, (uint64_t)k + 1);
+        o.exec.seed = ulam__rng_next(&r);
         double x[3];
         quad_point(s, p, k, x);
         ulam_rad_point pt;

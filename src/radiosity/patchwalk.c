@@ -29,7 +29,7 @@
  * A point solver (ulam_rad_point_alloc) runs point.c's walks from one point of the continuous
  * surfaces instead, with the same rounds, statistics and stopping rules.
  *
- * As in ulam_solve, block k of walks draws from the stream (seed, k) and blocks merge in
+ * As in ulam_solve_walks, block k of walks draws from the stream (seed, k) and blocks merge in
  * index order: the result does not depend on the number of threads. */
 #include "rad.h"
 #include "../round.h"
@@ -50,12 +50,10 @@ typedef struct {
 
 /* What a block of walks produced. */
 typedef struct {
+    ulam__block_head h; /* the round driver's part: the shooting tallies (rad_tally), walks, ... */
     ulam__moments m[3]; /* gathering scores per channel */
     double sq, maxsq;   /* sum and largest square of the channel-summed score (of the patch) */
-    rad_tally *t;       /* shooting tallies */
-    int64_t len, cap;
-    int64_t walks, rays, cut, nonfinite;
-    int complete, nomem;
+    int64_t rays, cut;
 } rad_block;
 
 /* Per-thread scratch of a shooting history. */
@@ -97,7 +95,7 @@ ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s)
         for (int k = 0; k < s->threads; k++)
             free(s->scratch[k].hist), free(s->scratch[k].touched), free(s->scratch[k].mark);
     if (s->blocks)
-        for (int k = 0; k < RROUND; k++) free(s->blocks[k].t);
+        for (int k = 0; k < RROUND; k++) free(s->blocks[k].h.tally);
     ulam__lights_free(&s->L);
     free(s->q), free(s->scratch), free(s->blocks);
     free(s->sum), free(s->sumsq);
@@ -125,12 +123,8 @@ static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, int point, 
                                                    "or collision)");
     if (point && o->mode != ULAM_ADJOINT)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "point walks gather (mode adjoint)");
-    if (!point && (o->index < 0 || o->index >= sc->npatches))
-        return ulam__fail(err, ULAM_EINVAL, 0, o->index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
-    if (o->continue_q != 0 || o->roulette != 0 || o->split != 0 || o->kernel_alpha != 1.0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "no continue_q, roulette, split or kernel exponent other "
-                                                   "than 1 (patch walks continue with the patch's largest "
-                                                   "reflectance and follow the form factors)");
+    if (!point && (o->query.index < 0 || o->query.index >= sc->npatches))
+        return ulam__fail(err, ULAM_EINVAL, 0, o->query.index, "a patch from 0 to %lld", (long long)sc->npatches - 1);
     return ulam__budgets_check(o, err);
 }
 
@@ -150,7 +144,7 @@ static int build_source(ulam_rad_solver *s, ulam_error *err)
 static void first_bounds(ulam_rad_solver *s)
 {
     const ulam_scene *sc = s->s;
-    int64_t i = s->at ? s->at_self : s->o.index;
+    int64_t i = s->at ? s->at_self : s->o.query.index;
     for (int c = 0; c < 3; c++) s->first[c] = 0.0, s->w1[c] = 1.0;
     if (!next_event(s->o.estimator) || s->o.mode != ULAM_ADJOINT || (i < 0 && !s->at)) return;
     ulam__lights_vertex_bound(&s->L, sc, s->o.estimator, i, i < 0 ? s->at_x : NULL, s->at ? s->at_n : sc->normal + 3 * i,
@@ -186,7 +180,7 @@ static void score_bounds(ulam_rad_solver *s)
     }
     if (s->o.mode == ULAM_FORWARD) {
         for (int c = 0; c < 3; c++) {
-            double w0 = 0.0, rho = sc->rho[3 * s->o.index + c], q = s->q[s->o.index];
+            double w0 = 0.0, rho = sc->rho[3 * s->o.query.index + c], q = s->q[s->o.query.index];
             for (int64_t k = 0; k < s->L.nem; k++) {
                 const double *E = sc->emit + 3 * s->L.emitter[k];
                 w0 = fmax(w0, s->L.ptot * E[c] / (E[0] + E[1] + E[2]));
@@ -205,7 +199,7 @@ static void score_bounds(ulam_rad_solver *s)
 static int check_bounded(const ulam_rad_solver *s, ulam_error *err)
 {
     for (int c = 0; c < 3; c++)
-        if (s->o.rel_err > 0 && !isfinite(s->per_step[c]))
+        if (s->o.stop.rel_err > 0 && !isfinite(s->per_step[c]))
             return ulam__fail(err, ULAM_EINVAL, 0, -1, "a certified bound on the scores for rel_err (light sampling "
                                                        "alone has none where a patch may touch an emitter: "
                                                        "use next-event with MIS, or a walk budget)");
@@ -236,13 +230,15 @@ static int alloc_work(ulam_rad_solver *s)
 }
 
 /* Prepare walks from patch opts->index, or (point) from a point. */
-static int solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, int point, ulam_rad_solver **out,
+static int solver_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, int point, ulam_rad_solver **out,
                         ulam_error *err)
 {
     ulam__clear(err);
     if (!t || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer and an output");
     *out = NULL;
-    ulam_walk_opts o = opts ? *opts : ulam_walk_defaults();
+    ulam_rad_opts r = opts ? *opts : ulam_rad_defaults();
+    ulam_walk_opts o = ulam_walk_defaults(); /* the round driver's view: the kernel's defaults are never read */
+    o.mode = r.mode, o.estimator = r.estimator, o.query.index = r.index, o.stop = r.stop, o.exec = r.exec;
     int status = check_opts(ulam__tracer_scene(t), &o, point, err);
     if (status) return status;
     ulam_rad_solver *s = calloc(1, sizeof *s);
@@ -250,9 +246,9 @@ static int solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, int po
     s->o = o;
     s->t = t;
     s->s = ulam__tracer_scene(t);
-    s->threads = ulam__threads(o.threads);
+    s->threads = ulam__threads(o.exec.threads);
     ulam__run_reset(&s->run);
-    s->o.max_walks = ulam__walk_cap(&o);
+    s->o.stop.max_walks = ulam__walk_cap(&o);
     s->at = point;
     if ((status = build_source(s, err))) {
         ulam_rad_solver_free(s);
@@ -270,15 +266,22 @@ static int solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, int po
     return ULAM_OK;
 }
 
+/* The radiosity defaults: gather at patch 0 by next-event estimation. */
+ulam_rad_opts ulam_rad_defaults(void)
+{
+    return (ulam_rad_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_RAD_NEXT_EVENT, .stop = ulam_stop_defaults(),
+                           .exec = ulam_exec_defaults()};
+}
+
 /* Prepare patch walks. */
-int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, ulam_rad_solver **out,
+int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, ulam_rad_solver **out,
                           ulam_error *err)
 {
     return solver_alloc(t, opts, 0, out, err);
 }
 
 /* Prepare walks from point x (normal n, or NULL: the patch's it lies on). */
-int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, const double x[3], const double n[3],
                          ulam_rad_solver **out, ulam_error *err)
 {
     ulam__clear(err);
@@ -334,7 +337,7 @@ int ulam_rad_point_result(const ulam_rad_solver *s, ulam_rad_point *r)
 }
 
 /* Run a point solver to the end (ulam_rad_point_alloc, iterate, result, free). */
-int ulam_rad_point_query(const ulam_tracer *t, const ulam_walk_opts *opts, const double x[3], const double n[3],
+int ulam_rad_point_query(const ulam_tracer *t, const ulam_rad_opts *opts, const double x[3], const double n[3],
                          ulam_rad_point *r, ulam_error *err)
 {
     ulam_rad_solver *s = NULL;
@@ -352,7 +355,7 @@ static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_b
 {
     const ulam_scene *sc = s->s;
     int absorb = s->o.estimator == ULAM_RAD_ABSORPTION;
-    int64_t p = s->o.index;
+    int64_t p = s->o.query.index;
     double W[3] = {1, 1, 1};
     score[0] = score[1] = score[2] = 0.0;
     for (int64_t step = 0;; step++) {
@@ -364,7 +367,7 @@ static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_b
                 for (int c = 0; c < 3; c++) score[c] += W[c] * E[c] / (1.0 - q);
             return;
         }
-        if (step >= s->o.max_steps) {
+        if (step >= s->o.stop.max_steps) {
             br->cut++;
             return;
         }
@@ -392,14 +395,14 @@ static void light_sample(const ulam_rad_solver *s, ulam_rng *r, int64_t p, const
 static void gather_next_event(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_block *br)
 {
     const ulam_scene *sc = s->s;
-    int64_t p = s->o.index;
+    int64_t p = s->o.query.index;
     double W[3] = {1, 1, 1};
     for (int c = 0; c < 3; c++) score[c] = sc->emit[3 * p + c];
     for (int64_t step = 0;; step++) {
         double q = s->q[p];
         if (q > 0 && s->L.nem) light_sample(s, r, p, W, score, br);
         if (ulam__rng_uniform(r) >= q) return;
-        if (step >= s->o.max_steps) {
+        if (step >= s->o.stop.max_steps) {
             br->cut++;
             return;
         }
@@ -436,7 +439,7 @@ static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_bl
     double W[3], esum = E0[0] + E0[1] + E0[2];
     for (int c = 0; c < 3; c++) W[c] = s->L.ptot * E0[c] / esum;
     for (int64_t step = 0;; step++) {
-        if (step >= s->o.max_steps) {
+        if (step >= s->o.stop.max_steps) {
             br->cut++;
             return;
         }
@@ -458,14 +461,15 @@ static void shoot(const ulam_rad_solver *s, ulam_rng *r, rad_scratch *sc, rad_bl
 /* Move a finished shooting history's tallies into the block; 0 or ULAM_ENOMEM. */
 static int flush_history(rad_scratch *sc, rad_block *br)
 {
-    if (ulam__grow(&br->t, &br->cap, br->len + sc->ntouched, sizeof *br->t)) return ULAM_ENOMEM;
+    ulam__block_head *h = &br->h;
+    if (ulam__grow(&h->tally, &h->cap, h->len + sc->ntouched, sizeof(rad_tally))) return ULAM_ENOMEM;
     for (int64_t k = 0; k < sc->ntouched; k++) {
         int32_t p = sc->touched[k];
-        rad_tally *e = &br->t[br->len++];
+        rad_tally *e = (rad_tally *)h->tally + h->len++;
         e->patch = p;
         for (int c = 0; c < 3; c++) {
             e->v[c] = sc->hist[3 * p + c];
-            if (!isfinite(e->v[c])) br->nonfinite++;
+            if (!isfinite(e->v[c])) h->nonfinite++;
             sc->hist[3 * p + c] = 0.0;
         }
         sc->mark[p] = 0;
@@ -482,17 +486,17 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     ulam__moments zero = {0};
     br->m[0] = br->m[1] = br->m[2] = zero;
     br->sq = br->maxsq = 0.0;
-    br->len = br->walks = br->rays = br->cut = br->nonfinite = 0;
-    br->complete = br->nomem = 0;
-    if (!ulam__mine(s->o.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
+    br->h.len = br->h.walks = br->rays = br->cut = br->h.nonfinite = 0;
+    br->h.complete = br->h.nomem = 0;
+    if (!ulam__mine(s->o.exec.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
     ulam_rng r;
-    ulam_rng_seed(&r, s->o.seed, (uint64_t)(first / RBLOCK));
+    ulam_rng_seed(&r, s->o.exec.seed, (uint64_t)(first / RBLOCK));
     for (int64_t w = 0; w < count; w++) {
         if (s->o.mode == ULAM_ADJOINT) {
             double sc[3];
             if (s->at) {
                 int64_t cut = 0;
-                ulam__point_walk(s->t, &s->L, s->q, s->o.estimator, s->o.max_steps, s->at_x, s->at_n, s->at_self, &r,
+                ulam__point_walk(s->t, &s->L, s->q, s->o.estimator, s->o.stop.max_steps, s->at_x, s->at_n, s->at_self, &r,
                                  sc, &br->rays, &cut);
                 br->cut += cut;
             } else if (next_event(s->o.estimator)) {
@@ -502,7 +506,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             }
             for (int c = 0; c < 3; c++) {
                 ulam__moments_add(&br->m[c], sc[c]);
-                if (!isfinite(sc[c])) br->nonfinite++;
+                if (!isfinite(sc[c])) br->h.nonfinite++;
             }
             double x = sc[0] + sc[1] + sc[2];
             br->sq += x * x;
@@ -510,15 +514,15 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
         } else {
             shoot(s, &r, &s->scratch[th], br);
             for (int c = 0; c < 3; c++) /* the patch's tally, 0 when untouched: its moments for rel_err */
-                ulam__moments_add(&br->m[c], s->scratch[th].hist[3 * s->o.index + c]);
+                ulam__moments_add(&br->m[c], s->scratch[th].hist[3 * s->o.query.index + c]);
             if (flush_history(&s->scratch[th], br)) {
-                br->nomem = 1;
+                br->h.nomem = 1;
                 return;
             }
         }
-        br->walks++;
+        br->h.walks++;
     }
-    br->complete = 1;
+    br->h.complete = 1;
 }
 
 /* Merge completed block k into the totals (ctx: the solver; the walk and non-finite counts are
@@ -530,13 +534,13 @@ static void merge_block(void *ctx, int k)
     for (int c = 0; c < 3; c++) ulam__moments_merge(&s->m[c], &br->m[c]);
     s->sq += br->sq;
     s->maxsq = fmax(s->maxsq, br->maxsq);
-    for (int64_t k = 0; k < br->len; k++) {
-        const rad_tally *e = &br->t[k];
+    for (int64_t k = 0; k < br->h.len; k++) {
+        const rad_tally *e = (const rad_tally *)br->h.tally + k;
         for (int c = 0; c < 3; c++) {
             s->sum[3 * e->patch + c] += e->v[c];
             s->sumsq[3 * e->patch + c] += e->v[c] * e->v[c];
         }
-        if (e->patch == s->o.index) {
+        if (e->patch == s->o.query.index) {
             double x = e->v[0] + e->v[1] + e->v[2];
             s->sq += x * x;
             s->maxsq = fmax(s->maxsq, x * x);
@@ -554,7 +558,7 @@ static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r)
  * (score_bounds). */
 static void channel_range(const ulam_rad_solver *s, int c, double m, double E, double *R, double *bias)
 {
-    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.index] : 1.0;
+    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
     double later = ulam__score_range(s->range[c], s->w1[c] * s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0);
     *R = (s->first[c] + later) / A;
     *bias = isfinite(s->range[c]) ? 0.0 : E * fabs(m) / 4.0;
@@ -564,8 +568,8 @@ static void channel_range(const ulam_rad_solver *s, int c, double m, double E, d
  * particles' tallies at the patch over its area (shooting, the emission exact). */
 static void channel_interval(const ulam_rad_solver *s, int c, double m, double E, ulam__stop_ci *ci)
 {
-    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.index] : 1.0, R, bias;
-    double off = s->o.mode == ULAM_FORWARD ? s->s->emit[3 * s->o.index + c] : 0.0;
+    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0, R, bias;
+    double off = s->o.mode == ULAM_FORWARD ? s->s->emit[3 * s->o.query.index + c] : 0.0;
     channel_range(s, c, m, E, &R, &bias);
     int64_t n = s->run.walks;
     ulam__stop_interval(n, off + s->m[c].mean / A, ulam__moments_variance(&s->m[c]) / (A * A), R, bias, 0.0, INFINITY,
@@ -575,7 +579,7 @@ static void channel_interval(const ulam_rad_solver *s, int c, double m, double E
 /* The walks the rel_err rule (stop.h) needs in channel c at estimate m. */
 static double channel_min_walks(const ulam_rad_solver *s, int c, double m, double E)
 {
-    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.index] : 1.0, R, bias;
+    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0, R, bias;
     channel_range(s, c, m, E, &R, &bias);
     return ulam__stop_walks_needed(m, ulam__moments_variance(&s->m[c]) / (A * A), R, bias, E,
                                    ulam__stop_epoch(s->run.walks));
@@ -590,9 +594,9 @@ static void channel_mins(const ulam_rad_solver *s, const ulam_rad_result *r, dou
     for (int c = 0; c < 3; c++) bright = fmax(bright, fabs(r->radiosity[c]));
     for (int c = 0; c < 3; c++) {
         mins[c] = 0.0;
-        if (!(s->o.rel_err > 0)) continue;
-        if (r->radiosity[c] != 0.0) mins[c] = channel_min_walks(s, c, r->radiosity[c], s->o.rel_err);
-        else if (s->per_step[c] > 0 && bright > 0) mins[c] = channel_min_walks(s, c, bright, s->o.rel_err);
+        if (!(s->o.stop.rel_err > 0)) continue;
+        if (r->radiosity[c] != 0.0) mins[c] = channel_min_walks(s, c, r->radiosity[c], s->o.stop.rel_err);
+        else if (s->per_step[c] > 0 && bright > 0) mins[c] = channel_min_walks(s, c, bright, s->o.stop.rel_err);
     }
 }
 
@@ -629,20 +633,17 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
 {
     if (!s) return ULAM_EINVAL;
     if (s->run.done) return s->run.status;
-    static const ulam__blocks B = {RBLOCK, RROUND, run_block, sizeof(rad_block), sizeof(rad_tally),
-                                   offsetof(rad_block, t), offsetof(rad_block, len), offsetof(rad_block, cap),
-                                   offsetof(rad_block, walks), offsetof(rad_block, nonfinite),
-                                   offsetof(rad_block, complete), offsetof(rad_block, nomem), merge_block,
+    static const ulam__blocks B = {RBLOCK, RROUND, run_block, sizeof(rad_block), sizeof(rad_tally), merge_block,
                                    NULL, NULL};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_rad_result r;
     double mins[3];
     result(s, mins, &r);
     int k = ulam__stop_epoch(r.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
-    if (check && s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN) s->epoch = k;
-    if (check && s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, mins, s->o.rel_err))
+    if (check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN) s->epoch = k;
+    if (check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, mins, s->o.stop.rel_err))
         s->run.done = s->met = 1;
-    if (s->o.rel_err > 0 && r.walks >= ULAM__REL_MIN && all_zero(&r)) s->run.done = s->zero = 1; /* can never be met */
+    if (s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN && all_zero(&r)) s->run.done = s->zero = 1; /* can never be met */
     return s->run.status;
 }
 
@@ -651,7 +652,7 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
 void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds)
 {
     ulam__moments zero = {0};
-    s->o.index = p, s->o.rel_err = rel_err, s->o.seed = seed, s->o.max_seconds = max_seconds;
+    s->o.query.index = p, s->o.stop.rel_err = rel_err, s->o.exec.seed = seed, s->o.stop.max_seconds = max_seconds;
     first_bounds(s);
     s->m[0] = s->m[1] = s->m[2] = zero;
     s->sq = s->maxsq = 0.0;
@@ -684,12 +685,12 @@ static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r)
             r->radiosity[c] = s->m[c].mean;
             r->std_error[c] = s->m[c].n > 0 ? sqrt(ulam__moments_variance(&s->m[c]) / (double)s->m[c].n) : INFINITY;
         } else {
-            shot_component(s, s->o.index, c, &r->radiosity[c], &r->std_error[c]);
+            shot_component(s, s->o.query.index, c, &r->radiosity[c], &r->std_error[c]);
         }
     }
     r->max_share = s->sq > 0 ? fmin(1.0, s->maxsq / s->sq) : 0.0;
     channel_mins(s, r, mins);
-    for (int c = 0; c < 3 && s->o.rel_err > 0; c++) {
+    for (int c = 0; c < 3 && s->o.stop.rel_err > 0; c++) {
         r->min_walks = fmax(r->min_walks, mins[c]); /* 0 in a channel where no minimum applies */
         if (s->m[c].mean != 0.0)
             r->variance_rel_error = fmax(r->variance_rel_error, ulam__moments_variance_rel_error(&s->m[c]));

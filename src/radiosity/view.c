@@ -8,20 +8,20 @@
 
 /* Check a view gather's arguments. */
 static int check_view(const ulam_tracer *t, const ulam_camera *cam, int w, int h, double coverage,
-                      const ulam_walk_opts *o, const double *B, const double *se, ulam_error *err)
+                      const ulam_rad_opts *o, const double *B, const double *se, ulam_error *err)
 {
     if (!t || !cam || !o || !B || !se) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, camera, options and outputs");
     if (w < 1 || h < 1 || !(cam->focal > 0) || !(cam->film > 0))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a picture of at least 1 x 1 and a camera with focal and film > 0");
     if (!(coverage >= 0 && coverage <= 1)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a coverage exponent in [0, 1]");
-    if (o->mode != ULAM_ADJOINT || !(o->rel_err > 0))
+    if (o->mode != ULAM_ADJOINT || !(o->stop.rel_err > 0))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "gathering (adjoint) with rel_err > 0");
     return ULAM_OK;
 }
 
 /* Gather the patches a camera sees. */
 int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, int height, double coverage,
-                     const ulam_walk_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err)
+                     const ulam_rad_opts *opts, double *B, double *se, ulam_view_info *info, ulam_error *err)
 {
     ulam__clear(err);
     int status = check_view(t, cam, width, height, coverage, opts, B, se, err);
@@ -43,7 +43,7 @@ int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, in
         most = pix[p] > most ? pix[p] : most;
         if (first < 0) first = p;
     }
-    ulam_walk_opts o = *opts;
+    ulam_rad_opts o = *opts;
     o.index = first >= 0 ? first : 0;
     ulam_rad_solver *sv = NULL;
     if (first >= 0 && (status = ulam_rad_solver_alloc(t, &o, &sv, err))) {
@@ -52,15 +52,15 @@ int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, in
     }
     for (int64_t p = first; p >= 0 && p < n && !status; p++) {
         if (!pix[p]) continue;
-        double left = opts->max_seconds > 0 ? opts->max_seconds - (ulam_now() - t0) : 0.0;
-        if (opts->max_seconds > 0 && left <= 0) { /* out of time: the rest unsolved */
+        double left = opts->stop.max_seconds > 0 ? opts->stop.max_seconds - (ulam_now() - t0) : 0.0;
+        if (opts->stop.max_seconds > 0 && left <= 0) { /* out of time: the rest unsolved */
             for (int c = 0; c < 3; c++) se[3 * p + c] = INFINITY;
             in.unmet++;
             continue;
         }
         ulam_rng r;
-        ulam_rng_seed(&r, opts->seed, (uint64_t)p);
-        double target = opts->rel_err * pow((double)most / (double)pix[p], coverage);
+        ulam_rng_seed(&r, opts->exec.seed, (uint64_t)p);
+        double target = opts->stop.rel_err * pow((double)most / (double)pix[p], coverage);
         ulam__rad_solver_restart(sv, p, target, ulam__rng_next(&r), left);
         while (!status && !ulam_rad_solver_done(sv)) status = ulam_rad_solver_iterate(sv);
         ulam_rad_result res;

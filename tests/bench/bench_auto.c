@@ -55,15 +55,15 @@ static run single(const ulam_csr *M, const double *b, int k)
 {
     run r = {0};
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = k / 6, o.estimator = k / 2 % 3, o.continue_q = k % 2 ? 0.9 : 0.0;
-    o.index = 0, o.rel_err = 0.01, o.max_walks = 0, o.threads = 2;
+    o.mode = k / 6, o.estimator = k / 2 % 3, o.kernel.continue_q = k % 2 ? 0.9 : 0.0;
+    o.query.index = 0, o.stop.rel_err = 0.01, o.stop.max_walks = 0, o.exec.threads = 2;
     double t0 = ulam_now();
     ulam_guard g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(o.mode);
     ulam_solver *s = NULL;
-    r.status = ulam_guard_check(M, o.continue_q, &go, &g, NULL);
-    o.guard = &g;
+    r.status = ulam_guard_check(M, o.kernel.continue_q, &go, &g, NULL);
+    o.policy.guard = &g;
     if (!r.status) r.status = ulam_solver_alloc(M, b, &o, &s, NULL);
     if (!r.status) finish(s, &r);
     r.seconds = ulam_now() - t0;
@@ -76,7 +76,7 @@ static run automatic(const ulam_csr *M, const double *b)
 {
     run r = {0};
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = 0, o.rel_err = 0.01, o.max_walks = 0, o.threads = 2;
+    o.query.index = 0, o.stop.rel_err = 0.01, o.stop.max_walks = 0, o.exec.threads = 2;
     double t0 = ulam_now();
     ulam_auto_result res;
     ulam_solver *s = NULL;

@@ -89,12 +89,12 @@ static int query(ulam_push *w, const ulam_csr *Mt, const ulam_guard *g, int64_t 
                  uint64_t seed, ulam_bidir_result *res)
 {
     ulam_bidir_opts o = ulam_bidir_defaults();
-    o.walk.guard = g;
+    o.walk.policy.guard = g;
     o.reach_all = 1;   /* the walks' bounds over every state, made at the first query, kept in w for the rest */
     o.keep_kernel = 1; /* the walks' (and pilot's) kernel rows kept in w, rescored to each query's residual */
     o.source = s, o.target = t, o.rmax = rmax;
-    o.walk.max_walks = 0, o.walk.rel_err = REL, o.walk.max_seconds = cap, o.walk.threads = 1, o.walk.seed = seed;
-    o.walk.max_steps = INT64_MAX / 4;
+    o.walk.stop.max_walks = 0, o.walk.stop.rel_err = REL, o.walk.stop.max_seconds = cap, o.walk.exec.threads = 1, o.walk.exec.seed = seed;
+    o.walk.stop.max_steps = INT64_MAX / 4;
     ulam_error err;
     int st = ulam_bidir_solve(w, Mt, &o, res, &err);
     if (st) fprintf(stderr, "bidir: pair (%lld, %lld): %s: %s\n", (long long)s, (long long)t, ulam_strerror(st), err.msg);
@@ -107,8 +107,8 @@ static double walks_alone(const ulam_csr *Mt, const ulam_guard *g, double *e, in
                           uint64_t seed, int *mark, int *covers)
 {
     ulam_walk_opts o = ulam_walk_defaults();
-    o.guard = g;
-    o.index = s, o.threads = 1, o.seed = seed, o.max_walks = 0, o.max_seconds = WALK_CAP, o.max_steps = INT64_MAX / 4;
+    o.policy.guard = g;
+    o.query.index = s, o.exec.threads = 1, o.exec.seed = seed, o.stop.max_walks = 0, o.stop.max_seconds = WALK_CAP, o.stop.max_steps = INT64_MAX / 4;
     e[t] = 1.0;
     ulam_solver *sv = NULL;
     double t0 = ulam_now(), c0 = cpu_now(), rate = INFINITY;

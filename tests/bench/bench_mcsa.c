@@ -72,7 +72,7 @@ static int outer(const ulam_csr *M, const double *b, int method, double tol, int
                  int64_t max_hist, double budget, ulam_outer_step *st, double *x, int *status)
 {
     ulam_outer_opts o = ulam_outer_defaults();
-    o.method = method, o.tol = tol, o.walk.threads = threads, o.max_iter = max_iter;
+    o.method = method, o.tol = tol, o.walk.exec.threads = threads, o.max_iter = max_iter;
     if (max_hist) o.max_histories = max_hist;
     ulam_outer *it = NULL;
     ulam_error err;

@@ -67,9 +67,9 @@ int main(int argc, char **argv)
     double inproc[PAIRS], cli[PAIRS], est[PAIRS];
     for (int k = 0; k < np; k++) {
         ulam_bidir_opts o = ulam_bidir_defaults();
-        o.walk.guard = &g, o.reach_all = 1, o.keep_kernel = 1, o.source = ps[k], o.target = pt[k];
-        o.walk.max_walks = 0, o.walk.rel_err = REL, o.walk.threads = 1, o.walk.seed = (uint64_t)k + 1;
-        o.walk.max_steps = INT64_MAX / 4;
+        o.walk.policy.guard = &g, o.reach_all = 1, o.keep_kernel = 1, o.source = ps[k], o.target = pt[k];
+        o.walk.stop.max_walks = 0, o.walk.stop.rel_err = REL, o.walk.exec.threads = 1, o.walk.exec.seed = (uint64_t)k + 1;
+        o.walk.stop.max_steps = INT64_MAX / 4;
         ulam_bidir_result res;
         if (ulam_bidir_solve(w, Mt, &o, &res, NULL)) return fprintf(stderr, "queries: pair %d failed\n", k + 1), 1;
         inproc[k] = res.seconds, est[k] = res.estimate;

@@ -55,8 +55,8 @@ static ulam_scene *subdivided(const ulam_scene *s, int64_t target)
 /* Gather at patch p with estimator est until rel_err (or walks, when rel_err is 0). */
 static ulam_rad_result gather(const ulam_tracer *t, int est, int64_t p, double rel_err, int64_t walks)
 {
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.index = p, o.estimator = est, o.max_walks = walks, o.rel_err = rel_err, o.seed = 1;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.index = p, o.estimator = est, o.stop.max_walks = walks, o.stop.rel_err = rel_err, o.exec.seed = 1;
     ulam_rad_solver *sv = NULL;
     ulam_rad_result r = {0};
     if (ulam_rad_solver_alloc(t, &o, &sv, NULL)) return r;
@@ -204,8 +204,8 @@ static void point_vs_patch(const char *what, const ulam_scene *s, const ulam_tra
 {
     int64_t p = ulam_scene_locate(s, x, ULAM_RAD_LOCATE_REL);
     if (p < 0) return;
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.rel_err = 0.01, o.max_walks = 0, o.seed = 1, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.rel_err = 0.01, o.stop.max_walks = 0, o.exec.seed = 1, o.exec.threads = 2;
     ulam_rad_point pt;
     if (ulam_rad_point_query(t, &o, x, NULL, &pt, NULL)) return;
     ulam_rad_result pa = gather(t, ULAM_RAD_NEXT_EVENT, p, 0.01, 0);
@@ -229,8 +229,8 @@ static int points_bench(void)
     }
     int64_t tri = s->start[s->npatches] - 2 * s->npatches;
     ulam_rad_grid g = office_grid();
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.rel_err = 0.02, o.max_walks = 0, o.seed = 1, o.threads = 2;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.rel_err = 0.02, o.stop.max_walks = 0, o.exec.seed = 1, o.exec.threads = 2;
     ulam_rad_point *pts = malloc(100 * sizeof *pts);
     double t0 = ulam_now();
     if (!pts || ulam_rad_grid_solve(t, &o, &g, pts, &err)) return 1;
@@ -338,12 +338,12 @@ int main(int argc, char **argv)
     ulam_camera cam = ulam_camera_frame(s, W, H);
     double *B = malloc((size_t)(3 * n) * sizeof *B), *se = malloc((size_t)(3 * n) * sizeof *se);
     double *Bs = malloc((size_t)(3 * n) * sizeof *Bs), *ses = malloc((size_t)(3 * n) * sizeof *ses);
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = ULAM_RAD_NEXT_EVENT, o.max_walks = 0, o.rel_err = 0.01, o.seed = 1;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.estimator = ULAM_RAD_NEXT_EVENT, o.stop.max_walks = 0, o.stop.rel_err = 0.01, o.exec.seed = 1;
     ulam_view_info vi;
     if (!B || !se || !Bs || !ses || ulam_view_gather(t, &cam, W, H, 0.0, &o, B, se, &vi, &err)) return 1;
-    ulam_walk_opts so = ulam_walk_defaults();
-    so.mode = ULAM_FORWARD, so.max_walks = P, so.seed = 1;
+    ulam_rad_opts so = ulam_rad_defaults();
+    so.mode = ULAM_FORWARD, so.stop.max_walks = P, so.exec.seed = 1;
     ulam_rad_solver *sv = NULL;
     if (ulam_rad_solver_alloc(t, &so, &sv, &err)) return 1;
     while (!ulam_rad_solver_done(sv)) ulam_rad_solver_iterate(sv);

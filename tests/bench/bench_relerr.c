@@ -100,17 +100,17 @@ static void exact(sys *s)
 static void row(const sys *s, int est, double E, int reps)
 {
     ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = est, o.index = s->index, o.max_walks = ORACLE, o.seed = 12345;
+    o.estimator = est, o.query.index = s->index, o.stop.max_walks = ORACLE, o.exec.seed = 12345;
     ulam_walk_result r;
-    if (ulam_solve(s->M, s->b, &o, &r, NULL)) {
+    if (ulam_solve_walks(s->M, s->b, &o, &r, NULL)) {
         printf("%-20s %-10s refused\n", s->name, est ? "absorption" : "collision");
         return;
     }
     double oracle = r.variance / (E * s->x * E * s->x), walks = 0, width = 0, secs = 0;
     int met = 0, covered = 0;
     for (int k = 0; k < reps; k++) {
-        o.max_walks = CAP, o.rel_err = E, o.seed = 1 + (uint64_t)k; /* past CAP: stopped early, not met */
-        if (ulam_solve(s->M, s->b, &o, &r, NULL)) continue;
+        o.stop.max_walks = CAP, o.stop.rel_err = E, o.exec.seed = 1 + (uint64_t)k; /* past CAP: stopped early, not met */
+        if (ulam_solve_walks(s->M, s->b, &o, &r, NULL)) continue;
         walks += (double)r.walks / reps, secs += r.seconds / reps, met += r.rel_err_met;
         width += (r.ci95[1] - r.ci95[0]) / 2 / (E * fabs(s->x)) / reps;
         covered += r.ci95[0] <= s->x && s->x <= r.ci95[1];
@@ -130,7 +130,7 @@ static void row_push(const sys *s, const char *label, int est, int push, const d
     int met = 0, covered = 0, ran = 0;
     for (int k = 0; k < reps; k++) {
         ulam_walk_opts o = ulam_walk_defaults();
-        o.index = s->index, o.max_walks = CAP, o.rel_err = E, o.seed = 1 + (uint64_t)k;
+        o.query.index = s->index, o.stop.max_walks = CAP, o.stop.rel_err = E, o.exec.seed = 1 + (uint64_t)k;
         if (est >= 0) o.estimator = est;
         ulam_method_opts mo = ulam_method_defaults();
         ulam_auto_opts ao = ulam_auto_defaults();
@@ -203,9 +203,9 @@ static void dense_table(double E, int reps, const char *only)
         double oracle[2];
         for (int est = 0; est < 2; est++) {
             ulam_walk_opts o = ulam_walk_defaults();
-            o.estimator = est ? ULAM_ABSORPTION : ULAM_COLLISION, o.index = s.index, o.max_walks = ORACLE, o.seed = 12345;
+            o.estimator = est ? ULAM_ABSORPTION : ULAM_COLLISION, o.query.index = s.index, o.stop.max_walks = ORACLE, o.exec.seed = 12345;
             ulam_walk_result r;
-            oracle[est] = ulam_solve(s.M, s.b, &o, &r, NULL) ? NAN : r.variance / (E * s.x * E * s.x);
+            oracle[est] = ulam_solve_walks(s.M, s.b, &o, &r, NULL) ? NAN : r.variance / (E * s.x * E * s.x);
         }
         row_push(&s, "walks collision", ULAM_COLLISION, 0, oracle, E, reps);
         row_push(&s, "walks absorption", ULAM_ABSORPTION, 0, oracle, E, reps);

@@ -217,8 +217,8 @@ static outcome walk_run(const ulam_csr *M, const double *b, int64_t I, int whole
 {
     outcome o = {.seconds = -1};
     ulam_walk_opts w = ulam_walk_defaults();
-    w.index = I, w.threads = 2, w.max_walks = 0, w.rel_err = 0.01, w.max_seconds = WALK_CAP, w.seed = 3;
-    w.max_steps = INT64_MAX / 4, w.whole_kernel = whole;
+    w.query.index = I, w.exec.threads = 2, w.stop.max_walks = 0, w.stop.rel_err = 0.01, w.stop.max_seconds = WALK_CAP, w.exec.seed = 3;
+    w.stop.max_steps = INT64_MAX / 4, w.kernel.whole_kernel = whole;
     ulam_solver *sv = NULL;
     double t0 = ulam_now();
     if (ulam_solver_alloc(M, b, &w, &sv, NULL)) return o;

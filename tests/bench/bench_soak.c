@@ -25,7 +25,7 @@ int main(void)
     free(x);
 
     ulam_walk_opts o = ulam_walk_defaults();
-    o.index = I, o.threads = 2, o.max_walks = INT64_MAX / 4, o.seed = 7; /* stopped by steps below */
+    o.query.index = I, o.exec.threads = 2, o.stop.max_walks = INT64_MAX / 4, o.exec.seed = 7; /* stopped by steps below */
     ulam_solver *sv = NULL;
     ulam_error err;
     if (ulam_solver_alloc(M, b, &o, &sv, &err)) {

@@ -26,14 +26,14 @@ int main(void)
         for (int rep = 0; rep < 3; rep++) /* alternate 1 and 2 threads: drift hits both */
             for (int t = 1; t <= 2; t++) {
                 ulam_walk_opts o = ulam_walk_defaults();
-                o.max_walks = 0;
-                o.max_seconds = 1.0;
-                o.threads = t;
-                o.whole_kernel = 1;
-                o.index = sizes[s] / 2;
-                o.seed = (uint64_t)rep + 1;
+                o.stop.max_walks = 0;
+                o.stop.max_seconds = 1.0;
+                o.exec.threads = t;
+                o.kernel.whole_kernel = 1;
+                o.query.index = sizes[s] / 2;
+                o.exec.seed = (uint64_t)rep + 1;
                 ulam_walk_result r;
-                if (ulam_solve(M, b, &o, &r, NULL)) return 1;
+                if (ulam_solve_walks(M, b, &o, &r, NULL)) return 1;
                 if (rep == 0 || r.steps / r.seconds > best[t - 1].steps / best[t - 1].seconds) best[t - 1] = r;
             }
         for (int t = 1; t <= 2; t++)

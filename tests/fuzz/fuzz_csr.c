@@ -56,9 +56,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         b[i] = v;
     }
     ulam_walk_opts o = ulam_walk_defaults();
-    o.mode = flags & 1, o.estimator = (flags >> 1) % 3, o.max_walks = 64, o.max_steps = 64, o.threads = 1;
-    o.continue_q = flags & 8 ? 0.5 : 0.0, o.index = (flags >> 4) % n;
-    o.force = (flags & 128) != 0;
+    o.mode = flags & 1, o.estimator = (flags >> 1) % 3, o.stop.max_walks = 64, o.stop.max_steps = 64, o.exec.threads = 1;
+    o.kernel.continue_q = flags & 8 ? 0.5 : 0.0, o.query.index = (flags >> 4) % n;
+    o.policy.force = (flags & 128) != 0;
     ulam_error err;
     ulam_walk_result r;
     ulam_solve_n(&A, b, n, &o, &r, &err);
@@ -75,7 +75,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     oo.method = ULAM_GAUSS_SEIDEL, oo.max_iter = 50;
     ulam_outer_solve(&A, b, &oo, x, NULL, 0, NULL, &err);
     ulam_push *w = NULL;
-    if (ulam_push_alloc(&A, &w) == ULAM_OK && ulam_push_start(w, o.index) == ULAM_OK) ulam_push_run(w, 0.01, 10000);
+    if (ulam_push_alloc(&A, &w) == ULAM_OK && ulam_push_start(w, o.query.index) == ULAM_OK) ulam_push_run(w, 0.01, 10000);
     ulam_push_free(w);
 done:
     free(A.rowptr), free(A.colidx), free(A.val), free(b), free(x), free(bp);

@@ -21,15 +21,15 @@ static void walk(const ulam_csr *M, const double *b, const ulam_system *lazy, in
     if (!b && !ones) return;
     for (int64_t i = 0; !b && i < n; i++) ones[i] = 1.0;
     ulam_walk_opts o = ulam_walk_defaults();
-    o.max_walks = 200, o.max_steps = 200, o.threads = 1, o.system = lazy;
+    o.stop.max_walks = 200, o.stop.max_steps = 200, o.exec.threads = 1, o.policy.system = lazy;
     ulam_walk_result r;
     for (int e = 0; e < 3; e++) {
         o.estimator = e;
-        ulam_solve(M, b ? b : ones, &o, &r, NULL);
+        ulam_solve_walks(M, b ? b : ones, &o, &r, NULL);
     }
     if (forward) {
         o.mode = ULAM_FORWARD, o.estimator = ULAM_COLLISION;
-        ulam_solve(M, b ? b : ones, &o, &r, NULL);
+        ulam_solve_walks(M, b ? b : ones, &o, &r, NULL);
     }
     free(ones);
 }
@@ -46,9 +46,9 @@ static void one(void *p, size_t size)
         ulam_walk_opts o = ulam_walk_defaults();
         if (!ulam_certificate_guard(ulam_system_certificate(s), 0.0, NULL, &g) && M && M->nrows == M->ncols &&
             M->nrows > 0 && M->nrows <= 100000) { /* a query on the certificate: lazily read */
-            o.max_walks = 200, o.max_steps = 200, o.threads = 2, o.guard = &g, o.system = s;
+            o.stop.max_walks = 200, o.stop.max_steps = 200, o.exec.threads = 2, o.policy.guard = &g, o.policy.system = s;
             ulam_walk_result r;
-            ulam_solve(M, b, &o, &r, NULL);
+            ulam_solve_walks(M, b, &o, &r, NULL);
         }
         walk(M, b, s, 1);                                        /* lazily, with the guards' own pass */
         walk(ulam_system_matrix(s), ulam_system_rhs(s, NULL), NULL, 1); /* verified whole */
