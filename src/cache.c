@@ -78,6 +78,8 @@ struct ulam_system {
     ulam__reach bounds;    /* the bounds extension (seen and K unset) */
     void *map;             /* the mapping (NULL: borrowed memory) */
     size_t map_bytes;
+    int fd;                /* the file, for rows read by pread (-1: borrowed memory) */
+    uint64_t off[4];       /* byte offsets of rowptr, colidx, val and b in the file */
     _Atomic int64_t *checked; /* [0] blocks verified, [1] rows of M they hold */
 };
 
@@ -239,19 +241,27 @@ static int64_t block_count(int64_t n, int shift)
     return (n + ((int64_t)1 << shift) - 1) >> shift;
 }
 
+/* The checksum of a block of rows rows: their row pointers rp[0 .. rows] and the entries
+ * rp[0] .. rp[rows] - 1 at col and val. */
+static uint64_t block_hash(const int64_t *rp, int64_t rows, const int32_t *col, const double *val)
+{
+    XXH3_state_t st;
+    XXH3_64bits_reset(&st);
+    int64_t a = rp[0], e = rp[rows];
+    XXH3_64bits_update(&st, rp, (size_t)(rows + 1) * sizeof *rp);
+    if (e > a) {
+        XXH3_64bits_update(&st, col, (size_t)(e - a) * sizeof *col);
+        XXH3_64bits_update(&st, val, (size_t)(e - a) * sizeof *val);
+    }
+    return (uint64_t)XXH3_64bits_digest(&st);
+}
+
 /* The checksum of rows r0 .. r1 - 1 of A (its rowptr checked): rowptr[r0 .. r1], then the
  * columns and values of those rows. */
 static uint64_t csr_block_hash(const ulam_csr *A, int64_t r0, int64_t r1)
 {
-    XXH3_state_t st;
-    XXH3_64bits_reset(&st);
-    int64_t a = A->rowptr[r0], e = A->rowptr[r1];
-    XXH3_64bits_update(&st, A->rowptr + r0, (size_t)(r1 - r0 + 1) * sizeof *A->rowptr);
-    if (e > a) {
-        XXH3_64bits_update(&st, A->colidx + a, (size_t)(e - a) * sizeof *A->colidx);
-        XXH3_64bits_update(&st, A->val + a, (size_t)(e - a) * sizeof *A->val);
-    }
-    return (uint64_t)XXH3_64bits_digest(&st);
+    int64_t a = A->rowptr[r0];
+    return block_hash(A->rowptr + r0, r1 - r0, A->colidx + a, A->val + a);
 }
 
 /* The checksums of A's blocks into sums[0 .. blocks). */
@@ -411,7 +421,7 @@ static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam
     if (tag && (w[W_TAG] != tag[0] || w[W_TAG + 1] != tag[1]))
         return ulam__fail(err, ULAM_ENOTFOUND, 0, -1, "a cache of the current source file (it changed)");
     *s = (ulam_system){.n = (int64_t)n, .has_matrix = m, .has_tr = t, .omega = real(w[W_OMEGA]), .shift = (int)shift,
-                       .sums = sums};
+                       .sums = sums, .fd = -1, .off = {w[W_OFF], w[W_OFF + 1], w[W_OFF + 2], w[W_OFF + 3]}};
     for (int k = 0; k < 3; k++) s->nblocks[k] = nb[k], s->first[k] = k ? s->first[k - 1] + nb[k - 1] : 0;
     if (m) {
         s->csr = csr_at(p, w + W_OFF, n, nc);
@@ -474,17 +484,18 @@ int ulam_system_open(const char *path, const uint64_t tag[2], ulam_system **out,
     }
     size_t len = (size_t)st.st_size;
     void *map = len ? mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0) : MAP_FAILED;
-    close(fd);
     if (map == MAP_FAILED) {
+        close(fd);
         if (len == 0) return ulam__fail(err, ULAM_EBANNER, 0, -1, "an ulam prepared system (the file is empty)");
         return ulam__fail(err, ULAM_EIO, 0, -1, "a file that can be mapped");
     }
     int status = ulam_system_from_memory(map, len, tag, out, err);
     if (status) {
         munmap(map, len);
+        close(fd);
         return status;
     }
-    (*out)->map = map, (*out)->map_bytes = len;
+    (*out)->map = map, (*out)->map_bytes = len, (*out)->fd = fd; /* kept: a lazy query preads its rows */
     return ULAM_OK;
 }
 
@@ -508,20 +519,34 @@ static void block_rows(const ulam_system *s, int64_t k, int64_t rows, int64_t *r
     *r1 = *r0 + ((int64_t)1 << s->shift) < rows ? *r0 + ((int64_t)1 << s->shift) : rows;
 }
 
+/* Nonzero when the row pointers rp[0 .. rows] of a block rise within [0, nnz]. */
+static int rowptr_ok(const int64_t *rp, int64_t rows, int64_t nnz)
+{
+    for (int64_t i = 0; i < rows; i++)
+        if (!(rp[i] >= 0 && rp[i] <= rp[i + 1] && rp[i + 1] <= nnz)) return 0;
+    return 1;
+}
+
+/* The state a block verifies to against checksum want: its row pointers rp[0 .. rows] (risen
+ * within the entries), its entries rp[0] .. at col and val (columns below ncols). */
+static int block_state(const int64_t *rp, int64_t rows, const int32_t *col, const double *val, int64_t ncols,
+                       uint64_t want)
+{
+    if (block_hash(rp, rows, col, val) != want) return BAD_SUM;
+    for (int64_t i = 0; i < rows; i++)
+        for (int64_t q = rp[i] - rp[0]; q < rp[i + 1] - rp[0]; q++) {
+            if (col[q] < 0 || col[q] >= ncols || (q > rp[i] - rp[0] && col[q] <= col[q - 1])) return BAD_COLUMN;
+            if (!isfinite(val[q]) || val[q] == 0.0) return BAD_VALUE;
+        }
+    return GOOD;
+}
+
 /* The state block rows r0 .. r1 - 1 of A (nnz entries) verify to against checksum want. */
 static int csr_block_state(const ulam_csr *A, int64_t r0, int64_t r1, uint64_t want)
 {
-    const int64_t *rp = A->rowptr, nnz = A->rowptr[A->nrows]; /* rowptr[nrows] was checked at open */
-    for (int64_t i = r0; i < r1; i++)
-        if (!(rp[i] >= 0 && rp[i] <= rp[i + 1] && rp[i + 1] <= nnz)) return BAD_ROWPTR;
-    if (csr_block_hash(A, r0, r1) != want) return BAD_SUM;
-    for (int64_t i = r0; i < r1; i++)
-        for (int64_t q = rp[i]; q < rp[i + 1]; q++) {
-            if (A->colidx[q] < 0 || A->colidx[q] >= A->ncols || (q > rp[i] && A->colidx[q] <= A->colidx[q - 1]))
-                return BAD_COLUMN;
-            if (!isfinite(A->val[q]) || A->val[q] == 0.0) return BAD_VALUE;
-        }
-    return GOOD;
+    const int64_t *rp = A->rowptr + r0; /* rowptr[nrows] was checked at open */
+    if (!rowptr_ok(rp, r1 - r0, A->rowptr[A->nrows])) return BAD_ROWPTR;
+    return block_state(rp, r1 - r0, A->colidx + rp[0], A->val + rp[0], A->ncols, want);
 }
 
 /* Verify block k of a part once (any thread; racing threads compute the same state). */
@@ -602,6 +627,127 @@ static int rows_check(const void *ctx, int64_t first, int64_t last, int with_b, 
     return status;
 }
 
+/* Read bytes [off, off + len) of s's file into p; 0, or -1 on a short read or an error. */
+static int read_at(const ulam_system *s, void *p, size_t len, uint64_t off)
+{
+    for (size_t got = 0; got < len;) {
+        ssize_t r = pread(s->fd, (char *)p + got, len - got, (off_t)(off + got));
+        if (r <= 0) return -1;
+        got += (size_t)r;
+    }
+    return 0;
+}
+
+/* Room for need bytes in r's block buffer (8-aligned). */
+static int blk_fit(ulam__rowbuf *r, int64_t need)
+{
+    return need <= r->blkcap ? 0 : ulam__grow(&r->blk, &r->blkcap, need, 1);
+}
+
+/* Verify block k of M from the file (it was unchecked), leaving its rowptr at r->blk, its columns
+ * at r->blk + cols and values at r->blk + vals (byte offsets); its state. */
+static unsigned char fetch_block(const ulam_system *s, int64_t k, ulam__rowbuf *r, int64_t *cols, int64_t *vals)
+{
+    int64_t r0, r1, nnz = s->csr.rowptr[s->n];
+    block_rows(s, k, s->n, &r0, &r1);
+    int64_t rows = r1 - r0, pb = (rows + 1) * 8;
+    if (blk_fit(r, pb) || read_at(s, r->blk, (size_t)pb, s->off[0] + (uint64_t)r0 * 8)) return BAD_ROWPTR;
+    int64_t a, m;
+    memcpy(&a, r->blk, 8);
+    memcpy(&m, r->blk + rows * 8, 8);
+    if (!rowptr_ok((const int64_t *)(void *)r->blk, rows, nnz)) return BAD_ROWPTR;
+    m -= a;
+    *cols = pb, *vals = pb + (m * 4 + 7) / 8 * 8;
+    if (blk_fit(r, *vals + m * 8) || read_at(s, r->blk + *cols, (size_t)m * 4, s->off[1] + (uint64_t)a * 4) ||
+        read_at(s, r->blk + *vals, (size_t)m * 8, s->off[2] + (uint64_t)a * 8))
+        return BAD_SUM;
+    return (unsigned char)block_state((const int64_t *)(void *)r->blk, rows, (const int32_t *)(void *)(r->blk + *cols),
+                                      (const double *)(void *)(r->blk + *vals), s->csr.ncols, s->sums[s->first[PART_M] + k]);
+}
+
+/* Record block k of a part verified to v (as verify_block does). */
+static void set_state(const ulam_system *s, int part, int64_t k, unsigned char v)
+{
+    int64_t r0, r1;
+    block_rows(s, k, s->n, &r0, &r1);
+    atomic_store_explicit(&s->state[s->first[part] + k], v, memory_order_release);
+    if (part == PART_M) atomic_fetch_add_explicit(&s->checked[1], r1 - r0, memory_order_relaxed);
+    atomic_fetch_add_explicit(&s->checked[0], 1, memory_order_relaxed);
+}
+
+/* b_j read from the file into *out, its block verified first (r: scratch); ULAM_OK or ULAM_ESYNTAX
+ * with *bad the block's first row. */
+static int b_value(const ulam_system *s, int64_t j, ulam__rowbuf *r, double *out, int64_t *bad)
+{
+    int64_t k = j >> s->shift, r0, r1;
+    block_rows(s, k, s->n, &r0, &r1);
+    unsigned char v = atomic_load_explicit(&s->state[s->first[PART_B] + k], memory_order_acquire);
+    if (v == UNCHECKED) {
+        const double *e = NULL;
+        if (blk_fit(r, (r1 - r0) * 8) || read_at(s, r->blk, (size_t)(r1 - r0) * 8, s->off[3] + (uint64_t)r0 * 8)) {
+            v = BAD_SUM;
+        } else {
+            e = (const double *)(void *)r->blk;
+            v = hash(e, (size_t)(r1 - r0) * 8) != s->sums[s->first[PART_B] + k] ? BAD_SUM : GOOD;
+            for (int64_t i = 0; v == GOOD && i < r1 - r0; i++)
+                if (!isfinite(e[i])) v = BAD_VALUE;
+        }
+        set_state(s, PART_B, k, v);
+        if (v == GOOD) *out = e[j - r0];
+    } else if (v == GOOD && read_at(s, out, 8, s->off[3] + (uint64_t)j * 8)) {
+        v = BAD_SUM;
+    }
+    if (v == GOOD) return ULAM_OK;
+    if (bad) *bad = r0;
+    return ULAM_ESYNTAX;
+}
+
+/* Row i of M read from the file into r (see ulam__rows_check.fetch). */
+static int fetch_row(const void *ctx, int64_t i, int with_b, ulam__rowbuf *r, int64_t *bad)
+{
+    const ulam_system *s = ctx;
+    int64_t k = i >> s->shift, r0, r1, a = 0, e = 0, cols = 0, vals = 0;
+    block_rows(s, k, s->n, &r0, &r1);
+    unsigned char v = atomic_load_explicit(&s->state[s->first[PART_M] + k], memory_order_acquire);
+    int fresh = v == UNCHECKED;
+    if (fresh) {
+        v = fetch_block(s, k, r, &cols, &vals);
+        set_state(s, PART_M, k, v);
+    }
+    if (v == GOOD) {
+        int64_t p[2], a0;
+        if (fresh) memcpy(p, r->blk + (i - r0) * 8, 16), memcpy(&a0, r->blk, 8);
+        else if (read_at(s, p, 16, s->off[0] + (uint64_t)i * 8)) v = BAD_SUM;
+        a = p[0], e = p[1];
+        int64_t cc = r->cap, cv = r->cap;
+        if (v == GOOD && (ulam__grow(&r->col, &cc, e - a, sizeof *r->col) || ulam__grow(&r->val, &cv, e - a, sizeof *r->val)))
+            v = BAD_SUM; /* no memory: the row fails as unreadable */
+        r->cap = cc < cv ? cc : cv;
+        if (v == GOOD && fresh) {
+            memcpy(r->col, r->blk + cols + (a - a0) * 4, (size_t)(e - a) * 4);
+            memcpy(r->val, r->blk + vals + (a - a0) * 8, (size_t)(e - a) * 8);
+        } else if (v == GOOD && (read_at(s, r->col, (size_t)(e - a) * 4, s->off[1] + (uint64_t)a * 4) ||
+                                 read_at(s, r->val, (size_t)(e - a) * 8, s->off[2] + (uint64_t)a * 8))) {
+            v = BAD_SUM;
+        }
+        r->len = e - a;
+    }
+    if (v != GOOD) {
+        if (bad) *bad = r0;
+        return ULAM_ESYNTAX;
+    }
+    return with_b ? b_value(s, i, r, &r->b, bad) : ULAM_OK;
+}
+
+/* b_j from the file (see ulam__rows_check.b_at). */
+static int b_at(const void *ctx, int64_t j, double *v, int64_t *bad)
+{
+    ulam__rowbuf r = {0};
+    int status = b_value(ctx, j, &r, v, bad);
+    free(r.blk);
+    return status;
+}
+
 /* The check a solver given opts->system makes before it reads rows (see internal.h). */
 int ulam__system_rows_check(const ulam_system *s, const ulam_csr *M, const double *b, ulam__rows_check *rc,
                             ulam_error *err)
@@ -609,6 +755,8 @@ int ulam__system_rows_check(const ulam_system *s, const ulam_csr *M, const doubl
     if (!s->has_matrix || M != &s->csr)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "the matrix of opts->system (ulam_system_lazy's) as M");
     *rc = (ulam__rows_check){.fn = rows_check, .ctx = s, .with_b = b && b == s->b};
+    if (s->fd >= 0) /* rows read by pread: a mapped page would bring its neighbours (docs/prepared.md) */
+        rc->fetch = fetch_row, rc->b_at = b_at, rc->fetch_of = &s->csr, rc->b_of = s->b;
     return ULAM_OK;
 }
 
@@ -681,6 +829,7 @@ ulam_system *ulam_system_free(ulam_system *s)
 {
     if (!s) return NULL;
     if (s->map) munmap(s->map, s->map_bytes);
+    if (s->fd >= 0) close(s->fd);
     free((void *)s->state);
     free((void *)s->checked);
     free(s);

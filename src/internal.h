@@ -205,6 +205,17 @@ int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_o
                            const ulam_method_opts *mo, const ulam__reach *reach, ulam_choice *ch, ulam_run **out,
                            ulam_error *err);
 
+/* A row read from a file: its len columns and values (and b_i), and the bytes of a block being
+ * verified; grown as rows need. */
+typedef struct ulam__rowbuf {
+    int32_t *col;
+    double *val;
+    int64_t len, cap;
+    double b;
+    unsigned char *blk;
+    int64_t blkcap;
+} ulam__rowbuf;
+
 /* A check of rows [first, last) of a borrowed matrix (and, with with_b, of b at those rows) made
  * before anything reads them: ULAM_OK, or ULAM_ESYNTAX with *bad (may be NULL) the first row of the
  * damaged block.  Thread-safe.  fn NULL: nothing to check.  A prepared system's (src/cache.c): a
@@ -214,7 +225,16 @@ typedef struct ulam__rows_check {
     int (*fn)(const void *ctx, int64_t first, int64_t last, int with_b, int64_t *bad);
     const void *ctx;
     int with_b;
+    /* A prepared file read by pread (src/cache.c; NULL: rows are read in place): row i of
+       fetch_of into r, its block verified first (and with b_of's b_i in r->b when with_b);
+       b_at: b_of's j-th entry, its block verified first.  ULAM_OK, or ULAM_ESYNTAX (ULAM_EIO)
+       with *bad (may be NULL) the first row of the damaged block.  Thread-safe (r: the thread's). */
+    int (*fetch)(const void *ctx, int64_t i, int with_b, ulam__rowbuf *r, int64_t *bad);
+    int (*b_at)(const void *ctx, int64_t j, double *v, int64_t *bad);
+    const ulam_csr *fetch_of;
+    const double *b_of;
 } ulam__rows_check;
+
 
 /* Run rc on rows [first, last) (ULAM_OK when rc or its fn is NULL). */
 static inline int ulam__rows_verify(const ulam__rows_check *rc, int64_t first, int64_t last, int64_t *bad)

@@ -48,8 +48,50 @@ ulam_kernel *ulam__kernel_free(ulam_kernel *k)
     free(k->fac);
     free(k->scored);
     free((void *)k->where);
+    free((void *)k->dir);
+    free((void *)k->leaves);
     free(k);
     return NULL;
+}
+
+/* Keep a new kernel's places in leaves: the directory and the leaves' storage, zero and untouched. */
+static int make_sparse(ulam_kernel *k)
+{
+    int64_t groups = k->n / ULAM__LEAF + 1;
+    /* calloc: zero pages never touched, so a leaf costs memory once it is handed out */
+    k->dir = ulam__calloc((size_t)groups, sizeof *k->dir);
+    k->leaves = ulam__calloc((size_t)groups * ULAM__LEAF, sizeof *k->leaves);
+    return k->dir && k->leaves ? ULAM_OK : ULAM_ENOMEM;
+}
+
+/* A leaf being made (the directory's mark while one thread takes it). */
+#define LEAF_CLAIMED ((_Atomic int32_t *)(uintptr_t)1)
+
+/* State j's place (0: no row, -1: being built, else its unit + 1), or NULL when its leaf is not
+ * made and make is 0 (no row).  make: the leaf is made if need be (racing threads agree: the first
+ * claims the group, the others wait for its leaf). */
+static _Atomic int32_t *place(ulam_kernel *k, int64_t j, int make)
+{
+    if (k->where) return &k->where[j];
+    _Atomic(_Atomic int32_t *) *d = &k->dir[j / ULAM__LEAF];
+    _Atomic int32_t *leaf = atomic_load_explicit(d, memory_order_acquire), *none = NULL;
+    if (leaf && leaf != LEAF_CLAIMED) return leaf + j % ULAM__LEAF;
+    if (!make) return NULL;
+    if (!leaf && atomic_compare_exchange_strong_explicit(d, &none, LEAF_CLAIMED, memory_order_acq_rel,
+                                                         memory_order_acquire)) {
+        leaf = k->leaves + atomic_fetch_add_explicit(&k->nleaves, 1, memory_order_relaxed) * ULAM__LEAF;
+        atomic_store_explicit(d, leaf, memory_order_release);
+        return leaf + j % ULAM__LEAF;
+    }
+    while ((leaf = atomic_load_explicit(d, memory_order_acquire)) == LEAF_CLAIMED) continue;
+    return leaf + j % ULAM__LEAF;
+}
+
+/* State j's place value (0 when its leaf is not made). */
+static int32_t place_of(ulam_kernel *k, int64_t j, memory_order mo)
+{
+    _Atomic int32_t *p = place(k, j, 0);
+    return p ? atomic_load_explicit(p, mo) : 0;
 }
 
 /* The 64-bit threshold of an alias fraction f in [0, 1]. */
@@ -122,11 +164,12 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam_
     atomic_init(&k->built, 0);
     atomic_init(&k->status, ULAM_OK);
     atomic_init(&k->bad, -1);
-    k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built; the pages of
-                                                              states never reached stay untouched */
+    atomic_init(&k->nleaves, 0);
+    int dense = n <= ULAM__DENSE_MAX;
+    if (dense) k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built */
     k->mem = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->mem);
     if (alpha != 1.0) k->fac = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->fac);
-    if (!k->where || !k->mem || (alpha != 1.0 && !k->fac)) {
+    if ((dense ? !k->where : make_sparse(k) != ULAM_OK) || !k->mem || (alpha != 1.0 && !k->fac)) {
         ulam__kernel_free(k);
         return ULAM_ENOMEM;
     }
@@ -167,6 +210,7 @@ int ulam__kscratch_alloc(const ulam_kernel *k, ulam__kscratch *w)
 void ulam__kscratch_free(ulam__kscratch *w)
 {
     free(w->p), free(w->scaled), free(w->f), free(w->o), free(w->small), free(w->large);
+    free(w->rb.col), free(w->rb.val), free(w->rb.blk);
     *w = (ulam__kscratch){0};
 }
 
@@ -178,22 +222,78 @@ static double row_sum(const ulam_csr *K, int64_t i)
     return S;
 }
 
+/* A row as the kernel reads it: its len columns and values, and b_i (1 without b). */
+typedef struct {
+    const int32_t *col;
+    const double *val;
+    int64_t len;
+    double g;
+} row_view;
+
+/* The sum of |values| of a row (as row_sum, in the same order). */
+static double view_sum(const row_view *v)
+{
+    double S = 0.0;
+    for (int64_t q = 0; q < v->len; q++) S += fabs(v->val[q]);
+    return S;
+}
+
+/* Nonzero when k reads K's rows from a file (pread) rather than in place. */
+static int fetching(const ulam_kernel *k)
+{
+    return k->rc.fetch && k->rc.fetch_of == k->K;
+}
+
+/* Nonzero when row i's range in rowptr lies within K's entries (a prepared file is trusted no
+ * further than its header). */
+static int range_ok(const ulam_csr *K, int64_t i)
+{
+    int64_t a = K->rowptr[i], b = K->rowptr[i + 1];
+    return a >= 0 && a <= b && b <= K->rowptr[K->nrows];
+}
+
+/* Row i of K into *v: read from the file into w's buffer (its block verified), or in place (its
+ * block verified first unless inplace: all of K was); ULAM_OK or ULAM_ESYNTAX (a damaged block
+ * or range). */
+static int get_row(ulam_kernel *k, int64_t i, ulam__kscratch *w, int inplace, row_view *v)
+{
+    const double *b = k->scores.b;
+    if (!inplace && fetching(k)) {
+        int with_b = b && b == k->rc.b_of;
+        if (k->rc.fetch(k->rc.ctx, i, with_b, &w->rb, NULL)) return ULAM_ESYNTAX;
+        *v = (row_view){w->rb.col, w->rb.val, w->rb.len, with_b ? w->rb.b : b ? b[i] : 1.0};
+        return ULAM_OK;
+    }
+    if ((!inplace && ulam__rows_verify(&k->rc, i, i + 1, NULL)) || !range_ok(k->K, i)) return ULAM_ESYNTAX;
+    int64_t a = k->K->rowptr[i];
+    *v = (row_view){k->K->colidx + a, k->K->val + a, k->K->rowptr[i + 1] - a, b ? b[i] : 1.0};
+    return ULAM_OK;
+}
+
+/* b_j for the expected estimator's score: from the file when k reads rows there; NAN when its
+ * block is damaged (the row then fails). */
+static double b_entry(const ulam_kernel *k, int64_t j)
+{
+    double v;
+    if (fetching(k) && k->scores.b == k->rc.b_of) return k->rc.b_at(k->rc.ctx, j, &v, NULL) ? NAN : v;
+    return k->scores.b[j];
+}
+
 /* The continuation probability q_i of row i. */
 double ulam__kernel_q(const ulam_csr *K, int64_t i, double continue_q)
 {
     return ulam__continuation(row_sum(K, i), continue_q);
 }
 
-/* The moves of row i at kernel exponent alpha != 1 (see kernel.h). */
-int ulam__kernel_moves(const ulam_csr *K, int64_t i, double q, double alpha, double *pm, double *f)
+/* The moves of the len values val of a row (see ulam__kernel_moves). */
+static int moves_of(const double *val, int64_t len, double q, double alpha, double *pm, double *f)
 {
-    int64_t a = K->rowptr[i], len = K->rowptr[i + 1] - a;
     double m = 0.0, T = 0.0;
-    for (int64_t k = 0; k < len; k++) m = fmax(m, fabs(K->val[a + k]));
-    for (int64_t k = 0; k < len; k++) T += pm[k] = K->val[a + k] != 0.0 ? pow(fabs(K->val[a + k]) / m, alpha) : 0.0;
+    for (int64_t k = 0; k < len; k++) m = fmax(m, fabs(val[k]));
+    for (int64_t k = 0; k < len; k++) T += pm[k] = val[k] != 0.0 ? pow(fabs(val[k]) / m, alpha) : 0.0;
     int status = ULAM_OK;
     for (int64_t k = 0; k < len; k++) {
-        double v = fabs(K->val[a + k]);
+        double v = fabs(val[k]);
         f[k] = v != 0.0 ? v * T / (q * pm[k]) : 0.0; /* |K_ij| / (q p_ij), with p_ij = pm T: no division by p */
         pm[k] /= T;
         if (v != 0.0 && !(pm[k] * (double)len >= 0x1p-40)) status = ULAM_ERANGE;
@@ -201,13 +301,20 @@ int ulam__kernel_moves(const ulam_csr *K, int64_t i, double q, double alpha, dou
     return status;
 }
 
-/* What a visit to and a termination at row i score (see ulam__scores). */
-static void row_scores(const ulam_kernel *k, int64_t i, double pstar, double *visit, double *end)
+/* The moves of row i at kernel exponent alpha != 1 (see kernel.h). */
+int ulam__kernel_moves(const ulam_csr *K, int64_t i, double q, double alpha, double *pm, double *f)
+{
+    int64_t a = K->rowptr[i];
+    return moves_of(K->val + a, K->rowptr[i + 1] - a, q, alpha, pm, f);
+}
+
+/* What a visit to and a termination at row v score (see ulam__scores). */
+static void row_scores(const ulam_kernel *k, const row_view *v, double pstar, double *visit, double *end)
 {
     const ulam__scores *s = &k->scores;
-    double g = s->b ? s->b[i] : 1.0, mb = 0.0;
+    double g = v->g, mb = 0.0;
     if (s->estimator == ULAM_EXPECTED && s->b)
-        for (int64_t q = k->K->rowptr[i]; q < k->K->rowptr[i + 1]; q++) mb += k->K->val[q] * s->b[k->K->colidx[q]];
+        for (int64_t q = 0; q < v->len; q++) mb += v->val[q] * b_entry(k, v->col[q]);
     *visit = s->estimator == ULAM_COLLISION ? g : mb;
     *end = s->estimator == ULAM_ABSORPTION && pstar > 0 ? g / pstar : 0.0;
 }
@@ -226,42 +333,50 @@ int ulam__kernel_rescore(ulam_kernel *k, int estimator)
     if (status) return status;
     k->scores.estimator = estimator;
     int64_t top = atomic_load(&k->top);
-    for (int64_t u = 0; u < top; u += ULAM__HEAD + row_outcomes(k->K, ulam__kernel_row(k, u)->state)) {
+    ulam__kscratch w = {0};
+    row_view v;
+    for (int64_t u = 0; u < top; u += ULAM__HEAD + v.len + 1) {
         /* the built rows one after another in the arena (not where[]: its n entries, untouched pages
            too, would cost a query O(n)); a failed build ended the loop above through k->status */
         ulam__row *h = ulam__kernel_row(k, u);
         int64_t i = h->state;
-        row_scores(k, i, 1.0 - ulam__continuation(row_sum(k->K, i), k->continue_q), &h->visit, &h->end);
+        if (get_row(k, i, &w, 0, &v)) { /* read before, so intact unless the file changed */
+            fail(k, ULAM_ESYNTAX, i);
+            break;
+        }
+        row_scores(k, &v, 1.0 - ulam__continuation(view_sum(&v), k->continue_q), &h->visit, &h->end);
         if (!isfinite(h->visit) || !isfinite(h->end)) {
             fail(k, ULAM_ENONFINITE, i);
-            return ULAM_ENONFINITE;
+            break;
         }
     }
-    return ULAM_OK;
+    ulam__kscratch_free(&w);
+    return atomic_load(&k->status);
 }
 
-/* Nonzero when row i's range in rowptr lies within K's entries (a prepared file is trusted no
- * further than its header). */
-static int range_ok(const ulam_csr *K, int64_t i)
+/* Nonzero when the entries of row v are columns in range (ncols) with finite, nonzero values. */
+static int view_ok(const row_view *v, int64_t ncols)
 {
-    int64_t a = K->rowptr[i], b = K->rowptr[i + 1];
-    return a >= 0 && a <= b && b <= K->rowptr[K->nrows];
+    for (int64_t q = 0; q < v->len; q++)
+        if (v->col[q] < 0 || v->col[q] >= ncols || !isfinite(v->val[q]) || v->val[q] == 0.0) return 0;
+    return 1;
 }
 
 /* Nonzero when the entries of row i (range checked) are columns in range with finite, nonzero
  * values. */
 static int entries_ok(const ulam_csr *K, int64_t i)
 {
-    for (int64_t q = K->rowptr[i]; q < K->rowptr[i + 1]; q++)
-        if (K->colidx[q] < 0 || K->colidx[q] >= K->ncols || !isfinite(K->val[q]) || K->val[q] == 0.0) return 0;
-    return 1;
+    int64_t a = K->rowptr[i];
+    row_view v = {K->colidx + a, K->val + a, K->rowptr[i + 1] - a, 1.0};
+    return view_ok(&v, K->ncols);
 }
 
 /* Ask for what building state j's row reads first: its place and its range in rowptr. */
 static void prefetch_state(const ulam_kernel *k, int64_t j)
 {
 #if defined(__GNUC__)
-    __builtin_prefetch((const void *)&k->where[j]);
+    if (k->where) __builtin_prefetch((const void *)&k->where[j]);
+    else __builtin_prefetch((const void *)&k->dir[j / ULAM__LEAF]);
     __builtin_prefetch((const void *)&k->K->rowptr[j]);
 #else
     (void)k, (void)j;
@@ -273,7 +388,7 @@ static void prefetch_state(const ulam_kernel *k, int64_t j)
 static int32_t move_outcome(ulam_kernel *k, int64_t j, double v, int placed)
 {
     if (!placed) prefetch_state(k, j); /* a walk here moves to one of these next */
-    int32_t t = placed ? atomic_load_explicit(&k->where[j], memory_order_relaxed) - 1 : ULAM__UNRESOLVED + (int32_t)j;
+    int32_t t = placed ? place_of(k, j, memory_order_relaxed) - 1 : ULAM__UNRESOLVED + (int32_t)j;
     return v < 0 ? ~t : t;
 }
 
@@ -281,11 +396,11 @@ static int32_t move_outcome(ulam_kernel *k, int64_t j, double v, int placed)
  * the table is built on the outcomes' numbers, then each slot gets its two outcomes and their
  * weight factors.  A probability too small for the table records ULAM_ERANGE (the dead row
  * instead); a factor that is not finite, ULAM_ENONFINITE. */
-static void build_moves(ulam_kernel *k, int64_t i, ulam__row *h, double qi, int placed, ulam__kscratch *w)
+static void build_moves(ulam_kernel *k, const row_view *v, int64_t i, ulam__row *h, double qi, int placed,
+                        ulam__kscratch *w)
 {
-    const ulam_csr *K = k->K;
-    int64_t b = K->rowptr[i], len = h->len - 1;
-    int status = len > 0 ? ulam__kernel_moves(K, i, qi, k->alpha, w->p, w->f) : ULAM_OK;
+    int64_t len = h->len - 1;
+    int status = len > 0 ? moves_of(v->val, len, qi, k->alpha, w->p, w->f) : ULAM_OK;
     for (int64_t q = 0; !status && q < len; q++)
         if (!isfinite(w->f[q])) status = ULAM_ENONFINITE;
     if (status) {
@@ -301,7 +416,7 @@ static void build_moves(ulam_kernel *k, int64_t i, ulam__row *h, double qi, int 
     w->f[len] = 0.0; /* termination: never read */
     ulam__slot *s = (ulam__slot *)(void *)h + ULAM__HEAD;
     ulam__alias_build(w->p, w->o, len + 1, s, w->scaled, w->small, w->large);
-    for (int64_t q = 0; q < len; q++) w->large[q] = move_outcome(k, K->colidx[b + q], K->val[b + q], placed);
+    for (int64_t q = 0; q < len; q++) w->large[q] = move_outcome(k, v->col[q], v->val[q], placed);
     w->large[len] = ULAM__TERMINATE; /* the table is built: large is free scratch again */
     int64_t u = s - k->mem;
     for (int64_t q = 0; q <= len; q++) {
@@ -315,39 +430,42 @@ static void build_moves(ulam_kernel *k, int64_t i, ulam__row *h, double qi, int 
  * Moves name their target rows' units when `placed` (every row has its place), else target
  * states still to be resolved.  A corrupt row (or no memory for its scratch) builds the dead
  * row instead and is recorded. */
-static void build_row(ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam__kscratch *w)
+static void build_row(ulam_kernel *k, const row_view *v, int64_t i, ulam__row *h, int placed, ulam__kscratch *w)
 {
-    const ulam_csr *K = k->K;
-    int ok = entries_ok(K, i);
-    if (ok && k->rc.with_b && k->scores.estimator == ULAM_EXPECTED) /* its score reads b at its columns */
-        for (int64_t q = K->rowptr[i]; ok && q < K->rowptr[i + 1]; q++)
-            ok = !ulam__rows_verify(&k->rc, K->colidx[q], K->colidx[q] + 1, NULL);
+    int ok = view_ok(v, k->K->ncols);
+    if (ok && k->rc.with_b && k->scores.estimator == ULAM_EXPECTED) { /* its score reads b at its columns */
+        double bj;
+        int fromfile = fetching(k) && k->scores.b == k->rc.b_of;
+        for (int64_t q = 0; ok && q < v->len; q++)
+            ok = fromfile ? !k->rc.b_at(k->rc.ctx, v->col[q], &bj, NULL)
+                          : !ulam__rows_verify(&k->rc, v->col[q], v->col[q] + 1, NULL);
+    }
     if (!ok) {
         dead_row(h, i);
         fail(k, ULAM_ESYNTAX, i);
         return;
     }
-    int64_t b = K->rowptr[i], len = row_outcomes(K, i) - 1;
+    int64_t len = v->len;
     if (kscratch_fit(w, len + 1)) {
         dead_row(h, i);
         fail(k, ULAM_ENOMEM, i);
         return;
     }
-    double S = row_sum(K, i), qi = ulam__continuation(S, k->continue_q);
+    double S = view_sum(v), qi = ulam__continuation(S, k->continue_q);
     *h = (ulam__row){.factor = qi > 0 && !k->fac ? S / qi : 0.0, .len = (int32_t)(len + 1), .state = (int32_t)i};
-    row_scores(k, i, 1.0 - qi, &h->visit, &h->end);
+    row_scores(k, v, 1.0 - qi, &h->visit, &h->end);
     if (!isfinite(h->factor) || !isfinite(h->visit) || !isfinite(h->end)) {
         dead_row(h, i);
         fail(k, ULAM_ENONFINITE, i);
         return;
     }
     if (k->fac) {
-        build_moves(k, i, h, qi, placed, w);
+        build_moves(k, v, i, h, qi, placed, w);
         return;
     }
     for (int64_t q = 0; q < len; q++) {
-        w->p[q] = qi * fabs(K->val[b + q]) / S;
-        w->o[q] = move_outcome(k, K->colidx[b + q], K->val[b + q], placed);
+        w->p[q] = qi * fabs(v->val[q]) / S;
+        w->o[q] = move_outcome(k, v->col[q], v->val[q], placed);
     }
     w->p[len] = 1.0 - qi;
     w->o[len] = ULAM__TERMINATE;
@@ -358,21 +476,23 @@ static void build_row(ulam_kernel *k, int64_t i, ulam__row *h, int placed, ulam_
  * builds the row there and publishes its place; any other thread waits for that. */
 int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
 {
-    int32_t v = atomic_load_explicit(&k->where[j], memory_order_acquire), expect = 0;
+    _Atomic int32_t *at = place(k, j, 1);
+    int32_t v = atomic_load_explicit(at, memory_order_acquire), expect = 0;
     if (v > 0) return v - 1;
-    if (atomic_compare_exchange_strong_explicit(&k->where[j], &expect, -1, memory_order_acquire,
+    if (atomic_compare_exchange_strong_explicit(at, &expect, -1, memory_order_acquire,
                                                 memory_order_acquire)) {
-        int ok = !ulam__rows_verify(&k->rc, j, j + 1, NULL) && range_ok(k->K, j);
-        int64_t len = ok ? ULAM__HEAD + row_outcomes(k->K, j) : 0;
+        row_view rv;
+        int ok = !get_row(k, j, w, 0, &rv);
+        int64_t len = ok ? ULAM__HEAD + rv.len + 1 : 0;
         int64_t u = len ? atomic_fetch_add_explicit(&k->top, len, memory_order_relaxed) : k->cap;
         if (len && u + len > k->cap) u = k->cap; /* rowptr's ranges overlap: the file is corrupt */
-        if (u < k->cap) build_row(k, j, ulam__kernel_row(k, u), 0, w);
+        if (u < k->cap) build_row(k, &rv, j, ulam__kernel_row(k, u), 0, w);
         else fail(k, ULAM_ESYNTAX, j);
-        atomic_store_explicit(&k->where[j], (int32_t)u + 1, memory_order_release);
+        atomic_store_explicit(at, (int32_t)u + 1, memory_order_release);
         atomic_fetch_add_explicit(&k->built, 1, memory_order_relaxed);
         return (int32_t)u;
     }
-    while ((v = atomic_load_explicit(&k->where[j], memory_order_acquire)) < 0) continue;
+    while ((v = atomic_load_explicit(at, memory_order_acquire)) < 0) continue;
     return v - 1;
 }
 
@@ -391,7 +511,7 @@ static void prefetch_targets(const ulam_kernel *k, int64_t i)
 #if defined(__GNUC__)
     if (i < k->n)
         for (int64_t q = k->K->rowptr[i]; q < k->K->rowptr[i + 1]; q++)
-            __builtin_prefetch((const void *)&k->where[k->K->colidx[q]]);
+            if (k->where) __builtin_prefetch((const void *)&k->where[k->K->colidx[q]]);
 #else
     (void)k, (void)i;
 #endif
@@ -408,13 +528,13 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
         return;
     }
     for (int64_t i = 0; i < k->n; i++)
-        if (atomic_load_explicit(&k->where[i], memory_order_relaxed) == 0) {
+        if (atomic_load_explicit(place(k, i, 1), memory_order_relaxed) == 0) {
             int64_t len = range_ok(K, i) ? ULAM__HEAD + row_outcomes(K, i) : 0;
             if (!len || u + len > k->cap) {
                 fail(k, ULAM_ESYNTAX, i);
                 len = 0;
             }
-            atomic_store_explicit(&k->where[i], (int32_t)(len ? u : k->cap) + 1, memory_order_relaxed);
+            atomic_store_explicit(place(k, i, 1), (int32_t)(len ? u : k->cap) + 1, memory_order_relaxed);
             u += len;
         }
     atomic_store(&k->top, u);
@@ -422,9 +542,11 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
     /* static chunks of 4096 rows: a kernel of fewer rows is one thread's work, so no team */
 #pragma omp parallel for schedule(static, 4096) num_threads(threads) if (k->n > 4096)
     for (int64_t i = 0; i < k->n; i++) {
-        int64_t at = atomic_load_explicit(&k->where[i], memory_order_relaxed) - 1;
+        int64_t at = place_of(k, i, memory_order_relaxed) - 1;
         prefetch_targets(k, i + 16);
-        if (at >= from && at < k->cap) build_row(k, i, ulam__kernel_row(k, at), 1, &w[ulam__thread_num()]);
+        row_view rv;
+        if (at >= from && at < k->cap && !get_row(k, i, NULL, 1, &rv)) /* verified whole above: read in place */
+            build_row(k, &rv, i, ulam__kernel_row(k, at), 1, &w[ulam__thread_num()]);
     }
 }
 
@@ -458,11 +580,19 @@ int ulam__kernel_reach(const ulam_csr *K, double continue_q, char *seen, const u
 /* Rescore row i, when built, from k's scores. */
 static void rescore_row(ulam_kernel *k, int64_t i)
 {
-    int32_t u = atomic_load_explicit(&k->where[i], memory_order_relaxed);
+    int32_t u = place_of(k, i, memory_order_relaxed);
     if (u <= 0) return;
     ulam__row *h = ulam__kernel_row(k, u - 1);
-    double pstar = k->scores.estimator == ULAM_ABSORPTION ? 1.0 - ulam__continuation(row_sum(k->K, i), k->continue_q) : 0.0;
-    row_scores(k, i, pstar, &h->visit, &h->end); /* p* is read by absorption alone */
+    ulam__kscratch w = {0};
+    row_view v;
+    if (get_row(k, i, &w, 0, &v)) {
+        ulam__kscratch_free(&w);
+        h->visit = h->end = 0.0, fail(k, ULAM_ESYNTAX, i);
+        return;
+    }
+    double pstar = k->scores.estimator == ULAM_ABSORPTION ? 1.0 - ulam__continuation(view_sum(&v), k->continue_q) : 0.0;
+    row_scores(k, &v, pstar, &h->visit, &h->end); /* p* is read by absorption alone */
+    ulam__kscratch_free(&w);
     if (!isfinite(h->visit) || !isfinite(h->end)) h->visit = h->end = 0.0, fail(k, ULAM_ENONFINITE, i);
 }
 

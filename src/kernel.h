@@ -36,6 +36,13 @@ typedef struct {
 
 #define ULAM__HEAD 2 /* units in a header */
 
+/* A kernel of more states keeps its places (where) in leaves of ULAM__LEAF states made when a
+ * walk first reaches one of their states, so a query that builds rows scattered over a large
+ * system keeps 8 bytes a group of ULAM__LEAF states and a leaf a group reached, not 4 bytes a
+ * state (40 MB at 10^7, nearly all of it touched by 10^5 scattered rows). */
+#define ULAM__DENSE_MAX (INT64_C(1) << 16)
+#define ULAM__LEAF 16
+
 /* What visits and terminations score, with g_i = b[i] (1 when b is NULL): collision g_i per
  * visit, absorption g_i / p*_i per termination, expected (K b)_i per visit (0 without b). */
 typedef struct {
@@ -55,7 +62,11 @@ typedef struct ulam_kernel {
                                ULAM_ENONFINITE (a non-finite score) or ULAM_ENOMEM (scratch) */
     _Atomic int64_t bad;    /* the row of that failure (-1: none) */
     ulam__slot *mem;
-    _Atomic int32_t *where;
+    _Atomic int32_t *where;   /* the places, one a state (n <= ULAM__DENSE_MAX), else NULL and: */
+    _Atomic(_Atomic int32_t *) *dir; /* one leaf of ULAM__LEAF places a group of states, made
+                                        the first time a state of the group is placed */
+    _Atomic int32_t *leaves;  /* their storage, handed out in order (touched as they are made) */
+    _Atomic int64_t nleaves;  /* leaves handed out */
     const ulam_csr *K;
     double continue_q;
     double alpha;       /* the kernel exponent: p_ij = q_i |K_ij|^alpha / sum_k |K_ik|^alpha */
@@ -74,6 +85,7 @@ typedef struct {
     int32_t *o;
     int64_t *small, *large;
     int64_t cap;
+    ulam__rowbuf rb; /* the row being built, read from a file (k->rc.fetch) */
 } ulam__kscratch;
 
 /* Vose's alias table of m outcomes out[] with probabilities p[] (sum 1) into s[0..m-1];
@@ -82,8 +94,8 @@ void ulam__alias_build(const double *p, const int32_t *out, int64_t m, ulam__slo
                        int64_t *small, int64_t *large);
 
 /* The kernel of K (which must outlive it; continue_q <= 0: analog) with exponent alpha, no row
- * built yet: O(n) time and 4 bytes a state (alpha != 1: room for two factors a slot, reserved
- * like the slots).  ULAM_OK, ULAM_ENOMEM, or ULAM_EOVERFLOW past 2^30 units. */
+ * built yet: O(n) time, 4 bytes a state up to ULAM__DENSE_MAX states and 0.5 beyond (alpha != 1:
+ * room for two factors a slot, reserved like the slots).  ULAM_OK, ULAM_ENOMEM, or ULAM_EOVERFLOW past 2^30 units. */
 int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam__scores scores, ulam_kernel **out);
 
 /* The moves of row i of K at kernel exponent alpha != 1 with continuation q > 0: pm[k] the
