@@ -17,19 +17,26 @@ int64_t ulam_method_sparse_limit(int64_t n)
     return n / 10 > 16 ? n / 10 : 16;
 }
 
-/* The nonzeros of b (n entries). */
-static int64_t nonzeros(const double *b, int64_t n)
+/* b's nonzeros, counted up to cap (a prepared b is read no further than the answer needs). */
+static int64_t nonzeros_upto(const double *b, int64_t n, int64_t cap)
 {
     int64_t k = 0;
-    for (int64_t i = 0; i < n; i++) k += b[i] != 0.0;
+    for (int64_t i = 0; i < n && k < cap; i++) k += b[i] != 0.0;
     return k;
+}
+
+/* b's nonzeros. */
+static int64_t nonzeros(const double *b, int64_t n)
+{
+    return nonzeros_upto(b, n, INT64_MAX);
 }
 
 /* The route: 1 the push on b (dense b, or an estimator or exponent pinned), 0 the reverse push. */
 int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o)
 {
     if (!b || !o) return 0;
-    return nonzeros(b, n) > ulam_method_sparse_limit(n) ||
+    int64_t limit = ulam_method_sparse_limit(n);
+    return nonzeros_upto(b, n, limit + 1) > limit ||
            (ao && (ao->pin_estimator || (ao->pin_alpha && o->kernel.kernel_alpha != 1.0)));
 }
 
@@ -39,7 +46,7 @@ static int applies(const ulam__query *q, int k, char *why, size_t len)
 {
     const ulam_walk_opts *o = q->o;
     const ulam_auto_result *au = &q->ch->walks;
-    int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
+    int64_t n = q->M->nrows, nb = nonzeros_upto(q->b, n, 1); /* whether b is zero */
     const char *pinned = o->mode == ULAM_FORWARD ? "forward mode (--mode forward, --out, --errors)"
                          : o->kernel.roulette > 0 || o->kernel.split > 0 ? "--roulette or --split (bidirectional takes neither)"
                                                            : NULL;

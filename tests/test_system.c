@@ -528,6 +528,24 @@ static void test_analysis_local(void **state)
         assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
         assert_true(isfinite(r1.ci95[0]) && fabs(r1.estimate - x[20]) < 4 * r1.std_error);
     }
+    { /* auto's choice on the lazily read file reads no more either (it checked all of M's rows first) */
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.query.index = 20, o.stop.max_walks = 0, o.stop.rel_err = 0.02, o.exec.threads = 2, o.exec.seed = 21;
+        o.policy.system = s;
+        ulam_auto_result *res = malloc(sizeof *res);
+        ulam_solver *sv = NULL;
+        ulam_error err;
+        assert_non_null(res);
+        ulam_auto_opts aop = ulam_auto_defaults(); /* the analysis' kernel: its guards from the certificate */
+        aop.pin_continue = aop.pin_alpha = aop.pin_mode = 1;
+        assert_int_equal(ulam_analysis_auto(af, bs, &o, &aop, res, &sv, &err), ULAM_OK);
+        while (!ulam_solver_done(sv)) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+        ulam_walk_result r;
+        ulam_solver_result(sv, &r);
+        assert_true(r.rel_err_met && fabs(r.estimate - x[20]) < 4 * r.std_error);
+        ulam_solver_free(sv);
+        free(res);
+    }
     ulam_analysis_info info;
     ulam_analysis_get_info(af, &info);
     assert_int_equal(info.bounds, 1), assert_int_equal(info.b_scores, 1), assert_int_equal(info.guard, 1);
