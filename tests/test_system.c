@@ -374,8 +374,9 @@ static void test_random_rows_checked(void **state)
         fail_msg("%lld rows built, %lld rows of M verified in %lld blocks", (long long)r1.rows, (long long)rows,
                  (long long)blocks);
     long kib = mapped_kib(path); /* of a 14 MiB file: the checksum table is 128 KiB, a fault maps up to 64
-                                    KiB (264 KiB here); through the mapping 14472 KiB, all of it */
-    if (kib >= 0 && kib > 1024) fail_msg("%ld KiB of the file resident after building %lld rows", kib, (long long)r1.rows);
+                                    KiB (264 KiB here, 1288 under valgrind); through the mapping 14472 KiB,
+                                    all of it: an eighth of the file separates the two */
+    if (kib >= 0 && kib > 14472 / 8) fail_msg("%ld KiB of the file resident after building %lld rows", kib, (long long)r1.rows);
     assert_int_equal(ulam_analysis_solve(ap, b, &o, &r2, NULL), ULAM_OK);
     assert_memory_equal(&r1.estimate, &r2.estimate, sizeof r1.estimate);
     assert_true(fabs(r1.estimate - x[5]) < 4 * r1.std_error);
