@@ -76,13 +76,13 @@ static int outer(const ulam_csr *M, const double *b, int method, double tol, int
     if (max_hist) o.max_histories = max_hist;
     ulam_outer *it = NULL;
     ulam_error err;
-    if (ulam_outer_alloc(M, b, &o, &it, &err)) {
-        fprintf(stderr, "bench_mcsa: %s\n", err.msg);
-        exit(1);
+    if ((*status = ulam_outer_alloc(M, b, &o, &it, &err))) { /* refused (e.g. an infinite variance): no step */
+        fprintf(stderr, "bench_mcsa: refused: %s\n", err.msg);
+        memset(x, 0, (size_t)M->nrows * sizeof *x); /* the start, x0 = 0 */
+        return 0;
     }
     int k = 0;
     double spent = 0;
-    *status = ULAM_OK;
     while (!ulam_outer_done(it) && k < STEPS) {
         *status = ulam_outer_iterate(it, &st[k]);
         spent += st[k++].seconds;
