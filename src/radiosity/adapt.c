@@ -271,15 +271,7 @@ static int to_scene(const mesh *m, const ulam_scene *s, ulam_scene **out)
         if (m->live[i]) nidx += m->len[i];
     ulam_scene *o = ulam__scene_alloc(m->nlive, m->nv, nidx, s->ngroups);
     if (!o) return ULAM_ENOMEM;
-    for (int64_t g = 0; g < s->ngroups; g++) {
-        size_t len = strlen(s->groups[g]) + 1;
-        if (!(o->groups[g] = malloc(len))) {
-            o->ngroups = g;
-            ulam_scene_free(o);
-            return ULAM_ENOMEM;
-        }
-        memcpy(o->groups[g], s->groups[g], len);
-    }
+    if (ulam__scene_copy_groups(o, s)) return ULAM_ENOMEM; /* o freed */
     o->ngroups = s->ngroups, o->nfaces = s->nfaces;
     memcpy(o->vert, m->vert, (size_t)(3 * m->nv) * sizeof *o->vert);
     int64_t p = 0, k = 0;

@@ -144,4 +144,7 @@ void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, const double 
 /* Allocate an empty scene with room for the given counts (arrays uninitialised). */
 ulam_scene *ulam__scene_alloc(int64_t npatches, int64_t nverts, int64_t nidx, int64_t ngroups);
 
+/* Copy s's group labels into o (made with s->ngroups); on failure o is freed (src/radiosity/scene.c). */
+int ulam__scene_copy_groups(ulam_scene *o, const ulam_scene *s);
+
 #endif

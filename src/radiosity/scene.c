@@ -27,6 +27,22 @@ ulam_scene *ulam__scene_alloc(int64_t np, int64_t nv, int64_t nidx, int64_t ngro
     return s;
 }
 
+/* Copy s's group labels into o (allocated with s->ngroups of them); on failure o is freed and
+ * ULAM_ENOMEM returned. */
+int ulam__scene_copy_groups(ulam_scene *o, const ulam_scene *s)
+{
+    for (int64_t g = 0; g < s->ngroups; g++) {
+        size_t len = strlen(s->groups[g]) + 1;
+        if (!(o->groups[g] = malloc(len))) {
+            o->ngroups = g;
+            ulam_scene_free(o);
+            return ULAM_ENOMEM;
+        }
+        memcpy(o->groups[g], s->groups[g], len);
+    }
+    return ULAM_OK;
+}
+
 /* Free a scene; accepts and returns NULL. */
 ulam_scene *ulam_scene_free(ulam_scene *s)
 {
@@ -210,15 +226,7 @@ int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out)
     }
     ulam_scene *o = ulam__scene_alloc(np, nv, nidx, s->ngroups);
     if (!o) return ULAM_ENOMEM;
-    for (int64_t g = 0; g < s->ngroups; g++) {
-        size_t len = strlen(s->groups[g]) + 1;
-        if (!(o->groups[g] = malloc(len))) {
-            o->ngroups = g;
-            ulam_scene_free(o);
-            return ULAM_ENOMEM;
-        }
-        memcpy(o->groups[g], s->groups[g], len);
-    }
+    if (ulam__scene_copy_groups(o, s)) return ULAM_ENOMEM; /* o freed */
     o->ngroups = s->ngroups;
     o->nfaces = s->nfaces;
     builder b = {.o = o};
