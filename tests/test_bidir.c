@@ -275,6 +275,45 @@ static void test_bidir_plan(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* Two kernel exponents through one analysis must not share a plan (issue 29: the plan memo
+ * once ignored the exponent, so a plan made for alpha 1 -- its pilot, rmax and the pilot's
+ * guards -- served alpha 2's walks).  On an analysis' transpose and push workspace a plan made
+ * for alpha 1 is reused by the same options and not by alpha 2, whose estimate is bit for bit a
+ * fresh workspace's at alpha 2. */
+static void test_analysis_bidir_exponent(void **state)
+{
+    (void)state;
+    ulam_csr *M = random_system(150, 5, 0, 0.85, 4), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    ulam_analysis *a = NULL;
+    ulam_error err;
+    assert_int_equal(ulam_analysis_alloc(M, NULL, &a, &err), ULAM_OK);
+    const ulam_csr *T = ulam_analysis_transpose(a, &err);
+    ulam_push *w = ulam_analysis_push(a, &err);
+    assert_non_null(T);
+    assert_non_null(w);
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    o.source = 3, o.target = 10, o.walk.stop.max_walks = 4000, o.walk.stop.rel_err = 0, o.walk.exec.threads = 1;
+    ulam_bidir_plan_info plan;
+    ulam_bidir_result one, two, ref;
+    assert_int_equal(ulam_bidir_plan(w, T, &o, &plan, &err), ULAM_OK);
+    assert_int_equal(ulam_bidir_solve(w, T, &o, &one, &err), ULAM_OK);
+    assert_true(one.plan_reused); /* the same options: the plan in place */
+    ulam_bidir_opts o2 = o;
+    o2.walk.kernel.kernel_alpha = 2.0;
+    assert_int_equal(ulam_bidir_solve(w, T, &o2, &two, &err), ULAM_OK);
+    assert_false(two.plan_reused); /* another exponent: another plan */
+    ulam_push *fresh = NULL;
+    assert_int_equal(ulam_push_alloc(M, &fresh), ULAM_OK);
+    assert_int_equal(ulam_bidir_solve(fresh, Mt, &o2, &ref, &err), ULAM_OK);
+    assert_memory_equal(&two.estimate, &ref.estimate, sizeof ref.estimate);
+    assert_memory_equal(&two.std_error, &ref.std_error, sizeof ref.std_error);
+    assert_true(two.plan.rmax == ref.plan.rmax && two.plan.pilot_steps == ref.plan.pilot_steps);
+    ulam_push_free(fresh);
+    ulam_analysis_free(a);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 /* The walk solver's start distribution (ulam_walk_opts.starts, what the sparse-b walks use):
  * <c, x> within 4 sigma of LAPACK for the three estimators and under a rel_err rule (which
  * must stop), and refused in forward mode, with a state out of range or all-zero weights. */
@@ -724,7 +763,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_push_invariant), cmocka_unit_test(test_push_bad_input),
-        cmocka_unit_test(test_bidir_unbiased), cmocka_unit_test(test_bidir_plan),
+        cmocka_unit_test(test_bidir_unbiased), cmocka_unit_test(test_bidir_plan), cmocka_unit_test(test_analysis_bidir_exponent),
         cmocka_unit_test(test_solver_starts), cmocka_unit_test(test_bidir_sparse_b),  cmocka_unit_test(test_bidir_coverage),
         cmocka_unit_test(test_bidir_rules),    cmocka_unit_test(test_bidir_rare_score),
         cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
