@@ -1465,11 +1465,18 @@ int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const
 int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
                        ulam_auto_result *res, ulam_solver **out, ulam_error *err);
 
-/* A's push workspace on M for point-source queries (ulam_bidir_solve with
- * ulam_analysis_transpose(a)), made at the first call and kept, so that the walks' bounds and
- * kernel rows later queries reuse (ulam_bidir_opts.reach_all, keep_kernel) stay with the
- * analysis; NULL: no memory (err filled). */
+/* A's push workspace on M, made at the first call and kept (ulam_analysis_bidir pushes on it);
+ * NULL: no memory (err filled). */
 ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err);
+
+/* A bidirectional estimate (as ulam_bidir_solve) on a's transpose (ulam_analysis_transpose: a
+ * prepared file's stored M^T when it has one, else made once), push workspace and plan memo,
+ * all made at the first call and kept across queries: a plan (ulam_bidir_plan's) is reused for
+ * the same options and the push as it left it; the walks' bounds over every state and kernel
+ * rows (o->reach_all, keep_kernel) stay with the analysis.  o->walk.kernel's continuation and
+ * exponent must be a's (ULAM_EINVAL otherwise: one analysis, one kernel).  The same seed gives
+ * the same estimate as ulam_bidir_solve on a fresh workspace.  Statuses as ulam_bidir_solve. */
+int ulam_analysis_bidir(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err);
 
 /* As ulam_auto_start for M = a's M: the walks row's candidates of a's kernel walk under a's bounds
  * over every state (as ulam_analysis_auto), the other rows as ulam_auto_start; the run borrows a

@@ -1,8 +1,11 @@
 /* The analysis: what queries on one M share, made once and held across them (CSparse's cs_sqr
  * before cs_lu): the guards, the bounds over every state the rel_err rule and absorption need
  * (ulam__reach_all, or the prepared file's stored copy), the shared b's scores, a kept walk
- * kernel per estimator and the transpose.  Each is made at the first query that needs it, so a
- * single query from a prepared file reads only the rows its walks reach. */
+ * kernel per estimator, and for point sources and sparse b (the bidirectional estimator) the
+ * transpose (the prepared file's stored M^T when it has one), the push workspace and the
+ * planner's memo (src/bidir.h).  Each is made at the first query that needs it, so a single
+ * query from a prepared file reads only the rows its walks reach. */
+#include "bidir.h"
 #include "kernel.h"
 
 #include <math.h>
@@ -21,8 +24,10 @@ struct ulam_analysis {
     char *seen;           /* n ones: R.seen */
     int bounds_from, b_from;
     ulam_kernel *k[3];    /* per estimator: the kept kernel of adjoint queries on b */
-    ulam_csr *T;          /* the transpose (NULL until asked) */
+    ulam_csr *T;          /* the transpose made here (NULL: not made) */
+    const ulam_csr *Tuse; /* the transpose: T or the prepared file's stored one (NULL until asked) */
     ulam_push *push;      /* the push workspace on M (NULL until asked) */
+    ulam__bidir *bidir;   /* the bidirectional planner's memo on push and Tuse (NULL until asked) */
     double seconds;
 };
 
@@ -61,6 +66,7 @@ ulam_analysis *ulam_analysis_free(ulam_analysis *a)
 {
     if (!a) return NULL;
     for (int e = 0; e < 3; e++) ulam__kernel_free(a->k[e]);
+    ulam__bidir_free(a->bidir);
     ulam_push_free(a->push);
     ulam_csr_free(a->T);
     free(a->seen);
@@ -185,19 +191,33 @@ int ulam_analysis_auto_start(ulam_analysis *a, const double *b, const ulam_walk_
 {
     ulam_auto_opts p;
     int status = auto_pins(a, o, ao, &p, err);
-    return status ? status : ulam__auto_start_reach(a->M, b, o, &p, mo, take_bounds(a), ch, out, err);
+    return status ? status : ulam__auto_start_reach(a->M, b, o, &p, mo, take_bounds(a), a, ch, out, err);
+}
+
+/* M's transpose, made once (the prepared file's when it stores one); *seconds (may be NULL): the
+ * time spent making it in this call (0 when a had it). */
+const ulam_csr *ulam__analysis_transpose(ulam_analysis *a, double *seconds, ulam_error *err)
+{
+    ulam__clear(err);
+    if (seconds) *seconds = 0.0;
+    if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis"), NULL;
+    if (a->Tuse) return a->Tuse;
+    double t0 = ulam_now();
+    const ulam_csr *stored = a->sys ? ulam_system_transpose(a->sys) : NULL; /* prepare --transpose */
+    if (stored && (stored->nrows != a->M->nrows || ulam_csr_nnz(stored) != ulam_csr_nnz(a->M))) stored = NULL;
+    if (!stored && ulam_csr_transpose(a->M, &a->T))
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose"), NULL;
+    a->Tuse = stored ? stored : a->T;
+    double dt = ulam_now() - t0;
+    a->seconds += dt;
+    if (seconds) *seconds = dt;
+    return a->Tuse;
 }
 
 /* M's transpose, made once. */
 const ulam_csr *ulam_analysis_transpose(ulam_analysis *a, ulam_error *err)
 {
-    ulam__clear(err);
-    if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis"), NULL;
-    if (a->T) return a->T;
-    double t0 = ulam_now();
-    if (ulam_csr_transpose(a->M, &a->T)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose"), NULL;
-    a->seconds += ulam_now() - t0;
-    return a->T;
+    return ulam__analysis_transpose(a, NULL, err);
 }
 
 /* The push workspace on M, made once. */
@@ -208,6 +228,46 @@ ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err)
     if (!a->push && ulam_push_alloc(a->M, &a->push))
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a push workspace"), NULL;
     return a->push;
+}
+
+/* The transpose, the push workspace and the planner's memo, made at the first call; 0 or a status. */
+static int take_bidir(ulam_analysis *a, const ulam_csr **Mt, ulam_push **w, ulam_error *err)
+{
+    if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis");
+    if (!(*Mt = ulam__analysis_transpose(a, NULL, err)) || !(*w = ulam_analysis_push(a, err))) return ULAM_ENOMEM;
+    if (!a->bidir && !(a->bidir = ulam__bidir_alloc())) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
+    return ULAM_OK;
+}
+
+/* A bidirectional plan on a's transpose, push workspace and memo, for any kernel (the memo keys
+ * its plans on the options, continuation and exponent among them). */
+int ulam__analysis_bidir_plan(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan, ulam_error *err)
+{
+    const ulam_csr *Mt;
+    ulam_push *w;
+    int status = take_bidir(a, &Mt, &w, err);
+    return status ? status : ulam__bidir_plan(a->M, Mt, w, a->bidir, o, plan, err);
+}
+
+/* A bidirectional estimate on a's transpose, push workspace and memo, for any kernel. */
+int ulam__analysis_bidir_solve(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err)
+{
+    const ulam_csr *Mt;
+    ulam_push *w;
+    int status = take_bidir(a, &Mt, &w, err);
+    return status ? status : ulam__bidir_solve(a->M, Mt, w, a->bidir, o, res, err);
+}
+
+/* A bidirectional estimate of a's kernel on a's transpose, push workspace and memo. */
+int ulam_analysis_bidir(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!a || !o || !res) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis, options and a place for the answer");
+    const ulam_kernel_opts *k = &o->walk.kernel;
+    if ((k->continue_q > 0 ? k->continue_q : 0.0) != a->continue_q || k->kernel_alpha != a->alpha)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the analysis' continuation %g and kernel exponent %g",
+                          a->continue_q, a->alpha);
+    return ulam__analysis_bidir_solve(a, o, res, err);
 }
 
 /* What a holds so far. */

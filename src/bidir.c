@@ -17,8 +17,10 @@
  * down to it, while the push's work so far is below the walks' predicted work (at a fixed walk
  * count: below what those walks cost), for |x_t| about the largest of min_value, p_s and a
  * probe's lower bound (see push()).  The interval: honest_interval.  ulam_bidir_plan does this and leaves the
- * pushed workspace with a memo of the plan (push.h), which ulam_bidir_solve reuses for the same
- * options instead of pushing again. */
+ * pushed workspace with a memo of the plan (bidir.h: the analysis', or one kept with a bare push
+ * workspace), which ulam_bidir_solve reuses for the same options and the push as the plan left it
+ * instead of pushing again. */
+#include "bidir.h"
 #include "internal.h"
 #include "kernel.h"
 #include "push.h"
@@ -48,6 +50,48 @@ ulam_bidir_opts ulam_bidir_defaults(void)
     return (ulam_bidir_opts){.walk = ulam_walk_defaults()};
 }
 
+/* The memo: the last plan made on a push workspace (w, at its state stamp, for Mt and options o
+ * with b's entries copied: idx, val, cap entries of room), what it found and the guards its
+ * pilot computed; the pilot's scores, the states it found its walks reach, every state's bounds
+ * (reach_all) and the kept kernels, for later queries. */
+struct ulam__bidir {
+    int valid;
+    const ulam_push *w; /* the workspace it was made on, and its stamp then (ulam__push_stamp) */
+    uint64_t stamp;
+    const ulam_csr *Mt; /* the transpose it was made with */
+    ulam_bidir_opts o;
+    int64_t *idx;
+    double *val;
+    int64_t cap;
+    ulam_bidir_plan_info plan;
+    ulam_guard guard; /* the pilot's guards on Mt, for the walks (have_guard 0: none) */
+    int have_guard;
+    double *ones; /* n ones (NULL until a pilot needs them): the pilot's scores */
+    char *seen;   /* n flags: the states the pilot found its walks can reach (have_seen 0: none) */
+    int have_seen;
+    char *all;          /* n ones: every state (reach_all; NULL until a query asks) */
+    ulam__reach reach;  /* what the walks reach: over seen (have_seen) or all (have_all) */
+    int have_all;       /* 1: reach holds ulam__reach_all's bounds over all, for reach.K and continuation */
+    ulam_kernel *kernel; /* keep_kernel: the last walks' kernel (ulam__solver_keep_kernel; NULL: none) */
+    ulam_kernel *pilot;  /* keep_kernel: the pilot's, scoring ones (fixed; NULL: none) */
+};
+
+/* An empty memo. */
+ulam__bidir *ulam__bidir_alloc(void)
+{
+    return calloc(1, sizeof(ulam__bidir));
+}
+
+/* Free a memo. */
+ulam__bidir *ulam__bidir_free(ulam__bidir *m)
+{
+    if (!m) return NULL;
+    free(m->idx), free(m->val), free(m->ones), free(m->seen), free(m->all);
+    ulam__kernel_free(m->kernel), ulam__kernel_free(m->pilot);
+    free(m);
+    return NULL;
+}
+
 /* Check the options against M and Mt. */
 static int check_opts(const ulam_csr *M, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_error *err)
 {
@@ -75,12 +119,13 @@ static int check_opts(const ulam_csr *M, const ulam_csr *Mt, const ulam_bidir_op
     return ulam__walk_opts_check(&o->walk, err); /* src/check.c */
 }
 
-/* Check a call's arguments (out: where its answer goes); err cleared first. */
-static int check_call(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, const void *out, ulam_error *err)
+/* Check a call's arguments (M: w's matrix; out: where its answer goes); err cleared first. */
+static int check_call(const ulam_csr *M, ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, const void *out,
+                      ulam_error *err)
 {
     ulam__clear(err);
     if (!w || !o || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a push workspace, options and a place for the answer");
-    return check_opts(ulam__push_matrix(w), Mt, o, err);
+    return check_opts(M, Mt, o, err);
 }
 
 /* The walks' options: adjoint on M' from s (or from b's entries), scoring r. */
@@ -111,7 +156,7 @@ static double norm_b(const ulam_bidir_opts *o)
 }
 
 /* Nonzero when a plan made for (Mt, a) is the plan of (Mt2, b): every option it read agrees. */
-static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_bidir_opts *b)
+static int same_plan(const ulam__bidir *m, const ulam_csr *Mt, const ulam_bidir_opts *b)
 {
     const ulam_bidir_opts *a = &m->o;
     const ulam_walk_opts *x = &a->walk, *y = &b->walk;
@@ -133,7 +178,7 @@ static int same_plan(const ulam__bidir_memo *m, const ulam_csr *Mt, const ulam_b
  * rmax); reach: every state's bounds (reach_all), or NULL to search; with keep_kernel the pilot's
  * kernel (scoring ones) is kept in memo for later pilots. */
 static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *o, const ulam__reach *reach,
-                 ulam__bidir_memo *memo, ulam_solver **out, ulam_error *err)
+                 ulam__bidir *memo, ulam_solver **out, ulam_error *err)
 {
     ulam_walk_opts po = walk_opts(o);
     po.estimator = ULAM_COLLISION;
@@ -169,12 +214,12 @@ static double predicted_walks(const ulam_bidir_opts *o, const ulam_solver *pilot
 }
 
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
-                ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err);
+                ulam__bidir *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err);
 
 /* A lower bound on |x_t| from a probe: PROBE walks on a seed of their own scoring the residual
  * as it stands (p_s + their estimate, less two standard errors; 0 when they say nothing).  The
  * final walks run after the push ends on their own seed, so x_t's estimate stays unbiased. */
-static double probe(const ulam_csr *Mt, ulam_push *w, const ulam_bidir_opts *o, ulam__bidir_memo *memo)
+static double probe(const ulam_csr *Mt, ulam_push *w, const ulam_bidir_opts *o, ulam__bidir *memo)
 {
     ulam_bidir_opts po = *o;
     po.walk.stop.rel_err = 0, po.walk.stop.max_walks = PROBE, po.walk.stop.max_seconds = 0, po.walk.stop.interrupt = NULL;
@@ -191,11 +236,11 @@ static double probe(const ulam_csr *Mt, ulam_push *w, const ulam_bidir_opts *o, 
  * about xhat = the largest of min_value (1 / n), |p_s| and, once the push has spent what the
  * rule's floor of walks costs, a probe's lower bound: planning for 1 / n alone over-predicted the
  * walks a median 2.2x (p90 12x) on the Zipf family of bench_bidir, and the push went on. */
-static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir_memo *memo, const ulam_bidir_opts *o,
+static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir *memo, const ulam_bidir_opts *o,
                 const ulam_solver *pl, int64_t cap, ulam_bidir_plan_info *plan)
 {
     const double *p = ulam_push_estimates(w);
-    int64_t n = ulam__push_matrix(w)->nrows;
+    int64_t n = Mt->nrows;
     double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n, V = plan->mean_visits, cost = step_cost(o);
     double rmax = o->rmax > 0 ? o->rmax : 1.0, walks, seen = 0.0;
     int fixed = o->walk.stop.rel_err <= 0 && o->walk.stop.max_walks > 0; /* walks known without V */
@@ -224,7 +269,7 @@ static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir_memo *memo, const 
 
 /* The memo's reach of every state of Mt for o's continuation and exponent, made once (reach_all);
  * NULL without reach_all. */
-static const ulam__reach *reach_all(ulam__bidir_memo *memo, const ulam_csr *Mt, const ulam_bidir_opts *o, int *status,
+static const ulam__reach *reach_all(ulam__bidir *memo, const ulam_csr *Mt, const ulam_bidir_opts *o, int *status,
                                     ulam_error *err)
 {
     const ulam_walk_opts *wo = &o->walk;
@@ -248,18 +293,17 @@ static const ulam__reach *reach_all(ulam__bidir_memo *memo, const ulam_csr *Mt, 
     return R;
 }
 
-/* Plan x_t's estimate: the push and the walks' predicted cost (see ulam.h). */
-int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
-                    ulam_error *err)
+/* Plan x_t's estimate on w with memo: the push and the walks' predicted cost (see ulam.h). */
+int ulam__bidir_plan(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bidir *memo, const ulam_bidir_opts *o,
+                     ulam_bidir_plan_info *plan, ulam_error *err)
 {
-    int status = check_call(w, Mt, o, plan, err);
+    int status = check_call(M, w, Mt, o, plan, err);
     if (status) return status;
     memset(plan, 0, sizeof *plan);
-    const ulam_csr *M = ulam__push_matrix(w);
     double t0 = ulam_now();
     int64_t cap = o->max_push_ops > 0 ? o->max_push_ops : 100 * ulam_csr_nnz(M) + 1000000;
     ulam_push_start(w, o->target);
-    ulam__bidir_memo *memo = ulam__push_memo(w);
+    memo->valid = 0; /* until this plan is whole */
     ulam_solver *pl = NULL;
     plan->target = o->target, plan->balanced = !(o->rmax > 0), plan->mean_visits = 1.0, plan->step_cost = step_cost(o);
     memo->have_guard = memo->have_seen = 0;
@@ -311,6 +355,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
         memcpy(memo->val, o->b_value, (size_t)o->nb * sizeof *memo->val);
     }
     memo->o = *o, memo->Mt = Mt, memo->plan = *plan, memo->valid = 1;
+    memo->w = w, memo->stamp = ulam__push_stamp(w);
     return ULAM_OK;
 }
 
@@ -319,7 +364,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
  * memo: the pilot's guards on Mt and the states it found the walks reach, when it has them, or
  * (reach_all) every state's bounds. */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
-                ulam__bidir_memo *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err)
+                ulam__bidir *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err)
 {
     memset(wr, 0, sizeof *wr);
     ulam_walk_opts wo = walk_opts(o);
@@ -383,16 +428,16 @@ static void honest_interval(ulam_bidir_result *res, double D, const ulam_walk_op
     res->ci95[0] = lo, res->ci95[1] = hi;
 }
 
-/* Estimate x_t of (I - M) x = b (e_s or a sparse b). */
-int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
-                     ulam_error *err)
+/* Estimate x_t of (I - M) x = b (e_s or a sparse b) on w with memo. */
+int ulam__bidir_solve(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bidir *memo, const ulam_bidir_opts *o,
+                      ulam_bidir_result *res, ulam_error *err)
 {
-    int status = check_call(w, Mt, o, res, err);
+    int status = check_call(M, w, Mt, o, res, err);
     if (status) return status;
     memset(res, 0, sizeof *res);
-    ulam__bidir_memo *memo = ulam__push_memo(w);
-    if (memo->valid && same_plan(memo, Mt, o)) res->plan = memo->plan, res->plan_reused = 1;
-    else if ((status = ulam_bidir_plan(w, Mt, o, &res->plan, err))) return status;
+    if (memo->valid && memo->w == w && memo->stamp == ulam__push_stamp(w) && same_plan(memo, Mt, o))
+        res->plan = memo->plan, res->plan_reused = 1;
+    else if ((status = ulam__bidir_plan(M, Mt, w, memo, o, &res->plan, err))) return status;
     double t0 = ulam_now();
     ulam_push_report(w, &res->push);
     res->push_part = res->plan.push_part;
@@ -409,4 +454,36 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
     }
     res->seconds = res->plan.seconds + (ulam_now() - t0);
     return ULAM_OK;
+}
+
+/* Drop a memo kept with a bare push workspace. */
+static void drop_memo(void *m)
+{
+    ulam__bidir_free(m);
+}
+
+/* The memo kept with a bare push workspace, made at its first plan (NULL: no memory). */
+static ulam__bidir *kept_memo(ulam_push *w)
+{
+    ulam__bidir *m = ulam__push_kept(w);
+    if (!m && (m = ulam__bidir_alloc())) ulam__push_keep(w, m, drop_memo);
+    return m;
+}
+
+/* Plan x_t's estimate on a bare push workspace (see ulam.h). */
+int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
+                    ulam_error *err)
+{
+    ulam__bidir *m = w ? kept_memo(w) : NULL;
+    if (w && !m) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
+    return ulam__bidir_plan(w ? ulam__push_matrix(w) : NULL, Mt, w, m, o, plan, err);
+}
+
+/* Estimate x_t on a bare push workspace (see ulam.h). */
+int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
+                     ulam_error *err)
+{
+    ulam__bidir *m = w ? kept_memo(w) : NULL;
+    if (w && !m) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
+    return ulam__bidir_solve(w ? ulam__push_matrix(w) : NULL, Mt, w, m, o, res, err);
 }

@@ -200,10 +200,22 @@ int ulam__solver_finish(ulam_solver *s, ulam_walk_result *result, ulam_error *er
 
 /* As ulam_auto_start, with reach (NULL: none; borrowed until the run is freed) the bounds over
  * every state the walks row's candidates of its kernel walk under (ulam__auto_solver_reach; src/method.c,
- * ulam_analysis_auto_start). */
+ * ulam_analysis_auto_start), and an (NULL: none; borrowed likewise) the analysis of M whose
+ * transpose, push workspace and plan memo the bidirectional row uses (without one the row makes
+ * its own). */
 int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                           const ulam_method_opts *mo, const ulam__reach *reach, ulam_choice *ch, ulam_run **out,
-                           ulam_error *err);
+                           const ulam_method_opts *mo, const ulam__reach *reach, ulam_analysis *an, ulam_choice *ch,
+                           ulam_run **out, ulam_error *err);
+
+/* The analysis' transpose (ulam_analysis_transpose), with *seconds (may be NULL) the time this
+ * call spent making it: 0 when the analysis had it (src/analysis.c). */
+const ulam_csr *ulam__analysis_transpose(ulam_analysis *a, double *seconds, ulam_error *err);
+
+/* ulam_bidir_plan and ulam_bidir_solve on the analysis' transpose, push workspace and planner's
+ * memo (made at the first call and kept), for any kernel: the memo reuses a plan only for the
+ * same options, continuation and exponent among them (src/analysis.c, src/bidir.c). */
+int ulam__analysis_bidir_plan(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan, ulam_error *err);
+int ulam__analysis_bidir_solve(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err);
 
 /* A row read from a file: its len columns and values (and b_i), and the bytes of a block being
  * verified; grown as rows need. */

@@ -98,13 +98,13 @@ static int choose(ulam__query *q, ulam_error *err)
 int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
                     const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
 {
-    return ulam__auto_start_reach(M, b, o, ao, mo, NULL, ch, out, err);
+    return ulam__auto_start_reach(M, b, o, ao, mo, NULL, NULL, ch, out, err);
 }
 
 /* As ulam_auto_start, the walks row racing on the given bounds over every state (see internal.h). */
 int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                           const ulam_method_opts *mo, const ulam__reach *reach, ulam_choice *ch, ulam_run **out,
-                           ulam_error *err)
+                           const ulam_method_opts *mo, const ulam__reach *reach, ulam_analysis *an, ulam_choice *ch,
+                           ulam_run **out, ulam_error *err)
 {
     ulam__clear(err);
     if (out) *out = NULL;
@@ -119,7 +119,7 @@ int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_o
     ulam_run *r = calloc(1, sizeof *r);
     if (!r) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the run");
     r->method = -1, r->M = M, r->b = b, r->o = *o;
-    ulam__query q = {.M = M, .b = b, .o = o, .ao = &a, .mo = &m, .ch = ch, .run = r, .reach = reach};
+    ulam__query q = {.M = M, .b = b, .o = o, .ao = &a, .mo = &m, .ch = ch, .run = r, .reach = reach, .an = an};
     if (m.method >= 0) {
         ch->pinned = 1;
         status = table[m.method]->pin(&q, m.method, err);

@@ -14,8 +14,10 @@ struct ulam_run {
     ulam_bidir_opts bo;   /* bidirectional: its options (b's nonzeros in idx, val) */
     int64_t *idx;
     double *val;
-    ulam_csr *Mt;
-    ulam_push *w;
+    ulam_analysis *an;    /* bidirectional: the analysis whose transpose, push workspace and plan
+                             memo it uses (the caller's, borrowed; or its own: own_an) */
+    int own_an;
+    const ulam_csr *Mt;   /* an's transpose */
     double *bq, *br;      /* bidirectional with a dense b: the push on b's q and residual r (src/bpush.c) */
     ulam_walk_opts bwo;   /* and the walks' options on r (adjoint from the index, offset q_i) */
     ulam_bidir_plan_info bplan; /* and its plan (also in the choice's bidir) */
@@ -31,6 +33,7 @@ typedef struct ulam__query {
     ulam_choice *ch;
     ulam_run *run;
     const ulam__reach *reach; /* the walks' bounds over every state (an analysis's), or NULL */
+    ulam_analysis *an;        /* that analysis (the bidirectional row's transpose, push and plans), or NULL */
 } ulam__query;
 
 /* A row of the table (GSL's gsl_root_fsolver_type): its name, what it answers, its applicability

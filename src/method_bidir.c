@@ -2,7 +2,9 @@
  * (src/bidir.c), or with a dense b the push on b and walks from the index scoring its residual
  * (src/bpush.c), considered by the choice against the walks' leader (rent or buy: it needs M's
  * transpose) with its push capped at half the leader's predicted work, chosen when its own
- * predicted work is below the leader's. */
+ * predicted work is below the leader's.  The transpose, the push workspace and the plan memo are
+ * an analysis' (src/analysis.c): the caller's (ulam_analysis_auto_start), made once for all its
+ * queries, or one of the run's own. */
 #include "method.h"
 #include "stats.h"
 
@@ -85,18 +87,35 @@ static double work(const ulam_csr *M, const ulam_bidir_plan_info *p, const ulam_
            walks * (p->mean_visits - 1.0 + ULAM_AUTO_WALK) + ULAM_AUTO_BUILD * (u + est);
 }
 
-/* Free what the run keeps for bidirectional. */
+/* Free what the run keeps for bidirectional (an analysis of its own with it). */
 static void release(ulam_run *r)
 {
     free(r->idx), free(r->val), free(r->bq), free(r->br);
     r->bq = r->br = NULL;
-    ulam_push_free(r->w);
-    ulam_csr_free(r->Mt);
-    r->idx = NULL, r->val = NULL, r->w = NULL, r->Mt = NULL;
+    if (r->own_an) ulam_analysis_free(r->an);
+    r->an = NULL, r->own_an = 0, r->Mt = NULL;
+    r->idx = NULL, r->val = NULL;
     r->bo.b_index = NULL, r->bo.b_value = NULL;
 }
 
-/* The options, b's nonzeros, the transpose and the push workspace (walk: the walks' options). */
+/* The analysis' transpose in r->Mt (the query's analysis, or one the run makes), its making time
+ * in the choice (0 when the analysis had it); 0 or a status. */
+static int transpose(ulam__query *q, ulam_error *err)
+{
+    ulam_run *r = q->run;
+    ulam_error e;
+    if (!r->an && q->an) r->an = q->an;
+    else if (!r->an) { /* the run's own: the default kernel (the row's plans key on the options' own) */
+        int status = ulam_analysis_alloc(q->M, NULL, &r->an, &e);
+        if (status) return ulam__fail(err, status, 0, -1, "memory for the transpose and the push");
+        r->own_an = 1;
+    }
+    if (!(r->Mt = ulam__analysis_transpose(r->an, &q->ch->transpose_seconds, &e)))
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose and the push");
+    return ULAM_OK;
+}
+
+/* The options, b's nonzeros and the analysis' transpose (walk: the walks' options). */
 static int setup(ulam__query *q, const ulam_walk_opts *walk, ulam_error *err)
 {
     ulam_run *r = q->run;
@@ -105,13 +124,10 @@ static int setup(ulam__query *q, const ulam_walk_opts *walk, ulam_error *err)
     r->bo.walk = *walk;
     r->bo.target = walk->query.index;
     r->idx = malloc((size_t)(nb ? nb : 1) * sizeof *r->idx), r->val = malloc((size_t)(nb ? nb : 1) * sizeof *r->val);
-    double t0 = ulam_now();
-    int status = r->idx && r->val ? ulam_csr_transpose(q->M, &r->Mt) : ULAM_ENOMEM;
-    q->ch->transpose_seconds = ulam_now() - t0;
-    if (!status) status = ulam_push_alloc(q->M, &r->w);
+    int status = r->idx && r->val ? transpose(q, err) : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose and the push");
     if (status) {
         release(r);
-        return ulam__fail(err, status, 0, -1, "memory for the transpose and the push");
+        return status;
     }
     for (int64_t i = 0, j = 0; i < n; i++)
         if (q->b[i] != 0.0) r->idx[j] = i, r->val[j++] = q->b[i];
@@ -148,9 +164,8 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     double E = o->stop.rel_err, t0 = ulam_now();
     memset(pl, 0, sizeof *pl);
     r->bq = calloc((size_t)n, sizeof *r->bq), r->br = malloc((size_t)n * sizeof *r->br);
-    int status = r->bq && r->br ? ulam_csr_transpose(q->M, &r->Mt) : ULAM_ENOMEM;
-    q->ch->transpose_seconds = ulam_now() - t0;
-    if (status) return release(r), ulam__fail(err, status, 0, -1, "memory for the transpose and the push on b");
+    int status = r->bq && r->br ? transpose(q, err) : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose and the push on b");
+    if (status) return release(r), status;
     memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
     double bmax = ulam__bpush_max(q->b, n), nv = var / (E * m * E * m);
     double rmax = isfinite(N) && N > 0 && nv > 0 ? bmax * fmin(1.0, nv / N) : bmax;
@@ -206,7 +221,7 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     r->bo.max_push_ops = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : 0; /* W infinite: the default cap */
     ulam_error e;
     ulam_method_verdict *v = &ch->method[k];
-    status = ulam_bidir_plan(r->w, r->Mt, &r->bo, &ch->bidir, &e);
+    status = ulam__analysis_bidir_plan(r->an, &r->bo, &ch->bidir, &e);
     ch->bidir_opts = r->bo;
     if (status == ULAM_ENOCONV) {
         snprintf(v->why, sizeof v->why, "dropped: its push passed W/2 = %lld operations", (long long)r->bo.max_push_ops);
@@ -277,7 +292,7 @@ static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
         return ULAM_OK;
     }
     r->bo.walk.stop.interrupt = r->o.stop.interrupt, r->bo.walk.exec.share = r->o.exec.share;
-    int status = ulam_bidir_solve(r->w, r->Mt, &r->bo, &a->bidir, err);
+    int status = ulam__analysis_bidir_solve(r->an, &r->bo, &a->bidir, err);
     if (status) return status;
     a->walks = a->bidir.walks;
     a->opts = r->bo.walk;

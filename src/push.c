@@ -7,7 +7,6 @@
  * wait in a FIFO queue, each at most once; p and r are dense arrays of n, zero outside a list
  * of touched states, so a new target costs the states the last one touched, not n. */
 #include "internal.h"
-#include "kernel.h"
 #include "push.h"
 
 #include <math.h>
@@ -25,7 +24,9 @@ struct ulam_push {
     double rmax;
     int64_t pushes, ops;
     double seconds;
-    ulam__bidir_memo memo; /* the last bidirectional plan on this push (src/bidir.c) */
+    uint64_t stamp; /* changed by every start and run: what a plan made on this state recorded */
+    void *kept;     /* what a caller keeps with the workspace (ulam__push_keep), freed by drop */
+    void (*drop)(void *);
 };
 
 /* Free a push workspace; accepts and returns NULL. */
@@ -33,8 +34,7 @@ ulam_push *ulam_push_free(ulam_push *w)
 {
     if (!w) return NULL;
     free(w->p), free(w->r), free(w->touched), free(w->mark), free(w->queue);
-    free(w->memo.idx), free(w->memo.val), free(w->memo.ones), free(w->memo.seen), free(w->memo.all);
-    ulam__kernel_free(w->memo.kernel), ulam__kernel_free(w->memo.pilot);
+    if (w->drop) w->drop(w->kept);
     free(w);
     return NULL;
 }
@@ -90,7 +90,7 @@ int ulam_push_start(ulam_push *w, int64_t target)
         w->mark[j] = 0;
     }
     w->ntouched = w->head = w->len = w->pushes = w->ops = 0;
-    w->memo.valid = 0;
+    w->stamp++;
     w->seconds = 0.0;
     w->target = target;
     w->rmax = INFINITY;
@@ -108,7 +108,7 @@ int ulam_push_run(ulam_push *w, double rmax, int64_t max_ops)
     double t0 = ulam_now();
     const ulam_csr *M = w->M;
     w->rmax = rmax;
-    w->memo.valid = 0;
+    w->stamp++;
     for (int64_t q = 0; q < w->ntouched; q++) enqueue(w, w->touched[q]);
     int status = ULAM_OK;
     while (w->len > 0) {
@@ -173,8 +173,20 @@ const ulam_csr *ulam__push_matrix(const ulam_push *w)
     return w->M;
 }
 
-/* The workspace's memo of the last bidirectional plan. */
-ulam__bidir_memo *ulam__push_memo(ulam_push *w)
+/* A count that changes whenever the workspace's state does (ulam_push_start, ulam_push_run). */
+uint64_t ulam__push_stamp(const ulam_push *w)
 {
-    return &w->memo;
+    return w->stamp;
+}
+
+/* What the caller keeps with the workspace (NULL: nothing yet). */
+void *ulam__push_kept(const ulam_push *w)
+{
+    return w->kept;
+}
+
+/* Keep data with the workspace, dropped by drop(data) when it is freed (once: set it once). */
+void ulam__push_keep(ulam_push *w, void *data, void (*drop)(void *))
+{
+    w->kept = data, w->drop = drop;
 }

@@ -309,6 +309,52 @@ static void test_analysis_bidir_exponent(void **state)
     assert_memory_equal(&two.estimate, &ref.estimate, sizeof ref.estimate);
     assert_memory_equal(&two.std_error, &ref.std_error, sizeof ref.std_error);
     assert_true(two.plan.rmax == ref.plan.rmax && two.plan.pilot_steps == ref.plan.pilot_steps);
+    /* ulam_analysis_bidir: its own memo on the analysis' transpose and push; the analysis' kernel only */
+    assert_int_equal(ulam_analysis_bidir(a, &o2, &two, &err), ULAM_EINVAL); /* alpha 2 on alpha 1's analysis */
+    ulam_bidir_result three, four;
+    assert_int_equal(ulam_analysis_bidir(a, &o, &three, &err), ULAM_OK);
+    assert_false(three.plan_reused); /* the analysis' memo held no plan: planned (the same plan) */
+    assert_int_equal(ulam_analysis_bidir(a, &o, &four, &err), ULAM_OK);
+    assert_true(four.plan_reused);
+    assert_memory_equal(&three.estimate, &one.estimate, sizeof one.estimate); /* a fresh plan's walks */
+    assert_memory_equal(&four.estimate, &one.estimate, sizeof one.estimate);
+    assert_ptr_equal(ulam_analysis_transpose(a, &err), T); /* made once */
+    ulam_analysis_opts ao = ulam_analysis_defaults();
+    ao.kernel_alpha = 2.0;
+    ulam_analysis *a2 = NULL;
+    assert_int_equal(ulam_analysis_alloc(M, &ao, &a2, &err), ULAM_OK);
+    assert_int_equal(ulam_analysis_bidir(a2, &o2, &three, &err), ULAM_OK);
+    assert_false(three.plan_reused);
+    assert_memory_equal(&three.estimate, &ref.estimate, sizeof ref.estimate);
+    assert_memory_equal(&three.std_error, &ref.std_error, sizeof ref.std_error);
+    ulam_analysis_free(a2);
+    /* the method table's bidirectional row on an analysis (ulam_analysis_auto_start): its
+       transpose, made by the first query, serves the second (no time spent making it), and the
+       answers are those of a run without an analysis (bit for bit) */
+    double *bv = calloc(150, sizeof *bv);
+    bv[3] = 1.0, bv[40] = -0.5;
+    ulam_walk_opts wo = ulam_walk_defaults();
+    wo.query.index = 10, wo.stop.max_walks = 0, wo.stop.rel_err = 0.05, wo.exec.threads = 1;
+    ulam_method_opts mo = ulam_method_defaults();
+    mo.method = ULAM_METHOD_BIDIRECTIONAL;
+    ulam_analysis *a3 = NULL;
+    assert_int_equal(ulam_analysis_alloc(M, NULL, &a3, &err), ULAM_OK);
+    for (int k = 0; k < 2; k++) {
+        ulam_choice ch, cref;
+        ulam_run *run = NULL;
+        ulam_answer ans, aref;
+        wo.exec.seed = (uint64_t)k + 1;
+        assert_int_equal(ulam_analysis_auto_start(a3, bv, &wo, NULL, &mo, &ch, &run, &err), ULAM_OK);
+        assert_int_equal(ulam_run_finish(run, &ans, &err), ULAM_OK);
+        ulam_run_free(run);
+        assert_int_equal(ulam_auto(M, bv, &wo, NULL, &mo, &cref, &aref, &err), ULAM_OK);
+        assert_true(ans.method == ULAM_METHOD_BIDIRECTIONAL && aref.method == ULAM_METHOD_BIDIRECTIONAL);
+        assert_memory_equal(&ans.estimate, &aref.estimate, sizeof ans.estimate);
+        assert_memory_equal(&ans.std_error, &aref.std_error, sizeof ans.std_error);
+        if (k == 1) assert_true(ch.transpose_seconds == 0.0 && cref.transpose_seconds > 0.0);
+    }
+    ulam_analysis_free(a3);
+    free(bv);
     ulam_push_free(fresh);
     ulam_analysis_free(a);
     ulam_csr_free(M), ulam_csr_free(Mt);

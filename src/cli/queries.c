@@ -176,8 +176,7 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
         walks = r.walks, interrupted = r.interrupted;
     } else {
         const ulam_csr *Mt = ulam_analysis_transpose(w->an, &err);
-        ulam_push *p = Mt ? ulam_analysis_push(w->an, &err) : NULL;
-        if (!p) return cli_report(w->s->matrix_path, &err);
+        if (!Mt) return cli_report(w->s->matrix_path, &err);
         int rc = transpose_guard(w, Mt, o.kernel.continue_q);
         if (rc) return rc;
         ulam_bidir_opts bo = ulam_bidir_defaults();
@@ -185,7 +184,7 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
         bo.walk.policy.guard = &w->gt;
         bo.source = q->source, bo.target = q->index, bo.reach_all = 1, bo.keep_kernel = 1;
         ulam_bidir_result r;
-        status = ulam_bidir_solve(p, Mt, &bo, &r, &err);
+        status = ulam_analysis_bidir(w->an, &bo, &r, &err); /* its transpose, push workspace and plans */
         est = r.estimate, se = r.std_error, ci[0] = r.ci95[0], ci[1] = r.ci95[1];
         met = r.walks.rel_err_met || r.walks.walks == 0, walks = r.walks.walks, interrupted = r.walks.interrupted;
     }
