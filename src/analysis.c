@@ -2,9 +2,10 @@
  * before cs_lu): the guards, the bounds over every state the rel_err rule and absorption need
  * (ulam__reach_all, or the prepared file's stored copy), the shared b's scores, a kept walk
  * kernel per estimator, and for point sources and sparse b (the bidirectional estimator) the
- * transpose (the prepared file's stored M^T when it has one), the push workspace and the
- * planner's memo (src/bidir.h).  Each is made at the first query that needs it, so a single
- * query from a prepared file reads only the rows its walks reach. */
+ * transpose (the prepared file's stored M^T when it has one), the push workspace and a place for
+ * the planner's memo (src/bidir.h: the planner takes these from here, as CSparse's cs_lu takes
+ * cs_sqr's result).  Each is made at the first query that needs it, so a single query from a
+ * prepared file reads only the rows its walks reach. */
 #include "bidir.h"
 #include "kernel.h"
 
@@ -230,44 +231,22 @@ ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err)
     return a->push;
 }
 
-/* The transpose, the push workspace and the planner's memo, made at the first call; 0 or a status. */
-static int take_bidir(ulam_analysis *a, const ulam_csr **Mt, ulam_push **w, ulam_error *err)
+/* The matrix a is made for. */
+const ulam_csr *ulam__analysis_matrix(const ulam_analysis *a)
 {
-    if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis");
-    if (!(*Mt = ulam__analysis_transpose(a, NULL, err)) || !(*w = ulam_analysis_push(a, err))) return ULAM_ENOMEM;
-    if (!a->bidir && !(a->bidir = ulam__bidir_alloc())) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
-    return ULAM_OK;
+    return a->M;
 }
 
-/* A bidirectional plan on a's transpose, push workspace and memo, for any kernel (the memo keys
- * its plans on the options, continuation and exponent among them). */
-int ulam__analysis_bidir_plan(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan, ulam_error *err)
+/* The kernel a is made for: its continuation (0: analog) and exponent. */
+void ulam__analysis_kernel(const ulam_analysis *a, double *continue_q, double *alpha)
 {
-    const ulam_csr *Mt;
-    ulam_push *w;
-    int status = take_bidir(a, &Mt, &w, err);
-    return status ? status : ulam__bidir_plan(a->M, Mt, w, a->bidir, o, plan, err);
+    *continue_q = a->continue_q, *alpha = a->alpha;
 }
 
-/* A bidirectional estimate on a's transpose, push workspace and memo, for any kernel. */
-int ulam__analysis_bidir_solve(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err)
+/* Where a keeps the bidirectional planner's memo (NULL until the planner makes it; a frees it). */
+ulam__bidir **ulam__analysis_bidir_memo(ulam_analysis *a)
 {
-    const ulam_csr *Mt;
-    ulam_push *w;
-    int status = take_bidir(a, &Mt, &w, err);
-    return status ? status : ulam__bidir_solve(a->M, Mt, w, a->bidir, o, res, err);
-}
-
-/* A bidirectional estimate of a's kernel on a's transpose, push workspace and memo. */
-int ulam_analysis_bidir(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err)
-{
-    ulam__clear(err);
-    if (!a || !o || !res) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis, options and a place for the answer");
-    const ulam_kernel_opts *k = &o->walk.kernel;
-    if ((k->continue_q > 0 ? k->continue_q : 0.0) != a->continue_q || k->kernel_alpha != a->alpha)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the analysis' continuation %g and kernel exponent %g",
-                          a->continue_q, a->alpha);
-    return ulam__analysis_bidir_solve(a, o, res, err);
+    return &a->bidir;
 }
 
 /* What a holds so far. */

@@ -294,7 +294,7 @@ static const ulam__reach *reach_all(ulam__bidir *memo, const ulam_csr *Mt, const
 }
 
 /* Plan x_t's estimate on w with memo: the push and the walks' predicted cost (see ulam.h). */
-int ulam__bidir_plan(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bidir *memo, const ulam_bidir_opts *o,
+static int plan_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bidir *memo, const ulam_bidir_opts *o,
                      ulam_bidir_plan_info *plan, ulam_error *err)
 {
     int status = check_call(M, w, Mt, o, plan, err);
@@ -429,7 +429,7 @@ static void honest_interval(ulam_bidir_result *res, double D, const ulam_walk_op
 }
 
 /* Estimate x_t of (I - M) x = b (e_s or a sparse b) on w with memo. */
-int ulam__bidir_solve(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bidir *memo, const ulam_bidir_opts *o,
+static int solve_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bidir *memo, const ulam_bidir_opts *o,
                       ulam_bidir_result *res, ulam_error *err)
 {
     int status = check_call(M, w, Mt, o, res, err);
@@ -437,7 +437,7 @@ int ulam__bidir_solve(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam_
     memset(res, 0, sizeof *res);
     if (memo->valid && memo->w == w && memo->stamp == ulam__push_stamp(w) && same_plan(memo, Mt, o))
         res->plan = memo->plan, res->plan_reused = 1;
-    else if ((status = ulam__bidir_plan(M, Mt, w, memo, o, &res->plan, err))) return status;
+    else if ((status = plan_on(M, Mt, w, memo, o, &res->plan, err))) return status;
     double t0 = ulam_now();
     ulam_push_report(w, &res->push);
     res->push_part = res->plan.push_part;
@@ -476,7 +476,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
 {
     ulam__bidir *m = w ? kept_memo(w) : NULL;
     if (w && !m) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
-    return ulam__bidir_plan(w ? ulam__push_matrix(w) : NULL, Mt, w, m, o, plan, err);
+    return plan_on(w ? ulam__push_matrix(w) : NULL, Mt, w, m, o, plan, err);
 }
 
 /* Estimate x_t on a bare push workspace (see ulam.h). */
@@ -485,5 +485,49 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
 {
     ulam__bidir *m = w ? kept_memo(w) : NULL;
     if (w && !m) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
-    return ulam__bidir_solve(w ? ulam__push_matrix(w) : NULL, Mt, w, m, o, res, err);
+    return solve_on(w ? ulam__push_matrix(w) : NULL, Mt, w, m, o, res, err);
+}
+
+/* The analysis' transpose, push workspace and memo (made at the first call); 0 or a status. */
+static int take(ulam_analysis *a, const ulam_csr **Mt, ulam_push **w, ulam__bidir **memo, ulam_error *err)
+{
+    if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis");
+    ulam__bidir **slot = ulam__analysis_bidir_memo(a);
+    if (!(*Mt = ulam__analysis_transpose(a, NULL, err)) || !(*w = ulam_analysis_push(a, err))) return ULAM_ENOMEM;
+    if (!*slot && !(*slot = ulam__bidir_alloc())) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
+    *memo = *slot;
+    return ULAM_OK;
+}
+
+/* Plan on an analysis (any kernel: the memo keys its plans on the options). */
+int ulam__bidir_plan_on(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan, ulam_error *err)
+{
+    const ulam_csr *Mt;
+    ulam_push *w;
+    ulam__bidir *m;
+    int status = take(a, &Mt, &w, &m, err);
+    return status ? status : plan_on(ulam__analysis_matrix(a), Mt, w, m, o, plan, err);
+}
+
+/* Estimate on an analysis (any kernel). */
+int ulam__bidir_solve_on(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err)
+{
+    const ulam_csr *Mt;
+    ulam_push *w;
+    ulam__bidir *m;
+    int status = take(a, &Mt, &w, &m, err);
+    return status ? status : solve_on(ulam__analysis_matrix(a), Mt, w, m, o, res, err);
+}
+
+/* Estimate on an analysis of its own kernel (see ulam.h). */
+int ulam_analysis_bidir(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!a || !o || !res) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis, options and a place for the answer");
+    double q, alpha;
+    ulam__analysis_kernel(a, &q, &alpha);
+    const ulam_kernel_opts *k = &o->walk.kernel;
+    if ((k->continue_q > 0 ? k->continue_q : 0.0) != q || k->kernel_alpha != alpha)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the analysis' continuation %g and kernel exponent %g", q, alpha);
+    return ulam__bidir_solve_on(a, o, res, err);
 }

@@ -16,12 +16,4 @@ ulam__bidir *ulam__bidir_alloc(void);
 /* Free a memo and what it keeps; accepts and returns NULL. */
 ulam__bidir *ulam__bidir_free(ulam__bidir *m);
 
-/* ulam_bidir_plan and ulam_bidir_solve with push workspace w on M, Mt M's transpose, and memo m:
- * a plan m holds is reused only for w's state as the plan left it and the same options (among
- * them the continuation, the kernel exponent and the estimator). */
-int ulam__bidir_plan(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bidir *m, const ulam_bidir_opts *o,
-                     ulam_bidir_plan_info *plan, ulam_error *err);
-int ulam__bidir_solve(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bidir *m, const ulam_bidir_opts *o,
-                      ulam_bidir_result *res, ulam_error *err);
-
 #endif

@@ -211,11 +211,20 @@ int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_o
  * call spent making it: 0 when the analysis had it (src/analysis.c). */
 const ulam_csr *ulam__analysis_transpose(ulam_analysis *a, double *seconds, ulam_error *err);
 
-/* ulam_bidir_plan and ulam_bidir_solve on the analysis' transpose, push workspace and planner's
+/* The matrix and the kernel (continuation, 0 analog, and exponent) an analysis is made for. */
+const ulam_csr *ulam__analysis_matrix(const ulam_analysis *a);
+void ulam__analysis_kernel(const ulam_analysis *a, double *continue_q, double *alpha);
+
+/* Where an analysis keeps the bidirectional planner's memo (src/bidir.h; NULL until the planner
+ * makes it there; freed with the analysis). */
+struct ulam__bidir;
+struct ulam__bidir **ulam__analysis_bidir_memo(ulam_analysis *a);
+
+/* ulam_bidir_plan and ulam_bidir_solve on an analysis' transpose, push workspace and planner's
  * memo (made at the first call and kept), for any kernel: the memo reuses a plan only for the
- * same options, continuation and exponent among them (src/analysis.c, src/bidir.c). */
-int ulam__analysis_bidir_plan(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan, ulam_error *err);
-int ulam__analysis_bidir_solve(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err);
+ * same options, continuation and exponent among them (src/bidir.c). */
+int ulam__bidir_plan_on(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan, ulam_error *err);
+int ulam__bidir_solve_on(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err);
 
 /* A row read from a file: its len columns and values (and b_i), and the bytes of a block being
  * verified; grown as rows need. */

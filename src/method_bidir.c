@@ -221,7 +221,7 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     r->bo.max_push_ops = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : 0; /* W infinite: the default cap */
     ulam_error e;
     ulam_method_verdict *v = &ch->method[k];
-    status = ulam__analysis_bidir_plan(r->an, &r->bo, &ch->bidir, &e);
+    status = ulam__bidir_plan_on(r->an, &r->bo, &ch->bidir, &e);
     ch->bidir_opts = r->bo;
     if (status == ULAM_ENOCONV) {
         snprintf(v->why, sizeof v->why, "dropped: its push passed W/2 = %lld operations", (long long)r->bo.max_push_ops);
@@ -292,7 +292,7 @@ static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
         return ULAM_OK;
     }
     r->bo.walk.stop.interrupt = r->o.stop.interrupt, r->bo.walk.exec.share = r->o.exec.share;
-    int status = ulam__analysis_bidir_solve(r->an, &r->bo, &a->bidir, err);
+    int status = ulam__bidir_solve_on(r->an, &r->bo, &a->bidir, err);
     if (status) return status;
     a->walks = a->bidir.walks;
     a->opts = r->bo.walk;
