@@ -217,21 +217,22 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
     return 0;
 }
 
-/* Transpose, push, walk and print; 0 or an exit code. */
+/* Transpose, push, walk and print, on an analysis of M (its transpose a prepared file's stored
+ * one after prepare --transpose: none to build); 0 or an exit code. */
 static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
 {
-    ulam_csr *Mt = NULL;
-    ulam_push *w = NULL;
+    ulam_analysis *an = NULL;
+    ulam_analysis_opts ao = ulam_analysis_defaults();
+    ao.continue_q = o->walk.kernel.continue_q, ao.kernel_alpha = o->walk.kernel.kernel_alpha, ao.system = s->sys_M;
+    ulam_error err;
+    int status = ulam_analysis_alloc(s->M, &ao, &an, &err);
     double t0 = ulam_now();
-    const ulam_csr *stored = s->sys_M ? ulam_system_transpose(s->sys_M) : NULL; /* prepare --transpose: none to build */
-    int status = stored ? ULAM_OK : ulam_csr_transpose(s->M, &Mt);
+    if (!status && !ulam_analysis_transpose(an, &err)) status = err.status;
     rp->transpose_seconds = ulam_now() - t0;
-    if (!status) status = ulam_push_alloc(s->M, &w);
-    ulam_error err = {.status = status, .msg = "memory for the transpose and the push"};
     ulam_bidir_result r;
     o->walk.stop.interrupt = &cli_interrupted, o->walk.exec.share = cli_share;
     cli_catch_sigint();
-    if (!status) status = ulam_bidir_solve(w, stored ? stored : Mt, o, &r, &err);
+    if (!status) status = ulam_analysis_bidir(an, o, &r, &err); /* its push workspace and plan */
     int rc = status ? cli_report(s->matrix_path, &err) : 0;
     if (!status) {
         if (rp->json) print_json(o, &r, rp);
@@ -240,8 +241,7 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     }
     cli_flush();
     cli_release_sigint();
-    ulam_push_free(w);
-    ulam_csr_free(Mt);
+    ulam_analysis_free(an);
     return rc;
 }
 
