@@ -191,20 +191,31 @@ static double score_factor(int estimator, double pl, double gmax, int light)
     return g / pl * ulam__mis_weight(estimator, pl, g, 1);
 }
 
-/* A certified bound, per channel, on what one vertex of a next-event walk at patch p (or, p < 0,
- * the point pt with normal n) scores with weights W <= 1: rho_pc (1 at the point or with
- * reflect 0) times the largest light sample plus the largest weighted landing on an emitter,
- * over every group of emitters (score_factor at g_max).  INFINITY where light sampling alone meets an
- * emitter it may touch (1 / r^2 unbounded). */
-void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
-                               const double n[3], int reflect, double out[3])
+/* Certified bounds, per channel and per unit of weight W, on one vertex of a next-event walk at
+ * patch p (or, p < 0, the point pt with normal n): light, the largest light sample (before any
+ * reflectance), and hit, the largest landing of the vertex's cosine ray on an emitter, weighted
+ * against light sampling; over every group of emitters (score_factor at g_max).  INFINITY
+ * where light sampling alone meets an emitter it may touch (1 / r^2 unbounded). */
+void ulam__lights_vertex_parts(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
+                               const double n[3], double light[3], double hit[3])
 {
-    double lmax[3] = {0, 0, 0}, hmax[3] = {0, 0, 0};
+    for (int c = 0; c < 3; c++) light[c] = hit[c] = 0.0;
     for (int64_t k = 0; k < L->ngroups; k++) {
         const double *E = L->group[k].E;
         double pl = (E[0] + E[1] + E[2]) / L->ptot, g = g_max(s, p, pt, n, &L->group[k]);
         double fl = score_factor(estimator, pl, g, 1), fh = score_factor(estimator, pl, g, 0);
-        for (int c = 0; c < 3; c++) lmax[c] = fmax(lmax[c], E[c] * fl), hmax[c] = fmax(hmax[c], E[c] * fh);
+        for (int c = 0; c < 3; c++) light[c] = fmax(light[c], E[c] * fl), hit[c] = fmax(hit[c], E[c] * fh);
     }
+}
+
+/* A certified bound, per channel, on what one vertex of a next-event walk at patch p (or, p < 0,
+ * the point pt with normal n) scores with weights W <= 1: rho_pc (1 at the point or with
+ * reflect 0) times the largest light sample plus the largest weighted landing on an emitter
+ * (ulam__lights_vertex_parts). */
+void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
+                               const double n[3], int reflect, double out[3])
+{
+    double lmax[3], hmax[3];
+    ulam__lights_vertex_parts(L, s, estimator, p, pt, n, lmax, hmax);
     for (int c = 0; c < 3; c++) out[c] = (reflect && p >= 0 ? s->rho[3 * p + c] : 1.0) * lmax[c] + hmax[c];
 }

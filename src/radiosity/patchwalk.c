@@ -72,6 +72,7 @@ struct ulam_rad_solver {
     double *q;            /* continuation per patch: max_c rho */
     double per_step[3], range[3], qmax; /* the score bounds of the rel_err rule (score_bounds) */
     double first[3], w1[3];             /* next-event: the first vertex's (first_bounds) */
+    ulam__point_bounds pb;              /* a point solver's (point_bounds) */
     ulam__lights L;       /* the emitters (shooting's source, next-event's lights) */
     int at;               /* a point solver: walks from at_x (normal at_n, on patch at_self or -1) */
     double at_x[3], at_n[3];
@@ -152,6 +153,37 @@ static void first_bounds(ulam_rad_solver *s)
     for (int c = 0; c < 3 && !s->at; c++) s->w1[c] = s->q[i] > 0 ? sc->rho[3 * i + c] / s->q[i] : 0.0;
 }
 
+/* A point solver's parts of its range (ulam__point_range): its own vertex's light sample and
+ * landing (at the point), every other vertex's largest over the patches, the largest
+ * reflectance, and whether every emitter is black (a landing on one ends the walk). */
+static void point_bounds(ulam_rad_solver *s)
+{
+    const ulam_scene *sc = s->s;
+    ulam__point_bounds *b = &s->pb;
+    int nee = next_event(s->o.estimator);
+    double emax[3] = {0, 0, 0};
+    memset(b, 0, sizeof *b);
+    b->black = 1;
+    for (int64_t k = 0; k < s->L.nem; k++) {
+        int64_t l = s->L.emitter[k];
+        b->black &= s->q[l] == 0.0;
+        for (int c = 0; c < 3; c++) emax[c] = fmax(emax[c], sc->emit[3 * l + c]);
+    }
+    for (int64_t p = 0; p < sc->npatches; p++) {
+        double l[3] = {0, 0, 0}, h[3] = {emax[0], emax[1], emax[2]}; /* collision: a landing scores W E, no light sample */
+        b->rho = fmax(b->rho, s->q[p]);
+        if (nee) ulam__lights_vertex_parts(&s->L, sc, s->o.estimator, p, NULL, sc->normal + 3 * p, l, h);
+        for (int c = 0; c < 3; c++) {
+            double r = sc->rho[3 * p + c];
+            b->light[c] = fmax(b->light[c], l[c]), b->hit[c] = fmax(b->hit[c], h[c]);
+            b->lr[c] = fmax(b->lr[c], r * l[c]), b->hr[c] = fmax(b->hr[c], r * h[c]);
+        }
+    }
+    if (nee) ulam__lights_vertex_parts(&s->L, sc, s->o.estimator, -1, s->at_x, s->at_n, b->light0, b->hit0); /* its own */
+    else
+        for (int c = 0; c < 3; c++) b->light0[c] = 0.0, b->hit0[c] = emax[c];
+}
+
 /* The bounds of the rel_err rule (per channel: per_step, what one step can score; range, a
  * bound on a whole walk's score when one is known, else INFINITY and the walks' length is
  * truncated, stop.h; qmax the largest survival).  Every weight stays at most its start
@@ -178,6 +210,7 @@ static void score_bounds(ulam_rad_solver *s)
             s->range[c] = fmax(s->range[c], E > 0 ? E / (1.0 - s->q[p]) : 0.0);
         }
     }
+    if (s->at) point_bounds(s);
     if (s->o.mode == ULAM_FORWARD) {
         for (int c = 0; c < 3; c++) {
             double w0 = 0.0, rho = sc->rho[3 * s->o.query.index + c], q = s->q[s->o.query.index];
@@ -496,7 +529,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             double sc[3];
             if (s->at) {
                 int64_t cut = 0;
-                ulam__point_walk(s->t, &s->L, s->q, s->o.estimator, s->o.stop.max_steps, s->at_x, s->at_n, s->at_self, &r,
+                ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, s->at_x, s->at_n, s->at_self, &r,
                                  sc, &br->rays, &cut);
                 br->cut += cut;
             } else if (next_event(s->o.estimator)) {
@@ -559,6 +592,11 @@ static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r)
 static void channel_range(const ulam_rad_solver *s, int c, double m, double E, double *R, double *bias)
 {
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
+    if (s->at) { /* point walks: their weight window's range (point.c) */
+        *R = ulam__point_range(&s->pb, c, fabs(m), E / 4.0);
+        *bias = E * fabs(m) / 4.0;
+        return;
+    }
     double later = ulam__score_range(s->range[c], s->w1[c] * s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0);
     *R = (s->first[c] + later) / A;
     *bias = isfinite(s->range[c]) ? 0.0 : E * fabs(m) / 4.0;
