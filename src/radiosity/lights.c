@@ -149,20 +149,28 @@ static void project_box(const ulam__light_group *G, const double u[3], double *l
 /* An upper bound on G(x, y) = cos cos_y / (pi r^2) over x on patch p (or, p < 0, the point pt
  * with normal n) and y on an emitter of group G (within its box, facing along its normal), both
  * facing each other: 0 when the box lies wholly on or behind x's plane or x's patch wholly on or
- * behind the emitters' plane (no pair faces), 1 / (pi d^2) for d > 0 a lower bound on their
- * distance (the widest gap along x's normal, against the emitters' normal, and along the line
- * between the centres: separating axes of convex sets), else INFINITY. */
+ * behind the emitters' plane (no pair faces); else, for d > 0 a lower bound on their distance
+ * r (the widest gap along x's normal, against the emitters' normal, along the line between the
+ * centres: separating axes of convex sets; and the least |v| with v . n >= the first gap and
+ * v . (-n_l) >= the second, both positive, which is sqrt((a^2 + b^2 - 2 c a b) / (1 - c^2)),
+ * c = -n . n_l, where both of its Lagrange multipliers are >= 0),
+ * min(1, A / d) min(1, B / d) / (pi d^2), A and B the largest distances of y from x's plane
+ * and of x from the emitters' plane: cos = (y - x) . n / r <= A / r, cos_y <= B / r, each <= 1,
+ * and that bound falls with r >= d; INFINITY without such a d. */
 static double g_max(const ulam_scene *s, int64_t p, const double *pt, const double n[3], const ulam__light_group *G)
 {
     double lo_p, hi_p, lo_l, hi_l, cp[3] = {0, 0, 0}, u[3];
     project(s, p, pt, n, &lo_p, &hi_p);
     project_box(G, n, &lo_l, &hi_l);
     if (hi_l - lo_p <= 1e-12 * (fmax(fabs(lo_p), fabs(hi_l)) + 1.0)) return 0.0; /* on or behind x's plane */
-    double gap = lo_l - hi_p;
+    double gx = lo_l - hi_p, A = hi_l - lo_p;
     project(s, p, pt, G->n, &lo_p, &hi_p);
     project_box(G, G->n, &lo_l, &hi_l);
     if (hi_p - lo_l <= 1e-12 * (fmax(fabs(hi_p), fabs(lo_l)) + 1.0)) return 0.0; /* x behind the emitters' plane */
-    gap = fmax(gap, lo_p - hi_l); /* along -n_l */
+    double gl = lo_p - hi_l, B = hi_p - lo_l, gap = fmax(gx, gl); /* gl along -n_l */
+    double c = -ulam__dot3(n, G->n);
+    if (gx > 0 && gl > 0 && fabs(c) < 1.0 - 1e-9 && gx - c * gl >= 0 && gl - c * gx >= 0)
+        gap = fmax(gap, sqrt(fmax(0.0, (gx * gx + gl * gl - 2.0 * c * gx * gl) / (1.0 - c * c))) * (1.0 - 1e-12));
     int64_t a = p < 0 ? 0 : s->start[p], b = p < 0 ? 1 : s->start[p + 1];
     for (int64_t k = a; k < b; k++)
         for (int i = 0; i < 3; i++) cp[i] += (p < 0 ? pt : s->vert + 3 * s->vidx[k])[i] / (double)(b - a);
@@ -174,7 +182,8 @@ static double g_max(const ulam_scene *s, int64_t p, const double *pt, const doub
         project_box(G, u, &lo_l, &hi_l);
         gap = fmax(gap, lo_l - hi_p);
     }
-    return gap > 0 ? 1.0 / (M_PI * gap * gap) : INFINITY;
+    if (!(gap > 0)) return INFINITY;
+    return fmin(1.0, A / gap) * fmin(1.0, B / gap) / (M_PI * gap * gap);
 }
 
 /* The most one light sample (light) or one landing of the walk's cosine ray on an emitter

@@ -53,6 +53,7 @@ typedef struct {
     ulam__block_head h; /* the round driver's part: the shooting tallies (rad_tally), walks, ... */
     ulam__moments m[3]; /* gathering scores per channel */
     double sq, maxsq;   /* sum and largest square of the channel-summed score (of the patch) */
+    double maxc[3];     /* the largest score per channel (gathering) */
     int64_t rays, cut;
 } rad_block;
 
@@ -81,7 +82,7 @@ struct ulam_rad_solver {
     rad_block *blocks;
     ulam__moments m[3];
     double *sum, *sumsq; /* shooting: per patch and channel, of history tallies */
-    double sq, maxsq;
+    double sq, maxsq, maxc[3];
     ulam__run run; /* walks, time, ending (round.c) */
     int64_t rays, cut;
     int zero, met;
@@ -518,7 +519,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     rad_block *br = &s->blocks[k];
     ulam__moments zero = {0};
     br->m[0] = br->m[1] = br->m[2] = zero;
-    br->sq = br->maxsq = 0.0;
+    br->sq = br->maxsq = br->maxc[0] = br->maxc[1] = br->maxc[2] = 0.0;
     br->h.len = br->h.walks = br->rays = br->cut = br->h.nonfinite = 0;
     br->h.complete = br->h.nomem = 0;
     if (!ulam__mine(s->o.exec.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
@@ -529,7 +530,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             double sc[3];
             if (s->at) {
                 int64_t cut = 0;
-                ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, s->at_x, s->at_n, s->at_self, &r,
+                ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, ulam__point_gamma(s->pb.rho), s->at_x, s->at_n, s->at_self, &r,
                                  sc, &br->rays, &cut);
                 br->cut += cut;
             } else if (next_event(s->o.estimator)) {
@@ -539,6 +540,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             }
             for (int c = 0; c < 3; c++) {
                 ulam__moments_add(&br->m[c], sc[c]);
+                br->maxc[c] = fmax(br->maxc[c], sc[c]);
                 if (!isfinite(sc[c])) br->h.nonfinite++;
             }
             double x = sc[0] + sc[1] + sc[2];
@@ -567,6 +569,7 @@ static void merge_block(void *ctx, int k)
     for (int c = 0; c < 3; c++) ulam__moments_merge(&s->m[c], &br->m[c]);
     s->sq += br->sq;
     s->maxsq = fmax(s->maxsq, br->maxsq);
+    for (int c = 0; c < 3; c++) s->maxc[c] = fmax(s->maxc[c], br->maxc[c]);
     for (int64_t k = 0; k < br->h.len; k++) {
         const rad_tally *e = (const rad_tally *)br->h.tally + k;
         for (int c = 0; c < 3; c++) {
@@ -593,8 +596,8 @@ static void channel_range(const ulam_rad_solver *s, int c, double m, double E, d
 {
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
     if (s->at) { /* point walks: their weight window's range (point.c) */
-        *R = ulam__point_range(&s->pb, c, fabs(m), E / 4.0);
-        *bias = E * fabs(m) / 4.0;
+        *R = ulam__point_range(&s->pb, c);
+        *bias = 0.0;
         return;
     }
     double later = ulam__score_range(s->range[c], s->w1[c] * s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0);
@@ -603,15 +606,17 @@ static void channel_range(const ulam_rad_solver *s, int c, double m, double E, d
 }
 
 /* Channel c's 95% interval (stop.h) at estimate m: on the walks' scores (gathering) or the
- * particles' tallies at the patch over its area (shooting, the emission exact). */
+ * particles' tallies at the patch over its area (shooting, the emission exact).  A point
+ * solver's scores are checked against their certified range: one past it leaves no interval
+ * (and no stop by rel_err), as in ulam_solve's. */
 static void channel_interval(const ulam_rad_solver *s, int c, double m, double E, ulam__stop_ci *ci)
 {
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0, R, bias;
     double off = s->o.mode == ULAM_FORWARD ? s->s->emit[3 * s->o.query.index + c] : 0.0;
     channel_range(s, c, m, E, &R, &bias);
     int64_t n = s->run.walks;
-    ulam__stop_interval(n, off + s->m[c].mean / A, ulam__moments_variance(&s->m[c]) / (A * A), R, bias, 0.0, INFINITY,
-                        ulam__stop_epoch(n), ci);
+    ulam__stop_interval(n, off + s->m[c].mean / A, ulam__moments_variance(&s->m[c]) / (A * A), R, bias,
+                        s->at ? s->maxc[c] : 0.0, s->at ? R : INFINITY, ulam__stop_epoch(n), ci);
 }
 
 /* The walks the rel_err rule (stop.h) needs in channel c at estimate m. */
@@ -693,7 +698,7 @@ void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uin
     s->o.query.index = p, s->o.stop.rel_err = rel_err, s->o.exec.seed = seed, s->o.stop.max_seconds = max_seconds;
     first_bounds(s);
     s->m[0] = s->m[1] = s->m[2] = zero;
-    s->sq = s->maxsq = 0.0;
+    s->sq = s->maxsq = s->maxc[0] = s->maxc[1] = s->maxc[2] = 0.0;
     s->rays = s->cut = 0;
     ulam__run_reset(&s->run);
     s->zero = s->met = s->epoch = 0;

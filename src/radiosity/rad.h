@@ -141,9 +141,13 @@ void ulam__lights_vertex_parts(const ulam__lights *L, const ulam_scene *s, int e
 void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
                                const double n[3], int reflect, double out[3]);
 
-/* A point walk's weight window (point.c): Russian roulette once its largest weight is below this,
- * so that vertex k weighs at most max(rho^k, ULAM__POINT_WMIN). */
+/* A point walk's weight window (point.c): Russian roulette at the k-th landing once its largest
+ * weight is below ULAM__POINT_WMIN gamma^k (gamma = ulam__point_gamma(rho)), so that vertex k
+ * weighs at most max(rho^k, ULAM__POINT_WMIN gamma^k). */
 #define ULAM__POINT_WMIN 0.1
+
+/* The rate at which a point walk's weight floor falls, for largest reflectance rho < 1. */
+double ulam__point_gamma(double rho);
 
 /* What a point walk's score range is made of (patchwalk.c fills it, ulam__point_range reads
  * it), per channel and unit weight: light0 and hit0 at the walk's own point; light and hit the
@@ -155,13 +159,13 @@ typedef struct {
     int black;
 } ulam__point_bounds;
 
-/* A certified range for channel c of one point walk's score at estimate m, its vertices past
- * a truncation that moves the mean by at most E m left out; INFINITY without one (m <= 0). */
-double ulam__point_range(const ulam__point_bounds *b, int c, double m, double E);
+/* A certified range [0, R] for channel c of one point walk's score (INFINITY: none, light
+ * sampling alone beside an emitter). */
+double ulam__point_range(const ulam__point_bounds *b, int c);
 
 /* A point walk (point.c): one walk from x (unit normal n, on patch self or -1) on the continuous
- * surfaces: its RGB irradiance score; *rays gets the rays cast, *cut 1 when cut at max_steps. */
-void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps,
+ * surfaces, its weight floor falling at gamma (ulam__point_gamma): its RGB irradiance score; *rays gets the rays cast, *cut 1 when cut at max_steps. */
+void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps, double gamma,
                       const double x[3], const double n[3], int64_t self, ulam_rng *r, double score[3],
                       int64_t *rays, int64_t *cut);
 
