@@ -314,6 +314,33 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, ulam_
     return solver_alloc(t, opts, 0, out, err);
 }
 
+/* Check point x (normal n, or NULL: the patch's it lies on) and place it: *p the patch it lies
+ * on or -1, xx the point on that patch's plane exactly, nn the unit normal. */
+static int point_place(const ulam_scene *sc, const double x[3], const double n[3], int64_t *p, double xx[3],
+                       double nn[3], ulam_error *err)
+{
+    double len = n ? sqrt(ulam__dot3(n, n)) : 0.0;
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(x[k]) || (n && !isfinite(n[k]))) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a finite point and normal");
+    if (n && !(len > 0)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero normal");
+    *p = ulam_scene_locate(sc, x, ULAM_RAD_LOCATE_REL);
+    if (!n && *p < 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point on a patch (within %g of its size) or a normal for a "
+                                                   "sensor off the surfaces", ULAM_RAD_LOCATE_REL);
+    for (int k = 0; k < 3; k++) nn[k] = n ? n[k] / len : sc->normal[3 * *p + k], xx[k] = x[k];
+    if (*p >= 0 && ulam__dot3(nn, sc->normal + 3 * *p) < 1.0 - 1e-9)
+        return ulam__fail(err, ULAM_EINVAL, 0, *p, "the normal of patch %lld the point lies on (or no normal)",
+                          (long long)*p + 1);
+    if (*p >= 0) { /* onto the patch's plane exactly */
+        const double *v = sc->vert + 3 * sc->vidx[sc->start[*p]], *pn = sc->normal + 3 * *p;
+        double d[3];
+        ulam__sub3(x, v, d);
+        double h = ulam__dot3(d, pn);
+        for (int k = 0; k < 3; k++) xx[k] -= h * pn[k];
+    }
+    return ULAM_OK;
+}
+
 /* Prepare walks from point x (normal n, or NULL: the patch's it lies on). */
 int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, const double x[3], const double n[3],
                          ulam_rad_solver **out, ulam_error *err)
@@ -321,34 +348,36 @@ int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, const 
     ulam__clear(err);
     if (!t || !x || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, a point and an output");
     *out = NULL;
-    const ulam_scene *sc = ulam__tracer_scene(t);
-    double nn[3], len = n ? sqrt(ulam__dot3(n, n)) : 0.0;
-    for (int k = 0; k < 3; k++)
-        if (!isfinite(x[k]) || (n && !isfinite(n[k]))) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a finite point and normal");
-    if (n && !(len > 0)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero normal");
-    int64_t p = ulam_scene_locate(sc, x, ULAM_RAD_LOCATE_REL);
-    if (!n && p < 0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point on a patch (within %g of its size) or a normal for a "
-                                                   "sensor off the surfaces", ULAM_RAD_LOCATE_REL);
-    for (int k = 0; k < 3; k++) nn[k] = n ? n[k] / len : sc->normal[3 * p + k];
-    if (p >= 0 && ulam__dot3(nn, sc->normal + 3 * p) < 1.0 - 1e-9)
-        return ulam__fail(err, ULAM_EINVAL, 0, p, "the normal of patch %lld the point lies on (or no normal)",
-                          (long long)p + 1);
-    int status = solver_alloc(t, opts, 1, out, err);
-    if (status) return status;
+    double xx[3], nn[3];
+    int64_t p;
+    int status = point_place(ulam__tracer_scene(t), x, n, &p, xx, nn, err);
+    if (status || (status = solver_alloc(t, opts, 1, out, err))) return status;
     ulam_rad_solver *s = *out;
-    for (int k = 0; k < 3; k++) s->at_x[k] = x[k], s->at_n[k] = nn[k];
+    for (int k = 0; k < 3; k++) s->at_x[k] = xx[k], s->at_n[k] = nn[k];
     s->at_self = p;
-    if (p >= 0) { /* onto the patch's plane exactly */
-        const double *v = sc->vert + 3 * sc->vidx[sc->start[p]], *pn = sc->normal + 3 * p;
-        double d[3];
-        ulam__sub3(x, v, d);
-        double h = ulam__dot3(d, pn);
-        for (int k = 0; k < 3; k++) s->at_x[k] -= h * pn[k];
-    }
     score_bounds(s); /* with the point's own first vertex */
     if ((status = check_bounded(s, err))) *out = ulam_rad_solver_free(s);
     return status;
+}
+
+/* Move point solver s to point x (normal n, as ulam_rad_point_alloc's) with seed and
+ * max_seconds, its statistics cleared: the scene-wide parts of its score bounds (every patch's,
+ * point_bounds) and its workspace are kept, only the point's own vertex's bound is made anew. */
+int ulam__rad_point_restart(ulam_rad_solver *s, const double x[3], const double n[3], uint64_t seed, double max_seconds,
+                            ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s || !s->at || !x) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point solver and a point");
+    double xx[3], nn[3];
+    int64_t p;
+    int status = point_place(s->s, x, n, &p, xx, nn, err);
+    if (status) return status;
+    for (int k = 0; k < 3; k++) s->at_x[k] = xx[k], s->at_n[k] = nn[k];
+    s->at_self = p;
+    ulam__rad_solver_restart(s, -1, s->o.stop.rel_err, seed, max_seconds);
+    if (next_event(s->o.estimator))
+        ulam__lights_vertex_parts(&s->L, s->s, s->o.estimator, -1, s->at_x, s->at_n, s->pb.light0, s->pb.hit0);
+    return ULAM_OK;
 }
 
 /* A point solver's answer: irradiance, and radiosity on the patch the point lies on. */

@@ -90,6 +90,11 @@ const ulam_scene *ulam__tracer_scene(const ulam_tracer *t);
  * statistics cleared and its workspace kept. */
 void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds);
 
+/* Move point solver s to x (normal n, as ulam_rad_point_alloc's) with seed and max_seconds, its
+ * statistics cleared, its scene-wide score bounds and workspace kept (sensor grids). */
+int ulam__rad_point_restart(ulam_rad_solver *s, const double x[3], const double n[3], uint64_t seed, double max_seconds,
+                            ulam_error *err);
+
 /* Emitters of one emission and one normal (a subdivided lamp), boxed: what the score bounds
  * of ulam__lights_vertex_bound read. */
 typedef struct {
