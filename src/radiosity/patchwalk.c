@@ -620,7 +620,7 @@ static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r)
 /* Channel c's certified score range R and bias at estimate m (of B), in B's units: the range of
  * one walk's score (gathering) or of one particle's tally at the patch over its area
  * (shooting), at a truncation whose bias is at most E |m| / 4 when no whole-walk bound is known
- * (score_bounds). */
+ * (score_bounds); a point walk's whole range, finite and with no bias (ulam__point_range). */
 static void channel_range(const ulam_rad_solver *s, int c, double m, double E, double *R, double *bias)
 {
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
