@@ -43,6 +43,11 @@ struct ulam_solver {
     double *pq, *pr; /* forward rel_err: the push on b's part and residual (src/fpush_b.c; owned; NULL: none):
                         the walks start from pr, every estimate adds pq */
     ulam__fpush_b_info push; /* what that push did */
+    double *hitv;    /* rel_err with no score yet: src/hit.c's bound on each state's chance to score (NULL: none) */
+    char *hitt;      /* and the states where a walk scores */
+    int64_t hit_reads; /* entries its sweeps read */
+    int hit_sweep, hit_done;
+    double hit_walks; /* the least walks the rule can then need, (1 / p - 1) / E^2 (0: not computed) */
     double *bs;      /* b 2^-bexp when b is far from 1 (ulam__b_exponent; owned), else NULL */
     int bexp;        /* the estimates found on bs are times 2^bexp */
     int overflow;    /* the run ended because its estimate was not finite */
@@ -143,6 +148,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
     if (!s) return NULL;
     if (!s->k_borrowed) ulam__kernel_free(s->k);
     free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac), free(s->bs), free(s->pq), free(s->pr);
+    free(s->hitv), free(s->hitt);
     free(s->start_src), free(s->start_units), free(s->start_b);
     ulam_csr_free(s->mt);
     if (s->scratch)
@@ -1188,6 +1194,48 @@ static int search_reach(ulam_solver *s, const ulam_walk_result *r)
     return 1;
 }
 
+/* A rel_err run no walk has scored in yet (its estimate 0 and no score seen): the least walks
+ * the rule can need, (1 / p - 1) / E^2 with p the chance a walk scores at all (src/hit.c's
+ * bound: at the start state, or averaged over the starts or the forward sources), into
+ * s->hit_walks; the bound's sweeps go on while their reads stay within the walks' steps so far
+ * (at least 16 passes over the reachable rows) and the count is within the walk budget.  Only
+ * where the walks' reachable set is known and a score is a visit's or an ending's (collision,
+ * absorption; no splitting, which lets copies of one walk score). */
+static void zero_bound(ulam_solver *s, const ulam_walk_result *r)
+{
+    const ulam_walk_opts *o = &s->o;
+    int fwd = o->mode == ULAM_FORWARD;
+    if (!(o->stop.rel_err > 0) || r->walks < ULAM__REL_MIN || r->estimate + o->stop.rel_err_offset != 0.0 ||
+        s->maxsq != 0.0 || !s->reached || o->kernel.split > 0 || o->estimator == ULAM_EXPECTED || s->hit_done == 2)
+        return;
+    const ulam_csr *K = fwd ? s->mt : s->k->K;
+    if (!s->hitv) {
+        s->hitv = ulam__malloc((size_t)s->n, sizeof *s->hitv), s->hitt = ulam__calloc((size_t)s->n, 1);
+        if (!s->hitv || !s->hitt) {
+            s->hit_done = 2; /* no memory: no bound (the run goes on as before) */
+            return;
+        }
+        for (int64_t i = 0; i < s->n; i++) s->hitv[i] = 1.0, s->hitt[i] = fwd ? i == o->query.index : s->b[i] != 0.0;
+    }
+    double E = o->stop.rel_err, budget = fmax(16.0 * (double)(s->reach_nnz > 0 ? s->reach_nnz : ulam_csr_nnz(K)),
+                                             (double)s->steps);
+    for (;;) {
+        double p = 0.0, norm = 0.0;
+        if (fwd)
+            for (int64_t j = 0; j < s->n; j++) p += fabs(s->b[j]) * s->hitv[j], norm += fabs(s->b[j]);
+        else if (o->query.nstarts)
+            for (int64_t j = 0; j < o->query.nstarts; j++)
+                p += fabs(o->query.start_weights[j]) * s->hitv[o->query.starts[j]], norm += fabs(o->query.start_weights[j]);
+        else
+            p = s->hitv[o->query.index], norm = 1.0;
+        p = fmin(1.0, p / norm * (1.0 + 1e-9)); /* the sweeps' rounding */
+        s->hit_walks = p > 0 ? (1.0 / p - 1.0) / (E * E) : INFINITY;
+        if (s->hit_done || s->hit_walks > (double)o->stop.max_walks || (double)s->hit_reads >= budget) return;
+        s->hit_reads += ulam__hit_sweeps(K, s->reached, o->kernel.continue_q, o->kernel.kernel_alpha, s->hitt,
+                                         o->estimator == ULAM_ABSORPTION, s->hitv, 1, &s->hit_sweep, &s->hit_done);
+    }
+}
+
 /* Run one round of walks. */
 int ulam_solver_iterate(ulam_solver *s)
 {
@@ -1206,7 +1254,11 @@ int ulam_solver_iterate(ulam_solver *s)
     }
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
+    if (check) zero_bound(s, &r);
     if (check && rel_err_met(s, &r)) s->run.done = s->met = 1;
+    else if (check && s->o.stop.rel_err > 0 && s->hit_walks > (double)s->o.stop.max_walks && s->maxsq == 0.0 &&
+             r.estimate + s->o.stop.rel_err_offset == 0.0 && !(s->o.stop.max_seconds > 0))
+        s->run.done = s->out_of_reach = 1; /* no score yet, and the rule needs more walks than the budget before one */
     else if (s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.stop.rel_err_offset) > 0 &&
              !(r.cut_bound <= ULAM__CUT_SHARE * s->o.stop.rel_err * fabs(r.estimate + s->o.stop.rel_err_offset)))
         s->run.done = s->cut_stop = 1; /* the cuts' bias may exceed the target: more walks cannot help */
@@ -1355,6 +1407,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
         r->min_walks = fmin(ulam__stop_walks_needed(m, r->variance, R, ci.bias, E, ci.k),
                             ulam__stop_walks_needed(m, r->variance, Rs, (truncated ? E * m / 4.0 : 0.0) + r->cut_bound,
                                                     E, ci.k));
+        if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0) r->min_walks = s->hit_walks; /* no score yet: src/hit.c */
     }
     r->cut_stop = s->cut_stop;
     r->out_of_reach = s->out_of_reach;
@@ -1456,6 +1509,8 @@ static void reset(ulam_solver *s)
     s->maxsq = 0.0;
     ulam__run_reset(&s->run);
     s->met = s->cut_stop = s->out_of_reach = s->epoch = 0;
+    free(s->hitv), free(s->hitt); /* made for this b and estimator */
+    s->hitv = NULL, s->hitt = NULL, s->hit_reads = 0, s->hit_sweep = s->hit_done = 0, s->hit_walks = 0.0;
 }
 
 /* Restart a forward solver on a new right-hand side b (borrowed like the first) with a new

@@ -446,12 +446,54 @@ static void test_forward_rel_err(void **state)
     }
 }
 
+/* A zero running estimate (issue 25: "runs that cannot meet a target say so early ... never
+ * spin silently"): upwind convection-diffusion 30 x 30 (bench/gen.h, c = 1) by its Jacobi
+ * splitting, a point source at the centre, the upstream corner x_0 = 1.1e-11, which a walk
+ * from it reaches about never (the flow carries it off the grid in ~1 step).  No walk scores,
+ * so the rule cannot be met: before, a --rel-err 0.1 run walked to its budget (here 2^22) or,
+ * alone, to the 10^9 cap (~400 s).  Now src/hit.c bounds the chance a walk scores at all, the
+ * rule needs at least (1 / p - 1) / E^2 walks, and the run stops "not met" once that passes the
+ * budget: within 2^20 walks in both cases, for collision and absorption, seeds 1..3, its printed
+ * interval covering the exact x_0 (a direct solve) and its min_walks past the budget. */
+static void test_zero_estimate_stops(void **state)
+{
+    (void)state;
+    ulam_csr *A = bench_convdiff(30, 1.0), *M;
+    double one[900], b[900], x[900];
+    for (int i = 0; i < 900; i++) one[i] = i == 15 * 30 + 15 ? 1.0 : 0.0;
+    assert_int_equal(ulam_jacobi(A, one, 1.0, &M, b, NULL), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    assert_true(x[0] > 0 && x[0] < 1e-10);
+    for (int c = 0; c < 12; c++) {
+        if (!test_case(5000L + c)) continue;
+        int est = c % 2 ? ULAM_ABSORPTION : ULAM_COLLISION;
+        int64_t budget = c / 6 ? 0 : (int64_t)1 << 22; /* a budget first: the old run fails fast */
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.estimator = est, o.stop.rel_err = 0.1, o.stop.max_walks = budget, o.exec.seed = 1 + (uint64_t)(c / 2 % 3);
+        ulam_walk_result r;
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+        if (c % 6 == 0 || c % 6 == 1)
+            print_message("convdiff upstream corner, %s, rel_err 0.1, %s: %lld walks, estimate %g, CI [%g, %g], "
+                          "min_walks %.4g, out of reach %d\n", est ? "absorption" : "collision",
+                          budget ? "budget 2^22" : "alone", (long long)r.walks, r.estimate, r.ci95[0], r.ci95[1],
+                          r.min_walks, r.out_of_reach);
+        assert_false(r.rel_err_met);
+        assert_true(r.out_of_reach);
+        assert_true(r.walks <= (int64_t)1 << 20);
+        assert_true(r.min_walks > (budget ? (double)budget : 1e9));
+        assert_true(r.ci95[0] <= x[0] && x[0] <= r.ci95[1]);
+    }
+    test_case_done();
+    ulam_csr_free(A), ulam_csr_free(M);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_never_zero_width), cmocka_unit_test(test_metastable_fixed),
                                        cmocka_unit_test(test_metastable_rounds), cmocka_unit_test(test_metastable_auto),
                                        cmocka_unit_test(test_metastable_rel_err), cmocka_unit_test(test_laplace_corner),
                                        cmocka_unit_test(test_rel_err_cost), cmocka_unit_test(test_push_b),
-                                       cmocka_unit_test(test_laplace_noisy_auto), cmocka_unit_test(test_forward_rel_err)};
+                                       cmocka_unit_test(test_laplace_noisy_auto), cmocka_unit_test(test_forward_rel_err),
+                                       cmocka_unit_test(test_zero_estimate_stops)};
     return test_run(tests);
 }
