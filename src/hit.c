@@ -22,27 +22,27 @@
 
 #include <math.h>
 
-/* Gauss-Seidel sweeps of v <- a + c P v over the states in seen (v: 1 on entry, kept between
- * calls), in ascending and descending order by turns (*sweep counts them), at most `sweeps`
- * of them or until one lowers no entry by more than a millionth of itself (then *done); the
- * entries read. */
-int64_t ulam__hit_sweeps(const ulam_csr *K, const char *seen, double continue_q, double alpha, const char *target,
-                         int absorb, double *v, int sweeps, int *sweep, int *done)
+/* Gauss-Seidel sweeps of v <- a + c P v over the states listed (ascending; v: 1 there on entry,
+ * kept between calls), in ascending and descending order by turns (*sweep counts them), at most
+ * `sweeps` of them or until one lowers no entry by more than a millionth of itself (then *done);
+ * the entries read. */
+int64_t ulam__hit_sweeps(const ulam_csr *K, const int64_t *states, int64_t count, double continue_q, double alpha,
+                         const char *target, int absorb, double *v, int sweeps, int *sweep, int *done)
 {
-    int64_t n = K->nrows, reads = 0;
+    int64_t reads = 0;
     for (int it = 0; it < sweeps && !*done; it++, (*sweep)++) {
         double worst = 0.0;
         int down = *sweep & 1;
-        for (int64_t t = 0; t < n; t++) {
-            int64_t i = down ? n - 1 - t : t;
-            if (!seen[i] || (target[i] && !absorb)) continue; /* collision: a scoring state scores, v = 1 */
+        for (int64_t t = 0; t < count; t++) {
+            int64_t i = states[down ? count - 1 - t : t];
+            if (target[i] && !absorb) continue; /* collision: a scoring state scores, v = 1 */
             int64_t a = K->rowptr[i], e = K->rowptr[i + 1];
             double S = 0.0, Sa = 0.0, acc = 0.0;
             for (int64_t k = a; k < e; k++) {
                 double w = fabs(K->val[k]), wa = alpha == 1.0 ? w : pow(w, alpha);
                 S += w, Sa += wa, acc += wa * v[K->colidx[k]];
             }
-            reads += e - a;
+            reads += 1 + e - a;
             double q = ulam__continuation(S, continue_q);
             double nv = fmin(v[i], (target[i] ? 1.0 - q : 0.0) + (Sa > 0 ? q * acc / Sa : 0.0)); /* both >= h */
             if (v[i] > 0) worst = fmax(worst, (v[i] - nv) / v[i]);

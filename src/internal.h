@@ -138,13 +138,14 @@ int ulam__fpush_b(const ulam_csr *Mt, int64_t index, ulam__fpush_b_cost cost, vo
                   double *r, ulam__fpush_b_info *info);
 
 /* The bound on the probability that a walk scores at all (src/hit.c): Gauss-Seidel sweeps of
- * v <- a + c P v over the states in seen, K the walks' kernel (continuation continue_q, exponent
- * alpha), target the states where a walk scores (absorb: by ending there; else by a visit), v
- * 1 on entry and an upper bound on each state's probability after every sweep; at most `sweeps`
- * sweeps (*sweep counts them, alternating ascending and descending order) or until converged
- * (*done); the entries read. */
-int64_t ulam__hit_sweeps(const ulam_csr *K, const char *seen, double continue_q, double alpha, const char *target,
-                         int absorb, double *v, int sweeps, int *sweep, int *done);
+ * v <- a + c P v over the `count` states listed in ascending order (the walks' reachable set:
+ * closed under their moves), K the walks' kernel (continuation continue_q, exponent alpha),
+ * target the states where a walk scores (absorb: by ending there; else by a visit), v 1 there on
+ * entry and an upper bound on each listed state's probability after every sweep; at most
+ * `sweeps` sweeps (*sweep counts them, alternating ascending and descending order) or until
+ * converged (*done); the entries read (and one a state). */
+int64_t ulam__hit_sweeps(const ulam_csr *K, const int64_t *states, int64_t count, double continue_q, double alpha,
+                         const char *target, int absorb, double *v, int sweeps, int *sweep, int *done);
 
 struct ulam_kernel; /* src/kernel.h */
 

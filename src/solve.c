@@ -45,6 +45,7 @@ struct ulam_solver {
     ulam__fpush_b_info push; /* what that push did */
     double *hitv;    /* rel_err with no score yet: src/hit.c's bound on each state's chance to score (NULL: none) */
     char *hitt;      /* and the states where a walk scores */
+    int64_t *hits, nhits; /* and the reachable states it sweeps, ascending */
     int64_t hit_reads; /* entries its sweeps read */
     int hit_sweep, hit_done;
     double hit_walks; /* the least walks the rule can then need, (1 / p - 1) / E^2 (0: not computed) */
@@ -148,7 +149,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
     if (!s) return NULL;
     if (!s->k_borrowed) ulam__kernel_free(s->k);
     free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac), free(s->bs), free(s->pq), free(s->pr);
-    free(s->hitv), free(s->hitt);
+    free(s->hitv), free(s->hitt), free(s->hits);
     free(s->start_src), free(s->start_units), free(s->start_b);
     ulam_csr_free(s->mt);
     if (s->scratch)
@@ -1209,20 +1210,23 @@ static void zero_bound(ulam_solver *s, const ulam_walk_result *r)
         s->maxsq != 0.0 || !s->reached || o->kernel.split > 0 || o->estimator == ULAM_EXPECTED || s->hit_done == 2)
         return;
     const ulam_csr *K = fwd ? s->mt : s->k->K;
-    if (!s->hitv) {
+    if (!s->hitv) { /* touching (and reading b at) the reachable states alone */
         s->hitv = ulam__malloc((size_t)s->n, sizeof *s->hitv), s->hitt = ulam__calloc((size_t)s->n, 1);
-        if (!s->hitv || !s->hitt) {
+        for (int64_t i = 0; i < s->n; i++) s->nhits += s->reached[i] != 0;
+        s->hits = ulam__malloc((size_t)(s->nhits > 0 ? s->nhits : 1), sizeof *s->hits);
+        if (!s->hitv || !s->hitt || !s->hits) {
             s->hit_done = 2; /* no memory: no bound (the run goes on as before) */
             return;
         }
-        for (int64_t i = 0; i < s->n; i++) s->hitv[i] = 1.0, s->hitt[i] = fwd ? i == o->query.index : s->b[i] != 0.0;
+        for (int64_t i = 0, k = 0; i < s->n; i++)
+            if (s->reached[i]) s->hits[k++] = i, s->hitv[i] = 1.0, s->hitt[i] = fwd ? i == o->query.index : s->b[i] != 0.0;
     }
     double E = o->stop.rel_err, budget = fmax(16.0 * (double)(s->reach_nnz > 0 ? s->reach_nnz : ulam_csr_nnz(K)),
                                              (double)s->steps);
     for (;;) {
         double p = 0.0, norm = 0.0;
-        if (fwd)
-            for (int64_t j = 0; j < s->n; j++) p += fabs(s->b[j]) * s->hitv[j], norm += fabs(s->b[j]);
+        if (fwd) /* the sources are reachable */
+            for (int64_t j = 0; j < s->n; j++) p += s->b[j] != 0.0 ? fabs(s->b[j]) * s->hitv[j] : 0.0, norm += fabs(s->b[j]);
         else if (o->query.nstarts)
             for (int64_t j = 0; j < o->query.nstarts; j++)
                 p += fabs(o->query.start_weights[j]) * s->hitv[o->query.starts[j]], norm += fabs(o->query.start_weights[j]);
@@ -1231,7 +1235,7 @@ static void zero_bound(ulam_solver *s, const ulam_walk_result *r)
         p = fmin(1.0, p / norm * (1.0 + 1e-9)); /* the sweeps' rounding */
         s->hit_walks = p > 0 ? (1.0 / p - 1.0) / (E * E) : INFINITY;
         if (s->hit_done || s->hit_walks > (double)o->stop.max_walks || (double)s->hit_reads >= budget) return;
-        s->hit_reads += ulam__hit_sweeps(K, s->reached, o->kernel.continue_q, o->kernel.kernel_alpha, s->hitt,
+        s->hit_reads += ulam__hit_sweeps(K, s->hits, s->nhits, o->kernel.continue_q, o->kernel.kernel_alpha, s->hitt,
                                          o->estimator == ULAM_ABSORPTION, s->hitv, 1, &s->hit_sweep, &s->hit_done);
     }
 }
@@ -1509,8 +1513,8 @@ static void reset(ulam_solver *s)
     s->maxsq = 0.0;
     ulam__run_reset(&s->run);
     s->met = s->cut_stop = s->out_of_reach = s->epoch = 0;
-    free(s->hitv), free(s->hitt); /* made for this b and estimator */
-    s->hitv = NULL, s->hitt = NULL, s->hit_reads = 0, s->hit_sweep = s->hit_done = 0, s->hit_walks = 0.0;
+    free(s->hitv), free(s->hitt), free(s->hits); /* made for this b and estimator */
+    s->hitv = NULL, s->hitt = NULL, s->hits = NULL, s->nhits = 0, s->hit_reads = 0, s->hit_sweep = s->hit_done = 0, s->hit_walks = 0.0;
 }
 
 /* Restart a forward solver on a new right-hand side b (borrowed like the first) with a new
