@@ -959,7 +959,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
-    if (!kernel) s->k->rc = rc;
+    if (!kernel && ulam__kernel_set_check(s->k, &rc)) goto nomem;
     s->rho4 = (ulam_power){.rho = NAN, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
     if ((status = take_bounds(s, K, o.stop.rel_err > 0 && o.stop.max_walks == 0 && o.stop.max_seconds == 0, err))) {
         ulam_solver_free(s);
