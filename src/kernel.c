@@ -356,31 +356,61 @@ static void fail(ulam_kernel *k, int status, int64_t i)
     if (atomic_compare_exchange_strong(&k->status, &ok, status)) atomic_store(&k->bad, i);
 }
 
-/* Rescore the rows k's records hold (every built row): from the records alone, but a row whose
- * (K b)_i the expected estimator needs, read again with its b_j (its record then keeps it). */
+/* A row left stale by rescore_records: its place holds -(record + 2) until a walk reaches it. */
+#define STALE(o) (-(int32_t)(o) - 2)
+
+/* Give row r of k (state i, at header h) its (M b)_i read again with its b_j (w: scratch) and
+ * its scores; a failure is recorded and the row scores nothing. */
+static void rescore_mb(ulam_kernel *k, ulam__rowrec *r, int64_t i, ulam__row *h, ulam__kscratch *w)
+{
+    if (k->rc.fetch(k->rc.ctx, i, 0, &w->rb, NULL)) { /* read before, so intact unless the file changed */
+        h->visit = h->end = 0.0, fail(k, ULAM_ESYNTAX, i);
+        return;
+    }
+    row_view v = {w->rb.col, w->rb.val, w->rb.len, r->g};
+    r->mb = expected_score(k, &v, &w->rb);
+    scores_of(k, r->g, r->pstar, r->mb, &h->visit, &h->end);
+    if (!isfinite(h->visit) || !isfinite(h->end)) h->visit = h->end = 0.0, fail(k, ULAM_ENONFINITE, i);
+}
+
+/* Rescore the rows k's records hold (every built row) from the records alone.  A row whose
+ * (M b)_i the expected estimator needs and no record holds is left stale instead of read now:
+ * its place marks it, every move into it is unresolved again, so the first walk to reach it
+ * rescores it (ulam__kernel_unit) and a row no walk reaches is never read; rescoring for
+ * another estimator makes every row current again. */
 static int rescore_records(ulam_kernel *k)
 {
-    int64_t nrec = atomic_load(&k->nrec);
-    ulam__kscratch w = {0};
+    int64_t nrec = atomic_load(&k->nrec), stale = 0;
     for (int64_t o = 0; o < nrec; o++) {
         ulam__rowrec *r = &k->rec[o];
         ulam__row *h = ulam__kernel_row(k, r->u);
-        int64_t i = h->state;
+        _Atomic int32_t *at = place(k, h->state, 0);
         if (scores_mb(k) && isnan(r->mb)) {
-            if (k->rc.fetch(k->rc.ctx, i, 0, &w.rb, NULL)) { /* read before, so intact unless the file changed */
-                fail(k, ULAM_ESYNTAX, i);
-                break;
-            }
-            row_view v = {w.rb.col, w.rb.val, w.rb.len, r->g};
-            r->mb = expected_score(k, &v, &w.rb);
+            atomic_store_explicit(at, STALE(o), memory_order_relaxed);
+            h->visit = h->end = 0.0, stale++;
+            continue;
         }
+        atomic_store_explicit(at, (int32_t)r->u + 1, memory_order_relaxed); /* current (it may have been stale) */
         scores_of(k, r->g, r->pstar, r->mb, &h->visit, &h->end);
         if (!isfinite(h->visit) || !isfinite(h->end)) {
-            fail(k, ULAM_ENONFINITE, i);
+            fail(k, ULAM_ENONFINITE, h->state);
             break;
         }
     }
-    ulam__kscratch_free(&w);
+    for (int64_t o = 0; stale && o < nrec; o++) { /* moves into stale rows: unresolved, as before they were built */
+        ulam__row *h = ulam__kernel_row(k, k->rec[o].u);
+        ulam__slot *sl = (ulam__slot *)(void *)h + ULAM__HEAD;
+        for (int32_t q = 0; q < h->len; q++)
+            for (int side = 0; side < 2; side++) {
+                _Atomic int32_t *x = side ? &sl[q].b : &sl[q].a;
+                int32_t out = atomic_load_explicit(x, memory_order_relaxed), t = ulam__outcome_target(out);
+                if (out == ULAM__TERMINATE || t >= ULAM__UNRESOLVED) continue;
+                int64_t j = ulam__kernel_row(k, t)->state;
+                if (atomic_load_explicit(place(k, j, 0), memory_order_relaxed) > -2) continue;
+                t = ULAM__UNRESOLVED + (int32_t)j;
+                atomic_store_explicit(x, out < 0 ? ~t : t, memory_order_relaxed);
+            }
+    }
     return atomic_load(&k->status);
 }
 
@@ -558,7 +588,13 @@ int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
         atomic_fetch_add_explicit(&k->built, 1, memory_order_relaxed);
         return (int32_t)u;
     }
-    while ((v = atomic_load_explicit(at, memory_order_acquire)) < 0) continue;
+    while ((v = atomic_load_explicit(at, memory_order_acquire)) < 0)
+        if (v <= -2 && atomic_compare_exchange_strong_explicit(at, &v, -1, memory_order_acquire, memory_order_acquire)) {
+            ulam__rowrec *r = &k->rec[-(int64_t)v - 2]; /* stale (rescore_records): rescored by the thread that claims it */
+            rescore_mb(k, r, j, ulam__kernel_row(k, r->u), w);
+            atomic_store_explicit(at, (int32_t)r->u + 1, memory_order_release);
+            return (int32_t)r->u;
+        }
     return v - 1;
 }
 
@@ -589,6 +625,13 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
 {
     const ulam_csr *K = k->K;
     int64_t from = atomic_load(&k->top), u = from, bad = -1;
+    for (int64_t o = 0; k->rec && !k->rec_stale && o < atomic_load(&k->nrec); o++) { /* stale rows current first: */
+        ulam__rowrec *r = &k->rec[o]; /* the rows built below name their targets' places */
+        int64_t i = ulam__kernel_row(k, r->u)->state;
+        if (atomic_load_explicit(place(k, i, 0), memory_order_relaxed) > -2) continue;
+        rescore_mb(k, r, i, ulam__kernel_row(k, r->u), &w[0]);
+        atomic_store_explicit(place(k, i, 0), (int32_t)r->u + 1, memory_order_relaxed);
+    }
     k->rec_stale = 1; /* the rows built here keep no record */
     if (ulam__rows_verify(&k->rc, 0, k->n, &bad)) { /* every row is read below: every block verified first */
         fail(k, ULAM_ESYNTAX, bad);

@@ -1450,6 +1450,10 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *e
     if ((status = check_verdicts(s->M, s, err))) return status;
     s->o.stop.max_walks = ulam__walk_cap(&o);
     if (rescore && (status = ulam__kernel_rescore(s->k, o.estimator))) return kernel_failure(s->k, s->o.policy.system, err);
+    if (rescore && o.mode == ULAM_ADJOINT) { /* the start row current (rescoring may leave rows to the walks) */
+        s->w.start = ulam__kernel_unit(s->k, o.query.index, &s->ks[0]);
+        if (atomic_load(&s->k->status)) return kernel_failure(s->k, s->o.policy.system, err);
+    }
     s->w.interrupt = o.stop.interrupt;
     s->w.score0 = o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED ? s->b[o.query.index] : 0.0;
     s->w.expected = o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED;
