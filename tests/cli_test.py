@@ -287,7 +287,8 @@ CASES += [
      r"^ulam radiosity: warning: .*shiny.mtl: material 'glass' is rendered matte \(Kd, Ke\): ignored Ks "
      r"\(.*shiny.mtl:12\), Ns \(.*:13\), d \(.*:14\), illum \(.*:15\), map_Kd \(.*:16\)\n$", r"point 1"),
     (["radiosity", SC + "cube.obj", "--at", "0.5,0,0.5", "--walks", "2000"], 0, "",
-     r"point 1 +0.5 0 0.5, normal 0 1 0 \(patch 1, floor\)"),
+     r"point 1 +0.5 0 0.5, normal 0 1 0 \(patch 1, floor\)\n  irradiance R [0-9.]+ \+- [0-9.e-]+ \(95% CI [0-9.]+ \.\. "
+     r"[0-9.]+\)   radiosity R [0-9.]+ \+- [0-9.e-]+ \(95% CI"),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "next-event", "--mis", "heavy"], 2,
      r"--mis expects power, balance or none", ""),
     (["radiosity", SC + "cube.obj", "--mode", "shoot", "--estimator", "next-event"], 2,
@@ -1328,8 +1329,12 @@ def check_radiosity_grid(ulam):
         assert j["grid"]["nu"] == 3 and j["grid"]["nv"] == 2 and len(pts) == 6, j["grid"]
         for p in pts:
             assert p["patch"] is None and abs(p["irradiance"][0] - 2) <= 4 * p["irradiance_stderr"][0], p
+            assert p["irradiance_ci95_lo"][0] <= p["irradiance"][0] <= p["irradiance_ci95_hi"][0], p
         rows = open(csv).read().splitlines()
-        assert rows[0].startswith("i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks") and len(rows) == 7, rows
+        assert rows[0] == "i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks,ci95_lo,ci95_hi" and len(rows) == 7, rows
+        for row in rows[1:]:  # the illuminance's 95% interval (src/stop.c's, the channels' half-widths weighted)
+            v = [float(x) for x in row.split(",")]
+            assert v[14] <= v[11] <= v[15] and v[15] - v[14] > 2 * 1.96 * v[12] * 0.5, row
         assert open(png, "rb").read()[:8] == b"\x89PNG\r\n\x1a\n"
         assert sorted(os.listdir(d)) == ["g.csv", "g.png"], os.listdir(d)
 
