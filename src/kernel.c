@@ -33,7 +33,9 @@
  *
  * With k->rc (a prepared file's verification, src/cache.c) every row's block is verified before
  * the row is first read, and all of K before the kernel is completed; a damaged block fails the
- * kernel as a corrupt row does. */
+ * kernel as a corrupt row does.  Rows read from a file are dear (a system call each part), so
+ * such a kernel keeps what rescoring a row for another estimator needs (ulam__rowrec) and reads a
+ * row again only for the expected estimator's (K b)_i, when a walk first reaches it. */
 #include "kernel.h"
 
 #include <math.h>
