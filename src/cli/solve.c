@@ -166,6 +166,12 @@ static void print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, in
         printf("rel-err         NOT met (target %.3g): a score passed the certified range, so no interval can be "
                "printed; stopped after %lld walks, over 1024 times the %.4g the rule asked for\n", o->stop.rel_err,
                (long long)r->walks, r->min_walks);
+    else if (o->stop.rel_err > 0 && r->estimate == 0 && r->out_of_reach && r->min_walks > 0 && isfinite(r->min_walks))
+        printf("rel-err         NOT met (target %.3g): no walk has scored in %lld; a walk scores at all with probability "
+               "at most %.3g (certified from where it can go), so the rule asks for at least %.4g walks, %s: stopped "
+               "early, the interval above\n", o->stop.rel_err, (long long)r->walks,
+               1.0 / (1.0 + r->min_walks * o->stop.rel_err * o->stop.rel_err), r->min_walks,
+               o->stop.max_walks > 0 ? "more than --walks" : "beyond the 1e9 cap");
     else if (o->stop.rel_err > 0 && r->fourth_finite != 1 && (verbose || !r->rel_err_met))
         printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
                "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
