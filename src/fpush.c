@@ -251,6 +251,7 @@ static void walk_one(walker *w, ulam_rng *rng)
             break;
         }
         double v = u - stop;
+        if (!w->known[j]) row_sums(Mt, j, w->cs, w->mx, w->known, w->cum); /* on the first visit */
         if (!(v < w->cs[j])) break; /* the walk dies */
         int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a;
         if (w->known[j] == 2) { /* the first entry whose running sum exceeds v */
@@ -318,7 +319,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     double *r = ulam__calloc((size_t)n, sizeof *r);
     if (!r) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the residual");
     int64_t cap = 100 * ulam_csr_nnz(M) + 1000000;
-    int status = ulam__sweep_push(Mt, o->source, o->rmax, o->rmax > 0 ? NULL : walk_work, &pl, cap, x, r, swi);
+    int status = ulam__sweep_push_pull(M, Mt, o->source, o->rmax, o->rmax > 0 ? NULL : walk_work, &pl, cap, x, r, swi);
     if (status == ULAM_ENOCONV) status = ULAM_OK; /* ||M||_1 < 1: the cap only ends the push; the walks take the rest */
     if (status) {
         free(r);
@@ -334,9 +335,9 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     walker w = {.Mt = Mt, .r = r, .k = swi->support, .alpha = alpha};
     int32_t *idx = NULL, *alias = NULL, *work = NULL;
     double *prob = NULL;
-    int sgn = 0;
-    for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn; e++) sgn = Mt->val[e] < 0;
-    for (int64_t j = 0; j < n && !sgn; j++) sgn = r[j] < 0;
+    int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 and r >= 0 */
+    for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
+    for (int64_t j = 0; j < n && !sgn && !swi->nonneg; j++) sgn = r[j] < 0;
     double R = sgn ? 2.0 * R0 : R0; /* the scores' range */
     int64_t N = 0;
     int k = 1;
@@ -352,7 +353,6 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     }
     if (!status && w.k > 0) {
         alias_build(r, n, swi->r_sum, idx, prob, alias, work);
-        for (int64_t j = 0; j < n; j++) row_sums(Mt, j, w.cs, w.mx, w.known, w.cum); /* one streaming pass */
         w.idx = idx, w.prob = prob, w.alias = alias;
         ulam_rng rng;
         ulam_rng_seed(&rng, o->walk.exec.seed, 0);
