@@ -14,7 +14,13 @@
  * makes, 1 / (1 - ||M||_1) from the guards' one-pass bound).  Intervals: p_i + the walks' normal
  * interval where the walks saw two values at i; where they did not (one score or none: the
  * sample says nothing about what it missed), the certified bound of the walk part,
- * |(I - M)^-1 r|_i <= ||r||_1 / (1 - ||M||_1); every interval clipped to p_i -+ that bound. */
+ * |(I - M)^-1 r|_i <= ||r||_1 / (1 - ||M||_1); every interval clipped to p_i -+ that bound.
+ *
+ * For ||M||_1 < 1 the sweep push (src/sweep.c) and terminal walks: each walk scores 0 or R0 at
+ * every component, so where M, r >= 0 a component's interval is src/stop.c's KL (Chernoff-
+ * Hoeffding) interval of its hit count, stitched over the checkpoints the rule may stop at; with
+ * signs, the empirical-Bernstein one.  A component no walk reached gets p_i + [0, about 3.7 R0 /
+ * N] against the empirical-Bernstein 9.6 R0 / N, so the same accuracy takes ~2.6x fewer walks. */
 #include "internal.h"
 #include "stop.h"
 
@@ -25,6 +31,7 @@
 #define ULAM__FPUSH_STEP_COST 100.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM under load:
                                       0.9 us a step, 6 ns a push operation; a step misses the cache, a sweep streams) */
 #define ULAM__FPUSH_RANGE_SHARE 0.8 /* the share of E delta the first checkpoint leaves the interval's range term */
+#define ULAM__FPUSH_KL_KEPT 1024    /* hit counts whose interval a checkpoint keeps (the rest computed each time) */
 
 /* The defaults. */
 ulam_fpush_opts ulam_fpush_defaults(void)
@@ -150,24 +157,35 @@ static int64_t epoch_end(int k)
     return m;
 }
 
-/* k0 for walk scores of range R. */
-static int first_epoch(double R, double E, double delta)
+/* The upper end of the interval of a component no walk ended at, N walks, R0 a hit's score,
+ * stitching index k (src/stop.c's KL interval; 0: a count fixed in advance). */
+static double none_hi(int64_t N, int k, double R0)
 {
-    double L = ulam__stop_log(1);
+    double lo, hi;
+    ulam__stop_kl_interval(N, 0.0, k, &lo, &hi);
+    return R0 * hi;
+}
+
+/* k0 for walk scores of range R (kl: scores 0 or R, the KL interval; else empirical Bernstein). */
+static int first_epoch(double R, double E, double delta, int kl)
+{
+    double L = ulam__stop_log(1), room = ULAM__FPUSH_RANGE_SHARE * E * delta;
     int k = 1;
-    while (k < 200 && !(7.0 * R * L / (3.0 * ((double)epoch_end(k) - 1.0)) <= ULAM__FPUSH_RANGE_SHARE * E * delta)) k++;
+    while (k < 200 && !(kl ? none_hi(epoch_end(k), 1, R) <= room : 7.0 * R * L / (3.0 * ((double)epoch_end(k) - 1.0)) <= room))
+        k++;
     return k;
 }
 
 /* The walks' work (push operations) a residual of mass r_sum leaves (ulam__sweep_cost): the
- * walk count whose range term is ULAM__FPUSH_RANGE_SHARE E delta at stitching index 1, at least
+ * walk count whose interval for a component no walk ended at is ULAM__FPUSH_RANGE_SHARE E delta
+ * wide at stitching index 1 (the KL interval of scores 0 or R0: M >= 0 makes r >= 0), at least
  * one block (a fixed count: that count in proportion to r_sum, the accuracy it buys). */
 static double walk_work(double r_sum, void *ctx)
 {
     const plan *pl = ctx;
-    double L = ulam__stop_log(1), R = r_sum / (1.0 - pl->alpha);
+    double R = r_sum / (1.0 - pl->alpha), c = log(2.0 / ULAM__STOP_DELTA) + log(2.0); /* N (1 - e^(-c/N)) ~ c */
     double N = pl->fixed > 0 ? (double)pl->fixed * r_sum
-                             : fmax(ULAM__STOP_N0, 7.0 * R * L / (3.0 * ULAM__FPUSH_RANGE_SHARE * pl->E * pl->delta) + 1.0);
+                             : fmax(ULAM__STOP_N0, c * R / (ULAM__FPUSH_RANGE_SHARE * pl->E * pl->delta) + 1.0);
     return N * pl->visits * pl->step_cost;
 }
 
@@ -228,6 +246,52 @@ typedef struct {
     int32_t *hp, *hn; /* walks that ended at i with score +R0, -R0 */
     int64_t steps;
 } walker;
+
+/* The KL intervals (src/stop.c) of hit counts below ULAM__FPUSH_KL_KEPT at one checkpoint. */
+typedef struct {
+    int64_t N;
+    int k;
+    double lo[ULAM__FPUSH_KL_KEPT], hi[ULAM__FPUSH_KL_KEPT];
+    unsigned char have[ULAM__FPUSH_KL_KEPT];
+} kl_kept;
+
+/* The interval R0 [lo, hi] for ((I - M)^-1 r)_i from h of N walks ending at i (scores 0 or R0),
+ * at stitching index k (0: a count fixed in advance). */
+static void hits_interval(kl_kept *c, int64_t N, int k, int64_t h, double R0, double *lo, double *hi)
+{
+    if (c->N != N || c->k != k) memset(c->have, 0, sizeof c->have), c->N = N, c->k = k;
+    double a, b;
+    if (h < ULAM__FPUSH_KL_KEPT && c->have[h]) {
+        a = c->lo[h], b = c->hi[h];
+    } else {
+        ulam__stop_kl_interval(N, (double)h / (double)N, k, &a, &b);
+        if (h < ULAM__FPUSH_KL_KEPT) c->lo[h] = a, c->hi[h] = b, c->have[h] = 1;
+    }
+    *lo = R0 * a, *hi = R0 * b;
+}
+
+/* Whether an interval [a, b] around est meets relative error E at delta: b < delta (x_i >= delta
+ * only if the interval misses it), or est within E max(a, delta) of both ends (so within E x_i of
+ * any x_i >= delta inside it). */
+static int interval_met(double a, double b, double est, double E, double delta)
+{
+    return b < delta || fmax(est - a, b - est) <= E * fmax(a, delta);
+}
+
+/* rule_met for scores 0 or R0 (M, r >= 0): the KL intervals. */
+static int rule_met_kl(const walker *w, kl_kept *c, const double *p, int64_t n, int64_t N, int k, double R0, double E,
+                       double delta)
+{
+    double lo, hi;
+    hits_interval(c, N, k, 0, R0, &lo, &hi);
+    if (!(hi <= E * delta)) return 0; /* a component no walk ended at, p_i just under delta */
+    for (int64_t i = 0; i < n; i++) {
+        if (!w->hp[i]) continue;
+        hits_interval(c, N, k, w->hp[i], R0, &lo, &hi);
+        if (!interval_met(p[i] + lo, p[i] + hi, p[i] + R0 * (double)w->hp[i] / (double)N, E, delta)) return 0;
+    }
+    return 1;
+}
 
 /* One terminal walk: from j drawn with probability |r_j| / ||r||_1, stop and score at the state
  * it is at with probability 1 - alpha, else move along column j of M with probability |M_kj|
@@ -340,7 +404,9 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     for (int64_t j = 0; j < n && !sgn && !swi->nonneg; j++) sgn = r[j] < 0;
     double R = sgn ? 2.0 * R0 : R0; /* the scores' range */
     int64_t N = 0;
-    int k = 1;
+    int k = 1, kk = -1; /* kk: the KL interval's index when not k */
+    kl_kept *kept = sgn ? NULL : ulam__malloc(1, sizeof *kept);
+    if (kept) kept->N = -1;
     if (w.k > 0) {
         idx = ulam__malloc((size_t)w.k, sizeof *idx), alias = ulam__malloc((size_t)w.k, sizeof *alias);
         work = ulam__malloc((size_t)w.k, sizeof *work), prob = ulam__malloc((size_t)w.k, sizeof *prob);
@@ -348,7 +414,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         w.cum = ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum);
         w.known = ulam__calloc((size_t)n, 1), w.hp = ulam__calloc((size_t)n, sizeof *w.hp);
         if (sgn) w.hn = ulam__calloc((size_t)n, sizeof *w.hn);
-        if (!idx || !alias || !work || !prob || !w.cs || !w.mx || !w.cum || !w.known || !w.hp || (sgn && !w.hn))
+        if (!idx || !alias || !work || !prob || !w.cs || !w.mx || !w.cum || !w.known || !w.hp || (sgn ? !w.hn : !kept))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
     }
     if (!status && w.k > 0) {
@@ -358,7 +424,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         ulam_rng_seed(&rng, o->walk.exec.seed, 0);
         int64_t cap_w = o->walk.stop.max_walks > 0 ? o->walk.stop.max_walks : INT32_MAX;
         if (cap_w > INT32_MAX) cap_w = INT32_MAX;
-        int k0 = first_epoch(R, pl.E, pl.delta), planned = 1;
+        int k0 = first_epoch(R, pl.E, pl.delta, !sgn), planned = 1;
         for (;;) { /* checkpoint k (stitching index) at the end of epoch k0 + k - 1 */
             int64_t target = o->walks > 0 ? o->walks : epoch_end(k0 + k - 1);
             if (target > cap_w) target = cap_w, planned = o->walks > 0 && o->walks == cap_w;
@@ -371,22 +437,30 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
                 }
             }
             if (!planned || o->walks > 0 || N >= cap_w) break;
-            if (rule_met(&w, x, n, N, k, R, R0, pl.E, pl.delta)) break;
+            if (sgn ? rule_met(&w, x, n, N, k, R, R0, pl.E, pl.delta) : rule_met_kl(&w, kept, x, n, N, k, R0, pl.E, pl.delta))
+                break;
             k++;
         }
         if (!planned) /* stopped between checkpoints: the next index */
             k = ulam__stop_epoch(N) > k0 ? ulam__stop_epoch(N) - k0 + 2 : k + 1;
+        else if (o->walks > 0)
+            kk = 0; /* a count fixed in advance: the KL interval at delta itself */
     }
     if (!status) {
         double Nd = (double)N, D = info->residual_bound;
         ulam__stop_ci none;
         if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &none);
         else none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
+        if (!sgn && N >= 1) hits_interval(kept, N, kk < 0 ? k : kk, 0, R0, &none.lo, &none.hi);
         for (int64_t i = 0; i < n; i++) {
             int64_t h = N > 0 ? w.hp[i] + (w.hn ? w.hn[i] : 0) : 0;
             double mean = 0.0, var = 0.0;
             ulam__stop_ci ci = none;
-            if (h > 0) {
+            if (h > 0 && !sgn) {
+                mean = R0 * (double)h / Nd;
+                var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
+                hits_interval(kept, N, kk < 0 ? k : kk, h, R0, &ci.lo, &ci.hi);
+            } else if (h > 0) {
                 mean = R0 * (double)(w.hp[i] - (w.hn ? w.hn[i] : 0)) / Nd;
                 var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
                 ulam__stop_interval(N, mean, var, R, 0.0, R0, R0, k, &ci);
@@ -402,7 +476,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         info->walks = N, info->steps = w.steps, info->walk_seconds = ulam_now() - t1;
     }
     free(idx), free(alias), free(work), free(prob), free(w.cs), free(w.mx), free(w.cum), free(w.known), free(w.hp), free(w.hn);
-    free(r);
+    free(r), free(kept);
     info->seconds = ulam_now() - t0;
     return status;
 }

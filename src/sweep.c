@@ -13,10 +13,10 @@
  * Given M itself (its rows: each state's in-neighbours) and M >= 0, a sweep pulls instead of
  * pushing: p_i <- e_s,i + sum_j M_ij p_j for i in order, the same Gauss-Seidel sweep (p_i + r_i,
  * r_i = e_s,i + (M p)_i - p_i being the residual the push would move) read like a sparse
- * matrix-vector product, with no scattered writes.  r is not kept during pull sweeps: its sum
- * is, as 1 - sum_i p_i (1 - c_i) (c_i = sum_k M_ki; r >= 0 when M >= 0), and r itself is formed
- * once at the end (one more product), negative roundings of a zero residual cut to 0 (at most
- * 1e-16 of (M p)_i). */
+ * matrix-vector product, with no scattered writes.  r is not kept during pull sweeps (its storage
+ * holds c_i = sum_k M_ki): its sum is, as 1 - sum_i p_i (1 - c_i) (r >= 0 when M >= 0), and r
+ * itself is formed once at the end (one more product), negative roundings of a zero residual cut
+ * to 0 (at most 1e-16 of (M p)_i). */
 #include "internal.h"
 
 #include <math.h>
@@ -38,33 +38,12 @@ static int64_t push_one(const ulam_csr *Mt, int64_t j, double *p, double *r, int
     return b - a + 1;
 }
 
-/* The pull sweeps' view of M: M and its column sums c (rows of Mt). */
+/* The pull sweeps' view of M: M and its column sums c (rows of Mt; kept in r's storage, which
+ * the pull sweeps do not use). */
 typedef struct {
     const ulam_csr *M;
     double *c;
 } pull;
-
-/* Read Mt once for the pull sweeps: ULAM_OK (pl->c NULL when M has a negative entry: no pull),
- * ULAM_ENOMEM. */
-static int pull_setup(const ulam_csr *M, const ulam_csr *Mt, pull *pl)
-{
-    int64_t n = Mt->nrows;
-    double *c = ulam__malloc((size_t)n, sizeof *c);
-    if (!c) return ULAM_ENOMEM;
-    for (int64_t j = 0; j < n; j++) {
-        double s = 0.0;
-        for (int64_t k = Mt->rowptr[j]; k < Mt->rowptr[j + 1]; k++) {
-            if (Mt->val[k] < 0) {
-                free(c);
-                return ULAM_OK;
-            }
-            s += Mt->val[k];
-        }
-        c[j] = s;
-    }
-    pl->M = M, pl->c = c;
-    return ULAM_OK;
-}
 
 /* (M p)_i. */
 static inline double pull_row(const ulam_csr *M, const double *p, int64_t i)
@@ -72,6 +51,26 @@ static inline double pull_row(const ulam_csr *M, const double *p, int64_t i)
     double s = 0.0;
     for (int64_t k = M->rowptr[i]; k < M->rowptr[i + 1]; k++) s += M->val[k] * p[M->colidx[k]];
     return s;
+}
+
+/* Read Mt once for the pull sweeps, c_j into r_j: 1; 0 when M has a negative entry (no pull: r
+ * made again as e_s + M p - p). */
+static int pull_setup(const ulam_csr *M, const ulam_csr *Mt, int64_t s, const double *p, double *r, pull *pl)
+{
+    int64_t n = Mt->nrows;
+    for (int64_t j = 0; j < n; j++) {
+        double sum = 0.0;
+        for (int64_t k = Mt->rowptr[j]; k < Mt->rowptr[j + 1]; k++) {
+            if (Mt->val[k] < 0) {
+                for (int64_t i = 0; i < n; i++) r[i] = pull_row(M, p, i) + (i == s ? 1.0 : 0.0) - p[i];
+                return 0;
+            }
+            sum += Mt->val[k];
+        }
+        r[j] = sum;
+    }
+    pl->M = M, pl->c = r;
+    return 1;
 }
 
 /* One Gauss-Seidel pull sweep (updates above thr); the updates made; *rsum falls with them. */
@@ -167,8 +166,7 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
             for (int64_t q = 0; q < nlist; q++) rsum += fabs(r[list[q]]);
             if (nlist >= n / 16) {
                 sweeping = 1;
-                if (M && (status = pull_setup(M, Mt, &pl))) break;
-                if (pl.c) { /* from here on r is implicit: rsum as 1 - sum_i p_i (1 - c_i) */
+                if (M && pull_setup(M, Mt, s, p, r, &pl)) { /* from here on r is implicit: rsum as 1 - sum_i p_i (1 - c_i) */
                     pulling = 1, ops += nnz;
                     rsum = 1.0;
                     for (int64_t i = 0; i < n; i++) rsum -= p[i] * (1.0 - pl.c[i]);
@@ -185,12 +183,12 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
         double rho = before > 0 ? rsum / before : 1.0, next_ops = sweeping ? (double)(nnz + 2 * n) : (double)round_ops;
         if (!(cost(rsum, ctx) - cost(rho * rsum, ctx) > next_ops)) break;
     }
-    if (pulling && status != ULAM_ENOMEM) rsum = pull_residual(&pl, s, p, r), ops += nnz + n;
+    if (pulling) rsum = pull_residual(&pl, s, p, r), ops += nnz + n; /* c in r is not needed after the sweeps */
     info->ops = ops;
     info->r_sum = rsum;
     info->nonneg = pl.c != NULL;
     for (int64_t j = 0; j < n; j++) info->support += r[j] != 0.0;
-    free(list), free(next), free(mark), free(pl.c);
+    free(list), free(next), free(mark);
     return status;
 }
 
