@@ -28,8 +28,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define ULAM__FPUSH_STEP_COST 100.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM under load:
-                                      0.9 us a step, 6 ns a push operation; a step misses the cache, a sweep streams) */
+#define ULAM__FPUSH_STEP_COST 300.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM at load ~9,
+                                      2026-12-02: ~1.8 us of CPU a step with its share of the walk phase's passes, ~4.5 ns
+                                      a pull-sweep operation; a step misses the cache, a sweep streams; 100 and 300
+                                      side by side: 300 took 0.8-0.95x the CPU over 3 sources) */
 #define ULAM__FPUSH_RANGE_SHARE 0.8 /* the share of E delta the first checkpoint leaves the interval's range term */
 #define ULAM__FPUSH_KL_KEPT 1024    /* hit counts whose interval a checkpoint keeps (the rest computed each time) */
 
