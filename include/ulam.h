@@ -1301,7 +1301,8 @@ typedef struct ulam_auto_result {
  *     ao->pilot_share of the leader's predicted run (then no new kernel is started either);
  *   - predicted work: units of the work model (ULAM_AUTO_*): walks x (steps + ULAM_AUTO_WALK +
  *     forward tallies) + the kernel units still to build; with rel_err the walks are the rule's:
- *     variance, range (min_walks) and variance-error terms.
+ *     variance, range (min_walks) and variance-error terms, at a lower bound where the pilots do
+ *     not resolve |x| (ulam_auto_lower_bound).
  * The pilots' walks are not used in the answer: it comes from fresh walks on base's seed
  * (ulam_auto_solver), which the choice, a function of the pilots alone, cannot bias. */
 int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
@@ -1314,6 +1315,14 @@ int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *b
  * a status when none is left).  Its refusals are ulam_solver_alloc's. */
 int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
                      ulam_auto_result *res, ulam_solver **out, ulam_error *err);
+
+/* 1 when candidate k's predicted_walks (a rel_err race's) is only a lower bound on the walks the
+ * rule will need: its pilots' mean is within 4 of its standard errors of 0 (offset: base's
+ * rel_err_offset added), so it does not resolve |x| (signed cancellation: x_1 = 1e-3 max|x|), and
+ * the prediction is made at the largest |x| the pilots allow (min over the piloted candidates of
+ * |mean| + 2 standard errors); such a leader's pilots grow past ao->pilot_max (up to 64 times)
+ * while the pilot share allows.  0 otherwise (also without a rel_err race or a pilot). */
+int ulam_auto_lower_bound(const ulam_auto_result *res, int k, double rel_err_offset);
 
 /* ---------------------------------------------------------------- the method table */
 /* All secondary, except primary: ulam_auto. */

@@ -21,6 +21,9 @@
 
 static const uint64_t PILOT_SEED = UINT64_C(0x5851f42d4c957f2d);
 
+#define ULAM__AUTO_RESOLVE 4.0 /* a pilot mean this many standard errors from 0 resolves |x| (to about 25%) */
+#define ULAM__AUTO_GROW 64     /* an unresolved leader's pilots grow to this many times pilot_max */
+
 enum { KERNELS = 6, GROUPS = 12 }; /* guards: 2 continuations x 3 exponents; kernels: x 2 modes */
 
 /* One kernel's solver and the work it has done (guards excluded). */
@@ -128,6 +131,63 @@ static double work_per_walk(const chooser *c, int k)
     return steps + ULAM_AUTO_WALK + ULAM_AUTO_TALLY * t;
 }
 
+/* Candidate k's variance for the comparisons: every candidate estimates the same x_i, so a pilot
+ * mean further than 2 of its standard errors from the most precise other pilot's has missed part
+ * of its scores' spread (a skewed score, rare large values, otherwise looks cheapest exactly when
+ * its pilot missed them): its variance is raised to what puts the difference at 2 standard errors. */
+static double variance_of(const ulam_auto_result *res, int k)
+{
+    const ulam_auto_candidate *a = &res->cand[k];
+    double best = INFINITY, m = NAN;
+    for (int j = 0; j < res->ncand; j++) {
+        const ulam_auto_candidate *o = &res->cand[j];
+        if (j == k || !o->pilot_walks || !isfinite(o->estimate) || !(o->variance > 0)) continue;
+        double se2 = o->variance / (double)o->pilot_walks;
+        if (se2 < best) best = se2, m = o->estimate;
+    }
+    double d = a->estimate - m, n = (double)a->pilot_walks;
+    return isnan(m) ? a->variance : fmax(a->variance, n * d * d / 4.0);
+}
+
+/* Candidate k's pilot mean |estimate + offset| and its standard error (the comparison variance
+ * over its pilot walks; INFINITY below 2 walks). */
+static double pilot_se(const ulam_auto_result *res, int k)
+{
+    double n = (double)res->cand[k].pilot_walks;
+    return n > 1 ? sqrt(variance_of(res, k) / n) : INFINITY;
+}
+
+/* Whether candidate k's pilot mean resolves |x|: at least ULAM__AUTO_RESOLVE of its standard
+ * errors from 0 (a prediction var / (E m)^2 at a mean of noise alone is a guess: case 7's 128
+ * walks of variance 110 put |m| near 1 where |x| = 1e-3, and predicted 1.5e4 walks where the
+ * rule needs 1.1e9). */
+static int resolved(const ulam_auto_result *res, int k, double offset)
+{
+    return fabs(res->cand[k].estimate + offset) >= ULAM__AUTO_RESOLVE * pilot_se(res, k);
+}
+
+/* The scale |x| candidate k's rel_err prediction is made at: its pilot mean when that resolves
+ * |x|; else the largest |x| the pilots allow, min over every piloted candidate with spread of
+ * |mean| + 2 standard errors (they all estimate the same x), at which the prediction is a lower
+ * bound on the walks the rule needs. */
+static double scale_of(const ulam_auto_result *res, int k, double offset)
+{
+    double m = fabs(res->cand[k].estimate + offset);
+    if (resolved(res, k, offset)) return m;
+    double cap = m + 2.0 * pilot_se(res, k);
+    for (int j = 0; j < res->ncand; j++)
+        if (res->cand[j].pilot_walks > 1 && variance_of(res, j) > 0 && isfinite(res->cand[j].estimate))
+            cap = fmin(cap, fabs(res->cand[j].estimate + offset) + 2.0 * pilot_se(res, j));
+    return cap;
+}
+
+/* Whether candidate k's predicted walks are a lower bound (its pilot mean does not resolve |x|). */
+int ulam_auto_lower_bound(const ulam_auto_result *res, int k, double rel_err_offset)
+{
+    if (!res || k < 0 || k >= res->ncand || res->cand[k].pilot_walks < 2 || !res->by_work) return 0;
+    return !resolved(res, k, rel_err_offset);
+}
+
 /* Candidate k's predicted walks and work at variance var (the pooled one, or a bound of it). */
 static double predict(const chooser *c, int k, double var, double *walks)
 {
@@ -135,13 +195,15 @@ static double predict(const chooser *c, int k, double var, double *walks)
     const group *g = &c->g[c->gi[k]];
     double E = c->base.stop.rel_err, N;
     if (E > 0) {
-        double m = fabs(a->estimate + c->base.stop.rel_err_offset), n = (double)a->pilot_walks;
+        double off = c->base.stop.rel_err_offset, m = fabs(a->estimate + off);
+        int exact = resolved(c->res, k, off);
         if (!c->tail_ok[k]) N = INFINITY; /* no bound on a single score: the rule cannot stop */
-        else if (m == 0) N = INFINITY; /* a pilot that saw nothing predicts nothing */
+        else if (m == 0 && !(a->variance > 0)) N = INFINITY; /* a pilot that saw nothing predicts nothing */
         else {
-            (void)n; /* the rule's own prediction (stop.h) holds its range term: a pilot without spread */
+            m = scale_of(c->res, k, off); /* unresolved: the largest |x| the pilots allow, a lower bound */
+            /* the rule's own prediction (stop.h) holds its range term: a pilot without spread */
             N = fmax((double)ULAM__REL_MIN, var / (E * m * E * m)); /* is no evidence of a small variance */
-            N = fmax(N, c->min_walks[k]); /* the pilot's own prediction (its variance, range and bias) */
+            if (exact) N = fmax(N, c->min_walks[k]); /* the pilot's own prediction (its variance, range and bias) */
             if (isfinite(c->range[k])) { /* the rule's at this variance: the range term shares the half-width */
                 double r = ulam__stop_walks_needed(m, var, c->range[k], 0.0, E, 1);
                 N = fmax(N, isfinite(r) ? ulam__stop_walks_needed(m, var, c->range[k], 0.0, E,
@@ -159,24 +221,6 @@ static double predict(const chooser *c, int k, double var, double *walks)
     double reach = g->walks > 0 ? fmin(cap, u * N / (double)g->walks) : cap;
     if (reach * ULAM__COMPLETE > cap) reach = cap; /* the solver then builds the rest at once */
     return N * work_per_walk(c, k) + ULAM_AUTO_BUILD * fmax(0.0, reach - u);
-}
-
-/* Candidate k's variance for the comparisons: every candidate estimates the same x_i, so a pilot
- * mean further than 2 of its standard errors from the most precise other pilot's has missed part
- * of its scores' spread (a skewed score, rare large values, otherwise looks cheapest exactly when
- * its pilot missed them): its variance is raised to what puts the difference at 2 standard errors. */
-static double variance_of(const chooser *c, int k)
-{
-    const ulam_auto_candidate *a = &c->res->cand[k];
-    double best = INFINITY, m = NAN;
-    for (int j = 0; j < c->res->ncand; j++) {
-        const ulam_auto_candidate *o = &c->res->cand[j];
-        if (j == k || !o->pilot_walks || !isfinite(o->estimate) || !(o->variance > 0)) continue;
-        double se2 = o->variance / (double)o->pilot_walks;
-        if (se2 < best) best = se2, m = o->estimate;
-    }
-    double d = a->estimate - m, n = (double)a->pilot_walks;
-    return isnan(m) ? a->variance : fmax(a->variance, n * d * d / 4.0);
 }
 
 /* An upper confidence bound on candidate k's variance from its pilot's sample variance var and
@@ -199,7 +243,7 @@ static double key(const chooser *c, int k, double scale)
     const ulam_auto_candidate *a = &c->res->cand[k];
     if (a->mode == ULAM_FORWARD && a->estimate == 0 && a->variance == 0)
         return INFINITY; /* no forward pilot walk has tallied the component yet: nothing is known */
-    double var = variance_of(c, k) * scale, walks;
+    double var = variance_of(c->res, k) * scale, walks;
     if (c->base.stop.rel_err > 0) return predict(c, k, var, &walks);
     return honest_variance(c, k, var) * work_per_walk(c, k);
 }
@@ -242,8 +286,8 @@ static void refresh(chooser *c, int k)
     a->variance = ulam__moments_variance(&c->mom[k]);
     a->steps_per_walk = a->pilot_walks ? c->steps[k] / (double)a->pilot_walks : 0.0;
     a->work_per_walk = work_per_walk(c, k);
-    a->cost = variance_of(c, k) * a->work_per_walk;
-    a->predicted_work = predict(c, k, variance_of(c, k), &a->predicted_walks);
+    a->cost = variance_of(c->res, k) * a->work_per_walk;
+    a->predicted_work = predict(c, k, variance_of(c->res, k), &a->predicted_walks);
     a->predicted_seconds = a->predicted_work * ULAM_AUTO_UNIT_SECONDS;
 }
 
@@ -414,7 +458,12 @@ static int race(chooser *c, ulam_error *err)
     int64_t n = c->a.pilot_walks;
     for (int stage = 1; c->leader >= 0; stage++) {
         c->res->stages = stage;
-        if (drop(c) <= 1 || 2 * n > c->a.pilot_max || overhead_share(c) >= c->a.pilot_share) return ULAM_OK;
+        /* a leader whose pilot does not resolve |x| predicts a lower bound: its pilots grow on, past
+           pilot_max up to ULAM__AUTO_GROW times it, while the overhead share allows */
+        int open = c->base.stop.rel_err > 0 && !resolved(c->res, c->leader, c->base.stop.rel_err_offset);
+        if ((drop(c) <= 1 && !open) || 2 * n > c->a.pilot_max * (open ? ULAM__AUTO_GROW : 1) ||
+            overhead_share(c) >= c->a.pilot_share)
+            return ULAM_OK;
         n *= 2;
         double more = 0.0, full = c->res->cand[c->leader].predicted_work + reused(c, c->leader);
         for (int k = 0; k < c->res->ncand; k++)

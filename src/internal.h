@@ -117,6 +117,36 @@ int ulam__bpush(const ulam_csr *Mt, double rmax, int64_t max_ops, double *q, dou
 /* max_j |r_j| over n entries. */
 double ulam__bpush_max(const double *r, int64_t n);
 
+/* The forward walks' predicted work (units of ULAM_AUTO_*) on a residual of l1 norm r_sum, the
+ * push part q_i of the watched x_i taken as its scale (src/fpush_b.c's cost model). */
+typedef double (*ulam__fpush_b_cost)(double r_sum, double q_i, void *ctx);
+
+/* What the push on b for forward walks did: sweeps, operations (a state read a sweep, a push its
+ * column's entries + 1), ||r||_1 before and after, the walks' predicted work before and after. */
+typedef struct {
+    int sweeps;
+    int64_t ops;
+    double r_sum0, r_sum, work0, work;
+} ulam__fpush_b_info;
+#define ULAM__FPUSH_B_SWEEPS 1000 /* the most sweeps (the cost model stops them long before) */
+
+/* The push on b for forward walks (src/fpush_b.c): Gauss-Seidel sweeps of the forward push on Mt,
+ * M's transpose, r (b on entry) into q (zero on entry), x = q + (I - M)^-1 r holding throughout,
+ * while the walks' work cost(||r||_1, q[index]) falls by more than a sweep costs; the first sweep
+ * when its reads cost at most `first` units.  ULAM_OK. */
+int ulam__fpush_b(const ulam_csr *Mt, int64_t index, ulam__fpush_b_cost cost, void *ctx, double first, double *q,
+                  double *r, ulam__fpush_b_info *info);
+
+/* The bound on the probability that a walk scores at all (src/hit.c): Gauss-Seidel sweeps of
+ * v <- a + c P v over the `count` states listed in ascending order (the walks' reachable set:
+ * closed under their moves), K the walks' kernel (continuation continue_q, exponent alpha),
+ * target the states where a walk scores (absorb: by ending there; else by a visit), v 1 there on
+ * entry and an upper bound on each listed state's probability after every sweep; at most
+ * `sweeps` sweeps (*sweep counts them, alternating ascending and descending order) or until
+ * converged (*done); the entries read (and one a state). */
+int64_t ulam__hit_sweeps(const ulam_csr *K, const int64_t *states, int64_t count, double continue_q, double alpha,
+                         const char *target, int absorb, double *v, int sweeps, int *sweep, int *done);
+
 struct ulam_kernel; /* src/kernel.h */
 
 /* A set of states adjoint walks on K can reach (seen: n flags, closed under the walk's moves,

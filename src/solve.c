@@ -39,7 +39,16 @@ struct ulam_solver {
     ulam_kernel *k;
     int k_borrowed; /* k is the caller's (ulam__solver_alloc_reached) or was kept (ulam__solver_keep_kernel) */
     ulam__walker w;
-    const double *b; /* the caller's, borrowed like M (or bs) */
+    const double *b; /* the caller's, borrowed like M (or bs, or pr) */
+    double *pq, *pr; /* forward rel_err: the push on b's part and residual (src/fpush_b.c; owned; NULL: none):
+                        the walks start from pr, every estimate adds pq */
+    ulam__fpush_b_info push; /* what that push did */
+    double *hitv;    /* rel_err with no score yet: src/hit.c's bound on each state's chance to score (NULL: none) */
+    char *hitt;      /* and the states where a walk scores */
+    int64_t *hits, nhits; /* and the reachable states it sweeps, ascending */
+    int64_t hit_reads; /* entries its sweeps read */
+    int hit_sweep, hit_done;
+    double hit_walks; /* the least walks the rule can then need, (1 / p - 1) / E^2 (0: not computed) */
     double *bs;      /* b 2^-bexp when b is far from 1 (ulam__b_exponent; owned), else NULL */
     int bexp;        /* the estimates found on bs are times 2^bexp */
     int overflow;    /* the run ended because its estimate was not finite */
@@ -139,7 +148,8 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
 {
     if (!s) return NULL;
     if (!s->k_borrowed) ulam__kernel_free(s->k);
-    free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac), free(s->bs);
+    free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac), free(s->bs), free(s->pq), free(s->pr);
+    free(s->hitv), free(s->hitt), free(s->hits);
     free(s->start_src), free(s->start_units), free(s->start_b);
     ulam_csr_free(s->mt);
     if (s->scratch)
@@ -897,6 +907,63 @@ static int kernel_failure(const ulam_kernel *k, const ulam_system *sys, ulam_err
                       "finite, nonzero values and score (the matrix is corrupt)", (long long)i + 1);
 }
 
+/* The expected steps of a walk by the length tail (qmax, or the certificate's u and kappa; 1
+ * without either). */
+static double mean_steps(const ulam_solver *s)
+{
+    if (s->qmax < 1.0) return 1.0 / (1.0 - s->qmax);
+    if (s->tail_u < 1.0 && isfinite(s->kappa)) return 1.0 / (1.0 - s->tail_u) + log(fmax(s->kappa, 1.0)) / -log(s->tail_u);
+    return 1.0;
+}
+
+/* The push on b's cost model (src/fpush_b.c): the forward walks' predicted work on a residual of
+ * l1 norm r_sum, with the bounds made on b (a forward walk's weight, and so its range and second
+ * moment, scale with the l1 norm of what it starts from): the rule's range term at |x_i| ~ |q_i|
+ * (ulam__solver_range_walks), at least ULAM__REL_MIN walks, each its expected steps plus a start
+ * and a tally a visit; 0 with nothing left to walk. */
+typedef struct {
+    const ulam_solver *s;
+    double bnorm1, per_walk;
+} push_ctx;
+
+static double push_cost(double r_sum, double q_i, void *ctx)
+{
+    const push_ctx *c = ctx;
+    if (r_sum == 0.0) return 0.0;
+    double E = c->s->o.stop.rel_err, m = fabs(q_i + c->s->o.stop.rel_err_offset);
+    return fmax((double)ULAM__REL_MIN, ulam__solver_range_walks(c->s, r_sum / c->bnorm1, 0, m, E)) * c->per_walk;
+}
+
+/* Forward walks with a rel_err target (no weight window): push b down while that lowers the walks'
+ * predicted work (src/fpush_b.c), then walk from the residual, its source table and score bounds
+ * made anew (*bnorm1 its l1 norm); rel_alone as take_bounds. */
+static int push_b(ulam_solver *s, int rel_alone, double *bnorm1, ulam_error *err)
+{
+    const ulam_walk_opts *o = &s->o;
+    if (o->mode != ULAM_FORWARD || !(o->stop.rel_err > 0) || o->kernel.roulette > 0 || o->kernel.split > 0 ||
+        !(*bnorm1 > 0) || !isfinite(*bnorm1))
+        return ULAM_OK;
+    double V = mean_steps(s);
+    push_ctx c = {s, *bnorm1, V + ULAM_AUTO_WALK + ULAM_AUTO_TALLY * (V + 1.0)};
+    s->pq = ulam__calloc((size_t)s->n, sizeof *s->pq), s->pr = ulam__malloc((size_t)s->n, sizeof *s->pr);
+    if (!s->pq || !s->pr) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push on b");
+    memcpy(s->pr, s->b, (size_t)s->n * sizeof *s->pr);
+    ulam__fpush_b(s->mt, o->query.index, push_cost, &c, ULAM__REL_MIN * c.per_walk, s->pq, s->pr, &s->push);
+    s->setup_work += s->push.ops;
+    if (s->push.sweeps == 0) { /* not worth a sweep: the walks start from b */
+        free(s->pq), free(s->pr);
+        s->pq = s->pr = NULL;
+        return ULAM_OK;
+    }
+    s->b = s->pr;
+    free(s->src), free(s->seen), free(s->fac); /* the source, reachable set and score bounds depend on b */
+    s->src = NULL, s->seen = NULL, s->reached = NULL, s->fac = NULL;
+    s->passed = s->tail_done = 0;
+    memset(s->v2_done, 0, sizeof s->v2_done);
+    if (build_source(s, bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");
+    return take_bounds(s, s->mt, rel_alone, err);
+}
+
 /* Prepare walks on (I - M) x = b; reach: the states they can reach, computed before (NULL: search);
  * kernel: a kept kernel to walk on, rescored to b (NULL: a new one). */
 static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
@@ -966,7 +1033,8 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         return status;
     }
     if ((status = take_fourth(s, K, err)) ||
-        (o.stop.max_walks == 0 && o.stop.max_seconds == 0 && (status = check_fourth(M, s, err)))) {
+        (o.stop.max_walks == 0 && o.stop.max_seconds == 0 && (status = check_fourth(M, s, err))) ||
+        (status = push_b(s, o.stop.rel_err > 0 && o.stop.max_walks == 0 && o.stop.max_seconds == 0, &bnorm1, err))) {
         ulam_solver_free(s);
         return status;
     }
@@ -1127,6 +1195,51 @@ static int search_reach(ulam_solver *s, const ulam_walk_result *r)
     return 1;
 }
 
+/* A rel_err run no walk has scored in yet (its estimate 0 and no score seen): the least walks
+ * the rule can need, (1 / p - 1) / E^2 with p the chance a walk scores at all (src/hit.c's
+ * bound: at the start state, or averaged over the starts or the forward sources), into
+ * s->hit_walks; the bound's sweeps go on while their reads stay within the walks' steps so far
+ * (at least 16 passes over the reachable rows) and the count is within the walk budget.  Only
+ * where the walks' reachable set is known and a score is a visit's or an ending's (collision,
+ * absorption; no splitting, which lets copies of one walk score). */
+static void zero_bound(ulam_solver *s, const ulam_walk_result *r)
+{
+    const ulam_walk_opts *o = &s->o;
+    int fwd = o->mode == ULAM_FORWARD;
+    if (!(o->stop.rel_err > 0) || r->walks < ULAM__REL_MIN || r->estimate + o->stop.rel_err_offset != 0.0 ||
+        s->maxsq != 0.0 || !s->reached || o->kernel.split > 0 || o->estimator == ULAM_EXPECTED || s->hit_done == 2)
+        return;
+    const ulam_csr *K = fwd ? s->mt : s->k->K;
+    if (!s->hitv) { /* touching (and reading b at) the reachable states alone */
+        s->hitv = ulam__malloc((size_t)s->n, sizeof *s->hitv), s->hitt = ulam__calloc((size_t)s->n, 1);
+        for (int64_t i = 0; i < s->n; i++) s->nhits += s->reached[i] != 0;
+        s->hits = ulam__malloc((size_t)(s->nhits > 0 ? s->nhits : 1), sizeof *s->hits);
+        if (!s->hitv || !s->hitt || !s->hits) {
+            s->hit_done = 2; /* no memory: no bound (the run goes on as before) */
+            return;
+        }
+        for (int64_t i = 0, k = 0; i < s->n; i++)
+            if (s->reached[i]) s->hits[k++] = i, s->hitv[i] = 1.0, s->hitt[i] = fwd ? i == o->query.index : s->b[i] != 0.0;
+    }
+    double E = o->stop.rel_err, budget = fmax(16.0 * (double)(s->reach_nnz > 0 ? s->reach_nnz : ulam_csr_nnz(K)),
+                                             (double)s->steps);
+    for (;;) {
+        double p = 0.0, norm = 0.0;
+        if (fwd) /* the sources are reachable */
+            for (int64_t j = 0; j < s->n; j++) p += s->b[j] != 0.0 ? fabs(s->b[j]) * s->hitv[j] : 0.0, norm += fabs(s->b[j]);
+        else if (o->query.nstarts)
+            for (int64_t j = 0; j < o->query.nstarts; j++)
+                p += fabs(o->query.start_weights[j]) * s->hitv[o->query.starts[j]], norm += fabs(o->query.start_weights[j]);
+        else
+            p = s->hitv[o->query.index], norm = 1.0;
+        p = fmin(1.0, p / norm * (1.0 + 1e-9)); /* the sweeps' rounding */
+        s->hit_walks = p > 0 ? (1.0 / p - 1.0) / (E * E) : INFINITY;
+        if (s->hit_done || s->hit_walks > (double)o->stop.max_walks || (double)s->hit_reads >= budget) return;
+        s->hit_reads += ulam__hit_sweeps(K, s->hits, s->nhits, o->kernel.continue_q, o->kernel.kernel_alpha, s->hitt,
+                                         o->estimator == ULAM_ABSORPTION, s->hitv, 1, &s->hit_sweep, &s->hit_done);
+    }
+}
+
 /* Run one round of walks. */
 int ulam_solver_iterate(ulam_solver *s)
 {
@@ -1145,7 +1258,11 @@ int ulam_solver_iterate(ulam_solver *s)
     }
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
+    if (check) zero_bound(s, &r);
     if (check && rel_err_met(s, &r)) s->run.done = s->met = 1;
+    else if (check && s->o.stop.rel_err > 0 && s->hit_walks > (double)s->o.stop.max_walks && s->maxsq == 0.0 &&
+             r.estimate + s->o.stop.rel_err_offset == 0.0 && !(s->o.stop.max_seconds > 0))
+        s->run.done = s->out_of_reach = 1; /* no score yet, and the rule needs more walks than the budget before one */
     else if (s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && fabs(r.estimate + s->o.stop.rel_err_offset) > 0 &&
              !(r.cut_bound <= ULAM__CUT_SHARE * s->o.stop.rel_err * fabs(r.estimate + s->o.stop.rel_err_offset)))
         s->run.done = s->cut_stop = 1; /* the cuts' bias may exceed the target: more walks cannot help */
@@ -1171,7 +1288,7 @@ static void forward_component(const ulam_solver *s, int64_t i, double *est, doub
 {
     double N = (double)s->run.walks, mean, v;
     ulam__sums_moments(N, s->sum[i], s->sumsq[i], &mean, &v);
-    *est = mean + (s->o.estimator == ULAM_EXPECTED ? s->b[i] : 0.0);
+    *est = mean + (s->o.estimator == ULAM_EXPECTED ? s->b[i] : 0.0) + (s->pq ? s->pq[i] : 0.0);
     *var = v;
     *se = N > 0 ? sqrt(v / N) : INFINITY;
     if (s->sum[i] == 0.0 && s->sumsq[i] == 0.0) *se = NAN; /* no walk tallied it: no estimate */
@@ -1294,6 +1411,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
         r->min_walks = fmin(ulam__stop_walks_needed(m, r->variance, R, ci.bias, E, ci.k),
                             ulam__stop_walks_needed(m, r->variance, Rs, (truncated ? E * m / 4.0 : 0.0) + r->cut_bound,
                                                     E, ci.k));
+        if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0) r->min_walks = s->hit_walks; /* no score yet: src/hit.c */
     }
     r->cut_stop = s->cut_stop;
     r->out_of_reach = s->out_of_reach;
@@ -1395,6 +1513,8 @@ static void reset(ulam_solver *s)
     s->maxsq = 0.0;
     ulam__run_reset(&s->run);
     s->met = s->cut_stop = s->out_of_reach = s->epoch = 0;
+    free(s->hitv), free(s->hitt), free(s->hits); /* made for this b and estimator */
+    s->hitv = NULL, s->hitt = NULL, s->hits = NULL, s->nhits = 0, s->hit_reads = 0, s->hit_sweep = s->hit_done = 0, s->hit_walks = 0.0;
 }
 
 /* Restart a forward solver on a new right-hand side b (borrowed like the first) with a new
@@ -1404,8 +1524,8 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
 {
     ulam__clear(err);
     if (!s || !b || s->o.mode != ULAM_FORWARD) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a forward solver and b");
-    free(s->src);
-    s->src = NULL;
+    free(s->src), free(s->pq), free(s->pr); /* a push on the first b is not this b's */
+    s->src = NULL, s->pq = s->pr = NULL;
     s->b = b;
     for (int64_t i = 0; s->bexp && i < s->n; i++) s->bs[i] = ldexp(b[i], -s->bexp); /* as the first b */
     if (s->bexp) s->b = s->bs;

@@ -287,7 +287,8 @@ CASES += [
      r"^ulam radiosity: warning: .*shiny.mtl: material 'glass' is rendered matte \(Kd, Ke\): ignored Ks "
      r"\(.*shiny.mtl:12\), Ns \(.*:13\), d \(.*:14\), illum \(.*:15\), map_Kd \(.*:16\)\n$", r"point 1"),
     (["radiosity", SC + "cube.obj", "--at", "0.5,0,0.5", "--walks", "2000"], 0, "",
-     r"point 1 +0.5 0 0.5, normal 0 1 0 \(patch 1, floor\)"),
+     r"point 1 +0.5 0 0.5, normal 0 1 0 \(patch 1, floor\)\n  irradiance R [0-9.]+ \+- [0-9.e-]+ \(95% CI [0-9.]+ \.\. "
+     r"[0-9.]+\)   radiosity R [0-9.]+ \+- [0-9.e-]+ \(95% CI"),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--estimator", "next-event", "--mis", "heavy"], 2,
      r"--mis expects power, balance or none", ""),
     (["radiosity", SC + "cube.obj", "--mode", "shoot", "--estimator", "next-event"], 2,
@@ -819,6 +820,44 @@ def check_cancellation_stops(ulam):
         assert rc == 0 and re.search(r"^rel-err +NOT met .*more than --walks: stopped early", out, re.M), out
 
 
+def check_zero_estimate_stops(ulam):
+    """A --rel-err run no walk has scored in (upwind convection-diffusion 30 x 30 by its Jacobi
+    splitting, a point source at the centre, the upstream corner x_1 = 1.1e-11): it stops, not met,
+    saying no walk has scored, the certified bound on a walk's chance to score and the walks the
+    rule would need (>= 1e9), its interval holding x_1 (it walked to the 1e9 cap, ~400 s); and
+    auto's listing marks a prediction its pilots cannot resolve (case 7) as a lower bound."""
+    L, c = 30, 1.0
+    ent, b = [], [0.0] * (L * L)
+    for i in range(L):
+        for j in range(L):
+            r = i * L + j
+            for a, e, w in ((i - 1, j, 1 + c), (i, j - 1, 1 + c), (i + 1, j, 1.0), (i, j + 1, 1.0)):
+                if 0 <= a < L and 0 <= e < L:
+                    ent.append((r + 1, a * L + e + 1, w / (4 + 2 * c)))
+    b[15 * L + 15] = 1 / (4 + 2 * c)
+    with tempfile.TemporaryDirectory() as d:
+        write_mtx(f"{d}/cd.mtx", L * L, ent)
+        write_vec(f"{d}/cd_b.mtx", b)
+        rc, out, err = run(ulam, ["solve", f"{d}/cd.mtx", "--rhs", f"{d}/cd_b.mtx", "--index", "1", "--method", "walks",
+                                  "--rel-err", "0.1"])
+        assert rc == 0, (rc, err)
+        m = re.search(r"^x\[1\] +0 \+- 0 \(95% CI (\S+) \.\. (\S+)\)", out, re.M)
+        assert m and float(m.group(1)) <= 1.1e-11 <= float(m.group(2)), out
+        m = re.search(r"^rel-err +NOT met \(target 0\.1\): no walk has scored in (\d+); a walk scores at all with "
+                      r"probability at most \S+ \(certified from where it can go\), so the rule asks for at least (\S+) "
+                      r"walks, beyond the 1e9 cap: stopped early", out, re.M)
+        assert m and int(m.group(1)) < 2 ** 21 and float(m.group(2)) > 1e9, out
+        for method in ("auto", "bidirectional"):  # the default, and the route auto took on a probe that saw nothing
+            rc, out, err = run(ulam, ["solve", f"{d}/cd.mtx", "--rhs", f"{d}/cd_b.mtx", "--index", "1", "--method", method,
+                                      "--rel-err", "0.1"])
+            assert rc == 0 and "nan" not in out and re.search(r"^rel-err +NOT met \(target 0\.1\)", out, re.M), (method, out)
+            m = re.search(r"^x\[1\] +\S+ \+- \S+ \(95% CI (\S+) \.\. (\S+)\)", out, re.M)
+            assert not m or float(m.group(1)) <= 1.1e-11 <= float(m.group(2)), (method, out)
+        p, pb = write_cancellation(d)
+        rc, out, err = run(ulam, ["solve", p, "--rhs", pb, "--index", "1", "--rel-err", "0.1", "--verbose"])
+        assert rc == 0 and re.search(r"^  \* .* predicted >= \S+ walks", out, re.M), out
+
+
 def check_honest_verdicts(ulam):
     """Verdicts only from bounds: a radius 5e-4 above 1 that power iteration cannot pin is
     unknown, refused (exit 3) and without an interval under --force; --rel-err with an infinite
@@ -1328,8 +1367,12 @@ def check_radiosity_grid(ulam):
         assert j["grid"]["nu"] == 3 and j["grid"]["nv"] == 2 and len(pts) == 6, j["grid"]
         for p in pts:
             assert p["patch"] is None and abs(p["irradiance"][0] - 2) <= 4 * p["irradiance_stderr"][0], p
+            assert p["irradiance_ci95_lo"][0] <= p["irradiance"][0] <= p["irradiance_ci95_hi"][0], p
         rows = open(csv).read().splitlines()
-        assert rows[0].startswith("i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks") and len(rows) == 7, rows
+        assert rows[0] == "i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks,ci95_lo,ci95_hi" and len(rows) == 7, rows
+        for row in rows[1:]:  # the illuminance's 95% interval (src/stop.c's, the channels' half-widths weighted)
+            v = [float(x) for x in row.split(",")]
+            assert v[14] <= v[11] <= v[15] and v[15] - v[14] > 2 * 1.96 * v[12] * 0.5, row
         assert open(png, "rb").read()[:8] == b"\x89PNG\r\n\x1a\n"
         assert sorted(os.listdir(d)) == ["g.csv", "g.png"], os.listdir(d)
 
@@ -1822,7 +1865,7 @@ def main():
         return 2
     part = "table" if "--table" in flags else "checks" if "--checks" in flags else None  # meson runs the halves apart
     failures, n = check_table(ulam, rows if cases else None) if part != "checks" else (0, 0)
-    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_cancellation_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_summary, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),

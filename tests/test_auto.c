@@ -389,6 +389,96 @@ static void test_solve_is_cli(void **state)
     free(json), free(a), free(ch);
 }
 
+/* Issue 25's case 7, signed cancellation (own generator, as tests/cli_test.py's): n = 200, 5
+ * signed entries a row whose |M| rows sum to 0.9, x* = +-1 except x*_0 = 1e-3 = 1e-3 max|x*|,
+ * b = (I - M) x* (b malloc'd). */
+static ulam_csr *cancellation(uint64_t seed, double **bp)
+{
+    enum { N = 200, K = 5 };
+    int32_t ti[N * K], tj[N * K];
+    double tx[N * K], x[N];
+    ulam_rng g;
+    ulam_rng_seed(&g, seed, 0);
+    for (int i = 0; i < N; i++) {
+        double w[K], sum = 0.0;
+        for (int k = 0; k < K; k++) {
+            int32_t j;
+            int again;
+            do { /* K distinct columns */
+                j = (int32_t)ulam_rng_bounded(&g, N), again = 0;
+                for (int l = 0; l < k; l++) again |= tj[i * K + l] == j;
+            } while (again);
+            ti[i * K + k] = i, tj[i * K + k] = j, sum += w[k] = 0.2 + 0.8 * ulam_rng_uniform(&g);
+        }
+        for (int k = 0; k < K; k++) tx[i * K + k] = (ulam_rng_uniform(&g) < 0.5 ? -0.9 : 0.9) * w[k] / sum;
+    }
+    for (int i = 0; i < N; i++) x[i] = i == 0 ? 1e-3 : ulam_rng_uniform(&g) < 0.5 ? -1.0 : 1.0;
+    ulam_csr *M;
+    assert_int_equal(ulam_csr_from_triplets(N, N, N * K, ti, tj, tx, &M), ULAM_OK);
+    double *b = malloc(N * sizeof *b);
+    ulam_csr_matvec(M, 0, x, b);
+    for (int i = 0; i < N; i++) b[i] = x[i] - b[i];
+    *bp = b;
+    return M;
+}
+
+/* Auto's rel_err prediction is honest (issue 25, case 7): a pilot of a few hundred walks of a
+ * score whose variance is ~1 to 100 has a mean of noise alone where |x_0| = 1e-3, so var / (E m)^2
+ * at that mean predicted 1.5e4 walks where the rule needs ~1e8-1e9.  Now the prediction of a
+ * candidate whose pilot does not resolve |x| (|mean| < 4 standard errors) is a lower bound, made
+ * at the largest |x| the pilots allow, and says so (ulam_auto_lower_bound): at seeds 1..3 the
+ * chosen candidate's prediction is flagged and at most the walks its own variance asks at the
+ * exact x, var / (E x)^2 (var: the run's, on a budget of 2^16 walks); the run stops, not met.  Beside it a system the pilots
+ * resolve (the same pattern of one sign, b_i = 0.5 + U(0, 1), x ~ 10, E = 0.01): not flagged, and the run meets
+ * the target within 4 times the prediction. */
+static void test_prediction_bound(void **state)
+{
+    (void)state;
+    for (int sys = 0; sys < 2; sys++) {
+        double *b, E = sys ? 0.01 : 0.1, x0;
+        ulam_csr *M = cancellation(7, &b);
+        if (sys) { /* the same pattern with every sign +: nothing cancels */
+            for (int64_t k = 0; k < ulam_csr_nnz(M); k++) M->val[k] = fabs(M->val[k]);
+            ulam_rng g;
+            ulam_rng_seed(&g, 8, 0);
+            for (int i = 0; i < 200; i++) b[i] = 0.5 + ulam_rng_uniform(&g);
+        }
+        double x[200];
+        assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+        x0 = x[0];
+        for (int s = 0; s < 3; s++) {
+            if (!test_case(100L * sys + s)) continue;
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.stop.rel_err = E, o.stop.max_walks = sys ? 0 : 1 << 16, o.exec.seed = 1 + (uint64_t)s; /* (lean: case 7
+                                                                       stops by its budget, out of reach) */
+            ulam_auto_result res;
+            ulam_solver *sv = NULL;
+            assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
+            ulam_walk_result r;
+            assert_int_equal(walk_out(sv, &r), ULAM_OK);
+            int k = res.chosen, bound = ulam_auto_lower_bound(&res, k, 0.0);
+            double need = r.variance / (E * x0 * E * x0), pred = res.cand[k].predicted_walks;
+            print_message("%s seed %d: x_0 = %.4g, chose %s %s, predicted %s%.4g walks; the run %s after %lld walks, "
+                          "var / (E x)^2 = %.4g\n", sys ? "one-signed" : "cancellation", s + 1, x0,
+                          res.cand[k].mode ? "forward" : "adjoint",
+                          res.cand[k].estimator == ULAM_COLLISION ? "collision" : res.cand[k].estimator == ULAM_ABSORPTION ? "absorption" : "expected",
+                          bound ? ">= " : "", pred, r.rel_err_met ? "met" : "NOT met", (long long)r.walks, need);
+            if (sys == 0) {
+                assert_true(bound);
+                assert_true(pred <= need);
+                assert_false(r.rel_err_met);
+            } else {
+                assert_false(bound);
+                assert_true(r.rel_err_met);
+                assert_true((double)r.walks <= 4.0 * pred);
+            }
+            ulam_solver_free(sv);
+        }
+        test_case_done();
+        ulam_csr_free(M), free(b);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -398,6 +488,7 @@ int main(void)
         cmocka_unit_test(test_none),
         cmocka_unit_test(test_table),
         cmocka_unit_test(test_solve_is_cli),
+        cmocka_unit_test(test_prediction_bound),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -269,6 +269,81 @@ static void test_grid(void **state)
     ulam_scene_free(s);
 }
 
+/* One-sensor grids (the grid's shared solver) over 100 seeds each: every score within the
+ * walk's certified range (a score past it leaves the run no interval, so every interval must be
+ * finite), and the printed 95% interval (src/stop.c's, on that range) covering the exact
+ * irradiance in at least 88 of 100 runs in every channel (P(Binomial(100, 0.95) < 88) < 0.002):
+ * the furnace (every face a grey-ish emitter, so walks of many bounces and landings on
+ * emitters that reflect) for a tilted sensor in the air at rel_err 0.05, and the black lamp of
+ * the parallel scene (one landing a walk) at a fixed 200 walks. */
+static void test_grid_interval(void **state)
+{
+    (void)state;
+    const char *scene[2] = {"tests/data/rad/furnace_half.obj", "tests/data/rad/point_parallel.obj"};
+    for (int m = 0; m < 2; m++) {
+        ulam_scene *s = NULL;
+        ulam_tracer *t = must_load(scene[m], &s);
+        double nf = 1.0 / sqrt(14.0);
+        ulam_rad_grid g = m ? (ulam_rad_grid){.origin = {0.4, 0.9, 0}, .u = {0.2, 0, 0}, .v = {0, 0.2, 0},
+                                              .normal = {0, 0, 1}, .nu = 1, .nv = 1}
+                            : (ulam_rad_grid){.origin = {0.2, 0.1, 0.7}, .u = {0.2, 0, 0}, .v = {0, 0.2, 0},
+                                              .normal = {nf, 2 * nf, 3 * nf}, .nu = 1, .nv = 1};
+        double exact[3] = {2.0, 1.5, 0.4 / 0.3};
+        if (m) exact[0] = exact[1] = exact[2] = parallel_at(0.5, 1, 0, 1, 0, 2, 1);
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.stop.rel_err = m ? 0 : 0.05, o.stop.max_walks = m ? 200 : 0, o.exec.threads = 2;
+        int inside[3] = {0, 0, 0}, finite = 0;
+        int64_t walks = 0;
+        for (uint64_t seed = 0; seed < 100; seed++) {
+            ulam_rad_point r;
+            ulam_error err;
+            o.exec.seed = 3000 + seed;
+            assert_int_equal(ulam_rad_grid_solve(t, &o, &g, &r, &err), ULAM_OK);
+            int ok = 1;
+            for (int c = 0; c < 3; c++) {
+                ok &= isfinite(r.run.ci95[c][0]) && isfinite(r.run.ci95[c][1]);
+                inside[c] += r.run.ci95[c][0] <= exact[c] && exact[c] <= r.run.ci95[c][1];
+            }
+            finite += ok, walks += r.run.walks;
+        }
+        print_message("%s: %d of 100 runs within the certified range; the 95%% interval covers %d, %d, %d of 100 "
+                      "(%lld walks)\n", scene[m], finite, inside[0], inside[1], inside[2], (long long)walks);
+        assert_int_equal(finite, 100);
+        for (int c = 0; c < 3; c++) assert_true(inside[c] >= 88);
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
+}
+
+/* The grid's sensors share one solver (ulam__rad_point_restart), yet a sensor's answer is its
+ * own: the second sensor of two grids whose first sensors differ reads bit for bit the same. */
+static void test_grid_shared_solver(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
+    /* cell centres origin + (i + 0.5) / 2 u: both grids' second sensor is at (0.5, 1, 0) */
+    ulam_rad_grid a = {.origin = {-0.25, 1, 0}, .u = {1, 0, 0}, .v = {0, 0.1, 0}, .normal = {0, 0, 1}, .nu = 2, .nv = 1};
+    ulam_rad_grid b = {.origin = {0.125, 1, 0}, .u = {0.5, 0, 0}, .v = {0, 0.1, 0}, .normal = {0, 0, 1}, .nu = 2, .nv = 1};
+    a.origin[1] = b.origin[1] = 0.95;
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.rel_err = 0.03, o.stop.max_walks = 0, o.exec.seed = 11, o.exec.threads = 2;
+    ulam_rad_point pa[2], pb[2];
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &a, pa, NULL), ULAM_OK);
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &b, pb, NULL), ULAM_OK);
+    assert_true(pa[0].x[0] != pb[0].x[0] && pa[0].run.walks > 0 && pb[0].run.walks > 0);
+    assert_close(pa[1].x[0], 0.5, 1e-12);
+    assert_close(pb[1].x[0], 0.5, 1e-12);
+    for (int c = 0; c < 3; c++) {
+        assert_true(pa[1].irradiance[c] == pb[1].irradiance[c] && pa[1].irradiance_se[c] == pb[1].irradiance_se[c]);
+        assert_true(pa[1].run.ci95[c][0] == pb[1].run.ci95[c][0] && pa[1].run.ci95[c][1] == pb[1].run.ci95[c][1]);
+    }
+    assert_true(pa[1].run.walks == pb[1].run.walks && pa[1].run.rays == pb[1].run.rays);
+    check_point(&pa[1], parallel_at(0.5, 1, 0, 1, 0, 2, 1), 0.5, "grid, shared solver");
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
 /* A patch solver run to its end with options o. */
 static ulam_rad_result run_solver(const ulam_tracer *t, const ulam_rad_opts *o)
 {
@@ -657,6 +732,7 @@ int main(void)
         cmocka_unit_test(test_point_parallel), cmocka_unit_test(test_point_perpendicular),
         cmocka_unit_test(test_point_furnace),  cmocka_unit_test(test_point_coverage),
         cmocka_unit_test(test_point_refused),  cmocka_unit_test(test_grid),
+        cmocka_unit_test(test_grid_interval),  cmocka_unit_test(test_grid_shared_solver),
         cmocka_unit_test(test_mesh_error_flags), cmocka_unit_test(test_mesh_converges),
         cmocka_unit_test(test_mtl_notes),        cmocka_unit_test(test_render_hdr),
         cmocka_unit_test(test_shoot_rel_err),    cmocka_unit_test(test_adapt_furnace),

@@ -367,12 +367,133 @@ static void test_laplace_noisy_auto(void **state)
     ulam_csr_free(M), free(b);
 }
 
+/* A random doubly substochastic M (n states, 8 weighted random permutations, every row and
+ * column summing to 0.9, as matrices/randsub1000) with b_i = 0.5 + U(0, 1), or (signed) 8
+ * random columns a row with random signs and rows of |M| summing to 0.8 (as signed200: its
+ * column sums vary, so forward weights grow and only a second moment bounds their tallies) with
+ * b_i = U(-0.5, 1); x by LAPACK (malloc'd). */
+static ulam_csr *forward_system(int64_t n, int sign, uint64_t seed, double **bp, double **xp)
+{
+    int64_t nz = 8 * n;
+    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj), *perm = malloc((size_t)n * sizeof *perm);
+    double *tx = malloc((size_t)nz * sizeof *tx), w[8], sum = 0.0;
+    ulam_rng g;
+    ulam_rng_seed(&g, seed, 0);
+    for (int k = 0; k < 8; k++) sum += w[k] = 0.1 + ulam_rng_uniform(&g);
+    for (int k = 0; k < 8; k++) {
+        bench_permutation(perm, n, &g);
+        for (int64_t i = 0; i < n; i++) {
+            int64_t e = k * n + i;
+            ti[e] = (int32_t)i, tj[e] = sign ? (int32_t)ulam_rng_bounded(&g, (uint64_t)n) : perm[i];
+            tx[e] = sign ? (0.1 + ulam_rng_uniform(&g)) * (ulam_rng_uniform(&g) < 0.5 ? -1.0 : 1.0) : 0.9 * w[k] / sum;
+        }
+    }
+    if (sign) { /* rows of |M| to 0.8 (a column drawn twice in a row sums: |M|'s row sum only falls) */
+        double *rs = calloc((size_t)n, sizeof *rs);
+        for (int64_t e = 0; e < nz; e++) rs[ti[e]] += fabs(tx[e]);
+        for (int64_t e = 0; e < nz; e++) tx[e] *= 0.8 / rs[ti[e]];
+        free(rs);
+    }
+    ulam_csr *M;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M), ULAM_OK);
+    double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
+    for (int64_t i = 0; i < n; i++) b[i] = sign ? ulam_rng_uniform(&g) * 1.5 - 0.5 : 0.5 + ulam_rng_uniform(&g);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    free(ti), free(tj), free(tx), free(perm);
+    *bp = b, *xp = x;
+    return M;
+}
+
+/* Forward-mode --rel-err's cost (issue 25: at most 3x the walks the variance asks, var / (E x)^2,
+ * var the forward tallies' own from 2^17 walks): a forward walk starts with weight ||b||_1, so its
+ * certified range against a small x_i asked 33x the oracle on randsub1000 at E = 0.1, and the
+ * signed system (forward weights grow: a second-moment range) stopped "not met" at its first
+ * round predicting 4e9 walks.  Both by collision at seed 1: met within 3 max(oracle, 1024) walks;
+ * and over 100 seeds each (a few thousand walks a run) the printed intervals cover (at least 89). */
+static void test_forward_rel_err(void **state)
+{
+    (void)state;
+    for (int sign = 0; sign < 2; sign++) {
+        int64_t n = sign ? 200 : 400;
+        double *b, *x, E = 0.1;
+        ulam_csr *M = forward_system(n, sign, 11 + (uint64_t)sign, &b, &x);
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.mode = ULAM_FORWARD, o.query.index = 0, o.stop.max_walks = 1 << 17, o.exec.seed = 12345;
+        ulam_walk_result r;
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+        double oracle = r.variance / (E * x[0] * E * x[0]);
+        int v[3] = {0, 0, 0};
+        for (int s = 0; s < 100; s++) {
+            if (!test_case(4000L + 100L * sign + s)) continue;
+            o.stop.max_walks = 0, o.stop.rel_err = E, o.exec.seed = 1 + (uint64_t)s;
+            ulam_error err;
+            int status = ulam_solve_walks(M, b, &o, &r, &err);
+            if (status) print_error("seed %d: %s\n", s + 1, err.msg);
+            assert_int_equal(status, ULAM_OK);
+            if (s == 0) {
+                print_message("%s n = %lld forward collision, rel_err %g: %s after %lld walks, oracle %.4g (%.3gx), "
+                              "x_0 = %.6g, estimate %.6g\n", sign ? "signed" : "doubly substochastic", (long long)n, E,
+                              r.rel_err_met ? "met" : "NOT met", (long long)r.walks, oracle, (double)r.walks / oracle,
+                              x[0], r.estimate);
+                assert_true(r.rel_err_met);
+                assert_true((double)r.walks <= 3.0 * fmax(oracle, 1024.0));
+            }
+            v[verdict(&r, x[0])]++;
+        }
+        test_case_done();
+        count(sign ? "signed forward rel_err 0.1:" : "doubly substochastic forward rel_err 0.1:", v[1], v[2], 100);
+        ulam_csr_free(M), free(b), free(x);
+    }
+}
+
+/* A zero running estimate (issue 25: "runs that cannot meet a target say so early ... never
+ * spin silently"): upwind convection-diffusion 30 x 30 (bench/gen.h, c = 1) by its Jacobi
+ * splitting, a point source at the centre, the upstream corner x_0 = 1.1e-11, which a walk
+ * from it reaches about never (the flow carries it off the grid in ~1 step).  No walk scores,
+ * so the rule cannot be met: before, a --rel-err 0.1 run walked to its budget (here 2^22) or,
+ * alone, to the 10^9 cap (~400 s).  Now src/hit.c bounds the chance a walk scores at all, the
+ * rule needs at least (1 / p - 1) / E^2 walks, and the run stops "not met" once that passes the
+ * budget: within 2^20 walks in both cases, for collision and absorption, seeds 1..3, its printed
+ * interval covering the exact x_0 (a direct solve) and its min_walks past the budget. */
+static void test_zero_estimate_stops(void **state)
+{
+    (void)state;
+    ulam_csr *A = bench_convdiff(30, 1.0), *M;
+    double one[900], b[900], x[900];
+    for (int i = 0; i < 900; i++) one[i] = i == 15 * 30 + 15 ? 1.0 : 0.0;
+    assert_int_equal(ulam_jacobi(A, one, 1.0, &M, b, NULL), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    assert_true(x[0] > 0 && x[0] < 1e-10);
+    for (int c = 0; c < 12; c++) {
+        if (!test_case(5000L + c)) continue;
+        int est = c % 2 ? ULAM_ABSORPTION : ULAM_COLLISION;
+        int64_t budget = c / 6 ? 0 : (int64_t)1 << 22; /* a budget first: the old run fails fast */
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.estimator = est, o.stop.rel_err = 0.1, o.stop.max_walks = budget, o.exec.seed = 1 + (uint64_t)(c / 2 % 3);
+        ulam_walk_result r;
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+        if (c % 6 == 0 || c % 6 == 1)
+            print_message("convdiff upstream corner, %s, rel_err 0.1, %s: %lld walks, estimate %g, CI [%g, %g], "
+                          "min_walks %.4g, out of reach %d\n", est ? "absorption" : "collision",
+                          budget ? "budget 2^22" : "alone", (long long)r.walks, r.estimate, r.ci95[0], r.ci95[1],
+                          r.min_walks, r.out_of_reach);
+        assert_false(r.rel_err_met);
+        assert_true(r.out_of_reach);
+        assert_true(r.walks <= (int64_t)1 << 20);
+        assert_true(r.min_walks > (budget ? (double)budget : 1e9));
+        assert_true(r.ci95[0] <= x[0] && x[0] <= r.ci95[1]);
+    }
+    test_case_done();
+    ulam_csr_free(A), ulam_csr_free(M);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_never_zero_width), cmocka_unit_test(test_metastable_fixed),
                                        cmocka_unit_test(test_metastable_rounds), cmocka_unit_test(test_metastable_auto),
                                        cmocka_unit_test(test_metastable_rel_err), cmocka_unit_test(test_laplace_corner),
                                        cmocka_unit_test(test_rel_err_cost), cmocka_unit_test(test_push_b),
-                                       cmocka_unit_test(test_laplace_noisy_auto)};
+                                       cmocka_unit_test(test_laplace_noisy_auto), cmocka_unit_test(test_forward_rel_err),
+                                       cmocka_unit_test(test_zero_estimate_stops)};
     return test_run(tests);
 }

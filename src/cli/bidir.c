@@ -51,9 +51,17 @@ typedef struct {
 static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, const report *rp)
 {
     const ulam_walk_result *w = &r->walks;
-    printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->target + 1,
-           o->target < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
-           w->interrupted ? "  [INTERRUPTED]" : "");
+    if (isfinite(r->ci95[0]) && isfinite(r->ci95[1]))
+        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->target + 1,
+               o->target < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+               w->interrupted ? "  [INTERRUPTED]" : "");
+    else
+        printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->target + 1,
+               o->target < 9 ? 10 : 9, "", r->estimate, r->std_error,
+               w->variance > 0 ? "no certified range of the walk part's score"
+                               : "no walk scored, and no bound certifies the part they missed",
+               w->interrupted ? "  [INTERRUPTED]" : "");
+    cli_print_rel_err(&o->walk, w, 0);
     if (rp->dense) { /* the push on b: its own lines */
         printf("method          bidirectional, the push on b: then %s walks from %lld scoring its "
                "residual\n", cli_estimator_names[o->walk.estimator], (long long)o->target + 1);

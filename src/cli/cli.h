@@ -169,6 +169,10 @@ int cli_method_error(const char *got);
 /* Print a bare JSON number (null when not finite). */
 void cli_json_value(double v);
 
+/* Print whether the --rel-err target of walks r run with o was met, and when not why (one line;
+ * nothing without a target; verbose: also when met). */
+void cli_print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int verbose);
+
 /* Print a JSON number (null when not finite). */
 void cli_json_number(const char *key, double v, int last);
 

@@ -886,6 +886,20 @@ static void print_json(const args *a, const report *r)
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
 }
 
+/* A point's 95% intervals per channel from its run's (src/stop.c's construction on the certified
+ * range, held on the irradiance H): [c][0] H's, [c][1] B = E + rho H's (rho >= 0 maps the
+ * interval), NaN where none is certified or off the surfaces. */
+static void point_ci(const ulam_scene *s, const ulam_rad_point *r, double lo[3][2], double hi[3][2])
+{
+    for (int c = 0; c < 3; c++) {
+        lo[c][0] = r->run.ci95[c][0], hi[c][0] = r->run.ci95[c][1];
+        lo[c][1] = hi[c][1] = NAN;
+        if (r->patch < 0 || !isfinite(lo[c][0]) || !isfinite(hi[c][0])) continue;
+        double E = s->emit[3 * r->patch + c], rho = s->rho[3 * r->patch + c];
+        lo[c][1] = E + rho * lo[c][0], hi[c][1] = E + rho * hi[c][0];
+    }
+}
+
 /* One point's answer as text. */
 static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int interrupted)
 {
@@ -897,9 +911,13 @@ static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int 
     } else {
         printf(" (a sensor on no surface)\n");
     }
+    double lo[3][2], hi[3][2];
+    point_ci(s, r, lo, hi);
     for (int c = 0; c < 3; c++) {
         printf("  irradiance %c %.8g +- %.3g", chan[c], r->irradiance[c], r->irradiance_se[c]);
+        if (isfinite(lo[c][0])) printf(" (95%% CI %.6g .. %.6g)", lo[c][0], hi[c][0]);
         if (r->patch >= 0) printf("   radiosity %c %.8g +- %.3g", chan[c], r->radiosity[c], r->radiosity_se[c]);
+        if (r->patch >= 0 && isfinite(lo[c][1])) printf(" (95%% CI %.6g .. %.6g)", lo[c][1], hi[c][1]);
         printf("%s\n", interrupted ? "  [INTERRUPTED]" : "");
     }
     printf("  walks      %lld, %lld rays, %.4f s%s\n", (long long)r->run.walks, (long long)r->run.rays, r->run.seconds,
@@ -907,8 +925,11 @@ static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int 
 }
 
 /* One point's answer as a JSON object. */
-static void point_json(const ulam_rad_point *r)
+static void point_json(const ulam_scene *s, const ulam_rad_point *r)
 {
+    double lo[3][2], hi[3][2], v[4][3];
+    point_ci(s, r, lo, hi);
+    for (int c = 0; c < 3; c++) v[0][c] = lo[c][0], v[1][c] = hi[c][0], v[2][c] = lo[c][1], v[3][c] = hi[c][1];
     printf("{");
     json_triple("x", r->x);
     json_triple("normal", r->n);
@@ -917,8 +938,10 @@ static void point_json(const ulam_rad_point *r)
     else printf("null, ");
     json_triple("irradiance", r->irradiance);
     json_triple("irradiance_stderr", r->irradiance_se);
+    json_triple("irradiance_ci95_lo", v[0]), json_triple("irradiance_ci95_hi", v[1]); /* null: none certified */
     json_triple(answer_key, r->radiosity); /* null off the surfaces */
     json_triple("stderr", r->radiosity_se);
+    json_triple("ci95_lo", v[2]), json_triple("ci95_hi", v[3]);
     printf("\"walks\": %lld, \"rays\": %lld, \"cut\": %lld, ", (long long)r->run.walks, (long long)r->run.rays,
            (long long)r->run.cut);
     cli_json_number("seconds", r->run.seconds, 1);
@@ -933,22 +956,36 @@ static void illuminance(const ulam_rad_point *r, double *Y, double *se)
     for (int c = 0; c < 3; c++) *Y += luma[c] * r->irradiance[c], *se += luma[c] * r->irradiance_se[c];
 }
 
+/* A 95% interval for a point's illuminance Y = sum_c l_c H_c (NaN .. NaN unless every channel has
+ * one): Y +- sum_c l_c h_c, h_c channel c's half-width.  It holds because it contains the
+ * interval src/stop.c would give on the walks' Y scores: their range is at most sum_c l_c R_c,
+ * their bias sum_c l_c of the channels', and their sample standard deviation at most
+ * sum_c l_c s_c (the sample covariance is positive semidefinite), so each term of that
+ * half-width is at most the weighted sum of the channels'; floored at 0 (every score >= 0). */
+static void illuminance_ci(const ulam_rad_point *r, double *lo, double *hi)
+{
+    double Y = 0.0, h = 0.0;
+    for (int c = 0; c < 3; c++) Y += luma[c] * r->irradiance[c], h += luma[c] * (r->run.ci95[c][1] - r->irradiance[c]);
+    *lo = isfinite(h) ? fmax(Y - h, 0.0) : NAN, *hi = isfinite(h) ? Y + h : NAN;
+}
+
 /* --grid: the CSV (one row a sensor), atomically; 0 or an exit code. */
 static int write_grid_csv(const char *path, const ulam_rad_grid *g, const ulam_rad_point *pts)
 {
     ulam_outfile o;
     int status = cli_outfile_open(&o, path);
     if (!status) {
-        fprintf(o.f, "i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks\n");
+        fprintf(o.f, "i,j,x,y,z,R,G,B,R_se,G_se,B_se,Y,Y_se_bound,walks,ci95_lo,ci95_hi\n");
         for (int j = 0; j < g->nv; j++)
             for (int i = 0; i < g->nu; i++) {
                 const ulam_rad_point *r = &pts[(size_t)j * (size_t)g->nu + (size_t)i];
-                double Y, se;
+                double Y, se, lo, hi;
                 illuminance(r, &Y, &se);
+                illuminance_ci(r, &lo, &hi);
                 fprintf(o.f, "%d,%d,%.17g,%.17g,%.17g", i + 1, j + 1, r->x[0], r->x[1], r->x[2]);
                 for (int c = 0; c < 3; c++) fprintf(o.f, ",%.17g", r->irradiance[c]);
                 for (int c = 0; c < 3; c++) fprintf(o.f, ",%.17g", r->irradiance_se[c]);
-                fprintf(o.f, ",%.17g,%.17g,%lld\n", Y, se, (long long)r->run.walks);
+                fprintf(o.f, ",%.17g,%.17g,%lld,%.17g,%.17g\n", Y, se, (long long)r->run.walks, lo, hi);
             }
         status = cli_outfile_commit(&o);
     }
@@ -1038,7 +1075,7 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         printf("\"points\": [");
         for (int k = 0; k < a->nat; k++) {
             if (k) printf(", ");
-            point_json(&pts[k]);
+            point_json(s, &pts[k]);
         }
         printf("], ");
         if (ngrid) {
@@ -1054,7 +1091,7 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
             printf("\"points\": [");
             for (int64_t k = a->nat; k < n; k++) {
                 if (k > a->nat) printf(", ");
-                point_json(&pts[k]);
+                point_json(s, &pts[k]);
             }
             printf("]}, ");
         }

@@ -152,7 +152,7 @@ static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 }
 
 /* Print whether the --rel-err target was met, and when not why (one line; nothing without a target). */
-static void print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int verbose)
+void cli_print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int verbose)
 {
     if (o->stop.rel_err > 0 && r->cut_stop)
         printf("rel-err         NOT met (target %.3g): %lld walks were cut at %lld steps and the cut's bias may be "
@@ -166,6 +166,13 @@ static void print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, in
         printf("rel-err         NOT met (target %.3g): a score passed the certified range, so no interval can be "
                "printed; stopped after %lld walks, over 1024 times the %.4g the rule asked for\n", o->stop.rel_err,
                (long long)r->walks, r->min_walks);
+    else if (o->stop.rel_err > 0 && r->estimate == 0 && r->out_of_reach && r->min_walks > 0 && isfinite(r->min_walks))
+        printf("rel-err         NOT met (target %.3g): no walk has scored in %lld; a walk scores at all with probability "
+               "at most %.3g (certified from where it can go), so the rule asks for at least %.4g walks, %s: stopped "
+               "early, %s\n", o->stop.rel_err, (long long)r->walks,
+               1.0 / (1.0 + r->min_walks * o->stop.rel_err * o->stop.rel_err), r->min_walks,
+               o->stop.max_walks > 0 ? "more than --walks" : "beyond the 1e9 cap",
+               isfinite(r->ci95[0]) ? "the interval above" : "the estimate so far above");
     else if (o->stop.rel_err > 0 && r->fourth_finite != 1 && (verbose || !r->rel_err_met))
         printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
                "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
@@ -197,7 +204,7 @@ static void print_brief(const ulam_walk_opts *o, const ulam_walk_result *r, cons
                r->walks ? (double)r->steps / (double)r->walks : 0.0);
     printf("seconds         %.3g walking on %d threads; %.3g in all (inputs, guards, set-up)\n", r->seconds,
            r->threads, ulam_now() - ro->t_start);
-    print_rel_err(o, r, 0);
+    cli_print_rel_err(o, r, 0);
     if (o->mode == ULAM_FORWARD && r->unreached)
         printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
                (long long)r->unreached, (long long)ro->n);
@@ -242,7 +249,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     if (o->mode == ULAM_FORWARD)
         printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
                (long long)r->unreached, (long long)ro->n);
-    print_rel_err(o, r, 1);
+    cli_print_rel_err(o, r, 1);
     printf("load            %.3f s inputs, %.3f s guards, %.3f s %s; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds,
            ro->ch ? "choice and solver set-up (auto's guards, pilots, set-up)" : "solver set-up", peak_rss_mib());

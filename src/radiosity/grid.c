@@ -1,6 +1,9 @@
 /* Sensor grids: the lighting designer's standard output, irradiance at the centres of the cells
  * of a rectangle on a work plane, each point a point query (point.c's walks) with its own seed
- * stream, so a point's answer depends neither on the threads nor on the other points. */
+ * stream, so a point's answer depends neither on the threads nor on the other points.  The
+ * sensors share one solver: its emitter table and the scene-wide part of its certified score
+ * range (a pass over every patch, the same for every sensor) are made once, and each sensor
+ * adds only its own vertex's bound (ulam__rad_point_restart). */
 #include "rad.h"
 
 #include <string.h>
@@ -36,8 +39,9 @@ int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const u
     int status = check_grid(g, err);
     if (status) return status;
     double t0 = ulam_now();
-    for (int j = 0; j < g->nv; j++)
-        for (int i = 0; i < g->nu; i++) {
+    ulam_rad_solver *sv = NULL;
+    for (int j = 0; j < g->nv && !status; j++)
+        for (int i = 0; i < g->nu && !status; i++) {
             int64_t k = (int64_t)j * g->nu + i;
             ulam_rad_opts o = *opts;
             ulam_rng r;
@@ -49,11 +53,18 @@ int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const u
             }
             double x[3];
             ulam_rad_grid_point(g, i, j, x);
-            if ((status = ulam_rad_point_query(t, &o, x, g->normal, &out[k], err))) return status;
-            if (out[k].run.interrupted) {
+            status = sv ? ulam__rad_point_restart(sv, x, g->normal, o.exec.seed, o.stop.max_seconds, err)
+                        : ulam_rad_point_alloc(t, &o, x, g->normal, &sv, err);
+            while (!status && !ulam_rad_solver_done(sv))
+                if ((status = ulam_rad_solver_iterate(sv))) ulam__fail(err, status, 0, -1, "finite scores");
+            if (status) break;
+            ulam_rad_point_result(sv, &out[k]);
+            if (out[k].run.interrupted) { /* the rest are left empty */
                 for (int64_t m = k + 1; m < (int64_t)g->nu * g->nv; m++) memset(&out[m], 0, sizeof out[m]);
-                return ULAM_OK;
+                j = g->nv;
+                break;
             }
         }
-    return ULAM_OK;
+    ulam_rad_solver_free(sv);
+    return status;
 }

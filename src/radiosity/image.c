@@ -37,21 +37,41 @@ static int normalise(double v[3])
     return 1;
 }
 
+/* A camera's orthonormal frame and film pitch for a width-pixel image. */
+typedef struct {
+    double f[3], up[3], right[3], focal, pitch;
+    int w, h;
+} film;
+
+/* The frame of cam for a w x h image. */
+static film film_make(const ulam_camera *cam, int w, int h)
+{
+    film m = {{cam->dir[0], cam->dir[1], cam->dir[2]}, {cam->up[0], cam->up[1], cam->up[2]}, {0, 0, 0},
+              cam->focal, cam->film / (double)w, w, h};
+    normalise(m.f);
+    ulam__cross3(m.f, m.up, m.right);
+    normalise(m.right);
+    ulam__cross3(m.right, m.f, m.up);
+    return m;
+}
+
+/* Unit direction through pixel (x, y) at offset (jx, jy) in [0,1)^2 from its top-left corner. */
+static void film_ray(const film *m, int x, double jx, int y, double jy, double d[3])
+{
+    double sx = ((double)x + jx - 0.5 * m->w) * m->pitch, sy = (0.5 * m->h - (double)y - jy) * m->pitch;
+    for (int k = 0; k < 3; k++) d[k] = m->focal * m->f[k] + sx * m->right[k] + sy * m->up[k];
+    normalise(d);
+}
+
 /* The patch each pixel centre sees (-1: nothing); back sides are seen through. */
 static void cast_pixels(const ulam_tracer *t, const ulam_camera *cam, int w, int h, int64_t *hit)
 {
-    double f[3] = {cam->dir[0], cam->dir[1], cam->dir[2]}, up[3] = {cam->up[0], cam->up[1], cam->up[2]}, right[3];
-    normalise(f);
-    ulam__cross3(f, up, right);
-    normalise(right);
-    ulam__cross3(right, f, up);
-    double pitch = cam->film / (double)w;
+    film m = film_make(cam, w, h);
 #pragma omp parallel for schedule(dynamic, 4)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
-            double sx = ((double)x + 0.5 - 0.5 * w) * pitch, sy = (0.5 * h - (double)y - 0.5) * pitch, d[3];
-            for (int k = 0; k < 3; k++) d[k] = cam->focal * f[k] + sx * right[k] + sy * up[k];
-            normalise(d);
+            double d[3];
+            film_ray(&m, x, 0.5, y, 0.5, d);
             hit[(size_t)y * (size_t)w + (size_t)x] = ulam__tracer_cast_front(t, cam->eye, d);
         }
 }
@@ -195,12 +215,7 @@ int ulam_render_hdr(const ulam_tracer *t, const double *B, const ulam_camera *ca
         free(cv), free(lum), free(lit);
         return ULAM_ENOMEM;
     }
-    double f[3] = {cam->dir[0], cam->dir[1], cam->dir[2]}, up[3] = {cam->up[0], cam->up[1], cam->up[2]}, right[3];
-    normalise(f);
-    ulam__cross3(f, up, right);
-    normalise(right);
-    ulam__cross3(right, f, up);
-    double pitch = cam->film / (double)width;
+    film fm = film_make(cam, width, height);
 #pragma omp parallel for schedule(dynamic, 4)
     for (int y = 0; y < height; y++)
         for (int x = 0; x < width; x++) {
@@ -211,9 +226,8 @@ int ulam_render_hdr(const ulam_tracer *t, const double *B, const ulam_camera *ca
             lit[2 * k] = lit[2 * k + 1] = 0;
             for (int m = 0; m < samples; m++) {
                 double jx = samples > 1 ? ulam__rng_uniform(&r) : 0.5, jy = samples > 1 ? ulam__rng_uniform(&r) : 0.5;
-                double sx = ((double)x + jx - 0.5 * width) * pitch, sy = (0.5 * height - (double)y - jy) * pitch, d[3];
-                for (int c = 0; c < 3; c++) d[c] = cam->focal * f[c] + sx * right[c] + sy * up[c];
-                normalise(d);
+                double d[3];
+                film_ray(&fm, x, jx, y, jy, d);
                 int64_t tri = 0;
                 double u = 0, v = 0;
                 int64_t p = ulam__tracer_cast_front_uv(t, cam->eye, d, &tri, &u, &v);

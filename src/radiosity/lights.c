@@ -149,20 +149,28 @@ static void project_box(const ulam__light_group *G, const double u[3], double *l
 /* An upper bound on G(x, y) = cos cos_y / (pi r^2) over x on patch p (or, p < 0, the point pt
  * with normal n) and y on an emitter of group G (within its box, facing along its normal), both
  * facing each other: 0 when the box lies wholly on or behind x's plane or x's patch wholly on or
- * behind the emitters' plane (no pair faces), 1 / (pi d^2) for d > 0 a lower bound on their
- * distance (the widest gap along x's normal, against the emitters' normal, and along the line
- * between the centres: separating axes of convex sets), else INFINITY. */
+ * behind the emitters' plane (no pair faces); else, for d > 0 a lower bound on their distance
+ * r (the widest gap along x's normal, against the emitters' normal, along the line between the
+ * centres: separating axes of convex sets; and the least |v| with v . n >= the first gap and
+ * v . (-n_l) >= the second, both positive, which is sqrt((a^2 + b^2 - 2 c a b) / (1 - c^2)),
+ * c = -n . n_l, where both of its Lagrange multipliers are >= 0),
+ * min(1, A / d) min(1, B / d) / (pi d^2), A and B the largest distances of y from x's plane
+ * and of x from the emitters' plane: cos = (y - x) . n / r <= A / r, cos_y <= B / r, each <= 1,
+ * and that bound falls with r >= d; INFINITY without such a d. */
 static double g_max(const ulam_scene *s, int64_t p, const double *pt, const double n[3], const ulam__light_group *G)
 {
     double lo_p, hi_p, lo_l, hi_l, cp[3] = {0, 0, 0}, u[3];
     project(s, p, pt, n, &lo_p, &hi_p);
     project_box(G, n, &lo_l, &hi_l);
     if (hi_l - lo_p <= 1e-12 * (fmax(fabs(lo_p), fabs(hi_l)) + 1.0)) return 0.0; /* on or behind x's plane */
-    double gap = lo_l - hi_p;
+    double gx = lo_l - hi_p, A = hi_l - lo_p;
     project(s, p, pt, G->n, &lo_p, &hi_p);
     project_box(G, G->n, &lo_l, &hi_l);
     if (hi_p - lo_l <= 1e-12 * (fmax(fabs(hi_p), fabs(lo_l)) + 1.0)) return 0.0; /* x behind the emitters' plane */
-    gap = fmax(gap, lo_p - hi_l); /* along -n_l */
+    double gl = lo_p - hi_l, B = hi_p - lo_l, gap = fmax(gx, gl); /* gl along -n_l */
+    double c = -ulam__dot3(n, G->n);
+    if (gx > 0 && gl > 0 && fabs(c) < 1.0 - 1e-9 && gx - c * gl >= 0 && gl - c * gx >= 0)
+        gap = fmax(gap, sqrt(fmax(0.0, (gx * gx + gl * gl - 2.0 * c * gx * gl) / (1.0 - c * c))) * (1.0 - 1e-12));
     int64_t a = p < 0 ? 0 : s->start[p], b = p < 0 ? 1 : s->start[p + 1];
     for (int64_t k = a; k < b; k++)
         for (int i = 0; i < 3; i++) cp[i] += (p < 0 ? pt : s->vert + 3 * s->vidx[k])[i] / (double)(b - a);
@@ -174,7 +182,8 @@ static double g_max(const ulam_scene *s, int64_t p, const double *pt, const doub
         project_box(G, u, &lo_l, &hi_l);
         gap = fmax(gap, lo_l - hi_p);
     }
-    return gap > 0 ? 1.0 / (M_PI * gap * gap) : INFINITY;
+    if (!(gap > 0)) return INFINITY;
+    return fmin(1.0, A / gap) * fmin(1.0, B / gap) / (M_PI * gap * gap);
 }
 
 /* The most one light sample (light) or one landing of the walk's cosine ray on an emitter
@@ -191,20 +200,31 @@ static double score_factor(int estimator, double pl, double gmax, int light)
     return g / pl * ulam__mis_weight(estimator, pl, g, 1);
 }
 
-/* A certified bound, per channel, on what one vertex of a next-event walk at patch p (or, p < 0,
- * the point pt with normal n) scores with weights W <= 1: rho_pc (1 at the point or with
- * reflect 0) times the largest light sample plus the largest weighted landing on an emitter,
- * over every group of emitters (score_factor at g_max).  INFINITY where light sampling alone meets an
- * emitter it may touch (1 / r^2 unbounded). */
-void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
-                               const double n[3], int reflect, double out[3])
+/* Certified bounds, per channel and per unit of weight W, on one vertex of a next-event walk at
+ * patch p (or, p < 0, the point pt with normal n): light, the largest light sample (before any
+ * reflectance), and hit, the largest landing of the vertex's cosine ray on an emitter, weighted
+ * against light sampling; over every group of emitters (score_factor at g_max).  INFINITY
+ * where light sampling alone meets an emitter it may touch (1 / r^2 unbounded). */
+void ulam__lights_vertex_parts(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
+                               const double n[3], double light[3], double hit[3])
 {
-    double lmax[3] = {0, 0, 0}, hmax[3] = {0, 0, 0};
+    for (int c = 0; c < 3; c++) light[c] = hit[c] = 0.0;
     for (int64_t k = 0; k < L->ngroups; k++) {
         const double *E = L->group[k].E;
         double pl = (E[0] + E[1] + E[2]) / L->ptot, g = g_max(s, p, pt, n, &L->group[k]);
         double fl = score_factor(estimator, pl, g, 1), fh = score_factor(estimator, pl, g, 0);
-        for (int c = 0; c < 3; c++) lmax[c] = fmax(lmax[c], E[c] * fl), hmax[c] = fmax(hmax[c], E[c] * fh);
+        for (int c = 0; c < 3; c++) light[c] = fmax(light[c], E[c] * fl), hit[c] = fmax(hit[c], E[c] * fh);
     }
+}
+
+/* A certified bound, per channel, on what one vertex of a next-event walk at patch p (or, p < 0,
+ * the point pt with normal n) scores with weights W <= 1: rho_pc (1 at the point or with
+ * reflect 0) times the largest light sample plus the largest weighted landing on an emitter
+ * (ulam__lights_vertex_parts). */
+void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
+                               const double n[3], int reflect, double out[3])
+{
+    double lmax[3], hmax[3];
+    ulam__lights_vertex_parts(L, s, estimator, p, pt, n, lmax, hmax);
     for (int c = 0; c < 3; c++) out[c] = (reflect && p >= 0 ? s->rho[3 * p + c] : 1.0) * lmax[c] + hmax[c];
 }

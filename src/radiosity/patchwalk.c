@@ -53,6 +53,7 @@ typedef struct {
     ulam__block_head h; /* the round driver's part: the shooting tallies (rad_tally), walks, ... */
     ulam__moments m[3]; /* gathering scores per channel */
     double sq, maxsq;   /* sum and largest square of the channel-summed score (of the patch) */
+    double maxc[3];     /* the largest score per channel (gathering) */
     int64_t rays, cut;
 } rad_block;
 
@@ -72,6 +73,7 @@ struct ulam_rad_solver {
     double *q;            /* continuation per patch: max_c rho */
     double per_step[3], range[3], qmax; /* the score bounds of the rel_err rule (score_bounds) */
     double first[3], w1[3];             /* next-event: the first vertex's (first_bounds) */
+    ulam__point_bounds pb;              /* a point solver's (point_bounds) */
     ulam__lights L;       /* the emitters (shooting's source, next-event's lights) */
     int at;               /* a point solver: walks from at_x (normal at_n, on patch at_self or -1) */
     double at_x[3], at_n[3];
@@ -80,7 +82,7 @@ struct ulam_rad_solver {
     rad_block *blocks;
     ulam__moments m[3];
     double *sum, *sumsq; /* shooting: per patch and channel, of history tallies */
-    double sq, maxsq;
+    double sq, maxsq, maxc[3];
     ulam__run run; /* walks, time, ending (round.c) */
     int64_t rays, cut;
     int zero, met;
@@ -152,6 +154,37 @@ static void first_bounds(ulam_rad_solver *s)
     for (int c = 0; c < 3 && !s->at; c++) s->w1[c] = s->q[i] > 0 ? sc->rho[3 * i + c] / s->q[i] : 0.0;
 }
 
+/* A point solver's parts of its range (ulam__point_range): its own vertex's light sample and
+ * landing (at the point), every other vertex's largest over the patches, the largest
+ * reflectance, and whether every emitter is black (a landing on one ends the walk). */
+static void point_bounds(ulam_rad_solver *s)
+{
+    const ulam_scene *sc = s->s;
+    ulam__point_bounds *b = &s->pb;
+    int nee = next_event(s->o.estimator);
+    double emax[3] = {0, 0, 0};
+    memset(b, 0, sizeof *b);
+    b->black = 1;
+    for (int64_t k = 0; k < s->L.nem; k++) {
+        int64_t l = s->L.emitter[k];
+        b->black &= s->q[l] == 0.0;
+        for (int c = 0; c < 3; c++) emax[c] = fmax(emax[c], sc->emit[3 * l + c]);
+    }
+    for (int64_t p = 0; p < sc->npatches; p++) {
+        double l[3] = {0, 0, 0}, h[3] = {emax[0], emax[1], emax[2]}; /* collision: a landing scores W E, no light sample */
+        b->rho = fmax(b->rho, s->q[p]);
+        if (nee) ulam__lights_vertex_parts(&s->L, sc, s->o.estimator, p, NULL, sc->normal + 3 * p, l, h);
+        for (int c = 0; c < 3; c++) {
+            double r = sc->rho[3 * p + c];
+            b->light[c] = fmax(b->light[c], l[c]), b->hit[c] = fmax(b->hit[c], h[c]);
+            b->lr[c] = fmax(b->lr[c], r * l[c]), b->hr[c] = fmax(b->hr[c], r * h[c]);
+        }
+    }
+    if (nee) ulam__lights_vertex_parts(&s->L, sc, s->o.estimator, -1, s->at_x, s->at_n, b->light0, b->hit0); /* its own */
+    else
+        for (int c = 0; c < 3; c++) b->light0[c] = 0.0, b->hit0[c] = emax[c];
+}
+
 /* The bounds of the rel_err rule (per channel: per_step, what one step can score; range, a
  * bound on a whole walk's score when one is known, else INFINITY and the walks' length is
  * truncated, stop.h; qmax the largest survival).  Every weight stays at most its start
@@ -178,6 +211,7 @@ static void score_bounds(ulam_rad_solver *s)
             s->range[c] = fmax(s->range[c], E > 0 ? E / (1.0 - s->q[p]) : 0.0);
         }
     }
+    if (s->at) point_bounds(s);
     if (s->o.mode == ULAM_FORWARD) {
         for (int c = 0; c < 3; c++) {
             double w0 = 0.0, rho = sc->rho[3 * s->o.query.index + c], q = s->q[s->o.query.index];
@@ -280,6 +314,33 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, ulam_
     return solver_alloc(t, opts, 0, out, err);
 }
 
+/* Check point x (normal n, or NULL: the patch's it lies on) and place it: *p the patch it lies
+ * on or -1, xx the point on that patch's plane exactly, nn the unit normal. */
+static int point_place(const ulam_scene *sc, const double x[3], const double n[3], int64_t *p, double xx[3],
+                       double nn[3], ulam_error *err)
+{
+    double len = n ? sqrt(ulam__dot3(n, n)) : 0.0;
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(x[k]) || (n && !isfinite(n[k]))) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a finite point and normal");
+    if (n && !(len > 0)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero normal");
+    *p = ulam_scene_locate(sc, x, ULAM_RAD_LOCATE_REL);
+    if (!n && *p < 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point on a patch (within %g of its size) or a normal for a "
+                                                   "sensor off the surfaces", ULAM_RAD_LOCATE_REL);
+    for (int k = 0; k < 3; k++) nn[k] = n ? n[k] / len : sc->normal[3 * *p + k], xx[k] = x[k];
+    if (*p >= 0 && ulam__dot3(nn, sc->normal + 3 * *p) < 1.0 - 1e-9)
+        return ulam__fail(err, ULAM_EINVAL, 0, *p, "the normal of patch %lld the point lies on (or no normal)",
+                          (long long)*p + 1);
+    if (*p >= 0) { /* onto the patch's plane exactly */
+        const double *v = sc->vert + 3 * sc->vidx[sc->start[*p]], *pn = sc->normal + 3 * *p;
+        double d[3];
+        ulam__sub3(x, v, d);
+        double h = ulam__dot3(d, pn);
+        for (int k = 0; k < 3; k++) xx[k] -= h * pn[k];
+    }
+    return ULAM_OK;
+}
+
 /* Prepare walks from point x (normal n, or NULL: the patch's it lies on). */
 int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, const double x[3], const double n[3],
                          ulam_rad_solver **out, ulam_error *err)
@@ -287,34 +348,36 @@ int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, const 
     ulam__clear(err);
     if (!t || !x || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, a point and an output");
     *out = NULL;
-    const ulam_scene *sc = ulam__tracer_scene(t);
-    double nn[3], len = n ? sqrt(ulam__dot3(n, n)) : 0.0;
-    for (int k = 0; k < 3; k++)
-        if (!isfinite(x[k]) || (n && !isfinite(n[k]))) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a finite point and normal");
-    if (n && !(len > 0)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero normal");
-    int64_t p = ulam_scene_locate(sc, x, ULAM_RAD_LOCATE_REL);
-    if (!n && p < 0)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point on a patch (within %g of its size) or a normal for a "
-                                                   "sensor off the surfaces", ULAM_RAD_LOCATE_REL);
-    for (int k = 0; k < 3; k++) nn[k] = n ? n[k] / len : sc->normal[3 * p + k];
-    if (p >= 0 && ulam__dot3(nn, sc->normal + 3 * p) < 1.0 - 1e-9)
-        return ulam__fail(err, ULAM_EINVAL, 0, p, "the normal of patch %lld the point lies on (or no normal)",
-                          (long long)p + 1);
-    int status = solver_alloc(t, opts, 1, out, err);
-    if (status) return status;
+    double xx[3], nn[3];
+    int64_t p;
+    int status = point_place(ulam__tracer_scene(t), x, n, &p, xx, nn, err);
+    if (status || (status = solver_alloc(t, opts, 1, out, err))) return status;
     ulam_rad_solver *s = *out;
-    for (int k = 0; k < 3; k++) s->at_x[k] = x[k], s->at_n[k] = nn[k];
+    for (int k = 0; k < 3; k++) s->at_x[k] = xx[k], s->at_n[k] = nn[k];
     s->at_self = p;
-    if (p >= 0) { /* onto the patch's plane exactly */
-        const double *v = sc->vert + 3 * sc->vidx[sc->start[p]], *pn = sc->normal + 3 * p;
-        double d[3];
-        ulam__sub3(x, v, d);
-        double h = ulam__dot3(d, pn);
-        for (int k = 0; k < 3; k++) s->at_x[k] -= h * pn[k];
-    }
     score_bounds(s); /* with the point's own first vertex */
     if ((status = check_bounded(s, err))) *out = ulam_rad_solver_free(s);
     return status;
+}
+
+/* Move point solver s to point x (normal n, as ulam_rad_point_alloc's) with seed and
+ * max_seconds, its statistics cleared: the scene-wide parts of its score bounds (every patch's,
+ * point_bounds) and its workspace are kept, only the point's own vertex's bound is made anew. */
+int ulam__rad_point_restart(ulam_rad_solver *s, const double x[3], const double n[3], uint64_t seed, double max_seconds,
+                            ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s || !s->at || !x) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point solver and a point");
+    double xx[3], nn[3];
+    int64_t p;
+    int status = point_place(s->s, x, n, &p, xx, nn, err);
+    if (status) return status;
+    for (int k = 0; k < 3; k++) s->at_x[k] = xx[k], s->at_n[k] = nn[k];
+    s->at_self = p;
+    ulam__rad_solver_restart(s, -1, s->o.stop.rel_err, seed, max_seconds);
+    if (next_event(s->o.estimator))
+        ulam__lights_vertex_parts(&s->L, s->s, s->o.estimator, -1, s->at_x, s->at_n, s->pb.light0, s->pb.hit0);
+    return ULAM_OK;
 }
 
 /* A point solver's answer: irradiance, and radiosity on the patch the point lies on. */
@@ -485,7 +548,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     rad_block *br = &s->blocks[k];
     ulam__moments zero = {0};
     br->m[0] = br->m[1] = br->m[2] = zero;
-    br->sq = br->maxsq = 0.0;
+    br->sq = br->maxsq = br->maxc[0] = br->maxc[1] = br->maxc[2] = 0.0;
     br->h.len = br->h.walks = br->rays = br->cut = br->h.nonfinite = 0;
     br->h.complete = br->h.nomem = 0;
     if (!ulam__mine(s->o.exec.share, first / RBLOCK) || !ulam__block_may_start(&s->o, s->run.t0, first)) return;
@@ -496,7 +559,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             double sc[3];
             if (s->at) {
                 int64_t cut = 0;
-                ulam__point_walk(s->t, &s->L, s->q, s->o.estimator, s->o.stop.max_steps, s->at_x, s->at_n, s->at_self, &r,
+                ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, ulam__point_gamma(s->pb.rho), s->at_x, s->at_n, s->at_self, &r,
                                  sc, &br->rays, &cut);
                 br->cut += cut;
             } else if (next_event(s->o.estimator)) {
@@ -506,6 +569,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             }
             for (int c = 0; c < 3; c++) {
                 ulam__moments_add(&br->m[c], sc[c]);
+                br->maxc[c] = fmax(br->maxc[c], sc[c]);
                 if (!isfinite(sc[c])) br->h.nonfinite++;
             }
             double x = sc[0] + sc[1] + sc[2];
@@ -534,6 +598,7 @@ static void merge_block(void *ctx, int k)
     for (int c = 0; c < 3; c++) ulam__moments_merge(&s->m[c], &br->m[c]);
     s->sq += br->sq;
     s->maxsq = fmax(s->maxsq, br->maxsq);
+    for (int c = 0; c < 3; c++) s->maxc[c] = fmax(s->maxc[c], br->maxc[c]);
     for (int64_t k = 0; k < br->h.len; k++) {
         const rad_tally *e = (const rad_tally *)br->h.tally + k;
         for (int c = 0; c < 3; c++) {
@@ -555,25 +620,32 @@ static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r)
 /* Channel c's certified score range R and bias at estimate m (of B), in B's units: the range of
  * one walk's score (gathering) or of one particle's tally at the patch over its area
  * (shooting), at a truncation whose bias is at most E |m| / 4 when no whole-walk bound is known
- * (score_bounds). */
+ * (score_bounds); a point walk's whole range, finite and with no bias (ulam__point_range). */
 static void channel_range(const ulam_rad_solver *s, int c, double m, double E, double *R, double *bias)
 {
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
+    if (s->at) { /* point walks: their weight window's range (point.c) */
+        *R = ulam__point_range(&s->pb, c);
+        *bias = 0.0;
+        return;
+    }
     double later = ulam__score_range(s->range[c], s->w1[c] * s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0);
     *R = (s->first[c] + later) / A;
     *bias = isfinite(s->range[c]) ? 0.0 : E * fabs(m) / 4.0;
 }
 
 /* Channel c's 95% interval (stop.h) at estimate m: on the walks' scores (gathering) or the
- * particles' tallies at the patch over its area (shooting, the emission exact). */
+ * particles' tallies at the patch over its area (shooting, the emission exact).  A point
+ * solver's scores are checked against their certified range: one past it leaves no interval
+ * (and no stop by rel_err), as in ulam_solve's. */
 static void channel_interval(const ulam_rad_solver *s, int c, double m, double E, ulam__stop_ci *ci)
 {
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0, R, bias;
     double off = s->o.mode == ULAM_FORWARD ? s->s->emit[3 * s->o.query.index + c] : 0.0;
     channel_range(s, c, m, E, &R, &bias);
     int64_t n = s->run.walks;
-    ulam__stop_interval(n, off + s->m[c].mean / A, ulam__moments_variance(&s->m[c]) / (A * A), R, bias, 0.0, INFINITY,
-                        ulam__stop_epoch(n), ci);
+    ulam__stop_interval(n, off + s->m[c].mean / A, ulam__moments_variance(&s->m[c]) / (A * A), R, bias,
+                        s->at ? s->maxc[c] : 0.0, s->at ? R : INFINITY, ulam__stop_epoch(n), ci);
 }
 
 /* The walks the rel_err rule (stop.h) needs in channel c at estimate m. */
@@ -655,7 +727,7 @@ void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uin
     s->o.query.index = p, s->o.stop.rel_err = rel_err, s->o.exec.seed = seed, s->o.stop.max_seconds = max_seconds;
     first_bounds(s);
     s->m[0] = s->m[1] = s->m[2] = zero;
-    s->sq = s->maxsq = 0.0;
+    s->sq = s->maxsq = s->maxc[0] = s->maxc[1] = s->maxc[2] = 0.0;
     s->rays = s->cut = 0;
     ulam__run_reset(&s->run);
     s->zero = s->met = s->epoch = 0;

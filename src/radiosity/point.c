@@ -5,9 +5,14 @@
  * lands on, the point itself and not a uniform point of its patch) it takes one next-event
  * light sample (lights.c), its own cosine ray landing on an emitter counting by multiple
  * importance sampling against it, so each vertex's direct light is counted once.  A landing
- * point y on patch j carries the walk on with Russian roulette: it continues with
- * q_j = max_c rho_jc, its weights multiplied by rho_jc / q_j (E[w] unchanged).  Then
- * B(x) = E + rho H(x) on the patch x lies on. */
+ * point y on patch j carries the walk on with its weights multiplied by rho_jc, and Russian
+ * roulette only once they are small (a weight window whose floor falls): at the k-th landing,
+ * when w = max_c W_c rho_jc is below f_k = ULAM__POINT_WMIN gamma^k, the walk continues with
+ * probability w / f_k, its weights divided by that (E[W] unchanged, so the estimate stays
+ * unbiased).  So vertex k weighs at most max(rho^k, f_k), rho the scene's largest reflectance,
+ * whatever the path, and one walk's score has a finite certified range (ulam__point_range),
+ * where roulette with q = max_c rho_c (weights rho / q, 1 on a grey surface) counted every
+ * vertex at full weight up to a truncation.  Then B(x) = E + rho H(x) on the patch x lies on. */
 #include "rad.h"
 
 /* Move y onto the plane of patch j (the hit point's float rounding, so that the next ray leaves
@@ -22,13 +27,13 @@ static void onto_plane(const ulam_scene *s, int64_t j, double y[3])
 }
 
 /* One walk from x: its RGB irradiance score. */
-void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, const double *q, int estimator, int64_t max_steps,
+void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps, double gamma,
                       const double x0[3], const double n0[3], int64_t self, ulam_rng *r, double score[3],
                       int64_t *rays, int64_t *cut)
 {
     const ulam_scene *s = ulam__tracer_scene(t);
     int light = estimator != ULAM_RAD_COLLISION && L->nem > 0;
-    double W[3] = {1, 1, 1}, x[3] = {x0[0], x0[1], x0[2]}, n[3] = {n0[0], n0[1], n0[2]};
+    double W[3] = {1, 1, 1}, floor = ULAM__POINT_WMIN, x[3] = {x0[0], x0[1], x0[2]}, n[3] = {n0[0], n0[1], n0[2]};
     score[0] = score[1] = score[2] = 0.0;
     for (int64_t step = 0;; step++) {
         if (light) *rays += ulam__lights_score(t, L, estimator, ulam__lights_pick(L, ulam__rng_uniform(r)), x, n, self,
@@ -45,14 +50,66 @@ void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, const double 
             double w = L->nem > 0 ? ulam__lights_hit_weight(L, s, estimator, j, &h) : 1.0;
             for (int c = 0; c < 3; c++) score[c] += W[c] * E[c] * w;
         }
-        if (ulam__rng_uniform(r) >= q[j]) return; /* Russian roulette at the landing point */
+        double w = 0.0;
+        floor *= gamma;
+        for (int c = 0; c < 3; c++) W[c] *= rho[c], w = fmax(w, W[c]);
+        if (w < floor) { /* Russian roulette once the weights are below the floor */
+            if (!(ulam__rng_uniform(r) * floor < w)) return;
+            for (int c = 0; c < 3; c++) W[c] *= floor / w;
+        }
         if (step >= max_steps) {
             *cut = 1;
             return;
         }
-        for (int c = 0; c < 3; c++) W[c] *= rho[c] / q[j];
         for (int k = 0; k < 3; k++) x[k] += dist * d[k], n[k] = s->normal[3 * j + k];
         onto_plane(s, j, x);
         self = j;
     }
+}
+
+/* The rate gamma = (1 + rho) / 2 at which a point walk's weight floor falls (ulam__point_walk):
+ * above rho, the largest reflectance, so that every walk ends; below 1, so that its weights'
+ * sum is finite. */
+double ulam__point_gamma(double rho)
+{
+    return 0.5 * (1.0 + rho);
+}
+
+/* Sum over k >= 1 of max(rho^(k-1) a, f_k b), f_k = WMIN gamma^k, for 0 <= a <= gamma b and
+ * rho < gamma: the terms are rho^(k-1) a while that is the larger (it falls faster), then
+ * f_k b, a geometric tail. */
+static double part_sum(double rho, double gamma, double a, double b)
+{
+    double sum = 0.0, r = 1.0, f = ULAM__POINT_WMIN * gamma; /* rho^(k-1) and f_k at k = 1 */
+    for (; r * a > f * b; r *= rho, f *= gamma) sum += r * a;
+    return sum + b * f / (1.0 - gamma);
+}
+
+/* A certified range of channel c of one walk's score (ulam__point_walk): every score lies in
+ * [0, R].  Why:
+ * - Weights.  W_0 = 1; at the k-th landing, on patch j, W <- W rho_j, and roulette (when
+ *   max_c W_c < f_k = WMIN gamma^k) sets max_c W_c = f_k: by induction max_c W_kc <= w_k =
+ *   max(rho^k, f_k), rho the largest reflectance (rho f_(k-1) < f_k as rho < gamma).
+ * - Vertex k >= 1 lies on the patch j its walk landed on; it takes one light sample and casts one
+ *   cosine ray that may land on an emitter, each scoring at most W_kc times lights.c's bound at
+ *   j (light_jc, hit_jc).  Without roulette there, W_kc = W_(k-1)c rho_jc <= w_(k-1) rho_jc;
+ *   with it W_kc <= f_k.  So its light sample scores at most max(w_(k-1) lr_c, f_k l_c) =
+ *   max(rho^(k-1) lr_c, f_k l_c) (as f_(k-1) lr_c <= f_(k-1) rho l_c < f_k l_c), lr_c =
+ *   max_j rho_jc light_jc, l_c = max_j light_jc; its landing likewise with hr, h.  Vertex 0,
+ *   the point itself, scores at most light0_c + hit0_c.
+ * - Landings on a black emitter (rho 0) end the walk, so when every emitter is black a walk
+ *   scores at most one landing: max(hit0_c, hr_c, f_1 h_c).
+ * - So R = light0_c + part_sum(lr_c, l_c) + (black ? max(hit0_c, hr_c, f_1 h_c) :
+ *   hit0_c + part_sum(hr_c, h_c)), finite with no truncation: no walk is cut and no bias is
+ *   added.  (Roulette with q = max_c rho_c, weights rho / q, 1 on a grey surface, has no finite
+ *   range: it was truncated at K vertices, R = first + (l_c + h_c)(K + 1), plus a bias.) */
+double ulam__point_range(const ulam__point_bounds *b, int c)
+{
+    double first = b->light0[c] + b->hit0[c];
+    if (b->light[c] + b->hit[c] == 0.0) return first;
+    if (!isfinite(b->light[c] + b->hit[c]) || !isfinite(first) || !(b->rho < 1.0)) return INFINITY;
+    double g = ulam__point_gamma(b->rho);
+    double hits = b->black ? fmax(b->hit0[c], fmax(b->hr[c], ULAM__POINT_WMIN * g * b->hit[c]))
+                           : b->hit0[c] + part_sum(b->rho, g, b->hr[c], b->hit[c]);
+    return b->light0[c] + part_sum(b->rho, g, b->lr[c], b->light[c]) + hits;
 }

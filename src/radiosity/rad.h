@@ -90,6 +90,11 @@ const ulam_scene *ulam__tracer_scene(const ulam_tracer *t);
  * statistics cleared and its workspace kept. */
 void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uint64_t seed, double max_seconds);
 
+/* Move point solver s to x (normal n, as ulam_rad_point_alloc's) with seed and max_seconds, its
+ * statistics cleared, its scene-wide score bounds and workspace kept (sensor grids). */
+int ulam__rad_point_restart(ulam_rad_solver *s, const double x[3], const double n[3], uint64_t seed, double max_seconds,
+                            ulam_error *err);
+
 /* Emitters of one emission and one normal (a subdivided lamp), boxed: what the score bounds
  * of ulam__lights_vertex_bound read. */
 typedef struct {
@@ -128,6 +133,12 @@ int ulam__lights_score(const ulam_tracer *t, const ulam__lights *L, int estimato
 double ulam__lights_hit_weight(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t j,
                                const ulam__hit *h);
 
+/* Certified bounds per channel and unit weight on one next-event vertex at patch p, or (p < 0)
+ * the point pt with unit normal n: light, the largest light sample (before reflectance); hit,
+ * the largest MIS-weighted landing of its cosine ray on an emitter. */
+void ulam__lights_vertex_parts(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
+                               const double n[3], double light[3], double hit[3]);
+
 /* A certified bound per channel on one next-event vertex's score (weights <= 1) at patch p, or
  * (p < 0) the point pt with unit normal n: rho_p (reflect, a patch) or 1 times the largest light
  * sample plus the largest MIS-weighted landing on an emitter; INFINITY for light sampling alone
@@ -135,9 +146,31 @@ double ulam__lights_hit_weight(const ulam__lights *L, const ulam_scene *s, int e
 void ulam__lights_vertex_bound(const ulam__lights *L, const ulam_scene *s, int estimator, int64_t p, const double *pt,
                                const double n[3], int reflect, double out[3]);
 
+/* A point walk's weight window (point.c): Russian roulette at the k-th landing once its largest
+ * weight is below ULAM__POINT_WMIN gamma^k (gamma = ulam__point_gamma(rho)), so that vertex k
+ * weighs at most max(rho^k, ULAM__POINT_WMIN gamma^k). */
+#define ULAM__POINT_WMIN 0.1
+
+/* The rate at which a point walk's weight floor falls, for largest reflectance rho < 1. */
+double ulam__point_gamma(double rho);
+
+/* What a point walk's score range is made of (patchwalk.c fills it, ulam__point_range reads
+ * it), per channel and unit weight: light0 and hit0 at the walk's own point; light and hit the
+ * largest at a patch (ulam__lights_vertex_parts; collision: hit the largest E), lr and hr the
+ * largest times the patch's reflectance; rho the largest reflectance; black nonzero when every
+ * emitter has reflectance 0. */
+typedef struct {
+    double light0[3], hit0[3], light[3], hit[3], lr[3], hr[3], rho;
+    int black;
+} ulam__point_bounds;
+
+/* A certified range [0, R] for channel c of one point walk's score (INFINITY: none, light
+ * sampling alone beside an emitter). */
+double ulam__point_range(const ulam__point_bounds *b, int c);
+
 /* A point walk (point.c): one walk from x (unit normal n, on patch self or -1) on the continuous
- * surfaces: its RGB irradiance score; *rays gets the rays cast, *cut 1 when cut at max_steps. */
-void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, const double *q, int estimator, int64_t max_steps,
+ * surfaces, its weight floor falling at gamma (ulam__point_gamma): its RGB irradiance score; *rays gets the rays cast, *cut 1 when cut at max_steps. */
+void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps, double gamma,
                       const double x[3], const double n[3], int64_t self, ulam_rng *r, double score[3],
                       int64_t *rays, int64_t *cut);
 

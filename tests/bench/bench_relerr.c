@@ -10,7 +10,12 @@
  *            round is 1024 walks: no run is shorter);
  *   width    the mean printed 95% half-width over E |x| (1.96 is what a CLT interval at
  *            stderr E |x| would show);
- *   covered  how many of the runs' printed intervals hold x.
+ *   covered  how many of the runs' printed intervals hold x;
+ *   seconds  the mean time of a whole --rel-err call (set-up, guards, forward mode's push on b,
+ *            walks), and cpu/orc that over the time the oracle's walks take at the fixed run's
+ *            rate (the push's work counted: forward walks from a pushed b may fall below the
+ *            oracle's count).
+ * Forward rows (fwd; the benign files only) run forward mode watching the same index.
  * A run is capped at CAP walks: one that predicts more stops early, not met (counted in walks).
  *
  *   bench_relerr [E [REPS [ONLY]]]    prints the tables (defaults 0.1 and 5; ONLY: the rows whose
@@ -96,28 +101,31 @@ static void exact(sys *s)
     free(x);
 }
 
-/* One row of the table. */
-static void row(const sys *s, int est, double E, int reps)
+/* One row of the table: est in mode (ULAM_ADJOINT, or ULAM_FORWARD watching the index). */
+static void row(const sys *s, int mode, int est, double E, int reps)
 {
     ulam_walk_opts o = ulam_walk_defaults();
-    o.estimator = est, o.query.index = s->index, o.stop.max_walks = ORACLE, o.exec.seed = 12345;
+    o.mode = mode, o.estimator = est, o.query.index = s->index, o.stop.max_walks = ORACLE, o.exec.seed = 12345;
     ulam_walk_result r;
+    char label[32];
+    snprintf(label, sizeof label, "%s%s", mode == ULAM_FORWARD ? "fwd " : "", est ? "absorption" : "collision");
     if (ulam_solve_walks(s->M, s->b, &o, &r, NULL)) {
-        printf("%-20s %-10s refused\n", s->name, est ? "absorption" : "collision");
+        printf("%-20s %-14s refused\n", s->name, label);
         return;
     }
     double oracle = r.variance / (E * s->x * E * s->x), walks = 0, width = 0, secs = 0;
+    double rate = r.seconds / (double)r.walks; /* the fixed run's seconds a walk: the oracle's walks cost oracle x rate */
     int met = 0, covered = 0;
     for (int k = 0; k < reps; k++) {
         o.stop.max_walks = CAP, o.stop.rel_err = E, o.exec.seed = 1 + (uint64_t)k; /* past CAP: stopped early, not met */
+        double t0 = ulam_now();
         if (ulam_solve_walks(s->M, s->b, &o, &r, NULL)) continue;
-        walks += (double)r.walks / reps, secs += r.seconds / reps, met += r.rel_err_met;
+        walks += (double)r.walks / reps, secs += (ulam_now() - t0) / reps, met += r.rel_err_met;
         width += (r.ci95[1] - r.ci95[0]) / 2 / (E * fabs(s->x)) / reps;
         covered += r.ci95[0] <= s->x && s->x <= r.ci95[1];
     }
-    printf("%-20s %-10s %11.4g %11.4g %3d/%-3d %8.3g %8.3g %8.3g %3d/%-3d %8.3g\n", s->name,
-           est ? "absorption" : "collision", oracle, walks, met, reps, walks / oracle, walks / fmax(oracle, 1024.0), width,
-           covered, reps, secs);
+    printf("%-20s %-14s %11.4g %11.4g %3d/%-3d %8.3g %8.3g %8.3g %3d/%-3d %8.3g %8.3g\n", s->name, label, oracle, walks,
+           met, reps, walks / oracle, walks / fmax(oracle, 1024.0), width, covered, reps, secs, secs / (oracle * rate));
     fflush(stdout);
 }
 
@@ -226,8 +234,8 @@ int main(int argc, char **argv)
     static const struct { const char *name; int jacobi; } files[] = {
         {"chain4", 0}, {"radiosity100", 0}, {"randsub1000", 0}, {"signed200", 0}, {"poisson20", 1}};
     printf("--rel-err %g, %d runs a row; oracle = var / (E x)^2 (var from %d walks)\n", E, reps, ORACLE);
-    printf("%-20s %-10s %11s %11s %7s %8s %8s %8s %7s %8s\n", "system", "estimator", "oracle", "walks", "met", "ratio",
-           "ratio1k", "width/Ex", "covered", "seconds");
+    printf("%-20s %-14s %11s %11s %7s %8s %8s %8s %7s %8s %8s\n", "system", "estimator", "oracle", "walks", "met", "ratio",
+           "ratio1k", "width/Ex", "covered", "seconds", "cpu/orc");
     for (int f = 0; f < (case6_only ? 0 : 7); f++) {
         sys s = {0};
         if (f < 5 && load(&s, files[f].name, files[f].jacobi)) {
@@ -241,7 +249,8 @@ int main(int argc, char **argv)
             continue;
         }
         exact(&s);
-        for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) row(&s, est, E, reps);
+        for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) row(&s, ULAM_ADJOINT, est, E, reps);
+        for (int est = ULAM_COLLISION; f < 5 && est <= ULAM_ABSORPTION; est++) row(&s, ULAM_FORWARD, est, E, reps);
         ulam_csr_free(s.M), free(s.b);
     }
     dense_table(E, reps, only);

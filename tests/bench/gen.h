@@ -156,6 +156,17 @@ static inline int bench_run(char *const argv[], char *out, size_t cap, int quiet
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+/* A uniform random permutation of 0 .. n-1 into perm from r (Fisher-Yates). */
+static inline void bench_permutation(int32_t *perm, int64_t n, ulam_rng *r)
+{
+    for (int64_t i = 0; i < n; i++) perm[i] = (int32_t)i;
+    for (int64_t i = n - 1; i > 0; i--) {
+        int64_t j = (int64_t)ulam_rng_bounded(r, (uint64_t)i + 1);
+        int32_t t = perm[i];
+        perm[i] = perm[j], perm[j] = t;
+    }
+}
+
 /* The R-MAT graph (Chakrabarti, Zhan, Faloutsos 2004; a = 0.57, b = c = 0.19, d = 0.05; states
  * relabelled by a random permutation; stream (L, 0)) as M = alpha P' (n = 2^L, 8 n edges, P the
  * random-walk matrix of the out-edges); *dangling counts states without out-edges (bench_bidir,
@@ -171,12 +182,7 @@ static inline ulam_csr *bench_rmat(int L, double alpha, int64_t *dangling, int64
     double *val = malloc((size_t)m * sizeof *val);
     ulam_csr *M = NULL;
     if (!perm || !src || !dst || !outdeg || !indeg || !val) goto done;
-    for (int64_t i = 0; i < n; i++) perm[i] = (int32_t)i;
-    for (int64_t i = n - 1; i > 0; i--) { /* Fisher-Yates */
-        int64_t j = (int64_t)ulam_rng_bounded(&r, (uint64_t)i + 1);
-        int32_t t = perm[i];
-        perm[i] = perm[j], perm[j] = t;
-    }
+    bench_permutation(perm, n, &r);
     for (int64_t e = 0; e < m; e++) {
         int64_t u = 0, v = 0;
         for (int l = 0; l < L; l++) {
