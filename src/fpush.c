@@ -33,6 +33,7 @@
                                       a pull-sweep operation; a step misses the cache, a sweep streams; 100 and 300
                                       side by side: 300 took 0.8-0.95x the CPU over 3 sources) */
 #define ULAM__FPUSH_RANGE_SHARE 0.8 /* the share of E delta the first checkpoint leaves the interval's range term */
+#define ULAM__FPUSH_BLOCK 64        /* states per block of the start's running sums */
 #define ULAM__FPUSH_KL_KEPT 1024    /* hit counts whose interval a checkpoint keeps (the rest computed each time) */
 
 /* The defaults. */
@@ -191,29 +192,17 @@ static double walk_work(double r_sum, void *ctx)
     return N * pl->visits * pl->step_cost;
 }
 
-/* Vose's alias table over the residual's support (k states: idx, prob, alias; work k slots). */
-static int64_t alias_build(const double *r, int64_t n, double r_sum, int32_t *idx, double *prob, int32_t *alias,
-                           int32_t *work)
+/* The running sums of |r| at the start of each block of ULAM__FPUSH_BLOCK states (nb + 1 of them,
+ * the last ||r||_1 as summed here). */
+static void block_sums(const double *r, int64_t n, double *bsum)
 {
-    int64_t k = 0;
-    for (int64_t j = 0; j < n; j++)
-        if (r[j] != 0.0) idx[k++] = (int32_t)j;
-    int64_t ns = 0, nl = k; /* small ones in work[0, ns), large ones in work[nl, k) */
-    for (int64_t q = 0; q < k; q++) {
-        prob[q] = fabs(r[idx[q]]) * (double)k / r_sum, alias[q] = (int32_t)q;
-        if (prob[q] < 1.0) work[ns++] = (int32_t)q;
-        else work[--nl] = (int32_t)q;
+    double acc = 0.0;
+    int64_t b = 0;
+    for (int64_t j = 0; j < n; j++) {
+        if (j % ULAM__FPUSH_BLOCK == 0) bsum[b++] = acc;
+        acc += fabs(r[j]);
     }
-    while (ns > 0 && nl < k) {
-        int32_t a = work[--ns], b = work[nl++];
-        alias[a] = b;
-        prob[b] += prob[a] - 1.0;
-        if (prob[b] < 1.0) work[ns++] = b;
-        else work[--nl] = b;
-    }
-    while (ns > 0) prob[work[--ns]] = 1.0; /* rounding */
-    while (nl < k) prob[work[nl++]] = 1.0;
-    return k;
+    bsum[b] = acc;
 }
 
 /* Row j of M' (column j of M) as a walk reads it: the sum and largest of its |entries| (known
@@ -235,12 +224,12 @@ static void row_sums(const ulam_csr *Mt, int64_t j, double *cs, double *mx, unsi
     }
 }
 
-/* The walk state: alias table of the start, per-row sums met so far, terminal counts. */
+/* The walk state: the start's block sums, per-row sums met so far, terminal counts. */
 typedef struct {
     const ulam_csr *Mt;
     const double *r;
-    const int32_t *idx, *alias;
-    const double *prob;
+    const double *bsum; /* block_sums of r */
+    int64_t nb, n;
     int64_t k;
     double alpha;
     double *cs, *mx, *cum;
@@ -305,8 +294,22 @@ static void walk_one(walker *w, ulam_rng *rng)
 {
     const ulam_csr *Mt = w->Mt;
     uint64_t frac;
-    int64_t q = (int64_t)ulam__rng_index(rng, (uint64_t)w->k, &frac);
-    int64_t j = w->idx[(double)frac * 0x1.0p-64 < w->prob[q] ? q : w->alias[q]];
+    int64_t j = -1;
+    while (j < 0) { /* the block by bisection of the running sums, the state by a scan of the block */
+        double u = ulam__rng_uniform(rng) * w->bsum[w->nb], acc;
+        int64_t l = 0, h = w->nb - 1;
+        while (l < h) {
+            int64_t m = l + (h - l + 1) / 2;
+            if (w->bsum[m] <= u) l = m;
+            else h = m - 1;
+        }
+        acc = w->bsum[l];
+        for (int64_t i = l * ULAM__FPUSH_BLOCK, e = i + ULAM__FPUSH_BLOCK < w->n ? i + ULAM__FPUSH_BLOCK : w->n; i < e; i++)
+            if (u < (acc += fabs(w->r[i]))) {
+                j = i;
+                break;
+            }
+    } /* none: u rounded onto ||r||_1, drawn again */
     int neg = w->r[j] < 0, steps = 0;
     double stop = 1.0 - w->alpha;
     for (;;) {
@@ -399,8 +402,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     double R0 = swi->r_sum / (1.0 - alpha), t1 = ulam_now();
     info->residual_bound = swi->r_sum * D1;
     walker w = {.Mt = Mt, .r = r, .k = swi->support, .alpha = alpha};
-    int32_t *idx = NULL, *alias = NULL, *work = NULL;
-    double *prob = NULL;
+    double *bsum = NULL;
     int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 and r >= 0 */
     for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
     for (int64_t j = 0; j < n && !sgn && !swi->nonneg; j++) sgn = r[j] < 0;
@@ -410,18 +412,18 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     kl_kept *kept = sgn ? NULL : ulam__malloc(1, sizeof *kept);
     if (kept) kept->N = -1;
     if (w.k > 0) {
-        idx = ulam__malloc((size_t)w.k, sizeof *idx), alias = ulam__malloc((size_t)w.k, sizeof *alias);
-        work = ulam__malloc((size_t)w.k, sizeof *work), prob = ulam__malloc((size_t)w.k, sizeof *prob);
+        w.n = n, w.nb = (n + ULAM__FPUSH_BLOCK - 1) / ULAM__FPUSH_BLOCK;
+        bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
         w.cs = ulam__malloc((size_t)n, sizeof *w.cs), w.mx = ulam__malloc((size_t)n, sizeof *w.mx);
         w.cum = ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum);
         w.known = ulam__calloc((size_t)n, 1), w.hp = ulam__calloc((size_t)n, sizeof *w.hp);
         if (sgn) w.hn = ulam__calloc((size_t)n, sizeof *w.hn);
-        if (!idx || !alias || !work || !prob || !w.cs || !w.mx || !w.cum || !w.known || !w.hp || (sgn ? !w.hn : !kept))
+        if (!bsum || !w.cs || !w.mx || !w.cum || !w.known || !w.hp || (sgn ? !w.hn : !kept))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
     }
     if (!status && w.k > 0) {
-        alias_build(r, n, swi->r_sum, idx, prob, alias, work);
-        w.idx = idx, w.prob = prob, w.alias = alias;
+        block_sums(r, n, bsum);
+        w.bsum = bsum;
         ulam_rng rng;
         ulam_rng_seed(&rng, o->walk.exec.seed, 0);
         int64_t cap_w = o->walk.stop.max_walks > 0 ? o->walk.stop.max_walks : INT32_MAX;
@@ -477,7 +479,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         }
         info->walks = N, info->steps = w.steps, info->walk_seconds = ulam_now() - t1;
     }
-    free(idx), free(alias), free(work), free(prob), free(w.cs), free(w.mx), free(w.cum), free(w.known), free(w.hp), free(w.hn);
+    free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.known), free(w.hp), free(w.hn);
     free(r), free(kept);
     info->seconds = ulam_now() - t0;
     return status;
