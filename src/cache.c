@@ -644,25 +644,26 @@ static int blk_fit(ulam__rowbuf *r, int64_t need)
     return need <= r->blkcap ? 0 : ulam__grow(&r->blk, &r->blkcap, need, 1);
 }
 
-/* Verify block k of M from the file (it was unchecked), leaving its rowptr at r->blk, its columns
- * at r->blk + cols and values at r->blk + vals (byte offsets); its state. */
-static unsigned char fetch_block(const ulam_system *s, int64_t k, ulam__rowbuf *r, int64_t *cols, int64_t *vals)
+/* Read block k of M (rows r0 .. r1 - 1) from the file into r's block buffer: its rowptr at
+ * r->blk, its columns and values at r->blk_cols and r->blk_vals (byte offsets), the row pointers
+ * checked to rise within the entries; its state when unchecked, else GOOD or BAD_SUM (unread). */
+static unsigned char read_block(const ulam_system *s, int64_t k, int64_t r0, int64_t r1, int unchecked, ulam__rowbuf *r)
 {
-    int64_t r0, r1, nnz = s->csr.rowptr[s->n];
-    block_rows(s, k, s->n, &r0, &r1);
-    int64_t rows = r1 - r0, pb = (rows + 1) * 8;
+    int64_t rows = r1 - r0, pb = (rows + 1) * 8, nnz = s->csr.rowptr[s->n], a, m;
+    r->blk_at = 0;
     if (blk_fit(r, pb) || read_at(s, r->blk, (size_t)pb, s->off[0] + (uint64_t)r0 * 8)) return BAD_ROWPTR;
-    int64_t a, m;
     memcpy(&a, r->blk, 8);
     memcpy(&m, r->blk + rows * 8, 8);
     if (!rowptr_ok((const int64_t *)(void *)r->blk, rows, nnz)) return BAD_ROWPTR;
     m -= a;
-    *cols = pb, *vals = pb + (m * 4 + 7) / 8 * 8;
-    if (blk_fit(r, *vals + m * 8) || read_at(s, r->blk + *cols, (size_t)m * 4, s->off[1] + (uint64_t)a * 4) ||
-        read_at(s, r->blk + *vals, (size_t)m * 8, s->off[2] + (uint64_t)a * 8))
+    r->blk_cols = pb, r->blk_vals = pb + (m * 4 + 7) / 8 * 8;
+    if (blk_fit(r, r->blk_vals + m * 8) || read_at(s, r->blk + r->blk_cols, (size_t)m * 4, s->off[1] + (uint64_t)a * 4) ||
+        read_at(s, r->blk + r->blk_vals, (size_t)m * 8, s->off[2] + (uint64_t)a * 8))
         return BAD_SUM;
-    return (unsigned char)block_state((const int64_t *)(void *)r->blk, rows, (const int32_t *)(void *)(r->blk + *cols),
-                                      (const double *)(void *)(r->blk + *vals), s->csr.ncols, s->sums[s->first[PART_M] + k]);
+    if (!unchecked) return GOOD; /* verified when first read: not again */
+    return (unsigned char)block_state((const int64_t *)(void *)r->blk, rows, (const int32_t *)(void *)(r->blk + r->blk_cols),
+                                      (const double *)(void *)(r->blk + r->blk_vals), s->csr.ncols,
+                                      s->sums[s->first[PART_M] + k]);
 }
 
 /* Record block k of a part verified to v (as verify_block does). */
@@ -675,76 +676,79 @@ static void set_state(const ulam_system *s, int part, int64_t k, unsigned char v
     atomic_fetch_add_explicit(&s->checked[0], 1, memory_order_relaxed);
 }
 
-/* b_j read from the file into *out, its block verified first (r: scratch); ULAM_OK or ULAM_ESYNTAX
- * with *bad the block's first row. */
+/* b_j read from the file into *out, its block verified first and kept in r's b buffer (a thread's
+ * next b_j in the block is read from there); ULAM_OK or ULAM_ESYNTAX with *bad the block's first row. */
 static int b_value(const ulam_system *s, int64_t j, ulam__rowbuf *r, double *out, int64_t *bad)
 {
     int64_t k = j >> s->shift, r0, r1;
     block_rows(s, k, s->n, &r0, &r1);
-    unsigned char v = atomic_load_explicit(&s->state[s->first[PART_B] + k], memory_order_acquire);
-    if (v == UNCHECKED) {
-        const double *e = NULL;
-        if (blk_fit(r, (r1 - r0) * 8) || read_at(s, r->blk, (size_t)(r1 - r0) * 8, s->off[3] + (uint64_t)r0 * 8)) {
-            v = BAD_SUM;
-        } else {
-            e = (const double *)(void *)r->blk;
-            v = hash(e, (size_t)(r1 - r0) * 8) != s->sums[s->first[PART_B] + k] ? BAD_SUM : GOOD;
-            for (int64_t i = 0; v == GOOD && i < r1 - r0; i++)
-                if (!isfinite(e[i])) v = BAD_VALUE;
-        }
-        set_state(s, PART_B, k, v);
-        if (v == GOOD) *out = e[j - r0];
-    } else if (v == GOOD && read_at(s, out, 8, s->off[3] + (uint64_t)j * 8)) {
-        v = BAD_SUM;
+    if (r->bblk_at == k + 1) {
+        *out = r->bblk[j - r0];
+        return ULAM_OK;
     }
-    if (v == GOOD) return ULAM_OK;
+    unsigned char v = atomic_load_explicit(&s->state[s->first[PART_B] + k], memory_order_acquire);
+    int fresh = v == UNCHECKED;
+    r->bblk_at = 0;
+    if (v == UNCHECKED || v == GOOD) {
+        if (r1 - r0 > r->bblkcap && ulam__grow(&r->bblk, &r->bblkcap, r1 - r0, sizeof *r->bblk)) v = BAD_SUM;
+        else if (read_at(s, r->bblk, (size_t)(r1 - r0) * 8, s->off[3] + (uint64_t)r0 * 8)) v = BAD_SUM;
+        else if (fresh) { /* verified once: its checksum and finite entries */
+            v = hash(r->bblk, (size_t)(r1 - r0) * 8) != s->sums[s->first[PART_B] + k] ? BAD_SUM : GOOD;
+            for (int64_t i = 0; v == GOOD && i < r1 - r0; i++)
+                if (!isfinite(r->bblk[i])) v = BAD_VALUE;
+        }
+    }
+    if (fresh) set_state(s, PART_B, k, v == UNCHECKED ? BAD_SUM : v);
+    if (v == GOOD) {
+        r->bblk_at = k + 1;
+        *out = r->bblk[j - r0];
+        return ULAM_OK;
+    }
     if (bad) *bad = r0;
     return ULAM_ESYNTAX;
 }
 
-/* Row i of M read from the file into r (see ulam__rows_check.fetch). */
+/* Row i of M read from the file into r (see ulam__rows_check.fetch): its block read whole (and
+ * verified the first time any thread reads it) and kept, so the thread's next row in the block
+ * is copied from memory. */
 static int fetch_row(const void *ctx, int64_t i, int with_b, ulam__rowbuf *r, int64_t *bad)
 {
     const ulam_system *s = ctx;
-    int64_t k = i >> s->shift, r0, r1, a = 0, e = 0, cols = 0, vals = 0;
+    int64_t k = i >> s->shift, r0, r1;
     block_rows(s, k, s->n, &r0, &r1);
-    unsigned char v = atomic_load_explicit(&s->state[s->first[PART_M] + k], memory_order_acquire);
-    int fresh = v == UNCHECKED;
-    if (fresh) {
-        v = fetch_block(s, k, r, &cols, &vals);
-        set_state(s, PART_M, k, v);
-    }
-    if (v == GOOD) {
-        int64_t p[2], a0;
-        if (fresh) memcpy(p, r->blk + (i - r0) * 8, 16), memcpy(&a0, r->blk, 8);
-        else if (read_at(s, p, 16, s->off[0] + (uint64_t)i * 8)) v = BAD_SUM;
-        a = p[0], e = p[1];
-        int64_t cc = r->cap, cv = r->cap;
-        if (v == GOOD && (ulam__grow(&r->col, &cc, e - a, sizeof *r->col) || ulam__grow(&r->val, &cv, e - a, sizeof *r->val)))
-            v = BAD_SUM; /* no memory: the row fails as unreadable */
-        r->cap = cc < cv ? cc : cv;
-        if (v == GOOD && fresh) {
-            memcpy(r->col, r->blk + cols + (a - a0) * 4, (size_t)(e - a) * 4);
-            memcpy(r->val, r->blk + vals + (a - a0) * 8, (size_t)(e - a) * 8);
-        } else if (v == GOOD && (read_at(s, r->col, (size_t)(e - a) * 4, s->off[1] + (uint64_t)a * 4) ||
-                                 read_at(s, r->val, (size_t)(e - a) * 8, s->off[2] + (uint64_t)a * 8))) {
-            v = BAD_SUM;
+    if (r->blk_at != k + 1) {
+        unsigned char v = atomic_load_explicit(&s->state[s->first[PART_M] + k], memory_order_acquire);
+        int fresh = v == UNCHECKED;
+        if (v == UNCHECKED || v == GOOD) v = read_block(s, k, r0, r1, fresh, r);
+        if (fresh) set_state(s, PART_M, k, v);
+        if (v != GOOD) {
+            if (bad) *bad = r0;
+            return ULAM_ESYNTAX;
         }
-        r->len = e - a;
+        r->blk_at = k + 1;
     }
-    if (v != GOOD) {
+    int64_t p[2], a0;
+    memcpy(p, r->blk + (i - r0) * 8, 16), memcpy(&a0, r->blk, 8);
+    int64_t len = p[1] - p[0], cc = r->cap, cv = r->cap;
+    int nomem = ulam__grow(&r->col, &cc, len, sizeof *r->col) || ulam__grow(&r->val, &cv, len, sizeof *r->val);
+    r->cap = cc < cv ? cc : cv;
+    if (nomem) { /* the row fails as unreadable */
         if (bad) *bad = r0;
         return ULAM_ESYNTAX;
     }
+    memcpy(r->col, r->blk + r->blk_cols + (p[0] - a0) * 4, (size_t)len * 4);
+    memcpy(r->val, r->blk + r->blk_vals + (p[0] - a0) * 8, (size_t)len * 8);
+    r->len = len;
     return with_b ? b_value(s, i, r, &r->b, bad) : ULAM_OK;
 }
 
 /* b_j from the file (see ulam__rows_check.b_at). */
-static int b_at(const void *ctx, int64_t j, double *v, int64_t *bad)
+static int b_at(const void *ctx, int64_t j, ulam__rowbuf *r, double *v, int64_t *bad)
 {
-    ulam__rowbuf r = {0};
-    int status = b_value(ctx, j, &r, v, bad);
-    free(r.blk);
+    if (r) return b_value(ctx, j, r, v, bad);
+    ulam__rowbuf t = {0};
+    int status = b_value(ctx, j, &t, v, bad);
+    ulam__rowbuf_free(&t);
     return status;
 }
 

@@ -5,6 +5,7 @@
 #include "ulam.h"
 
 #include <stdarg.h>
+#include <stdlib.h>
 
 /* xoshiro256** step, inline for the walkers (ulam_rng_next is this). */
 static inline uint64_t ulam__rng_next(ulam_rng *r)
@@ -235,8 +236,10 @@ int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_o
                            const ulam_method_opts *mo, const ulam__reach *reach, ulam_choice *ch, ulam_run **out,
                            ulam_error *err);
 
-/* A row read from a file: its len columns and values (and b_i), and the bytes of a block being
- * verified; grown as rows need. */
+/* A row read from a file: its len columns and values (and b_i); and a thread's cache of one block
+ * of M (its row pointers, columns and values at blk) and one of b (at bblk), each kept once
+ * verified, so the next row or b_j in the same block is read from memory; grown as rows need.
+ * All zero: empty. */
 typedef struct ulam__rowbuf {
     int32_t *col;
     double *val;
@@ -244,7 +247,17 @@ typedef struct ulam__rowbuf {
     double b;
     unsigned char *blk;
     int64_t blkcap;
+    int64_t blk_at, blk_cols, blk_vals; /* the block at blk + 1 (0: none), its columns' and values' offsets */
+    double *bblk;
+    int64_t bblkcap, bblk_at;           /* the block of b at bblk + 1 (0: none) */
 } ulam__rowbuf;
+
+/* Free r's buffers and empty it. */
+static inline void ulam__rowbuf_free(ulam__rowbuf *r)
+{
+    free(r->col), free(r->val), free(r->blk), free(r->bblk);
+    *r = (ulam__rowbuf){0};
+}
 
 /* A check of rows [first, last) of a borrowed matrix (and, with with_b, of b at those rows) made
  * before anything reads them: ULAM_OK, or ULAM_ESYNTAX with *bad (may be NULL) the first row of the
@@ -257,10 +270,11 @@ typedef struct ulam__rows_check {
     int with_b;
     /* A prepared file read by pread (src/cache.c; NULL: rows are read in place): row i of
        fetch_of into r, its block verified first (and with b_of's b_i in r->b when with_b);
-       b_at: b_of's j-th entry, its block verified first.  ULAM_OK, or ULAM_ESYNTAX (ULAM_EIO)
-       with *bad (may be NULL) the first row of the damaged block.  Thread-safe (r: the thread's). */
+       b_at: b_of's j-th entry, its block verified first (r: the thread's buffer, or NULL).
+       ULAM_OK, or ULAM_ESYNTAX (ULAM_EIO) with *bad (may be NULL) the first row of the damaged
+       block.  Thread-safe (r: the thread's). */
     int (*fetch)(const void *ctx, int64_t i, int with_b, ulam__rowbuf *r, int64_t *bad);
-    int (*b_at)(const void *ctx, int64_t j, double *v, int64_t *bad);
+    int (*b_at)(const void *ctx, int64_t j, ulam__rowbuf *r, double *v, int64_t *bad);
     const ulam_csr *fetch_of;
     const double *b_of;
 } ulam__rows_check;

@@ -33,7 +33,9 @@
  *
  * With k->rc (a prepared file's verification, src/cache.c) every row's block is verified before
  * the row is first read, and all of K before the kernel is completed; a damaged block fails the
- * kernel as a corrupt row does. */
+ * kernel as a corrupt row does.  Rows read from a file are dear (a system call each part), so
+ * such a kernel keeps what rescoring a row for another estimator needs (ulam__rowrec) and reads a
+ * row again only for the expected estimator's (K b)_i, when a walk first reaches it. */
 #include "kernel.h"
 
 #include <math.h>
@@ -47,6 +49,7 @@ ulam_kernel *ulam__kernel_free(ulam_kernel *k)
     free(k->mem);
     free(k->fac);
     free(k->scored);
+    free(k->rec);
     free((void *)k->where);
     free((void *)k->dir);
     free((void *)k->leaves);
@@ -165,6 +168,7 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam_
     atomic_init(&k->status, ULAM_OK);
     atomic_init(&k->bad, -1);
     atomic_init(&k->nleaves, 0);
+    atomic_init(&k->nrec, 0);
     int dense = n <= ULAM__DENSE_MAX;
     if (dense) k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built */
     k->mem = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->mem);
@@ -176,6 +180,16 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam_
     dead_row(ulam__kernel_row(k, k->cap), -1);
     *out = k;
     return ULAM_OK;
+}
+
+/* Give k its check (see kernel.h). */
+int ulam__kernel_set_check(ulam_kernel *k, const ulam__rows_check *rc)
+{
+    k->rc = *rc;
+    if (!rc->fetch || rc->fetch_of != k->K || k->rec) return ULAM_OK;
+    /* reserved for every state, touched as rows are built: a query pays for the rows it builds */
+    k->rec = ulam__malloc((size_t)k->n, sizeof *k->rec);
+    return k->rec ? ULAM_OK : ULAM_ENOMEM;
 }
 
 /* Room in scratch w for rows of m outcomes (grown to at least twice what it had). */
@@ -210,7 +224,7 @@ int ulam__kscratch_alloc(const ulam_kernel *k, ulam__kscratch *w)
 void ulam__kscratch_free(ulam__kscratch *w)
 {
     free(w->p), free(w->scaled), free(w->f), free(w->o), free(w->small), free(w->large);
-    free(w->rb.col), free(w->rb.val), free(w->rb.blk);
+    ulam__rowbuf_free(&w->rb);
     *w = (ulam__kscratch){0};
 }
 
@@ -270,13 +284,21 @@ static int get_row(ulam_kernel *k, int64_t i, ulam__kscratch *w, int inplace, ro
     return ULAM_OK;
 }
 
-/* b_j for the expected estimator's score: from the file when k reads rows there; NAN when its
- * block is damaged (the row then fails). */
-static double b_entry(const ulam_kernel *k, int64_t j)
+/* b_j for the expected estimator's score: from the file when k reads rows there (r: the
+ * thread's buffer, or NULL); NAN when its block is damaged (the row then fails). */
+static double b_entry(const ulam_kernel *k, int64_t j, ulam__rowbuf *r)
 {
     double v;
-    if (fetching(k) && k->scores.b == k->rc.b_of) return k->rc.b_at(k->rc.ctx, j, &v, NULL) ? NAN : v;
+    if (fetching(k) && k->scores.b == k->rc.b_of) return k->rc.b_at(k->rc.ctx, j, r, &v, NULL) ? NAN : v;
     return k->scores.b[j];
+}
+
+/* The expected estimator's score (K b)_i of row v (r: as b_entry's). */
+static double expected_score(const ulam_kernel *k, const row_view *v, ulam__rowbuf *r)
+{
+    double mb = 0.0;
+    for (int64_t q = 0; q < v->len; q++) mb += v->val[q] * b_entry(k, v->col[q], r);
+    return mb;
 }
 
 /* The continuation probability q_i of row i. */
@@ -308,15 +330,25 @@ int ulam__kernel_moves(const ulam_csr *K, int64_t i, double q, double alpha, dou
     return moves_of(K->val + a, K->rowptr[i + 1] - a, q, alpha, pm, f);
 }
 
-/* What a visit to and a termination at row v score (see ulam__scores). */
-static void row_scores(const ulam_kernel *k, const row_view *v, double pstar, double *visit, double *end)
+/* Nonzero when k's estimator scores (K b)_i. */
+static int scores_mb(const ulam_kernel *k)
 {
-    const ulam__scores *s = &k->scores;
-    double g = v->g, mb = 0.0;
-    if (s->estimator == ULAM_EXPECTED && s->b)
-        for (int64_t q = 0; q < v->len; q++) mb += v->val[q] * b_entry(k, v->col[q]);
-    *visit = s->estimator == ULAM_COLLISION ? g : mb;
-    *end = s->estimator == ULAM_ABSORPTION && pstar > 0 ? g / pstar : 0.0;
+    return k->scores.estimator == ULAM_EXPECTED && k->scores.b;
+}
+
+/* What a visit to and a termination at a row score from its g_i, p*_i and (K b)_i (read only
+ * when scores_mb; see ulam__scores). */
+static void scores_of(const ulam_kernel *k, double g, double pstar, double mb, double *visit, double *end)
+{
+    *visit = k->scores.estimator == ULAM_COLLISION ? g : scores_mb(k) ? mb : 0.0;
+    *end = k->scores.estimator == ULAM_ABSORPTION && pstar > 0 ? g / pstar : 0.0;
+}
+
+/* What a visit to and a termination at row v score (r: as b_entry's). */
+static void row_scores(const ulam_kernel *k, const row_view *v, double pstar, ulam__rowbuf *r, double *visit,
+                       double *end)
+{
+    scores_of(k, v->g, pstar, scores_mb(k) ? expected_score(k, v, r) : 0.0, visit, end);
 }
 
 /* Record the first failure of the kernel (status, at row i). */
@@ -326,12 +358,71 @@ static void fail(ulam_kernel *k, int status, int64_t i)
     if (atomic_compare_exchange_strong(&k->status, &ok, status)) atomic_store(&k->bad, i);
 }
 
+/* A row left stale by rescore_records: its place holds -(record + 2) until a walk reaches it. */
+#define STALE(o) (-(int32_t)(o) - 2)
+
+/* Give row r of k (state i, at header h) its (M b)_i read again with its b_j (w: scratch) and
+ * its scores; a failure is recorded and the row scores nothing. */
+static void rescore_mb(ulam_kernel *k, ulam__rowrec *r, int64_t i, ulam__row *h, ulam__kscratch *w)
+{
+    if (k->rc.fetch(k->rc.ctx, i, 0, &w->rb, NULL)) { /* read before, so intact unless the file changed */
+        h->visit = h->end = 0.0, fail(k, ULAM_ESYNTAX, i);
+        return;
+    }
+    row_view v = {w->rb.col, w->rb.val, w->rb.len, r->g};
+    r->mb = expected_score(k, &v, &w->rb);
+    scores_of(k, r->g, r->pstar, r->mb, &h->visit, &h->end);
+    if (!isfinite(h->visit) || !isfinite(h->end)) h->visit = h->end = 0.0, fail(k, ULAM_ENONFINITE, i);
+}
+
+/* Rescore the rows k's records hold (every built row) from the records alone.  A row whose
+ * (M b)_i the expected estimator needs and no record holds is left stale instead of read now:
+ * its place marks it, every move into it is unresolved again, so the first walk to reach it
+ * rescores it (ulam__kernel_unit) and a row no walk reaches is never read; rescoring for
+ * another estimator makes every row current again. */
+static int rescore_records(ulam_kernel *k)
+{
+    int64_t nrec = atomic_load(&k->nrec), stale = 0;
+    for (int64_t o = 0; o < nrec; o++) {
+        ulam__rowrec *r = &k->rec[o];
+        ulam__row *h = ulam__kernel_row(k, r->u);
+        _Atomic int32_t *at = place(k, h->state, 0);
+        if (scores_mb(k) && isnan(r->mb)) {
+            atomic_store_explicit(at, STALE(o), memory_order_relaxed);
+            h->visit = h->end = 0.0, stale++;
+            continue;
+        }
+        atomic_store_explicit(at, (int32_t)r->u + 1, memory_order_relaxed); /* current (it may have been stale) */
+        scores_of(k, r->g, r->pstar, r->mb, &h->visit, &h->end);
+        if (!isfinite(h->visit) || !isfinite(h->end)) {
+            fail(k, ULAM_ENONFINITE, h->state);
+            break;
+        }
+    }
+    for (int64_t o = 0; stale && o < nrec; o++) { /* moves into stale rows: unresolved, as before they were built */
+        ulam__row *h = ulam__kernel_row(k, k->rec[o].u);
+        ulam__slot *sl = (ulam__slot *)(void *)h + ULAM__HEAD;
+        for (int32_t q = 0; q < h->len; q++)
+            for (int side = 0; side < 2; side++) {
+                _Atomic int32_t *x = side ? &sl[q].b : &sl[q].a;
+                int32_t out = atomic_load_explicit(x, memory_order_relaxed), t = ulam__outcome_target(out);
+                if (out == ULAM__TERMINATE || t >= ULAM__UNRESOLVED) continue;
+                int64_t j = ulam__kernel_row(k, t)->state;
+                if (atomic_load_explicit(place(k, j, 0), memory_order_relaxed) > -2) continue;
+                t = ULAM__UNRESOLVED + (int32_t)j;
+                atomic_store_explicit(x, out < 0 ? ~t : t, memory_order_relaxed);
+            }
+    }
+    return atomic_load(&k->status);
+}
+
 /* Rescore every built row for another estimator. */
 int ulam__kernel_rescore(ulam_kernel *k, int estimator)
 {
     int status = atomic_load(&k->status);
     if (status) return status;
     k->scores.estimator = estimator;
+    if (k->rec && !k->rec_stale) return rescore_records(k);
     int64_t top = atomic_load(&k->top);
     ulam__kscratch w = {0};
     row_view v;
@@ -344,7 +435,7 @@ int ulam__kernel_rescore(ulam_kernel *k, int estimator)
             fail(k, ULAM_ESYNTAX, i);
             break;
         }
-        row_scores(k, &v, 1.0 - ulam__continuation(view_sum(&v), k->continue_q), &h->visit, &h->end);
+        row_scores(k, &v, 1.0 - ulam__continuation(view_sum(&v), k->continue_q), &w.rb, &h->visit, &h->end);
         if (!isfinite(h->visit) || !isfinite(h->end)) {
             fail(k, ULAM_ENONFINITE, i);
             break;
@@ -433,12 +524,14 @@ static void build_moves(ulam_kernel *k, const row_view *v, int64_t i, ulam__row 
 static void build_row(ulam_kernel *k, const row_view *v, int64_t i, ulam__row *h, int placed, ulam__kscratch *w)
 {
     int ok = view_ok(v, k->K->ncols);
+    double mb = NAN; /* (K b)_i once its b_j are read from the file */
     if (ok && k->rc.with_b && k->scores.estimator == ULAM_EXPECTED) { /* its score reads b at its columns */
         double bj;
         int fromfile = fetching(k) && k->scores.b == k->rc.b_of;
+        if (fromfile) mb = 0.0; /* summed as expected_score sums it */
         for (int64_t q = 0; ok && q < v->len; q++)
-            ok = fromfile ? !k->rc.b_at(k->rc.ctx, v->col[q], &bj, NULL)
-                          : !ulam__rows_verify(&k->rc, v->col[q], v->col[q] + 1, NULL);
+            if (!fromfile) ok = !ulam__rows_verify(&k->rc, v->col[q], v->col[q] + 1, NULL);
+            else if ((ok = !k->rc.b_at(k->rc.ctx, v->col[q], &w->rb, &bj, NULL))) mb += v->val[q] * bj;
     }
     if (!ok) {
         dead_row(h, i);
@@ -453,11 +546,16 @@ static void build_row(ulam_kernel *k, const row_view *v, int64_t i, ulam__row *h
     }
     double S = view_sum(v), qi = ulam__continuation(S, k->continue_q);
     *h = (ulam__row){.factor = qi > 0 && !k->fac ? S / qi : 0.0, .len = (int32_t)(len + 1), .state = (int32_t)i};
-    row_scores(k, v, 1.0 - qi, &h->visit, &h->end);
+    if (scores_mb(k) && isnan(mb)) mb = expected_score(k, v, &w->rb);
+    scores_of(k, v->g, 1.0 - qi, mb, &h->visit, &h->end);
     if (!isfinite(h->factor) || !isfinite(h->visit) || !isfinite(h->end)) {
         dead_row(h, i);
         fail(k, ULAM_ENONFINITE, i);
         return;
+    }
+    if (k->rec && !placed) { /* what rescoring it needs (claimed once: fewer records than states) */
+        int64_t o = atomic_fetch_add_explicit(&k->nrec, 1, memory_order_relaxed);
+        k->rec[o] = (ulam__rowrec){(ulam__slot *)(void *)h - k->mem, v->g, 1.0 - qi, scores_mb(k) ? mb : NAN};
     }
     if (k->fac) {
         build_moves(k, v, i, h, qi, placed, w);
@@ -492,7 +590,13 @@ int32_t ulam__kernel_unit(ulam_kernel *k, int64_t j, ulam__kscratch *w)
         atomic_fetch_add_explicit(&k->built, 1, memory_order_relaxed);
         return (int32_t)u;
     }
-    while ((v = atomic_load_explicit(at, memory_order_acquire)) < 0) continue;
+    while ((v = atomic_load_explicit(at, memory_order_acquire)) < 0)
+        if (v <= -2 && atomic_compare_exchange_strong_explicit(at, &v, -1, memory_order_acquire, memory_order_acquire)) {
+            ulam__rowrec *r = &k->rec[-(int64_t)v - 2]; /* stale (rescore_records): rescored by the thread that claims it */
+            rescore_mb(k, r, j, ulam__kernel_row(k, r->u), w);
+            atomic_store_explicit(at, (int32_t)r->u + 1, memory_order_release);
+            return (int32_t)r->u;
+        }
     return v - 1;
 }
 
@@ -523,6 +627,14 @@ void ulam__kernel_complete(ulam_kernel *k, int threads, ulam__kscratch *w)
 {
     const ulam_csr *K = k->K;
     int64_t from = atomic_load(&k->top), u = from, bad = -1;
+    for (int64_t o = 0; k->rec && !k->rec_stale && o < atomic_load(&k->nrec); o++) { /* stale rows current first: */
+        ulam__rowrec *r = &k->rec[o]; /* the rows built below name their targets' places */
+        int64_t i = ulam__kernel_row(k, r->u)->state;
+        if (atomic_load_explicit(place(k, i, 0), memory_order_relaxed) > -2) continue;
+        rescore_mb(k, r, i, ulam__kernel_row(k, r->u), &w[0]);
+        atomic_store_explicit(place(k, i, 0), (int32_t)r->u + 1, memory_order_relaxed);
+    }
+    k->rec_stale = 1; /* the rows built here keep no record */
     if (ulam__rows_verify(&k->rc, 0, k->n, &bad)) { /* every row is read below: every block verified first */
         fail(k, ULAM_ESYNTAX, bad);
         return;
@@ -591,7 +703,7 @@ static void rescore_row(ulam_kernel *k, int64_t i)
         return;
     }
     double pstar = k->scores.estimator == ULAM_ABSORPTION ? 1.0 - ulam__continuation(view_sum(&v), k->continue_q) : 0.0;
-    row_scores(k, &v, pstar, &h->visit, &h->end); /* p* is read by absorption alone */
+    row_scores(k, &v, pstar, &w.rb, &h->visit, &h->end); /* p* is read by absorption alone */
     ulam__kscratch_free(&w);
     if (!isfinite(h->visit) || !isfinite(h->end)) h->visit = h->end = 0.0, fail(k, ULAM_ENONFINITE, i);
 }
@@ -614,6 +726,7 @@ int ulam__kernel_rescore_b(ulam_kernel *k, const double *b)
     if (b == k->scores.b && k->fixed) return ULAM_OK; /* the same scores: nothing to do */
     if (k->fixed) return ULAM_EINVAL;
     k->scores.b = b;
+    k->rec_stale = 1; /* the records hold the old b's g_i */
     for (int64_t j = 0; j < k->nscored; j++) rescore_row(k, k->scored[j]); /* now b's (0 off its support) */
     int status = atomic_load(&k->status) ? atomic_load(&k->status) : ulam__kernel_keep(k);
     for (int64_t j = 0; !status && j < k->nscored; j++) rescore_row(k, k->scored[j]);

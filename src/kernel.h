@@ -50,6 +50,14 @@ typedef struct {
     int estimator;
 } ulam__scores;
 
+/* What rescoring a built row needs without reading it again (a kernel that reads its rows from a
+ * file keeps one a row it builds lazily, in the order the rows were claimed): the row's unit,
+ * g_i, p*_i = 1 - q_i and (K b)_i, the expected estimator's score (NAN until computed). */
+typedef struct {
+    int64_t u;
+    double g, pstar, mb;
+} ulam__rowrec;
+
 /* The kernel of a borrowed matrix K.  Rows are built when first reached and placed one after
  * another in an arena of 16-byte units, so the memory a run touches is the rows it visits,
  * densely packed; where[i] is 0 until row i is built, -1 while a thread builds it, then its
@@ -77,6 +85,11 @@ typedef struct ulam_kernel {
     int fixed;                /* kept with b's values fixed: only the same b rescores, as a no-op */
     ulam__rows_check rc;      /* made before a row of K (and of b) is first read (a prepared file's
                                  verification; fn NULL: none) */
+    ulam__rowrec *rec;        /* rows read from a file (rc.fetch): one record a lazily built row,
+                                 reserved for every state, touched as rows are built (NULL: none) */
+    _Atomic int64_t nrec;     /* records written */
+    int rec_stale;            /* the records no longer hold every built row's g (ulam__kernel_complete,
+                                 ulam__kernel_rescore_b): rescoring reads the rows again */
 } ulam_kernel;
 
 /* Per-thread scratch for building rows of up to cap outcomes (grown as rows need). */
@@ -118,6 +131,12 @@ int ulam__kernel_keep(ulam_kernel *k);
  * before, and rows built later read b; the alias tables are unchanged (they do not depend on b).
  * ULAM_OK, ULAM_EINVAL (not kept), ULAM_ENONFINITE (a non-finite score, recorded). */
 int ulam__kernel_rescore_b(ulam_kernel *k, const double *b);
+
+/* Give k the check *rc made before its rows are read (after ulam__kernel_alloc, before any row is
+ * built); when rc reads rows from a file, k keeps what rescoring needs (ulam__rowrec) so that a
+ * change of estimator reads no row again but the expected estimator's new ones.  ULAM_OK or
+ * ULAM_ENOMEM. */
+int ulam__kernel_set_check(ulam_kernel *k, const ulam__rows_check *rc);
 
 /* Free a kernel; accepts NULL. */
 ulam_kernel *ulam__kernel_free(ulam_kernel *k);

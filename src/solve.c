@@ -1026,7 +1026,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         return ulam__fail(err, status, 0, -1, "a walk kernel of under 2^30 units (3 n + nnz < 1073741824)");
     }
     if (status) goto nomem;
-    if (!kernel) s->k->rc = rc;
+    if (!kernel && ulam__kernel_set_check(s->k, &rc)) goto nomem;
     s->rho4 = (ulam_power){.rho = NAN, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
     if ((status = take_bounds(s, K, o.stop.rel_err > 0 && o.stop.max_walks == 0 && o.stop.max_seconds == 0, err))) {
         ulam_solver_free(s);
@@ -1570,6 +1570,10 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *e
     if ((status = check_verdicts(s->M, s, err))) return status;
     s->o.stop.max_walks = ulam__walk_cap(&o);
     if (rescore && (status = ulam__kernel_rescore(s->k, o.estimator))) return kernel_failure(s->k, s->o.policy.system, err);
+    if (rescore && o.mode == ULAM_ADJOINT) { /* the start row current (rescoring may leave rows to the walks) */
+        s->w.start = ulam__kernel_unit(s->k, o.query.index, &s->ks[0]);
+        if (atomic_load(&s->k->status)) return kernel_failure(s->k, s->o.policy.system, err);
+    }
     s->w.interrupt = o.stop.interrupt;
     s->w.score0 = o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED ? s->b[o.query.index] : 0.0;
     s->w.expected = o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED;

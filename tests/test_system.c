@@ -728,6 +728,104 @@ static void *mixed_file(int64_t n, size_t *len, ulam_certificate *c)
     return q;
 }
 
+/* Auto's run on a system: the choice (ulam_auto_solver, adjoint analog walks at exponent 1: the
+ * three estimators on one shared kernel, rescored at each change) and the chosen run to the end:
+ * the solver's status, its result in *r and the candidates in *res. */
+static int auto_run(const ulam_csr *M, const double *b, const ulam_system *s, const ulam_guard *g,
+                    ulam_auto_result *res, ulam_walk_result *r, ulam_error *err)
+{
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.query.index = 3, o.stop.max_walks = 3000, o.exec.threads = 2, o.exec.seed = 5, o.policy.system = s;
+    ulam_auto_opts ao = ulam_auto_defaults();
+    ao.pin_mode = ao.pin_continue = ao.pin_alpha = 1, ao.guard = g;
+    ulam_solver *sv = NULL;
+    int st = ulam_auto_solver(M, b, &o, &ao, res, &sv, err);
+    while (!st && !ulam_solver_done(sv))
+        if ((st = ulam_solver_iterate(sv))) ulam_solver_error(sv, err);
+    if (!st) ulam_solver_result(sv, r);
+    ulam_solver_free(sv);
+    return st;
+}
+
+/* Issue 29: on a prepared file read by pread, a kernel rescored for another estimator rescores its
+ * rows from what it kept when it built them (only the expected estimator's (M b)_i reads a row and
+ * its b_j again), and a thread keeps the last block of M and of b it read.  Auto's pilots (three
+ * estimators on one kernel) and its chosen run answer from the file bit for bit as on the parsed
+ * system, whose rows are read in place; a copy of the file with a byte of rowptr, colidx, val or b
+ * flipped (spread over each array) is refused with ULAM_ESYNTAX and a message, or answers the same. */
+static void test_rescore_file(void **state)
+{
+    (void)state;
+    const int64_t n = 5000;
+    ulam_csr *M = mixed(n);
+    double *b = malloc((size_t)n * sizeof *b);
+    for (int64_t i = 0; i < n; i++) b[i] = (double)(i % 5) - 1.5;
+    ulam_certificate c;
+    assert_int_equal(ulam_certificate_compute(M, 0.0, NULL, &c, NULL), ULAM_OK);
+    ulam_guard g;
+    assert_int_equal(ulam_certificate_guard(&c, 0.0, NULL, &g), ULAM_OK);
+    ulam_system_desc d = {.M = M, .b = b, .n = n, .cert = &c};
+    size_t len;
+    unsigned char *good = file_bytes(&d, &len), *p = malloc(len);
+    ulam_auto_result *want = malloc(sizeof *want), *res = malloc(sizeof *res);
+    ulam_walk_result rw, r;
+    ulam_error err;
+    assert_int_equal(auto_run(M, b, NULL, &g, want, &rw, &err), ULAM_OK);
+    int piloted = 0;
+    for (int k = 0; k < want->ncand; k++) piloted += want->cand[k].pilot_walks > 0;
+    assert_int_equal(piloted, 3);
+    enum { CLASSES = 4, PER = 12 };
+    uint64_t lo[CLASSES] = {word(good, 6), word(good, 7), word(good, 8), word(good, 9)};
+    uint64_t hi[CLASSES] = {lo[0] + 8 * (uint64_t)(n + 1), lo[1] + 4 * (uint64_t)M->rowptr[n],
+                            lo[2] + 8 * (uint64_t)M->rowptr[n], lo[3] + 8 * (uint64_t)n};
+    int refused[CLASSES] = {0};
+    for (int k = -1; k < CLASSES * PER; k++) { /* -1: the intact file */
+        if (!test_case(k)) continue;
+        memcpy(p, good, len);
+        if (k >= 0) {
+            int cl = k / PER, j = k % PER;
+            uint64_t at = lo[cl] + (hi[cl] - lo[cl]) * (uint64_t)j / PER + (uint64_t)j % 3; /* spread over the array */
+            p[at] ^= (unsigned char)(1u << (j % 8));
+        }
+        char path[] = "/tmp/ulam_test_rescoreXXXXXX";
+        int fd = mkstemp(path);
+        assert_true(fd >= 0);
+        assert_int_equal(write(fd, p, len), (ssize_t)len);
+        close(fd);
+        ulam_system *s = NULL;
+        int st = ulam_system_open(path, NULL, &s, &err); /* reads rowptr[0] and rowptr[n] alone of the arrays */
+        unlink(path);
+        if (st) {
+            if (k < 0 || !err.msg[0]) fail_msg("case %d: refused at open (%d, '%s')", k, st, err.msg);
+            refused[k / PER]++;
+            continue;
+        }
+        const ulam_csr *lm;
+        const double *lb;
+        ulam_system_lazy(s, &lm, &lb);
+        st = auto_run(lm, lb, s, &g, res, &r, &err);
+        if (st) {
+            if (k < 0 || st != ULAM_ESYNTAX || !strstr(err.msg, "block")) fail_msg("case %d: status %d, '%s'", k, st, err.msg);
+            refused[k / PER]++;
+        } else {
+            if (res->chosen != want->chosen || memcmp(&r.estimate, &rw.estimate, sizeof r.estimate))
+                fail_msg("case %d: chose %d, %.17g (the parsed system: %d, %.17g)", k, res->chosen, r.estimate,
+                         want->chosen, rw.estimate);
+            for (int q = 0; q < want->ncand; q++)
+                if (memcmp(&res->cand[q].estimate, &want->cand[q].estimate, sizeof(double)) ||
+                    memcmp(&res->cand[q].variance, &want->cand[q].variance, sizeof(double)))
+                    fail_msg("case %d: candidate %d's pilot %.17g, variance %.17g (the parsed system: %.17g, %.17g)", k, q,
+                             res->cand[q].estimate, res->cand[q].variance, want->cand[q].estimate, want->cand[q].variance);
+        }
+        ulam_system_free(s);
+    }
+    test_case_done();
+    for (int cl = 0; cl < CLASSES; cl++)
+        if (!refused[cl]) fail_msg("array %d: no flip was noticed", cl);
+    free(want), free(res), free(p), free(good), free(b);
+    ulam_csr_free(M);
+}
+
 /* Two solvers in two threads (each with two threads of walks) on one system opened fresh, its
  * blocks verified by whichever thread reaches them first: both answer as one solver alone does. */
 typedef struct {
@@ -873,6 +971,7 @@ int main(void)
         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_sound_sums_bad_arrays),
         cmocka_unit_test(test_analysis_local),
+        cmocka_unit_test(test_rescore_file),
     };
     return test_run(tests);
 }

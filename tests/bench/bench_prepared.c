@@ -13,12 +13,18 @@
  * time (user + system: on a machine shared with other work the wall time waits for a core).
  * Issue 29's targets (the 'fixed' row: the same query with --walks fixed to what the rule used):
  * whole process <= 2x fixed, peak RSS <= 64 MiB at 10^7, whole-process CPU <= 0.02x SciPy's CPU
- * (SciPy column: CPU seconds of the solve alone, time.process_time).
+ * (SciPy column: CPU seconds of the solve alone, time.process_time).  Two queries: 'auto', the
+ * default command line (--method auto: the choice's pilots, then its run; its 'fixed' row pins the
+ * chosen mode, estimator, continuation and exponent with --method walks), and 'walks'
+ * (--method walks: adjoint collision walks).  The first line names the machine, its cores, the
+ * load and the date; each system's summary line the load when it ran (CPU seconds, not wall
+ * time, are the figures to compare on a shared machine).
  * usage: bench_prepared path/to/ulam [path/to/old/ulam] [max n]
  *        bench_prepared --write-only PATH N [random] (the screened system of N states, for readme.sh;
  *        the random family's with 'random') */
 #include <math.h>
 #include <sys/stat.h>
+#include <time.h>
 
 #include "gen.h"
 
@@ -27,6 +33,28 @@ typedef struct {
     double load, guards, setup, walks, whole, cpu, rss, rows, estimate, stderr_;
     int rc;
 } figures;
+
+/* The string value of key in JSON text (its first occurrence) into out (empty when absent). */
+static void json_string(const char *text, const char *key, char *out, size_t cap)
+{
+    char pat[64];
+    snprintf(pat, sizeof pat, "\"%s\": \"", key);
+    const char *p = strstr(text, pat);
+    size_t k = 0;
+    if (p)
+        for (p += strlen(pat); *p && *p != '"' && k + 1 < cap; p++) out[k++] = *p;
+    out[k] = '\0';
+}
+
+/* The load average over the last minute. */
+static double load1(void)
+{
+    double l = NAN;
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f && fscanf(f, "%lf", &l) != 1) l = NAN;
+    if (f) fclose(f);
+    return l;
+}
 
 /* Run argv 3 times; the run of median whole-process time. */
 static char bench_last_output[1 << 16]; /* the last run's stdout */
@@ -50,6 +78,19 @@ static figures median_run(char *const argv[])
                 f[a] = f[b], f[b] = t;
             }
     return f[1];
+}
+
+/* Print one run's row (a failed run: its exit status, and *rc set). */
+static void print_row(const char *fname, int64_t n, const char *name, const figures *f, double sp_s, double xI, int *rc)
+{
+    if (f->rc) {
+        printf("%-9s %9lld %9s %-11s run failed (exit %d)\n", fname, (long long)n, "", name, f->rc);
+        *rc = 1;
+        return;
+    }
+    printf("%-9s %9lld %9s %-11s %8.3f %8.3f %8.4f %8.4f %8.3f %8.3f %9.0f %9.0f %8.3f %9.3f %7.2f\n", fname, (long long)n,
+           "", name, f->load, f->guards, f->setup, f->walks, f->whole, f->cpu, f->rss, f->rows, sp_s, f->whole / sp_s,
+           fabs(f->estimate - xI) / f->stderr_);
 }
 
 /* Write a cache in the format before the prepared one: magic, a byte-order word, nrows, ncols,
@@ -146,10 +187,25 @@ int main(int argc, char **argv)
     const char *py = scipy_python();
     char dir[] = "/tmp/ulam_bench_preparedXXXXXX";
     if (!mkdtemp(dir)) return 1;
-    printf("whole-process 'ulam solve --index n/2+1 --rel-err 0.01 --threads 2' (median of 3, warm page cache)\n");
+    char host[256] = "?", model[256] = "?", line[512];
+    gethostname(host, sizeof host);
+    FILE *ci = fopen("/proc/cpuinfo", "r");
+    while (ci && fgets(line, sizeof line, ci))
+        if (!strncmp(line, "model name", 10) && strchr(line, ':')) {
+            snprintf(model, sizeof model, "%s", strchr(line, ':') + 2);
+            model[strcspn(model, "\n")] = '\0';
+            break;
+        }
+    if (ci) fclose(ci);
+    time_t now = time(NULL);
+    char date[64];
+    strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", gmtime(&now));
+    printf("machine %s, %ld cores (%s), load %.2f, %s\n", host, sysconf(_SC_NPROCESSORS_ONLN), model, load1(), date);
+    printf("whole-process 'ulam solve --index n/2+1 --rel-err 0.01 --threads 2' (median of 3, warm page cache);\n"
+           "auto: the default (--method auto), walks: --method walks; fixed: the same with --walks fixed to what it used\n");
     if (!py) printf("SciPy is absent (Debian python3-scipy): no SciPy column\n");
     if (!old) printf("no old ulam given: no 'before' rows\n");
-    printf("%-9s %9s %9s %-9s %8s %8s %8s %8s %8s %8s %9s %9s %8s %9s %7s\n", "family", "n", "nnz", "path", "load s",
+    printf("%-9s %9s %9s %-11s %8s %8s %8s %8s %8s %8s %9s %9s %8s %9s %7s\n", "family", "n", "nnz", "path", "load s",
            "guards s", "set-up s", "walks s", "whole s", "CPU s", "peak MiB", "rows", "SciPy CPU", "whole/SP", "|dx|/se");
     int rc = 0;
     for (int fam = 0; fam < 2 && !rc; fam++)
@@ -197,34 +253,38 @@ int main(int argc, char **argv)
                                 "--threads", "2", "--json", "--cache", NULL};
                 before = median_run(args);
             }
-            char *args[] = {argv[1], "solve", sysf, "--method", "walks", "--index", idx, "--rel-err", "0.01", "--threads",
-                            "2", "--json", NULL};
-            figures after = median_run(args);
-            char walks[32]; /* the same query with the walk count fixed to what the rule used */
-            snprintf(walks, sizeof walks, "%.0f", bench_json_number(bench_last_output, "walks"));
-            char *fixed_args[] = {argv[1], "solve", sysf, "--method", "walks", "--index", idx, "--walks", walks,
-                                  "--threads", "2", "--json", NULL};
-            figures fixed = median_run(fixed_args);
-            static const char *const names[3] = {"before", "prepared", "fixed"};
             double sp_s = NAN, xI = NAN;
             if (py && scipy_run(py, dir, sysf, fam, n / 2, &sp_s, &xI)) sp_s = NAN;
-            for (int k = 0; k < 3; k++) {
-                const figures *f = k == 2 ? &fixed : k ? &after : &before;
-                if (f->rc == -2) continue;
-                if (f->rc) {
-                    printf("%-9s %9lld %9s %-9s run failed (exit %d)\n", fname, (long long)n, "", names[k],
-                           f->rc);
-                    rc = 1;
-                    continue;
-                }
-                printf("%-9s %9lld %9s %-9s %8.3f %8.3f %8.4f %8.4f %8.3f %8.3f %9.0f %9.0f %8.3f %9.3f %7.2f\n", fname,
-                       (long long)n, "", names[k], f->load, f->guards, f->setup, f->walks, f->whole,
-                       f->cpu, f->rss, f->rows, sp_s, f->whole / sp_s, fabs(f->estimate - xI) / f->stderr_);
+            if (before.rc != -2) print_row(fname, n, "before", &before, sp_s, xI, &rc);
+            for (int qk = 0; qk < 2; qk++) { /* auto (the default), then --method walks */
+                const char *method = qk ? "walks" : "auto";
+                char *args[] = {argv[1], "solve", sysf, "--method", (char *)method, "--index", idx, "--rel-err", "0.01",
+                                "--threads", "2", "--json", NULL};
+                figures after = median_run(args);
+                /* the same query with the walk count fixed to what the rule used, the chosen walks pinned */
+                char walks[32], mode[32], est[32], alpha[32], cont[32] = "analog";
+                snprintf(walks, sizeof walks, "%.0f", bench_json_number(bench_last_output, "walks"));
+                json_string(bench_last_output, "mode", mode, sizeof mode);
+                json_string(bench_last_output, "estimator", est, sizeof est);
+                snprintf(alpha, sizeof alpha, "%.17g", bench_json_number(bench_last_output, "kernel_alpha"));
+                const char *cands = strstr(bench_last_output, "\"candidates\": [");
+                int chosen = (int)bench_json_number(bench_last_output, "chosen");
+                for (int c = 0; cands && c <= chosen; c++) cands = strstr(cands + 1, "{\"mode\": ");
+                double q = cands ? bench_json_number(cands, "continue") : NAN; /* null (analog): atof gives 0 */
+                if (q > 0) snprintf(cont, sizeof cont, "%.17g", q);
+                char *fixed_args[] = {argv[1], "solve", sysf, "--method", "walks", "--mode", mode, "--estimator", est,
+                                      "--continue", cont, "--kernel-exponent", alpha, "--index", idx, "--walks", walks,
+                                      "--threads", "2", "--json", NULL};
+                figures fixed = after.rc || !mode[0] || !est[0] ? (figures){.rc = -1} : median_run(fixed_args);
+                char name[32];
+                print_row(fname, n, method, &after, sp_s, xI, &rc);
+                snprintf(name, sizeof name, "%s fixed", method);
+                print_row(fname, n, name, &fixed, sp_s, xI, &rc);
+                if (!after.rc && !fixed.rc)
+                    printf("%-9s %9lld   %s (%s %s, %s walks) / fixed: whole %.2fx, CPU %.2fx; peak RSS %.1f MiB (fixed %.1f); "
+                           "CPU / SciPy CPU %.4f; load %.2f\n", fname, (long long)n, method, mode, est, walks,
+                           after.whole / fixed.whole, after.cpu / fixed.cpu, after.rss, fixed.rss, after.cpu / sp_s, load1());
             }
-            if (!after.rc && !fixed.rc)
-                printf("%-9s %9lld   rel-err / fixed walks: whole %.2fx, CPU %.2fx; peak RSS %.1f MiB (fixed %.1f); "
-                       "CPU / SciPy CPU %.4f\n", fname, (long long)n, after.whole / fixed.whole, after.cpu / fixed.cpu,
-                       after.rss, fixed.rss, after.cpu / sp_s);
             char cmd[400];
             snprintf(cmd, sizeof cmd, "rm -f %s/*", dir);
             if (system(cmd)) rc = 1;
