@@ -14,7 +14,13 @@
  * makes, 1 / (1 - ||M||_1) from the guards' one-pass bound).  Intervals: p_i + the walks' normal
  * interval where the walks saw two values at i; where they did not (one score or none: the
  * sample says nothing about what it missed), the certified bound of the walk part,
- * |(I - M)^-1 r|_i <= ||r||_1 / (1 - ||M||_1); every interval clipped to p_i -+ that bound. */
+ * |(I - M)^-1 r|_i <= ||r||_1 / (1 - ||M||_1); every interval clipped to p_i -+ that bound.
+ *
+ * For ||M||_1 < 1 the sweep push (src/sweep.c) and terminal walks: each walk scores 0 or R0 at
+ * every component, so where M, r >= 0 a component's interval is src/stop.c's KL (Chernoff-
+ * Hoeffding) interval of its hit count, stitched over the checkpoints the rule may stop at; with
+ * signs, the empirical-Bernstein one.  A component no walk reached gets p_i + [0, about 3.7 R0 /
+ * N] against the empirical-Bernstein 9.6 R0 / N, so the same accuracy takes ~2.6x fewer walks. */
 #include "internal.h"
 #include "stop.h"
 
@@ -22,9 +28,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define ULAM__FPUSH_STEP_COST 100.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM under load:
-                                      0.9 us a step, 6 ns a push operation; a step misses the cache, a sweep streams) */
+#define ULAM__FPUSH_STEP_COST 300.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM at load ~9,
+                                      2026-12-02: ~1.8 us of CPU a step with its share of the walk phase's passes, ~4.5 ns
+                                      a pull-sweep operation; a step misses the cache, a sweep streams; 100 and 300
+                                      side by side: 300 took 0.8-0.95x the CPU over 3 sources) */
 #define ULAM__FPUSH_RANGE_SHARE 0.8 /* the share of E delta the first checkpoint leaves the interval's range term */
+#define ULAM__FPUSH_BLOCK 64        /* states per block of the start's running sums */
+#define ULAM__FPUSH_KL_KEPT 1024    /* hit counts whose interval a checkpoint keeps (the rest computed each time) */
 
 /* The defaults. */
 ulam_fpush_opts ulam_fpush_defaults(void)
@@ -150,50 +160,49 @@ static int64_t epoch_end(int k)
     return m;
 }
 
-/* k0 for walk scores of range R. */
-static int first_epoch(double R, double E, double delta)
+/* The upper end of the interval of a component no walk ended at, N walks, R0 a hit's score,
+ * stitching index k (src/stop.c's KL interval; 0: a count fixed in advance). */
+static double none_hi(int64_t N, int k, double R0)
 {
-    double L = ulam__stop_log(1);
+    double lo, hi;
+    ulam__stop_kl_interval(N, 0.0, k, &lo, &hi);
+    return R0 * hi;
+}
+
+/* k0 for walk scores of range R (kl: scores 0 or R, the KL interval; else empirical Bernstein). */
+static int first_epoch(double R, double E, double delta, int kl)
+{
+    double L = ulam__stop_log(1), room = ULAM__FPUSH_RANGE_SHARE * E * delta;
     int k = 1;
-    while (k < 200 && !(7.0 * R * L / (3.0 * ((double)epoch_end(k) - 1.0)) <= ULAM__FPUSH_RANGE_SHARE * E * delta)) k++;
+    while (k < 200 && !(kl ? none_hi(epoch_end(k), 1, R) <= room : 7.0 * R * L / (3.0 * ((double)epoch_end(k) - 1.0)) <= room))
+        k++;
     return k;
 }
 
 /* The walks' work (push operations) a residual of mass r_sum leaves (ulam__sweep_cost): the
- * walk count whose range term is ULAM__FPUSH_RANGE_SHARE E delta at stitching index 1, at least
+ * walk count whose interval for a component no walk ended at is ULAM__FPUSH_RANGE_SHARE E delta
+ * wide at stitching index 1 (the KL interval of scores 0 or R0: M >= 0 makes r >= 0), at least
  * one block (a fixed count: that count in proportion to r_sum, the accuracy it buys). */
 static double walk_work(double r_sum, void *ctx)
 {
     const plan *pl = ctx;
-    double L = ulam__stop_log(1), R = r_sum / (1.0 - pl->alpha);
+    double R = r_sum / (1.0 - pl->alpha), c = log(2.0 / ULAM__STOP_DELTA) + log(2.0); /* N (1 - e^(-c/N)) ~ c */
     double N = pl->fixed > 0 ? (double)pl->fixed * r_sum
-                             : fmax(ULAM__STOP_N0, 7.0 * R * L / (3.0 * ULAM__FPUSH_RANGE_SHARE * pl->E * pl->delta) + 1.0);
+                             : fmax(ULAM__STOP_N0, c * R / (ULAM__FPUSH_RANGE_SHARE * pl->E * pl->delta) + 1.0);
     return N * pl->visits * pl->step_cost;
 }
 
-/* Vose's alias table over the residual's support (k states: idx, prob, alias; work k slots). */
-static int64_t alias_build(const double *r, int64_t n, double r_sum, int32_t *idx, double *prob, int32_t *alias,
-                           int32_t *work)
+/* The running sums of |r| at the start of each block of ULAM__FPUSH_BLOCK states (nb + 1 of them,
+ * the last ||r||_1 as summed here). */
+static void block_sums(const double *r, int64_t n, double *bsum)
 {
-    int64_t k = 0;
-    for (int64_t j = 0; j < n; j++)
-        if (r[j] != 0.0) idx[k++] = (int32_t)j;
-    int64_t ns = 0, nl = k; /* small ones in work[0, ns), large ones in work[nl, k) */
-    for (int64_t q = 0; q < k; q++) {
-        prob[q] = fabs(r[idx[q]]) * (double)k / r_sum, alias[q] = (int32_t)q;
-        if (prob[q] < 1.0) work[ns++] = (int32_t)q;
-        else work[--nl] = (int32_t)q;
+    double acc = 0.0;
+    int64_t b = 0;
+    for (int64_t j = 0; j < n; j++) {
+        if (j % ULAM__FPUSH_BLOCK == 0) bsum[b++] = acc;
+        acc += fabs(r[j]);
     }
-    while (ns > 0 && nl < k) {
-        int32_t a = work[--ns], b = work[nl++];
-        alias[a] = b;
-        prob[b] += prob[a] - 1.0;
-        if (prob[b] < 1.0) work[ns++] = b;
-        else work[--nl] = b;
-    }
-    while (ns > 0) prob[work[--ns]] = 1.0; /* rounding */
-    while (nl < k) prob[work[nl++]] = 1.0;
-    return k;
+    bsum[b] = acc;
 }
 
 /* Row j of M' (column j of M) as a walk reads it: the sum and largest of its |entries| (known
@@ -215,12 +224,12 @@ static void row_sums(const ulam_csr *Mt, int64_t j, double *cs, double *mx, unsi
     }
 }
 
-/* The walk state: alias table of the start, per-row sums met so far, terminal counts. */
+/* The walk state: the start's block sums, per-row sums met so far, terminal counts. */
 typedef struct {
     const ulam_csr *Mt;
     const double *r;
-    const int32_t *idx, *alias;
-    const double *prob;
+    const double *bsum; /* block_sums of r */
+    int64_t nb, n;
     int64_t k;
     double alpha;
     double *cs, *mx, *cum;
@@ -228,6 +237,52 @@ typedef struct {
     int32_t *hp, *hn; /* walks that ended at i with score +R0, -R0 */
     int64_t steps;
 } walker;
+
+/* The KL intervals (src/stop.c) of hit counts below ULAM__FPUSH_KL_KEPT at one checkpoint. */
+typedef struct {
+    int64_t N;
+    int k;
+    double lo[ULAM__FPUSH_KL_KEPT], hi[ULAM__FPUSH_KL_KEPT];
+    unsigned char have[ULAM__FPUSH_KL_KEPT];
+} kl_kept;
+
+/* The interval R0 [lo, hi] for ((I - M)^-1 r)_i from h of N walks ending at i (scores 0 or R0),
+ * at stitching index k (0: a count fixed in advance). */
+static void hits_interval(kl_kept *c, int64_t N, int k, int64_t h, double R0, double *lo, double *hi)
+{
+    if (c->N != N || c->k != k) memset(c->have, 0, sizeof c->have), c->N = N, c->k = k;
+    double a, b;
+    if (h < ULAM__FPUSH_KL_KEPT && c->have[h]) {
+        a = c->lo[h], b = c->hi[h];
+    } else {
+        ulam__stop_kl_interval(N, (double)h / (double)N, k, &a, &b);
+        if (h < ULAM__FPUSH_KL_KEPT) c->lo[h] = a, c->hi[h] = b, c->have[h] = 1;
+    }
+    *lo = R0 * a, *hi = R0 * b;
+}
+
+/* Whether an interval [a, b] around est meets relative error E at delta: b < delta (x_i >= delta
+ * only if the interval misses it), or est within E max(a, delta) of both ends (so within E x_i of
+ * any x_i >= delta inside it). */
+static int interval_met(double a, double b, double est, double E, double delta)
+{
+    return b < delta || fmax(est - a, b - est) <= E * fmax(a, delta);
+}
+
+/* rule_met for scores 0 or R0 (M, r >= 0): the KL intervals. */
+static int rule_met_kl(const walker *w, kl_kept *c, const double *p, int64_t n, int64_t N, int k, double R0, double E,
+                       double delta)
+{
+    double lo, hi;
+    hits_interval(c, N, k, 0, R0, &lo, &hi);
+    if (!(hi <= E * delta)) return 0; /* a component no walk ended at, p_i just under delta */
+    for (int64_t i = 0; i < n; i++) {
+        if (!w->hp[i]) continue;
+        hits_interval(c, N, k, w->hp[i], R0, &lo, &hi);
+        if (!interval_met(p[i] + lo, p[i] + hi, p[i] + R0 * (double)w->hp[i] / (double)N, E, delta)) return 0;
+    }
+    return 1;
+}
 
 /* One terminal walk: from j drawn with probability |r_j| / ||r||_1, stop and score at the state
  * it is at with probability 1 - alpha, else move along column j of M with probability |M_kj|
@@ -239,8 +294,22 @@ static void walk_one(walker *w, ulam_rng *rng)
 {
     const ulam_csr *Mt = w->Mt;
     uint64_t frac;
-    int64_t q = (int64_t)ulam__rng_index(rng, (uint64_t)w->k, &frac);
-    int64_t j = w->idx[(double)frac * 0x1.0p-64 < w->prob[q] ? q : w->alias[q]];
+    int64_t j = -1;
+    while (j < 0) { /* the block by bisection of the running sums, the state by a scan of the block */
+        double u = ulam__rng_uniform(rng) * w->bsum[w->nb], acc;
+        int64_t l = 0, h = w->nb - 1;
+        while (l < h) {
+            int64_t m = l + (h - l + 1) / 2;
+            if (w->bsum[m] <= u) l = m;
+            else h = m - 1;
+        }
+        acc = w->bsum[l];
+        for (int64_t i = l * ULAM__FPUSH_BLOCK, e = i + ULAM__FPUSH_BLOCK < w->n ? i + ULAM__FPUSH_BLOCK : w->n; i < e; i++)
+            if (u < (acc += fabs(w->r[i]))) {
+                j = i;
+                break;
+            }
+    } /* none: u rounded onto ||r||_1, drawn again */
     int neg = w->r[j] < 0, steps = 0;
     double stop = 1.0 - w->alpha;
     for (;;) {
@@ -251,6 +320,7 @@ static void walk_one(walker *w, ulam_rng *rng)
             break;
         }
         double v = u - stop;
+        if (!w->known[j]) row_sums(Mt, j, w->cs, w->mx, w->known, w->cum); /* on the first visit */
         if (!(v < w->cs[j])) break; /* the walk dies */
         int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a;
         if (w->known[j] == 2) { /* the first entry whose running sum exceeds v */
@@ -318,7 +388,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     double *r = ulam__calloc((size_t)n, sizeof *r);
     if (!r) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the residual");
     int64_t cap = 100 * ulam_csr_nnz(M) + 1000000;
-    int status = ulam__sweep_push(Mt, o->source, o->rmax, o->rmax > 0 ? NULL : walk_work, &pl, cap, x, r, swi);
+    int status = ulam__sweep_push_pull(M, Mt, o->source, o->rmax, o->rmax > 0 ? NULL : walk_work, &pl, cap, x, r, swi);
     if (status == ULAM_ENOCONV) status = ULAM_OK; /* ||M||_1 < 1: the cap only ends the push; the walks take the rest */
     if (status) {
         free(r);
@@ -332,33 +402,33 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     double R0 = swi->r_sum / (1.0 - alpha), t1 = ulam_now();
     info->residual_bound = swi->r_sum * D1;
     walker w = {.Mt = Mt, .r = r, .k = swi->support, .alpha = alpha};
-    int32_t *idx = NULL, *alias = NULL, *work = NULL;
-    double *prob = NULL;
-    int sgn = 0;
-    for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn; e++) sgn = Mt->val[e] < 0;
-    for (int64_t j = 0; j < n && !sgn; j++) sgn = r[j] < 0;
+    double *bsum = NULL;
+    int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 and r >= 0 */
+    for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
+    for (int64_t j = 0; j < n && !sgn && !swi->nonneg; j++) sgn = r[j] < 0;
     double R = sgn ? 2.0 * R0 : R0; /* the scores' range */
     int64_t N = 0;
-    int k = 1;
+    int k = 1, kk = -1; /* kk: the KL interval's index when not k */
+    kl_kept *kept = sgn ? NULL : ulam__malloc(1, sizeof *kept);
+    if (kept) kept->N = -1;
     if (w.k > 0) {
-        idx = ulam__malloc((size_t)w.k, sizeof *idx), alias = ulam__malloc((size_t)w.k, sizeof *alias);
-        work = ulam__malloc((size_t)w.k, sizeof *work), prob = ulam__malloc((size_t)w.k, sizeof *prob);
+        w.n = n, w.nb = (n + ULAM__FPUSH_BLOCK - 1) / ULAM__FPUSH_BLOCK;
+        bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
         w.cs = ulam__malloc((size_t)n, sizeof *w.cs), w.mx = ulam__malloc((size_t)n, sizeof *w.mx);
         w.cum = ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum);
         w.known = ulam__calloc((size_t)n, 1), w.hp = ulam__calloc((size_t)n, sizeof *w.hp);
         if (sgn) w.hn = ulam__calloc((size_t)n, sizeof *w.hn);
-        if (!idx || !alias || !work || !prob || !w.cs || !w.mx || !w.cum || !w.known || !w.hp || (sgn && !w.hn))
+        if (!bsum || !w.cs || !w.mx || !w.cum || !w.known || !w.hp || (sgn ? !w.hn : !kept))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
     }
     if (!status && w.k > 0) {
-        alias_build(r, n, swi->r_sum, idx, prob, alias, work);
-        for (int64_t j = 0; j < n; j++) row_sums(Mt, j, w.cs, w.mx, w.known, w.cum); /* one streaming pass */
-        w.idx = idx, w.prob = prob, w.alias = alias;
+        block_sums(r, n, bsum);
+        w.bsum = bsum;
         ulam_rng rng;
         ulam_rng_seed(&rng, o->walk.exec.seed, 0);
         int64_t cap_w = o->walk.stop.max_walks > 0 ? o->walk.stop.max_walks : INT32_MAX;
         if (cap_w > INT32_MAX) cap_w = INT32_MAX;
-        int k0 = first_epoch(R, pl.E, pl.delta), planned = 1;
+        int k0 = first_epoch(R, pl.E, pl.delta, !sgn), planned = 1;
         for (;;) { /* checkpoint k (stitching index) at the end of epoch k0 + k - 1 */
             int64_t target = o->walks > 0 ? o->walks : epoch_end(k0 + k - 1);
             if (target > cap_w) target = cap_w, planned = o->walks > 0 && o->walks == cap_w;
@@ -371,22 +441,30 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
                 }
             }
             if (!planned || o->walks > 0 || N >= cap_w) break;
-            if (rule_met(&w, x, n, N, k, R, R0, pl.E, pl.delta)) break;
+            if (sgn ? rule_met(&w, x, n, N, k, R, R0, pl.E, pl.delta) : rule_met_kl(&w, kept, x, n, N, k, R0, pl.E, pl.delta))
+                break;
             k++;
         }
         if (!planned) /* stopped between checkpoints: the next index */
             k = ulam__stop_epoch(N) > k0 ? ulam__stop_epoch(N) - k0 + 2 : k + 1;
+        else if (o->walks > 0)
+            kk = 0; /* a count fixed in advance: the KL interval at delta itself */
     }
     if (!status) {
         double Nd = (double)N, D = info->residual_bound;
         ulam__stop_ci none;
         if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &none);
         else none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
+        if (!sgn && N >= 1) hits_interval(kept, N, kk < 0 ? k : kk, 0, R0, &none.lo, &none.hi);
         for (int64_t i = 0; i < n; i++) {
             int64_t h = N > 0 ? w.hp[i] + (w.hn ? w.hn[i] : 0) : 0;
             double mean = 0.0, var = 0.0;
             ulam__stop_ci ci = none;
-            if (h > 0) {
+            if (h > 0 && !sgn) {
+                mean = R0 * (double)h / Nd;
+                var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
+                hits_interval(kept, N, kk < 0 ? k : kk, h, R0, &ci.lo, &ci.hi);
+            } else if (h > 0) {
                 mean = R0 * (double)(w.hp[i] - (w.hn ? w.hn[i] : 0)) / Nd;
                 var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
                 ulam__stop_interval(N, mean, var, R, 0.0, R0, R0, k, &ci);
@@ -401,8 +479,8 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         }
         info->walks = N, info->steps = w.steps, info->walk_seconds = ulam_now() - t1;
     }
-    free(idx), free(alias), free(work), free(prob), free(w.cs), free(w.mx), free(w.cum), free(w.known), free(w.hp), free(w.hn);
-    free(r);
+    free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.known), free(w.hp), free(w.hn);
+    free(r), free(kept);
     info->seconds = ulam_now() - t0;
     return status;
 }

@@ -393,6 +393,8 @@ int ulam__mm_read_matrix_libc(FILE *f, const char *name, const ulam_mm_opts *o, 
 typedef struct {
     int64_t rounds, sweeps, pushes, ops, support;
     double r_sum;
+    int64_t pulls; /* sweeps made by pulling (ulam__sweep_push_pull) */
+    int nonneg;    /* 1: M was read whole and has no negative entry (r >= 0 then); 0: not known */
 } ulam__sweep_info;
 
 /* The walks' work (push operations) a residual of mass r_sum would leave. */
@@ -406,10 +408,11 @@ typedef double (*ulam__sweep_cost)(double r_sum, void *ctx);
 int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost, void *ctx, int64_t max_ops,
                      double *p, double *r, ulam__sweep_info *info);
 
-/* ulam_fpush_solve with the sweep push's counts in sw (may be NULL; zero when ||M||_1 >= 1 and
- * the queue push ran) (src/fpush.c). */
-int ulam__fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, double *std_error,
-                      double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw, ulam_error *err);
+/* ulam__sweep_push given M too (NULL: as ulam__sweep_push): when M >= 0 the whole sweeps pull
+ * along M's rows (the same Gauss-Seidel sweeps, read like a matrix-vector product), r formed once
+ * at the end. */
+int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost,
+                          void *ctx, int64_t max_ops, double *p, double *r, ulam__sweep_info *info);
 
 /* ulam_fpush_solve with the sweep push's counts in sw (may be NULL; zero when ||M||_1 >= 1 and
  * the queue push ran) (src/fpush.c). */

@@ -75,3 +75,33 @@ double ulam__stop_combined_target(double E, double f)
     if (!(E > 0)) return E;
     return f < E ? sqrt(E * E - f * f) : 0.0;
 }
+
+/* kl(a || b) between Bernoulli laws (0 ln 0 = 0). */
+static double kl_bernoulli(double a, double b)
+{
+    double s = 0.0;
+    if (a > 0) s += a * log(a / b);
+    if (a < 1) s += (1.0 - a) * log((1.0 - a) / (1.0 - b));
+    return s;
+}
+
+/* The KL interval of n scores in [0, 1]. */
+void ulam__stop_kl_interval(int64_t n, double m, int k, double *lo, double *hi)
+{
+    double c = log(2.0 / ULAM__STOP_DELTA) + (k >= 1 ? log((double)k * ((double)k + 1.0)) : 0.0), N = (double)n;
+    m = fmin(1.0, fmax(0.0, m));
+    double in = m, out = 1.0; /* kl(m || q) is 0 at q = m, rises to infinity at 0 and 1: bisect each side */
+    for (int it = 0; it < 64 && m < 1.0; it++) {
+        double q = 0.5 * (in + out);
+        if (N * kl_bernoulli(m, q) <= c) in = q;
+        else out = q;
+    }
+    *hi = out; /* outside the set: the conservative end */
+    in = m, out = 0.0;
+    for (int it = 0; it < 64 && m > 0.0; it++) {
+        double q = 0.5 * (in + out);
+        if (N * kl_bernoulli(m, q) <= c) in = q;
+        else out = q;
+    }
+    *lo = out;
+}

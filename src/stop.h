@@ -80,4 +80,15 @@ double ulam__stop_walks_needed(double m, double var, double R, double bias, doub
  * sqrt(E^2 - f^2); 0 when f >= E (no walk count can meet E). */
 double ulam__stop_combined_target(double E, double f);
 
+
+/* The Chernoff-Hoeffding interval for the mean of n independent scores in [0, 1] (Hoeffding 1963,
+ * Theorem 1: P(mean >= mu + t) <= exp(-n kl(mu + t || mu)), Bernoulli laws being the extreme
+ * case; the same below): [lo, hi] = the means q with n kl(m || q) <= ln(2 / delta_k) on each
+ * side, delta_k = ULAM__STOP_DELTA / (k (k + 1)) at checkpoint k >= 1 of a run that may stop at
+ * any of them (sum 1 / (k (k + 1)) = 1), ULAM__STOP_DELTA itself at k = 0 (a count fixed in
+ * advance); sample mean m.  For scores that are mostly 0 with rare hits of one
+ * size it is the binomial's own bound (no hit in n: hi = 1 - (delta_k / 2)^(1/n), about
+ * 3.7 / n), against the empirical-Bernstein range term 7 L / (3 (n - 1)) (about 9.6 / n). */
+void ulam__stop_kl_interval(int64_t n, double m, int k, double *lo, double *hi);
+
 #endif /* ULAM_STOP_H */

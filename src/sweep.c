@@ -8,7 +8,15 @@
  * sweep over the states in order, pushing each nonzero residual where it lies (Gauss-Seidel
  * order: a residual a sweep adds ahead of itself is pushed in the same sweep), which reads M' in
  * storage order instead of chasing a queue.  Rounds go on while the walks' work the residual
- * would leave falls by more than a round costs (the caller's cost model, push operations). */
+ * would leave falls by more than a round costs (the caller's cost model, push operations).
+ *
+ * Given M itself (its rows: each state's in-neighbours) and M >= 0, a sweep pulls instead of
+ * pushing: p_i <- e_s,i + sum_j M_ij p_j for i in order, the same Gauss-Seidel sweep (p_i + r_i,
+ * r_i = e_s,i + (M p)_i - p_i being the residual the push would move) read like a sparse
+ * matrix-vector product, with no scattered writes.  r is not kept during pull sweeps (its storage
+ * holds c_i = sum_k M_ki): its sum is, as 1 - sum_i p_i (1 - c_i) (r >= 0 when M >= 0), and r
+ * itself is formed once at the end (one more product), negative roundings of a zero residual cut
+ * to 0 (at most 1e-16 of (M p)_i). */
 #include "internal.h"
 
 #include <math.h>
@@ -30,14 +38,78 @@ static int64_t push_one(const ulam_csr *Mt, int64_t j, double *p, double *r, int
     return b - a + 1;
 }
 
-/* Forward push from s on M (given as its transpose Mt) into p and r (n entries, zero). */
-int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost, void *ctx, int64_t max_ops,
-                     double *p, double *r, ulam__sweep_info *info)
+/* The pull sweeps' view of M: M and its column sums c (rows of Mt; kept in r's storage, which
+ * the pull sweeps do not use). */
+typedef struct {
+    const ulam_csr *M;
+    double *c;
+} pull;
+
+/* (M p)_i. */
+static inline double pull_row(const ulam_csr *M, const double *p, int64_t i)
+{
+    double s = 0.0;
+    for (int64_t k = M->rowptr[i]; k < M->rowptr[i + 1]; k++) s += M->val[k] * p[M->colidx[k]];
+    return s;
+}
+
+/* Read Mt once for the pull sweeps, c_j into r_j: 1; 0 when M has a negative entry (no pull: r
+ * made again as e_s + M p - p). */
+static int pull_setup(const ulam_csr *M, const ulam_csr *Mt, int64_t s, const double *p, double *r, pull *pl)
+{
+    int64_t n = Mt->nrows;
+    for (int64_t j = 0; j < n; j++) {
+        double sum = 0.0;
+        for (int64_t k = Mt->rowptr[j]; k < Mt->rowptr[j + 1]; k++) {
+            if (Mt->val[k] < 0) {
+                for (int64_t i = 0; i < n; i++) r[i] = pull_row(M, p, i) + (i == s ? 1.0 : 0.0) - p[i];
+                return 0;
+            }
+            sum += Mt->val[k];
+        }
+        r[j] = sum;
+    }
+    pl->M = M, pl->c = r;
+    return 1;
+}
+
+/* One Gauss-Seidel pull sweep (updates above thr); the updates made; *rsum falls with them. */
+static int64_t pull_sweep(const pull *pl, int64_t s, double thr, double *p, double *rsum)
+{
+    int64_t n = pl->M->nrows, pushed = 0;
+    double fall = 0.0;
+    for (int64_t i = 0; i < n; i++) {
+        double v = pull_row(pl->M, p, i) + (i == s ? 1.0 : 0.0), d = v - p[i];
+        if (!(d > thr)) continue;
+        p[i] = v, pushed++;
+        fall += d * (1.0 - pl->c[i]);
+    }
+    *rsum -= fall;
+    return pushed;
+}
+
+/* r = e_s + M p - p (cut at 0); its sum. */
+static double pull_residual(const pull *pl, int64_t s, const double *p, double *r)
+{
+    int64_t n = pl->M->nrows;
+    double sum = 0.0;
+    for (int64_t i = 0; i < n; i++) {
+        double v = pull_row(pl->M, p, i) + (i == s ? 1.0 : 0.0) - p[i];
+        r[i] = v > 0 ? v : 0.0;
+        sum += r[i];
+    }
+    return sum;
+}
+
+/* Forward push from s on M (given as its transpose Mt, and as itself or NULL) into p and r. */
+int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost,
+                          void *ctx, int64_t max_ops, double *p, double *r, ulam__sweep_info *info)
 {
     int64_t n = Mt->nrows, nnz = ulam_csr_nnz(Mt);
     *info = (ulam__sweep_info){0};
     int32_t *list = ulam__malloc((size_t)n, sizeof *list), *next = ulam__malloc((size_t)n, sizeof *next);
     unsigned char *mark = ulam__calloc((size_t)n, 1);
+    pull pl = {0};
     if (!list || !next || !mark) {
         free(list), free(next), free(mark);
         return ULAM_ENOMEM;
@@ -47,9 +119,10 @@ int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cos
     list[0] = (int32_t)s;
     int64_t nlist = 1, ops = 0;
     double rsum = 1.0;
-    int status = ULAM_OK, sweeping = 0;
+    int status = ULAM_OK, sweeping = 0, pulling = 0;
     for (;;) {
         int64_t round_ops = 0, pushed = 0;
+        double before = rsum;
         if (!sweeping) {
             int64_t nnext = 0;
             for (int64_t q = 0; q < nlist; q++) mark[list[q]] = 0;
@@ -62,6 +135,10 @@ int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cos
                 if (r[list[q]] != 0.0 && !mark[list[q]]) mark[list[q]] = 1, next[nnext++] = list[q];
             int32_t *t = list;
             list = next, next = t, nlist = nnext;
+        } else if (pulling) {
+            pushed = pull_sweep(&pl, s, thr, p, &rsum);
+            round_ops = nnz + n;
+            info->sweeps++, info->pulls++;
         } else {
             for (int64_t j = 0; j < n; j++)
                 if (fabs(r[j]) > thr) round_ops += push_one(Mt, j, p, r, NULL, NULL, NULL), pushed++;
@@ -71,10 +148,11 @@ int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cos
         info->rounds++;
         info->pushes += pushed;
         ops += round_ops;
-        double before = rsum;
-        rsum = 0.0;
-        if (sweeping) {
+        if (pulling) {
+            /* rsum kept by pull_sweep */
+        } else if (sweeping) {
             int64_t active = 0;
+            rsum = 0.0;
             for (int64_t j = 0; j < n; j++) rsum += fabs(r[j]), active += r[j] != 0.0;
             ops += n;
             if (active < n / 16) { /* few states hold residual again: back to the list */
@@ -84,10 +162,18 @@ int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cos
                 sweeping = 0;
             }
         } else {
+            rsum = 0.0;
             for (int64_t q = 0; q < nlist; q++) rsum += fabs(r[list[q]]);
-            if (nlist >= n / 16) sweeping = 1;
+            if (nlist >= n / 16) {
+                sweeping = 1;
+                if (M && pull_setup(M, Mt, s, p, r, &pl)) { /* from here on r is implicit: rsum as 1 - sum_i p_i (1 - c_i) */
+                    pulling = 1, ops += nnz;
+                    rsum = 1.0;
+                    for (int64_t i = 0; i < n; i++) rsum -= p[i] * (1.0 - pl.c[i]);
+                }
+            }
         }
-        if (pushed == 0 || rsum == 0.0) break;
+        if (pushed == 0 || !(rsum > 0.0)) break;
         if (max_ops > 0 && ops > max_ops) {
             status = ULAM_ENOCONV;
             break;
@@ -97,9 +183,18 @@ int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cos
         double rho = before > 0 ? rsum / before : 1.0, next_ops = sweeping ? (double)(nnz + 2 * n) : (double)round_ops;
         if (!(cost(rsum, ctx) - cost(rho * rsum, ctx) > next_ops)) break;
     }
+    if (pulling) rsum = pull_residual(&pl, s, p, r), ops += nnz + n; /* c in r is not needed after the sweeps */
     info->ops = ops;
     info->r_sum = rsum;
+    info->nonneg = pl.c != NULL;
     for (int64_t j = 0; j < n; j++) info->support += r[j] != 0.0;
     free(list), free(next), free(mark);
     return status;
+}
+
+/* Forward push from s on M (given as its transpose Mt) into p and r (n entries, zero). */
+int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost, void *ctx, int64_t max_ops,
+                     double *p, double *r, ulam__sweep_info *info)
+{
+    return ulam__sweep_push_pull(NULL, Mt, s, rmax, cost, ctx, max_ops, p, r, info);
 }

@@ -48,6 +48,7 @@ static void test_fpush_rule(void **state)
         ulam_error err;
         assert_int_equal(ulam__fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, &sw, &err), ULAM_OK);
         assert_true(sw.sweeps >= 1 && sw.rounds > sw.sweeps); /* list rounds first, then whole sweeps */
+        assert_true(sw.pulls == sw.sweeps && sw.nonneg);     /* M >= 0: the sweeps pull along M's rows */
         assert_true(info.walks > 0 && info.push.r_sum > 0);
         int64_t b = 0, c = 0, w = 0;
         for (int64_t i = 0; i < n; i++) {
