@@ -419,7 +419,7 @@ static void honest_interval(ulam_bidir_result *res, double D, const ulam_walk_op
         int fixed = !(wo->stop.rel_err > 0) && !(wo->stop.max_seconds > 0) && w->walks == wo->stop.max_walks;
         ulam__stop_ci ci;
         ulam__stop_interval(w->walks, w->estimate, w->variance, 2.0 * w->score_bound, 0.0, 0.0, INFINITY,
-                            fixed ? 1 : ulam__stop_epoch(w->walks), &ci);
+                            fixed ? 0 : ulam__stop_epoch(w->walks), &ci);
         lo = res->push_part + ci.lo, hi = res->push_part + ci.hi;
     } else if (w->walks > 0 && !(w->variance > 0))
         lo = res->push_part - D, hi = res->push_part + D; /* NaN-free: D may be INFINITY (no bound) */

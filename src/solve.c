@@ -1363,7 +1363,7 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
     double cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m, se = r->std_error;
     int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
     int fixed = !(s->o.stop.rel_err > 0) && !(s->o.stop.max_seconds > 0) && r->walks == s->o.stop.max_walks;
-    int k = fixed ? 1 : ulam__stop_epoch(r->walks);
+    int k = fixed ? 0 : ulam__stop_epoch(r->walks);
     /* the truncation: a quarter of the standard error, or the decade of |m| that gives the
        narrowest interval (a longer truncation widens the range term, a shorter one the bias) */
     double bt = isfinite(se) ? fmin(cap, fmax(se / 4.0, 1e-6 * m)) : cap, best = INFINITY;

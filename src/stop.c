@@ -11,11 +11,10 @@ int ulam__stop_epoch(int64_t n)
     return 1 + (int)ceil(2.0 * log2((double)n / ULAM__STOP_N0) - 1e-12);
 }
 
-/* ln(3 / delta_k), delta_k = delta / (k (k + 1)). */
+/* ln(3 / delta_k): delta_k = delta / (k (k + 1)) at checkpoint k >= 1, delta itself at k = 0. */
 double ulam__stop_log(int k)
 {
-    double kk = k < 1 ? 1.0 : (double)k;
-    return log(3.0 / ULAM__STOP_DELTA) + (k > 1 ? log(kk * (kk + 1.0)) : 0.0);
+    return log(3.0 / ULAM__STOP_DELTA) + (k >= 1 ? log((double)k * ((double)k + 1.0)) : 0.0);
 }
 
 /* The interval of n scores. */

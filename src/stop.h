@@ -9,10 +9,10 @@
  * with probability at least 1 - delta_k (two Bernstein tails and the variance's own bound, a
  * third each).  Stitched over the checkpoints a run can stop at: walk counts are grouped in
  * epochs growing by sqrt(2) from ULAM__STOP_N0 (epoch k holds n in (N0 2^((k-2)/2),
- * N0 2^((k-1)/2)]), epoch k gets delta_k = delta / (k (k + 1)), so the bounds hold at every
- * epoch at once with probability 1 - delta (sum 1 / (k (k + 1)) = 1); the rel_err rule checks
- * once per epoch.  A run with a fixed walk count and no other rule stops at one count known in
- * advance: it takes delta itself (k = 1).
+ * N0 2^((k-1)/2)]), epoch k gets delta_k = delta / (k (k + 1)) (delta / 2 at the first), so the
+ * bounds hold at every epoch at once with probability 1 - delta (sum over k >= 1 of
+ * 1 / (k (k + 1)) = 1); the rel_err rule checks once per epoch.  A run with a fixed walk count and
+ * no other rule stops at one count known in advance: it takes delta itself (k = 0).
  *
  * R is certified by the caller (a bound on a single score, or the range of walks cut at a
  * length past which they add at most `bias` to the mean, or a second-moment route), as is
@@ -51,12 +51,12 @@ typedef struct {
 /* The epoch of n walks (1 for n <= ULAM__STOP_N0). */
 int ulam__stop_epoch(int64_t n);
 
-/* L = ln(3 / delta_k) of epoch k (k >= 1). */
+/* L = ln(3 / delta_k) of epoch k >= 1; of a count fixed in advance at k = 0. */
 double ulam__stop_log(int k);
 
 /* The interval of n scores with mean `mean`, sample variance `var`, certified range R (the width
  * of an interval holding every score; INFINITY none, 0 exact) and certified bias, at epoch k
- * (1 for a run that stops at a count fixed in advance); maxabs: the largest |score| seen, with
+ * (0 for a run that stops at a count fixed in advance); maxabs: the largest |score| seen, with
  * half: R / 2 when the scores may take both signs (else R) as the largest |score| the range
  * allows (kind ULAM__STOP_BEYOND past it). */
 void ulam__stop_interval(int64_t n, double mean, double var, double R, double bias, double maxabs, double limit, int k,
