@@ -112,6 +112,13 @@ static int next_event(int estimator)
            estimator == ULAM_RAD_NEXT_EVENT_LIGHT;
 }
 
+/* Nonzero when the solver's walks are point.c's weight-window walks: a point solver's, and
+ * gathering at a patch by next-event or collision (absorption keeps gather's roulette). */
+static int window(const ulam_rad_solver *s)
+{
+    return s->at || (s->o.mode == ULAM_ADJOINT && s->o.estimator != ULAM_RAD_ABSORPTION);
+}
+
 /* Check the options for a patch walk (point: a point solver, whose index is not read). */
 static int check_opts(const ulam_scene *sc, const ulam_walk_opts *o, int point, ulam_error *err)
 {
@@ -154,8 +161,26 @@ static void first_bounds(ulam_rad_solver *s)
     for (int c = 0; c < 3 && !s->at; c++) s->w1[c] = s->q[i] > 0 ? sc->rho[3 * i + c] / s->q[i] : 0.0;
 }
 
-/* A point solver's parts of its range (ulam__point_range): its own vertex's light sample and
- * landing (at the point), every other vertex's largest over the patches, the largest
+/* The own vertex's parts of a window walk's range (ulam__point_range): the light sample and the
+ * landing at the point, or anywhere on the gathering patch (collision: no light sample, a
+ * landing at most the largest emission). */
+static void own_parts(ulam_rad_solver *s)
+{
+    const ulam_scene *sc = s->s;
+    ulam__point_bounds *b = &s->pb;
+    int64_t i = s->o.query.index;
+    if (next_event(s->o.estimator)) {
+        ulam__lights_vertex_parts(&s->L, sc, s->o.estimator, s->at ? -1 : i, s->at ? s->at_x : NULL,
+                                  s->at ? s->at_n : sc->normal + 3 * i, b->light0, b->hit0);
+        return;
+    }
+    for (int c = 0; c < 3; c++) b->light0[c] = 0.0, b->hit0[c] = 0.0;
+    for (int64_t k = 0; k < s->L.nem; k++)
+        for (int c = 0; c < 3; c++) b->hit0[c] = fmax(b->hit0[c], sc->emit[3 * s->L.emitter[k] + c]);
+}
+
+/* A window walk's parts of its range (ulam__point_range): its own vertex's light sample and
+ * landing (own_parts), every other vertex's largest over the patches, the largest
  * reflectance, and whether every emitter is black (a landing on one ends the walk). */
 static void point_bounds(ulam_rad_solver *s)
 {
@@ -180,9 +205,7 @@ static void point_bounds(ulam_rad_solver *s)
             b->lr[c] = fmax(b->lr[c], r * l[c]), b->hr[c] = fmax(b->hr[c], r * h[c]);
         }
     }
-    if (nee) ulam__lights_vertex_parts(&s->L, sc, s->o.estimator, -1, s->at_x, s->at_n, b->light0, b->hit0); /* its own */
-    else
-        for (int c = 0; c < 3; c++) b->light0[c] = 0.0, b->hit0[c] = emax[c];
+    own_parts(s);
 }
 
 /* The bounds of the rel_err rule (per channel: per_step, what one step can score; range, a
@@ -211,7 +234,7 @@ static void score_bounds(ulam_rad_solver *s)
             s->range[c] = fmax(s->range[c], E > 0 ? E / (1.0 - s->q[p]) : 0.0);
         }
     }
-    if (s->at) point_bounds(s);
+    if (window(s)) point_bounds(s);
     if (s->o.mode == ULAM_FORWARD) {
         for (int c = 0; c < 3; c++) {
             double w0 = 0.0, rho = sc->rho[3 * s->o.query.index + c], q = s->q[s->o.query.index];
@@ -375,8 +398,6 @@ int ulam__rad_point_restart(ulam_rad_solver *s, const double x[3], const double 
     for (int k = 0; k < 3; k++) s->at_x[k] = xx[k], s->at_n[k] = nn[k];
     s->at_self = p;
     ulam__rad_solver_restart(s, -1, s->o.stop.rel_err, seed, max_seconds);
-    if (next_event(s->o.estimator))
-        ulam__lights_vertex_parts(&s->L, s->s, s->o.estimator, -1, s->at_x, s->at_n, s->pb.light0, s->pb.hit0);
     return ULAM_OK;
 }
 
@@ -442,45 +463,22 @@ static void gather(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_b
     }
 }
 
-/* Next event at patch p: one light sample (lights.c) from a uniform point of p, weighted
- * (W before p's reflection). */
-static void light_sample(const ulam_rad_solver *s, ulam_rng *r, int64_t p, const double W[3], double score[3],
-                         rad_block *br)
-{
-    const double *rho = s->s->rho + 3 * p;
-    double x[3], Wr[3] = {W[0] * rho[0], W[1] * rho[1], W[2] * rho[2]};
-    int64_t l = ulam__lights_pick(&s->L, ulam__rng_uniform(r));
-    ulam__tracer_point(s->t, p, r, x);
-    br->rays += ulam__lights_score(s->t, &s->L, s->o.estimator, l, x, s->s->normal + 3 * p, p, Wr, r, score);
-}
-
-/* One next-event gathering walk from the patch: its RGB score. */
-static void gather_next_event(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_block *br)
+/* One gathering walk from the patch by next-event or collision estimation: its emission, and
+ * its reflectance times a window walk (point.c) from a uniform point of it whose landings move
+ * to uniform points of the patches they reach (the patch-averaged F); a black patch walks not. */
+static void gather_window(const ulam_rad_solver *s, ulam_rng *r, double score[3], rad_block *br)
 {
     const ulam_scene *sc = s->s;
-    int64_t p = s->o.query.index;
-    double W[3] = {1, 1, 1};
-    for (int c = 0; c < 3; c++) score[c] = sc->emit[3 * p + c];
-    for (int64_t step = 0;; step++) {
-        double q = s->q[p];
-        if (q > 0 && s->L.nem) light_sample(s, r, p, W, score, br);
-        if (ulam__rng_uniform(r) >= q) return;
-        if (step >= s->o.stop.max_steps) {
-            br->cut++;
-            return;
-        }
-        for (int c = 0; c < 3; c++) W[c] *= sc->rho[3 * p + c] / q;
-        ulam__hit h;
-        int64_t j = ulam__tracer_shoot_hit(s->t, p, r, &h);
-        br->rays++;
-        if (j < 0) return;
-        const double *E = sc->emit + 3 * j;
-        if (E[0] + E[1] + E[2] > 0) { /* the walk's own hit on an emitter, weighted against light sampling */
-            double w = ulam__lights_hit_weight(&s->L, sc, s->o.estimator, j, &h);
-            for (int c = 0; c < 3; c++) score[c] += W[c] * E[c] * w;
-        }
-        p = j;
-    }
+    int64_t i = s->o.query.index, cut = 0;
+    const double *E = sc->emit + 3 * i, *rho = sc->rho + 3 * i;
+    double x[3], H[3];
+    for (int c = 0; c < 3; c++) score[c] = E[c];
+    if (s->q[i] == 0.0) return;
+    ulam__tracer_point(s->t, i, r, x);
+    ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, ulam__point_gamma(s->pb.rho), 1, x,
+                     sc->normal + 3 * i, i, r, H, &br->rays, &cut);
+    br->cut += cut;
+    for (int c = 0; c < 3; c++) score[c] += rho[c] * H[c];
 }
 
 /* Add w to the history tally of patch p. */
@@ -559,11 +557,11 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             double sc[3];
             if (s->at) {
                 int64_t cut = 0;
-                ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, ulam__point_gamma(s->pb.rho), s->at_x, s->at_n, s->at_self, &r,
-                                 sc, &br->rays, &cut);
+                ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, ulam__point_gamma(s->pb.rho), 0,
+                                 s->at_x, s->at_n, s->at_self, &r, sc, &br->rays, &cut);
                 br->cut += cut;
-            } else if (next_event(s->o.estimator)) {
-                gather_next_event(s, &r, sc, br);
+            } else if (window(s)) {
+                gather_window(s, &r, sc, br);
             } else {
                 gather(s, &r, sc, br);
             }
@@ -624,8 +622,9 @@ static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r)
 static void channel_range(const ulam_rad_solver *s, int c, double m, double E, double *R, double *bias)
 {
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
-    if (s->at) { /* point walks: their weight window's range (point.c) */
-        *R = ulam__point_range(&s->pb, c);
+    if (window(s)) { /* window walks: their range (point.c), times the patch's reflectance */
+        double R0 = ulam__point_range(&s->pb, c), rho = s->at ? 1.0 : s->s->rho[3 * s->o.query.index + c];
+        *R = rho > 0 ? rho * R0 : 0.0;
         *bias = 0.0;
         return;
     }
@@ -644,8 +643,10 @@ static void channel_interval(const ulam_rad_solver *s, int c, double m, double E
     double off = s->o.mode == ULAM_FORWARD ? s->s->emit[3 * s->o.query.index + c] : 0.0;
     channel_range(s, c, m, E, &R, &bias);
     int64_t n = s->run.walks;
-    ulam__stop_interval(n, off + s->m[c].mean / A, ulam__moments_variance(&s->m[c]) / (A * A), R, bias,
-                        s->at ? s->maxc[c] : 0.0, s->at ? R : INFINITY, ulam__stop_epoch(n), ci);
+    if (window(s) && !s->at) off = s->s->emit[3 * s->o.query.index + c]; /* scores in [E, E + R] */
+    ulam__stop_interval(n, s->m[c].mean / A + (s->o.mode == ULAM_FORWARD ? off : 0.0),
+                        ulam__moments_variance(&s->m[c]) / (A * A), R, bias, window(s) ? s->maxc[c] - off : 0.0,
+                        window(s) ? R : INFINITY, ulam__stop_epoch(n), ci);
 }
 
 /* The walks the rel_err rule (stop.h) needs in channel c at estimate m. */
@@ -726,6 +727,7 @@ void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uin
     ulam__moments zero = {0};
     s->o.query.index = p, s->o.stop.rel_err = rel_err, s->o.exec.seed = seed, s->o.stop.max_seconds = max_seconds;
     first_bounds(s);
+    if (window(s)) own_parts(s); /* the new patch's or point's own vertex */
     s->m[0] = s->m[1] = s->m[2] = zero;
     s->sq = s->maxsq = s->maxc[0] = s->maxc[1] = s->maxc[2] = 0.0;
     s->rays = s->cut = 0;

@@ -12,7 +12,11 @@
  * unbiased).  So vertex k weighs at most max(rho^k, f_k), rho the scene's largest reflectance,
  * whatever the path, and one walk's score has a finite certified range (ulam__point_range),
  * where roulette with q = max_c rho_c (weights rho / q, 1 on a grey surface) counted every
- * vertex at full weight up to a truncation.  Then B(x) = E + rho H(x) on the patch x lies on. */
+ * vertex at full weight up to a truncation.  Then B(x) = E + rho H(x) on the patch x lies on.
+ * A patch walk (patchwalk.c) is the same walk from a uniform point of its patch with every
+ * landing moved to a uniform point of the patch it reached (the patch-averaged F of the
+ * discrete equation B = E + diag(rho) F B); its range is the same sum, its own vertex's bound
+ * being its patch's. */
 #include "rad.h"
 
 /* Move y onto the plane of patch j (the hit point's float rounding, so that the next ray leaves
@@ -26,9 +30,10 @@ static void onto_plane(const ulam_scene *s, int64_t j, double y[3])
     for (int k = 0; k < 3; k++) y[k] -= h * n[k];
 }
 
-/* One walk from x: its RGB irradiance score. */
+/* One walk from x: its RGB irradiance score (uniform: each landing moves to a uniform point of
+ * the patch it landed on, the patch walks' discrete equation). */
 void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps, double gamma,
-                      const double x0[3], const double n0[3], int64_t self, ulam_rng *r, double score[3],
+                      int uniform, const double x0[3], const double n0[3], int64_t self, ulam_rng *r, double score[3],
                       int64_t *rays, int64_t *cut)
 {
     const ulam_scene *s = ulam__tracer_scene(t);
@@ -62,6 +67,7 @@ void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator
             return;
         }
         for (int k = 0; k < 3; k++) x[k] += dist * d[k], n[k] = s->normal[3 * j + k];
+        if (uniform) ulam__tracer_point(t, j, r, x);
         onto_plane(s, j, x);
         self = j;
     }
