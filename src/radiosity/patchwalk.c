@@ -1,11 +1,15 @@
 /* Patch walks: the radiosity equation B = E + diag(rho) F B solved by walks that sample F by
  * casting rays, never forming it.
  *
- * Gathering (adjoint) estimates B_i: a walk starts at patch i with weight 1 per channel; at
- * patch p it continues with probability q_p = max_c rho_pc, multiplying the weights by
- * rho_pc / q_p, and moves to the patch its cosine-distributed ray reaches (probability F_pj);
- * a ray that leaves the scene or hits a back side ends it.  Collision scores W E_p at every
- * patch; absorption scores W E_p / (1 - q_p) where the walk stops by its coin.
+ * Gathering (adjoint) estimates B_i: a walk starts at patch i with weight 1 per channel and
+ * moves to the patch its cosine-distributed ray from a uniform point of its patch reaches
+ * (probability F_pj); a ray that leaves the scene or hits a back side ends it.  Collision and
+ * next-event walks are point.c's weight-window walks (gather_window): B_i = E_i + rho_i H,
+ * H the walk's score from a uniform point of i, every landing moved to a uniform point of the
+ * patch it reached, so that the score has point.c's finite certified range (ulam__point_range)
+ * times rho_i.  Collision scores W E_j where the walk lands on an emitter j.  Absorption
+ * (gather) continues at p with probability q_p = max_c rho_pc, its weights times rho_pc / q_p,
+ * and scores W E_p / (1 - q_p) where the walk stops by its coin.
  *
  * Shooting (forward) estimates every patch's reflected power R = P - A E from P = A E +
  * diag(rho) F' P (by reciprocity): a particle leaves an emitter chosen in proportion to its
@@ -72,7 +76,6 @@ struct ulam_rad_solver {
     int threads;
     double *q;            /* continuation per patch: max_c rho */
     double per_step[3], range[3], qmax; /* the score bounds of the rel_err rule (score_bounds) */
-    double first[3], w1[3];             /* next-event: the first vertex's (first_bounds) */
     ulam__point_bounds pb;              /* a point solver's (point_bounds) */
     ulam__lights L;       /* the emitters (shooting's source, next-event's lights) */
     int at;               /* a point solver: walks from at_x (normal at_n, on patch at_self or -1) */
@@ -146,21 +149,6 @@ static int build_source(ulam_rad_solver *s, ulam_error *err)
     return ULAM_OK;
 }
 
-/* The first vertex's bounds of a next-event walk (score_bounds): first_c, what the start (patch
- * opts->index or the point) can score beyond its emission, and w1_c, the weight the walk leaves
- * it with (rho_c / q of the start patch; 1 from a point): the walk's score is at most
- * first_c + w1_c per_step_c a later vertex.  Others: first 0, w1 1. */
-static void first_bounds(ulam_rad_solver *s)
-{
-    const ulam_scene *sc = s->s;
-    int64_t i = s->at ? s->at_self : s->o.query.index;
-    for (int c = 0; c < 3; c++) s->first[c] = 0.0, s->w1[c] = 1.0;
-    if (!next_event(s->o.estimator) || s->o.mode != ULAM_ADJOINT || (i < 0 && !s->at)) return;
-    ulam__lights_vertex_bound(&s->L, sc, s->o.estimator, i, i < 0 ? s->at_x : NULL, s->at ? s->at_n : sc->normal + 3 * i,
-                              !s->at, s->first);
-    for (int c = 0; c < 3 && !s->at; c++) s->w1[c] = s->q[i] > 0 ? sc->rho[3 * i + c] / s->q[i] : 0.0;
-}
-
 /* The own vertex's parts of a window walk's range (ulam__point_range): the light sample and the
  * landing at the point, or anywhere on the gathering patch (collision: no light sample, a
  * landing at most the largest emission). */
@@ -214,14 +202,15 @@ static void point_bounds(ulam_rad_solver *s)
  * (rho_c / q <= 1).  Gathering: collision scores at most max_p E_pc a visit; absorption at most
  * max_p E_pc / (1 - q_p) once; next-event at most lights.c's vertex bound a vertex (the MIS
  * weights cap the 1 / r^2 of a light sample near its light; light sampling alone is bounded
- * only where no patch can touch an emitter), its start patch's emission being a constant.
+ * only where no patch can touch an emitter).  Window walks (gathering by collision or
+ * next-event, point solvers) take their whole range from point_bounds; per_step still says
+ * which channels can score and whether light sampling alone is bounded.
  * Shooting's tally at patch i: at most w0_c rho_ic a visit, w0_c = P max_l E_lc / sum_c E_lc
  * the largest starting weight (collision), or that / (1 - q_i) once (absorption). */
 static void score_bounds(ulam_rad_solver *s)
 {
     const ulam_scene *sc = s->s;
     int nee = next_event(s->o.estimator);
-    first_bounds(s);
     s->qmax = 0.0;
     for (int c = 0; c < 3; c++) s->per_step[c] = s->range[c] = 0.0;
     for (int64_t p = 0; p < sc->npatches; p++) {
@@ -615,10 +604,11 @@ static void merge_block(void *ctx, int k)
 
 static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r);
 
-/* Channel c's certified score range R and bias at estimate m (of B), in B's units: the range of
- * one walk's score (gathering) or of one particle's tally at the patch over its area
- * (shooting), at a truncation whose bias is at most E |m| / 4 when no whole-walk bound is known
- * (score_bounds); a point walk's whole range, finite and with no bias (ulam__point_range). */
+/* Channel c's certified score range R and bias at estimate m (of B), in B's units: a window
+ * walk's whole range, finite and with no bias (ulam__point_range; times rho_i at patch i, whose
+ * scores lie in [E_i, E_i + R]); else the range of one absorption walk's score or of one
+ * particle's tally at the patch over its area (shooting), at a truncation whose bias is at
+ * most E |m| / 4 when no whole-walk bound is known (score_bounds). */
 static void channel_range(const ulam_rad_solver *s, int c, double m, double E, double *R, double *bias)
 {
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
@@ -628,14 +618,13 @@ static void channel_range(const ulam_rad_solver *s, int c, double m, double E, d
         *bias = 0.0;
         return;
     }
-    double later = ulam__score_range(s->range[c], s->w1[c] * s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0);
-    *R = (s->first[c] + later) / A;
+    *R = ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0) / A;
     *bias = isfinite(s->range[c]) ? 0.0 : E * fabs(m) / 4.0;
 }
 
 /* Channel c's 95% interval (stop.h) at estimate m: on the walks' scores (gathering) or the
- * particles' tallies at the patch over its area (shooting, the emission exact).  A point
- * solver's scores are checked against their certified range: one past it leaves no interval
+ * particles' tallies at the patch over its area (shooting, the emission exact).  A window
+ * walk's scores are checked against their certified range: one past it leaves no interval
  * (and no stop by rel_err), as in ulam_solve's. */
 static void channel_interval(const ulam_rad_solver *s, int c, double m, double E, ulam__stop_ci *ci)
 {
@@ -726,7 +715,6 @@ void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uin
 {
     ulam__moments zero = {0};
     s->o.query.index = p, s->o.stop.rel_err = rel_err, s->o.exec.seed = seed, s->o.stop.max_seconds = max_seconds;
-    first_bounds(s);
     if (window(s)) own_parts(s); /* the new patch's or point's own vertex */
     s->m[0] = s->m[1] = s->m[2] = zero;
     s->sq = s->maxsq = s->maxc[0] = s->maxc[1] = s->maxc[2] = 0.0;
