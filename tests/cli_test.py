@@ -353,14 +353,16 @@ def check_radiosity_rare_lamp(ulam):
     Howell C-11 and the lamp's point form factor averaged over the floor).  The old --rel-err
     rule stopped collision walks after 3840 walks at 0.10 +- 0.005 (z = -24) in every seed: the
     lamp, 55% of the answer, had not been hit.  Now collision's rule is never met before a walk
-    count it announces (next-event named), and next-event's intervals cover."""
+    count it announces (next-event named): 2.4e6-4.1e6 from the weight window's certified range
+    (rho 10^4 = 5000 a walk; the variance needs ~6e6, se 0.019 at 2e6 walks), and next-event's
+    intervals cover."""
     exact, scene = 0.21981, R + "rare_lamp.obj"
     for seed in range(1, 11):
         rc, out, err = run(ulam, ["radiosity", scene, "--patch", "floor", "--rel-err", "0.05", "--walks", "20000",
                                   "--estimator", "collision", "--json", "--seed", str(seed)])
         assert rc == 0, err
         j = json.loads(out)
-        assert j["rel_err_met"] is False and j["min_walks"] > 1e8 and j["walks"] == 20000, (seed, j)
+        assert j["rel_err_met"] is False and j["min_walks"] > 1e6 and j["walks"] == 20000, (seed, j)
         assert "--estimator next-event samples the emitters directly" in err, (seed, err)
     covered = 0
     for seed in range(1, 101):
