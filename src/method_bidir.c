@@ -237,6 +237,12 @@ static int predict(ulam__query *q, int k, ulam_error *err)
         return ULAM_OK;
     }
     v->predicted_work = work(q->M, &ch->bidir, &ch->walks.guard);
+    if (q->o->stop.rel_err > 0 && !isfinite(W) && ch->bidir.push_part == 0.0 && !(ch->bidir.probe > 0)) {
+        v->predicted_work = INFINITY; /* as a walk pilot that saw nothing predicts nothing: the plan's walks
+                                         rest on its |x_t| >= min_value floor alone */
+        snprintf(v->why, sizeof v->why, "not predicted: no walk pilot, push or probe has seen x_t (its plan "
+                                        "assumes |x_t| >= %.3g)", r->bo.min_value > 0 ? r->bo.min_value : 1.0 / (double)q->M->nrows);
+    }
     return ULAM_OK;
 }
 
