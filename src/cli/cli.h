@@ -126,10 +126,9 @@ extern double cli_started;
  * runs when nothing is left (a tiny positive budget). */
 double cli_time_left(double budget);
 
-/* Make OpenMP threads wait passively (sleep, not spin) unless the user chose a policy: libgomp
- * reads OMP_WAIT_POLICY when it loads, before main, so the process runs itself again once with
- * it set (argv as given).  Returns only when no re-run happened (set already, or exec failed). */
-void cli_passive_threads(char **argv);
+/* OpenMP threads wait passively (sleep, not spin) on a busy machine unless the user chose a policy
+ * (OMP_WAIT_POLICY, GOMP_SPINCOUNT): libgomp reads it when it loads, before main, so common.c sets
+ * it from the executable's .preinit_array (issue 29 point 5). */
 
 /* With -Dmpi=enabled: start MPI when launched by mpirun, and end it (src/cli/mpi.c). */
 void cli_mpi_init(int *argc, char ***argv);

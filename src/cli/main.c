@@ -55,7 +55,6 @@ static int dispatch(int argc, char **argv)
 int main(int argc, char **argv)
 {
     cli_started = ulam_now();
-    cli_passive_threads(argv); /* threads that sleep, not spin, on a busy machine (issue 29 point 5) */
 #ifdef ULAM_MPI
     cli_mpi_init(&argc, &argv);
 #endif
