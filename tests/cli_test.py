@@ -605,6 +605,22 @@ def check_systems_as_held(ulam):
             assert rc == 0 and abs(o["estimate"] - ref) < 4 * o["stderr"] and 0.1 < ref < 0.5, (o, ref)
 
 
+def check_passive_threads(ulam):
+    """Issue 29 point 5: OpenMP's threads sleep (GOMP_SPINCOUNT 0) and OpenBLAS's sleep at once unless
+    the user chose a policy, whose choice is kept; libgomp's OMP_DISPLAY_ENV shows what it read."""
+    def shown(extra):
+        env = {k: v for k, v in os.environ.items()
+               if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "OPENBLAS_THREAD_TIMEOUT", "GOTO_THREAD_TIMEOUT")}
+        env.update(extra, OMP_DISPLAY_ENV="verbose")
+        p = subprocess.run([ulam, "--version"], capture_output=True, text=True, timeout=600, env=env)
+        assert p.returncode == 0 and p.stdout.startswith("ulam "), (p.returncode, p.stdout, p.stderr)
+        return p.stderr
+    err = shown({})
+    assert "OMP_WAIT_POLICY = 'PASSIVE'" in err and "GOMP_SPINCOUNT = '0'" in err, err
+    err = shown({"OMP_WAIT_POLICY": "active"})
+    assert "OMP_WAIT_POLICY = 'ACTIVE'" in err and "GOMP_SPINCOUNT = '0'" not in err, err
+
+
 def run(ulam, args):
     # 600 s: a guard against a hang, not a speed check (a quiet ASan run of check_auto_bidir's
     # solve takes tens of seconds, and more than 120 s with the machine loaded)
@@ -1879,7 +1895,7 @@ def main():
              (check_bidir, ulam), (check_queries, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
              (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
-             (check_systems_as_held, ulam),
+             (check_systems_as_held, ulam), (check_passive_threads, ulam),
              (check_disk_full, ulam), (check_signals, ulam)]
     if not radiosity:
         extra = [e for e in extra if "radiosity" not in e[0].__name__]

@@ -126,9 +126,10 @@ extern double cli_started;
  * runs when nothing is left (a tiny positive budget). */
 double cli_time_left(double budget);
 
-/* OpenMP threads wait passively (sleep, not spin) on a busy machine unless the user chose a policy
- * (OMP_WAIT_POLICY, GOMP_SPINCOUNT): libgomp reads it when it loads, before main, so common.c sets
- * it from the executable's .preinit_array (issue 29 point 5). */
+/* OpenMP's and OpenBLAS's threads wait passively (sleep, not spin) on a busy machine unless the user
+ * chose (OMP_WAIT_POLICY, GOMP_SPINCOUNT, OPENBLAS_THREAD_TIMEOUT): both read it when they load,
+ * before main, so common.c's .preinit_array function runs the process again once with it set
+ * (issue 29 point 5). */
 
 /* With -Dmpi=enabled: start MPI when launched by mpirun, and end it (src/cli/mpi.c). */
 void cli_mpi_init(int *argc, char ***argv);

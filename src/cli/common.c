@@ -28,13 +28,37 @@ double cli_time_left(double budget)
     return left > 1e-6 ? left : 1e-6;
 }
 
-/* Passive OpenMP waiting unless the user chose (see cli.h): set from the executable's
- * .preinit_array, which the dynamic loader runs before any shared library's initializer, so
- * libgomp reads it when it loads (a re-exec did this before and cost a second start, 26 ms). */
+/* Whether envp holds a variable called name. */
+static int env_has(char **envp, const char *name)
+{
+    size_t len = strlen(name);
+    for (char **e = envp; e && *e; e++)
+        if (!strncmp(*e, name, len) && (*e)[len] == '=') return 1;
+    return 0;
+}
+
+/* Passive waiting for OpenMP's and OpenBLAS's threads unless the user chose (see cli.h).  Both
+ * libraries read the environment in their initializers, before main, and a setenv here would be
+ * undone (libc's own initializer, which runs after .preinit_array, sets environ back to envp), so
+ * the process runs itself again once with the variables added.  From .preinit_array, before any
+ * shared library's initializer, that first image starts no thread and costs only its mapping: a
+ * re-exec from main cost a second full start (ulam --version 43.6 ms of CPU). */
 static void passive_threads(int argc, char **argv, char **envp)
 {
-    (void)argc, (void)argv, (void)envp;
-    if (!getenv("OMP_WAIT_POLICY") && !getenv("GOMP_SPINCOUNT")) setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+    (void)argc;
+    int omp = !env_has(envp, "OMP_WAIT_POLICY") && !env_has(envp, "GOMP_SPINCOUNT");
+    int blas = !env_has(envp, "OPENBLAS_THREAD_TIMEOUT") && !env_has(envp, "GOTO_THREAD_TIMEOUT");
+    if (!omp && !blas) return;
+    size_t n = 0;
+    while (envp && envp[n]) n++;
+    char *env[n + 3];
+    for (size_t k = 0; k < n; k++) env[k] = envp[k];
+    /* OpenBLAS's server threads spin 2^28 cycles (about 0.1 s) after they start and after each call
+     * before they sleep; 2^4 makes them sleep at once (a dense solve wakes them as before). */
+    if (omp) env[n++] = "OMP_WAIT_POLICY=PASSIVE";
+    if (blas) env[n++] = "OPENBLAS_THREAD_TIMEOUT=4";
+    env[n] = NULL;
+    execve("/proc/self/exe", argv, env); /* returns only on failure: run on as we are */
 }
 __attribute__((section(".preinit_array"), used)) static void (*const cli_preinit)(int, char **, char **) =
     passive_threads;
