@@ -205,21 +205,28 @@ static void block_sums(const double *r, int64_t n, double *bsum)
     bsum[b] = acc;
 }
 
-/* Row j of M' (column j of M) as a walk reads it: the sum and largest of its |entries| (known
- * 1), and when drawing an entry by rejection would take more than two tries on average, the
- * running sums of |entries| in cum (at the row's own offsets) for a binary search (known 2). */
-static void row_sums(const ulam_csr *Mt, int64_t j, double *cs, double *mx, unsigned char *known, double *cum)
+/* Row j of M' (column j of M) as a walk reads it: the sum and largest of its |entries| (read
+ * here unless pre: the sweep push left them), known 1, and when drawing an entry by rejection
+ * would take more than two tries on average, the running sums of |entries| for a binary search,
+ * appended to cum at *used (so cum's pages are touched only as far as rows need it; a first touch
+ * is dear), known 2, mx_j then holding their offset in cum instead of the largest entry. */
+static void row_sums(const ulam_csr *Mt, int64_t j, int pre, double *cs, double *mx, unsigned char *known, double *cum,
+                     int64_t *used)
 {
-    double s = 0.0, m = 0.0;
     int64_t a = Mt->rowptr[j], b = Mt->rowptr[j + 1];
-    for (int64_t e = a; e < b; e++) {
-        double v = fabs(Mt->val[e]);
-        s += v, m = v > m ? v : m;
+    if (!pre) {
+        double s = 0.0, m = 0.0;
+        for (int64_t e = a; e < b; e++) {
+            double v = fabs(Mt->val[e]);
+            s += v, m = v > m ? v : m;
+        }
+        cs[j] = s, mx[j] = m;
     }
-    cs[j] = s, mx[j] = m, known[j] = 1;
-    if (m * (double)(b - a) > 2.0 * s) {
-        double c = 0.0;
-        for (int64_t e = a; e < b; e++) c += fabs(Mt->val[e]), cum[e] = c;
+    known[j] = 1;
+    if (mx[j] * (double)(b - a) > 2.0 * cs[j]) {
+        double c = 0.0, *cu = cum + *used;
+        for (int64_t e = a; e < b; e++) c += fabs(Mt->val[e]), cu[e - a] = c;
+        mx[j] = (double)*used, *used += b - a;
         known[j] = 2;
     }
 }
@@ -233,7 +240,9 @@ typedef struct {
     int64_t k;
     double alpha;
     double *cs, *mx, *cum;
+    int64_t cum_used; /* entries of cum taken */
     unsigned char *known;
+    int pre; /* cs and mx filled by the sweep push */
     int32_t *hp, *hn; /* walks that ended at i with score +R0, -R0 */
     int64_t steps;
 } walker;
@@ -320,18 +329,19 @@ static void walk_one(walker *w, ulam_rng *rng)
             break;
         }
         double v = u - stop;
-        if (!w->known[j]) row_sums(Mt, j, w->cs, w->mx, w->known, w->cum); /* on the first visit */
+        if (!w->known[j]) row_sums(Mt, j, w->pre, w->cs, w->mx, w->known, w->cum, &w->cum_used); /* on the first visit */
         if (!(v < w->cs[j])) break; /* the walk dies */
         int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a;
         if (w->known[j] == 2) { /* the first entry whose running sum exceeds v */
-            int64_t l = a, h = a + d - 1;
+            const double *cu = w->cum + (int64_t)w->mx[j];
+            int64_t l = 0, h = d - 1;
             while (l < h) {
                 int64_t mid = l + (h - l) / 2;
-                if (w->cum[mid] > v) h = mid;
+                if (cu[mid] > v) h = mid;
                 else l = mid + 1;
             }
-            neg ^= Mt->val[l] < 0;
-            j = Mt->colidx[l];
+            neg ^= Mt->val[a + l] < 0;
+            j = Mt->colidx[a + l];
             steps++;
             continue;
         }
@@ -386,12 +396,18 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     info->mean_visits = D1;
     memset(x, 0, (size_t)n * sizeof *x);
     double *r = ulam__calloc((size_t)n, sizeof *r);
-    if (!r) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the residual");
+    walker w = {.Mt = Mt, .r = r, .alpha = alpha};
+    w.cs = ulam__malloc((size_t)n, sizeof *w.cs), w.mx = ulam__malloc((size_t)n, sizeof *w.mx);
+    if (!r || !w.cs || !w.mx) {
+        free(r), free(w.cs), free(w.mx);
+        return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the residual");
+    }
     int64_t cap = 100 * ulam_csr_nnz(M) + 1000000;
-    int status = ulam__sweep_push_pull(M, Mt, o->source, o->rmax, o->rmax > 0 ? NULL : walk_work, &pl, cap, x, r, swi);
+    int status = ulam__sweep_push_pull(M, Mt, o->source, o->rmax, o->rmax > 0 ? NULL : walk_work, &pl, cap, x, r, w.cs,
+                                       w.mx, swi);
     if (status == ULAM_ENOCONV) status = ULAM_OK; /* ||M||_1 < 1: the cap only ends the push; the walks take the rest */
     if (status) {
-        free(r);
+        free(r), free(w.cs), free(w.mx);
         return ulam__fail(err, status, 0, -1, "a push within %lld operations", (long long)cap);
     }
     info->push = (ulam_push_info){.target = o->source, .pushes = swi->pushes, .ops = swi->ops,
@@ -401,7 +417,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     info->push_seconds = info->push.seconds = ulam_now() - t0;
     double R0 = swi->r_sum / (1.0 - alpha), t1 = ulam_now();
     info->residual_bound = swi->r_sum * D1;
-    walker w = {.Mt = Mt, .r = r, .k = swi->support, .alpha = alpha};
+    w.k = swi->support, w.pre = swi->nonneg;
     double *bsum = NULL;
     int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 and r >= 0 */
     for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
@@ -414,11 +430,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     if (w.k > 0) {
         w.n = n, w.nb = (n + ULAM__FPUSH_BLOCK - 1) / ULAM__FPUSH_BLOCK;
         bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
-        w.cs = ulam__malloc((size_t)n, sizeof *w.cs), w.mx = ulam__malloc((size_t)n, sizeof *w.mx);
         w.cum = ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum);
         w.known = ulam__calloc((size_t)n, 1), w.hp = ulam__calloc((size_t)n, sizeof *w.hp);
         if (sgn) w.hn = ulam__calloc((size_t)n, sizeof *w.hn);
-        if (!bsum || !w.cs || !w.mx || !w.cum || !w.known || !w.hp || (sgn ? !w.hn : !kept))
+        if (!bsum || !w.cum || !w.known || !w.hp || (sgn ? !w.hn : !kept))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
     }
     if (!status && w.k > 0) {

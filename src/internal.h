@@ -410,9 +410,11 @@ int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cos
 
 /* ulam__sweep_push given M too (NULL: as ulam__sweep_push): when M >= 0 the whole sweeps pull
  * along M's rows (the same Gauss-Seidel sweeps, read like a matrix-vector product), r formed once
- * at the end. */
+ * at the end; then (info->nonneg) csum and cmax (n entries each, or NULL) hold the sum and the
+ * largest entry of each row of Mt. */
 int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost,
-                          void *ctx, int64_t max_ops, double *p, double *r, ulam__sweep_info *info);
+                          void *ctx, int64_t max_ops, double *p, double *r, double *csum, double *cmax,
+                          ulam__sweep_info *info);
 
 /* ulam_fpush_solve with the sweep push's counts in sw (may be NULL; zero when ||M||_1 >= 1 and
  * the queue push ran) (src/fpush.c). */

@@ -14,7 +14,7 @@
  * pushing: p_i <- e_s,i + sum_j M_ij p_j for i in order, the same Gauss-Seidel sweep (p_i + r_i,
  * r_i = e_s,i + (M p)_i - p_i being the residual the push would move) read like a sparse
  * matrix-vector product, with no scattered writes.  r is not kept during pull sweeps (its storage
- * holds c_i = sum_k M_ki): its sum is, as 1 - sum_i p_i (1 - c_i) (r >= 0 when M >= 0), and r
+ * holds c_i = sum_k M_ki unless the caller gives room for them, to keep for its walks): its sum is, as 1 - sum_i p_i (1 - c_i) (r >= 0 when M >= 0), and r
  * itself is formed once at the end (one more product), negative roundings of a zero residual cut
  * to 0 (at most 1e-16 of (M p)_i). */
 #include "internal.h"
@@ -53,23 +53,28 @@ static inline double pull_row(const ulam_csr *M, const double *p, int64_t i)
     return s;
 }
 
-/* Read Mt once for the pull sweeps, c_j into r_j: 1; 0 when M has a negative entry (no pull: r
- * made again as e_s + M p - p). */
-static int pull_setup(const ulam_csr *M, const ulam_csr *Mt, int64_t s, const double *p, double *r, pull *pl)
+/* Read Mt once for the pull sweeps, c_j (into csum, or r when NULL) and the largest entry of row
+ * j of Mt (into cmax when not NULL): 1; 0 when M has a negative entry (no pull: r made again as
+ * e_s + M p - p). */
+static int pull_setup(const ulam_csr *M, const ulam_csr *Mt, int64_t s, const double *p, double *r, double *csum,
+                      double *cmax, pull *pl)
 {
     int64_t n = Mt->nrows;
+    double *c = csum ? csum : r;
     for (int64_t j = 0; j < n; j++) {
-        double sum = 0.0;
+        double sum = 0.0, mx = 0.0;
         for (int64_t k = Mt->rowptr[j]; k < Mt->rowptr[j + 1]; k++) {
-            if (Mt->val[k] < 0) {
+            double v = Mt->val[k];
+            if (v < 0) {
                 for (int64_t i = 0; i < n; i++) r[i] = pull_row(M, p, i) + (i == s ? 1.0 : 0.0) - p[i];
                 return 0;
             }
-            sum += Mt->val[k];
+            sum += v, mx = v > mx ? v : mx;
         }
-        r[j] = sum;
+        c[j] = sum;
+        if (cmax) cmax[j] = mx;
     }
-    pl->M = M, pl->c = r;
+    pl->M = M, pl->c = c;
     return 1;
 }
 
@@ -103,7 +108,8 @@ static double pull_residual(const pull *pl, int64_t s, const double *p, double *
 
 /* Forward push from s on M (given as its transpose Mt, and as itself or NULL) into p and r. */
 int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost,
-                          void *ctx, int64_t max_ops, double *p, double *r, ulam__sweep_info *info)
+                          void *ctx, int64_t max_ops, double *p, double *r, double *csum, double *cmax,
+                          ulam__sweep_info *info)
 {
     int64_t n = Mt->nrows, nnz = ulam_csr_nnz(Mt);
     *info = (ulam__sweep_info){0};
@@ -166,7 +172,7 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
             for (int64_t q = 0; q < nlist; q++) rsum += fabs(r[list[q]]);
             if (nlist >= n / 16) {
                 sweeping = 1;
-                if (M && pull_setup(M, Mt, s, p, r, &pl)) { /* from here on r is implicit: rsum as 1 - sum_i p_i (1 - c_i) */
+                if (M && pull_setup(M, Mt, s, p, r, csum, cmax, &pl)) { /* from here on r is implicit: rsum as 1 - sum_i p_i (1 - c_i) */
                     pulling = 1, ops += nnz;
                     rsum = 1.0;
                     for (int64_t i = 0; i < n; i++) rsum -= p[i] * (1.0 - pl.c[i]);
@@ -196,5 +202,5 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
 int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost, void *ctx, int64_t max_ops,
                      double *p, double *r, ulam__sweep_info *info)
 {
-    return ulam__sweep_push_pull(NULL, Mt, s, rmax, cost, ctx, max_ops, p, r, info);
+    return ulam__sweep_push_pull(NULL, Mt, s, rmax, cost, ctx, max_ops, p, r, NULL, NULL, info);
 }

@@ -78,17 +78,37 @@ void ulam__clear(ulam_error *err)
 }
 
 /* malloc of n items of size sz, NULL on overflow. */
+#define ULAM__HUGE_BYTES ((size_t)4 << 20) /* blocks from this size on are asked for 2 MiB pages */
+#define ULAM__HUGE_PAGE ((uintptr_t)2 << 20)
+
+/* Ask the kernel for transparent huge pages on the whole 2 MiB pages inside a large block (fewer
+ * page faults on first touch, fewer TLB misses when a walk or a sweep reads it at random; NumPy
+ * does the same for its arrays).  A request the kernel refuses changes nothing. */
+static void *huge(void *p, size_t bytes)
+{
+#ifdef MADV_HUGEPAGE
+    if (p && bytes >= ULAM__HUGE_BYTES) {
+        uintptr_t a = ((uintptr_t)p + ULAM__HUGE_PAGE - 1) & ~(ULAM__HUGE_PAGE - 1);
+        uintptr_t b = ((uintptr_t)p + bytes) & ~(ULAM__HUGE_PAGE - 1);
+        if (b > a) (void)madvise((void *)a, b - a, MADV_HUGEPAGE);
+    }
+#endif
+    return p;
+}
+
+/* malloc of n items of size sz (2 MiB pages asked for a large block). */
 void *ulam__malloc(size_t n, size_t sz)
 {
     if (sz && n > SIZE_MAX / sz) return NULL;
     size_t bytes = n * sz;
-    return malloc(bytes ? bytes : 1);
+    return huge(malloc(bytes ? bytes : 1), bytes);
 }
 
-/* calloc of n items of size sz. */
+/* calloc of n items of size sz (2 MiB pages asked for a large block). */
 void *ulam__calloc(size_t n, size_t sz)
 {
-    return calloc(n ? n : 1, sz ? sz : 1);
+    if (sz && n > SIZE_MAX / sz) return NULL;
+    return huge(calloc(n ? n : 1, sz ? sz : 1), n * sz);
 }
 
 /* Make room for need items in the growable array at *pp of capacity *cap (doubling from 16). */

@@ -276,9 +276,9 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     rp->check = 0; /* prepare's direct value is for one index */
     int rc = prepare(s, source, force, (ulam_bidir_opts *)bo, NULL, NULL, rp);
     if (rc) return rc;
-    int64_t n = s->M->nrows, *order = malloc((size_t)n * sizeof *order);
-    double *x = malloc((size_t)n * sizeof *x), *se = malloc((size_t)n * sizeof *se);
-    double *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi), *xd = NULL;
+    int64_t n = s->M->nrows, *order = cli_alloc_vector((size_t)n, sizeof *order);
+    double *x = cli_alloc_vector((size_t)n, sizeof *x), *se = cli_alloc_vector((size_t)n, sizeof *se);
+    double *lo = cli_alloc_vector((size_t)n, sizeof *lo), *hi = cli_alloc_vector((size_t)n, sizeof *hi), *xd = NULL;
     ulam_csr *Mt = NULL;
     ulam_fpush_info info;
     ulam_error err;

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 
 const char *const cli_mode_names[2] = {"adjoint", "forward"};
@@ -19,6 +20,20 @@ volatile int cli_interrupted;
 const ulam_share *cli_share;
 int cli_rank;
 double cli_started;
+
+/* malloc of n items of size sz for a vector the library fills, 2 MiB pages asked for its whole
+ * 2 MiB pages from 4 MiB on (libulam's own blocks get them in src/util.c): a 4 KiB page's first
+ * touch costs ~15 us on a virtual machine, 250 ms for 64 MiB against 14 ms in 2 MiB pages. */
+void *cli_alloc_vector(size_t n, size_t sz)
+{
+    size_t bytes = sz && n > SIZE_MAX / sz ? 0 : n * sz;
+    void *p = bytes ? malloc(bytes) : NULL;
+#ifdef MADV_HUGEPAGE
+    uintptr_t page = (uintptr_t)2 << 20, a = ((uintptr_t)p + page - 1) & ~(page - 1), b = ((uintptr_t)p + bytes) & ~(page - 1);
+    if (p && bytes >= 2 * page && b > a) (void)madvise((void *)a, b - a, MADV_HUGEPAGE);
+#endif
+    return p;
+}
 
 /* The walks' share of a --time budget. */
 double cli_time_left(double budget)
