@@ -395,9 +395,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
                .visits = D1, .step_cost = o->step_cost > 0 ? o->step_cost : ULAM__FPUSH_STEP_COST, .fixed = o->walks};
     info->mean_visits = D1;
     memset(x, 0, (size_t)n * sizeof *x);
-    double *r = ulam__calloc((size_t)n, sizeof *r);
+    size_t bytes = (size_t)n * sizeof(double); /* r, and cs and mx (filled whole by the pull sweeps' set-up) */
+    double *r = ulam__huge(ulam__calloc((size_t)n, sizeof *r), bytes);
     walker w = {.Mt = Mt, .r = r, .alpha = alpha};
-    w.cs = ulam__malloc((size_t)n, sizeof *w.cs), w.mx = ulam__malloc((size_t)n, sizeof *w.mx);
+    w.cs = ulam__huge(ulam__malloc((size_t)n, sizeof *w.cs), bytes), w.mx = ulam__huge(ulam__malloc((size_t)n, sizeof *w.mx), bytes);
     if (!r || !w.cs || !w.mx) {
         free(r), free(w.cs), free(w.mx);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the residual");
@@ -430,9 +431,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     if (w.k > 0) {
         w.n = n, w.nb = (n + ULAM__FPUSH_BLOCK - 1) / ULAM__FPUSH_BLOCK;
         bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
-        w.cum = ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum);
-        w.known = ulam__calloc((size_t)n, 1), w.hp = ulam__calloc((size_t)n, sizeof *w.hp);
-        if (sgn) w.hn = ulam__calloc((size_t)n, sizeof *w.hn);
+        size_t cb = ((size_t)ulam_csr_nnz(Mt) + 1) * sizeof *w.cum, hb = (size_t)n * sizeof *w.hp;
+        w.cum = ulam__huge(ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum), cb); /* filled from its start */
+        w.known = ulam__calloc((size_t)n, 1), w.hp = ulam__huge(ulam__calloc((size_t)n, sizeof *w.hp), hb);
+        if (sgn) w.hn = ulam__huge(ulam__calloc((size_t)n, sizeof *w.hn), hb);
         if (!bsum || !w.cum || !w.known || !w.hp || (sgn ? !w.hn : !kept))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
     }

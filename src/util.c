@@ -78,13 +78,26 @@ void ulam__clear(ulam_error *err)
 }
 
 /* malloc of n items of size sz, NULL on overflow. */
-#define ULAM__HUGE_BYTES ((size_t)4 << 20) /* blocks from this size on are asked for 2 MiB pages */
+#define ULAM__HUGE_BYTES ((size_t)4 << 20) /* blocks from this size on may be given 2 MiB pages */
 #define ULAM__HUGE_PAGE ((uintptr_t)2 << 20)
 
-/* Ask the kernel for transparent huge pages on the whole 2 MiB pages inside a large block (fewer
- * page faults on first touch, fewer TLB misses when a walk or a sweep reads it at random; NumPy
- * does the same for its arrays).  A request the kernel refuses changes nothing. */
-static void *huge(void *p, size_t bytes)
+/* malloc of n items of size sz. */
+void *ulam__malloc(size_t n, size_t sz)
+{
+    if (sz && n > SIZE_MAX / sz) return NULL;
+    size_t bytes = n * sz;
+    return malloc(bytes ? bytes : 1);
+}
+
+/* calloc of n items of size sz. */
+void *ulam__calloc(size_t n, size_t sz)
+{
+    return calloc(n ? n : 1, sz ? sz : 1);
+}
+
+/* Ask the kernel for transparent huge pages on the whole 2 MiB pages inside a block of the given
+ * size (not yet touched) from 4 MiB on; p. */
+void *ulam__huge(void *p, size_t bytes)
 {
 #ifdef MADV_HUGEPAGE
     if (p && bytes >= ULAM__HUGE_BYTES) {
@@ -94,21 +107,6 @@ static void *huge(void *p, size_t bytes)
     }
 #endif
     return p;
-}
-
-/* malloc of n items of size sz (2 MiB pages asked for a large block). */
-void *ulam__malloc(size_t n, size_t sz)
-{
-    if (sz && n > SIZE_MAX / sz) return NULL;
-    size_t bytes = n * sz;
-    return huge(malloc(bytes ? bytes : 1), bytes);
-}
-
-/* calloc of n items of size sz (2 MiB pages asked for a large block). */
-void *ulam__calloc(size_t n, size_t sz)
-{
-    if (sz && n > SIZE_MAX / sz) return NULL;
-    return huge(calloc(n ? n : 1, sz ? sz : 1), n * sz);
 }
 
 /* Make room for need items in the growable array at *pp of capacity *cap (doubling from 16). */
