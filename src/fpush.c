@@ -28,13 +28,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define ULAM__FPUSH_STEP_COST 300.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM at load ~9,
-                                      2026-12-02: ~1.8 us of CPU a step with its share of the walk phase's passes, ~4.5 ns
-                                      a pull-sweep operation; a step misses the cache, a sweep streams; 100 and 300
-                                      side by side: 300 took 0.8-0.95x the CPU over 3 sources) */
+#define ULAM__FPUSH_STEP_COST 150.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM at load ~7,
+                                      2026-12-02, thread CPU: 0.4-0.65 us a step with ULAM__FPUSH_LANES walks in flight,
+                                      ~4 ns a pull-sweep operation; 300 before the lanes (1.8 us a step); 100, 150 and 300
+                                      side by side over 3 sources gave 0.92-1.34, 0.97-1.22, 1.04-1.12 s: within noise) */
 #define ULAM__FPUSH_RANGE_SHARE 0.8 /* the share of E delta the first checkpoint leaves the interval's range term */
 #define ULAM__FPUSH_BLOCK 64        /* states per block of the start's running sums */
 #define ULAM__FPUSH_KL_KEPT 1024    /* hit counts whose interval a checkpoint keeps (the rest computed each time) */
+#define ULAM__FPUSH_LANES 8         /* walks in flight at once (walk_many) */
 
 /* The defaults. */
 ulam_fpush_opts ulam_fpush_defaults(void)
@@ -293,16 +294,16 @@ static int rule_met_kl(const walker *w, kl_kept *c, const double *p, int64_t n, 
     return 1;
 }
 
-/* One terminal walk: from j drawn with probability |r_j| / ||r||_1, stop and score at the state
- * it is at with probability 1 - alpha, else move along column j of M with probability |M_kj|
- * (die, scoring 0, with the rest, alpha - sum_k |M_kj|); the score's sign is r_j's times the
- * signs of the entries it crossed.  The chance to end at i is (1 - alpha) ((I - M)^-1 |r|)_i /
- * ||r||_1 (for M, r >= 0; signed: the expectation), so score R0 = ||r||_1 / (1 - alpha) at the
- * end estimates ((I - M)^-1 r)_i for every i at once, every score within [-R0, R0]. */
-static void walk_one(walker *w, ulam_rng *rng)
+/* Terminal walks: from j drawn with probability |r_j| / ||r||_1, stop and score at the state it
+ * is at with probability 1 - alpha, else move along column j of M with probability |M_kj| (die,
+ * scoring 0, with the rest, alpha - sum_k |M_kj|); the score's sign is r_j's times the signs of
+ * the entries it crossed.  The chance to end at i is (1 - alpha) ((I - M)^-1 |r|)_i / ||r||_1
+ * (for M, r >= 0; signed: the expectation), so score R0 = ||r||_1 / (1 - alpha) at the end
+ * estimates ((I - M)^-1 r)_i for every i at once, every score within [-R0, R0]. */
+
+/* A walk's first state. */
+static int64_t walk_start(const walker *w, ulam_rng *rng)
 {
-    const ulam_csr *Mt = w->Mt;
-    uint64_t frac;
     int64_t j = -1;
     while (j < 0) { /* the block by bisection of the running sums, the state by a scan of the block */
         double u = ulam__rng_uniform(rng) * w->bsum[w->nb], acc;
@@ -319,45 +320,75 @@ static void walk_one(walker *w, ulam_rng *rng)
                 break;
             }
     } /* none: u rounded onto ||r||_1, drawn again */
-    int neg = w->r[j] < 0, steps = 0;
-    double stop = 1.0 - w->alpha;
-    for (;;) {
-        double u = ulam__rng_uniform(rng);
-        if (u < stop) {
-            if (neg) w->hn[j]++;
-            else w->hp[j]++;
-            break;
+    return j;
+}
+
+/* One step of a walk at *jp (*negp: its score's sign is negative): 1 and the next state in *jp, or
+ * 0 when the walk ended (its hit counted) or died. */
+static int walk_step(walker *w, ulam_rng *rng, int64_t *jp, int *negp)
+{
+    const ulam_csr *Mt = w->Mt;
+    int64_t j = *jp;
+    double u = ulam__rng_uniform(rng), stop = 1.0 - w->alpha;
+    if (u < stop) {
+        if (*negp) w->hn[j]++;
+        else w->hp[j]++;
+        return 0;
+    }
+    double v = u - stop;
+    if (!w->known[j]) row_sums(Mt, j, w->pre, w->cs, w->mx, w->known, w->cum, &w->cum_used); /* on the first visit */
+    if (!(v < w->cs[j])) return 0; /* the walk dies */
+    int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a, e;
+    if (w->known[j] == 2) { /* the first entry whose running sum exceeds v */
+        const double *cu = w->cum + (int64_t)w->mx[j];
+        int64_t l = 0, h = d - 1;
+        while (l < h) {
+            int64_t mid = l + (h - l) / 2;
+            if (cu[mid] > v) h = mid;
+            else l = mid + 1;
         }
-        double v = u - stop;
-        if (!w->known[j]) row_sums(Mt, j, w->pre, w->cs, w->mx, w->known, w->cum, &w->cum_used); /* on the first visit */
-        if (!(v < w->cs[j])) break; /* the walk dies */
-        int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a;
-        if (w->known[j] == 2) { /* the first entry whose running sum exceeds v */
-            const double *cu = w->cum + (int64_t)w->mx[j];
-            int64_t l = 0, h = d - 1;
-            while (l < h) {
-                int64_t mid = l + (h - l) / 2;
-                if (cu[mid] > v) h = mid;
-                else l = mid + 1;
-            }
-            neg ^= Mt->val[a + l] < 0;
-            j = Mt->colidx[a + l];
-            steps++;
-            continue;
-        }
-        double t = v / w->cs[j] * (double)d;
-        int64_t e = (int64_t)t;
+        e = l;
+    } else {
+        double t = v / w->cs[j] * (double)d, f;
+        uint64_t frac;
+        e = (int64_t)t;
         if (e >= d) e = d - 1;
-        double f = t - (double)e;
+        f = t - (double)e;
         while (f * w->mx[j] > fabs(Mt->val[a + e])) { /* rejection: entry e with probability |M_ej| / sum */
             e = (int64_t)ulam__rng_index(rng, (uint64_t)d, &frac);
             f = (double)frac * 0x1.0p-64;
         }
-        neg ^= Mt->val[a + e] < 0;
-        j = Mt->colidx[a + e];
-        steps++;
     }
-    w->steps += steps;
+    *negp ^= Mt->val[a + e] < 0;
+    *jp = Mt->colidx[a + e];
+    w->steps++;
+    return 1;
+}
+
+/* count walks, ULAM__FPUSH_LANES of them in flight (round robin, one step each, the row a lane
+ * moves to prefetched while the others step: their memory reads overlap, where one walk's are a
+ * chain).  Every walk launched is walked to its end, and walks launch in order, so the first
+ * count walks are taken whatever their lengths.  The walks made: count, or fewer when *interrupt
+ * is set (checked every 1024 launches). */
+static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile int *interrupt)
+{
+    int64_t j[ULAM__FPUSH_LANES], launched = 0;
+    int neg[ULAM__FPUSH_LANES], on[ULAM__FPUSH_LANES] = {0}, more = count > 0;
+    for (;;) {
+        int busy = 0;
+        for (int l = 0; l < ULAM__FPUSH_LANES; l++) {
+            if (on[l]) on[l] = walk_step(w, rng, &j[l], &neg[l]);
+            if (!on[l] && more) {
+                j[l] = walk_start(w, rng), neg[l] = w->r[j[l]] < 0, on[l] = 1, launched++;
+                more = launched < count && !((launched & 1023) == 0 && interrupt && *interrupt);
+            }
+            if (!on[l]) continue;
+            busy = 1;
+            __builtin_prefetch(&w->Mt->rowptr[j[l]]), __builtin_prefetch(&w->known[j[l]]);
+            __builtin_prefetch(&w->cs[j[l]]), __builtin_prefetch(&w->mx[j[l]]);
+        }
+        if (!busy) return launched;
+    }
 }
 
 /* Whether N walks at epoch k meet relative error E at every component whose interval reaches
@@ -449,14 +480,9 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         for (;;) { /* checkpoint k (stitching index) at the end of epoch k0 + k - 1 */
             int64_t target = o->walks > 0 ? o->walks : epoch_end(k0 + k - 1);
             if (target > cap_w) target = cap_w, planned = o->walks > 0 && o->walks == cap_w;
-            while (N < target) {
-                walk_one(&w, &rng);
-                N++;
-                if ((N & 1023) == 0 && o->walk.stop.interrupt && *o->walk.stop.interrupt) {
-                    info->interrupted = 1, planned = 0;
-                    break;
-                }
-            }
+            int64_t made = N < target ? walk_many(&w, &rng, target - N, o->walk.stop.interrupt) : 0;
+            if (made < target - N) info->interrupted = 1, planned = 0;
+            N += made;
             if (!planned || o->walks > 0 || N >= cap_w) break;
             if (sgn ? rule_met(&w, x, n, N, k, R, R0, pl.E, pl.delta) : rule_met_kl(&w, kept, x, n, N, k, R0, pl.E, pl.delta))
                 break;
