@@ -28,14 +28,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define ULAM__FPUSH_STEP_COST 150.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM at load ~7,
-                                      2026-12-02, thread CPU: 0.4-0.65 us a step with ULAM__FPUSH_LANES walks in flight,
-                                      ~4 ns a pull-sweep operation; 300 before the lanes (1.8 us a step); 100, 150 and 300
-                                      side by side over 3 sources gave 0.92-1.34, 0.97-1.22, 1.04-1.12 s: within noise) */
+#define ULAM__FPUSH_STEP_COST 150.0 /* push operations one terminal-walk step costs (R-MAT 2^20, a 2-core VM at load 5-7,
+                                      2026-12-02, thread CPU: 0.4-0.6 us a step with ULAM__FPUSH_LANES walks in flight,
+                                      ~4 ns a pull-sweep operation; 300 before the lanes, 1.8 us a step; side by side over
+                                      3 sources, solve CPU 1.03-1.05 s at 150 (one 1.47 outlier), 1.18-1.19 s at 50, 100
+                                      and 300 within noise of 150) */
 #define ULAM__FPUSH_RANGE_SHARE 0.8 /* the share of E delta the first checkpoint leaves the interval's range term */
 #define ULAM__FPUSH_BLOCK 64        /* states per block of the start's running sums */
 #define ULAM__FPUSH_KL_KEPT 1024    /* hit counts whose interval a checkpoint keeps (the rest computed each time) */
-#define ULAM__FPUSH_LANES 8         /* walks in flight at once (walk_many) */
+#define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
 
 /* The defaults. */
 ulam_fpush_opts ulam_fpush_defaults(void)
@@ -323,19 +324,36 @@ static int64_t walk_start(const walker *w, ulam_rng *rng)
     return j;
 }
 
-/* One step of a walk at *jp (*negp: its score's sign is negative): 1 and the next state in *jp, or
- * 0 when the walk ended (its hit counted) or died. */
-static int walk_step(walker *w, ulam_rng *rng, int64_t *jp, int *negp)
+/* A walk in flight: at state j (neg: its score's sign is negative), the uniform u that decides
+ * its next move drawn on arrival; phase 0: j's row sums prefetched; 1: the entry e of row j
+ * (at a) it moves along prefetched. */
+typedef struct {
+    int64_t j, a, e;
+    double u;
+    int neg, phase, on;
+} lane;
+
+/* Arrive at state j: draw the move's uniform, prefetch what the next phase reads. */
+static void lane_arrive(const walker *w, ulam_rng *rng, lane *L, int64_t j)
+{
+    L->j = j, L->u = ulam__rng_uniform(rng), L->phase = 0;
+    __builtin_prefetch(&w->Mt->rowptr[j]), __builtin_prefetch(&w->known[j]), __builtin_prefetch(&w->cs[j]);
+    __builtin_prefetch(&w->mx[j]), __builtin_prefetch(&w->hp[j], 1);
+}
+
+/* Phase 0: stop and score (the walk ends), die, or choose the entry of row j to move along
+ * (binary search of the running sums, or the first candidate of the rejection draw) and
+ * prefetch it; 0 when the walk ended. */
+static int lane_choose(walker *w, lane *L)
 {
     const ulam_csr *Mt = w->Mt;
-    int64_t j = *jp;
-    double u = ulam__rng_uniform(rng), stop = 1.0 - w->alpha;
-    if (u < stop) {
-        if (*negp) w->hn[j]++;
+    int64_t j = L->j;
+    double stop = 1.0 - w->alpha, v = L->u - stop;
+    if (L->u < stop) {
+        if (L->neg) w->hn[j]++;
         else w->hp[j]++;
         return 0;
     }
-    double v = u - stop;
     if (!w->known[j]) row_sums(Mt, j, w->pre, w->cs, w->mx, w->known, w->cum, &w->cum_used); /* on the first visit */
     if (!(v < w->cs[j])) return 0; /* the walk dies */
     int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a, e;
@@ -349,43 +367,57 @@ static int walk_step(walker *w, ulam_rng *rng, int64_t *jp, int *negp)
         }
         e = l;
     } else {
-        double t = v / w->cs[j] * (double)d, f;
-        uint64_t frac;
-        e = (int64_t)t;
+        e = (int64_t)(v / w->cs[j] * (double)d);
         if (e >= d) e = d - 1;
-        f = t - (double)e;
-        while (f * w->mx[j] > fabs(Mt->val[a + e])) { /* rejection: entry e with probability |M_ej| / sum */
+    }
+    L->a = a, L->e = e, L->phase = 1;
+    __builtin_prefetch(&Mt->val[a + e]), __builtin_prefetch(&Mt->colidx[a + e]);
+    return 1;
+}
+
+/* Phase 1: accept the entry (or draw again, rejection: entry e with probability |M_ej| / sum,
+ * the fraction of the first draw reused) and move along it. */
+static void lane_move(walker *w, ulam_rng *rng, lane *L)
+{
+    const ulam_csr *Mt = w->Mt;
+    int64_t j = L->j, a = L->a, e = L->e, d = Mt->rowptr[j + 1] - a;
+    if (w->known[j] != 2) {
+        double t = (L->u - (1.0 - w->alpha)) / w->cs[j] * (double)d, f = t - (double)e;
+        uint64_t frac;
+        while (f * w->mx[j] > fabs(Mt->val[a + e])) {
             e = (int64_t)ulam__rng_index(rng, (uint64_t)d, &frac);
             f = (double)frac * 0x1.0p-64;
         }
     }
-    *negp ^= Mt->val[a + e] < 0;
-    *jp = Mt->colidx[a + e];
+    L->neg ^= Mt->val[a + e] < 0;
     w->steps++;
-    return 1;
+    lane_arrive(w, rng, L, Mt->colidx[a + e]);
 }
 
-/* count walks, ULAM__FPUSH_LANES of them in flight (round robin, one step each, the row a lane
- * moves to prefetched while the others step: their memory reads overlap, where one walk's are a
- * chain).  Every walk launched is walked to its end, and walks launch in order, so the first
- * count walks are taken whatever their lengths.  The walks made: count, or fewer when *interrupt
- * is set (checked every 1024 launches). */
+/* count walks, ULAM__FPUSH_LANES of them in flight (round robin, one phase each, what a lane
+ * reads next prefetched while the others go on: their memory reads overlap, where one walk's
+ * are a chain).  Every walk launched is walked to its end, and walks launch in order, so the
+ * first count walks are taken whatever their lengths.  The walks made: count, or fewer when
+ * *interrupt is set (checked every 1024 launches). */
 static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile int *interrupt)
 {
-    int64_t j[ULAM__FPUSH_LANES], launched = 0;
-    int neg[ULAM__FPUSH_LANES], on[ULAM__FPUSH_LANES] = {0}, more = count > 0;
+    lane L[ULAM__FPUSH_LANES] = {{0}};
+    int64_t launched = 0;
+    int more = count > 0;
     for (;;) {
         int busy = 0;
         for (int l = 0; l < ULAM__FPUSH_LANES; l++) {
-            if (on[l]) on[l] = walk_step(w, rng, &j[l], &neg[l]);
-            if (!on[l] && more) {
-                j[l] = walk_start(w, rng), neg[l] = w->r[j[l]] < 0, on[l] = 1, launched++;
+            if (L[l].on) {
+                if (L[l].phase == 0) L[l].on = lane_choose(w, &L[l]);
+                else lane_move(w, rng, &L[l]);
+            }
+            if (!L[l].on && more) {
+                int64_t j = walk_start(w, rng);
+                L[l].on = 1, L[l].neg = w->r[j] < 0, launched++;
+                lane_arrive(w, rng, &L[l], j);
                 more = launched < count && !((launched & 1023) == 0 && interrupt && *interrupt);
             }
-            if (!on[l]) continue;
-            busy = 1;
-            __builtin_prefetch(&w->Mt->rowptr[j[l]]), __builtin_prefetch(&w->known[j[l]]);
-            __builtin_prefetch(&w->cs[j[l]]), __builtin_prefetch(&w->mx[j[l]]);
+            busy |= L[l].on;
         }
         if (!busy) return launched;
     }
