@@ -36,6 +36,7 @@
 #define ULAM__FPUSH_RANGE_SHARE 0.8 /* the share of E delta the first checkpoint leaves the interval's range term */
 #define ULAM__FPUSH_BLOCK 64        /* states per block of the start's running sums */
 #define ULAM__FPUSH_KL_KEPT 1024    /* hit counts whose interval a checkpoint keeps (the rest computed each time) */
+#define ULAM__FPUSH_CUT_SHARE 0.01  /* the largest negative residual cut from r, times 1 / (1 - alpha), as a share of E delta */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
 
 /* The defaults. */
@@ -280,17 +281,18 @@ static int interval_met(double a, double b, double est, double E, double delta)
     return b < delta || fmax(est - a, b - est) <= E * fmax(a, delta);
 }
 
-/* rule_met for scores 0 or R0 (M, r >= 0): the KL intervals. */
+/* rule_met for scores 0 or R0 (M, r >= 0): the KL intervals, every lower end lowered by cut
+ * (the bound on the part of x_i the negative residual cut from r takes away). */
 static int rule_met_kl(const walker *w, kl_kept *c, const double *p, int64_t n, int64_t N, int k, double R0, double E,
-                       double delta)
+                       double delta, double cut)
 {
     double lo, hi;
     hits_interval(c, N, k, 0, R0, &lo, &hi);
-    if (!(hi <= E * delta)) return 0; /* a component no walk ended at, p_i just under delta */
+    if (!(hi <= E * delta && cut <= E * delta)) return 0; /* a component no walk ended at, p_i just under delta */
     for (int64_t i = 0; i < n; i++) {
         if (!w->hp[i]) continue;
         hits_interval(c, N, k, w->hp[i], R0, &lo, &hi);
-        if (!interval_met(p[i] + lo, p[i] + hi, p[i] + R0 * (double)w->hp[i] / (double)N, E, delta)) return 0;
+        if (!interval_met(p[i] + lo - cut, p[i] + hi, p[i] + R0 * (double)w->hp[i] / (double)N, E, delta)) return 0;
     }
     return 1;
 }
@@ -474,18 +476,27 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         free(r), free(w.cs), free(w.mx);
         return ulam__fail(err, status, 0, -1, "a push within %lld operations", (long long)cap);
     }
+    /* a negative residual small beside the target (roundings; what over-relaxed sweeps left, R-MAT) is
+     * cut from r: x_i = p_i + ((I - M)^-1 r+)_i - [0, cut], lower ends lowered by cut; a larger one is
+     * walked with its signs */
+    double cut = 0.0;
+    if (swi->r_neg > 0 && swi->r_neg * D1 <= ULAM__FPUSH_CUT_SHARE * pl.E * pl.delta) {
+        swi->support = 0;
+        for (int64_t j = 0; j < n; j++) r[j] = r[j] < 0 ? 0.0 : r[j], swi->support += r[j] != 0.0;
+        cut = swi->r_neg * D1, swi->r_sum -= swi->r_neg;
+    }
     info->push = (ulam_push_info){.target = o->source, .pushes = swi->pushes, .ops = swi->ops,
                                   .touched = n, .r_sum = swi->r_sum, .support = swi->support};
     for (int64_t j = 0; j < n; j++) info->push.r_max = fmax(info->push.r_max, fabs(r[j]));
     info->push.rmax = info->rmax = o->rmax > 0 ? o->rmax : info->push.r_max;
     info->push_seconds = info->push.seconds = ulam_now() - t0;
     double R0 = swi->r_sum / (1.0 - alpha), t1 = ulam_now();
-    info->residual_bound = swi->r_sum * D1;
+    info->residual_bound = swi->r_sum * D1 + cut;
     w.k = swi->support, w.pre = swi->nonneg;
     double *bsum = NULL;
-    int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 and r >= 0 */
+    int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 */
     for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
-    for (int64_t j = 0; j < n && !sgn && !swi->nonneg; j++) sgn = r[j] < 0;
+    for (int64_t j = 0; j < n && !sgn; j++) sgn = r[j] < 0;
     double R = sgn ? 2.0 * R0 : R0; /* the scores' range */
     int64_t N = 0;
     int k = 1, kk = -1; /* kk: the KL interval's index when not k */
@@ -516,7 +527,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
             if (made < target - N) info->interrupted = 1, planned = 0;
             N += made;
             if (!planned || o->walks > 0 || N >= cap_w) break;
-            if (sgn ? rule_met(&w, x, n, N, k, R, R0, pl.E, pl.delta) : rule_met_kl(&w, kept, x, n, N, k, R0, pl.E, pl.delta))
+            if (sgn ? rule_met(&w, x, n, N, k, R, R0, pl.E, pl.delta) : rule_met_kl(&w, kept, x, n, N, k, R0, pl.E, pl.delta, cut))
                 break;
             k++;
         }
@@ -544,7 +555,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
                 var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
                 ulam__stop_interval(N, mean, var, R, 0.0, R0, R0, k, &ci);
             }
-            double p = x[i], a = p + ci.lo, b = p + ci.hi;
+            double p = x[i], a = p + ci.lo - cut, b = p + ci.hi;
             x[i] = p + mean;
             if (std_error) std_error[i] = N > 1 ? sqrt(var / Nd) : (w.k > 0 ? NAN : 0.0);
             if (isnan(a) && isfinite(D)) a = p - D, b = p + D; /* no interval from the walks */

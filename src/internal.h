@@ -401,6 +401,7 @@ typedef struct {
     double r_sum;
     int64_t pulls; /* sweeps made by pulling (ulam__sweep_push_pull) */
     int nonneg;    /* 1: M was read whole and has no negative entry (r >= 0 then); 0: not known */
+    double r_neg;  /* the mass of r's negative entries after pull sweeps (over-relaxed ones overshoot; roundings) */
 } ulam__sweep_info;
 
 /* The walks' work (push operations) a residual of mass r_sum would leave. */
