@@ -331,6 +331,12 @@ void ulam__analysis_keep(ulam_analysis *a, void *m, void (*drop)(void *))
     a->kept = m, a->drop = drop;
 }
 
+/* a's bounds over every state with the shared b's scores (see internal.h). */
+const ulam__reach *ulam__analysis_bounds(ulam_analysis *a)
+{
+    return take_bounds(a);
+}
+
 /* a's bounds over every state (see internal.h). */
 int ulam__analysis_bounds_all(ulam_analysis *a, ulam_error *err)
 {

@@ -81,8 +81,7 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *o, ulam_error *err)
  * (ulam__solver_alloc_reached, ulam__solver_keep_kernel, _keep_kernel_fixed, ulam__solver_reached,
  * ulam__reach_all below) are called from the analysis (src/analysis.c, the one home of "reach
  * once, keep the kernel, hand out solvers"), and besides it only from the method choice's
- * pilots (src/auto.c: ulam__solver_alloc_reached with the analysis' bounds) and the prepared
- * file's writer (src/cache.c: ulam__reach_all's bounds stored in the file). */
+ * pilots (src/auto.c: ulam__solver_alloc_reached with the analysis' bounds). */
 
 /* The deterministic set-up work of a solver so far: kernel units built (*units, 16 bytes each: a
  * row's nonzeros + 3) and matrix entries read by reachability checks and score-bound passes
@@ -273,6 +272,12 @@ enum {
     ULAM__WALKS_FIXED = 16 /* the kept kernel is the one for this b alone, whose values its owner keeps as
                               they are (one an estimator, ulam_analysis_solver's for the shared b) */
 };
+
+/* An analysis' bounds over every state with its shared b's scores (R->b: the analysis' b, NULL
+ * when they could not be made), as its queries walk under them: a prepared file's, else one pass
+ * over M (made once, kept); NULL when they cannot be made (no memory, a corrupt row, a damaged
+ * file).  Borrowed from the analysis (src/cache.c stores them in a prepared file). */
+const ulam__reach *ulam__analysis_bounds(ulam_analysis *a);
 
 /* The bounds over every state of an analysis' matrix (a prepared file's, else one pass,
  * ulam__reach_all; made once and kept): ULAM_OK, or the status and err (no memory, a corrupt
