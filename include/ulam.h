@@ -295,7 +295,7 @@ int ulam_direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max
  * fraction of the factorisation's time).  ULAM_EUNSUPPORTED without UMFPACK. */
 int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err);
 
-/* Nonzero when libulam was built with UMFPACK (ulam_direct_sparse works). */
+/* Nonzero when libulam was built with UMFPACK and libumfpack loads (ulam_direct_sparse works). */
 int ulam_direct_sparse_available(void);
 
 /* ---------------------------------------------------------------- spectral radius */
