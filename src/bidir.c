@@ -72,6 +72,8 @@ struct ulam__bidir {
     ulam_analysis *at; /* the walks' analysis of Mt (NULL until walks need it): their bounds over every
                           state, kept kernels (fixed for the pilot's ones, rescored for the residual)
                           and the pilot's reach */
+    const ulam_csr *at_K; /* what at was made for: its matrix, continuation (0: analog) and exponent */
+    double at_q, at_alpha;
 };
 
 /* An empty memo. */
@@ -262,13 +264,14 @@ static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir *memo, const ulam_
 static ulam_analysis *walks_on(ulam__bidir *memo, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_error *err)
 {
     const ulam_kernel_opts *k = &o->walk.kernel;
-    double q = k->continue_q > 0 ? k->continue_q : 0.0, aq, aa;
-    if (memo->at) ulam__analysis_kernel(memo->at, &aq, &aa);
-    if (memo->at && ulam__analysis_matrix(memo->at) == Mt && aq == q && aa == k->kernel_alpha) return memo->at;
+    double q = k->continue_q > 0 ? k->continue_q : 0.0;
+    if (memo->at && memo->at_K == Mt && memo->at_q == q && memo->at_alpha == k->kernel_alpha) return memo->at;
     memo->at = ulam_analysis_free(memo->at);
     ulam_analysis_opts ao = ulam_analysis_defaults();
     ao.continue_q = q, ao.kernel_alpha = k->kernel_alpha;
-    return ulam_analysis_alloc(Mt, &ao, &memo->at, err) ? NULL : memo->at;
+    if (ulam_analysis_alloc(Mt, &ao, &memo->at, err)) return NULL;
+    memo->at_K = Mt, memo->at_q = q, memo->at_alpha = k->kernel_alpha;
+    return memo->at;
 }
 
 /* Plan x_t's estimate on w with memo: the push and the walks' predicted cost (see ulam.h). */
