@@ -865,9 +865,9 @@ def check_zero_estimate_stops(ulam):
                       r"probability at most \S+ \(certified from where it can go\), so the rule asks for at least (\S+) "
                       r"walks, beyond the 1e9 cap: stopped early", out, re.M)
         assert m and int(m.group(1)) < 2 ** 21 and float(m.group(2)) > 1e9, out
-        for method in ("auto", "bidirectional"):  # the default, and the route auto took on a probe that saw nothing
+        for method, v in (("auto", []), ("auto", ["--verbose"]), ("bidirectional", [])):  # the default, and the route auto took on a probe that saw nothing
             rc, out, err = run(ulam, ["solve", f"{d}/cd.mtx", "--rhs", f"{d}/cd_b.mtx", "--index", "1", "--method", method,
-                                      "--rel-err", "0.1"])
+                                      "--rel-err", "0.1"] + v)
             assert rc == 0 and "nan" not in out and re.search(r"^rel-err +NOT met \(target 0\.1\)", out, re.M), (method, out)
             assert method != "auto" or "chose bidirectional" not in out, out  # its plan rested on |x| >= 1/n alone
             m = re.search(r"^x\[1\] +\S+ \+- \S+ \(95% CI (\S+) \.\. (\S+)\)", out, re.M)

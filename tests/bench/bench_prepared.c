@@ -13,7 +13,7 @@
  * time (user + system: on a machine shared with other work the wall time waits for a core).
  * Issue 29's targets (the 'fixed' row: the same query with --walks fixed to what the rule used):
  * whole process <= 2x fixed, peak RSS <= 64 MiB at 10^7, whole-process CPU <= 0.02x SciPy's CPU
- * (SciPy column: CPU seconds of the solve alone, time.process_time).  Two queries: 'auto', the
+ * (SciPy column: CPU seconds of the solve alone, time.process_time, with one OpenBLAS thread).  Two queries: 'auto', the
  * default command line (--method auto: the choice's pilots, then its run; its 'fixed' row pins the
  * chosen mode, estimator, continuation and exponent with --method walks), and 'walks'
  * (--method walks: adjoint collision walks).  The first line names the machine, its cores, the
@@ -159,7 +159,10 @@ static int scipy_run(const char *py, const char *dir, const char *sysf, int symm
     snprintf(script, sizeof script, "%s/solve.py", dir);
     FILE *f = fopen(script, "w");
     if (!f || fputs(scipy_script, f) < 0 || fclose(f)) return -1;
-    snprintf(cmd, sizeof cmd, "%s %s %s %s %lld", py, script, sysf, symmetric ? "cg" : "bicgstab", (long long)I);
+    /* one OpenBLAS thread: process_time counts every thread, and an idle OpenBLAS thread spins
+       (10^7 random: 12.8 s of CPU with the default threads, 10.8 s with one) */
+    snprintf(cmd, sizeof cmd, "OPENBLAS_NUM_THREADS=1 %s %s %s %s %lld", py, script, sysf, symmetric ? "cg" : "bicgstab",
+             (long long)I);
     FILE *p = popen(cmd, "r");
     int info = -1, ok = p && fgets(line, sizeof line, p) && sscanf(line, "%lf %d %lf", sec, &info, xI) == 3;
     if (p) pclose(p);
