@@ -1411,7 +1411,8 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
         r->min_walks = fmin(ulam__stop_walks_needed(m, r->variance, R, ci.bias, E, ci.k),
                             ulam__stop_walks_needed(m, r->variance, Rs, (truncated ? E * m / 4.0 : 0.0) + r->cut_bound,
                                                     E, ci.k));
-        if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0) r->min_walks = s->hit_walks; /* no score yet: src/hit.c */
+        if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0 && ci.kind != ULAM__STOP_EXACT)
+            r->min_walks = s->hit_walks; /* no score yet: src/hit.c (not over an x certified exactly) */
     }
     r->cut_stop = s->cut_stop;
     r->out_of_reach = s->out_of_reach;

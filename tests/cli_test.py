@@ -877,6 +877,26 @@ def check_zero_estimate_stops(ulam):
         assert rc == 0 and re.search(r"^  \* .* predicted >= \S+ walks", out, re.M), out
 
 
+def check_exact_zero_no_warning(ulam):
+    """Two disconnected rings, b on the first: x_15 = 0, certified exactly (nothing that scores
+    reaches it).  A --rel-err run is met at once with the interval [0, 0]; it warned that the rule
+    'needs about 1.79e+09 walks ... (out of reach in practice)' and reported that count as
+    min_walks (the zero-estimate hit bound, src/hit.c, laid over an exact interval)."""
+    ent = []
+    for base in (0, 10):
+        for i in range(10):
+            ent += [(base + i + 1, base + (i + 1) % 10 + 1, 0.5), (base + i + 1, base + (i + 3) % 10 + 1, 0.3)]
+    with tempfile.TemporaryDirectory() as d:
+        write_mtx(f"{d}/two.mtx", 20, ent)
+        write_vec(f"{d}/two_b.mtx", [1.0] * 10 + [0.0] * 10)
+        for mode in ("forward", "adjoint"):
+            rc, out, err = run(ulam, ["solve", f"{d}/two.mtx", "--rhs", f"{d}/two_b.mtx", "--index", "15", "--mode", mode,
+                                      "--rel-err", "0.1", "--json"])
+            o = json.loads(out)
+            assert rc == 0 and o["rel_err_met"] and o["ci95"] == [0, 0], (mode, rc, o)
+            assert o["min_walks"] <= o["walks"] and "needs about" not in err, (mode, o["min_walks"], err)
+
+
 def check_honest_verdicts(ulam):
     """Verdicts only from bounds: a radius 5e-4 above 1 that power iteration cannot pin is
     unknown, refused (exit 3) and without an interval under --force; --rel-err with an infinite
@@ -1884,7 +1904,7 @@ def main():
         return 2
     part = "table" if "--table" in flags else "checks" if "--checks" in flags else None  # meson runs the halves apart
     failures, n = check_table(ulam, rows if cases else None) if part != "checks" else (0, 0)
-    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_exact_zero_no_warning, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_summary, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),

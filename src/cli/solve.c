@@ -393,9 +393,9 @@ static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const 
     }
     if (!(r->min_walks > limit)) return;
     if (isfinite(r->score_bound))
-        fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %s score can reach %.4g, so the rule needs about "
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %sscore can reach %.4g, so the rule needs about "
                         "%.3g walks at this estimate before it may stop (%s)%s\n", s->matrix_path, o->stop.rel_err,
-                o->estimator == ULAM_ABSORPTION ? "absorption" : "", r->score_bound, r->min_walks,
+                o->estimator == ULAM_ABSORPTION ? "absorption " : "", r->score_bound, r->min_walks,
                 o->stop.max_walks > 0 ? "more than --walks" : "out of reach in practice",
                 o->estimator == ULAM_ABSORPTION ? "; the collision and expected estimators score b directly and "
                                                   "have no such tail" : "");
