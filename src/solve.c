@@ -1151,7 +1151,7 @@ static int kernel_status(void *ctx)
     return atomic_load(&s->k->status);
 }
 
-static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached);
+static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached, int walked);
 
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci);
 
@@ -1249,12 +1249,12 @@ int ulam_solver_iterate(ulam_solver *s)
                                    begin_round, kernel_status};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
-    result(s, &r, 0);
-    if (!s->run.status && !isfinite(r.estimate) && s->run.walks > 0) /* beyond the largest double */
+    result(s, &r, 0, 1); /* the rules compare it with bounds made on the walked b */
+    if (!s->run.status && !isfinite(ldexp(r.estimate, s->bexp)) && s->run.walks > 0) /* beyond the largest double */
         s->run.status = ULAM_ENONFINITE, s->run.done = s->overflow = 1;
     if (!s->run.status && search_reach(s, &r)) {
         if (s->run.status) return s->run.status; /* the search failed */
-        result(s, &r, 0);
+        result(s, &r, 0, 1);
     }
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
@@ -1378,8 +1378,10 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
     if (s->var_finite != 1 && ci->kind != ULAM__STOP_EXACT) ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
 }
 
-/* The result so far; the forward count of unreached components (O(n)) when asked. */
-static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached)
+/* The result so far; the forward count of unreached components (O(n)) when asked; walked: at the
+ * scale the walks ran on (b 2^-bexp, the scale of the solver's bounds: what the rules compare),
+ * else at b's. */
+static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached, int walked)
 {
     memset(r, 0, sizeof *r);
     if (!s) return;
@@ -1426,7 +1428,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->interrupted = s->run.interrupted;
     r->rho4 = s->rho4;
     r->fourth_finite = s->fourth;
-    if (s->bexp) { /* walked on b 2^-bexp: back to b's scale (exact) */
+    if (s->bexp && !walked) { /* walked on b 2^-bexp: back to b's scale (exact) */
         int e = s->bexp;
         r->estimate = ldexp(r->estimate, e), r->std_error = ldexp(r->std_error, e);
         r->ci95[0] = ldexp(r->ci95[0], e), r->ci95[1] = ldexp(r->ci95[1], e);
@@ -1438,7 +1440,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
 /* The result so far. */
 void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
 {
-    result(s, r, 1);
+    result(s, r, 1, 0);
 }
 
 /* The guards' verdicts the solver walks under. */
