@@ -987,10 +987,13 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
     s->o = o;
     s->b = b;
-    /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered;
-       not on the lazy path (adjoint with the guards given reads only the b_i its walks reach) */
-    s->bexp = !kernel && !reach && o.stop.rel_err_offset == 0.0 && (o.mode == ULAM_ADJOINT ? !o.policy.guard
-                                                                 : !(o.kernel.roulette > 0 || o.kernel.split > 0))
+    /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered
+       and no score's square underflows (b = 1e-300: a standard error of 0); not with a kernel
+       scored to b, nor on a prepared file's lazy path (adjoint with guards or a reach given reads
+       only the b_i its walks reach); a reach's summary of b is then not this b's (bounds_pass) */
+    int lazy = o.mode == ULAM_ADJOINT && o.policy.system && (o.policy.guard || reach);
+    s->bexp = !kernel && !lazy && o.stop.rel_err_offset == 0.0 &&
+                      (o.mode == ULAM_ADJOINT || !(o.kernel.roulette > 0 || o.kernel.split > 0))
                   ? ulam__b_exponent(b, M->nrows) : 0;
     if (s->bexp && !(s->b = b = s->bs = ulam__b_scaled(b, M->nrows, s->bexp))) goto nomem;
     s->n = M->nrows;
@@ -1078,7 +1081,7 @@ int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_wa
 /* The solver's kernel, kept for later solvers (see internal.h). */
 ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s)
 {
-    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || ulam__kernel_keep(s->k)) return NULL;
+    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || s->bexp || ulam__kernel_keep(s->k)) return NULL; /* bexp: scored to b 2^-bexp */
     s->k_borrowed = 1;
     return s->k;
 }
@@ -1086,7 +1089,7 @@ ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s)
 /* The solver's kernel, kept for later solvers with the same b, unchanged (see internal.h). */
 ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s)
 {
-    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || atomic_load(&s->k->status)) return NULL;
+    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || s->bexp || atomic_load(&s->k->status)) return NULL;
     s->k_borrowed = 1, s->k->fixed = 1; /* nothing recorded: only this b, unchanged, rescores (a no-op) */
     return s->k;
 }

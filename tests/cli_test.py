@@ -9,6 +9,7 @@ A failing case prints its name: `table:K` (K-th row of CASES, from 0) or a check
 (`check_study`); `--case NAME` (repeatable) runs only those, e.g. --case table:12 --case check_study.
 """
 import json
+import math
 import os
 import re
 import signal
@@ -895,6 +896,37 @@ def check_exact_zero_no_warning(ulam):
             o = json.loads(out)
             assert rc == 0 and o["rel_err_met"] and o["ci95"] == [0, 0], (mode, rc, o)
             assert o["min_walks"] <= o["walks"] and "needs about" not in err, (mode, o["min_walks"], err)
+
+
+def check_adjoint_scale(ulam):
+    """b = 2^-1000 (1, ..., 1) on a 30 x 30 system (rows of M sum to 0.7, x = 10/3 2^-1000): adjoint
+    walks are walked on b scaled back to 1 (a power of 2: exact) as forward walks are, so the pinned
+    run's estimate and interval are b = 1's times 2^-1000 and the rule stops at b = 1's walks.
+    Before, the CLI (which hands the solver its guards) walked on b itself: every score squared
+    underflowed to 0, the standard error printed 0 and the interval was the range term alone
+    (auto, seed 1, 20000 walks: [0.9915, 0.9995] x, excluding x; 43/100 seeds covered), and
+    --rel-err 0.02 was 'met' on that zero variance at 1024 walks."""
+    n, e = 30, -1000
+    ent = [(i + 1, (i * 7 + k * 11) % n + 1, w) for i in range(n) for k, w in enumerate((0.4, 0.2, 0.1))]
+    with tempfile.TemporaryDirectory() as d:
+        write_mtx(f"{d}/m.mtx", n, ent)
+        write_vec(f"{d}/one.mtx", [1.0] * n)
+        write_vec(f"{d}/tiny.mtx", [math.ldexp(1.0, e)] * n)
+        x = math.ldexp(10.0 / 3.0, e)
+        pinned = ["--method", "walks", "--mode", "adjoint", "--estimator", "collision", "--json", "--seed", "1"]
+        for rule in (["--walks", "20000"], ["--rel-err", "0.02"]):
+            got = []
+            for rhs in ("one", "tiny"):
+                rc, out, err = run(ulam, ["solve", f"{d}/m.mtx", "--rhs", f"{d}/{rhs}.mtx", "--index", "2"] + pinned + rule)
+                assert rc == 0, (rhs, rule, rc, err)
+                got.append(json.loads(out))
+            a, b = got
+            assert b["walks"] == a["walks"] and b["estimate"] == math.ldexp(a["estimate"], e), (rule, a, b)
+            assert b["ci95"] == [math.ldexp(c, e) for c in a["ci95"]] and b["stderr"] > 0, (rule, a["ci95"], b["ci95"])
+        rc, out, err = run(ulam, ["solve", f"{d}/m.mtx", "--rhs", f"{d}/tiny.mtx", "--index", "2", "--walks", "20000",
+                                  "--json", "--seed", "1"])
+        o = json.loads(out)
+        assert rc == 0 and o["stderr"] > 0 and o["ci95"][0] <= x <= o["ci95"][1], (rc, err, o["ci95"], x)
 
 
 def check_honest_verdicts(ulam):
@@ -1904,7 +1936,7 @@ def main():
         return 2
     part = "table" if "--table" in flags else "checks" if "--checks" in flags else None  # meson runs the halves apart
     failures, n = check_table(ulam, rows if cases else None) if part != "checks" else (0, 0)
-    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_exact_zero_no_warning, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_exact_zero_no_warning, ulam), (check_adjoint_scale, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_summary, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
