@@ -377,6 +377,28 @@ def check_radiosity_rare_lamp(ulam):
     assert covered >= 88, f"next-event on the rare lamp: {covered} of 100 intervals cover"
 
 
+def check_radiosity_emission_scale(ulam):
+    """A furnace (closed unit cube, Kd 0.5 0.6 0.7) whose Ke is 1e-300 or 1e300: the walks'
+    scores squared underflow or overflow.  It printed '1.99e-300 +- 0' with an interval of the
+    range term alone (--rel-err 0.05 'met' on that), or '1.99e+300 +- inf (95% CI 0 .. inf)' and
+    --rel-err spun past 60 s.  An emission the walks cannot square is refused where it is read
+    (file and line, no output); 1e-70 and 1e70 still run."""
+    cube = ["v 0 0 0", "v 1 0 0", "v 1 1 0", "v 0 1 0", "v 0 0 1", "v 1 0 1", "v 1 1 1", "v 0 1 1",
+            "f 1 2 3 4", "f 5 8 7 6", "f 1 4 8 5", "f 2 6 7 3", "f 1 5 6 2", "f 4 3 7 8"]
+    with tempfile.TemporaryDirectory() as d:
+        for ke, ok in (("1e-300", False), ("1e300", False), ("1e-70", True), ("1e70", True)):
+            with open(f"{d}/f.mtl", "w") as f:
+                f.write(f"newmtl glow\nKd 0.5 0.6 0.7\nKe {ke} 1 1\n")
+            with open(f"{d}/f.obj", "w") as f:
+                f.write("mtllib f.mtl\nusemtl glow\n" + "\n".join(cube) + "\n")
+            rc, out, err = run(ulam, ["radiosity", f"{d}/f.obj", "--patch", "1", "--walks", "200", "--json"])
+            if ok:
+                j = json.loads(out)
+                assert rc == 0 and j["stderr"][0] > 0 and j["ci95_lo"][0] <= 2 * float(ke) <= j["ci95_hi"][0], (ke, rc, err, j)
+            else:
+                assert rc != 0 and "f.mtl:3:" in out and "Ke" in out and '"error"' in out, (ke, rc, out, err)
+
+
 def on_tty(ulam, args):
     """Run ulam with stderr on a pseudo-terminal: (exit code, what it wrote there)."""
     import pty
@@ -1943,7 +1965,7 @@ def main():
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam), (check_radiosity_image_noise, ulam),
              (check_radiosity_matrix_rel_err, ulam), (check_radiosity_grid, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
-             (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
+             (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam), (check_radiosity_emission_scale, ulam),
              (check_bidir, ulam), (check_queries, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
              (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
