@@ -295,7 +295,7 @@ int ulam_direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max
  * fraction of the factorisation's time).  ULAM_EUNSUPPORTED without UMFPACK. */
 int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err);
 
-/* Nonzero when libulam was built with UMFPACK (ulam_direct_sparse works). */
+/* Nonzero when libulam was built with UMFPACK and libumfpack loads (ulam_direct_sparse works). */
 int ulam_direct_sparse_available(void);
 
 /* ---------------------------------------------------------------- spectral radius */
@@ -1065,12 +1065,14 @@ typedef struct ulam_bidir_opts {
     int reach_all;        /* 1: the walks' reachability bounds (rel_err, absorption) taken over
                              every state of Mt, a superset of what any source reaches, so they
                              hold for every query (looser where a source reaches less); computed
-                             once and kept in the push workspace for later queries on the same
-                             Mt and continuation; 0: a search from the source each query */
-    int keep_kernel;      /* 1 (collision or absorption): the walks' kernel rows of Mt kept in the
-                             push workspace and rescored to the next query's residual, so a query
-                             builds only the rows no earlier one reached (its walks are those a new
-                             kernel gives, bit for bit; walks.rows counts every row kept) */
+                             once and kept with the push workspace (or the analysis:
+                             ulam_analysis_bidir) for later queries on the same Mt, continuation
+                             and exponent; 0: a search from the source each query */
+    int keep_kernel;      /* 1 (collision or absorption): the walks' kernel rows of Mt kept with the
+                             push workspace (or the analysis) and rescored to the next query's
+                             residual, so a query builds only the rows no earlier one reached (its
+                             walks are those a new kernel gives, bit for bit; walks.rows counts
+                             every row kept) */
     double step_cost;     /* push operations one walk visit costs, for the balance (<= 0: the
                              default ULAM_BIDIR_STEP_COST); measure it on the machine and graph at
                              hand with bench_bidir, which prints push operations/s over walk

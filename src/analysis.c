@@ -3,10 +3,13 @@
  * (ulam__reach_all, or the prepared file's stored copy), the shared b's scores, a kept walk
  * kernel per estimator, and for point sources and sparse b (the bidirectional estimator) the
  * transpose (the prepared file's stored M^T when it has one), the push workspace and a place for
- * the planner's memo (src/bidir.h: the planner takes these from here, as CSparse's cs_lu takes
- * cs_sqr's result).  Each is made at the first query that needs it, so a single query from a
- * prepared file reads only the rows its walks reach. */
-#include "bidir.h"
+ * the planner's memo (src/bidir.c: the planner takes these from here, as CSparse's cs_lu takes
+ * cs_sqr's result, and walks on M^T through an analysis of M^T: ulam__analysis_walks).  Each is
+ * made at the first query that needs it, so a single query from a prepared file reads only the
+ * rows its walks reach.  This file is the one home of "reach once, keep the kernel, hand out
+ * solvers": the walk solver's construction and caching calls (ulam__solver_alloc_reached,
+ * ulam__solver_keep_kernel*, ulam__solver_reached, ulam__reach_all) are made here. */
+#include "internal.h"
 #include "kernel.h"
 
 #include <math.h>
@@ -24,11 +27,18 @@ struct ulam_analysis {
     ulam__reach R;        /* the bounds over every state (R.bounds 0: not yet) */
     char *seen;           /* n ones: R.seen */
     int bounds_from, b_from;
-    ulam_kernel *k[3];    /* per estimator: the kept kernel of adjoint queries on b */
+    ulam_kernel *k[3];    /* per estimator: the kept kernel of adjoint queries on b (or of an
+                             internal caller's fixed b: ULAM__WALKS_FIXED) */
+    ulam_kernel *kr;      /* ULAM__WALKS_KEEP: the last internal walks' kernel, rescored to any b */
+    char *found;          /* ULAM__WALKS_FIND: the states earlier walks found they reach (n flags) */
+    int have_found;
+    ulam__reach F;        /* over found: what ULAM__WALKS_FOUND walks are given */
     ulam_csr *T;          /* the transpose made here (NULL: not made) */
     const ulam_csr *Tuse; /* the transpose: T or the prepared file's stored one (NULL until asked) */
     ulam_push *push;      /* the push workspace on M (NULL until asked) */
-    ulam__bidir *bidir;   /* the bidirectional planner's memo on push and Tuse (NULL until asked) */
+    void *kept;           /* the bidirectional planner's memo on push and Tuse (NULL until made; opaque
+                             here, dropped with drop: ulam__analysis_keep) */
+    void (*drop)(void *);
     double seconds;
 };
 
@@ -66,8 +76,10 @@ int ulam_analysis_alloc(const ulam_csr *M, const ulam_analysis_opts *opts, ulam_
 ulam_analysis *ulam_analysis_free(ulam_analysis *a)
 {
     if (!a) return NULL;
+    if (a->kept && a->drop) a->drop(a->kept); /* first: it may hold an analysis of the transpose */
     for (int e = 0; e < 3; e++) ulam__kernel_free(a->k[e]);
-    ulam__bidir_free(a->bidir);
+    ulam__kernel_free(a->kr);
+    free(a->found);
     ulam_push_free(a->push);
     ulam_csr_free(a->T);
     free(a->seen);
@@ -91,6 +103,17 @@ static int take_guard(ulam_analysis *a, int mode, ulam_error *err)
     return status;
 }
 
+/* The bounds over every state by one pass over M (ulam__reach_all; kept in a->R): ULAM_OK,
+ * ULAM_ENOMEM, or the pass's status (a corrupt row, alpha's probabilities underflowing). */
+static int pass_all(ulam_analysis *a)
+{
+    if (!a->seen && !(a->seen = ulam__malloc((size_t)a->M->nrows, 1))) return ULAM_ENOMEM;
+    int status = ulam__reach_all(a->M, a->continue_q, a->alpha, a->seen, &a->R);
+    if (status) a->R.bounds = 0;
+    else a->bounds_from = 2;
+    return status;
+}
+
 /* The bounds over every state, with b's scores when b is the shared one: the prepared file's,
  * else one pass over M (kept); NULL when memory runs out or a row is corrupt (the solver then
  * searches the start's reach itself, and reports what it finds). */
@@ -102,13 +125,9 @@ static const ulam__reach *take_bounds(ulam_analysis *a)
             a->bounds_from = 1;
             if (a->R.b && a->R.b == a->b) a->b_from = 1;
             else a->R.b = NULL;
-        } else if ((a->sys && !ulam_system_matrix(a->sys)) || !(a->seen = ulam__malloc((size_t)a->M->nrows, 1))) {
-            return NULL; /* a damaged file (the pass would read all of it) or no memory: the solver searches */
-        } else if (!ulam__reach_all(a->M, a->continue_q, a->alpha, a->seen, &a->R)) {
-            a->bounds_from = 2;
-        } else {
-            a->R.bounds = 0;
-            return NULL;
+        } else if ((a->sys && !ulam_system_matrix(a->sys)) || pass_all(a)) {
+            return NULL; /* a damaged file (the pass would read all of it), no memory or a corrupt row:
+                            the solver searches */
         }
     }
     const double *sb = NULL;
@@ -158,6 +177,62 @@ int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts 
     ulam_solver *s = NULL;
     int status = ulam_analysis_solver(a, b, opts, &s, err);
     return status ? status : ulam__solver_finish(s, result, err);
+}
+
+/* The slot of an internal caller's kept kernel: a->k[estimator] for a fixed b, else a->kr (NULL:
+ * an estimator out of range). */
+static ulam_kernel **kernel_slot(ulam_analysis *a, const ulam_walk_opts *o, int how)
+{
+    if (!(how & ULAM__WALKS_FIXED)) return &a->kr;
+    return o->estimator >= ULAM_COLLISION && o->estimator <= ULAM_EXPECTED ? &a->k[o->estimator] : NULL;
+}
+
+/* Keep the states s found its walks reach in a->found (have_found 0: none, or no memory). */
+static void keep_found(ulam_analysis *a, const ulam_solver *s)
+{
+    const char *r = ulam__solver_reached(s);
+    a->have_found = 0;
+    if (!r || (!a->found && !(a->found = ulam__malloc((size_t)a->M->nrows, 1)))) return;
+    memcpy(a->found, r, (size_t)a->M->nrows);
+    a->F = (ulam__reach){.seen = a->found};
+    a->have_found = 1;
+}
+
+/* Walks on a's matrix run to their end with what a lends and keeps (see internal.h). */
+int ulam__analysis_walks(ulam_analysis *a, const double *b, const ulam_walk_opts *o, int how, ulam_walk_result *result,
+                         ulam_guard *guard, ulam_solver **out, ulam_error *err)
+{
+    if (out) *out = NULL;
+    if (!a || !b || !o) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis, b and options");
+    if ((o->kernel.continue_q > 0 ? o->kernel.continue_q : 0.0) != a->continue_q || o->kernel.kernel_alpha != a->alpha)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "the analysis' continuation %g and kernel exponent %g",
+                          a->continue_q, a->alpha);
+    int status = how & ULAM__WALKS_ALL ? ulam__analysis_bounds_all(a, err) : ULAM_OK;
+    if (status) return status;
+    if (how & ULAM__WALKS_FIND) a->have_found = 0;
+    const ulam__reach *reach = how & ULAM__WALKS_ALL ? &a->R : (how & ULAM__WALKS_FOUND) && a->have_found ? &a->F : NULL;
+    ulam_kernel **slot = kernel_slot(a, o, how), *k = slot ? *slot : NULL;
+    if (k && (!(how & ULAM__WALKS_KEEP) || k->K != a->M || k->continue_q != o->kernel.continue_q ||
+              k->alpha != o->kernel.kernel_alpha || k->scores.estimator != o->estimator ||
+              ((how & ULAM__WALKS_FIXED) && k->scores.b != b)))
+        *slot = k = ulam__kernel_free(k); /* not made for these walks */
+    ulam_solver *s = NULL;
+    if ((status = ulam__solver_alloc_reached(a->M, b, o, reach, k, &s, err))) {
+        if (k) *slot = ulam__kernel_free(k); /* a failed kernel is not kept */
+        return status;
+    }
+    while (!status && !ulam_solver_done(s)) status = ulam_solver_iterate(s);
+    if (result) ulam_solver_result(s, result);
+    if (guard) ulam_solver_guard(s, guard);
+    if (status) ulam_solver_error(s, err);
+    if ((how & ULAM__WALKS_FIND) && !status) keep_found(a, s);
+    if (slot && !k && (how & ULAM__WALKS_KEEP) && !status)
+        *slot = how & ULAM__WALKS_FIXED ? ulam__solver_keep_kernel_fixed(s)
+                : o->estimator != ULAM_EXPECTED ? ulam__solver_keep_kernel(s) : NULL;
+    if (out) *out = s; /* after a failure the caller only frees it: it never reads a dropped kernel */
+    else ulam_solver_free(s);
+    if (k && status) *slot = ulam__kernel_free(k);
+    return status;
 }
 
 /* The walks' pins o (from ao, or the defaults) with a's guards when they pin a's own kernel. */
@@ -243,10 +318,39 @@ void ulam__analysis_kernel(const ulam_analysis *a, double *continue_q, double *a
     *continue_q = a->continue_q, *alpha = a->alpha;
 }
 
-/* Where a keeps the bidirectional planner's memo (NULL until the planner makes it; a frees it). */
-ulam__bidir **ulam__analysis_bidir_memo(ulam_analysis *a)
+/* What a caller keeps with a (NULL: nothing yet). */
+void *ulam__analysis_kept(const ulam_analysis *a)
 {
-    return &a->bidir;
+    return a->kept;
+}
+
+/* Keep m with a, dropped with drop when a is freed (after any m kept before). */
+void ulam__analysis_keep(ulam_analysis *a, void *m, void (*drop)(void *))
+{
+    if (a->kept && a->drop) a->drop(a->kept);
+    a->kept = m, a->drop = drop;
+}
+
+/* a's bounds over every state with the shared b's scores (see internal.h). */
+const ulam__reach *ulam__analysis_bounds(ulam_analysis *a)
+{
+    return take_bounds(a);
+}
+
+/* a's bounds over every state (see internal.h). */
+int ulam__analysis_bounds_all(ulam_analysis *a, ulam_error *err)
+{
+    if (a->R.bounds) return ULAM_OK;
+    if (a->sys) /* the file's, or a pass once its every block is verified */
+        return take_bounds(a) ? ULAM_OK : ulam__fail(err, ULAM_ESYNTAX, 0, -1, "an intact prepared file and memory "
+                                                     "for the walks' reach");
+    double t0 = ulam_now();
+    int status = pass_all(a);
+    a->seconds += ulam_now() - t0;
+    if (!status) return ULAM_OK;
+    return status == ULAM_ENOMEM ? ulam__fail(err, status, 0, -1, "memory for the walks' reach")
+                                 : ulam__fail(err, status, 0, -1, "rows with columns in range and finite, nonzero "
+                                              "values (the matrix is corrupt)");
 }
 
 /* What a holds so far. */

@@ -19,10 +19,11 @@
  * probe's lower bound (see push()).  The interval: honest_interval.  ulam_bidir_plan does this and leaves the
  * pushed workspace with a memo of the plan (bidir.h: the analysis', or one kept with a bare push
  * workspace), which ulam_bidir_solve reuses for the same options and the push as the plan left it
- * instead of pushing again. */
+ * instead of pushing again.  Every walk here (pilot, probe, estimate) is handed out by an
+ * analysis of M' the memo holds (ulam__analysis_walks), which keeps what later walks share: the
+ * bounds over every state (reach_all), the kernel rows (keep_kernel) and the reach a pilot found. */
 #include "bidir.h"
 #include "internal.h"
-#include "kernel.h"
 #include "push.h"
 #include "stats.h"
 
@@ -52,8 +53,8 @@ ulam_bidir_opts ulam_bidir_defaults(void)
 
 /* The memo: the last plan made on a push workspace (w, at its state stamp, for Mt and options o
  * with b's entries copied: idx, val, cap entries of room), what it found and the guards its
- * pilot computed; the pilot's scores, the states it found its walks reach, every state's bounds
- * (reach_all) and the kept kernels, for later queries. */
+ * pilot computed; the pilot's scores, and the analysis of Mt the walks are handed out by (for one
+ * continuation and exponent: made again for another), for later queries. */
 struct ulam__bidir {
     int valid;
     const ulam_push *w; /* the workspace it was made on, and its stamp then (ulam__push_stamp) */
@@ -67,13 +68,12 @@ struct ulam__bidir {
     ulam_guard guard; /* the pilot's guards on Mt, for the walks (have_guard 0: none) */
     int have_guard;
     double *ones; /* n ones (NULL until a pilot needs them): the pilot's scores */
-    char *seen;   /* n flags: the states the pilot found its walks can reach (have_seen 0: none) */
-    int have_seen;
-    char *all;          /* n ones: every state (reach_all; NULL until a query asks) */
-    ulam__reach reach;  /* what the walks reach: over seen (have_seen) or all (have_all) */
-    int have_all;       /* 1: reach holds ulam__reach_all's bounds over all, for reach.K and continuation */
-    ulam_kernel *kernel; /* keep_kernel: the last walks' kernel (ulam__solver_keep_kernel; NULL: none) */
-    ulam_kernel *pilot;  /* keep_kernel: the pilot's, scoring ones (fixed; NULL: none) */
+    int found;    /* 1: this plan's pilot searched the states its walks reach, kept by at (ULAM__WALKS_FIND) */
+    ulam_analysis *at; /* the walks' analysis of Mt (NULL until walks need it): their bounds over every
+                          state, kept kernels (fixed for the pilot's ones, rescored for the residual)
+                          and the pilot's reach */
+    const ulam_csr *at_K; /* what at was made for: its matrix, continuation (0: analog) and exponent */
+    double at_q, at_alpha;
 };
 
 /* An empty memo. */
@@ -86,8 +86,8 @@ ulam__bidir *ulam__bidir_alloc(void)
 ulam__bidir *ulam__bidir_free(ulam__bidir *m)
 {
     if (!m) return NULL;
-    free(m->idx), free(m->val), free(m->ones), free(m->seen), free(m->all);
-    ulam__kernel_free(m->kernel), ulam__kernel_free(m->pilot);
+    free(m->idx), free(m->val), free(m->ones);
+    ulam_analysis_free(m->at);
     free(m);
     return NULL;
 }
@@ -172,13 +172,13 @@ static int same_plan(const ulam__bidir *m, const ulam_csr *Mt, const ulam_bidir_
            x->policy.force == y->policy.force && x->policy.assume_finite == y->policy.assume_finite && x->policy.guard == y->policy.guard;
 }
 
-/* The pilot's solver: PILOT collision walks from s on Mt on a seed of their own, scoring 1 at
- * every visit (ones: n of them), with rel_err when the walks have one so that the solver
- * computes its reachability bounds for scores of at most 1 a visit (the balance scales them to
- * rmax); reach: every state's bounds (reach_all), or NULL to search; with keep_kernel the pilot's
- * kernel (scoring ones) is kept in memo for later pilots. */
-static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *o, const ulam__reach *reach,
-                 ulam__bidir *memo, ulam_solver **out, ulam_error *err)
+/* The pilot's solver: PILOT collision walks from s on Mt (at's matrix) on a seed of their own,
+ * scoring 1 at every visit (ones: n of them), with rel_err when the walks have one so that the
+ * solver computes its reachability bounds for scores of at most 1 a visit (the balance scales
+ * them to rmax); under at's bounds over every state (reach_all), else searching the states its
+ * walks reach and keeping them in at for the estimate's walks; with keep_kernel the pilot's
+ * kernel (scoring ones) is kept in at for later pilots. */
+static int pilot(ulam_analysis *at, const double *ones, const ulam_bidir_opts *o, ulam_solver **out, ulam_error *err)
 {
     ulam_walk_opts po = walk_opts(o);
     po.estimator = ULAM_COLLISION;
@@ -186,16 +186,8 @@ static int pilot(const ulam_csr *Mt, const double *ones, const ulam_bidir_opts *
     po.exec.threads = 1; /* one partial block: a thread team would only be woken (same result for any count) */
     po.exec.seed = o->walk.exec.seed ^ UINT64_C(0x9e3779b97f4a7c15);
     po.stop.interrupt = NULL;
-    ulam_kernel *k = memo->pilot;
-    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != po.kernel.continue_q || k->alpha != po.kernel.kernel_alpha ||
-              k->scores.b != ones))
-        memo->pilot = k = ulam__kernel_free(k);
-    int status = ulam__solver_alloc_reached(Mt, ones, &po, reach, k, out, err);
-    while (!status && !ulam_solver_done(*out)) status = ulam_solver_iterate(*out);
-    if (status && *out) ulam_solver_error(*out, err);
-    if (!k && o->keep_kernel && !status) memo->pilot = ulam__solver_keep_kernel_fixed(*out);
-    if (k && status) memo->pilot = ulam__kernel_free(k); /* not kept; *out never reads a borrowed kernel again */
-    return status;
+    int how = ULAM__WALKS_FIXED | (o->reach_all ? ULAM__WALKS_ALL : ULAM__WALKS_FIND) | (o->keep_kernel ? ULAM__WALKS_KEEP : 0);
+    return ulam__analysis_walks(at, ones, &po, how, NULL, NULL, out, err);
 }
 
 /* Walks the stopping rule is predicted to need at threshold rmax for |x| about xhat (the
@@ -267,30 +259,19 @@ static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir *memo, const ulam_
     return status;
 }
 
-/* The memo's reach of every state of Mt for o's continuation and exponent, made once (reach_all);
- * NULL without reach_all. */
-static const ulam__reach *reach_all(ulam__bidir *memo, const ulam_csr *Mt, const ulam_bidir_opts *o, int *status,
-                                    ulam_error *err)
+/* The memo's analysis of Mt for o's continuation and exponent (made again for another Mt or
+ * kernel: what it kept was made for the old one); NULL with err filled when memory runs out. */
+static ulam_analysis *walks_on(ulam__bidir *memo, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_error *err)
 {
-    const ulam_walk_opts *wo = &o->walk;
-    ulam__reach *R = &memo->reach;
-    *status = ULAM_OK;
-    if (!o->reach_all) return NULL;
-    if (memo->have_all && R->K == Mt && R->continue_q == fmax(wo->kernel.continue_q, 0.0) && R->alpha == wo->kernel.kernel_alpha)
-        return R;
-    memo->have_all = 0;
-    if (!memo->all && !(memo->all = ulam__malloc((size_t)Mt->nrows, 1))) {
-        *status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' reach");
-        return NULL;
-    }
-    if ((*status = ulam__reach_all(Mt, wo->kernel.continue_q, wo->kernel.kernel_alpha, memo->all, R))) {
-        *status = *status == ULAM_ENOMEM ? ulam__fail(err, *status, 0, -1, "memory for the walks' reach")
-                                         : ulam__fail(err, *status, 0, -1, "rows of Mt with columns in range and "
-                                                      "finite, nonzero values (the matrix is corrupt)");
-        return NULL;
-    }
-    memo->have_all = 1;
-    return R;
+    const ulam_kernel_opts *k = &o->walk.kernel;
+    double q = k->continue_q > 0 ? k->continue_q : 0.0;
+    if (memo->at && memo->at_K == Mt && memo->at_q == q && memo->at_alpha == k->kernel_alpha) return memo->at;
+    memo->at = ulam_analysis_free(memo->at);
+    ulam_analysis_opts ao = ulam_analysis_defaults();
+    ao.continue_q = q, ao.kernel_alpha = k->kernel_alpha;
+    if (ulam_analysis_alloc(Mt, &ao, &memo->at, err)) return NULL;
+    memo->at_K = Mt, memo->at_q = q, memo->at_alpha = k->kernel_alpha;
+    return memo->at;
 }
 
 /* Plan x_t's estimate on w with memo: the push and the walks' predicted cost (see ulam.h). */
@@ -306,16 +287,17 @@ static int plan_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bi
     memo->valid = 0; /* until this plan is whole */
     ulam_solver *pl = NULL;
     plan->target = o->target, plan->balanced = !(o->rmax > 0), plan->mean_visits = 1.0, plan->step_cost = step_cost(o);
-    memo->have_guard = memo->have_seen = 0;
+    memo->have_guard = memo->found = 0;
     if (plan->balanced && !memo->ones) {
         if (!(memo->ones = ulam__malloc((size_t)M->nrows, sizeof *memo->ones)))
             return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the pilot's scores");
         for (int64_t i = 0; i < M->nrows; i++) memo->ones[i] = 1.0;
     }
-    const ulam__reach *all = reach_all(memo, Mt, o, &status, err);
-    if (status) return status;
+    ulam_analysis *at = walks_on(memo, Mt, o, err);
+    if (!at) return ULAM_ENOMEM;
+    if (o->reach_all && (status = ulam__analysis_bounds_all(at, err))) return status; /* before any work */
     if (plan->balanced) {
-        status = pilot(Mt, memo->ones, o, all, memo, &pl, err);
+        status = pilot(at, memo->ones, o, &pl, err);
         if (status) {
             ulam_solver_free(pl);
             return status;
@@ -326,12 +308,7 @@ static int plan_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bi
         plan->mean_visits = r.walks > 0 ? 1.0 + (double)r.steps / (double)r.walks : 1.0;
         ulam_solver_guard(pl, &memo->guard);
         memo->have_guard = 1;
-        const char *seen = all ? NULL : ulam__solver_reached(pl); /* the walks' reach: the estimate's solver need
-                                                                     not search again */
-        if (seen && (memo->seen || (memo->seen = ulam__malloc((size_t)M->nrows, 1)))) {
-            memcpy(memo->seen, seen, (size_t)M->nrows);
-            memo->have_seen = 1;
-        }
+        memo->found = !o->reach_all; /* the walks' reach, kept in at: the estimate's solver need not search again */
     }
     status = push(w, Mt, memo, o, pl, cap, plan);
     if (pl) ulam__solver_setup(pl, &plan->pilot_units, &plan->pilot_reads);
@@ -361,8 +338,9 @@ static int plan_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bi
 
 /* Walks on Mt from s scoring r until a stopping rule holds; the result in *wr.  The solver's
  * rel_err rule (the one of ulam_solve_walks) applies to the whole estimate push_part + <r, x>;
- * memo: the pilot's guards on Mt and the states it found the walks reach, when it has them, or
- * (reach_all) every state's bounds. */
+ * memo: the pilot's guards on Mt, and its analysis of Mt hands out the walks: under every state's
+ * bounds (reach_all), or the states this plan's pilot found the walks reach, with the kernel rows
+ * earlier walks built (keep_kernel). */
 static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, double push_part,
                 ulam__bidir *memo, ulam_walk_result *wr, ulam_guard *g, ulam_error *err)
 {
@@ -370,29 +348,10 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     ulam_walk_opts wo = walk_opts(o);
     wo.stop.rel_err_offset = push_part;
     if (!wo.policy.guard && memo->have_guard) wo.policy.guard = &memo->guard;
-    ulam_solver *sv = NULL;
-    ulam__reach seen = {.seen = memo->seen};
-    int status = ULAM_OK;
-    const ulam__reach *all = reach_all(memo, Mt, o, &status, err); /* the solver searches should x_t be 0 */
-    const ulam__reach *reach = all ? all : memo->have_seen ? &seen : NULL;
-    if (status) return status;
-    ulam_kernel *k = memo->kernel; /* keep_kernel: the rows earlier queries built, if made for these walks */
-    if (k && (!o->keep_kernel || k->K != Mt || k->continue_q != wo.kernel.continue_q || k->alpha != wo.kernel.kernel_alpha ||
-              k->scores.estimator != wo.estimator))
-        memo->kernel = k = ulam__kernel_free(k);
-    status = ulam__solver_alloc_reached(Mt, r, &wo, reach, k, &sv, err);
-    if (status) {
-        if (k) memo->kernel = ulam__kernel_free(k); /* a failed kernel is not kept */
-        return status;
-    }
-    while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
-    ulam_solver_result(sv, wr);
-    ulam_solver_guard(sv, g); /* the walks' guards on Mt: the walk part's certified bound */
-    if (status) ulam_solver_error(sv, err);
-    if (!k && o->keep_kernel && !status && wo.estimator != ULAM_EXPECTED) memo->kernel = ulam__solver_keep_kernel(sv);
-    ulam_solver_free(sv);
-    if (k && status) memo->kernel = ulam__kernel_free(k);
-    return status;
+    ulam_analysis *at = walks_on(memo, Mt, o, err);
+    if (!at) return ULAM_ENOMEM;
+    int how = (o->reach_all ? ULAM__WALKS_ALL : memo->found ? ULAM__WALKS_FOUND : 0) | (o->keep_kernel ? ULAM__WALKS_KEEP : 0);
+    return ulam__analysis_walks(at, r, &wo, how, wr, g, NULL, err); /* the solver searches should x_t be 0 */
 }
 
 /* The certified bound D on the walk part: |<r, x>| <= max|r| ||x||_1 <= max|r| ||b||_1 /
@@ -492,10 +451,11 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
 static int take(ulam_analysis *a, const ulam_csr **Mt, ulam_push **w, ulam__bidir **memo, ulam_error *err)
 {
     if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis");
-    ulam__bidir **slot = ulam__analysis_bidir_memo(a);
     if (!(*Mt = ulam__analysis_transpose(a, NULL, err)) || !(*w = ulam_analysis_push(a, err))) return ULAM_ENOMEM;
-    if (!*slot && !(*slot = ulam__bidir_alloc())) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
-    *memo = *slot;
+    if (!(*memo = ulam__analysis_kept(a))) {
+        if (!(*memo = ulam__bidir_alloc())) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
+        ulam__analysis_keep(a, *memo, drop_memo);
+    }
     return ULAM_OK;
 }
 

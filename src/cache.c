@@ -198,15 +198,16 @@ static int get_bounds(const uint64_t *w, const double *b, int64_t n, ulam__reach
 }
 
 /* The bounds of d's M (and scores of its b) at its certificate's continuation and exponent 1,
- * into the header words w; nothing when they cannot be made (a corrupt row, no memory). */
+ * into the header words w: an analysis' (ulam__analysis_bounds, the bounds its queries walk
+ * under); nothing when they cannot be made (a corrupt row, no memory). */
 static void make_bounds(const ulam_system_desc *d, uint64_t *w)
 {
-    char *seen = ulam__malloc((size_t)d->M->nrows, 1);
-    ulam__reach R;
-    if (seen && !ulam__reach_all(d->M, d->cert->continue_q, 1.0, seen, &R) &&
-        (!d->b || !ulam__reach_b(d->M, d->b, &R)))
-        put_bounds(w, &R);
-    free(seen);
+    ulam_analysis_opts o = ulam_analysis_defaults();
+    o.continue_q = d->cert->continue_q, o.kernel_alpha = 1.0, o.b = d->b;
+    ulam_analysis *a = NULL;
+    const ulam__reach *R = ulam_analysis_alloc(d->M, &o, &a, NULL) ? NULL : ulam__analysis_bounds(a);
+    if (R && (!d->b || R->b == d->b)) put_bounds(w, R);
+    ulam_analysis_free(a);
 }
 
 /* Round x up to the alignment. */

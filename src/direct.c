@@ -1,7 +1,6 @@
 /* The reference: a dense LU solve of (I - M) x = b with OpenBLAS's LAPACKE_dgesv. */
-#include "internal.h"
+#include "dynload.h"
 
-#include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -68,6 +67,8 @@ int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_
         return ulam__fail(err, ULAM_EMEMLIMIT, 0, -1,
                           "at most %.3g GiB for the dense matrix; n = %lld needs %.3g GiB",
                           (double)max_bytes / 1073741824.0, (long long)n, (double)bytes / 1073741824.0);
+    const ulam__lapacke_api *L = ulam__lapacke(err); /* src/dynload.c: opened on first use */
+    if (!L) return err ? err->status : ULAM_EIO;
     double *a = ulam__malloc((size_t)n * (size_t)n, sizeof *a);
     lapack_int *ipiv = ulam__malloc((size_t)n, sizeof *ipiv);
     if (!a || !ipiv) {
@@ -77,12 +78,11 @@ int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_
                           (double)bytes / 1073741824.0);
     }
     assemble(M, a);
-    double anorm = LAPACKE_dlange(LAPACK_COL_MAJOR, '1', (lapack_int)n, (lapack_int)n, a, (lapack_int)n);
+    double anorm = L->dlange(LAPACK_COL_MAJOR, '1', (lapack_int)n, (lapack_int)n, a, (lapack_int)n);
     memcpy(x, b, (size_t)n * sizeof *x);
-    lapack_int lerr = LAPACKE_dgesv(LAPACK_COL_MAJOR, (lapack_int)n, 1, a, (lapack_int)n, ipiv, x,
-                                    (lapack_int)n);
+    lapack_int lerr = L->dgesv(LAPACK_COL_MAJOR, (lapack_int)n, 1, a, (lapack_int)n, ipiv, x, (lapack_int)n);
     double rcond = 0.0;
-    if (lerr == 0) LAPACKE_dgecon(LAPACK_COL_MAJOR, '1', (lapack_int)n, a, (lapack_int)n, anorm, &rcond);
+    if (lerr == 0) L->dgecon(LAPACK_COL_MAJOR, '1', (lapack_int)n, a, (lapack_int)n, anorm, &rcond);
     free(a);
     free(ipiv);
     if (lerr > 0)

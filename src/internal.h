@@ -75,6 +75,14 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
  * ulam_solver_alloc's. */
 int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *o, ulam_error *err);
 
+/* The walk solver's internal interface (src/solve.c).  Queries on a solver (ulam__solver_setup,
+ * ulam__solver_range_walks) and its restarts (ulam__solver_restart, _rerun) are for any file
+ * downstream of it; its construction and caching on what earlier solvers made
+ * (ulam__solver_alloc_reached, ulam__solver_keep_kernel, _keep_kernel_fixed, ulam__solver_reached,
+ * ulam__reach_all below) are called from the analysis (src/analysis.c, the one home of "reach
+ * once, keep the kernel, hand out solvers"), and besides it only from the method choice's
+ * pilots (src/auto.c: ulam__solver_alloc_reached with the analysis' bounds). */
+
 /* The deterministic set-up work of a solver so far: kernel units built (*units, 16 bytes each: a
  * row's nonzeros + 3) and matrix entries read by reachability checks and score-bound passes
  * (*reads). */
@@ -246,10 +254,45 @@ const ulam_csr *ulam__analysis_transpose(ulam_analysis *a, double *seconds, ulam
 const ulam_csr *ulam__analysis_matrix(const ulam_analysis *a);
 void ulam__analysis_kernel(const ulam_analysis *a, double *continue_q, double *alpha);
 
-/* Where an analysis keeps the bidirectional planner's memo (src/bidir.h; NULL until the planner
- * makes it there; freed with the analysis). */
-struct ulam__bidir;
-struct ulam__bidir **ulam__analysis_bidir_memo(ulam_analysis *a);
+/* What a caller (the bidirectional planner: its memo, src/bidir.h) keeps with an analysis: NULL
+ * until ulam__analysis_keep; m is dropped with drop when the analysis is freed (or another is
+ * kept), before the rest of the analysis. */
+void *ulam__analysis_kept(const ulam_analysis *a);
+void ulam__analysis_keep(ulam_analysis *a, void *m, void (*drop)(void *));
+
+/* What an analysis lends an internal caller's walks and keeps from them (ulam__analysis_walks). */
+enum {
+    ULAM__WALKS_ALL = 1,   /* walk under the bounds over every state (ulam__analysis_bounds_all) */
+    ULAM__WALKS_FOUND = 2, /* else under the states the last ULAM__WALKS_FIND walks found they reach (the
+                              caller's to pass only for walks from the same starts; none kept: search) */
+    ULAM__WALKS_FIND = 4,  /* keep the states these walks find they reach, in place of the last ones */
+    ULAM__WALKS_KEEP = 8,  /* walk on the kept kernel made for these walks (matrix, continuation, exponent,
+                              estimator) and keep theirs when none was: rescored to each walks' b (not
+                              the expected estimator's); without it the kept kernel is dropped */
+    ULAM__WALKS_FIXED = 16 /* the kept kernel is the one for this b alone, whose values its owner keeps as
+                              they are (one an estimator, ulam_analysis_solver's for the shared b) */
+};
+
+/* An analysis' bounds over every state with its shared b's scores (R->b: the analysis' b, NULL
+ * when they could not be made), as its queries walk under them: a prepared file's, else one pass
+ * over M (made once, kept); NULL when they cannot be made (no memory, a corrupt row, a damaged
+ * file).  Borrowed from the analysis (src/cache.c stores them in a prepared file). */
+const ulam__reach *ulam__analysis_bounds(ulam_analysis *a);
+
+/* The bounds over every state of an analysis' matrix (a prepared file's, else one pass,
+ * ulam__reach_all; made once and kept): ULAM_OK, or the status and err (no memory, a corrupt
+ * row, alpha's probabilities underflowing, a damaged file). */
+int ulam__analysis_bounds_all(ulam_analysis *a, ulam_error *err);
+
+/* Adjoint walks on a's matrix for b (borrowed until the solver is freed) under o (its kernel's
+ * continuation and exponent a's, else ULAM_EINVAL; nothing else changed) run until a stopping
+ * rule holds, with what how (ULAM__WALKS_*) says a lends them and keeps from them; the result and
+ * guards (either may be NULL) filled, err on failure; the finished solver in *out (the caller
+ * frees it; after a failure it may only free it), or freed here when out is NULL.  The walks
+ * are those of ulam_solver_alloc with o, bit for bit, whatever a lends (src/analysis.c: the
+ * bidirectional planner walks on M^T through an analysis of M^T). */
+int ulam__analysis_walks(ulam_analysis *a, const double *b, const ulam_walk_opts *o, int how, ulam_walk_result *result,
+                         ulam_guard *guard, ulam_solver **out, ulam_error *err);
 
 /* ulam_bidir_plan and ulam_bidir_solve on an analysis' transpose, push workspace and planner's
  * memo (made at the first call and kept), for any kernel: the memo reuses a plan only for the

@@ -1,14 +1,13 @@
 /* The reference for large systems: a sparse LU solve of (I - M) x = b with UMFPACK (SuiteSparse).
  * I - M in CSR is the CSC of its transpose, so UMFPACK factors that and solves the transposed
  * system (UMFPACK_At); no copy of M in another layout is made beyond I - M itself. */
-#include "internal.h"
+#include "dynload.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #ifdef ULAM_UMFPACK
-#include <suitesparse/umfpack.h>
 
 /* Sort the row segment (col, val)[0..len) by column and merge duplicates; returns the new length. */
 static int64_t sort_row(SuiteSparse_long *col, double *val, int64_t len)
@@ -53,31 +52,33 @@ static int assemble(const ulam_csr *M, SuiteSparse_long **p, SuiteSparse_long **
 static int factor_solve(int64_t n, const SuiteSparse_long *p, const SuiteSparse_long *c, const double *v,
                         const double *b, double *x, size_t max_bytes, ulam_direct_info *info, ulam_error *err)
 {
+    const ulam__umfpack_api *U = ulam__umfpack(err); /* src/dynload.c: opened on first use */
+    if (!U) return err ? err->status : ULAM_EIO;
     double control[UMFPACK_CONTROL], stat[UMFPACK_INFO];
     void *symbolic = NULL, *numeric = NULL;
-    umfpack_dl_defaults(control);
+    U->defaults(control);
     SuiteSparse_long sn = (SuiteSparse_long)n;
-    int st = (int)umfpack_dl_symbolic(sn, sn, p, c, v, &symbolic, control, stat);
+    int st = (int)U->symbolic(sn, sn, p, c, v, &symbolic, control, stat);
     if (st == UMFPACK_ERROR_out_of_memory) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for UMFPACK's analysis");
     if (st != UMFPACK_OK) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix UMFPACK accepts (status %d)", st);
     double peak = stat[UMFPACK_PEAK_MEMORY_ESTIMATE] * stat[UMFPACK_SIZE_OF_UNIT];
     if (max_bytes && peak > (double)max_bytes) {
-        umfpack_dl_free_symbolic(&symbolic);
+        U->free_symbolic(&symbolic);
         return ulam__fail(err, ULAM_EMEMLIMIT, 0, -1, "at most %.3g GiB for the sparse LU; UMFPACK estimates %.3g GiB",
                           (double)max_bytes / 1073741824.0, peak / 1073741824.0);
     }
-    st = (int)umfpack_dl_numeric(p, c, v, symbolic, &numeric, control, stat);
-    umfpack_dl_free_symbolic(&symbolic);
+    st = (int)U->numeric(p, c, v, symbolic, &numeric, control, stat);
+    U->free_symbolic(&symbolic);
     if (st == UMFPACK_WARNING_singular_matrix || st == UMFPACK_ERROR_out_of_memory || st < 0) {
-        umfpack_dl_free_numeric(&numeric);
+        U->free_numeric(&numeric);
         if (st == UMFPACK_ERROR_out_of_memory) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the sparse LU factors");
         if (st == UMFPACK_WARNING_singular_matrix)
             return ulam__fail(err, ULAM_ESINGULAR, 0, -1, "a nonsingular I - M: its sparse LU has a zero pivot");
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix UMFPACK can factor (status %d)", st);
     }
     double rcond = stat[UMFPACK_RCOND];
-    st = (int)umfpack_dl_solve(UMFPACK_At, p, c, v, x, b, numeric, control, stat); /* (I - M) x = b */
-    umfpack_dl_free_numeric(&numeric);
+    st = (int)U->solve(UMFPACK_At, p, c, v, x, b, numeric, control, stat); /* (I - M) x = b */
+    U->free_numeric(&numeric);
     if (st != UMFPACK_OK) return ulam__fail(err, ULAM_ESINGULAR, 0, -1, "a solvable system (UMFPACK status %d)", st);
     if (info) info->rcond = rcond, info->bytes = (size_t)peak;
     return ULAM_OK;
@@ -90,13 +91,15 @@ static int estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error 
     SuiteSparse_long *p = NULL, *c = NULL;
     double *v = NULL, control[UMFPACK_CONTROL], stat[UMFPACK_INFO];
     void *symbolic = NULL;
+    const ulam__umfpack_api *U = ulam__umfpack(err); /* src/dynload.c: opened on first use */
+    if (!U) return err ? err->status : ULAM_EIO;
     int status = assemble(M, &p, &c, &v);
     if (status) {
         ulam__fail(err, status, 0, -1, "memory for I - M");
     } else {
-        umfpack_dl_defaults(control);
+        U->defaults(control);
         SuiteSparse_long sn = (SuiteSparse_long)M->nrows;
-        int st = (int)umfpack_dl_symbolic(sn, sn, p, c, v, &symbolic, control, stat);
+        int st = (int)U->symbolic(sn, sn, p, c, v, &symbolic, control, stat);
         if (st == UMFPACK_OK) {
             *bytes = stat[UMFPACK_PEAK_MEMORY_ESTIMATE] * stat[UMFPACK_SIZE_OF_UNIT];
             *flops = stat[UMFPACK_FLOPS_ESTIMATE];
@@ -104,7 +107,7 @@ static int estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error 
             status = ulam__fail(err, st == UMFPACK_ERROR_out_of_memory ? ULAM_ENOMEM : ULAM_EINVAL, 0, -1,
                                 "a matrix UMFPACK can analyse (status %d)", st);
         }
-        umfpack_dl_free_symbolic(&symbolic);
+        U->free_symbolic(&symbolic);
     }
     free(p), free(c), free(v);
     return status;
@@ -124,11 +127,11 @@ int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops,
 #endif
 }
 
-/* Nonzero when libulam was built with UMFPACK. */
+/* Nonzero when libulam was built with UMFPACK and its library loads. */
 int ulam_direct_sparse_available(void)
 {
 #ifdef ULAM_UMFPACK
-    return 1;
+    return ulam__umfpack(NULL) != NULL;
 #else
     return 0;
 #endif

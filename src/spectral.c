@@ -11,10 +11,8 @@
  * the guards use) comes instead from shifted power iteration with Collatz-Wielandt bounds: for
  * any positive x, min_i (Ax)_i / x_i <= rho <= max_i (Ax)_i / x_i, so each iterate certifies a
  * bracket. */
-#include "internal.h"
+#include "dynload.h"
 
-#include <arpack.h>
-#include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,6 +41,8 @@ static void csr_op(const void *ctx, const double *x, double *y)
 static int radius_dense(int64_t n, void (*op)(const void *, const double *, double *),
                         const void *ctx, ulam_radius *out)
 {
+    const ulam__lapacke_api *L = ulam__lapacke(NULL); /* src/dynload.c: opened on first use */
+    if (!L) return ULAM_EIO;
     double *a = ulam__malloc((size_t)(n * n), sizeof *a);
     double *e = ulam__calloc((size_t)n, sizeof *e);
     double *wr = ulam__malloc((size_t)n, sizeof *wr), *wi = ulam__malloc((size_t)n, sizeof *wi);
@@ -55,7 +55,7 @@ static int radius_dense(int64_t n, void (*op)(const void *, const double *, doub
         out->matvecs++;
     }
     status = ULAM_ENOCONV;
-    if (LAPACKE_dgeev(LAPACK_COL_MAJOR, 'N', 'N', (lapack_int)n, a, (lapack_int)n, wr, wi, NULL, 1,
+    if (L->dgeev(LAPACK_COL_MAJOR, 'N', 'N', (lapack_int)n, a, (lapack_int)n, wr, wi, NULL, 1,
                       NULL, 1) != 0)
         goto done;
     out->rho = 0.0;
@@ -148,7 +148,7 @@ static int extract(arpack_ws *w, a_int *iparam, a_int *ipntr, double tol,
                    ulam_radius *out)
 {
     a_int ierr = 0;
-    dneupd_c(1, "A", w->select, w->dr, w->di, w->z, w->n, 0.0, 0.0, w->workev, "I", w->n, "LM", NEV,
+    ulam__arpack(NULL)->dneupd(1, "A", w->select, w->dr, w->di, w->z, w->n, 0.0, 0.0, w->workev, "I", w->n, "LM", NEV,
              tol, w->resid, w->ncv, w->v, w->n, iparam, ipntr, w->workd, w->workl, w->lworkl, &ierr);
     if (ierr != 0) return ULAM_ENOCONV;
     a_int nconv = iparam[4], best = 0;
@@ -176,6 +176,8 @@ int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double 
     memset(out, 0, sizeof *out);
     if (n <= DENSE_MAX) return radius_dense(n, op, ctx, out);
     if (n > INT32_MAX) return ULAM_EOVERFLOW;
+    const ulam__arpack_api *A = ulam__arpack(NULL); /* src/dynload.c: opened on first use */
+    if (!A) return ULAM_EIO;
     a_int ncv = o.krylov_dim < 2 * NEV + 1 ? 2 * NEV + 1 : o.krylov_dim;
     arpack_ws w;
     if (ws_alloc(&w, (a_int)n, ncv)) return ULAM_ENOMEM;
@@ -187,7 +189,7 @@ int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double 
     iparam[2] = o.max_restarts;
     iparam[6] = 1; /* mode 1: A x = lambda x */
     for (;;) {
-        dnaupd_c(&ido, "I", w.n, "LM", NEV, o.tol, w.resid, w.ncv, w.v, w.n, iparam, ipntr, w.workd,
+        A->dnaupd(&ido, "I", w.n, "LM", NEV, o.tol, w.resid, w.ncv, w.v, w.n, iparam, ipntr, w.workd,
                  w.workl, w.lworkl, &info);
         if (ido != -1 && ido != 1) break;
         op(ctx, w.workd + ipntr[0] - 1, w.workd + ipntr[1] - 1);

@@ -9,33 +9,6 @@
 
 #include <string.h>
 
-/* A random n x n system with k entries a row (columns drawn with replacement, duplicates summed),
- * values U(0.2, 1) with a random sign when signed_, each row of |M| scaled to sum to U(0.3, rowsum). */
-static ulam_csr *random_system(int64_t n, int k, int signed_, double rowsum, uint64_t seed)
-{
-    ulam_rng r;
-    ulam_rng_seed(&r, seed, 0);
-    int64_t nz = n * k;
-    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
-    double *tx = malloc((size_t)nz * sizeof *tx);
-    for (int64_t i = 0; i < n; i++) {
-        double sum = 0, target = 0.3 + (rowsum - 0.3) * ulam_rng_uniform(&r);
-        for (int q = 0; q < k; q++) {
-            int64_t e = i * k + q;
-            ti[e] = (int32_t)i;
-            tj[e] = (int32_t)ulam_rng_bounded(&r, (uint64_t)n);
-            tx[e] = 0.2 + 0.8 * ulam_rng_uniform(&r);
-            sum += tx[e];
-            if (signed_ && ulam_rng_uniform(&r) < 0.4) tx[e] = -tx[e];
-        }
-        for (int q = 0; q < k; q++) tx[i * k + q] *= target / sum;
-    }
-    ulam_csr *M = NULL;
-    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M), ULAM_OK);
-    free(ti), free(tj), free(tx);
-    return M;
-}
-
 /* x = (I - M)^-1 e_s by LAPACK (a new array). */
 static double *exact_column(const ulam_csr *M, int64_t s)
 {
@@ -77,7 +50,7 @@ static void test_push_invariant(void **state)
     (void)state;
     for (int k = 0; k < NSYS; k++) {
         if (!test_case(k)) continue;
-        ulam_csr *M = random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k);
+        ulam_csr *M = test_random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k);
         int64_t n = M->nrows;
         ulam_rng rg;
         ulam_rng_seed(&rg, (uint64_t)k, 1);
@@ -118,7 +91,7 @@ static void test_push_invariant(void **state)
 static void test_push_bad_input(void **state)
 {
     (void)state;
-    ulam_csr *M = random_system(10, 2, 0, 0.9, 99), *R = ulam_csr_alloc(3, 4, 0);
+    ulam_csr *M = test_random_system(10, 2, 0, 0.9, 99), *R = ulam_csr_alloc(3, 4, 0);
     ulam_push *w = NULL;
     assert_int_equal(ulam_push_alloc(R, &w), ULAM_ENOTSQUARE);
     assert_null(w);
@@ -170,7 +143,7 @@ static void test_bidir_unbiased(void **state)
     (void)state;
     static const double rmaxes[] = {0.3, 0.05, 0};
     for (int k = 0; k < NSYS; k++) {
-        ulam_csr *M = random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k), *Mt = NULL;
+        ulam_csr *M = test_random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k), *Mt = NULL;
         assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
         int64_t n = M->nrows, s = (k * 7 + 1) % n, t = (k * 3 + 2) % n;
         double *x = exact_column(M, s);
@@ -214,7 +187,7 @@ static void test_bidir_unbiased(void **state)
 static void test_bidir_plan(void **state)
 {
     (void)state;
-    ulam_csr *M = random_system(150, 5, 0, 0.85, 4), *Mt = NULL;
+    ulam_csr *M = test_random_system(150, 5, 0, 0.85, 4), *Mt = NULL;
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     ulam_bidir_opts o = ulam_bidir_defaults();
     o.source = 3, o.target = 10, o.walk.stop.max_walks = 0, o.walk.stop.rel_err = 0.05, o.walk.exec.threads = 1;
@@ -283,7 +256,7 @@ static void test_bidir_plan(void **state)
 static void test_analysis_bidir_exponent(void **state)
 {
     (void)state;
-    ulam_csr *M = random_system(150, 5, 0, 0.85, 4), *Mt = NULL;
+    ulam_csr *M = test_random_system(150, 5, 0, 0.85, 4), *Mt = NULL;
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     ulam_analysis *a = NULL;
     ulam_error err;
@@ -366,7 +339,7 @@ static void test_analysis_bidir_exponent(void **state)
 static void test_solver_starts(void **state)
 {
     (void)state;
-    ulam_csr *M = random_system(60, 4, 1, 0.85, 7);
+    ulam_csr *M = test_random_system(60, 4, 1, 0.85, 7);
     int64_t n = M->nrows, st[3] = {5, 17, 5};
     double c[3] = {0.5, -2.0, 0.25}, *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
     for (int64_t i = 0; i < n; i++) b[i] = 1.0 + (double)(i % 5) / 4.0;
@@ -409,7 +382,7 @@ static void test_bidir_sparse_b(void **state)
     (void)state;
     static const double rmaxes[] = {0.05, 0};
     for (int k = 0; k < NSYS - 1; k++) { /* the long walks of the last system: test_bidir_unbiased */
-        ulam_csr *M = random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k), *Mt = NULL;
+        ulam_csr *M = test_random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k), *Mt = NULL;
         assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
         int64_t n = M->nrows, t = (k * 3 + 2) % n;
         int64_t idx[3] = {(k * 7 + 1) % n, (k * 5 + 4) % n, (k * 11 + 6) % n};
@@ -471,7 +444,7 @@ static void test_bidir_sparse_b(void **state)
 static void test_bidir_coverage(void **state)
 {
     (void)state;
-    ulam_csr *M = random_system(40, 4, 1, 0.9, 1), *Mt = NULL;
+    ulam_csr *M = test_random_system(40, 4, 1, 0.9, 1), *Mt = NULL;
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     double *x = exact_column(M, 5);
     int covered = 0, printed = 0;
@@ -527,7 +500,7 @@ static void test_bidir_rules(void **state)
     /* M' has rows summing to 0.9, so the walks on it carry weights that never grow and the
      * rel_err rule has a bound on a single score (with M's rows at 0.9 instead, M' has column
      * sums above 1 on cycles: no score bound, and rel_err alone stops as out of reach) */
-    ulam_csr *Mt = random_system(80, 6, 0, 0.9, 3), *M = NULL;
+    ulam_csr *Mt = test_random_system(80, 6, 0, 0.9, 3), *M = NULL;
     assert_int_equal(ulam_csr_transpose(Mt, &M), ULAM_OK);
     double *x = exact_column(M, 3);
     o = ulam_bidir_defaults();
@@ -585,7 +558,7 @@ static void test_bidir_deterministic_walks(void **state)
 static void test_bidir_small_budgets(void **state)
 {
     (void)state;
-    ulam_csr *M = random_system(80, 6, 0, 0.9, 3), *Mt = NULL;
+    ulam_csr *M = test_random_system(80, 6, 0, 0.9, 3), *Mt = NULL;
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     double *x = exact_column(M, 3);
     ulam_bidir_opts o = ulam_bidir_defaults();
@@ -650,9 +623,9 @@ static void test_bidir_reach_all(void **state)
     for (int k = 0; k < NSYS + 1; k++) {
         ulam_csr *M = NULL, *Mt = NULL;
         int block = k == NSYS;
-        if (!block) M = random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k);
+        if (!block) M = test_random_system(systems[k].n, systems[k].k, systems[k].signed_, systems[k].rowsum, (uint64_t)k);
         else { /* two random blocks of 30 states, the second's rows summing up to 0.95 */
-            ulam_csr *A = random_system(30, 4, 0, 0.6, 7), *B = random_system(30, 4, 0, 0.95, 8);
+            ulam_csr *A = test_random_system(30, 4, 0, 0.6, 7), *B = test_random_system(30, 4, 0, 0.95, 8);
             int64_t nz = ulam_csr_nnz(A) + ulam_csr_nnz(B), e = 0;
             int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
             double *tx = malloc((size_t)nz * sizeof *tx);

@@ -272,4 +272,31 @@ static inline ulam_csr *rare_system(int32_t n, double pstar, double brare, doubl
     return A;
 }
 
+/* A random n x n system with k entries a row (columns drawn with replacement, duplicates summed),
+ * values U(0.2, 1) with a random sign when signed_, each row of |M| scaled to sum to U(0.3, rowsum). */
+static inline ulam_csr *test_random_system(int64_t n, int k, int signed_, double rowsum, uint64_t seed)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 0);
+    int64_t nz = n * k;
+    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
+    double *tx = malloc((size_t)nz * sizeof *tx);
+    for (int64_t i = 0; i < n; i++) {
+        double sum = 0, target = 0.3 + (rowsum - 0.3) * ulam_rng_uniform(&r);
+        for (int q = 0; q < k; q++) {
+            int64_t e = i * k + q;
+            ti[e] = (int32_t)i;
+            tj[e] = (int32_t)ulam_rng_bounded(&r, (uint64_t)n);
+            tx[e] = 0.2 + 0.8 * ulam_rng_uniform(&r);
+            sum += tx[e];
+            if (signed_ && ulam_rng_uniform(&r) < 0.4) tx[e] = -tx[e];
+        }
+        for (int q = 0; q < k; q++) tx[i * k + q] *= target / sum;
+    }
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M), ULAM_OK);
+    free(ti), free(tj), free(tx);
+    return M;
+}
+
 #endif

@@ -1,9 +1,9 @@
 /* Form factors: estimated by ray casting, checked by reciprocity, row sums and Howell's exact
  * formulas; the radiosity system M = diag(rho_c) F and its LAPACK solve. */
 #include "rad.h"
+#include "../dynload.h"
 #include "../stop.h"
 
-#include <lapacke.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -247,6 +247,8 @@ int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays,
     if (max_bytes && 2 * bytes > max_bytes)
         return ulam__fail(err, ULAM_EMEMLIMIT, 0, -1, "at most %.3g GiB for two dense matrices; n = %lld needs %.3g GiB",
                           (double)max_bytes / 1073741824.0, (long long)n, 2.0 * (double)bytes / 1073741824.0);
+    const ulam__lapacke_api *L = ulam__lapacke(err); /* src/dynload.c: opened on first use */
+    if (!L) return err ? err->status : ULAM_EIO;
     double *a = ulam__malloc((size_t)n * (size_t)n, sizeof *a), *x = ulam__malloc((size_t)n * (size_t)n, sizeof *x);
     double *noise = ulam__malloc((size_t)n, sizeof *noise);
     lapack_int *ipiv = ulam__malloc((size_t)n, sizeof *ipiv);
@@ -259,8 +261,7 @@ int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays,
             for (int64_t q = F->rowptr[k]; q < F->rowptr[k + 1]; q++) a[F->colidx[q] + k * n] -= s->rho[3 * k + c] * F->val[q];
             noise[k] = row_noise(s, F, rays, B, k, c);
         }
-        lapack_int info = LAPACKE_dgesv(LAPACK_COL_MAJOR, (lapack_int)n, (lapack_int)n, a, (lapack_int)n, ipiv, x,
-                                        (lapack_int)n);
+        lapack_int info = L->dgesv(LAPACK_COL_MAJOR, (lapack_int)n, (lapack_int)n, a, (lapack_int)n, ipiv, x, (lapack_int)n);
         if (info) {
             status = ulam__fail(err, info > 0 ? ULAM_ESINGULAR : ULAM_EINVAL, 0, -1, "a nonsingular I - M");
             break;

@@ -1,8 +1,8 @@
 /* Pictures of a solution: one ray per pixel from a pinhole camera, the hit patch's radiosity,
  * exposure and the sRGB curve, written as PNG with libpng. */
 #include "rad.h"
+#include "../dynload.h"
 
-#include <png.h>
 #include <setjmp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -316,27 +316,27 @@ int ulam_hdr_write(const char *path, int width, int height, const float *rgb)
     return ulam_outfile_commit(&o);
 }
 
-/* Write the PNG stream to f; 0 or ULAM_EIO (libpng reports by longjmp). */
-static int png_stream(FILE *f, int width, int height, const unsigned char *rgb)
+/* Write the PNG stream to f with libpng's functions P; 0 or ULAM_EIO (libpng reports by longjmp). */
+static int png_stream(const ulam__png_api *P, FILE *f, int width, int height, const unsigned char *rgb)
 {
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
-    png_infop info = png ? png_create_info_struct(png) : NULL;
+    png_structp png = P->create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_infop info = png ? P->create_info_struct(png) : NULL;
     if (!info) {
-        png_destroy_write_struct(&png, NULL);
+        P->destroy_write_struct(&png, NULL);
         return ULAM_ENOMEM;
     }
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, &info);
+    if (setjmp(*P->set_longjmp_fn(png, longjmp, sizeof(jmp_buf)))) { /* png_jmpbuf(png) */
+        P->destroy_write_struct(&png, &info);
         return ULAM_EIO;
     }
-    png_init_io(png, f);
-    png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-    png_write_info(png, info);
-    for (int y = 0; y < height; y++) png_write_row(png, rgb + (size_t)y * (size_t)width * 3);
-    png_write_end(png, NULL);
-    png_destroy_write_struct(&png, &info);
+    P->init_io(png, f);
+    P->set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    P->set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    P->write_info(png, info);
+    for (int y = 0; y < height; y++) P->write_row(png, rgb + (size_t)y * (size_t)width * 3);
+    P->write_end(png, NULL);
+    P->destroy_write_struct(&png, &info);
     return ULAM_OK;
 }
 
@@ -344,10 +344,12 @@ static int png_stream(FILE *f, int width, int height, const unsigned char *rgb)
 int ulam_png_write(const char *path, int width, int height, const unsigned char *rgb)
 {
     if (!path || !rgb || width < 1 || height < 1) return ULAM_EINVAL;
+    const ulam__png_api *P = ulam__png(NULL); /* src/dynload.c: opened on first use */
+    if (!P) return ULAM_EIO;
     ulam_outfile o;
     int status = ulam_outfile_open(&o, path);
     if (status) return status;
-    if ((status = png_stream(o.f, width, height, rgb))) {
+    if ((status = png_stream(P, o.f, width, height, rgb))) {
         ulam_outfile_abort(&o);
         return status;
     }

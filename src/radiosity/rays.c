@@ -6,13 +6,14 @@
  * scene's bounding box (computed in double): a scene far from the origin keeps the precision
  * of one at the origin, and no offset has to outgrow a float's rounding there. */
 #include "rad.h"
+#include "../dynload.h"
 
-#include <embree3/rtcore.h>
 #include <float.h>
 #include <stdlib.h>
 
 struct ulam_tracer {
     const ulam_scene *s;
+    const ulam__embree_api *E; /* Embree's functions (src/dynload.c: opened on first use) */
     RTCDevice dev;
     RTCScene scene;
     int64_t *prim_patch; /* triangle -> patch */
@@ -34,8 +35,8 @@ typedef struct {
 ulam_tracer *ulam_tracer_free(ulam_tracer *t)
 {
     if (!t) return NULL;
-    if (t->scene) rtcReleaseScene(t->scene);
-    if (t->dev) rtcReleaseDevice(t->dev);
+    if (t->scene) t->E->ReleaseScene(t->scene);
+    if (t->dev) t->E->ReleaseDevice(t->dev);
     free(t->prim_patch);
     free(t->share);
     free(t);
@@ -112,38 +113,40 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
     int64_t ntri = s->start[s->npatches] - 2 * s->npatches;
     if (ntri < 1 || ntri > (int64_t)UINT32_MAX / 4 || s->nverts > (int64_t)UINT32_MAX / 4)
         return ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "fewer than 2^30 triangles and vertices");
+    const ulam__embree_api *E = ulam__embree(err);
+    if (!E) return err ? err->status : ULAM_EDEVICE;
     ulam_tracer *t = calloc(1, sizeof *t);
     if (!t || !(t->prim_patch = ulam__malloc((size_t)ntri, sizeof *t->prim_patch)) ||
         !(t->share = ulam__malloc((size_t)s->npatches, sizeof *t->share))) {
         ulam_tracer_free(t);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the ray tracer");
     }
-    t->s = s;
+    t->s = s, t->E = E;
     for (int64_t p = 0; p < s->npatches; p++) t->share[p] = ulam__first_share(s, p);
-    if (!(t->dev = rtcNewDevice(NULL))) {
+    if (!(t->dev = t->E->NewDevice(NULL))) {
         ulam_tracer_free(t);
         return ulam__fail(err, ULAM_EDEVICE, 0, -1, "an Embree device (rtcNewDevice failed)");
     }
-    t->scene = rtcNewScene(t->dev);
-    RTCGeometry g = rtcNewGeometry(t->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float *vb = t->scene && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+    t->scene = t->E->NewScene(t->dev);
+    RTCGeometry g = t->E->NewGeometry(t->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *vb = t->scene && g ? t->E->SetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                         3 * sizeof(float), (size_t)s->nverts) : NULL;
-    unsigned *ib = vb ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+    unsigned *ib = vb ? t->E->SetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                 3 * sizeof(unsigned), (size_t)ntri) : NULL;
     if (!ib) {
-        if (g) rtcReleaseGeometry(g);
+        if (g) t->E->ReleaseGeometry(g);
         ulam_tracer_free(t);
         return ulam__fail(err, ULAM_EDEVICE, 0, -1, "Embree buffers for %lld triangles", (long long)ntri);
     }
     fill_buffers(t, vb, ib);
-    rtcSetGeometryIntersectFilterFunction(g, skip_self);
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(t->scene, g);
-    rtcReleaseGeometry(g);
-    rtcSetSceneFlags(t->scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(t->scene, RTC_BUILD_QUALITY_HIGH);
-    rtcCommitScene(t->scene);
-    if (rtcGetDeviceError(t->dev) != RTC_ERROR_NONE) {
+    t->E->SetGeometryIntersectFilterFunction(g, skip_self);
+    t->E->CommitGeometry(g);
+    t->E->AttachGeometry(t->scene, g);
+    t->E->ReleaseGeometry(g);
+    t->E->SetSceneFlags(t->scene, RTC_SCENE_FLAG_ROBUST);
+    t->E->SetSceneBuildQuality(t->scene, RTC_BUILD_QUALITY_HIGH);
+    t->E->CommitScene(t->scene);
+    if (t->E->GetDeviceError(t->dev) != RTC_ERROR_NONE) {
         ulam_tracer_free(t);
         return ulam__fail(err, ULAM_EDEVICE, 0, -1, "an Embree scene (building it failed)");
     }
@@ -170,7 +173,7 @@ static int64_t cast_from(const ulam_tracer *t, const double org[3], const double
     rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(t->scene, &rc.ctx, &rh);
+    t->E->Intersect1(t->scene, &rc.ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
     int64_t p = t->prim_patch[rh.hit.primID];
     if (front) *front = ulam__dot3(dir, t->s->normal + 3 * p) < 0;
@@ -204,7 +207,7 @@ int64_t ulam__tracer_cast_front_uv(const ulam_tracer *t, const double org[3], co
     rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f, rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(t->scene, &rc.ctx, &rh);
+    t->E->Intersect1(t->scene, &rc.ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
     int64_t p = t->prim_patch[rh.hit.primID];
     *k = (int64_t)rh.hit.primID - (t->s->start[p] - 2 * p) + 1; /* a patch of m vertices has m - 2 triangles */
