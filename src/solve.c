@@ -1379,6 +1379,9 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
         if (j == 0 || c.half < best) best = c.half, *ci = c, *R = Rt;
     }
     if (s->var_finite != 1 && ci->kind != ULAM__STOP_EXACT) ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
+    if (ci->kind == ULAM__STOP_EB && r->estimate != 0.0 && s->maxsq < ULAM__STOP_TINY) /* a b not rescaled (a prepared
+        file's, read lazily) far below 1: b = 1e-300 printed '+- 0' and the range term alone, 22 of 50 seeds covered */
+        ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
 }
 
 /* The result so far; the forward count of unreached components (O(n)) when asked; walked: at the
