@@ -229,6 +229,10 @@ CASES += [
     (["radiosity", SC + "cube.obj", "--patch", "attic"], 2, r"neither a patch number nor a label; labels: floor ceiling", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--image", "x.png"], 2, r"--image needs --mode shoot, --direct or --view-gather", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "-5"], 2, r"--walks expects an integer", ""),
+    # --time counts the whole run: the walks spend a tiny budget, and the mesh error is not
+    # estimated after it (each of its points had the whole budget again: 32 s for --time 5)
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--time", "1e-6"], 0, r"^$",
+     r"^mesh error   not estimated: the walks spent --time"),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--subdivide", "0"], 2, r"--subdivide expects a number", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--mode", "sideways"], 2, r"--mode expects gather or shoot", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--size", "0x5"], 2, r"--size expects WxH", ""),
