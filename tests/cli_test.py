@@ -922,6 +922,9 @@ def check_exact_zero_no_warning(ulam):
             o = json.loads(out)
             assert rc == 0 and o["rel_err_met"] and o["ci95"] == [0, 0], (mode, rc, o)
             assert o["min_walks"] <= o["walks"] and "needs about" not in err, (mode, o["min_walks"], err)
+        rc, out, err = run(ulam, ["solve", f"{d}/two.mtx", "--rhs", f"{d}/two_b.mtx", "--index", "15", "--mode", "forward",
+                                  "--rel-err", "0.1"])  # the text says it is exact, not 'unreached'
+        assert rc == 0 and re.search(r"^x\[15\] +0 exactly \(95% CI 0 \.\. 0", out, re.M), out
 
 
 def check_adjoint_scale(ulam):

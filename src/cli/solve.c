@@ -138,7 +138,10 @@ static int too_small(const ulam_walk_result *r)
 /* Print the answer line: x[I] with its interval, or why there is none. */
 static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 {
-    if (o->mode == ULAM_FORWARD && isnan(r->std_error))
+    if (o->mode == ULAM_FORWARD && isnan(r->std_error) && r->ci95[0] == 0 && r->ci95[1] == 0)
+        printf("x[%lld]%*s0 exactly (95%% CI 0 .. 0: no walk from where b is nonzero can reach it)%s\n",
+               (long long)o->query.index + 1, o->query.index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
+    else if (o->mode == ULAM_FORWARD && isnan(r->std_error))
         printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->query.index + 1,
                o->query.index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1 && isnan(r->ci95[0]))
