@@ -327,7 +327,8 @@ typedef struct ulam_rad_mesh {
 /* The mesh error of the patch query of patch opts->index that answered B (RGB): point queries
  * (ulam_rad_point_query with opts, each its seed from stream (opts->exec.seed, k + 1)) on the
  * continuous surfaces at the patch's area centroid and half way from it to each of its first 8
- * vertices, against B. */
+ * vertices, against B.  opts->stop.max_seconds is for all the points (each gets what is left
+ * shared among the points left; one block of walks still runs when nothing is). */
 int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_rad_opts *opts, const double B[3], ulam_rad_mesh *out,
                         ulam_error *err);
 

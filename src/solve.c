@@ -987,10 +987,13 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
     s->o = o;
     s->b = b;
-    /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered;
-       not on the lazy path (adjoint with the guards given reads only the b_i its walks reach) */
-    s->bexp = !kernel && !reach && o.stop.rel_err_offset == 0.0 && (o.mode == ULAM_ADJOINT ? !o.policy.guard
-                                                                 : !(o.kernel.roulette > 0 || o.kernel.split > 0))
+    /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered
+       and no score's square underflows (b = 1e-300: a standard error of 0); not with a kernel
+       scored to b, nor on a prepared file's lazy path (adjoint with guards or a reach given reads
+       only the b_i its walks reach); a reach's summary of b is then not this b's (bounds_pass) */
+    int lazy = o.mode == ULAM_ADJOINT && o.policy.system && (o.policy.guard || reach);
+    s->bexp = !kernel && !lazy && o.stop.rel_err_offset == 0.0 &&
+                      (o.mode == ULAM_ADJOINT || !(o.kernel.roulette > 0 || o.kernel.split > 0))
                   ? ulam__b_exponent(b, M->nrows) : 0;
     if (s->bexp && !(s->b = b = s->bs = ulam__b_scaled(b, M->nrows, s->bexp))) goto nomem;
     s->n = M->nrows;
@@ -1078,7 +1081,7 @@ int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_wa
 /* The solver's kernel, kept for later solvers (see internal.h). */
 ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s)
 {
-    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || ulam__kernel_keep(s->k)) return NULL;
+    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || s->bexp || ulam__kernel_keep(s->k)) return NULL; /* bexp: scored to b 2^-bexp */
     s->k_borrowed = 1;
     return s->k;
 }
@@ -1086,7 +1089,7 @@ ulam_kernel *ulam__solver_keep_kernel(ulam_solver *s)
 /* The solver's kernel, kept for later solvers with the same b, unchanged (see internal.h). */
 ulam_kernel *ulam__solver_keep_kernel_fixed(ulam_solver *s)
 {
-    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || atomic_load(&s->k->status)) return NULL;
+    if (!s || s->k_borrowed || s->o.mode != ULAM_ADJOINT || s->bexp || atomic_load(&s->k->status)) return NULL;
     s->k_borrowed = 1, s->k->fixed = 1; /* nothing recorded: only this b, unchanged, rescores (a no-op) */
     return s->k;
 }
@@ -1151,7 +1154,7 @@ static int kernel_status(void *ctx)
     return atomic_load(&s->k->status);
 }
 
-static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached);
+static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached, int walked);
 
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci);
 
@@ -1249,12 +1252,12 @@ int ulam_solver_iterate(ulam_solver *s)
                                    begin_round, kernel_status};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
-    result(s, &r, 0);
-    if (!s->run.status && !isfinite(r.estimate) && s->run.walks > 0) /* beyond the largest double */
+    result(s, &r, 0, 1); /* the rules compare it with bounds made on the walked b */
+    if (!s->run.status && !isfinite(ldexp(r.estimate, s->bexp)) && s->run.walks > 0) /* beyond the largest double */
         s->run.status = ULAM_ENONFINITE, s->run.done = s->overflow = 1;
     if (!s->run.status && search_reach(s, &r)) {
         if (s->run.status) return s->run.status; /* the search failed */
-        result(s, &r, 0);
+        result(s, &r, 0, 1);
     }
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
@@ -1376,10 +1379,15 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
         if (j == 0 || c.half < best) best = c.half, *ci = c, *R = Rt;
     }
     if (s->var_finite != 1 && ci->kind != ULAM__STOP_EXACT) ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
+    if (ci->kind == ULAM__STOP_EB && r->estimate != 0.0 && s->maxsq < ULAM__STOP_TINY) /* a b not rescaled (a prepared
+        file's, read lazily) far below 1: b = 1e-300 printed '+- 0' and the range term alone, 22 of 50 seeds covered */
+        ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
 }
 
-/* The result so far; the forward count of unreached components (O(n)) when asked. */
-static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached)
+/* The result so far; the forward count of unreached components (O(n)) when asked; walked: at the
+ * scale the walks ran on (b 2^-bexp, the scale of the solver's bounds: what the rules compare),
+ * else at b's. */
+static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreached, int walked)
 {
     memset(r, 0, sizeof *r);
     if (!s) return;
@@ -1411,7 +1419,8 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
         r->min_walks = fmin(ulam__stop_walks_needed(m, r->variance, R, ci.bias, E, ci.k),
                             ulam__stop_walks_needed(m, r->variance, Rs, (truncated ? E * m / 4.0 : 0.0) + r->cut_bound,
                                                     E, ci.k));
-        if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0) r->min_walks = s->hit_walks; /* no score yet: src/hit.c */
+        if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0 && ci.kind != ULAM__STOP_EXACT)
+            r->min_walks = s->hit_walks; /* no score yet: src/hit.c (not over an x certified exactly) */
     }
     r->cut_stop = s->cut_stop;
     r->out_of_reach = s->out_of_reach;
@@ -1425,7 +1434,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->interrupted = s->run.interrupted;
     r->rho4 = s->rho4;
     r->fourth_finite = s->fourth;
-    if (s->bexp) { /* walked on b 2^-bexp: back to b's scale (exact) */
+    if (s->bexp && !walked) { /* walked on b 2^-bexp: back to b's scale (exact) */
         int e = s->bexp;
         r->estimate = ldexp(r->estimate, e), r->std_error = ldexp(r->std_error, e);
         r->ci95[0] = ldexp(r->ci95[0], e), r->ci95[1] = ldexp(r->ci95[1], e);
@@ -1437,7 +1446,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
 /* The result so far. */
 void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
 {
-    result(s, r, 1);
+    result(s, r, 1, 0);
 }
 
 /* The guards' verdicts the solver walks under. */

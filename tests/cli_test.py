@@ -9,6 +9,7 @@ A failing case prints its name: `table:K` (K-th row of CASES, from 0) or a check
 (`check_study`); `--case NAME` (repeatable) runs only those, e.g. --case table:12 --case check_study.
 """
 import json
+import math
 import os
 import re
 import signal
@@ -228,6 +229,10 @@ CASES += [
     (["radiosity", SC + "cube.obj", "--patch", "attic"], 2, r"neither a patch number nor a label; labels: floor ceiling", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--image", "x.png"], 2, r"--image needs --mode shoot, --direct or --view-gather", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "-5"], 2, r"--walks expects an integer", ""),
+    # --time counts the whole run: the walks spend a tiny budget, and the mesh error is not
+    # estimated after it (each of its points had the whole budget again: 32 s for --time 5)
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--time", "1e-6"], 0, r"^$",
+     r"^mesh error   not estimated: the walks spent --time"),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--subdivide", "0"], 2, r"--subdivide expects a number", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--mode", "sideways"], 2, r"--mode expects gather or shoot", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--size", "0x5"], 2, r"--size expects WxH", ""),
@@ -374,6 +379,28 @@ def check_radiosity_rare_lamp(ulam):
         covered += abs(j["radiosity"][0] - exact) <= Z95 * j["stderr"][0]
     # binomial(100, 0.95): P(X < 88) = 0.0015
     assert covered >= 88, f"next-event on the rare lamp: {covered} of 100 intervals cover"
+
+
+def check_radiosity_emission_scale(ulam):
+    """A furnace (closed unit cube, Kd 0.5 0.6 0.7) whose Ke is 1e-300 or 1e300: the walks'
+    scores squared underflow or overflow.  It printed '1.99e-300 +- 0' with an interval of the
+    range term alone (--rel-err 0.05 'met' on that), or '1.99e+300 +- inf (95% CI 0 .. inf)' and
+    --rel-err spun past 60 s.  An emission the walks cannot square is refused where it is read
+    (file and line, no output); 1e-70 and 1e70 still run."""
+    cube = ["v 0 0 0", "v 1 0 0", "v 1 1 0", "v 0 1 0", "v 0 0 1", "v 1 0 1", "v 1 1 1", "v 0 1 1",
+            "f 1 2 3 4", "f 5 8 7 6", "f 1 4 8 5", "f 2 6 7 3", "f 1 5 6 2", "f 4 3 7 8"]
+    with tempfile.TemporaryDirectory() as d:
+        for ke, ok in (("1e-300", False), ("1e300", False), ("1e-70", True), ("1e70", True)):
+            with open(f"{d}/f.mtl", "w") as f:
+                f.write(f"newmtl glow\nKd 0.5 0.6 0.7\nKe {ke} 1 1\n")
+            with open(f"{d}/f.obj", "w") as f:
+                f.write("mtllib f.mtl\nusemtl glow\n" + "\n".join(cube) + "\n")
+            rc, out, err = run(ulam, ["radiosity", f"{d}/f.obj", "--patch", "1", "--walks", "200", "--json"])
+            if ok:
+                j = json.loads(out)
+                assert rc == 0 and j["stderr"][0] > 0 and j["ci95_lo"][0] <= 2 * float(ke) <= j["ci95_hi"][0], (ke, rc, err, j)
+            else:
+                assert rc != 0 and "f.mtl:3:" in out and "Ke" in out and '"error"' in out, (ke, rc, out, err)
 
 
 def on_tty(ulam, args):
@@ -875,6 +902,69 @@ def check_zero_estimate_stops(ulam):
         p, pb = write_cancellation(d)
         rc, out, err = run(ulam, ["solve", p, "--rhs", pb, "--index", "1", "--rel-err", "0.1", "--verbose"])
         assert rc == 0 and re.search(r"^  \* .* predicted >= \S+ walks", out, re.M), out
+
+
+def check_exact_zero_no_warning(ulam):
+    """Two disconnected rings, b on the first: x_15 = 0, certified exactly (nothing that scores
+    reaches it).  A --rel-err run is met at once with the interval [0, 0]; it warned that the rule
+    'needs about 1.79e+09 walks ... (out of reach in practice)' and reported that count as
+    min_walks (the zero-estimate hit bound, src/hit.c, laid over an exact interval)."""
+    ent = []
+    for base in (0, 10):
+        for i in range(10):
+            ent += [(base + i + 1, base + (i + 1) % 10 + 1, 0.5), (base + i + 1, base + (i + 3) % 10 + 1, 0.3)]
+    with tempfile.TemporaryDirectory() as d:
+        write_mtx(f"{d}/two.mtx", 20, ent)
+        write_vec(f"{d}/two_b.mtx", [1.0] * 10 + [0.0] * 10)
+        for mode in ("forward", "adjoint"):
+            rc, out, err = run(ulam, ["solve", f"{d}/two.mtx", "--rhs", f"{d}/two_b.mtx", "--index", "15", "--mode", mode,
+                                      "--rel-err", "0.1", "--json"])
+            o = json.loads(out)
+            assert rc == 0 and o["rel_err_met"] and o["ci95"] == [0, 0], (mode, rc, o)
+            assert o["min_walks"] <= o["walks"] and "needs about" not in err, (mode, o["min_walks"], err)
+        rc, out, err = run(ulam, ["solve", f"{d}/two.mtx", "--rhs", f"{d}/two_b.mtx", "--index", "15", "--mode", "forward",
+                                  "--rel-err", "0.1"])  # the text says it is exact, not 'unreached'
+        assert rc == 0 and re.search(r"^x\[15\] +0 exactly \(95% CI 0 \.\. 0", out, re.M), out
+
+
+def check_adjoint_scale(ulam):
+    """b = 2^-1000 (1, ..., 1) on a 30 x 30 system (rows of M sum to 0.7, x = 10/3 2^-1000): adjoint
+    walks are walked on b scaled back to 1 (a power of 2: exact) as forward walks are, so the pinned
+    run's estimate and interval are b = 1's times 2^-1000 and the rule stops at b = 1's walks.
+    Before, the CLI (which hands the solver its guards) walked on b itself: every score squared
+    underflowed to 0, the standard error printed 0 and the interval was the range term alone
+    (auto, seed 1, 20000 walks: [0.9915, 0.9995] x, excluding x; 43/100 seeds covered), and
+    --rel-err 0.02 was 'met' on that zero variance at 1024 walks."""
+    n, e = 30, -1000
+    ent = [(i + 1, (i * 7 + k * 11) % n + 1, w) for i in range(n) for k, w in enumerate((0.4, 0.2, 0.1))]
+    with tempfile.TemporaryDirectory() as d:
+        write_mtx(f"{d}/m.mtx", n, ent)
+        write_vec(f"{d}/one.mtx", [1.0] * n)
+        write_vec(f"{d}/tiny.mtx", [math.ldexp(1.0, e)] * n)
+        x = math.ldexp(10.0 / 3.0, e)
+        pinned = ["--method", "walks", "--mode", "adjoint", "--estimator", "collision", "--json", "--seed", "1"]
+        for rule in (["--walks", "20000"], ["--rel-err", "0.02"]):
+            got = []
+            for rhs in ("one", "tiny"):
+                rc, out, err = run(ulam, ["solve", f"{d}/m.mtx", "--rhs", f"{d}/{rhs}.mtx", "--index", "2"] + pinned + rule)
+                assert rc == 0, (rhs, rule, rc, err)
+                got.append(json.loads(out))
+            a, b = got
+            assert b["walks"] == a["walks"] and b["estimate"] == math.ldexp(a["estimate"], e), (rule, a, b)
+            assert b["ci95"] == [math.ldexp(c, e) for c in a["ci95"]] and b["stderr"] > 0, (rule, a["ci95"], b["ci95"])
+        rc, out, err = run(ulam, ["solve", f"{d}/m.mtx", "--rhs", f"{d}/tiny.mtx", "--index", "2", "--walks", "20000",
+                                  "--json", "--seed", "1"])
+        o = json.loads(out)
+        assert rc == 0 and o["stderr"] > 0 and o["ci95"][0] <= x <= o["ci95"][1], (rc, err, o["ci95"], x)
+        # a prepared file's b is read lazily, not rescaled: no interval rather than one of the range term
+        # alone ('+- 0 (95% CI 3.305e-300 .. 3.332e-300)' against x = 3.111e-301 ... : 22 of 50 seeds covered)
+        rc, out, err = run(ulam, ["prepare", f"{d}/m.mtx", "--rhs", f"{d}/tiny.mtx", "-o", f"{d}/tiny.ulam"])
+        assert rc == 0, err
+        for v in (["--json"], []):
+            rc, out, err = run(ulam, ["solve", f"{d}/tiny.ulam", "--index", "2", "--walks", "20000", "--seed", "1"] + v)
+            assert rc == 0 and (json.loads(out)["ci95"] in (None, [None, None]) if v else "scores too small to square" in out), (rc, out, err)
+        rc, out, err = run(ulam, ["solve", f"{d}/tiny.ulam", "--index", "2", "--rel-err", "0.05", "--seed", "1"])
+        assert rc == 0 and re.search(r"^rel-err +NOT met .*too small to square", out, re.M), (rc, out, err)
 
 
 def check_honest_verdicts(ulam):
@@ -1884,14 +1974,14 @@ def main():
         return 2
     part = "table" if "--table" in flags else "checks" if "--checks" in flags else None  # meson runs the halves apart
     failures, n = check_table(ulam, rows if cases else None) if part != "checks" else (0, 0)
-    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_exact_zero_no_warning, ulam), (check_adjoint_scale, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_summary, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam), (check_radiosity_image_noise, ulam),
              (check_radiosity_matrix_rel_err, ulam), (check_radiosity_grid, ulam),
              (check_honest_verdicts, ulam), (check_study_question, ulam),
-             (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam),
+             (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam), (check_radiosity_emission_scale, ulam),
              (check_bidir, ulam), (check_queries, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
              (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),

@@ -460,6 +460,35 @@ static void test_forward_rel_err(void **state)
     }
 }
 
+/* Scale: b times 2^-1000 or 2^1000 is walked on b scaled by a power of 2 (exact), so a forward
+ * --rel-err run must stop where the run on b stops, with the same walks and the interval scaled.
+ * Before, the rule was checked on the result already scaled back (estimate 1e-300) against the
+ * bounds of the walked scale (~1): the rule was never met, and the run walked to its budget
+ * (10^9 by default, 48 s; here 2^20) "NOT met" where the run on b met at 1024 walks. */
+static void test_forward_rel_err_scale(void **state)
+{
+    (void)state;
+    int64_t n = 200;
+    double *b, *x;
+    ulam_csr *M = forward_system(n, 1, 12, &b, &x);
+    double *bs = malloc((size_t)n * sizeof *bs);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.mode = ULAM_FORWARD, o.query.index = 0, o.stop.rel_err = 0.1, o.stop.max_walks = (int64_t)1 << 20, o.exec.seed = 7;
+    ulam_walk_result r0, r;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r0, NULL), ULAM_OK);
+    assert_true(r0.rel_err_met && r0.walks < o.stop.max_walks);
+    for (int e = -1000; e <= 1000; e += 2000) {
+        for (int64_t i = 0; i < n; i++) bs[i] = ldexp(b[i], e);
+        assert_int_equal(ulam_solve_walks(M, bs, &o, &r, NULL), ULAM_OK);
+        print_message("b 2^%d: %s after %lld walks (b: %lld)\n", e, r.rel_err_met ? "met" : "NOT met", (long long)r.walks,
+                      (long long)r0.walks);
+        assert_true(r.rel_err_met);
+        assert_int_equal(r.walks, r0.walks);
+        assert_true(r.estimate == ldexp(r0.estimate, e) && r.ci95[0] == ldexp(r0.ci95[0], e) && r.ci95[1] == ldexp(r0.ci95[1], e));
+    }
+    free(bs), ulam_csr_free(M), free(b), free(x);
+}
+
 /* A zero running estimate (issue 25: "runs that cannot meet a target say so early ... never
  * spin silently"): upwind convection-diffusion 30 x 30 (bench/gen.h, c = 1) by its Jacobi
  * splitting, a point source at the centre, the upstream corner x_0 = 1.1e-11, which a walk
@@ -507,7 +536,7 @@ int main(void)
                                        cmocka_unit_test(test_metastable_rounds), cmocka_unit_test(test_metastable_auto),
                                        cmocka_unit_test(test_metastable_rel_err), cmocka_unit_test(test_laplace_corner),
                                        cmocka_unit_test(test_rel_err_cost), cmocka_unit_test(test_push_b),
-                                       cmocka_unit_test(test_laplace_noisy_auto), cmocka_unit_test(test_forward_rel_err),
+                                       cmocka_unit_test(test_laplace_noisy_auto), cmocka_unit_test(test_forward_rel_err), cmocka_unit_test(test_forward_rel_err_scale),
                                        cmocka_unit_test(test_zero_estimate_stops)};
     return test_run(tests);
 }

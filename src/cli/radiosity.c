@@ -639,6 +639,7 @@ typedef struct {
     const walked *w;
     ulam_view_info view; /* --view-gather */
     int mesh_known;      /* mesh holds the patch's mesh error (ray gathering at --patch) */
+    int mesh_no_time;    /* the mesh error was not estimated: the walks spent --time */
     ulam_rad_mesh mesh;
     int adapted, view_importance; /* --mesh-target: adapt holds what it did (by the view's importance) */
     ulam_rad_adapt_info adapt;
@@ -733,6 +734,8 @@ static void print_text(const args *a, const report *r)
                    "             answer is not exactly 0, a walk scores with probability below 3/%lld = %.2g (95%%)\n",
                    (long long)w->walks, (long long)w->walks, 3.0 / (double)w->walks);
         if (r->mesh_known) print_mesh(r, w);
+        if (r->mesh_no_time)
+            printf("mesh error   not estimated: the walks spent --time (raise it, or --no-mesh-error)\n");
     }
     if (w)
         printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)%s\n", (long long)w->walks,
@@ -821,6 +824,7 @@ static void print_json(const args *a, const report *r)
                 json_triple("surface_at_centroid_stderr", r->mesh.point_se[0]);
                 printf("\"mesh_error_dominates\": %s, ", dom ? "true" : "false");
             }
+            if (r->mesh_no_time) cli_json_string("mesh_error_skipped", "the walks spent --time", 0);
             if (a->matrix_walk) {
                 json_triple("walk_stderr", w->se_walk);
                 if (r->ff_se_known) json_triple("ff_stderr", r->direct_se);
@@ -1507,6 +1511,8 @@ int cli_radiosity(int argc, char **argv)
         fprintf(stderr, "ulam radiosity: warning: %s: patch %lld is only %.0f float steps across where it lies: ray "
                         "casting resolves it to %.2g of its size (move the scene's parts closer together)\n",
                 a.scene, (long long)coarse + 1, 1.0 / res, res);
+    double budget = a.o.stop.max_seconds; /* --time counts the whole run: reading, the tracer, the walks, the mesh */
+    a.o.stop.max_seconds = cli_time_left(budget);
     if (a.nat || a.grid) {
         rc = run_points(&a, t, s);
         goto done;
@@ -1520,10 +1526,13 @@ int cli_radiosity(int argc, char **argv)
                                           Bd && r.patch >= 0 ? Bd + 3 * r.patch : NULL, &w)
                            : ray_walks(&a, t, s->npatches, &w);
         if (rc) goto done;
-        if (a.patch && a.o.mode == ULAM_ADJOINT && !w.interrupted && !a.no_mesh) { /* the mesh's error beside */
+        r.mesh_no_time = budget > 0 && a.patch && a.o.mode == ULAM_ADJOINT && !w.interrupted && !a.no_mesh &&
+                         !(budget - (ulam_now() - cli_started) > 0);
+        if (a.patch && a.o.mode == ULAM_ADJOINT && !w.interrupted && !a.no_mesh && !r.mesh_no_time) { /* the mesh's error beside */
             ulam_rad_opts mo = rad_opts(&a.o); /* each point to twice the patch's relative error or 1/4 its walks (>= 256) */
             mo.index = r.patch, mo.estimator = ULAM_RAD_NEXT_EVENT, mo.stop.rel_err = 2 * a.o.stop.rel_err;
             if (a.o.stop.max_walks > 0) mo.stop.max_walks = a.o.stop.max_walks / 4 > 256 ? a.o.stop.max_walks / 4 : 256;
+            mo.stop.max_seconds = cli_time_left(budget); /* what the walks left of --time */
             cli_catch_sigint();
             int st = ulam_rad_mesh_error(t, &mo, w.B, &r.mesh, &err);
             cli_release_sigint();

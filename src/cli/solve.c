@@ -128,16 +128,28 @@ static double peak_rss_mib(void)
     return kb >= 0 ? kb / 1024.0 : getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
 }
 
+/* Nonzero when the interval was withheld because the scores are too small to square (a b far
+ * below 1 that the solver could not rescale: a prepared file's, read lazily; src/stop.h). */
+static int too_small(const ulam_walk_result *r)
+{
+    return r->estimate != 0 && fabs(r->estimate) < 0x1p-480 && r->std_error == 0 && isnan(r->ci95[0]);
+}
+
 /* Print the answer line: x[I] with its interval, or why there is none. */
 static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 {
-    if (o->mode == ULAM_FORWARD && isnan(r->std_error))
+    if (o->mode == ULAM_FORWARD && isnan(r->std_error) && r->ci95[0] == 0 && r->ci95[1] == 0)
+        printf("x[%lld]%*s0 exactly (95%% CI 0 .. 0: no walk from where b is nonzero can reach it)%s\n",
+               (long long)o->query.index + 1, o->query.index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
+    else if (o->mode == ULAM_FORWARD && isnan(r->std_error))
         printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->query.index + 1,
                o->query.index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1 && isnan(r->ci95[0]))
         printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->query.index + 1,
                o->query.index < 9 ? 10 : 9, "", r->estimate, r->std_error,
                !isfinite(r->cut_bound) ? "walks cut at --max-steps may have moved it by any amount"
+               : too_small(r) ? "scores too small to square in doubles, so no variance: scale b up (a prepared "
+                                "file's b is not rescaled)"
                : !isfinite(r->tail_bound) && r->estimate != 0 ? "no certified range of a single walk's score"
                : "no certified range yet, or a score past the certified one", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1)
@@ -163,8 +175,9 @@ void cli_print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int v
                o->stop.rel_err);
     else if (o->stop.rel_err > 0 && r->out_of_reach && !isfinite(r->ci95[0]) &&
              !(r->min_walks > (o->stop.max_walks > 0 ? (double)o->stop.max_walks : (double)ULAM_REL_ERR_CAP)))
-        printf("rel-err         NOT met (target %.3g): a score passed the certified range, so no interval can be "
+        printf("rel-err         NOT met (target %.3g): %s, so no interval can be "
                "printed; stopped after %lld walks, over 1024 times the %.4g the rule asked for\n", o->stop.rel_err,
+               too_small(r) ? "the scores are too small to square in doubles (scale b up)" : "a score passed the certified range",
                (long long)r->walks, r->min_walks);
     else if (o->stop.rel_err > 0 && r->estimate == 0 && r->out_of_reach && r->min_walks > 0 && isfinite(r->min_walks))
         printf("rel-err         NOT met (target %.3g): no walk has scored in %lld; a walk scores at all with probability "
@@ -393,9 +406,9 @@ static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const 
     }
     if (!(r->min_walks > limit)) return;
     if (isfinite(r->score_bound))
-        fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %s score can reach %.4g, so the rule needs about "
+        fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %sscore can reach %.4g, so the rule needs about "
                         "%.3g walks at this estimate before it may stop (%s)%s\n", s->matrix_path, o->stop.rel_err,
-                o->estimator == ULAM_ABSORPTION ? "absorption" : "", r->score_bound, r->min_walks,
+                o->estimator == ULAM_ABSORPTION ? "absorption " : "", r->score_bound, r->min_walks,
                 o->stop.max_walks > 0 ? "more than --walks" : "out of reach in practice",
                 o->estimator == ULAM_ABSORPTION ? "; the collision and expected estimators score b directly and "
                                                   "have no such tail" : "");

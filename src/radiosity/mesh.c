@@ -33,6 +33,10 @@ int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_rad_opts *opts, const d
     double t0 = ulam_now();
     for (int k = 0; k < out->npoints; k++) {
         ulam_rad_opts o = *opts;
+        if (opts->stop.max_seconds > 0) { /* the time limit is all the points': what is left, shared */
+            o.stop.max_seconds = (opts->stop.max_seconds - (ulam_now() - t0)) / (out->npoints - k);
+            if (!(o.stop.max_seconds > 0)) o.stop.max_seconds = 1e-9; /* one block still runs: an estimate */
+        }
         ulam_rng r;
         ulam_rng_seed(&r, opts->exec.seed, (uint64_t)k + 1);
         o.exec.seed = ulam__rng_next(&r);

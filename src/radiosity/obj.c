@@ -167,6 +167,12 @@ static int mtl_colour(objr *o, const char *path, long line, char *args, int is_k
     for (int i = 0; i < 3; i++)
         if (c[i] < 0 || (is_kd && c[i] >= 1))
             return mtl_fail(o, path, ULAM_ERANGE, line, "%s", what);
+    for (int i = 0; !is_kd && i < 3; i++) /* the walks square their scores: 2^(+-256) keeps every square a
+                                            normal double (1e-300 printed '+- 0', 1e300 '+- inf') */
+        if (c[i] > 0 && !(c[i] >= 0x1p-256 && c[i] <= 0x1p256))
+            return mtl_fail(o, path, ULAM_ERANGE, line, "%s",
+                            "Ke r g b: each nonzero emission within [2^-256, 2^256], about [8.6e-78, 1.2e77] (the walks square their scores; "
+                            "radiosity is linear in Ke: scale the scene's emission)");
     return ULAM_OK;
 }
 
