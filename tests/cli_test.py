@@ -646,6 +646,24 @@ def check_passive_threads(ulam):
     assert "OMP_WAIT_POLICY = 'PASSIVE'" in err and "GOMP_SPINCOUNT = '0'" in err, err
     err = shown({"OMP_WAIT_POLICY": "active"})
     assert "OMP_WAIT_POLICY = 'ACTIVE'" in err and "GOMP_SPINCOUNT = '0'" not in err, err
+    # the process run again keeps its name (mpi_test's interrupt check finds the ranks by it: an
+    # exec of /proc/self/exe named them "exe" and it waited forever)
+    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "OPENBLAS_THREAD_TIMEOUT")}
+    p = subprocess.Popen([ulam, "solve", "--method", "walks", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx",
+                          "--index", "2", "--walks", "100000000000", "--threads", "1"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=dict(env, ULAM_TEST_STOP_AT_WALKS="1"))
+    try:
+        state = ""
+        while state != "T" and p.poll() is None:  # it stops itself once the walks' handler is set
+            try:
+                state = [l for l in open(f"/proc/{p.pid}/status") if l.startswith("State:")][0].split()[1]
+            except (OSError, IndexError):
+                pass
+        comm = open(f"/proc/{p.pid}/comm").read().strip()
+        assert comm == "ulam", comm
+    finally:
+        p.kill()
+        p.communicate()
 
 
 def run(ulam, args):

@@ -73,7 +73,12 @@ static void passive_threads(int argc, char **argv, char **envp)
     if (omp) env[n++] = "OMP_WAIT_POLICY=PASSIVE";
     if (blas) env[n++] = "OPENBLAS_THREAD_TIMEOUT=4";
     env[n] = NULL;
-    execve("/proc/self/exe", argv, env); /* returns only on failure: run on as we are */
+    /* the file itself, not /proc/self/exe: the process keeps its name ("ulam", not "exe") */
+    char self[4096];
+    ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (len <= 0 || len >= (ssize_t)sizeof self - 1) return;
+    self[len] = '\0';
+    execve(self, argv, env); /* returns only on failure (the file moved or deleted): run on as we are */
 }
 __attribute__((section(".preinit_array"), used)) static void (*const cli_preinit)(int, char **, char **) =
     passive_threads;
