@@ -59,6 +59,11 @@ extern "C" {
 /* The standard normal's 97.5% quantile: every 95% interval is estimate -+ ULAM_Z95 stderr. */
 #define ULAM_Z95 1.959963984540054
 
+/* Scores below this in magnitude (all of a run's) are too small to square in doubles: their
+ * variance may underflow to 0, so such a run prints no interval (a b far below 1 that the solver
+ * cannot rescale: a prepared file's, read lazily). */
+#define ULAM_SCORE_TINY 0x1p-480
+
 /* ---------------------------------------------------------------- status codes */
 /* All primary. */
 

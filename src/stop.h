@@ -27,8 +27,8 @@
 #define ULAM__STOP_DELTA 0.05 /* 1 - the confidence of every printed interval */
 #define ULAM__STOP_N0 1024    /* the first epoch's walks (one block) */
 #define ULAM__STOP_TAIL 0.01  /* the largest share of |x| the truncation bias may take (fixed budgets) */
-#define ULAM__STOP_TINY 0x1p-960 /* below this largest score^2 (scores under 2^-480) a sample's squares are near the
-                                    subnormal doubles, its variance may have underflowed to 0: no interval */
+#define ULAM__STOP_TINY (ULAM_SCORE_TINY * ULAM_SCORE_TINY) /* below this largest score^2 a sample's squares are near
+                                    the subnormal doubles, its variance may have underflowed to 0: no interval */
 #define ULAM__STOP_ROUNDING 1e-9 /* a score at the range's edge, up to the rounding of a walk's weight
                                     products (S / q = 1 computed as 0.9 / 0.9 along many steps), is
                                     inside it: only a score past limit (1 + this) is beyond */

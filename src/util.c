@@ -77,11 +77,10 @@ void ulam__clear(ulam_error *err)
     err->file[0] = '\0';
 }
 
-/* malloc of n items of size sz, NULL on overflow. */
 #define ULAM__HUGE_BYTES ((size_t)4 << 20) /* blocks from this size on may be given 2 MiB pages */
 #define ULAM__HUGE_PAGE ((uintptr_t)2 << 20)
 
-/* malloc of n items of size sz. */
+/* malloc of n items of size sz, NULL on overflow. */
 void *ulam__malloc(size_t n, size_t sz)
 {
     if (sz && n > SIZE_MAX / sz) return NULL;

@@ -132,7 +132,7 @@ static double peak_rss_mib(void)
  * below 1 that the solver could not rescale: a prepared file's, read lazily; src/stop.h). */
 static int too_small(const ulam_walk_result *r)
 {
-    return r->estimate != 0 && fabs(r->estimate) < 0x1p-480 && r->std_error == 0 && isnan(r->ci95[0]);
+    return r->estimate != 0 && fabs(r->estimate) < ULAM_SCORE_TINY && r->std_error == 0 && isnan(r->ci95[0]);
 }
 
 /* Print the answer line: x[I] with its interval, or why there is none. */
