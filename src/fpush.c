@@ -247,7 +247,8 @@ typedef struct {
     unsigned char *known;
     int pre; /* cs and mx filled by the sweep push */
     int32_t *hp, *hn; /* walks that ended at i with score +R0, -R0 */
-    int64_t steps;
+    int32_t *hit;     /* the states some walk ended at, in the order first ended at (nhit of them) */
+    int64_t nhit, steps;
 } walker;
 
 /* The KL intervals (src/stop.c) of hit counts below ULAM__FPUSH_KL_KEPT at one checkpoint. */
@@ -283,14 +284,14 @@ static int interval_met(double a, double b, double est, double E, double delta)
 
 /* rule_met for scores 0 or R0 (M, r >= 0): the KL intervals, every lower end lowered by cut
  * (the bound on the part of x_i the negative residual cut from r takes away). */
-static int rule_met_kl(const walker *w, kl_kept *c, const double *p, int64_t n, int64_t N, int k, double R0, double E,
-                       double delta, double cut)
+static int rule_met_kl(const walker *w, kl_kept *c, const double *p, int64_t N, int k, double R0, double E, double delta,
+                       double cut)
 {
     double lo, hi;
     hits_interval(c, N, k, 0, R0, &lo, &hi);
     if (!(hi <= E * delta && cut <= E * delta)) return 0; /* a component no walk ended at, p_i just under delta */
-    for (int64_t i = 0; i < n; i++) {
-        if (!w->hp[i]) continue;
+    for (int64_t q = 0; q < w->nhit; q++) {
+        int64_t i = w->hit[q];
         hits_interval(c, N, k, w->hp[i], R0, &lo, &hi);
         if (!interval_met(p[i] + lo - cut, p[i] + hi, p[i] + R0 * (double)w->hp[i] / (double)N, E, delta)) return 0;
     }
@@ -352,6 +353,7 @@ static int lane_choose(walker *w, lane *L)
     int64_t j = L->j;
     double stop = 1.0 - w->alpha, v = L->u - stop;
     if (L->u < stop) {
+        if (w->hp[j] == 0 && (!w->hn || w->hn[j] == 0)) w->hit[w->nhit++] = (int32_t)j;
         if (L->neg) w->hn[j]++;
         else w->hp[j]++;
         return 0;
@@ -429,14 +431,12 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
  * delta: its 95% interval (src/stop.c) within -+ E max(|x_i|, delta) (the interval itself, not
  * the standard error, so every x_i >= delta is within E of the truth unless its interval misses
  * it); p + the walks' terminal counts, scores of range R, largest R0. */
-static int rule_met(const walker *w, const double *p, int64_t n, int64_t N, int k, double R, double R0, double E,
-                    double delta)
+static int rule_met(const walker *w, const double *p, int64_t N, int k, double R, double R0, double E, double delta)
 {
     double L = ulam__stop_log(k), rt = 7.0 * R * L / (3.0 * ((double)N - 1.0)), Nd = (double)N;
     if (!(rt <= E * delta)) return 0;
-    for (int64_t i = 0; i < n; i++) {
-        int64_t h = w->hp[i] + (w->hn ? w->hn[i] : 0);
-        if (h == 0) continue; /* its interval is p_i -+ rt: met above */
+    for (int64_t q = 0; q < w->nhit; q++) { /* a state no walk ended at: its interval is p_i -+ rt, met above */
+        int64_t i = w->hit[q], h = w->hp[i] + (w->hn ? w->hn[i] : 0);
         double s = (double)(w->hp[i] - (w->hn ? w->hn[i] : 0)), mean = R0 * s / Nd;
         double up = fabs(p[i]) + fabs(mean) + R0 * sqrt(2.0 * (double)h * L / (Nd * (Nd - 1.0))) + rt;
         if (up < delta) continue; /* cannot reach delta */
@@ -447,6 +447,29 @@ static int rule_met(const walker *w, const double *p, int64_t n, int64_t N, int 
             if (!(ci.kind == ULAM__STOP_EB && ci.half <= E * fmax(fabs(p[i] + mean), delta))) return 0;
     }
     return 1;
+}
+
+/* The outputs of every component no walk ended at: x_i = p_i (x holds p), standard error se,
+ * interval [p_i + a - cut, p_i + b] (a NaN: none from the walks, p_i -+ D), clipped to p_i -+ D
+ * where D is finite; passes with no branch on i (the states walks ended at are written over
+ * after). */
+static void none_fill(double *x, double *std_error, double *lo, double *hi, int64_t n, double a, double b, double cut,
+                      double se, double D)
+{
+    int fin = isfinite(D), nan = isnan(a - cut);
+    if (std_error)
+        for (int64_t i = 0; i < n; i++) std_error[i] = se;
+    for (int64_t i = 0; i < n; i++) x[i] += 0.0; /* p_i + the walks' mean, 0 */
+    if (!lo && !hi) return;
+    for (int64_t i = 0; i < n; i++) {
+        double p = x[i], l = nan && fin ? p - D : p + a - cut, h = nan && fin ? p + D : p + b;
+        if (fin) { /* both ends NaN or neither (p_i NaN, or not), so no fmax/fmin's NaN rule is needed */
+            l = l > p - D ? l : p - D;
+            h = h < p + D ? h : p + D;
+        }
+        if (lo) lo[i] = l;
+        if (hi) hi[i] = h;
+    }
 }
 
 /* Sweep push and terminal walks on its residual, for ||M||_1 < 1. */
@@ -507,9 +530,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
         size_t cb = ((size_t)ulam_csr_nnz(Mt) + 1) * sizeof *w.cum, hb = (size_t)n * sizeof *w.hp;
         w.cum = ulam__huge(ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum), cb); /* filled from its start */
+        w.hit = ulam__malloc((size_t)n, sizeof *w.hit);                                       /* filled from its start */
         w.known = ulam__calloc((size_t)n, 1), w.hp = ulam__huge(ulam__calloc((size_t)n, sizeof *w.hp), hb);
         if (sgn) w.hn = ulam__huge(ulam__calloc((size_t)n, sizeof *w.hn), hb);
-        if (!bsum || !w.cum || !w.known || !w.hp || (sgn ? !w.hn : !kept))
+        if (!bsum || !w.cum || !w.hit || !w.known || !w.hp || (sgn ? !w.hn : !kept))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
     }
     if (!status && w.k > 0) {
@@ -527,7 +551,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
             if (made < target - N) info->interrupted = 1, planned = 0;
             N += made;
             if (!planned || o->walks > 0 || N >= cap_w) break;
-            if (sgn ? rule_met(&w, x, n, N, k, R, R0, pl.E, pl.delta) : rule_met_kl(&w, kept, x, n, N, k, R0, pl.E, pl.delta, cut))
+            if (sgn ? rule_met(&w, x, N, k, R, R0, pl.E, pl.delta) : rule_met_kl(&w, kept, x, N, k, R0, pl.E, pl.delta, cut))
                 break;
             k++;
         }
@@ -542,15 +566,16 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &none);
         else none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
         if (!sgn && N >= 1) hits_interval(kept, N, kk < 0 ? k : kk, 0, R0, &none.lo, &none.hi);
-        for (int64_t i = 0; i < n; i++) {
-            int64_t h = N > 0 ? w.hp[i] + (w.hn ? w.hn[i] : 0) : 0;
+        none_fill(x, std_error, lo, hi, n, none.lo, none.hi, cut, N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0), D);
+        for (int64_t q = 0; q < (N > 0 ? w.nhit : 0); q++) { /* the states some walk ended at */
+            int64_t i = w.hit[q], h = w.hp[i] + (w.hn ? w.hn[i] : 0);
             double mean = 0.0, var = 0.0;
             ulam__stop_ci ci = none;
-            if (h > 0 && !sgn) {
+            if (!sgn) {
                 mean = R0 * (double)h / Nd;
                 var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
                 hits_interval(kept, N, kk < 0 ? k : kk, h, R0, &ci.lo, &ci.hi);
-            } else if (h > 0) {
+            } else {
                 mean = R0 * (double)(w.hp[i] - (w.hn ? w.hn[i] : 0)) / Nd;
                 var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
                 ulam__stop_interval(N, mean, var, R, 0.0, R0, R0, k, &ci);
@@ -565,7 +590,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         }
         info->walks = N, info->steps = w.steps, info->walk_seconds = ulam_now() - t1;
     }
-    free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.known), free(w.hp), free(w.hn);
+    free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.hit), free(w.known), free(w.hp), free(w.hn);
     free(r), free(kept);
     info->seconds = ulam_now() - t0;
     return status;

@@ -17,6 +17,7 @@
 #include <cmocka.h>
 
 #include "../src/internal.h"
+#include "../src/stop.h"
 #include "testutil.h"
 #include "zipf_graph.h"
 
@@ -226,6 +227,46 @@ static void test_fpush_interrupted(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* The walks' bookkeeping: with no push (rmax 2: r = e_s, p = 0) and no death (every column of
+ * M sums to alpha), each of N walks ends at one state, so x_i = R0 h_i / N sums to R0 exactly
+ * (a state ended at missed or counted twice by the list of states ended at breaks it); every
+ * state has the KL interval of its count (index 0: a fixed count), R0 [lo, hi] clipped to
+ * -+ R0, standard error R0 sqrt(h (1 - h / N) / (N - 1) / N), and the states no walk ended at
+ * the interval of a count 0 and standard error 0. */
+static void test_fpush_hits(void **state)
+{
+    (void)state;
+    int64_t n = 1500, s = 5, N = 3000;
+    ulam_csr *M = zipf_graph(n, 2.1, 0.75, 0.85, 3), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = malloc((size_t)n * sizeof *x), *se = malloc((size_t)n * sizeof *se);
+    double *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi);
+    ulam_fpush_opts o = ulam_fpush_defaults();
+    o.source = s, o.walk.exec.seed = 7, o.walks = N, o.rmax = 2.0;
+    ulam_fpush_info info;
+    ulam_error err;
+    assert_int_equal(ulam__fpush_solve(M, Mt, &o, x, se, lo, hi, &info, NULL, &err), ULAM_OK);
+    assert_int_equal(info.walks, N);
+    assert_int_equal(info.push.ops, 0);
+    double R0 = 1.0 / 0.15, total = 0.0, Nd = (double)N;
+    assert_close(info.residual_bound, R0, 1e-12);
+    int64_t ended = 0;
+    for (int64_t i = 0; i < n; i++) {
+        double h = x[i] * Nd / R0, a, b;
+        assert_true(fabs(h - round(h)) < 1e-6);
+        h = round(h), total += h, ended += h > 0;
+        ulam__stop_kl_interval(N, h / Nd, 0, &a, &b);
+        assert_close(lo[i], fmax(R0 * a, -R0), 1e-12);
+        assert_close(hi[i], fmin(R0 * b, R0), 1e-12);
+        assert_close(se[i], R0 * sqrt(h * (1.0 - h / Nd) / (Nd - 1.0) / Nd), 1e-12);
+    }
+    print_message("%lld walks ended at %lld states\n", (long long)N, (long long)ended);
+    assert_true(ended > 100);
+    assert_close(total, Nd, 1e-9);
+    free(x), free(se), free(lo), free(hi);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -233,6 +274,7 @@ int main(void)
         cmocka_unit_test(test_fpush_small_budgets),
         cmocka_unit_test(test_fpush_interrupted),
         cmocka_unit_test(test_fpush_rmat_cut),
+        cmocka_unit_test(test_fpush_hits),
     };
     return test_run(tests);
 }
