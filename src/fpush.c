@@ -38,6 +38,12 @@
 #define ULAM__FPUSH_KL_KEPT 1024    /* hit counts whose interval a checkpoint keeps (the rest computed each time) */
 #define ULAM__FPUSH_CUT_SHARE 0.01  /* the largest negative residual cut from r, times 1 / (1 - alpha), as a share of E delta */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
+#define ULAM__FPUSH_SKEW 16.0       /* rows drawn from by rejection up to this many tries on average, beyond by the
+                                      running sums (R-MAT 2^20, source 990665, 2026-12-02, load 2.2-2.7, median of 5:
+                                      walk loop 121 ms at 2 (2.6e6 running sums built for 117 562 steps), 84 at 4,
+                                      56 at 8, 47 at 16 (2.4e5 sums), 44 with no running sums at all; with the tries
+                                      overlapped across lanes 36-45 ms at 16, 35-38 at 64; a row's sums cost its whole
+                                      degree to build and first touch, a try one read in the row) */
 
 /* The defaults. */
 ulam_fpush_opts ulam_fpush_defaults(void)
@@ -210,7 +216,7 @@ static void block_sums(const double *r, int64_t n, double *bsum)
 
 /* Row j of M' (column j of M) as a walk reads it: the sum and largest of its |entries| (read
  * here unless pre: the sweep push left them), known 1, and when drawing an entry by rejection
- * would take more than two tries on average, the running sums of |entries| for a binary search,
+ * would take more than ULAM__FPUSH_SKEW tries on average, the running sums of |entries| for a binary search,
  * appended to cum at *used (so cum's pages are touched only as far as rows need it; a first touch
  * is dear), known 2, mx_j then holding their offset in cum instead of the largest entry. */
 static void row_sums(const ulam_csr *Mt, int64_t j, int pre, double *cs, double *mx, unsigned char *known, double *cum,
@@ -226,7 +232,7 @@ static void row_sums(const ulam_csr *Mt, int64_t j, int pre, double *cs, double 
         cs[j] = s, mx[j] = m;
     }
     known[j] = 1;
-    if (mx[j] * (double)(b - a) > 2.0 * cs[j]) {
+    if (mx[j] * (double)(b - a) > ULAM__FPUSH_SKEW * cs[j]) {
         double c = 0.0, *cu = cum + *used;
         for (int64_t e = a; e < b; e++) c += fabs(Mt->val[e]), cu[e - a] = c;
         mx[j] = (double)*used, *used += b - a;
@@ -329,10 +335,10 @@ static int64_t walk_start(const walker *w, ulam_rng *rng)
 
 /* A walk in flight: at state j (neg: its score's sign is negative), the uniform u that decides
  * its next move drawn on arrival; phase 0: j's row sums prefetched; 1: the entry e of row j
- * (at a) it moves along prefetched. */
+ * (at a) it moves along prefetched, taken if f mx_j <= |M_ej| (rejection; f = 0: taken). */
 typedef struct {
     int64_t j, a, e;
-    double u;
+    double u, f;
     int neg, phase, on;
 } lane;
 
@@ -369,29 +375,31 @@ static int lane_choose(walker *w, lane *L)
             if (cu[mid] > v) h = mid;
             else l = mid + 1;
         }
-        e = l;
-    } else {
-        e = (int64_t)(v / w->cs[j] * (double)d);
+        e = l, L->f = 0.0;
+    } else { /* the first candidate of the rejection draw, and its coin from the same uniform */
+        double t = v / w->cs[j] * (double)d;
+        e = (int64_t)t;
         if (e >= d) e = d - 1;
+        L->f = t - (double)e;
     }
     L->a = a, L->e = e, L->phase = 1;
     __builtin_prefetch(&Mt->val[a + e]), __builtin_prefetch(&Mt->colidx[a + e]);
     return 1;
 }
 
-/* Phase 1: accept the entry (or draw again, rejection: entry e with probability |M_ej| / sum,
- * the fraction of the first draw reused) and move along it. */
+/* Phase 1: accept the entry and move along it, or (rejection: entry e with probability
+ * |M_ej| / sum) draw the next candidate and its coin, prefetch it and stay in phase 1, so a
+ * walk's tries overlap the other lanes' reads as its steps do. */
 static void lane_move(walker *w, ulam_rng *rng, lane *L)
 {
     const ulam_csr *Mt = w->Mt;
-    int64_t j = L->j, a = L->a, e = L->e, d = Mt->rowptr[j + 1] - a;
-    if (w->known[j] != 2) {
-        double t = (L->u - (1.0 - w->alpha)) / w->cs[j] * (double)d, f = t - (double)e;
+    int64_t j = L->j, a = L->a, e = L->e;
+    if (L->f * w->mx[j] > fabs(Mt->val[a + e])) {
         uint64_t frac;
-        while (f * w->mx[j] > fabs(Mt->val[a + e])) {
-            e = (int64_t)ulam__rng_index(rng, (uint64_t)d, &frac);
-            f = (double)frac * 0x1.0p-64;
-        }
+        L->e = (int64_t)ulam__rng_index(rng, (uint64_t)(Mt->rowptr[j + 1] - a), &frac);
+        L->f = (double)frac * 0x1.0p-64;
+        __builtin_prefetch(&Mt->val[a + L->e]), __builtin_prefetch(&Mt->colidx[a + L->e]);
+        return;
     }
     L->neg ^= Mt->val[a + e] < 0;
     w->steps++;

@@ -267,6 +267,48 @@ static void test_fpush_hits(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* Both ways a walk draws its move: column 0 of M (0.5 and 39 entries of 0.35 / 39: rejection
+ * would take 23.5 tries on average) by the running sums, column 1 (0.6, 0.05, 0.05, 0.15: 2.8
+ * tries) by rejection, the rest single entries back to 0 (41's to 1).  With no push (rmax 2) the walks
+ * alone estimate x = (I - M)^-1 e_0, every component within 4 standard errors of the exact one
+ * (fixed point of x = e_0 + M x). */
+static void test_fpush_samplers(void **state)
+{
+    (void)state;
+    enum { n = 42, nz = 1 + 39 + 4 + 40 };
+    int32_t ti[nz], tj[nz];
+    double tx[nz], exact[n] = {0}, next[n];
+    int64_t q = 0;
+    ti[q] = 1, tj[q] = 0, tx[q++] = 0.5;
+    for (int k = 2; k <= 40; k++) ti[q] = k, tj[q] = 0, tx[q++] = 0.35 / 39.0;
+    double c1[4] = {0.6, 0.05, 0.05, 0.15};
+    int r1[4] = {0, 2, 3, 4};
+    for (int k = 0; k < 4; k++) ti[q] = r1[k], tj[q] = 1, tx[q++] = c1[k];
+    for (int k = 2; k < n; k++) ti[q] = k < 41 ? 0 : 1, tj[q] = k, tx[q++] = 0.85;
+    assert_int_equal(q, nz);
+    ulam_csr *M = NULL, *Mt = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M), ULAM_OK);
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    for (int it = 0; it < 2000; it++) {
+        for (int i = 0; i < n; i++) next[i] = i == 0;
+        for (int i = 0; i < n; i++)
+            for (int64_t e = M->rowptr[i]; e < M->rowptr[i + 1]; e++) next[i] += M->val[e] * exact[M->colidx[e]];
+        for (int i = 0; i < n; i++) exact[i] = next[i];
+    }
+    double x[n], se[n];
+    ulam_fpush_opts o = ulam_fpush_defaults();
+    o.source = 0, o.walk.exec.seed = 11, o.walks = 40000, o.rmax = 2.0;
+    ulam_fpush_info info;
+    ulam_error err;
+    assert_int_equal(ulam__fpush_solve(M, Mt, &o, x, se, NULL, NULL, &info, NULL, &err), ULAM_OK);
+    assert_int_equal(info.push.ops, 0);
+    for (int i = 0; i < n; i++) { /* 41 is reached from no state */
+        assert_true(i == 41 ? x[i] == 0.0 && exact[i] == 0.0 : se[i] > 0);
+        assert_close(x[i], exact[i], 4.0 * se[i]);
+    }
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -275,6 +317,7 @@ int main(void)
         cmocka_unit_test(test_fpush_interrupted),
         cmocka_unit_test(test_fpush_rmat_cut),
         cmocka_unit_test(test_fpush_hits),
+        cmocka_unit_test(test_fpush_samplers),
     };
     return test_run(tests);
 }
