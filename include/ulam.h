@@ -1204,6 +1204,16 @@ typedef struct ulam_fpush_info {
 int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, double *x, double *std_error,
                      double *lo, double *hi, ulam_fpush_info *info, ulam_error *err);
 
+/* ulam_fpush_solve's x (n entries), and of only the k (0 <= k <= n) components of largest
+ * estimate: their indices into index (k entries; by decreasing estimate, ties by smaller index,
+ * NaN last) and their standard errors and 95% intervals into std_error, lo and hi (k entries
+ * each, each may be NULL), the same as ulam_fpush_solve gives them.  For a query that reports a
+ * few components: no pass writes 3 n outputs (whose first touch alone dominated the walk phase on
+ * R-MAT 2^20) and no sort of n.  ulam_fpush_solve's statuses; ULAM_EINVAL for k out of range or
+ * no index array. */
+int ulam_fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, int64_t k, double *x, int64_t *index,
+                   double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam_error *err);
+
 /* ---------------------------------------------------------------- choosing the method */
 /* All secondary. */
 

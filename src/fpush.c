@@ -457,17 +457,15 @@ static int rule_met(const walker *w, const double *p, int64_t N, int k, double R
     return 1;
 }
 
-/* The outputs of every component no walk ended at: x_i = p_i (x holds p), standard error se,
- * interval [p_i + a - cut, p_i + b] (a NaN: none from the walks, p_i -+ D), clipped to p_i -+ D
- * where D is finite; passes with no branch on i (the states walks ended at are written over
- * after). */
-static void none_fill(double *x, double *std_error, double *lo, double *hi, int64_t n, double a, double b, double cut,
-                      double se, double D)
+/* The outputs of n components no walk ended at, x_i = p_i (x holds p; p_i + 0, never -0, as p
+ * starts at +0): standard error se, interval [p_i + a - cut, p_i + b] (a NaN: none from the walks,
+ * p_i -+ D), clipped to p_i -+ D where D is finite; passes with no branch on i. */
+static void none_fill(const double *x, double *std_error, double *lo, double *hi, int64_t n, double a, double b,
+                      double cut, double se, double D)
 {
     int fin = isfinite(D), nan = isnan(a - cut);
     if (std_error)
         for (int64_t i = 0; i < n; i++) std_error[i] = se;
-    for (int64_t i = 0; i < n; i++) x[i] += 0.0; /* p_i + the walks' mean, 0 */
     if (!lo && !hi) return;
     for (int64_t i = 0; i < n; i++) {
         double p = x[i], l = nan && fin ? p - D : p + a - cut, h = nan && fin ? p + D : p + b;
@@ -480,10 +478,102 @@ static void none_fill(double *x, double *std_error, double *lo, double *hi, int6
     }
 }
 
-/* Sweep push and terminal walks on its residual, for ||M||_1 < 1. */
+/* What the walks' ends give each component: the walks (N, stitching index k, KL index kk when
+ * not k), scores' range R and largest R0, sgn (signed scores: empirical Bernstein), the cut,
+ * residual_bound D and the interval of a component no walk ended at. */
+typedef struct {
+    const walker *w;
+    kl_kept *kept;
+    int64_t N;
+    int k, kk, sgn;
+    double R, R0, cut, D;
+    ulam__stop_ci none;
+} ends;
+
+/* The walks' mean at i (0 where none ended). */
+static double ends_mean(const ends *c, int64_t i)
+{
+    const walker *w = c->w;
+    if (c->N == 0) return 0.0;
+    return c->R0 * (double)(w->hp[i] - (w->hn ? w->hn[i] : 0)) / (double)c->N;
+}
+
+/* Component i's outputs from p = x_i: the walks' mean (returned), standard error *se and
+ * interval [*a, *b]. */
+static double ends_component(const ends *c, const double *x, int64_t i, double *se, double *a, double *b)
+{
+    const walker *w = c->w;
+    int64_t N = c->N, h = N > 0 ? w->hp[i] + (w->hn ? w->hn[i] : 0) : 0;
+    double Nd = (double)N, R0 = c->R0, p = x[i], D = c->D, mean = 0.0, var = 0.0;
+    if (h == 0) { /* the common interval, as none_fill gives it */
+        none_fill(x + i, se, a, b, 1, c->none.lo, c->none.hi, c->cut, N > 1 ? 0.0 : (w->k > 0 ? NAN : 0.0), D);
+        return 0.0;
+    }
+    ulam__stop_ci ci = c->none;
+    mean = ends_mean(c, i);
+    var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
+    if (!c->sgn) hits_interval(c->kept, N, c->kk < 0 ? c->k : c->kk, h, R0, &ci.lo, &ci.hi);
+    else ulam__stop_interval(N, mean, var, c->R, 0.0, R0, R0, c->k, &ci);
+    *a = p + ci.lo - c->cut, *b = p + ci.hi;
+    *se = N > 1 ? sqrt(var / Nd) : (w->k > 0 ? NAN : 0.0);
+    if (isnan(*a) && isfinite(D)) *a = p - D, *b = p + D; /* no interval from the walks */
+    if (isfinite(D)) *a = fmax(*a, p - D), *b = fmin(*b, p + D);
+    return mean;
+}
+
+/* Whether estimate u at i ranks before v at j: larger first, ties by smaller index, NaN last. */
+static int ranks_before(double u, int64_t i, double v, int64_t j)
+{
+    if (isnan(u) || isnan(v)) return isnan(u) == isnan(v) ? i < j : !isnan(u);
+    return u > v || (u == v && i < j);
+}
+
+/* Restore the heap order below slot t of the k-entry heap (idx, key): each entry ranks after
+ * neither child, so the root ranks last. */
+static void sift_down(int64_t *idx, double *key, int64_t k, int64_t t)
+{
+    for (;;) {
+        int64_t c = 2 * t + 1;
+        if (c >= k) return;
+        if (c + 1 < k && ranks_before(key[c], idx[c], key[c + 1], idx[c + 1])) c++; /* the child ranking last */
+        if (!ranks_before(key[t], idx[t], key[c], idx[c])) return;
+        int64_t ti = idx[t];
+        double tk = key[t];
+        idx[t] = idx[c], key[t] = key[c], idx[c] = ti, key[c] = tk;
+        t = c;
+    }
+}
+
+/* The k (<= n) components of largest estimate x_i + (c ? the walks' mean : 0) into index, by
+ * rank (ranks_before); key: k entries of scratch.  One pass over n with a heap of the k best so
+ * far (its root the last of them), then the heap sorted: O(n + changes log k). */
+static void select_top(const double *x, const ends *c, int64_t n, int64_t k, int64_t *index, double *key)
+{
+    if (k <= 0) return;
+    for (int64_t i = 0; i < n; i++) {
+        double u = x[i] + (c ? ends_mean(c, i) : 0.0);
+        if (i < k) {
+            index[i] = i, key[i] = u;
+            if (i == k - 1)
+                for (int64_t t = k / 2; t-- > 0;) sift_down(index, key, k, t);
+        } else if (ranks_before(u, i, key[0], index[0])) {
+            index[0] = i, key[0] = u;
+            sift_down(index, key, k, 0);
+        }
+    }
+    for (int64_t m = k - 1; m > 0; m--) { /* the last-ranked to the end, each in turn */
+        int64_t ti = index[0];
+        double tk = key[0];
+        index[0] = index[m], key[0] = key[m], index[m] = ti, key[m] = tk;
+        sift_down(index, key, m, 0);
+    }
+}
+
+/* Sweep push and terminal walks on its residual, for ||M||_1 < 1; top >= 0: std_error, lo and
+ * hi only for the top components of largest estimate, listed in index (select_top). */
 static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, const ulam_guard *g, double *x,
-                       double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *swi,
-                       ulam_error *err)
+                       int64_t top, int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info,
+                       ulam__sweep_info *swi, ulam_error *err)
 {
     int64_t n = M->nrows;
     double t0 = ulam_now(), alpha = g->abs.colsum_max, D1 = 1.0 / (1.0 - alpha);
@@ -568,49 +658,74 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         else if (o->walks > 0)
             kk = 0; /* a count fixed in advance: the KL interval at delta itself */
     }
+    double *key = !status && top > 0 ? ulam__malloc((size_t)top, sizeof *key) : NULL;
+    if (!status && top > 0 && !key) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the top components");
     if (!status) {
-        double Nd = (double)N, D = info->residual_bound;
-        ulam__stop_ci none;
-        if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &none);
-        else none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
-        if (!sgn && N >= 1) hits_interval(kept, N, kk < 0 ? k : kk, 0, R0, &none.lo, &none.hi);
-        none_fill(x, std_error, lo, hi, n, none.lo, none.hi, cut, N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0), D);
-        for (int64_t q = 0; q < (N > 0 ? w.nhit : 0); q++) { /* the states some walk ended at */
-            int64_t i = w.hit[q], h = w.hp[i] + (w.hn ? w.hn[i] : 0);
-            double mean = 0.0, var = 0.0;
-            ulam__stop_ci ci = none;
-            if (!sgn) {
-                mean = R0 * (double)h / Nd;
-                var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
-                hits_interval(kept, N, kk < 0 ? k : kk, h, R0, &ci.lo, &ci.hi);
-            } else {
-                mean = R0 * (double)(w.hp[i] - (w.hn ? w.hn[i] : 0)) / Nd;
-                var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
-                ulam__stop_interval(N, mean, var, R, 0.0, R0, R0, k, &ci);
+        ends c = {.w = &w, .kept = kept, .N = N, .k = k, .kk = kk, .sgn = sgn, .R = R, .R0 = R0, .cut = cut,
+                  .D = info->residual_bound};
+        if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &c.none);
+        else c.none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
+        if (!sgn && N >= 1) hits_interval(kept, N, kk < 0 ? k : kk, 0, R0, &c.none.lo, &c.none.hi);
+        double s, a, b;
+        if (top < 0) { /* every component: the common interval, then the states some walk ended at */
+            none_fill(x, std_error, lo, hi, n, c.none.lo, c.none.hi, cut, N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0), c.D);
+            for (int64_t q = 0; q < (N > 0 ? w.nhit : 0); q++) {
+                int64_t i = w.hit[q];
+                double mean = ends_component(&c, x, i, &s, &a, &b);
+                if (std_error) std_error[i] = s;
+                if (lo) lo[i] = a;
+                if (hi) hi[i] = b;
+                x[i] += mean;
             }
-            double p = x[i], a = p + ci.lo - cut, b = p + ci.hi;
-            x[i] = p + mean;
-            if (std_error) std_error[i] = N > 1 ? sqrt(var / Nd) : (w.k > 0 ? NAN : 0.0);
-            if (isnan(a) && isfinite(D)) a = p - D, b = p + D; /* no interval from the walks */
-            if (isfinite(D)) a = fmax(a, p - D), b = fmin(b, p + D);
-            if (lo) lo[i] = a;
-            if (hi) hi[i] = b;
+        } else { /* the top components by p_i + the walks' mean, their outputs from p, then x */
+            select_top(x, &c, n, top, index, key);
+            for (int64_t t = 0; t < top; t++) {
+                ends_component(&c, x, index[t], &s, &a, &b);
+                if (std_error) std_error[t] = s;
+                if (lo) lo[t] = a;
+                if (hi) hi[t] = b;
+            }
+            for (int64_t q = 0; q < (N > 0 ? w.nhit : 0); q++) x[w.hit[q]] += ends_mean(&c, w.hit[q]);
         }
         info->walks = N, info->steps = w.steps, info->walk_seconds = ulam_now() - t1;
     }
+    free(key);
     free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.hit), free(w.known), free(w.hp), free(w.hn);
     free(r), free(kept);
     info->seconds = ulam_now() - t0;
     return status;
 }
 
-/* Estimate every component of x = (I - M)^-1 e_source; sw (may be NULL) gets the sweep push's
- * counts (zero when the queue push ran). */
-int ulam__fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, double *std_error,
-                      double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw, ulam_error *err)
+/* The queue path's outputs for the top components (select_top): every component's into
+ * scratch, then theirs gathered. */
+static int solve_queue_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, ulam_guard g, double *x,
+                           int64_t top, int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info,
+                           ulam_error *err)
+{
+    size_t n = (size_t)M->nrows;
+    double *se = ulam__malloc(n, sizeof *se), *a = ulam__malloc(n, sizeof *a), *b = ulam__malloc(n, sizeof *b);
+    double *key = ulam__malloc(top > 0 ? (size_t)top : 1, sizeof *key);
+    int status = se && a && b && key ? solve_queue(M, Mt, opts, g, x, se, a, b, info, err)
+                                     : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for every component");
+    if (!status) select_top(x, NULL, M->nrows, top, index, key);
+    for (int64_t t = 0; !status && t < top; t++) {
+        if (std_error) std_error[t] = se[index[t]];
+        if (lo) lo[t] = a[index[t]];
+        if (hi) hi[t] = b[index[t]];
+    }
+    free(se), free(a), free(b), free(key);
+    return status;
+}
+
+/* ulam__fpush_solve, or with top >= 0 ulam_fpush_top's outputs (std_error, lo, hi: top entries). */
+static int fpush(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, int64_t top,
+                 int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw,
+                 ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !opts || !x || !info) return ulam__fail(err, ULAM_EINVAL, 0, -1, "M, options, x and info");
+    if (top >= 0 && (top > M->nrows || (top > 0 && !index)))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "k from 0 to n (%lld) and an index array", (long long)M->nrows);
     int status = check(M, Mt, opts, err);
     if (status) return status;
     memset(info, 0, sizeof *info);
@@ -621,16 +736,38 @@ int ulam__fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_op
     if (opts->walk.policy.guard) g = *opts->walk.policy.guard;
     else if ((status = ulam_guard_check(M, opts->walk.kernel.continue_q, &go, &g, err))) return status;
     if (g.abs.colsum_max < 1.0)
-        status = solve_sweep(M, Mt, opts, &g, x, std_error, lo, hi, info, &swi, err);
+        status = solve_sweep(M, Mt, opts, &g, x, top, index, std_error, lo, hi, info, &swi, err);
+    else if (top >= 0)
+        status = solve_queue_top(M, Mt, opts, g, x, top, index, std_error, lo, hi, info, err);
     else
         status = solve_queue(M, Mt, opts, g, x, std_error, lo, hi, info, err);
     if (sw) *sw = swi;
     return status;
 }
 
+/* Estimate every component of x = (I - M)^-1 e_source; sw (may be NULL) gets the sweep push's
+ * counts (zero when the queue push ran). */
+int ulam__fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, double *std_error,
+                      double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw, ulam_error *err)
+{
+    return fpush(M, Mt, opts, x, -1, NULL, std_error, lo, hi, info, sw, err);
+}
+
 /* Estimate every component of x = (I - M)^-1 e_source. */
 int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, double *std_error,
                      double *lo, double *hi, ulam_fpush_info *info, ulam_error *err)
 {
-    return ulam__fpush_solve(M, Mt, opts, x, std_error, lo, hi, info, NULL, err);
+    return fpush(M, Mt, opts, x, -1, NULL, std_error, lo, hi, info, NULL, err);
+}
+
+/* Estimate every component of x = (I - M)^-1 e_source, and the k largest with their standard
+ * errors and intervals. */
+int ulam_fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, int64_t k, double *x,
+                   int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam_error *err)
+{
+    if (k < 0) {
+        ulam__clear(err);
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "k >= 0 components");
+    }
+    return fpush(M, Mt, opts, x, k, index, std_error, lo, hi, info, NULL, err);
 }

@@ -309,6 +309,90 @@ static void test_fpush_samplers(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* Indices in ulam_fpush_top's order (decreasing estimate, ties by smaller index) by qsort. */
+static const double *by_rank_x;
+static int by_rank(const void *a, const void *b)
+{
+    int64_t i = *(const int64_t *)a, j = *(const int64_t *)b;
+    double u = by_rank_x[i], v = by_rank_x[j];
+    return u > v ? -1 : u < v ? 1 : (i > j) - (i < j);
+}
+
+/* ulam_fpush_top against ulam_fpush_solve and a full sort: the same x, the k first indices of
+ * the sort, and their standard errors and intervals, for k from 0 to n; with no push the
+ * estimates are R0 h / N, full of ties (and zeros), and with the rule the push's; and on the
+ * queue path. */
+static void test_fpush_top(void **state)
+{
+    (void)state;
+    int64_t n = 1500;
+    ulam_csr *M = zipf_graph(n, 2.1, 0.75, 0.85, 3), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = malloc((size_t)n * sizeof *x), *se = malloc((size_t)n * sizeof *se), *lo = malloc((size_t)n * sizeof *lo);
+    double *hi = malloc((size_t)n * sizeof *hi), *y = malloc((size_t)n * sizeof *y), *tse = malloc((size_t)n * sizeof *tse);
+    double *tlo = malloc((size_t)n * sizeof *tlo), *thi = malloc((size_t)n * sizeof *thi);
+    int64_t *order = malloc((size_t)n * sizeof *order), *idx = malloc((size_t)n * sizeof *idx);
+    int64_t ks[] = {0, 1, 7, 100, 400, 1499, 1500};
+    for (int c = 0; c < 2; c++) {
+        ulam_fpush_opts o = ulam_fpush_defaults();
+        o.source = 5, o.walk.exec.seed = 3;
+        if (c == 0) o.walks = 3000, o.rmax = 2.0;
+        else o.min_value = 1.0 / (0.15 * (double)n), o.walk.stop.max_walks = 0;
+        ulam_fpush_info info;
+        ulam_error err;
+        assert_int_equal(ulam_fpush_solve(M, Mt, &o, x, se, lo, hi, &info, &err), ULAM_OK);
+        for (int64_t i = 0; i < n; i++) order[i] = i;
+        by_rank_x = x;
+        qsort(order, (size_t)n, sizeof *order, by_rank);
+        int64_t ties = 0;
+        for (int64_t i = 1; i < n; i++) ties += x[order[i]] == x[order[i - 1]];
+        print_message("%s: %lld ties among the estimates\n", c ? "rule" : "no push", (long long)ties);
+        assert_true(ties > 100);
+        for (size_t t = 0; t < sizeof ks / sizeof *ks; t++) {
+            int64_t k = ks[t];
+            assert_int_equal(ulam_fpush_top(M, Mt, &o, k, y, idx, tse, tlo, thi, &info, &err), ULAM_OK);
+            for (int64_t i = 0; i < n; i++) assert_true(y[i] == x[i]);
+            for (int64_t q = 0; q < k; q++) {
+                int64_t i = order[q];
+                assert_int_equal(idx[q], i);
+                assert_true(tse[q] == se[i] || (isnan(tse[q]) && isnan(se[i])));
+                assert_true(tlo[q] == lo[i] && thi[q] == hi[i]);
+            }
+        }
+    }
+    { /* the queue path (||M||_1 = 1.2 >= 1, rho(M) = 0.6) */
+        int32_t ti[4] = {1, 2, 0, 0}, tj[4] = {0, 0, 1, 2};
+        double tx[4] = {0.6, 0.6, 0.3, 0.3}, q[3], qse[3], qlo[3], qhi[3];
+        ulam_csr *Q = NULL, *Qt = NULL;
+        assert_int_equal(ulam_csr_from_triplets(3, 3, 4, ti, tj, tx, &Q), ULAM_OK);
+        assert_int_equal(ulam_csr_transpose(Q, &Qt), ULAM_OK);
+        ulam_fpush_opts o = ulam_fpush_defaults();
+        o.source = 1, o.walk.exec.seed = 5, o.walk.exec.threads = 1, o.rmax = 0.05;
+        ulam_fpush_info info;
+        ulam_error err;
+        assert_int_equal(ulam_fpush_solve(Q, Qt, &o, x, se, lo, hi, &info, &err), ULAM_OK);
+        assert_true(info.walks > 0);
+        assert_int_equal(ulam_fpush_top(Q, Qt, &o, 3, q, idx, qse, qlo, qhi, &info, &err), ULAM_OK);
+        for (int64_t i = 0; i < 3; i++) order[i] = i;
+        by_rank_x = x;
+        qsort(order, 3, sizeof *order, by_rank);
+        for (int64_t t = 0; t < 3; t++) {
+            int64_t i = order[t];
+            assert_true(q[t] == x[t] && idx[t] == i && qse[t] == se[i] && qlo[t] == lo[i] && qhi[t] == hi[i]);
+        }
+        ulam_csr_free(Q), ulam_csr_free(Qt);
+    }
+    ulam_fpush_info info;
+    ulam_error err;
+    ulam_fpush_opts o = ulam_fpush_defaults();
+    o.source = 5;
+    assert_int_equal(ulam_fpush_top(M, Mt, &o, n + 1, y, idx, NULL, NULL, NULL, &info, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_fpush_top(M, Mt, &o, -1, y, idx, NULL, NULL, NULL, &info, &err), ULAM_EINVAL);
+    assert_int_equal(ulam_fpush_top(M, Mt, &o, 3, y, NULL, NULL, NULL, NULL, &info, &err), ULAM_EINVAL);
+    free(x), free(se), free(lo), free(hi), free(y), free(tse), free(tlo), free(thi), free(order), free(idx);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -318,6 +402,7 @@ int main(void)
         cmocka_unit_test(test_fpush_rmat_cut),
         cmocka_unit_test(test_fpush_hits),
         cmocka_unit_test(test_fpush_samplers),
+        cmocka_unit_test(test_fpush_top),
     };
     return test_run(tests);
 }

@@ -253,14 +253,6 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     return rc;
 }
 
-/* Components by decreasing estimate (qsort on indices into cli_fpush_x). */
-static const double *cli_fpush_x;
-static int by_estimate(const void *a, const void *b)
-{
-    double x = cli_fpush_x[*(const int64_t *)a], y = cli_fpush_x[*(const int64_t *)b];
-    return (x < y) - (x > y);
-}
-
 /* --source S without --index: every component by forward push and walks (src/fpush.c), the
  * largest K printed with their intervals; 0 or an exit code. */
 static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_opts *bo, int64_t top, report *rp)
@@ -276,9 +268,13 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     rp->check = 0; /* prepare's direct value is for one index */
     int rc = prepare(s, source, force, (ulam_bidir_opts *)bo, NULL, NULL, rp);
     if (rc) return rc;
-    int64_t n = s->M->nrows, *order = cli_alloc_vector((size_t)n, sizeof *order);
-    double *x = cli_alloc_vector((size_t)n, sizeof *x), *se = cli_alloc_vector((size_t)n, sizeof *se);
-    double *lo = cli_alloc_vector((size_t)n, sizeof *lo), *hi = cli_alloc_vector((size_t)n, sizeof *hi), *xd = NULL;
+    int64_t n = s->M->nrows;
+    if (top > n) top = n;
+    /* x for every component, the rest for the top ones only (ulam_fpush_top: no sort of n) */
+    size_t kk = top > 0 ? (size_t)top : 1;
+    int64_t *order = malloc(kk * sizeof *order);
+    double *x = cli_alloc_vector((size_t)n, sizeof *x), *se = malloc(kk * sizeof *se);
+    double *lo = malloc(kk * sizeof *lo), *hi = malloc(kk * sizeof *hi), *xd = NULL;
     ulam_csr *Mt = NULL;
     ulam_fpush_info info;
     ulam_error err;
@@ -287,16 +283,12 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
-    if (!status) status = ulam_fpush_solve(s->M, Mt, &o, x, se, lo, hi, &info, &err);
+    if (!status) status = ulam_fpush_top(s->M, Mt, &o, top, x, order, se, lo, hi, &info, &err);
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
     double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec); /* push and walks */
     if (status) rc = cli_report(s->matrix_path, &err);
     if (!rc && check) rc = cli_direct_solve(s, CLI_MAX_MEM, &xd, NULL);
     if (!rc && cli_rank == 0) {
-        for (int64_t i = 0; i < n; i++) order[i] = i;
-        cli_fpush_x = x;
-        qsort(order, (size_t)n, sizeof *order, by_estimate);
-        if (top > n) top = n;
         if (rp->json) {
             printf("{");
             cli_json_string("method", "single-source", 0);
@@ -312,11 +304,11 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
                 int64_t i = order[k];
                 printf("%s{\"index\": %lld, ", k ? ", " : "", (long long)i + 1);
                 cli_json_number("estimate", x[i], 0);
-                cli_json_number("stderr", se[i], 0);
+                cli_json_number("stderr", se[k], 0);
                 printf("\"ci95\": [");
-                cli_json_value(lo[i]);
+                cli_json_value(lo[k]);
                 printf(", ");
-                cli_json_value(hi[i]);
+                cli_json_value(hi[k]);
                 printf("]%s", xd ? ", " : "");
                 if (xd) cli_json_number("direct", xd[i], 1);
                 printf("}");
@@ -335,9 +327,9 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
                    xd ? "95% CI                    direct" : "95% CI");
             for (int64_t k = 0; k < top; k++) {
                 int64_t i = order[k];
-                printf("%-6lld %-10lld %-14.8g %-11.3g %-12.6g %.6g", (long long)k + 1, (long long)i + 1, x[i], se[i],
-                       lo[i], hi[i]);
-                if (xd) printf("%*s%.8g", 13 - (int)snprintf(NULL, 0, "%.6g", hi[i]), "", xd[i]);
+                printf("%-6lld %-10lld %-14.8g %-11.3g %-12.6g %.6g", (long long)k + 1, (long long)i + 1, x[i], se[k],
+                       lo[k], hi[k]);
+                if (xd) printf("%*s%.8g", 13 - (int)snprintf(NULL, 0, "%.6g", hi[k]), "", xd[i]);
                 printf("\n");
             }
         }
