@@ -215,11 +215,12 @@ static void block_sums(const double *r, int64_t n, double *bsum)
 }
 
 /* Row j of M' (column j of M) as a walk reads it: the sum and largest of its |entries| (read
- * here unless pre: the sweep push left them), known 1, and when drawing an entry by rejection
- * would take more than ULAM__FPUSH_SKEW tries on average, the running sums of |entries| for a binary search,
- * appended to cum at *used (so cum's pages are touched only as far as rows need it; a first touch
- * is dear), known 2, mx_j then holding their offset in cum instead of the largest entry. */
-static void row_sums(const ulam_csr *Mt, int64_t j, int pre, double *cs, double *mx, unsigned char *known, double *cum,
+ * here unless pre: the sweep push left them), its bit in known set, and when drawing an entry by
+ * rejection would take more than ULAM__FPUSH_SKEW tries on average, the running sums of |entries|
+ * for a binary search, appended to cum at *used (so cum's pages are touched only as far as rows
+ * need it; a first touch is dear), mx_j then -1 - their offset in cum instead of the largest
+ * entry (negative: sums built).  known is a bit a state (n / 8 bytes: its pages are few). */
+static void row_sums(const ulam_csr *Mt, int64_t j, int pre, double *cs, double *mx, uint64_t *known, double *cum,
                      int64_t *used)
 {
     int64_t a = Mt->rowptr[j], b = Mt->rowptr[j + 1];
@@ -231,12 +232,11 @@ static void row_sums(const ulam_csr *Mt, int64_t j, int pre, double *cs, double 
         }
         cs[j] = s, mx[j] = m;
     }
-    known[j] = 1;
+    known[j >> 6] |= (uint64_t)1 << (j & 63);
     if (mx[j] * (double)(b - a) > ULAM__FPUSH_SKEW * cs[j]) {
         double c = 0.0, *cu = cum + *used;
         for (int64_t e = a; e < b; e++) c += fabs(Mt->val[e]), cu[e - a] = c;
-        mx[j] = (double)*used, *used += b - a;
-        known[j] = 2;
+        mx[j] = -1.0 - (double)*used, *used += b - a;
     }
 }
 
@@ -250,7 +250,7 @@ typedef struct {
     double alpha;
     double *cs, *mx, *cum;
     int64_t cum_used; /* entries of cum taken */
-    unsigned char *known;
+    uint64_t *known; /* a bit a state: row_sums done */
     int pre; /* cs and mx filled by the sweep push */
     int32_t *hp, *hn; /* walks that ended at i with score +R0, -R0 */
     int32_t *hit;     /* the states some walk ended at, in the order first ended at (nhit of them) */
@@ -346,7 +346,7 @@ typedef struct {
 static void lane_arrive(const walker *w, ulam_rng *rng, lane *L, int64_t j)
 {
     L->j = j, L->u = ulam__rng_uniform(rng), L->phase = 0;
-    __builtin_prefetch(&w->Mt->rowptr[j]), __builtin_prefetch(&w->known[j]), __builtin_prefetch(&w->cs[j]);
+    __builtin_prefetch(&w->Mt->rowptr[j]), __builtin_prefetch(&w->known[j >> 6]), __builtin_prefetch(&w->cs[j]);
     __builtin_prefetch(&w->mx[j]), __builtin_prefetch(&w->hp[j], 1);
 }
 
@@ -364,11 +364,11 @@ static int lane_choose(walker *w, lane *L)
         else w->hp[j]++;
         return 0;
     }
-    if (!w->known[j]) row_sums(Mt, j, w->pre, w->cs, w->mx, w->known, w->cum, &w->cum_used); /* on the first visit */
+    if (!(w->known[j >> 6] >> (j & 63) & 1)) row_sums(Mt, j, w->pre, w->cs, w->mx, w->known, w->cum, &w->cum_used); /* on the first visit */
     if (!(v < w->cs[j])) return 0; /* the walk dies */
     int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a, e;
-    if (w->known[j] == 2) { /* the first entry whose running sum exceeds v */
-        const double *cu = w->cum + (int64_t)w->mx[j];
+    if (w->mx[j] < 0) { /* the first entry whose running sum exceeds v */
+        const double *cu = w->cum + (int64_t)(-1.0 - w->mx[j]);
         int64_t l = 0, h = d - 1;
         while (l < h) {
             int64_t mid = l + (h - l) / 2;
@@ -629,7 +629,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         size_t cb = ((size_t)ulam_csr_nnz(Mt) + 1) * sizeof *w.cum, hb = (size_t)n * sizeof *w.hp;
         w.cum = ulam__huge(ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum), cb); /* filled from its start */
         w.hit = ulam__malloc((size_t)n, sizeof *w.hit);                                       /* filled from its start */
-        w.known = ulam__calloc((size_t)n, 1), w.hp = ulam__huge(ulam__calloc((size_t)n, sizeof *w.hp), hb);
+        w.known = ulam__calloc(((size_t)n + 63) / 64, sizeof *w.known), w.hp = ulam__huge(ulam__calloc((size_t)n, sizeof *w.hp), hb);
         if (sgn) w.hn = ulam__huge(ulam__calloc((size_t)n, sizeof *w.hn), hb);
         if (!bsum || !w.cum || !w.hit || !w.known || !w.hp || (sgn ? !w.hn : !kept))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
