@@ -252,10 +252,51 @@ typedef struct {
     int64_t cum_used; /* entries of cum taken */
     uint64_t *known; /* a bit a state: row_sums done */
     int pre; /* cs and mx filled by the sweep push */
-    int32_t *hp, *hn; /* walks that ended at i with score +R0, -R0 */
-    int32_t *hit;     /* the states some walk ended at, in the order first ended at (nhit of them) */
-    int64_t nhit, steps;
+    int32_t *hit;       /* the states some walk ended at, in the order first ended at (nhit of them) */
+    int32_t *hc;        /* their counts: hc[2q], hc[2q + 1] walks that ended at hit[q] with score +R0, -R0 */
+    int32_t *slot;      /* open addressing (linear probing) from a state to its q; -1: empty */
+    int64_t nhit, hmax; /* hit and hc hold hmax states; slot has 2 hmax or more (a power of 2) */
+    int64_t hcap, steps;
 } walker;
+
+/* The slot of state j in w's table: where its q is, or the empty slot where it goes. */
+static int64_t hit_slot(const walker *w, int64_t j)
+{
+    int64_t m = w->hcap - 1, t = (int64_t)(((uint64_t)j * 0x9E3779B97F4A7C15u) >> 20) & m;
+    while (w->slot[t] >= 0 && w->hit[w->slot[t]] != j) t = (t + 1) & m;
+    return t;
+}
+
+/* Room in w's hit list and table for more walks' ends (each adds at most one state, at most n
+ * in all): the hit counts take memory in proportion to the states walks ended at, not to n
+ * (a dense count of n states, 4 MiB on R-MAT 2^20, took ~12 ms to zero in 4 KiB pages for
+ * ~15 000 states ended at); ULAM_OK or ULAM_ENOMEM (w as it was). */
+static int hit_room(walker *w, int64_t more)
+{
+    int64_t need = w->nhit + more < w->n ? w->nhit + more : w->n, cap = w->hcap ? w->hcap : 64;
+    if (need <= w->hmax) return ULAM_OK;
+    int64_t hm = w->hmax;
+    if (ulam__grow(&w->hit, &hm, need, sizeof *w->hit)) return ULAM_ENOMEM;
+    hm = w->hmax;
+    if (ulam__grow(&w->hc, &hm, need, 2 * sizeof *w->hc)) return ULAM_ENOMEM; /* the same doublings: hit's room */
+    while (cap < 2 * need) cap *= 2;
+    if (cap > w->hcap) {
+        int32_t *t = ulam__malloc((size_t)cap, sizeof *t);
+        if (!t) return ULAM_ENOMEM;
+        memset(t, 0xff, (size_t)cap * sizeof *t); /* -1: empty */
+        free(w->slot);
+        w->slot = t, w->hcap = cap;
+        for (int64_t q = 0; q < w->nhit; q++) w->slot[hit_slot(w, w->hit[q])] = (int32_t)q;
+    }
+    w->hmax = hm;
+    return ULAM_OK;
+}
+
+/* The q of state j in w's hit list, -1 when no walk ended at it. */
+static int64_t hit_index(const walker *w, int64_t j)
+{
+    return w->hcap ? w->slot[hit_slot(w, j)] : -1;
+}
 
 /* The KL intervals (src/stop.c) of hit counts below ULAM__FPUSH_KL_KEPT at one checkpoint. */
 typedef struct {
@@ -298,8 +339,8 @@ static int rule_met_kl(const walker *w, kl_kept *c, const double *p, int64_t N, 
     if (!(hi <= E * delta && cut <= E * delta)) return 0; /* a component no walk ended at, p_i just under delta */
     for (int64_t q = 0; q < w->nhit; q++) {
         int64_t i = w->hit[q];
-        hits_interval(c, N, k, w->hp[i], R0, &lo, &hi);
-        if (!interval_met(p[i] + lo - cut, p[i] + hi, p[i] + R0 * (double)w->hp[i] / (double)N, E, delta)) return 0;
+        hits_interval(c, N, k, w->hc[2 * q], R0, &lo, &hi);
+        if (!interval_met(p[i] + lo - cut, p[i] + hi, p[i] + R0 * (double)w->hc[2 * q] / (double)N, E, delta)) return 0;
     }
     return 1;
 }
@@ -347,7 +388,7 @@ static void lane_arrive(const walker *w, ulam_rng *rng, lane *L, int64_t j)
 {
     L->j = j, L->u = ulam__rng_uniform(rng), L->phase = 0;
     __builtin_prefetch(&w->Mt->rowptr[j]), __builtin_prefetch(&w->known[j >> 6]), __builtin_prefetch(&w->cs[j]);
-    __builtin_prefetch(&w->mx[j]), __builtin_prefetch(&w->hp[j], 1);
+    __builtin_prefetch(&w->mx[j]);
 }
 
 /* Phase 0: stop and score (the walk ends), die, or choose the entry of row j to move along
@@ -359,9 +400,9 @@ static int lane_choose(walker *w, lane *L)
     int64_t j = L->j;
     double stop = 1.0 - w->alpha, v = L->u - stop;
     if (L->u < stop) {
-        if (w->hp[j] == 0 && (!w->hn || w->hn[j] == 0)) w->hit[w->nhit++] = (int32_t)j;
-        if (L->neg) w->hn[j]++;
-        else w->hp[j]++;
+        int64_t t = hit_slot(w, j), q = w->slot[t];
+        if (q < 0) q = w->slot[t] = (int32_t)w->nhit, w->hit[w->nhit++] = (int32_t)j, w->hc[2 * q] = w->hc[2 * q + 1] = 0;
+        w->hc[2 * q + L->neg]++;
         return 0;
     }
     if (!(w->known[j >> 6] >> (j & 63) & 1)) row_sums(Mt, j, w->pre, w->cs, w->mx, w->known, w->cum, &w->cum_used); /* on the first visit */
@@ -444,8 +485,8 @@ static int rule_met(const walker *w, const double *p, int64_t N, int k, double R
     double L = ulam__stop_log(k), rt = 7.0 * R * L / (3.0 * ((double)N - 1.0)), Nd = (double)N;
     if (!(rt <= E * delta)) return 0;
     for (int64_t q = 0; q < w->nhit; q++) { /* a state no walk ended at: its interval is p_i -+ rt, met above */
-        int64_t i = w->hit[q], h = w->hp[i] + (w->hn ? w->hn[i] : 0);
-        double s = (double)(w->hp[i] - (w->hn ? w->hn[i] : 0)), mean = R0 * s / Nd;
+        int64_t i = w->hit[q], h = w->hc[2 * q] + w->hc[2 * q + 1];
+        double s = (double)(w->hc[2 * q] - w->hc[2 * q + 1]), mean = R0 * s / Nd;
         double up = fabs(p[i]) + fabs(mean) + R0 * sqrt(2.0 * (double)h * L / (Nd * (Nd - 1.0))) + rt;
         if (up < delta) continue; /* cannot reach delta */
         double var = fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0));
@@ -490,27 +531,26 @@ typedef struct {
     ulam__stop_ci none;
 } ends;
 
-/* The walks' mean at i (0 where none ended). */
-static double ends_mean(const ends *c, int64_t i)
+/* The walks' mean at the q-th state ended at. */
+static double ends_mean(const ends *c, int64_t q)
 {
     const walker *w = c->w;
-    if (c->N == 0) return 0.0;
-    return c->R0 * (double)(w->hp[i] - (w->hn ? w->hn[i] : 0)) / (double)c->N;
+    return c->R0 * (double)(w->hc[2 * q] - w->hc[2 * q + 1]) / (double)c->N;
 }
 
-/* Component i's outputs from p = x_i: the walks' mean (returned), standard error *se and
- * interval [*a, *b]. */
-static double ends_component(const ends *c, const double *x, int64_t i, double *se, double *a, double *b)
+/* The outputs of a component with p_i = p and the q-th state ended at (q < 0: none ended at
+ * it): the walks' mean (returned), standard error *se and interval [*a, *b]. */
+static double ends_component(const ends *c, double p, int64_t q, double *se, double *a, double *b)
 {
     const walker *w = c->w;
-    int64_t N = c->N, h = N > 0 ? w->hp[i] + (w->hn ? w->hn[i] : 0) : 0;
-    double Nd = (double)N, R0 = c->R0, p = x[i], D = c->D, mean = 0.0, var = 0.0;
+    int64_t N = c->N, h = q >= 0 && N > 0 ? w->hc[2 * q] + w->hc[2 * q + 1] : 0;
+    double Nd = (double)N, R0 = c->R0, D = c->D, mean = 0.0, var = 0.0;
     if (h == 0) { /* the common interval, as none_fill gives it */
-        none_fill(x + i, se, a, b, 1, c->none.lo, c->none.hi, c->cut, N > 1 ? 0.0 : (w->k > 0 ? NAN : 0.0), D);
+        none_fill(&p, se, a, b, 1, c->none.lo, c->none.hi, c->cut, N > 1 ? 0.0 : (w->k > 0 ? NAN : 0.0), D);
         return 0.0;
     }
     ulam__stop_ci ci = c->none;
-    mean = ends_mean(c, i);
+    mean = ends_mean(c, q);
     var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
     if (!c->sgn) hits_interval(c->kept, N, c->kk < 0 ? c->k : c->kk, h, R0, &ci.lo, &ci.hi);
     else ulam__stop_interval(N, mean, var, c->R, 0.0, R0, R0, c->k, &ci);
@@ -544,14 +584,14 @@ static void sift_down(int64_t *idx, double *key, int64_t k, int64_t t)
     }
 }
 
-/* The k (<= n) components of largest estimate x_i + (c ? the walks' mean : 0) into index, by
- * rank (ranks_before); key: k entries of scratch.  One pass over n with a heap of the k best so
- * far (its root the last of them), then the heap sorted: O(n + changes log k). */
-static void select_top(const double *x, const ends *c, int64_t n, int64_t k, int64_t *index, double *key)
+/* The k (<= n) components of largest x_i into index, by rank (ranks_before); key: k entries of
+ * scratch.  One pass over n with a heap of the k best so far (its root the last of them), then
+ * the heap sorted: O(n + changes log k). */
+static void select_top(const double *x, int64_t n, int64_t k, int64_t *index, double *key)
 {
     if (k <= 0) return;
     for (int64_t i = 0; i < n; i++) {
-        double u = x[i] + (c ? ends_mean(c, i) : 0.0);
+        double u = x[i];
         if (i < k) {
             index[i] = i, key[i] = u;
             if (i == k - 1)
@@ -626,12 +666,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     if (w.k > 0) {
         w.n = n, w.nb = (n + ULAM__FPUSH_BLOCK - 1) / ULAM__FPUSH_BLOCK;
         bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
-        size_t cb = ((size_t)ulam_csr_nnz(Mt) + 1) * sizeof *w.cum, hb = (size_t)n * sizeof *w.hp;
+        size_t cb = ((size_t)ulam_csr_nnz(Mt) + 1) * sizeof *w.cum;
         w.cum = ulam__huge(ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum), cb); /* filled from its start */
-        w.hit = ulam__malloc((size_t)n, sizeof *w.hit);                                       /* filled from its start */
-        w.known = ulam__calloc(((size_t)n + 63) / 64, sizeof *w.known), w.hp = ulam__huge(ulam__calloc((size_t)n, sizeof *w.hp), hb);
-        if (sgn) w.hn = ulam__huge(ulam__calloc((size_t)n, sizeof *w.hn), hb);
-        if (!bsum || !w.cum || !w.hit || !w.known || !w.hp || (sgn ? !w.hn : !kept))
+        w.known = ulam__calloc(((size_t)n + 63) / 64, sizeof *w.known);
+        if (!bsum || !w.cum || !w.known || (sgn ? 0 : !kept))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
     }
     if (!status && w.k > 0) {
@@ -645,6 +683,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         for (;;) { /* checkpoint k (stitching index) at the end of epoch k0 + k - 1 */
             int64_t target = o->walks > 0 ? o->walks : epoch_end(k0 + k - 1);
             if (target > cap_w) target = cap_w, planned = o->walks > 0 && o->walks == cap_w;
+            if (N < target && hit_room(&w, target - N)) {
+                status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' ends");
+                break;
+            }
             int64_t made = N < target ? walk_many(&w, &rng, target - N, o->walk.stop.interrupt) : 0;
             if (made < target - N) info->interrupted = 1, planned = 0;
             N += made;
@@ -658,7 +700,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         else if (o->walks > 0)
             kk = 0; /* a count fixed in advance: the KL interval at delta itself */
     }
-    double *key = !status && top > 0 ? ulam__malloc((size_t)top, sizeof *key) : NULL;
+    double *key = !status && top > 0 ? ulam__malloc((size_t)top, sizeof *key) : NULL, *pv = NULL;
     if (!status && top > 0 && !key) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the top components");
     if (!status) {
         ends c = {.w = &w, .kept = kept, .N = N, .k = k, .kk = kk, .sgn = sgn, .R = R, .R0 = R0, .cut = cut,
@@ -667,30 +709,34 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         else c.none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
         if (!sgn && N >= 1) hits_interval(kept, N, kk < 0 ? k : kk, 0, R0, &c.none.lo, &c.none.hi);
         double s, a, b;
+        int64_t nh = N > 0 ? w.nhit : 0;
         if (top < 0) { /* every component: the common interval, then the states some walk ended at */
             none_fill(x, std_error, lo, hi, n, c.none.lo, c.none.hi, cut, N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0), c.D);
-            for (int64_t q = 0; q < (N > 0 ? w.nhit : 0); q++) {
+            for (int64_t q = 0; q < nh; q++) {
                 int64_t i = w.hit[q];
-                double mean = ends_component(&c, x, i, &s, &a, &b);
+                double mean = ends_component(&c, x[i], q, &s, &a, &b);
                 if (std_error) std_error[i] = s;
                 if (lo) lo[i] = a;
                 if (hi) hi[i] = b;
                 x[i] += mean;
             }
-        } else { /* the top components by p_i + the walks' mean, their outputs from p, then x */
-            select_top(x, &c, n, top, index, key);
+        } else if (!(pv = ulam__malloc(nh > 0 ? (size_t)nh : 1, sizeof *pv))) {
+            status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the top components");
+        } else { /* x = p + the walks' means (p kept for the states ended at), the top ones, their outputs */
+            for (int64_t q = 0; q < nh; q++) pv[q] = x[w.hit[q]], x[w.hit[q]] += ends_mean(&c, q);
+            select_top(x, n, top, index, key);
             for (int64_t t = 0; t < top; t++) {
-                ends_component(&c, x, index[t], &s, &a, &b);
+                int64_t q = nh > 0 ? hit_index(&w, index[t]) : -1;
+                ends_component(&c, q >= 0 ? pv[q] : x[index[t]], q, &s, &a, &b);
                 if (std_error) std_error[t] = s;
                 if (lo) lo[t] = a;
                 if (hi) hi[t] = b;
             }
-            for (int64_t q = 0; q < (N > 0 ? w.nhit : 0); q++) x[w.hit[q]] += ends_mean(&c, w.hit[q]);
         }
         info->walks = N, info->steps = w.steps, info->walk_seconds = ulam_now() - t1;
     }
-    free(key);
-    free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.hit), free(w.known), free(w.hp), free(w.hn);
+    free(key), free(pv);
+    free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.hit), free(w.hc), free(w.slot), free(w.known);
     free(r), free(kept);
     info->seconds = ulam_now() - t0;
     return status;
@@ -707,7 +753,7 @@ static int solve_queue_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpu
     double *key = ulam__malloc(top > 0 ? (size_t)top : 1, sizeof *key);
     int status = se && a && b && key ? solve_queue(M, Mt, opts, g, x, se, a, b, info, err)
                                      : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for every component");
-    if (!status) select_top(x, NULL, M->nrows, top, index, key);
+    if (!status) select_top(x, M->nrows, top, index, key);
     for (int64_t t = 0; !status && t < top; t++) {
         if (std_error) std_error[t] = se[index[t]];
         if (lo) lo[t] = a[index[t]];
