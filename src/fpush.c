@@ -666,8 +666,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     if (w.k > 0) {
         w.n = n, w.nb = (n + ULAM__FPUSH_BLOCK - 1) / ULAM__FPUSH_BLOCK;
         bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
-        size_t cb = ((size_t)ulam_csr_nnz(Mt) + 1) * sizeof *w.cum;
-        w.cum = ulam__huge(ulam__malloc((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum), cb); /* filled from its start */
+        w.cum = ulam__alloc_big((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum); /* filled from its start: 2 MiB pages from it */
         w.known = ulam__calloc(((size_t)n + 63) / 64, sizeof *w.known);
         if (!bsum || !w.cum || !w.known || (sgn ? 0 : !kept))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
