@@ -76,8 +76,8 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         printf("load            %.3f s inputs\n", rp->load_seconds);
         if (rp->ch) cli_auto_print_text(rp->ch, 1);
         if (rp->check)
-            printf("direct          %.10g (LAPACK), z = %.3f\n", rp->direct,
-                   r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN);
+            printf("direct          %.10g (LAPACK), ", rp->direct),
+                cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
         return;
     }
     if (o->nb > 0)
@@ -106,8 +106,8 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     printf("load            %.3f s inputs, %.3f s guards\n", rp->load_seconds, rp->guard_seconds);
     if (rp->ch) cli_auto_print_text(rp->ch, 1);
     if (rp->check)
-        printf("direct          %.10g (LAPACK), z = %.3f\n", rp->direct,
-               r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN);
+        printf("direct          %.10g (LAPACK), ", rp->direct),
+            cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
 }
 
 /* Print the JSON object. */

@@ -186,6 +186,9 @@ void cli_json_string(const char *key, const char *v, int last);
 /* A verdict in words. */
 const char *cli_verdict_word(int verdict);
 
+/* Print "z = Z" for --check and a newline (see src/cli/common.c). */
+void cli_print_z(double estimate, double direct, double std_error, double lo, double hi);
+
 /* Print a power-iteration radius with its bounds (no newline). */
 void cli_print_power(const ulam_power *p);
 

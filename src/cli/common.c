@@ -590,6 +590,17 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
     return cli_report(s->matrix_path, &err);
 }
 
+/* The --check line's tail: "z = Z" with z = (estimate - direct) / stderr (0 when they are equal,
+ * +-inf when only the stderr is 0), and when |z| > 4 whether direct is inside [lo, hi] (an
+ * interval wider than the stderr says: a range term, or the allowance for rounding). */
+void cli_print_z(double estimate, double direct, double std_error, double lo, double hi)
+{
+    double d = estimate - direct, z = std_error > 0 ? d / std_error : d == 0 ? 0.0 : copysign(INFINITY, d);
+    printf("z = %.3f", z);
+    if (fabs(z) > 4.0) printf(" (direct %s the 95%% interval)", lo <= direct && direct <= hi ? "inside" : "OUTSIDE");
+    printf("\n");
+}
+
 /* Print a bare JSON number (null when not finite). */
 void cli_json_value(double v)
 {

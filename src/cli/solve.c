@@ -722,8 +722,9 @@ static int run(solve_args *a)
             rc = cli_system_verify(&a->s);
             rc = rc ? rc : direct_check(s, o->query.index, &ro);
             left = rc == EXIT_INTERRUPTED;
-            if (!ro.json && !rc) printf("direct          %.10g (%s, %.3g s), z = %.3f\n", ro.direct, ro.direct_method,
-                                        ro.direct_seconds, (r.estimate - ro.direct) / r.std_error);
+            if (!ro.json && !rc)
+                printf("direct          %.10g (%s, %.3g s), ", ro.direct, ro.direct_method, ro.direct_seconds),
+                    cli_print_z(r.estimate, ro.direct, r.std_error, r.ci95[0], r.ci95[1]);
             if (left && !ro.json) fprintf(stderr, "ulam: --check interrupted: the estimate above stands unchecked\n");
         }
         if (ro.json && (!rc || left)) print_json(o, &r, &ro);
