@@ -156,6 +156,8 @@ CASES += [
     (SOLVE + ["--index", "9"], 2, r"--index 9 is out of range 1..4", ""),
     (SOLVE, 2, r"adjoint walks need --index", ""),
     (SOLVE + ["--index", "1", "--out", "/tmp/x.mtx"], 2, r"--out and --errors need --mode forward", ""),
+    # a directory read as junk: "malformed entry ... binary or damaged", exit 22
+    (["solve", "tests/data", "--index", "1", "--rhs", M + "randsub1000_b.mtx"], code("EIO"), r"tests/data: .*readable file \(Is a directory\)", r"^$"),
     (["solve", "--method", "walks", D + "absorb_undefined.mtx", "--rhs", D + "ones3.mtx", "--index", "1", "--estimator", "absorption"],
      code("EUNDEFINED"), r"state 2 \(1-based\) is reachable and never terminates", ""),
     (SOLVE + ["--index", "2", "--walks", "20000", "--check"], 0, r"^$", r"direct\s+2\.34009.*z = "),
