@@ -199,12 +199,16 @@ CASES += [
 CASES += [
     # --method auto (src/cli/auto.c)
     (RS0 + ["--method", "sideways"], 2, r"--method expects auto, walks, bidirectional \(with --source or a sparse b\), richardson, gauss-seidel, sequential, mcsa, cg or gmres, got 'sideways'", r"^$"),
+    # rho(|M|) >= 1: the guards' refusal alone (auto warned 'running it', then the guards refused)
     (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--method", "auto",
-      "--rel-err", "0.01"], 3, r"error: --method auto: no candidate has a certified finite variance \(rho\(\|M\|\) is not "
-     r"certified below 1\); the closest is .*a --rel-err target cannot be met honestly", r"^$"),
+      "--rel-err", "0.01"], 3, r"^ulam: [^\n]*error: rho\(\|M\|\) is >= 1 \(certified: bounds \[1\.3, 1\.3\]\).*--force runs the walks anyway\.\n$", r"^$"),
     # the default is auto: the same refusal without --method
     (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--rel-err", "0.01"], 3,
-     r"error: --method auto: no candidate has a certified finite variance", r"^$"),
+     r"^ulam: [^\n]*error: rho\(\|M\|\) is >= 1", r"^$"),
+    # forced: auto names the closest candidate (its continuation in words: it printed 'analog, 0')
+    (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--rel-err", "0.01", "--force"], 3,
+     r"error: --method auto: no candidate has a certified finite variance \(rho\(\|M\|\) >= 1, certified\); the closest "
+     r"is \S+ \S+ \(continuation (analog|Q = [0-9.]+), kernel exponent [0-9.]+\) .*a --rel-err target cannot be met honestly", r"^$"),
     (RS0 + ["--method", "auto", "--walks", "20000", "--verbose"], 0, r"^$", r"auto\s+chose the least predicted variance x work a walk of 36 candidates"),
 ]
 
