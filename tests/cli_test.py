@@ -64,6 +64,8 @@ CASES += [
     ([], 2, r"usage: ulam", ""),
     (["--help"], 0, r"^$", r"1-based"),
     (["direct", "--help"], 0, r"^$", r"1-based"),
+    (["help"], 0, r"^$", r"^usage: ulam <command>"),  # was "unknown command 'help'", exit 2
+    (["help", "solve"], 0, r"^$", r"^usage: ulam solve M\.mtx"),
     (["info", M + "chain4.mtx"], 0, r"^$", r"walks\s+converge"),
     (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(M\)\s+0\.98883"),
     (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(\|M\|\)\s+0\.988[78]"),

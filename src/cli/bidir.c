@@ -53,11 +53,11 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     const ulam_walk_result *w = &r->walks;
     if (isfinite(r->ci95[0]) && isfinite(r->ci95[1]))
         printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->target + 1,
-               o->target < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+               cli_answer_pad(o->target + 1, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
                w->interrupted ? "  [INTERRUPTED]" : "");
     else
         printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->target + 1,
-               o->target < 9 ? 10 : 9, "", r->estimate, r->std_error,
+               cli_answer_pad(o->target + 1, 16), "", r->estimate, r->std_error,
                w->variance > 0 ? "no certified range of the walk part's score"
                                : "no walk scored, and no bound certifies the part they missed",
                w->interrupted ? "  [INTERRUPTED]" : "");

@@ -590,6 +590,15 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
     return cli_report(s->matrix_path, &err);
 }
 
+/* The spaces after "x[index]" (1-based) that put the value at the given column, the one of the
+ * lines below it (16 under "method          "); at least 1. */
+int cli_answer_pad(int64_t index, int column)
+{
+    char label[32];
+    int len = snprintf(label, sizeof label, "x[%lld]", (long long)index);
+    return len < column ? column - len : 1;
+}
+
 /* The --check line's tail: "z = Z" with z = (estimate - direct) / stderr (0 when they are equal,
  * +-inf when only the stderr is 0), and when |z| > 4 whether direct is inside [lo, hi] (an
  * interval wider than the stderr says: a range term, or the allowance for rounding). */
