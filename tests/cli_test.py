@@ -178,7 +178,7 @@ CASES += [
     (PS + ["--source", "3", "--rmax", "nan"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
     # an exact push (no residual): estimate and stderr both exact printed z = nan
-    (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check"], 0, r"^$", r"direct\s+1 \(LAPACK\), z = 0\.000$"),
+    (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check"], 0, r"^$", r"direct\s+1 \(dense LU\), z = 0\.000$"),
     (["solve", M + "randsub1000.mtx", "--source", "3", "--top", "2"], 0, r"^$",  # every target (src/fpush.c)
      r"single source: forward push from 3.*\n(.*\n)*rank .*95% CI\n1 +3 +1\.00\d+ .*\n2 +143 +0\.195"),
     (["solve", M + "randsub1000.mtx", "--source", "3", "--index", "4", "--top", "2"], 2, r"--top K .* not with --index",

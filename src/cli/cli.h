@@ -270,7 +270,7 @@ extern const cli_solve_row cli_solve_bidir_row, cli_solve_outer_row, cli_solve_w
 /* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print
  * its report with the choice; 0 or an exit code. */
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
-                       double load_seconds);
+                       const char *direct_method, double load_seconds);
 
 /* ulam solve --queries FILE (src/cli/queries.c): s (not loaded) and o from the command line
  * (adjoint), json, walks_given (--walks or --time given); 0 or an exit code. */

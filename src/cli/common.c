@@ -577,7 +577,8 @@ void cli_system_free(cli_system *s)
     s->M = NULL, s->b = NULL, s->cert = NULL;
 }
 
-/* Solve the loaded system densely into a new *x; 0 or an exit code. */
+/* Solve the loaded system into a new *x (sparse LU or dense, as cli_direct_sparse_wanted says); 0
+ * or an exit code. */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info)
 {
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
