@@ -9,7 +9,8 @@
  * rarely a walk comes back to i, 30x the variance's own need on randsub1000 at E = 0.1.  The
  * forward push keeps x = q + (I - M)^-1 r (q = 0, r = b at the start): pushing state j moves r_j
  * into q_j and adds M_kj r_j to r_k (column j of M, row j of Mt).  A sweep pushes every nonzero
- * residual in index order (a residual a push adds ahead of the sweep is pushed in the same sweep).
+ * residual in index order (src/sweep.c's push sweep: a residual a push adds ahead of the sweep is
+ * pushed in the same sweep).
  * The walks then start from r with weight ||r||_1: their range, second moment and variance shrink
  * with it.  Sweeps go on while the walks' predicted work (the caller's cost model, at the push part
  * q_i as the scale of x_i) falls by more than a sweep costs, so the push never costs more than the
@@ -18,21 +19,6 @@
 #include "internal.h"
 
 #include <math.h>
-
-/* One sweep: push every nonzero r_j in index order; the operations it took (a state read, and
- * a push its column's entries + 1). */
-static int64_t sweep(const ulam_csr *Mt, double *q, double *r)
-{
-    int64_t n = Mt->nrows, ops = n;
-    for (int64_t j = 0; j < n; j++) {
-        double v = r[j];
-        if (v == 0.0) continue;
-        q[j] += v, r[j] = 0.0;
-        for (int64_t p = Mt->rowptr[j]; p < Mt->rowptr[j + 1]; p++) r[Mt->colidx[p]] += Mt->val[p] * v;
-        ops += 1 + (Mt->rowptr[j + 1] - Mt->rowptr[j]);
-    }
-    return ops;
-}
 
 /* ||r||_1. */
 static double norm1(const double *r, int64_t n)
@@ -53,7 +39,8 @@ int ulam__fpush_b(const ulam_csr *Mt, int64_t index, ulam__fpush_b_cost cost, vo
     if (!(ULAM_AUTO_READ * step <= first)) return ULAM_OK; /* q_i = 0 prices nothing: the first sweep on trust */
     for (int it = 0; it < ULAM__FPUSH_B_SWEEPS && rsum > 0; it++) {
         double last = rsum;
-        info->ops += sweep(Mt, q, r);
+        int64_t pushed;
+        info->ops += ulam__sweep_once(Mt, 0.0, q, r, &pushed);
         info->sweeps++;
         rsum = norm1(r, n);
         now = info->work = cost(rsum, q[index], ctx);

@@ -721,10 +721,15 @@ int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error
     return ulam_mm_read_matrix_opts(f, name, NULL, A, err);
 }
 
-/* Open path for reading, recording a failure in err. */
+/* Open path for reading, recording a failure in err (a directory opens, then reads as junk). */
 static FILE *open_input(const char *path, ulam_error *err)
 {
     FILE *f = path ? fopen(path, "rb") : NULL;
+    struct stat st;
+    if (f && !fstat(fileno(f), &st) && S_ISDIR(st.st_mode)) {
+        fclose(f);
+        errno = EISDIR, f = NULL;
+    }
     if (!f) ulam__fail(err, ULAM_EIO, 0, -1, "a readable file (%s)", path ? strerror(errno) : "no path");
     return f;
 }

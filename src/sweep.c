@@ -47,6 +47,18 @@ static int64_t push_one(const ulam_csr *Mt, int64_t j, double *p, double *r, int
     return b - a + 1;
 }
 
+/* One push sweep over the states in order: push every |r_j| > thr (a residual a push adds ahead
+ * of the sweep is pushed in the same sweep); the operations (n, and each push's row entries + 1),
+ * the pushes in *pushed. */
+int64_t ulam__sweep_once(const ulam_csr *Mt, double thr, double *p, double *r, int64_t *pushed)
+{
+    int64_t n = Mt->nrows, ops = n, k = 0;
+    for (int64_t j = 0; j < n; j++)
+        if (fabs(r[j]) > thr) ops += push_one(Mt, j, p, r, NULL, NULL, NULL), k++;
+    *pushed = k;
+    return ops;
+}
+
 /* The pull sweeps' view of M: M and its column sums c (rows of Mt; kept in r's storage, which
  * the pull sweeps do not use). */
 typedef struct {
@@ -160,9 +172,7 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
             round_ops = nnz + n;
             info->sweeps++, info->pulls++;
         } else {
-            for (int64_t j = 0; j < n; j++)
-                if (fabs(r[j]) > thr) round_ops += push_one(Mt, j, p, r, NULL, NULL, NULL), pushed++;
-            round_ops += n;
+            round_ops = ulam__sweep_once(Mt, thr, p, r, &pushed);
             info->sweeps++;
         }
         info->rounds++;

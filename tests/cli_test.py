@@ -64,6 +64,8 @@ CASES += [
     ([], 2, r"usage: ulam", ""),
     (["--help"], 0, r"^$", r"1-based"),
     (["direct", "--help"], 0, r"^$", r"1-based"),
+    (["help"], 0, r"^$", r"^usage: ulam <command>"),  # was "unknown command 'help'", exit 2
+    (["help", "solve"], 0, r"^$", r"^usage: ulam solve M\.mtx"),
     (["info", M + "chain4.mtx"], 0, r"^$", r"walks\s+converge"),
     (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(M\)\s+0\.98883"),
     (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(\|M\|\)\s+0\.988[78]"),
@@ -156,6 +158,8 @@ CASES += [
     (SOLVE + ["--index", "9"], 2, r"--index 9 is out of range 1..4", ""),
     (SOLVE, 2, r"adjoint walks need --index", ""),
     (SOLVE + ["--index", "1", "--out", "/tmp/x.mtx"], 2, r"--out and --errors need --mode forward", ""),
+    # a directory read as junk: "malformed entry ... binary or damaged", exit 22
+    (["solve", "tests/data", "--index", "1", "--rhs", M + "randsub1000_b.mtx"], code("EIO"), r"tests/data: .*readable file \(Is a directory\)", r"^$"),
     (["solve", "--method", "walks", D + "absorb_undefined.mtx", "--rhs", D + "ones3.mtx", "--index", "1", "--estimator", "absorption"],
      code("EUNDEFINED"), r"state 2 \(1-based\) is reachable and never terminates", ""),
     (SOLVE + ["--index", "2", "--walks", "20000", "--check"], 0, r"^$", r"direct\s+2\.34009.*z = "),
@@ -173,6 +177,8 @@ CASES += [
     (PS + ["--source", "3", "--rmax", "-0.1"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--source", "3", "--rmax", "nan"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
+    # an exact push (no residual): estimate and stderr both exact printed z = nan
+    (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check"], 0, r"^$", r"direct\s+1 \(dense LU\), z = 0\.000$"),
     (["solve", M + "randsub1000.mtx", "--source", "3", "--top", "2"], 0, r"^$",  # every target (src/fpush.c)
      r"single source: forward push from 3.*\n(.*\n)*rank .*95% CI\n1 +3 +1\.00\d+ .*\n2 +143 +0\.195"),
     (["solve", M + "randsub1000.mtx", "--source", "3", "--index", "4", "--top", "2"], 2, r"--top K .* not with --index",
@@ -195,12 +201,16 @@ CASES += [
 CASES += [
     # --method auto (src/cli/auto.c)
     (RS0 + ["--method", "sideways"], 2, r"--method expects auto, walks, bidirectional \(with --source or a sparse b\), richardson, gauss-seidel, sequential, mcsa, cg or gmres, got 'sideways'", r"^$"),
+    # rho(|M|) >= 1: the guards' refusal alone (auto warned 'running it', then the guards refused)
     (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--method", "auto",
-      "--rel-err", "0.01"], 3, r"error: --method auto: no candidate has a certified finite variance \(rho\(\|M\|\) is not "
-     r"certified below 1\); the closest is .*a --rel-err target cannot be met honestly", r"^$"),
+      "--rel-err", "0.01"], 3, r"^ulam: [^\n]*error: rho\(\|M\|\) is >= 1 \(certified: bounds \[1\.3, 1\.3\]\).*--force runs the walks anyway\.\n$", r"^$"),
     # the default is auto: the same refusal without --method
     (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--rel-err", "0.01"], 3,
-     r"error: --method auto: no candidate has a certified finite variance", r"^$"),
+     r"^ulam: [^\n]*error: rho\(\|M\|\) is >= 1", r"^$"),
+    # forced: auto names the closest candidate (its continuation in words: it printed 'analog, 0')
+    (["solve", M + "signed_edge200.mtx", "--rhs", M + "signed_edge200_b.mtx", "--index", "1", "--rel-err", "0.01", "--force"], 3,
+     r"error: --method auto: no candidate has a certified finite variance \(rho\(\|M\|\) >= 1, certified\); the closest "
+     r"is \S+ \S+ \(continuation (analog|Q = [0-9.]+), kernel exponent [0-9.]+\) .*a --rel-err target cannot be met honestly", r"^$"),
     (RS0 + ["--method", "auto", "--walks", "20000", "--verbose"], 0, r"^$", r"auto\s+chose the least predicted variance x work a walk of 36 candidates"),
 ]
 

@@ -553,6 +553,39 @@ static void test_bidir_deterministic_walks(void **state)
     ulam_csr_free(N), ulam_csr_free(Nt);
 }
 
+/* A push taken down to rounding (rmax 1e-19 on a 600-state Zipf PageRank graph: <p, b> is x_t
+ * but for the roundings of ~10^5 operations, the residual ~1e-17, the walks' interval ~1e-22
+ * wide): every interval still holds LAPACK's x_t, with the allowance for the arithmetic's error,
+ * and is at most 1e-8 |x_t| wide either side.  Before, 0.2200611274 +- 3.85e-22 missed the
+ * exact value by 1.3 ulp (z = -144216) on such a graph. */
+static void test_bidir_rounding(void **state)
+{
+    (void)state;
+    int64_t n = 600, s = 3;
+    ulam_csr *M = zipf_graph(n, 2.1, 0.75, 0.85, 7), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = exact_column(M, s);
+    int tried = 0;
+    for (int64_t t = 0; t < n && tried < 40; t++) {
+        if (!(x[t] > 1e-6)) continue;
+        tried++;
+        if (!test_case(tried)) continue;
+        ulam_bidir_opts o = ulam_bidir_defaults();
+        o.source = s, o.target = t, o.rmax = 1e-19, o.walk.exec.seed = (uint64_t)t + 1;
+        o.walk.stop.max_walks = 0, o.walk.stop.rel_err = 0.1;
+        ulam_bidir_result res = bidir(M, Mt, &o);
+        if (!(res.ci95[0] <= x[t] && x[t] <= res.ci95[1]))
+            print_error("case %d (t %lld): %.17g in [%.17g, %.17g]? exact %.17g\n", tried, (long long)t, res.estimate,
+                        res.ci95[0], res.ci95[1], x[t]);
+        assert_true(res.ci95[0] <= x[t] && x[t] <= res.ci95[1]);
+        assert_true(res.ci95[1] - res.estimate <= 1e-8 * x[t] && res.estimate - res.ci95[0] <= 1e-8 * x[t]);
+    }
+    test_case_done();
+    assert_true(tried >= 20);
+    free(x);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 /* The time rule stops a run with no walk cap (its first block whole), and a run of a handful of
  * walks reports what it has: an estimate within 4 sigma when the walks scored differently. */
 static void test_bidir_small_budgets(void **state)
@@ -787,7 +820,7 @@ int main(void)
         cmocka_unit_test(test_bidir_rules),    cmocka_unit_test(test_bidir_rare_score),
         cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
         cmocka_unit_test(test_bidir_reach_all),  cmocka_unit_test(test_bidir_fixed_walks_honest),
-        cmocka_unit_test(test_fpush_all_targets),
+        cmocka_unit_test(test_fpush_all_targets), cmocka_unit_test(test_bidir_rounding),
     };
     return test_run(tests);
 }

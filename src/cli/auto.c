@@ -28,12 +28,19 @@ int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, c
     const ulam_auto_candidate *c = &res->cand[k];
     if (res->chosen < 0) {
         int diverge = !(res->abs.upper < 1);
+        if (diverge && !o->policy.force) { /* the guards' refusal says why; no candidate is run */
+            cli_guard_diverge(s, &res->guard, 0);
+            *run = ulam_run_free(*run);
+            return EXIT_DIVERGE;
+        }
         const char *hint = s->jacobi || s->pagerank > 0 ? "" : cli_system_hint(s->M);
+        char q[32] = "analog";
+        if (c->continue_q > 0) snprintf(q, sizeof q, "Q = %.3g", c->continue_q);
         fprintf(stderr, "ulam: %s: %s: --method auto: no candidate has a certified finite variance%s; the closest is "
-                        "%s %s (continuation %s%.3g, kernel exponent %g) with rho(M^) = %.6g (upper bound %.6g)%s.%s\n",
-                s->matrix_path, o->stop.rel_err > 0 ? "error" : "warning", diverge ? " (rho(|M|) is not certified below 1)" : "",
-                cli_mode_names[c->mode], cli_estimator_names[c->estimator], c->continue_q > 0 ? "" : "analog, ",
-                c->continue_q > 0 ? c->continue_q : 0.0, c->kernel_alpha, c->hat.rho, c->hat.upper,
+                        "%s %s (continuation %s, kernel exponent %g) with rho(M^) = %.6g (upper bound %.6g)%s.%s\n",
+                s->matrix_path, o->stop.rel_err > 0 ? "error" : "warning",
+                !diverge ? "" : res->abs.lower >= 1 ? " (rho(|M|) >= 1, certified)" : " (rho(|M|) is not certified below 1)",
+                cli_mode_names[c->mode], cli_estimator_names[c->estimator], q, c->kernel_alpha, c->hat.rho, c->hat.upper,
                 o->stop.rel_err > 0 ? ": a --rel-err target cannot be met honestly" : "; running it", hint);
         if (o->stop.rel_err > 0) {
             *run = ulam_run_free(*run);

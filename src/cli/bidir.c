@@ -41,6 +41,7 @@ static const char *const usage =
 typedef struct {
     int json, check;
     double direct, transpose_seconds, load_seconds, guard_seconds;
+    const char *direct_method; /* --check's solve: "dense LU" or "sparse LU" (NULL: "LU") */
     ulam_guard g;
     const ulam_choice *ch; /* chosen by --method auto: the choice (else NULL) */
     double bmax;           /* max |b| */
@@ -53,11 +54,11 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     const ulam_walk_result *w = &r->walks;
     if (isfinite(r->ci95[0]) && isfinite(r->ci95[1]))
         printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->target + 1,
-               o->target < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+               cli_answer_pad(o->target + 1, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
                w->interrupted ? "  [INTERRUPTED]" : "");
     else
         printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->target + 1,
-               o->target < 9 ? 10 : 9, "", r->estimate, r->std_error,
+               cli_answer_pad(o->target + 1, 16), "", r->estimate, r->std_error,
                w->variance > 0 ? "no certified range of the walk part's score"
                                : "no walk scored, and no bound certifies the part they missed",
                w->interrupted ? "  [INTERRUPTED]" : "");
@@ -76,8 +77,8 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         printf("load            %.3f s inputs\n", rp->load_seconds);
         if (rp->ch) cli_auto_print_text(rp->ch, 1);
         if (rp->check)
-            printf("direct          %.10g (LAPACK), z = %.3f\n", rp->direct,
-                   r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN);
+            printf("direct          %.10g (%s), ", rp->direct, rp->direct_method ? rp->direct_method : "LU"),
+                cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
         return;
     }
     if (o->nb > 0)
@@ -106,8 +107,8 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     printf("load            %.3f s inputs, %.3f s guards\n", rp->load_seconds, rp->guard_seconds);
     if (rp->ch) cli_auto_print_text(rp->ch, 1);
     if (rp->check)
-        printf("direct          %.10g (LAPACK), z = %.3f\n", rp->direct,
-               r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN);
+        printf("direct          %.10g (%s), ", rp->direct, rp->direct_method ? rp->direct_method : "LU"),
+            cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
 }
 
 /* Print the JSON object. */
@@ -220,6 +221,7 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
         double *x;
         if ((rc = cli_direct_solve(s, CLI_MAX_MEM, &x, NULL))) return rc;
         rp->direct = x[s->index - 1];
+        rp->direct_method = cli_direct_sparse_wanted(s->M) ? "sparse LU" : "dense LU";
         free(x);
     }
     return 0;
@@ -450,9 +452,9 @@ const cli_solve_row cli_solve_bidir_row = {"bidirectional", longopts, claims, se
 
 /* Run the chosen bidirectional (cli.h). */
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
-                       double load_seconds)
+                       const char *direct_method, double load_seconds)
 {
-    report rp = {.json = json, .check = check, .direct = direct, .load_seconds = load_seconds,
+    report rp = {.json = json, .check = check, .direct = direct, .direct_method = direct_method, .load_seconds = load_seconds,
                  .transpose_seconds = ch->transpose_seconds, .ch = ch};
     for (int64_t i = 0; i < s->M->nrows; i++) rp.bmax = fmax(rp.bmax, fabs(s->b[i]));
     rp.dense = route; /* ulam_method_bidir_route: the push on b */

@@ -186,6 +186,12 @@ void cli_json_string(const char *key, const char *v, int last);
 /* A verdict in words. */
 const char *cli_verdict_word(int verdict);
 
+/* The spaces after "x[index]" (1-based) that put its value at column (the lines below's). */
+int cli_answer_pad(int64_t index, int column);
+
+/* Print "z = Z" for --check and a newline (see src/cli/common.c). */
+void cli_print_z(double estimate, double direct, double std_error, double lo, double hi);
+
 /* Print a power-iteration radius with its bounds (no newline). */
 void cli_print_power(const ulam_power *p);
 
@@ -264,7 +270,7 @@ extern const cli_solve_row cli_solve_bidir_row, cli_solve_outer_row, cli_solve_w
 /* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print
  * its report with the choice; 0 or an exit code. */
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
-                       double load_seconds);
+                       const char *direct_method, double load_seconds);
 
 /* ulam solve --queries FILE (src/cli/queries.c): s (not loaded) and o from the command line
  * (adjoint), json, walks_given (--walks or --time given); 0 or an exit code. */

@@ -581,7 +581,8 @@ void cli_system_free(cli_system *s)
     s->M = NULL, s->b = NULL, s->cert = NULL;
 }
 
-/* Solve the loaded system densely into a new *x; 0 or an exit code. */
+/* Solve the loaded system into a new *x (sparse LU or dense, as cli_direct_sparse_wanted says); 0
+ * or an exit code. */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info)
 {
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
@@ -592,6 +593,26 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
     free(*x);
     *x = NULL;
     return cli_report(s->matrix_path, &err);
+}
+
+/* The spaces after "x[index]" (1-based) that put the value at the given column, the one of the
+ * lines below it (16 under "method          "); at least 1. */
+int cli_answer_pad(int64_t index, int column)
+{
+    char label[32];
+    int len = snprintf(label, sizeof label, "x[%lld]", (long long)index);
+    return len < column ? column - len : 1;
+}
+
+/* The --check line's tail: "z = Z" with z = (estimate - direct) / stderr (0 when they are equal,
+ * +-inf when only the stderr is 0), and when |z| > 4 whether direct is inside [lo, hi] (an
+ * interval wider than the stderr says: a range term, or the allowance for rounding). */
+void cli_print_z(double estimate, double direct, double std_error, double lo, double hi)
+{
+    double d = estimate - direct, z = std_error > 0 ? d / std_error : d == 0 ? 0.0 : copysign(INFINITY, d);
+    printf("z = %.3f", z);
+    if (fabs(z) > 4.0) printf(" (direct %s the 95%% interval)", lo <= direct && direct <= hi ? "inside" : "OUTSIDE");
+    printf("\n");
 }
 
 /* Print a bare JSON number (null when not finite). */

@@ -131,10 +131,10 @@ static void print_text(const cli_system *s, const double *x, int64_t index,
     int64_t n = s->M->nrows;
     printf("n          %lld\n", (long long)n);
     if (index > 0) {
-        printf("x[%lld]%*s%.17g\n", (long long)index, index < 10 ? 6 : index < 100 ? 5 : 1, "",
+        printf("x[%lld]%*s%.17g\n", (long long)index, cli_answer_pad(index, 11), "",
                x[index - 1]);
     } else if (!out) {
-        for (int64_t i = 0; i < n && i < 10; i++) printf("x[%lld]%*s%.17g\n", (long long)i + 1, i < 9 ? 6 : 5, "", x[i]);
+        for (int64_t i = 0; i < n && i < 10; i++) printf("x[%lld]%*s%.17g\n", (long long)i + 1, cli_answer_pad(i + 1, 11), "", x[i]);
         if (n > 10) printf("...        (%lld more: use --out or --index)\n", (long long)(n - 10));
     }
     printf("method     %s\n", cli_direct_sparse_wanted(s->M) ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");

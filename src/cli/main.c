@@ -6,7 +6,7 @@
 #include <string.h>
 
 static const char *const usage =
-    "usage: ulam <command> [options]   (ulam <command> --help for details)\n"
+    "usage: ulam <command> [options]   (ulam help <command>, or ulam <command> --help, for details)\n"
     "\n"
     "Solve (I - M) x = b by von Neumann-Ulam random walks, with an error bar, checked by a direct solve.\n"
     "\n"
@@ -29,6 +29,11 @@ static int dispatch(int argc, char **argv)
     if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
         fputs(usage, argc < 2 ? stderr : stdout);
         return argc < 2 ? EXIT_USAGE : 0;
+    }
+    if (!strcmp(argv[1], "help")) { /* ulam help [COMMAND]: COMMAND --help */
+        static char help[] = "--help";
+        char *sub[] = {argv[0], argc > 2 ? argv[2] : help, help, NULL};
+        return dispatch(argc > 2 ? 3 : 2, sub);
     }
     if (!strcmp(argv[1], "--version")) {
         printf("ulam %s\n", ULAM_VERSION);

@@ -123,7 +123,7 @@ static void print_text(const report *p)
         printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", p->g.abs.rho,
                cli_verdict_word(p->g.verdict_abs), p->g.hat[ULAM_FORWARD].rho,
                cli_verdict_word(p->g.verdict_hat[ULAM_FORWARD]));
-    if (p->index && p->x) printf("x[%lld]%*s%.12g\n", (long long)p->index, p->index < 10 ? 10 : 9, "", p->x[p->index - 1]);
+    if (p->index && p->x) printf("x[%lld]%*s%.12g\n", (long long)p->index, cli_answer_pad(p->index, 16), "", p->x[p->index - 1]);
     if (p->check) printf("direct          relative error ||x - x_LAPACK||_2 / ||x_LAPACK||_2 = %.4e (LAPACK %.4f s)\n",
                          p->err_direct, p->direct_seconds);
 }

@@ -21,7 +21,7 @@ static const char *const usage =
     "                  [--cache] [--whole-kernel]\n"
     "                  [--method auto]\n"
     "       ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R] ...\n"
-    "                  (b = e_S: a reverse push from I and walks from S; --source --help)\n"
+    "                  (b = e_S: a reverse push from I and walks from S; --source S --help)\n"
     "\n"
     "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
     "Indices are 1-based, as in Matrix Market files.\n"
@@ -35,8 +35,8 @@ static const char *const usage =
     "                     the walk ends, / p*), expected (score the exact next-step expectation)\n"
     "  --walks N          stop after N walks (default 100000 when no rule is given)\n"
     "  --rel-err E        (or --tol E) stop once stderr / |estimate| <= E, and only once enough walks have run\n"
-    "                     for the error bar to be trusted (README: 'When to trust the error\n"
-    "                     bar'); it watches x_I (--index, default 1 in forward mode) and never\n"
+    "                     for the error bar to be trusted (docs/error-bars.md); it watches\n"
+    "                     x_I (--index, default 1 in forward mode) and never\n"
     "                     stops while no walk has reached it; refused (exit 4) when the variance\n"
     "                     is not certified finite, unless --walks or --time bounds the run\n"
     "  --time S           stop S seconds after ulam started (reading, guards and set-up\n"
@@ -72,7 +72,7 @@ static const char *const usage3 =
     "                     (b = (1 - ALPHA) / n unless --rhs; a dangling node's rank leaks)\n"
     "  --quiet, -q        print the answer line alone\n"
     "  --verbose, -v      print everything: the candidates, the radii, the tail bound, timings\n"
-    "  --method auto      (default) choose mode, estimator, continuation and --alpha among\n"
+    "  --method auto      (default) choose mode, estimator, continuation and exponent among\n"
     "                     the candidates the guards certify, by pilots compared on a fixed\n"
     "                     work model (the same choice on every run); what is given stays\n"
     "                     pinned; fresh walks then estimate with the choice; with a sparse b\n"
@@ -84,7 +84,7 @@ static const char *const usage3 =
     "                     (--json: JSON lines); query k walks with seed --seed + k - 1; the\n"
     "                     guards, bounds and kernel rows are kept across them (docs/queries.md)\n"
     "  --method walks     the single method the options name, defaults for the rest (adjoint,\n"
-    "                     collision, --continue analog, --alpha 1): the run before auto\n"
+    "                     collision, --continue analog, --kernel-exponent 1): the run before auto\n"
     "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
     "                     is built when a walk first reaches it, so one unknown of a large\n"
     "                     system reads and keeps only the rows its walks visit)\n"
@@ -140,13 +140,13 @@ static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 {
     if (o->mode == ULAM_FORWARD && isnan(r->std_error) && r->ci95[0] == 0 && r->ci95[1] == 0)
         printf("x[%lld]%*s0 exactly (95%% CI 0 .. 0: no walk from where b is nonzero can reach it)%s\n",
-               (long long)o->query.index + 1, o->query.index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
+               (long long)o->query.index + 1, cli_answer_pad(o->query.index + 1, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (o->mode == ULAM_FORWARD && isnan(r->std_error))
         printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->query.index + 1,
-               o->query.index < 9 ? 10 : 9, "", r->interrupted ? "  [INTERRUPTED]" : "");
+               cli_answer_pad(o->query.index + 1, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1 && isnan(r->ci95[0]))
         printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->query.index + 1,
-               o->query.index < 9 ? 10 : 9, "", r->estimate, r->std_error,
+               cli_answer_pad(o->query.index + 1, 16), "", r->estimate, r->std_error,
                !isfinite(r->cut_bound) ? "walks cut at --max-steps may have moved it by any amount"
                : too_small(r) ? "scores too small to square in doubles, so no variance: scale b up (a prepared "
                                 "file's b is not rescaled)"
@@ -154,11 +154,11 @@ static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
                : "no certified range yet, or a score past the certified one", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1)
         printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->query.index + 1,
-               o->query.index < 9 ? 10 : 9, "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+               cli_answer_pad(o->query.index + 1, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
                r->interrupted ? "  [INTERRUPTED]" : "");
     else
         printf("x[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
-               "means nothing)%s\n", (long long)o->query.index + 1, o->query.index < 9 ? 10 : 9, "", r->estimate,
+               "means nothing)%s\n", (long long)o->query.index + 1, cli_answer_pad(o->query.index + 1, 16), "", r->estimate,
                r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
                r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
 }
@@ -672,7 +672,7 @@ static int run(solve_args *a)
         return rc;
     }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
-        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_method_bidir_route(a->s.b, a->s.M->nrows, &a->ao, &a->o), ro.json, ro.check, ro.direct, ro.load_seconds);
+        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_method_bidir_route(a->s.b, a->s.M->nrows, &a->ao, &a->o), ro.json, ro.check, ro.direct, ro.direct_method, ro.load_seconds);
         ulam_run_free(rn);
         a->an = ulam_analysis_free(a->an);
         cli_system_free(&a->s);
@@ -722,8 +722,9 @@ static int run(solve_args *a)
             rc = cli_system_verify(&a->s);
             rc = rc ? rc : direct_check(s, o->query.index, &ro);
             left = rc == EXIT_INTERRUPTED;
-            if (!ro.json && !rc) printf("direct          %.10g (%s, %.3g s), z = %.3f\n", ro.direct, ro.direct_method,
-                                        ro.direct_seconds, (r.estimate - ro.direct) / r.std_error);
+            if (!ro.json && !rc)
+                printf("direct          %.10g (%s, %.3g s), ", ro.direct, ro.direct_method, ro.direct_seconds),
+                    cli_print_z(r.estimate, ro.direct, r.std_error, r.ci95[0], r.ci95[1]);
             if (left && !ro.json) fprintf(stderr, "ulam: --check interrupted: the estimate above stands unchecked\n");
         }
         if (ro.json && (!rc || left)) print_json(o, &r, &ro);
