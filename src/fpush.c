@@ -622,9 +622,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     info->mean_visits = D1;
     memset(x, 0, (size_t)n * sizeof *x);
     size_t bytes = (size_t)n * sizeof(double); /* r, and cs and mx (filled whole by the pull sweeps' set-up) */
-    double *r = ulam__huge(ulam__calloc((size_t)n, sizeof *r), bytes);
+    double *r = ulam__alloc_big((size_t)n, sizeof *r); /* 2 MiB aligned: a malloc block's unaligned head stays in 4 KiB pages */
+    if (r) memset(r, 0, bytes);
     walker w = {.Mt = Mt, .r = r, .alpha = alpha};
-    w.cs = ulam__huge(ulam__malloc((size_t)n, sizeof *w.cs), bytes), w.mx = ulam__huge(ulam__malloc((size_t)n, sizeof *w.mx), bytes);
+    w.cs = ulam__alloc_big((size_t)n, sizeof *w.cs), w.mx = ulam__alloc_big((size_t)n, sizeof *w.mx);
     if (!r || !w.cs || !w.mx) {
         free(r), free(w.cs), free(w.mx);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the residual");
