@@ -24,6 +24,7 @@
 #include "internal.h"
 #include "stop.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -498,38 +499,54 @@ static int rule_met(const walker *w, const double *p, int64_t N, int k, double R
     return 1;
 }
 
-/* The outputs of n components no walk ended at, x_i = p_i (x holds p; p_i + 0, never -0, as p
- * starts at +0): standard error se, interval [p_i + a - cut, p_i + b] (a NaN: none from the walks,
- * p_i -+ D), clipped to p_i -+ D where D is finite; passes with no branch on i. */
-static void none_fill(const double *x, double *std_error, double *lo, double *hi, int64_t n, double a, double b,
-                      double cut, double se, double D)
+/* The allowance for the push's rounding, relative to |p_i|: each of its rounds or sweeps recomputes
+ * or pushes into p_i through at most a row of M (d entries, each a rounding), and an error in p
+ * carries through (I - M)^-1 at most 1 / (1 - alpha) times: (rounds + 1) (d + 2) u / (1 - alpha),
+ * d the longest row (4e-11 on R-MAT 2^20; far below any interval the walks give, but a push that
+ * leaves no residual no longer prints a zero-width interval for a p_i that is only rounded). */
+static double rounding_allowance(const ulam_csr *M, const ulam__sweep_info *swi, double alpha)
 {
-    int fin = isfinite(D), nan = isnan(a - cut);
-    if (std_error)
-        for (int64_t i = 0; i < n; i++) std_error[i] = se;
-    if (!lo && !hi) return;
-    for (int64_t i = 0; i < n; i++) {
-        double p = x[i], l = nan && fin ? p - D : p + a - cut, h = nan && fin ? p + D : p + b;
-        if (fin) { /* both ends NaN or neither (p_i NaN, or not), so no fmax/fmin's NaN rule is needed */
-            l = l > p - D ? l : p - D;
-            h = h < p + D ? h : p + D;
-        }
-        if (lo) lo[i] = l;
-        if (hi) hi[i] = h;
-    }
+    int64_t d = 0;
+    for (int64_t i = 0; i < M->nrows; i++) d = M->rowptr[i + 1] - M->rowptr[i] > d ? M->rowptr[i + 1] - M->rowptr[i] : d;
+    return ((double)swi->rounds + 1.0) * ((double)d + 2.0) * (DBL_EPSILON / 2.0) / (1.0 - alpha);
 }
 
 /* What the walks' ends give each component: the walks (N, stitching index k, KL index kk when
  * not k), scores' range R and largest R0, sgn (signed scores: empirical Bernstein), the cut,
- * residual_bound D and the interval of a component no walk ended at. */
+ * residual_bound D, the interval of a component no walk ended at and its standard error se0, the
+ * allowance fp for the push's rounding (relative to |p_i|), and nonneg (M >= 0: x >= 0, every
+ * lower end at least 0). */
 typedef struct {
     const walker *w;
     kl_kept *kept;
     int64_t N;
-    int k, kk, sgn;
-    double R, R0, cut, D;
+    int k, kk, sgn, nonneg;
+    double R, R0, cut, D, se0, fp;
     ulam__stop_ci none;
 } ends;
+
+/* The outputs of n components no walk ended at, x_i = p_i (x holds p; p_i + 0, never -0, as p
+ * starts at +0): standard error c->se0, interval [p_i + a - cut, p_i + b] (a NaN: none from the
+ * walks, p_i -+ D), clipped to p_i -+ D where D is finite, widened by fp |p_i| either side, its
+ * lower end at least min(p_i, 0) when x >= 0; passes with no branch on i. */
+static void none_fill(const ends *c, const double *x, double *std_error, double *lo, double *hi, int64_t n)
+{
+    double a = c->none.lo, b = c->none.hi, cut = c->cut, D = c->D, fp = c->fp, floor = c->nonneg ? 0.0 : -INFINITY;
+    int fin = isfinite(D), nan = isnan(a - cut);
+    if (std_error)
+        for (int64_t i = 0; i < n; i++) std_error[i] = c->se0;
+    if (!lo && !hi) return;
+    for (int64_t i = 0; i < n; i++) {
+        double p = x[i], l = nan && fin ? p - D : p + a - cut, h = nan && fin ? p + D : p + b, f = fp * fabs(p);
+        if (fin) { /* both ends NaN or neither (p_i NaN, or not), so no fmax/fmin's NaN rule is needed */
+            l = l > p - D ? l : p - D;
+            h = h < p + D ? h : p + D;
+        }
+        l -= f, h += f;
+        if (lo) lo[i] = !(l < floor) ? l : p < floor ? p : floor; /* x_i >= 0 (l <= p_i here), p_i inside; NaN kept */
+        if (hi) hi[i] = h;
+    }
+}
 
 /* The walks' mean at the q-th state ended at. */
 static double ends_mean(const ends *c, int64_t q)
@@ -546,7 +563,7 @@ static double ends_component(const ends *c, double p, int64_t q, double *se, dou
     int64_t N = c->N, h = q >= 0 && N > 0 ? w->hc[2 * q] + w->hc[2 * q + 1] : 0;
     double Nd = (double)N, R0 = c->R0, D = c->D, mean = 0.0, var = 0.0;
     if (h == 0) { /* the common interval, as none_fill gives it */
-        none_fill(&p, se, a, b, 1, c->none.lo, c->none.hi, c->cut, N > 1 ? 0.0 : (w->k > 0 ? NAN : 0.0), D);
+        none_fill(c, &p, se, a, b, 1);
         return 0.0;
     }
     ulam__stop_ci ci = c->none;
@@ -558,6 +575,8 @@ static double ends_component(const ends *c, double p, int64_t q, double *se, dou
     *se = N > 1 ? sqrt(var / Nd) : (w->k > 0 ? NAN : 0.0);
     if (isnan(*a) && isfinite(D)) *a = p - D, *b = p + D; /* no interval from the walks */
     if (isfinite(D)) *a = fmax(*a, p - D), *b = fmin(*b, p + D);
+    *a -= c->fp * fabs(p), *b += c->fp * fabs(p);
+    if (c->nonneg) *a = fmax(*a, fmin(p + mean, 0.0)); /* x_i >= 0, and the estimate inside its interval */
     return mean;
 }
 
@@ -658,6 +677,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     double *bsum = NULL;
     int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 */
     for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
+    int mpos = !sgn; /* M >= 0, so x >= 0 */
     for (int64_t j = 0; j < n && !sgn; j++) sgn = r[j] < 0;
     double R = sgn ? 2.0 * R0 : R0; /* the scores' range */
     int64_t N = 0;
@@ -703,15 +723,16 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     double *key = !status && top > 0 ? ulam__malloc((size_t)top, sizeof *key) : NULL, *pv = NULL;
     if (!status && top > 0 && !key) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the top components");
     if (!status) {
-        ends c = {.w = &w, .kept = kept, .N = N, .k = k, .kk = kk, .sgn = sgn, .R = R, .R0 = R0, .cut = cut,
-                  .D = info->residual_bound};
+        ends c = {.w = &w, .kept = kept, .N = N, .k = k, .kk = kk, .sgn = sgn, .nonneg = mpos, .R = R, .R0 = R0,
+                  .cut = cut, .D = info->residual_bound, .se0 = N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0),
+                  .fp = rounding_allowance(M, swi, alpha)};
         if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &c.none);
         else c.none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
         if (!sgn && N >= 1) hits_interval(kept, N, kk < 0 ? k : kk, 0, R0, &c.none.lo, &c.none.hi);
         double s, a, b;
         int64_t nh = N > 0 ? w.nhit : 0;
         if (top < 0) { /* every component: the common interval, then the states some walk ended at */
-            none_fill(x, std_error, lo, hi, n, c.none.lo, c.none.hi, cut, N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0), c.D);
+            none_fill(&c, x, std_error, lo, hi, n);
             for (int64_t q = 0; q < nh; q++) {
                 int64_t i = w.hit[q];
                 double mean = ends_component(&c, x[i], q, &s, &a, &b);

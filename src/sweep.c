@@ -203,7 +203,12 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
                 }
             }
         }
-        if (pushed == 0 || !(rsum > 0.0)) break;
+        if (pushed == 0 || !(rsum > 0.0)) {
+            if (!pulling || omega == 1.0) break;
+            omega = 1.0, settle = ULAM__SWEEP_SETTLE; /* an overshoot took r's sum to 0 or below (a DAG in
+                                                         order: one sweep is exact, 1.2 of it overshoots): settle */
+            continue;
+        }
         if (max_ops > 0 && ops > max_ops) {
             status = ULAM_ENOCONV;
             break;

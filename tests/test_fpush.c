@@ -35,6 +35,7 @@ static void count_big(int64_t n, const double *x, const double *est, const doubl
 {
     *b = *c = *w = 0;
     for (int64_t i = 0; i < n; i++) {
+        if (!(lo[i] <= est[i] && est[i] <= hi[i])) print_error("component %lld: %.17g in [%.17g, %.17g]?\n", (long long)i, est[i], lo[i], hi[i]);
         assert_true(lo[i] <= est[i] && est[i] <= hi[i]);
         if (0.15 * x[i] < 1.0 / (double)n) continue;
         ++*b;
@@ -393,6 +394,54 @@ static void test_fpush_top(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* A push that leaves no residual (a 300-state DAG numbered in topological order, M >= 0: one
+ * sweep moves all the mass to p): no walk runs, and every interval still holds the exact x_i (by
+ * substitution in long double), with the allowance for the push's rounding (before, [p_i, p_i]:
+ * zero-width beside a value only rounded), and no lower end is below 0 (x >= 0). */
+static void test_fpush_exact_push(void **state)
+{
+    (void)state;
+    int64_t n = 300, m = 5 * n, nt = 0;
+    int32_t *ti = malloc((size_t)m * sizeof *ti), *tj = malloc((size_t)m * sizeof *tj);
+    double *tx = malloc((size_t)m * sizeof *tx);
+    ulam_rng r;
+    ulam_rng_seed(&r, 11, 0);
+    for (int64_t j = 0; j + 1 < n; j++) /* up to 5 edges j -> i > j, column j of M summing to 0.9 */
+        for (int e = 0; e < 5; e++)
+            ti[nt] = (int32_t)(j + 1 + (int64_t)ulam_rng_bounded(&r, (uint64_t)(n - j - 1))), tj[nt] = (int32_t)j,
+            tx[nt++] = 0.9 / 5.0 * (0.5 + 0.5 * ulam_rng_uniform(&r));
+    ulam_csr *M = NULL, *Mt = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nt, ti, tj, tx, &M), ULAM_OK);
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    long double *xl = calloc((size_t)n, sizeof *xl); /* x_i = [i = 0] + sum_{j < i} M_ij x_j */
+    for (int64_t i = 0; i < n; i++) {
+        xl[i] = i == 0;
+        for (int64_t k = M->rowptr[i]; k < M->rowptr[i + 1]; k++) xl[i] += (long double)M->val[k] * xl[M->colidx[k]];
+    }
+    double *est = malloc((size_t)n * sizeof *est), *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi);
+    ulam_fpush_opts o = ulam_fpush_defaults();
+    o.source = 0, o.walk.exec.seed = 1, o.walk.stop.max_walks = 0;
+    ulam_fpush_info info;
+    ulam_error err;
+    ulam__sweep_info sw;
+    assert_int_equal(ulam__fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, &sw, &err), ULAM_OK);
+    print_message("push: %lld rounds, %lld sweeps (%lld pulls), %lld operations, r_sum %.3g, r_neg %.3g, %lld walks\n", (long long)sw.rounds, (long long)sw.sweeps, (long long)sw.pulls, (long long)info.push.ops, info.push.r_sum, sw.r_neg, (long long)info.walks);
+    assert_int_equal(info.walks, 0);
+    assert_true(info.push.r_sum == 0.0);
+    int64_t reached = 0, positive = 0;
+    for (int64_t i = 0; i < n; i++) {
+        double x = (double)xl[i];
+        if (!(lo[i] <= x && x <= hi[i] && lo[i] >= 0.0))
+            print_error("x_%lld = %.17g: %.17g in [%.17g, %.17g]?\n", (long long)i, x, est[i], lo[i], hi[i]);
+        assert_true(lo[i] <= x && x <= hi[i] && lo[i] >= 0.0);
+        assert_true(hi[i] - lo[i] <= 1e-9 * x);
+        reached += x > 0, positive += x > 0 && hi[i] > lo[i];
+    }
+    assert_true(reached >= 100 && positive == reached); /* every x_i > 0: a positive width */
+    free(ti), free(tj), free(tx), free(xl), free(est), free(lo), free(hi);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -403,6 +452,7 @@ int main(void)
         cmocka_unit_test(test_fpush_hits),
         cmocka_unit_test(test_fpush_samplers),
         cmocka_unit_test(test_fpush_top),
+        cmocka_unit_test(test_fpush_exact_push),
     };
     return test_run(tests);
 }
