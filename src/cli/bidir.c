@@ -317,16 +317,18 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
             }
             printf("]}\n");
         } else {
-            printf("method          single source: forward push from %lld, forward walks on its residual (FORA)\n",
-                   (long long)source);
-            printf("push            rmax %.3g: %lld operations, residual on %lld states, sum %.3g (walk part of any "
-                   "x_i at most %.3g)\n", info.rmax, (long long)info.push.ops, (long long)info.push.support,
-                   info.push.r_sum, info.residual_bound);
-            printf("walks           %lld (%lld steps)\n", (long long)info.walks, (long long)info.steps);
-            printf("seconds         %.4f (push %.4f, walks %.4f; CPU %.4f)\n", info.seconds, info.push_seconds,
-                   info.walk_seconds, cpu);
-            printf("%-6s %-10s %-14s %-11s %s\n", "rank", "index", "estimate", "stderr",
-                   xd ? "95% CI                    direct" : "95% CI");
+            if (cli_verbosity >= 0) { /* --quiet: the table's rows alone */
+                printf("method          single source: forward push from %lld, forward walks on its residual (FORA)\n",
+                       (long long)source);
+                printf("push            rmax %.3g: %lld operations, residual on %lld states, sum %.3g (walk part of "
+                       "any x_i at most %.3g)\n", info.rmax, (long long)info.push.ops, (long long)info.push.support,
+                       info.push.r_sum, info.residual_bound);
+                printf("walks           %lld (%lld steps)\n", (long long)info.walks, (long long)info.steps);
+                printf("seconds         %.4f (push %.4f, walks %.4f; CPU %.4f)\n", info.seconds, info.push_seconds,
+                       info.walk_seconds, cpu);
+                printf("%-6s %-10s %-14s %-11s %s\n", "rank", "index", "estimate", "stderr",
+                       xd ? "95% CI                    direct" : "95% CI");
+            }
             for (int64_t k = 0; k < top; k++) {
                 int64_t i = order[k];
                 printf("%-6lld %-10lld %-14.8g %-11.3g %-12.6g %.6g", (long long)k + 1, (long long)i + 1, x[i], se[k],
