@@ -300,6 +300,8 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
                    (long long)info.walks, (long long)info.steps);
             cli_json_number("residual_bound", info.residual_bound, 0);
             cli_json_number("seconds", info.seconds, 0);
+            cli_json_number("push_seconds", info.push_seconds, 0);
+            cli_json_number("walk_seconds", info.walk_seconds, 0);
             cli_json_number("cpu_seconds", cpu, 0);
             printf("\"top\": [");
             for (int64_t k = 0; k < top; k++) {

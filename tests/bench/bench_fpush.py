@@ -147,14 +147,14 @@ def main():
             cov = np.mean((lo[big] <= exact[big]) & (exact[big] <= hi[big]))
             close = np.mean(np.abs(est[big] - exact[big]) <= 0.1 * exact[big])
             rows.append((s + 1, int(big.sum()), sp_it, sp_s, o["cpu_seconds"], cpu, o["walks"], o["push_ops"], cov, close,
-                         sp_w, o["seconds"]))
+                         sp_w, o["seconds"], o["push_seconds"], o["walk_seconds"], o["steps"]))
     print(f"\n{'source':>8} {'pi>=1/n':>8} {'scipy_it':>8} {'scipy_s':>9} {'ulam_s':>9} {'ratio':>7} {'scipy_w':>8} "
-          f"{'ulam_w':>8} {'w_ratio':>7} {'proc_cpu':>9} {'walks':>8} {'push_ops':>10} {'sweeps':>6} {'cover95':>8} "
-          f"{'within10%':>9}")
+          f"{'ulam_w':>8} {'w_ratio':>7} {'proc_cpu':>9} {'walks':>8} {'steps':>8} {'push_w':>7} {'walks_w':>7} "
+          f"{'push_ops':>10} {'sweeps':>6} {'cover95':>8} {'within10%':>9}")
     for r in rows:
         print(f"{r[0]:>8} {r[1]:>8} {r[2]:>8} {r[3]:>9.4f} {r[4]:>9.4f} {r[4] / r[3]:>6.2f}x {r[10]:>8.4f} {r[11]:>8.4f} "
-              f"{r[11] / r[10]:>6.2f}x {r[5]:>9.3f} {r[6]:>8} {r[7]:>10} {r[7] / (M.nnz + n):>6.1f} {r[8]:>8.3f} "
-              f"{r[9]:>9.3f}")
+              f"{r[11] / r[10]:>6.2f}x {r[5]:>9.3f} {r[6]:>8} {r[14]:>8} {r[12]:>7.3f} {r[13]:>7.3f} {r[7]:>10} "
+              f"{r[7] / (M.nnz + n):>6.1f} {r[8]:>8.3f} {r[9]:>9.3f}")
     med = sorted(r[4] / r[3] for r in rows)[len(rows) // 2]
     medw = sorted(r[11] / r[10] for r in rows)[len(rows) // 2]
     medp = sorted(r[5] / r[3] for r in rows)[len(rows) // 2]
