@@ -1139,7 +1139,8 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
 
 /* What a bidirectional estimate found. */
 typedef struct ulam_bidir_result {
-    double estimate, std_error, ci95[2]; /* of x_t: <p, b> plus the walks' estimate of <r, x> */
+    double estimate, std_error, ci95[2]; /* of x_t: <p, b> plus the walks' estimate of <r, x>; the
+                                            interval widened by an allowance for the push's rounding */
     double push_part;      /* <p, b>, exact given the push */
     ulam_push_info push;   /* the push (its seconds are push_seconds) */
     ulam_walk_result walks; /* the walks' estimate of <r, x> (0 walks when r = 0: exact) */
@@ -1197,7 +1198,8 @@ typedef struct ulam_fpush_info {
 /* Estimate every x_i of (I - M) x = e_source into x (n entries); std_error, lo and hi (each may
  * be NULL) get each component's standard error and 95% interval: p_i + the walks' stitched
  * empirical-Bernstein interval (src/stop.h; every walk score within -+ ||r||_1 / (1 - ||M||_1)),
- * clipped to p_i -+ residual_bound (the queue path for ||M||_1 >= 1: the normal interval where the
+ * clipped to p_i -+ residual_bound, widened by an allowance for the push's rounding, its lower end
+ * at least min(x_i, 0) when M >= 0 (the queue path for ||M||_1 >= 1: the normal interval where the
  * walks scored two values, else p_i -+ residual_bound, NaN when there is none).  Mt is M's
  * transpose.  ULAM_OK, ULAM_EINVAL, ULAM_ENOCONV (queue push cap 100 nnz + 10^6), ULAM_ENOMEM,
  * the walk solver's statuses. */
