@@ -1597,6 +1597,12 @@ uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
 /* Monotonic wall clock in seconds. */
 double ulam_now(void);
 
+/* Uninitialised memory for n items of size sz, for a large array read at random (a vector of n
+ * for ulam_fpush_solve, say): cache-line aligned, and from 2 MiB on, 2 MiB aligned with
+ * transparent huge pages asked for (a first touch and a TLB miss cost less); freed with free();
+ * NULL on overflow or failure. */
+void *ulam_alloc_big(size_t n, size_t sz);
+
 #ifdef __cplusplus
 }
 #endif

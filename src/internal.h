@@ -385,10 +385,6 @@ void *ulam__huge(void *p, size_t bytes);
  * leaving the array as it was. */
 int ulam__grow(void *pp, int64_t *cap, int64_t need, size_t sz);
 
-/* Uninitialised memory for a large random-access table: cache-line aligned, and for tables
- * of 2 MB or more, 2 MB aligned with transparent huge pages requested (fewer TLB misses on
- * random access).  n items of size sz; freed with free(); NULL on overflow or failure. */
-void *ulam__alloc_big(size_t n, size_t sz);
 
 /* Sort every row of A by column (with `threads` threads), sum duplicates and drop zeros,
  * compacting A in place. */

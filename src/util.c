@@ -128,7 +128,7 @@ int ulam__grow(void *pp, int64_t *cap, int64_t need, size_t sz)
 }
 
 /* Aligned memory for a big random-access table, huge pages requested where it is large. */
-void *ulam__alloc_big(size_t n, size_t sz)
+void *ulam_alloc_big(size_t n, size_t sz)
 {
     if (sz && n > SIZE_MAX / sz) return NULL;
     size_t bytes = n * sz, align = bytes >= ((size_t)2 << 20) ? (size_t)2 << 20 : 64;

@@ -10,10 +10,6 @@
  * 3 walks would diverge, 4 a --rel-err target with a variance not certified finite, 10 + status for a library status, 130 interrupted. */
 enum { EXIT_USAGE = 2, EXIT_DIVERGE = 3, EXIT_INFVAR = 4, EXIT_STATUS_BASE = 10, EXIT_INTERRUPTED = 130 };
 
-/* malloc of n items of size sz (NULL on overflow or failure) for a large vector the library fills:
- * 2 MiB pages asked for. */
-void *cli_alloc_vector(size_t n, size_t sz);
-
 /* The exit code for a library status. */
 int cli_exit_code(int status);
 

@@ -10,7 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 
 const char *const cli_mode_names[2] = {"adjoint", "forward"};
@@ -20,24 +19,6 @@ volatile int cli_interrupted;
 const ulam_share *cli_share;
 int cli_rank;
 double cli_started;
-
-/* Memory for n items of size sz for a vector the library fills (freed with free()): from 4 MiB
- * on, 2 MiB aligned and rounded up to whole 2 MiB pages, all of them asked for 2 MiB pages
- * (libulam's own blocks get them in src/util.c): a 4 KiB page's first touch costs ~12-15 us on a
- * virtual machine (64 MiB: 250 ms against 14 ms in 2 MiB pages), and a malloc'd block's unaligned
- * head stayed in 4 KiB pages (an 8 MiB vector: ~500 faults, ~6 ms of a single-source query). */
-void *cli_alloc_vector(size_t n, size_t sz)
-{
-    size_t bytes = sz && n > SIZE_MAX / sz ? 0 : n * sz, page = (size_t)2 << 20;
-    if (!bytes) return NULL;
-    if (bytes < 2 * page || bytes > SIZE_MAX - page) return malloc(bytes);
-    size_t size = (bytes + page - 1) / page * page;
-    void *p = aligned_alloc(page, size);
-#ifdef MADV_HUGEPAGE
-    if (p) (void)madvise(p, size, MADV_HUGEPAGE); /* advice only: failure is harmless */
-#endif
-    return p;
-}
 
 /* The walks' share of a --time budget. */
 double cli_time_left(double budget)
