@@ -15,10 +15,11 @@ ulam_csr *ulam_csr_alloc(int64_t nrows, int64_t ncols, int64_t nnz)
     A->nrows = nrows;
     A->ncols = ncols;
     /* 2 MiB pages (every entry is written once built): a sweep streams them, a walk reads rows at random */
-    A->rowptr = ulam__huge(ulam__calloc((size_t)nrows + 1, sizeof *A->rowptr), ((size_t)nrows + 1) * sizeof *A->rowptr);
-    A->colidx = ulam__huge(ulam__malloc((size_t)nnz, sizeof *A->colidx), (size_t)nnz * sizeof *A->colidx);
-    A->val = ulam__huge(ulam__malloc((size_t)nnz, sizeof *A->val), (size_t)nnz * sizeof *A->val);
+    A->rowptr = ulam_alloc_big((size_t)nrows + 1, sizeof *A->rowptr);
+    A->colidx = ulam_alloc_big((size_t)nnz, sizeof *A->colidx);
+    A->val = ulam_alloc_big((size_t)nnz, sizeof *A->val);
     if (!A->rowptr || !A->colidx || !A->val) return ulam_csr_free(A);
+    memset(A->rowptr, 0, ((size_t)nrows + 1) * sizeof *A->rowptr);
     return A;
 }
 

@@ -374,11 +374,6 @@ void *ulam__malloc(size_t n, size_t sz);
 /* calloc of n items of size sz, NULL on failure (n == 0 allocates one byte). */
 void *ulam__calloc(size_t n, size_t sz);
 
-/* Ask for 2 MiB pages on a block of `bytes` (from 4 MiB on) that will be touched nearly whole:
- * a 4 KiB page's first touch costs ~15 us on a virtual machine (64 MiB: 250 ms against 14 ms in
- * 2 MiB pages), and a walk or a sweep reading it at random misses the TLB less.  Not for blocks
- * touched sparsely (every 2 MiB page touched is resident whole).  Returns p. */
-void *ulam__huge(void *p, size_t bytes);
 
 /* Make room for need items of size sz in a growable array: pp is the address of its pointer
  * (a T **), *cap its capacity (doubling from 16; both are updated); ULAM_OK, or ULAM_ENOMEM
