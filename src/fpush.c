@@ -525,25 +525,34 @@ typedef struct {
     ulam__stop_ci none;
 } ends;
 
+/* Finish the interval [*l, *h] of a component with p_i = p and estimate est: none from the walks
+ * (NaN) becomes p -+ D, it is clipped to p -+ D where D is finite, widened by fp |p| either side,
+ * and when x >= 0 its lower end is at least min(est, 0) (so est stays inside); NaN kept where D
+ * is not finite.  No branch on the component but the selects. */
+static inline void finish(const ends *c, double p, double est, double *l, double *h)
+{
+    double D = c->D, f = c->fp * fabs(p), floor = c->nonneg ? 0.0 : -INFINITY, a = *l, b = *h;
+    if (isfinite(D)) { /* both ends NaN or neither, so no fmax/fmin NaN rule is needed */
+        if (isnan(a)) a = p - D, b = p + D; /* no interval from the walks */
+        a = a > p - D ? a : p - D;
+        b = b < p + D ? b : p + D;
+    }
+    a -= f, b += f;
+    *l = !(a < floor) ? a : est < floor ? est : floor, *h = b;
+}
+
 /* The outputs of n components no walk ended at, x_i = p_i (x holds p; p_i + 0, never -0, as p
- * starts at +0): standard error c->se0, interval [p_i + a - cut, p_i + b] (a NaN: none from the
- * walks, p_i -+ D), clipped to p_i -+ D where D is finite, widened by fp |p_i| either side, its
- * lower end at least min(p_i, 0) when x >= 0; passes with no branch on i. */
+ * starts at +0): standard error c->se0, interval [p_i + a - cut, p_i + b] finished (finish). */
 static void none_fill(const ends *c, const double *x, double *std_error, double *lo, double *hi, int64_t n)
 {
-    double a = c->none.lo, b = c->none.hi, cut = c->cut, D = c->D, fp = c->fp, floor = c->nonneg ? 0.0 : -INFINITY;
-    int fin = isfinite(D), nan = isnan(a - cut);
+    double a = c->none.lo - c->cut, b = c->none.hi;
     if (std_error)
         for (int64_t i = 0; i < n; i++) std_error[i] = c->se0;
     if (!lo && !hi) return;
     for (int64_t i = 0; i < n; i++) {
-        double p = x[i], l = nan && fin ? p - D : p + a - cut, h = nan && fin ? p + D : p + b, f = fp * fabs(p);
-        if (fin) { /* both ends NaN or neither (p_i NaN, or not), so no fmax/fmin's NaN rule is needed */
-            l = l > p - D ? l : p - D;
-            h = h < p + D ? h : p + D;
-        }
-        l -= f, h += f;
-        if (lo) lo[i] = !(l < floor) ? l : p < floor ? p : floor; /* x_i >= 0 (l <= p_i here), p_i inside; NaN kept */
+        double p = x[i], l = p + a, h = p + b;
+        finish(c, p, p, &l, &h);
+        if (lo) lo[i] = l;
         if (hi) hi[i] = h;
     }
 }
@@ -561,7 +570,7 @@ static double ends_component(const ends *c, double p, int64_t q, double *se, dou
 {
     const walker *w = c->w;
     int64_t N = c->N, h = q >= 0 && N > 0 ? w->hc[2 * q] + w->hc[2 * q + 1] : 0;
-    double Nd = (double)N, R0 = c->R0, D = c->D, mean = 0.0, var = 0.0;
+    double Nd = (double)N, R0 = c->R0, mean = 0.0, var = 0.0;
     if (h == 0) { /* the common interval, as none_fill gives it */
         none_fill(c, &p, se, a, b, 1);
         return 0.0;
@@ -572,11 +581,8 @@ static double ends_component(const ends *c, double p, int64_t q, double *se, dou
     if (!c->sgn) hits_interval(c->kept, N, c->kk < 0 ? c->k : c->kk, h, R0, &ci.lo, &ci.hi);
     else ulam__stop_interval(N, mean, var, c->R, 0.0, R0, R0, c->k, &ci);
     *a = p + ci.lo - c->cut, *b = p + ci.hi;
-    *se = N > 1 ? sqrt(var / Nd) : (w->k > 0 ? NAN : 0.0);
-    if (isnan(*a) && isfinite(D)) *a = p - D, *b = p + D; /* no interval from the walks */
-    if (isfinite(D)) *a = fmax(*a, p - D), *b = fmin(*b, p + D);
-    *a -= c->fp * fabs(p), *b += c->fp * fabs(p);
-    if (c->nonneg) *a = fmax(*a, fmin(p + mean, 0.0)); /* x_i >= 0, and the estimate inside its interval */
+    *se = N > 1 ? sqrt(var / Nd) : c->se0;
+    finish(c, p, p + mean, a, b);
     return mean;
 }
 
