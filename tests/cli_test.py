@@ -179,6 +179,7 @@ CASES += [
     (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
     # an exact push (no residual): estimate and stderr both exact printed z = nan
     (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check"], 0, r"^$", r"direct\s+1 \(dense LU\), z = 0\.000$"),
+    (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check", "--json"], 0, r"^$", r'"z": 0[,}]'),  # was null
     # --quiet: the top rows alone (the method, push, walks, seconds lines and header were printed)
     (["solve", M + "randsub1000.mtx", "--source", "3", "--top", "2", "--quiet"], 0, r"^$", r"\A1 +3 +\S+ .*\n2 +\d+ .*\n\Z"),
     (["solve", M + "randsub1000.mtx", "--source", "3", "--top", "2"], 0, r"^$",  # every target (src/fpush.c)

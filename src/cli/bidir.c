@@ -158,7 +158,7 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
            cli_share ? cli_share->nranks : 1);
     if (rp->check) {
         cli_json_number("direct", rp->direct, 0);
-        cli_json_number("z", r->std_error > 0 ? (r->estimate - rp->direct) / r->std_error : NAN, 0);
+        cli_json_number("z", cli_z(r->estimate, rp->direct, r->std_error), 0);
     }
     if (o->walk.stop.rel_err > 0) printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
     if (rp->ch) cli_auto_print_json(rp->ch, 1);

@@ -185,6 +185,9 @@ const char *cli_verdict_word(int verdict);
 /* The spaces after "x[index]" (1-based) that put its value at column (the lines below's). */
 int cli_answer_pad(int64_t index, int column);
 
+/* --check's z = (estimate - direct) / stderr, 0 when both agree exactly. */
+double cli_z(double estimate, double direct, double std_error);
+
 /* Print "z = Z" for --check and a newline (see src/cli/common.c). */
 void cli_print_z(double estimate, double direct, double std_error, double lo, double hi);
 

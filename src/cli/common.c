@@ -585,12 +585,19 @@ int cli_answer_pad(int64_t index, int column)
     return len < column ? column - len : 1;
 }
 
-/* The --check line's tail: "z = Z" with z = (estimate - direct) / stderr (0 when they are equal,
- * +-inf when only the stderr is 0), and when |z| > 4 whether direct is inside [lo, hi] (an
- * interval wider than the stderr says: a range term, or the allowance for rounding). */
+/* --check's z = (estimate - direct) / stderr: 0 when they are equal, +-inf when only the stderr
+ * is 0. */
+double cli_z(double estimate, double direct, double std_error)
+{
+    double d = estimate - direct;
+    return std_error > 0 ? d / std_error : d == 0 ? 0.0 : copysign(INFINITY, d);
+}
+
+/* The --check line's tail: "z = Z" (cli_z), and when |z| > 4 whether direct is inside [lo, hi]
+ * (an interval wider than the stderr says: a range term, or the allowance for rounding). */
 void cli_print_z(double estimate, double direct, double std_error, double lo, double hi)
 {
-    double d = estimate - direct, z = std_error > 0 ? d / std_error : d == 0 ? 0.0 : copysign(INFINITY, d);
+    double z = cli_z(estimate, direct, std_error);
     printf("z = %.3f", z);
     if (fabs(z) > 4.0) printf(" (direct %s the 95%% interval)", lo <= direct && direct <= hi ? "inside" : "OUTSIDE");
     printf("\n");

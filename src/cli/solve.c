@@ -325,7 +325,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         cli_json_number("direct", ro->direct, 0);
         cli_json_number("direct_seconds", ro->direct_seconds, 0);
         cli_json_string("direct_method", ro->direct_method, 0);
-        cli_json_number("z", (r->estimate - ro->direct) / r->std_error, 0);
+        cli_json_number("z", cli_z(r->estimate, ro->direct, r->std_error), 0);
     }
     if (ro->ch) cli_auto_print_json(ro->ch, 1);
     printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
