@@ -3,6 +3,8 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -118,7 +120,7 @@ void *ulam_alloc_big(size_t n, size_t sz)
 {
     if (sz && n > SIZE_MAX / sz) return NULL;
     size_t bytes = n * sz, align = bytes >= ((size_t)2 << 20) ? (size_t)2 << 20 : 64;
-    if (bytes > SIZE_MAX - align) return NULL;
+    if (bytes > (size_t)PTRDIFF_MAX - align) return NULL; /* no object is larger (the allocator refuses it too) */
     size_t size = (bytes + align - 1) / align * align;
     void *p = aligned_alloc(align, size ? size : align);
 #ifdef MADV_HUGEPAGE
