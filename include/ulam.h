@@ -1591,6 +1591,11 @@ double ulam_rng_uniform(ulam_rng *r);
 /* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
 uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
 
+/* The k-th (k < 4) uniform double in [0, 1) of step t of walk w under seed: a counter-based
+ * stream (splitmix64's finalizer chained over the key), the same on every rank and thread, so a
+ * walk that migrates between ranks (ulam_dist.h) takes the same path. */
+double ulam_rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k);
+
 /* ---------------------------------------------------------------- utilities */
 /* All tertiary. */
 

@@ -1,0 +1,93 @@
+/* ulam_dist.h: one system partitioned by rows across ranks, with walks that migrate.
+ *
+ * Each rank holds a contiguous range of rows (balanced by nonzeros, at the prepared file's block
+ * boundaries) read from a prepared file by its blocks alone: no rank reads or maps the rest.  A
+ * walk that steps onto a row another rank owns travels there with its state (walk id, step,
+ * state, weight, score) in the next exchange.  The library stays MPI-free: the caller gives the
+ * exchange as callbacks (src/cli/mpi.c gives MPI_Alltoallv and MPI_Allreduce).
+ *
+ * Random numbers are counter-based: the k-th number of step t of walk w is a hash of (seed, w,
+ * t, k) (ulam_rng_counter), so a walk takes the same path whichever rank runs which step, and
+ * 1, 2, 3 or 64 ranks give the same answer bit for bit: walks' scores and tallies are combined
+ * in walk-id order, never in arrival order.
+ *
+ * API, in order of use: primary ulam_part_open, ulam_dist_adjoint, ulam_dist_forward,
+ * ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
+#ifndef ULAM_DIST_H
+#define ULAM_DIST_H
+
+#include "ulam.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The exchange between ranks.  rank and nranks as MPI gives them; with nranks 1 the callbacks
+ * may be NULL.  exchange: every rank sends sendcounts[r] bytes (consecutive in send, in rank
+ * order) to rank r and receives, in *recv (malloc'd by the callback, freed by the library),
+ * recvcounts[r] bytes from each rank r in rank order; sum: the element-wise sum of v[0 .. n)
+ * over all ranks, in place.  Each returns 0, or nonzero on failure (the run then ends with
+ * ULAM_EIO on every rank that sees it). */
+typedef struct ulam_comm {
+    int rank, nranks;
+    void *ctx;
+    int (*exchange)(void *ctx, const void *send, const size_t *sendcounts, void **recv, size_t *recvcounts);
+    int (*sum)(void *ctx, int64_t *v, int n);
+} ulam_comm;
+
+/* One rank's rows of a prepared system. */
+typedef struct ulam_part ulam_part;
+
+/* Open this rank's rows of the prepared system at path: rows [first, last) of the 'rows' array
+ * (M for adjoint walks, M' for forward walks: transpose nonzero, the file prepared with
+ * --transpose) and b's entries there, every block read verified against its checksum.  The
+ * split is the same on every rank (computed from the file alone).  Needs b in the file. */
+int ulam_part_open(const char *path, const ulam_comm *comm, int transpose, ulam_part **out, ulam_error *err);
+
+/* Free a part (NULL is fine); returns NULL. */
+ulam_part *ulam_part_free(ulam_part *p);
+
+/* The system's order; this rank's rows [*first, *last) and their nonzeros (any pointer may be NULL). */
+int64_t ulam_part_rows(const ulam_part *p, int64_t *first, int64_t *last, int64_t *nnz);
+
+/* Options of a partitioned run. */
+typedef struct ulam_dist_opts {
+    uint64_t seed;     /* the streams' key (default 1) */
+    int64_t walks;     /* histories (default 100000) */
+    int64_t max_steps; /* a walk longer than this is cut and counted (default 1000000) */
+    int64_t batch;     /* histories a round starts on all ranks together (default 65536) */
+} ulam_dist_opts;
+
+/* The defaults above. */
+ulam_dist_opts ulam_dist_defaults(void);
+
+/* What a partitioned run did (the same on every rank). */
+typedef struct ulam_dist_result {
+    double estimate, std_error; /* adjoint: x_index and its standard error; forward: 0 */
+    int64_t walks, steps;       /* histories run and steps taken in all */
+    int64_t crossings;          /* steps that moved a walk to another rank's rows */
+    int64_t bytes;              /* bytes of walks sent between ranks in all */
+    int64_t rounds;             /* exchanges */
+    int64_t cut;                /* histories cut at max_steps */
+} ulam_dist_result;
+
+/* x_index of (I - M) x = b by adjoint collision walks from index on rows of M: each step leaves
+ * row s with probability min(1, S_s) (S_s = sum_j |M_sj|) to j with probability |M_sj| / S_s,
+ * the weight times sign(M_sj) S_s / min(1, S_s), the score the sum of weight x b over every state
+ * visited.  Every rank gets the same result: the mean of the histories' scores in walk-id order
+ * and its standard error (a CLT one: no certified range of a score is computed here). */
+int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
+                      ulam_dist_result *r, ulam_error *err);
+
+/* Every x_i of (I - M) x = b by forward collision walks on rows of M' (the part opened with
+ * transpose): a source j ~ |b_j| / ||b||_1 with weight ||b||_1 sign(b_j), moves as above on M',
+ * and each history's tallies at each state it visits.  x and se (this rank's rows [first, last),
+ * may be NULL) get each component's mean over the histories and its standard error; a component
+ * no walk tallied gets x 0 and se NaN. */
+int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double *x, double *se,
+                      ulam_dist_result *r, ulam_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

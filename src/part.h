@@ -1,0 +1,22 @@
+/* Private to the partitioned walks (part.c, dist.c): a rank's rows of a prepared system. */
+#ifndef ULAM_PART_H
+#define ULAM_PART_H
+
+#include "internal.h"
+#include "ulam_dist.h"
+
+/* This rank's rows [first, last) of M (or M'), 0-based row pointers into col and val, b and the
+ * rows' sums of |entries| at those rows, and the split every rank shares. */
+struct ulam_part {
+    int64_t n, first, last, nnz;
+    int64_t *rowptr;
+    int32_t *col;
+    double *val, *b, *rowsum;
+    int64_t *split; /* nranks + 1 row boundaries: rank r owns rows [split[r], split[r + 1]) */
+    int nranks, rank, shift;
+};
+
+/* The rank owning row s. */
+int ulam__part_owner(const ulam_part *p, int64_t s);
+
+#endif

@@ -1,0 +1,284 @@
+/* Partitioned systems and walks that migrate (ulam_dist.h), with k ranks as k threads of this
+ * process sharing an in-memory exchange: the same answer bit for bit at 1, 2, 3 and 5 ranks, each
+ * rank holding only its rows, the estimates within 4 standard errors of LAPACK's x, and a damaged
+ * block refused by the rank that reads it. */
+#include "testutil.h"
+#include "ulam_dist.h"
+
+#include <pthread.h>
+#include <unistd.h>
+
+enum { MAXR = 8 };
+
+/* The in-memory exchange of k thread-ranks: each posts its send buffer, all meet, each copies
+ * what is addressed to it, all meet again. */
+typedef struct {
+    int k;
+    pthread_barrier_t bar;
+    const char *send[MAXR];
+    const size_t *counts[MAXR];
+    int64_t *sums[MAXR];
+} hub;
+
+typedef struct {
+    hub *h;
+    int rank;
+} port;
+
+/* The exchange (ulam_comm.exchange) between the hub's threads. */
+static int hub_exchange(void *ctx, const void *send, const size_t *sendcounts, void **recv, size_t *recvcounts)
+{
+    port *p = ctx;
+    hub *h = p->h;
+    h->send[p->rank] = send, h->counts[p->rank] = sendcounts;
+    pthread_barrier_wait(&h->bar);
+    size_t total = 0;
+    for (int r = 0; r < h->k; r++) recvcounts[r] = h->counts[r][p->rank], total += recvcounts[r];
+    char *buf = malloc(total ? total : 1);
+    size_t at = 0;
+    for (int r = 0; r < h->k; r++) {
+        size_t off = 0;
+        for (int q = 0; q < p->rank; q++) off += h->counts[r][q];
+        memcpy(buf + at, h->send[r] + off, recvcounts[r]);
+        at += recvcounts[r];
+    }
+    pthread_barrier_wait(&h->bar);
+    *recv = buf;
+    return 0;
+}
+
+/* The sum over the hub's threads (ulam_comm.sum). */
+static int hub_sum(void *ctx, int64_t *v, int n)
+{
+    port *p = ctx;
+    hub *h = p->h;
+    int64_t *mine = malloc((size_t)n * sizeof *mine);
+    memcpy(mine, v, (size_t)n * sizeof *v);
+    h->sums[p->rank] = mine;
+    pthread_barrier_wait(&h->bar);
+    for (int i = 0; i < n; i++) {
+        int64_t s = 0;
+        for (int r = 0; r < h->k; r++) s += h->sums[r][i];
+        v[i] = s;
+    }
+    pthread_barrier_wait(&h->bar);
+    free(mine);
+    return 0;
+}
+
+/* One thread-rank's job and what it found. */
+typedef struct {
+    port port;
+    const char *path;
+    int forward;
+    int64_t index, walks;
+    int status;
+    ulam_dist_result res;
+    double *x, *se; /* forward: the whole vector, each rank filling its rows */
+    int64_t first, last, n;
+} job;
+
+/* Run one rank's part of the job. */
+static void *rank_main(void *arg)
+{
+    job *j = arg;
+    ulam_comm c = {.rank = j->port.rank, .nranks = j->port.h->k, .ctx = &j->port, .exchange = hub_exchange, .sum = hub_sum};
+    ulam_part *p = NULL;
+    ulam_error err;
+    j->status = ulam_part_open(j->path, &c, j->forward, &p, &err);
+    int failed = j->status != ULAM_OK;
+    int64_t any = failed;
+    hub_sum(&j->port, &any, 1); /* every rank learns whether one failed, as a CLI would */
+    if (any) {
+        ulam_part_free(p);
+        return NULL;
+    }
+    j->n = ulam_part_rows(p, &j->first, &j->last, NULL);
+    ulam_dist_opts o = ulam_dist_defaults();
+    o.walks = j->walks, o.batch = 997, o.seed = 7;
+    if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
+    else j->status = ulam_dist_adjoint(p, &c, j->index, &o, &j->res, &err);
+    ulam_part_free(p);
+    return NULL;
+}
+
+/* Run a job on k thread-ranks; the jobs' results in jobs[0 .. k). */
+static void run_ranks(int k, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se, job *jobs)
+{
+    hub h = {.k = k};
+    pthread_barrier_init(&h.bar, NULL, (unsigned)k);
+    pthread_t t[MAXR];
+    for (int r = 0; r < k; r++) {
+        jobs[r] = (job){.port = {&h, r}, .path = path, .forward = forward, .index = index, .walks = walks, .x = x, .se = se};
+        pthread_create(&t[r], NULL, rank_main, &jobs[r]);
+    }
+    for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
+    pthread_barrier_destroy(&h.bar);
+}
+
+/* A random sparse signed M (n x n, about deg entries a row, |row sums| 0.9 at most, some rows
+ * leaving the system) and b, written as a prepared file with M' at path; x solved by LAPACK. */
+static void make_system(const char *path, int64_t n, int deg, uint64_t seed, double *x)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 0);
+    int64_t cap = n * deg;
+    int32_t *ti = malloc((size_t)cap * sizeof *ti), *tj = malloc((size_t)cap * sizeof *tj);
+    double *tv = malloc((size_t)cap * sizeof *tv), *b = malloc((size_t)n * sizeof *b);
+    int64_t nz = 0;
+    for (int64_t i = 0; i < n; i++) {
+        int d = 1 + (int)ulam_rng_bounded(&r, (uint64_t)deg);
+        double keep = i % 7 == 0 ? 0.3 : 0.9;
+        for (int q = 0; q < d; q++) {
+            int64_t j = q == 0 ? (i + 1) % n : (int64_t)ulam_rng_bounded(&r, (uint64_t)n); /* a long cycle: walks cross */
+            ti[nz] = (int32_t)i, tj[nz] = (int32_t)j;
+            tv[nz++] = keep / d * (ulam_rng_uniform(&r) < 0.2 ? -1.0 : 1.0);
+        }
+        b[i] = ulam_rng_uniform(&r) < 0.5 ? 0.0 : 1.0 + ulam_rng_uniform(&r);
+    }
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, &M), ULAM_OK);
+    ulam_system_desc d = ulam_system_desc_defaults();
+    d.M = M, d.b = b, d.n = n, d.transpose = 1;
+    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    ulam_csr_free(M);
+    free(ti), free(tj), free(tv), free(b);
+}
+
+/* Adjoint: one answer, bit for bit, at 1, 2, 3 and 5 ranks, within 4 standard errors of x. */
+static void test_dist_adjoint_identical(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 1500;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 6, 11, x);
+    const int ks[] = {1, 2, 3, 5};
+    const int64_t idx[] = {0, 749, 1499};
+    for (int c = 0; c < 3; c++) {
+        test_case(c);
+        double first = NAN, se = NAN;
+        for (int q = 0; q < 4; q++) {
+            job jobs[MAXR];
+            run_ranks(ks[q], path, 0, idx[c], 20000, NULL, NULL, jobs);
+            for (int r = 0; r < ks[q]; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+            for (int r = 1; r < ks[q]; r++) assert_memory_equal(&jobs[r].res.estimate, &jobs[0].res.estimate, sizeof(double));
+            if (q == 0) first = jobs[0].res.estimate, se = jobs[0].res.std_error;
+            assert_memory_equal(&jobs[0].res.estimate, &first, sizeof first);
+            assert_memory_equal(&jobs[0].res.std_error, &se, sizeof se);
+            if (ks[q] > 1) assert_true(jobs[0].res.crossings > 0); /* walks did migrate */
+            else assert_int_equal(jobs[0].res.crossings, 0);
+        }
+        assert_true(se > 0);
+        if (fabs(first - x[idx[c]]) >= 4 * se)
+            fail_msg("x[%lld] = %.9g, estimate %.9g +- %.3g", (long long)idx[c], x[idx[c]], first, se);
+    }
+    test_case_done();
+    free(x);
+    unlink(path);
+}
+
+/* Forward: every component bit for bit at 1, 2 and 3 ranks; each rank reads only its rows; the
+ * components' z-scores against x: at least 93% within 1.96 (binomial bound on 95% of 1500:
+ * mean 1425, sd 8.4; 1395 is 3.5 sd below), none beyond 6. */
+static void test_dist_forward_identical(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 1500;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 6, 12, x);
+    double *ref = malloc((size_t)n * sizeof *ref), *refse = malloc((size_t)n * sizeof *refse);
+    double *y = malloc((size_t)n * sizeof *y), *yse = malloc((size_t)n * sizeof *yse);
+    const int ks[] = {1, 2, 3};
+    for (int q = 0; q < 3; q++) {
+        job jobs[MAXR];
+        run_ranks(ks[q], path, 1, 0, 200000, q ? y : ref, q ? yse : refse, jobs);
+        int64_t rows = 0;
+        for (int r = 0; r < ks[q]; r++) {
+            assert_int_equal(jobs[r].status, ULAM_OK);
+            rows += jobs[r].last - jobs[r].first;
+            if (ks[q] > 1) assert_true(jobs[r].last - jobs[r].first < n); /* nobody holds all rows */
+        }
+        assert_int_equal(rows, n);
+        if (q) {
+            assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+            assert_memory_equal(yse, refse, (size_t)n * sizeof *yse);
+        }
+    }
+    int64_t in = 0;
+    for (int64_t i = 0; i < n; i++) {
+        double z = (ref[i] - x[i]) / refse[i];
+        if (!(fabs(z) < 6)) fail_msg("x[%lld] = %.9g, estimate %.9g +- %.3g", (long long)i, x[i], ref[i], refse[i]);
+        in += fabs(z) < 1.96;
+    }
+    if (in < 1395) fail_msg("%lld of %lld components within 1.96 standard errors", (long long)in, (long long)n);
+    free(x), free(ref), free(refse), free(y), free(yse);
+    unlink(path);
+}
+
+/* A damaged block: refused (ULAM_ESYNTAX) by the rank whose rows hold it, at 1 and 3 ranks. */
+static void test_dist_damaged(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 600;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 4, 13, x);
+    FILE *f = fopen(path, "r+b");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    long len = ftell(f);
+    fseek(f, len - 4096 * 3 - 100, SEEK_SET); /* inside M''s values, near the end */
+    int ch = fgetc(f);
+    fseek(f, len - 4096 * 3 - 100, SEEK_SET);
+    fputc(ch ^ 0x10, f);
+    fclose(f);
+    job jobs[MAXR];
+    run_ranks(1, path, 1, 0, 100, malloc(n * 8), malloc(n * 8), jobs);
+    assert_int_equal(jobs[0].status, ULAM_ESYNTAX);
+    run_ranks(3, path, 1, 0, 100, malloc(n * 8), malloc(n * 8), jobs);
+    int bad = 0;
+    for (int r = 0; r < 3; r++) bad += jobs[r].status == ULAM_ESYNTAX;
+    assert_int_equal(bad, 1);
+    free(x);
+    unlink(path);
+}
+
+/* Counter-based numbers: keyed by (seed, walk, step, k), in [0, 1), and not all alike. */
+static void test_dist_counter(void **state)
+{
+    (void)state;
+    assert_true(ulam_rng_counter(1, 2, 3, 0) == ulam_rng_counter(1, 2, 3, 0));
+    double s = 0, s2 = 0;
+    int N = 100000;
+    for (int i = 0; i < N; i++) {
+        double u = ulam_rng_counter(5, (uint64_t)i / 10, (uint64_t)i % 10, (unsigned)i % 3);
+        assert_true(u >= 0 && u < 1);
+        s += u, s2 += u * u;
+    }
+    double mean = s / N, var = s2 / N - mean * mean;
+    assert_true(fabs(mean - 0.5) < 4 * sqrt(1.0 / 12 / N)); /* 4 standard errors */
+    assert_true(fabs(var - 1.0 / 12) < 0.002);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_dist_counter),
+        cmocka_unit_test(test_dist_adjoint_identical),
+        cmocka_unit_test(test_dist_forward_identical),
+        cmocka_unit_test(test_dist_damaged),
+    };
+    return test_run(tests);
+}
