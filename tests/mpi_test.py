@@ -50,6 +50,60 @@ def check_interrupt(ulam, mpirun):
     assert o["interrupted"] is True and o["walks"] >= 0 and o["ranks"] == 2, (out, err)
 
 
+def write_system(d, n, seed):
+    """A random sparse signed M (row and column sums of |M| below 0.6: finite variance both ways, a
+    long cycle i -> i+1 so walks cross ranks) and b as Matrix Market files, prepared with M'."""
+    import random
+    rnd = random.Random(seed)
+    ent = {}
+    for i in range(n):
+        deg = rnd.randint(1, 5)
+        for q in range(deg):
+            j = (i + 1) % n if q == 0 else rnd.randrange(n)
+            ent[(i, j)] = ent.get((i, j), 0.0) + 0.4 / deg * (-1 if rnd.random() < 0.2 else 1)
+    with open(f"{d}/pm.mtx", "w") as f:
+        f.write("%%%%MatrixMarket matrix coordinate real general\n%d %d %d\n" % (n, n, len(ent)))
+        f.writelines("%d %d %.17g\n" % (i + 1, j + 1, v) for (i, j), v in sorted(ent.items()))
+    with open(f"{d}/pb.mtx", "w") as f:
+        f.write("%%%%MatrixMarket matrix array real general\n%d 1\n" % n)
+        f.writelines("%.17g\n" % rnd.random() for _ in range(n))
+    return f"{d}/pm.mtx", f"{d}/pb.mtx"
+
+
+def check_partition(ulam, mpirun, d):
+    """Issue 43: the rows split across 1, 2 and 3 ranks (oversubscribed), walks that migrate: the
+    adjoint answer line and the forward --out file byte for byte the same at every rank count, no
+    rank holding every row, walks crossing ranks; x within 4 standard errors of the direct solve; a
+    rank that dies ends the job with a non-zero exit, not a hang."""
+    n = 3000
+    m, b = write_system(d, n, 5)
+    sysf = f"{d}/p.ulam"
+    run([ulam, "prepare", m, "--rhs", b, "--transpose", "-o", sysf])
+    direct = f"{d}/pd.mtx"
+    run([ulam, "direct", m, "--rhs", b, "--out", direct])
+    exact = [float(v) for v in open(direct).read().split("\n")[3:] if v.strip()]
+    lines, files = [], []
+    for k in (1, 2, 3):
+        out = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--index", "1234",
+                   "--walks", "40000", "--seed", "3", "-v"])
+        lines.append(out.splitlines()[0])
+        rows = [l for l in out.splitlines() if l.startswith("ranks")][0].split(";")[0].split()[2:]
+        assert len(rows) == k and sum(map(int, rows)) == n and (k == 1 or max(map(int, rows)) < n), out
+        mig = float([l for l in out.splitlines() if l.startswith("migration")][0].split()[1])
+        assert (mig > 0) == (k > 1), out
+        x = f"{d}/px{k}.mtx"
+        run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--mode", "forward",
+             "--walks", "200000", "--seed", "3", "--out", x, "-q"])
+        files.append(open(x, "rb").read())
+    assert lines[0] == lines[1] == lines[2], lines
+    assert files[0] == files[1] == files[2], "forward --out files differ across rank counts"
+    est, se = float(lines[0].split()[1]), float(lines[0].split()[3])
+    assert abs(est - exact[1233]) < 4 * se, (lines[0], exact[1233])
+    p = subprocess.run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "5"],
+                       capture_output=True, text=True, env=dict(ENV, ULAM_TEST_PARTITION_DIE="1"), timeout=120)
+    assert p.returncode != 0 and not p.stdout, (p.returncode, p.stdout)
+
+
 def main():
     ulam, mpirun = sys.argv[1], sys.argv[2]
     par = [mpirun, "--oversubscribe", "-np", "2", ulam]
@@ -137,13 +191,19 @@ def main():
             except AssertionError as e:
                 failures += 1
                 print(f"FAIL {name}: {e}")
+        try:
+            check_partition(ulam, mpirun, d)
+            print("ok partition")
+        except AssertionError as e:
+            failures += 1
+            print(f"FAIL partition: {e}")
     try:
         check_interrupt(ulam, mpirun)
         print("ok interrupt")
     except AssertionError as e:
         failures += 1
         print(f"FAIL interrupt: {e}")
-    print(f"{len(cases) + 1 - failures} passed, {failures} failed")
+    print(f"{len(cases) + 2 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 

@@ -135,6 +135,10 @@ double cli_time_left(double budget);
 void cli_mpi_init(int *argc, char ***argv);
 void cli_mpi_finalize(void);
 
+/* The exchange between mpirun's ranks for a partitioned run (src/cli/mpi.c); unchanged alone. */
+struct ulam_comm;
+void cli_mpi_comm(struct ulam_comm *c);
+
 /* Signals and temporary files: every output is written to a temporary file (NAME.tmp.XXXXXX)
  * opened by cli_outfile_open, which registers it, and renamed into place by cli_outfile_commit
  * (or removed by cli_outfile_abort), which forget it; SIGINT, SIGTERM and SIGHUP remove every
@@ -263,8 +267,11 @@ typedef struct cli_solve_row {
 } cli_solve_row;
 
 /* The rows: bidirectional (src/cli/bidir.c), the outer iterations and Krylov peers
- * (src/cli/mcsa.c), the walks with auto (src/cli/solve.c). */
+ * (src/cli/mcsa.c), the walks with auto (src/cli/solve.c); --partition (below). */
 extern const cli_solve_row cli_solve_bidir_row, cli_solve_outer_row, cli_solve_walks_row;
+
+/* The rows split across MPI ranks, walks that migrate (--partition, src/cli/partition.c). */
+extern const cli_solve_row cli_solve_partition_row;
 
 /* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print
  * its report with the choice; 0 or an exit code. */

@@ -1,0 +1,230 @@
+/* ulam solve SYSTEM.ulam --partition: the system's rows split across the ranks of mpirun, walks
+ * that migrate (ulam_dist.h).  Alone (no mpirun, or a build without MPI) it is one rank. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "ulam_dist.h"
+
+static const char *const help =
+    "usage: ulam solve SYSTEM.ulam --partition (--index I | --mode forward [--out X.mtx])\n"
+    "                  [--walks N] [--seed S] [--max-steps N] [--batch N]\n"
+    "\n"
+    "The prepared system's rows are split across the ranks of mpirun (balanced by entries; each rank\n"
+    "reads only its rows' blocks of SYSTEM.ulam, prepared with --rhs, and --transpose for forward).\n"
+    "A walk that steps onto another rank's row travels there; random numbers are keyed by (seed,\n"
+    "walk, step), so 1, 2, 3 or 64 ranks print the same answer bit for bit.  Collision estimator,\n"
+    "analog kernel (p_ij = |M_ij| / row sum, leaving with min(1, row sum)); the interval is the\n"
+    "CLT's (1.96 standard errors): no certified range of a score is computed on a partition.\n"
+    "  --index I       x_I by adjoint walks from I (1-based)\n"
+    "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector\n"
+    "  --walks N       histories (default 100000)       --seed S   the streams' key (default 1)\n"
+    "  --max-steps N   cut a walk longer (default 1e6)  --batch N  walks a round starts (default 65536)\n"
+    "docs/distributed.md says more.\n";
+
+/* The parsed command line. */
+typedef struct {
+    const char *path, *out;
+    int64_t index; /* 1-based; 0 none */
+    int forward;
+    ulam_dist_opts o;
+} args;
+
+static const struct option longopts[] = {
+    {"partition", no_argument, 0, 'P'}, {"index", required_argument, 0, 'i'}, {"mode", required_argument, 0, 'm'},
+    {"out", required_argument, 0, 'o'}, {"walks", required_argument, 0, 'w'}, {"seed", required_argument, 0, 's'},
+    {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'},
+    {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+
+/* The defaults. */
+static void init(void *p)
+{
+    *(args *)p = (args){.o = ulam_dist_defaults()};
+}
+
+/* One option (see cli_solve_row.option). */
+static int option(void *p, int val, const char *name, const char *value)
+{
+    args *a = p;
+    int64_t v = 0;
+    int bad = 0;
+    switch (val) {
+    case 'P': return 0;
+    case 'i': return cli_parse_int("solve", "--index", value, 1, INT32_MAX, &a->index);
+    case 'm':
+        if (!strcmp(value, "forward")) a->forward = 1;
+        else if (strcmp(value, "adjoint"))
+            return cli_usage_error("solve", "--mode with --partition is adjoint or forward, got '%s'", value);
+        return 0;
+    case 'o': a->out = value; return 0;
+    case 'w': return cli_parse_int("solve", "--walks", value, 1, (int64_t)1 << 40, &a->o.walks);
+    case 's': bad = cli_parse_int("solve", "--seed", value, 0, INT64_MAX, &v), a->o.seed = (uint64_t)v; return bad;
+    case 'x': return cli_parse_int("solve", "--max-steps", value, 1, INT64_MAX, &a->o.max_steps);
+    case 'b': return cli_parse_int("solve", "--batch", value, 1, (int64_t)1 << 30, &a->o.batch);
+    case 'h': fputs(help, stdout); return -1;
+    default:
+        return cli_usage_error("solve", "--%s is not an option of a --partition run (ulam solve --partition --help)",
+                               name ? name : "?");
+    }
+}
+
+/* Check the operands and options read. */
+static int check(args *a, int argc, char **argv, int first)
+{
+    if (first != argc - 1) return cli_usage_error("solve", "one prepared system file with --partition");
+    a->path = argv[first];
+    if (!a->forward && !a->index) return cli_usage_error("solve", "--index I or --mode forward with --partition");
+    if (a->forward && a->index) return cli_usage_error("solve", "--index or --mode forward with --partition, not both");
+    if (a->out && !a->forward) return cli_usage_error("solve", "--out with --partition writes forward mode's x");
+    return 0;
+}
+
+/* Every rank's count of rows, in rank order, into rows[0 .. nranks). */
+static int all_rows(const ulam_comm *c, int64_t mine, int64_t *rows)
+{
+    memset(rows, 0, (size_t)c->nranks * sizeof *rows);
+    rows[c->rank] = mine;
+    return c->nranks > 1 && c->sum(c->ctx, rows, c->nranks);
+}
+
+/* Write x (this rank's rows x[0 .. mine)) to path on rank 0, the other ranks' rows sent to it in
+ * rank order through the exchange, a chunk a round; 0 or an exit code (on every rank). */
+static int write_x(const ulam_comm *c, const char *path, const double *x, int64_t mine, int64_t n)
+{
+    int64_t *rows = calloc((size_t)c->nranks, sizeof *rows), failed = 0;
+    ulam_outfile o = {0};
+    if (!rows || all_rows(c, mine, rows)) failed = 1;
+    if (!failed && c->rank == 0) {
+        int status = cli_outfile_open(&o, path);
+        if (status || fprintf(o.f, "%%%%MatrixMarket matrix array real general\n%% x by ulam solve --partition\n%lld 1\n",
+                              (long long)n) < 0) failed = status ? status : 1;
+        for (int64_t i = 0; !failed && i < mine; i++) failed = fprintf(o.f, "%.17g\n", x[i]) < 0;
+    }
+    enum { CHUNK = 1 << 16 };
+    size_t *cnt = calloc((size_t)c->nranks * 2, sizeof *cnt);
+    if (!cnt) failed = 1;
+    for (int r = 1; r < c->nranks && rows; r++)
+        for (int64_t at = 0; at < rows[r]; at += CHUNK) {
+            int64_t k = rows[r] - at < CHUNK ? rows[r] - at : CHUNK;
+            for (int q = 0; cnt && q < c->nranks; q++) cnt[q] = 0;
+            if (cnt && c->rank == r) cnt[0] = (size_t)k * sizeof *x;
+            void *got = NULL;
+            if (!cnt || c->exchange(c->ctx, x + at, cnt, &got, cnt + c->nranks)) failed = 1;
+            for (int64_t i = 0; !failed && c->rank == 0 && i < k; i++) failed = fprintf(o.f, "%.17g\n", ((double *)got)[i]) < 0;
+            free(got);
+        }
+    if (c->rank == 0 && o.f) {
+        if (failed) cli_outfile_abort(&o);
+        else failed = cli_outfile_commit(&o);
+        if (failed) cli_report_write(path, ULAM_EIO, 0);
+    }
+    free(rows), free(cnt);
+    int64_t any = failed != 0;
+    if (c->nranks > 1 && c->sum(c->ctx, &any, 1)) any = 1;
+    return any ? cli_exit_code(ULAM_EIO) : 0;
+}
+
+/* Each rank's rows and peak resident memory (KiB), in rank order, into v[0 .. 2 nranks) on every
+ * rank; nonzero when the sum fails. */
+static int per_rank(const ulam_comm *c, int64_t rows, int64_t *v)
+{
+    struct rusage u;
+    memset(v, 0, (size_t)c->nranks * 2 * sizeof *v);
+    v[c->rank] = rows;
+    v[c->nranks + c->rank] = getrusage(RUSAGE_SELF, &u) ? -1 : (int64_t)u.ru_maxrss;
+    return c->nranks > 1 && c->sum(c->ctx, v, 2 * c->nranks);
+}
+
+/* Print the run's summary (rank 0; v: per_rank's figures). */
+static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_t n, double seconds, const int64_t *v)
+{
+    if (!a->forward)
+        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g, CLT)\n", (long long)a->index, cli_answer_pad(a->index, 16),
+               "", r->estimate, r->std_error, r->estimate - 1.96 * r->std_error, r->estimate + 1.96 * r->std_error);
+    else printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
+                a->out ? a->out : "");
+    if (cli_verbosity < 0) return;
+    printf("method          %s collision walks on %d rank%s, rows split by entries\n", a->forward ? "forward" : "adjoint",
+           nranks, nranks == 1 ? "" : "s");
+    printf("walks           %lld (%lld steps; %lld cut at --max-steps)\n", (long long)r->walks, (long long)r->steps,
+           (long long)r->cut);
+    printf("migration       %.4g of steps crossed ranks, %.3g bytes a step, %lld rounds\n",
+           r->steps ? (double)r->crossings / (double)r->steps : 0.0, r->steps ? (double)r->bytes / (double)r->steps : 0.0,
+           (long long)r->rounds);
+    printf("seconds         %.3g in all\n", seconds);
+    if (cli_verbosity < 1) return;
+    printf("ranks           rows");
+    for (int k = 0; k < nranks; k++) printf(" %lld", (long long)v[k]);
+    printf("; peak RSS MiB");
+    for (int k = 0; k < nranks; k++) printf(" %.1f", (double)v[nranks + k] / 1024.0);
+    printf("\n");
+}
+
+/* Run the parsed command on this rank. */
+static int run(const args *a, const ulam_comm *c)
+{
+    ulam_part *p = NULL;
+    ulam_error err;
+    int status = ulam_part_open(a->path, c, a->forward, &p, &err);
+    int64_t bad = status != ULAM_OK; /* every rank ends together when one cannot read its rows */
+    if (c->nranks > 1 && c->sum(c->ctx, &bad, 1)) bad = 1;
+    if (bad) {
+        if (status) cli_report(a->path, &err);
+        ulam_part_free(p);
+        return status ? cli_exit_code(status) : cli_exit_code(ULAM_EIO);
+    }
+    const char *die = getenv("ULAM_TEST_PARTITION_DIE"); /* tests: this rank dies before its walks */
+    if (die && atoi(die) == c->rank && c->nranks > 1) _exit(9);
+    int64_t first, last, n = ulam_part_rows(p, &first, &last, NULL);
+    if (a->index > n) {
+        ulam_part_free(p);
+        return cli_usage_error("solve", "--index in 1 .. %lld, got %lld", (long long)n, (long long)a->index);
+    }
+    ulam_dist_result r;
+    double *x = NULL;
+    if (a->forward) {
+        x = malloc(((size_t)(last - first) + 1) * sizeof *x);
+        status = x ? ulam_dist_forward(p, c, &a->o, x, NULL, &r, &err) : ULAM_ENOMEM;
+    } else {
+        status = ulam_dist_adjoint(p, c, a->index - 1, &a->o, &r, &err);
+    }
+    ulam_part_free(p);
+    int rc = status ? (cli_report(a->path, &err), cli_exit_code(status)) : 0;
+    if (!rc && a->out) rc = write_x(c, a->out, x, last - first, n);
+    int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
+    if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
+    if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v);
+    free(x), free(v);
+    return rc;
+}
+
+/* Check and run (see cli_solve_row.run). */
+static int start_run(void *p, int argc, char **argv, int first)
+{
+    args *a = p;
+    int rc = check(a, argc, argv, first);
+    if (rc) return rc;
+    ulam_comm c = {.rank = 0, .nranks = 1};
+#ifdef ULAM_MPI
+    cli_mpi_comm(&c);
+#endif
+    return run(a, &c);
+}
+
+/* --partition selects this row whatever else is given. */
+static const char *const claims[] = {"partition", NULL};
+
+/* No --method value is this row's. */
+static int serves(const char *method)
+{
+    (void)method;
+    return 0;
+}
+
+const cli_solve_row cli_solve_partition_row = {"partition", longopts, claims, serves, sizeof(args), init, option, start_run};
