@@ -11,8 +11,8 @@
  * 1, 2, 3 or 64 ranks give the same answer bit for bit: walks' scores and tallies are combined
  * in walk-id order, never in arrival order.
  *
- * API, in order of use: primary ulam_part_open, ulam_dist_adjoint, ulam_dist_forward,
- * ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
+ * API, in order of use: primary ulam_part_open, ulam_dist_radius (the variance guard),
+ * ulam_dist_adjoint, ulam_dist_forward, ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
 #ifndef ULAM_DIST_H
 #define ULAM_DIST_H
 
@@ -86,6 +86,13 @@ int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, 
  * no walk tallied gets x 0 and se NaN. */
 int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double *x, double *se,
                       ulam_dist_result *r, ulam_error *err);
+
+/* A certified upper bound *upper on rho(M^), M^_ij = M_ij^2 / p_ij of the walks above on the part's
+ * rows (M^_ij = |M_ij| S_i / min(1, S_i)): below 1, the walks' scores have finite variance.  Power
+ * iteration on the rows each rank holds, the iterate shared through the exchange, each step's
+ * Collatz-Wielandt bound max_i (M^ v)_i / v_i rounded up; it stops when that is below 1 or after
+ * iters steps (the smallest bound seen).  The same bits on every rank and at any rank count. */
+int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int iters, double *upper, ulam_error *err);
 
 #ifdef __cplusplus
 }

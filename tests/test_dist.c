@@ -72,6 +72,8 @@ typedef struct {
     const char *path;
     int forward;
     int64_t index, walks;
+    int radius; /* run ulam_dist_radius instead of walks, into rho */
+    double rho;
     int status;
     ulam_dist_result res;
     double *x, *se; /* forward: the whole vector, each rank filling its rows */
@@ -96,7 +98,8 @@ static void *rank_main(void *arg)
     j->n = ulam_part_rows(p, &j->first, &j->last, NULL);
     ulam_dist_opts o = ulam_dist_defaults();
     o.walks = j->walks, o.batch = 997, o.seed = 7;
-    if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
+    if (j->radius) j->status = ulam_dist_radius(p, &c, 300, &j->rho, &err);
+    else if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
     else j->status = ulam_dist_adjoint(p, &c, j->index, &o, &j->res, &err);
     ulam_part_free(p);
     return NULL;
@@ -110,6 +113,20 @@ static void run_ranks(int k, const char *path, int forward, int64_t index, int64
     pthread_t t[MAXR];
     for (int r = 0; r < k; r++) {
         jobs[r] = (job){.port = {&h, r}, .path = path, .forward = forward, .index = index, .walks = walks, .x = x, .se = se};
+        pthread_create(&t[r], NULL, rank_main, &jobs[r]);
+    }
+    for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
+    pthread_barrier_destroy(&h.bar);
+}
+
+/* Run ulam_dist_radius on k thread-ranks. */
+static void run_ranks_radius(int k, const char *path, job *jobs)
+{
+    hub h = {.k = k};
+    pthread_barrier_init(&h.bar, NULL, (unsigned)k);
+    pthread_t t[MAXR];
+    for (int r = 0; r < k; r++) {
+        jobs[r] = (job){.port = {&h, r}, .path = path, .radius = 1, .walks = 1};
         pthread_create(&t[r], NULL, rank_main, &jobs[r]);
     }
     for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
@@ -255,6 +272,47 @@ static void test_dist_damaged(void **state)
     unlink(path);
 }
 
+/* The variance guard: the same bits at 1, 2 and 3 ranks, at or above rho(M^) (M^ = |M| here: row
+ * sums below 1) by 2000 dense power steps, and below 1 (certified). */
+static void test_dist_radius(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 400;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 5, 14, x);
+    ulam_system *sys = NULL;
+    assert_int_equal(ulam_system_open(path, NULL, &sys, NULL), ULAM_OK);
+    const ulam_csr *M = ulam_system_matrix(sys);
+    double *v = malloc((size_t)n * sizeof *v), *y = malloc((size_t)n * sizeof *y), rho = 0;
+    for (int64_t i = 0; i < n; i++) v[i] = 1.0;
+    for (int k = 0; k < 2000; k++) { /* |M| v / ||.||: its growth tends to rho(|M|) */
+        double top = 0;
+        for (int64_t i = 0; i < n; i++) {
+            y[i] = 0;
+            for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) y[i] += fabs(M->val[q]) * v[M->colidx[q]];
+            if (y[i] > top) top = y[i];
+        }
+        rho = top;
+        for (int64_t i = 0; i < n; i++) v[i] = y[i] / top;
+    }
+    ulam_system_free(sys);
+    double first = NAN;
+    for (int k = 1; k <= 3; k++) {
+        job jobs[MAXR];
+        run_ranks_radius(k, path, jobs);
+        for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+        if (k == 1) first = jobs[0].rho;
+        for (int r = 0; r < k; r++) assert_memory_equal(&jobs[r].rho, &first, sizeof first);
+    }
+    if (!(first >= rho && first < 1.0)) fail_msg("bound %.9g, rho(|M|) %.9g", first, rho);
+    free(x), free(v), free(y);
+    unlink(path);
+}
+
 /* Counter-based numbers: keyed by (seed, walk, step, k), in [0, 1), and not all alike. */
 static void test_dist_counter(void **state)
 {
@@ -279,6 +337,7 @@ int main(void)
         cmocka_unit_test(test_dist_adjoint_identical),
         cmocka_unit_test(test_dist_forward_identical),
         cmocka_unit_test(test_dist_damaged),
+        cmocka_unit_test(test_dist_radius),
     };
     return test_run(tests);
 }

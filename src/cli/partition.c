@@ -3,6 +3,7 @@
 #include "cli.h"
 
 #include <getopt.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -142,9 +143,14 @@ static int per_rank(const ulam_comm *c, int64_t rows, int64_t *v)
 }
 
 /* Print the run's summary (rank 0; v: per_rank's figures). */
-static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_t n, double seconds, const int64_t *v)
+static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_t n, double seconds, const int64_t *v,
+                    double rho)
 {
-    if (!a->forward)
+    if (!a->forward && !(rho < 1.0))
+        printf("x[%lld]%*s%.10g (no confidence interval: rho(M^) is not certified below 1, bound %.4g; the sample "
+               "stderr %.3g means nothing)\n", (long long)a->index, cli_answer_pad(a->index, 16), "", r->estimate, rho,
+               r->std_error);
+    else if (!a->forward)
         printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g, CLT)\n", (long long)a->index, cli_answer_pad(a->index, 16),
                "", r->estimate, r->std_error, r->estimate - 1.96 * r->std_error, r->estimate + 1.96 * r->std_error);
     else printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
@@ -152,6 +158,8 @@ static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_
     if (cli_verbosity < 0) return;
     printf("method          %s collision walks on %d rank%s, rows split by entries\n", a->forward ? "forward" : "adjoint",
            nranks, nranks == 1 ? "" : "s");
+    if (rho < 1.0) printf("variance        finite (rho(M^) <= %.6g, certified)\n", rho);
+    else if (a->forward) printf("variance        not certified finite (rho(M^) bound %.4g): no error bar can be trusted\n", rho);
     printf("walks           %lld (%lld steps; %lld cut at --max-steps)\n", (long long)r->walks, (long long)r->steps,
            (long long)r->cut);
     printf("migration       %.4g of steps crossed ranks, %.3g bytes a step, %lld rounds\n",
@@ -186,9 +194,12 @@ static int run(const args *a, const ulam_comm *c)
         ulam_part_free(p);
         return cli_usage_error("solve", "--index in 1 .. %lld, got %lld", (long long)n, (long long)a->index);
     }
-    ulam_dist_result r;
+    double rho = INFINITY; /* the variance guard: the interval is printed only when it is below 1 */
+    status = ulam_dist_radius(p, c, 200, &rho, &err);
+    ulam_dist_result r = {0};
     double *x = NULL;
-    if (a->forward) {
+    if (status) {
+    } else if (a->forward) {
         x = malloc(((size_t)(last - first) + 1) * sizeof *x);
         status = x ? ulam_dist_forward(p, c, &a->o, x, NULL, &r, &err) : ULAM_ENOMEM;
     } else {
@@ -199,7 +210,7 @@ static int run(const args *a, const ulam_comm *c)
     if (!rc && a->out) rc = write_x(c, a->out, x, last - first, n);
     int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
     if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
-    if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v);
+    if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v, rho);
     free(x), free(v);
     return rc;
 }
