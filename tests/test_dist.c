@@ -3,68 +3,11 @@
  * rank holding only its rows, the estimates within 4 standard errors of LAPACK's x, and a damaged
  * block refused by the rank that reads it. */
 #include "testutil.h"
-#include "ulam_dist.h"
+#include "hub.h"
 
-#include <pthread.h>
 #include <unistd.h>
 
-enum { MAXR = 8 };
-
-/* The in-memory exchange of k thread-ranks: each posts its send buffer, all meet, each copies
- * what is addressed to it, all meet again. */
-typedef struct {
-    int k;
-    pthread_barrier_t bar;
-    const char *send[MAXR];
-    const size_t *counts[MAXR];
-    int64_t *sums[MAXR];
-} hub;
-
-typedef struct {
-    hub *h;
-    int rank;
-} port;
-
-/* The exchange (ulam_comm.exchange) between the hub's threads. */
-static int hub_exchange(void *ctx, const void *send, const size_t *sendcounts, void **recv, size_t *recvcounts)
-{
-    port *p = ctx;
-    hub *h = p->h;
-    h->send[p->rank] = send, h->counts[p->rank] = sendcounts;
-    pthread_barrier_wait(&h->bar);
-    size_t total = 0;
-    for (int r = 0; r < h->k; r++) recvcounts[r] = h->counts[r][p->rank], total += recvcounts[r];
-    char *buf = malloc(total ? total : 1);
-    size_t at = 0;
-    for (int r = 0; r < h->k; r++) {
-        size_t off = 0;
-        for (int q = 0; q < p->rank; q++) off += h->counts[r][q];
-        memcpy(buf + at, h->send[r] + off, recvcounts[r]);
-        at += recvcounts[r];
-    }
-    pthread_barrier_wait(&h->bar);
-    *recv = buf;
-    return 0;
-}
-
-/* The sum over the hub's threads (ulam_comm.sum). */
-static int hub_sum(void *ctx, int64_t *v, int n)
-{
-    port *p = ctx;
-    hub *h = p->h;
-    int64_t *mine = malloc((size_t)n * sizeof *mine);
-    memcpy(mine, v, (size_t)n * sizeof *v);
-    h->sums[p->rank] = mine;
-    pthread_barrier_wait(&h->bar);
-    for (int i = 0; i < n; i++) {
-        int64_t s = 0;
-        for (int r = 0; r < h->k; r++) s += h->sums[r][i];
-        v[i] = s;
-    }
-    pthread_barrier_wait(&h->bar);
-    free(mine);
-    return 0;
-}
+enum { MAXR = HUB_MAX };
 
 /* One thread-rank's job and what it found. */
 typedef struct {
@@ -84,7 +27,7 @@ typedef struct {
 static void *rank_main(void *arg)
 {
     job *j = arg;
-    ulam_comm c = {.rank = j->port.rank, .nranks = j->port.h->k, .ctx = &j->port, .exchange = hub_exchange, .sum = hub_sum};
+    ulam_comm c = hub_comm(&j->port);
     ulam_part *p = NULL;
     ulam_error err;
     j->status = ulam_part_open(j->path, &c, j->forward, &p, &err);
@@ -108,8 +51,8 @@ static void *rank_main(void *arg)
 /* Run a job on k thread-ranks; the jobs' results in jobs[0 .. k). */
 static void run_ranks(int k, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se, job *jobs)
 {
-    hub h = {.k = k};
-    pthread_barrier_init(&h.bar, NULL, (unsigned)k);
+    hub h;
+    hub_init(&h, k);
     pthread_t t[MAXR];
     for (int r = 0; r < k; r++) {
         jobs[r] = (job){.port = {&h, r}, .path = path, .forward = forward, .index = index, .walks = walks, .x = x, .se = se};
@@ -122,8 +65,8 @@ static void run_ranks(int k, const char *path, int forward, int64_t index, int64
 /* Run ulam_dist_radius on k thread-ranks. */
 static void run_ranks_radius(int k, const char *path, job *jobs)
 {
-    hub h = {.k = k};
-    pthread_barrier_init(&h.bar, NULL, (unsigned)k);
+    hub h;
+    hub_init(&h, k);
     pthread_t t[MAXR];
     for (int r = 0; r < k; r++) {
         jobs[r] = (job){.port = {&h, r}, .path = path, .radius = 1, .walks = 1};
@@ -181,7 +124,7 @@ static void test_dist_adjoint_identical(void **state)
         double first = NAN, se = NAN;
         for (int q = 0; q < 4; q++) {
             job jobs[MAXR];
-            run_ranks(ks[q], path, 0, idx[c], 20000, NULL, NULL, jobs);
+            run_ranks(ks[q], path, 0, idx[c], 10000, NULL, NULL, jobs);
             for (int r = 0; r < ks[q]; r++) assert_int_equal(jobs[r].status, ULAM_OK);
             for (int r = 1; r < ks[q]; r++) assert_memory_equal(&jobs[r].res.estimate, &jobs[0].res.estimate, sizeof(double));
             if (q == 0) first = jobs[0].res.estimate, se = jobs[0].res.std_error;
@@ -217,7 +160,7 @@ static void test_dist_forward_identical(void **state)
     const int ks[] = {1, 2, 3};
     for (int q = 0; q < 3; q++) {
         job jobs[MAXR];
-        run_ranks(ks[q], path, 1, 0, 200000, q ? y : ref, q ? yse : refse, jobs);
+        run_ranks(ks[q], path, 1, 0, 60000, q ? y : ref, q ? yse : refse, jobs);
         int64_t rows = 0;
         for (int r = 0; r < ks[q]; r++) {
             assert_int_equal(jobs[r].status, ULAM_OK);
@@ -262,13 +205,14 @@ static void test_dist_damaged(void **state)
     fputc(ch ^ 0x10, f);
     fclose(f);
     job jobs[MAXR];
-    run_ranks(1, path, 1, 0, 100, malloc(n * 8), malloc(n * 8), jobs);
+    double *y = malloc((size_t)n * sizeof *y), *yse = malloc((size_t)n * sizeof *yse);
+    run_ranks(1, path, 1, 0, 100, y, yse, jobs);
     assert_int_equal(jobs[0].status, ULAM_ESYNTAX);
-    run_ranks(3, path, 1, 0, 100, malloc(n * 8), malloc(n * 8), jobs);
+    run_ranks(3, path, 1, 0, 100, y, yse, jobs);
     int bad = 0;
     for (int r = 0; r < 3; r++) bad += jobs[r].status == ULAM_ESYNTAX;
     assert_int_equal(bad, 1);
-    free(x);
+    free(x), free(y), free(yse);
     unlink(path);
 }
 
