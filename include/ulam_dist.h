@@ -27,9 +27,12 @@ extern "C" {
  * order) to rank r and receives, in *recv (malloc'd by the callback, freed by the library),
  * recvcounts[r] bytes from each rank r in rank order; sum: the element-wise sum of v[0 .. n)
  * over all ranks, in place.  Each returns 0, or nonzero on failure (the run then ends with
- * ULAM_EIO on every rank that sees it). */
+ * ULAM_EIO on every rank that sees it).  The answer is the same bits whatever nranks and sets. */
 typedef struct ulam_comm {
     int rank, nranks;
+    int sets; /* 0 or 1: one partition; k > 1 (dividing nranks): k sets of nranks / k consecutive
+                 ranks, each set a whole partition of the rows running its own batches of walks
+                 (memory per rank times k, and no message leaves a set while walks run) */
     void *ctx;
     int (*exchange)(void *ctx, const void *send, const size_t *sendcounts, void **recv, size_t *recvcounts);
     int (*sum)(void *ctx, int64_t *v, int n);
@@ -38,7 +41,8 @@ typedef struct ulam_comm {
 /* One rank's rows of a prepared system. */
 typedef struct ulam_part ulam_part;
 
-/* Open this rank's rows of the prepared system at path: rows [first, last) of the 'rows' array
+/* Open this rank's rows of the prepared system at path (split among the ranks of its set): rows
+ * [first, last) of the 'rows' array
  * (M for adjoint walks, M' for forward walks: transpose nonzero, the file prepared with
  * --transpose) and b's entries there, every block read verified against its checksum.  The
  * split is the same on every rank (computed from the file alone).  Needs b in the file. */
@@ -83,7 +87,8 @@ int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, 
  * transpose): a source j ~ |b_j| / ||b||_1 with weight ||b||_1 sign(b_j), moves as above on M',
  * and each history's tallies at each state it visits.  x and se (this rank's rows [first, last),
  * may be NULL) get each component's mean over the histories and its standard error; a component
- * no walk tallied gets x 0 and se NaN. */
+ * no walk tallied gets x 0 and se NaN.  With sets, the ranks of set 0 get them (the others' x and
+ * se are left as they were). */
 int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double *x, double *se,
                       ulam_dist_result *r, ulam_error *err);
 

@@ -96,9 +96,9 @@ static int advance(run *R, particle x, int forward)
         if (!move(p, R->o.seed, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
         R->steps++;
         int own = p->nranks > 1 ? ulam__part_owner(p, x.s) : 0;
-        if (own != p->rank) {
+        if (own != p->rank) { /* to the rank of this set that owns the row */
             R->crossings++;
-            return push(&R->out[own], &x, sizeof x);
+            return push(&R->out[p->set * p->nranks + own], &x, sizeof x);
         }
     }
     if (forward) return ULAM_OK;
@@ -178,7 +178,7 @@ static int start(run *R, const ulam_part *p, const ulam_comm *c, const ulam_dist
     *R = (run){.p = p, .c = c, .o = o ? *o : ulam_dist_defaults()};
     if (R->o.walks < 1 || R->o.max_steps < 1 || R->o.batch < 1)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "walks, max_steps and batch of at least 1");
-    if (c->nranks != p->nranks || c->rank != p->rank)
+    if (c->nranks != p->nranks * p->sets || c->rank != p->set * p->nranks + p->rank || (c->sets > 1 ? c->sets : 1) != p->sets)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "the comm the part was opened with");
     R->out = calloc((size_t)c->nranks, sizeof *R->out);
     return R->out ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for outboxes");
@@ -244,6 +244,12 @@ static int broadcast(run *R, double *v, int k, ulam_error *err)
     return status;
 }
 
+/* The walks of the batch from walk id a (up to o.batch; none past the last walk). */
+static int64_t my_batch(const run *R, int64_t a)
+{
+    return a >= R->o.walks ? 0 : R->o.walks - a < R->o.batch ? R->o.walks - a : R->o.batch;
+}
+
 /* x_index by adjoint walks on the partitioned rows. */
 int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
                       ulam_dist_result *res, ulam_error *err)
@@ -257,9 +263,9 @@ int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, 
     int status = start(&R, p, comm, o, err);
     int mine = ulam__part_owner(p, index) == p->rank;
     double m[3] = {0, 0, 0}; /* n, mean, M2 (rank 0) */
-    for (int64_t w0 = 0; !status && w0 < R.o.walks; w0 += R.o.batch) {
-        int64_t B = R.o.walks - w0 < R.o.batch ? R.o.walks - w0 : R.o.batch;
-        for (int64_t w = w0; mine && !status && w < w0 + B; w++) {
+    for (int64_t w0 = 0; !status && w0 < R.o.walks; w0 += R.o.batch * p->sets) { /* a batch a set */
+        int64_t a = w0 + p->set * R.o.batch, B = my_batch(&R, a);
+        for (int64_t w = a; mine && !status && w < a + B; w++) {
             particle x = {w, 0, index, 1.0, 0.0};
             status = push(&R.here, &x, sizeof x) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for walks") : ULAM_OK;
         }
@@ -292,7 +298,7 @@ static int block_prefix(run *R, double **P, int64_t *nb, ulam_error *err)
         free(bits);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld block sums", (long long)*nb);
     }
-    for (int64_t k = p->first >> p->shift; (k << p->shift) < p->last; k++) {
+    for (int64_t k = p->first >> p->shift; p->set == 0 && (k << p->shift) < p->last; k++) { /* one set's */
         double s = 0.0;
         int64_t r1 = (k + 1) << p->shift < p->last ? (k + 1) << p->shift : p->last;
         for (int64_t i = k << p->shift; i < r1; i++) s += fabs(p->b[i - p->first]);
@@ -344,19 +350,46 @@ static int forward_starts(run *R, const double *P, int64_t nb, int64_t w0, int64
     return ULAM_OK;
 }
 
-/* Add the batch's tallies to this rank's per-row sums, each history's total at a row once, in
- * (row, walk) order. */
-static void settle(run *R, double *sum, double *sumsq)
+/* Each history's total at each row of the batch's tallies, in (row, walk) order, in place. */
+static void totals(run *R)
 {
     tally *t = R->tallies.a;
     if (R->tallies.len) qsort(t, (size_t)R->tallies.len, sizeof *t, by_row_walk);
+    int64_t m = 0;
     for (int64_t q = 0; q < R->tallies.len;) {
-        double v = 0.0;
-        int64_t a = q;
-        for (; q < R->tallies.len && t[q].s == t[a].s && t[q].w == t[a].w; q++) v += t[q].v;
-        sum[t[a].s - R->p->first] += v, sumsq[t[a].s - R->p->first] += v * v;
+        tally e = {t[q].s, t[q].w, 0, 0.0};
+        for (; q < R->tallies.len && t[q].s == e.s && t[q].w == e.w; q++) e.v += t[q].v; /* in step order */
+        t[m++] = e;
+    }
+    R->tallies.len = m;
+}
+
+/* Add the batches' tallies to the per-row sums of set 0's ranks, each history's total at a row
+ * once, in (row, walk) order: with sets, each rank's totals go to the rank of set 0 that holds
+ * the same rows. */
+static int settle(run *R, double *sum, double *sumsq, ulam_error *err)
+{
+    const ulam_part *p = R->p;
+    totals(R);
+    if (p->sets > 1) {
+        vec *box = calloc((size_t)R->c->nranks, sizeof *box);
+        if (!box) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for an exchange");
+        box[p->rank] = R->tallies, R->tallies = (vec){0};
+        int64_t sent, before = R->bytes;
+        int status = exchange(R, box, sizeof(tally), &R->tallies, &sent, err);
+        R->bytes = before; /* results, not walks */
+        free(box[p->rank].a), free(box);
+        if (status) return status;
+        tally *t = R->tallies.a;
+        if (R->tallies.len) qsort(t, (size_t)R->tallies.len, sizeof *t, by_row_walk); /* walks differ across sets */
+    }
+    const tally *t = R->tallies.a;
+    for (int64_t q = 0; p->set == 0 && q < R->tallies.len; q++) {
+        sum[t[q].s - p->first] += t[q].v;
+        sumsq[t[q].s - p->first] += t[q].v * t[q].v;
     }
     R->tallies.len = 0;
+    return ULAM_OK;
 }
 
 /* Every x_i by forward walks on the partitioned rows of M'. */
@@ -372,18 +405,18 @@ int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist
     double *sum = calloc((size_t)rows + 1, sizeof *sum), *sumsq = calloc((size_t)rows + 1, sizeof *sumsq), *P = NULL;
     if (!status && (!sum || !sumsq)) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld sums", (long long)rows);
     if (!status) status = block_prefix(&R, &P, &nb, err);
-    for (int64_t w0 = 0; !status && P[nb] > 0 && w0 < R.o.walks; w0 += R.o.batch) {
-        int64_t B = R.o.walks - w0 < R.o.batch ? R.o.walks - w0 : R.o.batch;
-        status = forward_starts(&R, P, nb, w0, B, err);
+    for (int64_t w0 = 0; !status && P[nb] > 0 && w0 < R.o.walks; w0 += R.o.batch * p->sets) { /* a batch a set */
+        int64_t a = w0 + p->set * R.o.batch;
+        status = forward_starts(&R, P, nb, a, my_batch(&R, a), err);
         if (!status) status = rounds(&R, 1, err);
-        if (!status) settle(&R, sum, sumsq);
+        if (!status) status = settle(&R, sum, sumsq, err);
     }
     int64_t cut = R.cut;
     if (!status && R.c->nranks > 1 && R.c->sum(R.c->ctx, &cut, 1))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks that succeeds");
     if (!status) status = counts(&R, res, err);
     double N = (double)R.o.walks, zero_b = P && P[nb] == 0;
-    for (int64_t i = 0; !status && i < rows; i++) {
+    for (int64_t i = 0; !status && p->set == 0 && i < rows; i++) {
         double mean = sum[i] / N, var = (sumsq[i] - sum[i] * mean) / (N - 1.0);
         if (x) x[i] = mean;
         if (se) se[i] = zero_b ? 0.0 : sumsq[i] == 0.0 ? NAN : N > 1 ? sqrt(fmax(var, 0.0) / N) : NAN;

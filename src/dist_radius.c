@@ -7,7 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Every rank's slice of a vector (rows [split[r], split[r + 1])) into all[0 .. n) on every rank. */
+/* Every rank's slice of a vector (rows [split[r], split[r + 1])) into all[0 .. n) on every rank of
+ * its set. */
 static int share(const ulam_part *p, const ulam_comm *c, const double *mine, double *all)
 {
     int64_t rows = p->last - p->first;
@@ -17,11 +18,12 @@ static int share(const ulam_part *p, const ulam_comm *c, const double *mine, dou
     }
     size_t *counts = malloc((size_t)c->nranks * 2 * sizeof *counts);
     if (!counts) return 1;
-    for (int r = 0; r < c->nranks; r++) counts[r] = (size_t)rows * sizeof *mine;
-    char *send = malloc((size_t)c->nranks * (size_t)(rows ? rows : 1) * sizeof *mine);
+    int set0 = p->set * p->nranks; /* to the ranks of this set only */
+    for (int r = 0; r < c->nranks; r++) counts[r] = r >= set0 && r < set0 + p->nranks ? (size_t)rows * sizeof *mine : 0;
+    char *send = malloc((size_t)p->nranks * (size_t)(rows ? rows : 1) * sizeof *mine);
     void *got = NULL;
     int bad = !send;
-    for (int r = 0; !bad && r < c->nranks; r++) memcpy(send + (size_t)r * (size_t)rows * sizeof *mine, mine, counts[r]);
+    for (int r = 0; !bad && r < p->nranks; r++) memcpy(send + (size_t)r * (size_t)rows * sizeof *mine, mine, (size_t)rows * sizeof *mine);
     if (!bad) bad = c->exchange(c->ctx, send, counts, &got, counts + c->nranks);
     size_t total = 0;
     for (int r = 0; !bad && r < c->nranks; r++) total += counts[c->nranks + r];

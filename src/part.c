@@ -159,14 +159,15 @@ static int open_part(int fd, uint64_t len, const ulam_comm *c, int transpose, ul
     int status = read_layout(fd, len, transpose, &L, &sums, err);
     int part = transpose ? 2 : 0;
     const uint64_t off[3] = {L.off[transpose ? 4 : 0], L.off[transpose ? 5 : 1], L.off[transpose ? 6 : 2]};
-    p->n = L.n, p->nranks = c->nranks, p->rank = c->rank, p->shift = L.shift;
-    p->split = ulam__malloc((size_t)c->nranks + 1, sizeof *p->split);
+    p->sets = c->sets > 1 ? c->sets : 1, p->nranks = c->nranks / p->sets;
+    p->set = c->rank / p->nranks, p->rank = c->rank % p->nranks, p->n = L.n, p->shift = L.shift;
+    p->split = ulam__malloc((size_t)p->nranks + 1, sizeof *p->split);
     if (!status && !p->split) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the split");
-    if (!status && split_blocks(fd, off[0], L.shift, L.n, L.nblocks[part], L.nnz, c->nranks, p->split))
+    if (!status && split_blocks(fd, off[0], L.shift, L.n, L.nblocks[part], L.nnz, p->nranks, p->split))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "row pointers readable from the file");
     if (!status) {
-        for (int r = 0; r <= c->nranks; r++) p->split[r] = p->split[r] << L.shift < L.n ? p->split[r] << L.shift : L.n;
-        p->first = p->split[c->rank], p->last = p->split[c->rank + 1];
+        for (int r = 0; r <= p->nranks; r++) p->split[r] = p->split[r] << L.shift < L.n ? p->split[r] << L.shift : L.n;
+        p->first = p->split[p->rank], p->last = p->split[p->rank + 1];
         status = read_rows(fd, &L, off, sums, L.first[part], p, err);
     }
     if (!status) status = read_rhs(fd, &L, sums, L.first[1], p, err);
@@ -184,6 +185,8 @@ int ulam_part_open(const char *path, const ulam_comm *comm, int transpose, ulam_
     if (comm->nranks < 1 || comm->rank < 0 || comm->rank >= comm->nranks ||
         (comm->nranks > 1 && (!comm->exchange || !comm->sum)))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "0 <= rank < nranks, and an exchange and a sum with more than one rank");
+    if (comm->sets < 0 || (comm->sets > 1 && comm->nranks % comm->sets))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "sets dividing the %d ranks, got %d", comm->nranks, comm->sets);
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     struct stat st;
     if (fd < 0 || fstat(fd, &st) || !S_ISREG(st.st_mode)) {

@@ -12,11 +12,12 @@ struct ulam_part {
     int64_t *rowptr;
     int32_t *col;
     double *val, *b, *rowsum;
-    int64_t *split; /* nranks + 1 row boundaries: rank r owns rows [split[r], split[r + 1]) */
-    int nranks, rank, shift;
+    int64_t *split; /* nranks + 1 row boundaries: position r of a set owns rows [split[r], split[r + 1]) */
+    int nranks, rank, shift; /* ranks in this rank's set and its position there */
+    int set, sets;           /* this rank's set (world rank set * nranks + rank) of sets */
 };
 
-/* The rank owning row s. */
+/* The position in a set owning row s. */
 int ulam__part_owner(const ulam_part *p, int64_t s);
 
 #endif

@@ -71,8 +71,8 @@ def write_system(d, n, seed):
 
 
 def check_partition(ulam, mpirun, d):
-    """Issue 43: the rows split across 1, 2 and 3 ranks (oversubscribed), walks that migrate: the
-    adjoint answer line and the forward --out file byte for byte the same at every rank count, no
+    """Issue 43: the rows split across 1, 2 and 3 ranks (oversubscribed; and 4 in 2 sets), walks that
+    migrate: the adjoint answer line and the forward --out file byte for byte the same at every rank count, no
     rank holding every row, walks crossing ranks; x within 4 standard errors of the direct solve; a
     rank that dies ends the job with a non-zero exit, not a hang."""
     n = 3000
@@ -95,8 +95,12 @@ def check_partition(ulam, mpirun, d):
         run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--mode", "forward",
              "--walks", "200000", "--seed", "3", "--out", x, "-q"])
         files.append(open(x, "rb").read())
+    x = f"{d}/pxs.mtx"  # 4 ranks in 2 sets (replication x partition): the same file again
+    run([mpirun, "--oversubscribe", "-np", "4", ulam, "solve", sysf, "--partition", "--sets", "2", "--mode", "forward",
+         "--walks", "200000", "--seed", "3", "--out", x, "-q"])
+    files.append(open(x, "rb").read())
     assert lines[0] == lines[1] == lines[2], lines
-    assert files[0] == files[1] == files[2], "forward --out files differ across rank counts"
+    assert files[0] == files[1] == files[2] == files[3], "forward --out files differ across rank counts or sets"
     est, se = float(lines[0].split()[1]), float(lines[0].split()[3])
     assert abs(est - exact[1233]) < 4 * se, (lines[0], exact[1233])
     p = subprocess.run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "5"],

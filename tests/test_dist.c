@@ -16,6 +16,7 @@ typedef struct {
     int forward;
     int64_t index, walks;
     int radius; /* run ulam_dist_radius instead of walks, into rho */
+    int sets;   /* ranks in sets (0: one) */
     double rho;
     int status;
     ulam_dist_result res;
@@ -28,6 +29,7 @@ static void *rank_main(void *arg)
 {
     job *j = arg;
     ulam_comm c = hub_comm(&j->port);
+    c.sets = j->sets;
     ulam_part *p = NULL;
     ulam_error err;
     j->status = ulam_part_open(j->path, &c, j->forward, &p, &err);
@@ -49,17 +51,25 @@ static void *rank_main(void *arg)
 }
 
 /* Run a job on k thread-ranks; the jobs' results in jobs[0 .. k). */
-static void run_ranks(int k, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se, job *jobs)
+static void run_sets(int k, int sets, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se,
+                     job *jobs)
 {
     hub h;
     hub_init(&h, k);
     pthread_t t[MAXR];
     for (int r = 0; r < k; r++) {
-        jobs[r] = (job){.port = {&h, r}, .path = path, .forward = forward, .index = index, .walks = walks, .x = x, .se = se};
+        jobs[r] = (job){.port = {&h, r}, .path = path, .forward = forward, .index = index, .walks = walks, .x = x, .se = se,
+                        .sets = sets};
         pthread_create(&t[r], NULL, rank_main, &jobs[r]);
     }
     for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
     pthread_barrier_destroy(&h.bar);
+}
+
+/* Run a job on k thread-ranks as one partition. */
+static void run_ranks(int k, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se, job *jobs)
+{
+    run_sets(k, 0, path, forward, index, walks, x, se, jobs);
 }
 
 /* Run ulam_dist_radius on k thread-ranks. */
@@ -184,6 +194,50 @@ static void test_dist_forward_identical(void **state)
     unlink(path);
 }
 
+/* Replication x partition: ranks in 2 or 3 sets, each a whole partition running its own batches,
+ * give the adjoint and forward answers of one partition bit for bit; with sets each rank holds
+ * more rows than without. */
+static void test_dist_sets(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 900;
+    double *x = malloc((size_t)n * sizeof *x), *ref = malloc((size_t)n * sizeof *ref);
+    double *y = malloc((size_t)n * sizeof *y), *se = malloc((size_t)n * sizeof *se), *yse = malloc((size_t)n * sizeof *yse);
+    make_system(path, n, 5, 15, x);
+    job jobs[MAXR];
+    run_ranks(1, path, 0, 450, 5000, NULL, NULL, jobs);
+    double est = jobs[0].res.estimate, sd = jobs[0].res.std_error;
+    run_ranks(1, path, 1, 0, 20000, ref, se, jobs);
+    const int ks[][2] = {{2, 2}, {4, 2}, {6, 3}, {6, 2}};
+    for (int c = 0; c < 4; c++) {
+        test_case(c);
+        int k = ks[c][0], sets = ks[c][1];
+        run_sets(k, sets, path, 0, 450, 5000, NULL, NULL, jobs);
+        for (int r = 0; r < k; r++) {
+            assert_int_equal(jobs[r].status, ULAM_OK);
+            assert_memory_equal(&jobs[r].res.estimate, &est, sizeof est);
+            assert_memory_equal(&jobs[r].res.std_error, &sd, sizeof sd);
+        }
+        memset(y, 0, (size_t)n * sizeof *y);
+        run_sets(k, sets, path, 1, 0, 20000, y, yse, jobs);
+        for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+        assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+        assert_memory_equal(yse, se, (size_t)n * sizeof *y);
+        int64_t rows = 0;
+        for (int r = 0; r < k / sets; r++) rows += jobs[r].last - jobs[r].first; /* set 0 holds every row once */
+        assert_int_equal(rows, n);
+    }
+    test_case_done();
+    run_sets(3, 2, path, 0, 450, 100, NULL, NULL, jobs); /* 2 sets do not divide 3 ranks */
+    for (int r = 0; r < 3; r++) assert_int_equal(jobs[r].status, ULAM_EINVAL);
+    free(x), free(ref), free(y), free(se), free(yse);
+    unlink(path);
+}
+
 /* A damaged block: refused (ULAM_ESYNTAX) by the rank whose rows hold it, at 1 and 3 ranks. */
 static void test_dist_damaged(void **state)
 {
@@ -282,6 +336,7 @@ int main(void)
         cmocka_unit_test(test_dist_forward_identical),
         cmocka_unit_test(test_dist_damaged),
         cmocka_unit_test(test_dist_radius),
+        cmocka_unit_test(test_dist_sets),
     };
     return test_run(tests);
 }

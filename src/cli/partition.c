@@ -15,7 +15,7 @@
 
 static const char *const help =
     "usage: ulam solve SYSTEM.ulam --partition (--index I | --mode forward [--out X.mtx])\n"
-    "                  [--walks N] [--seed S] [--max-steps N] [--batch N]\n"
+    "                  [--walks N] [--seed S] [--max-steps N] [--batch N] [--sets K]\n"
     "\n"
     "The prepared system's rows are split across the ranks of mpirun (balanced by entries; each rank\n"
     "reads only its rows' blocks of SYSTEM.ulam, prepared with --rhs, and --transpose for forward).\n"
@@ -27,6 +27,8 @@ static const char *const help =
     "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector\n"
     "  --walks N       histories (default 100000)       --seed S   the streams' key (default 1)\n"
     "  --max-steps N   cut a walk longer (default 1e6)  --batch N  walks a round starts (default 65536)\n"
+    "  --sets K        the ranks in K sets, each a whole partition running its own batches (more\n"
+    "                  memory a rank, no message between sets while walking; the same answer)\n"
     "docs/distributed.md says more.\n";
 
 /* The parsed command line. */
@@ -34,13 +36,14 @@ typedef struct {
     const char *path, *out;
     int64_t index; /* 1-based; 0 none */
     int forward;
+    int64_t sets;
     ulam_dist_opts o;
 } args;
 
 static const struct option longopts[] = {
     {"partition", no_argument, 0, 'P'}, {"index", required_argument, 0, 'i'}, {"mode", required_argument, 0, 'm'},
     {"out", required_argument, 0, 'o'}, {"walks", required_argument, 0, 'w'}, {"seed", required_argument, 0, 's'},
-    {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'},
+    {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'}, {"sets", required_argument, 0, 'S'},
     {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
 
 /* The defaults. */
@@ -68,6 +71,7 @@ static int option(void *p, int val, const char *name, const char *value)
     case 's': bad = cli_parse_int("solve", "--seed", value, 0, INT64_MAX, &v), a->o.seed = (uint64_t)v; return bad;
     case 'x': return cli_parse_int("solve", "--max-steps", value, 1, INT64_MAX, &a->o.max_steps);
     case 'b': return cli_parse_int("solve", "--batch", value, 1, (int64_t)1 << 30, &a->o.batch);
+    case 'S': return cli_parse_int("solve", "--sets", value, 1, 1 << 20, &a->sets);
     case 'h': fputs(help, stdout); return -1;
     default:
         return cli_usage_error("solve", "--%s is not an option of a --partition run (ulam solve --partition --help)",
@@ -156,8 +160,10 @@ static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_
     else printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
                 a->out ? a->out : "");
     if (cli_verbosity < 0) return;
-    printf("method          %s collision walks on %d rank%s, rows split by entries\n", a->forward ? "forward" : "adjoint",
+    printf("method          %s collision walks on %d rank%s, rows split by entries", a->forward ? "forward" : "adjoint",
            nranks, nranks == 1 ? "" : "s");
+    if (a->sets > 1) printf(" within each of %lld sets", (long long)a->sets);
+    printf("\n");
     if (rho < 1.0) printf("variance        finite (rho(M^) <= %.6g, certified)\n", rho);
     else if (a->forward) printf("variance        not certified finite (rho(M^) bound %.4g): no error bar can be trusted\n", rho);
     printf("walks           %lld (%lld steps; %lld cut at --max-steps)\n", (long long)r->walks, (long long)r->steps,
@@ -207,7 +213,8 @@ static int run(const args *a, const ulam_comm *c)
     }
     ulam_part_free(p);
     int rc = status ? (cli_report(a->path, &err), cli_exit_code(status)) : 0;
-    if (!rc && a->out) rc = write_x(c, a->out, x, last - first, n);
+    int in_set0 = c->sets <= 1 || c->rank < c->nranks / c->sets; /* set 0's ranks hold x */
+    if (!rc && a->out) rc = write_x(c, a->out, x, in_set0 ? last - first : 0, n);
     int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
     if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
     if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v, rho);
@@ -225,6 +232,7 @@ static int start_run(void *p, int argc, char **argv, int first)
 #ifdef ULAM_MPI
     cli_mpi_comm(&c);
 #endif
+    c.sets = (int)a->sets;
     return run(a, &c);
 }
 
