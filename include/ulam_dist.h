@@ -83,6 +83,12 @@ typedef struct ulam_dist_result {
 int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
                       ulam_dist_result *r, ulam_error *err);
 
+/* x_index[k] for each k < nq at once (the queries' walks share the rounds): res[k] as
+ * ulam_dist_adjoint gives for index[k] with seed o->seed + k, bit for bit (the counts of walks,
+ * steps and messages are the whole run's in each). */
+int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
+                           const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err);
+
 /* Every x_i of (I - M) x = b by forward collision walks on rows of M' (the part opened with
  * transpose): a source j ~ |b_j| / ||b||_1 with weight ||b||_1 sign(b_j), moves as above on M',
  * and each history's tallies at each state it visits.  x and se (this rank's rows [first, last),

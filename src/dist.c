@@ -62,15 +62,17 @@ static int push(vec *v, const void *x, size_t sz)
     return ULAM_OK;
 }
 
-/* Move x one step from its row (owned here): 0 when the walk ends, 1 with x at its new row.  It
+/* Move x one step from its row (owned here): 0 when the walk ends, 1 with x at its new row (walk
+ * id k o->walks + w is walk w of query k, its numbers keyed by seed + k).  It
  * leaves with probability min(1, S) (S the row's sum of |entries|) to entry q with probability
  * |val_q| / S, the weight times sign(val_q) S / min(1, S). */
-static int move(const ulam_part *p, uint64_t seed, particle *x)
+static int move(const ulam_part *p, const ulam_dist_opts *o, particle *x)
 {
     int64_t i = x->s - p->first, t = x->t + 1;
+    uint64_t seed = o->seed + (uint64_t)(x->w / o->walks), w = (uint64_t)(x->w % o->walks); /* query k: seed + k */
     double S = p->rowsum[i], c = S < 1.0 ? S : 1.0;
-    if (S == 0.0 || ulam_rng_counter(seed, (uint64_t)x->w, (uint64_t)t, 0) >= c) return 0;
-    double u = ulam_rng_counter(seed, (uint64_t)x->w, (uint64_t)t, 1) * S, acc = 0.0;
+    if (S == 0.0 || ulam_rng_counter(seed, w, (uint64_t)t, 0) >= c) return 0;
+    double u = ulam_rng_counter(seed, w, (uint64_t)t, 1) * S, acc = 0.0;
     int64_t q = p->rowptr[i], e = p->rowptr[i + 1] - 1;
     for (; q < e; q++) {
         acc += fabs(p->val[q]);
@@ -93,7 +95,7 @@ static int advance(run *R, particle x, int forward)
         } else {
             x.score += x.wt * p->b[x.s - p->first];
         }
-        if (!move(p, R->o.seed, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
+        if (!move(p, &R->o, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
         R->steps++;
         int own = p->nranks > 1 ? ulam__part_owner(p, x.s) : 0;
         if (own != p->rank) { /* to the rank of this set that owns the row */
@@ -201,9 +203,9 @@ static int counts(run *R, ulam_dist_result *res, ulam_error *err)
     return ULAM_OK;
 }
 
-/* Rank 0's histories of one batch, sorted by walk id, into the running moments m (n, mean, M2)
- * and the cut count; the other ranks send theirs to rank 0. */
-static int gather_ends(run *R, double *m, ulam_error *err)
+/* Rank 0's histories of one batch, sorted by walk id, into the running moments m[3 k ..] (n,
+ * mean, M2) of their query k; the other ranks send theirs to rank 0. */
+static int gather_ends(run *R, double *mm, ulam_error *err)
 {
     if (R->c->nranks > 1) {
         vec *box = calloc((size_t)R->c->nranks, sizeof *box);
@@ -218,7 +220,7 @@ static int gather_ends(run *R, double *m, ulam_error *err)
     ended *e = R->ends.a;
     if (R->ends.len) qsort(e, (size_t)R->ends.len, sizeof *e, by_walk);
     for (int64_t q = 0; q < R->ends.len; q++) { /* Welford's update, in walk-id order */
-        double d = e[q].score - m[1];
+        double *m = mm + 3 * (e[q].w / R->o.walks), d = e[q].score - m[1];
         m[0] += 1.0, m[1] += d / m[0], m[2] += d * (e[q].score - m[1]);
     }
     R->ends.len = 0;
@@ -250,40 +252,57 @@ static int64_t my_batch(const run *R, int64_t a)
     return a >= R->o.walks ? 0 : R->o.walks - a < R->o.batch ? R->o.walks - a : R->o.batch;
 }
 
-/* x_index by adjoint walks on the partitioned rows. */
-int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
-                      ulam_dist_result *res, ulam_error *err)
+/* x_index[k] for k < nq by adjoint walks on the partitioned rows. */
+int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
+                           const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err)
 {
     ulam__clear(err);
-    if (!p || !comm || !res) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm and a result");
-    *res = (ulam_dist_result){0};
-    if (index < 0 || index >= p->n)
-        return ulam__fail(err, ULAM_EINVAL, 0, index, "an index in 1 .. %lld", (long long)p->n);
+    if (!p || !comm || !res || !index || nq < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "parts, indices and results");
+    for (int64_t k = 0; k < nq; k++) {
+        res[k] = (ulam_dist_result){0};
+        if (index[k] < 0 || index[k] >= p->n)
+            return ulam__fail(err, ULAM_EINVAL, 0, index[k], "an index in 1 .. %lld", (long long)p->n);
+    }
     run R;
     int status = start(&R, p, comm, o, err);
-    int mine = ulam__part_owner(p, index) == p->rank;
-    double m[3] = {0, 0, 0}; /* n, mean, M2 (rank 0) */
-    for (int64_t w0 = 0; !status && w0 < R.o.walks; w0 += R.o.batch * p->sets) { /* a batch a set */
-        int64_t a = w0 + p->set * R.o.batch, B = my_batch(&R, a);
-        for (int64_t w = a; mine && !status && w < a + B; w++) {
-            particle x = {w, 0, index, 1.0, 0.0};
-            status = push(&R.here, &x, sizeof x) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for walks") : ULAM_OK;
+    if (!status && R.o.walks > INT64_MAX / nq) status = ulam__fail(err, ULAM_EINVAL, 0, -1, "walks times queries below 2^63");
+    int64_t total = status ? 0 : R.o.walks * nq;
+    double *m = calloc((size_t)nq * 4, sizeof *m); /* n, mean, M2 of each query (rank 0); then stderr */
+    if (!status && !m) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
+    for (int64_t g0 = 0; !status && g0 < total; g0 += R.o.batch * p->sets) { /* a batch a set */
+        int64_t a = g0 + p->set * R.o.batch, B = a >= total ? 0 : total - a < R.o.batch ? total - a : R.o.batch;
+        for (int64_t g = a; !status && g < a + B; g++) {
+            int64_t i = index[g / R.o.walks];
+            particle x = {g, 0, i, 1.0, 0.0};
+            if (ulam__part_owner(p, i) == p->rank && push(&R.here, &x, sizeof x))
+                status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for walks");
         }
         if (!status) status = rounds(&R, 0, err);
         if (!status) status = gather_ends(&R, m, err);
     }
-    double v[4] = {m[1], m[0] > 1 ? sqrt(m[2] / (m[0] - 1.0) / m[0]) : NAN, (double)R.cut, m[0]};
-    if (!status && R.c->nranks > 1) {
-        int64_t cut = R.cut;
-        status = R.c->sum(R.c->ctx, &cut, 1) ? ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks that succeeds") : 0;
-        v[2] = (double)cut;
+    int64_t cut = R.cut;
+    if (!status && R.c->nranks > 1 && R.c->sum(R.c->ctx, &cut, 1))
+        status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks that succeeds");
+    for (int64_t k = 0; !status && R.c->rank == 0 && k < nq; k++) { /* estimate, stderr; n checked below */
+        double *q = m + 3 * k;
+        m[3 * nq + k] = q[0] > 1 ? sqrt(q[2] / (q[0] - 1.0) / q[0]) : NAN;
+        if (q[0] != (double)R.o.walks) status = ulam__fail(err, ULAM_EIO, 0, -1, "every history back at rank 0");
     }
-    if (!status) status = broadcast(&R, v, 4, err);
-    if (!status) status = counts(&R, res, err);
-    if (!status && v[3] != (double)R.o.walks) status = ulam__fail(err, ULAM_EIO, 0, -1, "every history back at rank 0");
-    if (!status) res->estimate = v[0], res->std_error = v[1], res->cut = (int64_t)v[2];
+    if (!status) status = broadcast(&R, m, (int)(nq * 4), err);
+    ulam_dist_result c = {0};
+    if (!status) status = counts(&R, &c, err);
+    for (int64_t k = 0; !status && k < nq; k++)
+        res[k] = c, res[k].estimate = m[3 * k + 1], res[k].std_error = m[3 * nq + k], res[k].cut = cut;
+    free(m);
     finish(&R);
     return status;
+}
+
+/* x_index by adjoint walks on the partitioned rows. */
+int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
+                      ulam_dist_result *res, ulam_error *err)
+{
+    return ulam_dist_adjoint_many(p, comm, &index, 1, o, res, err);
 }
 
 /* The blocks' sums of |b| (blocks of 2^shift rows, the same whatever the split) in every rank's

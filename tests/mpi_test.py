@@ -103,6 +103,11 @@ def check_partition(ulam, mpirun, d):
     assert files[0] == files[1] == files[2] == files[3], "forward --out files differ across rank counts or sets"
     est, se = float(lines[0].split()[1]), float(lines[0].split()[3])
     assert abs(est - exact[1233]) < 4 * se, (lines[0], exact[1233])
+    qf = f"{d}/pq.txt"  # many queries at once: each line the lone run's with seed + k - 1, at 1 and 3 ranks
+    open(qf, "w").write("1234\n# a comment\n7\n1234\n")
+    qs = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--queries", qf, "--walks",
+               "40000", "--seed", "3", "-q"]) for k in (1, 3)]
+    assert qs[0] == qs[1] and qs[0].splitlines()[0].split("  line")[0] == lines[0], (qs, lines[0])
     p = subprocess.run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "5"],
                        capture_output=True, text=True, env=dict(ENV, ULAM_TEST_PARTITION_DIE="1"), timeout=120)
     assert p.returncode != 0 and not p.stdout, (p.returncode, p.stdout)

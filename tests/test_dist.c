@@ -17,6 +17,10 @@ typedef struct {
     int64_t index, walks;
     int radius; /* run ulam_dist_radius instead of walks, into rho */
     int sets;   /* ranks in sets (0: one) */
+    const int64_t *many; /* nq > 0: ulam_dist_adjoint_many over many[0 .. nq) into manyres */
+    int64_t nq;
+    ulam_dist_result manyres[4];
+    uint64_t seed;
     double rho;
     int status;
     ulam_dist_result res;
@@ -42,8 +46,9 @@ static void *rank_main(void *arg)
     }
     j->n = ulam_part_rows(p, &j->first, &j->last, NULL);
     ulam_dist_opts o = ulam_dist_defaults();
-    o.walks = j->walks, o.batch = 997, o.seed = 7;
-    if (j->radius) j->status = ulam_dist_radius(p, &c, 300, &j->rho, &err);
+    o.walks = j->walks, o.batch = 997, o.seed = 7 + j->seed;
+    if (j->nq) j->status = ulam_dist_adjoint_many(p, &c, j->many, j->nq, &o, j->manyres, &err);
+    else if (j->radius) j->status = ulam_dist_radius(p, &c, 300, &j->rho, &err);
     else if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
     else j->status = ulam_dist_adjoint(p, &c, j->index, &o, &j->res, &err);
     ulam_part_free(p);
@@ -238,6 +243,49 @@ static void test_dist_sets(void **state)
     unlink(path);
 }
 
+/* Many queries at once (ulam_dist_adjoint_many): query k's answer is a lone run's with seed + k,
+ * bit for bit, at 1 and 3 ranks. */
+static void test_dist_many(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 700;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 5, 16, x);
+    const int64_t idx[4] = {3, 350, 699, 350};
+    for (int k = 1; k <= 3; k += 2) {
+        hub h;
+        hub_init(&h, k);
+        pthread_t t[MAXR];
+        job jobs[MAXR];
+        for (int r = 0; r < k; r++) {
+            jobs[r] = (job){.port = {&h, r}, .path = path, .walks = 3000, .many = idx, .nq = 4};
+            pthread_create(&t[r], NULL, rank_main, &jobs[r]);
+        }
+        for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
+        pthread_barrier_destroy(&h.bar);
+        for (int q = 0; q < 4; q++) {
+            job lone[MAXR];
+            hub h1;
+            hub_init(&h1, 1);
+            lone[0] = (job){.port = {&h1, 0}, .path = path, .walks = 3000, .index = idx[q], .seed = (uint64_t)q};
+            rank_main(&lone[0]);
+            pthread_barrier_destroy(&h1.bar);
+            for (int r = 0; r < k; r++) {
+                assert_int_equal(jobs[r].status, ULAM_OK);
+                assert_memory_equal(&jobs[r].manyres[q].estimate, &lone[0].res.estimate, sizeof(double));
+                assert_memory_equal(&jobs[r].manyres[q].std_error, &lone[0].res.std_error, sizeof(double));
+            }
+        }
+        assert_true(jobs[0].manyres[1].estimate != jobs[0].manyres[3].estimate); /* same index, other seed */
+    }
+    free(x);
+    unlink(path);
+}
+
 /* A damaged block: refused (ULAM_ESYNTAX) by the rank whose rows hold it, at 1 and 3 ranks. */
 static void test_dist_damaged(void **state)
 {
@@ -337,6 +385,7 @@ int main(void)
         cmocka_unit_test(test_dist_damaged),
         cmocka_unit_test(test_dist_radius),
         cmocka_unit_test(test_dist_sets),
+        cmocka_unit_test(test_dist_many),
     };
     return test_run(tests);
 }

@@ -278,6 +278,18 @@ extern const cli_solve_row cli_solve_partition_row;
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
                        const char *direct_method, double load_seconds);
 
+/* One line of a query file: source (0-based; -1: b), index (0-based), target (0: the command
+ * line's), line. */
+typedef struct cli_query {
+    int64_t source, index;
+    double target;
+    long line;
+} cli_query;
+
+/* Read every query of path ("-": stdin) into *out (*nq of them, malloc'd); 0 or an exit code
+ * (reported with the file and line). */
+int cli_read_queries(const char *path, cli_query **out, int64_t *nq);
+
 /* ulam solve --queries FILE (src/cli/queries.c): s (not loaded) and o from the command line
  * (adjoint), json, walks_given (--walks or --time given); 0 or an exit code. */
 int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int json, int walks_given);

@@ -14,7 +14,7 @@
 #include "ulam_dist.h"
 
 static const char *const help =
-    "usage: ulam solve SYSTEM.ulam --partition (--index I | --mode forward [--out X.mtx])\n"
+    "usage: ulam solve SYSTEM.ulam --partition (--index I | --queries FILE | --mode forward [--out X.mtx])\n"
     "                  [--walks N] [--seed S] [--max-steps N] [--batch N] [--sets K]\n"
     "\n"
     "The prepared system's rows are split across the ranks of mpirun (balanced by entries; each rank\n"
@@ -24,6 +24,8 @@ static const char *const help =
     "analog kernel (p_ij = |M_ij| / row sum, leaving with min(1, row sum)); the interval is the\n"
     "CLT's (1.96 standard errors): no certified range of a score is computed on a partition.\n"
     "  --index I       x_I by adjoint walks from I (1-based)\n"
+    "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, query k\n"
+    "                  with seed S + k - 1: a line answers what --index I --seed S+k-1 answers\n"
     "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector\n"
     "  --walks N       histories (default 100000)       --seed S   the streams' key (default 1)\n"
     "  --max-steps N   cut a walk longer (default 1e6)  --batch N  walks a round starts (default 65536)\n"
@@ -33,7 +35,7 @@ static const char *const help =
 
 /* The parsed command line. */
 typedef struct {
-    const char *path, *out;
+    const char *path, *out, *queries;
     int64_t index; /* 1-based; 0 none */
     int forward;
     int64_t sets;
@@ -43,7 +45,7 @@ typedef struct {
 static const struct option longopts[] = {
     {"partition", no_argument, 0, 'P'}, {"index", required_argument, 0, 'i'}, {"mode", required_argument, 0, 'm'},
     {"out", required_argument, 0, 'o'}, {"walks", required_argument, 0, 'w'}, {"seed", required_argument, 0, 's'},
-    {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'}, {"sets", required_argument, 0, 'S'},
+    {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'}, {"sets", required_argument, 0, 'S'}, {"queries", required_argument, 0, 'Q'},
     {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
 
 /* The defaults. */
@@ -71,6 +73,7 @@ static int option(void *p, int val, const char *name, const char *value)
     case 's': bad = cli_parse_int("solve", "--seed", value, 0, INT64_MAX, &v), a->o.seed = (uint64_t)v; return bad;
     case 'x': return cli_parse_int("solve", "--max-steps", value, 1, INT64_MAX, &a->o.max_steps);
     case 'b': return cli_parse_int("solve", "--batch", value, 1, (int64_t)1 << 30, &a->o.batch);
+    case 'Q': a->queries = value; return 0;
     case 'S': return cli_parse_int("solve", "--sets", value, 1, 1 << 20, &a->sets);
     case 'h': fputs(help, stdout); return -1;
     default:
@@ -84,8 +87,8 @@ static int check(args *a, int argc, char **argv, int first)
 {
     if (first != argc - 1) return cli_usage_error("solve", "one prepared system file with --partition");
     a->path = argv[first];
-    if (!a->forward && !a->index) return cli_usage_error("solve", "--index I or --mode forward with --partition");
-    if (a->forward && a->index) return cli_usage_error("solve", "--index or --mode forward with --partition, not both");
+    if (!!a->forward + !!a->index + !!a->queries != 1)
+        return cli_usage_error("solve", "one of --index I, --queries FILE and --mode forward with --partition");
     if (a->out && !a->forward) return cli_usage_error("solve", "--out with --partition writes forward mode's x");
     return 0;
 }
@@ -146,18 +149,56 @@ static int per_rank(const ulam_comm *c, int64_t rows, int64_t *v)
     return c->nranks > 1 && c->sum(c->ctx, v, 2 * c->nranks);
 }
 
+/* Read the query file at path: 'I' lines only (no point source, no target: walks are fixed on a
+ * partition), indices below n; 0 or an exit code (reported). */
+static int load_queries(const char *path, int64_t n, cli_query **q, int64_t *nq)
+{
+    int rc = cli_read_queries(path, q, nq);
+    for (int64_t k = 0; !rc && k < *nq; k++) {
+        const cli_query *x = &(*q)[k];
+        const char *why = x->source >= 0 ? "an 'I' line (a point source 'S I' is not run on a partition)"
+                          : x->target > 0 ? "an 'I' line without a target (a partition runs a fixed --walks)"
+                          : x->index >= n ? "an index within the system" : NULL;
+        if (why) {
+            fprintf(stderr, "ulam: %s:%ld: error: expected %s\n", path, x->line, why);
+            rc = EXIT_USAGE;
+        }
+    }
+    if (!rc && *nq == 0) {
+        fprintf(stderr, "ulam: %s: error: expected at least one query\n", path);
+        rc = EXIT_USAGE;
+    }
+    if (rc) free(*q), *q = NULL, *nq = 0;
+    return rc;
+}
+
+/* One query's answer line (rank 0): x[I] estimate +- stderr (95% CI, CLT) and its seed. */
+static void print_query(const cli_query *q, int64_t k, const ulam_dist_result *r, uint64_t seed, double rho)
+{
+    int64_t i = q->index + 1;
+    printf("x[%lld]%*s%.10g", (long long)i, cli_answer_pad(i, 16), "", r->estimate);
+    if (rho < 1.0)
+        printf(" +- %.3g (95%% CI %.10g .. %.10g, CLT)", r->std_error, r->estimate - 1.96 * r->std_error,
+               r->estimate + 1.96 * r->std_error);
+    else printf(" (no confidence interval: rho(M^) not certified below 1)");
+    printf("  line %ld, seed %llu\n", q->line, (unsigned long long)(seed + (uint64_t)k));
+}
+
 /* Print the run's summary (rank 0; v: per_rank's figures). */
 static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_t n, double seconds, const int64_t *v,
                     double rho)
 {
-    if (!a->forward && !(rho < 1.0))
+    if (a->queries) {
+        if (cli_verbosity >= 0) printf("queries         %s, each above (walks below: each query's)\n", a->queries);
+    }
+    else if (!a->forward && !(rho < 1.0))
         printf("x[%lld]%*s%.10g (no confidence interval: rho(M^) is not certified below 1, bound %.4g; the sample "
                "stderr %.3g means nothing)\n", (long long)a->index, cli_answer_pad(a->index, 16), "", r->estimate, rho,
                r->std_error);
     else if (!a->forward)
         printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g, CLT)\n", (long long)a->index, cli_answer_pad(a->index, 16),
                "", r->estimate, r->std_error, r->estimate - 1.96 * r->std_error, r->estimate + 1.96 * r->std_error);
-    else printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
+    else if (a->forward) printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
                 a->out ? a->out : "");
     if (cli_verbosity < 0) return;
     printf("method          %s collision walks on %d rank%s, rows split by entries", a->forward ? "forward" : "adjoint",
@@ -196,15 +237,30 @@ static int run(const args *a, const ulam_comm *c)
     const char *die = getenv("ULAM_TEST_PARTITION_DIE"); /* tests: this rank dies before its walks */
     if (die && atoi(die) == c->rank && c->nranks > 1) _exit(9);
     int64_t first, last, n = ulam_part_rows(p, &first, &last, NULL);
+    int rc0;
     if (a->index > n) {
         ulam_part_free(p);
         return cli_usage_error("solve", "--index in 1 .. %lld, got %lld", (long long)n, (long long)a->index);
+    }
+    cli_query *q = NULL;
+    int64_t nq = 0;
+    if (a->queries && (rc0 = load_queries(a->queries, n, &q, &nq))) {
+        ulam_part_free(p);
+        return rc0;
     }
     double rho = INFINITY; /* the variance guard: the interval is printed only when it is below 1 */
     status = ulam_dist_radius(p, c, 200, &rho, &err);
     ulam_dist_result r = {0};
     double *x = NULL;
+    ulam_dist_result *many = NULL;
     if (status) {
+    } else if (q) {
+        int64_t *idx = malloc((size_t)nq * sizeof *idx);
+        many = malloc((size_t)nq * sizeof *many);
+        for (int64_t k = 0; idx && many && k < nq; k++) idx[k] = q[k].index;
+        status = idx && many ? ulam_dist_adjoint_many(p, c, idx, nq, &a->o, many, &err) : ULAM_ENOMEM;
+        if (!status) r = many[0];
+        free(idx);
     } else if (a->forward) {
         x = malloc(((size_t)(last - first) + 1) * sizeof *x);
         status = x ? ulam_dist_forward(p, c, &a->o, x, NULL, &r, &err) : ULAM_ENOMEM;
@@ -217,8 +273,9 @@ static int run(const args *a, const ulam_comm *c)
     if (!rc && a->out) rc = write_x(c, a->out, x, in_set0 ? last - first : 0, n);
     int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
     if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
+    for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, &many[k], a->o.seed, rho);
     if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v, rho);
-    free(x), free(v);
+    free(x), free(v), free(q), free(many);
     return rc;
 }
 
