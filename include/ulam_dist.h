@@ -41,12 +41,15 @@ typedef struct ulam_comm {
 /* One rank's rows of a prepared system. */
 typedef struct ulam_part ulam_part;
 
-/* Open this rank's rows of the prepared system at path (split among the ranks of its set): rows
- * [first, last) of the 'rows' array
- * (M for adjoint walks, M' for forward walks: transpose nonzero, the file prepared with
- * --transpose) and b's entries there, every block read verified against its checksum.  The
- * split is the same on every rank (computed from the file alone).  Needs b in the file. */
-int ulam_part_open(const char *path, const ulam_comm *comm, int transpose, ulam_part **out, ulam_error *err);
+/* Which arrays a part holds: M's rows (adjoint walks), M''s (forward walks; the file prepared with
+ * --transpose), or both (single source and MCSA: products with M, walks on M'). */
+enum { ULAM_PART_M = 0, ULAM_PART_MT = 1, ULAM_PART_BOTH = 2 };
+
+/* Open this rank's rows of the prepared system at path (split among the ranks of its set, by the
+ * entries of M' for ULAM_PART_MT, else of M): rows [first, last) of the arrays `what` names and b's
+ * entries there, every block read verified against its checksum.  The split is the same on every
+ * rank (computed from the file alone).  Needs b in the file. */
+int ulam_part_open(const char *path, const ulam_comm *comm, int what, ulam_part **out, ulam_error *err);
 
 /* Free a part (NULL is fine); returns NULL. */
 ulam_part *ulam_part_free(ulam_part *p);
@@ -98,12 +101,17 @@ int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int6
 int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double *x, double *se,
                       ulam_dist_result *r, ulam_error *err);
 
+/* As ulam_dist_forward with the sources drawn from b (this rank's rows [first, last) of it) in
+ * place of the system's b: the walks of MCSA's correction and of single source's residual. */
+int ulam_dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
+                        double *se, ulam_dist_result *res, ulam_error *err);
+
 /* A certified upper bound *upper on rho(M^), M^_ij = M_ij^2 / p_ij of the walks above on the part's
- * rows (M^_ij = |M_ij| S_i / min(1, S_i)): below 1, the walks' scores have finite variance.  Power
+ * rows of M (forward 0: adjoint walks) or M' (forward 1) (M^_ij = |M_ij| S_i / min(1, S_i)): below 1, the walks' scores have finite variance.  Power
  * iteration on the rows each rank holds, the iterate shared through the exchange, each step's
  * Collatz-Wielandt bound max_i (M^ v)_i / v_i rounded up; it stops when that is below 1 or after
  * iters steps (the smallest bound seen).  The same bits on every rank and at any rank count. */
-int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int iters, double *upper, ulam_error *err);
+int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int forward, int iters, double *upper, ulam_error *err);
 
 #ifdef __cplusplus
 }

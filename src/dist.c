@@ -45,6 +45,7 @@ typedef struct {
     vec *out;           /* per destination rank: particles leaving */
     vec here;           /* particles to advance this round */
     vec ends, tallies;  /* finished adjoint histories; forward tallies of this batch */
+    const double *b;    /* forward: the sources' b at this rank's rows */
     int64_t steps, crossings, bytes, rounds, cut;
 } run;
 
@@ -66,20 +67,20 @@ static int push(vec *v, const void *x, size_t sz)
  * id k o->walks + w is walk w of query k, its numbers keyed by seed + k).  It
  * leaves with probability min(1, S) (S the row's sum of |entries|) to entry q with probability
  * |val_q| / S, the weight times sign(val_q) S / min(1, S). */
-static int move(const ulam_part *p, const ulam_dist_opts *o, particle *x)
+static int move(const ulam_part *p, const ulam__rows *A, const ulam_dist_opts *o, particle *x)
 {
     int64_t i = x->s - p->first, t = x->t + 1;
     uint64_t seed = o->seed + (uint64_t)(x->w / o->walks), w = (uint64_t)(x->w % o->walks); /* query k: seed + k */
-    double S = p->rowsum[i], c = S < 1.0 ? S : 1.0;
+    double S = A->rowsum[i], c = S < 1.0 ? S : 1.0;
     if (S == 0.0 || ulam_rng_counter(seed, w, (uint64_t)t, 0) >= c) return 0;
     double u = ulam_rng_counter(seed, w, (uint64_t)t, 1) * S, acc = 0.0;
-    int64_t q = p->rowptr[i], e = p->rowptr[i + 1] - 1;
+    int64_t q = A->rowptr[i], e = A->rowptr[i + 1] - 1;
     for (; q < e; q++) {
-        acc += fabs(p->val[q]);
+        acc += fabs(A->val[q]);
         if (u < acc) break;
     }
-    x->wt *= (p->val[q] < 0 ? -S : S) / c;
-    x->s = p->col[q], x->t = t;
+    x->wt *= (A->val[q] < 0 ? -S : S) / c;
+    x->s = A->col[q], x->t = t;
     return 1;
 }
 
@@ -95,7 +96,7 @@ static int advance(run *R, particle x, int forward)
         } else {
             x.score += x.wt * p->b[x.s - p->first];
         }
-        if (!move(p, &R->o, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
+        if (!move(p, forward ? &p->t : &p->m, &R->o, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
         R->steps++;
         int own = p->nranks > 1 ? ulam__part_owner(p, x.s) : 0;
         if (own != p->rank) { /* to the rank of this set that owns the row */
@@ -175,8 +176,10 @@ static int by_row_walk(const void *a, const void *b)
 }
 
 /* Set up R for a run on p. */
-static int start(run *R, const ulam_part *p, const ulam_comm *c, const ulam_dist_opts *o, ulam_error *err)
+static int start(run *R, const ulam_part *p, const ulam_comm *c, const ulam_dist_opts *o, int forward, ulam_error *err)
 {
+    if (!(forward ? p->t.rowptr : p->m.rowptr))
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding the rows of %s", forward ? "M' (forward walks)" : "M (adjoint walks)");
     *R = (run){.p = p, .c = c, .o = o ? *o : ulam_dist_defaults()};
     if (R->o.walks < 1 || R->o.max_steps < 1 || R->o.batch < 1)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "walks, max_steps and batch of at least 1");
@@ -264,7 +267,7 @@ int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int6
             return ulam__fail(err, ULAM_EINVAL, 0, index[k], "an index in 1 .. %lld", (long long)p->n);
     }
     run R;
-    int status = start(&R, p, comm, o, err);
+    int status = start(&R, p, comm, o, 0, err);
     if (!status && R.o.walks > INT64_MAX / nq) status = ulam__fail(err, ULAM_EINVAL, 0, -1, "walks times queries below 2^63");
     int64_t total = status ? 0 : R.o.walks * nq;
     double *m = calloc((size_t)nq * 4, sizeof *m); /* n, mean, M2 of each query (rank 0); then stderr */
@@ -320,7 +323,7 @@ static int block_prefix(run *R, double **P, int64_t *nb, ulam_error *err)
     for (int64_t k = p->first >> p->shift; p->set == 0 && (k << p->shift) < p->last; k++) { /* one set's */
         double s = 0.0;
         int64_t r1 = (k + 1) << p->shift < p->last ? (k + 1) << p->shift : p->last;
-        for (int64_t i = k << p->shift; i < r1; i++) s += fabs(p->b[i - p->first]);
+        for (int64_t i = k << p->shift; i < r1; i++) s += fabs(R->b[i - p->first]);
         memcpy(&bits[k], &s, 8);
     }
     if (R->c->nranks > 1 && R->c->sum(R->c->ctx, bits, (int)*nb)) { /* one owner a block: the sum is exact */
@@ -357,13 +360,13 @@ static int forward_starts(run *R, const double *P, int64_t nb, int64_t w0, int64
         int64_t r1 = (lo + 1) << p->shift < p->last ? (lo + 1) << p->shift : p->last, s = -1;
         double acc = P[lo];
         for (int64_t i = r0; i < r1; i++) {
-            double a = fabs(p->b[i - p->first]);
+            double a = fabs(R->b[i - p->first]);
             if (a == 0.0) continue;
             s = i, acc += a;
             if (u < acc) break;
         }
         if (s < 0) continue; /* no b in the block: P would not have chosen it */
-        particle x = {w, 0, s, p->b[s - p->first] < 0 ? -total : total, 0.0};
+        particle x = {w, 0, s, R->b[s - p->first] < 0 ? -total : total, 0.0};
         if (push(&R->here, &x, sizeof x)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for walks");
     }
     return ULAM_OK;
@@ -415,11 +418,21 @@ static int settle(run *R, double *sum, double *sumsq, ulam_error *err)
 int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double *x, double *se,
                       ulam_dist_result *res, ulam_error *err)
 {
+    return ulam_dist_forward_b(p, comm, o, p ? p->b : NULL, x, se, res, err);
+}
+
+/* As ulam_dist_forward with the sources' b given at this rank's rows. */
+int ulam_dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
+                        double *se, ulam_dist_result *res, ulam_error *err)
+{
     ulam__clear(err);
-    if (!p || !comm || !res) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm and a result");
+    if (!p || !comm || !res || !b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, b and a result");
     *res = (ulam_dist_result){0};
+    for (int64_t i = 0; i < p->last - p->first; i++)
+        if (!isfinite(b[i])) return ulam__fail(err, ULAM_EINVAL, 0, p->first + i, "a finite b");
     run R;
-    int status = start(&R, p, comm, o, err);
+    int status = start(&R, p, comm, o, 1, err);
+    R.b = b;
     int64_t rows = p->last - p->first, nb = 0;
     double *sum = calloc((size_t)rows + 1, sizeof *sum), *sumsq = calloc((size_t)rows + 1, sizeof *sumsq), *P = NULL;
     if (!status && (!sum || !sumsq)) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld sums", (long long)rows);

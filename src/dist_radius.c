@@ -52,13 +52,13 @@ static int largest(const ulam_comm *c, double *x)
 
 /* One step: y = M^ v on this rank's rows, the Collatz-Wielandt ratio's largest value (each row's
  * sum rounded up by its (length + 2) roundings) into *cw and y's largest into *top. */
-static void step(const ulam_part *p, const double *v, double *y, double *cw, double *top)
+static void step(const ulam_part *p, const ulam__rows *A, const double *v, double *y, double *cw, double *top)
 {
     *cw = 0.0, *top = 0.0;
     for (int64_t i = 0; i < p->last - p->first; i++) {
-        double S = p->rowsum[i], f = S > 1.0 ? S : 1.0, s = 0.0; /* S / min(1, S) */
-        int64_t len = p->rowptr[i + 1] - p->rowptr[i];
-        for (int64_t q = p->rowptr[i]; q < p->rowptr[i + 1]; q++) s += fabs(p->val[q]) * v[p->col[q]];
+        double S = A->rowsum[i], f = S > 1.0 ? S : 1.0, s = 0.0; /* S / min(1, S) */
+        int64_t len = A->rowptr[i + 1] - A->rowptr[i];
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += fabs(A->val[q]) * v[A->col[q]];
         s *= f * (1.0 + (double)(len + 3) * DBL_EPSILON);
         y[i] = s;
         double r = s / v[p->first + i];
@@ -68,10 +68,12 @@ static void step(const ulam_part *p, const double *v, double *y, double *cw, dou
 }
 
 /* A certified upper bound on rho(M^) of the partitioned walks. */
-int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int iters, double *upper, ulam_error *err)
+int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int forward, int iters, double *upper, ulam_error *err)
 {
     ulam__clear(err);
     if (!p || !comm || !upper || iters < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, a result, iters >= 1");
+    const ulam__rows *A = forward ? &p->t : &p->m;
+    if (!A->rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding the rows of %s", forward ? "M'" : "M");
     int64_t rows = p->last - p->first;
     double *v = malloc((size_t)p->n * sizeof *v), *y = malloc(((size_t)rows + 1) * sizeof *y);
     if (!v || !y) {
@@ -83,7 +85,7 @@ int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int iters, doubl
     int status = ULAM_OK;
     for (int k = 0; k < iters && !(best < 1.0); k++) {
         double cw, top;
-        step(p, v, y, &cw, &top);
+        step(p, A, v, y, &cw, &top);
         if (largest(comm, &cw) || largest(comm, &top)) {
             status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
             break;

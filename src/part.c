@@ -61,35 +61,35 @@ static int split_blocks(int fd, uint64_t at, int shift, int64_t n, int64_t nb, i
 /* Read and verify rows [p->first, p->last) of the array at offsets off[0..2] (rowptr, colidx, val),
  * their checksums from sums[k0 ..]. */
 static int read_rows(int fd, const ulam__layout *L, const uint64_t *off, const uint64_t *sums, int64_t k0, ulam_part *p,
-                     ulam_error *err)
+                     ulam__rows *A, ulam_error *err)
 {
     int64_t rows = p->last - p->first;
-    p->rowptr = ulam__malloc((size_t)rows + 1, sizeof *p->rowptr);
-    if (!p->rowptr) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld row pointers", (long long)rows + 1);
-    if (read_at(fd, p->rowptr, (size_t)(rows + 1) * 8, off[0] + (uint64_t)p->first * 8))
+    A->rowptr = ulam__malloc((size_t)rows + 1, sizeof *A->rowptr);
+    if (!A->rowptr) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld row pointers", (long long)rows + 1);
+    if (read_at(fd, A->rowptr, (size_t)(rows + 1) * 8, off[0] + (uint64_t)p->first * 8))
         return ulam__fail(err, ULAM_EIO, 0, p->first, "row pointers readable from the file");
-    int64_t a = p->rowptr[0], e = p->rowptr[rows];
+    int64_t a = A->rowptr[0], e = A->rowptr[rows];
     for (int64_t i = 0; i < rows; i++)
-        if (!(p->rowptr[i] >= 0 && p->rowptr[i] <= p->rowptr[i + 1] && p->rowptr[i + 1] <= L->nnz))
+        if (!(A->rowptr[i] >= 0 && A->rowptr[i] <= A->rowptr[i + 1] && A->rowptr[i + 1] <= L->nnz))
             return ulam__fail(err, ULAM_ESYNTAX, 0, p->first + i, "row pointers rising within the %lld entries",
                               (long long)L->nnz);
-    p->nnz = e - a;
-    p->col = ulam__malloc((size_t)p->nnz, sizeof *p->col);
-    p->val = ulam__malloc((size_t)p->nnz, sizeof *p->val);
-    if (!p->col || !p->val) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld entries", (long long)p->nnz);
-    if (read_at(fd, p->col, (size_t)p->nnz * 4, off[1] + (uint64_t)a * 4) ||
-        read_at(fd, p->val, (size_t)p->nnz * 8, off[2] + (uint64_t)a * 8))
+    A->nnz = e - a;
+    A->col = ulam__malloc((size_t)A->nnz, sizeof *A->col);
+    A->val = ulam__malloc((size_t)A->nnz, sizeof *A->val);
+    if (!A->col || !A->val) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld entries", (long long)A->nnz);
+    if (read_at(fd, A->col, (size_t)A->nnz * 4, off[1] + (uint64_t)a * 4) ||
+        read_at(fd, A->val, (size_t)A->nnz * 8, off[2] + (uint64_t)a * 8))
         return ulam__fail(err, ULAM_EIO, 0, p->first, "entries readable from the file");
     for (int64_t r0 = p->first; r0 < p->last; r0 += (int64_t)1 << L->shift) {
         int64_t r1 = r0 + ((int64_t)1 << L->shift) < p->last ? r0 + ((int64_t)1 << L->shift) : p->last;
-        const int64_t *rp = p->rowptr + (r0 - p->first);
-        if (!ulam__system_block_ok(rp, r1 - r0, p->col + (rp[0] - a), p->val + (rp[0] - a), L->ncols,
+        const int64_t *rp = A->rowptr + (r0 - p->first);
+        if (!ulam__system_block_ok(rp, r1 - r0, A->col + (rp[0] - a), A->val + (rp[0] - a), L->ncols,
                                    sums[k0 + (r0 >> L->shift)]))
             return ulam__fail(err, ULAM_ESYNTAX, 0, r0,
                               "a block matching its checksum with columns in range, rising, and finite nonzero "
                               "values (rows %lld .. %lld are damaged)", (long long)r0 + 1, (long long)r1);
     }
-    for (int64_t i = 0; i <= rows; i++) p->rowptr[i] -= a;
+    for (int64_t i = 0; i <= rows; i++) A->rowptr[i] -= a;
     return ULAM_OK;
 }
 
@@ -112,23 +112,23 @@ static int read_rhs(int fd, const ulam__layout *L, const uint64_t *sums, int64_t
     return ULAM_OK;
 }
 
-/* Each of this rank's rows' sum of |entries|. */
-static int row_sums(ulam_part *p, ulam_error *err)
+/* Each of this rank's rows' sum of |entries| in A. */
+static int row_sums(const ulam_part *p, ulam__rows *A, ulam_error *err)
 {
     int64_t rows = p->last - p->first;
-    p->rowsum = ulam__malloc((size_t)rows, sizeof *p->rowsum);
-    if (!p->rowsum) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld row sums", (long long)rows);
+    A->rowsum = ulam__malloc((size_t)rows, sizeof *A->rowsum);
+    if (!A->rowsum) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld row sums", (long long)rows);
     for (int64_t i = 0; i < rows; i++) {
         double s = 0.0;
-        for (int64_t q = p->rowptr[i]; q < p->rowptr[i + 1]; q++) s += fabs(p->val[q]);
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += fabs(A->val[q]);
         if (!isfinite(s)) return ulam__fail(err, ULAM_EOVERFLOW, 0, p->first + i, "a row whose |entries| sum to a finite number");
-        p->rowsum[i] = s;
+        A->rowsum[i] = s;
     }
     return ULAM_OK;
 }
 
 /* Read the header and checksum table of fd (a file of len bytes) into L and *sums (malloc'd). */
-static int read_layout(int fd, uint64_t len, int transpose, ulam__layout *L, uint64_t **sums, ulam_error *err)
+static int read_layout(int fd, uint64_t len, int what, ulam__layout *L, uint64_t **sums, ulam_error *err)
 {
     unsigned char h[HEADER_BYTES];
     if (len < HEADER_BYTES || read_at(fd, h, sizeof h, 0)) {
@@ -141,7 +141,7 @@ static int read_layout(int fd, uint64_t len, int transpose, ulam__layout *L, uin
     if (status) return status;
     if (!L->has_matrix || !L->has_rhs || L->n != L->ncols)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a prepared square system with its b (ulam prepare M.mtx --rhs b.mtx)");
-    if (transpose && !L->has_tr)
+    if (what != ULAM_PART_M && !L->has_tr)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "M' in the file for forward walks (ulam prepare --transpose)");
     int64_t nsums = L->nblocks[0] + L->nblocks[1] + L->nblocks[2];
     *sums = ulam__malloc((size_t)nsums, 8);
@@ -152,32 +152,34 @@ static int read_layout(int fd, uint64_t len, int transpose, ulam__layout *L, uin
 }
 
 /* Split and read this rank's rows of fd (see ulam_part_open). */
-static int open_part(int fd, uint64_t len, const ulam_comm *c, int transpose, ulam_part *p, ulam_error *err)
+static int open_part(int fd, uint64_t len, const ulam_comm *c, int what, ulam_part *p, ulam_error *err)
 {
     ulam__layout L;
     uint64_t *sums = NULL;
-    int status = read_layout(fd, len, transpose, &L, &sums, err);
-    int part = transpose ? 2 : 0;
-    const uint64_t off[3] = {L.off[transpose ? 4 : 0], L.off[transpose ? 5 : 1], L.off[transpose ? 6 : 2]};
+    int status = read_layout(fd, len, what, &L, &sums, err);
+    int part = what == ULAM_PART_MT ? 2 : 0; /* the array the split balances */
+    const uint64_t off[2][3] = {{L.off[0], L.off[1], L.off[2]}, {L.off[4], L.off[5], L.off[6]}};
     p->sets = c->sets > 1 ? c->sets : 1, p->nranks = c->nranks / p->sets;
     p->set = c->rank / p->nranks, p->rank = c->rank % p->nranks, p->n = L.n, p->shift = L.shift;
     p->split = ulam__malloc((size_t)p->nranks + 1, sizeof *p->split);
     if (!status && !p->split) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the split");
-    if (!status && split_blocks(fd, off[0], L.shift, L.n, L.nblocks[part], L.nnz, p->nranks, p->split))
+    if (!status && split_blocks(fd, off[part == 2][0], L.shift, L.n, L.nblocks[part], L.nnz, p->nranks, p->split))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "row pointers readable from the file");
     if (!status) {
         for (int r = 0; r <= p->nranks; r++) p->split[r] = p->split[r] << L.shift < L.n ? p->split[r] << L.shift : L.n;
         p->first = p->split[p->rank], p->last = p->split[p->rank + 1];
-        status = read_rows(fd, &L, off, sums, L.first[part], p, err);
+        if (what != ULAM_PART_MT) status = read_rows(fd, &L, off[0], sums, L.first[0], p, &p->m, err);
+        if (!status && what != ULAM_PART_M) status = read_rows(fd, &L, off[1], sums, L.first[2], p, &p->t, err);
     }
     if (!status) status = read_rhs(fd, &L, sums, L.first[1], p, err);
-    if (!status) status = row_sums(p, err);
+    if (!status && p->m.rowptr) status = row_sums(p, &p->m, err);
+    if (!status && p->t.rowptr) status = row_sums(p, &p->t, err);
     free(sums);
     return status;
 }
 
 /* Open this rank's rows of the prepared system at path. */
-int ulam_part_open(const char *path, const ulam_comm *comm, int transpose, ulam_part **out, ulam_error *err)
+int ulam_part_open(const char *path, const ulam_comm *comm, int what, ulam_part **out, ulam_error *err)
 {
     ulam__clear(err);
     if (!path || !comm || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path, a comm and a result");
@@ -185,6 +187,8 @@ int ulam_part_open(const char *path, const ulam_comm *comm, int transpose, ulam_
     if (comm->nranks < 1 || comm->rank < 0 || comm->rank >= comm->nranks ||
         (comm->nranks > 1 && (!comm->exchange || !comm->sum)))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "0 <= rank < nranks, and an exchange and a sum with more than one rank");
+    if (what < ULAM_PART_M || what > ULAM_PART_BOTH)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "ULAM_PART_M, ULAM_PART_MT or ULAM_PART_BOTH, got %d", what);
     if (comm->sets < 0 || (comm->sets > 1 && comm->nranks % comm->sets))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "sets dividing the %d ranks, got %d", comm->nranks, comm->sets);
     int fd = open(path, O_RDONLY | O_CLOEXEC);
@@ -194,7 +198,7 @@ int ulam_part_open(const char *path, const ulam_comm *comm, int transpose, ulam_
         return ulam__fail(err, ULAM_EIO, 0, -1, "a readable prepared system file");
     }
     ulam_part *p = calloc(1, sizeof *p);
-    int status = p ? open_part(fd, (uint64_t)st.st_size, comm, transpose, p, err)
+    int status = p ? open_part(fd, (uint64_t)st.st_size, comm, what, p, err)
                    : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a part");
     close(fd);
     if (status) {
@@ -209,7 +213,9 @@ int ulam_part_open(const char *path, const ulam_comm *comm, int transpose, ulam_
 ulam_part *ulam_part_free(ulam_part *p)
 {
     if (!p) return NULL;
-    free(p->rowptr), free(p->col), free(p->val), free(p->b), free(p->rowsum), free(p->split);
+    const ulam__rows *A[2] = {&p->m, &p->t};
+    for (int k = 0; k < 2; k++) free(A[k]->rowptr), free(A[k]->col), free(A[k]->val), free(A[k]->rowsum);
+    free(p->b), free(p->split);
     free(p);
     return NULL;
 }
@@ -220,7 +226,7 @@ int64_t ulam_part_rows(const ulam_part *p, int64_t *first, int64_t *last, int64_
     if (!p) return -1;
     if (first) *first = p->first;
     if (last) *last = p->last;
-    if (nnz) *nnz = p->nnz;
+    if (nnz) *nnz = p->m.rowptr ? p->m.nnz : p->t.nnz;
     return p->n;
 }
 

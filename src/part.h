@@ -5,13 +5,21 @@
 #include "internal.h"
 #include "ulam_dist.h"
 
-/* This rank's rows [first, last) of M (or M'), 0-based row pointers into col and val, b and the
- * rows' sums of |entries| at those rows, and the split every rank shares. */
-struct ulam_part {
-    int64_t n, first, last, nnz;
+/* Rows [first, last) of one array (M or M'): 0-based row pointers into col and val, each row's
+ * sum of |entries|; rowptr NULL when the part does not hold that array. */
+typedef struct {
+    int64_t nnz;
     int64_t *rowptr;
     int32_t *col;
-    double *val, *b, *rowsum;
+    double *val, *rowsum;
+} ulam__rows;
+
+/* This rank's rows [first, last) of M and/or M', b at those rows, and the split every rank
+ * shares. */
+struct ulam_part {
+    int64_t n, first, last;
+    ulam__rows m, t;
+    double *b;
     int64_t *split; /* nranks + 1 row boundaries: position r of a set owns rows [split[r], split[r + 1]) */
     int nranks, rank, shift; /* ranks in this rank's set and its position there */
     int set, sets;           /* this rank's set (world rank set * nranks + rank) of sets */

@@ -36,7 +36,7 @@ static void *rank_main(void *arg)
     c.sets = j->sets;
     ulam_part *p = NULL;
     ulam_error err;
-    j->status = ulam_part_open(j->path, &c, j->forward, &p, &err);
+    j->status = ulam_part_open(j->path, &c, j->forward ? ULAM_PART_MT : ULAM_PART_M, &p, &err);
     int failed = j->status != ULAM_OK;
     int64_t any = failed;
     hub_sum(&j->port, &any, 1); /* every rank learns whether one failed, as a CLI would */
@@ -48,7 +48,7 @@ static void *rank_main(void *arg)
     ulam_dist_opts o = ulam_dist_defaults();
     o.walks = j->walks, o.batch = 997, o.seed = 7 + j->seed;
     if (j->nq) j->status = ulam_dist_adjoint_many(p, &c, j->many, j->nq, &o, j->manyres, &err);
-    else if (j->radius) j->status = ulam_dist_radius(p, &c, 300, &j->rho, &err);
+    else if (j->radius) j->status = ulam_dist_radius(p, &c, 0, 300, &j->rho, &err);
     else if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
     else j->status = ulam_dist_adjoint(p, &c, j->index, &o, &j->res, &err);
     ulam_part_free(p);

@@ -226,7 +226,7 @@ static int run(const args *a, const ulam_comm *c)
 {
     ulam_part *p = NULL;
     ulam_error err;
-    int status = ulam_part_open(a->path, c, a->forward, &p, &err);
+    int status = ulam_part_open(a->path, c, a->forward ? ULAM_PART_MT : ULAM_PART_M, &p, &err);
     int64_t bad = status != ULAM_OK; /* every rank ends together when one cannot read its rows */
     if (c->nranks > 1 && c->sum(c->ctx, &bad, 1)) bad = 1;
     if (bad) {
@@ -249,7 +249,7 @@ static int run(const args *a, const ulam_comm *c)
         return rc0;
     }
     double rho = INFINITY; /* the variance guard: the interval is printed only when it is below 1 */
-    status = ulam_dist_radius(p, c, 200, &rho, &err);
+    status = ulam_dist_radius(p, c, a->forward, 200, &rho, &err);
     ulam_dist_result r = {0};
     double *x = NULL;
     ulam_dist_result *many = NULL;

@@ -32,7 +32,7 @@ static void *rank_main(void *arg)
     ulam_comm c = hub_comm(&j->port);
     ulam_part *p = NULL;
     double t0 = ulam_now();
-    j->status = ulam_part_open(j->path, &c, 1, &p, NULL);
+    j->status = ulam_part_open(j->path, &c, ULAM_PART_MT, &p, NULL);
     if (j->status) return NULL; /* (a failure on one rank would stall the others: the bench's files are sound) */
     int64_t first, last;
     ulam_part_rows(p, &first, &last, NULL);
