@@ -106,6 +106,34 @@ int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist
 int ulam_dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
                         double *se, ulam_dist_result *res, ulam_error *err);
 
+/* What MCSA on a partition did. */
+typedef struct ulam_dist_mcsa_info {
+    int iterations;                  /* Richardson step + Monte Carlo correction, each */
+    double residual;                 /* max |b - (I - M) x| / max |b| at the end */
+    int64_t walks, steps, crossings; /* of every correction */
+} ulam_dist_mcsa_info;
+
+/* x of (I - M) x = b by MCSA (Evans, Slattery, Wilson): x <- x + r (r = b - (I - M) x, a product
+ * with M over the ranks' rows), then x <- x + d, d forward walks (o->walks of them, seed o->seed +
+ * iteration) from the new residual; until max |r| <= tol max |b| or max_iter iterations.  x: this
+ * rank's rows.  Needs ULAM_PART_BOTH and one set.  The same bits at any rank count. */
+int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
+                   double *x, ulam_dist_mcsa_info *info, ulam_error *err);
+
+/* What single source on a partition did. */
+typedef struct ulam_dist_source_info {
+    int rounds;                      /* products of the push */
+    double residual;                 /* max |r| left to the walks */
+    int64_t walks, steps, crossings; /* of the walks from r */
+} ulam_dist_source_info;
+
+/* x = (I - M)^-1 e_source: a push x = sum_{k<K} M^k e_s (products with M over the ranks' rows)
+ * until max |M^K e_s| <= tol or K = max_rounds, then forward walks (o) from r = M^K e_s add
+ * (I - M)^-1 r with its standard errors se (NaN where no walk tallied; 0 everywhere when r = 0).
+ * x, se: this rank's rows.  Needs ULAM_PART_BOTH and one set.  The same bits at any rank count. */
+int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
+                     int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_error *err);
+
 /* A certified upper bound *upper on rho(M^), M^_ij = M_ij^2 / p_ij of the walks above on the part's
  * rows of M (forward 0: adjoint walks) or M' (forward 1) (M^_ij = |M_ij| S_i / min(1, S_i)): below 1, the walks' scores have finite variance.  Power
  * iteration on the rows each rank holds, the iterate shared through the exchange, each step's

@@ -7,49 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Every rank's slice of a vector (rows [split[r], split[r + 1])) into all[0 .. n) on every rank of
- * its set. */
-static int share(const ulam_part *p, const ulam_comm *c, const double *mine, double *all)
-{
-    int64_t rows = p->last - p->first;
-    if (c->nranks == 1) {
-        memcpy(all, mine, (size_t)rows * sizeof *all);
-        return 0;
-    }
-    size_t *counts = malloc((size_t)c->nranks * 2 * sizeof *counts);
-    if (!counts) return 1;
-    int set0 = p->set * p->nranks; /* to the ranks of this set only */
-    for (int r = 0; r < c->nranks; r++) counts[r] = r >= set0 && r < set0 + p->nranks ? (size_t)rows * sizeof *mine : 0;
-    char *send = malloc((size_t)p->nranks * (size_t)(rows ? rows : 1) * sizeof *mine);
-    void *got = NULL;
-    int bad = !send;
-    for (int r = 0; !bad && r < p->nranks; r++) memcpy(send + (size_t)r * (size_t)rows * sizeof *mine, mine, (size_t)rows * sizeof *mine);
-    if (!bad) bad = c->exchange(c->ctx, send, counts, &got, counts + c->nranks);
-    size_t total = 0;
-    for (int r = 0; !bad && r < c->nranks; r++) total += counts[c->nranks + r];
-    if (!bad && total == (size_t)p->n * sizeof *all) memcpy(all, got, total); /* rank order is row order */
-    else bad = 1;
-    free(counts), free(send), free(got);
-    return bad;
-}
-
-/* The largest of every rank's nonnegative x (as bits, which order as the values do). */
-static int largest(const ulam_comm *c, double *x)
-{
-    if (c->nranks == 1) return 0;
-    int64_t *v = calloc((size_t)c->nranks, sizeof *v);
-    if (!v) return 1;
-    memcpy(&v[c->rank], x, 8);
-    int bad = c->sum(c->ctx, v, c->nranks);
-    for (int r = 0; !bad && r < c->nranks; r++) {
-        double y;
-        memcpy(&y, &v[r], 8);
-        if (y > *x) *x = y;
-    }
-    free(v);
-    return bad;
-}
-
 /* One step: y = M^ v on this rank's rows, the Collatz-Wielandt ratio's largest value (each row's
  * sum rounded up by its (length + 2) roundings) into *cw and y's largest into *top. */
 static void step(const ulam_part *p, const ulam__rows *A, const double *v, double *y, double *cw, double *top)
@@ -86,14 +43,14 @@ int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int forward, int
     for (int k = 0; k < iters && !(best < 1.0); k++) {
         double cw, top;
         step(p, A, v, y, &cw, &top);
-        if (largest(comm, &cw) || largest(comm, &top)) {
+        if (ulam__dist_largest(comm, &cw) || ulam__dist_largest(comm, &top)) {
             status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
             break;
         }
         if (cw < best) best = cw;
         if (!(top > 0.0) || !isfinite(top)) break; /* M^ v = 0: nilpotent on v, or overflow */
         for (int64_t i = 0; i < rows; i++) y[i] = y[i] / top + 1e-6; /* kept positive: any positive v gives a valid bound */
-        if (share(p, comm, y, v)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+        if (ulam__dist_gather(p, comm, y, v)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
         if (status) break;
     }
     free(v), free(y);

@@ -28,4 +28,11 @@ struct ulam_part {
 /* The position in a set owning row s. */
 int ulam__part_owner(const ulam_part *p, int64_t s);
 
+/* Every rank's slice of a vector (its rows) into all[0 .. n) on every rank of its set
+ * (src/part.c); nonzero on a failed exchange. */
+int ulam__dist_gather(const ulam_part *p, const ulam_comm *c, const double *mine, double *all);
+
+/* The largest of every rank's nonnegative *x, into *x on every rank; nonzero on a failed sum. */
+int ulam__dist_largest(const ulam_comm *c, double *x);
+
 #endif

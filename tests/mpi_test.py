@@ -103,6 +103,18 @@ def check_partition(ulam, mpirun, d):
     assert files[0] == files[1] == files[2] == files[3], "forward --out files differ across rank counts or sets"
     est, se = float(lines[0].split()[1]), float(lines[0].split()[3])
     assert abs(est - exact[1233]) < 4 * se, (lines[0], exact[1233])
+    outer = []  # MCSA (x file) and single source (top-10 table) at 1 and 3 ranks: byte for byte
+    for k in (1, 3):
+        x = f"{d}/pm{k}.mtx"
+        run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--method", "mcsa", "--walks",
+             "20000", "--out", x, "-q"])
+        top = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--source", "77",
+                   "--top", "10", "--walks", "20000", "-q"])
+        outer.append((open(x).read(), top))
+    assert outer[0] == outer[1], "MCSA or single source differ across rank counts"
+    xm = [float(v) for v in outer[0][0].split("\n")[3:] if v.strip()]
+    assert max(abs(a - b) for a, b in zip(xm, exact)) < 1e-6 * max(abs(b) for b in exact), "MCSA's x is off"
+    assert len(outer[0][1].splitlines()) == 10 and outer[0][1].startswith("x[77]"), outer[0][1]
     qf = f"{d}/pq.txt"  # many queries at once: each line the lone run's with seed + k - 1, at 1 and 3 ranks
     open(qf, "w").write("1234\n# a comment\n7\n1234\n")
     qs = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--queries", qf, "--walks",

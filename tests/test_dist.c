@@ -21,6 +21,9 @@ typedef struct {
     int64_t nq;
     ulam_dist_result manyres[4];
     uint64_t seed;
+    int outer; /* 1: MCSA into x; 2: single source from index into x and se */
+    ulam_dist_mcsa_info mi;
+    ulam_dist_source_info si;
     double rho;
     int status;
     ulam_dist_result res;
@@ -36,7 +39,7 @@ static void *rank_main(void *arg)
     c.sets = j->sets;
     ulam_part *p = NULL;
     ulam_error err;
-    j->status = ulam_part_open(j->path, &c, j->forward ? ULAM_PART_MT : ULAM_PART_M, &p, &err);
+    j->status = ulam_part_open(j->path, &c, j->outer ? ULAM_PART_BOTH : j->forward ? ULAM_PART_MT : ULAM_PART_M, &p, &err);
     int failed = j->status != ULAM_OK;
     int64_t any = failed;
     hub_sum(&j->port, &any, 1); /* every rank learns whether one failed, as a CLI would */
@@ -47,7 +50,10 @@ static void *rank_main(void *arg)
     j->n = ulam_part_rows(p, &j->first, &j->last, NULL);
     ulam_dist_opts o = ulam_dist_defaults();
     o.walks = j->walks, o.batch = 997, o.seed = 7 + j->seed;
-    if (j->nq) j->status = ulam_dist_adjoint_many(p, &c, j->many, j->nq, &o, j->manyres, &err);
+    if (j->outer == 1) j->status = ulam_dist_mcsa(p, &c, &o, 1e-10, 60, j->x + j->first, &j->mi, &err);
+    else if (j->outer == 2)
+        j->status = ulam_dist_source(p, &c, j->index, &o, 1e-3, 1000, j->x + j->first, j->se + j->first, &j->si, &err);
+    else if (j->nq) j->status = ulam_dist_adjoint_many(p, &c, j->many, j->nq, &o, j->manyres, &err);
     else if (j->radius) j->status = ulam_dist_radius(p, &c, 0, 300, &j->rho, &err);
     else if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
     else j->status = ulam_dist_adjoint(p, &c, j->index, &o, &j->res, &err);
@@ -286,6 +292,89 @@ static void test_dist_many(void **state)
     unlink(path);
 }
 
+/* Run an outer method (1 MCSA, 2 single source from index) on k thread-ranks into x, se. */
+static void run_outer(int k, int outer, const char *path, int64_t index, int64_t walks, double *x, double *se, job *jobs)
+{
+    hub h;
+    hub_init(&h, k);
+    pthread_t t[MAXR];
+    for (int r = 0; r < k; r++) {
+        jobs[r] = (job){.port = {&h, r}, .path = path, .outer = outer, .index = index, .walks = walks, .x = x, .se = se};
+        pthread_create(&t[r], NULL, rank_main, &jobs[r]);
+    }
+    for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
+    pthread_barrier_destroy(&h.bar);
+}
+
+/* MCSA on a partition: to a residual of 1e-10 of max |b|, x within 1e-8 of LAPACK's, the same
+ * bits at 1, 2 and 3 ranks. */
+static void test_dist_mcsa(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 800;
+    double *x = malloc((size_t)n * sizeof *x), *ref = malloc((size_t)n * sizeof *ref), *y = malloc((size_t)n * sizeof *y);
+    make_system(path, n, 5, 17, x);
+    for (int k = 1; k <= 3; k++) {
+        job jobs[MAXR];
+        run_outer(k, 1, path, 0, 20000, k == 1 ? ref : y, NULL, jobs);
+        for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+        if (!(jobs[0].mi.residual <= 1e-10 && jobs[0].mi.iterations < 60)) fail_msg("residual %.3g after %d iterations", jobs[0].mi.residual, jobs[0].mi.iterations);
+        if (k > 1) assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+    }
+    double big = 0, worst = 0;
+    for (int64_t i = 0; i < n; i++) big = fmax(big, fabs(x[i])), worst = fmax(worst, fabs(ref[i] - x[i]));
+    if (!(worst <= 1e-8 * big)) fail_msg("max |x - LAPACK| = %.3g of max |x| %.3g", worst, big);
+    free(x), free(ref), free(y);
+    unlink(path);
+}
+
+/* Single source on a partition: x = (I - M)^-1 e_s within 4 standard errors of LAPACK's column
+ * wherever the walks gave one (the push's own part exact), at least 90% within 1.96, the same
+ * bits at 1, 2 and 3 ranks. */
+static void test_dist_source(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 600, s = 123;
+    double *x = malloc((size_t)n * sizeof *x), *col = calloc((size_t)n, sizeof *col), *e = calloc((size_t)n, sizeof *e);
+    double *ref = malloc((size_t)n * sizeof *ref), *rse = malloc((size_t)n * sizeof *rse);
+    double *y = malloc((size_t)n * sizeof *y), *yse = malloc((size_t)n * sizeof *yse);
+    make_system(path, n, 5, 18, x);
+    ulam_system *sys = NULL;
+    assert_int_equal(ulam_system_open(path, NULL, &sys, NULL), ULAM_OK);
+    e[s] = 1.0;
+    assert_int_equal(ulam_direct_solve(ulam_system_matrix(sys), e, col, 0, NULL, NULL), ULAM_OK);
+    ulam_system_free(sys);
+    for (int k = 1; k <= 3; k++) {
+        job jobs[MAXR];
+        run_outer(k, 2, path, s, 20000, k == 1 ? ref : y, k == 1 ? rse : yse, jobs);
+        for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+        assert_true(jobs[0].si.rounds > 0 && jobs[0].si.residual <= 1e-3);
+        if (k > 1) {
+            assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+            assert_memory_equal(yse, rse, (size_t)n * sizeof *y);
+        }
+    }
+    int64_t with = 0, in = 0;
+    for (int64_t i = 0; i < n; i++) {
+        if (isnan(rse[i]) || rse[i] == 0) continue;
+        double z = (ref[i] - col[i]) / rse[i];
+        if (!(fabs(z) < 4)) fail_msg("x[%lld] %.9g, column %.9g, se %.3g", (long long)i, ref[i], col[i], rse[i]);
+        with++, in += fabs(z) < 1.96;
+    }
+    assert_true(with > 50);
+    if (in < 0.9 * (double)with) fail_msg("%lld of %lld within 1.96 standard errors", (long long)in, (long long)with);
+    free(x), free(col), free(e), free(ref), free(rse), free(y), free(yse);
+    unlink(path);
+}
+
 /* A damaged block: refused (ULAM_ESYNTAX) by the rank whose rows hold it, at 1 and 3 ranks. */
 static void test_dist_damaged(void **state)
 {
@@ -386,6 +475,8 @@ int main(void)
         cmocka_unit_test(test_dist_radius),
         cmocka_unit_test(test_dist_sets),
         cmocka_unit_test(test_dist_many),
+        cmocka_unit_test(test_dist_mcsa),
+        cmocka_unit_test(test_dist_source),
     };
     return test_run(tests);
 }

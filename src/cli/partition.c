@@ -14,7 +14,8 @@
 #include "ulam_dist.h"
 
 static const char *const help =
-    "usage: ulam solve SYSTEM.ulam --partition (--index I | --queries FILE | --mode forward [--out X.mtx])\n"
+    "usage: ulam solve SYSTEM.ulam --partition (--index I | --queries FILE | --mode forward [--out X.mtx]\n"
+    "                  | --method mcsa [--tol T] [--out X.mtx] | --source S [--top K] [--out X.mtx])\n"
     "                  [--walks N] [--seed S] [--max-steps N] [--batch N] [--sets K]\n"
     "\n"
     "The prepared system's rows are split across the ranks of mpirun (balanced by entries; each rank\n"
@@ -27,6 +28,10 @@ static const char *const help =
     "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, query k\n"
     "                  with seed S + k - 1: a line answers what --index I --seed S+k-1 answers\n"
     "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector\n"
+    "  --method mcsa   every x_i by MCSA: Richardson steps (products with M across ranks) and forward\n"
+    "                  walks' corrections (--walks each) to --tol (default 1e-8) of max|b|, --max-iter\n"
+    "  --source S      x = (I - M)^-1 e_S: a push (products with M) to 1e-4, then forward walks; prints\n"
+    "                  the --top K (default 10) components.  mcsa and --source need M' in the file\n"
     "  --walks N       histories (default 100000)       --seed S   the streams' key (default 1)\n"
     "  --max-steps N   cut a walk longer (default 1e6)  --batch N  walks a round starts (default 65536)\n"
     "  --sets K        the ranks in K sets, each a whole partition running its own batches (more\n"
@@ -37,8 +42,9 @@ static const char *const help =
 typedef struct {
     const char *path, *out, *queries;
     int64_t index; /* 1-based; 0 none */
-    int forward;
-    int64_t sets;
+    int forward, mcsa;
+    int64_t sets, source, top, max_iter;
+    double tol;
     ulam_dist_opts o;
 } args;
 
@@ -46,12 +52,14 @@ static const struct option longopts[] = {
     {"partition", no_argument, 0, 'P'}, {"index", required_argument, 0, 'i'}, {"mode", required_argument, 0, 'm'},
     {"out", required_argument, 0, 'o'}, {"walks", required_argument, 0, 'w'}, {"seed", required_argument, 0, 's'},
     {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'}, {"sets", required_argument, 0, 'S'}, {"queries", required_argument, 0, 'Q'},
+    {"method", required_argument, 0, 'M'}, {"tol", required_argument, 0, 'T'}, {"max-iter", required_argument, 0, 'I'},
+    {"source", required_argument, 0, 'R'}, {"top", required_argument, 0, 'K'},
     {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
 
 /* The defaults. */
 static void init(void *p)
 {
-    *(args *)p = (args){.o = ulam_dist_defaults()};
+    *(args *)p = (args){.o = ulam_dist_defaults(), .tol = 1e-8, .max_iter = 100, .top = 10};
 }
 
 /* One option (see cli_solve_row.option). */
@@ -74,6 +82,15 @@ static int option(void *p, int val, const char *name, const char *value)
     case 'x': return cli_parse_int("solve", "--max-steps", value, 1, INT64_MAX, &a->o.max_steps);
     case 'b': return cli_parse_int("solve", "--batch", value, 1, (int64_t)1 << 30, &a->o.batch);
     case 'Q': a->queries = value; return 0;
+    case 'M':
+        if (!strcmp(value, "mcsa")) a->mcsa = 1;
+        else if (strcmp(value, "walks"))
+            return cli_usage_error("solve", "--method with --partition is walks or mcsa, got '%s'", value);
+        return 0;
+    case 'T': return cli_parse_real("solve", "--tol", value, 1e-300, 1.0, &a->tol);
+    case 'I': return cli_parse_int("solve", "--max-iter", value, 1, 1000000, &a->max_iter);
+    case 'R': return cli_parse_int("solve", "--source", value, 1, INT32_MAX, &a->source);
+    case 'K': return cli_parse_int("solve", "--top", value, 1, 1000000, &a->top);
     case 'S': return cli_parse_int("solve", "--sets", value, 1, 1 << 20, &a->sets);
     case 'h': fputs(help, stdout); return -1;
     default:
@@ -87,9 +104,11 @@ static int check(args *a, int argc, char **argv, int first)
 {
     if (first != argc - 1) return cli_usage_error("solve", "one prepared system file with --partition");
     a->path = argv[first];
-    if (!!a->forward + !!a->index + !!a->queries != 1)
-        return cli_usage_error("solve", "one of --index I, --queries FILE and --mode forward with --partition");
-    if (a->out && !a->forward) return cli_usage_error("solve", "--out with --partition writes forward mode's x");
+    if (!!a->forward + !!a->index + !!a->queries + a->mcsa + !!a->source != 1)
+        return cli_usage_error("solve", "one of --index I, --queries FILE, --mode forward, --method mcsa and --source S "
+                                        "with --partition");
+    if (a->out && (a->index || a->queries)) return cli_usage_error("solve", "--out with --partition writes a whole x");
+    if ((a->mcsa || a->source) && a->sets > 1) return cli_usage_error("solve", "--sets with --method walks only");
     return 0;
 }
 
@@ -184,12 +203,57 @@ static void print_query(const cli_query *q, int64_t k, const ulam_dist_result *r
     printf("  line %ld, seed %llu\n", q->line, (unsigned long long)(seed + (uint64_t)k));
 }
 
+/* A component for the top-K table: its index and estimate, its standard error. */
+typedef struct {
+    int64_t i;
+    double x, se;
+} entry;
+
+/* Larger estimate first, then the smaller index (NaN last). */
+static int by_estimate(const void *a, const void *b)
+{
+    const entry *p = a, *q = b;
+    if (p->x != q->x) return isnan(p->x) ? 1 : isnan(q->x) ? -1 : p->x < q->x ? 1 : -1;
+    return (p->i > q->i) - (p->i < q->i);
+}
+
+/* Each rank's K largest components to rank 0, which prints the K largest of all with their
+ * intervals (CLT, when the guard certified the walks' variance); 0 or an exit code. */
+static int print_top(const ulam_comm *c, const double *x, const double *se, int64_t first, int64_t rows, int64_t K,
+                     double rho)
+{
+    entry *e = malloc(((size_t)rows + 1) * sizeof *e);
+    size_t *cnt = calloc((size_t)c->nranks * 2, sizeof *cnt);
+    void *got = NULL;
+    int bad = !e || !cnt;
+    for (int64_t i = 0; !bad && i < rows; i++) e[i] = (entry){first + i, x[i], se[i]};
+    if (!bad) qsort(e, (size_t)rows, sizeof *e, by_estimate);
+    int64_t k = rows < K ? rows : K, all = k;
+    if (!bad && c->nranks > 1) {
+        cnt[0] = (size_t)k * sizeof *e;
+        bad = c->exchange(c->ctx, e, cnt, &got, cnt + c->nranks);
+        all = 0;
+        for (int r = 0; !bad && r < c->nranks; r++) all += (int64_t)(cnt[c->nranks + r] / sizeof *e);
+        if (!bad && c->rank == 0) qsort(got, (size_t)all, sizeof *e, by_estimate);
+    }
+    const entry *t = c->nranks > 1 ? got : e;
+    for (int64_t j = 0; !bad && c->rank == 0 && j < all && j < K; j++) {
+        printf("x[%lld]%*s%.10g", (long long)t[j].i + 1, cli_answer_pad(t[j].i + 1, 16), "", t[j].x);
+        if (rho < 1.0 && isfinite(t[j].se))
+            printf(" +- %.3g (95%% CI %.10g .. %.10g, CLT)\n", t[j].se, t[j].x - 1.96 * t[j].se, t[j].x + 1.96 * t[j].se);
+        else printf(" (no interval: %s)\n", rho < 1.0 ? "no walk reached it; the push's part alone" : "rho(M^) not certified below 1");
+    }
+    free(e), free(cnt), free(got);
+    return bad ? cli_exit_code(ULAM_EIO) : 0;
+}
+
 /* Print the run's summary (rank 0; v: per_rank's figures). */
 static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_t n, double seconds, const int64_t *v,
                     double rho)
 {
     if (a->queries) {
         if (cli_verbosity >= 0) printf("queries         %s, each above (walks below: each query's)\n", a->queries);
+    } else if (a->mcsa || a->source) { /* their answer is above */
     }
     else if (!a->forward && !(rho < 1.0))
         printf("x[%lld]%*s%.10g (no confidence interval: rho(M^) is not certified below 1, bound %.4g; the sample "
@@ -198,15 +262,15 @@ static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_
     else if (!a->forward)
         printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g, CLT)\n", (long long)a->index, cli_answer_pad(a->index, 16),
                "", r->estimate, r->std_error, r->estimate - 1.96 * r->std_error, r->estimate + 1.96 * r->std_error);
-    else if (a->forward) printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
+    else if (a->forward && !a->mcsa) printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
                 a->out ? a->out : "");
     if (cli_verbosity < 0) return;
-    printf("method          %s collision walks on %d rank%s, rows split by entries", a->forward ? "forward" : "adjoint",
-           nranks, nranks == 1 ? "" : "s");
+    printf("method          %s%s collision walks on %d rank%s, rows split by entries", a->mcsa ? "MCSA with " : a->source ? "push and " : "",
+           a->forward || a->mcsa || a->source ? "forward" : "adjoint", nranks, nranks == 1 ? "" : "s");
     if (a->sets > 1) printf(" within each of %lld sets", (long long)a->sets);
     printf("\n");
     if (rho < 1.0) printf("variance        finite (rho(M^) <= %.6g, certified)\n", rho);
-    else if (a->forward) printf("variance        not certified finite (rho(M^) bound %.4g): no error bar can be trusted\n", rho);
+    else if (a->forward || a->mcsa || a->source) printf("variance        not certified finite (rho(M^) bound %.4g): no error bar can be trusted\n", rho);
     printf("walks           %lld (%lld steps; %lld cut at --max-steps)\n", (long long)r->walks, (long long)r->steps,
            (long long)r->cut);
     printf("migration       %.4g of steps crossed ranks, %.3g bytes a step, %lld rounds\n",
@@ -226,7 +290,9 @@ static int run(const args *a, const ulam_comm *c)
 {
     ulam_part *p = NULL;
     ulam_error err;
-    int status = ulam_part_open(a->path, c, a->forward ? ULAM_PART_MT : ULAM_PART_M, &p, &err);
+    int walks_forward = a->forward || a->mcsa || a->source; /* the walks run on M' */
+    int status = ulam_part_open(a->path, c, a->mcsa || a->source ? ULAM_PART_BOTH : a->forward ? ULAM_PART_MT : ULAM_PART_M,
+                                &p, &err);
     int64_t bad = status != ULAM_OK; /* every rank ends together when one cannot read its rows */
     if (c->nranks > 1 && c->sum(c->ctx, &bad, 1)) bad = 1;
     if (bad) {
@@ -238,9 +304,10 @@ static int run(const args *a, const ulam_comm *c)
     if (die && atoi(die) == c->rank && c->nranks > 1) _exit(9);
     int64_t first, last, n = ulam_part_rows(p, &first, &last, NULL);
     int rc0;
-    if (a->index > n) {
+    if (a->index > n || a->source > n) {
         ulam_part_free(p);
-        return cli_usage_error("solve", "--index in 1 .. %lld, got %lld", (long long)n, (long long)a->index);
+        return cli_usage_error("solve", "%s in 1 .. %lld, got %lld", a->index ? "--index" : "--source", (long long)n,
+                               (long long)(a->index ? a->index : a->source));
     }
     cli_query *q = NULL;
     int64_t nq = 0;
@@ -249,9 +316,11 @@ static int run(const args *a, const ulam_comm *c)
         return rc0;
     }
     double rho = INFINITY; /* the variance guard: the interval is printed only when it is below 1 */
-    status = ulam_dist_radius(p, c, a->forward, 200, &rho, &err);
+    status = ulam_dist_radius(p, c, walks_forward, 200, &rho, &err);
     ulam_dist_result r = {0};
-    double *x = NULL;
+    ulam_dist_mcsa_info mi = {0};
+    ulam_dist_source_info si = {0};
+    double *x = NULL, *se = NULL;
     ulam_dist_result *many = NULL;
     if (status) {
     } else if (q) {
@@ -261,9 +330,15 @@ static int run(const args *a, const ulam_comm *c)
         status = idx && many ? ulam_dist_adjoint_many(p, c, idx, nq, &a->o, many, &err) : ULAM_ENOMEM;
         if (!status) r = many[0];
         free(idx);
-    } else if (a->forward) {
+    } else if (a->forward || a->mcsa || a->source) {
         x = malloc(((size_t)(last - first) + 1) * sizeof *x);
-        status = x ? ulam_dist_forward(p, c, &a->o, x, NULL, &r, &err) : ULAM_ENOMEM;
+        se = malloc(((size_t)(last - first) + 1) * sizeof *se);
+        if (!x || !se) status = ULAM_ENOMEM;
+        else if (a->mcsa) status = ulam_dist_mcsa(p, c, &a->o, a->tol, (int)a->max_iter, x, &mi, &err);
+        else if (a->source) status = ulam_dist_source(p, c, a->source - 1, &a->o, 1e-4, 1000, x, se, &si, &err);
+        else status = ulam_dist_forward(p, c, &a->o, x, NULL, &r, &err);
+        if (!status && a->mcsa) r.walks = mi.walks, r.steps = mi.steps, r.crossings = mi.crossings;
+        if (!status && a->source) r.walks = si.walks, r.steps = si.steps, r.crossings = si.crossings;
     } else {
         status = ulam_dist_adjoint(p, c, a->index - 1, &a->o, &r, &err);
     }
@@ -274,8 +349,20 @@ static int run(const args *a, const ulam_comm *c)
     int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
     if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
     for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, &many[k], a->o.seed, rho);
+    if (!rc && a->source) rc = print_top(c, x, se, first, last - first, a->top, rho);
+    if (!rc && c->rank == 0 && a->mcsa)
+        printf("x               %lld components by MCSA%s%s\nmcsa            %d iterations, residual %.3g of max |b| "
+               "(target %.3g)\n", (long long)n, a->out ? ", written to " : "", a->out ? a->out : "", mi.iterations,
+               mi.residual, a->tol);
+    if (!rc && c->rank == 0 && a->source && cli_verbosity >= 0)
+        printf("push            %d products with M, max |r| %.3g left to the walks\n", si.rounds, si.residual);
     if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v, rho);
-    free(x), free(v), free(q), free(many);
+    if (!rc && a->mcsa && mi.residual > a->tol) {
+        if (c->rank == 0) fprintf(stderr, "ulam: %s: error: MCSA stopped at --max-iter %lld with residual %.3g above --tol %.3g\n",
+                                  a->path, (long long)a->max_iter, mi.residual, a->tol);
+        rc = cli_exit_code(ULAM_ENOCONV);
+    }
+    free(x), free(se), free(v), free(q), free(many);
     return rc;
 }
 
