@@ -125,6 +125,32 @@ def check_partition(ulam, mpirun, d):
     assert p.returncode != 0 and not p.stdout, (p.returncode, p.stdout)
 
 
+def check_partition_memory(ulam, mpirun, d):
+    """Issue 43's memory test: forward mode on a 10^6-row system (8 entries a row, a band around the
+    diagonal, |row sums| 0.4), 3 ranks: each rank's peak RSS at most half of one rank's alone (MPI's
+    own memory included), and the same x file."""
+    n, width = 1000000, 8
+    with open(f"{d}/big.mtx", "w") as f:
+        f.write("%%%%MatrixMarket matrix coordinate real general\n%d %d %d\n" % (n, n, n * width))
+        for i in range(1, n + 1):
+            f.write("".join("%d %d %s\n" % (i, (i + k - 1) % n + 1, "-0.05" if k == 3 else "0.05") for k in range(1, width + 1)))
+    with open(f"{d}/bigb.mtx", "w") as f:
+        f.write("%%%%MatrixMarket matrix array real general\n%d 1\n" % n)
+        f.write("1\n" * n)
+    run([ulam, "prepare", f"{d}/big.mtx", "--rhs", f"{d}/bigb.mtx", "--transpose", "-o", f"{d}/big.ulam"])
+    os.unlink(f"{d}/big.mtx")
+    rss, files = [], []
+    for k in (1, 3):
+        out = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", f"{d}/big.ulam", "--partition", "--mode",
+                   "forward", "--walks", "100000", "--out", f"{d}/bx{k}.mtx", "-v"])
+        line = [l for l in out.splitlines() if l.startswith("ranks")][0]
+        rss.append([float(v) for v in line.split("peak RSS MiB")[1].split()])
+        files.append(open(f"{d}/bx{k}.mtx").read())
+    assert files[0] == files[1], "x differs"
+    assert len(rss[1]) == 3 and max(rss[1]) <= 0.5 * rss[0][0], rss
+    return rss
+
+
 def main():
     ulam, mpirun = sys.argv[1], sys.argv[2]
     par = [mpirun, "--oversubscribe", "-np", "2", ulam]
@@ -218,13 +244,19 @@ def main():
         except AssertionError as e:
             failures += 1
             print(f"FAIL partition: {e}")
+        try:
+            rss = check_partition_memory(ulam, mpirun, d)
+            print(f"ok partition memory (peak RSS MiB: 1 rank {rss[0][0]}, 3 ranks {rss[1]})")
+        except AssertionError as e:
+            failures += 1
+            print(f"FAIL partition memory: {e}")
     try:
         check_interrupt(ulam, mpirun)
         print("ok interrupt")
     except AssertionError as e:
         failures += 1
         print(f"FAIL interrupt: {e}")
-    print(f"{len(cases) + 2 - failures} passed, {failures} failed")
+    print(f"{len(cases) + 3 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 
