@@ -76,8 +76,11 @@ class Interrupted(KeyboardInterrupt):
 
     def __init__(self, result):
         self.result = result
-        super().__init__(f"interrupted after {result.walks} walks: estimate so far {result.estimate:.10g} "
-                         f"+- {result.stderr:.3g}")
+        if isinstance(result, VectorResult):
+            super().__init__(f"interrupted after {result.walks} walks: the estimates so far are in .result")
+        else:
+            super().__init__(f"interrupted after {result.walks} walks: estimate so far {result.estimate:.10g} "
+                             f"+- {result.stderr:.3g}")
 
 
 _INPUT = {"EINVAL", "EZERODIAG", "ENONFINITE", "EUNDEFINED"}
@@ -557,7 +560,7 @@ def _solve(system, b, index, *, source=None, method="auto", mode=None, estimator
             _input("rel_err= or rtol= (scipy's name for it), not both")
         rel_err = rtol
     n = system.n
-    if source is not None and index is None and mode is None:
+    if source is not None and index is None and mode in (None, "forward"):  # single source: forward by nature
         if b is not None:
             _input("source=S sets b = e_S: it cannot go with b")
         return _single_source(system, source, walks=walks, rel_err=rel_err, seed=seed, threads=threads, force=force,
