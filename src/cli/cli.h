@@ -194,6 +194,9 @@ void cli_print_z(double estimate, double direct, double std_error, double lo, do
 /* Print a power-iteration radius with its bounds (no newline). */
 void cli_print_power(const ulam_power *p);
 
+/* A radius in words (cli_print_power's figures): buf of 32 characters, returned. */
+const char *cli_radius_str(char *buf, double x);
+
 /* The guards' radii for a walk in mode on s with kernel exponent alpha (rho(|M|) and that mode's
  * rho(M^), stopped once certified): a prepared file's certificate made for this continuation
  * (and exponent: a certificate holds alpha = 1's) serves instead of a pass

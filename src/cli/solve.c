@@ -671,6 +671,13 @@ static int run(solve_args *a)
         a->an = ulam_analysis_free(a->an);
         return rc;
     }
+    if (!sv && ch.chosen != ULAM_METHOD_BIDIRECTIONAL) { /* no solver and not bidirectional: nothing to label */
+        fprintf(stderr, "ulam: %s: error: --method auto chose no method it can run\n", s->matrix_path);
+        ulam_run_free(rn);
+        a->an = ulam_analysis_free(a->an);
+        cli_system_free(&a->s);
+        return cli_exit_code(ULAM_EINVAL);
+    }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
         rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_method_bidir_route(a->s.b, a->s.M->nrows, &a->ao, &a->o), ro.json, ro.check, ro.direct, ro.direct_method, ro.load_seconds);
         ulam_run_free(rn);

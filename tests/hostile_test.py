@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""Hostile inputs to `ulam` (issue 39): no exit 0 with a wrong answer, no signal death, no write
+outside the paths asked for, no input destroyed.  Each check builds its own inputs in a temporary
+folder.  Run from the source root: hostile_test.py path/to/ulam [--no-radiosity] [--case NAME]...
+"""
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+from ulam_status import code  # noqa: E402  (the enum of include/ulam.h)
+
+
+def run(ulam, args, **kw):
+    # 300 s: a guard against a hang, not a speed check
+    p = subprocess.run([ulam] + args, capture_output=True, text=True, timeout=300, **kw)
+    return p.returncode, p.stdout, p.stderr
+
+
+def write_mtx(path, n, entries):
+    with open(path, "w") as f:
+        f.write(f"%%MatrixMarket matrix coordinate real general\n{n} {n} {len(entries)}\n")
+        for i, j, v in entries:
+            f.write(f"{i} {j} {v}\n")
+
+
+def write_vec(path, values):
+    with open(path, "w") as f:
+        f.write(f"%%MatrixMarket matrix array real general\n{len(values)} 1\n")
+        f.write("".join(f"{v!r}\n" for v in values))
+
+
+def direct(ulam, m, b, index):
+    rc, out, err = run(ulam, ["direct", m, "--rhs", b, "--index", str(index)])
+    assert rc == 0, err
+    return float(re.search(rf"^x\[{index}\]\s+(\S+)", out, re.M).group(1))
+
+
+def answer_or_refusal(ulam, args, index, exact, what):
+    """One solve: either a refusal (non-zero exit, a message that is not 'success', nothing on
+    stdout) or exit 0 with x[index] (never another unknown) whose printed interval holds exact."""
+    rc, out, err = run(ulam, args + ["--json"])
+    if rc != 0:
+        assert "success" not in err and re.search(r"error: ", err), f"{what}: exit {rc} without a clear error: {err}"
+        assert json.loads(out).get("exit") == rc, f"{what}: JSON {out}"
+        rc2, out2, err2 = run(ulam, args)
+        assert rc2 == rc and out2 == "" and "success" not in err2, f"{what}: text run: exit {rc2}, {out2} {err2}"
+        return "refused"
+    assert "error: success" not in err and "error:" not in err, f"{what}: exit 0 with an error: {err}"
+    j = json.loads(out)
+    assert j["index"] == index, f"{what}: answered x[{j['index']}] for --index {index}"
+    lo, hi = j["ci95"] if j.get("ci95") else (None, None)
+    if lo is not None:
+        tol = 1e-12 * max(1.0, abs(exact))
+        assert lo - tol <= exact <= hi + tol, f"{what}: x[{index}] = {exact} outside the printed interval [{lo}, {hi}]"
+    rc2, out2, err2 = run(ulam, args)
+    assert rc2 == 0 and re.search(rf"^x\[{index}\]", out2, re.M), f"{what}: text run labels another unknown: {out2}"
+    return "answered"
+
+
+def check_relabel(ulam):
+    """Point 1: M = [[0, t], [1e-201, 0]], b = (1, 1), solve --index 2 answered x[1] = 0 +- 0 as
+    'bidirectional' with 'error: success', exit 0, for t from 1e155 to 1e299; info printed
+    rho(M) 0.000000.  Now: a refusal or x[2] within its interval, for every t."""
+    with tempfile.TemporaryDirectory() as d:
+        b = os.path.join(d, "b.mtx")
+        write_vec(b, [1.0, 1.0])
+        for t in ["1e100", "1e155", "1e200", "1e250", "1e299"]:
+            m = os.path.join(d, f"m{t}.mtx")
+            write_mtx(m, 2, [(1, 2, t), (2, 1, "1e-201")])
+            exact = direct(ulam, m, b, 2)
+            for extra in ([], ["--mode", "adjoint"], ["--mode", "forward"], ["--walks", "1000"]):
+                answer_or_refusal(ulam, ["solve", m, "--rhs", b, "--index", "2"] + extra, 2, exact, f"t = {t} {extra}")
+            rc, out, err = run(ulam, ["info", m])
+            assert rc == 0, err
+            rho = re.search(r"^rho\(M\)\s+(\S+)", out, re.M).group(1)
+            assert float(rho) > 0, f"t = {t}: info prints rho(M) {rho} (it is sqrt({t} x 1e-201) > 0)"
+
+
+CHECKS = [check_relabel]
+
+
+def main():
+    ulam = sys.argv[1]
+    flags = sys.argv[2:]
+    radiosity = "--no-radiosity" not in flags
+    cases = [flags[k + 1] for k in range(len(flags) - 1) if flags[k] == "--case"]
+    checks = [c for c in CHECKS if radiosity or "radiosity" not in c.__name__]
+    if cases:
+        names = {c.__name__ for c in checks}
+        unknown = [c for c in cases if c not in names and "check_" + c not in names]
+        if unknown:
+            print(f"unknown --case {', '.join(unknown)}: one of {', '.join(sorted(names))}")
+            return 2
+        checks = [c for c in checks if c.__name__ in cases or c.__name__[6:] in cases]
+    failures = 0
+    for f in checks:
+        try:
+            f(ulam)
+        except AssertionError as e:
+            failures += 1
+            print(f"FAIL {f.__name__}: {e}\n  (rerun it alone: --case {f.__name__})")
+    print(f"{len(checks) - failures} passed, {failures} failed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
