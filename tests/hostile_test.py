@@ -80,7 +80,40 @@ def check_relabel(ulam):
             assert float(rho) > 0, f"t = {t}: info prints rho(M) {rho} (it is sqrt({t} x 1e-201) > 0)"
 
 
-CHECKS = [check_relabel]
+def check_study_counts_every_run(ulam):
+    """Point 2: study dropped the runs with no standard error (forward walks that never reached
+    x_I) yet printed '5 runs a cell', and named a winner from a cell where 2 of 5 runs had no
+    estimate (randsub1000, x[7], 100 walks: 'forward-collision-plain ... 3/3').  Every run is
+    counted: a run with no estimate is a failure, in runs.csv, summary.csv and on stdout, and
+    such a cell never wins."""
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "st")
+        args = ["study", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx", "--index", "7", "--methods",
+                "forward-collision-plain,adjoint-collision-plain", "--budgets", "100,1000", "--repeats", "5",
+                "--out", out, "--reference-time", "0"]
+        for attempt in ("fresh", "resumed"):
+            rc, stdout, err = run(ulam, args)
+            assert rc == 0, f"{attempt}: {err}"
+            runs = open(os.path.join(out, "runs.csv")).read().splitlines()[1:]
+            assert len(runs) == 2 * 2 * 5, f"{attempt}: runs.csv holds {len(runs)} runs of 20"
+            failed = [r for r in runs if r.split(",")[4] == ""]
+            assert failed and all(r.startswith("forward-") for r in failed), f"{attempt}: failed runs {failed}"
+            rows = [r.split(",") for r in open(os.path.join(out, "summary.csv")).read().splitlines()]
+            col = {k: i for i, k in enumerate(rows[0])}
+            for r in rows[1:]:
+                assert r[col["runs"]] == "5", f"{attempt}: a cell of {r[col['runs']]} runs: {r}"
+            nfail = sum(int(r[col["failed"]]) for r in rows[1:])
+            assert nfail == len(failed), f"{attempt}: summary.csv counts {nfail} failures, runs.csv {len(failed)}"
+            for line in stdout.splitlines():
+                m = re.match(r"^(\d+)\s+(\S+)\s+\S+\s+\S+\s+(\d+)/(\d+)", line)
+                if m:
+                    assert m.group(4) == "5", f"{attempt}: winner over {m.group(4)} runs: {line}"
+                    cell = [r for r in rows[1:] if r[0] == m.group(2) and float(r[1]) == float(m.group(1))][0]
+                    assert cell[col["failed"]] == "0", f"{attempt}: winner with runs that failed: {line}"
+            assert re.search(r"^no estimate: forward-collision-plain at 100: \d of 5 runs", stdout, re.M), stdout
+
+
+CHECKS = [check_relabel, check_study_counts_every_run]
 
 
 def main():
