@@ -113,7 +113,89 @@ def check_study_counts_every_run(ulam):
             assert re.search(r"^no estimate: forward-collision-plain at 100: \d of 5 runs", stdout, re.M), stdout
 
 
-CHECKS = [check_relabel, check_study_counts_every_run]
+CUBE_OBJ = """mtllib {mtl}
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0 0 1
+v 1 0 1
+v 1 1 1
+v 0 1 1
+usemtl white
+o floor
+f 1 5 6 2
+{comment}usemtl lamp
+o ceiling
+f 4 3 7 8
+"""
+CUBE_MTL = "newmtl lamp\nKd 0 0 0\nKe 1 1 1\nnewmtl white\nKd 0.7 0.7 0.7\n"
+
+
+def check_radiosity_obj_lines(ulam):
+    """Point 3: the OBJ reader took a failed read (ENOMEM on a 600 MB comment line) for the end of
+    the file and answered from the patches before it, exit 0.  Lines are bounded (1 MiB): a longer
+    one is refused at its line, before anything after it is dropped; a NUL byte likewise."""
+    with tempfile.TemporaryDirectory() as d:
+        open(os.path.join(d, "c.mtl"), "w").write(CUBE_MTL)
+        obj = os.path.join(d, "c.obj")
+        open(obj, "w").write(CUBE_OBJ.format(mtl="c.mtl", comment=""))
+        rc, out, err = run(ulam, ["radiosity", obj, "--list"])
+        assert rc == 0 and len(re.findall(r"^\s*\d+\s", out, re.M)) == 2, f"the plain scene: {rc} {out} {err}"
+        open(obj, "w").write(CUBE_OBJ.format(mtl="c.mtl", comment="# " + "x" * (3 << 20) + "\n"))
+        rc, out, err = run(ulam, ["radiosity", obj, "--list"])
+        assert rc == code("ESYNTAX") and re.search(rf"{re.escape(obj)}:13: error: .*line of at most 1048576 bytes", err), \
+            f"a 3 MiB comment line: exit {rc}: {err.strip()[:300]}"
+        assert out == "", out
+        long_mtl = os.path.join(d, "long.mtl")
+        open(long_mtl, "w").write("# " + "y" * (3 << 20) + "\n" + CUBE_MTL)
+        open(obj, "w").write(CUBE_OBJ.format(mtl="long.mtl", comment=""))
+        rc, out, err = run(ulam, ["radiosity", obj, "--list"])
+        assert rc == code("ESYNTAX") and re.search(rf"{re.escape(long_mtl)}:1: error: .*line of at most", err), \
+            f"a 3 MiB MTL line: exit {rc}: {err.strip()[:300]}"
+
+
+def check_radiosity_mtllib_not_regular(ulam):
+    """Point 5: 'mtllib /dev/zero' grew one line buffer to 4.2 GB; 'mtllib' naming a FIFO blocked
+    forever.  An MTL file must be a regular file: a device, FIFO or directory is refused at the
+    mtllib line without reading (or waiting on) it."""
+    with tempfile.TemporaryDirectory() as d:
+        obj = os.path.join(d, "c.obj")
+        fifo = os.path.join(d, "fifo.mtl")
+        os.mkfifo(fifo)
+        os.mkdir(os.path.join(d, "dir.mtl"))
+        for name, what in (("/dev/zero", "a device"), (fifo, "a FIFO"), ("dir.mtl", "a directory")):
+            open(obj, "w").write(CUBE_OBJ.format(mtl=name, comment=""))
+            rc, out, err = run(ulam, ["radiosity", obj, "--list"])  # a FIFO would block: run's timeout
+            assert rc == code("EIO") and re.search(rf"{re.escape(obj)}:1: error: .*a regular MTL file: .* is {what}", err), \
+                f"mtllib {name}: exit {rc}: {err.strip()[:300]}"
+
+
+def check_matrix_zeros_streamed(ulam):
+    """Point 5: a 5 GB sparse file of zeros given as a matrix was read whole (5.2 GB RSS) before
+    the NUL check.  A 1 GiB one (sparse: no disk) is refused at line 1 with a few MB resident, as
+    is a 2 MiB line with no newline."""
+    with tempfile.TemporaryDirectory() as d:
+        z = os.path.join(d, "zeros.mtx")
+        with open(z, "wb") as f:
+            f.truncate(1 << 30)
+        probe = ("import resource, subprocess, sys\n"
+                 "p = subprocess.run(sys.argv[1:], capture_output=True, text=True, timeout=300)\n"
+                 "print(p.returncode, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n"
+                 "sys.stderr.write(p.stderr)\n")
+        p = subprocess.run([sys.executable, "-c", probe, ulam, "info", z], capture_output=True, text=True, timeout=300)
+        rc, rss = map(int, p.stdout.split())
+        assert rc == code("ESYNTAX") and re.search(rf"{re.escape(z)}:1: error: .*NUL byte", p.stderr), f"exit {rc}: {p.stderr}"
+        assert rss < 200 * 1024, f"1 GiB of zeros: {rss} KiB resident (read whole?)"
+        long = os.path.join(d, "long.mtx")
+        open(long, "w").write("%%MatrixMarket matrix coordinate real general\n%" + "x" * (2 << 20))
+        rc, out, err = run(ulam, ["info", long])
+        assert rc == code("ESYNTAX") and re.search(rf"{re.escape(long)}:2: error: .*line of at most 1048576 bytes", err), \
+            f"a 2 MiB line: exit {rc}: {err}"
+
+
+CHECKS = [check_relabel, check_study_counts_every_run, check_radiosity_obj_lines,
+          check_radiosity_mtllib_not_regular, check_matrix_zeros_streamed]
 
 
 def main():
