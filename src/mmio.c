@@ -755,6 +755,16 @@ static FILE *open_input(const char *path, ulam_error *err)
  * (*f NULL). */
 static int gunzipped(FILE **f, const char *path, ulam_error *err)
 {
+    struct stat st;
+    if (fstat(fileno(*f), &st) || !S_ISREG(st.st_mode)) { /* a pipe: peek one byte, never rewind */
+        int c = getc(*f);
+        if (c == EOF) return ferror(*f) ? ulam__fail(err, ULAM_EIO, 0, -1, "a readable file (%s)", strerror(errno)) : ULAM_OK;
+        ungetc(c, *f);
+        if (c == 0x1f) /* zlib reads the descriptor, past what stdio has buffered: only a file can be gunzipped */
+            return ulam__fail(err, ULAM_EUNSUPPORTED, 1, -1, "a Matrix Market text stream: %s looks gzip-compressed "
+                                                              "(decompress it into the pipe: zcat FILE.gz)", path);
+        return ULAM_OK;
+    }
     unsigned char m[2];
     size_t got = fread(m, 1, 2, *f);
     rewind(*f);
