@@ -224,7 +224,50 @@ def check_pipes(ulam):
         assert p.returncode == code("EUNSUPPORTED") and "gzip" in p.stderr, f"gzip pipe: {p.returncode} {p.stderr}"
 
 
-CHECKS = [check_pipes, check_relabel, check_study_counts_every_run, check_radiosity_obj_lines,
+def check_output_is_input(ulam):
+    """Point 8: `solve m.mtx --out m.mtx`, `--out b.mtx`, `prepare m.mtx -o m.mtx` destroyed the
+    input silently, and `radiosity --image x.png --out x.hdr` overwrote the CSV with the HDR
+    image.  An output that is an input (the same file through any name, link or symlink) or
+    another output of the run is refused (exit 2) before anything is written; every input stays
+    byte for byte."""
+    import shutil
+    with tempfile.TemporaryDirectory() as d:
+        m, b = os.path.join(d, "m.mtx"), os.path.join(d, "b.mtx")
+        shutil.copy("matrices/chain4.mtx", m)
+        shutil.copy("matrices/chain4_b.mtx", b)
+        os.symlink("m.mtx", os.path.join(d, "link.mtx"))
+        os.link(b, os.path.join(d, "hard.mtx"))
+        fwd = ["solve", "--method", "walks", m, "--rhs", b, "--mode", "forward", "--walks", "100"]
+        cases = [
+            (fwd + ["--out", m], r"--out \S*m\.mtx is the matrix"),
+            (fwd + ["--out", b], r"--out \S*b\.mtx is --rhs"),
+            (fwd + ["--errors", os.path.join(d, "link.mtx")], r"--errors \S*link\.mtx is the matrix"),
+            (fwd + ["--out", os.path.join(d, "x.mtx"), "--errors", os.path.join(d, ".", "x.mtx")], r"is also --out"),
+            (["direct", m, "--rhs", b, "--out", os.path.join(d, "hard.mtx")], r"--out \S*hard\.mtx is --rhs"),
+            (["prepare", m, "-o", m], r"-o \S*m\.mtx is the matrix"),
+            (["prepare", m, "--rhs", b, "-o", os.path.join(d, "link.mtx")], r"is the matrix"),
+            (["solve", "--method", "richardson", m, "--rhs", b, "--out", b], r"--out \S*b\.mtx is --rhs"),
+        ]
+        before = {f: open(os.path.join(d, f), "rb").read() for f in ("m.mtx", "b.mtx")}
+        if run(ulam, ["radiosity", "--help"])[0] == 0 and os.path.exists("tests/data/rad/cube_black_lamp.obj"):
+            for f in ("cube_black_lamp.obj", "cube_black_lamp.mtl"):
+                shutil.copy("tests/data/rad/" + f, d)
+                before[f] = open(os.path.join(d, f), "rb").read()
+            scene = os.path.join(d, "cube_black_lamp.obj")
+            rad = ["radiosity", scene, "--patch", "1", "--direct"]
+            cases += [(rad + ["--image", os.path.join(d, "x.png"), "--out", os.path.join(d, "x.hdr")],
+                       r"--out \S*x\.hdr is also --image's HDR"),
+                      (rad + ["--out", scene], r"--out \S*cube_black_lamp\.obj is the scene")]
+        for args, msg in cases:
+            rc, out, err = run(ulam, args)
+            assert rc == 2 and re.search(msg, err), f"ulam {' '.join(args)}: exit {rc}: {err.strip()}"
+            for f, data in before.items():
+                assert open(os.path.join(d, f), "rb").read() == data, f"ulam {' '.join(args)}: {f} changed"
+            left = [f for f in os.listdir(d) if f.startswith("x.") or ".tmp." in f]
+            assert not left, f"ulam {' '.join(args)}: wrote {left}"
+
+
+CHECKS = [check_output_is_input, check_pipes, check_relabel, check_study_counts_every_run, check_radiosity_obj_lines,
           check_radiosity_mtllib_not_regular, check_matrix_zeros_streamed]
 
 

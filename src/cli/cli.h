@@ -297,6 +297,17 @@ int cli_prepare(int argc, char **argv);
  * 0 or an exit code (reported). */
 int cli_check_output(const char *path);
 
+/* A file a run names: the option that names it ("--out"; the input's own name for an input)
+ * and its path (NULL: not given). */
+typedef struct {
+    const char *opt, *path;
+} cli_file;
+
+/* Check the nout outputs (cli_check_output each), then refuse (usage error, EXIT_USAGE) an output
+ * that is one of the nin inputs (the same file: same device and inode, through any path, link
+ * or symlink) or another output of this run; 0 or the exit code (reported). */
+int cli_check_outputs(const char *command, const cli_file *outs, int nout, const cli_file *ins, int nin);
+
 /* A progress line on stderr for a terminal (nothing on a pipe, with --json, or off rank 0). */
 typedef struct cli_progress {
     int on, shown;

@@ -646,6 +646,50 @@ int cli_check_output(const char *path)
     return cli_report(path, &err);
 }
 
+/* path's file as (device, inode) when it exists, and as its directory's real path and its own
+ * name (an output not yet made); 0 when neither can be had. */
+static int file_id(const char *path, struct stat *st, int *exists, char *canon, size_t len)
+{
+    *exists = stat(path, st) == 0;
+    const char *slash = strrchr(path, '/');
+    char dir[4096], real[4096];
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash == path ? 1 : slash - path) : 1, slash ? path : ".");
+    if (!realpath(dir, real)) return *exists;
+    snprintf(canon, len, "%s/%s", real, slash ? slash + 1 : path);
+    return 1;
+}
+
+/* Whether the files a and b are one (same inode, or the same canonical name). */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    int ea, eb;
+    char ca[8400] = "", cb[8400] = "";
+    if (!file_id(a, &sa, &ea, ca, sizeof ca) || !file_id(b, &sb, &eb, cb, sizeof cb)) return !strcmp(a, b);
+    if (ea && eb) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    return ca[0] && !strcmp(ca, cb);
+}
+
+int cli_check_outputs(const char *command, const cli_file *outs, int nout, const cli_file *ins, int nin)
+{
+    for (int k = 0; k < nout; k++) {
+        if (!outs[k].path) continue;
+        for (int i = 0; i < nin; i++)
+            if (ins[i].path && same_file(outs[k].path, ins[i].path))
+                return cli_usage_error(command, "%s %s is %s %s: writing it would replace an input; choose another path",
+                                       outs[k].opt, outs[k].path, ins[i].opt, ins[i].path);
+        for (int j = 0; j < k; j++)
+            if (outs[j].path && same_file(outs[k].path, outs[j].path))
+                return cli_usage_error(command, "%s %s is also %s %s: one would overwrite the other; choose two paths",
+                                       outs[k].opt, outs[k].path, outs[j].opt, outs[j].path);
+    }
+    for (int k = 0; k < nout; k++) {
+        int rc = outs[k].path ? cli_check_output(outs[k].path) : 0;
+        if (rc) return rc;
+    }
+    return 0;
+}
+
 /* Start a progress line: only on a terminal, never with --json, only on rank 0. */
 void cli_progress_start(cli_progress *p, int json)
 {

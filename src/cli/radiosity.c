@@ -1475,10 +1475,10 @@ int cli_radiosity(int argc, char **argv)
         snprintf(a.hdr, sizeof a.hdr, "%.*s.pfm", (int)(png ? len - 4 : len), a.image);
         snprintf(a.rgbe, sizeof a.rgbe, "%.*s.hdr", (int)(png ? len - 4 : len), a.image);
     }
-    if (a.image && (rc = cli_check_output(a.image))) return rc;
-    if (a.image && !a.grid && (rc = cli_check_output(a.hdr))) return rc;
-    if (a.image && !a.grid && (rc = cli_check_output(a.rgbe))) return rc;
-    if (a.out && (rc = cli_check_output(a.out))) return rc;
+    const cli_file outs[] = {{"--image", a.image}, {"--image's PFM", a.image && !a.grid ? a.hdr : NULL},
+                             {"--image's HDR", a.image && !a.grid ? a.rgbe : NULL}, {"--out", a.out}},
+                   ins[] = {{"the scene", a.scene}};
+    if ((rc = cli_check_outputs("radiosity", outs, 4, ins, 1))) return rc;
     if ((rc = load_scene(&a, &s, &r.faces))) return rc;
     if (a.mesh_target > 0 && (rc = adapt_scene(&a, &s, &r.adapt, &r.view_importance, &r.adapt_cap))) goto done;
     r.adapted = a.mesh_target > 0;

@@ -575,7 +575,8 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
     int rc;
     /* read only the rows walks reach; auto does on a prepared system (see certified_auto) */
     s->lazy = o->mode == ULAM_ADJOINT && !cli_share && (!a->autom || ulam_system_is_file(s->matrix_path));
-    if ((a->out && (rc = cli_check_output(a->out))) || (a->errors && (rc = cli_check_output(a->errors)))) return rc;
+    const cli_file outs[] = {{"--out", a->out}, {"--errors", a->errors}}, ins[] = {{"the matrix", s->matrix_path}, {"--rhs", s->rhs_path}};
+    if ((rc = cli_check_outputs("solve", outs, 2, ins, 2))) return rc;
     double t0 = ulam_now();
     if ((rc = cli_load_system(s))) return rc;
     if (!s->b) {
