@@ -267,7 +267,32 @@ def check_output_is_input(ulam):
             assert not left, f"ulam {' '.join(args)}: wrote {left}"
 
 
-CHECKS = [check_output_is_input, check_pipes, check_relabel, check_study_counts_every_run, check_radiosity_obj_lines,
+def check_study_chart_symlinks(ulam):
+    """Point 7: study's charts were drawn by gnuplot to the fixed name DIR/NAME.tmp.png; a symlink
+    planted there made it overwrite a file outside the study folder, and the link was then renamed
+    into the folder.  Charts are drawn into a temporary file ulam makes (mkstemp), through its
+    descriptor: a planted link at any name is neither followed nor kept."""
+    if subprocess.run(["sh", "-c", "command -v gnuplot"], capture_output=True).returncode != 0:
+        return  # no gnuplot: no charts drawn
+    with tempfile.TemporaryDirectory() as d:
+        victim = os.path.join(d, "victim.txt")
+        open(victim, "wb").write(b"precious\n")
+        out = os.path.join(d, "st")
+        os.mkdir(out)
+        charts = ["rmse-collision", "work", "coverage"]
+        for c in charts:
+            os.symlink(victim, os.path.join(out, f"{c}.tmp.png"))
+        rc, stdout, err = run(ulam, ["study", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx", "--index", "1",
+                                     "--methods", "adjoint-collision-plain", "--budgets", "100,1000", "--repeats", "3",
+                                     "--out", out, "--reference-time", "0"])
+        assert rc == 0, err
+        assert open(victim, "rb").read() == b"precious\n", "a chart was drawn through the planted symlink"
+        for c in charts:
+            p = os.path.join(out, c + ".png")
+            assert not os.path.islink(p) and open(p, "rb").read(8) == b"\x89PNG\r\n\x1a\n", f"{c}.png: a link or not a PNG"
+
+
+CHECKS = [check_study_chart_symlinks, check_output_is_input, check_pipes, check_relabel, check_study_counts_every_run, check_radiosity_obj_lines,
           check_radiosity_mtllib_not_regular, check_matrix_zeros_streamed]
 
 

@@ -629,18 +629,19 @@ static void lapack_mark(const study *st, char *buf, size_t len)
 }
 
 /* Draw DIR/NAME.FORMAT from script, and keep the script beside it as DIR/NAME.gp ('cd DIR &&
- * gnuplot NAME.gp' redraws it from the CSVs there); the chart is drawn under a temporary name and
- * renamed into place.  ULAM_OK or ULAM_EIO (gnuplot missing or failed). */
+ * gnuplot NAME.gp' redraws it from the CSVs there); the chart is drawn into a temporary file that
+ * ulam made (mkstemp: O_EXCL, a fresh name, never a planted symlink), which gnuplot writes through
+ * the descriptor it inherits (/dev/fd/N: no name to follow), then renamed into place.  ULAM_OK or
+ * ULAM_EIO (gnuplot missing or failed). */
 static int draw(const study *st, const char *name, int width, int height, const char *script)
 {
-    char term[128], gp[4200], tmp[4200], out[4200], cmd[4200];
+    char term[128], gp[4200], out[4200], cmd[4200];
     const char *fmt = st->format;
     if (!strcmp(fmt, "pdf")) snprintf(term, sizeof term, "pdfcairo size %gin,%gin font 'sans,9'", width / 100.0, height / 100.0);
     else if (!strcmp(fmt, "svg")) snprintf(term, sizeof term, "svg size %d,%d font 'sans,10' background 'white'", width, height);
     else snprintf(term, sizeof term, "pngcairo size %d,%d font 'sans,10'", width, height);
     snprintf(gp, sizeof gp, "%s/%s.gp", st->out, name);
     snprintf(out, sizeof out, "%s/%s.%s", st->out, name, fmt);
-    snprintf(tmp, sizeof tmp, "%s/%s.tmp.%s", st->out, name, fmt);
     const char *head = "set datafile separator ','\nset grid\n";
     ulam_outfile o;
     if (!ulam_outfile_open(&o, gp)) {
@@ -649,13 +650,21 @@ static int draw(const study *st, const char *name, int width, int height, const 
         if (ulam_outfile_commit(&o)) return ULAM_EIO;
     }
     if (strchr(st->out, '\'')) return ULAM_EINVAL;
+    ulam_outfile chart;
+    if (cli_outfile_open(&chart, out)) return ULAM_EIO;
+    fflush(chart.f);
     snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot 2>/dev/null", st->out);
     FILE *g = popen(cmd, "w");
-    if (!g) return ULAM_EIO;
-    fprintf(g, "set terminal %s\nset output '%s.tmp.%s'\n%s%s\nset output\n", term, name, fmt, head, script);
-    int ok = pclose(g) == 0 && rename(tmp, out) == 0;
-    if (!ok) remove(tmp);
-    return ok ? ULAM_OK : ULAM_EIO;
+    if (!g) {
+        cli_outfile_abort(&chart);
+        return ULAM_EIO;
+    }
+    fprintf(g, "set terminal %s\nset output '/dev/fd/%d'\n%s%s\nset output\n", term, fileno(chart.f), head, script);
+    if (pclose(g) != 0) {
+        cli_outfile_abort(&chart);
+        return ULAM_EIO;
+    }
+    return cli_outfile_commit(&chart) ? ULAM_EIO : ULAM_OK;
 }
 
 /* The RMSE chart of the methods in names (one estimator's: at most 6, each its own colour and dash)
