@@ -832,6 +832,13 @@ double ulam_system_omega(const ulam_system *s)
     return s ? s->omega : 0.0;
 }
 
+/* The mapping's address and length. */
+void ulam_system_mapping(const ulam_system *s, const void **addr, size_t *bytes)
+{
+    if (addr) *addr = s ? s->map : NULL;
+    if (bytes) *bytes = s && s->map ? s->map_bytes : 0;
+}
+
 /* Unmap and free. */
 ulam_system *ulam_system_free(ulam_system *s)
 {

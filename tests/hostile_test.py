@@ -11,6 +11,7 @@ import subprocess
 import sys
 import tempfile
 
+from cli_test import stopped  # noqa: E402  (waits for a process to stop itself)
 from ulam_status import code  # noqa: E402  (the enum of include/ulam.h)
 
 
@@ -292,7 +293,55 @@ def check_study_chart_symlinks(ulam):
             assert not os.path.islink(p) and open(p, "rb").read(8) == b"\x89PNG\r\n\x1a\n", f"{c}.png: a link or not a PNG"
 
 
-CHECKS = [check_study_chart_symlinks, check_output_is_input, check_pipes, check_relabel, check_study_counts_every_run, check_radiosity_obj_lines,
+def check_radiosity_early_exit_frees(ulam):
+    """Point 10: ASan found 48 bytes leaked from parse_at (the --at list) when radiosity stopped early
+    on an error (a scene that does not load, an output refused).  Every early exit frees it: under
+    ASan's leak check (.ci/run step 2) a leak turns the exit code into LeakSanitizer's 23."""
+    with tempfile.TemporaryDirectory() as d:
+        bad = os.path.join(d, "bad.obj")
+        open(bad, "w").write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")
+        for scene, status in ((os.path.join(d, "missing.obj"), "EIO"), (bad, "ENOTFOUND")):
+            rc, out, err = run(ulam, ["radiosity", scene, "--at", "0,0,0", "--at", "0.5,0.5,0,0,0,1"])
+            assert rc == code(status) and "LeakSanitizer" not in err, f"{scene}: exit {rc}: {err.strip()[-400:]}"
+
+
+def check_mapped_file_shrinks(ulam):
+    """Point 4: SIGBUS (exit 135) when a prepared file was truncated during `info`, or replaced by
+    `cp new.ulam sys.ulam` during a default `solve`.  Deterministic: the process stops itself once
+    the file is mapped (ULAM_TEST_STOP_AT_MAP), the file shrinks, the process goes on and reads
+    the lost pages: a clear error naming the file, exit 13, nothing on stdout, no signal death."""
+    import shutil
+    import signal
+    with tempfile.TemporaryDirectory() as d:
+        sysf, small = os.path.join(d, "sys.ulam"), os.path.join(d, "small.ulam")
+        rc, out, err = run(ulam, ["prepare", "matrices/randsub1000.mtx", "--rhs", "matrices/randsub1000_b.mtx", "-o", sysf])
+        assert rc == 0, err
+        rc, out, err = run(ulam, ["prepare", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx", "-o", small])
+        assert rc == 0, err
+        whole = open(sysf, "rb").read()
+        cases = [("info, truncated", ["info", sysf], lambda: os.truncate(sysf, 4096)),
+                 ("solve, cp over it", ["solve", sysf, "--index", "3", "--walks", "2000"], lambda: shutil.copyfile(small, sysf)),
+                 ("direct, truncated to 0", ["direct", sysf], lambda: os.truncate(sysf, 0))]
+        for name, args, shrink in cases:
+            open(sysf, "wb").write(whole)
+            env = dict(os.environ, ULAM_TEST_STOP_AT_MAP="1")
+            p = subprocess.Popen([ulam] + args, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            try:
+                assert stopped(p), f"{name}: ended before the mapping: {p.communicate()}"
+                shrink()
+                p.send_signal(signal.SIGCONT)
+                out, err = p.communicate(timeout=300)
+            finally:
+                if p.poll() is None:
+                    p.kill()
+                    p.wait()
+            assert p.returncode == code("EIO"), f"{name}: exit {p.returncode}: {err.strip()[-300:]}"
+            assert re.search(rf"^ulam: {re.escape(sysf)}: error: .*prepared file that stays whole while in use", err, re.M), \
+                f"{name}: {err}"
+            assert out == "", f"{name}: printed {out}"
+
+
+CHECKS = [check_mapped_file_shrinks, check_radiosity_early_exit_frees, check_study_chart_symlinks, check_output_is_input, check_pipes, check_relabel, check_study_counts_every_run, check_radiosity_obj_lines,
           check_radiosity_mtllib_not_regular, check_matrix_zeros_streamed]
 
 

@@ -293,6 +293,10 @@ int cli_study(int argc, char **argv);
 int cli_radiosity(int argc, char **argv);
 int cli_prepare(int argc, char **argv);
 
+/* Remember (on 1) or forget (on 0) the mapping of the prepared system s read from path: a SIGBUS
+ * in it (the file shrank while in use) is reported as that file's error, exit 13. */
+void cli_map_register(const ulam_system *s, const char *path, int on);
+
 /* Check before any work that path can be written (a temporary file beside it, not a directory);
  * 0 or an exit code (reported). */
 int cli_check_output(const char *path);

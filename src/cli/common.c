@@ -115,11 +115,67 @@ static void catch(int sig, void (*h)(int))
     sigaction(sig, &sa, NULL);
 }
 
-/* Remove the temporary files on SIGINT, SIGTERM and SIGHUP, in every phase. */
+/* The mapped prepared files (cli_map_register): a SIGBUS inside one is that file shrinking. */
+enum { CLI_MAPS = 8 };
+static struct {
+    const char *path;
+    const char *addr;
+    size_t bytes;
+} cli_maps[CLI_MAPS];
+
+/* Write s to stderr from a signal handler (async-signal-safe). */
+static void say(const char *s)
+{
+    for (size_t n = strlen(s); n;) {
+        ssize_t w = write(2, s, n);
+        if (w <= 0) return;
+        s += w, n -= (size_t)w;
+    }
+}
+
+/* SIGBUS: a read of a mapped prepared file past its end, which shrank under ulam (truncated, or
+ * replaced in place by cp): say which file, remove the temporary files and exit with ULAM_EIO's
+ * code, nothing printed from it.  Any other SIGBUS dies as the default action would. */
+static void on_bus(int sig, siginfo_t *si, void *ctx)
+{
+    (void)ctx;
+    const char *a = si ? (const char *)si->si_addr : NULL;
+    for (int k = 0; a && k < CLI_MAPS; k++)
+        if (cli_maps[k].path && a >= cli_maps[k].addr && a < cli_maps[k].addr + cli_maps[k].bytes) {
+            say("ulam: "), say(cli_maps[k].path);
+            say(": error: file cannot be opened, read or written: expected a prepared file that stays whole while "
+                "in use (it shrank under ulam: truncated, or replaced in place; replace it by renaming a new file "
+                "over it)\n");
+            remove_tmps();
+            _exit(cli_exit_code(ULAM_EIO));
+        }
+    signal(sig, SIG_DFL);
+}
+
+/* Remember (on 1) or forget (on 0) the mapping of s, read from path, for on_bus. */
+void cli_map_register(const ulam_system *s, const char *path, int on)
+{
+    const void *addr;
+    size_t bytes;
+    ulam_system_mapping(s, &addr, &bytes);
+    if (!addr) return;
+    for (int k = 0; k < CLI_MAPS; k++)
+        if (on ? !cli_maps[k].path : cli_maps[k].addr == addr) {
+            cli_maps[k].addr = addr, cli_maps[k].bytes = bytes;
+            cli_maps[k].path = on ? path : NULL;
+            return;
+        }
+}
+
+/* Remove the temporary files on SIGINT, SIGTERM and SIGHUP, in every phase; report SIGBUS in a
+ * mapped prepared file. */
 void cli_signals_init(void)
 {
     cli_main_thread = pthread_self();
     catch(SIGINT, on_fatal), catch(SIGTERM, on_fatal), catch(SIGHUP, on_fatal);
+    struct sigaction sa = {.sa_sigaction = on_bus, .sa_flags = SA_SIGINFO};
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGBUS, &sa, NULL);
 }
 
 /* SIGINT (and SIGTERM under MPI, which mpirun sends every rank on Ctrl-C): the first asks the
@@ -500,6 +556,9 @@ int cli_load_system(cli_system *s)
                                s->matrix_path);
     int status = read_input(s->matrix_path, s->cache, &s->sys_M, &s->own_M, NULL, NULL, &err);
     if (status) return cli_report(s->matrix_path, &err);
+    cli_map_register(s->sys_M, s->matrix_path, 1);
+    /* test hook (tests/hostile_test.py): stop once the file is mapped, before its arrays are read */
+    if (s->sys_M && getenv("ULAM_TEST_STOP_AT_MAP")) raise(SIGSTOP);
     const ulam_csr *mapped = NULL;
     const double *mapped_b = NULL;
     ulam_system_lazy(s->sys_M, &mapped, &mapped_b); /* verified below, or as walks read it (lazy) */
@@ -519,6 +578,7 @@ int cli_load_system(cli_system *s)
             cli_system_free(s);
             return cli_report(s->rhs_path, &err);
         }
+        cli_map_register(s->sys_b, s->rhs_path, 1);
         const double *vb = NULL;
         ulam_system_lazy(s->sys_b, NULL, &vb);
         if (s->sys_b) ulam_system_rhs(s->sys_b, &nb);
@@ -557,6 +617,7 @@ void cli_system_free(cli_system *s)
     s->own_M = ulam_csr_free(s->own_M);
     free(s->own_b);
     s->own_b = NULL;
+    cli_map_register(s->sys_M, NULL, 0), cli_map_register(s->sys_b, NULL, 0);
     s->sys_M = ulam_system_free(s->sys_M);
     s->sys_b = ulam_system_free(s->sys_b);
     s->M = NULL, s->b = NULL, s->cert = NULL;
