@@ -154,6 +154,8 @@ def check_radiosity_obj_lines(ulam):
         rc, out, err = run(ulam, ["radiosity", obj, "--list"])
         assert rc == code("ESYNTAX") and re.search(rf"{re.escape(long_mtl)}:1: error: .*line of at most", err), \
             f"a 3 MiB MTL line: exit {rc}: {err.strip()[:300]}"
+        rc, out, err = run(ulam, ["radiosity", "/dev/zero", "--list"])  # said at the first NUL, not at the bound
+        assert rc == code("ESYNTAX") and re.search(r"/dev/zero:1: error: .*NUL byte", err), f"/dev/zero: {rc} {err}"
 
 
 def check_radiosity_mtllib_not_regular(ulam):

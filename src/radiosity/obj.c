@@ -26,7 +26,7 @@ enum { LINE_OK, LINE_EOF, LINE_LONG, LINE_NUL, LINE_NOMEM, LINE_EIO };
 static int next_line(FILE *f, char **buf, size_t *cap, size_t *len)
 {
     size_t n = 0;
-    int c, nul = 0;
+    int c;
     while ((c = getc(f)) != EOF) {
         if (n + 2 > *cap) {
             if (*cap >= OBJ_LINE_MAX) return LINE_LONG;
@@ -35,15 +35,15 @@ static int next_line(FILE *f, char **buf, size_t *cap, size_t *len)
             if (!nb) return LINE_NOMEM;
             *buf = nb, *cap = want;
         }
+        if (c == 0) return LINE_NUL; /* a binary file: said at once, not read on to the bound */
         (*buf)[n++] = (char)c;
-        nul |= c == 0;
         if (c == '\n') break;
     }
     if (c == EOF && ferror(f)) return LINE_EIO;
     if (n == 0) return LINE_EOF;
     (*buf)[n] = '\0';
     *len = n;
-    return nul ? LINE_NUL : LINE_OK;
+    return LINE_OK;
 }
 
 /* The status of a failed next_line (got) at line of the OBJ or MTL file, err filled. */
