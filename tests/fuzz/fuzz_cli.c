@@ -198,7 +198,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (!dir[0]) {
         const char *tmp = getenv("TMPDIR");
-        snprintf(dir, sizeof dir, "%s/ulam-fuzz-cli-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+        snprintf(dir, sizeof dir, "%s/ulam-fuzz-cli-XXXXXX", tmp && *tmp ? tmp : P_tmpdir);
         if (!mkdtemp(dir)) return dir[0] = 0, 0;
         atexit(cleanup);
     }
