@@ -544,6 +544,12 @@ double ulam_system_omega(const ulam_system *s);
 /* Unmap and free; accepts and returns NULL. */
 ulam_system *ulam_system_free(ulam_system *s);
 
+/* The file mapping behind s: its first byte in *addr and its length in *bytes (NULL and 0 for
+ * borrowed memory or s NULL).  A file that shrinks while mapped (truncated, or replaced in place
+ * by `cp`) makes a read of the lost pages raise SIGBUS: a program that catches SIGBUS can tell
+ * such a fault (si_addr inside the mapping) from others and report the file. */
+void ulam_system_mapping(const ulam_system *s, const void **addr, size_t *bytes);
+
 /* The content tag of a source file for a cache (ulam_system_desc.tag, ulam_system_open's tag):
  * the XXH3-128 hash of its bytes (low, high), so an edit that keeps the size and the modification
  * time still changes it.  ULAM_OK, ULAM_EIO or ULAM_ENOMEM. */

@@ -529,13 +529,16 @@ int ulam_system_open(const char *path, const uint64_t tag[2], ulam_system **out,
     return ULAM_OK;
 }
 
-/* 1 when path starts with the prepared-system magic. */
+/* 1 when path is a regular file that starts with the prepared-system magic.  A pipe, FIFO or
+ * device is never one (it cannot be mapped) and is not read: its first bytes stay for the parser
+ * (`info /dev/stdin`, `solve <(cat m.mtx)` found an empty file when this consumed them). */
 int ulam_system_is_file(const char *path)
 {
     char m[8];
-    FILE *f = path ? fopen(path, "rb") : NULL;
-    int yes = f && fread(m, 1, 8, f) == 8 && !memcmp(m, MAGIC, 8);
-    if (f) fclose(f);
+    struct stat st;
+    int fd = path ? open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC) : -1;
+    int yes = fd >= 0 && !fstat(fd, &st) && S_ISREG(st.st_mode) && pread(fd, m, 8, 0) == 8 && !memcmp(m, MAGIC, 8);
+    if (fd >= 0) close(fd);
     return yes;
 }
 
@@ -866,6 +869,13 @@ double ulam_system_omega(const ulam_system *s)
     return s ? s->omega : 0.0;
 }
 
+/* The mapping's address and length. */
+void ulam_system_mapping(const ulam_system *s, const void **addr, size_t *bytes)
+{
+    if (addr) *addr = s ? s->map : NULL;
+    if (bytes) *bytes = s && s->map ? s->map_bytes : 0;
+}
+
 /* Unmap and free. */
 ulam_system *ulam_system_free(ulam_system *s)
 {
@@ -883,8 +893,13 @@ int ulam_file_tag(const char *path, uint64_t tag[2], ulam_error *err)
 {
     ulam__clear(err);
     if (!path || !tag) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path and a tag");
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) return ulam__fail(err, ULAM_EIO, 0, -1, "a readable file");
+    struct stat sb;
+    if (fstat(fd, &sb) || !S_ISREG(sb.st_mode)) { /* a pipe read here would be lost to the parser */
+        close(fd);
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a regular file (a pipe or device has no lasting content to tag)");
+    }
     XXH3_state_t *st = XXH3_createState();
     enum { CHUNK = 1 << 20 };
     unsigned char *buf = malloc(CHUNK);

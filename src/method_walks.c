@@ -20,6 +20,12 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     const ulam_auto_result *au = &ch->walks;
     if (au->chosen >= 0) ch->leader_work = ch->method[k].predicted_work = au->cand[au->chosen].predicted_work;
     int c = au->chosen >= 0 ? au->chosen : au->closest;
+    if (!status && c < 0) /* no candidate to run, not even the closest: refused, never another row's answer */
+        return ulam__fail(err, au->abs.upper < 1 ? ULAM_EINFVAR : ULAM_EDIVERGE, 0, -1,
+                          "a walk candidate with a finite bound on rho(M^) (none of %d has one; rho(|M|) in [%.3g, "
+                          "%.3g]): M's entries may span too many orders of magnitude; scale its rows and columns, or "
+                          "use 'ulam direct'",
+                          au->ncand, au->abs.lower, au->abs.upper);
     if (c >= 0) {
         ulam_walk_opts *o = &q->run->o;
         o->mode = au->cand[c].mode, o->estimator = au->cand[c].estimator;

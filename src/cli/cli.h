@@ -198,6 +198,9 @@ void cli_print_z(double estimate, double direct, double std_error, double lo, do
 /* Print a power-iteration radius with its bounds (no newline). */
 void cli_print_power(const ulam_power *p);
 
+/* A radius in words (cli_print_power's figures): buf of 32 characters, returned. */
+const char *cli_radius_str(char *buf, double x);
+
 /* The guards' radii for a walk in mode on s with kernel exponent alpha (rho(|M|) and that mode's
  * rho(M^), stopped once certified): a prepared file's certificate made for this continuation
  * (and exponent: a certificate holds alpha = 1's) serves instead of a pass
@@ -309,9 +312,24 @@ int cli_study(int argc, char **argv);
 int cli_radiosity(int argc, char **argv);
 int cli_prepare(int argc, char **argv);
 
+/* Remember (on 1) or forget (on 0) the mapping of the prepared system s read from path: a SIGBUS
+ * in it (the file shrank while in use) is reported as that file's error, exit 13. */
+void cli_map_register(const ulam_system *s, const char *path, int on);
+
 /* Check before any work that path can be written (a temporary file beside it, not a directory);
  * 0 or an exit code (reported). */
 int cli_check_output(const char *path);
+
+/* A file a run names: the option that names it ("--out"; the input's own name for an input)
+ * and its path (NULL: not given). */
+typedef struct {
+    const char *opt, *path;
+} cli_file;
+
+/* Check the nout outputs (cli_check_output each), then refuse (usage error, EXIT_USAGE) an output
+ * that is one of the nin inputs (the same file: same device and inode, through any path, link
+ * or symlink) or another output of this run; 0 or the exit code (reported). */
+int cli_check_outputs(const char *command, const cli_file *outs, int nout, const cli_file *ins, int nin);
 
 /* A progress line on stderr for a terminal (nothing on a pipe, with --json, or off rank 0). */
 typedef struct cli_progress {
