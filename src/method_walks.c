@@ -18,7 +18,14 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     ulam_choice *ch = q->ch;
     int status = ulam__auto_solver_reach(q->M, q->b, q->o, q->ao, q->reach, &ch->walks, &q->run->sv, err);
     const ulam_auto_result *au = &ch->walks;
-    if (au->chosen >= 0) ch->leader_work = ch->method[k].predicted_work = au->cand[au->chosen].predicted_work;
+    if (au->chosen >= 0) {
+        double w = au->cand[au->chosen].predicted_work;
+        const ulam_stop_opts *st = &q->o->stop;
+        if (isnan(w) && !(st->rel_err > 0) && st->max_walks == 0 && st->max_seconds > 0)
+            w = st->max_seconds / ULAM_AUTO_UNIT_SECONDS; /* --time alone: the work the time buys at the work
+                                                            model's rate (a constant: the same on any machine) */
+        ch->leader_work = ch->method[k].predicted_work = w;
+    }
     int c = au->chosen >= 0 ? au->chosen : au->closest;
     if (c >= 0) {
         ulam_walk_opts *o = &q->run->o;
