@@ -233,6 +233,21 @@ static void interval_at(const ulam_walk_result *w, double n, ulam__stop_ci *ci)
         ulam__stop_interval((int64_t)n, w->estimate, w->variance, R, 0.0, 0.0, INFINITY, 0, ci);
 }
 
+/* A pilot round of the walks leader on b (seed o's ^ salt) on its own solver, which is then set
+ * back to the run's options (ulam__solver_rerun: the same walks as before, bit for bit; its rows,
+ * reachable set and bounds are reused, so the pilot costs its walks alone), into *wr. */
+static int leader_pilot(ulam_run *r, uint64_t salt, ulam_walk_result *wr, ulam_error *err)
+{
+    ulam_walk_opts po = r->o;
+    po.stop.max_walks = DENSE_PILOT, po.stop.max_seconds = 0, po.stop.interrupt = NULL, po.exec.share = NULL;
+    po.exec.seed = r->o.exec.seed ^ salt;
+    int status = ulam__solver_rerun(r->sv, &po, err);
+    while (!status && !ulam_solver_done(r->sv)) status = ulam_solver_iterate(r->sv);
+    if (!status) ulam_solver_result(r->sv, wr);
+    int back = ulam__solver_rerun(r->sv, &r->o, NULL);
+    return status ? status : back;
+}
+
 /* A fixed budget (a walk count, or --time: the walks the work it buys pays for, src/method_walks.c): the leader's
  * interval at that budget, predicted from a pilot of its own walks on b; where its range term
  * leads (a large b_j the walks reach rarely), b pushed down to rmax = max|b| times the variance
@@ -246,11 +261,8 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
     ulam_method_verdict *v = &ch->method[k];
     const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
     double N = q->o->stop.max_walks > 0 ? (double)q->o->stop.max_walks : floor(W / c->work_per_walk);
-    ulam_walk_opts lo = *q->o;
-    lo.mode = c->mode, lo.estimator = c->estimator, lo.kernel.continue_q = c->continue_q;
-    lo.kernel.kernel_alpha = c->kernel_alpha, lo.policy.guard = &ch->walks.guard;
     ulam_walk_result wb, wr;
-    int status = pilot_on(q->M, q->b, &lo, UINT64_C(0x2545f4914f6cdd1d), &wb, err);
+    int status = q->run->sv ? leader_pilot(q->run, UINT64_C(0x2545f4914f6cdd1d), &wb, err) : ULAM_EINVAL;
     if (status) return status == ULAM_ENOMEM ? status : ULAM_OK; /* the leader's own run will say why */
     ulam__stop_ci cb, cr;
     interval_at(&wb, N, &cb);

@@ -22,8 +22,9 @@ static int predict(ulam__query *q, int k, ulam_error *err)
         double w = au->cand[au->chosen].predicted_work;
         const ulam_stop_opts *st = &q->o->stop;
         if (isnan(w) && !(st->rel_err > 0) && st->max_walks == 0 && st->max_seconds > 0)
-            w = st->max_seconds / ULAM_AUTO_UNIT_SECONDS; /* --time alone: the work the time buys at the work
-                                                            model's rate (a constant: the same on any machine) */
+            w = exp2(floor(log2(st->max_seconds / ULAM_AUTO_UNIT_SECONDS))); /* --time alone: the work the time
+                buys at the work model's rate (a constant, not this machine's), rounded down to a power of 2 so that
+                the time a caller has left after its set-up (the CLI's) seldom changes a plan made on it */
         ch->leader_work = ch->method[k].predicted_work = w;
     }
     int c = au->chosen >= 0 ? au->chosen : au->closest;
