@@ -367,17 +367,23 @@ static int pin(ulam__query *q, int k, ulam_error *err)
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     if (nb == 0) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero b (b is zero, so x is 0)");
     if (ulam_method_bidir_route(q->b, n, q->ao, q->o)) { /* the push on b, planned from a pilot round on b */
-        if (!(q->o->stop.rel_err > 0))
-            return ulam__fail(err, ULAM_EINVAL, 0, -1, "a --rel-err target for bidirectional with a dense b "
-                                                       "(more than max(16, n/10) = %lld nonzeros)",
+        if (!(q->o->stop.rel_err > 0) && !(q->o->stop.max_walks > 0))
+            return ulam__fail(err, ULAM_EINVAL, 0, -1, "a --rel-err target or a walk count for bidirectional with a "
+                                                       "dense b (more than max(16, n/10) = %lld nonzeros)",
                               (long long)ulam_method_sparse_limit(n));
         ulam_walk_opts po = dense_walk_opts(q->o, NULL, 0.0);
         ulam_walk_result wr;
         int status = pilot_on(q->M, q->b, &po, UINT64_C(0x7f4a7c159e3779b9), &wr, err);
         if (status) return status;
-        double m = fabs(wr.estimate + q->o->stop.rel_err_offset);
-        status = dense_plan(q, q->o, NULL, rule_rmax(q->b, n, wr.variance, m, wr.min_walks, q->o->stop.rel_err),
-                            100 * ulam_csr_nnz(q->M) + 1000000, NULL, err);
+        double m = fabs(wr.estimate + q->o->stop.rel_err_offset), rmax;
+        if (q->o->stop.rel_err > 0) {
+            rmax = rule_rmax(q->b, n, wr.variance, m, wr.min_walks, q->o->stop.rel_err);
+        } else { /* a walk count: as fixed_predict, the range term brought to about the variance term's */
+            ulam__stop_ci ci;
+            interval_at(&wr, (double)q->o->stop.max_walks, &ci);
+            rmax = ulam__bpush_max(q->b, n) * (ci.range_term > ci.var_term && isfinite(ci.half) ? ci.var_term / ci.range_term : 1.0);
+        }
+        status = dense_plan(q, q->o, NULL, rmax, 100 * ulam_csr_nnz(q->M) + 1000000, NULL, err);
         q->ch->bidir_opts = ulam_bidir_defaults(), q->ch->bidir_opts.walk = q->run->bwo;
         return status;
     }

@@ -530,6 +530,10 @@ static void test_push_b_fixed_budget(void **state)
     print_message("10^4 walks: %d of %d cover (at least %d), mean half-width %.3g%% of x_0\n", covered, R, lower,
                   100 * width / x[0]);
     assert_true(covered >= lower);
+    ulam_method_opts mo = ulam_method_defaults(); /* the row pinned, at a walk count (was: refused without --rel-err) */
+    mo.method = ULAM_METHOD_BIDIRECTIONAL, o.exec.seed = 1;
+    assert_int_equal(ulam_auto(M, b, &o, NULL, &mo, ch, &a, NULL), ULAM_OK);
+    assert_true(a.walks.walks == 10000 && a.ci95[0] <= x[0] && x[0] <= a.ci95[1] && a.bidir.push.ops > 0);
     o = ulam_walk_defaults(); /* --time alone: the walks the time buys at the work model's rate (no clock) */
     o.stop.max_walks = 0, o.stop.max_seconds = 0.05;
     assert_int_equal(ulam_auto(M, b, &o, NULL, NULL, ch, &a, NULL), ULAM_OK);
