@@ -139,8 +139,9 @@ static int setup(ulam__query *q, const ulam_walk_opts *walk, ulam_error *err)
     return ULAM_OK;
 }
 
-/* Pilot walks of the dense route: one round of the walk solver on the residual. */
-enum { DENSE_PILOT = 1024 };
+/* Pilot walks of the dense route: one round of the walk solver on the residual; at a fixed
+ * budget, at most FIXED_ROUNDS rounds of push and pilot. */
+enum { DENSE_PILOT = 1024, FIXED_ROUNDS = 4 };
 
 /* The dense route's walks' options: adjoint from the index with kernel c's estimator,
  * continuation and exponent (c NULL: o's), the push part q_i as the rule's offset. */
@@ -165,19 +166,26 @@ static double rule_rmax(const double *b, int64_t n, double var, double m, double
 /* The dense route (b has more nonzeros than ulam_method_sparse_limit): the transpose, b pushed
  * down to rmax within max_ops, and a pilot round of the walks on the residual (into *wr), whose
  * rule (src/stop.c, on the residual's own range) predicts the walks; the plan in ch->bidir.  c:
- * the kernel the walks run with (NULL: o's). */
+ * the kernel the walks run with (NULL: o's).  Called again on the same run, the push goes on
+ * from where it stopped (its operations counted from the first call, max_ops theirs in all) and
+ * a new pilot runs on the new residual. */
 static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_candidate *c, double rmax,
                       int64_t max_ops, ulam_walk_result *wr_out, ulam_error *err)
 {
     ulam_run *r = q->run;
     ulam_bidir_plan_info *pl = &q->ch->bidir;
-    int64_t n = q->M->nrows, ops = 0, nnz = ulam_csr_nnz(q->M);
+    int64_t n = q->M->nrows, ops = 0, nnz = ulam_csr_nnz(q->M), pw = 0, ps = 0;
     double E = o->stop.rel_err, t0 = ulam_now();
-    memset(pl, 0, sizeof *pl);
-    r->bq = calloc((size_t)n, sizeof *r->bq), r->br = malloc((size_t)n * sizeof *r->br);
-    int status = r->bq && r->br ? transpose(q, err) : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose and the push on b");
-    if (status) return release(r), status;
-    memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
+    int status = ULAM_OK;
+    if (r->bq && r->br) { /* going on */
+        ops = pl->push.ops, pw = pl->pilot_walks, ps = pl->pilot_steps, t0 -= pl->seconds;
+    } else {
+        memset(pl, 0, sizeof *pl);
+        r->bq = calloc((size_t)n, sizeof *r->bq), r->br = malloc((size_t)n * sizeof *r->br);
+        status = r->bq && r->br ? transpose(q, err) : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose and the push on b");
+        if (status) return release(r), status;
+        memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
+    }
     if ((status = ulam__bpush(r->Mt, rmax, max_ops, r->bq, r->br, &ops)))
         return release(r), ulam__fail(err, status, 0, -1, "memory for the push on b");
     double qi = r->bq[o->query.index];
@@ -198,10 +206,10 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
                         : (double)o->stop.max_walks; /* a fixed budget: fixed_predict sets it */
     pl->target = o->query.index, pl->rmax = rmax, pl->balanced = 1, pl->push_part = qi;
     pl->push = (ulam_push_info){.target = o->query.index, .rmax = rmax, .ops = ops, .r_max = ulam__bpush_max(r->br, n)};
-    pl->pilot_walks = wr.walks, pl->pilot_steps = wr.steps, pl->mean_visits = V + 1.0;
+    pl->pilot_walks = pw + wr.walks, pl->pilot_steps = ps + wr.steps, pl->mean_visits = V + 1.0;
     pl->predicted_walks = mt > 0 ? need : INFINITY, pl->step_cost = 1.0;
     pl->predicted_work = ULAM_AUTO_READ * ((double)ops + 2.0 * (double)nnz) +
-                         ((double)wr.walks + pl->predicted_walks) * (V + ULAM_AUTO_WALK);
+                         ((double)pl->pilot_walks + pl->predicted_walks) * (V + ULAM_AUTO_WALK);
     pl->seconds = ulam_now() - t0;
     r->bplan = *pl;
     return ULAM_OK;
@@ -252,9 +260,11 @@ static int leader_pilot(ulam_run *r, uint64_t salt, ulam_walk_result *wr, ulam_e
  * interval at that budget, predicted from a pilot of its own walks on b; where its range term
  * leads (a large b_j the walks reach rarely), b pushed down to rmax = max|b| times the variance
  * term over the range term (the range term, linear in max|r|, then about the variance term)
- * within W / 2 operations, and the walks on the residual piloted.  Predicted work: the push, the
- * transpose, the pilot and the walks the residual needs for the leader's interval (its walks'
- * work when it then runs the budget's walks: a narrower interval at the same count). */
+ * within W / 2 operations, and the walks on the residual piloted; while the residual's range
+ * term still leads (the push lowers the variance too), rmax goes down by the same rule and the
+ * push on (FIXED_ROUNDS at most).  Predicted work: the walks the residual needs for the leader's
+ * interval at the budget (the push, transpose and pilots are spent by then either way); chosen,
+ * it runs the budget's walks (a narrower interval at the same count). */
 static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
 {
     ulam_choice *ch = q->ch;
@@ -273,14 +283,19 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
     }
     double rmax = ulam__bpush_max(q->b, q->M->nrows) * cb.var_term / cb.range_term;
     int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
-    if ((status = dense_plan(q, q->o, c, rmax, cap, &wr, err)) == ULAM_ENOMEM) return status;
-    ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = q->run->bwo, ch->bidir_opts.target = q->o->query.index;
-    if (status) {
-        snprintf(v->why, sizeof v->why, "refused: %.250s", err->msg);
-        return ULAM_OK;
-    }
-    interval_at(&wr, N, &cr);
     ulam_bidir_plan_info *pl = &ch->bidir;
+    for (int round = 1;; round++) { /* the push also lowers the variance: while the residual's range term still
+                                       leads, on down (a pilot a round, FIXED_ROUNDS at most) */
+        if ((status = dense_plan(q, q->o, c, rmax, cap, &wr, err)) == ULAM_ENOMEM) return status;
+        ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = q->run->bwo, ch->bidir_opts.target = q->o->query.index;
+        if (status) {
+            snprintf(v->why, sizeof v->why, "refused: %.250s", err->msg);
+            return ULAM_OK;
+        }
+        interval_at(&wr, N, &cr);
+        if (round >= FIXED_ROUNDS || !(cr.range_term > cr.var_term) || pl->push.ops >= cap || !(pl->push.r_max > 0)) break;
+        rmax = fmin(0.5 * rmax, pl->push.r_max * cr.var_term / cr.range_term);
+    }
     pl->predicted_walks = N;
     if (!(cr.half < cb.half)) {
         snprintf(v->why, sizeof v->why, "lost: at %.3g walks its interval is predicted -+ %.3g, the walks' -+ %.3g", N,
@@ -295,8 +310,7 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
         else lo_n = mid;
     }
     double V = wr.walks ? (double)wr.steps / (double)wr.walks : 0.0;
-    pl->predicted_work = ULAM_AUTO_READ * ((double)pl->push.ops + 2.0 * (double)ulam_csr_nnz(q->M)) +
-                         ((double)wr.walks + hi_n) * (V + ULAM_AUTO_WALK);
+    pl->predicted_work = hi_n * (V + ULAM_AUTO_WALK); /* from here: the push and pilots are spent either way */
     q->run->bplan = *pl;
     v->predicted_work = pl->predicted_work;
     return ULAM_OK;
