@@ -1215,7 +1215,10 @@ int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opt
 /* ulam_fpush_solve's x (n entries), and of only the k (0 <= k <= n) components of largest
  * estimate: their indices into index (k entries; by decreasing estimate, ties by smaller index,
  * NaN last) and their standard errors and 95% intervals into std_error, lo and hi (k entries
- * each, each may be NULL), the same as ulam_fpush_solve gives them.  For a query that reports a
+ * each, each may be NULL), as ulam_fpush_solve gives them but for the lower ends (0 < k < n): the
+ * k are chosen by their estimates after the walks, so their lower ends are taken at delta k / n
+ * (at most a share delta / 2 of them miss below in expectation; docs/bidirectional.md), and the
+ * relative-error rule, which checks them, may walk on, so x may differ.  For a query that reports a
  * few components: no pass writes 3 n outputs (whose first touch alone dominated the walk phase on
  * R-MAT 2^20) and no sort of n.  ulam_fpush_solve's statuses; ULAM_EINVAL for k out of range or
  * no index array. */
