@@ -61,40 +61,41 @@ static void *rank_main(void *arg)
     return NULL;
 }
 
-/* Run a job on k thread-ranks; the jobs' results in jobs[0 .. k). */
-static void run_sets(int k, int sets, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se,
-                     job *jobs)
+/* Run the job tmpl on k thread-ranks (each its own copy, at its own port); the jobs' results in
+ * jobs[0 .. k). */
+static void run_jobs(int k, const job *tmpl, job *jobs)
 {
     hub h;
     hub_init(&h, k);
     pthread_t t[MAXR];
     for (int r = 0; r < k; r++) {
-        jobs[r] = (job){.port = {&h, r}, .path = path, .forward = forward, .index = index, .walks = walks, .x = x, .se = se,
-                        .sets = sets};
+        jobs[r] = *tmpl, jobs[r].port = (port){&h, r};
         pthread_create(&t[r], NULL, rank_main, &jobs[r]);
     }
     for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
     pthread_barrier_destroy(&h.bar);
 }
 
-/* Run a job on k thread-ranks as one partition. */
+/* Walks on k thread-ranks in sets (0: one partition). */
+static void run_sets(int k, int sets, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se,
+                     job *jobs)
+{
+    job t = {.path = path, .forward = forward, .index = index, .walks = walks, .x = x, .se = se, .sets = sets};
+    run_jobs(k, &t, jobs);
+}
+
+/* Walks on k thread-ranks as one partition. */
 static void run_ranks(int k, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se, job *jobs)
 {
     run_sets(k, 0, path, forward, index, walks, x, se, jobs);
 }
 
-/* Run ulam_dist_radius on k thread-ranks. */
-static void run_ranks_radius(int k, const char *path, job *jobs)
+/* Make path (a mkstemp template) a new empty file's name. */
+static void temp_file(char *path)
 {
-    hub h;
-    hub_init(&h, k);
-    pthread_t t[MAXR];
-    for (int r = 0; r < k; r++) {
-        jobs[r] = (job){.port = {&h, r}, .path = path, .radius = 1, .walks = 1};
-        pthread_create(&t[r], NULL, rank_main, &jobs[r]);
-    }
-    for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
-    pthread_barrier_destroy(&h.bar);
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
 }
 
 /* A random sparse signed M (n x n, about deg entries a row, |row sums| 0.9 at most, some rows
@@ -132,9 +133,7 @@ static void test_dist_adjoint_identical(void **state)
 {
     (void)state;
     char path[] = "/tmp/ulam_test_dist_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
+    temp_file(path);
     int64_t n = 1500;
     double *x = malloc((size_t)n * sizeof *x);
     make_system(path, n, 6, 11, x);
@@ -170,9 +169,7 @@ static void test_dist_forward_identical(void **state)
 {
     (void)state;
     char path[] = "/tmp/ulam_test_dist_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
+    temp_file(path);
     int64_t n = 1500;
     double *x = malloc((size_t)n * sizeof *x);
     make_system(path, n, 6, 12, x);
@@ -212,9 +209,7 @@ static void test_dist_sets(void **state)
 {
     (void)state;
     char path[] = "/tmp/ulam_test_dist_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
+    temp_file(path);
     int64_t n = 900;
     double *x = malloc((size_t)n * sizeof *x), *ref = malloc((size_t)n * sizeof *ref);
     double *y = malloc((size_t)n * sizeof *y), *se = malloc((size_t)n * sizeof *se), *yse = malloc((size_t)n * sizeof *yse);
@@ -255,31 +250,17 @@ static void test_dist_many(void **state)
 {
     (void)state;
     char path[] = "/tmp/ulam_test_dist_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
+    temp_file(path);
     int64_t n = 700;
     double *x = malloc((size_t)n * sizeof *x);
     make_system(path, n, 5, 16, x);
     const int64_t idx[4] = {3, 350, 699, 350};
     for (int k = 1; k <= 3; k += 2) {
-        hub h;
-        hub_init(&h, k);
-        pthread_t t[MAXR];
-        job jobs[MAXR];
-        for (int r = 0; r < k; r++) {
-            jobs[r] = (job){.port = {&h, r}, .path = path, .walks = 3000, .many = idx, .nq = 4};
-            pthread_create(&t[r], NULL, rank_main, &jobs[r]);
-        }
-        for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
-        pthread_barrier_destroy(&h.bar);
+        job jobs[MAXR], t = {.path = path, .walks = 3000, .many = idx, .nq = 4};
+        run_jobs(k, &t, jobs);
         for (int q = 0; q < 4; q++) {
-            job lone[MAXR];
-            hub h1;
-            hub_init(&h1, 1);
-            lone[0] = (job){.port = {&h1, 0}, .path = path, .walks = 3000, .index = idx[q], .seed = (uint64_t)q};
-            rank_main(&lone[0]);
-            pthread_barrier_destroy(&h1.bar);
+            job lone[1], one = {.path = path, .walks = 3000, .index = idx[q], .seed = (uint64_t)q};
+            run_jobs(1, &one, lone);
             for (int r = 0; r < k; r++) {
                 assert_int_equal(jobs[r].status, ULAM_OK);
                 assert_memory_equal(&jobs[r].manyres[q].estimate, &lone[0].res.estimate, sizeof(double));
@@ -295,15 +276,8 @@ static void test_dist_many(void **state)
 /* Run an outer method (1 MCSA, 2 single source from index) on k thread-ranks into x, se. */
 static void run_outer(int k, int outer, const char *path, int64_t index, int64_t walks, double *x, double *se, job *jobs)
 {
-    hub h;
-    hub_init(&h, k);
-    pthread_t t[MAXR];
-    for (int r = 0; r < k; r++) {
-        jobs[r] = (job){.port = {&h, r}, .path = path, .outer = outer, .index = index, .walks = walks, .x = x, .se = se};
-        pthread_create(&t[r], NULL, rank_main, &jobs[r]);
-    }
-    for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
-    pthread_barrier_destroy(&h.bar);
+    job t = {.path = path, .outer = outer, .index = index, .walks = walks, .x = x, .se = se};
+    run_jobs(k, &t, jobs);
 }
 
 /* MCSA on a partition: to a residual of 1e-10 of max |b|, x within 1e-8 of LAPACK's, the same
@@ -312,9 +286,7 @@ static void test_dist_mcsa(void **state)
 {
     (void)state;
     char path[] = "/tmp/ulam_test_dist_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
+    temp_file(path);
     int64_t n = 800;
     double *x = malloc((size_t)n * sizeof *x), *ref = malloc((size_t)n * sizeof *ref), *y = malloc((size_t)n * sizeof *y);
     make_system(path, n, 5, 17, x);
@@ -339,9 +311,7 @@ static void test_dist_source(void **state)
 {
     (void)state;
     char path[] = "/tmp/ulam_test_dist_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
+    temp_file(path);
     int64_t n = 600, s = 123;
     double *x = malloc((size_t)n * sizeof *x), *col = calloc((size_t)n, sizeof *col), *e = calloc((size_t)n, sizeof *e);
     double *ref = malloc((size_t)n * sizeof *ref), *rse = malloc((size_t)n * sizeof *rse);
@@ -380,9 +350,7 @@ static void test_dist_damaged(void **state)
 {
     (void)state;
     char path[] = "/tmp/ulam_test_dist_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
+    temp_file(path);
     int64_t n = 600;
     double *x = malloc((size_t)n * sizeof *x);
     make_system(path, n, 4, 13, x);
@@ -413,9 +381,7 @@ static void test_dist_radius(void **state)
 {
     (void)state;
     char path[] = "/tmp/ulam_test_dist_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
+    temp_file(path);
     int64_t n = 400;
     double *x = malloc((size_t)n * sizeof *x);
     make_system(path, n, 5, 14, x);
@@ -438,7 +404,8 @@ static void test_dist_radius(void **state)
     double first = NAN;
     for (int k = 1; k <= 3; k++) {
         job jobs[MAXR];
-        run_ranks_radius(k, path, jobs);
+        job t = {.path = path, .radius = 1, .walks = 1};
+        run_jobs(k, &t, jobs);
         for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
         if (k == 1) first = jobs[0].rho;
         for (int r = 0; r < k; r++) assert_memory_equal(&jobs[r].rho, &first, sizeof first);
