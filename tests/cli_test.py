@@ -251,6 +251,9 @@ CASES += [
     (["radiosity", SC + "cube.obj", "--patch", "1", "--size", "0x5"], 2, r"--size expects WxH", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "1000", "--estimator", "absorption"], 0, r"^$", r"radiosity R  2 \+- 0"),
     (["radiosity", SC + "cube.obj", "--direct", "--max-mem", "10"], code("EMEMLIMIT"), r"memory limit", ""),
+    (["radiosity", SC + "cube.obj", "--mode", "shoot", "--walks", "100", "--image", "x.png", "--camera",
+      "1e19,0.5,0.5,0.5,0.5,0.5,0,1,0,40"], code("ERANGE"), r"--camera: an eye within a million scene sizes", ""),
+    (["radiosity", SC + "cube.obj", "--at", "1e20,0.5,0.5,1,0,0"], 2, r"a point within 1e\+06 scene sizes", ""),
 ]
 R = D + "rad/"
 CASES += [

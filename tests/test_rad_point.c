@@ -608,6 +608,149 @@ static void test_mtl_notes(void **state)
     ulam_scene_free(s);
 }
 
+/* Write a furnace cube into a new temporary directory: side scale, corner at off, each face
+ * n x n quads (normals inward), Kd 0.5 and Ke 1 (B = H = 2 at every point and sensor inside);
+ * path gets the OBJ's path (dir is removed by rm_scene). */
+static void write_furnace(char dir[64], char path[96], int n, double scale, double off)
+{
+    strcpy(dir, "/tmp/ulam_furnace_XXXXXX");
+    assert_non_null(mkdtemp(dir));
+    char mtl[96];
+    snprintf(path, 96, "%s/f.obj", dir), snprintf(mtl, sizeof mtl, "%s/f.mtl", dir);
+    FILE *f = fopen(mtl, "w");
+    assert_non_null(f);
+    fprintf(f, "newmtl glow\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
+    fclose(f);
+    assert_non_null(f = fopen(path, "w"));
+    fprintf(f, "mtllib f.mtl\nusemtl glow\n");
+    /* face k: fixed axis a at 0 or 1, spanned by axes b, c with b x c = e_a (inward at 0) */
+    static const int ax[6][4] = {{1, 2, 0, 0}, {1, 2, 0, 1}, {0, 1, 2, 0}, {0, 1, 2, 1}, {2, 0, 1, 0}, {2, 0, 1, 1}};
+    int v = 0;
+    for (int k = 0; k < 6; k++) {
+        int a = ax[k][0], b = ax[k][1], c = ax[k][2], side = ax[k][3];
+        if (side) b = ax[k][2], c = ax[k][1]; /* the far face: reversed, so its normal points back in */
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                const int du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
+                for (int q = 0; q < 4; q++) {
+                    double x[3];
+                    x[a] = side, x[b] = (double)(i + du[q]) / n, x[c] = (double)(j + dv[q]) / n;
+                    fprintf(f, "v %.17g %.17g %.17g\n", off + scale * x[0], off + scale * x[1], off + scale * x[2]);
+                }
+                fprintf(f, "f %d %d %d %d\n", v + 1, v + 2, v + 3, v + 4);
+                v += 4;
+            }
+    }
+    fclose(f);
+}
+
+/* Remove write_furnace's files. */
+static void rm_scene(const char *dir)
+{
+    char p[96];
+    snprintf(p, sizeof p, "%s/f.obj", dir), unlink(p);
+    snprintf(p, sizeof p, "%s/f.mtl", dir), unlink(p);
+    rmdir(dir);
+}
+
+/* Check H = 2 in every channel of a furnace answer, to 4 standard errors, the error bar nonzero
+ * and below 2%. */
+static void check_furnace(const ulam_rad_point *r, const char *what)
+{
+    print_message("%s: H %.5f +- %.2g, CI %.5f .. %.5f (patch %lld)\n", what, r->irradiance[0], r->irradiance_se[0],
+                  r->run.ci95[0][0], r->run.ci95[0][1], (long long)r->patch);
+    for (int c = 0; c < 3; c++) {
+        assert_true(r->irradiance_se[c] > 0 && r->irradiance_se[c] < 0.02);
+        assert_close(r->irradiance[c], 2.0, 4 * r->irradiance_se[c]);
+        assert_true(r->run.ci95[c][0] < 2.0 && r->run.ci95[c][1] > 2.0);
+    }
+}
+
+/* Points on shared edges and vertices read the continuous surface, not the mesh: a furnace of
+ * 4 x 4 quads a face, points where coplanar patches meet, on the concave edges between faces,
+ * at a corner, and a grid whose sensors sit on vertices (all read 0 or 0.665 before: a ray
+ * from the point met the neighbouring patch at distance 0). */
+static void test_point_on_edges(void **state)
+{
+    (void)state;
+    char dir[64], path[96];
+    write_furnace(dir, path, 4, 1.0, 0.0);
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load(path, &s);
+    const double pts[6][3] = {{0.5, 0, 0.5}, {0.25, 0, 0.6}, {0.5, 0, 0}, {0, 0.5, 0.5}, {0, 0, 0}, {1, 1, 0.75}};
+    for (int k = 0; k < 6; k++) {
+        if (!test_case(k)) continue;
+        ulam_rad_point r = query(t, pts[k], NULL, ULAM_RAD_NEXT_EVENT, 20000, 0, 70 + (uint64_t)k);
+        check_furnace(&r, "furnace point on an edge or vertex");
+        for (int c = 0; c < 3; c++) assert_close(r.radiosity[c], 2.0, 4 * r.radiosity_se[c] + 1e-12);
+    }
+    test_case_done();
+    /* a 2 x 2 grid on the floor whose sensors sit on the mesh's vertices (0.25, 0.75) */
+    ulam_rad_grid g = {.origin = {0, 0, 0}, .u = {1, 0, 0}, .v = {0, 0, 1}, .normal = {0, 1, 0}, .nu = 2, .nv = 2};
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.max_walks = 20000, o.exec.seed = 5, o.exec.threads = 2;
+    ulam_rad_point out[4];
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &g, out, NULL), ULAM_OK);
+    for (int k = 0; k < 4; k++) check_furnace(&out[k], "grid sensor on a vertex");
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    rm_scene(dir);
+}
+
+/* Radiosity is scale-free: the furnace (B = H = 2) of side 1e13, 4e18, 1e-12 and 1e-20 (and far
+ * from the origin), at a patch and at points on a face and an edge; a sensor normal of 1e200
+ * components; a sensor too far from the scene to be represented is refused with a message. */
+static void test_scale(void **state)
+{
+    (void)state;
+    const double scales[5][2] = {{1e13, 0}, {4e18, 0}, {1e-12, 0}, {1e-20, 0}, {1, 1e9}};
+    for (int k = 0; k < 5; k++) {
+        if (!test_case(k)) continue;
+        char dir[64], path[96];
+        write_furnace(dir, path, 2, scales[k][0], scales[k][1]);
+        ulam_scene *s = NULL;
+        ulam_tracer *t = must_load(path, &s);
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.stop.max_walks = 20000, o.exec.seed = 80 + (uint64_t)k, o.exec.threads = 2, o.index = 0;
+        ulam_rad_result pr = run_solver(t, &o);
+        print_message("scale %g: patch B %.5f +- %.2g, CI %.5f .. %.5f\n", scales[k][0], pr.radiosity[0],
+                      pr.std_error[0], pr.ci95[0][0], pr.ci95[0][1]);
+        for (int c = 0; c < 3; c++) {
+            assert_true(pr.std_error[c] > 0 && pr.std_error[c] < 0.02);
+            assert_close(pr.radiosity[c], 2.0, 4 * pr.std_error[c]);
+            assert_true(pr.ci95[c][0] < 2.0 && pr.ci95[c][1] > 2.0);
+        }
+        const double at[2][3] = {{0.3, 0, 0.3}, {0.3, 0, 0}};
+        for (int q = 0; q < 2; q++) {
+            double x[3];
+            for (int d = 0; d < 3; d++) x[d] = scales[k][1] + scales[k][0] * at[q][d];
+            ulam_rad_point r = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, 20000, 0, 90 + (uint64_t)q);
+            check_furnace(&r, "scaled furnace point");
+        }
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+        rm_scene(dir);
+    }
+    test_case_done();
+    char dir[64], path[96];
+    write_furnace(dir, path, 1, 1.0, 0.0);
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load(path, &s);
+    double mid[3] = {0.5, 0.5, 0.5}, huge_n[3] = {1e200, 1e200, 0}, far[3] = {1e20, 0.5, 0.5}, n[3] = {1, 0, 0};
+    ulam_rad_point r = query(t, mid, huge_n, ULAM_RAD_NEXT_EVENT, 20000, 0, 7);
+    assert_close(r.n[0], sqrt(0.5), 1e-12);
+    check_furnace(&r, "sensor with a normal of 1e200 components");
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.max_walks = 100;
+    ulam_error err;
+    assert_int_equal(ulam_rad_point_query(t, &o, far, n, &r, &err), ULAM_EINVAL);
+    print_message("refused: %s\n", err.msg);
+    assert_non_null(strstr(err.msg, "scene"));
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    rm_scene(dir);
+}
+
 /* ulam_render_hdr: one centre ray a pixel, flat, is ulam_render's picture byte for byte; smooth
  * shading of a constant radiosity is that constant at every pixel (corner means of equal values),
  * jittered or not; a linear gradient over a subdivided face is interpolated (between the patch
@@ -738,6 +881,7 @@ int main(void)
         cmocka_unit_test(test_shoot_rel_err),    cmocka_unit_test(test_adapt_furnace),
         cmocka_unit_test(test_adapt_cornell),    cmocka_unit_test(test_importance_furnace),
         cmocka_unit_test(test_adapt_view),       cmocka_unit_test(test_hdr_write),
+        cmocka_unit_test(test_point_on_edges),   cmocka_unit_test(test_scale),
     };
     return test_run(tests);
 }

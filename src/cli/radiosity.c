@@ -1213,6 +1213,10 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
         }
     }
     free(rgb), free(hdr);
+    if (status == ULAM_ERANGE) {
+        ulam_error err = {.status = status, .msg = "--camera: an eye within a million scene sizes of the scene"};
+        return cli_report(a->image, &err);
+    }
     if (status) {
         ulam_error err = {.status = status, .msg = "a writable PNG file"};
         return cli_report(a->image, &err);

@@ -30,6 +30,27 @@ static void onto_plane(const ulam_scene *s, int64_t j, double y[3])
     for (int k = 0; k < 3; k++) y[k] -= h * n[k];
 }
 
+/* Where a point walk from x (unit normal n, on patch p or -1) starts: a point on a patch may sit
+ * on an edge or vertex it shares with other patches, where a ray leaving it meets a neighbour at
+ * distance 0 (a coplanar one from behind, ending the walk dark; a wall across a concave edge
+ * from wherever the float origin rounded to).  The answer there is the surface's limit from
+ * the inside of the patch, so the walk starts ULAM__POINT_NUDGE scene sizes off the patch's
+ * plane along n and as far (at most half way) toward the patch's centroid, inside it: every
+ * neighbour is then at a distance 2^8 times the origin's float rounding, on the side it is
+ * on, and the answer moves by that share of its variation over the scene (far below its
+ * error bar).  A sensor off the surfaces starts where it is. */
+void ulam__point_start(const ulam_tracer *t, const double x[3], const double n[3], int64_t p, double out[3])
+{
+    const ulam_scene *s = ulam__tracer_scene(t);
+    double delta = ULAM__POINT_NUDGE * ulam__tracer_size(t, NULL), c[3], d[3];
+    for (int k = 0; k < 3; k++) out[k] = x[k];
+    if (p < 0) return;
+    ulam_scene_centroid(s, p, c);
+    ulam__sub3(c, x, d);
+    double len = sqrt(ulam__dot3(d, d)), step = len > 0 ? fmin(delta, 0.5 * len) / len : 0.0;
+    for (int k = 0; k < 3; k++) out[k] += step * d[k] + delta * n[k];
+}
+
 /* One walk from x: its RGB irradiance score (uniform: each landing moves to a uniform point of
  * the patch it landed on, the patch walks' discrete equation). */
 void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps, double gamma,
