@@ -751,6 +751,46 @@ static void test_scale(void **state)
     rm_scene(dir);
 }
 
+/* Walks cut at max_steps: on a furnace of Kd 0.999 and Ke 0.001 (B = H = 1) walks of at most 100
+ * steps see a tenth of the light; the interval must still hold the truth (it widens by the most
+ * the cut can miss, ulam__point_tail), at a point and at a patch; uncut, it is as narrow as ever
+ * (below 0.1 of B at 2000 walks of 10^6 steps). */
+static void test_cut_interval(void **state)
+{
+    (void)state;
+    char dir[64], path[96];
+    write_furnace(dir, path, 1, 1.0, 0.0);
+    char mtl[96];
+    snprintf(mtl, sizeof mtl, "%s/f.mtl", dir);
+    FILE *f = fopen(mtl, "w");
+    assert_non_null(f);
+    fprintf(f, "newmtl glow\nKd 0.999 0.999 0.999\nKe 0.001 0.001 0.001\n");
+    fclose(f);
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load(path, &s);
+    double x[3] = {0.3, 0, 0.4};
+    for (int k = 0; k < 2; k++) {
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.stop.max_walks = 2000, o.stop.max_steps = k ? 1000000 : 100, o.exec.seed = 11, o.exec.threads = 2;
+        ulam_rad_point r;
+        assert_int_equal(ulam_rad_point_query(t, &o, x, NULL, &r, NULL), ULAM_OK);
+        o.index = 2;
+        ulam_rad_result pr = run_solver(t, &o);
+        print_message("max_steps %lld: point H %.4f, CI %.4f .. %.4f, cut %lld; patch B %.4f, CI %.4f .. %.4f, cut %lld\n",
+                      (long long)o.stop.max_steps, r.irradiance[0], r.run.ci95[0][0], r.run.ci95[0][1],
+                      (long long)r.run.cut, pr.radiosity[0], pr.ci95[0][0], pr.ci95[0][1], (long long)pr.cut);
+        assert_true(k ? r.run.cut == 0 : r.run.cut > 1000);
+        for (int c = 0; c < 3; c++) {
+            assert_true(r.run.ci95[c][0] <= 1.0 && r.run.ci95[c][1] >= 1.0);
+            assert_true(pr.ci95[c][0] <= 1.0 && pr.ci95[c][1] >= 1.0);
+            if (k) assert_true(r.run.ci95[c][1] - r.run.ci95[c][0] < 0.2);
+        }
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    rm_scene(dir);
+}
+
 /* ulam_render_hdr: one centre ray a pixel, flat, is ulam_render's picture byte for byte; smooth
  * shading of a constant radiosity is that constant at every pixel (corner means of equal values),
  * jittered or not; a linear gradient over a subdivided face is interpolated (between the patch
@@ -882,6 +922,7 @@ int main(void)
         cmocka_unit_test(test_adapt_cornell),    cmocka_unit_test(test_importance_furnace),
         cmocka_unit_test(test_adapt_view),       cmocka_unit_test(test_hdr_write),
         cmocka_unit_test(test_point_on_edges),   cmocka_unit_test(test_scale),
+        cmocka_unit_test(test_cut_interval),
     };
     return test_run(tests);
 }

@@ -697,6 +697,13 @@ static void print_adapt(const args *a, const report *r)
            (long long)d->points, (long long)d->rays, d->seconds);
 }
 
+/* Nonzero when the walks' interval covers a cut at --max-steps (ray gathering by next-event or
+ * collision, whose walks have a certified tail; the library widens the interval by it). */
+static int cut_covered(const args *a)
+{
+    return !a->matrix_walk && a->o.mode == ULAM_ADJOINT && a->o.estimator != ULAM_RAD_ABSORPTION;
+}
+
 /* Print the text report. */
 static void print_text(const args *a, const report *r)
 {
@@ -716,6 +723,11 @@ static void print_text(const args *a, const report *r)
                c[0], c[1], c[2]);
     }
     const walked *w = r->w;
+    if (w && w->cut) /* before the numbers: they are biased low */
+        printf("warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
+               "             beyond the cut is lost); %s (raise --max-steps)\n", (long long)w->cut, (long long)w->walks,
+               (long long)a->o.stop.max_steps, cut_covered(a) ? "the interval includes the most the cut can miss"
+                                                               : "the error bar does not cover the bias");
     if (w && r->patch >= 0) {
         for (int c = 0; c < 3; c++) {
             printf("radiosity %c  %.8g +- %.3g", chan[c], w->B[c], w->se[c]);
@@ -759,10 +771,6 @@ static void print_text(const args *a, const report *r)
     if (a->view && r->view.unmet)
         printf("warning      %lld seen patches stopped short of their target (--walks or --time)\n",
                (long long)r->view.unmet);
-    if (w && w->cut)
-        printf("warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
-               "             beyond the cut is lost) and the error bar does not cover the bias\n",
-               (long long)w->cut, (long long)w->walks, (long long)a->o.stop.max_steps);
     if (r->Bdirect && r->patch >= 0)
         for (int c = 0; c < 3; c++) {
             printf("direct %c     %.8g", chan[c], r->Bdirect[3 * r->patch + c]);
@@ -915,6 +923,10 @@ static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int 
     } else {
         printf(" (a sensor on no surface)\n");
     }
+    if (r->run.cut)
+        printf("  warning    %lld of %lld walks cut at --max-steps: the estimate is biased low; the interval includes\n"
+               "             the most the cut can miss (raise --max-steps)\n", (long long)r->run.cut,
+               (long long)r->run.walks);
     double lo[3][2], hi[3][2];
     point_ci(s, r, lo, hi);
     for (int c = 0; c < 3; c++) {
@@ -924,8 +936,7 @@ static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int 
         if (r->patch >= 0 && isfinite(lo[c][1])) printf(" (95%% CI %.6g .. %.6g)", lo[c][1], hi[c][1]);
         printf("%s\n", interrupted ? "  [INTERRUPTED]" : "");
     }
-    printf("  walks      %lld, %lld rays, %.4f s%s\n", (long long)r->run.walks, (long long)r->run.rays, r->run.seconds,
-           r->run.cut ? " (some walks cut at --max-steps: biased low)" : "");
+    printf("  walks      %lld, %lld rays, %.4f s\n", (long long)r->run.walks, (long long)r->run.rays, r->run.seconds);
 }
 
 /* One point's answer as a JSON object. */

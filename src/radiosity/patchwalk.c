@@ -616,7 +616,8 @@ static void merge_block(void *ctx, int k)
 static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r);
 
 /* Channel c's certified score range R and bias at estimate m (of B), in B's units: a window
- * walk's whole range, finite and with no bias (ulam__point_range; times rho_i at patch i, whose
+ * walk's whole range, finite, and the most a cut at max_steps can miss (ulam__point_range and
+ * ulam__point_tail; times rho_i at patch i, whose
  * scores lie in [E_i, E_i + R]); else the range of one absorption walk's score or of one
  * particle's tally at the patch over its area (shooting), at a truncation whose bias is at
  * most E |m| / 4 when no whole-walk bound is known (score_bounds). */
@@ -625,8 +626,9 @@ static void channel_range(const ulam_rad_solver *s, int c, double m, double E, d
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
     if (window(s)) { /* window walks: their range (point.c), times the patch's reflectance */
         double R0 = ulam__point_range(&s->pb, c), rho = s->at ? 1.0 : s->s->rho[3 * s->o.query.index + c];
+        double tail = ulam__point_tail(&s->pb, c, s->o.stop.max_steps); /* what a cut at max_steps can miss */
         *R = rho > 0 ? rho * R0 : 0.0;
-        *bias = 0.0;
+        *bias = rho > 0 && tail > 0 ? rho * tail : 0.0;
         return;
     }
     *R = ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0) / A;

@@ -112,6 +112,22 @@ static double part_sum(double rho, double gamma, double a, double b)
     return sum + b * f / (1.0 - gamma);
 }
 
+/* A certified bound on what channel c of one walk (ulam__point_walk) can miss when cut at
+ * max_steps K: the walk has scored its vertices 0 .. K (each a light sample and the landing of
+ * its cosine ray), so the rest is at most the sum over k > K of vertex k's bound in
+ * ulam__point_range, max(rho^(k-1) lr_c, f_k l_c) + max(rho^(k-1) hr_c, f_k h_c) <= rho^(k-1)
+ * (lr_c + hr_c) + f_k (l_c + h_c), whose geometric tails are rho^K (lr_c + hr_c) / (1 - rho) +
+ * WMIN gamma^(K+1) (l_c + h_c) / (1 - gamma).  The mean of the walks is biased low by at most
+ * that (0 for a walk that cannot be cut short of anything: rho^K underflows on a dull scene). */
+double ulam__point_tail(const ulam__point_bounds *b, int c, int64_t max_steps)
+{
+    double a = b->lr[c] + b->hr[c], f = b->light[c] + b->hit[c];
+    if (a + f == 0.0) return 0.0;
+    if (!isfinite(a + f) || !(b->rho < 1.0)) return INFINITY;
+    double g = ulam__point_gamma(b->rho), K = (double)max_steps;
+    return (a > 0 ? a * pow(b->rho, K) / (1.0 - b->rho) : 0.0) + ULAM__POINT_WMIN * pow(g, K + 1.0) * f / (1.0 - g);
+}
+
 /* A certified range of channel c of one walk's score (ulam__point_walk): every score lies in
  * [0, R].  Why:
  * - Weights.  W_0 = 1; at the k-th landing, on patch j, W <- W rho_j, and roulette (when

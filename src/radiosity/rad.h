@@ -195,6 +195,10 @@ double ulam__point_range(const ulam__point_bounds *b, int c);
  * the ray's origin (point.c). */
 void ulam__point_start(const ulam_tracer *t, const double x[3], const double n[3], int64_t p, double out[3]);
 
+/* A certified bound on what channel c of one point walk can miss when cut at max_steps (the bias
+ * of the walks' mean, low; point.c). */
+double ulam__point_tail(const ulam__point_bounds *b, int c, int64_t max_steps);
+
 /* A point walk (point.c): one walk from x (unit normal n, on patch self or -1) on the continuous
  * surfaces (uniform: each landing moved to a uniform point of its patch, a patch walk), its
  * weight floor falling at gamma (ulam__point_gamma): its RGB irradiance score; *rays gets the
