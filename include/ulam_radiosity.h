@@ -127,6 +127,21 @@ int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double
  * back side (the light is lost).  Draws from r. */
 int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
 
+/* What rays say about a scene (ulam_rad_scene_diagnose): the emitting patches, and where
+ * cosine rays from uniform points of patches drawn by area land, from their fronts, from their
+ * backs and from the emitters' fronts: [0] on a patch's front, [1] on a back, [2] nowhere (they
+ * left the scene). */
+typedef struct {
+    int64_t emitters;
+    int64_t front[3], back[3], lamp[3];
+} ulam_rad_scene_diag;
+
+/* Diagnose a scene that answers 0: rays cosine rays from the fronts and as many from the backs
+ * (stream seed); in a room whose normals face in, the fronts' rays land on fronts and the backs'
+ * leave; with the winding reversed the fronts' leave and the backs' land on backs.  ULAM_OK,
+ * ULAM_EINVAL, ULAM_ENOMEM. */
+int ulam_rad_scene_diagnose(const ulam_tracer *t, int64_t rays, uint64_t seed, ulam_rad_scene_diag *out);
+
 /* ---------------------------------------------------------------- form factors and the direct solve */
 /* Primary: ulam_ff_estimate, ulam_rad_direct.  Secondary: ulam_ff_report_compute, ulam_rad_system,
  * ulam_rad_direct_error, ulam_rad_direct_errors.  Tertiary: the exact ulam_ff_*_rectangles. */

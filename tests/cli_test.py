@@ -439,6 +439,30 @@ def on_tty(ulam, args):
     return p.returncode, b"".join(chunks).decode(errors="replace")
 
 
+def check_radiosity_zero_notes(ulam):
+    """A scene that answers 0 says what is wrong with it (issue 40 pt 10), at the floor patch and
+    at a floor point: a cube with no Ke has no emitter; the cube with a ceiling lamp and every
+    face's winding reversed (the lamp's too) looks inside out; the generic zero-estimate note
+    alone said neither."""
+    faces = ["1 2 3 4", "5 8 7 6", "1 4 8 5", "2 6 7 3", "1 5 6 2", "4 3 7 8"]
+    with tempfile.TemporaryDirectory() as d:
+        for name, ke, flip, want in (("dark", "", False, r"the scene has no emitter: no material has Ke > 0"),
+                                     ("flipped", "Ke 5 5 5\n", True, r"the faces look inside out: 100% of rays")):
+            with open(os.path.join(d, name + ".mtl"), "w") as f:
+                f.write("newmtl g\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\n" + ke)
+            with open(os.path.join(d, name + ".obj"), "w") as f:
+                f.write(f"mtllib {name}.mtl\nusemtl g\n")
+                f.writelines(f"v {x} {y} {z}\n" for z in (0, 1) for y in (0, 1) for x in (0, 1))
+                order = [1, 2, 4, 3, 5, 6, 8, 7]  # x fastest above: renumber to the cube's 1..8
+                for k, fc in enumerate(faces):  # the second, z = 1, is the lamp
+                    vs = [str(order[int(v) - 1]) for v in fc.split()]
+                    f.write(f"usemtl {'lamp' if k == 1 else 'g'}\nf " + " ".join(reversed(vs) if flip else vs) + "\n")
+            scene = os.path.join(d, name + ".obj")
+            for extra in (["--patch", "1", "--rel-err", "0.05", "--no-mesh-error"], ["--at", "0.5,0.5,0"]):
+                rc, out, err = run(ulam, ["radiosity", scene] + extra)
+                assert rc == 0 and re.search(r"^ *note +" + want, out, re.M), (name, extra, out, err)
+
+
 def check_radiosity_json_path(ulam):
     """The JSON names the scene by a valid JSON string whatever its path holds (a quote, a
     backslash): it was printed unescaped, and the output did not parse."""
@@ -2018,6 +2042,7 @@ def main():
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam), (check_radiosity_emission_scale, ulam),
              (check_bidir, ulam), (check_queries, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
+             (check_radiosity_zero_notes, ulam),
              (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
              (check_systems_as_held, ulam), (check_passive_threads, ulam),
              (check_disk_full, ulam), (check_signals, ulam)]

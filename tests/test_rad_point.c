@@ -791,6 +791,72 @@ static void test_cut_interval(void **state)
     rm_scene(dir);
 }
 
+/* Rewrite the material of write_furnace's scene (Kd and Ke lines). */
+static void furnace_material(const char *dir, const char *mtl)
+{
+    char p[96];
+    snprintf(p, sizeof p, "%s/f.mtl", dir);
+    FILE *f = fopen(p, "w");
+    assert_non_null(f);
+    fprintf(f, "newmtl glow\n%s\n", mtl);
+    fclose(f);
+}
+
+/* Reverse the vertex order of every face of write_furnace's scene (inside out). */
+static void furnace_flip(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char line[256], out[1 << 16] = "";
+    size_t len = 0;
+    while (fgets(line, sizeof line, f)) {
+        int a, b, c, d;
+        if (sscanf(line, "f %d %d %d %d", &a, &b, &c, &d) == 4) snprintf(line, sizeof line, "f %d %d %d %d\n", d, c, b, a);
+        len += (size_t)snprintf(out + len, sizeof out - len, "%s", line);
+        assert_true(len < sizeof out);
+    }
+    fclose(f);
+    assert_non_null(f = fopen(path, "w"));
+    fputs(out, f);
+    fclose(f);
+}
+
+/* A scene that answers 0 says why (ulam_rad_scene_diagnose): the furnace with no Ke has no
+ * emitter; turned inside out, its backs' rays land on backs and its fronts' leave; as built,
+ * every front's ray lands on a front and every back's leaves. */
+static void test_scene_diagnose(void **state)
+{
+    (void)state;
+    char dir[64], path[96];
+    write_furnace(dir, path, 1, 1.0, 0.0);
+    for (int k = 0; k < 3; k++) {
+        furnace_material(dir, k == 0 ? "Kd 0.5 0.5 0.5" : "Kd 0.5 0.5 0.5\nKe 1 1 1");
+        if (k == 2) furnace_flip(path);
+        ulam_scene *s = NULL;
+        ulam_tracer *t = must_load(path, &s);
+        ulam_rad_scene_diag d;
+        assert_int_equal(ulam_rad_scene_diagnose(t, 1000, 3, &d), ULAM_OK);
+        print_message("case %d: %lld emitters; fronts %lld %lld %lld, backs %lld %lld %lld, lamps %lld %lld %lld\n", k,
+                      (long long)d.emitters, (long long)d.front[0], (long long)d.front[1], (long long)d.front[2],
+                      (long long)d.back[0], (long long)d.back[1], (long long)d.back[2], (long long)d.lamp[0],
+                      (long long)d.lamp[1], (long long)d.lamp[2]);
+        assert_int_equal(d.emitters, k ? 6 : 0);
+        assert_int_equal(d.front[0] + d.front[1] + d.front[2], 1000);
+        assert_int_equal(d.back[0] + d.back[1] + d.back[2], 1000);
+        if (k < 2) assert_true(d.front[0] == 1000 && d.back[2] == 1000);
+        else assert_true(d.front[2] == 1000 && d.back[1] == 1000 && d.lamp[2] == d.lamp[0] + d.lamp[1] + d.lamp[2]);
+        if (k == 2) { /* and the walks read exactly 0 */
+            double x[3] = {0.5, 0, 0.5};
+            ulam_rad_point r = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, 2000, 0, 1);
+            assert_true(r.irradiance[0] == 0 && r.irradiance_se[0] == 0);
+        }
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
+    assert_int_equal(ulam_rad_scene_diagnose(NULL, 10, 1, NULL), ULAM_EINVAL);
+    rm_scene(dir);
+}
+
 /* ulam_render_hdr: one centre ray a pixel, flat, is ulam_render's picture byte for byte; smooth
  * shading of a constant radiosity is that constant at every pixel (corner means of equal values),
  * jittered or not; a linear gradient over a subdivided face is interpolated (between the patch
@@ -922,7 +988,7 @@ int main(void)
         cmocka_unit_test(test_adapt_cornell),    cmocka_unit_test(test_importance_furnace),
         cmocka_unit_test(test_adapt_view),       cmocka_unit_test(test_hdr_write),
         cmocka_unit_test(test_point_on_edges),   cmocka_unit_test(test_scale),
-        cmocka_unit_test(test_cut_interval),
+        cmocka_unit_test(test_cut_interval),     cmocka_unit_test(test_scene_diagnose),
     };
     return test_run(tests);
 }

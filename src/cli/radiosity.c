@@ -644,6 +644,8 @@ typedef struct {
     int adapted, view_importance; /* --mesh-target: adapt holds what it did (by the view's importance) */
     ulam_rad_adapt_info adapt;
     int64_t adapt_cap; /* the most patches it could make (--max-patches, or what --max-mem holds) */
+    int diag_known;    /* the answer is exactly 0 and diag says why (scene_notes) */
+    ulam_rad_scene_diag diag;
 } report;
 
 /* (walk - direct) / the standard error of the difference at the patch, channel c: matrix walks
@@ -697,6 +699,45 @@ static void print_adapt(const args *a, const report *r)
            (long long)d->points, (long long)d->rays, d->seconds);
 }
 
+/* Rays cast by scene_diagnosis from the fronts (and as many from the backs). */
+enum { DIAG_RAYS = 4096 };
+
+/* Nonzero when every channel of v is exactly 0 with a zero standard error se. */
+static int exactly_zero(const double v[3], const double se[3])
+{
+    for (int c = 0; c < 3; c++)
+        if (v[c] != 0.0 || se[c] != 0.0) return 0;
+    return 1;
+}
+
+/* What is wrong with a scene that answers 0 (ulam_rad_scene_diagnose); 0 when nothing is found. */
+static int scene_diagnosis(const ulam_tracer *t, uint64_t seed, ulam_rad_scene_diag *d)
+{
+    return ulam_rad_scene_diagnose(t, DIAG_RAYS, seed, d) == ULAM_OK;
+}
+
+/* Print what is wrong with a scene whose answer is exactly 0 (label: the first line's label
+ * column, indent the next lines'). */
+static void scene_notes(const ulam_rad_scene_diag *d, const char *label, const char *indent)
+{
+    double fr = (double)d->front[0] / DIAG_RAYS, br = (double)d->back[1] / DIAG_RAYS; /* front to front, back to back */
+    int64_t lamp = d->lamp[0] + d->lamp[1] + d->lamp[2];
+    if (!d->emitters)
+        printf("%sthe scene has no emitter: no material has Ke > 0, so no light enters it and every\n"
+               "%sradiosity is exactly 0 (give the lamps' material Ke)\n", label, indent);
+    else if (br > 0.25 && br > 2.0 * fr)
+        printf("%sthe faces look inside out: %.0f%% of rays leaving the patches' backs land on another's\n"
+               "%sback, %.0f%% of those leaving their fronts on a front (OBJ faces are counter-clockwise seen\n"
+               "%sfrom their lit side: reverse each face's vertex order)\n", label, 100.0 * br, indent, 100.0 * fr, indent);
+    else if (lamp > 0 && d->lamp[0] == 0)
+        printf("%sno emitter's front faces into the scene: of %lld rays leaving the lamps' fronts, %lld\n"
+               "%sleave the scene and %lld land on a back side (turn the lamps' faces around)\n", label,
+               (long long)lamp, (long long)d->lamp[2], indent, (long long)d->lamp[1]);
+    else
+        printf("%sthe scene has %lld emitting patches and its faces face in (%.0f%% of the fronts' rays land\n"
+               "%son a front): no emitter's light reaches here\n", label, (long long)d->emitters, 100.0 * fr, indent);
+}
+
 /* Nonzero when the walks' interval covers a cut at --max-steps (ray gathering by next-event or
  * collision, whose walks have a certified tail; the library widens the interval by it). */
 static int cut_covered(const args *a)
@@ -745,6 +786,7 @@ static void print_text(const args *a, const report *r)
                    "             --rel-err can never be met by a zero estimate, so the walks stopped there; if the\n"
                    "             answer is not exactly 0, a walk scores with probability below 3/%lld = %.2g (95%%)\n",
                    (long long)w->walks, (long long)w->walks, 3.0 / (double)w->walks);
+        if (r->diag_known) scene_notes(&r->diag, "note         ", "             ");
         if (r->mesh_known) print_mesh(r, w);
         if (r->mesh_no_time)
             printf("mesh error   not estimated: the walks spent --time (raise it, or --no-mesh-error)\n");
@@ -913,7 +955,8 @@ static void point_ci(const ulam_scene *s, const ulam_rad_point *r, double lo[3][
 }
 
 /* One point's answer as text. */
-static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int interrupted)
+static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int interrupted,
+                       const ulam_rad_scene_diag *diag)
 {
     printf("point %-6d %.6g %.6g %.6g, normal %.4g %.4g %.4g", k + 1, r->x[0], r->x[1], r->x[2], r->n[0], r->n[1],
            r->n[2]);
@@ -937,6 +980,8 @@ static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int 
         printf("%s\n", interrupted ? "  [INTERRUPTED]" : "");
     }
     printf("  walks      %lld, %lld rays, %.4f s\n", (long long)r->run.walks, (long long)r->run.rays, r->run.seconds);
+    if (diag && !interrupted && r->run.walks > 0 && exactly_zero(r->irradiance, r->irradiance_se))
+        scene_notes(diag, "  note       ", "             ");
 }
 
 /* One point's answer as a JSON object. */
@@ -1117,7 +1162,12 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
     } else {
         printf("scene        %s: %lld patches\n", a->scene, (long long)s->npatches);
-        for (int k = 0; k < a->nat; k++) point_text(s, k, &pts[k], pts[k].run.interrupted);
+        ulam_rad_scene_diag diag;
+        int known = 0;
+        for (int k = 0; k < a->nat && !known; k++)
+            if (pts[k].run.walks > 0 && exactly_zero(pts[k].irradiance, pts[k].irradiance_se))
+                known = scene_diagnosis(t, a->o.exec.seed, &diag);
+        for (int k = 0; k < a->nat; k++) point_text(s, k, &pts[k], pts[k].run.interrupted, known ? &diag : NULL);
         if (ngrid)
             printf("grid         %d x %d sensors facing %.4g %.4g %.4g: illuminance (0.2126 R + 0.7152 G + 0.0722 B)\n"
                    "             min %.6g, mean %.6g, uniformity min/mean %.4f; worst relative error <= %.3g\n",
@@ -1559,6 +1609,8 @@ int cli_radiosity(int argc, char **argv)
         }
         if (a.matrix_walk) combine_errors(&r, &w);
         r.w = &w;
+        if (r.patch >= 0 && !w.interrupted && exactly_zero(w.B, w.se))
+            r.diag_known = scene_diagnosis(t, a.o.exec.seed, &r.diag);
     }
     r.pv = every_patch(&a, &r, &w, Bd);
     if (a.mesh_walks && r.pv.B && !w.interrupted && (rc = every_mesh_error(&a, t, s, &r.pv, &mesh_all))) goto done;
