@@ -77,6 +77,13 @@ void ulam_mtl_notes_free(ulam_mtl_note *notes, int64_t n);
  * are kept. */
 int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out);
 
+/* What ulam_scene_subdivide(s, max_side) would make, counted without making it (so that a memory
+ * limit can refuse it first): *patches, *vertices, *triangles (the ray tracer's) and *bytes of
+ * the new scene's arrays (any may be NULL).  ULAM_OK, ULAM_EINVAL, or ULAM_EOVERFLOW when the
+ * patches or vertices pass INT32_MAX (the counts are still given). */
+int ulam_scene_subdivide_plan(const ulam_scene *s, double max_side, double *patches, double *vertices,
+                              double *triangles, double *bytes);
+
 /* Free a scene; accepts and returns NULL. */
 ulam_scene *ulam_scene_free(ulam_scene *s);
 

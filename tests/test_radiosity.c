@@ -1150,6 +1150,39 @@ static void test_patch_window(void **state)
     ulam_scene_free(s);
 }
 
+/* ulam_scene_subdivide_plan counts what ulam_scene_subdivide makes, without making it: patches,
+ * vertices, the tracer's triangles and the arrays' bytes, on quads (the cube, the Cornell box's
+ * quads and its polygons) at several sizes; a plan past INT32_MAX patches is EOVERFLOW with the
+ * count still told (1.67e11 cube patches at 1e-5), as the subdivision itself refuses it. */
+static void test_subdivide_plan(void **state)
+{
+    (void)state;
+    const char *paths[2] = {"examples/scenes/cube.obj", "examples/scenes/cornell_box.obj"};
+    const double sides[2][3] = {{0.3, 0.05, 1.5}, {100, 37, 1000}};
+    for (int k = 0; k < 2; k++) {
+        ulam_scene *s = must_scene(paths[k]);
+        for (int q = 0; q < 3; q++) {
+            double np, nv, tri, bytes;
+            ulam_scene *d = NULL;
+            assert_int_equal(ulam_scene_subdivide_plan(s, sides[k][q], &np, &nv, &tri, &bytes), ULAM_OK);
+            assert_int_equal(ulam_scene_subdivide(s, sides[k][q], &d), ULAM_OK);
+            print_message("%s at %g: plan %.0f patches, %.0f vertices, %.0f triangles, %.0f bytes\n", paths[k],
+                          sides[k][q], np, nv, tri, bytes);
+            assert_true(np == (double)d->npatches && nv == (double)d->nverts);
+            assert_true(tri == (double)(d->start[d->npatches] - 2 * d->npatches));
+            assert_true(bytes > 100.0 * np + 24.0 * nv);
+            ulam_scene_free(d);
+        }
+        ulam_scene_free(s);
+    }
+    ulam_scene *s = must_scene(paths[0]);
+    double np = 0;
+    assert_int_equal(ulam_scene_subdivide_plan(s, 1e-5, &np, NULL, NULL, NULL), ULAM_EOVERFLOW);
+    assert_true(np == 6e10);
+    assert_int_equal(ulam_scene_subdivide_plan(s, 0, &np, NULL, NULL, NULL), ULAM_EINVAL);
+    ulam_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1165,7 +1198,7 @@ int main(void)
         cmocka_unit_test(test_render_framing),     cmocka_unit_test(test_camera_defaults),     cmocka_unit_test(test_next_event_coverage),
         cmocka_unit_test(test_next_event_back_sides), cmocka_unit_test(test_next_event_edge),
         cmocka_unit_test(test_next_event_hidden), cmocka_unit_test(test_rel_err_zero_channel),  cmocka_unit_test(test_view_gather),
-        cmocka_unit_test(test_patch_window),
+        cmocka_unit_test(test_patch_window), cmocka_unit_test(test_subdivide_plan),
     };
     return test_run(tests);
 }

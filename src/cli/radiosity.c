@@ -1294,6 +1294,9 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
     return 0;
 }
 
+static double need_counts(const args *a, double n, double tri, double nverts, char *what, size_t len);
+static void human(double b, char *out, size_t len);
+
 /* The scene, subdivided if asked; 0 or an exit code. */
 static int load_scene(const args *a, ulam_scene **out, int64_t *faces)
 {
@@ -1315,9 +1318,22 @@ static int load_scene(const args *a, ulam_scene **out, int64_t *faces)
     }
     ulam_mtl_notes_free(notes, nnotes);
     *faces = s->nfaces;
-    if (a->subdivide > 0) {
+    if (a->subdivide > 0) { /* counted first: --max-mem refuses a mesh before it is built */
+        double np = 0, nv = 0, tri = 0, bytes = 0, need;
+        char what[512], h[3][32];
+        int status = ulam_scene_subdivide_plan(s, a->subdivide, &np, &nv, &tri, &bytes);
+        need = bytes + (a->list ? 0.0 : need_counts(a, np, tri, nv, what, sizeof what));
+        if ((status == ULAM_OK || status == ULAM_EOVERFLOW) && need > (double)a->max_mem) {
+            human(need, h[0], 32), human((double)a->max_mem, h[1], 32), human(bytes, h[2], 32);
+            fprintf(stderr, "ulam radiosity: %s: memory limit: --subdivide %g makes %.4g patches (%.4g vertices): "
+                            "this run needs about %s, more than --max-mem %s (the patches %s%s%s); refused before "
+                            "building them: raise --subdivide or --max-mem\n",
+                    a->scene, a->subdivide, np, nv, h[0], h[1], h[2], a->list ? "" : ", ", a->list ? "" : what);
+            ulam_scene_free(s);
+            return cli_exit_code(ULAM_EMEMLIMIT);
+        }
         ulam_scene *d = NULL;
-        int status = ulam_scene_subdivide(s, a->subdivide, &d);
+        status = status ? status : ulam_scene_subdivide(s, a->subdivide, &d);
         ulam_scene_free(s);
         if (status) {
             err = (ulam_error){.status = status, .msg = "a subdivision that fits in memory"};
