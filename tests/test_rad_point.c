@@ -857,6 +857,38 @@ static void test_scene_diagnose(void **state)
     rm_scene(dir);
 }
 
+/* A block stops inside once time is up or the run is interrupted (a block of 256 walks of 10^6
+ * rays took minutes past --time 3): at a time limit already spent, the first block (which always
+ * runs, so there is an estimate) keeps the walks it finished, one here, not all 256 (counts, not
+ * seconds); a point and a patch solver on a furnace of Kd 0.99. */
+static void test_block_stops_inside(void **state)
+{
+    (void)state;
+    char dir[64], path[96];
+    write_furnace(dir, path, 1, 1.0, 0.0);
+    furnace_material(dir, "Kd 0.99 0.99 0.99\nKe 1 1 1");
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load(path, &s);
+    double x[3] = {0.5, 0, 0.5};
+    for (int k = 0; k < 2; k++) {
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.stop.max_walks = 0, o.stop.max_seconds = 1e-12, o.exec.threads = 1, o.index = 1;
+        ulam_rad_solver *sv = NULL;
+        assert_int_equal(k ? ulam_rad_solver_alloc(t, &o, &sv, NULL) : ulam_rad_point_alloc(t, &o, x, NULL, &sv, NULL),
+                         ULAM_OK);
+        while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
+        ulam_rad_result r;
+        ulam_rad_solver_result(sv, &r);
+        print_message("%s solver at a spent time limit: %lld walks, %lld rays\n", k ? "patch" : "point",
+                      (long long)r.walks, (long long)r.rays);
+        assert_true(r.walks >= 1 && r.walks < 256);
+        ulam_rad_solver_free(sv);
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    rm_scene(dir);
+}
+
 /* ulam_render_hdr: one centre ray a pixel, flat, is ulam_render's picture byte for byte; smooth
  * shading of a constant radiosity is that constant at every pixel (corner means of equal values),
  * jittered or not; a linear gradient over a subdivided face is interpolated (between the patch
@@ -989,6 +1021,7 @@ int main(void)
         cmocka_unit_test(test_adapt_view),       cmocka_unit_test(test_hdr_write),
         cmocka_unit_test(test_point_on_edges),   cmocka_unit_test(test_scale),
         cmocka_unit_test(test_cut_interval),     cmocka_unit_test(test_scene_diagnose),
+        cmocka_unit_test(test_block_stops_inside),
     };
     return test_run(tests);
 }

@@ -539,6 +539,15 @@ static int flush_history(rad_scratch *sc, rad_block *br)
     return ULAM_OK;
 }
 
+/* Nonzero when a block must stop before its next walk: interrupted, or out of time.  A block
+ * stops inside (one walk of 10^6 rays takes a second, a block of 256 of them minutes: --time 3
+ * took 68 s), keeping the walks it finished: the run ends with them (ulam__round_step). */
+static int block_must_stop(const ulam_rad_solver *s)
+{
+    if (s->o.stop.interrupt && *s->o.stop.interrupt) return 1;
+    return s->o.stop.max_seconds > 0 && ulam_now() - s->run.t0 >= s->o.stop.max_seconds;
+}
+
 /* Run walks [first, first + count) as block k on thread th (ctx: the solver). */
 static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
 {
@@ -553,6 +562,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     ulam_rng r;
     ulam_rng_seed(&r, s->o.exec.seed, (uint64_t)(first / RBLOCK));
     for (int64_t w = 0; w < count; w++) {
+        if (w > 0 && block_must_stop(s)) break; /* its walks so far stand: the run ends with them */
         if (s->o.mode == ULAM_ADJOINT) {
             double sc[3];
             if (s->at) {
