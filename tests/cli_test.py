@@ -467,6 +467,34 @@ def check_radiosity_zero_notes(ulam):
                 assert rc == 0 and re.search(r"^ *note +" + want, out, re.M), (name, extra, out, err)
 
 
+def check_radiosity_check_side(ulam):
+    """--check names the suspect side of a disagreement (|z| > 3): in an open box of 80 unit
+    patches with a one-patch lamp, floor patch 2's 1000 form-factor rays (seed 10) missed the lamp:
+    the direct solve, 0.035, lies below the walks' certified interval 0.0499 .. 0.0595 (z = 3.1),
+    and the run says to raise --ff-rays; the z alone (7.5 in the issue's box) said neither."""
+    with tempfile.TemporaryDirectory() as d:
+        with open(os.path.join(d, "box.mtl"), "w") as f:
+            f.write("newmtl g\nKd 0.6 0.6 0.6\nnewmtl lamp\nKd 0.6 0.6 0.6\nKe 10 10 10\n")
+        sides = [((0, 0, 0), (0, 0, 1), (1, 0, 0)), ((0, 0, 0), (1, 0, 0), (0, 1, 0)), ((0, 0, 4), (0, 1, 0), (1, 0, 0)),
+                 ((0, 0, 0), (0, 1, 0), (0, 0, 1)), ((4, 0, 0), (0, 0, 1), (0, 1, 0))]  # u x v inward
+        lines, v = ["mtllib box.mtl"], 0
+        for k, (o, u, w) in enumerate(sides):
+            for i in range(4):
+                for j in range(4):
+                    for du, dv in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                        lines.append("v " + " ".join(str(o[c] + (i + du) * u[c] + (j + dv) * w[c]) for c in range(3)))
+                    lines.append("usemtl " + ("lamp" if (k, i, j) == (1, 1, 3) else "g"))
+                    lines.append(f"f {v + 1} {v + 2} {v + 3} {v + 4}")
+                    v += 4
+        with open(os.path.join(d, "box.obj"), "w") as f:
+            f.write("\n".join(lines) + "\n")
+        rc, out, err = run(ulam, ["radiosity", os.path.join(d, "box.obj"), "--check", "--patch", "2", "--seed", "10",
+                                  "--walks", "20000", "--no-mesh-error"])
+        assert rc == 0 and re.search(r"^check R +\|z\| = 3.1: the direct solve, 0.03\d+, lies below the walks' certified "
+                                     r"95% interval .*\n +suspect the form factors \(1000 rays a patch; raise --ff-rays\)",
+                                     out, re.M), (out, err)
+
+
 def check_radiosity_json_path(ulam):
     """The JSON names the scene by a valid JSON string whatever its path holds (a quote, a
     backslash): it was printed unescaped, and the output did not parse."""
@@ -2046,7 +2074,7 @@ def main():
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam), (check_radiosity_emission_scale, ulam),
              (check_bidir, ulam), (check_queries, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
-             (check_radiosity_zero_notes, ulam),
+             (check_radiosity_zero_notes, ulam), (check_radiosity_check_side, ulam),
              (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
              (check_systems_as_held, ulam), (check_passive_threads, ulam),
              (check_disk_full, ulam), (check_signals, ulam)]

@@ -610,19 +610,11 @@ static void test_mtl_notes(void **state)
 
 /* Write a furnace cube into a new temporary directory: side scale, corner at off, each face
  * n x n quads (normals inward), Kd 0.5 and Ke 1 (B = H = 2 at every point and sensor inside);
- * path gets the OBJ's path (dir is removed by rm_scene). */
+ * path gets the OBJ's path (dir is removed by test_scene_rm). */
 static void write_furnace(char dir[64], char path[96], int n, double scale, double off)
 {
-    strcpy(dir, "/tmp/ulam_furnace_XXXXXX");
-    assert_non_null(mkdtemp(dir));
-    char mtl[96];
-    snprintf(path, 96, "%s/f.obj", dir), snprintf(mtl, sizeof mtl, "%s/f.mtl", dir);
-    FILE *f = fopen(mtl, "w");
-    assert_non_null(f);
-    fprintf(f, "newmtl glow\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
-    fclose(f);
-    assert_non_null(f = fopen(path, "w"));
-    fprintf(f, "mtllib f.mtl\nusemtl glow\n");
+    FILE *f = test_scene_open(dir, path, "newmtl glow\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
+    fprintf(f, "usemtl glow\n");
     /* face k: fixed axis a at 0 or 1, spanned by axes b, c with b x c = e_a (inward at 0) */
     static const int ax[6][4] = {{1, 2, 0, 0}, {1, 2, 0, 1}, {0, 1, 2, 0}, {0, 1, 2, 1}, {2, 0, 1, 0}, {2, 0, 1, 1}};
     int v = 0;
@@ -644,13 +636,15 @@ static void write_furnace(char dir[64], char path[96], int n, double scale, doub
     fclose(f);
 }
 
-/* Remove write_furnace's files. */
-static void rm_scene(const char *dir)
+/* Rewrite the material of write_furnace's scene (Kd and Ke lines). */
+static void furnace_material(const char *dir, const char *mtl)
 {
     char p[96];
-    snprintf(p, sizeof p, "%s/f.obj", dir), unlink(p);
-    snprintf(p, sizeof p, "%s/f.mtl", dir), unlink(p);
-    rmdir(dir);
+    snprintf(p, sizeof p, "%s/scene.mtl", dir);
+    FILE *f = fopen(p, "w");
+    assert_non_null(f);
+    fprintf(f, "newmtl glow\n%s\n", mtl);
+    fclose(f);
 }
 
 /* Check H = 2 in every channel of a furnace answer, to 4 standard errors, the error bar nonzero
@@ -694,7 +688,7 @@ static void test_point_on_edges(void **state)
     for (int k = 0; k < 4; k++) check_furnace(&out[k], "grid sensor on a vertex");
     ulam_tracer_free(t);
     ulam_scene_free(s);
-    rm_scene(dir);
+    test_scene_rm(dir);
 }
 
 /* Radiosity is scale-free: the furnace (B = H = 2) of side 1e13, 4e18, 1e-12 and 1e-20 (and far
@@ -729,7 +723,7 @@ static void test_scale(void **state)
         }
         ulam_tracer_free(t);
         ulam_scene_free(s);
-        rm_scene(dir);
+        test_scene_rm(dir);
     }
     test_case_done();
     char dir[64], path[96];
@@ -748,7 +742,7 @@ static void test_scale(void **state)
     assert_non_null(strstr(err.msg, "scene"));
     ulam_tracer_free(t);
     ulam_scene_free(s);
-    rm_scene(dir);
+    test_scene_rm(dir);
 }
 
 /* Walks cut at max_steps: on a furnace of Kd 0.999 and Ke 0.001 (B = H = 1) walks of at most 100
@@ -760,12 +754,7 @@ static void test_cut_interval(void **state)
     (void)state;
     char dir[64], path[96];
     write_furnace(dir, path, 1, 1.0, 0.0);
-    char mtl[96];
-    snprintf(mtl, sizeof mtl, "%s/f.mtl", dir);
-    FILE *f = fopen(mtl, "w");
-    assert_non_null(f);
-    fprintf(f, "newmtl glow\nKd 0.999 0.999 0.999\nKe 0.001 0.001 0.001\n");
-    fclose(f);
+    furnace_material(dir, "Kd 0.999 0.999 0.999\nKe 0.001 0.001 0.001");
     ulam_scene *s = NULL;
     ulam_tracer *t = must_load(path, &s);
     double x[3] = {0.3, 0, 0.4};
@@ -788,18 +777,7 @@ static void test_cut_interval(void **state)
     }
     ulam_tracer_free(t);
     ulam_scene_free(s);
-    rm_scene(dir);
-}
-
-/* Rewrite the material of write_furnace's scene (Kd and Ke lines). */
-static void furnace_material(const char *dir, const char *mtl)
-{
-    char p[96];
-    snprintf(p, sizeof p, "%s/f.mtl", dir);
-    FILE *f = fopen(p, "w");
-    assert_non_null(f);
-    fprintf(f, "newmtl glow\n%s\n", mtl);
-    fclose(f);
+    test_scene_rm(dir);
 }
 
 /* Reverse the vertex order of every face of write_furnace's scene (inside out). */
@@ -854,7 +832,7 @@ static void test_scene_diagnose(void **state)
         ulam_scene_free(s);
     }
     assert_int_equal(ulam_rad_scene_diagnose(NULL, 10, 1, NULL), ULAM_EINVAL);
-    rm_scene(dir);
+    test_scene_rm(dir);
 }
 
 /* A block stops inside once time is up or the run is interrupted (a block of 256 walks of 10^6
@@ -886,7 +864,7 @@ static void test_block_stops_inside(void **state)
     }
     ulam_tracer_free(t);
     ulam_scene_free(s);
-    rm_scene(dir);
+    test_scene_rm(dir);
 }
 
 /* ulam_render_hdr: one centre ray a pixel, flat, is ulam_render's picture byte for byte; smooth

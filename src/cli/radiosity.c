@@ -658,6 +658,27 @@ static double zscore(const args *a, const report *r, int c)
     return diff / se;
 }
 
+/* Which side of a --check disagreement (|z| > 3) in channel c is suspect: ray walks carry a
+ * certified interval, the direct solve a first-order bar from F's sampled noise, so a direct
+ * answer outside the walks' interval points at F (--ff-rays), one inside it at the walks;
+ * matrix walks share the sampled F, so only the walks' noise can be at fault. */
+static void check_side(const args *a, const report *r, int c)
+{
+    double d = r->Bdirect[3 * r->patch + c], lo = r->w->ci95[c][0], hi = r->w->ci95[c][1];
+    printf("check %c      |z| = %.2g: ", chan[c], fabs(zscore(a, r, c)));
+    if (a->matrix_walk)
+        printf("the walks on the same F disagree with its direct solve: the walks' noise (or a bug)\n");
+    else if (isfinite(lo) && isfinite(hi) && (d < lo || d > hi))
+        printf("the direct solve, %.6g, lies %s the walks' certified 95%% interval %.6g .. %.6g:\n"
+               "             suspect the form factors (%lld rays a patch; raise --ff-rays)\n", d,
+               d < lo ? "below" : "above", lo, hi, (long long)a->ff_rays);
+    else if (isfinite(lo) && isfinite(hi))
+        printf("the direct solve, %.6g, lies inside the walks' certified 95%% interval %.6g .. %.6g:\n"
+               "             its form-factor bar is too narrow (raise --ff-rays)\n", d, lo, hi);
+    else
+        printf("the walks have no certified interval here to tell which side is off\n");
+}
+
 /* Nonzero when the mesh error of channel c dominates the Monte Carlo error: larger than twice
  * it, and real (more than 4 standard errors of the difference: the largest of up to 9). */
 static int mesh_dominates(const report *r, const walked *w, int c)
@@ -820,6 +841,8 @@ static void print_text(const args *a, const report *r)
             if (w) printf("  z = %.3f%s", zscore(a, r, c), a->matrix_walk ? " (walk noise: the same F)" : "");
             printf("\n");
         }
+    for (int c = 0; r->Bdirect && r->patch >= 0 && w && c < 3; c++)
+        if (fabs(zscore(a, r, c)) > 3.0) check_side(a, r, c);
     if (a->out && r->out_written)
         printf("patches      %lld rows written to %s%s\n", (long long)r->s->npatches, a->out,
                r->pv.se == r->w_all_se_conditional ? " (standard errors: walk noise only, CONDITIONAL on the sampled F)" : "");
