@@ -476,7 +476,7 @@ static void gather_window(const ulam_rad_solver *s, ulam_rng *r, double score[3]
     if (s->q[i] == 0.0) return;
     ulam__tracer_point(s->t, i, r, x);
     ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, ulam__point_gamma(s->pb.rho), 1, x,
-                     sc->normal + 3 * i, i, r, H, &br->rays, &cut);
+                     sc->normal + 3 * i, i, s->o.stop.interrupt, r, H, &br->rays, &cut);
     br->cut += cut;
     for (int c = 0; c < 3; c++) score[c] += rho[c] * H[c];
 }
@@ -568,7 +568,7 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
             if (s->at) {
                 int64_t cut = 0;
                 ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, ulam__point_gamma(s->pb.rho), 0,
-                                 s->at_start, s->at_n, s->at_self, &r, sc, &br->rays, &cut);
+                                 s->at_start, s->at_n, s->at_self, s->o.stop.interrupt, &r, sc, &br->rays, &cut);
                 br->cut += cut;
             } else if (window(s)) {
                 gather_window(s, &r, sc, br);

@@ -54,8 +54,8 @@ void ulam__point_start(const ulam_tracer *t, const double x[3], const double n[3
 /* One walk from x: its RGB irradiance score (uniform: each landing moves to a uniform point of
  * the patch it landed on, the patch walks' discrete equation). */
 void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps, double gamma,
-                      int uniform, const double x0[3], const double n0[3], int64_t self, ulam_rng *r, double score[3],
-                      int64_t *rays, int64_t *cut)
+                      int uniform, const double x0[3], const double n0[3], int64_t self, const volatile int *interrupt,
+                      ulam_rng *r, double score[3], int64_t *rays, int64_t *cut)
 {
     const ulam_scene *s = ulam__tracer_scene(t);
     int light = estimator != ULAM_RAD_COLLISION && L->nem > 0;
@@ -83,8 +83,8 @@ void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator
             if (!(ulam__rng_uniform(r) * floor < w)) return;
             for (int c = 0; c < 3; c++) W[c] *= floor / w;
         }
-        if (step >= max_steps) {
-            *cut = 1;
+        if (step >= max_steps || ((step & 0xffff) == 0xffff && interrupt && *interrupt)) {
+            *cut = 1; /* at max_steps, or interrupted inside a walk of 65536 steps and more */
             return;
         }
         for (int k = 0; k < 3; k++) x[k] += dist * d[k], n[k] = s->normal[3 * j + k];
@@ -107,9 +107,17 @@ double ulam__point_gamma(double rho)
  * f_k b, a geometric tail. */
 static double part_sum(double rho, double gamma, double a, double b)
 {
-    double sum = 0.0, r = 1.0, f = ULAM__POINT_WMIN * gamma; /* rho^(k-1) and f_k at k = 1 */
-    for (; r * a > f * b; r *= rho, f *= gamma) sum += r * a;
-    return sum + b * f / (1.0 - gamma);
+    double k = 1.0; /* the first k where f_k b takes over: rho^(k-1) a <= f_k b */
+    if (a > ULAM__POINT_WMIN * gamma * b) {
+        if (!(b > 0)) return a / (1.0 - rho);
+        if (rho == 0.0) k = 2.0;
+        else k = fmax(2.0, ceil((log(a) - log(ULAM__POINT_WMIN * b) - log(rho)) / (log(gamma) - log(rho))));
+        /* by the closed form, then to the exact first k (a loop to it ran 4.6e7 steps at rho 1 - 1e-7) */
+        while (k > 2.0 && pow(rho, k - 2.0) * a <= ULAM__POINT_WMIN * pow(gamma, k - 1.0) * b) k -= 1.0;
+        while (pow(rho, k - 1.0) * a > ULAM__POINT_WMIN * pow(gamma, k) * b) k += 1.0;
+    }
+    double head = rho == 0.0 ? (k > 1.0 ? a : 0.0) : a * (1.0 - pow(rho, k - 1.0)) / (1.0 - rho);
+    return head + b * ULAM__POINT_WMIN * pow(gamma, k) / (1.0 - gamma);
 }
 
 /* A certified bound on what channel c of one walk (ulam__point_walk) can miss when cut at

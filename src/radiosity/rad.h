@@ -202,10 +202,10 @@ double ulam__point_tail(const ulam__point_bounds *b, int c, int64_t max_steps);
 /* A point walk (point.c): one walk from x (unit normal n, on patch self or -1) on the continuous
  * surfaces (uniform: each landing moved to a uniform point of its patch, a patch walk), its
  * weight floor falling at gamma (ulam__point_gamma): its RGB irradiance score; *rays gets the
- * rays cast, *cut 1 when cut at max_steps. */
+ * rays cast, *cut 1 when cut at max_steps or (every 65536 steps) by *interrupt (may be NULL). */
 void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps, double gamma,
-                      int uniform, const double x[3], const double n[3], int64_t self, ulam_rng *r, double score[3],
-                      int64_t *rays, int64_t *cut);
+                      int uniform, const double x[3], const double n[3], int64_t self, const volatile int *interrupt,
+                      ulam_rng *r, double score[3], int64_t *rays, int64_t *cut);
 
 /* Allocate an empty scene with room for the given counts (arrays uninitialised). */
 ulam_scene *ulam__scene_alloc(int64_t npatches, int64_t nverts, int64_t nidx, int64_t ngroups);
