@@ -449,7 +449,7 @@ def check_radiosity_zero_notes(ulam):
     face's winding reversed (the lamp's too) looks inside out; the generic zero-estimate note
     alone said neither."""
     faces = ["1 2 3 4", "5 8 7 6", "1 4 8 5", "2 6 7 3", "1 5 6 2", "4 3 7 8"]
-    with tempfile.TemporaryDirectory() as d:
+    with tempfile.TemporaryDirectory() as d:  # text notes, and JSON's zero_reason, at a patch, a point, a grid
         for name, ke, flip, want in (("dark", "", False, r"the scene has no emitter: no material has Ke > 0"),
                                      ("flipped", "Ke 5 5 5\n", True, r"the faces look inside out: 100% of rays")):
             with open(os.path.join(d, name + ".mtl"), "w") as f:
@@ -462,9 +462,15 @@ def check_radiosity_zero_notes(ulam):
                     vs = [str(order[int(v) - 1]) for v in fc.split()]
                     f.write(f"usemtl {'lamp' if k == 1 else 'g'}\nf " + " ".join(reversed(vs) if flip else vs) + "\n")
             scene = os.path.join(d, name + ".obj")
-            for extra in (["--patch", "1", "--rel-err", "0.05", "--no-mesh-error"], ["--at", "0.5,0.5,0"]):
+            for extra in (["--patch", "1", "--rel-err", "0.05", "--no-mesh-error"], ["--at", "0.5,0.5,0"],
+                          ["--grid", "0,0,0.5:1,1,0.5:0.5:0,0,1", "--walks", "1000"]):
                 rc, out, err = run(ulam, ["radiosity", scene] + extra)
                 assert rc == 0 and re.search(r"^ *note +" + want, out, re.M), (name, extra, out, err)
+                rc, out, err = run(ulam, ["radiosity", scene, "--json"] + extra)
+                o = json.loads(out)
+                why = [o.get("zero_reason")] if "--patch" in extra else [p["zero_reason"] for p in o["points"]] + \
+                    [p["zero_reason"] for p in o.get("grid", {}).get("points", [])]
+                assert rc == 0 and why and set(why) == {"no_emitter" if name == "dark" else "inside_out"}, (name, extra, o)
 
 
 def check_radiosity_check_side(ulam):

@@ -737,20 +737,31 @@ static int scene_diagnosis(const ulam_tracer *t, uint64_t seed, ulam_rad_scene_d
     return ulam_rad_scene_diagnose(t, DIAG_RAYS, seed, d) == ULAM_OK;
 }
 
+/* scene_notes' finding as a JSON word: no_emitter, inside_out, lamps_face_out or unreached. */
+static const char *zero_reason(const ulam_rad_scene_diag *d)
+{
+    double fr = (double)d->front[0] / DIAG_RAYS, br = (double)d->back[1] / DIAG_RAYS;
+    if (!d->emitters) return "no_emitter";
+    if (br > 0.25 && br > 2.0 * fr) return "inside_out";
+    if (d->lamp[0] + d->lamp[1] + d->lamp[2] > 0 && d->lamp[0] == 0) return "lamps_face_out";
+    return "unreached";
+}
+
 /* Print what is wrong with a scene whose answer is exactly 0 (label: the first line's label
  * column, indent the next lines'). */
 static void scene_notes(const ulam_rad_scene_diag *d, const char *label, const char *indent)
 {
     double fr = (double)d->front[0] / DIAG_RAYS, br = (double)d->back[1] / DIAG_RAYS; /* front to front, back to back */
     int64_t lamp = d->lamp[0] + d->lamp[1] + d->lamp[2];
-    if (!d->emitters)
+    const char *why = zero_reason(d);
+    if (!strcmp(why, "no_emitter"))
         printf("%sthe scene has no emitter: no material has Ke > 0, so no light enters it and every\n"
                "%sradiosity is exactly 0 (give the lamps' material Ke)\n", label, indent);
-    else if (br > 0.25 && br > 2.0 * fr)
+    else if (!strcmp(why, "inside_out"))
         printf("%sthe faces look inside out: %.0f%% of rays leaving the patches' backs land on another's\n"
                "%sback, %.0f%% of those leaving their fronts on a front (OBJ faces are counter-clockwise seen\n"
                "%sfrom their lit side: reverse each face's vertex order)\n", label, 100.0 * br, indent, 100.0 * fr, indent);
-    else if (lamp > 0 && d->lamp[0] == 0)
+    else if (!strcmp(why, "lamps_face_out"))
         printf("%sno emitter's front faces into the scene: of %lld rays leaving the lamps' fronts, %lld\n"
                "%sleave the scene and %lld land on a back side (turn the lamps' faces around)\n", label,
                (long long)lamp, (long long)d->lamp[2], indent, (long long)d->lamp[1]);
@@ -914,6 +925,7 @@ static void print_json(const args *a, const report *r)
                    (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
         cli_json_number("seconds", w->seconds, 0);
         printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
+        if (r->diag_known) cli_json_string("zero_reason", zero_reason(&r->diag), 0);
         if (a->o.stop.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT) {
             printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
             cli_json_number("min_walks", w->min_walks, 0);
@@ -1008,7 +1020,7 @@ static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int 
 }
 
 /* One point's answer as a JSON object. */
-static void point_json(const ulam_scene *s, const ulam_rad_point *r)
+static void point_json(const ulam_scene *s, const ulam_rad_point *r, const ulam_rad_scene_diag *diag)
 {
     double lo[3][2], hi[3][2], v[4][3];
     point_ci(s, r, lo, hi);
@@ -1027,6 +1039,8 @@ static void point_json(const ulam_scene *s, const ulam_rad_point *r)
     json_triple("ci95_lo", v[2]), json_triple("ci95_hi", v[3]);
     printf("\"walks\": %lld, \"rays\": %lld, \"cut\": %lld, ", (long long)r->run.walks, (long long)r->run.rays,
            (long long)r->run.cut);
+    if (diag && r->run.walks > 0 && exactly_zero(r->irradiance, r->irradiance_se))
+        cli_json_string("zero_reason", zero_reason(diag), 0);
     cli_json_number("seconds", r->run.seconds, 1);
     printf("}");
 }
@@ -1152,13 +1166,18 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         Ymin = fmin(Ymin, Y), Ysum += Y;
         if (Y > 0) worst = fmax(worst, se / Y);
     }
+    ulam_rad_scene_diag diag; /* what is wrong with the scene, when a point reads exactly 0 */
+    int known = 0;
+    for (int64_t k = 0; k < n && !known; k++)
+        if (pts[k].run.walks > 0 && exactly_zero(pts[k].irradiance, pts[k].irradiance_se))
+            known = scene_diagnosis(t, a->o.exec.seed, &diag);
     if (a->json) {
         printf("{");
         cli_json_string("scene", a->scene, 0);
         printf("\"points\": [");
         for (int k = 0; k < a->nat; k++) {
             if (k) printf(", ");
-            point_json(s, &pts[k]);
+            point_json(s, &pts[k], known ? &diag : NULL);
         }
         printf("], ");
         if (ngrid) {
@@ -1174,7 +1193,7 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
             printf("\"points\": [");
             for (int64_t k = a->nat; k < n; k++) {
                 if (k > a->nat) printf(", ");
-                point_json(s, &pts[k]);
+                point_json(s, &pts[k], known ? &diag : NULL);
             }
             printf("]}, ");
         }
@@ -1185,17 +1204,13 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
     } else {
         printf("scene        %s: %lld patches\n", a->scene, (long long)s->npatches);
-        ulam_rad_scene_diag diag;
-        int known = 0;
-        for (int k = 0; k < a->nat && !known; k++)
-            if (pts[k].run.walks > 0 && exactly_zero(pts[k].irradiance, pts[k].irradiance_se))
-                known = scene_diagnosis(t, a->o.exec.seed, &diag);
         for (int k = 0; k < a->nat; k++) point_text(s, k, &pts[k], pts[k].run.interrupted, known ? &diag : NULL);
         if (ngrid)
             printf("grid         %d x %d sensors facing %.4g %.4g %.4g: illuminance (0.2126 R + 0.7152 G + 0.0722 B)\n"
                    "             min %.6g, mean %.6g, uniformity min/mean %.4f; worst relative error <= %.3g\n",
                    a->g.nu, a->g.nv, a->g.normal[0], a->g.normal[1], a->g.normal[2], Ymin, Ysum / (double)ngrid,
                    Ysum > 0 ? Ymin / (Ysum / (double)ngrid) : NAN, worst);
+        if (ngrid && known && !(Ysum > 0)) scene_notes(&diag, "note         ", "             ");
         if (ngrid && a->out && !interrupted) printf("grid csv     %s\n", a->out);
         if (ngrid && a->image && !interrupted) printf("grid image   %s (false colour, 0 .. %.4g)\n", a->image, hi);
         printf("walks        %lld point walks (%s), %lld rays, %.4f s%s\n", (long long)walks,
