@@ -111,21 +111,25 @@ int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3
 /* A ray caster over a scene (Embree 3): opaque. */
 typedef struct ulam_tracer ulam_tracer;
 
-/* Build the ray-casting structure for s (which must outlive it). */
+/* Build the ray-casting structure for s (which must outlive it).  Embree sees the scene
+ * centred and in units of half its bounding box's largest side, so any size is cast alike;
+ * ULAM_ERANGE for a scene of that half-side outside 1e-60 .. 1e60. */
 int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err);
 
 /* Free a tracer; accepts and returns NULL. */
 ulam_tracer *ulam_tracer_free(ulam_tracer *t);
 
 /* How finely ray casting resolves the scene: Embree works in float (relative to the scene's
- * centre), so a patch far from the centre and small is resolved only to the float step there;
+ * centre, in units of its size), so a patch far from the centre and small is resolved only to the float step there;
  * the largest (float step at the patch) / sqrt(its area) over the patches, that patch in
  * *patch (may be NULL).  Above 10^-3 the geometry that rays see is off by more than 0.1% of a
  * patch. */
 double ulam_tracer_resolution(const ulam_tracer *t, int64_t *patch);
 
 /* The patch the ray org + t dir (t > 0, dir unit) first hits, or -1 when it leaves the
- * scene; *front (may be NULL) is 1 when it hits the patch's front side. */
+ * scene or starts more than 10^6 scene sizes (half the bounding box's largest side) from the
+ * scene's centre, where Embree's floats cannot take it; *front (may be NULL) is 1 when it hits
+ * the patch's front side. */
 int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3],
                          int *front);
 

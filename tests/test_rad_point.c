@@ -740,6 +740,11 @@ static void test_scale(void **state)
     assert_int_equal(ulam_rad_point_query(t, &o, far, n, &r, &err), ULAM_EINVAL);
     print_message("refused: %s\n", err.msg);
     assert_non_null(strstr(err.msg, "scene"));
+    double back[3] = {-1, 0, 0}; /* a ray from there: -1, not Embree's abort */
+    assert_int_equal(ulam_tracer_cast(t, far, back, NULL), -1);
+    double near[3] = {1e5, 0.5, 0.5};
+    int front = 1;
+    assert_true(ulam_tracer_cast(t, near, back, &front) >= 0 && !front); /* the cube's outside: a back side */
     ulam_tracer_free(t);
     ulam_scene_free(s);
     test_scene_rm(dir);

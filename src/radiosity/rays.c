@@ -225,6 +225,7 @@ static int64_t cast_from(const ulam_tracer *t, const double org[3], const double
 /* The first patch the ray hits, or -1. */
 int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3], int *front)
 {
+    if (!ulam__tracer_reaches(t, org)) return -1; /* Embree's float checks abort on such an origin */
     return cast_from(t, org, dir, -1, 0, front, NULL);
 }
 
