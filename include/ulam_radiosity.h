@@ -203,7 +203,8 @@ int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, do
  * G = (I - M)^-1 (one transposed LAPACK solve a channel) and v_k = sum_j F_kj B_j^2 -
  * (sum_j F_kj B_j)^2, plus, for each patch j whose own rays say by reciprocity that F_kj is
  * larger than row k saw (a small bright lamp none of row k's rays hit), (A_j F_jk / A_k -
- * F_kj) (B_j - sum_j F_kj B_j)^2. */
+ * F_kj) (B_j - sum_j F_kj B_j)^2, and for each emitter l facing k that neither's rays met,
+ * 0.5 / (rays (1 + A_k / A_l)) (B_l - sum_j F_kj B_j)^2. */
 int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                           int64_t p, size_t max_bytes, double se[3], ulam_error *err);
 
