@@ -299,11 +299,13 @@ static inline ulam_csr *test_random_system(int64_t n, int k, int signed_, double
     return M;
 }
 
-/* A scene written by a test (radiosity): a new temporary directory dir holding scene.obj (path)
- * and scene.mtl, whose text is mtl; returns the OBJ open for writing, its mtllib line written. */
+/* A scene written by a test (radiosity): a new temporary directory dir (under $TMPDIR, else the
+ * system's) holding scene.obj (path) and scene.mtl, whose text is mtl; returns the OBJ open for
+ * writing, its mtllib line written. */
 static inline FILE *test_scene_open(char dir[64], char path[96], const char *mtl)
 {
-    strcpy(dir, "/tmp/ulam_scene_XXXXXX");
+    const char *tmp = getenv("TMPDIR");
+    assert_true(snprintf(dir, 64, "%s/ulam_scene_XXXXXX", tmp && *tmp ? tmp : P_tmpdir) < 64);
     assert_non_null(mkdtemp(dir));
     char m[96];
     snprintf(path, 96, "%s/scene.obj", dir), snprintf(m, sizeof m, "%s/scene.mtl", dir);
