@@ -77,6 +77,13 @@ void ulam_mtl_notes_free(ulam_mtl_note *notes, int64_t n);
  * are kept. */
 int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out);
 
+/* What ulam_scene_subdivide(s, max_side) would make, counted without making it (so that a memory
+ * limit can refuse it first): *patches, *vertices, *triangles (the ray tracer's) and *bytes of
+ * the new scene's arrays (any may be NULL).  ULAM_OK, ULAM_EINVAL, or ULAM_EOVERFLOW when the
+ * patches or vertices pass INT32_MAX (the counts are still given). */
+int ulam_scene_subdivide_plan(const ulam_scene *s, double max_side, double *patches, double *vertices,
+                              double *triangles, double *bytes);
+
 /* Free a scene; accepts and returns NULL. */
 ulam_scene *ulam_scene_free(ulam_scene *s);
 
@@ -104,21 +111,25 @@ int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3
 /* A ray caster over a scene (Embree 3): opaque. */
 typedef struct ulam_tracer ulam_tracer;
 
-/* Build the ray-casting structure for s (which must outlive it). */
+/* Build the ray-casting structure for s (which must outlive it).  Embree sees the scene
+ * centred and in units of half its bounding box's largest side, so any size is cast alike;
+ * ULAM_ERANGE for a scene of that half-side outside 1e-60 .. 1e60. */
 int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err);
 
 /* Free a tracer; accepts and returns NULL. */
 ulam_tracer *ulam_tracer_free(ulam_tracer *t);
 
 /* How finely ray casting resolves the scene: Embree works in float (relative to the scene's
- * centre), so a patch far from the centre and small is resolved only to the float step there;
+ * centre, in units of its size), so a patch far from the centre and small is resolved only to the float step there;
  * the largest (float step at the patch) / sqrt(its area) over the patches, that patch in
  * *patch (may be NULL).  Above 10^-3 the geometry that rays see is off by more than 0.1% of a
  * patch. */
 double ulam_tracer_resolution(const ulam_tracer *t, int64_t *patch);
 
 /* The patch the ray org + t dir (t > 0, dir unit) first hits, or -1 when it leaves the
- * scene; *front (may be NULL) is 1 when it hits the patch's front side. */
+ * scene or starts more than 10^6 scene sizes (half the bounding box's largest side) from the
+ * scene's centre, where Embree's floats cannot take it; *front (may be NULL) is 1 when it hits
+ * the patch's front side. */
 int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3],
                          int *front);
 
@@ -126,6 +137,21 @@ int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double
  * (front side) is j with probability exactly F_pj; -1 when it leaves the scene or hits a
  * back side (the light is lost).  Draws from r. */
 int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
+
+/* What rays say about a scene (ulam_rad_scene_diagnose): the emitting patches, and where
+ * cosine rays from uniform points of patches drawn by area land, from their fronts, from their
+ * backs and from the emitters' fronts: [0] on a patch's front, [1] on a back, [2] nowhere (they
+ * left the scene). */
+typedef struct {
+    int64_t emitters;
+    int64_t front[3], back[3], lamp[3];
+} ulam_rad_scene_diag;
+
+/* Diagnose a scene that answers 0: rays cosine rays from the fronts and as many from the backs
+ * (stream seed); in a room whose normals face in, the fronts' rays land on fronts and the backs'
+ * leave; with the winding reversed the fronts' leave and the backs' land on backs.  ULAM_OK,
+ * ULAM_EINVAL, ULAM_ENOMEM. */
+int ulam_rad_scene_diagnose(const ulam_tracer *t, int64_t rays, uint64_t seed, ulam_rad_scene_diag *out);
 
 /* ---------------------------------------------------------------- form factors and the direct solve */
 /* Primary: ulam_ff_estimate, ulam_rad_direct.  Secondary: ulam_ff_report_compute, ulam_rad_system,
@@ -175,7 +201,10 @@ int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, do
  * with `rays` rays a patch) at patch p, per channel: the first-order propagation of the
  * multinomial noise of each row of F, se^2 = sum_k (G_pk rho_k)^2 v_k / rays with
  * G = (I - M)^-1 (one transposed LAPACK solve a channel) and v_k = sum_j F_kj B_j^2 -
- * (sum_j F_kj B_j)^2. */
+ * (sum_j F_kj B_j)^2, plus, for each patch j whose own rays say by reciprocity that F_kj is
+ * larger than row k saw (a small bright lamp none of row k's rays hit), (A_j F_jk / A_k -
+ * F_kj) (B_j - sum_j F_kj B_j)^2, and for each emitter l facing k that neither's rays met,
+ * 0.5 / (rays (1 + A_k / A_l)) (B_l - sum_j F_kj B_j)^2. */
 int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B,
                           int64_t p, size_t max_bytes, double se[3], ulam_error *err);
 

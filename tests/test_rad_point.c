@@ -608,6 +608,270 @@ static void test_mtl_notes(void **state)
     ulam_scene_free(s);
 }
 
+/* Write a furnace cube into a new temporary directory: side scale, corner at off, each face
+ * n x n quads (normals inward), Kd 0.5 and Ke 1 (B = H = 2 at every point and sensor inside);
+ * path gets the OBJ's path (dir is removed by test_scene_rm). */
+static void write_furnace(char dir[64], char path[96], int n, double scale, double off)
+{
+    FILE *f = test_scene_open(dir, path, "newmtl glow\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
+    fprintf(f, "usemtl glow\n");
+    /* face k: fixed axis a at 0 or 1, spanned by axes b, c with b x c = e_a (inward at 0) */
+    static const int ax[6][4] = {{1, 2, 0, 0}, {1, 2, 0, 1}, {0, 1, 2, 0}, {0, 1, 2, 1}, {2, 0, 1, 0}, {2, 0, 1, 1}};
+    int v = 0;
+    for (int k = 0; k < 6; k++) {
+        int a = ax[k][0], b = ax[k][1], c = ax[k][2], side = ax[k][3];
+        if (side) b = ax[k][2], c = ax[k][1]; /* the far face: reversed, so its normal points back in */
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                const int du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
+                for (int q = 0; q < 4; q++) {
+                    double x[3];
+                    x[a] = side, x[b] = (double)(i + du[q]) / n, x[c] = (double)(j + dv[q]) / n;
+                    fprintf(f, "v %.17g %.17g %.17g\n", off + scale * x[0], off + scale * x[1], off + scale * x[2]);
+                }
+                fprintf(f, "f %d %d %d %d\n", v + 1, v + 2, v + 3, v + 4);
+                v += 4;
+            }
+    }
+    fclose(f);
+}
+
+/* Rewrite the material of write_furnace's scene (Kd and Ke lines). */
+static void furnace_material(const char *dir, const char *mtl)
+{
+    char p[96];
+    snprintf(p, sizeof p, "%s/scene.mtl", dir);
+    FILE *f = fopen(p, "w");
+    assert_non_null(f);
+    fprintf(f, "newmtl glow\n%s\n", mtl);
+    fclose(f);
+}
+
+/* Check H = 2 in every channel of a furnace answer, to 4 standard errors, the error bar nonzero
+ * and below 2%. */
+static void check_furnace(const ulam_rad_point *r, const char *what)
+{
+    print_message("%s: H %.5f +- %.2g, CI %.5f .. %.5f (patch %lld)\n", what, r->irradiance[0], r->irradiance_se[0],
+                  r->run.ci95[0][0], r->run.ci95[0][1], (long long)r->patch);
+    for (int c = 0; c < 3; c++) {
+        assert_true(r->irradiance_se[c] > 0 && r->irradiance_se[c] < 0.02);
+        assert_close(r->irradiance[c], 2.0, 4 * r->irradiance_se[c]);
+        assert_true(r->run.ci95[c][0] < 2.0 && r->run.ci95[c][1] > 2.0);
+    }
+}
+
+/* Points on shared edges and vertices read the continuous surface, not the mesh: a furnace of
+ * 4 x 4 quads a face, points where coplanar patches meet, on the concave edges between faces,
+ * at a corner, and a grid whose sensors sit on vertices (all read 0 or 0.665 before: a ray
+ * from the point met the neighbouring patch at distance 0). */
+static void test_point_on_edges(void **state)
+{
+    (void)state;
+    char dir[64], path[96];
+    write_furnace(dir, path, 4, 1.0, 0.0);
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load(path, &s);
+    const double pts[6][3] = {{0.5, 0, 0.5}, {0.25, 0, 0.6}, {0.5, 0, 0}, {0, 0.5, 0.5}, {0, 0, 0}, {1, 1, 0.75}};
+    for (int k = 0; k < 6; k++) {
+        if (!test_case(k)) continue;
+        ulam_rad_point r = query(t, pts[k], NULL, ULAM_RAD_NEXT_EVENT, 20000, 0, 70 + (uint64_t)k);
+        check_furnace(&r, "furnace point on an edge or vertex");
+        for (int c = 0; c < 3; c++) assert_close(r.radiosity[c], 2.0, 4 * r.radiosity_se[c] + 1e-12);
+    }
+    test_case_done();
+    /* a 2 x 2 grid on the floor whose sensors sit on the mesh's vertices (0.25, 0.75) */
+    ulam_rad_grid g = {.origin = {0, 0, 0}, .u = {1, 0, 0}, .v = {0, 0, 1}, .normal = {0, 1, 0}, .nu = 2, .nv = 2};
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.max_walks = 20000, o.exec.seed = 5, o.exec.threads = 2;
+    ulam_rad_point out[4];
+    assert_int_equal(ulam_rad_grid_solve(t, &o, &g, out, NULL), ULAM_OK);
+    for (int k = 0; k < 4; k++) check_furnace(&out[k], "grid sensor on a vertex");
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    test_scene_rm(dir);
+}
+
+/* Radiosity is scale-free: the furnace (B = H = 2) of side 1e13, 4e18, 1e-12 and 1e-20 (and far
+ * from the origin), at a patch and at points on a face and an edge; a sensor normal of 1e200
+ * components; a sensor too far from the scene to be represented is refused with a message. */
+static void test_scale(void **state)
+{
+    (void)state;
+    const double scales[5][2] = {{1e13, 0}, {4e18, 0}, {1e-12, 0}, {1e-20, 0}, {1, 1e9}};
+    for (int k = 0; k < 5; k++) {
+        if (!test_case(k)) continue;
+        char dir[64], path[96];
+        write_furnace(dir, path, 2, scales[k][0], scales[k][1]);
+        ulam_scene *s = NULL;
+        ulam_tracer *t = must_load(path, &s);
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.stop.max_walks = 20000, o.exec.seed = 80 + (uint64_t)k, o.exec.threads = 2, o.index = 0;
+        ulam_rad_result pr = run_solver(t, &o);
+        print_message("scale %g: patch B %.5f +- %.2g, CI %.5f .. %.5f\n", scales[k][0], pr.radiosity[0],
+                      pr.std_error[0], pr.ci95[0][0], pr.ci95[0][1]);
+        for (int c = 0; c < 3; c++) {
+            assert_true(pr.std_error[c] > 0 && pr.std_error[c] < 0.02);
+            assert_close(pr.radiosity[c], 2.0, 4 * pr.std_error[c]);
+            assert_true(pr.ci95[c][0] < 2.0 && pr.ci95[c][1] > 2.0);
+        }
+        const double at[2][3] = {{0.3, 0, 0.3}, {0.3, 0, 0}};
+        for (int q = 0; q < 2; q++) {
+            double x[3];
+            for (int d = 0; d < 3; d++) x[d] = scales[k][1] + scales[k][0] * at[q][d];
+            ulam_rad_point r = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, 20000, 0, 90 + (uint64_t)q);
+            check_furnace(&r, "scaled furnace point");
+        }
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+        test_scene_rm(dir);
+    }
+    test_case_done();
+    char dir[64], path[96];
+    write_furnace(dir, path, 1, 1.0, 0.0);
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load(path, &s);
+    double mid[3] = {0.5, 0.5, 0.5}, huge_n[3] = {1e200, 1e200, 0}, far[3] = {1e20, 0.5, 0.5}, n[3] = {1, 0, 0};
+    ulam_rad_point r = query(t, mid, huge_n, ULAM_RAD_NEXT_EVENT, 20000, 0, 7);
+    assert_close(r.n[0], sqrt(0.5), 1e-12);
+    check_furnace(&r, "sensor with a normal of 1e200 components");
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.max_walks = 100;
+    ulam_error err;
+    assert_int_equal(ulam_rad_point_query(t, &o, far, n, &r, &err), ULAM_EINVAL);
+    print_message("refused: %s\n", err.msg);
+    assert_non_null(strstr(err.msg, "scene"));
+    double back[3] = {-1, 0, 0}; /* a ray from there: -1, not Embree's abort */
+    assert_int_equal(ulam_tracer_cast(t, far, back, NULL), -1);
+    double near[3] = {1e5, 0.5, 0.5};
+    int front = 1;
+    assert_true(ulam_tracer_cast(t, near, back, &front) >= 0 && !front); /* the cube's outside: a back side */
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    test_scene_rm(dir);
+}
+
+/* Walks cut at max_steps: on a furnace of Kd 0.999 and Ke 0.001 (B = H = 1) walks of at most 100
+ * steps see a tenth of the light; the interval must still hold the truth (it widens by the most
+ * the cut can miss, ulam__point_tail), at a point and at a patch; uncut, it is as narrow as ever
+ * (below 0.1 of B at 2000 walks of 10^6 steps). */
+static void test_cut_interval(void **state)
+{
+    (void)state;
+    char dir[64], path[96];
+    write_furnace(dir, path, 1, 1.0, 0.0);
+    furnace_material(dir, "Kd 0.999 0.999 0.999\nKe 0.001 0.001 0.001");
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load(path, &s);
+    double x[3] = {0.3, 0, 0.4};
+    for (int k = 0; k < 2; k++) {
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.stop.max_walks = 2000, o.stop.max_steps = k ? 1000000 : 100, o.exec.seed = 11, o.exec.threads = 2;
+        ulam_rad_point r;
+        assert_int_equal(ulam_rad_point_query(t, &o, x, NULL, &r, NULL), ULAM_OK);
+        o.index = 2;
+        ulam_rad_result pr = run_solver(t, &o);
+        print_message("max_steps %lld: point H %.4f, CI %.4f .. %.4f, cut %lld; patch B %.4f, CI %.4f .. %.4f, cut %lld\n",
+                      (long long)o.stop.max_steps, r.irradiance[0], r.run.ci95[0][0], r.run.ci95[0][1],
+                      (long long)r.run.cut, pr.radiosity[0], pr.ci95[0][0], pr.ci95[0][1], (long long)pr.cut);
+        assert_true(k ? r.run.cut == 0 : r.run.cut > 1000);
+        for (int c = 0; c < 3; c++) {
+            assert_true(r.run.ci95[c][0] <= 1.0 && r.run.ci95[c][1] >= 1.0);
+            assert_true(pr.ci95[c][0] <= 1.0 && pr.ci95[c][1] >= 1.0);
+            if (k) assert_true(r.run.ci95[c][1] - r.run.ci95[c][0] < 0.2);
+        }
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    test_scene_rm(dir);
+}
+
+/* Reverse the vertex order of every face of write_furnace's scene (inside out). */
+static void furnace_flip(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char line[256], out[1 << 16] = "";
+    size_t len = 0;
+    while (fgets(line, sizeof line, f)) {
+        int a, b, c, d;
+        if (sscanf(line, "f %d %d %d %d", &a, &b, &c, &d) == 4) snprintf(line, sizeof line, "f %d %d %d %d\n", d, c, b, a);
+        len += (size_t)snprintf(out + len, sizeof out - len, "%s", line);
+        assert_true(len < sizeof out);
+    }
+    fclose(f);
+    assert_non_null(f = fopen(path, "w"));
+    fputs(out, f);
+    fclose(f);
+}
+
+/* A scene that answers 0 says why (ulam_rad_scene_diagnose): the furnace with no Ke has no
+ * emitter; turned inside out, its backs' rays land on backs and its fronts' leave; as built,
+ * every front's ray lands on a front and every back's leaves. */
+static void test_scene_diagnose(void **state)
+{
+    (void)state;
+    char dir[64], path[96];
+    write_furnace(dir, path, 1, 1.0, 0.0);
+    for (int k = 0; k < 3; k++) {
+        furnace_material(dir, k == 0 ? "Kd 0.5 0.5 0.5" : "Kd 0.5 0.5 0.5\nKe 1 1 1");
+        if (k == 2) furnace_flip(path);
+        ulam_scene *s = NULL;
+        ulam_tracer *t = must_load(path, &s);
+        ulam_rad_scene_diag d;
+        assert_int_equal(ulam_rad_scene_diagnose(t, 1000, 3, &d), ULAM_OK);
+        print_message("case %d: %lld emitters; fronts %lld %lld %lld, backs %lld %lld %lld, lamps %lld %lld %lld\n", k,
+                      (long long)d.emitters, (long long)d.front[0], (long long)d.front[1], (long long)d.front[2],
+                      (long long)d.back[0], (long long)d.back[1], (long long)d.back[2], (long long)d.lamp[0],
+                      (long long)d.lamp[1], (long long)d.lamp[2]);
+        assert_int_equal(d.emitters, k ? 6 : 0);
+        assert_int_equal(d.front[0] + d.front[1] + d.front[2], 1000);
+        assert_int_equal(d.back[0] + d.back[1] + d.back[2], 1000);
+        if (k < 2) assert_true(d.front[0] == 1000 && d.back[2] == 1000);
+        else assert_true(d.front[2] == 1000 && d.back[1] == 1000 && d.lamp[2] == d.lamp[0] + d.lamp[1] + d.lamp[2]);
+        if (k == 2) { /* and the walks read exactly 0 */
+            double x[3] = {0.5, 0, 0.5};
+            ulam_rad_point r = query(t, x, NULL, ULAM_RAD_NEXT_EVENT, 2000, 0, 1);
+            assert_true(r.irradiance[0] == 0 && r.irradiance_se[0] == 0);
+        }
+        ulam_tracer_free(t);
+        ulam_scene_free(s);
+    }
+    assert_int_equal(ulam_rad_scene_diagnose(NULL, 10, 1, NULL), ULAM_EINVAL);
+    test_scene_rm(dir);
+}
+
+/* A block stops inside once time is up or the run is interrupted (a block of 256 walks of 10^6
+ * rays took minutes past --time 3): at a time limit already spent, the first block (which always
+ * runs, so there is an estimate) keeps the walks it finished, one here, not all 256 (counts, not
+ * seconds); a point and a patch solver on a furnace of Kd 0.99. */
+static void test_block_stops_inside(void **state)
+{
+    (void)state;
+    char dir[64], path[96];
+    write_furnace(dir, path, 1, 1.0, 0.0);
+    furnace_material(dir, "Kd 0.99 0.99 0.99\nKe 1 1 1");
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load(path, &s);
+    double x[3] = {0.5, 0, 0.5};
+    for (int k = 0; k < 2; k++) {
+        ulam_rad_opts o = ulam_rad_defaults();
+        o.stop.max_walks = 0, o.stop.max_seconds = 1e-12, o.exec.threads = 1, o.index = 1;
+        ulam_rad_solver *sv = NULL;
+        assert_int_equal(k ? ulam_rad_solver_alloc(t, &o, &sv, NULL) : ulam_rad_point_alloc(t, &o, x, NULL, &sv, NULL),
+                         ULAM_OK);
+        while (!ulam_rad_solver_done(sv)) assert_int_equal(ulam_rad_solver_iterate(sv), ULAM_OK);
+        ulam_rad_result r;
+        ulam_rad_solver_result(sv, &r);
+        print_message("%s solver at a spent time limit: %lld walks, %lld rays\n", k ? "patch" : "point",
+                      (long long)r.walks, (long long)r.rays);
+        assert_true(r.walks >= 1 && r.walks < 256);
+        ulam_rad_solver_free(sv);
+    }
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    test_scene_rm(dir);
+}
+
 /* ulam_render_hdr: one centre ray a pixel, flat, is ulam_render's picture byte for byte; smooth
  * shading of a constant radiosity is that constant at every pixel (corner means of equal values),
  * jittered or not; a linear gradient over a subdivided face is interpolated (between the patch
@@ -738,6 +1002,9 @@ int main(void)
         cmocka_unit_test(test_shoot_rel_err),    cmocka_unit_test(test_adapt_furnace),
         cmocka_unit_test(test_adapt_cornell),    cmocka_unit_test(test_importance_furnace),
         cmocka_unit_test(test_adapt_view),       cmocka_unit_test(test_hdr_write),
+        cmocka_unit_test(test_point_on_edges),   cmocka_unit_test(test_scale),
+        cmocka_unit_test(test_cut_interval),     cmocka_unit_test(test_scene_diagnose),
+        cmocka_unit_test(test_block_stops_inside),
     };
     return test_run(tests);
 }

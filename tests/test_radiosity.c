@@ -1150,6 +1150,114 @@ static void test_patch_window(void **state)
     ulam_scene_free(s);
 }
 
+/* Write an open box into a new temporary directory: a 4 x 4 floor and four walls of 4 x 4 unit
+ * patches (80, normals in, no top), Kd 0.6, one wall patch a lamp of Ke 10; path gets the
+ * OBJ's path, dir the directory (test_scene_rm). */
+static void write_open_box(char dir[64], char path[96])
+{
+    FILE *f = test_scene_open(dir, path, "newmtl g\nKd 0.6 0.6 0.6\nnewmtl lamp\nKd 0.6 0.6 0.6\nKe 10 10 10\n");
+    /* each side: corner o, unit steps u, v with u x v its inward normal, and its patches' origins */
+    static const double side[5][3][3] = {{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
+                                         {{0, 0, 4}, {0, 1, 0}, {1, 0, 0}}, {{0, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                                         {{4, 0, 0}, {0, 0, 1}, {0, 1, 0}}};
+    int v = 0;
+    for (int k = 0; k < 5; k++)
+        for (int i = 0; i < 4; i++)
+            for (int j = 0; j < 4; j++) {
+                const int du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
+                for (int q = 0; q < 4; q++) {
+                    double x[3];
+                    for (int d = 0; d < 3; d++)
+                        x[d] = side[k][0][d] + (i + du[q]) * side[k][1][d] + (j + dv[q]) * side[k][2][d];
+                    fprintf(f, "v %g %g %g\n", x[0], x[1], x[2]);
+                }
+                fprintf(f, "usemtl %s\nf %d %d %d %d\n", k == 1 && i == 3 && j == 1 ? "lamp" : "g", v + 1, v + 2, v + 3,
+                        v + 4);
+                v += 4;
+            }
+    fclose(f);
+}
+
+/* The direct solve and its form-factor error bar at rays rays a patch (seed). */
+static void direct_at(const ulam_tracer *t, const ulam_scene *s, int64_t rays, uint64_t seed, double *B, double *se)
+{
+    ulam_csr *F = NULL;
+    ulam_error err;
+    assert_int_equal(ulam_ff_estimate(t, rays, seed, 2, &F, &err), ULAM_OK);
+    assert_int_equal(ulam_rad_direct(s, F, 0, B, NULL, &err), ULAM_OK);
+    if (se) assert_int_equal(ulam_rad_direct_errors(s, F, rays, B, 0, se, &err), ULAM_OK);
+    ulam_csr_free(F);
+}
+
+/* --direct's error bar at 1000 form-factor rays against a 40000-ray solve, over the open box's
+ * 80 patches and 10 seeds: a patch none of whose rays hit the small lamp had a bar from the
+ * rest alone (751 of 800 within 1.96 sigma, 5 past 4, worst 9.96); now the lamp's own rays fill
+ * in by reciprocity (781, 0, 3.29). At most 1 |z| > 4 (normal: 0.05 expected) and at least 744
+ * of 800 within 1.96 sigma (P(Binomial(800, 0.95) < 744) < 0.01). */
+static void test_direct_error_bar(void **state)
+{
+    (void)state;
+    char dir[64], path[96];
+    write_open_box(dir, path);
+    ulam_scene *s = must_scene(path);
+    ulam_tracer *t = must_tracer(s);
+    int64_t n = s->npatches;
+    assert_int_equal(n, 80);
+    double *ref = malloc(3 * (size_t)n * sizeof *ref), *B = malloc(3 * (size_t)n * sizeof *B);
+    double *se = malloc(3 * (size_t)n * sizeof *se);
+    assert_true(ref && B && se);
+    direct_at(t, s, 40000, 99, ref, NULL);
+    int inside = 0, wild = 0;
+    double worst = 0;
+    for (uint64_t seed = 1; seed <= 10; seed++) {
+        direct_at(t, s, 1000, seed, B, se);
+        for (int64_t p = 0; p < n; p++) {
+            double z = (B[3 * p] - ref[3 * p]) / se[3 * p];
+            inside += fabs(z) <= 1.96, wild += fabs(z) > 4, worst = fmax(worst, fabs(z));
+        }
+    }
+    print_message("direct at 1000 rays: %d of 800 within 1.96 sigma, %d past 4, worst |z| %.2f\n", inside, wild, worst);
+    assert_true(wild <= 1);
+    assert_true(inside >= 744);
+    free(ref), free(B), free(se);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+    test_scene_rm(dir);
+}
+
+/* ulam_scene_subdivide_plan counts what ulam_scene_subdivide makes, without making it: patches,
+ * vertices, the tracer's triangles and the arrays' bytes, on quads (the cube, the Cornell box's
+ * quads and its polygons) at several sizes; a plan past INT32_MAX patches is EOVERFLOW with the
+ * count still told (1.67e11 cube patches at 1e-5), as the subdivision itself refuses it. */
+static void test_subdivide_plan(void **state)
+{
+    (void)state;
+    const char *paths[2] = {"examples/scenes/cube.obj", "examples/scenes/cornell_box.obj"};
+    const double sides[2][3] = {{0.3, 0.05, 1.5}, {100, 37, 1000}};
+    for (int k = 0; k < 2; k++) {
+        ulam_scene *s = must_scene(paths[k]);
+        for (int q = 0; q < 3; q++) {
+            double np, nv, tri, bytes;
+            ulam_scene *d = NULL;
+            assert_int_equal(ulam_scene_subdivide_plan(s, sides[k][q], &np, &nv, &tri, &bytes), ULAM_OK);
+            assert_int_equal(ulam_scene_subdivide(s, sides[k][q], &d), ULAM_OK);
+            print_message("%s at %g: plan %.0f patches, %.0f vertices, %.0f triangles, %.0f bytes\n", paths[k],
+                          sides[k][q], np, nv, tri, bytes);
+            assert_true(np == (double)d->npatches && nv == (double)d->nverts);
+            assert_true(tri == (double)(d->start[d->npatches] - 2 * d->npatches));
+            assert_true(bytes > 100.0 * np + 24.0 * nv);
+            ulam_scene_free(d);
+        }
+        ulam_scene_free(s);
+    }
+    ulam_scene *s = must_scene(paths[0]);
+    double np = 0;
+    assert_int_equal(ulam_scene_subdivide_plan(s, 1e-5, &np, NULL, NULL, NULL), ULAM_EOVERFLOW);
+    assert_true(np == 6e10);
+    assert_int_equal(ulam_scene_subdivide_plan(s, 0, &np, NULL, NULL, NULL), ULAM_EINVAL);
+    ulam_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1165,7 +1273,8 @@ int main(void)
         cmocka_unit_test(test_render_framing),     cmocka_unit_test(test_camera_defaults),     cmocka_unit_test(test_next_event_coverage),
         cmocka_unit_test(test_next_event_back_sides), cmocka_unit_test(test_next_event_edge),
         cmocka_unit_test(test_next_event_hidden), cmocka_unit_test(test_rel_err_zero_channel),  cmocka_unit_test(test_view_gather),
-        cmocka_unit_test(test_patch_window),
+        cmocka_unit_test(test_patch_window), cmocka_unit_test(test_subdivide_plan),
+        cmocka_unit_test(test_direct_error_bar),
     };
     return test_run(tests);
 }

@@ -299,4 +299,32 @@ static inline ulam_csr *test_random_system(int64_t n, int k, int signed_, double
     return M;
 }
 
+/* A scene written by a test (radiosity): a new temporary directory dir (under $TMPDIR, else the
+ * system's) holding scene.obj (path) and scene.mtl, whose text is mtl; returns the OBJ open for
+ * writing, its mtllib line written. */
+static inline FILE *test_scene_open(char dir[64], char path[96], const char *mtl)
+{
+    const char *tmp = getenv("TMPDIR");
+    assert_true(snprintf(dir, 64, "%s/ulam_scene_XXXXXX", tmp && *tmp ? tmp : P_tmpdir) < 64);
+    assert_non_null(mkdtemp(dir));
+    char m[96];
+    snprintf(path, 96, "%s/scene.obj", dir), snprintf(m, sizeof m, "%s/scene.mtl", dir);
+    FILE *f = fopen(m, "w");
+    assert_non_null(f);
+    fputs(mtl, f);
+    fclose(f);
+    assert_non_null(f = fopen(path, "w"));
+    fprintf(f, "mtllib scene.mtl\n");
+    return f;
+}
+
+/* Remove test_scene_open's directory and files. */
+static inline void test_scene_rm(const char *dir)
+{
+    char p[96];
+    snprintf(p, sizeof p, "%s/scene.obj", dir), remove(p);
+    snprintf(p, sizeof p, "%s/scene.mtl", dir), remove(p);
+    remove(dir);
+}
+
 #endif

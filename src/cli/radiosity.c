@@ -644,6 +644,8 @@ typedef struct {
     int adapted, view_importance; /* --mesh-target: adapt holds what it did (by the view's importance) */
     ulam_rad_adapt_info adapt;
     int64_t adapt_cap; /* the most patches it could make (--max-patches, or what --max-mem holds) */
+    int diag_known;    /* the answer is exactly 0 and diag says why (scene_notes) */
+    ulam_rad_scene_diag diag;
 } report;
 
 /* (walk - direct) / the standard error of the difference at the patch, channel c: matrix walks
@@ -654,6 +656,27 @@ static double zscore(const args *a, const report *r, int c)
     double diff = r->w->B[c] - d, se = sqrt(sw * sw + sf * sf);
     if (se == 0) return diff == 0 ? 0.0 : copysign(INFINITY, diff); /* both exact: agree, or not at all */
     return diff / se;
+}
+
+/* Which side of a --check disagreement (|z| > 3) in channel c is suspect: ray walks carry a
+ * certified interval, the direct solve a first-order bar from F's sampled noise, so a direct
+ * answer outside the walks' interval points at F (--ff-rays), one inside it at the walks;
+ * matrix walks share the sampled F, so only the walks' noise can be at fault. */
+static void check_side(const args *a, const report *r, int c)
+{
+    double d = r->Bdirect[3 * r->patch + c], lo = r->w->ci95[c][0], hi = r->w->ci95[c][1];
+    printf("check %c      |z| = %.2g: ", chan[c], fabs(zscore(a, r, c)));
+    if (a->matrix_walk)
+        printf("the walks on the same F disagree with its direct solve: the walks' noise (or a bug)\n");
+    else if (isfinite(lo) && isfinite(hi) && (d < lo || d > hi))
+        printf("the direct solve, %.6g, lies %s the walks' certified 95%% interval %.6g .. %.6g:\n"
+               "             suspect the form factors (%lld rays a patch; raise --ff-rays)\n", d,
+               d < lo ? "below" : "above", lo, hi, (long long)a->ff_rays);
+    else if (isfinite(lo) && isfinite(hi))
+        printf("the direct solve, %.6g, lies inside the walks' certified 95%% interval %.6g .. %.6g:\n"
+               "             its form-factor bar is too narrow (raise --ff-rays)\n", d, lo, hi);
+    else
+        printf("the walks have no certified interval here to tell which side is off\n");
 }
 
 /* Nonzero when the mesh error of channel c dominates the Monte Carlo error: larger than twice
@@ -697,6 +720,63 @@ static void print_adapt(const args *a, const report *r)
            (long long)d->points, (long long)d->rays, d->seconds);
 }
 
+/* Rays cast by scene_diagnosis from the fronts (and as many from the backs). */
+enum { DIAG_RAYS = 4096 };
+
+/* Nonzero when every channel of v is exactly 0 with a zero standard error se. */
+static int exactly_zero(const double v[3], const double se[3])
+{
+    for (int c = 0; c < 3; c++)
+        if (v[c] != 0.0 || se[c] != 0.0) return 0;
+    return 1;
+}
+
+/* What is wrong with a scene that answers 0 (ulam_rad_scene_diagnose); 0 when nothing is found. */
+static int scene_diagnosis(const ulam_tracer *t, uint64_t seed, ulam_rad_scene_diag *d)
+{
+    return ulam_rad_scene_diagnose(t, DIAG_RAYS, seed, d) == ULAM_OK;
+}
+
+/* scene_notes' finding as a JSON word: no_emitter, inside_out, lamps_face_out or unreached. */
+static const char *zero_reason(const ulam_rad_scene_diag *d)
+{
+    double fr = (double)d->front[0] / DIAG_RAYS, br = (double)d->back[1] / DIAG_RAYS;
+    if (!d->emitters) return "no_emitter";
+    if (br > 0.25 && br > 2.0 * fr) return "inside_out";
+    if (d->lamp[0] + d->lamp[1] + d->lamp[2] > 0 && d->lamp[0] == 0) return "lamps_face_out";
+    return "unreached";
+}
+
+/* Print what is wrong with a scene whose answer is exactly 0 (label: the first line's label
+ * column, indent the next lines'). */
+static void scene_notes(const ulam_rad_scene_diag *d, const char *label, const char *indent)
+{
+    double fr = (double)d->front[0] / DIAG_RAYS, br = (double)d->back[1] / DIAG_RAYS; /* front to front, back to back */
+    int64_t lamp = d->lamp[0] + d->lamp[1] + d->lamp[2];
+    const char *why = zero_reason(d);
+    if (!strcmp(why, "no_emitter"))
+        printf("%sthe scene has no emitter: no material has Ke > 0, so no light enters it and every\n"
+               "%sradiosity is exactly 0 (give the lamps' material Ke)\n", label, indent);
+    else if (!strcmp(why, "inside_out"))
+        printf("%sthe faces look inside out: %.0f%% of rays leaving the patches' backs land on another's\n"
+               "%sback, %.0f%% of those leaving their fronts on a front (OBJ faces are counter-clockwise seen\n"
+               "%sfrom their lit side: reverse each face's vertex order)\n", label, 100.0 * br, indent, 100.0 * fr, indent);
+    else if (!strcmp(why, "lamps_face_out"))
+        printf("%sno emitter's front faces into the scene: of %lld rays leaving the lamps' fronts, %lld\n"
+               "%sleave the scene and %lld land on a back side (turn the lamps' faces around)\n", label,
+               (long long)lamp, (long long)d->lamp[2], indent, (long long)d->lamp[1]);
+    else
+        printf("%sthe scene has %lld emitting patches and its faces face in (%.0f%% of the fronts' rays land\n"
+               "%son a front): no emitter's light reaches here\n", label, (long long)d->emitters, 100.0 * fr, indent);
+}
+
+/* Nonzero when the walks' interval covers a cut at --max-steps (ray gathering by next-event or
+ * collision, whose walks have a certified tail; the library widens the interval by it). */
+static int cut_covered(const args *a)
+{
+    return !a->matrix_walk && a->o.mode == ULAM_ADJOINT && a->o.estimator != ULAM_RAD_ABSORPTION;
+}
+
 /* Print the text report. */
 static void print_text(const args *a, const report *r)
 {
@@ -716,6 +796,11 @@ static void print_text(const args *a, const report *r)
                c[0], c[1], c[2]);
     }
     const walked *w = r->w;
+    if (w && w->cut) /* before the numbers: they are biased low */
+        printf("warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
+               "             beyond the cut is lost); %s (raise --max-steps)\n", (long long)w->cut, (long long)w->walks,
+               (long long)a->o.stop.max_steps, cut_covered(a) ? "the interval includes the most the cut can miss"
+                                                               : "the error bar does not cover the bias");
     if (w && r->patch >= 0) {
         for (int c = 0; c < 3; c++) {
             printf("radiosity %c  %.8g +- %.3g", chan[c], w->B[c], w->se[c]);
@@ -733,6 +818,7 @@ static void print_text(const args *a, const report *r)
                    "             --rel-err can never be met by a zero estimate, so the walks stopped there; if the\n"
                    "             answer is not exactly 0, a walk scores with probability below 3/%lld = %.2g (95%%)\n",
                    (long long)w->walks, (long long)w->walks, 3.0 / (double)w->walks);
+        if (r->diag_known) scene_notes(&r->diag, "note         ", "             ");
         if (r->mesh_known) print_mesh(r, w);
         if (r->mesh_no_time)
             printf("mesh error   not estimated: the walks spent --time (raise it, or --no-mesh-error)\n");
@@ -759,10 +845,6 @@ static void print_text(const args *a, const report *r)
     if (a->view && r->view.unmet)
         printf("warning      %lld seen patches stopped short of their target (--walks or --time)\n",
                (long long)r->view.unmet);
-    if (w && w->cut)
-        printf("warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
-               "             beyond the cut is lost) and the error bar does not cover the bias\n",
-               (long long)w->cut, (long long)w->walks, (long long)a->o.stop.max_steps);
     if (r->Bdirect && r->patch >= 0)
         for (int c = 0; c < 3; c++) {
             printf("direct %c     %.8g", chan[c], r->Bdirect[3 * r->patch + c]);
@@ -770,6 +852,8 @@ static void print_text(const args *a, const report *r)
             if (w) printf("  z = %.3f%s", zscore(a, r, c), a->matrix_walk ? " (walk noise: the same F)" : "");
             printf("\n");
         }
+    for (int c = 0; r->Bdirect && r->patch >= 0 && w && c < 3; c++)
+        if (fabs(zscore(a, r, c)) > 3.0) check_side(a, r, c);
     if (a->out && r->out_written)
         printf("patches      %lld rows written to %s%s\n", (long long)r->s->npatches, a->out,
                r->pv.se == r->w_all_se_conditional ? " (standard errors: walk noise only, CONDITIONAL on the sampled F)" : "");
@@ -841,6 +925,7 @@ static void print_json(const args *a, const report *r)
                    (long long)w->channel_walks[1], (long long)w->channel_walks[2]);
         cli_json_number("seconds", w->seconds, 0);
         printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
+        if (r->diag_known) cli_json_string("zero_reason", zero_reason(&r->diag), 0);
         if (a->o.stop.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT) {
             printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
             cli_json_number("min_walks", w->min_walks, 0);
@@ -905,7 +990,8 @@ static void point_ci(const ulam_scene *s, const ulam_rad_point *r, double lo[3][
 }
 
 /* One point's answer as text. */
-static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int interrupted)
+static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int interrupted,
+                       const ulam_rad_scene_diag *diag)
 {
     printf("point %-6d %.6g %.6g %.6g, normal %.4g %.4g %.4g", k + 1, r->x[0], r->x[1], r->x[2], r->n[0], r->n[1],
            r->n[2]);
@@ -915,6 +1001,10 @@ static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int 
     } else {
         printf(" (a sensor on no surface)\n");
     }
+    if (r->run.cut)
+        printf("  warning    %lld of %lld walks cut at --max-steps: the estimate is biased low; the interval includes\n"
+               "             the most the cut can miss (raise --max-steps)\n", (long long)r->run.cut,
+               (long long)r->run.walks);
     double lo[3][2], hi[3][2];
     point_ci(s, r, lo, hi);
     for (int c = 0; c < 3; c++) {
@@ -924,12 +1014,13 @@ static void point_text(const ulam_scene *s, int k, const ulam_rad_point *r, int 
         if (r->patch >= 0 && isfinite(lo[c][1])) printf(" (95%% CI %.6g .. %.6g)", lo[c][1], hi[c][1]);
         printf("%s\n", interrupted ? "  [INTERRUPTED]" : "");
     }
-    printf("  walks      %lld, %lld rays, %.4f s%s\n", (long long)r->run.walks, (long long)r->run.rays, r->run.seconds,
-           r->run.cut ? " (some walks cut at --max-steps: biased low)" : "");
+    printf("  walks      %lld, %lld rays, %.4f s\n", (long long)r->run.walks, (long long)r->run.rays, r->run.seconds);
+    if (diag && !interrupted && r->run.walks > 0 && exactly_zero(r->irradiance, r->irradiance_se))
+        scene_notes(diag, "  note       ", "             ");
 }
 
 /* One point's answer as a JSON object. */
-static void point_json(const ulam_scene *s, const ulam_rad_point *r)
+static void point_json(const ulam_scene *s, const ulam_rad_point *r, const ulam_rad_scene_diag *diag)
 {
     double lo[3][2], hi[3][2], v[4][3];
     point_ci(s, r, lo, hi);
@@ -948,6 +1039,8 @@ static void point_json(const ulam_scene *s, const ulam_rad_point *r)
     json_triple("ci95_lo", v[2]), json_triple("ci95_hi", v[3]);
     printf("\"walks\": %lld, \"rays\": %lld, \"cut\": %lld, ", (long long)r->run.walks, (long long)r->run.rays,
            (long long)r->run.cut);
+    if (diag && r->run.walks > 0 && exactly_zero(r->irradiance, r->irradiance_se))
+        cli_json_string("zero_reason", zero_reason(diag), 0);
     cli_json_number("seconds", r->run.seconds, 1);
     printf("}");
 }
@@ -1073,13 +1166,18 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         Ymin = fmin(Ymin, Y), Ysum += Y;
         if (Y > 0) worst = fmax(worst, se / Y);
     }
+    ulam_rad_scene_diag diag; /* what is wrong with the scene, when a point reads exactly 0 */
+    int known = 0;
+    for (int64_t k = 0; k < n && !known; k++)
+        if (pts[k].run.walks > 0 && exactly_zero(pts[k].irradiance, pts[k].irradiance_se))
+            known = scene_diagnosis(t, a->o.exec.seed, &diag);
     if (a->json) {
         printf("{");
         cli_json_string("scene", a->scene, 0);
         printf("\"points\": [");
         for (int k = 0; k < a->nat; k++) {
             if (k) printf(", ");
-            point_json(s, &pts[k]);
+            point_json(s, &pts[k], known ? &diag : NULL);
         }
         printf("], ");
         if (ngrid) {
@@ -1095,7 +1193,7 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
             printf("\"points\": [");
             for (int64_t k = a->nat; k < n; k++) {
                 if (k > a->nat) printf(", ");
-                point_json(s, &pts[k]);
+                point_json(s, &pts[k], known ? &diag : NULL);
             }
             printf("]}, ");
         }
@@ -1106,12 +1204,13 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
     } else {
         printf("scene        %s: %lld patches\n", a->scene, (long long)s->npatches);
-        for (int k = 0; k < a->nat; k++) point_text(s, k, &pts[k], pts[k].run.interrupted);
+        for (int k = 0; k < a->nat; k++) point_text(s, k, &pts[k], pts[k].run.interrupted, known ? &diag : NULL);
         if (ngrid)
             printf("grid         %d x %d sensors facing %.4g %.4g %.4g: illuminance (0.2126 R + 0.7152 G + 0.0722 B)\n"
                    "             min %.6g, mean %.6g, uniformity min/mean %.4f; worst relative error <= %.3g\n",
                    a->g.nu, a->g.nv, a->g.normal[0], a->g.normal[1], a->g.normal[2], Ymin, Ysum / (double)ngrid,
                    Ysum > 0 ? Ymin / (Ysum / (double)ngrid) : NAN, worst);
+        if (ngrid && known && !(Ysum > 0)) scene_notes(&diag, "note         ", "             ");
         if (ngrid && a->out && !interrupted) printf("grid csv     %s\n", a->out);
         if (ngrid && a->image && !interrupted) printf("grid image   %s (false colour, 0 .. %.4g)\n", a->image, hi);
         printf("walks        %lld point walks (%s), %lld rays, %.4f s%s\n", (long long)walks,
@@ -1213,6 +1312,10 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
         }
     }
     free(rgb), free(hdr);
+    if (status == ULAM_ERANGE) {
+        ulam_error err = {.status = status, .msg = "--camera: an eye within a million scene sizes of the scene"};
+        return cli_report(a->image, &err);
+    }
     if (status) {
         ulam_error err = {.status = status, .msg = "a writable PNG file"};
         return cli_report(a->image, &err);
@@ -1228,6 +1331,9 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
                         "(1 used; give --exposure or --camera)\n", a->image);
     return 0;
 }
+
+static double need_counts(const args *a, double n, double tri, double nverts, char *what, size_t len);
+static void human(double b, char *out, size_t len);
 
 /* The scene, subdivided if asked; 0 or an exit code. */
 static int load_scene(const args *a, ulam_scene **out, int64_t *faces)
@@ -1250,9 +1356,22 @@ static int load_scene(const args *a, ulam_scene **out, int64_t *faces)
     }
     ulam_mtl_notes_free(notes, nnotes);
     *faces = s->nfaces;
-    if (a->subdivide > 0) {
+    if (a->subdivide > 0) { /* counted first: --max-mem refuses a mesh before it is built */
+        double np = 0, nv = 0, tri = 0, bytes = 0, need;
+        char what[512], h[3][32];
+        int status = ulam_scene_subdivide_plan(s, a->subdivide, &np, &nv, &tri, &bytes);
+        need = bytes + (a->list ? 0.0 : need_counts(a, np, tri, nv, what, sizeof what));
+        if ((status == ULAM_OK || status == ULAM_EOVERFLOW) && need > (double)a->max_mem) {
+            human(need, h[0], 32), human((double)a->max_mem, h[1], 32), human(bytes, h[2], 32);
+            fprintf(stderr, "ulam radiosity: %s: memory limit: --subdivide %g makes %.4g patches (%.4g vertices): "
+                            "this run needs about %s, more than --max-mem %s (the patches %s%s%s); refused before "
+                            "building them: raise --subdivide or --max-mem\n",
+                    a->scene, a->subdivide, np, nv, h[0], h[1], h[2], a->list ? "" : ", ", a->list ? "" : what);
+            ulam_scene_free(s);
+            return cli_exit_code(ULAM_EMEMLIMIT);
+        }
         ulam_scene *d = NULL;
-        int status = ulam_scene_subdivide(s, a->subdivide, &d);
+        status = status ? status : ulam_scene_subdivide(s, a->subdivide, &d);
         ulam_scene_free(s);
         if (status) {
             err = (ulam_error){.status = status, .msg = "a subdivision that fits in memory"};
@@ -1546,6 +1665,8 @@ int cli_radiosity(int argc, char **argv)
         }
         if (a.matrix_walk) combine_errors(&r, &w);
         r.w = &w;
+        if (r.patch >= 0 && !w.interrupted && exactly_zero(w.B, w.se))
+            r.diag_known = scene_diagnosis(t, a.o.exec.seed, &r.diag);
     }
     r.pv = every_patch(&a, &r, &w, Bd);
     if (a.mesh_walks && r.pv.B && !w.interrupted && (rc = every_mesh_error(&a, t, s, &r.pv, &mesh_all))) goto done;

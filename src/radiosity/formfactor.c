@@ -190,18 +190,97 @@ int ulam_rad_direct(const ulam_scene *s, const ulam_csr *F, size_t max_bytes, do
     return status;
 }
 
-/* rho_kc^2 v_k / rays: the variance that row k's multinomial noise puts on (M B)_k, channel c,
- * with v_k = sum_j F_kj B_j^2 - (sum_j F_kj B_j)^2. */
-static double row_noise(const ulam_scene *s, const ulam_csr *F, int64_t rays, const double *B, int64_t k, int c)
+/* What row_noise reads besides F: its transpose and the emitters (em[0..nem), none when the
+ * pairs n * nem would pass NOISE_PAIRS: the unseen-lamp term is then skipped). */
+typedef struct {
+    ulam_csr *Ft;
+    int64_t *em, nem;
+} noise_src;
+
+enum { NOISE_PAIRS = 100000000 };
+
+/* Free a noise_src's arrays. */
+static void noise_src_free(noise_src *ns)
 {
-    double m1 = 0.0, m2 = 0.0;
+    ulam_csr_free(ns->Ft);
+    free(ns->em);
+}
+
+/* F's transpose and the emitters of s; ULAM_OK or ULAM_ENOMEM (ns freed). */
+static int noise_src_make(const ulam_scene *s, const ulam_csr *F, noise_src *ns)
+{
+    *ns = (noise_src){0};
+    if (ulam_csr_transpose(F, &ns->Ft)) return ULAM_ENOMEM;
+    int64_t n = s->npatches, m = 0;
+    for (int64_t k = 0; k < n; k++) m += ulam__max3(s->emit + 3 * k) > 0;
+    if ((double)m * (double)n > NOISE_PAIRS || m == 0) return ULAM_OK;
+    if (!(ns->em = ulam__malloc((size_t)m, sizeof *ns->em))) {
+        noise_src_free(ns);
+        return ULAM_ENOMEM;
+    }
+    for (int64_t k = 0; k < n; k++)
+        if (ulam__max3(s->emit + 3 * k) > 0) ns->em[ns->nem++] = k;
+    return ULAM_OK;
+}
+
+/* Nonzero when column j is in row k of A (columns sorted). */
+static int in_row(const ulam_csr *A, int64_t k, int64_t j)
+{
+    int64_t lo = A->rowptr[k], hi = A->rowptr[k + 1];
+    while (lo < hi) {
+        int64_t mid = lo + (hi - lo) / 2;
+        if (A->colidx[mid] < j) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < A->rowptr[k + 1] && A->colidx[lo] == j;
+}
+
+/* Nonzero when some vertex of patch a lies in front of patch b's plane (beyond rounding). */
+static int in_front(const ulam_scene *s, int64_t a, int64_t b)
+{
+    const double *v0 = s->vert + 3 * s->vidx[s->start[b]], *nb = s->normal + 3 * b;
+    double tol = 1e-9 * (sqrt(s->area[a]) + sqrt(s->area[b])), d[3];
+    for (int64_t q = s->start[a]; q < s->start[a + 1]; q++) {
+        ulam__sub3(s->vert + 3 * s->vidx[q], v0, d);
+        if (ulam__dot3(d, nb) > tol) return 1;
+    }
+    return 0;
+}
+
+/* rho_kc^2 v_k / rays: the variance that row k's multinomial noise puts on (M B)_k, channel c,
+ * with v_k = sum_j F_kj B_j^2 - (sum_j F_kj B_j)^2 the variance of the B_j a ray of row k lands
+ * on, plus what the row's rays never saw.  A patch j whose own rays say by reciprocity that F_kj
+ * is larger than row k saw (ns->Ft) adds (A_j F_jk / A_k - F_kj) (B_j - mean)^2.  An emitter l
+ * facing k that neither's rays met adds F~ (B_l - mean)^2 with F~ = 0.5 / (rays (1 + A_k / A_l)),
+ * the Jeffreys estimate of F_kl after no hit in rays trials at F_kl and rays at F_lk = F_kl A_k /
+ * A_l.  Without these a patch none of whose 1000 rays hit a small bright lamp had a bar from
+ * the rest alone: in an open box of 80 patches (a lamp one wall patch), 751 of 800 were within
+ * 1.96 sigma of a 40000-ray solve, |z| up to 9.96. */
+static double row_noise(const ulam_scene *s, const ulam_csr *F, const noise_src *ns, int64_t rays, const double *B,
+                        int64_t k, int c)
+{
+    const ulam_csr *Ft = ns->Ft;
+    double m1 = 0.0, m2 = 0.0, unseen = 0.0;
     for (int64_t q = F->rowptr[k]; q < F->rowptr[k + 1]; q++) {
         double x = B[3 * F->colidx[q] + c];
         m1 += F->val[q] * x;
         m2 += F->val[q] * x * x;
     }
+    int64_t q = F->rowptr[k], qe = F->rowptr[k + 1]; /* both rows' columns are sorted: a merge */
+    for (int64_t t = Ft->rowptr[k]; t < Ft->rowptr[k + 1]; t++) {
+        int64_t j = Ft->colidx[t];
+        while (q < qe && F->colidx[q] < j) q++;
+        double seen = q < qe && F->colidx[q] == j ? F->val[q] : 0.0, d = B[3 * j + c] - m1;
+        unseen += fmax(0.0, s->area[j] * Ft->val[t] / s->area[k] - seen) * d * d;
+    }
+    for (int64_t e = 0; e < ns->nem; e++) {
+        int64_t l = ns->em[e];
+        if (l == k || in_row(F, k, l) || in_row(Ft, k, l) || !in_front(s, l, k) || !in_front(s, k, l)) continue;
+        double d = B[3 * l + c] - m1;
+        unseen += 0.5 / ((double)rays * (1.0 + s->area[k] / s->area[l])) * d * d;
+    }
     double r = s->rho[3 * k + c];
-    return r * r * fmax(0.0, m2 - m1 * m1) / (double)rays;
+    return r * r * (fmax(0.0, m2 - m1 * m1) + unseen) / (double)rays;
 }
 
 /* Standard error of the direct B at patch p from the noise of F. */
@@ -213,7 +292,9 @@ int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, 
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a scene, F, B, rays >= 1 and a patch");
     int64_t n = s->npatches;
     double *e = ulam__calloc((size_t)n, sizeof *e), *g = ulam__malloc((size_t)n, sizeof *g);
-    int status = e && g ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a transposed solve");
+    noise_src ns = {0};
+    int status = e && g && !noise_src_make(s, F, &ns) ? ULAM_OK
+                                                       : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a transposed solve");
     if (!status) e[p] = 1.0;
     for (int c = 0; c < 3 && !status; c++) {
         ulam_csr *M = NULL, *Mt = NULL;
@@ -222,13 +303,14 @@ int ulam_rad_direct_error(const ulam_scene *s, const ulam_csr *F, int64_t rays, 
             ulam__fail(err, status, 0, -1, "memory for the transposed system");
         } else if (!(status = ulam_direct_solve(Mt, e, g, max_bytes, NULL, err))) {
             double var = 0.0; /* g = row p of (I - M)^-1 */
-            for (int64_t k = 0; k < n; k++) var += g[k] * g[k] * row_noise(s, F, rays, B, k, c);
+            for (int64_t k = 0; k < n; k++) var += g[k] * g[k] * row_noise(s, F, &ns, rays, B, k, c);
             se[c] = sqrt(var);
         }
         ulam_csr_free(M);
         ulam_csr_free(Mt);
     }
     free(e), free(g);
+    noise_src_free(&ns);
     return status;
 }
 
@@ -252,14 +334,17 @@ int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays,
     double *a = ulam__malloc((size_t)n * (size_t)n, sizeof *a), *x = ulam__malloc((size_t)n * (size_t)n, sizeof *x);
     double *noise = ulam__malloc((size_t)n, sizeof *noise);
     lapack_int *ipiv = ulam__malloc((size_t)n, sizeof *ipiv);
-    int status = a && x && noise && ipiv ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "two dense %lld x %lld matrices", (long long)n, (long long)n);
+    noise_src ns = {0};
+    int status = a && x && noise && ipiv && !noise_src_make(s, F, &ns)
+                     ? ULAM_OK
+                     : ulam__fail(err, ULAM_ENOMEM, 0, -1, "two dense %lld x %lld matrices", (long long)n, (long long)n);
     for (int c = 0; c < 3 && !status; c++) {
         memset(a, 0, (size_t)n * (size_t)n * sizeof *a);
         memset(x, 0, (size_t)n * (size_t)n * sizeof *x);
         for (int64_t k = 0; k < n; k++) { /* column k of (I - M)' is row k of I - M, column-major */
             a[k + k * n] = 1.0, x[k + k * n] = 1.0;
             for (int64_t q = F->rowptr[k]; q < F->rowptr[k + 1]; q++) a[F->colidx[q] + k * n] -= s->rho[3 * k + c] * F->val[q];
-            noise[k] = row_noise(s, F, rays, B, k, c);
+            noise[k] = row_noise(s, F, &ns, rays, B, k, c);
         }
         lapack_int info = L->dgesv(LAPACK_COL_MAJOR, (lapack_int)n, (lapack_int)n, a, (lapack_int)n, ipiv, x, (lapack_int)n);
         if (info) {
@@ -273,6 +358,7 @@ int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays,
         }
     }
     free(a), free(x), free(noise), free(ipiv);
+    noise_src_free(&ns);
     return status;
 }
 

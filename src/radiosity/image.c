@@ -76,10 +76,18 @@ static void cast_pixels(const ulam_tracer *t, const ulam_camera *cam, int w, int
         }
 }
 
+/* ULAM_OK, or ULAM_ERANGE for a camera whose eye Embree cannot start rays at (more than
+ * ULAM__TRACER_REACH scene sizes from the scene, where floats abort its ray checks). */
+int ulam__camera_check(const ulam_tracer *t, const ulam_camera *cam)
+{
+    return ulam__tracer_reaches(t, cam->eye) ? ULAM_OK : ULAM_ERANGE;
+}
+
 /* How many pixel centres see each patch's front. */
 int ulam_view_pixels(const ulam_tracer *t, const ulam_camera *cam, int width, int height, int64_t *pixels)
 {
     if (!t || !cam || !pixels || width < 1 || height < 1 || !(cam->focal > 0) || !(cam->film > 0)) return ULAM_EINVAL;
+    if (ulam__camera_check(t, cam)) return ULAM_ERANGE;
     size_t np = (size_t)width * (size_t)height;
     if (np > SIZE_MAX / 8 / 3) return ULAM_EOVERFLOW;
     int64_t *hit = ulam__malloc(np, sizeof *hit);
@@ -118,6 +126,7 @@ int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, i
     if (info) *info = (ulam_render_info){0};
     if (!t || !B || !cam || !rgb || width < 1 || height < 1 || !(cam->focal > 0) || !(cam->film > 0))
         return ULAM_EINVAL;
+    if (ulam__camera_check(t, cam)) return ULAM_ERANGE;
     const ulam_scene *s = ulam__tracer_scene(t);
     for (int64_t k = 0; k < 3 * s->npatches; k++)
         if (!isfinite(B[k])) return ULAM_ENONFINITE; /* no picture of a failed solve */
@@ -204,6 +213,7 @@ int ulam_render_hdr(const ulam_tracer *t, const double *B, const ulam_camera *ca
     if (info) *info = (ulam_render_info){0};
     if (!t || !B || !cam || !hdr || width < 1 || height < 1 || samples < 1 || !(cam->focal > 0) || !(cam->film > 0))
         return ULAM_EINVAL;
+    if (ulam__camera_check(t, cam)) return ULAM_ERANGE;
     const ulam_scene *s = ulam__tracer_scene(t);
     for (int64_t k = 0; k < 3 * s->npatches; k++)
         if (!isfinite(B[k])) return ULAM_ENONFINITE;

@@ -159,14 +159,16 @@ static void project_box(const ulam__light_group *G, const double u[3], double *l
  * and that bound falls with r >= d; INFINITY without such a d. */
 static double g_max(const ulam_scene *s, int64_t p, const double *pt, const double n[3], const ulam__light_group *G)
 {
-    double lo_p, hi_p, lo_l, hi_l, cp[3] = {0, 0, 0}, u[3];
+    double lo_p, hi_p, lo_l, hi_l, cp[3] = {0, 0, 0}, u[3], size = 0.0; /* the box's diagonal: the scene's unit */
+    for (int i = 0; i < 3; i++) size += (G->hi[i] - G->lo[i]) * (G->hi[i] - G->lo[i]);
+    size = sqrt(size);
     project(s, p, pt, n, &lo_p, &hi_p);
     project_box(G, n, &lo_l, &hi_l);
-    if (hi_l - lo_p <= 1e-12 * (fmax(fabs(lo_p), fabs(hi_l)) + 1.0)) return 0.0; /* on or behind x's plane */
+    if (hi_l - lo_p <= 1e-12 * (fmax(fabs(lo_p), fabs(hi_l)) + size)) return 0.0; /* on or behind x's plane */
     double gx = lo_l - hi_p, A = hi_l - lo_p;
     project(s, p, pt, G->n, &lo_p, &hi_p);
     project_box(G, G->n, &lo_l, &hi_l);
-    if (hi_p - lo_l <= 1e-12 * (fmax(fabs(hi_p), fabs(lo_l)) + 1.0)) return 0.0; /* x behind the emitters' plane */
+    if (hi_p - lo_l <= 1e-12 * (fmax(fabs(hi_p), fabs(lo_l)) + size)) return 0.0; /* x behind the emitters' plane */
     double gl = lo_p - hi_l, B = hi_p - lo_l, gap = fmax(gx, gl); /* gl along -n_l */
     double c = -ulam__dot3(n, G->n);
     if (gx > 0 && gl > 0 && fabs(c) < 1.0 - 1e-9 && gx - c * gl >= 0 && gl - c * gx >= 0)

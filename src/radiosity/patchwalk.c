@@ -79,7 +79,7 @@ struct ulam_rad_solver {
     ulam__point_bounds pb;              /* a point solver's (point_bounds) */
     ulam__lights L;       /* the emitters (shooting's source, next-event's lights) */
     int at;               /* a point solver: walks from at_x (normal at_n, on patch at_self or -1) */
-    double at_x[3], at_n[3];
+    double at_x[3], at_n[3], at_start[3]; /* at_start: where its walks start (ulam__point_start) */
     int64_t at_self;
     rad_scratch *scratch;
     rad_block *blocks;
@@ -158,7 +158,7 @@ static void own_parts(ulam_rad_solver *s)
     ulam__point_bounds *b = &s->pb;
     int64_t i = s->o.query.index;
     if (next_event(s->o.estimator)) {
-        ulam__lights_vertex_parts(&s->L, sc, s->o.estimator, s->at ? -1 : i, s->at ? s->at_x : NULL,
+        ulam__lights_vertex_parts(&s->L, sc, s->o.estimator, s->at ? -1 : i, s->at ? s->at_start : NULL,
                                   s->at ? s->at_n : sc->normal + 3 * i, b->light0, b->hit0);
         return;
     }
@@ -328,18 +328,27 @@ int ulam_rad_solver_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, ulam_
 
 /* Check point x (normal n, or NULL: the patch's it lies on) and place it: *p the patch it lies
  * on or -1, xx the point on that patch's plane exactly, nn the unit normal. */
-static int point_place(const ulam_scene *sc, const double x[3], const double n[3], int64_t *p, double xx[3],
+static int point_place(const ulam_tracer *t, const double x[3], const double n[3], int64_t *p, double xx[3],
                        double nn[3], ulam_error *err)
 {
-    double len = n ? sqrt(ulam__dot3(n, n)) : 0.0;
+    const ulam_scene *sc = ulam__tracer_scene(t);
+    double big = 0.0, m[3] = {0, 0, 0}, len = 0.0, c[3];
     for (int k = 0; k < 3; k++)
         if (!isfinite(x[k]) || (n && !isfinite(n[k]))) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a finite point and normal");
+    for (int k = 0; k < 3 && n; k++) big = fmax(big, fabs(n[k]));
+    for (int k = 0; k < 3 && big > 0; k++) m[k] = n[k] / big; /* scaled first: 1e200 squared overflows */
+    len = sqrt(ulam__dot3(m, m));
     if (n && !(len > 0)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero normal");
+    if (!ulam__tracer_reaches(t, x)) {
+        double size = ulam__tracer_size(t, c);
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point within %g scene sizes of the scene (its centre is %g %g %g, "
+                          "its size %g)", ULAM__TRACER_REACH, c[0], c[1], c[2], size);
+    }
     *p = ulam_scene_locate(sc, x, ULAM_RAD_LOCATE_REL);
     if (!n && *p < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point on a patch (within %g of its size) or a normal for a "
                                                    "sensor off the surfaces", ULAM_RAD_LOCATE_REL);
-    for (int k = 0; k < 3; k++) nn[k] = n ? n[k] / len : sc->normal[3 * *p + k], xx[k] = x[k];
+    for (int k = 0; k < 3; k++) nn[k] = n ? m[k] / len : sc->normal[3 * *p + k], xx[k] = x[k];
     if (*p >= 0 && ulam__dot3(nn, sc->normal + 3 * *p) < 1.0 - 1e-9)
         return ulam__fail(err, ULAM_EINVAL, 0, *p, "the normal of patch %lld the point lies on (or no normal)",
                           (long long)*p + 1);
@@ -362,11 +371,12 @@ int ulam_rad_point_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, const 
     *out = NULL;
     double xx[3], nn[3];
     int64_t p;
-    int status = point_place(ulam__tracer_scene(t), x, n, &p, xx, nn, err);
+    int status = point_place(t, x, n, &p, xx, nn, err);
     if (status || (status = solver_alloc(t, opts, 1, out, err))) return status;
     ulam_rad_solver *s = *out;
     for (int k = 0; k < 3; k++) s->at_x[k] = xx[k], s->at_n[k] = nn[k];
     s->at_self = p;
+    ulam__point_start(t, xx, nn, p, s->at_start);
     score_bounds(s); /* with the point's own first vertex */
     if ((status = check_bounded(s, err))) *out = ulam_rad_solver_free(s);
     return status;
@@ -382,10 +392,11 @@ int ulam__rad_point_restart(ulam_rad_solver *s, const double x[3], const double 
     if (!s || !s->at || !x) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a point solver and a point");
     double xx[3], nn[3];
     int64_t p;
-    int status = point_place(s->s, x, n, &p, xx, nn, err);
+    int status = point_place(s->t, x, n, &p, xx, nn, err);
     if (status) return status;
     for (int k = 0; k < 3; k++) s->at_x[k] = xx[k], s->at_n[k] = nn[k];
     s->at_self = p;
+    ulam__point_start(s->t, xx, nn, p, s->at_start);
     ulam__rad_solver_restart(s, -1, s->o.stop.rel_err, seed, max_seconds);
     return ULAM_OK;
 }
@@ -465,7 +476,7 @@ static void gather_window(const ulam_rad_solver *s, ulam_rng *r, double score[3]
     if (s->q[i] == 0.0) return;
     ulam__tracer_point(s->t, i, r, x);
     ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, ulam__point_gamma(s->pb.rho), 1, x,
-                     sc->normal + 3 * i, i, r, H, &br->rays, &cut);
+                     sc->normal + 3 * i, i, s->o.stop.interrupt, r, H, &br->rays, &cut);
     br->cut += cut;
     for (int c = 0; c < 3; c++) score[c] += rho[c] * H[c];
 }
@@ -528,6 +539,15 @@ static int flush_history(rad_scratch *sc, rad_block *br)
     return ULAM_OK;
 }
 
+/* Nonzero when a block must stop before its next walk: interrupted, or out of time.  A block
+ * stops inside (one walk of 10^6 rays takes a second, a block of 256 of them minutes: --time 3
+ * took 68 s), keeping the walks it finished: the run ends with them (ulam__round_step). */
+static int block_must_stop(const ulam_rad_solver *s)
+{
+    if (s->o.stop.interrupt && *s->o.stop.interrupt) return 1;
+    return s->o.stop.max_seconds > 0 && ulam_now() - s->run.t0 >= s->o.stop.max_seconds;
+}
+
 /* Run walks [first, first + count) as block k on thread th (ctx: the solver). */
 static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
 {
@@ -542,12 +562,13 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     ulam_rng r;
     ulam_rng_seed(&r, s->o.exec.seed, (uint64_t)(first / RBLOCK));
     for (int64_t w = 0; w < count; w++) {
+        if (w > 0 && block_must_stop(s)) break; /* its walks so far stand: the run ends with them */
         if (s->o.mode == ULAM_ADJOINT) {
             double sc[3];
             if (s->at) {
                 int64_t cut = 0;
                 ulam__point_walk(s->t, &s->L, s->o.estimator, s->o.stop.max_steps, ulam__point_gamma(s->pb.rho), 0,
-                                 s->at_x, s->at_n, s->at_self, &r, sc, &br->rays, &cut);
+                                 s->at_start, s->at_n, s->at_self, s->o.stop.interrupt, &r, sc, &br->rays, &cut);
                 br->cut += cut;
             } else if (window(s)) {
                 gather_window(s, &r, sc, br);
@@ -605,7 +626,8 @@ static void merge_block(void *ctx, int k)
 static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r);
 
 /* Channel c's certified score range R and bias at estimate m (of B), in B's units: a window
- * walk's whole range, finite and with no bias (ulam__point_range; times rho_i at patch i, whose
+ * walk's whole range, finite, and the most a cut at max_steps can miss (ulam__point_range and
+ * ulam__point_tail; times rho_i at patch i, whose
  * scores lie in [E_i, E_i + R]); else the range of one absorption walk's score or of one
  * particle's tally at the patch over its area (shooting), at a truncation whose bias is at
  * most E |m| / 4 when no whole-walk bound is known (score_bounds). */
@@ -614,8 +636,9 @@ static void channel_range(const ulam_rad_solver *s, int c, double m, double E, d
     double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
     if (window(s)) { /* window walks: their range (point.c), times the patch's reflectance */
         double R0 = ulam__point_range(&s->pb, c), rho = s->at ? 1.0 : s->s->rho[3 * s->o.query.index + c];
+        double tail = ulam__point_tail(&s->pb, c, s->o.stop.max_steps); /* what a cut at max_steps can miss */
         *R = rho > 0 ? rho * R0 : 0.0;
-        *bias = 0.0;
+        *bias = rho > 0 && tail > 0 ? rho * tail : 0.0;
         return;
     }
     *R = ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0) / A;

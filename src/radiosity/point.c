@@ -30,11 +30,32 @@ static void onto_plane(const ulam_scene *s, int64_t j, double y[3])
     for (int k = 0; k < 3; k++) y[k] -= h * n[k];
 }
 
+/* Where a point walk from x (unit normal n, on patch p or -1) starts: a point on a patch may sit
+ * on an edge or vertex it shares with other patches, where a ray leaving it meets a neighbour at
+ * distance 0 (a coplanar one from behind, ending the walk dark; a wall across a concave edge
+ * from wherever the float origin rounded to).  The answer there is the surface's limit from
+ * the inside of the patch, so the walk starts ULAM__POINT_NUDGE scene sizes off the patch's
+ * plane along n and as far (at most half way) toward the patch's centroid, inside it: every
+ * neighbour is then at a distance 2^8 times the origin's float rounding, on the side it is
+ * on, and the answer moves by that share of its variation over the scene (far below its
+ * error bar).  A sensor off the surfaces starts where it is. */
+void ulam__point_start(const ulam_tracer *t, const double x[3], const double n[3], int64_t p, double out[3])
+{
+    const ulam_scene *s = ulam__tracer_scene(t);
+    double delta = ULAM__POINT_NUDGE * ulam__tracer_size(t, NULL), c[3], d[3];
+    for (int k = 0; k < 3; k++) out[k] = x[k];
+    if (p < 0) return;
+    ulam_scene_centroid(s, p, c);
+    ulam__sub3(c, x, d);
+    double len = sqrt(ulam__dot3(d, d)), step = len > 0 ? fmin(delta, 0.5 * len) / len : 0.0;
+    for (int k = 0; k < 3; k++) out[k] += step * d[k] + delta * n[k];
+}
+
 /* One walk from x: its RGB irradiance score (uniform: each landing moves to a uniform point of
  * the patch it landed on, the patch walks' discrete equation). */
 void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps, double gamma,
-                      int uniform, const double x0[3], const double n0[3], int64_t self, ulam_rng *r, double score[3],
-                      int64_t *rays, int64_t *cut)
+                      int uniform, const double x0[3], const double n0[3], int64_t self, const volatile int *interrupt,
+                      ulam_rng *r, double score[3], int64_t *rays, int64_t *cut)
 {
     const ulam_scene *s = ulam__tracer_scene(t);
     int light = estimator != ULAM_RAD_COLLISION && L->nem > 0;
@@ -62,8 +83,8 @@ void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator
             if (!(ulam__rng_uniform(r) * floor < w)) return;
             for (int c = 0; c < 3; c++) W[c] *= floor / w;
         }
-        if (step >= max_steps) {
-            *cut = 1;
+        if (step >= max_steps || ((step & 0xffff) == 0xffff && interrupt && *interrupt)) {
+            *cut = 1; /* at max_steps, or interrupted inside a walk of 65536 steps and more */
             return;
         }
         for (int k = 0; k < 3; k++) x[k] += dist * d[k], n[k] = s->normal[3 * j + k];
@@ -86,9 +107,33 @@ double ulam__point_gamma(double rho)
  * f_k b, a geometric tail. */
 static double part_sum(double rho, double gamma, double a, double b)
 {
-    double sum = 0.0, r = 1.0, f = ULAM__POINT_WMIN * gamma; /* rho^(k-1) and f_k at k = 1 */
-    for (; r * a > f * b; r *= rho, f *= gamma) sum += r * a;
-    return sum + b * f / (1.0 - gamma);
+    double k = 1.0; /* the first k where f_k b takes over: rho^(k-1) a <= f_k b */
+    if (a > ULAM__POINT_WMIN * gamma * b) {
+        if (!(b > 0)) return a / (1.0 - rho);
+        if (rho == 0.0) k = 2.0;
+        else k = fmax(2.0, ceil((log(a) - log(ULAM__POINT_WMIN * b) - log(rho)) / (log(gamma) - log(rho))));
+        /* by the closed form, then to the exact first k (a loop to it ran 4.6e7 steps at rho 1 - 1e-7) */
+        while (k > 2.0 && pow(rho, k - 2.0) * a <= ULAM__POINT_WMIN * pow(gamma, k - 1.0) * b) k -= 1.0;
+        while (pow(rho, k - 1.0) * a > ULAM__POINT_WMIN * pow(gamma, k) * b) k += 1.0;
+    }
+    double head = rho == 0.0 ? (k > 1.0 ? a : 0.0) : a * (1.0 - pow(rho, k - 1.0)) / (1.0 - rho);
+    return head + b * ULAM__POINT_WMIN * pow(gamma, k) / (1.0 - gamma);
+}
+
+/* A certified bound on what channel c of one walk (ulam__point_walk) can miss when cut at
+ * max_steps K: the walk has scored its vertices 0 .. K (each a light sample and the landing of
+ * its cosine ray), so the rest is at most the sum over k > K of vertex k's bound in
+ * ulam__point_range, max(rho^(k-1) lr_c, f_k l_c) + max(rho^(k-1) hr_c, f_k h_c) <= rho^(k-1)
+ * (lr_c + hr_c) + f_k (l_c + h_c), whose geometric tails are rho^K (lr_c + hr_c) / (1 - rho) +
+ * WMIN gamma^(K+1) (l_c + h_c) / (1 - gamma).  The mean of the walks is biased low by at most
+ * that (0 for a walk that cannot be cut short of anything: rho^K underflows on a dull scene). */
+double ulam__point_tail(const ulam__point_bounds *b, int c, int64_t max_steps)
+{
+    double a = b->lr[c] + b->hr[c], f = b->light[c] + b->hit[c];
+    if (a + f == 0.0) return 0.0;
+    if (!isfinite(a + f) || !(b->rho < 1.0)) return INFINITY;
+    double g = ulam__point_gamma(b->rho), K = (double)max_steps;
+    return (a > 0 ? a * pow(b->rho, K) / (1.0 - b->rho) : 0.0) + ULAM__POINT_WMIN * pow(g, K + 1.0) * f / (1.0 - g);
 }
 
 /* A certified range of channel c of one walk's score (ulam__point_walk): every score lies in

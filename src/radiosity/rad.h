@@ -83,6 +83,24 @@ int ulam__tracer_sees_from(const ulam_tracer *t, const double x[3], const double
 int64_t ulam__tracer_ray(const ulam_tracer *t, const double org[3], const double dir[3], int64_t self, int *front,
                          double *dist);
 
+/* The sizes of scene a tracer takes (half the largest side of its bounding box): Embree sees it
+ * at size 1, and the doubles of areas, distances and form factors stay far from overflow. */
+#define ULAM__TRACER_SIZE_MIN 1e-60
+#define ULAM__TRACER_SIZE_MAX 1e60
+
+/* How far from the scene's centre, in scene sizes, a ray may start (a point, a sensor, an eye). */
+#define ULAM__TRACER_REACH 1e6
+
+/* The scene's size (half the largest side of its bounding box) and (centre non-NULL) the
+ * centre of that box. */
+double ulam__tracer_size(const ulam_tracer *t, double centre[3]);
+
+/* Nonzero when x is within ULAM__TRACER_REACH scene sizes of the scene's centre. */
+int ulam__tracer_reaches(const ulam_tracer *t, const double x[3]);
+
+/* ULAM_OK, or ULAM_ERANGE for a camera whose eye is past ULAM__TRACER_REACH (image.c). */
+int ulam__camera_check(const ulam_tracer *t, const ulam_camera *cam);
+
 /* The scene a tracer was built on. */
 const ulam_scene *ulam__tracer_scene(const ulam_tracer *t);
 
@@ -168,13 +186,26 @@ typedef struct {
  * sampling alone beside an emitter). */
 double ulam__point_range(const ulam__point_bounds *b, int c);
 
+/* How far off its patch, in scene sizes, a point walk from a point on the surfaces starts
+ * (ulam__point_start): 2^-16, 2^8 float roundings of Embree's unit-box frame. */
+#define ULAM__POINT_NUDGE 0x1p-16
+
+/* Where a point walk from x (unit normal n, on patch p or -1) starts: nudged off the patch's
+ * plane and into its interior, so that no neighbour sharing an edge or vertex with p touches
+ * the ray's origin (point.c). */
+void ulam__point_start(const ulam_tracer *t, const double x[3], const double n[3], int64_t p, double out[3]);
+
+/* A certified bound on what channel c of one point walk can miss when cut at max_steps (the bias
+ * of the walks' mean, low; point.c). */
+double ulam__point_tail(const ulam__point_bounds *b, int c, int64_t max_steps);
+
 /* A point walk (point.c): one walk from x (unit normal n, on patch self or -1) on the continuous
  * surfaces (uniform: each landing moved to a uniform point of its patch, a patch walk), its
  * weight floor falling at gamma (ulam__point_gamma): its RGB irradiance score; *rays gets the
- * rays cast, *cut 1 when cut at max_steps. */
+ * rays cast, *cut 1 when cut at max_steps or (every 65536 steps) by *interrupt (may be NULL). */
 void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator, int64_t max_steps, double gamma,
-                      int uniform, const double x[3], const double n[3], int64_t self, ulam_rng *r, double score[3],
-                      int64_t *rays, int64_t *cut);
+                      int uniform, const double x[3], const double n[3], int64_t self, const volatile int *interrupt,
+                      ulam_rng *r, double score[3], int64_t *rays, int64_t *cut);
 
 /* Allocate an empty scene with room for the given counts (arrays uninitialised). */
 ulam_scene *ulam__scene_alloc(int64_t npatches, int64_t nverts, int64_t nidx, int64_t ngroups);

@@ -3,8 +3,10 @@
  * function rejects every hit on the patch a ray leaves (a planar convex patch cannot be hit by
  * a ray leaving its front, so this is exact), and the ray starts at the sampled point itself.
  * Embree works in float, so vertices and origins are taken relative to the centre of the
- * scene's bounding box (computed in double): a scene far from the origin keeps the precision
- * of one at the origin, and no offset has to outgrow a float's rounding there. */
+ * scene's bounding box (computed in double) and in units of its half extent: a scene far from
+ * the origin keeps the precision of one at the origin, and a scene of any size (1e13 or 1e-20)
+ * meets Embree's float products (whose cubes overflow or underflow past ~1e12 and ~1e-12) at
+ * size 1; distances come back in the scene's units. */
 #include "rad.h"
 #include "../dynload.h"
 
@@ -19,6 +21,7 @@ struct ulam_tracer {
     int64_t *prim_patch; /* triangle -> patch */
     double *share;       /* per patch: ulam__first_share */
     double centre[3];    /* of the bounding box: Embree's coordinates are relative to it */
+    double scale;        /* its half extent: Embree's unit */
     double resolution;   /* the largest float step at a patch over the patch's size */
     int64_t coarsest;    /* the patch where it is */
 };
@@ -58,7 +61,16 @@ static void scene_centre(const ulam_scene *s, double c[3])
             lo[d] = fmin(lo[d], s->vert[3 * v + d]);
             hi[d] = fmax(hi[d], s->vert[3 * v + d]);
         }
-    for (int d = 0; d < 3; d++) c[d] = s->nverts ? 0.5 * (lo[d] + hi[d]) : 0.0;
+    for (int d = 0; d < 3; d++) c[d] = s->nverts ? 0.5 * lo[d] + 0.5 * hi[d] : 0.0;
+}
+
+/* Half the largest side of the scene's bounding box (0 for an empty or point scene). */
+static double scene_half_extent(const ulam_scene *s, const double c[3])
+{
+    double h = 0.0;
+    for (int64_t v = 0; v < s->nverts; v++)
+        for (int d = 0; d < 3; d++) h = fmax(h, fabs(s->vert[3 * v + d] - c[d]));
+    return h;
 }
 
 /* Fill Embree's vertex and index buffers with the patches' fan triangles (relative to the
@@ -66,9 +78,8 @@ static void scene_centre(const ulam_scene *s, double c[3])
 static void fill_buffers(ulam_tracer *t, float *vb, unsigned *ib)
 {
     const ulam_scene *s = t->s;
-    scene_centre(s, t->centre);
     for (int64_t v = 0; v < s->nverts; v++)
-        for (int d = 0; d < 3; d++) vb[3 * v + d] = (float)(s->vert[3 * v + d] - t->centre[d]);
+        for (int d = 0; d < 3; d++) vb[3 * v + d] = (float)((s->vert[3 * v + d] - t->centre[d]) / t->scale);
     int64_t tri = 0;
     for (int64_t p = 0; p < s->npatches; p++) {
         const int32_t *v = s->vidx + s->start[p];
@@ -113,6 +124,12 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
     int64_t ntri = s->start[s->npatches] - 2 * s->npatches;
     if (ntri < 1 || ntri > (int64_t)UINT32_MAX / 4 || s->nverts > (int64_t)UINT32_MAX / 4)
         return ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "fewer than 2^30 triangles and vertices");
+    double centre[3], half;
+    scene_centre(s, centre);
+    half = scene_half_extent(s, centre);
+    if (!(half >= ULAM__TRACER_SIZE_MIN && half <= ULAM__TRACER_SIZE_MAX))
+        return ulam__fail(err, ULAM_ERANGE, 0, -1, "a scene between %g and %g in size (this one's half extent is %g: "
+                          "rescale its units)", ULAM__TRACER_SIZE_MIN, ULAM__TRACER_SIZE_MAX, half);
     const ulam__embree_api *E = ulam__embree(err);
     if (!E) return err ? err->status : ULAM_EDEVICE;
     ulam_tracer *t = calloc(1, sizeof *t);
@@ -121,7 +138,8 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
         ulam_tracer_free(t);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the ray tracer");
     }
-    t->s = s, t->E = E;
+    t->s = s, t->E = E, t->scale = half;
+    for (int d = 0; d < 3; d++) t->centre[d] = centre[d];
     for (int64_t p = 0; p < s->npatches; p++) t->share[p] = ulam__first_share(s, p);
     if (!(t->dev = t->E->NewDevice(NULL))) {
         ulam_tracer_free(t);
@@ -154,6 +172,30 @@ int ulam_tracer_alloc(const ulam_scene *s, ulam_tracer **out, ulam_error *err)
     return ULAM_OK;
 }
 
+/* A ray's origin in Embree's frame (relative to the centre, in half extents). */
+static void embree_origin(const ulam_tracer *t, const double org[3], struct RTCRay *ray)
+{
+    ray->org_x = (float)((org[0] - t->centre[0]) / t->scale), ray->org_y = (float)((org[1] - t->centre[1]) / t->scale);
+    ray->org_z = (float)((org[2] - t->centre[2]) / t->scale);
+}
+
+/* The scene's size (half the largest side of its bounding box) and the centre of that box. */
+double ulam__tracer_size(const ulam_tracer *t, double centre[3])
+{
+    if (centre)
+        for (int d = 0; d < 3; d++) centre[d] = t->centre[d];
+    return t->scale;
+}
+
+/* Nonzero when x is within ULAM__TRACER_REACH scene sizes of the scene's centre: a ray's origin
+ * Embree can take. */
+int ulam__tracer_reaches(const ulam_tracer *t, const double x[3])
+{
+    for (int d = 0; d < 3; d++)
+        if (!(fabs(x[d] - t->centre[d]) <= ULAM__TRACER_REACH * t->scale)) return 0;
+    return 1;
+}
+
 /* The first patch other than self the ray hits (with cull, the first whose front it hits), or -1;
  * *dist (may be NULL) its distance. */
 static int64_t cast_from(const ulam_tracer *t, const double org[3], const double dir[3], int64_t self, int cull,
@@ -162,8 +204,7 @@ static int64_t cast_from(const ulam_tracer *t, const double org[3], const double
     ray_context rc = {.t = t, .self = self, .cull = cull ? dir : NULL};
     rtcInitIntersectContext(&rc.ctx);
     struct RTCRayHit rh;
-    rh.ray.org_x = (float)(org[0] - t->centre[0]), rh.ray.org_y = (float)(org[1] - t->centre[1]);
-    rh.ray.org_z = (float)(org[2] - t->centre[2]);
+    embree_origin(t, org, &rh.ray);
     rh.ray.dir_x = (float)dir[0], rh.ray.dir_y = (float)dir[1], rh.ray.dir_z = (float)dir[2];
     rh.ray.tnear = 0.0f;
     rh.ray.tfar = INFINITY;
@@ -177,13 +218,14 @@ static int64_t cast_from(const ulam_tracer *t, const double org[3], const double
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
     int64_t p = t->prim_patch[rh.hit.primID];
     if (front) *front = ulam__dot3(dir, t->s->normal + 3 * p) < 0;
-    if (dist) *dist = rh.ray.tfar;
+    if (dist) *dist = (double)rh.ray.tfar * t->scale;
     return p;
 }
 
 /* The first patch the ray hits, or -1. */
 int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3], int *front)
 {
+    if (!ulam__tracer_reaches(t, org)) return -1; /* Embree's float checks abort on such an origin */
     return cast_from(t, org, dir, -1, 0, front, NULL);
 }
 
@@ -201,8 +243,7 @@ int64_t ulam__tracer_cast_front_uv(const ulam_tracer *t, const double org[3], co
     ray_context rc = {.t = t, .self = -1, .cull = dir};
     rtcInitIntersectContext(&rc.ctx);
     struct RTCRayHit rh;
-    rh.ray.org_x = (float)(org[0] - t->centre[0]), rh.ray.org_y = (float)(org[1] - t->centre[1]);
-    rh.ray.org_z = (float)(org[2] - t->centre[2]);
+    embree_origin(t, org, &rh.ray);
     rh.ray.dir_x = (float)dir[0], rh.ray.dir_y = (float)dir[1], rh.ray.dir_z = (float)dir[2];
     rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f, rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;

@@ -211,6 +211,38 @@ static void split_triangle(builder *b, const ulam_scene *s, const double *A, con
 #undef AT
 }
 
+/* The bytes of a scene's arrays for np patches, nv vertices and nidx vertex indices
+ * (ulam__scene_alloc's). */
+static double scene_bytes(double np, double nv, double nidx)
+{
+    return np * (double)(sizeof(int64_t) + 10 * sizeof(double) + sizeof(int64_t) + sizeof(int32_t)) +
+           3.0 * sizeof(double) * nv + sizeof(int32_t) * nidx;
+}
+
+/* What ulam_scene_subdivide(s, max_side) would make, counted without making it: *patches,
+ * *vertices, *triangles (the ray tracer's) and *bytes of the new scene's arrays (any may be
+ * NULL), as doubles so that a count past what can be built is still told; ULAM_EOVERFLOW when
+ * the patches or vertices pass INT32_MAX (ulam_scene_subdivide refuses those). */
+int ulam_scene_subdivide_plan(const ulam_scene *s, double max_side, double *patches, double *vertices,
+                              double *triangles, double *bytes)
+{
+    if (!s || !(max_side > 0) || !isfinite(max_side)) return ULAM_EINVAL;
+    double np = 0, nv = 0, nidx = 0, tri = 0;
+    int64_t m = 1, k = 1, pv;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        int64_t n = s->start[p + 1] - s->start[p];
+        double c = (double)plan(s, p, max_side, &m, &k, &pv);
+        np += c, nv += (double)pv;
+        nidx += n == 4 ? 4 * c : c == 1 && n > 4 ? (double)n : 3 * c;
+        tri += n == 4 ? 2 * c : c == 1 && n > 4 ? (double)(n - 2) : c;
+    }
+    if (patches) *patches = np;
+    if (vertices) *vertices = nv;
+    if (triangles) *triangles = tri;
+    if (bytes) *bytes = scene_bytes(np, nv, nidx);
+    return np > (double)INT32_MAX || nv > (double)INT32_MAX ? ULAM_EOVERFLOW : ULAM_OK;
+}
+
 /* Split every patch so no side exceeds max_side. */
 int ulam_scene_subdivide(const ulam_scene *s, double max_side, ulam_scene **out)
 {

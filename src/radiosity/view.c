@@ -13,6 +13,8 @@ static int check_view(const ulam_tracer *t, const ulam_camera *cam, int w, int h
     if (!t || !cam || !o || !B || !se) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, camera, options and outputs");
     if (w < 1 || h < 1 || !(cam->focal > 0) || !(cam->film > 0))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a picture of at least 1 x 1 and a camera with focal and film > 0");
+    if (ulam__camera_check(t, cam))
+        return ulam__fail(err, ULAM_ERANGE, 0, -1, "a camera eye within %g scene sizes of the scene", ULAM__TRACER_REACH);
     if (!(coverage >= 0 && coverage <= 1)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a coverage exponent in [0, 1]");
     if (o->mode != ULAM_ADJOINT || !(o->stop.rel_err > 0))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "gathering (adjoint) with rel_err > 0");
