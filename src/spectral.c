@@ -346,6 +346,8 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
 
 /* ---- a Collatz-Wielandt vector of the walk's length tail from its expected lengths */
 
+enum { GMRES_MAX = 1 << 20 }; /* the most states the certificate's GMRES runs on */
+
 /* A positive v with |K| v <= u v over the rows in seen (closed under K's moves), from the
  * expected lengths h = (I - |K|)^-1 1 of walks that move by |K|: h - |K| h = 1 gives
  * |K| h <= (1 - 1 / max h) h, a certificate as close to rho(|K|) as 1 - 1 / max h, where power
@@ -387,7 +389,13 @@ int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, 
         for (int64_t i = 0; i < m; i++) one[i] = 1.0;
         double tol = 0.25 / sqrt((double)m); /* ||r||_inf <= ||r||_2 <= 1/4 */
         int sym = ulam_csr_symmetric(A);
-        status = sym ? ulam_cg(A, one, tol, max_iter, h, &it, NULL) : ulam_gmres(A, one, 30, tol, max_iter, h, &it, NULL);
+        status = sym               ? ulam_cg(A, one, tol, max_iter, h, &it, NULL)
+                 : m <= GMRES_MAX ? ulam_gmres(A, one, 30, tol, max_iter, h, &it, NULL)
+                                   : ULAM_ENOCONV; /* 31 Krylov vectors would not be small */
+        if (status == ULAM_ENOCONV && !sym && m > GMRES_MAX) {
+            free(at), free(one), free(h), ulam_csr_free(A);
+            return status;
+        }
         if (status == ULAM_ENOCONV) status = ULAM_OK; /* the product below decides */
         *matvecs += it + 1;
     }
