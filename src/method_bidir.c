@@ -221,6 +221,19 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     r->bo.max_push_ops = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : 0; /* W infinite: the default cap */
     ulam_error e;
     ulam_method_verdict *v = &ch->method[k];
+    ulam_guard_opts go = ulam_guard_defaults();
+    ulam_guard g;
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(ULAM_ADJOINT); /* the walks from b: adjoint on M' */
+    if ((status = ulam_guard_check(r->Mt, walk.kernel.continue_q, &go, &g, &e)) == ULAM_ENOMEM) {
+        release(r);
+        *err = e;
+        return status;
+    }
+    if (status || ulam_guard_variance(&g, ULAM_ADJOINT) != 1) { /* its rel_err run would be refused: no veto */
+        snprintf(v->why, sizeof v->why, "refused: its walks from b (forward on M) have rho(M^) in [%.4g, %.4g], "
+                                        "not certified below 1", g.hat[ULAM_ADJOINT].lower, g.hat[ULAM_ADJOINT].upper);
+        return ULAM_OK;
+    }
     status = ulam__bidir_plan_on(r->an, &r->bo, &ch->bidir, &e);
     ch->bidir_opts = r->bo;
     if (status == ULAM_ENOCONV) {
