@@ -803,7 +803,9 @@ def check_source_fallback(ulam):
     """A guard of a route auto would not take does not veto the run (issue 38 point 3): --source S
     --index T --rel-err 0.1 on three clusters whose walks from S (forward on M) have an infinite
     variance exited 36 (10 + EINFVAR, naming the modes the wrong way round); now the walks from T
-    answer (the adjoint rho(M^) is 0.99), exit 0, an interval that holds the direct solve."""
+    answer (the adjoint rho(M^) is 0.99), exit 0, an interval that holds the direct solve; with a
+    sparse --rhs b on the last cluster the default run exited 36 too (auto chose bidirectional,
+    whose walks from b were then refused)."""
     with tempfile.TemporaryDirectory() as d:
         p, _ = three_clusters(d)
         for source, index in ((45, 41), (45, 1)):
@@ -812,6 +814,14 @@ def check_source_fallback(ulam):
             assert rc == 0, (source, index, rc, err)
             o = json.loads(out)
             assert o["ci95"][0] <= o["direct"] <= o["ci95"][1], o
+        pe = os.path.join(d, "e_b.mtx")  # a sparse b: auto's bidirectional walks from b were its route
+        with open(pe, "w") as f:
+            f.write("%%MatrixMarket matrix array real general\n60 1\n" +
+                    "".join("1\n" if k in (44, 50, 55) else "0\n" for k in range(60)))
+        rc, out, err = run(ulam, ["solve", p, "--rhs", pe, "--index", "21", "--rel-err", "0.1", "--check", "--json"])
+        assert rc == 0, (rc, err)
+        o = json.loads(out)
+        assert o["ci95"][0] <= o["direct"] <= o["ci95"][1], o
 
 
 def check_solve_json(ulam):
