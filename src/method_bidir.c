@@ -196,13 +196,38 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     return ULAM_OK;
 }
 
-/* Plan with the push capped at W / 2 and predict the work; kept in the run. */
+/* Whether the walks the push on b would run from the index (adjoint, with the chosen walk
+ * candidate's estimator, continuation and exponent) are a certified candidate. */
+static int index_walks(const ulam_choice *ch)
+{
+    const ulam_auto_result *w = &ch->walks;
+    if (w->chosen < 0) return 0;
+    const ulam_auto_candidate *c = &w->cand[w->chosen];
+    for (int k = 0; k < w->ncand; k++) {
+        const ulam_auto_candidate *a = &w->cand[k];
+        if (a->mode == ULAM_ADJOINT && a->estimator == c->estimator && a->continue_q == c->continue_q &&
+            a->kernel_alpha == c->kernel_alpha)
+            return a->certified;
+    }
+    return 0;
+}
+
+/* Whether the walks' pins hold the push on b (an estimator, or an exponent other than 1). */
+static int pinned(const ulam__query *q)
+{
+    return q->ao && (q->ao->pin_estimator || (q->ao->pin_alpha && q->o->kernel.kernel_alpha != 1.0));
+}
+
+/* Plan with the push capped at W / 2 and predict the work; kept in the run.  A dense b takes
+ * the push on b, unless no walks from the index are certified (PageRank's M = alpha P' at a
+ * low-degree target, whose adjoint rho(M^) is far above 1): then the reverse push from the
+ * index and walks from b's distribution, as for a sparse b. */
 static int predict(ulam__query *q, int k, ulam_error *err)
 {
     ulam_choice *ch = q->ch;
     ulam_run *r = q->run;
     double W = ch->leader_work;
-    if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o)) { /* the push on b */
+    if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o) && (index_walks(ch) || pinned(q))) { /* the push on b */
         const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
         double m = fabs(c->estimate + q->o->stop.rel_err_offset);
         int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
