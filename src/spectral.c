@@ -346,7 +346,8 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
 
 /* ---- a Collatz-Wielandt vector of the walk's length tail from its expected lengths */
 
-enum { GMRES_MAX = 1 << 20 }; /* the most states the certificate's GMRES runs on */
+enum { GMRES_MAX = 1 << 20, GMRES_ITER = 1000 }; /* the most states the certificate's GMRES runs on, and
+                                                     its products (restarted, it may stall) */
 
 /* A positive v with |K| v <= u v over the rows in seen (closed under K's moves), from the
  * expected lengths h = (I - |K|)^-1 1 of walks that move by |K|: h - |K| h = 1 gives
@@ -390,7 +391,7 @@ int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, 
         double tol = 0.25 / sqrt((double)m); /* ||r||_inf <= ||r||_2 <= 1/4 */
         int sym = ulam_csr_symmetric(A);
         status = sym               ? ulam_cg(A, one, tol, max_iter, h, &it, NULL)
-                 : m <= GMRES_MAX ? ulam_gmres(A, one, 30, tol, max_iter, h, &it, NULL)
+                 : m <= GMRES_MAX ? ulam_gmres(A, one, 30, tol, max_iter < GMRES_ITER ? max_iter : GMRES_ITER, h, &it, NULL)
                                    : ULAM_ENOCONV; /* 31 Krylov vectors would not be small */
         if (status == ULAM_ENOCONV && !sym && m > GMRES_MAX) {
             free(at), free(one), free(h), ulam_csr_free(A);
