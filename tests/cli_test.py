@@ -822,6 +822,9 @@ def check_source_fallback(ulam):
         assert rc == 0, (rc, err)
         o = json.loads(out)
         assert o["ci95"][0] <= o["direct"] <= o["ci95"][1], o
+        # pinned, the walks from b are refused with the documented exit 4 (was 36), named as forward walks on M
+        rc, out, err = run(ulam, ["solve", p, "--method", "bidirectional", "--rhs", pe, "--index", "21", "--rel-err", "0.1"])
+        assert rc == 4 and out == "" and "forward walks on M" in err and "adjoint" not in err, (rc, err)
 
 
 def check_solve_json(ulam):

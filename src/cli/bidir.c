@@ -233,6 +233,18 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
     return 0;
 }
 
+/* The refusal of a --rel-err target the walks from b cannot meet (forward walks on M, adjoint on
+ * M', whose rho(M^) is not certified below 1): exit 4, as for the walks, the radius named by the
+ * forward guard g (the library's message names the mode on M'). */
+static int refuse_infvar(const cli_system *s, const ulam_bidir_opts *o, const ulam_guard *g)
+{
+    fprintf(stderr, "ulam: %s: error: --rel-err %g can never be met: the walks from b are forward walks on M, whose "
+                    "rho(M^) is in [%.4g, %.4g], not certified below 1. Bound the run with --walks N or --time S (no "
+                    "confidence interval is then printed), or let --method auto choose\n",
+            s->matrix_path, o->walk.stop.rel_err, g->hat[ULAM_FORWARD].lower, g->hat[ULAM_FORWARD].upper);
+    return EXIT_INFVAR;
+}
+
 /* Transpose, push, walk and print, on an analysis of M (its transpose a prepared file's stored
  * one after prepare --transpose: none to build); 0 or an exit code. */
 static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
@@ -249,7 +261,7 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     o->walk.stop.interrupt = &cli_interrupted, o->walk.exec.share = cli_share;
     cli_catch_sigint();
     if (!status) status = ulam_analysis_bidir(an, o, &r, &err); /* its push workspace and plan */
-    int rc = status ? cli_report(s->matrix_path, &err) : 0;
+    int rc = status == ULAM_EINFVAR ? refuse_infvar(s, o, &rp->g) : status ? cli_report(s->matrix_path, &err) : 0;
     if (!status) {
         if (rp->json) print_json(o, &r, rp);
         else print_text(o, &r, rp);
