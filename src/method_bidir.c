@@ -218,26 +218,36 @@ static int pinned(const ulam__query *q)
     return q->ao && (q->ao->pin_estimator || (q->ao->pin_alpha && q->o->kernel.kernel_alpha != 1.0));
 }
 
+/* The push on b's plan (the chosen walk candidate's kernel, the push capped at W / 2) and its
+ * predicted work, or why it is refused. */
+static int predict_push_on_b(ulam__query *q, int k, ulam_error *err)
+{
+    ulam_choice *ch = q->ch;
+    double W = ch->leader_work;
+    const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
+    double m = fabs(c->estimate + q->o->stop.rel_err_offset);
+    int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
+    int status = dense_plan(q, q->o, c, c->variance, m, c->predicted_walks, cap, err);
+    if (status == ULAM_ENOMEM) return status;
+    ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = q->run->bwo, ch->bidir_opts.target = q->o->query.index;
+    if (status) snprintf(ch->method[k].why, sizeof ch->method[k].why, "refused: %.250s", err->msg);
+    else ch->method[k].predicted_work = ch->bidir.predicted_work;
+    return ULAM_OK;
+}
+
 /* Plan with the push capped at W / 2 and predict the work; kept in the run.  A dense b takes
  * the push on b, unless no walks from the index are certified (PageRank's M = alpha P' at a
  * low-degree target, whose adjoint rho(M^) is far above 1): then the reverse push from the
- * index and walks from b's distribution, as for a sparse b. */
+ * index and walks from b's distribution, as for a sparse b; a sparse b whose walks (forward on
+ * M) have no certified finite variance takes the push on b when the walks from the index are
+ * certified, and is refused otherwise. */
 static int predict(ulam__query *q, int k, ulam_error *err)
 {
     ulam_choice *ch = q->ch;
     ulam_run *r = q->run;
     double W = ch->leader_work;
-    if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o) && (index_walks(ch) || pinned(q))) { /* the push on b */
-        const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
-        double m = fabs(c->estimate + q->o->stop.rel_err_offset);
-        int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
-        int status = dense_plan(q, q->o, c, c->variance, m, c->predicted_walks, cap, err);
-        if (status == ULAM_ENOMEM) return status;
-        ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = r->bwo, ch->bidir_opts.target = q->o->query.index;
-        if (status) snprintf(ch->method[k].why, sizeof ch->method[k].why, "refused: %.250s", err->msg);
-        else ch->method[k].predicted_work = ch->bidir.predicted_work;
-        return ULAM_OK;
-    }
+    if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o) && (index_walks(ch) || pinned(q)))
+        return predict_push_on_b(q, k, err);
     ulam_walk_opts walk = *q->o;
     walk.estimator = ULAM_COLLISION, walk.kernel.kernel_alpha = 1.0;
     walk.policy.guard = NULL, walk.stop.interrupt = NULL, walk.exec.share = NULL;
@@ -254,6 +264,8 @@ static int predict(ulam__query *q, int k, ulam_error *err)
         *err = e;
         return status;
     }
+    if ((status || ulam_guard_variance(&g, ULAM_ADJOINT) != 1) && index_walks(ch))
+        return predict_push_on_b(q, k, err); /* the walks from the index are certified: push b to them */
     if (status || ulam_guard_variance(&g, ULAM_ADJOINT) != 1) { /* its rel_err run would be refused: no veto */
         snprintf(v->why, sizeof v->why, "refused: its walks from b (forward on M) have rho(M^) in [%.4g, %.4g], "
                                         "not certified below 1", g.hat[ULAM_ADJOINT].lower, g.hat[ULAM_ADJOINT].upper);

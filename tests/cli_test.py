@@ -808,7 +808,7 @@ def check_source_fallback(ulam):
     whose walks from b were then refused)."""
     with tempfile.TemporaryDirectory() as d:
         p, _ = three_clusters(d)
-        for source, index in ((45, 41), (45, 1)):
+        for source, index in ((45, 41), (45, 1), (45, 21)):
             rc, out, err = run(ulam, ["solve", p, "--source", str(source), "--index", str(index), "--rel-err", "0.1",
                                       "--check", "--json"])
             assert rc == 0, (source, index, rc, err)
@@ -825,6 +825,9 @@ def check_source_fallback(ulam):
         # pinned, the walks from b are refused with the documented exit 4 (was 36), named as forward walks on M
         rc, out, err = run(ulam, ["solve", p, "--method", "bidirectional", "--rhs", pe, "--index", "21", "--rel-err", "0.1"])
         assert rc == 4 and out == "" and "forward walks on M" in err and "adjoint" not in err, (rc, err)
+        # --source 45 --index 21: the push on b = e_45 and walks from 21 (the walks from 45 are not certified)
+        rc, out, err = run(ulam, ["solve", p, "--source", "45", "--index", "21", "--rel-err", "0.1"])
+        assert rc == 0 and re.search(r"^method +bidirectional, the push on b", out, re.M), (rc, out, err)
 
 
 def check_solve_json(ulam):
