@@ -1479,6 +1479,11 @@ int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o,
  * ulam_run_free), or NULL for another row. */
 ulam_solver *ulam_run_solver(ulam_run *r);
 
+/* The route a bidirectional run takes: 1 the push on b and walks from the index, 0 the reverse
+ * push from the index and walks from b (ulam_method_bidir_route's, unless no walks from the
+ * index are certified: then the reverse push even for a dense b), -1 for another row. */
+int ulam_run_bidir_route(const ulam_run *r);
+
 /* Run to the end (walks: iterate the solver until done) and fill *a.  The walks' statuses, the
  * bidirectional and outer rows' (ULAM_ENOCONV, ULAM_ESTALL with a filled; a->status holds it). */
 int ulam_run_finish(ulam_run *r, ulam_answer *a, ulam_error *err);

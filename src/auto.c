@@ -231,7 +231,7 @@ static double predict(const chooser *c, int k, double var, double *walks)
 static double honest_variance(const chooser *c, int k, double var)
 {
     double n = (double)c->res->cand[k].pilot_walks, R = c->range[k];
-    if (!isfinite(R)) return var > 0 ? var : INFINITY;
+    if (!isfinite(R)) return var > 0 && c->res->cand[k].variance > 0 ? var : INFINITY; /* spread of its own */
     double sd = sqrt(var) + (n > 1 ? R * sqrt(2.0 * log(20.0) / (n - 1.0)) : INFINITY);
     return sd * sd;
 }
@@ -347,12 +347,22 @@ static int pilot(chooser *c, int k, int stage, int64_t n)
     return ULAM_OK;
 }
 
-/* The finalist of least key (-1: none). */
+/* Whether some finalist's pilot had a certified range of a single score (its run prints an
+ * interval). */
+static int any_ranged(const chooser *c)
+{
+    for (int k = 0; k < c->res->ncand; k++)
+        if (c->res->cand[k].state == ULAM_AUTO_FINALIST && c->tail_ok[k]) return 1;
+    return 0;
+}
+
+/* The finalist of least key (-1: none), among those with a certified range when any has one:
+ * a candidate whose run can print no interval never wins over one whose run can. */
 static int lead(const chooser *c)
 {
-    int best = -1;
+    int best = -1, ranged = any_ranged(c);
     for (int k = 0; k < c->res->ncand; k++) {
-        if (c->res->cand[k].state != ULAM_AUTO_FINALIST) continue;
+        if (c->res->cand[k].state != ULAM_AUTO_FINALIST || (ranged && !c->tail_ok[k])) continue;
         if (best < 0 || key(c, k, 1.0) < key(c, best, 1.0)) best = k;
     }
     return best;
@@ -445,7 +455,9 @@ static int drop(chooser *c)
     for (int k = 0; k < c->res->ncand; k++) {
         ulam_auto_candidate *a = &c->res->cand[k];
         if (a->state != ULAM_AUTO_FINALIST) continue;
-        if (k != c->leader && key(c, k, 1.0 / (1.0 + 2.0 * a->variance_rel_error)) > high) a->state = ULAM_AUTO_DROPPED;
+        if (k != c->leader && (key(c, k, 1.0 / (1.0 + 2.0 * a->variance_rel_error)) > high ||
+                               (c->tail_ok[c->leader] && !c->tail_ok[k])))
+            a->state = ULAM_AUTO_DROPPED;
         else left++;
     }
     return left;

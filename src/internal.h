@@ -99,6 +99,12 @@ int ulam__power_certain(double lower, double upper);
 int ulam__power_from(const ulam_csr *A, const double *left, const double *right, const ulam_power_opts *o,
                      ulam_power *out, ulam_error *err);
 
+/* A Collatz-Wielandt certificate |K| v <= u v over the rows in seen (closed under K's moves)
+ * from the expected lengths h = (I - |K|)^-1 1, solved roughly by CG or GMRES in at most
+ * max_iter products: *u (1: none), *kappa = max h / min h; *matvecs added to (src/spectral.c). */
+int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, double *u, double *kappa,
+                             int64_t *matvecs);
+
 /* rho(M4), M4_ij = |K_ij|^4 / (q_i p_ij)^3, of the walk kernel of K (M adjoint, M' forward) at
  * continuation continue_q and exponent alpha, with certified bounds (stopped once they decide
  * against 1 like the guards' radii): the walk's score has a finite fourth moment when it is

@@ -145,6 +145,12 @@ ulam_solver *ulam_run_solver(ulam_run *r)
     return r && r->method == ULAM_METHOD_WALKS ? r->sv : NULL;
 }
 
+/* The route of a bidirectional run: 1 the push on b, 0 the reverse push, -1 another row. */
+int ulam_run_bidir_route(const ulam_run *r)
+{
+    return r && r->method == ULAM_METHOD_BIDIRECTIONAL ? r->br != NULL : -1;
+}
+
 /* Run to the end and fill *a. */
 int ulam_run_finish(ulam_run *r, ulam_answer *a, ulam_error *err)
 {

@@ -316,30 +316,65 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
     return ULAM_OK;
 }
 
-/* Plan with the push capped at W / 2 and predict the work; kept in the run. */
+/* Whether the walks the push on b would run from the index (adjoint, with the chosen walk
+ * candidate's estimator, continuation and exponent) are a certified candidate. */
+static int index_walks(const ulam_choice *ch)
+{
+    const ulam_auto_result *w = &ch->walks;
+    if (w->chosen < 0) return 0;
+    const ulam_auto_candidate *c = &w->cand[w->chosen];
+    for (int k = 0; k < w->ncand; k++) {
+        const ulam_auto_candidate *a = &w->cand[k];
+        if (a->mode == ULAM_ADJOINT && a->estimator == c->estimator && a->continue_q == c->continue_q &&
+            a->kernel_alpha == c->kernel_alpha)
+            return a->certified;
+    }
+    return 0;
+}
+
+/* Whether the walks' pins hold the push on b (an estimator, or an exponent other than 1). */
+static int pinned(const ulam__query *q)
+{
+    return q->ao && (q->ao->pin_estimator || (q->ao->pin_alpha && q->o->kernel.kernel_alpha != 1.0));
+}
+
+/* The push on b's plan (the chosen walk candidate's kernel, the push capped at W / 2) and its
+ * predicted work, or why it is refused; at a fixed budget, fixed_predict's. */
+static int predict_push_on_b(ulam__query *q, int k, ulam_error *err)
+{
+    ulam_choice *ch = q->ch;
+    double W = ch->leader_work;
+    if (ulam__b_exponent(q->b, q->M->nrows)) { /* its residual walks carry q_i as an offset: not rescaled */
+        snprintf(ch->method[k].why, sizeof ch->method[k].why, "not considered: max|b| is outside 2^-256 .. 2^256 "
+                 "(the walks on the push's residual could not be rescaled: their squares would underflow)");
+        return ULAM_OK;
+    }
+    if (!(q->o->stop.rel_err > 0)) return fixed_predict(q, k, W, err);
+    const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
+    double m = fabs(c->estimate + q->o->stop.rel_err_offset);
+    int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
+    double rmax = rule_rmax(q->b, q->M->nrows, c->variance, m, c->predicted_walks, q->o->stop.rel_err);
+    int status = dense_plan(q, q->o, c, rmax, cap, NULL, err);
+    if (status == ULAM_ENOMEM) return status;
+    ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = q->run->bwo, ch->bidir_opts.target = q->o->query.index;
+    if (status) snprintf(ch->method[k].why, sizeof ch->method[k].why, "refused: %.250s", err->msg);
+    else ch->method[k].predicted_work = ch->bidir.predicted_work;
+    return ULAM_OK;
+}
+
+/* Plan with the push capped at W / 2 and predict the work; kept in the run.  A dense b takes
+ * the push on b, unless no walks from the index are certified (PageRank's M = alpha P' at a
+ * low-degree target, whose adjoint rho(M^) is far above 1): then the reverse push from the
+ * index and walks from b's distribution, as for a sparse b; a sparse b whose walks (forward on
+ * M) have no certified finite variance takes the push on b when the walks from the index are
+ * certified, and is refused otherwise. */
 static int predict(ulam__query *q, int k, ulam_error *err)
 {
     ulam_choice *ch = q->ch;
     ulam_run *r = q->run;
     double W = ch->leader_work;
-    if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o)) { /* the push on b */
-        if (ulam__b_exponent(q->b, q->M->nrows)) { /* its residual walks carry q_i as an offset: not rescaled */
-            snprintf(ch->method[k].why, sizeof ch->method[k].why, "not considered: max|b| is outside 2^-256 .. 2^256 "
-                     "(the walks on the push's residual could not be rescaled: their squares would underflow)");
-            return ULAM_OK;
-        }
-        if (!(q->o->stop.rel_err > 0)) return fixed_predict(q, k, W, err);
-        const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
-        double m = fabs(c->estimate + q->o->stop.rel_err_offset);
-        int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
-        double rmax = rule_rmax(q->b, q->M->nrows, c->variance, m, c->predicted_walks, q->o->stop.rel_err);
-        int status = dense_plan(q, q->o, c, rmax, cap, NULL, err);
-        if (status == ULAM_ENOMEM) return status;
-        ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = r->bwo, ch->bidir_opts.target = q->o->query.index;
-        if (status) snprintf(ch->method[k].why, sizeof ch->method[k].why, "refused: %.250s", err->msg);
-        else ch->method[k].predicted_work = ch->bidir.predicted_work;
-        return ULAM_OK;
-    }
+    if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o) && (index_walks(ch) || pinned(q)))
+        return predict_push_on_b(q, k, err);
     ulam_walk_opts walk = *q->o;
     walk.estimator = ULAM_COLLISION, walk.kernel.kernel_alpha = 1.0;
     walk.policy.guard = NULL, walk.stop.interrupt = NULL, walk.exec.share = NULL;
@@ -348,6 +383,21 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     r->bo.max_push_ops = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : 0; /* W infinite: the default cap */
     ulam_error e;
     ulam_method_verdict *v = &ch->method[k];
+    ulam_guard_opts go = ulam_guard_defaults();
+    ulam_guard g;
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(ULAM_ADJOINT); /* the walks from b: adjoint on M' */
+    if ((status = ulam_guard_check(r->Mt, walk.kernel.continue_q, &go, &g, &e)) == ULAM_ENOMEM) {
+        release(r);
+        *err = e;
+        return status;
+    }
+    if ((status || ulam_guard_variance(&g, ULAM_ADJOINT) != 1) && index_walks(ch))
+        return predict_push_on_b(q, k, err); /* the walks from the index are certified: push b to them */
+    if (status || ulam_guard_variance(&g, ULAM_ADJOINT) != 1) { /* its rel_err run would be refused: no veto */
+        snprintf(v->why, sizeof v->why, "refused: its walks from b (forward on M) have rho(M^) in [%.4g, %.4g], "
+                                        "not certified below 1", g.hat[ULAM_ADJOINT].lower, g.hat[ULAM_ADJOINT].upper);
+        return ULAM_OK;
+    }
     status = ulam__bidir_plan_on(r->an, &r->bo, &ch->bidir, &e);
     ch->bidir_opts = r->bo;
     if (status == ULAM_ENOCONV) {

@@ -274,6 +274,12 @@ static double weight_growth(const ulam_csr *K, double continue_q, const double *
  * (so kappa <= 1 / floor); the smallest u over ITER iterations is kept.  *u = 1
  * (no certificate) when none is below 1 or memory runs out.  second: the same for the
  * walk's second-moment matrix M^ = diag(S / q) |K| (E[w_k^2] = w0^2 (M^^k 1)_i, no roulette). */
+/* The expected steps a length tail of u and kappa allows (INFINITY for none). */
+static double tail_steps(double u, double kappa)
+{
+    return u < 1.0 && isfinite(kappa) ? 1.0 / (1.0 - u) + log(fmax(kappa, 1.0)) / -log(u) : INFINITY;
+}
+
 static void length_tail(const ulam_csr *K, const char *seen, double continue_q, int second, double floor,
                         double *u, double *kappa, int *iterations)
 {
@@ -300,6 +306,15 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
             if (seen[i]) v[i] = fmax((y[i] + v[i]) / ymax, floor);
     }
     free(v), free(y);
+    if (!second && !(*u < TAIL_Q)) { /* long walks: the expected lengths' certificate, when shorter */
+        double u2, k2;
+        int64_t products = 0;
+        int64_t cap = 4 * (int64_t)sqrt((double)n) + 2000;
+        if (ulam__length_certificate(K, seen, (int)cap, &u2, &k2, &products) == ULAM_OK &&
+            tail_steps(u2, k2) < tail_steps(*u, *kappa))
+            *u = u2, *kappa = k2;
+        *iterations += (int)products;
+    }
 }
 
 /* A certified bound on E[X^2] of a walk's score X (collision, expected, absorption; no roulette,
@@ -912,8 +927,8 @@ static int kernel_failure(const ulam_kernel *k, const ulam_system *sys, ulam_err
 static double mean_steps(const ulam_solver *s)
 {
     if (s->qmax < 1.0) return 1.0 / (1.0 - s->qmax);
-    if (s->tail_u < 1.0 && isfinite(s->kappa)) return 1.0 / (1.0 - s->tail_u) + log(fmax(s->kappa, 1.0)) / -log(s->tail_u);
-    return 1.0;
+    double t = tail_steps(s->tail_u, s->kappa);
+    return isfinite(t) ? t : 1.0;
 }
 
 /* The push on b's cost model (src/fpush_b.c): the forward walks' predicted work on a residual of

@@ -13,6 +13,7 @@
  * bracket. */
 #include "dynload.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -366,4 +367,77 @@ int ulam_spectral_power(const ulam_csr *A, const double *left, const double *rig
     if (bad || (bad = ulam__csr_check_structure(A, err))) return bad;
     *out = (ulam_power){.lower = 0.0, .upper = INFINITY, .rowsum_max = INFINITY, .colsum_max = INFINITY};
     return ulam__power_from(A, left, right, &o, out, err);
+}
+
+/* ---- a Collatz-Wielandt vector of the walk's length tail from its expected lengths */
+
+enum { GMRES_MAX = 1 << 20, GMRES_ITER = 1000 }; /* the most states the certificate's GMRES runs on, and
+                                                     its products (restarted, it may stall) */
+
+/* A positive v with |K| v <= u v over the rows in seen (closed under K's moves), from the
+ * expected lengths h = (I - |K|)^-1 1 of walks that move by |K|: h - |K| h = 1 gives
+ * |K| h <= (1 - 1 / max h) h, a certificate as close to rho(|K|) as 1 - 1 / max h, where power
+ * iteration from 1 needs about (1 - rho)^-1 steps to shape its iterate (a 200 x 200 Poisson
+ * grid: 10^4).  h is solved only roughly, by conjugate gradients when |K| restricted to seen is
+ * symmetric and restarted GMRES otherwise, to an infinity-norm residual below 1/4 (any
+ * residual below 1 keeps the bound below 1), floored at 1 (h >= 1 exactly); the certificate
+ * is then one product with |K| in floating point, each ratio raised by a rounding allowance.
+ * *u (1 when none holds) and *kappa = max h / min h; *matvecs gets the products spent. */
+int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, double *u, double *kappa,
+                             int64_t *matvecs)
+{
+    *u = 1.0, *kappa = INFINITY;
+    int64_t n = K->nrows, m = 0, nnz = 0;
+    int64_t *at = ulam__malloc((size_t)n + 1, sizeof *at);
+    if (!at) return ULAM_ENOMEM;
+    for (int64_t i = 0; i < n; i++) {
+        at[i] = seen[i] ? m++ : -1;
+        if (seen[i]) nnz += K->rowptr[i + 1] - K->rowptr[i];
+    }
+    ulam_csr *A = m > 0 ? ulam_csr_alloc(m, m, nnz) : NULL;
+    double *one = ulam__malloc((size_t)m + 1, sizeof *one), *h = ulam__malloc((size_t)m + 1, sizeof *h);
+    int status = A && one && h ? ULAM_OK : m > 0 ? ULAM_ENOMEM : ULAM_EINVAL;
+    int64_t q = 0;
+    for (int64_t i = 0; !status && i < n; i++) {
+        if (!seen[i]) continue;
+        for (int64_t k = K->rowptr[i]; k < K->rowptr[i + 1]; k++) {
+            if (K->val[k] == 0.0) continue;
+            if (at[K->colidx[k]] < 0) { /* a move out of seen: not closed, no certificate */
+                status = ULAM_EINVAL;
+                break;
+            }
+            A->colidx[q] = (int32_t)at[K->colidx[k]], A->val[q++] = fabs(K->val[k]);
+        }
+        A->rowptr[at[i] + 1] = q;
+    }
+    int it = 0;
+    if (!status) {
+        for (int64_t i = 0; i < m; i++) one[i] = 1.0;
+        double tol = 0.25 / sqrt((double)m); /* ||r||_inf <= ||r||_2 <= 1/4 */
+        int sym = ulam_csr_symmetric(A);
+        status = sym               ? ulam_cg(A, one, tol, max_iter, h, &it, NULL)
+                 : m <= GMRES_MAX ? ulam_gmres(A, one, 30, tol, max_iter < GMRES_ITER ? max_iter : GMRES_ITER, h, &it, NULL)
+                                   : ULAM_ENOCONV; /* 31 Krylov vectors would not be small */
+        if (status == ULAM_ENOCONV && !sym && m > GMRES_MAX) {
+            free(at), free(one), free(h), ulam_csr_free(A);
+            return status;
+        }
+        if (status == ULAM_ENOCONV) status = ULAM_OK; /* the product below decides */
+        *matvecs += it + 1;
+    }
+    if (!status) {
+        double ratio = 0.0, hmin = INFINITY, hmax = 0.0;
+        for (int64_t i = 0; i < m; i++) h[i] = isfinite(h[i]) ? fmax(h[i], 1.0) : INFINITY;
+        for (int64_t i = 0; i < m && isfinite(ratio); i++) {
+            double t = 0.0;
+            for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) t += A->val[k] * h[A->colidx[k]];
+            /* a sum of nonnegative terms is within (len + 1) eps of the exact one */
+            t *= 1.0 + (double)(A->rowptr[i + 1] - A->rowptr[i] + 2) * DBL_EPSILON;
+            ratio = fmax(ratio, t / h[i]), hmin = fmin(hmin, h[i]), hmax = fmax(hmax, h[i]);
+        }
+        if (ratio < 1.0) *u = ratio, *kappa = hmax / hmin;
+        else status = ULAM_ENOCONV;
+    }
+    free(at), free(one), free(h), ulam_csr_free(A);
+    return status;
 }

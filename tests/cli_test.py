@@ -838,6 +838,63 @@ def check_rel_err_stops(ulam):
     assert "no bound on a single walk's score" in err, err
 
 
+def three_clusters(d):
+    """Three clusters of 20 states (rows of |M| summing to 0.99, half of each row to its cluster's
+    first state, a hub whose column sums to about 10), the hub of each leaking 1e-4 into the next
+    cluster's; b = 1 on the last cluster.  The adjoint rho(M^) is 0.99, the forward one about 2.5
+    (infinite variance).  The paths of M and b."""
+    ents = []
+    for c in range(3):
+        hub = 20 * c
+        for i in range(20):
+            r = hub + i
+            rs = 0.99 - (1e-4 if i == 0 and c < 2 else 0.0)
+            if i == 0:
+                ents += [(r, hub + (i + h) % 20, rs / 4) for h in (1, 3, 7, 12)]
+            else:
+                ents += [(r, hub, 0.5 * rs)] + [(r, hub + (i + h) % 20, 0.5 * rs / 3) for h in (1, 3, 7)]
+        if c < 2:
+            ents.append((hub, hub + 20, 1e-4))
+    p, pb = os.path.join(d, "cl3.mtx"), os.path.join(d, "cl3_b.mtx")
+    with open(p, "w") as f:
+        f.write(f"%%MatrixMarket matrix coordinate real general\n60 60 {len(ents)}\n")
+        f.writelines(f"{r + 1} {c + 1} {v!r}\n" for r, c, v in ents)
+    with open(pb, "w") as f:
+        f.write("%%MatrixMarket matrix array real general\n60 1\n" + "0\n" * 40 + "1\n" * 20)
+    return p, pb
+
+
+def check_source_fallback(ulam):
+    """A guard of a route auto would not take does not veto the run (issue 38 point 3): --source S
+    --index T --rel-err 0.1 on three clusters whose walks from S (forward on M) have an infinite
+    variance exited 36 (10 + EINFVAR, naming the modes the wrong way round); now the walks from T
+    answer (the adjoint rho(M^) is 0.99), exit 0, an interval that holds the direct solve; with a
+    sparse --rhs b on the last cluster the default run exited 36 too (auto chose bidirectional,
+    whose walks from b were then refused)."""
+    with tempfile.TemporaryDirectory() as d:
+        p, _ = three_clusters(d)
+        for source, index in ((45, 41), (45, 1), (45, 21)):
+            rc, out, err = run(ulam, ["solve", p, "--source", str(source), "--index", str(index), "--rel-err", "0.1",
+                                      "--check", "--json"])
+            assert rc == 0, (source, index, rc, err)
+            o = json.loads(out)
+            assert o["ci95"][0] <= o["direct"] <= o["ci95"][1], o
+        pe = os.path.join(d, "e_b.mtx")  # a sparse b: auto's bidirectional walks from b were its route
+        with open(pe, "w") as f:
+            f.write("%%MatrixMarket matrix array real general\n60 1\n" +
+                    "".join("1\n" if k in (44, 50, 55) else "0\n" for k in range(60)))
+        rc, out, err = run(ulam, ["solve", p, "--rhs", pe, "--index", "21", "--rel-err", "0.1", "--check", "--json"])
+        assert rc == 0, (rc, err)
+        o = json.loads(out)
+        assert o["ci95"][0] <= o["direct"] <= o["ci95"][1], o
+        # pinned, the walks from b are refused with the documented exit 4 (was 36), named as forward walks on M
+        rc, out, err = run(ulam, ["solve", p, "--method", "bidirectional", "--rhs", pe, "--index", "21", "--rel-err", "0.1"])
+        assert rc == 4 and out == "" and "forward walks on M" in err and "adjoint" not in err, (rc, err)
+        # --source 45 --index 21: the push on b = e_45 and walks from 21 (the walks from 45 are not certified)
+        rc, out, err = run(ulam, ["solve", p, "--source", "45", "--index", "21", "--rel-err", "0.1"])
+        assert rc == 0 and re.search(r"^method +bidirectional, the push on b", out, re.M), (rc, out, err)
+
+
 def check_solve_json(ulam):
     """solve --json has the documented keys; --check adds direct and z; threads do not matter."""
     base = SOLVE + ["--index", "3", "--walks", "50000", "--seed", "5", "--json", "--check"]
@@ -2070,7 +2127,7 @@ def main():
         return 2
     part = "table" if "--table" in flags else "checks" if "--checks" in flags else None  # meson runs the halves apart
     failures, n = check_table(ulam, rows if cases else None) if part != "checks" else (0, 0)
-    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_exact_zero_no_warning, ulam), (check_adjoint_scale, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
+    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_source_fallback, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_exact_zero_no_warning, ulam), (check_adjoint_scale, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_summary, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),

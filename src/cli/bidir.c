@@ -187,8 +187,12 @@ static int sparse_b(const cli_system *s, ulam_bidir_opts *o, int64_t **idx, doub
     return 0;
 }
 
+/* prepare's answer when b = e_S, a --rel-err target, and the walks from S (forward on M) have a
+ * variance not certified finite: the run goes to the walks row (cli_solve_source). */
+enum { ROUTE_ADJOINT = -2 };
+
 /* Load the system with b from --rhs (sparse) or b = e_S, check S, run the guards and --check;
- * 0 or an exit code. */
+ * 0, ROUTE_ADJOINT or an exit code. */
 static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o, int64_t **idx, double **val,
                    report *rp)
 {
@@ -215,6 +219,8 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
         cli_guard_diverge(s, &rp->g, force);
         if (!force) return EXIT_DIVERGE;
     }
+    if (source && o->walk.stop.rel_err > 0 && ulam_guard_variance(&rp->g, ULAM_FORWARD) != 1)
+        return ROUTE_ADJOINT; /* walks from S cannot meet the target: the push on b and walks from I may */
     cli_guard_warn(s, &rp->g, ULAM_FORWARD, 0);
     rp->guard_seconds = rp->g.abs.seconds + rp->g.hat[0].seconds + rp->g.hat[1].seconds;
     if (rp->check) {
@@ -225,6 +231,18 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
         free(x);
     }
     return 0;
+}
+
+/* The refusal of a --rel-err target the walks from b cannot meet (forward walks on M, adjoint on
+ * M', whose rho(M^) is not certified below 1): exit 4, as for the walks, the radius named by the
+ * forward guard g (the library's message names the mode on M'). */
+static int refuse_infvar(const cli_system *s, const ulam_bidir_opts *o, const ulam_guard *g)
+{
+    fprintf(stderr, "ulam: %s: error: --rel-err %g can never be met: the walks from b are forward walks on M, whose "
+                    "rho(M^) is in [%.4g, %.4g], not certified below 1. Bound the run with --walks N or --time S (no "
+                    "confidence interval is then printed), or let --method auto choose\n",
+            s->matrix_path, o->walk.stop.rel_err, g->hat[ULAM_FORWARD].lower, g->hat[ULAM_FORWARD].upper);
+    return EXIT_INFVAR;
 }
 
 /* Transpose, push, walk and print, on an analysis of M (its transpose a prepared file's stored
@@ -243,7 +261,7 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     o->walk.stop.interrupt = &cli_interrupted, o->walk.exec.share = cli_share;
     cli_catch_sigint();
     if (!status) status = ulam_analysis_bidir(an, o, &r, &err); /* its push workspace and plan */
-    int rc = status ? cli_report(s->matrix_path, &err) : 0;
+    int rc = status == ULAM_EINFVAR ? refuse_infvar(s, o, &rp->g) : status ? cli_report(s->matrix_path, &err) : 0;
     if (!status) {
         if (rp->json) print_json(o, &r, rp);
         else print_text(o, &r, rp);
@@ -436,6 +454,10 @@ static int start_run(void *p, int argc, char **argv, int optind)
     if (!(rc = prepare(&s, source, force, &o, &bidx, &bval, &rp))) {
         o.target = s.index - 1, o.source = source ? source - 1 : 0;
         rc = run(&s, &o, &rp);
+    } else if (rc == ROUTE_ADJOINT) {
+        cli_system_free(&s);
+        s = a->s, s.matrix_path = argv[optind];
+        return cli_solve_source(&s, &o.walk, source, rp.json, rp.check, force);
     }
     free(bidx), free(bval);
     cli_system_free(&s);

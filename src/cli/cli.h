@@ -276,6 +276,11 @@ extern const cli_solve_row cli_solve_bidir_row, cli_solve_outer_row, cli_solve_w
 /* The rows split across MPI ranks, walks that migrate (--partition, src/cli/partition.c). */
 extern const cli_solve_row cli_solve_partition_row;
 
+/* x_I (s->index, 1-based) for b = e_source (1-based) by the walks row under --method auto with
+ * walk options o (the push on b, then walks from I): a --source solve's route when the walks
+ * from S have a variance not certified finite (src/cli/bidir.c).  0 or an exit code. */
+int cli_solve_source(const cli_system *s, const ulam_walk_opts *o, int64_t source, int json, int check, int force);
+
 /* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print
  * its report with the choice; 0 or an exit code. */
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,

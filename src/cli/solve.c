@@ -430,6 +430,7 @@ typedef struct {
     double max_seconds;   /* --time as given (o.max_seconds: what is left of it for the walks) */
     const char *queries;  /* --queries FILE ("-": stdin; NULL: one query) */
     int walks_given;      /* --walks or --time given */
+    int64_t source;       /* > 0: b = e_source, 1-based (cli_solve_source; 0: b from the files) */
 } solve_args;
 
 /* The walks row's options (src/cli/solve_rows.c reads them; the walk options go to cli_walk_option). */
@@ -579,6 +580,8 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
     if ((rc = cli_check_outputs("solve", outs, 2, ins, 2))) return rc;
     double t0 = ulam_now();
     if ((rc = cli_load_system(s))) return rc;
+    if (a->source > 0 && !s->b && (s->own_b = calloc((size_t)s->M->nrows, sizeof *s->own_b)))
+        s->own_b[a->source - 1] = 1.0, s->b = s->own_b; /* freed by cli_system_free */
     if (!s->b) {
         cli_system_free(s);
         return cli_usage_error("solve", "needs --rhs b.mtx (%s holds no b)", s->matrix_path);
@@ -680,7 +683,7 @@ static int run(solve_args *a)
         return cli_exit_code(ULAM_EINVAL);
     }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
-        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_method_bidir_route(a->s.b, a->s.M->nrows, &a->ao, &a->o), ro.json, ro.check, ro.direct, ro.direct_method, ro.load_seconds);
+        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_run_bidir_route(rn) == 1, ro.json, ro.check, ro.direct, ro.direct_method, ro.load_seconds);
         ulam_run_free(rn);
         a->an = ulam_analysis_free(a->an);
         cli_system_free(&a->s);
@@ -752,6 +755,18 @@ static int run(solve_args *a)
     a->an = ulam_analysis_free(a->an);
     cli_system_free(&a->s);
     return rc;
+}
+
+/* x_I for b = e_source by the walks row under auto (cli.h). */
+int cli_solve_source(const cli_system *s, const ulam_walk_opts *o, int64_t source, int json, int check, int force)
+{
+    solve_args a;
+    init(&a);
+    a.s.matrix_path = s->matrix_path, a.s.index = s->index, a.s.cache = s->cache;
+    a.o = *o, a.o.mode = ULAM_ADJOINT;
+    a.json = json, a.check = check, a.force = force, a.source = source;
+    a.walks_given = o->stop.max_walks > 0 || o->stop.max_seconds > 0;
+    return run(&a);
 }
 
 /* The options read: check them and run (many queries: src/cli/queries.c); 0 or an exit code. */
