@@ -173,8 +173,8 @@ int ulam_gonio_read_ies(const char *path, ulam_gonio **out, ulam_error *err)
         goto done;
     }
     if ((st = angles(&t, "vertical angles", nv, 0.0, 180.0, va, err))) goto done;
-    line = t.line;
     if ((st = angles(&t, "horizontal angles", nh, 0.0, 360.0, ha, err))) goto done;
+    line = t.line; /* the last horizontal angle's */
     int sym = ULAM__SYM_NONE;
     if ((st = symmetry(ha, nh, line, &sym, err))) goto done;
     double f = mult * ballast * blp;

@@ -63,10 +63,18 @@ static double one(const ulam_tracer *t, const ulam_luminaire *l, const double f[
     for (int k = 0; k < 3; k++) d[k] /= r;
     double cosx = ulam__dot3(d, n);
     if (!(cosx > 0)) return 0.0;
-    int front = 0;
-    double dist = INFINITY;
-    int64_t j = ulam__tracer_ray(t, x, d, self, &front, &dist);
-    if (j >= 0 && dist < r * (1.0 - 1e-9)) return 0.0; /* a surface between */
+    /* a surface between blocks it; a hit within 1e-9 r of the start (a neighbour sharing the edge x
+     * lies on) does not: the ray is cast again from just past it */
+    double o[3] = {x[0], x[1], x[2]}, done = 0.0;
+    for (int k = 0; k < 4; k++) {
+        int front = 0;
+        double dist = INFINITY;
+        int64_t j = ulam__tracer_ray(t, o, d, k ? -1 : self, &front, &dist);
+        if (j < 0 || done + dist >= r * (1.0 - 1e-9)) break;
+        if (dist > 1e-9 * r) return 0.0;
+        done += dist + 1e-9 * r;
+        for (int i = 0; i < 3; i++) o[i] = x[i] + done * d[i];
+    }
     double back[3] = {-d[0], -d[1], -d[2]};
     double I = toward(l, f, f + 3, f + 6, back);
     return I * cosx / (r * m * r * m);
