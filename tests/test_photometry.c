@@ -341,8 +341,8 @@ static void test_en12464(void **state)
     assert_close(ulam_en12464_spacing(10.0), 1.0, 1e-15);
     assert_close(ulam_en12464_spacing(100.0), 5.0, 1e-13);
     assert_close(ulam_en12464_spacing(1e4), 10.0, 0); /* capped */
-    /* a 6 x 4 m room at 0.8 m (y up), in millimetres: 5 x 3 m left, d = 5, p = 0.2 x 5^0.69897 = 0.6163 m:
-     * ceil(5 / 0.6163) = 9, ceil(3 / 0.6163) = 5 */
+    /* a 6 x 4 m room at 0.8 m (y up), in millimetres: 5 x 3 m left, d = 5, p = 0.2 x 5^0.69897 = 0.616 m:
+     * ceil(5 / 0.616) = 9, ceil(3 / 0.616) = 5 */
     double c0[3] = {0, 800, 0}, c1[3] = {6000, 800, 4000};
     ulam_rad_grid g;
     assert_int_equal(ulam_rad_grid_en12464(c0, c1, 0.001, 0.5, &g, NULL), ULAM_OK);
