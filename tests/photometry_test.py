@@ -132,6 +132,7 @@ def check_area_source(d):
     for (x, y, z), p in zip(pts, out["photometry"]["points"]):
         E = 500.0 * contour_factor((x, y, z), (0, 1, 0), panel)
         zscore = (p["illuminance_lx"] - E) / p["illuminance_lx_stderr"]
+        print(f"  E {p['illuminance_lx']:.6g} lx, truth {E:.6g}, z = {zscore:+.2f}")
         assert abs(zscore) < 4, (p, E, zscore)
         assert p["illuminance_lx_ci95_lo"] <= E * (1 + 1e-9) and E <= p["illuminance_lx_ci95_hi"] * (1 + 1e-9) or \
             abs(zscore) < 4, (p, E)
@@ -156,6 +157,7 @@ def check_furnace(d):
                           "--unit", "m", "--rel-err", "0.004", "--json"]).stdout)
     for k, p in enumerate(out["photometry"]["points"]):
         zscore = (p["illuminance_lx"] - 250.0) / p["illuminance_lx_stderr"]
+        print(f"  E {p['illuminance_lx']:.6g} lx, truth {250.0:.6g}, z = {zscore:+.2f}")
         assert abs(zscore) < 4, (k, p)
         if k < 2:
             zl = (p["luminance_cd_m2"] - 250.0 / math.pi) / (0.6 * p["illuminance_lx_stderr"] / math.pi)
@@ -206,6 +208,76 @@ def check_two_surface(d):
                           "--rel-err", "0.005", "--seed", "5", "--json"]).stdout)
     for p, E in zip(out["photometry"]["points"], (B2, (B1 + B2) / 2)):
         zscore = (p["illuminance_lx"] - E) / p["illuminance_lx_stderr"]
+        print(f"  E {p['illuminance_lx']:.6g} lx, truth {E:.6g}, z = {zscore:+.2f}")
+        assert abs(zscore) < 4, (p, E, zscore)
+
+
+def sphere(nphi, nth, R):
+    """A faceted sphere of radius R about the origin: vertices on it, quads between rings and triangles at
+    the poles, each face counter-clockwise seen from inside; (vertices, faces)."""
+    verts = [(0.0, -R, 0.0), (0.0, R, 0.0)]
+    ring = lambda j, i: 3 + (j - 1) * nphi + (i % nphi)  # noqa: E731  rings 1 .. nth - 1, south to north
+    for j in range(1, nth):
+        th = -math.pi / 2 + math.pi * j / nth
+        for i in range(nphi):
+            ph = 2 * math.pi * i / nphi
+            verts.append((R * math.cos(th) * math.cos(ph), R * math.sin(th), R * math.cos(th) * math.sin(ph)))
+    faces = [(1, ring(1, i), ring(1, i + 1)) for i in range(nphi)]
+    faces += [(ring(j, i), ring(j, i + 1), ring(j + 1, i + 1), ring(j + 1, i)) for j in range(1, nth - 1)
+              for i in range(nphi)]
+    faces += [(ring(nth - 1, i), ring(nth - 1, i + 1), 2) for i in range(nphi)]
+    out = []
+    for f in faces:
+        p = [verts[k - 1] for k in f]
+        a = [p[1][k] - p[0][k] for k in range(3)]
+        b = [p[2][k] - p[0][k] for k in range(3)]
+        n = (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+        c = [sum(q[k] for q in p) / len(p) for k in range(3)]
+        out.append(f if sum(n[k] * c[k] for k in range(3)) < 0 else f[::-1])
+    return verts, out
+
+
+def check_integrating_sphere(d):
+    """A luminaire off-centre in a sphere (radius 2 m, Kd 0.8): on a sphere G(x, y) = 1 / A for any two
+    of its points, so the reflected illuminance is the same everywhere, rho Phi / (A (1 - rho)) (Phi the
+    flux the walls receive, A their area) whatever the luminaire and its place, and the patch-mean first
+    bounce the luminaire's light goes through is exact there (only patch totals matter).  E = that + the
+    direct I cos / d^2, within 4 sigma; the flux line equals the table's flux to the midpoint rule."""
+    lamp = isotropic_cosine_ies(d)
+    R, rho = 2.0, 0.8
+    verts, faces = sphere(64, 32, R)
+    scene = obj(d, "sphere", verts, [("wall", f) for f in faces], {"wall": (rho, 0)})
+    pos = (0.3, 0.5, -0.2)
+    # the walls' area and two points on facets: the centroids of a south and a north facet
+    area = 0.0
+    for f in faces:
+        p = [verts[k - 1] for k in f]
+        for t in range(1, len(p) - 1):
+            a = [p[t][k] - p[0][k] for k in range(3)]
+            b = [p[t + 1][k] - p[0][k] for k in range(3)]
+            area += 0.5 * math.sqrt((a[1] * b[2] - a[2] * b[1]) ** 2 + (a[2] * b[0] - a[0] * b[2]) ** 2 +
+                                    (a[0] * b[1] - a[1] * b[0]) ** 2)
+    pts = []
+    for f in (faces[64 * 3 + 7], faces[64 * 20 + 40]):
+        pts.append([sum(verts[k - 1][m] for k in f) / len(f) for m in range(3)])
+    args = [scene, "--luminaire", f"{lamp}@{pos[0]},{pos[1]},{pos[2]}", "--rel-err", "0.005", "--seed", "9", "--json"]
+    for x in pts:
+        args += ["--at", ",".join(repr(t) for t in x)]
+    out = json.loads(run(args).stdout)
+    ph = out["photometry"]
+    phi = ph["flux_onto_surfaces_lm"]
+    table = ph["luminaires"][0]["flux_lm"]
+    assert abs(phi / table - 1) < 2e-3, (phi, table)  # all of it lands (the midpoint rule's error)
+    indirect = rho * phi / (area * (1 - rho))
+    for x, p in zip(pts, ph["points"]):
+        v = [pos[k] - x[k] for k in range(3)]
+        dist = math.sqrt(sum(t * t for t in v))
+        n = out["points"][ph["points"].index(p)]["normal"]  # the facet's own normal
+        cos = sum(v[k] * n[k] for k in range(3)) / dist
+        gamma = math.degrees(math.acos(v[1] / dist))  # from the lamp toward x (-v) against the nadir -y
+        E = intensity(gamma) * cos / dist ** 2 + indirect
+        zscore = (p["illuminance_lx"] - E) / p["illuminance_lx_stderr"]
+        print(f"  E {p['illuminance_lx']:.6g} lx, truth {E:.6g}, z = {zscore:+.2f}")
         assert abs(zscore) < 4, (p, E, zscore)
 
 
@@ -258,7 +330,8 @@ def check_refused(d):
 
 def main():
     with tempfile.TemporaryDirectory() as d:
-        for check in (check_point_source, check_area_source, check_furnace, check_two_surface, check_workplane,
+        for check in (check_point_source, check_area_source, check_furnace, check_two_surface, check_integrating_sphere,
+                      check_workplane,
                       check_refused):
             check(d)
             print(check.__name__, "ok")
