@@ -310,6 +310,21 @@ def check_workplane(d):
     assert re.search(r"U0 = E min / E mean 0\.\d+ \(0\.\d+ \.\. 0\.\d+\)", text), text
 
 
+def check_examples(d):
+    """examples/luminaires: the IES file and its EULUMDAT twin give the same flux and the same lux."""
+    scene = floor_scene(d, 1000.0)
+    res = []
+    for f in ("downlight.ies", "downlight.ldt"):
+        out = json.loads(run([scene, "--unit", "mm", "--luminaire", f"examples/luminaires/{f}@100,2400,-300",
+                              "--at", "500,0,700", "--at", "-1500,0,100", "--walks", "256", "--json"]).stdout)
+        res.append(out["photometry"])
+    a, b = res
+    assert abs(a["luminaires"][0]["flux_lm"] - b["luminaires"][0]["flux_lm"]) < 1e-9 * a["luminaires"][0]["flux_lm"]
+    assert a["luminaires"][0]["rated_lm"] == b["luminaires"][0]["rated_lm"] == 1000
+    for p, q in zip(a["points"], b["points"]):
+        assert abs(p["illuminance_lx"] - q["illuminance_lx"]) <= 1e-9 * p["illuminance_lx"] and p["illuminance_lx"] > 0
+
+
 def check_refused(d):
     """Malformed luminaires and options: a located message, no partial output."""
     bad = write(d, "bad.ies", "IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 3 1 1 2 0 0 0\n1 1 10\n0 90 180\n0\n1 oops 3\n")
@@ -331,7 +346,7 @@ def check_refused(d):
 def main():
     with tempfile.TemporaryDirectory() as d:
         for check in (check_point_source, check_area_source, check_furnace, check_two_surface, check_integrating_sphere,
-                      check_workplane,
+                      check_workplane, check_examples,
                       check_refused):
             check(d)
             print(check.__name__, "ok")

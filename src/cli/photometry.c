@@ -144,7 +144,11 @@ int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const cha
         p->lum[k].gonio = p->gonio[k], p->lum[k].scale = p->maintenance;
     }
     if (!p->nlum) return 0;
-    if (ulam_luminaire_patch_illuminance(t, p->lum, p->nlum, p->metres, 8, p->H, &err)) return cli_report(scene, &err);
+    double tri = 0.0; /* fan triangles: q^2 shadow rays each a luminaire, about 2 10^7 in all, q in 2 .. 8 */
+    for (int64_t i = 0; i < s->npatches; i++) tri += (double)(s->start[i + 1] - s->start[i] - 2);
+    p->q = (int)fmax(2.0, fmin(8.0, floor(sqrt(2e7 / fmax(1.0, tri * p->nlum)))));
+    if (ulam_luminaire_patch_illuminance(t, p->lum, p->nlum, p->metres, p->q, p->H, &err))
+        return cli_report(scene, &err);
     p->onto = 0.0;
     for (int64_t i = 0; i < s->npatches; i++) {
         p->onto += s->area[i] * p->metres * p->metres * p->H[i];
@@ -182,7 +186,9 @@ static void luminaires_text(const cli_photo *p)
         if (isfinite(rated)) printf(", lamps rated %.6g lm", rated);
         printf("\n");
     }
-    if (p->nlum) printf("flux         %.6g lm onto the surfaces (direct)\n", p->onto);
+    if (p->nlum)
+        printf("flux         %.6g lm onto the surfaces (direct; each patch's mean by a %d x %d midpoint rule a "
+               "triangle, its Kd times that its emission)\n", p->onto, p->q, p->q);
 }
 
 /* The points' photometric lines or JSON. */
@@ -273,11 +279,30 @@ void cli_photo_report(const cli_photo *p, const ulam_scene *s, const ulam_rad_po
 }
 
 /* A patch run's photometric lines. */
-void cli_photo_report_patch(const cli_photo *p, const double *B, const double luma[3])
+void cli_photo_report_patch(const cli_photo *p, const double *B, const double luma[3], int image)
 {
     if (!p->active) return;
     luminaires_text(p);
     if (B) printf("luminance    %.6g cd/m2 (B_Y / pi)\n", (luma[0] * B[0] + luma[1] * B[1] + luma[2] * B[2]) / M_PI);
+    if (image) printf("image        linear values (PFM, HDR) in cd/m2: the luminance B / pi\n");
+}
+
+/* The luminance an image shows: B / pi (cd/m2 from lm/m2). */
+void cli_photo_luminance(const cli_photo *p, const double *B, const double *se, int64_t n, double **L, double **Lse)
+{
+    *L = *Lse = NULL;
+    if (!p->active || !B) return;
+    *L = malloc(((size_t)n * 3 + 1) * sizeof **L);
+    *Lse = se ? malloc(((size_t)n * 3 + 1) * sizeof **Lse) : NULL;
+    if (!*L || (se && !*Lse)) {
+        free(*L), free(*Lse);
+        *L = *Lse = NULL;
+        return;
+    }
+    for (int64_t k = 0; k < 3 * n; k++) {
+        (*L)[k] = B[k] / M_PI;
+        if (se) (*Lse)[k] = se[k] / M_PI;
+    }
 }
 
 /* Free what p holds. */

@@ -23,6 +23,7 @@ typedef struct cli_photo {
     double *H;               /* every patch's mean direct illuminance (lx) */
     double *ke;              /* the scene's own emission (3 a patch) */
     double onto;             /* luminous flux onto the surfaces (lm) */
+    int q;                   /* the midpoint rule's q x q a fan triangle */
 } cli_photo;
 
 /* The usage lines of the photometric options. */
@@ -51,8 +52,13 @@ void cli_photo_report(const cli_photo *p, const ulam_scene *s, const ulam_rad_po
                       int json, const double luma[3], void (*Y)(const ulam_rad_point *, double *, double *),
                       void (*Yci)(const ulam_rad_point *, double *, double *));
 
-/* Text lines for a patch run (the luminaires, their flux; the patch's luminance B_Y / pi). */
-void cli_photo_report_patch(const cli_photo *p, const double *B, const double luma[3]);
+/* Text lines for a patch run (the luminaires, their flux; the patch's luminance B_Y / pi; what an
+ * image written holds). */
+void cli_photo_report_patch(const cli_photo *p, const double *B, const double luma[3], int image);
+
+/* Photometric runs: *L (and *Lse when se is given) new arrays of B / pi and se / pi (3 * n: the
+ * luminance in cd/m2 an image shows); otherwise, or out of memory, both NULL. */
+void cli_photo_luminance(const cli_photo *p, const double *B, const double *se, int64_t n, double **L, double **Lse);
 
 /* Free what p holds. */
 void cli_photo_free(cli_photo *p);

@@ -1564,12 +1564,17 @@ int cli_radiosity(int argc, char **argv)
         r.out_written = 1;
     }
     if (a.image && !w.interrupted && cli_rank == 0) {
-        if ((rc = write_image(&a, t, s, w.all ? w.all : Bd, w.all ? w.all_se : NULL, &r.exposure))) goto done;
+        double *L = NULL, *Lse = NULL; /* photometric: the picture's luminance B / pi, cd/m2 (photometry.c) */
+        cli_photo_luminance(&a.ph, w.all ? w.all : Bd, w.all ? w.all_se : NULL, s->npatches, &L, &Lse);
+        rc = write_image(&a, t, s, L ? L : w.all ? w.all : Bd, Lse ? Lse : w.all ? w.all_se : NULL, &r.exposure);
+        free(L), free(Lse);
+        if (rc) goto done;
         r.image_written = 1;
     }
     if (a.json) print_json(&a, &r);
     else print_text(&a, &r);
-    if (!a.json) cli_photo_report_patch(&a.ph, r.patch < 0 ? NULL : r.w ? w.B : Bd ? Bd + 3 * r.patch : NULL, luma);
+    if (!a.json) cli_photo_report_patch(&a.ph, r.patch < 0 ? NULL : r.w ? w.B : Bd ? Bd + 3 * r.patch : NULL, luma,
+                                       r.image_written);
     if (w.interrupted) rc = EXIT_INTERRUPTED;
 done:
     free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all), free(a.at), free(mesh_all);
