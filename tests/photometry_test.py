@@ -357,6 +357,12 @@ def check_examples(d):
     assert a["luminaires"][0]["rated_lm"] == b["luminaires"][0]["rated_lm"] == 1000
     for p, q in zip(a["points"], b["points"]):
         assert abs(p["illuminance_lx"] - q["illuminance_lx"]) <= 1e-9 * p["illuminance_lx"] and p["illuminance_lx"] > 0
+    # a patch run's JSON carries the luminaires and the flux too; its text the patch's luminance
+    args = ["examples/scenes/cornell_box.obj", "--unit", "mm", "--luminaire",
+            "examples/luminaires/downlight.ies@278,540,280", "--direct", "--ff-rays", "100", "--patch", "floor"]
+    ph = json.loads(run(args + ["--json"]).stdout)["photometry"]
+    assert ph["luminaires"][0]["rated_lm"] == 1000 and 0 < ph["flux_onto_surfaces_lm"] < ph["luminaires"][0]["flux_lm"]
+    assert re.search(r"luminance +[0-9.]+ cd/m2 \(B_Y / pi\)", run(args).stdout)
 
 
 def check_refused(d):

@@ -201,7 +201,7 @@ void cli_photo_report(const cli_photo *p, const ulam_scene *s, const ulam_rad_po
     double *E = malloc(((size_t)ngrid + 1) * sizeof *E), *se = malloc(((size_t)ngrid + 1) * sizeof *se);
     ulam_uniformity u;
     int have_u = 0;
-    if (E && se && ngrid) {
+    if (E && se && ngrid && Y) {
         for (int64_t k = 0; k < ngrid; k++) Y(&pts[nat + k], &E[k], &se[k]);
         have_u = !ulam_uniformity_compute(E, se, ngrid, 0.95, &u);
     }
@@ -223,7 +223,7 @@ void cli_photo_report(const cli_photo *p, const ulam_scene *s, const ulam_rad_po
         luminaires_text(p);
     }
     for (int64_t k = 0; k < n; k++) {
-        if (k >= nat && !json) break;
+        if ((k >= nat && !json) || !pts) break;
         const ulam_rad_point *r = &pts[k];
         double y, ys, lo, hi, L = NAN, Llo = NAN, Lhi = NAN;
         Y(r, &y, &ys);

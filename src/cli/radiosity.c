@@ -895,6 +895,7 @@ static void print_json(const args *a, const report *r)
         }
         printf("], ");
     }
+    cli_photo_report(&a->ph, r->s, NULL, 0, 0, 1, luma, NULL, NULL); /* photometric runs: the luminaires */
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
 }
 
