@@ -160,6 +160,30 @@ static void test_flux_lambertian(void **state)
     ulam_gonio_free(g);
 }
 
+/* IES: TILT=INCLUDE's block read past, commas as separators, numbers split across lines, the
+ * ballast and ballast-lamp factors applied; EULUMDAT: a decimal comma and CR LF. */
+static void test_variants(void **state)
+{
+    (void)state;
+    ulam_gonio *g = must(put("tilt.ies", "IESNA:LM-63-2002\n[TEST] tilt\nTILT=INCLUDE\n1\n3\n0 45 90\n1.0 0.95 0.9\n"
+                                         "2,-1,2.0,3,1,1,2,0,0,0\n0.5 0.8\n40\n0 90\n180\n0\n10 20\n 30\n"));
+    assert_close(ulam_gonio_intensity(g, 0, 0), 10 * 2.0 * 0.5 * 0.8, 1e-12);
+    assert_close(ulam_gonio_intensity(g, 123, 45), 15 * 0.8, 1e-12);
+    assert_close(ulam_gonio_intensity(g, 0, 180), 30 * 0.8, 1e-12);
+    assert_true(isnan(ulam_gonio_rated_flux(g)));
+    ulam_gonio_free(g);
+    g = must(put("comma.ldt", "x\r\n1\r\n1\r\n4\r\n90\r\n2\r\n90\r\nr\r\nn\r\nn\r\nf\r\nd\r\n"
+                              "1\r\n1\r\n1\r\n1\r\n1\r\n0\r\n0\r\n0\r\n0\r\n100\r\n80,5\r\n1,5\r\n0\r\n"
+                              "1\r\n1\r\nLED\r\n2000\r\n4000K\r\n1A\r\n20\r\n"
+                              "0,5\r\n0,5\r\n0,5\r\n0,5\r\n0,5\r\n0,5\r\n0,5\r\n0,5\r\n0,5\r\n0,5\r\n"
+                              "0\r\n90\r\n180\r\n270\r\n0\r\n90\r\n300,5\r\n100\r\n"));
+    /* cd/klm x conversion factor 1.5 x 2000 lm / 1000 */
+    assert_close(ulam_gonio_intensity(g, 77, 0), 300.5 * 1.5 * 2.0, 1e-9);
+    assert_close(ulam_gonio_intensity(g, 200, 45), 0.5 * (300.5 + 100) * 3.0, 1e-9);
+    assert_close(ulam_gonio_rated_flux(g), 2000, 0);
+    ulam_gonio_free(g);
+}
+
 /* A malformed file: its status and line, and a message naming what was expected. */
 static void refused(const char *name, const char *text, int status, long line, const char *what)
 {
@@ -404,7 +428,7 @@ int main(void)
     assert_non_null(mkdtemp(dir));
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ies_symmetries), cmocka_unit_test(test_ldt_symmetries),
-        cmocka_unit_test(test_flux_lambertian), cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_flux_lambertian), cmocka_unit_test(test_refused), cmocka_unit_test(test_variants),
         cmocka_unit_test(test_point_source),    cmocka_unit_test(test_box_flux),
         cmocka_unit_test(test_en12464),         cmocka_unit_test(test_uniformity),
     };

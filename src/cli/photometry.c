@@ -72,9 +72,10 @@ int cli_photo_option(cli_photo *p, const char *cmd, const char *name, const char
     if (!strcmp(name, "luminaire")) {
         const char *at = strrchr(arg, '@');
         ulam_luminaire l;
-        if (!at || at == arg || placement(at + 1, &l))
+        if (!at || at == arg || at - arg >= 4096 || placement(at + 1, &l))
             return cli_usage_error(cmd, "--luminaire expects FILE@x,y,z or FILE@x,y,z,nx,ny,nz or "
-                                        "FILE@x,y,z,nx,ny,nz,cx,cy,cz (finite numbers, a nonzero nadir), got '%s'",
+                                        "FILE@x,y,z,nx,ny,nz,cx,cy,cz (a path under 4 KiB, finite numbers, a nonzero "
+                                        "nadir and a C0 axis across it), got '%.200s'",
                                    arg);
         if (p->nlum >= 10000) return cli_usage_error(cmd, "at most 10000 luminaires");
         const char **sp = realloc(p->spec, (size_t)(p->nlum + 1) * sizeof *sp);
