@@ -2036,6 +2036,10 @@ def main():
             failures += 1
             print(f"FAIL {f.__name__}: {e}\n  (rerun it alone: --case {f.__name__})")
     total = n + len(extra)
+    if cases and total == 0:  # a --case this half does not hold ran nothing: not a pass
+        print(f"--case {' '.join(cases)} selects nothing in the {part} half: table:K rows are test 'cli' "
+              f"(--table), check_NAME cases test 'cli_checks' (--checks)")
+        return 2
     print(f"{total - failures} passed, {failures} failed")
     return 1 if failures else 0
 

@@ -38,6 +38,7 @@ typedef struct {
     int have_guard;
     ulam_analysis *an;   /* the library's analysis of M (analog, exponent 1): bounds over every
                             state, kept kernel rows, made by the first query that reuses them */
+    ulam_csr *Mt;        /* M's transpose, made by the first single-source query */
 } SystemObject;
 
 /* An int64 / int32 / float64 C-contiguous 1-d array from obj (a new reference), or NULL with a
@@ -57,6 +58,7 @@ static PyArrayObject *array_of(PyObject *obj, int type, const char *what)
 static void System_dealloc(SystemObject *self)
 {
     ulam_analysis_free(self->an);
+    ulam_csr_free(self->Mt);
     Py_XDECREF(self->rowptr);
     Py_XDECREF(self->colidx);
     Py_XDECREF(self->val);
@@ -320,6 +322,20 @@ static int walk_rounds(ulam_solver *sv, PyObject *progress, volatile int *flag, 
     return 0;
 }
 
+/* Forward walks' (x, std_error) of every component as a tuple of two NumPy arrays of n (a new
+ * reference), or NULL with an exception set. */
+static PyObject *forward_vectors(const ulam_solver *sv, int64_t n)
+{
+    npy_intp dn = (npy_intp)n;
+    PyObject *x = PyArray_SimpleNew(1, &dn, NPY_FLOAT64), *se = PyArray_SimpleNew(1, &dn, NPY_FLOAT64);
+    if (!x || !se) {
+        Py_XDECREF(x), Py_XDECREF(se);
+        return NULL;
+    }
+    int st = ulam_solver_vectors(sv, PyArray_DATA((PyArrayObject *)x), PyArray_DATA((PyArrayObject *)se));
+    return Py_BuildValue("(NNi)", x, se, st);
+}
+
 /* System.query(b, index, opts, progress): run the library's `ulam solve` for x_index. */
 static PyObject *System_query(SystemObject *self, PyObject *args)
 {
@@ -336,8 +352,8 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
     ulam_walk_opts o = ulam_walk_defaults();
     ulam_auto_opts ao = ulam_auto_defaults();
     ulam_method_opts mo = ulam_method_defaults();
-    int reuse = 0, catch = 0;
-    if (read_opts(od, &o, &ao, &mo, &reuse, &catch)) {
+    int reuse = 0, catch = 0, vectors = 0;
+    if (read_opts(od, &o, &ao, &mo, &reuse, &catch) || get_int(od, "vectors", &vectors)) {
         Py_DECREF(barr);
         return NULL;
     }
@@ -365,6 +381,8 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
     }
     ulam_solver *sv = ulam_run_solver(run);
     if (!status && sv) cb = walk_rounds(sv, progress, &flag, &status);
+    PyObject *xs = NULL; /* forward walks: (x, std_error) of every component, when asked */
+    if (!cb && vectors && sv && (!status || flag) && !(xs = forward_vectors(sv, self->M.nrows))) cb = 1;
     if (run && (!status || sv)) {
         int st;
         Py_BEGIN_ALLOW_THREADS
@@ -377,9 +395,67 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
     if (catch) release_sigint(&old);
     ulam_run_free(run);
     PyObject *d = cb ? NULL : answer(status, &err, ch, started, a, ran, flag && !cb);
+    if (d && xs && put(d, "vectors", xs)) Py_CLEAR(d);
+    else if (!d) Py_XDECREF(xs);
     free(ch), free(a);
     Py_DECREF(barr);
     return d;
+}
+
+/* System.fpush(source, opts): every x_i of (I - M) x = e_source (ulam_fpush_solve: a forward push
+ * and walks from its residual) as a dict: status, message, error_index, x, std_error, lo, hi (NumPy
+ * arrays of n), walks, steps, rmax, push_ops, interrupted, seconds. */
+static PyObject *System_fpush(SystemObject *self, PyObject *args)
+{
+    PyObject *od;
+    long long source;
+    if (!PyArg_ParseTuple(args, "LO!", &source, &PyDict_Type, &od)) return NULL;
+    ulam_fpush_opts o = ulam_fpush_defaults();
+    ulam_auto_opts ao = ulam_auto_defaults();
+    ulam_method_opts mo = ulam_method_defaults();
+    int reuse = 0, catch = 0;
+    if (read_opts(od, &o.walk, &ao, &mo, &reuse, &catch) || get_double(od, "fpush_rel_err", &o.rel_err) ||
+        get_int64(od, "fpush_walks", &o.walks))
+        return NULL;
+    o.walk.mode = ULAM_FORWARD, o.source = source;
+    npy_intp n = (npy_intp)self->M.nrows;
+    PyObject *x = PyArray_SimpleNew(1, &n, NPY_FLOAT64), *se = PyArray_SimpleNew(1, &n, NPY_FLOAT64),
+             *lo = PyArray_SimpleNew(1, &n, NPY_FLOAT64), *hi = PyArray_SimpleNew(1, &n, NPY_FLOAT64);
+    PyObject *d = x && se && lo && hi ? PyDict_New() : NULL;
+    if (!d) goto fail;
+    volatile int flag = 0;
+    o.walk.stop.interrupt = &flag;
+    ulam_error err = {0};
+    ulam_fpush_info info = {0};
+    int status = ULAM_OK;
+    struct sigaction old;
+    if (catch) catch_sigint(&flag, &old);
+    Py_BEGIN_ALLOW_THREADS
+    if (!self->Mt) status = ulam_csr_transpose(&self->M, &self->Mt);
+    if (status) err = (ulam_error){.status = status, .msg = "memory for M's transpose"};
+    else status = ulam_fpush_solve(&self->M, self->Mt, &o, PyArray_DATA((PyArrayObject *)x),
+                                   PyArray_DATA((PyArrayObject *)se), PyArray_DATA((PyArrayObject *)lo),
+                                   PyArray_DATA((PyArrayObject *)hi), &info, &err);
+    Py_END_ALLOW_THREADS
+    if (catch) release_sigint(&old);
+    if (put(d, "status", PyLong_FromLong(status)) || put(d, "message", PyUnicode_FromString(err.msg)) ||
+        put(d, "error_index", PyLong_FromLongLong((long long)err.index)) || put(d, "x", x) ||
+        put(d, "std_error", se) || put(d, "lo", lo) || put(d, "hi", hi))
+        goto fail_d;
+    if (put(d, "walks", PyLong_FromLongLong((long long)info.walks)) ||
+        put(d, "steps", PyLong_FromLongLong((long long)info.steps)) || put(d, "rmax", PyFloat_FromDouble(info.rmax)) ||
+        put(d, "push_ops", PyLong_FromLongLong((long long)info.push.ops)) ||
+        put(d, "residual_bound", PyFloat_FromDouble(info.residual_bound)) ||
+        put(d, "interrupted", PyBool_FromLong(info.interrupted || flag)) ||
+        put(d, "seconds", PyFloat_FromDouble(info.seconds)))
+        goto fail_d;
+    return d;
+fail:
+    Py_XDECREF(x), Py_XDECREF(se), Py_XDECREF(lo), Py_XDECREF(hi);
+    return PyErr_Occurred() ? NULL : PyErr_NoMemory();
+fail_d:
+    Py_DECREF(d);
+    return NULL;
 }
 
 /* jacobi(indptr, indices, data, n, b, omega): M = I - omega D^-1 A and omega D^-1 b (the
@@ -459,6 +535,7 @@ static PyObject *py_strerror(PyObject *mod, PyObject *args)
 
 static PyMethodDef System_methods[] = {
     {"query", (PyCFunction)System_query, METH_VARARGS, "query(b, index, opts, progress) -> dict (internal)"},
+    {"fpush", (PyCFunction)System_fpush, METH_VARARGS, "fpush(source, opts) -> dict (internal)"},
     {NULL, NULL, 0, NULL}};
 
 static PyTypeObject SystemType = {
