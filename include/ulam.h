@@ -544,6 +544,12 @@ double ulam_system_omega(const ulam_system *s);
 /* Unmap and free; accepts and returns NULL. */
 ulam_system *ulam_system_free(ulam_system *s);
 
+/* The file mapping behind s: its first byte in *addr and its length in *bytes (NULL and 0 for
+ * borrowed memory or s NULL).  A file that shrinks while mapped (truncated, or replaced in place
+ * by `cp`) makes a read of the lost pages raise SIGBUS: a program that catches SIGBUS can tell
+ * such a fault (si_addr inside the mapping) from others and report the file. */
+void ulam_system_mapping(const ulam_system *s, const void **addr, size_t *bytes);
+
 /* The content tag of a source file for a cache (ulam_system_desc.tag, ulam_system_open's tag):
  * the XXH3-128 hash of its bytes (low, high), so an edit that keeps the size and the modification
  * time still changes it.  ULAM_OK, ULAM_EIO or ULAM_ENOMEM. */
@@ -1209,7 +1215,10 @@ int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opt
 /* ulam_fpush_solve's x (n entries), and of only the k (0 <= k <= n) components of largest
  * estimate: their indices into index (k entries; by decreasing estimate, ties by smaller index,
  * NaN last) and their standard errors and 95% intervals into std_error, lo and hi (k entries
- * each, each may be NULL), the same as ulam_fpush_solve gives them.  For a query that reports a
+ * each, each may be NULL), as ulam_fpush_solve gives them but for the lower ends (0 < k < n): the
+ * k are chosen by their estimates after the walks, so their lower ends are taken at delta k / n
+ * (at most a share delta / 2 of them miss below in expectation; docs/bidirectional.md), and the
+ * relative-error rule, which checks them, may walk on, so x may differ.  For a query that reports a
  * few components: no pass writes 3 n outputs (whose first touch alone dominated the walk phase on
  * R-MAT 2^20) and no sort of n.  ulam_fpush_solve's statuses; ULAM_EINVAL for k out of range or
  * no index array. */
@@ -1590,6 +1599,11 @@ double ulam_rng_uniform(ulam_rng *r);
 
 /* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
 uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
+
+/* The k-th (k < 4) uniform double in [0, 1) of step t of walk w under seed: a counter-based
+ * stream (splitmix64's finalizer chained over the key), the same on every rank and thread, so a
+ * walk that migrates between ranks (ulam_dist.h) takes the same path. */
+double ulam_rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k);
 
 /* ---------------------------------------------------------------- utilities */
 /* All tertiary. */

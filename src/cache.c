@@ -379,7 +379,9 @@ static ulam_csr csr_at(const unsigned char *p, const uint64_t *off, uint64_t nro
 }
 
 /* Check the header of the len bytes at p and fill s (its arrays point into p). */
-static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam_system *s, ulam_error *err)
+/* Check a prepared file's header (its first HEADER bytes at p, the file len bytes long) and
+ * give the layout it states: every array inside the file, at most 2^31 - 1 rows and columns. */
+int ulam__system_header(const unsigned char *p, uint64_t len, ulam__layout *L, ulam_error *err)
 {
     uint64_t w[WORDS];
     if (len == 0) return ulam__fail(err, ULAM_EBANNER, 0, -1, "an ulam prepared system (the file is empty)");
@@ -387,7 +389,8 @@ static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam
         return ulam__fail(err, ULAM_EBANNER, 0, -1, "an ulam prepared system (magic 'ulamSYS1')");
     if (!little_endian()) return ulam__fail(err, ULAM_EUNSUPPORTED, 0, -1, "a little-endian machine");
     if (len < HEADER)
-        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a header of %d bytes (the file has %zu: truncated)", HEADER, len);
+        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a header of %d bytes (the file has %llu: truncated)", HEADER,
+                          (unsigned long long)len);
     memcpy(w, p, HEADER);
     if (hash(p, (size_t)W_SUM * 8) != w[W_SUM])
         return ulam__fail(err, ULAM_ESYNTAX, 0, -1,
@@ -396,8 +399,8 @@ static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam
         return ulam__fail(err, ULAM_EUNSUPPORTED, 0, -1, "format version %d (got %llu: prepare the file again)", VERSION,
                           (unsigned long long)(w[1] & 0xffffffffu));
     if (w[W_LEN] != len)
-        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a file of %llu bytes as its header states, got %zu (truncated?)",
-                          (unsigned long long)w[W_LEN], len);
+        return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a file of %llu bytes as its header states, got %llu (truncated?)",
+                          (unsigned long long)w[W_LEN], (unsigned long long)len);
     uint64_t flags = w[W_FLAGS], n = w[W_DIMS], nc = w[W_DIMS + 1], nnz = w[W_DIMS + 2], shift = w[W_SHIFT];
     int m = (flags & F_MATRIX) != 0, r = (flags & F_RHS) != 0, t = (flags & F_TRANSPOSE) != 0;
     if ((flags & ~(uint64_t)(F_MATRIX | F_RHS | F_CERT | F_TRANSPOSE)) || (!m && !r) || (t && !m) || (!m && (flags & F_CERT)) ||
@@ -416,6 +419,32 @@ static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam
     for (int k = 0; k < 8; k++)
         if (present[k] ? !inside(w[word[k]], bytes[k], len) : w[word[k]] != 0)
             return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "arrays inside the file at 4096-byte boundaries (%s is not)", name[k]);
+    *L = (ulam__layout){.n = (int64_t)n, .ncols = (int64_t)nc, .nnz = (int64_t)nnz, .shift = (int)shift,
+                        .has_matrix = m, .has_rhs = r, .has_tr = t, .sums_hash = w[W_SUMS_HASH],
+                        .tag = {w[W_TAG], w[W_TAG + 1]}, .omega = real(w[W_OMEGA])};
+    for (int k = 0; k < 8; k++) L->off[k] = w[word[k]];
+    for (int k = 0; k < 3; k++) L->nblocks[k] = nb[k], L->first[k] = k ? L->first[k - 1] + nb[k - 1] : 0;
+    return ULAM_OK;
+}
+
+/* XXH3-64 of n bytes: the prepared format's checksum of a b block or of the checksum table. */
+uint64_t ulam__system_hash(const void *p, size_t n)
+{
+    return hash(p, n);
+}
+
+/* Parse the header at p (len bytes in all) into s, arrays used in place. */
+static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam_system *s, ulam_error *err)
+{
+    uint64_t w[WORDS];
+    ulam__layout L;
+    int status = ulam__system_header(p, len, &L, err);
+    if (status) return status;
+    memcpy(w, p, HEADER);
+    uint64_t flags = w[W_FLAGS], n = w[W_DIMS], nc = w[W_DIMS + 1], nnz = w[W_DIMS + 2], shift = w[W_SHIFT];
+    int m = L.has_matrix, r = L.has_rhs, t = L.has_tr;
+    const int64_t *nb = L.nblocks;
+    uint64_t nsums = (uint64_t)(nb[0] + nb[1] + nb[2]);
     const uint64_t *sums = (const uint64_t *)(const void *)(p + w[W_SUMS]);
     if (hash(sums, (size_t)nsums * 8) != w[W_SUMS_HASH])
         return ulam__fail(err, ULAM_ESYNTAX, 0, -1, "a checksum table matching its checksum (the table is damaged)");
@@ -500,13 +529,16 @@ int ulam_system_open(const char *path, const uint64_t tag[2], ulam_system **out,
     return ULAM_OK;
 }
 
-/* 1 when path starts with the prepared-system magic. */
+/* 1 when path is a regular file that starts with the prepared-system magic.  A pipe, FIFO or
+ * device is never one (it cannot be mapped) and is not read: its first bytes stay for the parser
+ * (`info /dev/stdin`, `solve <(cat m.mtx)` found an empty file when this consumed them). */
 int ulam_system_is_file(const char *path)
 {
     char m[8];
-    FILE *f = path ? fopen(path, "rb") : NULL;
-    int yes = f && fread(m, 1, 8, f) == 8 && !memcmp(m, MAGIC, 8);
-    if (f) fclose(f);
+    struct stat st;
+    int fd = path ? open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC) : -1;
+    int yes = fd >= 0 && !fstat(fd, &st) && S_ISREG(st.st_mode) && pread(fd, m, 8, 0) == 8 && !memcmp(m, MAGIC, 8);
+    if (fd >= 0) close(fd);
     return yes;
 }
 
@@ -540,6 +572,14 @@ static int block_state(const int64_t *rp, int64_t rows, const int32_t *col, cons
             if (!isfinite(val[q]) || val[q] == 0.0) return BAD_VALUE;
         }
     return GOOD;
+}
+
+/* The checksum of a block of rows: its row pointers rp[0 .. rows] and entries col, val (the
+ * prepared format's rule); 1 when it is want and the entries hold the CSR invariants. */
+int ulam__system_block_ok(const int64_t *rp, int64_t rows, const int32_t *col, const double *val, int64_t ncols,
+                          uint64_t want)
+{
+    return block_state(rp, rows, col, val, ncols, want) == GOOD;
 }
 
 /* The state block rows r0 .. r1 - 1 of A (nnz entries) verify to against checksum want. */
@@ -829,6 +869,13 @@ double ulam_system_omega(const ulam_system *s)
     return s ? s->omega : 0.0;
 }
 
+/* The mapping's address and length. */
+void ulam_system_mapping(const ulam_system *s, const void **addr, size_t *bytes)
+{
+    if (addr) *addr = s ? s->map : NULL;
+    if (bytes) *bytes = s && s->map ? s->map_bytes : 0;
+}
+
 /* Unmap and free. */
 ulam_system *ulam_system_free(ulam_system *s)
 {
@@ -846,8 +893,13 @@ int ulam_file_tag(const char *path, uint64_t tag[2], ulam_error *err)
 {
     ulam__clear(err);
     if (!path || !tag) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path and a tag");
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) return ulam__fail(err, ULAM_EIO, 0, -1, "a readable file");
+    struct stat sb;
+    if (fstat(fd, &sb) || !S_ISREG(sb.st_mode)) { /* a pipe read here would be lost to the parser */
+        close(fd);
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a regular file (a pipe or device has no lasting content to tag)");
+    }
     XXH3_state_t *st = XXH3_createState();
     enum { CHUNK = 1 << 20 };
     unsigned char *buf = malloc(CHUNK);

@@ -20,7 +20,9 @@
  * every component, so where M, r >= 0 a component's interval is src/stop.c's KL (Chernoff-
  * Hoeffding) interval of its hit count, stitched over the checkpoints the rule may stop at; with
  * signs, the empirical-Bernstein one.  A component no walk reached gets p_i + [0, about 3.7 R0 /
- * N] against the empirical-Bernstein 9.6 R0 / N, so the same accuracy takes ~2.6x fewer walks. */
+ * N] against the empirical-Bernstein 9.6 R0 / N, so the same accuracy takes ~2.6x fewer walks.
+ * ulam_fpush_top's k components are chosen by their estimates: their lower ends at delta k / n
+ * (lower_index). */
 #include "internal.h"
 #include "stop.h"
 
@@ -322,6 +324,27 @@ static void hits_interval(kl_kept *c, int64_t N, int k, int64_t h, double R0, do
     *lo = R0 * a, *hi = R0 * b;
 }
 
+/* The stitching index j whose delta, delta / (j (j + 1)), is at most K / n times index k's
+ * (delta itself at k = 0): the lower ends of the K components ulam_fpush_top prints (k itself
+ * when K >= n, every component).  They are the K largest estimates, chosen after the walks: a
+ * component whose true walk part is tiny ranks among them because a walk or two ended at it, and
+ * its lower end, valid for a component named in advance, then excludes x_i (the issue's 72.8%
+ * coverage at 100 walks, every miss below).  At n K / n the expected number of printed lower
+ * ends that miss is at most the sum over all n components of K delta / (2 n), K delta / 2, under
+ * any dependence and any selection (Benjamini and Yekutieli's false coverage rate, JASA 2005,
+ * for a selection of fixed size K), so the share of printed intervals that miss below is at most
+ * delta / 2.  The upper ends keep index k: ranking by a larger estimate only makes a component
+ * whose walks ended at it too rarely less likely to be printed (at a fixed count, P(printed | h
+ * walks ended at i) rises with h). */
+static int lower_index(int k, int64_t K, int64_t n)
+{
+    if (K >= n) return k;
+    double t = (k >= 1 ? (double)k * ((double)k + 1.0) : 1.0) * (double)n / (double)(K > 0 ? K : 1);
+    double j = ceil(0.5 * (sqrt(1.0 + 4.0 * t) - 1.0));
+    while (j * (j + 1.0) < t) j++;
+    return j < 1 ? 1 : (int)j;
+}
+
 /* Whether an interval [a, b] around est meets relative error E at delta: b < delta (x_i >= delta
  * only if the interval misses it), or est within E max(a, delta) of both ends (so within E x_i of
  * any x_i >= delta inside it). */
@@ -331,16 +354,18 @@ static int interval_met(double a, double b, double est, double E, double delta)
 }
 
 /* rule_met for scores 0 or R0 (M, r >= 0): the KL intervals, every lower end lowered by cut
- * (the bound on the part of x_i the negative residual cut from r takes away). */
-static int rule_met_kl(const walker *w, kl_kept *c, const double *p, int64_t N, int k, double R0, double E, double delta,
-                       double cut)
+ * (the bound on the part of x_i the negative residual cut from r takes away) and taken at index
+ * klo from cl (lower_index; cl NULL: c's). */
+static int rule_met_kl(const walker *w, kl_kept *c, kl_kept *cl, const double *p, int64_t N, int k, int klo, double R0,
+                       double E, double delta, double cut)
 {
-    double lo, hi;
+    double lo, hi, h2;
     hits_interval(c, N, k, 0, R0, &lo, &hi);
     if (!(hi <= E * delta && cut <= E * delta)) return 0; /* a component no walk ended at, p_i just under delta */
     for (int64_t q = 0; q < w->nhit; q++) {
         int64_t i = w->hit[q];
         hits_interval(c, N, k, w->hc[2 * q], R0, &lo, &hi);
+        if (cl) hits_interval(cl, N, klo, w->hc[2 * q], R0, &lo, &h2);
         if (!interval_met(p[i] + lo - cut, p[i] + hi, p[i] + R0 * (double)w->hc[2 * q] / (double)N, E, delta)) return 0;
     }
     return 1;
@@ -482,7 +507,7 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
  * the standard error, so every x_i >= delta is within E of the truth unless its interval misses
  * it); p + the walks' terminal counts, scores of range R, largest R0. */
 static int rule_met(const walker *w, const double *p, int64_t N, int k, double R, double R0, double E, double delta)
-{
+{ /* (k: the lower ends' index, lower_index, which also widens the upper ends: the rule only stops later) */
     double L = ulam__stop_log(k), rt = 7.0 * R * L / (3.0 * ((double)N - 1.0)), Nd = (double)N;
     if (!(rt <= E * delta)) return 0;
     for (int64_t q = 0; q < w->nhit; q++) { /* a state no walk ended at: its interval is p_i -+ rt, met above */
@@ -518,9 +543,9 @@ static double rounding_allowance(const ulam_csr *M, const ulam__sweep_info *swi,
  * lower end at least 0). */
 typedef struct {
     const walker *w;
-    kl_kept *kept;
+    kl_kept *kept, *kept_lo; /* kept_lo: the lower ends' KL intervals at klo (NULL: klo is kk or k) */
     int64_t N;
-    int k, kk, sgn, nonneg;
+    int k, kk, klo, sgn, nonneg;
     double R, R0, cut, D, se0, fp;
     ulam__stop_ci none;
 } ends;
@@ -578,8 +603,15 @@ static double ends_component(const ends *c, double p, int64_t q, double *se, dou
     ulam__stop_ci ci = c->none;
     mean = ends_mean(c, q);
     var = N > 1 ? fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0)) : 0.0;
-    if (!c->sgn) hits_interval(c->kept, N, c->kk < 0 ? c->k : c->kk, h, R0, &ci.lo, &ci.hi);
-    else ulam__stop_interval(N, mean, var, c->R, 0.0, R0, R0, c->k, &ci);
+    if (!c->sgn) {
+        hits_interval(c->kept, N, c->kk < 0 ? c->k : c->kk, h, R0, &ci.lo, &ci.hi);
+        double up;
+        if (c->kept_lo) hits_interval(c->kept_lo, N, c->klo, h, R0, &ci.lo, &up);
+    } else {
+        ulam__stop_ci cl;
+        ulam__stop_interval(N, mean, var, c->R, 0.0, R0, R0, c->k, &ci);
+        if (c->klo != c->k) ulam__stop_interval(N, mean, var, c->R, 0.0, R0, R0, c->klo, &cl), ci.lo = cl.lo;
+    }
     *a = p + ci.lo - c->cut, *b = p + ci.hi;
     *se = N > 1 ? sqrt(var / Nd) : c->se0;
     finish(c, p, p + mean, a, b);
@@ -688,14 +720,16 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     double R = sgn ? 2.0 * R0 : R0; /* the scores' range */
     int64_t N = 0;
     int k = 1, kk = -1; /* kk: the KL interval's index when not k */
-    kl_kept *kept = sgn ? NULL : ulam__malloc(1, sizeof *kept);
+    int64_t K = top > 0 && top < n ? top : n; /* the components whose intervals are given (lower_index) */
+    kl_kept *kept = sgn ? NULL : ulam__malloc(1, sizeof *kept), *kept_lo = sgn || K >= n ? NULL : ulam__malloc(1, sizeof *kept_lo);
     if (kept) kept->N = -1;
+    if (kept_lo) kept_lo->N = -1;
     if (w.k > 0) {
         w.n = n, w.nb = (n + ULAM__FPUSH_BLOCK - 1) / ULAM__FPUSH_BLOCK;
         bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
         w.cum = ulam_alloc_big((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum); /* filled from its start: 2 MiB pages from it */
         w.known = ulam__calloc(((size_t)n + 63) / 64, sizeof *w.known);
-        if (!bsum || !w.cum || !w.known || (sgn ? 0 : !kept))
+        if (!bsum || !w.cum || !w.known || (sgn ? 0 : !kept || (K < n && !kept_lo)))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
     }
     if (!status && w.k > 0) {
@@ -717,7 +751,8 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
             if (made < target - N) info->interrupted = 1, planned = 0;
             N += made;
             if (!planned || o->walks > 0 || N >= cap_w) break;
-            if (sgn ? rule_met(&w, x, N, k, R, R0, pl.E, pl.delta) : rule_met_kl(&w, kept, x, N, k, R0, pl.E, pl.delta, cut))
+            if (sgn ? rule_met(&w, x, N, lower_index(k, K, n), R, R0, pl.E, pl.delta)
+                    : rule_met_kl(&w, kept, kept_lo, x, N, k, lower_index(k, K, n), R0, pl.E, pl.delta, cut))
                 break;
             k++;
         }
@@ -729,10 +764,15 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     double *key = !status && top > 0 ? ulam__malloc((size_t)top, sizeof *key) : NULL, *pv = NULL;
     if (!status && top > 0 && !key) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the top components");
     if (!status) {
-        ends c = {.w = &w, .kept = kept, .N = N, .k = k, .kk = kk, .sgn = sgn, .nonneg = mpos, .R = R, .R0 = R0,
-                  .cut = cut, .D = info->residual_bound, .se0 = N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0),
+        int klo = lower_index(sgn || kk < 0 ? k : kk, K, n);
+        ends c = {.w = &w, .kept = kept, .kept_lo = kept_lo, .N = N, .k = k, .kk = kk, .klo = klo, .sgn = sgn, .nonneg = mpos,
+                  .R = R, .R0 = R0, .cut = cut, .D = info->residual_bound, .se0 = N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0),
                   .fp = rounding_allowance(M, swi, alpha)};
-        if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &c.none);
+        if (N >= 2) {
+            ulam__stop_ci cl;
+            ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &c.none);
+            ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, klo, &cl), c.none.lo = cl.lo; /* signed: the lower end's index */
+        }
         else c.none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
         if (!sgn && N >= 1) hits_interval(kept, N, kk < 0 ? k : kk, 0, R0, &c.none.lo, &c.none.hi);
         double s, a, b;
@@ -764,7 +804,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     }
     free(key), free(pv);
     free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.hit), free(w.hc), free(w.slot), free(w.known);
-    free(r), free(kept);
+    free(r), free(kept), free(kept_lo);
     info->seconds = ulam_now() - t0;
     return status;
 }

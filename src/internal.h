@@ -358,6 +358,27 @@ int ulam__system_rows_check(const ulam_system *s, const ulam_csr *M, const doubl
 /* Why the block holding row i of s failed: ULAM_ESYNTAX with err naming the block and the fault. */
 int ulam__system_row_error(const ulam_system *s, int64_t i, ulam_error *err);
 
+/* What a valid prepared file's header states (src/cache.c): sizes, which arrays it holds, block
+ * size 2^shift rows, the byte offsets of rowptr, colidx, val, b, M^T's three and the checksum
+ * table (0 for an absent array), each part's blocks and first checksum, the table's own hash. */
+typedef struct {
+    int64_t n, ncols, nnz, nblocks[3], first[3];
+    int shift, has_matrix, has_rhs, has_tr;
+    uint64_t off[8], sums_hash, tag[2];
+    double omega;
+} ulam__layout;
+
+/* Check the header at p (its first 1024 bytes; the file is len bytes) and give its layout. */
+int ulam__system_header(const unsigned char *p, uint64_t len, ulam__layout *L, ulam_error *err);
+
+/* 1 when a block (row pointers rp[0 .. rows], entries col, val) has checksum want and holds the
+ * CSR invariants (columns below ncols, rising; values finite and nonzero). */
+int ulam__system_block_ok(const int64_t *rp, int64_t rows, const int32_t *col, const double *val, int64_t ncols,
+                          uint64_t want);
+
+/* XXH3-64 of n bytes (the prepared format's checksum of a b block and of the checksum table). */
+uint64_t ulam__system_hash(const void *p, size_t n);
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -2,11 +2,14 @@
  * (src/bidir.c), or with a dense b the push on b and walks from the index scoring its residual
  * (src/bpush.c), considered by the choice against the walks' leader (rent or buy: it needs M's
  * transpose) with its push capped at half the leader's predicted work, chosen when its own
- * predicted work is below the leader's.  The transpose, the push workspace and the plan memo are
+ * predicted work is below the leader's.  At a fixed budget (--walks, the default 10^5, or --time)
+ * the push on b is considered too, where the range term of the walks' interval would dominate
+ * (fixed_predict).  The transpose, the push workspace and the plan memo are
  * an analysis' (src/analysis.c): the caller's (ulam_analysis_auto_start), made once for all its
  * queries, or one of the run's own. */
 #include "method.h"
 #include "stats.h"
+#include "stop.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -42,8 +45,9 @@ int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao
            (ao && (ao->pin_estimator || (ao->pin_alpha && o->kernel.kernel_alpha != 1.0)));
 }
 
-/* An adjoint query with a rel_err target, nothing pinned it cannot honour, a walk leader to
- * compare with whose predicted work W exceeds nnz(M)/4, and a sparse b. */
+/* An adjoint query with a rel_err target (or a fixed budget and a b for the push on b), nothing
+ * pinned it cannot honour, a walk leader to compare with whose predicted work W exceeds nnz(M)/4,
+ * and a nonzero b. */
 static int applies(const ulam__query *q, int k, char *why, size_t len)
 {
     const ulam_walk_opts *o = q->o;
@@ -55,9 +59,9 @@ static int applies(const ulam__query *q, int k, char *why, size_t len)
     double nnz = (double)ulam_csr_nnz(q->M), W = q->ch->leader_work;
     if (pinned) snprintf(why, len, "not considered: %s", pinned);
     else if (ulam__method_excluded(q, k, why, len)) return 0;
-    else if (!(o->stop.rel_err > 0))
-        snprintf(why, len, "not considered: no --rel-err target (without one auto compares variance x work a walk, "
-                           "which bidirectional has no figure for)");
+    else if (!(o->stop.rel_err > 0) && !ulam_method_bidir_route(q->b, n, q->ao, o))
+        snprintf(why, len, "not considered: no --rel-err target with a sparse b (without one auto compares variance x "
+                           "work a walk, which the reverse push has no figure for)");
     else if (au->chosen < 0) snprintf(why, len, "not considered: no certified walk method to compare with");
     else if (nb == 0) snprintf(why, len, "not considered: b is zero");
     else if (!(W > nnz / 4))
@@ -135,8 +139,9 @@ static int setup(ulam__query *q, const ulam_walk_opts *walk, ulam_error *err)
     return ULAM_OK;
 }
 
-/* Pilot walks of the dense route: one round of the walk solver on the residual. */
-enum { DENSE_PILOT = 1024 };
+/* Pilot walks of the dense route: one round of the walk solver on the residual; at a fixed
+ * budget, at most FIXED_ROUNDS rounds of push and pilot. */
+enum { DENSE_PILOT = 1024, FIXED_ROUNDS = 4 };
 
 /* The dense route's walks' options: adjoint from the index with kernel c's estimator,
  * continuation and exponent (c NULL: o's), the push part q_i as the rule's offset. */
@@ -149,26 +154,38 @@ static ulam_walk_opts dense_walk_opts(const ulam_walk_opts *o, const ulam_auto_c
     return wo;
 }
 
+/* The rule's rmax: max|b| nv / N (N the walks the rule predicts on b, nv = var / (E m)^2 those
+ * the variance alone asks: the range term, linear in max|r|, then asks about what the variance
+ * does). */
+static double rule_rmax(const double *b, int64_t n, double var, double m, double N, double E)
+{
+    double bmax = ulam__bpush_max(b, n), nv = var / (E * m * E * m);
+    return isfinite(N) && N > 0 && nv > 0 ? bmax * fmin(1.0, nv / N) : bmax;
+}
+
 /* The dense route (b has more nonzeros than ulam_method_sparse_limit): the transpose, b pushed
- * down to rmax = max|b| nv / N (N the walks the rule predicts on b, nv = var / (E m)^2 those the
- * variance alone asks: the range term, linear in max|r|, then asks about what the variance
- * does) within max_ops, and a pilot round of the walks on the residual, whose rule (src/stop.c,
- * on the residual's own range) predicts the walks; the plan in ch->bidir.  c: the kernel the
- * walks run with (NULL: o's). */
-static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_candidate *c, double var, double m,
-                      double N, int64_t max_ops, ulam_error *err)
+ * down to rmax within max_ops, and a pilot round of the walks on the residual (into *wr), whose
+ * rule (src/stop.c, on the residual's own range) predicts the walks; the plan in ch->bidir.  c:
+ * the kernel the walks run with (NULL: o's).  Called again on the same run, the push goes on
+ * from where it stopped (its operations counted from the first call, max_ops theirs in all) and
+ * a new pilot runs on the new residual. */
+static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_candidate *c, double rmax,
+                      int64_t max_ops, ulam_walk_result *wr_out, ulam_error *err)
 {
     ulam_run *r = q->run;
     ulam_bidir_plan_info *pl = &q->ch->bidir;
-    int64_t n = q->M->nrows, ops = 0, nnz = ulam_csr_nnz(q->M);
+    int64_t n = q->M->nrows, ops = 0, nnz = ulam_csr_nnz(q->M), pw = 0, ps = 0;
     double E = o->stop.rel_err, t0 = ulam_now();
-    memset(pl, 0, sizeof *pl);
-    r->bq = calloc((size_t)n, sizeof *r->bq), r->br = malloc((size_t)n * sizeof *r->br);
-    int status = r->bq && r->br ? transpose(q, err) : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose and the push on b");
-    if (status) return release(r), status;
-    memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
-    double bmax = ulam__bpush_max(q->b, n), nv = var / (E * m * E * m);
-    double rmax = isfinite(N) && N > 0 && nv > 0 ? bmax * fmin(1.0, nv / N) : bmax;
+    int status = ULAM_OK;
+    if (r->bq && r->br) { /* going on */
+        ops = pl->push.ops, pw = pl->pilot_walks, ps = pl->pilot_steps, t0 -= pl->seconds;
+    } else {
+        memset(pl, 0, sizeof *pl);
+        r->bq = calloc((size_t)n, sizeof *r->bq), r->br = malloc((size_t)n * sizeof *r->br);
+        status = r->bq && r->br ? transpose(q, err) : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose and the push on b");
+        if (status) return release(r), status;
+        memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
+    }
     if ((status = ulam__bpush(r->Mt, rmax, max_ops, r->bq, r->br, &ops)))
         return release(r), ulam__fail(err, status, 0, -1, "memory for the push on b");
     double qi = r->bq[o->query.index];
@@ -183,16 +200,119 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     if (!status) ulam_solver_result(sv, &wr);
     ulam_solver_free(sv);
     if (status) return status;
+    if (wr_out) *wr_out = wr;
     double mt = fabs(qi + wr.estimate + o->stop.rel_err_offset), V = wr.walks ? (double)wr.steps / (double)wr.walks : 0.0;
-    double need = fmax((double)ULAM__REL_MIN, fmax(wr.min_walks, wr.variance / (E * mt * E * mt)));
+    double need = E > 0 ? fmax((double)ULAM__REL_MIN, fmax(wr.min_walks, wr.variance / (E * mt * E * mt)))
+                        : (double)o->stop.max_walks; /* a fixed budget: fixed_predict sets it */
     pl->target = o->query.index, pl->rmax = rmax, pl->balanced = 1, pl->push_part = qi;
     pl->push = (ulam_push_info){.target = o->query.index, .rmax = rmax, .ops = ops, .r_max = ulam__bpush_max(r->br, n)};
-    pl->pilot_walks = wr.walks, pl->pilot_steps = wr.steps, pl->mean_visits = V + 1.0;
+    pl->pilot_walks = pw + wr.walks, pl->pilot_steps = ps + wr.steps, pl->mean_visits = V + 1.0;
     pl->predicted_walks = mt > 0 ? need : INFINITY, pl->step_cost = 1.0;
     pl->predicted_work = ULAM_AUTO_READ * ((double)ops + 2.0 * (double)nnz) +
-                         ((double)wr.walks + pl->predicted_walks) * (V + ULAM_AUTO_WALK);
+                         ((double)pl->pilot_walks + pl->predicted_walks) * (V + ULAM_AUTO_WALK);
     pl->seconds = ulam_now() - t0;
     r->bplan = *pl;
+    return ULAM_OK;
+}
+
+/* A pilot round (DENSE_PILOT walks) of o's walks on b, seed o's ^ salt, into *wr. */
+static int pilot_on(const ulam_csr *M, const double *b, const ulam_walk_opts *o, uint64_t salt, ulam_walk_result *wr,
+                    ulam_error *err)
+{
+    ulam_walk_opts po = *o;
+    po.stop.max_walks = DENSE_PILOT, po.stop.max_seconds = 0, po.stop.interrupt = NULL, po.exec.share = NULL;
+    po.exec.seed = o->exec.seed ^ salt;
+    ulam_solver *sv = NULL;
+    int status = ulam_solver_alloc(M, b, &po, &sv, err);
+    while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
+    if (!status) ulam_solver_result(sv, wr);
+    ulam_solver_free(sv);
+    return status;
+}
+
+/* The 95% interval n walks would give at a pilot's variance and range (R = tail_bound walks
+ * |estimate|, the range its interval used), at a count fixed in advance (src/stop.h): *ci, whose
+ * half is INFINITY when the pilot has no range. */
+static void interval_at(const ulam_walk_result *w, double n, ulam__stop_ci *ci)
+{
+    double R = w->tail_bound * (double)w->walks * fabs(w->estimate);
+    *ci = (ulam__stop_ci){.half = INFINITY, .var_term = INFINITY, .range_term = INFINITY};
+    if (R >= 0 && isfinite(R) && n >= 2 && n < 4e18 && isfinite(w->variance))
+        ulam__stop_interval((int64_t)n, w->estimate, w->variance, R, 0.0, 0.0, INFINITY, 0, ci);
+}
+
+/* A pilot round of the walks leader on b (seed o's ^ salt) on its own solver, which is then set
+ * back to the run's options (ulam__solver_rerun: the same walks as before, bit for bit; its rows,
+ * reachable set and bounds are reused, so the pilot costs its walks alone), into *wr. */
+static int leader_pilot(ulam_run *r, uint64_t salt, ulam_walk_result *wr, ulam_error *err)
+{
+    ulam_walk_opts po = r->o;
+    po.stop.max_walks = DENSE_PILOT, po.stop.max_seconds = 0, po.stop.interrupt = NULL, po.exec.share = NULL;
+    po.exec.seed = r->o.exec.seed ^ salt;
+    int status = ulam__solver_rerun(r->sv, &po, err);
+    while (!status && !ulam_solver_done(r->sv)) status = ulam_solver_iterate(r->sv);
+    if (!status) ulam_solver_result(r->sv, wr);
+    int back = ulam__solver_rerun(r->sv, &r->o, NULL);
+    return status ? status : back;
+}
+
+/* A fixed budget (a walk count, or --time: the walks the work it buys pays for, src/method_walks.c): the leader's
+ * interval at that budget, predicted from a pilot of its own walks on b; where its range term
+ * leads (a large b_j the walks reach rarely), b pushed down to rmax = max|b| times the variance
+ * term over the range term (the range term, linear in max|r|, then about the variance term)
+ * within W / 2 operations, and the walks on the residual piloted; while the residual's range
+ * term still leads (the push lowers the variance too), rmax goes down by the same rule and the
+ * push on (FIXED_ROUNDS at most).  Predicted work: the walks the residual needs for the leader's
+ * interval at the budget (the push, transpose and pilots are spent by then either way); chosen,
+ * it runs the budget's walks (a narrower interval at the same count). */
+static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
+{
+    ulam_choice *ch = q->ch;
+    ulam_method_verdict *v = &ch->method[k];
+    const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
+    double N = q->o->stop.max_walks > 0 ? (double)q->o->stop.max_walks : floor(W / c->work_per_walk);
+    ulam_walk_result wb, wr;
+    int status = q->run->sv ? leader_pilot(q->run, UINT64_C(0x2545f4914f6cdd1d), &wb, err) : ULAM_EINVAL;
+    if (status) return status == ULAM_ENOMEM ? status : ULAM_OK; /* the leader's own run will say why */
+    ulam__stop_ci cb, cr;
+    interval_at(&wb, N, &cb);
+    if (!(cb.range_term > cb.var_term) || !isfinite(cb.half)) {
+        snprintf(v->why, sizeof v->why, "not considered: at %.3g walks the walks' interval is not led by its range "
+                 "term (%.3g, variance term %.3g): a push on b would narrow it little", N, cb.range_term, cb.var_term);
+        return ULAM_OK;
+    }
+    double rmax = ulam__bpush_max(q->b, q->M->nrows) * cb.var_term / cb.range_term;
+    int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
+    ulam_bidir_plan_info *pl = &ch->bidir;
+    for (int round = 1;; round++) { /* the push also lowers the variance: while the residual's range term still
+                                       leads, on down (a pilot a round, FIXED_ROUNDS at most) */
+        if ((status = dense_plan(q, q->o, c, rmax, cap, &wr, err)) == ULAM_ENOMEM) return status;
+        ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = q->run->bwo, ch->bidir_opts.target = q->o->query.index;
+        if (status) {
+            snprintf(v->why, sizeof v->why, "refused: %.250s", err->msg);
+            return ULAM_OK;
+        }
+        interval_at(&wr, N, &cr);
+        if (round >= FIXED_ROUNDS || !(cr.range_term > cr.var_term) || pl->push.ops >= cap || !(pl->push.r_max > 0)) break;
+        rmax = fmin(0.5 * rmax, pl->push.r_max * cr.var_term / cr.range_term);
+    }
+    pl->predicted_walks = N;
+    if (!(cr.half < cb.half)) {
+        snprintf(v->why, sizeof v->why, "lost: at %.3g walks its interval is predicted -+ %.3g, the walks' -+ %.3g", N,
+                 cr.half, cb.half);
+        return ULAM_OK;
+    }
+    double lo_n = 2.0, hi_n = N; /* the least walks whose interval on the residual is the leader's */
+    for (int it = 0; it < 64 && hi_n - lo_n > 1.0; it++) {
+        double mid = floor(0.5 * (lo_n + hi_n));
+        interval_at(&wr, mid, &cr);
+        if (cr.half <= cb.half) hi_n = mid;
+        else lo_n = mid;
+    }
+    double V = wr.walks ? (double)wr.steps / (double)wr.walks : 0.0;
+    pl->predicted_work = hi_n * (V + ULAM_AUTO_WALK); /* from here: the push and pilots are spent either way */
+    q->run->bplan = *pl;
+    v->predicted_work = pl->predicted_work;
     return ULAM_OK;
 }
 
@@ -203,10 +323,17 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     ulam_run *r = q->run;
     double W = ch->leader_work;
     if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o)) { /* the push on b */
+        if (ulam__b_exponent(q->b, q->M->nrows)) { /* its residual walks carry q_i as an offset: not rescaled */
+            snprintf(ch->method[k].why, sizeof ch->method[k].why, "not considered: max|b| is outside 2^-256 .. 2^256 "
+                     "(the walks on the push's residual could not be rescaled: their squares would underflow)");
+            return ULAM_OK;
+        }
+        if (!(q->o->stop.rel_err > 0)) return fixed_predict(q, k, W, err);
         const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
         double m = fabs(c->estimate + q->o->stop.rel_err_offset);
         int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
-        int status = dense_plan(q, q->o, c, c->variance, m, c->predicted_walks, cap, err);
+        double rmax = rule_rmax(q->b, q->M->nrows, c->variance, m, c->predicted_walks, q->o->stop.rel_err);
+        int status = dense_plan(q, q->o, c, rmax, cap, NULL, err);
         if (status == ULAM_ENOMEM) return status;
         ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = r->bwo, ch->bidir_opts.target = q->o->query.index;
         if (status) snprintf(ch->method[k].why, sizeof ch->method[k].why, "refused: %.250s", err->msg);
@@ -254,22 +381,23 @@ static int pin(ulam__query *q, int k, ulam_error *err)
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     if (nb == 0) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero b (b is zero, so x is 0)");
     if (ulam_method_bidir_route(q->b, n, q->ao, q->o)) { /* the push on b, planned from a pilot round on b */
-        if (!(q->o->stop.rel_err > 0))
-            return ulam__fail(err, ULAM_EINVAL, 0, -1, "a --rel-err target for bidirectional with a dense b "
-                                                       "(more than max(16, n/10) = %lld nonzeros)",
+        if (!(q->o->stop.rel_err > 0) && !(q->o->stop.max_walks > 0))
+            return ulam__fail(err, ULAM_EINVAL, 0, -1, "a --rel-err target or a walk count for bidirectional with a "
+                                                       "dense b (more than max(16, n/10) = %lld nonzeros)",
                               (long long)ulam_method_sparse_limit(n));
         ulam_walk_opts po = dense_walk_opts(q->o, NULL, 0.0);
-        po.stop.max_walks = DENSE_PILOT, po.stop.max_seconds = 0, po.stop.interrupt = NULL, po.exec.share = NULL;
-        po.exec.seed = q->o->exec.seed ^ UINT64_C(0x7f4a7c159e3779b9);
-        ulam_solver *sv = NULL;
         ulam_walk_result wr;
-        int status = ulam_solver_alloc(q->M, q->b, &po, &sv, err);
-        while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
-        if (!status) ulam_solver_result(sv, &wr);
-        ulam_solver_free(sv);
+        int status = pilot_on(q->M, q->b, &po, UINT64_C(0x7f4a7c159e3779b9), &wr, err);
         if (status) return status;
-        double m = fabs(wr.estimate + q->o->stop.rel_err_offset);
-        status = dense_plan(q, q->o, NULL, wr.variance, m, wr.min_walks, 100 * ulam_csr_nnz(q->M) + 1000000, err);
+        double m = fabs(wr.estimate + q->o->stop.rel_err_offset), rmax;
+        if (q->o->stop.rel_err > 0) {
+            rmax = rule_rmax(q->b, n, wr.variance, m, wr.min_walks, q->o->stop.rel_err);
+        } else { /* a walk count: as fixed_predict, the range term brought to about the variance term's */
+            ulam__stop_ci ci;
+            interval_at(&wr, (double)q->o->stop.max_walks, &ci);
+            rmax = ulam__bpush_max(q->b, n) * (ci.range_term > ci.var_term && isfinite(ci.half) ? ci.var_term / ci.range_term : 1.0);
+        }
+        status = dense_plan(q, q->o, NULL, rmax, 100 * ulam_csr_nnz(q->M) + 1000000, NULL, err);
         q->ch->bidir_opts = ulam_bidir_defaults(), q->ch->bidir_opts.walk = q->run->bwo;
         return status;
     }

@@ -18,8 +18,22 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     ulam_choice *ch = q->ch;
     int status = ulam__auto_solver_reach(q->M, q->b, q->o, q->ao, q->reach, &ch->walks, &q->run->sv, err);
     const ulam_auto_result *au = &ch->walks;
-    if (au->chosen >= 0) ch->leader_work = ch->method[k].predicted_work = au->cand[au->chosen].predicted_work;
+    if (au->chosen >= 0) {
+        double w = au->cand[au->chosen].predicted_work;
+        const ulam_stop_opts *st = &q->o->stop;
+        if (isnan(w) && !(st->rel_err > 0) && st->max_walks == 0 && st->max_seconds > 0)
+            w = exp2(floor(log2(st->max_seconds / ULAM_AUTO_UNIT_SECONDS))); /* --time alone: the work the time
+                buys at the work model's rate (a constant, not this machine's), rounded down to a power of 2 so that
+                the time a caller has left after its set-up (the CLI's) seldom changes a plan made on it */
+        ch->leader_work = ch->method[k].predicted_work = w;
+    }
     int c = au->chosen >= 0 ? au->chosen : au->closest;
+    if (!status && c < 0) /* no candidate to run, not even the closest: refused, never another row's answer */
+        return ulam__fail(err, au->abs.upper < 1 ? ULAM_EINFVAR : ULAM_EDIVERGE, 0, -1,
+                          "a walk candidate with a finite bound on rho(M^) (none of %d has one; rho(|M|) in [%.3g, "
+                          "%.3g]): M's entries may span too many orders of magnitude; scale its rows and columns, or "
+                          "use 'ulam direct'",
+                          au->ncand, au->abs.lower, au->abs.upper);
     if (c >= 0) {
         ulam_walk_opts *o = &q->run->o;
         o->mode = au->cand[c].mode, o->estimator = au->cand[c].estimator;

@@ -21,6 +21,10 @@ enum { FMT_COORD, FMT_ARRAY };
 enum { FLD_REAL, FLD_INTEGER, FLD_PATTERN };
 enum { SYM_GENERAL, SYM_SYMMETRIC, SYM_SKEW };
 
+/* The longest line read (a Matrix Market line holds a few numbers; a comment rarely more than a
+ * screen): past it the input is refused, never buffered whole (5 GB of zeros with no newline). */
+enum { MM_LINE_MAX = 1 << 20 };
+
 /* A buffered line reader that counts lines. */
 typedef struct {
     FILE *f;
@@ -28,6 +32,7 @@ typedef struct {
     size_t cap, len, pos;
     long line;
     int eof;
+    int toolong;       /* the failure was a line past MM_LINE_MAX, not a NUL byte */
     int64_t size;      /* bytes from the start position to the end of a regular file, or -1 */
     int64_t read_total; /* bytes fread so far */
 } reader;
@@ -111,6 +116,12 @@ static char *reader_next(reader *r, int *status)
             return start;
         }
         if (r->eof) return NULL;
+        /* a line not yet ended: a NUL in it, or more than MM_LINE_MAX bytes, is refused before reading on */
+        if (memchr(start, '\0', r->len - r->pos) || (r->toolong = r->len - r->pos > MM_LINE_MAX)) {
+            r->line++;
+            *status = ULAM_ESYNTAX;
+            return NULL;
+        }
         if ((*status = reader_fill(r)) != ULAM_OK) return NULL;
     }
 }
@@ -118,9 +129,12 @@ static char *reader_next(reader *r, int *status)
 /* A failure of reader_next (status) at the reader's line, with err filled. */
 static int read_failure(const reader *r, int status, ulam_error *err)
 {
+    if (status == ULAM_ESYNTAX && r->toolong)
+        return ulam__fail(err, status, r->line, -1, "a text line of at most %d bytes (this one is longer: the file is "
+                                                    "binary or damaged)", MM_LINE_MAX);
     if (status == ULAM_ESYNTAX)
         return ulam__fail(err, status, r->line, -1, "a text line with no NUL byte (the file is binary or damaged)");
-    return read_failure(r, status, err);
+    return ulam__fail(err, status, r->line, -1, status == ULAM_ENOMEM ? "memory for a line" : "a readable file");
 }
 
 /* Bytes of input not yet handed out as lines, or -1 when unknown (a pipe). */
@@ -512,6 +526,8 @@ static char *span_next(span *s)
             return start;
         }
         if (s->pos == s->end) return NULL;
+        if (s->len - s->at > MM_LINE_MAX || memchr(start, '\0', s->len - s->at))
+            return s->failed = 1, NULL; /* the sequential reader locates it, never buffering past MM_LINE_MAX */
         memmove(s->buf, start, s->len - s->at);
         s->len -= s->at, s->at = 0;
         if (s->cap - s->len < 2) {
@@ -739,6 +755,16 @@ static FILE *open_input(const char *path, ulam_error *err)
  * (*f NULL). */
 static int gunzipped(FILE **f, const char *path, ulam_error *err)
 {
+    struct stat st;
+    if (fstat(fileno(*f), &st) || !S_ISREG(st.st_mode)) { /* a pipe: peek one byte, never rewind */
+        int c = getc(*f);
+        if (c == EOF) return ferror(*f) ? ulam__fail(err, ULAM_EIO, 0, -1, "a readable file (%s)", strerror(errno)) : ULAM_OK;
+        ungetc(c, *f);
+        if (c == 0x1f) /* zlib reads the descriptor, past what stdio has buffered: only a file can be gunzipped */
+            return ulam__fail(err, ULAM_EUNSUPPORTED, 1, -1, "a Matrix Market text stream: %s looks gzip-compressed "
+                                                              "(decompress it into the pipe: zcat FILE.gz)", path);
+        return ULAM_OK;
+    }
     unsigned char m[2];
     size_t got = fread(m, 1, 2, *f);
     rewind(*f);

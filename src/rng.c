@@ -42,3 +42,20 @@ uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound)
     uint64_t frac;
     return ulam__rng_index(r, bound, &frac);
 }
+
+/* splitmix64's finalizer: a bijective mix of 64 bits. */
+static uint64_t mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+/* Uniform double in [0, 1) keyed by (seed, w, t, k): the mix chained over the key's words. */
+double ulam_rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k)
+{
+    uint64_t h = mix64(seed + 0x9e3779b97f4a7c15ULL);
+    h = mix64(h ^ (w + 0x632be59bd9b4e019ULL));
+    h = mix64(h + (t << 2 | (k & 3)) * 0x9e3779b97f4a7c15ULL);
+    return (double)(h >> 11) * 0x1.0p-53;
+}

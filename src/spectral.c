@@ -37,6 +37,30 @@ static void csr_op(const void *ctx, const double *x, double *y)
     ulam_csr_matvec(c->A, c->use_abs, x, y);
 }
 
+/* Balance a (n x n, column-major) by a diagonal similarity D^-1 a D in powers of 2 (Parlett and
+ * Reinsch, as LAPACK's dgebal): the eigenvalues stay, but entries spanning 1e-201 to 1e299 come
+ * within range of each other, where dgeev's own scaling by the largest would flush the smallest to
+ * zero (rho 0 for a radius of 1e49). */
+static void balance(int64_t n, double *a)
+{
+    for (int sweep = 0, changed = 1; changed && sweep < 100; sweep++) {
+        changed = 0;
+        for (int64_t i = 0; i < n; i++) {
+            double c = 0.0, r = 0.0;
+            for (int64_t k = 0; k < n; k++)
+                if (k != i) c += fabs(a[i * n + k]), r += fabs(a[k * n + i]); /* column i, row i */
+            if (c == 0.0 || r == 0.0) continue;
+            int ec, er;
+            frexp(c, &ec), frexp(r, &er);
+            int e = (er - ec) / 2; /* c 2^e and r 2^-e meet halfway */
+            if (abs(e) < 2) continue; /* within a factor 4: balanced enough */
+            double f = ldexp(1.0, e);
+            for (int64_t k = 0; k < n; k++) a[i * n + k] *= f, a[k * n + i] /= f;
+            changed = 1;
+        }
+    }
+}
+
 /* Small n: form the matrix column by column from op(e_j), take all eigenvalues. */
 static int radius_dense(int64_t n, void (*op)(const void *, const double *, double *),
                         const void *ctx, ulam_radius *out)
@@ -54,6 +78,7 @@ static int radius_dense(int64_t n, void (*op)(const void *, const double *, doub
         e[j] = 0.0;
         out->matvecs++;
     }
+    balance(n, a);
     status = ULAM_ENOCONV;
     if (L->dgeev(LAPACK_COL_MAJOR, 'N', 'N', (lapack_int)n, a, (lapack_int)n, wr, wi, NULL, 1,
                       NULL, 1) != 0)

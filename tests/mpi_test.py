@@ -50,6 +50,107 @@ def check_interrupt(ulam, mpirun):
     assert o["interrupted"] is True and o["walks"] >= 0 and o["ranks"] == 2, (out, err)
 
 
+def write_system(d, n, seed):
+    """A random sparse signed M (row and column sums of |M| below 0.6: finite variance both ways, a
+    long cycle i -> i+1 so walks cross ranks) and b as Matrix Market files, prepared with M'."""
+    import random
+    rnd = random.Random(seed)
+    ent = {}
+    for i in range(n):
+        deg = rnd.randint(1, 5)
+        for q in range(deg):
+            j = (i + 1) % n if q == 0 else rnd.randrange(n)
+            ent[(i, j)] = ent.get((i, j), 0.0) + 0.4 / deg * (-1 if rnd.random() < 0.2 else 1)
+    with open(f"{d}/pm.mtx", "w") as f:
+        f.write("%%%%MatrixMarket matrix coordinate real general\n%d %d %d\n" % (n, n, len(ent)))
+        f.writelines("%d %d %.17g\n" % (i + 1, j + 1, v) for (i, j), v in sorted(ent.items()))
+    with open(f"{d}/pb.mtx", "w") as f:
+        f.write("%%%%MatrixMarket matrix array real general\n%d 1\n" % n)
+        f.writelines("%.17g\n" % rnd.random() for _ in range(n))
+    return f"{d}/pm.mtx", f"{d}/pb.mtx"
+
+
+def check_partition(ulam, mpirun, d):
+    """Issue 43: the rows split across 1, 2 and 3 ranks (oversubscribed; and 4 in 2 sets), walks that
+    migrate: the adjoint answer line and the forward --out file byte for byte the same at every rank count, no
+    rank holding every row, walks crossing ranks; x within 4 standard errors of the direct solve; a
+    rank that dies ends the job with a non-zero exit, not a hang."""
+    n = 3000
+    m, b = write_system(d, n, 5)
+    sysf = f"{d}/p.ulam"
+    run([ulam, "prepare", m, "--rhs", b, "--transpose", "-o", sysf])
+    direct = f"{d}/pd.mtx"
+    run([ulam, "direct", m, "--rhs", b, "--out", direct])
+    exact = [float(v) for v in open(direct).read().split("\n")[3:] if v.strip()]
+    lines, files = [], []
+    for k in (1, 2, 3):
+        out = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--index", "1234",
+                   "--walks", "40000", "--seed", "3", "-v"])
+        lines.append(out.splitlines()[0])
+        rows = [l for l in out.splitlines() if l.startswith("ranks")][0].split(";")[0].split()[2:]
+        assert len(rows) == k and sum(map(int, rows)) == n and (k == 1 or max(map(int, rows)) < n), out
+        mig = float([l for l in out.splitlines() if l.startswith("migration")][0].split()[1])
+        assert (mig > 0) == (k > 1), out
+        x = f"{d}/px{k}.mtx"
+        run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--mode", "forward",
+             "--walks", "200000", "--seed", "3", "--out", x, "-q"])
+        files.append(open(x, "rb").read())
+    x = f"{d}/pxs.mtx"  # 4 ranks in 2 sets (replication x partition): the same file again
+    run([mpirun, "--oversubscribe", "-np", "4", ulam, "solve", sysf, "--partition", "--sets", "2", "--mode", "forward",
+         "--walks", "200000", "--seed", "3", "--out", x, "-q"])
+    files.append(open(x, "rb").read())
+    assert lines[0] == lines[1] == lines[2], lines
+    assert files[0] == files[1] == files[2] == files[3], "forward --out files differ across rank counts or sets"
+    est, se = float(lines[0].split()[1]), float(lines[0].split()[3])
+    assert abs(est - exact[1233]) < 4 * se, (lines[0], exact[1233])
+    outer = []  # MCSA (x file) and single source (top-10 table) at 1 and 3 ranks: byte for byte
+    for k in (1, 3):
+        x = f"{d}/pm{k}.mtx"
+        run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--method", "mcsa", "--walks",
+             "20000", "--out", x, "-q"])
+        top = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--source", "77",
+                   "--top", "10", "--walks", "20000", "-q"])
+        outer.append((open(x).read(), top))
+    assert outer[0] == outer[1], "MCSA or single source differ across rank counts"
+    xm = [float(v) for v in outer[0][0].split("\n")[3:] if v.strip()]
+    assert max(abs(a - b) for a, b in zip(xm, exact)) < 1e-6 * max(abs(b) for b in exact), "MCSA's x is off"
+    assert len(outer[0][1].splitlines()) == 10 and outer[0][1].startswith("x[77]"), outer[0][1]
+    qf = f"{d}/pq.txt"  # many queries at once: each line the lone run's with seed + k - 1, at 1 and 3 ranks
+    open(qf, "w").write("1234\n# a comment\n7\n1234\n")
+    qs = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--queries", qf, "--walks",
+               "40000", "--seed", "3", "-q"]) for k in (1, 3)]
+    assert qs[0] == qs[1] and qs[0].splitlines()[0].split("  line")[0] == lines[0], (qs, lines[0])
+    p = subprocess.run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "5"],
+                       capture_output=True, text=True, env=dict(ENV, ULAM_TEST_PARTITION_DIE="1"), timeout=120)
+    assert p.returncode != 0 and not p.stdout, (p.returncode, p.stdout)
+
+
+def check_partition_memory(ulam, mpirun, d):
+    """Issue 43's memory test: forward mode on a 10^6-row system (8 entries a row, a band around the
+    diagonal, |row sums| 0.4), 3 ranks: each rank's peak RSS at most half of one rank's alone (MPI's
+    own memory included), and the same x file."""
+    n, width = 1000000, 8
+    with open(f"{d}/big.mtx", "w") as f:
+        f.write("%%%%MatrixMarket matrix coordinate real general\n%d %d %d\n" % (n, n, n * width))
+        for i in range(1, n + 1):
+            f.write("".join("%d %d %s\n" % (i, (i + k - 1) % n + 1, "-0.05" if k == 3 else "0.05") for k in range(1, width + 1)))
+    with open(f"{d}/bigb.mtx", "w") as f:
+        f.write("%%%%MatrixMarket matrix array real general\n%d 1\n" % n)
+        f.write("1\n" * n)
+    run([ulam, "prepare", f"{d}/big.mtx", "--rhs", f"{d}/bigb.mtx", "--transpose", "-o", f"{d}/big.ulam"])
+    os.unlink(f"{d}/big.mtx")
+    rss, files = [], []
+    for k in (1, 3):
+        out = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", f"{d}/big.ulam", "--partition", "--mode",
+                   "forward", "--walks", "100000", "--out", f"{d}/bx{k}.mtx", "-v"])
+        line = [l for l in out.splitlines() if l.startswith("ranks")][0]
+        rss.append([float(v) for v in line.split("peak RSS MiB")[1].split()])
+        files.append(open(f"{d}/bx{k}.mtx").read())
+    assert files[0] == files[1], "x differs"
+    assert len(rss[1]) == 3 and max(rss[1]) <= 0.5 * rss[0][0], rss
+    return rss
+
+
 def main():
     ulam, mpirun = sys.argv[1], sys.argv[2]
     par = [mpirun, "--oversubscribe", "-np", "2", ulam]
@@ -137,13 +238,25 @@ def main():
             except AssertionError as e:
                 failures += 1
                 print(f"FAIL {name}: {e}")
+        try:
+            check_partition(ulam, mpirun, d)
+            print("ok partition")
+        except AssertionError as e:
+            failures += 1
+            print(f"FAIL partition: {e}")
+        try:
+            rss = check_partition_memory(ulam, mpirun, d)
+            print(f"ok partition memory (peak RSS MiB: 1 rank {rss[0][0]}, 3 ranks {rss[1]})")
+        except AssertionError as e:
+            failures += 1
+            print(f"FAIL partition memory: {e}")
     try:
         check_interrupt(ulam, mpirun)
         print("ok interrupt")
     except AssertionError as e:
         failures += 1
         print(f"FAIL interrupt: {e}")
-    print(f"{len(cases) + 1 - failures} passed, {failures} failed")
+    print(f"{len(cases) + 3 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 

@@ -1,6 +1,7 @@
 /* --method auto's choice (ulam_auto_choose, ulam_auto_solver): screening by certified guards, pins,
  * deterministic racing, and an unbiased estimate from fresh walks with the chosen method on the
  * pilots' solver. */
+#include "systems.h"
 #include "testutil.h"
 
 /* Load matrices/NAME.mtx and its b. */
@@ -479,6 +480,69 @@ static void test_prediction_bound(void **state)
     }
 }
 
+/* The push on b at fixed budgets (issue 38 point 4): M of 2000 states, 5 random entries a row,
+ * row sums 0.9 (examples/systems.h), b = 1 but b_j = 1e6 at the state j whose weight in x_0,
+ * ((I - M)^-1)_0j, is nearest 7.4e-6 (1.24e-5).  Before, the default 10^5 walks printed x_0 = 20.5,
+ * 95% CI -698 .. 739 (x_0 = 22.36: the walks' range term, 1e6 times their weight bound; the issue's
+ * case, -9529 .. 9579), while --rel-err 0.1 pushed b first.  Now auto considers the push on b at a
+ * fixed budget too: at 10^5 walks (the default), 10^4 and --time, it is chosen, and its interval is
+ * under 5% of x_0 at the default (1.5%); over 20 seeds at 10^4 walks the intervals cover (binomial
+ * bound) and are under 10% of x_0 on average (5.3%); the answer is the same on 1 and 2 threads. */
+static void test_push_b_fixed_budget(void **state)
+{
+    (void)state;
+    int64_t n = 2000;
+    ulam_csr *M = random_sparse(n, 5, 0.9, 0, 4), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *e = calloc((size_t)n, sizeof *e), *g = malloc((size_t)n * sizeof *g), *b = malloc((size_t)n * sizeof *b);
+    double *x = malloc((size_t)n * sizeof *x);
+    e[0] = 1.0;
+    assert_int_equal(ulam_direct_solve(Mt, e, g, 0, NULL, NULL), ULAM_OK); /* g_j = ((I - M)^-1)_0j */
+    int64_t j = 1;
+    for (int64_t i = 1; i < n; i++)
+        if (g[i] > 0 && fabs(log(g[i] / 7.4e-6)) < fabs(log(g[j] / 7.4e-6))) j = i;
+    for (int64_t i = 0; i < n; i++) b[i] = i == j ? 1e6 : 1.0;
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    print_message("b_%lld = 1e6 of weight %.3g in x_0 = %.10g\n", (long long)j, g[j], x[0]);
+    ulam_choice *ch = malloc(sizeof *ch);
+    ulam_answer a, a1;
+    ulam_walk_opts o = ulam_walk_defaults(); /* 10^5 walks */
+    assert_int_equal(ulam_auto(M, b, &o, NULL, NULL, ch, &a, NULL), ULAM_OK);
+    double half = 0.5 * (a.ci95[1] - a.ci95[0]);
+    print_message("default: %s, %.10g, 95%% CI %.10g .. %.10g (-+ %.3g%% of x_0)\n", ulam_method_name(ch->chosen),
+                  a.estimate, a.ci95[0], a.ci95[1], 100 * half / x[0]);
+    assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
+    assert_true(a.ci95[0] <= x[0] && x[0] <= a.ci95[1] && half <= 0.05 * x[0]);
+    o.exec.threads = 1;
+    assert_int_equal(ulam_auto(M, b, &o, NULL, NULL, ch, &a1, NULL), ULAM_OK);
+    assert_true(a1.estimate == a.estimate && a1.ci95[0] == a.ci95[0] && a1.ci95[1] == a.ci95[1]);
+    o.exec.threads = 0;
+    int covered = 0, R = 20, lower = (int)ceil(0.95 * R - 4.0 * sqrt(0.95 * 0.05 * R));
+    double width = 0.0;
+    for (int seed = 1; seed <= R; seed++) {
+        o.stop.max_walks = 10000, o.exec.seed = (uint64_t)seed;
+        assert_int_equal(ulam_auto(M, b, &o, NULL, NULL, ch, &a, NULL), ULAM_OK);
+        assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
+        assert_int_equal(a.walks.walks, 10000);
+        covered += a.ci95[0] <= x[0] && x[0] <= a.ci95[1];
+        width += 0.5 * (a.ci95[1] - a.ci95[0]) / R;
+    }
+    print_message("10^4 walks: %d of %d cover (at least %d), mean half-width %.3g%% of x_0\n", covered, R, lower,
+                  100 * width / x[0]);
+    assert_true(covered >= lower && width <= 0.1 * x[0]);
+    ulam_method_opts mo = ulam_method_defaults(); /* the row pinned, at a walk count (was: refused without --rel-err) */
+    mo.method = ULAM_METHOD_BIDIRECTIONAL, o.exec.seed = 1;
+    assert_int_equal(ulam_auto(M, b, &o, NULL, &mo, ch, &a, NULL), ULAM_OK);
+    assert_true(a.walks.walks == 10000 && a.ci95[0] <= x[0] && x[0] <= a.ci95[1] && a.bidir.push.ops > 0);
+    o = ulam_walk_defaults(); /* --time alone: the walks the time buys at the work model's rate (no clock) */
+    o.stop.max_walks = 0, o.stop.max_seconds = 0.05;
+    assert_int_equal(ulam_auto(M, b, &o, NULL, NULL, ch, &a, NULL), ULAM_OK);
+    assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
+    assert_true(isfinite(a.ci95[0]) && isfinite(a.ci95[1]));
+    free(e), free(g), free(b), free(x), free(ch);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -489,6 +553,7 @@ int main(void)
         cmocka_unit_test(test_table),
         cmocka_unit_test(test_solve_is_cli),
         cmocka_unit_test(test_prediction_bound),
+        cmocka_unit_test(test_push_b_fixed_budget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -24,7 +24,12 @@ int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, c
         snprintf(v->why, sizeof v->why, "not considered: %s", excluded_why);
     const ulam_auto_result *res = &ch->walks;
     int k = res->chosen >= 0 ? res->chosen : res->closest;
-    if (k < 0) return cli_report(s->matrix_path, err);
+    if (k < 0 && !*status) /* no walk candidate and no refusal: never run (nor label) another row's answer */
+        *status = err->status = ULAM_EINVAL, snprintf(err->msg, sizeof err->msg, "a walk candidate to run");
+    if (k < 0) {
+        int rc = cli_report(s->matrix_path, err);
+        return *status == ULAM_EDIVERGE ? EXIT_DIVERGE : *status == ULAM_EINFVAR ? EXIT_INFVAR : rc;
+    }
     const ulam_auto_candidate *c = &res->cand[k];
     if (res->chosen < 0) {
         int diverge = !(res->abs.upper < 1);

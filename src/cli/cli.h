@@ -135,6 +135,10 @@ double cli_time_left(double budget);
 void cli_mpi_init(int *argc, char ***argv);
 void cli_mpi_finalize(void);
 
+/* The exchange between mpirun's ranks for a partitioned run (src/cli/mpi.c); unchanged alone. */
+struct ulam_comm;
+void cli_mpi_comm(struct ulam_comm *c);
+
 /* Signals and temporary files: every output is written to a temporary file (NAME.tmp.XXXXXX)
  * opened by cli_outfile_open, which registers it, and renamed into place by cli_outfile_commit
  * (or removed by cli_outfile_abort), which forget it; SIGINT, SIGTERM and SIGHUP remove every
@@ -193,6 +197,9 @@ void cli_print_z(double estimate, double direct, double std_error, double lo, do
 
 /* Print a power-iteration radius with its bounds (no newline). */
 void cli_print_power(const ulam_power *p);
+
+/* A radius in words (cli_print_power's figures): buf of 32 characters, returned. */
+const char *cli_radius_str(char *buf, double x);
 
 /* The guards' radii for a walk in mode on s with kernel exponent alpha (rho(|M|) and that mode's
  * rho(M^), stopped once certified): a prepared file's certificate made for this continuation
@@ -263,13 +270,28 @@ typedef struct cli_solve_row {
 } cli_solve_row;
 
 /* The rows: bidirectional (src/cli/bidir.c), the outer iterations and Krylov peers
- * (src/cli/mcsa.c), the walks with auto (src/cli/solve.c). */
+ * (src/cli/mcsa.c), the walks with auto (src/cli/solve.c); --partition (below). */
 extern const cli_solve_row cli_solve_bidir_row, cli_solve_outer_row, cli_solve_walks_row;
+
+/* The rows split across MPI ranks, walks that migrate (--partition, src/cli/partition.c). */
+extern const cli_solve_row cli_solve_partition_row;
 
 /* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print
  * its report with the choice; 0 or an exit code. */
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
                        const char *direct_method, double load_seconds);
+
+/* One line of a query file: source (0-based; -1: b), index (0-based), target (0: the command
+ * line's), line. */
+typedef struct cli_query {
+    int64_t source, index;
+    double target;
+    long line;
+} cli_query;
+
+/* Read every query of path ("-": stdin) into *out (*nq of them, malloc'd); 0 or an exit code
+ * (reported with the file and line). */
+int cli_read_queries(const char *path, cli_query **out, int64_t *nq);
 
 /* ulam solve --queries FILE (src/cli/queries.c): s (not loaded) and o from the command line
  * (adjoint), json, walks_given (--walks or --time given); 0 or an exit code. */
@@ -290,9 +312,24 @@ int cli_study(int argc, char **argv);
 int cli_radiosity(int argc, char **argv);
 int cli_prepare(int argc, char **argv);
 
+/* Remember (on 1) or forget (on 0) the mapping of the prepared system s read from path: a SIGBUS
+ * in it (the file shrank while in use) is reported as that file's error, exit 13. */
+void cli_map_register(const ulam_system *s, const char *path, int on);
+
 /* Check before any work that path can be written (a temporary file beside it, not a directory);
  * 0 or an exit code (reported). */
 int cli_check_output(const char *path);
+
+/* A file a run names: the option that names it ("--out"; the input's own name for an input)
+ * and its path (NULL: not given). */
+typedef struct {
+    const char *opt, *path;
+} cli_file;
+
+/* Check the nout outputs (cli_check_output each), then refuse (usage error, EXIT_USAGE) an output
+ * that is one of the nin inputs (the same file: same device and inode, through any path, link
+ * or symlink) or another output of this run; 0 or the exit code (reported). */
+int cli_check_outputs(const char *command, const cli_file *outs, int nout, const cli_file *ins, int nin);
 
 /* A progress line on stderr for a terminal (nothing on a pipe, with --json, or off rank 0). */
 typedef struct cli_progress {

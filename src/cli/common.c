@@ -115,11 +115,67 @@ static void catch(int sig, void (*h)(int))
     sigaction(sig, &sa, NULL);
 }
 
-/* Remove the temporary files on SIGINT, SIGTERM and SIGHUP, in every phase. */
+/* The mapped prepared files (cli_map_register): a SIGBUS inside one is that file shrinking. */
+enum { CLI_MAPS = 8 };
+static struct {
+    const char *path;
+    const char *addr;
+    size_t bytes;
+} cli_maps[CLI_MAPS];
+
+/* Write s to stderr from a signal handler (async-signal-safe). */
+static void say(const char *s)
+{
+    for (size_t n = strlen(s); n;) {
+        ssize_t w = write(2, s, n);
+        if (w <= 0) return;
+        s += w, n -= (size_t)w;
+    }
+}
+
+/* SIGBUS: a read of a mapped prepared file past its end, which shrank under ulam (truncated, or
+ * replaced in place by cp): say which file, remove the temporary files and exit with ULAM_EIO's
+ * code, nothing printed from it.  Any other SIGBUS dies as the default action would. */
+static void on_bus(int sig, siginfo_t *si, void *ctx)
+{
+    (void)ctx;
+    const char *a = si ? (const char *)si->si_addr : NULL;
+    for (int k = 0; a && k < CLI_MAPS; k++)
+        if (cli_maps[k].path && a >= cli_maps[k].addr && a < cli_maps[k].addr + cli_maps[k].bytes) {
+            say("ulam: "), say(cli_maps[k].path);
+            say(": error: file cannot be opened, read or written: expected a prepared file that stays whole while "
+                "in use (it shrank under ulam: truncated, or replaced in place; replace it by renaming a new file "
+                "over it)\n");
+            remove_tmps();
+            _exit(cli_exit_code(ULAM_EIO));
+        }
+    signal(sig, SIG_DFL);
+}
+
+/* Remember (on 1) or forget (on 0) the mapping of s, read from path, for on_bus. */
+void cli_map_register(const ulam_system *s, const char *path, int on)
+{
+    const void *addr;
+    size_t bytes;
+    ulam_system_mapping(s, &addr, &bytes);
+    if (!addr) return;
+    for (int k = 0; k < CLI_MAPS; k++)
+        if (on ? !cli_maps[k].path : cli_maps[k].addr == addr) {
+            cli_maps[k].addr = addr, cli_maps[k].bytes = bytes;
+            cli_maps[k].path = on ? path : NULL;
+            return;
+        }
+}
+
+/* Remove the temporary files on SIGINT, SIGTERM and SIGHUP, in every phase; report SIGBUS in a
+ * mapped prepared file. */
 void cli_signals_init(void)
 {
     cli_main_thread = pthread_self();
     catch(SIGINT, on_fatal), catch(SIGTERM, on_fatal), catch(SIGHUP, on_fatal);
+    struct sigaction sa = {.sa_sigaction = on_bus, .sa_flags = SA_SIGINFO};
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGBUS, &sa, NULL);
 }
 
 /* SIGINT (and SIGTERM under MPI, which mpirun sends every rank on Ctrl-C): the first asks the
@@ -500,6 +556,9 @@ int cli_load_system(cli_system *s)
                                s->matrix_path);
     int status = read_input(s->matrix_path, s->cache, &s->sys_M, &s->own_M, NULL, NULL, &err);
     if (status) return cli_report(s->matrix_path, &err);
+    cli_map_register(s->sys_M, s->matrix_path, 1);
+    /* test hook (tests/hostile_test.py): stop once the file is mapped, before its arrays are read */
+    if (s->sys_M && getenv("ULAM_TEST_STOP_AT_MAP")) raise(SIGSTOP);
     const ulam_csr *mapped = NULL;
     const double *mapped_b = NULL;
     ulam_system_lazy(s->sys_M, &mapped, &mapped_b); /* verified below, or as walks read it (lazy) */
@@ -519,6 +578,7 @@ int cli_load_system(cli_system *s)
             cli_system_free(s);
             return cli_report(s->rhs_path, &err);
         }
+        cli_map_register(s->sys_b, s->rhs_path, 1);
         const double *vb = NULL;
         ulam_system_lazy(s->sys_b, NULL, &vb);
         if (s->sys_b) ulam_system_rhs(s->sys_b, &nb);
@@ -557,6 +617,7 @@ void cli_system_free(cli_system *s)
     s->own_M = ulam_csr_free(s->own_M);
     free(s->own_b);
     s->own_b = NULL;
+    cli_map_register(s->sys_M, NULL, 0), cli_map_register(s->sys_b, NULL, 0);
     s->sys_M = ulam_system_free(s->sys_M);
     s->sys_b = ulam_system_free(s->sys_b);
     s->M = NULL, s->b = NULL, s->cert = NULL;
@@ -644,6 +705,50 @@ int cli_check_output(const char *path)
     ulam_error err = {.status = status, .msg = "a writable output file (in an existing, writable directory; not a "
                                                "directory)"};
     return cli_report(path, &err);
+}
+
+/* path's file as (device, inode) when it exists, and as its directory's real path and its own
+ * name (an output not yet made); 0 when neither can be had. */
+static int file_id(const char *path, struct stat *st, int *exists, char *canon, size_t len)
+{
+    *exists = stat(path, st) == 0;
+    const char *slash = strrchr(path, '/');
+    char dir[4096], real[4096];
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash == path ? 1 : slash - path) : 1, slash ? path : ".");
+    if (!realpath(dir, real)) return *exists;
+    snprintf(canon, len, "%s/%s", real, slash ? slash + 1 : path);
+    return 1;
+}
+
+/* Whether the files a and b are one (same inode, or the same canonical name). */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    int ea, eb;
+    char ca[8400] = "", cb[8400] = "";
+    if (!file_id(a, &sa, &ea, ca, sizeof ca) || !file_id(b, &sb, &eb, cb, sizeof cb)) return !strcmp(a, b);
+    if (ea && eb) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    return ca[0] && !strcmp(ca, cb);
+}
+
+int cli_check_outputs(const char *command, const cli_file *outs, int nout, const cli_file *ins, int nin)
+{
+    for (int k = 0; k < nout; k++) {
+        if (!outs[k].path) continue;
+        for (int i = 0; i < nin; i++)
+            if (ins[i].path && same_file(outs[k].path, ins[i].path))
+                return cli_usage_error(command, "%s %s is %s %s: writing it would replace an input; choose another path",
+                                       outs[k].opt, outs[k].path, ins[i].opt, ins[i].path);
+        for (int j = 0; j < k; j++)
+            if (outs[j].path && same_file(outs[k].path, outs[j].path))
+                return cli_usage_error(command, "%s %s is also %s %s: one would overwrite the other; choose two paths",
+                                       outs[k].opt, outs[k].path, outs[j].opt, outs[j].path);
+    }
+    for (int k = 0; k < nout; k++) {
+        int rc = outs[k].path ? cli_check_output(outs[k].path) : 0;
+        if (rc) return rc;
+    }
+    return 0;
 }
 
 /* Start a progress line: only on a terminal, never with --json, only on rank 0. */

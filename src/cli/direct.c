@@ -201,7 +201,8 @@ int cli_direct(int argc, char **argv)
     if (optind != argc - 1) return cli_usage_error("direct", "expects exactly one matrix file");
     if (!s.rhs_path && !s.pagerank && !ulam_system_is_file(argv[optind])) return cli_need_rhs("direct", argv[optind]);
     s.matrix_path = argv[optind];
-    if (out && (rc = cli_check_output(out))) return rc;
+    const cli_file outs[] = {{"--out", out}}, ins[] = {{"the matrix", s.matrix_path}, {"--rhs", s.rhs_path}};
+    if ((rc = cli_check_outputs("direct", outs, 1, ins, 2))) return rc;
     if ((rc = cli_load_system(&s))) return rc;
     if (!s.b) {
         cli_system_free(&s);

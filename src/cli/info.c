@@ -55,7 +55,8 @@ static void print_text(const cli_system *s, const ulam_csr_stats *st, const ulam
     printf("signs            %s\n", st->nonnegative ? "nonnegative" : "mixed (weights carry signs)");
     printf("row sums of |M|  min %.6g, max %.6g\n", st->abs_rowsum_min, st->abs_rowsum_max);
     printf("substochastic    %s\n", st->substochastic ? "yes" : "no");
-    printf("rho(M)           %.6f (residual %.1e, %d matvecs%s)\n", r->rho, r->residual, r->matvecs,
+    char rho[32];
+    printf("rho(M)           %s (residual %.1e, %d matvecs%s)\n", cli_radius_str(rho, r->rho), r->residual, r->matvecs,
            r->converged ? "" : ", NOT converged");
     printf("rho(|M|)         ");
     cli_print_power(&g->abs);

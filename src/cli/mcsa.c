@@ -371,7 +371,8 @@ static int start_run(void *q, int argc, char **argv, int optind)
     if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
     if (!s.rhs_path) return cli_usage_error("solve", "needs --rhs b.mtx");
     s.matrix_path = argv[optind];
-    if (out && (rc = cli_check_output(out))) return rc;
+    const cli_file outs[] = {{"--out", out}}, ins[] = {{"the matrix", s.matrix_path}, {"--rhs", s.rhs_path}};
+    if ((rc = cli_check_outputs("solve", outs, 1, ins, 2))) return rc;
     if ((rc = cli_load_system(&s))) return rc;
     p.index = s.index;
     o.walk.exec.share = cli_share, o.walk.stop.interrupt = &cli_interrupted;

@@ -4,6 +4,7 @@
 #include "cli.h"
 
 #include <mpi.h>
+#include "ulam_dist.h"
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -56,4 +57,48 @@ void cli_mpi_init(int *argc, char ***argv)
 void cli_mpi_finalize(void)
 {
     if (started) MPI_Finalize();
+}
+
+/* The exchange of ulam_comm as MPI_Alltoall of the counts and MPI_Alltoallv of the bytes. */
+static int alltoallv(void *ctx, const void *send, const size_t *sendcounts, void **recv, size_t *recvcounts)
+{
+    (void)ctx;
+    int k = share.nranks, bad = 0;
+    int *sc = calloc((size_t)k * 4, sizeof *sc);
+    if (!sc) return 1;
+    int *sd = sc + k, *rc = sc + 2 * k, *rd = sc + 3 * k;
+    size_t at = 0, total = 0;
+    for (int r = 0; r < k; r++) {
+        if (sendcounts[r] > (size_t)INT32_MAX || at > (size_t)INT32_MAX) bad = 1;
+        sc[r] = (int)sendcounts[r], sd[r] = (int)at, at += sendcounts[r];
+    }
+    if (MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, MPI_COMM_WORLD) != MPI_SUCCESS) bad = 1;
+    for (int r = 0; r < k && !bad; r++) {
+        if (rc[r] < 0 || total > (size_t)INT32_MAX) bad = 1;
+        rd[r] = (int)total, total += (size_t)rc[r], recvcounts[r] = (size_t)rc[r];
+    }
+    char *buf = bad ? NULL : malloc(total ? total : 1);
+    if (!bad && (!buf || MPI_Alltoallv(send, sc, sd, MPI_BYTE, buf, rc, rd, MPI_BYTE, MPI_COMM_WORLD) != MPI_SUCCESS))
+        bad = 1; /* (a rank past 2^31 bytes or out of memory ends the job through MPI's error handler) */
+    free(sc);
+    if (bad) {
+        free(buf);
+        return 1;
+    }
+    *recv = buf;
+    return 0;
+}
+
+/* The sum of ulam_comm as MPI_Allreduce. */
+static int allreduce(void *ctx, int64_t *v, int n)
+{
+    (void)ctx;
+    return MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD) != MPI_SUCCESS;
+}
+
+/* This process's rank and the exchange, for a partitioned run (one rank without mpirun). */
+void cli_mpi_comm(ulam_comm *c)
+{
+    if (!started) return;
+    c->rank = share.rank, c->nranks = share.nranks, c->exchange = alltoallv, c->sum = allreduce;
 }

@@ -55,6 +55,8 @@ int cli_prepare(int argc, char **argv)
     if (optind != argc - 1) return cli_usage_error("prepare", "expects exactly one matrix file");
     if (!out) return cli_usage_error("prepare", "needs -o SYSTEM.ulam");
     s.matrix_path = argv[optind];
+    const cli_file outs[] = {{"-o", out}}, ins[] = {{"the matrix", s.matrix_path}, {"--rhs", s.rhs_path}};
+    if ((rc = cli_check_outputs("prepare", outs, 1, ins, 2))) return rc;
     ulam_outfile o;
     ulam_error err = {.msg = "a writable output file"};
     int status = cli_outfile_open(&o, out); /* checked before the work */

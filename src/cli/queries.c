@@ -19,12 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* One query: source (0-based; -1: b), index (0-based), target (0: the command line's), line. */
-typedef struct {
-    int64_t source, index;
-    double target;
-    long line;
-} query;
+typedef cli_query query;
 
 /* Nonzero when token t is written as a real (a point or an exponent), not an index. */
 static int real_token(const char *t)
@@ -64,7 +59,7 @@ static int parse_line(char *text, query *q, const char **why)
 }
 
 /* Read every query of path ("-": stdin) into *out (*nq of them); 0 or an exit code. */
-static int read_queries(const char *path, query **out, int64_t *nq)
+int cli_read_queries(const char *path, query **out, int64_t *nq)
 {
     FILE *f = strcmp(path, "-") ? fopen(path, "r") : stdin;
     if (!f) {
@@ -203,7 +198,7 @@ int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int js
 {
     query *q = NULL;
     int64_t nq = 0;
-    int rc = read_queries(path, &q, &nq), need_b = 0;
+    int rc = cli_read_queries(path, &q, &nq), need_b = 0;
     for (int64_t k = 0; k < nq; k++) need_b |= q[k].source < 0;
     s->lazy = 1;
     if (!rc) rc = cli_load_system(s);

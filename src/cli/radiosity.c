@@ -1483,15 +1483,17 @@ int cli_radiosity(int argc, char **argv)
     if (a.image) { /* the PFM beside the PNG: out.png -> out.pfm */
         size_t len = strlen(a.image);
         int png = len > 4 && !strcmp(a.image + len - 4, ".png");
-        if (len + 5 > sizeof a.hdr) return cli_usage_error("radiosity", "--image: a path shorter than 4 KiB");
+        if (len + 5 > sizeof a.hdr) {
+            rc = cli_usage_error("radiosity", "--image: a path shorter than 4 KiB");
+            goto done; /* every early exit frees what parse() made (--at's list: the 48-byte leak) */
+        }
         snprintf(a.hdr, sizeof a.hdr, "%.*s.pfm", (int)(png ? len - 4 : len), a.image);
         snprintf(a.rgbe, sizeof a.rgbe, "%.*s.hdr", (int)(png ? len - 4 : len), a.image);
     }
-    if (a.image && (rc = cli_check_output(a.image))) return rc;
-    if (a.image && !a.grid && (rc = cli_check_output(a.hdr))) return rc;
-    if (a.image && !a.grid && (rc = cli_check_output(a.rgbe))) return rc;
-    if (a.out && (rc = cli_check_output(a.out))) return rc;
-    if ((rc = load_scene(&a, &s, &r.faces))) return rc;
+    const cli_file outs[] = {{"--image", a.image}, {"--image's PFM", a.image && !a.grid ? a.hdr : NULL},
+                             {"--image's HDR", a.image && !a.grid ? a.rgbe : NULL}, {"--out", a.out}},
+                   ins[] = {{"the scene", a.scene}};
+    if ((rc = cli_check_outputs("radiosity", outs, 4, ins, 1)) || (rc = load_scene(&a, &s, &r.faces))) goto done;
     if (a.mesh_target > 0 && (rc = adapt_scene(&a, &s, &r.adapt, &r.view_importance, &r.adapt_cap))) goto done;
     r.adapted = a.mesh_target > 0;
     r.s = s;

@@ -575,7 +575,8 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
     int rc;
     /* read only the rows walks reach; auto does on a prepared system (see certified_auto) */
     s->lazy = o->mode == ULAM_ADJOINT && !cli_share && (!a->autom || ulam_system_is_file(s->matrix_path));
-    if ((a->out && (rc = cli_check_output(a->out))) || (a->errors && (rc = cli_check_output(a->errors)))) return rc;
+    const cli_file outs[] = {{"--out", a->out}, {"--errors", a->errors}}, ins[] = {{"the matrix", s->matrix_path}, {"--rhs", s->rhs_path}};
+    if ((rc = cli_check_outputs("solve", outs, 2, ins, 2))) return rc;
     double t0 = ulam_now();
     if ((rc = cli_load_system(s))) return rc;
     if (!s->b) {
@@ -670,6 +671,13 @@ static int run(solve_args *a)
     if (rc) {
         a->an = ulam_analysis_free(a->an);
         return rc;
+    }
+    if (!sv && ch.chosen != ULAM_METHOD_BIDIRECTIONAL) { /* no solver and not bidirectional: nothing to label */
+        fprintf(stderr, "ulam: %s: error: --method auto chose no method it can run\n", s->matrix_path);
+        ulam_run_free(rn);
+        a->an = ulam_analysis_free(a->an);
+        cli_system_free(&a->s);
+        return cli_exit_code(ULAM_EINVAL);
     }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
         rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_method_bidir_route(a->s.b, a->s.M->nrows, &a->ao, &a->o), ro.json, ro.check, ro.direct, ro.direct_method, ro.load_seconds);

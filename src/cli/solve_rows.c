@@ -8,7 +8,8 @@
 #include <string.h>
 
 /* The rows in the order they are tried; the last is the default. */
-static const cli_solve_row *const rows[] = {&cli_solve_bidir_row, &cli_solve_outer_row, &cli_solve_walks_row};
+static const cli_solve_row *const rows[] = {&cli_solve_partition_row, &cli_solve_bidir_row, &cli_solve_outer_row,
+                                            &cli_solve_walks_row};
 
 enum { NROWS = sizeof rows / sizeof rows[0], MAXOPTS = 128, BASE = 0x200 };
 

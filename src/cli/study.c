@@ -177,6 +177,24 @@ static const char *num(char buf[32], double v)
     return buf;
 }
 
+/* The fields of a runs.csv line: name, budget, repeat, estimate, stderr and seconds; a run with
+ * no estimate (both fields empty) gives NaN for them.  1 when the line is whole. */
+static int run_fields(const char *line, char name[64], double *budget, int *r, double *e, double *se, double *sec)
+{
+    char est[64], err[64];
+    if (sscanf(line, "%63[^,],%lf,%d,%*u,%63[^,],%63[^,],%*[^,],%*d,%*d,%lf", name, budget, r, est, err, sec) == 6) {
+        char *end1, *end2;
+        *e = strtod(est, &end1), *se = strtod(err, &end2);
+        return *end1 == '\0' && *end2 == '\0' && isfinite(*e) && isfinite(*se) && isfinite(*sec);
+    }
+    /* a failed run: ",," where the estimate and stderr (and the error) would be */
+    if (sscanf(line, "%63[^,],%lf,%d,%*u,,,,%*d,%*d,%lf", name, budget, r, sec) == 4 && isfinite(*sec)) {
+        *e = *se = NAN;
+        return 1;
+    }
+    return 0;
+}
+
 /* Keep the finished rows of an earlier run of this study (a torn line, left by an older
  * version that appended, is dropped). */
 static void resume(study *st, const char *path)
@@ -190,8 +208,7 @@ static void resume(study *st, const char *path)
         if (len == 0 || line[len - 1] != '\n') break;
         double budget, e, se, sec;
         int r;
-        if (sscanf(line, "%63[^,],%lf,%d,%*u,%lf,%lf,%*f,%*d,%*d,%lf", name, &budget, &r, &e, &se, &sec) == 6 &&
-            isfinite(e) && isfinite(se) && isfinite(sec))
+        if (run_fields(line, name, &budget, &r, &e, &se, &sec))
             for (int m = 0; m < NMETHOD; m++)
                 for (int b = 0; b < st->nbudget; b++)
                     if (!strcmp(st->m[m].name, name) && st->budget[b] == budget && r >= 0 && r < st->repeats) {
@@ -223,7 +240,10 @@ static int save_runs(const study *st)
     return status ? cli_report(path, &e) : 0;
 }
 
-/* One run; 0 when it finished (not interrupted) and was recorded. */
+/* One run; 0 when it finished (not interrupted) and was recorded.  A run that ends with no estimate
+ * (the solver refused or failed, fewer than 2 walks, or no standard error: forward walks that never
+ * reached x_I) is recorded as a failure of the method at that budget, its fields empty: never
+ * dropped, so that every cell counts all its runs. */
 static int one_run(study *st, int m, int b, int r)
 {
     const method *me = &st->m[m];
@@ -235,9 +255,18 @@ static int one_run(study *st, int m, int b, int r)
     if (st->time_budgets) o.stop.max_walks = 0, o.stop.max_seconds = st->budget[b];
     else o.stop.max_walks = (int64_t)st->budget[b];
     ulam_walk_result res;
-    if (ulam_solve_walks(st->s.M, st->s.b, &o, &res, NULL) || res.interrupted || res.walks < 2 || !isfinite(res.std_error))
-        return 1; /* nothing non-finite reaches runs.csv */
+    int status = ulam_solve_walks(st->s.M, st->s.b, &o, &res, NULL);
+    if (res.interrupted || cli_interrupted) return 1; /* not a run: it is made again on resuming */
     char line[512];
+    if (status || res.walks < 2 || !isfinite(res.std_error) || !isfinite(res.estimate)) {
+        snprintf(line, sizeof line, "%s,%.17g,%d,%llu,,,,%lld,%lld,%.6g,0\n", me->name, st->budget[b], r,
+                 (unsigned long long)o.exec.seed, (long long)res.walks, (long long)res.steps,
+                 isfinite(res.seconds) ? res.seconds : 0.0);
+        size_t i = at(st, m, b, r);
+        if (!(st->row[i] = strdup(line))) return 1;
+        st->est[i] = st->se[i] = NAN, st->sec[i] = isfinite(res.seconds) ? res.seconds : 0.0, st->done[i] = 1;
+        return 0;
+    }
     snprintf(line, sizeof line, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", me->name, st->budget[b], r,
              (unsigned long long)o.exec.seed, res.estimate, res.std_error, fabs(res.estimate - st->exact),
              (long long)res.walks, (long long)res.steps, res.seconds,
@@ -480,30 +509,39 @@ static int references(study *st)
 
 /* What R runs of one method at one budget say, against the exact value. */
 typedef struct {
-    int runs;
+    int runs;           /* every finished run, those with no estimate too */
+    int failed;         /* runs that ended with no estimate (a failure of the method at this budget) */
     double rmse;        /* sqrt(mean (estimate - exact)^2) */
     double mean_stderr; /* the mean reported standard error */
     double honesty;     /* rmse / mean_stderr: 1 when the error bars are honest */
-    double coverage;    /* share of runs whose 95% interval holds the exact value */
+    double coverage;    /* share of runs whose 95% interval holds the exact value (a failed run holds nothing) */
     double seconds;     /* mean seconds per run */
-    double work;        /* work-normalised variance rmse^2 x seconds (lower is better) */
+    double work;        /* work-normalised variance rmse^2 x seconds (lower is better; infinite with a
+                           failed run: such a cell never wins) */
 } cell;
 
-/* Summarise n runs (arrays of n) against the exact value into *out. */
+/* Summarise n runs (arrays of n; a NaN estimate: a run with no estimate) against the exact value
+ * into *out: RMSE and stderr over the runs with an estimate, coverage over all n. */
 static void cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
                          double exact, cell *out)
 {
     double se2 = 0, se = 0, t = 0;
-    int covered = 0;
+    int covered = 0, failed = 0;
     for (int k = 0; k < n; k++) {
+        t += seconds[k];
+        if (isnan(estimate[k])) {
+            failed++;
+            continue;
+        }
         double e = estimate[k] - exact;
-        se2 += e * e, se += std_error[k], t += seconds[k];
+        se2 += e * e, se += std_error[k];
         covered += fabs(e) <= ULAM_Z95 * std_error[k];
     }
-    double N = n > 0 ? n : 1;
-    *out = (cell){.runs = n, .rmse = sqrt(se2 / N), .mean_stderr = se / N, .coverage = covered / N, .seconds = t / N};
+    double N = n > 0 ? n : 1, G = n - failed > 0 ? n - failed : NAN;
+    *out = (cell){.runs = n, .failed = failed, .rmse = sqrt(se2 / G), .mean_stderr = se / G, .coverage = covered / N,
+                  .seconds = t / N};
     out->honesty = out->mean_stderr > 0 ? out->rmse / out->mean_stderr : INFINITY;
-    out->work = out->rmse * out->rmse * out->seconds;
+    out->work = failed ? INFINITY : out->rmse * out->rmse * out->seconds;
 }
 
 /* The summary c of method m's finished runs at budget b (e: scratch for 3 x repeats doubles);
@@ -534,7 +572,7 @@ static int summarise(study *st)
         return cli_report(path[k - 1], &err);
     }
     FILE *f = o[0].f, *g = o[1].f;
-    fprintf(f, "method,budget,runs,rmse,mean_stderr,honesty,coverage,seconds,work,variance_finite\n");
+    fprintf(f, "method,budget,runs,rmse,mean_stderr,honesty,coverage,seconds,work,variance_finite,failed\n");
     fprintf(g, "method,work,coverage,honesty,coverage_lo,coverage_hi,covered,runs\n");
     double *e = malloc((size_t)st->repeats * 3 * sizeof *e);
     for (int m = 0; m < NMETHOD && e; m++) {
@@ -543,9 +581,9 @@ static int summarise(study *st)
         for (int b = 0; b < st->nbudget; b++) {
             cell c;
             if (!method_cell(st, m, b, e, &c)) continue;
-            fprintf(f, "%s,%.17g,%d,%s,%s,%s,%s,%s,%s,%s\n", st->m[m].name, st->budget[b], c.runs,
+            fprintf(f, "%s,%.17g,%d,%s,%s,%s,%s,%s,%s,%s,%d\n", st->m[m].name, st->budget[b], c.runs,
                     num(v[0], c.rmse), num(v[1], c.mean_stderr), num(v[2], c.honesty), num(v[3], c.coverage),
-                    num(v[4], c.seconds), num(v[5], c.work), st->m[m].infinite ? "false" : "true");
+                    num(v[4], c.seconds), num(v[5], c.work), st->m[m].infinite ? "false" : "true", c.failed);
             last = c;
         }
         if (last.runs) {
@@ -591,18 +629,19 @@ static void lapack_mark(const study *st, char *buf, size_t len)
 }
 
 /* Draw DIR/NAME.FORMAT from script, and keep the script beside it as DIR/NAME.gp ('cd DIR &&
- * gnuplot NAME.gp' redraws it from the CSVs there); the chart is drawn under a temporary name and
- * renamed into place.  ULAM_OK or ULAM_EIO (gnuplot missing or failed). */
+ * gnuplot NAME.gp' redraws it from the CSVs there); the chart is drawn into a temporary file that
+ * ulam made (mkstemp: O_EXCL, a fresh name, never a planted symlink), which gnuplot writes through
+ * the descriptor it inherits (/dev/fd/N: no name to follow), then renamed into place.  ULAM_OK or
+ * ULAM_EIO (gnuplot missing or failed). */
 static int draw(const study *st, const char *name, int width, int height, const char *script)
 {
-    char term[128], gp[4200], tmp[4200], out[4200], cmd[4200];
+    char term[128], gp[4200], out[4200], cmd[4200];
     const char *fmt = st->format;
     if (!strcmp(fmt, "pdf")) snprintf(term, sizeof term, "pdfcairo size %gin,%gin font 'sans,9'", width / 100.0, height / 100.0);
     else if (!strcmp(fmt, "svg")) snprintf(term, sizeof term, "svg size %d,%d font 'sans,10' background 'white'", width, height);
     else snprintf(term, sizeof term, "pngcairo size %d,%d font 'sans,10'", width, height);
     snprintf(gp, sizeof gp, "%s/%s.gp", st->out, name);
     snprintf(out, sizeof out, "%s/%s.%s", st->out, name, fmt);
-    snprintf(tmp, sizeof tmp, "%s/%s.tmp.%s", st->out, name, fmt);
     const char *head = "set datafile separator ','\nset grid\n";
     ulam_outfile o;
     if (!ulam_outfile_open(&o, gp)) {
@@ -611,13 +650,21 @@ static int draw(const study *st, const char *name, int width, int height, const 
         if (ulam_outfile_commit(&o)) return ULAM_EIO;
     }
     if (strchr(st->out, '\'')) return ULAM_EINVAL;
+    ulam_outfile chart;
+    if (cli_outfile_open(&chart, out)) return ULAM_EIO;
+    fflush(chart.f);
     snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot 2>/dev/null", st->out);
     FILE *g = popen(cmd, "w");
-    if (!g) return ULAM_EIO;
-    fprintf(g, "set terminal %s\nset output '%s.tmp.%s'\n%s%s\nset output\n", term, name, fmt, head, script);
-    int ok = pclose(g) == 0 && rename(tmp, out) == 0;
-    if (!ok) remove(tmp);
-    return ok ? ULAM_OK : ULAM_EIO;
+    if (!g) {
+        cli_outfile_abort(&chart);
+        return ULAM_EIO;
+    }
+    fprintf(g, "set terminal %s\nset output '/dev/fd/%d'\n%s%s\nset output\n", term, fileno(chart.f), head, script);
+    if (pclose(g) != 0) {
+        cli_outfile_abort(&chart);
+        return ULAM_EIO;
+    }
+    return cli_outfile_commit(&chart) ? ULAM_EIO : ULAM_OK;
 }
 
 /* The RMSE chart of the methods in names (one estimator's: at most 6, each its own colour and dash)
@@ -645,9 +692,9 @@ static int rmse_chart(const study *st, const char *name, const char *names, cons
              "X0 = 10**floor(log10(STATS_min < X0 ? STATS_min : X0))\nX1 = 10**ceil(log10(STATS_max > X1 ? STATS_max : X1))\n"
              "set xrange [X0:X1]\n"
              "%s"
-             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) ? $8 : 1/0):4 w l lw 2 "
+             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) && $11 == 0 ? $8 : 1/0):4 w l lw 2 "
              "linecolor rgb word(C, i) dashtype i title word(M, i), "
-             "for [i=1:words(M)] for [j=1:words(B)] 'summary.csv' u (strcol(1) eq word(M, i) && $2 == word(B, j) + 0 ? "
+             "for [i=1:words(M)] for [j=1:words(B)] 'summary.csv' u (strcol(1) eq word(M, i) && $2 == word(B, j) + 0 && $11 == 0 ? "
              "$8 : 1/0):4 w p linecolor rgb word(C, i) pointtype (word(P, j) + 0) notitle, "
              "for [j=1:words(B)] NaN w p lc 'black' pointtype (word(P, j) + 0) title sprintf('%s', word(B, j) + 0), "
              "'reference.csv' u (strcol(1) eq 'gs' ? $2 : 1/0):3 w l lw 3 lc 'gray50' t 'Gauss-Seidel, whole vector', "
@@ -723,8 +770,8 @@ static void print_summary(const study *st)
             if (!method_cell(st, m, b, e, &c)) continue;
             if (best < 0 || c.work < bc.work) best = m, bc = c;
         }
-        if (best < 0) {
-            printf("%-12g (no finished runs)\n", st->budget[b]);
+        if (best < 0 || !isfinite(bc.work)) { /* none, or every cell has runs with no estimate */
+            printf("%-12g %s\n", st->budget[b], best < 0 ? "(no finished runs)" : "(no winner: every method has runs with no estimate)");
             continue;
         }
         double lo, hi;
@@ -733,6 +780,13 @@ static void print_summary(const study *st)
         printf("%-12g %-28s %-10.3g %-10.3g %d/%d (%.2f .. %.2f)\n", st->budget[b], st->m[best].name, bc.rmse,
                bc.seconds, covered, bc.runs, lo, hi);
     }
+    for (int m = 0; m < NMETHOD && e; m++) /* the failures, each cell where a run gave no estimate */
+        for (int b = 0; b < st->nbudget; b++) {
+            cell c;
+            if (st->m[m].on && !st->m[m].why[0] && method_cell(st, m, b, e, &c) && c.failed)
+                printf("no estimate: %s at %g: %d of %d runs (a failure: this cell cannot win)\n", st->m[m].name,
+                       st->budget[b], c.failed, c.runs);
+        }
     free(e);
     for (int m = 0; m < NMETHOD; m++)
         if (st->m[m].on && st->m[m].why[0]) printf("refused: %s: %s\n", st->m[m].name, st->m[m].why);

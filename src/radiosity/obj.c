@@ -3,12 +3,77 @@
 #include "rad.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 /* The largest vertex coordinate read: Embree traces in float (the scene centred first), and a
  * face's area, the square of its size, must stay finite in double. */
 #define ULAM__OBJ_MAX_COORD 1e30
+
+/* The longest OBJ or MTL line read: past it the file is refused, never buffered whole (a 600 MB
+ * comment, /dev/zero as an MTL file). */
+enum { OBJ_LINE_MAX = 1 << 20 };
+
+/* The end of a line read (next_line): a line, the end of the file, or why the reading stopped. */
+enum { LINE_OK, LINE_EOF, LINE_LONG, LINE_NUL, LINE_NOMEM, LINE_EIO };
+
+/* The next line of f into *buf (growing it, never past OBJ_LINE_MAX bytes), NUL-terminated with
+ * its newline: LINE_OK, LINE_EOF at the end, or a failure (a read error or no memory is never
+ * taken for the end of the file). */
+static int next_line(FILE *f, char **buf, size_t *cap, size_t *len)
+{
+    size_t n = 0;
+    int c;
+    while ((c = getc(f)) != EOF) {
+        if (n + 2 > *cap) {
+            if (*cap >= OBJ_LINE_MAX) return LINE_LONG;
+            size_t want = *cap ? 2 * *cap : 256;
+            char *nb = realloc(*buf, want);
+            if (!nb) return LINE_NOMEM;
+            *buf = nb, *cap = want;
+        }
+        if (c == 0) return LINE_NUL; /* a binary file: said at once, not read on to the bound */
+        (*buf)[n++] = (char)c;
+        if (c == '\n') break;
+    }
+    if (c == EOF && ferror(f)) return LINE_EIO;
+    if (n == 0) return LINE_EOF;
+    (*buf)[n] = '\0';
+    *len = n;
+    return LINE_OK;
+}
+
+/* The status of a failed next_line (got) at line of the OBJ or MTL file, err filled. */
+static int line_fail(ulam_error *err, int got, long line)
+{
+    if (got == LINE_LONG)
+        return ulam__fail(err, ULAM_ESYNTAX, line, -1, "a text line of at most %d bytes (this one is longer)", OBJ_LINE_MAX);
+    if (got == LINE_NUL) return ulam__fail(err, ULAM_ESYNTAX, line, -1, "text (this line holds a NUL byte)");
+    if (got == LINE_NOMEM) return ulam__fail(err, ULAM_ENOMEM, line, -1, "memory for line %ld", line);
+    return ulam__fail(err, ULAM_EIO, line, -1, "a readable file (%s)", strerror(errno));
+}
+
+/* Open path for reading when it is a regular file: a FIFO, device or directory is refused without
+ * blocking on it (NULL, *what saying what it is; errno for an open that failed, *what NULL). */
+static FILE *open_regular(const char *path, const char **what)
+{
+    *what = NULL;
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return NULL;
+    struct stat st;
+    if (fstat(fd, &st) || !S_ISREG(st.st_mode)) {
+        *what = S_ISDIR(st.st_mode) ? "a directory" : S_ISFIFO(st.st_mode) ? "a FIFO" : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device" : "not a regular file";
+        close(fd);
+        return NULL;
+    }
+    int fl = fcntl(fd, F_GETFL);
+    FILE *f = fl >= 0 && !fcntl(fd, F_SETFL, fl & ~O_NONBLOCK) ? fdopen(fd, "r") : NULL;
+    if (!f) close(fd);
+    return f;
+}
 
 /* A material: its name and the two colours ulam uses. */
 typedef struct {
@@ -215,20 +280,27 @@ static int read_mtl(objr *o, const char *name, long obj_line)
     char *path = malloc(len);
     if (!path) return ulam__fail(o->err, ULAM_ENOMEM, obj_line, -1, "memory for a file name");
     snprintf(path, len, "%s%s", name[0] == '/' ? "" : o->dir, name);
-    FILE *f = fopen(path, "r");
+    const char *what;
+    FILE *f = open_regular(path, &what);
     if (!f) {
         int e = errno;
-        ulam__fail(o->err, ULAM_EIO, obj_line, -1, "a readable MTL file %s (%s)", path, strerror(e));
+        if (what) ulam__fail(o->err, ULAM_EIO, obj_line, -1, "a regular MTL file: %s is %s", path, what);
+        else ulam__fail(o->err, ULAM_EIO, obj_line, -1, "a readable MTL file %s (%s)", path, strerror(e));
         free(path);
         return ULAM_EIO;
     }
     char *buf = NULL;
-    size_t cap = 0;
+    size_t cap = 0, got_len;
     long line = 0;
-    int status = ULAM_OK;
+    int status = ULAM_OK, got;
     mtl *cur = NULL;
-    while (!status && getline(&buf, &cap, f) != -1) {
+    while (!status && (got = next_line(f, &buf, &cap, &got_len)) != LINE_EOF) {
         line++;
+        if (got != LINE_OK) {
+            status = line_fail(o->err, got, line);
+            if (o->err) snprintf(o->err->file, sizeof o->err->file, "%s", path);
+            break;
+        }
         char *args, *s = statement(buf, &args);
         if (!s) continue;
         if (!strcmp(s, "newmtl")) {
@@ -277,7 +349,6 @@ static int read_mtl(objr *o, const char *name, long obj_line)
             status = mtl_fail(o, path, ULAM_ENOMEM, line, "%s", "memory for a note");
         }
     }
-    if (!status && ferror(f)) status = mtl_fail(o, path, ULAM_EIO, line, "%s", "a readable file");
     free(buf);
     fclose(f);
     free(path);
@@ -492,14 +563,13 @@ static int unknown_statement(objr *o, const char *kw, long line)
 static int read_statements(objr *o, FILE *f)
 {
     char *buf = NULL;
-    size_t cap = 0;
+    size_t cap = 0, len;
     long line = 0;
-    ssize_t got;
-    int status = ULAM_OK;
-    while (!status && (got = getline(&buf, &cap, f)) != -1) {
+    int status = ULAM_OK, got;
+    while (!status && (got = next_line(f, &buf, &cap, &len)) != LINE_EOF) {
         line++;
-        if ((size_t)got != strlen(buf)) {
-            status = ulam__fail(o->err, ULAM_ESYNTAX, line, -1, "text (this line holds a NUL byte)");
+        if (got != LINE_OK) {
+            status = line_fail(o->err, got, line);
             break;
         }
         char *args, *s = statement(buf, &args);
@@ -511,7 +581,6 @@ static int read_statements(objr *o, FILE *f)
         else if (!strcmp(s, "mtllib")) status = do_mtllib(o, args, line);
         else if (!ignored(s)) status = unknown_statement(o, s, line);
     }
-    if (!status && ferror(f)) status = ulam__fail(o->err, ULAM_EIO, line, -1, "a readable file");
     if (!status && o->nf == 0) status = ulam__fail(o->err, ULAM_EEMPTY, line, -1, "at least one face");
     free(buf);
     return status;

@@ -1,0 +1,147 @@
+/* ulam_dist.h: one system partitioned by rows across ranks, with walks that migrate.
+ *
+ * Each rank holds a contiguous range of rows (balanced by nonzeros, at the prepared file's block
+ * boundaries) read from a prepared file by its blocks alone: no rank reads or maps the rest.  A
+ * walk that steps onto a row another rank owns travels there with its state (walk id, step,
+ * state, weight, score) in the next exchange.  The library stays MPI-free: the caller gives the
+ * exchange as callbacks (src/cli/mpi.c gives MPI_Alltoallv and MPI_Allreduce).
+ *
+ * Random numbers are counter-based: the k-th number of step t of walk w is a hash of (seed, w,
+ * t, k) (ulam_rng_counter), so a walk takes the same path whichever rank runs which step, and
+ * 1, 2, 3 or 64 ranks give the same answer bit for bit: walks' scores and tallies are combined
+ * in walk-id order, never in arrival order.
+ *
+ * API, in order of use: primary ulam_part_open, ulam_dist_radius (the variance guard),
+ * ulam_dist_adjoint, ulam_dist_forward, ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
+#ifndef ULAM_DIST_H
+#define ULAM_DIST_H
+
+#include "ulam.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The exchange between ranks.  rank and nranks as MPI gives them; with nranks 1 the callbacks
+ * may be NULL.  exchange: every rank sends sendcounts[r] bytes (consecutive in send, in rank
+ * order) to rank r and receives, in *recv (malloc'd by the callback, freed by the library),
+ * recvcounts[r] bytes from each rank r in rank order; sum: the element-wise sum of v[0 .. n)
+ * over all ranks, in place.  Each returns 0, or nonzero on failure (the run then ends with
+ * ULAM_EIO on every rank that sees it).  The answer is the same bits whatever nranks and sets. */
+typedef struct ulam_comm {
+    int rank, nranks;
+    int sets; /* 0 or 1: one partition; k > 1 (dividing nranks): k sets of nranks / k consecutive
+                 ranks, each set a whole partition of the rows running its own batches of walks
+                 (memory per rank times k, and no message leaves a set while walks run) */
+    void *ctx;
+    int (*exchange)(void *ctx, const void *send, const size_t *sendcounts, void **recv, size_t *recvcounts);
+    int (*sum)(void *ctx, int64_t *v, int n);
+} ulam_comm;
+
+/* One rank's rows of a prepared system. */
+typedef struct ulam_part ulam_part;
+
+/* Which arrays a part holds: M's rows (adjoint walks), M''s (forward walks; the file prepared with
+ * --transpose), or both (single source and MCSA: products with M, walks on M'). */
+enum { ULAM_PART_M = 0, ULAM_PART_MT = 1, ULAM_PART_BOTH = 2 };
+
+/* Open this rank's rows of the prepared system at path (split among the ranks of its set, by the
+ * entries of M' for ULAM_PART_MT, else of M): rows [first, last) of the arrays `what` names and b's
+ * entries there, every block read verified against its checksum.  The split is the same on every
+ * rank (computed from the file alone).  Needs b in the file. */
+int ulam_part_open(const char *path, const ulam_comm *comm, int what, ulam_part **out, ulam_error *err);
+
+/* Free a part (NULL is fine); returns NULL. */
+ulam_part *ulam_part_free(ulam_part *p);
+
+/* The system's order; this rank's rows [*first, *last) and their nonzeros (any pointer may be NULL). */
+int64_t ulam_part_rows(const ulam_part *p, int64_t *first, int64_t *last, int64_t *nnz);
+
+/* Options of a partitioned run. */
+typedef struct ulam_dist_opts {
+    uint64_t seed;     /* the streams' key (default 1) */
+    int64_t walks;     /* histories (default 100000) */
+    int64_t max_steps; /* a walk longer than this is cut and counted (default 1000000) */
+    int64_t batch;     /* histories a round starts on all ranks together (default 65536) */
+} ulam_dist_opts;
+
+/* The defaults above. */
+ulam_dist_opts ulam_dist_defaults(void);
+
+/* What a partitioned run did (the same on every rank). */
+typedef struct ulam_dist_result {
+    double estimate, std_error; /* adjoint: x_index and its standard error; forward: 0 */
+    int64_t walks, steps;       /* histories run and steps taken in all */
+    int64_t crossings;          /* steps that moved a walk to another rank's rows */
+    int64_t bytes;              /* bytes of walks sent between ranks in all */
+    int64_t rounds;             /* exchanges */
+    int64_t cut;                /* histories cut at max_steps */
+} ulam_dist_result;
+
+/* x_index of (I - M) x = b by adjoint collision walks from index on rows of M: each step leaves
+ * row s with probability min(1, S_s) (S_s = sum_j |M_sj|) to j with probability |M_sj| / S_s,
+ * the weight times sign(M_sj) S_s / min(1, S_s), the score the sum of weight x b over every state
+ * visited.  Every rank gets the same result: the mean of the histories' scores in walk-id order
+ * and its standard error (a CLT one: no certified range of a score is computed here). */
+int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
+                      ulam_dist_result *r, ulam_error *err);
+
+/* x_index[k] for each k < nq at once (the queries' walks share the rounds): res[k] as
+ * ulam_dist_adjoint gives for index[k] with seed o->seed + k, bit for bit (the counts of walks,
+ * steps and messages are the whole run's in each). */
+int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
+                           const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err);
+
+/* Every x_i of (I - M) x = b by forward collision walks on rows of M' (the part opened with
+ * transpose): a source j ~ |b_j| / ||b||_1 with weight ||b||_1 sign(b_j), moves as above on M',
+ * and each history's tallies at each state it visits.  x and se (this rank's rows [first, last),
+ * may be NULL) get each component's mean over the histories and its standard error; a component
+ * no walk tallied gets x 0 and se NaN.  With sets, the ranks of set 0 get them (the others' x and
+ * se are left as they were). */
+int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double *x, double *se,
+                      ulam_dist_result *r, ulam_error *err);
+
+/* As ulam_dist_forward with the sources drawn from b (this rank's rows [first, last) of it) in
+ * place of the system's b: the walks of MCSA's correction and of single source's residual. */
+int ulam_dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
+                        double *se, ulam_dist_result *res, ulam_error *err);
+
+/* What MCSA on a partition did. */
+typedef struct ulam_dist_mcsa_info {
+    int iterations;                  /* Richardson step + Monte Carlo correction, each */
+    double residual;                 /* max |b - (I - M) x| / max |b| at the end */
+    int64_t walks, steps, crossings; /* of every correction */
+} ulam_dist_mcsa_info;
+
+/* x of (I - M) x = b by MCSA (Evans, Slattery, Wilson): x <- x + r (r = b - (I - M) x, a product
+ * with M over the ranks' rows), then x <- x + d, d forward walks (o->walks of them, seed o->seed +
+ * iteration) from the new residual; until max |r| <= tol max |b| or max_iter iterations.  x: this
+ * rank's rows.  Needs ULAM_PART_BOTH and one set.  The same bits at any rank count. */
+int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
+                   double *x, ulam_dist_mcsa_info *info, ulam_error *err);
+
+/* What single source on a partition did. */
+typedef struct ulam_dist_source_info {
+    int rounds;                      /* products of the push */
+    double residual;                 /* max |r| left to the walks */
+    int64_t walks, steps, crossings; /* of the walks from r */
+} ulam_dist_source_info;
+
+/* x = (I - M)^-1 e_source: a push x = sum_{k<K} M^k e_s (products with M over the ranks' rows)
+ * until max |M^K e_s| <= tol or K = max_rounds, then forward walks (o) from r = M^K e_s add
+ * (I - M)^-1 r with its standard errors se (NaN where no walk tallied; 0 everywhere when r = 0).
+ * x, se: this rank's rows.  Needs ULAM_PART_BOTH and one set.  The same bits at any rank count. */
+int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
+                     int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_error *err);
+
+/* A certified upper bound *upper on rho(M^), M^_ij = M_ij^2 / p_ij of the walks above on the part's
+ * rows of M (forward 0: adjoint walks) or M' (forward 1) (M^_ij = |M_ij| S_i / min(1, S_i)): below 1, the walks' scores have finite variance.  Power
+ * iteration on the rows each rank holds, the iterate shared through the exchange, each step's
+ * Collatz-Wielandt bound max_i (M^ v)_i / v_i rounded up; it stops when that is below 1 or after
+ * iters steps (the smallest bound seen).  The same bits on every rank and at any rank count. */
+int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int forward, int iters, double *upper, ulam_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,393 @@
+/* ulam solve SYSTEM.ulam --partition: the system's rows split across the ranks of mpirun, walks
+ * that migrate (ulam_dist.h).  Alone (no mpirun, or a build without MPI) it is one rank. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "ulam_dist.h"
+
+static const char *const help =
+    "usage: ulam solve SYSTEM.ulam --partition (--index I | --queries FILE | --mode forward [--out X.mtx]\n"
+    "                  | --method mcsa [--tol T] [--out X.mtx] | --source S [--top K] [--out X.mtx])\n"
+    "                  [--walks N] [--seed S] [--max-steps N] [--batch N] [--sets K]\n"
+    "\n"
+    "The prepared system's rows are split across the ranks of mpirun (balanced by entries; each rank\n"
+    "reads only its rows' blocks of SYSTEM.ulam, prepared with --rhs, and --transpose for forward).\n"
+    "A walk that steps onto another rank's row travels there; random numbers are keyed by (seed,\n"
+    "walk, step), so 1, 2, 3 or 64 ranks print the same answer bit for bit.  Collision estimator,\n"
+    "analog kernel (p_ij = |M_ij| / row sum, leaving with min(1, row sum)); the interval is the\n"
+    "CLT's (1.96 standard errors): no certified range of a score is computed on a partition.\n"
+    "  --index I       x_I by adjoint walks from I (1-based)\n"
+    "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, query k\n"
+    "                  with seed S + k - 1: a line answers what --index I --seed S+k-1 answers\n"
+    "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector\n"
+    "  --method mcsa   every x_i by MCSA: Richardson steps (products with M across ranks) and forward\n"
+    "                  walks' corrections (--walks each) to --tol (default 1e-8) of max|b|, --max-iter\n"
+    "  --source S      x = (I - M)^-1 e_S: a push (products with M) to 1e-4, then forward walks; prints\n"
+    "                  the --top K (default 10) components.  mcsa and --source need M' in the file\n"
+    "  --walks N       histories (default 100000)       --seed S   the streams' key (default 1)\n"
+    "  --max-steps N   cut a walk longer (default 1e6)  --batch N  walks a round starts (default 65536)\n"
+    "  --sets K        the ranks in K sets, each a whole partition running its own batches (more\n"
+    "                  memory a rank, no message between sets while walking; the same answer)\n"
+    "docs/distributed.md says more.\n";
+
+/* The parsed command line. */
+typedef struct {
+    const char *path, *out, *queries;
+    int64_t index; /* 1-based; 0 none */
+    int forward, mcsa;
+    int64_t sets, source, top, max_iter;
+    double tol;
+    ulam_dist_opts o;
+} args;
+
+static const struct option longopts[] = {
+    {"partition", no_argument, 0, 'P'}, {"index", required_argument, 0, 'i'}, {"mode", required_argument, 0, 'm'},
+    {"out", required_argument, 0, 'o'}, {"walks", required_argument, 0, 'w'}, {"seed", required_argument, 0, 's'},
+    {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'}, {"sets", required_argument, 0, 'S'}, {"queries", required_argument, 0, 'Q'},
+    {"method", required_argument, 0, 'M'}, {"tol", required_argument, 0, 'T'}, {"max-iter", required_argument, 0, 'I'},
+    {"source", required_argument, 0, 'R'}, {"top", required_argument, 0, 'K'},
+    {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+
+/* The defaults. */
+static void init(void *p)
+{
+    *(args *)p = (args){.o = ulam_dist_defaults(), .tol = 1e-8, .max_iter = 100, .top = 10};
+}
+
+/* One option (see cli_solve_row.option). */
+static int option(void *p, int val, const char *name, const char *value)
+{
+    args *a = p;
+    int64_t v = 0;
+    int bad = 0;
+    switch (val) {
+    case 'P': return 0;
+    case 'i': return cli_parse_int("solve", "--index", value, 1, INT32_MAX, &a->index);
+    case 'm':
+        if (!strcmp(value, "forward")) a->forward = 1;
+        else if (strcmp(value, "adjoint"))
+            return cli_usage_error("solve", "--mode with --partition is adjoint or forward, got '%s'", value);
+        return 0;
+    case 'o': a->out = value; return 0;
+    case 'w': return cli_parse_int("solve", "--walks", value, 1, (int64_t)1 << 40, &a->o.walks);
+    case 's': bad = cli_parse_int("solve", "--seed", value, 0, INT64_MAX, &v), a->o.seed = (uint64_t)v; return bad;
+    case 'x': return cli_parse_int("solve", "--max-steps", value, 1, INT64_MAX, &a->o.max_steps);
+    case 'b': return cli_parse_int("solve", "--batch", value, 1, (int64_t)1 << 30, &a->o.batch);
+    case 'Q': a->queries = value; return 0;
+    case 'M':
+        if (!strcmp(value, "mcsa")) a->mcsa = 1;
+        else if (strcmp(value, "walks"))
+            return cli_usage_error("solve", "--method with --partition is walks or mcsa, got '%s'", value);
+        return 0;
+    case 'T': return cli_parse_real("solve", "--tol", value, 1e-300, 1.0, &a->tol);
+    case 'I': return cli_parse_int("solve", "--max-iter", value, 1, 1000000, &a->max_iter);
+    case 'R': return cli_parse_int("solve", "--source", value, 1, INT32_MAX, &a->source);
+    case 'K': return cli_parse_int("solve", "--top", value, 1, 1000000, &a->top);
+    case 'S': return cli_parse_int("solve", "--sets", value, 1, 1 << 20, &a->sets);
+    case 'h': fputs(help, stdout); return -1;
+    default:
+        return cli_usage_error("solve", "--%s is not an option of a --partition run (ulam solve --partition --help)",
+                               name ? name : "?");
+    }
+}
+
+/* Check the operands and options read. */
+static int check(args *a, int argc, char **argv, int first)
+{
+    if (first != argc - 1) return cli_usage_error("solve", "one prepared system file with --partition");
+    a->path = argv[first];
+    if (!!a->forward + !!a->index + !!a->queries + a->mcsa + !!a->source != 1)
+        return cli_usage_error("solve", "one of --index I, --queries FILE, --mode forward, --method mcsa and --source S "
+                                        "with --partition");
+    if (a->out && (a->index || a->queries)) return cli_usage_error("solve", "--out with --partition writes a whole x");
+    if ((a->mcsa || a->source) && a->sets > 1) return cli_usage_error("solve", "--sets with --method walks only");
+    return 0;
+}
+
+/* Every rank's count of rows, in rank order, into rows[0 .. nranks). */
+static int all_rows(const ulam_comm *c, int64_t mine, int64_t *rows)
+{
+    memset(rows, 0, (size_t)c->nranks * sizeof *rows);
+    rows[c->rank] = mine;
+    return c->nranks > 1 && c->sum(c->ctx, rows, c->nranks);
+}
+
+/* Write x (this rank's rows x[0 .. mine)) to path on rank 0, the other ranks' rows sent to it in
+ * rank order through the exchange, a chunk a round; 0 or an exit code (on every rank). */
+static int write_x(const ulam_comm *c, const char *path, const double *x, int64_t mine, int64_t n)
+{
+    int64_t *rows = calloc((size_t)c->nranks, sizeof *rows), failed = 0;
+    ulam_outfile o = {0};
+    if (!rows || all_rows(c, mine, rows)) failed = 1;
+    if (!failed && c->rank == 0) {
+        int status = cli_outfile_open(&o, path);
+        if (status || fprintf(o.f, "%%%%MatrixMarket matrix array real general\n%% x by ulam solve --partition\n%lld 1\n",
+                              (long long)n) < 0) failed = status ? status : 1;
+        for (int64_t i = 0; !failed && i < mine; i++) failed = fprintf(o.f, "%.17g\n", x[i]) < 0;
+    }
+    enum { CHUNK = 1 << 16 };
+    size_t *cnt = calloc((size_t)c->nranks * 2, sizeof *cnt);
+    if (!cnt) failed = 1;
+    for (int r = 1; r < c->nranks && rows; r++)
+        for (int64_t at = 0; at < rows[r]; at += CHUNK) {
+            int64_t k = rows[r] - at < CHUNK ? rows[r] - at : CHUNK;
+            for (int q = 0; cnt && q < c->nranks; q++) cnt[q] = 0;
+            if (cnt && c->rank == r) cnt[0] = (size_t)k * sizeof *x;
+            void *got = NULL;
+            if (!cnt || c->exchange(c->ctx, x + at, cnt, &got, cnt + c->nranks)) failed = 1;
+            for (int64_t i = 0; !failed && c->rank == 0 && i < k; i++) failed = fprintf(o.f, "%.17g\n", ((double *)got)[i]) < 0;
+            free(got);
+        }
+    if (c->rank == 0 && o.f) {
+        if (failed) cli_outfile_abort(&o);
+        else failed = cli_outfile_commit(&o);
+        if (failed) cli_report_write(path, ULAM_EIO, 0);
+    }
+    free(rows), free(cnt);
+    int64_t any = failed != 0;
+    if (c->nranks > 1 && c->sum(c->ctx, &any, 1)) any = 1;
+    return any ? cli_exit_code(ULAM_EIO) : 0;
+}
+
+/* Each rank's rows and peak resident memory (KiB), in rank order, into v[0 .. 2 nranks) on every
+ * rank; nonzero when the sum fails. */
+static int per_rank(const ulam_comm *c, int64_t rows, int64_t *v)
+{
+    struct rusage u;
+    memset(v, 0, (size_t)c->nranks * 2 * sizeof *v);
+    v[c->rank] = rows;
+    v[c->nranks + c->rank] = getrusage(RUSAGE_SELF, &u) ? -1 : (int64_t)u.ru_maxrss;
+    return c->nranks > 1 && c->sum(c->ctx, v, 2 * c->nranks);
+}
+
+/* Read the query file at path: 'I' lines only (no point source, no target: walks are fixed on a
+ * partition), indices below n; 0 or an exit code (reported). */
+static int load_queries(const char *path, int64_t n, cli_query **q, int64_t *nq)
+{
+    int rc = cli_read_queries(path, q, nq);
+    for (int64_t k = 0; !rc && k < *nq; k++) {
+        const cli_query *x = &(*q)[k];
+        const char *why = x->source >= 0 ? "an 'I' line (a point source 'S I' is not run on a partition)"
+                          : x->target > 0 ? "an 'I' line without a target (a partition runs a fixed --walks)"
+                          : x->index >= n ? "an index within the system" : NULL;
+        if (why) {
+            fprintf(stderr, "ulam: %s:%ld: error: expected %s\n", path, x->line, why);
+            rc = EXIT_USAGE;
+        }
+    }
+    if (!rc && *nq == 0) {
+        fprintf(stderr, "ulam: %s: error: expected at least one query\n", path);
+        rc = EXIT_USAGE;
+    }
+    if (rc) free(*q), *q = NULL, *nq = 0;
+    return rc;
+}
+
+/* One query's answer line (rank 0): x[I] estimate +- stderr (95% CI, CLT) and its seed. */
+static void print_query(const cli_query *q, int64_t k, const ulam_dist_result *r, uint64_t seed, double rho)
+{
+    int64_t i = q->index + 1;
+    printf("x[%lld]%*s%.10g", (long long)i, cli_answer_pad(i, 16), "", r->estimate);
+    if (rho < 1.0)
+        printf(" +- %.3g (95%% CI %.10g .. %.10g, CLT)", r->std_error, r->estimate - 1.96 * r->std_error,
+               r->estimate + 1.96 * r->std_error);
+    else printf(" (no confidence interval: rho(M^) not certified below 1)");
+    printf("  line %ld, seed %llu\n", q->line, (unsigned long long)(seed + (uint64_t)k));
+}
+
+/* A component for the top-K table: its index and estimate, its standard error. */
+typedef struct {
+    int64_t i;
+    double x, se;
+} entry;
+
+/* Larger estimate first, then the smaller index (NaN last). */
+static int by_estimate(const void *a, const void *b)
+{
+    const entry *p = a, *q = b;
+    if (p->x != q->x) return isnan(p->x) ? 1 : isnan(q->x) ? -1 : p->x < q->x ? 1 : -1;
+    return (p->i > q->i) - (p->i < q->i);
+}
+
+/* Each rank's K largest components to rank 0, which prints the K largest of all with their
+ * intervals (CLT, when the guard certified the walks' variance); 0 or an exit code. */
+static int print_top(const ulam_comm *c, const double *x, const double *se, int64_t first, int64_t rows, int64_t K,
+                     double rho)
+{
+    entry *e = malloc(((size_t)rows + 1) * sizeof *e);
+    size_t *cnt = calloc((size_t)c->nranks * 2, sizeof *cnt);
+    void *got = NULL;
+    int bad = !e || !cnt;
+    for (int64_t i = 0; !bad && i < rows; i++) e[i] = (entry){first + i, x[i], se[i]};
+    if (!bad) qsort(e, (size_t)rows, sizeof *e, by_estimate);
+    int64_t k = rows < K ? rows : K, all = k;
+    if (!bad && c->nranks > 1) {
+        cnt[0] = (size_t)k * sizeof *e;
+        bad = c->exchange(c->ctx, e, cnt, &got, cnt + c->nranks);
+        all = 0;
+        for (int r = 0; !bad && r < c->nranks; r++) all += (int64_t)(cnt[c->nranks + r] / sizeof *e);
+        if (!bad && c->rank == 0) qsort(got, (size_t)all, sizeof *e, by_estimate);
+    }
+    const entry *t = c->nranks > 1 ? got : e;
+    for (int64_t j = 0; !bad && c->rank == 0 && j < all && j < K; j++) {
+        printf("x[%lld]%*s%.10g", (long long)t[j].i + 1, cli_answer_pad(t[j].i + 1, 16), "", t[j].x);
+        if (rho < 1.0 && isfinite(t[j].se))
+            printf(" +- %.3g (95%% CI %.10g .. %.10g, CLT)\n", t[j].se, t[j].x - 1.96 * t[j].se, t[j].x + 1.96 * t[j].se);
+        else printf(" (no interval: %s)\n", rho < 1.0 ? "no walk reached it; the push's part alone" : "rho(M^) not certified below 1");
+    }
+    free(e), free(cnt), free(got);
+    return bad ? cli_exit_code(ULAM_EIO) : 0;
+}
+
+/* Print the run's summary (rank 0; v: per_rank's figures). */
+static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_t n, double seconds, const int64_t *v,
+                    double rho)
+{
+    if (a->queries) {
+        if (cli_verbosity >= 0) printf("queries         %s, each above (walks below: each query's)\n", a->queries);
+    } else if (a->mcsa || a->source) { /* their answer is above */
+    }
+    else if (!a->forward && !(rho < 1.0))
+        printf("x[%lld]%*s%.10g (no confidence interval: rho(M^) is not certified below 1, bound %.4g; the sample "
+               "stderr %.3g means nothing)\n", (long long)a->index, cli_answer_pad(a->index, 16), "", r->estimate, rho,
+               r->std_error);
+    else if (!a->forward)
+        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g, CLT)\n", (long long)a->index, cli_answer_pad(a->index, 16),
+               "", r->estimate, r->std_error, r->estimate - 1.96 * r->std_error, r->estimate + 1.96 * r->std_error);
+    else if (a->forward && !a->mcsa) printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
+                a->out ? a->out : "");
+    if (cli_verbosity < 0) return;
+    printf("method          %s%s collision walks on %d rank%s, rows split by entries", a->mcsa ? "MCSA with " : a->source ? "push and " : "",
+           a->forward || a->mcsa || a->source ? "forward" : "adjoint", nranks, nranks == 1 ? "" : "s");
+    if (a->sets > 1) printf(" within each of %lld sets", (long long)a->sets);
+    printf("\n");
+    if (rho < 1.0) printf("variance        finite (rho(M^) <= %.6g, certified)\n", rho);
+    else if (a->forward || a->mcsa || a->source) printf("variance        not certified finite (rho(M^) bound %.4g): no error bar can be trusted\n", rho);
+    printf("walks           %lld (%lld steps; %lld cut at --max-steps)\n", (long long)r->walks, (long long)r->steps,
+           (long long)r->cut);
+    printf("migration       %.4g of steps crossed ranks, %.3g bytes a step, %lld rounds\n",
+           r->steps ? (double)r->crossings / (double)r->steps : 0.0, r->steps ? (double)r->bytes / (double)r->steps : 0.0,
+           (long long)r->rounds);
+    printf("seconds         %.3g in all\n", seconds);
+    if (cli_verbosity < 1) return;
+    printf("ranks           rows");
+    for (int k = 0; k < nranks; k++) printf(" %lld", (long long)v[k]);
+    printf("; peak RSS MiB");
+    for (int k = 0; k < nranks; k++) printf(" %.1f", (double)v[nranks + k] / 1024.0);
+    printf("\n");
+}
+
+/* Run the parsed command on this rank. */
+static int run(const args *a, const ulam_comm *c)
+{
+    ulam_part *p = NULL;
+    ulam_error err;
+    int walks_forward = a->forward || a->mcsa || a->source; /* the walks run on M' */
+    int status = ulam_part_open(a->path, c, a->mcsa || a->source ? ULAM_PART_BOTH : a->forward ? ULAM_PART_MT : ULAM_PART_M,
+                                &p, &err);
+    int64_t bad = status != ULAM_OK; /* every rank ends together when one cannot read its rows */
+    if (c->nranks > 1 && c->sum(c->ctx, &bad, 1)) bad = 1;
+    if (bad) {
+        if (status) cli_report(a->path, &err);
+        ulam_part_free(p);
+        return status ? cli_exit_code(status) : cli_exit_code(ULAM_EIO);
+    }
+    const char *die = getenv("ULAM_TEST_PARTITION_DIE"); /* tests: this rank dies before its walks */
+    if (die && atoi(die) == c->rank && c->nranks > 1) _exit(9);
+    int64_t first, last, n = ulam_part_rows(p, &first, &last, NULL);
+    int rc0;
+    if (a->index > n || a->source > n) {
+        ulam_part_free(p);
+        return cli_usage_error("solve", "%s in 1 .. %lld, got %lld", a->index ? "--index" : "--source", (long long)n,
+                               (long long)(a->index ? a->index : a->source));
+    }
+    cli_query *q = NULL;
+    int64_t nq = 0;
+    if (a->queries && (rc0 = load_queries(a->queries, n, &q, &nq))) {
+        ulam_part_free(p);
+        return rc0;
+    }
+    double rho = INFINITY; /* the variance guard: the interval is printed only when it is below 1 */
+    status = ulam_dist_radius(p, c, walks_forward, 200, &rho, &err);
+    ulam_dist_result r = {0};
+    ulam_dist_mcsa_info mi = {0};
+    ulam_dist_source_info si = {0};
+    double *x = NULL, *se = NULL;
+    ulam_dist_result *many = NULL;
+    if (status) {
+    } else if (q) {
+        int64_t *idx = malloc((size_t)nq * sizeof *idx);
+        many = malloc((size_t)nq * sizeof *many);
+        for (int64_t k = 0; idx && many && k < nq; k++) idx[k] = q[k].index;
+        status = idx && many ? ulam_dist_adjoint_many(p, c, idx, nq, &a->o, many, &err) : ULAM_ENOMEM;
+        if (!status) r = many[0];
+        free(idx);
+    } else if (a->forward || a->mcsa || a->source) {
+        x = malloc(((size_t)(last - first) + 1) * sizeof *x);
+        se = malloc(((size_t)(last - first) + 1) * sizeof *se);
+        if (!x || !se) status = ULAM_ENOMEM;
+        else if (a->mcsa) status = ulam_dist_mcsa(p, c, &a->o, a->tol, (int)a->max_iter, x, &mi, &err);
+        else if (a->source) status = ulam_dist_source(p, c, a->source - 1, &a->o, 1e-4, 1000, x, se, &si, &err);
+        else status = ulam_dist_forward(p, c, &a->o, x, NULL, &r, &err);
+        if (!status && a->mcsa) r.walks = mi.walks, r.steps = mi.steps, r.crossings = mi.crossings;
+        if (!status && a->source) r.walks = si.walks, r.steps = si.steps, r.crossings = si.crossings;
+    } else {
+        status = ulam_dist_adjoint(p, c, a->index - 1, &a->o, &r, &err);
+    }
+    ulam_part_free(p);
+    int rc = status ? (cli_report(a->path, &err), cli_exit_code(status)) : 0;
+    int in_set0 = c->sets <= 1 || c->rank < c->nranks / c->sets; /* set 0's ranks hold x */
+    if (!rc && a->out) rc = write_x(c, a->out, x, in_set0 ? last - first : 0, n);
+    int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
+    if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
+    for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, &many[k], a->o.seed, rho);
+    if (!rc && a->source) rc = print_top(c, x, se, first, last - first, a->top, rho);
+    if (!rc && c->rank == 0 && a->mcsa)
+        printf("x               %lld components by MCSA%s%s\nmcsa            %d iterations, residual %.3g of max |b| "
+               "(target %.3g)\n", (long long)n, a->out ? ", written to " : "", a->out ? a->out : "", mi.iterations,
+               mi.residual, a->tol);
+    if (!rc && c->rank == 0 && a->source && cli_verbosity >= 0)
+        printf("push            %d products with M, max |r| %.3g left to the walks\n", si.rounds, si.residual);
+    if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v, rho);
+    if (!rc && a->mcsa && mi.residual > a->tol) {
+        if (c->rank == 0) fprintf(stderr, "ulam: %s: error: MCSA stopped at --max-iter %lld with residual %.3g above --tol %.3g\n",
+                                  a->path, (long long)a->max_iter, mi.residual, a->tol);
+        rc = cli_exit_code(ULAM_ENOCONV);
+    }
+    free(x), free(se), free(v), free(q), free(many);
+    return rc;
+}
+
+/* Check and run (see cli_solve_row.run). */
+static int start_run(void *p, int argc, char **argv, int first)
+{
+    args *a = p;
+    int rc = check(a, argc, argv, first);
+    if (rc) return rc;
+    ulam_comm c = {.rank = 0, .nranks = 1};
+#ifdef ULAM_MPI
+    cli_mpi_comm(&c);
+#endif
+    c.sets = (int)a->sets;
+    return run(a, &c);
+}
+
+/* --partition selects this row whatever else is given. */
+static const char *const claims[] = {"partition", NULL};
+
+/* No --method value is this row's. */
+static int serves(const char *method)
+{
+    (void)method;
+    return 0;
+}
+
+const cli_solve_row cli_solve_partition_row = {"partition", longopts, claims, serves, sizeof(args), init, option, start_run};

@@ -1,0 +1,120 @@
+/* Outer iterations on a partition (ulam_dist.h): MCSA, whose residual is a product with M over
+ * the ranks' rows, and single source, a push of e_s by products with M then forward walks from
+ * what is left.  Both need the part's rows of M and of M' (ULAM_PART_BOTH).  Every norm that
+ * decides a stop is a largest |entry|, the same bits whatever the split. */
+#include "part.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* y = M v on this rank's rows, v whole (gathered first into all). */
+static void matvec(const ulam_part *p, const double *all, double *y)
+{
+    const ulam__rows *A = &p->m;
+    for (int64_t i = 0; i < p->last - p->first; i++) {
+        double s = 0.0;
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += A->val[q] * all[A->col[q]];
+        y[i] = s;
+    }
+}
+
+/* r = b - (I - M) x on this rank's rows (all: room for the whole x); the largest |r_i| over the
+ * ranks into *rmax; nonzero on a failed exchange. */
+static int residual(const ulam_part *p, const ulam_comm *c, const double *x, double *all, double *r, double *rmax)
+{
+    if (ulam__dist_gather(p, c, x, all)) return 1;
+    matvec(p, all, r);
+    *rmax = 0.0;
+    for (int64_t i = 0; i < p->last - p->first; i++) {
+        r[i] = p->b[i] - x[i] + r[i];
+        if (fabs(r[i]) > *rmax) *rmax = fabs(r[i]);
+    }
+    return ulam__dist_largest(c, rmax);
+}
+
+/* The largest |b_i| over the ranks. */
+static int largest_abs(const ulam_part *p, const ulam_comm *c, const double *v, double *out)
+{
+    *out = 0.0;
+    for (int64_t i = 0; i < p->last - p->first; i++)
+        if (fabs(v[i]) > *out) *out = fabs(v[i]);
+    return ulam__dist_largest(c, out);
+}
+
+/* x of (I - M) x = b by MCSA on the partition. */
+int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
+                   double *x, ulam_dist_mcsa_info *info, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!p || !comm || !x || !info || !(tol > 0) || max_iter < 1)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, info, tol > 0 and max_iter >= 1");
+    if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
+    if (p->sets > 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "one set (MCSA's walks are not split among sets)");
+    *info = (ulam_dist_mcsa_info){0};
+    int64_t rows = p->last - p->first;
+    double *all = malloc(((size_t)p->n + 1) * sizeof *all), *r = malloc(((size_t)rows + 1) * sizeof *r);
+    double *d = malloc(((size_t)rows + 1) * sizeof *d);
+    int status = all && r && d ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for MCSA's vectors");
+    double bmax = 0.0, rmax = 0.0;
+    if (!status && largest_abs(p, comm, p->b, &bmax)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
+    memset(x, 0, (size_t)rows * sizeof *x);
+    ulam_dist_opts w = o ? *o : ulam_dist_defaults();
+    for (int it = 0; !status; it++) {
+        if (residual(p, comm, x, all, r, &rmax)) {
+            status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+            break;
+        }
+        info->residual = bmax > 0 ? rmax / bmax : rmax;
+        if (!(info->residual > tol) || it == max_iter) break;
+        for (int64_t i = 0; i < rows; i++) x[i] += r[i]; /* the Richardson step */
+        if (residual(p, comm, x, all, r, &rmax)) {
+            status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+            break;
+        }
+        ulam_dist_result res;
+        w.seed = (o ? o->seed : 1) + (uint64_t)it; /* iteration it's walks: their own streams */
+        status = ulam_dist_forward_b(p, comm, &w, r, d, NULL, &res, err);
+        for (int64_t i = 0; !status && i < rows; i++) x[i] += d[i]; /* the Monte Carlo correction */
+        info->iterations = it + 1, info->walks += res.walks, info->steps += res.steps, info->crossings += res.crossings;
+    }
+    free(all), free(r), free(d);
+    return status;
+}
+
+/* x = (I - M)^-1 e_source on the partition: push, then walks from the rest. */
+int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
+                     int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!p || !comm || !x || !se || !info || !(tol >= 0) || max_rounds < 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, se, info, tol >= 0 and max_rounds >= 0");
+    if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
+    if (p->sets > 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "one set (single source's walks are not split among sets)");
+    if (source < 0 || source >= p->n) return ulam__fail(err, ULAM_EINVAL, 0, source, "a source in 1 .. %lld", (long long)p->n);
+    *info = (ulam_dist_source_info){0};
+    int64_t rows = p->last - p->first;
+    double *all = malloc(((size_t)p->n + 1) * sizeof *all), *r = calloc((size_t)rows + 1, sizeof *r);
+    double *y = malloc(((size_t)rows + 1) * sizeof *y);
+    int status = all && r && y ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push's vectors");
+    memset(x, 0, (size_t)rows * sizeof *x);
+    if (!status && source >= p->first && source < p->last) r[source - p->first] = 1.0;
+    double rmax = 1.0;
+    for (int k = 0; !status && k < max_rounds && rmax > tol; k++) { /* x += r, r <- M r */
+        for (int64_t i = 0; i < rows; i++) x[i] += r[i];
+        if (ulam__dist_gather(p, comm, r, all)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
+        if (!status) matvec(p, all, r);
+        if (!status && largest_abs(p, comm, r, &rmax)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
+        info->rounds = k + 1;
+    }
+    info->residual = rmax;
+    ulam_dist_result res = {0};
+    if (!status) status = ulam_dist_forward_b(p, comm, o, r, y, se, &res, err); /* (I - M)^-1 r by walks */
+    for (int64_t i = 0; !status && i < rows; i++) {
+        x[i] += y[i];
+        if (rmax == 0.0) se[i] = 0.0; /* nothing left to walk: the push is the answer */
+    }
+    info->walks = res.walks, info->steps = res.steps, info->crossings = res.crossings;
+    free(all), free(r), free(y);
+    return status;
+}

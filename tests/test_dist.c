@@ -1,0 +1,482 @@
+/* Partitioned systems and walks that migrate (ulam_dist.h), with k ranks as k threads of this
+ * process sharing an in-memory exchange: the same answer bit for bit at 1, 2, 3 and 5 ranks, each
+ * rank holding only its rows, the estimates within 4 standard errors of LAPACK's x, and a damaged
+ * block refused by the rank that reads it. */
+#include "testutil.h"
+#include "hub.h"
+
+#include <unistd.h>
+
+enum { MAXR = HUB_MAX };
+
+/* One thread-rank's job and what it found. */
+typedef struct {
+    port port;
+    const char *path;
+    int forward;
+    int64_t index, walks;
+    int radius; /* run ulam_dist_radius instead of walks, into rho */
+    int sets;   /* ranks in sets (0: one) */
+    const int64_t *many; /* nq > 0: ulam_dist_adjoint_many over many[0 .. nq) into manyres */
+    int64_t nq;
+    ulam_dist_result manyres[4];
+    uint64_t seed;
+    int outer; /* 1: MCSA into x; 2: single source from index into x and se */
+    ulam_dist_mcsa_info mi;
+    ulam_dist_source_info si;
+    double rho;
+    int status;
+    ulam_dist_result res;
+    double *x, *se; /* forward: the whole vector, each rank filling its rows */
+    int64_t first, last, n;
+} job;
+
+/* Run one rank's part of the job. */
+static void *rank_main(void *arg)
+{
+    job *j = arg;
+    ulam_comm c = hub_comm(&j->port);
+    c.sets = j->sets;
+    ulam_part *p = NULL;
+    ulam_error err;
+    j->status = ulam_part_open(j->path, &c, j->outer ? ULAM_PART_BOTH : j->forward ? ULAM_PART_MT : ULAM_PART_M, &p, &err);
+    int failed = j->status != ULAM_OK;
+    int64_t any = failed;
+    hub_sum(&j->port, &any, 1); /* every rank learns whether one failed, as a CLI would */
+    if (any) {
+        ulam_part_free(p);
+        return NULL;
+    }
+    j->n = ulam_part_rows(p, &j->first, &j->last, NULL);
+    ulam_dist_opts o = ulam_dist_defaults();
+    o.walks = j->walks, o.batch = 997, o.seed = 7 + j->seed;
+    if (j->outer == 1) j->status = ulam_dist_mcsa(p, &c, &o, 1e-10, 60, j->x + j->first, &j->mi, &err);
+    else if (j->outer == 2)
+        j->status = ulam_dist_source(p, &c, j->index, &o, 1e-3, 1000, j->x + j->first, j->se + j->first, &j->si, &err);
+    else if (j->nq) j->status = ulam_dist_adjoint_many(p, &c, j->many, j->nq, &o, j->manyres, &err);
+    else if (j->radius) j->status = ulam_dist_radius(p, &c, 0, 300, &j->rho, &err);
+    else if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
+    else j->status = ulam_dist_adjoint(p, &c, j->index, &o, &j->res, &err);
+    ulam_part_free(p);
+    return NULL;
+}
+
+/* Run a job on k thread-ranks; the jobs' results in jobs[0 .. k). */
+static void run_sets(int k, int sets, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se,
+                     job *jobs)
+{
+    hub h;
+    hub_init(&h, k);
+    pthread_t t[MAXR];
+    for (int r = 0; r < k; r++) {
+        jobs[r] = (job){.port = {&h, r}, .path = path, .forward = forward, .index = index, .walks = walks, .x = x, .se = se,
+                        .sets = sets};
+        pthread_create(&t[r], NULL, rank_main, &jobs[r]);
+    }
+    for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
+    pthread_barrier_destroy(&h.bar);
+}
+
+/* Run a job on k thread-ranks as one partition. */
+static void run_ranks(int k, const char *path, int forward, int64_t index, int64_t walks, double *x, double *se, job *jobs)
+{
+    run_sets(k, 0, path, forward, index, walks, x, se, jobs);
+}
+
+/* Run ulam_dist_radius on k thread-ranks. */
+static void run_ranks_radius(int k, const char *path, job *jobs)
+{
+    hub h;
+    hub_init(&h, k);
+    pthread_t t[MAXR];
+    for (int r = 0; r < k; r++) {
+        jobs[r] = (job){.port = {&h, r}, .path = path, .radius = 1, .walks = 1};
+        pthread_create(&t[r], NULL, rank_main, &jobs[r]);
+    }
+    for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
+    pthread_barrier_destroy(&h.bar);
+}
+
+/* A random sparse signed M (n x n, about deg entries a row, |row sums| 0.9 at most, some rows
+ * leaving the system) and b, written as a prepared file with M' at path; x solved by LAPACK. */
+static void make_system(const char *path, int64_t n, int deg, uint64_t seed, double *x)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 0);
+    int64_t cap = n * deg;
+    int32_t *ti = malloc((size_t)cap * sizeof *ti), *tj = malloc((size_t)cap * sizeof *tj);
+    double *tv = malloc((size_t)cap * sizeof *tv), *b = malloc((size_t)n * sizeof *b);
+    int64_t nz = 0;
+    for (int64_t i = 0; i < n; i++) {
+        int d = 1 + (int)ulam_rng_bounded(&r, (uint64_t)deg);
+        double keep = i % 7 == 0 ? 0.3 : 0.9;
+        for (int q = 0; q < d; q++) {
+            int64_t j = q == 0 ? (i + 1) % n : (int64_t)ulam_rng_bounded(&r, (uint64_t)n); /* a long cycle: walks cross */
+            ti[nz] = (int32_t)i, tj[nz] = (int32_t)j;
+            tv[nz++] = keep / d * (ulam_rng_uniform(&r) < 0.2 ? -1.0 : 1.0);
+        }
+        b[i] = ulam_rng_uniform(&r) < 0.5 ? 0.0 : 1.0 + ulam_rng_uniform(&r);
+    }
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, &M), ULAM_OK);
+    ulam_system_desc d = ulam_system_desc_defaults();
+    d.M = M, d.b = b, d.n = n, d.transpose = 1;
+    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    ulam_csr_free(M);
+    free(ti), free(tj), free(tv), free(b);
+}
+
+/* Adjoint: one answer, bit for bit, at 1, 2, 3 and 5 ranks, within 4 standard errors of x. */
+static void test_dist_adjoint_identical(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 1500;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 6, 11, x);
+    const int ks[] = {1, 2, 3, 5};
+    const int64_t idx[] = {0, 749, 1499};
+    for (int c = 0; c < 3; c++) {
+        test_case(c);
+        double first = NAN, se = NAN;
+        for (int q = 0; q < 4; q++) {
+            job jobs[MAXR];
+            run_ranks(ks[q], path, 0, idx[c], 10000, NULL, NULL, jobs);
+            for (int r = 0; r < ks[q]; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+            for (int r = 1; r < ks[q]; r++) assert_memory_equal(&jobs[r].res.estimate, &jobs[0].res.estimate, sizeof(double));
+            if (q == 0) first = jobs[0].res.estimate, se = jobs[0].res.std_error;
+            assert_memory_equal(&jobs[0].res.estimate, &first, sizeof first);
+            assert_memory_equal(&jobs[0].res.std_error, &se, sizeof se);
+            if (ks[q] > 1) assert_true(jobs[0].res.crossings > 0); /* walks did migrate */
+            else assert_int_equal(jobs[0].res.crossings, 0);
+        }
+        assert_true(se > 0);
+        if (fabs(first - x[idx[c]]) >= 4 * se)
+            fail_msg("x[%lld] = %.9g, estimate %.9g +- %.3g", (long long)idx[c], x[idx[c]], first, se);
+    }
+    test_case_done();
+    free(x);
+    unlink(path);
+}
+
+/* Forward: every component bit for bit at 1, 2 and 3 ranks; each rank reads only its rows; the
+ * components' z-scores against x: at least 93% within 1.96 (binomial bound on 95% of 1500:
+ * mean 1425, sd 8.4; 1395 is 3.5 sd below), none beyond 6. */
+static void test_dist_forward_identical(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 1500;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 6, 12, x);
+    double *ref = malloc((size_t)n * sizeof *ref), *refse = malloc((size_t)n * sizeof *refse);
+    double *y = malloc((size_t)n * sizeof *y), *yse = malloc((size_t)n * sizeof *yse);
+    const int ks[] = {1, 2, 3};
+    for (int q = 0; q < 3; q++) {
+        job jobs[MAXR];
+        run_ranks(ks[q], path, 1, 0, 60000, q ? y : ref, q ? yse : refse, jobs);
+        int64_t rows = 0;
+        for (int r = 0; r < ks[q]; r++) {
+            assert_int_equal(jobs[r].status, ULAM_OK);
+            rows += jobs[r].last - jobs[r].first;
+            if (ks[q] > 1) assert_true(jobs[r].last - jobs[r].first < n); /* nobody holds all rows */
+        }
+        assert_int_equal(rows, n);
+        if (q) {
+            assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+            assert_memory_equal(yse, refse, (size_t)n * sizeof *yse);
+        }
+    }
+    int64_t in = 0;
+    for (int64_t i = 0; i < n; i++) {
+        double z = (ref[i] - x[i]) / refse[i];
+        if (!(fabs(z) < 6)) fail_msg("x[%lld] = %.9g, estimate %.9g +- %.3g", (long long)i, x[i], ref[i], refse[i]);
+        in += fabs(z) < 1.96;
+    }
+    if (in < 1395) fail_msg("%lld of %lld components within 1.96 standard errors", (long long)in, (long long)n);
+    free(x), free(ref), free(refse), free(y), free(yse);
+    unlink(path);
+}
+
+/* Replication x partition: ranks in 2 or 3 sets, each a whole partition running its own batches,
+ * give the adjoint and forward answers of one partition bit for bit; with sets each rank holds
+ * more rows than without. */
+static void test_dist_sets(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 900;
+    double *x = malloc((size_t)n * sizeof *x), *ref = malloc((size_t)n * sizeof *ref);
+    double *y = malloc((size_t)n * sizeof *y), *se = malloc((size_t)n * sizeof *se), *yse = malloc((size_t)n * sizeof *yse);
+    make_system(path, n, 5, 15, x);
+    job jobs[MAXR];
+    run_ranks(1, path, 0, 450, 5000, NULL, NULL, jobs);
+    double est = jobs[0].res.estimate, sd = jobs[0].res.std_error;
+    run_ranks(1, path, 1, 0, 20000, ref, se, jobs);
+    const int ks[][2] = {{2, 2}, {4, 2}, {6, 3}, {6, 2}};
+    for (int c = 0; c < 4; c++) {
+        test_case(c);
+        int k = ks[c][0], sets = ks[c][1];
+        run_sets(k, sets, path, 0, 450, 5000, NULL, NULL, jobs);
+        for (int r = 0; r < k; r++) {
+            assert_int_equal(jobs[r].status, ULAM_OK);
+            assert_memory_equal(&jobs[r].res.estimate, &est, sizeof est);
+            assert_memory_equal(&jobs[r].res.std_error, &sd, sizeof sd);
+        }
+        memset(y, 0, (size_t)n * sizeof *y);
+        run_sets(k, sets, path, 1, 0, 20000, y, yse, jobs);
+        for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+        assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+        assert_memory_equal(yse, se, (size_t)n * sizeof *y);
+        int64_t rows = 0;
+        for (int r = 0; r < k / sets; r++) rows += jobs[r].last - jobs[r].first; /* set 0 holds every row once */
+        assert_int_equal(rows, n);
+    }
+    test_case_done();
+    run_sets(3, 2, path, 0, 450, 100, NULL, NULL, jobs); /* 2 sets do not divide 3 ranks */
+    for (int r = 0; r < 3; r++) assert_int_equal(jobs[r].status, ULAM_EINVAL);
+    free(x), free(ref), free(y), free(se), free(yse);
+    unlink(path);
+}
+
+/* Many queries at once (ulam_dist_adjoint_many): query k's answer is a lone run's with seed + k,
+ * bit for bit, at 1 and 3 ranks. */
+static void test_dist_many(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 700;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 5, 16, x);
+    const int64_t idx[4] = {3, 350, 699, 350};
+    for (int k = 1; k <= 3; k += 2) {
+        hub h;
+        hub_init(&h, k);
+        pthread_t t[MAXR];
+        job jobs[MAXR];
+        for (int r = 0; r < k; r++) {
+            jobs[r] = (job){.port = {&h, r}, .path = path, .walks = 3000, .many = idx, .nq = 4};
+            pthread_create(&t[r], NULL, rank_main, &jobs[r]);
+        }
+        for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
+        pthread_barrier_destroy(&h.bar);
+        for (int q = 0; q < 4; q++) {
+            job lone[MAXR];
+            hub h1;
+            hub_init(&h1, 1);
+            lone[0] = (job){.port = {&h1, 0}, .path = path, .walks = 3000, .index = idx[q], .seed = (uint64_t)q};
+            rank_main(&lone[0]);
+            pthread_barrier_destroy(&h1.bar);
+            for (int r = 0; r < k; r++) {
+                assert_int_equal(jobs[r].status, ULAM_OK);
+                assert_memory_equal(&jobs[r].manyres[q].estimate, &lone[0].res.estimate, sizeof(double));
+                assert_memory_equal(&jobs[r].manyres[q].std_error, &lone[0].res.std_error, sizeof(double));
+            }
+        }
+        assert_true(jobs[0].manyres[1].estimate != jobs[0].manyres[3].estimate); /* same index, other seed */
+    }
+    free(x);
+    unlink(path);
+}
+
+/* Run an outer method (1 MCSA, 2 single source from index) on k thread-ranks into x, se. */
+static void run_outer(int k, int outer, const char *path, int64_t index, int64_t walks, double *x, double *se, job *jobs)
+{
+    hub h;
+    hub_init(&h, k);
+    pthread_t t[MAXR];
+    for (int r = 0; r < k; r++) {
+        jobs[r] = (job){.port = {&h, r}, .path = path, .outer = outer, .index = index, .walks = walks, .x = x, .se = se};
+        pthread_create(&t[r], NULL, rank_main, &jobs[r]);
+    }
+    for (int r = 0; r < k; r++) pthread_join(t[r], NULL);
+    pthread_barrier_destroy(&h.bar);
+}
+
+/* MCSA on a partition: to a residual of 1e-10 of max |b|, x within 1e-8 of LAPACK's, the same
+ * bits at 1, 2 and 3 ranks. */
+static void test_dist_mcsa(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 800;
+    double *x = malloc((size_t)n * sizeof *x), *ref = malloc((size_t)n * sizeof *ref), *y = malloc((size_t)n * sizeof *y);
+    make_system(path, n, 5, 17, x);
+    for (int k = 1; k <= 3; k++) {
+        job jobs[MAXR];
+        run_outer(k, 1, path, 0, 20000, k == 1 ? ref : y, NULL, jobs);
+        for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+        if (!(jobs[0].mi.residual <= 1e-10 && jobs[0].mi.iterations < 60)) fail_msg("residual %.3g after %d iterations", jobs[0].mi.residual, jobs[0].mi.iterations);
+        if (k > 1) assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+    }
+    double big = 0, worst = 0;
+    for (int64_t i = 0; i < n; i++) big = fmax(big, fabs(x[i])), worst = fmax(worst, fabs(ref[i] - x[i]));
+    if (!(worst <= 1e-8 * big)) fail_msg("max |x - LAPACK| = %.3g of max |x| %.3g", worst, big);
+    free(x), free(ref), free(y);
+    unlink(path);
+}
+
+/* Single source on a partition: x = (I - M)^-1 e_s within 4 standard errors of LAPACK's column
+ * wherever the walks gave one (the push's own part exact), at least 90% within 1.96, the same
+ * bits at 1, 2 and 3 ranks. */
+static void test_dist_source(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 600, s = 123;
+    double *x = malloc((size_t)n * sizeof *x), *col = calloc((size_t)n, sizeof *col), *e = calloc((size_t)n, sizeof *e);
+    double *ref = malloc((size_t)n * sizeof *ref), *rse = malloc((size_t)n * sizeof *rse);
+    double *y = malloc((size_t)n * sizeof *y), *yse = malloc((size_t)n * sizeof *yse);
+    make_system(path, n, 5, 18, x);
+    ulam_system *sys = NULL;
+    assert_int_equal(ulam_system_open(path, NULL, &sys, NULL), ULAM_OK);
+    e[s] = 1.0;
+    assert_int_equal(ulam_direct_solve(ulam_system_matrix(sys), e, col, 0, NULL, NULL), ULAM_OK);
+    ulam_system_free(sys);
+    for (int k = 1; k <= 3; k++) {
+        job jobs[MAXR];
+        run_outer(k, 2, path, s, 20000, k == 1 ? ref : y, k == 1 ? rse : yse, jobs);
+        for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+        assert_true(jobs[0].si.rounds > 0 && jobs[0].si.residual <= 1e-3);
+        if (k > 1) {
+            assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+            assert_memory_equal(yse, rse, (size_t)n * sizeof *y);
+        }
+    }
+    int64_t with = 0, in = 0;
+    for (int64_t i = 0; i < n; i++) {
+        if (isnan(rse[i]) || rse[i] == 0) continue;
+        double z = (ref[i] - col[i]) / rse[i];
+        if (!(fabs(z) < 4)) fail_msg("x[%lld] %.9g, column %.9g, se %.3g", (long long)i, ref[i], col[i], rse[i]);
+        with++, in += fabs(z) < 1.96;
+    }
+    assert_true(with > 50);
+    if (in < 0.9 * (double)with) fail_msg("%lld of %lld within 1.96 standard errors", (long long)in, (long long)with);
+    free(x), free(col), free(e), free(ref), free(rse), free(y), free(yse);
+    unlink(path);
+}
+
+/* A damaged block: refused (ULAM_ESYNTAX) by the rank whose rows hold it, at 1 and 3 ranks. */
+static void test_dist_damaged(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 600;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 4, 13, x);
+    FILE *f = fopen(path, "r+b");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    long len = ftell(f);
+    fseek(f, len - 4096 * 3 - 100, SEEK_SET); /* inside M''s values, near the end */
+    int ch = fgetc(f);
+    fseek(f, len - 4096 * 3 - 100, SEEK_SET);
+    fputc(ch ^ 0x10, f);
+    fclose(f);
+    job jobs[MAXR];
+    double *y = malloc((size_t)n * sizeof *y), *yse = malloc((size_t)n * sizeof *yse);
+    run_ranks(1, path, 1, 0, 100, y, yse, jobs);
+    assert_int_equal(jobs[0].status, ULAM_ESYNTAX);
+    run_ranks(3, path, 1, 0, 100, y, yse, jobs);
+    int bad = 0;
+    for (int r = 0; r < 3; r++) bad += jobs[r].status == ULAM_ESYNTAX;
+    assert_int_equal(bad, 1);
+    free(x), free(y), free(yse);
+    unlink(path);
+}
+
+/* The variance guard: the same bits at 1, 2 and 3 ranks, at or above rho(M^) (M^ = |M| here: row
+ * sums below 1) by 2000 dense power steps, and below 1 (certified). */
+static void test_dist_radius(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    int64_t n = 400;
+    double *x = malloc((size_t)n * sizeof *x);
+    make_system(path, n, 5, 14, x);
+    ulam_system *sys = NULL;
+    assert_int_equal(ulam_system_open(path, NULL, &sys, NULL), ULAM_OK);
+    const ulam_csr *M = ulam_system_matrix(sys);
+    double *v = malloc((size_t)n * sizeof *v), *y = malloc((size_t)n * sizeof *y), rho = 0;
+    for (int64_t i = 0; i < n; i++) v[i] = 1.0;
+    for (int k = 0; k < 2000; k++) { /* |M| v / ||.||: its growth tends to rho(|M|) */
+        double top = 0;
+        for (int64_t i = 0; i < n; i++) {
+            y[i] = 0;
+            for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) y[i] += fabs(M->val[q]) * v[M->colidx[q]];
+            if (y[i] > top) top = y[i];
+        }
+        rho = top;
+        for (int64_t i = 0; i < n; i++) v[i] = y[i] / top;
+    }
+    ulam_system_free(sys);
+    double first = NAN;
+    for (int k = 1; k <= 3; k++) {
+        job jobs[MAXR];
+        run_ranks_radius(k, path, jobs);
+        for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+        if (k == 1) first = jobs[0].rho;
+        for (int r = 0; r < k; r++) assert_memory_equal(&jobs[r].rho, &first, sizeof first);
+    }
+    if (!(first >= rho && first < 1.0)) fail_msg("bound %.9g, rho(|M|) %.9g", first, rho);
+    free(x), free(v), free(y);
+    unlink(path);
+}
+
+/* Counter-based numbers: keyed by (seed, walk, step, k), in [0, 1), and not all alike. */
+static void test_dist_counter(void **state)
+{
+    (void)state;
+    assert_true(ulam_rng_counter(1, 2, 3, 0) == ulam_rng_counter(1, 2, 3, 0));
+    double s = 0, s2 = 0;
+    int N = 100000;
+    for (int i = 0; i < N; i++) {
+        double u = ulam_rng_counter(5, (uint64_t)i / 10, (uint64_t)i % 10, (unsigned)i % 3);
+        assert_true(u >= 0 && u < 1);
+        s += u, s2 += u * u;
+    }
+    double mean = s / N, var = s2 / N - mean * mean;
+    assert_true(fabs(mean - 0.5) < 4 * sqrt(1.0 / 12 / N)); /* 4 standard errors */
+    assert_true(fabs(var - 1.0 / 12) < 0.002);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_dist_counter),
+        cmocka_unit_test(test_dist_adjoint_identical),
+        cmocka_unit_test(test_dist_forward_identical),
+        cmocka_unit_test(test_dist_damaged),
+        cmocka_unit_test(test_dist_radius),
+        cmocka_unit_test(test_dist_sets),
+        cmocka_unit_test(test_dist_many),
+        cmocka_unit_test(test_dist_mcsa),
+        cmocka_unit_test(test_dist_source),
+    };
+    return test_run(tests);
+}
