@@ -86,10 +86,11 @@ double ulam_luminaire_illuminance(const ulam_tracer *t, const ulam_luminaire *l,
                                   const double x[3], const double n[3], int64_t self);
 
 /* Every patch's mean direct illuminance in lux (H: npatches), by the midpoint rule on a q x q
- * split of each fan triangle (q^2 equal sub-triangles, their centroids; q in 1..64).  The
- * luminous flux the patches receive is sum_p A_p metres^2 H_p.  ULAM_EINVAL for bad arguments. */
+ * split of each fan triangle (q^2 equal sub-triangles, their centroids; q in 1..64), on `threads`
+ * threads (0: all cores; the answer does not depend on them).  The luminous flux the patches
+ * receive is sum_p A_p metres^2 H_p.  ULAM_EINVAL for bad arguments. */
 int ulam_luminaire_patch_illuminance(const ulam_tracer *t, const ulam_luminaire *l, int64_t nl, double metres, int q,
-                                     double *H, ulam_error *err);
+                                     int threads, double *H, ulam_error *err);
 
 /* The EN 12464-1 calculation grid of a work plane: the rectangle with opposite corners c0 and c1
  * (equal in exactly one coordinate, its plane; scene units) less a band of `band` metres along

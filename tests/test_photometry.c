@@ -317,11 +317,15 @@ static void test_point_source(void **state)
     assert_true(ulam_luminaire_illuminance(t, &l, 1, 1.0, out, n, 3) > 0.0);
     /* patch means: the blocker's top face sees the lamp (facing up), the floor patch under it is part dark */
     double *H = calloc((size_t)sc->npatches, sizeof *H);
-    assert_int_equal(ulam_luminaire_patch_illuminance(t, &l, 1, 1.0, 8, H, NULL), ULAM_OK);
+    assert_int_equal(ulam_luminaire_patch_illuminance(t, &l, 1, 1.0, 8, 2, H, NULL), ULAM_OK);
     assert_true(H[4] > H[3]);
+    double *H1 = calloc((size_t)sc->npatches, sizeof *H1); /* one thread: the same bits */
+    assert_int_equal(ulam_luminaire_patch_illuminance(t, &l, 1, 1.0, 8, 1, H1, NULL), ULAM_OK);
+    assert_memory_equal(H, H1, (size_t)sc->npatches * sizeof *H);
+    free(H1);
     l.nadir[0] = l.nadir[1] = l.nadir[2] = 0; /* no frame */
     assert_true(isnan(ulam_luminaire_illuminance(t, &l, 1, 1.0, in, n, 3)));
-    assert_int_equal(ulam_luminaire_patch_illuminance(t, &l, 1, 1.0, 8, H, NULL), ULAM_EINVAL);
+    assert_int_equal(ulam_luminaire_patch_illuminance(t, &l, 1, 1.0, 8, 2, H, NULL), ULAM_EINVAL);
     free(H);
     ulam_tracer_free(t), ulam_scene_free(sc);
     ulam_gonio_free(g);
@@ -346,7 +350,7 @@ static void test_box_flux(void **state)
     l.gonio = g, l.pos[0] = l.pos[1] = l.pos[2] = 0.5;
     double *H = calloc((size_t)fine->npatches, sizeof *H), err_q[2];
     for (int k = 0; k < 2; k++) {
-        assert_int_equal(ulam_luminaire_patch_illuminance(t, &l, 1, 1.0, k ? 16 : 4, H, NULL), ULAM_OK);
+        assert_int_equal(ulam_luminaire_patch_illuminance(t, &l, 1, 1.0, k ? 16 : 4, k + 1, H, NULL), ULAM_OK);
         double flux = 0.0;
         for (int64_t p = 0; p < fine->npatches; p++) flux += fine->area[p] * H[p];
         err_q[k] = fabs(flux / (400.0 * M_PI) - 1.0);

@@ -125,7 +125,7 @@ int cli_photo_finish(cli_photo *p, const char *cmd, int grid_given, ulam_rad_gri
 }
 
 /* Read the luminaires and light the scene; 0 or an exit code. */
-int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const char *scene)
+int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const char *scene, int threads)
 {
     if (!p->active) return 0;
     ulam_error err;
@@ -148,7 +148,7 @@ int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const cha
     double tri = 0.0; /* fan triangles: q^2 shadow rays each a luminaire, about 2 10^7 in all, q in 2 .. 8 */
     for (int64_t i = 0; i < s->npatches; i++) tri += (double)(s->start[i + 1] - s->start[i] - 2);
     p->q = (int)fmax(2.0, fmin(8.0, floor(sqrt(2e7 / fmax(1.0, tri * p->nlum)))));
-    if (ulam_luminaire_patch_illuminance(t, p->lum, p->nlum, p->metres, p->q, p->H, &err))
+    if (ulam_luminaire_patch_illuminance(t, p->lum, p->nlum, p->metres, p->q, threads, p->H, &err))
         return cli_report(scene, &err);
     p->onto = 0.0;
     for (int64_t i = 0; i < s->npatches; i++) {

@@ -37,8 +37,9 @@ int cli_photo_option(cli_photo *p, const char *cmd, const char *name, const char
 int cli_photo_finish(cli_photo *p, const char *cmd, int grid_given, ulam_rad_grid *g, int *grid);
 
 /* Read the luminaires, light the scene s (tracer t on it): every patch's mean direct illuminance,
- * the reflected part rho H added to its emission (the scene's own kept); 0 or an exit code. */
-int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const char *scene);
+ * the reflected part rho H added to its emission (the scene's own kept), on `threads` threads (0:
+ * all cores, --threads); 0 or an exit code. */
+int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const char *scene, int threads);
 
 /* Point answers pts[0..n) (on the lit scene): add each point's direct illuminance
  * (exact) to its irradiance and interval and rho times it to its radiosity, and put the scene's

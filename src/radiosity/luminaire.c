@@ -116,7 +116,7 @@ double ulam_luminaire_illuminance(const ulam_tracer *t, const ulam_luminaire *l,
 
 /* Every patch's mean direct illuminance in lux (the midpoint rule on q x q splits). */
 int ulam_luminaire_patch_illuminance(const ulam_tracer *t, const ulam_luminaire *l, int64_t nl, double metres, int q,
-                                     double *H, ulam_error *err)
+                                     int threads, double *H, ulam_error *err)
 {
     ulam__clear(err);
     if (!t || (!l && nl) || nl < 0 || nl > 1000000 || !H || !(metres > 0) || !isfinite(metres) || q < 1 || q > 64)
@@ -129,7 +129,8 @@ int ulam_luminaire_patch_illuminance(const ulam_tracer *t, const ulam_luminaire 
                                                    "nadir and C0 axes that are not parallel");
     }
     const ulam_scene *s = ulam__tracer_scene(t);
-#pragma omp parallel for schedule(dynamic, 16)
+    int nth = ulam__threads(threads);
+#pragma omp parallel for schedule(dynamic, 16) num_threads(nth)
     for (int64_t p = 0; p < s->npatches; p++) {
         const double *n = s->normal + 3 * p, *v0 = s->vert + 3 * s->vidx[s->start[p]];
         double acc = 0.0, area = 0.0;
