@@ -375,6 +375,12 @@ def check_refused(d):
     assert "--luminaire expects FILE@x,y,z" in p.stderr, p.stderr
     p = run([scene, "--luminaire", f"{bad}@0,2,0,0,-1,0,0,-1,0", "--at", "0.1,0,0.1"], code=2)
     assert "--luminaire expects" in p.stderr, p.stderr
+    lamp = isotropic_cosine_ies(d)
+    mm = floor_scene(d, 1000.0)  # 4000 units across with no --unit: lux would be 1e6 too high, so a warning
+    p = run([mm, "--luminaire", f"{lamp}@0,2500,0", "--at", "100,0,100", "--walks", "100"])
+    assert re.search(r"warning: .*4000 units across, read as metres.*--unit mm", p.stderr), p.stderr
+    assert "warning" not in run([mm, "--luminaire", f"{lamp}@0,2500,0", "--at", "100,0,100", "--walks", "100",
+                                 "--unit", "mm"]).stderr
     p = run([scene, "--unit", "furlong", "--at", "0.1,0,0.1"], code=2)
     assert "--unit" in p.stderr, p.stderr
     p = run([scene, "--en12464", "0,0,0:0.8,0,3", "--walks", "10"], code=2)

@@ -87,6 +87,7 @@ int cli_photo_option(cli_photo *p, const char *cmd, const char *name, const char
         return 0;
     }
     if (!strcmp(name, "unit")) {
+        p->unit_given = 1;
         static const char *const names[] = {"m", "cm", "mm", "in", "ft", "km"};
         static const double metres[] = {1.0, 0.01, 0.001, 0.0254, 0.3048, 1000.0};
         for (int k = 0; k < 6; k++)
@@ -145,6 +146,13 @@ int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const cha
         p->lum[k].gonio = p->gonio[k], p->lum[k].scale = p->maintenance;
     }
     if (!p->nlum) return 0;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, size = 0.0;
+    for (int64_t v = 0; v < s->nverts; v++)
+        for (int c = 0; c < 3; c++) lo[c] = fmin(lo[c], s->vert[3 * v + c]), hi[c] = fmax(hi[c], s->vert[3 * v + c]);
+    for (int c = 0; c < 3; c++) size = fmax(size, hi[c] - lo[c]);
+    if (!p->unit_given && size > 200.0 && cli_rank == 0) /* lux need metres: a 200 m room is rare, a mm one common */
+        fprintf(stderr, "ulam radiosity: warning: %s: the scene is %.4g units across, read as metres (lux from the "
+                        "luminaires scale as 1 / unit^2): give --unit mm or cm if it is drawn in those\n", scene, size);
     double tri = 0.0; /* fan triangles: q^2 shadow rays each a luminaire, about 2 10^7 in all, q in 2 .. 8 */
     for (int64_t i = 0; i < s->npatches; i++) tri += (double)(s->start[i + 1] - s->start[i] - 2);
     p->q = (int)fmax(2.0, fmin(8.0, floor(sqrt(2e7 / fmax(1.0, tri * p->nlum)))));

@@ -16,6 +16,7 @@ typedef struct cli_photo {
     ulam_gonio **gonio;      /* read tables, one a luminaire */
     ulam_luminaire *lum;
     double metres;           /* --unit: metres a scene unit (1 unless given) */
+    int unit_given;
     double maintenance;      /* --maintenance: multiplies every luminaire (1) */
     int en12464;             /* --en12464 C0:C1 given */
     double c0[3], c1[3];
