@@ -505,7 +505,7 @@ static void test_adapt_furnace(void **state)
 static void test_adapt_cornell(void **state)
 {
     (void)state;
-    const double target = 0.08;
+    const double target = 0.21;
     ulam_scene *s = NULL, *d = NULL;
     ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
     ulam_rad_adapt_info in = adapt(t, NULL, target, 0, 1024, 100000, 7, &d);
@@ -566,8 +566,8 @@ static void test_adapt_view(void **state)
     double *Y = malloc((size_t)s->npatches * sizeof *Y);
     assert_non_null(Y);
     assert_int_equal(ulam_rad_importance(t, &cam, 64, 64, 20000, 4, Y, NULL), ULAM_OK);
-    ulam_rad_adapt_info ia = adapt(t, NULL, 0.06, 0, 1024, 100000, 9, &da);
-    ulam_rad_adapt_info iv = adapt(t, Y, 0.06, 0, 1024, 100000, 9, &dv);
+    ulam_rad_adapt_info ia = adapt(t, NULL, 0.12, 0, 1024, 100000, 9, &da);
+    ulam_rad_adapt_info iv = adapt(t, Y, 0.12, 0, 1024, 100000, 9, &dv);
     assert_true(ia.met && iv.met);
     int64_t floor_face = -1, fa = 0, fv = 0;
     assert_int_equal(ulam_scene_find(s, "floor", &floor_face), ULAM_OK);

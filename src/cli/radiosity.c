@@ -1,6 +1,7 @@
 /* ulam radiosity: a patch scene's radiosity by walks that sample F by ray casting, checked
  * against the LAPACK solve of the assembled system. */
 #include "cli.h"
+#include "photometry.h"
 #include "ulam_radiosity.h"
 
 #include <getopt.h>
@@ -142,6 +143,7 @@ typedef struct {
     ulam_camera cam;
     size_t max_mem;
     ulam_walk_opts o;
+    cli_photo ph; /* --luminaire, --unit, --maintenance, --en12464 (photometry.c) */
 } args;
 
 /* The radiosity options of the walk options the command line gave (mode, estimator, patch,
@@ -284,6 +286,8 @@ static int parse(int argc, char **argv, args *a)
         {"mesh-error", required_argument, 0, 'W'},  {"samples", required_argument, 0, 'S'},
         {"flat", no_argument, 0, 'F'},           {"mesh-target", required_argument, 0, 'T'},
         {"max-patches", required_argument, 0, 'K'},
+        {"luminaire", required_argument, 0, 'Q'}, {"unit", required_argument, 0, 'Q'},
+        {"maintenance", required_argument, 0, 'Q'}, {"en12464", required_argument, 0, 'Q'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int c, rc, idx;
@@ -338,13 +342,17 @@ static int parse(int argc, char **argv, args *a)
         case 'W': if ((rc = cli_parse_int(cmd, "--mesh-error", optarg, 1, INT32_MAX, &a->mesh_walks))) return rc; break;
         case 'P': if ((rc = parse_at(cmd, optarg, a))) return rc; break;
         case 'R': if ((rc = parse_grid(cmd, optarg, &a->g))) return rc; a->grid = 1; break;
-        case 'h': fputs(usage, stdout), fputs(usage_mesh, stdout), fputs(usage_points, stdout); return -1;
+        case 'Q': if ((rc = cli_photo_option(&a->ph, cmd, longopts[idx].name, optarg))) return rc; break;
+        case 'h':
+            fputs(usage, stdout), fputs(usage_mesh, stdout), fputs(usage_points, stdout), fputs(cli_photo_usage, stdout);
+            return -1;
         default: return cli_usage_error(cmd, "unknown option");
         }
     }
     if (optind != argc - 1) return cli_usage_error(cmd, "expects exactly one scene file");
     a->scene = argv[optind];
     if (a->list) return 0;
+    if ((rc = cli_photo_finish(&a->ph, cmd, a->grid, &a->g, &a->grid))) return rc;
     if (a->max_patches && !(a->mesh_target > 0)) return cli_usage_error(cmd, "--max-patches needs --mesh-target E");
     if (a->mesh_target > 0 && (a->subdivide > 0 || a->nat || a->grid || a->patch ||
                                (a->o.mode != ULAM_FORWARD && !a->direct && !a->view)))
@@ -972,6 +980,7 @@ static void print_json(const args *a, const report *r)
         }
         printf("], ");
     }
+    cli_photo_report(&a->ph, r->s, NULL, 0, 0, 1, luma, NULL, NULL); /* photometric runs: the luminaires */
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
 }
 
@@ -1152,6 +1161,7 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         }
         for (int64_t k = a->nat; k < n; k++) interrupted |= pts[k].run.interrupted || !pts[k].run.walks;
     }
+    cli_photo_points((cli_photo *)&a->ph, t, (ulam_scene *)s, pts, n); /* the luminaires' direct light; Ke back */
     double seconds = ulam_now() - t0, hi = 0.0;
     cli_release_sigint();
     if (ngrid && !interrupted && a->out && (rc = write_grid_csv(a->out, &a->g, pts + a->nat))) goto done;
@@ -1201,6 +1211,7 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         printf("\"walks\": %lld, \"rays\": %lld, \"interrupted\": %s, ", (long long)walks, (long long)rays,
                interrupted ? "true" : "false");
         cli_json_number("seconds", seconds, 0);
+        cli_photo_report(&a->ph, s, pts, a->nat, ngrid, 1, luma, illuminance, illuminance_ci);
         printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
     } else {
         printf("scene        %s: %lld patches\n", a->scene, (long long)s->npatches);
@@ -1216,6 +1227,7 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         printf("walks        %lld point walks (%s), %lld rays, %.4f s%s\n", (long long)walks,
                a->o.estimator == ULAM_RAD_COLLISION ? "collision" : "next-event with MIS", (long long)rays, seconds,
                interrupted ? "  [INTERRUPTED]" : "");
+        cli_photo_report(&a->ph, s, pts, a->nat, ngrid, 0, luma, illuminance, illuminance_ci);
     }
     if (interrupted) rc = EXIT_INTERRUPTED;
 done:
@@ -1572,7 +1584,7 @@ int cli_radiosity(int argc, char **argv)
     a.o.stop.interrupt = &cli_interrupted, a.o.exec.share = cli_share;
     int rc = parse(argc, argv, &a);
     if (rc) {
-        free(a.at);
+        free(a.at), cli_photo_free(&a.ph);
         return rc < 0 ? 0 : rc;
     }
     ulam_scene *s = NULL;
@@ -1632,6 +1644,7 @@ int cli_radiosity(int argc, char **argv)
         fprintf(stderr, "ulam radiosity: warning: %s: patch %lld is only %.0f float steps across where it lies: ray "
                         "casting resolves it to %.2g of its size (move the scene's parts closer together)\n",
                 a.scene, (long long)coarse + 1, 1.0 / res, res);
+    if ((rc = cli_photo_light(&a.ph, t, s, a.scene, a.o.exec.threads))) goto done; /* the luminaires light the patches */
     double budget = a.o.stop.max_seconds; /* --time counts the whole run: reading, the tracer, the walks, the mesh */
     a.o.stop.max_seconds = cli_time_left(budget);
     if (a.nat || a.grid) {
@@ -1675,16 +1688,23 @@ int cli_radiosity(int argc, char **argv)
         r.out_written = 1;
     }
     if (a.image && !w.interrupted && cli_rank == 0) {
-        if ((rc = write_image(&a, t, s, w.all ? w.all : Bd, w.all ? w.all_se : NULL, &r.exposure))) goto done;
+        double *L = NULL, *Lse = NULL; /* photometric: the picture's luminance B / pi, cd/m2 (photometry.c) */
+        cli_photo_luminance(&a.ph, w.all ? w.all : Bd, w.all ? w.all_se : NULL, s->npatches, &L, &Lse);
+        rc = write_image(&a, t, s, L ? L : w.all ? w.all : Bd, Lse ? Lse : w.all ? w.all_se : NULL, &r.exposure);
+        free(L), free(Lse);
+        if (rc) goto done;
         r.image_written = 1;
     }
     if (a.json) print_json(&a, &r);
     else print_text(&a, &r);
+    if (!a.json) cli_photo_report_patch(&a.ph, r.patch < 0 ? NULL : r.w ? w.B : Bd ? Bd + 3 * r.patch : NULL, luma,
+                                       r.image_written);
     if (w.interrupted) rc = EXIT_INTERRUPTED;
 done:
     free(w.all), free(w.all_se), free(Bd), free(r.direct_se_all), free(a.at), free(mesh_all);
     ulam_csr_free(F);
     ulam_tracer_free(t);
     ulam_scene_free(s);
+    cli_photo_free(&a.ph);
     return rc;
 }

@@ -3,10 +3,12 @@
  * where the view's importance is high, instead of splitting every patch alike.  A patch's
  * variation comes from point queries (point.c, no mesh in their answers) at its quadrature
  * points (the area centroid and half way to each vertex, as mesh.c's patch mesh error): the
- * RMS about their mean, each point's own noise removed (E[d_k^2] = true d_k^2 + var d_k), is
- * its mesh error e_p, what one value per patch cannot show.  The mesh's error is
+ * RMS about their mean, each point's own noise removed (E[d_k^2] = true d_k^2 + var d_k), scaled
+ * to the area's RMS of a linear field (linear_spread: the points alone see 1/1.29 of it on a
+ * square), is its mesh error e_p, what one value per patch cannot show.  The mesh's error is
  * max_c sum_p Y_p e_pc / sum_p Y_p mean_pc (Y the importance: the share of the picture, or of
- * the area, that rests on the patch), relative to the importance-weighted radiosity.  Each
+ * the area, that rests on the patch; mean_p the reflected radiosity B - E, the emission being
+ * exact on every mesh), relative to the importance-weighted reflected radiosity.  Each
  * round splits the patches of largest Y_p e_p until the rest would meet the target, and
  * measures their children. */
 #include "rad.h"
@@ -189,7 +191,38 @@ static int split(mesh *m, int64_t i)
     return 0;
 }
 
-/* Measure polygon i by point queries at its quadrature points: its mean and mesh error. */
+/* The area's spread of a linear field over polygon v[0..n) against its K quadrature points' (the
+ * centroid and half way to each of the first K - 1 vertices): int |x - g|^2 dA / A over
+ * (1 / K) sum_k |x_k - mean|^2, the ratio of the traces of the two second moments, exact for
+ * triangles (4/3) and parallelograms (5/3), where the two are proportional.  The points alone
+ * see 1/1.29 of a linear field's RMS on a square. */
+static double linear_spread(const double *vert, const int32_t *v, int64_t n, int K)
+{
+    double g[3], x[MAX_POINTS][3], xm[3] = {0, 0, 0}, area = 0.0, mom = 0.0, q = 0.0;
+    ulam__polygon_centroid(vert, v, n, g);
+    for (int64_t k = 1; k + 1 < n; k++) { /* fan triangles: A (|t - g|^2 + sum_j |v_j - t|^2 / 12) */
+        const double *a = vert + 3 * v[0], *b = vert + 3 * v[k], *c = vert + 3 * v[k + 1];
+        double e1[3], e2[3], cr[3], t[3], d[3];
+        ulam__sub3(b, a, e1), ulam__sub3(c, a, e2), ulam__cross3(e1, e2, cr);
+        double A = 0.5 * sqrt(ulam__dot3(cr, cr)), s = 0.0;
+        for (int j = 0; j < 3; j++) t[j] = (a[j] + b[j] + c[j]) / 3.0;
+        const double *w[3] = {a, b, c};
+        for (int j = 0; j < 3; j++) ulam__sub3(w[j], t, d), s += ulam__dot3(d, d);
+        ulam__sub3(t, g, d);
+        area += A, mom += A * (ulam__dot3(d, d) + s / 12.0);
+    }
+    for (int k = 0; k < K; k++)
+        for (int j = 0; j < 3; j++) x[k][j] = k ? 0.5 * (g[j] + vert[3 * v[k - 1] + j]) : g[j], xm[j] += x[k][j] / K;
+    for (int k = 0; k < K; k++) {
+        double d[3];
+        ulam__sub3(x[k], xm, d);
+        q += ulam__dot3(d, d) / K;
+    }
+    return area > 0 && q > 0 ? mom / area / q : 1.0;
+}
+
+/* Measure polygon i by point queries at its quadrature points: its mean (the reflected part,
+ * B - E) and mesh error. */
 static int measure(mesh *m, int64_t i, const ulam_tracer *t, const ulam_rad_opts *opts, double t0,
                    ulam_rad_adapt_info *info, ulam_error *err)
 {
@@ -219,6 +252,7 @@ static int measure(mesh *m, int64_t i, const ulam_tracer *t, const ulam_rad_opts
         }
         for (int ch = 0; ch < 3; ch++) b[k][ch] = pt.radiosity[ch], s2[k][ch] = pt.radiosity_se[ch] * pt.radiosity_se[ch];
     }
+    double f2 = linear_spread(m->vert, v, n, K), *E = ulam__tracer_scene(t)->emit + 3 * m->src[i];
     for (int ch = 0; ch < 3; ch++) {
         double mean = 0.0, sum2 = 0.0, e2 = 0.0;
         for (int k = 0; k < K; k++) mean += b[k][ch] / K, sum2 += s2[k][ch];
@@ -226,7 +260,9 @@ static int measure(mesh *m, int64_t i, const ulam_tracer *t, const ulam_rad_opts
             double d = b[k][ch] - mean;
             e2 += (d * d - s2[k][ch] * (1.0 - 2.0 / K) - sum2 / ((double)K * K)) / K;
         }
-        m->mean[3 * i + ch] = mean, m->e[3 * i + ch] = e2 > 0 ? sqrt(e2) : 0.0;
+        /* the reflected part's mean (the emission, constant on the patch, is no part of the
+         * error), and the spread scaled to the area's (linear_spread) */
+        m->mean[3 * i + ch] = fmax(0.0, mean - E[ch]), m->e[3 * i + ch] = e2 > 0 ? sqrt(e2 * f2) : 0.0;
     }
     m->known[i] = 1;
     return ULAM_OK;

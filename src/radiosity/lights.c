@@ -16,37 +16,56 @@ void ulam__lights_free(ulam__lights *L)
     L->emitter = NULL, L->cdf = NULL, L->group = NULL, L->nem = 0, L->ngroups = 0, L->ptot = 0.0;
 }
 
-/* Group of emitter l in L (the one of its emission and normal), made when new; -1 no memory. */
-static int64_t group_of(const ulam_scene *s, ulam__lights *L, int64_t l)
+/* Group of emitter l in L (merged 0: the one of its emission and normal; 1: of its normal and
+ * power bucket; 2: of its power bucket), made when new; -1 no memory. */
+static int64_t group_of(const ulam_scene *s, ulam__lights *L, int64_t l, int merged)
 {
     const double *E = s->emit + 3 * l, *n = s->normal + 3 * l;
+    double S = E[0] + E[1] + E[2];
+    int bucket = merged ? ilogb(S) : 0;
     int64_t g = 0;
-    while (g < L->ngroups && !(L->group[g].E[0] == E[0] && L->group[g].E[1] == E[1] && L->group[g].E[2] == E[2] &&
-                               fabs(L->group[g].n[0] - n[0]) + fabs(L->group[g].n[1] - n[1]) +
-                                       fabs(L->group[g].n[2] - n[2]) < 1e-9))
+    while (g < L->ngroups &&
+           !((merged ? L->group[g].bucket == bucket
+                     : L->group[g].E[0] == E[0] && L->group[g].E[1] == E[1] && L->group[g].E[2] == E[2]) &&
+             (merged == 2 ||
+              fabs(L->group[g].n[0] - n[0]) + fabs(L->group[g].n[1] - n[1]) + fabs(L->group[g].n[2] - n[2]) < 1e-9)))
         g++;
-    if (g < L->ngroups) return g;
-    ulam__light_group *G = realloc(L->group, (size_t)(g + 1) * sizeof *G);
-    if (!G) return -1;
-    L->group = G, L->ngroups = g + 1;
-    for (int c = 0; c < 3; c++) G[g].E[c] = E[c], G[g].n[c] = n[c], G[g].lo[c] = INFINITY, G[g].hi[c] = -INFINITY;
+    if (g == L->ngroups) {
+        ulam__light_group *G = realloc(L->group, (size_t)(g + 1) * sizeof *G);
+        if (!G) return -1;
+        L->group = G, L->ngroups = g + 1;
+        for (int c = 0; c < 3; c++)
+            G[g].E[c] = E[c], G[g].n[c] = n[c], G[g].lo[c] = INFINITY, G[g].hi[c] = -INFINITY, G[g].chroma[c] = E[c] / S;
+        G[g].smin = G[g].smax = S, G[g].merged = merged, G[g].bucket = bucket;
+    }
+    ulam__light_group *G = L->group + g;
+    for (int c = 0; c < 3; c++) G->E[c] = fmax(G->E[c], E[c]), G->chroma[c] = fmax(G->chroma[c], E[c] / S);
+    G->smin = fmin(G->smin, S), G->smax = fmax(G->smax, S);
     return g;
 }
 
-/* The emitters' groups (group_of) and their boxes; ULAM_OK or ULAM_ENOMEM. */
+/* The emitters' groups (group_of: by emission and normal; by normal and power once there are more
+ * than ULAM__LIGHT_GROUPS_EXACT; by power alone past 4 times that, many normals) and their boxes;
+ * ULAM_OK or ULAM_ENOMEM. */
 static int group(const ulam_scene *s, ulam__lights *L)
 {
-    for (int64_t k = 0; k < L->nem; k++) {
-        int64_t l = L->emitter[k], g = group_of(s, L, l);
-        if (g < 0) {
-            ulam__lights_free(L);
-            return ULAM_ENOMEM;
-        }
-        for (int64_t j = s->start[l]; j < s->start[l + 1]; j++)
-            for (int c = 0; c < 3; c++) {
-                double v = s->vert[3 * s->vidx[j] + c];
-                L->group[g].lo[c] = fmin(L->group[g].lo[c], v), L->group[g].hi[c] = fmax(L->group[g].hi[c], v);
+    for (int merged = 0; merged < 3; merged++) {
+        int64_t cap = merged == 0 ? ULAM__LIGHT_GROUPS_EXACT : merged == 1 ? 4 * ULAM__LIGHT_GROUPS_EXACT : INT64_MAX;
+        free(L->group), L->group = NULL, L->ngroups = 0;
+        int64_t k = 0;
+        for (; k < L->nem && L->ngroups <= cap; k++) {
+            int64_t l = L->emitter[k], g = group_of(s, L, l, merged);
+            if (g < 0) {
+                ulam__lights_free(L);
+                return ULAM_ENOMEM;
             }
+            for (int64_t j = s->start[l]; j < s->start[l + 1]; j++)
+                for (int c = 0; c < 3; c++) {
+                    double v = s->vert[3 * s->vidx[j] + c];
+                    L->group[g].lo[c] = fmin(L->group[g].lo[c], v), L->group[g].hi[c] = fmax(L->group[g].hi[c], v);
+                }
+        }
+        if (L->ngroups <= cap) break;
     }
     return ULAM_OK;
 }
@@ -212,10 +231,23 @@ void ulam__lights_vertex_parts(const ulam__lights *L, const ulam_scene *s, int e
 {
     for (int c = 0; c < 3; c++) light[c] = hit[c] = 0.0;
     for (int64_t k = 0; k < L->ngroups; k++) {
-        const double *E = L->group[k].E;
-        double pl = (E[0] + E[1] + E[2]) / L->ptot, g = g_max(s, p, pt, n, &L->group[k]);
-        double fl = score_factor(estimator, pl, g, 1), fh = score_factor(estimator, pl, g, 0);
-        for (int c = 0; c < 3; c++) light[c] = fmax(light[c], E[c] * fl), hit[c] = fmax(hit[c], E[c] * fh);
+        const ulam__light_group *G = &L->group[k];
+        const double *E = G->E;
+        double g = G->merged == 2 ? INFINITY : g_max(s, p, pt, n, G); /* many normals: no geometry bound */
+        if (!G->merged) {
+            double pl = (E[0] + E[1] + E[2]) / L->ptot;
+            double fl = score_factor(estimator, pl, g, 1), fh = score_factor(estimator, pl, g, 0);
+            for (int c = 0; c < 3; c++) light[c] = fmax(light[c], E[c] * fl), hit[c] = fmax(hit[c], E[c] * fh);
+            continue;
+        }
+        /* a merged group: a member of power S (chroma_c S in channel c, pl = S / ptot) scores at
+         * most chroma_c S score_factor(S / ptot) by light sampling, which rises with S under every
+         * heuristic (power: ptot g' pl^2 / (pl^2 + g'^2), g' = min(gmax, pl); balance: ptot g pl /
+         * (pl + g); light alone: ptot g), so smax bounds it; and at most E_c w_C(gmax, pl) by a
+         * landing, w_C falling with pl, so the largest E_c and smin bound it */
+        double fl = score_factor(estimator, G->smax / L->ptot, g, 1), fh = score_factor(estimator, G->smin / L->ptot, g, 0);
+        for (int c = 0; c < 3; c++)
+            light[c] = fmax(light[c], G->chroma[c] * G->smax * fl), hit[c] = fmax(hit[c], E[c] * fh);
     }
 }
 

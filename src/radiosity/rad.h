@@ -114,10 +114,19 @@ int ulam__rad_point_restart(ulam_rad_solver *s, const double x[3], const double 
                             ulam_error *err);
 
 /* Emitters of one emission and one normal (a subdivided lamp), boxed: what the score bounds
- * of ulam__lights_vertex_bound read. */
+ * of ulam__lights_vertex_bound read.  In a scene of more than ULAM__LIGHT_GROUPS_EXACT such
+ * groups (every patch lit differently: luminaires' first bounce) a group holds the emitters of one
+ * normal whose power a unit area S = sum_c E_c lies in [2^k, 2^(k+1)) (merged): E then is the
+ * largest of each channel, chroma the largest E_c / S, smin and smax S's range; past 4 times as
+ * many, a group holds one power bucket of any normals (merged 2: no geometric bound, G unbounded). */
 typedef struct {
     double E[3], n[3], lo[3], hi[3];
+    double chroma[3], smin, smax;
+    int merged, bucket;
 } ulam__light_group;
+
+/* The most groups of one emission and normal before emitters are grouped by normal and power. */
+#define ULAM__LIGHT_GROUPS_EXACT 64
 
 /* The emitters as a light source for next-event estimation (lights.c). */
 typedef struct {
