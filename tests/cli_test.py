@@ -61,6 +61,33 @@ CASES += [
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--bogus"], 2, r"unknown option '--bogus'", ""),
     (["info"], 2, r"exactly one matrix", ""),
     (["frobnicate"], 2, r"unknown command 'frobnicate'", ""),
+    (["sovle"], 2, r"unknown command 'sovle' \(did you mean 'solve'\?\)", ""),  # issue 42 pt 6
+    (["solve", M + "chain4.mtx", M + "chain4_b.mtx", "--index", "1"], 2,
+     r"expects exactly one matrix file, got two: .*give it as --rhs matrices/chain4_b.mtx", ""),
+    (["direct", M + "chain4.mtx", M + "chain4_b.mtx"], 2, r"give it as --rhs", ""),
+    # issue 42 pt 2: --pagerank (--damping) with every graph query; edge lists; pi = (1 - alpha) x
+    (["solve", D + "graph7.mtx", "--pagerank", "0.85", "--source", "1", "--top", "3"], 0, r"^$",
+     r"pi = \(1 - 0.85\) x(.|\n)*\nrank +index +pi .*\n1 +3 +0\.38\d* "),
+    (["solve", D + "graph7.txt", "--damping", "0.85", "--source", "0", "--top", "3"], 0, r"^$",
+     r"rank +node +pi .*\n1 +2 +0\.38\d* .*\n2 +0 +0\.31"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "0", "--index", "3", "--check"], 0, r"^$",
+     r"^pi\[3\] +0\.16\d* \+- .*95% CI(.|\n)*source 0(.|\n)*\ndirect +0\.16"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "0,4", "--index", "3", "--check"], 0, r"^$",
+     r"^pi\[3\] (.|\n)*direct"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", D + "graph7_seeds.txt", "--top", "2"], 0, r"^$",
+     r"the seeds tests/data/graph7_seeds.txt(.|\n)*\n1 +2 +0\.33"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--top", "7", "--check"], 0, r"^$", r"uniform \(global PageRank\)"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--index", "0", "--check"], 0, r"^$", r"^pi\[0\] (.|\n)*global PageRank"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "7", "--top", "3"], 2, r"--source 7 is out of range 0\.\.6", ""),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "0,9"], 2, r"seed node 9 is out of range 0\.\.6", ""),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", D + "no_such_seeds.txt"], 2,
+     r"--source expects a node id, .*got 'tests/data/no_such_seeds.txt'", ""),
+    (["solve", D + "graph7.txt", "--source", "0,1", "--top", "2"], 2, r"a seed set is a personalisation vector: it needs --pagerank", ""),
+    (["solve", D + "graph_bad_line.txt", "--pagerank", "0.85", "--index", "1"], code("ESYNTAX"),
+     r"^ulam: tests/data/graph_bad_line.txt:4: error: .*expected an edge 'u v' or 'u v weight'.*got '3 two'", ""),
+    (["solve", D + "graph_negative_weight.csv", "--pagerank", "0.85", "--index", "1"], code("ERANGE"),
+     r"graph_negative_weight.csv:2: error: .*weight that is finite and >= 0", ""),
+    (["info", D + "graph7.txt"], 0, r"", r"\nn +7\n"),
     ([], 2, r"usage: ulam", ""),
     (["--help"], 0, r"^$", r"1-based"),
     (["direct", "--help"], 0, r"^$", r"1-based"),
@@ -178,7 +205,7 @@ CASES += [
     (PS + ["--source", "3", "--rmax", "nan"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
     # an exact push (no residual): estimate and stderr both exact printed z = nan
-    (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check"], 0, r"^$", r"direct\s+1 \(dense LU\), z = 0\.000$"),
+    (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check"], 0, r"^$", r"direct\s+1 \(dense LU, [\d.e-]+ s\), z = 0\.000$"),
     (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check", "--json"], 0, r"^$", r'"z": 0[,}]'),  # was null
     # --quiet: the top rows alone (the method, push, walks, seconds lines and header were printed)
     (["solve", M + "randsub1000.mtx", "--source", "3", "--top", "2", "--quiet"], 0, r"^$", r"\A1 +3 +\S+ .*\n2 +\d+ .*\n\Z"),
@@ -549,6 +576,20 @@ def check_sparse_check(ulam):
             else:
                 assert re.match(r"x\[50000\]\s+[\d.]+ \+- ", out) and "direct" not in out, out
                 assert "--check interrupted: the estimate above stands unchecked" in err, err
+        # issue 42 pt 5: a point source's --check runs after its estimate is printed, as the walks' does
+        # (it ran first, before the walks, and an LU past the memory limit exited 28 with no estimate)
+        p = subprocess.Popen([ulam, "solve", d + "/g.mtx", "--source", "50001", "--index", "50000", "--rmax", "1e-4",
+                              "--walks", "2000", "--check"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        said = p.stderr.readline()
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=120)
+        assert "--check: sparse LU (UMFPACK) of n = 100489" in said and p.returncode == 130, (said, p.returncode, err)
+        assert re.match(r"x\[50000\]\s+[\d.e-]+ \+- ", out) and "\ndirect " not in out, out
+        assert "--check interrupted: the estimate above stands unchecked" in err, err
+        rc, out, err = run(ulam, ["solve", d + "/g.mtx", "--source", "50001", "--index", "50000", "--rmax", "1e-4",
+                                  "--walks", "2000", "--check", "--json"])
+        o5 = json.loads(out)
+        assert rc == 0 and o5["direct_method"] == "sparse LU" and o5["ci95"][0] <= o5["direct"] <= o5["ci95"][1], o5
         # a prepared system: the walks read it in place, then the check verifies and solves it whole
         rc, out, err = run(ulam, ["prepare", d + "/g.mtx", "--rhs", d + "/g_b.mtx", "-o", d + "/g.ulam"])
         assert rc == 0, err

@@ -73,12 +73,13 @@ static void *check_run(void *p)
     return NULL;
 }
 
-/* x_index of the reference solve of s for --check, *method "sparse LU", "dense LU" or "GMRES" (when
- * the LU would pass the memory limit); the needs announced first when large; 0, an exit code, or
- * EXIT_INTERRUPTED on Ctrl-C (cli_interrupted) while the solve still runs in its thread (s must
- * then stay loaded until exit). */
-int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method)
+/* The reference solve of s for --check into a new *x (all of it), *method "sparse LU", "dense LU"
+ * or "GMRES" (when the LU would pass the memory limit); the needs announced first when large; 0,
+ * an exit code (reported), or EXIT_INTERRUPTED on Ctrl-C (cli_interrupted) while the solve still
+ * runs in its thread (s must then stay loaded until exit). */
+int cli_direct_reference(const cli_system *s, double **x, double *seconds, const char **method)
 {
+    *x = NULL;
     check_job *j = calloc(1, sizeof *j);
     if (!j) return cli_exit_code(ULAM_ENOMEM);
     j->s = s, j->sparse = cli_direct_sparse_wanted(s->M);
@@ -97,9 +98,19 @@ int cli_direct_check(const cli_system *s, int64_t index, double *value, double *
     }
     *method = j->krylov ? "GMRES to residual 1e-12: the LU would pass 4 GiB" : j->sparse ? "sparse LU" : "dense LU";
     int rc = j->rc;
-    if (!rc) *value = j->x[index], *seconds = j->info.seconds;
-    free(j->x);
+    if (!rc) *x = j->x, *seconds = j->info.seconds;
+    else free(j->x);
     free(j);
+    return rc;
+}
+
+/* x_index of the reference solve of s for --check (cli_direct_reference). */
+int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method)
+{
+    double *x;
+    int rc = cli_direct_reference(s, &x, seconds, method);
+    if (!rc) *value = x[index];
+    free(x);
     return rc;
 }
 
@@ -198,7 +209,7 @@ int cli_direct(int argc, char **argv)
         default: return cli_usage_error("direct", "unknown option");
         }
     }
-    if (optind != argc - 1) return cli_usage_error("direct", "expects exactly one matrix file");
+    if (optind != argc - 1) return cli_operands_error("direct", argc, argv, optind);
     if (!s.rhs_path && !s.pagerank && !ulam_system_is_file(argv[optind])) return cli_need_rhs("direct", argv[optind]);
     s.matrix_path = argv[optind];
     if (out && (rc = cli_check_output(out))) return rc;

@@ -368,7 +368,7 @@ static int start_run(void *q, int argc, char **argv, int optind)
     p.o = &o, p.s = &s;
     const char *out = a->out;
     int rc, force = a->force;
-    if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
+    if (optind != argc - 1) return cli_operands_error("solve", argc, argv, optind);
     if (!s.rhs_path) return cli_usage_error("solve", "needs --rhs b.mtx");
     s.matrix_path = argv[optind];
     if (out && (rc = cli_check_output(out))) return rc;

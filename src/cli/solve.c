@@ -139,28 +139,31 @@ static int too_small(const ulam_walk_result *r)
 static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 {
     if (o->mode == ULAM_FORWARD && isnan(r->std_error) && r->ci95[0] == 0 && r->ci95[1] == 0)
-        printf("x[%lld]%*s0 exactly (95%% CI 0 .. 0: no walk from where b is nonzero can reach it)%s\n",
-               (long long)o->query.index + 1, cli_answer_pad(o->query.index + 1, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
+        printf("%s[%lld]%*s0 exactly (95%% CI 0 .. 0: no walk from where b is nonzero can reach it)%s\n",
+               cli_answer_name, (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (o->mode == ULAM_FORWARD && isnan(r->std_error))
-        printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->query.index + 1,
-               cli_answer_pad(o->query.index + 1, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
+        printf("%s[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", cli_answer_name,
+               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1 && isnan(r->ci95[0]))
-        printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->query.index + 1,
-               cli_answer_pad(o->query.index + 1, 16), "", r->estimate, r->std_error,
+        printf("%s[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", cli_answer_name,
+               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate, r->std_error,
                !isfinite(r->cut_bound) ? "walks cut at --max-steps may have moved it by any amount"
                : too_small(r) ? "scores too small to square in doubles, so no variance: scale b up (a prepared "
                                 "file's b is not rescaled)"
                : !isfinite(r->tail_bound) && r->estimate != 0 ? "no certified range of a single walk's score"
                : "no certified range yet, or a score past the certified one", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1)
-        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->query.index + 1,
-               cli_answer_pad(o->query.index + 1, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+        printf("%s[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", cli_answer_name,
+               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
                r->interrupted ? "  [INTERRUPTED]" : "");
     else
-        printf("x[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
-               "means nothing)%s\n", (long long)o->query.index + 1, cli_answer_pad(o->query.index + 1, 16), "", r->estimate,
+        printf("%s[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
+               "means nothing)%s\n", cli_answer_name, (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate,
                r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
                r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
+    if (strcmp(cli_answer_name, "x") && cli_verbosity >= 0) /* --pagerank with no --rhs */
+        printf("pagerank        pi = x of (I - alpha P^T) x = (1 - alpha) / n: global PageRank, uniform teleport; "
+               "dangling nodes' rank leaks (pi sums to 1 - the leak)\n");
 }
 
 /* Print whether the --rel-err target was met, and when not why (one line; nothing without a target). */
@@ -273,7 +276,8 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
 static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
 {
     double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
-    printf("{\"index\": %lld, ", (long long)o->query.index + 1);
+    printf("{\"index\": %lld, ", (long long)(o->query.index + cli_node_base));
+    if (strcmp(cli_answer_name, "x")) printf("\"quantity\": \"%s\", ", cli_answer_name);
     cli_json_number("estimate", r->estimate, 0);
     cli_json_number("stderr", r->std_error, 0);
     if (r->variance_finite == 1) {
@@ -476,7 +480,7 @@ static int option(void *p, int c, const char *name, const char *optarg)
         a->ao.pin_alpha |= !strcmp(name, "alpha") || !strcmp(name, "kernel-exponent");
         break;
     case 'b': a->s.rhs_path = optarg; break;
-    case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
+    case 'i': if ((rc = cli_parse_node("solve", "--index", optarg, &a->s.index))) return rc; break;
     case 'j': a->s.jacobi = 1; break;
     case 'C': a->s.cache = 1; break;
     case 'W': a->o.kernel.whole_kernel = 1; break;
@@ -503,7 +507,7 @@ static int option(void *p, int c, const char *name, const char *optarg)
 /* The checks once every option is read (argv[first..]: the operands); 0 or an exit code. */
 static int finish_parse(solve_args *a, int argc, char **argv, int optind)
 {
-    if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
+    if (optind != argc - 1) return cli_operands_error("solve", argc, argv, optind);
     if (a->queries && (a->s.index || a->o.mode != ULAM_ADJOINT || a->out || a->errors || a->check || a->s.jacobi))
         return cli_usage_error("solve", "--queries takes the indices from its file, in adjoint mode (no --index, "
                                         "--mode forward, --out, --errors, --check or --jacobi)");
@@ -647,13 +651,7 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
     int walks = *sv != NULL;
     if (walks && ro->g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(s, &ro->g, 1);
     if (walks) cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
-    if (ro->check && !walks && (rc = direct_check(s, o->query.index, ro))) { /* bidirectional: checked first */
-        *run = ulam_run_free(*run);
-        a->an = ulam_analysis_free(a->an);
-        cli_system_free(s);
-        return rc;
-    }
-    return 0;
+    return 0; /* bidirectional: --check once its estimate is printed (cli_bidir_auto_run) */
 }
 
 /* Walk until a stopping rule holds (a progress line on a terminal), then write and print the
@@ -672,7 +670,7 @@ static int run(solve_args *a)
         return rc;
     }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
-        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_method_bidir_route(a->s.b, a->s.M->nrows, &a->ao, &a->o), ro.json, ro.check, ro.direct, ro.direct_method, ro.load_seconds);
+        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_method_bidir_route(a->s.b, a->s.M->nrows, &a->ao, &a->o), ro.json, ro.check, ro.load_seconds);
         ulam_run_free(rn);
         a->an = ulam_analysis_free(a->an);
         cli_system_free(&a->s);
