@@ -88,6 +88,9 @@ CASES += [
     (["solve", D + "graph_negative_weight.csv", "--pagerank", "0.85", "--index", "1"], code("ERANGE"),
      r"graph_negative_weight.csv:2: error: .*weight that is finite and >= 0", ""),
     (["info", D + "graph7.txt"], 0, r"", r"\nn +7\n"),
+    (["direct", D + "graph7.txt", "--pagerank", "0.85", "--index", "2"], 0, r"^$", r"\npi\[2\] +0\.28946125802"),
+    (["direct", D + "graph7.mtx", "--pagerank", "0.85", "--index", "3"], 0, r"^$", r"\npi\[3\] +0\.28946125802"),
+    (["direct", D + "graph7.txt", "--pagerank", "0.85", "--index", "7"], 2, r"--index 7 is out of range 0\.\.6", ""),
     ([], 2, r"usage: ulam", ""),
     (["--help"], 0, r"^$", r"1-based"),
     (["direct", "--help"], 0, r"^$", r"1-based"),
@@ -105,7 +108,7 @@ SOLVE = ["solve", "--method", "walks", M + "chain4.mtx", "--rhs", M + "chain4_b.
 CASES += [  # counts written as whole numbers in exponent form are counts; fractions are not
     (SOLVE + ["--index", "1", "--walks", "2e4"], 0, r"^$", r"walks\s+20000 "),
     (SOLVE + ["--index", "1", "--walks", "1.5"], 2, r"--walks expects an integer from 1 to \d+, got '1\.5'", ""),
-    (SOLVE + ["--index", "1", "--walks", "1e30"], 2, r"--walks expects an integer", ""),
+    (SOLVE + ["--index", "1", "--walks", "1e30"], 2, r"--walks 1e30: more than 10\^15 walks would take years", ""),
     # output paths are checked before any work: 10^11 walks would not end within the test's timeout
     (SOLVE + ["--index", "1", "--mode", "forward", "--walks", "1e11", "--out", "/nonexistent/dir/x.mtx"], 13,
      r"/nonexistent/dir/x\.mtx: error: .*writable output file", r"^$"),
@@ -530,6 +533,60 @@ def write_grid(path, bpath, m, c):
     with open(path, "w") as f:
         f.write(f"%%MatrixMarket matrix coordinate real general\n{n} {n} {len(lines)}\n" + "\n".join(lines) + "\n")
     write_vec(bpath, [1.0 + i % 7 for i in range(n)])
+
+
+def check_info_bounded(ulam):
+    """Issue 42 pt 6: info --jacobi on a 250 x 250 Poisson (rho(J) = cos(pi/251)) spends at most
+    about 2^28 nonzeros of work on each radius (Arnoldi and power iteration ran to their caps: 81 s
+    on 500 x 500), its damping table follows rho(|M_w|) = 1 - w + w rho(|J|) (and rho(M_w) alike, J
+    >= 0) instead of iterating each M_w, and a bound below 1 is printed with the digits that show it."""
+    m = 250
+    with tempfile.TemporaryDirectory() as d:
+        lines = []
+        for i in range(m):
+            for j in range(m):
+                k = i * m + j + 1
+                lines.append(f"{k} {k} 4")
+                for di, dj in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+                    if 0 <= i + di < m and 0 <= j + dj < m:
+                        lines.append(f"{k} {(i + di) * m + j + dj + 1} -1")
+        with open(d + "/A.mtx", "w") as f:
+            f.write(f"%%MatrixMarket matrix coordinate real general\n{m * m} {m * m} {len(lines)}\n" + "\n".join(lines) + "\n")
+        rc, out, err = run(ulam, ["info", d + "/A.mtx", "--jacobi"])
+        assert rc == 0, err
+        nnz = len(lines) - m * m  # J's: the diagonal is gone
+        cap = max(200, 2 ** 28 // nnz)
+        mv = int(re.search(r"rho\(M\) .*?(\d+) matvecs", out).group(1))
+        it = int(re.search(r"rho\(\|M\|\) .*?(\d+) iterations", out).group(1))
+        assert mv <= cap + 20 and it <= cap, (mv, it, cap, out)
+        rows = re.findall(r"^ +(\d\.\d\d) +([\d.]+) +([\d.]+) +(\w+) +(\w+)$", out, re.M)
+        assert len(rows) == 6 and rows[0][0] == "1.00", out
+        r1, a1 = float(rows[0][1]), float(rows[0][2])
+        for w, rho, rabs, neumann, walks in rows:
+            w = float(w)
+            assert abs(float(rabs) - (1 - w + w * a1)) < 2e-6 and abs(float(rho) - (1 - w + w * r1)) < 2e-6, (w, out)
+            assert walks == rows[0][4], out  # the walks' verdict is plain Jacobi's at every w
+        for line in out.splitlines():
+            if line.startswith("rho(|M|)") and "1.000000]" in line:
+                assert "straddle" in out or "at or above" in out, line
+
+
+def check_walks_prediction(ulam):
+    """Issue 42 pt 6: --walks past 10^15 is refused; --walks 1e12 says after its first round how long
+    it would take (then Ctrl-C prints the estimate so far)."""
+    rc, out, err = run(ulam, RS0 + ["--walks", "1e16"])
+    assert rc == 2 and "more than 10^15 walks would take years" in err and out == "", (rc, out, err)
+    p = subprocess.Popen([ulam] + RS0 + ["--walks", "1e12"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    said = ""
+    for _ in range(20):
+        said = p.stderr.readline()
+        if not said or "warning: --walks" in said:
+            break
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=120)
+    assert re.search(r"warning: --walks 1000000000000 at the pace of the first \d+ \(.* s\) takes about [\d.]+ "
+                     r"(hours|days|years) more", said) and p.returncode == 130, (said, p.returncode, err)
+    assert out.startswith("x[1]"), out
 
 
 def check_default_output(ulam):
@@ -2056,7 +2113,7 @@ def main():
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam), (check_radiosity_emission_scale, ulam),
              (check_bidir, ulam), (check_queries, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
-             (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
+             (check_default_output, ulam), (check_info_bounded, ulam), (check_walks_prediction, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
              (check_systems_as_held, ulam), (check_passive_threads, ulam),
              (check_disk_full, ulam), (check_signals, ulam)]
     if not radiosity:

@@ -44,8 +44,11 @@ const char *cli_system_hint(const ulam_csr *M)
 /* Print a radius as "0.900000 (bounds [lo, hi], k iterations, s, converged or a bound)". */
 void cli_print_power(const ulam_power *p)
 {
-    printf("%.6f (bounds [%.6f, %.6f], %d iterations, %.3f s%s)", p->rho, p->lower, p->upper,
-           p->iterations, p->seconds,
+    /* an upper bound below 1 that 6 decimals round to 1.000000 gets the digits that show it
+     * (issue 42: "bounds [0.990002, 1.000000]" stood beside "below 1") */
+    char upper[40];
+    snprintf(upper, sizeof upper, p->upper < 1.0 && p->upper >= 0.9999995 ? "%.17g" : "%.6f", p->upper);
+    printf("%.6f (bounds [%.6f, %s], %d iterations, %.3f s%s)", p->rho, p->lower, upper, p->iterations, p->seconds,
            p->converged ? "" : p->iterations == 0 ? ", certified by row/column sums; the value is not an estimate"
                                                   : ", NOT converged: only the bounds are certain");
 }

@@ -396,6 +396,30 @@ static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, cons
     return status ? cli_report_write(fail, status, errnum) : 0;
 }
 
+/* A duration in words: seconds, minutes, hours, days or years. */
+static void say_duration(char *out, size_t size, double t)
+{
+    if (t < 120) snprintf(out, size, "%.0f seconds", t);
+    else if (t < 7200) snprintf(out, size, "%.0f minutes", t / 60);
+    else if (t < 172800) snprintf(out, size, "%.1f hours", t / 3600);
+    else if (t < 63115200) snprintf(out, size, "%.0f days", t / 86400);
+    else snprintf(out, size, "%.3g years", t / 31557600);
+}
+
+/* After the first round of a run bounded only by --walks N: when N walks at that round's pace
+ * would take over an hour, say how long (issue 42: --walks 1e12 started with no word of it). */
+static void walks_warning(const cli_system *s, const ulam_walk_opts *o, const ulam_walk_result *r)
+{
+    if (!(o->stop.max_walks > 0) || o->stop.max_seconds > 0 || !(r->walks > 0) || !(r->seconds > 0)) return;
+    double t = r->seconds / (double)r->walks * (double)(o->stop.max_walks - r->walks);
+    if (t < 3600) return;
+    char d[64];
+    say_duration(d, sizeof d, t);
+    fprintf(stderr, "ulam: %s: warning: --walks %lld at the pace of the first %lld (%.3g s) takes %sabout %s more; "
+                    "Ctrl-C stops and prints the estimate so far, --time S bounds the run\n", s->matrix_path,
+            (long long)o->stop.max_walks, (long long)r->walks, r->seconds, o->stop.rel_err > 0 ? "up to " : "", d);
+}
+
 /* After the first round: say so when the rel-err rule's minimum walk count (from the bound on a
  * single score) is out of reach, and name the estimators without that tail. */
 static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const ulam_walk_result *r)
@@ -683,7 +707,7 @@ static int run(solve_args *a)
     for (int first = 1; !status && !ulam_solver_done(sv); first = 0) {
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, &r);
-        if (first && !status) rel_err_warning(s, o, &r);
+        if (first && !status) rel_err_warning(s, o, &r), walks_warning(s, o, &r);
         cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o);
     }
     cli_progress_end(&pg);
