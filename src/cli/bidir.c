@@ -16,7 +16,7 @@ static const char *const usage =
     "       ulam solve M.mtx --index I --rhs b.mtx --method bidirectional [--rmax R]\n"
     "                  [--min-value V] [--step-cost C] [--estimator collision|absorption|expected] [--walks N]\n"
     "                  [--rel-err E] [--time S] [--seed S] [--threads T] [--continue Q]\n"
-    "                  [--max-steps K] [--check] [--json] [--force] [--cache]\n"
+    "                  [--max-steps K] [--check] [--json] [--force] [--cache] [--pagerank ALPHA]\n"
     "\n"
     "Estimate x_I of (I - M) x = b with an error bar, for a point source b = e_S (no --rhs\n"
     "file) or a sparse b (at most max(16, n/10) nonzeros; a denser b is refused):\n"
@@ -33,6 +33,10 @@ static const char *const usage =
     "                     residual (--rel-err E: every 95% interval of an x_i >= --min-value within\n"
     "                     E of it, default 0.1 and 1 / n; or --walks N), the K largest printed\n"
     "                     with their intervals (default 10)\n"
+    "  --pagerank ALPHA   (or --damping) the file is a graph (adjacency matrix or edge list):\n"
+    "                     personalized PageRank pi = (1 - ALPHA) x of (I - ALPHA P^T) x = s, s = e_S,\n"
+    "                     or a seed set --source 3,7,9 (equal weights) or --source FILE (lines\n"
+    "                     'id' or 'id weight'); --top K alone: global PageRank's K largest\n"
     "  --step-cost C      push operations one walk visit costs, for the balance (default 1.3;\n"
     "                     bench_bidir measures it: docs/bidirectional.md)\n"
     "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
@@ -79,6 +83,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
                w->variance > 0 ? "no certified range of the walk part's score"
                                : "no walk scored, and no bound certifies the part they missed",
                w->interrupted ? "  [INTERRUPTED]" : "");
+    if (cli_verbosity < 0) return; /* --quiet: the answer line alone */
     cli_print_rel_err(&o->walk, w, 0);
     if (rp->dense) { /* the push on b: its own lines */
         printf("method          bidirectional, the push on b: then %s walks from %lld scoring its "

@@ -67,9 +67,12 @@ static const char *const usage2 = /* the help in three strings: C99 promises 409
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
     "                     that instead of parsing while the file is unchanged (its XXH3 hash)\n";
 static const char *const usage3 =
-    "  --pagerank ALPHA   (or --damping) the file is a graph's adjacency matrix (edge i -> j);\n"
-    "                     walk on M = ALPHA P^T, P = D^-1 adjacency: x_I is node I's PageRank\n"
-    "                     (b = (1 - ALPHA) / n unless --rhs; a dangling node's rank leaks)\n"
+    "  --pagerank ALPHA   (or --damping) the file is a graph: an adjacency matrix (edge i -> j) or\n"
+    "                     an edge list ('u v' a line, SNAP's; ids as written); walk on\n"
+    "                     M = ALPHA P^T, P = D^-1 adjacency; the answer is pi[I], PageRank:\n"
+    "                     --index I alone global (b = (1 - ALPHA) / n unless --rhs), --source S\n"
+    "                     (or seeds 3,7,9, or a file of them) personalized, --top K the K largest;\n"
+    "                     pi = (1 - ALPHA) x; a dangling node's rank leaks (docs/commands.md)\n"
     "  --quiet, -q        print the answer line alone\n"
     "  --verbose, -v      print everything: the candidates, the radii, the tail bound, timings\n"
     "  --method auto      (default) choose mode, estimator, continuation and exponent among\n"
