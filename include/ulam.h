@@ -191,7 +191,8 @@ int ulam_pagerank_matrix(const ulam_csr *A, double alpha, ulam_csr **M, ulam_err
  * 1-based (n = largest id); *base (may be NULL) gets 0 or 1.  *A is the adjacency matrix (A_uv:
  * the summed weights of the edges u -> v, an unweighted edge 1; weights finite and >= 0).
  * ULAM_OK, or ULAM_EIO, ULAM_ESYNTAX (err->line: the line and what it should hold), ULAM_ERANGE
- * (a negative weight), ULAM_EEMPTY (no edge), ULAM_ENOMEM. */
+ * (a negative weight), ULAM_EEMPTY (no edge), ULAM_EOVERFLOW (an id past ULAM_MM_DIM_CAP of the
+ * edge count, as a Matrix Market size line), ULAM_ENOMEM. */
 int ulam_edgelist_read(const char *path, ulam_csr **A, int64_t *base, ulam_error *err);
 
 /* 1 when path names an edge list rather than a Matrix Market file or a prepared system: not

@@ -179,6 +179,10 @@ int ulam_edgelist_read(const char *path, ulam_csr **A, int64_t *base, ulam_error
     free(buf);
     if (!status && e.len == 0)
         status = ulam__fail(err, ULAM_EEMPTY, line, -1, "an edge list with at least one edge 'u v' (read %ld lines)", line);
+    if (!status && hi + 1 - (lo == 0 ? 0 : 1) > ULAM_MM_DIM_CAP(e.len)) /* as a Matrix Market size line */
+        status = ulam__fail(err, ULAM_EOVERFLOW, 0, -1, "node ids up to %lld for %lld edges (the largest is %lld: "
+                            "every node costs memory and time in each pass; renumber the ids 0..n-1)",
+                            (long long)ULAM_MM_DIM_CAP(e.len), (long long)e.len, (long long)hi);
     if (!status) {
         int64_t b = lo == 0 ? 0 : 1, n = hi + 1 - b;
         if (b)
