@@ -144,3 +144,25 @@ def test_point_queries(graph):
     out = ulam("solve", graph["txt"], "--pagerank", ALPHA, "--index", t, "--rel-err", 0.02, "--json")
     assert out["index"] == t and out["quantity"] == "pi"
     assert abs(out["estimate"] - g[t]) <= 4 * out["stderr"], (out, g[t])
+
+
+def test_top_coverage(graph):
+    """The printed 95% intervals over 20 seeds (200 intervals each: single source, seed set, global): misses
+    counted against a binomial bound (mean 10 at 95%; 22 is about 4 sigma above it)."""
+    n = graph["n"]
+    for seeds in ("6", "3,7,9", None):
+        s = np.full(n, 1.0 / n)  # None: global PageRank
+        if seeds:
+            s = np.zeros(n)
+            ids = [int(t) for t in seeds.split(",")]
+            s[ids] = 1.0 / len(ids)
+        ref = reference(n, graph["edges"], s)
+        miss = total = 0
+        for seed in range(1, 21):
+            out = ulam("solve", graph["txt"], "--pagerank", ALPHA, *(["--source", seeds] if seeds else []), "--top", 10,
+                       "--json", "--seed", seed, "--walks", 20000)
+            for t in out["top"]:
+                total += 1
+                miss += not (t["ci95"][0] <= ref[t["index"]] <= t["ci95"][1])
+        print(f"coverage {seeds}: {miss} of {total} intervals missed")
+        assert total == 200 and miss <= 22, (seeds, miss, total)
