@@ -196,9 +196,8 @@ int ulam_pagerank_matrix(const ulam_csr *A, double alpha, ulam_csr **M, ulam_err
 int ulam_edgelist_read(const char *path, ulam_csr **A, int64_t *base, ulam_error *err);
 
 /* 1 when path names an edge list rather than a Matrix Market file or a prepared system: not
- * named .mtx (.mtx.gz),
- * and named .txt, .tsv, .csv, .edges, .el or .edgelist (each also .gz), or a regular file that
- * does not start with "%%" (a pipe is not peeked at: Matrix Market). */
+ * named .mtx (.mtx.gz, .mm), and a regular file that does not start with "%%", or a file that
+ * cannot be peeked at (a pipe) named .txt, .tsv, .csv, .edges, .el or .edgelist (each also .gz). */
 int ulam_edgelist_is_file(const char *path);
 
 /* ---------------------------------------------------------------- Matrix Market */

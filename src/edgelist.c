@@ -27,24 +27,26 @@ static int ends_with(const char *s, const char *suffix)
 /* See ulam.h. */
 int ulam_edgelist_is_file(const char *path)
 {
-    if (!path || ulam_system_is_file(path)) return 0; /* a prepared system */
-    if (ends_with(path, ".mtx") || ends_with(path, ".mtx.gz") || ends_with(path, ".mm") || ends_with(path, ".mm.gz") ||
-        ends_with(path, ".ulam") || ends_with(path, ".ulamcache"))
+    if (!path || ends_with(path, ".mtx") || ends_with(path, ".mtx.gz") || ends_with(path, ".mm") ||
+        ends_with(path, ".mm.gz") || ends_with(path, ".ulam") || ends_with(path, ".ulamcache"))
         return 0;
+    struct stat st;
+    if (!stat(path, &st) && S_ISREG(st.st_mode) && st.st_size > 0) { /* the content decides (a pipe's is not read) */
+        if (ulam_system_is_file(path)) return 0; /* a prepared system */
+        gzFile z = gzopen(path, "rb");
+        if (!z) return 0;
+        char head[3] = "";
+        int got = gzread(z, head, 2);
+        gzclose(z);
+        return got > 0 && strncmp(head, "%%", 2); /* no Matrix Market banner */
+    }
     static const char *const named[] = {".txt", ".tsv", ".csv", ".edges", ".el", ".edgelist"};
     char base[4096];
     snprintf(base, sizeof base, "%s", path);
     if (ends_with(base, ".gz")) base[strlen(base) - 3] = '\0';
-    for (size_t k = 0; k < sizeof named / sizeof named[0]; k++)
+    for (size_t k = 0; k < sizeof named / sizeof named[0]; k++) /* a pipe is not peeked at: its name decides */
         if (ends_with(base, named[k])) return 1;
-    struct stat st;
-    if (stat(path, &st) || !S_ISREG(st.st_mode) || st.st_size == 0) return 0; /* a pipe is not peeked at */
-    gzFile z = gzopen(path, "rb");
-    if (!z) return 0;
-    char head[3] = "";
-    int got = gzread(z, head, 2);
-    gzclose(z);
-    return got > 0 && strncmp(head, "%%", 2); /* no Matrix Market banner */
+    return 0;
 }
 
 /* Parse a node id at *p (digits, at most 2^31 - 2) into *v, moving *p past it; 0 on failure. */
@@ -106,6 +108,8 @@ static int edges_push(edges *e, int64_t u, int64_t v, double w)
 static int parse_line(const char *s, long line, edges *e, int64_t *lo, int64_t *hi, ulam_error *err)
 {
     while (*s == ' ' || *s == '\t') s++;
+    if (!strncasecmp(s, "%%MatrixMarket", 14)) /* read as an edge list, its size line would be an edge */
+        return ulam__fail(err, ULAM_ESYNTAX, line, -1, "an edge list, got a Matrix Market banner (name the file .mtx)");
     if (!*s || *s == '#' || *s == '%' || *s == '\r' || *s == '\n') return ULAM_OK;
     int64_t u, v;
     double w = 1.0;

@@ -36,6 +36,12 @@ static void test_same_as_matrix_market(void **state)
     assert_int_equal(ulam_edgelist_is_file("tests/data/graph7.txt"), 1);
     assert_int_equal(ulam_edgelist_is_file("tests/data/graph7.mtx"), 0);
     assert_int_equal(ulam_edgelist_is_file("tests/data/no_banner.mtx"), 0); /* named .mtx: the MM reader's error */
+    char path[64]; /* a Matrix Market file named .txt: its banner decides, and the edge-list reader refuses it */
+    write_temp(path, "mm.txt", "%%MatrixMarket matrix coordinate pattern general\n2 2 1\n1 2\n");
+    assert_int_equal(ulam_edgelist_is_file(path), 0);
+    assert_int_equal(ulam_edgelist_read(path, &A, NULL, &err), ULAM_ESYNTAX);
+    assert_int_equal(err.line, 1);
+    unlink(path);
 }
 
 /* 1-based ids, commas, CR LF, weights, duplicates summed, a trailing comment, no final newline. */
