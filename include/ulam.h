@@ -185,6 +185,21 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
  * gives PageRank x.  alpha in (0, 1) is the damping; *M is new (ulam_csr_free). */
 int ulam_pagerank_matrix(const ulam_csr *A, double alpha, ulam_csr **M, ulam_error *err);
 
+/* Edge lists (src/edgelist.c): one edge "u v" or "u v weight" a line (blanks, tabs or a comma
+ * between; '#' and '%' lines are comments; gzip read through zlib), as SNAP and networkx write
+ * them.  Node ids are used as written: 0-based when some id is 0 (n = largest id + 1), else
+ * 1-based (n = largest id); *base (may be NULL) gets 0 or 1.  *A is the adjacency matrix (A_uv:
+ * the summed weights of the edges u -> v, an unweighted edge 1; weights finite and >= 0).
+ * ULAM_OK, or ULAM_EIO, ULAM_ESYNTAX (err->line: the line and what it should hold), ULAM_ERANGE
+ * (a negative weight), ULAM_EEMPTY (no edge), ULAM_EOVERFLOW (an id past ULAM_MM_DIM_CAP of the
+ * edge count, as a Matrix Market size line), ULAM_ENOMEM. */
+int ulam_edgelist_read(const char *path, ulam_csr **A, int64_t *base, ulam_error *err);
+
+/* 1 when path names an edge list rather than a Matrix Market file or a prepared system: not
+ * named .mtx (.mtx.gz, .mm), and a regular file that does not start with "%%", or a file that
+ * cannot be peeked at (a pipe) named .txt, .tsv, .csv, .edges, .el or .edgelist (each also .gz). */
+int ulam_edgelist_is_file(const char *path);
+
 /* ---------------------------------------------------------------- Matrix Market */
 /* Primary: ulam_mm_read_matrix, _read_vector, _write_vector.  Secondary: options, FILE readers,
  * _write_matrix.  Tertiary: ulam_strtod, ulam_outfile. */

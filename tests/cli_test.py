@@ -61,6 +61,43 @@ CASES += [
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--bogus"], 2, r"unknown option '--bogus'", ""),
     (["info"], 2, r"exactly one matrix", ""),
     (["frobnicate"], 2, r"unknown command 'frobnicate'", ""),
+    # issue 42 pt 5: every --check names its reference (GMRES past 4 GiB) and comes after the answer
+    (["solve", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--jacobi", "--method", "gmres", "--check"], 0, r"^$",
+     r"outcome +converged(.|\n)*\ndirect +relative error \|\|x - x_direct\|\|_2 .* \(dense LU, [\d.]+ s\)\n\Z"),
+    (["sovle"], 2, r"unknown command 'sovle' \(did you mean 'solve'\?\)", ""),  # issue 42 pt 6
+    (["solve", M + "chain4.mtx", M + "chain4_b.mtx", "--index", "1"], 2,
+     r"expects exactly one matrix file, got two: .*give it as --rhs matrices/chain4_b.mtx", ""),
+    (["direct", M + "chain4.mtx", M + "chain4_b.mtx"], 2, r"give it as --rhs", ""),
+    # issue 42 pt 2: --pagerank (--damping) with every graph query; edge lists; pi = (1 - alpha) x
+    (["solve", D + "graph7.mtx", "--pagerank", "0.85", "--source", "1", "--top", "3"], 0, r"^$",
+     r"pi = \(1 - 0.85\) x(.|\n)*\nrank +index +pi .*\n1 +3 +0\.38\d* "),
+    (["solve", D + "graph7.txt", "--damping", "0.85", "--source", "0", "--top", "3"], 0, r"^$",
+     r"rank +node +pi .*\n1 +2 +0\.38\d* .*\n2 +0 +0\.31"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "0", "--index", "3", "--check"], 0, r"^$",
+     r"^pi\[3\] +0\.16\d* \+- .*95% CI(.|\n)*source 0(.|\n)*\ndirect +0\.16"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "0,4", "--index", "3", "--check"], 0, r"^$",
+     r"^pi\[3\] (.|\n)*direct"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", D + "graph7_seeds.txt", "--top", "2"], 0, r"^$",
+     r"the seeds tests/data/graph7_seeds.txt(.|\n)*\n1 +2 +0\.33"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--top", "7", "--check"], 0, r"^$", r"uniform \(global PageRank\)"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--index", "0", "--check"], 0, r"^$", r"^pi\[0\] (.|\n)*global PageRank"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "7", "--top", "3"], 2, r"--source 7 is out of range 0\.\.6", ""),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "0,9"], 2, r"seed node 9 is out of range 0\.\.6", ""),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", D + "no_such_seeds.txt"], 2,
+     r"--source expects a node id, .*got 'tests/data/no_such_seeds.txt'", ""),
+    (["solve", D + "graph7.txt", "--source", "0,1", "--top", "2"], 2, r"a seed set is a personalisation vector: it needs --pagerank", ""),
+    (["solve", D + "graph_bad_line.txt", "--pagerank", "0.85", "--index", "1"], code("ESYNTAX"),
+     r"^ulam: tests/data/graph_bad_line.txt:4: error: .*expected an edge 'u v' or 'u v weight'.*got '3 two'", ""),
+    (["solve", D + "graph_negative_weight.csv", "--pagerank", "0.85", "--index", "1"], code("ERANGE"),
+     r"graph_negative_weight.csv:2: error: .*weight that is finite and >= 0", ""),
+    (["info", D + "graph7.txt"], 0, r"", r"\nn +7\n"),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--queries", D + "graph7_queries.txt", "--walks", "20000"], 0, r"^$",
+     r"^pi\[2\] 0\.2\d+ \+- .*\npi\[3\] \(source 0\) 0\.16455832\d* \+- "),
+    (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "0", "--index", "3", "--quiet"], 0, r"^$",
+     r"\Api\[3\] +0\.16455832\d* \+- [^\n]*\n\Z"),
+    (["direct", D + "graph7.txt", "--pagerank", "0.85", "--index", "2"], 0, r"^$", r"\npi\[2\] +0\.28946125802"),
+    (["direct", D + "graph7.mtx", "--pagerank", "0.85", "--index", "3"], 0, r"^$", r"\npi\[3\] +0\.28946125802"),
+    (["direct", D + "graph7.txt", "--pagerank", "0.85", "--index", "7"], 2, r"--index 7 is out of range 0\.\.6", ""),
     ([], 2, r"usage: ulam", ""),
     (["--help"], 0, r"^$", r"1-based"),
     (["direct", "--help"], 0, r"^$", r"1-based"),
@@ -78,7 +115,7 @@ SOLVE = ["solve", "--method", "walks", M + "chain4.mtx", "--rhs", M + "chain4_b.
 CASES += [  # counts written as whole numbers in exponent form are counts; fractions are not
     (SOLVE + ["--index", "1", "--walks", "2e4"], 0, r"^$", r"walks\s+20000 "),
     (SOLVE + ["--index", "1", "--walks", "1.5"], 2, r"--walks expects an integer from 1 to \d+, got '1\.5'", ""),
-    (SOLVE + ["--index", "1", "--walks", "1e30"], 2, r"--walks expects an integer", ""),
+    (SOLVE + ["--index", "1", "--walks", "1e30"], 2, r"--walks 1e30: more than 10\^15 walks would take years", ""),
     # output paths are checked before any work: 10^11 walks would not end within the test's timeout
     (SOLVE + ["--index", "1", "--mode", "forward", "--walks", "1e11", "--out", "/nonexistent/dir/x.mtx"], 13,
      r"/nonexistent/dir/x\.mtx: error: .*writable output file", r"^$"),
@@ -178,7 +215,7 @@ CASES += [
     (PS + ["--source", "3", "--rmax", "nan"], 2, r"--rmax expects a number from", r"^$"),
     (PS + ["--method", "bidirectional"], 2, r"--method bidirectional needs --source S", r"^$"),
     # an exact push (no residual): estimate and stderr both exact printed z = nan
-    (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check"], 0, r"^$", r"direct\s+1 \(dense LU\), z = 0\.000$"),
+    (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check"], 0, r"^$", r"direct\s+1 \(dense LU, [\d.e-]+ s\), z = 0\.000$"),
     (["solve", D + "dag5.mtx", "--source", "1", "--index", "1", "--check", "--json"], 0, r"^$", r'"z": 0[,}]'),  # was null
     # --quiet: the top rows alone (the method, push, walks, seconds lines and header were printed)
     (["solve", M + "randsub1000.mtx", "--source", "3", "--top", "2", "--quiet"], 0, r"^$", r"\A1 +3 +\S+ .*\n2 +\d+ .*\n\Z"),
@@ -570,6 +607,60 @@ def write_grid(path, bpath, m, c):
     write_vec(bpath, [1.0 + i % 7 for i in range(n)])
 
 
+def check_info_bounded(ulam):
+    """Issue 42 pt 6: info --jacobi on a 250 x 250 Poisson (rho(J) = cos(pi/251)) spends at most
+    about 2^28 nonzeros of work on each radius (Arnoldi and power iteration ran to their caps: 81 s
+    on 500 x 500), its damping table follows rho(|M_w|) = 1 - w + w rho(|J|) (and rho(M_w) alike, J
+    >= 0) instead of iterating each M_w, and a bound below 1 is printed with the digits that show it."""
+    m = 250
+    with tempfile.TemporaryDirectory() as d:
+        lines = []
+        for i in range(m):
+            for j in range(m):
+                k = i * m + j + 1
+                lines.append(f"{k} {k} 4")
+                for di, dj in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+                    if 0 <= i + di < m and 0 <= j + dj < m:
+                        lines.append(f"{k} {(i + di) * m + j + dj + 1} -1")
+        with open(d + "/A.mtx", "w") as f:
+            f.write(f"%%MatrixMarket matrix coordinate real general\n{m * m} {m * m} {len(lines)}\n" + "\n".join(lines) + "\n")
+        rc, out, err = run(ulam, ["info", d + "/A.mtx", "--jacobi"])
+        assert rc == 0, err
+        nnz = len(lines) - m * m  # J's: the diagonal is gone
+        cap = max(200, 2 ** 28 // nnz)
+        mv = int(re.search(r"rho\(M\) .*?(\d+) matvecs", out).group(1))
+        it = int(re.search(r"rho\(\|M\|\) .*?(\d+) iterations", out).group(1))
+        assert mv <= cap + 20 and it <= cap, (mv, it, cap, out)
+        rows = re.findall(r"^ +(\d\.\d\d) +([\d.]+) +([\d.]+) +(\w+) +(\w+)$", out, re.M)
+        assert len(rows) == 6 and rows[0][0] == "1.00", out
+        r1, a1 = float(rows[0][1]), float(rows[0][2])
+        for w, rho, rabs, neumann, walks in rows:
+            w = float(w)
+            assert abs(float(rabs) - (1 - w + w * a1)) < 2e-6 and abs(float(rho) - (1 - w + w * r1)) < 2e-6, (w, out)
+            assert walks == rows[0][4], out  # the walks' verdict is plain Jacobi's at every w
+        for line in out.splitlines():
+            if line.startswith("rho(|M|)") and "1.000000]" in line:
+                assert "straddle" in out or "at or above" in out, line
+
+
+def check_walks_prediction(ulam):
+    """Issue 42 pt 6: --walks past 10^15 is refused; --walks 1e12 says after its first round how long
+    it would take (then Ctrl-C prints the estimate so far)."""
+    rc, out, err = run(ulam, RS0 + ["--walks", "1e16"])
+    assert rc == 2 and "more than 10^15 walks would take years" in err and out == "", (rc, out, err)
+    p = subprocess.Popen([ulam] + RS0 + ["--walks", "1e12"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    said = ""
+    for _ in range(20):
+        said = p.stderr.readline()
+        if not said or "warning: --walks" in said:
+            break
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=120)
+    assert re.search(r"warning: --walks 1000000000000 at the pace of the first \d+ \(.* s\) takes about [\d.]+ "
+                     r"(hours|days|years) more", said) and p.returncode == 130, (said, p.returncode, err)
+    assert out.startswith("x[1]"), out
+
+
 def check_default_output(ulam):
     """Golden length: the default solve prints the answer, the method in words, the choice, walks,
     seconds and the target, one line each (6 lines); --quiet the answer line alone; --verbose the
@@ -614,6 +705,20 @@ def check_sparse_check(ulam):
             else:
                 assert re.match(r"x\[50000\]\s+[\d.]+ \+- ", out) and "direct" not in out, out
                 assert "--check interrupted: the estimate above stands unchecked" in err, err
+        # issue 42 pt 5: a point source's --check runs after its estimate is printed, as the walks' does
+        # (it ran first, before the walks, and an LU past the memory limit exited 28 with no estimate)
+        p = subprocess.Popen([ulam, "solve", d + "/g.mtx", "--source", "50001", "--index", "50000", "--rmax", "1e-4",
+                              "--walks", "2000", "--check"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        said = p.stderr.readline()
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=120)
+        assert "--check: sparse LU (UMFPACK) of n = 100489" in said and p.returncode == 130, (said, p.returncode, err)
+        assert re.match(r"x\[50000\]\s+[\d.e-]+ \+- ", out) and "\ndirect " not in out, out
+        assert "--check interrupted: the estimate above stands unchecked" in err, err
+        rc, out, err = run(ulam, ["solve", d + "/g.mtx", "--source", "50001", "--index", "50000", "--rmax", "1e-4",
+                                  "--walks", "2000", "--check", "--json"])
+        o5 = json.loads(out)
+        assert rc == 0 and o5["direct_method"] == "sparse LU" and o5["ci95"][0] <= o5["direct"] <= o5["ci95"][1], o5
         # a prepared system: the walks read it in place, then the check verifies and solves it whole
         rc, out, err = run(ulam, ["prepare", d + "/g.mtx", "--rhs", d + "/g_b.mtx", "-o", d + "/g.ulam"])
         assert rc == 0, err
@@ -2138,7 +2243,8 @@ def main():
              (check_bidir, ulam), (check_queries, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
              (check_radiosity_zero_notes, ulam), (check_radiosity_check_side, ulam),
-             (check_default_output, ulam), (check_sparse_check, ulam), (check_json_schemas, ulam),
+             (check_default_output, ulam), (check_info_bounded, ulam), (check_walks_prediction, ulam),
+             (check_sparse_check, ulam), (check_json_schemas, ulam),
              (check_systems_as_held, ulam), (check_passive_threads, ulam),
              (check_disk_full, ulam), (check_signals, ulam)]
     if not radiosity:

@@ -9,13 +9,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 static const char *const usage =
     "usage: ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R]\n"
     "       ulam solve M.mtx --index I --rhs b.mtx --method bidirectional [--rmax R]\n"
     "                  [--min-value V] [--step-cost C] [--estimator collision|absorption|expected] [--walks N]\n"
     "                  [--rel-err E] [--time S] [--seed S] [--threads T] [--continue Q]\n"
-    "                  [--max-steps K] [--check] [--json] [--force] [--cache]\n"
+    "                  [--max-steps K] [--check] [--json] [--force] [--cache] [--pagerank ALPHA]\n"
     "\n"
     "Estimate x_I of (I - M) x = b with an error bar, for a point source b = e_S (no --rhs\n"
     "file) or a sparse b (at most max(16, n/10) nonzeros; a denser b is refused):\n"
@@ -32,6 +33,10 @@ static const char *const usage =
     "                     residual (--rel-err E: every 95% interval of an x_i >= --min-value within\n"
     "                     E of it, default 0.1 and 1 / n; or --walks N), the K largest printed\n"
     "                     with their intervals (default 10)\n"
+    "  --pagerank ALPHA   (or --damping) the file is a graph (adjacency matrix or edge list):\n"
+    "                     personalized PageRank pi = (1 - ALPHA) x of (I - ALPHA P^T) x = s, s = e_S,\n"
+    "                     or a seed set --source 3,7,9 (equal weights) or --source FILE (lines\n"
+    "                     'id' or 'id weight'); --top K alone: global PageRank's K largest\n"
     "  --step-cost C      push operations one walk visit costs, for the balance (default 1.3;\n"
     "                     bench_bidir measures it: docs/bidirectional.md)\n"
     "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
@@ -46,28 +51,45 @@ typedef struct {
     const ulam_choice *ch; /* chosen by --method auto: the choice (else NULL) */
     double bmax;           /* max |b| */
     int dense;             /* the library pushed b and walked from the index (src/bpush.c) */
+    double scale;          /* what the answer is x times: 1, or 1 - alpha for PageRank's pi (0: 1) */
+    const char *seeds;     /* --source as a seed set (ids or a file; NULL: one source or none) */
 } report;
+
+/* PageRank's line: what pi is of x and what the personalisation is (nothing without --pagerank). */
+static void print_pagerank(const cli_system *s, int64_t source, const report *rp)
+{
+    if (!(s->pagerank > 0)) return;
+    double a = s->pagerank;
+    char who[200];
+    if (rp->seeds) snprintf(who, sizeof who, "the seeds %.120s", rp->seeds);
+    else if (source) snprintf(who, sizeof who, "e_%lld (source %lld)", (long long)(source - 1 + cli_node_base),
+                              (long long)(source - 1 + cli_node_base));
+    else snprintf(who, sizeof who, "uniform (global PageRank)");
+    printf("pagerank        pi = (1 - %g) x, x of (I - %g P^T) x = s, s %s; dangling nodes' rank leaks (no "
+           "teleport): pi sums to 1 - the leak\n", a, a, who);
+}
 
 /* Print the human-readable block. */
 static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, const report *rp)
 {
     const ulam_walk_result *w = &r->walks;
     if (isfinite(r->ci95[0]) && isfinite(r->ci95[1]))
-        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->target + 1,
-               cli_answer_pad(o->target + 1, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+        printf("%s[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", cli_answer_name,
+               (long long)(o->target + cli_node_base), cli_answer_pad(o->target + cli_node_base, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
                w->interrupted ? "  [INTERRUPTED]" : "");
     else
-        printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->target + 1,
-               cli_answer_pad(o->target + 1, 16), "", r->estimate, r->std_error,
+        printf("%s[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", cli_answer_name,
+               (long long)(o->target + cli_node_base), cli_answer_pad(o->target + cli_node_base, 16), "", r->estimate, r->std_error,
                w->variance > 0 ? "no certified range of the walk part's score"
                                : "no walk scored, and no bound certifies the part they missed",
                w->interrupted ? "  [INTERRUPTED]" : "");
+    if (cli_verbosity < 0) return; /* --quiet: the answer line alone */
     cli_print_rel_err(&o->walk, w, 0);
     if (rp->dense) { /* the push on b: its own lines */
         printf("method          bidirectional, the push on b: then %s walks from %lld scoring its "
-               "residual\n", cli_estimator_names[o->walk.estimator], (long long)o->target + 1);
+               "residual\n", cli_estimator_names[o->walk.estimator], (long long)(o->target + cli_node_base));
         printf("push            rmax %.3g: %lld operations; q_%lld = %.10g exact; residual max %.3g (b's was %.3g)\n",
-               r->push.rmax, (long long)r->push.ops, (long long)o->target + 1, r->push_part, r->push.r_max,
+               r->push.rmax, (long long)r->push.ops, (long long)(o->target + cli_node_base), r->push_part, r->push.r_max,
                r->plan.rmax > 0 ? rp->bmax : NAN);
         printf("walks           %lld (%lld cut, %lld steps, %d threads); a pilot of %lld walks predicted %.3g\n",
                (long long)w->walks, (long long)w->cut, (long long)w->steps, w->threads, (long long)r->plan.pilot_walks,
@@ -83,10 +105,11 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     }
     if (o->nb > 0)
         printf("method          bidirectional: reverse push from %lld, walks from b's %lld nonzeros (%s rmax)\n",
-               (long long)o->target + 1, (long long)o->nb, o->rmax > 0 ? "given" : "balanced");
+               (long long)(o->target + cli_node_base), (long long)o->nb, o->rmax > 0 ? "given" : "balanced");
     else
         printf("method          bidirectional: reverse push from %lld, walks from source %lld (%s rmax)\n",
-               (long long)o->target + 1, (long long)o->source + 1, o->rmax > 0 ? "given" : "balanced");
+               (long long)(o->target + cli_node_base), (long long)(o->source + cli_node_base),
+               o->rmax > 0 ? "given" : "balanced");
     printf("push            rmax %.3g: %lld pushes, %lld operations, %.4f s; <p, b> = %.10g; residual on %lld "
            "states, sum %.3g\n", r->push.rmax, (long long)r->push.pushes, (long long)r->push.ops, r->push.seconds,
            r->push_part, (long long)r->push.support, r->push.r_sum);
@@ -116,9 +139,10 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
 {
     const ulam_walk_result *w = &r->walks;
     int finite = rp->g.verdict_hat[ULAM_FORWARD] != ULAM_VERDICT_FAIL;
-    printf("{\"index\": %lld, ", (long long)o->target + 1);
+    printf("{\"index\": %lld, ", (long long)(o->target + cli_node_base));
+    if (strcmp(cli_answer_name, "x")) printf("\"quantity\": \"%s\", ", cli_answer_name);
     if (o->nb > 0) printf("\"source\": null, \"b_nonzeros\": %lld, ", (long long)o->nb);
-    else printf("\"source\": %lld, \"b_nonzeros\": 1, ", (long long)o->source + 1);
+    else printf("\"source\": %lld, \"b_nonzeros\": 1, ", (long long)(o->source + cli_node_base));
     cli_json_string("method", "bidirectional", 0);
     cli_json_number("estimate", r->estimate, 0);
     cli_json_number("stderr", r->std_error, 0);
@@ -157,6 +181,7 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->walk.exec.seed, w->threads,
            cli_share ? cli_share->nranks : 1);
     if (rp->check) {
+        cli_json_string("direct_method", rp->direct_method ? rp->direct_method : "LU", 0);
         cli_json_number("direct", rp->direct, 0);
         cli_json_number("z", cli_z(r->estimate, rp->direct, r->std_error), 0);
     }
@@ -166,19 +191,19 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
 }
 
 /* b's nonzeros as entries of o (new arrays in *idx, *val); 0 or an exit code (refused when b is
- * zero or denser than sparse_limit). */
-static int sparse_b(const cli_system *s, ulam_bidir_opts *o, int64_t **idx, double **val)
+ * zero, or when limit and denser than sparse_limit: a --rhs b; a seed set's is not limited). */
+static int sparse_b(const cli_system *s, int limit, ulam_bidir_opts *o, int64_t **idx, double **val)
 {
     int64_t n = s->M->nrows, k = 0;
     for (int64_t i = 0; i < n; i++) k += s->b[i] != 0.0;
     if (k == 0) return cli_usage_error("solve", "%s: b is zero, so x is 0: nothing to estimate", s->rhs_path);
-    if (k > ulam_method_sparse_limit(n))
+    if (limit && k > ulam_method_sparse_limit(n))
         return cli_usage_error("solve", "%s: --method bidirectional is for a sparse b, and this b has %lld nonzeros of "
                                "%lld (more than max(16, n/10) = %lld): use the walks (--method auto)", s->rhs_path,
                                (long long)k, (long long)n, (long long)ulam_method_sparse_limit(n));
     *idx = malloc((size_t)k * sizeof **idx), *val = malloc((size_t)k * sizeof **val);
     if (!*idx || !*val) {
-        fprintf(stderr, "ulam: %s: error: %s\n", s->rhs_path, ulam_strerror(ULAM_ENOMEM));
+        fprintf(stderr, "ulam: %s: error: %s\n", s->rhs_path ? s->rhs_path : s->matrix_path, ulam_strerror(ULAM_ENOMEM));
         return cli_exit_code(ULAM_ENOMEM);
     }
     for (int64_t i = 0, j = 0; i < n; i++)
@@ -202,16 +227,22 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
     rp->load_seconds = ulam_now() - t0;
     int64_t n = s->M->nrows;
     if (source > n)
-        return cli_usage_error("solve", "--source %lld is out of range 1..%lld", (long long)source, (long long)n);
+        return cli_usage_error("solve", "--source %lld is out of range %lld..%lld", (long long)(source - 1 + cli_node_base),
+                               (long long)cli_node_base, (long long)(n - 1 + cli_node_base));
     if (s->rhs_path) {
-        if ((rc = sparse_b(s, o, idx, val))) return rc;
+        if ((rc = sparse_b(s, 1, o, idx, val))) return rc;
     } else {
+        free(s->own_b); /* --pagerank's uniform b: the source or the seeds replace it */
         if (!(s->own_b = calloc((size_t)n, sizeof *s->own_b))) {
             fprintf(stderr, "ulam: %s: error: %s\n", s->matrix_path, ulam_strerror(ULAM_ENOMEM));
             return cli_exit_code(ULAM_ENOMEM);
         }
-        s->own_b[source - 1] = 1.0;
         s->b = s->own_b; /* freed by cli_system_free */
+        if (rp->seeds && (rc = cli_seeds_parse(rp->seeds, n, s->own_b))) return rc;
+        if (source) s->own_b[source - 1] = 1.0;
+        if (!source && !rp->seeds) /* --pagerank --top K: global PageRank, s uniform */
+            for (int64_t i = 0; i < n; i++) s->own_b[i] = 1.0 / (double)n;
+        if (rp->seeds && idx && (rc = sparse_b(s, 0, o, idx, val))) return rc; /* a point query: the seeds as b */
     }
     double continue_q = o->walk.kernel.continue_q;
     if ((rc = cli_guard(s, continue_q, 1.0, ULAM_FORWARD, &rp->g))) return rc;
@@ -223,14 +254,41 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
         return ROUTE_ADJOINT; /* walks from S cannot meet the target: the push on b and walks from I may */
     cli_guard_warn(s, &rp->g, ULAM_FORWARD, 0);
     rp->guard_seconds = rp->g.abs.seconds + rp->g.hat[0].seconds + rp->g.hat[1].seconds;
-    if (rp->check) {
-        double *x;
-        if ((rc = cli_direct_solve(s, CLI_MAX_MEM, &x, NULL))) return rc;
-        rp->direct = x[s->index - 1];
-        rp->direct_method = cli_direct_sparse_wanted(s->M) ? "sparse LU" : "dense LU";
-        free(x);
+    return 0; /* --check runs once the estimate is printed (answer) */
+}
+
+/* Report the estimate r (scaled to PageRank's pi when rp->scale) and, with --check, the reference
+ * solve after it: the text is printed and flushed first, as ulam solve's walks do (Ctrl-C or a
+ * failed reference keeps it); JSON waits for the check to hold it.  0 or an exit code. */
+static int answer(const cli_system *s, const ulam_bidir_opts *o, ulam_bidir_result *r, report *rp)
+{
+    int rc = 0, check = rp->check && !r->walks.interrupted && cli_rank == 0;
+    if (rp->scale > 0) /* PageRank's pi = (1 - alpha) x: the answer, its interval and --check's */
+        r->estimate *= rp->scale, r->std_error *= rp->scale, r->ci95[0] *= rp->scale, r->ci95[1] *= rp->scale;
+    rp->check = 0;
+    if (!rp->json) {
+        print_text(o, r, rp);
+        if (cli_verbosity >= 0 && rp->scale > 0) print_pagerank(s, o->nb ? 0 : o->source + 1, rp);
+        cli_flush();
     }
-    return 0;
+    double seconds = 0.0;
+    if (check) {
+        rc = cli_direct_check(s, s->index - 1, &rp->direct, &seconds, &rp->direct_method);
+        rp->direct *= rp->scale > 0 ? rp->scale : 1.0;
+        rp->check = !rc;
+    }
+    if (rc == EXIT_INTERRUPTED && !rp->json) fprintf(stderr, "ulam: --check interrupted: the estimate above stands unchecked\n");
+    if (!rc && rp->json) print_json(o, r, rp);
+    else if (!rc && rp->check)
+        printf("direct          %.10g (%s, %.3g s), ", rp->direct, rp->direct_method, seconds),
+            cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
+    if (!rc && r->walks.interrupted) rc = EXIT_INTERRUPTED;
+    cli_flush();
+    if (rc == EXIT_INTERRUPTED && check && !cli_share) { /* the reference's thread still reads the system */
+        fflush(stderr);
+        _exit(rc);
+    }
+    return rc;
 }
 
 /* The refusal of a --rel-err target the walks from b cannot meet (forward walks on M, adjoint on
@@ -261,20 +319,16 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     o->walk.stop.interrupt = &cli_interrupted, o->walk.exec.share = cli_share;
     cli_catch_sigint();
     if (!status) status = ulam_analysis_bidir(an, o, &r, &err); /* its push workspace and plan */
-    int rc = status == ULAM_EINFVAR ? refuse_infvar(s, o, &rp->g) : status ? cli_report(s->matrix_path, &err) : 0;
-    if (!status) {
-        if (rp->json) print_json(o, &r, rp);
-        else print_text(o, &r, rp);
-        if (r.walks.interrupted) rc = EXIT_INTERRUPTED;
-    }
-    cli_flush();
+    int rc = status == ULAM_EINFVAR ? refuse_infvar(s, o, &rp->g) : status ? cli_report(s->matrix_path, &err)
+                                                                    : answer(s, o, &r, rp);
     cli_release_sigint();
     ulam_analysis_free(an);
     return rc;
 }
 
-/* --source S without --index: every component by forward push and walks (src/fpush.c), the
- * largest K printed with their intervals; 0 or an exit code. */
+/* --source S (or seeds, or --pagerank's uniform s) without --index: every component by forward
+ * push and walks (src/fpush.c), the largest K printed with their intervals; a seed set is the one
+ * source of the system with a virtual state feeding it (cli_graph_augment); 0 or an exit code. */
 static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_opts *bo, int64_t top, report *rp)
 {
     ulam_fpush_opts o = ulam_fpush_defaults();
@@ -290,41 +344,66 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     if (rc) return rc;
     int64_t n = s->M->nrows;
     if (top > n) top = n;
+    double alpha = s->pagerank, scale = alpha > 0 ? 1.0 - alpha : 1.0;
+    ulam_csr *Ma = NULL, *Mt = NULL;
+    const ulam_csr *W = s->M;
+    int status = ULAM_OK;
+    if (!source) { /* seeds: one source, the virtual state n; x' = alpha x */
+        status = cli_graph_augment(s->M, s->b, alpha, &Ma);
+        W = Ma, o.source = n, scale /= alpha;
+        if (!(o.min_value > 0)) o.min_value = alpha / (double)n; /* 1 / n of x, as for one source */
+    }
+    int64_t nw = W ? W->nrows : n, want = top + (W != s->M); /* and the virtual state, the largest */
     /* x for every component, the rest for the top ones only (ulam_fpush_top: no sort of n) */
-    size_t kk = top > 0 ? (size_t)top : 1;
+    size_t kk = (size_t)want;
     int64_t *order = malloc(kk * sizeof *order);
-    double *x = ulam_alloc_big((size_t)n, sizeof *x), *se = malloc(kk * sizeof *se);
+    double *x = ulam_alloc_big((size_t)nw, sizeof *x), *se = malloc(kk * sizeof *se);
     double *lo = malloc(kk * sizeof *lo), *hi = malloc(kk * sizeof *hi), *xd = NULL;
-    ulam_csr *Mt = NULL;
     ulam_fpush_info info;
     ulam_error err;
-    int status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : ulam_csr_transpose(s->M, &Mt);
-    o.walk.policy.guard = &rp->g, o.walk.stop.interrupt = &cli_interrupted;
+    if (!status) status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : ulam_csr_transpose(W, &Mt);
+    o.walk.policy.guard = &rp->g, o.walk.stop.interrupt = &cli_interrupted; /* M's guards serve M': same spectrum */
     if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
-    if (!status) status = ulam_fpush_top(s->M, Mt, &o, top, x, order, se, lo, hi, &info, &err);
+    if (!status) status = ulam_fpush_top(W, Mt, &o, want, x, order, se, lo, hi, &info, &err);
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
     double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec); /* push and walks */
     if (status) rc = cli_report(s->matrix_path, &err);
-    if (!rc && check) rc = cli_direct_solve(s, CLI_MAX_MEM, &xd, NULL);
+    int crc = 0; /* --check's: a failed or interrupted reference still prints the table, without it */
+    double dsec = 0.0;
+    const char *dm = NULL;
+    if (!rc && check && cli_rank == 0) crc = cli_direct_reference(s, &xd, &dsec, &dm);
+    int64_t shown = 0; /* the top rows without the virtual state, scaled to pi */
+    for (int64_t k = 0; !rc && k < want && shown < top; k++)
+        if (order[k] < n) {
+            int64_t i = order[k];
+            order[shown] = i, se[shown] = se[k] * scale, lo[shown] = lo[k] * scale, hi[shown] = hi[k] * scale;
+            x[i] *= scale;
+            if (xd) xd[i] *= alpha > 0 ? 1.0 - alpha : 1.0;
+            shown++;
+        }
+    const char *est = alpha > 0 ? "pi" : "estimate";
     if (!rc && cli_rank == 0) {
         if (rp->json) {
             printf("{");
             cli_json_string("method", "single-source", 0);
-            printf("\"source\": %lld, \"n\": %lld, ", (long long)source, (long long)n);
+            if (source) printf("\"source\": %lld, ", (long long)(source - 1 + cli_node_base));
+            else printf("\"source\": null, ");
+            if (alpha > 0) cli_json_number("damping", alpha, 0), cli_json_string("quantity", "pi", 0);
+            printf("\"n\": %lld, ", (long long)n);
             cli_json_number("rmax", info.rmax, 0);
             printf("\"push_ops\": %lld, \"walks\": %lld, \"steps\": %lld, ", (long long)info.push.ops,
                    (long long)info.walks, (long long)info.steps);
-            cli_json_number("residual_bound", info.residual_bound, 0);
+            cli_json_number("residual_bound", info.residual_bound * scale, 0);
             cli_json_number("seconds", info.seconds, 0);
             cli_json_number("push_seconds", info.push_seconds, 0);
             cli_json_number("walk_seconds", info.walk_seconds, 0);
             cli_json_number("cpu_seconds", cpu, 0);
             printf("\"top\": [");
-            for (int64_t k = 0; k < top; k++) {
+            for (int64_t k = 0; k < shown; k++) {
                 int64_t i = order[k];
-                printf("%s{\"index\": %lld, ", k ? ", " : "", (long long)i + 1);
+                printf("%s{\"index\": %lld, ", k ? ", " : "", (long long)(i + cli_node_base));
                 cli_json_number("estimate", x[i], 0);
                 cli_json_number("stderr", se[k], 0);
                 printf("\"ci95\": [");
@@ -338,29 +417,41 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
             printf("]}\n");
         } else {
             if (cli_verbosity >= 0) { /* --quiet: the table's rows alone */
-                printf("method          single source: forward push from %lld, forward walks on its residual (FORA)\n",
-                       (long long)source);
+                if (source)
+                    printf("method          single source: forward push from %lld, forward walks on its residual (FORA)\n",
+                           (long long)(source - 1 + cli_node_base));
+                else
+                    printf("method          single source: forward push from a virtual state feeding %s, forward walks "
+                           "on its residual (FORA)\n", rp->seeds ? "the seeds" : "every node");
+                print_pagerank(s, source, rp);
                 printf("push            rmax %.3g: %lld operations, residual on %lld states, sum %.3g (walk part of "
-                       "any x_i at most %.3g)\n", info.rmax, (long long)info.push.ops, (long long)info.push.support,
-                       info.push.r_sum, info.residual_bound);
+                       "any %s at most %.3g)\n", info.rmax, (long long)info.push.ops, (long long)info.push.support,
+                       info.push.r_sum, alpha > 0 ? "pi_i" : "x_i", info.residual_bound * scale);
                 printf("walks           %lld (%lld steps)\n", (long long)info.walks, (long long)info.steps);
                 printf("seconds         %.4f (push %.4f, walks %.4f; CPU %.4f)\n", info.seconds, info.push_seconds,
                        info.walk_seconds, cpu);
-                printf("%-6s %-10s %-14s %-11s %s\n", "rank", "index", "estimate", "stderr",
+                if (xd) printf("direct          %s, %.3g s (the column direct)\n", dm, dsec);
+                printf("%-6s %-10s %-14s %-11s %s\n", "rank", cli_node_base ? "index" : "node", est, "stderr",
                        xd ? "95% CI                    direct" : "95% CI");
             }
-            for (int64_t k = 0; k < top; k++) {
+            for (int64_t k = 0; k < shown; k++) {
                 int64_t i = order[k];
-                printf("%-6lld %-10lld %-14.8g %-11.3g %-12.6g %.6g", (long long)k + 1, (long long)i + 1, x[i], se[k],
-                       lo[k], hi[k]);
+                printf("%-6lld %-10lld %-14.8g %-11.3g %-12.6g %.6g", (long long)k + 1, (long long)(i + cli_node_base),
+                       x[i], se[k], lo[k], hi[k]);
                 if (xd) printf("%*s%.8g", 13 - (int)snprintf(NULL, 0, "%.6g", hi[k]), "", xd[i]);
                 printf("\n");
             }
         }
     }
     if (!rc && cli_interrupted) rc = EXIT_INTERRUPTED;
+    if (!rc) rc = crc;
+    if (crc == EXIT_INTERRUPTED && !cli_share) { /* the reference's thread still reads the system */
+        cli_flush();
+        fprintf(stderr, "ulam: --check interrupted: the estimates above stand unchecked\n");
+        _exit(rc);
+    }
     free(order), free(x), free(se), free(lo), free(hi), free(xd);
-    ulam_csr_free(Mt);
+    ulam_csr_free(Mt), ulam_csr_free(Ma);
     return rc;
 }
 
@@ -376,6 +467,7 @@ static const struct option longopts[] = {
     CLI_WALK_OPTION("continue"),              CLI_WALK_OPTION("max-steps"),
     {"check", no_argument, 0, 'c'},           {"json", no_argument, 0, 'J'},
     {"force", no_argument, 0, 'F'},           {"cache", no_argument, 0, 'C'},
+    {"pagerank", required_argument, 0, 'P'},  {"damping", required_argument, 0, 'P'},
     {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
 
 /* What the command line gives a bidirectional solve. */
@@ -403,8 +495,14 @@ static int option(void *p, int c, const char *name, const char *optarg)
     switch (c) {
     case CLI_WALK: if ((rc = cli_walk_option("solve", name, optarg, &a->o.walk))) return rc; break;
     case 'b': a->s.rhs_path = optarg; break;
-    case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
-    case 'u': if ((rc = cli_parse_int("solve", "--source", optarg, 1, ULAM_MAX_DIM, &a->source))) return rc; break;
+    case 'i': if ((rc = cli_parse_node("solve", "--index", optarg, &a->s.index))) return rc; break;
+    case 'u': /* a node, or a seed set: ids with commas, or a file of them */
+        if (cli_seeds_is_list(optarg) || (strspn(optarg, "0123456789") != strlen(optarg) && !strchr("+-", optarg[0])))
+            a->rp.seeds = optarg, a->source = 0;
+        else if ((rc = cli_parse_node("solve", "--source", optarg, &a->source))) return rc;
+        else a->rp.seeds = NULL;
+        break;
+    case 'P': if ((rc = cli_parse_real("solve", "--pagerank", optarg, 1e-6, 1 - 1e-9, &a->s.pagerank))) return rc; break;
     case 'M':
         if (ulam_method_find(optarg) != ULAM_METHOD_BIDIRECTIONAL)
             return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
@@ -434,11 +532,15 @@ static int start_run(void *p, int argc, char **argv, int optind)
     int64_t source = a->source, top = a->top, *bidx = NULL;
     int rc, force = a->force, method = a->method;
     double *bval = NULL;
-    if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
-    if (s.rhs_path && source) return cli_usage_error("solve", "--source S sets b = e_S: it cannot go with --rhs");
+    if (optind != argc - 1) return cli_operands_error("solve", argc, argv, optind);
+    if (s.rhs_path && (source || rp.seeds)) return cli_usage_error("solve", "--source S sets b = e_S: it cannot go with --rhs");
+    if (rp.seeds && !(s.pagerank > 0))
+        return cli_usage_error("solve", "--source %s: a seed set is a personalisation vector: it needs --pagerank ALPHA "
+                               "(a plain system takes b as --rhs b.mtx with --method bidirectional)", rp.seeds);
+    if (s.pagerank > 0 && !s.rhs_path) rp.scale = 1.0 - s.pagerank, cli_answer_name = "pi"; /* b = s: pi = (1 - alpha) x */
     if (s.rhs_path && !method)
         return cli_usage_error("solve", "--rhs b with --rmax is a bidirectional solve: say --method bidirectional");
-    if (!source && !s.rhs_path)
+    if (!source && !s.rhs_path && !rp.seeds && !(s.pagerank > 0 && !s.index))
         return cli_usage_error("solve", "--method bidirectional needs --source S (b = e_S) or a sparse --rhs b.mtx");
     if (top && s.index) return cli_usage_error("solve", "--top K lists the largest of every component: not with --index");
     if (!s.index && s.rhs_path) return cli_usage_error("solve", "--method bidirectional needs --index I");
@@ -465,7 +567,7 @@ static int start_run(void *p, int argc, char **argv, int optind)
 }
 
 /* Bidirectional: --source S, --rmax or --method bidirectional. */
-static const char *const claims[] = {"source", "rmax", NULL};
+static const char *const claims[] = {"source", "rmax", "top", NULL};
 
 /* --method bidirectional is this row's. */
 static int serves(const char *method)
@@ -477,11 +579,11 @@ const cli_solve_row cli_solve_bidir_row = {"bidirectional", longopts, claims, se
                                            start_run};
 
 /* Run the chosen bidirectional (cli.h). */
-int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
-                       const char *direct_method, double load_seconds)
+int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check,
+                       double load_seconds)
 {
-    report rp = {.json = json, .check = check, .direct = direct, .direct_method = direct_method, .load_seconds = load_seconds,
-                 .transpose_seconds = ch->transpose_seconds, .ch = ch};
+    report rp = {.json = json, .check = check, .load_seconds = load_seconds, .transpose_seconds = ch->transpose_seconds,
+                 .ch = ch};
     for (int64_t i = 0; i < s->M->nrows; i++) rp.bmax = fmax(rp.bmax, fabs(s->b[i]));
     rp.dense = route; /* ulam_method_bidir_route: the push on b */
     int rc = 0;
@@ -494,14 +596,9 @@ int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int 
     ulam_error err;
     cli_catch_sigint();
     int status = ulam_run_finish(run, &a, &err);
-    rc = status ? cli_report(s->matrix_path, &err) : 0;
-    if (!status) {
-        ulam_bidir_opts o = ch->bidir_opts;
-        o.walk = a.opts;
-        if (json) print_json(&o, &a.bidir, &rp);
-        else print_text(&o, &a.bidir, &rp);
-        if (a.bidir.walks.interrupted) rc = EXIT_INTERRUPTED;
-    }
+    ulam_bidir_opts o = ch->bidir_opts;
+    o.walk = a.opts;
+    rc = status ? cli_report(s->matrix_path, &err) : answer(s, &o, &a.bidir, &rp);
     cli_flush();
     cli_release_sigint();
     return rc;

@@ -75,6 +75,25 @@ typedef struct cli_system {
     ulam_system *sys_M, *sys_b; /* mappings behind M and b */
 } cli_system;
 
+/* The usage error of a command that takes one matrix file and was given argv[first..argc) (two:
+ * a hint that the second, b, goes with --rhs); EXIT_USAGE. */
+int cli_operands_error(const char *command, int argc, char **argv, int first);
+
+/* The number the command line gives the first state (--index, --source, printed indices): 1, as
+ * in Matrix Market files, or 0 for an edge list whose ids are 0-based (SNAP's; src/edgelist.c):
+ * node ids are then used as written. */
+extern int64_t cli_node_base;
+
+/* Read the edge list at path (ulam_edgelist_read; cli_node_base becomes its ids' base): with A
+ * NULL keep it for the next call with that path (ulam solve reads it before its options, whose
+ * node ids need the base), else into *A (the kept one if it is path's).  ULAM_OK or a status with
+ * err filled. */
+int cli_graph_preload(const char *path, ulam_csr **A, ulam_error *err);
+
+/* Parse a node id option (--index, --source) as the command line numbers states (cli_node_base)
+ * into *out, 1-based (state *out - 1); 0 or EXIT_USAGE (reported). */
+int cli_parse_node(const char *command, const char *opt, const char *value, int64_t *out);
+
 /* Load M (and b if rhs_path is set, or from a prepared file, or zeros when jacobi needs
  * one) and check index against n; a prepared file (or a --cache copy) is mapped, and checked
  * whole unless s->lazy; 0 or an exit code (nothing stays loaded on failure). */
@@ -91,6 +110,23 @@ int cli_system_verify(cli_system *s);
  * (src/cli/graph.c); 0 or an exit code. */
 int cli_load_pagerank(cli_system *s);
 
+/* What the answer line calls the unknown: "x", or "pi" once --pagerank made b = (1 - alpha) / n
+ * (x is then PageRank itself; src/cli/graph.c). */
+extern const char *cli_answer_name;
+
+/* True when a --source value is a list of node ids ("3,7,9"). */
+int cli_seeds_is_list(const char *spec);
+
+/* A --source seed set (ids "3,7,9", equal weights, or a file of lines "id" or "id weight", '#'
+ * comments), node ids numbered as the command line numbers them, into the personalisation vector
+ * w (n entries, summing to 1); 0 or an exit code (reported, file:line for a bad line). */
+int cli_seeds_parse(const char *spec, int64_t n, double *w);
+
+/* The system (n + 1 states) whose state n is a virtual source feeding the seeds w: M with column
+ * n = alpha w, row n empty, so that x' = (I - M')^-1 e_n has x'_i = alpha x_i for x = (I - M)^-1 w
+ * (a single source for a seed set; column n sums to alpha < 1).  ULAM_OK or ULAM_ENOMEM. */
+int cli_graph_augment(const ulam_csr *M, const double *w, double alpha, ulam_csr **out);
+
 /* A hint naming the option that fits how M looks (--jacobi for a large diagonal, --pagerank for an
  * adjacency matrix), or "" (src/cli/guard.c). */
 const char *cli_system_hint(const ulam_csr *M);
@@ -106,6 +142,10 @@ int cli_direct_sparse_wanted(const ulam_csr *M);
 /* x_index of the reference solve for --check, interruptible by Ctrl-C (EXIT_INTERRUPTED: its thread
  * still reads s); *method "sparse LU" or "dense LU"; 0 or an exit code. */
 int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method);
+
+/* The whole reference solve for --check into a new *x (as cli_direct_check: GMRES past the memory
+ * limit, interruptible); 0 or an exit code. */
+int cli_direct_reference(const cli_system *s, double **x, double *seconds, const char **method);
 
 /* Solve the loaded system (sparse or dense LU) into a new *x; 0 or an exit code (error reported). */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info);
@@ -283,8 +323,8 @@ int cli_solve_source(const cli_system *s, const ulam_walk_opts *o, int64_t sourc
 
 /* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print
  * its report with the choice; 0 or an exit code. */
-int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check, double direct,
-                       const char *direct_method, double load_seconds);
+int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check,
+                       double load_seconds);
 
 /* One line of a query file: source (0-based; -1: b), index (0-based), target (0: the command
  * line's), line. */

@@ -476,6 +476,8 @@ static int read_input(const char *path, int cache, ulam_system **sys, ulam_csr *
         }
         *sys = ulam_system_free(*sys);
     }
+    if (!vec && ulam_edgelist_is_file(path)) /* a graph's edge list: no cache (its ids' base is not kept) */
+        return cli_graph_preload(path, A, err);
     int status = vec ? ulam_mm_read_vector(path, vec, n, err) : ulam_mm_read_matrix(path, A, err);
     if (status || !use) return status;
     double parsed = ulam_now() - t0;
@@ -546,6 +548,53 @@ int cli_need_rhs(const char *command, const char *path)
     return cli_usage_error(command, "needs --rhs b.mtx");
 }
 
+/* See cli.h. */
+int cli_operands_error(const char *command, int argc, char **argv, int first)
+{
+    if (argc - first == 2) /* M.mtx b.mtx: b is an option's */
+        return cli_usage_error(command, "expects exactly one matrix file, got two: '%s' and '%s' (is the second b? "
+                               "give it as --rhs %s)", argv[first], argv[first + 1], argv[first + 1]);
+    if (argc - first > 2) return cli_usage_error(command, "expects exactly one matrix file, got %d", argc - first);
+    return cli_usage_error(command, "expects exactly one matrix file");
+}
+
+/* See cli.h. */
+int64_t cli_node_base = 1;
+
+/* See cli.h: the edge list read ahead (its path's copy and matrix), handed over once. */
+static char *ahead_path;
+static ulam_csr *ahead;
+
+/* See cli.h. */
+int cli_graph_preload(const char *path, ulam_csr **A, ulam_error *err)
+{
+    if (A && ahead && !strcmp(ahead_path, path)) { /* read before the options: hand it over */
+        *A = ahead, ahead = NULL;
+        free(ahead_path), ahead_path = NULL;
+        return ULAM_OK;
+    }
+    ulam_csr *G = NULL;
+    int64_t base = 1;
+    int status = ulam_edgelist_read(path, &G, &base, err);
+    if (status) return status;
+    cli_node_base = base;
+    if (A) return *A = G, ULAM_OK;
+    ulam_csr_free(ahead), free(ahead_path);
+    ahead = G, ahead_path = strdup(path);
+    if (!ahead_path) ahead = ulam_csr_free(ahead);
+    return ULAM_OK;
+}
+
+/* See cli.h. */
+int cli_parse_node(const char *command, const char *opt, const char *value, int64_t *out)
+{
+    int64_t v;
+    if (cli_node_base == 1) return cli_parse_int(command, opt, value, 1, ULAM_MAX_DIM, out);
+    int rc = cli_parse_int(command, opt, value, 0, ULAM_MAX_DIM - 1, &v);
+    if (!rc) *out = v + 1; /* 0-based ids of an edge list: state v */
+    return rc;
+}
+
 /* Load M (and b); 0 or an exit code. */
 int cli_load_system(cli_system *s)
 {
@@ -603,8 +652,8 @@ int cli_load_system(cli_system *s)
     }
     if (rc) return rc;
     if (s->index > s->M->nrows) {
-        rc = cli_usage_error(s->command, "--index %lld is out of range 1..%lld",
-                             (long long)s->index, (long long)s->M->nrows);
+        rc = cli_usage_error(s->command, "--index %lld is out of range %lld..%lld", (long long)(s->index - 1 + cli_node_base),
+                             (long long)cli_node_base, (long long)(s->M->nrows - 1 + cli_node_base));
         cli_system_free(s);
         return rc;
     }
@@ -642,7 +691,7 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
 int cli_answer_pad(int64_t index, int column)
 {
     char label[32];
-    int len = snprintf(label, sizeof label, "x[%lld]", (long long)index);
+    int len = snprintf(label, sizeof label, "%s[%lld]", cli_answer_name, (long long)index);
     return len < column ? column - len : 1;
 }
 

@@ -73,12 +73,13 @@ static void *check_run(void *p)
     return NULL;
 }
 
-/* x_index of the reference solve of s for --check, *method "sparse LU", "dense LU" or "GMRES" (when
- * the LU would pass the memory limit); the needs announced first when large; 0, an exit code, or
- * EXIT_INTERRUPTED on Ctrl-C (cli_interrupted) while the solve still runs in its thread (s must
- * then stay loaded until exit). */
-int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method)
+/* The reference solve of s for --check into a new *x (all of it), *method "sparse LU", "dense LU"
+ * or "GMRES" (when the LU would pass the memory limit); the needs announced first when large; 0,
+ * an exit code (reported), or EXIT_INTERRUPTED on Ctrl-C (cli_interrupted) while the solve still
+ * runs in its thread (s must then stay loaded until exit). */
+int cli_direct_reference(const cli_system *s, double **x, double *seconds, const char **method)
 {
+    *x = NULL;
     check_job *j = calloc(1, sizeof *j);
     if (!j) return cli_exit_code(ULAM_ENOMEM);
     j->s = s, j->sparse = cli_direct_sparse_wanted(s->M);
@@ -97,9 +98,19 @@ int cli_direct_check(const cli_system *s, int64_t index, double *value, double *
     }
     *method = j->krylov ? "GMRES to residual 1e-12: the LU would pass 4 GiB" : j->sparse ? "sparse LU" : "dense LU";
     int rc = j->rc;
-    if (!rc) *value = j->x[index], *seconds = j->info.seconds;
-    free(j->x);
+    if (!rc) *x = j->x, *seconds = j->info.seconds;
+    else free(j->x);
     free(j);
+    return rc;
+}
+
+/* x_index of the reference solve of s for --check (cli_direct_reference). */
+int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method)
+{
+    double *x;
+    int rc = cli_direct_reference(s, &x, seconds, method);
+    if (!rc) *value = x[index];
+    free(x);
     return rc;
 }
 
@@ -131,10 +142,12 @@ static void print_text(const cli_system *s, const double *x, int64_t index,
     int64_t n = s->M->nrows;
     printf("n          %lld\n", (long long)n);
     if (index > 0) {
-        printf("x[%lld]%*s%.17g\n", (long long)index, cli_answer_pad(index, 11), "",
-               x[index - 1]);
+        printf("%s[%lld]%*s%.17g\n", cli_answer_name, (long long)(index - 1 + cli_node_base),
+               cli_answer_pad(index - 1 + cli_node_base, 11), "", x[index - 1]);
     } else if (!out) {
-        for (int64_t i = 0; i < n && i < 10; i++) printf("x[%lld]%*s%.17g\n", (long long)i + 1, cli_answer_pad(i + 1, 11), "", x[i]);
+        for (int64_t i = 0; i < n && i < 10; i++)
+            printf("%s[%lld]%*s%.17g\n", cli_answer_name, (long long)(i + cli_node_base),
+                   cli_answer_pad(i + cli_node_base, 11), "", x[i]);
         if (n > 10) printf("...        (%lld more: use --out or --index)\n", (long long)(n - 10));
     }
     printf("method     %s\n", cli_direct_sparse_wanted(s->M) ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");
@@ -149,7 +162,7 @@ static void print_json(const cli_system *s, const double *x, int64_t index,
 {
     printf("{\"n\": %lld, ", (long long)s->M->nrows);
     if (index > 0) {
-        printf("\"index\": %lld, ", (long long)index);
+        printf("\"index\": %lld, ", (long long)(index - 1 + cli_node_base));
         cli_json_number("estimate", x[index - 1], 0);
         cli_json_number("value", x[index - 1], 0); /* deprecated: "estimate", as in every command */
     }
@@ -172,7 +185,7 @@ int cli_direct(int argc, char **argv)
         {"damping", required_argument, 0, 'P'}, {0, 0, 0, 0}};
     static const char *const lu_names[] = {"dense", "sparse", "auto"};
     cli_system s = {.command = "direct", .omega = 1.0};
-    const char *out = NULL;
+    const char *out = NULL, *index = NULL;
     size_t max_mem = CLI_MAX_MEM;
     int json = 0, c, rc;
     if (cli_check_options("direct", argc, argv, longopts)) return EXIT_USAGE;
@@ -180,7 +193,7 @@ int cli_direct(int argc, char **argv)
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
         switch (c) {
         case 'b': s.rhs_path = optarg; break;
-        case 'i': if ((rc = cli_parse_int("direct", "--index", optarg, 1, ULAM_MAX_DIM, &s.index))) return rc; break;
+        case 'i': index = optarg; break; /* parsed once the file's node numbering is known */
         case 'o': out = optarg; break;
         case 'm': if ((rc = cli_parse_bytes("direct", "--max-mem", optarg, &max_mem))) return rc; break;
         case 'j': s.jacobi = 1; break;
@@ -198,7 +211,11 @@ int cli_direct(int argc, char **argv)
         default: return cli_usage_error("direct", "unknown option");
         }
     }
-    if (optind != argc - 1) return cli_usage_error("direct", "expects exactly one matrix file");
+    if (optind != argc - 1) return cli_operands_error("direct", argc, argv, optind);
+    ulam_error err;
+    if (ulam_edgelist_is_file(argv[optind]) && cli_graph_preload(argv[optind], NULL, &err))
+        return cli_report(argv[optind], &err); /* an edge list's ids number the states */
+    if (index && (rc = cli_parse_node("direct", "--index", index, &s.index))) return rc;
     if (!s.rhs_path && !s.pagerank && !ulam_system_is_file(argv[optind])) return cli_need_rhs("direct", argv[optind]);
     s.matrix_path = argv[optind];
     const cli_file outs[] = {{"--out", out}}, ins[] = {{"the matrix", s.matrix_path}, {"--rhs", s.rhs_path}};

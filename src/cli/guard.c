@@ -53,9 +53,12 @@ const char *cli_radius_str(char *buf, double x)
 /* Print a radius as "0.900000 (bounds [lo, hi], k iterations, s, converged or a bound)". */
 void cli_print_power(const ulam_power *p)
 {
-    char r[32], lo[32], hi[32];
-    printf("%s (bounds [%s, %s], %d iterations, %.3f s%s)", cli_radius_str(r, p->rho), cli_radius_str(lo, p->lower),
-           cli_radius_str(hi, p->upper),
+    /* an upper bound below 1 that 6 decimals round to 1.000000 gets the digits that show it
+     * (issue 42: "bounds [0.990002, 1.000000]" stood beside "below 1") */
+    char r[32], lo[32], hi[40];
+    if (p->upper < 1.0 && p->upper >= 0.9999995) snprintf(hi, sizeof hi, "%.17g", p->upper);
+    else cli_radius_str(hi, p->upper);
+    printf("%s (bounds [%s, %s], %d iterations, %.3f s%s)", cli_radius_str(r, p->rho), cli_radius_str(lo, p->lower), hi,
            p->iterations, p->seconds,
            p->converged ? "" : p->iterations == 0 ? ", certified by row/column sums; the value is not an estimate"
                                                   : ", NOT converged: only the bounds are certain");

@@ -117,26 +117,44 @@ static void print_json(const cli_system *s, const ulam_csr_stats *st, const ulam
     printf("}\n");
 }
 
-/* For --jacobi: rho(M) and rho(|M|) of the splitting at several dampings (A read once). */
-static int print_omegas(const cli_system *base, const ulam_spectral_opts *so)
+/* x -> 1 - w + w x: an eigenvalue of J = I - D^-1 A moved to M_w = (1 - w) I + w J. */
+static double damped(double w, double x)
+{
+    return 1.0 - w + w * x;
+}
+
+/* For --jacobi: rho(M) and rho(|M|) of the splitting M_w = (1 - w) I + w J at several dampings w,
+ * from J's radii (rJ, pJ: Arnoldi and the power iteration on |J|) where they are exact: J's
+ * diagonal is 0, so |M_w| = (1 - w) I + w |J| and rho(|M_w|) = 1 - w + w rho(|J|), its bounds
+ * moved the same way, for 0 < w <= 1; and for J >= 0 the Perron root gives rho(M_w) likewise.  A
+ * signed J's rho(M_w) needs Arnoldi on each M_w (A read again; only for n <= 100000).  Issue 42:
+ * Arnoldi and the power iteration on every M_w took 81 s on a 500 x 500 Poisson. */
+static int print_omegas(const cli_system *base, const ulam_spectral_opts *so, int nonneg, const ulam_radius *rJ,
+                        const ulam_power *pJ)
 {
     ulam_csr *A = NULL;
     ulam_error err;
-    int status = ulam_mm_read_matrix(base->matrix_path, &A, &err);
-    if (status) return cli_report(base->matrix_path, &err);
-    int64_t n = A->nrows;
-    double *b = calloc((size_t)n, sizeof *b), *bp = malloc((size_t)n * sizeof *bp);
-    if (!b || !bp) status = ULAM_ENOMEM;
+    int status = 0;
+    if (!nonneg && base->M->nrows > 100000) return 0; /* a signed J's Arnoldi on each M_w: too long */
+    if (!nonneg && (status = ulam_mm_read_matrix(base->matrix_path, &A, &err))) return cli_report(base->matrix_path, &err);
+    int64_t n = base->M->nrows;
+    double *b = A ? calloc((size_t)n, sizeof *b) : NULL, *bp = A ? malloc((size_t)n * sizeof *bp) : NULL;
+    if (A && (!b || !bp)) status = ULAM_ENOMEM;
     printf("damping          omega   rho(M)     rho(|M|)   Neumann    walks\n");
     for (int k = 0; k <= 5 && !status; k++) {
         double omega = 1.0 - 0.1 * k;
-        ulam_csr *M = NULL;
-        ulam_radius r;
-        ulam_power pa;
-        status = ulam_jacobi(A, b, omega, &M, bp, NULL);
-        if (!status) status = ulam_spectral_radius(M, 0, so, &r);
-        if (!status) status = ulam_spectral_power(M, NULL, NULL, NULL, &pa, NULL);
-        ulam_csr_free(M);
+        ulam_radius r = *rJ;
+        ulam_power pa = *pJ;
+        pa.rho = damped(omega, pJ->rho), pa.lower = damped(omega, pJ->lower), pa.upper = damped(omega, pJ->upper);
+        if (pJ->upper < 1.0) pa.upper = fmin(pa.upper, nextafter(1.0, 0.0)); /* below 1 iff J's is: not lost to rounding */
+        if (nonneg) {
+            r.rho = damped(omega, rJ->rho);
+        } else {
+            ulam_csr *M = NULL;
+            status = ulam_jacobi(A, b, omega, &M, bp, NULL);
+            if (!status) status = ulam_spectral_radius(M, 0, so, &r);
+            ulam_csr_free(M);
+        }
         if (!status)
             printf("                 %5.2f   %-9.6f  %-9.6f  %-9s  %s\n", omega, r.rho, pa.rho,
                    pa.upper < 1 ? "converges" : !r.converged || fabs(r.rho - 1) < 0.01 ? "unknown"
@@ -145,10 +163,21 @@ static int print_omegas(const cli_system *base, const ulam_spectral_opts *so)
     ulam_csr_free(A);
     free(b), free(bp);
     if (status) return cli_exit_code(status);
-    printf("                 (rho(|I - w D^-1 A|) = 1 - w + w rho(|J|) for 0 < w <= 1: damping can shrink\n"
-           "                 rho(M) when J has eigenvalues near -1, but never brings the walks'\n"
-           "                 rho(|M|) below plain Jacobi's)\n");
+    printf("                 (rho(|I - w D^-1 A|) = 1 - w + w rho(|J|) for 0 < w <= 1%s: damping can\n"
+           "                 shrink rho(M) when J has eigenvalues near -1, but never brings the walks'\n"
+           "                 rho(|M|) below plain Jacobi's)\n", nonneg ? ", as is rho(M) for J >= 0" : "");
     return 0;
+}
+
+/* A bound on each radius's work in matrix-vector products: about 2^28 nonzeros touched (a second
+ * or so), at least 200 products and at most the defaults, so that info on a large M ends in
+ * bounded time; a radius the cap stops says NOT converged and gives its certified bounds. */
+static void bound_work(int64_t nnz, ulam_spectral_opts *so, ulam_power_opts *po)
+{
+    double products = fmax(200.0, (double)(1 << 28) / (double)(nnz > 0 ? nnz : 1));
+    if (products < (double)po->max_iter) po->max_iter = (int)products;
+    int restarts = (int)(products / (double)so->krylov_dim);
+    if (restarts < so->max_restarts) so->max_restarts = restarts > 10 ? restarts : 10;
 }
 
 /* ulam info. */
@@ -190,10 +219,11 @@ int cli_info(int argc, char **argv)
     ulam_guard g;
     ulam_error err = {0};
     ulam_csr_stats_compute(s.M, &st);
+    ulam_guard_opts go = ulam_guard_defaults();
+    bound_work(st.nnz, &so, &go.power);
     int status = ulam_spectral_radius(s.M, 0, &so, &r);
     if (status) err = (ulam_error){.status = status, .msg = "memory for the radius estimate"};
     else {
-        ulam_guard_opts go = ulam_guard_defaults();
         go.tight = 1; /* info reports the radii themselves, not only the verdicts */
         go.kernel_alpha = alpha;
         status = ulam_guard_check(s.M, continue_q, &go, &g, &err);
@@ -205,7 +235,14 @@ int cli_info(int argc, char **argv)
     }
     if (json) print_json(&s, &st, &r, &g);
     else print_text(&s, &st, &r, &g);
-    if (!json && s.jacobi && st.n <= 100000) rc = print_omegas(&s, &so);
+    if (!json && s.jacobi && s.omega <= 1.0) { /* J's radii from M_w's: x -> (x - 1 + w) / w */
+        ulam_radius rJ = r;
+        ulam_power pJ = g.abs;
+        double w = s.omega;
+        rJ.rho = (r.rho - 1.0 + w) / w, pJ.rho = (g.abs.rho - 1.0 + w) / w;
+        pJ.lower = (g.abs.lower - 1.0 + w) / w, pJ.upper = (g.abs.upper - 1.0 + w) / w;
+        rc = print_omegas(&s, &so, st.nonnegative, &rJ, &pJ);
+    }
     cli_system_free(&s);
     return rc;
 }

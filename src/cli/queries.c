@@ -46,8 +46,9 @@ static int parse_line(char *text, query *q, const char **why)
         char *end;
         errno = 0;
         long long x = strtoll(tok[k], &end, 10);
-        if (*end || errno || x < 1 || x > ULAM_MAX_DIM) return *why = "1-based integer indices", -1;
-        v[k] = x - 1;
+        if (*end || errno || x < cli_node_base || x > ULAM_MAX_DIM)
+            return *why = cli_node_base ? "1-based integer indices" : "node ids (0-based, as in the edge list)", -1;
+        v[k] = x - cli_node_base;
     }
     q->source = ints == 2 ? v[0] : -1, q->index = v[ints - 1], q->target = 0.0;
     if (ints < n) {
@@ -132,9 +133,9 @@ static void print_answer(const query *q, int64_t k, uint64_t seed, double est, d
 {
     if (json) {
         printf("{\"query\": %lld, \"line\": %ld, \"source\": ", (long long)k + 1, q->line);
-        if (q->source >= 0) printf("%lld, ", (long long)q->source + 1);
+        if (q->source >= 0) printf("%lld, ", (long long)(q->source + cli_node_base));
         else printf("null, ");
-        printf("\"index\": %lld, ", (long long)q->index + 1);
+        printf("\"index\": %lld, ", (long long)(q->index + cli_node_base));
         cli_json_number("estimate", est, 0);
         cli_json_number("stderr", se, 0);
         printf("\"ci95\": ");
@@ -146,8 +147,8 @@ static void print_answer(const query *q, int64_t k, uint64_t seed, double est, d
         printf("}\n");
     } else {
         char src[32] = "";
-        if (q->source >= 0) snprintf(src, sizeof src, " (source %lld)", (long long)q->source + 1);
-        printf("x[%lld]%s %.10g +- %.3g", (long long)q->index + 1, src, est, se);
+        if (q->source >= 0) snprintf(src, sizeof src, " (source %lld)", (long long)(q->source + cli_node_base));
+        printf("%s[%lld]%s %.10g +- %.3g", cli_answer_name, (long long)(q->index + cli_node_base), src, est, se);
         if (!isnan(ci[0])) printf(" (95%% CI %.10g .. %.10g)", ci[0], ci[1]);
         printf("  walks %lld, %.4f s, seed %llu\n", (long long)walks, seconds, (unsigned long long)seed);
     }
@@ -180,7 +181,8 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
         bo.source = q->source, bo.target = q->index, bo.reach_all = 1, bo.keep_kernel = 1;
         ulam_bidir_result r;
         status = ulam_analysis_bidir(w->an, &bo, &r, &err); /* its transpose, push workspace and plans */
-        est = r.estimate, se = r.std_error, ci[0] = r.ci95[0], ci[1] = r.ci95[1];
+        double pi = w->s->pagerank > 0 && strcmp(cli_answer_name, "x") ? 1.0 - w->s->pagerank : 1.0; /* b = e_S: pi = (1 - alpha) x */
+        est = pi * r.estimate, se = pi * r.std_error, ci[0] = pi * r.ci95[0], ci[1] = pi * r.ci95[1];
         met = r.walks.rel_err_met || r.walks.walks == 0, walks = r.walks.walks, interrupted = r.walks.interrupted;
     }
     if (status) {
@@ -210,7 +212,8 @@ int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int js
     const int64_t n = s->M->nrows;
     for (int64_t k = 0; !rc && k < nq; k++)
         if (q[k].index >= n || q[k].source >= n) {
-            fprintf(stderr, "ulam: %s:%ld: error: expected indices from 1 to %lld\n", path, q[k].line, (long long)n);
+            fprintf(stderr, "ulam: %s:%ld: error: expected indices from %lld to %lld\n", path, q[k].line,
+                    (long long)cli_node_base, (long long)(n - 1 + cli_node_base));
             rc = EXIT_USAGE;
         }
     if (!rc && need_b && !s->b) rc = cli_usage_error("solve", "--queries with 'INDEX' lines needs b (--rhs b.mtx)");

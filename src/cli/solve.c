@@ -67,9 +67,12 @@ static const char *const usage2 = /* the help in three strings: C99 promises 409
     "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
     "                     that instead of parsing while the file is unchanged (its XXH3 hash)\n";
 static const char *const usage3 =
-    "  --pagerank ALPHA   (or --damping) the file is a graph's adjacency matrix (edge i -> j);\n"
-    "                     walk on M = ALPHA P^T, P = D^-1 adjacency: x_I is node I's PageRank\n"
-    "                     (b = (1 - ALPHA) / n unless --rhs; a dangling node's rank leaks)\n"
+    "  --pagerank ALPHA   (or --damping) the file is a graph: an adjacency matrix (edge i -> j) or\n"
+    "                     an edge list ('u v' a line, SNAP's; ids as written); walk on\n"
+    "                     M = ALPHA P^T, P = D^-1 adjacency; the answer is pi[I], PageRank:\n"
+    "                     --index I alone global (b = (1 - ALPHA) / n unless --rhs), --source S\n"
+    "                     (or seeds 3,7,9, or a file of them) personalized, --top K the K largest;\n"
+    "                     pi = (1 - ALPHA) x; a dangling node's rank leaks (docs/commands.md)\n"
     "  --quiet, -q        print the answer line alone\n"
     "  --verbose, -v      print everything: the candidates, the radii, the tail bound, timings\n"
     "  --method auto      (default) choose mode, estimator, continuation and exponent among\n"
@@ -139,28 +142,31 @@ static int too_small(const ulam_walk_result *r)
 static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
 {
     if (o->mode == ULAM_FORWARD && isnan(r->std_error) && r->ci95[0] == 0 && r->ci95[1] == 0)
-        printf("x[%lld]%*s0 exactly (95%% CI 0 .. 0: no walk from where b is nonzero can reach it)%s\n",
-               (long long)o->query.index + 1, cli_answer_pad(o->query.index + 1, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
+        printf("%s[%lld]%*s0 exactly (95%% CI 0 .. 0: no walk from where b is nonzero can reach it)%s\n",
+               cli_answer_name, (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (o->mode == ULAM_FORWARD && isnan(r->std_error))
-        printf("x[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", (long long)o->query.index + 1,
-               cli_answer_pad(o->query.index + 1, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
+        printf("%s[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", cli_answer_name,
+               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1 && isnan(r->ci95[0]))
-        printf("x[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", (long long)o->query.index + 1,
-               cli_answer_pad(o->query.index + 1, 16), "", r->estimate, r->std_error,
+        printf("%s[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", cli_answer_name,
+               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate, r->std_error,
                !isfinite(r->cut_bound) ? "walks cut at --max-steps may have moved it by any amount"
                : too_small(r) ? "scores too small to square in doubles, so no variance: scale b up (a prepared "
                                 "file's b is not rescaled)"
                : !isfinite(r->tail_bound) && r->estimate != 0 ? "no certified range of a single walk's score"
                : "no certified range yet, or a score past the certified one", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1)
-        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", (long long)o->query.index + 1,
-               cli_answer_pad(o->query.index + 1, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
+        printf("%s[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", cli_answer_name,
+               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
                r->interrupted ? "  [INTERRUPTED]" : "");
     else
-        printf("x[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
-               "means nothing)%s\n", (long long)o->query.index + 1, cli_answer_pad(o->query.index + 1, 16), "", r->estimate,
+        printf("%s[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
+               "means nothing)%s\n", cli_answer_name, (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate,
                r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
                r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
+    if (strcmp(cli_answer_name, "x") && cli_verbosity >= 0) /* --pagerank with no --rhs */
+        printf("pagerank        pi = x of (I - alpha P^T) x = (1 - alpha) / n: global PageRank, uniform teleport; "
+               "dangling nodes' rank leaks (pi sums to 1 - the leak)\n");
 }
 
 /* Print whether the --rel-err target was met, and when not why (one line; nothing without a target). */
@@ -273,7 +279,8 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
 static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
 {
     double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
-    printf("{\"index\": %lld, ", (long long)o->query.index + 1);
+    printf("{\"index\": %lld, ", (long long)(o->query.index + cli_node_base));
+    if (strcmp(cli_answer_name, "x")) printf("\"quantity\": \"%s\", ", cli_answer_name);
     cli_json_number("estimate", r->estimate, 0);
     cli_json_number("stderr", r->std_error, 0);
     if (r->variance_finite == 1) {
@@ -392,6 +399,30 @@ static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, cons
     return status ? cli_report_write(fail, status, errnum) : 0;
 }
 
+/* A duration in words: seconds, minutes, hours, days or years. */
+static void say_duration(char *out, size_t size, double t)
+{
+    if (t < 120) snprintf(out, size, "%.0f seconds", t);
+    else if (t < 7200) snprintf(out, size, "%.0f minutes", t / 60);
+    else if (t < 172800) snprintf(out, size, "%.1f hours", t / 3600);
+    else if (t < 63115200) snprintf(out, size, "%.0f days", t / 86400);
+    else snprintf(out, size, "%.3g years", t / 31557600);
+}
+
+/* After the first round of a run bounded only by --walks N: when N walks at that round's pace
+ * would take over an hour, say how long (issue 42: --walks 1e12 started with no word of it). */
+static void walks_warning(const cli_system *s, const ulam_walk_opts *o, const ulam_walk_result *r)
+{
+    if (!(o->stop.max_walks > 0) || o->stop.max_seconds > 0 || !(r->walks > 0) || !(r->seconds > 0)) return;
+    double t = r->seconds / (double)r->walks * (double)(o->stop.max_walks - r->walks);
+    if (t < 3600) return;
+    char d[64];
+    say_duration(d, sizeof d, t);
+    fprintf(stderr, "ulam: %s: warning: --walks %lld at the pace of the first %lld (%.3g s) takes %sabout %s more; "
+                    "Ctrl-C stops and prints the estimate so far, --time S bounds the run\n", s->matrix_path,
+            (long long)o->stop.max_walks, (long long)r->walks, r->seconds, o->stop.rel_err > 0 ? "up to " : "", d);
+}
+
 /* After the first round: say so when the rel-err rule's minimum walk count (from the bound on a
  * single score) is out of reach, and name the estimators without that tail. */
 static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const ulam_walk_result *r)
@@ -477,7 +508,7 @@ static int option(void *p, int c, const char *name, const char *optarg)
         a->ao.pin_alpha |= !strcmp(name, "alpha") || !strcmp(name, "kernel-exponent");
         break;
     case 'b': a->s.rhs_path = optarg; break;
-    case 'i': if ((rc = cli_parse_int("solve", "--index", optarg, 1, ULAM_MAX_DIM, &a->s.index))) return rc; break;
+    case 'i': if ((rc = cli_parse_node("solve", "--index", optarg, &a->s.index))) return rc; break;
     case 'j': a->s.jacobi = 1; break;
     case 'C': a->s.cache = 1; break;
     case 'W': a->o.kernel.whole_kernel = 1; break;
@@ -504,7 +535,7 @@ static int option(void *p, int c, const char *name, const char *optarg)
 /* The checks once every option is read (argv[first..]: the operands); 0 or an exit code. */
 static int finish_parse(solve_args *a, int argc, char **argv, int optind)
 {
-    if (optind != argc - 1) return cli_usage_error("solve", "expects exactly one matrix file");
+    if (optind != argc - 1) return cli_operands_error("solve", argc, argv, optind);
     if (a->queries && (a->s.index || a->o.mode != ULAM_ADJOINT || a->out || a->errors || a->check || a->s.jacobi))
         return cli_usage_error("solve", "--queries takes the indices from its file, in adjoint mode (no --index, "
                                         "--mode forward, --out, --errors, --check or --jacobi)");
@@ -651,13 +682,7 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
     int walks = *sv != NULL;
     if (walks && ro->g.verdict_abs >= ULAM_VERDICT_FAIL) cli_guard_diverge(s, &ro->g, 1);
     if (walks) cli_guard_warn(s, &ro->g, o->mode, ro->assume_finite);
-    if (ro->check && !walks && (rc = direct_check(s, o->query.index, ro))) { /* bidirectional: checked first */
-        *run = ulam_run_free(*run);
-        a->an = ulam_analysis_free(a->an);
-        cli_system_free(s);
-        return rc;
-    }
-    return 0;
+    return 0; /* bidirectional: --check once its estimate is printed (cli_bidir_auto_run) */
 }
 
 /* Walk until a stopping rule holds (a progress line on a terminal), then write and print the
@@ -683,7 +708,7 @@ static int run(solve_args *a)
         return cli_exit_code(ULAM_EINVAL);
     }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
-        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_run_bidir_route(rn) == 1, ro.json, ro.check, ro.direct, ro.direct_method, ro.load_seconds);
+        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_run_bidir_route(rn) == 1, ro.json, ro.check, ro.load_seconds);
         ulam_run_free(rn);
         a->an = ulam_analysis_free(a->an);
         cli_system_free(&a->s);
@@ -696,7 +721,7 @@ static int run(solve_args *a)
     for (int first = 1; !status && !ulam_solver_done(sv); first = 0) {
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, &r);
-        if (first && !status) rel_err_warning(s, o, &r);
+        if (first && !status) rel_err_warning(s, o, &r), walks_warning(s, o, &r);
         cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o);
     }
     cli_progress_end(&pg);

@@ -72,6 +72,9 @@ int cli_solve(int argc, char **argv)
     }
     const cli_solve_row *row = pick(u, g, ng);
     int rc = cli_check_options("solve", argc, argv, row->longopts) ? EXIT_USAGE : 0;
+    ulam_error err;
+    if (!rc && optind == argc - 1 && ulam_edgelist_is_file(argv[optind]) && cli_graph_preload(argv[optind], NULL, &err))
+        rc = cli_report(argv[optind], &err); /* an edge list's ids number the states: read before the options */
     void *args = rc ? NULL : calloc(1, row->size);
     if (!rc && !args) rc = cli_exit_code(ULAM_ENOMEM);
     if (args) row->init(args);

@@ -3,7 +3,9 @@
  * CLI_WALK_OPTION("name") and hands each to cli_walk_option. */
 #include "cli.h"
 
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Parse walk option --name's value into o: 0 handled, 1 not a walk option, else an exit code
@@ -13,7 +15,13 @@ int cli_walk_option(const char *command, const char *name, const char *value, ul
     const char *cmd = command;
     int64_t v;
     int rc;
-    if (!strcmp(name, "walks")) return cli_parse_int(cmd, "--walks", value, 1, INT64_MAX / 2, &o->stop.max_walks);
+    if (!strcmp(name, "walks")) { /* past 10^15 (years at 10^7 walks a second): refused, not started */
+        double v = strtod(value, NULL);
+        if (v > 1e15 && isfinite(v))
+            return cli_usage_error(cmd, "--walks %s: more than 10^15 walks would take years (at 10^7 walks a second, "
+                                   "about %.3g years): bound the run with --rel-err E or --time S", value, v / 1e7 / 31557600);
+        return cli_parse_int(cmd, "--walks", value, 1, (int64_t)1e15, &o->stop.max_walks);
+    }
     if (!strcmp(name, "tol")) name = "rel-err"; /* the iterations' spelling of the same target */
     if (!strcmp(name, "alpha")) /* deprecated: read as PageRank's alpha, which is --pagerank */
         fprintf(stderr, "ulam %s: note: --alpha is deprecated: the kernel exponent is --kernel-exponent (PageRank's "
