@@ -617,7 +617,10 @@ typedef struct ulam_stop_opts {
                               part): rel_err is then relative to |c + estimate| (0: none) */
 } ulam_stop_opts;
 
-/* The defaults: 10^5 walks, walk cap 10^6 steps, every other rule off. */
+/* The defaults: 10^5 walks, walk cap 10^6 steps, every other rule off.  The 10^5 walks are the
+ * budget of a run with no other rule: ulam_solve and ulam_solve_walks given a rel_err target with
+ * max_walks left at this default (and no max_seconds) run to the target, capped at
+ * ULAM_REL_ERR_CAP, as the command line's --rel-err does; another max_walks caps the target. */
 ulam_stop_opts ulam_stop_defaults(void);
 
 /* Where and how the walks run.  Start from ulam_exec_defaults(). */

@@ -207,6 +207,15 @@ int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err)
     return ULAM_OK;
 }
 
+/* A rel_err target with the default walk budget runs to the target. */
+ulam_walk_opts ulam__lift_default_cap(const ulam_walk_opts *o)
+{
+    ulam_walk_opts w = *o;
+    if (w.stop.rel_err > 0 && w.stop.max_walks == ulam_stop_defaults().max_walks && !(w.stop.max_seconds > 0))
+        w.stop.max_walks = 0;
+    return w;
+}
+
 /* The walk cap: ULAM_REL_ERR_CAP with rel_err alone, else max_walks. */
 int64_t ulam__walk_cap(const ulam_walk_opts *o)
 {

@@ -82,6 +82,11 @@ int ulam__mine(const ulam_share *sh, int64_t q);
  * least one stopping rule (walks, rel_err, time or an interrupt flag); ULAM_OK or ULAM_EINVAL. */
 int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err);
 
+/* Options as ulam_solve and ulam_solve_walks take them: a rel_err target with max_walks left at
+ * ulam_stop_defaults()'s (and no time limit) runs to the target, as the command line's --rel-err
+ * does (max_walks 0: the cap ULAM_REL_ERR_CAP); others unchanged. */
+ulam_walk_opts ulam__lift_default_cap(const ulam_walk_opts *o);
+
 /* The walk cap of a run whose only stopping rule is rel_err: ULAM_REL_ERR_CAP (a target out of
  * reach still ends), else o->stop.max_walks. */
 int64_t ulam__walk_cap(const ulam_walk_opts *o);

@@ -1540,7 +1540,9 @@ int ulam_solve_walks(const ulam_csr *M, const double *b, const ulam_walk_opts *o
                      ulam_walk_result *result, ulam_error *err)
 {
     ulam_solver *s = NULL;
-    int status = ulam_solver_alloc(M, b, opts, &s, err);
+    ulam_walk_opts o;
+    if (opts) o = ulam__lift_default_cap(opts);
+    int status = ulam_solver_alloc(M, b, opts ? &o : NULL, &s, err);
     return status ? status : ulam__solver_finish(s, result, err);
 }
 
