@@ -1483,6 +1483,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
         double E = s->o.stop.rel_err, A, b, h, nplan, Rp;
         plan_terms(s, &Rp, &A, &b, &h, &nplan);
         r->min_walks = R == 0.0 ? 0.0 : ulam__cs_walks_needed(m, r->variance, A, b + r->cut_bound, E);
+        if (s->met) r->min_walks = fmin(r->min_walks, (double)r->walks); /* it held there */
         if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0 && ci.kind != ULAM__STOP_EXACT)
             r->min_walks = s->hit_walks; /* no score yet: src/hit.c (not over an x certified exactly) */
     }
