@@ -971,6 +971,7 @@ static int push_b(ulam_solver *s, int rel_alone, double *bnorm1, ulam_error *err
 static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
                         ulam_kernel *kernel, ulam_solver **out, ulam_error *err)
 {
+    double t_alloc = ulam_now(); /* a time limit counts the set-up below (guards, reach, bounds, push) */
     ulam__clear(err);
     if (!M || !b || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
     *out = NULL;
@@ -1059,6 +1060,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         return status;
     }
     ulam__run_reset(&s->run);
+    if (o.stop.max_seconds > 0) s->run.t0 = t_alloc;
     *out = s;
     return ULAM_OK;
 nomem:

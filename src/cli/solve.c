@@ -626,6 +626,10 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
         ro->kernel_seconds = ulam_now() - t0;
     }
     ro->guard_seconds = ro->g.abs.seconds + ro->g.hat[0].seconds + ro->g.hat[1].seconds;
+    if (!status && a->max_seconds > 0 && ulam_now() - cli_started > a->max_seconds) /* --time counts the whole run */
+        fprintf(stderr, "ulam: %s: note: --time %g: reading (%.3g s), the guards, the choice and the set-up (%.3g s) "
+                        "took %.3g s before any walk, past the budget: the walks get their first round only\n",
+                s->matrix_path, a->max_seconds, ro->load_seconds, ro->kernel_seconds, ulam_now() - cli_started);
     if (status == ULAM_EINVAL && o->kernel.split > 0 && strstr(err.msg, "split weight")) {
         rc = cli_usage_error("solve", "--split W: %s", err.msg);
     } else if (status == ULAM_EDIVERGE) {
