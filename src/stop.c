@@ -125,7 +125,7 @@ void ulam__cs_plan(ulam__cs *cs, int64_t n, double mean, double var, double A, d
     double c = n > 0 && isfinite(mean) ? fmax(-A, fmin(A, mean)) : 0.0, s = A + fabs(c), N = (double)n;
     /* the variance in xi units, with one prior observation at the largest, 1/4 (as Waudby-Smith and
        Ramdas): a sample that has not yet seen its rare large scores bets small */
-    double v = ((n > 1 && isfinite(var) ? fmax(var, 0.0) * (N - 1.0) : 0.0) / (s * s) + 0.25) / (N + 1.0);
+    double v = ((n > 1 && isfinite(var) ? fmax(var, 0.0) * (N - 1.0) : 0.0) / s / s + 0.25) / (N + 1.0);
     double lam = h > 0 ? (h / s) / (v + h / s) /* the lambda that reaches h soonest: h_xi = psi'(l) v */
                        : sqrt(2.0 * cs_log() / (v * fmax(nplan, 2.0)));
     cs->lam = isfinite(lam) && lam > 0 ? fmin(lam, ULAM__CS_LMAX) : 0.0, cs->c = c, cs->s = s;
@@ -139,7 +139,7 @@ void ulam__cs_add(ulam__cs *cs, int64_t n, double mean, double m2, double maxabs
     double N = (double)n, eta = cs->lam / cs->s, d = mean - cs->c;
     if (eta > 0 && isfinite(eta) && !cs->beyond) {
         cs->eta += eta * N, cs->etax += eta * N * mean, cs->etab += eta * N * cs->bias;
-        cs->v += cs_psi(cs->lam) * (fmax(m2, 0.0) + N * d * d) / (cs->s * cs->s);
+        cs->v += cs_psi(cs->lam) * (fmax(m2, 0.0) + N * d * d) / cs->s / cs->s;
     }
     cs->n += n;
 }
@@ -168,7 +168,7 @@ double ulam__cs_walks_needed(double m, double var, double A, double b, double E)
     if (A == 0.0) return 0.0;
     double h = E * fabs(m) - b, s = A + fabs(m);
     if (!(fabs(m) > 0) || !isfinite(A) || !(h > 0)) return INFINITY;
-    double hx = h / s, vx = fmax(var, 0.0) / (s * s), lam = fmin(ULAM__CS_LMAX, hx / (vx + hx));
+    double hx = h / s, vx = fmax(var, 0.0) / s / s, lam = fmin(ULAM__CS_LMAX, hx / (vx + hx));
     double den = lam * hx - cs_psi(lam) * vx;
     return den > 0 ? ceil(fmax(cs_log() / den, 2.0)) : INFINITY;
 }
@@ -181,6 +181,6 @@ double ulam__cs_walks_left(const ulam__cs *cs, double mean, double var, double e
     double b = cs->eta > 0 ? cs->etab / cs->eta : cs->bias, hb = h - fmax(b, cs->bias) - extra;
     if (!(hb > 0)) return INFINITY;
     if (cs->eta > 0 && (L + cs->v) / cs->eta <= hb) return 0.0;
-    double a = cs_psi(cs->lam) * (fmax(var, 0.0) / (cs->s * cs->s) + d * d), den = hb * eta - a; /* per walk */
+    double a = cs_psi(cs->lam) * (fmax(var, 0.0) / cs->s / cs->s + d * d), den = hb * eta - a; /* per walk */
     return den > 0 ? ceil((L + cs->v - hb * cs->eta) / den) : INFINITY;
 }
