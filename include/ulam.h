@@ -638,7 +638,10 @@ typedef struct ulam_stop_opts {
                               part): rel_err is then relative to |c + estimate| (0: none) */
 } ulam_stop_opts;
 
-/* The defaults: 10^5 walks, walk cap 10^6 steps, every other rule off. */
+/* The defaults: 10^5 walks, walk cap 10^6 steps, every other rule off.  The 10^5 walks are the
+ * budget of a run with no other rule: ulam_solve and ulam_solve_walks given a rel_err target with
+ * max_walks left at this default (and no max_seconds) run to the target, capped at
+ * ULAM_REL_ERR_CAP, as the command line's --rel-err does; another max_walks caps the target. */
 ulam_stop_opts ulam_stop_defaults(void);
 
 /* Where and how the walks run.  Start from ulam_exec_defaults(). */
@@ -726,8 +729,9 @@ typedef struct ulam_walk_result {
                             how far one more walk could move the estimate, relatively;
                             luck-independent (INFINITY: no bound) */
     double min_walks;    /* rel_err: the walks the rule predicts it needs at this estimate and
-                            variance (the larger of the variance term's and the range term's;
-                            INFINITY: none can, 0: no target) */
+                            variance (a confidence sequence tuned to the target from the start,
+                            at the range it plans; at most walks once met; INFINITY: none can,
+                            0: no target) */
     double variance_rel_error; /* relative standard error of `variance` (fourth moment) */
     int rel_err_met;     /* 1: stopped by the rel_err rule */
     double cut_bound;    /* the most the walks cut at max_steps can have moved the mean (0: none
@@ -820,19 +824,19 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
  * call, with the refusals of ulam_solver_alloc (guards checked first).  It always ends: rel_err alone stops at 10^9
  * walks at most (ULAM_REL_ERR_CAP; rel_err_met 0).
  * The rel_err rule (opts->stop.rel_err = E, variance certified finite; docs/error-bars.md), checked
- * once per epoch of walk counts (sqrt(2) apart from 1024), stops when all of these hold (N walks,
- * estimate m, the 95% interval's terms of src/stop.h at L = ln(3 / delta_k)):
- *   N >= 1000, m != 0 (unless nothing that scores is reachable: x = 0, certified) and,
- *   forward, the watched component opts->query.index has been tallied;
- *   the variance term sqrt(2 V L / N) <= w = sqrt(2 L) E |m|, i.e. se <= E |m|;
- *   the range and bias terms 7 R L / (3 (N - 1)) + bias <= w, R the range of a single score
- *     (score_bound; for collision and expected the range of walks short enough to matter,
- *     from the continuation or a Collatz-Wielandt certificate of the length tail; with weights
- *     growing on cycles, from a certified second moment; twice it when scores take both
- *     signs): so any class of scores that could move the answer by E has been seen before a
- *     stop.  No such R (splitting, forward expected, no certificate): never met, and rel_err
- *     alone is refused with ULAM_EINFVAR (err->msg names the reason);
- *   with walks cut at max_steps, cut_bound <= 0.1 E |m|, else the run stops (cut_stop).
+ * after every round, stops when the printed 95% interval ci95 is at most E |m| wide on each side
+ * ((ci95[1] - ci95[0]) / 2 <= E |m|, m the estimate), after N >= 1000 walks, m != 0 (unless
+ * nothing that scores is reachable: x = 0, certified) and, forward, the watched component
+ * opts->query.index tallied.  ci95 is a confidence sequence (src/stop.h: the predictable
+ * plug-in empirical-Bernstein sequence of Waudby-Smith and Ramdas, 2023), valid at every walk
+ * count at once, so stopping on it keeps its 95%; it rests on R, the range of a single score
+ * (score_bound; for collision and expected the range of walks short enough to matter, from the
+ * continuation or a Collatz-Wielandt certificate of the length tail; with weights growing on
+ * cycles, from a certified second moment; twice it when scores take both signs), the scores
+ * clipped to it and the clipping's bias added.  No such R (splitting, forward expected, no
+ * certificate): never met, and rel_err alone is refused with ULAM_EINFVAR (err->msg names the
+ * reason);
+ * with walks cut at max_steps, cut_bound <= 0.1 E |m|, else the run stops (cut_stop).
  * A run whose predicted walks (min_walks) exceed max_walks or ULAM_REL_ERR_CAP stops after
  * the round, not met (out_of_reach), with the estimate so far; a zero estimate never does.  A split weight below the start weight (1 adjoint, ||b||_1 forward)
  * is refused with ULAM_EINVAL. */

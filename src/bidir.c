@@ -376,10 +376,8 @@ static double walk_part_bound(const ulam_push_info *push, const ulam_guard *g, c
     return g && (g->computed & ULAM_GUARD_ABS) && c < 1.0 ? push->r_max * norm_b(o) / (1.0 - c) : INFINITY;
 }
 
-/* The interval of x_t: with a certified range of one walk's score (the solver's score_bound,
- * absorption) src/stop.c's interval on that range (stitched over epochs unless the walks stop at
- * a count fixed in advance: no rel_err, no time limit); without one the walk solver's own
- * interval (stop.c's too, or withheld), except that a
+/* The interval of x_t: the walk solver's own (its confidence sequence on the certified range of
+ * one walk's score, src/stop.h, or withheld), except that, without a certified score bound, a
  * sample of one repeated score (the walks saw nothing else: its variance says nothing about what
  * they missed) gets the certified bound D of the walk part instead; either is clipped to
  * push_part -+ D.  Never zero-width while a residual is left unless D = 0. */
@@ -387,13 +385,8 @@ static void honest_interval(ulam_bidir_result *res, double D, const ulam_walk_op
 {
     const ulam_walk_result *w = &res->walks;
     double lo = res->push_part + w->ci95[0], hi = res->push_part + w->ci95[1];
-    if (w->walks > 0 && isfinite(w->score_bound)) {
-        int fixed = !(wo->stop.rel_err > 0) && !(wo->stop.max_seconds > 0) && w->walks == wo->stop.max_walks;
-        ulam__stop_ci ci;
-        ulam__stop_interval(w->walks, w->estimate, w->variance, 2.0 * w->score_bound, 0.0, 0.0, INFINITY,
-                            fixed ? 0 : ulam__stop_epoch(w->walks), &ci);
-        lo = res->push_part + ci.lo, hi = res->push_part + ci.hi;
-    } else if (w->walks > 0 && !(w->variance > 0))
+    (void)wo;
+    if (!(w->walks > 0 && isfinite(w->score_bound)) && w->walks > 0 && !(w->variance > 0))
         lo = res->push_part - D, hi = res->push_part + D; /* NaN-free: D may be INFINITY (no bound) */
     if (isfinite(D)) lo = fmax(lo, res->push_part - D), hi = fmin(hi, res->push_part + D);
     if (!isfinite(lo) || !isfinite(hi)) lo = hi = NAN; /* withheld: nothing certifies one */

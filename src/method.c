@@ -3,6 +3,7 @@
  * ulam_auto_start chooses among the rows, or starts the one pinned.  A new method is a row here
  * and its own file (src/method_*.c). */
 #include "method.h"
+#include "round.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -212,6 +213,8 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, u
     if (!M || !b || !opts) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and options");
     ulam_auto_opts ao;
     ulam_method_opts mo;
+    ulam_walk_opts o = ulam__lift_default_cap(opts);
+    opts = &o;
     solve_pins(opts, &ao, &mo);
     ulam_answer *a = malloc(sizeof *a);
     if (!a) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the answer");

@@ -131,11 +131,12 @@ static int exchange(const ulam_walk_opts *o, double t0, void *blocks, const ulam
  * 4, ... blocks up to B->round (a round is as long as all before it), so a --rel-err or time
  * rule is checked often while little has run, and the schedule depends on walks done only,
  * never on the thread count. */
-int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int threads, void *ctx,
-                void *results, int *nb, int *stop)
+int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int64_t want, int threads,
+                void *ctx, void *results, int *nb, int *stop)
 {
     int64_t left = o->stop.max_walks > 0 ? o->stop.max_walks - next : INT64_MAX, done = next / B->block;
     int round = done + 1 < B->round ? (int)(done + 1) : B->round, n = 0;
+    if (want > 0 && want / B->block + 1 < round) round = (int)(want / B->block + 1); /* a rule's stop is near */
     while (n < round && left > (int64_t)n * B->block) n++;
     /* A team only for rounds of at least TEAM_BLOCKS blocks a thread: a small round (the first
        ones, a small query) runs on the calling thread, which would otherwise wait at the round's
@@ -172,7 +173,7 @@ int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads
     double start = ulam_now();
     if (run->t0 < 0) run->t0 = start;
     if (B->begin) B->begin(ctx);
-    int nb, stop, st = ulam__round(B, o, run->t0, run->walks, threads, ctx, results, &nb, &stop);
+    int nb, stop, st = ulam__round(B, o, run->t0, run->walks, run->want, threads, ctx, results, &nb, &stop);
     if (st) run->status = st;
     for (int k = 0; k < nb; k++) {
         const ulam__block_head *h = head(B, results, k);
@@ -204,6 +205,15 @@ int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err)
     if (o->stop.max_walks == 0 && o->stop.rel_err == 0 && o->stop.max_seconds == 0 && !o->stop.interrupt)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a stopping rule: walks, rel_err or time");
     return ULAM_OK;
+}
+
+/* A rel_err target with the default walk budget runs to the target. */
+ulam_walk_opts ulam__lift_default_cap(const ulam_walk_opts *o)
+{
+    ulam_walk_opts w = *o;
+    if (w.stop.rel_err > 0 && w.stop.max_walks == ulam_stop_defaults().max_walks && !(w.stop.max_seconds > 0))
+        w.stop.max_walks = 0;
+    return w;
 }
 
 /* The walk cap: ULAM_REL_ERR_CAP with rel_err alone, else max_walks. */

@@ -49,6 +49,8 @@ typedef struct {
     int64_t walks, nonfinite;
     double t0, seconds;
     int done, interrupted, status;
+    int64_t want; /* the walks a rule (rel_err) predicts the run still needs, from its results so far
+                     (0: no prediction): a round runs at most the blocks that many take, at least one */
 } ulam__run;
 
 /* A run not yet started. */
@@ -59,8 +61,8 @@ void ulam__run_reset(ulam__run *run);
  * are then exchanged so all hold all of them.  *stop gets the stop flags (1: time is up,
  * 2: interrupted), or'ed over the processes.  ULAM_OK, ULAM_ENOMEM or ULAM_EIO (the exchange
  * failed; *nb is then 0). */
-int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int threads, void *ctx,
-                void *results, int *nb, int *stop);
+int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int64_t want, int threads,
+                void *ctx, void *results, int *nb, int *stop);
 
 /* The step a solver's iterate takes, shared by matrix and patch walks so each stopping rule
  * but the relative error is written once: one round (ulam__round) after B->begin, then its
@@ -79,6 +81,11 @@ int ulam__mine(const ulam_share *sh, int64_t q);
 /* The options' budgets both solvers check first: nonnegative budgets, max_steps >= 1, and at
  * least one stopping rule (walks, rel_err, time or an interrupt flag); ULAM_OK or ULAM_EINVAL. */
 int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err);
+
+/* Options as ulam_solve and ulam_solve_walks take them: a rel_err target with max_walks left at
+ * ulam_stop_defaults()'s (and no time limit) runs to the target, as the command line's --rel-err
+ * does (max_walks 0: the cap ULAM_REL_ERR_CAP); others unchanged. */
+ulam_walk_opts ulam__lift_default_cap(const ulam_walk_opts *o);
 
 /* The walk cap of a run whose only stopping rule is rel_err: ULAM_REL_ERR_CAP (a target out of
  * reach still ends), else o->stop.max_walks. */

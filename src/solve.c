@@ -103,6 +103,8 @@ struct ulam_solver {
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
     int met, cut_stop, out_of_reach;
     int epoch; /* the last epoch (stop.h) the rel_err rule was checked at */
+    ulam__cs cs; /* the confidence sequence (stop.h), fed a block at a time in block order */
+    double clip_b; /* the bias bound of the round's clipped scores (their limit: w.clip) */
 };
 
 /* The defaults. */
@@ -984,6 +986,7 @@ static int push_b(ulam_solver *s, int rel_alone, double *bnorm1, ulam_error *err
 static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
                         ulam_kernel *kernel, ulam_solver **out, ulam_error *err)
 {
+    double t_alloc = ulam_now(); /* a time limit counts the set-up below (guards, reach, bounds, push) */
     ulam__clear(err);
     if (!M || !b || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
     *out = NULL;
@@ -1072,6 +1075,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         return status;
     }
     ulam__run_reset(&s->run);
+    if (o.stop.max_seconds > 0) s->run.t0 = t_alloc;
     *out = s;
     return ULAM_OK;
 nomem:
@@ -1129,6 +1133,9 @@ static void run_block(void *ctx, int q, int64_t first, int64_t count, int t)
     else ulam__forward_block(&s->w, count, &r, &s->scratch[t], br);
 }
 
+static void cs_plan(ulam_solver *s);
+static void round_clip(ulam_solver *s);
+
 /* Merge completed block q into the totals (ctx: the solver; forward: the watched component's
  * moments count the block's histories that did not tally it as zeros; the walk and non-finite
  * counts are the round driver's). */
@@ -1136,6 +1143,8 @@ static void merge_block(void *ctx, int q)
 {
     ulam_solver *s = ctx;
     const ulam__block *br = &s->blocks[q];
+    cs_plan(s); /* from the blocks before this one alone */
+    if (s->o.mode == ULAM_ADJOINT) ulam__cs_add(&s->cs, br->clipped.n, br->clipped.mean, br->clipped.m2, 0.0);
     ulam__moments_merge(&s->adj, &br->m);
     s->maxsq = fmax(s->maxsq, br->maxsq);
     ulam__moments w = br->watched;
@@ -1147,6 +1156,9 @@ static void merge_block(void *ctx, int q)
     if (s->o.mode == ULAM_FORWARD) {
         ulam__moments zeros = {.n = br->h.walks - w.n};
         ulam__moments_merge(&w, &zeros);
+        ulam__moments c = br->clipped;
+        ulam__moments_merge(&c, &zeros);
+        ulam__cs_add(&s->cs, c.n, c.mean, c.m2, 0.0);
         ulam__moments_merge(&s->watched, &w);
     }
     s->steps += br->steps;
@@ -1158,6 +1170,7 @@ static void merge_block(void *ctx, int q)
 static void begin_round(void *ctx)
 {
     ulam_solver *s = ctx;
+    round_clip(s);
     if (atomic_load(&s->k->built) < s->n && atomic_load(&s->k->top) * COMPLETE > s->k->cap)
         ulam__kernel_complete(s->k, s->threads, s->ks);
 }
@@ -1187,7 +1200,7 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
     if (!(r->cut_bound <= ULAM__CUT_SHARE * E * m)) return 0;
     ulam__stop_ci ci;
     interval(s, r, &R, &ci);
-    return ulam__stop_rel_met(&ci, m, E);
+    return ci.kind == ULAM__STOP_EXACT || (ci.kind == ULAM__STOP_EB && ci.half <= E * m);
 }
 
 /* Under bounds over every state (ulam__reach_all), an estimate still exactly 0 once the rule
@@ -1274,10 +1287,17 @@ int ulam_solver_iterate(ulam_solver *s)
         if (s->run.status) return s->run.status; /* the search failed */
         result(s, &r, 0, 1);
     }
+    s->run.want = 0;
+    if (s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) { /* the next round no longer than the stop is near */
+        const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
+        double m = fabs(r.estimate + s->o.stop.rel_err_offset);
+        double left = ulam__cs_walks_left(&s->cs, mom->mean, ulam__moments_variance(mom), r.cut_bound, s->o.stop.rel_err * m);
+        s->run.want = isfinite(left) ? (int64_t)fmax(left, (double)s->run.walks / 8.0) : 0;
+    }
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
     if (check) zero_bound(s, &r);
-    if (check && rel_err_met(s, &r)) s->run.done = s->met = 1;
+    if (rel_err_met(s, &r)) s->run.done = s->met = 1; /* every round: the sequence holds at every count */
     else if (check && s->o.stop.rel_err > 0 && s->hit_walks > (double)s->o.stop.max_walks && s->maxsq == 0.0 &&
              r.estimate + s->o.stop.rel_err_offset == 0.0 && !(s->o.stop.max_seconds > 0))
         s->run.done = s->out_of_reach = 1; /* no score yet, and the rule needs more walks than the budget before one */
@@ -1366,37 +1386,85 @@ static double bias_scale(const ulam_solver *s, double m)
     return isfinite(X) && X > 0 ? X : isfinite(s->v2) && s->v2 > 0 ? sqrt(s->v2) : INFINITY;
 }
 
-/* The run's 95% interval so far (stop.h) from r's estimate, variance and walks, and the range R
- * it used: a single score's range (score_range: the width of its random part; the adjoint
- * expected estimator adds b_i, score0, to every score, so a score past |b_i| + R, not R, is
- * past the range), for scores without a bound at a truncation
- * whose bias is at most a quarter of the standard error, kept between 1e-6 and
- * max(ULAM__STOP_TAIL, E / 4) of |m| (the tighter the truncation, the wider the range; a
- * sample without spread takes the tightest); the truncation's and the cuts' bias widen it.
- * Stitched over epochs unless the run stops at a walk count fixed in advance (max_walks reached,
- * no time limit, no rel_err).  None while the variance is not certified finite. */
+/* The estimate the walks' moments make (forward: with b_i for expected and the push's part). */
+static double moments_estimate(const ulam_solver *s)
+{
+    double e, se, v;
+    if (s->o.mode == ULAM_ADJOINT) return s->adj.mean;
+    forward_component(s, s->o.query.index, &e, &se, &v);
+    return e;
+}
+
+/* The plan for the next block from the run so far (stop.h's ulam__cs): the half-width aimed at,
+ * h (rel_err: E |m|; else 0 and the planned walk count nplan: max_walks for a count fixed in
+ * advance, else four times the walks so far); the range Rt of a single score (score_range: the
+ * width of its random part), for scores without a bound at a truncation whose bias b is an
+ * eighth of h (or of 2.7 sigma / sqrt(nplan); under rel_err the share of h from 1/4 to 1/64 that
+ * ulam__cs_walks_needed says meets it soonest), kept between 1e-6 and max(ULAM__STOP_TAIL, E / 4)
+ * of |m| (with no estimate yet, of the least of bias_scale's bound on |x| and a visit's largest
+ * score: a loose bound on |x| would give the first blocks a bias that outweighs the rest); and the limit A of |score| (the adjoint expected estimator adds b_i,
+ * score0, to every score, so a score past |b_i| + R, not R, is past the range). */
+static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, double *h, double *nplan)
+{
+    const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
+    double E = s->o.stop.rel_err > 0 ? s->o.stop.rel_err : 0.0, mabs = fabs(moments_estimate(s) + s->o.stop.rel_err_offset);
+    double m = mabs > 0 ? mabs : fmin(bias_scale(s, 0.0), s->per_step), var = ulam__moments_variance(mom), N = (double)mom->n;
+    int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
+    int fixed = !(E > 0) && !(s->o.stop.max_seconds > 0) && s->o.stop.max_walks > 0;
+    *nplan = fixed ? (double)s->o.stop.max_walks : fmax(4.0 * N, 4096.0);
+    *h = E > 0 && mabs > 0 ? E * mabs : 0.0;
+    double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m;
+    double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
+    *Rt = !truncated ? score_range(s, 1.0, 1.0) : t > 0 ? score_range(s, m, t / m) : INFINITY;
+    for (int j = 2; truncated && *h > 0 && j <= 6; j++) { /* rel_err: the share of h (1/4 .. 1/64) that meets it soonest */
+        double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m);
+        double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
+        if (ulam__cs_walks_needed(mabs, var, Aj, tj, E) < ulam__cs_walks_needed(mabs, var, At, t, E)) t = tj, *Rt = Rj;
+    }
+    *A = isfinite(*Rt) ? fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt) : INFINITY;
+    *b = truncated ? t : 0.0;
+}
+
+/* Before a round: the limit its blocks clip their scores at for the sequence, and the bias
+ * bound that clipping leaves (plan_terms: a score past the range comes from a walk longer than
+ * the truncation, or above the second moment's threshold, and clipping it moves it no more than
+ * cutting that walk would); no clipping without a range. */
+static void round_clip(ulam_solver *s)
+{
+    double Rt, A, b, h, nplan;
+    plan_terms(s, &Rt, &A, &b, &h, &nplan);
+    s->w.clip = isfinite(A) && A > 0 ? A : 0.0, s->clip_b = b;
+}
+
+/* Plan the sequence's next block from the run so far (plan_terms) at the round's limit. */
+static void cs_plan(ulam_solver *s)
+{
+    const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
+    double Rt, A, b, h, nplan;
+    plan_terms(s, &Rt, &A, &b, &h, &nplan);
+    A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
+    ulam__cs_plan(&s->cs, mom->n, mom->mean, ulam__moments_variance(mom), A, b, h > b ? h - b : 0.0, nplan);
+}
+
+/* The run's 95% interval so far: the confidence sequence's (stop.h, ulam__cs), valid at every
+ * walk count, widened by the cuts' bias, and the range R the next block is planned at; zero
+ * width when nothing that scores is reachable (R = 0); none while the variance is not
+ * certified finite. */
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci)
 {
-    double E = s->o.stop.rel_err > 0 ? s->o.stop.rel_err : 0.0, m = bias_scale(s, fabs(r->estimate + s->o.stop.rel_err_offset));
-    double cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m, se = r->std_error;
-    int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
-    int fixed = !(s->o.stop.rel_err > 0) && !(s->o.stop.max_seconds > 0) && r->walks == s->o.stop.max_walks;
-    int k = fixed ? 0 : ulam__stop_epoch(r->walks);
-    /* the truncation: a quarter of the standard error, or the decade of |m| that gives the
-       narrowest interval (a longer truncation widens the range term, a shorter one the bias) */
-    double bt = isfinite(se) ? fmin(cap, fmax(se / 4.0, 1e-6 * m)) : cap, best = INFINITY;
-    for (int j = 0; j <= (truncated && isfinite(m) ? 6 : 0); j++) {
-        double t = j == 0 ? bt : fmin(cap, m * pow(10.0, -j)), Rt;
-        ulam__stop_ci c;
-        Rt = isfinite(m) ? score_range(s, m, t / m) : s->bound == 0.0 ? s->range : INFINITY;
-        ulam__stop_interval(r->walks, r->estimate, r->variance, Rt, (truncated ? t : 0.0) + r->cut_bound,
-                            sqrt(s->maxsq), fabs(s->w.score0) + (s->signs ? Rt / 2.0 : Rt), k, &c);
-        if (j == 0 || c.half < best) best = c.half, *ci = c, *R = Rt;
+    double A, b, h, nplan;
+    plan_terms(s, R, &A, &b, &h, &nplan);
+    if (*R == 0.0) ulam__stop_interval(r->walks, r->estimate, 0.0, 0.0, 0.0, 0.0, 0.0, 0, ci);
+    else {
+        double m0 = s->o.mode == ULAM_ADJOINT ? s->adj.mean : s->watched.mean, shift = r->estimate - m0;
+        ulam__cs_interval(&s->cs, m0, r->cut_bound, ci);
+        ci->lo += shift, ci->hi += shift; /* forward: b_i (expected) and the push's part */
     }
     if (s->var_finite != 1 && ci->kind != ULAM__STOP_EXACT) ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
     if (ci->kind == ULAM__STOP_EB && r->estimate != 0.0 && s->maxsq < ULAM__STOP_TINY) /* a b not rescaled (a prepared
         file's, read lazily) far below 1: b = 1e-300 printed '+- 0' and the range term alone, 22 of 50 seeds covered */
         ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
+    if (ci->kind != ULAM__STOP_EB && ci->kind != ULAM__STOP_EXACT) ci->half = INFINITY;
 }
 
 /* The result so far; the forward count of unreached components (O(n)) when asked; walked: at the
@@ -1428,12 +1496,11 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     ulam__stop_ci ci;
     interval(s, r, &R, &ci);
     r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
-    if (s->o.stop.rel_err > 0) { /* at this interval's truncation or at the one a stop would have (bias E |m| / 4) */
-        double E = s->o.stop.rel_err, Rs = m > 0 ? score_range(s, m, E / 4.0) : INFINITY;
-        int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
-        r->min_walks = fmin(ulam__stop_walks_needed(m, r->variance, R, ci.bias, E, ci.k),
-                            ulam__stop_walks_needed(m, r->variance, Rs, (truncated ? E * m / 4.0 : 0.0) + r->cut_bound,
-                                                    E, ci.k));
+    if (s->o.stop.rel_err > 0) { /* a sequence tuned to the target from the start, at the planned range */
+        double E = s->o.stop.rel_err, A, b, h, nplan, Rp;
+        plan_terms(s, &Rp, &A, &b, &h, &nplan);
+        r->min_walks = R == 0.0 ? 0.0 : ulam__cs_walks_needed(m, r->variance, A, b + r->cut_bound, E);
+        if (s->met) r->min_walks = fmin(r->min_walks, (double)r->walks); /* it held there */
         if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0 && ci.kind != ULAM__STOP_EXACT)
             r->min_walks = s->hit_walks; /* no score yet: src/hit.c (not over an x certified exactly) */
     }
@@ -1491,7 +1558,9 @@ int ulam_solve_walks(const ulam_csr *M, const double *b, const ulam_walk_opts *o
                      ulam_walk_result *result, ulam_error *err)
 {
     ulam_solver *s = NULL;
-    int status = ulam_solver_alloc(M, b, opts, &s, err);
+    ulam_walk_opts o;
+    if (opts) o = ulam__lift_default_cap(opts);
+    int status = ulam_solver_alloc(M, b, opts ? &o : NULL, &s, err);
     return status ? status : ulam__solver_finish(s, result, err);
 }
 
@@ -1537,6 +1606,7 @@ static void reset(ulam_solver *s)
     s->maxsq = 0.0;
     ulam__run_reset(&s->run);
     s->met = s->cut_stop = s->out_of_reach = s->epoch = 0;
+    s->cs = (ulam__cs){0};
     free(s->hitv), free(s->hitt), free(s->hits); /* made for this b and estimator */
     s->hitv = NULL, s->hitt = NULL, s->hits = NULL, s->nhits = 0, s->hit_reads = 0, s->hit_sweep = s->hit_done = 0, s->hit_walks = 0.0;
 }

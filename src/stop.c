@@ -104,3 +104,83 @@ void ulam__stop_kl_interval(int64_t n, double m, int k, double *lo, double *hi)
     }
     *lo = out;
 }
+
+/* psi_E(l) = -ln(1 - l) - l, the exponential-inequality penalty of a bet l in [0, 1). */
+static double cs_psi(double l)
+{
+    return -log1p(-l) - l;
+}
+
+/* ln(2 / delta): each side of the sequence takes delta / 2. */
+static double cs_log(void)
+{
+    return log(2.0 / ULAM__STOP_DELTA);
+}
+
+/* Plan the next block. */
+void ulam__cs_plan(ulam__cs *cs, int64_t n, double mean, double var, double A, double b, double h, double nplan)
+{
+    cs->limit = A, cs->bias = b, cs->lam = 0.0, cs->c = 0.0, cs->s = INFINITY;
+    if (!(A > 0) || !isfinite(A) || !(b >= 0) || !isfinite(b)) return; /* no range: the block weighs nothing */
+    double c = n > 0 && isfinite(mean) ? fmax(-A, fmin(A, mean)) : 0.0, s = A + fabs(c), N = (double)n;
+    /* the variance in xi units, with one prior observation at the largest, 1/4 (as Waudby-Smith and
+       Ramdas): a sample that has not yet seen its rare large scores bets small */
+    double v = ((n > 1 && isfinite(var) ? fmax(var, 0.0) * (N - 1.0) : 0.0) / s / s + 0.25) / (N + 1.0);
+    double lam = h > 0 ? (h / s) / (v + h / s) /* the lambda that reaches h soonest: h_xi = psi'(l) v */
+                       : sqrt(2.0 * cs_log() / (v * fmax(nplan, 2.0)));
+    cs->lam = isfinite(lam) && lam > 0 ? fmin(lam, ULAM__CS_LMAX) : 0.0, cs->c = c, cs->s = s;
+}
+
+/* Add a block under the current plan. */
+void ulam__cs_add(ulam__cs *cs, int64_t n, double mean, double m2, double maxabs)
+{
+    if (n <= 0) return;
+    if (maxabs > cs->limit * (1.0 + ULAM__STOP_ROUNDING) || !isfinite(mean)) cs->beyond = 1;
+    double N = (double)n, eta = cs->lam / cs->s, d = mean - cs->c;
+    if (eta > 0 && isfinite(eta) && !cs->beyond) {
+        cs->eta += eta * N, cs->etax += eta * N * mean, cs->etab += eta * N * cs->bias;
+        cs->v += cs_psi(cs->lam) * (fmax(m2, 0.0) + N * d * d) / cs->s / cs->s;
+    }
+    cs->n += n;
+}
+
+/* The sequence's interval. */
+void ulam__cs_interval(const ulam__cs *cs, double m, double extra, ulam__stop_ci *ci)
+{
+    *ci = (ulam__stop_ci){.lo = NAN, .hi = NAN, .half = INFINITY, .var_term = INFINITY, .range_term = INFINITY,
+                          .bias = extra, .L = cs_log(), .k = 0, .kind = ULAM__STOP_NONE};
+    if (cs->beyond) {
+        ci->kind = ULAM__STOP_BEYOND;
+        return;
+    }
+    if (cs->n < 2 || !(cs->eta > 0) || !isfinite(m) || !(extra >= 0) || !isfinite(extra)) return;
+    double c = cs->etax / cs->eta, w = (ci->L + cs->v) / cs->eta, b = cs->etab / cs->eta + extra;
+    ci->var_term = cs->v / cs->eta, ci->range_term = ci->L / cs->eta, ci->bias = b;
+    ci->lo = fmin(c - w - b, m), ci->hi = fmax(c + w + b, m); /* holding the estimate: a superset */
+    ci->half = 0.5 * (ci->hi - ci->lo);
+    ci->kind = ULAM__STOP_EB;
+}
+
+/* The walks a sequence tuned to target E needs. */
+double ulam__cs_walks_needed(double m, double var, double A, double b, double E)
+{
+    if (!(E > 0)) return 0.0;
+    if (A == 0.0) return 0.0;
+    double h = E * fabs(m) - b, s = A + fabs(m);
+    if (!(fabs(m) > 0) || !isfinite(A) || !(h > 0)) return INFINITY;
+    double hx = h / s, vx = fmax(var, 0.0) / s / s, lam = fmin(ULAM__CS_LMAX, hx / (vx + hx));
+    double den = lam * hx - cs_psi(lam) * vx;
+    return den > 0 ? ceil(fmax(cs_log() / den, 2.0)) : INFINITY;
+}
+
+/* The further walks that take the half-width to h. */
+double ulam__cs_walks_left(const ulam__cs *cs, double mean, double var, double extra, double h)
+{
+    double L = cs_log(), eta = cs->lam / cs->s, d = (mean - cs->c) / cs->s;
+    if (!(h > 0) || cs->beyond || !(eta > 0) || !isfinite(eta)) return INFINITY;
+    double b = cs->eta > 0 ? cs->etab / cs->eta : cs->bias, hb = h - fmax(b, cs->bias) - extra;
+    if (!(hb > 0)) return INFINITY;
+    if (cs->eta > 0 && (L + cs->v) / cs->eta <= hb) return 0.0;
+    double a = cs_psi(cs->lam) * (fmax(var, 0.0) / cs->s / cs->s + d * d), den = hb * eta - a; /* per walk */
+    return den > 0 ? ceil((L + cs->v - hb * cs->eta) / den) : INFINITY;
+}

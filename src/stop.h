@@ -83,6 +83,59 @@ double ulam__stop_walks_needed(double m, double var, double R, double bias, doub
 double ulam__stop_combined_target(double E, double f);
 
 
+/* The confidence sequence of the matrix solver (src/solve.c): the predictable plug-in
+ * empirical-Bernstein sequence of Waudby-Smith and Ramdas ("Estimating means of bounded random
+ * variables by betting", JRSS B 2023, Theorem 2), taken a block of walks at a time.  Block q's
+ * scores X all lie in [-A_q, A_q] (A_q, the block's limit, and everything below with index q is
+ * fixed from blocks 0 .. q-1 alone, before block q is looked at: predictable); with a centre c_q
+ * in that interval, s_q = A_q + |c_q| and xi = (X - c_q) / s_q lie in [-1, 1], and for every
+ * lambda in [0, 1) (Fan, Grama and Liu 2015) exp(lambda xi - psi(lambda) xi^2) <= 1 + lambda xi,
+ * psi(l) = -ln(1 - l) - l.  So for the true mean mu_q of block q's scores both
+ *     prod exp(+-lambda_q (X - mu_q) / s_q - psi(lambda_q) xi^2)
+ * are nonnegative supermartingales from 1, and by Ville's inequality, with probability
+ * 1 - delta at every walk count at once (each side delta / 2),
+ *     |sum eta_q (X - mu_q)| <= ln(2 / delta) + sum psi(lambda_q) xi^2,   eta_q = lambda_q / s_q:
+ * the interval centre sum eta X / sum eta, half-width (ln(2 / delta) + V) / sum eta, plus the
+ * eta-weighted bias bound of the blocks (mu_q within b_q of x: the truncation that set A_q).
+ * Valid at every count, so under any stopping rule (walks, time, rel_err) without a union over
+ * checkpoints.  lambda_q is tuned to the planned end: with a target half-width h (rel_err) the
+ * lambda whose interval first reaches h, lambda = h s / sigma^2 (for psi(l) ~ l^2 / 2); with a
+ * planned walk count n (a fixed budget, a time limit), the lambda narrowest at n,
+ * sqrt(2 ln(2 / delta) / (sigma_xi^2 n)); never above ULAM__CS_LMAX.  A block with a score past
+ * its A_q makes the sequence withhold the interval from then on (its clipped scores, which the
+ * bound is about, are not the ones seen). */
+#define ULAM__CS_LMAX 0.75
+
+typedef struct {
+    double eta, etax, v, etab; /* sum eta n, sum eta X, sum psi(lambda) xi^2, sum eta n b */
+    int64_t n;
+    int beyond;                /* a block had a score past its limit */
+    double lam, c, s, limit, bias; /* the plan for the next block */
+} ulam__cs;
+
+/* Plan the next block from the blocks so far (n scores, mean, sample variance var): its limit A
+ * (every score in [-A, A]), the bias bound b of its scores' mean, and either the target
+ * half-width h > 0 or the planned walk count nplan. */
+void ulam__cs_plan(ulam__cs *cs, int64_t n, double mean, double var, double A, double b, double h, double nplan);
+
+/* Add a block of n scores (mean, m2 = sum of squared deviations, largest |score| maxabs) under
+ * the current plan. */
+void ulam__cs_add(ulam__cs *cs, int64_t n, double mean, double m2, double maxabs);
+
+/* The sequence's 95% interval at estimate m (stretched to hold m), extra bias added on both
+ * sides (walks cut at max_steps); kind ULAM__STOP_EB (an interval), ULAM__STOP_BEYOND or
+ * ULAM__STOP_NONE (fewer than 2 scores, nothing weighted). */
+void ulam__cs_interval(const ulam__cs *cs, double m, double extra, ulam__stop_ci *ci);
+
+/* The further walks that take the sequence's half-width to h under its current plan, for scores
+ * of mean `mean` and variance var (extra: the bias added at the interval); 0 when it is there,
+ * INFINITY when the plan cannot reach it. */
+double ulam__cs_walks_left(const ulam__cs *cs, double mean, double var, double extra, double h);
+
+/* The walks at which a sequence tuned to target E at estimate m (variance var, limit A, bias b)
+ * reaches half-width E |m|; INFINITY when it cannot (bias too large, m = 0, A infinite). */
+double ulam__cs_walks_needed(double m, double var, double A, double b, double E);
+
 /* The Chernoff-Hoeffding interval for the mean of n independent scores in [0, 1] (Hoeffding 1963,
  * Theorem 1: P(mean >= mu + t) <= exp(-n kl(mu + t || mu)), Bernoulli laws being the extreme
  * case; the same below): [lo, hi] = the means q with n kl(m || q) <= ln(2 / delta_k) on each

@@ -154,11 +154,18 @@ static WALK_INLINE int lane_move(const ulam__walker *w, step_consts c, lane *x, 
     return !c.window || window(w, u, &x->w, r, &x->st);
 }
 
+/* x clipped to [-c, c] (c > 0), else x. */
+static WALK_INLINE double clip(double x, double c)
+{
+    return c > 0 ? fmax(-c, fmin(c, x)) : x;
+}
+
 /* Record a finished history's score (a non-finite one is counted, never averaged). */
-static void record(ulam__block *out, double score)
+static void record(const ulam__walker *w, ulam__block *out, double score)
 {
     if (isfinite(score)) {
         ulam__moments_add(&out->m, score);
+        ulam__moments_add(&out->clipped, clip(score, w->clip));
         out->maxsq = fmax(out->maxsq, score * score);
     } else {
         out->h.nonfinite++;
@@ -195,7 +202,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
                 l++;
                 continue;
             }
-            record(&acc, x->score);
+            record(w, &acc, x->score);
             if (started < count) {
                 if ((started & 63) == 0 && w->interrupt && *w->interrupt) break;
                 lane_start(w, x, r);
@@ -243,7 +250,9 @@ static WALK_INLINE void emit(const ulam__walker *w, ulam__scratch *sc, ulam__blo
             sc->btouched[sc->nbtouched++] = s;
         }
         sc->bsum[s] += v, sc->bsq[s] += v * v;
-        if (s == w->watch) ulam__moments_add(&out->watched, v), out->maxsq = fmax(out->maxsq, v * v);
+        if (s == w->watch)
+            ulam__moments_add(&out->watched, v), ulam__moments_add(&out->clipped, clip(v, w->clip)),
+                out->maxsq = fmax(out->maxsq, v * v);
         sc->hist[s] = 0.0;
         sc->mark[s] = 0;
     }

@@ -32,6 +32,8 @@ typedef struct {
     double roulette, split;
     int64_t max_steps;
     int lanes; /* adjoint histories interleaved (1 to 32) */
+    double clip; /* > 0: a block also keeps the moments of its scores clipped to [-clip, clip] (the
+                    confidence sequence's, src/stop.h); 0: none */
     volatile const int *interrupt;
 } ulam__walker;
 
@@ -59,6 +61,7 @@ typedef struct {
     ulam__moments m; /* adjoint scores */
     ulam__moments watched; /* forward: the watched component's history tallies (histories that
                               tallied it; the others count as zeros when merged) */
+    ulam__moments clipped; /* the scores (forward: the watched tallies) clipped to [-clip, clip] */
     int64_t steps, cut;
     double maxsq; /* the largest score^2 (forward: of the watched component) */
 } ulam__block;

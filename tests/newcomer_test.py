@@ -34,8 +34,9 @@ import tempfile
 
 NUM = r"-?[\d.]+(?:e[-+]?\d+)?"
 SHAPES = {  # KIND: regexes the stdout must match, each on a line of its own
-    "solve": [rf"^x\[\d+\]\s+{NUM} \+- {NUM} \(95% CI {NUM} \.\. {NUM}\)$", r"^method\s+\S.*random walks",
-              r"^walks\s+\d+", r"^seconds\s+", rf"^direct\s+{NUM} \((dense|sparse) LU, {NUM} s\), z = {NUM}$"],
+    "solve": [rf"^x\[\d+\]\s+{NUM} \+- {NUM} \(95% CI {NUM} \.\. {NUM}\)$",
+              r"^method\s+(\S.*random walks|bidirectional)", r"^walks\s+\d+", r"^seconds\s+",
+              rf"^direct\s+{NUM} \((dense|sparse) LU(, {NUM} s)?\), z = {NUM}$"],
     "study": [r"^study of x\[\d+\]: exact ", r"^walks\s+winner",
               rf"^\d+\s+\S+-\S+-\S+\s+{NUM}\s+{NUM}\s+\d+/\d+ \({NUM} \.\. {NUM}\)$"],
     "radiosity": [r"^scene\s+", r"^patch\s+\d+ \(floor", rf"^radiosity R\s+{NUM} \+- {NUM} \(95% CI {NUM} \.\. {NUM}\)$",

@@ -77,6 +77,35 @@ static void test_walk(void **state)
                 p.system == o.policy.system);
 }
 
+/* Issue 38 point 10: ulam_walk_defaults() with a rel_err target runs to the target, as the
+ * command line's --rel-err does: the default budget of 10^5 walks is a run's without another
+ * rule, not a cap on a target (signed200 by collision at E = 0.01 needs about 3.7e5 walks; it
+ * stopped "out of reach" after 1024).  Through ulam_solve_walks and ulam_solve; a budget given
+ * with the target (here 2^16) still caps it. */
+static void test_rel_err_lifts_default_cap(void **state)
+{
+    (void)state;
+    ulam_csr *M = must_read("matrices/signed200.mtx");
+    int64_t n;
+    double *b = must_read_vector("matrices/signed200_b.mtx", &n);
+    for (int api = 0; api < 2; api++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.stop.rel_err = 0.01;
+        ulam_walk_result r;
+        assert_int_equal(api ? ulam_solve(M, b, &o, &r, NULL) : ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+        print_message("%s: %lld walks, met %d, out of reach %d\n", api ? "ulam_solve" : "ulam_solve_walks",
+                      (long long)r.walks, r.rel_err_met, r.out_of_reach);
+        assert_true(r.rel_err_met && !r.out_of_reach);
+        assert_true((r.ci95[1] - r.ci95[0]) / 2 <= 0.01 * fabs(r.estimate));
+    }
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.stop.rel_err = 0.01, o.stop.max_walks = 1 << 16;
+    ulam_walk_result r;
+    assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+    assert_true(!r.rel_err_met && r.walks <= 1 << 16);
+    ulam_csr_free(M), free(b);
+}
+
 /* ulam_mm_defaults: all cores, ulam_strtod; and reading with them is reading with NULL options. */
 static void test_mm(void **state)
 {
@@ -242,7 +271,7 @@ static void test_system_desc(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_walk),       cmocka_unit_test(test_mm),    cmocka_unit_test(test_spectral_and_guards),
+        cmocka_unit_test(test_walk),       cmocka_unit_test(test_rel_err_lifts_default_cap), cmocka_unit_test(test_mm),    cmocka_unit_test(test_spectral_and_guards),
         cmocka_unit_test(test_outer),      cmocka_unit_test(test_bidir_and_auto), cmocka_unit_test(test_share),
         cmocka_unit_test(test_system_desc),
     };

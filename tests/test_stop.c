@@ -263,10 +263,12 @@ static void test_never_zero_width(void **state)
     ulam_csr_free(M), free(b);
 }
 
-/* The cost of --rel-err (issue 25's target: at most 3x the walks the variance asks, var /
- * (E x)^2): signed200 by collision at E = 0.01, where the range term dominates (the rule that
- * held the range and bias terms to w on their own spent 3.2x; sharing the half-width 2 w with
- * the variance term, 1.6x), seed 1; the oracle's variance from 2^18 walks of a fixed run. */
+/* The cost of --rel-err (issue 38 point 5: the printed 95% interval's half-width at most E |x|,
+ * bought at most 3x the walks a CLT interval of that width needs, (1.96 / E)^2 var / x^2):
+ * signed200 by collision at E = 0.01, where the scores' certified range is ~27 standard
+ * deviations, seed 1; the oracle's variance from 2^18 walks of a fixed run.  The stitched
+ * empirical-Bernstein interval this replaced stopped on the standard error: 1.6x var / (E x)^2
+ * walks, and a printed half-width of 4-9 E |x|. */
 static void test_rel_err_cost(void **state)
 {
     (void)state;
@@ -278,12 +280,14 @@ static void test_rel_err_cost(void **state)
     o.estimator = ULAM_COLLISION, o.stop.max_walks = 1 << 18, o.exec.seed = 12345;
     ulam_walk_result r;
     assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
-    double oracle = r.variance / (E * x[0] * E * x[0]);
+    double oracle = 1.96 * 1.96 * r.variance / (E * x[0] * E * x[0]);
     o.stop.max_walks = 0, o.stop.rel_err = E, o.exec.seed = 1;
     assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
-    print_message("signed200 collision, rel_err %g: %lld walks, oracle %.4g (%.3gx)\n", E, (long long)r.walks, oracle,
-                  (double)r.walks / oracle);
+    double half = (r.ci95[1] - r.ci95[0]) / 2;
+    print_message("signed200 collision, rel_err %g: %lld walks, CLT oracle %.4g (%.3gx), half-width %.3g E |x|\n", E,
+                  (long long)r.walks, oracle, (double)r.walks / oracle, half / (E * fabs(r.estimate)));
     assert_true(r.rel_err_met && r.ci95[0] <= x[0] && x[0] <= r.ci95[1]);
+    assert_true(half <= E * fabs(r.estimate));
     assert_true((double)r.walks <= 3.0 * oracle);
     ulam_csr_free(M), free(b), free(x);
 }
@@ -530,6 +534,106 @@ static void test_zero_estimate_stops(void **state)
     ulam_csr_free(A), ulam_csr_free(M);
 }
 
+/* Issue 38's hard systems (bench/gen.h): 0 signed (n = 200), 1 the hub at alpha 0.99, 2 upwind
+ * convection-diffusion 30 x 30 (cell Peclet 5 and 0.5, b = 30 entries U(0, 1) plus 1 at the last
+ * unknown), unknown 1; x by LAPACK. */
+static ulam_csr *hard38(int k, double **b, double *x0)
+{
+    ulam_csr *M = NULL;
+    if (k == 0) assert_int_equal(bench_signed(200, 5, &M, b), 0);
+    if (k == 1) assert_int_equal(bench_hub(200, 0.99, 5, &M, b), 0);
+    if (k == 2) assert_int_equal(bench_convdiff_b(30, 5.0, 0.5, 5, &M, b), 0);
+    double *x = malloc((size_t)M->nrows * sizeof *x);
+    assert_int_equal(ulam_direct_solve(M, *b, x, 0, NULL, NULL), ULAM_OK);
+    *x0 = x[0];
+    free(x);
+    return M;
+}
+
+/* Issue 38 point 5: --rel-err E means the printed interval's half-width is at most E |estimate|
+ * (the stitched interval stopped on the standard error and printed 3-9 E |x|), bought at most 3x
+ * the walks a CLT interval of that width needs, (1.96 / E)^2 var / x^2 (var from a fixed run of
+ * 2^18 walks).  Collision walks on issue 38's systems: at E = 0.1 over 40 seeds each, every run
+ * met with its half-width within E |estimate| and the intervals cover (honest at least 34 of 40:
+ * 95% coverage fails that with probability under 2%); at E = 0.01, seed 1, the signed system and
+ * the hub within 3x of the CLT oracle (convection-diffusion, whose certified range is ~400
+ * standard deviations, is printed, not held to it: 4x). */
+static void test_rel_err_width_hard(void **state)
+{
+    (void)state;
+    static const char *name[3] = {"signed200", "hub0.99", "convdiff30"};
+    for (int k = 0; k < 3; k++) {
+        double *b, x;
+        ulam_csr *M = hard38(k, &b, &x);
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.stop.max_walks = 1 << 18, o.exec.seed = 12345;
+        ulam_walk_result r;
+        assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+        double var = r.variance;
+        int v[3] = {0, 0, 0}, R = 40;
+        for (int s = 0; s < R; s++) {
+            if (!test_case(6000L + 100L * k + s)) continue;
+            o.stop.max_walks = 0, o.stop.rel_err = 0.1, o.exec.seed = 1 + (uint64_t)s;
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+            double half = (r.ci95[1] - r.ci95[0]) / 2;
+            if (!(r.rel_err_met && half <= 0.1 * fabs(r.estimate)))
+                print_error("%s seed %d: met %d, half-width %.3g E |estimate|\n", name[k], s + 1, r.rel_err_met,
+                            half / (0.1 * fabs(r.estimate)));
+            assert_true(r.rel_err_met && half <= 0.1 * fabs(r.estimate));
+            v[verdict(&r, x)]++;
+        }
+        test_case_done();
+        char what[64];
+        snprintf(what, sizeof what, "%s collision, rel_err 0.1:", name[k]);
+        int lower = (int)ceil(0.95 * R - 3 * sqrt(0.0475 * R));
+        print_message("%-44s covered %3d, withheld %3d of %d (honest at least %d)\n", what, v[1], v[2], R, lower);
+        if (test_case_all()) assert_true(v[1] + v[2] >= lower);
+        if (test_case(6500L + k)) {
+            double E = 0.01, clt = 1.96 * 1.96 * var / (E * x * E * x);
+            o.stop.rel_err = E, o.exec.seed = 1;
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+            print_message("%s collision, rel_err 0.01: %lld walks, CLT oracle %.4g (%.3gx), half-width %.3g E |x|\n",
+                          name[k], (long long)r.walks, clt, (double)r.walks / clt,
+                          (r.ci95[1] - r.ci95[0]) / 2 / (E * fabs(r.estimate)));
+            assert_true(r.rel_err_met && (r.ci95[1] - r.ci95[0]) / 2 <= E * fabs(r.estimate));
+            assert_true(r.ci95[0] <= x && x <= r.ci95[1]);
+            if (k < 2) assert_true((double)r.walks <= 3.0 * clt);
+        }
+        test_case_done();
+        ulam_csr_free(M), free(b);
+    }
+}
+
+/* Coverage at fixed budgets on issue 38's systems (collision, 100, 1000 and 10^4 walks, 40 seeds
+ * each): the sequence tuned to the planned count holds there as at every count. */
+static void test_fixed_hard(void **state)
+{
+    (void)state;
+    static const char *name[3] = {"signed200", "hub0.99", "convdiff30"};
+    for (int k = 0; k < 3; k++) {
+        double *b, x;
+        ulam_csr *M = hard38(k, &b, &x);
+        for (int w = 0; w < 3; w++) {
+            int v[3] = {0, 0, 0}, R = 40;
+            for (int s = 0; s < R; s++) {
+                if (!test_case(7000L + 1000L * k + 100L * w + s)) continue;
+                ulam_walk_opts o = ulam_walk_defaults();
+                o.stop.max_walks = w == 0 ? 100 : w == 1 ? 1000 : 10000, o.exec.seed = 1 + (uint64_t)s;
+                ulam_walk_result r;
+                assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+                v[verdict(&r, x)]++;
+            }
+            test_case_done();
+            char what[64];
+            snprintf(what, sizeof what, "%s collision, %d walks:", name[k], w == 0 ? 100 : w == 1 ? 1000 : 10000);
+            int lower = (int)ceil(0.95 * R - 3 * sqrt(0.0475 * R));
+            print_message("%-44s covered %3d, withheld %3d of %d (honest at least %d)\n", what, v[1], v[2], R, lower);
+            if (test_case_all()) assert_true(v[1] + v[2] >= lower);
+        }
+        ulam_csr_free(M), free(b);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_stitching_spends_delta), cmocka_unit_test(test_never_zero_width), cmocka_unit_test(test_metastable_fixed),
@@ -537,6 +641,7 @@ int main(void)
                                        cmocka_unit_test(test_metastable_rel_err), cmocka_unit_test(test_laplace_corner),
                                        cmocka_unit_test(test_rel_err_cost), cmocka_unit_test(test_push_b),
                                        cmocka_unit_test(test_laplace_noisy_auto), cmocka_unit_test(test_forward_rel_err), cmocka_unit_test(test_forward_rel_err_scale),
-                                       cmocka_unit_test(test_zero_estimate_stops)};
+                                       cmocka_unit_test(test_zero_estimate_stops), cmocka_unit_test(test_rel_err_width_hard),
+                                       cmocka_unit_test(test_fixed_hard)};
     return test_run(tests);
 }

@@ -703,8 +703,8 @@ def solve(*args, M=None, A=None, b=None, index=None, jacobi=False, omega=1.0, so
                   VectorResult); pins it for auto.
       estimator   "collision", "absorption" or "expected"; pins it for auto.
       walks       stop after this many walks (--walks; default 100000 when no rule is given).
-      rel_err     stop once stderr / |estimate| <= rel_err, and only once enough walks have run
-                  for the error bar to be trusted (--rel-err, in [1e-12, 1]); refused
+      rel_err     stop once the printed 95% interval's half-width is at most rel_err |estimate|
+                  (matrix walks), after at least 1000 walks (--rel-err, in [1e-12, 1]); refused
                   (InfiniteVarianceError) when the variance is not certified finite, unless
                   walks= or time= bounds the run.  Single source: every component whose interval
                   reaches 1/n within -+ rel_err of it (default 0.1).

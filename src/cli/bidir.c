@@ -39,7 +39,7 @@ static const char *const usage =
     "                     'id' or 'id weight'); --top K alone: global PageRank's K largest\n"
     "  --step-cost C      push operations one walk visit costs, for the balance (default 1.3;\n"
     "                     bench_bidir measures it: docs/bidirectional.md)\n"
-    "  --rel-err E        stop once stderr / |x_I estimate| <= E (whole estimate, >= 1000 walks)\n"
+    "  --rel-err E        stop once the 95% interval's half-width <= E |x_I estimate| (>= 1000 walks)\n"
     "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
     "  guards reported are those of the forward kernel\n";
 

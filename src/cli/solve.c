@@ -34,8 +34,8 @@ static const char *const usage =
     "  --estimator E      collision (score at every visit, default), absorption (score where\n"
     "                     the walk ends, / p*), expected (score the exact next-step expectation)\n"
     "  --walks N          stop after N walks (default 100000 when no rule is given)\n"
-    "  --rel-err E        (or --tol E) stop once stderr / |estimate| <= E, and only once enough walks have run\n"
-    "                     for the error bar to be trusted (docs/error-bars.md); it watches\n"
+    "  --rel-err E        (or --tol E) stop once the printed 95% interval's half-width is at most\n"
+    "                     E |estimate| (walks; docs/error-bars.md), after at least 1000 walks; it watches\n"
     "                     x_I (--index, default 1 in forward mode) and never\n"
     "                     stops while no walk has reached it; refused (exit 4) when the variance\n"
     "                     is not certified finite, unless --walks or --time bounds the run\n"
@@ -661,6 +661,10 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
         ro->kernel_seconds = ulam_now() - t0;
     }
     ro->guard_seconds = ro->g.abs.seconds + ro->g.hat[0].seconds + ro->g.hat[1].seconds;
+    if (!status && a->max_seconds > 0 && ulam_now() - cli_started > a->max_seconds) /* --time counts the whole run */
+        fprintf(stderr, "ulam: %s: note: --time %g: reading (%.3g s), the guards, the choice and the set-up (%.3g s) "
+                        "took %.3g s before any walk, past the budget: the walks get their first round only\n",
+                s->matrix_path, a->max_seconds, ro->load_seconds, ro->kernel_seconds, ulam_now() - cli_started);
     if (status == ULAM_EINVAL && o->kernel.split > 0 && strstr(err.msg, "split weight")) {
         rc = cli_usage_error("solve", "--split W: %s", err.msg);
     } else if (status == ULAM_EDIVERGE) {

@@ -18,8 +18,25 @@
  * Forward rows (fwd; the benign files only) run forward mode watching the same index.
  * A run is capped at CAP walks: one that predicts more stops early, not met (counted in walks).
  *
- *   bench_relerr [E [REPS [ONLY]]]    prints the tables (defaults 0.1 and 5; ONLY: the rows whose
- *                                     system name contains it, +ONLY: of case 6's table alone) */
+ * Issue 38's table (first): what the printed interval costs at a --rel-err stop on the hard
+ * systems of issue 38 point 8, generated here (gen.h): signed (n = 200), the hub at alpha 0.99
+ * (n = 200), the 12^3 Laplacian's corner (b = 1), upwind convection-diffusion 30 x 30 (cell Peclet 5 and
+ * 0.5, b = 30 entries U(0, 1) plus 1 at the last unknown, unknown 1), adjoint walks, collision and
+ * absorption, at E and E / 10:
+ *   clt      the walks a CLT interval of half-width E |x| needs, (1.96 / E)^2 var / x^2;
+ *   walks/clt  the mean walks of the --rel-err runs over it (the target: <= 3, median <= 2);
+ *   half/Ex  the printed half-width over E |x| (--rel-err E now promises <= 1);
+ *   half/1.96se  the printed half-width over 1.96 standard errors at the stop;
+ *   cov      the runs whose interval holds x.
+ * With OLD (a path to a previous build's libulam.so, opened with its own symbols first) each row
+ * is printed for it too, side by side: the previous construction (stitched empirical Bernstein,
+ * a rule on the standard error) against this one (the predictable plug-in empirical-Bernstein
+ * confidence sequence, a rule on the printed half-width).
+ *
+ *   bench_relerr [E [REPS [ONLY [OLD]]]]  prints the tables (defaults 0.1 and 5; ONLY: the rows whose
+ *                                     system name contains it, +ONLY: of case 6's table alone,
+ *                                     =ONLY: of issue 38's table alone) */
+#include <dlfcn.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -224,13 +241,108 @@ static void dense_table(double E, int reps, const char *only)
     }
 }
 
+/* The library a row runs: this build's, or a previous one opened by path. */
+typedef struct {
+    const char *name;
+    ulam_walk_opts (*defaults)(void);
+    int (*solve)(const ulam_csr *, const double *, const ulam_walk_opts *, ulam_walk_result *, ulam_error *);
+} lib;
+
+/* Issue 38's systems: k = 0 signed, 1 hub, 2 laplace corner, 3 convection-diffusion; 0 when made. */
+static int hard_system(int k, sys *s)
+{
+    s->index = 0;
+    if (k == 0) s->name = "signed200 gen", bench_signed(200, 5, &s->M, &s->b);
+    if (k == 1) s->name = "hub200 a=0.99", bench_hub(200, 0.99, 5, &s->M, &s->b);
+    if (k == 2) { /* b = 1 everywhere (Jacobi's b: 1/6), the corner unknown */
+        laplace(s, 12), s->name = "laplace12^3 b=1 corner";
+        for (int64_t i = 0; i < s->M->nrows; i++) s->b[i] = 1.0 / 6.0;
+    }
+    if (k == 3) s->name = "convdiff30 Pe 5/0.5", bench_convdiff_b(30, 5.0, 0.5, 5, &s->M, &s->b);
+    if (!s->M) return -1;
+    exact(s);
+    return 0;
+}
+
+/* One row of issue 38's table for library L: est at target E, reps seeds; the CLT oracle's
+ * variance from a fixed run of ORACLE walks (this build). */
+static void row38(const sys *s, const lib *L, int est, double E, int reps, double var)
+{
+    ulam_walk_opts o = L->defaults();
+    o.estimator = est, o.query.index = s->index;
+    double clt = 1.96 * 1.96 * var / (E * s->x * E * s->x), walks = 0, half = 0, hse = 0;
+    int met = 0, cov = 0, ran = 0;
+    double ratio[64];
+    for (int k = 0; k < reps && k < 64; k++) {
+        o.stop.max_walks = CAP, o.stop.rel_err = E, o.exec.seed = 1 + (uint64_t)k;
+        ulam_walk_result r;
+        if (L->solve(s->M, s->b, &o, &r, NULL)) continue;
+        double h = (r.ci95[1] - r.ci95[0]) / 2;
+        ratio[ran++] = (double)r.walks / clt;
+        walks += (double)r.walks, met += r.rel_err_met, half += h / (E * fabs(s->x)), hse += h / (1.96 * r.std_error);
+        cov += r.ci95[0] <= s->x && s->x <= r.ci95[1];
+    }
+    for (int i = 1; i < ran; i++) /* the median ratio */
+        for (int j = i; j > 0 && ratio[j] < ratio[j - 1]; j--) {
+            double t = ratio[j];
+            ratio[j] = ratio[j - 1], ratio[j - 1] = t;
+        }
+    double med = ran ? (ran % 2 ? ratio[ran / 2] : 0.5 * (ratio[ran / 2 - 1] + ratio[ran / 2])) : NAN;
+    printf("%-20s %-10s %-5g %-8s %10.4g %10.4g %8.3g %8.3g %8.3g %8.3g %3d/%-3d %3d/%-3d\n", s->name,
+           est ? "absorption" : "collision", E, L->name, clt, ran ? walks / ran : NAN, ran ? walks / ran / clt : NAN, med,
+           ran ? half / ran : NAN, ran ? hse / ran : NAN, met, ran, cov, ran);
+    fflush(stdout);
+}
+
+/* Issue 38's table: this build and, with old, a previous one side by side. */
+static void table38(double E, int reps, const char *only, const char *old)
+{
+    lib libs[2] = {{"this", ulam_walk_defaults, ulam_solve_walks}, {"previous", NULL, NULL}};
+    int nlib = 1;
+    if (old && *old) {
+        void *h = dlopen(old, RTLD_NOW | RTLD_LOCAL | RTLD_DEEPBIND);
+        if (!h) printf("cannot open %s: %s\n", old, dlerror());
+        else {
+            *(void **)&libs[1].defaults = dlsym(h, "ulam_walk_defaults");
+            *(void **)&libs[1].solve = dlsym(h, "ulam_solve_walks");
+            nlib = libs[1].defaults && libs[1].solve ? 2 : 1;
+        }
+    }
+    printf("issue 38: --rel-err on hard systems, %d runs a row; clt = (1.96 / E)^2 var / x^2\n", reps);
+    printf("%-20s %-10s %-5s %-8s %10s %10s %8s %8s %8s %8s %7s %7s\n", "system", "estimator", "E", "build", "clt",
+           "walks", "walks/clt", "median", "half/Ex", "h/1.96se", "met", "cov");
+    for (int k = 0; k < 4; k++) {
+        sys s = {0};
+        if (hard_system(k, &s)) continue;
+        if (!strstr(s.name, only)) {
+            ulam_csr_free(s.M), free(s.b);
+            continue;
+        }
+        for (int est = ULAM_COLLISION; est <= ULAM_ABSORPTION; est++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.estimator = est, o.query.index = s.index, o.stop.max_walks = ORACLE, o.exec.seed = 12345;
+            ulam_walk_result r;
+            if (ulam_solve_walks(s.M, s.b, &o, &r, NULL)) {
+                printf("%-20s %-10s refused\n", s.name, est ? "absorption" : "collision");
+                continue;
+            }
+            for (int e = 0; e < 2; e++)
+                for (int l = 0; l < nlib; l++) row38(&s, &libs[l], est, e ? E / 10 : E, reps, r.variance);
+        }
+        ulam_csr_free(s.M), free(s.b);
+    }
+    printf("\n");
+}
+
 int main(int argc, char **argv)
 {
     double E = argc > 1 ? atof(argv[1]) : 0.1;
     int reps = argc > 2 ? atoi(argv[2]) : 5;
-    const char *only = argc > 3 ? argv[3] : "";
-    int case6_only = only[0] == '+'; /* "+NAME": case 6's table alone */
-    only += case6_only;
+    const char *only = argc > 3 ? argv[3] : "", *old = argc > 4 ? argv[4] : NULL;
+    int case6_only = only[0] == '+', only38 = only[0] == '='; /* "+NAME": case 6's table alone; "=NAME": issue 38's */
+    only += case6_only || only38;
+    if (!case6_only) table38(E, reps, only, old);
+    if (only38) return 0;
     static const struct { const char *name; int jacobi; } files[] = {
         {"chain4", 0}, {"radiosity100", 0}, {"randsub1000", 0}, {"signed200", 0}, {"poisson20", 1}};
     printf("--rel-err %g, %d runs a row; oracle = var / (E x)^2 (var from %d walks)\n", E, reps, ORACLE);

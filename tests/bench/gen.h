@@ -318,6 +318,96 @@ static inline ulam_csr *bench_convdiff(int64_t L, double c)
     return A;
 }
 
+/* Issue 38 point 8's systems.  signed: n states, row i of M has 8 entries at uniform columns,
+ * magnitudes 0.1 + U(0, 1) with random signs, rows of |M| scaled to sum to 0.8; b = U(-0.5, 1).
+ * Stream (seed, 38).  Nonzero when out of memory. */
+static inline int bench_signed(int64_t n, uint64_t seed, ulam_csr **M, double **b)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 38);
+    int64_t nz = 8 * n;
+    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
+    double *tx = malloc((size_t)nz * sizeof *tx);
+    *b = malloc((size_t)n * sizeof **b);
+    int bad = !ti || !tj || !tx || !*b;
+    for (int64_t i = 0; !bad && i < n; i++) {
+        double sum = 0;
+        for (int k = 0; k < 8; k++) {
+            int64_t e = 8 * i + k;
+            ti[e] = (int32_t)i, tj[e] = (int32_t)ulam_rng_bounded(&r, (uint64_t)n);
+            tx[e] = (0.1 + ulam_rng_uniform(&r)) * (ulam_rng_uniform(&r) < 0.5 ? -1.0 : 1.0), sum += fabs(tx[e]);
+        }
+        for (int k = 0; k < 8; k++) tx[8 * i + k] *= 0.8 / sum;
+        (*b)[i] = 1.5 * ulam_rng_uniform(&r) - 0.5;
+    }
+    bad = bad || ulam_csr_from_triplets(n, n, nz, ti, tj, tx, M);
+    free(ti), free(tj), free(tx);
+    if (bad) free(*b), *b = NULL;
+    return bad ? -1 : 0;
+}
+
+/* A hub of damping alpha: state 0 moves to each of states 1 .. n-1 with probability alpha / (n - 1);
+ * state i >= 1 to the hub and to state i + 1 (wrapping to 1) with alpha / 2 each (M = alpha P,
+ * P a random walk's transition matrix: walks last 1 / (1 - alpha) steps); b = U(0, 1), stream
+ * (seed, 39).  The unknown: the hub.  Nonzero when out of memory. */
+static inline int bench_hub(int64_t n, double alpha, uint64_t seed, ulam_csr **M, double **b)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 39);
+    int64_t nz = 3 * n;
+    int32_t *ti = malloc((size_t)nz * sizeof *ti), *tj = malloc((size_t)nz * sizeof *tj);
+    double *tx = malloc((size_t)nz * sizeof *tx);
+    *b = malloc((size_t)n * sizeof **b);
+    int bad = !ti || !tj || !tx || !*b;
+    nz = 0;
+    for (int64_t i = 0; !bad && i < n; i++) {
+        (*b)[i] = ulam_rng_uniform(&r);
+        if (i == 0)
+            for (int64_t j = 1; j < n; j++) ti[nz] = 0, tj[nz] = (int32_t)j, tx[nz++] = alpha / (double)(n - 1);
+        else {
+            ti[nz] = (int32_t)i, tj[nz] = 0, tx[nz++] = alpha / 2;
+            ti[nz] = (int32_t)i, tj[nz] = (int32_t)(i + 1 < n ? i + 1 : 1), tx[nz++] = alpha / 2;
+        }
+    }
+    bad = bad || ulam_csr_from_triplets(n, n, nz, ti, tj, tx, M);
+    free(ti), free(tj), free(tx);
+    if (bad) free(*b), *b = NULL;
+    return bad ? -1 : 0;
+}
+
+/* Upwind convection-diffusion on an L x L grid with cell Peclet numbers cx (along j) and cy
+ * (along i): h^2 times, 4 + cx + cy on the diagonal, -1 - cx and -1 - cy to the upstream
+ * neighbours, -1 downstream; by its Jacobi splitting, b = 30 entries U(0, 1) at random states
+ * plus 1 at the last (stream (seed, 40)).  Nonzero when out of memory. */
+static inline int bench_convdiff_b(int64_t L, double cx, double cy, uint64_t seed, ulam_csr **M, double **b)
+{
+    int64_t n = L * L, nz = 0;
+    int32_t *ti = malloc((size_t)(5 * n) * sizeof *ti), *tj = malloc((size_t)(5 * n) * sizeof *tj);
+    double *tx = malloc((size_t)(5 * n) * sizeof *tx), *rhs = calloc((size_t)n, sizeof *rhs);
+    *b = malloc((size_t)n * sizeof **b);
+    ulam_csr *A = NULL;
+    int bad = !ti || !tj || !tx || !rhs || !*b;
+    for (int64_t i = 0; !bad && i < L; i++)
+        for (int64_t j = 0; j < L; j++) {
+            int32_t row = (int32_t)(i * L + j);
+            const int64_t at[4][2] = {{i - 1, j}, {i, j - 1}, {i + 1, j}, {i, j + 1}};
+            const double up[4] = {cy, cx, 0, 0};
+            ti[nz] = row, tj[nz] = row, tx[nz++] = 4.0 + cx + cy;
+            for (int k = 0; k < 4; k++) {
+                if (at[k][0] < 0 || at[k][0] >= L || at[k][1] < 0 || at[k][1] >= L) continue;
+                ti[nz] = row, tj[nz] = (int32_t)(at[k][0] * L + at[k][1]), tx[nz++] = -1.0 - up[k];
+            }
+        }
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 40);
+    for (int k = 0; !bad && k < 30; k++) rhs[ulam_rng_bounded(&r, (uint64_t)n)] = ulam_rng_uniform(&r);
+    if (!bad) rhs[n - 1] = 1.0;
+    bad = bad || ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &A) || ulam_jacobi(A, rhs, 1.0, M, *b, NULL);
+    ulam_csr_free(A), free(ti), free(tj), free(tx), free(rhs);
+    if (bad) free(*b), *b = NULL;
+    return bad ? -1 : 0;
+}
+
 /* x = (I - M)^-1 b by x <- b + M x to a change below 1e-15 ||x||_1 or 10^5 products; a new array
  * (NULL when out of memory). */
 static inline double *bench_neumann(const ulam_csr *M, const double *b)
