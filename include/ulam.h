@@ -1225,7 +1225,8 @@ typedef struct ulam_fpush_info {
  * empirical-Bernstein interval (src/stop.h; every walk score within -+ ||r||_1 / (1 - ||M||_1)),
  * clipped to p_i -+ residual_bound, widened by an allowance for the push's rounding, its lower end
  * at least min(x_i, 0) when M >= 0 (the queue path for ||M||_1 >= 1: the normal interval where the
- * walks scored two values, else p_i -+ residual_bound, NaN when there is none).  Mt is M's
+ * walks scored two values, else p_i -+ residual_bound, NaN when there is none, and NaN everywhere
+ * when the forward guard does not certify the walks' variance finite).  Mt is M's
  * transpose.  ULAM_OK, ULAM_EINVAL, ULAM_ENOCONV (queue push cap 100 nnz + 10^6), ULAM_ENOMEM,
  * the walk solver's statuses. */
 int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, double *x, double *std_error,

@@ -111,6 +111,7 @@ typedef struct ulam_dist_mcsa_info {
     int iterations;                  /* Richardson step + Monte Carlo correction, each */
     double residual;                 /* max |b - (I - M) x| / max |b| at the end */
     int64_t walks, steps, crossings; /* of every correction */
+    int64_t cut;                     /* walks cut at max_steps */
 } ulam_dist_mcsa_info;
 
 /* x of (I - M) x = b by MCSA (Evans, Slattery, Wilson): x <- x + r (r = b - (I - M) x, a product
@@ -125,6 +126,7 @@ typedef struct ulam_dist_source_info {
     int rounds;                      /* products of the push */
     double residual;                 /* max |r| left to the walks */
     int64_t walks, steps, crossings; /* of the walks from r */
+    int64_t cut;                     /* walks cut at max_steps */
 } ulam_dist_source_info;
 
 /* x = (I - M)^-1 e_source: a push x = sum_{k<K} M^k e_s (products with M over the ranks' rows)

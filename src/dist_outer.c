@@ -77,6 +77,7 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
         status = ulam_dist_forward_b(p, comm, &w, r, d, NULL, &res, err);
         for (int64_t i = 0; !status && i < rows; i++) x[i] += d[i]; /* the Monte Carlo correction */
         info->iterations = it + 1, info->walks += res.walks, info->steps += res.steps, info->crossings += res.crossings;
+        info->cut += res.cut;
     }
     free(all), free(r), free(d);
     return status;
@@ -114,7 +115,7 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
         x[i] += y[i];
         if (rmax == 0.0) se[i] = 0.0; /* nothing left to walk: the push is the answer */
     }
-    info->walks = res.walks, info->steps = res.steps, info->crossings = res.crossings;
+    info->walks = res.walks, info->steps = res.steps, info->crossings = res.crossings, info->cut = res.cut;
     free(all), free(r), free(y);
     return status;
 }

@@ -135,11 +135,12 @@ static int solve_queue(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     }
     if (!status) {
         double D = info->residual_bound;
+        int finite = ulam_guard_variance(&g, ULAM_FORWARD) == 1; /* else -+ 1.96 stderr means nothing */
         for (int64_t i = 0; i < n; i++) {
             x[i] = p[i] + xw[i];
             if (std_error) std_error[i] = se[i];
-            double a = x[i] - 1.959963984540054 * se[i], b = x[i] + 1.959963984540054 * se[i];
-            if (!(se[i] > 0) && D > 0) a = p[i] - D, b = p[i] + D; /* the walks saw one value at i, or none */
+            double a = finite ? x[i] - 1.959963984540054 * se[i] : NAN, b = finite ? x[i] + 1.959963984540054 * se[i] : NAN;
+            if (finite && !(se[i] > 0) && D > 0) a = p[i] - D, b = p[i] + D; /* the walks saw one value at i, or none */
             if (isfinite(D)) a = fmax(a, p[i] - D), b = fmin(b, p[i] + D);
             if (!isfinite(a) || !isfinite(b)) a = b = NAN; /* nothing certifies one */
             if (lo) lo[i] = a;

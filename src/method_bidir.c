@@ -11,6 +11,7 @@
 #include "stats.h"
 #include "stop.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -468,7 +469,13 @@ static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
         if (status) return status;
         double qi = r->bq[r->bwo.query.index];
         br->push_part = qi, br->estimate = qi + br->walks.estimate, br->std_error = br->walks.std_error;
-        br->ci95[0] = qi + br->walks.ci95[0], br->ci95[1] = qi + br->walks.ci95[1];
+        /* the push's arithmetic: each operation rounds q_j += r_j and r_k += M_kj r_j, which leave
+         * x = q + (I - M)^-1 r true only to roundings that add up over the push; the interval is
+         * widened either side by (ops + 2) u |q_i| and the sum's own rounding u |x_i| (as bidir.c's
+         * rounding_allowance), so a push taken down to rounding (residual walks' stderr ~1e-17)
+         * does not print a zero-width point beside x_i */
+        double fp = ((double)r->bplan.push.ops + 2.0) * (DBL_EPSILON / 2.0) * fabs(qi) + DBL_EPSILON * fabs(br->estimate);
+        br->ci95[0] = qi + br->walks.ci95[0] - fp, br->ci95[1] = qi + br->walks.ci95[1] + fp;
         br->plan = r->bplan, br->push = r->bplan.push;
         br->seconds = br->walks.seconds + r->bplan.seconds;
         a->walks = br->walks, a->opts = r->bwo;

@@ -45,8 +45,9 @@ static ulam_csr *poisson(int m, double **bp, int64_t *c, double *xc)
     return M;
 }
 
-/* At 1000 walks over 100 seeds: every interval is finite and at most a quarter of x wide each
- * side (before: about 8 x), and at least 89 cover (95% coverage fails that with probability under
+/* At 4096 walks (four of the confidence sequence's blocks: a single block, with no earlier one to
+ * tune its bet, is about twice as wide) over 100 seeds: every interval is finite and at most a
+ * quarter of x wide each side (before the length certificate: none, or about 8 x at 1000), and at least 89 cover (95% coverage fails that with probability under
  * 2%), under the collision and expected estimators. */
 static void test_poisson_fixed(void **state)
 {
@@ -60,7 +61,7 @@ static void test_poisson_fixed(void **state)
         for (int s = 0; s < 100; s++) {
             if (!test_case(1000L * e + s)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.query.index = c, o.estimator = e ? ULAM_EXPECTED : ULAM_COLLISION, o.stop.max_walks = 1000;
+            o.query.index = c, o.estimator = e ? ULAM_EXPECTED : ULAM_COLLISION, o.stop.max_walks = 4096;
             o.exec.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
             assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
@@ -72,7 +73,7 @@ static void test_poisson_fixed(void **state)
             covered += r.ci95[0] <= x && x <= r.ci95[1];
         }
         test_case_done();
-        print_message("poisson 70x70 centre %s, 1000 walks: covered %d of 100, widest half-width %.3g x\n",
+        print_message("poisson 70x70 centre %s, 4096 walks: covered %d of 100, widest half-width %.3g x\n",
                       e ? "expected" : "collision", covered, widest);
         if (test_case_all()) assert_true(covered >= 89);
     }

@@ -524,6 +524,44 @@ static void test_fpush_exact_push(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* The queue path (column sums of |M| past 1) with a forward variance certified infinite (a
+ * newcomer's 2000-state case: 4 of 8 printed intervals missed x, one by 2.6 standard errors):
+ * no interval is printed, where before x -+ 1.96 stderr was. */
+static void test_fpush_queue_infinite(void **state)
+{
+    (void)state;
+    int64_t n = 300;
+    ulam_rng r;
+    ulam_rng_seed(&r, 5, 0);
+    int32_t *ti = malloc(4 * (size_t)n * sizeof *ti), *tj = malloc(4 * (size_t)n * sizeof *tj);
+    double *tv = malloc(4 * (size_t)n * sizeof *tv);
+    int64_t nz = 0;
+    for (int64_t i = 0; i < n; i++) /* rows summing to 0.85; in-degrees uneven: columns past 1 */
+        for (int k = 0; k < 4; k++) {
+            int64_t j = k == 0 ? (i + 1) % n : (int64_t)(ulam_rng_uniform(&r) * ulam_rng_uniform(&r) * (double)n);
+            ti[nz] = (int32_t)i, tj[nz] = (int32_t)j, tv[nz++] = 0.85 / 4;
+        }
+    ulam_csr *M = NULL, *Mt = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, &M), ULAM_OK);
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    ulam_guard g;
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
+    assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
+    assert_true(g.abs.colsum_max >= 1.0 && ulam_guard_variance(&g, ULAM_FORWARD) == 0); /* the case */
+    ulam_fpush_opts o = ulam_fpush_defaults();
+    o.source = 3, o.walks = 2000;
+    double *x = malloc((size_t)n * sizeof *x), *se = malloc((size_t)n * sizeof *se), *lo = malloc((size_t)n * sizeof *lo);
+    double *hi = malloc((size_t)n * sizeof *hi);
+    ulam_fpush_info info;
+    assert_int_equal(ulam_fpush_solve(M, Mt, &o, x, se, lo, hi, &info, NULL), ULAM_OK);
+    int64_t printed = 0;
+    for (int64_t i = 0; i < n; i++) printed += !isnan(lo[i]) || !isnan(hi[i]);
+    assert_int_equal(printed, 0);
+    free(ti), free(tj), free(tv), free(x), free(se), free(lo), free(hi);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -534,6 +572,7 @@ int main(void)
         cmocka_unit_test(test_fpush_hits),
         cmocka_unit_test(test_fpush_samplers),
         cmocka_unit_test(test_fpush_top),
+        cmocka_unit_test(test_fpush_queue_infinite),
         cmocka_unit_test(test_fpush_top_coverage),
         cmocka_unit_test(test_fpush_exact_push),
     };

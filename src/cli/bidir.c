@@ -74,9 +74,10 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
 {
     const ulam_walk_result *w = &r->walks;
     if (isfinite(r->ci95[0]) && isfinite(r->ci95[1]))
-        printf("%s[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", cli_answer_name,
-               (long long)(o->target + cli_node_base), cli_answer_pad(o->target + cli_node_base, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
-               w->interrupted ? "  [INTERRUPTED]" : "");
+        printf("%s[%lld]%*s%.10g +- %.3g (95%% CI %.*g .. %.*g)%s\n", cli_answer_name,
+               (long long)(o->target + cli_node_base), cli_answer_pad(o->target + cli_node_base, 16), "", r->estimate,
+               r->std_error, cli_ci_digits(r->ci95[0], r->ci95[1]), r->ci95[0], cli_ci_digits(r->ci95[0], r->ci95[1]),
+               r->ci95[1], w->interrupted ? "  [INTERRUPTED]" : "");
     else
         printf("%s[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", cli_answer_name,
                (long long)(o->target + cli_node_base), cli_answer_pad(o->target + cli_node_base, 16), "", r->estimate, r->std_error,
@@ -436,9 +437,11 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
             }
             for (int64_t k = 0; k < shown; k++) {
                 int64_t i = order[k];
-                printf("%-6lld %-10lld %-14.8g %-11.3g %-12.6g %.6g", (long long)k + 1, (long long)(i + cli_node_base),
-                       x[i], se[k], lo[k], hi[k]);
-                if (xd) printf("%*s%.8g", 13 - (int)snprintf(NULL, 0, "%.6g", hi[k]), "", xd[i]);
+                printf("%-6lld %-10lld %-14.8g %-11.3g ", (long long)k + 1, (long long)(i + cli_node_base), x[i], se[k]);
+                int none = isnan(lo[k]) || isnan(hi[k]); /* no certified interval (an infinite variance) */
+                if (none) printf(xd ? "%-25s" : "%s", "none");
+                else printf("%-12.6g %.6g", lo[k], hi[k]);
+                if (xd) printf("%*s%.8g", none ? 0 : 13 - (int)snprintf(NULL, 0, "%.6g", hi[k]), "", xd[i]);
                 printf("\n");
             }
         }

@@ -229,6 +229,9 @@ const char *cli_verdict_word(int verdict);
 /* The spaces after "x[index]" (1-based) that put its value at column (the lines below's). */
 int cli_answer_pad(int64_t index, int column);
 
+/* The digits (10 to 17) that print lo and hi as two numbers (src/cli/common.c). */
+int cli_ci_digits(double lo, double hi);
+
 /* --check's z = (estimate - direct) / stderr, 0 when both agree exactly. */
 double cli_z(double estimate, double direct, double std_error);
 

@@ -686,6 +686,20 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
     return cli_report(s->matrix_path, &err);
 }
 
+/* The significant digits that print an interval's ends lo < hi apart: 10, or up to 17 (every
+ * double prints as itself) for an interval narrower than 10 digits show (a push taken down to
+ * rounding): its ends then do not print as one number. */
+int cli_ci_digits(double lo, double hi)
+{
+    char a[40], b[40];
+    int p = 10;
+    for (; p < 17 && lo < hi; p++) {
+        snprintf(a, sizeof a, "%.*g", p, lo), snprintf(b, sizeof b, "%.*g", p, hi);
+        if (strcmp(a, b)) break;
+    }
+    return p;
+}
+
 /* The spaces after "x[index]" (1-based) that put the value at the given column, the one of the
  * lines below it (16 under "method          "); at least 1. */
 int cli_answer_pad(int64_t index, int column)

@@ -22,12 +22,14 @@ static const char *const help =
     "reads only its rows' blocks of SYSTEM.ulam, prepared with --rhs, and --transpose for forward).\n"
     "A walk that steps onto another rank's row travels there; random numbers are keyed by (seed,\n"
     "walk, step), so 1, 2, 3 or 64 ranks print the same answer bit for bit.  Collision estimator,\n"
-    "analog kernel (p_ij = |M_ij| / row sum, leaving with min(1, row sum)); the interval is the\n"
-    "CLT's (1.96 standard errors): no certified range of a score is computed on a partition.\n"
+    "analog kernel (p_ij = |M_ij| / row sum, leaving with min(1, row sum)).  Answers carry their\n"
+    "standard error, and no 95% interval: no certified range of a score is computed on a partition\n"
+    "(the guard certifies only that the variance is finite).\n"
     "  --index I       x_I by adjoint walks from I (1-based)\n"
     "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, query k\n"
     "                  with seed S + k - 1: a line answers what --index I --seed S+k-1 answers\n"
-    "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector\n"
+    "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector, --errors\n"
+    "                  their standard errors (also with --source)\n"
     "  --method mcsa   every x_i by MCSA: Richardson steps (products with M across ranks) and forward\n"
     "                  walks' corrections (--walks each) to --tol (default 1e-8) of max|b|, --max-iter\n"
     "  --source S      x = (I - M)^-1 e_S: a push (products with M) to 1e-4, then forward walks; prints\n"
@@ -40,7 +42,7 @@ static const char *const help =
 
 /* The parsed command line. */
 typedef struct {
-    const char *path, *out, *queries;
+    const char *path, *out, *errors, *queries;
     int64_t index; /* 1-based; 0 none */
     int forward, mcsa;
     int64_t sets, source, top, max_iter;
@@ -51,7 +53,7 @@ typedef struct {
 static const struct option longopts[] = {
     {"partition", no_argument, 0, 'P'}, {"index", required_argument, 0, 'i'}, {"mode", required_argument, 0, 'm'},
     {"out", required_argument, 0, 'o'}, {"walks", required_argument, 0, 'w'}, {"seed", required_argument, 0, 's'},
-    {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'}, {"sets", required_argument, 0, 'S'}, {"queries", required_argument, 0, 'Q'},
+    {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'}, {"sets", required_argument, 0, 'S'}, {"queries", required_argument, 0, 'Q'}, {"errors", required_argument, 0, 'E'},
     {"method", required_argument, 0, 'M'}, {"tol", required_argument, 0, 'T'}, {"max-iter", required_argument, 0, 'I'},
     {"source", required_argument, 0, 'R'}, {"top", required_argument, 0, 'K'},
     {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
@@ -82,6 +84,7 @@ static int option(void *p, int val, const char *name, const char *value)
     case 'x': return cli_parse_int("solve", "--max-steps", value, 1, INT64_MAX, &a->o.max_steps);
     case 'b': return cli_parse_int("solve", "--batch", value, 1, (int64_t)1 << 30, &a->o.batch);
     case 'Q': a->queries = value; return 0;
+    case 'E': a->errors = value; return 0;
     case 'M':
         if (!strcmp(value, "mcsa")) a->mcsa = 1;
         else if (strcmp(value, "walks"))
@@ -107,7 +110,13 @@ static int check(args *a, int argc, char **argv, int first)
     if (!!a->forward + !!a->index + !!a->queries + a->mcsa + !!a->source != 1)
         return cli_usage_error("solve", "one of --index I, --queries FILE, --mode forward, --method mcsa and --source S "
                                         "with --partition");
-    if (a->out && (a->index || a->queries)) return cli_usage_error("solve", "--out with --partition writes a whole x");
+    if ((a->out || a->errors) && (a->index || a->queries))
+        return cli_usage_error("solve", "--out and --errors with --partition write a whole x");
+    if (a->errors && a->mcsa) return cli_usage_error("solve", "--errors with --mode forward or --source");
+    const cli_file outs[] = {{"--out", a->out}, {"--errors", a->errors}},
+                   ins[] = {{"the system", a->path}, {"--queries", a->queries}};
+    int rc = cli_check_outputs("solve", outs, 2, ins, 2);
+    if (rc) return rc;
     if ((a->mcsa || a->source) && a->sets > 1) return cli_usage_error("solve", "--sets with --method walks only");
     return 0;
 }
@@ -122,15 +131,15 @@ static int all_rows(const ulam_comm *c, int64_t mine, int64_t *rows)
 
 /* Write x (this rank's rows x[0 .. mine)) to path on rank 0, the other ranks' rows sent to it in
  * rank order through the exchange, a chunk a round; 0 or an exit code (on every rank). */
-static int write_x(const ulam_comm *c, const char *path, const double *x, int64_t mine, int64_t n)
+static int write_x(const ulam_comm *c, const char *path, const double *x, int64_t mine, int64_t n, const char *what)
 {
     int64_t *rows = calloc((size_t)c->nranks, sizeof *rows), failed = 0;
     ulam_outfile o = {0};
     if (!rows || all_rows(c, mine, rows)) failed = 1;
     if (!failed && c->rank == 0) {
         int status = cli_outfile_open(&o, path);
-        if (status || fprintf(o.f, "%%%%MatrixMarket matrix array real general\n%% x by ulam solve --partition\n%lld 1\n",
-                              (long long)n) < 0) failed = status ? status : 1;
+        if (status || fprintf(o.f, "%%%%MatrixMarket matrix array real general\n%% %s by ulam solve --partition\n%lld 1\n",
+                              what, (long long)n) < 0) failed = status ? status : 1;
         for (int64_t i = 0; !failed && i < mine; i++) failed = fprintf(o.f, "%.17g\n", x[i]) < 0;
     }
     enum { CHUNK = 1 << 16 };
@@ -191,15 +200,20 @@ static int load_queries(const char *path, int64_t n, cli_query **q, int64_t *nq)
     return rc;
 }
 
-/* One query's answer line (rank 0): x[I] estimate +- stderr (95% CI, CLT) and its seed. */
+/* "x[i]  estimate +- stderr (standard error; ...)" without a newline: a partition certifies the
+ * variance finite (rho < 1) but no range of a score, so no interval is printed. */
+static void print_estimate(int64_t i, double est, double se, double rho)
+{
+    printf("x[%lld]%*s%.10g", (long long)i, cli_answer_pad(i, 16), "", est);
+    if (!(rho < 1.0)) printf(" (no standard error: rho(M^) is not certified below 1)");
+    else if (isnan(se)) printf(" (no walk reached it: the push's part alone)");
+    else printf(" +- %.3g (standard error; no certified interval on a partition)", se);
+}
+
+/* One query's answer line (rank 0): x[I] estimate +- stderr and its seed. */
 static void print_query(const cli_query *q, int64_t k, const ulam_dist_result *r, uint64_t seed, double rho)
 {
-    int64_t i = q->index + 1;
-    printf("x[%lld]%*s%.10g", (long long)i, cli_answer_pad(i, 16), "", r->estimate);
-    if (rho < 1.0)
-        printf(" +- %.3g (95%% CI %.10g .. %.10g, CLT)", r->std_error, r->estimate - 1.96 * r->std_error,
-               r->estimate + 1.96 * r->std_error);
-    else printf(" (no confidence interval: rho(M^) not certified below 1)");
+    print_estimate(q->index + 1, r->estimate, r->std_error, rho);
     printf("  line %ld, seed %llu\n", q->line, (unsigned long long)(seed + (uint64_t)k));
 }
 
@@ -218,7 +232,7 @@ static int by_estimate(const void *a, const void *b)
 }
 
 /* Each rank's K largest components to rank 0, which prints the K largest of all with their
- * intervals (CLT, when the guard certified the walks' variance); 0 or an exit code. */
+ * standard errors; 0 or an exit code. */
 static int print_top(const ulam_comm *c, const double *x, const double *se, int64_t first, int64_t rows, int64_t K,
                      double rho)
 {
@@ -237,12 +251,7 @@ static int print_top(const ulam_comm *c, const double *x, const double *se, int6
         if (!bad && c->rank == 0) qsort(got, (size_t)all, sizeof *e, by_estimate);
     }
     const entry *t = c->nranks > 1 ? got : e;
-    for (int64_t j = 0; !bad && c->rank == 0 && j < all && j < K; j++) {
-        printf("x[%lld]%*s%.10g", (long long)t[j].i + 1, cli_answer_pad(t[j].i + 1, 16), "", t[j].x);
-        if (rho < 1.0 && isfinite(t[j].se))
-            printf(" +- %.3g (95%% CI %.10g .. %.10g, CLT)\n", t[j].se, t[j].x - 1.96 * t[j].se, t[j].x + 1.96 * t[j].se);
-        else printf(" (no interval: %s)\n", rho < 1.0 ? "no walk reached it; the push's part alone" : "rho(M^) not certified below 1");
-    }
+    for (int64_t j = 0; !bad && c->rank == 0 && j < all && j < K; j++) print_estimate(t[j].i + 1, t[j].x, t[j].se, rho), printf("\n");
     free(e), free(cnt), free(got);
     return bad ? cli_exit_code(ULAM_EIO) : 0;
 }
@@ -255,13 +264,7 @@ static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_
         if (cli_verbosity >= 0) printf("queries         %s, each above (walks below: each query's)\n", a->queries);
     } else if (a->mcsa || a->source) { /* their answer is above */
     }
-    else if (!a->forward && !(rho < 1.0))
-        printf("x[%lld]%*s%.10g (no confidence interval: rho(M^) is not certified below 1, bound %.4g; the sample "
-               "stderr %.3g means nothing)\n", (long long)a->index, cli_answer_pad(a->index, 16), "", r->estimate, rho,
-               r->std_error);
-    else if (!a->forward)
-        printf("x[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g, CLT)\n", (long long)a->index, cli_answer_pad(a->index, 16),
-               "", r->estimate, r->std_error, r->estimate - 1.96 * r->std_error, r->estimate + 1.96 * r->std_error);
+    else if (!a->forward) print_estimate(a->index, r->estimate, r->std_error, rho), printf("\n");
     else if (a->forward && !a->mcsa) printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
                 a->out ? a->out : "");
     if (cli_verbosity < 0) return;
@@ -285,6 +288,20 @@ static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_
     printf("\n");
 }
 
+/* The first nonzero status of the ranks, in rank order, on every rank (ULAM_EIO when the sum
+ * itself fails): the exit code does not depend on which rank read the damaged block. */
+static int first_status(const ulam_comm *c, int status)
+{
+    if (c->nranks == 1) return status;
+    int64_t *v = calloc((size_t)c->nranks, sizeof *v);
+    if (!v) return ULAM_ENOMEM;
+    v[c->rank] = status;
+    int bad = c->sum(c->ctx, v, c->nranks), first = 0;
+    for (int r = 0; !bad && !first && r < c->nranks; r++) first = (int)v[r];
+    free(v);
+    return bad ? ULAM_EIO : first;
+}
+
 /* Run the parsed command on this rank. */
 static int run(const args *a, const ulam_comm *c)
 {
@@ -293,12 +310,11 @@ static int run(const args *a, const ulam_comm *c)
     int walks_forward = a->forward || a->mcsa || a->source; /* the walks run on M' */
     int status = ulam_part_open(a->path, c, a->mcsa || a->source ? ULAM_PART_BOTH : a->forward ? ULAM_PART_MT : ULAM_PART_M,
                                 &p, &err);
-    int64_t bad = status != ULAM_OK; /* every rank ends together when one cannot read its rows */
-    if (c->nranks > 1 && c->sum(c->ctx, &bad, 1)) bad = 1;
-    if (bad) {
+    int shared = first_status(c, status); /* every rank ends together, with the same code, when one cannot read its rows */
+    if (shared) {
         if (status) cli_report(a->path, &err);
         ulam_part_free(p);
-        return status ? cli_exit_code(status) : cli_exit_code(ULAM_EIO);
+        return cli_exit_code(shared);
     }
     const char *die = getenv("ULAM_TEST_PARTITION_DIE"); /* tests: this rank dies before its walks */
     if (die && atoi(die) == c->rank && c->nranks > 1) _exit(9);
@@ -336,16 +352,17 @@ static int run(const args *a, const ulam_comm *c)
         if (!x || !se) status = ULAM_ENOMEM;
         else if (a->mcsa) status = ulam_dist_mcsa(p, c, &a->o, a->tol, (int)a->max_iter, x, &mi, &err);
         else if (a->source) status = ulam_dist_source(p, c, a->source - 1, &a->o, 1e-4, 1000, x, se, &si, &err);
-        else status = ulam_dist_forward(p, c, &a->o, x, NULL, &r, &err);
-        if (!status && a->mcsa) r.walks = mi.walks, r.steps = mi.steps, r.crossings = mi.crossings;
-        if (!status && a->source) r.walks = si.walks, r.steps = si.steps, r.crossings = si.crossings;
+        else status = ulam_dist_forward(p, c, &a->o, x, se, &r, &err);
+        if (!status && a->mcsa) r.walks = mi.walks, r.steps = mi.steps, r.crossings = mi.crossings, r.cut = mi.cut;
+        if (!status && a->source) r.walks = si.walks, r.steps = si.steps, r.crossings = si.crossings, r.cut = si.cut;
     } else {
         status = ulam_dist_adjoint(p, c, a->index - 1, &a->o, &r, &err);
     }
     ulam_part_free(p);
     int rc = status ? (cli_report(a->path, &err), cli_exit_code(status)) : 0;
     int in_set0 = c->sets <= 1 || c->rank < c->nranks / c->sets; /* set 0's ranks hold x */
-    if (!rc && a->out) rc = write_x(c, a->out, x, in_set0 ? last - first : 0, n);
+    if (!rc && a->out) rc = write_x(c, a->out, x, in_set0 ? last - first : 0, n, "x");
+    if (!rc && a->errors) rc = write_x(c, a->errors, se, in_set0 ? last - first : 0, n, "standard errors of x");
     int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
     if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
     for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, &many[k], a->o.seed, rho);
@@ -356,6 +373,10 @@ static int run(const args *a, const ulam_comm *c)
                mi.residual, a->tol);
     if (!rc && c->rank == 0 && a->source && cli_verbosity >= 0)
         printf("push            %d products with M, max |r| %.3g left to the walks\n", si.rounds, si.residual);
+    if (!rc && c->rank == 0 && r.cut)
+        fprintf(stderr, "ulam: %s: warning: %lld walks were cut at --max-steps %lld: the estimates and their standard "
+                        "errors leave out what those walks would have scored\n", a->path, (long long)r.cut,
+                (long long)a->o.max_steps);
     if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v, rho);
     if (!rc && a->mcsa && mi.residual > a->tol) {
         if (c->rank == 0) fprintf(stderr, "ulam: %s: error: MCSA stopped at --max-iter %lld with residual %.3g above --tol %.3g\n",

@@ -149,7 +149,7 @@ static void print_answer(const query *q, int64_t k, uint64_t seed, double est, d
         char src[32] = "";
         if (q->source >= 0) snprintf(src, sizeof src, " (source %lld)", (long long)(q->source + cli_node_base));
         printf("%s[%lld]%s %.10g +- %.3g", cli_answer_name, (long long)(q->index + cli_node_base), src, est, se);
-        if (!isnan(ci[0])) printf(" (95%% CI %.10g .. %.10g)", ci[0], ci[1]);
+        if (!isnan(ci[0])) printf(" (95%% CI %.*g .. %.*g)", cli_ci_digits(ci[0], ci[1]), ci[0], cli_ci_digits(ci[0], ci[1]), ci[1]);
         printf("  walks %lld, %.4f s, seed %llu\n", (long long)walks, seconds, (unsigned long long)seed);
     }
     fflush(stdout);

@@ -86,7 +86,9 @@ static const char *const usage3 =
     "                     by a target like 0.01 for that line's --rel-err; one answer a line\n"
     "                     (--json: JSON lines); query k walks with seed --seed + k - 1; the\n"
     "                     guards, bounds and kernel rows are kept across them (docs/queries.md)\n"
-    "  --method walks     the single method the options name, defaults for the rest (adjoint,\n"
+    "  --partition        the rows of a prepared SYSTEM.ulam split across mpirun's ranks, walks\n"
+    "                     that migrate (its own options: ulam solve --partition --help;\n"
+    "                     docs/distributed.md)\n"    "  --method walks     the single method the options name, defaults for the rest (adjoint,\n"
     "                     collision, --continue analog, --kernel-exponent 1): the run before auto\n"
     "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
     "                     is built when a walk first reaches it, so one unknown of a large\n"
@@ -156,9 +158,10 @@ static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
                : !isfinite(r->tail_bound) && r->estimate != 0 ? "no certified range of a single walk's score"
                : "no certified range yet, or a score past the certified one", r->interrupted ? "  [INTERRUPTED]" : "");
     else if (r->variance_finite == 1)
-        printf("%s[%lld]%*s%.10g +- %.3g (95%% CI %.10g .. %.10g)%s\n", cli_answer_name,
-               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate, r->std_error, r->ci95[0], r->ci95[1],
-               r->interrupted ? "  [INTERRUPTED]" : "");
+        printf("%s[%lld]%*s%.10g +- %.3g (95%% CI %.*g .. %.*g)%s\n", cli_answer_name,
+               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate,
+               r->std_error, cli_ci_digits(r->ci95[0], r->ci95[1]), r->ci95[0], cli_ci_digits(r->ci95[0], r->ci95[1]),
+               r->ci95[1], r->interrupted ? "  [INTERRUPTED]" : "");
     else
         printf("%s[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
                "means nothing)%s\n", cli_answer_name, (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate,
