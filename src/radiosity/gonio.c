@@ -243,12 +243,3 @@ void ulam_gonio_size(const ulam_gonio *g, int *nc, int *ng)
     if (nc) *nc = g ? g->nc : 0;
     if (ng) *ng = g ? g->ng : 0;
 }
-
-/* EULUMDAT by the name's .ldt ending, else IES. */
-int ulam_gonio_read(const char *path, ulam_gonio **out, ulam_error *err)
-{
-    size_t n = path ? strlen(path) : 0;
-    int ldt = n > 4 && path[n - 4] == '.' && (path[n - 3] | 32) == 'l' && (path[n - 2] | 32) == 'd' &&
-              (path[n - 1] | 32) == 't';
-    return ldt ? ulam_gonio_read_ldt(path, out, err) : ulam_gonio_read_ies(path, out, err);
-}
