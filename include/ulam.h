@@ -1630,6 +1630,21 @@ uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
  * walk that migrates between ranks (ulam_dist.h) takes the same path. */
 double ulam_rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k);
 
+/* What a derived seed is for: the one place sub-runs get their seeds (ulam_rng_substream). */
+typedef enum ulam_stream_purpose {
+    ULAM_STREAM_QUERY = 1,     /* query k of a batch (--queries, partition queries) */
+    ULAM_STREAM_PILOT = 2,     /* pilot k of auto's choice or bidir's plan */
+    ULAM_STREAM_PROBE = 3,     /* probe k of bidir's push/walk split */
+    ULAM_STREAM_ITERATION = 4, /* outer iteration k of MCSA / sequential Monte Carlo */
+    ULAM_STREAM_POINT = 5,     /* radiosity point or work-plane node k */
+    ULAM_STREAM_STUDY = 6      /* run k of a variance study */
+} ulam_stream_purpose;
+
+/* The seed of sub-run k for purpose p under seed: splitmix64's finalizer chained over (seed, p,
+ * k), so distinct (p, k) give unrelated seeds and the same triple gives the same seed from C, the
+ * CLI and Python.  Every derived seed in ulam comes from here (docs/streams.md). */
+uint64_t ulam_rng_substream(uint64_t seed, ulam_stream_purpose p, uint64_t k);
+
 /* ---------------------------------------------------------------- utilities */
 /* All tertiary. */
 
