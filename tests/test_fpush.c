@@ -1,6 +1,6 @@
 /* Single source, every target by sweep push + terminal walks (src/fpush.c, src/sweep.c; issue 29
- * point 4).  Linked with the library's objects: it reads the sweep push's counts through the
- * internal ulam__fpush_solve.
+ * point 4), through the public ulam_fpush_solve and ulam_fpush_top; the sweep push's own counts
+ * are read beside the module, in src/fpush_test.c.
  *
  * Each case draws the heavy-tailed Zipf digraph of tests/zipf_graph.h (M = 0.85 P', so
  * x = (I - M)^-1 e_s, pi = 0.15 x) and the exact column by a long power iteration, and counts,
@@ -16,8 +16,6 @@
 
 #include <cmocka.h>
 
-#include "../src/internal.h"
-#include "../src/stop.h"
 #include "testutil.h"
 #include "zipf_graph.h"
 
@@ -26,70 +24,6 @@ static int coverage_ok(int64_t k, int64_t N)
 {
     double Nd = (double)N;
     return (double)k >= 0.95 * Nd - 4.0 * sqrt(0.95 * 0.05 * Nd) && (double)k >= 0.9 * Nd;
-}
-
-/* Over the components with pi = 0.15 x_i >= 1/n: how many (*b), covered by their interval (*c),
- * estimated within 10% (*w); every estimate inside its interval. */
-static void count_big(int64_t n, const double *x, const double *est, const double *lo, const double *hi, int64_t *b,
-                      int64_t *c, int64_t *w)
-{
-    *b = *c = *w = 0;
-    for (int64_t i = 0; i < n; i++) {
-        if (!(lo[i] <= est[i] && est[i] <= hi[i])) print_error("component %lld: %.17g in [%.17g, %.17g]?\n", (long long)i, est[i], lo[i], hi[i]);
-        assert_true(lo[i] <= est[i] && est[i] <= hi[i]);
-        if (0.15 * x[i] < 1.0 / (double)n) continue;
-        ++*b;
-        *c += lo[i] <= x[i] && x[i] <= hi[i];
-        *w += fabs(est[i] - x[i]) <= 0.1 * x[i];
-    }
-}
-
-/* One run of seed from s under the relative-error rule (E = 0.1 on every pi >= 1/n, so delta =
- * 1 / (0.15 n)), against x, the exact column: every such component within 10% (their count added
- * to *big, those their interval covers to *covered); the walks in *info, the sweep push in *sw. */
-static void rule_run(const ulam_csr *M, const ulam_csr *Mt, int64_t s, const double *x, int seed, const char *name,
-                     ulam_fpush_info *info, ulam__sweep_info *sw, int64_t *big, int64_t *covered)
-{
-    int64_t n = M->nrows, b, c, w;
-    double *est = malloc((size_t)n * sizeof *est), *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi);
-    ulam_fpush_opts o = ulam_fpush_defaults();
-    o.source = s, o.walk.exec.seed = (uint64_t)seed, o.min_value = 1.0 / (0.15 * (double)n), o.walk.stop.max_walks = 0;
-    ulam_error err;
-    assert_int_equal(ulam__fpush_solve(M, Mt, &o, est, NULL, lo, hi, info, sw, &err), ULAM_OK);
-    count_big(n, x, est, lo, hi, &b, &c, &w);
-    print_message("%s seed %d: %lld rounds (%lld sweeps), %lld ops, r_sum %.3g, negative residual %.3g, %lld walks: "
-                  "%lld of %lld covered, %lld within 10%%\n", name, seed, (long long)sw->rounds, (long long)sw->sweeps,
-                  (long long)sw->ops, sw->r_sum, sw->r_neg, (long long)info->walks, (long long)c, (long long)b, (long long)w);
-    assert_int_equal(w, b);
-    *big += b, *covered += c;
-    free(est), free(lo), free(hi);
-}
-
-/* The relative-error rule (E = 0.1 on every pi >= 1/n): the push goes round the active list and
- * then sweeps (the counters say so), every component with pi >= 1/n is within 10% of the exact
- * value, and the intervals cover at the claimed rate over 8 seeds. */
-static void test_fpush_rule(void **state)
-{
-    (void)state;
-    int64_t n = 3000, s = 2, big = 0, covered = 0;
-    ulam_csr *M = zipf_graph(n, 2.1, 0.75, 0.85, 1), *Mt = NULL;
-    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
-    double *x = zipf_graph_column(M, s);
-    for (int seed = 1; seed <= 8; seed++) {
-        if (!test_case(seed)) continue;
-        ulam_fpush_info info;
-        ulam__sweep_info sw;
-        int64_t before = big;
-        rule_run(M, Mt, s, x, seed, "Zipf", &info, &sw, &big, &covered);
-        assert_true(sw.sweeps >= 1 && sw.rounds > sw.sweeps); /* list rounds first, then whole sweeps */
-        assert_true(sw.pulls == sw.sweeps && sw.nonneg);     /* M >= 0: the sweeps pull along M's rows */
-        assert_true(info.walks > 0 && info.push.r_sum > 0);
-        assert_true(big - before >= 20);
-    }
-    test_case_done();
-    if (test_case_all()) assert_true(coverage_ok(covered, big));
-    free(x);
-    ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
 /* Fixed small budgets on a large residual (rmax 0.02: a short push, then 64 or 256 walks, so most
@@ -112,9 +46,8 @@ static void test_fpush_small_budgets(void **state)
             ulam_fpush_opts o = ulam_fpush_defaults();
             o.source = s, o.walk.exec.seed = (uint64_t)seed, o.walks = walks[c], o.rmax = 0.02;
             ulam_fpush_info info;
-            ulam__sweep_info sw;
             ulam_error err;
-            assert_int_equal(ulam__fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, &sw, &err), ULAM_OK);
+            assert_int_equal(ulam_fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, &err), ULAM_OK);
             assert_int_equal(info.walks, walks[c]);
             rsum = info.push.r_sum;
             for (int64_t i = 0; i < n; i++) {
@@ -130,64 +63,6 @@ static void test_fpush_small_budgets(void **state)
     }
     test_case_done();
     free(x), free(est), free(lo), free(hi);
-    ulam_csr_free(M), ulam_csr_free(Mt);
-}
-
-/* An R-MAT digraph (a = 0.57, b = c = 0.19, d = 0.05, 8 n edges on n = 2^L states, relabelled at
- * random, multi-edges summed), M = alpha P'. */
-static ulam_csr *rmat_graph(int L, double alpha, uint64_t seed)
-{
-    int64_t n = (int64_t)1 << L, m = 8 * n, *out = calloc((size_t)n, sizeof *out);
-    int32_t *ti = malloc((size_t)m * sizeof *ti), *tj = malloc((size_t)m * sizeof *tj), *perm = malloc((size_t)n * sizeof *perm);
-    double *tx = malloc((size_t)m * sizeof *tx);
-    ulam_csr *M = NULL;
-    ulam_rng r;
-    ulam_rng_seed(&r, seed, 4);
-    for (int64_t i = 0; i < n; i++) perm[i] = (int32_t)i;
-    for (int64_t k = n - 1; k > 0; k--) {
-        int64_t j = (int64_t)ulam_rng_bounded(&r, (uint64_t)(k + 1));
-        int32_t t = perm[k];
-        perm[k] = perm[j], perm[j] = t;
-    }
-    for (int64_t e = 0; e < m; e++) {
-        int64_t u = 0, v = 0;
-        for (int l = 0; l < L; l++) {
-            double q = ulam_rng_uniform(&r);
-            u = 2 * u + (q >= 0.76), v = 2 * v + ((q >= 0.57 && q < 0.76) || q >= 0.95);
-        }
-        ti[e] = perm[v], tj[e] = perm[u], out[perm[u]]++; /* an edge u -> v: M_vu */
-    }
-    for (int64_t e = 0; e < m; e++) tx[e] = alpha / (double)out[tj[e]];
-    if (ulam_csr_from_triplets(n, n, m, ti, tj, tx, &M)) M = NULL;
-    free(out), free(ti), free(tj), free(perm), free(tx);
-    return M;
-}
-
-/* The relative-error rule on R-MAT 2^12, where the over-relaxed sweeps and the two plain ones
- * leave a negative residual of roundings only: it is cut (the KL intervals, every lower end
- * lowered by its bound), every pi >= 1/n is within 10%, and the intervals cover at the claimed
- * rate over 8 seeds. */
-static void test_fpush_rmat_cut(void **state)
-{
-    (void)state;
-    ulam_csr *M = rmat_graph(12, 0.85, 5), *Mt = NULL;
-    assert_non_null(M);
-    int64_t n = M->nrows, s = 0, big = 0, covered = 0;
-    while (M->rowptr[s + 1] == M->rowptr[s] || s == 0) s++; /* a state with in-edges, past 0 */
-    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
-    while (Mt->rowptr[s + 1] == Mt->rowptr[s]) s++; /* and out-edges */
-    double *x = zipf_graph_column(M, s), delta = 1.0 / (0.15 * (double)n);
-    for (int seed = 1; seed <= 8; seed++) {
-        if (!test_case(seed)) continue;
-        ulam_fpush_info info;
-        ulam__sweep_info sw;
-        rule_run(M, Mt, s, x, seed, "R-MAT", &info, &sw, &big, &covered);
-        assert_true(sw.pulls > 2 && sw.nonneg);
-        assert_true(sw.r_neg / 0.15 <= 0.01 * 0.1 * delta); /* cut: the KL path */
-    }
-    test_case_done();
-    if (test_case_all()) assert_true(coverage_ok(covered, big));
-    free(x);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
@@ -211,7 +86,7 @@ static void test_fpush_interrupted(void **state)
         o.walk.stop.interrupt = &stop;
         ulam_fpush_info info;
         ulam_error err;
-        assert_int_equal(ulam__fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, NULL, &err), ULAM_OK);
+        assert_int_equal(ulam_fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, &err), ULAM_OK);
         assert_true(info.interrupted);
         assert_int_equal(info.walks, 1024);
         for (int64_t i = 0; i < n; i++) {
@@ -225,6 +100,29 @@ static void test_fpush_interrupted(void **state)
     test_case_done();
     free(x), free(est), free(lo), free(hi);
     ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
+/* kl(a || b) between Bernoulli laws (0 ln 0 = 0): Hoeffding's exponent, the oracle's own. */
+static double kl(double a, double b)
+{
+    return (a > 0 ? a * log(a / b) : 0.0) + (a < 1 ? (1.0 - a) * log((1.0 - a) / (1.0 - b)) : 0.0);
+}
+
+/* The Chernoff-Hoeffding 95% interval of a count fixed in advance (Hoeffding 1963, Theorem 1),
+ * computed here: the q on each side of the mean m of n scores in [0, 1] where n kl(m || q) =
+ * ln(2 / 0.05), each by bisection to the last double. */
+static void kl_interval(int64_t n, double m, double *lo, double *hi)
+{
+    double c = log(2.0 / 0.05), N = (double)n, end[2];
+    for (int side = 0; side < 2; side++) {
+        double in = m, out = side, q;
+        while ((side ? m < 1.0 : m > 0.0) && (q = 0.5 * (in + out)) != in && q != out) {
+            if (N * kl(m, q) <= c) in = q;
+            else out = q;
+        }
+        end[side] = out;
+    }
+    *lo = end[0], *hi = end[1];
 }
 
 /* The walks' bookkeeping: with no push (rmax 2: r = e_s, p = 0) and no death (every column of
@@ -245,7 +143,7 @@ static void test_fpush_hits(void **state)
     o.source = s, o.walk.exec.seed = 7, o.walks = N, o.rmax = 2.0;
     ulam_fpush_info info;
     ulam_error err;
-    assert_int_equal(ulam__fpush_solve(M, Mt, &o, x, se, lo, hi, &info, NULL, &err), ULAM_OK);
+    assert_int_equal(ulam_fpush_solve(M, Mt, &o, x, se, lo, hi, &info, &err), ULAM_OK);
     assert_int_equal(info.walks, N);
     assert_int_equal(info.push.ops, 0);
     double R0 = 1.0 / 0.15, total = 0.0, Nd = (double)N;
@@ -255,7 +153,7 @@ static void test_fpush_hits(void **state)
         double h = x[i] * Nd / R0, a, b;
         assert_true(fabs(h - round(h)) < 1e-6);
         h = round(h), total += h, ended += h > 0;
-        ulam__stop_kl_interval(N, h / Nd, 0, &a, &b);
+        kl_interval(N, h / Nd, &a, &b);
         assert_close(lo[i], fmax(R0 * a, -R0), 1e-12);
         assert_close(hi[i], fmin(R0 * b, R0), 1e-12);
         assert_close(se[i], R0 * sqrt(h * (1.0 - h / Nd) / (Nd - 1.0) / Nd), 1e-12);
@@ -300,7 +198,7 @@ static void test_fpush_samplers(void **state)
     o.source = 0, o.walk.exec.seed = 11, o.walks = 40000, o.rmax = 2.0;
     ulam_fpush_info info;
     ulam_error err;
-    assert_int_equal(ulam__fpush_solve(M, Mt, &o, x, se, NULL, NULL, &info, NULL, &err), ULAM_OK);
+    assert_int_equal(ulam_fpush_solve(M, Mt, &o, x, se, NULL, NULL, &info, &err), ULAM_OK);
     assert_int_equal(info.push.ops, 0);
     for (int i = 0; i < n; i++) { /* 41 is reached from no state */
         assert_true(i == 41 ? x[i] == 0.0 && exact[i] == 0.0 : se[i] > 0);
@@ -505,9 +403,8 @@ static void test_fpush_exact_push(void **state)
     o.source = 0, o.walk.exec.seed = 1, o.walk.stop.max_walks = 0;
     ulam_fpush_info info;
     ulam_error err;
-    ulam__sweep_info sw;
-    assert_int_equal(ulam__fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, &sw, &err), ULAM_OK);
-    print_message("push: %lld rounds, %lld sweeps (%lld pulls), %lld operations, r_sum %.3g, r_neg %.3g, %lld walks\n", (long long)sw.rounds, (long long)sw.sweeps, (long long)sw.pulls, (long long)info.push.ops, info.push.r_sum, sw.r_neg, (long long)info.walks);
+    assert_int_equal(ulam_fpush_solve(M, Mt, &o, est, NULL, lo, hi, &info, &err), ULAM_OK);
+    print_message("push: %lld operations, r_sum %.3g, %lld walks\n", (long long)info.push.ops, info.push.r_sum, (long long)info.walks);
     assert_int_equal(info.walks, 0);
     assert_true(info.push.r_sum == 0.0);
     int64_t reached = 0, positive = 0;
@@ -565,10 +462,8 @@ static void test_fpush_queue_infinite(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_fpush_rule),
         cmocka_unit_test(test_fpush_small_budgets),
         cmocka_unit_test(test_fpush_interrupted),
-        cmocka_unit_test(test_fpush_rmat_cut),
         cmocka_unit_test(test_fpush_hits),
         cmocka_unit_test(test_fpush_samplers),
         cmocka_unit_test(test_fpush_top),

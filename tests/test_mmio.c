@@ -1,6 +1,5 @@
 /* Matrix Market reading and writing: every good kind, every malformed input class. */
 #include "testutil.h"
-#include "../src/internal.h" /* ulam__mm_read_matrix_libc: the libc reader compared */
 
 #include <string.h>
 #include <unistd.h>
@@ -371,13 +370,13 @@ static void write_big(const char *path, int64_t nrows, int k, int shuffled, long
     fclose(f);
 }
 
-/* Read path with the given threads (and libc's strtod or not). */
-static int read_with(const char *path, int threads, int libc, ulam_csr **A, ulam_error *err)
+/* Read path with the given threads (1: the sequential reader). */
+static int read_with(const char *path, int threads, ulam_csr **A, ulam_error *err)
 {
     FILE *f = fopen(path, "rb");
     assert_non_null(f);
     ulam_mm_opts o = {.threads = threads};
-    int st = libc ? ulam__mm_read_matrix_libc(f, path, &o, A, err) : ulam_mm_read_matrix_opts(f, path, &o, A, err);
+    int st = ulam_mm_read_matrix_opts(f, path, &o, A, err);
     fclose(f);
     return st;
 }
@@ -395,11 +394,11 @@ static void test_parallel_read(void **state)
     for (int shuffled = 0; shuffled < 2; shuffled++) {
         write_big(path, 3000, 8, shuffled, 0, NULL);
         ulam_csr *A = NULL, *B = NULL;
-        assert_int_equal(read_with(path, 1, 1, &A, NULL), ULAM_OK);
-        assert_int_equal(read_with(path, 2, 0, &B, NULL), ULAM_OK);
+        assert_int_equal(read_with(path, 1, &A, NULL), ULAM_OK);
+        assert_int_equal(read_with(path, 2, &B, NULL), ULAM_OK);
         assert_csr_same(A, B);
         ulam_csr_free(B);
-        assert_int_equal(read_with(path, 3, 0, &B, NULL), ULAM_OK);
+        assert_int_equal(read_with(path, 3, &B, NULL), ULAM_OK);
         assert_csr_same(A, B);
         ulam_csr_free(A), ulam_csr_free(B);
     }
@@ -421,7 +420,7 @@ static void test_parallel_read(void **state)
         }
         ulam_csr *A = NULL;
         ulam_error e1, e2;
-        int s1 = read_with(path, 1, 1, &A, &e1), s2 = read_with(path, 2, 0, &A, &e2);
+        int s1 = read_with(path, 1, &A, &e1), s2 = read_with(path, 2, &A, &e2);
         if (s1 != bad[c].status || s2 != s1 || e1.line != e2.line || strcmp(e1.msg, e2.msg))
             fail_msg("bad case %zu: sequential %d at line %ld, parallel %d at line %ld", c, s1, e1.line, s2, e2.line);
         if (bad[c].status != ULAM_ETOOMANY && bad[c].status != ULAM_ETOOFEW && e2.line != bad[c].line)

@@ -13,7 +13,6 @@
  *
  * laplace(m): the m^3 Laplacian (7-point, Dirichlet) by its Jacobi splitting, b a point source
  * at the centre, the unknown at a corner, which walks reach rarely (x_0 about 1e-3). */
-#include "../src/stop.h"
 #include "testutil.h"
 
 #include "bench/gen.h"
@@ -81,19 +80,6 @@ static void count(const char *what, int covered, int withheld, int R)
 }
 
 /* Case 1 at fixed budgets: collision at 100, 1000 and 10^4 walks, absorption at 1000. */
-/* The stitching spends delta once: a run that may stop at any checkpoint k >= 1 has confidence
- * levels delta_k = 3 exp(-L(k)) summing to at most delta (checkpoint 1 took delta itself, so the
- * sum was 1.5 delta), and a count fixed in advance (k = 0) takes delta. */
-static void test_stitching_spends_delta(void **state)
-{
-    (void)state;
-    double sum = 0.0;
-    for (int k = 1; k <= 100000; k++) sum += 3.0 * exp(-ulam__stop_log(k));
-    assert_true(sum <= ULAM__STOP_DELTA && sum > 0.9999 * ULAM__STOP_DELTA);
-    assert_close(3.0 * exp(-ulam__stop_log(0)), ULAM__STOP_DELTA, 1e-12);
-    assert_close(3.0 * exp(-ulam__stop_log(1)), ULAM__STOP_DELTA / 2.0, 1e-12);
-}
-
 static void test_metastable_fixed(void **state)
 {
     (void)state;
@@ -636,7 +622,7 @@ static void test_fixed_hard(void **state)
 
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_stitching_spends_delta), cmocka_unit_test(test_never_zero_width), cmocka_unit_test(test_metastable_fixed),
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_never_zero_width), cmocka_unit_test(test_metastable_fixed),
                                        cmocka_unit_test(test_metastable_rounds), cmocka_unit_test(test_metastable_auto),
                                        cmocka_unit_test(test_metastable_rel_err), cmocka_unit_test(test_laplace_corner),
                                        cmocka_unit_test(test_rel_err_cost), cmocka_unit_test(test_push_b),

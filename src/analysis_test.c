@@ -3,8 +3,9 @@
  * one b), the reach earlier walks found -- changes how much set-up they do, never what they
  * walk.  Each run handed out by an analysis equals, bit for bit, the run of a solver built
  * directly with the same options (ulam_solve_walks); a kernel made for another estimator or b is
- * not lent; an analysis refuses walks of another kernel.  Linked with the library's objects to
- * reach the internal entry point (as test_fpush). */
+ * not lent; an analysis refuses walks of another kernel.  A unit test built with the module
+ * (tests/meson.build's module units): it includes internal.h beside it for the internal entry
+ * points; the tests in tests/ include public headers only. */
 #include <math.h>
 #include <stdarg.h>
 #include <setjmp.h>
@@ -15,7 +16,7 @@
 
 #include <cmocka.h>
 
-#include "../src/internal.h"
+#include "internal.h"
 #include "testutil.h"
 
 /* Fail unless two runs are the same, bit for bit (the kernel rows built aside). */
