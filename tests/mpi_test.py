@@ -120,6 +120,13 @@ def check_partition(ulam, mpirun, d):
     qs = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--queries", qf, "--walks",
                "40000", "--seed", "3", "-q"]) for k in (1, 3)]
     assert qs[0] == qs[1] and qs[0].splitlines()[0].split("  line")[0] == lines[0], (qs, lines[0])
+    est, lo, hi = (float(lines[0].split()[i].rstrip(")")) for i in (1, 6, 8))  # the certified 95% interval holds x
+    assert lo <= exact[1233] <= hi and lo <= est <= hi, (lines[0], exact[1233])
+    rel = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--index", "1234",
+                "--rel-err", "0.01", "--batch", "8192", "--seed", "3", "-q"]) for k in (1, 3)]
+    assert rel[0] == rel[1] and "rel-err         met" in rel[0], rel  # --rel-err on a partition: the same bits
+    est, lo, hi = (float(rel[0].split()[i].rstrip(")")) for i in (1, 6, 8))
+    assert lo <= exact[1233] <= hi and hi - lo <= 0.02 * abs(est), rel[0]
     p = subprocess.run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "5"],
                        capture_output=True, text=True, env=dict(ENV, ULAM_TEST_PARTITION_DIE="1"), timeout=120)
     assert p.returncode != 0 and not p.stdout, (p.returncode, p.stdout)

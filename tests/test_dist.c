@@ -25,6 +25,9 @@ typedef struct {
     ulam_dist_mcsa_info mi;
     ulam_dist_source_info si;
     double rho;
+    int ci;         /* ulam_dist_adjoint_ci into cis, with rel_err */
+    double rel_err;
+    ulam_dist_ci cis[4];
     int status;
     ulam_dist_result res;
     double *x, *se; /* forward: the whole vector, each rank filling its rows */
@@ -53,6 +56,7 @@ static void *rank_main(void *arg)
     if (j->outer == 1) j->status = ulam_dist_mcsa(p, &c, &o, 1e-10, 60, j->x + j->first, &j->mi, &err);
     else if (j->outer == 2)
         j->status = ulam_dist_source(p, &c, j->index, &o, 1e-3, 1000, j->x + j->first, j->se + j->first, &j->si, &err);
+    else if (j->ci) j->status = ulam_dist_adjoint_ci(p, &c, &j->index, 1, &o, j->rel_err, &j->res, j->cis, &err);
     else if (j->nq) j->status = ulam_dist_adjoint_many(p, &c, j->many, j->nq, &o, j->manyres, &err);
     else if (j->radius) j->status = ulam_dist_radius(p, &c, 0, 300, &j->rho, &err);
     else if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
@@ -98,6 +102,21 @@ static void temp_file(char *path)
     close(fd);
 }
 
+/* Write M (nz triplets, n x n) and b as a prepared file at path (with M' when transpose), x by
+ * LAPACK; frees the triplets and b. */
+static void write_solve(const char *path, int64_t n, int64_t nz, int32_t *ti, int32_t *tj, double *tv, double *b,
+                        int transpose, double *x)
+{
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, &M), ULAM_OK);
+    ulam_system_desc d = ulam_system_desc_defaults();
+    d.M = M, d.b = b, d.n = n, d.transpose = transpose;
+    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    ulam_csr_free(M);
+    free(ti), free(tj), free(tv), free(b);
+}
+
 /* A random sparse signed M (n x n, about deg entries a row, |row sums| 0.9 at most, some rows
  * leaving the system) and b, written as a prepared file with M' at path; x solved by LAPACK. */
 static void make_system(const char *path, int64_t n, int deg, uint64_t seed, double *x)
@@ -118,14 +137,7 @@ static void make_system(const char *path, int64_t n, int deg, uint64_t seed, dou
         }
         b[i] = ulam_rng_uniform(&r) < 0.5 ? 0.0 : 1.0 + ulam_rng_uniform(&r);
     }
-    ulam_csr *M = NULL;
-    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, &M), ULAM_OK);
-    ulam_system_desc d = ulam_system_desc_defaults();
-    d.M = M, d.b = b, d.n = n, d.transpose = 1;
-    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
-    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
-    ulam_csr_free(M);
-    free(ti), free(tj), free(tv), free(b);
+    write_solve(path, n, nz, ti, tj, tv, b, 1, x);
 }
 
 /* Adjoint: one answer, bit for bit, at 1, 2, 3 and 5 ranks, within 4 standard errors of x. */
@@ -415,6 +427,90 @@ static void test_dist_radius(void **state)
     unlink(path);
 }
 
+/* A system whose x_0 rests on a rare large b (the reviewer's kind): n states, each row of |M|
+ * summing to 0.8 over 3 random columns below n - 1; row 1 also steps, with eps, to state
+ * n - 1, the only one with b (big) besides b = 1 elsewhere; x solved by LAPACK. */
+static void make_rare(const char *path, int64_t n, double big, double eps, uint64_t seed, double *x)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 0);
+    int64_t cap = n * 4;
+    int32_t *ti = malloc((size_t)cap * sizeof *ti), *tj = malloc((size_t)cap * sizeof *tj);
+    double *tv = malloc((size_t)cap * sizeof *tv), *b = malloc((size_t)n * sizeof *b);
+    int64_t nz = 0;
+    for (int64_t i = 0; i < n - 1; i++) {
+        for (int q = 0; q < 3; q++) {
+            ti[nz] = (int32_t)i, tj[nz] = (int32_t)(q == 0 ? (i + 1) % (n - 1) : (int64_t)ulam_rng_bounded(&r, (uint64_t)(n - 1)));
+            tv[nz++] = (i == 1 ? 0.8 - eps : 0.8) / 3;
+        }
+        if (i == 1) ti[nz] = 1, tj[nz] = (int32_t)(n - 1), tv[nz++] = eps;
+        b[i] = 1.0;
+    }
+    b[n - 1] = big;
+    write_solve(path, n, nz, ti, tj, tv, b, 0, x);
+}
+
+/* The certified interval on a rare-large-b system over 40 seeds on 2 thread-ranks: the
+ * standard error's CLT interval misses x_0 in most seeds (the walks seldom see the large b), the
+ * certified one covers it in at least 33 of 40 (Binomial(40, 0.95) is below 33 with
+ * probability 0.0034), at a fixed budget and under rel_err; the interval's bits are the same at
+ * 1, 2 and 3 ranks and in 2 sets of 2. */
+static void test_dist_interval(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    temp_file(path);
+    int64_t n = 300;
+    double *x = malloc((size_t)n * sizeof *x);
+    char mild[] = "/tmp/ulam_test_dist_XXXXXX";
+    temp_file(mild);
+    double *y = malloc((size_t)n * sizeof *y);
+    make_rare(path, n, 2e5, 2e-4, 3, x);
+    make_rare(mild, n, 20.0, 2e-3, 3, y); /* under rel_err: a range a test can afford */
+    int clt = 0, cover = 0, rcover = 0, met = 0, seeds = 40;
+    int64_t rwalks = 0;
+    for (int s = 0; s < seeds; s++) {
+        job jobs[MAXR], t = {.path = path, .walks = 3000, .index = 0, .ci = 1, .seed = (uint64_t)s};
+        run_jobs(2, &t, jobs);
+        assert_int_equal(jobs[0].status, ULAM_OK);
+        const ulam_dist_result *r = &jobs[0].res;
+        const ulam_dist_ci *c = &jobs[0].cis[0];
+        clt += fabs(r->estimate - x[0]) <= 1.96 * r->std_error;
+        if (!(c->lo <= r->estimate && r->estimate <= c->hi)) fail_msg("interval [%g, %g] without %g", c->lo, c->hi, r->estimate);
+        cover += c->lo <= x[0] && x[0] <= c->hi;
+        job rj[MAXR], rt = {.path = mild, .walks = 1 << 22, .index = 0, .ci = 1, .rel_err = 0.1, .seed = (uint64_t)s};
+        run_jobs(2, &rt, rj);
+        assert_int_equal(rj[0].status, ULAM_OK);
+        const ulam_dist_ci *q = &rj[0].cis[0];
+        met += q->met, rwalks += rj[0].res.walks;
+        rcover += q->lo <= y[0] && y[0] <= q->hi;
+        if (q->met && !(q->hi - q->lo <= 2 * 0.1 * fabs(rj[0].res.estimate))) fail_msg("met with [%g, %g]", q->lo, q->hi);
+    }
+    print_message("x_0 %.6g: CLT covered %d of %d, certified %d; milder x_0 %.6g under rel_err 0.1: %d (%d met, %lld walks "
+                  "a run)\n", x[0], clt, seeds, cover, y[0], rcover, met, (long long)(rwalks / seeds));
+    assert_true(clt <= 20); /* the system is hard: the CLT interval fails */
+    assert_true(cover >= 33);
+    assert_true(rcover >= 33);
+    assert_int_equal(met, seeds);
+    ulam_dist_ci first[2];
+    ulam_dist_result fr[2];
+    for (int k = 1; k <= 4; k++) /* the same bits at 1, 2, 3 ranks and 2 sets of 2 */
+        for (int e = 0; e < 2; e++) {
+            job jobs[MAXR], t = {.path = e ? mild : path, .walks = 20000, .index = 0, .ci = 1, .rel_err = e ? 0.1 : 0.0,
+                                 .sets = k == 4 ? 2 : 0};
+            run_jobs(k, &t, jobs);
+            if (k == 1) first[e] = jobs[0].cis[0], fr[e] = jobs[0].res;
+            for (int r = 0; r < k; r++) {
+                assert_int_equal(jobs[r].status, ULAM_OK);
+                assert_memory_equal(&jobs[r].cis[0], &first[e], sizeof first[e]);
+                assert_memory_equal(&jobs[r].res.estimate, &fr[e].estimate, sizeof(double));
+                assert_int_equal(jobs[r].res.walks, fr[e].walks);
+            }
+        }
+    free(x), free(y);
+    unlink(path), unlink(mild);
+}
+
 /* Counter-based numbers: keyed by (seed, walk, step, k), in [0, 1), and not all alike. */
 static void test_dist_counter(void **state)
 {
@@ -444,6 +540,7 @@ int main(void)
         cmocka_unit_test(test_dist_many),
         cmocka_unit_test(test_dist_mcsa),
         cmocka_unit_test(test_dist_source),
+        cmocka_unit_test(test_dist_interval),
     };
     return test_run(tests);
 }
