@@ -511,6 +511,58 @@ static void test_dist_interval(void **state)
     unlink(path), unlink(mild);
 }
 
+/* A system whose row sums do not certify rho(M^) (even rows of |M| sum to 1.2, odd ones to 0.4)
+ * but whose walks' variance is finite: the guard iterates, each rank holding the iterate at its
+ * rows and their halo only.  The bound is the same bits at 1, 2, 3 and 5 ranks (and in 2 sets of
+ * 2), at least rho(M^) as 3000 dense power steps estimate it, and below 1. */
+static void test_dist_radius_halo(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    temp_file(path);
+    int64_t n = 600, nz = 0;
+    ulam_rng r;
+    ulam_rng_seed(&r, 21, 0);
+    int32_t *ti = malloc((size_t)n * 3 * sizeof *ti), *tj = malloc((size_t)n * 3 * sizeof *tj);
+    double *tv = malloc((size_t)n * 3 * sizeof *tv), *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
+    double *hat = calloc((size_t)n * (size_t)n, sizeof *hat); /* dense M^ = diag(max(1, S)) |M| */
+    for (int64_t i = 0; i < n; i++) {
+        double S = i % 2 ? 0.4 : 1.2;
+        for (int q = 0; q < 3; q++) {
+            int64_t j = q == 0 ? (i + 1) % n : (int64_t)ulam_rng_bounded(&r, (uint64_t)n);
+            if (i % 2 == 0 && j % 2 == 0) j = (j + 1) % n; /* big rows step to small ones */
+            ti[nz] = (int32_t)i, tj[nz] = (int32_t)j, tv[nz++] = S / 3 * (q == 2 ? -1 : 1);
+            hat[i * n + j] += S / 3 * (S > 1 ? S : 1);
+        }
+        b[i] = 1.0;
+    }
+    write_solve(path, n, nz, ti, tj, tv, b, 1, x);
+    double *v = malloc((size_t)n * sizeof *v), *y = malloc((size_t)n * sizeof *y), rho = 0;
+    for (int64_t i = 0; i < n; i++) v[i] = 1.0;
+    for (int k = 0; k < 3000; k++) {
+        double top = 0;
+        for (int64_t i = 0; i < n; i++) {
+            y[i] = 0;
+            for (int64_t j = 0; j < n; j++) y[i] += hat[i * n + j] * v[j];
+            if (y[i] > top) top = y[i];
+        }
+        rho = top;
+        for (int64_t i = 0; i < n; i++) v[i] = y[i] / top;
+    }
+    double first = NAN;
+    const int ks[] = {1, 2, 3, 5, 4};
+    for (int c = 0; c < 5; c++) {
+        job jobs[MAXR], t = {.path = path, .radius = 1, .walks = 1, .sets = ks[c] == 4 ? 2 : 0};
+        run_jobs(ks[c], &t, jobs);
+        for (int q = 0; q < ks[c]; q++) assert_int_equal(jobs[q].status, ULAM_OK);
+        if (c == 0) first = jobs[0].rho;
+        for (int q = 0; q < ks[c]; q++) assert_memory_equal(&jobs[q].rho, &first, sizeof first);
+    }
+    if (!(first >= rho * (1 - 1e-9) && first < 1.0 && rho > 0.5)) fail_msg("bound %.9g, rho(M^) %.9g", first, rho);
+    free(x), free(v), free(y), free(hat);
+    unlink(path);
+}
+
 /* Counter-based numbers: keyed by (seed, walk, step, k), in [0, 1), and not all alike. */
 static void test_dist_counter(void **state)
 {
@@ -541,6 +593,7 @@ int main(void)
         cmocka_unit_test(test_dist_mcsa),
         cmocka_unit_test(test_dist_source),
         cmocka_unit_test(test_dist_interval),
+        cmocka_unit_test(test_dist_radius_halo),
     };
     return test_run(tests);
 }
