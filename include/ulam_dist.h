@@ -138,7 +138,8 @@ typedef struct ulam_dist_mcsa_info {
 /* x of (I - M) x = b by MCSA (Evans, Slattery, Wilson): x <- x + r (r = b - (I - M) x, a product
  * with M over the ranks' rows), then x <- x + d, d forward walks (o->walks of them, seed o->seed +
  * iteration) from the new residual; until max |r| <= tol max |b| or max_iter iterations.  x: this
- * rank's rows.  Needs ULAM_PART_BOTH and one set.  The same bits at any rank count. */
+ * rank's rows (in sets, every set's ranks get them).  Needs ULAM_PART_BOTH.  The same bits at any rank
+ * count and any number of sets. */
 int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
                    double *x, ulam_dist_mcsa_info *info, ulam_error *err);
 
@@ -153,7 +154,8 @@ typedef struct ulam_dist_source_info {
 /* x = (I - M)^-1 e_source: a push x = sum_{k<K} M^k e_s (products with M over the ranks' rows)
  * until max |M^K e_s| <= tol or K = max_rounds, then forward walks (o) from r = M^K e_s add
  * (I - M)^-1 r with its standard errors se (NaN where no walk tallied; 0 everywhere when r = 0).
- * x, se: this rank's rows.  Needs ULAM_PART_BOTH and one set.  The same bits at any rank count. */
+ * x, se: this rank's rows (in sets, every set's ranks get them).  Needs ULAM_PART_BOTH.  The same bits at
+ * any rank count and any number of sets. */
 int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
                      int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_error *err);
 

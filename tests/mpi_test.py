@@ -111,7 +111,13 @@ def check_partition(ulam, mpirun, d):
         top = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--source", "77",
                    "--top", "10", "--walks", "20000", "-q"])
         outer.append((open(x).read(), top))
-    assert outer[0] == outer[1], "MCSA or single source differ across rank counts"
+    x = f"{d}/pms.mtx"  # 4 ranks in 2 sets: MCSA's x file and single source's table again, byte for byte
+    run([mpirun, "--oversubscribe", "-np", "4", ulam, "solve", sysf, "--partition", "--sets", "2", "--method", "mcsa",
+         "--walks", "20000", "--out", x, "-q"])
+    top = run([mpirun, "--oversubscribe", "-np", "4", ulam, "solve", sysf, "--partition", "--sets", "2", "--source", "77",
+               "--top", "10", "--walks", "20000", "-q"])
+    outer.append((open(x).read(), top))
+    assert outer[0] == outer[1] == outer[2], "MCSA or single source differ across rank counts or sets"
     xm = [float(v) for v in outer[0][0].split("\n")[3:] if v.strip()]
     assert max(abs(a - b) for a, b in zip(xm, exact)) < 1e-6 * max(abs(b) for b in exact), "MCSA's x is off"
     assert len(outer[0][1].splitlines()) == 10 and outer[0][1].startswith("x[77]"), outer[0][1]

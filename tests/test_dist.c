@@ -31,6 +31,7 @@ typedef struct {
     int status;
     ulam_dist_result res;
     double *x, *se; /* forward: the whole vector, each rank filling its rows */
+    double *ox, *ose; /* outer methods in sets: a rank past set 0's own copy (malloc'd) */
     int64_t first, last, n;
 } job;
 
@@ -53,14 +54,17 @@ static void *rank_main(void *arg)
     j->n = ulam_part_rows(p, &j->first, &j->last, NULL);
     ulam_dist_opts o = ulam_dist_defaults();
     o.walks = j->walks, o.batch = 997, o.seed = 7 + j->seed;
-    if (j->outer == 1) j->status = ulam_dist_mcsa(p, &c, &o, 1e-10, 60, j->x + j->first, &j->mi, &err);
+    int other = j->sets > 1 && c.rank >= c.nranks / j->sets; /* a set past 0: its own copy, compared below */
+    double *ox = other ? calloc((size_t)j->n, sizeof *ox) : j->x, *ose = other ? calloc((size_t)j->n, sizeof *ose) : j->se;
+    if (j->outer == 1) j->status = ulam_dist_mcsa(p, &c, &o, 1e-10, 60, ox + j->first, &j->mi, &err);
     else if (j->outer == 2)
-        j->status = ulam_dist_source(p, &c, j->index, &o, 1e-3, 1000, j->x + j->first, j->se + j->first, &j->si, &err);
+        j->status = ulam_dist_source(p, &c, j->index, &o, 1e-3, 1000, ox + j->first, ose + j->first, &j->si, &err);
     else if (j->ci) j->status = ulam_dist_adjoint_ci(p, &c, &j->index, 1, &o, j->rel_err, &j->res, j->cis, &err);
     else if (j->nq) j->status = ulam_dist_adjoint_many(p, &c, j->many, j->nq, &o, j->manyres, &err);
     else if (j->radius) j->status = ulam_dist_radius(p, &c, 0, 300, &j->rho, &err);
     else if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
     else j->status = ulam_dist_adjoint(p, &c, j->index, &o, &j->res, &err);
+    if (other) j->ox = ox, j->ose = ose; /* compared with set 0's once every rank is done (check_sets) */
     ulam_part_free(p);
     return NULL;
 }
@@ -285,15 +289,27 @@ static void test_dist_many(void **state)
     unlink(path);
 }
 
-/* Run an outer method (1 MCSA, 2 single source from index) on k thread-ranks into x, se. */
+/* Run an outer method (1 MCSA, 2 single source from index) on k thread-ranks (4: in 2 sets of 2)
+ * into x, se. */
 static void run_outer(int k, int outer, const char *path, int64_t index, int64_t walks, double *x, double *se, job *jobs)
 {
-    job t = {.path = path, .outer = outer, .index = index, .walks = walks, .x = x, .se = se};
+    job t = {.path = path, .outer = outer, .index = index, .walks = walks, .x = x, .se = se, .sets = k == 4 ? 2 : 0};
     run_jobs(k, &t, jobs);
 }
 
+/* Each rank of a set past 0 (k = 4: 2 sets of 2) holds set 0's answer at its rows, bit for bit. */
+static void check_sets(int k, job *jobs, const double *x, const double *se)
+{
+    for (int r = k / 2; k == 4 && r < k; r++) {
+        size_t len = (size_t)(jobs[r].last - jobs[r].first) * sizeof *x;
+        assert_memory_equal(jobs[r].ox + jobs[r].first, x + jobs[r].first, len);
+        if (se) assert_memory_equal(jobs[r].ose + jobs[r].first, se + jobs[r].first, len);
+        free(jobs[r].ox), free(jobs[r].ose);
+    }
+}
+
 /* MCSA on a partition: to a residual of 1e-10 of max |b|, x within 1e-8 of LAPACK's, the same
- * bits at 1, 2 and 3 ranks. */
+ * bits at 1, 2 and 3 ranks and in 2 sets of 2 (each set's ranks with the whole answer). */
 static void test_dist_mcsa(void **state)
 {
     (void)state;
@@ -302,12 +318,14 @@ static void test_dist_mcsa(void **state)
     int64_t n = 800;
     double *x = malloc((size_t)n * sizeof *x), *ref = malloc((size_t)n * sizeof *ref), *y = malloc((size_t)n * sizeof *y);
     make_system(path, n, 5, 17, x);
-    for (int k = 1; k <= 3; k++) {
+    for (int k = 1; k <= 4; k++) {
         job jobs[MAXR];
+        memset(y, 0, (size_t)n * sizeof *y);
         run_outer(k, 1, path, 0, 20000, k == 1 ? ref : y, NULL, jobs);
         for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
         if (!(jobs[0].mi.residual <= 1e-10 && jobs[0].mi.iterations < 60)) fail_msg("residual %.3g after %d iterations", jobs[0].mi.residual, jobs[0].mi.iterations);
         if (k > 1) assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+        check_sets(k, jobs, y, NULL);
     }
     double big = 0, worst = 0;
     for (int64_t i = 0; i < n; i++) big = fmax(big, fabs(x[i])), worst = fmax(worst, fabs(ref[i] - x[i]));
@@ -318,7 +336,7 @@ static void test_dist_mcsa(void **state)
 
 /* Single source on a partition: x = (I - M)^-1 e_s within 4 standard errors of LAPACK's column
  * wherever the walks gave one (the push's own part exact), at least 90% within 1.96, the same
- * bits at 1, 2 and 3 ranks. */
+ * bits at 1, 2 and 3 ranks and in 2 sets of 2. */
 static void test_dist_source(void **state)
 {
     (void)state;
@@ -334,8 +352,9 @@ static void test_dist_source(void **state)
     e[s] = 1.0;
     assert_int_equal(ulam_direct_solve(ulam_system_matrix(sys), e, col, 0, NULL, NULL), ULAM_OK);
     ulam_system_free(sys);
-    for (int k = 1; k <= 3; k++) {
+    for (int k = 1; k <= 4; k++) {
         job jobs[MAXR];
+        memset(y, 0, (size_t)n * sizeof *y), memset(yse, 0, (size_t)n * sizeof *yse);
         run_outer(k, 2, path, s, 20000, k == 1 ? ref : y, k == 1 ? rse : yse, jobs);
         for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
         assert_true(jobs[0].si.rounds > 0 && jobs[0].si.residual <= 1e-3);
@@ -343,6 +362,7 @@ static void test_dist_source(void **state)
             assert_memory_equal(y, ref, (size_t)n * sizeof *y);
             assert_memory_equal(yse, rse, (size_t)n * sizeof *y);
         }
+        check_sets(k, jobs, y, yse);
     }
     int64_t with = 0, in = 0;
     for (int64_t i = 0; i < n; i++) {

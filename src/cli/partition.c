@@ -123,7 +123,6 @@ static int check(args *a, int argc, char **argv, int first)
                    ins[] = {{"the system", a->path}, {"--queries", a->queries}};
     int rc = cli_check_outputs("solve", outs, 2, ins, 2);
     if (rc) return rc;
-    if ((a->mcsa || a->source) && a->sets > 1) return cli_usage_error("solve", "--sets with --method walks only");
     if (a->rel_err > 0 && !a->index && !a->queries)
         return cli_usage_error("solve", "--rel-err with --partition and --index or --queries (forward mode, MCSA and "
                                         "--source give standard errors only)");
@@ -395,7 +394,7 @@ static int run(const args *a, const ulam_comm *c)
     int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
     if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
     for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, &many[k], a->o.seed, rho, &ci[k]);
-    if (!rc && a->source) rc = print_top(c, x, se, first, last - first, a->top, rho);
+    if (!rc && a->source) rc = print_top(c, x, se, first, in_set0 ? last - first : 0, a->top, rho); /* set 0's rows */
     if (!rc && c->rank == 0 && a->mcsa)
         printf("x               %lld components by MCSA%s%s\nmcsa            %d iterations, residual %.3g of max |b| "
                "(target %.3g)\n", (long long)n, a->out ? ", written to " : "", a->out ? a->out : "", mi.iterations,
