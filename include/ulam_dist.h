@@ -12,7 +12,7 @@
  * in walk-id order, never in arrival order.
  *
  * API, in order of use: primary ulam_part_open, ulam_dist_radius (the variance guard),
- * ulam_dist_adjoint, ulam_dist_forward, ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
+ * ulam_dist_adjoint (ulam_dist_adjoint_ci with its interval), ulam_dist_forward, ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
 #ifndef ULAM_DIST_H
 #define ULAM_DIST_H
 
@@ -82,7 +82,7 @@ typedef struct ulam_dist_result {
  * row s with probability min(1, S_s) (S_s = sum_j |M_sj|) to j with probability |M_sj| / S_s,
  * the weight times sign(M_sj) S_s / min(1, S_s), the score the sum of weight x b over every state
  * visited.  Every rank gets the same result: the mean of the histories' scores in walk-id order
- * and its standard error (a CLT one: no certified range of a score is computed here). */
+ * and its standard error (ulam_dist_adjoint_ci adds a certified 95% interval). */
 int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
                       ulam_dist_result *r, ulam_error *err);
 
@@ -91,6 +91,27 @@ int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, 
  * steps and messages are the whole run's in each). */
 int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
                            const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err);
+
+/* A certified 95% interval of a partitioned adjoint query (ulam_dist_adjoint_ci). */
+typedef struct ulam_dist_ci {
+    double lo, hi;     /* NaN when none is certified */
+    double limit;      /* the last block's clip of |score| (INFINITY: none) */
+    double bias;       /* the most clipping and cuts at max_steps move the mean (in [lo, hi]) */
+    int met;           /* rel_err > 0: the half-width reached rel_err |estimate| */
+} ulam_dist_ci;
+
+/* As ulam_dist_adjoint_many, with each query's 95% interval in ci[k]: when every row sum of |M|
+ * is at most 1 (the walks' weights stay +-1) and power iteration certifies a Collatz-Wielandt
+ * vector v with |M| v <= u v, u < 1 (so a walk from i lives k steps with probability at most
+ * u^k v_i / min v, and a walk of T steps scores at most max|b| (T + 1)), the scores clipped at a
+ * limit whose bias that tail bounds feed a predictable plug-in empirical-Bernstein confidence
+ * sequence, block by block of o->batch walk ids in walk-id order (the single-machine solver's,
+ * src/stop.h): valid at every block, so under rel_err > 0 too, which ends a query's walks (and
+ * the run, once all met) at the first block whose half-width is at most rel_err |estimate|,
+ * o->walks then the most a query takes (res[k].walks: the walks it took).  Else ci[k] has NaN
+ * ends.  The same bits at any rank count and any number of sets. */
+int ulam_dist_adjoint_ci(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
+                         const ulam_dist_opts *o, double rel_err, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err);
 
 /* Every x_i of (I - M) x = b by forward collision walks on rows of M' (the part opened with
  * transpose): a source j ~ |b_j| / ||b||_1 with weight ||b||_1 sign(b_j), moves as above on M',
@@ -117,7 +138,8 @@ typedef struct ulam_dist_mcsa_info {
 /* x of (I - M) x = b by MCSA (Evans, Slattery, Wilson): x <- x + r (r = b - (I - M) x, a product
  * with M over the ranks' rows), then x <- x + d, d forward walks (o->walks of them, seed o->seed +
  * iteration) from the new residual; until max |r| <= tol max |b| or max_iter iterations.  x: this
- * rank's rows.  Needs ULAM_PART_BOTH and one set.  The same bits at any rank count. */
+ * rank's rows (in sets, every set's ranks get them).  Needs ULAM_PART_BOTH.  The same bits at any rank
+ * count and any number of sets. */
 int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
                    double *x, ulam_dist_mcsa_info *info, ulam_error *err);
 
@@ -132,7 +154,8 @@ typedef struct ulam_dist_source_info {
 /* x = (I - M)^-1 e_source: a push x = sum_{k<K} M^k e_s (products with M over the ranks' rows)
  * until max |M^K e_s| <= tol or K = max_rounds, then forward walks (o) from r = M^K e_s add
  * (I - M)^-1 r with its standard errors se (NaN where no walk tallied; 0 everywhere when r = 0).
- * x, se: this rank's rows.  Needs ULAM_PART_BOTH and one set.  The same bits at any rank count. */
+ * x, se: this rank's rows (in sets, every set's ranks get them).  Needs ULAM_PART_BOTH.  The same bits at
+ * any rank count and any number of sets. */
 int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
                      int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_error *err);
 

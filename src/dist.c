@@ -8,6 +8,7 @@
  * 0 at the walk's end; forward tallies stay where they happen (the row's owner) and are summed,
  * per state, in (walk, step) order: both are combined in walk-id order whatever the ranks. */
 #include "part.h"
+#include "stop.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -206,9 +207,82 @@ static int counts(run *R, ulam_dist_result *res, ulam_error *err)
     return ULAM_OK;
 }
 
+/* The certified interval of adjoint runs (rank 0's): the tail certificate, each query's
+ * confidence sequence over its clipped scores (stop.h), which queries met rel_err. */
+typedef struct {
+    ulam__dist_cert cert;
+    ulam__cs *cs;
+    char *done;
+    double E; /* rel_err (0: none) */
+} seq;
+
+/* The clip of the next block of query k (mk: its n, mean and M2 so far): *A the limit of |score|,
+ * *b the most clipping at A moves the mean (stop.h), *h the target half-width, *nplan the walks
+ * planned.  A walk of T steps scores at most bmax (T + 1), so past A = bmax K only walks of K
+ * steps or more, and E (|X| - A)_+ <= bmax sum_{j >= K} P(T >= j) <= bmax c u^K / (1 - u); K the
+ * least with that at most t, t as the single-machine plan takes it (src/solve.c plan_terms): an
+ * eighth of the target half-width, at most a hundredth of |x| (or of its bound bmax c / (1 - u)). */
+static void clip_plan(const seq *S, int64_t k, const double *mk, int64_t walks, double *A, double *b, double *h,
+                      double *nplan)
+{
+    double u = S->cert.u, c = S->cert.c[k], bm = S->cert.bmax, N = mk[0], var = N > 1 ? mk[2] / (N - 1.0) : 0.0;
+    double xb = bm * c / (1.0 - u), mabs = fabs(mk[1]), m = N > 0 && mabs > 0 ? fmin(mabs, xb) : xb;
+    *nplan = S->E > 0 ? fmax(4.0 * N, 4096.0) : (double)walks;
+    *h = S->E > 0 && mabs > 0 ? S->E * mabs : 0.0;
+    double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), t = fmin(fmax(ULAM__STOP_TAIL, S->E / 4.0) * m, fmax(hp / 8.0, 1e-6 * m));
+    double K = u > 0 ? ceil(log(t * (1.0 - u) / (bm * c)) / log(u)) : 1.0;
+    K = K >= 1.0 ? fmin(K, 1e15) : 1.0;
+    *A = bm * K, *b = bm * c * pow(u, K) / (1.0 - u) * (1.0 + 1e-9);
+}
+
+/* The bias of walks cut at max_steps in query k: bmax c u^max_steps / (1 - u). */
+static double cut_bias(const seq *S, int64_t k, int64_t max_steps)
+{
+    return S->cert.bmax * S->cert.c[k] * pow(S->cert.u, (double)max_steps) / (1.0 - S->cert.u) * (1.0 + 1e-9);
+}
+
+/* Whether S certifies intervals (a length tail, or b = 0). */
+static int seq_on(const seq *S)
+{
+    return S && (S->cert.u < 1.0 || S->cert.bmax == 0.0);
+}
+
+/* Query k's interval so far (mk: n, mean, M2) into ci[0 .. 5): lo, hi, limit, bias, met. */
+static void seq_interval(const seq *S, int64_t k, const double *mk, int64_t max_steps, double *ci)
+{
+    ci[0] = ci[1] = NAN, ci[2] = ci[3] = INFINITY, ci[4] = 0.0;
+    if (S->cert.bmax == 0.0) { /* nothing scores: x = 0, exactly */
+        ci[0] = ci[1] = ci[2] = ci[3] = 0.0, ci[4] = 1.0;
+        return;
+    }
+    if (!(S->cert.u < 1.0)) return;
+    ulam__stop_ci c;
+    ulam__cs_interval(&S->cs[k], mk[1], cut_bias(S, k, max_steps), &c);
+    if (c.kind != ULAM__STOP_EB) return;
+    ci[0] = c.lo, ci[1] = c.hi, ci[2] = S->cs[k].limit, ci[3] = c.bias;
+    ci[4] = S->E > 0 && c.half <= S->E * fabs(mk[1]);
+}
+
+/* Add one block of query k's histories e[0 .. nb) (walk-id order) to its sequence, clipped at
+ * the limit planned from the blocks before it. */
+static void seq_block(seq *S, int64_t k, const double *mk, const ended *e, int64_t nb, const ulam_dist_opts *o)
+{
+    if (!(S->cert.u < 1.0)) return;
+    double A, b, h, nplan, N = mk[0];
+    clip_plan(S, k, mk, o->walks, &A, &b, &h, &nplan);
+    ulam__cs_plan(&S->cs[k], (int64_t)N, mk[1], N > 1 ? mk[2] / (N - 1.0) : 0.0, A, b, h > b ? h - b : 0.0, nplan);
+    double n = 0.0, mean = 0.0, m2 = 0.0, top = 0.0;
+    for (int64_t q = 0; q < nb; q++) {
+        double x = fmax(-A, fmin(A, e[q].score)), d = x - mean;
+        n += 1.0, mean += d / n, m2 += d * (x - mean), top = fmax(top, fabs(x));
+    }
+    ulam__cs_add(&S->cs[k], nb, mean, m2, top);
+}
+
 /* Rank 0's histories of one batch, sorted by walk id, into the running moments m[3 k ..] (n,
- * mean, M2) of their query k; the other ranks send theirs to rank 0. */
-static int gather_ends(run *R, double *mm, ulam_error *err)
+ * mean, M2) of their query k, block by block of o.batch walk ids (and with S, into the query's
+ * sequence: a query that met its target takes no more); the other ranks send theirs to rank 0. */
+static int gather_ends(run *R, double *mm, seq *S, ulam_error *err)
 {
     if (R->c->nranks > 1) {
         vec *box = calloc((size_t)R->c->nranks, sizeof *box);
@@ -222,9 +296,19 @@ static int gather_ends(run *R, double *mm, ulam_error *err)
     }
     ended *e = R->ends.a;
     if (R->ends.len) qsort(e, (size_t)R->ends.len, sizeof *e, by_walk);
-    for (int64_t q = 0; q < R->ends.len; q++) { /* Welford's update, in walk-id order */
-        double *m = mm + 3 * (e[q].w / R->o.walks), d = e[q].score - m[1];
-        m[0] += 1.0, m[1] += d / m[0], m[2] += d * (e[q].score - m[1]);
+    for (int64_t q = 0, q1; q < R->ends.len; q = q1) {
+        int64_t k = e[q].w / R->o.walks, blk = e[q].w / R->o.batch;
+        for (q1 = q; q1 < R->ends.len && e[q1].w / R->o.walks == k && e[q1].w / R->o.batch == blk; q1++) {
+        }
+        double *m = mm + 3 * k;
+        if (S && S->done[k]) continue;
+        if (S) seq_block(S, k, m, e + q, q1 - q, &R->o);
+        for (int64_t i = q; i < q1; i++) { /* Welford's update, in walk-id order */
+            double d = e[i].score - m[1];
+            m[0] += 1.0, m[1] += d / m[0], m[2] += d * (e[i].score - m[1]);
+        }
+        double ci[5];
+        if (S && S->E > 0 && seq_on(S)) seq_interval(S, k, m, R->o.max_steps, ci), S->done[k] = ci[4] > 0;
     }
     R->ends.len = 0;
     return ULAM_OK;
@@ -255,12 +339,23 @@ static int64_t my_batch(const run *R, int64_t a)
     return a >= R->o.walks ? 0 : R->o.walks - a < R->o.batch ? R->o.walks - a : R->o.batch;
 }
 
-/* x_index[k] for k < nq by adjoint walks on the partitioned rows. */
-int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
-                           const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err)
+/* Whether every query of the batch of walk ids [a, a + B) is done. */
+static int all_done(const seq *S, int64_t a, int64_t B, int64_t walks)
+{
+    for (int64_t k = a / walks; S && S->done && k <= (a + B - 1) / walks; k++)
+        if (!S->done[k]) return 0;
+    return S && S->done;
+}
+
+/* x_index[k] for k < nq by adjoint walks on the partitioned rows; with ci (5 nq doubles), each
+ * query's certified interval (ulam_dist_adjoint_ci), and with rel_err > 0 the run ends once
+ * every query met it. */
+static int adjoint(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq, const ulam_dist_opts *o,
+                   double rel_err, ulam_dist_result *res, double *ci, ulam_error *err)
 {
     ulam__clear(err);
     if (!p || !comm || !res || !index || nq < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "parts, indices and results");
+    if (!(rel_err >= 0) || !isfinite(rel_err)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a relative error >= 0, got %g", rel_err);
     for (int64_t k = 0; k < nq; k++) {
         res[k] = (ulam_dist_result){0};
         if (index[k] < 0 || index[k] >= p->n)
@@ -270,10 +365,22 @@ int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int6
     int status = start(&R, p, comm, o, 0, err);
     if (!status && R.o.walks > INT64_MAX / nq) status = ulam__fail(err, ULAM_EINVAL, 0, -1, "walks times queries below 2^63");
     int64_t total = status ? 0 : R.o.walks * nq;
-    double *m = calloc((size_t)nq * 4, sizeof *m); /* n, mean, M2 of each query (rank 0); then stderr */
+    double *m = calloc((size_t)nq * 9, sizeof *m); /* n, mean, M2 of each query (rank 0); then stderr; then ci */
     if (!status && !m) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
-    for (int64_t g0 = 0; !status && g0 < total; g0 += R.o.batch * p->sets) { /* a batch a set */
-        int64_t a = g0 + p->set * R.o.batch, B = a >= total ? 0 : total - a < R.o.batch ? total - a : R.o.batch;
+    seq S0 = {.E = rel_err}, *S = ci ? &S0 : NULL;
+    if (!status && S) status = ulam__dist_tail(p, comm, 200, index, nq, &S->cert, err);
+    if (!status && S && (!(S->cs = calloc((size_t)nq, sizeof *S->cs)) || !(S->done = calloc((size_t)nq, 1))))
+        status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
+    int stops = S && rel_err > 0 && seq_on(S); /* the run may end early: rank 0 says which queries are done */
+    int64_t nblocks = status ? 0 : (total + R.o.batch - 1) / R.o.batch;
+    for (int64_t j = 0; !status && j < nblocks;) { /* a batch a set: the next blocks of walk ids with a query not done */
+        int64_t a = -1;
+        for (int s = 0; j < nblocks && s < p->sets; j++) {
+            int64_t aj = j * R.o.batch;
+            if (all_done(S, aj, total - aj < R.o.batch ? total - aj : R.o.batch, R.o.walks)) continue;
+            if (s++ == p->set) a = aj;
+        }
+        int64_t B = a < 0 ? 0 : total - a < R.o.batch ? total - a : R.o.batch;
         for (int64_t g = a; !status && g < a + B; g++) {
             int64_t i = index[g / R.o.walks];
             particle x = {g, 0, i, 1.0, 0.0};
@@ -281,7 +388,10 @@ int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int6
                 status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for walks");
         }
         if (!status) status = rounds(&R, 0, err);
-        if (!status) status = gather_ends(&R, m, err);
+        if (!status) status = gather_ends(&R, m, S, err);
+        for (int64_t k = 0; !status && stops && k < nq; k++) m[4 * nq + k] = S->done[k];
+        if (!status && stops) status = broadcast(&R, m + 4 * nq, (int)nq, err);
+        for (int64_t k = 0; !status && stops && k < nq; k++) S->done[k] = m[4 * nq + k] > 0;
     }
     int64_t cut = R.cut;
     if (!status && R.c->nranks > 1 && R.c->sum(R.c->ctx, &cut, 1))
@@ -289,15 +399,43 @@ int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int6
     for (int64_t k = 0; !status && R.c->rank == 0 && k < nq; k++) { /* estimate, stderr; n checked below */
         double *q = m + 3 * k;
         m[3 * nq + k] = q[0] > 1 ? sqrt(q[2] / (q[0] - 1.0) / q[0]) : NAN;
-        if (q[0] != (double)R.o.walks) status = ulam__fail(err, ULAM_EIO, 0, -1, "every history back at rank 0");
+        if (S) seq_interval(S, k, q, R.o.max_steps, m + 4 * nq + 5 * k);
+        if (q[0] != (double)R.o.walks && !(stops && S->done[k] && q[0] >= 1))
+            status = ulam__fail(err, ULAM_EIO, 0, -1, "every history back at rank 0");
     }
-    if (!status) status = broadcast(&R, m, (int)(nq * 4), err);
+    if (!status) status = broadcast(&R, m, (int)(nq * (S ? 9 : 4)), err);
     ulam_dist_result c = {0};
     if (!status) status = counts(&R, &c, err);
-    for (int64_t k = 0; !status && k < nq; k++)
+    for (int64_t k = 0; !status && k < nq; k++) {
         res[k] = c, res[k].estimate = m[3 * k + 1], res[k].std_error = m[3 * nq + k], res[k].cut = cut;
+        res[k].walks = (int64_t)m[3 * k];
+        if (ci) memcpy(ci + 5 * k, m + 4 * nq + 5 * k, 5 * sizeof *ci);
+    }
     free(m);
+    if (S) free(S->cert.c), free(S->cs), free(S->done);
     finish(&R);
+    return status;
+}
+
+/* x_index[k] for k < nq by adjoint walks on the partitioned rows. */
+int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
+                           const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err)
+{
+    return adjoint(p, comm, index, nq, o, 0.0, res, NULL, err);
+}
+
+/* As ulam_dist_adjoint_many with each query's certified 95% interval. */
+int ulam_dist_adjoint_ci(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
+                         const ulam_dist_opts *o, double rel_err, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err)
+{
+    double *v = ci && nq > 0 ? calloc((size_t)nq * 5, sizeof *v) : NULL;
+    if (!ci || nq < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "intervals and at least one query");
+    if (!v) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld intervals", (long long)nq);
+    int status = adjoint(p, comm, index, nq, o, rel_err, res, v, err);
+    for (int64_t k = 0; k < nq; k++)
+        ci[k] = status ? (ulam_dist_ci){NAN, NAN, INFINITY, INFINITY, 0}
+                       : (ulam_dist_ci){v[5 * k], v[5 * k + 1], v[5 * k + 2], v[5 * k + 3], v[5 * k + 4] > 0};
+    free(v);
     return status;
 }
 

@@ -42,6 +42,29 @@ static int largest_abs(const ulam_part *p, const ulam_comm *c, const double *v, 
     return ulam__dist_largest(c, out);
 }
 
+/* Set 0's values v at this rank's rows to the ranks holding the same rows in the other sets
+ * (forward walks in sets leave their answer on set 0); nonzero on a failed exchange. */
+static int from_set0(const ulam_part *p, const ulam_comm *c, double *v)
+{
+    if (p->sets <= 1) return 0;
+    int64_t rows = p->last - p->first;
+    size_t *cnt = calloc((size_t)c->nranks * 2, sizeof *cnt), bytes = (size_t)rows * sizeof *v;
+    double *send = p->set == 0 ? malloc((size_t)(p->sets - 1) * bytes + 1) : NULL;
+    void *got = NULL;
+    int bad = !cnt || (p->set == 0 && !send);
+    for (int s = 1; !bad && p->set == 0 && s < p->sets; s++) {
+        cnt[s * p->nranks + p->rank] = bytes;
+        memcpy((char *)send + (size_t)(s - 1) * bytes, v, bytes);
+    }
+    if (!bad) bad = c->exchange(c->ctx, send ? send : (void *)v, cnt, &got, cnt + c->nranks);
+    size_t total = 0;
+    for (int r = 0; !bad && r < c->nranks; r++) total += cnt[c->nranks + r];
+    if (!bad && p->set > 0 && total == bytes && cnt[c->nranks + p->rank] == bytes) memcpy(v, got, bytes);
+    else if (!bad && total != (p->set > 0 ? bytes : 0)) bad = 1;
+    free(cnt), free(send), free(got);
+    return bad;
+}
+
 /* x of (I - M) x = b by MCSA on the partition. */
 int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
                    double *x, ulam_dist_mcsa_info *info, ulam_error *err)
@@ -50,7 +73,6 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
     if (!p || !comm || !x || !info || !(tol > 0) || max_iter < 1)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, info, tol > 0 and max_iter >= 1");
     if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
-    if (p->sets > 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "one set (MCSA's walks are not split among sets)");
     *info = (ulam_dist_mcsa_info){0};
     int64_t rows = p->last - p->first;
     double *all = malloc(((size_t)p->n + 1) * sizeof *all), *r = malloc(((size_t)rows + 1) * sizeof *r);
@@ -75,6 +97,7 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
         ulam_dist_result res;
         w.seed = (o ? o->seed : 1) + (uint64_t)it; /* iteration it's walks: their own streams */
         status = ulam_dist_forward_b(p, comm, &w, r, d, NULL, &res, err);
+        if (!status && from_set0(p, comm, d)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
         for (int64_t i = 0; !status && i < rows; i++) x[i] += d[i]; /* the Monte Carlo correction */
         info->iterations = it + 1, info->walks += res.walks, info->steps += res.steps, info->crossings += res.crossings;
         info->cut += res.cut;
@@ -91,7 +114,6 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
     if (!p || !comm || !x || !se || !info || !(tol >= 0) || max_rounds < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, se, info, tol >= 0 and max_rounds >= 0");
     if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
-    if (p->sets > 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "one set (single source's walks are not split among sets)");
     if (source < 0 || source >= p->n) return ulam__fail(err, ULAM_EINVAL, 0, source, "a source in 1 .. %lld", (long long)p->n);
     *info = (ulam_dist_source_info){0};
     int64_t rows = p->last - p->first;
@@ -111,6 +133,8 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
     info->residual = rmax;
     ulam_dist_result res = {0};
     if (!status) status = ulam_dist_forward_b(p, comm, o, r, y, se, &res, err); /* (I - M)^-1 r by walks */
+    if (!status && (from_set0(p, comm, y) || from_set0(p, comm, se)))
+        status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
     for (int64_t i = 0; !status && i < rows; i++) {
         x[i] += y[i];
         if (rmax == 0.0) se[i] = 0.0; /* nothing left to walk: the push is the answer */

@@ -7,21 +7,194 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* One step: y = M^ v on this rank's rows (v NULL: all ones), the Collatz-Wielandt ratio's largest value (each row's
- * sum rounded up by its (length + 2) roundings) into *cw and y's largest into *top. */
-static void step(const ulam_part *p, const ulam__rows *A, const double *v, double *y, double *cw, double *top)
+/* The halo of this rank's rows of A: the columns they reference that other ranks of its set own
+ * (ghost, sorted), and what this rank sends each iteration: the offsets (into its rows) others
+ * asked for, at[r] .. at[r + 1) of idx for world rank r.  A product then needs the iterate at
+ * the halo only, not the whole O(n) vector. */
+typedef struct {
+    int64_t nghost, *ghost;
+    int64_t *idx, *at; /* at: nranks + 1 */
+} halo;
+
+/* Free h's arrays. */
+static void halo_free(halo *h)
+{
+    free(h->ghost), free(h->idx), free(h->at);
+}
+
+/* Order of int64_t. */
+static int by_int64(const void *a, const void *b)
+{
+    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Add column j to the open-addressing set t (cap a power of 2, -1 empty, *len entries), doubling
+ * it at half full; nonzero when out of memory. */
+static int set_add(int32_t **t, int64_t *cap, int64_t *len, int32_t j)
+{
+    if (2 * (*len + 1) > *cap) {
+        int64_t nc = *cap ? 2 * *cap : 1024;
+        int32_t *nt = malloc((size_t)nc * sizeof *nt);
+        if (!nt) return 1;
+        memset(nt, 0xff, (size_t)nc * sizeof *nt);
+        for (int64_t q = 0; q < *cap; q++) {
+            if ((*t)[q] < 0) continue;
+            uint64_t at = ((uint64_t)(*t)[q] * 0x9E3779B97F4A7C15u) >> 20 & (uint64_t)(nc - 1);
+            while (nt[at] >= 0) at = (at + 1) & (uint64_t)(nc - 1);
+            nt[at] = (*t)[q];
+        }
+        free(*t);
+        *t = nt, *cap = nc;
+    }
+    uint64_t at = ((uint64_t)j * 0x9E3779B97F4A7C15u) >> 20 & (uint64_t)(*cap - 1);
+    while ((*t)[at] >= 0 && (*t)[at] != j) at = (at + 1) & (uint64_t)(*cap - 1);
+    if ((*t)[at] < 0) (*t)[at] = j, ++*len;
+    return 0;
+}
+
+/* Find the halo of A's rows on this rank: its sorted distinct outside columns (gathered in a hash
+ * set: memory by the halo, not by the entries or n), each asked of its owner through one
+ * exchange; nonzero on failure (memory or the exchange). */
+static int halo_make(const ulam_part *p, const ulam_comm *c, const ulam__rows *A, halo *h)
+{
+    *h = (halo){0};
+    int64_t rows = p->last - p->first, k = c->nranks, cap = 0, u = 0;
+    int32_t *t = NULL;
+    for (int64_t q = 0; q < A->rowptr[rows]; q++)
+        if ((A->col[q] < p->first || A->col[q] >= p->last) && set_add(&t, &cap, &u, A->col[q])) return free(t), 1;
+    h->ghost = malloc(((size_t)u + 1) * sizeof *h->ghost);
+    h->at = calloc((size_t)k + 1, sizeof *h->at);
+    size_t *cnt = calloc((size_t)k * 2, sizeof *cnt);
+    if (!h->ghost || !h->at || !cnt) return free(t), free(cnt), 1;
+    for (int64_t q = 0, m = 0; q < cap; q++)
+        if (t[q] >= 0) h->ghost[m++] = t[q];
+    free(t);
+    h->nghost = u;
+    if (u) qsort(h->ghost, (size_t)u, sizeof *h->ghost, by_int64);
+    for (int64_t q = 0; q < u; q++) cnt[p->set * p->nranks + ulam__part_owner(p, h->ghost[q])] += sizeof(int64_t);
+    void *got = NULL;
+    int bad = k > 1 ? c->exchange(c->ctx, h->ghost, cnt, &got, cnt + k) : 0; /* ghosts sorted: in owner order */
+    size_t total = 0;
+    for (int r = 0; !bad && r < k; r++) h->at[r + 1] = h->at[r] + (int64_t)(cnt[k + r] / sizeof(int64_t)), total += cnt[k + r];
+    h->idx = malloc(total + 1);
+    if (!bad && h->idx) {
+        memcpy(h->idx, got, total);
+        for (int64_t q = 0; q < h->at[k]; q++) {
+            h->idx[q] -= p->first;
+            if (h->idx[q] < 0 || h->idx[q] >= rows) bad = 1; /* a request for a row this rank does not hold */
+        }
+    }
+    free(got), free(cnt);
+    return bad || !h->idx;
+}
+
+/* The iterate's halo values into gv (in h->ghost order) from every rank's rows mine; nonzero on a
+ * failed exchange. */
+static int halo_swap(const ulam_part *p, const ulam_comm *c, const halo *h, const double *mine, double *gv)
+{
+    int k = c->nranks;
+    if (k == 1) return 0;
+    size_t *cnt = calloc((size_t)k * 2, sizeof *cnt);
+    double *send = malloc(((size_t)h->at[k] + 1) * sizeof *send);
+    void *got = NULL;
+    int bad = !cnt || !send;
+    for (int r = 0; !bad && r < k; r++) cnt[r] = (size_t)(h->at[r + 1] - h->at[r]) * sizeof *send;
+    for (int64_t q = 0; !bad && q < h->at[k]; q++) send[q] = mine[h->idx[q]];
+    if (!bad) bad = c->exchange(c->ctx, send, cnt, &got, cnt + k);
+    size_t total = 0;
+    for (int r = 0; !bad && r < k; r++) total += cnt[k + r];
+    if (!bad && total == (size_t)h->nghost * sizeof *gv) memcpy(gv, got, total);
+    else bad = 1;
+    (void)p;
+    free(cnt), free(send), free(got);
+    return bad;
+}
+
+/* The iterate at column j: this rank's own rows, else its halo. */
+static double at_col(const ulam_part *p, const halo *h, const double *own, const double *gv, int64_t j)
+{
+    if (j >= p->first && j < p->last) return own[j - p->first];
+    int64_t lo = 0, hi = h->nghost - 1;
+    while (lo < hi) {
+        int64_t mid = (lo + hi) / 2;
+        if (h->ghost[mid] < j) lo = mid + 1;
+        else hi = mid;
+    }
+    return gv[lo];
+}
+
+/* One step: y = M^ v on this rank's rows (own NULL: v all ones; else v at its rows own, at its
+ * halo gv), the Collatz-Wielandt ratio's largest value (each row's sum rounded up by its
+ * (length + 2) roundings) into *cw and y's largest into *top. */
+static void step(const ulam_part *p, const ulam__rows *A, const halo *h, const double *own, const double *gv, double *y,
+                 double *cw, double *top)
 {
     *cw = 0.0, *top = 0.0;
     for (int64_t i = 0; i < p->last - p->first; i++) {
         double S = A->rowsum[i], f = S > 1.0 ? S : 1.0, s = 0.0; /* S / min(1, S) */
         int64_t len = A->rowptr[i + 1] - A->rowptr[i];
-        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += fabs(A->val[q]) * (v ? v[A->col[q]] : 1.0);
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++)
+            s += fabs(A->val[q]) * (own ? at_col(p, h, own, gv, A->col[q]) : 1.0);
         s *= f * (1.0 + (double)(len + 3) * DBL_EPSILON);
         y[i] = s;
-        double r = v ? s / v[p->first + i] : s;
+        double r = own ? s / own[i] : s;
         if (r > *cw) *cw = r;
         if (s > *top) *top = s;
     }
+}
+
+/* Power iteration on M^ (see ulam_dist_radius) into *best; with keep, also this rank's rows of
+ * the iterate v whose Collatz-Wielandt bound is *best (keep[0 .. rows)) and the least entry of
+ * that v over the ranks (*vmin).  Each rank holds v at its rows and their halo only. */
+static int power(const ulam_part *p, const ulam_comm *comm, const ulam__rows *A, int iters, double *best_out, double *keep,
+                 double *vmin, ulam_error *err)
+{
+    int64_t rows = p->last - p->first;
+    double *own = NULL, *gv = NULL, *y = malloc(((size_t)rows + 1) * sizeof *y); /* own, gv: once the row sums do not do */
+    if (!y) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the power iteration (%lld doubles)", (long long)rows);
+    halo h = {0};
+    double best = INFINITY;
+    int status = ULAM_OK, made = 0;
+    for (int k = 0; k < iters && !(best < 1.0); k++) {
+        double cw, top;
+        step(p, A, &h, k ? own : NULL, gv, y, &cw, &top);
+        if (ulam__dist_largest(comm, &cw) || ulam__dist_largest(comm, &top)) {
+            status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+            break;
+        }
+        if (cw < best) {
+            best = cw;
+            double lo = INFINITY; /* the least entry as a largest of 1 / v: ulam__dist_largest takes nonnegatives */
+            for (int64_t i = 0; keep && i < rows; i++) keep[i] = k ? own[i] : 1.0, lo = fmin(lo, keep[i]);
+            double inv = rows ? 1.0 / lo : 0.0;
+            if (keep && ulam__dist_largest(comm, &inv)) {
+                status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+                break;
+            }
+            if (keep) *vmin = 1.0 / inv; /* rounded: the caller's ratios take a margin */
+        }
+        if (best < 1.0 || !(top > 0.0) || !isfinite(top)) break; /* certified; or M^ v = 0, or overflow */
+        if (!made) { /* the halo, once: every rank gets here together (the same best and top) */
+            made = 1;
+            int64_t bad = halo_make(p, comm, A, &h);
+            own = malloc(((size_t)rows + 1) * sizeof *own), gv = malloc(((size_t)h.nghost + 1) * sizeof *gv);
+            bad |= !own || !gv;
+            if (comm->nranks > 1 && comm->sum(comm->ctx, &bad, 1)) bad = 1; /* all stop together */
+            if (bad) {
+                status = ulam__fail(err, ULAM_ENOMEM, 0, -1,
+                                    "memory for the power iteration's halo and an exchange that succeeds");
+                break;
+            }
+        }
+        for (int64_t i = 0; i < rows; i++) own[i] = y[i] / top + 1e-6; /* kept positive: any positive v gives a valid bound */
+        if (halo_swap(p, comm, &h, own, gv)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+        if (status) break;
+    }
+    halo_free(&h);
+    free(own), free(gv), free(y);
+    if (!status) *best_out = best;
+    return status;
 }
 
 /* A certified upper bound on rho(M^) of the partitioned walks. */
@@ -31,29 +204,38 @@ int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int forward, int
     if (!p || !comm || !upper || iters < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, a result, iters >= 1");
     const ulam__rows *A = forward ? &p->t : &p->m;
     if (!A->rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding the rows of %s", forward ? "M'" : "M");
+    return power(p, comm, A, iters, upper, NULL, NULL, err);
+}
+
+/* The length tail of adjoint walks (part.h). */
+int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const int64_t *index, int64_t nq,
+                    ulam__dist_cert *cert, ulam_error *err)
+{
     int64_t rows = p->last - p->first;
-    double *v = NULL, *y = malloc(((size_t)rows + 1) * sizeof *y); /* v: the whole iterate, once the row sums do not do */
-    if (!y) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the power iteration (%lld doubles)", (long long)rows);
-    double best = INFINITY;
-    int status = ULAM_OK;
-    for (int k = 0; k < iters && !(best < 1.0); k++) {
-        double cw, top;
-        step(p, A, k ? v : NULL, y, &cw, &top);
-        if (ulam__dist_largest(comm, &cw) || ulam__dist_largest(comm, &top)) {
-            status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
-            break;
-        }
-        if (cw < best) best = cw;
-        if (best < 1.0 || !(top > 0.0) || !isfinite(top)) break; /* certified; or M^ v = 0, or overflow */
-        if (!v && !(v = malloc((size_t)p->n * sizeof *v))) {
-            status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the power iteration (%lld doubles)", (long long)p->n);
-            break;
-        }
-        for (int64_t i = 0; i < rows; i++) y[i] = y[i] / top + 1e-6; /* kept positive: any positive v gives a valid bound */
-        if (ulam__dist_gather(p, comm, y, v)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
-        if (status) break;
+    const ulam__rows *A = &p->m;
+    *cert = (ulam__dist_cert){.u = INFINITY};
+    double smax = 0.0, bmax = 0.0;
+    for (int64_t i = 0; i < rows; i++) smax = fmax(smax, A->rowsum[i]), bmax = fmax(bmax, fabs(p->b[i]));
+    if (ulam__dist_largest(comm, &smax) || ulam__dist_largest(comm, &bmax))
+        return ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+    cert->bmax = bmax;
+    cert->c = calloc((size_t)nq, sizeof *cert->c);
+    if (!cert->c) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
+    if (smax > 1.0 || bmax == 0.0) return ULAM_OK; /* weights that grow: no length bound bounds a score; b = 0: x = 0 */
+    double *keep = malloc(((size_t)rows + 1) * sizeof *keep), u = INFINITY, vmin = 0.0;
+    int64_t *bits = calloc((size_t)nq, sizeof *bits);
+    int status = keep && bits ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the power iteration");
+    if (!status) status = power(p, comm, A, iters, &u, keep, &vmin, err);
+    for (int64_t k = 0; !status && k < nq; k++) /* v at each query's start, from the rank that owns it (exact: one owner) */
+        if (index[k] >= p->first && index[k] < p->last && p->set == 0) memcpy(&bits[k], &keep[index[k] - p->first], 8);
+    if (!status && comm->nranks > 1 && comm->sum(comm->ctx, bits, (int)nq))
+        status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks that succeeds");
+    for (int64_t k = 0; !status && k < nq; k++) {
+        double vk;
+        memcpy(&vk, &bits[k], 8);
+        cert->c[k] = vk / vmin * (1.0 + 4.0 * DBL_EPSILON); /* v_i / min v, rounded up */
     }
-    free(v), free(y);
-    if (!status) *upper = best;
+    if (!status && u < 1.0) cert->u = u;
+    free(keep), free(bits);
     return status;
 }

@@ -35,4 +35,19 @@ int ulam__dist_gather(const ulam_part *p, const ulam_comm *c, const double *mine
 /* The largest of every rank's nonnegative *x, into *x on every rank; nonzero on a failed sum. */
 int ulam__dist_largest(const ulam_comm *c, double *x);
 
+/* What bounds an adjoint walk's length on a partition: every row sum of |M| at most 1 (so the
+ * analog kernel's weights stay +-1 and a walk from i is alive after k steps with probability
+ * (|M|^k 1)_i) and a positive v with |M| v <= u v (a Collatz-Wielandt vector of ulam_dist_radius's
+ * power iteration, certified by one product rounded up): alive with probability at most
+ * u^k v_i / min v = u^k c[k] for query k.  bmax = max |b_i|: a walk of T steps scores at most
+ * bmax (T + 1).  u INFINITY: no certificate. */
+typedef struct {
+    double u, bmax;
+    double *c; /* per query, malloc'd */
+} ulam__dist_cert;
+
+/* The certificate above for walks from index[0 .. nq) (src/dist_radius.c), at most iters products. */
+int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const int64_t *index, int64_t nq,
+                    ulam__dist_cert *cert, ulam_error *err);
+
 #endif

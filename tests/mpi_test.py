@@ -111,7 +111,13 @@ def check_partition(ulam, mpirun, d):
         top = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--source", "77",
                    "--top", "10", "--walks", "20000", "-q"])
         outer.append((open(x).read(), top))
-    assert outer[0] == outer[1], "MCSA or single source differ across rank counts"
+    x = f"{d}/pms.mtx"  # 4 ranks in 2 sets: MCSA's x file and single source's table again, byte for byte
+    run([mpirun, "--oversubscribe", "-np", "4", ulam, "solve", sysf, "--partition", "--sets", "2", "--method", "mcsa",
+         "--walks", "20000", "--out", x, "-q"])
+    top = run([mpirun, "--oversubscribe", "-np", "4", ulam, "solve", sysf, "--partition", "--sets", "2", "--source", "77",
+               "--top", "10", "--walks", "20000", "-q"])
+    outer.append((open(x).read(), top))
+    assert outer[0] == outer[1] == outer[2], "MCSA or single source differ across rank counts or sets"
     xm = [float(v) for v in outer[0][0].split("\n")[3:] if v.strip()]
     assert max(abs(a - b) for a, b in zip(xm, exact)) < 1e-6 * max(abs(b) for b in exact), "MCSA's x is off"
     assert len(outer[0][1].splitlines()) == 10 and outer[0][1].startswith("x[77]"), outer[0][1]
@@ -120,6 +126,13 @@ def check_partition(ulam, mpirun, d):
     qs = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--queries", qf, "--walks",
                "40000", "--seed", "3", "-q"]) for k in (1, 3)]
     assert qs[0] == qs[1] and qs[0].splitlines()[0].split("  line")[0] == lines[0], (qs, lines[0])
+    est, lo, hi = (float(lines[0].split()[i].rstrip(")")) for i in (1, 6, 8))  # the certified 95% interval holds x
+    assert lo <= exact[1233] <= hi and lo <= est <= hi, (lines[0], exact[1233])
+    rel = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--index", "1234",
+                "--rel-err", "0.01", "--batch", "8192", "--seed", "3", "-q"]) for k in (1, 3)]
+    assert rel[0] == rel[1] and "rel-err         met" in rel[0], rel  # --rel-err on a partition: the same bits
+    est, lo, hi = (float(rel[0].split()[i].rstrip(")")) for i in (1, 6, 8))
+    assert lo <= exact[1233] <= hi and hi - lo <= 0.02 * abs(est), rel[0]
     p = subprocess.run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "5"],
                        capture_output=True, text=True, env=dict(ENV, ULAM_TEST_PARTITION_DIE="1"), timeout=120)
     assert p.returncode != 0 and not p.stdout, (p.returncode, p.stdout)

@@ -25,9 +25,13 @@ typedef struct {
     ulam_dist_mcsa_info mi;
     ulam_dist_source_info si;
     double rho;
+    int ci;         /* ulam_dist_adjoint_ci into cis, with rel_err */
+    double rel_err;
+    ulam_dist_ci cis[4];
     int status;
     ulam_dist_result res;
     double *x, *se; /* forward: the whole vector, each rank filling its rows */
+    double *ox, *ose; /* outer methods in sets: a rank past set 0's own copy (malloc'd) */
     int64_t first, last, n;
 } job;
 
@@ -50,13 +54,17 @@ static void *rank_main(void *arg)
     j->n = ulam_part_rows(p, &j->first, &j->last, NULL);
     ulam_dist_opts o = ulam_dist_defaults();
     o.walks = j->walks, o.batch = 997, o.seed = 7 + j->seed;
-    if (j->outer == 1) j->status = ulam_dist_mcsa(p, &c, &o, 1e-10, 60, j->x + j->first, &j->mi, &err);
+    int other = j->sets > 1 && c.rank >= c.nranks / j->sets; /* a set past 0: its own copy, compared below */
+    double *ox = other ? calloc((size_t)j->n, sizeof *ox) : j->x, *ose = other ? calloc((size_t)j->n, sizeof *ose) : j->se;
+    if (j->outer == 1) j->status = ulam_dist_mcsa(p, &c, &o, 1e-10, 60, ox + j->first, &j->mi, &err);
     else if (j->outer == 2)
-        j->status = ulam_dist_source(p, &c, j->index, &o, 1e-3, 1000, j->x + j->first, j->se + j->first, &j->si, &err);
+        j->status = ulam_dist_source(p, &c, j->index, &o, 1e-3, 1000, ox + j->first, ose + j->first, &j->si, &err);
+    else if (j->ci) j->status = ulam_dist_adjoint_ci(p, &c, &j->index, 1, &o, j->rel_err, &j->res, j->cis, &err);
     else if (j->nq) j->status = ulam_dist_adjoint_many(p, &c, j->many, j->nq, &o, j->manyres, &err);
     else if (j->radius) j->status = ulam_dist_radius(p, &c, 0, 300, &j->rho, &err);
     else if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
     else j->status = ulam_dist_adjoint(p, &c, j->index, &o, &j->res, &err);
+    if (other) j->ox = ox, j->ose = ose; /* compared with set 0's once every rank is done (check_sets) */
     ulam_part_free(p);
     return NULL;
 }
@@ -98,6 +106,21 @@ static void temp_file(char *path)
     close(fd);
 }
 
+/* Write M (nz triplets, n x n) and b as a prepared file at path (with M' when transpose), x by
+ * LAPACK; frees the triplets and b. */
+static void write_solve(const char *path, int64_t n, int64_t nz, int32_t *ti, int32_t *tj, double *tv, double *b,
+                        int transpose, double *x)
+{
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, &M), ULAM_OK);
+    ulam_system_desc d = ulam_system_desc_defaults();
+    d.M = M, d.b = b, d.n = n, d.transpose = transpose;
+    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    ulam_csr_free(M);
+    free(ti), free(tj), free(tv), free(b);
+}
+
 /* A random sparse signed M (n x n, about deg entries a row, |row sums| 0.9 at most, some rows
  * leaving the system) and b, written as a prepared file with M' at path; x solved by LAPACK. */
 static void make_system(const char *path, int64_t n, int deg, uint64_t seed, double *x)
@@ -118,14 +141,7 @@ static void make_system(const char *path, int64_t n, int deg, uint64_t seed, dou
         }
         b[i] = ulam_rng_uniform(&r) < 0.5 ? 0.0 : 1.0 + ulam_rng_uniform(&r);
     }
-    ulam_csr *M = NULL;
-    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, &M), ULAM_OK);
-    ulam_system_desc d = ulam_system_desc_defaults();
-    d.M = M, d.b = b, d.n = n, d.transpose = 1;
-    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
-    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
-    ulam_csr_free(M);
-    free(ti), free(tj), free(tv), free(b);
+    write_solve(path, n, nz, ti, tj, tv, b, 1, x);
 }
 
 /* Adjoint: one answer, bit for bit, at 1, 2, 3 and 5 ranks, within 4 standard errors of x. */
@@ -273,15 +289,27 @@ static void test_dist_many(void **state)
     unlink(path);
 }
 
-/* Run an outer method (1 MCSA, 2 single source from index) on k thread-ranks into x, se. */
+/* Run an outer method (1 MCSA, 2 single source from index) on k thread-ranks (4: in 2 sets of 2)
+ * into x, se. */
 static void run_outer(int k, int outer, const char *path, int64_t index, int64_t walks, double *x, double *se, job *jobs)
 {
-    job t = {.path = path, .outer = outer, .index = index, .walks = walks, .x = x, .se = se};
+    job t = {.path = path, .outer = outer, .index = index, .walks = walks, .x = x, .se = se, .sets = k == 4 ? 2 : 0};
     run_jobs(k, &t, jobs);
 }
 
+/* Each rank of a set past 0 (k = 4: 2 sets of 2) holds set 0's answer at its rows, bit for bit. */
+static void check_sets(int k, job *jobs, const double *x, const double *se)
+{
+    for (int r = k / 2; k == 4 && r < k; r++) {
+        size_t len = (size_t)(jobs[r].last - jobs[r].first) * sizeof *x;
+        assert_memory_equal(jobs[r].ox + jobs[r].first, x + jobs[r].first, len);
+        if (se) assert_memory_equal(jobs[r].ose + jobs[r].first, se + jobs[r].first, len);
+        free(jobs[r].ox), free(jobs[r].ose);
+    }
+}
+
 /* MCSA on a partition: to a residual of 1e-10 of max |b|, x within 1e-8 of LAPACK's, the same
- * bits at 1, 2 and 3 ranks. */
+ * bits at 1, 2 and 3 ranks and in 2 sets of 2 (each set's ranks with the whole answer). */
 static void test_dist_mcsa(void **state)
 {
     (void)state;
@@ -290,12 +318,14 @@ static void test_dist_mcsa(void **state)
     int64_t n = 800;
     double *x = malloc((size_t)n * sizeof *x), *ref = malloc((size_t)n * sizeof *ref), *y = malloc((size_t)n * sizeof *y);
     make_system(path, n, 5, 17, x);
-    for (int k = 1; k <= 3; k++) {
+    for (int k = 1; k <= 4; k++) {
         job jobs[MAXR];
+        memset(y, 0, (size_t)n * sizeof *y);
         run_outer(k, 1, path, 0, 20000, k == 1 ? ref : y, NULL, jobs);
         for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
         if (!(jobs[0].mi.residual <= 1e-10 && jobs[0].mi.iterations < 60)) fail_msg("residual %.3g after %d iterations", jobs[0].mi.residual, jobs[0].mi.iterations);
         if (k > 1) assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+        check_sets(k, jobs, y, NULL);
     }
     double big = 0, worst = 0;
     for (int64_t i = 0; i < n; i++) big = fmax(big, fabs(x[i])), worst = fmax(worst, fabs(ref[i] - x[i]));
@@ -306,7 +336,7 @@ static void test_dist_mcsa(void **state)
 
 /* Single source on a partition: x = (I - M)^-1 e_s within 4 standard errors of LAPACK's column
  * wherever the walks gave one (the push's own part exact), at least 90% within 1.96, the same
- * bits at 1, 2 and 3 ranks. */
+ * bits at 1, 2 and 3 ranks and in 2 sets of 2. */
 static void test_dist_source(void **state)
 {
     (void)state;
@@ -322,8 +352,9 @@ static void test_dist_source(void **state)
     e[s] = 1.0;
     assert_int_equal(ulam_direct_solve(ulam_system_matrix(sys), e, col, 0, NULL, NULL), ULAM_OK);
     ulam_system_free(sys);
-    for (int k = 1; k <= 3; k++) {
+    for (int k = 1; k <= 4; k++) {
         job jobs[MAXR];
+        memset(y, 0, (size_t)n * sizeof *y), memset(yse, 0, (size_t)n * sizeof *yse);
         run_outer(k, 2, path, s, 20000, k == 1 ? ref : y, k == 1 ? rse : yse, jobs);
         for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
         assert_true(jobs[0].si.rounds > 0 && jobs[0].si.residual <= 1e-3);
@@ -331,6 +362,7 @@ static void test_dist_source(void **state)
             assert_memory_equal(y, ref, (size_t)n * sizeof *y);
             assert_memory_equal(yse, rse, (size_t)n * sizeof *y);
         }
+        check_sets(k, jobs, y, yse);
     }
     int64_t with = 0, in = 0;
     for (int64_t i = 0; i < n; i++) {
@@ -415,6 +447,142 @@ static void test_dist_radius(void **state)
     unlink(path);
 }
 
+/* A system whose x_0 rests on a rare large b (the reviewer's kind): n states, each row of |M|
+ * summing to 0.8 over 3 random columns below n - 1; row 1 also steps, with eps, to state
+ * n - 1, the only one with b (big) besides b = 1 elsewhere; x solved by LAPACK. */
+static void make_rare(const char *path, int64_t n, double big, double eps, uint64_t seed, double *x)
+{
+    ulam_rng r;
+    ulam_rng_seed(&r, seed, 0);
+    int64_t cap = n * 4;
+    int32_t *ti = malloc((size_t)cap * sizeof *ti), *tj = malloc((size_t)cap * sizeof *tj);
+    double *tv = malloc((size_t)cap * sizeof *tv), *b = malloc((size_t)n * sizeof *b);
+    int64_t nz = 0;
+    for (int64_t i = 0; i < n - 1; i++) {
+        for (int q = 0; q < 3; q++) {
+            ti[nz] = (int32_t)i, tj[nz] = (int32_t)(q == 0 ? (i + 1) % (n - 1) : (int64_t)ulam_rng_bounded(&r, (uint64_t)(n - 1)));
+            tv[nz++] = (i == 1 ? 0.8 - eps : 0.8) / 3;
+        }
+        if (i == 1) ti[nz] = 1, tj[nz] = (int32_t)(n - 1), tv[nz++] = eps;
+        b[i] = 1.0;
+    }
+    b[n - 1] = big;
+    write_solve(path, n, nz, ti, tj, tv, b, 0, x);
+}
+
+/* The certified interval on a rare-large-b system over 40 seeds on 2 thread-ranks: the
+ * standard error's CLT interval misses x_0 in most seeds (the walks seldom see the large b), the
+ * certified one covers it in at least 33 of 40 (Binomial(40, 0.95) is below 33 with
+ * probability 0.0034), at a fixed budget and under rel_err; the interval's bits are the same at
+ * 1, 2 and 3 ranks and in 2 sets of 2. */
+static void test_dist_interval(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    temp_file(path);
+    int64_t n = 300;
+    double *x = malloc((size_t)n * sizeof *x);
+    char mild[] = "/tmp/ulam_test_dist_XXXXXX";
+    temp_file(mild);
+    double *y = malloc((size_t)n * sizeof *y);
+    make_rare(path, n, 2e5, 2e-4, 3, x);
+    make_rare(mild, n, 20.0, 2e-3, 3, y); /* under rel_err: a range a test can afford */
+    int clt = 0, cover = 0, rcover = 0, met = 0, seeds = 40;
+    int64_t rwalks = 0;
+    for (int s = 0; s < seeds; s++) {
+        job jobs[MAXR], t = {.path = path, .walks = 3000, .index = 0, .ci = 1, .seed = (uint64_t)s};
+        run_jobs(2, &t, jobs);
+        assert_int_equal(jobs[0].status, ULAM_OK);
+        const ulam_dist_result *r = &jobs[0].res;
+        const ulam_dist_ci *c = &jobs[0].cis[0];
+        clt += fabs(r->estimate - x[0]) <= 1.96 * r->std_error;
+        if (!(c->lo <= r->estimate && r->estimate <= c->hi)) fail_msg("interval [%g, %g] without %g", c->lo, c->hi, r->estimate);
+        cover += c->lo <= x[0] && x[0] <= c->hi;
+        job rj[MAXR], rt = {.path = mild, .walks = 1 << 22, .index = 0, .ci = 1, .rel_err = 0.1, .seed = (uint64_t)s};
+        run_jobs(2, &rt, rj);
+        assert_int_equal(rj[0].status, ULAM_OK);
+        const ulam_dist_ci *q = &rj[0].cis[0];
+        met += q->met, rwalks += rj[0].res.walks;
+        rcover += q->lo <= y[0] && y[0] <= q->hi;
+        if (q->met && !(q->hi - q->lo <= 2 * 0.1 * fabs(rj[0].res.estimate))) fail_msg("met with [%g, %g]", q->lo, q->hi);
+    }
+    print_message("x_0 %.6g: CLT covered %d of %d, certified %d; milder x_0 %.6g under rel_err 0.1: %d (%d met, %lld walks "
+                  "a run)\n", x[0], clt, seeds, cover, y[0], rcover, met, (long long)(rwalks / seeds));
+    assert_true(clt <= 20); /* the system is hard: the CLT interval fails */
+    assert_true(cover >= 33);
+    assert_true(rcover >= 33);
+    assert_int_equal(met, seeds);
+    ulam_dist_ci first[2];
+    ulam_dist_result fr[2];
+    for (int k = 1; k <= 4; k++) /* the same bits at 1, 2, 3 ranks and 2 sets of 2 */
+        for (int e = 0; e < 2; e++) {
+            job jobs[MAXR], t = {.path = e ? mild : path, .walks = 20000, .index = 0, .ci = 1, .rel_err = e ? 0.1 : 0.0,
+                                 .sets = k == 4 ? 2 : 0};
+            run_jobs(k, &t, jobs);
+            if (k == 1) first[e] = jobs[0].cis[0], fr[e] = jobs[0].res;
+            for (int r = 0; r < k; r++) {
+                assert_int_equal(jobs[r].status, ULAM_OK);
+                assert_memory_equal(&jobs[r].cis[0], &first[e], sizeof first[e]);
+                assert_memory_equal(&jobs[r].res.estimate, &fr[e].estimate, sizeof(double));
+                assert_int_equal(jobs[r].res.walks, fr[e].walks);
+            }
+        }
+    free(x), free(y);
+    unlink(path), unlink(mild);
+}
+
+/* A system whose row sums do not certify rho(M^) (even rows of |M| sum to 1.2, odd ones to 0.4)
+ * but whose walks' variance is finite: the guard iterates, each rank holding the iterate at its
+ * rows and their halo only.  The bound is the same bits at 1, 2, 3 and 5 ranks (and in 2 sets of
+ * 2), at least rho(M^) as 3000 dense power steps estimate it, and below 1. */
+static void test_dist_radius_halo(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    temp_file(path);
+    int64_t n = 600, nz = 0;
+    ulam_rng r;
+    ulam_rng_seed(&r, 21, 0);
+    int32_t *ti = malloc((size_t)n * 3 * sizeof *ti), *tj = malloc((size_t)n * 3 * sizeof *tj);
+    double *tv = malloc((size_t)n * 3 * sizeof *tv), *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
+    double *hat = calloc((size_t)n * (size_t)n, sizeof *hat); /* dense M^ = diag(max(1, S)) |M| */
+    for (int64_t i = 0; i < n; i++) {
+        double S = i % 2 ? 0.4 : 1.2;
+        for (int q = 0; q < 3; q++) {
+            int64_t j = q == 0 ? (i + 1) % n : (int64_t)ulam_rng_bounded(&r, (uint64_t)n);
+            if (i % 2 == 0 && j % 2 == 0) j = (j + 1) % n; /* big rows step to small ones */
+            ti[nz] = (int32_t)i, tj[nz] = (int32_t)j, tv[nz++] = S / 3 * (q == 2 ? -1 : 1);
+            hat[i * n + j] += S / 3 * (S > 1 ? S : 1);
+        }
+        b[i] = 1.0;
+    }
+    write_solve(path, n, nz, ti, tj, tv, b, 1, x);
+    double *v = malloc((size_t)n * sizeof *v), *y = malloc((size_t)n * sizeof *y), rho = 0;
+    for (int64_t i = 0; i < n; i++) v[i] = 1.0;
+    for (int k = 0; k < 3000; k++) {
+        double top = 0;
+        for (int64_t i = 0; i < n; i++) {
+            y[i] = 0;
+            for (int64_t j = 0; j < n; j++) y[i] += hat[i * n + j] * v[j];
+            if (y[i] > top) top = y[i];
+        }
+        rho = top;
+        for (int64_t i = 0; i < n; i++) v[i] = y[i] / top;
+    }
+    double first = NAN;
+    const int ks[] = {1, 2, 3, 5, 4};
+    for (int c = 0; c < 5; c++) {
+        job jobs[MAXR], t = {.path = path, .radius = 1, .walks = 1, .sets = ks[c] == 4 ? 2 : 0};
+        run_jobs(ks[c], &t, jobs);
+        for (int q = 0; q < ks[c]; q++) assert_int_equal(jobs[q].status, ULAM_OK);
+        if (c == 0) first = jobs[0].rho;
+        for (int q = 0; q < ks[c]; q++) assert_memory_equal(&jobs[q].rho, &first, sizeof first);
+    }
+    if (!(first >= rho * (1 - 1e-9) && first < 1.0 && rho > 0.5)) fail_msg("bound %.9g, rho(M^) %.9g", first, rho);
+    free(x), free(v), free(y), free(hat);
+    unlink(path);
+}
+
 /* Counter-based numbers: keyed by (seed, walk, step, k), in [0, 1), and not all alike. */
 static void test_dist_counter(void **state)
 {
@@ -444,6 +612,8 @@ int main(void)
         cmocka_unit_test(test_dist_many),
         cmocka_unit_test(test_dist_mcsa),
         cmocka_unit_test(test_dist_source),
+        cmocka_unit_test(test_dist_interval),
+        cmocka_unit_test(test_dist_radius_halo),
     };
     return test_run(tests);
 }

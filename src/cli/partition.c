@@ -16,15 +16,16 @@
 static const char *const help =
     "usage: ulam solve SYSTEM.ulam --partition (--index I | --queries FILE | --mode forward [--out X.mtx]\n"
     "                  | --method mcsa [--tol T] [--out X.mtx] | --source S [--top K] [--out X.mtx])\n"
-    "                  [--walks N] [--seed S] [--max-steps N] [--batch N] [--sets K]\n"
+    "                  [--walks N | --rel-err E] [--seed S] [--max-steps N] [--batch N] [--sets K]\n"
     "\n"
     "The prepared system's rows are split across the ranks of mpirun (balanced by entries; each rank\n"
     "reads only its rows' blocks of SYSTEM.ulam, prepared with --rhs, and --transpose for forward).\n"
     "A walk that steps onto another rank's row travels there; random numbers are keyed by (seed,\n"
     "walk, step), so 1, 2, 3 or 64 ranks print the same answer bit for bit.  Collision estimator,\n"
     "analog kernel (p_ij = |M_ij| / row sum, leaving with min(1, row sum)).  Answers carry their\n"
-    "standard error, and no 95% interval: no certified range of a score is computed on a partition\n"
-    "(the guard certifies only that the variance is finite).\n"
+    "standard error; --index and --queries also a certified 95% interval when every row sum of |M| is\n"
+    "at most 1 and power iteration certifies a Collatz-Wielandt vector below 1 (the walk's length\n"
+    "tail, so a score's range after clipping; docs/distributed.md).\n"
     "  --index I       x_I by adjoint walks from I (1-based)\n"
     "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, query k\n"
     "                  with seed S + k - 1: a line answers what --index I --seed S+k-1 answers\n"
@@ -35,6 +36,9 @@ static const char *const help =
     "  --source S      x = (I - M)^-1 e_S: a push (products with M) to 1e-4, then forward walks; prints\n"
     "                  the --top K (default 10) components.  mcsa and --source need M' in the file\n"
     "  --walks N       histories (default 100000)       --seed S   the streams' key (default 1)\n"
+    "  --rel-err E     (--index, --queries) stop a query at the first block of --batch walks whose\n"
+    "                  interval's half-width is at most E |estimate|; --walks is then its most\n"
+    "                  (default 2^30)\n"
     "  --max-steps N   cut a walk longer (default 1e6)  --batch N  walks a round starts (default 65536)\n"
     "  --sets K        the ranks in K sets, each a whole partition running its own batches (more\n"
     "                  memory a rank, no message between sets while walking; the same answer)\n"
@@ -46,7 +50,8 @@ typedef struct {
     int64_t index; /* 1-based; 0 none */
     int forward, mcsa;
     int64_t sets, source, top, max_iter;
-    double tol;
+    double tol, rel_err;
+    int walks_given;
     ulam_dist_opts o;
 } args;
 
@@ -55,7 +60,7 @@ static const struct option longopts[] = {
     {"out", required_argument, 0, 'o'}, {"walks", required_argument, 0, 'w'}, {"seed", required_argument, 0, 's'},
     {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'}, {"sets", required_argument, 0, 'S'}, {"queries", required_argument, 0, 'Q'}, {"errors", required_argument, 0, 'E'},
     {"method", required_argument, 0, 'M'}, {"tol", required_argument, 0, 'T'}, {"max-iter", required_argument, 0, 'I'},
-    {"source", required_argument, 0, 'R'}, {"top", required_argument, 0, 'K'},
+    {"source", required_argument, 0, 'R'}, {"top", required_argument, 0, 'K'}, {"rel-err", required_argument, 0, 'e'},
     {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
 
 /* The defaults. */
@@ -79,7 +84,8 @@ static int option(void *p, int val, const char *name, const char *value)
             return cli_usage_error("solve", "--mode with --partition is adjoint or forward, got '%s'", value);
         return 0;
     case 'o': a->out = value; return 0;
-    case 'w': return cli_parse_int("solve", "--walks", value, 1, (int64_t)1 << 40, &a->o.walks);
+    case 'w': a->walks_given = 1; return cli_parse_int("solve", "--walks", value, 1, (int64_t)1 << 40, &a->o.walks);
+    case 'e': return cli_parse_real("solve", "--rel-err", value, 1e-12, 1.0, &a->rel_err);
     case 's': bad = cli_parse_int("solve", "--seed", value, 0, INT64_MAX, &v), a->o.seed = (uint64_t)v; return bad;
     case 'x': return cli_parse_int("solve", "--max-steps", value, 1, INT64_MAX, &a->o.max_steps);
     case 'b': return cli_parse_int("solve", "--batch", value, 1, (int64_t)1 << 30, &a->o.batch);
@@ -117,7 +123,10 @@ static int check(args *a, int argc, char **argv, int first)
                    ins[] = {{"the system", a->path}, {"--queries", a->queries}};
     int rc = cli_check_outputs("solve", outs, 2, ins, 2);
     if (rc) return rc;
-    if ((a->mcsa || a->source) && a->sets > 1) return cli_usage_error("solve", "--sets with --method walks only");
+    if (a->rel_err > 0 && !a->index && !a->queries)
+        return cli_usage_error("solve", "--rel-err with --partition and --index or --queries (forward mode, MCSA and "
+                                        "--source give standard errors only)");
+    if (a->rel_err > 0 && !a->walks_given) a->o.walks = (int64_t)1 << 30;
     return 0;
 }
 
@@ -200,21 +209,29 @@ static int load_queries(const char *path, int64_t n, cli_query **q, int64_t *nq)
     return rc;
 }
 
-/* "x[i]  estimate +- stderr (standard error; ...)" without a newline: a partition certifies the
- * variance finite (rho < 1) but no range of a score, so no interval is printed. */
-static void print_estimate(int64_t i, double est, double se, double rho)
+/* "x[i]  estimate +- stderr (95% CI lo .. hi)" without a newline (ci NULL: forward walks, whose
+ * components have no certified range on a partition; the variance is certified finite, rho < 1). */
+static void print_estimate(int64_t i, double est, double se, double rho, const ulam_dist_ci *ci)
 {
     printf("x[%lld]%*s%.10g", (long long)i, cli_answer_pad(i, 16), "", est);
-    if (!(rho < 1.0)) printf(" (no standard error: rho(M^) is not certified below 1)");
+    if (ci && ci->lo == ci->hi && ci->lo == est) printf(" +- 0 (95%% CI %.10g .. %.10g: b is 0, x is exactly 0)", ci->lo, ci->hi);
+    else if (!(rho < 1.0)) printf(" (no standard error: rho(M^) is not certified below 1)");
     else if (isnan(se)) printf(" (no walk reached it: the push's part alone)");
-    else printf(" +- %.3g (standard error; no certified interval on a partition)", se);
+    else if (ci && isfinite(ci->lo))
+        printf(" +- %.3g (95%% CI %.*g .. %.*g)", se, cli_ci_digits(ci->lo, ci->hi), ci->lo, cli_ci_digits(ci->lo, ci->hi),
+               ci->hi);
+    else if (ci) printf(" +- %.3g (standard error; no certified interval: a row of |M| sums above 1 or no length tail)", se);
+    else printf(" +- %.3g (standard error; no certified interval for forward walks on a partition)", se);
 }
 
 /* One query's answer line (rank 0): x[I] estimate +- stderr and its seed. */
-static void print_query(const cli_query *q, int64_t k, const ulam_dist_result *r, uint64_t seed, double rho)
+static void print_query(const cli_query *q, int64_t k, const ulam_dist_result *r, uint64_t seed, double rho,
+                        const ulam_dist_ci *ci)
 {
-    print_estimate(q->index + 1, r->estimate, r->std_error, rho);
-    printf("  line %ld, seed %llu\n", q->line, (unsigned long long)(seed + (uint64_t)k));
+    print_estimate(q->index + 1, r->estimate, r->std_error, rho, ci);
+    printf("  line %ld, seed %llu", q->line, (unsigned long long)(seed + (uint64_t)k));
+    if (ci->met) printf(", %lld walks", (long long)r->walks);
+    printf("\n");
 }
 
 /* A component for the top-K table: its index and estimate, its standard error. */
@@ -251,20 +268,28 @@ static int print_top(const ulam_comm *c, const double *x, const double *se, int6
         if (!bad && c->rank == 0) qsort(got, (size_t)all, sizeof *e, by_estimate);
     }
     const entry *t = c->nranks > 1 ? got : e;
-    for (int64_t j = 0; !bad && c->rank == 0 && j < all && j < K; j++) print_estimate(t[j].i + 1, t[j].x, t[j].se, rho), printf("\n");
+    for (int64_t j = 0; !bad && c->rank == 0 && j < all && j < K; j++) print_estimate(t[j].i + 1, t[j].x, t[j].se, rho, NULL), printf("\n");
     free(e), free(cnt), free(got);
     return bad ? cli_exit_code(ULAM_EIO) : 0;
 }
 
 /* Print the run's summary (rank 0; v: per_rank's figures). */
 static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_t n, double seconds, const int64_t *v,
-                    double rho)
+                    double rho, const ulam_dist_ci *ci, int64_t nq)
 {
     if (a->queries) {
         if (cli_verbosity >= 0) printf("queries         %s, each above (walks below: each query's)\n", a->queries);
     } else if (a->mcsa || a->source) { /* their answer is above */
     }
-    else if (!a->forward) print_estimate(a->index, r->estimate, r->std_error, rho), printf("\n");
+    else if (!a->forward) print_estimate(a->index, r->estimate, r->std_error, rho, ci), printf("\n");
+    int64_t met = 0;
+    for (int64_t k = 0; ci && k < nq; k++) met += ci[k].met;
+    if (a->rel_err > 0 && met == nq)
+        printf("rel-err         met (target %.3g)%s\n", a->rel_err, a->queries ? " by every query" : "");
+    else if (a->rel_err > 0)
+        printf("rel-err         NOT met (target %.3g) by %lld of %lld quer%s in --walks %lld%s\n", a->rel_err,
+               (long long)(nq - met), (long long)nq, nq == 1 ? "y" : "ies", (long long)a->o.walks,
+               ci && isfinite(ci[0].lo) ? "" : " (no certified interval: a row of |M| sums above 1, or no length tail)");
     else if (a->forward && !a->mcsa) printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
                 a->out ? a->out : "");
     if (cli_verbosity < 0) return;
@@ -338,12 +363,14 @@ static int run(const args *a, const ulam_comm *c)
     ulam_dist_source_info si = {0};
     double *x = NULL, *se = NULL;
     ulam_dist_result *many = NULL;
+    ulam_dist_ci *ci = NULL, one = {NAN, NAN, INFINITY, INFINITY, 0};
     if (status) {
     } else if (q) {
         int64_t *idx = malloc((size_t)nq * sizeof *idx);
         many = malloc((size_t)nq * sizeof *many);
+        ci = malloc((size_t)nq * sizeof *ci);
         for (int64_t k = 0; idx && many && k < nq; k++) idx[k] = q[k].index;
-        status = idx && many ? ulam_dist_adjoint_many(p, c, idx, nq, &a->o, many, &err) : ULAM_ENOMEM;
+        status = idx && many && ci ? ulam_dist_adjoint_ci(p, c, idx, nq, &a->o, a->rel_err, many, ci, &err) : ULAM_ENOMEM;
         if (!status) r = many[0];
         free(idx);
     } else if (a->forward || a->mcsa || a->source) {
@@ -356,7 +383,8 @@ static int run(const args *a, const ulam_comm *c)
         if (!status && a->mcsa) r.walks = mi.walks, r.steps = mi.steps, r.crossings = mi.crossings, r.cut = mi.cut;
         if (!status && a->source) r.walks = si.walks, r.steps = si.steps, r.crossings = si.crossings, r.cut = si.cut;
     } else {
-        status = ulam_dist_adjoint(p, c, a->index - 1, &a->o, &r, &err);
+        int64_t i = a->index - 1;
+        status = ulam_dist_adjoint_ci(p, c, &i, 1, &a->o, a->rel_err, &r, &one, &err);
     }
     ulam_part_free(p);
     int rc = status ? (cli_report(a->path, &err), cli_exit_code(status)) : 0;
@@ -365,8 +393,8 @@ static int run(const args *a, const ulam_comm *c)
     if (!rc && a->errors) rc = write_x(c, a->errors, se, in_set0 ? last - first : 0, n, "standard errors of x");
     int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
     if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
-    for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, &many[k], a->o.seed, rho);
-    if (!rc && a->source) rc = print_top(c, x, se, first, last - first, a->top, rho);
+    for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, &many[k], a->o.seed, rho, &ci[k]);
+    if (!rc && a->source) rc = print_top(c, x, se, first, in_set0 ? last - first : 0, a->top, rho); /* set 0's rows */
     if (!rc && c->rank == 0 && a->mcsa)
         printf("x               %lld components by MCSA%s%s\nmcsa            %d iterations, residual %.3g of max |b| "
                "(target %.3g)\n", (long long)n, a->out ? ", written to " : "", a->out ? a->out : "", mi.iterations,
@@ -377,13 +405,13 @@ static int run(const args *a, const ulam_comm *c)
         fprintf(stderr, "ulam: %s: warning: %lld walks were cut at --max-steps %lld: the estimates and their standard "
                         "errors leave out what those walks would have scored\n", a->path, (long long)r.cut,
                 (long long)a->o.max_steps);
-    if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v, rho);
+    if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v, rho, q ? ci : a->index ? &one : NULL, q ? nq : 1);
     if (!rc && a->mcsa && mi.residual > a->tol) {
         if (c->rank == 0) fprintf(stderr, "ulam: %s: error: MCSA stopped at --max-iter %lld with residual %.3g above --tol %.3g\n",
                                   a->path, (long long)a->max_iter, mi.residual, a->tol);
         rc = cli_exit_code(ULAM_ENOCONV);
     }
-    free(x), free(se), free(v), free(q), free(many);
+    free(x), free(se), free(v), free(q), free(many), free(ci);
     return rc;
 }
 
