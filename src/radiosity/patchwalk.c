@@ -817,8 +817,8 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     int k = ulam__stop_epoch(r.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN) s->epoch = k;
     if (s->whole > 0) { /* the whole scene (ulam_rad_solver_whole) instead of patch index */
-        int d = s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN ? scene_done(s) : 0;
-        if (d > 0 && check) s->run.done = s->met = 1;
+        int d = check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN ? scene_done(s) : 0; /* once an epoch */
+        if (d > 0) s->run.done = s->met = 1;
         if (d < 0) s->run.done = s->zero = 1; /* no particle lit anything: can never be met */
         return s->run.status;
     }

@@ -192,6 +192,51 @@ static int write_office(const char *path)
     return bad ? -1 : 0;
 }
 
+/* Write the hall: a 30 x 15 x 6 m room (y up; floor Kd 0.3 in cells of 0.15 m, walls 0.5 and
+ * ceiling 0.7 in cells of 0.2 m), 24 ceiling panels of 1 x 1 m (Ke 30, Kd 0) 1 cm below it, and
+ * twelve 2 x 1 x 2 m crates (Kd 0.4, bottomless, 0.15 m cells) on the floor, the first over the
+ * floor's first triangle (patch 1 under a box, as in issue 40's hall): about 10^5 triangles.  0
+ * or -1. */
+static int write_hall(const char *path)
+{
+    char mtl[4096];
+    snprintf(mtl, sizeof mtl, "%s", path);
+    char *dot = strrchr(mtl, '.');
+    if (!dot || strlen(mtl) + 4 >= sizeof mtl) return -1;
+    strcpy(dot, ".mtl");
+    FILE *f = fopen(path, "w"), *m = fopen(mtl, "w");
+    if (!f || !m) return -1;
+    fprintf(m, "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl ceiling\nKd 0.7 0.7 0.7\n"
+               "newmtl panel\nKd 0 0 0\nKe 30 30 30\nnewmtl crate\nKd 0.4 0.4 0.4\n");
+    const char *base = strrchr(mtl, '/');
+    fprintf(f, "# The hall of bench_radiosity (tests/bench/bench_radiosity.c)\nmtllib %s\n", base ? base + 1 : mtl);
+    const double W = 30, D = 15, H = 6;
+    long nv = 0;
+    fprintf(f, "o floor\nusemtl floor\n");
+    rect(f, (double[3]){0, 0, 0}, (double[3]){0, 0, D}, (double[3]){W, 0, 0}, 0.15, &nv);
+    fprintf(f, "o ceiling\nusemtl ceiling\n");
+    rect(f, (double[3]){0, H, 0}, (double[3]){W, 0, 0}, (double[3]){0, 0, D}, 0.2, &nv);
+    fprintf(f, "o walls\nusemtl wall\n");
+    rect(f, (double[3]){0, 0, 0}, (double[3]){0, H, 0}, (double[3]){0, 0, D}, 0.2, &nv);
+    rect(f, (double[3]){W, 0, 0}, (double[3]){0, 0, D}, (double[3]){0, H, 0}, 0.2, &nv);
+    rect(f, (double[3]){0, 0, 0}, (double[3]){W, 0, 0}, (double[3]){0, H, 0}, 0.2, &nv);
+    rect(f, (double[3]){0, 0, D}, (double[3]){0, H, 0}, (double[3]){W, 0, 0}, 0.2, &nv);
+    fprintf(f, "o panels\nusemtl panel\n");
+    for (int i = 0; i < 6; i++)
+        for (int k = 0; k < 4; k++)
+            rect(f, (double[3]){2.0 + 5.0 * i, H - 0.01, 1.5 + 3.5 * k}, (double[3]){1, 0, 0}, (double[3]){0, 0, 1}, 0.5,
+                 &nv);
+    fprintf(f, "o crates\nusemtl crate\n");
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = i == 0 && k == 0 ? 0.0 : 3.0 + 7.0 * i, z = i == 0 && k == 0 ? 0.0 : 2.0 + 4.5 * k;
+            box(f, (double[3]){x, 0, z}, (double[3]){x + 2, 1, z + 2}, 0.15, &nv);
+        }
+    int bad = ferror(f) | ferror(m);
+    bad |= fclose(f) | fclose(m);
+    return bad ? -1 : 0;
+}
+
 /* The office's work-plane grid: 10 x 10 sensors at 0.8 m over x in [0.3, 5.7], z in [0.3, 3.7]. */
 static ulam_rad_grid office_grid(void)
 {
@@ -270,6 +315,7 @@ int main(int argc, char **argv)
 {
     if (argc > 1 && !strcmp(argv[1], "points")) return points_bench();
     if (argc > 2 && !strcmp(argv[1], "office")) return write_office(argv[2]) ? 1 : 0;
+    if (argc > 2 && !strcmp(argv[1], "hall")) return write_hall(argv[2]) ? 1 : 0;
     const char *path = argc > 1 ? argv[1] : "examples/scenes/cornell_box.obj";
     int W = 16, H = 16;
     if (argc > 2 && (sscanf(argv[2], "%dx%d", &W, &H) != 2 || W < 1 || H < 1)) return 2;
