@@ -1681,7 +1681,8 @@ int cli_radiosity(int argc, char **argv)
         fprintf(stderr, "ulam radiosity: warning: %s: patch %lld is only %.0f float steps across where it lies: ray "
                         "casting resolves it to %.2g of its size (move the scene's parts closer together)\n",
                 a.scene, (long long)coarse + 1, 1.0 / res, res);
-    if ((rc = cli_photo_light(&a.ph, t, s, a.scene, a.o.exec.threads))) goto done; /* the luminaires light the patches */
+    if ((rc = cli_photo_light(&a.ph, t, s, a.scene, a.o.exec.threads, cli_time_left(a.o.stop.max_seconds))))
+        goto done; /* the luminaires light the patches */
     double budget = a.o.stop.max_seconds; /* --time counts the whole run: reading, the tracer, the walks, the mesh */
     a.o.stop.max_seconds = cli_time_left(budget);
     if (a.nat || a.grid) {

@@ -20,8 +20,10 @@
  * 5. (bench_radiosity points) A point query to 1% against a next-event patch query to 1% on the
  *    same scene (the patch holding the point): rays of each and their ratio (target <= 2), on the
  *    Cornell box floor centre (unsubdivided and at ~2,000 patches) and the office floor.
+ * 6. (bench_radiosity hall) The hall of about 10^5 triangles (issue 40's whole-room case, written by
+ *    this program): shooting for 60 s under the whole-scene rule, the floor's median error.
  * Usage: bench_radiosity [scene.obj [WxH [P]]] (run from the source root); bench_radiosity points;
- * bench_radiosity office OUT.obj (write the office scene and its .mtl). */
+ * bench_radiosity hall; bench_radiosity office|hall OUT.obj (write the scene and its .mtl). */
 #include "ulam_radiosity.h"
 
 #include <math.h>
@@ -311,11 +313,65 @@ static int points_bench(void)
     return 0;
 }
 
+/* Sort doubles ascending (qsort). */
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* 6. The hall (write_hall, written to build/): shooting to --rel-err E = 0.05 / 1.96 on the whole
+ * scene at share 0.5 for at most `seconds`; the floor patches' relative 95% half-widths (1.96 se /
+ * B) at the end: the median, the tenth and ninetieth percentiles, the floor patches at 0, and the
+ * whole-scene rule's counts. */
+static int hall_bench(double seconds)
+{
+    const char *hall = "build/bench_hall.obj";
+    ulam_scene *s = NULL;
+    ulam_tracer *t = NULL;
+    ulam_error err;
+    if (write_hall(hall) || ulam_scene_read_obj(hall, &s, &err) || ulam_tracer_alloc(s, &t, &err)) {
+        fprintf(stderr, "%s: cannot write or read the hall\n", hall);
+        return 1;
+    }
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.mode = ULAM_FORWARD, o.estimator = ULAM_RAD_COLLISION, o.stop.rel_err = 0.05 / 1.96, o.stop.max_walks = 0;
+    o.stop.max_seconds = seconds, o.exec.seed = 1, o.exec.threads = 2;
+    ulam_rad_solver *sv = NULL;
+    int64_t n = s->npatches, nf = 0, zero = 0;
+    double *B = malloc(3 * (size_t)n * sizeof *B), *se = malloc(3 * (size_t)n * sizeof *se), *rel = malloc((size_t)n * sizeof *rel);
+    if (!B || !se || !rel || ulam_rad_solver_alloc(t, &o, &sv, &err) || ulam_rad_solver_whole(sv, 0.5)) return 1;
+    while (!ulam_rad_solver_done(sv))
+        if (ulam_rad_solver_iterate(sv)) return 1;
+    ulam_rad_result r;
+    ulam_rad_scene_rule q;
+    ulam_rad_solver_result(sv, &r);
+    ulam_rad_solver_vectors(sv, B, se);
+    ulam_rad_solver_scene(sv, &q, NULL, 0);
+    for (int64_t p = 0; p < n; p++) {
+        if (s->group[p] < 0 || strcmp(s->groups[s->group[p]], "floor")) continue;
+        zero += B[3 * p + 1] == 0.0;
+        rel[nf++] = B[3 * p + 1] > 0 ? 1.96 * se[3 * p + 1] / B[3 * p + 1] : INFINITY;
+    }
+    qsort(rel, (size_t)nf, sizeof *rel, cmp_double);
+    printf("6. Hall (%lld patches, %lld on the floor), shooting to 1.96 se / B <= 5%% on half the lit area, at most "
+           "%.0f s, 2 threads\n\n", (long long)n, (long long)nf, seconds);
+    printf("   %lld particles, %lld rays, %.1f s (rule %s: %lld of %lld lit patches; %lld unreached)\n",
+           (long long)r.walks, (long long)r.rays, r.seconds, r.rel_err_met ? "met" : "not met", (long long)q.met,
+           (long long)q.lit, (long long)q.unreached);
+    printf("   floor 1.96 se / B: median %.4f, 10%% %.4f, 90%% %.4f; %lld floor patches at 0\n\n", rel[nf / 2],
+           rel[nf / 10], rel[9 * nf / 10], (long long)zero);
+    free(B), free(se), free(rel);
+    ulam_rad_solver_free(sv), ulam_tracer_free(t), ulam_scene_free(s);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && !strcmp(argv[1], "points")) return points_bench();
     if (argc > 2 && !strcmp(argv[1], "office")) return write_office(argv[2]) ? 1 : 0;
     if (argc > 2 && !strcmp(argv[1], "hall")) return write_hall(argv[2]) ? 1 : 0;
+    if (argc > 1 && !strcmp(argv[1], "hall")) return hall_bench(60.0);
     const char *path = argc > 1 ? argv[1] : "examples/scenes/cornell_box.obj";
     int W = 16, H = 16;
     if (argc > 2 && (sscanf(argv[2], "%dx%d", &W, &H) != 2 || W < 1 || H < 1)) return 2;
