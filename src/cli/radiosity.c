@@ -264,8 +264,9 @@ static int parse_grid(const char *cmd, const char *arg, ulam_rad_grid *g)
     if (nu * nv > ULAM_RAD_GRID_MAX)
         return cli_usage_error(cmd, "--grid %s makes %.0f x %.0f points, more than %d", arg, nu, nv, ULAM_RAD_GRID_MAX);
     g->nu = (int)nu, g->nv = (int)nv;
-    double len = 0.0;
-    for (int k = 0; k < 3; k++) g->normal[k] = np == 4 ? n[k] : k == flat, len += g->normal[k] * g->normal[k];
+    double len = 0.0, big = 0.0;
+    for (int k = 0; k < 3; k++) g->normal[k] = np == 4 ? n[k] : k == flat, big = fmax(big, fabs(g->normal[k]));
+    for (int k = 0; k < 3 && big > 0; k++) g->normal[k] /= big, len += g->normal[k] * g->normal[k]; /* 1e200^2 overflowed */
     if (!(len > 0)) return cli_usage_error(cmd, "--grid: the normal must not be zero, got '%s'", arg);
     for (int k = 0; k < 3; k++) g->normal[k] /= sqrt(len);
     return 0;
