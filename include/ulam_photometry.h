@@ -9,6 +9,7 @@
  * The API by rank:
  *   primary: ulam_gonio_read, ulam_gonio_free, ulam_gonio_flux, ulam_luminaire_defaults,
  *     ulam_luminaire_illuminance, ulam_luminaire_patch_illuminance, ulam_rad_grid_en12464,
+ *     ulam_luminaire_patch_illuminance_stop,
  *     ulam_uniformity_compute;
  *   secondary: ulam_gonio_read_ies, ulam_gonio_read_ldt, ulam_gonio_intensity,
  *     ulam_gonio_rated_flux, ulam_gonio_size, ulam_luminaire_intensity, ulam_en12464_spacing. */
@@ -91,6 +92,13 @@ double ulam_luminaire_illuminance(const ulam_tracer *t, const ulam_luminaire *l,
  * receive is sum_p A_p metres^2 H_p.  ULAM_EINVAL for bad arguments. */
 int ulam_luminaire_patch_illuminance(const ulam_tracer *t, const ulam_luminaire *l, int64_t nl, double metres, int q,
                                      int threads, double *H, ulam_error *err);
+
+/* ulam_luminaire_patch_illuminance that can be stopped: once *interrupt (may be NULL) is nonzero or
+ * max_seconds (> 0; 0: no limit) have passed, the patches not yet lit are left NaN; *lit (may be
+ * NULL) gets the patches lit (npatches when it ran to the end).  ULAM_OK when stopped. */
+int ulam_luminaire_patch_illuminance_stop(const ulam_tracer *t, const ulam_luminaire *l, int64_t nl, double metres,
+                                          int q, int threads, const volatile int *interrupt, double max_seconds,
+                                          double *H, int64_t *lit, ulam_error *err);
 
 /* The EN 12464-1 calculation grid of a work plane: the rectangle with opposite corners c0 and c1
  * (equal in exactly one coordinate, its plane; scene units) less a band of `band` metres along

@@ -380,6 +380,32 @@ int ulam_rad_solver_vectors(const ulam_rad_solver *s, double *B, double *std_err
 /* Free; accepts and returns NULL. */
 ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s);
 
+/* The whole scene under shooting's rel_err rule (ulam_rad_solver_whole, ulam_rad_solver_scene). */
+typedef struct ulam_rad_scene_rule {
+    int64_t lit;          /* patches light is on: an emitter, or a patch some particle reached */
+    int64_t met;          /* of them, those whose every channel meets rel_err (src/stop.c's rule, as
+                             at one patch: its 95% interval's variance term within E B's width) */
+    int64_t unreached;    /* patches that reflect (rho > 0) and emit nothing that no particle reached
+                             (light may still reach them: 3 / walks bounds the share of particles that do) */
+    double lit_area, met_area;
+    double worst_se;      /* the largest relative standard error se / B over the lit patches' channels */
+    double worst_half;    /* the largest relative 95% half-width (src/stop.c's certified interval) */
+    int64_t worst_patch;  /* its patch (0-based), -1 when none is lit */
+    double share;         /* the rule's share (ulam_rad_solver_whole), 0 when not set */
+} ulam_rad_scene_rule;
+
+/* Shooting: stop by opts->stop.rel_err when the lit patches (ulam_rad_scene_rule's) that meet it
+ * hold at least share (in (0, 1]; 1: every lit patch) of the lit area, instead of when patch
+ * opts->index does; patches no particle reached do not hold the run (ulam_rad_solver_scene names
+ * them).  Call before the first iterate.  ULAM_EINVAL for a gathering or point solver, or a share
+ * outside (0, 1]. */
+int ulam_rad_solver_whole(ulam_rad_solver *s, double share);
+
+/* Shooting: the whole scene's state under opts->stop.rel_err so far (met counts 0 without
+ * rel_err), and the first max patches no particle reached (0-based, in order) into unreached (may
+ * be NULL when max is 0).  ULAM_EINVAL for a gathering or point solver. */
+int ulam_rad_solver_scene(const ulam_rad_solver *s, ulam_rad_scene_rule *out, int64_t *unreached, int64_t max);
+
 /* ---------------------------------------------------------------- images */
 /* Primary: ulam_camera_cornell, ulam_camera_frame, ulam_render, ulam_png_write.  Secondary:
  * ulam_view_pixels, ulam_view_gather. */

@@ -327,6 +327,13 @@ CASES.append((["radiosity", SC + "cornell_box.obj", "--subdivide", "2", "--direc
               r"tracer .*dense matrices 3.74 TiB.*refused before building them", r"^$"))
 CASES.append((["radiosity", SC + "cornell_box.obj", "--subdivide", "5", "--patch", "floor", "--matrix-walk",
                "--max-mem", "100M"], code("EMEMLIMIT"), r"needs about 3.9\d* GiB, more than --max-mem 100 MiB", r"^$"))
+# a --grid normal of 1e200 (or 1e-300) squared to inf (0) and was refused as zero: it is scaled first
+for nrm in ("1e200,1e200,0", "1e-300,1e-300,0"):
+    CASES.append((["radiosity", R + "furnace_half.obj", "--grid", "0.1,0.5,0.1:0.9,0.5,0.9:2x2:" + nrm, "--walks", "200"],
+                  0, r"^$", r"grid +2 x 2 sensors facing 0.7071 0.7071 0:"))
+# --mode shoot --rel-err without --patch stopped when patch 1 met it: the whole scene's rule now
+CASES.append((["radiosity", SC + "cornell_box.obj", "--mode", "shoot", "--rel-err", "0.1", "--threads", "2"], 0, r"^$",
+              r"rel-err +met on the whole scene: 17 of 17 lit patches \(1 of the lit area; the rule: 1\) within 0.1"))
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # cuts at --max-steps were silent (96 for 1000)
     CASES.append((["radiosity", R + "furnace999.obj", "--patch", "1", "--max-steps", "100", "--walks", "2000"] + extra,
                   0, r"^$", r"^warning +\d+ of \d+ walks cut at --max-steps 100: the estimate is biased low"))

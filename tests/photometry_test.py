@@ -389,11 +389,27 @@ def check_refused(d):
     assert "not with --grid" in p.stderr, p.stderr
 
 
+def check_first_bounce_time(d):
+    """The luminaires' first bounce (every patch's direct light: 2.6e7 shadow rays here, 6400 patches
+    and 500 luminaires) ignored --time: it now stops at --time, prints nothing and says how far it
+    got (it would have to finish to print anything true)."""
+    scene = floor_scene(d, 1)
+    lamp = isotropic_cosine_ies(d)
+    args = [scene, "--subdivide", "0.05", "--at", "0.1,0,0.1", "--walks", "100", "--time", "0.5"]
+    for k in range(500):
+        args += ["--luminaire", f"{lamp}@{(k % 25) * 0.16 - 2:.2f},2.5,{(k // 25) * 0.2 - 2:.2f}"]
+    p = run(args, code=code("ENOCONV"))
+    m = re.search(r"error: --time ran out during the luminaires' direct light \((\d+) of 6400 patches lit\): nothing "
+                  r"to print \(raise --time\)", p.stderr)
+    assert m and int(m.group(1)) < 6400 and p.stdout == "", (p.stdout, p.stderr)
+    print(f"  stopped with {m.group(1)} of 6400 patches lit")
+
+
 def main():
     with tempfile.TemporaryDirectory() as d:
         for check in (check_point_source, check_area_source, check_furnace, check_two_surface, check_integrating_sphere,
                       check_many_emitters, check_workplane, check_examples,
-                      check_refused):
+                      check_refused, check_first_bounce_time):
             check(d)
             print(check.__name__, "ok")
 

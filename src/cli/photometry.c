@@ -126,7 +126,8 @@ int cli_photo_finish(cli_photo *p, const char *cmd, int grid_given, ulam_rad_gri
 }
 
 /* Read the luminaires and light the scene; 0 or an exit code. */
-int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const char *scene, int threads)
+int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const char *scene, int threads,
+                    double max_seconds)
 {
     if (!p->active) return 0;
     ulam_error err;
@@ -156,8 +157,18 @@ int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const cha
     double tri = 0.0; /* fan triangles: q^2 shadow rays each a luminaire, about 2 10^7 in all, q in 2 .. 8 */
     for (int64_t i = 0; i < s->npatches; i++) tri += (double)(s->start[i + 1] - s->start[i] - 2);
     p->q = (int)fmax(2.0, fmin(8.0, floor(sqrt(2e7 / fmax(1.0, tri * p->nlum)))));
-    if (ulam_luminaire_patch_illuminance(t, p->lum, p->nlum, p->metres, p->q, threads, p->H, &err))
-        return cli_report(scene, &err);
+    int64_t lit = 0;
+    cli_catch_sigint(); /* a first bounce of 2 10^7 shadow rays ignored Ctrl-C and --time */
+    int st = ulam_luminaire_patch_illuminance_stop(t, p->lum, p->nlum, p->metres, p->q, threads, &cli_interrupted,
+                                                   max_seconds, p->H, &lit, &err);
+    cli_release_sigint();
+    if (st) return cli_report(scene, &err);
+    if (lit < s->npatches) {
+        fprintf(stderr, "ulam: %s: error: %s during the luminaires' direct light (%lld of %lld patches lit): "
+                        "nothing to print%s\n", scene, cli_interrupted ? "interrupted" : "--time ran out",
+                (long long)lit, (long long)s->npatches, cli_interrupted ? "" : " (raise --time)");
+        return cli_interrupted ? EXIT_INTERRUPTED : cli_exit_code(ULAM_ENOCONV);
+    }
     p->onto = 0.0;
     for (int64_t i = 0; i < s->npatches; i++) {
         p->onto += s->area[i] * p->metres * p->metres * p->H[i];

@@ -39,8 +39,11 @@ int cli_photo_finish(cli_photo *p, const char *cmd, int grid_given, ulam_rad_gri
 
 /* Read the luminaires, light the scene s (tracer t on it): every patch's mean direct illuminance,
  * the reflected part rho H added to its emission (the scene's own kept), on `threads` threads (0:
- * all cores, --threads); 0 or an exit code. */
-int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const char *scene, int threads);
+ * all cores, --threads), within max_seconds (> 0; 0: no limit) and until Ctrl-C: stopped before the
+ * last patch, nothing is printed (the light is not all there) and the exit says why; 0 or an exit
+ * code. */
+int cli_photo_light(cli_photo *p, const ulam_tracer *t, ulam_scene *s, const char *scene, int threads,
+                    double max_seconds);
 
 /* Point answers pts[0..n) (on the lit scene): add each point's direct illuminance
  * (exact) to its irradiance and interval and rho times it to its radiosity, and put the scene's

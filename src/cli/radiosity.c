@@ -89,7 +89,10 @@ static const char *const usage_mesh =
     "                    radiosity varies and (with --image) the camera's importance is high, until\n"
     "                    the importance-weighted mesh error is at most E (relative, e.g. 0.05)\n"
     "  --max-patches N   stop splitting before the mesh passes N patches (default 100000, and what\n"
-    "                    --max-mem allows)\n";
+    "                    --max-mem allows)\n"
+    "  --share X         --mode shoot --rel-err E without --patch runs until every lit patch meets E\n"
+    "                    (a particle reached it), or with X the lit patches holding X of the lit\n"
+    "                    area (0.5: the median by area), and names the patches none reached\n";
 
 /* The usage's second half (a literal each stays within C99's 4095 characters). */
 static const char *const usage_points =
@@ -139,6 +142,7 @@ typedef struct {
     int grid;     /* --grid given: g holds it */
     ulam_rad_grid g;
     double coverage;
+    double share; /* --share X: shooting's whole-scene rule holds this share of the lit area (0: 1) */
     int camera_given; /* --camera: cam holds it */
     ulam_camera cam;
     size_t max_mem;
@@ -168,6 +172,9 @@ typedef struct {
     double min_walks; /* ray walks: the walks the rule needs at this estimate */
     double ci95[3][2]; /* ray walks: each channel's 95% interval (NaN: none certified) */
     double *all, *all_se; /* shooting: 3 per patch each */
+    int whole;                 /* shooting --rel-err without --patch: the whole scene's rule */
+    ulam_rad_scene_rule scene; /* its state at the end */
+    int64_t unreached[8];      /* the first patches no particle reached */
 } walked;
 
 /* Parse --camera: 'cornell', or ex,ey,ez,ax,ay,az,ux,uy,uz,fov (degrees, horizontal). */
@@ -257,8 +264,9 @@ static int parse_grid(const char *cmd, const char *arg, ulam_rad_grid *g)
     if (nu * nv > ULAM_RAD_GRID_MAX)
         return cli_usage_error(cmd, "--grid %s makes %.0f x %.0f points, more than %d", arg, nu, nv, ULAM_RAD_GRID_MAX);
     g->nu = (int)nu, g->nv = (int)nv;
-    double len = 0.0;
-    for (int k = 0; k < 3; k++) g->normal[k] = np == 4 ? n[k] : k == flat, len += g->normal[k] * g->normal[k];
+    double len = 0.0, big = 0.0;
+    for (int k = 0; k < 3; k++) g->normal[k] = np == 4 ? n[k] : k == flat, big = fmax(big, fabs(g->normal[k]));
+    for (int k = 0; k < 3 && big > 0; k++) g->normal[k] /= big, len += g->normal[k] * g->normal[k]; /* 1e200^2 overflowed */
     if (!(len > 0)) return cli_usage_error(cmd, "--grid: the normal must not be zero, got '%s'", arg);
     for (int k = 0; k < 3; k++) g->normal[k] /= sqrt(len);
     return 0;
@@ -285,7 +293,7 @@ static int parse(int argc, char **argv, args *a)
         {"grid", required_argument, 0, 'R'},     {"no-mesh-error", no_argument, 0, 'N'},
         {"mesh-error", required_argument, 0, 'W'},  {"samples", required_argument, 0, 'S'},
         {"flat", no_argument, 0, 'F'},           {"mesh-target", required_argument, 0, 'T'},
-        {"max-patches", required_argument, 0, 'K'},
+        {"max-patches", required_argument, 0, 'K'}, {"share", required_argument, 0, 'Y'},
         {"luminaire", required_argument, 0, 'Q'}, {"unit", required_argument, 0, 'Q'},
         {"maintenance", required_argument, 0, 'Q'}, {"en12464", required_argument, 0, 'Q'},
         {0, 0, 0, 0}};
@@ -297,6 +305,7 @@ static int parse(int argc, char **argv, args *a)
         switch (c) {
         case CLI_WALK: if ((rc = cli_walk_option(cmd, longopts[idx].name, optarg, &a->o))) return rc; break;
         case 'p': a->patch = optarg; break;
+        case 'Y': if ((rc = cli_parse_real(cmd, "--share", optarg, 1e-9, 1.0, &a->share))) return rc; break;
         case 'm':
             if ((a->o.mode = cli_lookup(optarg, mode_names, 2)) < 0)
                 return cli_usage_error(cmd, "--mode expects gather or shoot, got '%s'", optarg);
@@ -440,6 +449,8 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     ulam_rad_opts ro = rad_opts(&a->o);
     int status = ulam_rad_solver_alloc(t, &ro, &sv, &err);
     if (status) return cli_report(a->scene, &err);
+    w->whole = a->o.mode == ULAM_FORWARD && a->o.stop.rel_err > 0 && !a->patch; /* the whole scene, not patch 1 */
+    if (w->whole) ulam_rad_solver_whole(sv, a->share > 0 ? a->share : 1.0);
     cli_catch_sigint();
     cli_progress pg;
     cli_progress_start(&pg, a->json);
@@ -465,6 +476,7 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
         w->all_se = malloc((size_t)np * 3 * sizeof *w->all_se);
         if (!w->all || !w->all_se) status = ULAM_ENOMEM;
         else ulam_rad_solver_vectors(sv, w->all, w->all_se);
+        if (w->whole) ulam_rad_solver_scene(sv, &w->scene, w->unreached, 8);
     }
     ulam_rad_solver_free(sv);
     if (!status) return 0;
@@ -523,6 +535,24 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, c
     if (!status) return 0;
     err.status = status;
     return cli_report(a->scene, &err);
+}
+
+/* The whole scene's rule after shooting --rel-err without --patch: how many lit patches met it,
+ * the worst one, and the patches no particle reached. */
+static void print_scene_rule(const args *a, const walked *w)
+{
+    const ulam_rad_scene_rule *q = &w->scene;
+    printf("rel-err      %s on the whole scene: %lld of %lld lit patches (%.4g of the lit area; the rule: %.4g) within "
+           "%g;\n             the largest relative standard error %.3g, 95%% half-width %.3g (patch %lld)\n",
+           w->rel_err_met ? "met" : "NOT met", (long long)q->met, (long long)q->lit,
+           q->lit_area > 0 ? q->met_area / q->lit_area : 0.0, q->share, a->o.stop.rel_err, q->worst_se, q->worst_half,
+           (long long)q->worst_patch + 1);
+    if (q->unreached) {
+        printf("unreached    %lld patches no particle reached in %lld walks (each gets under 3/%lld of the particles, "
+               "95%%):", (long long)q->unreached, (long long)w->walks, (long long)w->walks);
+        for (int64_t k = 0; k < q->unreached && k < 8; k++) printf(" %lld", (long long)w->unreached[k] + 1);
+        printf("%s\n", q->unreached > 8 ? " ..." : "");
+    }
 }
 
 /* Print a JSON array of three numbers under key. */
@@ -836,6 +866,7 @@ static void print_text(const args *a, const report *r)
                a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
+    if (w && w->whole) print_scene_rule(a, w);
     for (int c = 0; w && a->matrix_walk && c < 3; c++)
         if (w->ff_limited[c])
             printf("rel-err      NOT met in %c: the form factors' error alone is %.3g, past --rel-err %g of the "
@@ -934,6 +965,13 @@ static void print_json(const args *a, const report *r)
         cli_json_number("seconds", w->seconds, 0);
         printf("\"interrupted\": %s, \"zero\": %s, ", w->interrupted ? "true" : "false", w->zero ? "true" : "false");
         if (r->diag_known) cli_json_string("zero_reason", zero_reason(&r->diag), 0);
+        if (w->whole)
+            printf("\"scene_rule\": {\"met\": %s, \"lit\": %lld, \"lit_met\": %lld, \"unreached\": %lld, "
+                   "\"share\": %.6g, \"area_met\": %.6g, \"worst_patch\": %lld, \"worst_half\": %.6g, \"worst_se\": %.6g}, ",
+                   w->rel_err_met ? "true" : "false", (long long)w->scene.lit, (long long)w->scene.met,
+                   (long long)w->scene.unreached, w->scene.share,
+                   w->scene.lit_area > 0 ? w->scene.met_area / w->scene.lit_area : 0.0,
+                   (long long)w->scene.worst_patch + 1, w->scene.worst_half, w->scene.worst_se);
         if (a->o.stop.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT) {
             printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
             cli_json_number("min_walks", w->min_walks, 0);
@@ -1644,7 +1682,8 @@ int cli_radiosity(int argc, char **argv)
         fprintf(stderr, "ulam radiosity: warning: %s: patch %lld is only %.0f float steps across where it lies: ray "
                         "casting resolves it to %.2g of its size (move the scene's parts closer together)\n",
                 a.scene, (long long)coarse + 1, 1.0 / res, res);
-    if ((rc = cli_photo_light(&a.ph, t, s, a.scene, a.o.exec.threads))) goto done; /* the luminaires light the patches */
+    if ((rc = cli_photo_light(&a.ph, t, s, a.scene, a.o.exec.threads, cli_time_left(a.o.stop.max_seconds))))
+        goto done; /* the luminaires light the patches */
     double budget = a.o.stop.max_seconds; /* --time counts the whole run: reading, the tracer, the walks, the mesh */
     a.o.stop.max_seconds = cli_time_left(budget);
     if (a.nat || a.grid) {

@@ -118,7 +118,16 @@ double ulam_luminaire_illuminance(const ulam_tracer *t, const ulam_luminaire *l,
 int ulam_luminaire_patch_illuminance(const ulam_tracer *t, const ulam_luminaire *l, int64_t nl, double metres, int q,
                                      int threads, double *H, ulam_error *err)
 {
+    return ulam_luminaire_patch_illuminance_stop(t, l, nl, metres, q, threads, NULL, 0.0, H, NULL, err);
+}
+
+/* The same, stopping when *interrupt is set or max_seconds have passed. */
+int ulam_luminaire_patch_illuminance_stop(const ulam_tracer *t, const ulam_luminaire *l, int64_t nl, double metres,
+                                          int q, int threads, const volatile int *interrupt, double max_seconds,
+                                          double *H, int64_t *lit, ulam_error *err)
+{
     ulam__clear(err);
+    if (lit) *lit = 0;
     if (!t || (!l && nl) || nl < 0 || nl > 1000000 || !H || !(metres > 0) || !isfinite(metres) || q < 1 || q > 64)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, luminaires, metres > 0, q in 1 .. 64 and an output");
     double *f = ulam__malloc((size_t)(nl ? nl : 1) * 9, sizeof *f);
@@ -129,9 +138,24 @@ int ulam_luminaire_patch_illuminance(const ulam_tracer *t, const ulam_luminaire 
                                                    "nadir and C0 axes that are not parallel");
     }
     const ulam_scene *s = ulam__tracer_scene(t);
-    int nth = ulam__threads(threads);
-#pragma omp parallel for schedule(dynamic, 16) num_threads(nth)
+    int nth = ulam__threads(threads), stop = 0;
+    int64_t done = 0;
+    double t0 = ulam_now();
+#pragma omp parallel for schedule(dynamic, 16) num_threads(nth) reduction(+ : done)
     for (int64_t p = 0; p < s->npatches; p++) {
+        int halt; /* a patch's q^2 nl shadow rays at most after the stop */
+#pragma omp atomic read
+        halt = stop;
+        if (!halt && ((interrupt && *interrupt) || (max_seconds > 0 && ulam_now() - t0 >= max_seconds))) {
+#pragma omp atomic write
+            stop = 1;
+            halt = 1;
+        }
+        if (halt) {
+            H[p] = NAN;
+            continue;
+        }
+        done++;
         const double *n = s->normal + 3 * p, *v0 = s->vert + 3 * s->vidx[s->start[p]];
         double acc = 0.0, area = 0.0;
         for (int64_t k = s->start[p] + 1; k + 1 < s->start[p + 1]; k++) {
@@ -151,5 +175,6 @@ int ulam_luminaire_patch_illuminance(const ulam_tracer *t, const ulam_luminaire 
         H[p] = area > 0 ? acc / area : 0.0;
     }
     free(f);
+    if (lit) *lit = done;
     return ULAM_OK;
 }

@@ -90,6 +90,8 @@ struct ulam_rad_solver {
     int64_t rays, cut;
     int zero, met;
     int epoch; /* the last epoch (stop.h) the rel_err rule was checked at */
+    double w0[3];  /* shooting: the largest starting weight per channel (score_bounds) */
+    double whole;  /* shooting: the whole-scene rule's area share (ulam_rad_solver_whole), 0: patch index's rule */
 };
 
 /* Free; accepts and returns NULL. */
@@ -231,6 +233,7 @@ static void score_bounds(ulam_rad_solver *s)
                 const double *E = sc->emit + 3 * s->L.emitter[k];
                 w0 = fmax(w0, s->L.ptot * E[c] / (E[0] + E[1] + E[2]));
             }
+            s->w0[c] = w0;
             s->per_step[c] = w0 * rho;
             s->range[c] = s->o.estimator == ULAM_RAD_ABSORPTION ? (w0 * rho > 0 ? w0 * rho / (1.0 - q) : 0.0) : INFINITY;
         }
@@ -704,6 +707,93 @@ static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, co
     return any;
 }
 
+/* Shooting: the range R of one particle's tally at patch p in channel c over its area (w0_c rho_pc
+ * a visit, weights never growing; by absorption that / (1 - q_p) once; by collision truncated where
+ * longer histories add at most E |m| / 4) and the bias that truncation allows, at estimate m. */
+static void shot_range(const ulam_rad_solver *s, int64_t p, int c, double m, double E, double *R, double *bias)
+{
+    double A = s->s->area[p], ps = s->w0[c] * s->s->rho[3 * p + c];
+    double range = s->o.estimator == ULAM_RAD_ABSORPTION ? (ps > 0 ? ps / (1.0 - s->q[p]) : 0.0) : INFINITY;
+    *R = ulam__score_range(range, ps, s->qmax, 1.0, 0, fabs(m) * A, E / 4.0) / A;
+    *bias = isfinite(range) ? 0.0 : E * fabs(m) / 4.0;
+}
+
+/* Shooting: patch p under the rel_err rule (stop.h) at target E.  *kind: 0 dark (emits nothing,
+ * reflects nothing: B = 0 exactly), 1 unreached (it reflects, emits nothing, and no particle has
+ * reached it), 2 lit.  A lit patch's *se and *half are its largest relative standard error and
+ * relative 95% half-width over the nonzero channels; returns 1 when every channel meets E (a
+ * channel still at 0 that a particle could light waits, as precise_enough's, for the walks its
+ * range term needs at the brightest channel). */
+static int shot_patch(const ulam_rad_solver *s, int64_t p, double E, int *kind, double *se, double *half)
+{
+    const ulam_scene *sc = s->s;
+    double N = (double)s->run.walks, A = sc->area[p], m[3], v[3], bright = 0.0;
+    int reached = 0, emits = 0, reflects = 0, met = 1, k = ulam__stop_epoch(s->run.walks);
+    for (int c = 0; c < 3; c++) {
+        double mean;
+        ulam__sums_moments(N, s->sum[3 * p + c], s->sumsq[3 * p + c], &mean, &v[c]);
+        m[c] = sc->emit[3 * p + c] + mean / A, v[c] /= A * A;
+        reached |= s->sum[3 * p + c] != 0.0, emits |= sc->emit[3 * p + c] > 0, reflects |= sc->rho[3 * p + c] > 0;
+        bright = fmax(bright, fabs(m[c]));
+    }
+    *se = *half = 0.0;
+    *kind = reached || emits ? 2 : reflects ? 1 : 0;
+    if (*kind < 2) return *kind == 0;
+    for (int c = 0; c < 3; c++) {
+        double R, bias;
+        if (m[c] == 0.0) {
+            if (s->w0[c] * sc->rho[3 * p + c] > 0) {
+                shot_range(s, p, c, bright, E, &R, &bias);
+                met &= N >= ulam__stop_walks_needed(bright, v[c], R, bias, E, k);
+            }
+            continue;
+        }
+        ulam__stop_ci ci;
+        shot_range(s, p, c, m[c], E, &R, &bias);
+        ulam__stop_interval(s->run.walks, m[c], v[c], R, bias, 0.0, INFINITY, k, &ci);
+        *se = fmax(*se, N > 1 ? sqrt(v[c] / N) / fabs(m[c]) : INFINITY);
+        *half = fmax(*half, ci.half / fabs(m[c]));
+        met &= E > 0 && ulam__stop_rel_met(&ci, m[c], E);
+    }
+    return met;
+}
+
+/* Shooting: the whole scene under the rel_err rule (ulam_rad_solver_scene); the first max
+ * unreached patches into unreached (may be NULL). */
+static void scene_state(const ulam_rad_solver *s, ulam_rad_scene_rule *r, int64_t *unreached, int64_t max)
+{
+    memset(r, 0, sizeof *r);
+    r->worst_patch = -1;
+    r->share = s->whole;
+    for (int64_t p = 0; p < s->s->npatches; p++) {
+        int kind;
+        double se, half;
+        int met = shot_patch(s, p, s->o.stop.rel_err, &kind, &se, &half);
+        if (kind == 1) {
+            if (unreached && r->unreached < max) unreached[r->unreached] = p;
+            r->unreached++;
+        }
+        if (kind < 2) continue;
+        r->lit++, r->lit_area += s->s->area[p];
+        if (met) r->met++, r->met_area += s->s->area[p];
+        r->worst_se = fmax(r->worst_se, se);
+        if (r->worst_patch < 0 || half > r->worst_half) r->worst_half = half, r->worst_patch = p;
+    }
+}
+
+/* Shooting under the whole-scene rule: 1 once the lit patches that meet rel_err hold the share
+ * of the lit area (and some patch reflects light), -1 when after the first walks no particle
+ * lit any patch (rel_err can never be met), else 0. */
+static int scene_done(const ulam_rad_solver *s)
+{
+    ulam_rad_scene_rule r;
+    scene_state(s, &r, NULL, 0);
+    int any = 0;
+    for (int64_t p = 0; p < 3 * s->s->npatches && !any; p++) any = s->sum[p] != 0.0;
+    if (!any) return -1;
+    return r.met_area >= s->whole * r.lit_area * (1.0 - 1e-12);
+}
+
 /* Nonzero when every channel is exactly 0 with zero variance: no walk scored, and a relative
  * error can never be met. */
 static int all_zero(const ulam_rad_result *r)
@@ -726,6 +816,12 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     result(s, mins, &r);
     int k = ulam__stop_epoch(r.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN) s->epoch = k;
+    if (s->whole > 0) { /* the whole scene (ulam_rad_solver_whole) instead of patch index */
+        int d = check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN ? scene_done(s) : 0; /* once an epoch */
+        if (d > 0) s->run.done = s->met = 1;
+        if (d < 0) s->run.done = s->zero = 1; /* no particle lit anything: can never be met */
+        return s->run.status;
+    }
     if (check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, mins, s->o.stop.rel_err))
         s->run.done = s->met = 1;
     if (s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN && all_zero(&r)) s->run.done = s->zero = 1; /* can never be met */
@@ -818,5 +914,21 @@ int ulam_rad_solver_vectors(const ulam_rad_solver *s, double *B, double *std_err
             if (B) B[3 * p + c] = e;
             if (std_error) std_error[3 * p + c] = se;
         }
+    return ULAM_OK;
+}
+
+/* Shooting: hold rel_err on the whole scene. */
+int ulam_rad_solver_whole(ulam_rad_solver *s, double share)
+{
+    if (!s || s->at || s->o.mode != ULAM_FORWARD || !(share > 0 && share <= 1)) return ULAM_EINVAL;
+    s->whole = share;
+    return ULAM_OK;
+}
+
+/* Shooting: the whole scene's state under rel_err. */
+int ulam_rad_solver_scene(const ulam_rad_solver *s, ulam_rad_scene_rule *out, int64_t *unreached, int64_t max)
+{
+    if (!s || !out || s->at || s->o.mode != ULAM_FORWARD || max < 0 || (max > 0 && !unreached)) return ULAM_EINVAL;
+    scene_state(s, out, unreached, max);
     return ULAM_OK;
 }

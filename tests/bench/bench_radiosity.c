@@ -20,8 +20,10 @@
  * 5. (bench_radiosity points) A point query to 1% against a next-event patch query to 1% on the
  *    same scene (the patch holding the point): rays of each and their ratio (target <= 2), on the
  *    Cornell box floor centre (unsubdivided and at ~2,000 patches) and the office floor.
+ * 6. (bench_radiosity hall) The hall of about 10^5 triangles (issue 40's whole-room case, written by
+ *    this program): shooting for 60 s under the whole-scene rule, the floor's median error.
  * Usage: bench_radiosity [scene.obj [WxH [P]]] (run from the source root); bench_radiosity points;
- * bench_radiosity office OUT.obj (write the office scene and its .mtl). */
+ * bench_radiosity hall; bench_radiosity office|hall OUT.obj (write the scene and its .mtl). */
 #include "ulam_radiosity.h"
 
 #include <math.h>
@@ -192,6 +194,51 @@ static int write_office(const char *path)
     return bad ? -1 : 0;
 }
 
+/* Write the hall: a 30 x 15 x 6 m room (y up; floor Kd 0.3 in cells of 0.15 m, walls 0.5 and
+ * ceiling 0.7 in cells of 0.2 m), 24 ceiling panels of 1 x 1 m (Ke 30, Kd 0) 1 cm below it, and
+ * twelve 2 x 1 x 2 m crates (Kd 0.4, bottomless, 0.15 m cells) on the floor, the first over the
+ * floor's first triangle (patch 1 under a box, as in issue 40's hall): about 10^5 triangles.  0
+ * or -1. */
+static int write_hall(const char *path)
+{
+    char mtl[4096];
+    snprintf(mtl, sizeof mtl, "%s", path);
+    char *dot = strrchr(mtl, '.');
+    if (!dot || strlen(mtl) + 4 >= sizeof mtl) return -1;
+    strcpy(dot, ".mtl");
+    FILE *f = fopen(path, "w"), *m = fopen(mtl, "w");
+    if (!f || !m) return -1;
+    fprintf(m, "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl ceiling\nKd 0.7 0.7 0.7\n"
+               "newmtl panel\nKd 0 0 0\nKe 30 30 30\nnewmtl crate\nKd 0.4 0.4 0.4\n");
+    const char *base = strrchr(mtl, '/');
+    fprintf(f, "# The hall of bench_radiosity (tests/bench/bench_radiosity.c)\nmtllib %s\n", base ? base + 1 : mtl);
+    const double W = 30, D = 15, H = 6;
+    long nv = 0;
+    fprintf(f, "o floor\nusemtl floor\n");
+    rect(f, (double[3]){0, 0, 0}, (double[3]){0, 0, D}, (double[3]){W, 0, 0}, 0.15, &nv);
+    fprintf(f, "o ceiling\nusemtl ceiling\n");
+    rect(f, (double[3]){0, H, 0}, (double[3]){W, 0, 0}, (double[3]){0, 0, D}, 0.2, &nv);
+    fprintf(f, "o walls\nusemtl wall\n");
+    rect(f, (double[3]){0, 0, 0}, (double[3]){0, H, 0}, (double[3]){0, 0, D}, 0.2, &nv);
+    rect(f, (double[3]){W, 0, 0}, (double[3]){0, 0, D}, (double[3]){0, H, 0}, 0.2, &nv);
+    rect(f, (double[3]){0, 0, 0}, (double[3]){W, 0, 0}, (double[3]){0, H, 0}, 0.2, &nv);
+    rect(f, (double[3]){0, 0, D}, (double[3]){0, H, 0}, (double[3]){W, 0, 0}, 0.2, &nv);
+    fprintf(f, "o panels\nusemtl panel\n");
+    for (int i = 0; i < 6; i++)
+        for (int k = 0; k < 4; k++)
+            rect(f, (double[3]){2.0 + 5.0 * i, H - 0.01, 1.5 + 3.5 * k}, (double[3]){1, 0, 0}, (double[3]){0, 0, 1}, 0.5,
+                 &nv);
+    fprintf(f, "o crates\nusemtl crate\n");
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = i == 0 && k == 0 ? 0.0 : 3.0 + 7.0 * i, z = i == 0 && k == 0 ? 0.0 : 2.0 + 4.5 * k;
+            box(f, (double[3]){x, 0, z}, (double[3]){x + 2, 1, z + 2}, 0.15, &nv);
+        }
+    int bad = ferror(f) | ferror(m);
+    bad |= fclose(f) | fclose(m);
+    return bad ? -1 : 0;
+}
+
 /* The office's work-plane grid: 10 x 10 sensors at 0.8 m over x in [0.3, 5.7], z in [0.3, 3.7]. */
 static ulam_rad_grid office_grid(void)
 {
@@ -266,10 +313,65 @@ static int points_bench(void)
     return 0;
 }
 
+/* Sort doubles ascending (qsort). */
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* 6. The hall (write_hall, written to build/): shooting to --rel-err E = 0.05 / 1.96 on the whole
+ * scene at share 0.5 for at most `seconds`; the floor patches' relative 95% half-widths (1.96 se /
+ * B) at the end: the median, the tenth and ninetieth percentiles, the floor patches at 0, and the
+ * whole-scene rule's counts. */
+static int hall_bench(double seconds)
+{
+    const char *hall = "build/bench_hall.obj";
+    ulam_scene *s = NULL;
+    ulam_tracer *t = NULL;
+    ulam_error err;
+    if (write_hall(hall) || ulam_scene_read_obj(hall, &s, &err) || ulam_tracer_alloc(s, &t, &err)) {
+        fprintf(stderr, "%s: cannot write or read the hall\n", hall);
+        return 1;
+    }
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.mode = ULAM_FORWARD, o.estimator = ULAM_RAD_COLLISION, o.stop.rel_err = 0.05 / 1.96, o.stop.max_walks = 0;
+    o.stop.max_seconds = seconds, o.exec.seed = 1, o.exec.threads = 2;
+    ulam_rad_solver *sv = NULL;
+    int64_t n = s->npatches, nf = 0, zero = 0;
+    double *B = malloc(3 * (size_t)n * sizeof *B), *se = malloc(3 * (size_t)n * sizeof *se), *rel = malloc((size_t)n * sizeof *rel);
+    if (!B || !se || !rel || ulam_rad_solver_alloc(t, &o, &sv, &err) || ulam_rad_solver_whole(sv, 0.5)) return 1;
+    while (!ulam_rad_solver_done(sv))
+        if (ulam_rad_solver_iterate(sv)) return 1;
+    ulam_rad_result r;
+    ulam_rad_scene_rule q;
+    ulam_rad_solver_result(sv, &r);
+    ulam_rad_solver_vectors(sv, B, se);
+    ulam_rad_solver_scene(sv, &q, NULL, 0);
+    for (int64_t p = 0; p < n; p++) {
+        if (s->group[p] < 0 || strcmp(s->groups[s->group[p]], "floor")) continue;
+        zero += B[3 * p + 1] == 0.0;
+        rel[nf++] = B[3 * p + 1] > 0 ? 1.96 * se[3 * p + 1] / B[3 * p + 1] : INFINITY;
+    }
+    qsort(rel, (size_t)nf, sizeof *rel, cmp_double);
+    printf("6. Hall (%lld patches, %lld on the floor), shooting to 1.96 se / B <= 5%% on half the lit area, at most "
+           "%.0f s, 2 threads\n\n", (long long)n, (long long)nf, seconds);
+    printf("   %lld particles, %lld rays, %.1f s (rule %s: %lld of %lld lit patches; %lld unreached)\n",
+           (long long)r.walks, (long long)r.rays, r.seconds, r.rel_err_met ? "met" : "not met", (long long)q.met,
+           (long long)q.lit, (long long)q.unreached);
+    printf("   floor 1.96 se / B: median %.4f, 10%% %.4f, 90%% %.4f; %lld floor patches at 0\n\n", rel[nf / 2],
+           rel[nf / 10], rel[9 * nf / 10], (long long)zero);
+    free(B), free(se), free(rel);
+    ulam_rad_solver_free(sv), ulam_tracer_free(t), ulam_scene_free(s);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && !strcmp(argv[1], "points")) return points_bench();
     if (argc > 2 && !strcmp(argv[1], "office")) return write_office(argv[2]) ? 1 : 0;
+    if (argc > 2 && !strcmp(argv[1], "hall")) return write_hall(argv[2]) ? 1 : 0;
+    if (argc > 1 && !strcmp(argv[1], "hall")) return hall_bench(60.0);
     const char *path = argc > 1 ? argv[1] : "examples/scenes/cornell_box.obj";
     int W = 16, H = 16;
     if (argc > 2 && (sscanf(argv[2], "%dx%d", &W, &H) != 2 || W < 1 || H < 1)) return 2;
