@@ -585,10 +585,85 @@ static void test_push_b_rounding(void **state)
     ulam_csr_free(M);
 }
 
+/* The m^3 Laplacian's Jacobi splitting M and bp (malloc'd), b = 1. */
+static ulam_csr *laplace3(int m, double **bp)
+{
+    int64_t n = (int64_t)m * m * m, nz = 0;
+    int32_t *ti = malloc((size_t)(7 * n) * sizeof *ti), *tj = malloc((size_t)(7 * n) * sizeof *tj);
+    double *tx = malloc((size_t)(7 * n) * sizeof *tx), *b = malloc((size_t)n * sizeof *b);
+    static const int d[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < m; j++)
+            for (int k = 0; k < m; k++) {
+                int32_t r = (int32_t)((i * m + j) * m + k);
+                ti[nz] = r, tj[nz] = r, tx[nz++] = 6.0, b[r] = 1.0;
+                for (int q = 0; q < 6; q++) {
+                    int a = i + d[q][0], c = j + d[q][1], e = k + d[q][2];
+                    if (a < 0 || c < 0 || e < 0 || a >= m || c >= m || e >= m) continue;
+                    ti[nz] = r, tj[nz] = (int32_t)((a * m + c) * m + e), tx[nz++] = -1.0;
+                }
+            }
+    ulam_csr *A, *M;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &A), ULAM_OK);
+    *bp = malloc((size_t)n * sizeof **bp);
+    assert_int_equal(ulam_jacobi(A, b, 1.0, &M, *bp, NULL), ULAM_OK);
+    free(ti), free(tj), free(tx), free(b);
+    ulam_csr_free(A);
+    return M;
+}
+
+/* The kernels (mode, continuation, exponent) auto piloted. */
+static int kernels_piloted(const ulam_auto_result *res)
+{
+    int n = 0;
+    for (int k = 0; k < res->ncand; k++) {
+        const ulam_auto_candidate *a = &res->cand[k];
+        int first = a->pilot_walks > 0;
+        for (int j = 0; first && j < k; j++) {
+            const ulam_auto_candidate *p = &res->cand[j];
+            first = !(p->pilot_walks > 0 && p->mode == a->mode && p->continue_q == a->continue_q &&
+                      p->kernel_alpha == a->kernel_alpha);
+        }
+        n += first;
+    }
+    return n;
+}
+
+/* auto's pilots take a time limit (issue 38 point 9): under --time S alone the run predicted no
+ * walk count, so the pilots' overhead share never reached its cap and --time 0.05 on a 24^3
+ * Laplacian (--jacobi) piloted six kernels, 2.0e8 units of work (6 s at the work model's rate,
+ * 1.5 s of a 2 s run) before its walks.  Now the leader's run is the work the time buys
+ * (S / ULAM_AUTO_UNIT_SECONDS, no clock read): on a 16^3 Laplacian at S = 0.05 one kernel is
+ * piloted (its set-up alone passes the budget) and the pilots' work is that kernel's, while at
+ * S = 1000 the race pilots several (the budget scales with S). */
+static void test_time_budget(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M = laplace3(16, &b);
+    double pilot_work[2];
+    int kernels[2];
+    const double S[2] = {0.05, 1000.0};
+    for (int t = 0; t < 2; t++) {
+        ulam_walk_opts o = ulam_walk_defaults();
+        o.query.index = (8 * 16 + 8) * 16 + 8, o.stop.max_walks = 0, o.stop.max_seconds = S[t];
+        ulam_auto_result res;
+        ulam_error err;
+        assert_int_equal(ulam_auto_choose(M, b, &o, NULL, &res, &err), ULAM_OK);
+        assert_true(res.chosen >= 0);
+        pilot_work[t] = res.pilot_work, kernels[t] = kernels_piloted(&res);
+        print_message("--time %g: %d kernels piloted, %.3g units\n", S[t], kernels[t], pilot_work[t]);
+    }
+    assert_int_equal(kernels[0], 1);
+    assert_true(kernels[1] > 1 && pilot_work[1] > pilot_work[0]);
+    ulam_csr_free(M), free(b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_push_b_rounding),
+        cmocka_unit_test(test_time_budget),
         cmocka_unit_test(test_choice),
         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_pins),
