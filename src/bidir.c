@@ -129,6 +129,24 @@ static int check_call(const ulam_csr *M, ulam_push *w, const ulam_csr *Mt, const
     return check_opts(M, Mt, o, err);
 }
 
+/* The walk solver's message about walks on M' (adjoint there) said of M: "adjoint" and "forward"
+ * swapped, the walks named (a refusal named the mode backwards: "rho(M^) of the adjoint kernel is
+ * in [1.087, 1.336]" where on M the adjoint radius is 0.99 and the forward one 1.318). */
+static void name_on_M(ulam_error *err)
+{
+    if (!err) return;
+    static const char *const word[2] = {"adjoint", "forward"};
+    char out[sizeof err->msg];
+    int len = snprintf(out, sizeof out, "the walks from b are forward walks on M: ");
+    for (const char *p = err->msg; *p && len < (int)sizeof out - 1;) {
+        int w = strncmp(p, word[0], 7) == 0 ? 0 : strncmp(p, word[1], 7) == 0 ? 1 : -1;
+        if (w >= 0) len += snprintf(out + len, sizeof out - (size_t)len, "%s", word[1 - w]), p += 7;
+        else out[len++] = *p++;
+    }
+    out[len < (int)sizeof out ? len : (int)sizeof out - 1] = '\0';
+    memcpy(err->msg, out, sizeof out);
+}
+
 /* The walks' options: adjoint on M' from s (or from b's entries), scoring r. */
 static ulam_walk_opts walk_opts(const ulam_bidir_opts *o)
 {
@@ -364,7 +382,9 @@ static int walk(const ulam_csr *Mt, const double *r, const ulam_bidir_opts *o, d
     ulam_analysis *at = walks_on(memo, Mt, o, err);
     if (!at) return ULAM_ENOMEM;
     int how = (o->reach_all ? ULAM__WALKS_ALL : memo->found ? ULAM__WALKS_FOUND : 0) | (o->keep_kernel ? ULAM__WALKS_KEEP : 0);
-    return ulam__analysis_walks(at, r, &wo, how, wr, g, NULL, err); /* the solver searches should x_t be 0 */
+    int status = ulam__analysis_walks(at, r, &wo, how, wr, g, NULL, err); /* the solver searches should x_t be 0 */
+    if (status == ULAM_EINFVAR) name_on_M(err);
+    return status;
 }
 
 /* The certified bound D on the walk part: |<r, x>| <= max|r| ||x||_1 <= max|r| ||b||_1 /

@@ -46,6 +46,8 @@ int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao
            (ao && (ao->pin_estimator || (ao->pin_alpha && o->kernel.kernel_alpha != 1.0)));
 }
 
+static int index_walks(const ulam_choice *ch);
+
 /* An adjoint query with a rel_err target (or a fixed budget and a b for the push on b), nothing
  * pinned it cannot honour, a walk leader to compare with whose predicted work W exceeds nnz(M)/4,
  * and a nonzero b. */
@@ -60,9 +62,10 @@ static int applies(const ulam__query *q, int k, char *why, size_t len)
     double nnz = (double)ulam_csr_nnz(q->M), W = q->ch->leader_work;
     if (pinned) snprintf(why, len, "not considered: %s", pinned);
     else if (ulam__method_excluded(q, k, why, len)) return 0;
-    else if (!(o->stop.rel_err > 0) && !ulam_method_bidir_route(q->b, n, q->ao, o))
-        snprintf(why, len, "not considered: no --rel-err target with a sparse b (without one auto compares variance x "
-                           "work a walk, which the reverse push has no figure for)");
+    else if (!(o->stop.rel_err > 0) && !ulam_method_bidir_route(q->b, n, q->ao, o) && !index_walks(q->ch))
+        snprintf(why, len, "not considered: no --rel-err target with a sparse b and no certified walks from the index "
+                           "for the push on b (without a target auto compares variance x work a walk, which the "
+                           "reverse push has no figure for)");
     else if (au->chosen < 0) snprintf(why, len, "not considered: no certified walk method to compare with");
     else if (nb == 0) snprintf(why, len, "not considered: b is zero");
     else if (!(W > nnz / 4))
@@ -231,12 +234,18 @@ static int pilot_on(const ulam_csr *M, const double *b, const ulam_walk_opts *o,
     return status;
 }
 
-/* The 95% interval n walks would give at a pilot's variance and range (R = tail_bound walks
- * |estimate|, the range its interval used), at a count fixed in advance (src/stop.h): *ci, whose
- * half is INFINITY when the pilot has no range. */
-static void interval_at(const ulam_walk_result *w, double n, ulam__stop_ci *ci)
+/* The range of a pilot's single score: tail_bound walks |estimate + off| (off: its options'
+ * rel_err_offset, which tail_bound's scale held; the residual's walks carry q_i there). */
+static double pilot_range(const ulam_walk_result *w, double off)
 {
-    double R = w->tail_bound * (double)w->walks * fabs(w->estimate);
+    return w->tail_bound * (double)w->walks * fabs(w->estimate + off);
+}
+
+/* The 95% interval n walks would give at a pilot's variance and range (pilot_range at off), at
+ * a count fixed in advance (src/stop.h): *ci, whose half is INFINITY when the pilot has no range. */
+static void interval_at(const ulam_walk_result *w, double off, double n, ulam__stop_ci *ci)
+{
+    double R = pilot_range(w, off);
     *ci = (ulam__stop_ci){.half = INFINITY, .var_term = INFINITY, .range_term = INFINITY};
     if (R >= 0 && isfinite(R) && n >= 2 && n < 4e18 && isfinite(w->variance))
         ulam__stop_interval((int64_t)n, w->estimate, w->variance, R, 0.0, 0.0, INFINITY, 0, ci);
@@ -276,13 +285,17 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
     int status = q->run->sv ? leader_pilot(q->run, UINT64_C(0x2545f4914f6cdd1d), &wb, err) : ULAM_EINVAL;
     if (status) return status == ULAM_ENOMEM ? status : ULAM_OK; /* the leader's own run will say why */
     ulam__stop_ci cb, cr;
-    interval_at(&wb, N, &cb);
-    if (!(cb.range_term > cb.var_term) || !isfinite(cb.half)) {
+    interval_at(&wb, q->o->stop.rel_err_offset, N, &cb);
+    /* a pilot on b that saw no score (a sparse b the walks reach rarely) has no variance and no range
+       to go by, and a zero variance must not be believed: the walks' interval is then planned from the
+       residual's walks below, whose range scaled by max|b| / max|r| bounds theirs */
+    int blind = wb.walks > 0 && wb.estimate == 0.0 && !(wb.variance > 0) && q->o->stop.rel_err_offset == 0.0;
+    if (!blind && (!(cb.range_term > cb.var_term) || !isfinite(cb.half))) {
         snprintf(v->why, sizeof v->why, "not considered: at %.3g walks the walks' interval is not led by its range "
                  "term (%.3g, variance term %.3g): a push on b would narrow it little", N, cb.range_term, cb.var_term);
         return ULAM_OK;
     }
-    double rmax = ulam__bpush_max(q->b, q->M->nrows) * cb.var_term / cb.range_term;
+    double bmax = ulam__bpush_max(q->b, q->M->nrows), rmax = blind ? 0.5 * bmax : bmax * cb.var_term / cb.range_term;
     int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
     ulam_bidir_plan_info *pl = &ch->bidir;
     for (int round = 1;; round++) { /* the push also lowers the variance: while the residual's range term still
@@ -293,8 +306,19 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
             snprintf(v->why, sizeof v->why, "refused: %.250s", err->msg);
             return ULAM_OK;
         }
-        interval_at(&wr, N, &cr);
-        if (round >= FIXED_ROUNDS || !(cr.range_term > cr.var_term) || pl->push.ops >= cap || !(pl->push.r_max > 0)) break;
+        interval_at(&wr, q->run->bwo.stop.rel_err_offset, N, &cr);
+        if (blind && !isfinite(cb.half)) { /* the walks on b: the residual's range scaled to b, at a variance of the
+            rule of three (a score of that size in at most 3 / n of the pilot's n walks, 95%) */
+            double Rb = pilot_range(&wr, q->run->bwo.stop.rel_err_offset) * bmax / pl->push.r_max;
+            if (isfinite(Rb) && Rb > 0 && N >= 2 && N < 4e18)
+                ulam__stop_interval((int64_t)N, 0.0, Rb * Rb * 3.0 / (double)wb.walks, Rb, 0.0, 0.0, INFINITY, 0, &cb);
+        }
+        if (round >= FIXED_ROUNDS || pl->push.ops >= cap || !(pl->push.r_max > 0)) break;
+        if (blind && !isfinite(cb.half)) { /* the residual's walks saw nothing either: push on */
+            rmax = pl->push.r_max / 16.0;
+            continue;
+        }
+        if (!(cr.range_term > cr.var_term)) break;
         rmax = fmin(0.5 * rmax, pl->push.r_max * cr.var_term / cr.range_term);
     }
     pl->predicted_walks = N;
@@ -306,7 +330,7 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
     double lo_n = 2.0, hi_n = N; /* the least walks whose interval on the residual is the leader's */
     for (int it = 0; it < 64 && hi_n - lo_n > 1.0; it++) {
         double mid = floor(0.5 * (lo_n + hi_n));
-        interval_at(&wr, mid, &cr);
+        interval_at(&wr, q->run->bwo.stop.rel_err_offset, mid, &cr);
         if (cr.half <= cb.half) hi_n = mid;
         else lo_n = mid;
     }
@@ -374,7 +398,9 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     ulam_choice *ch = q->ch;
     ulam_run *r = q->run;
     double W = ch->leader_work;
-    if (ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o) && (index_walks(ch) || pinned(q)))
+    int fixed = !(q->o->stop.rel_err > 0); /* a fixed budget: the push on b for a sparse b too (the reverse push
+                                              has no figure to compare there) */
+    if ((fixed || ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o)) && (index_walks(ch) || pinned(q)))
         return predict_push_on_b(q, k, err);
     ulam_walk_opts walk = *q->o;
     walk.estimator = ULAM_COLLISION, walk.kernel.kernel_alpha = 1.0;
@@ -445,7 +471,7 @@ static int pin(ulam__query *q, int k, ulam_error *err)
             rmax = rule_rmax(q->b, n, wr.variance, m, wr.min_walks, q->o->stop.rel_err);
         } else { /* a walk count: as fixed_predict, the range term brought to about the variance term's */
             ulam__stop_ci ci;
-            interval_at(&wr, (double)q->o->stop.max_walks, &ci);
+            interval_at(&wr, q->o->stop.rel_err_offset, (double)q->o->stop.max_walks, &ci);
             rmax = ulam__bpush_max(q->b, n) * (ci.range_term > ci.var_term && isfinite(ci.half) ? ci.var_term / ci.range_term : 1.0);
         }
         status = dense_plan(q, q->o, NULL, rmax, 100 * ulam_csr_nnz(q->M) + 1000000, NULL, err);

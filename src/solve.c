@@ -1134,7 +1134,31 @@ static void run_block(void *ctx, int q, int64_t first, int64_t count, int t)
 }
 
 static void cs_plan(ulam_solver *s);
+static void cs_plan_from(ulam_solver *s, const ulam__moments *run);
 static void round_clip(ulam_solver *s);
+
+/* Feed the sequence the run's first block br a part at a time (walk.h's ULAM__SUB_WALKS histories
+ * in start order; forward: with the zeros of the histories that did not tally the watched
+ * component), each bet planned from the parts before it: a block of 1024 scores with no earlier
+ * one to plan from bet as if the variance were the largest possible (a --walks 1000 run printed
+ * 10 times the width of the 4096-walk one, Poisson 70 x 70 centre). */
+static void cs_first(ulam_solver *s, const ulam__block *br)
+{
+    ulam__moments run = {0};
+    for (int q = 0; q < ULAM__SUBS; q++) {
+        ulam__moments c = br->sub[q];
+        if (s->o.mode == ULAM_FORWARD) {
+            int64_t first = (int64_t)q * ULAM__SUB_WALKS, left = br->h.walks - first;
+            int64_t walks = q == ULAM__SUBS - 1 ? left : left < ULAM__SUB_WALKS ? left : ULAM__SUB_WALKS;
+            ulam__moments zeros = {.n = walks > c.n ? walks - c.n : 0};
+            ulam__moments_merge(&c, &zeros);
+        }
+        if (c.n == 0) continue;
+        cs_plan_from(s, &run);
+        ulam__cs_add(&s->cs, c.n, c.mean, c.m2, 0.0);
+        ulam__moments_merge(&run, &c);
+    }
+}
 
 /* Merge completed block q into the totals (ctx: the solver; forward: the watched component's
  * moments count the block's histories that did not tally it as zeros; the walk and non-finite
@@ -1143,8 +1167,10 @@ static void merge_block(void *ctx, int q)
 {
     ulam_solver *s = ctx;
     const ulam__block *br = &s->blocks[q];
-    cs_plan(s); /* from the blocks before this one alone */
-    if (s->o.mode == ULAM_ADJOINT) ulam__cs_add(&s->cs, br->clipped.n, br->clipped.mean, br->clipped.m2, 0.0);
+    int parts = s->cs.n == 0 && s->w.clip > 0;
+    if (parts) cs_first(s, br); /* the first block, a part at a time */
+    else cs_plan(s); /* from the blocks before this one alone */
+    if (s->o.mode == ULAM_ADJOINT && !parts) ulam__cs_add(&s->cs, br->clipped.n, br->clipped.mean, br->clipped.m2, 0.0);
     ulam__moments_merge(&s->adj, &br->m);
     s->maxsq = fmax(s->maxsq, br->maxsq);
     ulam__moments w = br->watched;
@@ -1158,7 +1184,7 @@ static void merge_block(void *ctx, int q)
         ulam__moments_merge(&w, &zeros);
         ulam__moments c = br->clipped;
         ulam__moments_merge(&c, &zeros);
-        ulam__cs_add(&s->cs, c.n, c.mean, c.m2, 0.0);
+        if (!parts) ulam__cs_add(&s->cs, c.n, c.mean, c.m2, 0.0);
         ulam__moments_merge(&s->watched, &w);
     }
     s->steps += br->steps;
@@ -1416,6 +1442,16 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m;
     double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
     *Rt = !truncated ? score_range(s, 1.0, 1.0) : t > 0 ? score_range(s, m, t / m) : INFINITY;
+    double X = bias_scale(s, 0.0), n1 = fmin(*nplan, (double)BLOCK), least = INFINITY, t0 = 1e-6 * m;
+    for (int j = 0; truncated && !(E > 0) && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
+        /* no estimate yet, no target: the truncation whose bias and range term over the first round's
+           walks (a bet at its largest) add up least, whatever x is (a bias of a millionth of a
+           visit's score tripled the range of the first block: a --walks 1000 run's half-width
+           was 0.16 x against 0.048 x at 4096, Poisson 70 x 70 centre) */
+        double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X);
+        double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, n1) + tj;
+        if (isfinite(Rj) && wj < least) least = wj, t = tj, *Rt = Rj;
+    }
     for (int j = 2; truncated && *h > 0 && j <= 6; j++) { /* rel_err: the share of h (1/4 .. 1/64) that meets it soonest */
         double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m);
         double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
@@ -1444,6 +1480,18 @@ static void cs_plan(ulam_solver *s)
     plan_terms(s, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     ulam__cs_plan(&s->cs, mom->n, mom->mean, ulam__moments_variance(mom), A, b, h > b ? h - b : 0.0, nplan);
+}
+
+/* Plan the sequence's next part of the first block from the parts so far (run): as cs_plan, with
+ * run's moments in place of the run's (none yet) and under rel_err the half-width aimed at from
+ * run's mean. */
+static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
+{
+    double Rt, A, b, h, nplan, E = s->o.stop.rel_err;
+    plan_terms(s, &Rt, &A, &b, &h, &nplan);
+    A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
+    if (!(h > 0) && E > 0 && run->n >= 2) h = E * fabs(run->mean + s->o.stop.rel_err_offset);
+    ulam__cs_plan(&s->cs, run->n, run->mean, ulam__moments_variance(run), A, b, h > b ? h - b : 0.0, nplan);
 }
 
 /* The run's 95% interval so far: the confidence sequence's (stop.h, ulam__cs), valid at every

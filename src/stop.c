@@ -161,6 +161,12 @@ void ulam__cs_interval(const ulam__cs *cs, double m, double extra, ulam__stop_ci
     ci->kind = ULAM__STOP_EB;
 }
 
+/* The half-width's range term at a bet at its largest. */
+double ulam__cs_range_width(double A, double n)
+{
+    return cs_log() * A / (ULAM__CS_LMAX * n);
+}
+
 /* The walks a sequence tuned to target E needs. */
 double ulam__cs_walks_needed(double m, double var, double A, double b, double E)
 {

@@ -132,6 +132,11 @@ void ulam__cs_interval(const ulam__cs *cs, double m, double extra, ulam__stop_ci
  * INFINITY when the plan cannot reach it. */
 double ulam__cs_walks_left(const ulam__cs *cs, double mean, double var, double extra, double h);
 
+/* The range term ln(2 / delta) A / (ULAM__CS_LMAX n) of the half-width of n scores in [-A, A] under
+ * bets at their largest (scores of small variance; about the centre 0): what a block of n scores
+ * with limit A adds to the interval at least, for planning. */
+double ulam__cs_range_width(double A, double n);
+
 /* The walks at which a sequence tuned to target E at estimate m (variance var, limit A, bias b)
  * reaches half-width E |m|; INFINITY when it cannot (bias too large, m = 0, A infinite). */
 double ulam__cs_walks_needed(double m, double var, double A, double b, double E);

@@ -88,6 +88,7 @@ typedef struct {
     uint64_t frac;
     double w, score;
     int64_t len; /* steps in this history */
+    int64_t id;  /* the history's start order in its block */
     stack st;
 } lane;
 
@@ -160,12 +161,19 @@ static WALK_INLINE double clip(double x, double c)
     return c > 0 ? fmax(-c, fmin(c, x)) : x;
 }
 
-/* Record a finished history's score (a non-finite one is counted, never averaged). */
-static void record(const ulam__walker *w, ulam__block *out, double score)
+/* The part of a block that history id (in start order) counts in. */
+static inline int sub_of(int64_t id)
+{
+    return id / ULAM__SUB_WALKS < ULAM__SUBS ? (int)(id / ULAM__SUB_WALKS) : ULAM__SUBS - 1;
+}
+
+/* Record history id's score (a non-finite one is counted, never averaged). */
+static void record(const ulam__walker *w, ulam__block *out, double score, int64_t id)
 {
     if (isfinite(score)) {
         ulam__moments_add(&out->m, score);
         ulam__moments_add(&out->clipped, clip(score, w->clip));
+        if (w->clip > 0) ulam__moments_add(&out->sub[sub_of(id)], clip(score, w->clip));
         out->maxsq = fmax(out->maxsq, score * score);
     } else {
         out->h.nonfinite++;
@@ -188,6 +196,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
     for (; act < lanes && started < count; act++, started++) {
         L[act].st = (stack){sc->stack_s + act * cap, sc->stack_w + act * cap, 0, cap};
         lane_start(w, &L[act], r);
+        L[act].id = started;
     }
     while (act > 0) {
         for (int l = 0; l < act; l++) {
@@ -202,11 +211,11 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
                 l++;
                 continue;
             }
-            record(w, &acc, x->score);
+            record(w, &acc, x->score, x->id);
             if (started < count) {
                 if ((started & 63) == 0 && w->interrupt && *w->interrupt) break;
                 lane_start(w, x, r);
-                started++;
+                x->id = started++;
                 l++;
             } else {
                 stack keep = x->st; /* the lane that moves in brings its own stack */
@@ -250,9 +259,11 @@ static WALK_INLINE void emit(const ulam__walker *w, ulam__scratch *sc, ulam__blo
             sc->btouched[sc->nbtouched++] = s;
         }
         sc->bsum[s] += v, sc->bsq[s] += v * v;
-        if (s == w->watch)
+        if (s == w->watch) {
             ulam__moments_add(&out->watched, v), ulam__moments_add(&out->clipped, clip(v, w->clip)),
                 out->maxsq = fmax(out->maxsq, v * v);
+            if (w->clip > 0) ulam__moments_add(&out->sub[sub_of(out->h.walks - 1)], clip(v, w->clip)); /* one at a time */
+        }
         sc->hist[s] = 0.0;
         sc->mark[s] = 0;
     }

@@ -54,6 +54,9 @@ typedef struct {
     int64_t nbtouched;
 } ulam__scratch;
 
+#define ULAM__SUB_WALKS 64 /* the histories of a block's part (by start order) */
+#define ULAM__SUBS 16      /* a block's parts (the last one takes the histories past them) */
+
 /* What a block of histories produced. */
 typedef struct {
     ulam__block_head h; /* the round driver's part (forward: one ulam__tally per state the block
@@ -62,6 +65,9 @@ typedef struct {
     ulam__moments watched; /* forward: the watched component's history tallies (histories that
                               tallied it; the others count as zeros when merged) */
     ulam__moments clipped; /* the scores (forward: the watched tallies) clipped to [-clip, clip] */
+    ulam__moments sub[ULAM__SUBS]; /* clipped as well, by start order: histories q ULAM__SUB_WALKS .. in sub[q]
+                                       (the confidence sequence bets on each of a first block's parts
+                                       from the parts before it) */
     int64_t steps, cut;
     double maxsq; /* the largest score^2 (forward: of the watched component) */
 } ulam__block;

@@ -811,6 +811,64 @@ static void test_fpush_all_targets(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* Three clusters of 20 states (rows of |M| summing to 0.99, half of each row to its cluster's
+ * first state, a hub whose column sums to about 10), each hub leaking 1e-4 into the next
+ * cluster's: the adjoint rho(M^) is 0.99, the forward one above 1 (tests/cli_test.py's). */
+static ulam_csr *three_clusters(void)
+{
+    int32_t ti[300], tj[300];
+    double tx[300];
+    int64_t nz = 0;
+    for (int c = 0; c < 3; c++) {
+        int hub = 20 * c;
+        for (int i = 0; i < 20; i++) {
+            int r = hub + i;
+            double rs = 0.99 - (i == 0 && c < 2 ? 1e-4 : 0.0);
+            static const int h[4] = {1, 3, 7, 12};
+            for (int q = 0; q < (i == 0 ? 4 : 3); q++)
+                ti[nz] = r, tj[nz] = hub + (i + h[q]) % 20, tx[nz++] = i == 0 ? rs / 4 : 0.5 * rs / 3;
+            if (i > 0) ti[nz] = r, tj[nz] = hub, tx[nz++] = 0.5 * rs;
+        }
+        if (c < 2) ti[nz] = hub, tj[nz] = hub + 20, tx[nz++] = 1e-4;
+    }
+    ulam_csr *M;
+    assert_int_equal(ulam_csr_from_triplets(60, 60, nz, ti, tj, tx, &M), ULAM_OK);
+    return M;
+}
+
+/* Walks from a sparse b on the three clusters are forward walks on M (adjoint on M'), whose
+ * variance is infinite: a --rel-err target is refused (ULAM_EINFVAR), and the message names
+ * them as forward walks on M with the forward rho(M^) (above 1), not as adjoint walks (before:
+ * "rho(M^) of the adjoint kernel is in [1.087, 1.336]", the mode as the walk solver saw it on M',
+ * while on M the adjoint rho(M^) is 0.99). */
+static void test_bidir_refusal_names_mode(void **state)
+{
+    (void)state;
+    ulam_csr *M = three_clusters(), *Mt;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    ulam_push *w = NULL;
+    assert_int_equal(ulam_push_alloc(M, &w), ULAM_OK);
+    int64_t idx[3] = {44, 50, 55};
+    double val[3] = {1.0, 1.0, 1.0};
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    o.target = 21, o.nb = 3, o.b_index = idx, o.b_value = val;
+    o.walk.stop.rel_err = 0.1, o.walk.stop.max_walks = 0;
+    ulam_bidir_result res;
+    ulam_error err;
+    int st = ulam_bidir_solve(w, Mt, &o, &res, &err);
+    print_message("status %d: %s\n", st, err.msg);
+    assert_int_equal(st, ULAM_EINFVAR);
+    assert_non_null(strstr(err.msg, "forward walks on M"));
+    assert_null(strstr(err.msg, "adjoint kernel"));
+    double lo = 0, hi = 0;
+    const char *at = strstr(err.msg, "rho(M^)");
+    assert_non_null(at);
+    assert_int_equal(sscanf(strstr(at, "["), "[%lf, %lf]", &lo, &hi), 2);
+    assert_true(hi > 1.0 && lo <= hi); /* the forward radius, not the adjoint 0.99 */
+    ulam_push_free(w);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -821,6 +879,7 @@ int main(void)
         cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
         cmocka_unit_test(test_bidir_reach_all),  cmocka_unit_test(test_bidir_fixed_walks_honest),
         cmocka_unit_test(test_fpush_all_targets), cmocka_unit_test(test_bidir_rounding),
+        cmocka_unit_test(test_bidir_refusal_names_mode),
     };
     return test_run(tests);
 }

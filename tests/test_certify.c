@@ -45,10 +45,13 @@ static ulam_csr *poisson(int m, double **bp, int64_t *c, double *xc)
     return M;
 }
 
-/* At 4096 walks (four of the confidence sequence's blocks: a single block, with no earlier one to
- * tune its bet, is about twice as wide) over 100 seeds: every interval is finite and at most a
- * quarter of x wide each side (before the length certificate: none, or about 8 x at 1000), and at least 89 cover (95% coverage fails that with probability under
- * 2%), under the collision and expected estimators. */
+/* At 1000 walks (a single block: each 64-walk part of it bets from the parts before, and the
+ * first round's truncation is the one whose bias and range term add up least; before, the block bet
+ * as if the variance were the largest possible at a truncation of a millionth of a visit's score,
+ * half-width 0.57 x against 0.048 x at 4096 walks) over 100 seeds: every interval is finite and at
+ * most 0.15 x wide each side (about 0.1 x now: the 4096-walk width times sqrt(4096 / 1000) is
+ * 0.097 x), and at least 89 cover (95% coverage fails that with probability under 2%), under the
+ * collision and expected estimators. */
 static void test_poisson_fixed(void **state)
 {
     (void)state;
@@ -61,19 +64,19 @@ static void test_poisson_fixed(void **state)
         for (int s = 0; s < 100; s++) {
             if (!test_case(1000L * e + s)) continue;
             ulam_walk_opts o = ulam_walk_defaults();
-            o.query.index = c, o.estimator = e ? ULAM_EXPECTED : ULAM_COLLISION, o.stop.max_walks = 4096;
+            o.query.index = c, o.estimator = e ? ULAM_EXPECTED : ULAM_COLLISION, o.stop.max_walks = 1000;
             o.exec.seed = 1 + (uint64_t)s;
             ulam_walk_result r;
             assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
             assert_true(isfinite(r.ci95[0]) && isfinite(r.ci95[1]) && r.ci95[1] > r.ci95[0]);
             widest = fmax(widest, (r.ci95[1] - r.ci95[0]) / 2 / x);
-            if (!(r.ci95[1] - r.ci95[0] <= 0.5 * x))
+            if (!(r.ci95[1] - r.ci95[0] <= 0.3 * x))
                 print_error("seed %d: %.6g .. %.6g for x = %.6g\n", s + 1, r.ci95[0], r.ci95[1], x);
-            assert_true(r.ci95[1] - r.ci95[0] <= 0.5 * x);
+            assert_true(r.ci95[1] - r.ci95[0] <= 0.3 * x);
             covered += r.ci95[0] <= x && x <= r.ci95[1];
         }
         test_case_done();
-        print_message("poisson 70x70 centre %s, 4096 walks: covered %d of 100, widest half-width %.3g x\n",
+        print_message("poisson 70x70 centre %s, 1000 walks: covered %d of 100, widest half-width %.3g x\n",
                       e ? "expected" : "collision", covered, widest);
         if (test_case_all()) assert_true(covered >= 89);
     }
