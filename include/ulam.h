@@ -1641,8 +1641,9 @@ typedef enum ulam_stream_purpose {
 } ulam_stream_purpose;
 
 /* The seed of sub-run k for purpose p under seed: splitmix64's finalizer chained over (seed, p,
- * k), so distinct (p, k) give unrelated seeds and the same triple gives the same seed from C, the
- * CLI and Python.  Every derived seed in ulam comes from here (docs/streams.md). */
+ * k), its top bit cleared (below 2^63, so the CLI's --seed and Python take it), so distinct (p, k)
+ * give unrelated seeds and the same triple gives the same seed from C, the CLI and Python.  Every
+ * derived seed in ulam comes from here (docs/streams.md). */
 uint64_t ulam_rng_substream(uint64_t seed, ulam_stream_purpose p, uint64_t k);
 
 /* ---------------------------------------------------------------- utilities */

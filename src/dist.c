@@ -47,6 +47,7 @@ typedef struct {
     vec ends, tallies;  /* finished adjoint histories; forward tallies of this batch */
     const double *b;    /* forward: the sources' b at this rank's rows */
     int64_t steps, crossings, bytes, rounds, cut;
+    int many;           /* a batch of queries: query k walks on seed ulam_rng_substream(seed, QUERY, k) */
 } run;
 
 /* The defaults. */
@@ -64,13 +65,15 @@ static int push(vec *v, const void *x, size_t sz)
 }
 
 /* Move x one step from its row (owned here): 0 when the walk ends, 1 with x at its new row (walk
- * id k o->walks + w is walk w of query k, its numbers keyed by seed + k).  It
+ * id k o->walks + w is walk w of query k; a batch's query k keyed by its QUERY substream, a lone
+ * run's walks by seed: docs/streams.md).  It
  * leaves with probability min(1, S) (S the row's sum of |entries|) to entry q with probability
  * |val_q| / S, the weight times sign(val_q) S / min(1, S). */
-static int move(const ulam_part *p, const ulam__rows *A, const ulam_dist_opts *o, particle *x)
+static int move(const ulam_part *p, const ulam__rows *A, const ulam_dist_opts *o, int many, particle *x)
 {
     int64_t i = x->s - p->first, t = x->t + 1;
-    uint64_t seed = o->seed + (uint64_t)(x->w / o->walks), w = (uint64_t)(x->w % o->walks); /* query k: seed + k */
+    uint64_t k = (uint64_t)(x->w / o->walks), w = (uint64_t)(x->w % o->walks);
+    uint64_t seed = many ? ulam_rng_substream(o->seed, ULAM_STREAM_QUERY, k) : o->seed;
     double S = A->rowsum[i], c = S < 1.0 ? S : 1.0;
     if (S == 0.0 || ulam_rng_counter(seed, w, (uint64_t)t, 0) >= c) return 0;
     double u = ulam_rng_counter(seed, w, (uint64_t)t, 1) * S, acc = 0.0;
@@ -96,7 +99,7 @@ static int advance(run *R, particle x, int forward)
         } else {
             x.score += x.wt * p->b[x.s - p->first];
         }
-        if (!move(p, forward ? &p->t : &p->m, &R->o, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
+        if (!move(p, forward ? &p->t : &p->m, &R->o, R->many, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
         R->steps++;
         int own = p->nranks > 1 ? ulam__part_owner(p, x.s) : 0;
         if (own != p->rank) { /* to the rank of this set that owns the row */
@@ -255,9 +258,9 @@ static int64_t my_batch(const run *R, int64_t a)
     return a >= R->o.walks ? 0 : R->o.walks - a < R->o.batch ? R->o.walks - a : R->o.batch;
 }
 
-/* x_index[k] for k < nq by adjoint walks on the partitioned rows. */
-int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
-                           const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err)
+/* x_index[k] for k < nq by adjoint walks on the partitioned rows (many: as a batch of queries). */
+static int adjoint(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq, int many,
+                   const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err)
 {
     ulam__clear(err);
     if (!p || !comm || !res || !index || nq < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "parts, indices and results");
@@ -268,6 +271,7 @@ int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int6
     }
     run R;
     int status = start(&R, p, comm, o, 0, err);
+    R.many = many;
     if (!status && R.o.walks > INT64_MAX / nq) status = ulam__fail(err, ULAM_EINVAL, 0, -1, "walks times queries below 2^63");
     int64_t total = status ? 0 : R.o.walks * nq;
     double *m = calloc((size_t)nq * 4, sizeof *m); /* n, mean, M2 of each query (rank 0); then stderr */
@@ -305,7 +309,14 @@ int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int6
 int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
                       ulam_dist_result *res, ulam_error *err)
 {
-    return ulam_dist_adjoint_many(p, comm, &index, 1, o, res, err);
+    return adjoint(p, comm, &index, 1, 0, o, res, err);
+}
+
+/* x_index[k] for k < nq, query k on its own seed (docs/streams.md). */
+int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
+                           const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err)
+{
+    return adjoint(p, comm, index, nq, 1, o, res, err);
 }
 
 /* The blocks' sums of |b| (blocks of 2^shift rows, the same whatever the split) in every rank's

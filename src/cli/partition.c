@@ -26,8 +26,8 @@ static const char *const help =
     "standard error, and no 95% interval: no certified range of a score is computed on a partition\n"
     "(the guard certifies only that the variance is finite).\n"
     "  --index I       x_I by adjoint walks from I (1-based)\n"
-    "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, query k\n"
-    "                  with seed S + k - 1: a line answers what --index I --seed S+k-1 answers\n"
+    "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, each on\n"
+    "                  a seed of its own, printed: a line answers what --index I --seed SEED answers\n"
     "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector, --errors\n"
     "                  their standard errors (also with --source)\n"
     "  --method mcsa   every x_i by MCSA: Richardson steps (products with M across ranks) and forward\n"
@@ -214,7 +214,8 @@ static void print_estimate(int64_t i, double est, double se, double rho)
 static void print_query(const cli_query *q, int64_t k, const ulam_dist_result *r, uint64_t seed, double rho)
 {
     print_estimate(q->index + 1, r->estimate, r->std_error, rho);
-    printf("  line %ld, seed %llu\n", q->line, (unsigned long long)(seed + (uint64_t)k));
+    uint64_t own = ulam_rng_substream(seed, ULAM_STREAM_QUERY, (uint64_t)k); /* docs/streams.md */
+    printf("  line %ld, seed %llu\n", q->line, (unsigned long long)own);
 }
 
 /* A component for the top-K table: its index and estimate, its standard error. */
