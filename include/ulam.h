@@ -1636,7 +1636,7 @@ typedef enum ulam_stream_purpose {
     ULAM_STREAM_PILOT = 2,     /* pilot k of auto's choice or bidir's plan */
     ULAM_STREAM_PROBE = 3,     /* probe k of bidir's push/walk split */
     ULAM_STREAM_ITERATION = 4, /* outer iteration k of MCSA / sequential Monte Carlo */
-    ULAM_STREAM_POINT = 5,     /* radiosity point or work-plane node k */
+    ULAM_STREAM_POINT = 5,     /* radiosity point, work-plane node, mesh sample or view patch k */
     ULAM_STREAM_STUDY = 6      /* run k of a variance study */
 } ulam_stream_purpose;
 

@@ -995,9 +995,15 @@ def check_source_fallback(ulam):
         # pinned, the walks from b are refused with the documented exit 4 (was 36), named as forward walks on M
         rc, out, err = run(ulam, ["solve", p, "--method", "bidirectional", "--rhs", pe, "--index", "21", "--rel-err", "0.1"])
         assert rc == 4 and out == "" and "forward walks on M" in err and "adjoint" not in err, (rc, err)
-        # --source 45 --index 21: the push on b = e_45 and walks from 21 (the walks from 45 are not certified)
-        rc, out, err = run(ulam, ["solve", p, "--source", "45", "--index", "21", "--rel-err", "0.1"])
-        assert rc == 0 and re.search(r"^method +bidirectional, the push on b", out, re.M), (rc, out, err)
+        # --source 45 --index 21: bidirectional is the push on b = e_45 and walks from 21 (the walks from 45 are not
+        # certified), a candidate with a prediction; auto's pick between it and the adjoint walks is a near tie its
+        # pilots' seeds decide (predicted work 5.15e7 against 6.72e7 under the old pilot seeds, 5.03e7 against
+        # 4.68e7 under docs/streams.md's), so either may run, and bidirectional only as the push on b
+        rc, out, err = run(ulam, ["solve", p, "--source", "45", "--index", "21", "--rel-err", "0.1", "--verbose"])
+        method = re.search(r"^method +(.*)$", out, re.M)
+        assert rc == 0 and method and re.search(r"^ +\*? *bidirectional \(reverse push, walks from b\) .* predicted "
+                                                r"[0-9.e+]+ walks", out, re.M), (rc, out, err)
+        assert re.match(r"adjoint walks|bidirectional, the push on b", method.group(1)), out
 
 
 def check_solve_json(ulam):
