@@ -1636,13 +1636,14 @@ typedef enum ulam_stream_purpose {
     ULAM_STREAM_PILOT = 2,     /* pilot k of auto's choice or bidir's plan */
     ULAM_STREAM_PROBE = 3,     /* probe k of bidir's push/walk split */
     ULAM_STREAM_ITERATION = 4, /* outer iteration k of MCSA / sequential Monte Carlo */
-    ULAM_STREAM_POINT = 5,     /* radiosity point or work-plane node k */
+    ULAM_STREAM_POINT = 5,     /* radiosity point, work-plane node, mesh sample or view patch k */
     ULAM_STREAM_STUDY = 6      /* run k of a variance study */
 } ulam_stream_purpose;
 
 /* The seed of sub-run k for purpose p under seed: splitmix64's finalizer chained over (seed, p,
- * k), so distinct (p, k) give unrelated seeds and the same triple gives the same seed from C, the
- * CLI and Python.  Every derived seed in ulam comes from here (docs/streams.md). */
+ * k), its top bit cleared (below 2^63, so the CLI's --seed and Python take it), so distinct (p, k)
+ * give unrelated seeds and the same triple gives the same seed from C, the CLI and Python.  Every
+ * derived seed in ulam comes from here (docs/streams.md). */
 uint64_t ulam_rng_substream(uint64_t seed, ulam_stream_purpose p, uint64_t k);
 
 /* ---------------------------------------------------------------- utilities */

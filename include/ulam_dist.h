@@ -87,8 +87,8 @@ int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, 
                       ulam_dist_result *r, ulam_error *err);
 
 /* x_index[k] for each k < nq at once (the queries' walks share the rounds): res[k] as
- * ulam_dist_adjoint gives for index[k] with seed o->seed + k, bit for bit (the counts of walks,
- * steps and messages are the whole run's in each). */
+ * ulam_dist_adjoint gives for index[k] with seed ulam_rng_substream(o->seed, ULAM_STREAM_QUERY, k),
+ * bit for bit (the counts of walks, steps and messages are the whole run's in each). */
 int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
                            const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err);
 

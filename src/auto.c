@@ -19,8 +19,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const uint64_t PILOT_SEED = UINT64_C(0x5851f42d4c957f2d);
-
 #define ULAM__AUTO_RESOLVE 4.0 /* a pilot mean this many standard errors from 0 resolves |x| (to about 25%) */
 #define ULAM__AUTO_GROW 64     /* an unresolved leader's pilots grow to this many times pilot_max */
 
@@ -311,7 +309,7 @@ static ulam_walk_opts pilot_opts(const chooser *c, int k, int stage, int64_t n)
     ulam_walk_opts o = c->base;
     o.mode = a->mode, o.estimator = a->estimator, o.kernel.continue_q = a->continue_q;
     o.stop.max_walks = n, o.stop.max_seconds = 0, o.stop.interrupt = NULL, o.exec.share = NULL, o.kernel.whole_kernel = 0;
-    o.exec.seed = c->base.exec.seed ^ (PILOT_SEED + (uint64_t)(64 * k + stage));
+    o.exec.seed = ulam_rng_substream(c->base.exec.seed, ULAM_STREAM_PILOT, (uint64_t)(64 * k + stage)); /* streams.md */
     o.kernel.kernel_alpha = a->kernel_alpha;
     o.policy.guard = &c->guard[c->gi[k] % KERNELS];
     return o;

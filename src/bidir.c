@@ -212,7 +212,7 @@ static int pilot(ulam_analysis *at, const double *ones, const ulam_bidir_opts *o
     po.estimator = ULAM_COLLISION;
     po.stop.max_walks = PILOT, po.stop.max_seconds = 0, po.exec.share = NULL, po.kernel.whole_kernel = 0;
     po.exec.threads = 1; /* one partial block: a thread team would only be woken (same result for any count) */
-    po.exec.seed = o->walk.exec.seed ^ UINT64_C(0x9e3779b97f4a7c15);
+    po.exec.seed = ulam_rng_substream(o->walk.exec.seed, ULAM_STREAM_PILOT, UINT64_C(1) << 32); /* docs/streams.md */
     po.stop.interrupt = NULL;
     int how = ULAM__WALKS_FIXED | (o->reach_all ? ULAM__WALKS_ALL : ULAM__WALKS_FIND) | (o->keep_kernel ? ULAM__WALKS_KEEP : 0);
     return ulam__analysis_walks(at, ones, &po, how, NULL, NULL, out, err);
@@ -243,7 +243,8 @@ static double probe(const ulam_csr *Mt, ulam_push *w, const ulam_bidir_opts *o, 
 {
     ulam_bidir_opts po = *o;
     po.walk.stop.rel_err = 0, po.walk.stop.max_walks = PROBE, po.walk.stop.max_seconds = 0, po.walk.stop.interrupt = NULL;
-    po.walk.exec.share = NULL, po.walk.exec.threads = 1, po.walk.exec.seed = o->walk.exec.seed ^ UINT64_C(0x3c6ef372fe94f82b);
+    po.walk.exec.share = NULL, po.walk.exec.threads = 1;
+    po.walk.exec.seed = ulam_rng_substream(o->walk.exec.seed, ULAM_STREAM_PROBE, 0); /* docs/streams.md */
     ulam_walk_result wr;
     ulam_guard g;
     double part = dot_b(ulam_push_estimates(w), o);

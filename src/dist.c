@@ -48,6 +48,7 @@ typedef struct {
     vec ends, tallies;  /* finished adjoint histories; forward tallies of this batch */
     const double *b;    /* forward: the sources' b at this rank's rows */
     int64_t steps, crossings, bytes, rounds, cut;
+    int many;           /* a batch of two or more queries: query k walks on seed ulam_rng_substream(seed, QUERY, k) */
 } run;
 
 /* The defaults. */
@@ -65,13 +66,15 @@ static int push(vec *v, const void *x, size_t sz)
 }
 
 /* Move x one step from its row (owned here): 0 when the walk ends, 1 with x at its new row (walk
- * id k o->walks + w is walk w of query k, its numbers keyed by seed + k).  It
+ * id k o->walks + w is walk w of query k; in a batch of two or more queries query k is keyed by
+ * its QUERY substream, a lone query by seed: docs/streams.md).  It
  * leaves with probability min(1, S) (S the row's sum of |entries|) to entry q with probability
  * |val_q| / S, the weight times sign(val_q) S / min(1, S). */
-static int move(const ulam_part *p, const ulam__rows *A, const ulam_dist_opts *o, particle *x)
+static int move(const ulam_part *p, const ulam__rows *A, const ulam_dist_opts *o, int many, particle *x)
 {
     int64_t i = x->s - p->first, t = x->t + 1;
-    uint64_t seed = o->seed + (uint64_t)(x->w / o->walks), w = (uint64_t)(x->w % o->walks); /* query k: seed + k */
+    uint64_t k = (uint64_t)(x->w / o->walks), w = (uint64_t)(x->w % o->walks);
+    uint64_t seed = many ? ulam_rng_substream(o->seed, ULAM_STREAM_QUERY, k) : o->seed;
     double S = A->rowsum[i], c = S < 1.0 ? S : 1.0;
     if (S == 0.0 || ulam_rng_counter(seed, w, (uint64_t)t, 0) >= c) return 0;
     double u = ulam_rng_counter(seed, w, (uint64_t)t, 1) * S, acc = 0.0;
@@ -97,7 +100,7 @@ static int advance(run *R, particle x, int forward)
         } else {
             x.score += x.wt * p->b[x.s - p->first];
         }
-        if (!move(p, forward ? &p->t : &p->m, &R->o, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
+        if (!move(p, forward ? &p->t : &p->m, &R->o, R->many, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
         R->steps++;
         int own = p->nranks > 1 ? ulam__part_owner(p, x.s) : 0;
         if (own != p->rank) { /* to the rank of this set that owns the row */
@@ -363,6 +366,7 @@ static int adjoint(const ulam_part *p, const ulam_comm *comm, const int64_t *ind
     }
     run R;
     int status = start(&R, p, comm, o, 0, err);
+    R.many = nq > 1;
     if (!status && R.o.walks > INT64_MAX / nq) status = ulam__fail(err, ULAM_EINVAL, 0, -1, "walks times queries below 2^63");
     int64_t total = status ? 0 : R.o.walks * nq;
     double *m = calloc((size_t)nq * 9, sizeof *m); /* n, mean, M2 of each query (rank 0); then stderr; then ci */

@@ -95,7 +95,7 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
             break;
         }
         ulam_dist_result res;
-        w.seed = (o ? o->seed : 1) + (uint64_t)it; /* iteration it's walks: their own streams */
+        w.seed = ulam_rng_substream(o ? o->seed : 1, ULAM_STREAM_ITERATION, (uint64_t)it); /* docs/streams.md */
         status = ulam_dist_forward_b(p, comm, &w, r, d, NULL, &res, err);
         if (!status && from_set0(p, comm, d)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
         for (int64_t i = 0; !status && i < rows; i++) x[i] += d[i]; /* the Monte Carlo correction */

@@ -173,14 +173,6 @@ int ulam_outer_alloc(const ulam_csr *M, const double *b, const ulam_outer_opts *
     return ULAM_OK;
 }
 
-/* The seed of iteration l's walks: drawn from the stream (seed, l). */
-static uint64_t iteration_seed(uint64_t seed, int l)
-{
-    ulam_rng r;
-    ulam_rng_seed(&r, seed, (uint64_t)l);
-    return ulam_rng_next(&r);
-}
-
 /* ||stderr||_1 / ||delta||_1 of the walks so far, into delta and se. */
 static double rel_sd(ulam_outer *s)
 {
@@ -213,7 +205,7 @@ static int correct(ulam_outer *s, double fed, ulam_outer_step *st)
     ulam_walk_opts w = s->o.walk;
     w.mode = ULAM_FORWARD, w.query.index = 0;
     w.stop.max_walks = s->o.max_histories, w.stop.rel_err = 0.0, w.stop.max_seconds = 0.0;
-    w.exec.seed = iteration_seed(s->o.walk.exec.seed, s->iter);
+    w.exec.seed = ulam_rng_substream(s->o.walk.exec.seed, ULAM_STREAM_ITERATION, (uint64_t)s->iter); /* streams.md */
     memcpy(s->rf, s->r, (size_t)s->n * sizeof *s->rf); /* the walks' source: r is overwritten by trials */
     memcpy(s->x0, s->x, (size_t)s->n * sizeof *s->x0);
     int status = s->sv ? ulam__solver_restart(s->sv, s->rf, w.exec.seed, NULL)

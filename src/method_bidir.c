@@ -196,7 +196,7 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     r->bwo = dense_walk_opts(o, c, qi);
     ulam_walk_opts po = r->bwo;
     po.stop.max_walks = DENSE_PILOT, po.stop.max_seconds = 0, po.stop.interrupt = NULL, po.exec.share = NULL;
-    po.exec.seed = o->exec.seed ^ UINT64_C(0x9e3779b97f4a7c15);
+    po.exec.seed = ulam_rng_substream(o->exec.seed, ULAM_STREAM_PILOT, (UINT64_C(1) << 32) + 1); /* docs/streams.md */
     ulam_solver *sv = NULL;
     ulam_walk_result wr;
     status = ulam_solver_alloc(q->M, r->br, &po, &sv, err);
@@ -219,13 +219,13 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     return ULAM_OK;
 }
 
-/* A pilot round (DENSE_PILOT walks) of o's walks on b, seed o's ^ salt, into *wr. */
-static int pilot_on(const ulam_csr *M, const double *b, const ulam_walk_opts *o, uint64_t salt, ulam_walk_result *wr,
+/* A pilot round (DENSE_PILOT walks) of o's walks on b, on pilot k's seed (docs/streams.md), into *wr. */
+static int pilot_on(const ulam_csr *M, const double *b, const ulam_walk_opts *o, uint64_t k, ulam_walk_result *wr,
                     ulam_error *err)
 {
     ulam_walk_opts po = *o;
     po.stop.max_walks = DENSE_PILOT, po.stop.max_seconds = 0, po.stop.interrupt = NULL, po.exec.share = NULL;
-    po.exec.seed = o->exec.seed ^ salt;
+    po.exec.seed = ulam_rng_substream(o->exec.seed, ULAM_STREAM_PILOT, k);
     ulam_solver *sv = NULL;
     int status = ulam_solver_alloc(M, b, &po, &sv, err);
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
@@ -251,14 +251,14 @@ static void interval_at(const ulam_walk_result *w, double off, double n, ulam__s
         ulam__stop_interval((int64_t)n, w->estimate, w->variance, R, 0.0, 0.0, INFINITY, 0, ci);
 }
 
-/* A pilot round of the walks leader on b (seed o's ^ salt) on its own solver, which is then set
+/* A pilot round of the walks leader on b (pilot k's seed, docs/streams.md) on its own solver, which is then set
  * back to the run's options (ulam__solver_rerun: the same walks as before, bit for bit; its rows,
  * reachable set and bounds are reused, so the pilot costs its walks alone), into *wr. */
-static int leader_pilot(ulam_run *r, uint64_t salt, ulam_walk_result *wr, ulam_error *err)
+static int leader_pilot(ulam_run *r, uint64_t k, ulam_walk_result *wr, ulam_error *err)
 {
     ulam_walk_opts po = r->o;
     po.stop.max_walks = DENSE_PILOT, po.stop.max_seconds = 0, po.stop.interrupt = NULL, po.exec.share = NULL;
-    po.exec.seed = r->o.exec.seed ^ salt;
+    po.exec.seed = ulam_rng_substream(r->o.exec.seed, ULAM_STREAM_PILOT, k);
     int status = ulam__solver_rerun(r->sv, &po, err);
     while (!status && !ulam_solver_done(r->sv)) status = ulam_solver_iterate(r->sv);
     if (!status) ulam_solver_result(r->sv, wr);
@@ -282,7 +282,7 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
     const ulam_auto_candidate *c = &ch->walks.cand[ch->walks.chosen];
     double N = q->o->stop.max_walks > 0 ? (double)q->o->stop.max_walks : floor(W / c->work_per_walk);
     ulam_walk_result wb, wr;
-    int status = q->run->sv ? leader_pilot(q->run, UINT64_C(0x2545f4914f6cdd1d), &wb, err) : ULAM_EINVAL;
+    int status = q->run->sv ? leader_pilot(q->run, (UINT64_C(1) << 32) + 3, &wb, err) : ULAM_EINVAL;
     if (status) return status == ULAM_ENOMEM ? status : ULAM_OK; /* the leader's own run will say why */
     ulam__stop_ci cb, cr;
     interval_at(&wb, q->o->stop.rel_err_offset, N, &cb);
@@ -464,7 +464,7 @@ static int pin(ulam__query *q, int k, ulam_error *err)
                               (long long)ulam_method_sparse_limit(n));
         ulam_walk_opts po = dense_walk_opts(q->o, NULL, 0.0);
         ulam_walk_result wr;
-        int status = pilot_on(q->M, q->b, &po, UINT64_C(0x7f4a7c159e3779b9), &wr, err);
+        int status = pilot_on(q->M, q->b, &po, (UINT64_C(1) << 32) + 2, &wr, err);
         if (status) return status;
         double m = fabs(wr.estimate + q->o->stop.rel_err_offset), rmax;
         if (q->o->stop.rel_err > 0) {

@@ -60,10 +60,11 @@ double ulam_rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k)
     return (double)(h >> 11) * 0x1.0p-53;
 }
 
-/* The seed of sub-run k for purpose p: the mix chained over (seed, p, k). */
+/* The seed of sub-run k for purpose p: the mix chained over (seed, p, k), its top bit cleared
+ * (a seed the CLI's --seed and Python's seed= take: 0 .. 2^63 - 1). */
 uint64_t ulam_rng_substream(uint64_t seed, ulam_stream_purpose p, uint64_t k)
 {
     uint64_t h = mix64(seed + 0x9e3779b97f4a7c15ULL);
     h = mix64(h ^ ((uint64_t)p * 0xd1b54a32d192ed03ULL));
-    return mix64(h + (k + 1) * 0x9e3779b97f4a7c15ULL);
+    return mix64(h + (k + 1) * 0x9e3779b97f4a7c15ULL) & 0x7fffffffffffffffULL;
 }

@@ -260,8 +260,8 @@ static void test_dist_sets(void **state)
     unlink(path);
 }
 
-/* Many queries at once (ulam_dist_adjoint_many): query k's answer is a lone run's with seed + k,
- * bit for bit, at 1 and 3 ranks. */
+/* Many queries at once (ulam_dist_adjoint_many): query k's answer is a lone run's with seed
+ * ulam_rng_substream(seed, ULAM_STREAM_QUERY, k) (docs/streams.md), bit for bit, at 1 and 3 ranks. */
 static void test_dist_many(void **state)
 {
     (void)state;
@@ -275,7 +275,8 @@ static void test_dist_many(void **state)
         job jobs[MAXR], t = {.path = path, .walks = 3000, .many = idx, .nq = 4};
         run_jobs(k, &t, jobs);
         for (int q = 0; q < 4; q++) {
-            job lone[1], one = {.path = path, .walks = 3000, .index = idx[q], .seed = (uint64_t)q};
+            uint64_t own = ulam_rng_substream(7, ULAM_STREAM_QUERY, (uint64_t)q); /* run_job's seed is 7 + .seed */
+            job lone[1], one = {.path = path, .walks = 3000, .index = idx[q], .seed = own - 7};
             run_jobs(1, &one, lone);
             for (int r = 0; r < k; r++) {
                 assert_int_equal(jobs[r].status, ULAM_OK);

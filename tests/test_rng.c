@@ -69,11 +69,51 @@ static void test_bounded(void **state)
     for (int k = 0; k < 1000; k++) assert_true(ulam_rng_bounded(&r, big) < big);
 }
 
+/* ulam_rng_substream: the documented formula's values (docs/streams.md, computed independently),
+ * the same triple the same seed, below 2^63 (a --seed the CLI takes), and the 6 x 2000 (purpose,
+ * k) of three seeds all distinct from each other and from the seeds themselves. */
+/* qsort's order on uint64_t. */
+static int by_value(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* ulam_rng_substream: the documented formula's values (docs/streams.md, computed independently),
+ * the same triple the same seed, below 2^63 (a --seed the CLI takes), and the 6 x 2000 (purpose,
+ * k) of three seeds all distinct from each other and from the seeds themselves. */
+static void test_substream(void **state)
+{
+    (void)state;
+    assert_true(ulam_rng_substream(1, ULAM_STREAM_QUERY, 0) == UINT64_C(3603747775286318917));
+    assert_true(ulam_rng_substream(11, ULAM_STREAM_QUERY, 3) == UINT64_C(2099057283005048251));
+    assert_true(ulam_rng_substream(42, ULAM_STREAM_PILOT, 0) == UINT64_C(6161051708188775094));
+    assert_true(ulam_rng_substream(0, ULAM_STREAM_STUDY, 7) == UINT64_C(2006811855215911423));
+    enum { P = 6, K = 2000, S = 3 };
+    const uint64_t seeds[S] = {0, 1, 2};
+    uint64_t *all_seeds = malloc((size_t)(P * K * S + S) * sizeof *all_seeds);
+    assert_non_null(all_seeds);
+    size_t n = 0;
+    for (int s = 0; s < S; s++) {
+        all_seeds[n++] = seeds[s];
+        for (int p = ULAM_STREAM_QUERY; p <= ULAM_STREAM_STUDY; p++)
+            for (uint64_t k = 0; k < K; k++) {
+                uint64_t v = ulam_rng_substream(seeds[s], (ulam_stream_purpose)p, k);
+                assert_true(v == ulam_rng_substream(seeds[s], (ulam_stream_purpose)p, k) && v < UINT64_C(1) << 63);
+                all_seeds[n++] = v;
+            }
+    }
+    qsort(all_seeds, n, sizeof *all_seeds, by_value);
+    for (size_t q = 1; q < n; q++) assert_true(all_seeds[q] != all_seeds[q - 1]);
+    free(all_seeds);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reference_output), cmocka_unit_test(test_streams),
         cmocka_unit_test(test_uniform), cmocka_unit_test(test_bounded),
+        cmocka_unit_test(test_substream),
     };
     return test_run(tests);
 }

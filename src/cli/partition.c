@@ -27,8 +27,8 @@ static const char *const help =
     "at most 1 and power iteration certifies a Collatz-Wielandt vector below 1 (the walk's length\n"
     "tail, so a score's range after clipping; docs/distributed.md).\n"
     "  --index I       x_I by adjoint walks from I (1-based)\n"
-    "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, query k\n"
-    "                  with seed S + k - 1: a line answers what --index I --seed S+k-1 answers\n"
+    "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, each on\n"
+    "                  a seed of its own, printed: a line answers what --index I --seed SEED answers\n"
     "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector, --errors\n"
     "                  their standard errors (also with --source)\n"
     "  --method mcsa   every x_i by MCSA: Richardson steps (products with M across ranks) and forward\n"
@@ -225,11 +225,12 @@ static void print_estimate(int64_t i, double est, double se, double rho, const u
 }
 
 /* One query's answer line (rank 0): x[I] estimate +- stderr and its seed. */
-static void print_query(const cli_query *q, int64_t k, const ulam_dist_result *r, uint64_t seed, double rho,
+static void print_query(const cli_query *q, int64_t k, int64_t nq, const ulam_dist_result *r, uint64_t seed, double rho,
                         const ulam_dist_ci *ci)
 {
     print_estimate(q->index + 1, r->estimate, r->std_error, rho, ci);
-    printf("  line %ld, seed %llu", q->line, (unsigned long long)(seed + (uint64_t)k));
+    uint64_t own = nq > 1 ? ulam_rng_substream(seed, ULAM_STREAM_QUERY, (uint64_t)k) : seed; /* docs/streams.md */
+    printf("  line %ld, seed %llu", q->line, (unsigned long long)own);
     if (ci->met) printf(", %lld walks", (long long)r->walks);
     printf("\n");
 }
@@ -393,7 +394,7 @@ static int run(const args *a, const ulam_comm *c)
     if (!rc && a->errors) rc = write_x(c, a->errors, se, in_set0 ? last - first : 0, n, "standard errors of x");
     int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
     if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
-    for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, &many[k], a->o.seed, rho, &ci[k]);
+    for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, nq, &many[k], a->o.seed, rho, &ci[k]);
     if (!rc && a->source) rc = print_top(c, x, se, first, in_set0 ? last - first : 0, a->top, rho); /* set 0's rows */
     if (!rc && c->rank == 0 && a->mcsa)
         printf("x               %lld components by MCSA%s%s\nmcsa            %d iterations, residual %.3g of max |b| "

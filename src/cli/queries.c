@@ -5,8 +5,9 @@
  * point source, by the bidirectional method), then optionally a relative-error target for that
  * line alone written as a real with a point or an exponent (0.01, 1e-3); indices are 1-based
  * integers; '#' starts a comment; blank lines are skipped.  Query k (1-based, in file order)
- * walks with seed --seed + k - 1, so it answers exactly what `ulam solve --method walks --index
- * I --seed S+k-1` answers on a prepared file (and on a Matrix Market file at fixed --walks; a
+ * walks with the seed ulam_rng_substream(--seed, ULAM_STREAM_QUERY, k - 1) it prints (docs/streams.md),
+ * so it answers exactly what `ulam solve --method walks --index I --seed SEED` with that printed seed
+ * answers on a prepared file (and on a Matrix Market file at fixed --walks; a
  * --rel-err run there walks under bounds over every state, which may ask for more walks than a
  * lone run's search of its start's reach).  One result a line, flushed as it is made: Ctrl-C
  * stops the query under way and keeps the answered lines (exit 130).  The whole file is read
@@ -227,7 +228,7 @@ int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int js
     cli_catch_sigint();
     for (int64_t k = 0; !rc && k < nq; k++) {
         ulam_walk_opts ok = base;
-        ok.exec.seed = o->exec.seed + (uint64_t)k; /* query k's seed: --seed + k - 1 (1-based k) */
+        ok.exec.seed = ulam_rng_substream(o->exec.seed, ULAM_STREAM_QUERY, (uint64_t)k); /* printed with the answer */
         if (q[k].target > 0) ok.stop.rel_err = q[k].target, ok.stop.max_walks = walks_given ? ok.stop.max_walks : 0;
         rc = run_query(&w, &q[k], k, ok, json);
     }

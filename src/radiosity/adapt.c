@@ -235,9 +235,7 @@ static int measure(mesh *m, int64_t i, const ulam_tracer *t, const ulam_rad_opts
         double x[3];
         for (int d = 0; d < 3; d++) x[d] = k ? 0.5 * (c[d] + m->vert[3 * v[k - 1] + d]) : c[d];
         ulam_rad_opts o = *opts;
-        ulam_rng r;
-        ulam_rng_seed(&r, opts->exec.seed, 16 * (uint64_t)i + (uint64_t)k);
-        o.exec.seed = ulam__rng_next(&r);
+        o.exec.seed = ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, 16 * (uint64_t)i + (uint64_t)k);
         if (opts->stop.max_seconds > 0 && !((o.stop.max_seconds = opts->stop.max_seconds - (ulam_now() - t0)) > 0)) {
             info->interrupted = 1;
             return ULAM_OK;

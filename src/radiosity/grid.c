@@ -44,9 +44,7 @@ int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const u
         for (int i = 0; i < g->nu && !status; i++) {
             int64_t k = (int64_t)j * g->nu + i;
             ulam_rad_opts o = *opts;
-            ulam_rng r;
-            ulam_rng_seed(&r, opts->exec.seed, (uint64_t)k);
-            o.exec.seed = ulam__rng_next(&r);
+            o.exec.seed = ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, (uint64_t)k); /* docs/streams.md */
             if (opts->stop.max_seconds > 0) { /* the time limit is the whole grid's */
                 o.stop.max_seconds = opts->stop.max_seconds - (ulam_now() - t0);
                 if (!(o.stop.max_seconds > 0)) o.stop.max_seconds = 1e-9; /* one block still runs: an estimate */

@@ -37,9 +37,7 @@ int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_rad_opts *opts, const d
             o.stop.max_seconds = (opts->stop.max_seconds - (ulam_now() - t0)) / (out->npoints - k);
             if (!(o.stop.max_seconds > 0)) o.stop.max_seconds = 1e-9; /* one block still runs: an estimate */
         }
-        ulam_rng r;
-        ulam_rng_seed(&r, opts->exec.seed, (uint64_t)k + 1);
-        o.exec.seed = ulam__rng_next(&r);
+        o.exec.seed = ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, (uint64_t)k); /* docs/streams.md */
         double x[3];
         quad_point(s, p, k, x);
         ulam_rad_point pt;

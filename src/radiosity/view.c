@@ -60,10 +60,9 @@ int ulam_view_gather(const ulam_tracer *t, const ulam_camera *cam, int width, in
             in.unmet++;
             continue;
         }
-        ulam_rng r;
-        ulam_rng_seed(&r, opts->exec.seed, (uint64_t)p);
         double target = opts->stop.rel_err * pow((double)most / (double)pix[p], coverage);
-        ulam__rad_solver_restart(sv, p, target, ulam__rng_next(&r), left);
+        uint64_t seed = ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, (uint64_t)p); /* docs/streams.md */
+        ulam__rad_solver_restart(sv, p, target, seed, left);
         while (!status && !ulam_rad_solver_done(sv)) status = ulam_rad_solver_iterate(sv);
         ulam_rad_result res;
         ulam_rad_solver_result(sv, &res);
