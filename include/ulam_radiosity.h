@@ -12,7 +12,8 @@
  *     ulam_render, ulam_png_write;
  *   secondary: ulam_scene_subdivide, ulam_scene_centroid, ulam_scene_label_centroid,
  *     ulam_tracer_cast, ulam_tracer_shoot, ulam_ff_report_compute, ulam_rad_system,
- *     ulam_rad_direct_error, ulam_rad_direct_errors, ulam_view_gather, ulam_view_pixels;
+ *     ulam_rad_direct_error, ulam_rad_direct_errors, ulam_view_gather, ulam_view_pixels,
+ *     ulam_rad_solver_whole, ulam_rad_solver_scene;
  *   tertiary: ulam_tracer_resolution, ulam_ff_parallel_rectangles,
  *     ulam_ff_perpendicular_rectangles (exact references for tests). */
 #ifndef ULAM_RADIOSITY_H
@@ -214,7 +215,7 @@ int ulam_rad_direct_errors(const ulam_scene *s, const ulam_csr *F, int64_t rays,
                            size_t max_bytes, double *se, ulam_error *err);
 
 /* ---------------------------------------------------------------- patch walks */
-/* All primary. */
+/* All primary but ulam_rad_solver_whole and ulam_rad_solver_scene (secondary). */
 
 /* The radiosity estimators: opts->estimator of ulam_rad_solver_alloc and ulam_rad_point_alloc
  * is one of these (its own enum, not ulam.h's ulam_estimator; 0, ulam_rad_defaults()'s, is
