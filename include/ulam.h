@@ -1707,6 +1707,22 @@ int ulam_study_cell_get(const ulam_study *s, int k, int b, ulam_study_cell *out)
  * (a method not yet measured: the dearest measured); a time budget is its own cost. */
 double ulam_study_seconds_left(const ulam_study *s);
 
+/* 1 when forward walks on M have a certified finite variance (rho(|M|) and the forward rho(M^)
+ * below 1): the outer iterations' reference lines can walk. */
+int ulam_study_forward_walks(const ulam_study *s);
+
+/* The reference lines a study's charts draw beside its runs, each point to fn(kind, seconds,
+ * error on x_index, arg) in this order: "lapack" (when the exact value is LAPACK's: its seconds,
+ * its difference from Gauss-Seidel's settled value), "gs" (Gauss-Seidel from x = 0 at sweeps 1,
+ * 2, 4, ... and the sweep its error falls to 1e-9 |x|), "sequential" and "mcsa" (one run each,
+ * seed p->seed, tolerance 1e-10, for at most reference_time seconds; only when
+ * ulam_study_forward_walks and reference_time > 0), then "cg" when M is symmetric, else "gmres"
+ * (GMRES(30)), at tolerances 1e-1 .. 1e-10 (a solve's seconds: the mean of repeats over at least
+ * 1 ms).  p->interrupt stops them.  ULAM_OK, ULAM_EINVAL or ULAM_ENOMEM. */
+int ulam_study_reference_lines(const ulam_study *s, double reference_time,
+                               void (*fn)(const char *kind, double seconds, double error, void *arg), void *arg,
+                               ulam_error *err);
+
 /* ---------------------------------------------------------------- random numbers */
 /* All tertiary. */
 

@@ -403,3 +403,76 @@ double ulam_study_seconds_left(const ulam_study *s)
                     left += s->p.time_budgets ? s->budget[b] : s->budget[b] * (isnan(spw[m]) ? dearest : spw[m]);
     return left;
 }
+
+/* See ulam.h. */
+int ulam_study_forward_walks(const ulam_study *s)
+{
+    return s && (s->g.verdict_abs == ULAM_VERDICT_OK || s->g.verdict_abs == ULAM_VERDICT_EDGE) &&
+           ulam_guard_variance(&s->g, ULAM_FORWARD) == 1;
+}
+
+/* Nonzero once the study's interrupt is set. */
+static int stopped(const ulam_study *s)
+{
+    return s->p.interrupt && *s->p.interrupt;
+}
+
+/* Sequential MC's and MCSA's lines: one run each, its error on x_index against its seconds. */
+static void outer_lines(const ulam_study *s, double reference_time,
+                        void (*fn)(const char *kind, double seconds, double error, void *arg), void *arg)
+{
+    int64_t n = s->M->nrows;
+    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA && ulam_study_forward_walks(s) && reference_time > 0; m++) {
+        ulam_outer_opts o = ulam_outer_defaults();
+        o.method = m, o.tol = 1e-10, o.walk.exec.seed = s->p.seed, o.walk.exec.threads = s->p.threads;
+        o.walk.stop.interrupt = s->p.interrupt, o.max_histories = 20 * n > 1000000 ? 20 * n : 1000000;
+        ulam_outer *it = NULL;
+        if (ulam_outer_alloc(s->M, s->b, &o, &it, NULL)) continue;
+        double t = 0;
+        while (!ulam_outer_done(it) && t < reference_time && !stopped(s)) {
+            ulam_outer_step step;
+            ulam_outer_iterate(it, &step);
+            t += step.seconds;
+            fn(m == ULAM_MCSA ? "mcsa" : "sequential", t, fabs(ulam_outer_x(it)[s->index] - s->ref.exact), arg);
+        }
+        ulam_outer_free(it);
+    }
+}
+
+/* See ulam.h. */
+int ulam_study_reference_lines(const ulam_study *s, double reference_time,
+                               void (*fn)(const char *kind, double seconds, double error, void *arg), void *arg,
+                               ulam_error *err)
+{
+    ulam__clear(err);
+    if (!s || !fn) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a study and a function for the points");
+    int64_t n = s->M->nrows, I = s->index;
+    double *x = ulam__calloc((size_t)n, sizeof *x), exact = s->ref.exact;
+    if (!x) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the reference solves");
+    if (s->ref.direct) fn("lapack", s->ref.direct_seconds, fabs(exact - s->ref.settled), arg);
+    double t = 0;
+    for (int k = 1; k <= 100000; k++) {
+        double t0 = ulam_now();
+        ulam_gauss_seidel_sweep(s->M, s->b, x);
+        t += ulam_now() - t0;
+        double e = fabs(x[I] - exact);
+        if ((k & (k - 1)) == 0 || e <= 1e-9 * fabs(exact)) fn("gs", t, e, arg);
+        if (!(e > 1e-9 * fabs(exact))) break;
+    }
+    outer_lines(s, reference_time, fn, arg);
+    int cg = ulam_csr_symmetric(s->M);
+    for (int k = 1; k <= 10 && !stopped(s); k++) { /* a solve's time: the mean of repeats over >= 1 ms (one solve
+                                                      of a small system is microseconds, the first ones many times
+                                                      the rest: the line ran backwards) */
+        int its, reps = 0, status;
+        double res, t0 = ulam_now();
+        do {
+            status = cg ? ulam_cg(s->M, s->b, pow(10.0, -k), 100000, x, &its, &res)
+                        : ulam_gmres(s->M, s->b, 30, pow(10.0, -k), 100000, x, &its, &res);
+            t = ulam_now() - t0;
+        } while (++reps < 1000 && t < 1e-3 && (status == ULAM_OK || status == ULAM_ENOCONV));
+        if (status == ULAM_OK || status == ULAM_ENOCONV) fn(cg ? "cg" : "gmres", t / reps, fabs(x[I] - exact), arg);
+    }
+    free(x);
+    return ULAM_OK;
+}

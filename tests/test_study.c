@@ -113,6 +113,49 @@ static void test_refused(void **state)
     test_sys_free(&s);
 }
 
+/* The reference lines' points, in order. */
+typedef struct {
+    char kind[16][16];
+    double seconds[256], error[256];
+    int n, kinds;
+} lines;
+
+/* Keep one point of a reference line. */
+static void keep(const char *kind, double seconds, double error, void *arg)
+{
+    lines *l = arg;
+    if (!l->kinds || strcmp(l->kind[l->kinds - 1], kind)) snprintf(l->kind[l->kinds++], 16, "%s", kind);
+    if (l->n < 256) l->seconds[l->n] = seconds, l->error[l->n++] = error;
+}
+
+/* The reference lines on chain4 (n = 4, forward walks certified): LAPACK's point, Gauss-Seidel
+ * down to 1e-9 |x_2|, sequential MC and MCSA, then the Krylov peer (GMRES: chain4 is not
+ * symmetric) ending within 1e-9 of x_2; none of the walked lines at reference_time 0. */
+static void test_reference_lines(void **state)
+{
+    (void)state;
+    test_sys s = test_sys_load("chain4");
+    int methods[2] = {0, 1};
+    double budgets[2] = {100, 1000};
+    ulam_study_params p = params(methods, budgets, 2);
+    ulam_study *st = NULL;
+    assert_int_equal(ulam_study_alloc(s.M, s.b, 1, &p, &st, NULL), ULAM_OK);
+    assert_int_equal(ulam_study_forward_walks(st), 1);
+    static lines l;
+    memset(&l, 0, sizeof l);
+    assert_int_equal(ulam_study_reference_lines(st, 0.01, keep, &l, NULL), ULAM_OK);
+    const char *want[] = {"lapack", "gs", "sequential", "mcsa", ulam_csr_symmetric(s.M) ? "cg" : "gmres"};
+    assert_int_equal(l.kinds, 5);
+    for (int k = 0; k < 5; k++) assert_string_equal(l.kind[k], want[k]);
+    assert_true(l.error[l.n - 1] <= 1e-9 * fabs(s.x[1]) && l.error[0] <= 1e-12 * fabs(s.x[1]));
+    memset(&l, 0, sizeof l);
+    assert_int_equal(ulam_study_reference_lines(st, 0, keep, &l, NULL), ULAM_OK);
+    assert_int_equal(l.kinds, 3); /* lapack, gs, the Krylov peer */
+    assert_int_equal(ulam_study_reference_lines(st, 0, NULL, NULL, NULL), ULAM_EINVAL);
+    ulam_study_free(st);
+    test_sys_free(&s);
+}
+
 /* A run stopped by the interrupt flag is not recorded; bad parameters are ULAM_EINVAL. */
 static void test_interrupt_and_bad_params(void **state)
 {
@@ -154,6 +197,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_runs_honest), cmocka_unit_test(test_same_seed_same_runs),
         cmocka_unit_test(test_refused), cmocka_unit_test(test_interrupt_and_bad_params),
+        cmocka_unit_test(test_reference_lines),
     };
     return test_run(tests);
 }

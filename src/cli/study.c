@@ -150,8 +150,7 @@ static int screen_methods(study *st)
     if (ulam_study_alloc(st->s.M, st->s.b, st->s.index - 1, &p, &st->lib, &err))
         return cli_report(st->s.matrix_path, &err);
     const ulam_guard *g = ulam_study_guard(st->lib);
-    st->forward_walks = (g->verdict_abs == ULAM_VERDICT_OK || g->verdict_abs == ULAM_VERDICT_EDGE) &&
-                        ulam_guard_variance(g, ULAM_FORWARD) == 1;
+    st->forward_walks = ulam_study_forward_walks(st->lib);
     int left = 0;
     for (int k = 0; k < NMETHOD; k++) {
         method *m = &st->m[k];
@@ -384,90 +383,39 @@ static int run_all(study *st)
     return rc ? rc : cli_interrupted ? EXIT_INTERRUPTED : 0;
 }
 
-/* Reference lines of the methods that solve for every unknown: sequential MC and MCSA (one
- * run each, seed --seed, 10^-10 or --reference-time seconds, only when forward walks have finite
- * variance) and the Krylov peer (CG when M is symmetric, else GMRES(30); a run a tolerance
- * 10^-1 .. 10^-10): error on x_I against seconds, into f. */
-static void outer_references(const study *st, FILE *f)
+/* One point of a reference line as a reference.csv row (the error nudged off 0 for the log axis). */
+static void line_point(const char *kind, double seconds, double error, void *f)
 {
-    int64_t n = st->s.M->nrows, I = st->s.index - 1;
-    double *x = malloc((size_t)n * sizeof *x);
     char v[2][32];
-    if (!x) return;
-    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA && st->forward_walks && st->reference_time > 0; m++) {
-        ulam_outer_opts o = ulam_outer_defaults();
-        o.method = m, o.tol = 1e-10, o.walk.exec.seed = st->seed, o.walk.exec.threads = st->threads;
-        o.walk.stop.interrupt = &cli_interrupted, o.max_histories = 20 * n > 1000000 ? 20 * n : 1000000;
-        ulam_outer *it = NULL;
-        if (ulam_outer_alloc(st->s.M, st->s.b, &o, &it, NULL)) continue;
-        double t = 0;
-        while (!ulam_outer_done(it) && t < st->reference_time && !cli_interrupted) {
-            ulam_outer_step step;
-            ulam_outer_iterate(it, &step);
-            t += step.seconds;
-            fprintf(f, "%s,%s,%s\n", m == ULAM_MCSA ? "mcsa" : "sequential", num(v[0], t),
-                    num(v[1], fabs(ulam_outer_x(it)[I] - st->exact) + 1e-300));
-        }
-        ulam_outer_free(it);
-    }
-    int cg = ulam_csr_symmetric(st->s.M);
-    for (int k = 1; k <= 10 && !cli_interrupted; k++) { /* a solve's time: the mean of repeats over >= 1 ms (one
-                                                             solve of a small system is microseconds, the first
-                                                             ones many times the rest: the line ran backwards) */
-        int its, reps = 0, status;
-        double res, t0 = ulam_now(), t;
-        do {
-            status = cg ? ulam_cg(st->s.M, st->s.b, pow(10.0, -k), 100000, x, &its, &res)
-                        : ulam_gmres(st->s.M, st->s.b, 30, pow(10.0, -k), 100000, x, &its, &res);
-            t = ulam_now() - t0;
-        } while (++reps < 1000 && t < 1e-3 && (status == ULAM_OK || status == ULAM_ENOCONV));
-        if (status == ULAM_OK || status == ULAM_ENOCONV)
-            fprintf(f, "%s,%s,%s\n", cg ? "cg" : "gmres", num(v[0], t / reps), num(v[1], fabs(x[I] - st->exact) + 1e-300));
-    }
-    free(x);
+    fprintf(f, "%s,%s,%s\n", kind, num(v[0], seconds), num(v[1], error + 1e-300));
 }
 
-/* The exact x_I (ulam_study_reference) and the reference lines: LAPACK (n <= 8000: its time and
- * its error against Gauss-Seidel run to convergence) and Gauss-Seidel from x = 0 (time against
- * its error on x_I), into reference.csv.  0 or an exit code. */
+/* The exact x_I (the study's) and the reference lines (ulam_study_reference_lines: LAPACK's
+ * point, Gauss-Seidel, sequential MC and MCSA, the Krylov peer), into reference.csv.  0 or an
+ * exit code. */
 static int references(study *st)
 {
-    int64_t n = st->s.M->nrows, I = st->s.index - 1;
     const ulam_study_ref *ref = ulam_study_exact(st->lib);
     st->exact = ref->exact;
     st->direct = ref->direct, st->direct_seconds = ref->direct_seconds;
     st->direct_error = fabs(ref->exact - ref->settled) + 1e-300;
-    double *x = calloc((size_t)n, sizeof *x);
-    if (!x) return cli_exit_code(ULAM_ENOMEM);
-    char path[4096], v[2][32];
+    char path[4096];
     snprintf(path, sizeof path, "%s/reference.csv", st->out);
     ulam_outfile o = {0};
     int status = cli_rank ? ULAM_OK : cli_outfile_open(&o, path); /* under MPI, rank 0 writes */
     if (status) {
-        free(x);
         ulam_error e = {.status = status, .msg = "a writable output directory"};
         return cli_report(path, &e);
     }
     FILE *f = o.f ? o.f : fopen("/dev/null", "w");
-    if (!f) {
-        free(x);
-        return cli_exit_code(ULAM_EIO);
-    }
+    if (!f) return cli_exit_code(ULAM_EIO);
     fprintf(f, "kind,seconds,error\n");
-    if (ref->direct)
-        fprintf(f, "lapack,%s,%s\n", num(v[0], st->direct_seconds), num(v[1], st->direct_error));
-    double t = 0;
-    for (int k = 1; k <= 100000; k++) {
-        double t0 = ulam_now();
-        ulam_gauss_seidel_sweep(st->s.M, st->s.b, x);
-        t += ulam_now() - t0;
-        double e = fabs(x[I] - st->exact);
-        if ((k & (k - 1)) == 0 || e <= 1e-9 * fabs(st->exact))
-            fprintf(f, "gs,%s,%s\n", num(v[0], t), num(v[1], e + 1e-300));
-        if (!(e > 1e-9 * fabs(st->exact))) break;
+    ulam_error err;
+    if ((status = ulam_study_reference_lines(st->lib, st->reference_time, line_point, f, &err))) {
+        if (o.f) cli_outfile_abort(&o);
+        else fclose(f);
+        return cli_report(st->s.matrix_path, &err);
     }
-    free(x);
-    outer_references(st, f);
     if (!o.f) return fclose(f), 0;
     ulam_error e = {.status = cli_outfile_commit(&o), .msg = "a writable output directory"};
     return e.status ? cli_report(path, &e) : 0;
