@@ -1707,6 +1707,12 @@ int ulam_study_cell_get(const ulam_study *s, int k, int b, ulam_study_cell *out)
  * (a method not yet measured: the dearest measured); a time budget is its own cost. */
 double ulam_study_seconds_left(const ulam_study *s);
 
+/* The winner at budget b: the method with the least work (RMSE^2 x seconds) among those run with
+ * a certified finite variance and finished runs at b, its cell into *out; the method, or -1 when
+ * none has finished runs at b.  A winner whose work is infinite (every such cell has a run with
+ * no estimate) is no winner: the caller says so. */
+int ulam_study_winner(const ulam_study *s, int b, ulam_study_cell *out);
+
 /* 1 when forward walks on M have a certified finite variance (rho(|M|) and the forward rho(M^)
  * below 1): the outer iterations' reference lines can walk. */
 int ulam_study_forward_walks(const ulam_study *s);

@@ -405,6 +405,18 @@ double ulam_study_seconds_left(const ulam_study *s)
 }
 
 /* See ulam.h. */
+int ulam_study_winner(const ulam_study *s, int b, ulam_study_cell *out)
+{
+    int best = -1;
+    ulam_study_cell bc = {0}, c;
+    for (int m = 0; s && m < ULAM_STUDY_METHODS; m++)
+        if (runs(s, m) && !s->screen[m].infinite && ulam_study_cell_get(s, m, b, &c) && (best < 0 || c.work < bc.work))
+            best = m, bc = c;
+    if (out) *out = bc;
+    return best;
+}
+
+/* See ulam.h. */
 int ulam_study_forward_walks(const ulam_study *s)
 {
     return s && (s->g.verdict_abs == ULAM_VERDICT_OK || s->g.verdict_abs == ULAM_VERDICT_EDGE) &&

@@ -50,6 +50,13 @@ static void test_runs_honest(void **state)
             assert_true(c.rmse > 0 && c.mean_stderr > 0 && c.coverage >= 0 && c.coverage <= 1);
         }
     assert_int_equal(ulam_study_cell_get(st, 0 == methods[0] ? 1 : 0, 0, &c), 0); /* a method not chosen */
+    for (int b = 0; b < 2; b++) { /* the winner: the least RMSE^2 x seconds of the two */
+        ulam_study_cell c0, c1, w;
+        ulam_study_cell_get(st, methods[0], b, &c0), ulam_study_cell_get(st, methods[1], b, &c1);
+        assert_int_equal(ulam_study_winner(st, b, &w), c1.work < c0.work ? methods[1] : methods[0]);
+        assert_true(w.work == fmin(c0.work, c1.work));
+    }
+    assert_int_equal(ulam_study_winner(st, 2, &c), -1); /* no such budget */
     assert_true(ulam_study_seconds_left(st) == 0.0);
     ulam_study_free(st);
     test_sys_free(&s);

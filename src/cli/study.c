@@ -632,14 +632,8 @@ static void print_summary(const study *st)
     printf("%-12s %-28s %-10s %-10s %s\n", st->time_budgets ? "seconds" : "walks", "winner (least RMSE^2 x s)", "RMSE",
            "s a run", "coverage (95% interval)");
     for (int b = 0; b < st->nbudget; b++) {
-        int best = -1;
-        cell bc = {0};
-        for (int m = 0; m < NMETHOD; m++) {
-            if (!st->m[m].on || st->m[m].why[0] || st->m[m].infinite) continue;
-            cell c;
-            if (!method_cell(st, m, b, &c)) continue;
-            if (best < 0 || c.work < bc.work) best = m, bc = c;
-        }
+        cell bc;
+        int best = ulam_study_winner(st->lib, b, &bc);
         if (best < 0 || !isfinite(bc.work)) { /* none, or every cell has runs with no estimate */
             printf("%-12g %s\n", st->budget[b], best < 0 ? "(no finished runs)" : "(no winner: every method has runs with no estimate)");
             continue;
