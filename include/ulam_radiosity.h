@@ -338,6 +338,36 @@ void ulam_rad_grid_point(const ulam_rad_grid *g, int i, int j, double x[3]);
 int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const ulam_rad_grid *g, ulam_rad_point *out,
                         ulam_error *err);
 
+/* Point queries (ulam_rad_point_query with opts) at n given points: at[6 k .. 6 k + 2] the point,
+ * at[6 k + 3 .. 6 k + 5] its sensor's unit normal (at[6 k + 3] NaN: on a patch, its normal), out[k]
+ * its answer, point k seeded by ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, k) so it
+ * depends on no other point.  Interrupted: the points not reached are zeroed (run.walks 0).
+ * ULAM_OK, or point k's failure (err->index = k). */
+int ulam_rad_points_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const double *at, int64_t n,
+                          ulam_rad_point *out, ulam_error *err);
+
+/* The luminance weights of R, G and B (Rec. 709: 0.2126, 0.7152, 0.0722): Y = sum_c w_c X_c. */
+const double *ulam_rad_luma(void);
+
+/* A point's illuminance Y = sum_c w_c H_c (ulam_rad_luma; in the scene's units) and a bound on its
+ * standard error, the channels' added (they come from the same walks). */
+void ulam_rad_illuminance(const ulam_rad_point *r, double *Y, double *se);
+
+/* A 95% interval [*lo, *hi] for a point's illuminance, Y +- sum_c w_c h_c (h_c channel c's
+ * half-width), floored at 0; NaN .. NaN unless every channel has one. */
+void ulam_rad_illuminance_ci(const ulam_rad_point *r, double *lo, double *hi);
+
+/* What a work plane's sensors say together (ulam_rad_grid_stats). */
+typedef struct ulam_rad_grid_summary {
+    double min, mean;   /* the sensors' illuminance */
+    double uniformity;  /* min / mean (NaN when the mean is not positive) */
+    double worst;       /* the largest relative standard-error bound, over the sensors with Y > 0 */
+    int64_t walks, rays;
+} ulam_rad_grid_summary;
+
+/* The summary of n sensors' answers (n >= 1); ULAM_OK or ULAM_EINVAL. */
+int ulam_rad_grid_stats(const ulam_rad_point *pts, int64_t n, ulam_rad_grid_summary *out);
+
 /* The most quadrature points of a mesh-error estimate: the centroid and up to 8 vertex halves. */
 #define ULAM_RAD_MESH_POINTS 9
 
@@ -361,6 +391,12 @@ typedef struct ulam_rad_mesh {
  * shared among the points left; one block of walks still runs when nothing is). */
 int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_rad_opts *opts, const double B[3], ulam_rad_mesh *out,
                         ulam_error *err);
+
+/* The mesh error of every patch p (ulam_rad_mesh_error with opts, opts->index = p, seeded by
+ * ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, p)) against B (3 a patch) into out (3 a
+ * patch; NaN for the patches an interrupt left).  ULAM_OK or patch p's failure (err->index = p). */
+int ulam_rad_mesh_errors(const ulam_tracer *t, const ulam_rad_opts *opts, const double *B, double *out,
+                         ulam_error *err);
 
 /* Run one round of walks (rounds grow 1, 2, 4 ... 32 blocks of 256 walks as walks accumulate,
  * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,

@@ -269,6 +269,52 @@ static void test_grid(void **state)
     ulam_scene_free(s);
 }
 
+/* Points asked for by the caller (ulam_rad_points_solve): point k is the point query seeded by
+ * ulam_rng_substream(seed, ULAM_STREAM_POINT, k), bit for bit, and within 4 standard errors of
+ * Howell on the floor; the illuminance and the grid summary are the luminance-weighted sums (a
+ * grey scene: Y = H); a point on no patch without a normal is point k's ULAM_EINVAL. */
+static void test_points_solve(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL;
+    ulam_tracer *t = must_load("tests/data/rad/point_parallel.obj", &s);
+    double at[3][6] = {{0.25, 0.5, 0, NAN, NAN, NAN}, {1.5, 1.5, 0, NAN, NAN, NAN}, {0.5, 1.0, 0, 0, 0, 1}};
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.rel_err = 0.02, o.stop.max_walks = 0, o.exec.seed = 9, o.exec.threads = 2;
+    ulam_rad_point pts[3], one;
+    ulam_error err;
+    assert_int_equal(ulam_rad_points_solve(t, &o, &at[0][0], 3, pts, &err), ULAM_OK);
+    double sum = 0, min = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        ulam_rad_opts ok = o;
+        ok.exec.seed = ulam_rng_substream(9, ULAM_STREAM_POINT, (uint64_t)k);
+        assert_int_equal(ulam_rad_point_query(t, &ok, at[k], isnan(at[k][3]) ? NULL : at[k] + 3, &one, &err), ULAM_OK);
+        assert_memory_equal(one.irradiance, pts[k].irradiance, sizeof one.irradiance);
+        assert_true(one.run.walks == pts[k].run.walks);
+        check_point(&pts[k], parallel_at(at[k][0], at[k][1], 0, 1, 0, 2, 1), 0.5, "points");
+        double Y, se, lo, hi;
+        ulam_rad_illuminance(&pts[k], &Y, &se);
+        ulam_rad_illuminance_ci(&pts[k], &lo, &hi);
+        const double *w = ulam_rad_luma();
+        assert_close(Y, w[0] * pts[k].irradiance[0] + w[1] * pts[k].irradiance[1] + w[2] * pts[k].irradiance[2], 1e-15);
+        assert_close(w[0] + w[1] + w[2], 1.0, 1e-12);
+        assert_true(lo <= Y && Y <= hi && se > 0);
+        sum += Y, min = fmin(min, Y);
+    }
+    ulam_rad_grid_summary gs;
+    assert_int_equal(ulam_rad_grid_stats(pts, 3, &gs), ULAM_OK);
+    assert_close(gs.mean, sum / 3, 1e-15);
+    assert_close(gs.min, min, 0);
+    assert_close(gs.uniformity, min / (sum / 3), 1e-15);
+    assert_true(gs.walks == pts[0].run.walks + pts[1].run.walks + pts[2].run.walks && gs.worst > 0 && gs.worst < 0.03);
+    assert_int_equal(ulam_rad_grid_stats(pts, 0, &gs), ULAM_EINVAL);
+    at[1][0] = at[1][1] = at[1][2] = 100; /* on no patch, and no normal given */
+    assert_int_equal(ulam_rad_points_solve(t, &o, &at[0][0], 3, pts, &err), ULAM_EINVAL);
+    assert_int_equal(err.index, 1);
+    ulam_tracer_free(t);
+    ulam_scene_free(s);
+}
+
 /* One-sensor grids (the grid's shared solver) over 100 seeds each: every score within the
  * walk's certified range (a score past it leaves the run no interval, so every interval must be
  * finite), and the printed 95% interval (src/stop.c's, on that range) covering the exact
@@ -1004,7 +1050,7 @@ int main(void)
         cmocka_unit_test(test_adapt_view),       cmocka_unit_test(test_hdr_write),
         cmocka_unit_test(test_point_on_edges),   cmocka_unit_test(test_scale),
         cmocka_unit_test(test_cut_interval),     cmocka_unit_test(test_scene_diagnose),
-        cmocka_unit_test(test_block_stops_inside),
+        cmocka_unit_test(test_block_stops_inside), cmocka_unit_test(test_points_solve),
     };
     return test_run(tests);
 }

@@ -459,3 +459,42 @@ def test_type_hints():
         else:
             real = {p.name for p in inspect.signature(f).parameters.values() if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)}
         assert hinted == real, (name, hinted ^ real)
+
+
+def test_study_same_as_cli():
+    """ulam.study runs the library's study engine: the same runs as `ulam study` for the same seed
+    (run k's seed is ulam_rng_substream(seed, STUDY, k) in both, its estimate the same to the last
+    bit), each run within 4 of its stderr of spsolve's x_2, a cell per method and budget."""
+    M = scipy.io.mmread(os.path.join(ROOT, "matrices/chain4.mtx")).tocsr()
+    b = scipy.io.mmread(os.path.join(ROOT, "matrices/chain4_b.mtx"))
+    b = np.asarray(b.toarray() if sp.issparse(b) else b).reshape(-1)
+    methods = ["adjoint-collision-plain", "forward-expected-split"]
+    d = ulam.study(M=M, b=b, index=1, methods=methods, budgets=[100, 1000], repeats=4, seed=5)
+    assert d["done"] and not d["interrupted"] and d["direct"]
+    assert abs(d["exact"] - exact(M, b)[1]) <= 1e-12 * abs(d["exact"])
+    assert len(d["runs"]) == 2 * 2 * 4 and len(d["cells"]) == 2 * 2
+    assert all(abs(r["estimate"] - d["exact"]) < 4 * r["std_error"] for r in d["runs"])
+    assert {c["method"] for c in d["cells"]} == set(methods) and all(c["runs"] == 4 for c in d["cells"])
+    with tempfile.TemporaryDirectory() as out:
+        p = subprocess.run([ULAM, "study", os.path.join(ROOT, "matrices/chain4.mtx"), "--rhs",
+                            os.path.join(ROOT, "matrices/chain4_b.mtx"), "--index", "2", "--methods", ",".join(methods),
+                            "--budgets", "100,1000", "--repeats", "4", "--seed", "5", "--reference-time", "0",
+                            "--out", out + "/s"], capture_output=True, text=True, timeout=600)
+        assert p.returncode == 0, p.stderr
+        with open(out + "/s/runs.csv") as f:
+            rows = [line.rstrip("\n").split(",") for line in f][1:]
+    cli = {(r[0], float(r[1]), int(r[2])): (int(r[3]), float(r[4])) for r in rows}
+    assert len(cli) == len(d["runs"])
+    for r in d["runs"]:
+        assert cli[(r["method"], r["budget"], r["repeat"])] == (r["seed"], r["estimate"])
+
+
+def test_study_bad_input():
+    """ulam.study refuses an unknown method, too few repeats and an index out of range."""
+    M, b = random_system(20, 3, 0.5, 1)
+    with pytest.raises(ulam.InputError):
+        ulam.study(M=M, b=b, index=0, methods=["adjoint-nothing-plain"], budgets=[10], repeats=2)
+    with pytest.raises(ulam.InputError):
+        ulam.study(M=M, b=b, index=0, budgets=[10], repeats=1)
+    with pytest.raises(ulam.InputError):
+        ulam.study(M=M, b=b, index=20, budgets=[10], repeats=2)

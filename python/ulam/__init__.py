@@ -27,7 +27,7 @@ import numpy as np
 
 from . import _ulam
 
-__all__ = ["solve", "pagerank", "System", "Result", "VectorResult", "methods", "Error", "InputError", "DivergenceError",
+__all__ = ["solve", "pagerank", "study", "System", "Result", "VectorResult", "methods", "Error", "InputError", "DivergenceError",
            "InfiniteVarianceError", "ConvergenceError", "OutOfMemoryError", "Interrupted"]
 __version__ = _ulam.version
 
@@ -800,6 +800,46 @@ def pagerank(adj, alpha=None, source=None, target=None, *, damping=None, **kw):
     if target is None:
         kw.setdefault("mode", "forward")
     return _solve(system, b, target, _scale=1.0 - alpha, **kw)
+
+
+def study(*args, M=None, b=None, index=None, methods=None, budgets=(100, 1000, 10000, 100000, 1000000),
+          time_budgets=False, repeats=30, seed=1, threads=None):
+    """A variance study of x_index (0-based) of (I - M) x = b, as `ulam study` runs it (the
+    library's ulam_study_*): every method of the grid named in methods (names like
+    "adjoint-collision-plain"; None: all 18) at every budget (walks a run, or seconds with
+    time_budgets=True), repeats runs each, run k walking with seed
+    ulam_rng_substream(seed, STUDY, k), each scored against the exact x_index (LAPACK up to n =
+    8000, else Gauss-Seidel).  Returns a dict: exact, direct (LAPACK's), done, interrupted,
+    runs (a dict a run: method, budget, repeat, seed, status, estimate, std_error, abs_error,
+    walks, steps, seconds, covered; a run with no estimate has NaN there), cells (a dict per
+    method and budget: runs, failed, rmse, mean_stderr, honesty, coverage, seconds, work) and
+    screens (a dict per method: infinite, refused: why, or "")."""
+    if args:
+        _positional("study")
+    if M is None or b is None or index is None:
+        _input("study(M=M, b=b, index=i): the matrix, b and the unknown")
+    system = System(M=M)
+    n = system.n
+    index = _number("index", index, 0, n - 1, integer=True)
+    names = [m[0] for m in _ulam.study_methods()]
+    if methods is not None:
+        methods = [methods] if isinstance(methods, str) else list(methods)
+        for m in methods:
+            if m not in names:
+                _input(f"methods: names of the study's grid ({', '.join(names[:2])}, ...), got {m!r}")
+        methods = [names.index(m) for m in methods]
+    budgets = [_number("budgets", v, 1e-6 if time_budgets else 1, 1e6 if time_budgets else 2**62,
+                       integer=not time_budgets) for v in budgets]
+    if not 1 <= len(budgets) <= 16:
+        _input(f"budgets: 1 to 16 budgets, got {len(budgets)}")
+    repeats = _number("repeats", repeats, 2, 4096, integer=True)
+    seed = _number("seed", seed, 0, 2**64 - 1, integer=True)
+    threads = 0 if threads is None else _number("threads", threads, 1, 1024, integer=True)
+    d = system._sys.study(_vector(b, n), index, methods, [float(v) for v in budgets], int(bool(time_budgets)),
+                          repeats, seed, threads)
+    if d["status"]:
+        _raise(d["status"], d["message"])
+    return d
 
 
 def _csr_input(m, what):

@@ -89,3 +89,7 @@ def solve(*, M: Optional[Matrix] = ..., A: Optional[Matrix] = ..., b: Optional[V
 
 def pagerank(adj: Matrix, alpha: Optional[float] = ..., source: Optional[int] = ..., target: Optional[int] = ...,
              *, damping: Optional[float] = ..., **kw: Any) -> Union[Result, VectorResult]: ...
+
+def study(*, M: Optional[Matrix] = ..., b: Optional[Vector] = ..., index: Optional[int] = ...,
+          methods: Union[None, str, List[str]] = ..., budgets: Any = ..., time_budgets: bool = ...,
+          repeats: int = ..., seed: int = ..., threads: Optional[int] = ...) -> Dict[str, Any]: ...

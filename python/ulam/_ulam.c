@@ -402,6 +402,111 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
     return d;
 }
 
+/* A study run as a dict. */
+static PyObject *study_run(const ulam_study_run *u)
+{
+    return Py_BuildValue("{s:s,s:d,s:i,s:K,s:i,s:d,s:d,s:d,s:L,s:L,s:d,s:O}", "method",
+                         ulam_study_method_get(u->method)->name, "budget", u->budget_value, "repeat", u->repeat, "seed",
+                         (unsigned long long)u->seed, "status", u->status, "estimate", u->estimate, "std_error",
+                         u->std_error, "abs_error", u->abs_error, "walks", (long long)u->walks, "steps",
+                         (long long)u->steps, "seconds", u->seconds, "covered", u->covered ? Py_True : Py_False);
+}
+
+/* A study's cell as a dict. */
+static PyObject *study_cell(int m, double budget, const ulam_study_cell *c)
+{
+    return Py_BuildValue("{s:s,s:d,s:i,s:i,s:d,s:d,s:d,s:d,s:d,s:d}", "method", ulam_study_method_get(m)->name, "budget",
+                         budget, "runs", c->runs, "failed", c->failed, "rmse", c->rmse, "mean_stderr", c->mean_stderr,
+                         "honesty", c->honesty, "coverage", c->coverage, "seconds", c->seconds, "work", c->work);
+}
+
+/* Append o (a new reference, stolen) to list; nonzero on failure. */
+static int append(PyObject *list, PyObject *o)
+{
+    int rc = !o || PyList_Append(list, o);
+    Py_XDECREF(o);
+    return rc;
+}
+
+/* d with what a study holds as lists of dicts: runs, cells, screens (the chosen methods'); d, or
+ * NULL with d released. */
+static PyObject *study_lists(const ulam_study *st, const double *budgets, int nb, int repeats, PyObject *d)
+{
+    PyObject *runs = PyList_New(0), *cells = PyList_New(0), *screens = PyList_New(0);
+    int bad = !runs || !cells || !screens || PyDict_SetItemString(d, "runs", runs) ||
+              PyDict_SetItemString(d, "cells", cells) || PyDict_SetItemString(d, "screens", screens);
+    for (int k = 0; !bad && k < ULAM_STUDY_METHODS; k++) {
+        ulam_study_screen sc;
+        ulam_study_screen_get(st, k, &sc);
+        if (!sc.on) continue;
+        bad = append(screens, Py_BuildValue("{s:s,s:O,s:s}", "method", ulam_study_method_get(k)->name, "infinite",
+                                            sc.infinite ? Py_True : Py_False, "refused", sc.why));
+        for (int b = 0; !bad && b < nb; b++) {
+            ulam_study_cell c;
+            if (ulam_study_cell_get(st, k, b, &c)) bad = append(cells, study_cell(k, budgets[b], &c));
+            for (int r = 0; !bad && r < repeats; r++) {
+                ulam_study_run u;
+                if (ulam_study_run_get(st, k, b, r, &u)) bad = append(runs, study_run(&u));
+            }
+        }
+    }
+    Py_XDECREF(runs), Py_XDECREF(cells), Py_XDECREF(screens);
+    if (bad) Py_CLEAR(d);
+    return d;
+}
+
+/* System.study(b, index, methods, budgets, time_budgets, repeats, seed, threads): a variance study
+ * of x_index (ulam_study_*; methods: grid indices or None for all 18) as a dict: status, message,
+ * exact, direct, done, runs, cells, screens (lists of dicts). */
+static PyObject *System_study(SystemObject *self, PyObject *args)
+{
+    PyObject *bobj, *mobj, *bud;
+    long long index;
+    int time_budgets, repeats, threads;
+    unsigned long long seed;
+    if (!PyArg_ParseTuple(args, "OLOOiiKi", &bobj, &index, &mobj, &bud, &time_budgets, &repeats, &seed, &threads))
+        return NULL;
+    PyArrayObject *barr = array_of(bobj, NPY_FLOAT64, "b");
+    if (!barr) return NULL;
+    int methods[ULAM_STUDY_METHODS], nm = 0, nb = 0;
+    double budgets[16];
+    PyObject *ms = mobj == Py_None ? NULL : PySequence_Fast(mobj, "methods"), *bs = PySequence_Fast(bud, "budgets");
+    int bad = (mobj != Py_None && !ms) || !bs || PyArray_SIZE(barr) != self->M.nrows;
+    for (Py_ssize_t k = 0; !bad && ms && k < PySequence_Fast_GET_SIZE(ms) && nm < ULAM_STUDY_METHODS; k++)
+        methods[nm++] = (int)PyLong_AsLong(PySequence_Fast_GET_ITEM(ms, k));
+    for (Py_ssize_t k = 0; !bad && k < PySequence_Fast_GET_SIZE(bs) && nb < 16; k++)
+        budgets[nb++] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(bs, k));
+    Py_XDECREF(ms), Py_XDECREF(bs);
+    if (bad || PyErr_Occurred()) {
+        Py_DECREF(barr);
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "b has not n entries");
+        return NULL;
+    }
+    ulam_study_params p = ulam_study_defaults();
+    volatile int flag = 0;
+    p.methods = ms ? methods : NULL, p.nmethods = nm, p.budgets = budgets, p.nbudgets = nb;
+    p.time_budgets = time_budgets, p.repeats = repeats, p.seed = seed, p.threads = threads, p.interrupt = &flag;
+    ulam_study *st = NULL;
+    ulam_error err = {0};
+    int status;
+    struct sigaction old;
+    catch_sigint(&flag, &old);
+    Py_BEGIN_ALLOW_THREADS
+    status = ulam_study_alloc(&self->M, PyArray_DATA(barr), index, &p, &st, &err);
+    if (!status) status = ulam_study_run_all(st, NULL, NULL, &err);
+    Py_END_ALLOW_THREADS
+    release_sigint(&old);
+    Py_DECREF(barr);
+    const ulam_study_ref *ref = ulam_study_exact(st);
+    PyObject *d = Py_BuildValue("{s:i,s:s,s:d,s:O,s:O,s:O}", "status", status, "message", status ? err.msg : "",
+                                "exact", ref ? ref->exact : NAN, "direct", ref && ref->direct ? Py_True : Py_False,
+                                "done", st && ulam_study_done(st) ? Py_True : Py_False, "interrupted",
+                                flag ? Py_True : Py_False);
+    if (d && st) d = study_lists(st, budgets, nb, repeats, d);
+    ulam_study_free(st);
+    return d;
+}
+
 /* System.fpush(source, opts): every x_i of (I - M) x = e_source (ulam_fpush_solve: a forward push
  * and walks from its residual) as a dict: status, message, error_index, x, std_error, lo, hi (NumPy
  * arrays of n), walks, steps, rmax, push_ops, interrupted, seconds. */
@@ -524,6 +629,18 @@ static PyObject *py_methods(PyObject *mod, PyObject *args)
     return l;
 }
 
+/* study_methods(): the study's method grid as (name, mode, estimator, window) tuples. */
+static PyObject *py_study_methods(PyObject *mod, PyObject *args)
+{
+    (void)mod, (void)args;
+    PyObject *l = PyList_New(0);
+    for (int k = 0; l && k < ULAM_STUDY_METHODS; k++) {
+        const ulam_study_method *m = ulam_study_method_get(k);
+        if (append(l, Py_BuildValue("(siii)", m->name, m->mode, m->estimator, m->window))) Py_CLEAR(l);
+    }
+    return l;
+}
+
 /* strerror(status): the library's description of a status. */
 static PyObject *py_strerror(PyObject *mod, PyObject *args)
 {
@@ -536,6 +653,8 @@ static PyObject *py_strerror(PyObject *mod, PyObject *args)
 static PyMethodDef System_methods[] = {
     {"query", (PyCFunction)System_query, METH_VARARGS, "query(b, index, opts, progress) -> dict (internal)"},
     {"fpush", (PyCFunction)System_fpush, METH_VARARGS, "fpush(source, opts) -> dict (internal)"},
+    {"study", (PyCFunction)System_study, METH_VARARGS,
+     "study(b, index, methods, budgets, time_budgets, repeats, seed, threads) -> dict (internal)"},
     {NULL, NULL, 0, NULL}};
 
 static PyTypeObject SystemType = {
@@ -551,6 +670,7 @@ static PyTypeObject SystemType = {
 
 static PyMethodDef module_methods[] = {
     {"jacobi", py_jacobi, METH_VARARGS, "jacobi(indptr, indices, data, n, b, omega) (internal)"},
+    {"study_methods", py_study_methods, METH_NOARGS, "study_methods() -> [(name, mode, estimator, window)]: the study's grid"},
     {"methods", py_methods, METH_NOARGS, "methods() -> [(name, answers)]: the library's method table"},
     {"strerror", py_strerror, METH_VARARGS, "strerror(status) -> str"},
     {NULL, NULL, 0, NULL}};

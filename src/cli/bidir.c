@@ -480,6 +480,7 @@ typedef struct {
     report rp;
     int64_t source, top;
     int force, method;
+    cli_solve_route route; /* set when the walks row solves instead (CLI_ROUTE_WALKS) */
 } bidir_args;
 
 /* The arguments before any option. */
@@ -561,8 +562,10 @@ static int start_run(void *p, int argc, char **argv, int optind)
         rc = run(&s, &o, &rp);
     } else if (rc == ROUTE_ADJOINT) {
         cli_system_free(&s);
-        s = a->s, s.matrix_path = argv[optind];
-        return cli_solve_source(&s, &o.walk, source, rp.json, rp.check, force);
+        a->route = (cli_solve_route){.s = a->s, .walk = o.walk, .source = source, .json = rp.json, .check = rp.check,
+                                     .force = force};
+        a->route.s.matrix_path = argv[optind];
+        return CLI_ROUTE_WALKS;
     }
     free(bidx), free(bval);
     cli_system_free(&s);
@@ -576,6 +579,12 @@ static const char *const claims[] = {"source", "rmax", "top", NULL};
 static int serves(const char *method)
 {
     return method && ulam_method_find(method) == ULAM_METHOD_BIDIRECTIONAL;
+}
+
+/* See cli.h. */
+const cli_solve_route *cli_bidir_route(const void *p)
+{
+    return &((const bidir_args *)p)->route;
 }
 
 const cli_solve_row cli_solve_bidir_row = {"bidirectional", longopts, claims, serves, sizeof(bidir_args), init, option,

@@ -216,6 +216,8 @@ void cli_json_value(double v);
 /* Print whether the --rel-err target of walks r run with o was met, and when not why (one line;
  * nothing without a target; verbose: also when met). */
 void cli_print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int verbose);
+/* Nonzero when the interval was withheld because the scores are too small to square in doubles. */
+int cli_score_too_small(const ulam_walk_result *r);
 
 /* Print a JSON number (null when not finite). */
 void cli_json_number(const char *key, double v, int last);
@@ -312,6 +314,21 @@ typedef struct cli_solve_row {
     int (*run)(void *args, int argc, char **argv, int first);
 } cli_solve_row;
 
+/* A row's hand-over to the walks row (cli_solve_source's arguments): x_I for b = e_source. */
+typedef struct cli_solve_route {
+    cli_system s;
+    ulam_walk_opts walk;
+    int64_t source;
+    int json, check, force;
+} cli_solve_route;
+
+/* The bidirectional row's run returns this when the walks row should solve instead: cli_solve
+ * then runs cli_solve_source on cli_bidir_route(args). */
+enum { CLI_ROUTE_WALKS = -2 };
+
+/* The hand-over the bidirectional row's run set when it returned CLI_ROUTE_WALKS. */
+const cli_solve_route *cli_bidir_route(const void *args);
+
 /* The rows: bidirectional (src/cli/bidir.c), the outer iterations and Krylov peers
  * (src/cli/mcsa.c), the walks with auto (src/cli/solve.c); --partition (below). */
 extern const cli_solve_row cli_solve_bidir_row, cli_solve_outer_row, cli_solve_walks_row;
@@ -321,7 +338,8 @@ extern const cli_solve_row cli_solve_partition_row;
 
 /* x_I (s->index, 1-based) for b = e_source (1-based) by the walks row under --method auto with
  * walk options o (the push on b, then walks from I): a --source solve's route when the walks
- * from S have a variance not certified finite (src/cli/bidir.c).  0 or an exit code. */
+ * from S have a variance not certified finite (bidir.c's cli_solve_route, src/cli/solve_rows.c).  0 or an
+ * exit code. */
 int cli_solve_source(const cli_system *s, const ulam_walk_opts *o, int64_t source, int json, int check, int force);
 
 /* Run bidirectional, chosen by solve --method auto (run: the library's, ch: its choice), and print

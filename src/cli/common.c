@@ -17,8 +17,8 @@ const char *const cli_estimator_names[3] = {"collision", "absorption", "expected
 
 volatile int cli_interrupted;
 const ulam_share *cli_share;
-int cli_rank;
 double cli_started;
+int cli_direct_force = -1;
 
 /* The walks' share of a --time budget. */
 double cli_time_left(double budget)
@@ -306,14 +306,6 @@ int cli_write_vector(const char *path, const double *x, int64_t n, const char *c
     return status ? status : cli_outfile_commit(&o);
 }
 
-/* Index of word in names[0..n), or -1. */
-int cli_lookup(const char *word, const char *const *names, int n)
-{
-    for (int k = 0; k < n; k++)
-        if (!strcmp(word, names[k])) return k;
-    return -1;
-}
-
 /* The exit code for a library status. */
 int cli_exit_code(int status)
 {
@@ -369,18 +361,6 @@ int cli_flush(void)
     errno = 0;
     if ((fflush(stdout) != 0 || ferror(stdout)) && !stdout_errno) stdout_errno = errno ? errno : EIO;
     return stdout_errno;
-}
-
-/* Print a usage error and return EXIT_USAGE. */
-int cli_usage_error(const char *command, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "ulam %s: ", command);
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, " (see 'ulam %s --help')\n", command);
-    va_end(ap);
-    return EXIT_USAGE;
 }
 
 /* Parse an integer option value in [lo, hi]. */
@@ -727,35 +707,6 @@ void cli_print_z(double estimate, double direct, double std_error, double lo, do
     printf("\n");
 }
 
-/* Print a bare JSON number (null when not finite). */
-void cli_json_value(double v)
-{
-    if (isfinite(v)) printf("%.17g", v);
-    else printf("null");
-}
-
-/* Print a JSON number (null when not finite). */
-void cli_json_number(const char *key, double v, int last)
-{
-    cli_json_done = 1;
-    printf("\"%s\": ", key);
-    cli_json_value(v);
-    printf("%s", last ? "" : ", ");
-}
-
-/* Print a JSON string (escaped). */
-void cli_json_string(const char *key, const char *v, int last)
-{
-    cli_json_done = 1;
-    printf("\"%s\": \"", key);
-    for (const unsigned char *c = (const unsigned char *)v; *c; c++) {
-        if (*c == '"' || *c == '\\') printf("\\%c", *c);
-        else if (*c < 0x20) printf("\\u%04x", *c);
-        else putchar(*c);
-    }
-    printf("\"%s", last ? "" : ", ");
-}
-
 /* Check before any work that path can be written (a temporary file can be made beside it and
  * it is not a directory); 0 or an exit code (reported). */
 int cli_check_output(const char *path)
@@ -844,4 +795,52 @@ void cli_progress_end(cli_progress *p)
 {
     if (p->on && p->shown) fputc('\n', stderr);
     p->shown = 0;
+}
+
+/* Nonzero when the reference solve of M should be the sparse LU: --lu sparse, or (auto) UMFPACK is
+ * there and M is large (n > 1000: dense LU takes over a second from n of a few thousand) and sparse
+ * (under 5% nonzeros). */
+int cli_direct_sparse_wanted(const ulam_csr *M)
+{
+    int64_t n = M->nrows;
+    if (cli_direct_force >= 0) return cli_direct_force;
+    return ulam_direct_sparse_available() && n > 1000 && (double)M->rowptr[n] < 0.05 * (double)n * (double)n;
+}
+
+/* Replace the loaded adjacency matrix by alpha P^T (ulam_pagerank_matrix) and, without --rhs, b by
+ * (1 - alpha) / n; 0 or an exit code (nothing stays loaded on failure). */
+int cli_load_pagerank(cli_system *s)
+{
+    int rc = cli_system_verify(s);
+    if (rc) return rc;
+    ulam_error err;
+    ulam_csr *M = NULL;
+    int64_t n = s->M->nrows;
+    int status = ulam_pagerank_matrix(s->M, s->pagerank, &M, &err);
+    double *b = status || s->b ? NULL : malloc((size_t)n * sizeof *b);
+    if (!status && !s->b && !b) status = ULAM_ENOMEM, err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for b"};
+    if (status) {
+        cli_system_free(s);
+        return cli_report(s->matrix_path, &err);
+    }
+    if (b)
+        for (int64_t i = 0; i < n; i++) b[i] = (1.0 - s->pagerank) / (double)n;
+    double *keep_b = NULL;
+    if (!b && s->own_b) keep_b = s->own_b, s->own_b = NULL; /* --rhs parsed: keep it */
+    else if (!b) { /* --rhs mapped: copy it before the mapping goes */
+        keep_b = malloc((size_t)n * sizeof *keep_b);
+        if (!keep_b) {
+            ulam_csr_free(M);
+            cli_system_free(s);
+            err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for b"};
+            return cli_report(s->matrix_path, &err);
+        }
+        for (int64_t i = 0; i < n; i++) keep_b[i] = s->b[i];
+    }
+    cli_system_free(s);
+    s->M = s->own_M = M;
+    s->b = s->own_b = b ? b : keep_b;
+    s->verified = 1;
+    if (b) cli_answer_name = "pi"; /* b = (1 - alpha) / n: x is PageRank itself */
+    return 0;
 }

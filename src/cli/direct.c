@@ -10,18 +10,6 @@
 #include <stdlib.h>
 #include <time.h>
 
-int cli_direct_force = -1;
-
-/* Nonzero when the reference solve of M should be the sparse LU: --lu sparse, or (auto) UMFPACK is
- * there and M is large (n > 1000: dense LU takes over a second from n of a few thousand) and sparse
- * (under 5% nonzeros). */
-int cli_direct_sparse_wanted(const ulam_csr *M)
-{
-    int64_t n = M->nrows;
-    if (cli_direct_force >= 0) return cli_direct_force;
-    return ulam_direct_sparse_available() && n > 1000 && (double)M->rowptr[n] < 0.05 * (double)n * (double)n;
-}
-
 /* Before a reference solve that may take long: what it needs, on stderr (nothing when it is quick). */
 static void announce(const cli_system *s, int sparse)
 {

@@ -119,9 +119,6 @@ static const char *const chan = "RGB";
 /* The JSON key of the answer (the radiosity), in one place so that it can be renamed. */
 static const char *const answer_key = "radiosity";
 
-/* Luminance weights of linear Rec. 709 RGB: the illuminance column of a grid. */
-static const double luma[3] = {0.2126, 0.7152, 0.0722};
-
 /* Everything the command was asked. */
 typedef struct {
     const char *scene, *patch, *image, *out;
@@ -1018,7 +1015,7 @@ static void print_json(const args *a, const report *r)
         }
         printf("], ");
     }
-    cli_photo_report(&a->ph, r->s, NULL, 0, 0, 1, luma, NULL, NULL); /* photometric runs: the luminaires */
+    cli_photo_report(&a->ph, r->s, NULL, 0, 0, 1, ulam_rad_luma(), NULL, NULL); /* photometric runs: the luminaires */
     printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
 }
 
@@ -1092,27 +1089,6 @@ static void point_json(const ulam_scene *s, const ulam_rad_point *r, const ulam_
     printf("}");
 }
 
-/* The luminance-weighted irradiance (illuminance in the scene's units) of a point, and a bound
- * on its standard error (the channels' added: they come from the same walks). */
-static void illuminance(const ulam_rad_point *r, double *Y, double *se)
-{
-    *Y = *se = 0.0;
-    for (int c = 0; c < 3; c++) *Y += luma[c] * r->irradiance[c], *se += luma[c] * r->irradiance_se[c];
-}
-
-/* A 95% interval for a point's illuminance Y = sum_c l_c H_c (NaN .. NaN unless every channel has
- * one): Y +- sum_c l_c h_c, h_c channel c's half-width.  It holds because it contains the
- * interval src/stop.c would give on the walks' Y scores: their range is at most sum_c l_c R_c,
- * their bias sum_c l_c of the channels', and their sample standard deviation at most
- * sum_c l_c s_c (the sample covariance is positive semidefinite), so each term of that
- * half-width is at most the weighted sum of the channels'; floored at 0 (every score >= 0). */
-static void illuminance_ci(const ulam_rad_point *r, double *lo, double *hi)
-{
-    double Y = 0.0, h = 0.0;
-    for (int c = 0; c < 3; c++) Y += luma[c] * r->irradiance[c], h += luma[c] * (r->run.ci95[c][1] - r->irradiance[c]);
-    *lo = isfinite(h) ? fmax(Y - h, 0.0) : NAN, *hi = isfinite(h) ? Y + h : NAN;
-}
-
 /* --grid: the CSV (one row a sensor), atomically; 0 or an exit code. */
 static int write_grid_csv(const char *path, const ulam_rad_grid *g, const ulam_rad_point *pts)
 {
@@ -1124,8 +1100,8 @@ static int write_grid_csv(const char *path, const ulam_rad_grid *g, const ulam_r
             for (int i = 0; i < g->nu; i++) {
                 const ulam_rad_point *r = &pts[(size_t)j * (size_t)g->nu + (size_t)i];
                 double Y, se, lo, hi;
-                illuminance(r, &Y, &se);
-                illuminance_ci(r, &lo, &hi);
+                ulam_rad_illuminance(r, &Y, &se);
+                ulam_rad_illuminance_ci(r, &lo, &hi);
                 fprintf(o.f, "%d,%d,%.17g,%.17g,%.17g", i + 1, j + 1, r->x[0], r->x[1], r->x[2]);
                 for (int c = 0; c < 3; c++) fprintf(o.f, ",%.17g", r->irradiance[c]);
                 for (int c = 0; c < 3; c++) fprintf(o.f, ",%.17g", r->irradiance_se[c]);
@@ -1151,7 +1127,7 @@ static int write_grid_png(const char *path, const ulam_rad_grid *g, const ulam_r
     int status = Y ? ULAM_OK : ULAM_ENOMEM;
     *hi = 0.0;
     for (size_t k = 0; Y && k < n; k++) {
-        illuminance(&pts[k], &Y[k], &se);
+        ulam_rad_illuminance(&pts[k], &Y[k], &se);
         *hi = fmax(*hi, Y[k]);
     }
     if (!(*hi > 0)) *hi = 1.0;
@@ -1179,18 +1155,14 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
     int rc = 0, interrupted = 0;
     double t0 = ulam_now();
     cli_catch_sigint();
-    for (int k = 0; k < a->nat && !interrupted; k++) {
-        ulam_rad_opts o = rad_opts(&a->o);
-        o.exec.seed = a->o.exec.seed + (uint64_t)k; /* each point its own walks */
-        const double *x = a->at + 6 * k;
-        if (ulam_rad_point_query(t, &o, x, isnan(x[3]) ? NULL : x + 3, &pts[k], &err)) {
-            fprintf(stderr, "ulam radiosity: --at %g,%g,%g: %s: %s\n", x[0], x[1], x[2], ulam_strerror(err.status),
-                    err.msg);
-            rc = err.status == ULAM_EINVAL ? EXIT_USAGE : cli_exit_code(err.status); /* the point itself */
-            goto done;
-        }
-        interrupted = pts[k].run.interrupted;
+    ulam_rad_opts po = rad_opts(&a->o);
+    if (a->nat && ulam_rad_points_solve(t, &po, a->at, a->nat, pts, &err)) { /* each point its own walks */
+        const double *x = a->at + 6 * err.index;
+        fprintf(stderr, "ulam radiosity: --at %g,%g,%g: %s: %s\n", x[0], x[1], x[2], ulam_strerror(err.status), err.msg);
+        rc = err.status == ULAM_EINVAL ? EXIT_USAGE : cli_exit_code(err.status); /* the point itself */
+        goto done;
     }
+    for (int k = 0; k < a->nat; k++) interrupted |= pts[k].run.interrupted;
     if (ngrid && !interrupted) {
         ulam_rad_opts ro = rad_opts(&a->o);
         if (ulam_rad_grid_solve(t, &ro, &a->g, pts + a->nat, &err)) {
@@ -1204,16 +1176,10 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
     cli_release_sigint();
     if (ngrid && !interrupted && a->out && (rc = write_grid_csv(a->out, &a->g, pts + a->nat))) goto done;
     if (ngrid && !interrupted && a->image && (rc = write_grid_png(a->image, &a->g, pts + a->nat, &hi))) goto done;
-    double Ymin = INFINITY, Ysum = 0.0, worst = 0.0;
-    int64_t walks = 0, rays = 0;
-    for (int64_t k = 0; k < n; k++) {
-        walks += pts[k].run.walks, rays += pts[k].run.rays;
-        if (k < a->nat) continue;
-        double Y, se;
-        illuminance(&pts[k], &Y, &se);
-        Ymin = fmin(Ymin, Y), Ysum += Y;
-        if (Y > 0) worst = fmax(worst, se / Y);
-    }
+    ulam_rad_grid_summary gs = {0}, all;
+    if (ngrid) ulam_rad_grid_stats(pts + a->nat, ngrid, &gs);
+    ulam_rad_grid_stats(pts, n, &all);
+    int64_t walks = all.walks, rays = all.rays;
     ulam_rad_scene_diag diag; /* what is wrong with the scene, when a point reads exactly 0 */
     int known = 0;
     for (int64_t k = 0; k < n && !known; k++)
@@ -1232,10 +1198,10 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
             printf("\"grid\": {\"nu\": %d, \"nv\": %d, ", a->g.nu, a->g.nv);
             json_triple("origin", a->g.origin), json_triple("u", a->g.u), json_triple("v", a->g.v);
             json_triple("normal", a->g.normal);
-            cli_json_number("illuminance_min", Ymin, 0);
-            cli_json_number("illuminance_mean", Ysum / (double)ngrid, 0);
-            cli_json_number("uniformity", Ysum > 0 ? Ymin / (Ysum / (double)ngrid) : NAN, 0);
-            cli_json_number("worst_rel_stderr_bound", worst, 0);
+            cli_json_number("illuminance_min", gs.min, 0);
+            cli_json_number("illuminance_mean", gs.mean, 0);
+            cli_json_number("uniformity", gs.uniformity, 0);
+            cli_json_number("worst_rel_stderr_bound", gs.worst, 0);
             if (a->out) cli_json_string("out", interrupted ? "" : a->out, 0);
             if (a->image) cli_json_string("image", interrupted ? "" : a->image, 0);
             printf("\"points\": [");
@@ -1249,7 +1215,8 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         printf("\"walks\": %lld, \"rays\": %lld, \"interrupted\": %s, ", (long long)walks, (long long)rays,
                interrupted ? "true" : "false");
         cli_json_number("seconds", seconds, 0);
-        cli_photo_report(&a->ph, s, pts, a->nat, ngrid, 1, luma, illuminance, illuminance_ci);
+        cli_photo_report(&a->ph, s, pts, a->nat, ngrid, 1, ulam_rad_luma(), ulam_rad_illuminance,
+                         ulam_rad_illuminance_ci);
         printf("\"seed\": %llu}\n", (unsigned long long)a->o.exec.seed);
     } else {
         printf("scene        %s: %lld patches\n", a->scene, (long long)s->npatches);
@@ -1257,15 +1224,16 @@ static int run_points(const args *a, const ulam_tracer *t, const ulam_scene *s)
         if (ngrid)
             printf("grid         %d x %d sensors facing %.4g %.4g %.4g: illuminance (0.2126 R + 0.7152 G + 0.0722 B)\n"
                    "             min %.6g, mean %.6g, uniformity min/mean %.4f; worst relative error <= %.3g\n",
-                   a->g.nu, a->g.nv, a->g.normal[0], a->g.normal[1], a->g.normal[2], Ymin, Ysum / (double)ngrid,
-                   Ysum > 0 ? Ymin / (Ysum / (double)ngrid) : NAN, worst);
-        if (ngrid && known && !(Ysum > 0)) scene_notes(&diag, "note         ", "             ");
+                   a->g.nu, a->g.nv, a->g.normal[0], a->g.normal[1], a->g.normal[2], gs.min, gs.mean, gs.uniformity,
+                   gs.worst);
+        if (ngrid && known && !(gs.mean > 0)) scene_notes(&diag, "note         ", "             ");
         if (ngrid && a->out && !interrupted) printf("grid csv     %s\n", a->out);
         if (ngrid && a->image && !interrupted) printf("grid image   %s (false colour, 0 .. %.4g)\n", a->image, hi);
         printf("walks        %lld point walks (%s), %lld rays, %.4f s%s\n", (long long)walks,
                a->o.estimator == ULAM_RAD_COLLISION ? "collision" : "next-event with MIS", (long long)rays, seconds,
                interrupted ? "  [INTERRUPTED]" : "");
-        cli_photo_report(&a->ph, s, pts, a->nat, ngrid, 0, luma, illuminance, illuminance_ci);
+        cli_photo_report(&a->ph, s, pts, a->nat, ngrid, 0, ulam_rad_luma(), ulam_rad_illuminance,
+                         ulam_rad_illuminance_ci);
     }
     if (interrupted) rc = EXIT_INTERRUPTED;
 done:
@@ -1600,16 +1568,9 @@ static int every_mesh_error(const args *a, const ulam_tracer *t, const ulam_scen
     o.mode = ULAM_ADJOINT, o.estimator = ULAM_RAD_NEXT_EVENT, o.stop.rel_err = 0, o.stop.max_seconds = 0;
     o.stop.max_walks = a->mesh_walks;
     cli_catch_sigint();
-    for (int64_t p = 0; p < s->npatches; p++) {
-        ulam_rad_mesh m;
-        o.index = p, o.exec.seed = a->o.exec.seed + (uint64_t)p;
-        if (ulam_rad_mesh_error(t, &o, pv->B + 3 * p, &m, &err)) {
-            cli_release_sigint();
-            return cli_report(a->scene, &err);
-        }
-        for (int c = 0; c < 3; c++) (*out)[3 * p + c] = m.interrupted ? NAN : m.error[c];
-    }
+    int status = ulam_rad_mesh_errors(t, &o, pv->B, *out, &err); /* patch p seeded by its substream */
     cli_release_sigint();
+    if (status) return cli_report(a->scene, &err);
     pv->mesh = *out;
     return 0;
 }
@@ -1736,7 +1697,7 @@ int cli_radiosity(int argc, char **argv)
     }
     if (a.json) print_json(&a, &r);
     else print_text(&a, &r);
-    if (!a.json) cli_photo_report_patch(&a.ph, r.patch < 0 ? NULL : r.w ? w.B : Bd ? Bd + 3 * r.patch : NULL, luma,
+    if (!a.json) cli_photo_report_patch(&a.ph, r.patch < 0 ? NULL : r.w ? w.B : Bd ? Bd + 3 * r.patch : NULL, ulam_rad_luma(),
                                        r.image_written);
     if (w.interrupted) rc = EXIT_INTERRUPTED;
 done:

@@ -83,6 +83,8 @@ int cli_solve(int argc, char **argv)
         rc = row->option(args, g[k].refused ? '?' : row_code(row, name), name, g[k].value);
     }
     if (!rc) rc = row->run(args, argc, argv, optind);
+    const cli_solve_route *to = rc == CLI_ROUTE_WALKS && row == &cli_solve_bidir_row ? cli_bidir_route(args) : NULL;
+    if (to) rc = cli_solve_source(&to->s, &to->walk, to->source, to->json, to->check, to->force);
     free(args), free(g);
     return rc < 0 ? 0 : rc;
 }

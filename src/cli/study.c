@@ -74,22 +74,14 @@ typedef struct {
     int partial;           /* interrupted: charts and summary say so */
     uint64_t seed;
     const char *out;
-    ulam_guard g; /* the verdicts, computed once for every run */
+    ulam_study *lib; /* the engine: the guards' verdicts, the exact value and every run (src/study.c) */
     double exact;
     int direct; double direct_seconds, direct_error; /* LAPACK's point on the chart (n <= 8000) */
     int forward_walks; /* rho(|M|) < 1 and the forward rho(M^) < 1: the outer iterations can walk */
-    double *est, *se, *sec; /* [m][b][r] */
-    unsigned char *done;
     char **row; /* [m][b][r]: the runs.csv line of a finished run */
 } study;
 
 static const char runs_header[] = "method,budget,repeat,seed,estimate,stderr,abs_error,walks,steps,seconds,covered\n";
-
-/* Flat index of (method, budget, repeat). */
-static size_t at(const study *st, int m, int b, int r)
-{
-    return ((size_t)m * MAXBUDGET + (size_t)b) * (size_t)st->repeats + (size_t)r;
-}
 
 /* The 18 methods, all on. */
 static void methods_init(method *m)
@@ -133,32 +125,39 @@ static int parse_budgets(study *st, const char *opt, const char *list, int integ
     return st->nbudget ? 0 : cli_usage_error("study", "%s expects a list of numbers", opt);
 }
 
-/* Refuse what the guards or the estimator's definition refuse, flag infinite variance. */
+/* The runs.csv line of run (m, b, r) (NULL: none yet). */
+static char **row_at(const study *st, int m, int b, int r)
+{
+    return &st->row[((size_t)m * MAXBUDGET + (size_t)b) * (size_t)st->repeats + (size_t)r];
+}
+
+/* The library's study of the chosen methods (ulam_study_alloc: the guards, each method screened,
+ * the exact value); each refused or flagged method said on stderr.  0 or an exit code. */
 static int screen_methods(study *st)
 {
-    ulam_guard *g = &st->g;
+    int chosen[NMETHOD], n = 0;
+    for (int k = 0; k < NMETHOD; k++)
+        if (st->m[k].on) chosen[n++] = k;
+    if (!n) {
+        fprintf(stderr, "ulam: study: every selected method is refused\n");
+        return EXIT_DIVERGE;
+    }
+    ulam_study_params p = ulam_study_defaults();
+    p.methods = chosen, p.nmethods = n, p.budgets = st->budget, p.nbudgets = st->nbudget;
+    p.time_budgets = st->time_budgets, p.repeats = st->repeats, p.seed = st->seed, p.threads = st->threads;
+    p.interrupt = &cli_interrupted, p.share = cli_share;
     ulam_error err;
-    int status = ulam_guard_check(st->s.M, 0.0, NULL, g, &err);
-    if (status) return cli_report(st->s.matrix_path, &err);
-    st->forward_walks = (g->verdict_abs == ULAM_VERDICT_OK || g->verdict_abs == ULAM_VERDICT_EDGE) &&
-                        ulam_guard_variance(g, ULAM_FORWARD) == 1;
+    if (ulam_study_alloc(st->s.M, st->s.b, st->s.index - 1, &p, &st->lib, &err))
+        return cli_report(st->s.matrix_path, &err);
+    const ulam_guard *g = ulam_study_guard(st->lib);
+    st->forward_walks = ulam_study_forward_walks(st->lib);
     int left = 0;
     for (int k = 0; k < NMETHOD; k++) {
         method *m = &st->m[k];
         if (!m->on) continue;
-        if (g->verdict_abs >= ULAM_VERDICT_FAIL) {
-            snprintf(m->why, sizeof m->why, "rho(|M|) in [%.4g, %.4g] is not certified below 1: the walks may diverge",
-                     g->abs.lower, g->abs.upper);
-        } else {
-            ulam_walk_opts o = ulam_walk_defaults();
-            ulam_study_method_opts(k, st->s.b, st->s.M->nrows, &o);
-            o.kernel.roulette = o.kernel.split = 0, o.query.index = st->s.index - 1, o.stop.max_walks = 1, o.policy.guard = g; /* screened unwindowed */
-            ulam_solver *sv = NULL;
-            if (ulam_solver_alloc(st->s.M, st->s.b, &o, &sv, &err))
-                snprintf(m->why, sizeof m->why, "%s: expected %s", ulam_strerror(err.status), err.msg);
-            ulam_solver_free(sv);
-        }
-        m->infinite = ulam_guard_variance(g, m->mode) != 1;
+        ulam_study_screen sc;
+        ulam_study_screen_get(st->lib, k, &sc);
+        snprintf(m->why, sizeof m->why, "%s", sc.why), m->infinite = sc.infinite;
         if (m->why[0]) fprintf(stderr, "ulam: study: %s refused: %s\n", m->name, m->why);
         else if (m->infinite)
             fprintf(stderr, "ulam: study: %s runs with a variance not certified finite (rho(M^) in [%.4g, %.4g]): its "
@@ -212,9 +211,10 @@ static void resume(study *st, const char *path)
             for (int m = 0; m < NMETHOD; m++)
                 for (int b = 0; b < st->nbudget; b++)
                     if (!strcmp(st->m[m].name, name) && st->budget[b] == budget && r >= 0 && r < st->repeats) {
-                        size_t i = at(st, m, b, r);
-                        if (st->done[i] || !(st->row[i] = strdup(line))) continue;
-                        st->est[i] = e, st->se[i] = se, st->sec[i] = sec, st->done[i] = 1;
+                        ulam_study_run u = {.method = m, .budget = b, .repeat = r, .has_estimate = !isnan(e),
+                                            .estimate = e, .std_error = se, .seconds = sec};
+                        if (*row_at(st, m, b, r) || ulam_study_restore(st->lib, &u)) continue;
+                        if (!(*row_at(st, m, b, r) = strdup(line))) continue;
                         rows++;
                     }
     }
@@ -232,49 +232,12 @@ static int save_runs(const study *st)
     int status = cli_outfile_open(&o, path);
     if (!status) {
         fputs(runs_header, o.f);
-        for (size_t i = 0, n = at(st, NMETHOD, 0, 0); i < n; i++)
-            if (st->done[i]) fputs(st->row[i], o.f);
+        for (size_t i = 0, n = (size_t)NMETHOD * MAXBUDGET * (size_t)st->repeats; i < n; i++)
+            if (st->row[i]) fputs(st->row[i], o.f);
         status = cli_outfile_commit(&o);
     }
     ulam_error e = {.status = status, .msg = "a writable output directory"};
     return status ? cli_report(path, &e) : 0;
-}
-
-/* One run; 0 when it finished (not interrupted) and was recorded.  A run that ends with no estimate
- * (the solver refused or failed, fewer than 2 walks, or no standard error: forward walks that never
- * reached x_I) is recorded as a failure of the method at that budget, its fields empty: never
- * dropped, so that every cell counts all its runs. */
-static int one_run(study *st, int m, int b, int r)
-{
-    const method *me = &st->m[m];
-    ulam_walk_opts o = ulam_walk_defaults();
-    ulam_study_method_opts(m, st->s.b, st->s.M->nrows, &o);
-    o.query.index = st->s.index - 1, o.exec.threads = st->threads;
-    o.exec.seed = (st->seed << 32) + ((uint64_t)m << 24) + ((uint64_t)b << 16) + (uint64_t)r;
-    o.stop.interrupt = &cli_interrupted, o.exec.share = cli_share, o.policy.guard = &st->g, o.policy.force = 1;
-    if (st->time_budgets) o.stop.max_walks = 0, o.stop.max_seconds = st->budget[b];
-    else o.stop.max_walks = (int64_t)st->budget[b];
-    ulam_walk_result res;
-    int status = ulam_solve_walks(st->s.M, st->s.b, &o, &res, NULL);
-    if (res.interrupted || cli_interrupted) return 1; /* not a run: it is made again on resuming */
-    char line[512];
-    if (status || res.walks < 2 || !isfinite(res.std_error) || !isfinite(res.estimate)) {
-        snprintf(line, sizeof line, "%s,%.17g,%d,%llu,,,,%lld,%lld,%.6g,0\n", me->name, st->budget[b], r,
-                 (unsigned long long)o.exec.seed, (long long)res.walks, (long long)res.steps,
-                 isfinite(res.seconds) ? res.seconds : 0.0);
-        size_t i = at(st, m, b, r);
-        if (!(st->row[i] = strdup(line))) return 1;
-        st->est[i] = st->se[i] = NAN, st->sec[i] = isfinite(res.seconds) ? res.seconds : 0.0, st->done[i] = 1;
-        return 0;
-    }
-    snprintf(line, sizeof line, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", me->name, st->budget[b], r,
-             (unsigned long long)o.exec.seed, res.estimate, res.std_error, fabs(res.estimate - st->exact),
-             (long long)res.walks, (long long)res.steps, res.seconds,
-             fabs(res.estimate - st->exact) <= ULAM_Z95 * res.std_error);
-    size_t i = at(st, m, b, r);
-    if (!(st->row[i] = strdup(line))) return 1;
-    st->est[i] = res.estimate, st->se[i] = res.std_error, st->sec[i] = res.seconds, st->done[i] = 1;
-    return 0;
 }
 
 /* FNV-1a 64 of n bytes, continuing from h. */
@@ -362,199 +325,110 @@ static int check_question(study *st)
     return status ? cli_report(path, &e) : 0;
 }
 
-/* The seconds the runs not yet done will take, from the measured cost: a time budget is its own
- * cost; a walk budget costs the method's measured seconds per walk (over its finished runs; a
- * method not yet measured takes the dearest measured), so the tenfold budgets still to come weigh
- * tenfold. */
-static double seconds_left(const study *st)
+/* Keep run u's runs.csv line (a run with no estimate: its fields empty); 0 or an exit code. */
+static int keep_row(study *st, const ulam_study_run *u)
 {
-    double spw[NMETHOD], dearest = 0.0, left = 0.0;
-    for (int m = 0; m < NMETHOD; m++) {
-        double s = 0.0, w = 0.0;
-        for (int b = 0; b < st->nbudget; b++)
-            for (int r = 0; r < st->repeats; r++)
-                if (st->m[m].on && st->done[at(st, m, b, r)]) s += st->sec[at(st, m, b, r)], w += st->budget[b];
-        spw[m] = w > 0 ? s / w : NAN;
-        if (spw[m] > dearest) dearest = spw[m];
-    }
-    for (int m = 0; m < NMETHOD; m++)
-        for (int b = 0; b < st->nbudget; b++)
-            for (int r = 0; r < st->repeats; r++)
-                if (st->m[m].on && !st->m[m].why[0] && !st->done[at(st, m, b, r)])
-                    left += st->time_budgets ? st->budget[b] : st->budget[b] * (isnan(spw[m]) ? dearest : spw[m]);
-    return left;
+    char line[512];
+    const char *name = st->m[u->method].name;
+    if (!u->has_estimate)
+        snprintf(line, sizeof line, "%s,%.17g,%d,%llu,,,,%lld,%lld,%.6g,0\n", name, u->budget_value, u->repeat,
+                 (unsigned long long)u->seed, (long long)u->walks, (long long)u->steps, u->seconds);
+    else
+        snprintf(line, sizeof line, "%s,%.17g,%d,%llu,%.17g,%.17g,%.17g,%lld,%lld,%.6g,%d\n", name, u->budget_value,
+                 u->repeat, (unsigned long long)u->seed, u->estimate, u->std_error, u->abs_error, (long long)u->walks,
+                 (long long)u->steps, u->seconds, u->covered);
+    char **row = row_at(st, u->method, u->budget, u->repeat);
+    free(*row);
+    return (*row = strdup(line)) ? 0 : cli_exit_code(ULAM_ENOMEM);
 }
 
-/* Run every missing run, saving runs.csv after each cell (and every 10 s within one) and on
- * Ctrl-C; 0, EXIT_INTERRUPTED, or an exit code when runs.csv cannot be written. */
+/* The cells whose every run is done. */
+static int cells_done(const study *st)
+{
+    int cells = 0;
+    ulam_study_cell c;
+    for (int m = 0; m < NMETHOD; m++)
+        for (int b = 0; st->m[m].on && !st->m[m].why[0] && b < st->nbudget; b++)
+            cells += ulam_study_cell_get(st->lib, m, b, &c) == st->repeats;
+    return cells;
+}
+
+/* Run every missing run (ulam_study_iterate), saving runs.csv after each cell (and every 10 s
+ * within one) and on Ctrl-C; 0, EXIT_INTERRUPTED, or an exit code when runs.csv cannot be written. */
 static int run_all(study *st)
 {
     char path[4096];
     snprintf(path, sizeof path, "%s/runs.csv", st->out);
     resume(st, path);
-    int rc = save_runs(st), cells = 0, total = 0, tty = isatty(2);
+    int rc = save_runs(st), total = 0, tty = isatty(2);
     if (rc) return rc;
     for (int m = 0; m < NMETHOD; m++) total += st->m[m].on && !st->m[m].why[0];
     total *= st->nbudget;
     double t0 = ulam_now(), saved = t0;
     cli_catch_sigint();
-    for (int b = 0; b < st->nbudget && !cli_interrupted && !rc; b++)
-        for (int m = 0; m < NMETHOD && !cli_interrupted && !rc; m++) {
-            if (!st->m[m].on || st->m[m].why[0]) continue;
-            for (int r = 0; r < st->repeats && !cli_interrupted && !rc; r++)
-                if (!st->done[at(st, m, b, r)] && !one_run(st, m, b, r) && ulam_now() - saved > 10.0)
-                    rc = save_runs(st), saved = ulam_now();
-            if (!rc) rc = save_runs(st), saved = ulam_now();
-            cells++;
-            double el = ulam_now() - t0;
-            if (tty)
-                fprintf(stderr, "\rulam: study: cells %d/%d, %.1f s elapsed, about %.0f s left   ", cells, total,
-                        el, seconds_left(st));
-        }
+    while (!rc && !cli_interrupted && !ulam_study_done(st->lib)) {
+        ulam_study_run u;
+        ulam_error err;
+        if (ulam_study_iterate(st->lib, &u, &err)) rc = cli_report(st->s.matrix_path, &err);
+        if (rc || u.interrupted) break;
+        if ((rc = keep_row(st, &u))) break;
+        if (u.last_in_cell || ulam_now() - saved > 10.0) rc = save_runs(st), saved = ulam_now();
+        if (u.last_in_cell && tty)
+            fprintf(stderr, "\rulam: study: cells %d/%d, %.1f s elapsed, about %.0f s left   ", cells_done(st), total,
+                    ulam_now() - t0, ulam_study_seconds_left(st->lib));
+    }
     if (!rc) rc = save_runs(st); /* the rows finished before Ctrl-C */
     cli_release_sigint();
     if (tty) fputc('\n', stderr);
     return rc ? rc : cli_interrupted ? EXIT_INTERRUPTED : 0;
 }
 
-/* Reference lines of the methods that solve for every unknown: sequential MC and MCSA (one
- * run each, seed --seed, 10^-10 or --reference-time seconds, only when forward walks have finite
- * variance) and the Krylov peer (CG when M is symmetric, else GMRES(30); a run a tolerance
- * 10^-1 .. 10^-10): error on x_I against seconds, into f. */
-static void outer_references(const study *st, FILE *f)
+/* One point of a reference line as a reference.csv row (the error nudged off 0 for the log axis). */
+static void line_point(const char *kind, double seconds, double error, void *f)
 {
-    int64_t n = st->s.M->nrows, I = st->s.index - 1;
-    double *x = malloc((size_t)n * sizeof *x);
     char v[2][32];
-    if (!x) return;
-    for (int m = ULAM_SEQUENTIAL; m <= ULAM_MCSA && st->forward_walks && st->reference_time > 0; m++) {
-        ulam_outer_opts o = ulam_outer_defaults();
-        o.method = m, o.tol = 1e-10, o.walk.exec.seed = st->seed, o.walk.exec.threads = st->threads;
-        o.walk.stop.interrupt = &cli_interrupted, o.max_histories = 20 * n > 1000000 ? 20 * n : 1000000;
-        ulam_outer *it = NULL;
-        if (ulam_outer_alloc(st->s.M, st->s.b, &o, &it, NULL)) continue;
-        double t = 0;
-        while (!ulam_outer_done(it) && t < st->reference_time && !cli_interrupted) {
-            ulam_outer_step step;
-            ulam_outer_iterate(it, &step);
-            t += step.seconds;
-            fprintf(f, "%s,%s,%s\n", m == ULAM_MCSA ? "mcsa" : "sequential", num(v[0], t),
-                    num(v[1], fabs(ulam_outer_x(it)[I] - st->exact) + 1e-300));
-        }
-        ulam_outer_free(it);
-    }
-    int cg = ulam_csr_symmetric(st->s.M);
-    for (int k = 1; k <= 10 && !cli_interrupted; k++) { /* a solve's time: the mean of repeats over >= 1 ms (one
-                                                             solve of a small system is microseconds, the first
-                                                             ones many times the rest: the line ran backwards) */
-        int its, reps = 0, status;
-        double res, t0 = ulam_now(), t;
-        do {
-            status = cg ? ulam_cg(st->s.M, st->s.b, pow(10.0, -k), 100000, x, &its, &res)
-                        : ulam_gmres(st->s.M, st->s.b, 30, pow(10.0, -k), 100000, x, &its, &res);
-            t = ulam_now() - t0;
-        } while (++reps < 1000 && t < 1e-3 && (status == ULAM_OK || status == ULAM_ENOCONV));
-        if (status == ULAM_OK || status == ULAM_ENOCONV)
-            fprintf(f, "%s,%s,%s\n", cg ? "cg" : "gmres", num(v[0], t / reps), num(v[1], fabs(x[I] - st->exact) + 1e-300));
-    }
-    free(x);
+    fprintf(f, "%s,%s,%s\n", kind, num(v[0], seconds), num(v[1], error + 1e-300));
 }
 
-/* The exact x_I (ulam_study_reference) and the reference lines: LAPACK (n <= 8000: its time and
- * its error against Gauss-Seidel run to convergence) and Gauss-Seidel from x = 0 (time against
- * its error on x_I), into reference.csv.  0 or an exit code. */
+/* The exact x_I (the study's) and the reference lines (ulam_study_reference_lines: LAPACK's
+ * point, Gauss-Seidel, sequential MC and MCSA, the Krylov peer), into reference.csv.  0 or an
+ * exit code. */
 static int references(study *st)
 {
-    int64_t n = st->s.M->nrows, I = st->s.index - 1;
-    ulam_study_ref ref;
-    ulam_error err;
-    if (ulam_study_reference(st->s.M, st->s.b, I, &ref, &err)) return cli_report(st->s.matrix_path, &err);
-    st->exact = ref.exact;
-    st->direct = ref.direct, st->direct_seconds = ref.direct_seconds, st->direct_error = fabs(ref.exact - ref.settled) + 1e-300;
-    double *x = calloc((size_t)n, sizeof *x);
-    if (!x) return cli_exit_code(ULAM_ENOMEM);
-    char path[4096], v[2][32];
+    const ulam_study_ref *ref = ulam_study_exact(st->lib);
+    st->exact = ref->exact;
+    st->direct = ref->direct, st->direct_seconds = ref->direct_seconds;
+    st->direct_error = fabs(ref->exact - ref->settled) + 1e-300;
+    char path[4096];
     snprintf(path, sizeof path, "%s/reference.csv", st->out);
     ulam_outfile o = {0};
     int status = cli_rank ? ULAM_OK : cli_outfile_open(&o, path); /* under MPI, rank 0 writes */
     if (status) {
-        free(x);
         ulam_error e = {.status = status, .msg = "a writable output directory"};
         return cli_report(path, &e);
     }
     FILE *f = o.f ? o.f : fopen("/dev/null", "w");
-    if (!f) {
-        free(x);
-        return cli_exit_code(ULAM_EIO);
-    }
+    if (!f) return cli_exit_code(ULAM_EIO);
     fprintf(f, "kind,seconds,error\n");
-    if (ref.direct)
-        fprintf(f, "lapack,%s,%s\n", num(v[0], st->direct_seconds), num(v[1], st->direct_error));
-    double t = 0;
-    for (int k = 1; k <= 100000; k++) {
-        double t0 = ulam_now();
-        ulam_gauss_seidel_sweep(st->s.M, st->s.b, x);
-        t += ulam_now() - t0;
-        double e = fabs(x[I] - st->exact);
-        if ((k & (k - 1)) == 0 || e <= 1e-9 * fabs(st->exact))
-            fprintf(f, "gs,%s,%s\n", num(v[0], t), num(v[1], e + 1e-300));
-        if (!(e > 1e-9 * fabs(st->exact))) break;
+    ulam_error err;
+    if ((status = ulam_study_reference_lines(st->lib, st->reference_time, line_point, f, &err))) {
+        if (o.f) cli_outfile_abort(&o);
+        else fclose(f);
+        return cli_report(st->s.matrix_path, &err);
     }
-    free(x);
-    outer_references(st, f);
     if (!o.f) return fclose(f), 0;
     ulam_error e = {.status = cli_outfile_commit(&o), .msg = "a writable output directory"};
     return e.status ? cli_report(path, &e) : 0;
 }
 
-/* What R runs of one method at one budget say, against the exact value. */
-typedef struct {
-    int runs;           /* every finished run, those with no estimate too */
-    int failed;         /* runs that ended with no estimate (a failure of the method at this budget) */
-    double rmse;        /* sqrt(mean (estimate - exact)^2) */
-    double mean_stderr; /* the mean reported standard error */
-    double honesty;     /* rmse / mean_stderr: 1 when the error bars are honest */
-    double coverage;    /* share of runs whose 95% interval holds the exact value (a failed run holds nothing) */
-    double seconds;     /* mean seconds per run */
-    double work;        /* work-normalised variance rmse^2 x seconds (lower is better; infinite with a
-                           failed run: such a cell never wins) */
-} cell;
+/* What R runs of one method at one budget say, against the exact value (src/study.c). */
+typedef ulam_study_cell cell;
 
-/* Summarise n runs (arrays of n; a NaN estimate: a run with no estimate) against the exact value
- * into *out: RMSE and stderr over the runs with an estimate, coverage over all n. */
-static void cell_summary(int n, const double *estimate, const double *std_error, const double *seconds,
-                         double exact, cell *out)
+/* The summary c of method m's finished runs at budget b; the number of runs it summarises (0:
+ * none). */
+static int method_cell(const study *st, int m, int b, cell *c)
 {
-    double se2 = 0, se = 0, t = 0;
-    int covered = 0, failed = 0;
-    for (int k = 0; k < n; k++) {
-        t += seconds[k];
-        if (isnan(estimate[k])) {
-            failed++;
-            continue;
-        }
-        double e = estimate[k] - exact;
-        se2 += e * e, se += std_error[k];
-        covered += fabs(e) <= ULAM_Z95 * std_error[k];
-    }
-    double N = n > 0 ? n : 1, G = n - failed > 0 ? n - failed : NAN;
-    *out = (cell){.runs = n, .failed = failed, .rmse = sqrt(se2 / G), .mean_stderr = se / G, .coverage = covered / N,
-                  .seconds = t / N};
-    out->honesty = out->mean_stderr > 0 ? out->rmse / out->mean_stderr : INFINITY;
-    out->work = failed ? INFINITY : out->rmse * out->rmse * out->seconds;
-}
-
-/* The summary c of method m's finished runs at budget b (e: scratch for 3 x repeats doubles);
- * the number of runs it summarises (0: none, c untouched). */
-static int method_cell(const study *st, int m, int b, double *e, cell *c)
-{
-    int k = 0;
-    for (int r = 0; r < st->repeats; r++) {
-        size_t i = at(st, m, b, r);
-        if (st->done[i]) e[k] = st->est[i], e[st->repeats + k] = st->se[i], e[2 * st->repeats + k++] = st->sec[i];
-    }
-    if (k) cell_summary(k, e, e + st->repeats, e + 2 * st->repeats, st->exact, c);
-    return k;
+    return ulam_study_cell_get(st->lib, m, b, c);
 }
 
 /* summary.csv (a row per cell) and bars.csv (per method, at the largest budget). */
@@ -574,13 +448,12 @@ static int summarise(study *st)
     FILE *f = o[0].f, *g = o[1].f;
     fprintf(f, "method,budget,runs,rmse,mean_stderr,honesty,coverage,seconds,work,variance_finite,failed\n");
     fprintf(g, "method,work,coverage,honesty,coverage_lo,coverage_hi,covered,runs\n");
-    double *e = malloc((size_t)st->repeats * 3 * sizeof *e);
-    for (int m = 0; m < NMETHOD && e; m++) {
+    for (int m = 0; m < NMETHOD; m++) {
         if (!st->m[m].on || st->m[m].why[0]) continue;
         cell last = {0};
         for (int b = 0; b < st->nbudget; b++) {
             cell c;
-            if (!method_cell(st, m, b, e, &c)) continue;
+            if (!method_cell(st, m, b, &c)) continue;
             fprintf(f, "%s,%.17g,%d,%s,%s,%s,%s,%s,%s,%s,%d\n", st->m[m].name, st->budget[b], c.runs,
                     num(v[0], c.rmse), num(v[1], c.mean_stderr), num(v[2], c.honesty), num(v[3], c.coverage),
                     num(v[4], c.seconds), num(v[5], c.work), st->m[m].infinite ? "false" : "true", c.failed);
@@ -594,8 +467,6 @@ static int summarise(study *st)
                     num(v[2], last.honesty), num(v[3], lo), num(v[4], hi), covered, last.runs);
         }
     }
-    status = e ? ULAM_OK : ULAM_ENOMEM;
-    free(e);
     for (k = 0; k < 2 && !status; k++) status = cli_outfile_commit(&o[k]);
     cli_outfile_abort(&o[0]), cli_outfile_abort(&o[1]); /* whatever was not committed */
     ulam_error err = {.status = status, .msg = "a writable output directory"};
@@ -760,16 +631,9 @@ static void print_summary(const study *st)
            st->partial ? "; PARTIAL (interrupted): the cells below hold the runs finished" : "");
     printf("%-12s %-28s %-10s %-10s %s\n", st->time_budgets ? "seconds" : "walks", "winner (least RMSE^2 x s)", "RMSE",
            "s a run", "coverage (95% interval)");
-    double *e = malloc((size_t)st->repeats * 3 * sizeof *e);
-    for (int b = 0; b < st->nbudget && e; b++) {
-        int best = -1;
-        cell bc = {0};
-        for (int m = 0; m < NMETHOD; m++) {
-            if (!st->m[m].on || st->m[m].why[0] || st->m[m].infinite) continue;
-            cell c;
-            if (!method_cell(st, m, b, e, &c)) continue;
-            if (best < 0 || c.work < bc.work) best = m, bc = c;
-        }
+    for (int b = 0; b < st->nbudget; b++) {
+        cell bc;
+        int best = ulam_study_winner(st->lib, b, &bc);
         if (best < 0 || !isfinite(bc.work)) { /* none, or every cell has runs with no estimate */
             printf("%-12g %s\n", st->budget[b], best < 0 ? "(no finished runs)" : "(no winner: every method has runs with no estimate)");
             continue;
@@ -780,14 +644,13 @@ static void print_summary(const study *st)
         printf("%-12g %-28s %-10.3g %-10.3g %d/%d (%.2f .. %.2f)\n", st->budget[b], st->m[best].name, bc.rmse,
                bc.seconds, covered, bc.runs, lo, hi);
     }
-    for (int m = 0; m < NMETHOD && e; m++) /* the failures, each cell where a run gave no estimate */
+    for (int m = 0; m < NMETHOD; m++) /* the failures, each cell where a run gave no estimate */
         for (int b = 0; b < st->nbudget; b++) {
             cell c;
-            if (st->m[m].on && !st->m[m].why[0] && method_cell(st, m, b, e, &c) && c.failed)
+            if (st->m[m].on && !st->m[m].why[0] && method_cell(st, m, b, &c) && c.failed)
                 printf("no estimate: %s at %g: %d of %d runs (a failure: this cell cannot win)\n", st->m[m].name,
                        st->budget[b], c.failed, c.runs);
         }
-    free(e);
     for (int m = 0; m < NMETHOD; m++)
         if (st->m[m].on && st->m[m].why[0]) printf("refused: %s: %s\n", st->m[m].name, st->m[m].why);
 }
@@ -853,9 +716,8 @@ int cli_study(int argc, char **argv)
         return cli_usage_error("study", "needs --rhs b.mtx (%s holds no b)", st.s.matrix_path);
     }
     size_t cells = (size_t)NMETHOD * MAXBUDGET * (size_t)st.repeats;
-    st.est = malloc(cells * sizeof *st.est), st.se = malloc(cells * sizeof *st.se);
-    st.sec = malloc(cells * sizeof *st.sec), st.done = calloc(cells, 1), st.row = calloc(cells, sizeof *st.row);
-    rc = st.est && st.se && st.sec && st.done && st.row ? 0 : cli_exit_code(ULAM_ENOMEM);
+    st.row = calloc(cells, sizeof *st.row);
+    rc = st.row ? 0 : cli_exit_code(ULAM_ENOMEM);
     if (!rc) rc = check_question(&st);
     if (!rc) rc = screen_methods(&st);
     if (!rc) rc = references(&st);
@@ -874,7 +736,8 @@ int cli_study(int argc, char **argv)
         }
     }
     for (size_t i = 0; st.row && i < cells; i++) free(st.row[i]);
-    free(st.est), free(st.se), free(st.sec), free(st.done), free(st.row);
+    free(st.row);
+    st.lib = ulam_study_free(st.lib);
     cli_system_free(&st.s);
     return rc;
 }

@@ -66,3 +66,73 @@ int ulam_rad_grid_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const u
     ulam_rad_solver_free(sv);
     return status;
 }
+
+/* See ulam_radiosity.h. */
+int ulam_rad_points_solve(const ulam_tracer *t, const ulam_rad_opts *opts, const double *at, int64_t n,
+                          ulam_rad_point *out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!t || !opts || (n > 0 && (!at || !out)) || n < 0)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, options, points and an output");
+    for (int64_t k = 0; k < n; k++) {
+        ulam_rad_opts o = *opts;
+        o.exec.seed = ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, (uint64_t)k); /* each its own walks */
+        const double *x = at + 6 * k;
+        int status = ulam_rad_point_query(t, &o, x, isnan(x[3]) ? NULL : x + 3, &out[k], err);
+        if (status) {
+            if (err) err->index = k;
+            return status;
+        }
+        if (out[k].run.interrupted) { /* the rest are left empty */
+            memset(out + k + 1, 0, (size_t)(n - k - 1) * sizeof *out);
+            break;
+        }
+    }
+    return ULAM_OK;
+}
+
+/* Rec. 709's luminance weights. */
+static const double luma[3] = {0.2126, 0.7152, 0.0722};
+
+/* See ulam_radiosity.h. */
+const double *ulam_rad_luma(void)
+{
+    return luma;
+}
+
+/* See ulam_radiosity.h. */
+void ulam_rad_illuminance(const ulam_rad_point *r, double *Y, double *se)
+{
+    *Y = *se = 0.0;
+    for (int c = 0; c < 3; c++) *Y += luma[c] * r->irradiance[c], *se += luma[c] * r->irradiance_se[c];
+}
+
+/* See ulam_radiosity.h.  It holds because it contains the interval src/stop.c would give on the
+ * walks' Y scores: their range is at most sum_c l_c R_c, their bias sum_c l_c of the channels', and
+ * their sample standard deviation at most sum_c l_c s_c (the sample covariance is positive
+ * semidefinite), so each term of that half-width is at most the weighted sum of the channels';
+ * floored at 0 (every score >= 0). */
+void ulam_rad_illuminance_ci(const ulam_rad_point *r, double *lo, double *hi)
+{
+    double Y = 0.0, h = 0.0;
+    for (int c = 0; c < 3; c++) Y += luma[c] * r->irradiance[c], h += luma[c] * (r->run.ci95[c][1] - r->irradiance[c]);
+    *lo = isfinite(h) ? fmax(Y - h, 0.0) : NAN, *hi = isfinite(h) ? Y + h : NAN;
+}
+
+/* See ulam_radiosity.h. */
+int ulam_rad_grid_stats(const ulam_rad_point *pts, int64_t n, ulam_rad_grid_summary *out)
+{
+    if (!pts || n < 1 || !out) return ULAM_EINVAL;
+    double Ymin = INFINITY, Ysum = 0.0, worst = 0.0;
+    *out = (ulam_rad_grid_summary){0};
+    for (int64_t k = 0; k < n; k++) {
+        double Y, se;
+        ulam_rad_illuminance(&pts[k], &Y, &se);
+        Ymin = fmin(Ymin, Y), Ysum += Y;
+        if (Y > 0) worst = fmax(worst, se / Y);
+        out->walks += pts[k].run.walks, out->rays += pts[k].run.rays;
+    }
+    out->min = Ymin, out->mean = Ysum / (double)n, out->worst = worst;
+    out->uniformity = Ysum > 0 ? Ymin / out->mean : NAN;
+    return ULAM_OK;
+}

@@ -58,3 +58,26 @@ int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_rad_opts *opts, const d
     out->seconds = ulam_now() - t0;
     return ULAM_OK;
 }
+
+/* See ulam_radiosity.h. */
+int ulam_rad_mesh_errors(const ulam_tracer *t, const ulam_rad_opts *opts, const double *B, double *out,
+                         ulam_error *err)
+{
+    ulam__clear(err);
+    if (!t || !opts || !B || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a tracer, options, B and an output");
+    const ulam_scene *s = ulam__tracer_scene(t);
+    int interrupted = 0;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        ulam_rad_mesh m = {.interrupted = 1};
+        ulam_rad_opts o = *opts;
+        o.index = p, o.exec.seed = ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, (uint64_t)p);
+        int status = interrupted ? ULAM_OK : ulam_rad_mesh_error(t, &o, B + 3 * p, &m, err);
+        if (status) {
+            if (err) err->index = p;
+            return status;
+        }
+        interrupted |= m.interrupted;
+        for (int c = 0; c < 3; c++) out[3 * p + c] = m.interrupted ? NAN : m.error[c];
+    }
+    return ULAM_OK;
+}
