@@ -289,7 +289,8 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
     /* a pilot on b that saw no score (a sparse b the walks reach rarely) has no variance and no range
        to go by, and a zero variance must not be believed: the walks' interval is then planned from the
        residual's walks below, whose range scaled by max|b| / max|r| bounds theirs */
-    int blind = wb.walks > 0 && wb.estimate == 0.0 && !(wb.variance > 0) && q->o->stop.rel_err_offset == 0.0;
+    int blind = wb.walks > 0 && !(wb.variance > 1e-12 * wb.estimate * wb.estimate) && q->o->stop.rel_err_offset == 0.0;
+    /* (every score alike up to rounding: a variance of 3.1e-33 against an actual 3.6e8 was believed) */
     if (!blind && (!(cb.range_term > cb.var_term) || !isfinite(cb.half))) {
         snprintf(v->why, sizeof v->why, "not considered: at %.3g walks the walks' interval is not led by its range "
                  "term (%.3g, variance term %.3g): a push on b would narrow it little", N, cb.range_term, cb.var_term);
@@ -307,14 +308,14 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
             return ULAM_OK;
         }
         interval_at(&wr, q->run->bwo.stop.rel_err_offset, N, &cr);
-        if (blind && !isfinite(cb.half)) { /* the walks on b: the residual's range scaled to b, at a variance of the
-            rule of three (a score of that size in at most 3 / n of the pilot's n walks, 95%) */
+        if (blind && !(cb.var_term > 0 && isfinite(cb.half))) { /* the walks on b: the residual's range scaled to b,
+            at a variance of the rule of three (a score of that size in at most 3 / n of the pilot's n walks, 95%) */
             double Rb = pilot_range(&wr, q->run->bwo.stop.rel_err_offset) * bmax / pl->push.r_max;
             if (isfinite(Rb) && Rb > 0 && N >= 2 && N < 4e18)
                 ulam__stop_interval((int64_t)N, 0.0, Rb * Rb * 3.0 / (double)wb.walks, Rb, 0.0, 0.0, INFINITY, 0, &cb);
         }
         if (round >= FIXED_ROUNDS || pl->push.ops >= cap || !(pl->push.r_max > 0)) break;
-        if (blind && !isfinite(cb.half)) { /* the residual's walks saw nothing either: push on */
+        if (blind && !(cb.var_term > 0 && isfinite(cb.half))) { /* the residual's walks saw nothing either: push on */
             rmax = pl->push.r_max / 16.0;
             continue;
         }
