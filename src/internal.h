@@ -361,6 +361,13 @@ static inline int ulam__rows_verify(const ulam__rows_check *rc, int64_t first, i
 int ulam__system_rows_check(const ulam_system *s, const ulam_csr *M, const double *b, ulam__rows_check *rc,
                             ulam_error *err);
 
+/* What a prepared system is written from checked (ulam_system_write_file's refusals: ULAM_EINVAL),
+ * and its bytes written to f with the bounds R (an analysis' of d->M at the certificate's
+ * continuation and exponent 1, with d->b's scores; NULL: none stored) once checked (src/cache.c;
+ * the writer, src/prepare.c, makes R). */
+int ulam__system_desc_check(FILE *f, const ulam_system_desc *d);
+int ulam__system_write_checked(FILE *f, const ulam_system_desc *d, const ulam__reach *R);
+
 /* Why the block holding row i of s failed: ULAM_ESYNTAX with err naming the block and the fault. */
 int ulam__system_row_error(const ulam_system *s, int64_t i, ulam_error *err);
 

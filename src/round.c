@@ -10,6 +10,12 @@
 
 enum { TEAM_BLOCKS = 4 }; /* blocks a thread a round must have before a round takes a team */
 
+/* The stopping defaults: 10^5 walks, 10^6 steps a walk. */
+ulam_stop_opts ulam_stop_defaults(void)
+{
+    return (ulam_stop_opts){.max_walks = 100000, .max_steps = 1000000};
+}
+
 /* One process. */
 ulam_share ulam_share_defaults(void)
 {

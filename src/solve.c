@@ -121,12 +121,6 @@ ulam_kernel_opts ulam_kernel_defaults(void)
     return (ulam_kernel_opts){.kernel_alpha = 1.0};
 }
 
-/* The stopping defaults: 10^5 walks, 10^6 steps a walk. */
-ulam_stop_opts ulam_stop_defaults(void)
-{
-    return (ulam_stop_opts){.max_walks = 100000, .max_steps = 1000000};
-}
-
 /* The execution defaults: seed 1, all cores, one process. */
 ulam_exec_opts ulam_exec_defaults(void)
 {
@@ -1088,6 +1082,17 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
                       ulam_solver **out, ulam_error *err)
 {
     return solver_alloc(M, b, opts, NULL, NULL, out, err);
+}
+
+/* As ulam_solver_alloc with b's length checked. */
+int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
+                        ulam_solver **out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (out) *out = NULL;
+    if (!M) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
+    int status = ulam__length_check(b, nb, M->nrows, "b", err);
+    return status ? status : ulam_solver_alloc(M, b, opts, out, err);
 }
 
 /* As ulam_solver_alloc with the reachable states and a kept kernel (both borrowed). */
