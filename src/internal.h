@@ -243,14 +243,10 @@ int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_
  * The status (src/solve.c: the rest of ulam_solve_walks). */
 int ulam__solver_finish(ulam_solver *s, ulam_walk_result *result, ulam_error *err);
 
-/* As ulam_auto_start, with reach (NULL: none; borrowed until the run is freed) the bounds over
- * every state the walks row's candidates of its kernel walk under (ulam__auto_solver_reach; src/method.c,
- * ulam_analysis_auto_start), and an (NULL: none; borrowed likewise) the analysis of M whose
- * transpose, push workspace and plan memo the bidirectional row uses (without one the row makes
- * its own). */
-int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                           const ulam_method_opts *mo, const ulam__reach *reach, ulam_analysis *an, ulam_choice *ch,
-                           ulam_run **out, ulam_error *err);
+/* The walks' pins o (the caller's, or ulam_auto_defaults()) given a's guards when they pin a's own
+ * kernel (adjoint, a's continuation and exponent, no guard of their own): ULAM_OK, or the guards'
+ * status (src/analysis.c; ulam_analysis_auto, ulam_analysis_auto_start). */
+int ulam__analysis_pin_guard(ulam_analysis *a, const ulam_walk_opts *base, ulam_auto_opts *o, ulam_error *err);
 
 /* The analysis' transpose (ulam_analysis_transpose), with *seconds (may be NULL) the time this
  * call spent making it: 0 when the analysis had it (src/analysis.c). */

@@ -4,6 +4,8 @@
 
 #include "internal.h"
 
+#include <stdio.h>
+
 /* A chosen method ready to run: what the rows keep between their prediction and their run. */
 struct ulam_run {
     int method;           /* enum ulam_method_row; -1 before a row is chosen or pinned */
@@ -58,7 +60,13 @@ typedef struct ulam__method_type {
 extern const ulam__method_type ulam__method_walks, ulam__method_bidir, ulam__method_richardson,
     ulam__method_gauss_seidel, ulam__method_sequential, ulam__method_mcsa, ulam__method_cg, ulam__method_gmres;
 
-/* 1 when row k is excluded by q's options (why filled: "not considered: excluded"). */
-int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len);
+/* 1 when row k is excluded by q's options (why filled: "not considered: excluded"); a row's
+ * applicability test asks it (here, below the rows: the table calls the rows, never back). */
+static inline int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len)
+{
+    if (!(q->mo->exclude & (1u << k))) return 0;
+    snprintf(why, len, "not considered: excluded");
+    return 1;
+}
 
 #endif
