@@ -9,8 +9,10 @@
  * rows its walks reach.  This file is the one home of "reach once, keep the kernel, hand out
  * solvers": the walk solver's construction and caching calls (ulam__solver_alloc_reached,
  * ulam__solver_keep_kernel*, ulam__solver_reached, ulam__reach_all) are made here. */
-#include "internal.h"
+#include "analysis.h"
+#include "cache.h"
 #include "kernel.h"
+#include "solve.h"
 
 #include <math.h>
 #include <stdlib.h>

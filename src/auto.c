@@ -11,7 +11,10 @@
  * machine load.  The estimate then comes from fresh walks on the caller's seed with the chosen
  * candidate's solver: the choice is a function of the pilots alone, which are independent of
  * those walks, so it cannot bias them (README: reusing the pilot's walks would). */
-#include "internal.h"
+#include "auto.h"
+#include "analysis.h"
+#include "check.h"
+#include "solve.h"
 #include "stats.h"
 #include "stop.h"
 

@@ -31,7 +31,8 @@
  * _rhs and _transpose verify their arrays whole; ulam_system_lazy hands the arrays out unverified
  * for a solver given ulam_walk_opts.system, whose kernel verifies each row's block before it
  * builds the row (so a one-row query reads a few blocks). */
-#include "internal.h"
+#include "cache.h"
+#include "solve.h"
 
 #include <fcntl.h>
 #include <math.h>

@@ -3,7 +3,7 @@
  * naming the field, and a matrix's structure (row pointers, column indices) is checked before a
  * pass reads all of it, so a matrix built by hand or mapped from a damaged file is refused, never
  * read out of bounds.  One home for these checks: the solvers call them first. */
-#include "internal.h"
+#include "check.h"
 
 #include <float.h>
 #include <math.h>

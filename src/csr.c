@@ -1,5 +1,6 @@
 /* Compressed sparse row matrices: build, transpose, multiply, summarise, split. */
-#include "internal.h"
+#include "csr.h"
+#include "check.h"
 
 #include <math.h>
 #include <stdlib.h>

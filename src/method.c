@@ -3,7 +3,10 @@
  * ulam_auto_start chooses among the rows, or starts the one pinned.  A new method is a row here
  * and its own file (src/method_*.c). */
 #include "method.h"
+#include "analysis.h"
+#include "check.h"
 #include "round.h"
+#include "solve.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -3,6 +3,7 @@
 #define ULAM_METHOD_H
 
 #include "internal.h"
+#include "solve.h"
 
 #include <stdio.h>
 

@@ -1,6 +1,7 @@
 /* The method table's walks row: adjoint or forward von Neumann-Ulam walks, the candidate (mode,
  * estimator, continuation, kernel exponent) chosen by the pilots' race (src/auto.c), run by the
  * walk solver (src/solve.c). */
+#include "auto.h"
 #include "method.h"
 
 #include <math.h>

@@ -2,7 +2,9 @@
  * b's scores) from an analysis of M at the certificate's continuation and exponent 1, the very
  * bounds an analysis of the mapped file then walks under; the bytes and their checksums by
  * src/cache.c, which reads and verifies files and knows nothing of analyses. */
-#include "internal.h"
+#include "analysis.h"
+#include "cache.h"
+#include "solve.h"
 
 /* Write a prepared system to f. */
 int ulam_system_write_file(FILE *f, const ulam_system_desc *d)

@@ -4,6 +4,7 @@
  * totals); and the after-round step both solvers take (ulam__round_step: merge in block order,
  * failures, interrupt, budget and time), so those stopping rules are written once. */
 #include "round.h"
+#include "check.h"
 
 #include <stdlib.h>
 #include <string.h>

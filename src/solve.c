@@ -6,7 +6,14 @@
  * (Chan's formula for the adjoint score, per-state sums for forward tallies), so the result is
  * bit-for-bit the same for any number of threads.  Stopping rules are checked between rounds; an interrupt or the time limit
  * also stops blocks that have not started. */
+#include "solve.h"
+#include "cache.h"
+#include "check.h"
+#include "fpush_b.h"
+#include "guard.h"
+#include "hit.h"
 #include "round.h"
+#include "spectral.h"
 #include "stats.h"
 #include "stop.h"
 #include "walk.h"

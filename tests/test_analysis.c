@@ -16,6 +16,8 @@
 #include <cmocka.h>
 
 #include "../src/internal.h"
+#include "../src/analysis.h"
+#include "../src/solve.h"
 #include "testutil.h"
 
 /* Fail unless two runs are the same, bit for bit (the kernel rows built aside). */

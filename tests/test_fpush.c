@@ -17,6 +17,8 @@
 #include <cmocka.h>
 
 #include "../src/internal.h"
+#include "../src/fpush.h"
+#include "../src/sweep.h"
 #include "../src/stop.h"
 #include "testutil.h"
 #include "zipf_graph.h"

@@ -1,6 +1,7 @@
 /* Matrix Market reading and writing: every good kind, every malformed input class. */
 #include "testutil.h"
 #include "../src/internal.h" /* ulam__mm_read_matrix_libc: the libc reader compared */
+#include "../src/mmio.h"
 
 #include <string.h>
 #include <unistd.h>
