@@ -2,7 +2,7 @@
  * (I - M) x = b is a row with its name, its applicability test, its cost prediction and its run;
  * ulam_auto_start chooses among the rows, or starts the one pinned.  A new method is a row here
  * and its own file (src/method_*.c). */
-#include "method.h"
+#include "method_row.h"
 #include "analysis.h"
 #include "check.h"
 #include "round.h"

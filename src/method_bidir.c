@@ -10,7 +10,7 @@
 #include "analysis.h"
 #include "bidir.h"
 #include "bpush.h"
-#include "method.h"
+#include "method_row.h"
 #include "solve.h"
 #include "stats.h"
 #include "stop.h"

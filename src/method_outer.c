@@ -1,7 +1,7 @@
 /* The method table's outer-iteration rows (src/mcsa.c): richardson, gauss-seidel, sequential and
  * mcsa answer every unknown to a residual tolerance; asked for one entry they answer x_index with
  * no error bar, so the choice does not consider them for a query that wants one. */
-#include "method.h"
+#include "method_row.h"
 
 #include <math.h>
 #include <stdio.h>

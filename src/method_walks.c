@@ -2,7 +2,7 @@
  * estimator, continuation, kernel exponent) chosen by the pilots' race (src/auto.c), run by the
  * walk solver (src/solve.c). */
 #include "auto.h"
-#include "method.h"
+#include "method_row.h"
 
 #include <math.h>
 

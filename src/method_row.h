@@ -1,6 +1,8 @@
-/* The method table's rows (src/method.c): what a row is and the state a choice builds.  Internal. */
-#ifndef ULAM_METHOD_H
-#define ULAM_METHOD_H
+/* A row of the method table: what a row is, the state a choice builds and the helpers a row asks
+ * (the exclusion test); the rows (src/method_walks.c, src/method_bidir.c, src/method_outer.c)
+ * include it, and the table (src/method.c) above them calls them.  Internal. */
+#ifndef ULAM_METHOD_ROW_H
+#define ULAM_METHOD_ROW_H
 
 #include "internal.h"
 #include "solve.h"
