@@ -9,8 +9,10 @@
  * rows its walks reach.  This file is the one home of "reach once, keep the kernel, hand out
  * solvers": the walk solver's construction and caching calls (ulam__solver_alloc_reached,
  * ulam__solver_keep_kernel*, ulam__solver_reached, ulam__reach_all) are made here. */
-#include "internal.h"
+#include "analysis.h"
+#include "cache.h"
 #include "kernel.h"
+#include "solve.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -235,13 +237,11 @@ int ulam__analysis_walks(ulam_analysis *a, const double *b, const ulam_walk_opts
     return status;
 }
 
-/* The walks' pins o (from ao, or the defaults) with a's guards when they pin a's own kernel. */
-static int auto_pins(ulam_analysis *a, const ulam_walk_opts *base, const ulam_auto_opts *ao, ulam_auto_opts *o,
-                     ulam_error *err)
+/* a's guards in o (the walks' pins) when they pin a's own kernel (see internal.h). */
+int ulam__analysis_pin_guard(ulam_analysis *a, const ulam_walk_opts *base, ulam_auto_opts *o, ulam_error *err)
 {
     ulam__clear(err);
     if (!a || !base) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis and options");
-    *o = ao ? *ao : ulam_auto_defaults();
     int mine = o->pin_continue && o->pin_alpha && o->pin_mode && base->mode == ULAM_ADJOINT &&
                (base->kernel.continue_q > 0 ? base->kernel.continue_q : 0.0) == a->continue_q && base->kernel.kernel_alpha == a->alpha;
     if (mine && !o->guard) {
@@ -250,24 +250,6 @@ static int auto_pins(ulam_analysis *a, const ulam_walk_opts *base, const ulam_au
         o->guard = &a->g;
     }
     return ULAM_OK;
-}
-
-/* The walks' choice on a's bounds. */
-int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
-                       ulam_auto_result *res, ulam_solver **out, ulam_error *err)
-{
-    ulam_auto_opts o;
-    int status = auto_pins(a, base, ao, &o, err);
-    return status ? status : ulam__auto_solver_reach(a->M, b, base, &o, take_bounds(a), res, out, err);
-}
-
-/* The method table's choice, its walks row on a's bounds. */
-int ulam_analysis_auto_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                             const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
-{
-    ulam_auto_opts p;
-    int status = auto_pins(a, o, ao, &p, err);
-    return status ? status : ulam__auto_start_reach(a->M, b, o, &p, mo, take_bounds(a), a, ch, out, err);
 }
 
 /* M's transpose, made once (the prepared file's when it stores one); *seconds (may be NULL): the

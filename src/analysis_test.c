@@ -17,6 +17,8 @@
 #include <cmocka.h>
 
 #include "internal.h"
+#include "analysis.h"
+#include "solve.h"
 #include "testutil.h"
 
 /* Fail unless two runs are the same, bit for bit (the kernel rows built aside). */

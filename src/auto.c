@@ -11,7 +11,10 @@
  * machine load.  The estimate then comes from fresh walks on the caller's seed with the chosen
  * candidate's solver: the choice is a function of the pilots alone, which are independent of
  * those walks, so it cannot bias them (README: reusing the pilot's walks would). */
-#include "internal.h"
+#include "auto.h"
+#include "analysis.h"
+#include "check.h"
+#include "solve.h"
 #include "stats.h"
 #include "stop.h"
 
@@ -605,4 +608,14 @@ int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *b
                      ulam_auto_result *res, ulam_error *err)
 {
     return ulam_auto_solver(M, b, base, ao, res, NULL, err);
+}
+
+/* The walks' choice on an analysis' bounds. */
+int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
+                       ulam_auto_result *res, ulam_solver **out, ulam_error *err)
+{
+    ulam_auto_opts o = ao ? *ao : ulam_auto_defaults();
+    int status = ulam__analysis_pin_guard(a, base, &o, err);
+    return status ? status
+                  : ulam__auto_solver_reach(ulam__analysis_matrix(a), b, base, &o, ulam__analysis_bounds(a), res, out, err);
 }

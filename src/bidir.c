@@ -23,10 +23,11 @@
  * analysis of M' the memo holds (ulam__analysis_walks), which keeps what later walks share: the
  * bounds over every state (reach_all), the kernel rows (keep_kernel) and the reach a pilot found. */
 #include "bidir.h"
-#include "internal.h"
+#include "analysis.h"
+#include "check.h"
 #include "push.h"
+#include "solve.h"
 #include "stats.h"
-
 #include "stop.h"
 
 #include <float.h>

@@ -18,4 +18,10 @@ ulam__bidir *ulam__bidir_alloc(void);
 /* Free a memo and what it keeps; accepts and returns NULL. */
 ulam__bidir *ulam__bidir_free(ulam__bidir *m);
 
+/* ulam_bidir_plan and ulam_bidir_solve on an analysis' transpose, push workspace and planner's
+ * memo (made at the first call and kept), for any kernel: the memo reuses a plan only for the
+ * same options, continuation and exponent among them (src/bidir.c). */
+int ulam__bidir_plan_on(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan, ulam_error *err);
+int ulam__bidir_solve_on(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err);
+
 #endif

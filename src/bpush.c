@@ -12,7 +12,7 @@
  * walks' estimate is unbiased, and the walks' interval shifted by q_i is the interval of x_i.
  * (The importance of b_j to x_i is the adjoint solution ((I - M)^-1)_ij: a large b_j that walks
  * from i rarely reach is worth little to x_i, and the push takes it out of their range.) */
-#include "internal.h"
+#include "bpush.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -31,7 +31,8 @@
  * _rhs and _transpose verify their arrays whole; ulam_system_lazy hands the arrays out unverified
  * for a solver given ulam_walk_opts.system, whose kernel verifies each row's block before it
  * builds the row (so a one-row query reads a few blocks). */
-#include "internal.h"
+#include "cache.h"
+#include "solve.h"
 
 #include <fcntl.h>
 #include <math.h>
@@ -197,19 +198,6 @@ static int get_bounds(const uint64_t *w, const double *b, int64_t n, ulam__reach
     return R->continue_q >= 0 && R->qmax >= 0 && R->fbig >= 0 && R->growth >= 1 && R->bad >= -1 && R->bad < n;
 }
 
-/* The bounds of d's M (and scores of its b) at its certificate's continuation and exponent 1,
- * into the header words w: an analysis' (ulam__analysis_bounds, the bounds its queries walk
- * under); nothing when they cannot be made (a corrupt row, no memory). */
-static void make_bounds(const ulam_system_desc *d, uint64_t *w)
-{
-    ulam_analysis_opts o = ulam_analysis_defaults();
-    o.continue_q = d->cert->continue_q, o.kernel_alpha = 1.0, o.b = d->b;
-    ulam_analysis *a = NULL;
-    const ulam__reach *R = ulam_analysis_alloc(d->M, &o, &a, NULL) ? NULL : ulam__analysis_bounds(a);
-    if (R && (!d->b || R->b == d->b)) put_bounds(w, R);
-    ulam_analysis_free(a);
-}
-
 /* Round x up to the alignment. */
 static uint64_t aligned(uint64_t x)
 {
@@ -291,17 +279,25 @@ ulam_system_desc ulam_system_desc_defaults(void)
     return (ulam_system_desc){.M = NULL, .b = NULL, .n = 0, .tag = {0, 0}, .omega = 0.0, .cert = NULL, .transpose = 0};
 }
 
-/* Write a prepared system to f. */
-int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
+/* Check what a prepared system is written from (ulam_system_write_file's refusals). */
+int ulam__system_desc_check(FILE *f, const ulam_system_desc *d)
 {
     if (!f || !d || (!d->M && !d->b) || !little_endian() || (d->transpose && !d->M)) return ULAM_EINVAL;
     const ulam_csr *M = d->M;
-    int64_t n = M ? M->nrows : d->n, nnz = M ? M->rowptr[M->nrows] : 0;
+    int64_t n = M ? M->nrows : d->n;
     if (n < 0 || (M && d->n != M->nrows && d->b)) return ULAM_EINVAL;
     if (d->cert && (d->cert->guard.kernel_alpha != 1.0 || !M)) return ULAM_EINVAL; /* exponent 1's guards, of M */
     if (M && ulam_csr_check(M)) return ULAM_EINVAL; /* never a file that fails its own verification */
     for (int64_t i = 0; d->b && i < n; i++)
         if (!isfinite(d->b[i])) return ULAM_EINVAL;
+    return ULAM_OK;
+}
+
+/* Write a prepared system (d checked) to f with the bounds R (NULL: none). */
+int ulam__system_write_checked(FILE *f, const ulam_system_desc *d, const ulam__reach *R)
+{
+    const ulam_csr *M = d->M;
+    int64_t n = M ? M->nrows : d->n, nnz = M ? M->rowptr[M->nrows] : 0;
     ulam_csr *T = NULL;
     if (d->transpose && ulam_csr_transpose(M, &T)) return ULAM_ENOMEM;
     int shift = block_shift(n, nnz);
@@ -339,7 +335,7 @@ int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
     w[W_SHIFT] = (uint64_t)shift;
     w[W_SUMS_HASH] = hash(sums, nsums * 8);
     if (d->cert) put_cert(w + W_CERT, d->cert, hash(sums, (size_t)nb[0] * 8));
-    if (d->cert && M && M->nrows == M->ncols) make_bounds(d, w + W_BOUNDS);
+    if (R && d->cert && M && M->nrows == M->ncols) put_bounds(w + W_BOUNDS, R);
     w[W_SUM] = hash(w, (size_t)W_SUM * 8);
     uint64_t pos = 0;
     int ok = put_part(f, w, HEADER, &pos);
@@ -348,21 +344,6 @@ int ulam_system_write_file(FILE *f, const ulam_system_desc *d)
     free(sums);
     ulam_csr_free(T);
     return ok && pos == at ? ULAM_OK : ULAM_EIO;
-}
-
-/* Write a prepared system to path atomically. */
-int ulam_system_write(const char *path, const ulam_system_desc *d)
-{
-    if (!path || !d) return ULAM_EINVAL;
-    ulam_outfile o;
-    int status = ulam_outfile_open(&o, path);
-    if (status) return status;
-    status = ulam_system_write_file(o.f, d);
-    if (status) {
-        ulam_outfile_abort(&o);
-        return status;
-    }
-    return ulam_outfile_commit(&o);
 }
 
 /* Nonzero when an array of bytes at offset off lies inside a file of len bytes past the header. */

@@ -3,7 +3,7 @@
  * naming the field, and a matrix's structure (row pointers, column indices) is checked before a
  * pass reads all of it, so a matrix built by hand or mapped from a damaged file is refused, never
  * read out of bounds.  One home for these checks: the solvers call them first. */
-#include "internal.h"
+#include "check.h"
 
 #include <float.h>
 #include <math.h>
@@ -143,26 +143,4 @@ int ulam__csr_check_structure(const ulam_csr *A, ulam_error *err)
 {
     int status = check_shape(A, err);
     return status ? status : ulam__csr_check_rows(A, 0, A->nrows, err);
-}
-
-/* As ulam_solver_alloc with b's length checked. */
-int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                        ulam_solver **out, ulam_error *err)
-{
-    ulam__clear(err);
-    if (out) *out = NULL;
-    if (!M) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
-    int status = ulam__length_check(b, nb, M->nrows, "b", err);
-    return status ? status : ulam_solver_alloc(M, b, opts, out, err);
-}
-
-/* As ulam_jacobi with b's (and bp's) length checked. */
-int ulam_jacobi_n(const ulam_csr *A, const double *b, int64_t nb, double omega, ulam_csr **M, double *bp,
-                  ulam_error *err)
-{
-    ulam__clear(err);
-    if (M) *M = NULL;
-    if (!A) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, a right-hand side and omega > 0");
-    int status = ulam__length_check(b, nb, A->nrows, "b", err);
-    return status ? status : ulam_jacobi(A, b, omega, M, bp, err);
 }

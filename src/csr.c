@@ -1,5 +1,6 @@
 /* Compressed sparse row matrices: build, transpose, multiply, summarise, split. */
-#include "internal.h"
+#include "csr.h"
+#include "check.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -330,4 +331,15 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
     R->rowptr[n] = out;
     *M = R;
     return ULAM_OK;
+}
+
+/* As ulam_jacobi with b's (and bp's) length checked. */
+int ulam_jacobi_n(const ulam_csr *A, const double *b, int64_t nb, double omega, ulam_csr **M, double *bp,
+                  ulam_error *err)
+{
+    ulam__clear(err);
+    if (M) *M = NULL;
+    if (!A) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, a right-hand side and omega > 0");
+    int status = ulam__length_check(b, nb, A->nrows, "b", err);
+    return status ? status : ulam_jacobi(A, b, omega, M, bp, err);
 }

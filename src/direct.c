@@ -1,4 +1,6 @@
 /* The reference: a dense LU solve of (I - M) x = b with OpenBLAS's LAPACKE_dgesv. */
+#include "direct.h"
+#include "check.h"
 #include "dynload.h"
 
 #include <math.h>

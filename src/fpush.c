@@ -23,8 +23,10 @@
  * N] against the empirical-Bernstein 9.6 R0 / N, so the same accuracy takes ~2.6x fewer walks.
  * ulam_fpush_top's k components are chosen by their estimates: their lower ends at delta k / n
  * (lower_index). */
-#include "internal.h"
+#include "fpush.h"
+#include "check.h"
 #include "stop.h"
+#include "sweep.h"
 
 #include <float.h>
 #include <math.h>

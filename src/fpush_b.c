@@ -16,7 +16,8 @@
  * q_i as the scale of x_i) falls by more than a sweep costs, so the push never costs more than the
  * walks it saves, as predicted.  r is fixed before any walk: q + the walks' estimate is unbiased
  * component by component, and the walks' interval shifted by q_i is x_i's. */
-#include "internal.h"
+#include "fpush_b.h"
+#include "sweep.h"
 
 #include <math.h>
 

@@ -9,6 +9,8 @@
  * iteration, and counts, over seeds, the components whose printed 95% interval holds the exact
  * value: the pooled count k of N passes 0.95 N - 4 sqrt(0.95 0.05 N) and 0.9 N. */
 #include "internal.h"
+#include "fpush.h"
+#include "sweep.h"
 #include "testutil.h"
 #include "zipf_graph.h"
 

@@ -29,7 +29,10 @@
  *
  * The radii of these nonnegative matrices come from power iteration with Collatz-Wielandt
  * bounds (spectral.c), which certify a verdict whenever the bracket lies on one side of 1. */
+#include "guard.h"
+#include "check.h"
 #include "kernel.h"
+#include "spectral.h"
 
 #include <float.h>
 #include <math.h>

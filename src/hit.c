@@ -18,7 +18,7 @@
  * variance.  A run that has seen no score cannot meet its target before a walk scores; with
  * p <= v at its start, it can say so as soon as that count passes its budget or the cap, instead
  * of walking on to the cap. */
-#include "internal.h"
+#include "hit.h"
 
 #include <math.h>
 

@@ -37,6 +37,7 @@
  * such a kernel keeps what rescoring a row for another estimator needs (ulam__rowrec) and reads a
  * row again only for the expected estimator's (K b)_i, when a walk first reaches it. */
 #include "kernel.h"
+#include "cache.h"
 
 #include <math.h>
 #include <stdlib.h>

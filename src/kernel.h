@@ -4,6 +4,7 @@
 #define ULAM_KERNEL_H
 
 #include "internal.h"
+#include "cache.h"
 
 #include <stdatomic.h>
 

@@ -3,7 +3,7 @@
  * as in Saad, "Iterative Methods for Sparse Linear Systems", 2nd ed., Algorithms 6.9 and 6.11.
  * Both start from x = 0 and stop on ||b - (I - M) x||_2 / ||b||_2 <= tol, the true residual
  * checked again at the end. */
-#include "internal.h"
+#include "check.h"
 
 #include <math.h>
 #include <stdlib.h>

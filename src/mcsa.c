@@ -9,7 +9,9 @@
  * correction restarts it on the new residual with the seed of that iteration.  Its rounds are
  * the batches of the adaptive rule: walk until ||stderr||_1 / ||delta||_1 < eps1.  The walks
  * are bit-identical for any thread count, and so is everything else here (sequential sums). */
-#include "internal.h"
+#include "check.h"
+#include "guard.h"
+#include "solve.h"
 
 #include <math.h>
 #include <stdlib.h>

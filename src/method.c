@@ -2,8 +2,11 @@
  * (I - M) x = b is a row with its name, its applicability test, its cost prediction and its run;
  * ulam_auto_start chooses among the rows, or starts the one pinned.  A new method is a row here
  * and its own file (src/method_*.c). */
-#include "method.h"
+#include "method_row.h"
+#include "analysis.h"
+#include "check.h"
 #include "round.h"
+#include "solve.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -33,14 +36,6 @@ int ulam_method_find(const char *name)
 int ulam_method_answers(int k)
 {
     return k >= 0 && k < ULAM_NMETHODS ? table[k]->answers : 0;
-}
-
-/* 1 when row k is excluded by q's options. */
-int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len)
-{
-    if (!(q->mo->exclude & (1u << k))) return 0;
-    snprintf(why, len, "not considered: excluded");
-    return 1;
 }
 
 /* The default row options: none pinned, none excluded. */
@@ -95,15 +90,11 @@ static int choose(ulam__query *q, ulam_error *err)
     return ULAM_OK;
 }
 
-/* Choose (or start the pinned row) and hand out the run. */
-int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                    const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
-{
-    return ulam__auto_start_reach(M, b, o, ao, mo, NULL, NULL, ch, out, err);
-}
-
-/* As ulam_auto_start, the walks row racing on the given bounds over every state (see internal.h). */
-int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+/* As ulam_auto_start, with reach (NULL: none; borrowed until the run is freed) the bounds over
+ * every state the walks row's candidates of its kernel walk under (ulam__auto_solver_reach), and
+ * an (NULL: none; borrowed likewise) the analysis of M whose transpose, push workspace and plan
+ * memo the bidirectional row uses (without one the row makes its own). */
+static int start_reach(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
                            const ulam_method_opts *mo, const ulam__reach *reach, ulam_analysis *an, ulam_choice *ch,
                            ulam_run **out, ulam_error *err)
 {
@@ -138,6 +129,23 @@ int ulam__auto_start_reach(const ulam_csr *M, const double *b, const ulam_walk_o
     r->method = ch->chosen;
     *out = r;
     return ULAM_OK;
+}
+
+/* Choose (or start the pinned row) and hand out the run. */
+int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                    const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
+{
+    return start_reach(M, b, o, ao, mo, NULL, NULL, ch, out, err);
+}
+
+/* The method table's choice on an analysis, its walks row on the analysis' bounds. */
+int ulam_analysis_auto_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                             const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
+{
+    ulam_auto_opts p = ao ? *ao : ulam_auto_defaults();
+    int status = ulam__analysis_pin_guard(a, o, &p, err);
+    return status ? status
+                  : start_reach(ulam__analysis_matrix(a), b, o, &p, mo, ulam__analysis_bounds(a), a, ch, out, err);
 }
 
 /* The walk solver of a walks run (borrowed), or NULL. */

@@ -7,7 +7,11 @@
  * (fixed_predict).  The transpose, the push workspace and the plan memo are
  * an analysis' (src/analysis.c): the caller's (ulam_analysis_auto_start), made once for all its
  * queries, or one of the run's own. */
-#include "method.h"
+#include "analysis.h"
+#include "bidir.h"
+#include "bpush.h"
+#include "method_row.h"
+#include "solve.h"
 #include "stats.h"
 #include "stop.h"
 

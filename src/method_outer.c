@@ -1,18 +1,27 @@
 /* The method table's outer-iteration rows (src/mcsa.c): richardson, gauss-seidel, sequential and
  * mcsa answer every unknown to a residual tolerance; asked for one entry they answer x_index with
  * no error bar, so the choice does not consider them for a query that wants one. */
-#include "method.h"
+#include "method_row.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+
+/* The name of row k, one of this file's (ULAM_METHOD_RICHARDSON to ULAM_METHOD_GMRES, in order). */
+static const char *row_name(int k)
+{
+    static const ulam__method_type *const rows[] = {&ulam__method_richardson, &ulam__method_gauss_seidel,
+                                                    &ulam__method_sequential, &ulam__method_mcsa,
+                                                    &ulam__method_cg,         &ulam__method_gmres};
+    return rows[k - ULAM_METHOD_RICHARDSON]->name;
+}
 
 /* Not for an entry query with an error bar (shared with the Krylov rows). */
 static int applies(const ulam__query *q, int k, char *why, size_t len)
 {
     (void)q;
     snprintf(why, len, "not considered: %s answers every unknown to a residual tolerance, with no error bar on one "
-             "entry", ulam_method_name(k));
+             "entry", row_name(k));
     return 0;
 }
 

@@ -1,7 +1,8 @@
 /* The method table's walks row: adjoint or forward von Neumann-Ulam walks, the candidate (mode,
  * estimator, continuation, kernel exponent) chosen by the pilots' race (src/auto.c), run by the
  * walk solver (src/solve.c). */
-#include "method.h"
+#include "auto.h"
+#include "method_row.h"
 
 #include <math.h>
 

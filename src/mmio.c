@@ -6,7 +6,8 @@
  * symmetric and skew-symmetric files expanded to full storage.  A comment line may be indented;
  * a NUL byte in a line is refused (a binary or damaged file).  A gzip-compressed file is read
  * through zlib when opened by its path, and named as such when given as an open FILE. */
-#include "internal.h"
+#include "mmio.h"
+#include "csr.h"
 
 #include <errno.h>
 #include <math.h>

@@ -5,6 +5,7 @@
  * first whose entries start at or past r/nranks of all entries.  Nothing else of the file is
  * read but the header, the checksum table and one row pointer a step of the split's searches. */
 #include "part.h"
+#include "cache.h"
 
 #include <fcntl.h>
 #include <math.h>

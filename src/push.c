@@ -6,8 +6,8 @@
  * sides of the invariant are unchanged (up to rounding).  States whose residual exceeds rmax
  * wait in a FIFO queue, each at most once; p and r are dense arrays of n, zero outside a list
  * of touched states, so a new target costs the states the last one touched, not n. */
-#include "internal.h"
 #include "push.h"
+#include "check.h"
 
 #include <math.h>
 #include <stdlib.h>

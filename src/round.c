@@ -4,11 +4,18 @@
  * totals); and the after-round step both solvers take (ulam__round_step: merge in block order,
  * failures, interrupt, budget and time), so those stopping rules are written once. */
 #include "round.h"
+#include "check.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 enum { TEAM_BLOCKS = 4 }; /* blocks a thread a round must have before a round takes a team */
+
+/* The stopping defaults: 10^5 walks, 10^6 steps a walk. */
+ulam_stop_opts ulam_stop_defaults(void)
+{
+    return (ulam_stop_opts){.max_walks = 100000, .max_steps = 1000000};
+}
 
 /* One process. */
 ulam_share ulam_share_defaults(void)

@@ -6,7 +6,14 @@
  * (Chan's formula for the adjoint score, per-state sums for forward tallies), so the result is
  * bit-for-bit the same for any number of threads.  Stopping rules are checked between rounds; an interrupt or the time limit
  * also stops blocks that have not started. */
+#include "solve.h"
+#include "cache.h"
+#include "check.h"
+#include "fpush_b.h"
+#include "guard.h"
+#include "hit.h"
 #include "round.h"
+#include "spectral.h"
 #include "stats.h"
 #include "stop.h"
 #include "walk.h"
@@ -119,12 +126,6 @@ ulam_walk_opts ulam_walk_defaults(void)
 ulam_kernel_opts ulam_kernel_defaults(void)
 {
     return (ulam_kernel_opts){.kernel_alpha = 1.0};
-}
-
-/* The stopping defaults: 10^5 walks, 10^6 steps a walk. */
-ulam_stop_opts ulam_stop_defaults(void)
-{
-    return (ulam_stop_opts){.max_walks = 100000, .max_steps = 1000000};
 }
 
 /* The execution defaults: seed 1, all cores, one process. */
@@ -1088,6 +1089,17 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
                       ulam_solver **out, ulam_error *err)
 {
     return solver_alloc(M, b, opts, NULL, NULL, out, err);
+}
+
+/* As ulam_solver_alloc with b's length checked. */
+int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
+                        ulam_solver **out, ulam_error *err)
+{
+    ulam__clear(err);
+    if (out) *out = NULL;
+    if (!M) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
+    int status = ulam__length_check(b, nb, M->nrows, "b", err);
+    return status ? status : ulam_solver_alloc(M, b, opts, out, err);
 }
 
 /* As ulam_solver_alloc with the reachable states and a kept kernel (both borrowed). */

@@ -1,6 +1,7 @@
 /* The reference for large systems: a sparse LU solve of (I - M) x = b with UMFPACK (SuiteSparse).
  * I - M in CSR is the CSC of its transpose, so UMFPACK factors that and solves the transposed
  * system (UMFPACK_At); no copy of M in another layout is made beyond I - M itself. */
+#include "direct.h"
 #include "dynload.h"
 
 #include <math.h>

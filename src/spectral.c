@@ -11,6 +11,8 @@
  * the guards use) comes instead from shifted power iteration with Collatz-Wielandt bounds: for
  * any positive x, min_i (Ax)_i / x_i <= rho <= max_i (Ax)_i / x_i, so each iterate certifies a
  * bracket. */
+#include "spectral.h"
+#include "check.h"
 #include "dynload.h"
 
 #include <float.h>

@@ -21,7 +21,7 @@
  * holds c_i = sum_k M_ki unless the caller gives room for them, to keep for its walks): its sum is, as 1 - sum_i p_i (1 - c_i) (r >= 0 when M >= 0), and r
  * itself is formed once at the end (one more product), negative roundings of a zero residual
  * included (at most 1e-16 of (M p)_i). */
-#include "internal.h"
+#include "sweep.h"
 
 #define ULAM__SWEEP_OMEGA 1.2 /* over-relaxation of the pull sweeps (R-MAT 2^20, M = 0.85 P': ||r||_1 1.8e-3 after 12
                                  sweeps at 1.2, 2.5e-3 after 18 at 1; the contraction 0.57 a sweep against 0.705) */

@@ -10,6 +10,7 @@
 
 #include "gen.h"
 #include "../../src/internal.h" /* ulam__mm_read_matrix_libc: the reader as it was */
+#include "../../src/mmio.h"
 
 /* Parse path with o in a child: seconds into *t, its CPU seconds (user + system, the whole
  * process) into *cpu, peak RSS (MiB) into *rss, CSR MiB into *csr. */

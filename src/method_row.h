@@ -1,8 +1,13 @@
-/* The method table's rows (src/method.c): what a row is and the state a choice builds.  Internal. */
-#ifndef ULAM_METHOD_H
-#define ULAM_METHOD_H
+/* A row of the method table: what a row is, the state a choice builds and the helpers a row asks
+ * (the exclusion test); the rows (src/method_walks.c, src/method_bidir.c, src/method_outer.c)
+ * include it, and the table (src/method.c) above them calls them.  Internal. */
+#ifndef ULAM_METHOD_ROW_H
+#define ULAM_METHOD_ROW_H
 
 #include "internal.h"
+#include "solve.h"
+
+#include <stdio.h>
 
 /* A chosen method ready to run: what the rows keep between their prediction and their run. */
 struct ulam_run {
@@ -58,7 +63,13 @@ typedef struct ulam__method_type {
 extern const ulam__method_type ulam__method_walks, ulam__method_bidir, ulam__method_richardson,
     ulam__method_gauss_seidel, ulam__method_sequential, ulam__method_mcsa, ulam__method_cg, ulam__method_gmres;
 
-/* 1 when row k is excluded by q's options (why filled: "not considered: excluded"). */
-int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len);
+/* 1 when row k is excluded by q's options (why filled: "not considered: excluded"); a row's
+ * applicability test asks it (here, below the rows: the table calls the rows, never back). */
+static inline int ulam__method_excluded(const ulam__query *q, int k, char *why, size_t len)
+{
+    if (!(q->mo->exclude & (1u << k))) return 0;
+    snprintf(why, len, "not considered: excluded");
+    return 1;
+}
 
 #endif

@@ -1,0 +1,11 @@
+/* The CSR matrix's privates (src/csr.c).  Internal. */
+#ifndef ULAM_CSR_H
+#define ULAM_CSR_H
+
+#include "internal.h"
+
+/* Sort every row of A by column (with `threads` threads), sum duplicates and drop zeros,
+ * compacting A in place. */
+int ulam__csr_canonicalize(ulam_csr *A, int threads);
+
+#endif
