@@ -465,7 +465,9 @@ static int drop(chooser *c)
 {
     int left = 0;
     const ulam_auto_candidate *L = &c->res->cand[c->leader];
-    double high = key(c, c->leader, 1.0 + 2.0 * fmin(L->variance_rel_error, 1e6));
+    /* a leader whose pilot does not resolve |x| predicts a lower bound: nothing is clearly worse than it */
+    double high = ulam_auto_lower_bound(c->res, c->leader, c->base.stop.rel_err_offset)
+                      ? INFINITY : key(c, c->leader, 1.0 + 2.0 * fmin(L->variance_rel_error, 1e6));
     for (int k = 0; k < c->res->ncand; k++) {
         ulam_auto_candidate *a = &c->res->cand[k];
         if (a->state != ULAM_AUTO_FINALIST) continue;

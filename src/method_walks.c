@@ -26,7 +26,13 @@ static int predict(ulam__query *q, int k, ulam_error *err)
             w = exp2(floor(log2(st->max_seconds / ULAM_AUTO_UNIT_SECONDS))); /* --time alone: the work the time
                 buys at the work model's rate (a constant, not this machine's), rounded down to a power of 2 so that
                 the time a caller has left after its set-up (the CLI's) seldom changes a plan made on it */
-        ch->leader_work = ch->method[k].predicted_work = w;
+        /* with a target, a leader whose pilot saw no score predicts nothing: the cap at max_walks bounds its work
+           (the other rows' plans are capped by it) but is no prediction of meeting the target, so it does not
+           beat a row that has one (a PageRank point query chose walks that stopped out of reach, interval 1000
+           times |x|, on 6 of 40 seeds) */
+        const ulam_auto_candidate *c = &au->cand[au->chosen];
+        int blind = st->rel_err > 0 && c->estimate + st->rel_err_offset == 0 && !(c->variance > 0);
+        ch->leader_work = w, ch->method[k].predicted_work = blind ? INFINITY : w;
     }
     int c = au->chosen >= 0 ? au->chosen : au->closest;
     if (!status && c < 0) /* no candidate to run, not even the closest: refused, never another row's answer */
