@@ -448,9 +448,11 @@ static void test_dist_radius(void **state)
 }
 
 /* A system whose x_0 rests on a rare large b (the reviewer's kind): n states, each row of |M|
- * summing to 0.8 over 3 random columns below n - 1; row 1 also steps, with eps, to state
- * n - 1, the only one with b (big) besides b = 1 elsewhere; x solved by LAPACK. */
-static void make_rare(const char *path, int64_t n, double big, double eps, uint64_t seed, double *x)
+ * summing to 0.8 over 3 random columns below n - 1 (with unit, the even ones to exactly 1: the row
+ * sums then certify nothing and the guard's power iteration finds the length tail); row 1 also
+ * steps, with eps, to state n - 1, the only one with b (big) besides b = 1 elsewhere; x solved by
+ * LAPACK. */
+static void make_rare(const char *path, int64_t n, double big, double eps, int unit, uint64_t seed, double *x)
 {
     ulam_rng r;
     ulam_rng_seed(&r, seed, 0);
@@ -461,7 +463,7 @@ static void make_rare(const char *path, int64_t n, double big, double eps, uint6
     for (int64_t i = 0; i < n - 1; i++) {
         for (int q = 0; q < 3; q++) {
             ti[nz] = (int32_t)i, tj[nz] = (int32_t)(q == 0 ? (i + 1) % (n - 1) : (int64_t)ulam_rng_bounded(&r, (uint64_t)(n - 1)));
-            tv[nz++] = (i == 1 ? 0.8 - eps : 0.8) / 3;
+            tv[nz++] = unit && i % 2 == 0 ? (q ? 0.25 : 0.5) : (i == 1 ? 0.8 - eps : 0.8) / 3; /* unit: sums of exactly 1 */
         }
         if (i == 1) ti[nz] = 1, tj[nz] = (int32_t)(n - 1), tv[nz++] = eps;
         b[i] = 1.0;
@@ -485,8 +487,8 @@ static void test_dist_interval(void **state)
     char mild[] = "/tmp/ulam_test_dist_XXXXXX";
     temp_file(mild);
     double *y = malloc((size_t)n * sizeof *y);
-    make_rare(path, n, 2e5, 2e-4, 3, x);
-    make_rare(mild, n, 20.0, 2e-3, 3, y); /* under rel_err: a range a test can afford */
+    make_rare(path, n, 2e5, 2e-4, 0, 3, x);
+    make_rare(mild, n, 20.0, 2e-3, 1, 3, y); /* under rel_err: a range a test can afford, a tail by iteration */
     int clt = 0, cover = 0, rcover = 0, met = 0, seeds = 40;
     int64_t rwalks = 0;
     for (int s = 0; s < seeds; s++) {
