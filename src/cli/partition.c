@@ -229,9 +229,8 @@ static void print_query(const cli_query *q, int64_t k, const ulam_dist_result *r
                         const ulam_dist_ci *ci)
 {
     print_estimate(q->index + 1, r->estimate, r->std_error, rho, ci);
-    printf("  line %ld, seed %llu", q->line, (unsigned long long)(seed + (uint64_t)k));
-    if (ci->met) printf(", %lld walks", (long long)r->walks);
-    printf("\n");
+    if (ci->met) printf("  %lld walks,", (long long)r->walks);
+    printf("  line %ld, seed %llu\n", q->line, (unsigned long long)(seed + (uint64_t)k));
 }
 
 /* A component for the top-K table: its index and estimate, its standard error. */
