@@ -491,6 +491,7 @@ static void test_dist_interval(void **state)
     make_rare(mild, n, 20.0, 2e-3, 1, 3, y); /* under rel_err: a range a test can afford, a tail by iteration */
     int clt = 0, cover = 0, rcover = 0, met = 0, seeds = 40;
     int64_t rwalks = 0;
+    double width = 0; /* the certified half-width's mean, relative to x_0 */
     for (int s = 0; s < seeds; s++) {
         job jobs[MAXR], t = {.path = path, .walks = 3000, .index = 0, .ci = 1, .seed = (uint64_t)s};
         run_jobs(2, &t, jobs);
@@ -500,6 +501,7 @@ static void test_dist_interval(void **state)
         clt += fabs(r->estimate - x[0]) <= 1.96 * r->std_error;
         if (!(c->lo <= r->estimate && r->estimate <= c->hi)) fail_msg("interval [%g, %g] without %g", c->lo, c->hi, r->estimate);
         cover += c->lo <= x[0] && x[0] <= c->hi;
+        width += (c->hi - c->lo) / 2 / x[0] / seeds;
         job rj[MAXR], rt = {.path = mild, .walks = 1 << 22, .index = 0, .ci = 1, .rel_err = 0.1, .seed = (uint64_t)s};
         run_jobs(2, &rt, rj);
         assert_int_equal(rj[0].status, ULAM_OK);
@@ -508,8 +510,9 @@ static void test_dist_interval(void **state)
         rcover += q->lo <= y[0] && y[0] <= q->hi;
         if (q->met && !(q->hi - q->lo <= 2 * 0.1 * fabs(rj[0].res.estimate))) fail_msg("met with [%g, %g]", q->lo, q->hi);
     }
-    print_message("x_0 %.6g: CLT covered %d of %d, certified %d; milder x_0 %.6g under rel_err 0.1: %d (%d met, %lld walks "
-                  "a run)\n", x[0], clt, seeds, cover, y[0], rcover, met, (long long)(rwalks / seeds));
+    print_message("x_0 %.6g: CLT covered %d of %d, certified %d (half-width %.3g x_0 on average); milder x_0 %.6g under "
+                  "rel_err 0.1: %d (%d met, %lld walks a run)\n", x[0], clt, seeds, cover, width, y[0], rcover, met,
+                  (long long)(rwalks / seeds));
     assert_true(clt <= 20); /* the system is hard: the CLT interval fails */
     assert_true(cover >= 33);
     assert_true(rcover >= 33);
