@@ -146,7 +146,7 @@ static void step(const ulam_part *p, const ulam__rows *A, const halo *h, const d
 
 /* Power iteration on M^ (see ulam_dist_radius) into *best; with keep, also this rank's rows of
  * the iterate v whose Collatz-Wielandt bound is *best (keep[0 .. rows)) and the least entry of
- * that v over the ranks (*vmin).  Each rank holds v at its rows and their halo only. */
+ * that v over the ranks (*vmin), iterating past 1 until 20 steps gain less than 1% of 1 - best.  Each rank holds v at its rows and their halo only. */
 static int power(const ulam_part *p, const ulam_comm *comm, const ulam__rows *A, int iters, double *best_out, double *keep,
                  double *vmin, ulam_error *err)
 {
@@ -156,8 +156,10 @@ static int power(const ulam_part *p, const ulam_comm *comm, const ulam__rows *A,
     halo h = {0};
     double best = INFINITY;
     int status = ULAM_OK, made = 0;
-    for (int k = 0; k < iters && !(best < 1.0); k++) {
+    double before = INFINITY; /* keep: the best 20 steps ago (the tail wants u well below 1, not just below) */
+    for (int k = 0; k < iters && (keep ? !(best < 1.0 && before - best < 0.01 * (1.0 - best)) : !(best < 1.0)); k++) {
         double cw, top;
+        if (k % 20 == 0) before = k ? best : INFINITY;
         step(p, A, &h, k ? own : NULL, gv, y, &cw, &top);
         if (ulam__dist_largest(comm, &cw) || ulam__dist_largest(comm, &top)) {
             status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
@@ -174,7 +176,7 @@ static int power(const ulam_part *p, const ulam_comm *comm, const ulam__rows *A,
             }
             if (keep) *vmin = 1.0 / inv; /* rounded: the caller's ratios take a margin */
         }
-        if (best < 1.0 || !(top > 0.0) || !isfinite(top)) break; /* certified; or M^ v = 0, or overflow */
+        if ((best < 1.0 && !keep) || !(top > 0.0) || !isfinite(top)) break; /* certified; or M^ v = 0, or overflow */
         if (!made) { /* the halo, once: every rank gets here together (the same best and top) */
             made = 1;
             int64_t bad = halo_make(p, comm, A, &h);

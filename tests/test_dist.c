@@ -449,9 +449,11 @@ static void test_dist_radius(void **state)
 }
 
 /* A system whose x_0 rests on a rare large b (the reviewer's kind): n states, each row of |M|
- * summing to 0.8 over 3 random columns below n - 1; row 1 also steps, with eps, to state
- * n - 1, the only one with b (big) besides b = 1 elsewhere; x solved by LAPACK. */
-static void make_rare(const char *path, int64_t n, double big, double eps, uint64_t seed, double *x)
+ * summing to 0.8 over 3 random columns below n - 1 (with unit, the even ones to exactly 1: the row
+ * sums then certify nothing and the guard's power iteration finds the length tail); row 1 also
+ * steps, with eps, to state n - 1, the only one with b (big) besides b = 1 elsewhere; x solved by
+ * LAPACK. */
+static void make_rare(const char *path, int64_t n, double big, double eps, int unit, uint64_t seed, double *x)
 {
     ulam_rng r;
     ulam_rng_seed(&r, seed, 0);
@@ -462,7 +464,7 @@ static void make_rare(const char *path, int64_t n, double big, double eps, uint6
     for (int64_t i = 0; i < n - 1; i++) {
         for (int q = 0; q < 3; q++) {
             ti[nz] = (int32_t)i, tj[nz] = (int32_t)(q == 0 ? (i + 1) % (n - 1) : (int64_t)ulam_rng_bounded(&r, (uint64_t)(n - 1)));
-            tv[nz++] = (i == 1 ? 0.8 - eps : 0.8) / 3;
+            tv[nz++] = unit && i % 2 == 0 ? (q ? 0.25 : 0.5) : (i == 1 ? 0.8 - eps : 0.8) / 3; /* unit: sums of exactly 1 */
         }
         if (i == 1) ti[nz] = 1, tj[nz] = (int32_t)(n - 1), tv[nz++] = eps;
         b[i] = 1.0;
@@ -486,10 +488,11 @@ static void test_dist_interval(void **state)
     char mild[] = "/tmp/ulam_test_dist_XXXXXX";
     temp_file(mild);
     double *y = malloc((size_t)n * sizeof *y);
-    make_rare(path, n, 2e5, 2e-4, 3, x);
-    make_rare(mild, n, 20.0, 2e-3, 3, y); /* under rel_err: a range a test can afford */
+    make_rare(path, n, 2e5, 2e-4, 0, 3, x);
+    make_rare(mild, n, 20.0, 2e-3, 1, 3, y); /* under rel_err: a range a test can afford, a tail by iteration */
     int clt = 0, cover = 0, rcover = 0, met = 0, seeds = 40;
     int64_t rwalks = 0;
+    double width = 0; /* the certified half-width's mean, relative to x_0 */
     for (int s = 0; s < seeds; s++) {
         job jobs[MAXR], t = {.path = path, .walks = 3000, .index = 0, .ci = 1, .seed = (uint64_t)s};
         run_jobs(2, &t, jobs);
@@ -499,6 +502,7 @@ static void test_dist_interval(void **state)
         clt += fabs(r->estimate - x[0]) <= 1.96 * r->std_error;
         if (!(c->lo <= r->estimate && r->estimate <= c->hi)) fail_msg("interval [%g, %g] without %g", c->lo, c->hi, r->estimate);
         cover += c->lo <= x[0] && x[0] <= c->hi;
+        width += (c->hi - c->lo) / 2 / x[0] / seeds;
         job rj[MAXR], rt = {.path = mild, .walks = 1 << 22, .index = 0, .ci = 1, .rel_err = 0.1, .seed = (uint64_t)s};
         run_jobs(2, &rt, rj);
         assert_int_equal(rj[0].status, ULAM_OK);
@@ -507,8 +511,9 @@ static void test_dist_interval(void **state)
         rcover += q->lo <= y[0] && y[0] <= q->hi;
         if (q->met && !(q->hi - q->lo <= 2 * 0.1 * fabs(rj[0].res.estimate))) fail_msg("met with [%g, %g]", q->lo, q->hi);
     }
-    print_message("x_0 %.6g: CLT covered %d of %d, certified %d; milder x_0 %.6g under rel_err 0.1: %d (%d met, %lld walks "
-                  "a run)\n", x[0], clt, seeds, cover, y[0], rcover, met, (long long)(rwalks / seeds));
+    print_message("x_0 %.6g: CLT covered %d of %d, certified %d (half-width %.3g x_0 on average); milder x_0 %.6g under "
+                  "rel_err 0.1: %d (%d met, %lld walks a run)\n", x[0], clt, seeds, cover, width, y[0], rcover, met,
+                  (long long)(rwalks / seeds));
     assert_true(clt <= 20); /* the system is hard: the CLT interval fails */
     assert_true(cover >= 33);
     assert_true(rcover >= 33);

@@ -230,9 +230,8 @@ static void print_query(const cli_query *q, int64_t k, int64_t nq, const ulam_di
 {
     print_estimate(q->index + 1, r->estimate, r->std_error, rho, ci);
     uint64_t own = nq > 1 ? ulam_rng_substream(seed, ULAM_STREAM_QUERY, (uint64_t)k) : seed; /* docs/streams.md */
-    printf("  line %ld, seed %llu", q->line, (unsigned long long)own);
-    if (ci->met) printf(", %lld walks", (long long)r->walks);
-    printf("\n");
+    if (ci->met) printf("  %lld walks,", (long long)r->walks);
+    printf("  line %ld, seed %llu\n", q->line, (unsigned long long)own);
 }
 
 /* A component for the top-K table: its index and estimate, its standard error. */
