@@ -79,7 +79,7 @@ static int halo_make(const ulam_part *p, const ulam_comm *c, const ulam__rows *A
     for (int r = 0; !bad && r < k; r++) h->at[r + 1] = h->at[r] + (int64_t)(cnt[k + r] / sizeof(int64_t)), total += cnt[k + r];
     h->idx = malloc(total + 1);
     if (!bad && h->idx) {
-        memcpy(h->idx, got, total);
+        if (total) memcpy(h->idx, got, total);
         for (int64_t q = 0; q < h->at[k]; q++) {
             h->idx[q] -= p->first;
             if (h->idx[q] < 0 || h->idx[q] >= rows) bad = 1; /* a request for a row this rank does not hold */
@@ -104,8 +104,11 @@ static int halo_swap(const ulam_part *p, const ulam_comm *c, const halo *h, cons
     if (!bad) bad = c->exchange(c->ctx, send, cnt, &got, cnt + k);
     size_t total = 0;
     for (int r = 0; !bad && r < k; r++) total += cnt[k + r];
-    if (!bad && total == (size_t)h->nghost * sizeof *gv) memcpy(gv, got, total);
-    else bad = 1;
+    if (!bad && total == (size_t)h->nghost * sizeof *gv) {
+        if (total) memcpy(gv, got, total); /* no ghosts: got may be NULL */
+    } else {
+        bad = 1;
+    }
     (void)p;
     free(cnt), free(send), free(got);
     return bad;

@@ -64,7 +64,8 @@ static void *rank_main(void *arg)
     else if (j->radius) j->status = ulam_dist_radius(p, &c, 0, 300, &j->rho, &err);
     else if (j->forward) j->status = ulam_dist_forward(p, &c, &o, j->x + j->first, j->se + j->first, &j->res, &err);
     else j->status = ulam_dist_adjoint(p, &c, j->index, &o, &j->res, &err);
-    if (other) j->ox = ox, j->ose = ose; /* compared with set 0's once every rank is done (check_sets) */
+    if (other && j->outer) j->ox = ox, j->ose = ose; /* compared with set 0's once every rank is done (check_sets) */
+    else if (other) free(ox), free(ose);              /* the other runs compare set 0's answer only */
     ulam_part_free(p);
     return NULL;
 }
