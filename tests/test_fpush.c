@@ -469,7 +469,8 @@ static int cmp_double(const void *a, const void *b)
 /* Signed scores (issue 38 point 5): the Zipf digraph with every third entry of M negated, a
  * short push (rmax 0.02), then 256 and 4096 walks and the rel_err 0.2 rule, 8 seeds each: every
  * component's interval (each its own plug-in empirical-Bernstein sequence, valid at every walk
- * count) covers at the claimed rate, and at 4096 walks the median printed half-width of the
+ * count), and the printed intervals of ulam_fpush_top's 50 largest (lower ends at delta K / n),
+ * cover at the claimed rate, and at 4096 walks the median printed half-width of the
  * components the walks saw two values at is at most 3 times 1.96 standard errors (the stitched
  * empirical-Bernstein interval it replaced: 7.3 times at 10^4 walks on 5000 states). */
 static void test_fpush_signed(void **state)
@@ -485,7 +486,7 @@ static void test_fpush_signed(void **state)
     double *ratio = malloc((size_t)(8 * n) * sizeof *ratio);
     int64_t walks[] = {256, 4096, 0};
     for (int c = 0; c < 3; c++) {
-        int64_t N = 0, covered = 0, m = 0, used = 0;
+        int64_t N = 0, covered = 0, m = 0, used = 0, Nt = 0, ct = 0, K = 50, idx[50];
         for (int seed = 1; seed <= 8; seed++) {
             if (!test_case(100 * c + seed)) continue;
             ulam_fpush_opts o = ulam_fpush_defaults();
@@ -501,13 +502,16 @@ static void test_fpush_signed(void **state)
                 assert_true(lo[i] <= est[i] && est[i] <= hi[i]);
                 if (se[i] > 0 && walks[c] > 0) ratio[m++] = 0.5 * (hi[i] - lo[i]) / (1.959963984540054 * se[i]);
             }
+            assert_int_equal(ulam_fpush_top(M, Mt, &o, K, est, idx, se, lo, hi, &info, &err), ULAM_OK);
+            for (int64_t t = 0; t < K; t++) Nt++, ct += lo[t] <= x[idx[t]] && x[idx[t]] <= hi[t];
         }
         qsort(ratio, (size_t)m, sizeof *ratio, cmp_double);
         print_message("signed, %lld walks (%lld in all): %lld of %lld intervals cover; half-width / 1.96 se median %.2f "
                       "(%lld components)\n", (long long)walks[c], (long long)used, (long long)covered, (long long)N,
                       m ? ratio[m / 2] : NAN, (long long)m);
+        print_message("signed, top %lld: %lld of %lld printed intervals cover\n", (long long)K, (long long)ct, (long long)Nt);
         if (test_case_all()) {
-            assert_true(coverage_ok(covered, N));
+            assert_true(coverage_ok(covered, N) && coverage_ok(ct, Nt));
             if (c == 1) assert_true(m > 0 && ratio[m / 2] <= 3.0);
         }
     }
