@@ -19,7 +19,7 @@
  * For ||M||_1 < 1 the sweep push (src/sweep.c) and terminal walks: each walk scores 0 or R0 at
  * every component, so where M, r >= 0 a component's interval is src/stop.c's KL (Chernoff-
  * Hoeffding) interval of its hit count, stitched over the checkpoints the rule may stop at; with
- * signs, the empirical-Bernstein one.  A component no walk reached gets p_i + [0, about 3.7 R0 /
+ * signs, each component's own plug-in empirical-Bernstein confidence sequence (cs_set).  A component no walk reached gets p_i + [0, about 3.7 R0 /
  * N] against the empirical-Bernstein 9.6 R0 / N, so the same accuracy takes ~2.6x fewer walks.
  * ulam_fpush_top's k components are chosen by their estimates: their lower ends at delta k / n
  * (lower_index). */
@@ -42,6 +42,9 @@
 #define ULAM__FPUSH_BLOCK 64        /* states per block of the start's running sums */
 #define ULAM__FPUSH_KL_KEPT 1024    /* hit counts whose interval a checkpoint keeps (the rest computed each time) */
 #define ULAM__FPUSH_CUT_SHARE 0.01  /* the largest negative residual cut from r, times 1 / (1 - alpha), as a share of E delta */
+#define ULAM__FPUSH_CS_SPLITS 3     /* a fixed count of walks with signed scores is walked in blocks ending at 1/8, 1/4,
+                                      1/2 of it and at it: each block's bets set from the blocks before (one block
+                                      would bet as if the variance were the largest) */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
 #define ULAM__FPUSH_SKEW 16.0       /* rows drawn from by rejection up to this many tries on average, beyond by the
                                       running sums (R-MAT 2^20, source 990665, 2026-12-02, load 2.2-2.7, median of 5:
@@ -184,12 +187,14 @@ static double none_hi(int64_t N, int k, double R0)
     return R0 * hi;
 }
 
-/* k0 for walk scores of range R (kl: scores 0 or R, the KL interval; else empirical Bernstein). */
+/* k0 for walk scores of range R (kl: scores 0 or R, the KL interval; else, signed scores in
+ * [-R / 2, R / 2], the plug-in sequence's range term at its largest bet). */
 static int first_epoch(double R, double E, double delta, int kl)
 {
     double L = ulam__stop_log(1), room = ULAM__FPUSH_RANGE_SHARE * E * delta;
     int k = 1;
-    while (k < 200 && !(kl ? none_hi(epoch_end(k), 1, R) <= room : 7.0 * R * L / (3.0 * ((double)epoch_end(k) - 1.0)) <= room))
+    (void)L;
+    while (k < 200 && !(kl ? none_hi(epoch_end(k), 1, R) <= room : ulam__cs_range_width(R / 2.0, (double)epoch_end(k)) <= room))
         k++;
     return k;
 }
@@ -505,22 +510,75 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
     }
 }
 
-/* Whether N walks at epoch k meet relative error E at every component whose interval reaches
- * delta: its 95% interval (src/stop.c) within -+ E max(|x_i|, delta) (the interval itself, not
- * the standard error, so every x_i >= delta is within E of the truth unless its interval misses
- * it); p + the walks' terminal counts, scores of range R, largest R0. */
-static int rule_met(const walker *w, const double *p, int64_t N, int k, double R, double R0, double E, double delta)
-{ /* (k: the lower ends' index, lower_index, which also widens the upper ends: the rule only stops later) */
-    double L = ulam__stop_log(k), rt = 7.0 * R * L / (3.0 * ((double)N - 1.0)), Nd = (double)N;
-    if (!(rt <= E * delta)) return 0;
-    for (int64_t q = 0; q < w->nhit; q++) { /* a state no walk ended at: its interval is p_i -+ rt, met above */
-        int64_t i = w->hit[q], h = w->hc[2 * q] + w->hc[2 * q + 1];
-        double s = (double)(w->hc[2 * q] - w->hc[2 * q + 1]), mean = R0 * s / Nd;
-        double up = fabs(p[i]) + fabs(mean) + R0 * sqrt(2.0 * (double)h * L / (Nd * (Nd - 1.0))) + rt;
-        if (up < delta) continue; /* cannot reach delta */
-        double var = fmax(0.0, (R0 * R0 * (double)h - Nd * mean * mean) / (Nd - 1.0));
-        ulam__stop_ci ci;
-        ulam__stop_interval(N, mean, var, R, 0.0, R0, R0, k, &ci);
+/* Signed scores (M or r with negative entries): each component's walk scores, R0 times the sign of
+ * a walk that ended at it (0 for one that did not), are independent across walks, identically
+ * distributed and in [-R0, R0], so each gets src/stop.c's predictable plug-in empirical-Bernstein
+ * sequence (Waudby-Smith and Ramdas 2023), fed a block of walks (a checkpoint's) at a time and
+ * valid at every walk count at once: no stitching over checkpoints.  Its bet for a block is set
+ * from the blocks before it (a target half-width E max(|x_i|, delta), or for a fixed count, the
+ * count), so predictable.  Every component no walk has ended at has the same past, all zeros,
+ * hence the same sequence (none); a component first ended at in a block starts from none's state
+ * before that block (none's bet was its bet).  The lower ends take ln(2 n / (delta K)) (the
+ * false-coverage rate of ulam_fpush_top's K of n, as lower_index), the upper ln(2 / delta). */
+typedef struct {
+    ulam__cs *q;   /* per state ended at, in w's hit order */
+    int32_t *prev; /* w's counts at the block's start, 2 a state */
+    int64_t nq, qmax, pmax;
+    ulam__cs none; /* a state no walk has ended at */
+    double llo, lhi;
+} cs_set;
+
+/* The walks' mean and sample variance at the q-th state ended at, N walks, hit scores -+R0. */
+static void cs_moments(const walker *w, int64_t q, int64_t N, double R0, double *mean, double *var)
+{
+    double Nd = (double)N, h = (double)(w->hc[2 * q] + w->hc[2 * q + 1]);
+    *mean = N > 0 ? R0 * (double)(w->hc[2 * q] - w->hc[2 * q + 1]) / Nd : 0.0;
+    *var = N > 1 ? fmax(0.0, (R0 * R0 * h - Nd * *mean * *mean) / (Nd - 1.0)) : 0.0;
+}
+
+/* Plan every sequence's next block after N walks (p: the push's estimates; nplan > 0: a fixed
+ * count, else target E at delta). */
+static void cs_plan_all(cs_set *S, const walker *w, const double *p, int64_t N, double R0, double E, double delta,
+                        double nplan)
+{
+    for (int64_t q = 0; q < S->nq; q++) {
+        double mean, var;
+        cs_moments(w, q, N, R0, &mean, &var);
+        ulam__cs_plan(&S->q[q], N, mean, var, R0, 0.0, nplan > 0 ? 0.0 : E * fmax(fabs(p[w->hit[q]] + mean), delta), nplan);
+    }
+    ulam__cs_plan(&S->none, N, 0.0, 0.0, R0, 0.0, nplan > 0 ? 0.0 : E * delta, nplan);
+}
+
+/* Add the block of `made` walks just walked to every sequence; ULAM_OK or ULAM_ENOMEM. */
+static int cs_add_all(cs_set *S, const walker *w, int64_t made, double R0)
+{
+    if (ulam__grow(&S->q, &S->qmax, w->nhit, sizeof *S->q) || ulam__grow(&S->prev, &S->pmax, w->nhit, 2 * sizeof *S->prev))
+        return ULAM_ENOMEM;
+    for (int64_t q = S->nq; q < w->nhit; q++) S->q[q] = S->none, S->prev[2 * q] = S->prev[2 * q + 1] = 0;
+    S->nq = w->nhit;
+    double Nb = (double)made;
+    for (int64_t q = 0; q < S->nq && made > 0; q++) {
+        int64_t hp = w->hc[2 * q] - S->prev[2 * q], hm = w->hc[2 * q + 1] - S->prev[2 * q + 1];
+        double mean = R0 * (double)(hp - hm) / Nb, m2 = fmax(0.0, R0 * R0 * (double)(hp + hm) - Nb * mean * mean);
+        ulam__cs_add(&S->q[q], made, mean, m2, hp + hm > 0 ? R0 : 0.0);
+        S->prev[2 * q] = w->hc[2 * q], S->prev[2 * q + 1] = w->hc[2 * q + 1];
+    }
+    ulam__cs_add(&S->none, made, 0.0, 0.0, 0.0);
+    return ULAM_OK;
+}
+
+/* Whether N walks meet relative error E at every component whose interval reaches delta: its
+ * sequence's 95% interval within -+ E max(|x_i|, delta) (p: the push's estimates). */
+static int cs_rule_met(const cs_set *S, const walker *w, const double *p, int64_t N, double R0, double E, double delta)
+{
+    ulam__stop_ci ci;
+    ulam__cs_interval_sides(&S->none, 0.0, 0.0, S->llo, S->lhi, &ci);
+    if (!(ci.kind == ULAM__STOP_EB && ci.half <= E * delta)) return 0; /* a component no walk ended at */
+    for (int64_t q = 0; q < w->nhit; q++) {
+        int64_t i = w->hit[q];
+        double mean, var;
+        cs_moments(w, q, N, R0, &mean, &var);
+        ulam__cs_interval_sides(&S->q[q], mean, 0.0, S->llo, S->lhi, &ci);
         if (ci.lo + p[i] > delta || ci.hi + p[i] >= delta)
             if (!(ci.kind == ULAM__STOP_EB && ci.half <= E * fmax(fabs(p[i] + mean), delta))) return 0;
     }
@@ -547,6 +605,7 @@ static double rounding_allowance(const ulam_csr *M, const ulam__sweep_info *swi,
 typedef struct {
     const walker *w;
     kl_kept *kept, *kept_lo; /* kept_lo: the lower ends' KL intervals at klo (NULL: klo is kk or k) */
+    const cs_set *cs;        /* signed scores: the plug-in sequences */
     int64_t N;
     int k, kk, klo, sgn, nonneg;
     double R, R0, cut, D, se0, fp;
@@ -611,9 +670,7 @@ static double ends_component(const ends *c, double p, int64_t q, double *se, dou
         double up;
         if (c->kept_lo) hits_interval(c->kept_lo, N, c->klo, h, R0, &ci.lo, &up);
     } else {
-        ulam__stop_ci cl;
-        ulam__stop_interval(N, mean, var, c->R, 0.0, R0, R0, c->k, &ci);
-        if (c->klo != c->k) ulam__stop_interval(N, mean, var, c->R, 0.0, R0, R0, c->klo, &cl), ci.lo = cl.lo;
+        ulam__cs_interval_sides(&c->cs->q[q], mean, 0.0, c->cs->llo, c->cs->lhi, &ci);
     }
     *a = p + ci.lo - c->cut, *b = p + ci.hi;
     *se = N > 1 ? sqrt(var / Nd) : c->se0;
@@ -724,6 +781,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     int64_t N = 0;
     int k = 1, kk = -1; /* kk: the KL interval's index when not k */
     int64_t K = top > 0 && top < n ? top : n; /* the components whose intervals are given (lower_index) */
+    cs_set S = {.llo = log(2.0 / ULAM__STOP_DELTA) + log((double)n / (double)K), .lhi = log(2.0 / ULAM__STOP_DELTA)};
     kl_kept *kept = sgn ? NULL : ulam__malloc(1, sizeof *kept), *kept_lo = sgn || K >= n ? NULL : ulam__malloc(1, sizeof *kept_lo);
     if (kept) kept->N = -1;
     if (kept_lo) kept_lo->N = -1;
@@ -742,19 +800,28 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         ulam_rng_seed(&rng, o->walk.exec.seed, 0);
         int64_t cap_w = o->walk.stop.max_walks > 0 ? o->walk.stop.max_walks : INT32_MAX;
         if (cap_w > INT32_MAX) cap_w = INT32_MAX;
-        int k0 = first_epoch(R, pl.E, pl.delta, !sgn), planned = 1;
+        int k0 = first_epoch(R, pl.E, pl.delta, !sgn), planned = 1, seg = sgn && o->walks > 0 ? ULAM__FPUSH_CS_SPLITS : 0;
         for (;;) { /* checkpoint k (stitching index) at the end of epoch k0 + k - 1 */
-            int64_t target = o->walks > 0 ? o->walks : epoch_end(k0 + k - 1);
+            int64_t target = o->walks > 0 ? o->walks >> seg : epoch_end(k0 + k - 1);
             if (target > cap_w) target = cap_w, planned = o->walks > 0 && o->walks == cap_w;
             if (N < target && hit_room(&w, target - N)) {
                 status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' ends");
                 break;
             }
+            if (sgn) cs_plan_all(&S, &w, x, N, R0, pl.E, pl.delta, o->walks > 0 ? (double)o->walks : 0.0);
             int64_t made = N < target ? walk_many(&w, &rng, target - N, o->walk.stop.interrupt) : 0;
             if (made < target - N) info->interrupted = 1, planned = 0;
             N += made;
+            if (sgn && cs_add_all(&S, &w, made, R0)) {
+                status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' sequences");
+                break;
+            }
+            if (o->walks > 0 && seg > 0 && planned && N < cap_w) { /* the fixed count's next block */
+                seg--;
+                continue;
+            }
             if (!planned || o->walks > 0 || N >= cap_w) break;
-            if (sgn ? rule_met(&w, x, N, lower_index(k, K, n), R, R0, pl.E, pl.delta)
+            if (sgn ? cs_rule_met(&S, &w, x, N, R0, pl.E, pl.delta)
                     : rule_met_kl(&w, kept, kept_lo, x, N, k, lower_index(k, K, n), R0, pl.E, pl.delta, cut))
                 break;
             k++;
@@ -768,14 +835,11 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     if (!status && top > 0 && !key) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the top components");
     if (!status) {
         int klo = lower_index(sgn || kk < 0 ? k : kk, K, n);
-        ends c = {.w = &w, .kept = kept, .kept_lo = kept_lo, .N = N, .k = k, .kk = kk, .klo = klo, .sgn = sgn, .nonneg = mpos,
+        ends c = {.w = &w, .cs = &S, .kept = kept, .kept_lo = kept_lo, .N = N, .k = k, .kk = kk, .klo = klo, .sgn = sgn, .nonneg = mpos,
                   .R = R, .R0 = R0, .cut = cut, .D = info->residual_bound, .se0 = N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0),
                   .fp = rounding_allowance(M, swi, alpha)};
-        if (N >= 2) {
-            ulam__stop_ci cl;
-            ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &c.none);
-            ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, klo, &cl), c.none.lo = cl.lo; /* signed: the lower end's index */
-        }
+        if (N >= 2 && sgn) ulam__cs_interval_sides(&S.none, 0.0, 0.0, S.llo, S.lhi, &c.none);
+        else if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &c.none); /* its ends: the KL interval's, below */
         else c.none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
         if (!sgn && N >= 1) hits_interval(kept, N, kk < 0 ? k : kk, 0, R0, &c.none.lo, &c.none.hi);
         double s, a, b;
@@ -807,7 +871,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     }
     free(key), free(pv);
     free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.hit), free(w.hc), free(w.slot), free(w.known);
-    free(r), free(kept), free(kept_lo);
+    free(r), free(kept), free(kept_lo), free(S.q), free(S.prev);
     info->seconds = ulam_now() - t0;
     return status;
 }

@@ -147,16 +147,22 @@ void ulam__cs_add(ulam__cs *cs, int64_t n, double mean, double m2, double maxabs
 /* The sequence's interval. */
 void ulam__cs_interval(const ulam__cs *cs, double m, double extra, ulam__stop_ci *ci)
 {
+    ulam__cs_interval_sides(cs, m, extra, cs_log(), cs_log(), ci);
+}
+
+/* The sequence's interval, each side at its own ln(1 / delta_side). */
+void ulam__cs_interval_sides(const ulam__cs *cs, double m, double extra, double llo, double lhi, ulam__stop_ci *ci)
+{
     *ci = (ulam__stop_ci){.lo = NAN, .hi = NAN, .half = INFINITY, .var_term = INFINITY, .range_term = INFINITY,
-                          .bias = extra, .L = cs_log(), .k = 0, .kind = ULAM__STOP_NONE};
+                          .bias = extra, .L = fmax(llo, lhi), .k = 0, .kind = ULAM__STOP_NONE};
     if (cs->beyond) {
         ci->kind = ULAM__STOP_BEYOND;
         return;
     }
     if (cs->n < 2 || !(cs->eta > 0) || !isfinite(m) || !(extra >= 0) || !isfinite(extra)) return;
-    double c = cs->etax / cs->eta, w = (ci->L + cs->v) / cs->eta, b = cs->etab / cs->eta + extra;
+    double c = cs->etax / cs->eta, b = cs->etab / cs->eta + extra;
     ci->var_term = cs->v / cs->eta, ci->range_term = ci->L / cs->eta, ci->bias = b;
-    ci->lo = fmin(c - w - b, m), ci->hi = fmax(c + w + b, m); /* holding the estimate: a superset */
+    ci->lo = fmin(c - (llo + cs->v) / cs->eta - b, m), ci->hi = fmax(c + (lhi + cs->v) / cs->eta + b, m); /* holding m */
     ci->half = 0.5 * (ci->hi - ci->lo);
     ci->kind = ULAM__STOP_EB;
 }

@@ -127,6 +127,11 @@ void ulam__cs_add(ulam__cs *cs, int64_t n, double mean, double m2, double maxabs
  * ULAM__STOP_NONE (fewer than 2 scores, nothing weighted). */
 void ulam__cs_interval(const ulam__cs *cs, double m, double extra, ulam__stop_ci *ci);
 
+/* ulam__cs_interval with the lower end at ln(1 / delta_lo) = llo and the upper at lhi in place of
+ * ln(2 / delta) each (Ville's inequality on each side's supermartingale alone: the lower end
+ * misses with probability at most delta_lo, the upper at most delta_hi, at every count at once). */
+void ulam__cs_interval_sides(const ulam__cs *cs, double m, double extra, double llo, double lhi, ulam__stop_ci *ci);
+
 /* The further walks that take the sequence's half-width to h under its current plan, for scores
  * of mean `mean` and variance var (extra: the bias added at the interval); 0 when it is there,
  * INFINITY when the plan cannot reach it. */
