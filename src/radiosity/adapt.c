@@ -31,8 +31,9 @@ typedef struct {
     double *pb, *ps2;           /* MAX_POINTS x 3 each: its interior points' B and their variances */
     char *live, *known;
     int64_t np, capp, nlive;
-    double *vb, *vs2; /* 3 per vertex: B at it (on the surface of vsrc's patch), its variance */
-    int64_t *vsrc, capvs, capvb; /* the source patch vb was measured on (-1 none); room */
+    int32_t *nu;            /* nodes measured: (vertex nu + 1, source patch ns) -> B nb, variance ns2 (3 each); */
+    int64_t *ns, ncap, ncount; /* nu 0 empty */
+    double *nb, *ns2;
     double *bx;                  /* half the length of the boundary segment after each node */
     int64_t capb;
     uint64_t *key; /* edge (lo << 32 | hi) + 1 -> its midpoint vertex; 0 empty */
@@ -83,7 +84,7 @@ static void mesh_free(mesh *m)
 {
     free(m->vert), free(m->idx), free(m->first), free(m->len), free(m->src), free(m->Y), free(m->mean);
     free(m->e), free(m->live), free(m->known), free(m->key), free(m->mid), free(m->pb), free(m->ps2);
-    free(m->vb), free(m->vs2), free(m->vsrc), free(m->bx);
+    free(m->nu), free(m->ns), free(m->nb), free(m->ns2), free(m->bx);
 }
 
 /* A new vertex at x; its index, or -1 without memory. */
@@ -325,29 +326,61 @@ static void edge_nodes(mesh *m, int32_t a, int32_t b, int64_t *nb, int32_t *node
     (*nb)++;
 }
 
+/* The slot of node (vertex u, source patch src) in the node table. */
+static int64_t node_slot(const mesh *m, int32_t u, int64_t src)
+{
+    uint64_t h = ((uint64_t)u * 0x9E3779B97F4A7C15ull) ^ ((uint64_t)src * 0xC2B2AE3D27D4EB4Full);
+    int64_t i = (int64_t)(h >> 20) & (m->ncap - 1);
+    while (m->nu[i] && !(m->nu[i] == u + 1 && m->ns[i] == src)) i = (i + 1) & (m->ncap - 1);
+    return i;
+}
+
+/* Room for one more node (rehash at half full); 0 or ULAM_ENOMEM. */
+static int node_room(mesh *m)
+{
+    if (2 * (m->ncount + 1) <= m->ncap) return 0;
+    int64_t oc = m->ncap, nc = oc ? 2 * oc : 1024;
+    int32_t *ou = m->nu;
+    int64_t *os = m->ns;
+    double *ob = m->nb, *o2 = m->ns2;
+    m->nu = calloc((size_t)nc, sizeof *m->nu), m->ns = malloc((size_t)nc * sizeof *m->ns);
+    m->nb = malloc((size_t)(3 * nc) * sizeof *m->nb), m->ns2 = malloc((size_t)(3 * nc) * sizeof *m->ns2);
+    if (!m->nu || !m->ns || !m->nb || !m->ns2) {
+        free(m->nu), free(m->ns), free(m->nb), free(m->ns2);
+        m->nu = ou, m->ns = os, m->nb = ob, m->ns2 = o2;
+        return ULAM_ENOMEM;
+    }
+    m->ncap = nc;
+    for (int64_t i = 0; i < oc; i++)
+        if (ou[i]) {
+            int64_t j = node_slot(m, ou[i] - 1, os[i]);
+            m->nu[j] = ou[i], m->ns[j] = os[i];
+            memcpy(m->nb + 3 * j, ob + 3 * i, 3 * sizeof *ob), memcpy(m->ns2 + 3 * j, o2 + 3 * i, 3 * sizeof *o2);
+        }
+    free(ou), free(os), free(ob), free(o2);
+    return 0;
+}
+
 /* B at vertex u of polygon i (a hair inside i, on its surface), measured once per vertex and
  * source patch, into b, s2. */
 static int vertex_value(mesh *m, int32_t u, int64_t i, const double c[3], const ulam_tracer *t,
                         const ulam_rad_opts *opts, double t0, double b[3], double s2[3],
                         ulam_rad_adapt_info *info, ulam_error *err)
 {
-    int64_t old = m->capvs, cb = m->capvb;
-    if (grow((void **)&m->vsrc, &m->capvs, m->nv, sizeof *m->vsrc) || grow((void **)&m->vb, &cb, 3 * m->nv, sizeof *m->vb) ||
-        grow((void **)&m->vs2, &m->capvb, 3 * m->nv, sizeof *m->vs2))
-        return ULAM_ENOMEM;
-    for (int64_t k = old; k < m->capvs; k++) m->vsrc[k] = -1;
-    if (m->vsrc[u] != m->src[i]) {
+    if (node_room(m)) return ULAM_ENOMEM;
+    int64_t k = node_slot(m, u, m->src[i]);
+    if (!m->nu[k]) {
         double x[3], d[3]; /* 1e-4 scene sizes toward i's centroid: 100 times locate's tolerance, so the
                             * point is on i's surface, not a wall across a concave edge (1e-6 of the way
                             * read the Cornell box's corners dark: its mesh error 0.764 for 0.403) */
         ulam__sub3(c, m->vert + 3 * u, d);
         double len = sqrt(ulam__dot3(d, d)), step = len > 0 ? fmin(1e-4 * ulam__tracer_size(t, NULL), 0.25 * len) / len : 0.0;
-        for (int k = 0; k < 3; k++) x[k] = m->vert[3 * u + k] + step * d[k];
-        int st = query(t, opts, t0, x, 16 * (uint64_t)u + 15, m->vb + 3 * u, m->vs2 + 3 * u, info, err);
+        for (int j = 0; j < 3; j++) x[j] = m->vert[3 * u + j] + step * d[j];
+        int st = query(t, opts, t0, x, 16 * (uint64_t)u + 15, m->nb + 3 * k, m->ns2 + 3 * k, info, err);
         if (st || info->interrupted) return st;
-        m->vsrc[u] = m->src[i];
+        m->nu[k] = u + 1, m->ns[k] = m->src[i], m->ncount++;
     }
-    memcpy(b, m->vb + 3 * u, 3 * sizeof *b), memcpy(s2, m->vs2 + 3 * u, 3 * sizeof *s2);
+    memcpy(b, m->nb + 3 * k, 3 * sizeof *b), memcpy(s2, m->ns2 + 3 * k, 3 * sizeof *s2);
     return ULAM_OK;
 }
 
