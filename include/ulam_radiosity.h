@@ -556,14 +556,17 @@ typedef struct ulam_rad_adapt_info {
 /* Adaptive, importance-driven subdivision of the tracer's scene: the mesh error of a patch p,
  * e_p, is the RMS of the continuous surface's radiosity about its mean over the patch, from
  * point queries (ulam_rad_point_query with opts, no mesh in their answers) at the patch's area
- * centroid and half way to each vertex (the points' noise removed: d_k^2 - var d_k); the mesh's
+ * centroid and half way to each vertex, weight 2/3, and at the nodes on its boundary (its
+ * vertices and the midpoints finer neighbours put on its edges, each measured once), weight 1/3
+ * by length (the points' noise removed, scaled to a linear field's RMS over the area); the mesh's
  * error is max over channels of sum_p Y_p e_p / sum_p Y_p mean_p, Y_p the importance of p
  * (importance: one a patch of the tracer's scene, e.g. ulam_rad_importance's, a child getting
  * its area's share; NULL: the area, every surface alike).  While it is above target, the
  * patches of largest Y_p e_p are split (triangles and quads into 4 at their edge midpoints,
  * shared by neighbours; larger polygons into their fan) and their children measured, until
  * target is met, the mesh would pass max_patches, or opts->interrupt / max_seconds stops it.
- * Point k of the i-th polygon measured draws its seed from stream (opts->seed, 16 i + k).
+ * Point k of the i-th polygon measured draws its seed from stream (opts->seed, 16 i + k), the
+ * node at vertex v from (opts->seed, 16 v + 15).
  * *out gets the mesh made (faces, groups and materials kept; the tracer's scene when nothing
  * was split is copied).  info may be NULL. */
 int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double *importance, double target,

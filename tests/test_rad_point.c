@@ -528,7 +528,8 @@ static ulam_rad_adapt_info adapt(const ulam_tracer *t, const double *Y, double t
 
 /* The furnace: the radiosity is the same at every point, so any mesh is exact and adaptive
  * subdivision splits nothing (its measured mesh error, the points' noise removed, is below the
- * target from the start). */
+ * target from the start): 5 points inside each of the 6 faces and a node at each of the 8
+ * corners on each of its 3 faces. */
 static void test_adapt_furnace(void **state)
 {
     (void)state;
@@ -538,7 +539,7 @@ static void test_adapt_furnace(void **state)
     assert_true(in.met && !in.capped && !in.interrupted);
     assert_int_equal(in.splits, 0);
     assert_int_equal(d->npatches, s->npatches);
-    assert_true(in.error0 <= 0.02 && in.points == 30);
+    assert_true(in.error0 <= 0.02 && in.points == 6 * 5 + 8 * 3);
     for (int64_t p = 0; p < s->npatches; p++) assert_close(d->area[p], s->area[p], 1e-12);
     ulam_tracer_free(t);
     ulam_scene_free(d), ulam_scene_free(s);
@@ -551,7 +552,7 @@ static void test_adapt_furnace(void **state)
 static void test_adapt_cornell(void **state)
 {
     (void)state;
-    const double target = 0.21;
+    const double target = 0.25; /* uniform: 49 patches 0.311, 185 0.211 (0.21 took 662, 18 s more) */
     ulam_scene *s = NULL, *d = NULL;
     ulam_tracer *t = must_load("examples/scenes/cornell_box.obj", &s);
     ulam_rad_adapt_info in = adapt(t, NULL, target, 0, 1024, 100000, 7, &d);

@@ -2,10 +2,12 @@
  * Salesin 1992): refine a patch where the continuous surface's radiosity varies across it and
  * where the view's importance is high, instead of splitting every patch alike.  A patch's
  * variation comes from point queries (point.c, no mesh in their answers) at its quadrature
- * points (the area centroid and half way to each vertex, as mesh.c's patch mesh error): the
- * RMS about their mean, each point's own noise removed (E[d_k^2] = true d_k^2 + var d_k), scaled
- * to the area's RMS of a linear field (linear_spread: the points alone see 1/1.29 of it on a
- * square), is its mesh error e_p, what one value per patch cannot show.  The mesh's error is
+ * points (the area centroid and half way to each vertex, as mesh.c's patch mesh error) and at
+ * the nodes on its boundary (its vertices and the midpoints its finer neighbours put on its
+ * edges: a shadow reaching into a patch between its interior points shows there, the radiosity
+ * being continuous across the edge): the weighted RMS about their mean, each point's own noise
+ * removed (E[d_k^2] = true d_k^2 + var d_k), scaled to the area's RMS of a linear field
+ * (linear_spread), is its mesh error e_p, what one value per patch cannot show.  The mesh's error is
  * max_c sum_p Y_p e_pc / sum_p Y_p mean_pc (Y the importance: the share of the picture, or of
  * the area, that rests on the patch; mean_p the reflected radiosity B - E, the emission being
  * exact on every mesh), relative to the importance-weighted reflected radiosity.  Each
@@ -26,8 +28,14 @@ typedef struct {
     int64_t nidx, capi;
     int64_t *first, *len, *src; /* per polygon: its vertices idx[first, first + len), its source patch */
     double *Y, *mean, *e;       /* importance; 3 each: mean radiosity over its points, mesh error */
+    double *pb, *ps2;           /* MAX_POINTS x 3 each: its interior points' B and their variances */
     char *live, *known;
     int64_t np, capp, nlive;
+    int32_t *nu;            /* nodes measured: (vertex nu + 1, source patch ns) -> B nb, variance ns2 (3 each); */
+    int64_t *ns, ncap, ncount; /* nu 0 empty */
+    double *nb, *ns2;
+    double *bx;                  /* half the length of the boundary segment after each node */
+    int64_t capb;
     uint64_t *key; /* edge (lo << 32 | hi) + 1 -> its midpoint vertex; 0 empty */
     int32_t *mid;
     int64_t hcap, hcount;
@@ -45,22 +53,29 @@ static int grow(void **p, int64_t *cap, int64_t need, size_t size)
     return 0;
 }
 
-/* Room for `more` polygons; 0 or ULAM_ENOMEM. */
+/* Resize *p to n elements of size bytes; 0 or ULAM_ENOMEM (*p kept). */
+static int resize(void **p, int64_t n, size_t size)
+{
+    void *q = realloc(*p, (size_t)n * size);
+    if (!q) return ULAM_ENOMEM;
+    *p = q;
+    return 0;
+}
+
+/* Room for `more` polygons, every per-polygon array to one capacity; 0 or ULAM_ENOMEM. */
 static int grow_polys(mesh *m, int64_t more)
 {
-    int64_t need = m->np + more, cap = m->capp, c;
-    if (need <= cap) return 0;
-    c = cap;
-    int st = grow((void **)&m->first, &c, need, sizeof *m->first);
-    c = cap, st |= grow((void **)&m->len, &c, need, sizeof *m->len);
-    c = cap, st |= grow((void **)&m->src, &c, need, sizeof *m->src);
-    c = cap, st |= grow((void **)&m->Y, &c, need, sizeof *m->Y);
-    c = cap, st |= grow((void **)&m->live, &c, need, 1);
-    c = cap, st |= grow((void **)&m->known, &c, need, 1);
-    c = 3 * cap, st |= grow((void **)&m->mean, &c, 3 * need, sizeof *m->mean);
-    c = 3 * cap, st |= grow((void **)&m->e, &c, 3 * need, sizeof *m->e);
+    int64_t need = m->np + more, c = m->capp ? m->capp : 64;
+    if (need <= m->capp) return 0;
+    while (c < need) c *= 2;
+    int st = resize((void **)&m->first, c, sizeof *m->first) | resize((void **)&m->len, c, sizeof *m->len);
+    st |= resize((void **)&m->src, c, sizeof *m->src) | resize((void **)&m->Y, c, sizeof *m->Y);
+    st |= resize((void **)&m->live, c, 1) | resize((void **)&m->known, c, 1);
+    st |= resize((void **)&m->mean, 3 * c, sizeof *m->mean) | resize((void **)&m->e, 3 * c, sizeof *m->e);
+    st |= resize((void **)&m->pb, 3 * MAX_POINTS * c, sizeof *m->pb);
+    st |= resize((void **)&m->ps2, 3 * MAX_POINTS * c, sizeof *m->ps2);
     if (st) return ULAM_ENOMEM;
-    m->capp = c / 3;
+    m->capp = c;
     return 0;
 }
 
@@ -68,7 +83,8 @@ static int grow_polys(mesh *m, int64_t more)
 static void mesh_free(mesh *m)
 {
     free(m->vert), free(m->idx), free(m->first), free(m->len), free(m->src), free(m->Y), free(m->mean);
-    free(m->e), free(m->live), free(m->known), free(m->key), free(m->mid);
+    free(m->e), free(m->live), free(m->known), free(m->key), free(m->mid), free(m->pb), free(m->ps2);
+    free(m->nu), free(m->ns), free(m->nb), free(m->ns2), free(m->bx);
 }
 
 /* A new vertex at x; its index, or -1 without memory. */
@@ -86,6 +102,15 @@ static int64_t slot(const mesh *m, uint64_t k)
     int64_t i = (int64_t)(h >> 20) & (m->hcap - 1);
     while (m->key[i] && m->key[i] != k) i = (i + 1) & (m->hcap - 1);
     return i;
+}
+
+/* The midpoint vertex of edge (a, b) if a split made it, else -1. */
+static int32_t find_midpoint(const mesh *m, int32_t a, int32_t b)
+{
+    if (!m->hcap) return -1;
+    uint64_t lo = (uint64_t)(a < b ? a : b), hi = (uint64_t)(a < b ? b : a), k = (lo << 32 | hi) + 1;
+    int64_t i = slot(m, k);
+    return m->key[i] ? m->mid[i] : -1;
 }
 
 /* The midpoint vertex of edge (a, b), shared with the neighbour across it; -1 without memory. */
@@ -191,14 +216,15 @@ static int split(mesh *m, int64_t i)
     return 0;
 }
 
-/* The area's spread of a linear field over polygon v[0..n) against its K quadrature points' (the
- * centroid and half way to each of the first K - 1 vertices): int |x - g|^2 dA / A over
- * (1 / K) sum_k |x_k - mean|^2, the ratio of the traces of the two second moments, exact for
- * triangles (4/3) and parallelograms (5/3), where the two are proportional.  The points alone
- * see 1/1.29 of a linear field's RMS on a square. */
-static double linear_spread(const double *vert, const int32_t *v, int64_t n, int K)
+/* The area's spread of a linear field over polygon v[0..n) against that of K points x with
+ * weights w (summing to 1): int |x - g|^2 dA / A over sum_k w_k |x_k - xbar|^2, the ratio of the
+ * traces of the two second moments, exact where the two are proportional (triangles and
+ * parallelograms, the points an affine image of a symmetric set: the centroid, half way to each
+ * vertex, the vertices).  The centroid and half-way points alone see 1/1.29 of a linear field's
+ * RMS on a square. */
+static double linear_spread(const double *vert, const int32_t *v, int64_t n, const double *x, const double *w, int64_t K)
 {
-    double g[3], x[MAX_POINTS][3], xm[3] = {0, 0, 0}, area = 0.0, mom = 0.0, q = 0.0;
+    double g[3], xm[3] = {0, 0, 0}, area = 0.0, mom = 0.0, q = 0.0;
     ulam__polygon_centroid(vert, v, n, g);
     for (int64_t k = 1; k + 1 < n; k++) { /* fan triangles: A (|t - g|^2 + sum_j |v_j - t|^2 / 12) */
         const double *a = vert + 3 * v[0], *b = vert + 3 * v[k], *c = vert + 3 * v[k + 1];
@@ -206,64 +232,212 @@ static double linear_spread(const double *vert, const int32_t *v, int64_t n, int
         ulam__sub3(b, a, e1), ulam__sub3(c, a, e2), ulam__cross3(e1, e2, cr);
         double A = 0.5 * sqrt(ulam__dot3(cr, cr)), s = 0.0;
         for (int j = 0; j < 3; j++) t[j] = (a[j] + b[j] + c[j]) / 3.0;
-        const double *w[3] = {a, b, c};
-        for (int j = 0; j < 3; j++) ulam__sub3(w[j], t, d), s += ulam__dot3(d, d);
+        const double *u[3] = {a, b, c};
+        for (int j = 0; j < 3; j++) ulam__sub3(u[j], t, d), s += ulam__dot3(d, d);
         ulam__sub3(t, g, d);
         area += A, mom += A * (ulam__dot3(d, d) + s / 12.0);
     }
-    for (int k = 0; k < K; k++)
-        for (int j = 0; j < 3; j++) x[k][j] = k ? 0.5 * (g[j] + vert[3 * v[k - 1] + j]) : g[j], xm[j] += x[k][j] / K;
-    for (int k = 0; k < K; k++) {
+    for (int64_t k = 0; k < K; k++)
+        for (int j = 0; j < 3; j++) xm[j] += w[k] * x[3 * k + j];
+    for (int64_t k = 0; k < K; k++) {
         double d[3];
-        ulam__sub3(x[k], xm, d);
-        q += ulam__dot3(d, d) / K;
+        ulam__sub3(x + 3 * k, xm, d);
+        q += w[k] * ulam__dot3(d, d);
     }
     return area > 0 && q > 0 ? mom / area / q : 1.0;
 }
 
-/* Measure polygon i by point queries at its quadrature points: its mean (the reflected part,
- * B - E) and mesh error. */
+/* Quadrature point k of polygon v[0..n) with centroid c: c itself, then half way to vertex k - 1. */
+static void interior_point(const double *vert, const int32_t *v, const double c[3], int k, double x[3])
+{
+    for (int d = 0; d < 3; d++) x[d] = k ? 0.5 * (c[d] + vert[3 * v[k - 1] + d]) : c[d];
+}
+
+/* The number of interior quadrature points of an n-gon. */
+static int interior_points(int64_t n)
+{
+    return (int)(1 + (n < MAX_POINTS - 1 ? n : MAX_POINTS - 1));
+}
+
+/* One point query at x (seed stream k) into b, s2 (3 each); ULAM_OK with info->interrupted set
+ * when the time ran out. */
+static int query(const ulam_tracer *t, const ulam_rad_opts *opts, double t0, const double x[3], uint64_t k,
+                 double *b, double *s2, ulam_rad_adapt_info *info, ulam_error *err)
+{
+    ulam_rad_opts o = *opts;
+    o.exec.seed = ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, k);
+    if (opts->stop.max_seconds > 0 && !((o.stop.max_seconds = opts->stop.max_seconds - (ulam_now() - t0)) > 0)) {
+        info->interrupted = 1;
+        return ULAM_OK;
+    }
+    ulam_rad_point pt;
+    int st = ulam_rad_point_query(t, &o, x, NULL, &pt, err);
+    if (st) return st;
+    info->points++, info->walks += pt.run.walks, info->rays += pt.run.rays;
+    if (pt.run.interrupted) info->interrupted = 1;
+    for (int ch = 0; ch < 3; ch++) b[ch] = pt.radiosity[ch], s2[ch] = pt.radiosity_se[ch] * pt.radiosity_se[ch];
+    return ULAM_OK;
+}
+
+/* Measure polygon i by point queries at its interior quadrature points (kept for estimate) and
+ * their mean (the reflected part, B - E). */
 static int measure(mesh *m, int64_t i, const ulam_tracer *t, const ulam_rad_opts *opts, double t0,
                    ulam_rad_adapt_info *info, ulam_error *err)
 {
     const int32_t *v = m->idx + m->first[i];
     int64_t n = m->len[i];
-    int K = (int)(1 + (n < MAX_POINTS - 1 ? n : MAX_POINTS - 1));
-    double b[MAX_POINTS][3], s2[MAX_POINTS][3], c[3];
+    int K = interior_points(n);
+    double *b = m->pb + 3 * MAX_POINTS * i, *s2 = m->ps2 + 3 * MAX_POINTS * i, c[3];
     ulam__polygon_centroid(m->vert, v, n, c);
     for (int k = 0; k < K; k++) {
         double x[3];
-        for (int d = 0; d < 3; d++) x[d] = k ? 0.5 * (c[d] + m->vert[3 * v[k - 1] + d]) : c[d];
-        ulam_rad_opts o = *opts;
-        o.exec.seed = ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, 16 * (uint64_t)i + (uint64_t)k);
-        if (opts->stop.max_seconds > 0 && !((o.stop.max_seconds = opts->stop.max_seconds - (ulam_now() - t0)) > 0)) {
-            info->interrupted = 1;
-            return ULAM_OK;
-        }
-        ulam_rad_point pt;
-        int st = ulam_rad_point_query(t, &o, x, NULL, &pt, err);
-        if (st) return st;
-        info->points++, info->walks += pt.run.walks, info->rays += pt.run.rays;
-        if (pt.run.interrupted) {
-            info->interrupted = 1;
-            return ULAM_OK;
-        }
-        for (int ch = 0; ch < 3; ch++) b[k][ch] = pt.radiosity[ch], s2[k][ch] = pt.radiosity_se[ch] * pt.radiosity_se[ch];
+        interior_point(m->vert, v, c, k, x);
+        int st = query(t, opts, t0, x, 16 * (uint64_t)i + (uint64_t)k, b + 3 * k, s2 + 3 * k, info, err);
+        if (st || info->interrupted) return st;
     }
-    double f2 = linear_spread(m->vert, v, n, K), *E = ulam__tracer_scene(t)->emit + 3 * m->src[i];
-    for (int ch = 0; ch < 3; ch++) {
-        double mean = 0.0, sum2 = 0.0, e2 = 0.0;
-        for (int k = 0; k < K; k++) mean += b[k][ch] / K, sum2 += s2[k][ch];
-        for (int k = 0; k < K; k++) { /* d_k = b_k - mean: var d_k = s_k^2 (1 - 2 / K) + sum_j s_j^2 / K^2 */
-            double d = b[k][ch] - mean;
-            e2 += (d * d - s2[k][ch] * (1.0 - 2.0 / K) - sum2 / ((double)K * K)) / K;
-        }
-        /* the reflected part's mean (the emission, constant on the patch, is no part of the
-         * error), and the spread scaled to the area's (linear_spread) */
-        m->mean[3 * i + ch] = fmax(0.0, mean - E[ch]), m->e[3 * i + ch] = e2 > 0 ? sqrt(e2 * f2) : 0.0;
+    double *E = ulam__tracer_scene(t)->emit + 3 * m->src[i];
+    for (int ch = 0; ch < 3; ch++) { /* the emission, constant on the patch, is no part of the error */
+        double mean = 0.0;
+        for (int k = 0; k < K; k++) mean += b[3 * k + ch] / K;
+        m->mean[3 * i + ch] = fmax(0.0, mean - E[ch]);
     }
     m->known[i] = 1;
     return ULAM_OK;
+}
+
+/* Append the nodes on edge (a, b) of a polygon, a included, b not: a, and the midpoints the
+ * neighbours' splits put on it, in order, each with half the length of the segment after it in
+ * m->bx (node NULL: only count them in *nb). */
+static void edge_nodes(mesh *m, int32_t a, int32_t b, int64_t *nb, int32_t *node)
+{
+    int32_t h = find_midpoint(m, a, b);
+    if (h >= 0) {
+        edge_nodes(m, a, h, nb, node), edge_nodes(m, h, b, nb, node);
+        return;
+    }
+    if (!node) {
+        (*nb)++;
+        return;
+    }
+    double d[3];
+    ulam__sub3(m->vert + 3 * b, m->vert + 3 * a, d);
+    double L = sqrt(ulam__dot3(d, d));
+    node[*nb] = a, m->bx[*nb] = 0.5 * L;
+    (*nb)++;
+}
+
+/* The slot of node (vertex u, source patch src) in the node table. */
+static int64_t node_slot(const mesh *m, int32_t u, int64_t src)
+{
+    uint64_t h = ((uint64_t)u * 0x9E3779B97F4A7C15ull) ^ ((uint64_t)src * 0xC2B2AE3D27D4EB4Full);
+    int64_t i = (int64_t)(h >> 20) & (m->ncap - 1);
+    while (m->nu[i] && !(m->nu[i] == u + 1 && m->ns[i] == src)) i = (i + 1) & (m->ncap - 1);
+    return i;
+}
+
+/* Room for one more node (rehash at half full); 0 or ULAM_ENOMEM. */
+static int node_room(mesh *m)
+{
+    if (2 * (m->ncount + 1) <= m->ncap) return 0;
+    int64_t oc = m->ncap, nc = oc ? 2 * oc : 1024;
+    int32_t *ou = m->nu;
+    int64_t *os = m->ns;
+    double *ob = m->nb, *o2 = m->ns2;
+    m->nu = calloc((size_t)nc, sizeof *m->nu), m->ns = malloc((size_t)nc * sizeof *m->ns);
+    m->nb = malloc((size_t)(3 * nc) * sizeof *m->nb), m->ns2 = malloc((size_t)(3 * nc) * sizeof *m->ns2);
+    if (!m->nu || !m->ns || !m->nb || !m->ns2) {
+        free(m->nu), free(m->ns), free(m->nb), free(m->ns2);
+        m->nu = ou, m->ns = os, m->nb = ob, m->ns2 = o2;
+        return ULAM_ENOMEM;
+    }
+    m->ncap = nc;
+    for (int64_t i = 0; i < oc; i++)
+        if (ou[i]) {
+            int64_t j = node_slot(m, ou[i] - 1, os[i]);
+            m->nu[j] = ou[i], m->ns[j] = os[i];
+            memcpy(m->nb + 3 * j, ob + 3 * i, 3 * sizeof *ob), memcpy(m->ns2 + 3 * j, o2 + 3 * i, 3 * sizeof *o2);
+        }
+    free(ou), free(os), free(ob), free(o2);
+    return 0;
+}
+
+/* B at vertex u of polygon i (a hair inside i, on its surface), measured once per vertex and
+ * source patch, into b, s2. */
+static int vertex_value(mesh *m, int32_t u, int64_t i, const double c[3], const ulam_tracer *t,
+                        const ulam_rad_opts *opts, double t0, double b[3], double s2[3],
+                        ulam_rad_adapt_info *info, ulam_error *err)
+{
+    if (node_room(m)) return ULAM_ENOMEM;
+    int64_t k = node_slot(m, u, m->src[i]);
+    if (!m->nu[k]) {
+        double x[3], d[3]; /* 1e-4 scene sizes toward i's centroid: 100 times locate's tolerance, so the
+                            * point is on i's surface, not a wall across a concave edge (1e-6 of the way
+                            * read the Cornell box's corners dark: its mesh error 0.764 for 0.403) */
+        ulam__sub3(c, m->vert + 3 * u, d);
+        double len = sqrt(ulam__dot3(d, d)), step = len > 0 ? fmin(1e-4 * ulam__tracer_size(t, NULL), 0.25 * len) / len : 0.0;
+        for (int j = 0; j < 3; j++) x[j] = m->vert[3 * u + j] + step * d[j];
+        int st = query(t, opts, t0, x, 16 * (uint64_t)u + 15, m->nb + 3 * k, m->ns2 + 3 * k, info, err);
+        if (st || info->interrupted) return st;
+        m->nu[k] = u + 1, m->ns[k] = m->src[i], m->ncount++;
+    }
+    memcpy(b, m->nb + 3 * k, 3 * sizeof *b), memcpy(s2, m->ns2 + 3 * k, 3 * sizeof *s2);
+    return ULAM_OK;
+}
+
+/* Polygon i's mesh error from its interior points and the nodes on its boundary (its vertices
+ * and the midpoints its finer neighbours put on its edges: the surface's radiosity is continuous
+ * across an edge, so a neighbour's shadow reaching it shows there even where the interior points
+ * miss it).  Weights: 2/3 the interior points alike, 1/3 the boundary nodes by the length beside
+ * each.  The weighted RMS about the weighted mean, each point's own noise removed
+ * (E[S] = S_true + sum_k w_k s_k^2 - sum_k w_k^2 s_k^2), scaled to the area's RMS of a linear
+ * field (linear_spread). */
+static int estimate(mesh *m, int64_t i, const ulam_tracer *t, const ulam_rad_opts *opts, double t0,
+                    ulam_rad_adapt_info *info, ulam_error *err)
+{
+    int64_t n = m->len[i], nb = 0;
+    int st = ULAM_OK;
+    for (int64_t e = 0; e < n; e++) edge_nodes(m, m->idx[m->first[i] + e], m->idx[m->first[i] + (e + 1) % n], &nb, NULL);
+    int32_t *node = ulam__malloc((size_t)(nb > 0 ? nb : 1), sizeof *node);
+    if (!node || grow((void **)&m->bx, &m->capb, nb, sizeof *m->bx)) {
+        free(node);
+        return ULAM_ENOMEM;
+    }
+    nb = 0;
+    for (int64_t e = 0; e < n; e++) edge_nodes(m, m->idx[m->first[i] + e], m->idx[m->first[i] + (e + 1) % n], &nb, node);
+    int K = interior_points(n);
+    int64_t N = K + nb;
+    double *x = ulam__malloc((size_t)(3 * N), sizeof *x), *w = ulam__malloc((size_t)N, sizeof *w);
+    double *b = ulam__malloc((size_t)(3 * N), sizeof *b), *s2 = ulam__malloc((size_t)(3 * N), sizeof *s2);
+    if (!st && (!x || !w || !b || !s2)) st = ULAM_ENOMEM;
+    const int32_t *v = m->idx + m->first[i];
+    double c[3], per = 0.0;
+    ulam__polygon_centroid(m->vert, v, n, c);
+    for (int k = 0; !st && k < K; k++) {
+        interior_point(m->vert, v, c, k, x + 3 * k), w[k] = (nb ? 2.0 / 3.0 : 1.0) / K;
+        memcpy(b + 3 * k, m->pb + 3 * (MAX_POINTS * i + k), 3 * sizeof *b);
+        memcpy(s2 + 3 * k, m->ps2 + 3 * (MAX_POINTS * i + k), 3 * sizeof *s2);
+    }
+    for (int64_t j = 0; !st && j < nb; j++) /* each node: half its segment and half the one before */
+        w[K + j] = m->bx[j] + m->bx[(j + nb - 1) % nb], per += 2 * m->bx[j];
+    for (int64_t j = 0; !st && j < nb && !info->interrupted; j++) {
+        w[K + j] = per > 0 ? w[K + j] / per / 3.0 : 1.0 / (3.0 * nb);
+        memcpy(x + 3 * (K + j), m->vert + 3 * node[j], 3 * sizeof *x);
+        st = vertex_value(m, node[j], i, c, t, opts, t0, b + 3 * (K + j), s2 + 3 * (K + j), info, err);
+    }
+    if (!st && !info->interrupted) {
+        double f2 = linear_spread(m->vert, v, n, x, w, N);
+        for (int ch = 0; ch < 3; ch++) {
+            double mean = 0.0, S = 0.0, noise = 0.0;
+            for (int64_t k = 0; k < N; k++) mean += w[k] * b[3 * k + ch];
+            for (int64_t k = 0; k < N; k++) {
+                double d = b[3 * k + ch] - mean;
+                S += w[k] * d * d, noise += w[k] * (1.0 - w[k]) * s2[3 * k + ch];
+            }
+            m->e[3 * i + ch] = S > noise ? sqrt((S - noise) * f2) : 0.0;
+        }
+    }
+    free(node), free(x), free(w), free(b), free(s2);
+    return st;
 }
 
 /* The mesh error of the live polygons (max over channels) and each one's share of it in r
@@ -363,6 +537,8 @@ int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double
     for (int round = 0; !status; round++) {
         for (int64_t i = 0; i < m.np && !status && !in.interrupted; i++)
             if (m.live[i] && !m.known[i]) status = measure(&m, i, t, opts, t0, &in, err);
+        for (int64_t i = 0; i < m.np && !status && !in.interrupted; i++) /* their neighbours' nodes may be new */
+            if (m.live[i]) status = estimate(&m, i, t, opts, t0, &in, err);
         if (status || in.interrupted) break;
         in.error = mesh_error(&m, NULL);
         if (round == 0) in.error0 = in.error;
