@@ -79,13 +79,13 @@ struct ulam__bidir {
 };
 
 /* An empty memo. */
-ulam__bidir *ulam__bidir_alloc(void)
+static ulam__bidir *ulam__bidir_alloc(void)
 {
     return calloc(1, sizeof(ulam__bidir));
 }
 
 /* Free a memo. */
-ulam__bidir *ulam__bidir_free(ulam__bidir *m)
+static ulam__bidir *ulam__bidir_free(ulam__bidir *m)
 {
     if (!m) return NULL;
     free(m->idx), free(m->val), free(m->ones);

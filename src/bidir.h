@@ -12,12 +12,6 @@
 
 typedef struct ulam__bidir ulam__bidir;
 
-/* An empty memo (NULL: no memory). */
-ulam__bidir *ulam__bidir_alloc(void);
-
-/* Free a memo and what it keeps; accepts and returns NULL. */
-ulam__bidir *ulam__bidir_free(ulam__bidir *m);
-
 /* ulam_bidir_plan and ulam_bidir_solve on an analysis' transpose, push workspace and planner's
  * memo (made at the first call and kept), for any kernel: the memo reuses a plan only for the
  * same options, continuation and exponent among them (src/bidir.c). */

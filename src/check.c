@@ -120,7 +120,7 @@ static int check_shape(const ulam_csr *A, ulam_error *err)
 }
 
 /* Check rows [lo, hi) of A: row pointers rising within [0, nnz], column indices in range. */
-int ulam__csr_check_rows(const ulam_csr *A, int64_t lo, int64_t hi, ulam_error *err)
+static int ulam__csr_check_rows(const ulam_csr *A, int64_t lo, int64_t hi, ulam_error *err)
 {
     int64_t nnz = A->rowptr[A->nrows];
     for (int64_t i = lo; i < hi; i++) {

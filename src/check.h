@@ -26,7 +26,4 @@ int ulam__length_check(const double *x, int64_t len, int64_t n, const char *name
  * rows it touches with ulam__csr_check_rows instead. */
 int ulam__csr_check_structure(const ulam_csr *A, ulam_error *err);
 
-/* As ulam__csr_check_structure for rows [lo, hi) of A only (A's sizes and rowptr[nrows] trusted). */
-int ulam__csr_check_rows(const ulam_csr *A, int64_t lo, int64_t hi, ulam_error *err);
-
 #endif

@@ -138,7 +138,7 @@ static int exchange(const ulam_walk_opts *o, double t0, void *blocks, const ulam
  * 4, ... blocks up to B->round (a round is as long as all before it), so a --rel-err or time
  * rule is checked often while little has run, and the schedule depends on walks done only,
  * never on the thread count. */
-int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int64_t want, int threads,
+static int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int64_t want, int threads,
                 void *ctx, void *results, int *nb, int *stop)
 {
     int64_t left = o->stop.max_walks > 0 ? o->stop.max_walks - next : INT64_MAX, done = next / B->block;

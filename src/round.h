@@ -56,14 +56,6 @@ typedef struct {
 /* A run not yet started. */
 void ulam__run_reset(ulam__run *run);
 
-/* One round from walk `next` (no further than o->stop.max_walks), shared dynamically among
- * `threads`, its *nb block results left in results[].  With o->exec.share, every process's blocks
- * are then exchanged so all hold all of them.  *stop gets the stop flags (1: time is up,
- * 2: interrupted), or'ed over the processes.  ULAM_OK, ULAM_ENOMEM or ULAM_EIO (the exchange
- * failed; *nb is then 0). */
-int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int64_t want, int threads,
-                void *ctx, void *results, int *nb, int *stop);
-
 /* The step a solver's iterate takes, shared by matrix and patch walks so each stopping rule
  * but the relative error is written once: one round (ulam__round) after B->begin, then its
  * completed blocks merged in block order (B->merge; the first incomplete block, interrupted or

@@ -234,9 +234,3 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
     return status;
 }
 
-/* Forward push from s on M (given as its transpose Mt) into p and r (n entries, zero). */
-int ulam__sweep_push(const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost, void *ctx, int64_t max_ops,
-                     double *p, double *r, ulam__sweep_info *info)
-{
-    return ulam__sweep_push_pull(NULL, Mt, s, rmax, cost, ctx, max_ops, p, r, NULL, NULL, info);
-}

@@ -109,7 +109,7 @@ int64_t ulam__lights_pick(const ulam__lights *L, double u)
 /* The weight of a strategy of density a against the other's b: the power heuristic (exponent 2),
  * the balance heuristic, or for light sampling alone 1 (light) and 0 (the walk's hit); collision
  * (the walk's hits alone) the reverse.  In the ratio form a density a = inf gets weight 1. */
-double ulam__mis_weight(int estimator, double a, double b, int light)
+static double ulam__mis_weight(int estimator, double a, double b, int light)
 {
     if (estimator == ULAM_RAD_NEXT_EVENT_LIGHT) return light ? 1.0 : 0.0;
     if (estimator == ULAM_RAD_COLLISION) return light ? 0.0 : 1.0;

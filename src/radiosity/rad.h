@@ -70,11 +70,9 @@ int64_t ulam__tracer_shoot_hit(const ulam_tracer *t, int64_t p, ulam_rng *r, ula
 /* A uniform point of patch p. */
 void ulam__tracer_point(const ulam_tracer *t, int64_t p, ulam_rng *r, double pt[3]);
 
-/* A shadow ray: nonzero when the segment from x (on patch p) to y (on patch l) leaves p's front,
- * reaches l's front and meets no other patch on the way; *h gets its length and cosines. */
-int ulam__tracer_sees(const ulam_tracer *t, int64_t p, const double x[3], int64_t l, const double y[3], ulam__hit *h);
-
-/* ulam__tracer_sees from a point x with unit normal n on patch self (-1: on no patch). */
+/* A shadow ray: nonzero when the segment from a point x with unit normal n on patch self (-1: on
+ * no patch) to y (on patch l) leaves x's front, reaches l's front and meets no other patch on the
+ * way; *h gets its length and cosines. */
 int ulam__tracer_sees_from(const ulam_tracer *t, const double x[3], const double n[3], int64_t self, int64_t l,
                            const double y[3], ulam__hit *h);
 
@@ -146,10 +144,6 @@ void ulam__lights_free(ulam__lights *L);
 
 /* The emitter drawn in proportion to power from u in [0, 1). */
 int64_t ulam__lights_pick(const ulam__lights *L, double u);
-
-/* MIS weight of a strategy of density a against the other's b (light: the strategy is light
- * sampling), for estimator (enum ulam_rad_estimator). */
-double ulam__mis_weight(int estimator, double a, double b, int light);
 
 /* A light sample at x (unit normal n, on patch self or -1) toward emitter l: a uniform point y of
  * l and W E_l G / p_L w_L added to score when seen; the shadow rays cast (0 or 1). */

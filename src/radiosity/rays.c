@@ -285,14 +285,9 @@ void ulam__tracer_point(const ulam_tracer *t, int64_t p, ulam_rng *r, double pt[
     ulam__patch_point(t->s, p, t->share[p], r, pt);
 }
 
-/* Nonzero when the segment from x (on patch p) to y (on patch l) leaves p's front, reaches l's
- * front and meets no other patch first; *h gets the distance and the two cosines either way. */
-int ulam__tracer_sees(const ulam_tracer *t, int64_t p, const double x[3], int64_t l, const double y[3], ulam__hit *h)
-{
-    return ulam__tracer_sees_from(t, x, t->s->normal + 3 * p, p, l, y, h);
-}
-
-/* The same from a point x with unit normal n on patch self (-1: a point on no patch). */
+/* Nonzero when the segment from x (unit normal n, on patch self; -1: on no patch) to y (on patch l)
+ * leaves x's front, reaches l's front and meets no other patch first; *h gets the distance and the
+ * two cosines either way. */
 int ulam__tracer_sees_from(const ulam_tracer *t, const double x[3], const double n[3], int64_t self, int64_t l,
                            const double y[3], ulam__hit *h)
 {
