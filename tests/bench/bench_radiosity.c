@@ -153,22 +153,37 @@ static void box(FILE *f, const double lo[3], const double hi[3], double h, long 
     rect(f, (double[3]){lo[0], lo[1], hi[2]}, (double[3]){dx, 0, 0}, (double[3]){0, dy, 0}, h, nv); /* +z */
 }
 
+/* Open path (an OBJ) and the MTL beside it (path's extension replaced by .mtl), write mtl_text
+ * into the MTL and the OBJ's header naming scene and the MTL; the OBJ, *m the MTL, or NULL with
+ * neither left open. */
+static FILE *open_scene(const char *path, const char *scene, const char *mtl_text, FILE **m)
+{
+    char mtl[4096];
+    snprintf(mtl, sizeof mtl, "%s", path);
+    char *dot = strrchr(mtl, '.');
+    if (!dot || strlen(mtl) + 4 >= sizeof mtl) return NULL;
+    strcpy(dot, ".mtl");
+    FILE *f = fopen(path, "w");
+    *m = f ? fopen(mtl, "w") : NULL;
+    if (!*m) {
+        if (f) fclose(f);
+        return NULL;
+    }
+    fputs(mtl_text, *m);
+    const char *base = strrchr(mtl, '/');
+    fprintf(f, "# The %s of bench_radiosity (tests/bench/bench_radiosity.c)\nmtllib %s\n", scene, base ? base + 1 : mtl);
+    return f;
+}
+
 /* Write the office: a 6 x 4 x 3 m room (y up; floor Kd 0.2, walls 0.5, ceiling 0.7), six
  * 0.6 x 0.6 m ceiling panels (Ke 20, Kd 0) 1 cm below it and four 1.4 x 0.7 m desks 0.72 m high
  * (Kd 0.4), in cells of 0.15 m: about 10^4 triangles.  0 or -1. */
 static int write_office(const char *path)
 {
-    char mtl[4096];
-    snprintf(mtl, sizeof mtl, "%s", path);
-    char *dot = strrchr(mtl, '.');
-    if (!dot || strlen(mtl) + 4 >= sizeof mtl) return -1;
-    strcpy(dot, ".mtl");
-    FILE *f = fopen(path, "w"), *m = fopen(mtl, "w");
-    if (!f || !m) return -1;
-    fprintf(m, "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl wall\nKd 0.5 0.5 0.45\nnewmtl ceiling\nKd 0.7 0.7 0.7\n"
-               "newmtl panel\nKd 0 0 0\nKe 20 20 18\nnewmtl desk\nKd 0.4 0.3 0.2\n");
-    const char *base = strrchr(mtl, '/');
-    fprintf(f, "# The office of bench_radiosity (tests/bench/bench_radiosity.c)\nmtllib %s\n", base ? base + 1 : mtl);
+    FILE *m = NULL, *f = open_scene(path, "office", "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl wall\nKd 0.5 0.5 0.45\n"
+                                    "newmtl ceiling\nKd 0.7 0.7 0.7\nnewmtl panel\nKd 0 0 0\nKe 20 20 18\n"
+                                    "newmtl desk\nKd 0.4 0.3 0.2\n", &m);
+    if (!f) return -1;
     const double W = 6, D = 4, H = 3, h = 0.15;
     long nv = 0;
     fprintf(f, "o floor\nusemtl floor\n");
@@ -201,17 +216,10 @@ static int write_office(const char *path)
  * or -1. */
 static int write_hall(const char *path)
 {
-    char mtl[4096];
-    snprintf(mtl, sizeof mtl, "%s", path);
-    char *dot = strrchr(mtl, '.');
-    if (!dot || strlen(mtl) + 4 >= sizeof mtl) return -1;
-    strcpy(dot, ".mtl");
-    FILE *f = fopen(path, "w"), *m = fopen(mtl, "w");
-    if (!f || !m) return -1;
-    fprintf(m, "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl ceiling\nKd 0.7 0.7 0.7\n"
-               "newmtl panel\nKd 0 0 0\nKe 30 30 30\nnewmtl crate\nKd 0.4 0.4 0.4\n");
-    const char *base = strrchr(mtl, '/');
-    fprintf(f, "# The hall of bench_radiosity (tests/bench/bench_radiosity.c)\nmtllib %s\n", base ? base + 1 : mtl);
+    FILE *m = NULL, *f = open_scene(path, "hall", "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl wall\nKd 0.5 0.5 0.5\n"
+                                    "newmtl ceiling\nKd 0.7 0.7 0.7\nnewmtl panel\nKd 0 0 0\nKe 30 30 30\n"
+                                    "newmtl crate\nKd 0.4 0.4 0.4\n", &m);
+    if (!f) return -1;
     const double W = 30, D = 15, H = 6;
     long nv = 0;
     fprintf(f, "o floor\nusemtl floor\n");
