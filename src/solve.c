@@ -112,6 +112,8 @@ struct ulam_solver {
     int epoch; /* the last epoch (stop.h) the rel_err rule was checked at */
     ulam__cs cs; /* the confidence sequence (stop.h), fed a block at a time in block order */
     double clip_b; /* the bias bound of the round's clipped scores (their limit: w.clip) */
+    double deadline; /* a time limit's end (ulam_now; INFINITY: none): set-up past it takes the cheaper
+                        paths (length_tail, second_moment) */
 };
 
 /* The defaults. */
@@ -283,15 +285,34 @@ static double tail_steps(double u, double kappa)
     return u < 1.0 && isfinite(kappa) ? 1.0 / (1.0 - u) + log(fmax(kappa, 1.0)) / -log(u) : INFINITY;
 }
 
+/* The expected lengths' certificate (ulam__length_certificate) in place of *u, *kappa when it
+ * allows shorter walks. */
+static void length_certificate(const ulam_csr *K, const char *seen, double *u, double *kappa, int *iterations)
+{
+    double u2, k2;
+    int64_t products = 0, n = K->nrows;
+    int64_t cap = 4 * (int64_t)sqrt((double)n) + 2000;
+    if (ulam__length_certificate(K, seen, (int)cap, &u2, &k2, &products) == ULAM_OK &&
+        tail_steps(u2, k2) < tail_steps(*u, *kappa))
+        *u = u2, *kappa = k2;
+    *iterations += (int)products;
+}
+
+/* Under a time limit (deadline finite) the expected lengths' certificate comes first and the
+ * power iterations run only while the clock is before the deadline (they are the optional
+ * stage: a 500 x 500 Poisson grid's 300 took 0.6 s and certified nothing the certificate does
+ * not; any iterate is a valid certificate, so stopping early only loosens it). */
 static void length_tail(const ulam_csr *K, const char *seen, double continue_q, int second, double floor,
-                        double *u, double *kappa, int *iterations)
+                        double deadline, double *u, double *kappa, int *iterations)
 {
     enum { ITER = 300 };
     int64_t n = K->nrows;
-    double *v = ulam__malloc((size_t)n, sizeof *v), *y = ulam__malloc((size_t)n, sizeof *y);
+    int timed = isfinite(deadline);
+    double *v = ulam__malloc((size_t)n, sizeof *v), *y = ulam__malloc((size_t)n, sizeof *y), u0 = 1.0, k0 = INFINITY;
     *u = 1.0, *kappa = INFINITY;
+    if (timed && !second) length_certificate(K, seen, &u0, &k0, iterations);
     for (int64_t i = 0; v && y && i < n; i++) v[i] = 1.0;
-    for (int it = 0; v && y && it < ITER; it++) {
+    for (int it = 0; v && y && it < ITER && !(timed && ulam_now() >= deadline); it++) {
         double ratio = 0.0, ymax = 0.0, vmin = INFINITY, vmax = 0.0;
         for (int64_t i = 0; i < n; i++) {
             if (!seen[i]) continue;
@@ -309,15 +330,9 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
             if (seen[i]) v[i] = fmax((y[i] + v[i]) / ymax, floor);
     }
     free(v), free(y);
-    if (!second && !(*u < TAIL_Q)) { /* long walks: the expected lengths' certificate, when shorter */
-        double u2, k2;
-        int64_t products = 0;
-        int64_t cap = 4 * (int64_t)sqrt((double)n) + 2000;
-        if (ulam__length_certificate(K, seen, (int)cap, &u2, &k2, &products) == ULAM_OK &&
-            tail_steps(u2, k2) < tail_steps(*u, *kappa))
-            *u = u2, *kappa = k2;
-        *iterations += (int)products;
-    }
+    if (timed && tail_steps(u0, k0) < tail_steps(*u, *kappa)) *u = u0, *kappa = k0;
+    else if (!timed && !second && !(*u < TAIL_Q))
+        length_certificate(K, seen, u, kappa, iterations); /* long walks: the expected lengths' certificate, when shorter */
 }
 
 /* A certified bound on E[X^2] of a walk's score X (collision, expected, absorption; no roulette,
@@ -334,7 +349,7 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const doubl
 {
     enum { ITER = 300 };
     int64_t n = K->nrows;
-    int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION;
+    int adj = s->o.mode == ULAM_ADJOINT, absorb = s->o.estimator == ULAM_ABSORPTION, late = 0;
     double *g = ulam__malloc((size_t)n, sizeof *g), *v = ulam__malloc((size_t)n, sizeof *v);
     double *y = ulam__malloc((size_t)n, sizeof *y), *f = ulam__malloc((size_t)n, sizeof *f), best = INFINITY;
     double b0 = 0.0, gmax = 0.0;
@@ -352,9 +367,10 @@ static double second_moment(const ulam_solver *s, const ulam_csr *K, const doubl
         gmax = fmax(gmax, g[i]);
     }
     static const double floors[] = {1e-30, 1e-6, 1e-3, 1e-2, 0.1};
-    for (int fl = 0; g && v && y && f && gmax > 0 && isfinite(gmax) && fl < 5; fl++) {
+    for (int fl = 0; g && v && y && f && gmax > 0 && isfinite(gmax) && fl < 5 && !late; fl++) {
         for (int64_t i = 0; i < n; i++) v[i] = seen[i] ? fmax(g[i] / gmax, floors[fl]) : 1.0;
         for (int it = 0, last = 0; it < ITER && it - last < 30; it++) { /* until 30 iterations bring nothing */
+            if ((late = isfinite(best) && ulam_now() >= s->deadline)) break; /* a time limit: any bound holds, looser */
             double u = 0.0, c = 0.0, z0 = 0.0, ymax = 0.0;
             ++*iterations;
             for (int64_t i = 0; i < n; i++) {
@@ -601,7 +617,8 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
             s->tail_uc = given->tail_u, s->tail_kc = given->kappa, s->tail_done = 1;
         if (!s->tail_done && (status = reached_flags(s, err))) return status;
         if (!s->tail_done) /* kappa enters by its log */
-            length_tail(K, s->reached, s->o.kernel.continue_q, 0, 1e-30, &s->tail_uc, &s->tail_kc, &it), s->tail_done = 1;
+            length_tail(K, s->reached, s->o.kernel.continue_q, 0, 1e-30, s->deadline, &s->tail_uc, &s->tail_kc, &it),
+                s->tail_done = 1;
         s->tail_u = s->tail_uc, s->kappa = s->tail_kc;
     }
     if (vmax > 0 && !isfinite(Wmax) && !(s->o.kernel.roulette > 0) && !(s->o.kernel.split > 0) &&
@@ -638,7 +655,7 @@ int ulam__reach_all(const ulam_csr *K, double continue_q, double alpha, char *se
     R->growth = R->fbig > 1.0 ? weight_growth(K, continue_q, fac, seen) : 1.0;
     if (!(R->qmax < TAIL_Q) || !isfinite(R->growth)) { /* the tail certificate check_reach would need */
         int it = 0;
-        length_tail(K, seen, continue_q, 0, 1e-30, &R->tail_u, &R->kappa, &it);
+        length_tail(K, seen, continue_q, 0, 1e-30, INFINITY, &R->tail_u, &R->kappa, &it);
         R->tail = 1;
     }
     free(fac);
@@ -985,7 +1002,7 @@ static int push_b(ulam_solver *s, int rel_alone, double *bnorm1, ulam_error *err
 /* Prepare walks on (I - M) x = b; reach: the states they can reach, computed before (NULL: search);
  * kernel: a kept kernel to walk on, rescored to b (NULL: a new one). */
 static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
-                        ulam_kernel *kernel, ulam_solver **out, ulam_error *err)
+                        ulam_kernel *kernel, double deadline, ulam_solver **out, ulam_error *err)
 {
     double t_alloc = ulam_now(); /* a time limit counts the set-up below (guards, reach, bounds, push) */
     ulam__clear(err);
@@ -1006,6 +1023,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
     s->o = o;
     s->b = b;
+    s->deadline = fmin(deadline, o.stop.max_seconds > 0 ? t_alloc + o.stop.max_seconds : INFINITY);
     /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered
        and no score's square underflows (b = 1e-300: a standard error of 0); not with a kernel
        scored to b, nor on a prepared file's lazy path (adjoint with guards or a reach given reads
@@ -1088,7 +1106,7 @@ nomem:
 int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                       ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, NULL, NULL, out, err);
+    return solver_alloc(M, b, opts, NULL, NULL, INFINITY, out, err);
 }
 
 /* As ulam_solver_alloc with b's length checked. */
@@ -1106,7 +1124,22 @@ int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ul
 int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                                const ulam__reach *reach, ulam_kernel *kernel, ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, reach, kernel, out, err);
+    return solver_alloc(M, b, opts, reach, kernel, INFINITY, out, err);
+}
+
+/* As ulam__solver_alloc_reached, its set-up taking the cheaper paths past deadline (see solve.h). */
+int ulam__solver_alloc_until(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
+                             double deadline, ulam_solver **out, ulam_error *err)
+{
+    return solver_alloc(M, b, opts, reach, NULL, deadline, out, err);
+}
+
+/* A time limit's end for the set-up that follows (deadline, INFINITY: none) and the time the
+ * walks' limit counts from (t0 >= 0; < 0: left as it is) (see solve.h). */
+void ulam__solver_clock(ulam_solver *s, double t0, double deadline)
+{
+    s->deadline = deadline;
+    if (t0 >= 0 && s->o.stop.max_seconds > 0) s->run.t0 = t0;
 }
 
 /* The solver's kernel, kept for later solvers (see internal.h). */

@@ -83,6 +83,18 @@ int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_wa
                                const ulam__reach *reach, struct ulam_kernel *kernel, ulam_solver **out,
                                ulam_error *err);
 
+/* As ulam__solver_alloc_reached (no kept kernel) under a time limit that ends at deadline
+ * (ulam_now; INFINITY: none; the earlier of it and opts' max_seconds from now): past it the
+ * set-up takes the cheaper paths (the length tail's power iterations and the second moment's
+ * iterations stop, their bounds looser but valid).  For the method choice's pilots (src/auto.c). */
+int ulam__solver_alloc_until(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
+                             double deadline, ulam_solver **out, ulam_error *err);
+
+/* Set the time limit's end for the set-up that follows (deadline, INFINITY: none), and when t0
+ * >= 0 and the solver has max_seconds, the time its walks' limit counts from (a rerun's walks
+ * otherwise count from their first block: the caller's set-up then would not count). */
+void ulam__solver_clock(ulam_solver *s, double t0, double deadline);
+
 /* The kernel of an adjoint collision or absorption solver, kept for later solvers on the same M,
  * continuation, exponent and estimator with any b (ulam__solver_alloc_reached's kernel, rescored
  * to its b: rows already built are not built again, and walks take exactly the moves a new
