@@ -47,9 +47,12 @@ struct ulam_solver {
     int k_borrowed; /* k is the caller's (ulam__solver_alloc_reached) or was kept (ulam__solver_keep_kernel) */
     ulam__walker w;
     const double *b; /* the caller's, borrowed like M (or bs, or pr) */
-    double *pq, *pr; /* forward rel_err: the push on b's part and residual (src/fpush_b.c; owned; NULL: none):
+    double *pq, *pr; /* forward: the push on b's part and residual (src/fpush_b.c; owned; NULL: none):
                         the walks start from pr, every estimate adds pq */
     ulam__fpush_b_info push; /* what that push did */
+    const double *b0; /* b before the push (pr in place of it: a rerun's push starts again from b0) */
+    double push_plan; /* the budget the push was planned for (push_plan(); -1: none planned yet) */
+    int push_fixed;   /* fixed budgets push too (the method choice's solvers: ulam__solver_alloc_until) */
     double *hitv;    /* rel_err with no score yet: src/hit.c's bound on each state's chance to score (NULL: none) */
     char *hitt;      /* and the states where a walk scores */
     int64_t *hits, nhits; /* and the reachable states it sweeps, ascending */
@@ -958,39 +961,62 @@ static double mean_steps(const ulam_solver *s)
  * and a tally a visit; 0 with nothing left to walk. */
 typedef struct {
     const ulam_solver *s;
-    double bnorm1, per_walk;
+    double bnorm1, per_walk, budget;
 } push_ctx;
 
+/* At a fixed budget (budget > 0 units of walks' work: --walks, --time) the model is instead the
+ * work that would take walks from r_sum to the half-width the budget's walks from b reach: each
+ * walk's weight, and so the interval's range and standard-error terms, scales with the l1 norm
+ * it starts from, so that work is the budget times (r_sum / ||b||_1)^2; a sweep is then made
+ * while it saves more of it than it costs (a b of one entry 10^6: --walks 10^5 printed +-6100
+ * for x = 9441 before the push served fixed budgets). */
 static double push_cost(double r_sum, double q_i, void *ctx)
 {
     const push_ctx *c = ctx;
     if (r_sum == 0.0) return 0.0;
+    if (c->budget > 0) return c->budget * (r_sum / c->bnorm1) * (r_sum / c->bnorm1);
     double E = c->s->o.stop.rel_err, m = fabs(q_i + c->s->o.stop.rel_err_offset);
     return fmax((double)ULAM__REL_MIN, ulam__solver_range_walks(c->s, r_sum / c->bnorm1, 0, m, E)) * c->per_walk;
 }
 
-/* Forward walks with a rel_err target (no weight window): push b down while that lowers the walks'
- * predicted work (src/fpush_b.c), then walk from the residual, its source table and score bounds
- * made anew (*bnorm1 its l1 norm); rel_alone as take_bounds. */
+/* The budget a forward push is planned for: 0 under a rel_err target (its own model), else for
+ * the method choice's solvers (push_fixed) with the variance certified finite (else there is no
+ * bar to narrow) the walks' work a fixed budget buys in units (max_walks walks of per_walk, or
+ * max_seconds at the work model's rate, the less); 0 without either. */
+static double push_plan(const ulam_solver *s, double per_walk)
+{
+    const ulam_stop_opts *st = &s->o.stop;
+    if (st->rel_err > 0 || !s->push_fixed || s->var_finite != 1) return 0.0;
+    double w = st->max_walks > 0 ? (double)st->max_walks * per_walk : INFINITY;
+    if (st->max_seconds > 0) w = fmin(w, st->max_seconds / ULAM_AUTO_UNIT_SECONDS);
+    return isfinite(w) ? w : 0.0;
+}
+
+/* Forward walks (no weight window) with a rel_err target or a fixed budget: push b down while
+ * that lowers the walks' predicted work (src/fpush_b.c; push_cost's two models), then walk from
+ * the residual, its source table and score bounds made anew (*bnorm1 its l1 norm); rel_alone as
+ * take_bounds. */
 static int push_b(ulam_solver *s, int rel_alone, double *bnorm1, ulam_error *err)
 {
     const ulam_walk_opts *o = &s->o;
-    if (o->mode != ULAM_FORWARD || !(o->stop.rel_err > 0) || o->kernel.roulette > 0 || o->kernel.split > 0 ||
+    double V = mean_steps(s), pw = V + ULAM_AUTO_WALK + ULAM_AUTO_TALLY * (V + 1.0), plan = push_plan(s, pw);
+    s->push_plan = plan;
+    if (o->mode != ULAM_FORWARD || !(o->stop.rel_err > 0 || plan > 0) || o->kernel.roulette > 0 || o->kernel.split > 0 ||
         !(*bnorm1 > 0) || !isfinite(*bnorm1))
         return ULAM_OK;
-    double V = mean_steps(s);
-    push_ctx c = {s, *bnorm1, V + ULAM_AUTO_WALK + ULAM_AUTO_TALLY * (V + 1.0)};
+    push_ctx c = {s, *bnorm1, pw, plan};
     s->pq = ulam__calloc((size_t)s->n, sizeof *s->pq), s->pr = ulam__malloc((size_t)s->n, sizeof *s->pr);
     if (!s->pq || !s->pr) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push on b");
     memcpy(s->pr, s->b, (size_t)s->n * sizeof *s->pr);
-    ulam__fpush_b(s->mt, o->query.index, push_cost, &c, ULAM__REL_MIN * c.per_walk, s->pq, s->pr, &s->push);
+    ulam__fpush_b(s->mt, o->query.index, push_cost, &c, plan > 0 ? plan / 2 : ULAM__REL_MIN * c.per_walk, s->pq, s->pr,
+                  &s->push);
     s->setup_work += s->push.ops;
     if (s->push.sweeps == 0) { /* not worth a sweep: the walks start from b */
         free(s->pq), free(s->pr);
         s->pq = s->pr = NULL;
         return ULAM_OK;
     }
-    s->b = s->pr;
+    s->b0 = s->b, s->b = s->pr;
     free(s->src), free(s->seen), free(s->fac); /* the source, reachable set and score bounds depend on b */
     s->src = NULL, s->seen = NULL, s->reached = NULL, s->fac = NULL;
     s->passed = s->tail_done = 0;
@@ -1002,7 +1028,7 @@ static int push_b(ulam_solver *s, int rel_alone, double *bnorm1, ulam_error *err
 /* Prepare walks on (I - M) x = b; reach: the states they can reach, computed before (NULL: search);
  * kernel: a kept kernel to walk on, rescored to b (NULL: a new one). */
 static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
-                        ulam_kernel *kernel, double deadline, ulam_solver **out, ulam_error *err)
+                        ulam_kernel *kernel, double deadline, int push_fixed, ulam_solver **out, ulam_error *err)
 {
     double t_alloc = ulam_now(); /* a time limit counts the set-up below (guards, reach, bounds, push) */
     ulam__clear(err);
@@ -1023,6 +1049,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     if (!s) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the solver");
     s->o = o;
     s->b = b;
+    s->push_plan = -1.0, s->push_fixed = push_fixed;
     s->deadline = fmin(deadline, o.stop.max_seconds > 0 ? t_alloc + o.stop.max_seconds : INFINITY);
     /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered
        and no score's square underflows (b = 1e-300: a standard error of 0); not with a kernel
@@ -1106,7 +1133,7 @@ nomem:
 int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                       ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, NULL, NULL, INFINITY, out, err);
+    return solver_alloc(M, b, opts, NULL, NULL, INFINITY, 0, out, err);
 }
 
 /* As ulam_solver_alloc with b's length checked. */
@@ -1124,14 +1151,14 @@ int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ul
 int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                                const ulam__reach *reach, ulam_kernel *kernel, ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, reach, kernel, INFINITY, out, err);
+    return solver_alloc(M, b, opts, reach, kernel, INFINITY, 0, out, err);
 }
 
 /* As ulam__solver_alloc_reached, its set-up taking the cheaper paths past deadline (see solve.h). */
 int ulam__solver_alloc_until(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
                              double deadline, ulam_solver **out, ulam_error *err)
 {
-    return solver_alloc(M, b, opts, reach, NULL, deadline, out, err);
+    return solver_alloc(M, b, opts, reach, NULL, deadline, 1, out, err);
 }
 
 /* A time limit's end for the set-up that follows (deadline, INFINITY: none) and the time the
@@ -1734,6 +1761,30 @@ int ulam__solver_restart(ulam_solver *s, const double *b, uint64_t seed, ulam_er
     return ULAM_OK;
 }
 
+/* A forward rerun whose budget plans another push than the one made (the method choice's pilots
+ * plan for their few walks): b as it was, then the push for this budget, as a solver allocated
+ * with these options makes it. */
+static int repush(ulam_solver *s, int rel_alone, ulam_error *err)
+{
+    double V = mean_steps(s), bnorm1 = 0.0;
+    if (s->push_plan < 0 || push_plan(s, V + ULAM_AUTO_WALK + ULAM_AUTO_TALLY * (V + 1.0)) == s->push_plan) return ULAM_OK;
+    int status = ULAM_OK;
+    if (s->pq) { /* undo the push: b, its source table and its bounds */
+        free(s->pq), free(s->pr), free(s->src), free(s->seen), free(s->fac);
+        s->pq = s->pr = NULL, s->src = NULL, s->seen = NULL, s->reached = NULL, s->fac = NULL;
+        s->b = s->b0;
+        s->passed = s->tail_done = 0;
+        memset(s->v2_done, 0, sizeof s->v2_done);
+        if (build_source(s, &bnorm1)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the source table");
+        if ((status = take_bounds(s, s->mt, rel_alone, err))) return status;
+    } else {
+        for (int64_t i = 0; i < s->n; i++) bnorm1 += fabs(s->b[i]);
+    }
+    if ((status = push_b(s, rel_alone, &bnorm1, err))) return status;
+    s->w.src = s->src, s->w.bnorm1 = bnorm1;
+    return ULAM_OK;
+}
+
 /* Walk again with options o that differ from the solver's only in the estimator, the seed, the
  * stopping rules, interrupt, share, force, assume_finite and rel_err_offset. */
 int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *err)
@@ -1764,9 +1815,9 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *e
     s->w.interrupt = o.stop.interrupt;
     s->w.score0 = o.mode == ULAM_ADJOINT && o.estimator == ULAM_EXPECTED ? s->b[o.query.index] : 0.0;
     s->w.expected = o.mode == ULAM_FORWARD && o.estimator == ULAM_EXPECTED;
-    if ((status = take_bounds(s, o.mode == ULAM_FORWARD ? s->mt : s->M, o.stop.rel_err > 0 && o.stop.max_walks == 0 &&
-                              o.stop.max_seconds == 0, err)))
-        return status;
+    int rel_alone = o.stop.rel_err > 0 && o.stop.max_walks == 0 && o.stop.max_seconds == 0;
+    if ((status = take_bounds(s, o.mode == ULAM_FORWARD ? s->mt : s->M, rel_alone, err))) return status;
+    if (o.mode == ULAM_FORWARD && (status = repush(s, rel_alone, err))) return status;
     reset(s);
     return ULAM_OK;
 }

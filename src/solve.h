@@ -86,7 +86,11 @@ int ulam__solver_alloc_reached(const ulam_csr *M, const double *b, const ulam_wa
 /* As ulam__solver_alloc_reached (no kept kernel) under a time limit that ends at deadline
  * (ulam_now; INFINITY: none; the earlier of it and opts' max_seconds from now): past it the
  * set-up takes the cheaper paths (the length tail's power iterations and the second moment's
- * iterations stop, their bounds looser but valid).  For the method choice's pilots (src/auto.c). */
+ * iterations stop, their bounds looser but valid); and forward walks with a certified finite
+ * variance at a fixed budget (max_walks, max_seconds, no rel_err) push b first too, as far as the
+ * budget's walks gain by it (src/fpush_b.c; a rerun with another budget pushes again from b:
+ * ulam_solver_alloc's walks start from b there, the raw method).  For the method choice's pilots
+ * and run (src/auto.c). */
 int ulam__solver_alloc_until(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, const ulam__reach *reach,
                              double deadline, ulam_solver **out, ulam_error *err);
 
