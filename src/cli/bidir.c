@@ -429,6 +429,9 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
                        "any %s at most %.3g)\n", info.rmax, (long long)info.push.ops, (long long)info.push.support,
                        info.push.r_sum, alpha > 0 ? "pi_i" : "x_i", info.residual_bound * scale);
                 printf("walks           %lld (%lld steps)\n", (long long)info.walks, (long long)info.steps);
+                if (info.push.support > 0 && !isfinite(info.residual_bound)) /* the queue path (src/fpush.c) */
+                    printf("intervals       the source's alone: with ||M||_1 >= 1 the other components' walk parts "
+                           "have no certified range (none printed)\n");
                 printf("seconds         %.4f (push %.4f, walks %.4f; CPU %.4f)\n", info.seconds, info.push_seconds,
                        info.walk_seconds, cpu);
                 if (xd) printf("direct          %s, %.3g s (the column direct)\n", dm, dsec);
