@@ -423,6 +423,29 @@ static void test_fpush_exact_push(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* The queue path's system: n = 300 states, 4 entries a row summing to rowsum, one to the next
+ * state and three to states drawn towards the low indices (in-degrees uneven: columns past 1);
+ * M, its transpose and the guards of |M| and of the forward kernel. */
+static void queue_system(double rowsum, ulam_csr **M, ulam_csr **Mt, ulam_guard *g)
+{
+    int64_t n = 300, nz = 0;
+    ulam_rng r;
+    ulam_rng_seed(&r, 5, 0);
+    int32_t *ti = malloc(4 * (size_t)n * sizeof *ti), *tj = malloc(4 * (size_t)n * sizeof *tj);
+    double *tv = malloc(4 * (size_t)n * sizeof *tv);
+    for (int64_t i = 0; i < n; i++)
+        for (int k = 0; k < 4; k++) {
+            int64_t j = k == 0 ? (i + 1) % n : (int64_t)(ulam_rng_uniform(&r) * ulam_rng_uniform(&r) * (double)n);
+            ti[nz] = (int32_t)i, tj[nz] = (int32_t)j, tv[nz++] = rowsum / 4;
+        }
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, M), ULAM_OK);
+    assert_int_equal(ulam_csr_transpose(*M, Mt), ULAM_OK);
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
+    assert_int_equal(ulam_guard_check(*M, 0.0, &go, g, NULL), ULAM_OK);
+    free(ti), free(tj), free(tv);
+}
+
 /* The queue path (column sums of |M| past 1) with a forward variance certified infinite (a
  * newcomer's 2000-state case: 4 of 8 printed intervals missed x, one by 2.6 standard errors):
  * no interval is printed, where before x -+ 1.96 stderr was. */
@@ -430,23 +453,9 @@ static void test_fpush_queue_infinite(void **state)
 {
     (void)state;
     int64_t n = 300;
-    ulam_rng r;
-    ulam_rng_seed(&r, 5, 0);
-    int32_t *ti = malloc(4 * (size_t)n * sizeof *ti), *tj = malloc(4 * (size_t)n * sizeof *tj);
-    double *tv = malloc(4 * (size_t)n * sizeof *tv);
-    int64_t nz = 0;
-    for (int64_t i = 0; i < n; i++) /* rows summing to 0.85; in-degrees uneven: columns past 1 */
-        for (int k = 0; k < 4; k++) {
-            int64_t j = k == 0 ? (i + 1) % n : (int64_t)(ulam_rng_uniform(&r) * ulam_rng_uniform(&r) * (double)n);
-            ti[nz] = (int32_t)i, tj[nz] = (int32_t)j, tv[nz++] = 0.85 / 4;
-        }
     ulam_csr *M = NULL, *Mt = NULL;
-    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, &M), ULAM_OK);
-    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     ulam_guard g;
-    ulam_guard_opts go = ulam_guard_defaults();
-    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
-    assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
+    queue_system(0.85, &M, &Mt, &g);
     assert_true(g.abs.colsum_max >= 1.0 && ulam_guard_variance(&g, ULAM_FORWARD) == 0); /* the case */
     ulam_fpush_opts o = ulam_fpush_defaults();
     o.source = 3, o.walks = 2000;
@@ -457,7 +466,7 @@ static void test_fpush_queue_infinite(void **state)
     int64_t printed = 0;
     for (int64_t i = 0; i < n; i++) printed += !isnan(lo[i]) || !isnan(hi[i]);
     assert_int_equal(printed, 0);
-    free(ti), free(tj), free(tv), free(x), free(se), free(lo), free(hi);
+    free(x), free(se), free(lo), free(hi);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
@@ -470,23 +479,9 @@ static void test_fpush_queue_certified(void **state)
 {
     (void)state;
     int64_t n = 300;
-    ulam_rng r;
-    ulam_rng_seed(&r, 5, 0);
-    int32_t *ti = malloc(4 * (size_t)n * sizeof *ti), *tj = malloc(4 * (size_t)n * sizeof *tj);
-    double *tv = malloc(4 * (size_t)n * sizeof *tv);
-    int64_t nz = 0;
-    for (int64_t i = 0; i < n; i++) /* rows summing to 0.4; in-degrees uneven: columns past 1 */
-        for (int k = 0; k < 4; k++) {
-            int64_t j = k == 0 ? (i + 1) % n : (int64_t)(ulam_rng_uniform(&r) * ulam_rng_uniform(&r) * (double)n);
-            ti[nz] = (int32_t)i, tj[nz] = (int32_t)j, tv[nz++] = 0.4 / 4;
-        }
     ulam_csr *M = NULL, *Mt = NULL;
-    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tv, &M), ULAM_OK);
-    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     ulam_guard g;
-    ulam_guard_opts go = ulam_guard_defaults();
-    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
-    assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
+    queue_system(0.4, &M, &Mt, &g);
     print_message("||M||_1 = %.3g, forward rho(M^) <= %.3g\n", g.abs.colsum_max, g.hat[1].upper);
     assert_true(g.abs.colsum_max >= 1.0 && ulam_guard_variance(&g, ULAM_FORWARD) == 1); /* the case */
     int64_t S = 3;
@@ -509,7 +504,7 @@ static void test_fpush_queue_certified(void **state)
     print_message("queue path: x_S covered on %d of %d seeds; other components' intervals printed: %d\n", covered, N,
                   others);
     assert_true(covered >= 34 && others == 0);
-    free(ti), free(tj), free(tv), free(x), free(se), free(lo), free(hi), free(e), free(xd);
+    free(x), free(se), free(lo), free(hi), free(e), free(xd);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
