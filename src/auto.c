@@ -584,7 +584,8 @@ int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_
     chooser *c = calloc(1, sizeof *c);
     if (!c) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the choice");
     c->M = M, c->b = b, c->base = *base, c->a = a, c->res = res, c->leader = -1, c->reach = reach;
-    c->deadline = base->stop.max_seconds > 0 ? t0 + base->stop.max_seconds : INFINITY; /* the set-up counts */
+    c->deadline = base->stop.max_seconds > 0 ? t0 + base->stop.max_seconds : INFINITY; /* the set-up counts, */
+    if (base->exec.share && base->exec.share->nranks > 1) c->deadline = INFINITY; /* but every rank chooses alike */
     c->qs[0] = a.pin_continue ? base->kernel.continue_q : 0.0, c->qs[1] = a.continue_q;
     c->nq = a.pin_continue ? 1 : 2;
     c->as[0] = a.pin_alpha ? base->kernel.kernel_alpha : 1.0, c->as[1] = 0.0, c->as[2] = 2.0;

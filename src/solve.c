@@ -1051,6 +1051,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
     s->b = b;
     s->push_plan = -1.0, s->push_fixed = push_fixed;
     s->deadline = fmin(deadline, o.stop.max_seconds > 0 ? t_alloc + o.stop.max_seconds : INFINITY);
+    if (o.exec.share && o.exec.share->nranks > 1) s->deadline = INFINITY; /* every rank's bounds the same: no clock */
     /* b far from 1: walk on b 2^-e and scale what they find (exact), so x = 6.7e307 is answered
        and no score's square underflows (b = 1e-300: a standard error of 0); not with a kernel
        scored to b, nor on a prepared file's lazy path (adjoint with guards or a reach given reads
