@@ -301,10 +301,10 @@ static void length_certificate(const ulam_csr *K, const char *seen, double *u, d
     *iterations += (int)products;
 }
 
-/* Under a time limit (deadline finite) the expected lengths' certificate comes first and the
- * power iterations run only while the clock is before the deadline (they are the optional
- * stage: a 500 x 500 Poisson grid's 300 took 0.6 s and certified nothing the certificate does
- * not; any iterate is a valid certificate, so stopping early only loosens it). */
+/* Under a time limit (deadline finite) the expected lengths' certificate comes first and, when
+ * it holds, the power iterations run only while the clock is before the deadline (they are the
+ * optional stage then: a 500 x 500 Poisson grid's 300 took 0.6 s and certified nothing the
+ * certificate does not; any iterate is a valid certificate, so stopping early only loosens it). */
 static void length_tail(const ulam_csr *K, const char *seen, double continue_q, int second, double floor,
                         double deadline, double *u, double *kappa, int *iterations)
 {
@@ -315,7 +315,7 @@ static void length_tail(const ulam_csr *K, const char *seen, double continue_q, 
     *u = 1.0, *kappa = INFINITY;
     if (timed && !second) length_certificate(K, seen, &u0, &k0, iterations);
     for (int64_t i = 0; v && y && i < n; i++) v[i] = 1.0;
-    for (int it = 0; v && y && it < ITER && !(timed && ulam_now() >= deadline); it++) {
+    for (int it = 0; v && y && it < ITER && !(timed && u0 < 1.0 && ulam_now() >= deadline); it++) {
         double ratio = 0.0, ymax = 0.0, vmin = INFINITY, vmax = 0.0;
         for (int64_t i = 0; i < n; i++) {
             if (!seen[i]) continue;

@@ -338,7 +338,10 @@ def test_single_source_arrays():
     assert isinstance(r, ulam.VectorResult) and r.method == "single-source"
     assert r.estimate.shape == r.stderr.shape == r.ci95[0].shape == r.ci95[1].shape == (80,)
     assert (np.abs(r.estimate - x) <= 4 * r.stderr + 1e-12).all(), np.max(np.abs(r.estimate - x) / r.stderr)
-    assert (r.ci95[0] <= r.estimate).all() and (r.estimate <= r.ci95[1]).all()
+    # the intervals printed bracket the estimates; with ||M||_1 >= 1 (the queue path) only the
+    # source's is certified, the others are none (NaN), not the CLT's x -+ 1.96 stderr
+    shown = ~np.isnan(r.ci95[0])
+    assert shown[9] and (r.ci95[0][shown] <= r.estimate[shown]).all() and (r.estimate[shown] <= r.ci95[1][shown]).all()
     # the call, source= with mode="forward": the same (it printed x[0] = 0 +- 0, 0 walks)
     r2 = ulam.solve(M=M, source=9, mode="forward", walks=20000, seed=3)
     assert np.array_equal(r2.estimate, r.estimate) and r2.walks == r.walks > 0
