@@ -495,6 +495,7 @@ static void init(void *p)
 static int option(void *p, int c, const char *name, const char *optarg)
 {
     bidir_args *a = p;
+    ulam_error err;
     int rc;
     switch (c) {
     case CLI_WALK: if ((rc = cli_walk_option("solve", name, optarg, &a->o.walk))) return rc; break;
@@ -512,9 +513,9 @@ static int option(void *p, int c, const char *name, const char *optarg)
             return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
         a->method = 1;
         break;
-    case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &a->o.rmax))) return rc; break;
-    case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &a->o.min_value))) return rc; break;
-    case 'k': if ((rc = cli_parse_real("solve", "--step-cost", optarg, 1e-3, 1e6, &a->o.step_cost))) return rc; break;
+    case 'x': case 'v': case 'k': /* the library's table (src/options.c) */
+        if (ulam_options_set(ULAM_OPTIONS_BIDIR, &a->o, name, optarg, &err)) return cli_usage_error("solve", "%s", err.msg);
+        break;
     case 'T': if ((rc = cli_parse_int("solve", "--top", optarg, 1, ULAM_MAX_DIM, &a->top))) return rc; break;
     case 'c': a->rp.check = 1; break;
     case 'J': a->rp.json = 1; break;

@@ -3,6 +3,8 @@
 #define ULAM_CLI_H
 
 #include "ulam.h"
+#include "ulam_options.h"
+#include "ulam_report.h"
 
 #include <getopt.h>
 
@@ -278,9 +280,6 @@ void cli_output_begin(int *argc, char **argv);
 int cli_output_finish(int rc);
 
 /* Every value of solve --method (src/cli/output.c), and them in words for messages. */
-
-/* The name among names[0..n) closest to word, or NULL. */
-const char *cli_suggest(const char *word, const char *const *names, int n);
 
 /* Refuse an unknown --name in argv (no abbreviations), naming the closest of longopts; 0 or EXIT_USAGE. */
 int cli_check_options(const char *command, int argc, char **argv, const struct option *longopts);

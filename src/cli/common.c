@@ -363,37 +363,20 @@ int cli_flush(void)
     return stdout_errno;
 }
 
-/* Parse an integer option value in [lo, hi]. */
+/* Parse an integer option value in [lo, hi] (the library's parser, src/options.c). */
 int cli_parse_int(const char *command, const char *opt, const char *s, int64_t lo, int64_t hi,
                   int64_t *out)
 {
-    char *end;
-    errno = 0;
-    long long v = strtoll(s, &end, 10);
-    if (end != s && (*end == 'e' || *end == 'E' || *end == '.')) { /* 1e12, 2.5e6: whole numbers */
-        double d = strtod(s, &end);
-        int whole = !*end && d == floor(d) && fabs(d) <= 9007199254740992.0; /* 2^53: exact */
-        v = whole ? (long long)d : v, errno = whole ? 0 : ERANGE;
-    }
-    if (end == s || *end || errno == ERANGE || v < lo || v > hi)
-        return cli_usage_error(command, "%s expects an integer from %lld to %lld%s, got '%s'", opt,
-                               (long long)lo, (long long)hi,
-                               lo == 1 && v == 0 && (strstr(opt, "index") || strstr(opt, "source") || strstr(opt, "patch"))
-                                   ? " (1-based, as in Matrix Market files)" : "", s);
-    *out = v;
-    return 0;
+    ulam_error err;
+    return ulam_options_parse_int(opt, s, lo, hi, out, &err) ? cli_usage_error(command, "%s", err.msg) : 0;
 }
 
 /* Parse a finite real option value in [lo, hi]. */
 int cli_parse_real(const char *command, const char *opt, const char *s, double lo, double hi,
                    double *out)
 {
-    char *end;
-    double v = strtod(s, &end);
-    if (end == s || *end || !isfinite(v) || v < lo || v > hi)
-        return cli_usage_error(command, "%s expects a number from %g to %g, got '%s'", opt, lo, hi, s);
-    *out = v;
-    return 0;
+    ulam_error err;
+    return ulam_options_parse_real(opt, s, lo, hi, out, &err) ? cli_usage_error(command, "%s", err.msg) : 0;
 }
 
 /* Parse a byte count with an optional K, M, G or T suffix. */
