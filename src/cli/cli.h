@@ -5,6 +5,7 @@
 #include "ulam.h"
 #include "ulam_options.h"
 #include "ulam_report.h"
+#include "ulam_reference.h"
 
 #include <getopt.h>
 
@@ -40,6 +41,9 @@ int cli_parse_int(const char *command, const char *opt, const char *s, int64_t l
 /* Parse a finite real option value in [lo, hi]. */
 int cli_parse_real(const char *command, const char *opt, const char *s, double lo, double hi,
                    double *out);
+
+/* Parse n comma-separated finite numbers of s (exactly n) into x; 0 or -1 (the caller reports). */
+int cli_parse_numbers(const char *s, int n, double *x);
 
 /* Parse a byte count with an optional K, M, G or T suffix (powers of 1024). */
 int cli_parse_bytes(const char *command, const char *opt, const char *s, size_t *out);
@@ -136,10 +140,9 @@ const char *cli_system_hint(const ulam_csr *M);
 /* Free what cli_load_system loaded. */
 void cli_system_free(cli_system *s);
 
-/* The reference solve (src/cli/direct.c): sparse LU when cli_direct_sparse_wanted(M) (--lu of
- * ulam direct sets cli_direct_force: -1 auto, 0 dense, 1 sparse), else dense. */
+/* The reference solve (src/cli/direct.c; the library's ulam_reference_*): --lu of ulam direct
+ * sets cli_direct_force: -1 auto, 0 dense, 1 sparse. */
 extern int cli_direct_force;
-int cli_direct_sparse_wanted(const ulam_csr *M);
 
 /* x_index of the reference solve for --check, interruptible by Ctrl-C (EXIT_INTERRUPTED: its thread
  * still reads s); *method "sparse LU" or "dense LU"; 0 or an exit code. */
