@@ -30,6 +30,16 @@ void ulam_json_string(FILE *f, const char *key, const char *v, int last);
  * "index" before, "ranks" and the timings after). */
 void ulam_walk_result_json(FILE *f, const ulam_walk_opts *o, const ulam_walk_result *r, const ulam_guard *g);
 
+/* The formats of ulam_choice_fprint. */
+enum ulam_report_format { ULAM_REPORT_BRIEF = 0, ULAM_REPORT_VERBOSE = 1, ULAM_REPORT_JSON = 2 };
+
+/* Write what --method auto chose (ulam_auto_start's ch) to f: BRIEF, one line (what was chosen
+ * among how many); VERBOSE, the choice and a line a candidate (mode, estimator, continuation,
+ * exponent, rho(M^), pilots, predicted walks and work); JSON, the member "auto": {...} followed
+ * by ", " (the candidates, 1-based "chosen" and "closest", the pilots' share of the work).  With
+ * bidir, the bidirectional row's plan and why it was or was not chosen too. */
+void ulam_choice_fprint(FILE *f, const ulam_choice *ch, int bidir, int format);
+
 #ifdef __cplusplus
 }
 #endif

@@ -47,6 +47,41 @@ static void test_json(void **state)
     free(s);
 }
 
+/* What auto chose, by hand: one candidate chosen; brief, verbose and JSON say so. */
+static void test_choice(void **state)
+{
+    (void)state;
+    static ulam_choice ch; /* large: not on the stack */
+    memset(&ch, 0, sizeof ch);
+    ch.walks.ncand = 1, ch.walks.chosen = 0, ch.walks.closest = 0, ch.walks.stages = 1, ch.walks.pilot_work = 30;
+    ch.walks.reused_work = 10;
+    ulam_auto_candidate *c = &ch.walks.cand[0];
+    c->mode = ULAM_ADJOINT, c->estimator = ULAM_EXPECTED, c->kernel_alpha = 1, c->certified = 1;
+    c->state = ULAM_AUTO_CHOSEN, c->pilot_walks = 128, c->predicted_work = 60, c->hat.rho = 0.5, c->hat.upper = 0.6;
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    ulam_choice_fprint(f, &ch, 0, ULAM_REPORT_BRIEF);
+    fclose(f);
+    assert_string_equal(buf, "auto            chose it among 1 candidates by predicted cost (--verbose lists them)\n");
+    free(buf);
+    f = open_memstream(&buf, &len);
+    ulam_choice_fprint(f, &ch, 0, ULAM_REPORT_VERBOSE);
+    fclose(f);
+    assert_non_null(strstr(buf, "the pilots' overhead is 22.2% of the predicted work")); /* (30 - 10) / (20 + 10 + 60) */
+    assert_non_null(strstr(buf, "  * adjoint  expected   analog     alpha 1   rho(M^) 0.5 "));
+    free(buf);
+    f = open_memstream(&buf, &len);
+    ulam_choice_fprint(f, &ch, 0, ULAM_REPORT_JSON);
+    fclose(f);
+    const char *head = "\"auto\": {\"chosen\": 1, \"closest\": 1, \"stages\": 1, "; /* 1-based */
+    assert_int_equal(strncmp(buf, head, strlen(head)), 0);
+    assert_non_null(strstr(buf, "\"pilot_share\": 0.22222222222222221, "));
+    assert_non_null(strstr(buf, "\"state\": \"chosen\", "));
+    assert_string_equal(buf + strlen(buf) - 4, "]}, ");
+    free(buf);
+}
+
 /* The reference solve: dense LU on a small M (auto), GMRES past a tiny memory limit, the limit
  * refused without the fallback. */
 static void test_reference(void **state)
@@ -77,6 +112,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_json),
+        cmocka_unit_test(test_choice),
         cmocka_unit_test(test_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

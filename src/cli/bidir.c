@@ -98,7 +98,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         printf("seconds         %.4f (push and pilot %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
                r->plan.seconds, w->seconds, (unsigned long long)o->walk.exec.seed, rp->transpose_seconds);
         printf("load            %.3f s inputs\n", rp->load_seconds);
-        if (rp->ch) cli_auto_print_text(rp->ch, 1);
+        if (rp->ch) ulam_choice_fprint(stdout, rp->ch, 1, cli_verbosity >= 1);
         if (rp->check)
             printf("direct          %.10g (%s), ", rp->direct, rp->direct_method ? rp->direct_method : "LU"),
                 cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
@@ -129,7 +129,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
            cli_verdict_word(rp->g.verdict_abs), rp->g.hat[ULAM_FORWARD].rho, cli_verdict_word(rp->g.verdict_hat[ULAM_FORWARD]));
     printf("load            %.3f s inputs, %.3f s guards\n", rp->load_seconds, rp->guard_seconds);
-    if (rp->ch) cli_auto_print_text(rp->ch, 1);
+    if (rp->ch) ulam_choice_fprint(stdout, rp->ch, 1, cli_verbosity >= 1);
     if (rp->check)
         printf("direct          %.10g (%s), ", rp->direct, rp->direct_method ? rp->direct_method : "LU"),
             cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
@@ -187,7 +187,7 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         cli_json_number("z", cli_z(r->estimate, rp->direct, r->std_error), 0);
     }
     if (o->walk.stop.rel_err > 0) printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
-    if (rp->ch) cli_auto_print_json(rp->ch, 1);
+    if (rp->ch) ulam_choice_fprint(stdout, rp->ch, 1, ULAM_REPORT_JSON);
     printf("\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
 }
 

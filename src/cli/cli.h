@@ -369,12 +369,9 @@ int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int js
  * stays; ao->exclude: rows the command line rules out, their reason excluded_why) through the
  * library's table (ulam_auto_start; an: ulam_analysis_auto_start, the walks on its bounds), make
  * the run *run and set o to the walks' choice; *status and err get the refusal.  0 or an exit
- * code.  Then print the candidates as text, or as the JSON key "auto" (bidir: with the
- * bidirectional row's line). */
+ * code.  The report prints the candidates (ulam_choice_fprint). */
 int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, const ulam_auto_opts *ao,
                     const char *excluded_why, ulam_choice *ch, ulam_run **run, int *status, ulam_error *err);
-void cli_auto_print_text(const ulam_choice *ch, int bidir);
-void cli_auto_print_json(const ulam_choice *ch, int bidir);
 int cli_study(int argc, char **argv);
 
 int cli_radiosity(int argc, char **argv);

@@ -174,7 +174,7 @@ static void print_brief(const ulam_walk_opts *o, const ulam_walk_result *r, cons
     printf("method          %s random walks, %s estimator%s\n", cli_mode_names[o->mode],
            cli_estimator_names[o->estimator], o->mode == ULAM_ADJOINT ? " (walks start at the unknown)"
                                                                      : " (walks start from b: every unknown at once)");
-    if (ro->ch) cli_auto_print_text(ro->ch, 1);
+    if (ro->ch) ulam_choice_fprint(stdout, ro->ch, 1, cli_verbosity >= 1);
     if (r->cut)
         printf("walks           %lld (%lld cut at %lld steps: the estimate is biased by the cut)\n",
                (long long)r->walks, (long long)r->cut, (long long)o->stop.max_steps);
@@ -232,7 +232,7 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     printf("load            %.3f s inputs, %.3f s guards, %.3f s %s; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds,
            ro->ch ? "choice and solver set-up (auto's guards, pilots, set-up)" : "solver set-up", peak_rss_mib());
-    if (ro->ch) cli_auto_print_text(ro->ch, 1);
+    if (ro->ch) ulam_choice_fprint(stdout, ro->ch, 1, cli_verbosity >= 1);
 }
 
 /* Print the JSON object. */
@@ -253,7 +253,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         cli_json_string("direct_method", ro->direct_method, 0);
         cli_json_number("z", cli_z(r->estimate, ro->direct, r->std_error), 0);
     }
-    if (ro->ch) cli_auto_print_json(ro->ch, 1);
+    if (ro->ch) ulam_choice_fprint(stdout, ro->ch, 1, ULAM_REPORT_JSON);
     printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
 }
 
