@@ -98,7 +98,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         printf("seconds         %.4f (push and pilot %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
                r->plan.seconds, w->seconds, (unsigned long long)o->walk.exec.seed, rp->transpose_seconds);
         printf("load            %.3f s inputs\n", rp->load_seconds);
-        if (rp->ch) cli_auto_print_text(rp->ch, 1);
+        if (rp->ch) ulam_choice_fprint(stdout, rp->ch, 1, cli_verbosity >= 1);
         if (rp->check)
             printf("direct          %.10g (%s), ", rp->direct, rp->direct_method ? rp->direct_method : "LU"),
                 cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
@@ -129,7 +129,7 @@ static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
     printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
            cli_verdict_word(rp->g.verdict_abs), rp->g.hat[ULAM_FORWARD].rho, cli_verdict_word(rp->g.verdict_hat[ULAM_FORWARD]));
     printf("load            %.3f s inputs, %.3f s guards\n", rp->load_seconds, rp->guard_seconds);
-    if (rp->ch) cli_auto_print_text(rp->ch, 1);
+    if (rp->ch) ulam_choice_fprint(stdout, rp->ch, 1, cli_verbosity >= 1);
     if (rp->check)
         printf("direct          %.10g (%s), ", rp->direct, rp->direct_method ? rp->direct_method : "LU"),
             cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
@@ -187,7 +187,7 @@ static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, con
         cli_json_number("z", cli_z(r->estimate, rp->direct, r->std_error), 0);
     }
     if (o->walk.stop.rel_err > 0) printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
-    if (rp->ch) cli_auto_print_json(rp->ch, 1);
+    if (rp->ch) ulam_choice_fprint(stdout, rp->ch, 1, ULAM_REPORT_JSON);
     printf("\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
 }
 
@@ -498,6 +498,7 @@ static void init(void *p)
 static int option(void *p, int c, const char *name, const char *optarg)
 {
     bidir_args *a = p;
+    ulam_error err;
     int rc;
     switch (c) {
     case CLI_WALK: if ((rc = cli_walk_option("solve", name, optarg, &a->o.walk))) return rc; break;
@@ -515,9 +516,9 @@ static int option(void *p, int c, const char *name, const char *optarg)
             return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);
         a->method = 1;
         break;
-    case 'x': if ((rc = cli_parse_real("solve", "--rmax", optarg, 1e-300, 1e300, &a->o.rmax))) return rc; break;
-    case 'v': if ((rc = cli_parse_real("solve", "--min-value", optarg, 1e-300, 1e300, &a->o.min_value))) return rc; break;
-    case 'k': if ((rc = cli_parse_real("solve", "--step-cost", optarg, 1e-3, 1e6, &a->o.step_cost))) return rc; break;
+    case 'x': case 'v': case 'k': /* the library's table (src/options.c) */
+        if (ulam_options_set(ULAM_OPTIONS_BIDIR, &a->o, name, optarg, &err)) return cli_usage_error("solve", "%s", err.msg);
+        break;
     case 'T': if ((rc = cli_parse_int("solve", "--top", optarg, 1, ULAM_MAX_DIM, &a->top))) return rc; break;
     case 'c': a->rp.check = 1; break;
     case 'J': a->rp.json = 1; break;

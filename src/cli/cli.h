@@ -3,6 +3,9 @@
 #define ULAM_CLI_H
 
 #include "ulam.h"
+#include "ulam_options.h"
+#include "ulam_report.h"
+#include "ulam_reference.h"
 
 #include <getopt.h>
 
@@ -38,6 +41,9 @@ int cli_parse_int(const char *command, const char *opt, const char *s, int64_t l
 /* Parse a finite real option value in [lo, hi]. */
 int cli_parse_real(const char *command, const char *opt, const char *s, double lo, double hi,
                    double *out);
+
+/* Parse n comma-separated finite numbers of s (exactly n) into x; 0 or -1 (the caller reports). */
+int cli_parse_numbers(const char *s, int n, double *x);
 
 /* Parse a byte count with an optional K, M, G or T suffix (powers of 1024). */
 int cli_parse_bytes(const char *command, const char *opt, const char *s, size_t *out);
@@ -134,10 +140,9 @@ const char *cli_system_hint(const ulam_csr *M);
 /* Free what cli_load_system loaded. */
 void cli_system_free(cli_system *s);
 
-/* The reference solve (src/cli/direct.c): sparse LU when cli_direct_sparse_wanted(M) (--lu of
- * ulam direct sets cli_direct_force: -1 auto, 0 dense, 1 sparse), else dense. */
+/* The reference solve (src/cli/direct.c; the library's ulam_reference_*): --lu of ulam direct
+ * sets cli_direct_force: -1 auto, 0 dense, 1 sparse. */
 extern int cli_direct_force;
-int cli_direct_sparse_wanted(const ulam_csr *M);
 
 /* x_index of the reference solve for --check, interruptible by Ctrl-C (EXIT_INTERRUPTED: its thread
  * still reads s); *method "sparse LU" or "dense LU"; 0 or an exit code. */
@@ -279,9 +284,6 @@ int cli_output_finish(int rc);
 
 /* Every value of solve --method (src/cli/output.c), and them in words for messages. */
 
-/* The name among names[0..n) closest to word, or NULL. */
-const char *cli_suggest(const char *word, const char *const *names, int n);
-
 /* Refuse an unknown --name in argv (no abbreviations), naming the closest of longopts; 0 or EXIT_USAGE. */
 int cli_check_options(const char *command, int argc, char **argv, const struct option *longopts);
 
@@ -367,12 +369,9 @@ int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int js
  * stays; ao->exclude: rows the command line rules out, their reason excluded_why) through the
  * library's table (ulam_auto_start; an: ulam_analysis_auto_start, the walks on its bounds), make
  * the run *run and set o to the walks' choice; *status and err get the refusal.  0 or an exit
- * code.  Then print the candidates as text, or as the JSON key "auto" (bidir: with the
- * bidirectional row's line). */
+ * code.  The report prints the candidates (ulam_choice_fprint). */
 int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, const ulam_auto_opts *ao,
                     const char *excluded_why, ulam_choice *ch, ulam_run **run, int *status, ulam_error *err);
-void cli_auto_print_text(const ulam_choice *ch, int bidir);
-void cli_auto_print_json(const ulam_choice *ch, int bidir);
 int cli_study(int argc, char **argv);
 
 int cli_radiosity(int argc, char **argv);

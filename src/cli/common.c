@@ -363,36 +363,31 @@ int cli_flush(void)
     return stdout_errno;
 }
 
-/* Parse an integer option value in [lo, hi]. */
+/* Parse an integer option value in [lo, hi] (the library's parser, src/options.c). */
 int cli_parse_int(const char *command, const char *opt, const char *s, int64_t lo, int64_t hi,
                   int64_t *out)
 {
-    char *end;
-    errno = 0;
-    long long v = strtoll(s, &end, 10);
-    if (end != s && (*end == 'e' || *end == 'E' || *end == '.')) { /* 1e12, 2.5e6: whole numbers */
-        double d = strtod(s, &end);
-        int whole = !*end && d == floor(d) && fabs(d) <= 9007199254740992.0; /* 2^53: exact */
-        v = whole ? (long long)d : v, errno = whole ? 0 : ERANGE;
-    }
-    if (end == s || *end || errno == ERANGE || v < lo || v > hi)
-        return cli_usage_error(command, "%s expects an integer from %lld to %lld%s, got '%s'", opt,
-                               (long long)lo, (long long)hi,
-                               lo == 1 && v == 0 && (strstr(opt, "index") || strstr(opt, "source") || strstr(opt, "patch"))
-                                   ? " (1-based, as in Matrix Market files)" : "", s);
-    *out = v;
-    return 0;
+    ulam_error err;
+    return ulam_options_parse_int(opt, s, lo, hi, out, &err) ? cli_usage_error(command, "%s", err.msg) : 0;
 }
 
 /* Parse a finite real option value in [lo, hi]. */
 int cli_parse_real(const char *command, const char *opt, const char *s, double lo, double hi,
                    double *out)
 {
-    char *end;
-    double v = strtod(s, &end);
-    if (end == s || *end || !isfinite(v) || v < lo || v > hi)
-        return cli_usage_error(command, "%s expects a number from %g to %g, got '%s'", opt, lo, hi, s);
-    *out = v;
+    ulam_error err;
+    return ulam_options_parse_real(opt, s, lo, hi, out, &err) ? cli_usage_error(command, "%s", err.msg) : 0;
+}
+
+/* Parse n comma-separated finite numbers of s (n of them exactly); 0 or -1. */
+int cli_parse_numbers(const char *s, int n, double *x)
+{
+    for (int k = 0; k < n; k++) {
+        char *end;
+        x[k] = strtod(s, &end);
+        if (end == s || !isfinite(x[k]) || (k < n - 1 ? *end != ',' : *end != 0)) return -1;
+        s = end + (k < n - 1);
+    }
     return 0;
 }
 
@@ -652,14 +647,13 @@ void cli_system_free(cli_system *s)
     s->M = NULL, s->b = NULL, s->cert = NULL;
 }
 
-/* Solve the loaded system into a new *x (sparse LU or dense, as cli_direct_sparse_wanted says); 0
+/* Solve the loaded system into a new *x (sparse LU or dense, as ulam_reference_sparse says); 0
  * or an exit code. */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info)
 {
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
     *x = malloc((size_t)s->M->nrows * sizeof **x);
-    int status = !*x ? ULAM_ENOMEM : cli_direct_sparse_wanted(s->M) ? ulam_direct_sparse(s->M, s->b, *x, max_mem, info, &err)
-                                                                  : ulam_direct_solve(s->M, s->b, *x, max_mem, info, &err);
+    int status = !*x ? ULAM_ENOMEM : ulam_reference_solve(s->M, s->b, cli_direct_force, max_mem, 0, *x, info, NULL, &err);
     if (!status) return 0;
     free(*x);
     *x = NULL;
@@ -795,16 +789,6 @@ void cli_progress_end(cli_progress *p)
 {
     if (p->on && p->shown) fputc('\n', stderr);
     p->shown = 0;
-}
-
-/* Nonzero when the reference solve of M should be the sparse LU: --lu sparse, or (auto) UMFPACK is
- * there and M is large (n > 1000: dense LU takes over a second from n of a few thousand) and sparse
- * (under 5% nonzeros). */
-int cli_direct_sparse_wanted(const ulam_csr *M)
-{
-    int64_t n = M->nrows;
-    if (cli_direct_force >= 0) return cli_direct_force;
-    return ulam_direct_sparse_available() && n > 1000 && (double)M->rowptr[n] < 0.05 * (double)n * (double)n;
 }
 
 /* Replace the loaded adjacency matrix by alpha P^T (ulam_pagerank_matrix) and, without --rhs, b by

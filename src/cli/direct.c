@@ -8,6 +8,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 /* Before a reference solve that may take long: what it needs, on stderr (nothing when it is quick). */
@@ -45,17 +46,11 @@ static void *check_run(void *p)
     check_job *j = p;
     const ulam_csr *M = j->s->M;
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
-    int status = ULAM_ENOMEM, it;
-    if ((j->x = malloc((size_t)M->nrows * sizeof *j->x)))
-        status = j->sparse ? ulam_direct_sparse(M, j->s->b, j->x, CLI_MAX_MEM, &j->info, &err)
-                           : ulam_direct_solve(M, j->s->b, j->x, CLI_MAX_MEM, &j->info, &err);
-    if (status == ULAM_EMEMLIMIT) {
-        double t0 = ulam_now();
-        j->krylov = 1;
-        status = ulam_gmres(M, j->s->b, 50, 1e-12, 10000000, j->x, &it, &j->info.residual);
-        j->info.seconds = ulam_now() - t0;
-        if (status) err = (ulam_error){.status = status, .msg = "GMRES to converge (the LU would pass the memory limit)"};
-    }
+    int status = ULAM_ENOMEM;
+    const char *how = "";
+    if ((j->x = malloc((size_t)M->nrows * sizeof *j->x))) /* GMRES when the LU would pass the limit */
+        status = ulam_reference_solve(M, j->s->b, cli_direct_force, CLI_MAX_MEM, 1, j->x, &j->info, &how, &err);
+    j->krylov = !strcmp(how, "GMRES");
     j->rc = status ? cli_report(j->s->matrix_path, &err) : 0;
     atomic_store(&j->done, 1);
     return NULL;
@@ -70,7 +65,7 @@ int cli_direct_reference(const cli_system *s, double **x, double *seconds, const
     *x = NULL;
     check_job *j = calloc(1, sizeof *j);
     if (!j) return cli_exit_code(ULAM_ENOMEM);
-    j->s = s, j->sparse = cli_direct_sparse_wanted(s->M);
+    j->s = s, j->sparse = ulam_reference_sparse(s->M, cli_direct_force);
     announce(s, j->sparse);
     pthread_t t;
     if (pthread_create(&t, NULL, check_run, j)) {
@@ -138,7 +133,7 @@ static void print_text(const cli_system *s, const double *x, int64_t index,
                    cli_answer_pad(i + cli_node_base, 11), "", x[i]);
         if (n > 10) printf("...        (%lld more: use --out or --index)\n", (long long)(n - 10));
     }
-    printf("method     %s\n", cli_direct_sparse_wanted(s->M) ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");
+    printf("method     %s\n", ulam_reference_sparse(s->M, cli_direct_force) ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");
     printf("rcond      %.3e\n", info->rcond);
     printf("residual   %.3e\n", info->residual);
     printf("seconds    %.6f\n", info->seconds);
@@ -154,7 +149,7 @@ static void print_json(const cli_system *s, const double *x, int64_t index,
         cli_json_number("estimate", x[index - 1], 0);
         cli_json_number("value", x[index - 1], 0); /* deprecated: "estimate", as in every command */
     }
-    cli_json_string("method", cli_direct_sparse_wanted(s->M) ? "sparse LU" : "dense LU", 0);
+    cli_json_string("method", ulam_reference_sparse(s->M, cli_direct_force) ? "sparse LU" : "dense LU", 0);
     cli_json_number("rcond", info->rcond, 0);
     cli_json_number("residual", info->residual, 0);
     cli_json_number("seconds", info->seconds, 1);

@@ -54,7 +54,7 @@ static int dispatch(int argc, char **argv)
 #endif
     if (!strcmp(argv[1], "prepare")) return cli_prepare(argc - 1, argv + 1);
     static const char *const commands[] = {"info", "solve", "direct", "study", "radiosity", "prepare", "help"};
-    const char *near = cli_suggest(argv[1], commands, (int)(sizeof commands / sizeof commands[0]));
+    const char *near = ulam_options_suggest(argv[1], commands, (int)(sizeof commands / sizeof commands[0]));
     if (near) fprintf(stderr, "ulam: unknown command '%s' (did you mean '%s'?)\n%s", argv[1], near, usage);
     else fprintf(stderr, "ulam: unknown command '%s'\n%s", argv[1], usage);
     return EXIT_USAGE;

@@ -316,6 +316,7 @@ static int option(void *q, int c, const char *name, const char *optarg)
 {
     outer_args *a = q;
     ulam_outer_opts *o = &a->o;
+    ulam_error err;
     int64_t v;
     int rc;
     switch (c) {
@@ -331,28 +332,9 @@ static int option(void *q, int c, const char *name, const char *optarg)
         if ((rc = cli_parse_int("solve", "--restart", optarg, 1, 10000, &v))) return rc;
         a->p.restart = (int)v;
         break;
-    case 'l': {
-        char *end;
-        o->tol = strtod(optarg, &end);
-        if (end == optarg || *end || !(o->tol > 0 && o->tol < 1))
-            return cli_usage_error("solve", "--tol expects a residual reduction strictly between 0 and 1 "
-                                            "(such as 1e-8), got '%s'", optarg);
+    case 'l': case 'k': case 'p': case 'H': case 'a': /* the library's table (src/options.c) */
+        if (ulam_options_set(ULAM_OPTIONS_OUTER, o, c == 'l' ? "tol" : name, optarg, &err)) return cli_usage_error("solve", "%s", err.msg);
         break;
-    }
-    case 'k':
-        if ((rc = cli_parse_int("solve", "--max-iter", optarg, 1, 100000000, &v))) return rc;
-        o->max_iter = (int)v;
-        break;
-    case 'p': {
-        char *end;
-        o->eps1 = strtod(optarg, &end);
-        if (end == optarg || *end || !(o->eps1 > 0 && o->eps1 < 1))
-            return cli_usage_error("solve", "--eps1 expects a relative standard deviation strictly between "
-                                            "0 and 1 (such as 0.1), got '%s'", optarg);
-        break;
-    }
-    case 'H': if ((rc = cli_parse_int("solve", "--max-histories", optarg, 1, INT64_MAX / 2, &o->max_histories))) return rc; break;
-    case 'a': if ((rc = cli_parse_int("solve", "--stall", optarg, 1, 1000000, &v))) return rc; o->stall = (int)v; break;
     case 'j': a->s.jacobi = 1; break;
     case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
     case 'J': a->p.json = 1; break;

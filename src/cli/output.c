@@ -83,35 +83,6 @@ int cli_output_finish(int rc)
     return rc;
 }
 
-/* Levenshtein distance of a and b (both short), capped at 99. */
-static int distance(const char *a, const char *b)
-{
-    size_t la = strlen(a), lb = strlen(b);
-    if (la > 60 || lb > 60) return 99;
-    int d[61][61];
-    for (size_t i = 0; i <= la; i++) d[i][0] = (int)i;
-    for (size_t j = 0; j <= lb; j++) d[0][j] = (int)j;
-    for (size_t i = 1; i <= la; i++)
-        for (size_t j = 1; j <= lb; j++) {
-            int sub = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]), del = d[i - 1][j] + 1, ins = d[i][j - 1] + 1;
-            d[i][j] = sub < del ? (sub < ins ? sub : ins) : (del < ins ? del : ins);
-        }
-    return d[la][lb];
-}
-
-/* The name among names[0..n) closest to word (a prefix of it, or within a third of its length in
- * edits), or NULL. */
-const char *cli_suggest(const char *word, const char *const *names, int n)
-{
-    const char *best = NULL;
-    int bd = 99, len = (int)strlen(word);
-    for (int k = 0; k < n; k++) {
-        int d = len >= 3 && !strncmp(names[k], word, (size_t)len) ? 0 : distance(word, names[k]);
-        if (d < bd) bd = d, best = names[k];
-    }
-    return best && bd <= (len + 2) / 3 ? best : NULL;
-}
-
 /* Check every --name in argv against longopts before getopt_long sees them (it would take an
  * abbreviation silently): an unknown one is a usage error naming the closest option.  0 or
  * EXIT_USAGE. */
@@ -131,7 +102,7 @@ int cli_check_options(const char *command, int argc, char **argv, const struct o
             k += longopts[i].has_arg == required_argument && !eq; /* its value may start with "--" */
             continue;
         }
-        const char *s = cli_suggest(name, names, n);
+        const char *s = ulam_options_suggest(name, names, n);
         return s ? cli_usage_error(command, "unknown option '--%s' (did you mean '--%s'?)", name, s)
                  : cli_usage_error(command, "unknown option '--%s'", name);
     }
@@ -145,7 +116,7 @@ int cli_choose(const char *command, const char *opt, const char *value, const ch
 {
     int k = cli_lookup(value, names, n);
     if (k >= 0) return k;
-    const char *s = cli_suggest(value, names, n);
+    const char *s = ulam_options_suggest(value, names, n);
     if (s) cli_usage_error(command, "%s expects %s, got '%s' (did you mean '%s'?)", opt, what, value, s);
     else cli_usage_error(command, "%s expects %s, got '%s'", opt, what, value);
     return -1;
@@ -174,30 +145,21 @@ int cli_usage_error(const char *command, const char *fmt, ...)
 /* Print a bare JSON number (null when not finite). */
 void cli_json_value(double v)
 {
-    if (isfinite(v)) printf("%.17g", v);
-    else printf("null");
+    ulam_json_number(stdout, NULL, v, 1);
 }
 
-/* Print a JSON number (null when not finite). */
+/* Print a JSON member (ulam_json_number), noting that JSON was printed. */
 void cli_json_number(const char *key, double v, int last)
 {
     cli_json_done = 1;
-    printf("\"%s\": ", key);
-    cli_json_value(v);
-    printf("%s", last ? "" : ", ");
+    ulam_json_number(stdout, key, v, last);
 }
 
-/* Print a JSON string (escaped). */
+/* Print a JSON string member (ulam_json_string), noting that JSON was printed. */
 void cli_json_string(const char *key, const char *v, int last)
 {
     cli_json_done = 1;
-    printf("\"%s\": \"", key);
-    for (const unsigned char *c = (const unsigned char *)v; *c; c++) {
-        if (*c == '"' || *c == '\\') printf("\\%c", *c);
-        else if (*c < 0x20) printf("\\u%04x", *c);
-        else putchar(*c);
-    }
-    printf("\"%s", last ? "" : ", ");
+    ulam_json_string(stdout, key, v, last);
 }
 
 /* Nonzero when the interval was withheld because the scores are too small to square (a b far

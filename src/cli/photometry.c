@@ -29,23 +29,11 @@ const char *const cli_photo_usage =
     "                    5^log10(d) m; prints E mean, E min, E max and U0 = E min / E mean with\n"
     "                    simultaneous 95% intervals (--out and --image as for --grid)\n";
 
-/* n comma-separated finite numbers (exactly n); 0 or -1. */
-static int numbers(const char *s, int n, double *x)
-{
-    for (int k = 0; k < n; k++) {
-        char *end;
-        x[k] = strtod(s, &end);
-        if (end == s || !isfinite(x[k]) || (k < n - 1 ? *end != ',' : *end != 0)) return -1;
-        s = end + 1;
-    }
-    return 0;
-}
-
 /* --luminaire's numbers after the last '@' (3, 6 or 9) into l; 0 or -1. */
 static int placement(const char *s, ulam_luminaire *l)
 {
     double x[9];
-    int n = !numbers(s, 9, x) ? 9 : !numbers(s, 6, x) ? 6 : !numbers(s, 3, x) ? 3 : 0;
+    int n = !cli_parse_numbers(s, 9, x) ? 9 : !cli_parse_numbers(s, 6, x) ? 6 : !cli_parse_numbers(s, 3, x) ? 3 : 0;
     if (!n) return -1;
     *l = ulam_luminaire_defaults();
     for (int k = 0; k < 3; k++) {
@@ -102,7 +90,7 @@ int cli_photo_option(cli_photo *p, const char *cmd, const char *name, const char
         return cli_usage_error(cmd, "--en12464 expects x0,y0,z0:x1,y1,z1 (opposite corners of the room at work-plane "
                                     "height), got '%s'", arg);
     memcpy(buf, arg, (size_t)(colon - arg)), buf[colon - arg] = 0;
-    if (numbers(buf, 3, p->c0) || numbers(colon + 1, 3, p->c1))
+    if (cli_parse_numbers(buf, 3, p->c0) || cli_parse_numbers(colon + 1, 3, p->c1))
         return cli_usage_error(cmd, "--en12464 expects x0,y0,z0:x1,y1,z1 (finite numbers), got '%s'", arg);
     p->en12464 = 1;
     return 0;

@@ -200,23 +200,11 @@ static int parse_camera(const char *cmd, const char *arg, ulam_camera *cam)
                                 "apart from it, an up not along the view, fov in (0, 180) degrees), got '%s'", arg);
 }
 
-/* Parse n comma-separated finite numbers of s (n of them exactly); 0 or -1. */
-static int parse_numbers(const char *s, int n, double *x)
-{
-    for (int k = 0; k < n; k++) {
-        char *end;
-        x[k] = strtod(s, &end);
-        if (end == s || !isfinite(x[k]) || (k < n - 1 ? *end != ',' : *end != 0)) return -1;
-        s = end + (k < n - 1);
-    }
-    return 0;
-}
-
 /* Parse --at x,y,z[,nx,ny,nz] onto a's list. */
 static int parse_at(const char *cmd, const char *arg, args *a)
 {
     double x[6];
-    int n = parse_numbers(arg, 6, x) == 0 ? 6 : parse_numbers(arg, 3, x) == 0 ? 3 : 0;
+    int n = cli_parse_numbers(arg, 6, x) == 0 ? 6 : cli_parse_numbers(arg, 3, x) == 0 ? 3 : 0;
     if (!n || (n == 6 && !(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] > 0)))
         return cli_usage_error(cmd, "--at expects x,y,z or x,y,z,nx,ny,nz (finite, a nonzero normal), got '%s'", arg);
     double *m = realloc(a->at, (size_t)(a->nat + 1) * 6 * sizeof *m);
@@ -240,9 +228,9 @@ static int parse_grid(const char *cmd, const char *arg, ulam_rad_grid *g)
     }
     int cu = 0, cv = 0, used = 0; /* S may be counts NUxNV instead of a spacing */
     int counts = np >= 3 && sscanf(part[2], "%dx%d%n", &cu, &cv, &used) == 2 && !part[2][used];
-    int ok = (np == 3 || np == 4) && !parse_numbers(part[0], 3, c0) && !parse_numbers(part[1], 3, c1) &&
-             (counts ? cu >= 1 && cv >= 1 : !parse_numbers(part[2], 1, &S) && S > 0) &&
-             (np == 3 || !parse_numbers(part[3], 3, n));
+    int ok = (np == 3 || np == 4) && !cli_parse_numbers(part[0], 3, c0) && !cli_parse_numbers(part[1], 3, c1) &&
+             (counts ? cu >= 1 && cv >= 1 : !cli_parse_numbers(part[2], 1, &S) && S > 0) &&
+             (np == 3 || !cli_parse_numbers(part[3], 3, n));
     int flat = -1, eq = 0;
     for (int k = 0; ok && k < 3; k++)
         if (c0[k] == c1[k]) flat = k, eq++;
@@ -1311,22 +1299,16 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
         status = ulam_png_write(a->image, a->width, a->height, rgb);
         cli_hold_signals(0);
     }
-    if (!status) {
+    static const char *const what[] = {"a writable PFM file", "a writable Radiance .hdr file"};
+    for (int k = 0; k < 2 && !status; k++) { /* the PFM and the Radiance .hdr beside the PNG */
         cli_hold_signals(1);
-        status = ulam_pfm_write(a->hdr, a->width, a->height, hdr);
+        status = k ? ulam_hdr_write(a->rgbe, a->width, a->height, hdr) : ulam_pfm_write(a->hdr, a->width, a->height, hdr);
         cli_hold_signals(0);
         if (status) {
             free(rgb), free(hdr);
-            ulam_error err = {.status = status, .msg = "a writable PFM file"};
-            return cli_report(a->hdr, &err);
-        }
-        cli_hold_signals(1);
-        status = ulam_hdr_write(a->rgbe, a->width, a->height, hdr);
-        cli_hold_signals(0);
-        if (status) {
-            free(rgb), free(hdr);
-            ulam_error err = {.status = status, .msg = "a writable Radiance .hdr file"};
-            return cli_report(a->rgbe, &err);
+            ulam_error err = {.status = status};
+            snprintf(err.msg, sizeof err.msg, "%s", what[k]);
+            return cli_report(k ? a->rgbe : a->hdr, &err);
         }
     }
     free(rgb), free(hdr);

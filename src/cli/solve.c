@@ -174,7 +174,7 @@ static void print_brief(const ulam_walk_opts *o, const ulam_walk_result *r, cons
     printf("method          %s random walks, %s estimator%s\n", cli_mode_names[o->mode],
            cli_estimator_names[o->estimator], o->mode == ULAM_ADJOINT ? " (walks start at the unknown)"
                                                                      : " (walks start from b: every unknown at once)");
-    if (ro->ch) cli_auto_print_text(ro->ch, 1);
+    if (ro->ch) ulam_choice_fprint(stdout, ro->ch, 1, cli_verbosity >= 1);
     if (r->cut)
         printf("walks           %lld (%lld cut at %lld steps: the estimate is biased by the cut)\n",
                (long long)r->walks, (long long)r->cut, (long long)o->stop.max_steps);
@@ -232,57 +232,16 @@ static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const
     printf("load            %.3f s inputs, %.3f s guards, %.3f s %s; peak memory %.0f MiB\n",
            ro->load_seconds, ro->guard_seconds, ro->kernel_seconds,
            ro->ch ? "choice and solver set-up (auto's guards, pilots, set-up)" : "solver set-up", peak_rss_mib());
-    if (ro->ch) cli_auto_print_text(ro->ch, 1);
+    if (ro->ch) ulam_choice_fprint(stdout, ro->ch, 1, cli_verbosity >= 1);
 }
 
 /* Print the JSON object. */
 static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
 {
-    double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
     printf("{\"index\": %lld, ", (long long)(o->query.index + cli_node_base));
     if (strcmp(cli_answer_name, "x")) printf("\"quantity\": \"%s\", ", cli_answer_name);
-    cli_json_number("estimate", r->estimate, 0);
-    cli_json_number("stderr", r->std_error, 0);
-    if (r->variance_finite == 1) {
-        printf("\"ci95\": [");
-        cli_json_value(r->ci95[0]);
-        printf(", ");
-        cli_json_value(r->ci95[1]);
-        printf("], ");
-    } else {
-        printf("\"ci95\": null, ");
-    }
-    cli_json_variance("variance_finite", r->variance_finite);
-    cli_json_radius("rho_abs", &ro->g.abs);
-    cli_json_radius("rho_hat", &ro->g.hat[o->mode]);
-    cli_json_number("kernel_alpha", o->kernel.kernel_alpha, 0);
-    cli_json_number("max_share", r->max_share, 0);
-    cli_json_number("score_bound", r->score_bound, 0);
-    cli_json_number("tail_bound", r->tail_bound, 0);
-    cli_json_number("variance_rel_error", r->variance_rel_error, 0);
-    if (o->stop.rel_err > 0) {
-        cli_json_number("min_walks", r->min_walks, 0);
-        printf("\"rel_err_met\": %s, ", r->rel_err_met ? "true" : "false");
-        cli_json_number("cut_bound", r->cut_bound, 0);
-        printf("\"rel_err_stop\": %s, ", r->cut_stop ? "\"cuts\"" : r->out_of_reach ? "\"out_of_reach\""
-                                       : !isfinite(r->tail_bound) && r->estimate != 0 ? "\"no_bound\""
-                                       : !r->rel_err_met && r->fourth_finite != 1 ? "\"fourth_moment\"" : "null");
-        cli_json_variance("fourth_finite", r->fourth_finite);
-        cli_json_radius("rho4", &r->rho4);
-    }
-    if (o->mode == ULAM_FORWARD) printf("\"unreached\": %lld, ", (long long)r->unreached);
-    cli_json_number("variance", r->variance, 0);
-    printf("\"walks\": %lld, \"steps\": %lld, \"cut\": %lld, ", (long long)r->walks, (long long)r->steps,
-           (long long)r->cut);
-    cli_json_number("mean_length", r->walks ? (double)r->steps / (double)r->walks : 0.0, 0);
-    cli_json_number("seconds", r->seconds, 0);
-    cli_json_number("steps_per_second", r->seconds > 0 ? (double)r->steps / r->seconds : 0.0, 0);
-    cli_json_number("figure_of_merit", r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : NAN, 0);
-    cli_json_string("method", "walks", 0);
-    cli_json_string("mode", cli_mode_names[o->mode], 0);
-    cli_json_string("estimator", cli_estimator_names[o->estimator], 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->exec.seed, r->threads,
-           cli_share ? cli_share->nranks : 1);
+    ulam_walk_result_json(stdout, o, r, &ro->g); /* the result's members: the library's schema */
+    printf("\"ranks\": %d, ", cli_share ? cli_share->nranks : 1);
     cli_json_number("load_seconds", ro->load_seconds, 0);
     cli_json_number("guard_seconds", ro->guard_seconds, 0);
     cli_json_number("kernel_seconds", ro->kernel_seconds, 0);
@@ -294,7 +253,7 @@ static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const
         cli_json_string("direct_method", ro->direct_method, 0);
         cli_json_number("z", cli_z(r->estimate, ro->direct, r->std_error), 0);
     }
-    if (ro->ch) cli_auto_print_json(ro->ch, 1);
+    if (ro->ch) ulam_choice_fprint(stdout, ro->ch, 1, ULAM_REPORT_JSON);
     printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
 }
 

@@ -1,0 +1,119 @@
+/* A walk result as JSON (include/ulam_report.h) and the reference solve (include/ulam_reference.h):
+ * the members ulam solve --json prints, written to the caller's stream, null for what is not
+ * finite; the reference LU as chosen, and GMRES when the LU would pass the memory limit. */
+#include "testutil.h"
+#include "ulam_reference.h"
+#include "ulam_report.h"
+
+/* Numbers, strings and the result's members, in order, with null for NaN and infinities. */
+static void test_json(void **state)
+{
+    (void)state;
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    ulam_json_number(f, "a", 0.1, 0);
+    ulam_json_number(f, "b", NAN, 0);
+    ulam_json_string(f, "c", "q\"\\\n", 1);
+    ulam_json_number(f, NULL, INFINITY, 1);
+    fclose(f); /* buf now holds what was written */
+    char *s = buf;
+    assert_string_equal(s, "\"a\": 0.10000000000000001, \"b\": null, \"c\": \"q\\\"\\\\\\u000a\"null");
+    free(s);
+
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.exec.seed = 7;
+    ulam_walk_result r = {.estimate = 1.875, .std_error = 0.01, .ci95 = {1.85, 1.9}, .variance_finite = 1,
+                          .walks = 2000, .steps = 6000, .threads = 1, .seconds = 0.5, .tail_bound = INFINITY};
+    buf = NULL, f = open_memstream(&buf, &len);
+    ulam_walk_result_json(f, &o, &r, NULL);
+    fclose(f);
+    s = buf;
+    const char *keys[] = {"\"estimate\": ", "\"stderr\": ", "\"ci95\": ", "\"variance_finite\": ", "\"kernel_alpha\": ",
+                          "\"walks\": 2000, ", "\"method\": \"walks\", \"mode\": \"adjoint\", \"estimator\": \"collision\", ",
+                          "\"seed\": 7, \"threads\": 1, "};
+    const char *at = s;
+    for (size_t k = 0; k < sizeof keys / sizeof *keys; k++) { /* each present, in this order */
+        const char *p = strstr(at, keys[k]);
+        assert_non_null(p);
+        at = p;
+    }
+    assert_null(strstr(s, "rho_abs")); /* no guard given */
+    assert_null(strstr(s, "rel_err_met")); /* no target */
+    assert_true(strtod(strstr(s, "\"estimate\": ") + 12, NULL) == r.estimate); /* %.17g reads back exactly */
+    assert_int_equal(s[strlen(s) - 2], ','); /* every member followed by ", ": the caller closes */
+    assert_non_null(strstr(s, "\"tail_bound\": null, ")); /* not finite: null */
+    assert_non_null(strstr(s, "\"ci95\": [1.8500000000000001, 1.8999999999999999], "));
+    free(s);
+}
+
+/* What auto chose, by hand: one candidate chosen; brief, verbose and JSON say so. */
+static void test_choice(void **state)
+{
+    (void)state;
+    static ulam_choice ch; /* large: not on the stack */
+    memset(&ch, 0, sizeof ch);
+    ch.walks.ncand = 1, ch.walks.chosen = 0, ch.walks.closest = 0, ch.walks.stages = 1, ch.walks.pilot_work = 30;
+    ch.walks.reused_work = 10;
+    ulam_auto_candidate *c = &ch.walks.cand[0];
+    c->mode = ULAM_ADJOINT, c->estimator = ULAM_EXPECTED, c->kernel_alpha = 1, c->certified = 1;
+    c->state = ULAM_AUTO_CHOSEN, c->pilot_walks = 128, c->predicted_work = 60, c->hat.rho = 0.5, c->hat.upper = 0.6;
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    ulam_choice_fprint(f, &ch, 0, ULAM_REPORT_BRIEF);
+    fclose(f);
+    assert_string_equal(buf, "auto            chose it among 1 candidates by predicted cost (--verbose lists them)\n");
+    free(buf);
+    f = open_memstream(&buf, &len);
+    ulam_choice_fprint(f, &ch, 0, ULAM_REPORT_VERBOSE);
+    fclose(f);
+    assert_non_null(strstr(buf, "the pilots' overhead is 22.2% of the predicted work")); /* (30 - 10) / (20 + 10 + 60) */
+    assert_non_null(strstr(buf, "  * adjoint  expected   analog     alpha 1   rho(M^) 0.5 "));
+    free(buf);
+    f = open_memstream(&buf, &len);
+    ulam_choice_fprint(f, &ch, 0, ULAM_REPORT_JSON);
+    fclose(f);
+    const char *head = "\"auto\": {\"chosen\": 1, \"closest\": 1, \"stages\": 1, "; /* 1-based */
+    assert_int_equal(strncmp(buf, head, strlen(head)), 0);
+    assert_non_null(strstr(buf, "\"pilot_share\": 0.22222222222222221, "));
+    assert_non_null(strstr(buf, "\"state\": \"chosen\", "));
+    assert_string_equal(buf + strlen(buf) - 4, "]}, ");
+    free(buf);
+}
+
+/* The reference solve: dense LU on a small M (auto), GMRES past a tiny memory limit, the limit
+ * refused without the fallback. */
+static void test_reference(void **state)
+{
+    (void)state;
+    int32_t ti[2] = {0, 1}, tj[2] = {1, 0}; /* M = [0 1/2; 1/4 0], b = 1: x = (12/7, 10/7) */
+    double tx[2] = {0.5, 0.25}, b[2] = {1, 1}, x[2], want[2] = {12.0 / 7, 10.0 / 7};
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(2, 2, 2, ti, tj, tx, &M), ULAM_OK);
+    ulam_direct_info info;
+    ulam_error err;
+    const char *how = NULL;
+    assert_int_equal(ulam_reference_sparse(M, -1), 0); /* n = 2: dense */
+    assert_int_equal(ulam_reference_sparse(M, 1), 1);
+    assert_int_equal(ulam_reference_solve(M, b, -1, (size_t)1 << 30, 1, x, &info, &how, &err), ULAM_OK);
+    assert_string_equal(how, "dense LU");
+    for (int i = 0; i < 2; i++) assert_true(fabs(x[i] - want[i]) < 1e-14);
+    assert_int_equal(ulam_reference_solve(M, b, 0, 16, 0, x, &info, &how, &err), ULAM_EMEMLIMIT);
+    assert_int_equal(ulam_reference_solve(M, b, 0, 16, 1, x, &info, &how, &err), ULAM_OK);
+    assert_string_equal(how, "GMRES");
+    for (int i = 0; i < 2; i++) assert_true(fabs(x[i] - want[i]) < 1e-11);
+    assert_true(info.residual <= 1e-12);
+    assert_int_equal(ulam_reference_solve(NULL, b, 0, 16, 1, x, &info, &how, &err), ULAM_EINVAL);
+    ulam_csr_free(M);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_json),
+        cmocka_unit_test(test_choice),
+        cmocka_unit_test(test_reference),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
