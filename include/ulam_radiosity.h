@@ -542,11 +542,12 @@ int ulam_rad_importance(const ulam_tracer *t, const ulam_camera *cam, int width,
 /* What adaptive subdivision did (ulam_rad_adapt). */
 typedef struct ulam_rad_adapt_info {
     int64_t patches_in, patches; /* the tracer's scene's patches, and the mesh made */
-    int64_t splits, rounds;      /* patches split, rounds of splitting */
+    int64_t splits, rounds;      /* patches split, rounds that split any */
     int64_t points, walks, rays; /* point queries made, their walks and rays */
     double error0, error;        /* the mesh error (below) of the tracer's mesh and of the mesh made
-                                    (interrupted: of the last mesh measured whole, before the
-                                    round that was cut) */
+                                    (interrupted: the round that was cut is undone, the mesh made
+                                    is the last one measured whole; NaN both when the first
+                                    round was cut, the tracer's scene then copied) */
     double target, seconds;
     int met;         /* error <= target */
     int capped;      /* stopped by max_patches (or no patch left large enough to split) */

@@ -376,6 +376,9 @@ CASES += [
      0, r"^$", r"mesh +adaptive \(area importance\): 17 -> (2\d|30) patches, .*NOT met \(--max-patches 30\)"),
     (["radiosity", SC + "cornell_box.obj", "--direct", "--mesh-target", "0.01", "--max-mem", "300K", "--ff-rays", "100"],
      0, r"^$", r"mesh +adaptive \(area importance\): 17 -> \d+ patches, .*NOT met \(--max-mem holds \d+ patches\)"),
+    # --time reaches the adaptive mesh (half of it): cut, it says so and keeps what it measured whole
+    (["radiosity", SC + "cornell_box.obj", "--direct", "--mesh-target", "0.01", "--time", "0.05", "--ff-rays", "100"],
+     0, r"^$", r"mesh +adaptive \(area importance\): .*(NOT measured \(cut in the first round by --time|NOT met \(cut by --time)"),
     (["radiosity", SC + "cube.obj", "--view-gather", "--rel-err", "0.1"], 2, r"--view-gather needs --image and --rel-err", ""),
     (["radiosity", SC + "cube.obj", "--view-gather", "--image", "x.png"], 2, r"--view-gather needs --image and --rel-err", ""),
     (["radiosity", SC + "cube.obj", "--view-gather", "--rel-err", "0.1", "--image", "x.png", "--coverage", "2"], 2,

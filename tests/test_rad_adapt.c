@@ -64,15 +64,23 @@ static double true_error(int q)
     return num / den;
 }
 
+/* The scene at rel (from the source tree) into *s, and a tracer over it. */
+static ulam_tracer *open_tracer(const char *rel, ulam_scene **s)
+{
+    ulam_error err;
+    ulam_tracer *t = NULL;
+    assert_int_equal(ulam_scene_read_obj(src_path(rel), s, &err), ULAM_OK);
+    assert_int_equal(ulam_tracer_alloc(*s, &t, NULL), ULAM_OK);
+    return t;
+}
+
 /* The measured mesh error of the unsplit mesh is within 10% of the true one. */
 static void test_mesh_error_true(void **state)
 {
     (void)state;
     ulam_scene *s = NULL, *out = NULL;
     ulam_error err;
-    assert_int_equal(ulam_scene_read_obj(src_path("tests/data/rad/mesh_linear.obj"), &s, &err), ULAM_OK);
-    ulam_tracer *t = NULL;
-    assert_int_equal(ulam_tracer_alloc(s, &t, NULL), ULAM_OK);
+    ulam_tracer *t = open_tracer("tests/data/rad/mesh_linear.obj", &s);
     ulam_rad_opts o = ulam_rad_defaults();
     o.stop.rel_err = 0.005, o.stop.max_walks = 1000000, o.exec.seed = 3, o.exec.threads = 2;
     ulam_rad_adapt_info in;
@@ -96,9 +104,10 @@ static void test_mesh_error_true(void **state)
  * grids need 631 .. 690 (ratio 0.117 .. 0.129), the printed error 1.20 .. 1.25 of the true one.
  * With the interior points alone (no boundary nodes) one seed stopped at 16 floor patches printing
  * 0.0080 for a true 0.0440 (ratio 0.716): a 3 x 3 patch the shadow reached into between its
- * points read flat.  With a small lamp (0.5 x 0.5, occluder 0.5 up) the smooth fall-off, not
- * the shadow, carries the error and adaptive is no better than uniform (286 patches at 0.0803
- * against 295): not asserted. */
+ * points read flat.  With a small lamp (SH_L 0.25, SH_H 0.5) the smooth fall-off, not the
+ * shadow, carries the error: seeds 1 .. 3 make 388 floor patches at true error 0.0656 (printed
+ * 0.0667) where uniform needs 475 (ratio 0.82; 286 against 295 before the boundary nodes): not
+ * asserted (13.5 million walks a seed). */
 #define SH_L 15.0 /* the lamp's half side */
 #define SH_H 0.1  /* the occluder's height */
 static const double sh_lamp[4][3] = {{-SH_L, 3, -SH_L}, {SH_L, 3, -SH_L}, {SH_L, 3, SH_L}, {-SH_L, 3, SH_L}};
@@ -259,8 +268,61 @@ static void test_adapt_shadow(void **state)
     ulam_tracer_free(t), ulam_scene_free(s);
 }
 
+/* A time budget cuts the refinement, and the mesh returned is the one whose error is printed
+ * (issue 40: the CLI passed no --time to the adaptive mesh; before, a cut round's children were
+ * kept while the error printed was the coarser mesh's).  Wherever the cut falls: the first round
+ * cut leaves the scene as read and no error (NaN); a later one returns the last mesh measured
+ * whole, which an uncut run capped at its patch count makes again, to the bit of its error. */
+static void test_adapt_time(void **state)
+{
+    (void)state;
+    ulam_scene *s = NULL, *out = NULL, *again = NULL;
+    ulam_error err;
+    ulam_tracer *t = open_tracer("examples/scenes/cornell_box.obj", &s);
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.rel_err = 0.05, o.stop.max_walks = 256, o.exec.seed = 7, o.exec.threads = 2;
+    ulam_rad_adapt_info full, cut, re;
+    volatile int stop = 1; /* an interrupt before the first query */
+    o.stop.interrupt = &stop;
+    assert_int_equal(ulam_rad_adapt(t, &o, NULL, 0.15, 100000, &out, &cut, &err), ULAM_OK);
+    print_message("interrupt set: %lld points, error %g, interrupted %d\n", (long long)cut.points, cut.error, cut.interrupted);
+    assert_true(cut.interrupted && isnan(cut.error) && !cut.met && cut.splits == 0);
+    assert_int_equal(out->npatches, s->npatches);
+    ulam_scene_free(out), out = NULL;
+    o.stop.interrupt = NULL;
+    assert_int_equal(ulam_rad_adapt(t, &o, NULL, 0.15, 100000, &out, &full, &err), ULAM_OK);
+    ulam_scene_free(out), out = NULL;
+    print_message("uncut: %lld -> %lld patches in %lld rounds, error %.4f, %.3f s\n", (long long)full.patches_in,
+                  (long long)full.patches, (long long)full.rounds, full.error, full.seconds);
+    for (int k = 1; k <= 2; k++) {
+        o.stop.max_seconds = full.seconds * k / 3.0; /* where it falls varies; the assertions hold anywhere */
+        assert_int_equal(ulam_rad_adapt(t, &o, NULL, 0.15, 100000, &out, &cut, &err), ULAM_OK);
+        print_message("cut at %.3f s: %lld patches, %lld rounds, %lld splits, error %.4f, interrupted %d\n",
+                      o.stop.max_seconds, (long long)cut.patches, (long long)cut.rounds, (long long)cut.splits, cut.error,
+                      cut.interrupted);
+        assert_int_equal(out->npatches, cut.patches);
+        if (!cut.interrupted) {
+            assert_true(cut.met && cut.patches == full.patches);
+        } else if (isnan(cut.error)) {
+            assert_true(cut.patches == s->npatches && cut.splits == 0);
+        } else { /* the same mesh from an uncut run capped there (each round's splits are as before it) */
+            ulam_rad_opts u = o;
+            u.stop.max_seconds = 0;
+            assert_int_equal(ulam_rad_adapt(t, &u, NULL, 0.15, cut.patches, &again, &re, &err), ULAM_OK);
+            assert_true(re.capped && !re.interrupted);
+            assert_int_equal(re.patches, cut.patches);
+            assert_int_equal(re.rounds, cut.rounds);
+            assert_true(re.error == cut.error);
+            ulam_scene_free(again), again = NULL;
+        }
+        ulam_scene_free(out), out = NULL;
+    }
+    ulam_tracer_free(t), ulam_scene_free(s);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_mesh_error_true), cmocka_unit_test(test_adapt_shadow)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_mesh_error_true), cmocka_unit_test(test_adapt_shadow),
+                                       cmocka_unit_test(test_adapt_time)};
     return test_run(tests);
 }

@@ -87,7 +87,8 @@ static const char *const usage_mesh =
     "  --mesh-target E   adaptive subdivision instead of --subdivide (--mode shoot, --direct or\n"
     "                    --view-gather): split the patches where point queries show the surface's\n"
     "                    radiosity varies and (with --image) the camera's importance is high, until\n"
-    "                    the importance-weighted mesh error is at most E (relative, e.g. 0.05)\n"
+    "                    the importance-weighted mesh error is at most E (relative, e.g. 0.05);\n"
+    "                    with --time S it takes at most half of S (what it measured whole is kept)\n"
     "  --max-patches N   stop splitting before the mesh passes N patches (default 100000, and what\n"
     "                    --max-mem allows)\n"
     "  --share X         --mode shoot --rel-err E without --patch runs until every lit patch meets E\n"
@@ -736,11 +737,17 @@ static void print_adapt(const args *a, const report *r)
     int64_t asked = a->max_patches ? a->max_patches : 100000;
     if (asked > r->adapt_cap) snprintf(why, sizeof why, "NOT met (--max-mem holds %lld patches)", (long long)r->adapt_cap);
     else snprintf(why, sizeof why, "NOT met (--max-patches %lld)", (long long)r->adapt_cap);
+    if (d->interrupted) snprintf(why, sizeof why, "NOT met (cut by --time, half of it, or Ctrl-C; the last mesh measured whole kept)");
+    if (isnan(d->error)) { /* cut inside the first round: the scene as read */
+        printf("mesh         adaptive (%s importance): NOT measured (cut in the first round by --time or Ctrl-C); the scene's "
+               "%lld patches kept, target %g; %lld point queries, %.3f s\n", r->view_importance ? "the view's" : "area",
+               (long long)d->patches, a->mesh_target, (long long)d->points, d->seconds);
+        return;
+    }
     printf("mesh         adaptive (%s importance): %lld -> %lld patches, %lld split in %lld rounds; mesh error "
            "%.3g -> %.3g, target %g %s; %lld point queries, %lld rays, %.3f s\n", r->view_importance ? "the view's" : "area",
            (long long)d->patches_in, (long long)d->patches, (long long)d->splits, (long long)d->rounds, d->error0,
-           d->error, a->mesh_target, d->met ? "met" : d->interrupted ? "NOT met (interrupted)" : why,
-           (long long)d->points, (long long)d->rays, d->seconds);
+           d->error, a->mesh_target, d->met ? "met" : why, (long long)d->points, (long long)d->rays, d->seconds);
 }
 
 /* Rays cast by scene_diagnosis from the fronts (and as many from the backs). */
@@ -896,13 +903,18 @@ static void print_json(const args *a, const report *r)
     printf("{");
     cli_json_string("scene", a->scene, 0); /* a path may hold quotes and backslashes */
     printf("\"npatches\": %lld, ", (long long)r->s->npatches);
-    if (r->adapted)
+    if (r->adapted) {
+        char e[2][32]; /* null: --time ran out before the first mesh was measured whole */
+        for (int k = 0; k < 2; k++)
+            if (isnan(k ? r->adapt.error : r->adapt.error0)) snprintf(e[k], sizeof e[k], "null");
+            else snprintf(e[k], sizeof e[k], "%.6g", k ? r->adapt.error : r->adapt.error0);
         printf("\"adaptive\": {\"importance\": \"%s\", \"patches_in\": %lld, \"patches\": %lld, \"splits\": %lld, "
-               "\"rounds\": %lld, \"mesh_error_initial\": %.6g, \"mesh_error\": %.6g, \"target\": %g, \"met\": %s, "
-               "\"points\": %lld, \"rays\": %lld, \"seconds\": %.6g}, ", r->view_importance ? "view" : "area",
+               "\"rounds\": %lld, \"mesh_error_initial\": %s, \"mesh_error\": %s, \"target\": %g, \"met\": %s, "
+               "\"interrupted\": %s, \"points\": %lld, \"rays\": %lld, \"seconds\": %.6g}, ", r->view_importance ? "view" : "area",
                (long long)r->adapt.patches_in, (long long)r->adapt.patches, (long long)r->adapt.splits,
-               (long long)r->adapt.rounds, r->adapt.error0, r->adapt.error, a->mesh_target,
-               r->adapt.met ? "true" : "false", (long long)r->adapt.points, (long long)r->adapt.rays, r->adapt.seconds);
+               (long long)r->adapt.rounds, e[0], e[1], a->mesh_target, r->adapt.met ? "true" : "false",
+               r->adapt.interrupted ? "true" : "false", (long long)r->adapt.points, (long long)r->adapt.rays, r->adapt.seconds);
+    }
     if (r->patch >= 0) {
         int32_t g = r->s->group[r->patch];
         double c[3];
@@ -1526,7 +1538,8 @@ static int adapt_scene(const args *a, ulam_scene **s, ulam_rad_adapt_info *info,
     }
     ulam_rad_opts o = rad_opts(&a->o); /* the points: next-event, to half the target or 1024 walks each */
     o.mode = ULAM_ADJOINT, o.estimator = ULAM_RAD_NEXT_EVENT + (a->mis > 0 ? a->mis : 0);
-    o.stop.rel_err = a->mesh_target / 2, o.stop.max_walks = 1024, o.stop.max_seconds = 0;
+    o.stop.rel_err = a->mesh_target / 2, o.stop.max_walks = 1024; /* --time: the mesh half of what is left, the solve the rest */
+    o.stop.max_seconds = a->o.stop.max_seconds > 0 ? cli_time_left(a->o.stop.max_seconds) / 2 : 0;
     if (!rc) {
         cli_catch_sigint();
         if (ulam_rad_adapt(t, &o, Y, a->mesh_target, cap, &d, info, &err)) rc = cli_report(a->scene, &err);

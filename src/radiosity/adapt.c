@@ -514,6 +514,14 @@ static int mesh_init(mesh *m, const ulam_scene *s, const double *Y)
     return ULAM_OK;
 }
 
+/* Undo the last round's splits: polygons np0 and after dropped, the nundo split ones live again. */
+static void undo_splits(mesh *m, const int64_t *undo, int64_t nundo, int64_t np0)
+{
+    for (int64_t i = np0; i < m->np; i++) m->nlive -= m->live[i];
+    m->np = np0;
+    for (int64_t k = 0; k < nundo; k++) m->live[undo[k]] = 1, m->nlive++;
+}
+
 /* Refine the tracer's scene until its importance-weighted mesh error is at most target. */
 int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double *importance, double target,
                    int64_t max_patches, ulam_scene **out, ulam_rad_adapt_info *info, ulam_error *err)
@@ -533,13 +541,19 @@ int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double
     for (int64_t p = 0; p < s->npatches; p++) total_area += s->area[p];
     mesh m = {0};
     share *sh = NULL;
+    int64_t *undo = NULL, nundo = 0, np0 = 0; /* the round's split polygons, and the count before them */
     int status = mesh_init(&m, s, importance);
+    in.error0 = in.error = NAN; /* until a mesh is measured whole */
     for (int round = 0; !status; round++) {
         for (int64_t i = 0; i < m.np && !status && !in.interrupted; i++)
             if (m.live[i] && !m.known[i]) status = measure(&m, i, t, opts, t0, &in, err);
         for (int64_t i = 0; i < m.np && !status && !in.interrupted; i++) /* their neighbours' nodes may be new */
             if (m.live[i]) status = estimate(&m, i, t, opts, t0, &in, err);
-        if (status || in.interrupted) break;
+        if (!status && in.interrupted) { /* undo the round cut short: the mesh made is the one measured */
+            undo_splits(&m, undo, nundo, round ? np0 : m.np);
+            break;
+        }
+        if (status) break;
         in.error = mesh_error(&m, NULL);
         if (round == 0) in.error0 = in.error;
         if ((in.met = in.error <= target)) break;
@@ -549,7 +563,10 @@ int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double
             break;
         }
         double *r = ulam__malloc((size_t)m.np, sizeof *r), rest = 0.0;
-        if (!r) {
+        int64_t *u = realloc(undo, (size_t)m.np * sizeof *undo);
+        if (u) undo = u;
+        if (!r || !u) {
+            free(r);
             status = ULAM_ENOMEM;
             break;
         }
@@ -559,6 +576,7 @@ int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double
             if (m.live[i]) sh[ns++] = (share){r[i], i}, rest += r[i];
         free(r);
         qsort(sh, (size_t)ns, sizeof *sh, cmp_share);
+        np0 = m.np, nundo = 0;
         for (int64_t k = 0; k < ns && rest > target && !status && sh[k].r > 0; k++) {
             int64_t i = sh[k].i;
             if (nlive - 1 + children(&m, i) > max_patches) {
@@ -567,18 +585,20 @@ int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double
             }
             if (area2(&m, m.idx + m.first[i], m.len[i]) < 1e-12 * total_area) continue; /* as fine as floats allow */
             status = split(&m, i);
+            if (!status) undo[nundo++] = i;
             nlive = m.nlive, rest -= sh[k].r, made++;
         }
         free(sh), sh = NULL;
-        in.splits += made, in.rounds++;
+        in.splits += made, in.rounds += made > 0;
         if (!made) {
             in.capped = 1;
             break;
         }
     }
+    if (in.interrupted) in.splits -= nundo, in.rounds -= nundo > 0;
     if (!status) status = to_scene(&m, s, out);
     mesh_free(&m);
-    free(sh);
+    free(sh), free(undo);
     in.patches = *out ? (*out)->npatches : 0;
     in.seconds = ulam_now() - t0;
     if (info) *info = in;
