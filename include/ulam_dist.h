@@ -11,8 +11,10 @@
  * 1, 2, 3 or 64 ranks give the same answer bit for bit: walks' scores and tallies are combined
  * in walk-id order, never in arrival order.
  *
- * API, in order of use: primary ulam_part_open, ulam_dist_radius (the variance guard),
- * ulam_dist_adjoint (ulam_dist_adjoint_ci with its interval), ulam_dist_forward, ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
+ * API, in order of use: primary ulam_part_open (ulam_part_open_mtx from Matrix Market by byte
+ * ranges), ulam_dist_radius (the variance guard), ulam_dist_adjoint (ulam_dist_adjoint_ci with its
+ * interval), ulam_dist_forward, ulam_dist_bound (a certified range from the residual),
+ * ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
 #ifndef ULAM_DIST_H
 #define ULAM_DIST_H
 
