@@ -11,8 +11,10 @@
  * 1, 2, 3 or 64 ranks give the same answer bit for bit: walks' scores and tallies are combined
  * in walk-id order, never in arrival order.
  *
- * API, in order of use: primary ulam_part_open, ulam_dist_radius (the variance guard),
- * ulam_dist_adjoint (ulam_dist_adjoint_ci with its interval), ulam_dist_forward, ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
+ * API, in order of use: primary ulam_part_open (ulam_part_open_mtx from Matrix Market by byte
+ * ranges), ulam_dist_radius (the variance guard), ulam_dist_adjoint (ulam_dist_adjoint_ci with its
+ * interval), ulam_dist_forward, ulam_dist_bound (a certified range from the residual),
+ * ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
 #ifndef ULAM_DIST_H
 #define ULAM_DIST_H
 
@@ -50,6 +52,17 @@ enum { ULAM_PART_M = 0, ULAM_PART_MT = 1, ULAM_PART_BOTH = 2 };
  * entries there, every block read verified against its checksum.  The split is the same on every
  * rank (computed from the file alone).  Needs b in the file. */
 int ulam_part_open(const char *path, const ulam_comm *comm, int what, ulam_part **out, ulam_error *err);
+
+/* As ulam_part_open from a coordinate Matrix Market file of M (square; general, symmetric or
+ * skew-symmetric; real, integer or pattern) and a vector file of b, read by byte ranges: each rank
+ * of a set parses the entry lines in its share of the file's bytes, a failure located at its line
+ * of the file (the same error, from the first failing rank, on every rank), and the entries travel
+ * to their rows' owners, where duplicates are summed in file order and zeros dropped.  The part
+ * is the one ulam_part_open gives on the file `ulam prepare path --rhs rhs --transpose` writes,
+ * bit for bit (the same split, blocks and rows); no rank holds more than its rows' entries (each
+ * reads b whole, once, and keeps its rows). */
+int ulam_part_open_mtx(const char *path, const char *rhs, const ulam_comm *comm, int what, ulam_part **out,
+                       ulam_error *err);
 
 /* Free a part (NULL is fine); returns NULL. */
 ulam_part *ulam_part_free(ulam_part *p);
@@ -158,6 +171,18 @@ typedef struct ulam_dist_source_info {
  * any rank count and any number of sets. */
 int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
                      int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_error *err);
+
+/* A certified range [lo[i], hi[i]] of the exact x*_i of (I - M) x* = b around any x (this rank's
+ * rows; b NULL: the system's, else this rank's rows of another), from x's residual: r = b - (I - M) x
+ * computed with each row's rounding bounded (rho = its largest |entry| over the ranks), and a
+ * Collatz-Wielandt vector v > 0 with |M| v <= u v, u < 1, by at most iters products of power
+ * iteration over the ranks' rows, give |x*_i - x_i| <= rho v_i / (min v (1 - u)); with M >= 0 the
+ * range takes r's signs (above by its positive part, below by its negative part).  No sampling:
+ * the range is certain, for MCSA's x, single source's or forward walks' alike.  NaN ends (and
+ * *worst INFINITY) when no u < 1 is certified; else *worst is the largest half-width over the
+ * ranks.  Needs the part's rows of M.  The same bits at any rank count. */
+int ulam_dist_bound(const ulam_part *p, const ulam_comm *comm, const double *b, const double *x, int iters, double *lo,
+                    double *hi, double *worst, ulam_error *err);
 
 /* A certified upper bound *upper on rho(M^), M^_ij = M_ij^2 / p_ij of the walks above on the part's
  * rows of M (forward 0: adjoint walks) or M' (forward 1) (M^_ij = |M_ij| S_i / min(1, S_i)): below 1, the walks' scores have finite variance.  Power

@@ -216,7 +216,7 @@ static int put_part(FILE *f, const void *p, size_t n, uint64_t *at)
 
 /* log2 of the rows of a block: at most about BLOCK_ENTRIES entries of the matrix (b alone: 1024 rows),
  * from 16 to 65536 rows. */
-static int block_shift(int64_t n, int64_t nnz)
+int ulam__system_block_shift(int64_t n, int64_t nnz)
 {
     double want = nnz > 0 ? (double)BLOCK_ENTRIES * (double)n / (double)nnz : 1024.0;
     int s = 4;
@@ -300,7 +300,7 @@ int ulam__system_write_checked(FILE *f, const ulam_system_desc *d, const ulam__r
     int64_t n = M ? M->nrows : d->n, nnz = M ? M->rowptr[M->nrows] : 0;
     ulam_csr *T = NULL;
     if (d->transpose && ulam_csr_transpose(M, &T)) return ULAM_ENOMEM;
-    int shift = block_shift(n, nnz);
+    int shift = ulam__system_block_shift(n, nnz);
     int64_t nb[3] = {M ? block_count(n, shift) : 0, d->b ? block_count(n, shift) : 0, T ? block_count(T->nrows, shift) : 0};
     size_t nsums = (size_t)(nb[0] + nb[1] + nb[2]);
     uint64_t *sums = malloc((nsums ? nsums : 1) * sizeof *sums);

@@ -99,4 +99,7 @@ int ulam__system_block_ok(const int64_t *rp, int64_t rows, const int32_t *col, c
 /* XXH3-64 of n bytes (the prepared format's checksum of a b block and of the checksum table). */
 uint64_t ulam__system_hash(const void *p, size_t n);
 
+/* log2 of a prepared file's block of rows for an n-row M with nnz entries (src/cache.c). */
+int ulam__system_block_shift(int64_t n, int64_t nnz);
+
 #endif

@@ -462,7 +462,7 @@ static int block_prefix(run *R, double **P, int64_t *nb, ulam_error *err)
         free(bits);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld block sums", (long long)*nb);
     }
-    for (int64_t k = p->first >> p->shift; p->set == 0 && (k << p->shift) < p->last; k++) { /* one set's */
+    for (int64_t k = p->first >> p->shift; p->set == 0 && p->first < p->last && (k << p->shift) < p->last; k++) { /* one set's; none on a rank without rows */
         double s = 0.0;
         int64_t r1 = (k + 1) << p->shift < p->last ? (k + 1) << p->shift : p->last;
         for (int64_t i = k << p->shift; i < r1; i++) s += fabs(R->b[i - p->first]);

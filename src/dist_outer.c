@@ -4,27 +4,42 @@
  * decides a stop is a largest |entry|, the same bits whatever the split. */
 #include "part.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* y = M v on this rank's rows, v whole (gathered first into all). */
-static void matvec(const ulam_part *p, const double *all, double *y)
+/* The halo of this rank's rows of M and room gv for a vector there, made on every rank together;
+ * nonzero (on every rank) on failure. */
+static int halo_open(const ulam_part *p, const ulam_comm *c, ulam__halo *h, double **gv)
 {
+    int64_t bad = ulam__halo_make(p, c, &p->m, h);
+    *gv = malloc(((size_t)h->nghost + 1) * sizeof **gv);
+    bad |= !*gv;
+    if (c->nranks > 1 && c->sum(c->ctx, &bad, 1)) bad = 1; /* all stop together */
+    return bad != 0;
+}
+
+/* y = M v on this rank's rows, v at its rows (own) and at their halo (gv, swapped first): the
+ * same doubles, in the same order, as a product with the whole v; nonzero on a failed exchange. */
+static int matvec(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, const double *own, double *gv, double *y)
+{
+    if (ulam__halo_swap(p, c, h, own, gv)) return 1;
     const ulam__rows *A = &p->m;
     for (int64_t i = 0; i < p->last - p->first; i++) {
         double s = 0.0;
-        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += A->val[q] * all[A->col[q]];
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += A->val[q] * ulam__halo_at(p, h, own, gv, A->col[q]);
         y[i] = s;
     }
+    return 0;
 }
 
-/* r = b - (I - M) x on this rank's rows (all: room for the whole x); the largest |r_i| over the
+/* r = b - (I - M) x on this rank's rows (gv: room for x's halo); the largest |r_i| over the
  * ranks into *rmax; nonzero on a failed exchange. */
-static int residual(const ulam_part *p, const ulam_comm *c, const double *x, double *all, double *r, double *rmax)
+static int residual(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, const double *x, double *gv, double *r,
+                    double *rmax)
 {
-    if (ulam__dist_gather(p, c, x, all)) return 1;
-    matvec(p, all, r);
+    if (matvec(p, c, h, x, gv, r)) return 1;
     *rmax = 0.0;
     for (int64_t i = 0; i < p->last - p->first; i++) {
         r[i] = p->b[i] - x[i] + r[i];
@@ -75,22 +90,23 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
     if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
     *info = (ulam_dist_mcsa_info){0};
     int64_t rows = p->last - p->first;
-    double *all = malloc(((size_t)p->n + 1) * sizeof *all), *r = malloc(((size_t)rows + 1) * sizeof *r);
-    double *d = malloc(((size_t)rows + 1) * sizeof *d);
-    int status = all && r && d ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for MCSA's vectors");
+    double *gv = NULL, *r = malloc(((size_t)rows + 1) * sizeof *r), *d = malloc(((size_t)rows + 1) * sizeof *d);
+    ulam__halo h = {0};
+    int status = halo_open(p, comm, &h, &gv) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the halo and an exchange that succeeds")
+                 : r && d ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for MCSA's vectors");
     double bmax = 0.0, rmax = 0.0;
     if (!status && largest_abs(p, comm, p->b, &bmax)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
     memset(x, 0, (size_t)rows * sizeof *x);
     ulam_dist_opts w = o ? *o : ulam_dist_defaults();
     for (int it = 0; !status; it++) {
-        if (residual(p, comm, x, all, r, &rmax)) {
+        if (residual(p, comm, &h, x, gv, r, &rmax)) {
             status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
             break;
         }
         info->residual = bmax > 0 ? rmax / bmax : rmax;
         if (!(info->residual > tol) || it == max_iter) break;
         for (int64_t i = 0; i < rows; i++) x[i] += r[i]; /* the Richardson step */
-        if (residual(p, comm, x, all, r, &rmax)) {
+        if (residual(p, comm, &h, x, gv, r, &rmax)) {
             status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
             break;
         }
@@ -102,7 +118,8 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
         info->iterations = it + 1, info->walks += res.walks, info->steps += res.steps, info->crossings += res.crossings;
         info->cut += res.cut;
     }
-    free(all), free(r), free(d);
+    ulam__halo_free(&h);
+    free(gv), free(r), free(d);
     return status;
 }
 
@@ -117,16 +134,17 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
     if (source < 0 || source >= p->n) return ulam__fail(err, ULAM_EINVAL, 0, source, "a source in 1 .. %lld", (long long)p->n);
     *info = (ulam_dist_source_info){0};
     int64_t rows = p->last - p->first;
-    double *all = malloc(((size_t)p->n + 1) * sizeof *all), *r = calloc((size_t)rows + 1, sizeof *r);
-    double *y = malloc(((size_t)rows + 1) * sizeof *y);
-    int status = all && r && y ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push's vectors");
+    double *gv = NULL, *r = calloc((size_t)rows + 1, sizeof *r), *y = malloc(((size_t)rows + 1) * sizeof *y);
+    ulam__halo h = {0};
+    int status = halo_open(p, comm, &h, &gv) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the halo and an exchange that succeeds")
+                 : r && y ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push's vectors");
     memset(x, 0, (size_t)rows * sizeof *x);
     if (!status && source >= p->first && source < p->last) r[source - p->first] = 1.0;
     double rmax = 1.0;
     for (int k = 0; !status && k < max_rounds && rmax > tol; k++) { /* x += r, r <- M r */
         for (int64_t i = 0; i < rows; i++) x[i] += r[i];
-        if (ulam__dist_gather(p, comm, r, all)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
-        if (!status) matvec(p, all, r);
+        memcpy(y, r, (size_t)rows * sizeof *y);
+        if (matvec(p, comm, &h, y, gv, r)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
         if (!status && largest_abs(p, comm, r, &rmax)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
         info->rounds = k + 1;
     }
@@ -140,6 +158,67 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
         if (rmax == 0.0) se[i] = 0.0; /* nothing left to walk: the push is the answer */
     }
     info->walks = res.walks, info->steps = res.steps, info->crossings = res.crossings, info->cut = res.cut;
-    free(all), free(r), free(y);
+    ulam__halo_free(&h);
+    free(gv), free(r), free(y);
+    return status;
+}
+
+/* The residual r = b - (I - M) x at this rank's rows with each entry's rounding bound e (x's halo
+ * in gv): the largest r + e and e - r over the ranks into up[0], up[1] (both >= 0), and up[2] 1
+ * when every entry of M is nonnegative, else 0; nonzero on a failed exchange. */
+static int residual_bounds(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, const double *b, const double *x,
+                           double *gv, double up[3])
+{
+    if (ulam__halo_swap(p, c, h, x, gv)) return 1;
+    const ulam__rows *A = &p->m;
+    double neg = 0.0;
+    up[0] = up[1] = 0.0;
+    for (int64_t i = 0; i < p->last - p->first; i++) {
+        double s = 0.0, a = 0.0;
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) {
+            double xj = ulam__halo_at(p, h, x, gv, A->col[q]);
+            s += A->val[q] * xj, a += fabs(A->val[q] * xj);
+            if (A->val[q] < 0) neg = 1.0;
+        }
+        double r = b[i] - x[i] + s; /* (len + 3) roundings, each at most DBL_EPSILON / 2 of the sizes summed */
+        double e = (double)(A->rowptr[i + 1] - A->rowptr[i] + 4) * DBL_EPSILON * (fabs(b[i]) + fabs(x[i]) + a);
+        up[0] = fmax(up[0], (r + e) * (1.0 + DBL_EPSILON)), up[1] = fmax(up[1], (e - r) * (1.0 + DBL_EPSILON));
+    }
+    int bad = ulam__dist_largest(c, &up[0]) || ulam__dist_largest(c, &up[1]) || ulam__dist_largest(c, &neg);
+    up[2] = neg == 0.0;
+    return bad;
+}
+
+/* A certified range of the exact solution around x (see ulam_dist.h). */
+int ulam_dist_bound(const ulam_part *p, const ulam_comm *comm, const double *b, const double *x, int iters, double *lo,
+                    double *hi, double *worst, ulam_error *err)
+{
+    ulam__clear(err);
+    if (!p || !comm || !x || !lo || !hi || !worst || iters < 1)
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, lo, hi, worst and iters >= 1");
+    if (!p->m.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding the rows of M");
+    int64_t rows = p->last - p->first;
+    for (int64_t i = 0; i < rows; i++)
+        if (!isfinite(x[i])) return ulam__fail(err, ULAM_EINVAL, 0, p->first + i, "a finite x");
+    double *gv = NULL, *cv = malloc(((size_t)rows + 1) * sizeof *cv), u = INFINITY, up[3] = {0, 0, 0};
+    ulam__halo h = {0};
+    int status = halo_open(p, comm, &h, &gv) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the halo and an exchange that succeeds")
+                 : cv ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld doubles", (long long)rows);
+    if (!status) status = ulam__dist_cw(p, comm, iters, &u, cv, err);
+    if (!status && residual_bounds(p, comm, &h, b ? b : p->b, x, gv, up))
+        status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+    /* x* - x = (I - M)^-1 r = sum_k M^k r; |r| <= rho 1 <= rho v / min v, so |M|^k |r| <= rho u^k v / min v.
+     * With M >= 0 the sum keeps r's signs: above by r's positive part, below by its negative part. */
+    double k = (1.0 + 8.0 * DBL_EPSILON) / (1.0 - u), above = up[2] ? up[0] : fmax(up[0], up[1]), below = up[2] ? up[1] : above;
+    *worst = 0.0;
+    for (int64_t i = 0; !status && i < rows; i++) {
+        double slack = 2.0 * DBL_EPSILON * fabs(x[i]);
+        lo[i] = u < 1.0 ? x[i] - (below * cv[i] * k + slack) : NAN;
+        hi[i] = u < 1.0 ? x[i] + (above * cv[i] * k + slack) : NAN;
+        *worst = u < 1.0 ? fmax(*worst, (hi[i] - lo[i]) / 2.0) : INFINITY;
+    }
+    if (!status && u < 1.0 && ulam__dist_largest(comm, worst)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
+    ulam__halo_free(&h);
+    free(gv), free(cv);
     return status;
 }

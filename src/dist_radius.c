@@ -7,17 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The halo of this rank's rows of A: the columns they reference that other ranks of its set own
- * (ghost, sorted), and what this rank sends each iteration: the offsets (into its rows) others
- * asked for, at[r] .. at[r + 1) of idx for world rank r.  A product then needs the iterate at
- * the halo only, not the whole O(n) vector. */
-typedef struct {
-    int64_t nghost, *ghost;
-    int64_t *idx, *at; /* at: nranks + 1 */
-} halo;
-
 /* Free h's arrays. */
-static void halo_free(halo *h)
+void ulam__halo_free(ulam__halo *h)
 {
     free(h->ghost), free(h->idx), free(h->at);
 }
@@ -56,9 +47,9 @@ static int set_add(int32_t **t, int64_t *cap, int64_t *len, int32_t j)
 /* Find the halo of A's rows on this rank: its sorted distinct outside columns (gathered in a hash
  * set: memory by the halo, not by the entries or n), each asked of its owner through one
  * exchange; nonzero on failure (memory or the exchange). */
-static int halo_make(const ulam_part *p, const ulam_comm *c, const ulam__rows *A, halo *h)
+int ulam__halo_make(const ulam_part *p, const ulam_comm *c, const ulam__rows *A, ulam__halo *h)
 {
-    *h = (halo){0};
+    *h = (ulam__halo){0};
     int64_t rows = p->last - p->first, k = c->nranks, cap = 0, u = 0;
     int32_t *t = NULL;
     for (int64_t q = 0; q < A->rowptr[rows]; q++)
@@ -91,7 +82,7 @@ static int halo_make(const ulam_part *p, const ulam_comm *c, const ulam__rows *A
 
 /* The iterate's halo values into gv (in h->ghost order) from every rank's rows mine; nonzero on a
  * failed exchange. */
-static int halo_swap(const ulam_part *p, const ulam_comm *c, const halo *h, const double *mine, double *gv)
+int ulam__halo_swap(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, const double *mine, double *gv)
 {
     int k = c->nranks;
     if (k == 1) return 0;
@@ -115,7 +106,7 @@ static int halo_swap(const ulam_part *p, const ulam_comm *c, const halo *h, cons
 }
 
 /* The iterate at column j: this rank's own rows, else its halo. */
-static double at_col(const ulam_part *p, const halo *h, const double *own, const double *gv, int64_t j)
+double ulam__halo_at(const ulam_part *p, const ulam__halo *h, const double *own, const double *gv, int64_t j)
 {
     if (j >= p->first && j < p->last) return own[j - p->first];
     int64_t lo = 0, hi = h->nghost - 1;
@@ -130,7 +121,7 @@ static double at_col(const ulam_part *p, const halo *h, const double *own, const
 /* One step: y = M^ v on this rank's rows (own NULL: v all ones; else v at its rows own, at its
  * halo gv), the Collatz-Wielandt ratio's largest value (each row's sum rounded up by its
  * (length + 2) roundings) into *cw and y's largest into *top. */
-static void step(const ulam_part *p, const ulam__rows *A, const halo *h, const double *own, const double *gv, double *y,
+static void step(const ulam_part *p, const ulam__rows *A, const ulam__halo *h, const double *own, const double *gv, double *y,
                  double *cw, double *top)
 {
     *cw = 0.0, *top = 0.0;
@@ -138,7 +129,7 @@ static void step(const ulam_part *p, const ulam__rows *A, const halo *h, const d
         double S = A->rowsum[i], f = S > 1.0 ? S : 1.0, s = 0.0; /* S / min(1, S) */
         int64_t len = A->rowptr[i + 1] - A->rowptr[i];
         for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++)
-            s += fabs(A->val[q]) * (own ? at_col(p, h, own, gv, A->col[q]) : 1.0);
+            s += fabs(A->val[q]) * (own ? ulam__halo_at(p, h, own, gv, A->col[q]) : 1.0);
         s *= f * (1.0 + (double)(len + 3) * DBL_EPSILON);
         y[i] = s;
         double r = own ? s / own[i] : s;
@@ -156,7 +147,7 @@ static int power(const ulam_part *p, const ulam_comm *comm, const ulam__rows *A,
     int64_t rows = p->last - p->first;
     double *own = NULL, *gv = NULL, *y = malloc(((size_t)rows + 1) * sizeof *y); /* own, gv: once the row sums do not do */
     if (!y) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the power iteration (%lld doubles)", (long long)rows);
-    halo h = {0};
+    ulam__halo h = {0};
     double best = INFINITY;
     int status = ULAM_OK, made = 0;
     double before = INFINITY; /* keep: the best 20 steps ago (the tail wants u well below 1, not just below) */
@@ -182,7 +173,7 @@ static int power(const ulam_part *p, const ulam_comm *comm, const ulam__rows *A,
         if ((best < 1.0 && !keep) || !(top > 0.0) || !isfinite(top)) break; /* certified; or M^ v = 0, or overflow */
         if (!made) { /* the halo, once: every rank gets here together (the same best and top) */
             made = 1;
-            int64_t bad = halo_make(p, comm, A, &h);
+            int64_t bad = ulam__halo_make(p, comm, A, &h);
             own = malloc(((size_t)rows + 1) * sizeof *own), gv = malloc(((size_t)h.nghost + 1) * sizeof *gv);
             bad |= !own || !gv;
             if (comm->nranks > 1 && comm->sum(comm->ctx, &bad, 1)) bad = 1; /* all stop together */
@@ -193,10 +184,10 @@ static int power(const ulam_part *p, const ulam_comm *comm, const ulam__rows *A,
             }
         }
         for (int64_t i = 0; i < rows; i++) own[i] = y[i] / top + 1e-6; /* kept positive: any positive v gives a valid bound */
-        if (halo_swap(p, comm, &h, own, gv)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+        if (ulam__halo_swap(p, comm, &h, own, gv)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
         if (status) break;
     }
-    halo_free(&h);
+    ulam__halo_free(&h);
     free(own), free(gv), free(y);
     if (!status) *best_out = best;
     return status;
@@ -242,5 +233,18 @@ int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const 
     }
     if (!status && u < 1.0) cert->u = u;
     free(keep), free(bits);
+    return status;
+}
+
+/* A Collatz-Wielandt certificate of |M| on the part's rows of M: u < 1 (INFINITY when none) with
+ * |M| v <= u v for a positive v, and c[i] >= v_i / min v at this rank's rows (M^ >= |M| entry by
+ * entry, so power's bound on M^ holds for |M|). */
+int ulam__dist_cw(const ulam_part *p, const ulam_comm *comm, int iters, double *u, double *c, ulam_error *err)
+{
+    double vmin = 0.0;
+    *u = INFINITY;
+    int status = power(p, comm, &p->m, iters, u, c, &vmin, err);
+    for (int64_t i = 0; !status && i < p->last - p->first; i++) c[i] = c[i] / vmin * (1.0 + 4.0 * DBL_EPSILON);
+    if (!status && !(*u < 1.0)) *u = INFINITY;
     return status;
 }

@@ -508,7 +508,8 @@ typedef struct {
     int64_t pos, end;
     char *buf;
     size_t cap, len, at;
-    int failed; /* 1 a read error, 2 no memory */
+    int failed; /* 1 a malformed line or a read error, 2 no memory */
+    int toolong, nul; /* the malformed line: past MM_LINE_MAX, or holding a NUL byte */
 } span;
 
 /* The next line of the span, NUL-terminated without its newline (or CR LF), as reader_next
@@ -520,15 +521,15 @@ static char *span_next(span *s)
         char *nl = memchr(start, '\n', s->len - s->at);
         if (nl || (s->pos == s->end && s->at < s->len)) {
             char *e = nl ? nl : s->buf + s->len;
-            if (memchr(start, '\0', (size_t)(e - start))) return s->failed = 1, NULL; /* the sequential reader locates it */
+            if (memchr(start, '\0', (size_t)(e - start))) return s->failed = s->nul = 1, NULL; /* the sequential reader locates it */
             *e = '\0';
             if (e > start && e[-1] == '\r') e[-1] = '\0';
             s->at = (size_t)(e - s->buf) + (nl ? 1 : 0);
             return start;
         }
         if (s->pos == s->end) return NULL;
-        if (s->len - s->at > MM_LINE_MAX || memchr(start, '\0', s->len - s->at))
-            return s->failed = 1, NULL; /* the sequential reader locates it, never buffering past MM_LINE_MAX */
+        if ((s->toolong = s->len - s->at > MM_LINE_MAX) || memchr(start, '\0', s->len - s->at))
+            return s->failed = 1, s->nul = !s->toolong, NULL; /* the sequential reader locates it, never buffering past MM_LINE_MAX */
         memmove(s->buf, start, s->len - s->at);
         s->len -= s->at, s->at = 0;
         if (s->cap - s->len < 2) {
@@ -686,6 +687,98 @@ static int read_entries_parallel(int fd, int64_t data, int64_t end, const mm_hea
     }
     *out = A;
     return ULAM_OK;
+}
+
+/* The header of a coordinate Matrix Market file opened at fd (named name), checked as the
+ * sequential reader checks it, for reading its entries by byte ranges (ulam__mm_read_range). */
+int ulam__mm_coord_header(int fd, const char *name, ulam__mm_coord *c, ulam_error *err)
+{
+    unsigned char magic[2] = {0, 0};
+    if (pread(fd, magic, 2, 0) == 2 && magic[0] == 0x1f && magic[1] == 0x8b)
+        return ulam__fail(err, ULAM_EUNSUPPORTED, 1, -1, "an uncompressed Matrix Market file (each rank reads a byte "
+                                                         "range of it): gunzip %s", name);
+    int fd2 = dup(fd);
+    FILE *f = fd2 < 0 ? NULL : fdopen(fd2, "rb");
+    if (!f) {
+        if (fd2 >= 0) close(fd2);
+        return ulam__fail(err, ULAM_EIO, 0, -1, "a readable file");
+    }
+    mm_header h = {0};
+    reader r;
+    int status = reader_init(&r, f) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a read buffer")
+                                    : read_header(&r, name, &h, err);
+    if (!status && h.format != FMT_COORD)
+        status = ulam__fail(err, ULAM_EUNSUPPORTED, 1, -1, "a coordinate Matrix Market file on a partition (a dense "
+                                                           "array: prepare it with ulam prepare)");
+    if (!status && h.m != h.n)
+        status = ulam__fail(err, ULAM_ENOTSQUARE, r.line, -1, "a square matrix, got %lld x %lld", (long long)h.m,
+                            (long long)h.n);
+    if (!status && r.size < 0) status = ulam__fail(err, ULAM_EIO, 0, -1, "a regular file (each rank reads a byte range)");
+    if (!status) {
+        *c = (ulam__mm_coord){.n = h.n, .nnz = h.nnz, .field = h.field, .symmetry = h.symmetry, .lines = r.line};
+        c->data = r.read_total - (int64_t)(r.len - r.pos); /* the byte after the size line */
+        c->end = r.size;
+    }
+    free(r.buf);
+    fclose(f);
+    return status;
+}
+
+/* The first line start at or after byte at of a coordinate file's entries (c->end when none). */
+int64_t ulam__mm_line_start(int fd, const ulam__mm_coord *c, int64_t at)
+{
+    return at <= c->data ? c->data : line_start(fd, at, c->end);
+}
+
+/* Add an entry and its mirror to a growing array (zeros dropped, as add_entry does). */
+static int range_add(ulam__mm_entry **e, int64_t *len, int64_t *cap, const mm_header *h, int64_t i, int64_t j, double x)
+{
+    if (x == 0.0) return ULAM_OK;
+    if (ulam__grow(e, cap, *len + 2, sizeof **e)) return ULAM_ENOMEM;
+    (*e)[(*len)++] = (ulam__mm_entry){(int32_t)(i - 1), (int32_t)(j - 1), x};
+    if (h->symmetry != SYM_GENERAL && i != j)
+        (*e)[(*len)++] = (ulam__mm_entry){(int32_t)(j - 1), (int32_t)(i - 1), h->symmetry == SYM_SKEW ? -x : x};
+    return ULAM_OK;
+}
+
+/* The entries of lines [from, to) of a coordinate file (from a line start), in file order with
+ * their mirrors and without zeros, into *e (malloc'd, *len of them); *lines the lines read and
+ * *entries the entry lines.  Errors are located at the line counted from `from` (1 its first); more
+ * than limit entry lines fail there as the sequential reader's "found more" does. */
+int ulam__mm_read_range(int fd, const ulam__mm_coord *c, int64_t from, int64_t to, int64_t limit, ulam__mm_entry **e,
+                        int64_t *len, int64_t *entries, long *lines, ulam_error *err)
+{
+    mm_header h = {.format = FMT_COORD, .field = c->field, .symmetry = c->symmetry, .m = c->n, .n = c->n, .nnz = c->nnz};
+    span s = {.fd = fd, .pos = from, .end = to, .cap = CHUNK_BUF};
+    int64_t cap = 0;
+    int status = ULAM_OK;
+    *e = NULL, *len = 0, *entries = 0, *lines = 0;
+    s.buf = malloc(s.cap);
+    char *line;
+    while (s.buf && !status && (line = span_next(&s)) != NULL) {
+        ++*lines;
+        if (*skip_ws(line) == '%' || at_end(line)) continue;
+        if (*entries == limit) {
+            status = ulam__fail(err, ULAM_ETOOMANY, *lines, -1, "%lld entries as the size line says, found more",
+                                (long long)c->nnz);
+            break;
+        }
+        int64_t i, j;
+        double x;
+        if ((status = parse_coord(*lines, line, &h, &i, &j, &x, err))) break;
+        ++*entries;
+        if ((status = range_add(e, len, &cap, &h, i, j, x))) ulam__fail(err, status, *lines, -1, "memory for the entries");
+    }
+    if (status) {
+    } else if (!s.buf || s.failed == 2) status = ulam__fail(err, ULAM_ENOMEM, *lines + 1, -1, "memory for a line");
+    else if (s.failed && s.toolong)
+        status = ulam__fail(err, ULAM_ESYNTAX, *lines + 1, -1, "a text line of at most %d bytes (this one is longer: "
+                                                               "the file is binary or damaged)", MM_LINE_MAX);
+    else if (s.failed && s.nul)
+        status = ulam__fail(err, ULAM_ESYNTAX, *lines + 1, -1, "a text line with no NUL byte (the file is binary or damaged)");
+    else if (s.failed) status = ulam__fail(err, ULAM_EIO, *lines + 1, -1, "a readable file");
+    free(s.buf);
+    return status;
 }
 
 /* The reader's defaults. */

@@ -114,7 +114,7 @@ static int read_rhs(int fd, const ulam__layout *L, const uint64_t *sums, int64_t
 }
 
 /* Each of this rank's rows' sum of |entries| in A. */
-static int row_sums(const ulam_part *p, ulam__rows *A, ulam_error *err)
+int ulam__part_sums(const ulam_part *p, ulam__rows *A, ulam_error *err)
 {
     int64_t rows = p->last - p->first;
     A->rowsum = ulam__malloc((size_t)rows, sizeof *A->rowsum);
@@ -173,8 +173,8 @@ static int open_part(int fd, uint64_t len, const ulam_comm *c, int what, ulam_pa
         if (!status && what != ULAM_PART_M) status = read_rows(fd, &L, off[1], sums, L.first[2], p, &p->t, err);
     }
     if (!status) status = read_rhs(fd, &L, sums, L.first[1], p, err);
-    if (!status && p->m.rowptr) status = row_sums(p, &p->m, err);
-    if (!status && p->t.rowptr) status = row_sums(p, &p->t, err);
+    if (!status && p->m.rowptr) status = ulam__part_sums(p, &p->m, err);
+    if (!status && p->t.rowptr) status = ulam__part_sums(p, &p->t, err);
     free(sums);
     return status;
 }
@@ -183,7 +183,31 @@ static int open_part(int fd, uint64_t len, const ulam_comm *c, int what, ulam_pa
 int ulam_part_open(const char *path, const ulam_comm *comm, int what, ulam_part **out, ulam_error *err)
 {
     ulam__clear(err);
-    if (!path || !comm || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path, a comm and a result");
+    if (!path) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path, a comm and a result");
+    int status = ulam__part_args(comm, what, out, err);
+    if (status) return status;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) || !S_ISREG(st.st_mode)) {
+        if (fd >= 0) close(fd);
+        return ulam__fail(err, ULAM_EIO, 0, -1, "a readable prepared system file");
+    }
+    ulam_part *p = calloc(1, sizeof *p);
+    status = p ? open_part(fd, (uint64_t)st.st_size, comm, what, p, err)
+               : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a part");
+    close(fd);
+    if (status) {
+        ulam_part_free(p);
+        return status;
+    }
+    *out = p;
+    return ULAM_OK;
+}
+
+/* Check a comm, what and out of ulam_part_open (*out set to NULL). */
+int ulam__part_args(const ulam_comm *comm, int what, ulam_part **out, ulam_error *err)
+{
+    if (!comm || !out) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a path, a comm and a result");
     *out = NULL;
     if (comm->nranks < 1 || comm->rank < 0 || comm->rank >= comm->nranks ||
         (comm->nranks > 1 && (!comm->exchange || !comm->sum)))
@@ -192,21 +216,6 @@ int ulam_part_open(const char *path, const ulam_comm *comm, int what, ulam_part 
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "ULAM_PART_M, ULAM_PART_MT or ULAM_PART_BOTH, got %d", what);
     if (comm->sets < 0 || (comm->sets > 1 && comm->nranks % comm->sets))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "sets dividing the %d ranks, got %d", comm->nranks, comm->sets);
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    struct stat st;
-    if (fd < 0 || fstat(fd, &st) || !S_ISREG(st.st_mode)) {
-        if (fd >= 0) close(fd);
-        return ulam__fail(err, ULAM_EIO, 0, -1, "a readable prepared system file");
-    }
-    ulam_part *p = calloc(1, sizeof *p);
-    int status = p ? open_part(fd, (uint64_t)st.st_size, comm, what, p, err)
-                   : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a part");
-    close(fd);
-    if (status) {
-        ulam_part_free(p);
-        return status;
-    }
-    *out = p;
     return ULAM_OK;
 }
 
@@ -241,32 +250,6 @@ int ulam__part_owner(const ulam_part *p, int64_t s)
         else hi = mid - 1;
     }
     return lo;
-}
-
-/* Every rank's slice of a vector (rows [split[r], split[r + 1])) into all[0 .. n) on every rank of
- * its set. */
-int ulam__dist_gather(const ulam_part *p, const ulam_comm *c, const double *mine, double *all)
-{
-    int64_t rows = p->last - p->first;
-    if (c->nranks == 1) {
-        memcpy(all, mine, (size_t)rows * sizeof *all);
-        return 0;
-    }
-    size_t *counts = malloc((size_t)c->nranks * 2 * sizeof *counts);
-    if (!counts) return 1;
-    int set0 = p->set * p->nranks; /* to the ranks of this set only */
-    for (int r = 0; r < c->nranks; r++) counts[r] = r >= set0 && r < set0 + p->nranks ? (size_t)rows * sizeof *mine : 0;
-    char *send = malloc((size_t)p->nranks * (size_t)(rows ? rows : 1) * sizeof *mine);
-    void *got = NULL;
-    int bad = !send;
-    for (int r = 0; !bad && r < p->nranks; r++) memcpy(send + (size_t)r * (size_t)rows * sizeof *mine, mine, (size_t)rows * sizeof *mine);
-    if (!bad) bad = c->exchange(c->ctx, send, counts, &got, counts + c->nranks);
-    size_t total = 0;
-    for (int r = 0; !bad && r < c->nranks; r++) total += counts[c->nranks + r];
-    if (!bad && total == (size_t)p->n * sizeof *all) memcpy(all, got, total); /* rank order is row order */
-    else bad = 1;
-    free(counts), free(send), free(got);
-    return bad;
 }
 
 /* The largest of every rank's nonnegative x (as bits, which order as the values do). */

@@ -25,15 +25,38 @@ struct ulam_part {
     int set, sets;           /* this rank's set (world rank set * nranks + rank) of sets */
 };
 
+/* Check ulam_part_open's comm, what and out (*out set to NULL); a status (src/part.c). */
+int ulam__part_args(const ulam_comm *comm, int what, ulam_part **out, ulam_error *err);
+
+/* Each of p's rows' sum of |entries| of A into A->rowsum (src/part.c). */
+int ulam__part_sums(const ulam_part *p, ulam__rows *A, ulam_error *err);
+
 /* The position in a set owning row s. */
 int ulam__part_owner(const ulam_part *p, int64_t s);
 
-/* Every rank's slice of a vector (its rows) into all[0 .. n) on every rank of its set
- * (src/part.c); nonzero on a failed exchange. */
-int ulam__dist_gather(const ulam_part *p, const ulam_comm *c, const double *mine, double *all);
-
 /* The largest of every rank's nonnegative *x, into *x on every rank; nonzero on a failed sum. */
 int ulam__dist_largest(const ulam_comm *c, double *x);
+
+/* The halo of this rank's rows of A: the columns they reference that other ranks of its set own
+ * (ghost, sorted), and what this rank sends each product: the offsets (into its rows) others
+ * asked for, at[r] .. at[r + 1) of idx for world rank r.  A product then needs the vector at the
+ * halo only, not the whole O(n) vector (src/dist_radius.c). */
+typedef struct {
+    int64_t nghost, *ghost;
+    int64_t *idx, *at; /* at: nranks + 1 */
+} ulam__halo;
+
+/* Find the halo of A's rows (one exchange); nonzero on failure (memory or the exchange). */
+int ulam__halo_make(const ulam_part *p, const ulam_comm *c, const ulam__rows *A, ulam__halo *h);
+
+/* A vector's halo values into gv (h->ghost order) from every rank's rows mine; nonzero on failure. */
+int ulam__halo_swap(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, const double *mine, double *gv);
+
+/* The vector at column j: this rank's own rows own, else its halo gv. */
+double ulam__halo_at(const ulam_part *p, const ulam__halo *h, const double *own, const double *gv, int64_t j);
+
+/* Free h's arrays. */
+void ulam__halo_free(ulam__halo *h);
 
 /* What bounds an adjoint walk's length on a partition: every row sum of |M| at most 1 (so the
  * analog kernel's weights stay +-1 and a walk from i is alive after k steps with probability
@@ -49,5 +72,9 @@ typedef struct {
 /* The certificate above for walks from index[0 .. nq) (src/dist_radius.c), at most iters products. */
 int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const int64_t *index, int64_t nq,
                     ulam__dist_cert *cert, ulam_error *err);
+
+/* A Collatz-Wielandt certificate |M| v <= u v of the part's rows of M (u INFINITY: none) and
+ * c[i] >= v_i / min v at this rank's rows (src/dist_radius.c), at most iters products. */
+int ulam__dist_cw(const ulam_part *p, const ulam_comm *comm, int iters, double *u, double *c, ulam_error *err);
 
 #endif

@@ -121,6 +121,25 @@ def check_partition(ulam, mpirun, d):
     xm = [float(v) for v in outer[0][0].split("\n")[3:] if v.strip()]
     assert max(abs(a - b) for a, b in zip(xm, exact)) < 1e-6 * max(abs(b) for b in exact), "MCSA's x is off"
     assert len(outer[0][1].splitlines()) == 10 and outer[0][1].startswith("x[77]"), outer[0][1]
+    import re  # certified ranges from the residual (point 2): MCSA's bound, single source's top 10, forward --bound
+    out = run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--method", "mcsa", "--walks",
+               "20000", "--out", f"{d}/pmb.mtx", "-q"])
+    worst = float(re.search(r"^bound +every \|x_i - x\*_i\| <= (\S+)", out, re.M).group(1))
+    xm = [float(v) for v in open(f"{d}/pmb.mtx").read().split("\n")[3:] if v.strip()]
+    assert max(abs(a - b) for a, b in zip(xm, exact)) <= worst < 1e-6, (out, worst)
+    with open(f"{d}/e77.mtx", "w") as f:
+        f.write("%%%%MatrixMarket matrix array real general\n%d 1\n" % n + "".join("1\n" if i == 76 else "0\n" for i in range(n)))
+    run([ulam, "direct", m, "--rhs", f"{d}/e77.mtx", "--out", f"{d}/c77.mtx"])
+    col = [float(v) for v in open(f"{d}/c77.mtx").read().split("\n")[3:] if v.strip()]
+    for line in outer[0][1].splitlines():
+        i = int(re.match(r"x\[(\d+)\]", line).group(1))
+        lo, hi = (float(v) for v in re.search(r"CI (\S+) \.\. ([^;)\s]+)", line).groups())
+        assert lo <= col[i - 1] <= hi and hi - lo < 1e-4, (line, col[i - 1])
+    out = run([mpirun, "--oversubscribe", "-np", "2", ulam, "solve", sysf, "--partition", "--mode", "forward", "--bound",
+               "--walks", "50000", "--seed", "3", "--out", f"{d}/pfb.mtx", "-q"])
+    worst = float(re.search(r"^bound +every \|x_i - x\*_i\| <= (\S+)", out, re.M).group(1))
+    xf = [float(v) for v in open(f"{d}/pfb.mtx").read().split("\n")[3:] if v.strip()]
+    assert max(abs(a - b) for a, b in zip(xf, exact)) <= worst, (out, worst)
     qf = f"{d}/pq.txt"  # many queries at once: each line the lone run's with the seed it prints, at 1 and 3 ranks
     open(qf, "w").write("1234\n# a comment\n7\n1234\n")
     qs = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--queries", qf, "--walks",
@@ -141,6 +160,86 @@ def check_partition(ulam, mpirun, d):
     assert p.returncode != 0 and not p.stdout, (p.returncode, p.stdout)
 
 
+def check_partition_mtx(ulam, mpirun, d):
+    """Issue 43: Matrix Market read by byte ranges on a partition (--rhs): each rank parses its share
+    of the lines.  A file with shuffled rows, split duplicates, an explicit zero, a comment and a blank
+    line gives, at 1, 2 and 3 ranks (and 4 in 2 sets), byte for byte what the prepared file gives:
+    the adjoint line, the forward, MCSA and --errors files, the single-source table.  A symmetric
+    4-row system (one block: ranks 2 and 3 hold no rows) likewise.  A malformed line in the first,
+    middle or last rank's range, and too many or too few entries, are reported at the file's line as
+    `ulam prepare` reports them, once, at every rank count, with a non-zero exit and no stdout."""
+    import random
+    rnd = random.Random(11)
+    n = 3000
+    m, b = write_system(d, n, 5)
+    body = open(m).read().splitlines(True)
+    head, lines = body[:2], body[2:]
+    rnd.shuffle(lines)
+    out = []
+    for l in lines:  # a tenth of the entries split in two lines (summed in file order)
+        i, j, v = l.split()
+        if rnd.random() < 0.1:
+            out += ["%s %s %.17g\n" % (i, j, float(v) * 0.25), "%s %s %.17g\n" % (i, j, float(v) * 0.75)]
+        else:
+            out.append(l)
+    out.insert(100, "% a comment\n")
+    out.insert(200, "\n")
+    out.append("1 5 0\n")
+    count = sum(1 for l in out if l.strip() and not l.startswith("%"))
+    mm = f"{d}/mm.mtx"
+    with open(mm, "w") as f:
+        f.write("%%%%MatrixMarket matrix coordinate real general\n%% shuffled\n%d %d %d\n" % (n, n, count))
+        f.writelines(out)
+    sysf = f"{d}/mm.ulam"
+    run([ulam, "prepare", mm, "--rhs", b, "--transpose", "-o", sysf])
+
+    def answers(k, src, extra=()):
+        pre = [mpirun, "--oversubscribe", "-np", str(k), ulam, "solve"] + src + ["--partition"] + list(extra)
+        res = [run(pre + ["--index", "1234", "--walks", "20000", "--seed", "3", "-q"]).splitlines()[0]]
+        run(pre + ["--mode", "forward", "--walks", "50000", "--seed", "3", "--out", f"{d}/mf.mtx", "--errors", f"{d}/me.mtx", "-q"])
+        run(pre + ["--method", "mcsa", "--walks", "20000", "--out", f"{d}/mc.mtx", "-q"])
+        res += [open(f"{d}/mf.mtx").read(), open(f"{d}/me.mtx").read(), open(f"{d}/mc.mtx").read()]
+        res.append(run(pre + ["--source", "77", "--top", "10", "--walks", "20000", "-q"]))
+        return res
+
+    want = answers(1, [sysf])
+    for k in (1, 2, 3):
+        assert answers(k, [mm, "--rhs", b]) == want, f"Matrix Market by byte ranges at {k} ranks differs from the prepared file"
+    assert answers(4, [mm, "--rhs", b], ["--sets", "2"]) == want, "Matrix Market in 2 sets differs"
+    sym, sb = f"{d}/sym.mtx", f"{d}/symb.mtx"
+    open(sym, "w").write("%%MatrixMarket matrix coordinate real symmetric\n4 4 5\n1 1 0.1\n2 1 0.2\n3 2 -0.3\n4 3 0.1\n4 4 0.2\n")
+    open(sb, "w").write("%%MatrixMarket matrix array real general\n4 1\n1\n2\n3\n4\n")
+    run([ulam, "prepare", sym, "--rhs", sb, "--transpose", "-o", f"{d}/sym.ulam"])
+    xs = []
+    for k in (1, 2, 3):
+        for src in ([f"{d}/sym.ulam"], [sym, "--rhs", sb]):
+            run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve"] + src + ["--partition", "--mode", "forward",
+                 "--walks", "10000", "--out", f"{d}/sx.mtx", "-q"])
+            xs.append(open(f"{d}/sx.mtx").read())
+    assert len(set(xs)) == 1, "ranks without rows change the answer"
+    total = len(open(mm).read().splitlines())
+    bad = []
+    for at in (10, total // 2, total - 3):  # a malformed line in the first, a middle and the last rank's range
+        t = open(mm).read().splitlines(True)
+        t[at - 1] = "12 x 0.5\n"
+        bad.append(("".join(t), f"{at}:"))
+    t = open(mm).read()
+    bad.append((t + "1 2 0.1\n", f"{total + 1}:"))  # one entry more than the size line says
+    t = t.splitlines(True)
+    bad.append(("".join(t[:500] + t[505:]), f"{total - 5}:"))  # five fewer
+    for text, where in bad:
+        f = f"{d}/bad.mtx"
+        open(f, "w").write(text)
+        p = subprocess.run([ulam, "prepare", f, "--rhs", b, "-o", f"{d}/bad.ulam"], capture_output=True, text=True, env=ENV, timeout=120)
+        ref = [l for l in p.stderr.splitlines() if l.startswith("ulam:")]
+        assert p.returncode != 0 and len(ref) == 1 and f"bad.mtx:{where}" in ref[0], (where, p.stderr)
+        for k in (1, 2, 3):
+            p = subprocess.run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", f, "--rhs", b, "--partition", "--index",
+                                "3"], capture_output=True, text=True, env=ENV, timeout=120)
+            got = [l for l in p.stderr.splitlines() if l.startswith("ulam:")]
+            assert p.returncode != 0 and not p.stdout and got == ref, (k, where, got, ref)
+
+
 def check_partition_memory(ulam, mpirun, d):
     """Issue 43's memory test: forward mode on a 10^6-row system (8 entries a row, a band around the
     diagonal, |row sums| 0.4), 3 ranks: each rank's peak RSS at most half of one rank's alone (MPI's
@@ -154,16 +253,18 @@ def check_partition_memory(ulam, mpirun, d):
         f.write("%%%%MatrixMarket matrix array real general\n%d 1\n" % n)
         f.write("1\n" * n)
     run([ulam, "prepare", f"{d}/big.mtx", "--rhs", f"{d}/bigb.mtx", "--transpose", "-o", f"{d}/big.ulam"])
-    os.unlink(f"{d}/big.mtx")
     rss, files = [], []
-    for k in (1, 3):
-        out = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", f"{d}/big.ulam", "--partition", "--mode",
+    for k, src in ((1, [f"{d}/big.ulam"]), (3, [f"{d}/big.ulam"]), (1, [f"{d}/big.mtx", "--rhs", f"{d}/bigb.mtx"]),
+                   (3, [f"{d}/big.mtx", "--rhs", f"{d}/bigb.mtx"])):  # prepared, then Matrix Market by byte ranges
+        out = run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve"] + src + ["--partition", "--mode",
                    "forward", "--walks", "100000", "--out", f"{d}/bx{k}.mtx", "-v"])
         line = [l for l in out.splitlines() if l.startswith("ranks")][0]
         rss.append([float(v) for v in line.split("peak RSS MiB")[1].split()])
         files.append(open(f"{d}/bx{k}.mtx").read())
-    assert files[0] == files[1], "x differs"
+    os.unlink(f"{d}/big.mtx")
+    assert files[0] == files[1] == files[2] == files[3], "x differs"
     assert len(rss[1]) == 3 and max(rss[1]) <= 0.5 * rss[0][0], rss
+    assert len(rss[3]) == 3 and max(rss[3]) <= 0.5 * rss[2][0], rss  # no rank holds the whole matrix
     return rss
 
 
@@ -254,15 +355,17 @@ def main():
             except AssertionError as e:
                 failures += 1
                 print(f"FAIL {name}: {e}")
-        try:
-            check_partition(ulam, mpirun, d)
-            print("ok partition")
-        except AssertionError as e:
-            failures += 1
-            print(f"FAIL partition: {e}")
+        for name, check in (("partition", check_partition), ("partition matrix market", check_partition_mtx)):
+            try:
+                check(ulam, mpirun, d)
+                print(f"ok {name}")
+            except AssertionError as e:
+                failures += 1
+                print(f"FAIL {name}: {e}")
         try:
             rss = check_partition_memory(ulam, mpirun, d)
-            print(f"ok partition memory (peak RSS MiB: 1 rank {rss[0][0]}, 3 ranks {rss[1]})")
+            print(f"ok partition memory (peak RSS MiB: prepared 1 rank {rss[0][0]}, 3 ranks {rss[1]}; Matrix Market "
+                  f"1 rank {rss[2][0]}, 3 ranks {rss[3]})")
         except AssertionError as e:
             failures += 1
             print(f"FAIL partition memory: {e}")
@@ -272,7 +375,7 @@ def main():
     except AssertionError as e:
         failures += 1
         print(f"FAIL interrupt: {e}")
-    print(f"{len(cases) + 3 - failures} passed, {failures} failed")
+    print(f"{len(cases) + 4 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 

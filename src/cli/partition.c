@@ -14,7 +14,7 @@
 #include "ulam_dist.h"
 
 static const char *const help =
-    "usage: ulam solve SYSTEM.ulam --partition (--index I | --queries FILE | --mode forward [--out X.mtx]\n"
+    "usage: ulam solve (SYSTEM.ulam | M.mtx --rhs B.mtx) --partition (--index I | --queries FILE | --mode forward [--out X.mtx]\n"
     "                  | --method mcsa [--tol T] [--out X.mtx] | --source S [--top K] [--out X.mtx])\n"
     "                  [--walks N | --rel-err E] [--seed S] [--max-steps N] [--batch N] [--sets K]\n"
     "\n"
@@ -26,6 +26,11 @@ static const char *const help =
     "standard error; --index and --queries also a certified 95% interval when every row sum of |M| is\n"
     "at most 1 and power iteration certifies a Collatz-Wielandt vector below 1 (the walk's length\n"
     "tail, so a score's range after clipping; docs/distributed.md).\n"
+    "  --bound         (--mode forward) a certified range of every x_i from x's residual (needs M in the\n"
+    "                  part too); MCSA and --source always print theirs\n"
+    "  --rhs B.mtx     M.mtx is a coordinate Matrix Market file read by byte ranges: each rank parses\n"
+    "                  its share of the lines, and the entries travel to their rows' ranks (the same\n"
+    "                  rows and answer as the prepared file; b is read whole by each rank)\n"
     "  --index I       x_I by adjoint walks from I (1-based)\n"
     "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, each on\n"
     "                  a seed of its own, printed: a line answers what --index I --seed SEED answers\n"
@@ -46,12 +51,12 @@ static const char *const help =
 
 /* The parsed command line. */
 typedef struct {
-    const char *path, *out, *errors, *queries;
+    const char *path, *out, *errors, *queries, *rhs;
     int64_t index; /* 1-based; 0 none */
     int forward, mcsa;
     int64_t sets, source, top, max_iter;
     double tol, rel_err;
-    int walks_given;
+    int walks_given, bound;
     ulam_dist_opts o;
 } args;
 
@@ -61,7 +66,7 @@ static const struct option longopts[] = {
     {"max-steps", required_argument, 0, 'x'}, {"batch", required_argument, 0, 'b'}, {"sets", required_argument, 0, 'S'}, {"queries", required_argument, 0, 'Q'}, {"errors", required_argument, 0, 'E'},
     {"method", required_argument, 0, 'M'}, {"tol", required_argument, 0, 'T'}, {"max-iter", required_argument, 0, 'I'},
     {"source", required_argument, 0, 'R'}, {"top", required_argument, 0, 'K'}, {"rel-err", required_argument, 0, 'e'},
-    {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+    {"rhs", required_argument, 0, 'r'}, {"bound", no_argument, 0, 'B'}, {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
 
 /* The defaults. */
 static void init(void *p)
@@ -90,6 +95,8 @@ static int option(void *p, int val, const char *name, const char *value)
     case 'x': return cli_parse_int("solve", "--max-steps", value, 1, INT64_MAX, &a->o.max_steps);
     case 'b': return cli_parse_int("solve", "--batch", value, 1, (int64_t)1 << 30, &a->o.batch);
     case 'Q': a->queries = value; return 0;
+    case 'r': a->rhs = value; return 0;
+    case 'B': a->bound = 1; return 0;
     case 'E': a->errors = value; return 0;
     case 'M':
         if (!strcmp(value, "mcsa")) a->mcsa = 1;
@@ -111,17 +118,19 @@ static int option(void *p, int val, const char *name, const char *value)
 /* Check the operands and options read. */
 static int check(args *a, int argc, char **argv, int first)
 {
-    if (first != argc - 1) return cli_usage_error("solve", "one prepared system file with --partition");
+    if (first != argc - 1) return cli_usage_error("solve", "one prepared system file (or M.mtx --rhs B.mtx) with --partition");
     a->path = argv[first];
     if (!!a->forward + !!a->index + !!a->queries + a->mcsa + !!a->source != 1)
         return cli_usage_error("solve", "one of --index I, --queries FILE, --mode forward, --method mcsa and --source S "
                                         "with --partition");
     if ((a->out || a->errors) && (a->index || a->queries))
         return cli_usage_error("solve", "--out and --errors with --partition write a whole x");
+    if (a->bound && (!a->forward || a->mcsa || a->sets > 1))
+        return cli_usage_error("solve", "--bound with --mode forward in one set (MCSA and --source print theirs)");
     if (a->errors && a->mcsa) return cli_usage_error("solve", "--errors with --mode forward or --source");
     const cli_file outs[] = {{"--out", a->out}, {"--errors", a->errors}},
-                   ins[] = {{"the system", a->path}, {"--queries", a->queries}};
-    int rc = cli_check_outputs("solve", outs, 2, ins, 2);
+                   ins[] = {{"the system", a->path}, {"--queries", a->queries}, {"--rhs", a->rhs}};
+    int rc = cli_check_outputs("solve", outs, 2, ins, 3);
     if (rc) return rc;
     if (a->rel_err > 0 && !a->index && !a->queries)
         return cli_usage_error("solve", "--rel-err with --partition and --index or --queries (forward mode, MCSA and "
@@ -216,6 +225,9 @@ static void print_estimate(int64_t i, double est, double se, double rho, const u
     printf("x[%lld]%*s%.10g", (long long)i, cli_answer_pad(i, 16), "", est);
     if (ci && ci->lo == ci->hi && ci->lo == est) printf(" +- 0 (95%% CI %.10g .. %.10g: b is 0, x is exactly 0)", ci->lo, ci->hi);
     else if (!(rho < 1.0)) printf(" (no standard error: rho(M^) is not certified below 1)");
+    else if (isnan(se) && ci && isfinite(ci->lo))
+        printf(" (95%% CI %.*g .. %.*g; no walk reached it: the push's part alone)", cli_ci_digits(ci->lo, ci->hi), ci->lo,
+               cli_ci_digits(ci->lo, ci->hi), ci->hi);
     else if (isnan(se)) printf(" (no walk reached it: the push's part alone)");
     else if (ci && isfinite(ci->lo))
         printf(" +- %.3g (95%% CI %.*g .. %.*g)", se, cli_ci_digits(ci->lo, ci->hi), ci->lo, cli_ci_digits(ci->lo, ci->hi),
@@ -237,7 +249,7 @@ static void print_query(const cli_query *q, int64_t k, int64_t nq, const ulam_di
 /* A component for the top-K table: its index and estimate, its standard error. */
 typedef struct {
     int64_t i;
-    double x, se;
+    double x, se, lo, hi;
 } entry;
 
 /* Larger estimate first, then the smaller index (NaN last). */
@@ -250,14 +262,14 @@ static int by_estimate(const void *a, const void *b)
 
 /* Each rank's K largest components to rank 0, which prints the K largest of all with their
  * standard errors; 0 or an exit code. */
-static int print_top(const ulam_comm *c, const double *x, const double *se, int64_t first, int64_t rows, int64_t K,
-                     double rho)
+static int print_top(const ulam_comm *c, const double *x, const double *se, const double *lo, const double *hi, int64_t first,
+                     int64_t rows, int64_t K, double rho)
 {
     entry *e = malloc(((size_t)rows + 1) * sizeof *e);
     size_t *cnt = calloc((size_t)c->nranks * 2, sizeof *cnt);
     void *got = NULL;
     int bad = !e || !cnt;
-    for (int64_t i = 0; !bad && i < rows; i++) e[i] = (entry){first + i, x[i], se[i]};
+    for (int64_t i = 0; !bad && i < rows; i++) e[i] = (entry){first + i, x[i], se[i], lo[i], hi[i]};
     if (!bad) qsort(e, (size_t)rows, sizeof *e, by_estimate);
     int64_t k = rows < K ? rows : K, all = k;
     if (!bad && c->nranks > 1) {
@@ -268,7 +280,10 @@ static int print_top(const ulam_comm *c, const double *x, const double *se, int6
         if (!bad && c->rank == 0) qsort(got, (size_t)all, sizeof *e, by_estimate);
     }
     const entry *t = c->nranks > 1 ? got : e;
-    for (int64_t j = 0; !bad && c->rank == 0 && j < all && j < K; j++) print_estimate(t[j].i + 1, t[j].x, t[j].se, rho, NULL), printf("\n");
+    for (int64_t j = 0; !bad && c->rank == 0 && j < all && j < K; j++) {
+        ulam_dist_ci ci = {t[j].lo, t[j].hi, INFINITY, 0.0, 0};
+        print_estimate(t[j].i + 1, t[j].x, t[j].se, rho, isfinite(ci.lo) ? &ci : NULL), printf("\n");
+    }
     free(e), free(cnt), free(got);
     return bad ? cli_exit_code(ULAM_EIO) : 0;
 }
@@ -327,17 +342,34 @@ static int first_status(const ulam_comm *c, int status)
     return bad ? ULAM_EIO : first;
 }
 
+/* The certified range [lo, hi] of every x_i at this rank's rows (ulam_dist_bound; single source's
+ * b is e_source) and its largest half-width *worst. */
+static int bound(const ulam_part *p, const ulam_comm *c, int64_t source, const double *x, double **lo, double **hi,
+                 double *worst, ulam_error *err)
+{
+    int64_t first, last;
+    ulam_part_rows(p, &first, &last, NULL);
+    size_t rows = (size_t)(last - first) + 1;
+    double *e = source ? calloc(rows, sizeof *e) : NULL;
+    *lo = malloc(rows * sizeof **lo), *hi = malloc(rows * sizeof **hi);
+    if (e && source - 1 >= first && source - 1 < last) e[source - 1 - first] = 1.0;
+    int status = !*lo || !*hi || (source && !e) ? ULAM_ENOMEM : ulam_dist_bound(p, c, e, x, 200, *lo, *hi, worst, err);
+    if (status == ULAM_ENOMEM) err->status = status, snprintf(err->msg, sizeof err->msg, "memory for the bounds");
+    free(e);
+    return status;
+}
+
 /* Run the parsed command on this rank. */
 static int run(const args *a, const ulam_comm *c)
 {
     ulam_part *p = NULL;
     ulam_error err;
     int walks_forward = a->forward || a->mcsa || a->source; /* the walks run on M' */
-    int status = ulam_part_open(a->path, c, a->mcsa || a->source ? ULAM_PART_BOTH : a->forward ? ULAM_PART_MT : ULAM_PART_M,
-                                &p, &err);
+    int what = a->mcsa || a->source || a->bound ? ULAM_PART_BOTH : a->forward ? ULAM_PART_MT : ULAM_PART_M;
+    int status = a->rhs ? ulam_part_open_mtx(a->path, a->rhs, c, what, &p, &err) : ulam_part_open(a->path, c, what, &p, &err);
     int shared = first_status(c, status); /* every rank ends together, with the same code, when one cannot read its rows */
     if (shared) {
-        if (status) cli_report(a->path, &err);
+        if (status && (!a->rhs || c->rank == 0)) cli_report(a->path, &err); /* Matrix Market: every rank holds the first failure */
         ulam_part_free(p);
         return cli_exit_code(shared);
     }
@@ -361,7 +393,7 @@ static int run(const args *a, const ulam_comm *c)
     ulam_dist_result r = {0};
     ulam_dist_mcsa_info mi = {0};
     ulam_dist_source_info si = {0};
-    double *x = NULL, *se = NULL;
+    double *x = NULL, *se = NULL, *lo = NULL, *hi = NULL, worst = INFINITY;
     ulam_dist_result *many = NULL;
     ulam_dist_ci *ci = NULL, one = {NAN, NAN, INFINITY, INFINITY, 0};
     if (status) {
@@ -382,6 +414,7 @@ static int run(const args *a, const ulam_comm *c)
         else status = ulam_dist_forward(p, c, &a->o, x, se, &r, &err);
         if (!status && a->mcsa) r.walks = mi.walks, r.steps = mi.steps, r.crossings = mi.crossings, r.cut = mi.cut;
         if (!status && a->source) r.walks = si.walks, r.steps = si.steps, r.crossings = si.crossings, r.cut = si.cut;
+        if (!status && (a->mcsa || a->source || a->bound)) status = bound(p, c, a->source, x, &lo, &hi, &worst, &err);
     } else {
         int64_t i = a->index - 1;
         status = ulam_dist_adjoint_ci(p, c, &i, 1, &a->o, a->rel_err, &r, &one, &err);
@@ -394,13 +427,17 @@ static int run(const args *a, const ulam_comm *c)
     int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
     if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
     for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, nq, &many[k], a->o.seed, rho, &ci[k]);
-    if (!rc && a->source) rc = print_top(c, x, se, first, in_set0 ? last - first : 0, a->top, rho); /* set 0's rows */
+    if (!rc && a->source) rc = print_top(c, x, se, lo, hi, first, in_set0 ? last - first : 0, a->top, rho); /* set 0's rows */
     if (!rc && c->rank == 0 && a->mcsa)
         printf("x               %lld components by MCSA%s%s\nmcsa            %d iterations, residual %.3g of max |b| "
                "(target %.3g)\n", (long long)n, a->out ? ", written to " : "", a->out ? a->out : "", mi.iterations,
                mi.residual, a->tol);
     if (!rc && c->rank == 0 && a->source && cli_verbosity >= 0)
         printf("push            %d products with M, max |r| %.3g left to the walks\n", si.rounds, si.residual);
+    if (!rc && c->rank == 0 && (a->mcsa || a->bound)) {
+        if (isfinite(worst)) printf("bound           every |x_i - x*_i| <= %.3g (certified from x's residual and rho(|M|) < 1)\n", worst);
+        else printf("bound           none certified (power iteration did not certify rho(|M|) below 1)\n");
+    }
     if (!rc && c->rank == 0 && r.cut)
         fprintf(stderr, "ulam: %s: warning: %lld walks were cut at --max-steps %lld: the estimates and their standard "
                         "errors leave out what those walks would have scored\n", a->path, (long long)r.cut,
@@ -411,7 +448,7 @@ static int run(const args *a, const ulam_comm *c)
                                   a->path, (long long)a->max_iter, mi.residual, a->tol);
         rc = cli_exit_code(ULAM_ENOCONV);
     }
-    free(x), free(se), free(v), free(q), free(many), free(ci);
+    free(x), free(se), free(lo), free(hi), free(v), free(q), free(many), free(ci);
     return rc;
 }
 

@@ -49,9 +49,9 @@ def graph(n, seed=1):
     return M
 
 
-def rmat(L, alpha=0.85, seed=1):
+def rmat_edges(L, seed=1):
+    """The R-MAT draw's edges (src, dst), relabelled, and the generator after it."""
     import numpy as np
-    import scipy.sparse as sp
     n, rng = 1 << L, np.random.default_rng(seed)
     m = 8 * n
     u = np.zeros(m, np.int64)
@@ -61,7 +61,14 @@ def rmat(L, alpha=0.85, seed=1):
         u = 2 * u + (q >= 0.76)
         v = 2 * v + (((q >= 0.57) & (q < 0.76)) | (q >= 0.95))
     perm = rng.permutation(n)
-    src, dst = perm[u], perm[v]
+    return perm[u], perm[v], rng
+
+
+def rmat(L, alpha=0.85, seed=1):
+    import numpy as np
+    import scipy.sparse as sp
+    n = 1 << L
+    src, dst, _ = rmat_edges(L, seed)
     out = np.bincount(src, minlength=n).astype(float)
     M = sp.csr_matrix((alpha / out[src], (dst, src)), shape=(n, n))  # M_ji = alpha P_ij
     M.sum_duplicates()
