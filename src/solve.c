@@ -1167,7 +1167,7 @@ static void cs_first(ulam_solver *s, const ulam__block *br)
         }
         if (c.n == 0) continue;
         cs_plan_from(s, &run);
-        ulam__cs_add(&s->cs, c.n, c.mean, c.m2, 0.0);
+        ulam__cs_add4(&s->cs, c.n, c.mean, c.m2, c.m3, c.m4, 0.0);
         ulam__moments_merge(&run, &c);
     }
 }
@@ -1182,7 +1182,7 @@ static void merge_block(void *ctx, int q)
     int parts = s->cs.n == 0 && s->w.clip > 0;
     if (parts) cs_first(s, br); /* the first block, a part at a time */
     else cs_plan(s); /* from the blocks before this one alone */
-    if (s->o.mode == ULAM_ADJOINT && !parts) ulam__cs_add(&s->cs, br->clipped.n, br->clipped.mean, br->clipped.m2, 0.0);
+    if (s->o.mode == ULAM_ADJOINT && !parts) ulam__cs_add4(&s->cs, br->clipped.n, br->clipped.mean, br->clipped.m2, br->clipped.m3, br->clipped.m4, 0.0);
     ulam__moments_merge(&s->adj, &br->m);
     s->maxsq = fmax(s->maxsq, br->maxsq);
     ulam__moments w = br->watched;
@@ -1196,7 +1196,7 @@ static void merge_block(void *ctx, int q)
         ulam__moments_merge(&w, &zeros);
         ulam__moments c = br->clipped;
         ulam__moments_merge(&c, &zeros);
-        if (!parts) ulam__cs_add(&s->cs, c.n, c.mean, c.m2, 0.0);
+        if (!parts) ulam__cs_add4(&s->cs, c.n, c.mean, c.m2, c.m3, c.m4, 0.0);
         ulam__moments_merge(&s->watched, &w);
     }
     s->steps += br->steps;
@@ -1455,15 +1455,21 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
     double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
     *Rt = !truncated ? score_range(s, 1.0, 1.0) : t > 0 ? score_range(s, m, t / m) : INFINITY;
     double X = bias_scale(s, 0.0), n1 = fmin(*nplan, (double)BLOCK), least = INFINITY, t0 = 1e-6 * m;
-    for (int j = 0; truncated && !(E > 0) && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
-        /* no estimate yet, no target: the truncation whose bias and range term over the first round's
-           walks (a bet at its largest) add up least, whatever x is (a bias of a millionth of a
-           visit's score tripled the range of the first block: a --walks 1000 run's half-width
-           was 0.16 x against 0.048 x at 4096, Poisson 70 x 70 centre) */
-        double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X);
-        double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, n1) + tj;
-        if (isfinite(Rj) && wj < least) least = wj, t = tj, *Rt = Rj;
-    }
+    for (int pass = 0; pass < 2; pass++) /* under rel_err a second pass: the least bias within 5% of the least */
+        for (int j = 0; truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
+            /* no estimate yet: the truncation whose bias and range term over the first round's walks (a
+               bet at its largest) add up least, whatever x is (a bias of a millionth of a visit's score
+               tripled the range of the first block: a --walks 1000 run's half-width was 0.16 x against
+               0.048 x at 4096, Poisson 70 x 70 centre); under rel_err a bias of at most E X / 16 and,
+               the sum being flat near its least, the smallest bias within 5% of it (the first block's
+               bias stays in the sequence's weighted bias to the end: at E = 0.01 the least sum's bias,
+               near E x, took 10% more walks, hub at 0.99) */
+            double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X);
+            double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, n1) + tj;
+            if (!isfinite(Rj) || (E > 0 && tj > E * X / 16.0)) continue;
+            if (pass == 0 && wj < least) least = wj, t = tj, *Rt = Rj;
+            if (pass == 1 && E > 0 && wj <= 1.05 * least) t = tj, *Rt = Rj;
+        }
     for (int j = 2; truncated && *h > 0 && j <= 6; j++) { /* rel_err: the share of h (1/4 .. 1/64) that meets it soonest */
         double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m);
         double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);

@@ -108,6 +108,7 @@ double ulam__stop_combined_target(double E, double f);
 
 typedef struct {
     double eta, etax, v, etab; /* sum eta n, sum eta X, sum psi(lambda) xi^2, sum eta n b */
+    double vlo, vhi;           /* the lower and the upper end's penalty sums (each v under ulam__cs_add) */
     int64_t n;
     int beyond;                /* a block had a score past its limit */
     double lam, c, s, limit, bias; /* the plan for the next block */
@@ -121,6 +122,19 @@ void ulam__cs_plan(ulam__cs *cs, int64_t n, double mean, double var, double A, d
 /* Add a block of n scores (mean, m2 = sum of squared deviations, largest |score| maxabs) under
  * the current plan. */
 void ulam__cs_add(ulam__cs *cs, int64_t n, double mean, double m2, double maxabs);
+
+/* ulam__cs_add for a block whose third and fourth central moments are known too (m3, m4: sums of
+ * cubed and fourth-power deviations from mean), each end with its own penalty, a quartic in xi in
+ * place of psi(lambda) xi^2: for y >= -u (u < 1), ln(1 + y) >= y - y^2 / 2 + y^3 / 3 - psi4(u) (y / u)^4,
+ * psi4(u) = -ln(1 - u) - u - u^2 / 2 - u^3 / 3 (the quartic's remainder is largest at the lowest y),
+ * so with the scores in [-A, A], xi >= -a_lo for the lower end's bet (a_lo = (c + A) / s) and
+ * -xi >= -a_hi for the upper end's (a_hi = (A - c) / s), each end's supermartingale holds with the
+ * penalty lambda^2 xi^2 / 2 -+ lambda^3 xi^3 / 3 + psi4(lambda a) xi^4 / a^4 in place of
+ * psi(lambda) xi^2.  It is at most psi(lambda a) xi^2 / a^2 <= psi(lambda) xi^2 wherever xi is in
+ * range (equal at its end), and near the betting sequence's own ln(1 + lambda xi) where the scores
+ * sit well inside their range: Fan's psi(lambda) charged every score as if it were at the range's
+ * end. */
+void ulam__cs_add4(ulam__cs *cs, int64_t n, double mean, double m2, double m3, double m4, double maxabs);
 
 /* The sequence's 95% interval at estimate m (stretched to hold m), extra bias added on both
  * sides (walks cut at max_steps); kind ULAM__STOP_EB (an interval), ULAM__STOP_BEYOND or
