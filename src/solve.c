@@ -38,6 +38,11 @@
 #define TAIL_Q 0.99
 
 enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = ULAM__COMPLETE };
+/* A --rel-err run's first round: walks of block 0's stream (the rest of it left unrun: round.h's
+ * skip), and the fewest walks a later round makes; the confidence sequence holds at every count,
+ * so the rule may stop after any round (a first round of a whole block made every run at least
+ * 1024 walks, 10.7 times the CLT's count at E = 0.1 on the hub at 0.99). */
+enum { REL_FIRST = 256, REL_STEP = 64 };
 
 
 struct ulam_solver {
@@ -1232,7 +1237,7 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
 {
     double E = s->o.stop.rel_err, m = fabs(r->estimate + s->o.stop.rel_err_offset), R;
-    if (!(E > 0) || s->var_finite != 1 || r->walks < ULAM__REL_MIN) return 0;
+    if (!(E > 0) || s->var_finite != 1 || r->walks < REL_FIRST) return 0;
     if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
     if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.query.index] == 0)) return 0;
     if (!(r->cut_bound <= ULAM__CUT_SHARE * E * m)) return 0;
@@ -1249,7 +1254,7 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
  * (a failure ends the run with its status). */
 static int search_reach(ulam_solver *s, const ulam_walk_result *r)
 {
-    if (!s->given || !s->given->bounds || !(s->o.stop.rel_err > 0) || s->run.walks < ULAM__REL_MIN ||
+    if (!s->given || !s->given->bounds || !(s->o.stop.rel_err > 0) || s->run.walks < REL_FIRST ||
         r->estimate + s->o.stop.rel_err_offset != 0.0 || s->o.mode != ULAM_ADJOINT)
         return 0;
     s->given = NULL;
@@ -1315,7 +1320,8 @@ int ulam_solver_iterate(ulam_solver *s)
     if (!s) return ULAM_EINVAL;
     if (s->run.done) return s->run.status;
     static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally), merge_block,
-                                   begin_round, kernel_status};
+                                   begin_round, kernel_status, 1};
+    if (s->o.stop.rel_err > 0 && s->run.walks == 0) s->run.want = REL_FIRST;
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
     result(s, &r, 0, 1); /* the rules compare it with bounds made on the walked b */
@@ -1326,11 +1332,13 @@ int ulam_solver_iterate(ulam_solver *s)
         result(s, &r, 0, 1);
     }
     s->run.want = 0;
-    if (s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) { /* the next round no longer than the stop is near */
+    if (s->o.stop.rel_err > 0 && s->run.walks > 0) { /* the next round no longer than the stop is near */
         const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
         double m = fabs(r.estimate + s->o.stop.rel_err_offset);
         double left = ulam__cs_walks_left(&s->cs, mom->mean, ulam__moments_variance(mom), r.cut_bound, s->o.stop.rel_err * m);
-        s->run.want = isfinite(left) ? (int64_t)fmax(left, (double)s->run.walks / 8.0) : 0;
+        s->run.want = isfinite(left) && left > 0 ? (int64_t)fmax(fmax(left, (double)s->run.walks / 16.0), REL_STEP) : 0;
+        if (s->run.want == 0 && s->run.walks < ULAM__REL_MIN) /* no prediction yet: on to the walks the rules that */
+            s->run.want = ULAM__REL_MIN - s->run.walks;         /* give up (out of reach, cuts) judge from */
     }
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
@@ -1497,7 +1505,7 @@ static void cs_plan(ulam_solver *s)
     double Rt, A, b, h, nplan;
     plan_terms(s, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
-    ulam__cs_plan(&s->cs, mom->n, mom->mean, ulam__moments_variance(mom), A, b, h > b ? h - b : 0.0, nplan);
+    ulam__cs_plan4(&s->cs, mom->n, mom->mean, ulam__moments_variance(mom), mom->m3, mom->m4, A, b, h > b ? h - b : 0.0, nplan);
 }
 
 /* Plan the sequence's next part of the first block from the parts so far (run): as cs_plan, with
@@ -1509,7 +1517,7 @@ static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
     plan_terms(s, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     if (!(h > 0) && E > 0 && run->n >= 2) h = E * fabs(run->mean + s->o.stop.rel_err_offset);
-    ulam__cs_plan(&s->cs, run->n, run->mean, ulam__moments_variance(run), A, b, h > b ? h - b : 0.0, nplan);
+    ulam__cs_plan4(&s->cs, run->n, run->mean, ulam__moments_variance(run), run->m3, run->m4, A, b, h > b ? h - b : 0.0, nplan);
 }
 
 /* The run's 95% interval so far: the confidence sequence's (stop.h, ulam__cs), valid at every

@@ -140,6 +140,38 @@ static double cs_psi4_u4(double u)
     return sum;
 }
 
+/* The two ends' mean quartic penalty a score at bet l (plan: centre c, scale s, limit A), for
+ * scores of second and fourth moments v2, v4 about c in xi units. */
+static double cs_pen(const ulam__cs *cs, double l, double v2, double v4)
+{
+    double alo = fmin(1.0, (cs->c + cs->limit) / cs->s), ahi = fmin(1.0, (cs->limit - cs->c) / cs->s);
+    double c4 = 0.5 * (cs_psi4_u4(l * fmax(alo, 0.0)) + cs_psi4_u4(l * fmax(ahi, 0.0)));
+    return fmin(l * l / 2.0 * v2 + l * l * l * l * c4 * v4, cs_psi(l) * v2);
+}
+
+/* Plan the next block with the scores' higher moments. */
+void ulam__cs_plan4(ulam__cs *cs, int64_t n, double mean, double var, double m3, double m4, double A, double b, double h,
+                    double nplan)
+{
+    ulam__cs_plan(cs, n, mean, var, A, b, h, nplan); /* the limit, centre, scale and Fan's bet */
+    if (!(cs->lam > 0)) return;
+    double s = cs->s, N = (double)n, d = n > 0 && isfinite(mean) ? (mean - cs->c) / s : 0.0;
+    double M2 = n > 1 && isfinite(var) ? fmax(var, 0.0) * (N - 1.0) / (s * s) : 0.0;
+    double M3 = n > 1 && isfinite(m3) ? m3 / (s * s * s) : 0.0, M4 = n > 1 && isfinite(m4) ? fmax(m4, 0.0) / (s * s * s * s) : 0.0;
+    double v2 = (M2 + N * d * d + 0.25) / (N + 1.0); /* about c, with the prior observation */
+    double v4 = fmax((M4 + 4.0 * d * M3 + 6.0 * d * d * M2 + N * d * d * d * d + 0.0625) / (N + 1.0), v2 * v2);
+    double lo = 1e-9, hi = ULAM__CS_LMAX, g = 0.5 * (sqrt(5.0) - 1.0); /* golden-section: the objective is unimodal */
+    for (int it = 0; it < 60; it++) {
+        double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1, f2;
+        if (h > 0) f1 = -(x1 * h / s - cs_pen(cs, x1, v2, v4)), f2 = -(x2 * h / s - cs_pen(cs, x2, v2, v4));
+        else f1 = (cs_log() / fmax(nplan, 2.0) + cs_pen(cs, x1, v2, v4)) / x1, f2 = (cs_log() / fmax(nplan, 2.0) + cs_pen(cs, x2, v2, v4)) / x2;
+        if (f1 <= f2) hi = x2;
+        else lo = x1;
+    }
+    double lam = 0.5 * (lo + hi);
+    if (isfinite(lam) && lam > 0) cs->lam = fmin(lam, ULAM__CS_LMAX);
+}
+
 /* Add a block under the current plan: its scores' moments about the block's centre c in xi units
  * (S2, S3, S4: sums of xi^2, xi^3, xi^4; S3 = S4 = NAN when not known: Fan's psi both ends). */
 static void cs_add_sums(ulam__cs *cs, int64_t n, double mean, double S2, double S3, double S4, double maxabs)

@@ -101,7 +101,9 @@ double ulam__stop_combined_target(double E, double f);
  * checkpoints.  lambda_q is tuned to the planned end: with a target half-width h (rel_err) the
  * lambda whose interval first reaches h, lambda = h s / sigma^2 (for psi(l) ~ l^2 / 2); with a
  * planned walk count n (a fixed budget, a time limit), the lambda narrowest at n,
- * sqrt(2 ln(2 / delta) / (sigma_xi^2 n)); never above ULAM__CS_LMAX.  A block with a score past
+ * sqrt(2 ln(2 / delta) / (sigma_xi^2 n)); never above ULAM__CS_LMAX.  The matrix solver adds its
+ * blocks with ulam__cs_add4 (each end's quartic penalty, below Fan's) and plans them with
+ * ulam__cs_plan4 (the bets that penalty pays best for).  A block with a score past
  * its A_q makes the sequence withhold the interval from then on (its clipped scores, which the
  * bound is about, are not the ones seen). */
 #define ULAM__CS_LMAX 0.75
@@ -118,6 +120,16 @@ typedef struct {
  * (every score in [-A, A]), the bias bound b of its scores' mean, and either the target
  * half-width h > 0 or the planned walk count nplan. */
 void ulam__cs_plan(ulam__cs *cs, int64_t n, double mean, double var, double A, double b, double h, double nplan);
+
+/* ulam__cs_plan for blocks added by ulam__cs_add4, from the blocks so far with their sums of
+ * cubed and fourth-power deviations too (m3, m4; with n, mean and var): the bet that maximises
+ * lambda h_xi - pen(lambda) with a target, or minimises (ln(2 / delta) / nplan + pen(lambda)) / lambda
+ * with a planned count, pen the two ends' mean quartic penalty a score (its cubes cancel between
+ * the ends) at the scores' second and fourth moments about the centre, with the one prior
+ * observation at xi^2 = 1/4 (xi^4 = 1/16) as ulam__cs_plan's; ulam__cs_plan's bet is the least
+ * of Fan's psi, which the quartic undercuts, so it bet smaller than the quartic pays best for. */
+void ulam__cs_plan4(ulam__cs *cs, int64_t n, double mean, double var, double m3, double m4, double A, double b, double h,
+                    double nplan);
 
 /* Add a block of n scores (mean, m2 = sum of squared deviations, largest |score| maxabs) under
  * the current plan. */

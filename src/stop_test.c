@@ -1,5 +1,6 @@
 /* A unit test of src/stop.c built with the module (tests/meson.build's module units): the
- * stitching's confidence levels, which no public call shows one by one.  It includes stop.h, its
+ * stitching's confidence levels and the confidence sequence's quartic penalty (ulam__cs_add4),
+ * which no public call shows one by one.  It includes stop.h, its
  * module's private header, beside it; the tests in tests/ include public headers only. */
 #include "stop.h"
 #include "stats.h"
