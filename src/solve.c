@@ -44,6 +44,12 @@ enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = ULAM
  * 1024 walks, 10.7 times the CLT's count at E = 0.1 on the hub at 0.99). */
 enum { REL_FIRST = 256, REL_STEP = 64 };
 
+/* The lesser of a and b. */
+static int64_t imin64(int64_t a, int64_t b)
+{
+    return a < b ? a : b;
+}
+
 
 struct ulam_solver {
     ulam_walk_opts o;
@@ -1336,9 +1342,11 @@ int ulam_solver_iterate(ulam_solver *s)
         const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
         double m = fabs(r.estimate + s->o.stop.rel_err_offset);
         double left = ulam__cs_walks_left(&s->cs, mom->mean, ulam__moments_variance(mom), r.cut_bound, s->o.stop.rel_err * m);
-        s->run.want = isfinite(left) && left > 0 ? (int64_t)fmax(fmax(left, (double)s->run.walks / 16.0), REL_STEP) : 0;
-        if (s->run.want == 0 && s->run.walks < ULAM__REL_MIN) /* no prediction yet: on to the walks the rules that */
-            s->run.want = ULAM__REL_MIN - s->run.walks;         /* give up (out of reach, cuts) judge from */
+        s->run.want = isfinite(left) && left > 0 ? (int64_t)fmin(fmax(fmax(left, (double)s->run.walks / 16.0), REL_STEP), 1e15)
+                                                 : 0; /* 1e15: past any budget, inside int64_t */
+        if (s->run.walks < ULAM__REL_MIN) /* at most on to the walks the rules that give up (out of reach, cuts) */
+            s->run.want = s->run.want > 0 ? imin64(s->run.want, ULAM__REL_MIN - s->run.walks) /* judge from */
+                                          : ULAM__REL_MIN - s->run.walks;
     }
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;

@@ -160,7 +160,7 @@ void ulam__cs_plan4(ulam__cs *cs, int64_t n, double mean, double var, double m3,
     double M3 = n > 1 && isfinite(m3) ? m3 / (s * s * s) : 0.0, M4 = n > 1 && isfinite(m4) ? fmax(m4, 0.0) / (s * s * s * s) : 0.0;
     double v2 = (M2 + N * d * d + 0.25) / (N + 1.0); /* about c, with the prior observation */
     double v4 = fmax((M4 + 4.0 * d * M3 + 6.0 * d * d * M2 + N * d * d * d * d + 0.0625) / (N + 1.0), v2 * v2);
-    double lo = 1e-9, hi = ULAM__CS_LMAX, g = 0.5 * (sqrt(5.0) - 1.0); /* golden-section: the objective is unimodal */
+    double lo = 1e-9, hi = ULAM__CS_LMAX4, g = 0.5 * (sqrt(5.0) - 1.0); /* golden-section: the objective is unimodal */
     for (int it = 0; it < 60; it++) {
         double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1, f2;
         if (h > 0) f1 = -(x1 * h / s - cs_pen(cs, x1, v2, v4)), f2 = -(x2 * h / s - cs_pen(cs, x2, v2, v4));
@@ -169,7 +169,7 @@ void ulam__cs_plan4(ulam__cs *cs, int64_t n, double mean, double var, double m3,
         else lo = x1;
     }
     double lam = 0.5 * (lo + hi);
-    if (isfinite(lam) && lam > 0) cs->lam = fmin(lam, ULAM__CS_LMAX);
+    if (isfinite(lam) && lam > 0) cs->lam = fmin(lam, ULAM__CS_LMAX4);
 }
 
 /* Add a block under the current plan: its scores' moments about the block's centre c in xi units
