@@ -138,13 +138,15 @@ static int exchange(const ulam_walk_opts *o, double t0, void *blocks, const ulam
  * 4, ... blocks up to B->round (a round is as long as all before it), so a --rel-err or time
  * rule is checked often while little has run, and the schedule depends on walks done only,
  * never on the thread count. */
-static int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int64_t want, int threads,
-                void *ctx, void *results, int *nb, int *stop)
+static int ulam__round(const ulam__blocks *B, const ulam_walk_opts *o, double t0, int64_t next, int64_t skip, int64_t want,
+                int threads, void *ctx, void *results, int *nb, int *stop)
 {
-    int64_t left = o->stop.max_walks > 0 ? o->stop.max_walks - next : INT64_MAX, done = next / B->block;
+    int64_t left = o->stop.max_walks > 0 ? o->stop.max_walks - next : INT64_MAX, done = (next + skip) / B->block;
     int round = done + 1 < B->round ? (int)(done + 1) : B->round, n = 0;
     if (want > 0 && want / B->block + 1 < round) round = (int)(want / B->block + 1); /* a rule's stop is near */
+    if (B->partial && want > 0 && want < left) left = want; /* exactly the walks asked: the last block cut short */
     while (n < round && left > (int64_t)n * B->block) n++;
+    next += skip; /* the walks' place in the streams */
     /* A team only for rounds of at least TEAM_BLOCKS blocks a thread: a small round (the first
        ones, a small query) runs on the calling thread, which would otherwise wait at the round's
        end for a worker to be scheduled: on a busy machine a time slice or more, 40-100x the walks
@@ -180,7 +182,7 @@ int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads
     double start = ulam_now();
     if (run->t0 < 0) run->t0 = start;
     if (B->begin) B->begin(ctx);
-    int nb, stop, st = ulam__round(B, o, run->t0, run->walks, run->want, threads, ctx, results, &nb, &stop);
+    int nb, stop, st = ulam__round(B, o, run->t0, run->walks, run->skip, run->want, threads, ctx, results, &nb, &stop);
     if (st) run->status = st;
     for (int k = 0; k < nb; k++) {
         const ulam__block_head *h = head(B, results, k);
@@ -191,6 +193,7 @@ int ulam__round_step(const ulam__blocks *B, const ulam_walk_opts *o, int threads
         }
         B->merge(ctx, k);
         run->walks += h->walks;
+        if (B->partial && h->walks < B->block) run->skip += B->block - h->walks; /* the rest of its stream unrun */
         run->nonfinite += h->nonfinite;
     }
     run->seconds += ulam_now() - start;

@@ -38,6 +38,7 @@ typedef struct {
     void (*merge)(void *ctx, int k);
     void (*begin)(void *ctx);
     int (*failure)(void *ctx);
+    int partial; /* nonzero: a round runs the walks `want` asks, its last block cut short (see ulam__run) */
 } ulam__blocks;
 
 /* Where a walk run stands between rounds, the part of a solver the round driver keeps: walks
@@ -50,7 +51,12 @@ typedef struct {
     double t0, seconds;
     int done, interrupted, status;
     int64_t want; /* the walks a rule (rel_err) predicts the run still needs, from its results so far
-                     (0: no prediction): a round runs at most the blocks that many take, at least one */
+                     (0: no prediction): a round runs at most the blocks that many take, at least one;
+                     with B->partial exactly that many walks (the last block's cut short) */
+    int64_t skip; /* with B->partial, the walks of short blocks' streams left unrun: a block's first
+                     walk (and so its stream, first / block) is walks + skip, every stream a block's
+                     alone (a rule checks after a few walks of a block without the next round
+                     reusing the rest of its stream) */
 } ulam__run;
 
 /* A run not yet started. */

@@ -38,6 +38,17 @@
 #define TAIL_Q 0.99
 
 enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = ULAM__COMPLETE };
+/* A --rel-err run's first round: walks of block 0's stream (the rest of it left unrun: round.h's
+ * skip), and the fewest walks a later round makes; the confidence sequence holds at every count,
+ * so the rule may stop after any round (a first round of a whole block made every run at least
+ * 1024 walks, 10.7 times the CLT's count at E = 0.1 on the hub at 0.99). */
+enum { REL_FIRST = 256, REL_STEP = 64 };
+
+/* The lesser of a and b. */
+static int64_t imin64(int64_t a, int64_t b)
+{
+    return a < b ? a : b;
+}
 
 
 struct ulam_solver {
@@ -1228,7 +1239,7 @@ static void cs_first(ulam_solver *s, const ulam__block *br)
         }
         if (c.n == 0) continue;
         cs_plan_from(s, &run);
-        ulam__cs_add(&s->cs, c.n, c.mean, c.m2, 0.0);
+        ulam__cs_add4(&s->cs, c.n, c.mean, c.m2, c.m3, c.m4, 0.0);
         ulam__moments_merge(&run, &c);
     }
 }
@@ -1243,7 +1254,7 @@ static void merge_block(void *ctx, int q)
     int parts = s->cs.n == 0 && s->w.clip > 0;
     if (parts) cs_first(s, br); /* the first block, a part at a time */
     else cs_plan(s); /* from the blocks before this one alone */
-    if (s->o.mode == ULAM_ADJOINT && !parts) ulam__cs_add(&s->cs, br->clipped.n, br->clipped.mean, br->clipped.m2, 0.0);
+    if (s->o.mode == ULAM_ADJOINT && !parts) ulam__cs_add4(&s->cs, br->clipped.n, br->clipped.mean, br->clipped.m2, br->clipped.m3, br->clipped.m4, 0.0);
     ulam__moments_merge(&s->adj, &br->m);
     s->maxsq = fmax(s->maxsq, br->maxsq);
     ulam__moments w = br->watched;
@@ -1257,7 +1268,7 @@ static void merge_block(void *ctx, int q)
         ulam__moments_merge(&w, &zeros);
         ulam__moments c = br->clipped;
         ulam__moments_merge(&c, &zeros);
-        if (!parts) ulam__cs_add(&s->cs, c.n, c.mean, c.m2, 0.0);
+        if (!parts) ulam__cs_add4(&s->cs, c.n, c.mean, c.m2, c.m3, c.m4, 0.0);
         ulam__moments_merge(&s->watched, &w);
     }
     s->steps += br->steps;
@@ -1293,7 +1304,7 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
 {
     double E = s->o.stop.rel_err, m = fabs(r->estimate + s->o.stop.rel_err_offset), R;
-    if (!(E > 0) || s->var_finite != 1 || r->walks < ULAM__REL_MIN) return 0;
+    if (!(E > 0) || s->var_finite != 1 || r->walks < REL_FIRST) return 0;
     if (s->bound == 0.0 || s->per_step == 0.0) return 1; /* nothing that scores is reachable: x is 0 */
     if (m == 0 || (s->o.mode == ULAM_FORWARD && s->sumsq[s->o.query.index] == 0)) return 0;
     if (!(r->cut_bound <= ULAM__CUT_SHARE * E * m)) return 0;
@@ -1310,7 +1321,7 @@ static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
  * (a failure ends the run with its status). */
 static int search_reach(ulam_solver *s, const ulam_walk_result *r)
 {
-    if (!s->given || !s->given->bounds || !(s->o.stop.rel_err > 0) || s->run.walks < ULAM__REL_MIN ||
+    if (!s->given || !s->given->bounds || !(s->o.stop.rel_err > 0) || s->run.walks < REL_FIRST ||
         r->estimate + s->o.stop.rel_err_offset != 0.0 || s->o.mode != ULAM_ADJOINT)
         return 0;
     s->given = NULL;
@@ -1376,7 +1387,8 @@ int ulam_solver_iterate(ulam_solver *s)
     if (!s) return ULAM_EINVAL;
     if (s->run.done) return s->run.status;
     static const ulam__blocks B = {BLOCK, ROUND, run_block, sizeof(ulam__block), sizeof(ulam__tally), merge_block,
-                                   begin_round, kernel_status};
+                                   begin_round, kernel_status, 1};
+    if (s->o.stop.rel_err > 0 && s->run.walks == 0) s->run.want = REL_FIRST;
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_walk_result r;
     result(s, &r, 0, 1); /* the rules compare it with bounds made on the walked b */
@@ -1387,11 +1399,15 @@ int ulam_solver_iterate(ulam_solver *s)
         result(s, &r, 0, 1);
     }
     s->run.want = 0;
-    if (s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) { /* the next round no longer than the stop is near */
+    if (s->o.stop.rel_err > 0 && s->run.walks > 0) { /* the next round no longer than the stop is near */
         const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
         double m = fabs(r.estimate + s->o.stop.rel_err_offset);
         double left = ulam__cs_walks_left(&s->cs, mom->mean, ulam__moments_variance(mom), r.cut_bound, s->o.stop.rel_err * m);
-        s->run.want = isfinite(left) ? (int64_t)fmax(left, (double)s->run.walks / 8.0) : 0;
+        s->run.want = isfinite(left) && left > 0 ? (int64_t)fmin(fmax(fmax(left, (double)s->run.walks / 16.0), REL_STEP), 1e15)
+                                                 : 0; /* 1e15: past any budget, inside int64_t */
+        if (s->run.walks < ULAM__REL_MIN) /* at most on to the walks the rules that give up (out of reach, cuts) */
+            s->run.want = s->run.want > 0 ? imin64(s->run.want, ULAM__REL_MIN - s->run.walks) /* judge from */
+                                          : ULAM__REL_MIN - s->run.walks;
     }
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
@@ -1516,15 +1532,21 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
     double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
     *Rt = !truncated ? score_range(s, 1.0, 1.0) : t > 0 ? score_range(s, m, t / m) : INFINITY;
     double X = bias_scale(s, 0.0), n1 = fmin(*nplan, (double)BLOCK), least = INFINITY, t0 = 1e-6 * m;
-    for (int j = 0; truncated && !(E > 0) && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
-        /* no estimate yet, no target: the truncation whose bias and range term over the first round's
-           walks (a bet at its largest) add up least, whatever x is (a bias of a millionth of a
-           visit's score tripled the range of the first block: a --walks 1000 run's half-width
-           was 0.16 x against 0.048 x at 4096, Poisson 70 x 70 centre) */
-        double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X);
-        double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, n1) + tj;
-        if (isfinite(Rj) && wj < least) least = wj, t = tj, *Rt = Rj;
-    }
+    for (int pass = 0; pass < 2; pass++) /* under rel_err a second pass: the least bias within 5% of the least */
+        for (int j = 0; truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
+            /* no estimate yet: the truncation whose bias and range term over the first round's walks (a
+               bet at its largest) add up least, whatever x is (a bias of a millionth of a visit's score
+               tripled the range of the first block: a --walks 1000 run's half-width was 0.16 x against
+               0.048 x at 4096, Poisson 70 x 70 centre); under rel_err a bias of at most E X / 16 and,
+               the sum being flat near its least, the smallest bias within 5% of it (the first block's
+               bias stays in the sequence's weighted bias to the end: at E = 0.01 the least sum's bias,
+               near E x, took 10% more walks, hub at 0.99) */
+            double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X);
+            double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, n1) + tj;
+            if (!isfinite(Rj) || (E > 0 && tj > E * X / 16.0)) continue;
+            if (pass == 0 && wj < least) least = wj, t = tj, *Rt = Rj;
+            if (pass == 1 && E > 0 && wj <= 1.05 * least) t = tj, *Rt = Rj;
+        }
     for (int j = 2; truncated && *h > 0 && j <= 6; j++) { /* rel_err: the share of h (1/4 .. 1/64) that meets it soonest */
         double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m);
         double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
@@ -1552,7 +1574,7 @@ static void cs_plan(ulam_solver *s)
     double Rt, A, b, h, nplan;
     plan_terms(s, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
-    ulam__cs_plan(&s->cs, mom->n, mom->mean, ulam__moments_variance(mom), A, b, h > b ? h - b : 0.0, nplan);
+    ulam__cs_plan4(&s->cs, mom->n, mom->mean, ulam__moments_variance(mom), mom->m3, mom->m4, A, b, h > b ? h - b : 0.0, nplan);
 }
 
 /* Plan the sequence's next part of the first block from the parts so far (run): as cs_plan, with
@@ -1564,7 +1586,7 @@ static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
     plan_terms(s, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     if (!(h > 0) && E > 0 && run->n >= 2) h = E * fabs(run->mean + s->o.stop.rel_err_offset);
-    ulam__cs_plan(&s->cs, run->n, run->mean, ulam__moments_variance(run), A, b, h > b ? h - b : 0.0, nplan);
+    ulam__cs_plan4(&s->cs, run->n, run->mean, ulam__moments_variance(run), run->m3, run->m4, A, b, h > b ? h - b : 0.0, nplan);
 }
 
 /* The run's 95% interval so far: the confidence sequence's (stop.h, ulam__cs), valid at every

@@ -131,17 +131,83 @@ void ulam__cs_plan(ulam__cs *cs, int64_t n, double mean, double var, double A, d
     cs->lam = isfinite(lam) && lam > 0 ? fmin(lam, ULAM__CS_LMAX) : 0.0, cs->c = c, cs->s = s;
 }
 
-/* Add a block under the current plan. */
-void ulam__cs_add(ulam__cs *cs, int64_t n, double mean, double m2, double maxabs)
+/* psi4(u) / u^4 = sum over k >= 4 of u^(k - 4) / k, u in [0, 1): the quartic's coefficient. */
+static double cs_psi4_u4(double u)
+{
+    if (u >= 0.25) return (-log1p(-u) - u - u * u / 2.0 - u * u * u / 3.0) / (u * u * u * u);
+    double sum = 0.0, p = 1.0;
+    for (int k = 4; k < 40; k++, p *= u) sum += p / k; /* 0.25^36: past the double's precision */
+    return sum;
+}
+
+/* The two ends' mean quartic penalty a score at bet l (plan: centre c, scale s, limit A), for
+ * scores of second and fourth moments v2, v4 about c in xi units. */
+static double cs_pen(const ulam__cs *cs, double l, double v2, double v4)
+{
+    double alo = fmin(1.0, (cs->c + cs->limit) / cs->s), ahi = fmin(1.0, (cs->limit - cs->c) / cs->s);
+    double c4 = 0.5 * (cs_psi4_u4(l * fmax(alo, 0.0)) + cs_psi4_u4(l * fmax(ahi, 0.0)));
+    return fmin(l * l / 2.0 * v2 + l * l * l * l * c4 * v4, cs_psi(l) * v2);
+}
+
+/* Plan the next block with the scores' higher moments. */
+void ulam__cs_plan4(ulam__cs *cs, int64_t n, double mean, double var, double m3, double m4, double A, double b, double h,
+                    double nplan)
+{
+    ulam__cs_plan(cs, n, mean, var, A, b, h, nplan); /* the limit, centre, scale and Fan's bet */
+    if (!(cs->lam > 0)) return;
+    double s = cs->s, N = (double)n, d = n > 0 && isfinite(mean) ? (mean - cs->c) / s : 0.0;
+    double M2 = n > 1 && isfinite(var) ? fmax(var, 0.0) * (N - 1.0) / (s * s) : 0.0;
+    double M3 = n > 1 && isfinite(m3) ? m3 / (s * s * s) : 0.0, M4 = n > 1 && isfinite(m4) ? fmax(m4, 0.0) / (s * s * s * s) : 0.0;
+    double v2 = (M2 + N * d * d + 0.25) / (N + 1.0); /* about c, with the prior observation */
+    double v4 = fmax((M4 + 4.0 * d * M3 + 6.0 * d * d * M2 + N * d * d * d * d + 0.0625) / (N + 1.0), v2 * v2);
+    double lo = 1e-9, hi = ULAM__CS_LMAX4, g = 0.5 * (sqrt(5.0) - 1.0); /* golden-section: the objective is unimodal */
+    for (int it = 0; it < 60; it++) {
+        double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1, f2;
+        if (h > 0) f1 = -(x1 * h / s - cs_pen(cs, x1, v2, v4)), f2 = -(x2 * h / s - cs_pen(cs, x2, v2, v4));
+        else f1 = (cs_log() / fmax(nplan, 2.0) + cs_pen(cs, x1, v2, v4)) / x1, f2 = (cs_log() / fmax(nplan, 2.0) + cs_pen(cs, x2, v2, v4)) / x2;
+        if (f1 <= f2) hi = x2;
+        else lo = x1;
+    }
+    double lam = 0.5 * (lo + hi);
+    if (isfinite(lam) && lam > 0) cs->lam = fmin(lam, ULAM__CS_LMAX4);
+}
+
+/* Add a block under the current plan: its scores' moments about the block's centre c in xi units
+ * (S2, S3, S4: sums of xi^2, xi^3, xi^4; S3 = S4 = NAN when not known: Fan's psi both ends). */
+static void cs_add_sums(ulam__cs *cs, int64_t n, double mean, double S2, double S3, double S4, double maxabs)
 {
     if (n <= 0) return;
     if (maxabs > cs->limit * (1.0 + ULAM__STOP_ROUNDING) || !isfinite(mean)) cs->beyond = 1;
-    double N = (double)n, eta = cs->lam / cs->s, d = mean - cs->c;
+    double N = (double)n, eta = cs->lam / cs->s, l = cs->lam;
     if (eta > 0 && isfinite(eta) && !cs->beyond) {
         cs->eta += eta * N, cs->etax += eta * N * mean, cs->etab += eta * N * cs->bias;
-        cs->v += cs_psi(cs->lam) * (fmax(m2, 0.0) + N * d * d) / cs->s / cs->s;
+        double fan = cs_psi(l) * S2, lo = fan, hi = fan;
+        if (isfinite(S3) && isfinite(S4)) { /* the quartic, each end at its own range end (stop.h) */
+            double alo = fmin(1.0, (cs->c + cs->limit) / cs->s), ahi = fmin(1.0, (cs->limit - cs->c) / cs->s);
+            double l4 = l * l * l * l, q = l * l / 2.0 * S2, t = l * l * l / 3.0 * S3;
+            lo = fmin(fan, q - t + l4 * cs_psi4_u4(l * fmax(alo, 0.0)) * S4);
+            hi = fmin(fan, q + t + l4 * cs_psi4_u4(l * fmax(ahi, 0.0)) * S4);
+        }
+        cs->v += fan, cs->vlo += lo, cs->vhi += hi;
     }
     cs->n += n;
+}
+
+/* Add a block under the current plan. */
+void ulam__cs_add(ulam__cs *cs, int64_t n, double mean, double m2, double maxabs)
+{
+    double d = (mean - cs->c) / cs->s, N = (double)n;
+    cs_add_sums(cs, n, mean, (fmax(m2, 0.0) / cs->s / cs->s + N * d * d), NAN, NAN, maxabs);
+}
+
+/* Add a block with its third and fourth moments under the current plan. */
+void ulam__cs_add4(ulam__cs *cs, int64_t n, double mean, double m2, double m3, double m4, double maxabs)
+{
+    double s = cs->s, d = (mean - cs->c) / s, N = (double)n, M2 = fmax(m2, 0.0) / (s * s), M3 = m3 / (s * s * s);
+    double M4 = fmax(m4, 0.0) / (s * s * s * s); /* about the block's mean, then shifted to c: sum (y + d)^k */
+    double S2 = M2 + N * d * d, S3 = M3 + 3.0 * d * M2 + N * d * d * d;
+    double S4 = M4 + 4.0 * d * M3 + 6.0 * d * d * M2 + N * d * d * d * d;
+    cs_add_sums(cs, n, mean, S2, S3, fmax(S4, 0.0), maxabs);
 }
 
 /* The sequence's interval. */
@@ -161,8 +227,8 @@ void ulam__cs_interval_sides(const ulam__cs *cs, double m, double extra, double 
     }
     if (cs->n < 2 || !(cs->eta > 0) || !isfinite(m) || !(extra >= 0) || !isfinite(extra)) return;
     double c = cs->etax / cs->eta, b = cs->etab / cs->eta + extra;
-    ci->var_term = cs->v / cs->eta, ci->range_term = ci->L / cs->eta, ci->bias = b;
-    ci->lo = fmin(c - (llo + cs->v) / cs->eta - b, m), ci->hi = fmax(c + (lhi + cs->v) / cs->eta + b, m); /* holding m */
+    ci->var_term = 0.5 * (cs->vlo + cs->vhi) / cs->eta, ci->range_term = ci->L / cs->eta, ci->bias = b;
+    ci->lo = fmin(c - (llo + cs->vlo) / cs->eta - b, m), ci->hi = fmax(c + (lhi + cs->vhi) / cs->eta + b, m); /* holding m */
     ci->half = 0.5 * (ci->hi - ci->lo);
     ci->kind = ULAM__STOP_EB;
 }
@@ -192,7 +258,8 @@ double ulam__cs_walks_left(const ulam__cs *cs, double mean, double var, double e
     if (!(h > 0) || cs->beyond || !(eta > 0) || !isfinite(eta)) return INFINITY;
     double b = cs->eta > 0 ? cs->etab / cs->eta : cs->bias, hb = h - fmax(b, cs->bias) - extra;
     if (!(hb > 0)) return INFINITY;
-    if (cs->eta > 0 && (L + cs->v) / cs->eta <= hb) return 0.0;
-    double a = cs_psi(cs->lam) * (fmax(var, 0.0) / cs->s / cs->s + d * d), den = hb * eta - a; /* per walk */
-    return den > 0 ? ceil((L + cs->v - hb * cs->eta) / den) : INFINITY;
+    double v = 0.5 * (cs->vlo + cs->vhi), f = cs->v > 0 ? v / cs->v : 1.0; /* the ends' penalty over Fan's so far */
+    if (cs->eta > 0 && (L + v) / cs->eta <= hb) return 0.0;
+    double a = f * cs_psi(cs->lam) * (fmax(var, 0.0) / cs->s / cs->s + d * d), den = hb * eta - a; /* per walk */
+    return den > 0 ? ceil((L + v - hb * cs->eta) / den) : INFINITY;
 }

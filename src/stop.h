@@ -101,13 +101,20 @@ double ulam__stop_combined_target(double E, double f);
  * checkpoints.  lambda_q is tuned to the planned end: with a target half-width h (rel_err) the
  * lambda whose interval first reaches h, lambda = h s / sigma^2 (for psi(l) ~ l^2 / 2); with a
  * planned walk count n (a fixed budget, a time limit), the lambda narrowest at n,
- * sqrt(2 ln(2 / delta) / (sigma_xi^2 n)); never above ULAM__CS_LMAX.  A block with a score past
+ * sqrt(2 ln(2 / delta) / (sigma_xi^2 n)); never above ULAM__CS_LMAX.  The matrix solver adds its
+ * blocks with ulam__cs_add4 (each end's quartic penalty, below Fan's) and plans them with
+ * ulam__cs_plan4 (the bets that penalty pays best for).  A block with a score past
  * its A_q makes the sequence withhold the interval from then on (its clipped scores, which the
  * bound is about, are not the ones seen). */
 #define ULAM__CS_LMAX 0.75
+/* ulam__cs_plan4's cap: the quartic charges a large bet little where the scores sit inside the
+ * range (bench_relerr at E = 0.1, 3 seeds: walks/clt 3.91 -> 3.48 on the Laplacian's corner,
+ * 21.8 -> 17.1 on convection-diffusion, against 0.75); any cap below 1 keeps lambda a < 1 */
+#define ULAM__CS_LMAX4 0.95
 
 typedef struct {
     double eta, etax, v, etab; /* sum eta n, sum eta X, sum psi(lambda) xi^2, sum eta n b */
+    double vlo, vhi;           /* the lower and the upper end's penalty sums (each v under ulam__cs_add) */
     int64_t n;
     int beyond;                /* a block had a score past its limit */
     double lam, c, s, limit, bias; /* the plan for the next block */
@@ -118,9 +125,32 @@ typedef struct {
  * half-width h > 0 or the planned walk count nplan. */
 void ulam__cs_plan(ulam__cs *cs, int64_t n, double mean, double var, double A, double b, double h, double nplan);
 
+/* ulam__cs_plan for blocks added by ulam__cs_add4, from the blocks so far with their sums of
+ * cubed and fourth-power deviations too (m3, m4; with n, mean and var): the bet that maximises
+ * lambda h_xi - pen(lambda) with a target, or minimises (ln(2 / delta) / nplan + pen(lambda)) / lambda
+ * with a planned count, pen the two ends' mean quartic penalty a score (its cubes cancel between
+ * the ends) at the scores' second and fourth moments about the centre, with the one prior
+ * observation at xi^2 = 1/4 (xi^4 = 1/16) as ulam__cs_plan's; ulam__cs_plan's bet is the least
+ * of Fan's psi, which the quartic undercuts, so it bet smaller than the quartic pays best for. */
+void ulam__cs_plan4(ulam__cs *cs, int64_t n, double mean, double var, double m3, double m4, double A, double b, double h,
+                    double nplan);
+
 /* Add a block of n scores (mean, m2 = sum of squared deviations, largest |score| maxabs) under
  * the current plan. */
 void ulam__cs_add(ulam__cs *cs, int64_t n, double mean, double m2, double maxabs);
+
+/* ulam__cs_add for a block whose third and fourth central moments are known too (m3, m4: sums of
+ * cubed and fourth-power deviations from mean), each end with its own penalty, a quartic in xi in
+ * place of psi(lambda) xi^2: for y >= -u (u < 1), ln(1 + y) >= y - y^2 / 2 + y^3 / 3 - psi4(u) (y / u)^4,
+ * psi4(u) = -ln(1 - u) - u - u^2 / 2 - u^3 / 3 (the quartic's remainder is largest at the lowest y),
+ * so with the scores in [-A, A], xi >= -a_lo for the lower end's bet (a_lo = (c + A) / s) and
+ * -xi >= -a_hi for the upper end's (a_hi = (A - c) / s), each end's supermartingale holds with the
+ * penalty lambda^2 xi^2 / 2 -+ lambda^3 xi^3 / 3 + psi4(lambda a) xi^4 / a^4 in place of
+ * psi(lambda) xi^2.  It is at most psi(lambda a) xi^2 / a^2 <= psi(lambda) xi^2 wherever xi is in
+ * range (equal at its end), and near the betting sequence's own ln(1 + lambda xi) where the scores
+ * sit well inside their range: Fan's psi(lambda) charged every score as if it were at the range's
+ * end. */
+void ulam__cs_add4(ulam__cs *cs, int64_t n, double mean, double m2, double m3, double m4, double maxabs);
 
 /* The sequence's 95% interval at estimate m (stretched to hold m), extra bias added on both
  * sides (walks cut at max_steps); kind ULAM__STOP_EB (an interval), ULAM__STOP_BEYOND or

@@ -941,7 +941,7 @@ def check_rel_err_stops(ulam):
         args = ["solve", "--method", "walks", p, "--rhs", pb, "--index", "1", "--rel-err", "0.01"]
         rc, out, err = run(ulam, args + ["--max-steps", "2000", "--json"])
         o = json.loads(out)
-        assert rc == 0 and o["rel_err_met"] is False and o["rel_err_stop"] == "cuts" and o["walks"] == 1024, o
+        assert rc == 0 and o["rel_err_met"] is False and o["rel_err_stop"] == "cuts" and o["walks"] == 1000, o
         assert o["cut_bound"] > 1000 and "raise --max-steps" in err, (o, err)
         rc, out, err = run(ulam, args + ["--max-steps", "2000"])
         assert rc == 0 and re.search(r"^rel-err +NOT met .*raise --max-steps", out, re.M), out
@@ -2074,13 +2074,15 @@ def check_auto_bidir(progs):
     assert b["predicted_work"] >= b["leader_work"] and o["auto"]["bidirectional"].startswith("lost: "), b
     assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], o
     # a dense b or a pinned estimator: considered by the push on b (src/bpush.c), planned with a
-    # pilot round of 1024 walks on the residual; on randsub1000 at 0.02 the walks are cheaper
+    # pilot of the walk solver's first rounds on the residual (256 walks, then the walks the
+    # sequence predicts, on to 1000 at most: 320 and 1000 here; a whole 1024-walk block before
+    # 2026-12-05); on randsub1000 at 0.02 the walks are cheaper
     for extra in (["--rhs", M + "randsub1000_b.mtx", "--rel-err", "0.02"],
                   ["--rhs", D + "sparse3_b.mtx", "--rel-err", "0.02", "--estimator", "expected"]):
         rc, out, err = run(ulam, PS + extra + ["--json", "--check"])
         o = json.loads(out)
         b = o["auto"]["candidates"][-1]
-        assert rc == 0 and b["mode"] == "bidirectional" and b["pilot_walks"] == 1024, (extra, o)
+        assert rc == 0 and b["mode"] == "bidirectional" and 256 <= b["pilot_walks"] <= 1024, (extra, o)
         assert abs(o["estimate"] - o["direct"]) < 4 * o["stderr"], (extra, o)
     # no --rel-err target, a sparse b: the push on b is considered at the fixed budget (the walks from
     # the index are certified; issue 38 point 4) and chosen, its interval holding LAPACK's and far

@@ -546,7 +546,7 @@ static void test_bidir_deterministic_walks(void **state)
         ulam_bidir_result res = bidir(N, Nt, &o);
         if (!(res.std_error == 0 && res.estimate == x[cases[k].t]))
             print_error("case %d: %.6g +- %.3g, exact %.6g\n", k, res.estimate, res.std_error, x[cases[k].t]);
-        assert_true(res.std_error == 0 && res.estimate == x[cases[k].t] && res.walks.walks >= 1000);
+        assert_true(res.std_error == 0 && res.estimate == x[cases[k].t] && res.walks.walks >= 256); /* a first round */
         free(x);
     }
     test_case_done();

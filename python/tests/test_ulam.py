@@ -51,7 +51,7 @@ def test_spsolve_4sigma():
             assert r.ci95 is not None and r.variance_finite, r
             assert abs(r.estimate - x[i]) < 4 * r.stderr, (seed, i, r, x[i])
             assert r.stderr <= 0.02 * abs(r.estimate) and r.report["rel_err_met"], r.report
-            assert r.ci95[0] < r.estimate < r.ci95[1] and r.walks >= 1000
+            assert r.ci95[0] < r.estimate < r.ci95[1] and r.walks >= 256  # a rel_err run's first round
 
 
 def coverage_bound(n):

@@ -809,7 +809,7 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     if (!s) return ULAM_EINVAL;
     if (s->run.done) return s->run.status;
     static const ulam__blocks B = {RBLOCK, RROUND, run_block, sizeof(rad_block), sizeof(rad_tally), merge_block,
-                                   NULL, NULL};
+                                   NULL, NULL, 0};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_rad_result r;
     double mins[3];

@@ -7,7 +7,7 @@
  *            variance of a rich fixed run (ORACLE walks), x by LAPACK;
  *   walks    the mean walks of REPS --rel-err E runs (seeds 1..REPS), and how many met;
  *   ratio    walks / oracle (the target: <= 3), and walks / max(oracle, 1024) (a run's first
- *            round is 1024 walks: no run is shorter);
+ *            round was 1024 walks; it is 256 since 2026-12-05);
  *   width    the mean printed 95% half-width over E |x| (1.96 is what a CLT interval at
  *            stderr E |x| would show);
  *   covered  how many of the runs' printed intervals hold x;
@@ -29,9 +29,9 @@
  *   half/1.96se  the printed half-width over 1.96 standard errors at the stop;
  *   cov      the runs whose interval holds x.
  * With OLD (a path to a previous build's libulam.so, opened with its own symbols first) each row
- * is printed for it too, side by side: the previous construction (stitched empirical Bernstein,
- * a rule on the standard error) against this one (the predictable plug-in empirical-Bernstein
- * confidence sequence, a rule on the printed half-width).
+ * is printed for it too, side by side (docs/error-bars.md's What it costs: 5e702dc's stitched
+ * empirical Bernstein against the plug-in sequence, then 0becb6a's sequence with Fan's penalty
+ * and whole-block rounds against each end's quartic penalty and rounds of the walks predicted).
  *
  *   bench_relerr [E [REPS [ONLY [OLD]]]]  prints the tables (defaults 0.1 and 5; ONLY: the rows whose
  *                                     system name contains it, +ONLY: of case 6's table alone,
