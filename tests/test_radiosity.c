@@ -1357,7 +1357,8 @@ static void test_rel_err_width(void **state)
 /* Coverage of the printed 95% intervals against LAPACK (open_box_ref) per mode, under --rel-err
  * (0.1 for next-event, 0.3 for the others, whose walks cost more) and at a fixed budget of 2000
  * walks, over 100 seeds (next-event; at most 10 miss: P(Binomial(100, 0.05) > 10) = 0.011) or 40
- * (at most 5: P(Binomial(40, 0.05) > 5) = 0.014).  The whole-scene rule (every lit patch to 0.25)
+ * (at most 5: P(Binomial(40, 0.05) > 5) = 0.014); shooting at 200 particles, inside the first
+ * round, prints an interval (it printed none: the round weighed nothing without an estimate).  The whole-scene rule (every lit patch to 0.25)
  * over 5 seeds: each of the 80 patches within 0.25 B of the reference (its interval, within
  * 0.25 B, holds it) in all but 8% of the 400 (a 95% interval each; expected at most 20). */
 static void test_interval_coverage(void **state)
@@ -1387,6 +1388,16 @@ static void test_interval_coverage(void **state)
                           budget ? "walks" : "rel-err", budget ? 2000.0 : E, miss, seeds, (long long)(walks / seeds));
             assert_true(!test_case_all() || miss <= (seeds == 100 ? 10 : 5));
         }
+    int miss = 0; /* a budget inside the first round (one block of 256): its bets are still made, an interval printed */
+    for (uint64_t seed = 0; seed < 40; seed++) {
+        double B, se, ci[2];
+        int met;
+        iv_run(t, IV_SHOOT, 200, 0.0, 400 + seed, &B, &se, ci, &met);
+        assert_true(isfinite(ci[0]) && isfinite(ci[1]));
+        miss += !(ci[0] <= ref[15] && ref[15] <= ci[1]);
+    }
+    print_message("shoot collision    200 walks: %d of 40 intervals miss\n", miss);
+    assert_true(miss <= 5);
     int far = 0;
     double *B = malloc(3 * (size_t)s->npatches * sizeof *B);
     assert_non_null(B);

@@ -743,6 +743,21 @@ static double shot_trunc(const ulam_rad_solver *s, double B, double v, double np
     return fmin(cap, fmax(h / 8.0, 1e-6 * b));
 }
 
+/* Shooting, the first round at a budget (no estimate, no target) of a collision tally at patch p in
+ * channel c: the truncation whose bias and range term over the round's n1 particles (a bet at its
+ * largest) add up least, over biases X 2^(-j/4) from X = w0_c rho_pc / ((1 - q_max) A_p), a bound on
+ * the tally's mean, down to 1e-6 X (as the matrix solver's plan_terms); 0 when none has a range. */
+static double shot_first_trunc(const ulam_rad_solver *s, int64_t p, int c, double n1)
+{
+    double ps = s->w0[c] * s->s->rho[3 * p + c], X = s->qmax < 1.0 ? ps / ((1.0 - s->qmax) * s->s->area[p]) : INFINITY;
+    double t = 0.0, least = INFINITY;
+    for (int j = 0; isfinite(X) && X > 0 && j <= 80; j++) {
+        double tj = X * exp2(-0.25 * j), Rj = shot_range(s, p, c, tj), wj = ulam__cs_range_width(Rj, n1) + tj;
+        if (isfinite(Rj) && wj < least) least = wj, t = tj;
+    }
+    return t;
+}
+
 /* Before a round of shooting: plan every patch's and channel's sequence from the particles so
  * far (the tallies over the area, limit the range at the planned truncation, clipped there: a
  * longer history's tally clipped to it moves the mean no more than cutting the history would),
@@ -754,7 +769,11 @@ static void cs_plan_shoot(ulam_rad_solver *s)
         double mean, v, B;
         shot_moments(s, j, &mean, &v);
         B = s->s->emit[j] + mean;
-        double t = shot_trunc(s, B, v, nplan), R = shot_range(s, j / 3, (int)(j % 3), t);
+        double t = shot_trunc(s, B, v, nplan);
+        if (B == 0.0 && s->run.walks == 0 && !(E > 0) && s->o.estimator != ULAM_RAD_ABSORPTION)
+            t = shot_first_trunc(s, j / 3, (int)(j % 3), fmin(nplan, (double)RBLOCK)); /* a budget's first round (one
+                block): else it would weigh nothing, and a budget of 256 particles would print no interval */
+        double R = shot_range(s, j / 3, (int)(j % 3), t);
         double h = E > 0 && B != 0.0 ? E * fabs(B) - t : 0.0;
         s->clip[j] = t > 0 && isfinite(R) ? R : INFINITY;
         s->rsum[j] = s->rsq[j] = s->rmax[j] = 0.0;
