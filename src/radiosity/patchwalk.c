@@ -61,6 +61,12 @@ typedef struct {
     int64_t rays, cut;
 } rad_block;
 
+/* Shooting: one patch's channel since the sequence's plan: the clipped tallies' sum, sum of
+ * squares and largest, and the clip limit of tally / area (INFINITY: none). */
+typedef struct {
+    double sum, sq, max, clip;
+} rad_pend;
+
 /* Per-thread scratch of a shooting history. */
 typedef struct {
     double *hist; /* 3 per patch */
@@ -93,9 +99,9 @@ struct ulam_rad_solver {
     double whole;  /* shooting: the whole-scene rule's area share (ulam_rad_solver_whole), 0: patch index's rule */
     ulam__cs cs[3]; /* gathering and points: each channel's confidence sequence (stop.h), on score - off */
     ulam__cs *pcs;  /* shooting: per patch and channel, the sequence of the tallies over the area */
-    double *clip;   /* shooting: per patch and channel, the round's clip limit of tally / area (INFINITY: none) */
-    double *rsum, *rsq, *rmax; /* shooting: per patch and channel, the round's clipped sums and largest */
-    int64_t round0; /* shooting: the walks before the round (its tallies go to pcs after it) */
+    rad_pend *pend; /* shooting: per patch and channel, the tallies since the plan and their clip limit */
+    int64_t round0; /* shooting: the walks at the current plan (the tallies since go to pcs at the next) */
+    int64_t checked; /* shooting: the walks at the whole-scene rule's last check */
 };
 
 /* Free; accepts and returns NULL. */
@@ -110,7 +116,7 @@ ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s)
     ulam__lights_free(&s->L);
     free(s->q), free(s->scratch), free(s->blocks);
     free(s->sum), free(s->sumsq);
-    free(s->pcs), free(s->clip), free(s->rsum), free(s->rsq), free(s->rmax);
+    free(s->pcs), free(s->pend);
     free(s);
     return NULL;
 }
@@ -288,13 +294,9 @@ static int alloc_work(ulam_rad_solver *s)
     s->sum = ulam__calloc((size_t)(3 * n), sizeof *s->sum);
     s->sumsq = ulam__calloc((size_t)(3 * n), sizeof *s->sumsq);
     s->pcs = ulam__calloc((size_t)(3 * n), sizeof *s->pcs);
-    s->clip = ulam__malloc((size_t)(3 * n), sizeof *s->clip);
-    s->rsum = ulam__calloc((size_t)(3 * n), sizeof *s->rsum);
-    s->rsq = ulam__calloc((size_t)(3 * n), sizeof *s->rsq);
-    s->rmax = ulam__calloc((size_t)(3 * n), sizeof *s->rmax);
-    if (s->clip)
-        for (int64_t k = 0; k < 3 * n; k++) s->clip[k] = INFINITY;
-    return s->sum && s->sumsq && s->pcs && s->clip && s->rsum && s->rsq && s->rmax ? ULAM_OK : ULAM_ENOMEM;
+    s->pend = ulam__calloc((size_t)(3 * n), sizeof *s->pend);
+    for (int64_t k = 0; s->pend && k < 3 * n; k++) s->pend[k].clip = INFINITY;
+    return s->sum && s->sumsq && s->pcs && s->pend ? ULAM_OK : ULAM_ENOMEM;
 }
 
 /* Prepare walks from patch opts->index, or (point) from a point. */
@@ -640,10 +642,11 @@ static void merge_block(void *ctx, int k)
         const rad_tally *e = (const rad_tally *)br->h.tally + k;
         for (int c = 0; c < 3; c++) {
             int64_t j = 3 * (int64_t)e->patch + c;
-            double x = fmin(e->v[c] / s->s->area[e->patch], s->clip[j]); /* over the area, clipped (cs_plan_round) */
+            rad_pend *q = &s->pend[j];
+            double x = fmin(e->v[c] / s->s->area[e->patch], q->clip); /* over the area, clipped (cs_plan_shoot) */
             s->sum[j] += e->v[c];
             s->sumsq[j] += e->v[c] * e->v[c];
-            s->rsum[j] += x, s->rsq[j] += x * x, s->rmax[j] = fmax(s->rmax[j], x);
+            q->sum += x, q->sq += x * x, q->max = fmax(q->max, x);
         }
         if (e->patch == s->o.query.index) {
             double x = e->v[0] + e->v[1] + e->v[2];
@@ -743,40 +746,52 @@ static double shot_trunc(const ulam_rad_solver *s, double B, double v, double np
     return fmin(cap, fmax(h / 8.0, 1e-6 * b));
 }
 
-/* Shooting, the first round at a budget (no estimate, no target) of a collision tally at patch p in
- * channel c: the truncation whose bias and range term over the round's n1 particles (a bet at its
- * largest) add up least, over biases X 2^(-j/4) from X = w0_c rho_pc / ((1 - q_max) A_p), a bound on
- * the tally's mean, down to 1e-6 X (as the matrix solver's plan_terms); 0 when none has a range. */
-static double shot_first_trunc(const ulam_rad_solver *s, int64_t p, int c, double n1)
+/* Shooting, the first round at a budget (no estimate, no target yet) of collision tallies: the
+ * truncation whose bias and range term over the round's n1 particles (a bet at its largest) add
+ * up least, over biases u 2^(-j/4) / (1 - q_max) of a visit's score w0_c rho_pc / A_p (from the
+ * bound 1 / (1 - q_max) on the tally's mean visits down to 1e-6 of it, as the matrix solver's
+ * plan_terms), as the share u of a visit's score: the same for every patch (the range is a
+ * visit's score times the visits of histories so truncated); 0 when none has a range. */
+static double shot_first_share(const ulam_rad_solver *s, double n1)
 {
-    double ps = s->w0[c] * s->s->rho[3 * p + c], X = s->qmax < 1.0 ? ps / ((1.0 - s->qmax) * s->s->area[p]) : INFINITY;
-    double t = 0.0, least = INFINITY;
-    for (int j = 0; isfinite(X) && X > 0 && j <= 80; j++) {
-        double tj = X * exp2(-0.25 * j), Rj = shot_range(s, p, c, tj), wj = ulam__cs_range_width(Rj, n1) + tj;
-        if (isfinite(Rj) && wj < least) least = wj, t = tj;
+    double u = 0.0, least = INFINITY;
+    for (int j = 0; s->qmax < 1.0 && j <= 80; j++) {
+        double uj = exp2(-0.25 * j) / (1.0 - s->qmax), Rj = ulam__score_range(INFINITY, 1.0, s->qmax, 1.0, 0, uj, 1.0);
+        double wj = ulam__cs_range_width(Rj, n1) + uj;
+        if (isfinite(Rj) && wj < least) least = wj, u = uj;
     }
-    return t;
+    return u;
 }
 
-/* Before a round of shooting: plan every patch's and channel's sequence from the particles so
- * far (the tallies over the area, limit the range at the planned truncation, clipped there: a
- * longer history's tally clipped to it moves the mean no more than cutting the history would),
- * and start the round's sums. */
+static void cs_add_shoot(ulam_rad_solver *s);
+
+/* Before a round of shooting, once the particles have doubled since the last plan and grown by
+ * one a patch, or grown fourfold (the planned count nplan is four times the particles so far), or
+ * by 24 a patch (a plan costs O(patches), a round's particles may be fewer: replanning every round
+ * tripled the CPU time of 3 10^5 particles on 80 270 patches): the tallies since that plan into
+ * each sequence,
+ * then every patch's and channel's sequence planned from the particles so far (the tallies over
+ * the area, limit the range at the planned truncation, clipped there: a longer history's tally
+ * clipped to it moves the mean no more than cutting the history would); the sums start anew. */
 static void cs_plan_shoot(ulam_rad_solver *s)
 {
-    double E = s->o.stop.rel_err, nplan = plan_walks(s);
+    int64_t N = s->run.walks, since = N - s->round0, n = s->s->npatches;
+    if (N > 0 && !(N >= 2 * s->round0 && since >= n) && N < 4 * s->round0 && since < 24 * n)
+        return; /* the plan stands (predictable still) */
+    cs_add_shoot(s);
+    double E = s->o.stop.rel_err, nplan = plan_walks(s), u = 0.0;
+    int first = s->run.walks == 0 && !(E > 0) && s->o.estimator != ULAM_RAD_ABSORPTION;
+    if (first) u = shot_first_share(s, fmin(nplan, (double)RBLOCK)); /* a budget's first round (one block) */
     for (int64_t j = 0; j < 3 * s->s->npatches; j++) {
         double mean, v, B;
         shot_moments(s, j, &mean, &v);
         B = s->s->emit[j] + mean;
         double t = shot_trunc(s, B, v, nplan);
-        if (B == 0.0 && s->run.walks == 0 && !(E > 0) && s->o.estimator != ULAM_RAD_ABSORPTION)
-            t = shot_first_trunc(s, j / 3, (int)(j % 3), fmin(nplan, (double)RBLOCK)); /* a budget's first round (one
-                block): else it would weigh nothing, and a budget of 256 particles would print no interval */
+        if (B == 0.0 && first) /* else that round would weigh nothing: 256 particles would print no interval */
+            t = u * s->w0[j % 3] * s->s->rho[j] / s->s->area[j / 3];
         double R = shot_range(s, j / 3, (int)(j % 3), t);
         double h = E > 0 && B != 0.0 ? E * fabs(B) - t : 0.0;
-        s->clip[j] = t > 0 && isfinite(R) ? R : INFINITY;
-        s->rsum[j] = s->rsq[j] = s->rmax[j] = 0.0;
+        s->pend[j] = (rad_pend){.clip = t > 0 && isfinite(R) ? R : INFINITY};
         ulam__cs_plan(&s->pcs[j], s->run.walks, mean, v, R, t, h > 0 ? h : 0.0, nplan);
     }
     s->round0 = s->run.walks;
@@ -790,18 +805,31 @@ static void plan_round(void *ctx)
     if (s->o.mode == ULAM_FORWARD) cs_plan_shoot(s);
 }
 
-/* After a round of shooting: every patch's and channel's clipped tallies of the round (the
- * particles that did not reach it count 0) into its sequence. */
+/* Shooting: every patch's and channel's clipped tallies since the plan (the particles that did
+ * not reach it count 0) into its sequence, under that plan. */
 static void cs_add_shoot(ulam_rad_solver *s)
 {
     int64_t n = s->run.walks - s->round0;
     if (n <= 0) return;
     for (int64_t j = 0; j < 3 * s->s->npatches; j++) {
-        double mean = s->rsum[j] / (double)n;
-        ulam__cs_add(&s->pcs[j], n, mean, fmax(0.0, s->rsq[j] - (double)n * mean * mean), s->rmax[j]);
-        s->rsum[j] = s->rsq[j] = s->rmax[j] = 0.0;
+        const rad_pend *q = &s->pend[j];
+        double mean = q->sum / (double)n;
+        ulam__cs_add(&s->pcs[j], n, mean, fmax(0.0, q->sq - (double)n * mean * mean), q->max);
+        s->pend[j] = (rad_pend){.clip = q->clip};
     }
     s->round0 = s->run.walks;
+}
+
+/* Shooting: the sequence of entry j (patch j / 3, channel j % 3) with the tallies since the plan
+ * added (a copy: pieces added under one plan sum to the whole). */
+static void shot_cs(const ulam_rad_solver *s, int64_t j, ulam__cs *cs)
+{
+    int64_t n = s->run.walks - s->round0;
+    *cs = s->pcs[j];
+    if (n <= 0) return;
+    const rad_pend *q = &s->pend[j];
+    double mean = q->sum / (double)n;
+    ulam__cs_add(cs, n, mean, fmax(0.0, q->sq - (double)n * mean * mean), q->max);
 }
 
 /* Shooting: patch p's channel-c 95% interval (stop.h's confidence sequence on its tallies over
@@ -815,7 +843,9 @@ static void shot_interval(const ulam_rad_solver *s, int64_t p, int c, ulam__stop
         ulam__stop_interval(s->run.walks, E + mean, 0.0, 0.0, 0.0, 0.0, 0.0, 0, ci);
         return;
     }
-    ulam__cs_interval(&s->pcs[j], mean, shot_cut(s, p, c), ci);
+    ulam__cs cs;
+    shot_cs(s, j, &cs);
+    ulam__cs_interval(&cs, mean, shot_cut(s, p, c), ci);
     ci->lo += E, ci->hi += E;
 }
 
@@ -908,7 +938,9 @@ static int64_t walks_wanted(const ulam_rad_solver *s, const ulam_rad_result *r)
             int64_t j = 3 * s->o.query.index + c;
             double mean, v;
             shot_moments(s, j, &mean, &v);
-            left = ulam__cs_walks_left(&s->pcs[j], mean, v, shot_cut(s, s->o.query.index, c), E * fabs(m));
+            ulam__cs cs;
+            shot_cs(s, j, &cs);
+            left = ulam__cs_walks_left(&cs, mean, v, shot_cut(s, s->o.query.index, c), E * fabs(m));
         } else {
             double R, cut;
             gather_range(s, c, &R, &cut);
@@ -1008,13 +1040,14 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     static const ulam__blocks B = {RBLOCK, RROUND, run_block, sizeof(rad_block), sizeof(rad_tally), merge_block,
                                    plan_round, NULL};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
-    if (s->o.mode == ULAM_FORWARD) cs_add_shoot(s);
     ulam_rad_result r;
     double mins[3];
     result(s, mins, &r);
     int check = s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN; /* every round: the sequences hold at every count */
-    if (s->whole > 0) { /* the whole scene (ulam_rad_solver_whole) instead of patch index */
-        int d = check ? scene_done(s) : 0;
+    if (s->whole > 0) { /* the whole scene (ulam_rad_solver_whole) instead of patch index: checked
+                           once the particles grew by an eighth (O(patches) a check) */
+        int d = check && 8 * r.walks >= 9 * s->checked ? scene_done(s) : 0;
+        if (check && 8 * r.walks >= 9 * s->checked) s->checked = r.walks;
         if (d > 0) s->run.done = s->met = 1;
         if (d < 0) s->run.done = s->zero = 1; /* no particle lit anything: can never be met */
         return s->run.status;
