@@ -253,13 +253,15 @@ typedef struct ulam_rad_result {
     int threads, interrupted;
     int zero; /* rel_err could never be met: every channel exactly 0 with zero variance after
                * the first round (no walk scored); the run stopped there */
-    double min_walks;          /* with rel_err: the walks the rule (src/stop.c) needs at this
-                                  estimate (largest over channels; gathering and shooting) */
+    double min_walks;          /* with rel_err: the walks a confidence sequence tuned to the target
+                                  needs at this estimate (src/stop.c; largest over channels) */
     double variance_rel_error; /* with rel_err: the largest relative standard error of a
                                   channel's variance (fourth moment; reported, not a stop rule) */
-    int rel_err_met;           /* the run stopped because the rel_err rule holds */
-    double ci95[3][2];         /* each channel's 95% interval (src/stop.c's construction on the
-                                  certified score range); NaN .. NaN where none is certified */
+    int rel_err_met;           /* the run stopped because the rel_err rule holds: every nonzero
+                                  channel's ci95 half-width at most rel_err times its estimate */
+    double ci95[3][2];         /* each channel's 95% interval (src/stop.c's confidence sequence on
+                                  the certified score range, valid at every walk count); NaN .. NaN
+                                  where none is certified */
 } ulam_rad_result;
 
 /* How patch walks run and when they stop: radiosity's own options (the matrix walks' kernel,
@@ -420,13 +422,13 @@ ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s);
 /* The whole scene under shooting's rel_err rule (ulam_rad_solver_whole, ulam_rad_solver_scene). */
 typedef struct ulam_rad_scene_rule {
     int64_t lit;          /* patches light is on: an emitter, or a patch some particle reached */
-    int64_t met;          /* of them, those whose every channel meets rel_err (src/stop.c's rule, as
-                             at one patch: its 95% interval's variance term within E B's width) */
+    int64_t met;          /* of them, those whose every channel meets rel_err (as at one patch: its
+                             95% interval's half-width at most E B) */
     int64_t unreached;    /* patches that reflect (rho > 0) and emit nothing that no particle reached
                              (light may still reach them: 3 / walks bounds the share of particles that do) */
     double lit_area, met_area;
     double worst_se;      /* the largest relative standard error se / B over the lit patches' channels */
-    double worst_half;    /* the largest relative 95% half-width (src/stop.c's certified interval) */
+    double worst_half;    /* the largest relative 95% half-width (each patch's confidence sequence) */
     int64_t worst_patch;  /* its patch (0-based), -1 when none is lit */
     double share;         /* the rule's share (ulam_rad_solver_whole), 0 when not set */
 } ulam_rad_scene_rule;

@@ -1479,7 +1479,8 @@ static double need_counts(const args *a, double n, double tri, double nverts, ch
     if (forms && a->matrix_walk) ff *= 3; /* F, one channel's M and the walk's kernel rows */
     if (forms && (a->direct || a->check)) dense = (double)ulam_direct_bytes((int64_t)n);
     if (forms && (a->direct || a->check) && (a->out || a->all)) dense *= 2; /* every patch's error: G whole */
-    if (a->o.mode == ULAM_FORWARD) walks = n * (48.0 + 29.0 * threads) + 32.0 * 256 * 32 * 64;
+    if (a->o.mode == ULAM_FORWARD) /* per patch: sums (48), the sequences and round sums (360), scratch a thread */
+        walks = n * (408.0 + 29.0 * threads) + 32.0 * 256 * 32 * 64;
     if (a->image) pic = (double)a->width * a->height * 11.0 + (a->view ? 8.0 * n : 0.0);
     if (a->nat || a->grid) walks = (double)(a->nat + (a->grid ? (int64_t)a->g.nu * a->g.nv : 0)) * sizeof(ulam_rad_point);
     char h[5][32];

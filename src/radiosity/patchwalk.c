@@ -61,6 +61,12 @@ typedef struct {
     int64_t rays, cut;
 } rad_block;
 
+/* Shooting: one patch's channel since the sequence's plan: the clipped tallies' sum, sum of
+ * squares and largest, and the clip limit of tally / area (INFINITY: none). */
+typedef struct {
+    double sum, sq, max, clip;
+} rad_pend;
+
 /* Per-thread scratch of a shooting history. */
 typedef struct {
     double *hist; /* 3 per patch */
@@ -89,9 +95,13 @@ struct ulam_rad_solver {
     ulam__run run; /* walks, time, ending (round.c) */
     int64_t rays, cut;
     int zero, met;
-    int epoch; /* the last epoch (stop.h) the rel_err rule was checked at */
     double w0[3];  /* shooting: the largest starting weight per channel (score_bounds) */
     double whole;  /* shooting: the whole-scene rule's area share (ulam_rad_solver_whole), 0: patch index's rule */
+    ulam__cs cs[3]; /* gathering and points: each channel's confidence sequence (stop.h), on score - off */
+    ulam__cs *pcs;  /* shooting: per patch and channel, the sequence of the tallies over the area */
+    rad_pend *pend; /* shooting: per patch and channel, the tallies since the plan and their clip limit */
+    int64_t round0; /* shooting: the walks at the current plan (the tallies since go to pcs at the next) */
+    int64_t checked; /* shooting: the walks at the whole-scene rule's last check */
 };
 
 /* Free; accepts and returns NULL. */
@@ -106,6 +116,7 @@ ulam_rad_solver *ulam_rad_solver_free(ulam_rad_solver *s)
     ulam__lights_free(&s->L);
     free(s->q), free(s->scratch), free(s->blocks);
     free(s->sum), free(s->sumsq);
+    free(s->pcs), free(s->pend);
     free(s);
     return NULL;
 }
@@ -122,6 +133,13 @@ static int next_event(int estimator)
 static int window(const ulam_rad_solver *s)
 {
     return s->at || (s->o.mode == ULAM_ADJOINT && s->o.estimator != ULAM_RAD_ABSORPTION);
+}
+
+/* The exact part of channel c's every score, which its sequence is fed without: gathering at a
+ * patch by window walks scores E_i + rho_i H (the emission); else 0. */
+static double score_offset(const ulam_rad_solver *s, int c)
+{
+    return window(s) && !s->at ? s->s->emit[3 * s->o.query.index + c] : 0.0;
 }
 
 /* Check the options for a patch walk (point: a point solver, whose index is not read). */
@@ -275,7 +293,10 @@ static int alloc_work(ulam_rad_solver *s)
     }
     s->sum = ulam__calloc((size_t)(3 * n), sizeof *s->sum);
     s->sumsq = ulam__calloc((size_t)(3 * n), sizeof *s->sumsq);
-    return s->sum && s->sumsq ? ULAM_OK : ULAM_ENOMEM;
+    s->pcs = ulam__calloc((size_t)(3 * n), sizeof *s->pcs);
+    s->pend = ulam__calloc((size_t)(3 * n), sizeof *s->pend);
+    for (int64_t k = 0; s->pend && k < 3 * n; k++) s->pend[k].clip = INFINITY;
+    return s->sum && s->sumsq && s->pcs && s->pend ? ULAM_OK : ULAM_ENOMEM;
 }
 
 /* Prepare walks from patch opts->index, or (point) from a point. */
@@ -600,12 +621,19 @@ static void run_block(void *ctx, int k, int64_t first, int64_t count, int th)
     br->h.complete = 1;
 }
 
+static void cs_plan_gather(ulam_rad_solver *s);
+
 /* Merge completed block k into the totals (ctx: the solver; the walk and non-finite counts are
  * the round driver's). */
 static void merge_block(void *ctx, int k)
 {
     ulam_rad_solver *s = ctx;
     const rad_block *br = &s->blocks[k];
+    if (s->o.mode == ULAM_ADJOINT) cs_plan_gather(s); /* from the blocks merged before this one alone */
+    for (int c = 0; c < 3 && s->o.mode == ULAM_ADJOINT; c++) {
+        double off = score_offset(s, c);
+        ulam__cs_add(&s->cs[c], br->m[c].n, br->m[c].mean - off, br->m[c].m2, br->m[c].n > 0 ? br->maxc[c] - off : 0.0);
+    }
     for (int c = 0; c < 3; c++) ulam__moments_merge(&s->m[c], &br->m[c]);
     s->sq += br->sq;
     s->maxsq = fmax(s->maxsq, br->maxsq);
@@ -613,8 +641,12 @@ static void merge_block(void *ctx, int k)
     for (int64_t k = 0; k < br->h.len; k++) {
         const rad_tally *e = (const rad_tally *)br->h.tally + k;
         for (int c = 0; c < 3; c++) {
-            s->sum[3 * e->patch + c] += e->v[c];
-            s->sumsq[3 * e->patch + c] += e->v[c] * e->v[c];
+            int64_t j = 3 * (int64_t)e->patch + c;
+            rad_pend *q = &s->pend[j];
+            double x = fmin(e->v[c] / s->s->area[e->patch], q->clip); /* over the area, clipped (cs_plan_shoot) */
+            s->sum[j] += e->v[c];
+            s->sumsq[j] += e->v[c] * e->v[c];
+            q->sum += x, q->sq += x * x, q->max = fmax(q->max, x);
         }
         if (e->patch == s->o.query.index) {
             double x = e->v[0] + e->v[1] + e->v[2];
@@ -628,49 +660,235 @@ static void merge_block(void *ctx, int k)
 
 static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r);
 
-/* Channel c's certified score range R and bias at estimate m (of B), in B's units: a window
- * walk's whole range, finite, and the most a cut at max_steps can miss (ulam__point_range and
- * ulam__point_tail; times rho_i at patch i, whose
- * scores lie in [E_i, E_i + R]); else the range of one absorption walk's score or of one
- * particle's tally at the patch over its area (shooting), at a truncation whose bias is at
- * most E |m| / 4 when no whole-walk bound is known (score_bounds). */
-static void channel_range(const ulam_rad_solver *s, int c, double m, double E, double *R, double *bias)
+/* Nonzero when interval ci at estimate m meets relative target E: the printed half-width at most
+ * E |m| (x certified exactly meets it at once); never at m = 0 otherwise. */
+static int half_met(const ulam__stop_ci *ci, double m, double E)
 {
-    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0;
-    if (window(s)) { /* window walks: their range (point.c), times the patch's reflectance */
+    if (ci->kind == ULAM__STOP_EXACT) return E > 0;
+    return ci->kind == ULAM__STOP_EB && E > 0 && m != 0.0 && ci->half <= E * fabs(m);
+}
+
+/* The walks a sequence planned for a fixed count or an open-ended run aims at (stop.h's nplan):
+ * the count fixed in advance, else four times the walks so far (at least 4096). */
+static double plan_walks(const ulam_rad_solver *s)
+{
+    int fixed = !(s->o.stop.rel_err > 0) && !(s->o.stop.max_seconds > 0) && s->o.stop.max_walks > 0;
+    return fixed ? (double)s->o.stop.max_walks : fmax(4.0 * (double)s->run.walks, 4096.0);
+}
+
+/* Gathering and points: channel c's certified score range R (every score in [off, off + R],
+ * score_offset) and the most the walks cut at max_steps can have moved the mean (cut): a window
+ * walk's whole range (ulam__point_range, times the patch's reflectance) and tail
+ * (ulam__point_tail), or one absorption walk's range (INFINITY: none, an emitter reflecting all). */
+static void gather_range(const ulam_rad_solver *s, int c, double *R, double *cut)
+{
+    if (window(s)) {
         double R0 = ulam__point_range(&s->pb, c), rho = s->at ? 1.0 : s->s->rho[3 * s->o.query.index + c];
-        double tail = ulam__point_tail(&s->pb, c, s->o.stop.max_steps); /* what a cut at max_steps can miss */
+        double tail = ulam__point_tail(&s->pb, c, s->o.stop.max_steps);
         *R = rho > 0 ? rho * R0 : 0.0;
-        *bias = rho > 0 && tail > 0 ? rho * tail : 0.0;
+        *cut = rho > 0 && tail > 0 ? rho * tail : 0.0;
         return;
     }
-    *R = ulam__score_range(s->range[c], s->per_step[c], s->qmax, 1.0, 0, fabs(m) * A, E / 4.0) / A;
-    *bias = isfinite(s->range[c]) ? 0.0 : E * fabs(m) / 4.0;
+    *R = s->range[c];
+    *cut = s->cut > 0 && isfinite(*R) ? ulam__cut_bound(*R, s->qmax, 1.0, s->o.stop.max_steps) : 0.0;
 }
 
-/* Channel c's 95% interval (stop.h) at estimate m: on the walks' scores (gathering) or the
- * particles' tallies at the patch over its area (shooting, the emission exact).  A window
- * walk's scores are checked against their certified range: one past it leaves no interval
- * (and no stop by rel_err), as in ulam_solve's. */
-static void channel_interval(const ulam_rad_solver *s, int c, double m, double E, ulam__stop_ci *ci)
+/* Before a block of gathering (or point) walks is added: plan each channel's sequence (stop.h's ulam__cs)
+ * from the walks so far, for scores less their exact offset in [0, R] (limit R): tuned to the
+ * half-width E |m| - cut under rel_err once there is an estimate, else to the planned count. */
+static void cs_plan_gather(ulam_rad_solver *s)
 {
-    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0, R, bias;
-    double off = s->o.mode == ULAM_FORWARD ? s->s->emit[3 * s->o.query.index + c] : 0.0;
-    channel_range(s, c, m, E, &R, &bias);
-    int64_t n = s->run.walks;
-    if (window(s) && !s->at) off = s->s->emit[3 * s->o.query.index + c]; /* scores in [E, E + R] */
-    ulam__stop_interval(n, s->m[c].mean / A + (s->o.mode == ULAM_FORWARD ? off : 0.0),
-                        ulam__moments_variance(&s->m[c]) / (A * A), R, bias, window(s) ? s->maxc[c] - off : 0.0,
-                        window(s) ? R : INFINITY, ulam__stop_epoch(n), ci);
+    double E = s->o.stop.rel_err, nplan = plan_walks(s);
+    for (int c = 0; c < 3; c++) {
+        double R, cut, off = score_offset(s, c), m = s->m[c].mean;
+        gather_range(s, c, &R, &cut);
+        double h = E > 0 && m != 0.0 ? E * fabs(m) - cut : 0.0;
+        ulam__cs_plan(&s->cs[c], s->m[c].n, m - off, ulam__moments_variance(&s->m[c]), R, 0.0, h > 0 ? h : 0.0, nplan);
+    }
 }
 
-/* The walks the rel_err rule (stop.h) needs in channel c at estimate m. */
+/* Shooting: patch p's channel-c tallies over its area so far, their mean and variance. */
+static void shot_moments(const ulam_rad_solver *s, int64_t j, double *mean, double *var)
+{
+    double A = s->s->area[j / 3];
+    ulam__sums_moments((double)s->run.walks, s->sum[j], s->sumsq[j], mean, var);
+    *mean /= A, *var /= A * A;
+}
+
+/* Shooting: the range R of one particle's tally at patch p in channel c over its area, truncated
+ * (collision) where longer histories add at most t to its mean (w0_c rho_pc a visit, weights
+ * never growing; by absorption that / (1 - q_p) once, no truncation); 0 when nothing can tally
+ * there, INFINITY when no truncation is asked (t = 0) for a collision tally. */
+static double shot_range(const ulam_rad_solver *s, int64_t p, int c, double t)
+{
+    double A = s->s->area[p], ps = s->w0[c] * s->s->rho[3 * p + c];
+    if (!(ps > 0)) return 0.0;
+    if (s->o.estimator == ULAM_RAD_ABSORPTION) return ps / (1.0 - s->q[p]) / A;
+    return t > 0 ? ulam__score_range(INFINITY, ps, s->qmax, 1.0, 0, t * A, 1.0) / A : INFINITY;
+}
+
+/* Shooting: the most the particles cut at max_steps can have moved patch p's channel-c mean. */
+static double shot_cut(const ulam_rad_solver *s, int64_t p, int c)
+{
+    double ps = s->w0[c] * s->s->rho[3 * p + c];
+    return s->cut > 0 && ps > 0 ? ulam__cut_bound(ps, s->qmax, 1.0, s->o.stop.max_steps) / s->s->area[p] : 0.0;
+}
+
+/* Shooting: the truncation bias a collision tally is planned at for patch p's channel c of
+ * radiosity estimate B (|B| > 0) and variance v: an eighth of the half-width aimed at (E |B|, or
+ * without a target 2.7 sigma / sqrt(nplan)), between 1e-6 and max(ULAM__STOP_TAIL, E / 4) of
+ * |B|; 0 without an estimate (the tally then has no range yet). */
+static double shot_trunc(const ulam_rad_solver *s, double B, double v, double nplan)
+{
+    double E = s->o.stop.rel_err > 0 ? s->o.stop.rel_err : 0.0, b = fabs(B);
+    if (!(b > 0) || s->o.estimator == ULAM_RAD_ABSORPTION) return 0.0;
+    double h = E > 0 ? E * b : 2.7 * sqrt(v / nplan), cap = fmax(ULAM__STOP_TAIL, E / 4.0) * b;
+    return fmin(cap, fmax(h / 8.0, 1e-6 * b));
+}
+
+/* Shooting, the first round at a budget (no estimate, no target yet) of collision tallies: the
+ * truncation whose bias and range term over the round's n1 particles (a bet at its largest) add
+ * up least, over biases u 2^(-j/4) / (1 - q_max) of a visit's score w0_c rho_pc / A_p (from the
+ * bound 1 / (1 - q_max) on the tally's mean visits down to 1e-6 of it, as the matrix solver's
+ * plan_terms), as the share u of a visit's score: the same for every patch (the range is a
+ * visit's score times the visits of histories so truncated); 0 when none has a range. */
+static double shot_first_share(const ulam_rad_solver *s, double n1)
+{
+    double u = 0.0, least = INFINITY;
+    for (int j = 0; s->qmax < 1.0 && j <= 80; j++) {
+        double uj = exp2(-0.25 * j) / (1.0 - s->qmax), Rj = ulam__score_range(INFINITY, 1.0, s->qmax, 1.0, 0, uj, 1.0);
+        double wj = ulam__cs_range_width(Rj, n1) + uj;
+        if (isfinite(Rj) && wj < least) least = wj, u = uj;
+    }
+    return u;
+}
+
+static void cs_add_shoot(ulam_rad_solver *s);
+
+/* Before a round of shooting, once the particles have doubled since the last plan and grown by
+ * one a patch, or grown fourfold (the planned count nplan is four times the particles so far), or
+ * by 24 a patch (a plan costs O(patches), a round's particles may be fewer: replanning every round
+ * tripled the CPU time of 3 10^5 particles on 80 270 patches): the tallies since that plan into
+ * each sequence,
+ * then every patch's and channel's sequence planned from the particles so far (the tallies over
+ * the area, limit the range at the planned truncation, clipped there: a longer history's tally
+ * clipped to it moves the mean no more than cutting the history would); the sums start anew. */
+static void cs_plan_shoot(ulam_rad_solver *s)
+{
+    int64_t N = s->run.walks, since = N - s->round0, n = s->s->npatches;
+    if (N > 0 && !(N >= 2 * s->round0 && since >= n) && N < 4 * s->round0 && since < 24 * n)
+        return; /* the plan stands (predictable still) */
+    cs_add_shoot(s);
+    double E = s->o.stop.rel_err, nplan = plan_walks(s), u = 0.0;
+    int first = s->run.walks == 0 && !(E > 0) && s->o.estimator != ULAM_RAD_ABSORPTION;
+    if (first) u = shot_first_share(s, fmin(nplan, (double)RBLOCK)); /* a budget's first round (one block) */
+    for (int64_t j = 0; j < 3 * s->s->npatches; j++) {
+        double mean, v, B;
+        shot_moments(s, j, &mean, &v);
+        B = s->s->emit[j] + mean;
+        double t = shot_trunc(s, B, v, nplan);
+        if (B == 0.0 && first) /* else that round would weigh nothing: 256 particles would print no interval */
+            t = u * s->w0[j % 3] * s->s->rho[j] / s->s->area[j / 3];
+        double R = shot_range(s, j / 3, (int)(j % 3), t);
+        double h = E > 0 && B != 0.0 ? E * fabs(B) - t : 0.0;
+        s->pend[j] = (rad_pend){.clip = t > 0 && isfinite(R) ? R : INFINITY};
+        ulam__cs_plan(&s->pcs[j], s->run.walks, mean, v, R, t, h > 0 ? h : 0.0, nplan);
+    }
+    s->round0 = s->run.walks;
+}
+
+/* Before a round (ctx: the solver): shooting's plans (stop.h: from earlier rounds alone; gathering
+ * plans a block at a time as it merges them, merge_block). */
+static void plan_round(void *ctx)
+{
+    ulam_rad_solver *s = ctx;
+    if (s->o.mode == ULAM_FORWARD) cs_plan_shoot(s);
+}
+
+/* Shooting: every patch's and channel's clipped tallies since the plan (the particles that did
+ * not reach it count 0) into its sequence, under that plan. */
+static void cs_add_shoot(ulam_rad_solver *s)
+{
+    int64_t n = s->run.walks - s->round0;
+    if (n <= 0) return;
+    for (int64_t j = 0; j < 3 * s->s->npatches; j++) {
+        const rad_pend *q = &s->pend[j];
+        double mean = q->sum / (double)n;
+        ulam__cs_add(&s->pcs[j], n, mean, fmax(0.0, q->sq - (double)n * mean * mean), q->max);
+        s->pend[j] = (rad_pend){.clip = q->clip};
+    }
+    s->round0 = s->run.walks;
+}
+
+/* Shooting: the sequence of entry j (patch j / 3, channel j % 3) with the tallies since the plan
+ * added (a copy: pieces added under one plan sum to the whole). */
+static void shot_cs(const ulam_rad_solver *s, int64_t j, ulam__cs *cs)
+{
+    int64_t n = s->run.walks - s->round0;
+    *cs = s->pcs[j];
+    if (n <= 0) return;
+    const rad_pend *q = &s->pend[j];
+    double mean = q->sum / (double)n;
+    ulam__cs_add(cs, n, mean, fmax(0.0, q->sq - (double)n * mean * mean), q->max);
+}
+
+/* Shooting: patch p's channel-c 95% interval (stop.h's confidence sequence on its tallies over
+ * the area, the emission exact), at its estimate. */
+static void shot_interval(const ulam_rad_solver *s, int64_t p, int c, ulam__stop_ci *ci)
+{
+    int64_t j = 3 * p + c;
+    double mean, v, E = s->s->emit[j];
+    shot_moments(s, j, &mean, &v);
+    if (shot_range(s, p, c, 1.0) == 0.0) { /* nothing tallies here: B = E exactly */
+        ulam__stop_interval(s->run.walks, E + mean, 0.0, 0.0, 0.0, 0.0, 0.0, 0, ci);
+        return;
+    }
+    ulam__cs cs;
+    shot_cs(s, j, &cs);
+    ulam__cs_interval(&cs, mean, shot_cut(s, p, c), ci);
+    ci->lo += E, ci->hi += E;
+}
+
+/* Channel c's 95% interval (stop.h's confidence sequence, valid at every walk count) at the
+ * solver's estimate: on the walks' scores less their exact offset (gathering, points), or patch
+ * index's tallies over its area (shooting).  A window walk's score past its certified range
+ * leaves no interval from then on (and no stop by rel_err), as in ulam_solve's. */
+static void channel_interval(const ulam_rad_solver *s, int c, ulam__stop_ci *ci)
+{
+    if (s->o.mode == ULAM_FORWARD) {
+        shot_interval(s, s->o.query.index, c, ci);
+        return;
+    }
+    double R, cut, off = score_offset(s, c), m = s->m[c].mean;
+    gather_range(s, c, &R, &cut);
+    if (R == 0.0) { /* nothing that scores is reachable: the offset exactly */
+        ulam__stop_interval(s->run.walks, m, 0.0, 0.0, 0.0, 0.0, 0.0, 0, ci);
+        return;
+    }
+    ulam__cs_interval(&s->cs[c], m - off, cut, ci);
+    ci->lo += off, ci->hi += off;
+}
+
+/* Shooting: the particles a sequence tuned to target E at radiosity B of patch p's channel c
+ * (tally variance v over the area) needs. */
+static double shot_needed(const ulam_rad_solver *s, int64_t p, int c, double B, double v, double E)
+{
+    double t = s->o.estimator == ULAM_RAD_ABSORPTION ? 0.0 : E * fabs(B) / 8.0, R = shot_range(s, p, c, t);
+    return R == 0.0 ? 0.0 : ulam__cs_walks_needed(B, v, R, t + shot_cut(s, p, c), E);
+}
+
+/* The walks the rel_err rule needs in channel c at estimate m: those of a sequence tuned to E
+ * from the start (stop.h's ulam__cs_walks_needed). */
 static double channel_min_walks(const ulam_rad_solver *s, int c, double m, double E)
 {
-    double A = s->o.mode == ULAM_FORWARD ? s->s->area[s->o.query.index] : 1.0, R, bias;
-    channel_range(s, c, m, E, &R, &bias);
-    return ulam__stop_walks_needed(m, ulam__moments_variance(&s->m[c]) / (A * A), R, bias, E,
-                                   ulam__stop_epoch(s->run.walks));
+    if (s->o.mode == ULAM_FORWARD) {
+        double mean, v;
+        shot_moments(s, 3 * s->o.query.index + c, &mean, &v);
+        return shot_needed(s, s->o.query.index, c, m, v, E);
+    }
+    double R, cut;
+    gather_range(s, c, &R, &cut);
+    return R == 0.0 ? 0.0 : ulam__cs_walks_needed(m, ulam__moments_variance(&s->m[c]), R, cut, E);
 }
 
 /* With rel_err: the walks the rule needs in each channel, at its estimate, or for a channel
@@ -688,11 +906,11 @@ static void channel_mins(const ulam_rad_solver *s, const ulam_rad_result *r, dou
     }
 }
 
-/* Nonzero when the rel_err rule of src/stop.h holds in every nonzero channel (and one is
- * nonzero): ulam__stop_rel_met on each channel's 95% interval; a channel still at 0 that some
- * walk could score in blocks the stop until the walks its range term needs at the brightest
- * channel's estimate have run (mins, channel_mins): only then would it have seen any of its
- * scores worth E times that. */
+/* Nonzero when the rel_err rule holds in every nonzero channel (and one is nonzero): the
+ * channel's printed 95% interval (channel_interval) at most E |m| on each side; a channel
+ * still at 0 that some walk could score in blocks the stop until the walks a sequence would
+ * need at the brightest channel's estimate have run (mins, channel_mins): only then would it
+ * have seen any of its scores worth E times that. */
 static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, const double mins[3], double rel_err)
 {
     int any = 0;
@@ -700,39 +918,55 @@ static int precise_enough(const ulam_rad_solver *s, const ulam_rad_result *r, co
         if (r->radiosity[c] == 0.0 && s->per_step[c] > 0 && !((double)r->walks >= mins[c])) return 0;
         if (r->radiosity[c] == 0.0) continue;
         ulam__stop_ci ci;
-        channel_interval(s, c, r->radiosity[c], rel_err, &ci);
-        if (!ulam__stop_rel_met(&ci, r->radiosity[c], rel_err)) return 0;
+        channel_interval(s, c, &ci);
+        if (!half_met(&ci, r->radiosity[c], rel_err)) return 0;
         any = 1;
     }
     return any;
 }
 
-/* Shooting: the range R of one particle's tally at patch p in channel c over its area (w0_c rho_pc
- * a visit, weights never growing; by absorption that / (1 - q_p) once; by collision truncated where
- * longer histories add at most E |m| / 4) and the bias that truncation allows, at estimate m. */
-static void shot_range(const ulam_rad_solver *s, int64_t p, int c, double m, double E, double *R, double *bias)
+/* With rel_err on one answer (a patch or point): the further walks the slowest nonzero channel's
+ * sequence needs to reach E |m| under its plan (ulam__cs_walks_left), at least an eighth of the
+ * walks so far; 0 (no prediction) when one cannot say. */
+static int64_t walks_wanted(const ulam_rad_solver *s, const ulam_rad_result *r)
 {
-    double A = s->s->area[p], ps = s->w0[c] * s->s->rho[3 * p + c];
-    double range = s->o.estimator == ULAM_RAD_ABSORPTION ? (ps > 0 ? ps / (1.0 - s->q[p]) : 0.0) : INFINITY;
-    *R = ulam__score_range(range, ps, s->qmax, 1.0, 0, fabs(m) * A, E / 4.0) / A;
-    *bias = isfinite(range) ? 0.0 : E * fabs(m) / 4.0;
+    double E = s->o.stop.rel_err, most = 0.0;
+    for (int c = 0; c < 3; c++) {
+        double m = r->radiosity[c], left;
+        if (m == 0.0) continue;
+        if (s->o.mode == ULAM_FORWARD) {
+            int64_t j = 3 * s->o.query.index + c;
+            double mean, v;
+            shot_moments(s, j, &mean, &v);
+            ulam__cs cs;
+            shot_cs(s, j, &cs);
+            left = ulam__cs_walks_left(&cs, mean, v, shot_cut(s, s->o.query.index, c), E * fabs(m));
+        } else {
+            double R, cut;
+            gather_range(s, c, &R, &cut);
+            left = ulam__cs_walks_left(&s->cs[c], s->m[c].mean - score_offset(s, c), ulam__moments_variance(&s->m[c]),
+                                       cut, E * fabs(m));
+        }
+        most = fmax(most, left);
+    }
+    return isfinite(most) && most > 0 ? (int64_t)fmax(most, (double)s->run.walks / 8.0) : 0;
 }
 
-/* Shooting: patch p under the rel_err rule (stop.h) at target E.  *kind: 0 dark (emits nothing,
+/* Shooting: patch p under the rel_err rule at target E.  *kind: 0 dark (emits nothing,
  * reflects nothing: B = 0 exactly), 1 unreached (it reflects, emits nothing, and no particle has
  * reached it), 2 lit.  A lit patch's *se and *half are its largest relative standard error and
- * relative 95% half-width over the nonzero channels; returns 1 when every channel meets E (a
- * channel still at 0 that a particle could light waits, as precise_enough's, for the walks its
- * range term needs at the brightest channel). */
+ * relative 95% half-width over the nonzero channels; returns 1 when every channel's printed
+ * half-width is at most E |B| (a channel still at 0 that a particle could light waits, as
+ * precise_enough's, for the walks a sequence needs at the brightest channel). */
 static int shot_patch(const ulam_rad_solver *s, int64_t p, double E, int *kind, double *se, double *half)
 {
     const ulam_scene *sc = s->s;
-    double N = (double)s->run.walks, A = sc->area[p], m[3], v[3], bright = 0.0;
-    int reached = 0, emits = 0, reflects = 0, met = 1, k = ulam__stop_epoch(s->run.walks);
+    double N = (double)s->run.walks, m[3], v[3], bright = 0.0;
+    int reached = 0, emits = 0, reflects = 0, met = 1;
     for (int c = 0; c < 3; c++) {
         double mean;
-        ulam__sums_moments(N, s->sum[3 * p + c], s->sumsq[3 * p + c], &mean, &v[c]);
-        m[c] = sc->emit[3 * p + c] + mean / A, v[c] /= A * A;
+        shot_moments(s, 3 * p + c, &mean, &v[c]);
+        m[c] = sc->emit[3 * p + c] + mean;
         reached |= s->sum[3 * p + c] != 0.0, emits |= sc->emit[3 * p + c] > 0, reflects |= sc->rho[3 * p + c] > 0;
         bright = fmax(bright, fabs(m[c]));
     }
@@ -740,20 +974,15 @@ static int shot_patch(const ulam_rad_solver *s, int64_t p, double E, int *kind, 
     *kind = reached || emits ? 2 : reflects ? 1 : 0;
     if (*kind < 2) return *kind == 0;
     for (int c = 0; c < 3; c++) {
-        double R, bias;
         if (m[c] == 0.0) {
-            if (s->w0[c] * sc->rho[3 * p + c] > 0) {
-                shot_range(s, p, c, bright, E, &R, &bias);
-                met &= N >= ulam__stop_walks_needed(bright, v[c], R, bias, E, k);
-            }
+            if (s->w0[c] * sc->rho[3 * p + c] > 0) met &= N >= shot_needed(s, p, c, bright, v[c], E);
             continue;
         }
         ulam__stop_ci ci;
-        shot_range(s, p, c, m[c], E, &R, &bias);
-        ulam__stop_interval(s->run.walks, m[c], v[c], R, bias, 0.0, INFINITY, k, &ci);
+        shot_interval(s, p, c, &ci);
         *se = fmax(*se, N > 1 ? sqrt(v[c] / N) / fabs(m[c]) : INFINITY);
         *half = fmax(*half, ci.half / fabs(m[c]));
-        met &= E > 0 && ulam__stop_rel_met(&ci, m[c], E);
+        met &= half_met(&ci, m[c], E);
     }
     return met;
 }
@@ -809,20 +1038,22 @@ int ulam_rad_solver_iterate(ulam_rad_solver *s)
     if (!s) return ULAM_EINVAL;
     if (s->run.done) return s->run.status;
     static const ulam__blocks B = {RBLOCK, RROUND, run_block, sizeof(rad_block), sizeof(rad_tally), merge_block,
-                                   NULL, NULL, 0};
+                                   plan_round, NULL, 0};
     ulam__round_step(&B, &s->o, s->threads, s, s->blocks, &s->run);
     ulam_rad_result r;
     double mins[3];
     result(s, mins, &r);
-    int k = ulam__stop_epoch(r.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
-    if (check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN) s->epoch = k;
-    if (s->whole > 0) { /* the whole scene (ulam_rad_solver_whole) instead of patch index */
-        int d = check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN ? scene_done(s) : 0; /* once an epoch */
+    int check = s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN; /* every round: the sequences hold at every count */
+    if (s->whole > 0) { /* the whole scene (ulam_rad_solver_whole) instead of patch index: checked
+                           once the particles grew by an eighth (O(patches) a check) */
+        int d = check && 8 * r.walks >= 9 * s->checked ? scene_done(s) : 0;
+        if (check && 8 * r.walks >= 9 * s->checked) s->checked = r.walks;
         if (d > 0) s->run.done = s->met = 1;
         if (d < 0) s->run.done = s->zero = 1; /* no particle lit anything: can never be met */
         return s->run.status;
     }
-    if (check && s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN && precise_enough(s, &r, mins, s->o.stop.rel_err))
+    s->run.want = s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN ? walks_wanted(s, &r) : 0;
+    if (check && precise_enough(s, &r, mins, s->o.stop.rel_err))
         s->run.done = s->met = 1;
     if (s->o.stop.rel_err > 0 && r.walks >= ULAM__REL_MIN && all_zero(&r)) s->run.done = s->zero = 1; /* can never be met */
     return s->run.status;
@@ -836,10 +1067,11 @@ void ulam__rad_solver_restart(ulam_rad_solver *s, int64_t p, double rel_err, uin
     s->o.query.index = p, s->o.stop.rel_err = rel_err, s->o.exec.seed = seed, s->o.stop.max_seconds = max_seconds;
     if (window(s)) own_parts(s); /* the new patch's or point's own vertex */
     s->m[0] = s->m[1] = s->m[2] = zero;
+    memset(s->cs, 0, sizeof s->cs);
     s->sq = s->maxsq = s->maxc[0] = s->maxc[1] = s->maxc[2] = 0.0;
     s->rays = s->cut = 0;
     ulam__run_reset(&s->run);
-    s->zero = s->met = s->epoch = 0;
+    s->zero = s->met = 0;
 }
 
 /* Nonzero once a stopping rule is met. */
@@ -885,8 +1117,8 @@ static void result(const ulam_rad_solver *s, double mins[3], ulam_rad_result *r)
     r->zero = s->zero;
     r->rel_err_met = s->met;
     for (int c = 0; c < 3; c++) {
-        ulam__stop_ci ci; /* a fixed budget's truncation takes at most ULAM__STOP_TAIL of |B| */
-        channel_interval(s, c, r->radiosity[c], s->o.stop.rel_err > 0 ? s->o.stop.rel_err : 4.0 * ULAM__STOP_TAIL, &ci);
+        ulam__stop_ci ci;
+        channel_interval(s, c, &ci);
         /* every score is >= 0 (emission and reflectance are), so B >= 0 is certain */
         r->ci95[c][0] = r->walks > 1 && !isnan(ci.lo) ? fmax(ci.lo, 0.0) : NAN, r->ci95[c][1] = r->walks > 1 ? ci.hi : NAN;
     }
