@@ -10,8 +10,8 @@
  *   - the library never prints and never exits;
  *   - ABI habit: a struct the caller fills starts from its defaults function, which sets every
  *     field, and the caller then sets what it needs (ulam_walk_defaults with its parts by concern:
- *     ulam_kernel_defaults, ulam_stop_defaults, ulam_exec_defaults, ulam_query_defaults,
- *     ulam_policy_defaults; ulam_mm_defaults,
+ *     ulam__kernel_defaults, ulam__stop_defaults, ulam__exec_defaults, ulam__query_defaults,
+ *     ulam__policy_defaults; ulam_mm_defaults,
  *     ulam_spectral_defaults, ulam_power_defaults, ulam_guard_defaults, ulam_outer_defaults,
  *     ulam_bidir_defaults, ulam_auto_defaults, ulam_share_defaults, ulam_system_desc_defaults;
  *     in ulam_radiosity.h ulam_camera_cornell or ulam_camera_frame): a field a later version
@@ -24,8 +24,8 @@
  * The API by rank, as CSparse's header ranks its own (each section banner below names the
  * ranks it holds; sections follow the data flow, file -> matrix -> guards -> walks -> output):
  *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
- *     ulam_guard_check, ulam_walk_defaults (its parts: ulam_kernel_defaults, ulam_stop_defaults,
- *     ulam_exec_defaults, ulam_query_defaults, ulam_policy_defaults), ulam_solver_alloc, ulam_solver_iterate,
+ *     ulam_guard_check, ulam_walk_defaults (its parts: ulam__kernel_defaults, ulam__stop_defaults,
+ *     ulam__exec_defaults, ulam__query_defaults, ulam__policy_defaults), ulam_solver_alloc, ulam_solver_iterate,
  *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
  *     ulam_solver_free, ulam_solve (the method table's choice: what `ulam solve` runs), ulam_solve_walks
  *     (the walks pinned), ulam_auto (the choice with its verdicts),
@@ -39,7 +39,7 @@
  *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_plan, ulam_bidir_solve), the method
  *     table and its choice (ulam_method_*, ulam_auto_start, ulam_run_*, ulam_auto_choose), ulam_direct_bytes;
  *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
- *     ulam_strtod, ulam_outfile_*, ulam_spectral_radius_op, ulam_gauss_seidel_*, the studies'
+ *     ulam_strtod, ulam_outfile_*, ulam__spectral_radius_op, ulam_gauss_seidel_*, the studies'
  *     method grid and exact value (ulam_study_*), random numbers (ulam_rng_*), ulam_now.
  * The radiosity front end ranks its own in ulam_radiosity.h.
  */
@@ -151,14 +151,8 @@ int ulam_csr_from_triplets(int64_t nrows, int64_t ncols, int64_t nz, const int32
 /* The transpose of A (new matrix in *out). */
 int ulam_csr_transpose(const ulam_csr *A, ulam_csr **out);
 
-/* A deep copy of A. */
-int ulam_csr_copy(const ulam_csr *A, ulam_csr **out);
-
 /* y = A x (use_abs != 0: y = |A| x). */
 int ulam_csr_matvec(const ulam_csr *A, int use_abs, const double *x, double *y);
-
-/* Dense row-major copy of A into a caller buffer of nrows*ncols doubles. */
-int ulam_csr_to_dense(const ulam_csr *A, double *dense);
 
 /* Summary statistics of a square matrix M (the walk kernel's raw material). */
 typedef struct ulam_csr_stats {
@@ -214,9 +208,6 @@ int ulam_edgelist_is_file(const char *path);
  * expanded). */
 int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err);
 
-/* As ulam_mm_read_matrix, from an open file; name is used only in error details. */
-int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
-
 /* Options of the matrix reader.  Start from ulam_mm_defaults(). */
 typedef struct ulam_mm_opts {
     int threads;     /* 0: all cores; 1: the sequential streaming reader.  A regular file of
@@ -229,7 +220,7 @@ typedef struct ulam_mm_opts {
 /* The defaults: all cores (threads 0). */
 ulam_mm_opts ulam_mm_defaults(void);
 
-/* As ulam_mm_read_matrix_file with options (o NULL: ulam_mm_defaults()). */
+/* As ulam__mm_read_matrix_file with options (o NULL: ulam_mm_defaults()). */
 int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
 
 /* Read a dense vector from path: "array" m x 1, or "coordinate" m x 1 (missing entries are
@@ -319,7 +310,7 @@ int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops,
 int ulam_direct_sparse_available(void);
 
 /* ---------------------------------------------------------------- spectral radius */
-/* Secondary, except tertiary: ulam_spectral_radius_op. */
+/* Secondary, except tertiary: ulam__spectral_radius_op. */
 
 /* Options of the spectral radius estimate: ARPACK's implicitly restarted Arnoldi
  * (dense dgeev for n <= 128), stopped when the dominant Ritz pair reaches
@@ -347,11 +338,6 @@ typedef struct ulam_radius {
  * not as a failure. */
 int ulam_spectral_radius(const ulam_csr *A, int use_abs, const ulam_spectral_opts *opts,
                          ulam_radius *out);
-
-/* Spectral radius of a linear operator given as y = op(ctx, x), n x n. */
-int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double *x, double *y),
-                            const void *ctx, int positive_start, const ulam_spectral_opts *opts,
-                            ulam_radius *out);
 
 /* Options of the power iteration for nonnegative operators (the guards' radii).  Start from
  * ulam_power_defaults(). */
@@ -608,7 +594,7 @@ typedef struct ulam_share {
 ulam_share ulam_share_defaults(void);
 
 /* The walk kernel: how a walk moves and how its weight is kept in a window.  Start from
- * ulam_kernel_defaults(). */
+ * ulam__kernel_defaults(). */
 typedef struct ulam_kernel_opts {
     double continue_q;   /* fixed continuation probability in (0, 1); <= 0: analog min(1, S_i) */
     double kernel_alpha; /* the kernel exponent alpha, finite and >= 0: a walk that continues from
@@ -624,10 +610,7 @@ typedef struct ulam_kernel_opts {
     double split;        /* weight window ceiling: above it split into ceil(|w|/W) copies; 0 off */
 } ulam_kernel_opts;
 
-/* The defaults: analog continuation, exponent 1, rows built as reached, no weight window. */
-ulam_kernel_opts ulam_kernel_defaults(void);
-
-/* When a run stops: the first rule met ends it.  Start from ulam_stop_defaults(). */
+/* When a run stops: the first rule met ends it.  Start from ulam__stop_defaults(). */
 typedef struct ulam_stop_opts {
     int64_t max_walks;   /* stop after this many walks (0: no limit) */
     double rel_err;      /* stop once the relative-error rule holds (see ulam_solve_walks); 0 off */
@@ -638,23 +621,14 @@ typedef struct ulam_stop_opts {
                               part): rel_err is then relative to |c + estimate| (0: none) */
 } ulam_stop_opts;
 
-/* The defaults: 10^5 walks, walk cap 10^6 steps, every other rule off.  The 10^5 walks are the
- * budget of a run with no other rule: ulam_solve and ulam_solve_walks given a rel_err target with
- * max_walks left at this default (and no max_seconds) run to the target, capped at
- * ULAM_REL_ERR_CAP, as the command line's --rel-err does; another max_walks caps the target. */
-ulam_stop_opts ulam_stop_defaults(void);
-
-/* Where and how the walks run.  Start from ulam_exec_defaults(). */
+/* Where and how the walks run.  Start from ulam__exec_defaults(). */
 typedef struct ulam_exec_opts {
     uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */
     int threads;         /* 0: all cores */
     const ulam_share *share; /* NULL: this process runs every block */
 } ulam_exec_opts;
 
-/* The defaults: seed 1, all cores, one process. */
-ulam_exec_opts ulam_exec_defaults(void);
-
-/* What is asked: which x_i (or which weighted sum of them).  Start from ulam_query_defaults(). */
+/* What is asked: which x_i (or which weighted sum of them).  Start from ulam__query_defaults(). */
 typedef struct ulam_query_opts {
     int64_t index;       /* 0-based component reported (the start state in adjoint mode) */
     int64_t nstarts;     /* adjoint: 0 starts every walk at index; k > 0 starts it at starts[j]
@@ -665,11 +639,8 @@ typedef struct ulam_query_opts {
     const double *start_weights; /* k finite weights, not all 0 */
 } ulam_query_opts;
 
-/* The defaults: x_0, walks starting there. */
-ulam_query_opts ulam_query_defaults(void);
-
 /* What the run trusts: the guards' verdicts, computed before or to compute, and what to do when
- * they do not certify.  Start from ulam_policy_defaults(). */
+ * they do not certify.  Start from ulam__policy_defaults(). */
 typedef struct ulam_policy_opts {
     int force;           /* 1: walk even when rho(|M|) is not certified below 1 (else ULAM_EDIVERGE) */
     int assume_finite;   /* 1: treat a variance the guards cannot certify either way as finite */
@@ -683,9 +654,6 @@ typedef struct ulam_policy_opts {
                                   pass over all of M), and a damaged one fails the run with
                                   ULAM_ESYNTAX naming it */
 } ulam_policy_opts;
-
-/* The defaults: refuse what is not certified, compute the guards, no prepared system. */
-ulam_policy_opts ulam_policy_defaults(void);
 
 /* How to walk and when to stop, by concern.  Start from ulam_walk_defaults() (each part from its
  * own defaults function). */
@@ -843,17 +811,6 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
 int ulam_solve_walks(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                      ulam_walk_result *result, ulam_error *err);
 
-/* As ulam_solve, ulam_solver_alloc and ulam_jacobi with b's length nb: b must have one entry a
- * row of M (A), else ULAM_EDIM (ULAM_EINVAL for a NULL b), so a short b is refused, never read
- * past its end (the functions without a length read M->nrows entries of b and trust that they
- * are there).  ulam_jacobi_n writes nb entries of bp. */
-int ulam_solve_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                 ulam_walk_result *result, ulam_error *err);
-int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                        ulam_solver **out, ulam_error *err);
-int ulam_jacobi_n(const ulam_csr *A, const double *b, int64_t nb, double omega, ulam_csr **M, double *bp,
-                  ulam_error *err);
-
 /* The walk cap of a run whose only rule is rel_err. */
 #define ULAM_REL_ERR_CAP 1000000000
 
@@ -929,7 +886,7 @@ void ulam_analysis_get_info(const ulam_analysis *a, ulam_analysis_info *info);
 /* Iterations on (I - M) x = b from x = 0 that stop on the exact residual
  * ||b - (I - M) x||_2 / ||b||_2 <= tol:
  *   ULAM_RICHARDSON  x <- M x + b (the deterministic reference);
- *   ULAM_GAUSS_SEIDEL one sweep of ulam_gauss_seidel_sweep;
+ *   ULAM_GAUSS_SEIDEL one sweep of ulam__gauss_seidel_sweep;
  *   ULAM_SEQUENTIAL  Halton's sequential Monte Carlo: r = b - (I - M) x, delta ~ (I - M)^-1 r
  *                    by forward walks from r, x <- x + delta;
  *   ULAM_MCSA        Monte Carlo Synthetic Acceleration (Evans and Mosher): a Richardson step
@@ -1410,12 +1367,6 @@ int ulam_method_answers(int k);
  * max(16, n / 10) (a denser b: the push on b, see ulam_auto_start). */
 int64_t ulam_method_sparse_limit(int64_t n);
 
-/* Which route the bidirectional row takes for x of (I - M) x = b (n entries) under the walks'
- * pins ao (NULL: none) and options o: 0 the reverse push from the index and collision walks from
- * b (a sparse b, nothing pinned it cannot honour), 1 the push on b and walks from the index with
- * the walks' own estimator and exponent (a dense b, or an estimator or exponent pinned). */
-int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o);
-
 /* Which rows a choice may take.  Start from ulam_method_defaults(). */
 typedef struct ulam_method_opts {
     int method;       /* the row pinned (enum ulam_method_row); -1: choose among the rows */
@@ -1500,7 +1451,7 @@ int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o,
 ulam_solver *ulam_run_solver(ulam_run *r);
 
 /* The route a bidirectional run takes: 1 the push on b and walks from the index, 0 the reverse
- * push from the index and walks from b (ulam_method_bidir_route's, unless no walks from the
+ * push from the index and walks from b (ulam__method_bidir_route's, unless no walks from the
  * index are certified: then the reverse push even for a dense b), -1 for another row. */
 int ulam_run_bidir_route(const ulam_run *r);
 
@@ -1574,19 +1525,6 @@ int ulam_study_method_find(const char *name);
  * value (runs > 0; else [0, 1]). */
 void ulam_study_coverage_interval(int covered, int runs, double *lo, double *hi);
 
-/* Set o's mode, estimator, roulette and split to method k's on b (n entries; read only in
- * forward mode, for w0 = ||b||_1).  ULAM_OK or ULAM_EINVAL. */
-int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o);
-
-/* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
-void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
-
-/* Gauss-Seidel sweeps on x (in place, from what it holds) until, after at least min_sweeps, one
- * sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps are made; returns the
- * sweeps made. */
-int ulam_gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
-                             int min_sweeps, int max_sweeps);
-
 /* Up to this n a study's exact value is LAPACK's. */
 #define ULAM_STUDY_DIRECT_MAX 8000
 
@@ -1600,12 +1538,8 @@ typedef struct ulam_study_ref {
     double direct_seconds; /* that solve's time */
 } ulam_study_ref;
 
-/* The exact x_index of (I - M) x = b for a study (index 0-based).  ULAM_OK, ULAM_EINVAL or
- * ULAM_ENOMEM. */
-int ulam_study_reference(const ulam_csr *M, const double *b, int64_t index, ulam_study_ref *ref, ulam_error *err);
-
 /* A variance study: every chosen method of the grid at every budget, repeats runs each, scored
- * against the exact x_index (ulam_study_reference).  Run k = (method << 24) + (budget << 16) +
+ * against the exact x_index (ulam__study_reference).  Run k = (method << 24) + (budget << 16) +
  * repeat walks with seed ulam_rng_substream(seed, ULAM_STREAM_STUDY, k). */
 typedef struct ulam_study ulam_study;
 
@@ -1749,11 +1683,6 @@ double ulam_rng_uniform(ulam_rng *r);
 
 /* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
 uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
-
-/* The k-th (k < 4) uniform double in [0, 1) of step t of walk w under seed: a counter-based
- * stream (splitmix64's finalizer chained over the key), the same on every rank and thread, so a
- * walk that migrates between ranks (ulam_dist.h) takes the same path. */
-double ulam_rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k);
 
 /* What a derived seed is for: the one place sub-runs get their seeds (ulam_rng_substream). */
 typedef enum ulam_stream_purpose {

@@ -18,4 +18,10 @@ typedef struct ulam__bidir ulam__bidir;
 int ulam__bidir_plan_on(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan, ulam_error *err);
 int ulam__bidir_solve_on(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err);
 
+/* Which route the bidirectional row takes for x of (I - M) x = b (n entries) under the walks'
+ * pins ao (NULL: none) and options o: 0 the reverse push from the index and collision walks from
+ * b (a sparse b, nothing pinned it cannot honour), 1 the push on b and walks from the index with
+ * the walks' own estimator and exponent (a dense b, or an estimator or exponent pinned). */
+int ulam__method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o);
+
 #endif

@@ -270,7 +270,7 @@ int ulam_outer_iterate(ulam_outer *s, ulam_outer_step *step)
         for (int64_t i = 0; i < s->n; i++) s->x[i] += s->r[i]; /* x + r = M x + b */
         break;
     case ULAM_GAUSS_SEIDEL:
-        ulam_gauss_seidel_sweep(s->M, s->b, s->x);
+        ulam__gauss_seidel_sweep(s->M, s->b, s->x);
         break;
     case ULAM_MCSA:
         for (int64_t i = 0; i < s->n; i++) s->x[i] += s->r[i];

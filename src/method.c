@@ -237,13 +237,3 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, u
     free(a);
     return status;
 }
-
-/* As ulam_solve with b's length checked. */
-int ulam_solve_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                 ulam_walk_result *result, ulam_error *err)
-{
-    ulam__clear(err);
-    if (!M) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
-    int status = ulam__length_check(b, nb, M->nrows, "b", err);
-    return status ? status : ulam_solve(M, b, opts, result, err);
-}

@@ -10,4 +10,7 @@
  * reader as it was), for the reader's benchmark and tests to compare (src/mmio.c). */
 int ulam__mm_read_matrix_libc(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
 
+/* As ulam_mm_read_matrix, from an open file; name is used only in error details. */
+int ulam__mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
+
 #endif

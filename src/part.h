@@ -50,4 +50,9 @@ typedef struct {
 int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const int64_t *index, int64_t nq,
                     ulam__dist_cert *cert, ulam_error *err);
 
+/* As ulam_dist_forward with the sources drawn from b (this rank's rows [first, last) of it) in
+ * place of the system's b: the walks of MCSA's correction and of single source's residual. */
+int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
+                        double *se, ulam_dist_result *res, ulam_error *err);
+
 #endif

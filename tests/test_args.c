@@ -200,43 +200,6 @@ static void test_other_options(void **state)
     ulam_csr_free(M);
 }
 
-/* Vectors passed with their length: a short (or long) b is ULAM_EDIM, not a read past its end. */
-static void test_lengths(void **state)
-{
-    (void)state;
-    ulam_csr *M = chain(), *J = NULL;
-    ulam_walk_opts o = ulam_walk_defaults();
-    o.stop.max_walks = 1000, o.exec.threads = 1;
-    ulam_walk_result r;
-    ulam_error err;
-    double *b3 = malloc(3 * sizeof *b3), bp[4];
-    b3[0] = b3[1] = b3[2] = 1.0;
-    for (int mode = 0; mode < 2; mode++) {
-        o.mode = mode;
-        assert_int_equal(ulam_solve_n(M, b3, 3, &o, &r, &err), ULAM_EDIM);
-        assert_int_equal(err.status, ULAM_EDIM);
-        assert_int_equal(ulam_solve_n(M, ones, 5, &o, &r, &err), ULAM_EDIM);
-        assert_int_equal(ulam_solve_n(M, NULL, 4, &o, &r, &err), ULAM_EINVAL);
-        assert_int_equal(ulam_solve_n(M, ones, 4, &o, &r, &err), ULAM_OK);
-        ulam_solver *s = NULL;
-        assert_int_equal(ulam_solver_alloc_n(M, b3, 3, &o, &s, &err), ULAM_EDIM);
-        assert_null(s);
-        assert_int_equal(ulam_solver_alloc_n(M, ones, 4, &o, &s, &err), ULAM_OK);
-        ulam_solver_free(s);
-    }
-    assert_int_equal(ulam_jacobi_n(M, b3, 3, 1.0, &J, bp, &err), ULAM_EDIM);
-    assert_null(J);
-    ulam_csr *A = NULL; /* I - M: nonzero diagonal */
-    int32_t ti[7] = {0, 1, 2, 3, 0, 1, 2}, tj[7] = {0, 1, 2, 3, 1, 2, 3};
-    double tx[7] = {1, 1, 1, 1, -0.5, -0.5, -0.5};
-    assert_int_equal(ulam_csr_from_triplets(4, 4, 7, ti, tj, tx, &A), ULAM_OK);
-    assert_int_equal(ulam_jacobi_n(A, ones, 4, 1.0, &J, bp, &err), ULAM_OK);
-    ulam_csr_free(J);
-    ulam_csr_free(A);
-    free(b3);
-    ulam_csr_free(M);
-}
-
 /* A damaged copy of the chain: kind 0 rowptr[0] != 0, 1 a row pointer far past nnz, 2 falling
  * row pointers, 3 a negative one, 4 a column index past n, 5 a negative column, 6 rowptr[n]
  * negative, 7 more rows than ULAM_MAX_DIM. */
@@ -399,7 +362,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_walk_options),   cmocka_unit_test(test_nested_walk_options),
-        cmocka_unit_test(test_other_options),  cmocka_unit_test(test_lengths),
+        cmocka_unit_test(test_other_options),
         cmocka_unit_test(test_damaged_matrix), cmocka_unit_test(test_overflow),
         cmocka_unit_test(test_scaling_exact),
     };

@@ -59,22 +59,6 @@ static void test_walk(void **state)
     assert_null(o.query.starts);
     assert_null(o.query.start_weights);
     assert_null(o.policy.system);
-    /* each concern is its own defaults function's (the parts a caller may start from alone) */
-    ulam_kernel_opts k = ulam_kernel_defaults();
-    ulam_stop_opts st = ulam_stop_defaults();
-    ulam_exec_opts e = ulam_exec_defaults();
-    ulam_query_opts q = ulam_query_defaults();
-    ulam_policy_opts p = ulam_policy_defaults();
-    assert_true(k.continue_q == o.kernel.continue_q && k.kernel_alpha == o.kernel.kernel_alpha &&
-                k.whole_kernel == o.kernel.whole_kernel && k.roulette == o.kernel.roulette && k.split == o.kernel.split);
-    assert_true(st.max_walks == o.stop.max_walks && st.rel_err == o.stop.rel_err &&
-                st.max_seconds == o.stop.max_seconds && st.max_steps == o.stop.max_steps &&
-                st.interrupt == o.stop.interrupt && st.rel_err_offset == o.stop.rel_err_offset);
-    assert_true(e.seed == o.exec.seed && e.threads == o.exec.threads && e.share == o.exec.share);
-    assert_true(q.index == o.query.index && q.nstarts == o.query.nstarts && q.starts == o.query.starts &&
-                q.start_weights == o.query.start_weights);
-    assert_true(p.force == o.policy.force && p.assume_finite == o.policy.assume_finite && p.guard == o.policy.guard &&
-                p.system == o.policy.system);
 }
 
 /* Issue 38 point 10: ulam_walk_defaults() with a rel_err target runs to the target, as the

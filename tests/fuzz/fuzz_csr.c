@@ -61,12 +61,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     o.policy.force = (flags & 128) != 0;
     ulam_error err;
     ulam_walk_result r;
-    ulam_solve_n(&A, b, n, &o, &r, &err);
+    ulam_solve_walks(&A, b, &o, &r, &err);
     ulam_guard g;
     ulam_guard_check(&A, 0.0, NULL, &g, &err);
     ulam_csr *T = NULL, *J = NULL;
     if (ulam_csr_transpose(&A, &T) == ULAM_OK) ulam_csr_free(T);
-    if (ulam_jacobi_n(&A, b, n, 1.0, &J, bp, &err) == ULAM_OK) ulam_csr_free(J);
+    if (ulam_jacobi(&A, b, 1.0, &J, bp, &err) == ULAM_OK) ulam_csr_free(J);
     ulam_direct_solve(&A, b, x, 0, NULL, &err);
     int it;
     double res;
