@@ -776,18 +776,6 @@ int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error);
 /* Free a solver; accepts and returns NULL. */
 ulam_solver *ulam_solver_free(ulam_solver *s);
 
-/* The library's `ulam solve`: x_{opts->query.index} by the method the table chooses (ulam_auto), so a
- * caller with ulam_walk_defaults() gets what `ulam solve` gives by default: the same choice and,
- * on the same seed, the same estimate.  As the command line pins what it is given, a walk option
- * that differs from ulam_walk_defaults() pins that part of the walks' race (mode, estimator,
- * continue_q, kernel_alpha; opts->policy.guard serves as ulam_auto_opts.guard); all four differing, or
- * nstarts > 0, pin the walks row: ulam_solve_walks's run.  The answer comes as a walk result:
- * the chosen walks' run, or for bidirectional its walks on <r, x> with the whole answer's
- * estimate, std_error and ci95.  Statuses: ulam_auto's.  To run exactly the walks opts name, call
- * ulam_solve_walks (or ulam_auto with ulam_method_opts.method = ULAM_METHOD_WALKS). */
-int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-               ulam_walk_result *result, ulam_error *err);
-
 /* The walks opts name, pinned (no choice): allocate, iterate until done, report, free in one
  * call, with the refusals of ulam_solver_alloc (guards checked first).  It always ends: rel_err alone stops at 10^9
  * walks at most (ULAM_REL_ERR_CAP; rel_err_met 0).
@@ -838,9 +826,13 @@ typedef struct ulam_analysis_opts {
     const ulam_system *system; /* the prepared system M is mapped from (NULL: none): its
                                 certificate and stored bounds serve when made for this
                                 continuation and exponent */
+    int shared_bounds;       /* 1: the method table's walks (ulam_analysis_start, _solve) walk
+                                under the bounds over every state, made once for all queries (a
+                                prepared file's, or one pass over M); 0 (the default): each query
+                                searches its own start's reach, as on M alone */
 } ulam_analysis_opts;
 
-/* The defaults: analog continuation, exponent 1, no b, no system. */
+/* The defaults: analog continuation, exponent 1, no b, no system, bounds per query. */
 ulam_analysis_opts ulam_analysis_defaults(void);
 
 /* An analysis of square M (borrowed: it must outlive the analysis) under opts (NULL: the
@@ -860,10 +852,6 @@ ulam_analysis *ulam_analysis_free(ulam_analysis *a);
  * rel_err run's length, may differ). */
 int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_solver **out,
                          ulam_error *err);
-
-/* One query to its end (ulam_analysis_solver, iterate, report, free): as ulam_solve_walks. */
-int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_walk_result *result,
-                        ulam_error *err);
 
 /* M's transpose, made at the first call and kept (NULL: no memory, err filled). */
 const ulam_csr *ulam_analysis_transpose(ulam_analysis *a, ulam_error *err);
@@ -1011,26 +999,6 @@ typedef struct ulam_push_info {
     double seconds;  /* wall time in ulam_push_run */
 } ulam_push_info;
 
-/* A workspace for pushes on the square matrix M, which is borrowed until the workspace is freed. */
-int ulam_push_alloc(const ulam_csr *M, ulam_push **out);
-
-/* Free a workspace; accepts and returns NULL. */
-ulam_push *ulam_push_free(ulam_push *w);
-
-/* Start over for target t (0-based): p = 0, r = e_t; ULAM_EINVAL when t is out of range. */
-int ulam_push_start(ulam_push *w, int64_t target);
-
-/* Push every state with |r_j| > rmax until none is left (FIFO order); ULAM_EINVAL for rmax <= 0 or
- * no start; ULAM_ENOCONV when the work passes max_ops (> 0; 0 is no cap), the invariant intact. */
-int ulam_push_run(ulam_push *w, double rmax, int64_t max_ops);
-
-/* The dense estimates p and residuals r (n entries each, owned by the workspace). */
-const double *ulam_push_estimates(const ulam_push *w);
-const double *ulam_push_residuals(const ulam_push *w);
-
-/* Fill *info about the pushes since the last start. */
-void ulam_push_report(const ulam_push *w, ulam_push_info *info);
-
 /* Bidirectional estimate of x_t of (I - M) x = b for b = e_s or a sparse b (src/bidir.c; Lofgren,
  * Banerjee, Goel, "Personalized PageRank estimation and search: a bidirectional approach", WSDM
  * 2016): a reverse push from t gives x_t = <p, b> + <r, x>, and <r, x> = b' (I - M')^-1 r is
@@ -1102,23 +1070,6 @@ typedef struct ulam_bidir_plan_info {
                                (0: no probe ran, or it saw nothing), which the balance plans for */
 } ulam_bidir_plan_info;
 
-/* Plan a bidirectional estimate without its walks: start the push at o->target and, when o->rmax
- * <= 0, run a pilot of 256 walks on a seed of its own (o->walk.seed mixed) and halve rmax from 1,
- * pushing down to it, while the push's operations are below the walks' predicted work (walks
- * predicted by the stopping rule's terms: its 1000-walk floor, the variance ||b||_1 rmax V /
- * (E^2 x^), and for a rel_err target E the range term the walk solver's own bounds (the pilot's
- * solver, over the states the walks reach) give for scores of at most rmax a visit, when they
- * give one; x^ = max(min_value, |<p, b>|); E = 0.1 for a run stopped by time alone); with
- * o->rmax > 0 push to it.  w is left pushed, and remembers the plan: ulam_bidir_solve with the
- * same options (target, b, rmax, min_value, max_push_ops and the walk options the pilot and
- * prediction read) uses that push and pilot as they are, until ulam_push_start or ulam_push_run
- * changes the workspace.  The push's operations are exact; the walks are a model's prediction:
- * the solver runs what its rule needs, in whole rounds, fewer or more (on the R-MAT benchmark the
- * median prediction was 1.8e4 walks where 7168 ran; x^ far above |x| predicts too few).
- * Statuses as ulam_bidir_solve. */
-int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
-                    ulam_error *err);
-
 /* What a bidirectional estimate found. */
 typedef struct ulam_bidir_result {
     double estimate, std_error, ci95[2]; /* of x_t: <p, b> plus the walks' estimate of <r, x>; the
@@ -1131,15 +1082,6 @@ typedef struct ulam_bidir_result {
     double seconds;        /* the whole estimate: the plan's seconds (pilot and push, also when
                               reused) plus the walks' set-up and walks */
 } ulam_bidir_result;
-
-/* Estimate x_t of (I - M) x = b (e_s, or o's sparse b) with push workspace w (on M) and Mt, the
- * transpose of M (borrowed;
- * computing it is one O(nnz) pass the caller makes once for any number of queries): the plan of
- * ulam_bidir_plan (reused when w holds it for these options), then walks from s on Mt scoring the
- * residual (from b's states, in proportion to |b_j|) until o->walk's stopping rules hold.  ULAM_OK, ULAM_EINVAL (bad options, index out of
- * range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap), the walk solver's statuses. */
-int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
-                     ulam_error *err);
 
 /* Single source, every target (src/fpush.c, src/sweep.c; FORA, Wang et al., KDD 2017, with
  * SpeedPPR's sweeps, Wu et al., 2021): x = (I - M)^-1 e_s by a forward push from s (rounds over
@@ -1205,7 +1147,7 @@ int ulam_fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts 
 /* ---------------------------------------------------------------- choosing the method */
 /* All secondary. */
 
-/* What became of a candidate of ulam_auto_choose. */
+/* What became of a candidate of ulam_auto_solver. */
 enum ulam_auto_state {
     ULAM_AUTO_UNCERTIFIED = 0, /* its variance is not certified finite (or its guard was not computed) */
     ULAM_AUTO_REFUSED,         /* the solver refused it (status: absorption with p* = 0) */
@@ -1215,7 +1157,7 @@ enum ulam_auto_state {
     ULAM_AUTO_CHOSEN
 };
 
-/* One candidate of ulam_auto_choose: a mode, an estimator and a continuation. */
+/* One candidate of ulam_auto_solver: a mode, an estimator and a continuation. */
 typedef struct ulam_auto_candidate {
     int mode, estimator;
     double continue_q;    /* <= 0: analog */
@@ -1310,11 +1252,9 @@ typedef struct ulam_auto_result {
  *     not resolve |x| (ulam_auto_lower_bound).
  * The pilots' walks are not used in the answer: it comes from fresh walks on base's seed
  * (ulam_auto_solver), which the choice, a function of the pilots alone, cannot bias. */
-int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
-                     ulam_auto_result *res, ulam_error *err);
 
-/* As ulam_auto_choose, and *out gets the solver to run: the chosen candidate's (or, when none is
- * certified, the closest's) on base's options with that mode, estimator and continuation, its
+/* ulam_auto_solver: the choice above, and *out (NULL: the choice alone) gets the solver to run:
+ * the chosen candidate's (or, when none is certified, the closest's) on base's options with that mode, estimator and continuation, its
  * kernel rows, reachable set, score bounds and guards kept from the pilots, no walk made yet:
  * iterating it gives, bit for bit, what a solver allocated with those options would (NULL with
  * a status when none is left).  Its refusals are ulam_solver_alloc's. */
@@ -1470,18 +1410,6 @@ ulam_run *ulam_run_free(ulam_run *r);
 int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
               const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err);
 
-/* As ulam_auto_solver for M = a's M, its candidates of a's kernel (adjoint, a's continuation and
- * exponent) walking under a's bounds over every state (a prepared file's, or one pass over M)
- * rather than each searching its start's reach; ao->guard, when NULL and ao pins a's
- * continuation, exponent and adjoint mode, is a's.  The same choice as ulam_auto_solver where
- * those bounds equal the start's (a start that reaches every state). */
-int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
-                       ulam_auto_result *res, ulam_solver **out, ulam_error *err);
-
-/* A's push workspace on M, made at the first call and kept (ulam_analysis_bidir pushes on it);
- * NULL: no memory (err filled). */
-ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err);
-
 /* A bidirectional estimate (as ulam_bidir_solve) on a's transpose (ulam_analysis_transpose: a
  * prepared file's stored M^T when it has one, else made once), push workspace and plan memo,
  * all made at the first call and kept across queries: a plan (ulam_bidir_plan's) is reused for
@@ -1491,11 +1419,46 @@ ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err);
  * the same estimate as ulam_bidir_solve on a fresh workspace.  Statuses as ulam_bidir_solve. */
 int ulam_analysis_bidir(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err);
 
-/* As ulam_auto_start for M = a's M: the walks row's candidates of a's kernel walk under a's bounds
- * over every state (as ulam_analysis_auto), the other rows as ulam_auto_start; the run borrows a
- * (free the run first). */
-int ulam_analysis_auto_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                             const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err);
+/* ---------------------------------------------------------------- one unknown: the primary call */
+/* Primary: ulam_analysis_solve (with ulam_analysis_alloc, ulam_analysis_free, ulam_method_find).
+ * Secondary: ulam_analysis_start and the run's ulam_run_solver, ulam_run_finish, ulam_run_free
+ * (the same, step by step: iterate the walks to show progress or stop early).
+ *
+ * To ask for x_i of (I - M) x = b:
+ *     ulam_analysis *a;  ulam_analysis_alloc(M, NULL, &a, &err);      (once per M, reused)
+ *     ulam_walk_opts o = ulam_walk_defaults();  o.query.index = i;  o.stop.rel_err = 0.01;
+ *     ulam_answer ans;   ulam_analysis_solve(a, b, &o, NULL, NULL, NULL, &ans, &err);
+ *     ... ans.estimate, ans.ci95 ...;   ulam_analysis_free(a);
+ * and a method by name: ulam_method_opts mo = ulam_method_defaults();
+ *     mo.method = ulam_method_find("bidirectional");  ulam_analysis_solve(a, b, &o, NULL, &mo, ...). */
+
+/* x_{o->query.index} of (I - M) x = b, M = a's, as `ulam solve` answers it: by the method the
+ * table chooses (mo NULL, or mo->method -1: every row's applicability and predicted work, the walks
+ * racing their candidates) or by the row mo->method names (ulam_method_find; ULAM_METHOD_WALKS with
+ * every walk option as o says: ulam_solve_walks's run, bit for bit, when a does not share bounds).
+ * ao NULL takes the walks' pins from o as the command line takes them from its options: a walk
+ * option that differs from ulam_walk_defaults() (mode, estimator, continuation, exponent) pins
+ * that part of the race, and all four, or weighted starts, pin the walks row (when mo is NULL);
+ * o->policy.guard serves as ao's guard.  A rel_err target with max_walks left at its default runs
+ * to the target (capped at ULAM_REL_ERR_CAP), as --rel-err does.  So a caller with
+ * ulam_walk_defaults() and an analysis with ulam_analysis_defaults() gets what `ulam solve` gives
+ * for a Matrix Market file: the same choice and, on the same seed, the same estimate.  ch (may be
+ * NULL) gets every row's verdict; ans the answer: x_i with its error bar (ans->estimate,
+ * std_error, ci95; NaN without one: the rows that answer every unknown to a residual), the row
+ * that ran and its own result.  Statuses: the walks' refusals (ulam_solver_alloc's: ch->walks
+ * says which candidate), the rows' (ULAM_ENOCONV, ULAM_ESTALL, with ans filled), ULAM_EINVAL,
+ * ULAM_ENOMEM. */
+int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                        const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *ans, ulam_error *err);
+
+/* ulam_analysis_solve's first half: choose (or start mo's row) and hand out the run in *out (NULL
+ * on failure), no walk made yet; ao NULL: ulam_auto_defaults(), nothing pinned (o's walk options
+ * are not read as pins here), and o's budget as given.  The walks row's candidates walk under a's
+ * bounds over every state when a shares them (ulam_analysis_opts.shared_bounds: a prepared
+ * file's, or one pass over M), else each on its start's reach as ulam_auto_start does on M.  The
+ * run borrows a (free the run first). */
+int ulam_analysis_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                        const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err);
 
 /* ---------------------------------------------------------------- studies */
 /* All tertiary. */

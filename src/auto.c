@@ -604,20 +604,3 @@ int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_
     res->seconds = ulam_now() - t0;
     return status;
 }
-
-/* Screen, race and choose. */
-int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
-                     ulam_auto_result *res, ulam_error *err)
-{
-    return ulam_auto_solver(M, b, base, ao, res, NULL, err);
-}
-
-/* The walks' choice on an analysis' bounds. */
-int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
-                       ulam_auto_result *res, ulam_solver **out, ulam_error *err)
-{
-    ulam_auto_opts o = ao ? *ao : ulam_auto_defaults();
-    int status = ulam__analysis_pin_guard(a, base, &o, err);
-    return status ? status
-                  : ulam__auto_solver_reach(ulam__analysis_matrix(a), b, base, &o, ulam__analysis_bounds(a), res, out, err);
-}

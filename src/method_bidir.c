@@ -5,7 +5,7 @@
  * predicted work is below the leader's.  At a fixed budget (--walks, the default 10^5, or --time)
  * the push on b is considered too, where the range term of the walks' interval would dominate
  * (fixed_predict).  The transpose, the push workspace and the plan memo are
- * an analysis' (src/analysis.c): the caller's (ulam_analysis_auto_start), made once for all its
+ * an analysis' (src/analysis.c): the caller's (ulam_analysis_start), made once for all its
  * queries, or one of the run's own. */
 #include "analysis.h"
 #include "bidir.h"

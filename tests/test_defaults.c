@@ -64,7 +64,7 @@ static void test_walk(void **state)
 /* Issue 38 point 10: ulam_walk_defaults() with a rel_err target runs to the target, as the
  * command line's --rel-err does: the default budget of 10^5 walks is a run's without another
  * rule, not a cap on a target (signed200 by collision at E = 0.01 needs about 3.7e5 walks; it
- * stopped "out of reach" after 1024).  Through ulam_solve_walks and ulam_solve; a budget given
+ * stopped "out of reach" after 1024).  Through ulam_solve_walks and ulam_analysis_solve; a budget given
  * with the target (here 2^16) still caps it. */
 static void test_rel_err_lifts_default_cap(void **state)
 {
@@ -76,8 +76,8 @@ static void test_rel_err_lifts_default_cap(void **state)
         ulam_walk_opts o = ulam_walk_defaults();
         o.stop.rel_err = 0.01;
         ulam_walk_result r;
-        assert_int_equal(api ? ulam_solve(M, b, &o, &r, NULL) : ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
-        print_message("%s: %lld walks, met %d, out of reach %d\n", api ? "ulam_solve" : "ulam_solve_walks",
+        assert_int_equal(api ? solve_default(M, b, &o, &r, NULL) : ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+        print_message("%s: %lld walks, met %d, out of reach %d\n", api ? "ulam_analysis_solve" : "ulam_solve_walks",
                       (long long)r.walks, r.rel_err_met, r.out_of_reach);
         assert_true(r.rel_err_met && !r.out_of_reach);
         assert_true((r.ci95[1] - r.ci95[0]) / 2 <= 0.01 * fabs(r.estimate));

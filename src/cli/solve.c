@@ -544,6 +544,7 @@ static int lazy_analysis(solve_args *a)
     if (!s->lazy || !s->sys_M || a->an) return 0;
     ulam_analysis_opts ao = ulam_analysis_defaults();
     ao.continue_q = a->o.kernel.continue_q, ao.kernel_alpha = a->o.kernel.kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
+    ao.shared_bounds = 1; /* the file's stored bounds: no pass over what each start can reach */
     ulam_error err;
     return ulam_analysis_alloc(s->M, &ao, &a->an, &err) ? cli_report(s->matrix_path, &err) : 0;
 }

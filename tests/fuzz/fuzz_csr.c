@@ -74,9 +74,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ulam_outer_opts oo = ulam_outer_defaults();
     oo.method = ULAM_GAUSS_SEIDEL, oo.max_iter = 50;
     ulam_outer_solve(&A, b, &oo, x, NULL, 0, NULL, &err);
-    ulam_push *w = NULL;
-    if (ulam_push_alloc(&A, &w) == ULAM_OK && ulam_push_start(w, o.query.index) == ULAM_OK) ulam_push_run(w, 0.01, 10000);
-    ulam_push_free(w);
 done:
     free(A.rowptr), free(A.colidx), free(A.val), free(b), free(x), free(bp);
     return 0;
