@@ -102,14 +102,6 @@ void ulam__gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
 int ulam__gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
                              int min_sweeps, int max_sweeps);
 
-/* The exact x_index of (I - M) x = b for a study (index 0-based).  ULAM_OK, ULAM_EINVAL or
- * ULAM_ENOMEM. */
-int ulam__study_reference(const ulam_csr *M, const double *b, int64_t index, ulam_study_ref *ref, ulam_error *err);
-
-/* Set o's mode, estimator, roulette and split to method k's on b (n entries; read only in
- * forward mode, for w0 = ||b||_1).  ULAM_OK or ULAM_EINVAL. */
-int ulam__study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o);
-
 /* The k-th (k < 4) uniform double in [0, 1) of step t of walk w under seed: a counter-based
  * stream (splitmix64's finalizer chained over the key), the same on every rank and thread, so a
  * walk that migrates between ranks (ulam_dist.h) takes the same path. */

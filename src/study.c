@@ -2,7 +2,7 @@
  * each of the study's method names means as walk options) and the exact value a study scores
  * against (LAPACK, or Gauss-Seidel run until x_I settles); and the study itself (ulam_study_*):
  * every method at every budget, repeats runs each, scored against that value. */
-#include "internal.h"
+#include "study.h"
 
 #include <math.h>
 #include <stdio.h>

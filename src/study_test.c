@@ -2,7 +2,7 @@
  * reference value (ulam__study_reference) and the options of its method grid
  * (ulam__study_method_opts), which the public study calls use inside.  It includes internal.h,
  * where the module declares them; the tests in tests/ include public headers only. */
-#include "internal.h"
+#include "study.h"
 #include "testutil.h"
 
 #include <stdio.h>

@@ -2,6 +2,7 @@
  * (UMFPACK) one against it; PageRank's matrix; the study's reference (LAPACK or Gauss-Seidel), its
  * method grid and its coverage interval. */
 #include "testutil.h"
+#include "ulam_study.h"
 
 #include <math.h>
 #include <string.h>

@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "ulam.h"
+#include "ulam_study.h"
 
 /* The interrupt flag of the query running in the main thread (the SIGINT handler's only way in). */
 static volatile int *sigint_flag;
