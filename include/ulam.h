@@ -532,24 +532,26 @@ const ulam_csr *ulam_system_transpose(const ulam_system *s);
  * the blocks of the rows it reaches.  ULAM_OK, or ULAM_EINVAL for s NULL. */
 int ulam_system_lazy(const ulam_system *s, const ulam_csr **M, const double **b);
 
-/* The blocks of M, b and M^T verified so far (each once), and in *rows (may be NULL) the rows of M
- * they hold: what a query read of the file beyond its header and checksum table. */
-int64_t ulam_system_checked(const ulam_system *s, int64_t *rows);
-
-/* The stored certificate, or NULL when there is none (or of a version this reader does not know). */
-const ulam_certificate *ulam_system_certificate(const ulam_system *s);
-
-/* The Jacobi damping the stored M was made with (0: none). */
-double ulam_system_omega(const ulam_system *s);
-
 /* Unmap and free; accepts and returns NULL. */
 ulam_system *ulam_system_free(ulam_system *s);
 
-/* The file mapping behind s: its first byte in *addr and its length in *bytes (NULL and 0 for
- * borrowed memory or s NULL).  A file that shrinks while mapped (truncated, or replaced in place
- * by `cp`) makes a read of the lost pages raise SIGBUS: a program that catches SIGBUS can tell
- * such a fault (si_addr inside the mapping) from others and report the file. */
-void ulam_system_mapping(const ulam_system *s, const void **addr, size_t *bytes);
+/* What a prepared system holds besides M, b and M^T, and what its queries have read. */
+typedef struct ulam_system_info {
+    const ulam_certificate *cert; /* the stored certificate, or NULL when there is none (or of a
+                                     version this reader does not know) */
+    double omega;            /* the Jacobi damping the stored M was made with (0: none) */
+    int64_t blocks_checked;  /* the blocks of M, b and M^T verified so far (each once) ... */
+    int64_t rows_checked;    /* ... and the rows of M they hold: what queries read of the file
+                                beyond its header and checksum table */
+    const void *map;         /* the file mapping behind s: its first byte and its length (NULL and
+                                0 for borrowed memory).  A file that shrinks while mapped */
+    size_t map_bytes;        /* (truncated, or replaced in place by `cp`) makes a read of the lost
+                                pages raise SIGBUS: a program that catches SIGBUS can tell such a
+                                fault (si_addr inside the mapping) from others and report the file */
+} ulam_system_info;
+
+/* Fill info (all zero for s NULL). */
+void ulam_system_get_info(const ulam_system *s, ulam_system_info *info);
 
 /* The content tag of a source file for a cache (ulam_system_desc.tag, ulam_system_open's tag):
  * the XXH3-128 hash of its bytes (low, high), so an edit that keeps the size and the modification
@@ -938,11 +940,17 @@ int ulam_outer_iterate(ulam_outer *s, ulam_outer_step *step);
 /* Nonzero once converged, failed, interrupted or capped. */
 int ulam_outer_done(const ulam_outer *s);
 
-/* Nonzero once ||r||_2 / ||b||_2 <= tol. */
-int ulam_outer_converged(const ulam_outer *s);
+/* Where an outer iteration stands. */
+typedef struct ulam_outer_info {
+    const double *x; /* the current iterate (n entries, owned by the workspace) */
+    int converged;   /* nonzero once ||r||_2 / ||b||_2 <= tol */
+    int rejected;    /* corrections rejected so far: a walk correction that did not lower the
+                        residual is never applied; its walks go on to more histories (see
+                        ulam_outer_iterate) */
+} ulam_outer_info;
 
-/* The current iterate (n entries, owned by s). */
-const double *ulam_outer_x(const ulam_outer *s);
+/* Fill info (all zero for s NULL). */
+void ulam_outer_get_info(const ulam_outer *s, ulam_outer_info *info);
 
 /* Free; accepts and returns NULL. */
 ulam_outer *ulam_outer_free(ulam_outer *s);
@@ -951,9 +959,6 @@ ulam_outer *ulam_outer_free(ulam_outer *s);
  * goes on or once converged). */
 int ulam_outer_error(const ulam_outer *s, ulam_error *err);
 
-/* Corrections rejected so far: a walk correction that did not lower the residual is never
- * applied; its walks go on to more histories (see ulam_outer_iterate). */
-int ulam_outer_rejected(const ulam_outer *s);
 
 /* Iterate until done into x (n entries); steps (may be NULL) gets up to max_steps records,
  * *nsteps (may be NULL) the iterations run.  Returns the last iterate's status. */
@@ -1178,6 +1183,13 @@ typedef struct ulam_auto_candidate {
     double predicted_walks; /* walks the run would make (rel_err: the rule's variance, range and
                                variance-error terms at the pilots' values, rounded up to the rounds
                                the rule is checked at; else max_walks; NaN for time alone) */
+    int predicted_lower;    /* 1: predicted_walks is only a lower bound on the walks the rule will
+                               need: the pilots' mean is within 4 of its standard errors of 0
+                               (base's rel_err_offset added), so it does not resolve |x| (signed
+                               cancellation), and the prediction is made at the largest |x| the
+                               pilots allow; such a leader's pilots grow past ao->pilot_max (up to
+                               64 times) while the pilot share allows.  0 otherwise (also without
+                               a rel_err race or a pilot) */
     double predicted_work;  /* units: predicted_walks x work_per_walk + the kernel still to build */
     double predicted_seconds; /* predicted_work x ULAM_AUTO_UNIT_SECONDS (for the report only) */
 } ulam_auto_candidate;
@@ -1249,7 +1261,7 @@ typedef struct ulam_auto_result {
  *   - predicted work: units of the work model (ULAM_AUTO_*): walks x (steps + ULAM_AUTO_WALK +
  *     forward tallies) + the kernel units still to build; with rel_err the walks are the rule's:
  *     variance, range (min_walks) and variance-error terms, at a lower bound where the pilots do
- *     not resolve |x| (ulam_auto_lower_bound).
+ *     not resolve |x| (ulam_auto_candidate.predicted_lower).
  * The pilots' walks are not used in the answer: it comes from fresh walks on base's seed
  * (ulam_auto_solver), which the choice, a function of the pilots alone, cannot bias. */
 
@@ -1260,14 +1272,6 @@ typedef struct ulam_auto_result {
  * a status when none is left).  Its refusals are ulam_solver_alloc's. */
 int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
                      ulam_auto_result *res, ulam_solver **out, ulam_error *err);
-
-/* 1 when candidate k's predicted_walks (a rel_err race's) is only a lower bound on the walks the
- * rule will need: its pilots' mean is within 4 of its standard errors of 0 (offset: base's
- * rel_err_offset added), so it does not resolve |x| (signed cancellation: x_1 = 1e-3 max|x|), and
- * the prediction is made at the largest |x| the pilots allow (min over the piloted candidates of
- * |mean| + 2 standard errors); such a leader's pilots grow past ao->pilot_max (up to 64 times)
- * while the pilot share allows.  0 otherwise (also without a rel_err race or a pilot). */
-int ulam_auto_lower_bound(const ulam_auto_result *res, int k, double rel_err_offset);
 
 /* ---------------------------------------------------------------- the method table */
 /* All secondary, except primary: ulam_auto. */

@@ -102,7 +102,9 @@ static int take_guard(ulam_analysis *a, int mode, ulam_error *err)
     go.need = need | a->g.computed;
     go.kernel_alpha = a->alpha;
     int status = ULAM_OK;
-    if (a->sys && !ulam_certificate_guard(ulam_system_certificate(a->sys), a->continue_q, &go, &a->g)) a->guard_from = 1;
+    ulam_system_info si;
+    ulam_system_get_info(a->sys, &si);
+    if (a->sys && !ulam_certificate_guard(si.cert, a->continue_q, &go, &a->g)) a->guard_from = 1;
     else if (!(status = ulam_guard_check(a->M, a->continue_q, &go, &a->g, err))) a->guard_from = 2;
     a->seconds += ulam_now() - t0;
     return status;

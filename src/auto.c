@@ -183,7 +183,7 @@ static double scale_of(const ulam_auto_result *res, int k, double offset)
 }
 
 /* Whether candidate k's predicted walks are a lower bound (its pilot mean does not resolve |x|). */
-int ulam_auto_lower_bound(const ulam_auto_result *res, int k, double rel_err_offset)
+static int lower_bound(const ulam_auto_result *res, int k, double rel_err_offset)
 {
     if (!res || k < 0 || k >= res->ncand || res->cand[k].pilot_walks < 2 || !res->by_work) return 0;
     return !resolved(res, k, rel_err_offset);
@@ -466,7 +466,7 @@ static int drop(chooser *c)
     int left = 0;
     const ulam_auto_candidate *L = &c->res->cand[c->leader];
     /* a leader whose pilot does not resolve |x| predicts a lower bound: nothing is clearly worse than it */
-    double high = ulam_auto_lower_bound(c->res, c->leader, c->base.stop.rel_err_offset)
+    double high = lower_bound(c->res, c->leader, c->base.stop.rel_err_offset)
                       ? INFINITY : key(c, c->leader, 1.0 + 2.0 * fmin(L->variance_rel_error, 1e6));
     for (int k = 0; k < c->res->ncand; k++) {
         ulam_auto_candidate *a = &c->res->cand[k];
@@ -599,6 +599,7 @@ int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_
             status = alloc_solver(c, &o, out, err);
         }
     }
+    for (int k = 0; k < res->ncand; k++) res->cand[k].predicted_lower = lower_bound(res, k, base->stop.rel_err_offset);
     free_groups(c, -1);
     free(c);
     res->seconds = ulam_now() - t0;

@@ -9,6 +9,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The current iterate of outer iteration s (owned by it). */
+static const double *outer_x(const ulam_outer *s)
+{
+    ulam_outer_info info;
+    ulam_outer_get_info(s, &info);
+    return info.x;
+}
+
 /* The grid, k = 9 mode + 3 estimator + window. */
 static const ulam_study_method methods[ULAM_STUDY_METHODS] = {
     {"adjoint-collision-plain", ULAM_ADJOINT, ULAM_COLLISION, ULAM_WINDOW_PLAIN},
@@ -421,7 +429,7 @@ static void outer_lines(const ulam_study *s, double reference_time,
             ulam_outer_step step;
             ulam_outer_iterate(it, &step);
             t += step.seconds;
-            fn(m == ULAM_MCSA ? "mcsa" : "sequential", t, fabs(ulam_outer_x(it)[s->index] - s->ref.exact), arg);
+            fn(m == ULAM_MCSA ? "mcsa" : "sequential", t, fabs(outer_x(it)[s->index] - s->ref.exact), arg);
         }
         ulam_outer_free(it);
     }

@@ -429,7 +429,7 @@ static ulam_csr *cancellation(uint64_t seed, double **bp)
  * score whose variance is ~1 to 100 has a mean of noise alone where |x_0| = 1e-3, so var / (E m)^2
  * at that mean predicted 1.5e4 walks where the rule needs ~1e8-1e9.  Now the prediction of a
  * candidate whose pilot does not resolve |x| (|mean| < 4 standard errors) is a lower bound, made
- * at the largest |x| the pilots allow, and says so (ulam_auto_lower_bound): at seeds 1..3 the
+ * at the largest |x| the pilots allow, and says so (ulam_auto_candidate.predicted_lower): at seeds 1..3 the
  * chosen candidate's prediction is flagged and at most the walks its own variance asks at the
  * exact x, var / (E x)^2 (var: the run's, on a budget of 2^16 walks); the run stops, not met.  Beside it a system the pilots
  * resolve (the same pattern of one sign, b_i = 0.5 + U(0, 1), x ~ 10, E = 0.01): not flagged, and the run meets
@@ -459,7 +459,7 @@ static void test_prediction_bound(void **state)
             assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
             ulam_walk_result r;
             assert_int_equal(walk_out(sv, &r), ULAM_OK);
-            int k = res.chosen, bound = ulam_auto_lower_bound(&res, k, 0.0);
+            int k = res.chosen, bound = res.cand[k].predicted_lower;
             double need = r.variance / (E * x0 * E * x0), pred = res.cand[k].predicted_walks;
             print_message("%s seed %d: x_0 = %.4g, chose %s %s, predicted %s%.4g walks; the run %s after %lld walks, "
                           "var / (E x)^2 = %.4g\n", sys ? "one-signed" : "cancellation", s + 1, x0,

@@ -113,8 +113,10 @@ static void test_roundtrip(void **state)
     int64_t nb = 0;
     assert_memory_equal(ulam_system_rhs(s, &nb), b, (size_t)n * sizeof *b);
     assert_int_equal(nb, n);
-    assert_close(ulam_system_omega(s), 0.75, 0);
-    const ulam_certificate *r = ulam_system_certificate(s);
+    ulam_system_info si;
+    ulam_system_get_info(s, &si);
+    assert_close(si.omega, 0.75, 0);
+    const ulam_certificate *r = system_cert(s);
     assert_non_null(r);
     assert_memory_equal(&r->guard.abs, &c.guard.abs, sizeof c.guard.abs);
     assert_memory_equal(r->guard.hat, c.guard.hat, sizeof c.guard.hat);
@@ -138,7 +140,7 @@ static void test_roundtrip(void **state)
     assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
     assert_int_equal(ulam_system_open(path, NULL, &s, &err), ULAM_OK);
     assert_null(ulam_system_matrix(s));
-    assert_null(ulam_system_certificate(s));
+    assert_null(system_cert(s));
     assert_memory_equal(ulam_system_rhs(s, &nb), b, (size_t)n * sizeof *b);
     s = ulam_system_free(s);
     assert_int_equal(ulam_system_open("/nonexistent/x", NULL, &s, &err), ULAM_EIO);
@@ -208,8 +210,8 @@ static void test_damaged(void **state)
         memcpy(q, p, len);
         ulam_system *s = NULL;
         assert_int_equal(ulam_system_from_memory(q, len, NULL, &s, NULL), ULAM_OK);
-        if (v == 2) assert_null(ulam_system_certificate(s));
-        else assert_memory_equal(&ulam_system_certificate(s)->guard.abs, &c.guard.abs, sizeof c.guard.abs);
+        if (v == 2) assert_null(system_cert(s));
+        else assert_memory_equal(&system_cert(s)->guard.abs, &c.guard.abs, sizeof c.guard.abs);
         ulam_system_free(s);
         free(q), free(p);
     }
@@ -380,7 +382,9 @@ static void test_random_rows_checked(void **state)
     ulam_walk_result r1, r2;
     assert_int_equal(walks_on(af, lb, &o, &r1, NULL), ULAM_OK);
     o.exec.threads = 1; /* the parsed system's run below: one thread, the same estimate */
-    int64_t rows = 0, blocks = ulam_system_checked(s, &rows);
+    ulam_system_info si;
+    ulam_system_get_info(s, &si);
+    int64_t rows = si.rows_checked, blocks = si.blocks_checked;
     if (!(r1.rows > 100 && rows >= r1.rows && rows <= 16 * r1.rows && blocks > 0))
         fail_msg("%lld rows built, %lld rows of M verified in %lld blocks", (long long)r1.rows, (long long)rows,
                  (long long)blocks);
@@ -627,7 +631,7 @@ static void query_copy(const unsigned char *p, size_t len, const double want[3],
         free(q);
         return;
     }
-    const ulam_certificate *c = ulam_system_certificate(s);
+    const ulam_certificate *c = system_cert(s);
     if (!c) fail_msg("case %d: opened without its certificate", label);
     ulam_guard g;
     assert_int_equal(ulam_certificate_guard(c, 0.0, NULL, &g), ULAM_OK);
@@ -951,7 +955,7 @@ static void test_sound_sums_bad_arrays(void **state)
         const double *lb;
         ulam_system_lazy(s, &lm, &lb);
         ulam_guard g;
-        assert_int_equal(ulam_certificate_guard(ulam_system_certificate(s), 0.0, NULL, &g), ULAM_OK);
+        assert_int_equal(ulam_certificate_guard(system_cert(s), 0.0, NULL, &g), ULAM_OK);
         static const char *const why[3] = {"column", "row pointers", "value"};
         for (int run = 0; run < 3; run++) {
             ulam_walk_opts o = ulam_walk_defaults();

@@ -220,6 +220,14 @@ static inline ulam_walk_result test_sys_run(const test_sys *s, ulam_walk_opts o)
     return r;
 }
 
+/* The certificate a prepared system stores (NULL: none). */
+static inline const ulam_certificate *system_cert(const ulam_system *s)
+{
+    ulam_system_info si;
+    ulam_system_get_info(s, &si);
+    return si.cert;
+}
+
 /* The primary call as `ulam solve` makes it on a Matrix Market file: a fresh analysis of M with
  * its defaults, ulam_analysis_solve with no pins but o's; *r gets the walks' result with the
  * whole answer's estimate, std_error and ci95 (bidirectional: its walks on <r, x>). */

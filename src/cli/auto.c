@@ -117,7 +117,7 @@ void cli_auto_print_text(const ulam_choice *ch, int bidir)
         else
             printf("pilots %lld walks  variance %-9.4g (+-%.0f%%) %.3g steps/walk  predicted %s%.4g walks, %.3g units "
                    "(%.2g s)%s\n", (long long)c->pilot_walks, c->variance, 100 * fmin(c->variance_rel_error, 99.99),
-                   c->steps_per_walk, ulam_auto_lower_bound(res, k, 0.0) ? ">= " : "", c->predicted_walks,
+                   c->steps_per_walk, c->predicted_lower ? ">= " : "", c->predicted_walks,
                    c->predicted_work, c->predicted_seconds,
                    c->state == ULAM_AUTO_DROPPED ? "  dropped" : "");
     }
@@ -164,7 +164,7 @@ void cli_auto_print_json(const ulam_choice *ch, int bidir)
         cli_json_number("work_per_walk", c->pilot_walks ? c->work_per_walk : NAN, 0);
         cli_json_number("cost", c->cost, 0);
         cli_json_number("predicted_walks", c->predicted_walks, 0);
-        printf("\"predicted_is\": \"%s\", ", ulam_auto_lower_bound(res, k, 0.0) ? "lower bound" : "estimate");
+        printf("\"predicted_is\": \"%s\", ", c->predicted_lower ? "lower bound" : "estimate");
         cli_json_number("predicted_work", c->predicted_work, 0);
         cli_json_number("predicted_seconds", c->predicted_seconds, 1);
         printf("}");
