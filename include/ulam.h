@@ -1347,6 +1347,10 @@ typedef struct ulam_choice {
     ulam_bidir_opts bidir_opts;   /* the options it was planned with and runs with (its b arrays
                                      are owned by the run: valid until ulam_run_free) */
     double transpose_seconds;     /* the bidirectional row's transpose of M */
+    int bidir_route;              /* the route the bidirectional run takes: 1 the push on b and walks
+                                     from the index, 0 the reverse push from the index and walks from
+                                     b (a sparse b, or no walks from the index certified), -1 another
+                                     row chosen */
 } ulam_choice;
 
 /* A chosen method ready to run (opaque): the walk solver, the bidirectional plan, or the outer
@@ -1393,11 +1397,6 @@ int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o,
 /* The walk solver of a run of the walks row (borrowed: iterate it, read it; freed by
  * ulam_run_free), or NULL for another row. */
 ulam_solver *ulam_run_solver(ulam_run *r);
-
-/* The route a bidirectional run takes: 1 the push on b and walks from the index, 0 the reverse
- * push from the index and walks from b (ulam__method_bidir_route's, unless no walks from the
- * index are certified: then the reverse push even for a dense b), -1 for another row. */
-int ulam_run_bidir_route(const ulam_run *r);
 
 /* Run to the end (walks: iterate the solver until done) and fill *a.  The walks' statuses, the
  * bidirectional and outer rows' (ULAM_ENOCONV, ULAM_ESTALL with a filled; a->status holds it). */

@@ -127,6 +127,7 @@ static int start_reach(const ulam_csr *M, const double *b, const ulam_walk_opts 
     ch->method[ch->chosen].state = ULAM_METHOD_CHOSEN;
     ch->method[ch->chosen].why[0] = 0;
     r->method = ch->chosen;
+    ch->bidir_route = r->method == ULAM_METHOD_BIDIRECTIONAL ? r->br != NULL : -1;
     *out = r;
     return ULAM_OK;
 }
@@ -161,12 +162,6 @@ int ulam_analysis_start(ulam_analysis *a, const double *b, const ulam_walk_opts 
 ulam_solver *ulam_run_solver(ulam_run *r)
 {
     return r && r->method == ULAM_METHOD_WALKS ? r->sv : NULL;
-}
-
-/* The route of a bidirectional run: 1 the push on b, 0 the reverse push, -1 another row. */
-int ulam_run_bidir_route(const ulam_run *r)
-{
-    return r && r->method == ULAM_METHOD_BIDIRECTIONAL ? r->br != NULL : -1;
 }
 
 /* Run to the end and fill *a. */

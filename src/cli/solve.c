@@ -673,7 +673,7 @@ static int run(solve_args *a)
         return cli_exit_code(ULAM_EINVAL);
     }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
-        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_run_bidir_route(rn) == 1, ro.json, ro.check, ro.load_seconds);
+        rc = cli_bidir_auto_run(&a->s, rn, &ch, ch.bidir_route == 1, ro.json, ro.check, ro.load_seconds);
         ulam_run_free(rn);
         a->an = ulam_analysis_free(a->an);
         cli_system_free(&a->s);
