@@ -1,7 +1,9 @@
 /* ulam: linear systems (I - M) x = b by von Neumann-Ulam random walks.
  *
- * The core solver's public header (matrices, I/O, guards, walks, statistics, direct solves);
- * the radiosity front end is in ulam_radiosity.h.  Conventions (CSparse / GSL style):
+ * The core solver's public header (libulam: matrices, I/O, guards, the analysis and the method
+ * table, walks, statistics, direct solves); ulam_dist.h holds the walks across processes,
+ * ulam_study.h the variance studies (libulam_study) and ulam_radiosity.h the radiosity front end
+ * (libulam_radiosity).  Conventions (CSparse / GSL style):
  *   - every fallible function returns an int status (ULAM_OK == 0), see ulam_strerror();
  *   - functions that read files also fill an optional ulam_error with the line and a
  *     sentence saying what was expected;
@@ -9,39 +11,43 @@
  *   - inputs are const, outputs are caller-owned, every _free accepts and returns NULL;
  *   - the library never prints and never exits;
  *   - ABI habit: a struct the caller fills starts from its defaults function, which sets every
- *     field, and the caller then sets what it needs (ulam_walk_defaults with its parts by concern:
- *     ulam__kernel_defaults, ulam__stop_defaults, ulam__exec_defaults, ulam__query_defaults,
- *     ulam__policy_defaults; ulam_mm_defaults,
- *     ulam_spectral_defaults, ulam_power_defaults, ulam_guard_defaults, ulam_outer_defaults,
- *     ulam_bidir_defaults, ulam_auto_defaults, ulam_share_defaults, ulam_system_desc_defaults;
- *     in ulam_radiosity.h ulam_camera_cornell or ulam_camera_frame): a field a later version
- *     adds then takes its default there, so such a program keeps its meaning when rebuilt.
- *     Handles (ulam_solver, ulam_outer, ulam_push, ulam_system; ulam_tracer, ulam_rad_solver)
- *     are opaque, reached only through their functions; what the library fills (results,
- *     reports, ulam_guard, ulam_certificate, ulam_csr and ulam_scene from their allocators and
- *     readers) is plain data to read.
+ *     field, and the caller then sets what it needs (ulam_walk_defaults, whose parts by concern
+ *     kernel, stop, exec, query and policy are set with it; ulam_analysis_defaults,
+ *     ulam_method_defaults, ulam_auto_defaults, ulam_mm_defaults, ulam_spectral_defaults,
+ *     ulam_power_defaults, ulam_guard_defaults, ulam_outer_defaults, ulam_bidir_defaults,
+ *     ulam_fpush_defaults, ulam_share_defaults, ulam_system_desc_defaults; in ulam_radiosity.h
+ *     ulam_camera_cornell or ulam_camera_frame): a field a later version adds then takes its
+ *     default there, so such a program keeps its meaning when rebuilt.  Handles (ulam_analysis,
+ *     ulam_run, ulam_solver, ulam_outer, ulam_system; ulam_tracer, ulam_rad_solver) are opaque,
+ *     reached only through their functions; what the library fills (answers, results, reports,
+ *     the _get_info structs, ulam_guard, ulam_certificate, ulam_csr and ulam_scene from their
+ *     allocators and readers) is plain data to read.
  *
  * The API by rank, as CSparse's header ranks its own (each section banner below names the
- * ranks it holds; sections follow the data flow, file -> matrix -> guards -> walks -> output):
+ * ranks it holds; sections follow the data flow, file -> matrix -> analysis -> method -> walks
+ * -> output):
  *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
- *     ulam_guard_check, ulam_walk_defaults (its parts: ulam__kernel_defaults, ulam__stop_defaults,
- *     ulam__exec_defaults, ulam__query_defaults, ulam__policy_defaults), ulam_solver_alloc, ulam_solver_iterate,
- *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
- *     ulam_solver_free, ulam_solve (the method table's choice: what `ulam solve` runs), ulam_solve_walks
- *     (the walks pinned), ulam_auto (the choice with its verdicts),
- *     ulam_direct_solve, ulam_mm_write_vector, ulam_strerror;
- *   secondary, more control and the other methods: building and transforming matrices
- *     (ulam_csr_alloc, _from_triplets, _check, _transpose, ulam_jacobi), reader options and
- *     files (ulam_mm_read_matrix_opts, _file, ulam_mm_write_matrix), verdicts
- *     (ulam_guard_variance, ulam_verdict_of, ulam_solver_guard), spectral radii
- *     (ulam_spectral_power, ulam_spectral_radius), prepared systems (ulam_system_*,
- *     ulam_certificate_*), processes (ulam_share), outer iterations (ulam_outer_*), Krylov
- *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_plan, ulam_bidir_solve), the method
- *     table and its choice (ulam_method_*, ulam_auto_start, ulam_run_*, ulam_auto_choose), ulam_direct_bytes;
- *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
- *     ulam_strtod, ulam_outfile_*, ulam__spectral_radius_op, ulam_gauss_seidel_*, the studies'
- *     method grid and exact value (ulam_study_*), random numbers (ulam_rng_*), ulam_now.
- * The radiosity front end ranks its own in ulam_radiosity.h.
+ *     ulam_walk_defaults, and for one unknown ONE call on one reusable analysis:
+ *     ulam_analysis_alloc, ulam_analysis_solve (auto by default, a method by name through
+ *     ulam_method_find: what `ulam solve` runs), ulam_analysis_free; then ulam_direct_solve,
+ *     ulam_mm_write_vector, ulam_strerror;
+ *   secondary, more control and the other methods: ulam_analysis_start with ulam_run_solver,
+ *     ulam_run_finish, ulam_run_free (the same call step by step), the walk solver by hand
+ *     (ulam_solver_alloc, _iterate, _done, _result, _vectors, _error, _guard, _free;
+ *     ulam_analysis_solver on an analysis' kept kernel), the guards (ulam_guard_check,
+ *     ulam_guard_variance, ulam_verdict_of), building and transforming matrices (ulam_csr_alloc,
+ *     _from_triplets, _check, _transpose, ulam_jacobi, ulam_pagerank_matrix), reader options
+ *     and files (ulam_mm_read_matrix_opts, ulam_mm_write_matrix), spectral radii
+ *     (ulam_spectral_radius), prepared systems (ulam_system_*, ulam_certificate_*), processes
+ *     (ulam_share), outer iterations (ulam_outer_*), Krylov peers (ulam_cg, ulam_gmres), point
+ *     sources (ulam_analysis_bidir, ulam_fpush_*), the method table (ulam_method_*),
+ *     ulam_analysis_transpose, _get_info, ulam_direct_sparse, ulam_direct_bytes;
+ *   tertiary, mirrors kept for what they pin and utilities: ulam_solve_walks (the walks o names,
+ *     no choice, no analysis), ulam_auto and ulam_auto_start (the table's choice on M alone),
+ *     ulam_auto_solver (the walks' race alone), ulam_csr_nnz, _matvec, _stats_compute,
+ *     _symmetric, ulam_strtod, ulam_outfile_*, ulam_edgelist_*, random numbers (ulam_rng_*),
+ *     ulam_now, ulam_alloc_big, ulam_file_tag.
+ * ulam_dist.h, ulam_study.h and ulam_radiosity.h rank their own.
  */
 #ifndef ULAM_H
 #define ULAM_H
@@ -220,7 +226,8 @@ typedef struct ulam_mm_opts {
 /* The defaults: all cores (threads 0). */
 ulam_mm_opts ulam_mm_defaults(void);
 
-/* As ulam__mm_read_matrix_file with options (o NULL: ulam_mm_defaults()). */
+/* Read a matrix as ulam_mm_read_matrix, from an open file f (name is used only in error
+ * details), with options (o NULL: ulam_mm_defaults()). */
 int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
 
 /* Read a dense vector from path: "array" m x 1, or "coordinate" m x 1 (missing entries are
@@ -310,7 +317,7 @@ int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops,
 int ulam_direct_sparse_available(void);
 
 /* ---------------------------------------------------------------- spectral radius */
-/* Secondary, except tertiary: ulam__spectral_radius_op. */
+/* Secondary. */
 
 /* Options of the spectral radius estimate: ARPACK's implicitly restarted Arnoldi
  * (dense dgeev for n <= 128), stopped when the dominant Ritz pair reaches
@@ -596,7 +603,7 @@ typedef struct ulam_share {
 ulam_share ulam_share_defaults(void);
 
 /* The walk kernel: how a walk moves and how its weight is kept in a window.  Start from
- * ulam__kernel_defaults(). */
+ * ulam_walk_defaults() (its kernel). */
 typedef struct ulam_kernel_opts {
     double continue_q;   /* fixed continuation probability in (0, 1); <= 0: analog min(1, S_i) */
     double kernel_alpha; /* the kernel exponent alpha, finite and >= 0: a walk that continues from
@@ -612,7 +619,7 @@ typedef struct ulam_kernel_opts {
     double split;        /* weight window ceiling: above it split into ceil(|w|/W) copies; 0 off */
 } ulam_kernel_opts;
 
-/* When a run stops: the first rule met ends it.  Start from ulam__stop_defaults(). */
+/* When a run stops: the first rule met ends it.  Start from ulam_walk_defaults() (its stop). */
 typedef struct ulam_stop_opts {
     int64_t max_walks;   /* stop after this many walks (0: no limit) */
     double rel_err;      /* stop once the relative-error rule holds (see ulam_solve_walks); 0 off */
@@ -623,14 +630,14 @@ typedef struct ulam_stop_opts {
                               part): rel_err is then relative to |c + estimate| (0: none) */
 } ulam_stop_opts;
 
-/* Where and how the walks run.  Start from ulam__exec_defaults(). */
+/* Where and how the walks run.  Start from ulam_walk_defaults() (its exec). */
 typedef struct ulam_exec_opts {
     uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */
     int threads;         /* 0: all cores */
     const ulam_share *share; /* NULL: this process runs every block */
 } ulam_exec_opts;
 
-/* What is asked: which x_i (or which weighted sum of them).  Start from ulam__query_defaults(). */
+/* What is asked: which x_i (or which weighted sum of them).  Start from ulam_walk_defaults() (its query). */
 typedef struct ulam_query_opts {
     int64_t index;       /* 0-based component reported (the start state in adjoint mode) */
     int64_t nstarts;     /* adjoint: 0 starts every walk at index; k > 0 starts it at starts[j]
@@ -642,7 +649,7 @@ typedef struct ulam_query_opts {
 } ulam_query_opts;
 
 /* What the run trusts: the guards' verdicts, computed before or to compute, and what to do when
- * they do not certify.  Start from ulam__policy_defaults(). */
+ * they do not certify.  Start from ulam_walk_defaults() (its policy). */
 typedef struct ulam_policy_opts {
     int force;           /* 1: walk even when rho(|M|) is not certified below 1 (else ULAM_EDIVERGE) */
     int assume_finite;   /* 1: treat a variance the guards cannot certify either way as finite */
@@ -876,7 +883,7 @@ void ulam_analysis_get_info(const ulam_analysis *a, ulam_analysis_info *info);
 /* Iterations on (I - M) x = b from x = 0 that stop on the exact residual
  * ||b - (I - M) x||_2 / ||b||_2 <= tol:
  *   ULAM_RICHARDSON  x <- M x + b (the deterministic reference);
- *   ULAM_GAUSS_SEIDEL one sweep of ulam__gauss_seidel_sweep;
+ *   ULAM_GAUSS_SEIDEL one Gauss-Seidel sweep;
  *   ULAM_SEQUENTIAL  Halton's sequential Monte Carlo: r = b - (I - M) x, delta ~ (I - M)^-1 r
  *                    by forward walks from r, x <- x + delta;
  *   ULAM_MCSA        Monte Carlo Synthetic Acceleration (Evans and Mosher): a Richardson step
@@ -1001,7 +1008,7 @@ typedef struct ulam_push_info {
     int64_t touched; /* states whose p or r was ever set */
     int64_t support; /* states with r_j != 0 */
     double r_sum, r_max; /* sum and largest of |r_j| */
-    double seconds;  /* wall time in ulam_push_run */
+    double seconds;  /* wall time pushing */
 } ulam_push_info;
 
 /* Bidirectional estimate of x_t of (I - M) x = b for b = e_s or a sparse b (src/bidir.c; Lofgren,
@@ -1048,7 +1055,7 @@ typedef struct ulam_bidir_opts {
  * (the default cap), walk ulam_walk_defaults(), step_cost 0 (ULAM_BIDIR_STEP_COST). */
 ulam_bidir_opts ulam_bidir_defaults(void);
 
-/* A bidirectional estimate's plan (ulam_bidir_plan): the push it runs and what the walks after it
+/* A bidirectional estimate's plan: the push it runs and what the walks after it
  * are predicted to cost, in a deterministic unit of work (push operations; a walk's visits, its
  * steps + 1, count step_cost operations each), so a comparison of methods on it gives the same
  * answer on every run, thread count and MPI rank. */
@@ -1083,7 +1090,7 @@ typedef struct ulam_bidir_result {
     ulam_push_info push;   /* the push (its seconds are push_seconds) */
     ulam_walk_result walks; /* the walks' estimate of <r, x> (0 walks when r = 0: exact) */
     ulam_bidir_plan_info plan; /* the plan the estimate followed */
-    int plan_reused;       /* 1: the workspace held this plan (ulam_bidir_plan), not redone */
+    int plan_reused;       /* 1: the workspace held this plan (ulam_analysis_bidir), not redone */
     double seconds;        /* the whole estimate: the plan's seconds (pilot and push, also when
                               reused) plus the walks' set-up and walks */
 } ulam_bidir_result;
@@ -1175,7 +1182,7 @@ typedef struct ulam_auto_candidate {
     int64_t pilot_walks;  /* walks of its pilots, all stages (0: not piloted) */
     double estimate, variance, variance_rel_error; /* pooled over its pilots (never used in the answer) */
     double steps_per_walk; /* the pilots' mean steps a walk */
-    double work_per_walk;  /* the work model's units a walk (see ulam_auto_choose) */
+    double work_per_walk;  /* the work model's units a walk (see ulam_auto_solver) */
     double cost;           /* variance x work_per_walk (INFINITY when not piloted); the variance
                               compared is at least what puts the pilot's mean within 2 standard
                               errors of the most precise other pilot's (a pilot that missed a
@@ -1283,7 +1290,7 @@ int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *b
  * one entry they answer x_i without an error bar).  Row k's number is stable: */
 enum ulam_method_row {
     ULAM_METHOD_WALKS = 0,         /* adjoint or forward walks: mode x estimator x continuation x
-                                      kernel exponent, raced by ulam_auto_choose */
+                                      kernel exponent, raced by ulam_auto_solver */
     ULAM_METHOD_BIDIRECTIONAL = 1, /* reverse push from the index, walks from a sparse b */
     ULAM_METHOD_RICHARDSON = 2,    /* then ULAM_METHOD_RICHARDSON + enum ulam_method: richardson, */
     ULAM_METHOD_GAUSS_SEIDEL = 3,  /* gauss-seidel, */
@@ -1341,7 +1348,7 @@ typedef struct ulam_choice {
     int chosen;                   /* the row that runs (enum ulam_method_row; -1: none) */
     int pinned;                   /* 1: the row was pinned (ulam_method_opts.method), not chosen */
     ulam_method_verdict method[ULAM_NMETHODS];
-    ulam_auto_result walks;       /* the walks row's race (ulam_auto_choose): its candidates */
+    ulam_auto_result walks;       /* the walks row's race (ulam_auto_solver): its candidates */
     double leader_work;           /* the walks' chosen candidate's predicted work (NaN: none) */
     ulam_bidir_plan_info bidir;   /* the bidirectional row's plan (state PLANNED or CHOSEN) */
     ulam_bidir_opts bidir_opts;   /* the options it was planned with and runs with (its b arrays
@@ -1408,18 +1415,19 @@ ulam_run *ulam_run_free(ulam_run *r);
 /* The library's `ulam solve`: ulam_auto_start, ulam_run_finish, ulam_run_free in one call
  * (ch may be NULL).  With ao and mo NULL it chooses as `ulam solve` does by default (the same
  * choice and, on the same seed, the same estimate); pin a row with mo->method
- * (ULAM_METHOD_WALKS: ulam_solve_walks's run, bit for bit); ulam_solve is this call with its
- * answer as a walk result. */
+ * (ULAM_METHOD_WALKS: ulam_solve_walks's run, bit for bit).  Tertiary: ulam_analysis_solve on an
+ * analysis of M is the primary call. */
 int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
               const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err);
 
-/* A bidirectional estimate (as ulam_bidir_solve) on a's transpose (ulam_analysis_transpose: a
+/* A bidirectional estimate (b = e_source or o's sparse b; x_target) on a's transpose (ulam_analysis_transpose: a
  * prepared file's stored M^T when it has one, else made once), push workspace and plan memo,
- * all made at the first call and kept across queries: a plan (ulam_bidir_plan's) is reused for
+ * all made at the first call and kept across queries: a plan is reused for
  * the same options and the push as it left it; the walks' bounds over every state and kernel
  * rows (o->reach_all, keep_kernel) stay with the analysis.  o->walk.kernel's continuation and
  * exponent must be a's (ULAM_EINVAL otherwise: one analysis, one kernel).  The same seed gives
- * the same estimate as ulam_bidir_solve on a fresh workspace.  Statuses as ulam_bidir_solve. */
+ * the same estimate as a fresh analysis.  ULAM_OK, ULAM_EINVAL (bad options), ULAM_ENOMEM,
+ * and the walks' refusals (ulam_solver_alloc's). */
 int ulam_analysis_bidir(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err);
 
 /* ---------------------------------------------------------------- one unknown: the primary call */
@@ -1458,8 +1466,8 @@ int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts 
  * on failure), no walk made yet; ao NULL: ulam_auto_defaults(), nothing pinned (o's walk options
  * are not read as pins here), and o's budget as given.  The walks row's candidates walk under a's
  * bounds over every state when a shares them (ulam_analysis_opts.shared_bounds: a prepared
- * file's, or one pass over M), else each on its start's reach as ulam_auto_start does on M.  The
- * run borrows a (free the run first). */
+ * file's, or one pass over M), else each on its start's reach as ulam_auto_start does on M; the
+ * bidirectional row on a's transpose and plans either way.  The run borrows a (free it first). */
 int ulam_analysis_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
                         const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err);
 

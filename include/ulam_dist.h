@@ -7,12 +7,12 @@
  * exchange as callbacks (src/cli/mpi.c gives MPI_Alltoallv and MPI_Allreduce).
  *
  * Random numbers are counter-based: the k-th number of step t of walk w is a hash of (seed, w,
- * t, k) (ulam__rng_counter), so a walk takes the same path whichever rank runs which step, and
+ * t, k) (src/rng.c's counter-based numbers), so a walk takes the same path whichever rank runs which step, and
  * 1, 2, 3 or 64 ranks give the same answer bit for bit: walks' scores and tallies are combined
  * in walk-id order, never in arrival order.
  *
  * API, in order of use: primary ulam_part_open, ulam_dist_radius (the variance guard),
- * ulam_dist_adjoint (ulam_dist_adjoint_ci with its interval), ulam_dist_forward, ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam__rng_counter in ulam.h). */
+ * ulam_dist_adjoint (ulam_dist_adjoint_ci with its interval), ulam_dist_forward, ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows. */
 #ifndef ULAM_DIST_H
 #define ULAM_DIST_H
 

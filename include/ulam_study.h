@@ -58,7 +58,7 @@ typedef struct ulam_study_ref {
 } ulam_study_ref;
 
 /* A variance study: every chosen method of the grid at every budget, repeats runs each, scored
- * against the exact x_index (ulam__study_reference).  Run k = (method << 24) + (budget << 16) +
+ * against the exact x_index (LAPACK when small, else Gauss-Seidel settled).  Run k = (method << 24) + (budget << 16) +
  * repeat walks with seed ulam_rng_substream(seed, ULAM_STREAM_STUDY, k). */
 typedef struct ulam_study ulam_study;
 
