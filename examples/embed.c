@@ -1,5 +1,6 @@
 /* embed: the smallest program built against an installed ulam (pkg-config --cflags --libs ulam).
- * It estimates x_0 of (I - M) x = b for a 3-state chain by adjoint walks, solves the same
+ * It estimates x_0 of (I - M) x = b for a 3-state chain by the library's primary call (an
+ * analysis of M, then ulam_analysis_solve: the method `ulam solve` chooses), solves the same
  * system with LAPACK, and exits 0 only when the two agree within four standard errors. */
 #include <math.h>
 #include <stdio.h>
@@ -17,20 +18,24 @@ int main(void)
     int st = ulam_csr_from_triplets(3, 3, 5, ti, tj, tx, &M);
     ulam_walk_opts o = ulam_walk_defaults();
     o.exec.seed = 7;
-    ulam_walk_result r;
+    ulam_analysis *a = NULL;
+    ulam_answer ans;
     ulam_error err;
     double x[3];
     if (!st)
-        st = ulam_solve(M, b, &o, &r, &err);
+        st = ulam_analysis_alloc(M, NULL, &a, &err);
+    if (!st)
+        st = ulam_analysis_solve(a, b, &o, NULL, NULL, NULL, &ans, &err);
     if (!st)
         st = ulam_direct_solve(M, b, x, 0, NULL, &err);
+    ulam_analysis_free(a);
     ulam_csr_free(M);
     if (st) {
         fprintf(stderr, "embed: %s\n", ulam_strerror(st));
         return 1;
     }
-    double z = (r.estimate - x[0]) / r.std_error;
-    printf("ulam %s: x_0 = %.6f +- %.6f by %lld walks; LAPACK %.6f; z = %.2f\n", ULAM_VERSION,
-           r.estimate, r.std_error, (long long)r.walks, x[0], z);
+    double z = (ans.estimate - x[0]) / ans.std_error;
+    printf("ulam %s: x_0 = %.6f +- %.6f by %s (%lld walks); LAPACK %.6f; z = %.2f\n", ULAM_VERSION,
+           ans.estimate, ans.std_error, ulam_method_name(ans.method), (long long)ans.walks.walks, x[0], z);
     return fabs(z) < 4 ? 0 : 1;
 }

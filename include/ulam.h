@@ -1,7 +1,9 @@
 /* ulam: linear systems (I - M) x = b by von Neumann-Ulam random walks.
  *
- * The core solver's public header (matrices, I/O, guards, walks, statistics, direct solves);
- * the radiosity front end is in ulam_radiosity.h.  Conventions (CSparse / GSL style):
+ * The core solver's public header (libulam: matrices, I/O, guards, the analysis and the method
+ * table, walks, statistics, direct solves); ulam_dist.h holds the walks across processes,
+ * ulam_study.h the variance studies (libulam_study) and ulam_radiosity.h the radiosity front end
+ * (libulam_radiosity).  Conventions (CSparse / GSL style):
  *   - every fallible function returns an int status (ULAM_OK == 0), see ulam_strerror();
  *   - functions that read files also fill an optional ulam_error with the line and a
  *     sentence saying what was expected;
@@ -9,39 +11,43 @@
  *   - inputs are const, outputs are caller-owned, every _free accepts and returns NULL;
  *   - the library never prints and never exits;
  *   - ABI habit: a struct the caller fills starts from its defaults function, which sets every
- *     field, and the caller then sets what it needs (ulam_walk_defaults with its parts by concern:
- *     ulam_kernel_defaults, ulam_stop_defaults, ulam_exec_defaults, ulam_query_defaults,
- *     ulam_policy_defaults; ulam_mm_defaults,
- *     ulam_spectral_defaults, ulam_power_defaults, ulam_guard_defaults, ulam_outer_defaults,
- *     ulam_bidir_defaults, ulam_auto_defaults, ulam_share_defaults, ulam_system_desc_defaults;
- *     in ulam_radiosity.h ulam_camera_cornell or ulam_camera_frame): a field a later version
- *     adds then takes its default there, so such a program keeps its meaning when rebuilt.
- *     Handles (ulam_solver, ulam_outer, ulam_push, ulam_system; ulam_tracer, ulam_rad_solver)
- *     are opaque, reached only through their functions; what the library fills (results,
- *     reports, ulam_guard, ulam_certificate, ulam_csr and ulam_scene from their allocators and
- *     readers) is plain data to read.
+ *     field, and the caller then sets what it needs (ulam_walk_defaults, whose parts by concern
+ *     kernel, stop, exec, query and policy are set with it; ulam_analysis_defaults,
+ *     ulam_method_defaults, ulam_auto_defaults, ulam_mm_defaults, ulam_spectral_defaults,
+ *     ulam_power_defaults, ulam_guard_defaults, ulam_outer_defaults, ulam_bidir_defaults,
+ *     ulam_fpush_defaults, ulam_share_defaults, ulam_system_desc_defaults; in ulam_radiosity.h
+ *     ulam_camera_cornell or ulam_camera_frame): a field a later version adds then takes its
+ *     default there, so such a program keeps its meaning when rebuilt.  Handles (ulam_analysis,
+ *     ulam_run, ulam_solver, ulam_outer, ulam_system; ulam_tracer, ulam_rad_solver) are opaque,
+ *     reached only through their functions; what the library fills (answers, results, reports,
+ *     the _get_info structs, ulam_guard, ulam_certificate, ulam_csr and ulam_scene from their
+ *     allocators and readers) is plain data to read.
  *
  * The API by rank, as CSparse's header ranks its own (each section banner below names the
- * ranks it holds; sections follow the data flow, file -> matrix -> guards -> walks -> output):
+ * ranks it holds; sections follow the data flow, file -> matrix -> analysis -> method -> walks
+ * -> output):
  *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
- *     ulam_guard_check, ulam_walk_defaults (its parts: ulam_kernel_defaults, ulam_stop_defaults,
- *     ulam_exec_defaults, ulam_query_defaults, ulam_policy_defaults), ulam_solver_alloc, ulam_solver_iterate,
- *     ulam_solver_done, ulam_solver_result, ulam_solver_vectors, ulam_solver_error,
- *     ulam_solver_free, ulam_solve (the method table's choice: what `ulam solve` runs), ulam_solve_walks
- *     (the walks pinned), ulam_auto (the choice with its verdicts),
- *     ulam_direct_solve, ulam_mm_write_vector, ulam_strerror;
- *   secondary, more control and the other methods: building and transforming matrices
- *     (ulam_csr_alloc, _from_triplets, _check, _transpose, ulam_jacobi), reader options and
- *     files (ulam_mm_read_matrix_opts, _file, ulam_mm_write_matrix), verdicts
- *     (ulam_guard_variance, ulam_verdict_of, ulam_solver_guard), spectral radii
- *     (ulam_spectral_power, ulam_spectral_radius), prepared systems (ulam_system_*,
- *     ulam_certificate_*), processes (ulam_share), outer iterations (ulam_outer_*), Krylov
- *     peers (ulam_cg, ulam_gmres), point sources (ulam_push_*, ulam_bidir_plan, ulam_bidir_solve), the method
- *     table and its choice (ulam_method_*, ulam_auto_start, ulam_run_*, ulam_auto_choose), ulam_direct_bytes;
- *   tertiary, utilities: ulam_csr_nnz, _copy, _matvec, _to_dense, _stats_compute, _symmetric,
- *     ulam_strtod, ulam_outfile_*, ulam_spectral_radius_op, ulam_gauss_seidel_*, the studies'
- *     method grid and exact value (ulam_study_*), random numbers (ulam_rng_*), ulam_now.
- * The radiosity front end ranks its own in ulam_radiosity.h.
+ *     ulam_walk_defaults, and for one unknown ONE call on one reusable analysis:
+ *     ulam_analysis_alloc, ulam_analysis_solve (auto by default, a method by name through
+ *     ulam_method_find: what `ulam solve` runs), ulam_analysis_free; then ulam_direct_solve,
+ *     ulam_mm_write_vector, ulam_strerror;
+ *   secondary, more control and the other methods: ulam_analysis_start with ulam_run_solver,
+ *     ulam_run_finish, ulam_run_free (the same call step by step), the walk solver by hand
+ *     (ulam_solver_alloc, _iterate, _done, _result, _vectors, _error, _guard, _free;
+ *     ulam_analysis_solver on an analysis' kept kernel), the guards (ulam_guard_check,
+ *     ulam_guard_variance, ulam_verdict_of), building and transforming matrices (ulam_csr_alloc,
+ *     _from_triplets, _check, _transpose, ulam_jacobi, ulam_pagerank_matrix), reader options
+ *     and files (ulam_mm_read_matrix_opts, ulam_mm_write_matrix), spectral radii
+ *     (ulam_spectral_radius), prepared systems (ulam_system_*, ulam_certificate_*), processes
+ *     (ulam_share), outer iterations (ulam_outer_*), Krylov peers (ulam_cg, ulam_gmres), point
+ *     sources (ulam_analysis_bidir, ulam_fpush_*), the method table (ulam_method_*),
+ *     ulam_analysis_transpose, _get_info, ulam_direct_sparse, ulam_direct_bytes;
+ *   tertiary, mirrors kept for what they pin and utilities: ulam_solve_walks (the walks o names,
+ *     no choice, no analysis), ulam_auto and ulam_auto_start (the table's choice on M alone),
+ *     ulam_auto_solver (the walks' race alone), ulam_csr_nnz, _matvec, _stats_compute,
+ *     _symmetric, ulam_strtod, ulam_outfile_*, ulam_edgelist_*, random numbers (ulam_rng_*),
+ *     ulam_now, ulam_alloc_big, ulam_file_tag.
+ * ulam_dist.h, ulam_study.h and ulam_radiosity.h rank their own.
  */
 #ifndef ULAM_H
 #define ULAM_H
@@ -151,14 +157,8 @@ int ulam_csr_from_triplets(int64_t nrows, int64_t ncols, int64_t nz, const int32
 /* The transpose of A (new matrix in *out). */
 int ulam_csr_transpose(const ulam_csr *A, ulam_csr **out);
 
-/* A deep copy of A. */
-int ulam_csr_copy(const ulam_csr *A, ulam_csr **out);
-
 /* y = A x (use_abs != 0: y = |A| x). */
 int ulam_csr_matvec(const ulam_csr *A, int use_abs, const double *x, double *y);
-
-/* Dense row-major copy of A into a caller buffer of nrows*ncols doubles. */
-int ulam_csr_to_dense(const ulam_csr *A, double *dense);
 
 /* Summary statistics of a square matrix M (the walk kernel's raw material). */
 typedef struct ulam_csr_stats {
@@ -214,9 +214,6 @@ int ulam_edgelist_is_file(const char *path);
  * expanded). */
 int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err);
 
-/* As ulam_mm_read_matrix, from an open file; name is used only in error details. */
-int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
-
 /* Options of the matrix reader.  Start from ulam_mm_defaults(). */
 typedef struct ulam_mm_opts {
     int threads;     /* 0: all cores; 1: the sequential streaming reader.  A regular file of
@@ -229,7 +226,8 @@ typedef struct ulam_mm_opts {
 /* The defaults: all cores (threads 0). */
 ulam_mm_opts ulam_mm_defaults(void);
 
-/* As ulam_mm_read_matrix_file with options (o NULL: ulam_mm_defaults()). */
+/* Read a matrix as ulam_mm_read_matrix, from an open file f (name is used only in error
+ * details), with options (o NULL: ulam_mm_defaults()). */
 int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
 
 /* Read a dense vector from path: "array" m x 1, or "coordinate" m x 1 (missing entries are
@@ -319,7 +317,7 @@ int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops,
 int ulam_direct_sparse_available(void);
 
 /* ---------------------------------------------------------------- spectral radius */
-/* Secondary, except tertiary: ulam_spectral_radius_op. */
+/* Secondary. */
 
 /* Options of the spectral radius estimate: ARPACK's implicitly restarted Arnoldi
  * (dense dgeev for n <= 128), stopped when the dominant Ritz pair reaches
@@ -347,11 +345,6 @@ typedef struct ulam_radius {
  * not as a failure. */
 int ulam_spectral_radius(const ulam_csr *A, int use_abs, const ulam_spectral_opts *opts,
                          ulam_radius *out);
-
-/* Spectral radius of a linear operator given as y = op(ctx, x), n x n. */
-int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double *x, double *y),
-                            const void *ctx, int positive_start, const ulam_spectral_opts *opts,
-                            ulam_radius *out);
 
 /* Options of the power iteration for nonnegative operators (the guards' radii).  Start from
  * ulam_power_defaults(). */
@@ -546,24 +539,26 @@ const ulam_csr *ulam_system_transpose(const ulam_system *s);
  * the blocks of the rows it reaches.  ULAM_OK, or ULAM_EINVAL for s NULL. */
 int ulam_system_lazy(const ulam_system *s, const ulam_csr **M, const double **b);
 
-/* The blocks of M, b and M^T verified so far (each once), and in *rows (may be NULL) the rows of M
- * they hold: what a query read of the file beyond its header and checksum table. */
-int64_t ulam_system_checked(const ulam_system *s, int64_t *rows);
-
-/* The stored certificate, or NULL when there is none (or of a version this reader does not know). */
-const ulam_certificate *ulam_system_certificate(const ulam_system *s);
-
-/* The Jacobi damping the stored M was made with (0: none). */
-double ulam_system_omega(const ulam_system *s);
-
 /* Unmap and free; accepts and returns NULL. */
 ulam_system *ulam_system_free(ulam_system *s);
 
-/* The file mapping behind s: its first byte in *addr and its length in *bytes (NULL and 0 for
- * borrowed memory or s NULL).  A file that shrinks while mapped (truncated, or replaced in place
- * by `cp`) makes a read of the lost pages raise SIGBUS: a program that catches SIGBUS can tell
- * such a fault (si_addr inside the mapping) from others and report the file. */
-void ulam_system_mapping(const ulam_system *s, const void **addr, size_t *bytes);
+/* What a prepared system holds besides M, b and M^T, and what its queries have read. */
+typedef struct ulam_system_info {
+    const ulam_certificate *cert; /* the stored certificate, or NULL when there is none (or of a
+                                     version this reader does not know) */
+    double omega;            /* the Jacobi damping the stored M was made with (0: none) */
+    int64_t blocks_checked;  /* the blocks of M, b and M^T verified so far (each once) ... */
+    int64_t rows_checked;    /* ... and the rows of M they hold: what queries read of the file
+                                beyond its header and checksum table */
+    const void *map;         /* the file mapping behind s: its first byte and its length (NULL and
+                                0 for borrowed memory).  A file that shrinks while mapped */
+    size_t map_bytes;        /* (truncated, or replaced in place by `cp`) makes a read of the lost
+                                pages raise SIGBUS: a program that catches SIGBUS can tell such a
+                                fault (si_addr inside the mapping) from others and report the file */
+} ulam_system_info;
+
+/* Fill info (all zero for s NULL). */
+void ulam_system_get_info(const ulam_system *s, ulam_system_info *info);
 
 /* The content tag of a source file for a cache (ulam_system_desc.tag, ulam_system_open's tag):
  * the XXH3-128 hash of its bytes (low, high), so an edit that keeps the size and the modification
@@ -608,7 +603,7 @@ typedef struct ulam_share {
 ulam_share ulam_share_defaults(void);
 
 /* The walk kernel: how a walk moves and how its weight is kept in a window.  Start from
- * ulam_kernel_defaults(). */
+ * ulam_walk_defaults() (its kernel). */
 typedef struct ulam_kernel_opts {
     double continue_q;   /* fixed continuation probability in (0, 1); <= 0: analog min(1, S_i) */
     double kernel_alpha; /* the kernel exponent alpha, finite and >= 0: a walk that continues from
@@ -624,10 +619,7 @@ typedef struct ulam_kernel_opts {
     double split;        /* weight window ceiling: above it split into ceil(|w|/W) copies; 0 off */
 } ulam_kernel_opts;
 
-/* The defaults: analog continuation, exponent 1, rows built as reached, no weight window. */
-ulam_kernel_opts ulam_kernel_defaults(void);
-
-/* When a run stops: the first rule met ends it.  Start from ulam_stop_defaults(). */
+/* When a run stops: the first rule met ends it.  Start from ulam_walk_defaults() (its stop). */
 typedef struct ulam_stop_opts {
     int64_t max_walks;   /* stop after this many walks (0: no limit) */
     double rel_err;      /* stop once the relative-error rule holds (see ulam_solve_walks); 0 off */
@@ -638,23 +630,14 @@ typedef struct ulam_stop_opts {
                               part): rel_err is then relative to |c + estimate| (0: none) */
 } ulam_stop_opts;
 
-/* The defaults: 10^5 walks, walk cap 10^6 steps, every other rule off.  The 10^5 walks are the
- * budget of a run with no other rule: ulam_solve and ulam_solve_walks given a rel_err target with
- * max_walks left at this default (and no max_seconds) run to the target, capped at
- * ULAM_REL_ERR_CAP, as the command line's --rel-err does; another max_walks caps the target. */
-ulam_stop_opts ulam_stop_defaults(void);
-
-/* Where and how the walks run.  Start from ulam_exec_defaults(). */
+/* Where and how the walks run.  Start from ulam_walk_defaults() (its exec). */
 typedef struct ulam_exec_opts {
     uint64_t seed;       /* block q of walks uses the stream (seed, q): same result for any thread count */
     int threads;         /* 0: all cores */
     const ulam_share *share; /* NULL: this process runs every block */
 } ulam_exec_opts;
 
-/* The defaults: seed 1, all cores, one process. */
-ulam_exec_opts ulam_exec_defaults(void);
-
-/* What is asked: which x_i (or which weighted sum of them).  Start from ulam_query_defaults(). */
+/* What is asked: which x_i (or which weighted sum of them).  Start from ulam_walk_defaults() (its query). */
 typedef struct ulam_query_opts {
     int64_t index;       /* 0-based component reported (the start state in adjoint mode) */
     int64_t nstarts;     /* adjoint: 0 starts every walk at index; k > 0 starts it at starts[j]
@@ -665,11 +648,8 @@ typedef struct ulam_query_opts {
     const double *start_weights; /* k finite weights, not all 0 */
 } ulam_query_opts;
 
-/* The defaults: x_0, walks starting there. */
-ulam_query_opts ulam_query_defaults(void);
-
 /* What the run trusts: the guards' verdicts, computed before or to compute, and what to do when
- * they do not certify.  Start from ulam_policy_defaults(). */
+ * they do not certify.  Start from ulam_walk_defaults() (its policy). */
 typedef struct ulam_policy_opts {
     int force;           /* 1: walk even when rho(|M|) is not certified below 1 (else ULAM_EDIVERGE) */
     int assume_finite;   /* 1: treat a variance the guards cannot certify either way as finite */
@@ -683,9 +663,6 @@ typedef struct ulam_policy_opts {
                                   pass over all of M), and a damaged one fails the run with
                                   ULAM_ESYNTAX naming it */
 } ulam_policy_opts;
-
-/* The defaults: refuse what is not certified, compute the guards, no prepared system. */
-ulam_policy_opts ulam_policy_defaults(void);
 
 /* How to walk and when to stop, by concern.  Start from ulam_walk_defaults() (each part from its
  * own defaults function). */
@@ -808,18 +785,6 @@ int ulam_solver_vectors(const ulam_solver *s, double *x, double *std_error);
 /* Free a solver; accepts and returns NULL. */
 ulam_solver *ulam_solver_free(ulam_solver *s);
 
-/* The library's `ulam solve`: x_{opts->query.index} by the method the table chooses (ulam_auto), so a
- * caller with ulam_walk_defaults() gets what `ulam solve` gives by default: the same choice and,
- * on the same seed, the same estimate.  As the command line pins what it is given, a walk option
- * that differs from ulam_walk_defaults() pins that part of the walks' race (mode, estimator,
- * continue_q, kernel_alpha; opts->policy.guard serves as ulam_auto_opts.guard); all four differing, or
- * nstarts > 0, pin the walks row: ulam_solve_walks's run.  The answer comes as a walk result:
- * the chosen walks' run, or for bidirectional its walks on <r, x> with the whole answer's
- * estimate, std_error and ci95.  Statuses: ulam_auto's.  To run exactly the walks opts name, call
- * ulam_solve_walks (or ulam_auto with ulam_method_opts.method = ULAM_METHOD_WALKS). */
-int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
-               ulam_walk_result *result, ulam_error *err);
-
 /* The walks opts name, pinned (no choice): allocate, iterate until done, report, free in one
  * call, with the refusals of ulam_solver_alloc (guards checked first).  It always ends: rel_err alone stops at 10^9
  * walks at most (ULAM_REL_ERR_CAP; rel_err_met 0).
@@ -842,17 +807,6 @@ int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
  * is refused with ULAM_EINVAL. */
 int ulam_solve_walks(const ulam_csr *M, const double *b, const ulam_walk_opts *opts,
                      ulam_walk_result *result, ulam_error *err);
-
-/* As ulam_solve, ulam_solver_alloc and ulam_jacobi with b's length nb: b must have one entry a
- * row of M (A), else ULAM_EDIM (ULAM_EINVAL for a NULL b), so a short b is refused, never read
- * past its end (the functions without a length read M->nrows entries of b and trust that they
- * are there).  ulam_jacobi_n writes nb entries of bp. */
-int ulam_solve_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                 ulam_walk_result *result, ulam_error *err);
-int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                        ulam_solver **out, ulam_error *err);
-int ulam_jacobi_n(const ulam_csr *A, const double *b, int64_t nb, double omega, ulam_csr **M, double *bp,
-                  ulam_error *err);
 
 /* The walk cap of a run whose only rule is rel_err. */
 #define ULAM_REL_ERR_CAP 1000000000
@@ -881,9 +835,13 @@ typedef struct ulam_analysis_opts {
     const ulam_system *system; /* the prepared system M is mapped from (NULL: none): its
                                 certificate and stored bounds serve when made for this
                                 continuation and exponent */
+    int shared_bounds;       /* 1: the method table's walks (ulam_analysis_start, _solve) walk
+                                under the bounds over every state, made once for all queries (a
+                                prepared file's, or one pass over M); 0 (the default): each query
+                                searches its own start's reach, as on M alone */
 } ulam_analysis_opts;
 
-/* The defaults: analog continuation, exponent 1, no b, no system. */
+/* The defaults: analog continuation, exponent 1, no b, no system, bounds per query. */
 ulam_analysis_opts ulam_analysis_defaults(void);
 
 /* An analysis of square M (borrowed: it must outlive the analysis) under opts (NULL: the
@@ -903,10 +861,6 @@ ulam_analysis *ulam_analysis_free(ulam_analysis *a);
  * rel_err run's length, may differ). */
 int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_solver **out,
                          ulam_error *err);
-
-/* One query to its end (ulam_analysis_solver, iterate, report, free): as ulam_solve_walks. */
-int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_walk_result *result,
-                        ulam_error *err);
 
 /* M's transpose, made at the first call and kept (NULL: no memory, err filled). */
 const ulam_csr *ulam_analysis_transpose(ulam_analysis *a, ulam_error *err);
@@ -929,7 +883,7 @@ void ulam_analysis_get_info(const ulam_analysis *a, ulam_analysis_info *info);
 /* Iterations on (I - M) x = b from x = 0 that stop on the exact residual
  * ||b - (I - M) x||_2 / ||b||_2 <= tol:
  *   ULAM_RICHARDSON  x <- M x + b (the deterministic reference);
- *   ULAM_GAUSS_SEIDEL one sweep of ulam_gauss_seidel_sweep;
+ *   ULAM_GAUSS_SEIDEL one Gauss-Seidel sweep;
  *   ULAM_SEQUENTIAL  Halton's sequential Monte Carlo: r = b - (I - M) x, delta ~ (I - M)^-1 r
  *                    by forward walks from r, x <- x + delta;
  *   ULAM_MCSA        Monte Carlo Synthetic Acceleration (Evans and Mosher): a Richardson step
@@ -993,11 +947,17 @@ int ulam_outer_iterate(ulam_outer *s, ulam_outer_step *step);
 /* Nonzero once converged, failed, interrupted or capped. */
 int ulam_outer_done(const ulam_outer *s);
 
-/* Nonzero once ||r||_2 / ||b||_2 <= tol. */
-int ulam_outer_converged(const ulam_outer *s);
+/* Where an outer iteration stands. */
+typedef struct ulam_outer_info {
+    const double *x; /* the current iterate (n entries, owned by the workspace) */
+    int converged;   /* nonzero once ||r||_2 / ||b||_2 <= tol */
+    int rejected;    /* corrections rejected so far: a walk correction that did not lower the
+                        residual is never applied; its walks go on to more histories (see
+                        ulam_outer_iterate) */
+} ulam_outer_info;
 
-/* The current iterate (n entries, owned by s). */
-const double *ulam_outer_x(const ulam_outer *s);
+/* Fill info (all zero for s NULL). */
+void ulam_outer_get_info(const ulam_outer *s, ulam_outer_info *info);
 
 /* Free; accepts and returns NULL. */
 ulam_outer *ulam_outer_free(ulam_outer *s);
@@ -1006,9 +966,6 @@ ulam_outer *ulam_outer_free(ulam_outer *s);
  * goes on or once converged). */
 int ulam_outer_error(const ulam_outer *s, ulam_error *err);
 
-/* Corrections rejected so far: a walk correction that did not lower the residual is never
- * applied; its walks go on to more histories (see ulam_outer_iterate). */
-int ulam_outer_rejected(const ulam_outer *s);
 
 /* Iterate until done into x (n entries); steps (may be NULL) gets up to max_steps records,
  * *nsteps (may be NULL) the iterations run.  Returns the last iterate's status. */
@@ -1051,28 +1008,8 @@ typedef struct ulam_push_info {
     int64_t touched; /* states whose p or r was ever set */
     int64_t support; /* states with r_j != 0 */
     double r_sum, r_max; /* sum and largest of |r_j| */
-    double seconds;  /* wall time in ulam_push_run */
+    double seconds;  /* wall time pushing */
 } ulam_push_info;
-
-/* A workspace for pushes on the square matrix M, which is borrowed until the workspace is freed. */
-int ulam_push_alloc(const ulam_csr *M, ulam_push **out);
-
-/* Free a workspace; accepts and returns NULL. */
-ulam_push *ulam_push_free(ulam_push *w);
-
-/* Start over for target t (0-based): p = 0, r = e_t; ULAM_EINVAL when t is out of range. */
-int ulam_push_start(ulam_push *w, int64_t target);
-
-/* Push every state with |r_j| > rmax until none is left (FIFO order); ULAM_EINVAL for rmax <= 0 or
- * no start; ULAM_ENOCONV when the work passes max_ops (> 0; 0 is no cap), the invariant intact. */
-int ulam_push_run(ulam_push *w, double rmax, int64_t max_ops);
-
-/* The dense estimates p and residuals r (n entries each, owned by the workspace). */
-const double *ulam_push_estimates(const ulam_push *w);
-const double *ulam_push_residuals(const ulam_push *w);
-
-/* Fill *info about the pushes since the last start. */
-void ulam_push_report(const ulam_push *w, ulam_push_info *info);
 
 /* Bidirectional estimate of x_t of (I - M) x = b for b = e_s or a sparse b (src/bidir.c; Lofgren,
  * Banerjee, Goel, "Personalized PageRank estimation and search: a bidirectional approach", WSDM
@@ -1118,7 +1055,7 @@ typedef struct ulam_bidir_opts {
  * (the default cap), walk ulam_walk_defaults(), step_cost 0 (ULAM_BIDIR_STEP_COST). */
 ulam_bidir_opts ulam_bidir_defaults(void);
 
-/* A bidirectional estimate's plan (ulam_bidir_plan): the push it runs and what the walks after it
+/* A bidirectional estimate's plan: the push it runs and what the walks after it
  * are predicted to cost, in a deterministic unit of work (push operations; a walk's visits, its
  * steps + 1, count step_cost operations each), so a comparison of methods on it gives the same
  * answer on every run, thread count and MPI rank. */
@@ -1145,23 +1082,6 @@ typedef struct ulam_bidir_plan_info {
                                (0: no probe ran, or it saw nothing), which the balance plans for */
 } ulam_bidir_plan_info;
 
-/* Plan a bidirectional estimate without its walks: start the push at o->target and, when o->rmax
- * <= 0, run a pilot of 256 walks on a seed of its own (o->walk.seed mixed) and halve rmax from 1,
- * pushing down to it, while the push's operations are below the walks' predicted work (walks
- * predicted by the stopping rule's terms: its 1000-walk floor, the variance ||b||_1 rmax V /
- * (E^2 x^), and for a rel_err target E the range term the walk solver's own bounds (the pilot's
- * solver, over the states the walks reach) give for scores of at most rmax a visit, when they
- * give one; x^ = max(min_value, |<p, b>|); E = 0.1 for a run stopped by time alone); with
- * o->rmax > 0 push to it.  w is left pushed, and remembers the plan: ulam_bidir_solve with the
- * same options (target, b, rmax, min_value, max_push_ops and the walk options the pilot and
- * prediction read) uses that push and pilot as they are, until ulam_push_start or ulam_push_run
- * changes the workspace.  The push's operations are exact; the walks are a model's prediction:
- * the solver runs what its rule needs, in whole rounds, fewer or more (on the R-MAT benchmark the
- * median prediction was 1.8e4 walks where 7168 ran; x^ far above |x| predicts too few).
- * Statuses as ulam_bidir_solve. */
-int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
-                    ulam_error *err);
-
 /* What a bidirectional estimate found. */
 typedef struct ulam_bidir_result {
     double estimate, std_error, ci95[2]; /* of x_t: <p, b> plus the walks' estimate of <r, x>; the
@@ -1170,19 +1090,10 @@ typedef struct ulam_bidir_result {
     ulam_push_info push;   /* the push (its seconds are push_seconds) */
     ulam_walk_result walks; /* the walks' estimate of <r, x> (0 walks when r = 0: exact) */
     ulam_bidir_plan_info plan; /* the plan the estimate followed */
-    int plan_reused;       /* 1: the workspace held this plan (ulam_bidir_plan), not redone */
+    int plan_reused;       /* 1: the workspace held this plan (ulam_analysis_bidir), not redone */
     double seconds;        /* the whole estimate: the plan's seconds (pilot and push, also when
                               reused) plus the walks' set-up and walks */
 } ulam_bidir_result;
-
-/* Estimate x_t of (I - M) x = b (e_s, or o's sparse b) with push workspace w (on M) and Mt, the
- * transpose of M (borrowed;
- * computing it is one O(nnz) pass the caller makes once for any number of queries): the plan of
- * ulam_bidir_plan (reused when w holds it for these options), then walks from s on Mt scoring the
- * residual (from b's states, in proportion to |b_j|) until o->walk's stopping rules hold.  ULAM_OK, ULAM_EINVAL (bad options, index out of
- * range, Mt not n x n with M's nnz), ULAM_ENOCONV (push cap), the walk solver's statuses. */
-int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
-                     ulam_error *err);
 
 /* Single source, every target (src/fpush.c, src/sweep.c; FORA, Wang et al., KDD 2017, with
  * SpeedPPR's sweeps, Wu et al., 2021): x = (I - M)^-1 e_s by a forward push from s (rounds over
@@ -1248,7 +1159,7 @@ int ulam_fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts 
 /* ---------------------------------------------------------------- choosing the method */
 /* All secondary. */
 
-/* What became of a candidate of ulam_auto_choose. */
+/* What became of a candidate of ulam_auto_solver. */
 enum ulam_auto_state {
     ULAM_AUTO_UNCERTIFIED = 0, /* its variance is not certified finite (or its guard was not computed) */
     ULAM_AUTO_REFUSED,         /* the solver refused it (status: absorption with p* = 0) */
@@ -1258,7 +1169,7 @@ enum ulam_auto_state {
     ULAM_AUTO_CHOSEN
 };
 
-/* One candidate of ulam_auto_choose: a mode, an estimator and a continuation. */
+/* One candidate of ulam_auto_solver: a mode, an estimator and a continuation. */
 typedef struct ulam_auto_candidate {
     int mode, estimator;
     double continue_q;    /* <= 0: analog */
@@ -1271,7 +1182,7 @@ typedef struct ulam_auto_candidate {
     int64_t pilot_walks;  /* walks of its pilots, all stages (0: not piloted) */
     double estimate, variance, variance_rel_error; /* pooled over its pilots (never used in the answer) */
     double steps_per_walk; /* the pilots' mean steps a walk */
-    double work_per_walk;  /* the work model's units a walk (see ulam_auto_choose) */
+    double work_per_walk;  /* the work model's units a walk (see ulam_auto_solver) */
     double cost;           /* variance x work_per_walk (INFINITY when not piloted); the variance
                               compared is at least what puts the pilot's mean within 2 standard
                               errors of the most precise other pilot's (a pilot that missed a
@@ -1279,6 +1190,13 @@ typedef struct ulam_auto_candidate {
     double predicted_walks; /* walks the run would make (rel_err: the rule's variance, range and
                                variance-error terms at the pilots' values, rounded up to the rounds
                                the rule is checked at; else max_walks; NaN for time alone) */
+    int predicted_lower;    /* 1: predicted_walks is only a lower bound on the walks the rule will
+                               need: the pilots' mean is within 4 of its standard errors of 0
+                               (base's rel_err_offset added), so it does not resolve |x| (signed
+                               cancellation), and the prediction is made at the largest |x| the
+                               pilots allow; such a leader's pilots grow past ao->pilot_max (up to
+                               64 times) while the pilot share allows.  0 otherwise (also without
+                               a rel_err race or a pilot) */
     double predicted_work;  /* units: predicted_walks x work_per_walk + the kernel still to build */
     double predicted_seconds; /* predicted_work x ULAM_AUTO_UNIT_SECONDS (for the report only) */
 } ulam_auto_candidate;
@@ -1350,27 +1268,17 @@ typedef struct ulam_auto_result {
  *   - predicted work: units of the work model (ULAM_AUTO_*): walks x (steps + ULAM_AUTO_WALK +
  *     forward tallies) + the kernel units still to build; with rel_err the walks are the rule's:
  *     variance, range (min_walks) and variance-error terms, at a lower bound where the pilots do
- *     not resolve |x| (ulam_auto_lower_bound).
+ *     not resolve |x| (ulam_auto_candidate.predicted_lower).
  * The pilots' walks are not used in the answer: it comes from fresh walks on base's seed
  * (ulam_auto_solver), which the choice, a function of the pilots alone, cannot bias. */
-int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
-                     ulam_auto_result *res, ulam_error *err);
 
-/* As ulam_auto_choose, and *out gets the solver to run: the chosen candidate's (or, when none is
- * certified, the closest's) on base's options with that mode, estimator and continuation, its
+/* ulam_auto_solver: the choice above, and *out (NULL: the choice alone) gets the solver to run:
+ * the chosen candidate's (or, when none is certified, the closest's) on base's options with that mode, estimator and continuation, its
  * kernel rows, reachable set, score bounds and guards kept from the pilots, no walk made yet:
  * iterating it gives, bit for bit, what a solver allocated with those options would (NULL with
  * a status when none is left).  Its refusals are ulam_solver_alloc's. */
 int ulam_auto_solver(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
                      ulam_auto_result *res, ulam_solver **out, ulam_error *err);
-
-/* 1 when candidate k's predicted_walks (a rel_err race's) is only a lower bound on the walks the
- * rule will need: its pilots' mean is within 4 of its standard errors of 0 (offset: base's
- * rel_err_offset added), so it does not resolve |x| (signed cancellation: x_1 = 1e-3 max|x|), and
- * the prediction is made at the largest |x| the pilots allow (min over the piloted candidates of
- * |mean| + 2 standard errors); such a leader's pilots grow past ao->pilot_max (up to 64 times)
- * while the pilot share allows.  0 otherwise (also without a rel_err race or a pilot). */
-int ulam_auto_lower_bound(const ulam_auto_result *res, int k, double rel_err_offset);
 
 /* ---------------------------------------------------------------- the method table */
 /* All secondary, except primary: ulam_auto. */
@@ -1382,7 +1290,7 @@ int ulam_auto_lower_bound(const ulam_auto_result *res, int k, double rel_err_off
  * one entry they answer x_i without an error bar).  Row k's number is stable: */
 enum ulam_method_row {
     ULAM_METHOD_WALKS = 0,         /* adjoint or forward walks: mode x estimator x continuation x
-                                      kernel exponent, raced by ulam_auto_choose */
+                                      kernel exponent, raced by ulam_auto_solver */
     ULAM_METHOD_BIDIRECTIONAL = 1, /* reverse push from the index, walks from a sparse b */
     ULAM_METHOD_RICHARDSON = 2,    /* then ULAM_METHOD_RICHARDSON + enum ulam_method: richardson, */
     ULAM_METHOD_GAUSS_SEIDEL = 3,  /* gauss-seidel, */
@@ -1409,12 +1317,6 @@ int ulam_method_answers(int k);
 /* The densest b the bidirectional row takes by its reverse push from the index: nonzeros at most
  * max(16, n / 10) (a denser b: the push on b, see ulam_auto_start). */
 int64_t ulam_method_sparse_limit(int64_t n);
-
-/* Which route the bidirectional row takes for x of (I - M) x = b (n entries) under the walks'
- * pins ao (NULL: none) and options o: 0 the reverse push from the index and collision walks from
- * b (a sparse b, nothing pinned it cannot honour), 1 the push on b and walks from the index with
- * the walks' own estimator and exponent (a dense b, or an estimator or exponent pinned). */
-int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o);
 
 /* Which rows a choice may take.  Start from ulam_method_defaults(). */
 typedef struct ulam_method_opts {
@@ -1446,12 +1348,16 @@ typedef struct ulam_choice {
     int chosen;                   /* the row that runs (enum ulam_method_row; -1: none) */
     int pinned;                   /* 1: the row was pinned (ulam_method_opts.method), not chosen */
     ulam_method_verdict method[ULAM_NMETHODS];
-    ulam_auto_result walks;       /* the walks row's race (ulam_auto_choose): its candidates */
+    ulam_auto_result walks;       /* the walks row's race (ulam_auto_solver): its candidates */
     double leader_work;           /* the walks' chosen candidate's predicted work (NaN: none) */
     ulam_bidir_plan_info bidir;   /* the bidirectional row's plan (state PLANNED or CHOSEN) */
     ulam_bidir_opts bidir_opts;   /* the options it was planned with and runs with (its b arrays
                                      are owned by the run: valid until ulam_run_free) */
     double transpose_seconds;     /* the bidirectional row's transpose of M */
+    int bidir_route;              /* the route the bidirectional run takes: 1 the push on b and walks
+                                     from the index, 0 the reverse push from the index and walks from
+                                     b (a sparse b, or no walks from the index certified), -1 another
+                                     row chosen */
 } ulam_choice;
 
 /* A chosen method ready to run (opaque): the walk solver, the bidirectional plan, or the outer
@@ -1499,11 +1405,6 @@ int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o,
  * ulam_run_free), or NULL for another row. */
 ulam_solver *ulam_run_solver(ulam_run *r);
 
-/* The route a bidirectional run takes: 1 the push on b and walks from the index, 0 the reverse
- * push from the index and walks from b (ulam_method_bidir_route's, unless no walks from the
- * index are certified: then the reverse push even for a dense b), -1 for another row. */
-int ulam_run_bidir_route(const ulam_run *r);
-
 /* Run to the end (walks: iterate the solver until done) and fill *a.  The walks' statuses, the
  * bidirectional and outer rows' (ULAM_ENOCONV, ULAM_ESTALL with a filled; a->status holds it). */
 int ulam_run_finish(ulam_run *r, ulam_answer *a, ulam_error *err);
@@ -1514,220 +1415,61 @@ ulam_run *ulam_run_free(ulam_run *r);
 /* The library's `ulam solve`: ulam_auto_start, ulam_run_finish, ulam_run_free in one call
  * (ch may be NULL).  With ao and mo NULL it chooses as `ulam solve` does by default (the same
  * choice and, on the same seed, the same estimate); pin a row with mo->method
- * (ULAM_METHOD_WALKS: ulam_solve_walks's run, bit for bit); ulam_solve is this call with its
- * answer as a walk result. */
+ * (ULAM_METHOD_WALKS: ulam_solve_walks's run, bit for bit).  Tertiary: ulam_analysis_solve on an
+ * analysis of M is the primary call. */
 int ulam_auto(const ulam_csr *M, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
               const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *a, ulam_error *err);
 
-/* As ulam_auto_solver for M = a's M, its candidates of a's kernel (adjoint, a's continuation and
- * exponent) walking under a's bounds over every state (a prepared file's, or one pass over M)
- * rather than each searching its start's reach; ao->guard, when NULL and ao pins a's
- * continuation, exponent and adjoint mode, is a's.  The same choice as ulam_auto_solver where
- * those bounds equal the start's (a start that reaches every state). */
-int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
-                       ulam_auto_result *res, ulam_solver **out, ulam_error *err);
-
-/* A's push workspace on M, made at the first call and kept (ulam_analysis_bidir pushes on it);
- * NULL: no memory (err filled). */
-ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err);
-
-/* A bidirectional estimate (as ulam_bidir_solve) on a's transpose (ulam_analysis_transpose: a
+/* A bidirectional estimate (b = e_source or o's sparse b; x_target) on a's transpose (ulam_analysis_transpose: a
  * prepared file's stored M^T when it has one, else made once), push workspace and plan memo,
- * all made at the first call and kept across queries: a plan (ulam_bidir_plan's) is reused for
+ * all made at the first call and kept across queries: a plan is reused for
  * the same options and the push as it left it; the walks' bounds over every state and kernel
  * rows (o->reach_all, keep_kernel) stay with the analysis.  o->walk.kernel's continuation and
  * exponent must be a's (ULAM_EINVAL otherwise: one analysis, one kernel).  The same seed gives
- * the same estimate as ulam_bidir_solve on a fresh workspace.  Statuses as ulam_bidir_solve. */
+ * the same estimate as a fresh analysis.  ULAM_OK, ULAM_EINVAL (bad options), ULAM_ENOMEM,
+ * and the walks' refusals (ulam_solver_alloc's). */
 int ulam_analysis_bidir(ulam_analysis *a, const ulam_bidir_opts *o, ulam_bidir_result *res, ulam_error *err);
 
-/* As ulam_auto_start for M = a's M: the walks row's candidates of a's kernel walk under a's bounds
- * over every state (as ulam_analysis_auto), the other rows as ulam_auto_start; the run borrows a
- * (free the run first). */
-int ulam_analysis_auto_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                             const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err);
+/* ---------------------------------------------------------------- one unknown: the primary call */
+/* Primary: ulam_analysis_solve (with ulam_analysis_alloc, ulam_analysis_free, ulam_method_find).
+ * Secondary: ulam_analysis_start and the run's ulam_run_solver, ulam_run_finish, ulam_run_free
+ * (the same, step by step: iterate the walks to show progress or stop early).
+ *
+ * To ask for x_i of (I - M) x = b:
+ *     ulam_analysis *a;  ulam_analysis_alloc(M, NULL, &a, &err);      (once per M, reused)
+ *     ulam_walk_opts o = ulam_walk_defaults();  o.query.index = i;  o.stop.rel_err = 0.01;
+ *     ulam_answer ans;   ulam_analysis_solve(a, b, &o, NULL, NULL, NULL, &ans, &err);
+ *     ... ans.estimate, ans.ci95 ...;   ulam_analysis_free(a);
+ * and a method by name: ulam_method_opts mo = ulam_method_defaults();
+ *     mo.method = ulam_method_find("bidirectional");  ulam_analysis_solve(a, b, &o, NULL, &mo, ...). */
 
-/* ---------------------------------------------------------------- studies */
-/* All tertiary. */
-
-/* The weight windows of a study's methods: none, Russian roulette below 0.5 w0, or roulette and
- * splitting above 2 w0 (w0 the starting weight: 1 adjoint, ||b||_1 forward). */
-enum ulam_window { ULAM_WINDOW_PLAIN, ULAM_WINDOW_ROULETTE, ULAM_WINDOW_SPLIT };
-
-/* A study's method grid: mode x estimator x window, 18 methods. */
-enum { ULAM_STUDY_METHODS = 18 };
-
-/* One method of the grid. */
-typedef struct ulam_study_method {
-    const char *name; /* "mode-estimator-window", e.g. "adjoint-collision-plain" */
-    int mode;         /* ULAM_ADJOINT or ULAM_FORWARD */
-    int estimator;    /* ULAM_COLLISION, ULAM_ABSORPTION or ULAM_EXPECTED */
-    int window;       /* enum ulam_window */
-} ulam_study_method;
-
-/* Method k (0 <= k < ULAM_STUDY_METHODS; k = 9 mode + 3 estimator + window), or NULL. */
-const ulam_study_method *ulam_study_method_get(int k);
-
-/* The index of the method named name, or -1. */
-int ulam_study_method_find(const char *name);
-
-/* The 95% Wilson score interval [*lo, *hi] of a coverage: covered of runs intervals held the exact
- * value (runs > 0; else [0, 1]). */
-void ulam_study_coverage_interval(int covered, int runs, double *lo, double *hi);
-
-/* Set o's mode, estimator, roulette and split to method k's on b (n entries; read only in
- * forward mode, for w0 = ||b||_1).  ULAM_OK or ULAM_EINVAL. */
-int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o);
-
-/* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
-void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
-
-/* Gauss-Seidel sweeps on x (in place, from what it holds) until, after at least min_sweeps, one
- * sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps are made; returns the
- * sweeps made. */
-int ulam_gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
-                             int min_sweeps, int max_sweeps);
-
-/* Up to this n a study's exact value is LAPACK's. */
-#define ULAM_STUDY_DIRECT_MAX 8000
-
-/* The exact value a study scores its runs against. */
-typedef struct ulam_study_ref {
-    double exact;          /* x_index: LAPACK's when direct, else settled */
-    double settled;        /* Gauss-Seidel from x = 0 until x_index settles (1e-16 relative, after
-                              at least 12 sweeps, at most 10^5) */
-    int sweeps;            /* the sweeps it made */
-    int direct;            /* 1: n <= ULAM_STUDY_DIRECT_MAX and the LAPACK solve succeeded */
-    double direct_seconds; /* that solve's time */
-} ulam_study_ref;
-
-/* The exact x_index of (I - M) x = b for a study (index 0-based).  ULAM_OK, ULAM_EINVAL or
+/* x_{o->query.index} of (I - M) x = b, M = a's, as `ulam solve` answers it: by the method the
+ * table chooses (mo NULL, or mo->method -1: every row's applicability and predicted work, the walks
+ * racing their candidates) or by the row mo->method names (ulam_method_find; ULAM_METHOD_WALKS with
+ * every walk option as o says: ulam_solve_walks's run, bit for bit, when a does not share bounds).
+ * ao NULL takes the walks' pins from o as the command line takes them from its options: a walk
+ * option that differs from ulam_walk_defaults() (mode, estimator, continuation, exponent) pins
+ * that part of the race, and all four, or weighted starts, pin the walks row (when mo is NULL);
+ * o->policy.guard serves as ao's guard.  A rel_err target with max_walks left at its default runs
+ * to the target (capped at ULAM_REL_ERR_CAP), as --rel-err does.  So a caller with
+ * ulam_walk_defaults() and an analysis with ulam_analysis_defaults() gets what `ulam solve` gives
+ * for a Matrix Market file: the same choice and, on the same seed, the same estimate.  ch (may be
+ * NULL) gets every row's verdict; ans the answer: x_i with its error bar (ans->estimate,
+ * std_error, ci95; NaN without one: the rows that answer every unknown to a residual), the row
+ * that ran and its own result.  Statuses: the walks' refusals (ulam_solver_alloc's: ch->walks
+ * says which candidate), the rows' (ULAM_ENOCONV, ULAM_ESTALL, with ans filled), ULAM_EINVAL,
  * ULAM_ENOMEM. */
-int ulam_study_reference(const ulam_csr *M, const double *b, int64_t index, ulam_study_ref *ref, ulam_error *err);
+int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                        const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *ans, ulam_error *err);
 
-/* A variance study: every chosen method of the grid at every budget, repeats runs each, scored
- * against the exact x_index (ulam_study_reference).  Run k = (method << 24) + (budget << 16) +
- * repeat walks with seed ulam_rng_substream(seed, ULAM_STREAM_STUDY, k). */
-typedef struct ulam_study ulam_study;
-
-/* What a study runs (ulam_study_defaults, then set what differs). */
-typedef struct ulam_study_params {
-    const int *methods;      /* grid indices (ulam_study_method_find), nmethods of them; NULL: all 18 */
-    int nmethods;
-    const double *budgets;   /* walks per run (whole numbers), or seconds when time_budgets */
-    int nbudgets;            /* 1 .. 16 */
-    int time_budgets;        /* 1: budgets are seconds a run */
-    int repeats;             /* runs per method and budget, 2 .. 4096 */
-    uint64_t seed;           /* the base seed of every run */
-    int threads;             /* threads a run (0: all cores) */
-    const volatile int *interrupt; /* nonzero stops the run under way (not recorded); may be NULL */
-    const ulam_share *share; /* walks shared across MPI ranks (ulam_walk_opts.exec.share); NULL: none */
-} ulam_study_params;
-
-/* One run of a study: which, with what seed, and what it gave. */
-typedef struct ulam_study_run {
-    int method, budget, repeat; /* grid index, budget index, repeat */
-    double budget_value;        /* walks or seconds */
-    uint64_t seed;              /* its walks' seed */
-    int status;                 /* the solve's status (ULAM_OK) */
-    int has_estimate;           /* 0: no estimate (refused, failed, < 2 walks, no stderr): a failure */
-    double estimate, std_error, abs_error, seconds; /* NaN estimate and stderr without one */
-    int64_t walks, steps;
-    int covered;                /* |estimate - exact| <= 1.96 stderr */
-    int last_in_cell;           /* the cell (method, budget) has every run once this one is done */
-    int interrupted;            /* stopped by p->interrupt: not recorded (made again by the next call) */
-} ulam_study_run;
-
-/* A method's screening: refused (why non-empty) or run, flagged when rho(M^) is not certified
- * below 1 (its error bars mean nothing). */
-typedef struct ulam_study_screen {
-    int on;        /* chosen */
-    int infinite;  /* variance not certified finite */
-    char why[320]; /* non-empty: refused, and why */
-} ulam_study_screen;
-
-/* What the runs of one method at one budget say, against the exact value. */
-typedef struct ulam_study_cell {
-    int runs;           /* every finished run, those with no estimate too */
-    int failed;         /* runs that ended with no estimate */
-    double rmse;        /* sqrt(mean (estimate - exact)^2) over the runs with an estimate */
-    double mean_stderr; /* the mean reported standard error */
-    double honesty;     /* rmse / mean_stderr: 1 when the error bars are honest */
-    double coverage;    /* share of runs whose 95% interval holds the exact value (a failed run holds nothing) */
-    double seconds;     /* mean seconds per run */
-    double work;        /* rmse^2 x seconds (lower is better; infinite with a failed run) */
-} ulam_study_cell;
-
-/* The defaults: all 18 methods, walk budgets 100 .. 10^6 (tenfold), 30 repeats, seed 1. */
-ulam_study_params ulam_study_defaults(void);
-
-/* A study of x_index (0-based) of (I - M) x = b (M and b borrowed until ulam_study_free): checks
- * p, runs the guards once (ulam_guard_check), screens each chosen method (refused when the guards
- * or the solver refuse it) and computes the exact value.  ULAM_OK, ULAM_EINVAL, ULAM_ENOMEM, or the
- * guards' status. */
-int ulam_study_alloc(const ulam_csr *M, const double *b, int64_t index, const ulam_study_params *p,
-                     ulam_study **out, ulam_error *err);
-
-/* Free s (NULL allowed); returns NULL. */
-ulam_study *ulam_study_free(ulam_study *s);
-
-/* Method k's screening into *out; ULAM_OK or ULAM_EINVAL (k out of range). */
-int ulam_study_screen_get(const ulam_study *s, int k, ulam_study_screen *out);
-
-/* The exact value and how it was found. */
-const ulam_study_ref *ulam_study_exact(const ulam_study *s);
-
-/* The guards' verdicts the study ran under. */
-const ulam_guard *ulam_study_guard(const ulam_study *s);
-
-/* 1 when every run of the chosen, unrefused methods is done. */
-int ulam_study_done(const ulam_study *s);
-
-/* Run the next run not yet done (budgets outer, methods, repeats inner) into *run; ULAM_OK (a
- * run that ends with no estimate is recorded, as a failure; one stopped by p->interrupt is not:
- * run->interrupted), ULAM_ENOMEM, or ULAM_EINVAL when s is done. */
-int ulam_study_iterate(ulam_study *s, ulam_study_run *run, ulam_error *err);
-
-/* Every run not yet done, until p->interrupt; each recorded run goes to fn(run, arg) when fn is
- * not NULL.  ULAM_OK (ulam_study_done says whether all ran) or ulam_study_iterate's failure. */
-int ulam_study_run_all(ulam_study *s, void (*fn)(const ulam_study_run *run, void *arg), void *arg, ulam_error *err);
-
-/* Run (method, budget, repeat) into *run when done (1), else 0. */
-int ulam_study_run_get(const ulam_study *s, int method, int budget, int repeat, ulam_study_run *run);
-
-/* Record an earlier run (a resumed file's row: method, budget, repeat, has_estimate, estimate,
- * std_error, seconds, walks and steps read; seed, abs_error and covered derived).  ULAM_OK, or
- * ULAM_EINVAL (out of range, a method not run, or that run already done). */
-int ulam_study_restore(ulam_study *s, const ulam_study_run *run);
-
-/* The summary of method k's finished runs at budget b into *out; the runs it summarises (0: none,
- * *out zeroed). */
-int ulam_study_cell_get(const ulam_study *s, int k, int b, ulam_study_cell *out);
-
-/* The seconds the runs not yet done will take, from the measured seconds per walk of each method
- * (a method not yet measured: the dearest measured); a time budget is its own cost. */
-double ulam_study_seconds_left(const ulam_study *s);
-
-/* The winner at budget b: the method with the least work (RMSE^2 x seconds) among those run with
- * a certified finite variance and finished runs at b, its cell into *out; the method, or -1 when
- * none has finished runs at b.  A winner whose work is infinite (every such cell has a run with
- * no estimate) is no winner: the caller says so. */
-int ulam_study_winner(const ulam_study *s, int b, ulam_study_cell *out);
-
-/* 1 when forward walks on M have a certified finite variance (rho(|M|) and the forward rho(M^)
- * below 1): the outer iterations' reference lines can walk. */
-int ulam_study_forward_walks(const ulam_study *s);
-
-/* The reference lines a study's charts draw beside its runs, each point to fn(kind, seconds,
- * error on x_index, arg) in this order: "lapack" (when the exact value is LAPACK's: its seconds,
- * its difference from Gauss-Seidel's settled value), "gs" (Gauss-Seidel from x = 0 at sweeps 1,
- * 2, 4, ... and the sweep its error falls to 1e-9 |x|), "sequential" and "mcsa" (one run each,
- * seed p->seed, tolerance 1e-10, for at most reference_time seconds; only when
- * ulam_study_forward_walks and reference_time > 0), then "cg" when M is symmetric, else "gmres"
- * (GMRES(30)), at tolerances 1e-1 .. 1e-10 (a solve's seconds: the mean of repeats over at least
- * 1 ms).  p->interrupt stops them.  ULAM_OK, ULAM_EINVAL or ULAM_ENOMEM. */
-int ulam_study_reference_lines(const ulam_study *s, double reference_time,
-                               void (*fn)(const char *kind, double seconds, double error, void *arg), void *arg,
-                               ulam_error *err);
+/* ulam_analysis_solve's first half: choose (or start mo's row) and hand out the run in *out (NULL
+ * on failure), no walk made yet; ao NULL: ulam_auto_defaults(), nothing pinned (o's walk options
+ * are not read as pins here), and o's budget as given.  The walks row's candidates walk under a's
+ * bounds over every state when a shares them (ulam_analysis_opts.shared_bounds: a prepared
+ * file's, or one pass over M), else each on its start's reach as ulam_auto_start does on M; the
+ * bidirectional row on a's transpose and plans either way.  The run borrows a (free it first). */
+int ulam_analysis_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                        const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err);
 
 /* ---------------------------------------------------------------- random numbers */
 /* All tertiary. */
@@ -1749,11 +1491,6 @@ double ulam_rng_uniform(ulam_rng *r);
 
 /* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
 uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
-
-/* The k-th (k < 4) uniform double in [0, 1) of step t of walk w under seed: a counter-based
- * stream (splitmix64's finalizer chained over the key), the same on every rank and thread, so a
- * walk that migrates between ranks (ulam_dist.h) takes the same path. */
-double ulam_rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k);
 
 /* What a derived seed is for: the one place sub-runs get their seeds (ulam_rng_substream). */
 typedef enum ulam_stream_purpose {

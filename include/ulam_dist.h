@@ -7,14 +7,14 @@
  * exchange as callbacks (src/cli/mpi.c gives MPI_Alltoallv and MPI_Allreduce).
  *
  * Random numbers are counter-based: the k-th number of step t of walk w is a hash of (seed, w,
- * t, k) (ulam_rng_counter), so a walk takes the same path whichever rank runs which step, and
+ * t, k) (src/rng.c's counter-based numbers), so a walk takes the same path whichever rank runs which step, and
  * 1, 2, 3 or 64 ranks give the same answer bit for bit: walks' scores and tallies are combined
  * in walk-id order, never in arrival order.
  *
  * API, in order of use: primary ulam_part_open (ulam_part_open_mtx from Matrix Market by byte
  * ranges), ulam_dist_radius (the variance guard), ulam_dist_adjoint (ulam_dist_adjoint_ci with its
  * interval), ulam_dist_forward, ulam_dist_bound (a certified range from the residual),
- * ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows (and ulam_rng_counter in ulam.h). */
+ * ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows. */
 #ifndef ULAM_DIST_H
 #define ULAM_DIST_H
 
@@ -134,11 +134,6 @@ int ulam_dist_adjoint_ci(const ulam_part *p, const ulam_comm *comm, const int64_
  * se are left as they were). */
 int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double *x, double *se,
                       ulam_dist_result *r, ulam_error *err);
-
-/* As ulam_dist_forward with the sources drawn from b (this rank's rows [first, last) of it) in
- * place of the system's b: the walks of MCSA's correction and of single source's residual. */
-int ulam_dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
-                        double *se, ulam_dist_result *res, ulam_error *err);
 
 /* What MCSA on a partition did. */
 typedef struct ulam_dist_mcsa_info {

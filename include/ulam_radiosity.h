@@ -275,8 +275,8 @@ typedef struct ulam_rad_opts {
     ulam_exec_opts exec; /* seed, threads, processes */
 } ulam_rad_opts;
 
-/* The defaults: gathering at patch 0 with next-event estimation, and ulam_stop_defaults() and
- * ulam_exec_defaults() (10^5 walks, walk cap 10^6 steps, seed 1, all cores). */
+/* The defaults: gathering at patch 0 with next-event estimation, and ulam_walk_defaults()'s stop and
+ * exec parts (10^5 walks, walk cap 10^6 steps, seed 1, all cores). */
 ulam_rad_opts ulam_rad_defaults(void);
 
 /* An opaque patch-walk solver: walks that sample F by ray casting, never forming it. */

@@ -12,6 +12,7 @@
 #include "analysis.h"
 #include "cache.h"
 #include "kernel.h"
+#include "push.h"
 #include "solve.h"
 
 #include <math.h>
@@ -24,6 +25,7 @@ struct ulam_analysis {
     double alpha;
     const double *b;      /* the shared b (borrowed; NULL: none) */
     const ulam_system *sys;
+    int shared_bounds;    /* ulam_analysis_opts.shared_bounds */
     ulam_guard g;         /* the guards so far (g.computed: which radii) */
     int guard_from;       /* 0 none, 1 certificate, 2 computed */
     ulam__reach R;        /* the bounds over every state (R.bounds 0: not yet) */
@@ -70,6 +72,7 @@ int ulam_analysis_alloc(const ulam_csr *M, const ulam_analysis_opts *opts, ulam_
     const ulam_csr *mapped = NULL;
     if (o.system) ulam_system_lazy(o.system, &mapped, NULL);
     a->b = o.b, a->sys = mapped == M ? o.system : NULL;
+    a->shared_bounds = o.shared_bounds != 0;
     *out = a;
     return ULAM_OK;
 }
@@ -82,7 +85,7 @@ ulam_analysis *ulam_analysis_free(ulam_analysis *a)
     for (int e = 0; e < 3; e++) ulam__kernel_free(a->k[e]);
     ulam__kernel_free(a->kr);
     free(a->found);
-    ulam_push_free(a->push);
+    ulam__push_free(a->push);
     ulam_csr_free(a->T);
     free(a->seen);
     free(a);
@@ -99,7 +102,9 @@ static int take_guard(ulam_analysis *a, int mode, ulam_error *err)
     go.need = need | a->g.computed;
     go.kernel_alpha = a->alpha;
     int status = ULAM_OK;
-    if (a->sys && !ulam_certificate_guard(ulam_system_certificate(a->sys), a->continue_q, &go, &a->g)) a->guard_from = 1;
+    ulam_system_info si;
+    ulam_system_get_info(a->sys, &si);
+    if (a->sys && !ulam_certificate_guard(si.cert, a->continue_q, &go, &a->g)) a->guard_from = 1;
     else if (!(status = ulam_guard_check(a->M, a->continue_q, &go, &a->g, err))) a->guard_from = 2;
     a->seconds += ulam_now() - t0;
     return status;
@@ -170,15 +175,6 @@ int ulam_analysis_solver(ulam_analysis *a, const double *b, const ulam_walk_opts
     status = ulam__solver_alloc_reached(a->M, b, &o, R, k, out, err);
     if (!status && shared && e >= 0 && !k) a->k[e] = ulam__solver_keep_kernel_fixed(*out);
     return status;
-}
-
-/* One query to its end. */
-int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *opts, ulam_walk_result *result,
-                        ulam_error *err)
-{
-    ulam_solver *s = NULL;
-    int status = ulam_analysis_solver(a, b, opts, &s, err);
-    return status ? status : ulam__solver_finish(s, result, err);
 }
 
 /* The slot of an internal caller's kept kernel: a->k[estimator] for a fixed b, else a->kr (NULL:
@@ -279,11 +275,11 @@ const ulam_csr *ulam_analysis_transpose(ulam_analysis *a, ulam_error *err)
 }
 
 /* The push workspace on M, made once. */
-ulam_push *ulam_analysis_push(ulam_analysis *a, ulam_error *err)
+ulam_push *ulam__analysis_push(ulam_analysis *a, ulam_error *err)
 {
     ulam__clear(err);
     if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis"), NULL;
-    if (!a->push && ulam_push_alloc(a->M, &a->push))
+    if (!a->push && ulam__push_alloc(a->M, &a->push))
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for a push workspace"), NULL;
     return a->push;
 }
@@ -311,6 +307,12 @@ void ulam__analysis_keep(ulam_analysis *a, void *m, void (*drop)(void *))
 {
     if (a->kept && a->drop) a->drop(a->kept);
     a->kept = m, a->drop = drop;
+}
+
+/* 1 when a's queries share its bounds over every state (ulam_analysis_opts.shared_bounds). */
+int ulam__analysis_shares_bounds(const ulam_analysis *a)
+{
+    return a && a->shared_bounds;
 }
 
 /* a's bounds over every state with the shared b's scores (see internal.h). */

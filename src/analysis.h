@@ -8,7 +8,7 @@
 
 /* The walks' pins o (the caller's, or ulam_auto_defaults()) given a's guards when they pin a's own
  * kernel (adjoint, a's continuation and exponent, no guard of their own): ULAM_OK, or the guards'
- * status (src/analysis.c; ulam_analysis_auto, ulam_analysis_auto_start). */
+ * status (src/analysis.c; ulam_analysis_auto, ulam_analysis_start). */
 int ulam__analysis_pin_guard(ulam_analysis *a, const ulam_walk_opts *base, ulam_auto_opts *o, ulam_error *err);
 
 /* The analysis' transpose (ulam_analysis_transpose), with *seconds (may be NULL) the time this
@@ -44,6 +44,10 @@ enum {
  * file).  Borrowed from the analysis (src/cache.c stores them in a prepared file). */
 const ulam__reach *ulam__analysis_bounds(ulam_analysis *a);
 
+/* 1 when a's queries share its bounds over every state (ulam_analysis_opts.shared_bounds): the
+ * method table's walks row then walks under them (src/method.c). */
+int ulam__analysis_shares_bounds(const ulam_analysis *a);
+
 /* The bounds over every state of an analysis' matrix (a prepared file's, else one pass,
  * ulam__reach_all; made once and kept): ULAM_OK, or the status and err (no memory, a corrupt
  * row, alpha's probabilities underflowing, a damaged file). */
@@ -58,5 +62,9 @@ int ulam__analysis_bounds_all(ulam_analysis *a, ulam_error *err);
  * bidirectional planner walks on M^T through an analysis of M^T). */
 int ulam__analysis_walks(ulam_analysis *a, const double *b, const ulam_walk_opts *o, int how, ulam_walk_result *result,
                          ulam_guard *guard, ulam_solver **out, ulam_error *err);
+
+/* A's push workspace on M, made at the first call and kept (ulam_analysis_bidir pushes on it);
+ * NULL: no memory (err filled). */
+ulam_push *ulam__analysis_push(ulam_analysis *a, ulam_error *err);
 
 #endif

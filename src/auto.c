@@ -185,7 +185,7 @@ static double scale_of(const ulam_auto_result *res, int k, double offset)
 }
 
 /* Whether candidate k's predicted walks are a lower bound (its pilot mean does not resolve |x|). */
-int ulam_auto_lower_bound(const ulam_auto_result *res, int k, double rel_err_offset)
+static int lower_bound(const ulam_auto_result *res, int k, double rel_err_offset)
 {
     if (!res || k < 0 || k >= res->ncand || res->cand[k].pilot_walks < 2 || !res->by_work) return 0;
     return !resolved(res, k, rel_err_offset);
@@ -478,7 +478,7 @@ static int drop(chooser *c)
     int left = 0;
     const ulam_auto_candidate *L = &c->res->cand[c->leader];
     /* a leader whose pilot does not resolve |x| predicts a lower bound: nothing is clearly worse than it */
-    double high = ulam_auto_lower_bound(c->res, c->leader, c->base.stop.rel_err_offset)
+    double high = lower_bound(c->res, c->leader, c->base.stop.rel_err_offset)
                       ? INFINITY : key(c, c->leader, 1.0 + 2.0 * fmin(L->variance_rel_error, 1e6));
     for (int k = 0; k < c->res->ncand; k++) {
         ulam_auto_candidate *a = &c->res->cand[k];
@@ -617,25 +617,9 @@ int ulam__auto_solver_reach(const ulam_csr *M, const double *b, const ulam_walk_
         }
         if (!status && isfinite(c->deadline)) ulam__solver_clock(*out, t0, c->deadline); /* the walks' limit counts the choice */
     }
+    for (int k = 0; k < res->ncand; k++) res->cand[k].predicted_lower = lower_bound(res, k, base->stop.rel_err_offset);
     free_groups(c, -1);
     free(c);
     res->seconds = ulam_now() - t0;
     return status;
-}
-
-/* Screen, race and choose. */
-int ulam_auto_choose(const ulam_csr *M, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
-                     ulam_auto_result *res, ulam_error *err)
-{
-    return ulam_auto_solver(M, b, base, ao, res, NULL, err);
-}
-
-/* The walks' choice on an analysis' bounds. */
-int ulam_analysis_auto(ulam_analysis *a, const double *b, const ulam_walk_opts *base, const ulam_auto_opts *ao,
-                       ulam_auto_result *res, ulam_solver **out, ulam_error *err)
-{
-    ulam_auto_opts o = ao ? *ao : ulam_auto_defaults();
-    int status = ulam__analysis_pin_guard(a, base, &o, err);
-    return status ? status
-                  : ulam__auto_solver_reach(ulam__analysis_matrix(a), b, base, &o, ulam__analysis_bounds(a), res, out, err);
 }

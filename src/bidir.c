@@ -16,9 +16,9 @@
  * rule's floor, each costing E[V] visits of step_cost push operations.  rmax halves, pushing
  * down to it, while the push's work so far is below the walks' predicted work (at a fixed walk
  * count: below what those walks cost), for |x_t| about the largest of min_value, p_s and a
- * probe's lower bound (see push()).  The interval: honest_interval.  ulam_bidir_plan does this and leaves the
+ * probe's lower bound (see push()).  The interval: honest_interval.  ulam__bidir_plan does this and leaves the
  * pushed workspace with a memo of the plan (bidir.h: the analysis', or one kept with a bare push
- * workspace), which ulam_bidir_solve reuses for the same options and the push as the plan left it
+ * workspace), which ulam__bidir_solve reuses for the same options and the push as the plan left it
  * instead of pushing again.  Every walk here (pilot, probe, estimate) is handed out by an
  * analysis of M' the memo holds (ulam__analysis_walks), which keeps what later walks share: the
  * bounds over every state (reach_all), the kernel rows (keep_kernel) and the reach a pilot found. */
@@ -220,7 +220,7 @@ static int pilot(ulam_analysis *at, const double *ones, const ulam_bidir_opts *o
 }
 
 /* Walks the stopping rule is predicted to need at threshold rmax for |x| about xhat (the
- * balance's model, ulam_bidir_plan in ulam.h); pilot: its solver (NULL: none). */
+ * balance's model, ulam__bidir_plan in ulam.h); pilot: its solver (NULL: none). */
 static double predicted_walks(const ulam_bidir_opts *o, const ulam_solver *pilot, double rmax, double visits,
                               double xhat)
 {
@@ -248,8 +248,8 @@ static double probe(const ulam_csr *Mt, ulam_push *w, const ulam_bidir_opts *o, 
     po.walk.exec.seed = ulam_rng_substream(o->walk.exec.seed, ULAM_STREAM_PROBE, 0); /* docs/streams.md */
     ulam_walk_result wr;
     ulam_guard g;
-    double part = dot_b(ulam_push_estimates(w), o);
-    if (walk(Mt, ulam_push_residuals(w), &po, part, memo, &wr, &g, NULL) || !(wr.variance > 0)) return 0.0;
+    double part = dot_b(ulam__push_estimates(w), o);
+    if (walk(Mt, ulam__push_residuals(w), &po, part, memo, &wr, &g, NULL) || !(wr.variance > 0)) return 0.0;
     return fmax(0.0, fabs(part + wr.estimate) - 2.0 * wr.std_error);
 }
 
@@ -261,15 +261,15 @@ static double probe(const ulam_csr *Mt, ulam_push *w, const ulam_bidir_opts *o, 
 static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir *memo, const ulam_bidir_opts *o,
                 const ulam_solver *pl, int64_t cap, ulam_bidir_plan_info *plan)
 {
-    const double *p = ulam_push_estimates(w);
+    const double *p = ulam__push_estimates(w);
     int64_t n = Mt->nrows;
     double delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n, V = plan->mean_visits, cost = step_cost(o);
     double rmax = o->rmax > 0 ? o->rmax : 1.0, walks, seen = 0.0;
     int fixed = o->walk.stop.rel_err <= 0 && o->walk.stop.max_walks > 0; /* walks known without V */
     int probed = fixed || !(o->walk.stop.rel_err > 0) || o->min_value > 0; /* a given min_value is the plan's */
-    int status = ulam_push_run(w, rmax, cap); /* balanced: r = e_t, nothing to push yet */
+    int status = ulam__push_run(w, rmax, cap); /* balanced: r = e_t, nothing to push yet */
     for (;;) {
-        ulam_push_report(w, &plan->push);
+        ulam__push_report(w, &plan->push);
         walks = predicted_walks(o, pl, rmax, V, fmax(fmax(delta, seen), fabs(dot_b(p, o))));
         if (!probed && o->rmax <= 0 && !status && plan->push.support > 0 && walks > ULAM__REL_MIN &&
             (double)plan->push.ops >= ULAM__REL_MIN * V * cost) {
@@ -284,7 +284,7 @@ static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir *memo, const ulam_
                       100000 walks' work outran the push, which halved rmax into denormals and
                       hit its operation cap) */
         rmax /= 2;
-        status = ulam_push_run(w, rmax, cap);
+        status = ulam__push_run(w, rmax, cap);
     }
     plan->rmax = rmax;
     plan->push_part = dot_b(p, o);
@@ -316,7 +316,7 @@ static int plan_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bi
     memset(plan, 0, sizeof *plan);
     double t0 = ulam_now();
     int64_t cap = o->max_push_ops > 0 ? o->max_push_ops : 100 * ulam_csr_nnz(M) + 1000000;
-    ulam_push_start(w, o->target);
+    ulam__push_start(w, o->target);
     memo->valid = 0; /* until this plan is whole */
     ulam_solver *pl = NULL;
     plan->target = o->target, plan->balanced = !(o->rmax > 0), plan->mean_visits = 1.0, plan->step_cost = step_cost(o);
@@ -423,7 +423,7 @@ static void honest_interval(ulam_bidir_result *res, double D, const ulam_walk_op
  * rounding does not print a zero-width interval beside x_t. */
 static double rounding_allowance(const ulam_push *w, const ulam_push_info *push, const ulam_bidir_opts *o)
 {
-    return ((double)push->ops + (double)o->nb + 2.0) * (DBL_EPSILON / 2.0) * dot_abs_b(ulam_push_estimates(w), o);
+    return ((double)push->ops + (double)o->nb + 2.0) * (DBL_EPSILON / 2.0) * dot_abs_b(ulam__push_estimates(w), o);
 }
 
 /* Estimate x_t of (I - M) x = b (e_s or a sparse b) on w with memo. */
@@ -437,10 +437,10 @@ static int solve_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__b
         res->plan = memo->plan, res->plan_reused = 1;
     else if ((status = plan_on(M, Mt, w, memo, o, &res->plan, err))) return status;
     double t0 = ulam_now();
-    ulam_push_report(w, &res->push);
+    ulam__push_report(w, &res->push);
     res->push_part = res->plan.push_part;
     ulam_guard g = {0};
-    if (res->push.support > 0 && (status = walk(Mt, ulam_push_residuals(w), o, res->push_part, memo, &res->walks, &g, err)))
+    if (res->push.support > 0 && (status = walk(Mt, ulam__push_residuals(w), o, res->push_part, memo, &res->walks, &g, err)))
         return status;
     res->estimate = res->push_part + res->walks.estimate;
     res->std_error = res->walks.std_error;
@@ -471,7 +471,7 @@ static ulam__bidir *kept_memo(ulam_push *w)
 }
 
 /* Plan x_t's estimate on a bare push workspace (see ulam.h). */
-int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
+int ulam__bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
                     ulam_error *err)
 {
     ulam__bidir *m = w ? kept_memo(w) : NULL;
@@ -480,7 +480,7 @@ int ulam_bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, 
 }
 
 /* Estimate x_t on a bare push workspace (see ulam.h). */
-int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
+int ulam__bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
                      ulam_error *err)
 {
     ulam__bidir *m = w ? kept_memo(w) : NULL;
@@ -492,7 +492,7 @@ int ulam_bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o,
 static int take(ulam_analysis *a, const ulam_csr **Mt, ulam_push **w, ulam__bidir **memo, ulam_error *err)
 {
     if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis");
-    if (!(*Mt = ulam__analysis_transpose(a, NULL, err)) || !(*w = ulam_analysis_push(a, err))) return ULAM_ENOMEM;
+    if (!(*Mt = ulam__analysis_transpose(a, NULL, err)) || !(*w = ulam__analysis_push(a, err))) return ULAM_ENOMEM;
     if (!(*memo = ulam__analysis_kept(a))) {
         if (!(*memo = ulam__bidir_alloc())) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
         ulam__analysis_keep(a, *memo, drop_memo);

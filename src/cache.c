@@ -821,19 +821,6 @@ const ulam_csr *ulam_system_transpose(const ulam_system *s)
     return s && s->has_tr && !verify_part(s, PART_T, 0, s->tr.nrows, NULL) ? &s->tr : NULL;
 }
 
-/* The blocks verified so far and the rows of M they hold. */
-int64_t ulam_system_checked(const ulam_system *s, int64_t *rows)
-{
-    if (rows) *rows = s ? atomic_load(&s->checked[1]) : 0;
-    return s ? atomic_load(&s->checked[0]) : 0;
-}
-
-/* The stored certificate, or NULL. */
-const ulam_certificate *ulam_system_certificate(const ulam_system *s)
-{
-    return s && s->has_cert ? &s->cert : NULL;
-}
-
 /* The bounds extension of s for its matrix at continuation continue_q and kernel exponent alpha
  * (R->seen unset: every state): 1 when the file holds them, else 0 (see internal.h). */
 int ulam__system_bounds(const ulam_system *s, double continue_q, double alpha, ulam__reach *R)
@@ -844,17 +831,16 @@ int ulam__system_bounds(const ulam_system *s, double continue_q, double alpha, u
     return 1;
 }
 
-/* The Jacobi damping of the stored M. */
-double ulam_system_omega(const ulam_system *s)
+/* What s holds besides M, b and M^T, and what its queries have read. */
+void ulam_system_get_info(const ulam_system *s, ulam_system_info *info)
 {
-    return s ? s->omega : 0.0;
-}
-
-/* The mapping's address and length. */
-void ulam_system_mapping(const ulam_system *s, const void **addr, size_t *bytes)
-{
-    if (addr) *addr = s ? s->map : NULL;
-    if (bytes) *bytes = s && s->map ? s->map_bytes : 0;
+    if (!info) return;
+    memset(info, 0, sizeof *info);
+    if (!s) return;
+    info->cert = s->has_cert ? &s->cert : NULL;
+    info->omega = s->omega;
+    info->blocks_checked = atomic_load(&s->checked[0]), info->rows_checked = atomic_load(&s->checked[1]);
+    info->map = s->map, info->map_bytes = s->map ? s->map_bytes : 0;
 }
 
 /* Unmap and free. */

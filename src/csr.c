@@ -199,7 +199,7 @@ int ulam_csr_transpose(const ulam_csr *A, ulam_csr **out)
 }
 
 /* A deep copy of A. */
-int ulam_csr_copy(const ulam_csr *A, ulam_csr **out)
+int ulam__csr_copy(const ulam_csr *A, ulam_csr **out)
 {
     if (!A || !out) return ULAM_EINVAL;
     int bad = ulam__csr_check_structure(A, NULL); /* src/check.c */
@@ -228,7 +228,7 @@ int ulam_csr_matvec(const ulam_csr *A, int use_abs, const double *x, double *y)
 }
 
 /* Dense row-major copy of A. */
-int ulam_csr_to_dense(const ulam_csr *A, double *dense)
+int ulam__csr_to_dense(const ulam_csr *A, double *dense)
 {
     if (!A || !dense) return ULAM_EINVAL;
     int bad = ulam__csr_check_structure(A, NULL); /* src/check.c */
@@ -331,15 +331,4 @@ int ulam_jacobi(const ulam_csr *A, const double *b, double omega, ulam_csr **M, 
     R->rowptr[n] = out;
     *M = R;
     return ULAM_OK;
-}
-
-/* As ulam_jacobi with b's (and bp's) length checked. */
-int ulam_jacobi_n(const ulam_csr *A, const double *b, int64_t nb, double omega, ulam_csr **M, double *bp,
-                  ulam_error *err)
-{
-    ulam__clear(err);
-    if (M) *M = NULL;
-    if (!A) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, a right-hand side and omega > 0");
-    int status = ulam__length_check(b, nb, A->nrows, "b", err);
-    return status ? status : ulam_jacobi(A, b, omega, M, bp, err);
 }

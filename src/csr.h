@@ -8,4 +8,10 @@
  * compacting A in place. */
 int ulam__csr_canonicalize(ulam_csr *A, int threads);
 
+/* A deep copy of A. */
+int ulam__csr_copy(const ulam_csr *A, ulam_csr **out);
+
+/* Dense row-major copy of A into a caller buffer of nrows*ncols doubles. */
+int ulam__csr_to_dense(const ulam_csr *A, double *dense);
+
 #endif

@@ -76,8 +76,8 @@ static int move(const ulam_part *p, const ulam__rows *A, const ulam_dist_opts *o
     uint64_t k = (uint64_t)(x->w / o->walks), w = (uint64_t)(x->w % o->walks);
     uint64_t seed = many ? ulam_rng_substream(o->seed, ULAM_STREAM_QUERY, k) : o->seed;
     double S = A->rowsum[i], c = S < 1.0 ? S : 1.0;
-    if (S == 0.0 || ulam_rng_counter(seed, w, (uint64_t)t, 0) >= c) return 0;
-    double u = ulam_rng_counter(seed, w, (uint64_t)t, 1) * S, acc = 0.0;
+    if (S == 0.0 || ulam__rng_counter(seed, w, (uint64_t)t, 0) >= c) return 0;
+    double u = ulam__rng_counter(seed, w, (uint64_t)t, 1) * S, acc = 0.0;
     int64_t q = A->rowptr[i], e = A->rowptr[i + 1] - 1;
     for (; q < e; q++) {
         acc += fabs(A->val[q]);
@@ -489,7 +489,7 @@ static int forward_starts(run *R, const double *P, int64_t nb, int64_t w0, int64
     const ulam_part *p = R->p;
     double total = P[nb];
     for (int64_t w = w0; w < w0 + B; w++) {
-        double u = ulam_rng_counter(R->o.seed, (uint64_t)w, 0, 2) * total;
+        double u = ulam__rng_counter(R->o.seed, (uint64_t)w, 0, 2) * total;
         int64_t lo = 0, hi = nb - 1; /* the last block k with P[k] <= u and a positive sum */
         while (lo < hi) {
             int64_t mid = (lo + hi + 1) / 2;
@@ -560,11 +560,11 @@ static int settle(run *R, double *sum, double *sumsq, ulam_error *err)
 int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double *x, double *se,
                       ulam_dist_result *res, ulam_error *err)
 {
-    return ulam_dist_forward_b(p, comm, o, p ? p->b : NULL, x, se, res, err);
+    return ulam__dist_forward_b(p, comm, o, p ? p->b : NULL, x, se, res, err);
 }
 
 /* As ulam_dist_forward with the sources' b given at this rank's rows. */
-int ulam_dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
+int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
                         double *se, ulam_dist_result *res, ulam_error *err)
 {
     ulam__clear(err);

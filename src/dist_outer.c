@@ -112,7 +112,7 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
         }
         ulam_dist_result res;
         w.seed = ulam_rng_substream(o ? o->seed : 1, ULAM_STREAM_ITERATION, (uint64_t)it); /* docs/streams.md */
-        status = ulam_dist_forward_b(p, comm, &w, r, d, NULL, &res, err);
+        status = ulam__dist_forward_b(p, comm, &w, r, d, NULL, &res, err);
         if (!status && from_set0(p, comm, d)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
         for (int64_t i = 0; !status && i < rows; i++) x[i] += d[i]; /* the Monte Carlo correction */
         info->iterations = it + 1, info->walks += res.walks, info->steps += res.steps, info->crossings += res.crossings;
@@ -150,7 +150,7 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
     }
     info->residual = rmax;
     ulam_dist_result res = {0};
-    if (!status) status = ulam_dist_forward_b(p, comm, o, r, y, se, &res, err); /* (I - M)^-1 r by walks */
+    if (!status) status = ulam__dist_forward_b(p, comm, o, r, y, se, &res, err); /* (I - M)^-1 r by walks */
     if (!status && (from_set0(p, comm, y) || from_set0(p, comm, se)))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
     for (int64_t i = 0; !status && i < rows; i++) {

@@ -25,6 +25,7 @@
  * (lower_index). */
 #include "fpush.h"
 #include "check.h"
+#include "push.h"
 #include "stop.h"
 #include "sweep.h"
 
@@ -98,26 +99,26 @@ static int solve_queue(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     info->mean_visits = isfinite(D1) ? D1 : 1.0 / fmax(1e-3, 1.0 - fmin(g.abs.upper, 0.999));
     double cost = o.step_cost > 0 && isfinite(o.step_cost) ? o.step_cost : ULAM_BIDIR_STEP_COST;
     ulam_push *w = NULL;
-    if ((status = ulam_push_alloc(Mt, &w))) return ulam__fail(err, status, 0, -1, "memory for the push");
-    ulam_push_start(w, o.source);
+    if ((status = ulam__push_alloc(Mt, &w))) return ulam__fail(err, status, 0, -1, "memory for the push");
+    ulam__push_start(w, o.source);
     double rmax = o.rmax > 0 ? o.rmax : 1.0, W;
     int64_t cap = 100 * ulam_csr_nnz(M) + 1000000;
-    status = ulam_push_run(w, rmax, cap);
+    status = ulam__push_run(w, rmax, cap);
     for (;;) {
-        ulam_push_report(w, &info->push);
+        ulam__push_report(w, &info->push);
         W = info->push.support ? walk_count(&o, info->push.r_sum, n) : 0.0;
         if (o.rmax > 0 || status || info->push.support == 0 || (double)info->push.ops >= W * info->mean_visits * cost)
             break;
         rmax /= 2;
-        status = ulam_push_run(w, rmax, cap);
+        status = ulam__push_run(w, rmax, cap);
     }
     info->rmax = rmax;
     info->push_seconds = info->push.seconds;
     if (status) {
-        ulam_push_free(w);
+        ulam__push_free(w);
         return ulam__fail(err, status, 0, -1, "a push within %lld operations (is rho(|M|) < 1?)", (long long)cap);
     }
-    const double *p = ulam_push_estimates(w), *r = ulam_push_residuals(w);
+    const double *p = ulam__push_estimates(w), *r = ulam__push_residuals(w);
     double *xw = ulam__calloc((size_t)n, sizeof *xw), *se = ulam__calloc((size_t)n, sizeof *se), ws[2] = {NAN, NAN};
     if (!xw || !se) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' estimates");
     info->residual_bound = info->push.r_sum * D1;
@@ -157,7 +158,7 @@ static int solve_queue(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         }
     }
     free(xw), free(se);
-    ulam_push_free(w);
+    ulam__push_free(w);
     info->seconds = ulam_now() - t0;
     return status;
 }

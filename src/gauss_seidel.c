@@ -5,7 +5,7 @@
 #include <math.h>
 
 /* One Gauss-Seidel sweep on x = M x + b. */
-void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x)
+void ulam__gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x)
 {
     for (int64_t i = 0; i < M->nrows; i++) {
         double s = b[i];
@@ -15,13 +15,13 @@ void ulam_gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x)
 }
 
 /* Gauss-Seidel sweeps on x until x_index settles; the sweeps made. */
-int ulam_gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
+int ulam__gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
                              int min_sweeps, int max_sweeps)
 {
     int k = 0;
     while (k < max_sweeps) {
         double old = x[index];
-        ulam_gauss_seidel_sweep(M, b, x);
+        ulam__gauss_seidel_sweep(M, b, x);
         k++;
         if (k >= min_sweeps && fabs(x[index] - old) <= rel_tol * fabs(x[index])) break;
     }

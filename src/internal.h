@@ -93,4 +93,18 @@ int ulam__grow(void *pp, int64_t *cap, int64_t need, size_t sz);
 int ulam__b_exponent(const double *b, int64_t n);
 double *ulam__b_scaled(const double *b, int64_t n, int e);
 
+/* One Gauss-Seidel sweep on x = M x + b, in place (rows in order, new values used at once). */
+void ulam__gauss_seidel_sweep(const ulam_csr *M, const double *b, double *x);
+
+/* Gauss-Seidel sweeps on x (in place, from what it holds) until, after at least min_sweeps, one
+ * sweep changes x[index] by at most rel_tol |x[index]|, or max_sweeps are made; returns the
+ * sweeps made. */
+int ulam__gauss_seidel_settle(const ulam_csr *M, const double *b, double *x, int64_t index, double rel_tol,
+                             int min_sweeps, int max_sweeps);
+
+/* The k-th (k < 4) uniform double in [0, 1) of step t of walk w under seed: a counter-based
+ * stream (splitmix64's finalizer chained over the key), the same on every rank and thread, so a
+ * walk that migrates between ranks (ulam_dist.h) takes the same path. */
+double ulam__rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k);
+
 #endif

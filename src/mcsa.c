@@ -270,7 +270,7 @@ int ulam_outer_iterate(ulam_outer *s, ulam_outer_step *step)
         for (int64_t i = 0; i < s->n; i++) s->x[i] += s->r[i]; /* x + r = M x + b */
         break;
     case ULAM_GAUSS_SEIDEL:
-        ulam_gauss_seidel_sweep(s->M, s->b, s->x);
+        ulam__gauss_seidel_sweep(s->M, s->b, s->x);
         break;
     case ULAM_MCSA:
         for (int64_t i = 0; i < s->n; i++) s->x[i] += s->r[i];
@@ -301,16 +301,12 @@ int ulam_outer_done(const ulam_outer *s)
     return !s || s->done;
 }
 
-/* Nonzero once converged. */
-int ulam_outer_converged(const ulam_outer *s)
+/* Where s stands: its iterate, convergence and rejected corrections. */
+void ulam_outer_get_info(const ulam_outer *s, ulam_outer_info *info)
 {
-    return s && s->converged;
-}
-
-/* The current iterate. */
-const double *ulam_outer_x(const ulam_outer *s)
-{
-    return s ? s->x : NULL;
+    if (!info) return;
+    *info = (ulam_outer_info){0};
+    if (s) info->x = s->x, info->converged = s->converged, info->rejected = s->rejected;
 }
 
 /* Iterate until done. */
@@ -355,10 +351,4 @@ int ulam_outer_error(const ulam_outer *s, ulam_error *err)
     else if (status)
         ulam__fail(err, status, 0, -1, "memory for the walks");
     return status;
-}
-
-/* Corrections rejected so far (each redone with more histories). */
-int ulam_outer_rejected(const ulam_outer *s)
-{
-    return s ? s->rejected : 0;
 }

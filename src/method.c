@@ -1,7 +1,7 @@
 /* The method table (GSL's gsl_root_fsolver_type, Lua's luaL_Reg): every way ulam answers
  * (I - M) x = b is a row with its name, its applicability test, its cost prediction and its run;
- * ulam_auto_start chooses among the rows, or starts the one pinned.  A new method is a row here
- * and its own file (src/method_*.c). */
+ * ulam_analysis_start (ulam_auto_start on M alone) chooses among the rows, or starts the one
+ * pinned.  A new method is a row here and its own file (src/method_*.c). */
 #include "method_row.h"
 #include "analysis.h"
 #include "check.h"
@@ -127,6 +127,7 @@ static int start_reach(const ulam_csr *M, const double *b, const ulam_walk_opts 
     ch->method[ch->chosen].state = ULAM_METHOD_CHOSEN;
     ch->method[ch->chosen].why[0] = 0;
     r->method = ch->chosen;
+    ch->bidir_route = r->method == ULAM_METHOD_BIDIRECTIONAL ? r->br != NULL : -1;
     *out = r;
     return ULAM_OK;
 }
@@ -138,10 +139,19 @@ int ulam_auto_start(const ulam_csr *M, const double *b, const ulam_walk_opts *o,
     return start_reach(M, b, o, ao, mo, NULL, NULL, ch, out, err);
 }
 
-/* The method table's choice on an analysis, its walks row on the analysis' bounds. */
-int ulam_analysis_auto_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
-                             const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
+/* The method table's choice on an analysis: its walks row on the analysis' bounds over every
+ * state when it shares them (ulam_analysis_opts.shared_bounds), else on each start's reach as on
+ * M alone; the bidirectional row on its transpose and plans either way. */
+int ulam_analysis_start(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                        const ulam_method_opts *mo, ulam_choice *ch, ulam_run **out, ulam_error *err)
 {
+    if (!a) {
+        ulam__clear(err);
+        if (out) *out = NULL;
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis");
+    }
+    if (!ulam__analysis_shares_bounds(a)) /* its transpose and plans still serve the bidirectional row */
+        return start_reach(ulam__analysis_matrix(a), b, o, ao, mo, NULL, a, ch, out, err);
     ulam_auto_opts p = ao ? *ao : ulam_auto_defaults();
     int status = ulam__analysis_pin_guard(a, o, &p, err);
     return status ? status
@@ -152,12 +162,6 @@ int ulam_analysis_auto_start(ulam_analysis *a, const double *b, const ulam_walk_
 ulam_solver *ulam_run_solver(ulam_run *r)
 {
     return r && r->method == ULAM_METHOD_WALKS ? r->sv : NULL;
-}
-
-/* The route of a bidirectional run: 1 the push on b, 0 the reverse push, -1 another row. */
-int ulam_run_bidir_route(const ulam_run *r)
-{
-    return r && r->method == ULAM_METHOD_BIDIRECTIONAL ? r->br != NULL : -1;
 }
 
 /* Run to the end and fill *a. */
@@ -213,37 +217,25 @@ static void solve_pins(const ulam_walk_opts *o, ulam_auto_opts *ao, ulam_method_
         mo->method = ULAM_METHOD_WALKS;
 }
 
-/* The library's `ulam solve` with its answer as a walk result. */
-int ulam_solve(const ulam_csr *M, const double *b, const ulam_walk_opts *opts, ulam_walk_result *result,
-               ulam_error *err)
+/* One unknown on an analysis, as `ulam solve`: pins from o when ao is NULL, the default walk
+ * budget lifted under a rel_err target; choose (or start mo's row), run to the end, free. */
+int ulam_analysis_solve(ulam_analysis *a, const double *b, const ulam_walk_opts *o, const ulam_auto_opts *ao,
+                        const ulam_method_opts *mo, ulam_choice *ch, ulam_answer *ans, ulam_error *err)
 {
     ulam__clear(err);
-    if (!M || !b || !opts) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and options");
-    ulam_auto_opts ao;
-    ulam_method_opts mo;
-    ulam_walk_opts o = ulam__lift_default_cap(opts);
-    opts = &o;
-    solve_pins(opts, &ao, &mo);
-    ulam_answer *a = malloc(sizeof *a);
-    if (!a) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the answer");
-    memset(a, 0, sizeof *a);
-    a->method = -1; /* a run that never started leaves result as it was */
-    int status = ulam_auto(M, b, opts, &ao, &mo, NULL, a, err);
-    if (result && (!status || a->method >= 0)) {
-        *result = a->walks; /* bidirectional: its walks on <r, x>, with the whole answer's estimate */
-        result->estimate = a->estimate, result->std_error = a->std_error;
-        result->ci95[0] = a->ci95[0], result->ci95[1] = a->ci95[1];
-    }
-    free(a);
+    if (!a || !b || !o || !ans) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis, b, options and an answer");
+    ulam_walk_opts lifted = ulam__lift_default_cap(o);
+    ulam_auto_opts pa;
+    ulam_method_opts pm;
+    solve_pins(&lifted, &pa, &pm);
+    if (ao) pa = *ao;
+    if (mo) pm = *mo;
+    ulam_choice *own = ch ? NULL : malloc(sizeof *own);
+    if (!ch && !own) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the choice");
+    ulam_run *r = NULL;
+    int status = ulam_analysis_start(a, b, &lifted, &pa, &pm, ch ? ch : own, &r, err);
+    if (!status) status = ulam_run_finish(r, ans, err);
+    ulam_run_free(r);
+    free(own);
     return status;
-}
-
-/* As ulam_solve with b's length checked. */
-int ulam_solve_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                 ulam_walk_result *result, ulam_error *err)
-{
-    ulam__clear(err);
-    if (!M) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
-    int status = ulam__length_check(b, nb, M->nrows, "b", err);
-    return status ? status : ulam_solve(M, b, opts, result, err);
 }

@@ -5,7 +5,7 @@
  * predicted work is below the leader's.  At a fixed budget (--walks, the default 10^5, or --time)
  * the push on b is considered too, where the range term of the walks' interval would dominate
  * (fixed_predict).  The transpose, the push workspace and the plan memo are
- * an analysis' (src/analysis.c): the caller's (ulam_analysis_auto_start), made once for all its
+ * an analysis' (src/analysis.c): the caller's (ulam_analysis_start), made once for all its
  * queries, or one of the run's own. */
 #include "analysis.h"
 #include "bidir.h"
@@ -42,7 +42,7 @@ static int64_t nonzeros(const double *b, int64_t n)
 }
 
 /* The route: 1 the push on b (dense b, or an estimator or exponent pinned), 0 the reverse push. */
-int ulam_method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o)
+int ulam__method_bidir_route(const double *b, int64_t n, const ulam_auto_opts *ao, const ulam_walk_opts *o)
 {
     if (!b || !o) return 0;
     int64_t limit = ulam_method_sparse_limit(n);
@@ -66,7 +66,7 @@ static int applies(const ulam__query *q, int k, char *why, size_t len)
     double nnz = (double)ulam_csr_nnz(q->M), W = q->ch->leader_work;
     if (pinned) snprintf(why, len, "not considered: %s", pinned);
     else if (ulam__method_excluded(q, k, why, len)) return 0;
-    else if (!(o->stop.rel_err > 0) && !ulam_method_bidir_route(q->b, n, q->ao, o) && !index_walks(q->ch))
+    else if (!(o->stop.rel_err > 0) && !ulam__method_bidir_route(q->b, n, q->ao, o) && !index_walks(q->ch))
         snprintf(why, len, "not considered: no --rel-err target with a sparse b and no certified walks from the index "
                            "for the push on b (without a target auto compares variance x work a walk, which the "
                            "reverse push has no figure for)");
@@ -405,7 +405,7 @@ static int predict(ulam__query *q, int k, ulam_error *err)
     double W = ch->leader_work;
     int fixed = !(q->o->stop.rel_err > 0); /* a fixed budget: the push on b for a sparse b too (the reverse push
                                               has no figure to compare there) */
-    if ((fixed || ulam_method_bidir_route(q->b, q->M->nrows, q->ao, q->o)) && (index_walks(ch) || pinned(q)))
+    if ((fixed || ulam__method_bidir_route(q->b, q->M->nrows, q->ao, q->o)) && (index_walks(ch) || pinned(q)))
         return predict_push_on_b(q, k, err);
     ulam_walk_opts walk = *q->o;
     walk.estimator = ULAM_COLLISION, walk.kernel.kernel_alpha = 1.0;
@@ -462,7 +462,7 @@ static int pin(ulam__query *q, int k, ulam_error *err)
     (void)k;
     int64_t n = q->M->nrows, nb = nonzeros(q->b, n);
     if (nb == 0) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a nonzero b (b is zero, so x is 0)");
-    if (ulam_method_bidir_route(q->b, n, q->ao, q->o)) { /* the push on b, planned from a pilot round on b */
+    if (ulam__method_bidir_route(q->b, n, q->ao, q->o)) { /* the push on b, planned from a pilot round on b */
         if (!(q->o->stop.rel_err > 0) && !(q->o->stop.max_walks > 0))
             return ulam__fail(err, ULAM_EINVAL, 0, -1, "a --rel-err target or a walk count for bidirectional with a "
                                                        "dense b (more than max(16, n/10) = %lld nonzeros)",

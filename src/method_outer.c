@@ -7,6 +7,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+/* The current iterate of outer iteration s (owned by it). */
+static const double *outer_x(const ulam_outer *s)
+{
+    ulam_outer_info info;
+    ulam_outer_get_info(s, &info);
+    return info.x;
+}
+
 /* The name of row k, one of this file's (ULAM_METHOD_RICHARDSON to ULAM_METHOD_GMRES, in order). */
 static const char *row_name(int k)
 {
@@ -67,7 +75,7 @@ static int finish_outer(ulam_run *r, ulam_answer *a, ulam_error *err)
         status = ulam_outer_iterate(s, &st);
         a->iterations = st.iteration, a->residual = st.residual, histories += st.histories;
     }
-    if (s) a->estimate = ulam_outer_x(s)[r->o.query.index];
+    if (s) a->estimate = outer_x(s)[r->o.query.index];
     a->walks.walks = histories;
     ulam_outer_free(s);
     return status;

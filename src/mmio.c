@@ -826,7 +826,7 @@ static int read_matrix(FILE *f, const char *name, const ulam_mm_opts *o, int lib
 }
 
 /* Read a sparse matrix from f. */
-int ulam_mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err)
+int ulam__mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err)
 {
     return ulam_mm_read_matrix_opts(f, name, NULL, A, err);
 }
@@ -898,7 +898,7 @@ int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err)
     if (!f) return ULAM_EIO;
     int gz = gunzipped(&f, path, err);
     if (gz) return gz;
-    int status = ulam_mm_read_matrix_file(f, path, A, err);
+    int status = ulam__mm_read_matrix_file(f, path, A, err);
     fclose(f);
     return status;
 }

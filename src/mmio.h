@@ -36,4 +36,7 @@ int64_t ulam__mm_line_start(int fd, const ulam__mm_coord *c, int64_t at);
 int ulam__mm_read_range(int fd, const ulam__mm_coord *c, int64_t from, int64_t to, int64_t limit, ulam__mm_entry **e,
                         int64_t *len, int64_t *entries, long *lines, ulam_error *err);
 
+/* As ulam_mm_read_matrix, from an open file; name is used only in error details. */
+int ulam__mm_read_matrix_file(FILE *f, const char *name, ulam_csr **A, ulam_error *err);
+
 #endif

@@ -77,4 +77,9 @@ int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const 
  * c[i] >= v_i / min v at this rank's rows (src/dist_radius.c), at most iters products. */
 int ulam__dist_cw(const ulam_part *p, const ulam_comm *comm, int iters, double *u, double *c, ulam_error *err);
 
+/* As ulam_dist_forward with the sources drawn from b (this rank's rows [first, last) of it) in
+ * place of the system's b: the walks of MCSA's correction and of single source's residual. */
+int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
+                        double *se, ulam_dist_result *res, ulam_error *err);
+
 #endif

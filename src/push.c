@@ -30,7 +30,7 @@ struct ulam_push {
 };
 
 /* Free a push workspace; accepts and returns NULL. */
-ulam_push *ulam_push_free(ulam_push *w)
+ulam_push *ulam__push_free(ulam_push *w)
 {
     if (!w) return NULL;
     free(w->p), free(w->r), free(w->touched), free(w->mark), free(w->queue);
@@ -40,7 +40,7 @@ ulam_push *ulam_push_free(ulam_push *w)
 }
 
 /* A workspace for pushes on the square matrix M (borrowed until freed). */
-int ulam_push_alloc(const ulam_csr *M, ulam_push **out)
+int ulam__push_alloc(const ulam_csr *M, ulam_push **out)
 {
     if (!M || !out) return ULAM_EINVAL;
     *out = NULL;
@@ -57,7 +57,7 @@ int ulam_push_alloc(const ulam_csr *M, ulam_push **out)
     w->mark = ulam__calloc(n, 1);
     w->queue = ulam__malloc(n, sizeof *w->queue);
     if (!w->p || !w->r || !w->touched || !w->mark || !w->queue) {
-        ulam_push_free(w);
+        ulam__push_free(w);
         return ULAM_ENOMEM;
     }
     *out = w;
@@ -81,7 +81,7 @@ static void enqueue(ulam_push *w, int64_t j)
 }
 
 /* Start over for target t: p = 0, r = e_t. */
-int ulam_push_start(ulam_push *w, int64_t target)
+int ulam__push_start(ulam_push *w, int64_t target)
 {
     if (!w || target < 0 || target >= w->n) return ULAM_EINVAL;
     for (int64_t q = 0; q < w->ntouched; q++) {
@@ -102,7 +102,7 @@ int ulam_push_start(ulam_push *w, int64_t target)
 /* Push until every |r_j| <= rmax.  ULAM_OK; ULAM_EINVAL for rmax <= 0 (or not started);
  * ULAM_ENOCONV once ops exceeds max_ops (> 0), with the invariant intact (the pushes so far
  * are whole) and the queue kept, so a later call goes on from there. */
-int ulam_push_run(ulam_push *w, double rmax, int64_t max_ops)
+int ulam__push_run(ulam_push *w, double rmax, int64_t max_ops)
 {
     if (!w || w->target < 0 || !(rmax > 0) || !isfinite(rmax) || max_ops < 0) return ULAM_EINVAL;
     double t0 = ulam_now();
@@ -137,19 +137,19 @@ int ulam_push_run(ulam_push *w, double rmax, int64_t max_ops)
 }
 
 /* The estimates p (dense, n entries). */
-const double *ulam_push_estimates(const ulam_push *w)
+const double *ulam__push_estimates(const ulam_push *w)
 {
     return w ? w->p : NULL;
 }
 
 /* The residuals r (dense, n entries). */
-const double *ulam_push_residuals(const ulam_push *w)
+const double *ulam__push_residuals(const ulam_push *w)
 {
     return w ? w->r : NULL;
 }
 
 /* What the pushes since the last start did. */
-void ulam_push_report(const ulam_push *w, ulam_push_info *info)
+void ulam__push_report(const ulam_push *w, ulam_push_info *info)
 {
     *info = (ulam_push_info){.target = -1};
     if (!w) return;
@@ -173,7 +173,7 @@ const ulam_csr *ulam__push_matrix(const ulam_push *w)
     return w->M;
 }
 
-/* A count that changes whenever the workspace's state does (ulam_push_start, ulam_push_run). */
+/* A count that changes whenever the workspace's state does (ulam__push_start, ulam__push_run). */
 uint64_t ulam__push_stamp(const ulam_push *w)
 {
     return w->stamp;

@@ -8,14 +8,35 @@
 /* The matrix a workspace pushes on. */
 const ulam_csr *ulam__push_matrix(const ulam_push *w);
 
-/* A count that changes whenever the workspace's state changes (ulam_push_start, ulam_push_run):
+/* A count that changes whenever the workspace's state changes (ulam__push_start, ulam__push_run):
  * a plan that recorded it describes the push in place while it is unchanged. */
 uint64_t ulam__push_stamp(const ulam_push *w);
 
 /* What a caller keeps with the workspace for the workspace's lifetime (src/bidir.c keeps the
- * plan memo of ulam_bidir_plan and ulam_bidir_solve there): push.c neither reads it nor knows its
- * type, and frees it with drop(data) in ulam_push_free.  Set once; NULL until set. */
+ * plan memo of ulam__bidir_plan and ulam__bidir_solve there): push.c neither reads it nor knows its
+ * type, and frees it with drop(data) in ulam__push_free.  Set once; NULL until set. */
 void *ulam__push_kept(const ulam_push *w);
 void ulam__push_keep(ulam_push *w, void *data, void (*drop)(void *));
+
+/* A workspace for pushes on the square matrix M, which is borrowed until the workspace is freed. */
+int ulam__push_alloc(const ulam_csr *M, ulam_push **out);
+
+/* Free a workspace; accepts and returns NULL. */
+ulam_push *ulam__push_free(ulam_push *w);
+
+/* Start over for target t (0-based): p = 0, r = e_t; ULAM_EINVAL when t is out of range. */
+int ulam__push_start(ulam_push *w, int64_t target);
+
+/* Push every state with |r_j| > rmax until none is left (FIFO order); ULAM_EINVAL for rmax <= 0 or
+ * no start; ULAM_ENOCONV when the work passes max_ops (> 0; 0 is no cap), the invariant intact. */
+int ulam__push_run(ulam_push *w, double rmax, int64_t max_ops);
+
+/* The dense estimates p and residuals r (n entries each, owned by the workspace). */
+const double *ulam__push_estimates(const ulam_push *w);
+
+const double *ulam__push_residuals(const ulam_push *w);
+
+/* Fill *info about the pushes since the last start. */
+void ulam__push_report(const ulam_push *w, ulam_push_info *info);
 
 #endif

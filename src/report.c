@@ -165,7 +165,7 @@ static void choice_text(FILE *f, const ulam_choice *ch, int bidir, int verbose)
         else
             fprintf(f, "pilots %lld walks  variance %-9.4g (+-%.0f%%) %.3g steps/walk  predicted %s%.4g walks, %.3g units "
                    "(%.2g s)%s\n", (long long)c->pilot_walks, c->variance, 100 * fmin(c->variance_rel_error, 99.99),
-                   c->steps_per_walk, ulam_auto_lower_bound(res, k, 0.0) ? ">= " : "", c->predicted_walks,
+                   c->steps_per_walk, c->predicted_lower ? ">= " : "", c->predicted_walks,
                    c->predicted_work, c->predicted_seconds,
                    c->state == ULAM_AUTO_DROPPED ? "  dropped" : "");
     }
@@ -212,7 +212,7 @@ static void choice_json(FILE *f, const ulam_choice *ch, int bidir)
         ulam_json_number(f, "work_per_walk", c->pilot_walks ? c->work_per_walk : NAN, 0);
         ulam_json_number(f, "cost", c->cost, 0);
         ulam_json_number(f, "predicted_walks", c->predicted_walks, 0);
-        fprintf(f, "\"predicted_is\": \"%s\", ", ulam_auto_lower_bound(res, k, 0.0) ? "lower bound" : "estimate");
+        fprintf(f, "\"predicted_is\": \"%s\", ", c->predicted_lower ? "lower bound" : "estimate");
         ulam_json_number(f, "predicted_work", c->predicted_work, 0);
         ulam_json_number(f, "predicted_seconds", c->predicted_seconds, 1);
         fprintf(f, "}");

@@ -52,7 +52,7 @@ static uint64_t mix64(uint64_t z)
 }
 
 /* Uniform double in [0, 1) keyed by (seed, w, t, k): the mix chained over the key's words. */
-double ulam_rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k)
+double ulam__rng_counter(uint64_t seed, uint64_t w, uint64_t t, unsigned k)
 {
     uint64_t h = mix64(seed + 0x9e3779b97f4a7c15ULL);
     h = mix64(h ^ (w + 0x632be59bd9b4e019ULL));

@@ -12,7 +12,7 @@
 enum { TEAM_BLOCKS = 4 }; /* blocks a thread a round must have before a round takes a team */
 
 /* The stopping defaults: 10^5 walks, 10^6 steps a walk. */
-ulam_stop_opts ulam_stop_defaults(void)
+ulam_stop_opts ulam__stop_defaults(void)
 {
     return (ulam_stop_opts){.max_walks = 100000, .max_steps = 1000000};
 }
@@ -221,7 +221,7 @@ int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err)
 ulam_walk_opts ulam__lift_default_cap(const ulam_walk_opts *o)
 {
     ulam_walk_opts w = *o;
-    if (w.stop.rel_err > 0 && w.stop.max_walks == ulam_stop_defaults().max_walks && !(w.stop.max_seconds > 0))
+    if (w.stop.rel_err > 0 && w.stop.max_walks == ulam__stop_defaults().max_walks && !(w.stop.max_seconds > 0))
         w.stop.max_walks = 0;
     return w;
 }

@@ -81,12 +81,18 @@ int ulam__mine(const ulam_share *sh, int64_t q);
 int ulam__budgets_check(const ulam_walk_opts *o, ulam_error *err);
 
 /* Options as ulam_solve and ulam_solve_walks take them: a rel_err target with max_walks left at
- * ulam_stop_defaults()'s (and no time limit) runs to the target, as the command line's --rel-err
+ * ulam__stop_defaults()'s (and no time limit) runs to the target, as the command line's --rel-err
  * does (max_walks 0: the cap ULAM_REL_ERR_CAP); others unchanged. */
 ulam_walk_opts ulam__lift_default_cap(const ulam_walk_opts *o);
 
 /* The walk cap of a run whose only stopping rule is rel_err: ULAM_REL_ERR_CAP (a target out of
  * reach still ends), else o->stop.max_walks. */
 int64_t ulam__walk_cap(const ulam_walk_opts *o);
+
+/* The defaults: 10^5 walks, walk cap 10^6 steps, every other rule off.  The 10^5 walks are the
+ * budget of a run with no other rule: ulam_solve and ulam_solve_walks given a rel_err target with
+ * max_walks left at this default (and no max_seconds) run to the target, capped at
+ * ULAM_REL_ERR_CAP, as the command line's --rel-err does; another max_walks caps the target. */
+ulam_stop_opts ulam__stop_defaults(void);
 
 #endif /* ULAM_ROUND_H */

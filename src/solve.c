@@ -133,31 +133,31 @@ struct ulam_solver {
 /* The defaults. */
 ulam_walk_opts ulam_walk_defaults(void)
 {
-    return (ulam_walk_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_COLLISION, .kernel = ulam_kernel_defaults(),
-                            .stop = ulam_stop_defaults(), .exec = ulam_exec_defaults(),
-                            .query = ulam_query_defaults(), .policy = ulam_policy_defaults()};
+    return (ulam_walk_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_COLLISION, .kernel = ulam__kernel_defaults(),
+                            .stop = ulam__stop_defaults(), .exec = ulam__exec_defaults(),
+                            .query = ulam__query_defaults(), .policy = ulam__policy_defaults()};
 }
 
 /* The kernel's defaults: analog, exponent 1, rows built as reached, no window. */
-ulam_kernel_opts ulam_kernel_defaults(void)
+ulam_kernel_opts ulam__kernel_defaults(void)
 {
     return (ulam_kernel_opts){.kernel_alpha = 1.0};
 }
 
 /* The execution defaults: seed 1, all cores, one process. */
-ulam_exec_opts ulam_exec_defaults(void)
+ulam_exec_opts ulam__exec_defaults(void)
 {
     return (ulam_exec_opts){.seed = 1};
 }
 
 /* The query defaults: x_0. */
-ulam_query_opts ulam_query_defaults(void)
+ulam_query_opts ulam__query_defaults(void)
 {
     return (ulam_query_opts){.index = 0};
 }
 
 /* The policy defaults: refuse the uncertified, compute the guards. */
-ulam_policy_opts ulam_policy_defaults(void)
+ulam_policy_opts ulam__policy_defaults(void)
 {
     return (ulam_policy_opts){.force = 0};
 }
@@ -1146,17 +1146,6 @@ int ulam_solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts *
                       ulam_solver **out, ulam_error *err)
 {
     return solver_alloc(M, b, opts, NULL, NULL, INFINITY, 0, out, err);
-}
-
-/* As ulam_solver_alloc with b's length checked. */
-int ulam_solver_alloc_n(const ulam_csr *M, const double *b, int64_t nb, const ulam_walk_opts *opts,
-                        ulam_solver **out, ulam_error *err)
-{
-    ulam__clear(err);
-    if (out) *out = NULL;
-    if (!M) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a matrix, b and an output");
-    int status = ulam__length_check(b, nb, M->nrows, "b", err);
-    return status ? status : ulam_solver_alloc(M, b, opts, out, err);
 }
 
 /* As ulam_solver_alloc with the reachable states and a kept kernel (both borrowed). */

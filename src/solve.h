@@ -122,4 +122,16 @@ enum { ULAM__COMPLETE = 4 };
  * The status (src/solve.c: the rest of ulam_solve_walks). */
 int ulam__solver_finish(ulam_solver *s, ulam_walk_result *result, ulam_error *err);
 
+/* The defaults: analog continuation, exponent 1, rows built as reached, no weight window. */
+ulam_kernel_opts ulam__kernel_defaults(void);
+
+/* The defaults: seed 1, all cores, one process. */
+ulam_exec_opts ulam__exec_defaults(void);
+
+/* The defaults: x_0, walks starting there. */
+ulam_query_opts ulam__query_defaults(void);
+
+/* The defaults: refuse what is not certified, compute the guards, no prepared system. */
+ulam_policy_opts ulam__policy_defaults(void);
+
 #endif

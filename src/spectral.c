@@ -194,7 +194,7 @@ static int extract(arpack_ws *w, a_int *iparam, a_int *ipntr, double tol,
 }
 
 /* Spectral radius of a linear operator. */
-int ulam_spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double *x, double *y),
+int ulam__spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double *x, double *y),
                             const void *ctx, int positive_start, const ulam_spectral_opts *opts,
                             ulam_radius *out)
 {
@@ -240,7 +240,7 @@ int ulam_spectral_radius(const ulam_csr *A, int use_abs, const ulam_spectral_opt
     int bad = ulam__csr_check_structure(A, NULL); /* src/check.c */
     if (bad) return bad;
     csr_op_ctx ctx = {A, use_abs};
-    return ulam_spectral_radius_op(A->nrows, csr_op, &ctx, use_abs, opts, out);
+    return ulam__spectral_radius_op(A->nrows, csr_op, &ctx, use_abs, opts, out);
 }
 
 /* ---- power iteration on nonnegative operators, with Collatz-Wielandt bounds (the guards' radii) */

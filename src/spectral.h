@@ -22,4 +22,9 @@ int ulam__power_from(const ulam_csr *A, const double *left, const double *right,
 int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, double *u, double *kappa,
                              int64_t *matvecs);
 
+/* Spectral radius of a linear operator given as y = op(ctx, x), n x n. */
+int ulam__spectral_radius_op(int64_t n, void (*op)(const void *ctx, const double *x, double *y),
+                            const void *ctx, int positive_start, const ulam_spectral_opts *opts,
+                            ulam_radius *out);
+
 #endif

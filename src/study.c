@@ -2,12 +2,20 @@
  * each of the study's method names means as walk options) and the exact value a study scores
  * against (LAPACK, or Gauss-Seidel run until x_I settles); and the study itself (ulam_study_*):
  * every method at every budget, repeats runs each, scored against that value. */
-#include "internal.h"
+#include "study.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* The current iterate of outer iteration s (owned by it). */
+static const double *outer_x(const ulam_outer *s)
+{
+    ulam_outer_info info;
+    ulam_outer_get_info(s, &info);
+    return info.x;
+}
 
 /* The grid, k = 9 mode + 3 estimator + window. */
 static const ulam_study_method methods[ULAM_STUDY_METHODS] = {
@@ -46,7 +54,7 @@ int ulam_study_method_find(const char *name)
 }
 
 /* Set o's mode, estimator and weight window for method k on b. */
-int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o)
+int ulam__study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o)
 {
     const ulam_study_method *m = ulam_study_method_get(k);
     if (!m || !o || (m->mode == ULAM_FORWARD && (!b || n < 0))) return ULAM_EINVAL;
@@ -60,7 +68,7 @@ int ulam_study_method_opts(int k, const double *b, int64_t n, ulam_walk_opts *o)
 }
 
 /* The exact x_index a study scores against. */
-int ulam_study_reference(const ulam_csr *M, const double *b, int64_t index, ulam_study_ref *ref, ulam_error *err)
+int ulam__study_reference(const ulam_csr *M, const double *b, int64_t index, ulam_study_ref *ref, ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !b || !ref || M->nrows != M->ncols || index < 0 || index >= M->nrows)
@@ -69,7 +77,7 @@ int ulam_study_reference(const ulam_csr *M, const double *b, int64_t index, ulam
     double *x = ulam__calloc((size_t)n, sizeof *x), *xd = NULL;
     if (!x) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the reference solve");
     *ref = (ulam_study_ref){0};
-    ref->sweeps = ulam_gauss_seidel_settle(M, b, x, index, 1e-16, 12, 100000);
+    ref->sweeps = ulam__gauss_seidel_settle(M, b, x, index, 1e-16, 12, 100000);
     ref->exact = ref->settled = x[index];
     ulam_direct_info info;
     if (n <= ULAM_STUDY_DIRECT_MAX && (xd = ulam__malloc((size_t)n, sizeof *xd)) &&
@@ -148,7 +156,7 @@ static void screen(ulam_study *s)
         } else {
             ulam_walk_opts o = ulam_walk_defaults();
             ulam_error err;
-            ulam_study_method_opts(k, s->b, s->M->nrows, &o);
+            ulam__study_method_opts(k, s->b, s->M->nrows, &o);
             o.kernel.roulette = o.kernel.split = 0, o.query.index = s->index, o.stop.max_walks = 1; /* unwindowed */
             o.policy.guard = g;
             ulam_solver *sv = NULL;
@@ -182,7 +190,7 @@ int ulam_study_alloc(const ulam_csr *M, const double *b, int64_t index, const ul
     for (int k = 0; k < ULAM_STUDY_METHODS; k++) s->screen[k].on = !p->methods;
     for (int k = 0; p->methods && k < p->nmethods; k++) s->screen[p->methods[k]].on = 1;
     int status = ulam_guard_check(M, 0.0, NULL, &s->g, err);
-    if (!status) status = ulam_study_reference(M, b, index, &s->ref, err);
+    if (!status) status = ulam__study_reference(M, b, index, &s->ref, err);
     if (status) {
         ulam_study_free(s);
         return status;
@@ -272,7 +280,7 @@ int ulam_study_iterate(ulam_study *s, ulam_study_run *run, ulam_error *err)
     int m, b, r;
     if (!s || !run || !next(s, &m, &b, &r)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a study with runs left");
     ulam_walk_opts o = ulam_walk_defaults();
-    ulam_study_method_opts(m, s->b, s->M->nrows, &o);
+    ulam__study_method_opts(m, s->b, s->M->nrows, &o);
     o.query.index = s->index, o.exec.threads = s->p.threads, o.exec.seed = run_seed(s, m, b, r);
     o.stop.interrupt = s->p.interrupt, o.exec.share = s->p.share, o.policy.guard = &s->g, o.policy.force = 1;
     if (s->p.time_budgets) o.stop.max_walks = 0, o.stop.max_seconds = s->budget[b];
@@ -421,7 +429,7 @@ static void outer_lines(const ulam_study *s, double reference_time,
             ulam_outer_step step;
             ulam_outer_iterate(it, &step);
             t += step.seconds;
-            fn(m == ULAM_MCSA ? "mcsa" : "sequential", t, fabs(ulam_outer_x(it)[s->index] - s->ref.exact), arg);
+            fn(m == ULAM_MCSA ? "mcsa" : "sequential", t, fabs(outer_x(it)[s->index] - s->ref.exact), arg);
         }
         ulam_outer_free(it);
     }
@@ -441,7 +449,7 @@ int ulam_study_reference_lines(const ulam_study *s, double reference_time,
     double t = 0;
     for (int k = 1; k <= 100000; k++) {
         double t0 = ulam_now();
-        ulam_gauss_seidel_sweep(s->M, s->b, x);
+        ulam__gauss_seidel_sweep(s->M, s->b, x);
         t += ulam_now() - t0;
         double e = fabs(x[I] - exact);
         if ((k & (k - 1)) == 0 || e <= 1e-9 * fabs(exact)) fn("gs", t, e, arg);

@@ -1,4 +1,4 @@
-/* --method auto's choice (ulam_auto_choose, ulam_auto_solver): screening by certified guards, pins,
+/* --method auto's choice (ulam_auto_solver, ulam_auto_solver): screening by certified guards, pins,
  * deterministic racing, and an unbiased estimate from fresh walks with the chosen method on the
  * pilots' solver. */
 #include "systems.h"
@@ -137,7 +137,7 @@ static void test_pins(void **state)
     ulam_auto_opts ao = ulam_auto_defaults();
     ao.pin_mode = ao.pin_continue = 1;
     ulam_auto_result res;
-    assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_OK);
+    assert_int_equal(ulam_auto_solver(M, b, &o, &ao, &res, NULL, NULL), ULAM_OK);
     assert_int_equal(res.ncand, 9);
     for (int c = 0; c < 9; c++) assert_true(res.cand[c].mode == ULAM_FORWARD && res.cand[c].continue_q == 0.5);
     ao.pin_estimator = ao.pin_alpha = 1;
@@ -155,12 +155,12 @@ static void test_pins(void **state)
         assert_true(same_result(&r, &plain) && (k ? r.rel_err_met : r.walks == 3000));
     }
     ao.continue_q = 1.0;
-    assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_EINVAL);
+    assert_int_equal(ulam_auto_solver(M, b, &o, &ao, &res, NULL, NULL), ULAM_EINVAL);
     ao = ulam_auto_defaults();
     ao.pilot_max = ao.pilot_walks - 1;
-    assert_int_equal(ulam_auto_choose(M, b, &o, &ao, &res, NULL), ULAM_EINVAL);
+    assert_int_equal(ulam_auto_solver(M, b, &o, &ao, &res, NULL, NULL), ULAM_EINVAL);
     o.query.index = M->nrows;
-    assert_int_equal(ulam_auto_choose(M, b, &o, NULL, &res, NULL), ULAM_EINVAL);
+    assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, NULL, NULL), ULAM_EINVAL);
     free(b);
     ulam_csr_free(M);
 }
@@ -330,7 +330,7 @@ static void cli_json(const char *args, char *out, size_t len)
     assert_int_equal(pclose(f), 0);
 }
 
-/* ulam_solve with the defaults is `ulam solve`: on the same seed the same row, the same walk
+/* ulam_analysis_solve with the defaults is `ulam solve`: on the same seed the same row, the same walk
  * candidate (mode, estimator) and the same estimate and standard error, bit for bit (JSON's %.17g
  * reads back exactly): the walks on chain4 at the default budget, bidirectional on randsub1000's
  * x_7 for a 3-nonzero b at --rel-err 0.02; a walk option set away from its default is pinned as
@@ -363,7 +363,7 @@ static void test_solve_is_cli(void **state)
         if (cases[t].rel_err > 0) o.stop.rel_err = cases[t].rel_err, o.stop.max_walks = 0; /* as the CLI: no --walks */
         if (cases[t].estimator >= 0) o.estimator = cases[t].estimator;
         ulam_walk_result r;
-        assert_int_equal(ulam_solve(M, b, &o, &r, NULL), ULAM_OK);
+        assert_int_equal(solve_default(M, b, &o, &r, NULL), ULAM_OK);
         char args[512];
         snprintf(args, sizeof args, "%s --rhs %s %s --threads 2", cases[t].M, cases[t].b, cases[t].args);
         cli_json(args, json, 1 << 16);
@@ -372,7 +372,7 @@ static void test_solve_is_cli(void **state)
         assert_memory_equal(method + 1, cases[t].method, strlen(cases[t].method));
         assert_true(strtod(est, NULL) == r.estimate);
         assert_true(strtod(se, NULL) == r.std_error);
-        /* the row and the walk candidate ulam_solve ran: ulam_auto's (the same estimate) */
+        /* the row and the walk candidate it ran: ulam_auto's (the same estimate) */
         ulam_auto_opts ao = ulam_auto_defaults();
         ao.pin_estimator = cases[t].estimator >= 0;
         assert_int_equal(ulam_auto(M, b, &o, &ao, NULL, ch, a, NULL), ULAM_OK);
@@ -429,7 +429,7 @@ static ulam_csr *cancellation(uint64_t seed, double **bp)
  * score whose variance is ~1 to 100 has a mean of noise alone where |x_0| = 1e-3, so var / (E m)^2
  * at that mean predicted 1.5e4 walks where the rule needs ~1e8-1e9.  Now the prediction of a
  * candidate whose pilot does not resolve |x| (|mean| < 4 standard errors) is a lower bound, made
- * at the largest |x| the pilots allow, and says so (ulam_auto_lower_bound): at seeds 1..3 the
+ * at the largest |x| the pilots allow, and says so (ulam_auto_candidate.predicted_lower): at seeds 1..3 the
  * chosen candidate's prediction is flagged and at most the walks its own variance asks at the
  * exact x, var / (E x)^2 (var: the run's, on a budget of 2^16 walks); the run stops, not met.  Beside it a system the pilots
  * resolve (the same pattern of one sign, b_i = 0.5 + U(0, 1), x ~ 10, E = 0.01): not flagged, and the run meets
@@ -459,7 +459,7 @@ static void test_prediction_bound(void **state)
             assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, &sv, NULL), ULAM_OK);
             ulam_walk_result r;
             assert_int_equal(walk_out(sv, &r), ULAM_OK);
-            int k = res.chosen, bound = ulam_auto_lower_bound(&res, k, 0.0);
+            int k = res.chosen, bound = res.cand[k].predicted_lower;
             double need = r.variance / (E * x0 * E * x0), pred = res.cand[k].predicted_walks;
             print_message("%s seed %d: x_0 = %.4g, chose %s %s, predicted %s%.4g walks; the run %s after %lld walks, "
                           "var / (E x)^2 = %.4g\n", sys ? "one-signed" : "cancellation", s + 1, x0,
@@ -704,7 +704,7 @@ static void test_time_budget(void **state)
         o.query.index = (8 * 16 + 8) * 16 + 8, o.stop.max_walks = 0, o.stop.max_seconds = S[t];
         ulam_auto_result res;
         ulam_error err;
-        assert_int_equal(ulam_auto_choose(M, b, &o, NULL, &res, &err), ULAM_OK);
+        assert_int_equal(ulam_auto_solver(M, b, &o, NULL, &res, NULL, &err), ULAM_OK);
         assert_true(res.chosen >= 0);
         pilot_work[t] = res.pilot_work, kernels[t] = kernels_piloted(&res);
         print_message("--time %g: %d kernels piloted, %.3g units\n", S[t], kernels[t], pilot_work[t]);

@@ -594,23 +594,6 @@ static void test_dist_radius_halo(void **state)
     unlink(path);
 }
 
-/* Counter-based numbers: keyed by (seed, walk, step, k), in [0, 1), and not all alike. */
-static void test_dist_counter(void **state)
-{
-    (void)state;
-    assert_true(ulam_rng_counter(1, 2, 3, 0) == ulam_rng_counter(1, 2, 3, 0));
-    double s = 0, s2 = 0;
-    int N = 100000;
-    for (int i = 0; i < N; i++) {
-        double u = ulam_rng_counter(5, (uint64_t)i / 10, (uint64_t)i % 10, (unsigned)i % 3);
-        assert_true(u >= 0 && u < 1);
-        s += u, s2 += u * u;
-    }
-    double mean = s / N, var = s2 / N - mean * mean;
-    assert_true(fabs(mean - 0.5) < 4 * sqrt(1.0 / 12 / N)); /* 4 standard errors */
-    assert_true(fabs(var - 1.0 / 12) < 0.002);
-}
-
 /* Matrix Market by byte ranges (ulam_part_open_mtx): a file with rows out of order, duplicates
  * split over two lines, a comment, a blank line and an explicit zero gives, at 1, 2, 3 and 5 ranks
  * and in 2 sets of 2, the forward answer of the prepared file written from the same matrix bit for
@@ -690,7 +673,6 @@ static void test_dist_mtx(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_dist_counter),
         cmocka_unit_test(test_dist_adjoint_identical),
         cmocka_unit_test(test_dist_forward_identical),
         cmocka_unit_test(test_dist_damaged),

@@ -169,7 +169,7 @@ static void test_gzip(void **state)
     assert_non_null(f);
     ulam_csr *B = NULL;
     ulam_error err;
-    assert_int_equal(ulam_mm_read_matrix_file(f, "dag5.mtx.gz", &B, &err), ULAM_EUNSUPPORTED);
+    assert_int_equal(ulam_mm_read_matrix_opts(f, "dag5.mtx.gz", NULL, &B, &err), ULAM_EUNSUPPORTED);
     assert_non_null(strstr(err.msg, "gzip"));
     fclose(f);
     ulam_csr_free(A), ulam_csr_free(Z);
@@ -272,7 +272,7 @@ static void test_read_from_stream(void **state)
     FILE *f = fmemopen(text, sizeof text - 1, "r");
     assert_non_null(f);
     ulam_csr *A = NULL;
-    assert_int_equal(ulam_mm_read_matrix_file(f, "mem", &A, NULL), ULAM_OK);
+    assert_int_equal(ulam_mm_read_matrix_opts(f, "mem", NULL, &A, NULL), ULAM_OK);
     fclose(f);
     assert_close(csr_get(A, 0, 1), 0.5, 0);
     assert_close(csr_get(A, 1, 0), 0.25, 0);

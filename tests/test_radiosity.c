@@ -169,13 +169,13 @@ static void check_all_modes(const exact_scene *e, int64_t walks, uint64_t seed)
 }
 
 /* ulam_rad_defaults: gathering at patch 0 by next-event estimation, the stopping and execution
- * parts their own defaults functions' (radiosity carries no matrix-walk field). */
+ * parts the walks' defaults (ulam_walk_defaults) (radiosity carries no matrix-walk field). */
 static void test_rad_defaults(void **state)
 {
     (void)state;
     ulam_rad_opts o = ulam_rad_defaults();
-    ulam_stop_opts st = ulam_stop_defaults();
-    ulam_exec_opts e = ulam_exec_defaults();
+    ulam_stop_opts st = ulam_walk_defaults().stop;
+    ulam_exec_opts e = ulam_walk_defaults().exec;
     assert_int_equal(o.mode, ULAM_ADJOINT);
     assert_int_equal(o.estimator, ULAM_RAD_NEXT_EVENT);
     assert_int_equal(o.index, 0);

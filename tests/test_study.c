@@ -2,6 +2,7 @@
  * estimate honest against LAPACK, the same seed gives the same runs (whatever the repeats), a
  * restored study needs no run, refused and interrupted runs, and bad parameters. */
 #include "testutil.h"
+#include "ulam_study.h"
 
 #include <string.h>
 

@@ -77,7 +77,7 @@ static void test_two_solvers(void **state)
     const ulam_csr *M = ulam_system_matrix(sys);
     const double *mb = ulam_system_rhs(sys, NULL);
     ulam_guard g;
-    assert_int_equal(ulam_certificate_guard(ulam_system_certificate(sys), 0.0, NULL, &g), ULAM_OK);
+    assert_int_equal(ulam_certificate_guard(system_cert(sys), 0.0, NULL, &g), ULAM_OK);
     job jobs[4];
     for (int k = 0; k < 4; k++) {
         jobs[k] = (job){.M = M, .b = mb, .o = ulam_walk_defaults()};

@@ -220,6 +220,33 @@ static inline ulam_walk_result test_sys_run(const test_sys *s, ulam_walk_opts o)
     return r;
 }
 
+/* The certificate a prepared system stores (NULL: none). */
+static inline const ulam_certificate *system_cert(const ulam_system *s)
+{
+    ulam_system_info si;
+    ulam_system_get_info(s, &si);
+    return si.cert;
+}
+
+/* The primary call as `ulam solve` makes it on a Matrix Market file: a fresh analysis of M with
+ * its defaults, ulam_analysis_solve with no pins but o's; *r gets the walks' result with the
+ * whole answer's estimate, std_error and ci95 (bidirectional: its walks on <r, x>). */
+static inline int solve_default(const ulam_csr *M, const double *b, const ulam_walk_opts *o, ulam_walk_result *r,
+                                ulam_error *err)
+{
+    ulam_analysis *a = NULL;
+    ulam_answer *ans = calloc(1, sizeof *ans);
+    int status = ans ? ulam_analysis_alloc(M, NULL, &a, err) : ULAM_ENOMEM;
+    if (!status) status = ulam_analysis_solve(a, b, o, NULL, NULL, NULL, ans, err);
+    if (ans && (!status || ans->method >= 0)) {
+        *r = ans->walks;
+        r->estimate = ans->estimate, r->std_error = ans->std_error, r->ci95[0] = ans->ci95[0], r->ci95[1] = ans->ci95[1];
+    }
+    ulam_analysis_free(a);
+    free(ans);
+    return status;
+}
+
 /* A nonnegative n x n matrix whose Perron root is exactly rho but whose row and column sums
  * vary (so no one-pass bound is tight) and whose spectral gap is ~1/n^2 (so power iteration
  * converges slowly): rho / cos(pi / (n + 1)) D^-1 T D, T the path graph's tridiagonal (1/2

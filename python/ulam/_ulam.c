@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "ulam.h"
+#include "ulam_study.h"
 
 /* The interrupt flag of the query running in the main thread (the SIGINT handler's only way in). */
 static volatile int *sigint_flag;
@@ -92,12 +93,14 @@ static int System_init(SystemObject *self, PyObject *args, PyObject *kw)
 }
 
 /* The reusable analysis a query of this system takes instead of its own passes over M: the
- * library's analysis object (ulam_analysis_auto_start races the walks on its bounds over every
+ * library's analysis object (ulam_analysis_start races the walks on its bounds over every
  * state) and the guards of the analog kernel at exponent 1 (ulam_auto_opts.guard). */
 static int system_analysis(SystemObject *self, ulam_auto_opts *ao, ulam_error *err)
 {
     if (!self->an) {
-        int status = ulam_analysis_alloc(&self->M, NULL, &self->an, err);
+        ulam_analysis_opts ao = ulam_analysis_defaults();
+        ao.shared_bounds = 1; /* one pass over M for every query's walks */
+        int status = ulam_analysis_alloc(&self->M, &ao, &self->an, err);
         if (status) return status;
     }
     if (!self->have_guard) {
@@ -374,7 +377,7 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
     if (catch) catch_sigint(&flag, &old);
     if (!status) {
         Py_BEGIN_ALLOW_THREADS
-        status = reuse ? ulam_analysis_auto_start(self->an, b, &o, &ao, &mo, ch, &run, &err)
+        status = reuse ? ulam_analysis_start(self->an, b, &o, &ao, &mo, ch, &run, &err)
                        : ulam_auto_start(&self->M, b, &o, &ao, &mo, ch, &run, &err);
         Py_END_ALLOW_THREADS
         started = 1;

@@ -17,7 +17,7 @@ int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, c
     ulam_method_opts mo = ulam_method_defaults();
     if (excluded_why) mo.exclude |= 1u << ULAM_METHOD_BIDIRECTIONAL;
     ch->walks.chosen = ch->walks.closest = -1;
-    *status = an ? ulam_analysis_auto_start(an, s->b, o, ao, &mo, ch, run, err)
+    *status = an ? ulam_analysis_start(an, s->b, o, ao, &mo, ch, run, err)
                  : ulam_auto_start(s->M, s->b, o, ao, &mo, ch, run, err);
     ulam_method_verdict *v = &ch->method[ULAM_METHOD_BIDIRECTIONAL];
     if (excluded_why && v->state == ULAM_METHOD_NOT_CONSIDERED && !strcmp(v->why, "not considered: excluded"))

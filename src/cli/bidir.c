@@ -601,7 +601,7 @@ int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int 
     report rp = {.json = json, .check = check, .load_seconds = load_seconds, .transpose_seconds = ch->transpose_seconds,
                  .ch = ch};
     for (int64_t i = 0; i < s->M->nrows; i++) rp.bmax = fmax(rp.bmax, fabs(s->b[i]));
-    rp.dense = route; /* ulam_method_bidir_route: the push on b */
+    rp.dense = route; /* ulam__method_bidir_route: the push on b */
     int rc = 0;
     if (!rp.dense) { /* the dense route's walks run on M under the walks' own guards */
         if ((rc = cli_guard(s, ch->bidir_opts.walk.kernel.continue_q, 1.0, ULAM_FORWARD, &rp.g))) return rc;

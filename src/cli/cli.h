@@ -367,7 +367,7 @@ int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int js
 
 /* solve --method auto (src/cli/auto.c): choose the method for the loaded s under o (what ao pins
  * stays; ao->exclude: rows the command line rules out, their reason excluded_why) through the
- * library's table (ulam_auto_start; an: ulam_analysis_auto_start, the walks on its bounds), make
+ * library's table (ulam_auto_start; an: ulam_analysis_start, the walks on its bounds), make
  * the run *run and set o to the walks' choice; *status and err get the refusal.  0 or an exit
  * code.  The report prints the candidates (ulam_choice_fprint). */
 int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, const ulam_auto_opts *ao,

@@ -155,9 +155,10 @@ static void on_bus(int sig, siginfo_t *si, void *ctx)
 /* Remember (on 1) or forget (on 0) the mapping of s, read from path, for on_bus. */
 void cli_map_register(const ulam_system *s, const char *path, int on)
 {
-    const void *addr;
-    size_t bytes;
-    ulam_system_mapping(s, &addr, &bytes);
+    ulam_system_info si;
+    ulam_system_get_info(s, &si);
+    const void *addr = si.map;
+    size_t bytes = si.map_bytes;
     if (!addr) return;
     for (int k = 0; k < CLI_MAPS; k++)
         if (on ? !cli_maps[k].path : cli_maps[k].addr == addr) {
@@ -587,7 +588,9 @@ int cli_load_system(cli_system *s)
     const double *mapped_b = NULL;
     ulam_system_lazy(s->sys_M, &mapped, &mapped_b); /* verified below, or as walks read it (lazy) */
     s->M = s->own_M ? s->own_M : mapped;
-    if (prepared) s->cert = ulam_system_certificate(s->sys_M);
+    ulam_system_info si;
+    ulam_system_get_info(s->sys_M, &si);
+    if (prepared) s->cert = si.cert;
     if (s->M->nrows != s->M->ncols) {
         fprintf(stderr, "ulam: %s: error: %s: expected a square matrix, got %lld x %lld\n",
                 s->matrix_path, ulam_strerror(ULAM_ENOTSQUARE), (long long)s->M->nrows,

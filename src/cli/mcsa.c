@@ -249,12 +249,14 @@ static int run(const cli_system *s, const ulam_outer_opts *o, report *p, ulam_ou
     p->seconds = ulam_now() - t0;
     p->status = status;
     p->iterations = p->nsteps;
-    p->converged = ulam_outer_converged(it);
+    ulam_outer_info oi;
+    ulam_outer_get_info(it, &oi);
+    p->converged = oi.converged;
     p->residual = p->nsteps ? (*steps)[p->nsteps - 1].residual : 1.0;
     ulam_outer_error(it, &p->why);
-    p->rejected = ulam_outer_rejected(it);
+    p->rejected = oi.rejected;
     *x = malloc((size_t)s->M->nrows * sizeof **x);
-    if (*x) memcpy(*x, ulam_outer_x(it), (size_t)s->M->nrows * sizeof **x);
+    if (*x) memcpy(*x, oi.x, (size_t)s->M->nrows * sizeof **x);
     ulam_outer_free(it);
     return *x ? 0 : cli_exit_code(ULAM_ENOMEM);
 }

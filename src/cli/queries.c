@@ -156,6 +156,19 @@ static void print_answer(const query *q, int64_t k, uint64_t seed, double est, d
     fflush(stdout);
 }
 
+/* The walks o names on the analysis' kept kernel, to their end (ulam_analysis_solver): the status,
+ * r filled (as far as they went) and err on failure. */
+static int walks_on(ulam_analysis *an, const double *b, const ulam_walk_opts *o, ulam_walk_result *r, ulam_error *err)
+{
+    ulam_solver *sv = NULL;
+    int status = ulam_analysis_solver(an, b, o, &sv, err);
+    while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
+    if (sv) ulam_solver_result(sv, r);
+    if (status && sv) ulam_solver_error(sv, err);
+    ulam_solver_free(sv);
+    return status;
+}
+
 /* Run query k with options o (its seed and target set); 0, an exit code, or EXIT_INTERRUPTED. */
 static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int json)
 {
@@ -168,7 +181,7 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
     if (q->source < 0) {
         o.query.index = q->index;
         ulam_walk_result r;
-        status = ulam_analysis_solve(w->an, w->s->b, &o, &r, &err);
+        status = walks_on(w->an, w->s->b, &o, &r, &err);
         est = r.estimate, se = r.std_error, ci[0] = r.ci95[0], ci[1] = r.ci95[1], met = r.rel_err_met;
         walks = r.walks, interrupted = r.interrupted;
     } else {

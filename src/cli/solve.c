@@ -503,6 +503,7 @@ static int lazy_analysis(solve_args *a)
     if (!s->lazy || !s->sys_M || a->an) return 0;
     ulam_analysis_opts ao = ulam_analysis_defaults();
     ao.continue_q = a->o.kernel.continue_q, ao.kernel_alpha = a->o.kernel.kernel_alpha, ao.b = s->b, ao.system = s->sys_M;
+    ao.shared_bounds = 1; /* the file's stored bounds: no pass over what each start can reach */
     ulam_error err;
     return ulam_analysis_alloc(s->M, &ao, &a->an, &err) ? cli_report(s->matrix_path, &err) : 0;
 }
@@ -659,7 +660,7 @@ static int run(solve_args *a)
         return cli_exit_code(ULAM_EINVAL);
     }
     if (!sv) { /* auto chose bidirectional: its own report, with the choice */
-        rc = cli_bidir_auto_run(&a->s, rn, &ch, ulam_run_bidir_route(rn) == 1, ro.json, ro.check, ro.load_seconds);
+        rc = cli_bidir_auto_run(&a->s, rn, &ch, ch.bidir_route == 1, ro.json, ro.check, ro.load_seconds);
         ulam_run_free(rn);
         a->an = ulam_analysis_free(a->an);
         cli_system_free(&a->s);

@@ -3,6 +3,7 @@
  * resumes; then summary.csv and charts.  No output file is ever seen half written, and no
  * non-finite number is written: an undefined statistic is an empty field. */
 #include "cli.h"
+#include "ulam_study.h"
 #include "gnuplot.h"
 
 #include <errno.h>

@@ -1,6 +1,7 @@
 /* Form factors: estimated by ray casting, checked by reciprocity, row sums and Howell's exact
  * formulas; the radiosity system M = diag(rho_c) F and its LAPACK solve. */
 #include "rad.h"
+#include "../csr.h"
 #include "../dynload.h"
 #include "../stop.h"
 
@@ -81,7 +82,7 @@ int ulam_ff_report_compute(const ulam_scene *s, const ulam_csr *F, ulam_ff_repor
 {
     if (!s || !F || !r || F->nrows != s->npatches || F->ncols != s->npatches) return ULAM_EINVAL;
     ulam_csr *G = NULL, *Gt = NULL;
-    if (ulam_csr_copy(F, &G)) return ULAM_ENOMEM;
+    if (ulam__csr_copy(F, &G)) return ULAM_ENOMEM;
     memset(r, 0, sizeof *r);
     r->rowsum_min = INFINITY;
     for (int64_t i = 0; i < F->nrows; i++) {

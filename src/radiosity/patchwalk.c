@@ -37,6 +37,7 @@
  * index order: the result does not depend on the number of threads. */
 #include "rad.h"
 #include "../round.h"
+#include "../solve.h"
 
 #include "../stats.h"
 #include "../stop.h"
@@ -339,8 +340,8 @@ static int solver_alloc(const ulam_tracer *t, const ulam_rad_opts *opts, int poi
 /* The radiosity defaults: gather at patch 0 by next-event estimation. */
 ulam_rad_opts ulam_rad_defaults(void)
 {
-    return (ulam_rad_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_RAD_NEXT_EVENT, .stop = ulam_stop_defaults(),
-                           .exec = ulam_exec_defaults()};
+    return (ulam_rad_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_RAD_NEXT_EVENT, .stop = ulam__stop_defaults(),
+                           .exec = ulam__exec_defaults()};
 }
 
 /* Prepare patch walks. */

@@ -41,6 +41,8 @@
  * rank^-0.75, M = 0.85 P'), SOURCES (default 10) random sources with one target each, drawn among
  * the states with 1/n <= pi_t <= 20/n, pi = 0.15 x the personalized PageRank; the same methods.
  * Usage: bench_bidir [L [SOURCES]] (default 20 and 20: n = 1048576, 100 pairs). */
+#include "../../src/bidir.h" /* ulam__bidir_solve on a kept push workspace: the estimator alone */
+#include "../../src/push.h"
 #include "gen.h"
 #include "../zipf_graph.h"
 
@@ -96,7 +98,7 @@ static int query(ulam_push *w, const ulam_csr *Mt, const ulam_guard *g, int64_t 
     o.walk.stop.max_walks = 0, o.walk.stop.rel_err = REL, o.walk.stop.max_seconds = cap, o.walk.exec.threads = 1, o.walk.exec.seed = seed;
     o.walk.stop.max_steps = INT64_MAX / 4;
     ulam_error err;
-    int st = ulam_bidir_solve(w, Mt, &o, res, &err);
+    int st = ulam__bidir_solve(w, Mt, &o, res, &err);
     if (st) fprintf(stderr, "bidir: pair (%lld, %lld): %s: %s\n", (long long)s, (long long)t, ulam_strerror(st), err.msg);
     return st;
 }
@@ -142,13 +144,13 @@ static double walks_alone(const ulam_csr *Mt, const ulam_guard *g, double *e, in
 static double push_alone(ulam_push *w, int64_t s, int64_t t, double exact, int *capped, double *rmax_reached)
 {
     double c0 = cpu_now();
-    ulam_push_start(w, t);
+    ulam__push_start(w, t);
     ulam_push_info pi;
     for (double rmax = 1.0;; rmax /= 2) {
-        ulam_push_run(w, rmax, 0);
-        ulam_push_report(w, &pi);
+        ulam__push_run(w, rmax, 0);
+        ulam__push_report(w, &pi);
         *rmax_reached = rmax;
-        if (fabs(ulam_push_estimates(w)[s] - exact) <= REL * exact || pi.support == 0) {
+        if (fabs(ulam__push_estimates(w)[s] - exact) <= REL * exact || pi.support == 0) {
             *capped = 0;
             return cpu_now() - c0;
         }
@@ -208,7 +210,7 @@ int main(int argc, char **argv)
                (long long)dangling, (long long)maxin, (long long)maxout, ulam_now() - t0);
     t0 = ulam_now();
     ulam_push *w = NULL;
-    if (ulam_csr_transpose(M, &Mt) || ulam_push_alloc(M, &w)) return fprintf(stderr, "bidir: out of memory\n"), 1;
+    if (ulam_csr_transpose(M, &Mt) || ulam__push_alloc(M, &w)) return fprintf(stderr, "bidir: out of memory\n"), 1;
     printf("transpose M' (once, for every query): %.3f s\n", ulam_now() - t0);
     ulam_guard g; /* the walks' guards on M' (adjoint kernel), once for every query of either method */
     ulam_guard_opts go = ulam_guard_defaults();
@@ -286,7 +288,7 @@ int main(int argc, char **argv)
            "pilot and the walk solver's set-up\n", quantile(bi.other, np, 0.5), quantile(bi.other, np, 0.9),
            quantile(bi.walk, np, 0.5), quantile(bi.walk, np, 0.9));
     free(x), free(old), free(b), free(e), free(cand);
-    ulam_push_free(w);
+    ulam__push_free(w);
     ulam_csr_free(M), ulam_csr_free(Mt);
     return 0;
 }

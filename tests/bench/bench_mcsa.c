@@ -22,6 +22,14 @@
 #include "gnuplot.h"
 
 enum { NTOL = 7, STEPS = 100000 };
+/* The current iterate of outer iteration s (owned by it). */
+static const double *outer_x(const ulam_outer *s)
+{
+    ulam_outer_info info;
+    ulam_outer_get_info(s, &info);
+    return info.x;
+}
+
 static const double BUDGET = 120.0; /* seconds of MCSA per random system (checked between iterations) */
 enum { HIST_PER_N = 5 };             /* its history cap an iteration: 5 n */
 
@@ -91,7 +99,7 @@ static int outer(const ulam_csr *M, const double *b, int method, double tol, int
             break;
         }
     }
-    memcpy(x, ulam_outer_x(it), (size_t)M->nrows * sizeof *x);
+    memcpy(x, outer_x(it), (size_t)M->nrows * sizeof *x);
     ulam_outer_free(it);
     return k;
 }

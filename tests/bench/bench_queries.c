@@ -1,6 +1,6 @@
 /* Many point-source queries in one process (issue 29, point 2): `ulam solve SYSTEM --queries FILE`
  * from a prepared file of the R-MAT graph of bench_bidir (2^L states, M = 0.85 P'), against the
- * in-process figure of bench_bidir (ulam_bidir_solve on one kept push workspace with reach_all and
+ * in-process figure of bench_bidir (ulam__bidir_solve on one kept push workspace with reach_all and
  * keep_kernel, the transpose and guards made before the clock), on the same pairs (bench_bidir's
  * draw: SOURCES random sources reaching at least TARGETS states of x_t >= 1/n, TARGETS of those),
  * the same seeds (pair k: seed k; the queries' --seed 1 gives query k seed k) and the same rule
@@ -9,6 +9,8 @@
  * in-process ones; median and 90th percentile and the whole process.  Target: CLI per-query
  * median <= 1.5x the in-process median.  Usage: bench_queries path/to/ulam [L [SOURCES]]
  * (default 20 and 20: 100 pairs). */
+#include "../../src/bidir.h" /* ulam__bidir_solve on a kept push workspace: the estimator alone */
+#include "../../src/push.h"
 #include "gen.h"
 
 enum { SOURCES = 20, TARGETS = 5, PAIRS = SOURCES * TARGETS };
@@ -62,7 +64,7 @@ int main(int argc, char **argv)
     ulam_guard g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(ULAM_ADJOINT);
-    if (ulam_csr_transpose(M, &Mt) || ulam_push_alloc(M, &w) || ulam_guard_check(Mt, 0.0, &go, &g, NULL))
+    if (ulam_csr_transpose(M, &Mt) || ulam__push_alloc(M, &w) || ulam_guard_check(Mt, 0.0, &go, &g, NULL))
         return fprintf(stderr, "queries: set-up failed\n"), 1;
     double inproc[PAIRS], cli[PAIRS], est[PAIRS];
     for (int k = 0; k < np; k++) {
@@ -71,10 +73,10 @@ int main(int argc, char **argv)
         o.walk.stop.max_walks = 0, o.walk.stop.rel_err = REL, o.walk.exec.threads = 1, o.walk.exec.seed = (uint64_t)k + 1;
         o.walk.stop.max_steps = INT64_MAX / 4;
         ulam_bidir_result res;
-        if (ulam_bidir_solve(w, Mt, &o, &res, NULL)) return fprintf(stderr, "queries: pair %d failed\n", k + 1), 1;
+        if (ulam__bidir_solve(w, Mt, &o, &res, NULL)) return fprintf(stderr, "queries: pair %d failed\n", k + 1), 1;
         inproc[k] = res.seconds, est[k] = res.estimate;
     }
-    ulam_push_free(w);
+    ulam__push_free(w);
     ulam_csr_free(Mt);
     /* the CLI: a prepared file (certificate and stored bounds) and one process for every pair */
     char dir[] = "/tmp/ulam_bench_queriesXXXXXX", sysf[128], qf[128];

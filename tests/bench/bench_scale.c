@@ -171,7 +171,7 @@ static outcome gs_run(const ulam_csr *M, const double *b, int64_t I, double *ref
     double *xs = NULL, *ts = NULL; /* the trace: x_I and seconds after each sweep (ref unknown) */
     while (x && t < GS_CAP) {
         double t0 = ulam_now();
-        ulam_gauss_seidel_sweep(M, b, x);
+        ulam__gauss_seidel_sweep(M, b, x);
         t += ulam_now() - t0, k++;
         if (known) {
             double e = fabs(x[I] - *ref);

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "ulam.h"
+#include "../../src/internal.h" /* ulam__gauss_seidel_sweep, _settle: the reference solves */
 
 /* Radiosity-like M: n x n, 8 nonzeros a row at columns drawn uniformly (stream (n, 0)),
  * values 0.1 + U(0, 1) scaled so every row sums to 0.9, so rho(|M|) = rho(M) = 0.9 exactly
@@ -217,7 +218,7 @@ static inline int bench_exact_column(const ulam_csr *M, int64_t s, double *x, do
     int sweeps = 0;
     for (double change = INFINITY; change > 1e-15 && sweeps < 2000; sweeps++) {
         memcpy(old, x, (size_t)n * sizeof *x);
-        ulam_gauss_seidel_sweep(M, b, x);
+        ulam__gauss_seidel_sweep(M, b, x);
         change = 0;
         for (int64_t i = 0; i < n; i++) change = fmax(change, fabs(x[i] - old[i]));
     }

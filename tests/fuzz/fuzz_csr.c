@@ -61,12 +61,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     o.policy.force = (flags & 128) != 0;
     ulam_error err;
     ulam_walk_result r;
-    ulam_solve_n(&A, b, n, &o, &r, &err);
+    ulam_solve_walks(&A, b, &o, &r, &err);
     ulam_guard g;
     ulam_guard_check(&A, 0.0, NULL, &g, &err);
     ulam_csr *T = NULL, *J = NULL;
     if (ulam_csr_transpose(&A, &T) == ULAM_OK) ulam_csr_free(T);
-    if (ulam_jacobi_n(&A, b, n, 1.0, &J, bp, &err) == ULAM_OK) ulam_csr_free(J);
+    if (ulam_jacobi(&A, b, 1.0, &J, bp, &err) == ULAM_OK) ulam_csr_free(J);
     ulam_direct_solve(&A, b, x, 0, NULL, &err);
     int it;
     double res;
@@ -74,9 +74,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ulam_outer_opts oo = ulam_outer_defaults();
     oo.method = ULAM_GAUSS_SEIDEL, oo.max_iter = 50;
     ulam_outer_solve(&A, b, &oo, x, NULL, 0, NULL, &err);
-    ulam_push *w = NULL;
-    if (ulam_push_alloc(&A, &w) == ULAM_OK && ulam_push_start(w, o.query.index) == ULAM_OK) ulam_push_run(w, 0.01, 10000);
-    ulam_push_free(w);
 done:
     free(A.rowptr), free(A.colidx), free(A.val), free(b), free(x), free(bp);
     return 0;

@@ -15,7 +15,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (!f) return 0;
     ulam_csr *A = NULL;
     ulam_error err;
-    if (ulam_mm_read_matrix_file(f, "fuzz", &A, &err) == ULAM_OK) {
+    if (ulam_mm_read_matrix_opts(f, "fuzz", NULL, &A, &err) == ULAM_OK) {
         ulam_csr_stats st;
         ulam_csr_stats_compute(A, &st);
     }

@@ -44,7 +44,9 @@ static void one(void *p, size_t size)
         ulam_system_lazy(s, &M, &b);
         ulam_guard g;
         ulam_walk_opts o = ulam_walk_defaults();
-        if (!ulam_certificate_guard(ulam_system_certificate(s), 0.0, NULL, &g) && M && M->nrows == M->ncols &&
+        ulam_system_info si;
+        ulam_system_get_info(s, &si);
+        if (!ulam_certificate_guard(si.cert, 0.0, NULL, &g) && M && M->nrows == M->ncols &&
             M->nrows > 0 && M->nrows <= 100000) { /* a query on the certificate: lazily read */
             o.stop.max_walks = 200, o.stop.max_steps = 200, o.exec.threads = 2, o.policy.guard = &g, o.policy.system = s;
             ulam_walk_result r;
