@@ -7,8 +7,7 @@
  * warnings and error lines to opts->log (NULL: none), and each call returns a status.
  *
  * Primary: ulam_rad_run_defaults, ulam_rad_run_alloc, ulam_rad_run_solve, ulam_rad_run_print,
- * ulam_rad_run_free.  Secondary: ulam_rad_run_write_csv, ulam_rad_run_write_image,
- * ulam_rad_unit_metres. */
+ * ulam_rad_run_free.  Secondary: ulam_rad_run_write, ulam_rad_unit_metres. */
 #ifndef ULAM_RADIOSITY_RUN_H
 #define ULAM_RADIOSITY_RUN_H
 
@@ -83,12 +82,16 @@ int ulam_rad_run_alloc(const ulam_rad_run_opts *opts, ulam_rad_run **out);
  * short (nothing is then written).  ULAM_OK, a status or ULAM_RAD_RUN_USAGE (the line written). */
 int ulam_rad_run_solve(ulam_rad_run *r, int *interrupted);
 
-/* The CSV rows for --out into f (the caller opens and commits the file); the run then names it. */
-void ulam_rad_run_write_csv(ulam_rad_run *r, FILE *f);
+/* What ulam_rad_run_write writes. */
+enum ulam_rad_run_file {
+    ULAM_RAD_RUN_CSV,  /* --out's rows (one a patch, or one a grid sensor) into f: the caller opens and
+                          commits the file, and the report then names it */
+    ULAM_RAD_RUN_IMAGE /* --image's PNG with its PFM and HDR (or the grid's false-colour PNG), to the
+                          paths of the options (f unused) */
+};
 
-/* The pictures: --image's PNG, PFM and HDR (or the grid's false colour PNG); ULAM_OK or a status
- * (its line written to opts->log). */
-int ulam_rad_run_write_image(ulam_rad_run *r);
+/* Write one of the run's files; ULAM_OK or a status (its line written to opts->log). */
+int ulam_rad_run_write(ulam_rad_run *r, int what, FILE *f);
 
 /* The report, text or (opts->json) one JSON object, into f. */
 void ulam_rad_run_print(const ulam_rad_run *r, FILE *f);

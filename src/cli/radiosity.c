@@ -357,7 +357,7 @@ static int write_csv(ulam_rad_run *run, const char *path)
     ulam_outfile o;
     int status = cli_outfile_open(&o, path);
     if (!status) {
-        ulam_rad_run_write_csv(run, o.f);
+        ulam_rad_run_write(run, ULAM_RAD_RUN_CSV, o.f);
         status = cli_outfile_commit(&o);
     }
     if (!status) return 0;
@@ -411,7 +411,7 @@ int cli_radiosity(int argc, char **argv)
     }
     int write = !interrupted && !a.list && (a.nat || a.grid ? a.grid : cli_rank == 0); /* the files, then the report */
     if (a.out && write && (rc = write_csv(run, a.out))) goto done;
-    if (a.image && write && (st = ulam_rad_run_write_image(run))) {
+    if (a.image && write && (st = ulam_rad_run_write(run, ULAM_RAD_RUN_IMAGE, NULL))) {
         rc = exit_code(st);
         goto done;
     }

@@ -129,8 +129,7 @@ void ulam__run_photo_report(FILE *f, const ulam_rad_run *r, int json);
 void ulam__run_photo_report_patch(FILE *f, const ulam_rad_run *r, const double *B);
 void ulam__run_photo_free(photo *p);
 
-/* The reports (run_report.c): every patch's rows; the points' report. */
-void ulam__run_rows(FILE *f, int csv, const ulam_scene *s, const patch_values *v);
-void ulam__run_print_points(FILE *f, const ulam_rad_run *r);
+/* --out's CSV rows (run_report.c). */
+void ulam__run_write_csv(ulam_rad_run *run, FILE *f);
 
 #endif

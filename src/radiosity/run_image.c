@@ -118,10 +118,11 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
     return 0;
 }
 
-/* The pictures (ulam_radiosity_run.h). */
-int ulam_rad_run_write_image(ulam_rad_run *r)
+/* One of the run's files (ulam_radiosity_run.h): the CSV rows, or the pictures. */
+int ulam_rad_run_write(ulam_rad_run *r, int what, FILE *f)
 {
     const args *a = r->a;
+    if (what == ULAM_RAD_RUN_CSV) return f ? (ulam__run_write_csv(r, f), ULAM_OK) : ULAM_EINVAL;
     if (r->pointed) return write_grid_png(a, a->image, &a->g, r->q.pts + a->nat, &r->q.hi);
     const double *B = r->w.all ? r->w.all : r->Bd, *se = r->w.all ? r->w.all_se : NULL;
     ulam__run_photo_luminance(r, B, se); /* photometric: the picture's luminance B / pi, cd/m2 */

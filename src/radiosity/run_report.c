@@ -519,7 +519,7 @@ static void point_json(FILE *f, const ulam_scene *s, const ulam_rad_point *r, co
 }
 
 /* The point queries' report (--at, --grid), text or JSON. */
-void ulam__run_print_points(FILE *f, const ulam_rad_run *run)
+static void print_points(FILE *f, const ulam_rad_run *run)
 {
     const args *a = run->a;
     const ulam_scene *s = run->s;
@@ -586,7 +586,7 @@ void ulam__run_print_points(FILE *f, const ulam_rad_run *run)
 void ulam_rad_run_print(const ulam_rad_run *r, FILE *f)
 {
     if (r->listed) print_list(f, r->a, r->s);
-    else if (r->pointed) ulam__run_print_points(f, r);
+    else if (r->pointed) print_points(f, r);
     else if (r->a->json) print_json(f, r);
     else print_text(f, r);
     const double *Bd = r->Bd, *B = r->r.patch < 0 ? NULL : r->r.w ? r->w.B : Bd ? Bd + 3 * r->r.patch : NULL;
@@ -594,7 +594,7 @@ void ulam_rad_run_print(const ulam_rad_run *r, FILE *f)
 }
 
 /* The CSV rows for --out: one a sensor of the grid, or one a patch. */
-void ulam_rad_run_write_csv(ulam_rad_run *run, FILE *f)
+void ulam__run_write_csv(ulam_rad_run *run, FILE *f)
 {
     if (!run->pointed) {
         row_header(f, ROW_CSV, &run->r.pv);
