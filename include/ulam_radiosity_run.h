@@ -25,7 +25,7 @@ typedef struct ulam_rad_run_opts {
     const char *scene;      /* the OBJ file */
     const char *patch;      /* --patch: a 1-based number or a label, or NULL */
     const char *image, *out; /* --image (PNG), --out (CSV): the paths reports name and pictures go to */
-    const char *pfm, *hdr;   /* the PFM and Radiance .hdr beside --image */
+    const char *pfm, *hdr;   /* the PFM and Radiance .hdr beside --image (NULL: not written) */
     double subdivide, exposure;
     int64_t ff_rays;
     int direct, check, matrix_walk, json, width, height, all, list;
@@ -56,7 +56,8 @@ typedef struct ulam_rad_run_opts {
     double started;         /* ulam_now() when the run began: --time counts the whole run */
     void (*catch_interrupt)(int on);  /* around the walks (NULL: none) */
     void (*hold_signals)(int on);     /* around the writing of the pictures (NULL: none) */
-    void (*progress)(void *ctx, int what, int64_t walks, double estimate, double se); /* 0 start, 1 show, 2 end */
+    void (*progress)(void *ctx, const ulam_walk_opts *o, int what, int64_t walks, double estimate, double se);
+                            /* ray walks' progress (o: their rules): 0 start, 1 show, 2 end */
     void *progress_ctx;
 } ulam_rad_run_opts;
 
@@ -74,7 +75,8 @@ typedef struct ulam_rad_run ulam_rad_run;
 #define ULAM_RAD_RUN_INTERRUPTED (-2)
 
 /* Read, subdivide or adapt, check the memory, build the tracer and light the scene (with
- * opts->list, stop after the mesh).  *out is set even on failure (free it).  ULAM_OK, a status
+ * opts->list, stop after the mesh).  The run keeps opts' strings and arrays (scene, patch, paths,
+ * at, spec, lum): they outlive it.  *out is set even on failure (free it).  ULAM_OK, a status
  * (its line written to opts->log) or one of the two above. */
 int ulam_rad_run_alloc(const ulam_rad_run_opts *opts, ulam_rad_run **out);
 

@@ -336,12 +336,11 @@ static int parse(int argc, char **argv, args *a, cli_photo *ph)
 
 
 /* The progress line of ray walks (ulam_rad_run_opts.progress): 0 start, 1 show, 2 end. */
-static void progress(void *ctx, int what, int64_t walks, double estimate, double se)
+static void progress(void *ctx, const ulam_walk_opts *o, int what, int64_t walks, double estimate, double se)
 {
     static cli_progress pg;
-    const args *a = ctx;
-    if (what == 0) cli_progress_start(&pg, a->json);
-    else if (what == 1) cli_progress_show(&pg, walks, estimate, se, &a->o);
+    if (what == 0) cli_progress_start(&pg, *(const int *)ctx);
+    else if (what == 1) cli_progress_show(&pg, walks, estimate, se, o);
     else cli_progress_end(&pg);
 }
 
@@ -380,7 +379,7 @@ int cli_radiosity(int argc, char **argv)
     char hdr[4096], rgbe[4096]; /* the PFM and the Radiance .hdr beside --image */
     a.o.stop.interrupt = &cli_interrupted, a.o.exec.share = cli_share;
     a.log = cli_rank == 0 ? stderr : NULL, a.rank = cli_rank, a.started = cli_started;
-    a.catch_interrupt = interrupt_hook, a.hold_signals = cli_hold_signals, a.progress = progress, a.progress_ctx = &a;
+    a.catch_interrupt = interrupt_hook, a.hold_signals = cli_hold_signals, a.progress = progress, a.progress_ctx = &a.json;
     int rc = parse(argc, argv, &a, &ph), interrupted = 0;
     ulam_rad_run *run = NULL;
     if (rc) goto done;

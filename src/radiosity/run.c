@@ -305,15 +305,15 @@ static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
     w->whole = a->o.mode == ULAM_FORWARD && a->o.stop.rel_err > 0 && !a->patch; /* the whole scene, not patch 1 */
     if (w->whole) ulam_rad_solver_whole(sv, a->share > 0 ? a->share : 1.0);
     interrupt_on(a, 1);
-    if (a->progress) a->progress(a->progress_ctx, 0, 0, 0, 0);
+    if (a->progress) a->progress(a->progress_ctx, &a->o, 0, 0, 0, 0);
     ulam_rad_result r;
     for (int round = 0; !status && !ulam_rad_solver_done(sv); round++) {
         status = ulam_rad_solver_iterate(sv);
         ulam_rad_solver_result(sv, &r);
         if (round == 0) rel_err_warning(a, &r);
-        if (a->progress) a->progress(a->progress_ctx, 1, r.walks, r.radiosity[0], r.std_error[0]); /* the red channel */
+        if (a->progress) a->progress(a->progress_ctx, &a->o, 1, r.walks, r.radiosity[0], r.std_error[0]); /* the red channel */
     }
-    if (a->progress) a->progress(a->progress_ctx, 2, 0, 0, 0);
+    if (a->progress) a->progress(a->progress_ctx, &a->o, 2, 0, 0, 0);
     interrupt_on(a, 0);
     ulam_rad_solver_result(sv, &r);
     memcpy(w->B, r.radiosity, sizeof w->B);

@@ -12,7 +12,7 @@ static void hold(const args *a, int on)
     if (a->hold_signals) a->hold_signals(on);
 }
 
-/* --grid --image: the false-colour picture of the illuminance, 0 to the largest; 0 or an exit code. */
+/* --grid --image: the false-colour picture of the illuminance, 0 to the largest; ULAM_OK or a status (written). */
 static int write_grid_png(const args *a, const char *path, const ulam_rad_grid *g, const ulam_rad_point *pts, double *hi)
 {
     size_t n = (size_t)g->nu * (size_t)g->nv;
@@ -68,7 +68,7 @@ static void noise_warning(const args *a, const ulam_tracer *t, const ulam_scene 
                         "1/sqrt(walks)), or --view-gather --rel-err\n", a->image, (long long)seen, 100.0 * sum / n);
 }
 
-/* Render B into a->image, warning when the picture cannot show the light; 0 or an exit code. */
+/* Render B into a->image, warning when the picture cannot show the light; ULAM_OK or a status (written). */
 static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s, const double *B, const double *se,
                        double *used)
 {
@@ -87,6 +87,7 @@ static int write_image(const args *a, const ulam_tracer *t, const ulam_scene *s,
     }
     static const char *const what[] = {"a writable PFM file", "a writable Radiance .hdr file"};
     for (int k = 0; k < 2 && !status; k++) { /* the PFM and the Radiance .hdr beside the PNG */
+        if (!(k ? a->hdr : a->pfm)) continue;
         hold(a, 1);
         status = k ? ulam_hdr_write(a->hdr, a->width, a->height, hdr) : ulam_pfm_write(a->pfm, a->width, a->height, hdr);
         hold(a, 0);
