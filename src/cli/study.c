@@ -15,47 +15,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static const char *const usage =
-    "usage: ulam study M.mtx --rhs b.mtx --index I [--methods LIST] [--budgets LIST |\n"
-    "                  --time-budgets LIST] [--repeats R] [--out DIR] [--seed S] [--threads T]\n"
-    "                  [--jacobi [--omega W]] [--cache] [--force] [--reference-time S]\n"
-    "                  [--format png|svg|pdf]\n"
-    "\n"
-    "Run every method (mode-estimator-window: adjoint|forward, collision|absorption|expected,\n"
-    "plain|roulette|split) at every budget R times with distinct seeds, and compare each run\n"
-    "with the exact x_I (LAPACK when n <= 8000, else Gauss-Seidel run to convergence).\n"
-    "\n"
-    "  --methods LIST       comma-separated method names (default: all 18), e.g.\n"
-    "                       adjoint-collision-plain,forward-expected-split\n"
-    "  --budgets LIST       walks per run (default 100,1000,10000,100000,1000000)\n"
-    "  --time-budgets LIST  seconds per run instead of walk counts\n"
-    "  --repeats R          runs per method and budget (default 30)\n"
-    "  --out DIR            output directory (default study): runs.csv (a row per run, saved\n"
-    "                       after each method and budget; rerunning resumes), summary.csv,\n"
-    "                       reference.csv, rmse-*.png, work.png, coverage.png\n"
-    "  --cache              binary copies of the inputs beside them, as in 'ulam solve'\n"
-    "  --seed S             base seed (default 1); run r of method m at budget k has its own\n"
-    "  --force              start afresh when --out holds runs of a different question\n"
-    "  --threads T          threads per run (default: all cores)\n"
-    "  --jacobi             the file holds A of A x = b: walk on M = I - w D^-1 A, b' = w D^-1 b\n"
-    "  --omega W            the damping w of --jacobi, in (0, 2] (default 1)\n"
-    "  --reference-time S   seconds for each reference line of the methods that solve for every\n"
-    "                       unknown (sequential MC, MCSA; default 10); 0 leaves them out\n"
-    "  --format F           png (default), svg or pdf charts; each chart's gnuplot script is kept\n"
-    "                       beside it (NAME.gp: 'cd DIR && gnuplot NAME.gp' redraws it from the CSVs)\n"
-    "\n"
-    "On stdout: the winner at each budget (least RMSE^2 x seconds) with its coverage and the\n"
-    "coverage's 95% binomial (Wilson) interval, and the refused methods.  The RMSE charts are\n"
-    "one per estimator (rmse-collision, rmse-absorption, rmse-expected: at most 6 lines each).\n"
-    "\n"
-    "A rerun resumes only the same question: DIR/question.txt records a fingerprint of it (the\n"
-    "contents of M and b, n, --index, --jacobi and --omega, --seed, the methods, walk or time\n"
-    "budgets); a rerun that differs in any of them is refused, naming the field (exit 2),\n"
-    "unless --force discards the old runs.\n"
-    "\n"
-    "Windows: roulette W = 0.5 w0, split W = 2 w0 (w0 the starting weight).  Ctrl-C keeps\n"
-    "every finished row and writes the summary (exit 130); a second Ctrl-C exits at once.\n";
-
 enum { NMETHOD = ULAM_STUDY_METHODS, MAXBUDGET = 16, MAXREPEAT = 4096 };
 
 typedef struct {
@@ -436,7 +395,7 @@ int cli_study(int argc, char **argv)
             st.format = formats[rc];
             break;
         case 'w': if ((rc = cli_parse_real("study", "--omega", optarg, 1e-6, 2.0, &st.s.omega))) return rc; break;
-        case 'h': fputs(usage, stdout); return 0;
+        case 'h': ulam_options_help(stdout, "study"); return 0;
         default: return cli_usage_error("study", "unknown option");
         }
     }
