@@ -28,7 +28,7 @@ static int matvec(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, c
     const ulam__rows *A = &p->m;
     for (int64_t i = 0; i < p->last - p->first; i++) {
         double s = 0.0;
-        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += A->val[q] * ulam__halo_at(p, h, own, gv, A->col[q]);
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += A->val[q] * ulam__halo_at(p, A, h, own, gv, q);
         y[i] = s;
     }
     return 0;
@@ -88,6 +88,7 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
     if (!p || !comm || !x || !info || !(tol > 0) || max_iter < 1)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, info, tol > 0 and max_iter >= 1");
     if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
+    if (!p->b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
     *info = (ulam_dist_mcsa_info){0};
     int64_t rows = p->last - p->first;
     double *gv = NULL, *r = malloc(((size_t)rows + 1) * sizeof *r), *d = malloc(((size_t)rows + 1) * sizeof *d);
@@ -176,7 +177,7 @@ static int residual_bounds(const ulam_part *p, const ulam_comm *c, const ulam__h
     for (int64_t i = 0; i < p->last - p->first; i++) {
         double s = 0.0, a = 0.0;
         for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) {
-            double xj = ulam__halo_at(p, h, x, gv, A->col[q]);
+            double xj = ulam__halo_at(p, A, h, x, gv, q);
             s += A->val[q] * xj, a += fabs(A->val[q] * xj);
             if (A->val[q] < 0) neg = 1.0;
         }
@@ -197,6 +198,7 @@ int ulam_dist_bound(const ulam_part *p, const ulam_comm *comm, const double *b, 
     if (!p || !comm || !x || !lo || !hi || !worst || iters < 1)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, lo, hi, worst and iters >= 1");
     if (!p->m.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding the rows of M");
+    if (!b && !p->b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
     int64_t rows = p->last - p->first;
     for (int64_t i = 0; i < rows; i++)
         if (!isfinite(x[i])) return ulam__fail(err, ULAM_EINVAL, 0, p->first + i, "a finite x");
