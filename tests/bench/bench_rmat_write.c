@@ -2,9 +2,9 @@
  * source at scale": 2^24 nodes, 2^28 edges), with its certificate, its bounds and M' stored, so
  * no Matrix Market text (about 10 GB at that size) is ever written or parsed.
  *
- * Graph: R-MAT (Chakrabarti, Zhan, Faloutsos 2004; a = 0.57, b = c = 0.19, d = 0.05), 2^L nodes,
- * E 2^L edges (default E = 16), stream (L, 0), nodes relabelled by a random permutation
- * (tests/bench/gen.h's bench_rmat draw); each node without an out-edge is given one to a node
+ * Graph: R-MAT (Chakrabarti, Zhan, Faloutsos 2004; a = 0.57, b = c = 0.19, d = 0.05, each level
+ * drawn from 16 bits: 4 levels a 64-bit draw), 2^L nodes, E 2^L edges (default E = 16), stream
+ * (L, 0), nodes relabelled by a random permutation (as tests/bench/gen.h's bench_rmat); each node without an out-edge is given one to a node
  * drawn uniformly (as tests/bench/bench_igraph.py does, so PRPACK's dangling rule does not
  * enter); multi-edges summed: M_vu = 0.85 (edges u -> v) / outdeg(u).
  *
@@ -37,8 +37,14 @@ int main(int argc, char **argv)
     if (!perm || !src || !dst || !outp) return fprintf(stderr, "bench_rmat_write: out of memory\n"), 1;
     bench_permutation(perm, n, &r);
     for (int64_t e = 0; e < m; e++) {
-        int64_t u, v;
-        bench_rmat_edge(&r, L, &u, &v);
+        int64_t u = 0, v = 0;
+        for (int l = 0; l < L; l += 4) { /* four levels a 64-bit draw, 16 bits each (a quarter of the draws) */
+            uint64_t z = ulam_rng_next(&r);
+            for (int k = 0; k < 4 && l + k < L; k++, z >>= 16) {
+                uint64_t q = z & 0xffff; /* a = 37356 / 65536, a + b = 49807, a + b + c = 62259 */
+                u = 2 * u + (q >= 49807), v = 2 * v + ((q >= 37356 && q < 49807) || q >= 62259);
+            }
+        }
         src[e] = perm[u], dst[e] = perm[v];
         outp[perm[u] + 1]++;
     }
@@ -88,7 +94,9 @@ int main(int argc, char **argv)
     fflush(stdout);
     ulam_certificate cert;
     ulam_error err;
-    if (ulam_certificate_compute(&M, 0.0, NULL, &cert, &err))
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD; /* what single source reads (an adjoint query makes its own) */
+    if (ulam_certificate_compute(&M, 0.0, &go, &cert, &err))
         return fprintf(stderr, "bench_rmat_write: certificate: %s\n", err.msg), 1;
     double t3 = ulam_now();
     printf("certificate in %.1f s: rho(|M|) in [%.6g, %.6g]\n", t3 - t2, cert.guard.abs.lower, cert.guard.abs.upper);
