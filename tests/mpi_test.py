@@ -244,7 +244,8 @@ def check_partition_source_graph(ulam, mpirun, d):
     """Single source on a PageRank graph prepared without b (M = 0.85 P' of a digraph whose heads
     favour low-numbered nodes, so rows reach every rank): runs on a partition (it needed a b in the
     file before), the top-10 table byte for byte the same at 1, 2 and 3 ranks, each line within 4
-    standard errors of the direct column; an adjoint query on the same file ends with a
+    standard errors of the direct column and inside its certified range (from ||M||_1 < 1: the power
+    iteration certifies no u < 1 on such a graph, and no range was printed before); an adjoint query on the same file ends with a
     clear error, not a wrong answer."""
     import random
     rnd = random.Random(11)
@@ -276,6 +277,8 @@ def check_partition_source_graph(ulam, mpirun, d):
         i, est = int(re.match(r"x\[(\d+)\]", line).group(1)) - 1, float(line.split()[1])
         se = re.search(r"\+- (\S+)", line)
         assert abs(est - exact[i]) < (4 * float(se.group(1)) if se else 1e-3 * exact[i]), (line, exact[i])
+        ci = re.search(r"CI (\S+) \.\. ([^;)\s]+)", line)  # the l1 range (||M||_1 = 0.85): none was certified before
+        assert ci and float(ci.group(1)) <= exact[i] <= float(ci.group(2)), (line, exact[i])
     p = subprocess.run([mpirun, "--oversubscribe", "-np", "2", ulam, "solve", sysf, "--partition", "--index", "3"],
                        capture_output=True, text=True, env=ENV, timeout=300)
     assert p.returncode != 0 and "a b in the prepared file" in p.stderr, (p.returncode, p.stderr)
