@@ -193,11 +193,12 @@ static int residual_bounds(const ulam_part *p, const ulam_comm *c, const ulam__h
 
 /* An upper bound on the sum of the rows' v_i >= 0 (this rank's rows; top: their largest over every
  * rank) the same bits at any split: each v_i / top rounded up to a multiple of 2^-30 and counted
- * as an integer, so the sum over the ranks is exact; nonzero on a failed sum. */
+ * as an integer, so the sum over the ranks (set 0's: every row once) is exact; nonzero on a failed sum. */
 static int sum_up(const ulam_part *p, const ulam_comm *c, const double *v, double top, double *out)
 {
     int64_t k = 0;
-    for (int64_t i = 0; top > 0 && i < p->last - p->first; i++) k += (int64_t)ceil(v[i] / top * 1073741824.0) + 1;
+    for (int64_t i = 0; top > 0 && p->set == 0 && i < p->last - p->first; i++) /* one set's rows: each once */
+        k += (int64_t)ceil(v[i] / top * 1073741824.0) + 1;
     if (c->nranks > 1 && c->sum(c->ctx, &k, 1)) return 1;
     *out = top > 0 ? top * ((double)k / 1073741824.0) * (1.0 + 4.0 * DBL_EPSILON) : 0.0;
     return 0;

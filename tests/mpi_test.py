@@ -243,7 +243,7 @@ def check_partition_mtx(ulam, mpirun, d):
 def check_partition_source_graph(ulam, mpirun, d):
     """Single source on a PageRank graph prepared without b (M = 0.85 P' of a digraph whose heads
     favour low-numbered nodes, so rows reach every rank): runs on a partition (it needed a b in the
-    file before), the top-10 table byte for byte the same at 1, 2 and 3 ranks, each line within 4
+    file before), the top-10 table byte for byte the same at 1, 2 and 3 ranks and in 2 sets, each line within 4
     standard errors of the direct column and inside its certified range (from ||M||_1 < 1: the power
     iteration certifies no u < 1 on such a graph, and no range was printed before); an adjoint query on the same file ends with a
     clear error, not a wrong answer."""
@@ -271,7 +271,9 @@ def check_partition_source_graph(ulam, mpirun, d):
     exact = [float(v) for v in open(f"{d}/gx.mtx").read().split("\n")[3:] if v.strip()]
     tops = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--source", "5", "--top",
                  "10", "--walks", "20000", "-q"]) for k in (1, 2, 3)]
-    assert tops[0] == tops[1] == tops[2], tops
+    tops.append(run([mpirun, "--oversubscribe", "-np", "4", ulam, "solve", sysf, "--partition", "--sets", "2",
+                     "--source", "5", "--top", "10", "--walks", "20000", "-q"]))  # 2 sets: ||r||_1 over one set's rows
+    assert tops[0] == tops[1] == tops[2] == tops[3], tops
     import re
     for line in tops[0].splitlines():  # within 4 standard errors, or 1e-3 of it where no walk reached it
         i, est = int(re.match(r"x\[(\d+)\]", line).group(1)) - 1, float(line.split()[1])
