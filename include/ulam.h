@@ -119,6 +119,34 @@ typedef struct ulam_error {
                        file read for an OBJ file); empty otherwise */
 } ulam_error;
 
+/* ---------------------------------------------------------------- defaults */
+/* Primary, through each struct's wrapper (ulam_walk_defaults() ...). */
+
+/* The option structs the library fills with their defaults (ulam_defaults) and, the first three,
+ * sets by name (ulam_options.h). */
+enum ulam_kind {
+    ULAM_KIND_WALK = 0,     /* ulam_walk_opts */
+    ULAM_KIND_OUTER = 1,    /* ulam_outer_opts */
+    ULAM_KIND_BIDIR = 2,    /* ulam_bidir_opts */
+    ULAM_KIND_ANALYSIS = 3, /* ulam_analysis_opts */
+    ULAM_KIND_METHOD = 4,   /* ulam_method_opts */
+    ULAM_KIND_AUTO = 5,     /* ulam_auto_opts */
+    ULAM_KIND_MM = 6,       /* ulam_mm_opts */
+    ULAM_KIND_SPECTRAL = 7, /* ulam_spectral_opts */
+    ULAM_KIND_POWER = 8,    /* ulam_power_opts */
+    ULAM_KIND_GUARD = 9,    /* ulam_guard_opts */
+    ULAM_KIND_FPUSH = 10,   /* ulam_fpush_opts */
+    ULAM_KIND_SHARE = 11,   /* ulam_share */
+    ULAM_KIND_SYSTEM_DESC = 12, /* ulam_system_desc */
+    ULAM_KIND_DIST = 13     /* ulam_dist_opts (ulam_dist.h) */
+};
+
+/* Fill *opts, the struct kind names, with its defaults; size is the caller's sizeof *opts, which
+ * must be this library's.  ULAM_OK, or ULAM_EINVAL (opts zeroed) for an unknown kind or another
+ * size.  Each struct's wrapper below its typedef (ulam_walk_defaults() ...) is this call: the
+ * values stay the library's, so a field a later version adds takes its default there. */
+int ulam_defaults(int kind, void *opts, size_t size);
+
 /* ---------------------------------------------------------------- sparse matrices */
 /* Primary: the struct, ulam_csr_free.  Secondary: building, checking, transposing, ulam_jacobi.
  * Tertiary: nnz, copy, matvec, dense, stats. */
@@ -224,7 +252,12 @@ typedef struct ulam_mm_opts {
 } ulam_mm_opts;
 
 /* The defaults: all cores (threads 0). */
-ulam_mm_opts ulam_mm_defaults(void);
+static inline ulam_mm_opts ulam_mm_defaults(void)
+{
+    ulam_mm_opts o;
+    ulam_defaults(ULAM_KIND_MM, &o, sizeof o);
+    return o;
+}
 
 /* Read a matrix as ulam_mm_read_matrix, from an open file f (name is used only in error
  * details), with options (o NULL: ulam_mm_defaults()). */
@@ -330,7 +363,12 @@ typedef struct ulam_spectral_opts {
 } ulam_spectral_opts;
 
 /* The defaults: tol 1e-6, max_restarts 300, krylov_dim 20, seed 1. */
-ulam_spectral_opts ulam_spectral_defaults(void);
+static inline ulam_spectral_opts ulam_spectral_defaults(void)
+{
+    ulam_spectral_opts o;
+    ulam_defaults(ULAM_KIND_SPECTRAL, &o, sizeof o);
+    return o;
+}
 
 /* Result of a spectral radius estimate. */
 typedef struct ulam_radius {
@@ -359,7 +397,12 @@ typedef struct ulam_power_opts {
 } ulam_power_opts;
 
 /* The defaults: tol 1e-4, max_iter 1000, certify 0. */
-ulam_power_opts ulam_power_defaults(void);
+static inline ulam_power_opts ulam_power_defaults(void)
+{
+    ulam_power_opts o;
+    ulam_defaults(ULAM_KIND_POWER, &o, sizeof o);
+    return o;
+}
 
 /* Spectral radius of a nonnegative operator by power iteration, with Collatz-Wielandt bounds
  * from the same iterates: for any positive x, min_i (Ax)_i / x_i <= rho(A) <= max_i (Ax)_i / x_i.
@@ -406,7 +449,12 @@ typedef struct ulam_guard_opts {
 
 /* The defaults: all three radii (need ULAM_GUARD_ALL), tight 0 (stopped once certified), power
  * ulam_power_defaults(), kernel_alpha 1. */
-ulam_guard_opts ulam_guard_defaults(void);
+static inline ulam_guard_opts ulam_guard_defaults(void)
+{
+    ulam_guard_opts o;
+    ulam_defaults(ULAM_KIND_GUARD, &o, sizeof o);
+    return o;
+}
 
 /* The guards of a walk on M with continuation continue_q (<= 0: analog) and kernel exponent
  * alpha, a plain struct (a certificate a prepared-system file can store and reload):
@@ -485,7 +533,12 @@ typedef struct ulam_system_desc {
 
 /* The defaults: nothing to write yet (M, b and cert NULL, n 0, tag {0, 0}, omega 0, no
  * transpose); set M and/or b and n. */
-ulam_system_desc ulam_system_desc_defaults(void);
+static inline ulam_system_desc ulam_system_desc_defaults(void)
+{
+    ulam_system_desc o;
+    ulam_defaults(ULAM_KIND_SYSTEM_DESC, &o, sizeof o);
+    return o;
+}
 
 /* Write a prepared system to f (positioned at 0; the caller closes it): ULAM_OK, ULAM_EINVAL
  * (also for an M that fails ulam_csr_check, a b not finite, a certificate without M or whose
@@ -600,7 +653,12 @@ typedef struct ulam_share {
 } ulam_share;
 
 /* The defaults: one process (rank 0 of 1; allgather and ctx NULL, never called). */
-ulam_share ulam_share_defaults(void);
+static inline ulam_share ulam_share_defaults(void)
+{
+    ulam_share o;
+    ulam_defaults(ULAM_KIND_SHARE, &o, sizeof o);
+    return o;
+}
 
 /* The walk kernel: how a walk moves and how its weight is kept in a window.  Start from
  * ulam_walk_defaults() (its kernel). */
@@ -678,7 +736,12 @@ typedef struct ulam_walk_opts {
 
 /* The defaults: adjoint collision walks and each part's defaults (index 0, analog kernel with
  * exponent 1, seed 1, all cores, 10^5 walks, walk cap 10^6 steps). */
-ulam_walk_opts ulam_walk_defaults(void);
+static inline ulam_walk_opts ulam_walk_defaults(void)
+{
+    ulam_walk_opts o;
+    ulam_defaults(ULAM_KIND_WALK, &o, sizeof o);
+    return o;
+}
 
 /* What a run has found so far. */
 typedef struct ulam_walk_result {
@@ -842,7 +905,12 @@ typedef struct ulam_analysis_opts {
 } ulam_analysis_opts;
 
 /* The defaults: analog continuation, exponent 1, no b, no system, bounds per query. */
-ulam_analysis_opts ulam_analysis_defaults(void);
+static inline ulam_analysis_opts ulam_analysis_defaults(void)
+{
+    ulam_analysis_opts o;
+    ulam_defaults(ULAM_KIND_ANALYSIS, &o, sizeof o);
+    return o;
+}
 
 /* An analysis of square M (borrowed: it must outlive the analysis) under opts (NULL: the
  * defaults).  O(1) work and memory here; what the queries need is made at the first that needs
@@ -911,7 +979,12 @@ typedef struct ulam_outer_opts {
 
 /* The defaults: MCSA, tol 1e-8, max_iter 0, stall 0, eps1 0.1, max_histories 10^8, walk
  * ulam_walk_defaults() but forward expected-value walks (seed 1). */
-ulam_outer_opts ulam_outer_defaults(void);
+static inline ulam_outer_opts ulam_outer_defaults(void)
+{
+    ulam_outer_opts o;
+    ulam_defaults(ULAM_KIND_OUTER, &o, sizeof o);
+    return o;
+}
 
 /* What one iteration did. */
 typedef struct ulam_outer_step {
@@ -1053,7 +1126,12 @@ typedef struct ulam_bidir_opts {
 
 /* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
  * (the default cap), walk ulam_walk_defaults(), step_cost 0 (ULAM_BIDIR_STEP_COST). */
-ulam_bidir_opts ulam_bidir_defaults(void);
+static inline ulam_bidir_opts ulam_bidir_defaults(void)
+{
+    ulam_bidir_opts o;
+    ulam_defaults(ULAM_KIND_BIDIR, &o, sizeof o);
+    return o;
+}
 
 /* A bidirectional estimate's plan: the push it runs and what the walks after it
  * are predicted to cost, in a deterministic unit of work (push operations; a walk's visits, its
@@ -1117,7 +1195,12 @@ typedef struct ulam_fpush_opts {
 
 /* The defaults: source 0, rel_err 0.1, min_value 0, walks 0, rmax 0, step_cost 0, walk
  * ulam_walk_defaults() in forward mode. */
-ulam_fpush_opts ulam_fpush_defaults(void);
+static inline ulam_fpush_opts ulam_fpush_defaults(void)
+{
+    ulam_fpush_opts o;
+    ulam_defaults(ULAM_KIND_FPUSH, &o, sizeof o);
+    return o;
+}
 
 /* What a single-source estimate did. */
 typedef struct ulam_fpush_info {
@@ -1234,7 +1317,12 @@ typedef struct ulam_auto_opts {
 } ulam_auto_opts;
 
 /* The default options: nothing pinned, Q = 0.9, pilots of 128 walks doubling up to 1024, 0.2. */
-ulam_auto_opts ulam_auto_defaults(void);
+static inline ulam_auto_opts ulam_auto_defaults(void)
+{
+    ulam_auto_opts o;
+    ulam_defaults(ULAM_KIND_AUTO, &o, sizeof o);
+    return o;
+}
 
 /* The candidates and the choice. */
 typedef struct ulam_auto_result {
@@ -1326,7 +1414,12 @@ typedef struct ulam_method_opts {
 } ulam_method_opts;
 
 /* The defaults: no row pinned (method -1), none excluded. */
-ulam_method_opts ulam_method_defaults(void);
+static inline ulam_method_opts ulam_method_defaults(void)
+{
+    ulam_method_opts o;
+    ulam_defaults(ULAM_KIND_METHOD, &o, sizeof o);
+    return o;
+}
 
 /* What became of a row in a choice. */
 enum ulam_method_state {

@@ -14,7 +14,7 @@ extern "C" {
 #endif
 
 /* The option structs a table row may set. */
-enum ulam_options_kind { ULAM_OPTIONS_WALK = 0, ULAM_OPTIONS_OUTER = 1, ULAM_OPTIONS_BIDIR = 2 };
+enum ulam_options_kind { ULAM_OPTIONS_WALK = ULAM_KIND_WALK, ULAM_OPTIONS_OUTER = ULAM_KIND_OUTER, ULAM_OPTIONS_BIDIR = ULAM_KIND_BIDIR };
 
 /* Set option name of opts, a ulam_walk_opts, ulam_outer_opts or ulam_bidir_opts as kind says,
  * from its text value, checked against the option's range.  The walk options: "walks",

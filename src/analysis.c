@@ -10,6 +10,7 @@
  * solvers": the walk solver's construction and caching calls (ulam__solver_alloc_reached,
  * ulam__solver_keep_kernel*, ulam__solver_reached, ulam__reach_all) are made here. */
 #include "analysis.h"
+#include "defaults.h"
 #include "cache.h"
 #include "kernel.h"
 #include "push.h"
@@ -47,7 +48,7 @@ struct ulam_analysis {
 };
 
 /* The defaults. */
-ulam_analysis_opts ulam_analysis_defaults(void)
+ulam_analysis_opts ulam__analysis_defaults(void)
 {
     return (ulam_analysis_opts){.size = sizeof(ulam_analysis_opts), .continue_q = 0.0, .kernel_alpha = 1.0};
 }

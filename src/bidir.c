@@ -23,6 +23,7 @@
  * analysis of M' the memo holds (ulam__analysis_walks), which keeps what later walks share: the
  * bounds over every state (reach_all), the kernel rows (keep_kernel) and the reach a pilot found. */
 #include "bidir.h"
+#include "defaults.h"
 #include "analysis.h"
 #include "check.h"
 #include "push.h"
@@ -48,7 +49,7 @@ static double step_cost(const ulam_bidir_opts *o)
 }
 
 /* The defaults. */
-ulam_bidir_opts ulam_bidir_defaults(void)
+ulam_bidir_opts ulam__bidir_defaults(void)
 {
     return (ulam_bidir_opts){.walk = ulam_walk_defaults()};
 }

@@ -32,6 +32,7 @@
  * for a solver given ulam_walk_opts.system, whose kernel verifies each row's block before it
  * builds the row (so a one-row query reads a few blocks). */
 #include "cache.h"
+#include "defaults.h"
 #include "solve.h"
 
 #include <fcntl.h>
@@ -274,7 +275,7 @@ static void vec_sums(const double *b, int64_t n, int shift, uint64_t *sums)
 }
 
 /* An empty description. */
-ulam_system_desc ulam_system_desc_defaults(void)
+ulam_system_desc ulam__system_desc_defaults(void)
 {
     return (ulam_system_desc){.M = NULL, .b = NULL, .n = 0, .tag = {0, 0}, .omega = 0.0, .cert = NULL, .transpose = 0};
 }

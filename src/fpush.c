@@ -24,6 +24,7 @@
  * ulam_fpush_top's k components are chosen by their estimates: their lower ends at delta k / n
  * (lower_index). */
 #include "fpush.h"
+#include "defaults.h"
 #include "check.h"
 #include "push.h"
 #include "stop.h"
@@ -55,7 +56,7 @@
                                       degree to build and first touch, a try one read in the row) */
 
 /* The defaults. */
-ulam_fpush_opts ulam_fpush_defaults(void)
+ulam_fpush_opts ulam__fpush_defaults(void)
 {
     ulam_fpush_opts o = {.rel_err = 0.1, .walk = ulam_walk_defaults()};
     o.walk.mode = ULAM_FORWARD;

@@ -7,6 +7,7 @@
  * a NUL byte in a line is refused (a binary or damaged file).  A gzip-compressed file is read
  * through zlib when opened by its path, and named as such when given as an open FILE. */
 #include "mmio.h"
+#include "defaults.h"
 #include "csr.h"
 
 #include <errno.h>
@@ -782,7 +783,7 @@ int ulam__mm_read_range(int fd, const ulam__mm_coord *c, int64_t from, int64_t t
 }
 
 /* The reader's defaults. */
-ulam_mm_opts ulam_mm_defaults(void)
+ulam_mm_opts ulam__mm_defaults(void)
 {
     return (ulam_mm_opts){.threads = 0};
 }

@@ -12,6 +12,7 @@
  * any positive x, min_i (Ax)_i / x_i <= rho <= max_i (Ax)_i / x_i, so each iterate certifies a
  * bracket. */
 #include "spectral.h"
+#include "defaults.h"
 #include "check.h"
 #include "dynload.h"
 
@@ -23,7 +24,7 @@
 enum { DENSE_MAX = 128, NEV = 2 };
 
 /* The default options. */
-ulam_spectral_opts ulam_spectral_defaults(void)
+ulam_spectral_opts ulam__spectral_defaults(void)
 {
     return (ulam_spectral_opts){.tol = 1e-6, .max_restarts = 300, .krylov_dim = 20, .seed = 1};
 }
@@ -251,7 +252,7 @@ enum { MARGIN_TRIES = 20, SUPPORT_EVERY = 10 };
 #define SUPPORT_CUT 1e-10 /* the support of an iterate for support_lower */
 
 /* The default power-iteration options. */
-ulam_power_opts ulam_power_defaults(void)
+ulam_power_opts ulam__power_defaults(void)
 {
     return (ulam_power_opts){.tol = 1e-4, .max_iter = 1000};
 }
