@@ -46,7 +46,7 @@
  *     no choice, no analysis), ulam_auto and ulam_auto_start (the table's choice on M alone),
  *     ulam_auto_solver (the walks' race alone), ulam_csr_nnz, _matvec, _stats_compute,
  *     _symmetric, ulam_strtod, ulam_outfile_*, ulam_edgelist_*, random numbers (ulam_rng_*),
- *     ulam_now, ulam_alloc_big, ulam_file_tag.
+ *     ulam_now, ulam_file_tag.
  * ulam_dist.h, ulam_study.h and ulam_radiosity.h rank their own.
  */
 #ifndef ULAM_H
@@ -417,10 +417,6 @@ typedef struct ulam_power {
     int converged;       /* stopped by the tolerance: rho is an estimate to tol */
     double seconds;
 } ulam_power;
-
-/* rho(diag(left) |A| diag(right)); left and right may be NULL (all ones).  opts may be NULL. */
-int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
-                        const ulam_power_opts *opts, ulam_power *out, ulam_error *err);
 
 /* ---------------------------------------------------------------- stability guards */
 /* Primary: ulam_guard_check and its options.  Secondary: ulam_verdict_of, ulam_guard_variance. */
@@ -1606,12 +1602,6 @@ uint64_t ulam_rng_substream(uint64_t seed, ulam_stream_purpose p, uint64_t k);
 
 /* Monotonic wall clock in seconds. */
 double ulam_now(void);
-
-/* Uninitialised memory for n items of size sz, for a large array read at random (a vector of n
- * for ulam_fpush_solve, say): cache-line aligned, and from 2 MiB on, 2 MiB aligned with
- * transparent huge pages asked for (a first touch and a TLB miss cost less); freed with free();
- * NULL on overflow or failure. */
-void *ulam_alloc_big(size_t n, size_t sz);
 
 #ifdef __cplusplus
 }

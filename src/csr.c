@@ -16,9 +16,9 @@ ulam_csr *ulam_csr_alloc(int64_t nrows, int64_t ncols, int64_t nnz)
     A->nrows = nrows;
     A->ncols = ncols;
     /* 2 MiB pages (every entry is written once built): a sweep streams them, a walk reads rows at random */
-    A->rowptr = ulam_alloc_big((size_t)nrows + 1, sizeof *A->rowptr);
-    A->colidx = ulam_alloc_big((size_t)nnz, sizeof *A->colidx);
-    A->val = ulam_alloc_big((size_t)nnz, sizeof *A->val);
+    A->rowptr = ulam__alloc_big((size_t)nrows + 1, sizeof *A->rowptr);
+    A->colidx = ulam__alloc_big((size_t)nnz, sizeof *A->colidx);
+    A->val = ulam__alloc_big((size_t)nnz, sizeof *A->val);
     if (!A->rowptr || !A->colidx || !A->val) return ulam_csr_free(A);
     memset(A->rowptr, 0, ((size_t)nrows + 1) * sizeof *A->rowptr);
     return A;

@@ -81,6 +81,12 @@ void *ulam__malloc(size_t n, size_t sz);
 /* calloc of n items of size sz, NULL on failure (n == 0 allocates one byte). */
 void *ulam__calloc(size_t n, size_t sz);
 
+/* Uninitialised memory for n items of size sz, for a large array read at random (a matrix's
+ * arrays, a push's vectors): cache-line aligned, and from 2 MiB on, 2 MiB aligned with
+ * transparent huge pages asked for (a first touch and a TLB miss cost less); freed with free();
+ * NULL on overflow or failure (src/util.c). */
+void *ulam__alloc_big(size_t n, size_t sz);
+
 /* Make room for need items of size sz in a growable array: pp is the address of its pointer
  * (a T **), *cap its capacity (doubling from 16; both are updated); ULAM_OK, or ULAM_ENOMEM
  * leaving the array as it was. */

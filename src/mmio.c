@@ -659,7 +659,7 @@ static int read_entries_parallel(int fd, int64_t data, int64_t end, const mm_hea
         prev = c[k].row[c[k].len - 1];
     }
     ulam_csr *A = !bad && total == h->nnz ? ulam_csr_alloc(h->m, h->n, total) : NULL;
-    int32_t *ti = A && !sorted ? ulam_alloc_big((size_t)total, sizeof *ti) : NULL;
+    int32_t *ti = A && !sorted ? ulam__alloc_big((size_t)total, sizeof *ti) : NULL;
     int status = nomem || (A && !sorted && !ti) || (!A && !bad && total == h->nnz) ? ULAM_ENOMEM : A ? ULAM_OK : -1;
     int64_t nz = 0;
     for (int k = 0; k < nc; k++) {

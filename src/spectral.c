@@ -7,7 +7,7 @@
  * recomputed from the returned eigenvector.  Small operators (n <= DENSE_MAX, where ARPACK's
  * nev < n - 1 constraint bites) are formed densely from n products and solved by dgeev.
  *
- * The radius of a nonnegative operator diag(left) |A| diag(right) (ulam_spectral_power, which
+ * The radius of a nonnegative operator diag(left) |A| diag(right) (ulam__spectral_power, which
  * the guards use) comes instead from shifted power iteration with Collatz-Wielandt bounds: for
  * any positive x, min_i (Ax)_i / x_i <= rho <= max_i (Ax)_i / x_i, so each iterate certifies a
  * bracket. */
@@ -359,7 +359,7 @@ int ulam__power_from(const ulam_csr *A, const double *left, const double *right,
 }
 
 /* rho(diag(left) |A| diag(right)) by shifted power iteration with Collatz-Wielandt bounds. */
-int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
+int ulam__spectral_power(const ulam_csr *A, const double *left, const double *right,
                         const ulam_power_opts *opts, ulam_power *out, ulam_error *err)
 {
     ulam__clear(err);

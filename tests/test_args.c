@@ -147,11 +147,6 @@ static void test_other_options(void **state)
         assert_names(&err, "kernel_alpha");
         assert_int_equal(ulam_guard_check(M, v, NULL, &g, &err), ULAM_EINVAL);
         assert_names(&err, "continue_q");
-        ulam_power_opts po = ulam_power_defaults();
-        po.tol = v;
-        ulam_power p;
-        assert_int_equal(ulam_spectral_power(M, NULL, NULL, &po, &p, &err), ULAM_EINVAL);
-        assert_names(&err, "tol");
         ulam_spectral_opts so = ulam_spectral_defaults();
         so.tol = v;
         ulam_radius rad;
@@ -249,8 +244,6 @@ static void test_damaged_matrix(void **state)
             }
         }
         assert_int_not_equal(ulam_guard_check(M, 0.0, NULL, &g, &err), ULAM_OK);
-        ulam_power p;
-        assert_int_not_equal(ulam_spectral_power(M, NULL, NULL, NULL, &p, &err), ULAM_OK);
         ulam_radius rad;
         assert_int_not_equal(ulam_spectral_radius(M, 0, NULL, &rad), ULAM_OK);
         assert_int_not_equal(ulam_csr_transpose(M, &T), ULAM_OK);
