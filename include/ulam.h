@@ -41,7 +41,7 @@
  *     (ulam_spectral_radius), prepared systems (ulam_system_*, ulam_certificate_*), processes
  *     (ulam_share), outer iterations (ulam_outer_*), Krylov peers (ulam_cg, ulam_gmres), point
  *     sources (ulam_analysis_bidir, ulam_fpush_*), the method table (ulam_method_*),
- *     ulam_analysis_transpose, _get_info, ulam_direct_sparse, ulam_direct_bytes;
+ *     ulam_analysis_transpose, _get_info, ulam_direct_bytes, ulam_reference_plan and ulam_reference_solve (ulam_reference.h);
  *   tertiary, mirrors kept for what they pin and utilities: ulam_solve_walks (the walks o names,
  *     no choice, no analysis), ulam_auto and ulam_auto_start (the table's choice on M alone),
  *     ulam_auto_solver (the walks' race alone), ulam_csr_nnz, _matvec, _stats_compute,
@@ -313,8 +313,8 @@ int ulam_outfile_commit_all(ulam_outfile *o, int k);
 void ulam_outfile_abort(ulam_outfile *o);
 
 /* ---------------------------------------------------------------- direct solve */
-/* Primary: ulam_direct_solve, ulam_direct_sparse.  Secondary: ulam_direct_bytes,
- * ulam_direct_sparse_available. */
+/* Primary: ulam_direct_solve.  Secondary: ulam_direct_bytes.  The sparse LU (UMFPACK) and the
+ * choice between them: ulam_reference.h. */
 
 /* What a LAPACK direct solve reports besides the solution. */
 typedef struct ulam_direct_info {
@@ -332,22 +332,6 @@ size_t ulam_direct_bytes(int64_t n);
  * ULAM_ESINGULAR (err->index is the zero pivot).  info may be NULL. */
 int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
                       ulam_direct_info *info, ulam_error *err);
-
-/* Solve (I - M) x = b by a sparse LU factorisation (UMFPACK, SuiteSparse): memory about that of
- * the factors, not n^2.  UMFPACK's own estimate of the factorisation's peak memory is checked
- * against max_bytes (0: no limit) before it starts (ULAM_EMEMLIMIT); ULAM_ESINGULAR for a
- * singular I - M; ULAM_EUNSUPPORTED when libulam was built without UMFPACK.  info may be NULL
- * (its rcond is UMFPACK's estimate, its bytes the peak memory). */
-int ulam_direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
-                       ulam_direct_info *info, ulam_error *err);
-
-/* What ulam_direct_sparse will need, before it starts: UMFPACK's estimates of the factorisation's
- * peak memory (*bytes) and floating-point operations (*flops), from its symbolic analysis (a
- * fraction of the factorisation's time).  ULAM_EUNSUPPORTED without UMFPACK. */
-int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err);
-
-/* Nonzero when libulam was built with UMFPACK and libumfpack loads (ulam_direct_sparse works). */
-int ulam_direct_sparse_available(void);
 
 /* ---------------------------------------------------------------- spectral radius */
 /* Secondary. */
