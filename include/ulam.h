@@ -267,9 +267,6 @@ int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, u
  * 0).  *x is malloc'd with *n entries. */
 int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *err);
 
-/* As ulam_mm_read_vector, from an open file; name is used only in error details. */
-int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
-
 /* strtod(s, end) exactly (the same double and end for every input, C locale), faster for
  * decimals of up to 19 significant digits with normal results (Clinger's fast path, else the
  * Eisel-Lemire algorithm); everything else is strtod's own work.  errno is set only when
@@ -548,10 +545,6 @@ int ulam_system_is_file(const char *path);
  * ULAM_ESYNTAX with err naming the damaged block (err->index its first row) and the fault. */
 int ulam_system_check(const ulam_system *s, ulam_error *err);
 
-/* Verify the blocks of M and b that hold rows [first, last) (clipped to 0 .. n), as
- * ulam_system_check does; thread-safe. */
-int ulam_system_verify(const ulam_system *s, int64_t first, int64_t last, ulam_error *err);
-
 /* The mapped matrix, verified whole on the first call (NULL when the file holds none or it is
  * damaged: ulam_system_check says where): read-only, owned by s (never pass it to
  * ulam_csr_free), valid until ulam_system_free. */
@@ -614,7 +607,7 @@ int ulam_certificate_guard(const ulam_certificate *c, double continue_q, const u
                            ulam_guard *g);
 
 /* ---------------------------------------------------------------- random walks */
-/* Primary, except secondary: ulam_share, ulam_solver_guard. */
+/* Primary, except secondary: ulam_share. */
 
 enum ulam_mode { ULAM_ADJOINT = 0, ULAM_FORWARD = 1 };
 enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2 };
@@ -692,7 +685,7 @@ typedef struct ulam_policy_opts {
     int force;           /* 1: walk even when rho(|M|) is not certified below 1 (else ULAM_EDIVERGE) */
     int assume_finite;   /* 1: treat a variance the guards cannot certify either way as finite */
     const ulam_guard *guard; /* the verdicts for this M and continue_q computed before (an earlier
-                                solver's ulam_solver_guard, a prepared system): used instead of
+                                ulam_guard_check, a prepared system): used instead of
                                 computing them when they hold the radii this run needs; NULL:
                                 the solver computes them */
     const ulam_system *system; /* the prepared system M (and b, when it is the system's) come from
@@ -783,7 +776,7 @@ typedef struct ulam_solver ulam_solver;
  * solver is freed, for the walk kernel's rows are built from them when a walk first reaches
  * them (so a query for one x_i reads and keeps only the rows its walks visit).
  * Before any walk it takes the guards' verdicts (opts->policy.guard, or ulam_guard_check on rho(|M|)
- * and this mode's rho(M^), stopped once certified) and keeps them (ulam_solver_guard):
+ * and this mode's rho(M^), stopped once certified) and keeps them:
  *   - rho(|M|) not certified below 1 (>= 1, or bounds straddling 1): ULAM_EDIVERGE unless
  *     opts->policy.force;
  *   - rho(M^) not certified below 1: the variance counts as infinite (result variance_finite
@@ -809,9 +802,6 @@ int ulam_solver_iterate(ulam_solver *s);
  * corrupt mapped file, no memory, a failed exchange, a non-finite score; ULAM_OK while it has
  * not failed. */
 int ulam_solver_error(const ulam_solver *s, ulam_error *err);
-
-/* The guards' verdicts the solver walks under (a plain struct to keep or store). */
-void ulam_solver_guard(const ulam_solver *s, ulam_guard *g);
 
 /* Nonzero once a stopping rule (walks, rel_err, time, interrupt) is met. */
 int ulam_solver_done(const ulam_solver *s);

@@ -222,7 +222,7 @@ int ulam__analysis_walks(ulam_analysis *a, const double *b, const ulam_walk_opts
     }
     while (!status && !ulam_solver_done(s)) status = ulam_solver_iterate(s);
     if (result) ulam_solver_result(s, result);
-    if (guard) ulam_solver_guard(s, guard);
+    if (guard) ulam__solver_guard(s, guard);
     if (status) ulam_solver_error(s, err);
     if ((how & ULAM__WALKS_FIND) && !status) keep_found(a, s);
     if (slot && !k && (how & ULAM__WALKS_KEEP) && !status)

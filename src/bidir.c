@@ -340,7 +340,7 @@ static int plan_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bi
         ulam_solver_result(pl, &r);
         plan->pilot_walks = r.walks, plan->pilot_steps = r.steps;
         plan->mean_visits = r.walks > 0 ? 1.0 + (double)r.steps / (double)r.walks : 1.0;
-        ulam_solver_guard(pl, &memo->guard);
+        ulam__solver_guard(pl, &memo->guard);
         memo->have_guard = 1;
         memo->found = !o->reach_all; /* the walks' reach, kept in at: the estimate's solver need not search again */
     }

@@ -620,15 +620,6 @@ static int verify_part(const ulam_system *s, int part, int64_t first, int64_t la
     return ULAM_OK;
 }
 
-/* Verify the blocks of M and b holding rows [first, last). */
-int ulam_system_verify(const ulam_system *s, int64_t first, int64_t last, ulam_error *err)
-{
-    ulam__clear(err);
-    if (!s) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a system");
-    int status = verify_part(s, PART_M, first, last, err);
-    return status ? status : verify_part(s, PART_B, first, last, err);
-}
-
 /* Verify every block. */
 int ulam_system_check(const ulam_system *s, ulam_error *err)
 {

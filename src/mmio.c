@@ -905,7 +905,7 @@ int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err)
 }
 
 /* Read a dense n x 1 vector from f. */
-int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err)
+static int read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err)
 {
     ulam__clear(err);
     if (!f || !x || !n) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a file and output pointers");
@@ -941,7 +941,7 @@ int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *er
     if (!f) return ULAM_EIO;
     int gz = gunzipped(&f, path, err);
     if (gz) return gz;
-    int status = ulam_mm_read_vector_file(f, path, x, n, err);
+    int status = read_vector_file(f, path, x, n, err);
     fclose(f);
     return status;
 }

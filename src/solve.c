@@ -1665,7 +1665,7 @@ void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
 }
 
 /* The guards' verdicts the solver walks under. */
-void ulam_solver_guard(const ulam_solver *s, ulam_guard *g)
+void ulam__solver_guard(const ulam_solver *s, ulam_guard *g)
 {
     if (s && g) *g = s->g;
 }
