@@ -1546,13 +1546,11 @@ typedef struct ulam_rng {
 /* Seed from a 64-bit seed and a stream number (e.g. a walk or block index). */
 void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream);
 
-/* Next 64 random bits. */
-uint64_t ulam_rng_next(ulam_rng *r);
-
 /* Uniform double in [0, 1) with 53 random bits. */
 double ulam_rng_uniform(ulam_rng *r);
 
-/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
+/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound 0: the next 64
+ * random bits (the whole range, [0, 2^64)). */
 uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
 
 /* What a derived seed is for: the one place sub-runs get their seeds (ulam_rng_substream). */

@@ -28,10 +28,6 @@ enum ulam_options_kind { ULAM_OPTIONS_WALK = ULAM_KIND_WALK, ULAM_OPTIONS_OUTER 
  * 'collision'?)").  opts is untouched unless ULAM_OK. */
 int ulam_options_set(int kind, void *opts, const char *name, const char *value, ulam_error *err);
 
-/* The k-th option (from 0) of kind's table, its own rows first, then the walk rows it hands on:
- * its name, and its help line in *help (may be NULL); NULL past the last. */
-const char *ulam_options_name(int kind, int k, const char **help);
-
 /* Parse value, the text of option opt (named in the message as given, "--walks"), as an integer
  * in [lo, hi] (1e6 and 2.5e3 are read as whole numbers) into *out: ULAM_OK, or ULAM_EINVAL with
  * err->msg the sentence ("--walks expects an integer from 1 to 10, got 'x'"). */

@@ -10,7 +10,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 
-/* xoshiro256** step, inline for the walkers (ulam_rng_next is this). */
+/* xoshiro256** step, inline for the walkers (ulam_rng_bounded(r, 0) is this). */
 static inline uint64_t ulam__rng_next(ulam_rng *r)
 {
     uint64_t *s = r->s;
