@@ -45,7 +45,7 @@
  *   tertiary, mirrors kept for what they pin and utilities: ulam_solve_walks (the walks o names,
  *     no choice, no analysis), ulam_auto and ulam_auto_start (the table's choice on M alone),
  *     ulam_auto_solver (the walks' race alone), ulam_csr_nnz, _matvec, _stats_compute,
- *     _symmetric, ulam_strtod, ulam_outfile_*, ulam_edgelist_*, random numbers (ulam_rng_*),
+ *     ulam_strtod, ulam_outfile_*, ulam_edgelist_*, random numbers (ulam_rng_*),
  *     ulam_now, ulam_file_tag.
  * ulam_dist.h, ulam_study.h and ulam_radiosity.h rank their own.
  */
@@ -197,6 +197,8 @@ typedef struct ulam_csr_stats {
     double abs_rowsum_min; /* min_i sum_j |M_ij| */
     double abs_rowsum_max; /* max_i sum_j |M_ij| */
     int substochastic;    /* nonnegative and every row sum <= 1 */
+    int symmetric;        /* M equals its transpose exactly (CG's condition, with I - M positive
+                             definite) */
 } ulam_csr_stats;
 
 /* Fill *st with the statistics of A. */
@@ -1016,7 +1018,7 @@ int ulam_outer_solve(const ulam_csr *M, const double *b, const ulam_outer_opts *
                      ulam_outer_step *steps, int max_steps, int *nsteps, ulam_error *err);
 
 /* ---------------------------------------------------------------- Krylov peers */
-/* Secondary, except tertiary: ulam_csr_symmetric. */
+/* Secondary (CG asks a symmetric M: ulam_csr_stats_compute's symmetric). */
 
 /* Krylov solvers for (I - M) x = b from x = 0, stopped when ||b - (I - M) x||_2 / ||b||_2 <=
  * tol (the true residual, recomputed at the end): conjugate gradients for symmetric positive
@@ -1029,9 +1031,6 @@ int ulam_cg(const ulam_csr *M, const double *b, double tol, int max_iter, double
             double *residual);
 int ulam_gmres(const ulam_csr *M, const double *b, int restart, double tol, int max_iter, double *x,
                int *iterations, double *residual);
-
-/* Nonzero when M equals its transpose exactly. */
-int ulam_csr_symmetric(const ulam_csr *M);
 
 /* ---------------------------------------------------------------- point sources: push and bidirectional */
 /* All secondary. */

@@ -12,6 +12,7 @@
  * any positive x, min_i (Ax)_i / x_i <= rho <= max_i (Ax)_i / x_i, so each iterate certifies a
  * bracket. */
 #include "spectral.h"
+#include "csr.h"
 #include "defaults.h"
 #include "check.h"
 #include "dynload.h"
@@ -417,7 +418,7 @@ int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, 
     if (!status) {
         for (int64_t i = 0; i < m; i++) one[i] = 1.0;
         double tol = 0.25 / sqrt((double)m); /* ||r||_inf <= ||r||_2 <= 1/4 */
-        int sym = ulam_csr_symmetric(A);
+        int sym = ulam__csr_symmetric(A);
         status = sym               ? ulam_cg(A, one, tol, max_iter, h, &it, NULL)
                  : m <= GMRES_MAX ? ulam_gmres(A, one, 30, tol, max_iter < GMRES_ITER ? max_iter : GMRES_ITER, h, &it, NULL)
                                    : ULAM_ENOCONV; /* 31 Krylov vectors would not be small */
