@@ -27,7 +27,8 @@
  * ranks it holds; sections follow the data flow, file -> matrix -> analysis -> method -> walks
  * -> output):
  *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
- *     ulam_walk_defaults, and for one unknown ONE call on one reusable analysis:
+ *     ulam_walk_defaults (each options struct's wrapper over ulam_defaults), and for one
+ *     unknown ONE call on one reusable analysis:
  *     ulam_analysis_alloc, ulam_analysis_solve (auto by default, a method by name through
  *     ulam_method_find: what `ulam solve` runs), ulam_analysis_free; then ulam_direct_solve,
  *     ulam_mm_write_vector, ulam_strerror;
