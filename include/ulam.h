@@ -27,7 +27,8 @@
  * ranks it holds; sections follow the data flow, file -> matrix -> analysis -> method -> walks
  * -> output):
  *   primary, what most programs call: ulam_mm_read_matrix, ulam_mm_read_vector, ulam_csr_free,
- *     ulam_walk_defaults, and for one unknown ONE call on one reusable analysis:
+ *     ulam_walk_defaults (each options struct's wrapper over ulam_defaults), and for one
+ *     unknown ONE call on one reusable analysis:
  *     ulam_analysis_alloc, ulam_analysis_solve (auto by default, a method by name through
  *     ulam_method_find: what `ulam solve` runs), ulam_analysis_free; then ulam_direct_solve,
  *     ulam_mm_write_vector, ulam_strerror;
@@ -41,12 +42,12 @@
  *     (ulam_spectral_radius), prepared systems (ulam_system_*, ulam_certificate_*), processes
  *     (ulam_share), outer iterations (ulam_outer_*), Krylov peers (ulam_cg, ulam_gmres), point
  *     sources (ulam_analysis_bidir, ulam_fpush_*), the method table (ulam_method_*),
- *     ulam_analysis_transpose, _get_info, ulam_direct_sparse, ulam_direct_bytes;
+ *     ulam_analysis_transpose, _get_info, ulam_direct_bytes, ulam_reference_plan and ulam_reference_solve (ulam_reference.h);
  *   tertiary, mirrors kept for what they pin and utilities: ulam_solve_walks (the walks o names,
  *     no choice, no analysis), ulam_auto and ulam_auto_start (the table's choice on M alone),
  *     ulam_auto_solver (the walks' race alone), ulam_csr_nnz, _matvec, _stats_compute,
- *     _symmetric, ulam_strtod, ulam_outfile_*, ulam_edgelist_*, random numbers (ulam_rng_*),
- *     ulam_now, ulam_alloc_big, ulam_file_tag.
+ *     ulam_strtod, ulam_outfile_*, ulam_edgelist_*, random numbers (ulam_rng_*),
+ *     ulam_now, ulam_file_tag.
  * ulam_dist.h, ulam_study.h and ulam_radiosity.h rank their own.
  */
 #ifndef ULAM_H
@@ -119,6 +120,34 @@ typedef struct ulam_error {
                        file read for an OBJ file); empty otherwise */
 } ulam_error;
 
+/* ---------------------------------------------------------------- defaults */
+/* Primary, through each struct's wrapper (ulam_walk_defaults() ...). */
+
+/* The option structs the library fills with their defaults (ulam_defaults) and, the first three,
+ * sets by name (ulam_options.h). */
+enum ulam_kind {
+    ULAM_KIND_WALK = 0,     /* ulam_walk_opts */
+    ULAM_KIND_OUTER = 1,    /* ulam_outer_opts */
+    ULAM_KIND_BIDIR = 2,    /* ulam_bidir_opts */
+    ULAM_KIND_ANALYSIS = 3, /* ulam_analysis_opts */
+    ULAM_KIND_METHOD = 4,   /* ulam_method_opts */
+    ULAM_KIND_AUTO = 5,     /* ulam_auto_opts */
+    ULAM_KIND_MM = 6,       /* ulam_mm_opts */
+    ULAM_KIND_SPECTRAL = 7, /* ulam_spectral_opts */
+    ULAM_KIND_POWER = 8,    /* ulam_power_opts */
+    ULAM_KIND_GUARD = 9,    /* ulam_guard_opts */
+    ULAM_KIND_FPUSH = 10,   /* ulam_fpush_opts */
+    ULAM_KIND_SHARE = 11,   /* ulam_share */
+    ULAM_KIND_SYSTEM_DESC = 12, /* ulam_system_desc */
+    ULAM_KIND_DIST = 13     /* ulam_dist_opts (ulam_dist.h) */
+};
+
+/* Fill *opts, the struct kind names, with its defaults; size is the caller's sizeof *opts, which
+ * must be this library's.  ULAM_OK, or ULAM_EINVAL (opts zeroed) for an unknown kind or another
+ * size.  Each struct's wrapper below its typedef (ulam_walk_defaults() ...) is this call: the
+ * values stay the library's, so a field a later version adds takes its default there. */
+int ulam_defaults(int kind, void *opts, size_t size);
+
 /* ---------------------------------------------------------------- sparse matrices */
 /* Primary: the struct, ulam_csr_free.  Secondary: building, checking, transposing, ulam_jacobi.
  * Tertiary: nnz, copy, matvec, dense, stats. */
@@ -169,6 +198,8 @@ typedef struct ulam_csr_stats {
     double abs_rowsum_min; /* min_i sum_j |M_ij| */
     double abs_rowsum_max; /* max_i sum_j |M_ij| */
     int substochastic;    /* nonnegative and every row sum <= 1 */
+    int symmetric;        /* M equals its transpose exactly (CG's condition, with I - M positive
+                             definite) */
 } ulam_csr_stats;
 
 /* Fill *st with the statistics of A. */
@@ -224,7 +255,12 @@ typedef struct ulam_mm_opts {
 } ulam_mm_opts;
 
 /* The defaults: all cores (threads 0). */
-ulam_mm_opts ulam_mm_defaults(void);
+static inline ulam_mm_opts ulam_mm_defaults(void)
+{
+    ulam_mm_opts o;
+    ulam_defaults(ULAM_KIND_MM, &o, sizeof o);
+    return o;
+}
 
 /* Read a matrix as ulam_mm_read_matrix, from an open file f (name is used only in error
  * details), with options (o NULL: ulam_mm_defaults()). */
@@ -233,9 +269,6 @@ int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, u
 /* Read a dense vector from path: "array" m x 1, or "coordinate" m x 1 (missing entries are
  * 0).  *x is malloc'd with *n entries. */
 int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *err);
-
-/* As ulam_mm_read_vector, from an open file; name is used only in error details. */
-int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err);
 
 /* strtod(s, end) exactly (the same double and end for every input, C locale), faster for
  * decimals of up to 19 significant digits with normal results (Clinger's fast path, else the
@@ -280,8 +313,8 @@ int ulam_outfile_commit_all(ulam_outfile *o, int k);
 void ulam_outfile_abort(ulam_outfile *o);
 
 /* ---------------------------------------------------------------- direct solve */
-/* Primary: ulam_direct_solve, ulam_direct_sparse.  Secondary: ulam_direct_bytes,
- * ulam_direct_sparse_available. */
+/* Primary: ulam_direct_solve.  Secondary: ulam_direct_bytes.  The sparse LU (UMFPACK) and the
+ * choice between them: ulam_reference.h. */
 
 /* What a LAPACK direct solve reports besides the solution. */
 typedef struct ulam_direct_info {
@@ -300,22 +333,6 @@ size_t ulam_direct_bytes(int64_t n);
 int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
                       ulam_direct_info *info, ulam_error *err);
 
-/* Solve (I - M) x = b by a sparse LU factorisation (UMFPACK, SuiteSparse): memory about that of
- * the factors, not n^2.  UMFPACK's own estimate of the factorisation's peak memory is checked
- * against max_bytes (0: no limit) before it starts (ULAM_EMEMLIMIT); ULAM_ESINGULAR for a
- * singular I - M; ULAM_EUNSUPPORTED when libulam was built without UMFPACK.  info may be NULL
- * (its rcond is UMFPACK's estimate, its bytes the peak memory). */
-int ulam_direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
-                       ulam_direct_info *info, ulam_error *err);
-
-/* What ulam_direct_sparse will need, before it starts: UMFPACK's estimates of the factorisation's
- * peak memory (*bytes) and floating-point operations (*flops), from its symbolic analysis (a
- * fraction of the factorisation's time).  ULAM_EUNSUPPORTED without UMFPACK. */
-int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err);
-
-/* Nonzero when libulam was built with UMFPACK and libumfpack loads (ulam_direct_sparse works). */
-int ulam_direct_sparse_available(void);
-
 /* ---------------------------------------------------------------- spectral radius */
 /* Secondary. */
 
@@ -330,7 +347,12 @@ typedef struct ulam_spectral_opts {
 } ulam_spectral_opts;
 
 /* The defaults: tol 1e-6, max_restarts 300, krylov_dim 20, seed 1. */
-ulam_spectral_opts ulam_spectral_defaults(void);
+static inline ulam_spectral_opts ulam_spectral_defaults(void)
+{
+    ulam_spectral_opts o;
+    ulam_defaults(ULAM_KIND_SPECTRAL, &o, sizeof o);
+    return o;
+}
 
 /* Result of a spectral radius estimate. */
 typedef struct ulam_radius {
@@ -359,7 +381,12 @@ typedef struct ulam_power_opts {
 } ulam_power_opts;
 
 /* The defaults: tol 1e-4, max_iter 1000, certify 0. */
-ulam_power_opts ulam_power_defaults(void);
+static inline ulam_power_opts ulam_power_defaults(void)
+{
+    ulam_power_opts o;
+    ulam_defaults(ULAM_KIND_POWER, &o, sizeof o);
+    return o;
+}
 
 /* Spectral radius of a nonnegative operator by power iteration, with Collatz-Wielandt bounds
  * from the same iterates: for any positive x, min_i (Ax)_i / x_i <= rho(A) <= max_i (Ax)_i / x_i.
@@ -374,10 +401,6 @@ typedef struct ulam_power {
     int converged;       /* stopped by the tolerance: rho is an estimate to tol */
     double seconds;
 } ulam_power;
-
-/* rho(diag(left) |A| diag(right)); left and right may be NULL (all ones).  opts may be NULL. */
-int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
-                        const ulam_power_opts *opts, ulam_power *out, ulam_error *err);
 
 /* ---------------------------------------------------------------- stability guards */
 /* Primary: ulam_guard_check and its options.  Secondary: ulam_verdict_of, ulam_guard_variance. */
@@ -406,7 +429,12 @@ typedef struct ulam_guard_opts {
 
 /* The defaults: all three radii (need ULAM_GUARD_ALL), tight 0 (stopped once certified), power
  * ulam_power_defaults(), kernel_alpha 1. */
-ulam_guard_opts ulam_guard_defaults(void);
+static inline ulam_guard_opts ulam_guard_defaults(void)
+{
+    ulam_guard_opts o;
+    ulam_defaults(ULAM_KIND_GUARD, &o, sizeof o);
+    return o;
+}
 
 /* The guards of a walk on M with continuation continue_q (<= 0: analog) and kernel exponent
  * alpha, a plain struct (a certificate a prepared-system file can store and reload):
@@ -485,7 +513,12 @@ typedef struct ulam_system_desc {
 
 /* The defaults: nothing to write yet (M, b and cert NULL, n 0, tag {0, 0}, omega 0, no
  * transpose); set M and/or b and n. */
-ulam_system_desc ulam_system_desc_defaults(void);
+static inline ulam_system_desc ulam_system_desc_defaults(void)
+{
+    ulam_system_desc o;
+    ulam_defaults(ULAM_KIND_SYSTEM_DESC, &o, sizeof o);
+    return o;
+}
 
 /* Write a prepared system to f (positioned at 0; the caller closes it): ULAM_OK, ULAM_EINVAL
  * (also for an M that fails ulam_csr_check, a b not finite, a certificate without M or whose
@@ -514,10 +547,6 @@ int ulam_system_is_file(const char *path);
  * finite b): one pass over the file, and none again (each block's verdict is kept).  ULAM_OK or
  * ULAM_ESYNTAX with err naming the damaged block (err->index its first row) and the fault. */
 int ulam_system_check(const ulam_system *s, ulam_error *err);
-
-/* Verify the blocks of M and b that hold rows [first, last) (clipped to 0 .. n), as
- * ulam_system_check does; thread-safe. */
-int ulam_system_verify(const ulam_system *s, int64_t first, int64_t last, ulam_error *err);
 
 /* The mapped matrix, verified whole on the first call (NULL when the file holds none or it is
  * damaged: ulam_system_check says where): read-only, owned by s (never pass it to
@@ -581,7 +610,7 @@ int ulam_certificate_guard(const ulam_certificate *c, double continue_q, const u
                            ulam_guard *g);
 
 /* ---------------------------------------------------------------- random walks */
-/* Primary, except secondary: ulam_share, ulam_solver_guard. */
+/* Primary, except secondary: ulam_share. */
 
 enum ulam_mode { ULAM_ADJOINT = 0, ULAM_FORWARD = 1 };
 enum ulam_estimator { ULAM_COLLISION = 0, ULAM_ABSORPTION = 1, ULAM_EXPECTED = 2 };
@@ -600,7 +629,12 @@ typedef struct ulam_share {
 } ulam_share;
 
 /* The defaults: one process (rank 0 of 1; allgather and ctx NULL, never called). */
-ulam_share ulam_share_defaults(void);
+static inline ulam_share ulam_share_defaults(void)
+{
+    ulam_share o;
+    ulam_defaults(ULAM_KIND_SHARE, &o, sizeof o);
+    return o;
+}
 
 /* The walk kernel: how a walk moves and how its weight is kept in a window.  Start from
  * ulam_walk_defaults() (its kernel). */
@@ -654,7 +688,7 @@ typedef struct ulam_policy_opts {
     int force;           /* 1: walk even when rho(|M|) is not certified below 1 (else ULAM_EDIVERGE) */
     int assume_finite;   /* 1: treat a variance the guards cannot certify either way as finite */
     const ulam_guard *guard; /* the verdicts for this M and continue_q computed before (an earlier
-                                solver's ulam_solver_guard, a prepared system): used instead of
+                                ulam_guard_check, a prepared system): used instead of
                                 computing them when they hold the radii this run needs; NULL:
                                 the solver computes them */
     const ulam_system *system; /* the prepared system M (and b, when it is the system's) come from
@@ -678,7 +712,12 @@ typedef struct ulam_walk_opts {
 
 /* The defaults: adjoint collision walks and each part's defaults (index 0, analog kernel with
  * exponent 1, seed 1, all cores, 10^5 walks, walk cap 10^6 steps). */
-ulam_walk_opts ulam_walk_defaults(void);
+static inline ulam_walk_opts ulam_walk_defaults(void)
+{
+    ulam_walk_opts o;
+    ulam_defaults(ULAM_KIND_WALK, &o, sizeof o);
+    return o;
+}
 
 /* What a run has found so far. */
 typedef struct ulam_walk_result {
@@ -740,7 +779,7 @@ typedef struct ulam_solver ulam_solver;
  * solver is freed, for the walk kernel's rows are built from them when a walk first reaches
  * them (so a query for one x_i reads and keeps only the rows its walks visit).
  * Before any walk it takes the guards' verdicts (opts->policy.guard, or ulam_guard_check on rho(|M|)
- * and this mode's rho(M^), stopped once certified) and keeps them (ulam_solver_guard):
+ * and this mode's rho(M^), stopped once certified) and keeps them:
  *   - rho(|M|) not certified below 1 (>= 1, or bounds straddling 1): ULAM_EDIVERGE unless
  *     opts->policy.force;
  *   - rho(M^) not certified below 1: the variance counts as infinite (result variance_finite
@@ -766,9 +805,6 @@ int ulam_solver_iterate(ulam_solver *s);
  * corrupt mapped file, no memory, a failed exchange, a non-finite score; ULAM_OK while it has
  * not failed. */
 int ulam_solver_error(const ulam_solver *s, ulam_error *err);
-
-/* The guards' verdicts the solver walks under (a plain struct to keep or store). */
-void ulam_solver_guard(const ulam_solver *s, ulam_guard *g);
 
 /* Nonzero once a stopping rule (walks, rel_err, time, interrupt) is met. */
 int ulam_solver_done(const ulam_solver *s);
@@ -842,7 +878,12 @@ typedef struct ulam_analysis_opts {
 } ulam_analysis_opts;
 
 /* The defaults: analog continuation, exponent 1, no b, no system, bounds per query. */
-ulam_analysis_opts ulam_analysis_defaults(void);
+static inline ulam_analysis_opts ulam_analysis_defaults(void)
+{
+    ulam_analysis_opts o;
+    ulam_defaults(ULAM_KIND_ANALYSIS, &o, sizeof o);
+    return o;
+}
 
 /* An analysis of square M (borrowed: it must outlive the analysis) under opts (NULL: the
  * defaults).  O(1) work and memory here; what the queries need is made at the first that needs
@@ -911,7 +952,12 @@ typedef struct ulam_outer_opts {
 
 /* The defaults: MCSA, tol 1e-8, max_iter 0, stall 0, eps1 0.1, max_histories 10^8, walk
  * ulam_walk_defaults() but forward expected-value walks (seed 1). */
-ulam_outer_opts ulam_outer_defaults(void);
+static inline ulam_outer_opts ulam_outer_defaults(void)
+{
+    ulam_outer_opts o;
+    ulam_defaults(ULAM_KIND_OUTER, &o, sizeof o);
+    return o;
+}
 
 /* What one iteration did. */
 typedef struct ulam_outer_step {
@@ -973,7 +1019,7 @@ int ulam_outer_solve(const ulam_csr *M, const double *b, const ulam_outer_opts *
                      ulam_outer_step *steps, int max_steps, int *nsteps, ulam_error *err);
 
 /* ---------------------------------------------------------------- Krylov peers */
-/* Secondary, except tertiary: ulam_csr_symmetric. */
+/* Secondary (CG asks a symmetric M: ulam_csr_stats_compute's symmetric). */
 
 /* Krylov solvers for (I - M) x = b from x = 0, stopped when ||b - (I - M) x||_2 / ||b||_2 <=
  * tol (the true residual, recomputed at the end): conjugate gradients for symmetric positive
@@ -986,9 +1032,6 @@ int ulam_cg(const ulam_csr *M, const double *b, double tol, int max_iter, double
             double *residual);
 int ulam_gmres(const ulam_csr *M, const double *b, int restart, double tol, int max_iter, double *x,
                int *iterations, double *residual);
-
-/* Nonzero when M equals its transpose exactly. */
-int ulam_csr_symmetric(const ulam_csr *M);
 
 /* ---------------------------------------------------------------- point sources: push and bidirectional */
 /* All secondary. */
@@ -1053,7 +1096,12 @@ typedef struct ulam_bidir_opts {
 
 /* The defaults: target and source 0, balanced rmax (0), min_value 0 (1 / n), max_push_ops 0
  * (the default cap), walk ulam_walk_defaults(), step_cost 0 (ULAM_BIDIR_STEP_COST). */
-ulam_bidir_opts ulam_bidir_defaults(void);
+static inline ulam_bidir_opts ulam_bidir_defaults(void)
+{
+    ulam_bidir_opts o;
+    ulam_defaults(ULAM_KIND_BIDIR, &o, sizeof o);
+    return o;
+}
 
 /* A bidirectional estimate's plan: the push it runs and what the walks after it
  * are predicted to cost, in a deterministic unit of work (push operations; a walk's visits, its
@@ -1117,7 +1165,12 @@ typedef struct ulam_fpush_opts {
 
 /* The defaults: source 0, rel_err 0.1, min_value 0, walks 0, rmax 0, step_cost 0, walk
  * ulam_walk_defaults() in forward mode. */
-ulam_fpush_opts ulam_fpush_defaults(void);
+static inline ulam_fpush_opts ulam_fpush_defaults(void)
+{
+    ulam_fpush_opts o;
+    ulam_defaults(ULAM_KIND_FPUSH, &o, sizeof o);
+    return o;
+}
 
 /* What a single-source estimate did. */
 typedef struct ulam_fpush_info {
@@ -1234,7 +1287,12 @@ typedef struct ulam_auto_opts {
 } ulam_auto_opts;
 
 /* The default options: nothing pinned, Q = 0.9, pilots of 128 walks doubling up to 1024, 0.2. */
-ulam_auto_opts ulam_auto_defaults(void);
+static inline ulam_auto_opts ulam_auto_defaults(void)
+{
+    ulam_auto_opts o;
+    ulam_defaults(ULAM_KIND_AUTO, &o, sizeof o);
+    return o;
+}
 
 /* The candidates and the choice. */
 typedef struct ulam_auto_result {
@@ -1326,7 +1384,12 @@ typedef struct ulam_method_opts {
 } ulam_method_opts;
 
 /* The defaults: no row pinned (method -1), none excluded. */
-ulam_method_opts ulam_method_defaults(void);
+static inline ulam_method_opts ulam_method_defaults(void)
+{
+    ulam_method_opts o;
+    ulam_defaults(ULAM_KIND_METHOD, &o, sizeof o);
+    return o;
+}
 
 /* What became of a row in a choice. */
 enum ulam_method_state {
@@ -1483,13 +1546,11 @@ typedef struct ulam_rng {
 /* Seed from a 64-bit seed and a stream number (e.g. a walk or block index). */
 void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream);
 
-/* Next 64 random bits. */
-uint64_t ulam_rng_next(ulam_rng *r);
-
 /* Uniform double in [0, 1) with 53 random bits. */
 double ulam_rng_uniform(ulam_rng *r);
 
-/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound > 0. */
+/* Unbiased uniform integer in [0, bound) (Lemire's multiply-and-reject); bound 0: the next 64
+ * random bits (the whole range, [0, 2^64)). */
 uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound);
 
 /* What a derived seed is for: the one place sub-runs get their seeds (ulam_rng_substream). */
@@ -1513,12 +1574,6 @@ uint64_t ulam_rng_substream(uint64_t seed, ulam_stream_purpose p, uint64_t k);
 
 /* Monotonic wall clock in seconds. */
 double ulam_now(void);
-
-/* Uninitialised memory for n items of size sz, for a large array read at random (a vector of n
- * for ulam_fpush_solve, say): cache-line aligned, and from 2 MiB on, 2 MiB aligned with
- * transparent huge pages asked for (a first touch and a TLB miss cost less); freed with free();
- * NULL on overflow or failure. */
-void *ulam_alloc_big(size_t n, size_t sz);
 
 #ifdef __cplusplus
 }

@@ -79,7 +79,12 @@ typedef struct ulam_dist_opts {
 } ulam_dist_opts;
 
 /* The defaults above. */
-ulam_dist_opts ulam_dist_defaults(void);
+static inline ulam_dist_opts ulam_dist_defaults(void)
+{
+    ulam_dist_opts o;
+    ulam_defaults(ULAM_KIND_DIST, &o, sizeof o);
+    return o;
+}
 
 /* What a partitioned run did (the same on every rank). */
 typedef struct ulam_dist_result {

@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 /* The option structs a table row may set. */
-enum ulam_options_kind { ULAM_OPTIONS_WALK = 0, ULAM_OPTIONS_OUTER = 1, ULAM_OPTIONS_BIDIR = 2 };
+enum ulam_options_kind { ULAM_OPTIONS_WALK = ULAM_KIND_WALK, ULAM_OPTIONS_OUTER = ULAM_KIND_OUTER, ULAM_OPTIONS_BIDIR = ULAM_KIND_BIDIR };
 
 /* Set option name of opts, a ulam_walk_opts, ulam_outer_opts or ulam_bidir_opts as kind says,
  * from its text value, checked against the option's range.  The walk options: "walks",
@@ -29,10 +29,6 @@ enum ulam_options_kind { ULAM_OPTIONS_WALK = 0, ULAM_OPTIONS_OUTER = 1, ULAM_OPT
  * expects an integer from 1 to ..., got 'x'"; an enum's with the closest name: "(did you mean
  * 'collision'?)").  opts is untouched unless ULAM_OK. */
 int ulam_options_set(int kind, void *opts, const char *name, const char *value, ulam_error *err);
-
-/* The k-th option (from 0) of kind's table, its own rows first, then the walk rows it hands on:
- * its name, and its help line in *help (may be NULL); NULL past the last. */
-const char *ulam_options_name(int kind, int k, const char **help);
 
 /* Parse value, the text of option opt (named in the message as given, "--walks"), as an integer
  * in [lo, hi] (1e6 and 2.5e3 are read as whole numbers) into *out: ULAM_OK, or ULAM_EINVAL with

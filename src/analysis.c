@@ -10,6 +10,7 @@
  * solvers": the walk solver's construction and caching calls (ulam__solver_alloc_reached,
  * ulam__solver_keep_kernel*, ulam__solver_reached, ulam__reach_all) are made here. */
 #include "analysis.h"
+#include "defaults.h"
 #include "cache.h"
 #include "kernel.h"
 #include "push.h"
@@ -40,14 +41,13 @@ struct ulam_analysis {
     ulam_csr *T;          /* the transpose made here (NULL: not made) */
     const ulam_csr *Tuse; /* the transpose: T or the prepared file's stored one (NULL until asked) */
     ulam_push *push;      /* the push workspace on M (NULL until asked) */
-    void *kept;           /* the bidirectional planner's memo on push and Tuse (NULL until made; opaque
-                             here, dropped with drop: ulam__analysis_keep) */
-    void (*drop)(void *);
+    ulam__bidir *bidir;   /* the bidirectional planner's memo on push and Tuse (NULL until made:
+                             ulam__analysis_bidir; src/bidir.c fills it) */
     double seconds;
 };
 
 /* The defaults. */
-ulam_analysis_opts ulam_analysis_defaults(void)
+ulam_analysis_opts ulam__analysis_defaults(void)
 {
     return (ulam_analysis_opts){.size = sizeof(ulam_analysis_opts), .continue_q = 0.0, .kernel_alpha = 1.0};
 }
@@ -81,7 +81,7 @@ int ulam_analysis_alloc(const ulam_csr *M, const ulam_analysis_opts *opts, ulam_
 ulam_analysis *ulam_analysis_free(ulam_analysis *a)
 {
     if (!a) return NULL;
-    if (a->kept && a->drop) a->drop(a->kept); /* first: it may hold an analysis of the transpose */
+    ulam__bidir_free(a->bidir); /* first: it may hold an analysis of the transpose */
     for (int e = 0; e < 3; e++) ulam__kernel_free(a->k[e]);
     ulam__kernel_free(a->kr);
     free(a->found);
@@ -221,7 +221,7 @@ int ulam__analysis_walks(ulam_analysis *a, const double *b, const ulam_walk_opts
     }
     while (!status && !ulam_solver_done(s)) status = ulam_solver_iterate(s);
     if (result) ulam_solver_result(s, result);
-    if (guard) ulam_solver_guard(s, guard);
+    if (guard) ulam__solver_guard(s, guard);
     if (status) ulam_solver_error(s, err);
     if ((how & ULAM__WALKS_FIND) && !status) keep_found(a, s);
     if (slot && !k && (how & ULAM__WALKS_KEEP) && !status)
@@ -296,17 +296,29 @@ void ulam__analysis_kernel(const ulam_analysis *a, double *continue_q, double *a
     *continue_q = a->continue_q, *alpha = a->alpha;
 }
 
-/* What a caller keeps with a (NULL: nothing yet). */
-void *ulam__analysis_kept(const ulam_analysis *a)
+/* An empty memo. */
+ulam__bidir *ulam__bidir_alloc(void)
 {
-    return a->kept;
+    return calloc(1, sizeof(ulam__bidir));
 }
 
-/* Keep m with a, dropped with drop when a is freed (after any m kept before). */
-void ulam__analysis_keep(ulam_analysis *a, void *m, void (*drop)(void *))
+/* Free a memo. */
+ulam__bidir *ulam__bidir_free(ulam__bidir *m)
 {
-    if (a->kept && a->drop) a->drop(a->kept);
-    a->kept = m, a->drop = drop;
+    if (!m) return NULL;
+    free(m->idx), free(m->val), free(m->ones);
+    ulam_analysis_free(m->at);
+    free(m);
+    return NULL;
+}
+
+
+/* a's memo of the bidirectional planner (made at the first call). */
+ulam__bidir *ulam__analysis_bidir(ulam_analysis *a, ulam_error *err)
+{
+    if (!a->bidir && !(a->bidir = ulam__bidir_alloc()))
+        ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
+    return a->bidir;
 }
 
 /* 1 when a's queries share its bounds over every state (ulam_analysis_opts.shared_bounds). */

@@ -19,11 +19,40 @@ const ulam_csr *ulam__analysis_transpose(ulam_analysis *a, double *seconds, ulam
 const ulam_csr *ulam__analysis_matrix(const ulam_analysis *a);
 void ulam__analysis_kernel(const ulam_analysis *a, double *continue_q, double *alpha);
 
-/* What a caller (the bidirectional planner: its memo, src/bidir.h) keeps with an analysis: NULL
- * until ulam__analysis_keep; m is dropped with drop when the analysis is freed (or another is
- * kept), before the rest of the analysis. */
-void *ulam__analysis_kept(const ulam_analysis *a);
-void ulam__analysis_keep(ulam_analysis *a, void *m, void (*drop)(void *));
+/* The bidirectional planner's memo (src/bidir.c fills it; an analysis owns one, and a caller
+ * of the bare-workspace calls ulam__bidir_plan and ulam__bidir_solve its own): the last plan made on a push workspace (w, at its state stamp, for Mt and options o
+ * with b's entries copied: idx, val, cap entries of room), what it found and the guards its
+ * pilot computed; the pilot's scores, and the analysis of Mt the walks are handed out by (for one
+ * continuation and exponent: made again for another), for later queries. */
+typedef struct ulam__bidir {
+    int valid;
+    const ulam_push *w; /* the workspace it was made on, and its stamp then (ulam__push_stamp) */
+    uint64_t stamp;
+    const ulam_csr *Mt; /* the transpose it was made with */
+    ulam_bidir_opts o;
+    int64_t *idx;
+    double *val;
+    int64_t cap;
+    ulam_bidir_plan_info plan;
+    ulam_guard guard; /* the pilot's guards on Mt, for the walks (have_guard 0: none) */
+    int have_guard;
+    double *ones; /* n ones (NULL until a pilot needs them): the pilot's scores */
+    int found;    /* 1: this plan's pilot searched the states its walks reach, kept by at (ULAM__WALKS_FIND) */
+    ulam_analysis *at; /* the walks' analysis of Mt (NULL until walks need it): their bounds over every
+                          state, kept kernels (fixed for the pilot's ones, rescored for the residual)
+                          and the pilot's reach */
+    const ulam_csr *at_K; /* what at was made for: its matrix, continuation (0: analog) and exponent */
+    double at_q, at_alpha;
+} ulam__bidir;
+
+/* An empty memo (NULL: no memory), and its free (accepts NULL; src/analysis.c). */
+ulam__bidir *ulam__bidir_alloc(void);
+ulam__bidir *ulam__bidir_free(ulam__bidir *m);
+
+/* The analysis' memo of the bidirectional planner, made at the first call and freed with the
+ * analysis (before the rest of it: it holds an analysis of the transpose); NULL when memory runs
+ * out (err filled). */
+ulam__bidir *ulam__analysis_bidir(ulam_analysis *a, ulam_error *err);
 
 /* What an analysis lends an internal caller's walks and keeps from them (ulam__analysis_walks). */
 enum {

@@ -12,6 +12,7 @@
  * candidate's solver: the choice is a function of the pilots alone, which are independent of
  * those walks, so it cannot bias them (README: reusing the pilot's walks would). */
 #include "auto.h"
+#include "defaults.h"
 #include "analysis.h"
 #include "check.h"
 #include "solve.h"
@@ -69,7 +70,7 @@ static int alloc_solver(const chooser *c, const ulam_walk_opts *o, ulam_solver *
 }
 
 /* The default options. */
-ulam_auto_opts ulam_auto_defaults(void)
+ulam_auto_opts ulam__auto_defaults(void)
 {
     return (ulam_auto_opts){.continue_q = 0.9, .pilot_walks = 128, .pilot_max = 1024, .pilot_share = 0.2};
 }

@@ -23,6 +23,7 @@
  * analysis of M' the memo holds (ulam__analysis_walks), which keeps what later walks share: the
  * bounds over every state (reach_all), the kernel rows (keep_kernel) and the reach a pilot found. */
 #include "bidir.h"
+#include "defaults.h"
 #include "analysis.h"
 #include "check.h"
 #include "push.h"
@@ -48,50 +49,9 @@ static double step_cost(const ulam_bidir_opts *o)
 }
 
 /* The defaults. */
-ulam_bidir_opts ulam_bidir_defaults(void)
+ulam_bidir_opts ulam__bidir_defaults(void)
 {
     return (ulam_bidir_opts){.walk = ulam_walk_defaults()};
-}
-
-/* The memo: the last plan made on a push workspace (w, at its state stamp, for Mt and options o
- * with b's entries copied: idx, val, cap entries of room), what it found and the guards its
- * pilot computed; the pilot's scores, and the analysis of Mt the walks are handed out by (for one
- * continuation and exponent: made again for another), for later queries. */
-struct ulam__bidir {
-    int valid;
-    const ulam_push *w; /* the workspace it was made on, and its stamp then (ulam__push_stamp) */
-    uint64_t stamp;
-    const ulam_csr *Mt; /* the transpose it was made with */
-    ulam_bidir_opts o;
-    int64_t *idx;
-    double *val;
-    int64_t cap;
-    ulam_bidir_plan_info plan;
-    ulam_guard guard; /* the pilot's guards on Mt, for the walks (have_guard 0: none) */
-    int have_guard;
-    double *ones; /* n ones (NULL until a pilot needs them): the pilot's scores */
-    int found;    /* 1: this plan's pilot searched the states its walks reach, kept by at (ULAM__WALKS_FIND) */
-    ulam_analysis *at; /* the walks' analysis of Mt (NULL until walks need it): their bounds over every
-                          state, kept kernels (fixed for the pilot's ones, rescored for the residual)
-                          and the pilot's reach */
-    const ulam_csr *at_K; /* what at was made for: its matrix, continuation (0: analog) and exponent */
-    double at_q, at_alpha;
-};
-
-/* An empty memo. */
-static ulam__bidir *ulam__bidir_alloc(void)
-{
-    return calloc(1, sizeof(ulam__bidir));
-}
-
-/* Free a memo. */
-static ulam__bidir *ulam__bidir_free(ulam__bidir *m)
-{
-    if (!m) return NULL;
-    free(m->idx), free(m->val), free(m->ones);
-    ulam_analysis_free(m->at);
-    free(m);
-    return NULL;
 }
 
 /* Check the options against M and Mt. */
@@ -339,7 +299,7 @@ static int plan_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bi
         ulam_solver_result(pl, &r);
         plan->pilot_walks = r.walks, plan->pilot_steps = r.steps;
         plan->mean_visits = r.walks > 0 ? 1.0 + (double)r.steps / (double)r.walks : 1.0;
-        ulam_solver_guard(pl, &memo->guard);
+        ulam__solver_guard(pl, &memo->guard);
         memo->have_guard = 1;
         memo->found = !o->reach_all; /* the walks' reach, kept in at: the estimate's solver need not search again */
     }
@@ -456,36 +416,20 @@ static int solve_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__b
     return ULAM_OK;
 }
 
-/* Drop a memo kept with a bare push workspace. */
-static void drop_memo(void *m)
+/* Plan x_t's estimate on a bare push workspace with the caller's memo (see bidir.h). */
+int ulam__bidir_plan(ulam_push *w, ulam__bidir *memo, const ulam_csr *Mt, const ulam_bidir_opts *o,
+                     ulam_bidir_plan_info *plan, ulam_error *err)
 {
-    ulam__bidir_free(m);
+    if (w && !memo) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a memo for the plan");
+    return plan_on(w ? ulam__push_matrix(w) : NULL, Mt, w, memo, o, plan, err);
 }
 
-/* The memo kept with a bare push workspace, made at its first plan (NULL: no memory). */
-static ulam__bidir *kept_memo(ulam_push *w)
+/* Estimate x_t on a bare push workspace with the caller's memo (see bidir.h). */
+int ulam__bidir_solve(ulam_push *w, ulam__bidir *memo, const ulam_csr *Mt, const ulam_bidir_opts *o,
+                      ulam_bidir_result *res, ulam_error *err)
 {
-    ulam__bidir *m = ulam__push_kept(w);
-    if (!m && (m = ulam__bidir_alloc())) ulam__push_keep(w, m, drop_memo);
-    return m;
-}
-
-/* Plan x_t's estimate on a bare push workspace (see ulam.h). */
-int ulam__bidir_plan(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_plan_info *plan,
-                    ulam_error *err)
-{
-    ulam__bidir *m = w ? kept_memo(w) : NULL;
-    if (w && !m) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
-    return plan_on(w ? ulam__push_matrix(w) : NULL, Mt, w, m, o, plan, err);
-}
-
-/* Estimate x_t on a bare push workspace (see ulam.h). */
-int ulam__bidir_solve(ulam_push *w, const ulam_csr *Mt, const ulam_bidir_opts *o, ulam_bidir_result *res,
-                     ulam_error *err)
-{
-    ulam__bidir *m = w ? kept_memo(w) : NULL;
-    if (w && !m) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
-    return solve_on(w ? ulam__push_matrix(w) : NULL, Mt, w, m, o, res, err);
+    if (w && !memo) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a memo for the plan");
+    return solve_on(w ? ulam__push_matrix(w) : NULL, Mt, w, memo, o, res, err);
 }
 
 /* The analysis' transpose, push workspace and memo (made at the first call); 0 or a status. */
@@ -493,11 +437,7 @@ static int take(ulam_analysis *a, const ulam_csr **Mt, ulam_push **w, ulam__bidi
 {
     if (!a) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an analysis");
     if (!(*Mt = ulam__analysis_transpose(a, NULL, err)) || !(*w = ulam__analysis_push(a, err))) return ULAM_ENOMEM;
-    if (!(*memo = ulam__analysis_kept(a))) {
-        if (!(*memo = ulam__bidir_alloc())) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the plan's memo");
-        ulam__analysis_keep(a, *memo, drop_memo);
-    }
-    return ULAM_OK;
+    return (*memo = ulam__analysis_bidir(a, err)) ? ULAM_OK : ULAM_ENOMEM;
 }
 
 /* Plan on an analysis (any kernel: the memo keys its plans on the options). */

@@ -69,6 +69,7 @@ static void test_push_invariant(void **state)
         }
         ulam_push *w = NULL;
         assert_int_equal(ulam__push_alloc(M, &w), ULAM_OK);
+        ulam__bidir *w_memo = ulam__bidir_alloc(); /* its plan memo */
         for (int64_t t = 0; t < n; t += n / 4) {
             assert_int_equal(ulam__push_start(w, t), ULAM_OK);
             for (int q = 0; q < 3; q++) assert_invariant(w, M, t, b[q], x[q], k);
@@ -87,7 +88,7 @@ static void test_push_invariant(void **state)
             for (int q = 0; q < 3; q++) assert_invariant(w, M, t, b[q], x[q], k);
         }
         for (int q = 0; q < 3; q++) free(b[q]), free(x[q]);
-        ulam__push_free(w);
+        ulam__push_free(w), ulam__bidir_free(w_memo);
         ulam_csr_free(M);
     }
     test_case_done();
@@ -102,6 +103,7 @@ static void test_push_bad_input(void **state)
     assert_int_equal(ulam__push_alloc(R, &w), ULAM_ENOTSQUARE);
     assert_null(w);
     assert_int_equal(ulam__push_alloc(M, &w), ULAM_OK);
+    ulam__bidir *w_memo = ulam__bidir_alloc(); /* its plan memo */
     assert_int_equal(ulam__push_run(w, 0.1, 0), ULAM_EINVAL); /* not started */
     assert_int_equal(ulam__push_start(w, 10), ULAM_EINVAL);
     assert_int_equal(ulam__push_start(w, -1), ULAM_EINVAL);
@@ -115,16 +117,16 @@ static void test_push_bad_input(void **state)
     ulam_bidir_result res;
     ulam_error err;
     o.source = 10;
-    assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL);
+    assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_EINVAL);
     assert_non_null(strstr(err.msg, "source"));
     o.source = 0, o.target = -1;
-    assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL);
+    assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_EINVAL);
     o.target = 0, o.rmax = INFINITY;
-    assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL);
+    assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_EINVAL);
     o.rmax = 0;
-    assert_int_equal(ulam__bidir_solve(w, R, &o, &res, &err), ULAM_EINVAL); /* not M's transpose */
+    assert_int_equal(ulam__bidir_solve(w, w_memo, R, &o, &res, &err), ULAM_EINVAL); /* not M's transpose */
     assert_null(ulam__push_free(NULL));
-    ulam__push_free(w);
+    ulam__push_free(w), ulam__bidir_free(w_memo);
     ulam_csr_free(M), ulam_csr_free(Mt), ulam_csr_free(R);
 }
 
@@ -133,12 +135,13 @@ static ulam_bidir_result bidir(const ulam_csr *M, const ulam_csr *Mt, const ulam
 {
     ulam_push *w = NULL;
     assert_int_equal(ulam__push_alloc(M, &w), ULAM_OK);
+    ulam__bidir *w_memo = ulam__bidir_alloc(); /* its plan memo */
     ulam_bidir_result res;
     ulam_error err;
-    int st = ulam__bidir_solve(w, Mt, o, &res, &err);
+    int st = ulam__bidir_solve(w, w_memo, Mt, o, &res, &err);
     if (st) print_error("ulam__bidir_solve: %s: %s\n", ulam_strerror(st), err.msg);
     assert_int_equal(st, ULAM_OK);
-    ulam__push_free(w);
+    ulam__push_free(w), ulam__bidir_free(w_memo);
     return res;
 }
 
@@ -199,10 +202,12 @@ static void test_bidir_plan(void **state)
     o.source = 3, o.target = 10, o.walk.stop.max_walks = 0, o.walk.stop.rel_err = 0.05, o.walk.exec.threads = 1;
     ulam_push *w = NULL, *fresh = NULL;
     assert_int_equal(ulam__push_alloc(M, &w), ULAM_OK);
+    ulam__bidir *w_memo = ulam__bidir_alloc(); /* its plan memo */
     assert_int_equal(ulam__push_alloc(M, &fresh), ULAM_OK);
+    ulam__bidir *fresh_memo = ulam__bidir_alloc(); /* its plan memo */
     ulam_bidir_plan_info plan, again;
     ulam_error err;
-    assert_int_equal(ulam__bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_plan(w, w_memo, Mt, &o, &plan, &err), ULAM_OK);
     ulam_push_info pi;
     ulam__push_report(w, &pi);
     assert_true(plan.balanced && plan.target == 10 && plan.rmax == pi.rmax && plan.push.ops == pi.ops && pi.ops > 0);
@@ -212,45 +217,45 @@ static void test_bidir_plan(void **state)
     assert_close(plan.predicted_work, (double)plan.push.ops + plan.step_cost * ((double)(256 + plan.pilot_steps) +
                                       plan.predicted_walks * plan.mean_visits), 1e-9 * plan.predicted_work);
     ulam_bidir_result res, ref;
-    assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_OK);
     print_message("plan: rmax %g, %lld push operations, %g walks predicted; the solve ran %lld\n", plan.rmax,
                   (long long)plan.push.ops, plan.predicted_walks, (long long)res.walks.walks);
     assert_true(res.plan_reused && res.push.ops == plan.push.ops && res.push.pushes == plan.push.pushes);
     assert_memory_equal(&res.plan.predicted_work, &plan.predicted_work, sizeof plan.predicted_work);
-    assert_int_equal(ulam__bidir_solve(fresh, Mt, &o, &ref, &err), ULAM_OK); /* plans inside */
+    assert_int_equal(ulam__bidir_solve(fresh, fresh_memo, Mt, &o, &ref, &err), ULAM_OK); /* plans inside */
     assert_false(ref.plan_reused);
     assert_memory_equal(&res.estimate, &ref.estimate, sizeof res.estimate);
     assert_memory_equal(&res.std_error, &ref.std_error, sizeof res.std_error);
     assert_true(ref.plan.rmax == plan.rmax && ref.plan.push.ops == plan.push.ops && ref.walks.walks == res.walks.walks);
-    assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_OK); /* still the plan in place */
+    assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_OK); /* still the plan in place */
     assert_true(res.plan_reused);
     o.walk.kernel.kernel_alpha = 2.0; /* another kernel exponent: its walks' plan is another (issue 29) */
-    int st = ulam__bidir_solve(w, Mt, &o, &res, &err);
+    int st = ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err);
     assert_true(st != ULAM_OK || !res.plan_reused);
     o.walk.kernel.kernel_alpha = 1.0;
     o.walk.exec.seed = 2; /* another pilot: plan again */
-    assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_OK);
     assert_false(res.plan_reused);
-    assert_int_equal(ulam__bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_plan(w, w_memo, Mt, &o, &plan, &err), ULAM_OK);
     assert_int_equal(ulam__push_run(w, plan.rmax / 2, 0), ULAM_OK); /* the push moved on: plan again */
-    assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_OK);
     assert_false(res.plan_reused);
     assert_true(res.push.rmax == plan.rmax && res.push.ops == plan.push.ops);
     o.walk.exec.threads = 2;
-    assert_int_equal(ulam__bidir_plan(w, Mt, &o, &again, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_plan(w, w_memo, Mt, &o, &again, &err), ULAM_OK);
     assert_true(again.rmax == plan.rmax && again.push.ops == plan.push.ops && again.pilot_steps == plan.pilot_steps);
     assert_memory_equal(&again.predicted_work, &plan.predicted_work, sizeof plan.predicted_work);
     o.rmax = 0.01, o.walk.stop.rel_err = 0, o.walk.stop.max_walks = 5000; /* given rmax: no pilot, walks known */
-    assert_int_equal(ulam__bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_plan(w, w_memo, Mt, &o, &plan, &err), ULAM_OK);
     assert_true(!plan.balanced && plan.pilot_walks == 0 && plan.rmax == 0.01 && plan.predicted_walks == 5000);
     assert_true(isnan(plan.predicted_work)); /* V unknown */
     o.walk.stop.rel_err = 0.05, o.walk.stop.max_walks = 0;
-    assert_int_equal(ulam__bidir_plan(w, Mt, &o, &plan, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_plan(w, w_memo, Mt, &o, &plan, &err), ULAM_OK);
     assert_true(isnan(plan.predicted_walks) && isnan(plan.predicted_work)); /* no pilot measured V */
     o.source = 150;
-    assert_int_equal(ulam__bidir_plan(w, Mt, &o, &plan, &err), ULAM_EINVAL);
-    assert_int_equal(ulam__bidir_plan(NULL, Mt, &o, &plan, &err), ULAM_EINVAL);
-    ulam__push_free(w), ulam__push_free(fresh);
+    assert_int_equal(ulam__bidir_plan(w, w_memo, Mt, &o, &plan, &err), ULAM_EINVAL);
+    assert_int_equal(ulam__bidir_plan(NULL, NULL, Mt, &o, &plan, &err), ULAM_EINVAL);
+    ulam__push_free(w), ulam__bidir_free(w_memo), ulam__push_free(fresh), ulam__bidir_free(fresh_memo);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
@@ -271,20 +276,22 @@ static void test_analysis_bidir_exponent(void **state)
     ulam_push *w = ulam__analysis_push(a, &err);
     assert_non_null(T);
     assert_non_null(w);
+    ulam__bidir *w_memo = ulam__bidir_alloc(); /* a plan memo of its own on the analysis' workspace */
     ulam_bidir_opts o = ulam_bidir_defaults();
     o.source = 3, o.target = 10, o.walk.stop.max_walks = 4000, o.walk.stop.rel_err = 0, o.walk.exec.threads = 1;
     ulam_bidir_plan_info plan;
     ulam_bidir_result one, two, ref;
-    assert_int_equal(ulam__bidir_plan(w, T, &o, &plan, &err), ULAM_OK);
-    assert_int_equal(ulam__bidir_solve(w, T, &o, &one, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_plan(w, w_memo, T, &o, &plan, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_solve(w, w_memo, T, &o, &one, &err), ULAM_OK);
     assert_true(one.plan_reused); /* the same options: the plan in place */
     ulam_bidir_opts o2 = o;
     o2.walk.kernel.kernel_alpha = 2.0;
-    assert_int_equal(ulam__bidir_solve(w, T, &o2, &two, &err), ULAM_OK);
+    assert_int_equal(ulam__bidir_solve(w, w_memo, T, &o2, &two, &err), ULAM_OK);
     assert_false(two.plan_reused); /* another exponent: another plan */
     ulam_push *fresh = NULL;
     assert_int_equal(ulam__push_alloc(M, &fresh), ULAM_OK);
-    assert_int_equal(ulam__bidir_solve(fresh, Mt, &o2, &ref, &err), ULAM_OK);
+    ulam__bidir *fresh_memo = ulam__bidir_alloc(); /* its plan memo */
+    assert_int_equal(ulam__bidir_solve(fresh, fresh_memo, Mt, &o2, &ref, &err), ULAM_OK);
     assert_memory_equal(&two.estimate, &ref.estimate, sizeof ref.estimate);
     assert_memory_equal(&two.std_error, &ref.std_error, sizeof ref.std_error);
     assert_true(two.plan.rmax == ref.plan.rmax && two.plan.pilot_steps == ref.plan.pilot_steps);
@@ -333,8 +340,9 @@ static void test_analysis_bidir_exponent(void **state)
         if (k == 1) assert_true(ch.transpose_seconds == 0.0 && cref.transpose_seconds > 0.0);
     }
     ulam_analysis_free(a3);
+    ulam__bidir_free(w_memo);
     free(bv);
-    ulam__push_free(fresh);
+    ulam__push_free(fresh), ulam__bidir_free(fresh_memo);
     ulam_analysis_free(a);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
@@ -398,6 +406,7 @@ static void test_bidir_sparse_b(void **state)
         assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
         ulam_push *w = NULL;
         assert_int_equal(ulam__push_alloc(M, &w), ULAM_OK);
+        ulam__bidir *w_memo = ulam__bidir_alloc(); /* its plan memo */
         for (int q = 0; q < 2; q++)
             for (int est = ULAM_COLLISION; est <= ULAM_EXPECTED; est += 2) {
                 ulam_bidir_opts o = ulam_bidir_defaults();
@@ -405,7 +414,7 @@ static void test_bidir_sparse_b(void **state)
                 o.walk.stop.max_walks = 20000, o.walk.estimator = est, o.walk.exec.seed = (uint64_t)(k * 10 + q + 100);
                 ulam_bidir_result res;
                 ulam_error err;
-                int st = ulam__bidir_solve(w, Mt, &o, &res, &err);
+                int st = ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err);
                 if (st) print_error("case %d: %s: %s\n", k, ulam_strerror(st), err.msg);
                 assert_int_equal(st, ULAM_OK);
                 assert_invariant(w, M, t, b, x, k);
@@ -423,7 +432,7 @@ static void test_bidir_sparse_b(void **state)
                 if (k == 1 && q == 1 && est == ULAM_COLLISION) { /* any thread count, the same answer */
                     ulam_bidir_result two;
                     o.walk.exec.threads = 2;
-                    assert_int_equal(ulam__bidir_solve(w, Mt, &o, &two, &err), ULAM_OK);
+                    assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &two, &err), ULAM_OK);
                     assert_memory_equal(&two.estimate, &res.estimate, sizeof res.estimate);
                     assert_memory_equal(&two.std_error, &res.std_error, sizeof res.std_error);
                 }
@@ -434,12 +443,12 @@ static void test_bidir_sparse_b(void **state)
         int64_t bad_idx[2] = {0, n};
         double zeros[2] = {0, 0}, nan_val[2] = {1, NAN};
         o.target = t, o.nb = 2, o.b_index = bad_idx, o.b_value = val;
-        assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL); /* index n */
+        assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_EINVAL); /* index n */
         o.b_index = idx, o.b_value = zeros;
-        assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL); /* ||b||_1 = 0 */
+        assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_EINVAL); /* ||b||_1 = 0 */
         o.b_value = nan_val;
-        assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_EINVAL);
-        ulam__push_free(w);
+        assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_EINVAL);
+        ulam__push_free(w), ulam__bidir_free(w_memo);
         free(b), free(x);
         ulam_csr_free(M), ulam_csr_free(Mt);
     }
@@ -682,6 +691,7 @@ static void test_bidir_reach_all(void **state)
         int64_t n = M->nrows;
         ulam_push *shared = NULL;
         assert_int_equal(ulam__push_alloc(M, &shared), ULAM_OK);
+        ulam__bidir *shared_memo = ulam__bidir_alloc(); /* its plan memo */
         for (int qe = 0; qe < 12; qe++) { /* collision, absorption, expected: 4 queries each (a kernel kept 4) */
             int q = qe % 4, est = qe < 4 ? ULAM_COLLISION : qe < 8 ? ULAM_ABSORPTION : ULAM_EXPECTED;
             if (!test_case(100L * k + qe)) continue;
@@ -694,7 +704,7 @@ static void test_bidir_reach_all(void **state)
             if (est == ULAM_ABSORPTION) o.walk.kernel.continue_q = 0.9; /* rows of M' may sum past 1: p* = 0.1 */
             ulam_bidir_result res;
             ulam_error err;
-            int st = ulam__bidir_solve(shared, Mt, &o, &res, &err);
+            int st = ulam__bidir_solve(shared, shared_memo, Mt, &o, &res, &err);
             if (st) print_error("case %d: %s: %s\n", 100 * k + qe, ulam_strerror(st), err.msg);
             assert_int_equal(st, ULAM_OK);
             double z = (res.estimate - x[t]) / (res.std_error + 1e-13 * fabs(x[t]) + 1e-300);
@@ -718,7 +728,7 @@ static void test_bidir_reach_all(void **state)
             }
             free(x);
         }
-        ulam__push_free(shared);
+        ulam__push_free(shared), ulam__bidir_free(shared_memo);
         ulam_csr_free(M), ulam_csr_free(Mt);
     }
     test_case_done();
@@ -747,6 +757,7 @@ static void test_bidir_fixed_walks_honest(void **state)
     assert_true(x[t] > 0.002 && x[t] < 0.004);
     ulam_push *w = NULL;
     assert_int_equal(ulam__push_alloc(M, &w), ULAM_OK);
+    ulam__bidir *w_memo = ulam__bidir_alloc(); /* its plan memo */
     static const struct { int est, seeds, need; double rmax; } cases[] = {
         {ULAM_COLLISION, 200, 180, 0}, {ULAM_ABSORPTION, 100, 95, 0}, {ULAM_COLLISION, 100, 90, 2}};
     for (int c = 0; c < 3; c++) {
@@ -759,7 +770,7 @@ static void test_bidir_fixed_walks_honest(void **state)
             o.walk.stop.max_walks = 100, o.walk.exec.seed = (uint64_t)seed, o.walk.estimator = cases[c].est;
             ulam_bidir_result res;
             ulam_error err;
-            assert_int_equal(ulam__bidir_solve(w, Mt, &o, &res, &err), ULAM_OK);
+            assert_int_equal(ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err), ULAM_OK);
             covered += res.ci95[0] <= x[t] && x[t] <= res.ci95[1];
             zero += !(res.ci95[1] > res.ci95[0]);
             blind += res.walks.variance == 0;
@@ -773,7 +784,7 @@ static void test_bidir_fixed_walks_honest(void **state)
         else assert_true(blind > 0); /* some samples saw nothing: the case the bound is for */
     }
     test_case_done();
-    ulam__push_free(w);
+    ulam__push_free(w), ulam__bidir_free(w_memo);
     free(x);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
@@ -854,6 +865,7 @@ static void test_bidir_refusal_names_mode(void **state)
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     ulam_push *w = NULL;
     assert_int_equal(ulam__push_alloc(M, &w), ULAM_OK);
+    ulam__bidir *w_memo = ulam__bidir_alloc(); /* its plan memo */
     int64_t idx[3] = {44, 50, 55};
     double val[3] = {1.0, 1.0, 1.0};
     ulam_bidir_opts o = ulam_bidir_defaults();
@@ -861,7 +873,7 @@ static void test_bidir_refusal_names_mode(void **state)
     o.walk.stop.rel_err = 0.1, o.walk.stop.max_walks = 0;
     ulam_bidir_result res;
     ulam_error err;
-    int st = ulam__bidir_solve(w, Mt, &o, &res, &err);
+    int st = ulam__bidir_solve(w, w_memo, Mt, &o, &res, &err);
     print_message("status %d: %s\n", st, err.msg);
     assert_int_equal(st, ULAM_EINFVAR);
     assert_non_null(strstr(err.msg, "forward walks on M"));
@@ -871,7 +883,7 @@ static void test_bidir_refusal_names_mode(void **state)
     assert_non_null(at);
     assert_int_equal(sscanf(strstr(at, "["), "[%lf, %lf]", &lo, &hi), 2);
     assert_true(hi > 1.0 && lo <= hi); /* the forward radius, not the adjoint 0.99 */
-    ulam__push_free(w);
+    ulam__push_free(w), ulam__bidir_free(w_memo);
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 

@@ -32,6 +32,7 @@
  * for a solver given ulam_walk_opts.system, whose kernel verifies each row's block before it
  * builds the row (so a one-row query reads a few blocks). */
 #include "cache.h"
+#include "defaults.h"
 #include "solve.h"
 
 #include <fcntl.h>
@@ -274,7 +275,7 @@ static void vec_sums(const double *b, int64_t n, int shift, uint64_t *sums)
 }
 
 /* An empty description. */
-ulam_system_desc ulam_system_desc_defaults(void)
+ulam_system_desc ulam__system_desc_defaults(void)
 {
     return (ulam_system_desc){.M = NULL, .b = NULL, .n = 0, .tag = {0, 0}, .omega = 0.0, .cert = NULL, .transpose = 0};
 }
@@ -617,15 +618,6 @@ static int verify_part(const ulam_system *s, int part, int64_t first, int64_t la
     for (int64_t k = first >> s->shift; first < last && k <= (last - 1) >> s->shift; k++)
         if (verify_block(s, part, k)) return block_error(s, part, k, err);
     return ULAM_OK;
-}
-
-/* Verify the blocks of M and b holding rows [first, last). */
-int ulam_system_verify(const ulam_system *s, int64_t first, int64_t last, ulam_error *err)
-{
-    ulam__clear(err);
-    if (!s) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a system");
-    int status = verify_part(s, PART_M, first, last, err);
-    return status ? status : verify_part(s, PART_B, first, last, err);
 }
 
 /* Verify every block. */

@@ -16,9 +16,9 @@ ulam_csr *ulam_csr_alloc(int64_t nrows, int64_t ncols, int64_t nnz)
     A->nrows = nrows;
     A->ncols = ncols;
     /* 2 MiB pages (every entry is written once built): a sweep streams them, a walk reads rows at random */
-    A->rowptr = ulam_alloc_big((size_t)nrows + 1, sizeof *A->rowptr);
-    A->colidx = ulam_alloc_big((size_t)nnz, sizeof *A->colidx);
-    A->val = ulam_alloc_big((size_t)nnz, sizeof *A->val);
+    A->rowptr = ulam__alloc_big((size_t)nrows + 1, sizeof *A->rowptr);
+    A->colidx = ulam__alloc_big((size_t)nnz, sizeof *A->colidx);
+    A->val = ulam__alloc_big((size_t)nnz, sizeof *A->val);
     if (!A->rowptr || !A->colidx || !A->val) return ulam_csr_free(A);
     memset(A->rowptr, 0, ((size_t)nrows + 1) * sizeof *A->rowptr);
     return A;
@@ -240,6 +240,24 @@ int ulam__csr_to_dense(const ulam_csr *A, double *dense)
     return ULAM_OK;
 }
 
+/* Nonzero when M equals its transpose exactly (columns sorted, as ulam_csr_check asks). */
+int ulam__csr_symmetric(const ulam_csr *M)
+{
+    if (!M || M->nrows != M->ncols) return 0;
+    for (int64_t i = 0; i < M->nrows; i++)
+        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) {
+            int32_t j = M->colidx[q];
+            int64_t lo = M->rowptr[j], hi = M->rowptr[j + 1];
+            while (lo < hi) { /* binary search for i in row j (columns sorted) */
+                int64_t mid = lo + (hi - lo) / 2;
+                if (M->colidx[mid] < i) lo = mid + 1;
+                else hi = mid;
+            }
+            if (lo == M->rowptr[j + 1] || M->colidx[lo] != i || M->val[lo] != M->val[q]) return 0;
+        }
+    return 1;
+}
+
 /* Fill *st with the statistics of A. */
 int ulam_csr_stats_compute(const ulam_csr *A, ulam_csr_stats *st)
 {
@@ -266,6 +284,7 @@ int ulam_csr_stats_compute(const ulam_csr *A, ulam_csr_stats *st)
     }
     st->row_nnz_mean = A->nrows ? (double)st->nnz / (double)A->nrows : 0.0;
     st->substochastic = st->nonnegative && st->abs_rowsum_max <= 1.0;
+    st->symmetric = ulam__csr_symmetric(A);
     return ULAM_OK;
 }
 

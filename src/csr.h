@@ -14,4 +14,7 @@ int ulam__csr_copy(const ulam_csr *A, ulam_csr **out);
 /* Dense row-major copy of A into a caller buffer of nrows*ncols doubles. */
 int ulam__csr_to_dense(const ulam_csr *A, double *dense);
 
+/* Nonzero when M equals its transpose exactly (columns sorted; ulam_csr_stats' symmetric). */
+int ulam__csr_symmetric(const ulam_csr *M);
+
 #endif

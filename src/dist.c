@@ -8,6 +8,7 @@
  * 0 at the walk's end; forward tallies stay where they happen (the row's owner) and are summed,
  * per state, in (walk, step) order: both are combined in walk-id order whatever the ranks. */
 #include "part.h"
+#include "defaults.h"
 #include "stop.h"
 
 #include <math.h>
@@ -52,7 +53,7 @@ typedef struct {
 } run;
 
 /* The defaults. */
-ulam_dist_opts ulam_dist_defaults(void)
+ulam_dist_opts ulam__dist_defaults(void)
 {
     return (ulam_dist_opts){.seed = 1, .walks = 100000, .max_steps = 1000000, .batch = 65536};
 }

@@ -24,6 +24,7 @@
  * ulam_fpush_top's k components are chosen by their estimates: their lower ends at delta k / n
  * (lower_index). */
 #include "fpush.h"
+#include "defaults.h"
 #include "check.h"
 #include "push.h"
 #include "stop.h"
@@ -55,7 +56,7 @@
                                       degree to build and first touch, a try one read in the row) */
 
 /* The defaults. */
-ulam_fpush_opts ulam_fpush_defaults(void)
+ulam_fpush_opts ulam__fpush_defaults(void)
 {
     ulam_fpush_opts o = {.rel_err = 0.1, .walk = ulam_walk_defaults()};
     o.walk.mode = ULAM_FORWARD;
@@ -744,10 +745,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     info->mean_visits = D1;
     memset(x, 0, (size_t)n * sizeof *x);
     size_t bytes = (size_t)n * sizeof(double); /* r, and cs and mx (filled whole by the pull sweeps' set-up) */
-    double *r = ulam_alloc_big((size_t)n, sizeof *r); /* 2 MiB aligned: a malloc block's unaligned head stays in 4 KiB pages */
+    double *r = ulam__alloc_big((size_t)n, sizeof *r); /* 2 MiB aligned: a malloc block's unaligned head stays in 4 KiB pages */
     if (r) memset(r, 0, bytes);
     walker w = {.Mt = Mt, .r = r, .alpha = alpha};
-    w.cs = ulam_alloc_big((size_t)n, sizeof *w.cs), w.mx = ulam_alloc_big((size_t)n, sizeof *w.mx);
+    w.cs = ulam__alloc_big((size_t)n, sizeof *w.cs), w.mx = ulam__alloc_big((size_t)n, sizeof *w.mx);
     if (!r || !w.cs || !w.mx) {
         free(r), free(w.cs), free(w.mx);
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the residual");
@@ -793,7 +794,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     if (w.k > 0) {
         w.n = n, w.nb = (n + ULAM__FPUSH_BLOCK - 1) / ULAM__FPUSH_BLOCK;
         bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
-        w.cum = ulam_alloc_big((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum); /* filled from its start: 2 MiB pages from it */
+        w.cum = ulam__alloc_big((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum); /* filled from its start: 2 MiB pages from it */
         w.known = ulam__calloc(((size_t)n + 63) / 64, sizeof *w.known);
         if (!bsum || !w.cum || !w.known || (sgn ? 0 : !kept || (K < n && !kept_lo)))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");

@@ -30,6 +30,7 @@
  * The radii of these nonnegative matrices come from power iteration with Collatz-Wielandt
  * bounds (spectral.c), which certify a verdict whenever the bracket lies on one side of 1. */
 #include "guard.h"
+#include "defaults.h"
 #include "check.h"
 #include "kernel.h"
 #include "spectral.h"
@@ -39,7 +40,7 @@
 #include <stdlib.h>
 
 /* The default guard options: all three radii, stopped once certified. */
-ulam_guard_opts ulam_guard_defaults(void)
+ulam_guard_opts ulam__guard_defaults(void)
 {
     return (ulam_guard_opts){.need = ULAM_GUARD_ALL, .power = ulam_power_defaults(), .kernel_alpha = 1.0};
 }

@@ -10,7 +10,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 
-/* xoshiro256** step, inline for the walkers (ulam_rng_next is this). */
+/* xoshiro256** step, inline for the walkers (ulam_rng_bounded(r, 0) is this). */
 static inline uint64_t ulam__rng_next(ulam_rng *r)
 {
     uint64_t *s = r->s;
@@ -80,6 +80,12 @@ void *ulam__malloc(size_t n, size_t sz);
 
 /* calloc of n items of size sz, NULL on failure (n == 0 allocates one byte). */
 void *ulam__calloc(size_t n, size_t sz);
+
+/* Uninitialised memory for n items of size sz, for a large array read at random (a matrix's
+ * arrays, a push's vectors): cache-line aligned, and from 2 MiB on, 2 MiB aligned with
+ * transparent huge pages asked for (a first touch and a TLB miss cost less); freed with free();
+ * NULL on overflow or failure (src/util.c). */
+void *ulam__alloc_big(size_t n, size_t sz);
 
 /* Make room for need items of size sz in a growable array: pp is the address of its pointer
  * (a T **), *cap its capacity (doubling from 16; both are updated); ULAM_OK, or ULAM_ENOMEM

@@ -172,8 +172,8 @@ int ulam__kernel_alloc(const ulam_csr *K, double continue_q, double alpha, ulam_
     atomic_init(&k->nrec, 0);
     int dense = n <= ULAM__DENSE_MAX;
     if (dense) k->where = ulam__calloc((size_t)n, sizeof *k->where); /* zero: no row built */
-    k->mem = ulam_alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->mem);
-    if (alpha != 1.0) k->fac = ulam_alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->fac);
+    k->mem = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->mem);
+    if (alpha != 1.0) k->fac = ulam__alloc_big((size_t)(k->cap + ULAM__HEAD + 1), sizeof *k->fac);
     if ((dense ? !k->where : make_sparse(k) != ULAM_OK) || !k->mem || (alpha != 1.0 && !k->fac)) {
         ulam__kernel_free(k);
         return ULAM_ENOMEM;

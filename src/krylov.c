@@ -32,24 +32,6 @@ static double true_residual(const ulam_csr *M, const double *b, const double *x,
     return sqrt(dot(w, w, M->nrows)) / bnorm;
 }
 
-/* Nonzero when M equals its transpose exactly. */
-int ulam_csr_symmetric(const ulam_csr *M)
-{
-    if (!M || M->nrows != M->ncols) return 0;
-    for (int64_t i = 0; i < M->nrows; i++)
-        for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) {
-            int32_t j = M->colidx[q];
-            int64_t lo = M->rowptr[j], hi = M->rowptr[j + 1];
-            while (lo < hi) { /* binary search for i in row j (columns sorted) */
-                int64_t mid = lo + (hi - lo) / 2;
-                if (M->colidx[mid] < i) lo = mid + 1;
-                else hi = mid;
-            }
-            if (lo == M->rowptr[j + 1] || M->colidx[lo] != i || M->val[lo] != M->val[q]) return 0;
-        }
-    return 1;
-}
-
 /* Conjugate gradients (b scaled by the caller: see ulam_cg). */
 static int cg(const ulam_csr *M, const double *b, double tol, int max_iter, double *x, int *iterations,
               double *residual)

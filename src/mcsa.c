@@ -10,6 +10,7 @@
  * the batches of the adaptive rule: walk until ||stderr||_1 / ||delta||_1 < eps1.  The walks
  * are bit-identical for any thread count, and so is everything else here (sequential sums). */
 #include "check.h"
+#include "defaults.h"
 #include "guard.h"
 #include "solve.h"
 
@@ -51,7 +52,7 @@ struct ulam_outer {
 };
 
 /* The defaults. */
-ulam_outer_opts ulam_outer_defaults(void)
+ulam_outer_opts ulam__outer_defaults(void)
 {
     ulam_outer_opts o = {.method = ULAM_MCSA, .tol = 1e-8, .eps1 = 0.1, .max_histories = 100000000};
     o.walk = ulam_walk_defaults();

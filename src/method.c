@@ -3,6 +3,7 @@
  * ulam_analysis_start (ulam_auto_start on M alone) chooses among the rows, or starts the one
  * pinned.  A new method is a row here and its own file (src/method_*.c). */
 #include "method_row.h"
+#include "defaults.h"
 #include "analysis.h"
 #include "check.h"
 #include "round.h"
@@ -39,7 +40,7 @@ int ulam_method_answers(int k)
 }
 
 /* The default row options: none pinned, none excluded. */
-ulam_method_opts ulam_method_defaults(void)
+ulam_method_opts ulam__method_defaults(void)
 {
     return (ulam_method_opts){.method = -1, .exclude = 0};
 }

@@ -2,6 +2,7 @@
  * mcsa answer every unknown to a residual tolerance; asked for one entry they answer x_index with
  * no error bar, so the choice does not consider them for a query that wants one. */
 #include "method_row.h"
+#include "csr.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -99,7 +100,7 @@ static int finish_krylov(ulam_run *r, ulam_answer *a, ulam_error *err)
     if (r->o.query.index < 0 || r->o.query.index >= r->M->nrows || r->M->nrows != r->M->ncols)
         return ulam__fail(err, ULAM_EINVAL, 0, r->o.query.index, "a square M and an index from 0 to %lld",
                           (long long)r->M->nrows - 1);
-    if (r->method == ULAM_METHOD_CG && !ulam_csr_symmetric(r->M))
+    if (r->method == ULAM_METHOD_CG && !ulam__csr_symmetric(r->M))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a symmetric M for cg (I - M symmetric positive definite): use gmres");
     double *x = calloc((size_t)r->M->nrows, sizeof *x);
     if (!x) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for x");

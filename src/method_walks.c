@@ -63,7 +63,7 @@ static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
     int status = ulam_solver_error(r->sv, NULL);
     while (!status && !ulam_solver_done(r->sv)) status = ulam_solver_iterate(r->sv);
     ulam_solver_result(r->sv, &a->walks);
-    ulam_solver_guard(r->sv, &a->guard);
+    ulam__solver_guard(r->sv, &a->guard);
     if (status) ulam_solver_error(r->sv, err);
     a->estimate = a->walks.estimate;
     a->std_error = a->walks.std_error;

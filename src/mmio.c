@@ -7,6 +7,7 @@
  * a NUL byte in a line is refused (a binary or damaged file).  A gzip-compressed file is read
  * through zlib when opened by its path, and named as such when given as an open FILE. */
 #include "mmio.h"
+#include "defaults.h"
 #include "csr.h"
 
 #include <errno.h>
@@ -658,7 +659,7 @@ static int read_entries_parallel(int fd, int64_t data, int64_t end, const mm_hea
         prev = c[k].row[c[k].len - 1];
     }
     ulam_csr *A = !bad && total == h->nnz ? ulam_csr_alloc(h->m, h->n, total) : NULL;
-    int32_t *ti = A && !sorted ? ulam_alloc_big((size_t)total, sizeof *ti) : NULL;
+    int32_t *ti = A && !sorted ? ulam__alloc_big((size_t)total, sizeof *ti) : NULL;
     int status = nomem || (A && !sorted && !ti) || (!A && !bad && total == h->nnz) ? ULAM_ENOMEM : A ? ULAM_OK : -1;
     int64_t nz = 0;
     for (int k = 0; k < nc; k++) {
@@ -782,7 +783,7 @@ int ulam__mm_read_range(int fd, const ulam__mm_coord *c, int64_t from, int64_t t
 }
 
 /* The reader's defaults. */
-ulam_mm_opts ulam_mm_defaults(void)
+ulam_mm_opts ulam__mm_defaults(void)
 {
     return (ulam_mm_opts){.threads = 0};
 }
@@ -904,7 +905,7 @@ int ulam_mm_read_matrix(const char *path, ulam_csr **A, ulam_error *err)
 }
 
 /* Read a dense n x 1 vector from f. */
-int ulam_mm_read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err)
+static int read_vector_file(FILE *f, const char *name, double **x, int64_t *n, ulam_error *err)
 {
     ulam__clear(err);
     if (!f || !x || !n) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a file and output pointers");
@@ -940,7 +941,7 @@ int ulam_mm_read_vector(const char *path, double **x, int64_t *n, ulam_error *er
     if (!f) return ULAM_EIO;
     int gz = gunzipped(&f, path, err);
     if (gz) return gz;
-    int status = ulam_mm_read_vector_file(f, path, x, n, err);
+    int status = read_vector_file(f, path, x, n, err);
     fclose(f);
     return status;
 }

@@ -209,17 +209,3 @@ int ulam_options_set(int kind, void *opts, const char *name, const char *value, 
     return ULAM_ENOTFOUND;
 }
 
-/* The k-th listed option of kind: its own rows, then the walks'. */
-const char *ulam_options_name(int kind, int k, const char **help)
-{
-    for (int pass = 0; pass < 2 && k >= 0; pass++) {
-        int want = pass ? ULAM_OPTIONS_WALK : kind;
-        for (int i = 0; i < NROWS; i++)
-            if (rows[i].kind == want && rows[i].help && k-- == 0) {
-                if (help) *help = rows[i].help;
-                return rows[i].name;
-            }
-        if (kind == ULAM_OPTIONS_WALK) break;
-    }
-    return NULL;
-}

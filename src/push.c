@@ -25,8 +25,6 @@ struct ulam_push {
     int64_t pushes, ops;
     double seconds;
     uint64_t stamp; /* changed by every start and run: what a plan made on this state recorded */
-    void *kept;     /* what a caller keeps with the workspace (ulam__push_keep), freed by drop */
-    void (*drop)(void *);
 };
 
 /* Free a push workspace; accepts and returns NULL. */
@@ -34,7 +32,6 @@ ulam_push *ulam__push_free(ulam_push *w)
 {
     if (!w) return NULL;
     free(w->p), free(w->r), free(w->touched), free(w->mark), free(w->queue);
-    if (w->drop) w->drop(w->kept);
     free(w);
     return NULL;
 }
@@ -179,14 +176,3 @@ uint64_t ulam__push_stamp(const ulam_push *w)
     return w->stamp;
 }
 
-/* What the caller keeps with the workspace (NULL: nothing yet). */
-void *ulam__push_kept(const ulam_push *w)
-{
-    return w->kept;
-}
-
-/* Keep data with the workspace, dropped by drop(data) when it is freed (once: set it once). */
-void ulam__push_keep(ulam_push *w, void *data, void (*drop)(void *))
-{
-    w->kept = data, w->drop = drop;
-}

@@ -12,11 +12,6 @@ const ulam_csr *ulam__push_matrix(const ulam_push *w);
  * a plan that recorded it describes the push in place while it is unchanged. */
 uint64_t ulam__push_stamp(const ulam_push *w);
 
-/* What a caller keeps with the workspace for the workspace's lifetime (src/bidir.c keeps the
- * plan memo of ulam__bidir_plan and ulam__bidir_solve there): push.c neither reads it nor knows its
- * type, and frees it with drop(data) in ulam__push_free.  Set once; NULL until set. */
-void *ulam__push_kept(const ulam_push *w);
-void ulam__push_keep(ulam_push *w, void *data, void (*drop)(void *));
 
 /* A workspace for pushes on the square matrix M, which is borrowed until the workspace is freed. */
 int ulam__push_alloc(const ulam_csr *M, ulam_push **out);

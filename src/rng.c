@@ -24,23 +24,18 @@ void ulam_rng_seed(ulam_rng *r, uint64_t seed, uint64_t stream)
     if (!(r->s[0] | r->s[1] | r->s[2] | r->s[3])) r->s[0] = 1; /* the one forbidden state */
 }
 
-/* Next 64 random bits. */
-uint64_t ulam_rng_next(ulam_rng *r)
-{
-    return ulam__rng_next(r);
-}
-
 /* Uniform double in [0, 1): the top 53 bits times 2^-53. */
 double ulam_rng_uniform(ulam_rng *r)
 {
     return ulam__rng_uniform(r);
 }
 
-/* Unbiased integer in [0, bound) (Lemire's multiply-and-reject, see internal.h). */
+/* Unbiased integer in [0, bound) (Lemire's multiply-and-reject, see internal.h); bound 0: the
+ * next 64 bits, [0, 2^64). */
 uint64_t ulam_rng_bounded(ulam_rng *r, uint64_t bound)
 {
     uint64_t frac;
-    return ulam__rng_index(r, bound, &frac);
+    return bound ? ulam__rng_index(r, bound, &frac) : ulam__rng_next(r);
 }
 
 /* splitmix64's finalizer: a bijective mix of 64 bits. */

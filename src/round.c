@@ -4,6 +4,7 @@
  * totals); and the after-round step both solvers take (ulam__round_step: merge in block order,
  * failures, interrupt, budget and time), so those stopping rules are written once. */
 #include "round.h"
+#include "defaults.h"
 #include "check.h"
 
 #include <stdlib.h>
@@ -18,7 +19,7 @@ ulam_stop_opts ulam__stop_defaults(void)
 }
 
 /* One process. */
-ulam_share ulam_share_defaults(void)
+ulam_share ulam__share_defaults(void)
 {
     return (ulam_share){.rank = 0, .nranks = 1, .allgather = NULL, .ctx = NULL};
 }

@@ -7,6 +7,7 @@
  * bit-for-bit the same for any number of threads.  Stopping rules are checked between rounds; an interrupt or the time limit
  * also stops blocks that have not started. */
 #include "solve.h"
+#include "defaults.h"
 #include "cache.h"
 #include "check.h"
 #include "fpush_b.h"
@@ -131,7 +132,7 @@ struct ulam_solver {
 };
 
 /* The defaults. */
-ulam_walk_opts ulam_walk_defaults(void)
+ulam_walk_opts ulam__walk_defaults(void)
 {
     return (ulam_walk_opts){.mode = ULAM_ADJOINT, .estimator = ULAM_COLLISION, .kernel = ulam__kernel_defaults(),
                             .stop = ulam__stop_defaults(), .exec = ulam__exec_defaults(),
@@ -1664,7 +1665,7 @@ void ulam_solver_result(const ulam_solver *s, ulam_walk_result *r)
 }
 
 /* The guards' verdicts the solver walks under. */
-void ulam_solver_guard(const ulam_solver *s, ulam_guard *g)
+void ulam__solver_guard(const ulam_solver *s, ulam_guard *g)
 {
     if (s && g) *g = s->g;
 }

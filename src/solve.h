@@ -134,4 +134,8 @@ ulam_query_opts ulam__query_defaults(void);
 /* The defaults: refuse what is not certified, compute the guards, no prepared system. */
 ulam_policy_opts ulam__policy_defaults(void);
 
+/* The guards' verdicts the solver walks under, a plain struct to keep or store (the analysis
+ * keeps them for its next solver; src/solve.c). */
+void ulam__solver_guard(const ulam_solver *s, ulam_guard *g);
+
 #endif

@@ -116,7 +116,7 @@ static int estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error 
 #endif
 
 /* What the sparse LU of I - M will need, before it starts. */
-int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err)
+int ulam__direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops, ulam_error *err)
 {
     ulam__clear(err);
     if (!M || !bytes || !flops || M->nrows != M->ncols)
@@ -129,7 +129,7 @@ int ulam_direct_sparse_estimate(const ulam_csr *M, double *bytes, double *flops,
 }
 
 /* Nonzero when libulam was built with UMFPACK and its library loads. */
-int ulam_direct_sparse_available(void)
+int ulam__direct_sparse_available(void)
 {
 #ifdef ULAM_UMFPACK
     return ulam__umfpack(NULL) != NULL;
@@ -139,7 +139,7 @@ int ulam_direct_sparse_available(void)
 }
 
 /* Solve (I - M) x = b by sparse LU. */
-int ulam_direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
+int ulam__direct_sparse(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
                        ulam_direct_info *info, ulam_error *err)
 {
     int bad = ulam__direct_args(M, b, x, err); /* src/direct.c */

@@ -7,11 +7,13 @@
  * recomputed from the returned eigenvector.  Small operators (n <= DENSE_MAX, where ARPACK's
  * nev < n - 1 constraint bites) are formed densely from n products and solved by dgeev.
  *
- * The radius of a nonnegative operator diag(left) |A| diag(right) (ulam_spectral_power, which
+ * The radius of a nonnegative operator diag(left) |A| diag(right) (ulam__spectral_power, which
  * the guards use) comes instead from shifted power iteration with Collatz-Wielandt bounds: for
  * any positive x, min_i (Ax)_i / x_i <= rho <= max_i (Ax)_i / x_i, so each iterate certifies a
  * bracket. */
 #include "spectral.h"
+#include "csr.h"
+#include "defaults.h"
 #include "check.h"
 #include "dynload.h"
 
@@ -23,7 +25,7 @@
 enum { DENSE_MAX = 128, NEV = 2 };
 
 /* The default options. */
-ulam_spectral_opts ulam_spectral_defaults(void)
+ulam_spectral_opts ulam__spectral_defaults(void)
 {
     return (ulam_spectral_opts){.tol = 1e-6, .max_restarts = 300, .krylov_dim = 20, .seed = 1};
 }
@@ -251,7 +253,7 @@ enum { MARGIN_TRIES = 20, SUPPORT_EVERY = 10 };
 #define SUPPORT_CUT 1e-10 /* the support of an iterate for support_lower */
 
 /* The default power-iteration options. */
-ulam_power_opts ulam_power_defaults(void)
+ulam_power_opts ulam__power_defaults(void)
 {
     return (ulam_power_opts){.tol = 1e-4, .max_iter = 1000};
 }
@@ -358,7 +360,7 @@ int ulam__power_from(const ulam_csr *A, const double *left, const double *right,
 }
 
 /* rho(diag(left) |A| diag(right)) by shifted power iteration with Collatz-Wielandt bounds. */
-int ulam_spectral_power(const ulam_csr *A, const double *left, const double *right,
+int ulam__spectral_power(const ulam_csr *A, const double *left, const double *right,
                         const ulam_power_opts *opts, ulam_power *out, ulam_error *err)
 {
     ulam__clear(err);
@@ -416,7 +418,7 @@ int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, 
     if (!status) {
         for (int64_t i = 0; i < m; i++) one[i] = 1.0;
         double tol = 0.25 / sqrt((double)m); /* ||r||_inf <= ||r||_2 <= 1/4 */
-        int sym = ulam_csr_symmetric(A);
+        int sym = ulam__csr_symmetric(A);
         status = sym               ? ulam_cg(A, one, tol, max_iter, h, &it, NULL)
                  : m <= GMRES_MAX ? ulam_gmres(A, one, 30, tol, max_iter < GMRES_ITER ? max_iter : GMRES_ITER, h, &it, NULL)
                                    : ULAM_ENOCONV; /* 31 Krylov vectors would not be small */

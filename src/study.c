@@ -440,7 +440,8 @@ int ulam_study_reference_lines(const ulam_study *s, double reference_time,
         if (!(e > 1e-9 * fabs(exact))) break;
     }
     outer_lines(s, reference_time, fn, arg);
-    int cg = ulam_csr_symmetric(s->M);
+    ulam_csr_stats st;
+    int cg = !ulam_csr_stats_compute(s->M, &st) && st.symmetric;
     for (int k = 1; k <= 10 && !stopped(s); k++) { /* a solve's time: the mean of repeats over >= 1 ms (one solve
                                                       of a small system is microseconds, the first ones many times
                                                       the rest: the line ran backwards) */

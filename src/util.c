@@ -116,7 +116,7 @@ int ulam__grow(void *pp, int64_t *cap, int64_t need, size_t sz)
  * touch costs ~15 us on a virtual machine (64 MiB: 250 ms against 14 ms in 2 MiB pages), a walk
  * or a sweep reading it at random misses the TLB less, and a malloc'd block's unaligned head
  * would stay in 4 KiB pages. */
-void *ulam_alloc_big(size_t n, size_t sz)
+void *ulam__alloc_big(size_t n, size_t sz)
 {
     if (sz && n > SIZE_MAX / sz) return NULL;
     size_t bytes = n * sz, align = bytes >= ((size_t)2 << 20) ? (size_t)2 << 20 : 64;

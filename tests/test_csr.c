@@ -188,27 +188,13 @@ static void test_invalid(void **state)
     for (int s = 0; s < ULAM_NSTATUS; s++) assert_true(strlen(ulam_strerror(s)) > 3);
 }
 
-/* ulam_alloc_big: 64-byte aligned below 2 MiB, 2 MiB aligned from 2 MiB on (the whole block
- * writable), NULL when n sz overflows. */
-static void test_alloc_big(void **state)
-{
-    (void)state;
-    char *a = ulam_alloc_big(1000, 1), *b = ulam_alloc_big((size_t)1 << 19, 8), *c = ulam_alloc_big(0, 8);
-    assert_non_null(a), assert_non_null(b), assert_non_null(c);
-    assert_int_equal((uintptr_t)a % 64, 0);
-    assert_int_equal((uintptr_t)b % ((uintptr_t)2 << 20), 0);
-    memset(a, 1, 1000), memset(b, 1, (size_t)4 << 20);
-    assert_null(ulam_alloc_big(SIZE_MAX / 2, 4));
-    free(a), free(b), free(c);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_from_triplets), cmocka_unit_test(test_transpose),
         cmocka_unit_test(test_matvec),        cmocka_unit_test(test_stats),
         cmocka_unit_test(test_jacobi),        cmocka_unit_test(test_jacobi_errors),
-        cmocka_unit_test(test_invalid),       cmocka_unit_test(test_alloc_big),
+        cmocka_unit_test(test_invalid),
     };
     return test_run(tests);
 }

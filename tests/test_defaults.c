@@ -252,12 +252,28 @@ static void test_system_desc(void **state)
     ulam_csr_free(M);
 }
 
+/* ulam_defaults, the one call behind every wrapper: an unknown kind or a struct size that is not
+ * the library's (a caller built against another header) is refused and the struct zeroed. */
+static void test_defaults_call(void **state)
+{
+    (void)state;
+    ulam_walk_opts o, d = ulam_walk_defaults();
+    assert_int_equal(ulam_defaults(ULAM_KIND_WALK, &o, sizeof o), ULAM_OK);
+    assert_true(d.stop.max_walks > 0 && d.stop.max_walks == o.stop.max_walks && d.query.index == o.query.index);
+    assert_int_equal(ulam_defaults(ULAM_KIND_WALK, &o, sizeof o - 8), ULAM_EINVAL);
+    assert_int_equal(o.stop.max_walks, 0);
+    ulam_mm_opts m;
+    assert_int_equal(ulam_defaults(ULAM_KIND_DIST + 1, &m, sizeof m), ULAM_EINVAL);
+    assert_int_equal(ulam_defaults(-1, &m, sizeof m), ULAM_EINVAL);
+    assert_int_equal(ulam_defaults(ULAM_KIND_MM, NULL, sizeof m), ULAM_EINVAL);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_walk),       cmocka_unit_test(test_rel_err_lifts_default_cap), cmocka_unit_test(test_mm),    cmocka_unit_test(test_spectral_and_guards),
         cmocka_unit_test(test_outer),      cmocka_unit_test(test_bidir_and_auto), cmocka_unit_test(test_share),
-        cmocka_unit_test(test_system_desc),
+        cmocka_unit_test(test_system_desc), cmocka_unit_test(test_defaults_call),
     };
     return test_run(tests);
 }

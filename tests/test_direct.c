@@ -2,6 +2,7 @@
  * (UMFPACK) one against it; PageRank's matrix; the study's reference (LAPACK or Gauss-Seidel), its
  * method grid and its coverage interval. */
 #include "testutil.h"
+#include "ulam_reference.h"
 #include "ulam_study.h"
 
 #include <math.h>
@@ -107,11 +108,14 @@ static void test_sparse(void **state)
     static const char *const names[] = {"chain4", "randsub1000", "radiosity100", "signed200", "poisson900"};
     char mp[256], bpath[256];
     ulam_error err;
-    if (!ulam_direct_sparse_available()) {
+    ulam_reference_info plan;
+    ulam_direct_info info;
+    assert_int_equal(ulam_reference_plan(NULL, 1, 0, &plan, NULL), ULAM_OK);
+    if (!plan.umfpack) {
         ulam_csr *M = must_read("matrices/chain4.mtx");
-        double b[4] = {1, 1, 1, 1}, x[4], by, fl;
-        assert_int_equal(ulam_direct_sparse(M, b, x, 0, NULL, &err), ULAM_EUNSUPPORTED);
-        assert_int_equal(ulam_direct_sparse_estimate(M, &by, &fl, &err), ULAM_EUNSUPPORTED);
+        double b[4] = {1, 1, 1, 1}, x[4];
+        assert_int_equal(ulam_reference_solve(M, b, 1, 0, 0, x, &info, NULL, &err), ULAM_EUNSUPPORTED);
+        assert_int_equal(ulam_reference_plan(M, 1, 1, &plan, &err), ULAM_EUNSUPPORTED);
         ulam_csr_free(M);
         return;
     }
@@ -121,21 +125,22 @@ static void test_sparse(void **state)
         ulam_csr *M = must_read(mp);
         int64_t n;
         double *b = must_read_vector(bpath, &n);
-        double *x = malloc((size_t)n * sizeof *x), *xs = malloc((size_t)n * sizeof *xs), bytes, flops;
-        ulam_direct_info info;
+        double *x = malloc((size_t)n * sizeof *x), *xs = malloc((size_t)n * sizeof *xs);
+        const char *how = NULL;
         assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
-        assert_int_equal(ulam_direct_sparse(M, b, xs, 0, &info, NULL), ULAM_OK);
+        assert_int_equal(ulam_reference_solve(M, b, 1, 0, 0, xs, &info, &how, &err), ULAM_OK);
+        assert_string_equal(how, "sparse LU");
         for (int64_t i = 0; i < n; i++) assert_close(xs[i], x[i], 1e-10 * (1 + fabs(x[i])));
         assert_true(info.residual < 1e-12 && info.seconds >= 0);
-        assert_int_equal(ulam_direct_sparse_estimate(M, &bytes, &flops, NULL), ULAM_OK);
-        assert_true(bytes >= (double)info.bytes && bytes > 0 && flops >= 0);
-        assert_int_equal(ulam_direct_sparse(M, b, xs, 16, NULL, &err), ULAM_EMEMLIMIT);
+        assert_int_equal(ulam_reference_plan(M, 1, 1, &plan, NULL), ULAM_OK);
+        assert_true(plan.sparse && plan.bytes >= (double)info.bytes && plan.bytes > 0 && plan.flops >= 0);
+        assert_int_equal(ulam_reference_solve(M, b, 1, 16, 0, xs, &info, NULL, &err), ULAM_EMEMLIMIT);
         free(x), free(xs), free(b);
         ulam_csr_free(M);
     }
     ulam_csr *S = must_read("tests/data/singular.mtx");
     double b3[3] = {1, 1, 1}, x3[3];
-    assert_int_equal(ulam_direct_sparse(S, b3, x3, 0, NULL, &err), ULAM_ESINGULAR);
+    assert_int_equal(ulam_reference_solve(S, b3, 1, 0, 0, x3, &info, NULL, &err), ULAM_ESINGULAR);
     ulam_csr_free(S);
 }
 

@@ -94,8 +94,12 @@ static void test_reference(void **state)
     ulam_direct_info info;
     ulam_error err;
     const char *how = NULL;
-    assert_int_equal(ulam_reference_sparse(M, -1), 0); /* n = 2: dense */
-    assert_int_equal(ulam_reference_sparse(M, 1), 1);
+    ulam_reference_info plan;
+    assert_int_equal(ulam_reference_plan(M, -1, 1, &plan, &err), ULAM_OK); /* n = 2: dense */
+    assert_true(!plan.sparse && plan.bytes == (double)ulam_direct_bytes(2) && plan.flops == 2.0 / 3.0 * 8);
+    assert_int_equal(ulam_reference_plan(M, 1, 0, &plan, &err), ULAM_OK);
+    assert_true(plan.sparse && isnan(plan.bytes));
+    assert_int_equal(ulam_reference_plan(M, 1, 0, NULL, &err), ULAM_EINVAL);
     assert_int_equal(ulam_reference_solve(M, b, -1, (size_t)1 << 30, 1, x, &info, &how, &err), ULAM_OK);
     assert_string_equal(how, "dense LU");
     for (int i = 0; i < 2; i++) assert_true(fabs(x[i] - want[i]) < 1e-14);

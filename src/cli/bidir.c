@@ -326,7 +326,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     /* x for every component, the rest for the top ones only (ulam_fpush_top: no sort of n) */
     size_t kk = (size_t)want;
     int64_t *order = malloc(kk * sizeof *order);
-    double *x = ulam_alloc_big((size_t)nw, sizeof *x), *se = malloc(kk * sizeof *se);
+    double *x = malloc((size_t)nw * sizeof *x), *se = malloc(kk * sizeof *se);
     double *lo = malloc(kk * sizeof *lo), *hi = malloc(kk * sizeof *hi), *xd = NULL;
     ulam_fpush_info info;
     ulam_error err;

@@ -650,7 +650,7 @@ void cli_system_free(cli_system *s)
     s->M = NULL, s->b = NULL, s->cert = NULL;
 }
 
-/* Solve the loaded system into a new *x (sparse LU or dense, as ulam_reference_sparse says); 0
+/* Solve the loaded system into a new *x (sparse LU or dense, as ulam_reference_plan says); 0
  * or an exit code. */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info)
 {

@@ -16,9 +16,11 @@ static void announce(const cli_system *s, int sparse)
 {
     int64_t n = s->M->nrows, nnz = s->M->rowptr[n];
     double flops = 2.0 / 3.0 * (double)n * (double)n * (double)n, gib = (double)ulam_direct_bytes(n) / 1073741824.0;
-    double bytes, lu_flops;
+    ulam_reference_info p;
     ulam_error err;
-    if (sparse && nnz + n > 200000 && !ulam_direct_sparse_estimate(s->M, &bytes, &lu_flops, &err))
+    int est = !ulam_reference_plan(s->M, sparse, sparse && nnz + n > 200000, &p, &err);
+    double bytes = p.bytes, lu_flops = p.flops;
+    if (sparse && nnz + n > 200000 && est)
         fprintf(stderr, "ulam: --check: sparse LU (UMFPACK) of n = %lld, %lld nonzeros: at most %.3g GiB and %.2g flops "
                         "(UMFPACK's bounds; at most about %.0f s at 10 Gflop/s)%s; Ctrl-C keeps the estimate\n",
                 (long long)n, (long long)nnz, bytes / 1073741824.0, lu_flops, lu_flops / 1e10,
@@ -26,7 +28,7 @@ static void announce(const cli_system *s, int sparse)
     else if (!sparse && flops > 2e10)
         fprintf(stderr, "ulam: --check: dense LU (LAPACK) of n = %lld: %.3g GiB and 2/3 n^3 = %.2g flops (about %.0f s "
                         "at 10 Gflop/s)%s; Ctrl-C keeps the estimate\n", (long long)n, gib, flops, flops / 1e10,
-                ulam_direct_sparse_available() ? "" : " (this ulam has no UMFPACK for a sparse LU)");
+                p.umfpack ? "" : " (this ulam has no UMFPACK for a sparse LU)");
 }
 
 /* The reference solve in a thread, so that Ctrl-C can leave it. */
@@ -65,7 +67,9 @@ int cli_direct_reference(const cli_system *s, double **x, double *seconds, const
     *x = NULL;
     check_job *j = calloc(1, sizeof *j);
     if (!j) return cli_exit_code(ULAM_ENOMEM);
-    j->s = s, j->sparse = ulam_reference_sparse(s->M, cli_direct_force);
+    ulam_reference_info p;
+    ulam_reference_plan(s->M, cli_direct_force, 0, &p, NULL);
+    j->s = s, j->sparse = p.sparse;
     announce(s, j->sparse);
     pthread_t t;
     if (pthread_create(&t, NULL, check_run, j)) {
@@ -113,7 +117,9 @@ static void print_text(const cli_system *s, const double *x, int64_t index,
                    cli_answer_pad(i + cli_node_base, 11), "", x[i]);
         if (n > 10) printf("...        (%lld more: use --out or --index)\n", (long long)(n - 10));
     }
-    printf("method     %s\n", ulam_reference_sparse(s->M, cli_direct_force) ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");
+    ulam_reference_info p;
+    ulam_reference_plan(s->M, cli_direct_force, 0, &p, NULL);
+    printf("method     %s\n", p.sparse ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");
     printf("rcond      %.3e\n", info->rcond);
     printf("residual   %.3e\n", info->residual);
     printf("seconds    %.6f\n", info->seconds);
@@ -129,7 +135,9 @@ static void print_json(const cli_system *s, const double *x, int64_t index,
         cli_json_number("estimate", x[index - 1], 0);
         cli_json_number("value", x[index - 1], 0); /* deprecated: "estimate", as in every command */
     }
-    cli_json_string("method", ulam_reference_sparse(s->M, cli_direct_force) ? "sparse LU" : "dense LU", 0);
+    ulam_reference_info p;
+    ulam_reference_plan(s->M, cli_direct_force, 0, &p, NULL);
+    cli_json_string("method", p.sparse ? "sparse LU" : "dense LU", 0);
     cli_json_number("rcond", info->rcond, 0);
     cli_json_number("residual", info->residual, 0);
     cli_json_number("seconds", info->seconds, 1);
@@ -151,6 +159,7 @@ int cli_direct(int argc, char **argv)
     const char *out = NULL, *index = NULL;
     size_t max_mem = CLI_MAX_MEM;
     int json = 0, c, rc;
+    ulam_reference_info plan;
     if (cli_check_options("direct", argc, argv, longopts)) return EXIT_USAGE;
     optind = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
@@ -167,7 +176,7 @@ int cli_direct(int argc, char **argv)
             if ((cli_direct_force = cli_choose("direct", "--lu", optarg, lu_names, 3, "auto, sparse or dense")) < 0)
                 return EXIT_USAGE;
             if (cli_direct_force == 2) cli_direct_force = -1;
-            if (cli_direct_force == 1 && !ulam_direct_sparse_available())
+            if (cli_direct_force == 1 && (ulam_reference_plan(NULL, 1, 0, &plan, NULL), !plan.umfpack))
                 return cli_usage_error("direct", "--lu sparse: this ulam was built without UMFPACK (libsuitesparse-dev)");
             break;
         case 'h': ulam_options_help(stdout, "direct"); return 0;

@@ -229,7 +229,8 @@ static int run_krylov(const cli_system *s, const ulam_outer_opts *o, report *p, 
     if (!*x) return cli_exit_code(ULAM_ENOMEM);
     int cap = o->max_iter ? o->max_iter : 100000;
     double t0 = ulam_now();
-    if (p->method == KRYLOV_CG && !ulam_csr_symmetric(s->M)) {
+    ulam_csr_stats st;
+    if (p->method == KRYLOV_CG && (ulam_csr_stats_compute(s->M, &st) || !st.symmetric)) {
         fprintf(stderr, "ulam: %s: error: --method cg needs a symmetric M (I - M symmetric positive definite); "
                         "use --method gmres\n", s->matrix_path);
         return EXIT_USAGE;

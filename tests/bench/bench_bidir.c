@@ -87,18 +87,18 @@ static double quantile(const double *v, int n, double q)
 }
 
 /* A bidirectional query (rmax 0: balanced). */
-static int query(ulam_push *w, const ulam_csr *Mt, const ulam_guard *g, int64_t s, int64_t t, double rmax, double cap,
+static int query(ulam_push *w, ulam__bidir *memo, const ulam_csr *Mt, const ulam_guard *g, int64_t s, int64_t t, double rmax, double cap,
                  uint64_t seed, ulam_bidir_result *res)
 {
     ulam_bidir_opts o = ulam_bidir_defaults();
     o.walk.policy.guard = g;
-    o.reach_all = 1;   /* the walks' bounds over every state, made at the first query, kept in w for the rest */
-    o.keep_kernel = 1; /* the walks' (and pilot's) kernel rows kept in w, rescored to each query's residual */
+    o.reach_all = 1;   /* the walks' bounds over every state, made at the first query, kept in memo for the rest */
+    o.keep_kernel = 1; /* the walks' (and pilot's) kernel rows kept in memo, rescored to each query's residual */
     o.source = s, o.target = t, o.rmax = rmax;
     o.walk.stop.max_walks = 0, o.walk.stop.rel_err = REL, o.walk.stop.max_seconds = cap, o.walk.exec.threads = 1, o.walk.exec.seed = seed;
     o.walk.stop.max_steps = INT64_MAX / 4;
     ulam_error err;
-    int st = ulam__bidir_solve(w, Mt, &o, res, &err);
+    int st = ulam__bidir_solve(w, memo, Mt, &o, res, &err);
     if (st) fprintf(stderr, "bidir: pair (%lld, %lld): %s: %s\n", (long long)s, (long long)t, ulam_strerror(st), err.msg);
     return st;
 }
@@ -210,7 +210,8 @@ int main(int argc, char **argv)
                (long long)dangling, (long long)maxin, (long long)maxout, ulam_now() - t0);
     t0 = ulam_now();
     ulam_push *w = NULL;
-    if (ulam_csr_transpose(M, &Mt) || ulam__push_alloc(M, &w)) return fprintf(stderr, "bidir: out of memory\n"), 1;
+    ulam__bidir *memo = ulam__bidir_alloc(); /* the plan memo the queries on w share */
+    if (!memo || ulam_csr_transpose(M, &Mt) || ulam__push_alloc(M, &w)) return fprintf(stderr, "bidir: out of memory\n"), 1;
     printf("transpose M' (once, for every query): %.3f s\n", ulam_now() - t0);
     ulam_guard g; /* the walks' guards on M' (adjoint kernel), once for every query of either method */
     ulam_guard_opts go = ulam_guard_defaults();
@@ -247,7 +248,7 @@ int main(int argc, char **argv)
             cand[j] = cand[q], cand[q] = t;
             ulam_bidir_result rb;
             double c0 = cpu_now();
-            if (query(w, Mt, &g, s, t, 0, 0, (uint64_t)k + 1, &rb)) return 1;
+            if (query(w, memo, Mt, &g, s, t, 0, 0, (uint64_t)k + 1, &rb)) return 1;
             bi.seconds[k] = cpu_now() - c0, bi.other[k] = rb.push.seconds, bi.walk[k] = rb.walks.seconds;
             bi.covered += rb.ci95[0] <= x[t] && x[t] <= rb.ci95[1], bi.intervals++;
             sum_push_ops += (double)rb.push.ops, sum_steps += (double)(rb.walks.steps + rb.walks.walks);
@@ -288,7 +289,7 @@ int main(int argc, char **argv)
            "pilot and the walk solver's set-up\n", quantile(bi.other, np, 0.5), quantile(bi.other, np, 0.9),
            quantile(bi.walk, np, 0.5), quantile(bi.walk, np, 0.9));
     free(x), free(old), free(b), free(e), free(cand);
-    ulam__push_free(w);
+    ulam__push_free(w), ulam__bidir_free(memo);
     ulam_csr_free(M), ulam_csr_free(Mt);
     return 0;
 }

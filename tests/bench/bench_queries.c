@@ -64,7 +64,8 @@ int main(int argc, char **argv)
     ulam_guard g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(ULAM_ADJOINT);
-    if (ulam_csr_transpose(M, &Mt) || ulam__push_alloc(M, &w) || ulam_guard_check(Mt, 0.0, &go, &g, NULL))
+    ulam__bidir *memo = ulam__bidir_alloc(); /* the plan memo the queries on w share */
+    if (!memo || ulam_csr_transpose(M, &Mt) || ulam__push_alloc(M, &w) || ulam_guard_check(Mt, 0.0, &go, &g, NULL))
         return fprintf(stderr, "queries: set-up failed\n"), 1;
     double inproc[PAIRS], cli[PAIRS], est[PAIRS];
     for (int k = 0; k < np; k++) {
@@ -73,10 +74,10 @@ int main(int argc, char **argv)
         o.walk.stop.max_walks = 0, o.walk.stop.rel_err = REL, o.walk.exec.threads = 1, o.walk.exec.seed = (uint64_t)k + 1;
         o.walk.stop.max_steps = INT64_MAX / 4;
         ulam_bidir_result res;
-        if (ulam__bidir_solve(w, Mt, &o, &res, NULL)) return fprintf(stderr, "queries: pair %d failed\n", k + 1), 1;
+        if (ulam__bidir_solve(w, memo, Mt, &o, &res, NULL)) return fprintf(stderr, "queries: pair %d failed\n", k + 1), 1;
         inproc[k] = res.seconds, est[k] = res.estimate;
     }
-    ulam__push_free(w);
+    ulam__push_free(w), ulam__bidir_free(memo);
     ulam_csr_free(Mt);
     /* the CLI: a prepared file (certificate and stored bounds) and one process for every pair */
     char dir[] = "/tmp/ulam_bench_queriesXXXXXX", sysf[128], qf[128];
