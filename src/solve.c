@@ -1499,17 +1499,17 @@ static void forward_component(const ulam_solver *s, int64_t i, double *est, doub
  * range of walks of at most l steps, l the length past which walks can add no more than E |m|
  * to the mean: visits score at most per_step and a walk is alive after k steps with
  * probability at most qmax^k, so the rest adds at most per_step qmax^(l+1) / (1 - qmax).
- * Adjoint collision from one start: also the l at which the start's own tail (tail_len) adds at
- * most f E |m|, when shorter.  INFINITY when no bound holds (qmax = 1, weights that can grow). */
-static double score_range(const ulam_solver *s, double m, double E, double f)
+ * Adjoint collision from one start, when own: also the l at which the start's own tail
+ * (tail_len) adds at most E |m|, when shorter.  INFINITY when no bound holds (qmax = 1, weights that can grow). */
+static double score_range(const ulam_solver *s, double m, double E, int own)
 {
     if (s->bound == 0.0) return s->range;
     double R = fmin(ulam__score_range(s->range, s->per_step, s->qmax, 1.0, s->signs, m, E),
                     ulam__score_range(s->range, s->per_step, s->tail_u, s->kappa, s->signs, m, E));
-    if (s->tailT_n && s->tailT_at == s->o.query.index && s->o.mode == ULAM_ADJOINT && s->o.estimator == ULAM_COLLISION &&
+    if (own && s->tailT_n && s->tailT_at == s->o.query.index && s->o.mode == ULAM_ADJOINT && s->o.estimator == ULAM_COLLISION &&
         !s->o.query.nstarts && !isfinite(s->range) && m > 0 && E > 0) /* tail_len: the start's own tail */
         for (int64_t l = 0; l < s->tailT_n; l++)
-            if (s->per_step * s->tailT[l] <= E * m * f) {
+            if (s->per_step * s->tailT[l] <= E * m) {
                 R = fmin(R, s->per_step * (double)(l + 1) * (s->signs ? 2.0 : 1.0));
                 break;
             }
@@ -1585,12 +1585,7 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
     *h = E > 0 && mabs > 0 ? E * mabs : 0.0;
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m;
     double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
-    /* tail_len's clip at f = (10 E)^2 of the bias below E = h / |m| = 0.1 (the first round's too): a
-       long run (E = 0.01) sees the scores a clip that tight cuts, and its variance term grew (12^3
-       Laplacian's corner, 3 seeds: walks 2.07-2.49 the CLT's count at f = 1, 2.08-2.18 at (10 E)^2, 2.0-2.1
-       before tail_len); at E = 0.1 the range term decides and the tight clip pays */
-    double f = fmin(1.0, 100.0 * (hp / m) * (hp / m));
-    *Rt = !truncated ? score_range(s, 1.0, 1.0, 1.0) : t > 0 ? score_range(s, m, t / m, f) : INFINITY;
+    *Rt = !truncated ? score_range(s, 1.0, 1.0, 1) : t > 0 ? score_range(s, m, t / m, 1) : INFINITY;
     double X = bias_scale(s, 0.0), n1 = fmin(*nplan, (double)BLOCK), least = INFINITY, t0 = 1e-6 * m;
     for (int pass = 0; pass < 2; pass++) /* under rel_err a second pass: the least bias within 5% of the least */
         for (int j = 0; truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
@@ -1601,14 +1596,18 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
                the sum being flat near its least, the smallest bias within 5% of it (the first block's
                bias stays in the sequence's weighted bias to the end: at E = 0.01 the least sum's bias,
                near E x, took 10% more walks, hub at 0.99) */
-            double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X, E > 0 ? fmin(1.0, 100.0 * E * E) : 1.0);
+            /* not the start's own tail here: a tight clip gives the first blocks a small scale, so a
+               large bet weight, and the bias X t / X of a loose X: weighted in to the end (a sticky chain
+               at E = 0.1 took 2.0e7 walks for 2.8e6, the 12^3 Laplacian's corner at E = 0.01 2.07-2.49
+               the CLT's count for 2.07-2.12) */
+            double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X, 0);
             double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, n1) + tj;
             if (!isfinite(Rj) || (E > 0 && tj > E * X / 16.0)) continue;
             if (pass == 0 && wj < least) least = wj, t = tj, *Rt = Rj;
             if (pass == 1 && E > 0 && wj <= 1.05 * least) t = tj, *Rt = Rj;
         }
     for (int j = 2; truncated && *h > 0 && j <= 6; j++) { /* rel_err: the share of h (1/4 .. 1/64) that meets it soonest */
-        double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m, f);
+        double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m, 1);
         double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
         if (ulam__cs_walks_needed(mabs, var, Aj, tj, E) < ulam__cs_walks_needed(mabs, var, At, t, E)) t = tj, *Rt = Rj;
     }
