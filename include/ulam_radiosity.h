@@ -466,6 +466,7 @@ typedef struct ulam_rad_final_info {
     int64_t gathered;                 /* patches gathered (those that reflect and were reached in time) */
     ulam_rad_scene_rule scene;        /* the whole scene's rule at rel_err (ulam_rad_scene_rule's
                                          meaning; unreached: no sample scored, or the stop came first) */
+    int64_t unreached[8];             /* the first unreached patches (0-based; -1 past scene.unreached) */
     int met;                          /* rel_err met on share of the lit area */
     double pilot_seconds, seconds;
     int threads, interrupted;

@@ -12,7 +12,7 @@
 #include <sys/stat.h>
 
 static const char *const usage =
-    "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot]\n"
+    "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot|final]\n"
     "                      [--estimator collision|absorption|next-event] [--mis power|balance|none]\n"
     "                      [--walks N] [--rel-err E] [--time S]\n"
     "                      [--seed S] [--threads T] [--max-steps K] [--subdivide L] [--ff-rays K]\n"
@@ -112,7 +112,6 @@ static const char *const usage_points =
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
 
-static const char *const mode_names[] = {"gather", "shoot"};
 static const char *const est_names[] = {"collision", "absorption", "next-event"};
 static const char *const mis_names[] = {"power", "balance", "none"};
 static const char *const chan = "RGB";
@@ -128,6 +127,7 @@ typedef struct {
     int direct, check, matrix_walk, json, width, height, all, list;
     int est, mis; /* indices into est_names and mis_names (-1: not given) */
     int view;     /* --view-gather */
+    int final;    /* --mode final (o.mode ULAM_FORWARD: every patch) */
     int no_mesh;  /* --no-mesh-error */
     int samples, flat; /* --samples N jittered rays a pixel, --flat: one colour a patch */
     char hdr[4096];    /* the PFM beside --image */
@@ -293,8 +293,9 @@ static int parse(int argc, char **argv, args *a)
         case 'p': a->patch = optarg; break;
         case 'Y': if ((rc = cli_parse_real(cmd, "--share", optarg, 1e-9, 1.0, &a->share))) return rc; break;
         case 'm':
-            if ((a->o.mode = cli_lookup(optarg, mode_names, 2)) < 0)
-                return cli_usage_error(cmd, "--mode expects gather or shoot, got '%s'", optarg);
+            if ((a->o.mode = ulam_rad_mode_find(optarg)) < 0) /* the library's table of modes */
+                return cli_usage_error(cmd, "--mode expects gather, shoot or final, got '%s'", optarg);
+            if ((a->final = a->o.mode == ULAM_RAD_FINAL)) a->o.mode = ULAM_FORWARD; /* every patch, as shoot */
             break;
         case 'e':
             if ((a->est = cli_lookup(optarg, est_names, 3)) < 0)
@@ -427,9 +428,35 @@ static void rel_err_warning(const args *a, const ulam_rad_result *r)
             a->scene, a->o.stop.rel_err, r->min_walks, limit < 1e8 ? "more than --walks" : "out of reach in practice");
 }
 
+/* --mode final (ulam_rad_final): every patch; 0 or an exit code. */
+static int final_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
+{
+    ulam_error err;
+    ulam_rad_opts ro = rad_opts(&a->o);
+    ulam_rad_final_info in;
+    double *half = malloc((size_t)np * 3 * sizeof *half);
+    w->all = malloc((size_t)np * 3 * sizeof *w->all), w->all_se = malloc((size_t)np * 3 * sizeof *w->all_se);
+    if (!half || !w->all || !w->all_se) return free(half), cli_exit_code(ULAM_ENOMEM);
+    cli_catch_sigint();
+    int status = ulam_rad_final(t, &ro, 0, a->share > 0 ? a->share : 1.0, w->all, w->all_se, half, &in, &err);
+    cli_release_sigint();
+    if (status) return free(half), cli_report(a->scene, &err);
+    int64_t p = a->o.query.index;
+    for (int c = 0; c < 3; c++)
+        w->B[c] = w->all[3 * p + c], w->se[c] = w->se_walk[c] = w->all_se[3 * p + c],
+        w->ci95[c][0] = fmax(0.0, w->B[c] - half[3 * p + c]), w->ci95[c][1] = w->B[c] + half[3 * p + c];
+    w->walks = in.samples, w->steps = in.rays + in.particle_rays, w->seconds = in.seconds, w->threads = in.threads;
+    w->interrupted = in.interrupted, w->rel_err_met = in.met, w->scene = in.scene;
+    w->whole = a->o.stop.rel_err > 0 && !a->patch;
+    memcpy(w->unreached, in.unreached, sizeof w->unreached);
+    free(half);
+    return 0;
+}
+
 /* Ray walks (gathering or shooting); 0 or an exit code. */
 static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
 {
+    if (a->final) return final_walks(a, t, np, w);
     ulam_rad_solver *sv = NULL;
     ulam_error err;
     ulam_rad_opts ro = rad_opts(&a->o);
@@ -855,7 +882,7 @@ static void print_text(const args *a, const report *r)
     }
     if (w)
         printf("walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)%s\n", (long long)w->walks,
-               a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
+               a->matrix_walk ? "matrix" : "ray", ulam_rad_mode_name(a->final ? ULAM_RAD_FINAL : a->o.mode, NULL), (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
     if (w && w->whole) print_scene_rule(a, w);
@@ -950,7 +977,7 @@ static void print_json(const args *a, const report *r)
                 if (r->ff_se_known) json_triple("ff_stderr", r->direct_se);
             }
         }
-        cli_json_string("mode", mode_names[a->o.mode], 0);
+        cli_json_string("mode", ulam_rad_mode_name(a->final ? ULAM_RAD_FINAL : a->o.mode, NULL), 0);
         cli_json_string("estimator", est_names[a->est], 0);
         if (a->est == 2) cli_json_string("mis", mis_names[a->mis > 0 ? a->mis : 0], 0);
         printf("\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, \"cut\": %lld, \"max_steps\": %lld, ",

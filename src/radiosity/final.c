@@ -372,9 +372,10 @@ static int final_pilot(final_ctx *x, const ulam_rad_opts *o, int64_t particles, 
  * scored on it; unreached when it reflects, emits nothing, and no sample scored (or the stop came
  * first: NaN); lit patches meet E when every nonzero channel's 95% half-width is at most E B. */
 static void final_rule(const ulam_scene *s, const double *B, const double *se, const double *half, double E,
-                       double share, ulam_rad_scene_rule *q)
+                       double share, ulam_rad_scene_rule *q, int64_t first[8])
 {
     memset(q, 0, sizeof *q);
+    for (int k = 0; k < 8; k++) first[k] = -1;
     q->worst_patch = -1, q->share = share;
     for (int64_t p = 0; p < s->npatches; p++) {
         double bright = 0.0, worst = 0.0, wse = 0.0;
@@ -387,6 +388,7 @@ static void final_rule(const ulam_scene *s, const double *B, const double *se, c
                 met &= half[3 * p + c] <= E * b;
         }
         if (isnan(B[3 * p]) || !(bright > 0)) {
+            if (ulam__max3(s->rho + 3 * p) > 0 && q->unreached < 8) first[q->unreached] = p;
             q->unreached += ulam__max3(s->rho + 3 * p) > 0;
             continue;
         }
@@ -493,7 +495,7 @@ int ulam_rad_final(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilo
         in.gathered += a->k > 0;
     }
     if (!status) {
-        final_rule(s, B, se, half, E, share, &in.scene);
+        final_rule(s, B, se, half, E, share, &in.scene, in.unreached);
         in.met = E > 0 && in.scene.met_area >= share * in.scene.lit_area * (1.0 - 1e-12) && in.scene.lit > 0;
     }
     in.seconds = ulam_now() - t0;
