@@ -429,6 +429,50 @@ int ulam_rad_solver_whole(ulam_rad_solver *s, double share);
  * be NULL when max is 0).  ULAM_EINVAL for a gathering or point solver. */
 int ulam_rad_solver_scene(const ulam_rad_solver *s, ulam_rad_scene_rule *out, int64_t *unreached, int64_t max);
 
+/* ---------------------------------------------------------------- radiosity modes */
+/* Secondary: ulam_rad_mode_find, ulam_rad_mode_name, ulam_rad_final. */
+
+/* The mode of final gathering over a shooting pilot (ulam_rad_final), beside ULAM_ADJOINT
+ * (gather, one patch) and ULAM_FORWARD (shoot, every patch). */
+#define ULAM_RAD_FINAL 2
+
+/* The radiosity modes by name (src/radiosity/modes.c: one row each): "gather" ULAM_ADJOINT,
+ * "shoot" ULAM_FORWARD, "final" ULAM_RAD_FINAL; -1 for an unknown name. */
+int ulam_rad_mode_find(const char *name);
+
+/* A mode's name and one-line summary (summary may be NULL); NULL for an unknown mode. */
+const char *ulam_rad_mode_name(int mode, const char **summary);
+
+/* What a final gather did (ulam_rad_final). */
+typedef struct ulam_rad_final_info {
+    int64_t particles, particle_rays; /* the pilot's shooting */
+    int64_t samples, rays;            /* the gather's samples (two rays each) */
+    int64_t gathered;                 /* patches gathered (those that reflect and were reached in time) */
+    ulam_rad_scene_rule scene;        /* the whole scene's rule at rel_err (ulam_rad_scene_rule's
+                                         meaning; unreached: no sample scored, or the stop came first) */
+    int64_t unreached[8];             /* the first unreached patches (0-based; -1 past scene.unreached) */
+    int met;                          /* rel_err met on share of the lit area */
+    double pilot_seconds, seconds;
+    int threads, interrupted;
+} ulam_rad_final_info;
+
+/* Every patch's radiosity by final gathering over a shooting pilot (the method of large scenes,
+ * docs/radiosity.md): 16 independent shooting runs of pilot / 16 particles (pilot 0: 4 a patch,
+ * at least 65536) estimate the reflected radiosity; then every patch that reflects gathers from
+ * uniform points: a light sample (an emitter drawn by its unoccluded transfer to the patch, MIS
+ * with the cosine ray) and a cosine ray whose landing scores its patch's emission and the pilot's
+ * reflected radiosity.  half: the 95% half-width, the samples' confidence sequence (stop.h, on
+ * the range certified given the pilot, valid at every count) at 97.5% plus the pilot runs' part
+ * (Student's t on 15 degrees of freedom) at 97.5%; se the central-limit standard error beside it.
+ * opts->stop.rel_err E > 0: each patch stops once every channel's half-width is at most E B
+ * (passes to 64, 256, 1024 ... samples a patch, at most max_walks, 0: 10^6); E = 0: max_walks
+ * samples a patch (0: 64).  max_seconds for the whole (the pilot at most a quarter), interrupt.
+ * Patch p's samples draw from stream (seed, ULAM_STREAM_POINT, p), the pilot's run g from (seed,
+ * ULAM_STREAM_PILOT, g): the answer does not depend on threads.  B, se, half: 3 * npatches (NaN
+ * where the stop came first).  info may be NULL.  ULAM_EUNDEFINED for a scene without emitters. */
+int ulam_rad_final(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilot, double share, double *B, double *se,
+                   double *half, ulam_rad_final_info *info, ulam_error *err);
+
 /* ---------------------------------------------------------------- images */
 /* Primary: ulam_camera_cornell, ulam_camera_frame, ulam_render, ulam_png_write.  Secondary:
  * ulam_view_pixels, ulam_view_gather. */

@@ -31,6 +31,7 @@ typedef struct ulam_rad_run_opts {
     int direct, check, matrix_walk, json, width, height, all, list;
     int est, mis;           /* 0 collision, 1 absorption, 2 next-event; 0 power, 1 balance, 2 none (-1: not given) */
     int view, no_mesh, samples, flat; /* --view-gather, --no-mesh-error, --samples, --flat */
+    int final;              /* --mode final: every patch by ulam_rad_final (o.mode is then ULAM_FORWARD) */
     int64_t mesh_walks;     /* --mesh-error N */
     double mesh_target;     /* --mesh-target E (0: none) */
     int64_t max_patches;    /* --max-patches (0: not given) */

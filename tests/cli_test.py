@@ -284,7 +284,7 @@ CASES += [
     (["radiosity", SC + "cube.obj", "--patch", "1", "--time", "1e-6"], 0, r"^$",
      r"^mesh error   not estimated: the walks spent --time"),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--subdivide", "0"], 2, r"--subdivide expects a number", ""),
-    (["radiosity", SC + "cube.obj", "--patch", "1", "--mode", "sideways"], 2, r"--mode expects gather or shoot", ""),
+    (["radiosity", SC + "cube.obj", "--patch", "1", "--mode", "sideways"], 2, r"--mode expects gather, shoot or final", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--size", "0x5"], 2, r"--size expects WxH", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "1000", "--estimator", "absorption"], 0, r"^$", r"radiosity R  2 \+- 0"),
     (["radiosity", SC + "cube.obj", "--direct", "--max-mem", "10"], code("EMEMLIMIT"), r"memory limit", ""),

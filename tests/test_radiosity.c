@@ -1158,27 +1158,7 @@ static void test_patch_window(void **state)
  * OBJ's path, dir the directory (test_scene_rm). */
 static void write_open_box(char dir[64], char path[96])
 {
-    FILE *f = test_scene_open(dir, path, "newmtl g\nKd 0.6 0.6 0.6\nnewmtl lamp\nKd 0.6 0.6 0.6\nKe 10 10 10\n");
-    /* each side: corner o, unit steps u, v with u x v its inward normal, and its patches' origins */
-    static const double side[5][3][3] = {{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
-                                         {{0, 0, 4}, {0, 1, 0}, {1, 0, 0}}, {{0, 0, 0}, {0, 1, 0}, {0, 0, 1}},
-                                         {{4, 0, 0}, {0, 0, 1}, {0, 1, 0}}};
-    int v = 0;
-    for (int k = 0; k < 5; k++)
-        for (int i = 0; i < 4; i++)
-            for (int j = 0; j < 4; j++) {
-                const int du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
-                for (int q = 0; q < 4; q++) {
-                    double x[3];
-                    for (int d = 0; d < 3; d++)
-                        x[d] = side[k][0][d] + (i + du[q]) * side[k][1][d] + (j + dv[q]) * side[k][2][d];
-                    fprintf(f, "v %g %g %g\n", x[0], x[1], x[2]);
-                }
-                fprintf(f, "usemtl %s\nf %d %d %d %d\n", k == 1 && i == 3 && j == 1 ? "lamp" : "g", v + 1, v + 2, v + 3,
-                        v + 4);
-                v += 4;
-            }
-    fclose(f);
+    test_open_box(dir, path);
 }
 
 /* The direct solve and its form-factor error bar at rays rays a patch (seed). */

@@ -345,6 +345,32 @@ static inline FILE *test_scene_open(char dir[64], char path[96], const char *mtl
     return f;
 }
 
+/* The open box: a 4 x 4 x 4 box without its top, 80 unit patches (Kd 0.6), one of them a lamp
+ * (Ke 10) on the wall z = 0 (the radiosity tests' scene). */
+static inline void test_open_box(char dir[64], char path[96])
+{
+    FILE *f = test_scene_open(dir, path, "newmtl g\nKd 0.6 0.6 0.6\nnewmtl lamp\nKd 0.6 0.6 0.6\nKe 10 10 10\n");
+    static const double side[5][3][3] = {{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
+                                         {{0, 0, 4}, {0, 1, 0}, {1, 0, 0}}, {{0, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                                         {{4, 0, 0}, {0, 0, 1}, {0, 1, 0}}};
+    int v = 0;
+    for (int k = 0; k < 5; k++)
+        for (int i = 0; i < 4; i++)
+            for (int j = 0; j < 4; j++) {
+                const int du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
+                for (int q = 0; q < 4; q++) {
+                    double x[3];
+                    for (int d = 0; d < 3; d++)
+                        x[d] = side[k][0][d] + (i + du[q]) * side[k][1][d] + (j + dv[q]) * side[k][2][d];
+                    fprintf(f, "v %g %g %g\n", x[0], x[1], x[2]);
+                }
+                fprintf(f, "usemtl %s\nf %d %d %d %d\n", k == 1 && i == 3 && j == 1 ? "lamp" : "g", v + 1, v + 2, v + 3,
+                        v + 4);
+                v += 4;
+            }
+    fclose(f);
+}
+
 /* Remove test_scene_open's directory and files. */
 static inline void test_scene_rm(const char *dir)
 {

@@ -12,7 +12,7 @@
 #include <sys/stat.h>
 
 static const char *const usage =
-    "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot]\n"
+    "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot|final]\n"
     "                      [--estimator collision|absorption|next-event] [--mis power|balance|none]\n"
     "                      [--walks N] [--rel-err E] [--time S]\n"
     "                      [--seed S] [--threads T] [--max-steps K] [--subdivide L] [--ff-rays K]\n"
@@ -112,7 +112,6 @@ static const char *const usage_points =
     "\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
 
-static const char *const mode_names[] = {"gather", "shoot"};
 static const char *const est_names[] = {"collision", "absorption", "next-event"};
 static const char *const mis_names[] = {"power", "balance", "none"};
 /* Everything the command was asked: the run's options (ulam_radiosity_run.h). */
@@ -236,8 +235,9 @@ static int parse(int argc, char **argv, args *a, cli_photo *ph)
         case 'p': a->patch = optarg; break;
         case 'Y': if ((rc = cli_parse_real(cmd, "--share", optarg, 1e-9, 1.0, &a->share))) return rc; break;
         case 'm':
-            if ((a->o.mode = cli_lookup(optarg, mode_names, 2)) < 0)
-                return cli_usage_error(cmd, "--mode expects gather or shoot, got '%s'", optarg);
+            if ((a->o.mode = ulam_rad_mode_find(optarg)) < 0) /* the library's table of modes */
+                return cli_usage_error(cmd, "--mode expects gather, shoot or final, got '%s'", optarg);
+            if ((a->final = a->o.mode == ULAM_RAD_FINAL)) a->o.mode = ULAM_FORWARD; /* every patch, as shoot */
             break;
         case 'e':
             if ((a->est = cli_lookup(optarg, est_names, 3)) < 0)

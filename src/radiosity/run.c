@@ -294,9 +294,35 @@ static void rel_err_warning(const args *a, const ulam_rad_result *r)
                       a->scene, a->o.stop.rel_err, r->min_walks, reach);
 }
 
-/* Ray walks (gathering or shooting); ULAM_OK or a status (written). */
+/* --mode final (ulam_rad_final): every patch; ULAM_OK or a status (written). */
+static int final_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
+{
+    ulam_error err;
+    ulam_rad_opts ro = ulam__run_rad_opts(&a->o);
+    ulam_rad_final_info in;
+    double *half = malloc((size_t)np * 3 * sizeof *half);
+    w->all = malloc((size_t)np * 3 * sizeof *w->all), w->all_se = malloc((size_t)np * 3 * sizeof *w->all_se);
+    if (!half || !w->all || !w->all_se) return free(half), fail(a, a->scene, ULAM_ENOMEM, "memory for every patch");
+    interrupt_on(a, 1);
+    int status = ulam_rad_final(t, &ro, 0, a->share > 0 ? a->share : 1.0, w->all, w->all_se, half, &in, &err);
+    interrupt_on(a, 0);
+    if (status) return free(half), ulam__run_error(a, a->scene, &err);
+    int64_t p = a->o.query.index;
+    for (int c = 0; c < 3; c++)
+        w->B[c] = w->all[3 * p + c], w->se[c] = w->se_walk[c] = w->all_se[3 * p + c],
+        w->ci95[c][0] = fmax(0.0, w->B[c] - half[3 * p + c]), w->ci95[c][1] = w->B[c] + half[3 * p + c];
+    w->walks = in.samples, w->steps = in.rays + in.particle_rays, w->seconds = in.seconds, w->threads = in.threads;
+    w->interrupted = in.interrupted, w->rel_err_met = in.met, w->scene = in.scene;
+    w->whole = a->o.stop.rel_err > 0 && !a->patch;
+    memcpy(w->unreached, in.unreached, sizeof w->unreached);
+    free(half);
+    return ULAM_OK;
+}
+
+/* Ray walks (gathering, shooting or --mode final); ULAM_OK or a status (written). */
 static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
 {
+    if (a->final) return final_walks(a, t, np, w);
     ulam_rad_solver *sv = NULL;
     ulam_error err;
     ulam_rad_opts ro = ulam__run_rad_opts(&a->o);

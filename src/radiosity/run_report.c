@@ -6,7 +6,6 @@
 
 #include <string.h>
 
-static const char *const mode_names[] = {"gather", "shoot"};
 static const char *const est_names[] = {"collision", "absorption", "next-event"};
 static const char *const mis_names[] = {"power", "balance", "none"};
 static const char *const chan = "RGB";
@@ -282,7 +281,8 @@ static void print_text(FILE *f, const ulam_rad_run *run)
     }
     if (w)
         fprintf(f, "walks        %lld %s %s walks, %lld %s, %.4f s (%.3g M %s/s, %d threads)%s\n", (long long)w->walks,
-               a->matrix_walk ? "matrix" : "ray", mode_names[a->o.mode], (long long)w->steps,
+               a->matrix_walk ? "matrix" : "ray", ulam_rad_mode_name(a->final ? ULAM_RAD_FINAL : a->o.mode, NULL),
+               (long long)w->steps,
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
     if (w && w->whole) print_scene_rule(f, a, w);
@@ -379,7 +379,7 @@ static void print_json(FILE *f, const ulam_rad_run *run)
                 if (r->ff_se_known) json_triple(f, "ff_stderr", r->direct_se);
             }
         }
-        ulam_json_string(f, "mode", mode_names[a->o.mode], 0);
+        ulam_json_string(f, "mode", ulam_rad_mode_name(a->final ? ULAM_RAD_FINAL : a->o.mode, NULL), 0);
         ulam_json_string(f, "estimator", est_names[a->est], 0);
         if (a->est == 2) ulam_json_string(f, "mis", mis_names[a->mis > 0 ? a->mis : 0], 0);
         fprintf(f, "\"matrix_walk\": %s, \"walks\": %lld, \"%s\": %lld, \"cut\": %lld, \"max_steps\": %lld, ",

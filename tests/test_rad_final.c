@@ -1,0 +1,223 @@
+/* Final gathering over a shooting pilot (ulam_rad_final, mode "final"): its intervals against
+ * LAPACK on the open box (80 patches) counted over seeds, its answer independent of threads, and
+ * its errors.  Fixed seeds. */
+#include "testutil.h"
+#include "ulam_radiosity.h"
+
+#include <string.h>
+
+/* Gauss-Legendre nodes and weights on [0, 1] (n points; Newton on P_n). */
+static void gauss01(int n, double *x, double *w)
+{
+    for (int i = 0; i < n; i++) {
+        double z = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1;
+        for (int it = 0; it < 100; it++) {
+            double p0 = 1, p1 = z;
+            for (int k = 2; k <= n; k++) {
+                double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
+                p0 = p1, p1 = p2;
+            }
+            dp = n * (z * p1 - p0) / (z * z - 1);
+            double dz = p1 / dp;
+            z -= dz;
+            if (fabs(dz) < 1e-15) break;
+        }
+        x[i] = 0.5 * (1 - z), w[i] = 1 / ((1 - z * z) * dp * dp);
+    }
+}
+
+/* Lambert's contour integral: the form factor from the point x (unit normal n) to the polygon
+ * v[0..3] wholly in front of it. */
+static double point_to_quad(const double x[3], const double n[3], double v[4][3])
+{
+    double sum = 0;
+    for (int k = 0; k < 4; k++) {
+        double a[3], b[3], c[3];
+        for (int d = 0; d < 3; d++) a[d] = v[k][d] - x[d], b[d] = v[(k + 1) % 4][d] - x[d];
+        c[0] = a[1] * b[2] - a[2] * b[1], c[1] = a[2] * b[0] - a[0] * b[2], c[2] = a[0] * b[1] - a[1] * b[0];
+        double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+        double lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        if (lc == 0) continue;
+        double cosb = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
+        sum += acos(fmax(-1.0, fmin(1.0, cosb))) * (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]) / lc;
+    }
+    return fabs(sum) / (2 * M_PI);
+}
+
+/* The open box, its tracer and its exact reference: every pair of its unit squares sees the
+ * other whole (no occluder), so F_ij is the mean over i of Lambert's point-to-square factor
+ * (24 x 24 Gauss-Legendre points), and B = E + rho F B by Jacobi iteration (rho 0.6: 200 sweeps
+ * reach 1e-40).  Its F rows match 10^6 cosine rays a patch to their binomial error. */
+typedef struct {
+    char dir[64], path[96];
+    ulam_scene *s;
+    ulam_tracer *t;
+    double *ref;
+} box;
+
+static box box_open(void)
+{
+    box b;
+    test_open_box(b.dir, b.path);
+    assert_int_equal(ulam_scene_read_obj(b.path, &b.s, NULL), ULAM_OK);
+    assert_int_equal(ulam_tracer_alloc(b.s, &b.t, NULL), ULAM_OK);
+    const ulam_scene *s = b.s;
+    int64_t n = s->npatches;
+    enum { Q = 24 };
+    double gx[Q], gw[Q], *F = calloc((size_t)(n * n), sizeof *F), *x = calloc(3 * (size_t)n, sizeof *x);
+    b.ref = malloc(3 * (size_t)n * sizeof *b.ref);
+    assert_non_null(F), assert_non_null(x), assert_non_null(b.ref);
+    gauss01(Q, gx, gw);
+    for (int64_t i = 0; i < n; i++) {
+        const double *o = s->vert + 3 * s->vidx[s->start[i]], *p1 = s->vert + 3 * s->vidx[s->start[i] + 1],
+                     *p3 = s->vert + 3 * s->vidx[s->start[i] + 3];
+        for (int64_t j = 0; j < n; j++) {
+            if (fabs(s->normal[3 * i] * s->normal[3 * j] + s->normal[3 * i + 1] * s->normal[3 * j + 1] +
+                     s->normal[3 * i + 2] * s->normal[3 * j + 2] - 1) < 1e-9)
+                continue; /* the same face */
+            double v[4][3];
+            for (int k = 0; k < 4; k++)
+                for (int d = 0; d < 3; d++) v[k][d] = s->vert[3 * s->vidx[s->start[j] + k] + d];
+            double f = 0;
+            for (int a = 0; a < Q; a++)
+                for (int c = 0; c < Q; c++) {
+                    double pt[3];
+                    for (int d = 0; d < 3; d++) pt[d] = o[d] + gx[a] * (p1[d] - o[d]) + gx[c] * (p3[d] - o[d]);
+                    f += gw[a] * gw[c] * point_to_quad(pt, s->normal + 3 * i, v);
+                }
+            F[i * n + j] = f;
+        }
+    }
+    for (int it = 0; it < 200; it++) {
+        for (int64_t i = 0; i < n; i++)
+            for (int c = 0; c < 3; c++) {
+                double h = 0;
+                for (int64_t j = 0; j < n; j++) h += F[i * n + j] * x[3 * j + c];
+                b.ref[3 * i + c] = s->emit[3 * i + c] + s->rho[3 * i + c] * h;
+            }
+        memcpy(x, b.ref, 3 * (size_t)n * sizeof *x);
+    }
+    free(F), free(x);
+    return b;
+}
+
+static void box_close(box *b)
+{
+    free(b->ref);
+    ulam_tracer_free(b->t);
+    ulam_scene_free(b->s);
+    test_scene_rm(b->dir);
+}
+
+/* One final gather on the box: rel_err E (0: walks samples a patch), pilot particles, seed. */
+static void run(const box *b, double E, int64_t walks, int64_t pilot, uint64_t seed, int threads, double *B, double *se,
+                double *half, ulam_rad_final_info *in)
+{
+    ulam_rad_opts o = ulam_rad_defaults();
+    o.stop.rel_err = E, o.stop.max_walks = walks, o.exec.seed = seed, o.exec.threads = threads;
+    ulam_error err;
+    int st = ulam_rad_final(b->t, &o, pilot, 1.0, B, se, half, in, &err);
+    if (st) print_error("%s\n", err.msg);
+    assert_int_equal(st, ULAM_OK);
+}
+
+/* Coverage of the 95% intervals (B -+ half) against the exact solution over the box's 80
+ * patches and 20 seeds, under rel_err 0.1 (the default pilot) and at a fixed 256 samples a patch
+ * (a small pilot, 4096 particles: its noise matters).  Each run's patches share its pilot, so
+ * misses come in bunches; at most 5% of the 1600 may miss (the intervals hold 95% each, and the
+ * sequence's part is conservative).  The central-limit interval 1.96 se, which the first version
+ * printed, missed 171 and 168 of 1600 here (var z 1.57, 1.54: the pilot's few bright patches
+ * next to the lamp make the scores skewed).  Under rel_err every patch meets it. */
+static void test_final_coverage(void **state)
+{
+    (void)state;
+    box b = box_open();
+    int64_t n = b.s->npatches;
+    double *B = malloc(3 * (size_t)n * sizeof *B), *se = malloc(3 * (size_t)n * sizeof *se),
+           *half = malloc(3 * (size_t)n * sizeof *half);
+    assert_non_null(B), assert_non_null(se), assert_non_null(half);
+    for (int mode = 0; mode < 2; mode++) {
+        double E = mode ? 0.0 : 0.1;
+        int miss = 0, clt = 0, total = 0, met = 0;
+        double samples = 0, width = 0;
+        for (uint64_t seed = 0; seed < 20; seed++) {
+            if (!test_case(100L * mode + (long)seed)) continue;
+            ulam_rad_final_info in;
+            run(&b, E, E > 0 ? 0 : 256, E > 0 ? 0 : 4096, 300 + seed, 2, B, se, half, &in);
+            samples += (double)in.samples, met += in.met;
+            for (int64_t p = 0; p < n; p++) {
+                double d = fabs(B[3 * p] - b.ref[3 * p]);
+                miss += !(d <= half[3 * p]), clt += !(d <= ULAM_Z95 * se[3 * p]), total++;
+                width += half[3 * p] / (ULAM_Z95 * se[3 * p]);
+                if (E > 0) assert_true(half[3 * p] <= E * B[3 * p]);
+            }
+        }
+        test_case_done();
+        print_message("final %s: %d of %d intervals miss (1.96 se: %d); half-width %.2f x 1.96 se; %.0f samples a "
+                      "patch; rule met %d of 20\n", E > 0 ? "rel-err 0.1" : "256 samples, pilot 4096", miss, total,
+                      clt, width / total, samples / total, met);
+        if (!test_case_all()) continue;
+        assert_true(miss <= 80);
+        if (E > 0) assert_int_equal(met, 20);
+    }
+    free(B), free(se), free(half);
+    box_close(&b);
+}
+
+/* The same bits at 1 and 2 threads; a stop before the gather leaves NaN and says so; the
+ * errors. */
+static void test_final_threads_and_errors(void **state)
+{
+    (void)state;
+    box b = box_open();
+    int64_t n = b.s->npatches;
+    double *B1 = malloc(6 * (size_t)n * sizeof *B1), *B2 = B1 + 3 * n, *se = malloc(6 * (size_t)n * sizeof *se),
+           *half = se + 3 * n;
+    assert_non_null(B1), assert_non_null(se);
+    ulam_rad_final_info in;
+    run(&b, 0.0, 128, 0, 7, 1, B1, se, half, &in);
+    run(&b, 0.0, 128, 0, 7, 2, B2, se, half, &in);
+    assert_memory_equal(B1, B2, 3 * (size_t)n * sizeof *B1);
+    assert_int_equal(in.gathered, n);
+    assert_int_equal(in.scene.lit, n);
+    assert_int_equal(in.scene.unreached, 0);
+    assert_true(in.rays == 2 * in.samples);
+    ulam_rad_opts o = ulam_rad_defaults();
+    volatile int stop = 1;
+    o.stop.rel_err = 0.1, o.stop.interrupt = &stop, o.exec.threads = 2;
+    assert_int_equal(ulam_rad_final(b.t, &o, 4096, 1.0, B1, se, half, &in, NULL), ULAM_OK);
+    assert_true(in.interrupted);
+    assert_true(isnan(B1[0]) && in.gathered == 0 && !in.met && in.scene.unreached == n);
+    o.stop.interrupt = NULL;
+    assert_int_equal(ulam_rad_final(b.t, &o, 4096, 0.0, B1, se, half, &in, NULL), ULAM_EINVAL);
+    assert_int_equal(ulam_rad_final(b.t, &o, -1, 1.0, B1, se, half, &in, NULL), ULAM_EINVAL);
+    assert_int_equal(ulam_rad_final(b.t, &o, 4096, 1.0, NULL, se, half, &in, NULL), ULAM_EINVAL);
+    free(B1), free(se);
+    box_close(&b);
+}
+
+/* The modes by name: a row each, found and named. */
+static void test_final_modes(void **state)
+{
+    (void)state;
+    const char *names[] = {"gather", "shoot", "final"}, *summary = NULL;
+    const int modes[] = {ULAM_ADJOINT, ULAM_FORWARD, ULAM_RAD_FINAL};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(ulam_rad_mode_find(names[k]), modes[k]);
+        assert_string_equal(ulam_rad_mode_name(modes[k], &summary), names[k]);
+        assert_non_null(summary);
+    }
+    assert_int_equal(ulam_rad_mode_find("jacobi"), -1);
+    assert_int_equal(ulam_rad_mode_find(NULL), -1);
+    assert_null(ulam_rad_mode_name(7, NULL));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_final_modes),
+        cmocka_unit_test(test_final_threads_and_errors),
+        cmocka_unit_test(test_final_coverage),
+    };
+    return test_run(tests);
+}
