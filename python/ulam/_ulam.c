@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "ulam.h"
+#include "ulam_report.h"
 #include "ulam_study.h"
 
 /* The interrupt flag of the query running in the main thread (the SIGINT handler's only way in). */
@@ -245,6 +246,27 @@ static PyObject *walk_result(const ulam_walk_result *r)
                          r->interrupted, "rho4", radius(&r->rho4), "fourth_finite", r->fourth_finite);
 }
 
+/* What writer(f, ...) writes, as a Python str (open_memstream around the library's FILE *
+ * writers): the library's JSON, parsed by the Python half. */
+static PyObject *json_text(const ulam_walk_opts *o, const ulam_answer *a, const ulam_choice *ch, int walk, int interrupted)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f) return PyErr_NoMemory();
+    fputc('{', f);
+    if (walk) ulam_walk_result_json(f, o, &a->walks, &a->guard);
+    else ulam_choice_fprint(f, ch, 1, ULAM_REPORT_JSON);
+    fprintf(f, "\"interrupted\": %s}", interrupted ? "true" : "false");
+    if (fclose(f)) {
+        free(buf);
+        return PyErr_NoMemory();
+    }
+    PyObject *s = PyUnicode_FromStringAndSize(buf, (Py_ssize_t)len);
+    free(buf);
+    return s;
+}
+
 /* The answer, the choice and the status as one dict. */
 static PyObject *answer(int status, const ulam_error *err, const ulam_choice *ch, int started, const ulam_answer *a,
                         int ran, int interrupted)
@@ -268,6 +290,9 @@ static PyObject *answer(int status, const ulam_error *err, const ulam_choice *ch
         put(d, "rho_abs", radius(&a->guard.abs)) || put(d, "rho_hat", radius(&a->guard.hat[o->mode == 1])) ||
         put(d, "iterations", PyLong_FromLong(a->iterations)) || put(d, "residual", PyFloat_FromDouble(a->residual)))
         goto fail;
+    int stopped = interrupted || a->walks.interrupted;
+    if (a->method == ULAM_METHOD_WALKS && put(d, "report_json", json_text(o, a, ch, 1, stopped))) goto fail;
+    if (started && !ch->pinned && put(d, "auto_json", json_text(o, a, ch, 0, stopped))) goto fail;
     if (a->method == ULAM_METHOD_BIDIRECTIONAL &&
         put(d, "bidirectional", Py_BuildValue("{s:d,s:i,s:d,s:d,s:d,s:L,s:L,s:L,s:d,s:L,s:d,s:d,s:d}", "rmax",
                                               br->push.rmax, "rmax_balanced", br->plan.balanced, "predicted_work",
