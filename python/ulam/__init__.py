@@ -20,6 +20,7 @@ estimate so far in its .result.
 """
 import json
 import math
+import re
 import threading
 import warnings
 import zlib
@@ -322,11 +323,10 @@ def _report(d, index, b_nonzeros, source, scale):
     return rep
 
 
-# The numeric options: the library's field, and the CLI's range (integer or real).
-_RANGES = {"walks": ("max_walks", 1, 2**62, True), "rel_err": ("rel_err", 1e-12, 1.0, False),
-           "time": ("max_seconds", 1e-6, 1e9, False), "threads": ("threads", 1, 1024, True),
-           "max_steps": ("max_steps", 1, 2**62, True), "roulette": ("roulette", 1e-300, 1e300, False),
-           "split": ("split", 1e-300, 1e300, False)}
+def _option_message(message):
+    """The options table's refusal named as Python names it ("--rel-err expects a real ..." ->
+    "rel_err: a real ..."); other messages as they are."""
+    return re.sub(r"^--([a-z-]+) expects ", lambda m: m.group(1).replace("-", "_") + ": ", message)
 
 
 def _method_error(name):
@@ -534,13 +534,15 @@ def _solve(system, b, index, *, source=None, method="auto", mode=None, estimator
         opts["kernel_alpha"], opts["pin_alpha"] = _number("kernel_alpha", kernel_alpha, 0.0, 1000.0), 1
     given = {"walks": walks, "rel_err": rel_err, "time": time, "threads": threads, "max_steps": max_steps,
              "roulette": roulette, "split": split}
-    for name, (field, lo, hi, integer) in _RANGES.items():
-        if given[name] is not None:
-            opts[field] = _number(name, given[name], lo, hi, integer)
+    # the numeric options, set and checked by the library's options table (ulam_options_set)
+    opts["set"] = {name: str(v) for name, v in given.items() if v is not None}
     if walks is None:
         opts["max_walks"] = 100000 if rel_err is None and time is None else 0  # the CLI's default budget
-    if roulette is not None and split is not None and split <= roulette:
-        _input("split: a weight above roulette's")
+    try:
+        if roulette is not None and split is not None and float(split) <= float(roulette):
+            _input("split: a weight above roulette's")
+    except (TypeError, ValueError):
+        pass  # not numbers: the options table refuses them
     mode_forward = opts.get("mode") == 1
     if index is None:
         if not mode_forward:
@@ -570,7 +572,7 @@ def _solve(system, b, index, *, source=None, method="auto", mode=None, estimator
     d["rel_err"] = rel_err
     if d["status"]:
         _divergence(d, force)
-        _raise(d["status"], d["message"], d["error_index"])
+        _raise(d["status"], _option_message(d["message"]), d["error_index"])
     ch = d.get("choice")
     if method == "auto" and ch and ch["walks"]["chosen"] < 0:
         w = ch["walks"]
