@@ -18,7 +18,9 @@ queries of one matrix, reusing its set-up.  Errors raise ulam.Error subclasses c
 library's status and message; Ctrl-C raises ulam.Interrupted (a KeyboardInterrupt) with the
 estimate so far in its .result.
 """
+import json
 import math
+import re
 import threading
 import warnings
 import zlib
@@ -35,8 +37,6 @@ MODES = ("adjoint", "forward")
 ESTIMATORS = ("collision", "absorption", "expected")
 _ROWS = [name for name, _ in _ulam.methods()]
 _METHOD_WALKS, _METHOD_BIDIR = _ROWS.index("walks"), _ROWS.index("bidirectional")
-_STATES = ("uncertified", "refused", "skipped", "dropped", "finalist", "chosen")
-_ROW_STATES = ("not_considered", "planned", "chosen")
 
 
 class Error(Exception):
@@ -279,55 +279,6 @@ def _num(v):
     return v if isinstance(v, (int, bool)) or (v is not None and math.isfinite(v)) else None
 
 
-def _radius(rep, prefix, p):
-    """The CLI's radius keys (cli_json_radius)."""
-    rep[prefix] = _num(p["rho"] if p["converged"] else p["upper"])
-    rep[prefix + "_is"] = "estimate" if p["converged"] else "upper bound"
-    rep[prefix + "_lower"], rep[prefix + "_upper"] = _num(p["lower"]), _num(p["upper"])
-    rep[prefix + "_converged"] = bool(p["converged"])
-
-
-def _auto(ch):
-    """The CLI's "auto" key (cli_auto_print_json) from the library's choice."""
-    w, rows = ch["walks"], ch["rows"]
-    bid = rows[_METHOD_BIDIR]
-    chosen_bidir = ch["chosen"] == _METHOD_BIDIR
-    cands = w["candidates"]
-    run = cands[w["chosen"]]["predicted_work"] if w["chosen"] >= 0 else float("nan")
-    over = w["pilot_work"] - w["reused_work"]
-    share = over / (over + w["reused_work"] + run) if w["chosen"] >= 0 and math.isfinite(run) else float("nan")
-    out = {"chosen": (len(cands) if chosen_bidir else w["chosen"]) + 1, "closest": w["closest"] + 1, "stages": w["stages"],
-           "seconds": w["seconds"], "pilot_work": w["pilot_work"], "reused_work": w["reused_work"],
-           "pilot_share": _num(share), "candidates": []}
-    for k, c in enumerate(cands):
-        piloted = c["pilot_walks"] > 0
-        state = _STATES[c["state"]]
-        if state == "chosen" and chosen_bidir:
-            state = "finalist"
-        out["candidates"].append({
-            "mode": MODES[c["mode"]], "estimator": ESTIMATORS[c["estimator"]],
-            "continue": _num(c["continue_q"]) if c["continue_q"] > 0 else None, "kernel_alpha": c["kernel_alpha"],
-            "rho_hat": _num(c["rho_hat"]) if math.isfinite(c["rho_hat_upper"]) else None,
-            "rho_hat_upper": _num(c["rho_hat_upper"]), "certified": c["certified"], "state": state,
-            "status": "ok" if not c["status"] else _ulam.strerror(c["status"]), "pilot_walks": c["pilot_walks"],
-            "variance": _num(c["variance"]) if piloted else None,
-            "variance_rel_error": _num(c["variance_rel_error"]) if piloted else None,
-            "steps_per_walk": _num(c["steps_per_walk"]) if piloted else None,
-            "work_per_walk": _num(c["work_per_walk"]) if piloted else None, "cost": _num(c["cost"]),
-            "predicted_walks": _num(c["predicted_walks"]), "predicted_work": _num(c["predicted_work"]),
-            "predicted_seconds": _num(c["predicted_seconds"])})
-    if bid["state"]:
-        p = ch["bidirectional"]
-        out["candidates"].append({"mode": "bidirectional", "state": _ROW_STATES[bid["state"]], "rmax": _num(p["rmax"]),
-                                  "push_ops": p["push_ops"], "pilot_walks": p["pilot_walks"],
-                                  "predicted_walks": _num(p["predicted_walks"]),
-                                  "predicted_work": _num(bid["predicted_work"]), "leader_work": _num(ch["leader_work"])})
-    out["bidirectional"] = None if chosen_bidir else bid["why"]
-    out["rows"] = [{"name": r["name"], "state": _ROW_STATES[r["state"]], "predicted_work": _num(r["predicted_work"]),
-                    "why": r["why"] or None} for r in rows]
-    return out
-
-
 def _report(d, index, b_nonzeros, source, scale):
     """The JSON object `ulam solve --json` prints, from the library's answer (the CLI's keys)."""
     w, o = d["walk"], d["opts"]
@@ -355,46 +306,27 @@ def _report(d, index, b_nonzeros, source, scale):
     elif d["method"] != "walks":
         rep.update({"method": d["method"], "estimate": d["estimate"] * scale, "iterations": d["iterations"],
                     "residual": _num(d["residual"]), "histories": w["walks"], "seed": o["seed"]})
-    else:
-        rep.update({"method": "walks", "estimate": w["estimate"] * scale, "stderr": w["std_error"] * abs(scale)})
-        lo, hi = d["ci95"]
-        rep["ci95"] = [lo * scale, hi * scale] if w["variance_finite"] == 1 and math.isfinite(lo) else None
-        fin = w["variance_finite"]
-        rep["variance_finite"] = True if fin == 1 else False if fin == 0 else None
-        _radius(rep, "rho_abs", d["rho_abs"])
-        _radius(rep, "rho_hat", d["rho_hat"])
-        rep.update({"kernel_alpha": o["kernel_alpha"], "max_share": _num(w["max_share"]),
-                    "score_bound": _num(w["score_bound"]), "tail_bound": _num(w["tail_bound"]),
-                    "variance_rel_error": _num(w["variance_rel_error"])})
-        if d.get("rel_err"):
-            r = w
-            stop = ("cuts" if r["cut_stop"] else "out_of_reach" if r["out_of_reach"]
-                    else "no_bound" if not math.isfinite(r["tail_bound"]) and r["estimate"] != 0
-                    else "fourth_moment" if not r["rel_err_met"] and r["fourth_finite"] != 1 else None)
-            rep.update({"min_walks": _num(r["min_walks"]), "rel_err_met": bool(r["rel_err_met"]),
-                        "cut_bound": _num(r["cut_bound"]), "rel_err_stop": stop,
-                        "fourth_finite": True if r["fourth_finite"] == 1 else False if r["fourth_finite"] == 0 else None})
-            _radius(rep, "rho4", r["rho4"])
-        if o["mode"] == 1:
-            rep["unreached"] = w["unreached"]
-        rel = w["std_error"] / abs(w["estimate"]) if w["estimate"] != 0 else float("inf")
-        rep.update({"variance": _num(w["variance"]), "walks": w["walks"], "steps": w["steps"], "cut": w["cut"],
-                    "mean_length": w["steps"] / w["walks"] if w["walks"] else 0.0, "seconds": w["seconds"],
-                    "steps_per_second": w["steps"] / w["seconds"] if w["seconds"] > 0 else 0.0,
-                    "figure_of_merit": _num(1.0 / (rel * rel * w["seconds"])) if w["seconds"] > 0 and rel > 0 else None,
-                    "mode": MODES[o["mode"]], "estimator": ESTIMATORS[o["estimator"]], "seed": o["seed"],
-                    "threads": w["threads"], "ranks": 1, "kernel_rows": w["rows"]})
-    if auto:
-        rep["auto"] = _auto(ch)
+    else:  # the library's members (ulam_walk_result_json), as `ulam solve --json` prints them
+        rep.update(json.loads(d["report_json"]))
+        # the CLI's own keys around them (ranks: MPI; kernel_rows), and pagerank's scale (1 - alpha)
+        rep.update({"ranks": 1, "kernel_rows": w["rows"]})
+        if scale != 1.0:
+            rep["estimate"], rep["stderr"] = rep["estimate"] * scale, rep["stderr"] * abs(scale)
+            if rep["ci95"]:
+                rep["ci95"] = sorted(c * scale for c in rep["ci95"])
+    if auto:  # the library's "auto" member (ulam_choice_fprint), as the CLI prints it
+        rep["auto"] = json.loads(d["auto_json"])["auto"]
+        why = ch["rows"][_METHOD_BIDIR]["why"]
+        if rep["auto"]["bidirectional"] is not None and why == "not considered: --jacobi":
+            rep["auto"]["bidirectional"] = why  # the CLI's wording for its --jacobi (set by _solve)
     rep["interrupted"] = bool(d["interrupted"] or w["interrupted"])
     return rep
 
 
-# The numeric options: the library's field, and the CLI's range (integer or real).
-_RANGES = {"walks": ("max_walks", 1, 2**62, True), "rel_err": ("rel_err", 1e-12, 1.0, False),
-           "time": ("max_seconds", 1e-6, 1e9, False), "threads": ("threads", 1, 1024, True),
-           "max_steps": ("max_steps", 1, 2**62, True), "roulette": ("roulette", 1e-300, 1e300, False),
-           "split": ("split", 1e-300, 1e300, False)}
+def _option_message(message):
+    """The options table's refusal named as Python names it ("--rel-err expects a real ..." ->
+    "rel_err: a real ..."); other messages as they are."""
+    return re.sub(r"^--([a-z-]+) expects ", lambda m: m.group(1).replace("-", "_") + ": ", message)
 
 
 def _method_error(name):
@@ -602,13 +534,15 @@ def _solve(system, b, index, *, source=None, method="auto", mode=None, estimator
         opts["kernel_alpha"], opts["pin_alpha"] = _number("kernel_alpha", kernel_alpha, 0.0, 1000.0), 1
     given = {"walks": walks, "rel_err": rel_err, "time": time, "threads": threads, "max_steps": max_steps,
              "roulette": roulette, "split": split}
-    for name, (field, lo, hi, integer) in _RANGES.items():
-        if given[name] is not None:
-            opts[field] = _number(name, given[name], lo, hi, integer)
+    # the numeric options, set and checked by the library's options table (ulam_options_set)
+    opts["set"] = {name: str(v) for name, v in given.items() if v is not None}
     if walks is None:
         opts["max_walks"] = 100000 if rel_err is None and time is None else 0  # the CLI's default budget
-    if roulette is not None and split is not None and split <= roulette:
-        _input("split: a weight above roulette's")
+    try:
+        if roulette is not None and split is not None and float(split) <= float(roulette):
+            _input("split: a weight above roulette's")
+    except (TypeError, ValueError):
+        pass  # not numbers: the options table refuses them
     mode_forward = opts.get("mode") == 1
     if index is None:
         if not mode_forward:
@@ -638,7 +572,7 @@ def _solve(system, b, index, *, source=None, method="auto", mode=None, estimator
     d["rel_err"] = rel_err
     if d["status"]:
         _divergence(d, force)
-        _raise(d["status"], d["message"], d["error_index"])
+        _raise(d["status"], _option_message(d["message"]), d["error_index"])
     ch = d.get("choice")
     if method == "auto" and ch and ch["walks"]["chosen"] < 0:
         w = ch["walks"]

@@ -17,6 +17,8 @@
 #include <string.h>
 
 #include "ulam.h"
+#include "ulam_options.h"
+#include "ulam_report.h"
 #include "ulam_study.h"
 
 /* The interrupt flag of the query running in the main thread (the SIGINT handler's only way in). */
@@ -142,9 +144,11 @@ static int get_int(PyObject *d, const char *key, int *v)
     return 0;
 }
 
-/* The walk and choice options from the Python half's dict (its keys: the fields' names). */
+/* The walk and choice options from the Python half's dict (its keys: the fields' names; its
+ * "set", a dict of option name to text, through the library's options table, ulam_options_set):
+ * 0, -1 with an exception set, or 1 with err the library's refusal of a value. */
 static int read_opts(PyObject *d, ulam_walk_opts *o, ulam_auto_opts *ao, ulam_method_opts *mo, int *reuse,
-                     int *catch_sigint)
+                     int *catch_sigint, ulam_error *err)
 {
     int64_t seed = (int64_t)o->exec.seed;
     if (get_int(d, "mode", &o->mode) || get_int(d, "estimator", &o->estimator) ||
@@ -163,7 +167,22 @@ static int read_opts(PyObject *d, ulam_walk_opts *o, ulam_auto_opts *ao, ulam_me
     int exclude = 0;
     if (get_int(d, "exclude", &exclude)) return -1;
     mo->exclude = (unsigned)exclude;
+    PyObject *set = PyDict_GetItemString(d, "set"), *key, *value;
+    Py_ssize_t pos = 0;
+    while (set && PyDict_Check(set) && PyDict_Next(set, &pos, &key, &value)) {
+        const char *name = PyUnicode_AsUTF8(key), *text = PyUnicode_AsUTF8(value);
+        if (!name || !text) return -1;
+        int status = ulam_options_set(ULAM_OPTIONS_WALK, o, name, text, err);
+        if (status) return err->status = status, 1;
+    }
     return 0;
+}
+
+/* The dict of a refused option (read_opts's 1). */
+static PyObject *refusal(const ulam_error *err)
+{
+    return Py_BuildValue("{s:i,s:s,s:L,s:O}", "status", err->status, "message", err->msg, "error_index", -1LL,
+                         "interrupted", Py_False);
 }
 
 /* Set d[key] = v (a new reference, stolen); -1 on failure. */
@@ -245,6 +264,27 @@ static PyObject *walk_result(const ulam_walk_result *r)
                          r->interrupted, "rho4", radius(&r->rho4), "fourth_finite", r->fourth_finite);
 }
 
+/* What writer(f, ...) writes, as a Python str (open_memstream around the library's FILE *
+ * writers): the library's JSON, parsed by the Python half. */
+static PyObject *json_text(const ulam_walk_opts *o, const ulam_answer *a, const ulam_choice *ch, int walk, int interrupted)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f) return PyErr_NoMemory();
+    fputc('{', f);
+    if (walk) ulam_walk_result_json(f, o, &a->walks, &a->guard);
+    else ulam_choice_fprint(f, ch, 1, ULAM_REPORT_JSON);
+    fprintf(f, "\"interrupted\": %s}", interrupted ? "true" : "false");
+    if (fclose(f)) {
+        free(buf);
+        return PyErr_NoMemory();
+    }
+    PyObject *s = PyUnicode_FromStringAndSize(buf, (Py_ssize_t)len);
+    free(buf);
+    return s;
+}
+
 /* The answer, the choice and the status as one dict. */
 static PyObject *answer(int status, const ulam_error *err, const ulam_choice *ch, int started, const ulam_answer *a,
                         int ran, int interrupted)
@@ -268,6 +308,9 @@ static PyObject *answer(int status, const ulam_error *err, const ulam_choice *ch
         put(d, "rho_abs", radius(&a->guard.abs)) || put(d, "rho_hat", radius(&a->guard.hat[o->mode == 1])) ||
         put(d, "iterations", PyLong_FromLong(a->iterations)) || put(d, "residual", PyFloat_FromDouble(a->residual)))
         goto fail;
+    int stopped = interrupted || a->walks.interrupted;
+    if (a->method == ULAM_METHOD_WALKS && put(d, "report_json", json_text(o, a, ch, 1, stopped))) goto fail;
+    if (started && !ch->pinned && put(d, "auto_json", json_text(o, a, ch, 0, stopped))) goto fail;
     if (a->method == ULAM_METHOD_BIDIRECTIONAL &&
         put(d, "bidirectional", Py_BuildValue("{s:d,s:i,s:d,s:d,s:d,s:L,s:L,s:L,s:d,s:L,s:d,s:d,s:d}", "rmax",
                                               br->push.rmax, "rmax_balanced", br->plan.balanced, "predicted_work",
@@ -356,9 +399,11 @@ static PyObject *System_query(SystemObject *self, PyObject *args)
     ulam_auto_opts ao = ulam_auto_defaults();
     ulam_method_opts mo = ulam_method_defaults();
     int reuse = 0, catch = 0, vectors = 0;
-    if (read_opts(od, &o, &ao, &mo, &reuse, &catch) || get_int(od, "vectors", &vectors)) {
+    ulam_error oerr = {0};
+    int rc = read_opts(od, &o, &ao, &mo, &reuse, &catch, &oerr);
+    if (rc || get_int(od, "vectors", &vectors)) {
         Py_DECREF(barr);
-        return NULL;
+        return rc > 0 ? refusal(&oerr) : NULL;
     }
     volatile int flag = 0;
     o.query.index = index, o.stop.interrupt = &flag;
@@ -522,8 +567,10 @@ static PyObject *System_fpush(SystemObject *self, PyObject *args)
     ulam_auto_opts ao = ulam_auto_defaults();
     ulam_method_opts mo = ulam_method_defaults();
     int reuse = 0, catch = 0;
-    if (read_opts(od, &o.walk, &ao, &mo, &reuse, &catch) || get_double(od, "fpush_rel_err", &o.rel_err) ||
-        get_int64(od, "fpush_walks", &o.walks))
+    ulam_error oerr = {0};
+    int rc = read_opts(od, &o.walk, &ao, &mo, &reuse, &catch, &oerr);
+    if (rc > 0) return refusal(&oerr);
+    if (rc || get_double(od, "fpush_rel_err", &o.rel_err) || get_int64(od, "fpush_walks", &o.walks))
         return NULL;
     o.walk.mode = ULAM_FORWARD, o.source = source;
     npy_intp n = (npy_intp)self->M.nrows;
