@@ -9,9 +9,8 @@
  * The API by rank:
  *   primary: ulam_gonio_read, ulam_gonio_free, ulam_gonio_flux, ulam_luminaire_defaults,
  *     ulam_luminaire_illuminance, ulam_luminaire_patch_illuminance, ulam_rad_grid_en12464,
- *     ulam_luminaire_patch_illuminance_stop,
  *     ulam_uniformity_compute;
- *   secondary: ulam_gonio_read_ies, ulam_gonio_read_ldt, ulam_gonio_intensity,
+ *   secondary: ulam_gonio_intensity,
  *     ulam_gonio_rated_flux, ulam_gonio_size, ulam_luminaire_intensity, ulam_en12464_spacing. */
 #ifndef ULAM_PHOTOMETRY_H
 #define ULAM_PHOTOMETRY_H
@@ -33,15 +32,7 @@ typedef struct ulam_gonio ulam_gonio;
 #define ULAM_GONIO_MAX_ANGLES 3601
 #define ULAM_GONIO_MAX_VALUES 2000000
 
-/* Read an IES LM-63 file (TILT=NONE or INCLUDE; type C photometry; candela times the
- * multiplier, the ballast factor and the ballast-lamp factor).  Errors: the line and what was
- * expected (ULAM_ESYNTAX, ULAM_ERANGE, ULAM_EUNSUPPORTED for type A or B photometry or a TILT
- * file; ULAM_EIO). */
-int ulam_gonio_read_ies(const char *path, ulam_gonio **out, ulam_error *err);
 
-/* Read a EULUMDAT file (.ldt: symmetry 0 to 4, intensities in cd/klm times the conversion
- * factor and the first lamp set's flux / 1000).  Errors as ulam_gonio_read_ies's. */
-int ulam_gonio_read_ldt(const char *path, ulam_gonio **out, ulam_error *err);
 
 /* Read either: EULUMDAT when the name ends in .ldt (any case), else IES. */
 int ulam_gonio_read(const char *path, ulam_gonio **out, ulam_error *err);
@@ -92,13 +83,6 @@ double ulam_luminaire_illuminance(const ulam_tracer *t, const ulam_luminaire *l,
  * receive is sum_p A_p metres^2 H_p.  ULAM_EINVAL for bad arguments. */
 int ulam_luminaire_patch_illuminance(const ulam_tracer *t, const ulam_luminaire *l, int64_t nl, double metres, int q,
                                      int threads, double *H, ulam_error *err);
-
-/* ulam_luminaire_patch_illuminance that can be stopped: once *interrupt (may be NULL) is nonzero or
- * max_seconds (> 0; 0: no limit) have passed, the patches not yet lit are left NaN; *lit (may be
- * NULL) gets the patches lit (npatches when it ran to the end).  ULAM_OK when stopped. */
-int ulam_luminaire_patch_illuminance_stop(const ulam_tracer *t, const ulam_luminaire *l, int64_t nl, double metres,
-                                          int q, int threads, const volatile int *interrupt, double max_seconds,
-                                          double *H, int64_t *lit, ulam_error *err);
 
 /* The EN 12464-1 calculation grid of a work plane: the rectangle with opposite corners c0 and c1
  * (equal in exactly one coordinate, its plane; scene units) less a band of `band` metres along

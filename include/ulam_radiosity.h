@@ -11,7 +11,7 @@
  *     ulam_ff_estimate, ulam_rad_direct, ulam_camera_cornell, ulam_camera_frame,
  *     ulam_render, ulam_png_write;
  *   secondary: ulam_scene_subdivide, ulam_scene_centroid, ulam_scene_label_centroid,
- *     ulam_tracer_cast, ulam_tracer_shoot, ulam_ff_report_compute, ulam_rad_system,
+ *     ulam_tracer_cast, ulam_ff_report_compute, ulam_rad_system,
  *     ulam_rad_direct_error, ulam_rad_direct_errors, ulam_view_gather, ulam_view_pixels,
  *     ulam_rad_solver_whole, ulam_rad_solver_scene;
  *   tertiary: ulam_tracer_resolution, ulam_ff_parallel_rectangles,
@@ -106,7 +106,7 @@ void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3]);
 int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3]);
 
 /* ---------------------------------------------------------------- rays */
-/* Primary: ulam_tracer_alloc, ulam_tracer_free.  Secondary: ulam_tracer_cast, ulam_tracer_shoot.
+/* Primary: ulam_tracer_alloc, ulam_tracer_free.  Secondary: ulam_tracer_cast.
  * Tertiary: ulam_tracer_resolution. */
 
 /* A ray caster over a scene (Embree 3): opaque. */
@@ -134,10 +134,6 @@ double ulam_tracer_resolution(const ulam_tracer *t, int64_t *patch);
 int64_t ulam_tracer_cast(const ulam_tracer *t, const double org[3], const double dir[3],
                          int *front);
 
-/* A cosine-distributed ray leaving a uniform point of patch p: the patch it reaches
- * (front side) is j with probability exactly F_pj; -1 when it leaves the scene or hits a
- * back side (the light is lost).  Draws from r. */
-int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
 
 /* What rays say about a scene (ulam_rad_scene_diagnose): the emitting patches, and where
  * cosine rays from uniform points of patches drawn by area land, from their fronts, from their
@@ -186,12 +182,6 @@ double ulam_ff_perpendicular_rectangles(double w, double h, double l);
 int ulam_rad_system(const ulam_scene *s, const ulam_csr *F, int channel, ulam_csr **M,
                     double *b);
 
-/* The relative target of walks on the assembled M at a patch under --matrix-walk --rel-err E,
- * so that the answer's error, the walks' and the sampled F's combined, meets E: E' =
- * sqrt(E^2 - (ff_se / |B|)^2), ff_se being F's standard error at the patch and B the direct
- * solution there (src/stop.c's rule); 0 when F's error alone reaches E (more walks cannot meet
- * it: more form-factor rays can); E when F's error is unknown (ff_known 0). */
-double ulam_rad_walk_target(double rel_err, double ff_se, double B, int ff_known);
 
 /* Solve the three channels' systems with LAPACKE_dgesv into B (3 * npatches, RGB per patch);
  * refuses with ULAM_EMEMLIMIT like ulam_direct_solve.  info (may be NULL) sums the three. */
@@ -394,12 +384,6 @@ typedef struct ulam_rad_mesh {
 int ulam_rad_mesh_error(const ulam_tracer *t, const ulam_rad_opts *opts, const double B[3], ulam_rad_mesh *out,
                         ulam_error *err);
 
-/* The mesh error of every patch p (ulam_rad_mesh_error with opts, opts->index = p, seeded by
- * ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, p)) against B (3 a patch) into out (3 a
- * patch; NaN for the patches an interrupt left).  ULAM_OK or patch p's failure (err->index = p). */
-int ulam_rad_mesh_errors(const ulam_tracer *t, const ulam_rad_opts *opts, const double *B, double *out,
-                         ulam_error *err);
-
 /* Run one round of walks (rounds grow 1, 2, 4 ... 32 blocks of 256 walks as walks accumulate,
  * whatever the thread count); ULAM_OK, or the status that ends the run: ULAM_ENONFINITE,
  * ULAM_ENOMEM (shooting's tallies), ULAM_EIO (the share's allgather). */
@@ -492,9 +476,6 @@ int ulam_render(const ulam_tracer *t, const double *B, const ulam_camera *cam, i
 int ulam_render_hdr(const ulam_tracer *t, const double *B, const ulam_camera *cam, int width, int height, int samples,
                     int smooth, uint64_t seed, double exposure, float *hdr, unsigned char *rgb, ulam_render_info *info);
 
-/* Write linear float RGB (3 a pixel, rows top first) as a PFM file (Portable Float Map,
- * little-endian), atomically. */
-int ulam_pfm_write(const char *path, int width, int height, const float *rgb);
 
 /* Write linear float RGB (3 a pixel, rows top first) as a Radiance .hdr file (RGBE, flat
  * scanlines: 8 bits of mantissa a channel under a shared exponent), atomically. */

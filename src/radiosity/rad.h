@@ -3,6 +3,7 @@
 #define ULAM_RAD_H
 
 #include "../internal.h"
+#include "ulam_photometry.h"
 #include "ulam_radiosity.h"
 
 #include <math.h>
@@ -215,5 +216,46 @@ ulam_scene *ulam__scene_alloc(int64_t npatches, int64_t nverts, int64_t nidx, in
 
 /* Copy s's group labels into o (made with s->ngroups); on failure o is freed (src/radiosity/scene.c). */
 int ulam__scene_copy_groups(ulam_scene *o, const ulam_scene *s);
+
+/* Library-internal (not exported: the run, ulam_radiosity_run.h, or one reader calls them; their
+ * names kept ulam_ for the estimator files that call them). */
+/* A cosine-distributed ray leaving a uniform point of patch p: the patch it reaches
+ * (front side) is j with probability exactly F_pj; -1 when it leaves the scene or hits a
+ * back side (the light is lost).  Draws from r. */
+int64_t ulam_tracer_shoot(const ulam_tracer *t, int64_t p, ulam_rng *r);
+
+/* The relative target of walks on the assembled M at a patch under --matrix-walk --rel-err E,
+ * so that the answer's error, the walks' and the sampled F's combined, meets E: E' =
+ * sqrt(E^2 - (ff_se / |B|)^2), ff_se being F's standard error at the patch and B the direct
+ * solution there (src/stop.c's rule); 0 when F's error alone reaches E (more walks cannot meet
+ * it: more form-factor rays can); E when F's error is unknown (ff_known 0). */
+double ulam_rad_walk_target(double rel_err, double ff_se, double B, int ff_known);
+
+/* The mesh error of every patch p (ulam_rad_mesh_error with opts, opts->index = p, seeded by
+ * ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, p)) against B (3 a patch) into out (3 a
+ * patch; NaN for the patches an interrupt left).  ULAM_OK or patch p's failure (err->index = p). */
+int ulam_rad_mesh_errors(const ulam_tracer *t, const ulam_rad_opts *opts, const double *B, double *out,
+                         ulam_error *err);
+
+/* Write linear float RGB (3 a pixel, rows top first) as a PFM file (Portable Float Map,
+ * little-endian), atomically. */
+int ulam_pfm_write(const char *path, int width, int height, const float *rgb);
+
+/* Read an IES LM-63 file (TILT=NONE or INCLUDE; type C photometry; candela times the
+ * multiplier, the ballast factor and the ballast-lamp factor).  Errors: the line and what was
+ * expected (ULAM_ESYNTAX, ULAM_ERANGE, ULAM_EUNSUPPORTED for type A or B photometry or a TILT
+ * file; ULAM_EIO). */
+int ulam_gonio_read_ies(const char *path, ulam_gonio **out, ulam_error *err);
+
+/* Read a EULUMDAT file (.ldt: symmetry 0 to 4, intensities in cd/klm times the conversion
+ * factor and the first lamp set's flux / 1000).  Errors as ulam_gonio_read_ies's. */
+int ulam_gonio_read_ldt(const char *path, ulam_gonio **out, ulam_error *err);
+
+/* ulam_luminaire_patch_illuminance that can be stopped: once *interrupt (may be NULL) is nonzero or
+ * max_seconds (> 0; 0: no limit) have passed, the patches not yet lit are left NaN; *lit (may be
+ * NULL) gets the patches lit (npatches when it ran to the end).  ULAM_OK when stopped. */
+int ulam_luminaire_patch_illuminance_stop(const ulam_tracer *t, const ulam_luminaire *l, int64_t nl, double metres,
+                                          int q, int threads, const volatile int *interrupt, double max_seconds,
+                                          double *H, int64_t *lit, ulam_error *err);
 
 #endif
