@@ -7,6 +7,8 @@
 #ifndef ULAM_OPTIONS_H
 #define ULAM_OPTIONS_H
 
+#include <stdio.h>
+
 #include "ulam.h"
 
 #ifdef __cplusplus
@@ -41,6 +43,11 @@ int ulam_options_parse_real(const char *opt, const char *value, double lo, doubl
 /* The name among names[0..n) closest to word (a prefix of 3 or more letters, or within a third
  * of its length in edits), or NULL: the "did you mean" of a misspelt name. */
 const char *ulam_options_suggest(const char *word, const char *const *names, int n);
+
+/* Write the help of topic to f: a command of ulam ("info", "solve", "direct", "study",
+ * "prepare"), a solve method's own ("bidirectional", "mcsa"), or "ulam" (the commands).  ULAM_OK,
+ * ULAM_EINVAL (no such topic) or ULAM_EIO (f has an error). */
+int ulam_options_help(FILE *f, const char *topic);
 
 #ifdef __cplusplus
 }

@@ -11,6 +11,8 @@
 #ifndef ULAM_STUDY_H
 #define ULAM_STUDY_H
 
+#include <stdio.h>
+
 #include "ulam.h"
 
 #ifdef __cplusplus
@@ -181,6 +183,38 @@ int ulam_study_forward_walks(const ulam_study *s);
 int ulam_study_reference_lines(const ulam_study *s, double reference_time,
                                void (*fn)(const char *kind, double seconds, double error, void *arg), void *arg,
                                ulam_error *err);
+
+/* What ulam_study_fprint writes (the files and text of `ulam study`; the caller opens, names and
+ * closes the stream). */
+enum ulam_study_report {
+    ULAM_STUDY_RUNS_CSV = 0,    /* runs.csv: a row per finished run (ulam_study_runs_read reads it back) */
+    ULAM_STUDY_SUMMARY_CSV = 1, /* summary.csv: a row per (method, budget) cell */
+    ULAM_STUDY_BARS_CSV = 2,    /* bars.csv: per method at its largest budget, the coverage's Wilson interval */
+    ULAM_STUDY_QUESTION = 3,    /* question.txt: the question's fingerprint, a "field value" line each */
+    ULAM_STUDY_TEXT = 4,        /* the winner at each budget, the failures and the refused methods */
+    ULAM_STUDY_CHART_COLLISION = 5, /* a gnuplot script (reading the CSVs in its directory): RMSE against */
+    ULAM_STUDY_CHART_ABSORPTION = 6, /* seconds of one estimator's methods (nothing when none runs) */
+    ULAM_STUDY_CHART_EXPECTED = 7,
+    ULAM_STUDY_CHART_WORK = 8,      /* RMSE^2 x seconds at the largest budget, from bars.csv */
+    ULAM_STUDY_CHART_COVERAGE = 9   /* the coverage with its binomial interval, from bars.csv */
+};
+
+/* What a report says that the study does not know. */
+typedef struct ulam_study_report_opts {
+    int jacobi;            /* M = I - omega D^-1 A was made from A (the question's fields) */
+    double omega;
+    double reference_time; /* seconds of each one-run reference line (0: none; the RMSE charts' legend) */
+    int partial;           /* interrupted: the text and the charts say so */
+} ulam_study_report_opts;
+
+/* Write report kind of s to f (ro NULL: no Jacobi, not partial, no reference lines).  ULAM_OK,
+ * ULAM_EINVAL, or ULAM_EIO when f has an error. */
+int ulam_study_fprint(FILE *f, const ulam_study *s, int kind, const ulam_study_report_opts *ro);
+
+/* Restore the runs of an earlier runs.csv read from f (ulam_study_fprint's ULAM_STUDY_RUNS_CSV)
+ * that belong to s's grid and are not done yet; a torn last line ends the reading.  The number
+ * restored. */
+int ulam_study_runs_read(ulam_study *s, FILE *f);
 
 #ifdef __cplusplus
 }

@@ -100,22 +100,6 @@ void ulam_study_coverage_interval(int covered, int runs, double *lo, double *hi)
     *lo = covered <= 0 ? 0.0 : fmax(0.0, mid - half), *hi = covered >= runs ? 1.0 : fmin(1.0, mid + half); /* exact ends */
 }
 
-enum { MAXBUDGET = 16, MAXREPEAT = 4096 };
-
-/* A study: its question, the guards' verdicts, each method's screening and every run's record. */
-struct ulam_study {
-    const ulam_csr *M;
-    const double *b;
-    int64_t index;
-    ulam_study_params p;
-    double budget[MAXBUDGET];
-    ulam_guard g;
-    ulam_study_ref ref;
-    ulam_study_screen screen[ULAM_STUDY_METHODS];
-    ulam_study_run *run; /* [method][budget][repeat] */
-    unsigned char *done;
-};
-
 /* See ulam.h. */
 ulam_study_params ulam_study_defaults(void)
 {

@@ -11,38 +11,6 @@
 #include <time.h>
 #include <unistd.h>
 
-static const char *const usage =
-    "usage: ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R]\n"
-    "       ulam solve M.mtx --index I --rhs b.mtx --method bidirectional [--rmax R]\n"
-    "                  [--min-value V] [--step-cost C] [--estimator collision|absorption|expected] [--walks N]\n"
-    "                  [--rel-err E] [--time S] [--seed S] [--threads T] [--continue Q]\n"
-    "                  [--max-steps K] [--check] [--json] [--force] [--cache] [--pagerank ALPHA]\n"
-    "\n"
-    "Estimate x_I of (I - M) x = b with an error bar, for a point source b = e_S (no --rhs\n"
-    "file) or a sparse b (at most max(16, n/10) nonzeros; a denser b is refused):\n"
-    "a reverse push from I on the adjoint equation leaves x_I = <p, b> + <r, x> with every\n"
-    "|r_j| <= R, then walks from b's states (S, or state j with probability |b_j| / ||b||_1;\n"
-    "on the columns of M) score the residual r.  Indices are 1-based.\n"
-    "\n"
-    "  --rmax R           push threshold (default: balance the push's work against the work\n"
-    "                     the walks are predicted to need for the target)\n"
-    "  --min-value V      the smallest x_I the balance plans for (default 1 / n, raised by a probe\n"
-    "                     of 1024 walks once the push has spent what they cost)\n"
-    "  --top K            with --source S and no --index: every component of x = (I - M)^-1 e_S by\n"
-    "                     forward push (sweeps once the residual spreads) and walks from its\n"
-    "                     residual (--rel-err E: every 95% interval of an x_i >= --min-value within\n"
-    "                     E of it, default 0.1 and 1 / n; or --walks N), the K largest printed\n"
-    "                     with their intervals (default 10)\n"
-    "  --pagerank ALPHA   (or --damping) the file is a graph (adjacency matrix or edge list):\n"
-    "                     personalized PageRank pi = (1 - ALPHA) x of (I - ALPHA P^T) x = s, s = e_S,\n"
-    "                     or a seed set --source 3,7,9 (equal weights) or --source FILE (lines\n"
-    "                     'id' or 'id weight'); --top K alone: global PageRank's K largest\n"
-    "  --step-cost C      push operations one walk visit costs, for the balance (default 1.3;\n"
-    "                     bench_bidir measures it: docs/bidirectional.md)\n"
-    "  --rel-err E        stop once the 95% interval's half-width <= E |x_I estimate| (>= 1000 walks)\n"
-    "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
-    "  guards reported are those of the forward kernel\n";
-
 typedef struct {
     int json, check;
     double direct, transpose_seconds, load_seconds, guard_seconds;
@@ -524,7 +492,7 @@ static int option(void *p, int c, const char *name, const char *optarg)
     case 'J': a->rp.json = 1; break;
     case 'F': a->force = 1; break;
     case 'C': a->s.cache = 1; break;
-    case 'h': fputs(usage, stdout); return -1;
+    case 'h': ulam_options_help(stdout, "bidirectional"); return -1;
     default: return cli_usage_error("solve", "unknown option for a --source solve");
     }
     return 0;

@@ -102,26 +102,6 @@ int cli_direct_check(const cli_system *s, int64_t index, double *value, double *
 }
 
 
-static const char *const usage =
-    "usage: ulam direct M.mtx --rhs b.mtx [--index I] [--out x.mtx] [--max-mem SIZE]\n"
-    "                   [--lu auto|sparse|dense] [--jacobi [--omega W]] [--json]\n"
-    "\n"
-    "Solve (I - M) x = b with a sparse LU factorisation (UMFPACK) for a large sparse M, else\n"
-    "a dense one (LAPACKE_dgesv, OpenBLAS), and report the reciprocal condition number (dense:\n"
-    "LAPACKE_dgecon, 1-norm; sparse: UMFPACK's estimate), the relative residual\n"
-    "||b - (I - M) x||_inf / ||b||_inf and the time.\n"
-    "\n"
-    "  --rhs b.mtx     right-hand side, a Matrix Market n x 1 vector (required)\n"
-    "  --index I       report x_I; indices are 1-based, as in Matrix Market files\n"
-    "  --out x.mtx     write the whole solution (array format)\n"
-    "  --max-mem SIZE  refuse when the dense matrix or the sparse factors need more (default 4G)\n"
-    "  --lu L          auto (default: sparse when n > 1000 and under 5% of M is nonzero and\n"
-    "                  UMFPACK is there), sparse or dense\n"
-    "  --jacobi        the file holds A of A x = b; solve with M = I - omega D^-1 A\n"
-    "  --omega W       damping of the Jacobi splitting (default 1)\n"
-    "  --pagerank A    (or --damping) the file is an adjacency matrix: solve PageRank at damping A\n"
-    "  --json          print one JSON object\n";
-
 /* Print the human-readable report. */
 static void print_text(const cli_system *s, const double *x, int64_t index,
                        const ulam_direct_info *info, const char *out)
@@ -199,7 +179,7 @@ int cli_direct(int argc, char **argv)
             if (cli_direct_force == 1 && (ulam_reference_plan(NULL, 1, 0, &plan, NULL), !plan.umfpack))
                 return cli_usage_error("direct", "--lu sparse: this ulam was built without UMFPACK (libsuitesparse-dev)");
             break;
-        case 'h': fputs(usage, stdout); return 0;
+        case 'h': ulam_options_help(stdout, "direct"); return 0;
         default: return cli_usage_error("direct", "unknown option");
         }
     }

@@ -7,26 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const usage =
-    "usage: ulam info M.mtx [--jacobi [--omega W]] [--continue Q] [--kernel-exponent A] [--tol T] [--json]\n"
-    "\n"
-    "Describe the iteration matrix M of (I - M) x = b: size, nonzeros per row, signs,\n"
-    "row sums of |M| (the continuation probabilities of an analog walk), and the guards:\n"
-    "  rho(M)          restarted Arnoldi (ARPACK), relative residual tolerance T (default\n"
-    "                  1e-6): the Neumann series sum M^k b converges iff < 1;\n"
-    "  rho(|M|)        power iteration with Collatz-Wielandt bounds: the walks converge iff < 1;\n"
-    "  rho(M^) adjoint the second-moment matrix of the adjoint kernel, and\n"
-    "  rho(M^) forward of the forward kernel: each estimator's variance is finite iff < 1.\n"
-    "\n"
-    "  --jacobi     the file holds A of A x = b; describe M = I - omega D^-1 A, and list\n"
-    "               rho(M) and rho(|M|) for omega = 1, 0.9, ..., 0.5 (n <= 100000)\n"
-    "  --omega W    damping of the Jacobi splitting (default 1)\n"
-    "  --continue Q the kernel's fixed continuation probability (default: analog)\n"
-    "  --kernel-exponent A  (was --alpha) the kernel's exponent, p_ij proportional to |M_ij|^A (default 1): the\n"
-    "               rho(M^) are that kernel's\n"
-    "  --tol T      relative residual tolerance of the rho(M) estimate\n"
-    "  --json       print one JSON object\n";
-
 static const char *const unsure = " [the estimate did not converge]";
 
 /* The Neumann verdict on rho(M) < 1: 1 converges, 0 diverges, -1 unknown; *certified says
@@ -207,7 +187,7 @@ int cli_info(int argc, char **argv)
             if ((rc = cli_parse_real("info", c == 'a' ? "--alpha" : "--kernel-exponent", optarg, 0.0, 1000.0, &alpha))) return rc;
             break;
         case 'J': json = 1; break;
-        case 'h': fputs(usage, stdout); return 0;
+        case 'h': ulam_options_help(stdout, "info"); return 0;
         default: return cli_usage_error("info", "unknown option");
         }
     }

@@ -5,29 +5,11 @@
 #include <stdio.h>
 #include <string.h>
 
-static const char *const usage =
-    "usage: ulam <command> [options]   (ulam help <command>, or ulam <command> --help, for details)\n"
-    "\n"
-    "Solve (I - M) x = b by von Neumann-Ulam random walks, with an error bar, checked by a direct solve.\n"
-    "\n"
-    "commands:\n"
-    "  info     describe M: sizes, signs, spectral radii, convergence verdicts\n"
-    "  solve    one unknown (adjoint) or all (forward) by random walks, with error bars\n"
-    "  direct   the reference solve: sparse LU (UMFPACK) or dense LU (LAPACK)\n"
-    "  study    every method at every budget, repeated: accuracy against time, charts\n"
-    "  radiosity  a patch scene (OBJ + MTL): one patch by ray-cast walks, or all, or LAPACK\n"
-    "  prepare  write M, b and the guards' certificate as a file that queries map in place\n"
-    "\n"
-    "Matrices and vectors are Matrix Market files (or prepared systems).  Indices on the command line are\n"
-    "1-based, as in Matrix Market files (the C API is 0-based).  solve, direct, info and radiosity take\n"
-    "--json (one JSON object; {\"error\": ..., \"exit\": N} on failure); every command --quiet (-q) and\n"
-    "--verbose (-v).\n";
-
 /* Run the subcommand. */
 static int dispatch(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
-        fputs(usage, argc < 2 ? stderr : stdout);
+        ulam_options_help(argc < 2 ? stderr : stdout, "ulam");
         return argc < 2 ? EXIT_USAGE : 0;
     }
     if (!strcmp(argv[1], "help")) { /* ulam help [COMMAND]: COMMAND --help */
@@ -55,8 +37,9 @@ static int dispatch(int argc, char **argv)
     if (!strcmp(argv[1], "prepare")) return cli_prepare(argc - 1, argv + 1);
     static const char *const commands[] = {"info", "solve", "direct", "study", "radiosity", "prepare", "help"};
     const char *near = ulam_options_suggest(argv[1], commands, (int)(sizeof commands / sizeof commands[0]));
-    if (near) fprintf(stderr, "ulam: unknown command '%s' (did you mean '%s'?)\n%s", argv[1], near, usage);
-    else fprintf(stderr, "ulam: unknown command '%s'\n%s", argv[1], usage);
+    if (near) fprintf(stderr, "ulam: unknown command '%s' (did you mean '%s'?)\n", argv[1], near);
+    else fprintf(stderr, "ulam: unknown command '%s'\n", argv[1]);
+    ulam_options_help(stderr, "ulam");
     return EXIT_USAGE;
 }
 

@@ -10,45 +10,6 @@
 #include <string.h>
 #include <unistd.h>
 
-static const char *const usage =
-    "usage: ulam solve M.mtx --rhs b.mtx --method mcsa|sequential|richardson|gauss-seidel|cg|gmres\n"
-    "                  [--tol T] [--max-iter K] [--eps1 E] [--max-histories N] [--stall K]\n"
-    "                  [--restart K]\n"
-    "                  [--estimator collision|absorption|expected] [--seed S] [--threads T]\n"
-    "                  [--continue Q] [--max-steps K] [--jacobi [--omega W]] [--json]\n"
-    "                  [--out x.mtx [--index I]] [--check] [--force] [--cache]\n"
-    "\n"
-    "Every unknown of (I - M) x = b by an outer iteration from x = 0 that stops when the exact\n"
-    "residual ||b - (I - M) x||_2 / ||b||_2 is at most T:\n"
-    "\n"
-    "  --method mcsa         Monte Carlo Synthetic Acceleration: a Richardson step x <- M x + b,\n"
-    "                        then the correction (I - M)^-1 r of its residual by forward walks\n"
-    "  --method sequential   Halton's sequential Monte Carlo: the walk correction alone\n"
-    "  --method richardson   x <- M x + b (no walks; the reference iteration)\n"
-    "  --method gauss-seidel one Gauss-Seidel sweep an iteration (no walks)\n"
-    "  --method cg           conjugate gradients (the Krylov peer for symmetric M)\n"
-    "  --method gmres        restarted GMRES (--restart K, default 30), the peer otherwise\n"
-    "  --tol T               residual reduction, 0 < T < 1 (default 1e-8)\n"
-    "  --max-iter K          iteration cap (default 1000 with walks, 100000 without)\n"
-    "  --eps1 E              walk each correction until ||stderr||_1 / ||delta||_1 < E (default 0.1)\n"
-    "  --max-histories N     cap on one correction's walks (default 100000000)\n"
-    "  --stall K             stop (exit 10 + ESTALL) after K iterations without a new smallest\n"
-    "                        residual (default 5 with walks, 100 without)\n"
-    "  --estimator E         of the forward walks (default expected)\n"
-    "  --seed S              iteration l walks with a seed drawn from stream (S, l) (default 1):\n"
-    "                        identical results for any --threads\n"
-    "  --out x.mtx           write the solution\n"
-    "  --index I             print x_I (with or without --out)\n"
-    "  --check               also solve with LAPACK and report the relative error of x\n"
-    "  --json                one JSON object with the history of every iteration\n"
-    "  --jacobi, --omega, --continue, --max-steps, --threads, --force, --cache: as for walks\n"
-    "\n"
-    "A walk correction that does not lower the residual is rejected and its walks go on to more\n"
-    "histories; when the count its variance predicts is beyond 100x what --eps1 asked for (or\n"
-    "--max-histories), the run stops (exit 10 + ESTALL) saying so.  Walks whose variance is not\n"
-    "certified finite (rho(M^) >= 1) are refused before any walk (exit 10 + EINFVAR).\n"
-    "Each iteration prints its residual, its walks (histories, rejected ones too) and its seconds.\n";
-
 /* The method's name: its row of the library's table (p->method counts from ULAM_METHOD_RICHARDSON). */
 #define method_name(m) ulam_method_name(ULAM_METHOD_RICHARDSON + (m))
 enum { KRYLOV_CG = ULAM_METHOD_CG - ULAM_METHOD_RICHARDSON, KRYLOV_GMRES = ULAM_METHOD_GMRES - ULAM_METHOD_RICHARDSON };
@@ -346,7 +307,7 @@ static int option(void *q, int c, const char *name, const char *optarg)
     case 'c': a->p.check = 1; break;
     case 'F': a->force = 1; break;
     case 'C': a->s.cache = 1; break;
-    case 'h': fputs(usage, stdout); return -1;
+    case 'h': ulam_options_help(stdout, "mcsa"); return -1;
     default: return cli_usage_error("solve", "unknown option (for --method: see 'ulam solve --method mcsa --help')");
     }
     return 0;

@@ -6,25 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const usage =
-    "usage: ulam prepare M.mtx [--rhs b.mtx] [--jacobi [--omega W]] [--continue Q] [--transpose] -o SYSTEM.ulam\n"
-    "\n"
-    "Write M (and b) of (I - M) x = b as a prepared system: the CSR arrays and b as they sit in\n"
-    "memory (little-endian, 4096-byte aligned) behind a checksummed header that also holds the\n"
-    "guards' certificate (rho(|M|), rho(M^) of both kernels with their bounds, the row and\n"
-    "column sums of |M|), with an XXH3 checksum for each block of rows, verified when first\n"
-    "read.  'ulam solve SYSTEM.ulam --index I' then maps the file and reads only the blocks of\n"
-    "the rows its walks reach: no parse, no guard pass.  The file is written atomically.\n"
-    "\n"
-    "  --rhs b.mtx   store b too (solve then needs no --rhs)\n"
-    "  --jacobi      the file holds A of A x = b: store M = I - omega D^-1 A and omega D^-1 b\n"
-    "  --omega W     damping of the Jacobi splitting (default 1)\n"
-    "  --continue Q  certify the kernel of fixed continuation Q (default: analog); a query with\n"
-    "                another continuation runs its own guards\n"
-    "  --transpose   store M^T too (CSR of the transpose): bidirectional and point-source\n"
-    "                queries push on it instead of transposing M each run\n"
-    "  -o, --output PATH  the output file (required)\n";
-
 /* ulam prepare. */
 int cli_prepare(int argc, char **argv)
 {
@@ -48,7 +29,7 @@ int cli_prepare(int argc, char **argv)
         case 'q': if ((rc = cli_parse_real("prepare", "--continue", optarg, 1e-9, 1 - 1e-12, &continue_q))) return rc; break;
         case 'o': out = optarg; break;
         case 't': transpose = 1; break;
-        case 'h': fputs(usage, stdout); return 0;
+        case 'h': ulam_options_help(stdout, "prepare"); return 0;
         default: return cli_usage_error("prepare", "unknown option");
         }
     }

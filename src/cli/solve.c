@@ -11,101 +11,6 @@
 #include <string.h>
 #include <unistd.h>
 
-static const char *const usage =
-    "usage: ulam solve M.mtx --rhs b.mtx --index I [--mode adjoint|forward]\n"
-    "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"
-    "                  [--time S] [--seed S] [--threads T] [--continue Q] [--kernel-exponent A]\n"
-    "                  [--roulette W] [--split W] [--max-steps K] [--jacobi [--omega W]] [--check]\n"
-    "                  [--json] [--quiet | --verbose] [--pagerank ALPHA]\n"
-    "                  [--out x.mtx] [--errors e.mtx] [--force] [--assume-finite-variance]\n"
-    "                  [--cache] [--whole-kernel]\n"
-    "                  [--method auto]\n"
-    "       ulam solve M.mtx --index I --source S [--method bidirectional] [--rmax R] ...\n"
-    "                  (b = e_S: a reverse push from I and walks from S; --source S --help)\n"
-    "\n"
-    "Estimate x_I of (I - M) x = b by von Neumann-Ulam random walks, with an error bar.\n"
-    "Indices are 1-based, as in Matrix Market files.\n"
-    "M.mtx may be a prepared system (ulam prepare): it is mapped and read only where the walks\n"
-    "go, its certificate serves the guards, and it holds b unless --rhs is given.\n"
-    "\n"
-    "  --mode adjoint     start walks at I and gather b (default): one unknown, cheaply\n"
-    "  --mode forward     start walks from the source b and tally where they go: every unknown\n"
-    "                     (--out x.mtx, --errors e.mtx write all estimates and standard errors)\n"
-    "  --estimator E      collision (score at every visit, default), absorption (score where\n"
-    "                     the walk ends, / p*), expected (score the exact next-step expectation)\n"
-    "  --walks N          stop after N walks (default 100000 when no rule is given)\n"
-    "  --rel-err E        (or --tol E) stop once the printed 95% interval's half-width is at most\n"
-    "                     E |estimate| (walks; docs/error-bars.md), after at least 1000 walks; it watches\n"
-    "                     x_I (--index, default 1 in forward mode) and never\n"
-    "                     stops while no walk has reached it; refused (exit 4) when the variance\n"
-    "                     is not certified finite, unless --walks or --time bounds the run\n"
-    "  --time S           stop S seconds after ulam started (reading, guards and set-up\n"
-    "                     count); the first rule reached wins\n"
-    "  --seed S           block q of walks uses stream (S, q) (default 1): identical results for\n"
-    "                     any --threads\n"
-    "  --threads T        threads (default: all cores)\n";
-static const char *const usage2 = /* the help in three strings: C99 promises 4095 characters a literal */
-    "  --continue Q       continue with probability Q in every state (analog, the default:\n"
-    "                     q_i = min(1, sum_j |M_ij|)); weights keep the estimate unbiased;\n"
-    "                     --continue analog names the default (pins it for --method auto)\n"
-    "  --kernel-exponent A  (was --alpha) move to j with probability proportional to\n"
-    "                     |M_ij|^A over the row's nonzeros (default 1, |M_ij| / S_i; 0 uniform,\n"
-    "                     2 Alea's); rho(M^) and the error bar are this kernel's\n"
-    "  --roulette W       Russian roulette below weight W (survive with |w|/W, weight W; default off)\n"
-    "  --split W          split particles above weight W into ceil(|w|/W) copies (default off)\n"
-    "  --max-steps K      cut walks longer than K steps and count them (default 1000000)\n"
-    "  --jacobi           the file holds A of A x = b; walk on M = I - omega D^-1 A\n"
-    "  --omega W          damping of the Jacobi splitting (default 1)\n"
-    "  --check            after printing the estimate, solve directly (sparse LU above n = 1000,\n"
-    "                     dense below, GMRES past 4 GiB; its needs said first when large; Ctrl-C\n"
-    "                     keeps the estimate): adds direct and z = (estimate - direct) / stderr\n"
-    "  --json             print one JSON object ({\"error\": ..., \"exit\": N} on failure)\n"
-    "  --force            walk even when rho(|M|) is not certified below 1 (otherwise refused\n"
-    "                     with exit 3)\n"
-    "  --assume-finite-variance  print a confidence interval when the guards cannot tell\n"
-    "                     whether rho(M^) < 1 (unknown is otherwise treated as infinite)\n"
-    "  --cache            keep a binary copy of each input beside it (FILE.ulamcache) and read\n"
-    "                     that instead of parsing while the file is unchanged (its XXH3 hash)\n";
-static const char *const usage3 =
-    "  --pagerank ALPHA   (or --damping) the file is a graph: an adjacency matrix (edge i -> j) or\n"
-    "                     an edge list ('u v' a line, SNAP's; ids as written); walk on\n"
-    "                     M = ALPHA P^T, P = D^-1 adjacency; the answer is pi[I], PageRank:\n"
-    "                     --index I alone global (b = (1 - ALPHA) / n unless --rhs), --source S\n"
-    "                     (or seeds 3,7,9, or a file of them) personalized, --top K the K largest;\n"
-    "                     pi = (1 - ALPHA) x; a dangling node's rank leaks (docs/commands.md)\n"
-    "  --quiet, -q        print the answer line alone\n"
-    "  --verbose, -v      print everything: the candidates, the radii, the tail bound, timings\n"
-    "  --method auto      (default) choose mode, estimator, continuation and exponent among\n"
-    "                     the candidates the guards certify, by pilots compared on a fixed\n"
-    "                     work model (the same choice on every run); what is given stays\n"
-    "                     pinned; fresh walks then estimate with the choice; with a sparse b\n"
-    "                     and --rel-err, also bidirectional (push + walks) when the best walks\n"
-    "                     are predicted to cost more than nnz(M)/4\n"
-    "  --queries FILE     many queries in one process ('-': stdin), one a line: 'I' (x_I), or\n"
-    "                     'S I' (x_I with b = e_S, bidirectional), either optionally followed\n"
-    "                     by a target like 0.01 for that line's --rel-err; one answer a line\n"
-    "                     (--json: JSON lines) with the seed it walked on: --index I --seed\n"
-    "                     SEED reruns it (docs/streams.md); the guards, bounds and kernel rows\n"
-    "                     are kept across them (docs/queries.md)\n"
-    "  --partition        the rows of a prepared SYSTEM.ulam split across mpirun's ranks, walks\n"
-    "                     that migrate (its own options: ulam solve --partition --help;\n"
-    "                     docs/distributed.md)\n"    "  --method walks     the single method the options name, defaults for the rest (adjoint,\n"
-    "                     collision, --continue analog, --kernel-exponent 1): the run before auto\n"
-    "  --whole-kernel     build the walk kernel's every row before walking (default: a row\n"
-    "                     is built when a walk first reaches it, so one unknown of a large\n"
-    "                     system reads and keeps only the rows its walks visit)\n"
-    "\n"
-    "Before walking, the guards bound rho(|M|) (the walks converge iff < 1) and rho(M^) of\n"
-    "the kernel's second-moment matrix (the variance is finite iff < 1); a verdict counts only\n"
-    "when its certified bounds lie on one side of 1.  With rho(M^) not certified below 1 the\n"
-    "run goes on but reports no confidence interval.\n"
-    "\n"
-    "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C\n"
-    "exits at once.\n"
-    "\n"
-    "Every unknown to a residual tolerance (MCSA, sequential MC, Krylov): see\n"
-    "'ulam solve --method mcsa --help'.\n";
-
 
 typedef struct {
     int check, json;
@@ -445,7 +350,7 @@ static int option(void *p, int c, const char *name, const char *optarg)
     case 'o': a->out = optarg; break;
     case 'E': a->errors = optarg; break;
     case 'Q': a->queries = optarg; break;
-    case 'h': fputs(usage, stdout), fputs(usage2, stdout), fputs(usage3, stdout); return -1;
+    case 'h': ulam_options_help(stdout, "solve"); return -1;
     default: return cli_usage_error("solve", "unknown option");
     }
     return 0;
