@@ -542,8 +542,9 @@ typedef struct ulam_rad_adapt_info {
  * point queries (ulam_rad_point_query with opts, no mesh in their answers) at the patch's area
  * centroid and half way to each vertex, weight 2/3, and at the nodes on its boundary (its
  * vertices and the midpoints finer neighbours put on its edges, each measured once), weight 1/3
- * by length (the points' noise removed, scaled to a linear field's RMS over the area); the mesh's
- * error is max over channels of sum_p Y_p e_p / sum_p Y_p mean_p, Y_p the importance of p
+ * by length (the points' noise and one SD of its spread removed, scaled to a linear field's RMS
+ * over the area); the mesh's error is max over channels of sum_p Y_p e_p / sum_p Y_p mean_p,
+ * Y_p the importance of p
  * (importance: one a patch of the tracer's scene, e.g. ulam_rad_importance's, a child getting
  * its area's share; NULL: the area, every surface alike).  While it is above target, the
  * patches of largest Y_p e_p are split (triangles and quads into 4 at their edge midpoints,
