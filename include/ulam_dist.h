@@ -177,9 +177,11 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
  * computed with each row's rounding bounded (rho = its largest |entry| over the ranks), and a
  * Collatz-Wielandt vector v > 0 with |M| v <= u v, u < 1, by at most iters products of power
  * iteration over the ranks' rows, give |x*_i - x_i| <= rho v_i / (min v (1 - u)); with M >= 0 the
- * range takes r's signs (above by its positive part, below by its negative part).  No sampling:
+ * range takes r's signs (above by its positive part, below by its negative part).  With M' in the
+ * part and ||M||_1 = c < 1, also |x*_i - x_i| <= ||r||_1 / (1 - c) (each end the nearer; ||r||_1
+ * summed in fixed point, the same bits at any split).  No sampling:
  * the range is certain, for MCSA's x, single source's or forward walks' alike.  NaN ends (and
- * *worst INFINITY) when no u < 1 is certified; else *worst is the largest half-width over the
+ * *worst INFINITY) when neither u < 1 nor c < 1 is certified; else *worst is the largest half-width over the
  * ranks.  Needs the part's rows of M.  The same bits at any rank count. */
 int ulam_dist_bound(const ulam_part *p, const ulam_comm *comm, const double *b, const double *x, int iters, double *lo,
                     double *hi, double *worst, ulam_error *err);

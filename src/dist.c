@@ -359,6 +359,7 @@ static int adjoint(const ulam_part *p, const ulam_comm *comm, const int64_t *ind
 {
     ulam__clear(err);
     if (!p || !comm || !res || !index || nq < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "parts, indices and results");
+    if (!p->b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
     if (!(rel_err >= 0) || !isfinite(rel_err)) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a relative error >= 0, got %g", rel_err);
     for (int64_t k = 0; k < nq; k++) {
         res[k] = (ulam_dist_result){0};
@@ -569,7 +570,8 @@ int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_d
                         double *se, ulam_dist_result *res, ulam_error *err)
 {
     ulam__clear(err);
-    if (!p || !comm || !res || !b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, b and a result");
+    if (p && comm && res && !b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
+    if (!p || !comm || !res) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, b and a result");
     *res = (ulam_dist_result){0};
     for (int64_t i = 0; i < p->last - p->first; i++)
         if (!isfinite(b[i])) return ulam__fail(err, ULAM_EINVAL, 0, p->first + i, "a finite b");

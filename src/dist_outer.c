@@ -28,7 +28,7 @@ static int matvec(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, c
     const ulam__rows *A = &p->m;
     for (int64_t i = 0; i < p->last - p->first; i++) {
         double s = 0.0;
-        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += A->val[q] * ulam__halo_at(p, h, own, gv, A->col[q]);
+        for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) s += A->val[q] * ulam__halo_at(p, A, h, own, gv, q);
         y[i] = s;
     }
     return 0;
@@ -88,6 +88,7 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
     if (!p || !comm || !x || !info || !(tol > 0) || max_iter < 1)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, info, tol > 0 and max_iter >= 1");
     if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
+    if (!p->b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
     *info = (ulam_dist_mcsa_info){0};
     int64_t rows = p->last - p->first;
     double *gv = NULL, *r = malloc(((size_t)rows + 1) * sizeof *r), *d = malloc(((size_t)rows + 1) * sizeof *d);
@@ -167,7 +168,7 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
  * in gv): the largest r + e and e - r over the ranks into up[0], up[1] (both >= 0), and up[2] 1
  * when every entry of M is nonnegative, else 0; nonzero on a failed exchange. */
 static int residual_bounds(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, const double *b, const double *x,
-                           double *gv, double up[3])
+                           double *gv, double up[3], double *pos, double *neg_part)
 {
     if (ulam__halo_swap(p, c, h, x, gv)) return 1;
     const ulam__rows *A = &p->m;
@@ -176,17 +177,31 @@ static int residual_bounds(const ulam_part *p, const ulam_comm *c, const ulam__h
     for (int64_t i = 0; i < p->last - p->first; i++) {
         double s = 0.0, a = 0.0;
         for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++) {
-            double xj = ulam__halo_at(p, h, x, gv, A->col[q]);
+            double xj = ulam__halo_at(p, A, h, x, gv, q);
             s += A->val[q] * xj, a += fabs(A->val[q] * xj);
             if (A->val[q] < 0) neg = 1.0;
         }
         double r = b[i] - x[i] + s; /* (len + 3) roundings, each at most DBL_EPSILON / 2 of the sizes summed */
         double e = (double)(A->rowptr[i + 1] - A->rowptr[i] + 4) * DBL_EPSILON * (fabs(b[i]) + fabs(x[i]) + a);
         up[0] = fmax(up[0], (r + e) * (1.0 + DBL_EPSILON)), up[1] = fmax(up[1], (e - r) * (1.0 + DBL_EPSILON));
+        pos[i] = fmax(r + e, 0.0) * (1.0 + DBL_EPSILON), neg_part[i] = fmax(e - r, 0.0) * (1.0 + DBL_EPSILON);
     }
     int bad = ulam__dist_largest(c, &up[0]) || ulam__dist_largest(c, &up[1]) || ulam__dist_largest(c, &neg);
     up[2] = neg == 0.0;
     return bad;
+}
+
+/* An upper bound on the sum of the rows' v_i >= 0 (this rank's rows; top: their largest over every
+ * rank) the same bits at any split: each v_i / top rounded up to a multiple of 2^-30 and counted
+ * as an integer, so the sum over the ranks (set 0's: every row once) is exact; nonzero on a failed sum. */
+static int sum_up(const ulam_part *p, const ulam_comm *c, const double *v, double top, double *out)
+{
+    int64_t k = 0;
+    for (int64_t i = 0; top > 0 && p->set == 0 && i < p->last - p->first; i++) /* one set's rows: each once */
+        k += (int64_t)ceil(v[i] / top * 1073741824.0) + 1;
+    if (c->nranks > 1 && c->sum(c->ctx, &k, 1)) return 1;
+    *out = top > 0 ? top * ((double)k / 1073741824.0) * (1.0 + 4.0 * DBL_EPSILON) : 0.0;
+    return 0;
 }
 
 /* A certified range of the exact solution around x (see ulam_dist.h). */
@@ -197,28 +212,48 @@ int ulam_dist_bound(const ulam_part *p, const ulam_comm *comm, const double *b, 
     if (!p || !comm || !x || !lo || !hi || !worst || iters < 1)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, lo, hi, worst and iters >= 1");
     if (!p->m.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding the rows of M");
+    if (!b && !p->b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
     int64_t rows = p->last - p->first;
     for (int64_t i = 0; i < rows; i++)
         if (!isfinite(x[i])) return ulam__fail(err, ULAM_EINVAL, 0, p->first + i, "a finite x");
     double *gv = NULL, *cv = malloc(((size_t)rows + 1) * sizeof *cv), u = INFINITY, up[3] = {0, 0, 0};
+    double *rp = malloc(((size_t)rows + 1) * sizeof *rp), *rn = malloc(((size_t)rows + 1) * sizeof *rn);
     ulam__halo h = {0};
     int status = halo_open(p, comm, &h, &gv) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the halo and an exchange that succeeds")
-                 : cv ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld doubles", (long long)rows);
+                 : cv && rp && rn ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld doubles", (long long)rows);
     if (!status) status = ulam__dist_cw(p, comm, iters, &u, cv, err);
-    if (!status && residual_bounds(p, comm, &h, b ? b : p->b, x, gv, up))
+    if (!status && residual_bounds(p, comm, &h, b ? b : p->b, x, gv, up, rp, rn))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
+    /* With M' held and ||M||_1 = c < 1 (its largest column sum of |M|: a row sum of M'), also
+     * |(I - M)^-1 r|_i <= ||(I - M)^-1 r||_1 <= ||r||_1 / (1 - c), r's parts summed the same bits at
+     * any split (sum_up); each end the nearer of the two ranges.  R-MAT PageRank (M = 0.85 P'):
+     * the power iteration certifies no u < 1 within iters products, c = 0.85 exactly. */
+    double cmax = INFINITY, l1p = INFINITY, l1n = INFINITY;
+    if (!status && p->t.rowptr) {
+        cmax = 0.0;
+        for (int64_t i = 0; i < rows; i++) cmax = fmax(cmax, p->t.rowsum[i] * (1.0 + (double)(p->t.rowptr[i + 1] - p->t.rowptr[i]) * DBL_EPSILON));
+        double sp = 0.0, sn = 0.0;
+        if (ulam__dist_largest(comm, &cmax) || sum_up(p, comm, rp, up[0], &sp) || sum_up(p, comm, rn, up[1], &sn))
+            status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks that succeeds");
+        if (cmax < 1.0) {
+            double k1 = (1.0 + 8.0 * DBL_EPSILON) / (1.0 - cmax);
+            l1p = (up[2] ? sp : sp + sn) * k1, l1n = (up[2] ? sn : sp + sn) * k1;
+        }
+    }
     /* x* - x = (I - M)^-1 r = sum_k M^k r; |r| <= rho 1 <= rho v / min v, so |M|^k |r| <= rho u^k v / min v.
      * With M >= 0 the sum keeps r's signs: above by r's positive part, below by its negative part. */
     double k = (1.0 + 8.0 * DBL_EPSILON) / (1.0 - u), above = up[2] ? up[0] : fmax(up[0], up[1]), below = up[2] ? up[1] : above;
+    int certified = u < 1.0 || isfinite(l1p);
     *worst = 0.0;
     for (int64_t i = 0; !status && i < rows; i++) {
         double slack = 2.0 * DBL_EPSILON * fabs(x[i]);
-        lo[i] = u < 1.0 ? x[i] - (below * cv[i] * k + slack) : NAN;
-        hi[i] = u < 1.0 ? x[i] + (above * cv[i] * k + slack) : NAN;
-        *worst = u < 1.0 ? fmax(*worst, (hi[i] - lo[i]) / 2.0) : INFINITY;
+        double dn = u < 1.0 ? fmin(below * cv[i] * k, l1n) : l1n, dp = u < 1.0 ? fmin(above * cv[i] * k, l1p) : l1p;
+        lo[i] = certified ? x[i] - (dn + slack) : NAN;
+        hi[i] = certified ? x[i] + (dp + slack) : NAN;
+        *worst = certified ? fmax(*worst, (hi[i] - lo[i]) / 2.0) : INFINITY;
     }
-    if (!status && u < 1.0 && ulam__dist_largest(comm, worst)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
+    if (!status && certified && ulam__dist_largest(comm, worst)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
     ulam__halo_free(&h);
-    free(gv), free(cv);
+    free(gv), free(cv), free(rp), free(rn);
     return status;
 }

@@ -10,7 +10,7 @@
 /* Free h's arrays. */
 void ulam__halo_free(ulam__halo *h)
 {
-    free(h->ghost), free(h->idx), free(h->at);
+    free(h->ghost), free(h->idx), free(h->at), free(h->loc);
 }
 
 /* Order of int64_t. */
@@ -77,6 +77,24 @@ int ulam__halo_make(const ulam_part *p, const ulam_comm *c, const ulam__rows *A,
         }
     }
     free(got), free(cnt);
+    h->rows = rows;
+    if (!bad && h->idx && k > 1) { /* each entry's place, by one search now instead of one a product */
+        h->loc = malloc(((size_t)A->rowptr[rows] + 1) * sizeof *h->loc);
+        for (int64_t q = 0; h->loc && q < A->rowptr[rows]; q++) {
+            int64_t j = A->col[q], lo = 0, hi = u - 1;
+            if (j >= p->first && j < p->last) {
+                h->loc[q] = (int32_t)(j - p->first);
+                continue;
+            }
+            while (lo < hi) {
+                int64_t mid = (lo + hi) / 2;
+                if (h->ghost[mid] < j) lo = mid + 1;
+                else hi = mid;
+            }
+            h->loc[q] = (int32_t)(rows + lo);
+        }
+        if (!h->loc) bad = 1;
+    }
     return bad || !h->idx;
 }
 
@@ -105,19 +123,6 @@ int ulam__halo_swap(const ulam_part *p, const ulam_comm *c, const ulam__halo *h,
     return bad;
 }
 
-/* The iterate at column j: this rank's own rows, else its halo. */
-double ulam__halo_at(const ulam_part *p, const ulam__halo *h, const double *own, const double *gv, int64_t j)
-{
-    if (j >= p->first && j < p->last) return own[j - p->first];
-    int64_t lo = 0, hi = h->nghost - 1;
-    while (lo < hi) {
-        int64_t mid = (lo + hi) / 2;
-        if (h->ghost[mid] < j) lo = mid + 1;
-        else hi = mid;
-    }
-    return gv[lo];
-}
-
 /* One step: y = M^ v on this rank's rows (own NULL: v all ones; else v at its rows own, at its
  * halo gv), the Collatz-Wielandt ratio's largest value (each row's sum rounded up by its
  * (length + 2) roundings) into *cw and y's largest into *top. */
@@ -129,7 +134,7 @@ static void step(const ulam_part *p, const ulam__rows *A, const ulam__halo *h, c
         double S = A->rowsum[i], f = S > 1.0 ? S : 1.0, s = 0.0; /* S / min(1, S) */
         int64_t len = A->rowptr[i + 1] - A->rowptr[i];
         for (int64_t q = A->rowptr[i]; q < A->rowptr[i + 1]; q++)
-            s += fabs(A->val[q]) * (own ? ulam__halo_at(p, h, own, gv, A->col[q]) : 1.0);
+            s += fabs(A->val[q]) * (own ? ulam__halo_at(p, A, h, own, gv, q) : 1.0);
         s *= f * (1.0 + (double)(len + 3) * DBL_EPSILON);
         y[i] = s;
         double r = own ? s / own[i] : s;

@@ -140,8 +140,8 @@ static int read_layout(int fd, uint64_t len, int what, ulam__layout *L, uint64_t
     }
     int status = ulam__system_header(h, len, L, err);
     if (status) return status;
-    if (!L->has_matrix || !L->has_rhs || L->n != L->ncols)
-        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a prepared square system with its b (ulam prepare M.mtx --rhs b.mtx)");
+    if (!L->has_matrix || L->n != L->ncols) /* b may be absent: single source needs none (p->b NULL) */
+        return ulam__fail(err, ULAM_EINVAL, 0, -1, "a prepared square system (ulam prepare M.mtx [--rhs b.mtx])");
     if (what != ULAM_PART_M && !L->has_tr)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "M' in the file for forward walks (ulam prepare --transpose)");
     int64_t nsums = L->nblocks[0] + L->nblocks[1] + L->nblocks[2];
@@ -172,7 +172,7 @@ static int open_part(int fd, uint64_t len, const ulam_comm *c, int what, ulam_pa
         if (what != ULAM_PART_MT) status = read_rows(fd, &L, off[0], sums, L.first[0], p, &p->m, err);
         if (!status && what != ULAM_PART_M) status = read_rows(fd, &L, off[1], sums, L.first[2], p, &p->t, err);
     }
-    if (!status) status = read_rhs(fd, &L, sums, L.first[1], p, err);
+    if (!status && L.has_rhs) status = read_rhs(fd, &L, sums, L.first[1], p, err);
     if (!status && p->m.rowptr) status = ulam__part_sums(p, &p->m, err);
     if (!status && p->t.rowptr) status = ulam__part_sums(p, &p->t, err);
     free(sums);

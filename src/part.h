@@ -19,7 +19,7 @@ typedef struct {
 struct ulam_part {
     int64_t n, first, last;
     ulam__rows m, t;
-    double *b;
+    double *b; /* NULL when the file holds no b (single source needs none) */
     int64_t *split; /* nranks + 1 row boundaries: position r of a set owns rows [split[r], split[r + 1]) */
     int nranks, rank, shift; /* ranks in this rank's set and its position there */
     int set, sets;           /* this rank's set (world rank set * nranks + rank) of sets */
@@ -44,6 +44,8 @@ int ulam__dist_largest(const ulam_comm *c, double *x);
 typedef struct {
     int64_t nghost, *ghost;
     int64_t *idx, *at; /* at: nranks + 1 */
+    int64_t rows;      /* this rank's rows */
+    int32_t *loc;      /* per entry q of A: its column's place, own row (< rows) or rows + ghost; NULL with one rank */
 } ulam__halo;
 
 /* Find the halo of A's rows (one exchange); nonzero on failure (memory or the exchange). */
@@ -52,8 +54,15 @@ int ulam__halo_make(const ulam_part *p, const ulam_comm *c, const ulam__rows *A,
 /* A vector's halo values into gv (h->ghost order) from every rank's rows mine; nonzero on failure. */
 int ulam__halo_swap(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, const double *mine, double *gv);
 
-/* The vector at column j: this rank's own rows own, else its halo gv. */
-double ulam__halo_at(const ulam_part *p, const ulam__halo *h, const double *own, const double *gv, int64_t j);
+/* The vector at the column of entry q of the rows the halo was made for (h->loc, found once: no
+ * search a product): this rank's own rows own, else its halo gv. */
+static inline double ulam__halo_at(const ulam_part *p, const ulam__rows *A, const ulam__halo *h, const double *own,
+                                   const double *gv, int64_t q)
+{
+    if (!h->loc) return own[A->col[q] - p->first];
+    int64_t l = h->loc[q];
+    return l < h->rows ? own[l] : gv[l - h->rows];
+}
 
 /* Free h's arrays. */
 void ulam__halo_free(ulam__halo *h);

@@ -1486,6 +1486,11 @@ def check_prepare(ulam):
         assert rc == 0, err
         rc, kept, err = run(ulam, ["solve", d + "/t.ulam"] + pair)
         assert rc == 0 and json.loads(kept)["estimate"] == json.loads(built)["estimate"], (err, kept, built)
+        # single source's every component walks on the stored M^T too (no transpose a run): the same table
+        one = ["--source", "3", "--top", "20", "--walks", "4000", "--threads", "1", "-q"]
+        rc, built, err = run(ulam, ["solve", sysf] + one)
+        rc2, kept, err2 = run(ulam, ["solve", d + "/t.ulam"] + one)
+        assert rc == rc2 == 0 and kept == built and len(kept.splitlines()) == 20, (err, err2, kept, built)
         os.remove(d + "/t.ulam")
         rc, fwd, err = run(ulam, ["solve", "--method", "walks", sysf, "--mode", "forward", "--walks", "2000", "--json"])
         assert rc == 0, err

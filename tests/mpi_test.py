@@ -240,6 +240,52 @@ def check_partition_mtx(ulam, mpirun, d):
             assert p.returncode != 0 and not p.stdout and got == ref, (k, where, got, ref)
 
 
+def check_partition_source_graph(ulam, mpirun, d):
+    """Single source on a PageRank graph prepared without b (M = 0.85 P' of a digraph whose heads
+    favour low-numbered nodes, so rows reach every rank): runs on a partition (it needed a b in the
+    file before), the top-10 table byte for byte the same at 1, 2 and 3 ranks and in 2 sets, each line within 4
+    standard errors of the direct column and inside its certified range (from ||M||_1 < 1: the power
+    iteration certifies no u < 1 on such a graph, and no range was printed before); an adjoint query on the same file ends with a
+    clear error, not a wrong answer."""
+    import random
+    rnd = random.Random(11)
+    n, edges = 2000, {}
+    for u in range(n):
+        for _ in range(1 + int(rnd.paretovariate(1.5))):
+            v = min(int(rnd.paretovariate(0.7)) - 1, n - 1) if rnd.random() < 0.5 else rnd.randrange(n)
+            if v != u:
+                edges[(u, v)] = edges.get((u, v), 0) + 1
+    out = {}
+    for (u, v), c in edges.items():
+        out[u] = out.get(u, 0) + c
+    m = f"{d}/g.mtx"
+    with open(m, "w") as f:
+        f.write("%%%%MatrixMarket matrix coordinate real general\n%d %d %d\n" % (n, n, len(edges)))
+        f.writelines("%d %d %.17g\n" % (v + 1, u + 1, 0.85 * c / out[u]) for (u, v), c in sorted(edges.items()))
+    sysf, e = f"{d}/g.ulam", f"{d}/ge.mtx"
+    run([ulam, "prepare", m, "--transpose", "-o", sysf])
+    with open(e, "w") as f:
+        f.write("%%%%MatrixMarket matrix array real general\n%d 1\n" % n)
+        f.writelines("%d\n" % (i == 4) for i in range(n))
+    run([ulam, "direct", m, "--rhs", e, "--out", f"{d}/gx.mtx"])
+    exact = [float(v) for v in open(f"{d}/gx.mtx").read().split("\n")[3:] if v.strip()]
+    tops = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--source", "5", "--top",
+                 "10", "--walks", "20000", "-q"]) for k in (1, 2, 3)]
+    tops.append(run([mpirun, "--oversubscribe", "-np", "4", ulam, "solve", sysf, "--partition", "--sets", "2",
+                     "--source", "5", "--top", "10", "--walks", "20000", "-q"]))  # 2 sets: ||r||_1 over one set's rows
+    assert tops[0] == tops[1] == tops[2] == tops[3], tops
+    import re
+    for line in tops[0].splitlines():  # within 4 standard errors, or 1e-3 of it where no walk reached it
+        i, est = int(re.match(r"x\[(\d+)\]", line).group(1)) - 1, float(line.split()[1])
+        se = re.search(r"\+- (\S+)", line)
+        assert abs(est - exact[i]) < (4 * float(se.group(1)) if se else 1e-3 * exact[i]), (line, exact[i])
+        ci = re.search(r"CI (\S+) \.\. ([^;)\s]+)", line)  # the l1 range (||M||_1 = 0.85): none was certified before
+        assert ci and float(ci.group(1)) <= exact[i] <= float(ci.group(2)), (line, exact[i])
+    p = subprocess.run([mpirun, "--oversubscribe", "-np", "2", ulam, "solve", sysf, "--partition", "--index", "3"],
+                       capture_output=True, text=True, env=ENV, timeout=300)
+    assert p.returncode != 0 and "a b in the prepared file" in p.stderr, (p.returncode, p.stderr)
+
+
 def check_partition_memory(ulam, mpirun, d):
     """Issue 43's memory test: forward mode on a 10^6-row system (8 entries a row, a band around the
     diagonal, |row sums| 0.4), 3 ranks: each rank's peak RSS at most half of one rank's alone (MPI's
@@ -355,7 +401,8 @@ def main():
             except AssertionError as e:
                 failures += 1
                 print(f"FAIL {name}: {e}")
-        for name, check in (("partition", check_partition), ("partition matrix market", check_partition_mtx)):
+        for name, check in (("partition", check_partition), ("partition matrix market", check_partition_mtx),
+                            ("partition source without b", check_partition_source_graph)):
             try:
                 check(ulam, mpirun, d)
                 print(f"ok {name}")
@@ -375,7 +422,7 @@ def main():
     except AssertionError as e:
         failures += 1
         print(f"FAIL interrupt: {e}")
-    print(f"{len(cases) + 4 - failures} passed, {failures} failed")
+    print(f"{len(cases) + 5 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 

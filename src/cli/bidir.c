@@ -330,12 +330,15 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     double *lo = malloc(kk * sizeof *lo), *hi = malloc(kk * sizeof *hi), *xd = NULL;
     ulam_fpush_info info;
     ulam_error err;
-    if (!status) status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : ulam_csr_transpose(W, &Mt);
+    const ulam_csr *T = W == s->M && s->sys_M ? ulam_system_transpose(s->sys_M) : NULL; /* prepare --transpose's */
+    if (T && (T->nrows != nw || ulam_csr_nnz(T) != ulam_csr_nnz(W))) T = NULL;
+    if (!status) status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : T ? ULAM_OK : ulam_csr_transpose(W, &Mt);
+    if (!T) T = Mt;
     o.walk.policy.guard = &rp->g, o.walk.stop.interrupt = &cli_interrupted; /* M's guards serve M': same spectrum */
     if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
-    if (!status) status = ulam_fpush_top(W, Mt, &o, want, x, order, se, lo, hi, &info, &err);
+    if (!status) status = ulam_fpush_top(W, T, &o, want, x, order, se, lo, hi, &info, &err);
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
     double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec); /* push and walks */
     if (status) rc = cli_report(s->matrix_path, &err);

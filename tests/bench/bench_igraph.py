@@ -13,7 +13,13 @@ coverage: how many of ulam's top-100 95% intervals hold igraph's pi / 0.15, and 
 igraph's top 100 are in ulam's.  Dated, with the machine, cores and load average.
 
 Usage: bench_igraph.py path/to/ulam [L [SOURCES]] (default 20 and 3).  Needs NumPy, SciPy and
-python3-igraph (skipped with a note when missing: the peer is optional)."""
+python3-igraph (skipped with a note when missing: the peer is optional).
+
+At scale (issue 43's 2^24 nodes and 2^28 edges, beyond igraph and SciPy in this machine's memory):
+bench_igraph.py path/to/ulam --prepared G.ulam [SOURCES], G.ulam written once by
+build/tests/bench_rmat_write G.ulam 24 (no Matrix Market text): ulam alone, each query's whole
+process under /usr/bin/time (wall, CPU, peak RSS) with its JSON's walks, push operations and
+seconds, and how many top-100 lines carry an interval."""
 import json
 import os
 import resource
@@ -37,9 +43,40 @@ def edges(L, seed=1):
     return n, src, dst
 
 
+def prepared(ulam, path, nsrc):
+    """ulam alone on a prepared graph (no peer): wall, CPU and peak RSS of each query's process."""
+    import random
+    with open(path, "rb") as f:
+        head = f.read(48)
+    n = int.from_bytes(head[24:32], "little")
+    print(f"prepared {path}: n = {n}, nnz = {int.from_bytes(head[40:48], 'little')}; machine: {os.uname().nodename}, "
+          f"{os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
+    rng = random.Random(7)
+    print(f"{'source':>9} {'wall':>7} {'cpu':>7} {'maxrss_MiB':>10} {'query_s':>8} {'push_s':>7} {'push_ops':>11} "
+          f"{'walks':>9} {'with_ci':>7}")
+    for _ in range(nsrc):
+        s = rng.randrange(n)
+        with tempfile.NamedTemporaryFile("r") as t:
+            p = subprocess.run(["/usr/bin/time", "-f", "%e %U %S %M", "-o", t.name, ulam, "solve", path, "--source",
+                                str(s + 1), "--top", "100", "--json", "--threads", "1", "--seed", str(s + 1)],
+                               capture_output=True, text=True)
+            wall, u, sy, rss = t.read().split()[-4:]
+        if p.returncode:
+            print(p.stderr)
+            return 1
+        o = json.loads(p.stdout)
+        ci = sum(c["ci95"][0] is not None for c in o["top"])
+        print(f"{s + 1:>9} {float(wall):>7.2f} {float(u) + float(sy):>7.2f} {int(rss) / 1024:>10.0f} {o['seconds']:>8.3f} "
+              f"{o['push_seconds']:>7.3f} {o['push_ops']:>11} {o['walks']:>9} {ci:>4}/{len(o['top'])}")
+    print(f"load now {os.getloadavg()[0]:.1f} (timings under load are upper bounds)")
+    return 0
+
+
 def main():
     args = sys.argv[1:]
     ulam = args.pop(0)
+    if args and args[0] == "--prepared":
+        return prepared(ulam, args[1], int(args[2]) if len(args) > 2 else 3)
     L = int(args[0]) if args else 20
     nsrc = int(args[1]) if len(args) > 1 else 3
     try:

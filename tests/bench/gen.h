@@ -168,6 +168,18 @@ static inline void bench_permutation(int32_t *perm, int64_t n, ulam_rng *r)
     }
 }
 
+/* One R-MAT edge (a = 0.57, b = c = 0.19, d = 0.05) of a 2^L-node graph from r: tail *u, head *v
+ * (before any relabelling). */
+static inline void bench_rmat_edge(ulam_rng *r, int L, int64_t *u, int64_t *v)
+{
+    *u = *v = 0;
+    for (int l = 0; l < L; l++) {
+        double q = ulam_rng_uniform(r);
+        int down = q >= 0.57 + 0.19, right = (q >= 0.57 && q < 0.76) || q >= 0.95;
+        *u = 2 * *u + down, *v = 2 * *v + right;
+    }
+}
+
 /* The R-MAT graph (Chakrabarti, Zhan, Faloutsos 2004; a = 0.57, b = c = 0.19, d = 0.05; states
  * relabelled by a random permutation; stream (L, 0)) as M = alpha P' (n = 2^L, 8 n edges, P the
  * random-walk matrix of the out-edges); *dangling counts states without out-edges (bench_bidir,
@@ -185,12 +197,8 @@ static inline ulam_csr *bench_rmat(int L, double alpha, int64_t *dangling, int64
     if (!perm || !src || !dst || !outdeg || !indeg || !val) goto done;
     bench_permutation(perm, n, &r);
     for (int64_t e = 0; e < m; e++) {
-        int64_t u = 0, v = 0;
-        for (int l = 0; l < L; l++) {
-            double q = ulam_rng_uniform(&r);
-            int down = q >= 0.57 + 0.19, right = (q >= 0.57 && q < 0.76) || q >= 0.95;
-            u = 2 * u + down, v = 2 * v + right;
-        }
+        int64_t u, v;
+        bench_rmat_edge(&r, L, &u, &v);
         src[e] = perm[u], dst[e] = perm[v];
         outdeg[perm[u]]++, indeg[perm[v]]++;
     }
