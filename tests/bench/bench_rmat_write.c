@@ -39,7 +39,7 @@ int main(int argc, char **argv)
     for (int64_t e = 0; e < m; e++) {
         int64_t u = 0, v = 0;
         for (int l = 0; l < L; l += 4) { /* four levels a 64-bit draw, 16 bits each (a quarter of the draws) */
-            uint64_t z = ulam_rng_next(&r);
+            uint64_t z = ulam_rng_bounded(&r, 0);
             for (int k = 0; k < 4 && l + k < L; k++, z >>= 16) {
                 uint64_t q = z & 0xffff; /* a = 37356 / 65536, a + b = 49807, a + b + c = 62259 */
                 u = 2 * u + (q >= 49807), v = 2 * v + ((q >= 37356 && q < 49807) || q >= 62259);
