@@ -40,6 +40,31 @@ enum ulam_report_format { ULAM_REPORT_BRIEF = 0, ULAM_REPORT_VERBOSE = 1, ULAM_R
  * bidir, the bidirectional row's plan and why it was or was not chosen too. */
 void ulam_choice_fprint(FILE *f, const ulam_choice *ch, int bidir, int format);
 
+/* A guard's verdict (ULAM_VERDICT_*) in words: "below 1", "at or above 1", ... */
+const char *ulam_verdict_word(int verdict);
+
+/* What an outer iteration (ulam solve --method richardson ... gmres) reports besides its steps. */
+typedef struct ulam_outer_report {
+    int method;        /* its row of the method table (ULAM_METHOD_RICHARDSON ... ULAM_METHOD_GMRES) */
+    int estimator;     /* the walks' (ULAM_COLLISION, ...) */
+    double tol, eps1;  /* the residual tolerance; the corrections' first relative error */
+    uint64_t seed;
+    int threads, ranks;
+    const ulam_outer_step *steps; /* the iterations (NULL for the Krylov methods) */
+    int nsteps, iterations, restart, status, converged, rejected;
+    double residual, seconds;
+    int64_t index;     /* 1-based x[index] to show (0: none) */
+    const double *x;   /* the solution (NULL: none) */
+    const char *answer_name; /* the name x[index] pads as ("x", or "pi" for PageRank) */
+    int check;         /* err_direct holds the relative error against a direct solve */
+    double err_direct;
+    ulam_guard g;      /* the guards (their radii shown when the method walks) */
+} ulam_outer_report;
+
+/* Write r to f: its totals as text lines (format ULAM_REPORT_BRIEF or _VERBOSE; the iterations'
+ * lines are the caller's, as they end), or one JSON object with the history (ULAM_REPORT_JSON). */
+void ulam_outer_report_fprint(FILE *f, const ulam_outer_report *r, int format);
+
 #ifdef __cplusplus
 }
 #endif

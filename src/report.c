@@ -1,8 +1,9 @@
 /* A walk result as JSON to a caller's stream (include/ulam_report.h): the one home of the
- * schema ulam solve --json prints. */
+ * schema ulam solve --json prints; an outer iteration's report, text or JSON. */
 #include "ulam_report.h"
 
 #include <math.h>
+#include <string.h>
 
 /* The walk modes and estimators by name (enum ulam_mode, enum ulam_estimator). */
 static const char *const modes[] = {"adjoint", "forward"}, *const estimators[] = {"collision", "absorption", "expected"};
@@ -244,4 +245,117 @@ void ulam_choice_fprint(FILE *f, const ulam_choice *ch, int bidir, int format)
     if (!f || !ch) return;
     if (format == ULAM_REPORT_JSON) choice_json(f, ch, bidir);
     else choice_text(f, ch, bidir, format == ULAM_REPORT_VERBOSE);
+}
+
+/* See ulam_report.h. */
+const char *ulam_verdict_word(int verdict)
+{
+    switch (verdict) {
+    case ULAM_VERDICT_OK: return "below 1";
+    case ULAM_VERDICT_EDGE: return "below 1, not certified below 0.99";
+    case ULAM_VERDICT_FAIL: return "at or above 1";
+    default: return "unknown: the bounds straddle 1";
+    }
+}
+
+/* Sum of the steps' histories and walk seconds. */
+static void totals(const ulam_outer_report *p, int64_t *hist, double *walk_s)
+{
+    *hist = 0, *walk_s = 0;
+    for (int k = 0; p->steps && k < p->nsteps; k++) *hist += p->steps[k].histories, *walk_s += p->steps[k].walk_seconds;
+}
+
+/* The outcome in words. */
+static const char *outcome(const ulam_outer_report *p)
+{
+    return p->converged ? "converged" : p->status == ULAM_ESTALL ? "stalled" : p->status == ULAM_ENOCONV ? "capped"
+                                      : p->status == ULAM_OK    ? "interrupted" : "failed";
+}
+
+/* The spaces after "name[index]" that put the value at column; at least 1. */
+static int pad(const char *name, int64_t index, int column)
+{
+    char label[64];
+    int len = snprintf(label, sizeof label, "%s[%lld]", name ? name : "x", (long long)index);
+    return len < column ? column - len : 1;
+}
+
+/* The text report's totals. */
+static void print_text(FILE *f, const ulam_outer_report *p)
+{
+    int walks = p->method == ULAM_METHOD_SEQUENTIAL || p->method == ULAM_METHOD_MCSA;
+    int krylov = p->method == ULAM_METHOD_CG || p->method == ULAM_METHOD_GMRES;
+    int64_t hist;
+    double walk_s;
+    totals(p, &hist, &walk_s);
+    fprintf(f, "method          %s%s%s, tol %g%s\n", ulam_method_name(p->method), walks ? ", " : "",
+            walks ? estimators[p->estimator] : "", p->tol, walks ? "" : " (no walks)");
+    if (p->method == ULAM_METHOD_GMRES) fprintf(f, "restart         %d\n", p->restart);
+    fprintf(f, "outcome         %s after %d iterations%s, residual %.4e\n", outcome(p), p->iterations,
+            krylov ? " (matrix-vector products)" : "", p->residual);
+    if (walks)
+        fprintf(f, "histories       %lld (%.4g per iteration), eps1 %g, corrections rejected %d\n", (long long)hist,
+                p->nsteps ? (double)hist / p->nsteps : 0.0, p->eps1, p->rejected);
+    fprintf(f, "seconds         %.4f (walks %.4f)\n", p->seconds, walk_s);
+    if (walks)
+        fprintf(f, "guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", p->g.abs.rho,
+                ulam_verdict_word(p->g.verdict_abs), p->g.hat[ULAM_FORWARD].rho,
+                ulam_verdict_word(p->g.verdict_hat[ULAM_FORWARD]));
+    if (p->index && p->x)
+        fprintf(f, "x[%lld]%*s%.12g\n", (long long)p->index, pad(p->answer_name, p->index, 16), "", p->x[p->index - 1]);
+}
+
+/* The JSON object with the history. */
+static void print_json(FILE *f, const ulam_outer_report *p)
+{
+    int walks = p->method == ULAM_METHOD_SEQUENTIAL || p->method == ULAM_METHOD_MCSA;
+    int64_t hist;
+    double walk_s;
+    totals(p, &hist, &walk_s);
+    fprintf(f, "{");
+    ulam_json_string(f, "method", ulam_method_name(p->method), 0);
+    if (walks) ulam_json_string(f, "estimator", estimators[p->estimator], 0);
+    ulam_json_string(f, "outcome", outcome(p), 0);
+    fprintf(f, "\"converged\": %s, \"iterations\": %d, ", p->converged ? "true" : "false", p->iterations);
+    if (p->method == ULAM_METHOD_GMRES) fprintf(f, "\"restart\": %d, ", p->restart);
+    ulam_json_number(f, "tol", p->tol, 0);
+    ulam_json_number(f, "eps1", p->eps1, 0);
+    ulam_json_number(f, "residual", p->residual, 0);
+    fprintf(f, "\"histories\": %lld, ", (long long)hist);
+    if (walks) fprintf(f, "\"rejected\": %d, ", p->rejected);
+    ulam_json_number(f, "seconds", p->seconds, 0);
+    ulam_json_number(f, "walk_seconds", walk_s, 0);
+    if (walks) {
+        ulam_json_number(f, "rho_abs", p->g.abs.rho, 0);
+        ulam_json_number(f, "rho_hat", p->g.hat[ULAM_FORWARD].rho, 0);
+    }
+    if (p->index && p->x) {
+        fprintf(f, "\"index\": %lld, ", (long long)p->index);
+        ulam_json_number(f, "estimate", p->x[p->index - 1], 0);
+    }
+    if (p->check) ulam_json_number(f, "relative_error", p->err_direct, 0);
+    fprintf(f, "\"seed\": %llu, \"threads\": %d, \"ranks\": %d, \"history\": [", (unsigned long long)p->seed, p->threads,
+            p->ranks);
+    for (int k = 0; p->steps && k < p->nsteps; k++) {
+        const ulam_outer_step *s = &p->steps[k];
+        fprintf(f, "%s{\"iteration\": %d, ", k ? ", " : "", s->iteration);
+        ulam_json_number(f, "residual", s->residual, 0);
+        fprintf(f, "\"histories\": %lld, \"steps\": %lld, \"cut\": %lld, ", (long long)s->histories, (long long)s->steps,
+                (long long)s->cut);
+        ulam_json_number(f, "rel_sd", s->histories ? s->rel_sd : NAN, 0);
+        ulam_json_number(f, "walk_seconds", s->walk_seconds, 0);
+        ulam_json_number(f, "seconds", s->seconds, 1);
+        fprintf(f, "}");
+    }
+    fprintf(f, "]}\n");
+}
+
+/* See ulam_report.h. */
+void ulam_outer_report_fprint(FILE *f, const ulam_outer_report *r, int format)
+{
+    if (!f || !r || r->method < ULAM_METHOD_RICHARDSON || r->method > ULAM_METHOD_GMRES || r->estimator < 0 ||
+        r->estimator > 2)
+        return;
+    if (format == ULAM_REPORT_JSON) print_json(f, r);
+    else print_text(f, r);
 }

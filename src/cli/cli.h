@@ -112,10 +112,6 @@ int cli_need_rhs(const char *command, const char *path);
 /* Check a mapped M and b whole (ulam_system_check) if not yet done; 0 or an exit code. */
 int cli_system_verify(cli_system *s);
 
-/* --pagerank: replace the loaded adjacency matrix by alpha P^T and a missing b by (1 - alpha) / n
- * (src/cli/graph.c); 0 or an exit code. */
-int cli_load_pagerank(cli_system *s);
-
 /* What the answer line calls the unknown: "x", or "pi" once --pagerank made b = (1 - alpha) / n
  * (x is then PageRank itself; src/cli/graph.c). */
 extern const char *cli_answer_name;

@@ -1,5 +1,6 @@
 /* Shared pieces of the command-line tool. */
 #include "cli.h"
+#include "ulam_load.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -413,103 +414,6 @@ int cli_parse_bytes(const char *command, const char *opt, const char *s, size_t 
     return 0;
 }
 
-/* The matrix (vec == NULL) or b a prepared system holds, unverified (NULL: none). */
-static const void *held(const ulam_system *sys, const double **vec)
-{
-    const ulam_csr *M = NULL;
-    const double *b = NULL;
-    ulam_system_lazy(sys, &M, &b);
-    return vec ? (const void *)b : (const void *)M;
-}
-
-/* Read a matrix (vec == NULL) or vector.  A prepared file is mapped (*sys); with cache, its
- * copy PATH.ulamcache (a prepared file) is mapped when it was made from the file as it is now,
- * else the file is parsed (*A or *vec) and the copy written (a failure to write it is only a
- * warning).  A library status, err filled. */
-static int read_input(const char *path, int cache, ulam_system **sys, ulam_csr **A, double **vec, int64_t *n,
-                      ulam_error *err)
-{
-    char cpath[4200];
-    uint64_t tag[2];
-    double t0 = ulam_now();
-    if (ulam_system_is_file(path)) {
-        int status = ulam_system_open(path, NULL, sys, err);
-        if (!status && !held(*sys, (const double **)vec)) {
-            *sys = ulam_system_free(*sys);
-            *err = (ulam_error){.status = ULAM_ENOTFOUND, .index = -1};
-            snprintf(err->msg, sizeof err->msg, "%s", vec ? "a prepared system holding b (prepare it with --rhs)"
-                                                          : "a prepared system holding a matrix (this one holds only b)");
-            status = ULAM_ENOTFOUND;
-        }
-        return status;
-    }
-    int use = cache && strlen(path) < 4096 && !ulam_file_tag(path, tag, NULL); /* the source's content hash */
-    if (use) {
-        snprintf(cpath, sizeof cpath, "%s.ulamcache", path);
-        if (!ulam_system_open(cpath, tag, sys, err) && held(*sys, (const double **)vec)) {
-            fprintf(stderr, "ulam: %s: loaded from its cache in %.3f s\n", path, ulam_now() - t0);
-            return ULAM_OK;
-        }
-        *sys = ulam_system_free(*sys);
-    }
-    if (!vec && ulam_edgelist_is_file(path)) /* a graph's edge list: no cache (its ids' base is not kept) */
-        return cli_graph_preload(path, A, err);
-    int status = vec ? ulam_mm_read_vector(path, vec, n, err) : ulam_mm_read_matrix(path, A, err);
-    if (status || !use) return status;
-    double parsed = ulam_now() - t0;
-    ulam_system_desc d = ulam_system_desc_defaults();
-    d.M = vec ? NULL : *A, d.b = vec ? *vec : NULL, d.n = vec ? *n : (*A)->nrows;
-    d.tag[0] = tag[0], d.tag[1] = tag[1];
-    int st = cli_system_write(cpath, &d);
-    if (st) fprintf(stderr, "ulam: %s: warning: cache not written: %s\n", cpath, ulam_strerror(st));
-    else fprintf(stderr, "ulam: %s: parsed in %.3f s, cache written to %s\n", path, parsed, cpath);
-    return ULAM_OK;
-}
-
-/* Check a mapped M and b whole if not yet done. */
-int cli_system_verify(cli_system *s)
-{
-    ulam_error err;
-    if (s->verified) return 0;
-    if (s->sys_M && ulam_system_check(s->sys_M, &err)) {
-        cli_system_free(s);
-        return cli_report(s->matrix_path, &err);
-    }
-    if (s->sys_b && ulam_system_check(s->sys_b, &err)) {
-        cli_system_free(s);
-        return cli_report(s->rhs_path, &err);
-    }
-    s->verified = 1;
-    return 0;
-}
-
-/* Replace M and b by the Jacobi splitting of the loaded A (b zeros without --rhs). */
-static int load_jacobi(cli_system *s)
-{
-    int rc = cli_system_verify(s); /* a mapped copy is checked before the splitting reads it all */
-    if (rc) return rc;
-    ulam_error err;
-    int64_t n = s->M->nrows;
-    ulam_csr *M = NULL;
-    double *zeros = s->b ? NULL : calloc((size_t)n, sizeof *zeros), *bp = malloc((size_t)n * sizeof *bp);
-    const double *b = s->b ? s->b : zeros;
-    int status = b && bp ? ulam_jacobi(s->M, b, s->omega > 0 ? s->omega : 1.0, &M, bp, &err) : ULAM_ENOMEM;
-    free(zeros);
-    int with_b = s->b != NULL;
-    if (status) {
-        free(bp);
-        if (status == ULAM_ENOMEM) err.status = status, err.line = 0, err.msg[0] = '\0';
-        cli_system_free(s);
-        return cli_report(s->matrix_path, &err);
-    }
-    cli_system_free(s);
-    s->M = s->own_M = M;
-    if (with_b) s->b = s->own_b = bp;
-    else free(bp);
-    s->verified = 1;
-    return 0;
-}
-
 /* See cli.h. */
 int cli_need_rhs(const char *command, const char *path)
 {
@@ -571,64 +475,79 @@ int cli_parse_node(const char *command, const char *opt, const char *value, int6
     return rc;
 }
 
+/* The mapping address of sys (NULL: none). */
+static const void *map_of(const ulam_system *sys)
+{
+    ulam_system_info si;
+    if (!sys) return NULL;
+    ulam_system_get_info(sys, &si);
+    return si.map;
+}
+
+/* s's request and state as the library's loader holds them; maps[] its mapping addresses. */
+static ulam_load to_load(const cli_system *s, const void *maps[2])
+{
+    maps[0] = map_of(s->sys_M), maps[1] = map_of(s->sys_b);
+    return (ulam_load){.matrix_path = s->matrix_path, .rhs_path = s->rhs_path, .jacobi = s->jacobi, .omega = s->omega,
+                       .pagerank = s->pagerank, .cache = s->cache, .lazy = s->lazy, .write = cli_system_write,
+                       .node_base = cli_node_base, .M = s->M, .b = s->b, .cert = s->cert, .verified = s->verified,
+                       .own_M = s->own_M, .own_b = s->own_b, .sys_M = s->sys_M, .sys_b = s->sys_b};
+}
+
+/* Forget the mapping at addr (it is gone). */
+static void forget_map(const void *addr)
+{
+    for (int k = 0; addr && k < CLI_MAPS; k++)
+        if (cli_maps[k].addr == addr) cli_maps[k].path = NULL, cli_maps[k].addr = NULL;
+}
+
+/* Take back what the loader L holds into s, forgetting the mappings it let go; status's exit
+ * code (the error reported). */
+static int from_load(cli_system *s, const ulam_load *L, const void *const maps[2], int status, const ulam_error *err)
+{
+    if (L->sys_M != s->sys_M) forget_map(maps[0]);
+    if (L->sys_b != s->sys_b) forget_map(maps[1]);
+    s->M = L->M, s->b = L->b, s->cert = L->cert, s->verified = L->verified;
+    s->own_M = L->own_M, s->own_b = L->own_b, s->sys_M = L->sys_M, s->sys_b = L->sys_b;
+    cli_node_base = L->node_base;
+    return status ? cli_report(NULL, err) : 0;
+}
+
+/* Check a mapped M and b whole if not yet done. */
+int cli_system_verify(cli_system *s)
+{
+    ulam_error err;
+    const void *maps[2];
+    ulam_load L = to_load(s, maps);
+    int status = ulam_load_verify(&L, &err);
+    return from_load(s, &L, maps, status, &err);
+}
+
 /* Load M (and b); 0 or an exit code. */
 int cli_load_system(cli_system *s)
 {
     ulam_error err;
-    int prepared = ulam_system_is_file(s->matrix_path);
-    if (prepared && (s->jacobi || s->pagerank > 0))
+    if (ulam_system_is_file(s->matrix_path) && (s->jacobi || s->pagerank > 0))
         return cli_usage_error(s->command, "%s is a prepared system: it holds M already (prepare it with --jacobi)",
                                s->matrix_path);
-    int status = read_input(s->matrix_path, s->cache, &s->sys_M, &s->own_M, NULL, NULL, &err);
-    if (status) return cli_report(s->matrix_path, &err);
-    cli_map_register(s->sys_M, s->matrix_path, 1);
+    const void *maps[2];
+    ulam_load L = to_load(s, maps);
+    if (ahead && !strcmp(ahead_path, s->matrix_path)) { /* read before the options: hand it over */
+        L.preloaded = ahead, ahead = NULL;
+        free(ahead_path), ahead_path = NULL;
+    }
+    int status = ulam_load_open(&L, stderr, &err);
+    ulam_csr_free(L.preloaded);
+    L.preloaded = NULL;
+    int rc = from_load(s, &L, maps, status, &err);
+    if (rc) return rc;
+    cli_map_register(s->sys_M, s->matrix_path, 1), cli_map_register(s->sys_b, s->rhs_path, 1);
     /* test hook (tests/hostile_test.py): stop once the file is mapped, before its arrays are read */
     if (s->sys_M && getenv("ULAM_TEST_STOP_AT_MAP")) raise(SIGSTOP);
-    const ulam_csr *mapped = NULL;
-    const double *mapped_b = NULL;
-    ulam_system_lazy(s->sys_M, &mapped, &mapped_b); /* verified below, or as walks read it (lazy) */
-    s->M = s->own_M ? s->own_M : mapped;
-    ulam_system_info si;
-    ulam_system_get_info(s->sys_M, &si);
-    if (prepared) s->cert = si.cert;
-    if (s->M->nrows != s->M->ncols) {
-        fprintf(stderr, "ulam: %s: error: %s: expected a square matrix, got %lld x %lld\n",
-                s->matrix_path, ulam_strerror(ULAM_ENOTSQUARE), (long long)s->M->nrows,
-                (long long)s->M->ncols);
-        cli_system_free(s);
-        return cli_exit_code(ULAM_ENOTSQUARE);
-    }
-    int64_t n = s->M->nrows, nb = n;
-    if (s->rhs_path) {
-        status = read_input(s->rhs_path, s->cache, &s->sys_b, NULL, &s->own_b, &nb, &err);
-        if (status) {
-            cli_system_free(s);
-            return cli_report(s->rhs_path, &err);
-        }
-        cli_map_register(s->sys_b, s->rhs_path, 1);
-        const double *vb = NULL;
-        ulam_system_lazy(s->sys_b, NULL, &vb);
-        if (s->sys_b) ulam_system_rhs(s->sys_b, &nb);
-        s->b = s->own_b ? s->own_b : vb;
-        if (nb != n) {
-            fprintf(stderr, "ulam: %s: error: %s: expected %lld entries to match %s, got %lld\n",
-                    s->rhs_path, ulam_strerror(ULAM_EDIM), (long long)n, s->matrix_path,
-                    (long long)nb);
-            cli_system_free(s);
-            return cli_exit_code(ULAM_EDIM);
-        }
-    } else if (prepared) {
-        s->b = mapped_b;
-    }
-    s->verified = !s->sys_M && !s->sys_b;
-    int rc = s->jacobi ? load_jacobi(s) : 0;
-    if (!rc && s->pagerank > 0) rc = cli_load_pagerank(s);
-    if (!rc && !s->lazy) rc = cli_system_verify(s);
-    if (!rc && s->lazy && s->sys_b && ulam_system_check(s->sys_b, &err)) { /* a b of its own file: whole */
-        cli_system_free(s);
-        return cli_report(s->rhs_path, &err);
-    }
-    if (rc) return rc;
+    maps[0] = map_of(s->sys_M), maps[1] = map_of(s->sys_b);
+    status = ulam_load_finish(&L, &err);
+    if ((rc = from_load(s, &L, maps, status, &err))) return rc;
+    if (L.b_pagerank) cli_answer_name = "pi"; /* b = (1 - alpha) / n: x is PageRank itself */
     if (s->index > s->M->nrows) {
         rc = cli_usage_error(s->command, "--index %lld is out of range %lld..%lld", (long long)(s->index - 1 + cli_node_base),
                              (long long)cli_node_base, (long long)(s->M->nrows - 1 + cli_node_base));
@@ -641,13 +560,11 @@ int cli_load_system(cli_system *s)
 /* Free what cli_load_system loaded. */
 void cli_system_free(cli_system *s)
 {
-    s->own_M = ulam_csr_free(s->own_M);
-    free(s->own_b);
-    s->own_b = NULL;
     cli_map_register(s->sys_M, NULL, 0), cli_map_register(s->sys_b, NULL, 0);
-    s->sys_M = ulam_system_free(s->sys_M);
-    s->sys_b = ulam_system_free(s->sys_b);
-    s->M = NULL, s->b = NULL, s->cert = NULL;
+    const void *maps[2];
+    ulam_load L = to_load(s, maps);
+    ulam_load_free(&L);
+    from_load(s, &L, maps, 0, NULL);
 }
 
 /* Solve the loaded system into a new *x (sparse LU or dense, as ulam_reference_plan says); 0
@@ -792,42 +709,4 @@ void cli_progress_end(cli_progress *p)
 {
     if (p->on && p->shown) fputc('\n', stderr);
     p->shown = 0;
-}
-
-/* Replace the loaded adjacency matrix by alpha P^T (ulam_pagerank_matrix) and, without --rhs, b by
- * (1 - alpha) / n; 0 or an exit code (nothing stays loaded on failure). */
-int cli_load_pagerank(cli_system *s)
-{
-    int rc = cli_system_verify(s);
-    if (rc) return rc;
-    ulam_error err;
-    ulam_csr *M = NULL;
-    int64_t n = s->M->nrows;
-    int status = ulam_pagerank_matrix(s->M, s->pagerank, &M, &err);
-    double *b = status || s->b ? NULL : malloc((size_t)n * sizeof *b);
-    if (!status && !s->b && !b) status = ULAM_ENOMEM, err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for b"};
-    if (status) {
-        cli_system_free(s);
-        return cli_report(s->matrix_path, &err);
-    }
-    if (b)
-        for (int64_t i = 0; i < n; i++) b[i] = (1.0 - s->pagerank) / (double)n;
-    double *keep_b = NULL;
-    if (!b && s->own_b) keep_b = s->own_b, s->own_b = NULL; /* --rhs parsed: keep it */
-    else if (!b) { /* --rhs mapped: copy it before the mapping goes */
-        keep_b = malloc((size_t)n * sizeof *keep_b);
-        if (!keep_b) {
-            ulam_csr_free(M);
-            cli_system_free(s);
-            err = (ulam_error){.status = ULAM_ENOMEM, .msg = "memory for b"};
-            return cli_report(s->matrix_path, &err);
-        }
-        for (int64_t i = 0; i < n; i++) keep_b[i] = s->b[i];
-    }
-    cli_system_free(s);
-    s->M = s->own_M = M;
-    s->b = s->own_b = b ? b : keep_b;
-    s->verified = 1;
-    if (b) cli_answer_name = "pi"; /* b = (1 - alpha) / n: x is PageRank itself */
-    return 0;
 }

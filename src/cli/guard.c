@@ -7,12 +7,7 @@
 /* A verdict in words. */
 const char *cli_verdict_word(int verdict)
 {
-    switch (verdict) {
-    case ULAM_VERDICT_OK: return "below 1";
-    case ULAM_VERDICT_EDGE: return "below 1, not certified below 0.99";
-    case ULAM_VERDICT_FAIL: return "at or above 1";
-    default: return "unknown: the bounds straddle 1";
-    }
+    return ulam_verdict_word(verdict);
 }
 
 /* A hint naming the option that fits how M looks: a diagonal of magnitude >= 1 in at least half

@@ -30,20 +30,6 @@ typedef struct {
     int rejected;   /* corrections rejected and redone with more histories */
 } report;
 
-/* Sum of the steps' histories and walk seconds. */
-static void totals(const report *p, int64_t *hist, double *walk_s)
-{
-    *hist = 0, *walk_s = 0;
-    for (int k = 0; k < p->nsteps; k++) *hist += p->steps[k].histories, *walk_s += p->steps[k].walk_seconds;
-}
-
-/* The outcome in words. */
-static const char *outcome(const report *p)
-{
-    return p->converged ? "converged" : p->status == ULAM_ESTALL ? "stalled" : p->status == ULAM_ENOCONV ? "capped"
-                                      : p->status == ULAM_OK    ? "interrupted" : "failed";
-}
-
 /* Nonzero when the method walks. */
 static int walking(int method)
 {
@@ -73,72 +59,18 @@ static void print_check(const report *p)
            p->direct_method ? p->direct_method : "LU", p->direct_seconds);
 }
 
-/* Print the text report's totals (the iterations were printed as they ended). */
-static void print_text(const report *p)
+/* Print the report to stdout as the library writes it (text totals, or JSON with the history). */
+static void print_report(const report *p)
 {
-    int walks = walking(p->method);
-    int64_t hist;
-    double walk_s;
-    totals(p, &hist, &walk_s);
-    printf("method          %s%s%s, tol %g%s\n", method_name(p->method), walks ? ", " : "",
-           walks ? cli_estimator_names[p->o->walk.estimator] : "", p->o->tol, walks ? "" : " (no walks)");
-    if (p->method == KRYLOV_GMRES) printf("restart         %d\n", p->restart);
-    printf("outcome         %s after %d iterations%s, residual %.4e\n", outcome(p), p->iterations,
-           p->method >= KRYLOV_CG ? " (matrix-vector products)" : "", p->residual);
-    if (walks)
-        printf("histories       %lld (%.4g per iteration), eps1 %g, corrections rejected %d\n", (long long)hist,
-               p->nsteps ? (double)hist / p->nsteps : 0.0, p->o->eps1, p->rejected);
-    printf("seconds         %.4f (walks %.4f)\n", p->seconds, walk_s);
-    if (walks)
-        printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", p->g.abs.rho,
-               cli_verdict_word(p->g.verdict_abs), p->g.hat[ULAM_FORWARD].rho,
-               cli_verdict_word(p->g.verdict_hat[ULAM_FORWARD]));
-    if (p->index && p->x) printf("x[%lld]%*s%.12g\n", (long long)p->index, cli_answer_pad(p->index, 16), "", p->x[p->index - 1]);
-    if (p->check) print_check(p);
-}
-
-/* Print the JSON object with the history. */
-static void print_json(const report *p)
-{
-    int64_t hist;
-    double walk_s;
-    totals(p, &hist, &walk_s);
-    printf("{");
-    cli_json_string("method", method_name(p->method), 0);
-    if (walking(p->method)) cli_json_string("estimator", cli_estimator_names[p->o->walk.estimator], 0);
-    cli_json_string("outcome", outcome(p), 0);
-    printf("\"converged\": %s, \"iterations\": %d, ", p->converged ? "true" : "false", p->iterations);
-    if (p->method == KRYLOV_GMRES) printf("\"restart\": %d, ", p->restart);
-    cli_json_number("tol", p->o->tol, 0);
-    cli_json_number("eps1", p->o->eps1, 0);
-    cli_json_number("residual", p->residual, 0);
-    printf("\"histories\": %lld, ", (long long)hist);
-    if (walking(p->method)) printf("\"rejected\": %d, ", p->rejected);
-    cli_json_number("seconds", p->seconds, 0);
-    cli_json_number("walk_seconds", walk_s, 0);
-    if (walking(p->method)) {
-        cli_json_number("rho_abs", p->g.abs.rho, 0);
-        cli_json_number("rho_hat", p->g.hat[ULAM_FORWARD].rho, 0);
-    }
-    if (p->index && p->x) {
-        printf("\"index\": %lld, ", (long long)p->index);
-        cli_json_number("estimate", p->x[p->index - 1], 0);
-    }
-    if (p->check) cli_json_number("relative_error", p->err_direct, 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, \"history\": [", (unsigned long long)p->o->walk.exec.seed,
-           p->o->walk.exec.threads, cli_share ? cli_share->nranks : 1);
-    for (int k = 0; k < p->nsteps; k++) {
-        const ulam_outer_step *s = &p->steps[k];
-        printf("%s{\"iteration\": %d, ", k ? ", " : "", s->iteration);
-        cli_json_number("residual", s->residual, 0);
-        printf("\"histories\": %lld, \"steps\": %lld, \"cut\": %lld, ", (long long)s->histories, (long long)s->steps,
-               (long long)s->cut);
-        cli_json_number("rel_sd", s->histories ? s->rel_sd : NAN, 0);
-        cli_json_number("walk_seconds", s->walk_seconds, 0);
-        cli_json_number("seconds", s->seconds, 1);
-        printf("}");
-    }
-    printf("]}\n");
+    ulam_outer_report r = {.method = ULAM_METHOD_RICHARDSON + p->method, .estimator = p->o->walk.estimator,
+                           .tol = p->o->tol, .eps1 = p->o->eps1, .seed = p->o->walk.exec.seed,
+                           .threads = p->o->walk.exec.threads, .ranks = cli_share ? cli_share->nranks : 1,
+                           .steps = p->steps, .nsteps = p->nsteps, .iterations = p->iterations, .restart = p->restart,
+                           .status = p->status, .converged = p->converged, .rejected = p->rejected,
+                           .residual = p->residual, .seconds = p->seconds, .index = p->index, .x = p->x,
+                           .answer_name = cli_answer_name, .check = p->check, .err_direct = p->err_direct, .g = p->g};
+    if (p->json) cli_json_done = 1;
+    ulam_outer_report_fprint(stdout, &r, p->json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
 }
 
 /* The relative 2-norm error of x against the reference solve (cli_direct_reference: LU, or GMRES
@@ -354,10 +286,10 @@ static int start_run(void *q, int argc, char **argv, int optind)
     } else if (!rc) {
         int want = p.check && cli_rank == 0, crc = 0; /* the answer first, then --check (its GMRES past 4 GiB) */
         p.check = 0;
-        if (!p.json && cli_rank == 0) print_text(&p), cli_flush(); /* a failed write of --out below cannot lose it */
+        if (!p.json && cli_rank == 0) print_report(&p), cli_flush(); /* a failed write of --out below cannot lose it */
         if (want) crc = direct_error(&s, x, &p);
         p.check = want && !crc;
-        if (p.json && cli_rank == 0 && !crc) print_json(&p);
+        if (p.json && cli_rank == 0 && !crc) print_report(&p);
         else if (p.check && !p.json) print_check(&p);
         cli_flush();
         if (crc == EXIT_INTERRUPTED && !cli_share) { /* the reference's thread still reads the system */
