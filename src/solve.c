@@ -708,9 +708,13 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     s->range = s->bound * (s->signs ? 2.0 : 1.0);
     s->per_step = vmax > 0 ? W * vmax : 0.0;
     s->qmax = s->pass_qmax;
-    if (adj && e == ULAM_COLLISION && !given && !s->o.query.nstarts && !isfinite(s->range) && s->per_step > 0 &&
-        isfinite(s->per_step) && !(s->tailT_n && s->tailT_at == s->o.query.index))
-        tail_len(s, K); /* no memory: none, the certificates' bound as before; given bounds: M not read (a lazy file) */
+    if (adj && e == ULAM_COLLISION && !s->o.policy.system && !(given && given->shared) && !s->o.query.nstarts &&
+        !isfinite(s->range) && s->per_step > 0 && isfinite(s->per_step) &&
+        !(s->tailT_n && s->tailT_at == s->o.query.index))
+        tail_len(s, K); /* no memory: none, the certificates' bound as before.  Not on a prepared file (read
+                           lazily: only the rows walks reach) nor on an analysis' shared bounds (every query
+                           alike, file or memory); bounds lent otherwise do not skip it, so a lent run equals
+                           a directly built one bit for bit (analysis_test) */
     return ULAM_OK;
 }
 
