@@ -142,6 +142,7 @@ static const ulam__reach *take_bounds(ulam_analysis *a)
     if (a->b && !a->R.b && (a->b != sb || ulam_system_rhs(a->sys, NULL)) && !ulam__reach_b(a->M, a->b, &a->R))
         a->b_from = 2; /* (a file's b verified whole first: the pass reads all of it) */
     a->seconds += ulam_now() - t0;
+    a->R.shared = a->shared_bounds;
     return &a->R;
 }
 

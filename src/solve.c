@@ -97,6 +97,8 @@ struct ulam_solver {
                               continuation over reachable states (walk length tail q^l) */
     double tail_u, kappa;  /* the length tail (Collatz-Wielandt): |K| v <= tail_u v over reachable
                               states, kappa = max v / min v (tail_u 1: none) */
+    double *tailT;         /* adjoint collision: tailT[l] >= sum over k > l of (|K|^k 1)_index (tail_len) */
+    int64_t tailT_n, tailT_at; /* its length (0: none) and the index it was made from */
     double visit;          /* the start weight times the largest |score| of one visit */
     double weight;         /* the weight bound W over reachable states (INFINITY with splitting) */
     double v2;             /* a certified bound on E[score^2] (INFINITY: none) */
@@ -169,7 +171,7 @@ ulam_solver *ulam_solver_free(ulam_solver *s)
     if (!s) return NULL;
     if (!s->k_borrowed) ulam__kernel_free(s->k);
     free(s->src), free(s->sum), free(s->sumsq), free(s->seen), free(s->fac), free(s->bs), free(s->pq), free(s->pr);
-    free(s->hitv), free(s->hitt), free(s->hits);
+    free(s->hitv), free(s->hitt), free(s->hits), free(s->tailT);
     free(s->start_src), free(s->start_units), free(s->start_b);
     ulam_csr_free(s->mt);
     if (s->scratch)
@@ -603,6 +605,59 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     return ULAM_OK;
 }
 
+/* The length tail seen from the start state itself (adjoint, one start): a_k = (|K|^k 1)_i, the
+ * expected |weight| a walk from i still has after k steps over the start weight, by propagating
+ * e_i' |K|^k over the states it reaches (a_k is its sum), for k up to the first of: the mass gone,
+ * a work budget of max(16 nnz, 2^21) reads, 4096 steps, the set-up's deadline (n <= 2^20: five
+ * arrays of n, 36 MB at most); the rest past the last k by the certified
+ * tails (every state's (|K|^j 1) <= min(qmax^j, kappa u^j)).  tailT[l] = sum over k > l of a_k
+ * with that rest, rounded up: the bias of a truncation after l steps is at most per_step tailT[l]
+ * (ulam__score_range's bound with kappa u^k in place of a_k, which it never exceeds).  On an
+ * advective grid (convection-diffusion 30 x 30, cell Peclet 5) kappa = max v / min v is 1e12:
+ * the range the rule clipped at was 414 standard deviations. */
+static void tail_len(ulam_solver *s, const ulam_csr *K)
+{
+    enum { LMAX = 4096 };
+    free(s->tailT), s->tailT = NULL, s->tailT_n = 0;
+    int64_t n = K->nrows, i = s->o.query.index, reads = 0, budget = 16 * ulam_csr_nnz(K);
+    double G = fmin(s->qmax < 1.0 ? s->qmax / (1.0 - s->qmax) : INFINITY,
+                    s->tail_u < 1.0 && isfinite(s->kappa) ? s->kappa * s->tail_u / (1.0 - s->tail_u) : INFINITY);
+    if (budget < (1 << 21)) budget = 1 << 21;
+    if (!isfinite(G) || i < 0 || i >= n || n > (1 << 20)) return;
+    double *r = ulam__calloc((size_t)n, sizeof *r), *y = ulam__calloc((size_t)n, sizeof *y), *a = ulam__malloc(LMAX + 1, sizeof *a);
+    int64_t *on = ulam__malloc((size_t)n, sizeof *on), *nx = ulam__malloc((size_t)n, sizeof *nx), non = 1, L = 0;
+    char *mk = ulam__calloc((size_t)n, 1);
+    if (!r || !y || !a || !on || !nx || !mk) goto done;
+    r[i] = 1.0, on[0] = i, a[0] = 1.0;
+    while (L < LMAX && a[L] > 0 && reads < budget && !(isfinite(s->deadline) && ulam_now() >= s->deadline)) { /* r |K| */
+        int64_t nn = 0;
+        for (int64_t q = 0; q < non; q++) {
+            int64_t u = on[q];
+            for (int64_t k = K->rowptr[u]; k < K->rowptr[u + 1]; k++) {
+                int64_t v = K->colidx[k];
+                if (!mk[v]) mk[v] = 1, nx[nn++] = v;
+                y[v] += r[u] * fabs(K->val[k]);
+            }
+            reads += K->rowptr[u + 1] - K->rowptr[u];
+            r[u] = 0.0;
+        }
+        double sum = 0.0;
+        for (int64_t q = 0; q < nn; q++) sum += y[nx[q]], r[nx[q]] = y[nx[q]], y[nx[q]] = 0.0, mk[nx[q]] = 0;
+        int64_t *t = on;
+        on = nx, nx = t, non = nn, a[++L] = sum;
+    }
+    s->tailT = ulam__malloc((size_t)L + 1, sizeof *s->tailT);
+    if (!s->tailT) goto done;
+    double rest = a[L] * G; /* past step L */
+    for (int64_t l = L; l >= 0; l--) {
+        s->tailT[l] = rest * (1.0 + 1e-9); /* the sums' rounding */
+        rest += a[l];
+    }
+    s->tailT_n = L + 1, s->tailT_at = i, s->setup_work += reads;
+done:
+    free(r), free(y), free(a), free(on), free(nx), free(mk);
+}
+
 /* Over the states walks can reach: absorption's p* > 0 wherever it scores (else ULAM_EUNDEFINED
  * naming the state), and the bound on a single score and the scores' range (s->bound, s->range):
  * 0 when nothing that scores is reachable; for absorption W |g_i| / p*_i, W the weight bound
@@ -653,6 +708,13 @@ static int check_reach(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     s->range = s->bound * (s->signs ? 2.0 : 1.0);
     s->per_step = vmax > 0 ? W * vmax : 0.0;
     s->qmax = s->pass_qmax;
+    if (adj && e == ULAM_COLLISION && !s->o.policy.system && !(given && given->shared) && !s->o.query.nstarts &&
+        !isfinite(s->range) && s->per_step > 0 && isfinite(s->per_step) &&
+        !(s->tailT_n && s->tailT_at == s->o.query.index))
+        tail_len(s, K); /* no memory: none, the certificates' bound as before.  Not on a prepared file (read
+                           lazily: only the rows walks reach) nor on an analysis' shared bounds (every query
+                           alike, file or memory); bounds lent otherwise do not skip it, so a lent run equals
+                           a directly built one bit for bit (analysis_test) */
     return ULAM_OK;
 }
 
@@ -1442,12 +1504,20 @@ static void forward_component(const ulam_solver *s, int64_t i, double *est, doub
  * range of walks of at most l steps, l the length past which walks can add no more than E |m|
  * to the mean: visits score at most per_step and a walk is alive after k steps with
  * probability at most qmax^k, so the rest adds at most per_step qmax^(l+1) / (1 - qmax).
- * INFINITY when no bound holds (qmax = 1, weights that can grow). */
-static double score_range(const ulam_solver *s, double m, double E)
+ * Adjoint collision from one start, when own: also the l at which the start's own tail
+ * (tail_len) adds at most E |m|, when shorter.  INFINITY when no bound holds (qmax = 1, weights that can grow). */
+static double score_range(const ulam_solver *s, double m, double E, int own)
 {
     if (s->bound == 0.0) return s->range;
     double R = fmin(ulam__score_range(s->range, s->per_step, s->qmax, 1.0, s->signs, m, E),
                     ulam__score_range(s->range, s->per_step, s->tail_u, s->kappa, s->signs, m, E));
+    if (own && s->tailT_n && s->tailT_at == s->o.query.index && s->o.mode == ULAM_ADJOINT && s->o.estimator == ULAM_COLLISION &&
+        !s->o.query.nstarts && !isfinite(s->range) && m > 0 && E > 0) /* tail_len: the start's own tail */
+        for (int64_t l = 0; l < s->tailT_n; l++)
+            if (s->per_step * s->tailT[l] <= E * m) {
+                R = fmin(R, s->per_step * (double)(l + 1) * (s->signs ? 2.0 : 1.0));
+                break;
+            }
     return isfinite(R) ? R : ulam__moment_range(s->v2, s->signs, m, E);
 }
 
@@ -1520,7 +1590,7 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
     *h = E > 0 && mabs > 0 ? E * mabs : 0.0;
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m;
     double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
-    *Rt = !truncated ? score_range(s, 1.0, 1.0) : t > 0 ? score_range(s, m, t / m) : INFINITY;
+    *Rt = !truncated ? score_range(s, 1.0, 1.0, 1) : t > 0 ? score_range(s, m, t / m, 1) : INFINITY;
     double X = bias_scale(s, 0.0), n1 = fmin(*nplan, (double)BLOCK), least = INFINITY, t0 = 1e-6 * m;
     for (int pass = 0; pass < 2; pass++) /* under rel_err a second pass: the least bias within 5% of the least */
         for (int j = 0; truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
@@ -1531,14 +1601,18 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
                the sum being flat near its least, the smallest bias within 5% of it (the first block's
                bias stays in the sequence's weighted bias to the end: at E = 0.01 the least sum's bias,
                near E x, took 10% more walks, hub at 0.99) */
-            double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X);
+            /* not the start's own tail here: a tight clip gives the first blocks a small scale, so a
+               large bet weight, and the bias X t / X of a loose X: weighted in to the end (a sticky chain
+               at E = 0.1 took 2.0e7 walks for 2.8e6, the 12^3 Laplacian's corner at E = 0.01 2.07-2.49
+               the CLT's count for 2.07-2.12) */
+            double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X, 0);
             double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, n1) + tj;
             if (!isfinite(Rj) || (E > 0 && tj > E * X / 16.0)) continue;
             if (pass == 0 && wj < least) least = wj, t = tj, *Rt = Rj;
             if (pass == 1 && E > 0 && wj <= 1.05 * least) t = tj, *Rt = Rj;
         }
     for (int j = 2; truncated && *h > 0 && j <= 6; j++) { /* rel_err: the share of h (1/4 .. 1/64) that meets it soonest */
-        double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m);
+        double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m, 1);
         double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
         if (ulam__cs_walks_needed(mabs, var, Aj, tj, E) < ulam__cs_walks_needed(mabs, var, At, t, E)) t = tj, *Rt = Rj;
     }

@@ -61,6 +61,8 @@ typedef struct ulam__reach {
     double bmax, kbmax, gabs, g2abs;
     int64_t bad;
     int bpos, bneg;
+    int shared; /* an analysis' bounds every query shares (ulam_analysis_opts.shared_bounds): the
+                   solver reads no more of K for its own start (no tail_len) */
 } ulam__reach;
 
 /* The reach of every state of K at continuation continue_q and exponent alpha with its bounds;
