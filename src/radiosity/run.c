@@ -1,11 +1,10 @@
 /* One radiosity run (ulam_radiosity_run.h): the scene read, subdivided or adapted within
  * --max-mem, lit, then the walks, solves and point queries the options ask for.  What it finds
  * the reports (run_report.c) print; warnings and error lines go to the caller's log. */
-#include "run.h"
+#include "runstate.h"
 
 #include "rad.h"
 
-#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,35 +15,6 @@ ulam_rad_run_opts ulam_rad_run_defaults(void)
                            .height = 512, .max_mem = (size_t)4 << 30, .o = ulam_walk_defaults()};
     a.o.stop.max_walks = 0;
     return a;
-}
-
-/* The seconds left of budget counted from a->started. */
-double ulam__run_time_left(const args *a, double budget)
-{
-    if (!(budget > 0)) return budget;
-    double left = budget - (ulam_now() - a->started);
-    return left > 1e-6 ? left : 1e-6;
-}
-
-/* A line to the caller's log. */
-void ulam__run_log(const args *a, const char *fmt, ...)
-{
-    if (!a->log) return;
-    va_list ap;
-    va_start(ap, fmt);
-    vfprintf(a->log, fmt, ap);
-    va_end(ap);
-}
-
-/* A located error line to the caller's log; its status. */
-int ulam__run_error(const args *a, const char *file, const ulam_error *err)
-{
-    if (err->file[0]) file = err->file;
-    if (file && err->line > 0) ulam__run_log(a, "ulam: %s:%ld: ", file, err->line);
-    else if (file) ulam__run_log(a, "ulam: %s: ", file);
-    else ulam__run_log(a, "ulam: ");
-    ulam__run_log(a, "error: %s%s%s\n", ulam_strerror(err->status), err->msg[0] ? ": expected " : "", err->msg);
-    return err->status;
 }
 
 /* ulam__run_error for a status and what was expected. */

@@ -1,6 +1,6 @@
 /* A radiosity run's pictures (ulam_radiosity_run.h): the rendered solution (PNG, PFM and Radiance
  * .hdr) with its warnings, and a sensor grid's false-colour picture. */
-#include "run.h"
+#include "runstate.h"
 
 #include "rad.h"
 

@@ -3,7 +3,7 @@
  * plane.  The direct light of the luminaires is exact (point sources, shadow rays); what the
  * surfaces reflect of it is each patch's mean direct illuminance times its reflectance, added to
  * the patch's emission and solved by the run's radiosity machinery. */
-#include "run.h"
+#include "runstate.h"
 
 #include "rad.h"
 

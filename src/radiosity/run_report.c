@@ -1,6 +1,6 @@
 /* A radiosity run's reports (ulam_radiosity_run.h): the text a person reads, one JSON object,
  * the patch rows (table, CSV, JSON) and the point queries' answers, each into the caller's FILE *. */
-#include "run.h"
+#include "runstate.h"
 
 #include "rad.h"
 

@@ -1,5 +1,5 @@
 /* The radiosity run's private parts, shared by its engine (run.c), reports (run_report.c),
- * pictures (run_image.c) and photometry (run_photo.c). */
+ * pictures (run_image.c), photometry (run_photo.c) and its log, errors and clock (run_log.c). */
 #ifndef ULAM_RAD_RUN_H
 #define ULAM_RAD_RUN_H
 
