@@ -117,7 +117,7 @@ static int pass_all(ulam_analysis *a)
     if (!a->seen && !(a->seen = ulam__malloc((size_t)a->M->nrows, 1))) return ULAM_ENOMEM;
     int status = ulam__reach_all(a->M, a->continue_q, a->alpha, a->seen, &a->R);
     if (status) a->R.bounds = 0;
-    else a->bounds_from = 2;
+    else a->bounds_from = 2, a->R.shared = a->shared_bounds;
     return status;
 }
 
@@ -129,7 +129,7 @@ static const ulam__reach *take_bounds(ulam_analysis *a)
     double t0 = ulam_now();
     if (!a->R.bounds) {
         if (a->sys && ulam__system_bounds(a->sys, a->continue_q, a->alpha, &a->R)) { /* seen NULL: every state */
-            a->bounds_from = 1;
+            a->bounds_from = 1, a->R.shared = a->shared_bounds;
             if (a->R.b && a->R.b == a->b) a->b_from = 1;
             else a->R.b = NULL;
         } else if ((a->sys && !ulam_system_matrix(a->sys)) || pass_all(a)) {
@@ -142,7 +142,6 @@ static const ulam__reach *take_bounds(ulam_analysis *a)
     if (a->b && !a->R.b && (a->b != sb || ulam_system_rhs(a->sys, NULL)) && !ulam__reach_b(a->M, a->b, &a->R))
         a->b_from = 2; /* (a file's b verified whole first: the pass reads all of it) */
     a->seconds += ulam_now() - t0;
-    a->R.shared = a->shared_bounds;
     return &a->R;
 }
 
