@@ -1,6 +1,7 @@
 /* A walk result as JSON to a caller's stream (include/ulam_report.h): the one home of the
  * schema ulam solve --json prints; an outer iteration's report, text or JSON. */
 #include "ulam_report.h"
+#include "report.h"
 
 #include <math.h>
 #include <string.h>
@@ -272,14 +273,6 @@ static const char *outcome(const ulam_outer_report *p)
                                       : p->status == ULAM_OK    ? "interrupted" : "failed";
 }
 
-/* The spaces after "name[index]" that put the value at column; at least 1. */
-static int pad(const char *name, int64_t index, int column)
-{
-    char label[64];
-    int len = snprintf(label, sizeof label, "%s[%lld]", name ? name : "x", (long long)index);
-    return len < column ? column - len : 1;
-}
-
 /* The text report's totals. */
 static void print_text(FILE *f, const ulam_outer_report *p)
 {
@@ -302,7 +295,7 @@ static void print_text(FILE *f, const ulam_outer_report *p)
                 ulam_verdict_word(p->g.verdict_abs), p->g.hat[ULAM_FORWARD].rho,
                 ulam_verdict_word(p->g.verdict_hat[ULAM_FORWARD]));
     if (p->index && p->x)
-        fprintf(f, "x[%lld]%*s%.12g\n", (long long)p->index, pad(p->answer_name, p->index, 16), "", p->x[p->index - 1]);
+        fprintf(f, "x[%lld]%*s%.12g\n", (long long)p->index, ulam__report_pad(p->answer_name ? p->answer_name : "x", p->index, 16), "", p->x[p->index - 1]);
 }
 
 /* The JSON object with the history. */

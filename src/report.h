@@ -1,0 +1,31 @@
+/* report.h: the report module's private pieces (ulam__report_), shared by its writers
+ * (src/report*.c): the answer line's column, an interval's digits, --check's z, the rel_err
+ * rule's outcome in words. */
+#ifndef ULAM_REPORT_PRIVATE_H
+#define ULAM_REPORT_PRIVATE_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "ulam.h"
+
+/* The spaces after "name[index]" that put the value at column (16: under "method          "); at least 1. */
+int ulam__report_pad(const char *name, int64_t index, int column);
+
+/* The significant digits (10 to 17) that print an interval's ends lo < hi as two numbers. */
+int ulam__report_ci_digits(double lo, double hi);
+
+/* --check's z = (estimate - direct) / std_error: 0 when they are equal, +-inf when only the stderr is 0. */
+double ulam__report_z(double estimate, double direct, double std_error);
+
+/* Write "z = Z", when |z| > 4 whether direct is inside [lo, hi], and a newline. */
+void ulam__report_z_fprint(FILE *f, double estimate, double direct, double std_error, double lo, double hi);
+
+/* Nonzero when r's interval was withheld because its scores are too small to square in doubles. */
+int ulam__report_score_too_small(const ulam_walk_result *r);
+
+/* Write whether o's rel_err target was met by r, and when not why (one line; nothing without a
+ * target; verbose: also a met target's rule). */
+void ulam__report_rel_err_fprint(FILE *f, const ulam_walk_opts *o, const ulam_walk_result *r, int verbose);
+
+#endif
