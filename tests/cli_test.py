@@ -286,6 +286,9 @@ CASES += [
     (["radiosity", SC + "cube.obj", "--patch", "1", "--subdivide", "0"], 2, r"--subdivide expects a number", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--mode", "sideways"], 2, r"--mode expects gather, shoot or final", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--size", "0x5"], 2, r"--size expects WxH", ""),
+    # --mode final is ray gathering over a ray-shot pilot: with --matrix-walk it ran plain shooting
+    (["radiosity", SC + "cube.obj", "--mode", "final", "--matrix-walk", "--walks", "100"], 2,
+     r"--mode final gathers by rays .*not with --matrix-walk", ""),
     (["radiosity", SC + "cube.obj", "--patch", "1", "--walks", "1000", "--estimator", "absorption"], 0, r"^$", r"radiosity R  2 \+- 0"),
     (["radiosity", SC + "cube.obj", "--direct", "--max-mem", "10"], code("EMEMLIMIT"), r"memory limit", ""),
     (["radiosity", SC + "cube.obj", "--subdivide", "0.0003", "--list", "--max-mem", "100M"], code("EMEMLIMIT"),

@@ -220,6 +220,11 @@ int ulam_rad_run_alloc(const ulam_rad_run_opts *opts, ulam_rad_run **out)
     r->opts = *opts, r->a = &r->opts, r->r.patch = -1;
     args *a = &r->opts;
     ulam_error err;
+    if (a->final && a->matrix_walk) { /* final gathers by rays over a ray-shot pilot: no matrix form */
+        ulam__run_log(a, "ulam radiosity: --mode final gathers by rays over a shooting pilot: not with --matrix-walk "
+                         "(use --mode shoot --matrix-walk, or drop --matrix-walk)\n");
+        return ULAM_RAD_RUN_USAGE;
+    }
     int rc = load_scene(a, &r->s, &r->r.faces);
     if (rc || (a->mesh_target > 0 && (rc = adapt_scene(a, &r->s, &r->r)))) return rc;
     r->r.adapted = a->mesh_target > 0;
