@@ -384,6 +384,37 @@ static inline int bench_hub(int64_t n, double alpha, uint64_t seed, ulam_csr **M
     return bad ? -1 : 0;
 }
 
+/* Issue 38's three clusters (tests/cli_test.py's three_clusters at leak 1e-4): 60 states, three
+ * clusters of 20 with rows of |M| summing to 0.99; cluster c's first state (its hub) moves to
+ * states +1, +3, +7, +12 of its cluster with a quarter each, every other state half to the hub
+ * and a sixth to each of +1, +3, +7; the hubs of the first two clusters move `leak` (taken
+ * from their own rows) to the next cluster's hub.  b = 1 on the last cluster, 0 elsewhere: x_0
+ * is reached only through both leaks.  Nonzero when out of memory. */
+static inline int bench_clusters(double leak, ulam_csr **M, double **b)
+{
+    int32_t ti[242], tj[242];
+    double tx[242];
+    int nz = 0;
+    static const int hop[4] = {1, 3, 7, 12};
+    for (int c = 0; c < 3; c++) {
+        int32_t hub = 20 * c;
+        for (int32_t i = 0; i < 20; i++) {
+            double rs = 0.99 - (i == 0 && c < 2 ? leak : 0.0);
+            if (i == 0)
+                for (int h = 0; h < 4; h++) ti[nz] = hub, tj[nz] = hub + hop[h], tx[nz++] = rs / 4;
+            else {
+                ti[nz] = hub + i, tj[nz] = hub, tx[nz++] = rs / 2;
+                for (int h = 0; h < 3; h++) ti[nz] = hub + i, tj[nz] = hub + (i + hop[h]) % 20, tx[nz++] = rs / 6;
+            }
+        }
+        if (c < 2) ti[nz] = hub, tj[nz] = hub + 20, tx[nz++] = leak;
+    }
+    *b = malloc(60 * sizeof **b);
+    if (!*b || ulam_csr_from_triplets(60, 60, nz, ti, tj, tx, M)) return free(*b), *b = NULL, -1;
+    for (int i = 0; i < 60; i++) (*b)[i] = i < 40 ? 0.0 : 1.0;
+    return 0;
+}
+
 /* Upwind convection-diffusion on an L x L grid with cell Peclet numbers cx (along j) and cy
  * (along i): h^2 times, 4 + cx + cy on the diagonal, -1 - cx and -1 - cy to the upstream
  * neighbours, -1 downstream; by its Jacobi splitting, b = 30 entries U(0, 1) at random states
