@@ -548,8 +548,9 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     if (!given && s->o.kernel.kernel_alpha != 1.0 &&
         !(fac = s->fac = move_factors(K, seen, s->o.kernel.continue_q, s->o.kernel.kernel_alpha)))
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the kernel's weight factors");
-    int pos = 0, neg = given ? given->neg : 0, any = 0;
+    int pos = 0, neg = given ? given->neg : 0, any = 0, anyexp = 0;
     int need_q = !given || only == ULAM_ABSORPTION, need_c = adj && (!given || only == ULAM_EXPECTED);
+    int need_j = !adj && (!given || only == ULAM_EXPECTED); /* forward expected: a visit to i scores K_{i,index} */
     int64_t bad = -1, reads = 0;
     double w0 = 1.0, fbig = given ? given->fbig : 0.0, gabs = 0.0, g2abs = 0.0, vb = 0.0, vexp = 0.0;
     double qmax = given ? given->qmax : 0.0;
@@ -560,7 +561,7 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     for (int64_t i = 0; !summary && i < s->n; i++) {
         if (!seen[i] || (given && only != ULAM_EXPECTED && s->b[i] == 0.0)) continue; /* scores nothing here */
         double S = need_q ? row_sum(K, i) : 0.0, q = need_q ? ulam__continuation(S, s->o.kernel.continue_q) : 0.0, c = 0.0;
-        if (need_q || need_c) reads += K->rowptr[i + 1] - K->rowptr[i];
+        if (need_q || need_c || need_j) reads += K->rowptr[i + 1] - K->rowptr[i];
         if (!given) {
             if (!fac) fbig = fmax(fbig, ulam__factor(S, s->o.kernel.continue_q));
             qmax = fmax(qmax, q);
@@ -570,10 +571,15 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
             if (fac) fbig = fmax(fbig, fac[k]);
             if (need_c) c += K->val[k] * s->b[K->colidx[k]];
         }
+        for (int64_t k = K->rowptr[i]; need_j && k < K->rowptr[i + 1]; k++)
+            if (K->colidx[k] == s->o.query.index) c = fmax(c, fabs(K->val[k]));
         if ((adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
-        /* what one visit scores: b_i (collision), (M b)_i (expected), forward 1 at the index */
+        /* what one visit scores: b_i (collision), (M b)_i (expected); forward, at the index: 1
+         * (collision), |K_{i,index}| = |M_{index,i}| (expected: the visit tallies w M_{k,i} at
+         * every neighbour k) */
         vb = fmax(vb, adj ? fabs(s->b[i]) : i == s->o.query.index ? 1.0 : 0.0);
-        vexp = fmax(vexp, adj ? fabs(c) : i == s->o.query.index ? INFINITY : 0.0);
+        vexp = fmax(vexp, fabs(c));
+        anyexp |= !adj && c > 0.0; /* forward expected scores next to the index too */
         int scores = adj ? s->b[i] != 0.0 : i == s->o.query.index;
         if (!scores) continue;
         double g = adj ? fabs(s->b[i]) : 1.0;
@@ -591,8 +597,9 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
     for (int e = ULAM_COLLISION; e <= ULAM_EXPECTED; e++) {
         int absorb = e == ULAM_ABSORPTION;
         s->pass[e].vmax = e == ULAM_EXPECTED ? vexp : vb;
-        s->pass[e].gmax = absorb ? gabs : any ? INFINITY : 0.0;
-        s->pass[e].g2max = absorb ? g2abs : any ? INFINITY : 0.0;
+        int scored = any || (e == ULAM_EXPECTED && anyexp);
+        s->pass[e].gmax = absorb ? gabs : scored ? INFINITY : 0.0;
+        s->pass[e].g2max = absorb ? g2abs : scored ? INFINITY : 0.0;
         s->pass[e].bad = absorb ? bad : -1;
         if (only >= 0 && e != only) /* not read: never an optimistic bound (check_reach passes again) */
             s->pass[e].vmax = s->pass[e].gmax = s->pass[e].g2max = INFINITY;
@@ -767,17 +774,14 @@ int ulam__reach_b(const ulam_csr *K, const double *b, ulam__reach *R)
 /* Refuse a rel_err target no bound on a single score can certify (nothing else ends the run):
  * absorption with weights that can grow without bound (a cycle of factors S / q > 1, or
  * splitting); collision and expected with such weights, or a continuation of 1 (qmax = 1) and
- * no Collatz-Wielandt certificate below 1, or the forward expected estimator (unbounded
- * per-visit tallies). */
+ * no Collatz-Wielandt certificate below 1. */
 static int check_bounded(const ulam_solver *s, ulam_error *err)
 {
     if (s->bound == 0.0 || s->per_step == 0.0) return ULAM_OK;
     int absorb = s->o.estimator == ULAM_ABSORPTION;
     double t = s->qmax < 1.0 ? s->qmax : s->tail_u;
     if (isfinite(s->v2) || (absorb ? isfinite(s->range) : isfinite(s->per_step) && t < 1.0)) return ULAM_OK;
-    const char *why = !isfinite(s->per_step) && !absorb && s->o.mode == ULAM_FORWARD && s->o.estimator == ULAM_EXPECTED
-                          ? "the forward expected estimator's tallies have no per-visit bound"
-                      : s->o.kernel.split > 0 ? "splitting leaves the weights without a bound"
+    const char *why = s->o.kernel.split > 0 ? "splitting leaves the weights without a bound"
                       : !isfinite(s->per_step) ? "a reachable cycle of weight factors S/q > 1 lets weights grow without "
                                                  "bound, and no second-moment certificate holds"
                                                : "a reachable row of |M| sums to 1 or more and no Collatz-Wielandt vector "
