@@ -30,8 +30,16 @@ void ulam_json_string(FILE *f, const char *key, const char *v, int last);
  * "index" before, "ranks" and the timings after). */
 void ulam_walk_result_json(FILE *f, const ulam_walk_opts *o, const ulam_walk_result *r, const ulam_guard *g);
 
-/* The formats of ulam_choice_fprint. */
-enum ulam_report_format { ULAM_REPORT_BRIEF = 0, ULAM_REPORT_VERBOSE = 1, ULAM_REPORT_JSON = 2 };
+/* The formats of the writers: BRIEF, a few lines; VERBOSE, everything; JSON, one object; QUIET,
+ * the answer line (or the table's rows) alone; CHECK, --check's line alone (written once the
+ * reference solve is done, after the rest was flushed). */
+enum ulam_report_format {
+    ULAM_REPORT_BRIEF = 0,
+    ULAM_REPORT_VERBOSE = 1,
+    ULAM_REPORT_JSON = 2,
+    ULAM_REPORT_QUIET = 3,
+    ULAM_REPORT_CHECK = 4
+};
 
 /* Write what --method auto chose (ulam_auto_start's ch) to f: BRIEF, one line (what was chosen
  * among how many); VERBOSE, the choice and a line a candidate (mode, estimator, continuation,
@@ -64,6 +72,40 @@ typedef struct ulam_outer_report {
 /* Write r to f: its totals as text lines (format ULAM_REPORT_BRIEF or _VERBOSE; the iterations'
  * lines are the caller's, as they end), or one JSON object with the history (ULAM_REPORT_JSON). */
 void ulam_outer_report_fprint(FILE *f, const ulam_outer_report *r, int format);
+
+/* What a bidirectional solve of one x_t (ulam_analysis_bidir, or the bidirectional row of
+ * ulam_run_finish) or a single-source estimate of every x_i (ulam_fpush_top) reports: the caller
+ * fills it (zero what it does not know) and ulam_bidir_report_fprint writes it. */
+typedef struct ulam_bidir_report {
+    const ulam_bidir_opts *opts;     /* the point query's options (NULL: the single-source table) */
+    const ulam_bidir_result *result; /* its answer (scaled to pi with pagerank) */
+    const ulam_guard *guard;         /* M's guards, forward kernel (NULL: not computed; JSON radii null) */
+    const ulam_choice *choice;       /* --method auto's choice (NULL: the row was pinned) */
+    int dense;                       /* 1: the push on b and walks from t (ulam_choice.bidir_route) */
+    double bmax;                     /* max |b| (the push on b's line) */
+    double pagerank;                 /* alpha when the answer is PageRank's pi = (1 - alpha) x (0: none) */
+    const char *seeds;               /* the personalisation's seed set as given (NULL: a source, or uniform) */
+    const char *answer_name;         /* what the answer is called (NULL: "x") */
+    int64_t node_base;               /* the number state 0 is shown as (0 or 1) */
+    int check;                       /* 1: direct holds a direct solve's value of the answer */
+    double direct, direct_seconds;
+    const char *direct_method;       /* "dense LU", "sparse LU" (NULL: "LU") */
+    double transpose_seconds, load_seconds, guard_seconds;
+    int ranks;                       /* MPI ranks (0: 1) */
+    /* the single-source table (opts NULL): */
+    const ulam_fpush_info *top;      /* the estimate (residual_bound scaled as the estimates are) */
+    int64_t n, source;               /* the states, and the 1-based source (0: seeds or uniform) */
+    int64_t rows;                    /* the rows shown, largest first */
+    const int64_t *order;            /* their 0-based states */
+    const double *x, *direct_x;      /* every state's estimate, and direct value (NULL: no --check) */
+    const double *se, *lo, *hi;      /* the rows' standard errors and 95% intervals (NaN: none) */
+    double cpu_seconds;              /* the push and walks' CPU time */
+} ulam_bidir_report;
+
+/* Write r to f as text (ULAM_REPORT_BRIEF, _VERBOSE, _QUIET: the answer line or the table's rows
+ * alone), as one JSON object (ULAM_REPORT_JSON, with --check's members when r->check), or
+ * --check's line alone (ULAM_REPORT_CHECK); the text writes --check's line last when r->check. */
+void ulam_bidir_report_fprint(FILE *f, const ulam_bidir_report *r, int format);
 
 #ifdef __cplusplus
 }

@@ -21,6 +21,9 @@ double ulam__report_z(double estimate, double direct, double std_error);
 /* Write "z = Z", when |z| > 4 whether direct is inside [lo, hi], and a newline. */
 void ulam__report_z_fprint(FILE *f, double estimate, double direct, double std_error, double lo, double hi);
 
+/* An estimator's name (enum ulam_estimator): "collision", "absorption", "expected" ("?" for another). */
+const char *ulam__report_estimator_name(int estimator);
+
 /* Nonzero when r's interval was withheld because its scores are too small to square in doubles. */
 int ulam__report_score_too_small(const ulam_walk_result *r);
 

@@ -46,6 +46,13 @@ void ulam__report_z_fprint(FILE *f, double estimate, double direct, double std_e
     fputc('\n', f);
 }
 
+/* An estimator's name, as the options table spells it. */
+const char *ulam__report_estimator_name(int estimator)
+{
+    static const char *const names[] = {"collision", "absorption", "expected"};
+    return estimator >= 0 && estimator < 3 ? names[estimator] : "?";
+}
+
 /* Nonzero when the interval was withheld because the scores are too small to square (a b far
  * below 1 that the solver could not rescale: a prepared file's, read lazily; src/stop.h). */
 int ulam__report_score_too_small(const ulam_walk_result *r)

@@ -82,6 +82,80 @@ static void test_choice(void **state)
     free(buf);
 }
 
+/* What f's writer wrote (the caller frees it). */
+static char *written(FILE *f, char **buf)
+{
+    fclose(f);
+    return *buf;
+}
+
+/* A bidirectional report by hand: the answer line alone (QUIET), the reverse push's lines and
+ * PageRank's (BRIEF), --check's line alone, JSON without guards (radii null, the interval by its
+ * ends); the single-source table's rows; nothing for a report with neither. */
+static void test_bidir(void **state)
+{
+    (void)state;
+    ulam_bidir_opts o = ulam_bidir_defaults();
+    o.target = 6, o.source = 2, o.walk.exec.seed = 5;
+    ulam_bidir_result r = {.estimate = 0.25, .std_error = 0.001, .ci95 = {0.248, 0.252}, .push_part = 0.2};
+    r.push.rmax = 0.001, r.push.ops = 100, r.push.support = 4, r.walks.walks = 1000, r.walks.threads = 1;
+    ulam_bidir_report p = {.opts = &o, .result = &r, .node_base = 1, .answer_name = "pi", .pagerank = 0.85,
+                           .check = 1, .direct = 0.2515, .direct_method = "dense LU", .direct_seconds = 0.5};
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    ulam_bidir_report_fprint(f, &p, ULAM_REPORT_QUIET);
+    assert_string_equal(written(f, &buf), "pi[7]           0.25 +- 0.001 (95% CI 0.248 .. 0.252)\n");
+    free(buf);
+    f = open_memstream(&buf, &len);
+    ulam_bidir_report_fprint(f, &p, ULAM_REPORT_BRIEF);
+    char *s = written(f, &buf);
+    const char *lines[] = {"pi[7] ", "\nmethod          bidirectional: reverse push from 7, walks from source 3 (balanced rmax)\n",
+                           "\nwalks           1000 (0 cut, 0 steps, 1 threads)\n", "\nbalance ", "\nseconds ",
+                           "\nload ", "\npagerank        pi = (1 - 0.85) x, ", "s e_3 (source 3)",
+                           "\ndirect          0.2515 (dense LU, 0.5 s), z = -1.500\n"};
+    const char *at = s;
+    for (size_t k = 0; k < sizeof lines / sizeof *lines; k++) { /* each present, in this order */
+        assert_non_null(at = strstr(at, lines[k]));
+    }
+    assert_null(strstr(s, "guards ")); /* no guard given */
+    free(s);
+    f = open_memstream(&buf, &len);
+    ulam_bidir_report_fprint(f, &p, ULAM_REPORT_CHECK);
+    assert_string_equal(written(f, &buf), "direct          0.2515 (dense LU, 0.5 s), z = -1.500\n");
+    free(buf);
+    f = open_memstream(&buf, &len);
+    ulam_bidir_report_fprint(f, &p, ULAM_REPORT_JSON);
+    s = written(f, &buf);
+    assert_int_equal(strncmp(s, "{\"index\": 7, \"quantity\": \"pi\", \"source\": 3, \"b_nonzeros\": 1, ", 60), 0);
+    assert_non_null(strstr(s, "\"ci95\": [0.248, 0.252], \"variance_finite\": true, \"rho_abs\": null, \"rho_hat\": null, "));
+    assert_non_null(strstr(s, "\"direct\": 0.2515, \"z\": -1.5000000000000013, "));
+    assert_string_equal(s + strlen(s) - 22, "\"interrupted\": false}\n");
+    free(s);
+
+    ulam_fpush_info t = {.rmax = 0.01, .residual_bound = 0.5, .walks = 10};
+    int64_t order[2] = {4, 0};
+    double x[5] = {0.1, 0, 0, 0, 0.3}, se[2] = {0.01, 0.02}, lo[2] = {0.2, NAN}, hi[2] = {0.4, NAN};
+    ulam_bidir_report q = {.top = &t, .n = 5, .source = 5, .rows = 2, .order = order, .x = x, .se = se, .lo = lo, .hi = hi};
+    f = open_memstream(&buf, &len);
+    ulam_bidir_report_fprint(f, &q, ULAM_REPORT_QUIET);
+    assert_string_equal(written(f, &buf), "1      4          0.3            0.01        0.2          0.4\n"
+                                          "2      0          0.1            0.02        none\n");
+    free(buf);
+    f = open_memstream(&buf, &len);
+    ulam_bidir_report_fprint(f, &q, ULAM_REPORT_JSON);
+    s = written(f, &buf);
+    assert_non_null(strstr(s, "\"top\": [{\"index\": 4, \"estimate\": 0.29999999999999999, "));
+    assert_non_null(strstr(s, "\"ci95\": [null, null]}]}\n"));
+    free(s);
+    ulam_bidir_report none = {0};
+    f = open_memstream(&buf, &len);
+    ulam_bidir_report_fprint(f, &none, ULAM_REPORT_BRIEF);
+    ulam_bidir_report_fprint(NULL, &p, ULAM_REPORT_BRIEF);
+    assert_string_equal(written(f, &buf), "");
+    free(buf);
+}
+
 /* The reference solve: dense LU on a small M (auto), GMRES past a tiny memory limit, the limit
  * refused without the fallback. */
 static void test_reference(void **state)
@@ -117,6 +191,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_json),
         cmocka_unit_test(test_choice),
+        cmocka_unit_test(test_bidir),
         cmocka_unit_test(test_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -285,35 +285,21 @@ def _report(d, index, b_nonzeros, source, scale):
     ch = d.get("choice")
     auto = ch is not None and not ch["pinned"]
     rep = {"index": index + 1}
-    if d["method"] == "bidirectional":
-        b = d["bidirectional"]
-        rep.update({"source": source + 1 if source is not None else None, "b_nonzeros": b_nonzeros,
-                    "method": "bidirectional", "estimate": d["estimate"] * scale, "stderr": d["std_error"] * scale})
-        lo, hi = d["ci95"]
-        rep["ci95"] = [lo * scale, hi * scale] if math.isfinite(lo) else None
-        rep["variance_finite"] = rep["ci95"] is not None
-        # the guards of the forward kernel the CLI prints beside: not computed by the library's run
-        rep.update({"rho_abs": None, "rho_hat": None, "rmax": b["rmax"], "rmax_balanced": bool(b["rmax_balanced"]),
-                    "push_part": b["push_part"] * scale, "pushes": b["pushes"],
-                    "push_ops": b["push_ops"], "residual_support": b["residual_support"],
-                    "residual_sum": b["residual_sum"], "walks": w["walks"], "steps": w["steps"], "cut": w["cut"],
-                    "pilot_walks": b["pilot_walks"], "variance": _num(w["variance"]),
-                    "mean_visits": _num(b["mean_visits"]), "predicted_walks": _num(b["predicted_walks"]),
-                    "predicted_work": _num(b["predicted_work"]), "push_seconds": b["push_seconds"], "walk_seconds": w["seconds"], "seconds": b["seconds"], "estimator": ESTIMATORS[o["estimator"]],
-                    "seed": o["seed"], "threads": w["threads"], "ranks": 1})
-        if d.get("rel_err"):
-            rep["rel_err_met"] = bool(w["rel_err_met"])
-    elif d["method"] != "walks":
-        rep.update({"method": d["method"], "estimate": d["estimate"] * scale, "iterations": d["iterations"],
-                    "residual": _num(d["residual"]), "histories": w["walks"], "seed": o["seed"]})
-    else:  # the library's members (ulam_walk_result_json), as `ulam solve --json` prints them
+    if d["method"] in ("walks", "bidirectional"):  # the library's JSON, as `ulam solve --json` prints it
         rep.update(json.loads(d["report_json"]))
-        # the CLI's own keys around them (ranks: MPI; kernel_rows), and pagerank's scale (1 - alpha)
-        rep.update({"ranks": 1, "kernel_rows": w["rows"]})
-        if scale != 1.0:
+        if d["method"] == "walks":  # ulam_walk_result_json's members, and the CLI's own keys around them
+            rep.update({"ranks": 1, "kernel_rows": w["rows"]})  # (ranks: MPI; kernel_rows)
+        else:  # ulam_bidir_report_fprint's object, less the process's keys; source and b as given
+            for k in ("transpose_seconds", "load_seconds", "guard_seconds"):
+                del rep[k]
+            rep.update({"source": source + 1 if source is not None else None, "b_nonzeros": b_nonzeros})
+        if scale != 1.0:  # pagerank's scale (1 - alpha)
             rep["estimate"], rep["stderr"] = rep["estimate"] * scale, rep["stderr"] * abs(scale)
             if rep["ci95"]:
                 rep["ci95"] = sorted(c * scale for c in rep["ci95"])
+    else:
+        rep.update({"method": d["method"], "estimate": d["estimate"] * scale, "iterations": d["iterations"],
+                    "residual": _num(d["residual"]), "histories": w["walks"], "seed": o["seed"]})
     if auto:  # the library's "auto" member (ulam_choice_fprint), as the CLI prints it
         rep["auto"] = json.loads(d["auto_json"])["auto"]
         why = ch["rows"][_METHOD_BIDIR]["why"]

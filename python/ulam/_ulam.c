@@ -264,18 +264,29 @@ static PyObject *walk_result(const ulam_walk_result *r)
                          r->interrupted, "rho4", radius(&r->rho4), "fourth_finite", r->fourth_finite);
 }
 
+/* The kinds of JSON json_text writes: a walk result's members, the choice's "auto", a
+ * bidirectional run's whole report. */
+enum { JSON_WALK, JSON_AUTO, JSON_BIDIR };
+
 /* What writer(f, ...) writes, as a Python str (open_memstream around the library's FILE *
  * writers): the library's JSON, parsed by the Python half. */
-static PyObject *json_text(const ulam_walk_opts *o, const ulam_answer *a, const ulam_choice *ch, int walk, int interrupted)
+static PyObject *json_text(const ulam_walk_opts *o, const ulam_answer *a, const ulam_choice *ch, int kind, int interrupted)
 {
     char *buf = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&buf, &len);
     if (!f) return PyErr_NoMemory();
-    fputc('{', f);
-    if (walk) ulam_walk_result_json(f, o, &a->walks, &a->guard);
-    else ulam_choice_fprint(f, ch, 1, ULAM_REPORT_JSON);
-    fprintf(f, "\"interrupted\": %s}", interrupted ? "true" : "false");
+    if (kind == JSON_BIDIR) { /* the report ulam solve --json prints (no guards: the CLI computes them beside) */
+        ulam_bidir_opts bo = ch->bidir_opts;
+        bo.walk = *o, bo.b_index = NULL, bo.b_value = NULL; /* the run that owned b's arrays is freed */
+        ulam_bidir_report rep = {.opts = &bo, .result = &a->bidir, .dense = ch->bidir_route == 1, .node_base = 1};
+        ulam_bidir_report_fprint(f, &rep, ULAM_REPORT_JSON);
+    } else {
+        fputc('{', f);
+        if (kind == JSON_WALK) ulam_walk_result_json(f, o, &a->walks, &a->guard);
+        else ulam_choice_fprint(f, ch, 1, ULAM_REPORT_JSON);
+        fprintf(f, "\"interrupted\": %s}", interrupted ? "true" : "false");
+    }
     if (fclose(f)) {
         free(buf);
         return PyErr_NoMemory();
@@ -291,7 +302,6 @@ static PyObject *answer(int status, const ulam_error *err, const ulam_choice *ch
 {
     PyObject *d = PyDict_New();
     if (!d) return NULL;
-    const ulam_bidir_result *br = &a->bidir;
     const ulam_walk_opts *o = &a->opts;
     if (put(d, "status", PyLong_FromLong(status)) || put(d, "message", PyUnicode_FromString(err->msg)) ||
         put(d, "error_index", PyLong_FromLongLong((long long)err->index)) ||
@@ -309,18 +319,10 @@ static PyObject *answer(int status, const ulam_error *err, const ulam_choice *ch
         put(d, "iterations", PyLong_FromLong(a->iterations)) || put(d, "residual", PyFloat_FromDouble(a->residual)))
         goto fail;
     int stopped = interrupted || a->walks.interrupted;
-    if (a->method == ULAM_METHOD_WALKS && put(d, "report_json", json_text(o, a, ch, 1, stopped))) goto fail;
-    if (started && !ch->pinned && put(d, "auto_json", json_text(o, a, ch, 0, stopped))) goto fail;
-    if (a->method == ULAM_METHOD_BIDIRECTIONAL &&
-        put(d, "bidirectional", Py_BuildValue("{s:d,s:i,s:d,s:d,s:d,s:L,s:L,s:L,s:d,s:L,s:d,s:d,s:d}", "rmax",
-                                              br->push.rmax, "rmax_balanced", br->plan.balanced, "predicted_work",
-                                              br->plan.predicted_work, "push_seconds", br->push.seconds,
-                                              "push_part", br->push_part, "pushes", (long long)br->push.pushes,
-                                              "push_ops", (long long)br->push.ops, "residual_support",
-                                              (long long)br->push.support, "residual_sum", br->push.r_sum,
-                                              "pilot_walks", (long long)br->plan.pilot_walks, "mean_visits",
-                                              br->plan.mean_visits, "predicted_walks", br->plan.predicted_walks,
-                                              "seconds", br->seconds)))
+    if (a->method == ULAM_METHOD_WALKS && put(d, "report_json", json_text(o, a, ch, JSON_WALK, stopped))) goto fail;
+    if (started && !ch->pinned && put(d, "auto_json", json_text(o, a, ch, JSON_AUTO, stopped))) goto fail;
+    if (a->method == ULAM_METHOD_BIDIRECTIONAL && started &&
+        put(d, "report_json", json_text(o, a, ch, JSON_BIDIR, stopped)))
         goto fail;
     return d;
 fail:

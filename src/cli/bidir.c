@@ -11,152 +11,23 @@
 #include <time.h>
 #include <unistd.h>
 
+/* What a run reports (the library's writer, ulam_bidir_report_fprint), and how. */
 typedef struct {
     int json, check;
-    double direct, transpose_seconds, load_seconds, guard_seconds;
-    const char *direct_method; /* --check's solve: "dense LU" or "sparse LU" (NULL: "LU") */
     ulam_guard g;
-    const ulam_choice *ch; /* chosen by --method auto: the choice (else NULL) */
-    double bmax;           /* max |b| */
-    int dense;             /* the library pushed b and walked from the index (src/bpush.c) */
-    double scale;          /* what the answer is x times: 1, or 1 - alpha for PageRank's pi (0: 1) */
-    const char *seeds;     /* --source as a seed set (ids or a file; NULL: one source or none) */
+    double scale;       /* what the answer is x times: 1, or 1 - alpha for PageRank's pi (0: 1) */
+    const char *seeds;  /* --source as a seed set (ids or a file; NULL: one source or none) */
+    ulam_bidir_report rep;
 } report;
 
-/* PageRank's line: what pi is of x and what the personalisation is (nothing without --pagerank). */
-static void print_pagerank(const cli_system *s, int64_t source, const report *rp)
+/* The writer's fields the command line knows: how states are numbered, what the answer is
+ * called, PageRank's alpha (when the answer is pi), the seeds, the ranks. */
+static void report_fill(const cli_system *s, report *rp)
 {
-    if (!(s->pagerank > 0)) return;
-    double a = s->pagerank;
-    char who[200];
-    if (rp->seeds) snprintf(who, sizeof who, "the seeds %.120s", rp->seeds);
-    else if (source) snprintf(who, sizeof who, "e_%lld (source %lld)", (long long)(source - 1 + cli_node_base),
-                              (long long)(source - 1 + cli_node_base));
-    else snprintf(who, sizeof who, "uniform (global PageRank)");
-    printf("pagerank        pi = (1 - %g) x, x of (I - %g P^T) x = s, s %s; dangling nodes' rank leaks (no "
-           "teleport): pi sums to 1 - the leak\n", a, a, who);
-}
-
-/* Print the human-readable block. */
-static void print_text(const ulam_bidir_opts *o, const ulam_bidir_result *r, const report *rp)
-{
-    const ulam_walk_result *w = &r->walks;
-    if (isfinite(r->ci95[0]) && isfinite(r->ci95[1]))
-        printf("%s[%lld]%*s%.10g +- %.3g (95%% CI %.*g .. %.*g)%s\n", cli_answer_name,
-               (long long)(o->target + cli_node_base), cli_answer_pad(o->target + cli_node_base, 16), "", r->estimate,
-               r->std_error, cli_ci_digits(r->ci95[0], r->ci95[1]), r->ci95[0], cli_ci_digits(r->ci95[0], r->ci95[1]),
-               r->ci95[1], w->interrupted ? "  [INTERRUPTED]" : "");
-    else
-        printf("%s[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", cli_answer_name,
-               (long long)(o->target + cli_node_base), cli_answer_pad(o->target + cli_node_base, 16), "", r->estimate, r->std_error,
-               w->variance > 0 ? "no certified range of the walk part's score"
-                               : "no walk scored, and no bound certifies the part they missed",
-               w->interrupted ? "  [INTERRUPTED]" : "");
-    if (cli_verbosity < 0) return; /* --quiet: the answer line alone */
-    cli_print_rel_err(&o->walk, w, 0);
-    if (rp->dense) { /* the push on b: its own lines */
-        printf("method          bidirectional, the push on b: then %s walks from %lld scoring its "
-               "residual\n", cli_estimator_names[o->walk.estimator], (long long)(o->target + cli_node_base));
-        printf("push            rmax %.3g: %lld operations; q_%lld = %.10g exact; residual max %.3g (b's was %.3g)\n",
-               r->push.rmax, (long long)r->push.ops, (long long)(o->target + cli_node_base), r->push_part, r->push.r_max,
-               r->plan.rmax > 0 ? rp->bmax : NAN);
-        printf("walks           %lld (%lld cut, %lld steps, %d threads); a pilot of %lld walks predicted %.3g\n",
-               (long long)w->walks, (long long)w->cut, (long long)w->steps, w->threads, (long long)r->plan.pilot_walks,
-               r->plan.predicted_walks);
-        printf("seconds         %.4f (push and pilot %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
-               r->plan.seconds, w->seconds, (unsigned long long)o->walk.exec.seed, rp->transpose_seconds);
-        printf("load            %.3f s inputs\n", rp->load_seconds);
-        if (rp->ch) ulam_choice_fprint(stdout, rp->ch, 1, cli_verbosity >= 1);
-        if (rp->check)
-            printf("direct          %.10g (%s), ", rp->direct, rp->direct_method ? rp->direct_method : "LU"),
-                cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
-        return;
-    }
-    if (o->nb > 0)
-        printf("method          bidirectional: reverse push from %lld, walks from b's %lld nonzeros (%s rmax)\n",
-               (long long)(o->target + cli_node_base), (long long)o->nb, o->rmax > 0 ? "given" : "balanced");
-    else
-        printf("method          bidirectional: reverse push from %lld, walks from source %lld (%s rmax)\n",
-               (long long)(o->target + cli_node_base), (long long)(o->source + cli_node_base),
-               o->rmax > 0 ? "given" : "balanced");
-    printf("push            rmax %.3g: %lld pushes, %lld operations, %.4f s; <p, b> = %.10g; residual on %lld "
-           "states, sum %.3g\n", r->push.rmax, (long long)r->push.pushes, (long long)r->push.ops, r->push.seconds,
-           r->push_part, (long long)r->push.support, r->push.r_sum);
-    if (r->push.support == 0)
-        printf("walks           none: the push left no residual, the value is exact (to rounding)\n");
-    else
-        printf("walks           %lld (%lld cut, %lld steps, %d threads)\n", (long long)w->walks, (long long)w->cut,
-               (long long)w->steps, w->threads);
-    if (o->rmax <= 0)
-        printf("balance         pilot %lld walks, %.3g visits a walk; %.3g walks predicted at this rmax, "
-               "work %.3g operations predicted in all (a visit %.3g operations; probe's |x| >= %.3g)\n",
-               (long long)r->plan.pilot_walks, r->plan.mean_visits, r->plan.predicted_walks, r->plan.predicted_work,
-               r->plan.step_cost, r->plan.probe);
-    printf("seconds         %.4f (push %.4f, walks %.4f, seed %llu); transpose %.3f s\n", r->seconds,
-           r->push.seconds, w->seconds, (unsigned long long)o->walk.exec.seed, rp->transpose_seconds);
-    printf("guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s, forward kernel)\n", rp->g.abs.rho,
-           cli_verdict_word(rp->g.verdict_abs), rp->g.hat[ULAM_FORWARD].rho, cli_verdict_word(rp->g.verdict_hat[ULAM_FORWARD]));
-    printf("load            %.3f s inputs, %.3f s guards\n", rp->load_seconds, rp->guard_seconds);
-    if (rp->ch) ulam_choice_fprint(stdout, rp->ch, 1, cli_verbosity >= 1);
-    if (rp->check)
-        printf("direct          %.10g (%s), ", rp->direct, rp->direct_method ? rp->direct_method : "LU"),
-            cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
-}
-
-/* Print the JSON object. */
-static void print_json(const ulam_bidir_opts *o, const ulam_bidir_result *r, const report *rp)
-{
-    const ulam_walk_result *w = &r->walks;
-    int finite = rp->g.verdict_hat[ULAM_FORWARD] != ULAM_VERDICT_FAIL;
-    printf("{\"index\": %lld, ", (long long)(o->target + cli_node_base));
-    if (strcmp(cli_answer_name, "x")) printf("\"quantity\": \"%s\", ", cli_answer_name);
-    if (o->nb > 0) printf("\"source\": null, \"b_nonzeros\": %lld, ", (long long)o->nb);
-    else printf("\"source\": %lld, \"b_nonzeros\": 1, ", (long long)(o->source + cli_node_base));
-    cli_json_string("method", "bidirectional", 0);
-    cli_json_number("estimate", r->estimate, 0);
-    cli_json_number("stderr", r->std_error, 0);
-    printf("\"ci95\": ");
-    if (finite) {
-        printf("[");
-        cli_json_value(r->ci95[0]);
-        printf(", ");
-        cli_json_value(r->ci95[1]);
-        printf("], ");
-    } else {
-        printf("null, ");
-    }
-    printf("\"variance_finite\": %s, ", finite ? "true" : "false");
-    cli_json_number("rho_abs", rp->g.abs.rho, 0);
-    cli_json_number("rho_hat", rp->g.hat[ULAM_FORWARD].rho, 0);
-    cli_json_number("rmax", r->push.rmax, 0);
-    printf("\"rmax_balanced\": %s, ", o->rmax > 0 ? "false" : "true");
-    cli_json_number("push_part", r->push_part, 0);
-    printf("\"pushes\": %lld, \"push_ops\": %lld, \"residual_support\": %lld, ", (long long)r->push.pushes,
-           (long long)r->push.ops, (long long)r->push.support);
-    cli_json_number("residual_sum", r->push.r_sum, 0);
-    cli_json_number("push_seconds", r->push.seconds, 0);
-    printf("\"walks\": %lld, \"steps\": %lld, \"cut\": %lld, \"pilot_walks\": %lld, ", (long long)w->walks,
-           (long long)w->steps, (long long)w->cut, (long long)r->plan.pilot_walks);
-    cli_json_number("variance", w->variance, 0);
-    cli_json_number("mean_visits", r->plan.mean_visits, 0);
-    cli_json_number("predicted_walks", r->plan.predicted_walks, 0);
-    cli_json_number("predicted_work", r->plan.predicted_work, 0);
-    cli_json_number("walk_seconds", w->seconds, 0);
-    cli_json_number("seconds", r->seconds, 0);
-    cli_json_number("transpose_seconds", rp->transpose_seconds, 0);
-    cli_json_number("load_seconds", rp->load_seconds, 0);
-    cli_json_number("guard_seconds", rp->guard_seconds, 0);
-    cli_json_string("estimator", cli_estimator_names[o->walk.estimator], 0);
-    printf("\"seed\": %llu, \"threads\": %d, \"ranks\": %d, ", (unsigned long long)o->walk.exec.seed, w->threads,
-           cli_share ? cli_share->nranks : 1);
-    if (rp->check) {
-        cli_json_string("direct_method", rp->direct_method ? rp->direct_method : "LU", 0);
-        cli_json_number("direct", rp->direct, 0);
-        cli_json_number("z", cli_z(r->estimate, rp->direct, r->std_error), 0);
-    }
-    if (o->walk.stop.rel_err > 0) printf("\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
-    if (rp->ch) ulam_choice_fprint(stdout, rp->ch, 1, ULAM_REPORT_JSON);
-    printf("\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
+    ulam_bidir_report *p = &rp->rep;
+    p->node_base = cli_node_base, p->answer_name = cli_answer_name, p->seeds = rp->seeds;
+    p->ranks = cli_share ? cli_share->nranks : 1;
+    p->pagerank = s->pagerank > 0 && (rp->scale > 0 || !p->opts) ? s->pagerank : 0;
 }
 
 /* b's nonzeros as entries of o (new arrays in *idx, *val); 0 or an exit code (refused when b is
@@ -193,7 +64,7 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
     double t0 = ulam_now();
     int rc = cli_load_system(s);
     if (rc) return rc;
-    rp->load_seconds = ulam_now() - t0;
+    rp->rep.load_seconds = ulam_now() - t0;
     int64_t n = s->M->nrows;
     if (source > n)
         return cli_usage_error("solve", "--source %lld is out of range %lld..%lld", (long long)(source - 1 + cli_node_base),
@@ -222,7 +93,7 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
     if (source && o->walk.stop.rel_err > 0 && ulam_guard_variance(&rp->g, ULAM_FORWARD) != 1)
         return ROUTE_ADJOINT; /* walks from S cannot meet the target: the push on b and walks from I may */
     cli_guard_warn(s, &rp->g, ULAM_FORWARD, 0);
-    rp->guard_seconds = rp->g.abs.seconds + rp->g.hat[0].seconds + rp->g.hat[1].seconds;
+    rp->rep.guard_seconds = rp->g.abs.seconds + rp->g.hat[0].seconds + rp->g.hat[1].seconds;
     return 0; /* --check runs once the estimate is printed (answer) */
 }
 
@@ -232,25 +103,23 @@ static int prepare(cli_system *s, int64_t source, int force, ulam_bidir_opts *o,
 static int answer(const cli_system *s, const ulam_bidir_opts *o, ulam_bidir_result *r, report *rp)
 {
     int rc = 0, check = rp->check && !r->walks.interrupted && cli_rank == 0;
+    ulam_bidir_report *p = &rp->rep;
     if (rp->scale > 0) /* PageRank's pi = (1 - alpha) x: the answer, its interval and --check's */
         r->estimate *= rp->scale, r->std_error *= rp->scale, r->ci95[0] *= rp->scale, r->ci95[1] *= rp->scale;
-    rp->check = 0;
+    p->opts = o, p->result = r, p->guard = &rp->g, p->check = 0;
+    report_fill(s, rp);
     if (!rp->json) {
-        print_text(o, r, rp);
-        if (cli_verbosity >= 0 && rp->scale > 0) print_pagerank(s, o->nb ? 0 : o->source + 1, rp);
+        ulam_bidir_report_fprint(stdout, p, cli_verbosity < 0 ? ULAM_REPORT_QUIET : cli_verbosity > 0 ? ULAM_REPORT_VERBOSE : ULAM_REPORT_BRIEF);
         cli_flush();
     }
-    double seconds = 0.0;
     if (check) {
-        rc = cli_direct_check(s, s->index - 1, &rp->direct, &seconds, &rp->direct_method);
-        rp->direct *= rp->scale > 0 ? rp->scale : 1.0;
-        rp->check = !rc;
+        rc = cli_direct_check(s, s->index - 1, &p->direct, &p->direct_seconds, &p->direct_method);
+        p->direct *= rp->scale > 0 ? rp->scale : 1.0;
+        p->check = !rc;
     }
     if (rc == EXIT_INTERRUPTED && !rp->json) fprintf(stderr, "ulam: --check interrupted: the estimate above stands unchecked\n");
-    if (!rc && rp->json) print_json(o, r, rp);
-    else if (!rc && rp->check)
-        printf("direct          %.10g (%s, %.3g s), ", rp->direct, rp->direct_method, seconds),
-            cli_print_z(r->estimate, rp->direct, r->std_error, r->ci95[0], r->ci95[1]);
+    if (!rc && rp->json) ulam_bidir_report_fprint(stdout, p, ULAM_REPORT_JSON), cli_json_done = 1;
+    else if (!rc && p->check) ulam_bidir_report_fprint(stdout, p, ULAM_REPORT_CHECK);
     if (!rc && r->walks.interrupted) rc = EXIT_INTERRUPTED;
     cli_flush();
     if (rc == EXIT_INTERRUPTED && check && !cli_share) { /* the reference's thread still reads the system */
@@ -283,7 +152,7 @@ static int run(cli_system *s, ulam_bidir_opts *o, report *rp)
     int status = ulam_analysis_alloc(s->M, &ao, &an, &err);
     double t0 = ulam_now();
     if (!status && !ulam_analysis_transpose(an, &err)) status = err.status;
-    rp->transpose_seconds = ulam_now() - t0;
+    rp->rep.transpose_seconds = ulam_now() - t0;
     ulam_bidir_result r;
     o->walk.stop.interrupt = &cli_interrupted, o->walk.exec.share = cli_share;
     cli_catch_sigint();
@@ -355,70 +224,15 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
             if (xd) xd[i] *= alpha > 0 ? 1.0 - alpha : 1.0;
             shown++;
         }
-    const char *est = alpha > 0 ? "pi" : "estimate";
     if (!rc && cli_rank == 0) {
-        if (rp->json) {
-            printf("{");
-            cli_json_string("method", "single-source", 0);
-            if (source) printf("\"source\": %lld, ", (long long)(source - 1 + cli_node_base));
-            else printf("\"source\": null, ");
-            if (alpha > 0) cli_json_number("damping", alpha, 0), cli_json_string("quantity", "pi", 0);
-            printf("\"n\": %lld, ", (long long)n);
-            cli_json_number("rmax", info.rmax, 0);
-            printf("\"push_ops\": %lld, \"walks\": %lld, \"steps\": %lld, ", (long long)info.push.ops,
-                   (long long)info.walks, (long long)info.steps);
-            cli_json_number("residual_bound", info.residual_bound * scale, 0);
-            cli_json_number("seconds", info.seconds, 0);
-            cli_json_number("push_seconds", info.push_seconds, 0);
-            cli_json_number("walk_seconds", info.walk_seconds, 0);
-            cli_json_number("cpu_seconds", cpu, 0);
-            printf("\"top\": [");
-            for (int64_t k = 0; k < shown; k++) {
-                int64_t i = order[k];
-                printf("%s{\"index\": %lld, ", k ? ", " : "", (long long)(i + cli_node_base));
-                cli_json_number("estimate", x[i], 0);
-                cli_json_number("stderr", se[k], 0);
-                printf("\"ci95\": [");
-                cli_json_value(lo[k]);
-                printf(", ");
-                cli_json_value(hi[k]);
-                printf("]%s", xd ? ", " : "");
-                if (xd) cli_json_number("direct", xd[i], 1);
-                printf("}");
-            }
-            printf("]}\n");
-        } else {
-            if (cli_verbosity >= 0) { /* --quiet: the table's rows alone */
-                if (source)
-                    printf("method          single source: forward push from %lld, forward walks on its residual (FORA)\n",
-                           (long long)(source - 1 + cli_node_base));
-                else
-                    printf("method          single source: forward push from a virtual state feeding %s, forward walks "
-                           "on its residual (FORA)\n", rp->seeds ? "the seeds" : "every node");
-                print_pagerank(s, source, rp);
-                printf("push            rmax %.3g: %lld operations, residual on %lld states, sum %.3g (walk part of "
-                       "any %s at most %.3g)\n", info.rmax, (long long)info.push.ops, (long long)info.push.support,
-                       info.push.r_sum, alpha > 0 ? "pi_i" : "x_i", info.residual_bound * scale);
-                printf("walks           %lld (%lld steps)\n", (long long)info.walks, (long long)info.steps);
-                if (info.push.support > 0 && !isfinite(info.residual_bound)) /* the queue path (src/fpush.c) */
-                    printf("intervals       the source's alone: with ||M||_1 >= 1 the other components' walk parts "
-                           "have no certified range (none printed)\n");
-                printf("seconds         %.4f (push %.4f, walks %.4f; CPU %.4f)\n", info.seconds, info.push_seconds,
-                       info.walk_seconds, cpu);
-                if (xd) printf("direct          %s, %.3g s (the column direct)\n", dm, dsec);
-                printf("%-6s %-10s %-14s %-11s %s\n", "rank", cli_node_base ? "index" : "node", est, "stderr",
-                       xd ? "95% CI                    direct" : "95% CI");
-            }
-            for (int64_t k = 0; k < shown; k++) {
-                int64_t i = order[k];
-                printf("%-6lld %-10lld %-14.8g %-11.3g ", (long long)k + 1, (long long)(i + cli_node_base), x[i], se[k]);
-                int none = isnan(lo[k]) || isnan(hi[k]); /* no certified interval (an infinite variance) */
-                if (none) printf(xd ? "%-25s" : "%s", "none");
-                else printf("%-12.6g %.6g", lo[k], hi[k]);
-                if (xd) printf("%*s%.8g", none ? 0 : 13 - (int)snprintf(NULL, 0, "%.6g", hi[k]), "", xd[i]);
-                printf("\n");
-            }
-        }
+        ulam_bidir_report *p = &rp->rep;
+        info.residual_bound *= scale; /* as the estimates: of pi, or of x */
+        p->top = &info, p->n = n, p->source = source, p->rows = shown, p->order = order, p->x = x, p->direct_x = xd;
+        p->se = se, p->lo = lo, p->hi = hi, p->cpu_seconds = cpu, p->direct_seconds = dsec, p->direct_method = dm;
+        report_fill(s, rp);
+        ulam_bidir_report_fprint(stdout, p, rp->json ? ULAM_REPORT_JSON : cli_verbosity < 0 ? ULAM_REPORT_QUIET
+                                                                                            : ULAM_REPORT_BRIEF);
+        cli_json_done |= rp->json;
     }
     if (!rc && cli_interrupted) rc = EXIT_INTERRUPTED;
     if (!rc) rc = crc;
@@ -569,14 +383,14 @@ const cli_solve_row cli_solve_bidir_row = {"bidirectional", longopts, claims, se
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check,
                        double load_seconds)
 {
-    report rp = {.json = json, .check = check, .load_seconds = load_seconds, .transpose_seconds = ch->transpose_seconds,
-                 .ch = ch};
-    for (int64_t i = 0; i < s->M->nrows; i++) rp.bmax = fmax(rp.bmax, fabs(s->b[i]));
-    rp.dense = route; /* ulam__method_bidir_route: the push on b */
+    report rp = {.json = json, .check = check,
+                 .rep = {.load_seconds = load_seconds, .transpose_seconds = ch->transpose_seconds, .choice = ch}};
+    for (int64_t i = 0; i < s->M->nrows; i++) rp.rep.bmax = fmax(rp.rep.bmax, fabs(s->b[i]));
+    rp.rep.dense = route; /* ulam__method_bidir_route: the push on b */
     int rc = 0;
-    if (!rp.dense) { /* the dense route's walks run on M under the walks' own guards */
+    if (!route) { /* the dense route's walks run on M under the walks' own guards */
         if ((rc = cli_guard(s, ch->bidir_opts.walk.kernel.continue_q, 1.0, ULAM_FORWARD, &rp.g))) return rc;
-        rp.guard_seconds = rp.g.abs.seconds + rp.g.hat[0].seconds + rp.g.hat[1].seconds;
+        rp.rep.guard_seconds = rp.g.abs.seconds + rp.g.hat[0].seconds + rp.g.hat[1].seconds;
         cli_guard_warn(s, &rp.g, ULAM_FORWARD, 0);
     }
     ulam_answer a;
