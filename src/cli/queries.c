@@ -15,7 +15,6 @@
 #include "cli.h"
 
 #include <errno.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -128,34 +127,6 @@ static int transpose_guard(shared *w, const ulam_csr *Mt, double q)
     return 0;
 }
 
-/* Print one answer (text or a JSON line) and flush. */
-static void print_answer(const query *q, int64_t k, uint64_t seed, double est, double se, const double ci[2],
-                         int met, int64_t walks, double seconds, int json)
-{
-    if (json) {
-        printf("{\"query\": %lld, \"line\": %ld, \"source\": ", (long long)k + 1, q->line);
-        if (q->source >= 0) printf("%lld, ", (long long)(q->source + cli_node_base));
-        else printf("null, ");
-        printf("\"index\": %lld, ", (long long)(q->index + cli_node_base));
-        cli_json_number("estimate", est, 0);
-        cli_json_number("stderr", se, 0);
-        printf("\"ci95\": ");
-        if (isnan(ci[0])) printf("null, ");
-        else printf("[%.17g, %.17g], ", ci[0], ci[1]);
-        printf("\"rel_err_met\": %s, \"walks\": %lld, \"seed\": %llu, ", met ? "true" : "false", (long long)walks,
-               (unsigned long long)seed);
-        cli_json_number("seconds", seconds, 1);
-        printf("}\n");
-    } else {
-        char src[32] = "";
-        if (q->source >= 0) snprintf(src, sizeof src, " (source %lld)", (long long)(q->source + cli_node_base));
-        printf("%s[%lld]%s %.10g +- %.3g", cli_answer_name, (long long)(q->index + cli_node_base), src, est, se);
-        if (!isnan(ci[0])) printf(" (95%% CI %.*g .. %.*g)", cli_ci_digits(ci[0], ci[1]), ci[0], cli_ci_digits(ci[0], ci[1]), ci[1]);
-        printf("  walks %lld, %.4f s, seed %llu\n", (long long)walks, seconds, (unsigned long long)seed);
-    }
-    fflush(stdout);
-}
-
 /* The walks o names on the analysis' kept kernel, to their end (ulam_analysis_solver): the status,
  * r filled (as far as they went) and err on failure. */
 static int walks_on(ulam_analysis *an, const double *b, const ulam_walk_opts *o, ulam_walk_result *r, ulam_error *err)
@@ -204,7 +175,13 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
         return cli_report(w->s->matrix_path, &err);
     }
     if (interrupted) return EXIT_INTERRUPTED; /* the answered lines stay; this one is not an answer */
-    print_answer(q, k, o.exec.seed, est, se, ci, met, walks, ulam_now() - t0, json);
+    ulam_query_report a = {.query = k, .line = q->line, .source = q->source, .index = q->index, .estimate = est,
+                           .std_error = se, .ci95 = {ci[0], ci[1]}, .rel_err_met = met, .walks = walks,
+                           .seconds = ulam_now() - t0, .seed = o.exec.seed, .answer_name = cli_answer_name,
+                           .node_base = cli_node_base};
+    cli_json_done |= json;
+    ulam_report_fprint(stdout, ULAM_REPORT_QUERY, &a, json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
+    fflush(stdout);
     return 0;
 }
 
