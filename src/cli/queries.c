@@ -146,15 +146,14 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
     ulam_error err;
     double t0 = ulam_now();
     int status, interrupted;
-    double est, se, ci[2];
-    int met;
-    int64_t walks;
+    ulam_query_report a = {.query = k, .line = q->line, .source = q->source, .index = q->index, .seed = o.exec.seed,
+                           .answer_name = cli_answer_name, .node_base = cli_node_base};
     if (q->source < 0) {
         o.query.index = q->index;
         ulam_walk_result r;
         status = walks_on(w->an, w->s->b, &o, &r, &err);
-        est = r.estimate, se = r.std_error, ci[0] = r.ci95[0], ci[1] = r.ci95[1], met = r.rel_err_met;
-        walks = r.walks, interrupted = r.interrupted;
+        a.estimate = r.estimate, a.std_error = r.std_error, a.ci95[0] = r.ci95[0], a.ci95[1] = r.ci95[1];
+        a.rel_err_met = r.rel_err_met, a.walks = r.walks, interrupted = r.interrupted;
     } else {
         const ulam_csr *Mt = ulam_analysis_transpose(w->an, &err);
         if (!Mt) return cli_report(w->s->matrix_path, &err);
@@ -167,18 +166,15 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
         ulam_bidir_result r;
         status = ulam_analysis_bidir(w->an, &bo, &r, &err); /* its transpose, push workspace and plans */
         double pi = w->s->pagerank > 0 && strcmp(cli_answer_name, "x") ? 1.0 - w->s->pagerank : 1.0; /* b = e_S: pi = (1 - alpha) x */
-        est = pi * r.estimate, se = pi * r.std_error, ci[0] = pi * r.ci95[0], ci[1] = pi * r.ci95[1];
-        met = r.walks.rel_err_met || r.walks.walks == 0, walks = r.walks.walks, interrupted = r.walks.interrupted;
+        a.estimate = pi * r.estimate, a.std_error = pi * r.std_error, a.ci95[0] = pi * r.ci95[0], a.ci95[1] = pi * r.ci95[1];
+        a.rel_err_met = r.walks.rel_err_met || r.walks.walks == 0, a.walks = r.walks.walks, interrupted = r.walks.interrupted;
     }
     if (status) {
         fprintf(stderr, "ulam: %s: query %lld (line %ld): ", w->path, (long long)k + 1, q->line);
         return cli_report(w->s->matrix_path, &err);
     }
     if (interrupted) return EXIT_INTERRUPTED; /* the answered lines stay; this one is not an answer */
-    ulam_query_report a = {.query = k, .line = q->line, .source = q->source, .index = q->index, .estimate = est,
-                           .std_error = se, .ci95 = {ci[0], ci[1]}, .rel_err_met = met, .walks = walks,
-                           .seconds = ulam_now() - t0, .seed = o.exec.seed, .answer_name = cli_answer_name,
-                           .node_base = cli_node_base};
+    a.seconds = ulam_now() - t0;
     cli_json_done |= json;
     ulam_report_fprint(stdout, ULAM_REPORT_QUERY, &a, json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
     fflush(stdout);
