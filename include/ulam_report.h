@@ -107,6 +107,56 @@ typedef struct ulam_bidir_report {
  * --check's line alone (ULAM_REPORT_CHECK); the text writes --check's line last when r->check. */
 void ulam_bidir_report_fprint(FILE *f, const ulam_bidir_report *r, int format);
 
+/* What ulam info reports on M (ulam_report_fprint's ULAM_REPORT_INFO): its statistics, rho(M),
+ * the guards' radii and the Neumann series' verdict; for a Jacobi splitting with omega <= 1 (text
+ * only), the table of rho(M) and rho(|M|) at the dampings 1, 0.9, ..., 0.5 (from J's radii, and
+ * for a signed J Arnoldi on each damped splitting of A). */
+typedef struct ulam_info_report {
+    const char *matrix;            /* the file M came from, as named */
+    int jacobi;                    /* M = I - omega D^-1 A, the Jacobi splitting of the file's A */
+    double omega;                  /* its damping (1: plain Jacobi) */
+    ulam_csr_stats st;             /* ulam_csr_stats_compute(M) */
+    ulam_radius rho;               /* rho(M) (ulam_spectral_radius) */
+    ulam_guard g;                  /* the guards (ulam_guard_check, tight) */
+    const ulam_csr *A;             /* A, for a signed J's damping table (NULL: no table for a signed J) */
+    const ulam_spectral_opts *so;  /* the options of the damped splittings' Arnoldi (NULL: defaults) */
+} ulam_info_report;
+
+/* A direct solve as ulam direct reports it (ULAM_REPORT_DIRECT). */
+typedef struct ulam_direct_report {
+    int64_t n;
+    const double *x;               /* the solution */
+    int64_t index;                 /* 1-based x[index] to show alone; 0: the first ten unless list is 0 */
+    int list;                      /* with index 0, write the first ten entries (0: the caller writes x elsewhere) */
+    int sparse;                    /* the LU was sparse (UMFPACK), else dense (LAPACK) */
+    ulam_direct_info info;
+    const char *answer_name;       /* the name x[index] prints as ("x", or "pi" for PageRank) */
+    int64_t node_base;             /* what the first state prints as: 1, or 0 for an edge list's ids */
+} ulam_direct_report;
+
+/* One answer of a batch of queries (ULAM_REPORT_QUERY): one line of text, or one JSON object. */
+typedef struct ulam_query_report {
+    int64_t query;                 /* its 0-based place in the batch */
+    long line;                     /* its line in the query file */
+    int64_t source, index;         /* 0-based; source -1: b is the system's */
+    double estimate, std_error, ci95[2]; /* ci95 NaN: no interval */
+    int rel_err_met;
+    int64_t walks;
+    double seconds;
+    uint64_t seed;                 /* the query's own seed */
+    const char *answer_name;       /* as in ulam_direct_report */
+    int64_t node_base;
+} ulam_query_report;
+
+/* The kinds of ulam_report_fprint. */
+enum ulam_report_kind { ULAM_REPORT_INFO = 1, ULAM_REPORT_DIRECT = 2, ULAM_REPORT_QUERY = 3 };
+
+/* Write report, the struct kind names (ulam_info_report, ulam_direct_report, ulam_query_report),
+ * to f as text (format ULAM_REPORT_BRIEF or _VERBOSE) or as one JSON object and a newline
+ * (ULAM_REPORT_JSON), as ulam info, ulam direct and ulam solve --queries print them.  ULAM_OK,
+ * ULAM_EINVAL (NULL, or an unknown kind), or the damping table's failure (ULAM_ENOMEM). */
+int ulam_report_fprint(FILE *f, int kind, const void *report, int format);
+
 #ifdef __cplusplus
 }
 #endif

@@ -38,15 +38,15 @@ void ulam_json_string(FILE *f, const char *key, const char *v, int last)
     fprintf(f, "\"%s", last ? "" : ", ");
 }
 
-/* A verdict on a variance: true, false or null (unknown). */
-static void verdict(FILE *f, const char *key, int finite)
+/* A verdict on a variance: true, false or null (unknown) (report.h). */
+void ulam__report_verdict_json(FILE *f, const char *key, int finite)
 {
     fprintf(f, "\"%s\": %s, ", key, finite == 1 ? "true" : finite == 0 ? "false" : "null");
 }
 
 /* A radius as prefix (the estimate when converged, else the upper bound), prefix_is,
  * prefix_lower, prefix_upper, prefix_converged. */
-static void radius(FILE *f, const char *prefix, const ulam_power *p)
+void ulam__report_radius_json(FILE *f, const char *prefix, const ulam_power *p)
 {
     fprintf(f, "\"%s\": ", prefix);
     value(f, p->converged ? p->rho : p->upper);
@@ -79,8 +79,8 @@ void ulam_walk_result_json(FILE *f, const ulam_walk_opts *o, const ulam_walk_res
     } else {
         fputs("null, ", f);
     }
-    verdict(f, "variance_finite", r->variance_finite);
-    if (g) radius(f, "rho_abs", &g->abs), radius(f, "rho_hat", &g->hat[mode]);
+    ulam__report_verdict_json(f, "variance_finite", r->variance_finite);
+    if (g) ulam__report_radius_json(f, "rho_abs", &g->abs), ulam__report_radius_json(f, "rho_hat", &g->hat[mode]);
     ulam_json_number(f, "kernel_alpha", o->kernel.kernel_alpha, 0);
     ulam_json_number(f, "max_share", r->max_share, 0);
     ulam_json_number(f, "score_bound", r->score_bound, 0);
@@ -91,8 +91,8 @@ void ulam_walk_result_json(FILE *f, const ulam_walk_opts *o, const ulam_walk_res
         fprintf(f, "\"rel_err_met\": %s, ", r->rel_err_met ? "true" : "false");
         ulam_json_number(f, "cut_bound", r->cut_bound, 0);
         fprintf(f, "\"rel_err_stop\": %s, ", rel_err_stop(r));
-        verdict(f, "fourth_finite", r->fourth_finite);
-        radius(f, "rho4", &r->rho4);
+        ulam__report_verdict_json(f, "fourth_finite", r->fourth_finite);
+        ulam__report_radius_json(f, "rho4", &r->rho4);
     }
     if (mode) fprintf(f, "\"unreached\": %lld, ", (long long)r->unreached);
     ulam_json_number(f, "variance", r->variance, 0);

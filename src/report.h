@@ -31,4 +31,17 @@ int ulam__report_score_too_small(const ulam_walk_result *r);
  * target; verbose: also a met target's rule). */
 void ulam__report_rel_err_fprint(FILE *f, const ulam_walk_opts *o, const ulam_walk_result *r, int verbose);
 
+/* Write the JSON member "key": true, false or null (finite 1, 0, else) and ", ". */
+void ulam__report_verdict_json(FILE *f, const char *key, int finite);
+
+/* Write radius p as JSON members prefix (the estimate when converged, else the upper bound),
+ * prefix_is, prefix_lower, prefix_upper, prefix_converged, each followed by ", ". */
+void ulam__report_radius_json(FILE *f, const char *prefix, const ulam_power *p);
+
+/* The writers of ulam_report_fprint's kinds (src/report_info.c, _direct.c, _query.c): report is
+ * the kind's struct; 0 or a status. */
+int ulam__report_info_fprint(FILE *f, const void *report, int format);
+int ulam__report_direct_fprint(FILE *f, const void *report, int format);
+int ulam__report_query_fprint(FILE *f, const void *report, int format);
+
 #endif

@@ -1,4 +1,4 @@
-/* A walk result as JSON (include/ulam_report.h) and the reference solve (include/ulam_reference.h):
+/* A walk result as JSON (include/ulam_report.h), the report kinds (ulam info, direct, a query) and the reference solve (include/ulam_reference.h):
  * the members ulam solve --json prints, written to the caller's stream, null for what is not
  * finite; the reference LU as chosen, and GMRES when the LU would pass the memory limit. */
 #include "testutil.h"
@@ -186,6 +186,109 @@ static void test_reference(void **state)
     ulam_csr_free(M);
 }
 
+/* Write a report of kind to a string (the caller frees it); *status gets ulam_report_fprint's. */
+static char *kind_text(int kind, const void *report, int format, int *status)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    *status = ulam_report_fprint(f, kind, report, format);
+    fclose(f);
+    return buf;
+}
+
+/* The report kinds: a query's line and JSON object, a direct solve's first ten entries under an
+ * edge list's 0-based ids, ulam info's radii, verdicts and damping table; unknown kinds refused. */
+static void test_kinds(void **state)
+{
+    (void)state;
+    int st;
+    ulam_query_report q = {.query = 4, .line = 9, .source = -1, .index = 2, .estimate = 0.5, .std_error = 0.01,
+                           .ci95 = {0.48, 0.52}, .rel_err_met = 1, .walks = 100, .seconds = 0.25, .seed = 9,
+                           .answer_name = "x", .node_base = 1};
+    char *s = kind_text(ULAM_REPORT_QUERY, &q, ULAM_REPORT_BRIEF, &st);
+    assert_int_equal(st, ULAM_OK);
+    assert_string_equal(s, "x[3] 0.5 +- 0.01 (95% CI 0.48 .. 0.52)  walks 100, 0.2500 s, seed 9\n");
+    free(s);
+    q.ci95[0] = q.ci95[1] = NAN, q.source = 0;
+    s = kind_text(ULAM_REPORT_QUERY, &q, ULAM_REPORT_JSON, &st);
+    assert_string_equal(s, "{\"query\": 5, \"line\": 9, \"source\": 1, \"index\": 3, \"estimate\": 0.5, \"stderr\": "
+                           "0.01, \"ci95\": null, \"rel_err_met\": true, \"walks\": 100, \"seed\": 9, \"seconds\": 0.25}\n");
+    free(s);
+
+    double x[12];
+    for (int i = 0; i < 12; i++) x[i] = i / 4.0;
+    ulam_direct_report d = {.n = 12, .x = x, .list = 1, .info = {.rcond = 0.5, .residual = 1e-16, .seconds = 0.125},
+                            .answer_name = "pi", .node_base = 0};
+    s = kind_text(ULAM_REPORT_DIRECT, &d, ULAM_REPORT_BRIEF, &st);
+    assert_int_equal(st, ULAM_OK);
+    assert_non_null(strstr(s, "n          12\npi[0]      0\npi[1]      0.25\n"));
+    assert_non_null(strstr(s, "pi[9]      2.25\n...        (2 more: use --out or --index)\nmethod     dense LU (LAPACK)\n"));
+    free(s);
+    d.index = 12, d.sparse = 1;
+    s = kind_text(ULAM_REPORT_DIRECT, &d, ULAM_REPORT_JSON, &st);
+    assert_string_equal(s, "{\"n\": 12, \"index\": 11, \"estimate\": 2.75, \"value\": 2.75, \"method\": \"sparse LU\", "
+                           "\"rcond\": 0.5, \"residual\": 9.9999999999999998e-17, \"seconds\": 0.125}\n");
+    free(s);
+    d.index = 13; /* past n */
+    s = kind_text(ULAM_REPORT_DIRECT, &d, ULAM_REPORT_JSON, &st);
+    assert_int_equal(st, ULAM_EINVAL);
+    assert_string_equal(s, ""); /* refused before a byte */
+    free(s);
+
+    int32_t ti[2] = {0, 1}, tj[2] = {1, 0}; /* M = [0 1/2; 1/4 0]: rho(M) = rho(|M|) = sqrt(1/8) */
+    double tx[2] = {0.5, 0.25};
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(2, 2, 2, ti, tj, tx, &M), ULAM_OK);
+    ulam_info_report ir = {.matrix = "m.mtx", .jacobi = 1, .omega = 1.0};
+    ulam_error err;
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.tight = 1;
+    assert_int_equal(ulam_csr_stats_compute(M, &ir.st), ULAM_OK);
+    assert_int_equal(ulam_spectral_radius(M, 0, NULL, &ir.rho), ULAM_OK);
+    assert_int_equal(ulam_guard_check(M, 0.0, &go, &ir.g, &err), ULAM_OK);
+    s = kind_text(ULAM_REPORT_INFO, &ir, ULAM_REPORT_BRIEF, &st);
+    assert_int_equal(st, ULAM_OK);
+    assert_non_null(strstr(s, "matrix           m.mtx (Jacobi splitting of A)\nn                2\n"));
+    assert_non_null(strstr(s, "Neumann series   converges (rho(M) < 1) [certified: rho(M) <= rho(|M|) < 1]\n"));
+    /* J >= 0: the table from J's radii, rho(M_w) = 1 - w + w rho(J) */
+    assert_non_null(strstr(s, "                  1.00   0.353553   "));
+    assert_non_null(strstr(s, "                  0.50   0.676777   "));
+    assert_non_null(strstr(s, "converges  converge\n                 (rho(|I - w D^-1 A|) = 1 - w + w rho(|J|)"));
+    free(s);
+    s = kind_text(ULAM_REPORT_INFO, &ir, ULAM_REPORT_JSON, &st);
+    assert_non_null(strstr(s, "{\"matrix\": \"m.mtx\", \"jacobi\": true, \"n\": 2, "));
+    assert_non_null(strstr(s, "\"neumann_converges\": true, \"neumann_certified\": true, \"walks_converge\": true, "));
+    assert_null(strstr(s, "damping"));
+    free(s);
+    ulam_csr_free(M);
+
+    /* a signed J = [0 -1/2; -1/4 0] of A = [1 1/2; 1/4 1]: a table only with A, by Arnoldi on each M_w */
+    int32_t ai[4] = {0, 0, 1, 1}, aj[4] = {0, 1, 0, 1};
+    double ax[4] = {1, 0.5, 0.25, 1}, sx[2] = {-0.5, -0.25};
+    ulam_csr *A = NULL;
+    assert_int_equal(ulam_csr_from_triplets(2, 2, 2, ti, tj, sx, &M), ULAM_OK);
+    assert_int_equal(ulam_csr_from_triplets(2, 2, 4, ai, aj, ax, &A), ULAM_OK);
+    assert_int_equal(ulam_csr_stats_compute(M, &ir.st), ULAM_OK);
+    assert_int_equal(ulam_spectral_radius(M, 0, NULL, &ir.rho), ULAM_OK);
+    assert_int_equal(ulam_guard_check(M, 0.0, &go, &ir.g, &err), ULAM_OK);
+    s = kind_text(ULAM_REPORT_INFO, &ir, ULAM_REPORT_BRIEF, &st);
+    assert_null(strstr(s, "damping"));
+    free(s);
+    ir.A = A;
+    s = kind_text(ULAM_REPORT_INFO, &ir, ULAM_REPORT_BRIEF, &st);
+    assert_int_equal(st, ULAM_OK);
+    assert_non_null(strstr(s, "                  1.00   0.353553   "));
+    assert_non_null(strstr(s, "                  0.50   0.676777   ")); /* eigenvalues +-0.3536 move to 0.68, 0.32 */
+    assert_null(strstr(s, "as is rho(M) for J >= 0"));
+    free(s);
+    ulam_csr_free(M), ulam_csr_free(A);
+
+    assert_int_equal(ulam_report_fprint(stdout, 0, &q, ULAM_REPORT_BRIEF), ULAM_EINVAL);
+    assert_int_equal(ulam_report_fprint(stdout, 99, &q, ULAM_REPORT_BRIEF), ULAM_EINVAL);
+    assert_int_equal(ulam_report_fprint(stdout, ULAM_REPORT_QUERY, NULL, ULAM_REPORT_BRIEF), ULAM_EINVAL);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -193,6 +296,7 @@ int main(void)
         cmocka_unit_test(test_choice),
         cmocka_unit_test(test_bidir),
         cmocka_unit_test(test_reference),
+        cmocka_unit_test(test_kinds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

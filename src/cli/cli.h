@@ -260,13 +260,6 @@ void cli_guard_diverge(const cli_system *s, const ulam_guard *g, int force);
 /* Print the warnings of radii near 1, past it or unknown that do not stop a run. */
 void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assume_finite);
 
-/* Print a JSON verdict on a variance: true, false or null (unknown). */
-void cli_json_variance(const char *key, int finite);
-
-/* Print a radius as JSON keys prefix (the estimate when converged, else the upper bound),
- * prefix_is ("estimate" or "upper bound"), prefix_lower, prefix_upper, prefix_converged. */
-void cli_json_radius(const char *prefix, const ulam_power *p);
-
 /* Output (src/cli/output.c).  cli_verbosity: -1 --quiet (the answer line), 0 default (a few lines),
  * 1 --verbose (everything); cli_json_mode: --json was given; cli_json_done: a JSON object was
  * printed (set by cli_json_number and cli_json_string). */

@@ -102,48 +102,6 @@ int cli_direct_check(const cli_system *s, int64_t index, double *value, double *
 }
 
 
-/* Print the human-readable report. */
-static void print_text(const cli_system *s, const double *x, int64_t index,
-                       const ulam_direct_info *info, const char *out)
-{
-    int64_t n = s->M->nrows;
-    printf("n          %lld\n", (long long)n);
-    if (index > 0) {
-        printf("%s[%lld]%*s%.17g\n", cli_answer_name, (long long)(index - 1 + cli_node_base),
-               cli_answer_pad(index - 1 + cli_node_base, 11), "", x[index - 1]);
-    } else if (!out) {
-        for (int64_t i = 0; i < n && i < 10; i++)
-            printf("%s[%lld]%*s%.17g\n", cli_answer_name, (long long)(i + cli_node_base),
-                   cli_answer_pad(i + cli_node_base, 11), "", x[i]);
-        if (n > 10) printf("...        (%lld more: use --out or --index)\n", (long long)(n - 10));
-    }
-    ulam_reference_info p;
-    ulam_reference_plan(s->M, cli_direct_force, 0, &p, NULL);
-    printf("method     %s\n", p.sparse ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");
-    printf("rcond      %.3e\n", info->rcond);
-    printf("residual   %.3e\n", info->residual);
-    printf("seconds    %.6f\n", info->seconds);
-}
-
-/* Print the JSON object. */
-static void print_json(const cli_system *s, const double *x, int64_t index,
-                       const ulam_direct_info *info)
-{
-    printf("{\"n\": %lld, ", (long long)s->M->nrows);
-    if (index > 0) {
-        printf("\"index\": %lld, ", (long long)(index - 1 + cli_node_base));
-        cli_json_number("estimate", x[index - 1], 0);
-        cli_json_number("value", x[index - 1], 0); /* deprecated: "estimate", as in every command */
-    }
-    ulam_reference_info p;
-    ulam_reference_plan(s->M, cli_direct_force, 0, &p, NULL);
-    cli_json_string("method", p.sparse ? "sparse LU" : "dense LU", 0);
-    cli_json_number("rcond", info->rcond, 0);
-    cli_json_number("residual", info->residual, 0);
-    cli_json_number("seconds", info->seconds, 1);
-    printf("}\n");
-}
-
 /* ulam direct. */
 int cli_direct(int argc, char **argv)
 {
@@ -203,8 +161,11 @@ int cli_direct(int argc, char **argv)
     if ((rc = cli_direct_solve(&s, max_mem, &x, &info))) {
         /* reported */
     } else { /* the answer first: a failed write of --out below cannot lose it */
-        if (json) print_json(&s, x, s.index, &info);
-        else print_text(&s, x, s.index, &info, out);
+        ulam_reference_plan(s.M, cli_direct_force, 0, &plan, NULL);
+        ulam_direct_report d = {.n = s.M->nrows, .x = x, .index = s.index, .list = !out, .sparse = plan.sparse,
+                                .info = info, .answer_name = cli_answer_name, .node_base = cli_node_base};
+        cli_json_done |= json;
+        ulam_report_fprint(stdout, ULAM_REPORT_DIRECT, &d, json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
         cli_flush();
         if (out && (status = cli_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct")))
             rc = cli_report_write(out, status, errno);

@@ -122,24 +122,3 @@ void cli_guard_warn(const cli_system *s, const ulam_guard *g, int mode, int assu
                         "the variance is finite but may be huge, and the error bar converges slowly\n",
                 s->matrix_path, h->lower, h->upper);
 }
-
-/* Print a JSON verdict on a variance: true, false or null (unknown). */
-void cli_json_variance(const char *key, int finite)
-{
-    printf("\"%s\": %s, ", key, finite == 1 ? "true" : finite == 0 ? "false" : "null");
-}
-
-/* Print a radius as JSON keys prefix (the estimate when converged, else the upper bound),
- * prefix_is ("estimate" or "upper bound"), prefix_lower, prefix_upper, prefix_converged. */
-void cli_json_radius(const char *prefix, const ulam_power *p)
-{
-    char key[64];
-    cli_json_number(prefix, p->converged ? p->rho : p->upper, 0);
-    snprintf(key, sizeof key, "%s_is", prefix);
-    cli_json_string(key, p->converged ? "estimate" : "upper bound", 0);
-    snprintf(key, sizeof key, "%s_lower", prefix);
-    cli_json_number(key, p->lower, 0);
-    snprintf(key, sizeof key, "%s_upper", prefix);
-    cli_json_number(key, p->upper, 0);
-    printf("\"%s_converged\": %s, ", prefix, p->converged ? "true" : "false");
-}

@@ -15,7 +15,6 @@
 #include "cli.h"
 
 #include <errno.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -128,34 +127,6 @@ static int transpose_guard(shared *w, const ulam_csr *Mt, double q)
     return 0;
 }
 
-/* Print one answer (text or a JSON line) and flush. */
-static void print_answer(const query *q, int64_t k, uint64_t seed, double est, double se, const double ci[2],
-                         int met, int64_t walks, double seconds, int json)
-{
-    if (json) {
-        printf("{\"query\": %lld, \"line\": %ld, \"source\": ", (long long)k + 1, q->line);
-        if (q->source >= 0) printf("%lld, ", (long long)(q->source + cli_node_base));
-        else printf("null, ");
-        printf("\"index\": %lld, ", (long long)(q->index + cli_node_base));
-        cli_json_number("estimate", est, 0);
-        cli_json_number("stderr", se, 0);
-        printf("\"ci95\": ");
-        if (isnan(ci[0])) printf("null, ");
-        else printf("[%.17g, %.17g], ", ci[0], ci[1]);
-        printf("\"rel_err_met\": %s, \"walks\": %lld, \"seed\": %llu, ", met ? "true" : "false", (long long)walks,
-               (unsigned long long)seed);
-        cli_json_number("seconds", seconds, 1);
-        printf("}\n");
-    } else {
-        char src[32] = "";
-        if (q->source >= 0) snprintf(src, sizeof src, " (source %lld)", (long long)(q->source + cli_node_base));
-        printf("%s[%lld]%s %.10g +- %.3g", cli_answer_name, (long long)(q->index + cli_node_base), src, est, se);
-        if (!isnan(ci[0])) printf(" (95%% CI %.*g .. %.*g)", cli_ci_digits(ci[0], ci[1]), ci[0], cli_ci_digits(ci[0], ci[1]), ci[1]);
-        printf("  walks %lld, %.4f s, seed %llu\n", (long long)walks, seconds, (unsigned long long)seed);
-    }
-    fflush(stdout);
-}
-
 /* The walks o names on the analysis' kept kernel, to their end (ulam_analysis_solver): the status,
  * r filled (as far as they went) and err on failure. */
 static int walks_on(ulam_analysis *an, const double *b, const ulam_walk_opts *o, ulam_walk_result *r, ulam_error *err)
@@ -175,15 +146,14 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
     ulam_error err;
     double t0 = ulam_now();
     int status, interrupted;
-    double est, se, ci[2];
-    int met;
-    int64_t walks;
+    ulam_query_report a = {.query = k, .line = q->line, .source = q->source, .index = q->index, .seed = o.exec.seed,
+                           .answer_name = cli_answer_name, .node_base = cli_node_base};
     if (q->source < 0) {
         o.query.index = q->index;
         ulam_walk_result r;
         status = walks_on(w->an, w->s->b, &o, &r, &err);
-        est = r.estimate, se = r.std_error, ci[0] = r.ci95[0], ci[1] = r.ci95[1], met = r.rel_err_met;
-        walks = r.walks, interrupted = r.interrupted;
+        a.estimate = r.estimate, a.std_error = r.std_error, a.ci95[0] = r.ci95[0], a.ci95[1] = r.ci95[1];
+        a.rel_err_met = r.rel_err_met, a.walks = r.walks, interrupted = r.interrupted;
     } else {
         const ulam_csr *Mt = ulam_analysis_transpose(w->an, &err);
         if (!Mt) return cli_report(w->s->matrix_path, &err);
@@ -196,15 +166,18 @@ static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int
         ulam_bidir_result r;
         status = ulam_analysis_bidir(w->an, &bo, &r, &err); /* its transpose, push workspace and plans */
         double pi = w->s->pagerank > 0 && strcmp(cli_answer_name, "x") ? 1.0 - w->s->pagerank : 1.0; /* b = e_S: pi = (1 - alpha) x */
-        est = pi * r.estimate, se = pi * r.std_error, ci[0] = pi * r.ci95[0], ci[1] = pi * r.ci95[1];
-        met = r.walks.rel_err_met || r.walks.walks == 0, walks = r.walks.walks, interrupted = r.walks.interrupted;
+        a.estimate = pi * r.estimate, a.std_error = pi * r.std_error, a.ci95[0] = pi * r.ci95[0], a.ci95[1] = pi * r.ci95[1];
+        a.rel_err_met = r.walks.rel_err_met || r.walks.walks == 0, a.walks = r.walks.walks, interrupted = r.walks.interrupted;
     }
     if (status) {
         fprintf(stderr, "ulam: %s: query %lld (line %ld): ", w->path, (long long)k + 1, q->line);
         return cli_report(w->s->matrix_path, &err);
     }
     if (interrupted) return EXIT_INTERRUPTED; /* the answered lines stay; this one is not an answer */
-    print_answer(q, k, o.exec.seed, est, se, ci, met, walks, ulam_now() - t0, json);
+    a.seconds = ulam_now() - t0;
+    cli_json_done |= json;
+    ulam_report_fprint(stdout, ULAM_REPORT_QUERY, &a, json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
+    fflush(stdout);
     return 0;
 }
 
