@@ -12,9 +12,11 @@
  * in walk-id order, never in arrival order.
  *
  * API, in order of use: primary ulam_part_open (ulam_part_open_mtx from Matrix Market by byte
- * ranges), ulam_dist_radius (the variance guard), ulam_dist_adjoint (ulam_dist_adjoint_ci with its
- * interval), ulam_dist_forward, ulam_dist_bound (a certified range from the residual),
- * ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows. */
+ * ranges), ulam_dist_run (one run as `ulam solve --partition` makes it) and ulam_dist_fprint (its
+ * answer in words), ulam_part_free; the pieces ulam_dist_run calls: ulam_dist_radius (the variance
+ * guard), ulam_dist_adjoint_ci (ulam_dist_adjoint and _many without an interval), ulam_dist_forward,
+ * ulam_dist_mcsa, ulam_dist_source, ulam_dist_bound (a certified range from the residual);
+ * secondary ulam_dist_defaults, ulam_part_rows. */
 #ifndef ULAM_DIST_H
 #define ULAM_DIST_H
 
@@ -123,7 +125,8 @@ typedef struct ulam_dist_ci {
  * src/stop.h): valid at every block, so under rel_err > 0 too, which ends a query's walks (and
  * the run, once all met) at the first block whose half-width is at most rel_err |estimate|,
  * o->walks then the most a query takes (res[k].walks: the walks it took).  Else ci[k] has NaN
- * ends.  The same bits at any rank count and any number of sets. */
+ * ends.  ci NULL (rel_err 0): the walks alone, no interval.  The same bits at any rank count and
+ * any number of sets. */
 int ulam_dist_adjoint_ci(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
                          const ulam_dist_opts *o, double rel_err, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err);
 
