@@ -12,9 +12,11 @@
  * in walk-id order, never in arrival order.
  *
  * API, in order of use: primary ulam_part_open (ulam_part_open_mtx from Matrix Market by byte
- * ranges), ulam_dist_radius (the variance guard), ulam_dist_adjoint (ulam_dist_adjoint_ci with its
- * interval), ulam_dist_forward, ulam_dist_bound (a certified range from the residual),
- * ulam_part_free; secondary ulam_dist_defaults, ulam_part_rows. */
+ * ranges), ulam_dist_run (one run as `ulam solve --partition` makes it) and ulam_dist_fprint (its
+ * answer in words), ulam_part_free; the pieces ulam_dist_run calls: ulam_dist_radius (the variance
+ * guard), ulam_dist_adjoint_ci (ulam_dist_adjoint and _many without an interval), ulam_dist_forward,
+ * ulam_dist_mcsa, ulam_dist_source, ulam_dist_bound (a certified range from the residual);
+ * secondary ulam_dist_defaults, ulam_part_rows. */
 #ifndef ULAM_DIST_H
 #define ULAM_DIST_H
 
@@ -101,14 +103,10 @@ typedef struct ulam_dist_result {
  * the weight times sign(M_sj) S_s / min(1, S_s), the score the sum of weight x b over every state
  * visited.  Every rank gets the same result: the mean of the histories' scores in walk-id order
  * and its standard error (ulam_dist_adjoint_ci adds a certified 95% interval). */
-int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
-                      ulam_dist_result *r, ulam_error *err);
 
 /* x_index[k] for each k < nq at once (the queries' walks share the rounds): res[k] as
  * ulam_dist_adjoint gives for index[k] with seed ulam_rng_substream(o->seed, ULAM_STREAM_QUERY, k),
  * bit for bit (the counts of walks, steps and messages are the whole run's in each). */
-int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
-                           const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err);
 
 /* A certified 95% interval of a partitioned adjoint query (ulam_dist_adjoint_ci). */
 typedef struct ulam_dist_ci {
@@ -127,9 +125,25 @@ typedef struct ulam_dist_ci {
  * src/stop.h): valid at every block, so under rel_err > 0 too, which ends a query's walks (and
  * the run, once all met) at the first block whose half-width is at most rel_err |estimate|,
  * o->walks then the most a query takes (res[k].walks: the walks it took).  Else ci[k] has NaN
- * ends.  The same bits at any rank count and any number of sets. */
+ * ends.  ci NULL (rel_err 0): the walks alone, no interval.  The same bits at any rank count and
+ * any number of sets. */
 int ulam_dist_adjoint_ci(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
                          const ulam_dist_opts *o, double rel_err, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err);
+
+/* ulam_dist_adjoint_many and ulam_dist_adjoint (above): ulam_dist_adjoint_ci without intervals
+ * (ci NULL, rel_err 0), the same bits. */
+static inline int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
+                                         const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err)
+{
+    return ulam_dist_adjoint_ci(p, comm, index, nq, o, 0.0, res, NULL, err);
+}
+
+/* One query: ulam_dist_adjoint_many with nq 1. */
+static inline int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
+                                    ulam_dist_result *res, ulam_error *err)
+{
+    return ulam_dist_adjoint_many(p, comm, &index, 1, o, res, err);
+}
 
 /* Every x_i of (I - M) x = b by forward collision walks on rows of M' (the part opened with
  * transpose): a source j ~ |b_j| / ||b||_1 with weight ||b||_1 sign(b_j), moves as above on M',
@@ -192,6 +206,63 @@ int ulam_dist_bound(const ulam_part *p, const ulam_comm *comm, const double *b, 
  * Collatz-Wielandt bound max_i (M^ v)_i / v_i rounded up; it stops when that is below 1 or after
  * iters steps (the smallest bound seen).  The same bits on every rank and at any rank count. */
 int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int forward, int iters, double *upper, ulam_error *err);
+
+/* What one partitioned run asks (ulam_dist_run): the mode and its inputs. */
+enum { ULAM_DIST_ADJOINT = 0, ULAM_DIST_FORWARD = 1, ULAM_DIST_MCSA = 2, ULAM_DIST_SOURCE = 3 };
+typedef struct ulam_dist_ask {
+    int mode;             /* ULAM_DIST_ADJOINT, _FORWARD, _MCSA or _SOURCE */
+    const int64_t *index; /* adjoint: the nq queries' 0-based rows (ulam_dist_adjoint_ci) */
+    int64_t nq;
+    double rel_err;       /* adjoint: the queries' stop (0: o.walks each) */
+    int bound;            /* forward: also x's certified range from its residual (ulam_dist_bound) */
+    double tol;           /* MCSA: the residual's target, of max |b| */
+    int max_iter;         /* MCSA: its most iterations */
+    int64_t source, top;  /* single source: its 0-based row; the top components gathered to rank 0 */
+    ulam_dist_opts o;
+} ulam_dist_ask;
+
+/* A component of single source's top table: its 0-based row, estimate, standard error, range. */
+typedef struct ulam_dist_top {
+    int64_t i;
+    double x, se, lo, hi;
+} ulam_dist_top;
+
+/* What one partitioned run found.  The caller gives the arrays (ulam_dist_run says which modes
+ * fill which); the rest the run fills, the same on every rank unless said. */
+typedef struct ulam_dist_answer {
+    double *x, *se;            /* forward, MCSA, single source: this rank's rows (se not for MCSA); the
+                                  ranks of set 0 hold them (a rank of another set: its rows, or 0 rows) */
+    ulam_dist_result *res;     /* adjoint: nq of them */
+    ulam_dist_ci *ci;          /* adjoint: nq of them */
+    ulam_dist_top *tops;       /* single source: top of them; rank 0 gets the ntop largest of all */
+    int64_t *ranks;            /* 2 nranks: every rank's rows, then its peak resident memory (KiB) */
+    int64_t n, ntop;           /* the system's order; the top table's rows (rank 0) */
+    ulam_dist_result r;        /* the whole run's walks, steps, crossings, bytes, rounds and cuts
+                                  (adjoint: also the first query's estimate) */
+    double rho;                /* the variance guard: certified bound on rho(M^), INFINITY when none */
+    double worst;              /* MCSA, single source, forward with bound: the largest certified half-width */
+    int iterations;            /* MCSA: iterations; single source: the push's products with M */
+    double residual;           /* MCSA: max |r| / max |b| at the end; single source: max |r| left to the walks */
+} ulam_dist_answer;
+
+/* Run ask on the part (every rank of comm together): the variance guard (ulam_dist_radius), then
+ * the mode's walks (ulam_dist_adjoint_ci, _forward, _mcsa or _source; MCSA, single source and
+ * forward with ask->bound also ulam_dist_bound around x, single source's b being e_source), and
+ * each rank's rows and peak memory.  ans's arrays: adjoint res and ci (nq each); forward, MCSA and
+ * single source x (this rank's rows), forward and single source se, single source tops (ask->top);
+ * ranks (2 nranks) always.  An MCSA run that stops at max_iter above tol is not an error here
+ * (ans->residual says so).  The same answer at any rank count and any number of sets. */
+int ulam_dist_run(const ulam_part *p, const ulam_comm *comm, const ulam_dist_ask *ask, ulam_dist_answer *ans,
+                  ulam_error *err);
+
+/* Write ulam_dist_run's answer to f as `ulam solve --partition` prints it (rank 0): the answer
+ * lines (each query's with its file line lines[k] and seed; single source's top table; MCSA's and
+ * the push's lines; the bound), then the summary (rel-err, method, variance, walks, migration,
+ * seconds; verbosity 1: each rank's rows and peak memory; -1: the answers alone).  queries: the
+ * query file's name (NULL: one --index), out: where x was written (NULL: nowhere).  The run's
+ * nranks and sets label the method.  Nonzero when a write fails. */
+int ulam_dist_fprint(FILE *f, const ulam_dist_ask *ask, const ulam_dist_answer *ans, const ulam_comm *comm,
+                     const char *queries, const long *lines, const char *out, double seconds, int verbosity);
 
 #ifdef __cplusplus
 }

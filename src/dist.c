@@ -423,19 +423,15 @@ static int adjoint(const ulam_part *p, const ulam_comm *comm, const int64_t *ind
     return status;
 }
 
-/* x_index[k] for k < nq by adjoint walks on the partitioned rows. */
-int ulam_dist_adjoint_many(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
-                           const ulam_dist_opts *o, ulam_dist_result *res, ulam_error *err)
-{
-    return adjoint(p, comm, index, nq, o, 0.0, res, NULL, err);
-}
-
 /* As ulam_dist_adjoint_many with each query's certified 95% interval. */
 int ulam_dist_adjoint_ci(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
                          const ulam_dist_opts *o, double rel_err, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err)
 {
-    double *v = ci && nq > 0 ? calloc((size_t)nq * 5, sizeof *v) : NULL;
-    if (!ci || nq < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "intervals and at least one query");
+    if (!ci) /* no interval: the walks alone (ulam_dist_adjoint_many) */
+        return rel_err == 0 ? adjoint(p, comm, index, nq, o, 0.0, res, NULL, err)
+                            : ulam__fail(err, ULAM_EINVAL, 0, -1, "intervals with a relative error target");
+    double *v = nq > 0 ? calloc((size_t)nq * 5, sizeof *v) : NULL;
+    if (nq < 1) return ulam__fail(err, ULAM_EINVAL, 0, -1, "at least one query");
     if (!v) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld intervals", (long long)nq);
     int status = adjoint(p, comm, index, nq, o, rel_err, res, v, err);
     for (int64_t k = 0; k < nq; k++)
@@ -443,13 +439,6 @@ int ulam_dist_adjoint_ci(const ulam_part *p, const ulam_comm *comm, const int64_
                        : (ulam_dist_ci){v[5 * k], v[5 * k + 1], v[5 * k + 2], v[5 * k + 3], v[5 * k + 4] > 0};
     free(v);
     return status;
-}
-
-/* x_index by adjoint walks on the partitioned rows. */
-int ulam_dist_adjoint(const ulam_part *p, const ulam_comm *comm, int64_t index, const ulam_dist_opts *o,
-                      ulam_dist_result *res, ulam_error *err)
-{
-    return ulam_dist_adjoint_many(p, comm, &index, 1, o, res, err);
 }
 
 /* The blocks' sums of |b| (blocks of 2^shift rows, the same whatever the split) in every rank's

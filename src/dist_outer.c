@@ -84,7 +84,16 @@ static int from_set0(const ulam_part *p, const ulam_comm *c, double *v)
 int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
                    double *x, ulam_dist_mcsa_info *info, ulam_error *err)
 {
+    ulam_dist_result all;
+    return ulam__dist_mcsa(p, comm, o, tol, max_iter, x, info, &all, err);
+}
+
+/* As ulam_dist_mcsa, every correction's walks' counts summed into *all (bytes and rounds too). */
+int ulam__dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
+                    double *x, ulam_dist_mcsa_info *info, ulam_dist_result *all, ulam_error *err)
+{
     ulam__clear(err);
+    *all = (ulam_dist_result){0};
     if (!p || !comm || !x || !info || !(tol > 0) || max_iter < 1)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, info, tol > 0 and max_iter >= 1");
     if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
@@ -118,6 +127,8 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
         for (int64_t i = 0; !status && i < rows; i++) x[i] += d[i]; /* the Monte Carlo correction */
         info->iterations = it + 1, info->walks += res.walks, info->steps += res.steps, info->crossings += res.crossings;
         info->cut += res.cut;
+        all->walks += res.walks, all->steps += res.steps, all->crossings += res.crossings, all->cut += res.cut;
+        all->bytes += res.bytes, all->rounds += res.rounds;
     }
     ulam__halo_free(&h);
     free(gv), free(r), free(d);
@@ -128,7 +139,17 @@ int ulam_dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
 int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
                      int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_error *err)
 {
+    ulam_dist_result walks;
+    return ulam__dist_source(p, comm, source, o, tol, max_rounds, x, se, info, &walks, err);
+}
+
+/* As ulam_dist_source, the walks' counts (bytes and rounds too) into *walks. */
+int ulam__dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
+                      int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_dist_result *walks,
+                      ulam_error *err)
+{
     ulam__clear(err);
+    *walks = (ulam_dist_result){0};
     if (!p || !comm || !x || !se || !info || !(tol >= 0) || max_rounds < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, se, info, tol >= 0 and max_rounds >= 0");
     if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
@@ -159,6 +180,7 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
         if (rmax == 0.0) se[i] = 0.0; /* nothing left to walk: the push is the answer */
     }
     info->walks = res.walks, info->steps = res.steps, info->crossings = res.crossings, info->cut = res.cut;
+    *walks = res;
     ulam__halo_free(&h);
     free(gv), free(r), free(y);
     return status;

@@ -91,4 +91,13 @@ int ulam__dist_cw(const ulam_part *p, const ulam_comm *comm, int iters, double *
 int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
                         double *se, ulam_dist_result *res, ulam_error *err);
 
+/* ulam_dist_mcsa with its corrections' walk counts summed into *all (src/dist_outer.c). */
+int ulam__dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
+                    double *x, ulam_dist_mcsa_info *info, ulam_dist_result *all, ulam_error *err);
+
+/* ulam_dist_source with its walks' counts in *walks (src/dist_outer.c). */
+int ulam__dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
+                      int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_dist_result *walks,
+                      ulam_error *err);
+
 #endif

@@ -75,6 +75,7 @@ def check_partition(ulam, mpirun, d):
     migrate: the adjoint answer line and the forward --out file byte for byte the same at every rank count, no
     rank holding every row, walks crossing ranks; x within 4 standard errors of the direct solve; a
     rank that dies ends the job with a non-zero exit, not a hang."""
+    import re
     n = 3000
     m, b = write_system(d, n, 5)
     sysf = f"{d}/p.ulam"
@@ -118,10 +119,21 @@ def check_partition(ulam, mpirun, d):
                "--top", "10", "--walks", "20000", "-q"])
     outer.append((open(x).read(), top))
     assert outer[0] == outer[1] == outer[2], "MCSA or single source differ across rank counts or sets"
+    # the migration line of every mode at 3 ranks: walks cross, and each crossing sends one walk's
+    # bytes (the same record whatever the mode), so bytes a step over the share crossing is one
+    # size; single source and MCSA once printed "0 bytes a step, 0 rounds" (issue 43)
+    per = {}
+    for name, mode in (("forward", ["--mode", "forward"]), ("source", ["--source", "77"]), ("mcsa", ["--method", "mcsa"])):
+        out = run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", *mode, "--walks", "20000"])
+        mig = re.search(r"^migration +(\S+) of steps crossed ranks, (\S+) bytes a step, (\d+) rounds", out, re.M)
+        share, step, rounds = float(mig.group(1)), float(mig.group(2)), int(mig.group(3))
+        assert share > 0 and step > 0 and rounds > 0, (name, out)
+        per[name] = step / share
+    assert all(abs(v / per["forward"] - 1) < 0.01 for v in per.values()), per
     xm = [float(v) for v in outer[0][0].split("\n")[3:] if v.strip()]
     assert max(abs(a - b) for a, b in zip(xm, exact)) < 1e-6 * max(abs(b) for b in exact), "MCSA's x is off"
     assert len(outer[0][1].splitlines()) == 10 and outer[0][1].startswith("x[77]"), outer[0][1]
-    import re  # certified ranges from the residual (point 2): MCSA's bound, single source's top 10, forward --bound
+    # certified ranges from the residual (point 2): MCSA's bound, single source's top 10, forward --bound
     out = run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--method", "mcsa", "--walks",
                "20000", "--out", f"{d}/pmb.mtx", "-q"])
     worst = float(re.search(r"^bound +every \|x_i - x\*_i\| <= (\S+)", out, re.M).group(1))

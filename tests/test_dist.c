@@ -35,6 +35,9 @@ typedef struct {
     int64_t first, last, n;
     const char *rhs; /* the system as Matrix Market by byte ranges: path M, rhs b (ulam_part_open_mtx) */
     ulam_error err;  /* what the open reported */
+    ulam_dist_answer ans; /* outer 3: ulam_dist_run's single source, its top 5 and each rank's rows */
+    ulam_dist_top tops[5];
+    int64_t ranks[2 * MAXR];
 } job;
 
 /* Run one rank's part of the job. */
@@ -63,6 +66,11 @@ static void *rank_main(void *arg)
     if (j->outer == 1) j->status = ulam_dist_mcsa(p, &c, &o, 1e-10, 60, ox + j->first, &j->mi, &err);
     else if (j->outer == 2)
         j->status = ulam_dist_source(p, &c, j->index, &o, 1e-3, 1000, ox + j->first, ose + j->first, &j->si, &err);
+    else if (j->outer == 3) {
+        ulam_dist_ask a = {.mode = ULAM_DIST_SOURCE, .source = j->index, .top = 5, .o = o};
+        j->ans = (ulam_dist_answer){.x = ox + j->first, .se = ose + j->first, .tops = j->tops, .ranks = j->ranks};
+        j->status = ulam_dist_run(p, &c, &a, &j->ans, &err);
+    }
     else if (j->ci) j->status = ulam_dist_adjoint_ci(p, &c, &j->index, 1, &o, j->rel_err, &j->res, j->cis, &err);
     else if (j->nq) j->status = ulam_dist_adjoint_many(p, &c, j->many, j->nq, &o, j->manyres, &err);
     else if (j->radius) j->status = ulam_dist_radius(p, &c, 0, 300, &j->rho, &err);
@@ -383,6 +391,53 @@ static void test_dist_source(void **state)
     unlink(path);
 }
 
+/* One run as the CLI's (ulam_dist_run, single source): the same x and se bits at 1, 2 and 3 ranks,
+ * rank 0's top 5 the largest of x in order, every rank's rows, a certified range, and the walks'
+ * migration counted (issue 43: single source once reported 0 bytes and 0 rounds): with walks
+ * crossing ranks, bytes and rounds > 0 and one walk's bytes a crossing, as forward walks send. */
+static void test_dist_run(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ulam_test_dist_XXXXXX";
+    temp_file(path);
+    int64_t n = 600, s = 123;
+    double *x = malloc((size_t)n * sizeof *x), *ref = malloc((size_t)n * sizeof *ref), *rse = malloc((size_t)n * sizeof *rse);
+    double *y = malloc((size_t)n * sizeof *y), *yse = malloc((size_t)n * sizeof *yse), *fx = malloc((size_t)n * sizeof *fx);
+    make_system(path, n, 5, 18, x);
+    for (int k = 1; k <= 3; k++) {
+        job jobs[MAXR], fw[MAXR];
+        run_outer(k, 3, path, s, 20000, k == 1 ? ref : y, k == 1 ? rse : yse, jobs);
+        for (int r = 0; r < k; r++) assert_int_equal(jobs[r].status, ULAM_OK);
+        if (k > 1) {
+            assert_memory_equal(y, ref, (size_t)n * sizeof *y);
+            assert_memory_equal(yse, rse, (size_t)n * sizeof *y);
+        }
+        const ulam_dist_answer *a = &jobs[0].ans;
+        assert_int_equal(a->n, n);
+        assert_int_equal(a->ntop, 5);
+        for (int j = 0; j < 5; j++) {
+            assert_memory_equal(&a->tops[j].x, &ref[a->tops[j].i], sizeof(double));
+            assert_true(j == 0 || a->tops[j].x <= a->tops[j - 1].x);
+        }
+        for (int64_t i = 0; i < n; i++) assert_true(ref[i] <= a->tops[4].x || i == a->tops[0].i || i == a->tops[1].i ||
+                                                    i == a->tops[2].i || i == a->tops[3].i || i == a->tops[4].i);
+        int64_t rows = 0;
+        for (int r = 0; r < k; r++) rows += a->ranks[r];
+        assert_int_equal(rows, n);
+        assert_true(isfinite(a->worst) && a->iterations > 0 && a->r.walks == 20000 && a->r.steps > 0);
+        if (k == 1) continue;
+        run_ranks(k, path, 1, 0, 20000, fx, fx, fw); /* forward walks on the same split: their bytes a crossing */
+        for (int r = 0; r < k; r++) assert_int_equal(fw[r].status, ULAM_OK);
+        if (!(a->r.crossings > 0 && a->r.rounds > 0 && a->r.bytes > 0 && fw[0].res.crossings > 0 &&
+              a->r.bytes * fw[0].res.crossings == fw[0].res.bytes * a->r.crossings))
+            fail_msg("%d ranks: %lld crossings, %lld bytes, %lld rounds (forward: %lld bytes for %lld crossings)", k,
+                     (long long)a->r.crossings, (long long)a->r.bytes, (long long)a->r.rounds, (long long)fw[0].res.bytes,
+                     (long long)fw[0].res.crossings);
+    }
+    free(x), free(ref), free(rse), free(y), free(yse), free(fx);
+    unlink(path);
+}
+
 /* A damaged block: refused (ULAM_ESYNTAX) by the rank whose rows hold it, at 1 and 3 ranks. */
 static void test_dist_damaged(void **state)
 {
@@ -681,6 +736,7 @@ int main(void)
         cmocka_unit_test(test_dist_many),
         cmocka_unit_test(test_dist_mcsa),
         cmocka_unit_test(test_dist_source),
+        cmocka_unit_test(test_dist_run),
         cmocka_unit_test(test_dist_interval),
         cmocka_unit_test(test_dist_radius_halo),
         cmocka_unit_test(test_dist_mtx),

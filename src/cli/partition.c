@@ -3,12 +3,10 @@
 #include "cli.h"
 
 #include <getopt.h>
-#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include "ulam_dist.h"
@@ -184,17 +182,6 @@ static int write_x(const ulam_comm *c, const char *path, const double *x, int64_
     return any ? cli_exit_code(ULAM_EIO) : 0;
 }
 
-/* Each rank's rows and peak resident memory (KiB), in rank order, into v[0 .. 2 nranks) on every
- * rank; nonzero when the sum fails. */
-static int per_rank(const ulam_comm *c, int64_t rows, int64_t *v)
-{
-    struct rusage u;
-    memset(v, 0, (size_t)c->nranks * 2 * sizeof *v);
-    v[c->rank] = rows;
-    v[c->nranks + c->rank] = getrusage(RUSAGE_SELF, &u) ? -1 : (int64_t)u.ru_maxrss;
-    return c->nranks > 1 && c->sum(c->ctx, v, 2 * c->nranks);
-}
-
 /* Read the query file at path: 'I' lines only (no point source, no target: walks are fixed on a
  * partition), indices below n; 0 or an exit code (reported). */
 static int load_queries(const char *path, int64_t n, cli_query **q, int64_t *nq)
@@ -218,116 +205,6 @@ static int load_queries(const char *path, int64_t n, cli_query **q, int64_t *nq)
     return rc;
 }
 
-/* "x[i]  estimate +- stderr (95% CI lo .. hi)" without a newline (ci NULL: forward walks, whose
- * components have no certified range on a partition; the variance is certified finite, rho < 1). */
-static void print_estimate(int64_t i, double est, double se, double rho, const ulam_dist_ci *ci)
-{
-    printf("x[%lld]%*s%.10g", (long long)i, cli_answer_pad(i, 16), "", est);
-    if (ci && ci->lo == ci->hi && ci->lo == est) printf(" +- 0 (95%% CI %.10g .. %.10g: b is 0, x is exactly 0)", ci->lo, ci->hi);
-    else if (!(rho < 1.0)) printf(" (no standard error: rho(M^) is not certified below 1)");
-    else if (isnan(se) && ci && isfinite(ci->lo))
-        printf(" (95%% CI %.*g .. %.*g; no walk reached it: the push's part alone)", cli_ci_digits(ci->lo, ci->hi), ci->lo,
-               cli_ci_digits(ci->lo, ci->hi), ci->hi);
-    else if (isnan(se)) printf(" (no walk reached it: the push's part alone)");
-    else if (ci && isfinite(ci->lo))
-        printf(" +- %.3g (95%% CI %.*g .. %.*g)", se, cli_ci_digits(ci->lo, ci->hi), ci->lo, cli_ci_digits(ci->lo, ci->hi),
-               ci->hi);
-    else if (ci) printf(" +- %.3g (standard error; no certified interval: a row of |M| sums above 1 or no length tail)", se);
-    else printf(" +- %.3g (standard error; no certified interval for forward walks on a partition)", se);
-}
-
-/* One query's answer line (rank 0): x[I] estimate +- stderr and its seed. */
-static void print_query(const cli_query *q, int64_t k, int64_t nq, const ulam_dist_result *r, uint64_t seed, double rho,
-                        const ulam_dist_ci *ci)
-{
-    print_estimate(q->index + 1, r->estimate, r->std_error, rho, ci);
-    uint64_t own = nq > 1 ? ulam_rng_substream(seed, ULAM_STREAM_QUERY, (uint64_t)k) : seed; /* docs/streams.md */
-    if (ci->met) printf("  %lld walks,", (long long)r->walks);
-    printf("  line %ld, seed %llu\n", q->line, (unsigned long long)own);
-}
-
-/* A component for the top-K table: its index and estimate, its standard error. */
-typedef struct {
-    int64_t i;
-    double x, se, lo, hi;
-} entry;
-
-/* Larger estimate first, then the smaller index (NaN last). */
-static int by_estimate(const void *a, const void *b)
-{
-    const entry *p = a, *q = b;
-    if (p->x != q->x) return isnan(p->x) ? 1 : isnan(q->x) ? -1 : p->x < q->x ? 1 : -1;
-    return (p->i > q->i) - (p->i < q->i);
-}
-
-/* Each rank's K largest components to rank 0, which prints the K largest of all with their
- * standard errors; 0 or an exit code. */
-static int print_top(const ulam_comm *c, const double *x, const double *se, const double *lo, const double *hi, int64_t first,
-                     int64_t rows, int64_t K, double rho)
-{
-    entry *e = malloc(((size_t)rows + 1) * sizeof *e);
-    size_t *cnt = calloc((size_t)c->nranks * 2, sizeof *cnt);
-    void *got = NULL;
-    int bad = !e || !cnt;
-    for (int64_t i = 0; !bad && i < rows; i++) e[i] = (entry){first + i, x[i], se[i], lo[i], hi[i]};
-    if (!bad) qsort(e, (size_t)rows, sizeof *e, by_estimate);
-    int64_t k = rows < K ? rows : K, all = k;
-    if (!bad && c->nranks > 1) {
-        cnt[0] = (size_t)k * sizeof *e;
-        bad = c->exchange(c->ctx, e, cnt, &got, cnt + c->nranks);
-        all = 0;
-        for (int r = 0; !bad && r < c->nranks; r++) all += (int64_t)(cnt[c->nranks + r] / sizeof *e);
-        if (!bad && c->rank == 0) qsort(got, (size_t)all, sizeof *e, by_estimate);
-    }
-    const entry *t = c->nranks > 1 ? got : e;
-    for (int64_t j = 0; !bad && c->rank == 0 && j < all && j < K; j++) {
-        ulam_dist_ci ci = {t[j].lo, t[j].hi, INFINITY, 0.0, 0};
-        print_estimate(t[j].i + 1, t[j].x, t[j].se, rho, isfinite(ci.lo) ? &ci : NULL), printf("\n");
-    }
-    free(e), free(cnt), free(got);
-    return bad ? cli_exit_code(ULAM_EIO) : 0;
-}
-
-/* Print the run's summary (rank 0; v: per_rank's figures). */
-static void summary(const args *a, const ulam_dist_result *r, int nranks, int64_t n, double seconds, const int64_t *v,
-                    double rho, const ulam_dist_ci *ci, int64_t nq)
-{
-    if (a->queries) {
-        if (cli_verbosity >= 0) printf("queries         %s, each above (walks below: each query's)\n", a->queries);
-    } else if (a->mcsa || a->source) { /* their answer is above */
-    }
-    else if (!a->forward) print_estimate(a->index, r->estimate, r->std_error, rho, ci), printf("\n");
-    int64_t met = 0;
-    for (int64_t k = 0; ci && k < nq; k++) met += ci[k].met;
-    if (a->rel_err > 0 && met == nq)
-        printf("rel-err         met (target %.3g)%s\n", a->rel_err, a->queries ? " by every query" : "");
-    else if (a->rel_err > 0)
-        printf("rel-err         NOT met (target %.3g) by %lld of %lld quer%s in --walks %lld%s\n", a->rel_err,
-               (long long)(nq - met), (long long)nq, nq == 1 ? "y" : "ies", (long long)a->o.walks,
-               ci && isfinite(ci[0].lo) ? "" : " (no certified interval: a row of |M| sums above 1, or no length tail)");
-    else if (a->forward && !a->mcsa) printf("x               %lld components by forward walks%s%s\n", (long long)n, a->out ? ", written to " : "",
-                a->out ? a->out : "");
-    if (cli_verbosity < 0) return;
-    printf("method          %s%s collision walks on %d rank%s, rows split by entries", a->mcsa ? "MCSA with " : a->source ? "push and " : "",
-           a->forward || a->mcsa || a->source ? "forward" : "adjoint", nranks, nranks == 1 ? "" : "s");
-    if (a->sets > 1) printf(" within each of %lld sets", (long long)a->sets);
-    printf("\n");
-    if (rho < 1.0) printf("variance        finite (rho(M^) <= %.6g, certified)\n", rho);
-    else if (a->forward || a->mcsa || a->source) printf("variance        not certified finite (rho(M^) bound %.4g): no error bar can be trusted\n", rho);
-    printf("walks           %lld (%lld steps; %lld cut at --max-steps)\n", (long long)r->walks, (long long)r->steps,
-           (long long)r->cut);
-    printf("migration       %.4g of steps crossed ranks, %.3g bytes a step, %lld rounds\n",
-           r->steps ? (double)r->crossings / (double)r->steps : 0.0, r->steps ? (double)r->bytes / (double)r->steps : 0.0,
-           (long long)r->rounds);
-    printf("seconds         %.3g in all\n", seconds);
-    if (cli_verbosity < 1) return;
-    printf("ranks           rows");
-    for (int k = 0; k < nranks; k++) printf(" %lld", (long long)v[k]);
-    printf("; peak RSS MiB");
-    for (int k = 0; k < nranks; k++) printf(" %.1f", (double)v[nranks + k] / 1024.0);
-    printf("\n");
-}
-
 /* The first nonzero status of the ranks, in rank order, on every rank (ULAM_EIO when the sum
  * itself fails): the exit code does not depend on which rank read the damaged block. */
 static int first_status(const ulam_comm *c, int status)
@@ -342,29 +219,11 @@ static int first_status(const ulam_comm *c, int status)
     return bad ? ULAM_EIO : first;
 }
 
-/* The certified range [lo, hi] of every x_i at this rank's rows (ulam_dist_bound; single source's
- * b is e_source) and its largest half-width *worst. */
-static int bound(const ulam_part *p, const ulam_comm *c, int64_t source, const double *x, double **lo, double **hi,
-                 double *worst, ulam_error *err)
-{
-    int64_t first, last;
-    ulam_part_rows(p, &first, &last, NULL);
-    size_t rows = (size_t)(last - first) + 1;
-    double *e = source ? calloc(rows, sizeof *e) : NULL;
-    *lo = malloc(rows * sizeof **lo), *hi = malloc(rows * sizeof **hi);
-    if (e && source - 1 >= first && source - 1 < last) e[source - 1 - first] = 1.0;
-    int status = !*lo || !*hi || (source && !e) ? ULAM_ENOMEM : ulam_dist_bound(p, c, e, x, 200, *lo, *hi, worst, err);
-    if (status == ULAM_ENOMEM) err->status = status, snprintf(err->msg, sizeof err->msg, "memory for the bounds");
-    free(e);
-    return status;
-}
-
 /* Run the parsed command on this rank. */
 static int run(const args *a, const ulam_comm *c)
 {
     ulam_part *p = NULL;
     ulam_error err;
-    int walks_forward = a->forward || a->mcsa || a->source; /* the walks run on M' */
     int what = a->mcsa || a->source || a->bound ? ULAM_PART_BOTH : a->forward ? ULAM_PART_MT : ULAM_PART_M;
     int status = a->rhs ? ulam_part_open_mtx(a->path, a->rhs, c, what, &p, &err) : ulam_part_open(a->path, c, what, &p, &err);
     int shared = first_status(c, status); /* every rank ends together, with the same code, when one cannot read its rows */
@@ -375,80 +234,51 @@ static int run(const args *a, const ulam_comm *c)
     }
     const char *die = getenv("ULAM_TEST_PARTITION_DIE"); /* tests: this rank dies before its walks */
     if (die && atoi(die) == c->rank && c->nranks > 1) _exit(9);
-    int64_t first, last, n = ulam_part_rows(p, &first, &last, NULL);
-    int rc0;
+    int64_t first, last, n = ulam_part_rows(p, &first, &last, NULL), rows = last - first;
+    int rc = 0;
     if (a->index > n || a->source > n) {
         ulam_part_free(p);
         return cli_usage_error("solve", "%s in 1 .. %lld, got %lld", a->index ? "--index" : "--source", (long long)n,
                                (long long)(a->index ? a->index : a->source));
     }
     cli_query *q = NULL;
-    int64_t nq = 0;
-    if (a->queries && (rc0 = load_queries(a->queries, n, &q, &nq))) {
+    int64_t nq = 1, one = a->index - 1;
+    if (a->queries && (rc = load_queries(a->queries, n, &q, &nq))) {
         ulam_part_free(p);
-        return rc0;
+        return rc;
     }
-    double rho = INFINITY; /* the variance guard: the interval is printed only when it is below 1 */
-    status = ulam_dist_radius(p, c, walks_forward, 200, &rho, &err);
-    ulam_dist_result r = {0};
-    ulam_dist_mcsa_info mi = {0};
-    ulam_dist_source_info si = {0};
-    double *x = NULL, *se = NULL, *lo = NULL, *hi = NULL, worst = INFINITY;
-    ulam_dist_result *many = NULL;
-    ulam_dist_ci *ci = NULL, one = {NAN, NAN, INFINITY, INFINITY, 0};
-    if (status) {
-    } else if (q) {
-        int64_t *idx = malloc((size_t)nq * sizeof *idx);
-        many = malloc((size_t)nq * sizeof *many);
-        ci = malloc((size_t)nq * sizeof *ci);
-        for (int64_t k = 0; idx && many && k < nq; k++) idx[k] = q[k].index;
-        status = idx && many && ci ? ulam_dist_adjoint_ci(p, c, idx, nq, &a->o, a->rel_err, many, ci, &err) : ULAM_ENOMEM;
-        if (!status) r = many[0];
-        free(idx);
-    } else if (a->forward || a->mcsa || a->source) {
-        x = malloc(((size_t)(last - first) + 1) * sizeof *x);
-        se = malloc(((size_t)(last - first) + 1) * sizeof *se);
-        if (!x || !se) status = ULAM_ENOMEM;
-        else if (a->mcsa) status = ulam_dist_mcsa(p, c, &a->o, a->tol, (int)a->max_iter, x, &mi, &err);
-        else if (a->source) status = ulam_dist_source(p, c, a->source - 1, &a->o, 1e-4, 1000, x, se, &si, &err);
-        else status = ulam_dist_forward(p, c, &a->o, x, se, &r, &err);
-        if (!status && a->mcsa) r.walks = mi.walks, r.steps = mi.steps, r.crossings = mi.crossings, r.cut = mi.cut;
-        if (!status && a->source) r.walks = si.walks, r.steps = si.steps, r.crossings = si.crossings, r.cut = si.cut;
-        if (!status && (a->mcsa || a->source || a->bound)) status = bound(p, c, a->source, x, &lo, &hi, &worst, &err);
-    } else {
-        int64_t i = a->index - 1;
-        status = ulam_dist_adjoint_ci(p, c, &i, 1, &a->o, a->rel_err, &r, &one, &err);
-    }
+    ulam_dist_ask ask = {.mode = a->mcsa ? ULAM_DIST_MCSA : a->source ? ULAM_DIST_SOURCE : a->forward ? ULAM_DIST_FORWARD : ULAM_DIST_ADJOINT,
+                         .nq = nq, .rel_err = a->rel_err, .bound = a->bound, .tol = a->tol, .max_iter = (int)a->max_iter,
+                         .source = a->source - 1, .top = a->top, .o = a->o};
+    int64_t *idx = malloc((size_t)nq * sizeof *idx);
+    long *lines = malloc((size_t)nq * sizeof *lines);
+    for (int64_t k = 0; idx && lines && k < nq; k++) idx[k] = q ? q[k].index : one, lines[k] = q ? q[k].line : 0;
+    ask.index = idx;
+    int walks_forward = ask.mode != ULAM_DIST_ADJOINT;
+    ulam_dist_answer s = {.ranks = malloc((size_t)c->nranks * 2 * sizeof(int64_t))};
+    if (walks_forward) s.x = malloc(((size_t)rows + 1) * sizeof *s.x), s.se = malloc(((size_t)rows + 1) * sizeof *s.se);
+    if (a->source) s.tops = malloc(((size_t)a->top + 1) * sizeof *s.tops);
+    if (!walks_forward) s.res = malloc((size_t)nq * sizeof *s.res), s.ci = malloc((size_t)nq * sizeof *s.ci);
+    if (!idx || !lines || !s.ranks || (walks_forward ? !s.x || !s.se || (a->source && !s.tops) : !s.res || !s.ci))
+        status = ULAM_ENOMEM, err.status = status, snprintf(err.msg, sizeof err.msg, "memory for the answer");
+    else status = ulam_dist_run(p, c, &ask, &s, &err);
     ulam_part_free(p);
-    int rc = status ? (cli_report(a->path, &err), cli_exit_code(status)) : 0;
+    rc = status ? (cli_report(a->path, &err), cli_exit_code(status)) : 0;
     int in_set0 = c->sets <= 1 || c->rank < c->nranks / c->sets; /* set 0's ranks hold x */
-    if (!rc && a->out) rc = write_x(c, a->out, x, in_set0 ? last - first : 0, n, "x");
-    if (!rc && a->errors) rc = write_x(c, a->errors, se, in_set0 ? last - first : 0, n, "standard errors of x");
-    int64_t *v = rc ? NULL : malloc((size_t)c->nranks * 2 * sizeof *v);
-    if (!rc && (!v || per_rank(c, last - first, v))) rc = cli_exit_code(v ? ULAM_EIO : ULAM_ENOMEM);
-    for (int64_t k = 0; !rc && c->rank == 0 && k < nq; k++) print_query(&q[k], k, nq, &many[k], a->o.seed, rho, &ci[k]);
-    if (!rc && a->source) rc = print_top(c, x, se, lo, hi, first, in_set0 ? last - first : 0, a->top, rho); /* set 0's rows */
-    if (!rc && c->rank == 0 && a->mcsa)
-        printf("x               %lld components by MCSA%s%s\nmcsa            %d iterations, residual %.3g of max |b| "
-               "(target %.3g)\n", (long long)n, a->out ? ", written to " : "", a->out ? a->out : "", mi.iterations,
-               mi.residual, a->tol);
-    if (!rc && c->rank == 0 && a->source && cli_verbosity >= 0)
-        printf("push            %d products with M, max |r| %.3g left to the walks\n", si.rounds, si.residual);
-    if (!rc && c->rank == 0 && (a->mcsa || a->bound)) {
-        if (isfinite(worst)) printf("bound           every |x_i - x*_i| <= %.3g (certified from x's residual and rho(|M|) < 1)\n", worst);
-        else printf("bound           none certified (power iteration did not certify rho(|M|) below 1)\n");
-    }
-    if (!rc && c->rank == 0 && r.cut)
+    if (!rc && a->out) rc = write_x(c, a->out, s.x, in_set0 ? rows : 0, n, "x");
+    if (!rc && a->errors) rc = write_x(c, a->errors, s.se, in_set0 ? rows : 0, n, "standard errors of x");
+    if (!rc && c->rank == 0)
+        ulam_dist_fprint(stdout, &ask, &s, c, a->queries, lines, a->out, ulam_now() - cli_started, cli_verbosity);
+    if (!rc && c->rank == 0 && s.r.cut)
         fprintf(stderr, "ulam: %s: warning: %lld walks were cut at --max-steps %lld: the estimates and their standard "
-                        "errors leave out what those walks would have scored\n", a->path, (long long)r.cut,
+                        "errors leave out what those walks would have scored\n", a->path, (long long)s.r.cut,
                 (long long)a->o.max_steps);
-    if (!rc && c->rank == 0) summary(a, &r, c->nranks, n, ulam_now() - cli_started, v, rho, q ? ci : a->index ? &one : NULL, q ? nq : 1);
-    if (!rc && a->mcsa && mi.residual > a->tol) {
+    if (!rc && a->mcsa && s.residual > a->tol) {
         if (c->rank == 0) fprintf(stderr, "ulam: %s: error: MCSA stopped at --max-iter %lld with residual %.3g above --tol %.3g\n",
-                                  a->path, (long long)a->max_iter, mi.residual, a->tol);
+                                  a->path, (long long)a->max_iter, s.residual, a->tol);
         rc = cli_exit_code(ULAM_ENOCONV);
     }
-    free(x), free(se), free(lo), free(hi), free(v), free(q), free(many), free(ci);
+    free(s.x), free(s.se), free(s.tops), free(s.res), free(s.ci), free(s.ranks), free(idx), free(lines), free(q);
     return rc;
 }
 
