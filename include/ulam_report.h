@@ -30,8 +30,16 @@ void ulam_json_string(FILE *f, const char *key, const char *v, int last);
  * "index" before, "ranks" and the timings after). */
 void ulam_walk_result_json(FILE *f, const ulam_walk_opts *o, const ulam_walk_result *r, const ulam_guard *g);
 
-/* The formats of ulam_choice_fprint. */
-enum ulam_report_format { ULAM_REPORT_BRIEF = 0, ULAM_REPORT_VERBOSE = 1, ULAM_REPORT_JSON = 2 };
+/* The formats of the writers below: ulam_choice_fprint and ulam_outer_report_fprint take the
+ * first three; ulam_walk_report_fprint all of them. */
+enum ulam_report_format {
+    ULAM_REPORT_BRIEF = 0,   /* a few lines a person reads at a glance */
+    ULAM_REPORT_VERBOSE = 1, /* every line */
+    ULAM_REPORT_JSON = 2,    /* one JSON object (or member) */
+    ULAM_REPORT_QUIET = 3,   /* the answer line alone */
+    ULAM_REPORT_CHECK = 4,   /* the line comparing the answer with a direct solve alone */
+    ULAM_REPORT_WARN = 5     /* what a first round of walks warns of (a budget's time, the rel_err rule's reach) */
+};
 
 /* Write what --method auto chose (ulam_auto_start's ch) to f: BRIEF, one line (what was chosen
  * among how many); VERBOSE, the choice and a line a candidate (mode, estimator, continuation,
@@ -64,6 +72,35 @@ typedef struct ulam_outer_report {
 /* Write r to f: its totals as text lines (format ULAM_REPORT_BRIEF or _VERBOSE; the iterations'
  * lines are the caller's, as they end), or one JSON object with the history (ULAM_REPORT_JSON). */
 void ulam_outer_report_fprint(FILE *f, const ulam_outer_report *r, int format);
+
+/* A walk run (ulam solve's walks row) as its report shows it: the result and what the caller
+ * measured around it. */
+typedef struct ulam_walk_report {
+    const ulam_walk_opts *opts;     /* the options the walks ran with (mode, estimator, seed, rules) */
+    const ulam_walk_result *result; /* what they found */
+    const ulam_guard *guard;        /* the guards (their radii; NULL: not written) */
+    const ulam_choice *choice;      /* what --method auto chose (NULL: nothing was chosen) */
+    int64_t n;                      /* the unknowns (forward walks' "unreached ... of n") */
+    int64_t index_base;             /* added to opts->query.index to name the unknown (1: 1-based) */
+    const char *answer_name;        /* the unknown's name, "x" (NULL too) or "pi" (PageRank: a line saying so) */
+    int ranks;                      /* the processes that walked (JSON "ranks") */
+    double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the set-up */
+    double total_seconds;           /* the whole run so far (BRIEF's "in all") */
+    int check;                      /* direct, direct_seconds, direct_method hold a direct solve's x_index */
+    double direct, direct_seconds;
+    const char *direct_method;      /* "dense LU", "sparse LU", ... */
+    const char *prefix;             /* WARN: the start of each line ("ulam: M.mtx: "; NULL: none) */
+} ulam_walk_report;
+
+/* Write r to f: BRIEF, the answer line (x[i] with its interval, or why there is none), the method
+ * in words, the walks, the seconds and the rel_err rule's outcome; VERBOSE, every line (steps,
+ * variance, figure of merit, guards, tail, timings and the process's peak memory); QUIET, the
+ * answer line alone; JSON, one object ("index", ulam_walk_result_json's members, the timings,
+ * the direct solve with check, the choice, "interrupted") and a newline; CHECK, the line
+ * "direct ..., z = ..." (with check); WARN, after a first round of walks, a line "warning: ..."
+ * (after r->prefix) for a run bounded by a walk count that would take over an hour at that pace,
+ * and for a rel_err rule that cannot be met or needs walks out of reach (nothing else). */
+void ulam_walk_report_fprint(FILE *f, const ulam_walk_report *r, int format);
 
 #ifdef __cplusplus
 }

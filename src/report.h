@@ -9,6 +9,9 @@
 
 #include "ulam.h"
 
+/* The walk modes and estimators by name (enum ulam_mode, enum ulam_estimator). */
+extern const char *const ulam__report_modes[2], *const ulam__report_estimators[3];
+
 /* The spaces after "name[index]" that put the value at column (16: under "method          "); at least 1. */
 int ulam__report_pad(const char *name, int64_t index, int column);
 

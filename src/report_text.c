@@ -5,6 +5,10 @@
 #include <math.h>
 #include <string.h>
 
+/* See report.h. */
+const char *const ulam__report_modes[2] = {"adjoint", "forward"};
+const char *const ulam__report_estimators[3] = {"collision", "absorption", "expected"};
+
 /* The significant digits that print an interval's ends lo < hi apart: 10, or up to 17 (every
  * double prints as itself) for an interval narrower than 10 digits show (a push taken down to
  * rounding): its ends then do not print as one number. */
