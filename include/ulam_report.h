@@ -30,15 +30,15 @@ void ulam_json_string(FILE *f, const char *key, const char *v, int last);
  * "index" before, "ranks" and the timings after). */
 void ulam_walk_result_json(FILE *f, const ulam_walk_opts *o, const ulam_walk_result *r, const ulam_guard *g);
 
-/* The formats of the writers below: ulam_choice_fprint and ulam_outer_report_fprint take the
- * first three; ulam_walk_report_fprint all of them. */
+/* The formats of the writers: BRIEF, a few lines; VERBOSE, everything; JSON, one object; QUIET,
+ * the answer line (or the table's rows) alone; CHECK, --check's line alone (written once the
+ * reference solve is done, after the rest was flushed). */
 enum ulam_report_format {
-    ULAM_REPORT_BRIEF = 0,   /* a few lines a person reads at a glance */
-    ULAM_REPORT_VERBOSE = 1, /* every line */
-    ULAM_REPORT_JSON = 2,    /* one JSON object (or member) */
-    ULAM_REPORT_QUIET = 3,   /* the answer line alone */
-    ULAM_REPORT_CHECK = 4,   /* the line comparing the answer with a direct solve alone */
-    ULAM_REPORT_WARN = 5     /* what a first round of walks warns of (a budget's time, the rel_err rule's reach) */
+    ULAM_REPORT_BRIEF = 0,
+    ULAM_REPORT_VERBOSE = 1,
+    ULAM_REPORT_JSON = 2,
+    ULAM_REPORT_QUIET = 3,
+    ULAM_REPORT_CHECK = 4
 };
 
 /* Write what --method auto chose (ulam_auto_start's ch) to f: BRIEF, one line (what was chosen
@@ -72,6 +72,9 @@ typedef struct ulam_outer_report {
 /* Write r to f: its totals as text lines (format ULAM_REPORT_BRIEF or _VERBOSE; the iterations'
  * lines are the caller's, as they end), or one JSON object with the history (ULAM_REPORT_JSON). */
 void ulam_outer_report_fprint(FILE *f, const ulam_outer_report *r, int format);
+
+/* The format only ulam_walk_report_fprint has: a first round's warnings. */
+enum ulam_walk_report_format { ULAM_REPORT_WARN = 5 };
 
 /* A walk run (ulam solve's walks row) as its report shows it: the result and what the caller
  * measured around it. */

@@ -6,8 +6,8 @@
 #include <math.h>
 #include <string.h>
 
-/* The walk modes and estimators by name (src/report_text.c). */
-static const char *const *const modes = ulam__report_modes, *const *const estimators = ulam__report_estimators;
+/* The walk modes and estimators by name (enum ulam_mode, enum ulam_estimator). */
+static const char *const modes[] = {"adjoint", "forward"}, *const estimators[] = {"collision", "absorption", "expected"};
 
 /* Write v, or null when it is not finite. */
 static void value(FILE *f, double v)

@@ -9,9 +9,6 @@
 
 #include "ulam.h"
 
-/* The walk modes and estimators by name (enum ulam_mode, enum ulam_estimator). */
-extern const char *const ulam__report_modes[2], *const ulam__report_estimators[3];
-
 /* The spaces after "name[index]" that put the value at column (16: under "method          "); at least 1. */
 int ulam__report_pad(const char *name, int64_t index, int column);
 
@@ -23,6 +20,9 @@ double ulam__report_z(double estimate, double direct, double std_error);
 
 /* Write "z = Z", when |z| > 4 whether direct is inside [lo, hi], and a newline. */
 void ulam__report_z_fprint(FILE *f, double estimate, double direct, double std_error, double lo, double hi);
+
+/* An estimator's name (enum ulam_estimator): "collision", "absorption", "expected" ("?" for another). */
+const char *ulam__report_estimator_name(int estimator);
 
 /* Nonzero when r's interval was withheld because its scores are too small to square in doubles. */
 int ulam__report_score_too_small(const ulam_walk_result *r);

@@ -5,10 +5,6 @@
 #include <math.h>
 #include <string.h>
 
-/* See report.h. */
-const char *const ulam__report_modes[2] = {"adjoint", "forward"};
-const char *const ulam__report_estimators[3] = {"collision", "absorption", "expected"};
-
 /* The significant digits that print an interval's ends lo < hi apart: 10, or up to 17 (every
  * double prints as itself) for an interval narrower than 10 digits show (a push taken down to
  * rounding): its ends then do not print as one number. */
@@ -48,6 +44,13 @@ void ulam__report_z_fprint(FILE *f, double estimate, double direct, double std_e
     fprintf(f, "z = %.3f", z);
     if (fabs(z) > 4.0) fprintf(f, " (direct %s the 95%% interval)", lo <= direct && direct <= hi ? "inside" : "OUTSIDE");
     fputc('\n', f);
+}
+
+/* An estimator's name, as the options table spells it. */
+const char *ulam__report_estimator_name(int estimator)
+{
+    static const char *const names[] = {"collision", "absorption", "expected"};
+    return estimator >= 0 && estimator < 3 ? names[estimator] : "?";
 }
 
 /* Nonzero when the interval was withheld because the scores are too small to square (a b far
