@@ -84,7 +84,7 @@ typedef struct ulam_walk_report {
     const ulam_guard *guard;        /* the guards (their radii; NULL: not written) */
     const ulam_choice *choice;      /* what --method auto chose (NULL: nothing was chosen) */
     int64_t n;                      /* the unknowns (forward walks' "unreached ... of n") */
-    int64_t index_base;             /* added to opts->query.index to name the unknown (1: 1-based) */
+    int64_t node_base;              /* added to opts->query.index to name the unknown (1: 1-based) */
     const char *answer_name;        /* the unknown's name, "x" (NULL too) or "pi" (PageRank: a line saying so) */
     int ranks;                      /* the processes that walked (JSON "ranks") */
     double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the set-up */

@@ -41,7 +41,7 @@ static void answer(FILE *f, const ulam_walk_report *p, int quiet)
 {
     const ulam_walk_opts *o = p->opts;
     const ulam_walk_result *r = p->result;
-    long long i = (long long)(o->query.index + p->index_base);
+    long long i = (long long)(o->query.index + p->node_base);
     int pad = ulam__report_pad(name(p), i, 16);
     const char *stop = r->interrupted ? "  [INTERRUPTED]" : "";
     if (o->mode == ULAM_FORWARD && isnan(r->std_error) && r->ci95[0] == 0 && r->ci95[1] == 0)
@@ -151,7 +151,7 @@ static void verbose(FILE *f, const ulam_walk_report *p)
 static void json(FILE *f, const ulam_walk_report *p)
 {
     const ulam_walk_result *r = p->result;
-    fprintf(f, "{\"index\": %lld, ", (long long)(p->opts->query.index + p->index_base));
+    fprintf(f, "{\"index\": %lld, ", (long long)(p->opts->query.index + p->node_base));
     if (strcmp(name(p), "x")) fprintf(f, "\"quantity\": \"%s\", ", name(p));
     ulam_walk_result_json(f, p->opts, r, p->guard); /* the result's members: the library's schema */
     fprintf(f, "\"ranks\": %d, ", p->ranks > 0 ? p->ranks : 1);

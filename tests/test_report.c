@@ -146,7 +146,7 @@ static void test_walk_report(void **state)
     ulam_walk_result r = {.estimate = 1.875, .std_error = 0.01, .ci95 = {1.85, 1.9}, .variance_finite = 1,
                           .walks = 2000, .steps = 6000, .threads = 1, .seconds = 0.5, .tail_bound = INFINITY,
                           .score_bound = INFINITY, .cut_bound = 0, .rel_err_met = 0};
-    ulam_walk_report p = {.opts = &o, .result = &r, .n = 10, .index_base = 1, .total_seconds = 0.75,
+    ulam_walk_report p = {.opts = &o, .result = &r, .n = 10, .node_base = 1, .total_seconds = 0.75,
                           .check = 1, .direct = 1.87, .direct_seconds = 0.5, .direct_method = "dense LU",
                           .prefix = "ulam: m.mtx: "};
     sink k = {0};

@@ -357,7 +357,7 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
 static ulam_walk_report walk_report(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
 {
     return (ulam_walk_report){.opts = o, .result = r, .guard = &ro->g, .choice = ro->ch, .n = ro->n,
-                              .index_base = cli_node_base, .answer_name = cli_answer_name,
+                              .node_base = cli_node_base, .answer_name = cli_answer_name,
                               .ranks = cli_share ? cli_share->nranks : 1, .load_seconds = ro->load_seconds,
                               .guard_seconds = ro->guard_seconds, .kernel_seconds = ro->kernel_seconds,
                               .total_seconds = ulam_now() - ro->t_start, .check = ro->check, .direct = ro->direct,
