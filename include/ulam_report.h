@@ -75,7 +75,7 @@ void ulam_outer_report_fprint(FILE *f, const ulam_outer_report *r, int format);
 
 /* What a bidirectional solve of one x_t (ulam_analysis_bidir, or the bidirectional row of
  * ulam_run_finish) or a single-source estimate of every x_i (ulam_fpush_top) reports: the caller
- * fills it (zero what it does not know) and ulam_bidir_report_fprint writes it. */
+ * fills it (zero what it does not know) and ulam_report_fprint writes it. */
 typedef struct ulam_bidir_report {
     const ulam_bidir_opts *opts;     /* the point query's options (NULL: the single-source table) */
     const ulam_bidir_result *result; /* its answer (scaled to pi with pagerank) */
@@ -102,10 +102,10 @@ typedef struct ulam_bidir_report {
     double cpu_seconds;              /* the push and walks' CPU time */
 } ulam_bidir_report;
 
-/* Write r to f as text (ULAM_REPORT_BRIEF, _VERBOSE, _QUIET: the answer line or the table's rows
- * alone), as one JSON object (ULAM_REPORT_JSON, with --check's members when r->check), or
- * --check's line alone (ULAM_REPORT_CHECK); the text writes --check's line last when r->check. */
-void ulam_bidir_report_fprint(FILE *f, const ulam_bidir_report *r, int format);
+/* Its formats (ulam_report_fprint, ULAM_REPORT_BIDIR): text (ULAM_REPORT_BRIEF, _VERBOSE, _QUIET:
+ * the answer line or the table's rows alone), one JSON object (ULAM_REPORT_JSON, with --check's
+ * members when r->check), or --check's line alone (ULAM_REPORT_CHECK); the text writes --check's
+ * line last when r->check. */
 
 /* What ulam info reports on M (ulam_report_fprint's ULAM_REPORT_INFO): its statistics, rho(M),
  * the guards' radii and the Neumann series' verdict; for a Jacobi splitting with omega <= 1 (text
@@ -148,14 +148,52 @@ typedef struct ulam_query_report {
     int64_t node_base;
 } ulam_query_report;
 
-/* The kinds of ulam_report_fprint. */
-enum ulam_report_kind { ULAM_REPORT_INFO = 1, ULAM_REPORT_DIRECT = 2, ULAM_REPORT_QUERY = 3 };
+/* The kinds of ulam_report_fprint, a row each in its table (src/report_kind.c). */
+enum ulam_report_kind {
+    ULAM_REPORT_INFO = 1,   /* ulam_info_report: ulam info */
+    ULAM_REPORT_DIRECT = 2, /* ulam_direct_report: ulam direct */
+    ULAM_REPORT_QUERY = 3,  /* ulam_query_report: one line of ulam solve --queries */
+    ULAM_REPORT_BIDIR = 4,  /* ulam_bidir_report: a bidirectional solve, or the single-source table */
+    ULAM_REPORT_WALK = 5    /* ulam_walk_report: ulam solve's walks */
+};
 
-/* Write report, the struct kind names (ulam_info_report, ulam_direct_report, ulam_query_report),
- * to f as text (format ULAM_REPORT_BRIEF or _VERBOSE) or as one JSON object and a newline
- * (ULAM_REPORT_JSON), as ulam info, ulam direct and ulam solve --queries print them.  ULAM_OK,
- * ULAM_EINVAL (NULL, or an unknown kind), or the damping table's failure (ULAM_ENOMEM). */
+/* Write report, the struct kind names, to f in format (enum ulam_report_format; the walk report
+ * also ULAM_REPORT_WARN), as the command line prints it (see each struct for what its formats
+ * write).  ULAM_OK; ULAM_EINVAL (NULL, an unknown kind, a report missing what it must hold: a
+ * walk report's options and result, a bidirectional report's point or table), writing nothing;
+ * or the damping table's failure (ULAM_ENOMEM). */
 int ulam_report_fprint(FILE *f, int kind, const void *report, int format);
+
+/* The format only the walk report has: a first round's warnings. */
+enum ulam_walk_report_format { ULAM_REPORT_WARN = 5 };
+
+/* A walk run (ulam solve's walks row) as its report shows it: the result and what the caller
+ * measured around it. */
+typedef struct ulam_walk_report {
+    const ulam_walk_opts *opts;     /* the options the walks ran with (mode, estimator, seed, rules) */
+    const ulam_walk_result *result; /* what they found */
+    const ulam_guard *guard;        /* the guards (their radii; NULL: not written) */
+    const ulam_choice *choice;      /* what --method auto chose (NULL: nothing was chosen) */
+    int64_t n;                      /* the unknowns (forward walks' "unreached ... of n") */
+    int64_t node_base;              /* added to opts->query.index to name the unknown (1: 1-based) */
+    const char *answer_name;        /* the unknown's name, "x" (NULL too) or "pi" (PageRank: a line saying so) */
+    int ranks;                      /* the processes that walked (JSON "ranks") */
+    double load_seconds, guard_seconds, kernel_seconds; /* reading the inputs; the guards; the set-up */
+    double total_seconds;           /* the whole run so far (BRIEF's "in all") */
+    int check;                      /* direct, direct_seconds, direct_method hold a direct solve's x_index */
+    double direct, direct_seconds;
+    const char *direct_method;      /* "dense LU", "sparse LU", ... */
+    const char *prefix;             /* WARN: the start of each line ("ulam: M.mtx: "; NULL: none) */
+} ulam_walk_report;
+
+/* Its formats (ulam_report_fprint, ULAM_REPORT_WALK): BRIEF, the answer line (x[i] with its interval, or why there is none), the method
+ * in words, the walks, the seconds and the rel_err rule's outcome; VERBOSE, every line (steps,
+ * variance, figure of merit, guards, tail, timings and the process's peak memory); QUIET, the
+ * answer line alone; JSON, one object ("index", ulam_walk_result_json's members, the timings,
+ * the direct solve with check, the choice, "interrupted") and a newline; CHECK, the line
+ * "direct ..., z = ..." (with check); WARN, after a first round of walks, a line "warning: ..."
+ * (after r->prefix) for a run bounded by a walk count that would take over an hour at that pace,
+ * and for a rel_err rule that cannot be met or needs walks out of reach (nothing else). */
 
 #ifdef __cplusplus
 }

@@ -43,5 +43,7 @@ void ulam__report_radius_json(FILE *f, const char *prefix, const ulam_power *p);
 int ulam__report_info_fprint(FILE *f, const void *report, int format);
 int ulam__report_direct_fprint(FILE *f, const void *report, int format);
 int ulam__report_query_fprint(FILE *f, const void *report, int format);
+int ulam__report_bidir_fprint(FILE *f, const void *report, int format);
+int ulam__report_walk_fprint(FILE *f, const void *report, int format);
 
 #endif

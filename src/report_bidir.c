@@ -260,10 +260,10 @@ static void table_json(FILE *f, const ulam_bidir_report *p)
     fputs("]}\n", f);
 }
 
-/* See ulam_report.h. */
-void ulam_bidir_report_fprint(FILE *f, const ulam_bidir_report *r, int format)
+/* ulam_report_fprint's ULAM_REPORT_BIDIR (src/report.h). */
+int ulam__report_bidir_fprint(FILE *f, const void *report, int format)
 {
-    if (!f || !r) return;
+    const ulam_bidir_report *r = report;
     if (r->opts && r->result) {
         if (format == ULAM_REPORT_JSON) point_json(f, r);
         else if (format == ULAM_REPORT_CHECK) check_line(f, r);
@@ -271,5 +271,6 @@ void ulam_bidir_report_fprint(FILE *f, const ulam_bidir_report *r, int format)
     } else if (r->top && r->order && r->x && r->se && r->lo && r->hi) {
         if (format == ULAM_REPORT_JSON) table_json(f, r);
         else if (format != ULAM_REPORT_CHECK) table_text(f, r, format);
-    }
+    } else return ULAM_EINVAL;
+    return ULAM_OK;
 }

@@ -7,6 +7,8 @@ static int (*const writers[])(FILE *, const void *, int) = {
     [ULAM_REPORT_INFO] = ulam__report_info_fprint,
     [ULAM_REPORT_DIRECT] = ulam__report_direct_fprint,
     [ULAM_REPORT_QUERY] = ulam__report_query_fprint,
+    [ULAM_REPORT_BIDIR] = ulam__report_bidir_fprint,
+    [ULAM_REPORT_WALK] = ulam__report_walk_fprint,
 };
 
 /* See ulam_report.h. */

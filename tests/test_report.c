@@ -1,6 +1,7 @@
-/* A walk result as JSON (include/ulam_report.h), the report kinds (ulam info, direct, a query) and the reference solve (include/ulam_reference.h):
- * the members ulam solve --json prints, written to the caller's stream, null for what is not
- * finite; the reference LU as chosen, and GMRES when the LU would pass the memory limit. */
+/* A walk result as JSON, a walk run's report, the report kinds (ulam info, direct, a query)
+ * (include/ulam_report.h) and the reference solve (include/ulam_reference.h): the members ulam
+ * solve --json prints, written to the caller's stream, null for what is not finite; the
+ * reference LU as chosen, and GMRES when the LU would pass the memory limit. */
 #include "testutil.h"
 #include "ulam_reference.h"
 #include "ulam_report.h"
@@ -104,11 +105,11 @@ static void test_bidir(void **state)
     char *buf = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&buf, &len);
-    ulam_bidir_report_fprint(f, &p, ULAM_REPORT_QUIET);
+    ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_QUIET);
     assert_string_equal(written(f, &buf), "pi[7]           0.25 +- 0.001 (95% CI 0.248 .. 0.252)\n");
     free(buf);
     f = open_memstream(&buf, &len);
-    ulam_bidir_report_fprint(f, &p, ULAM_REPORT_BRIEF);
+    ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_BRIEF);
     char *s = written(f, &buf);
     const char *lines[] = {"pi[7] ", "\nmethod          bidirectional: reverse push from 7, walks from source 3 (balanced rmax)\n",
                            "\nwalks           1000 (0 cut, 0 steps, 1 threads)\n", "\nbalance ", "\nseconds ",
@@ -121,11 +122,11 @@ static void test_bidir(void **state)
     assert_null(strstr(s, "guards ")); /* no guard given */
     free(s);
     f = open_memstream(&buf, &len);
-    ulam_bidir_report_fprint(f, &p, ULAM_REPORT_CHECK);
+    ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_CHECK);
     assert_string_equal(written(f, &buf), "direct          0.2515 (dense LU, 0.5 s), z = -1.500\n");
     free(buf);
     f = open_memstream(&buf, &len);
-    ulam_bidir_report_fprint(f, &p, ULAM_REPORT_JSON);
+    ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_JSON);
     s = written(f, &buf);
     assert_int_equal(strncmp(s, "{\"index\": 7, \"quantity\": \"pi\", \"source\": 3, \"b_nonzeros\": 1, ", 60), 0);
     assert_non_null(strstr(s, "\"ci95\": [0.248, 0.252], \"variance_finite\": true, \"rho_abs\": null, \"rho_hat\": null, "));
@@ -138,20 +139,20 @@ static void test_bidir(void **state)
     double x[5] = {0.1, 0, 0, 0, 0.3}, se[2] = {0.01, 0.02}, lo[2] = {0.2, NAN}, hi[2] = {0.4, NAN};
     ulam_bidir_report q = {.top = &t, .n = 5, .source = 5, .rows = 2, .order = order, .x = x, .se = se, .lo = lo, .hi = hi};
     f = open_memstream(&buf, &len);
-    ulam_bidir_report_fprint(f, &q, ULAM_REPORT_QUIET);
+    ulam_report_fprint(f, ULAM_REPORT_BIDIR, &q, ULAM_REPORT_QUIET);
     assert_string_equal(written(f, &buf), "1      4          0.3            0.01        0.2          0.4\n"
                                           "2      0          0.1            0.02        none\n");
     free(buf);
     f = open_memstream(&buf, &len);
-    ulam_bidir_report_fprint(f, &q, ULAM_REPORT_JSON);
+    ulam_report_fprint(f, ULAM_REPORT_BIDIR, &q, ULAM_REPORT_JSON);
     s = written(f, &buf);
     assert_non_null(strstr(s, "\"top\": [{\"index\": 4, \"estimate\": 0.29999999999999999, "));
     assert_non_null(strstr(s, "\"ci95\": [null, null]}]}\n"));
     free(s);
     ulam_bidir_report none = {0};
     f = open_memstream(&buf, &len);
-    ulam_bidir_report_fprint(f, &none, ULAM_REPORT_BRIEF);
-    ulam_bidir_report_fprint(NULL, &p, ULAM_REPORT_BRIEF);
+    assert_int_equal(ulam_report_fprint(f, ULAM_REPORT_BIDIR, &none, ULAM_REPORT_BRIEF), ULAM_EINVAL);
+    assert_int_equal(ulam_report_fprint(NULL, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_BRIEF), ULAM_EINVAL);
     assert_string_equal(written(f, &buf), "");
     free(buf);
 }
@@ -289,6 +290,79 @@ static void test_kinds(void **state)
     assert_int_equal(ulam_report_fprint(stdout, ULAM_REPORT_QUERY, NULL, ULAM_REPORT_BRIEF), ULAM_EINVAL);
 }
 
+/* What a writer wrote: the string of its last call (freed by the next, and at the end). */
+typedef struct {
+    char *buf;
+    size_t len;
+} sink;
+
+/* Write p in format to k, and return what was written. */
+static const char *walk_report_text(sink *k, const ulam_walk_report *p, int format)
+{
+    free(k->buf);
+    k->buf = NULL;
+    FILE *f = open_memstream(&k->buf, &k->len);
+    ulam_report_fprint(f, ULAM_REPORT_WALK, p, format);
+    fclose(f);
+    return k->buf;
+}
+
+/* Nonzero when s starts with prefix. */
+static int starts(const char *s, const char *prefix)
+{
+    return !strncmp(s, prefix, strlen(prefix));
+}
+
+/* A walk run's report by hand: the quiet answer line, the brief block, PageRank's line, the
+ * --check line, the JSON object and the first round's warnings, each as ulam solve prints it. */
+static void test_walk_report(void **state)
+{
+    (void)state;
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.query.index = 2, o.exec.seed = 7, o.stop.rel_err = 0.01, o.stop.max_walks = 0;
+    ulam_walk_result r = {.estimate = 1.875, .std_error = 0.01, .ci95 = {1.85, 1.9}, .variance_finite = 1,
+                          .walks = 2000, .steps = 6000, .threads = 1, .seconds = 0.5, .tail_bound = INFINITY,
+                          .score_bound = INFINITY, .cut_bound = 0, .rel_err_met = 0};
+    ulam_walk_report p = {.opts = &o, .result = &r, .n = 10, .node_base = 1, .total_seconds = 0.75,
+                          .check = 1, .direct = 1.87, .direct_seconds = 0.5, .direct_method = "dense LU",
+                          .prefix = "ulam: m.mtx: "};
+    sink k = {0};
+    const char *s = walk_report_text(&k, &p, ULAM_REPORT_QUIET);
+    assert_string_equal(s, "x[3]            1.875 +- 0.01 (95% CI 1.85 .. 1.9)\n");
+    s = walk_report_text(&k, &p, ULAM_REPORT_BRIEF);
+    assert_string_equal(s, "x[3]            1.875 +- 0.01 (95% CI 1.85 .. 1.9)\n"
+                           "method          adjoint random walks, collision estimator (walks start at the unknown)\n"
+                           "walks           2000 (mean length 3 steps)\n"
+                           "seconds         0.5 walking on 1 threads; 0.75 in all (inputs, guards, set-up)\n"
+                           "rel-err         NOT met (target 0.01; no bound on a single score: no walk count can certify it)\n");
+    s = walk_report_text(&k, &p, ULAM_REPORT_CHECK);
+    assert_string_equal(s, "direct          1.87 (dense LU, 0.5 s), z = 0.500\n");
+    s = walk_report_text(&k, &p, ULAM_REPORT_WARN);
+    assert_string_equal(s, "ulam: m.mtx: warning: --rel-err 0.01: no bound on a single walk's score holds (weights can "
+                           "grow without bound, or the walk's length tail is not certified): the rule cannot be met; the "
+                           "run ends by --walks or --time\n");
+    s = walk_report_text(&k, &p, ULAM_REPORT_JSON);
+    assert_true(starts(s, "{\"index\": 3, \"estimate\": 1.875, "));
+    const char *key = "\"direct_method\": \"dense LU\", \"z\": ";
+    assert_non_null(strstr(s, key));
+    assert_true(fabs(strtod(strstr(s, key) + strlen(key), NULL) - 0.5) < 1e-9); /* (1.875 - 1.87) / 0.01 */
+    assert_null(strstr(s, "quantity")); /* x: no name */
+    assert_string_equal(s + strlen(s) - 22, "\"interrupted\": false}\n");
+    p.answer_name = "pi", r.interrupted = 1; /* PageRank's pi: named, with its line (not when quiet) */
+    s = walk_report_text(&k, &p, ULAM_REPORT_BRIEF);
+    assert_true(starts(s, "pi[3]           1.875 +- 0.01 (95% CI 1.85 .. 1.9)  [INTERRUPTED]\npagerank        pi = x"));
+    s = walk_report_text(&k, &p, ULAM_REPORT_QUIET);
+    assert_null(strstr(s, "pagerank"));
+    s = walk_report_text(&k, &p, ULAM_REPORT_JSON);
+    assert_non_null(strstr(s, "{\"index\": 3, \"quantity\": \"pi\", "));
+    o.estimator = 3; /* not an estimator: nothing */
+    s = walk_report_text(&k, &p, ULAM_REPORT_BRIEF);
+    assert_string_equal(s, "");
+    assert_int_equal(ulam_report_fprint(NULL, ULAM_REPORT_WALK, &p, ULAM_REPORT_BRIEF), ULAM_EINVAL); /* nothing */
+    assert_int_equal(ulam_report_fprint(stdout, ULAM_REPORT_WALK, NULL, ULAM_REPORT_BRIEF), ULAM_EINVAL);
+    free(k.buf);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -297,6 +371,7 @@ int main(void)
         cmocka_unit_test(test_bidir),
         cmocka_unit_test(test_reference),
         cmocka_unit_test(test_kinds),
+        cmocka_unit_test(test_walk_report),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -289,7 +289,7 @@ def _report(d, index, b_nonzeros, source, scale):
         rep.update(json.loads(d["report_json"]))
         if d["method"] == "walks":  # ulam_walk_result_json's members, and the CLI's own keys around them
             rep.update({"ranks": 1, "kernel_rows": w["rows"]})  # (ranks: MPI; kernel_rows)
-        else:  # ulam_bidir_report_fprint's object, less the process's keys; source and b as given
+        else:  # ulam_report_fprint's bidirectional object, less the process's keys; source and b as given
             for k in ("transpose_seconds", "load_seconds", "guard_seconds"):
                 del rep[k]
             rep.update({"source": source + 1 if source is not None else None, "b_nonzeros": b_nonzeros})

@@ -280,7 +280,7 @@ static PyObject *json_text(const ulam_walk_opts *o, const ulam_answer *a, const 
         ulam_bidir_opts bo = ch->bidir_opts;
         bo.walk = *o, bo.b_index = NULL, bo.b_value = NULL; /* the run that owned b's arrays is freed */
         ulam_bidir_report rep = {.opts = &bo, .result = &a->bidir, .dense = ch->bidir_route == 1, .node_base = 1};
-        ulam_bidir_report_fprint(f, &rep, ULAM_REPORT_JSON);
+        ulam_report_fprint(f, ULAM_REPORT_BIDIR, &rep, ULAM_REPORT_JSON);
     } else {
         fputc('{', f);
         if (kind == JSON_WALK) ulam_walk_result_json(f, o, &a->walks, &a->guard);

@@ -11,7 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 
-/* What a run reports (the library's writer, ulam_bidir_report_fprint), and how. */
+/* What a run reports (the library's writer, ulam_report_fprint), and how. */
 typedef struct {
     int json, check;
     ulam_guard g;
@@ -109,7 +109,7 @@ static int answer(const cli_system *s, const ulam_bidir_opts *o, ulam_bidir_resu
     p->opts = o, p->result = r, p->guard = &rp->g, p->check = 0;
     report_fill(s, rp);
     if (!rp->json) {
-        ulam_bidir_report_fprint(stdout, p, cli_verbosity < 0 ? ULAM_REPORT_QUIET : cli_verbosity > 0 ? ULAM_REPORT_VERBOSE : ULAM_REPORT_BRIEF);
+        ulam_report_fprint(stdout, ULAM_REPORT_BIDIR, p, cli_verbosity < 0 ? ULAM_REPORT_QUIET : cli_verbosity > 0 ? ULAM_REPORT_VERBOSE : ULAM_REPORT_BRIEF);
         cli_flush();
     }
     if (check) {
@@ -118,8 +118,8 @@ static int answer(const cli_system *s, const ulam_bidir_opts *o, ulam_bidir_resu
         p->check = !rc;
     }
     if (rc == EXIT_INTERRUPTED && !rp->json) fprintf(stderr, "ulam: --check interrupted: the estimate above stands unchecked\n");
-    if (!rc && rp->json) ulam_bidir_report_fprint(stdout, p, ULAM_REPORT_JSON), cli_json_done = 1;
-    else if (!rc && p->check) ulam_bidir_report_fprint(stdout, p, ULAM_REPORT_CHECK);
+    if (!rc && rp->json) ulam_report_fprint(stdout, ULAM_REPORT_BIDIR, p, ULAM_REPORT_JSON), cli_json_done = 1;
+    else if (!rc && p->check) ulam_report_fprint(stdout, ULAM_REPORT_BIDIR, p, ULAM_REPORT_CHECK);
     if (!rc && r->walks.interrupted) rc = EXIT_INTERRUPTED;
     cli_flush();
     if (rc == EXIT_INTERRUPTED && check && !cli_share) { /* the reference's thread still reads the system */
@@ -230,7 +230,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
         p->top = &info, p->n = n, p->source = source, p->rows = shown, p->order = order, p->x = x, p->direct_x = xd;
         p->se = se, p->lo = lo, p->hi = hi, p->cpu_seconds = cpu, p->direct_seconds = dsec, p->direct_method = dm;
         report_fill(s, rp);
-        ulam_bidir_report_fprint(stdout, p, rp->json ? ULAM_REPORT_JSON : cli_verbosity < 0 ? ULAM_REPORT_QUIET
+        ulam_report_fprint(stdout, ULAM_REPORT_BIDIR, p, rp->json ? ULAM_REPORT_JSON : cli_verbosity < 0 ? ULAM_REPORT_QUIET
                                                                                             : ULAM_REPORT_BRIEF);
         cli_json_done |= rp->json;
     }

@@ -211,35 +211,11 @@ int cli_lookup(const char *word, const char *const *names, int n);
 /* The usage error for an unknown --method: auto and the rows of the library's table; EXIT_USAGE. */
 int cli_method_error(const char *got);
 
-/* Print a bare JSON number (null when not finite). */
-void cli_json_value(double v);
-
-/* Print whether the --rel-err target of walks r run with o was met, and when not why (one line;
- * nothing without a target; verbose: also when met). */
-void cli_print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int verbose);
-/* Nonzero when the interval was withheld because the scores are too small to square in doubles. */
-int cli_score_too_small(const ulam_walk_result *r);
-
 /* Print a JSON number (null when not finite). */
 void cli_json_number(const char *key, double v, int last);
 
 /* Print a JSON string (escaped). */
 void cli_json_string(const char *key, const char *v, int last);
-
-/* A verdict in words. */
-const char *cli_verdict_word(int verdict);
-
-/* The spaces after "x[index]" (1-based) that put its value at column (the lines below's). */
-int cli_answer_pad(int64_t index, int column);
-
-/* The digits (10 to 17) that print lo and hi as two numbers (src/cli/common.c). */
-int cli_ci_digits(double lo, double hi);
-
-/* --check's z = (estimate - direct) / stderr, 0 when both agree exactly. */
-double cli_z(double estimate, double direct, double std_error);
-
-/* Print "z = Z" for --check and a newline (see src/cli/common.c). */
-void cli_print_z(double estimate, double direct, double std_error, double lo, double hi);
 
 /* Print a power-iteration radius with its bounds (no newline). */
 void cli_print_power(const ulam_power *p);

@@ -580,47 +580,6 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
     return cli_report(s->matrix_path, &err);
 }
 
-/* The significant digits that print an interval's ends lo < hi apart: 10, or up to 17 (every
- * double prints as itself) for an interval narrower than 10 digits show (a push taken down to
- * rounding): its ends then do not print as one number. */
-int cli_ci_digits(double lo, double hi)
-{
-    char a[40], b[40];
-    int p = 10;
-    for (; p < 17 && lo < hi; p++) {
-        snprintf(a, sizeof a, "%.*g", p, lo), snprintf(b, sizeof b, "%.*g", p, hi);
-        if (strcmp(a, b)) break;
-    }
-    return p;
-}
-
-/* The spaces after "x[index]" (1-based) that put the value at the given column, the one of the
- * lines below it (16 under "method          "); at least 1. */
-int cli_answer_pad(int64_t index, int column)
-{
-    char label[32];
-    int len = snprintf(label, sizeof label, "%s[%lld]", cli_answer_name, (long long)index);
-    return len < column ? column - len : 1;
-}
-
-/* --check's z = (estimate - direct) / stderr: 0 when they are equal, +-inf when only the stderr
- * is 0. */
-double cli_z(double estimate, double direct, double std_error)
-{
-    double d = estimate - direct;
-    return std_error > 0 ? d / std_error : d == 0 ? 0.0 : copysign(INFINITY, d);
-}
-
-/* The --check line's tail: "z = Z" (cli_z), and when |z| > 4 whether direct is inside [lo, hi]
- * (an interval wider than the stderr says: a range term, or the allowance for rounding). */
-void cli_print_z(double estimate, double direct, double std_error, double lo, double hi)
-{
-    double z = cli_z(estimate, direct, std_error);
-    printf("z = %.3f", z);
-    if (fabs(z) > 4.0) printf(" (direct %s the 95%% interval)", lo <= direct && direct <= hi ? "inside" : "OUTSIDE");
-    printf("\n");
-}
-
 /* Check before any work that path can be written (a temporary file can be made beside it and
  * it is not a directory); 0 or an exit code (reported). */
 int cli_check_output(const char *path)

@@ -4,12 +4,6 @@
 #include <math.h>
 #include <stdio.h>
 
-/* A verdict in words. */
-const char *cli_verdict_word(int verdict)
-{
-    return ulam_verdict_word(verdict);
-}
-
 /* A hint naming the option that fits how M looks: a diagonal of magnitude >= 1 in at least half
  * the rows is A of A x = b (--jacobi); nonnegative whole-number weights off an empty diagonal with
  * some row sum above 1 are a graph's adjacency matrix (--pagerank); else "". */

@@ -142,12 +142,6 @@ int cli_usage_error(const char *command, const char *fmt, ...)
     return EXIT_USAGE;
 }
 
-/* Print a bare JSON number (null when not finite). */
-void cli_json_value(double v)
-{
-    ulam_json_number(stdout, NULL, v, 1);
-}
-
 /* Print a JSON member (ulam_json_number), noting that JSON was printed. */
 void cli_json_number(const char *key, double v, int last)
 {
@@ -162,46 +156,3 @@ void cli_json_string(const char *key, const char *v, int last)
     ulam_json_string(stdout, key, v, last);
 }
 
-/* Nonzero when the interval was withheld because the scores are too small to square (a b far
- * below 1 that the solver could not rescale: a prepared file's, read lazily; src/stop.h). */
-int cli_score_too_small(const ulam_walk_result *r)
-{
-    return r->estimate != 0 && fabs(r->estimate) < ULAM_SCORE_TINY && r->std_error == 0 && isnan(r->ci95[0]);
-}
-
-/* Print whether the --rel-err target was met, and when not why (one line; nothing without a target). */
-void cli_print_rel_err(const ulam_walk_opts *o, const ulam_walk_result *r, int verbose)
-{
-    if (o->stop.rel_err > 0 && r->cut_stop)
-        printf("rel-err         NOT met (target %.3g): %lld walks were cut at %lld steps and the cut's bias may be "
-               "%.3g, more than a tenth of the target error: unreachable by more walks (raise --max-steps)\n",
-               o->stop.rel_err, (long long)r->cut, (long long)o->stop.max_steps, r->cut_bound);
-    else if (o->stop.rel_err > 0 && !isfinite(r->tail_bound) && r->estimate != 0)
-        printf("rel-err         NOT met (target %.3g; no bound on a single score: no walk count can certify it)\n",
-               o->stop.rel_err);
-    else if (o->stop.rel_err > 0 && r->out_of_reach && !isfinite(r->ci95[0]) &&
-             !(r->min_walks > (o->stop.max_walks > 0 ? (double)o->stop.max_walks : (double)ULAM_REL_ERR_CAP)))
-        printf("rel-err         NOT met (target %.3g): %s, so no interval can be "
-               "printed; stopped after %lld walks, over 1024 times the %.4g the rule asked for\n", o->stop.rel_err,
-               cli_score_too_small(r) ? "the scores are too small to square in doubles (scale b up)" : "a score passed the certified range",
-               (long long)r->walks, r->min_walks);
-    else if (o->stop.rel_err > 0 && r->estimate == 0 && r->out_of_reach && r->min_walks > 0 && isfinite(r->min_walks))
-        printf("rel-err         NOT met (target %.3g): no walk has scored in %lld; a walk scores at all with probability "
-               "at most %.3g (certified from where it can go), so the rule asks for at least %.4g walks, %s: stopped "
-               "early, %s\n", o->stop.rel_err, (long long)r->walks,
-               1.0 / (1.0 + r->min_walks * o->stop.rel_err * o->stop.rel_err), r->min_walks,
-               o->stop.max_walks > 0 ? "more than --walks" : "beyond the 1e9 cap",
-               isfinite(r->ci95[0]) ? "the interval above" : "the estimate so far above");
-    else if (o->stop.rel_err > 0 && r->fourth_finite != 1 && (verbose || !r->rel_err_met))
-        printf("rel-err         %s (target %.3g; the certified second moment asks for %.4g walks at this estimate): "
-               "scores are unbounded and rho(M4) is in [%.4g, %.4g], so the fourth moment is %s and the rule does "
-               "not use the variance's own error bar\n", r->rel_err_met ? "met" : "NOT met", o->stop.rel_err, r->min_walks,
-               r->rho4.lower, r->rho4.upper, r->fourth_finite == 0 ? "infinite" : "not certified finite");
-    else if (o->stop.rel_err > 0 && r->min_walks > 0 && (verbose || !r->rel_err_met))
-        printf("rel-err         %s (target %.3g; the rule asks for %.4g walks at this estimate and variance%s)\n",
-               r->rel_err_met ? "met" : "NOT met", o->stop.rel_err, r->min_walks,
-               !r->out_of_reach ? "" : o->stop.max_walks > 0 ? ", more than --walks: stopped early, the estimate so far above"
-                                                        : ", beyond the 1e9 cap: stopped early, the estimate so far above");
-    else if (o->stop.rel_err > 0)
-        printf("rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->stop.rel_err);
-}

@@ -76,7 +76,7 @@ int cli_prepare(int argc, char **argv)
         printf("rho(|M|)       ");
         cli_print_power(&cert.guard.abs);
         printf("  (%s)\nrow sums |M|   %.6g .. %.6g; column sums %.6g .. %.6g\n",
-               cli_verdict_word(cert.guard.verdict_abs), cert.rowsum_min, cert.rowsum_max, cert.colsum_min,
+               ulam_verdict_word(cert.guard.verdict_abs), cert.rowsum_min, cert.rowsum_max, cert.colsum_min,
                cert.colsum_max);
         printf("seconds        %.3f load, %.3f guards\n", load, guards);
     }

@@ -4,7 +4,6 @@
 #include <errno.h>
 
 #include <getopt.h>
-#include <sys/resource.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,144 +22,6 @@ typedef struct {
     double t_start;             /* when the command started (ulam_now) */
     const char *direct_method;  /* --check: "dense LU", "sparse LU" or "interrupted" */
 } report_opts;
-
-/* Peak resident memory of this process so far, in MiB: VmHWM of /proc/self/status, the high-water
- * mark of this program's own memory (getrusage's ru_maxrss keeps, across the exec, that of the
- * process it was forked from: a benchmark's 119 MiB showed as this query's peak), else ru_maxrss. */
-static double peak_rss_mib(void)
-{
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    double kb = -1;
-    while (f && kb < 0 && fgets(line, sizeof line, f))
-        if (sscanf(line, "VmHWM: %lf", &kb) != 1) kb = -1;
-    if (f) fclose(f);
-    struct rusage ru;
-    return kb >= 0 ? kb / 1024.0 : getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
-}
-
-/* Print the answer line: x[I] with its interval, or why there is none. */
-static void print_answer(const ulam_walk_opts *o, const ulam_walk_result *r)
-{
-    if (o->mode == ULAM_FORWARD && isnan(r->std_error) && r->ci95[0] == 0 && r->ci95[1] == 0)
-        printf("%s[%lld]%*s0 exactly (95%% CI 0 .. 0: no walk from where b is nonzero can reach it)%s\n",
-               cli_answer_name, (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
-    else if (o->mode == ULAM_FORWARD && isnan(r->std_error))
-        printf("%s[%lld]%*sunreached (no walk tallied it: no estimate)%s\n", cli_answer_name,
-               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->interrupted ? "  [INTERRUPTED]" : "");
-    else if (r->variance_finite == 1 && isnan(r->ci95[0]))
-        printf("%s[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", cli_answer_name,
-               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate, r->std_error,
-               !isfinite(r->cut_bound) ? "walks cut at --max-steps may have moved it by any amount"
-               : cli_score_too_small(r) ? "scores too small to square in doubles, so no variance: scale b up (a prepared "
-                                "file's b is not rescaled)"
-               : !isfinite(r->tail_bound) && r->estimate != 0 ? "no certified range of a single walk's score"
-               : "no certified range yet, or a score past the certified one", r->interrupted ? "  [INTERRUPTED]" : "");
-    else if (r->variance_finite == 1)
-        printf("%s[%lld]%*s%.10g +- %.3g (95%% CI %.*g .. %.*g)%s\n", cli_answer_name,
-               (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate,
-               r->std_error, cli_ci_digits(r->ci95[0], r->ci95[1]), r->ci95[0], cli_ci_digits(r->ci95[0], r->ci95[1]),
-               r->ci95[1], r->interrupted ? "  [INTERRUPTED]" : "");
-    else
-        printf("%s[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
-               "means nothing)%s\n", cli_answer_name, (long long)(o->query.index + cli_node_base), cli_answer_pad(o->query.index + cli_node_base, 16), "", r->estimate,
-               r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
-               r->std_error, r->interrupted ? "  [INTERRUPTED]" : "");
-    if (strcmp(cli_answer_name, "x") && cli_verbosity >= 0) /* --pagerank with no --rhs */
-        printf("pagerank        pi = x of (I - alpha P^T) x = (1 - alpha) / n: global PageRank, uniform teleport; "
-               "dangling nodes' rank leaks (pi sums to 1 - the leak)\n");
-}
-
-/* Print the default block: the answer, the method in words, the cost, the target (about 5 lines). */
-static void print_brief(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
-{
-    print_answer(o, r);
-    if (cli_verbosity < 0) return;
-    printf("method          %s random walks, %s estimator%s\n", cli_mode_names[o->mode],
-           cli_estimator_names[o->estimator], o->mode == ULAM_ADJOINT ? " (walks start at the unknown)"
-                                                                     : " (walks start from b: every unknown at once)");
-    if (ro->ch) ulam_choice_fprint(stdout, ro->ch, 1, cli_verbosity >= 1);
-    if (r->cut)
-        printf("walks           %lld (%lld cut at %lld steps: the estimate is biased by the cut)\n",
-               (long long)r->walks, (long long)r->cut, (long long)o->stop.max_steps);
-    else
-        printf("walks           %lld (mean length %.3g steps)\n", (long long)r->walks,
-               r->walks ? (double)r->steps / (double)r->walks : 0.0);
-    printf("seconds         %.3g walking on %d threads; %.3g in all (inputs, guards, set-up)\n", r->seconds,
-           r->threads, ulam_now() - ro->t_start);
-    cli_print_rel_err(o, r, 0);
-    if (o->mode == ULAM_FORWARD && r->unreached)
-        printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
-               (long long)r->unreached, (long long)ro->n);
-}
-
-/* Print the whole human-readable block (--verbose). */
-static void print_text(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
-{
-    double mean_len = r->walks ? (double)r->steps / (double)r->walks : 0.0;
-    double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
-    if (cli_verbosity < 1) {
-        print_brief(o, r, ro);
-        return;
-    }
-    print_answer(o, r);
-    printf("method          %s walks, %s estimator\n", cli_mode_names[o->mode], cli_estimator_names[o->estimator]);
-    printf("walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
-           (long long)o->stop.max_steps, r->cut ? ": the estimate is biased by the cut" : "");
-    printf("steps           %lld (mean walk length %.4g; kernel rows built %lld)\n", (long long)r->steps, mean_len,
-           (long long)r->rows);
-    printf("variance        %.6g per walk (relative error %.3g)\n", r->variance, rel);
-    printf("seconds         %.4f (%.3g M steps/s, %d threads, seed %llu)\n", r->seconds,
-           r->seconds > 0 ? (double)r->steps / r->seconds / 1e6 : 0.0, r->threads,
-           (unsigned long long)o->exec.seed);
-    printf("figure of merit %.4g (1 / (relative variance x seconds))\n",
-           r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : INFINITY);
-    printf("guards          rho(|M|) in [%.6g, %.6g] (%s), rho(M^) in [%.6g, %.6g] (%s)", ro->g.abs.lower,
-           ro->g.abs.upper, cli_verdict_word(ro->g.verdict_abs), ro->g.hat[o->mode].lower, ro->g.hat[o->mode].upper,
-           cli_verdict_word(ro->g.verdict_hat[o->mode]));
-    if (o->kernel.kernel_alpha != 1.0) printf(" at kernel exponent alpha = %g", o->kernel.kernel_alpha);
-    printf("\n");
-    if (isfinite(r->score_bound))
-        printf("tail            a single score is at most %.4g: one more walk could move the estimate by at "
-               "most %.3g%%\n", r->score_bound, 100 * r->tail_bound);
-    else if (isfinite(r->tail_bound))
-        printf("tail            scores grow with the walk's length; walks short enough to matter (the rest add under "
-               "%.3g%% of the answer) could move it by at most %.3g%% more\n", 100 * (o->stop.rel_err > 0 ? o->stop.rel_err : 0.01),
-               100 * r->tail_bound);
-    else
-        printf("tail            scores are unbounded (walk length, weights): no walk count rules out an unseen "
-               "large score; the variance's own relative error is %.3g\n", r->variance_rel_error);
-    if (o->mode == ULAM_FORWARD)
-        printf("unreached       %lld of %lld components (no walk tallied them: no estimate)\n",
-               (long long)r->unreached, (long long)ro->n);
-    cli_print_rel_err(o, r, 1);
-    printf("load            %.3f s inputs, %.3f s guards, %.3f s %s; peak memory %.0f MiB\n",
-           ro->load_seconds, ro->guard_seconds, ro->kernel_seconds,
-           ro->ch ? "choice and solver set-up (auto's guards, pilots, set-up)" : "solver set-up", peak_rss_mib());
-    if (ro->ch) ulam_choice_fprint(stdout, ro->ch, 1, cli_verbosity >= 1);
-}
-
-/* Print the JSON object. */
-static void print_json(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
-{
-    printf("{\"index\": %lld, ", (long long)(o->query.index + cli_node_base));
-    if (strcmp(cli_answer_name, "x")) printf("\"quantity\": \"%s\", ", cli_answer_name);
-    ulam_walk_result_json(stdout, o, r, &ro->g); /* the result's members: the library's schema */
-    printf("\"ranks\": %d, ", cli_share ? cli_share->nranks : 1);
-    cli_json_number("load_seconds", ro->load_seconds, 0);
-    cli_json_number("guard_seconds", ro->guard_seconds, 0);
-    cli_json_number("kernel_seconds", ro->kernel_seconds, 0);
-    printf("\"kernel_rows\": %lld, ", (long long)r->rows);
-    cli_json_number("peak_rss_mib", peak_rss_mib(), 0);
-    if (ro->check) {
-        cli_json_number("direct", ro->direct, 0);
-        cli_json_number("direct_seconds", ro->direct_seconds, 0);
-        cli_json_string("direct_method", ro->direct_method, 0);
-        cli_json_number("z", cli_z(r->estimate, ro->direct, r->std_error), 0);
-    }
-    if (ro->ch) ulam_choice_fprint(stdout, ro->ch, 1, ULAM_REPORT_JSON);
-    printf("\"interrupted\": %s}\n", r->interrupted ? "true" : "false");
-}
 
 /* The reference value of x_index for --check (sparse or dense LU, src/cli/direct.c), interruptible:
  * 0, EXIT_INTERRUPTED (the solve still runs: the caller must leave s alone) or an exit code. */
@@ -221,56 +82,6 @@ static int write_vectors(const ulam_solver *sv, int64_t n, const char *out, cons
     free(x), free(e);
     if (!fail) fail = out ? out : errors;
     return status ? cli_report_write(fail, status, errnum) : 0;
-}
-
-/* A duration in words: seconds, minutes, hours, days or years. */
-static void say_duration(char *out, size_t size, double t)
-{
-    if (t < 120) snprintf(out, size, "%.0f seconds", t);
-    else if (t < 7200) snprintf(out, size, "%.0f minutes", t / 60);
-    else if (t < 172800) snprintf(out, size, "%.1f hours", t / 3600);
-    else if (t < 63115200) snprintf(out, size, "%.0f days", t / 86400);
-    else snprintf(out, size, "%.3g years", t / 31557600);
-}
-
-/* After the first round of a run bounded only by --walks N: when N walks at that round's pace
- * would take over an hour, say how long (issue 42: --walks 1e12 started with no word of it). */
-static void walks_warning(const cli_system *s, const ulam_walk_opts *o, const ulam_walk_result *r)
-{
-    if (!(o->stop.max_walks > 0) || o->stop.max_seconds > 0 || !(r->walks > 0) || !(r->seconds > 0)) return;
-    double t = r->seconds / (double)r->walks * (double)(o->stop.max_walks - r->walks);
-    if (t < 3600) return;
-    char d[64];
-    say_duration(d, sizeof d, t);
-    fprintf(stderr, "ulam: %s: warning: --walks %lld at the pace of the first %lld (%.3g s) takes %sabout %s more; "
-                    "Ctrl-C stops and prints the estimate so far, --time S bounds the run\n", s->matrix_path,
-            (long long)o->stop.max_walks, (long long)r->walks, r->seconds, o->stop.rel_err > 0 ? "up to " : "", d);
-}
-
-/* After the first round: say so when the rel-err rule's minimum walk count (from the bound on a
- * single score) is out of reach, and name the estimators without that tail. */
-static void rel_err_warning(const cli_system *s, const ulam_walk_opts *o, const ulam_walk_result *r)
-{
-    double limit = o->stop.max_walks > 0 ? (double)o->stop.max_walks : 1e8;
-    if (!(o->stop.rel_err > 0)) return;
-    if (!isfinite(r->tail_bound) && r->walks > 0 && r->estimate != 0) { /* (at 0 the tail is infinite too) */
-        fprintf(stderr, "ulam: %s: warning: --rel-err %g: no bound on a single walk's score holds (weights can grow "
-                        "without bound, or the walk's length tail is not certified): the rule cannot be met; the "
-                        "run ends by --walks or --time\n", s->matrix_path, o->stop.rel_err);
-        return;
-    }
-    if (!(r->min_walks > limit)) return;
-    if (isfinite(r->score_bound))
-        fprintf(stderr, "ulam: %s: warning: --rel-err %g: a single %sscore can reach %.4g, so the rule needs about "
-                        "%.3g walks at this estimate before it may stop (%s)%s\n", s->matrix_path, o->stop.rel_err,
-                o->estimator == ULAM_ABSORPTION ? "absorption " : "", r->score_bound, r->min_walks,
-                o->stop.max_walks > 0 ? "more than --walks" : "out of reach in practice",
-                o->estimator == ULAM_ABSORPTION ? "; the collision and expected estimators score b directly and "
-                                                  "have no such tail" : "");
-    else
-        fprintf(stderr, "ulam: %s: warning: --rel-err %g: scores grow with the walk's length, so the rule needs about "
-                        "%.3g walks at this estimate before it may stop (%s)\n", s->matrix_path, o->stop.rel_err, r->min_walks,
-                o->stop.max_walks > 0 ? "more than --walks" : "out of reach in practice");
 }
 
 /* Everything ulam solve was asked: parse fills it from argv, run does it. */
@@ -542,6 +353,17 @@ static int start(solve_args *a, report_opts *ro, ulam_choice *ch, ulam_run **run
     return 0; /* bidirectional: --check once its estimate is printed (cli_bidir_auto_run) */
 }
 
+/* The report of walks r run with o (the library writes it: ulam_report_fprint). */
+static ulam_walk_report walk_report(const ulam_walk_opts *o, const ulam_walk_result *r, const report_opts *ro)
+{
+    return (ulam_walk_report){.opts = o, .result = r, .guard = &ro->g, .choice = ro->ch, .n = ro->n,
+                              .node_base = cli_node_base, .answer_name = cli_answer_name,
+                              .ranks = cli_share ? cli_share->nranks : 1, .load_seconds = ro->load_seconds,
+                              .guard_seconds = ro->guard_seconds, .kernel_seconds = ro->kernel_seconds,
+                              .total_seconds = ulam_now() - ro->t_start, .check = ro->check, .direct = ro->direct,
+                              .direct_seconds = ro->direct_seconds, .direct_method = ro->direct_method};
+}
+
 /* Walk until a stopping rule holds (a progress line on a terminal), then write and print the
  * results; 0 or an exit code. */
 static int run(solve_args *a)
@@ -578,7 +400,13 @@ static int run(solve_args *a)
     for (int first = 1; !status && !ulam_solver_done(sv); first = 0) {
         status = ulam_solver_iterate(sv);
         ulam_solver_result(sv, &r);
-        if (first && !status) rel_err_warning(s, o, &r), walks_warning(s, o, &r);
+        if (first && !status) { /* what the first round warns of */
+            char pre[1100];
+            snprintf(pre, sizeof pre, "ulam: %s: ", s->matrix_path);
+            ulam_walk_report w = walk_report(o, &r, &ro);
+            w.prefix = pre;
+            ulam_report_fprint(stderr, ULAM_REPORT_WALK, &w, ULAM_REPORT_WARN);
+        }
         cli_progress_show(&pg, r.walks, r.estimate, r.std_error, o);
     }
     cli_progress_end(&pg);
@@ -609,18 +437,24 @@ static int run(solve_args *a)
     }
     int left = 0; /* a check still running when Ctrl-C came: leave the system to it */
     if (!status && !rc) {
-        if (!ro.json) print_text(o, &r, &ro);
+        ulam_walk_report w = walk_report(o, &r, &ro);
+        if (!ro.json)
+            ulam_report_fprint(stdout, ULAM_REPORT_WALK, &w, cli_verbosity < 0 ? ULAM_REPORT_QUIET : cli_verbosity ? ULAM_REPORT_VERBOSE
+                                                                                                        : ULAM_REPORT_BRIEF);
         cli_flush(); /* the estimate first: a check may take long, a failed write of the files below cannot lose it, and Ctrl-C keeps what is printed */
         if (ro.check && !r.interrupted && cli_rank == 0) {
             rc = cli_system_verify(&a->s);
             rc = rc ? rc : direct_check(s, o->query.index, &ro);
             left = rc == EXIT_INTERRUPTED;
-            if (!ro.json && !rc)
-                printf("direct          %.10g (%s, %.3g s), ", ro.direct, ro.direct_method, ro.direct_seconds),
-                    cli_print_z(r.estimate, ro.direct, r.std_error, r.ci95[0], r.ci95[1]);
+            w = walk_report(o, &r, &ro);
+            if (!ro.json && !rc) ulam_report_fprint(stdout, ULAM_REPORT_WALK, &w, ULAM_REPORT_CHECK);
             if (left && !ro.json) fprintf(stderr, "ulam: --check interrupted: the estimate above stands unchecked\n");
         }
-        if (ro.json && (!rc || left)) print_json(o, &r, &ro);
+        if (ro.json && (!rc || left)) {
+            w = walk_report(o, &r, &ro);
+            ulam_report_fprint(stdout, ULAM_REPORT_WALK, &w, ULAM_REPORT_JSON);
+            cli_json_done = 1;
+        }
         if (r.interrupted) rc = EXIT_INTERRUPTED;
         else if (o->mode == ULAM_FORWARD && (a->out || a->errors) && cli_rank == 0)
             rc = write_vectors(sv, ro.n, a->out, a->errors, &r);
