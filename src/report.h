@@ -1,5 +1,5 @@
 /* report.h: the report module's private pieces (ulam__report_), shared by its writers
- * (src/report*.c): the answer line's column, an interval's digits, --check's z, the rel_err
+ * (src/report_*.c over src/report.c): the answer line's column, an interval's digits, --check's z, the rel_err
  * rule's outcome in words. */
 #ifndef ULAM_REPORT_PRIVATE_H
 #define ULAM_REPORT_PRIVATE_H
