@@ -33,7 +33,7 @@
  * builds the row (so a one-row query reads a few blocks). */
 #include "cache.h"
 #include "defaults.h"
-#include "solve.h"
+#include "reach.h"
 
 #include <fcntl.h>
 #include <math.h>

@@ -4,7 +4,7 @@
 #define ULAM_CACHE_H
 
 #include "internal.h"
-#include "solve.h"
+#include "reach.h"
 
 #include <stdio.h>
 

@@ -4,6 +4,7 @@
 #define ULAM_SOLVE_H
 
 #include "internal.h"
+#include "reach.h"
 
 /* Restart a forward solver on right-hand side b (borrowed) with seed: the kernel is kept,
  * tallies, counts and stopping state are reset (src/solve.c; used by the outer iterations). */
@@ -39,31 +40,6 @@ double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int sign
 
 struct ulam_kernel; /* src/kernel.h */
 
-/* A set of states adjoint walks on K can reach (seen: n flags, closed under the walk's moves,
- * rows checked) and, when bounds is set, what check_reach computes over it from K alone
- * (src/solve.c): the largest weight factor S / q (fbig), continuation (qmax), whether K has a
- * negative entry (neg), the weight growth along paths, and (tail) the length tail's
- * certificate.  ulam__reach_all makes it over every state: a superset of any start's reach, so
- * its bounds hold for every start and b (looser where a start reaches less), computed once. */
-typedef struct ulam__reach {
-    const char *seen;
-    int bounds;
-    const ulam_csr *K;
-    double continue_q, alpha;
-    double fbig, qmax, growth;
-    int neg, tail;
-    double tail_u, kappa;
-    /* the scores of one b over every state (ulam__reach_b; b NULL: none): the largest |b_i|
-       (bmax), |(K b)_i| (kbmax), absorption's |b_i| / p*_i and b_i^2 / p*_i where b_i != 0
-       (gabs, g2abs; INFINITY where p*_i = 0), its first such state with p*_i = 0 (bad, -1:
-       none), and b's signs (bpos, bneg) */
-    const double *b;
-    double bmax, kbmax, gabs, g2abs;
-    int64_t bad;
-    int bpos, bneg;
-    int shared; /* an analysis' bounds every query shares (ulam_analysis_opts.shared_bounds): the
-                   solver reads no more of K for its own start (no tail_len) */
-} ulam__reach;
 
 /* The reach of every state of K at continuation continue_q and exponent alpha with its bounds;
  * seen: n bytes of room, set to all ones (borrowed by R).  ULAM_OK, ULAM_ENOMEM, ULAM_ESYNTAX
