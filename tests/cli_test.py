@@ -572,7 +572,7 @@ def check_radiosity_json_path(ulam):
 
 def check_radiosity_progress(ulam):
     """radiosity shows its progress line on a terminal too."""
-    rc, err = on_tty(ulam, ["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.001",
+    rc, err = on_tty(ulam, ["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.003",
                             "--threads", "1", "--estimator", "next-event"])
     assert rc == 0 and re.search(r"\rulam: \d+ walks, ", err), err
 
@@ -582,13 +582,13 @@ def check_progress(ulam):
     time left for --rel-err), and nothing with --json; on a pipe the table's empty-stderr cases
     show there is none."""
     solve = ["solve", "--method", "walks", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "7", "--threads", "1",
-             "--rel-err", "0.0003"]
+             "--rel-err", "0.0004"]  # 3-4 s: progress lines come 4 a second, the first above the target
     rc, err = on_tty(ulam, solve)
     assert rc == 0 and re.search(r"\rulam: \d+ walks, [-\d.e+]+ \+- [\d.e+-]+, [\d.]+ s, (about \d+|under 1) s left", err), err
     # the time left counts --time too (radiosity --time 3 said "about 26 s left"): under 1 s of 1 s
     rc, err = on_tty(ulam, solve[:-2] + ["--walks", "1e12", "--time", "1"])
     assert rc == 0 and "under 1 s left" in err and not re.search(r"about \d+ s left", err), err
-    rc, err = on_tty(ulam, solve + ["--json"])
+    rc, err = on_tty(ulam, solve[:-2] + ["--time", "1", "--walks", "1e12", "--json"])  # 1 s, 4 lines' time
     assert rc == 0 and "walks," not in err, err
 
 
