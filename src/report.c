@@ -55,6 +55,12 @@ const char *ulam__report_estimator_name(int estimator)
     return estimator >= 0 && estimator < 3 ? names[estimator] : "?";
 }
 
+/* A walk mode's name. */
+const char *ulam__report_mode_name(int mode)
+{
+    return mode == ULAM_FORWARD ? "forward" : "adjoint";
+}
+
 /* Nonzero when the interval was withheld because the scores are too small to square (a b far
  * below 1 that the solver could not rescale: a prepared file's, read lazily; src/stop.h). */
 int ulam__report_score_too_small(const ulam_walk_result *r)

@@ -24,6 +24,9 @@ void ulam__report_z_fprint(FILE *f, double estimate, double direct, double std_e
 /* An estimator's name (enum ulam_estimator): "collision", "absorption", "expected" ("?" for another). */
 const char *ulam__report_estimator_name(int estimator);
 
+/* A walk mode's name (enum ulam_mode): "adjoint" or "forward". */
+const char *ulam__report_mode_name(int mode);
+
 /* Nonzero when r's interval was withheld because its scores are too small to square in doubles. */
 int ulam__report_score_too_small(const ulam_walk_result *r);
 

@@ -72,7 +72,6 @@ static int damping_fprint(FILE *f, const ulam_info_report *ir)
 /* Write the report as text. */
 static int info_text(FILE *f, const ulam_info_report *ir)
 {
-    static const char *const modes[2] = {"adjoint", "forward"};
     const ulam_csr_stats *st = &ir->st;
     const ulam_radius *r = &ir->rho;
     const ulam_guard *g = &ir->g;
@@ -102,7 +101,7 @@ static int info_text(FILE *f, const ulam_info_report *ir)
             ulam_verdict_word(g->verdict_abs));
     for (int m = 0; m < 2; m++) {
         int v = ulam_guard_variance(g, m);
-        fprintf(f, "variance %s %s (rho(M^) %s)\n", modes[m],
+        fprintf(f, "variance %s %s (rho(M^) %s)\n", ulam__report_mode_name(m),
                 v == 0 ? "infinite: no error bar can be trusted"
                 : v < 0 ? "unknown: treated as infinite (no interval) unless --assume-finite-variance" : "finite",
                 ulam_verdict_word(g->verdict_hat[m]));

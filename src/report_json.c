@@ -6,9 +6,6 @@
 #include <math.h>
 #include <string.h>
 
-/* The walk modes and estimators by name (enum ulam_mode, enum ulam_estimator). */
-static const char *const modes[] = {"adjoint", "forward"}, *const estimators[] = {"collision", "absorption", "expected"};
-
 /* Write v, or null when it is not finite. */
 static void value(FILE *f, double v)
 {
@@ -102,7 +99,7 @@ void ulam_walk_result_json(FILE *f, const ulam_walk_opts *o, const ulam_walk_res
     ulam_json_number(f, "seconds", r->seconds, 0);
     ulam_json_number(f, "steps_per_second", r->seconds > 0 ? (double)r->steps / r->seconds : 0.0, 0);
     ulam_json_number(f, "figure_of_merit", r->seconds > 0 && rel > 0 ? 1.0 / (rel * rel * r->seconds) : NAN, 0);
-    fprintf(f, "\"method\": \"walks\", \"mode\": \"%s\", \"estimator\": \"%s\", ", modes[mode], estimators[est]);
+    fprintf(f, "\"method\": \"walks\", \"mode\": \"%s\", \"estimator\": \"%s\", ", ulam__report_mode_name(mode), ulam__report_estimator_name(est));
     fprintf(f, "\"seed\": %llu, \"threads\": %d, ", (unsigned long long)o->exec.seed, r->threads);
 }
 
@@ -156,7 +153,7 @@ static void choice_text(FILE *f, const ulam_choice *ch, int bidir, int verbose)
         fprintf(f, "auto            no certified candidate among %d: ran the closest\n", res->ncand);
     for (int k = 0; k < res->ncand; k++) {
         const ulam_auto_candidate *c = &res->cand[k];
-        fprintf(f, "  %c %-8s %-10s ", k == res->chosen && !(bstate == ULAM_METHOD_CHOSEN) ? '*' : ' ', modes[c->mode], estimators[c->estimator]);
+        fprintf(f, "  %c %-8s %-10s ", k == res->chosen && !(bstate == ULAM_METHOD_CHOSEN) ? '*' : ' ', ulam__report_mode_name(c->mode), ulam__report_estimator_name(c->estimator));
         print_q(f, c->continue_q);
         fprintf(f, " alpha %-3.3g", c->kernel_alpha);
         if (isfinite(c->hat.upper)) fprintf(f, " rho(M^) %-9.4g ", c->hat.rho);
@@ -198,8 +195,8 @@ static void choice_json(FILE *f, const ulam_choice *ch, int bidir)
     for (int k = 0; k < res->ncand; k++) {
         const ulam_auto_candidate *c = &res->cand[k];
         fprintf(f, "%s{", k ? ", " : "");
-        ulam_json_string(f, "mode", modes[c->mode], 0);
-        ulam_json_string(f, "estimator", estimators[c->estimator], 0);
+        ulam_json_string(f, "mode", ulam__report_mode_name(c->mode), 0);
+        ulam_json_string(f, "estimator", ulam__report_estimator_name(c->estimator), 0);
         ulam_json_number(f, "continue", c->continue_q > 0 ? c->continue_q : NAN, 0);
         ulam_json_number(f, "kernel_alpha", c->kernel_alpha, 0);
         ulam_json_number(f, "rho_hat", isfinite(c->hat.upper) ? c->hat.rho : NAN, 0);
@@ -282,7 +279,7 @@ static void print_text(FILE *f, const ulam_outer_report *p)
     double walk_s;
     totals(p, &hist, &walk_s);
     fprintf(f, "method          %s%s%s, tol %g%s\n", ulam_method_name(p->method), walks ? ", " : "",
-            walks ? estimators[p->estimator] : "", p->tol, walks ? "" : " (no walks)");
+            walks ? ulam__report_estimator_name(p->estimator) : "", p->tol, walks ? "" : " (no walks)");
     if (p->method == ULAM_METHOD_GMRES) fprintf(f, "restart         %d\n", p->restart);
     fprintf(f, "outcome         %s after %d iterations%s, residual %.4e\n", outcome(p), p->iterations,
             krylov ? " (matrix-vector products)" : "", p->residual);
@@ -307,7 +304,7 @@ static void print_json(FILE *f, const ulam_outer_report *p)
     totals(p, &hist, &walk_s);
     fprintf(f, "{");
     ulam_json_string(f, "method", ulam_method_name(p->method), 0);
-    if (walks) ulam_json_string(f, "estimator", estimators[p->estimator], 0);
+    if (walks) ulam_json_string(f, "estimator", ulam__report_estimator_name(p->estimator), 0);
     ulam_json_string(f, "outcome", outcome(p), 0);
     fprintf(f, "\"converged\": %s, \"iterations\": %d, ", p->converged ? "true" : "false", p->iterations);
     if (p->method == ULAM_METHOD_GMRES) fprintf(f, "\"restart\": %d, ", p->restart);

@@ -24,12 +24,6 @@ static double peak_rss_mib(void)
     return kb >= 0 ? kb / 1024.0 : getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
 }
 
-/* A walk mode's name (enum ulam_mode). */
-static const char *mode_name(int mode)
-{
-    return mode == ULAM_FORWARD ? "forward" : "adjoint";
-}
-
 /* The unknown's name ("x" unless the caller names it). */
 static const char *name(const ulam_walk_report *p)
 {
@@ -77,7 +71,7 @@ static void brief(FILE *f, const ulam_walk_report *p)
     const ulam_walk_opts *o = p->opts;
     const ulam_walk_result *r = p->result;
     answer(f, p, 0);
-    fprintf(f, "method          %s random walks, %s estimator%s\n", mode_name(o->mode),
+    fprintf(f, "method          %s random walks, %s estimator%s\n", ulam__report_mode_name(o->mode),
             ulam__report_estimator_name(o->estimator), o->mode == ULAM_ADJOINT ? " (walks start at the unknown)"
                                                                          : " (walks start from b: every unknown at once)");
     if (p->choice) ulam_choice_fprint(f, p->choice, 1, ULAM_REPORT_BRIEF);
@@ -115,7 +109,7 @@ static void verbose(FILE *f, const ulam_walk_report *p)
     double mean_len = r->walks ? (double)r->steps / (double)r->walks : 0.0;
     double rel = r->estimate != 0 ? r->std_error / fabs(r->estimate) : INFINITY;
     answer(f, p, 0);
-    fprintf(f, "method          %s walks, %s estimator\n", mode_name(o->mode),
+    fprintf(f, "method          %s walks, %s estimator\n", ulam__report_mode_name(o->mode),
             ulam__report_estimator_name(o->estimator));
     fprintf(f, "walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
             (long long)o->stop.max_steps, r->cut ? ": the estimate is biased by the cut" : "");

@@ -566,13 +566,12 @@ static int bounds_pass(ulam_solver *s, const ulam_csr *K, ulam_error *err)
             if (!fac) fbig = fmax(fbig, ulam__factor(S, s->o.kernel.continue_q));
             qmax = fmax(qmax, q);
         }
-        for (int64_t k = K->rowptr[i]; (!given || need_c) && k < K->rowptr[i + 1]; k++) {
-            neg |= K->val[k] < 0;
+        for (int64_t k = K->rowptr[i]; (!given || need_c || need_j) && k < K->rowptr[i + 1]; k++) {
+            if (!given || need_c) neg |= K->val[k] < 0; /* the forward column scan under given bounds keeps theirs */
             if (fac) fbig = fmax(fbig, fac[k]);
             if (need_c) c += K->val[k] * s->b[K->colidx[k]];
+            else if (need_j && K->colidx[k] == s->o.query.index) c = fmax(c, fabs(K->val[k]));
         }
-        for (int64_t k = K->rowptr[i]; need_j && k < K->rowptr[i + 1]; k++)
-            if (K->colidx[k] == s->o.query.index) c = fmax(c, fabs(K->val[k]));
         if ((adj ? s->b[i] != 0.0 : 1) && q >= 1.0 && bad < 0) bad = i;
         /* what one visit scores: b_i (collision), (M b)_i (expected); forward, at the index: 1
          * (collision), |K_{i,index}| = |M_{index,i}| (expected: the visit tallies w M_{k,i} at
