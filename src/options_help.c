@@ -274,6 +274,7 @@ static const struct help_row {
     "                       unknown (sequential MC, MCSA; default 10); 0 leaves them out\n"
     "  --format F           png (default), svg or pdf charts; each chart's gnuplot script is kept\n"
     "                       beside it (NAME.gp: 'cd DIR && gnuplot NAME.gp' redraws it from the CSVs)\n"
+    "  --no-charts          the CSVs alone: no chart drawn, no gnuplot script written\n"
     "\n"
     "On stdout: the winner at each budget (least RMSE^2 x seconds) with its coverage and the\n"
     "coverage's 95% binomial (Wilson) interval, and the refused methods.  The RMSE charts are\n"

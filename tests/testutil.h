@@ -74,8 +74,41 @@ static inline int test_case_report(void **state)
     return 0;
 }
 
+/* Nonzero when the comma-separated list names holds name. */
+static inline int test_listed(const char *names, const char *name)
+{
+    size_t len = strlen(name);
+    for (const char *p = names; *p; p += strcspn(p, ",") + (p[strcspn(p, ",")] == ',')) {
+        if (strcspn(p, ",") == len && !strncmp(p, name, len)) return 1;
+    }
+    return 0;
+}
+
+/* Keep those of the n tests t[] that ULAM_TEST_ONLY lists, or those ULAM_TEST_EXCEPT does not
+ * (comma-separated names: meson runs a long program as two tests, one of each, so that both
+ * cores work and every test runs once); the count kept, or -1 when the list names a test the
+ * program lacks.  ULAM_TEST or ULAM_TEST_CASE (a rerun by hand) selects from all of them. */
+static inline long test_shard(struct CMUnitTest *t, size_t n)
+{
+    const char *only = getenv("ULAM_TEST_ONLY"), *except = getenv("ULAM_TEST_EXCEPT"), *name = getenv("ULAM_TEST");
+    const char *names = only && *only ? only : except && *except ? except : NULL;
+    if (!names || (name && *name) || test_case_only() >= 0) return (long)n;
+    for (const char *p = names; *p; p += strcspn(p, ",") + (p[strcspn(p, ",")] == ',')) {
+        size_t k = 0, len = strcspn(p, ",");
+        while (k < n && !(strlen(t[k].name) == len && !strncmp(p, t[k].name, len))) k++;
+        if (k == n) {
+            print_error("[  SHARD   ] no test '%.*s' in this program (ULAM_TEST_ONLY / ULAM_TEST_EXCEPT)\n", (int)len, p);
+            return -1;
+        }
+    }
+    size_t m = 0;
+    for (size_t k = 0; k < n; k++)
+        if (test_listed(names, t[k].name) == (names == only)) t[m++] = t[k];
+    return (long)m;
+}
+
 /* Run a program's tests (as cmocka_run_group_tests), each with test_case_report as teardown (and
- * its name as state where it has none) and filtered by ULAM_TEST. */
+ * its name as state where it has none), filtered by ULAM_TEST and sharded by test_shard. */
 #define test_run(tests) test_run_(#tests, (tests), sizeof(tests) / sizeof *(tests))
 
 static inline int test_run_(const char *group, const struct CMUnitTest *tests, size_t n)
@@ -87,6 +120,9 @@ static inline int test_run_(const char *group, const struct CMUnitTest *tests, s
         if (!t[k].teardown_func) t[k].teardown_func = test_case_report;
         if (!t[k].initial_state) t[k].initial_state = (void *)(uintptr_t)t[k].name;
     }
+    long kept = test_shard(t, n);
+    if (kept < 0) return free(t), 1;
+    n = (size_t)kept;
     const char *only = getenv("ULAM_TEST");
     if (only && *only) cmocka_set_test_filter(only);
     int rc = _cmocka_run_group_tests(group, t, n, NULL, NULL);

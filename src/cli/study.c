@@ -31,6 +31,7 @@ typedef struct {
     int nbudget, time_budgets, repeats, threads, force;
     double reference_time; /* seconds for each of sequential MC's and MCSA's reference lines (0: none) */
     const char *format;    /* png, svg or pdf */
+    int no_charts;         /* --no-charts: the CSVs alone, no gnuplot run */
     int partial;           /* interrupted: charts and summary say so */
     uint64_t seed;
     const char *out;
@@ -364,7 +365,7 @@ int cli_study(int argc, char **argv)
         {"omega", required_argument, 0, 'w'},   {"help", no_argument, 0, 'h'},
         {"cache", no_argument, 0, 'C'},         {"force", no_argument, 0, 'F'},
         {"reference-time", required_argument, 0, 'r'}, {"format", required_argument, 0, 'f'},
-        {0, 0, 0, 0}};
+        {"no-charts", no_argument, 0, 'P'},     {0, 0, 0, 0}};
     static const char *const formats[] = {"png", "svg", "pdf"};
     static study st;
     st = (study){.s = {.command = "study", .omega = 1.0}, .repeats = 30, .seed = 1, .out = "study",
@@ -389,6 +390,7 @@ int cli_study(int argc, char **argv)
         case 'j': st.s.jacobi = 1; break;
         case 'C': st.s.cache = 1; break;
         case 'F': st.force = 1; break;
+        case 'P': st.no_charts = 1; break;
         case 'r': if ((rc = cli_parse_real("study", "--reference-time", optarg, 0, 1e6, &st.reference_time))) return rc; break;
         case 'f':
             if ((rc = cli_choose("study", "--format", optarg, formats, 3, "png, svg or pdf")) < 0) return EXIT_USAGE;
@@ -422,9 +424,9 @@ int cli_study(int argc, char **argv)
         int rs = write_report(&st, "summary.csv", ULAM_STUDY_SUMMARY_CSV);
         if (!rs) rs = write_report(&st, "bars.csv", ULAM_STUDY_BARS_CSV);
         if (!rs) {
-            char drawn[512];
+            char drawn[512] = "";
             ulam_study_report_opts ro = report_opts(&st);
-            if (charts(&st, drawn, sizeof drawn)) drawn[0] = '\0';
+            if (!st.no_charts && charts(&st, drawn, sizeof drawn)) drawn[0] = '\0';
             ulam_study_fprint(stdout, st.lib, ULAM_STUDY_TEXT, &ro);
             fprintf(stderr, "ulam: study: wrote %s/: runs.csv, summary.csv, bars.csv, reference.csv, question.txt%s\n",
                     st.out, drawn);
