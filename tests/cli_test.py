@@ -2137,7 +2137,7 @@ def check_method_table(ulam):
     for name in names:
         args = (RS0 + ["--walks", "2000", "--json"] if name == "walks"
                 else PS + ["--rhs", D + "sparse3_b.mtx", "--walks", "2000", "--json"] if name == "bidirectional"
-                else p20 + ["--tol", "1e-6", "--out", os.devnull])
+                else p20 + ["--tol", "1e-3", "--out", os.devnull])  # at 1e-6 sequential and mcsa took 4.9 s of CPU, now 2.3
         rc, out, err = run(ulam, args + ["--method", name])
         assert rc == 0, (name, err)
         o = json.loads(out)
