@@ -148,13 +148,25 @@ typedef struct ulam_query_report {
     int64_t node_base;
 } ulam_query_report;
 
+/* A prepared system file as ulam prepare reports it (ULAM_REPORT_PREPARE; text only: BRIEF and
+ * VERBOSE write the same four lines, path and sizes, rho(|M|) with its verdict, the row and column
+ * sums of |M|, the seconds; another format is ULAM_EINVAL). */
+typedef struct ulam_prepare_report {
+    const char *path;              /* the file written, as named */
+    int64_t n, nnz;                /* M's order and nonzeros */
+    int with_b, jacobi, transpose; /* the file holds b; M is a Jacobi splitting; it holds M^T too */
+    const ulam_certificate *cert;  /* the guards' certificate written with M */
+    double load_seconds, guard_seconds; /* reading the inputs; the certificate */
+} ulam_prepare_report;
+
 /* The kinds of ulam_report_fprint, a row each in its table (src/report_kind.c). */
 enum ulam_report_kind {
     ULAM_REPORT_INFO = 1,   /* ulam_info_report: ulam info */
     ULAM_REPORT_DIRECT = 2, /* ulam_direct_report: ulam direct */
     ULAM_REPORT_QUERY = 3,  /* ulam_query_report: one line of ulam solve --queries */
     ULAM_REPORT_BIDIR = 4,  /* ulam_bidir_report: a bidirectional solve, or the single-source table */
-    ULAM_REPORT_WALK = 5    /* ulam_walk_report: ulam solve's walks */
+    ULAM_REPORT_WALK = 5,   /* ulam_walk_report: ulam solve's walks */
+    ULAM_REPORT_PREPARE = 6 /* ulam_prepare_report: ulam prepare */
 };
 
 /* Write report, the struct kind names, to f in format (enum ulam_report_format; the walk report

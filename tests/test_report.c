@@ -199,7 +199,8 @@ static char *kind_text(int kind, const void *report, int format, int *status)
 }
 
 /* The report kinds: a query's line and JSON object, a direct solve's first ten entries under an
- * edge list's 0-based ids, ulam info's radii, verdicts and damping table; unknown kinds refused. */
+ * edge list's 0-based ids, ulam info's radii, verdicts and damping table, ulam prepare's lines;
+ * unknown kinds refused. */
 static void test_kinds(void **state)
 {
     (void)state;
@@ -284,6 +285,28 @@ static void test_kinds(void **state)
     assert_null(strstr(s, "as is rho(M) for J >= 0"));
     free(s);
     ulam_csr_free(M), ulam_csr_free(A);
+
+    /* ulam prepare's lines: an upper bound just below 1 shows its digits, a tiny one six significant ones */
+    ulam_certificate c = {.rowsum_min = 0.5, .rowsum_max = 1.25, .colsum_min = 0.25, .colsum_max = 2};
+    c.guard.abs = (ulam_power){.rho = 0.99, .lower = 2e-23, .upper = 0.99999999, .iterations = 7, .converged = 1,
+                               .seconds = 0.125};
+    c.guard.verdict_abs = ULAM_VERDICT_EDGE;
+    ulam_prepare_report pr = {.path = "s.ulam", .n = 2, .nnz = 3, .with_b = 1, .transpose = 1, .cert = &c,
+                              .load_seconds = 0.5, .guard_seconds = 0.25};
+    s = kind_text(ULAM_REPORT_PREPARE, &pr, ULAM_REPORT_BRIEF, &st);
+    assert_int_equal(st, ULAM_OK);
+    char want[512];
+    snprintf(want, sizeof want,
+             "prepared       s.ulam: n 2, nnz 3, with b, with M^T\n"
+             "rho(|M|)       0.990000 (bounds [2e-23, 0.99999998999999995], 7 iterations, 0.125 s)  (%s)\n"
+             "row sums |M|   0.5 .. 1.25; column sums 0.25 .. 2\nseconds        0.500 load, 0.250 guards\n",
+             ulam_verdict_word(ULAM_VERDICT_EDGE));
+    assert_string_equal(s, want);
+    free(s);
+    s = kind_text(ULAM_REPORT_PREPARE, &pr, ULAM_REPORT_JSON, &st);
+    assert_int_equal(st, ULAM_EINVAL);
+    assert_string_equal(s, "");
+    free(s);
 
     assert_int_equal(ulam_report_fprint(stdout, 0, &q, ULAM_REPORT_BRIEF), ULAM_EINVAL);
     assert_int_equal(ulam_report_fprint(stdout, 99, &q, ULAM_REPORT_BRIEF), ULAM_EINVAL);
