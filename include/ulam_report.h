@@ -148,6 +148,19 @@ typedef struct ulam_query_report {
     int64_t node_base;
 } ulam_query_report;
 
+/* Answer one query of a batch on analysis a, as ulam solve --queries does (src/queries.c), into q
+ * for ulam_report_fprint's ULAM_REPORT_QUERY: the caller sets q->source and q->index (0-based) and
+ * its own members (query, line, answer_name, node_base); this sets the estimate, std_error, ci95,
+ * rel_err_met, walks, seconds and seed (o->exec.seed: a batch's query k takes
+ * ulam_rng_substream(seed, ULAM_STREAM_QUERY, k)).  source < 0: x_index of (I - M) x = b by o's
+ * adjoint walks (b: a's b, ulam_analysis_opts.b, to walk on a's kept kernel); else x_index with
+ * b = e_source by the bidirectional method on a's transpose under M^T's guards *gt, caller-owned
+ * and zeroed before the first query: derived from o->policy.guard (M's) when it holds the forward
+ * radius at exponent 1, else computed on M^T, then kept.  *interrupted: o's interrupt stopped the
+ * walks (q is then not an answer).  ULAM_OK, ULAM_EINVAL, or the walks' and guards' statuses. */
+int ulam_analysis_query(ulam_analysis *a, const double *b, const ulam_walk_opts *o, ulam_guard *gt,
+                        ulam_query_report *q, int *interrupted, ulam_error *err);
+
 /* A prepared system file as ulam prepare reports it (ULAM_REPORT_PREPARE; text only: BRIEF and
  * VERBOSE write the same four lines, path and sizes, rho(|M|) with its verdict, the row and column
  * sums of |M|, the seconds; another format is ULAM_EINVAL). */
