@@ -148,13 +148,38 @@ typedef struct ulam_query_report {
     int64_t node_base;
 } ulam_query_report;
 
+/* Answer one query of a batch on analysis a, as ulam solve --queries does (src/queries.c), into q
+ * for ulam_report_fprint's ULAM_REPORT_QUERY: the caller sets q->source and q->index (0-based) and
+ * its own members (query, line, answer_name, node_base); this sets the estimate, std_error, ci95,
+ * rel_err_met, walks, seconds and seed (o->exec.seed: a batch's query k takes
+ * ulam_rng_substream(seed, ULAM_STREAM_QUERY, k)).  source < 0: x_index of (I - M) x = b by o's
+ * adjoint walks (b: a's b, ulam_analysis_opts.b, to walk on a's kept kernel); else x_index with
+ * b = e_source by the bidirectional method on a's transpose under M^T's guards *gt, caller-owned
+ * and zeroed before the first query: derived from o->policy.guard (M's) when it holds the forward
+ * radius at exponent 1, else computed on M^T, then kept.  *interrupted: o's interrupt stopped the
+ * walks (q is then not an answer).  ULAM_OK, ULAM_EINVAL, or the walks' and guards' statuses. */
+int ulam_analysis_query(ulam_analysis *a, const double *b, const ulam_walk_opts *o, ulam_guard *gt,
+                        ulam_query_report *q, int *interrupted, ulam_error *err);
+
+/* A prepared system file as ulam prepare reports it (ULAM_REPORT_PREPARE; text only: BRIEF and
+ * VERBOSE write the same four lines, path and sizes, rho(|M|) with its verdict, the row and column
+ * sums of |M|, the seconds; another format is ULAM_EINVAL). */
+typedef struct ulam_prepare_report {
+    const char *path;              /* the file written, as named */
+    int64_t n, nnz;                /* M's order and nonzeros */
+    int with_b, jacobi, transpose; /* the file holds b; M is a Jacobi splitting; it holds M^T too */
+    const ulam_certificate *cert;  /* the guards' certificate written with M */
+    double load_seconds, guard_seconds; /* reading the inputs; the certificate */
+} ulam_prepare_report;
+
 /* The kinds of ulam_report_fprint, a row each in its table (src/report_kind.c). */
 enum ulam_report_kind {
     ULAM_REPORT_INFO = 1,   /* ulam_info_report: ulam info */
     ULAM_REPORT_DIRECT = 2, /* ulam_direct_report: ulam direct */
     ULAM_REPORT_QUERY = 3,  /* ulam_query_report: one line of ulam solve --queries */
     ULAM_REPORT_BIDIR = 4,  /* ulam_bidir_report: a bidirectional solve, or the single-source table */
-    ULAM_REPORT_WALK = 5    /* ulam_walk_report: ulam solve's walks */
+    ULAM_REPORT_WALK = 5,   /* ulam_walk_report: ulam solve's walks */
+    ULAM_REPORT_PREPARE = 6 /* ulam_prepare_report: ulam prepare */
 };
 
 /* Write report, the struct kind names, to f in format (enum ulam_report_format; the walk report

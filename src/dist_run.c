@@ -6,16 +6,14 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 
-/* Each rank's rows and peak resident memory (KiB), in rank order, into v[0 .. 2 nranks) on every
- * rank; nonzero when the sum fails. */
+/* Each rank's rows and peak resident memory (KiB, ulam__peak_rss_kib), in rank order, into
+ * v[0 .. 2 nranks) on every rank; nonzero when the sum fails. */
 static int per_rank(const ulam_comm *c, int64_t rows, int64_t *v)
 {
-    struct rusage u;
     memset(v, 0, (size_t)c->nranks * 2 * sizeof *v);
     v[c->rank] = rows;
-    v[c->nranks + c->rank] = getrusage(RUSAGE_SELF, &u) ? -1 : (int64_t)u.ru_maxrss;
+    v[c->nranks + c->rank] = (int64_t)ulam__peak_rss_kib();
     return c->nranks > 1 && c->sum(c->ctx, v, 2 * c->nranks);
 }
 

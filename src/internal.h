@@ -65,6 +65,10 @@ int ulam__threads(int requested);
 /* The calling thread's number in the enclosing OpenMP team (0 outside one or without OpenMP). */
 int ulam__thread_num(void);
 
+/* This process's peak resident memory so far, in KiB (VmHWM, else ru_maxrss; -1: unknown): the one
+ * measure of ulam solve's peak_rss_mib and a partitioned run's per-rank memory (src/util.c). */
+double ulam__peak_rss_kib(void);
+
 /* Record a failure in err (which may be NULL) and return status. */
 int ulam__fail(ulam_error *err, int status, long line, int64_t index, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -42,7 +42,6 @@ typedef struct {
 typedef struct {
     int format, field, symmetry;
     int64_t m, n, nnz; /* nnz: declared entries (m*n for array) */
-    int libc_strtod;   /* reals by the C library's strtod (the reader as it was, for comparisons) */
 } mm_header;
 
 /* Growing triplet arrays. */
@@ -178,14 +177,13 @@ static int scan_int(const char **pp, int64_t *v)
     return 0;
 }
 
-/* Scan a real number (by the C library's strtod when libc, else ulam_strtod: the same
- * double); 0 on success, -1 if malformed, 2 if NaN or infinite. */
-static int scan_real(const char **pp, int libc, double *v)
+/* Scan a real number (ulam_strtod); 0 on success, -1 if malformed, 2 if NaN or infinite. */
+static int scan_real(const char **pp, double *v)
 {
     const char *p = skip_ws(*pp);
     char *end;
     errno = 0;
-    double x = libc ? strtod(p, &end) : ulam_strtod(p, &end);
+    double x = ulam_strtod(p, &end);
     if (end == p || (*end && *end != ' ' && *end != '\t')) return -1;
     *pp = end;
     *v = x;
@@ -418,7 +416,7 @@ static int parse_value(long line, const char **p, const mm_header *h, double *x,
         *x = (double)v;
         return ULAM_OK;
     }
-    int s = scan_real(p, h->libc_strtod, x);
+    int s = scan_real(p, x);
     if (s < 0) return ulam__fail(err, ULAM_ESYNTAX, line, -1, "a real value");
     if (s > 0)
         return ulam__fail(err, ULAM_ENONFINITE, line, -1, "a finite real value (no NaN or Inf)");
@@ -788,9 +786,8 @@ ulam_mm_opts ulam__mm_defaults(void)
     return (ulam_mm_opts){.threads = 0};
 }
 
-/* Read a sparse matrix from f with options o (NULL: the defaults), reals by the C library's
- * strtod when libc (the reader as it was, for the benchmark's comparison), else ulam_strtod. */
-static int read_matrix(FILE *f, const char *name, const ulam_mm_opts *o, int libc, ulam_csr **A, ulam_error *err)
+/* Read a sparse matrix from f with options o (NULL: the defaults). */
+static int read_matrix(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err)
 {
     ulam__clear(err);
     if (!f || !A) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a file and an output pointer");
@@ -799,7 +796,7 @@ static int read_matrix(FILE *f, const char *name, const ulam_mm_opts *o, int lib
     name = name ? name : "input";
     int threads = ulam__threads(opts.threads), fd = fileno(f);
     long start = ftell(f);
-    mm_header h = {.libc_strtod = libc};
+    mm_header h = {0};
     triplets t = {0};
     reader r;
     if (reader_init(&r, f)) {
@@ -1002,11 +999,5 @@ int ulam_mm_write_vector(const char *path, const double *x, int64_t n, const cha
 /* Read a sparse matrix from f with options o (NULL: the defaults). */
 int ulam_mm_read_matrix_opts(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err)
 {
-    return read_matrix(f, name, o, 0, A, err);
-}
-
-/* As ulam_mm_read_matrix_opts with the C library's strtod (see internal.h). */
-int ulam__mm_read_matrix_libc(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err)
-{
-    return read_matrix(f, name, o, 1, A, err);
+    return read_matrix(f, name, o, A, err);
 }

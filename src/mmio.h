@@ -6,10 +6,6 @@
 
 #include <stdio.h>
 
-/* As ulam_mm_read_matrix_opts with reals by the C library's strtod (the same doubles, slower: the
- * reader as it was), for the reader's benchmark and tests to compare (src/mmio.c). */
-int ulam__mm_read_matrix_libc(FILE *f, const char *name, const ulam_mm_opts *o, ulam_csr **A, ulam_error *err);
-
 /* A coordinate Matrix Market file's header, for reading its entries by byte ranges: order n
  * (square), declared entries, field and symmetry (src/mmio.c's enums), the byte after the size
  * line, the file's size, and the lines up to the size line. */

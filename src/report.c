@@ -1,7 +1,7 @@
 /* The report module's core (its private header src/report.h, which every writer includes): the
- * answer line's column, an interval's digits, --check's z and the rel_err rule's outcome, one
- * home for each; the writers stand above it (report_json.c, report_walk.c, report_bidir.c,
- * report_info.c, report_direct.c, report_query.c, report_kind.c's table). */
+ * answer line's column, an interval's digits, a radius in words, --check's z and the rel_err rule's
+ * outcome, one home for each; the writers stand above it (report_json.c, report_walk.c, report_bidir.c,
+ * report_info.c, report_prepare.c, report_direct.c, report_query.c, report_kind.c's table). */
 #include "report.h"
 
 #include <math.h>
@@ -19,6 +19,29 @@ int ulam__report_ci_digits(double lo, double hi)
         if (strcmp(a, b)) break;
     }
     return p;
+}
+
+/* A radius in words: six decimals from 1e-4 to 1e6 (and 0, inf), six significant digits past them
+ * (1e-23 is not 0.000000, 1e99 not a hundred digits); buf holds 32 characters. */
+const char *ulam__report_radius_str(char *buf, double x)
+{
+    double a = fabs(x);
+    snprintf(buf, 32, a == 0 || !isfinite(a) || (a >= 1e-4 && a < 1e6) ? "%.6f" : "%.6g", x);
+    return buf;
+}
+
+/* Write a radius as "0.900000 (bounds [lo, hi], k iterations, s, converged or a bound)". */
+void ulam__report_power_fprint(FILE *f, const ulam_power *p)
+{
+    /* an upper bound below 1 that 6 decimals round to 1.000000 gets the digits that show it
+     * (issue 42: "bounds [0.990002, 1.000000]" stood beside "below 1") */
+    char r[32], lo[32], hi[40];
+    if (p->upper < 1.0 && p->upper >= 0.9999995) snprintf(hi, sizeof hi, "%.17g", p->upper);
+    else ulam__report_radius_str(hi, p->upper);
+    fprintf(f, "%s (bounds [%s, %s], %d iterations, %.3f s%s)", ulam__report_radius_str(r, p->rho),
+            ulam__report_radius_str(lo, p->lower), hi, p->iterations, p->seconds,
+            p->converged ? "" : p->iterations == 0 ? ", certified by row/column sums; the value is not an estimate"
+                                                   : ", NOT converged: only the bounds are certain");
 }
 
 /* The spaces after "x[index]" (1-based) that put the value at the given column, the one of the

@@ -15,6 +15,13 @@ int ulam__report_pad(const char *name, int64_t index, int column);
 /* The significant digits (10 to 17) that print an interval's ends lo < hi as two numbers. */
 int ulam__report_ci_digits(double lo, double hi);
 
+/* A radius in words: six decimals from 1e-4 to 1e6 (and 0, inf), else six significant digits;
+ * buf holds 32 characters, returned. */
+const char *ulam__report_radius_str(char *buf, double x);
+
+/* Write radius p as "0.900000 (bounds [lo, hi], k iterations, s, converged or a bound)" (no newline). */
+void ulam__report_power_fprint(FILE *f, const ulam_power *p);
+
 /* --check's z = (estimate - direct) / std_error: 0 when they are equal, +-inf when only the stderr is 0. */
 double ulam__report_z(double estimate, double direct, double std_error);
 
@@ -41,12 +48,13 @@ void ulam__report_verdict_json(FILE *f, const char *key, int finite);
  * prefix_is, prefix_lower, prefix_upper, prefix_converged, each followed by ", ". */
 void ulam__report_radius_json(FILE *f, const char *prefix, const ulam_power *p);
 
-/* The writers of ulam_report_fprint's kinds (src/report_info.c, _direct.c, _query.c): report is
+/* The writers of ulam_report_fprint's kinds (src/report_info.c, _direct.c, _query.c, _bidir.c, _walk.c, _prepare.c): report is
  * the kind's struct; 0 or a status. */
 int ulam__report_info_fprint(FILE *f, const void *report, int format);
 int ulam__report_direct_fprint(FILE *f, const void *report, int format);
 int ulam__report_query_fprint(FILE *f, const void *report, int format);
 int ulam__report_bidir_fprint(FILE *f, const void *report, int format);
 int ulam__report_walk_fprint(FILE *f, const void *report, int format);
+int ulam__report_prepare_fprint(FILE *f, const void *report, int format);
 
 #endif

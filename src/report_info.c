@@ -23,28 +23,12 @@ static int neumann_verdict(const ulam_csr_stats *st, const ulam_radius *r, const
     return -1;
 }
 
-/* A radius in words: six decimals from 1e-4 to 1e6 (and 0, inf), six significant digits past them
- * (1e-23 is not 0.000000, 1e99 not a hundred digits); buf holds 32 characters. */
-static const char *radius_str(char *buf, double x)
-{
-    double a = fabs(x);
-    snprintf(buf, 32, a == 0 || !isfinite(a) || (a >= 1e-4 && a < 1e6) ? "%.6f" : "%.6g", x);
-    return buf;
-}
-
-/* Write a radius as "0.900000 (bounds [lo, hi], k iterations, s, converged or a bound)"; at
+/* Write a radius as "label0.900000 (bounds [lo, hi], k iterations, s, converged or a bound)"; at
  * kernel exponent alpha when not 1, and a newline. */
 static void power_fprint(FILE *f, const char *label, const ulam_power *p, double alpha)
 {
-    /* an upper bound below 1 that 6 decimals round to 1.000000 gets the digits that show it
-     * (issue 42: "bounds [0.990002, 1.000000]" stood beside "below 1") */
-    char r[32], lo[32], hi[40];
-    if (p->upper < 1.0 && p->upper >= 0.9999995) snprintf(hi, sizeof hi, "%.17g", p->upper);
-    else radius_str(hi, p->upper);
-    fprintf(f, "%s%s (bounds [%s, %s], %d iterations, %.3f s%s)", label, radius_str(r, p->rho), radius_str(lo, p->lower),
-            hi, p->iterations, p->seconds,
-            p->converged ? "" : p->iterations == 0 ? ", certified by row/column sums; the value is not an estimate"
-                                                   : ", NOT converged: only the bounds are certain");
+    fputs(label, f);
+    ulam__report_power_fprint(f, p);
     if (alpha != 1.0) fprintf(f, " at kernel exponent alpha = %g", alpha);
     fputc('\n', f);
 }
@@ -84,7 +68,7 @@ static int info_text(FILE *f, const ulam_info_report *ir)
     fprintf(f, "row sums of |M|  min %.6g, max %.6g\n", st->abs_rowsum_min, st->abs_rowsum_max);
     fprintf(f, "substochastic    %s\n", st->substochastic ? "yes" : "no");
     char rho[32];
-    fprintf(f, "rho(M)           %s (residual %.1e, %d matvecs%s)\n", radius_str(rho, r->rho), r->residual, r->matvecs,
+    fprintf(f, "rho(M)           %s (residual %.1e, %d matvecs%s)\n", ulam__report_radius_str(rho, r->rho), r->residual, r->matvecs,
             r->converged ? "" : ", NOT converged");
     power_fprint(f, "rho(|M|)         ", &g->abs, 1.0);
     power_fprint(f, "rho(M^) adjoint  ", &g->hat[ULAM_ADJOINT], g->kernel_alpha);

@@ -9,6 +9,7 @@ static int (*const writers[])(FILE *, const void *, int) = {
     [ULAM_REPORT_QUERY] = ulam__report_query_fprint,
     [ULAM_REPORT_BIDIR] = ulam__report_bidir_fprint,
     [ULAM_REPORT_WALK] = ulam__report_walk_fprint,
+    [ULAM_REPORT_PREPARE] = ulam__report_prepare_fprint,
 };
 
 /* See ulam_report.h. */

@@ -3,25 +3,17 @@
  * walks row. */
 #include "ulam_report.h"
 #include "report.h"
+#include "internal.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/resource.h>
 
-/* Peak resident memory of this process so far, in MiB: VmHWM of /proc/self/status, the high-water
- * mark of this program's own memory (getrusage's ru_maxrss keeps, across the exec, that of the
- * process it was forked from: a benchmark's 119 MiB showed as this query's peak), else ru_maxrss. */
+/* Peak resident memory of this process so far, in MiB (ulam__peak_rss_kib; 0 when unknown). */
 static double peak_rss_mib(void)
 {
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    double kb = -1;
-    while (f && kb < 0 && fgets(line, sizeof line, f))
-        if (sscanf(line, "VmHWM: %lf", &kb) != 1) kb = -1;
-    if (f) fclose(f);
-    struct rusage ru;
-    return kb >= 0 ? kb / 1024.0 : getrusage(RUSAGE_SELF, &ru) ? 0.0 : (double)ru.ru_maxrss / 1024.0;
+    double kib = ulam__peak_rss_kib();
+    return kib >= 0 ? kib / 1024.0 : 0.0;
 }
 
 /* The unknown's name ("x" unless the caller names it). */

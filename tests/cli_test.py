@@ -2105,6 +2105,7 @@ def check_auto_bidir(progs):
     o = json.loads(out)
     assert rc == 0 and o["method"] == "bidirectional" and o["walks"] == 2000 and o["push_ops"] > 0, o
     assert o["ci95"][0] <= o["direct"] <= o["ci95"][1] and o["ci95"][1] - o["ci95"][0] < 0.01, o
+    assert o["rho_abs"] is None and o["rho_hat"] is None, o  # the push on b computes no guard (was 0 and 0)
     # rent or buy: the study's r500 (b has 6 nonzeros) has walks cheaper than nnz/4 = 62 400
     with tempfile.TemporaryDirectory() as d:
         assert subprocess.run([genmat, "--radiosity", "500", d + "/r.mtx", d + "/r_b.mtx"], timeout=120).returncode == 0

@@ -1,7 +1,8 @@
 /* A walk result as JSON, a walk run's report, the report kinds (ulam info, direct, a query)
  * (include/ulam_report.h) and the reference solve (include/ulam_reference.h): the members ulam
  * solve --json prints, written to the caller's stream, null for what is not finite; the
- * reference LU as chosen, and GMRES when the LU would pass the memory limit. */
+ * reference LU as chosen, and GMRES when the LU would pass the memory limit; a query of a batch run
+ * by the library (ulam_analysis_query). */
 #include "testutil.h"
 #include "ulam_reference.h"
 #include "ulam_report.h"
@@ -199,7 +200,8 @@ static char *kind_text(int kind, const void *report, int format, int *status)
 }
 
 /* The report kinds: a query's line and JSON object, a direct solve's first ten entries under an
- * edge list's 0-based ids, ulam info's radii, verdicts and damping table; unknown kinds refused. */
+ * edge list's 0-based ids, ulam info's radii, verdicts and damping table, ulam prepare's lines;
+ * unknown kinds refused. */
 static void test_kinds(void **state)
 {
     (void)state;
@@ -285,9 +287,82 @@ static void test_kinds(void **state)
     free(s);
     ulam_csr_free(M), ulam_csr_free(A);
 
+    /* ulam prepare's lines: an upper bound just below 1 shows its digits, a tiny one six significant ones */
+    ulam_certificate c = {.rowsum_min = 0.5, .rowsum_max = 1.25, .colsum_min = 0.25, .colsum_max = 2};
+    c.guard.abs = (ulam_power){.rho = 0.99, .lower = 2e-23, .upper = 0.99999999, .iterations = 7, .converged = 1,
+                               .seconds = 0.125};
+    c.guard.verdict_abs = ULAM_VERDICT_EDGE;
+    ulam_prepare_report pr = {.path = "s.ulam", .n = 2, .nnz = 3, .with_b = 1, .transpose = 1, .cert = &c,
+                              .load_seconds = 0.5, .guard_seconds = 0.25};
+    s = kind_text(ULAM_REPORT_PREPARE, &pr, ULAM_REPORT_BRIEF, &st);
+    assert_int_equal(st, ULAM_OK);
+    char want[512];
+    snprintf(want, sizeof want,
+             "prepared       s.ulam: n 2, nnz 3, with b, with M^T\n"
+             "rho(|M|)       0.990000 (bounds [2e-23, 0.99999998999999995], 7 iterations, 0.125 s)  (%s)\n"
+             "row sums |M|   0.5 .. 1.25; column sums 0.25 .. 2\nseconds        0.500 load, 0.250 guards\n",
+             ulam_verdict_word(ULAM_VERDICT_EDGE));
+    assert_string_equal(s, want);
+    free(s);
+    s = kind_text(ULAM_REPORT_PREPARE, &pr, ULAM_REPORT_JSON, &st);
+    assert_int_equal(st, ULAM_EINVAL);
+    assert_string_equal(s, "");
+    free(s);
+
     assert_int_equal(ulam_report_fprint(stdout, 0, &q, ULAM_REPORT_BRIEF), ULAM_EINVAL);
     assert_int_equal(ulam_report_fprint(stdout, 99, &q, ULAM_REPORT_BRIEF), ULAM_EINVAL);
     assert_int_equal(ulam_report_fprint(stdout, ULAM_REPORT_QUERY, NULL, ULAM_REPORT_BRIEF), ULAM_EINVAL);
+}
+
+/* ulam_analysis_query, ulam solve --queries' engine: an index line is the walks on the analysis'
+ * kept kernel, ulam_solve_walks' bit for bit (same seed, a fixed budget), within 4 sigma of LAPACK; a point source's line is within
+ * 4 sigma of LAPACK with b = e_S, under M^T's guards it derives once; missing pieces refused. */
+static void test_query_run(void **state)
+{
+    (void)state;
+    enum { N = 60 };
+    int32_t ti[4 * N], tj[4 * N];
+    double tx[4 * N], b[N], e[N] = {0}, x[N], xs[N];
+    for (int i = 0; i < N; i++) /* four entries of 0.2 a row: rho(M) = 0.8 */
+        for (int k = 0; k < 4; k++)
+            ti[4 * i + k] = i, tj[4 * i + k] = (int32_t)((i + 1 + 7 * k + (k == 3 ? i : 0)) % N), tx[4 * i + k] = 0.2;
+    for (int i = 0; i < N; i++) b[i] = 1 + i % 3;
+    e[2] = 1;
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(N, N, 4 * N, ti, tj, tx, &M), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, e, xs, 0, NULL, NULL), ULAM_OK);
+    ulam_guard g;
+    ulam_guard_opts go = ulam_guard_defaults();
+    assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
+    ulam_analysis_opts ao = ulam_analysis_defaults();
+    ao.b = b;
+    ulam_analysis *a = NULL;
+    assert_int_equal(ulam_analysis_alloc(M, &ao, &a, NULL), ULAM_OK);
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.mode = ULAM_ADJOINT, o.stop.max_walks = 4000, o.exec.threads = 1, o.exec.seed = 7, o.policy.guard = &g;
+    ulam_guard gt = {0};
+    int stopped = 1;
+    ulam_query_report q = {.source = -1, .index = 5, .answer_name = "x", .node_base = 1};
+    assert_int_equal(ulam_analysis_query(a, b, &o, &gt, &q, &stopped, NULL), ULAM_OK);
+    ulam_walk_opts w = o;
+    w.query.index = 5;
+    ulam_walk_result r;
+    assert_int_equal(ulam_solve_walks(M, b, &w, &r, NULL), ULAM_OK);
+    assert_false(stopped);
+    assert_true(q.estimate == r.estimate && q.std_error == r.std_error && q.walks == 4000 && q.seed == 7);
+    assert_true(fabs(q.estimate - x[5]) < 4 * q.std_error);
+    q.source = 2, o.exec.seed = 8;
+    assert_int_equal(ulam_analysis_query(a, b, &o, &gt, &q, &stopped, NULL), ULAM_OK);
+    assert_true(gt.computed & ULAM_GUARD_ADJOINT); /* M^T's guards, kept for the next point source */
+    assert_true(q.std_error > 0 && fabs(q.estimate - xs[5]) < 4 * q.std_error && q.seed == 8);
+    ulam_error err;
+    assert_int_equal(ulam_analysis_query(a, b, &o, NULL, &q, &stopped, &err), ULAM_EINVAL); /* no M^T guards */
+    q.source = -1;
+    assert_int_equal(ulam_analysis_query(a, NULL, &o, &gt, &q, &stopped, &err), ULAM_EINVAL); /* no b */
+    assert_int_equal(ulam_analysis_query(a, b, &o, &gt, &q, NULL, &err), ULAM_EINVAL);
+    ulam_analysis_free(a);
+    ulam_csr_free(M);
 }
 
 /* What a writer wrote: the string of its last call (freed by the next, and at the end). */
@@ -372,6 +447,7 @@ int main(void)
         cmocka_unit_test(test_reference),
         cmocka_unit_test(test_kinds),
         cmocka_unit_test(test_walk_report),
+        cmocka_unit_test(test_query_run),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -106,7 +106,8 @@ static int answer(const cli_system *s, const ulam_bidir_opts *o, ulam_bidir_resu
     ulam_bidir_report *p = &rp->rep;
     if (rp->scale > 0) /* PageRank's pi = (1 - alpha) x: the answer, its interval and --check's */
         r->estimate *= rp->scale, r->std_error *= rp->scale, r->ci95[0] *= rp->scale, r->ci95[1] *= rp->scale;
-    p->opts = o, p->result = r, p->guard = &rp->g, p->check = 0;
+    p->opts = o, p->result = r, p->check = 0;
+    p->guard = p->dense ? NULL : &rp->g; /* the push on b computes no guard here: none written (JSON null) */
     report_fill(s, rp);
     if (!rp->json) {
         ulam_report_fprint(stdout, ULAM_REPORT_BIDIR, p, cli_verbosity < 0 ? ULAM_REPORT_QUIET : cli_verbosity > 0 ? ULAM_REPORT_VERBOSE : ULAM_REPORT_BRIEF);

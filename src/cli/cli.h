@@ -217,12 +217,6 @@ void cli_json_number(const char *key, double v, int last);
 /* Print a JSON string (escaped). */
 void cli_json_string(const char *key, const char *v, int last);
 
-/* Print a power-iteration radius with its bounds (no newline). */
-void cli_print_power(const ulam_power *p);
-
-/* A radius in words (cli_print_power's figures): buf of 32 characters, returned. */
-const char *cli_radius_str(char *buf, double x);
-
 /* The guards' radii for a walk in mode on s with kernel exponent alpha (rho(|M|) and that mode's
  * rho(M^), stopped once certified): a prepared file's certificate made for this continuation
  * (and exponent: a certificate holds alpha = 1's) serves instead of a pass

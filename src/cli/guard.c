@@ -30,29 +30,6 @@ const char *cli_system_hint(const ulam_csr *M)
     return "";
 }
 
-/* A radius in words: six decimals from 1e-4 to 1e6 (and 0, inf), six significant digits past them
- * (1e-23 is not 0.000000, 1e99 not a hundred digits); buf holds 32 characters. */
-const char *cli_radius_str(char *buf, double x)
-{
-    double a = fabs(x);
-    snprintf(buf, 32, a == 0 || !isfinite(a) || (a >= 1e-4 && a < 1e6) ? "%.6f" : "%.6g", x);
-    return buf;
-}
-
-/* Print a radius as "0.900000 (bounds [lo, hi], k iterations, s, converged or a bound)". */
-void cli_print_power(const ulam_power *p)
-{
-    /* an upper bound below 1 that 6 decimals round to 1.000000 gets the digits that show it
-     * (issue 42: "bounds [0.990002, 1.000000]" stood beside "below 1") */
-    char r[32], lo[32], hi[40];
-    if (p->upper < 1.0 && p->upper >= 0.9999995) snprintf(hi, sizeof hi, "%.17g", p->upper);
-    else cli_radius_str(hi, p->upper);
-    printf("%s (bounds [%s, %s], %d iterations, %.3f s%s)", cli_radius_str(r, p->rho), cli_radius_str(lo, p->lower), hi,
-           p->iterations, p->seconds,
-           p->converged ? "" : p->iterations == 0 ? ", certified by row/column sums; the value is not an estimate"
-                                                  : ", NOT converged: only the bounds are certain");
-}
-
 /* The guards' radii for a walk in mode on s (rho(|M|) and that mode's rho(M^), stopped once
  * certified); 0 or an exit code (error reported). */
 int cli_guard(cli_system *s, double continue_q, double alpha, int mode, ulam_guard *g)

@@ -71,14 +71,10 @@ int cli_prepare(int argc, char **argv)
         err = (ulam_error){.status = status, .msg = "a writable output file"};
         rc = cli_report(out, &err);
     } else {
-        printf("prepared       %s: n %lld, nnz %lld%s%s%s\n", out, (long long)s.M->nrows, (long long)ulam_csr_nnz(s.M),
-               s.b ? ", with b" : ", no b", s.jacobi ? ", Jacobi splitting" : "", transpose ? ", with M^T" : "");
-        printf("rho(|M|)       ");
-        cli_print_power(&cert.guard.abs);
-        printf("  (%s)\nrow sums |M|   %.6g .. %.6g; column sums %.6g .. %.6g\n",
-               ulam_verdict_word(cert.guard.verdict_abs), cert.rowsum_min, cert.rowsum_max, cert.colsum_min,
-               cert.colsum_max);
-        printf("seconds        %.3f load, %.3f guards\n", load, guards);
+        ulam_prepare_report pr = {.path = out, .n = s.M->nrows, .nnz = ulam_csr_nnz(s.M), .with_b = s.b != NULL,
+                                  .jacobi = s.jacobi, .transpose = transpose, .cert = &cert,
+                                  .load_seconds = load, .guard_seconds = guards};
+        ulam_report_fprint(stdout, ULAM_REPORT_PREPARE, &pr, ULAM_REPORT_BRIEF);
     }
     cli_system_free(&s);
     return rc;

@@ -11,7 +11,9 @@
  * --rel-err run there walks under bounds over every state, which may ask for more walks than a
  * lone run's search of its start's reach).  One result a line, flushed as it is made: Ctrl-C
  * stops the query under way and keeps the answered lines (exit 130).  The whole file is read
- * and checked before the first query runs: a bad line is an error (file:line) with no output. */
+ * and checked before the first query runs: a bad line is an error (file:line) with no output.
+ * The queries themselves are the library's (ulam_analysis_query, src/queries.c); this file reads
+ * the file, loads the system and prints. */
 #include "cli.h"
 
 #include <errno.h>
@@ -101,80 +103,25 @@ typedef struct {
     cli_system *s;
     ulam_analysis *an;
     const char *path;
-    ulam_guard g, gt; /* the guards of M and (point sources) of its transpose */
-    int have_gt;
+    ulam_guard g, gt; /* the guards of M and (point sources, ulam_analysis_query's) of its transpose */
 } shared;
 
-/* The guards of M's transpose from M's (rho(|M^T|) = rho(|M|); the adjoint kernel of M^T is M's
- * forward one), computed when M's lack the forward radius; 0 or an exit code. */
-static int transpose_guard(shared *w, const ulam_csr *Mt, double q)
-{
-    if (w->have_gt) return 0;
-    ulam_guard_opts go = ulam_guard_defaults();
-    go.need = ULAM_GUARD_ABS | ULAM_GUARD_ADJOINT;
-    ulam_error err;
-    int fwd = (w->g.computed & ULAM_GUARD_FORWARD) && w->g.kernel_alpha == 1.0;
-    if (fwd) {
-        w->gt = w->g;
-        w->gt.hat[ULAM_ADJOINT] = w->g.hat[ULAM_FORWARD], w->gt.hat[ULAM_FORWARD] = w->g.hat[ULAM_ADJOINT];
-        w->gt.verdict_hat[ULAM_ADJOINT] = w->g.verdict_hat[ULAM_FORWARD];
-        w->gt.verdict_hat[ULAM_FORWARD] = w->g.verdict_hat[ULAM_ADJOINT];
-        w->gt.computed = ULAM_GUARD_ABS | ULAM_GUARD_ADJOINT | ((w->g.computed & ULAM_GUARD_ADJOINT) ? ULAM_GUARD_FORWARD : 0);
-    } else if (ulam_guard_check(Mt, q, &go, &w->gt, &err)) {
-        return cli_report(w->s->matrix_path, &err);
-    }
-    w->have_gt = 1;
-    return 0;
-}
-
-/* The walks o names on the analysis' kept kernel, to their end (ulam_analysis_solver): the status,
- * r filled (as far as they went) and err on failure. */
-static int walks_on(ulam_analysis *an, const double *b, const ulam_walk_opts *o, ulam_walk_result *r, ulam_error *err)
-{
-    ulam_solver *sv = NULL;
-    int status = ulam_analysis_solver(an, b, o, &sv, err);
-    while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
-    if (sv) ulam_solver_result(sv, r);
-    if (status && sv) ulam_solver_error(sv, err);
-    ulam_solver_free(sv);
-    return status;
-}
-
-/* Run query k with options o (its seed and target set); 0, an exit code, or EXIT_INTERRUPTED. */
-static int run_query(shared *w, const query *q, int64_t k, ulam_walk_opts o, int json)
+/* Run query k with options o (its seed and target set) by ulam_analysis_query and print its line;
+ * 0, an exit code, or EXIT_INTERRUPTED. */
+static int run_query(shared *w, const query *q, int64_t k, const ulam_walk_opts *o, int json)
 {
     ulam_error err;
-    double t0 = ulam_now();
-    int status, interrupted;
-    ulam_query_report a = {.query = k, .line = q->line, .source = q->source, .index = q->index, .seed = o.exec.seed,
+    int interrupted;
+    ulam_query_report a = {.query = k, .line = q->line, .source = q->source, .index = q->index,
                            .answer_name = cli_answer_name, .node_base = cli_node_base};
-    if (q->source < 0) {
-        o.query.index = q->index;
-        ulam_walk_result r;
-        status = walks_on(w->an, w->s->b, &o, &r, &err);
-        a.estimate = r.estimate, a.std_error = r.std_error, a.ci95[0] = r.ci95[0], a.ci95[1] = r.ci95[1];
-        a.rel_err_met = r.rel_err_met, a.walks = r.walks, interrupted = r.interrupted;
-    } else {
-        const ulam_csr *Mt = ulam_analysis_transpose(w->an, &err);
-        if (!Mt) return cli_report(w->s->matrix_path, &err);
-        int rc = transpose_guard(w, Mt, o.kernel.continue_q);
-        if (rc) return rc;
-        ulam_bidir_opts bo = ulam_bidir_defaults();
-        bo.walk = o;
-        bo.walk.policy.guard = &w->gt;
-        bo.source = q->source, bo.target = q->index, bo.reach_all = 1, bo.keep_kernel = 1;
-        ulam_bidir_result r;
-        status = ulam_analysis_bidir(w->an, &bo, &r, &err); /* its transpose, push workspace and plans */
-        double pi = w->s->pagerank > 0 && strcmp(cli_answer_name, "x") ? 1.0 - w->s->pagerank : 1.0; /* b = e_S: pi = (1 - alpha) x */
-        a.estimate = pi * r.estimate, a.std_error = pi * r.std_error, a.ci95[0] = pi * r.ci95[0], a.ci95[1] = pi * r.ci95[1];
-        a.rel_err_met = r.walks.rel_err_met || r.walks.walks == 0, a.walks = r.walks.walks, interrupted = r.walks.interrupted;
-    }
+    int status = ulam_analysis_query(w->an, w->s->b, o, &w->gt, &a, &interrupted, &err);
     if (status) {
         fprintf(stderr, "ulam: %s: query %lld (line %ld): ", w->path, (long long)k + 1, q->line);
         return cli_report(w->s->matrix_path, &err);
     }
     if (interrupted) return EXIT_INTERRUPTED; /* the answered lines stay; this one is not an answer */
-    a.seconds = ulam_now() - t0;
+    double pi = q->source >= 0 && w->s->pagerank > 0 && strcmp(cli_answer_name, "x") ? 1.0 - w->s->pagerank : 1.0;
+    a.estimate *= pi, a.std_error *= pi, a.ci95[0] *= pi, a.ci95[1] *= pi; /* b = e_S: pi = (1 - alpha) x */
     cli_json_done |= json;
     ulam_report_fprint(stdout, ULAM_REPORT_QUERY, &a, json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
     fflush(stdout);
@@ -216,7 +163,7 @@ int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int js
         ulam_walk_opts ok = base;
         ok.exec.seed = ulam_rng_substream(o->exec.seed, ULAM_STREAM_QUERY, (uint64_t)k); /* printed with the answer */
         if (q[k].target > 0) ok.stop.rel_err = q[k].target, ok.stop.max_walks = walks_given ? ok.stop.max_walks : 0;
-        rc = run_query(&w, &q[k], k, ok, json);
+        rc = run_query(&w, &q[k], k, &ok, json);
     }
     fflush(stdout);
     cli_release_sigint();

@@ -43,7 +43,7 @@
  * Usage: bench_bidir [L [SOURCES]] (default 20 and 20: n = 1048576, 100 pairs). */
 #include "../../src/bidir.h" /* ulam__bidir_solve on a kept push workspace: the estimator alone */
 #include "../../src/push.h"
-#include "gen.h"
+#include "exact.h"
 #include "../zipf_graph.h"
 
 #include <math.h>

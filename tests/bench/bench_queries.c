@@ -11,7 +11,7 @@
  * (default 20 and 20: 100 pairs). */
 #include "../../src/bidir.h" /* ulam__bidir_solve on a kept push workspace: the estimator alone */
 #include "../../src/push.h"
-#include "gen.h"
+#include "exact.h"
 
 enum { SOURCES = 20, TARGETS = 5, PAIRS = SOURCES * TARGETS };
 static const double REL = 0.1, ALPHA = 0.85;

@@ -24,6 +24,7 @@
 #include <sys/wait.h>
 
 #include "gen.h"
+#include "../../src/internal.h" /* ulam__gauss_seidel_sweep: the reference solve */
 #include "gnuplot.h"
 
 #ifdef HAVE_UMFPACK

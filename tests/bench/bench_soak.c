@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "gen.h"
+#include "../../src/internal.h" /* ulam__gauss_seidel_settle: the reference solve */
 
 int main(void)
 {

@@ -11,7 +11,6 @@
 #include <unistd.h>
 
 #include "ulam.h"
-#include "../../src/internal.h" /* ulam__gauss_seidel_sweep, _settle: the reference solves */
 
 /* Radiosity-like M: n x n, 8 nonzeros a row at columns drawn uniformly (stream (n, 0)),
  * values 0.1 + U(0, 1) scaled so every row sums to 0.9, so rho(|M|) = rho(M) = 0.9 exactly
@@ -214,23 +213,6 @@ static inline ulam_csr *bench_rmat(int L, double alpha, int64_t *dangling, int64
 done:
     free(perm), free(src), free(dst), free(outdeg), free(indeg), free(val);
     return M;
-}
-
-/* x = (I - M)^-1 e_s by Gauss-Seidel until no entry moves by more than 1e-15; the sweeps done. */
-static inline int bench_exact_column(const ulam_csr *M, int64_t s, double *x, double *old, double *b)
-{
-    int64_t n = M->nrows;
-    memset(x, 0, (size_t)n * sizeof *x);
-    memset(b, 0, (size_t)n * sizeof *b);
-    b[s] = 1.0;
-    int sweeps = 0;
-    for (double change = INFINITY; change > 1e-15 && sweeps < 2000; sweeps++) {
-        memcpy(old, x, (size_t)n * sizeof *x);
-        ulam__gauss_seidel_sweep(M, b, x);
-        change = 0;
-        for (int64_t i = 0; i < n; i++) change = fmax(change, fabs(x[i] - old[i]));
-    }
-    return sweeps;
 }
 
 /* The metastable chain of issue 25 (tests/test_stop.c): 40 states; cluster A (states 0..19,
