@@ -221,8 +221,8 @@ static void test_final_corridor(void **state)
     box_close(&b);
 }
 
-/* The same bits at 1 and 2 threads; a stop before the gather leaves NaN and says so; the
- * errors. */
+/* The same bits at 1 and 2 threads, and on a subset (ulam_rad_final_some); a stop before the
+ * gather leaves NaN and says so; the errors. */
 static void test_final_threads_and_errors(void **state)
 {
     (void)state;
@@ -239,6 +239,21 @@ static void test_final_threads_and_errors(void **state)
     assert_int_equal(in.scene.lit, n);
     assert_int_equal(in.scene.unreached, 0);
     assert_true(in.rays == 2 * in.samples);
+    /* ulam_rad_final_some on the even patches: their bits as the whole run's, the others NaN and
+       out of the rule */
+    unsigned char *want = malloc((size_t)n);
+    assert_non_null(want);
+    for (int64_t p = 0; p < n; p++) want[p] = p % 2 == 0;
+    ulam_rad_opts q = ulam_rad_defaults();
+    q.stop.rel_err = 0.0, q.stop.max_walks = 128, q.exec.seed = 7, q.exec.threads = 2;
+    assert_int_equal(ulam_rad_final_some(b.t, &q, 0, 1.0, want, B2, se, half, &in, NULL), ULAM_OK);
+    for (int64_t p = 0; p < n; p++)
+        if (want[p]) assert_memory_equal(B1 + 3 * p, B2 + 3 * p, 3 * sizeof *B1);
+        else assert_true(isnan(B2[3 * p]));
+    assert_int_equal(in.gathered, n / 2);
+    assert_int_equal(in.scene.lit, n / 2);
+    assert_int_equal(in.scene.unreached, 0);
+    free(want);
     ulam_rad_opts o = ulam_rad_defaults();
     volatile int stop = 1;
     o.stop.rel_err = 0.1, o.stop.interrupt = &stop, o.exec.threads = 2;

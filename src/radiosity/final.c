@@ -378,13 +378,14 @@ static int final_pilot(final_ctx *x, const ulam_rad_opts *o, int64_t particles, 
 /* The whole scene's rule from the patches' answers: a patch is lit when it emits or a sample
  * scored on it; unreached when it reflects, emits nothing, and no sample scored (or the stop came
  * first: NaN); lit patches meet E when every nonzero channel's 95% half-width is at most E B. */
-static void final_rule(const ulam_scene *s, const double *B, const double *se, const double *half, double E,
-                       double share, ulam_rad_scene_rule *q, int64_t first[8])
+static void final_rule(const ulam_scene *s, const unsigned char *want, const double *B, const double *se, const double *half,
+                       double E, double share, ulam_rad_scene_rule *q, int64_t first[8])
 {
     memset(q, 0, sizeof *q);
     for (int k = 0; k < 8; k++) first[k] = -1;
     q->worst_patch = -1, q->share = share;
     for (int64_t p = 0; p < s->npatches; p++) {
+        if (want && !want[p]) continue;
         double bright = 0.0, worst = 0.0, wse = 0.0;
         int met = 1;
         for (int c = 0; c < 3; c++) {
@@ -409,6 +410,14 @@ static void final_rule(const ulam_scene *s, const double *B, const double *se, c
 /* Every patch's radiosity by final gathering over a shooting pilot. */
 int ulam_rad_final(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilot, double share, double *B, double *se,
                    double *half, ulam_rad_final_info *info, ulam_error *err)
+{
+    return ulam_rad_final_some(t, opts, pilot, share, NULL, B, se, half, info, err);
+}
+
+/* The wanted patches' radiosity by final gathering over a shooting pilot. */
+int ulam_rad_final_some(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilot, double share,
+                        const unsigned char *want, double *B, double *se, double *half, ulam_rad_final_info *info,
+                        ulam_error *err)
 {
     ulam_rad_final_info in;
     memset(&in, 0, sizeof in);
@@ -465,7 +474,7 @@ int ulam_rad_final(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilo
 #pragma omp atomic read
                 halt = stop;
                 final_acc *a = &acc[p];
-                if (halt || nomem || a->state == 2) continue;
+                if (halt || nomem || a->state == 2 || (want && !want[p])) continue;
                 if (a->state == 0) {
                     ulam_rng_seed(&a->r, ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, (uint64_t)p), 0);
                     a->state = ulam__max3(s->rho + 3 * p) == 0.0 ? 2 : 1; /* rho 0: B = E exactly */
@@ -503,7 +512,7 @@ int ulam_rad_final(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilo
         in.gathered += a->k > 0;
     }
     if (!status) {
-        final_rule(s, B, se, half, E, share, &in.scene, in.unreached);
+        final_rule(s, want, B, se, half, E, share, &in.scene, in.unreached);
         in.met = E > 0 && in.scene.met_area >= share * in.scene.lit_area * (1.0 - 1e-12) && in.scene.lit > 0;
     }
     in.seconds = ulam_now() - t0;
