@@ -473,6 +473,13 @@ typedef struct ulam_rad_final_info {
 int ulam_rad_final(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilot, double share, double *B, double *se,
                    double *half, ulam_rad_final_info *info, ulam_error *err);
 
+/* ulam_rad_final on the patches with want[p] != 0 only (want: npatches flags; NULL: all), the
+ * importance of a work plane: the pilot still shoots the whole scene, the others are left NaN
+ * and out of the whole scene's rule (info->scene counts the wanted). */
+int ulam_rad_final_some(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilot, double share,
+                        const unsigned char *want, double *B, double *se, double *half, ulam_rad_final_info *info,
+                        ulam_error *err);
+
 /* ---------------------------------------------------------------- images */
 /* Primary: ulam_camera_cornell, ulam_camera_frame, ulam_render, ulam_png_write.  Secondary:
  * ulam_view_pixels, ulam_view_gather. */

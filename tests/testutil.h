@@ -381,18 +381,21 @@ static inline FILE *test_scene_open(char dir[64], char path[96], const char *mtl
     return f;
 }
 
-/* The open box: a 4 x 4 x 4 box without its top, 80 unit patches (Kd 0.6), one of them a lamp
- * (Ke 10) on the wall z = 0 (the radiosity tests' scene). */
-static inline void test_open_box(char dir[64], char path[96])
+/* An open box: X x Y x Z without its top (y = Y), in unit patches (Kd 0.6): the floor y = 0, the
+ * walls z = 0, z = Z, x = 0, x = X (sides 0 .. 4, in that order), one of them a lamp (Ke 10): side
+ * lside's cell (li, lj). */
+static inline void test_open_box_sized(char dir[64], char path[96], int X, int Y, int Z, int lside, int li, int lj)
 {
     FILE *f = test_scene_open(dir, path, "newmtl g\nKd 0.6 0.6 0.6\nnewmtl lamp\nKd 0.6 0.6 0.6\nKe 10 10 10\n");
-    static const double side[5][3][3] = {{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
-                                         {{0, 0, 4}, {0, 1, 0}, {1, 0, 0}}, {{0, 0, 0}, {0, 1, 0}, {0, 0, 1}},
-                                         {{4, 0, 0}, {0, 0, 1}, {0, 1, 0}}};
+    /* each side: origin, u, v (u x v points in); its cells along u and v */
+    const double side[5][3][3] = {{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
+                                  {{0, 0, Z}, {0, 1, 0}, {1, 0, 0}}, {{0, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                                  {{X, 0, 0}, {0, 0, 1}, {0, 1, 0}}};
+    const int cells[5][2] = {{Z, X}, {X, Y}, {Y, X}, {Y, Z}, {Z, Y}};
     int v = 0;
     for (int k = 0; k < 5; k++)
-        for (int i = 0; i < 4; i++)
-            for (int j = 0; j < 4; j++) {
+        for (int i = 0; i < cells[k][0]; i++)
+            for (int j = 0; j < cells[k][1]; j++) {
                 const int du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
                 for (int q = 0; q < 4; q++) {
                     double x[3];
@@ -400,11 +403,18 @@ static inline void test_open_box(char dir[64], char path[96])
                         x[d] = side[k][0][d] + (i + du[q]) * side[k][1][d] + (j + dv[q]) * side[k][2][d];
                     fprintf(f, "v %g %g %g\n", x[0], x[1], x[2]);
                 }
-                fprintf(f, "usemtl %s\nf %d %d %d %d\n", k == 1 && i == 3 && j == 1 ? "lamp" : "g", v + 1, v + 2, v + 3,
-                        v + 4);
+                fprintf(f, "usemtl %s\nf %d %d %d %d\n", k == lside && i == li && j == lj ? "lamp" : "g", v + 1, v + 2,
+                        v + 3, v + 4);
                 v += 4;
             }
     fclose(f);
+}
+
+/* The open box: a 4 x 4 x 4 box without its top, 80 unit patches (Kd 0.6), one of them a lamp
+ * (Ke 10) on the wall z = 0 (the radiosity tests' scene). */
+static inline void test_open_box(char dir[64], char path[96])
+{
+    test_open_box_sized(dir, path, 4, 4, 4, 1, 3, 1);
 }
 
 /* Remove test_scene_open's directory and files. */

@@ -464,20 +464,6 @@ static double mesh_error(const mesh *m, double *r)
     return worst;
 }
 
-/* A polygon and its share of the mesh error. */
-typedef struct {
-    double r;
-    int64_t i;
-} share;
-
-/* Largest share first, ties by polygon number. */
-static int cmp_share(const void *a, const void *b)
-{
-    const share *x = a, *y = b;
-    if (x->r != y->r) return x->r > y->r ? -1 : 1;
-    return (x->i > y->i) - (x->i < y->i);
-}
-
 /* The live polygons of m as a new scene, materials, faces and groups from s. */
 static int to_scene(const mesh *m, const ulam_scene *s, ulam_scene **out)
 {
@@ -547,7 +533,7 @@ int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double
     double t0 = ulam_now(), total_area = 0.0;
     for (int64_t p = 0; p < s->npatches; p++) total_area += s->area[p];
     mesh m = {0};
-    share *sh = NULL;
+    ulam__ranked *sh = NULL;
     int64_t *undo = NULL, nundo = 0, np0 = 0; /* the round's split polygons, and the count before them */
     int status = mesh_init(&m, s, importance);
     in.error0 = in.error = NAN; /* until a mesh is measured whole */
@@ -580,9 +566,9 @@ int ulam_rad_adapt(const ulam_tracer *t, const ulam_rad_opts *opts, const double
         mesh_error(&m, r);
         int64_t ns = 0, np = m.np, nlive = m.nlive, made = 0;
         for (int64_t i = 0; i < np; i++)
-            if (m.live[i]) sh[ns++] = (share){r[i], i}, rest += r[i];
+            if (m.live[i]) sh[ns++] = (ulam__ranked){r[i], i}, rest += r[i];
         free(r);
-        qsort(sh, (size_t)ns, sizeof *sh, cmp_share);
+        qsort(sh, (size_t)ns, sizeof *sh, ulam__ranked_desc);
         np0 = m.np, nundo = 0;
         for (int64_t k = 0; k < ns && rest > target && !status && sh[k].r > 0; k++) {
             int64_t i = sh[k].i;

@@ -21,7 +21,10 @@
  *    light sample (the power heuristic keeps E_l G / p_L w_L at most E_l / 2, and at most
  *    E_l Gmax A_l / pi_l with Gmax = 1 / (pi d^2), d the least distance between the patches'
  *    bounding spheres), the largest weighted emitter hit (E_j min(1, (Gmax A_j / pi_j)^2)) and
- *    the pilot's largest mean reflected radiosity; the pilot's part, given the rays, is t sqrt(V2)
+ *    the patch's clip of the pilot's mean reflected radiosity (final_cap: the brightest pilot
+ *    patches clipped where the form-factor bound F_ij <= A_j Gmax makes the certified bias
+ *    small; a floor far from the hall's bright few clips them all), the bias added to the
+ *    half-width; the pilot's part, given the rays, is t sqrt(V2)
  *    at 97.5%, V2 = var_g(mean_k s^g) / G (the G runs are independent), t Student's quantile on
  *    G - 1 degrees of freedom.  Patches run blocks of ULAM__FINAL_BLOCK samples in passes to
  *    64, 256, 1024 ... samples (so that a time limit leaves the patches balanced), each stopping
@@ -42,7 +45,8 @@
 #define ULAM__FINAL_K0 64
 #define ULAM__FINAL_BLOCK 32
 #define ULAM__FINAL_EMITTERS_GEOM 1024
-#define ULAM__FINAL_SPIKES 256 /* the most pilot patches clipped */
+#define ULAM__FINAL_BRIGHT 1024 /* the brightest pilot patches a patch may clip (final_cap) */
+#define ULAM__FINAL_KPLAN 1024  /* the samples a patch plans for (its cap's trade, its first block) */
 
 /* Student's t on 15 degrees of freedom (G - 1) at 98.75%: the pilot's half of the 95%. */
 static const double t9875 = 2.489880;
@@ -54,6 +58,7 @@ typedef struct {
     double s1[3], s2[3], g[ULAM__FINAL_GROUPS][3];
     ulam__cs cs[3];
     double A[3], bias[3]; /* bias: the most the clipping of the pilot's bright patches takes off */
+    double cap;           /* the pilot's mean reflected radiosity is clipped here at this patch */
     ulam_rng r;
     int state; /* 0 not started, 1 running, 2 finished (met, capped, exact or dark) */
 } final_acc;
@@ -67,11 +72,11 @@ typedef struct {
     float *R;        /* G * 3 * npatches: the pilot runs' reflected radiosity */
     double *power;   /* nem: A_l sum_c E_lc */
     double *ec;      /* 4 * nem: the emitters' centroids and bounding radii */
-    double Rmax[3];  /* the largest score of the pilot's part: min(mean_g R^g_j, Rcap) */
-    double Rcap;     /* the pilot's mean reflected radiosity is clipped here (the brightest few patches) */
-    int64_t *spike;  /* the patches clipped, nspike of them, and their balls (4 each) */
-    double *sball;
-    int64_t nspike;
+    double Rmax[3];  /* the largest mean_g R^g_j a channel, rounded up */
+    int64_t *bright; /* the nbright brightest patches by max_c mean_g R^g_j, descending, their */
+    double *btop;    /* values (nbright + 1: the next one's, 0 past the last) and balls (4 each) */
+    double *bball;
+    int64_t nbright;
 } final_ctx;
 
 /* Patch p's centroid c and the radius of a ball about it holding p. */
@@ -150,16 +155,34 @@ static void final_table(const final_ctx *x, int64_t p, double *pi, double *cdf, 
             light[ch] = fmax(light[ch], E * fmin(q, 0.5)), hit[ch] = fmax(hit[ch], E * fmin(1.0, q * q));
         }
     }
-    for (int ch = 0; ch < 3; ch++) a->A[ch] = s->rho[3 * p + ch] * (light[ch] + hit[ch] + x->Rmax[ch]), a->bias[ch] = 0.0;
-    for (int64_t k = 0; k < x->nspike; k++) { /* F_pj <= A_j Gmax: what clipping j took off p's mean */
-        int64_t j = x->spike[k];
-        double f = j == p ? 0.0 : fmin(1.0, s->area[j] * g_bound2(c, r, n, x->sball + 4 * k, x->sball[4 * k + 3], s->normal + 3 * j));
-        for (int ch = 0; ch < 3 && f > 0; ch++) {
-            double m = 0.0;
-            for (int g = 0; g < ULAM__FINAL_GROUPS; g++) m += x->R[((size_t)g * (size_t)s->npatches + (size_t)j) * 3 + (size_t)ch];
-            a->bias[ch] += s->rho[3 * p + ch] * f * fmax(0.0, m / ULAM__FINAL_GROUPS - x->Rcap) * (1 + 1e-6);
-        }
+    for (int ch = 0; ch < 3; ch++) a->A[ch] = s->rho[3 * p + ch] * (light[ch] + hit[ch] + fmin(x->Rmax[ch], a->cap));
+}
+
+/* Patch p's clip of the pilot's landing scores (a->cap) and the most it takes off p's mean
+ * (a->bias): clipping the k brightest pilot patches at the next one's value C takes off
+ * rho_p sum_j F_pj (Rbar_j - C)+ <= rho_p sum_j f_j (top_j - C), f_j = min(1, A_j / A_p,
+ * A_j Gmax(p, j)) (F_pj <= 1, reciprocity, and G's bound g_bound2); the range it leaves costs
+ * about C L / (lambda_max K) at K samples (the sequence's range term, stop.h).  The k (0 .. the
+ * nbright brightest) least in C kappa + bias, kappa that cost at the kplan samples planned: a
+ * patch far from the bright few (a floor under lamps seen at a grazing angle) clips them all
+ * for little. */
+static void final_cap(const final_ctx *x, int64_t p, final_acc *a, double kplan)
+{
+    const ulam_scene *s = x->s;
+    double c[3], r = patch_ball(s, p, c), w0 = 0.0, w1 = 0.0, kappa = log(2.0 / (ULAM__STOP_DELTA / 2)) / (ULAM__CS_LMAX * kplan);
+    double best = x->nbright > 0 ? x->btop[0] * kappa : INFINITY, bias = 0.0;
+    a->cap = INFINITY;
+    for (int64_t k = 0; k < x->nbright; k++) {
+        int64_t j = x->bright[k];
+        double f = j == p ? 0.0
+                          : fmin(fmin(1.0, s->area[j] / s->area[p]),
+                                 s->area[j] * g_bound2(c, r, s->normal + 3 * p, x->bball + 4 * k, x->bball[4 * k + 3], s->normal + 3 * j));
+        w0 += f, w1 += f * x->btop[k];
+        double C = x->btop[k + 1], b = fmax(0.0, w1 - C * w0);
+        if (b >= best) break; /* the bias only grows with k */
+        if (C * kappa + b < best) best = C * kappa + b, a->cap = C, bias = b;
     }
+    for (int ch = 0; ch < 3; ch++) a->bias[ch] = s->rho[3 * p + ch] * bias * (1 + 1e-6); /* float sums rounded up */
 }
 
 /* The index k with cdf[k - 1] <= u < cdf[k] (u in [0, cdf[nem - 1])). */
@@ -216,7 +239,7 @@ static void final_sample(const final_ctx *x, int64_t p, const double *pi, const 
             a->g[g][c] += E[c] + rho[c] * (direct[c] + R);
             Rbar += R;
         }
-        Rbar = fmin(Rbar / ULAM__FINAL_GROUPS, x->Rcap); /* the brightest few clipped (a->bias) */
+        Rbar = fmin(Rbar / ULAM__FINAL_GROUPS, a->cap); /* the brightest clipped (final_cap, a->bias) */
         double y = rho[c] * (direct[c] + Rbar), v = E[c] + y;
         a->s1[c] += v, a->s2[c] += v * v;
         blk[c][0] += y, blk[c][1] += y * y, blk[c][2] = fmax(blk[c][2], y);
@@ -280,7 +303,8 @@ static void final_run(const final_ctx *x, int64_t p, const double *pi, const dou
             double K = (double)a->k, m = K > 0 ? a->s1[c] / K - E[c] : 0.0,
                    v = K > 1 ? fmax(0.0, a->s2[c] - K * (m + E[c]) * (m + E[c])) / (K - 1) : 0.0;
             double h = rel_err > 0 && K > 0 && m + E[c] > 0 ? 0.8 * rel_err * (m + E[c]) - a->bias[c] : 0.0;
-            ulam__cs_plan(&a->cs[c], a->k, m, v, a->A[c], 0.0, h > 0 ? h : 0.0, (double)cap);
+            ulam__cs_plan(&a->cs[c], a->k, m, v, a->A[c], 0.0, h > 0 ? h : 0.0,
+                          rel_err > 0 && cap > ULAM__FINAL_KPLAN ? ULAM__FINAL_KPLAN : (double)cap);
         }
         for (int64_t k = 0; k < nb; k++) final_sample(x, p, pi, cdf, a, blk);
         for (int c = 0; c < 3; c++) {
@@ -292,13 +316,6 @@ static void final_run(const final_ctx *x, int64_t p, const double *pi, const dou
             return;
         }
     }
-}
-
-/* Descending doubles (qsort). */
-static int cmp_desc(const void *a, const void *b)
-{
-    double u = *(const double *)a, v = *(const double *)b;
-    return (u < v) - (u > v);
 }
 
 /* The pilot: G shooting runs of particles / G each (at most max_seconds between them). */
@@ -329,41 +346,31 @@ static int final_pilot(final_ctx *x, const ulam_rad_opts *o, int64_t particles, 
         ulam_rad_solver_free(sv);
         if (status) ulam__fail(err, status, 0, -1, "the pilot's shooting");
     }
-    double *top = B; /* reused: each patch's brightest mean reflected radiosity */
+    ulam__ranked *top = status ? NULL : ulam__malloc((size_t)n, sizeof *top);
+    int64_t nb = n < ULAM__FINAL_BRIGHT ? n : ULAM__FINAL_BRIGHT;
+    x->bright = ulam__malloc((size_t)nb, sizeof *x->bright);
+    x->btop = ulam__malloc((size_t)nb + 1, sizeof *x->btop);
+    x->bball = ulam__malloc((size_t)(4 * nb), sizeof *x->bball);
+    if (!status && (!top || !x->bright || !x->btop || !x->bball)) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the pilot");
     for (int64_t j = 0; j < n && !status; j++) {
-        top[j] = 0.0;
+        top[j].r = 0.0, top[j].i = j;
         for (int c = 0; c < 3; c++) {
             double m = 0.0;
             for (int g = 0; g < ULAM__FINAL_GROUPS; g++) m += x->R[((size_t)g * (size_t)n + (size_t)j) * 3 + (size_t)c];
-            top[j] = fmax(top[j], m / ULAM__FINAL_GROUPS);
+            m = m / ULAM__FINAL_GROUPS * (1 + 1e-6); /* float sums rounded up */
+            top[j].r = fmax(top[j].r, m), x->Rmax[c] = fmax(x->Rmax[c], m);
         }
     }
-    int64_t ns = n / 64 < ULAM__FINAL_SPIKES ? n / 64 : ULAM__FINAL_SPIKES;
-    x->Rcap = INFINITY;
-    if (!status && ns > 0) { /* clip at 4 times the (ns + 1)-th brightest: at most ns outliers above it */
-        double *srt = ulam__malloc((size_t)n, sizeof *srt);
-        x->spike = ulam__malloc((size_t)ns, sizeof *x->spike);
-        x->sball = ulam__malloc((size_t)(4 * ns), sizeof *x->sball);
-        if (!srt || !x->spike || !x->sball) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the pilot");
-        if (!status) {
-            memcpy(srt, top, (size_t)n * sizeof *srt);
-            qsort(srt, (size_t)n, sizeof *srt, cmp_desc);
-            x->Rcap = 4.0 * srt[ns];
-            for (int64_t j = 0; j < n; j++)
-                if (top[j] > x->Rcap && x->nspike < ns) {
-                    x->spike[x->nspike] = j;
-                    x->sball[4 * x->nspike + 3] = patch_ball(s, j, x->sball + 4 * x->nspike);
-                    x->nspike++;
-                }
+    if (!status) { /* the brightest nb with their balls (final_cap) */
+        qsort(top, (size_t)n, sizeof *top, ulam__ranked_desc);
+        for (int64_t k = 0; k < nb; k++) {
+            x->bright[k] = top[k].i, x->btop[k] = top[k].r;
+            x->bball[4 * k + 3] = patch_ball(s, top[k].i, x->bball + 4 * k);
         }
-        free(srt);
+        x->btop[nb] = nb < n ? top[nb].r : 0.0;
+        x->nbright = nb;
     }
-    for (int64_t j = 0; j < n && !status; j++)
-        for (int c = 0; c < 3; c++) {
-            double m = 0.0;
-            for (int g = 0; g < ULAM__FINAL_GROUPS; g++) m += x->R[((size_t)g * (size_t)n + (size_t)j) * 3 + (size_t)c];
-            x->Rmax[c] = fmax(x->Rmax[c], fmin(m / ULAM__FINAL_GROUPS, x->Rcap) * (1 + 1e-6)); /* float sums rounded up */
-        }
+    free(top);
     free(B);
     return status;
 }
@@ -371,13 +378,14 @@ static int final_pilot(final_ctx *x, const ulam_rad_opts *o, int64_t particles, 
 /* The whole scene's rule from the patches' answers: a patch is lit when it emits or a sample
  * scored on it; unreached when it reflects, emits nothing, and no sample scored (or the stop came
  * first: NaN); lit patches meet E when every nonzero channel's 95% half-width is at most E B. */
-static void final_rule(const ulam_scene *s, const double *B, const double *se, const double *half, double E,
-                       double share, ulam_rad_scene_rule *q, int64_t first[8])
+static void final_rule(const ulam_scene *s, const unsigned char *want, const double *B, const double *se, const double *half,
+                       double E, double share, ulam_rad_scene_rule *q, int64_t first[8])
 {
     memset(q, 0, sizeof *q);
     for (int k = 0; k < 8; k++) first[k] = -1;
     q->worst_patch = -1, q->share = share;
     for (int64_t p = 0; p < s->npatches; p++) {
+        if (want && !want[p]) continue;
         double bright = 0.0, worst = 0.0, wse = 0.0;
         int met = 1;
         for (int c = 0; c < 3; c++) {
@@ -402,6 +410,14 @@ static void final_rule(const ulam_scene *s, const double *B, const double *se, c
 /* Every patch's radiosity by final gathering over a shooting pilot. */
 int ulam_rad_final(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilot, double share, double *B, double *se,
                    double *half, ulam_rad_final_info *info, ulam_error *err)
+{
+    return ulam_rad_final_some(t, opts, pilot, share, NULL, B, se, half, info, err);
+}
+
+/* The wanted patches' radiosity by final gathering over a shooting pilot. */
+int ulam_rad_final_some(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilot, double share,
+                        const unsigned char *want, double *B, double *se, double *half, ulam_rad_final_info *info,
+                        ulam_error *err)
 {
     ulam_rad_final_info in;
     memset(&in, 0, sizeof in);
@@ -458,11 +474,12 @@ int ulam_rad_final(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilo
 #pragma omp atomic read
                 halt = stop;
                 final_acc *a = &acc[p];
-                if (halt || nomem || a->state == 2) continue;
+                if (halt || nomem || a->state == 2 || (want && !want[p])) continue;
                 if (a->state == 0) {
                     ulam_rng_seed(&a->r, ulam_rng_substream(opts->exec.seed, ULAM_STREAM_POINT, (uint64_t)p), 0);
                     a->state = ulam__max3(s->rho + 3 * p) == 0.0 ? 2 : 1; /* rho 0: B = E exactly */
                     if (a->state == 2) continue;
+                    final_cap(&x, p, a, E > 0 && cap > ULAM__FINAL_KPLAN ? ULAM__FINAL_KPLAN : (double)cap);
                 }
                 final_table(&x, p, pi, cdf, a);
                 final_run(&x, p, pi, cdf, a, upto, E, cap);
@@ -495,13 +512,13 @@ int ulam_rad_final(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t pilo
         in.gathered += a->k > 0;
     }
     if (!status) {
-        final_rule(s, B, se, half, E, share, &in.scene, in.unreached);
+        final_rule(s, want, B, se, half, E, share, &in.scene, in.unreached);
         in.met = E > 0 && in.scene.met_area >= share * in.scene.lit_area * (1.0 - 1e-12) && in.scene.lit > 0;
     }
     in.seconds = ulam_now() - t0;
     in.threads = threads;
     if (info) *info = in;
     ulam__lights_free(&x.L);
-    free(x.eidx), free(x.R), free(x.power), free(x.ec), free(x.spike), free(x.sball), free(acc);
+    free(x.eidx), free(x.R), free(x.power), free(x.ec), free(x.bright), free(x.btop), free(x.bball), free(acc);
     return status;
 }

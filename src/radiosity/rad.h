@@ -25,6 +25,20 @@ static inline double ulam__dot3(const double *a, const double *b)
 }
 
 /* The largest channel of an RGB triple. */
+/* A value and its index (a polygon's share of the mesh error, a patch's pilot brightness). */
+typedef struct {
+    double r;
+    int64_t i;
+} ulam__ranked;
+
+/* Largest r first, ties by index (qsort). */
+static inline int ulam__ranked_desc(const void *a, const void *b)
+{
+    const ulam__ranked *x = a, *y = b;
+    if (x->r != y->r) return x->r > y->r ? -1 : 1;
+    return (x->i > y->i) - (x->i < y->i);
+}
+
 static inline double ulam__max3(const double *v)
 {
     return fmax(v[0], fmax(v[1], v[2]));

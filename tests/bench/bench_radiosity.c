@@ -22,14 +22,26 @@
  *    Cornell box floor centre (unsubdivided and at ~2,000 patches) and the office floor.
  * 6. (bench_radiosity hall) The hall of about 10^5 triangles (issue 40's whole-room case, written by
  *    this program): shooting for 60 s under the whole-scene rule, the floor's median error.
- *    6b (bench_radiosity hall-final [SECONDS [PILOT]]): final gathering over a shooting pilot
- *    (ulam_rad_final) for 60 s, the same floor figures and the printed interval's.
+ *    6b (bench_radiosity hall-final [SECONDS [PILOT [floor [SAMPLES]]]]): final gathering over a
+ *    shooting pilot (ulam_rad_final; with "floor", ulam_rad_final_some on the floor's patches
+ *    only; with SAMPLES, that many a patch instead of --rel-err 0.05) for 60 s, the same floor
+ *    figures and the printed interval's.
  *    2026-12-05, 2 threads of a shared 2-core machine at load 24.6 (each run got about 10 CPU
  *    seconds of its 60): shooting 2 592 923 particles, 4.60 M rays: floor 1.96 se / B median
  *    0.286, 3 719 floor patches at 0; final: pilot 361 845 particles (0.64 M rays, 15.7 s) and
  *    2 701 952 samples (5.40 M rays): floor 1.96 se / B median 0.121, but its printed 95%
  *    half-width / B median 6.80 (the pilot's part and the certified range at 64 samples a
  *    patch); 65 074 wall/ceiling patches not reached in time.  Goal (<= 0.05 in 60 s) not met.
+ *    2026-12-05 after each patch's own clip of the pilot (final_cap), same machine, load 15-22:
+ *    every patch, 60 s: 4.71 M samples (64 a patch), floor printed half-width / B median 0.985
+ *    (was 19.3 in a run beside it: the certified range held the pilot's global maximum, 6.2 B at
+ *    the floor's median), 1.96 se / B 0.095; the floor only (hall-final 60 0 floor), 60 s:
+ *    pilot 378 155 particles (11.4 s), 9.39 M samples (235 a floor patch), printed half-width / B
+ *    median 0.127 (10% 0.098, 90% 4.72: the patches beside the crates), 1.96 se / B 0.035;
+ *    3 657 floor patches under the crates unreached (no light).  At 128 samples a floor patch
+ *    (hall-final 600 0 floor 128): 0.218, 1.96 se / B 0.041.  The certified range (the light
+ *    sample's bound ~1.1 B, the clip ~2.3 B) needs ~10^3 samples a patch for 0.05: 4 10^7
+ *    samples, 8 10^7 rays, out of 60 s at this load (about 0.3 M rays a second).  Not met.
  * Usage: bench_radiosity [scene.obj [WxH [P]]] (run from the source root); bench_radiosity points;
  * bench_radiosity hall; bench_radiosity office|hall OUT.obj (write the scene and its .mtl). */
 #include "ulam_radiosity.h"
@@ -391,19 +403,24 @@ static int hall_bench(double seconds)
 /* 6b. The hall by final gathering over a shooting pilot (ulam_rad_final) to a 95% half-width <= 5% B on
  * every patch, at most `seconds`: the floor patches' relative 95% half-widths (the printed
  * interval's, and 1.96 se / B as 6 reads them) at the end. */
-static int hall_final(double seconds, int64_t pilot)
+static int hall_final(double seconds, int64_t pilot, int floor_only, int64_t samples)
 {
     ulam_scene *s = NULL;
     ulam_tracer *t = NULL;
     ulam_error err;
     if (load_hall(&s, &t)) return 1;
     ulam_rad_opts o = ulam_rad_defaults();
-    o.stop.rel_err = 0.05, o.stop.max_walks = 0, o.stop.max_seconds = seconds, o.exec.seed = 1, o.exec.threads = 2;
+    o.stop.rel_err = samples > 0 ? 0.0 : 0.05, o.stop.max_walks = samples, o.stop.max_seconds = seconds, o.exec.seed = 1;
+    o.exec.threads = 2;
     int64_t n = s->npatches, nf = 0, nan = 0;
     double *B = malloc(3 * (size_t)n * sizeof *B), *se = malloc(3 * (size_t)n * sizeof *se), *rel = malloc((size_t)n * sizeof *rel),
            *half = malloc(3 * (size_t)n * sizeof *half), *clt = malloc((size_t)n * sizeof *clt);
+    unsigned char *want = floor_only ? malloc((size_t)n) : NULL;
+    for (int64_t p = 0; p < n && want; p++) want[p] = s->group[p] >= 0 && !strcmp(s->groups[s->group[p]], "floor");
     ulam_rad_final_info in;
-    if (!B || !se || !rel || !half || !clt || ulam_rad_final(t, &o, pilot, 1.0, B, se, half, &in, &err)) return 1;
+    if (!B || !se || !rel || !half || !clt || (floor_only && !want) ||
+        ulam_rad_final_some(t, &o, pilot, 1.0, want, B, se, half, &in, &err))
+        return 1;
     for (int64_t p = 0; p < n; p++) {
         if (s->group[p] < 0 || strcmp(s->groups[s->group[p]], "floor")) continue;
         nan += isnan(B[3 * p + 1]);
@@ -413,21 +430,23 @@ static int hall_final(double seconds, int64_t pilot)
     qsort(rel, (size_t)nf, sizeof *rel, cmp_double);
     qsort(clt, (size_t)nf, sizeof *clt, cmp_double);
     printf("6b. Hall (%lld patches, %lld on the floor), final gathering over a shooting pilot to a 95%% half-width "
-           "<= 5%% B on every patch, at most %.0f s, 2 threads\n\n", (long long)n, (long long)nf, seconds);
+           "<= 5%% B on %s, at most %.0f s, 2 threads\n\n", (long long)n, (long long)nf,
+           floor_only ? "the floor (ulam_rad_final_some)" : "every patch", seconds);
     printf("   pilot %lld particles, %lld rays, %.1f s; gather %lld samples, %lld rays; %.1f s in all (rule %s: %lld of "
            "%lld lit patches; %lld unreached)\n", (long long)in.particles, (long long)in.particle_rays, in.pilot_seconds,
            (long long)in.samples, (long long)in.rays, in.seconds, in.met ? "met" : "not met", (long long)in.scene.met,
            (long long)in.scene.lit, (long long)in.scene.unreached);
     printf("   floor 95%% half-width / B: median %.4f, 10%% %.4f, 90%% %.4f (1.96 se / B: median %.4f); %lld floor "
            "patches not reached in time\n\n", rel[nf / 2], rel[nf / 10], rel[9 * nf / 10], clt[nf / 2], (long long)nan);
-    free(B), free(se), free(rel), free(half), free(clt);
+    free(B), free(se), free(rel), free(half), free(clt), free(want);
     ulam_tracer_free(t), ulam_scene_free(s);
     return 0;
 }
 
 int main(int argc, char **argv)
 {
-    if (argc > 1 && !strcmp(argv[1], "hall-final")) return hall_final(argc > 2 ? atof(argv[2]) : 60.0, argc > 3 ? atoll(argv[3]) : 0);
+    if (argc > 1 && !strcmp(argv[1], "hall-final")) return hall_final(argc > 2 ? atof(argv[2]) : 60.0, argc > 3 ? atoll(argv[3]) : 0,
+                                                                    argc > 4 && !strcmp(argv[4], "floor"), argc > 5 ? atoll(argv[5]) : 0);
     if (argc > 1 && !strcmp(argv[1], "points")) return points_bench();
     if (argc > 2 && !strcmp(argv[1], "office")) return write_office(argv[2]) ? 1 : 0;
     if (argc > 2 && !strcmp(argv[1], "hall")) return write_hall(argv[2]) ? 1 : 0;
