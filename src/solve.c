@@ -1615,6 +1615,20 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
             if (pass == 0 && wj < least) least = wj, t = tj, *Rt = Rj;
             if (pass == 1 && E > 0 && wj <= 1.05 * least) t = tj, *Rt = Rj;
         }
+    if (truncated && N > 0 && !(*h > 0) && isfinite(X) && X > t0 && t0 > 0) {
+        /* a budget, no target: hp / 8 or the grid's truncation whose bias and range term over the
+           planned walks add up least.  Where the range grows as 1 / t (the second moment's route:
+           weights without a bound) hp / 8 took R to 1e9 and every later block's bet to nothing, so
+           the first block's bias (139 for x = 0.57) stayed the interval's (signed forward 200:
+           +-244 at 1e3 walks, +-407 at 1e5) */
+        double At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
+        double best = isfinite(*Rt) ? ulam__cs_range_width(At, *nplan) + t : INFINITY;
+        for (int j = 0; j <= 4 * log2(X / t0); j++) {
+            double tj = X * exp2(-0.25 * j), Rj = score_range(s, m, tj / m, 1);
+            double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, *nplan) + tj;
+            if (isfinite(Rj) && wj < best) best = wj, t = tj, *Rt = Rj;
+        }
+    }
     for (int j = 2; truncated && *h > 0 && j <= 6; j++) { /* rel_err: the share of h (1/4 .. 1/64) that meets it soonest */
         double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m, 1);
         double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
