@@ -1579,7 +1579,8 @@ static double moments_estimate(const ulam_solver *s)
  * advance, else four times the walks so far); the range Rt of a single score (score_range: the
  * width of its random part), for scores without a bound at a truncation whose bias b is an
  * eighth of h (or of 2.7 sigma / sqrt(nplan); under rel_err the share of h from 1/4 to 1/64 that
- * ulam__cs_walks_needed says meets it soonest), kept between 1e-6 and max(ULAM__STOP_TAIL, E / 4)
+ * ulam__cs_walks_needed says meets it soonest; without a target the grid's truncation whose bias
+ * and range term over nplan walks add up least when that is less), kept between 1e-6 and max(ULAM__STOP_TAIL, E / 4)
  * of |m| (with no estimate yet, of the least of bias_scale's bound on |x| and a visit's largest
  * score: a loose bound on |x| would give the first blocks a bias that outweighs the rest); and the limit A of |score| (the adjoint expected estimator adds b_i,
  * score0, to every score, so a score past |b_i| + R, not R, is past the range). */
@@ -1595,11 +1596,13 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m;
     double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
     *Rt = !truncated ? score_range(s, 1.0, 1.0, 1) : t > 0 ? score_range(s, m, t / m, 1) : INFINITY;
-    double X = bias_scale(s, 0.0), n1 = fmin(*nplan, (double)BLOCK), least = INFINITY, t0 = 1e-6 * m;
+    double X = bias_scale(s, 0.0), n1 = fixed ? *nplan : fmin(*nplan, (double)BLOCK), least = INFINITY, t0 = 1e-6 * m;
     for (int pass = 0; pass < 2; pass++) /* under rel_err a second pass: the least bias within 5% of the least */
         for (int j = 0; truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
             /* no estimate yet: the truncation whose bias and range term over the first round's walks (a
-               bet at its largest) add up least, whatever x is (a bias of a millionth of a visit's score
+               bet at its largest; a fixed budget: over all its walks, as the later blocks plan, so the
+               first block's bias is theirs and its weight no more than theirs: signed forward 200 at
+               10^4 walks +-92 -> +-76, at 10^5 +-28 -> +-24) add up least, whatever x is (a bias of a millionth of a visit's score
                tripled the range of the first block: a --walks 1000 run's half-width was 0.16 x against
                0.048 x at 4096, Poisson 70 x 70 centre); under rel_err a bias of at most E X / 16 and,
                the sum being flat near its least, the smallest bias within 5% of it (the first block's
