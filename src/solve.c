@@ -1574,6 +1574,24 @@ static double moments_estimate(const ulam_solver *s)
     return e;
 }
 
+/* The walks the first block's truncation is planned over: the first round's (BLOCK); at a fixed
+ * count (fixed) all nplan of them, as the later blocks plan; under a time limit without a target
+ * the walks the work model (ULAM_AUTO_*: a walk's expected steps, start and tallies) says the time
+ * left buys, at most max_walks, at least BLOCK.  A first block planned for more walks than the run
+ * makes bets smaller (a larger range), so weighs less against the later blocks; one planned for
+ * fewer keeps its bias in the interval at its weight to the end (signed forward 200, --time 1:
+ * the first block's bias, 139 for x = 0.57, about half of the +-12.6). */
+static double first_walks(const ulam_solver *s, double nplan, int fixed)
+{
+    const ulam_stop_opts *st = &s->o.stop;
+    if (fixed) return nplan;
+    if (!(st->max_seconds > 0) || st->rel_err > 0 || !(s->run.t0 >= 0)) return fmin(nplan, (double)BLOCK);
+    double V = mean_steps(s), left = st->max_seconds - (ulam_now() - s->run.t0);
+    double n = left / ULAM_AUTO_UNIT_SECONDS / (V + ULAM_AUTO_WALK + ULAM_AUTO_TALLY * (V + 1.0));
+    if (st->max_walks > 0) n = fmin(n, (double)st->max_walks);
+    return isfinite(n) && n > BLOCK ? n : (double)BLOCK;
+}
+
 /* The plan for the next block from the run so far (stop.h's ulam__cs): the half-width aimed at,
  * h (rel_err: E |m|; else 0 and the planned walk count nplan: max_walks for a count fixed in
  * advance, else four times the walks so far); the range Rt of a single score (score_range: the
@@ -1596,7 +1614,7 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m;
     double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
     *Rt = !truncated ? score_range(s, 1.0, 1.0, 1) : t > 0 ? score_range(s, m, t / m, 1) : INFINITY;
-    double X = bias_scale(s, 0.0), n1 = fixed ? *nplan : fmin(*nplan, (double)BLOCK), least = INFINITY, t0 = 1e-6 * m;
+    double X = bias_scale(s, 0.0), n1 = first_walks(s, *nplan, fixed), least = INFINITY, t0 = 1e-6 * m;
     for (int pass = 0; pass < 2; pass++) /* under rel_err a second pass: the least bias within 5% of the least */
         for (int j = 0; truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
             /* no estimate yet: the truncation whose bias and range term over the first round's walks (a
