@@ -1601,8 +1601,10 @@ static double first_walks(const ulam_solver *s, double nplan, int fixed)
  * and range term over nplan walks add up least when that is less), kept between 1e-6 and max(ULAM__STOP_TAIL, E / 4)
  * of |m| (with no estimate yet, of the least of bias_scale's bound on |x| and a visit's largest
  * score: a loose bound on |x| would give the first blocks a bias that outweighs the rest); and the limit A of |score| (the adjoint expected estimator adds b_i,
- * score0, to every score, so a score past |b_i| + R, not R, is past the range). */
-static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, double *h, double *nplan)
+ * score0, to every score, so a score past |b_i| + R, not R, is past the range).  grid 0: h and
+ * nplan alone are asked for (a block's bet: its limit and bias are the round's), the grids'
+ * searches skipped (4-5% of a run's instructions when made for every block). */
+static void plan_terms(const ulam_solver *s, int grid, double *Rt, double *A, double *b, double *h, double *nplan)
 {
     const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
     double E = s->o.stop.rel_err > 0 ? s->o.stop.rel_err : 0.0, mabs = fabs(moments_estimate(s) + s->o.stop.rel_err_offset);
@@ -1616,7 +1618,7 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
     *Rt = !truncated ? score_range(s, 1.0, 1.0, 1) : t > 0 ? score_range(s, m, t / m, 1) : INFINITY;
     double X = bias_scale(s, 0.0), n1 = first_walks(s, *nplan, fixed), least = INFINITY, t0 = 1e-6 * m;
     for (int pass = 0; pass < 2; pass++) /* under rel_err a second pass: the least bias within 5% of the least */
-        for (int j = 0; truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
+        for (int j = 0; grid && truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
             /* no estimate yet: the truncation whose bias and range term over the first round's walks (a
                bet at its largest; a fixed budget: over all its walks, as the later blocks plan, so the
                first block's bias is theirs and its weight no more than theirs: signed forward 200 at
@@ -1636,7 +1638,7 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
             if (pass == 0 && wj < least) least = wj, t = tj, *Rt = Rj;
             if (pass == 1 && E > 0 && wj <= 1.05 * least) t = tj, *Rt = Rj;
         }
-    if (truncated && N > 0 && !(*h > 0) && isfinite(X) && X > t0 && t0 > 0) {
+    if (grid && truncated && N > 0 && !(*h > 0) && isfinite(X) && X > t0 && t0 > 0) {
         /* a budget, no target: hp / 8 or the grid's truncation whose bias and range term over the
            planned walks add up least.  Where the range grows as 1 / t (the second moment's route:
            weights without a bound) hp / 8 took R to 1e9 and every later block's bet to nothing, so
@@ -1666,7 +1668,7 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
 static void round_clip(ulam_solver *s)
 {
     double Rt, A, b, h, nplan;
-    plan_terms(s, &Rt, &A, &b, &h, &nplan);
+    plan_terms(s, 1, &Rt, &A, &b, &h, &nplan);
     s->w.clip = isfinite(A) && A > 0 ? A : 0.0, s->clip_b = b;
 }
 
@@ -1675,7 +1677,7 @@ static void cs_plan(ulam_solver *s)
 {
     const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
     double Rt, A, b, h, nplan;
-    plan_terms(s, &Rt, &A, &b, &h, &nplan);
+    plan_terms(s, 0, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     ulam__cs_plan4(&s->cs, mom->n, mom->mean, ulam__moments_variance(mom), mom->m3, mom->m4, A, b, h > b ? h - b : 0.0, nplan);
 }
@@ -1686,7 +1688,7 @@ static void cs_plan(ulam_solver *s)
 static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
 {
     double Rt, A, b, h, nplan, E = s->o.stop.rel_err;
-    plan_terms(s, &Rt, &A, &b, &h, &nplan);
+    plan_terms(s, 0, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     if (!(h > 0) && E > 0 && run->n >= 2) h = E * fabs(run->mean + s->o.stop.rel_err_offset);
     ulam__cs_plan4(&s->cs, run->n, run->mean, ulam__moments_variance(run), run->m3, run->m4, A, b, h > b ? h - b : 0.0, nplan);
@@ -1699,7 +1701,7 @@ static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci)
 {
     double A, b, h, nplan;
-    plan_terms(s, R, &A, &b, &h, &nplan);
+    plan_terms(s, 1, R, &A, &b, &h, &nplan);
     if (*R == 0.0) ulam__stop_interval(r->walks, r->estimate, 0.0, 0.0, 0.0, 0.0, 0.0, 0, ci);
     else {
         double m0 = s->o.mode == ULAM_ADJOINT ? s->adj.mean : s->watched.mean, shift = r->estimate - m0;
@@ -1744,7 +1746,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
     if (s->o.stop.rel_err > 0) { /* a sequence tuned to the target from the start, at the planned range */
         double E = s->o.stop.rel_err, A, b, h, nplan, Rp;
-        plan_terms(s, &Rp, &A, &b, &h, &nplan);
+        plan_terms(s, 1, &Rp, &A, &b, &h, &nplan);
         r->min_walks = R == 0.0 ? 0.0 : ulam__cs_walks_needed(m, r->variance, A, b + r->cut_bound, E);
         if (s->met) r->min_walks = fmin(r->min_walks, (double)r->walks); /* it held there */
         if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0 && ci.kind != ULAM__STOP_EXACT)
