@@ -1577,15 +1577,17 @@ static double moments_estimate(const ulam_solver *s)
 /* The walks the first block's truncation is planned over: the first round's (BLOCK); at a fixed
  * count (fixed) all nplan of them, as the later blocks plan; under a time limit without a target
  * the walks the work model (ULAM_AUTO_*: a walk's expected steps, start and tallies) says the time
- * left buys, at most max_walks, at least BLOCK.  A first block planned for more walks than the run
- * makes bets smaller (a larger range), so weighs less against the later blocks; one planned for
- * fewer keeps its bias in the interval at its weight to the end (signed forward 200, --time 1:
- * the first block's bias, 139 for x = 0.57, about half of the +-12.6). */
+ * left buys, at most max_walks, at least BLOCK (not across ranks: their plans must agree, their
+ * clocks need not).  A first block planned for more walks than the run makes bets smaller (a
+ * larger range), so weighs less against the later blocks; one planned for fewer keeps its bias
+ * in the interval at its weight to the end (signed forward 200, --time 1: the first block's bias,
+ * 139 for x = 0.57, about half of the +-12.6). */
 static double first_walks(const ulam_solver *s, double nplan, int fixed)
 {
     const ulam_stop_opts *st = &s->o.stop;
     if (fixed) return nplan;
-    if (!(st->max_seconds > 0) || st->rel_err > 0 || !(s->run.t0 >= 0)) return fmin(nplan, (double)BLOCK);
+    if (!(st->max_seconds > 0) || st->rel_err > 0 || !(s->run.t0 >= 0) || (s->o.exec.share && s->o.exec.share->nranks > 1))
+        return fmin(nplan, (double)BLOCK);
     double V = mean_steps(s), left = st->max_seconds - (ulam_now() - s->run.t0);
     double n = left / ULAM_AUTO_UNIT_SECONDS / (V + ULAM_AUTO_WALK + ULAM_AUTO_TALLY * (V + 1.0));
     if (st->max_walks > 0) n = fmin(n, (double)st->max_walks);
