@@ -1574,16 +1574,39 @@ static double moments_estimate(const ulam_solver *s)
     return e;
 }
 
+/* The walks the first block's truncation is planned over: the first round's (BLOCK); at a fixed
+ * count (fixed) all nplan of them, as the later blocks plan; under a time limit without a target
+ * the walks the work model (ULAM_AUTO_*: a walk's expected steps, start and tallies) says the time
+ * left buys, at most max_walks, at least BLOCK (not across ranks: their plans must agree, their
+ * clocks need not).  A first block planned for more walks than the run makes bets smaller (a
+ * larger range), so weighs less against the later blocks; one planned for fewer keeps its bias
+ * in the interval at its weight to the end (signed forward 200, --time 1: the first block's bias,
+ * 139 for x = 0.57, about half of the +-12.6). */
+static double first_walks(const ulam_solver *s, double nplan, int fixed)
+{
+    const ulam_stop_opts *st = &s->o.stop;
+    if (fixed) return nplan;
+    if (!(st->max_seconds > 0) || st->rel_err > 0 || !(s->run.t0 >= 0) || (s->o.exec.share && s->o.exec.share->nranks > 1))
+        return fmin(nplan, (double)BLOCK);
+    double V = mean_steps(s), left = st->max_seconds - (ulam_now() - s->run.t0);
+    double n = left / ULAM_AUTO_UNIT_SECONDS / (V + ULAM_AUTO_WALK + ULAM_AUTO_TALLY * (V + 1.0));
+    if (st->max_walks > 0) n = fmin(n, (double)st->max_walks);
+    return isfinite(n) && n > BLOCK ? n : (double)BLOCK;
+}
+
 /* The plan for the next block from the run so far (stop.h's ulam__cs): the half-width aimed at,
  * h (rel_err: E |m|; else 0 and the planned walk count nplan: max_walks for a count fixed in
  * advance, else four times the walks so far); the range Rt of a single score (score_range: the
  * width of its random part), for scores without a bound at a truncation whose bias b is an
  * eighth of h (or of 2.7 sigma / sqrt(nplan); under rel_err the share of h from 1/4 to 1/64 that
- * ulam__cs_walks_needed says meets it soonest), kept between 1e-6 and max(ULAM__STOP_TAIL, E / 4)
+ * ulam__cs_walks_needed says meets it soonest; without a target the grid's truncation whose bias
+ * and range term over nplan walks add up least when that is less), kept between 1e-6 and max(ULAM__STOP_TAIL, E / 4)
  * of |m| (with no estimate yet, of the least of bias_scale's bound on |x| and a visit's largest
  * score: a loose bound on |x| would give the first blocks a bias that outweighs the rest); and the limit A of |score| (the adjoint expected estimator adds b_i,
- * score0, to every score, so a score past |b_i| + R, not R, is past the range). */
-static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, double *h, double *nplan)
+ * score0, to every score, so a score past |b_i| + R, not R, is past the range).  grid 0: h and
+ * nplan alone are asked for (a block's bet: its limit and bias are the round's), the grids'
+ * searches skipped (4-5% of a run's instructions when made for every block). */
+static void plan_terms(const ulam_solver *s, int grid, double *Rt, double *A, double *b, double *h, double *nplan)
 {
     const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
     double E = s->o.stop.rel_err > 0 ? s->o.stop.rel_err : 0.0, mabs = fabs(moments_estimate(s) + s->o.stop.rel_err_offset);
@@ -1595,11 +1618,13 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m;
     double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
     *Rt = !truncated ? score_range(s, 1.0, 1.0, 1) : t > 0 ? score_range(s, m, t / m, 1) : INFINITY;
-    double X = bias_scale(s, 0.0), n1 = fmin(*nplan, (double)BLOCK), least = INFINITY, t0 = 1e-6 * m;
+    double X = bias_scale(s, 0.0), n1 = first_walks(s, *nplan, fixed), least = INFINITY, t0 = 1e-6 * m;
     for (int pass = 0; pass < 2; pass++) /* under rel_err a second pass: the least bias within 5% of the least */
-        for (int j = 0; truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
+        for (int j = 0; grid && truncated && N == 0 && isfinite(X) && X > t0 && t0 > 0 && j <= 4 * log2(X / t0); j++) {
             /* no estimate yet: the truncation whose bias and range term over the first round's walks (a
-               bet at its largest) add up least, whatever x is (a bias of a millionth of a visit's score
+               bet at its largest; a fixed budget: over all its walks, as the later blocks plan, so the
+               first block's bias is theirs and its weight no more than theirs: signed forward 200 at
+               10^4 walks +-92 -> +-76, at 10^5 +-28 -> +-24) add up least, whatever x is (a bias of a millionth of a visit's score
                tripled the range of the first block: a --walks 1000 run's half-width was 0.16 x against
                0.048 x at 4096, Poisson 70 x 70 centre); under rel_err a bias of at most E X / 16 and,
                the sum being flat near its least, the smallest bias within 5% of it (the first block's
@@ -1615,6 +1640,20 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
             if (pass == 0 && wj < least) least = wj, t = tj, *Rt = Rj;
             if (pass == 1 && E > 0 && wj <= 1.05 * least) t = tj, *Rt = Rj;
         }
+    if (grid && truncated && N > 0 && !(*h > 0) && isfinite(X) && X > t0 && t0 > 0) {
+        /* a budget, no target: hp / 8 or the grid's truncation whose bias and range term over the
+           planned walks add up least.  Where the range grows as 1 / t (the second moment's route:
+           weights without a bound) hp / 8 took R to 1e9 and every later block's bet to nothing, so
+           the first block's bias (139 for x = 0.57) stayed the interval's (signed forward 200:
+           +-244 at 1e3 walks, +-407 at 1e5) */
+        double At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
+        double best = isfinite(*Rt) ? ulam__cs_range_width(At, *nplan) + t : INFINITY;
+        for (int j = 0; j <= 4 * log2(X / t0); j++) {
+            double tj = X * exp2(-0.25 * j), Rj = score_range(s, m, tj / m, 1);
+            double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, *nplan) + tj;
+            if (isfinite(Rj) && wj < best) best = wj, t = tj, *Rt = Rj;
+        }
+    }
     for (int j = 2; truncated && *h > 0 && j <= 6; j++) { /* rel_err: the share of h (1/4 .. 1/64) that meets it soonest */
         double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m, 1);
         double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
@@ -1631,7 +1670,7 @@ static void plan_terms(const ulam_solver *s, double *Rt, double *A, double *b, d
 static void round_clip(ulam_solver *s)
 {
     double Rt, A, b, h, nplan;
-    plan_terms(s, &Rt, &A, &b, &h, &nplan);
+    plan_terms(s, 1, &Rt, &A, &b, &h, &nplan);
     s->w.clip = isfinite(A) && A > 0 ? A : 0.0, s->clip_b = b;
 }
 
@@ -1640,7 +1679,7 @@ static void cs_plan(ulam_solver *s)
 {
     const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
     double Rt, A, b, h, nplan;
-    plan_terms(s, &Rt, &A, &b, &h, &nplan);
+    plan_terms(s, 0, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     ulam__cs_plan4(&s->cs, mom->n, mom->mean, ulam__moments_variance(mom), mom->m3, mom->m4, A, b, h > b ? h - b : 0.0, nplan);
 }
@@ -1651,7 +1690,7 @@ static void cs_plan(ulam_solver *s)
 static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
 {
     double Rt, A, b, h, nplan, E = s->o.stop.rel_err;
-    plan_terms(s, &Rt, &A, &b, &h, &nplan);
+    plan_terms(s, 0, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     if (!(h > 0) && E > 0 && run->n >= 2) h = E * fabs(run->mean + s->o.stop.rel_err_offset);
     ulam__cs_plan4(&s->cs, run->n, run->mean, ulam__moments_variance(run), run->m3, run->m4, A, b, h > b ? h - b : 0.0, nplan);
@@ -1664,7 +1703,7 @@ static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci)
 {
     double A, b, h, nplan;
-    plan_terms(s, R, &A, &b, &h, &nplan);
+    plan_terms(s, 1, R, &A, &b, &h, &nplan);
     if (*R == 0.0) ulam__stop_interval(r->walks, r->estimate, 0.0, 0.0, 0.0, 0.0, 0.0, 0, ci);
     else {
         double m0 = s->o.mode == ULAM_ADJOINT ? s->adj.mean : s->watched.mean, shift = r->estimate - m0;
@@ -1709,7 +1748,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
     if (s->o.stop.rel_err > 0) { /* a sequence tuned to the target from the start, at the planned range */
         double E = s->o.stop.rel_err, A, b, h, nplan, Rp;
-        plan_terms(s, &Rp, &A, &b, &h, &nplan);
+        plan_terms(s, 1, &Rp, &A, &b, &h, &nplan);
         r->min_walks = R == 0.0 ? 0.0 : ulam__cs_walks_needed(m, r->variance, A, b + r->cut_bound, E);
         if (s->met) r->min_walks = fmin(r->min_walks, (double)r->walks); /* it held there */
         if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0 && ci.kind != ULAM__STOP_EXACT)

@@ -733,6 +733,79 @@ static void test_fixed_hard(void **state)
     }
 }
 
+/* Fixed budgets narrow as the budget grows (issue 38): forward collision walks on a signed system,
+ * whose weights have no bound, clip their scores by the second-moment certificate (a clip R costs
+ * a bias of v2 / R).  Every block after the first took its truncation at an eighth of the planned
+ * half-width, so R ~ 1e9 and those blocks' bets weighed nothing: the first block's bias (139 for
+ * x = 0.57) stayed the interval's, and --walks 10^3, 10^4, 10^5 printed +-244, +-267, +-407.  At
+ * seed 1 the half-width at 4W walks must be below 0.7 of the one at W (W = 1000, 4000, 16000:
+ * the variance's own rate is 0.5); stopped after 2, 4 and 6 rounds as a clock stops a --time run,
+ * each half-width below 0.7 of the one before; and over 100 seeds at 1000 and 10^4 walks and at
+ * 1 to 6 rounds of a clock's stop the intervals cover (at least 89 of 100). */
+static void test_fixed_narrows(void **state)
+{
+    (void)state;
+    for (int k = 0; k < 2; k++) {
+        double *b, *x = NULL, x0;
+        ulam_csr *M = k == 0 ? hard38(0, &b, &x0) : forward_system(200, 1, 11, &b, &x);
+        if (k == 1) x0 = x[0], free(x);
+        double half[4];
+        for (int w = 0; w < 4; w++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.mode = ULAM_FORWARD, o.query.index = 0, o.exec.seed = 1, o.stop.max_walks = 1000 << (2 * w);
+            ulam_walk_result r;
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+            half[w] = (r.ci95[1] - r.ci95[0]) / 2;
+            print_message("%s forward collision, %6lld walks: x_0 %.4g, estimate %.4g, stderr %.3g, half-width %.4g\n",
+                          k ? "signed forward 200" : "signed200", (long long)r.walks, x0, r.estimate, r.std_error, half[w]);
+            assert_true(isfinite(half[w]) && half[w] > 0);
+        }
+        for (int w = 1; w < 4; w++) assert_true(half[w] < 0.7 * half[w - 1]);
+        double th[3]; /* a clock's stop: 2, 4 and 6 rounds (3072, 15360, 64512 walks) under max_seconds */
+        for (int w = 0; w < 3; w++) {
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.mode = ULAM_FORWARD, o.query.index = 0, o.exec.seed = 1, o.stop.max_walks = 0, o.stop.max_seconds = 1e9;
+            ulam_solver *sv;
+            assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, NULL), ULAM_OK);
+            for (int q = 0; q < 2 + 2 * w; q++) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+            ulam_walk_result r;
+            ulam_solver_result(sv, &r);
+            th[w] = (r.ci95[1] - r.ci95[0]) / 2;
+            print_message("%s forward collision, %d rounds (%lld walks) of a clock's stop: half-width %.4g\n",
+                          k ? "signed forward 200" : "signed200", 2 + 2 * w, (long long)r.walks, th[w]);
+            assert_true(isfinite(th[w]) && th[w] > 0);
+            ulam_solver_free(sv);
+        }
+        for (int w = 1; w < 3; w++) assert_true(th[w] < 0.7 * th[w - 1]);
+        for (int w = 0; w < 3; w++) {
+            int v[3] = {0, 0, 0}, R = 100;
+            for (int s = 0; s < R; s++) {
+                if (!test_case(12000L + 1000L * k + 100L * w + s)) continue;
+                ulam_walk_opts o = ulam_walk_defaults();
+                o.mode = ULAM_FORWARD, o.query.index = 0, o.exec.seed = 1 + (uint64_t)s;
+                o.stop.max_walks = w == 0 ? 1000 : w == 1 ? 10000 : 0;
+                if (w == 2) o.stop.max_seconds = 1e9;
+                ulam_walk_result r;
+                if (w < 2) assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+                else {
+                    ulam_solver *sv;
+                    assert_int_equal(ulam_solver_alloc(M, b, &o, &sv, NULL), ULAM_OK);
+                    for (int q = 0; q < 1 + s % 6; q++) assert_int_equal(ulam_solver_iterate(sv), ULAM_OK);
+                    ulam_solver_result(sv, &r);
+                    ulam_solver_free(sv);
+                }
+                v[verdict(&r, x0)]++;
+            }
+            test_case_done();
+            char what[64];
+            snprintf(what, sizeof what, "%s forward collision, %s:", k ? "signed forward 200" : "signed200",
+                     w == 0 ? "1000 walks" : w == 1 ? "10^4 walks" : "1 to 6 rounds");
+            count(what, v[1], v[2], R);
+        }
+        ulam_csr_free(M), free(b);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_never_zero_width), cmocka_unit_test(test_metastable_fixed),
@@ -742,6 +815,7 @@ int main(void)
                                        cmocka_unit_test(test_laplace_noisy_auto), cmocka_unit_test(test_forward_rel_err), cmocka_unit_test(test_forward_rel_err_scale), cmocka_unit_test(test_forward_expected),
                                        cmocka_unit_test(test_zero_estimate_stops), cmocka_unit_test(test_rel_err_width_hard),
                                        cmocka_unit_test(test_fixed_hard), cmocka_unit_test(test_rel_err_small_counts),
-                                       cmocka_unit_test(test_rel_err_convdiff)};
+                                       cmocka_unit_test(test_rel_err_convdiff),
+                                       cmocka_unit_test(test_fixed_narrows)};
     return test_run(tests);
 }
