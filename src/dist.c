@@ -220,28 +220,48 @@ typedef struct {
     double E; /* rel_err (0: none) */
 } seq;
 
+/* Query k's bound on E X^2 of one score when the weights grow (cert.second): each step's
+ * E (w_t b_s)^2 <= bmax^2 c u^t, so by Minkowski sqrt(E X^2) <= bmax sqrt(c) / (1 - sqrt u),
+ * rounded up. */
+static double second_moment(const seq *S, int64_t k)
+{
+    double r = 1.0 - sqrt(S->cert.u);
+    return S->cert.bmax * S->cert.bmax * S->cert.c[k] / (r * r) * (1.0 + 1e-9);
+}
+
 /* The clip of the next block of query k (mk: its n, mean and M2 so far): *A the limit of |score|,
  * *b the most clipping at A moves the mean (stop.h), *h the target half-width, *nplan the walks
  * planned.  A walk of T steps scores at most bmax (T + 1), so past A = bmax K only walks of K
  * steps or more, and E (|X| - A)_+ <= bmax sum_{j >= K} P(T >= j) <= bmax c u^K / (1 - u); K the
  * least with that at most t, t as the single-machine plan takes it (src/solve.c plan_terms): an
- * eighth of the target half-width, at most a hundredth of |x| (or of its bound bmax c / (1 - u)). */
+ * eighth of the target half-width, at most a hundredth of |x| (or of its bound bmax c / (1 - u)).
+ * With growing weights (cert.second) the second moment bounds the clipping instead. */
 static void clip_plan(const seq *S, int64_t k, const double *mk, int64_t walks, double *A, double *b, double *h,
                       double *nplan)
 {
     double u = S->cert.u, c = S->cert.c[k], bm = S->cert.bmax, N = mk[0], var = N > 1 ? mk[2] / (N - 1.0) : 0.0;
-    double xb = bm * c / (1.0 - u), mabs = fabs(mk[1]), m = N > 0 && mabs > 0 ? fmin(mabs, xb) : xb;
+    double v2 = second_moment(S, k), xb = S->cert.second ? sqrt(v2) : bm * c / (1.0 - u);
+    double mabs = fabs(mk[1]), m = N > 0 && mabs > 0 ? fmin(mabs, xb) : xb;
+    if (S->cert.second && N < 2) var = v2; /* no walks yet: the certified second moment plans the first block */
     *nplan = S->E > 0 ? fmax(4.0 * N, 4096.0) : (double)walks;
     *h = S->E > 0 && mabs > 0 ? S->E * mabs : 0.0;
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), t = fmin(fmax(ULAM__STOP_TAIL, S->E / 4.0) * m, fmax(hp / 8.0, 1e-6 * m));
+    if (S->cert.second) { /* (|X| - A)_+ <= X^2 / (4 A): past A = v2 / (4 t) clipping moves the mean at most t */
+        *A = v2 / (4.0 * t), *b = t * (1.0 + 1e-9);
+        return;
+    }
     double K = u > 0 ? ceil(log(t * (1.0 - u) / (bm * c)) / log(u)) : 1.0;
     K = K >= 1.0 ? fmin(K, 1e15) : 1.0;
     *A = bm * K, *b = bm * c * pow(u, K) / (1.0 - u) * (1.0 + 1e-9);
 }
 
-/* The bias of walks cut at max_steps in query k: bmax c u^max_steps / (1 - u). */
+/* The bias of walks cut at max_steps in query k: bmax c u^max_steps / (1 - u) (growing weights:
+ * the steps' root second moments past max_steps, bmax sqrt(c) u^((max_steps + 1) / 2) / (1 - sqrt u)). */
 static double cut_bias(const seq *S, int64_t k, int64_t max_steps)
 {
+    if (S->cert.second)
+        return S->cert.bmax * sqrt(S->cert.c[k]) * pow(S->cert.u, 0.5 * (double)(max_steps + 1)) / (1.0 - sqrt(S->cert.u)) *
+               (1.0 + 1e-9);
     return S->cert.bmax * S->cert.c[k] * pow(S->cert.u, (double)max_steps) / (1.0 - S->cert.u) * (1.0 + 1e-9);
 }
 

@@ -222,7 +222,8 @@ int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const 
     cert->bmax = bmax;
     cert->c = calloc((size_t)nq, sizeof *cert->c);
     if (!cert->c) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
-    if (smax > 1.0 || bmax == 0.0) return ULAM_OK; /* weights that grow: no length bound bounds a score; b = 0: x = 0 */
+    if (bmax == 0.0) return ULAM_OK; /* b = 0: x = 0 */
+    cert->second = smax > 1.0;       /* weights that grow: no length bound bounds a score, a second moment may */
     double *keep = malloc(((size_t)rows + 1) * sizeof *keep), u = INFINITY, vmin = 0.0;
     int64_t *bits = calloc((size_t)nq, sizeof *bits);
     int status = keep && bits ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the power iteration");
@@ -231,10 +232,14 @@ int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const 
         if (index[k] >= p->first && index[k] < p->last && p->set == 0) memcpy(&bits[k], &keep[index[k] - p->first], 8);
     if (!status && comm->nranks > 1 && comm->sum(comm->ctx, bits, (int)nq))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks that succeeds");
+    double g = 0.0; /* second: max b_i^2 / v_i, so b^2 <= g v (tighter than bmax^2 / min v where b is small) */
+    for (int64_t i = 0; !status && cert->second && i < rows; i++) g = fmax(g, p->b[i] * p->b[i] / keep[i]);
+    if (!status && cert->second && ulam__dist_largest(comm, &g))
+        status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
     for (int64_t k = 0; !status && k < nq; k++) {
         double vk;
         memcpy(&vk, &bits[k], 8);
-        cert->c[k] = vk / vmin * (1.0 + 4.0 * DBL_EPSILON); /* v_i / min v, rounded up */
+        cert->c[k] = cert->second ? vk * g / (bmax * bmax) * (1.0 + 8.0 * DBL_EPSILON) : vk / vmin * (1.0 + 4.0 * DBL_EPSILON);
     }
     if (!status && u < 1.0) cert->u = u;
     free(keep), free(bits);

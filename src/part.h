@@ -72,10 +72,15 @@ void ulam__halo_free(ulam__halo *h);
  * (|M|^k 1)_i) and a positive v with |M| v <= u v (a Collatz-Wielandt vector of ulam_dist_radius's
  * power iteration, certified by one product rounded up): alive with probability at most
  * u^k v_i / min v = u^k c[k] for query k.  bmax = max |b_i|: a walk of T steps scores at most
- * bmax (T + 1).  u INFINITY: no certificate. */
+ * bmax (T + 1).  With a row sum above 1 (second) the same power iteration's u certifies the
+ * weights' second moment instead, and bmax^2 c[k] >= v_k max_i b_i^2 / v_i.  u INFINITY: no
+ * certificate. */
 typedef struct {
     double u, bmax;
-    double *c; /* per query, malloc'd */
+    double *c;  /* per query, malloc'd */
+    int second; /* a row sums above 1: u certifies M^ = diag(max(1, S)) |M| (the weights' second moment),
+                   and a score's E X^2 <= bmax^2 c / (1 - sqrt u)^2 (Minkowski over the steps) bounds
+                   the clipping in place of the length */
 } ulam__dist_cert;
 
 /* The certificate above for walks from index[0 .. nq) (src/dist_radius.c), at most iters products. */
