@@ -62,7 +62,8 @@ static void summary_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answ
     const ulam_dist_ci *ci = adjoint ? s->ci : NULL;
     if (queries) {
         if (verbosity >= 0) fprintf(f, "queries         %s, each above (walks below: each query's)\n", queries);
-    } else if (adjoint) estimate_fprint(f, a->index[0] + 1, r->estimate, r->std_error, s->rho, ci), fputc('\n', f);
+    } else if (adjoint || (forward && a->index)) /* forward: the watched component's line (its sequence) */
+        estimate_fprint(f, a->index[0] + 1, r->estimate, r->std_error, s->rho, adjoint ? ci : s->ci), fputc('\n', f);
     for (int64_t k = 0; ci && k < nq; k++) met += ci[k].met;
     if (a->rel_err > 0 && met == nq)
         fprintf(f, "rel-err         met (target %.3g)%s\n", a->rel_err, queries ? " by every query" : "");
