@@ -245,6 +245,28 @@ def check_partition_forward_index(ulam, mpirun, d):
             assert hi - lo < 3.0 * abs(x), lines[0]  # the length tail's: within +-150% of x (the second moment's: +-1e4)
 
 
+def check_partition_kill(ulam, mpirun, d):
+    """Issue 43: a rank killed mid-run (SIGKILL, no word to the others, while they wait in an
+    exchange: the ULAM_TEST_PARTITION_KILL=rank:exchange hook of src/cli/mpi.c) ends the job with
+    a non-zero exit, mpirun's message naming the rank and the signal, and no stdout, not a hang.
+    Rank 1 of 3 makes 31 exchanges on this query (a kill at the 32nd is never reached: the run
+    ends normally); the walks' 7 rounds are exchanges 23-29, so 26 kills it among the walks and 31
+    at the last (rank 0 holds the answer, unprinted).  A quiet run takes about 1.5 s here; the
+    timeout is 120 s."""
+    m, b = write_system(d, 3000, 5)
+    sysf = f"{d}/k.ulam"
+    run([ulam, "prepare", m, "--rhs", b, "--transpose", "-o", sysf])
+    cmd = [mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "1234", "--walks", "40000",
+           "--seed", "3"]
+    quiet = run(cmd)
+    for at in (26, 31, 32):
+        p = subprocess.run(cmd, capture_output=True, text=True, env=dict(ENV, ULAM_TEST_PARTITION_KILL=f"1:{at}"), timeout=120)
+        if at == 32:
+            assert p.returncode == 0 and p.stdout.splitlines()[0] == quiet.splitlines()[0], (at, p.returncode, p.stderr)
+        else:
+            assert p.returncode != 0 and not p.stdout and "rank 1" in p.stderr and "signal 9" in p.stderr, (at, p.returncode, p.stdout, p.stderr)
+
+
 def check_partition_mtx(ulam, mpirun, d):
     """Issue 43: Matrix Market read by byte ranges on a partition (--rhs): each rank parses its share
     of the lines.  A file with shuffled rows, split duplicates, an explicit zero, a comment and a blank
@@ -488,6 +510,7 @@ def main():
                 print(f"FAIL {name}: {e}")
         for name, check in (("partition", check_partition), ("partition rows above 1", check_partition_growing),
                             ("partition forward index", check_partition_forward_index),
+                            ("partition rank killed", check_partition_kill),
                             ("partition matrix market", check_partition_mtx),
                             ("partition source without b", check_partition_source_graph)):
             try:
@@ -509,7 +532,7 @@ def main():
     except AssertionError as e:
         failures += 1
         print(f"FAIL interrupt: {e}")
-    print(f"{len(cases) + 7 - failures} passed, {failures} failed")
+    print(f"{len(cases) + 8 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 
