@@ -124,8 +124,10 @@ typedef struct ulam_dist_ci {
  * sequence, block by block of o->batch walk ids in walk-id order (the single-machine solver's,
  * src/stop.h): valid at every block, so under rel_err > 0 too, which ends a query's walks (and
  * the run, once all met) at the first block whose half-width is at most rel_err |estimate|,
- * o->walks then the most a query takes (res[k].walks: the walks it took).  Else ci[k] has NaN
- * ends.  ci NULL (rel_err 0): the walks alone, no interval.  The same bits at any rank count and
+ * o->walks then the most a query takes (res[k].walks: the walks it took).  With a row sum above
+ * 1 the same iteration on M^ = diag(max(1, S)) |M| bounds the score's second moment instead
+ * (E X^2 <= max_j (b_j^2 / v_j) v_i / (1 - sqrt u)^2), and that bounds the clipping's bias
+ * (docs/distributed.md).  Else ci[k] has NaN ends.  ci NULL (rel_err 0): the walks alone, no interval.  The same bits at any rank count and
  * any number of sets. */
 int ulam_dist_adjoint_ci(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
                          const ulam_dist_opts *o, double rel_err, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err);
