@@ -124,8 +124,10 @@ typedef struct ulam_dist_ci {
  * sequence, block by block of o->batch walk ids in walk-id order (the single-machine solver's,
  * src/stop.h): valid at every block, so under rel_err > 0 too, which ends a query's walks (and
  * the run, once all met) at the first block whose half-width is at most rel_err |estimate|,
- * o->walks then the most a query takes (res[k].walks: the walks it took).  Else ci[k] has NaN
- * ends.  ci NULL (rel_err 0): the walks alone, no interval.  The same bits at any rank count and
+ * o->walks then the most a query takes (res[k].walks: the walks it took).  With a row sum above
+ * 1 the same iteration on M^ = diag(max(1, S)) |M| bounds the score's second moment instead
+ * (E X^2 <= max_j (b_j^2 / v_j) v_i / (1 - sqrt u)^2), and that bounds the clipping's bias
+ * (docs/distributed.md).  Else ci[k] has NaN ends.  ci NULL (rel_err 0): the walks alone, no interval.  The same bits at any rank count and
  * any number of sets. */
 int ulam_dist_adjoint_ci(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq,
                          const ulam_dist_opts *o, double rel_err, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err);
@@ -211,7 +213,8 @@ int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int forward, int
 enum { ULAM_DIST_ADJOINT = 0, ULAM_DIST_FORWARD = 1, ULAM_DIST_MCSA = 2, ULAM_DIST_SOURCE = 3 };
 typedef struct ulam_dist_ask {
     int mode;             /* ULAM_DIST_ADJOINT, _FORWARD, _MCSA or _SOURCE */
-    const int64_t *index; /* adjoint: the nq queries' 0-based rows (ulam_dist_adjoint_ci) */
+    const int64_t *index; /* adjoint: the nq queries' 0-based rows (ulam_dist_adjoint_ci); forward:
+                             NULL, or one row whose certified interval goes to ci[0] */
     int64_t nq;
     double rel_err;       /* adjoint: the queries' stop (0: o.walks each) */
     int bound;            /* forward: also x's certified range from its residual (ulam_dist_bound) */
@@ -233,12 +236,12 @@ typedef struct ulam_dist_answer {
     double *x, *se;            /* forward, MCSA, single source: this rank's rows (se not for MCSA); the
                                   ranks of set 0 hold them (a rank of another set: its rows, or 0 rows) */
     ulam_dist_result *res;     /* adjoint: nq of them */
-    ulam_dist_ci *ci;          /* adjoint: nq of them */
+    ulam_dist_ci *ci;          /* adjoint: nq of them; forward with an index: one */
     ulam_dist_top *tops;       /* single source: top of them; rank 0 gets the ntop largest of all */
     int64_t *ranks;            /* 2 nranks: every rank's rows, then its peak resident memory (KiB) */
     int64_t n, ntop;           /* the system's order; the top table's rows (rank 0) */
     ulam_dist_result r;        /* the whole run's walks, steps, crossings, bytes, rounds and cuts
-                                  (adjoint: also the first query's estimate) */
+                                  (adjoint, forward with an index: also that row's estimate) */
     double rho;                /* the variance guard: certified bound on rho(M^), INFINITY when none */
     double worst;              /* MCSA, single source, forward with bound: the largest certified half-width */
     int iterations;            /* MCSA: iterations; single source: the push's products with M */

@@ -220,28 +220,48 @@ typedef struct {
     double E; /* rel_err (0: none) */
 } seq;
 
+/* Query k's bound on E X^2 of one score when the weights grow (cert.second): each step's
+ * E (w_t b_s)^2 <= bmax^2 c u^t, so by Minkowski sqrt(E X^2) <= bmax sqrt(c) / (1 - sqrt u),
+ * rounded up. */
+static double second_moment(const seq *S, int64_t k)
+{
+    double r = 1.0 - sqrt(S->cert.u);
+    return S->cert.bmax * S->cert.bmax * S->cert.c[k] / (r * r) * (1.0 + 1e-9);
+}
+
 /* The clip of the next block of query k (mk: its n, mean and M2 so far): *A the limit of |score|,
  * *b the most clipping at A moves the mean (stop.h), *h the target half-width, *nplan the walks
  * planned.  A walk of T steps scores at most bmax (T + 1), so past A = bmax K only walks of K
  * steps or more, and E (|X| - A)_+ <= bmax sum_{j >= K} P(T >= j) <= bmax c u^K / (1 - u); K the
  * least with that at most t, t as the single-machine plan takes it (src/solve.c plan_terms): an
- * eighth of the target half-width, at most a hundredth of |x| (or of its bound bmax c / (1 - u)). */
+ * eighth of the target half-width, at most a hundredth of |x| (or of its bound bmax c / (1 - u)).
+ * With growing weights (cert.second) the second moment bounds the clipping instead. */
 static void clip_plan(const seq *S, int64_t k, const double *mk, int64_t walks, double *A, double *b, double *h,
                       double *nplan)
 {
     double u = S->cert.u, c = S->cert.c[k], bm = S->cert.bmax, N = mk[0], var = N > 1 ? mk[2] / (N - 1.0) : 0.0;
-    double xb = bm * c / (1.0 - u), mabs = fabs(mk[1]), m = N > 0 && mabs > 0 ? fmin(mabs, xb) : xb;
+    double v2 = second_moment(S, k), xb = S->cert.second ? sqrt(v2) : bm * c / (1.0 - u);
+    double mabs = fabs(mk[1]), m = N > 0 && mabs > 0 ? fmin(mabs, xb) : xb;
+    if (S->cert.second && N < 2) var = v2; /* no walks yet: the certified second moment plans the first block */
     *nplan = S->E > 0 ? fmax(4.0 * N, 4096.0) : (double)walks;
     *h = S->E > 0 && mabs > 0 ? S->E * mabs : 0.0;
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), t = fmin(fmax(ULAM__STOP_TAIL, S->E / 4.0) * m, fmax(hp / 8.0, 1e-6 * m));
+    if (S->cert.second) { /* (|X| - A)_+ <= X^2 / (4 A): past A = v2 / (4 t) clipping moves the mean at most t */
+        *A = v2 / (4.0 * t), *b = t * (1.0 + 1e-9);
+        return;
+    }
     double K = u > 0 ? ceil(log(t * (1.0 - u) / (bm * c)) / log(u)) : 1.0;
     K = K >= 1.0 ? fmin(K, 1e15) : 1.0;
     *A = bm * K, *b = bm * c * pow(u, K) / (1.0 - u) * (1.0 + 1e-9);
 }
 
-/* The bias of walks cut at max_steps in query k: bmax c u^max_steps / (1 - u). */
+/* The bias of walks cut at max_steps in query k: bmax c u^max_steps / (1 - u) (growing weights:
+ * the steps' root second moments past max_steps, bmax sqrt(c) u^((max_steps + 1) / 2) / (1 - sqrt u)). */
 static double cut_bias(const seq *S, int64_t k, int64_t max_steps)
 {
+    if (S->cert.second)
+        return S->cert.bmax * sqrt(S->cert.c[k]) * pow(S->cert.u, 0.5 * (double)(max_steps + 1)) / (1.0 - sqrt(S->cert.u)) *
+               (1.0 + 1e-9);
     return S->cert.bmax * S->cert.c[k] * pow(S->cert.u, (double)max_steps) / (1.0 - S->cert.u) * (1.0 + 1e-9);
 }
 
@@ -374,7 +394,7 @@ static int adjoint(const ulam_part *p, const ulam_comm *comm, const int64_t *ind
     double *m = calloc((size_t)nq * 9, sizeof *m); /* n, mean, M2 of each query (rank 0); then stderr; then ci */
     if (!status && !m) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
     seq S0 = {.E = rel_err}, *S = ci ? &S0 : NULL;
-    if (!status && S) status = ulam__dist_tail(p, comm, 200, index, nq, &S->cert, err);
+    if (!status && S) status = ulam__dist_tail(p, comm, 200, index, nq, -1.0, &S->cert, err);
     if (!status && S && (!(S->cs = calloc((size_t)nq, sizeof *S->cs)) || !(S->done = calloc((size_t)nq, 1))))
         status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
     int stops = S && rel_err > 0 && seq_on(S); /* the run may end early: rank 0 says which queries are done */
@@ -522,7 +542,7 @@ static void totals(run *R)
 /* Add the batches' tallies to the per-row sums of set 0's ranks, each history's total at a row
  * once, in (row, walk) order: with sets, each rank's totals go to the rank of set 0 that holds
  * the same rows. */
-static int settle(run *R, double *sum, double *sumsq, ulam_error *err)
+static int settle(run *R, double *sum, double *sumsq, int64_t watch, int64_t w0, int64_t w1, ulam_error *err)
 {
     const ulam_part *p = R->p;
     totals(R);
@@ -539,10 +559,18 @@ static int settle(run *R, double *sum, double *sumsq, ulam_error *err)
         if (R->tallies.len) qsort(t, (size_t)R->tallies.len, sizeof *t, by_row_walk); /* walks differ across sets */
     }
     const tally *t = R->tallies.a;
+    int64_t at = -1; /* the watched row's first total (its walks in order) */
     for (int64_t q = 0; p->set == 0 && q < R->tallies.len; q++) {
         sum[t[q].s - p->first] += t[q].v;
         sumsq[t[q].s - p->first] += t[q].v * t[q].v;
+        if (t[q].s == watch && at < 0) at = q;
     }
+    if (watch >= p->first && watch < p->last && p->set == 0) /* every history of walk ids [w0, w1), 0 where none tallied */
+        for (int64_t w = w0, q = at; w < w1; w++) {
+            ended e = {w, 0.0};
+            if (q >= 0 && q < R->tallies.len && t[q].s == watch && t[q].w == w) e.score = t[q++].v;
+            if (push(&R->ends, &e, sizeof e)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the watched row's histories");
+        }
     R->tallies.len = 0;
     return ULAM_OK;
 }
@@ -551,12 +579,13 @@ static int settle(run *R, double *sum, double *sumsq, ulam_error *err)
 int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double *x, double *se,
                       ulam_dist_result *res, ulam_error *err)
 {
-    return ulam__dist_forward_b(p, comm, o, p ? p->b : NULL, x, se, res, err);
+    return ulam__dist_forward_ci(p, comm, o, -1, x, se, res, NULL, err);
 }
 
-/* As ulam_dist_forward with the sources' b given at this rank's rows. */
-int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
-                        double *se, ulam_dist_result *res, ulam_error *err)
+/* Forward walks from b (this rank's rows of it); with S, component watch's histories into S and
+ * its moments m (n, mean, M2) at rank 0. */
+static int forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, int64_t watch,
+                   seq *S, double *m, double *x, double *se, ulam_dist_result *res, ulam_error *err)
 {
     ulam__clear(err);
     if (p && comm && res && !b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
@@ -571,11 +600,13 @@ int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_d
     double *sum = calloc((size_t)rows + 1, sizeof *sum), *sumsq = calloc((size_t)rows + 1, sizeof *sumsq), *P = NULL;
     if (!status && (!sum || !sumsq)) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld sums", (long long)rows);
     if (!status) status = block_prefix(&R, &P, &nb, err);
+    if (!status && S) status = ulam__dist_tail(p, comm, 200, &watch, 1, P[nb], &S->cert, err);
     for (int64_t w0 = 0; !status && P[nb] > 0 && w0 < R.o.walks; w0 += R.o.batch * p->sets) { /* a batch a set */
-        int64_t a = w0 + p->set * R.o.batch;
+        int64_t a = w0 + p->set * R.o.batch, w1 = w0 + R.o.batch * p->sets;
         status = forward_starts(&R, P, nb, a, my_batch(&R, a), err);
         if (!status) status = rounds(&R, 1, err);
-        if (!status) status = settle(&R, sum, sumsq, err);
+        if (!status) status = settle(&R, sum, sumsq, S ? watch : -1, w0, w1 < R.o.walks ? w1 : R.o.walks, err);
+        if (!status && S) status = gather_ends(&R, m, S, err);
     }
     int64_t cut = R.cut;
     if (!status && R.c->nranks > 1 && R.c->sum(R.c->ctx, &cut, 1))
@@ -587,8 +618,47 @@ int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_d
         if (x) x[i] = mean;
         if (se) se[i] = zero_b ? 0.0 : sumsq[i] == 0.0 ? NAN : N > 1 ? sqrt(fmax(var, 0.0) / N) : NAN;
     }
+    if (!status && S && zero_b) m[0] = N; /* b = 0: x = 0, every history 0 */
     res->cut = cut;
     free(sum), free(sumsq), free(P);
     finish(&R);
+    return status;
+}
+
+/* As ulam_dist_forward with the sources' b given at this rank's rows. */
+int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
+                        double *se, ulam_dist_result *res, ulam_error *err)
+{
+    return forward(p, comm, o, b, -1, NULL, NULL, x, se, res, err);
+}
+
+/* Forward walks with component watch's certified interval (part.h). */
+int ulam__dist_forward_ci(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, int64_t watch, double *x,
+                          double *se, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err)
+{
+    if (!ci || watch < 0) return forward(p, comm, o, p ? p->b : NULL, -1, NULL, NULL, x, se, res, err);
+    if (!p || watch >= p->n) return ulam__fail(err, ULAM_EINVAL, 0, watch, "a part and an index in 1 .. %lld", p ? (long long)p->n : 0LL);
+    seq S0 = {.E = 0.0};
+    double m[9] = {0}, mk[3] = {0};
+    S0.cs = calloc(1, sizeof *S0.cs), S0.done = calloc(1, 1);
+    int status = S0.cs && S0.done ? forward(p, comm, o, p->b, watch, &S0, mk, x, se, res, err)
+                                  : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for an interval");
+    if (!status && comm->rank == 0) {
+        m[0] = mk[1], m[1] = mk[0] > 1 ? sqrt(mk[2] / (mk[0] - 1.0) / mk[0]) : NAN;
+        if (S0.cert.bmax == 0.0) m[1] = 0.0;
+        seq_interval(&S0, 0, mk, o ? o->max_steps : ulam_dist_defaults().max_steps, m + 2);
+        if (mk[0] != (double)res->walks) status = ulam__fail(err, ULAM_EIO, 0, -1, "every history back at rank 0");
+    }
+    if (!status && comm->nranks > 1) { /* rank 0's to all (a sum: the others add zeros) */
+        int64_t bits[7] = {0};
+        if (comm->rank == 0) memcpy(bits, m, sizeof bits);
+        if (comm->sum(comm->ctx, bits, 7)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks that succeeds");
+        memcpy(m, bits, sizeof bits);
+    }
+    if (!status) {
+        res->estimate = m[0], res->std_error = m[1];
+        *ci = (ulam_dist_ci){m[2], m[3], m[4], m[5], m[6] > 0};
+    }
+    free(S0.cert.c), free(S0.cs), free(S0.done);
     return status;
 }

@@ -208,21 +208,23 @@ int ulam_dist_radius(const ulam_part *p, const ulam_comm *comm, int forward, int
     return power(p, comm, A, iters, upper, NULL, NULL, err);
 }
 
-/* The length tail of adjoint walks (part.h). */
-int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const int64_t *index, int64_t nq,
+/* The length tail of adjoint walks, or of forward walks with total >= 0 (part.h). */
+int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const int64_t *index, int64_t nq, double total,
                     ulam__dist_cert *cert, ulam_error *err)
 {
     int64_t rows = p->last - p->first;
-    const ulam__rows *A = &p->m;
+    int fwd = total >= 0.0;
+    const ulam__rows *A = fwd ? &p->t : &p->m;
     *cert = (ulam__dist_cert){.u = INFINITY};
     double smax = 0.0, bmax = 0.0;
     for (int64_t i = 0; i < rows; i++) smax = fmax(smax, A->rowsum[i]), bmax = fmax(bmax, fabs(p->b[i]));
     if (ulam__dist_largest(comm, &smax) || ulam__dist_largest(comm, &bmax))
         return ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
-    cert->bmax = bmax;
+    cert->bmax = fwd ? (bmax > 0.0 ? total : 0.0) : bmax; /* forward: every weight is +-||b||_1 while rows are <= 1 */
     cert->c = calloc((size_t)nq, sizeof *cert->c);
     if (!cert->c) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
-    if (smax > 1.0 || bmax == 0.0) return ULAM_OK; /* weights that grow: no length bound bounds a score; b = 0: x = 0 */
+    if (bmax == 0.0) return ULAM_OK; /* b = 0: x = 0 */
+    cert->second = smax > 1.0;       /* weights that grow: no length bound bounds a score, a second moment may */
     double *keep = malloc(((size_t)rows + 1) * sizeof *keep), u = INFINITY, vmin = 0.0;
     int64_t *bits = calloc((size_t)nq, sizeof *bits);
     int status = keep && bits ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the power iteration");
@@ -231,10 +233,18 @@ int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const 
         if (index[k] >= p->first && index[k] < p->last && p->set == 0) memcpy(&bits[k], &keep[index[k] - p->first], 8);
     if (!status && comm->nranks > 1 && comm->sum(comm->ctx, bits, (int)nq))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks that succeeds");
+    double g = 0.0; /* adjoint, second: max b_i^2 / v_i, so b^2 <= g v; forward: max v_j where b_j != 0 (the starts) */
+    for (int64_t i = 0; !status && (cert->second || fwd) && i < rows; i++)
+        g = fmax(g, fwd ? (p->b[i] != 0.0 ? keep[i] : 0.0) : p->b[i] * p->b[i] / keep[i]);
+    if (!status && (cert->second || fwd) && ulam__dist_largest(comm, &g))
+        status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
     for (int64_t k = 0; !status && k < nq; k++) {
         double vk;
         memcpy(&vk, &bits[k], 8);
-        cert->c[k] = vk / vmin * (1.0 + 4.0 * DBL_EPSILON); /* v_i / min v, rounded up */
+        if (fwd) /* a walk from j is alive after t steps w.p. <= u^t v_j / min v; E w_t^2 [s_t = i] <= total^2 u^t v_j / v_i */
+            cert->c[k] = (cert->second ? g / vk : g / vmin) * (1.0 + 8.0 * DBL_EPSILON);
+        else
+            cert->c[k] = cert->second ? vk * g / (bmax * bmax) * (1.0 + 8.0 * DBL_EPSILON) : vk / vmin * (1.0 + 4.0 * DBL_EPSILON);
     }
     if (!status && u < 1.0) cert->u = u;
     free(keep), free(bits);

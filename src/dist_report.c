@@ -19,7 +19,7 @@ static void estimate_fprint(FILE *f, int64_t i, double est, double se, double rh
         fprintf(f, " (95%% CI %.*g .. %.*g; no walk reached it: the push's part alone)", d, ci->lo, d, ci->hi);
     else if (isnan(se)) fprintf(f, " (no walk reached it: the push's part alone)");
     else if (ci && isfinite(ci->lo)) fprintf(f, " +- %.3g (95%% CI %.*g .. %.*g)", se, d, ci->lo, d, ci->hi);
-    else if (ci) fprintf(f, " +- %.3g (standard error; no certified interval: a row of |M| sums above 1, or no length tail)", se);
+    else if (ci) fprintf(f, " +- %.3g (standard error; no certified interval: no certified u < 1 for the walks' length tail or second moment)", se);
     else fprintf(f, " +- %.3g (standard error; no certified interval for forward walks on a partition)", se);
 }
 
@@ -62,14 +62,15 @@ static void summary_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answ
     const ulam_dist_ci *ci = adjoint ? s->ci : NULL;
     if (queries) {
         if (verbosity >= 0) fprintf(f, "queries         %s, each above (walks below: each query's)\n", queries);
-    } else if (adjoint) estimate_fprint(f, a->index[0] + 1, r->estimate, r->std_error, s->rho, ci), fputc('\n', f);
+    } else if (adjoint || (forward && a->index)) /* forward: the watched component's line (its sequence) */
+        estimate_fprint(f, a->index[0] + 1, r->estimate, r->std_error, s->rho, adjoint ? ci : s->ci), fputc('\n', f);
     for (int64_t k = 0; ci && k < nq; k++) met += ci[k].met;
     if (a->rel_err > 0 && met == nq)
         fprintf(f, "rel-err         met (target %.3g)%s\n", a->rel_err, queries ? " by every query" : "");
     else if (a->rel_err > 0)
         fprintf(f, "rel-err         NOT met (target %.3g) by %lld of %lld quer%s in --walks %lld%s\n", a->rel_err,
                 (long long)(nq - met), (long long)nq, nq == 1 ? "y" : "ies", (long long)a->o.walks,
-                ci && isfinite(ci[0].lo) ? "" : " (no certified interval: a row of |M| sums above 1, or no length tail)");
+                ci && isfinite(ci[0].lo) ? "" : " (no certified interval: no certified u < 1 for the walks' length tail or second moment)");
     else if (forward) fprintf(f, "x               %lld components by forward walks%s%s\n", (long long)s->n, out ? ", written to " : "", out ? out : "");
     if (verbosity < 0) return;
     fprintf(f, "method          %s%s collision walks on %d rank%s, rows split by entries",

@@ -81,7 +81,8 @@ static int walks(const ulam_part *p, const ulam_comm *c, const ulam_dist_ask *a,
     if (a->mode == ULAM_DIST_MCSA) status = ulam__dist_mcsa(p, c, &a->o, a->tol, a->max_iter, ans->x, &mi, &ans->r, err);
     else if (a->mode == ULAM_DIST_SOURCE)
         status = ulam__dist_source(p, c, a->source, &a->o, 1e-4, 1000, ans->x, ans->se, &si, &ans->r, err);
-    else status = ulam_dist_forward(p, c, &a->o, ans->x, ans->se, &ans->r, err);
+    else status = ulam__dist_forward_ci(p, c, &a->o, a->index ? a->index[0] : -1, ans->x, ans->se, &ans->r,
+                                        a->index ? ans->ci : NULL, err);
     ans->iterations = a->mode == ULAM_DIST_MCSA ? mi.iterations : si.rounds;
     ans->residual = a->mode == ULAM_DIST_MCSA ? mi.residual : si.residual;
     if (!status && (a->mode != ULAM_DIST_FORWARD || a->bound))
@@ -100,7 +101,8 @@ int ulam_dist_run(const ulam_part *p, const ulam_comm *comm, const ulam_dist_ask
     if (!p || !comm || !ask || !ans || !ans->ranks || ask->mode < ULAM_DIST_ADJOINT || ask->mode > ULAM_DIST_SOURCE)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, an ask of a known mode and an answer with ranks");
     int forward = ask->mode != ULAM_DIST_ADJOINT;
-    if (forward ? !ans->x || (ask->mode != ULAM_DIST_MCSA && !ans->se) || (ask->mode == ULAM_DIST_SOURCE && !ans->tops)
+    if (forward ? !ans->x || (ask->mode != ULAM_DIST_MCSA && !ans->se) || (ask->mode == ULAM_DIST_SOURCE && !ans->tops) ||
+                      (ask->mode == ULAM_DIST_FORWARD && ask->index && !ans->ci)
                 : !ans->res || !ans->ci)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "the answer's arrays the mode fills");
     ans->n = p->n, ans->ntop = 0, ans->r = (ulam_dist_result){0};

@@ -72,15 +72,29 @@ void ulam__halo_free(ulam__halo *h);
  * (|M|^k 1)_i) and a positive v with |M| v <= u v (a Collatz-Wielandt vector of ulam_dist_radius's
  * power iteration, certified by one product rounded up): alive with probability at most
  * u^k v_i / min v = u^k c[k] for query k.  bmax = max |b_i|: a walk of T steps scores at most
- * bmax (T + 1).  u INFINITY: no certificate. */
+ * bmax (T + 1).  With a row sum above 1 (second) the same power iteration's u certifies the
+ * weights' second moment instead, and bmax^2 c[k] >= v_k max_i b_i^2 / v_i.  u INFINITY: no
+ * certificate. */
 typedef struct {
     double u, bmax;
-    double *c; /* per query, malloc'd */
+    double *c;  /* per query, malloc'd */
+    int second; /* a row sums above 1: u certifies M^ = diag(max(1, S)) |M| (the weights' second moment),
+                   and a score's E X^2 <= bmax^2 c / (1 - sqrt u)^2 (Minkowski over the steps) bounds
+                   the clipping in place of the length */
 } ulam__dist_cert;
 
-/* The certificate above for walks from index[0 .. nq) (src/dist_radius.c), at most iters products. */
-int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const int64_t *index, int64_t nq,
+/* The certificate above for walks from index[0 .. nq) (src/dist_radius.c), at most iters products.
+ * total >= 0: forward walks' tallies at index[k] instead (on M', from the system's b, every weight
+ * +-total = ||b||_1 while rows are <= 1): bmax is total and c[k] bounds max_{b_j != 0} v_j / min v
+ * (second: / v at index[k]). */
+int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const int64_t *index, int64_t nq, double total,
                     ulam__dist_cert *cert, ulam_error *err);
+
+/* ulam_dist_forward with, for watch >= 0 (0-based), that component's estimate and standard error
+ * in res and its certified 95% interval in *ci: its histories' tallies, block by block of walk ids
+ * at rank 0, feed the confidence sequence adjoint queries use (src/dist.c). */
+int ulam__dist_forward_ci(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, int64_t watch, double *x,
+                          double *se, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err);
 
 /* A Collatz-Wielandt certificate |M| v <= u v of the part's rows of M (u INFINITY: none) and
  * c[i] >= v_i / min v at this rank's rows (src/dist_radius.c), at most iters products. */

@@ -172,6 +172,101 @@ def check_partition(ulam, mpirun, d):
     assert p.returncode != 0 and not p.stdout, (p.returncode, p.stdout)
 
 
+def check_partition_growing(ulam, mpirun, d):
+    """Issue 43: adjoint intervals on a partition when rows of |M| sum above 1 (a tenth of the rows
+    at 1.5, the rest 0.4: weights that grow, rho(M^) < 1).  The line said "no certified interval"
+    before; now the weights' certified second moment bounds the clipping: a 95% CI at 1, 2 and 3
+    ranks, byte for byte the same line, holding x from the direct solve, for queries at 3 seeds."""
+    import random
+    rnd = random.Random(5)
+    n, ent = 3000, {}
+    for i in range(n):
+        deg = rnd.randint(1, 5)
+        tot = 1.5 if rnd.random() < 0.1 else 0.4
+        for q in range(deg):
+            j = (i + 1) % n if q == 0 else rnd.randrange(n)
+            ent[(i, j)] = ent.get((i, j), 0.0) + tot / deg * (-1 if rnd.random() < 0.2 else 1)
+    m, b = f"{d}/gm.mtx", f"{d}/gb.mtx"
+    with open(m, "w") as f:
+        f.write("%%%%MatrixMarket matrix coordinate real general\n%d %d %d\n" % (n, n, len(ent)))
+        f.writelines("%d %d %.17g\n" % (i + 1, j + 1, v) for (i, j), v in sorted(ent.items()))
+    with open(b, "w") as f:
+        f.write("%%%%MatrixMarket matrix array real general\n%d 1\n" % n)
+        f.writelines("%.17g\n" % rnd.random() for _ in range(n))
+    sysf = f"{d}/g3.ulam"
+    prep = run([ulam, "prepare", m, "--rhs", b, "--transpose", "-o", sysf])
+    assert "0.4 .. 1.5" in prep, prep  # rows above 1
+    run([ulam, "direct", m, "--rhs", b, "--out", f"{d}/gd.mtx"])
+    exact = [float(v) for v in open(f"{d}/gd.mtx").read().split("\n")[3:] if v.strip()]
+    for idx, seed in ((1234, 3), (7, 4), (2999, 5)):
+        lines = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--index", str(idx),
+                      "--walks", "100000", "--seed", str(seed), "-q"]).splitlines()[0] for k in (1, 2, 3)]
+        assert lines[0] == lines[1] == lines[2], lines
+        assert "95% CI" in lines[0], lines[0]
+        est, se, lo, hi = (float(lines[0].split()[i].rstrip(")")) for i in (1, 3, 6, 8))
+        x = exact[idx - 1]
+        assert abs(est - x) < 4 * se and lo <= x <= hi and lo <= est <= hi, (lines[0], x)
+
+
+def check_partition_forward_index(ulam, mpirun, d):
+    """Issue 43: forward mode on a partition with --index I prints x_I's line with a certified 95%
+    interval (its histories' tallies in the confidence sequence adjoint queries use; --index with
+    --mode forward was a usage error before): at 1, 2, 3 ranks and 4 in 2 sets the line and the
+    --out file byte for byte the same, the file the same as without --index, the interval holding
+    x_I from the direct solve and the estimate within 4 standard errors.  Two systems: M' rows of
+    |M'| at most 0.4 (the length tail) and write_system's own (columns of |M| above 1: the
+    weights' second moment, honest and wide)."""
+    n = 3000
+    m, b = write_system(d, n, 5)
+    t = f"{d}/ft.mtx"
+    with open(m) as f, open(t, "w") as g:
+        for k, l in enumerate(f):
+            g.write(l if k < 2 else "%s %s %s\n" % tuple(l.split()[i] for i in (1, 0, 2)))
+    for mm in (t, m):
+        sysf = f"{d}/fi.ulam"
+        run([ulam, "prepare", mm, "--rhs", b, "--transpose", "-o", sysf])
+        run([ulam, "direct", mm, "--rhs", b, "--out", f"{d}/fd.mtx"])
+        exact = [float(v) for v in open(f"{d}/fd.mtx").read().split("\n")[3:] if v.strip()]
+        base = [mpirun, "--oversubscribe", "-np"]
+        run(base + ["1", ulam, "solve", sysf, "--partition", "--mode", "forward", "--walks", "200000", "--seed", "3",
+                    "--out", f"{d}/f0.mtx", "-q"])
+        lines, files = [], [open(f"{d}/f0.mtx").read()]
+        for k, extra in (("1", []), ("2", []), ("3", []), ("4", ["--sets", "2"])):
+            out = run(base + [k, ulam, "solve", sysf, "--partition", "--mode", "forward", "--index", "1234", "--walks",
+                              "200000", "--seed", "3", "--out", f"{d}/f{k}.mtx", "-q"] + extra)
+            lines.append(out.splitlines()[0])
+            files.append(open(f"{d}/f{k}.mtx").read())
+        assert len(set(lines)) == 1 and len(set(files)) == 1, (mm, lines)
+        assert lines[0].startswith("x[1234]") and "95% CI" in lines[0], lines[0]
+        est, se, lo, hi = (float(lines[0].split()[i].rstrip(")")) for i in (1, 3, 6, 8))
+        x = exact[1233]
+        assert abs(est - x) < 4 * se and lo <= x <= hi and lo <= est <= hi, (mm, lines[0], x)
+        if mm == t:
+            assert hi - lo < 3.0 * abs(x), lines[0]  # the length tail's: within +-150% of x (the second moment's: +-1e4)
+
+
+def check_partition_kill(ulam, mpirun, d):
+    """Issue 43: a rank killed mid-run (SIGKILL, no word to the others, while they wait in an
+    exchange: the ULAM_TEST_PARTITION_KILL=rank:exchange hook of src/cli/mpi.c) ends the job with
+    a non-zero exit, mpirun's message naming the rank and the signal, and no stdout, not a hang.
+    Rank 1 of 3 makes 31 exchanges on this query (a kill at the 32nd is never reached: the run
+    ends normally); the walks' 7 rounds are exchanges 23-29, so 26 kills it among the walks and 31
+    at the last (rank 0 holds the answer, unprinted).  A quiet run takes about 1.5 s here; the
+    timeout is 120 s."""
+    m, b = write_system(d, 3000, 5)
+    sysf = f"{d}/k.ulam"
+    run([ulam, "prepare", m, "--rhs", b, "--transpose", "-o", sysf])
+    cmd = [mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "1234", "--walks", "40000",
+           "--seed", "3"]
+    quiet = run(cmd)
+    for at in (26, 31, 32):
+        p = subprocess.run(cmd, capture_output=True, text=True, env=dict(ENV, ULAM_TEST_PARTITION_KILL=f"1:{at}"), timeout=120)
+        if at == 32:
+            assert p.returncode == 0 and p.stdout.splitlines()[0] == quiet.splitlines()[0], (at, p.returncode, p.stderr)
+        else:
+            assert p.returncode != 0 and not p.stdout and "rank 1" in p.stderr and "signal 9" in p.stderr, (at, p.returncode, p.stdout, p.stderr)
+
+
 def check_partition_mtx(ulam, mpirun, d):
     """Issue 43: Matrix Market read by byte ranges on a partition (--rhs): each rank parses its share
     of the lines.  A file with shuffled rows, split duplicates, an explicit zero, a comment and a blank
@@ -413,7 +508,10 @@ def main():
             except AssertionError as e:
                 failures += 1
                 print(f"FAIL {name}: {e}")
-        for name, check in (("partition", check_partition), ("partition matrix market", check_partition_mtx),
+        for name, check in (("partition", check_partition), ("partition rows above 1", check_partition_growing),
+                            ("partition forward index", check_partition_forward_index),
+                            ("partition rank killed", check_partition_kill),
+                            ("partition matrix market", check_partition_mtx),
                             ("partition source without b", check_partition_source_graph)):
             try:
                 check(ulam, mpirun, d)
@@ -434,7 +532,7 @@ def main():
     except AssertionError as e:
         failures += 1
         print(f"FAIL interrupt: {e}")
-    print(f"{len(cases) + 5 - failures} passed, {failures} failed")
+    print(f"{len(cases) + 8 - failures} passed, {failures} failed")
     return 1 if failures else 0
 
 

@@ -5,6 +5,7 @@
 
 #include <mpi.h>
 #include "ulam_dist.h"
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -59,10 +60,22 @@ void cli_mpi_finalize(void)
     if (started) MPI_Finalize();
 }
 
+/* Tests: ULAM_TEST_PARTITION_KILL=R:N kills rank R (SIGKILL, no word to the others) as it enters
+ * its Nth exchange, while the other ranks wait in it: the job must end with an error, not hang. */
+static void test_kill(void)
+{
+    static long calls;
+    const char *e = getenv("ULAM_TEST_PARTITION_KILL");
+    int r;
+    long at;
+    if (e && sscanf(e, "%d:%ld", &r, &at) == 2 && r == share.rank && ++calls == at) raise(SIGKILL);
+}
+
 /* The exchange of ulam_comm as MPI_Alltoall of the counts and MPI_Alltoallv of the bytes. */
 static int alltoallv(void *ctx, const void *send, const size_t *sendcounts, void **recv, size_t *recvcounts)
 {
     (void)ctx;
+    test_kill();
     int k = share.nranks, bad = 0;
     int *sc = calloc((size_t)k * 4, sizeof *sc);
     if (!sc) return 1;

@@ -21,9 +21,10 @@ static const char *const help =
     "A walk that steps onto another rank's row travels there; random numbers are keyed by (seed,\n"
     "walk, step), so 1, 2, 3 or 64 ranks print the same answer bit for bit.  Collision estimator,\n"
     "analog kernel (p_ij = |M_ij| / row sum, leaving with min(1, row sum)).  Answers carry their\n"
-    "standard error; --index and --queries also a certified 95% interval when every row sum of |M| is\n"
-    "at most 1 and power iteration certifies a Collatz-Wielandt vector below 1 (the walk's length\n"
-    "tail, so a score's range after clipping; docs/distributed.md).\n"
+    "standard error; --index and --queries (and --mode forward --index I) also a certified 95%\n"
+    "interval when power iteration certifies a Collatz-Wielandt vector below 1 (the walk's length\n"
+    "tail, or with a row sum above 1 its weights' second moment, so a score's range after clipping;\n"
+    "docs/distributed.md).\n"
     "  --bound         (--mode forward) a certified range of every x_i from x's residual (needs M in the\n"
     "                  part too); MCSA and --source always print theirs\n"
     "  --rhs B.mtx     M.mtx is a coordinate Matrix Market file read by byte ranges: each rank parses\n"
@@ -33,7 +34,8 @@ static const char *const help =
     "  --queries FILE  x_I of each line 'I' of FILE (docs/queries.md), all walking together, each on\n"
     "                  a seed of its own, printed: a line answers what --index I --seed SEED answers\n"
     "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector, --errors\n"
-    "                  their standard errors (also with --source)\n"
+    "                  their standard errors (also with --source); --index I prints x_I's line with its\n"
+    "                  interval (its histories' tallies in a confidence sequence)\n"
     "  --method mcsa   every x_i by MCSA: Richardson steps (products with M across ranks) and forward\n"
     "                  walks' corrections (--walks each) to --tol (default 1e-8) of max|b|, --max-iter\n"
     "  --source S      x = (I - M)^-1 e_S: a push (products with M) to 1e-4, then forward walks; prints\n"
@@ -118,10 +120,10 @@ static int check(args *a, int argc, char **argv, int first)
 {
     if (first != argc - 1) return cli_usage_error("solve", "one prepared system file (or M.mtx --rhs B.mtx) with --partition");
     a->path = argv[first];
-    if (!!a->forward + !!a->index + !!a->queries + a->mcsa + !!a->source != 1)
+    if (!!a->forward + !!(a->index && !a->forward) + !!a->queries + a->mcsa + !!a->source != 1) /* forward: --index watches one */
         return cli_usage_error("solve", "one of --index I, --queries FILE, --mode forward, --method mcsa and --source S "
                                         "with --partition");
-    if ((a->out || a->errors) && (a->index || a->queries))
+    if ((a->out || a->errors) && ((a->index && !a->forward) || a->queries))
         return cli_usage_error("solve", "--out and --errors with --partition write a whole x");
     if (a->bound && (!a->forward || a->mcsa || a->sets > 1))
         return cli_usage_error("solve", "--bound with --mode forward in one set (MCSA and --source print theirs)");
@@ -253,13 +255,14 @@ static int run(const args *a, const ulam_comm *c)
     int64_t *idx = malloc((size_t)nq * sizeof *idx);
     long *lines = malloc((size_t)nq * sizeof *lines);
     for (int64_t k = 0; idx && lines && k < nq; k++) idx[k] = q ? q[k].index : one, lines[k] = q ? q[k].line : 0;
-    ask.index = idx;
+    ask.index = ask.mode == ULAM_DIST_FORWARD && !a->index ? NULL : idx; /* forward: a watched row, or none */
     int walks_forward = ask.mode != ULAM_DIST_ADJOINT;
     ulam_dist_answer s = {.ranks = malloc((size_t)c->nranks * 2 * sizeof(int64_t))};
     if (walks_forward) s.x = malloc(((size_t)rows + 1) * sizeof *s.x), s.se = malloc(((size_t)rows + 1) * sizeof *s.se);
     if (a->source) s.tops = malloc(((size_t)a->top + 1) * sizeof *s.tops);
-    if (!walks_forward) s.res = malloc((size_t)nq * sizeof *s.res), s.ci = malloc((size_t)nq * sizeof *s.ci);
-    if (!idx || !lines || !s.ranks || (walks_forward ? !s.x || !s.se || (a->source && !s.tops) : !s.res || !s.ci))
+    if (!walks_forward || ask.index) s.res = malloc((size_t)nq * sizeof *s.res), s.ci = malloc((size_t)nq * sizeof *s.ci);
+    if (!idx || !lines || !s.ranks || (walks_forward ? !s.x || !s.se || (a->source && !s.tops) : !s.res || !s.ci) ||
+        (ask.index && (!s.res || !s.ci)))
         status = ULAM_ENOMEM, err.status = status, snprintf(err.msg, sizeof err.msg, "memory for the answer");
     else status = ulam_dist_run(p, c, &ask, &s, &err);
     ulam_part_free(p);
