@@ -883,18 +883,20 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         free(r), free(w.cs), free(w.mx);
         return ulam__fail(err, status, 0, -1, "a push within %lld operations", (long long)cap);
     }
-    /* a negative residual small beside the target (roundings; what over-relaxed sweeps left, R-MAT) is
-     * cut from r: x_i = p_i + ((I - M)^-1 r+)_i - [0, cut], lower ends lowered by cut; a larger one is
-     * walked with its signs */
     int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 */
     for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
     int mpos = !sgn; /* M >= 0, so x >= 0 */
-    if (!status && topk) { /* the walks' floor, certified: M >= 0 gives x_i >= p_i + r_i+ - r_neg / (1 - alpha) */
+    if (!status && topk) { /* the walks' floor, certified: M >= 0 gives x_i >= p_i + r_i+ - r_neg / (1 - alpha) (the
+                              over-relaxed sweeps' negative residual: R-MAT 2^20, source 101, 2.2e-4, floor 3.3e-4
+                              where the plan's was 1.8e-3) */
         double f = 1.0 / (double)n;
         if (mpos) f = fmax(f, raise_floor(x, r, n, top, swi->r_neg * D1, &pl.buf, &pl.cap) - swi->r_neg * D1);
         pl.delta = f;
         free(pl.buf), pl.buf = NULL, pl.cap = 0;
     }
+    /* a negative residual small beside the target (roundings; what over-relaxed sweeps left, R-MAT) is
+     * cut from r: x_i = p_i + ((I - M)^-1 r+)_i - [0, cut], lower ends lowered by cut; a larger one is
+     * walked with its signs */
     double cut = 0.0;
     if (swi->r_neg > 0 && swi->r_neg * D1 <= ULAM__FPUSH_CUT_SHARE * pl.E * pl.delta) {
         swi->support = 0;
