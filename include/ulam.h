@@ -1182,6 +1182,10 @@ typedef struct ulam_fpush_info {
     int64_t walks, steps;  /* the walks and their transitions */
     int interrupted;
     double seconds, push_seconds, walk_seconds;
+    double rel_err, min_value; /* the target the walks were planned for: relative error rel_err at every x_i
+                                  whose interval reaches min_value (ulam_fpush_top with min_value <= 0: the
+                                  k-th largest p_i + r_i after the push, which x's k-th largest is at least
+                                  when M >= 0; else min_value, or 1 / n) */
 } ulam_fpush_info;
 
 /* Estimate every x_i of (I - M) x = e_source into x (n entries); std_error, lo and hi (each may

@@ -47,6 +47,8 @@
 #define ULAM__FPUSH_CS_SPLITS 3     /* a fixed count of walks with signed scores is walked in blocks ending at 1/8, 1/4,
                                       1/2 of it and at it: each block's bets set from the blocks before (one block
                                       would bet as if the variance were the largest) */
+#define ULAM__FPUSH_LOCAL_SHARE 16 /* the top-K target's queue push gives way to the sweeps once its operations pass
+                                      nnz / this (a sixteenth of a sweep: a queue push's operation reads at random) */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
 #define ULAM__FPUSH_SKEW 16.0       /* rows drawn from by rejection up to this many tries on average, beyond by the
                                       running sums (R-MAT 2^20, source 990665, 2026-12-02, load 2.2-2.7, median of 5:
@@ -167,7 +169,12 @@ static int solve_queue(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
 /* The walks' plan: residual mass, kernel norm alpha = ||M||_1 < 1, target and costs. */
 typedef struct {
     double alpha, E, delta, visits, step_cost;
+    double llo;    /* the lower ends' extra log: ln(n / K) for ulam_fpush_top's K of n (lower_index), else 0 */
     int64_t fixed; /* > 0: this many walks */
+    const double *p; /* the top-K target (walk_work_top): the push's estimates, n, K, the residual at the last */
+    int64_t n, K;    /* raise of the floor, and the buffer raise_floor gathers in */
+    double last, *buf;
+    int64_t cap;
 } plan;
 
 /* The checkpoints: the walks stop at the ends of src/stop.c's epochs from the first, k0, whose
@@ -207,14 +214,20 @@ static int first_epoch(double R, double E, double delta, int kl)
 
 /* The walks' work (push operations) a residual of mass r_sum leaves (ulam__sweep_cost): the
  * walk count whose interval for a component no walk ended at is ULAM__FPUSH_RANGE_SHARE E delta
- * wide at stitching index 1 (the KL interval of scores 0 or R0: M >= 0 makes r >= 0), at least
- * one block (a fixed count: that count in proportion to r_sum, the accuracy it buys). */
+ * wide at stitching index 1 (the KL interval of scores 0 or R0: M >= 0 makes r >= 0), or, when
+ * more, whose KL interval is within -+ E delta at a component x_i = delta whose walk part is the
+ * residual's share r_sum of it (half-width sqrt(2 c w R0 / N) at w = r_sum delta, c with ln(n / K)
+ * more for the lower ends of a top-K query: lower_index; R-MAT 2^22, source 101, r_sum 0.122:
+ * 54 000 walks predicted, 46 340 walked, against 15 800 without it; the range term
+ * alone took R-MAT 2^22's --min-value 0.001 to 5.9e6 walks after a push left r_sum ~ 0.3), at
+ * least one block (a fixed count: that count in proportion to r_sum, the accuracy it buys). */
 static double walk_work(double r_sum, void *ctx)
 {
     const plan *pl = ctx;
     double R = r_sum / (1.0 - pl->alpha), c = log(2.0 / ULAM__STOP_DELTA) + log(2.0); /* N (1 - e^(-c/N)) ~ c */
-    double N = pl->fixed > 0 ? (double)pl->fixed * r_sum
-                             : fmax(ULAM__STOP_N0, c * R / (ULAM__FPUSH_RANGE_SHARE * pl->E * pl->delta) + 1.0);
+    double range = c * R / (ULAM__FPUSH_RANGE_SHARE * pl->E * pl->delta) + 1.0;
+    double var = 2.0 * (c + pl->llo) * R * fmin(1.0, r_sum) / (pl->E * pl->E * pl->delta); /* the variance term */
+    double N = pl->fixed > 0 ? (double)pl->fixed * r_sum : fmax(ULAM__STOP_N0, fmax(range, var));
     return N * pl->visits * pl->step_cost;
 }
 
@@ -595,9 +608,13 @@ static int cs_rule_met(const cs_set *S, const walker *w, const double *p, int64_
  * or pushes into p_i through at most a row of M (d entries, each a rounding), and an error in p
  * carries through (I - M)^-1 at most 1 / (1 - alpha) times: (rounds + 1) (d + 2) u / (1 - alpha),
  * d the longest row (4e-11 on R-MAT 2^20; far below any interval the walks give, but a push that
- * leaves no residual no longer prints a zero-width interval for a p_i that is only rounded). */
+ * leaves no residual no longer prints a zero-width interval for a p_i that is only rounded).  A
+ * queue push (swi->chain: its operations) adds nonnegative terms where M >= 0, each addition a
+ * factor within 1 -+ u, and no value goes through more additions than the push made: (chain + 2) u
+ * / (1 - alpha). */
 static double rounding_allowance(const ulam_csr *M, const ulam__sweep_info *swi, double alpha)
 {
+    if (swi->chain > 0) return ((double)swi->chain + 2.0) * (DBL_EPSILON / 2.0) / (1.0 - alpha);
     int64_t d = 0;
     for (int64_t i = 0; i < M->nrows; i++) d = M->rowptr[i + 1] - M->rowptr[i] > d ? M->rowptr[i + 1] - M->rowptr[i] : d;
     return ((double)swi->rounds + 1.0) * ((double)d + 2.0) * (DBL_EPSILON / 2.0) / (1.0 - alpha);
@@ -732,6 +749,103 @@ static void select_top(const double *x, int64_t n, int64_t k, int64_t *index, do
     }
 }
 
+/* The K-th largest (1 <= K <= m) of v[0 .. m), v reordered (Hoare's selection). */
+static double kth_largest(double *v, int64_t m, int64_t K)
+{
+    int64_t lo = 0, hi = m - 1, t = K - 1;
+    while (lo < hi) {
+        double piv = v[lo + (hi - lo) / 2], tmp;
+        int64_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] > piv) i++;
+            while (v[j] < piv) j--;
+            if (i <= j) tmp = v[i], v[i] = v[j], v[j] = tmp, i++, j--;
+        }
+        if (t <= j) hi = j;
+        else if (t >= i) lo = i;
+        else return v[t];
+    }
+    return v[t];
+}
+
+/* The K-th largest of p_i + max(r_i, 0) over the n states (r NULL: p_i alone) when above delta,
+ * else delta: the values above delta gathered into *buf (*cap entries, grown), so a floor near
+ * the top takes a few entries, not n. */
+static double raise_floor(const double *p, const double *r, int64_t n, int64_t K, double delta, double **buf, int64_t *cap)
+{
+    int64_t m = 0;
+    for (int64_t i = 0; i < n; i++) {
+        double v = p[i] + (r && r[i] > 0 ? r[i] : 0.0);
+        if (!(v > delta)) continue;
+        if (m == *cap && ulam__grow(buf, cap, m + 1, sizeof **buf)) return delta; /* no memory: the floor stays */
+        (*buf)[m++] = v;
+    }
+    return m >= K ? kth_largest(*buf, m, K) : delta;
+}
+
+/* The sweep push's cost model for the top-K target (walk_work at a floor raised as the push
+ * goes): each time the residual has halved, delta is raised to the K-th largest p_i (pl->p; a
+ * plan, not a bound: over-relaxed sweeps may overshoot x_i; solve_sweep certifies the floor the
+ * walks take). */
+static double walk_work_top(double r_sum, void *ctx)
+{
+    plan *pl = ctx;
+    if (r_sum <= 0.5 * pl->last) pl->last = r_sum, pl->delta = raise_floor(pl->p, NULL, pl->n, pl->K, pl->delta, &pl->buf, &pl->cap);
+    return walk_work(r_sum, ctx);
+}
+
+/* The top-K target's push (FORA's top-k, Wang et al. 2017): the queue push from s (src/push.c),
+ * which reads only the rows it pushes, with rmax halving from 1; after each run the floor delta
+ * is the K-th largest p_i (floor when given > 0 instead: the caller's min_value; at least 1 / n)
+ * -- where M >= 0, x_i >= p_i, so the K-th largest x_i is at least the K-th largest p_i, and the
+ * relative target at delta covers every one of the K largest x_i -- and the halving stops once
+ * the push's operations reach the walks' predicted work at that delta (walk_work).  x and r
+ * (zero on entry) get p and the residual, swi the counts and delta; *local 0 instead (x and r
+ * untouched, pl->delta the floor so far) once the push's operations pass nnz /
+ * ULAM__FPUSH_LOCAL_SHARE: the residual has spread, and whole sweeps do better than a queue. */
+static int push_top(const ulam_csr *Mt, int64_t s, int64_t K, double floor, plan *pl, int64_t cap, double *x, double *r,
+                    ulam__sweep_info *swi, int *local)
+{
+    int64_t m = 0, vmax = 0;
+    ulam_push *w = NULL;
+    double *v = NULL, rmax = 1.0;
+    ulam_push_info pi = {0};
+    int status = ulam__push_alloc_trusted(Mt, &w);
+    *local = 1;
+    if (!status) status = ulam__push_start(w, s);
+    const int32_t *t = NULL;
+    while (!status) {
+        if ((status = ulam__push_run(w, rmax, cap))) break;
+        t = ulam__push_touched(w, &m);
+        ulam__push_report(w, &pi);
+        if (pi.ops >= ulam_csr_nnz(Mt) / ULAM__FPUSH_LOCAL_SHARE) {
+            *local = 0;
+            break;
+        }
+        const double *p = ulam__push_estimates(w), *rr = ulam__push_residuals(w);
+        if (floor > 0) {
+            pl->delta = floor;
+        } else if (ulam__grow(&v, &vmax, m, sizeof *v)) {
+            status = ULAM_ENOMEM;
+            break;
+        } else {
+            for (int64_t q = 0; q < m; q++) v[q] = p[t[q]] + rr[t[q]];
+            pl->delta = fmax(pl->delta, m >= K ? kth_largest(v, m, K) : 0.0);
+        }
+        if (pi.support == 0 || (double)pi.ops >= walk_work(pi.r_sum, pl)) break;
+        rmax /= 2;
+    }
+    if (!status && *local) {
+        const double *p = ulam__push_estimates(w), *rr = ulam__push_residuals(w);
+        for (int64_t q = 0; q < m; q++) x[t[q]] = p[t[q]], r[t[q]] = rr[t[q]], swi->r_neg += rr[t[q]] < 0 ? -rr[t[q]] : 0.0;
+        swi->rounds = 1, swi->pushes = pi.pushes, swi->ops = pi.ops, swi->support = pi.support, swi->r_sum = pi.r_sum;
+        swi->chain = pi.ops, swi->delta = pl->delta;
+    }
+    free(v);
+    ulam__push_free(w);
+    return status;
+}
+
 /* Sweep push and terminal walks on its residual, for ||M||_1 < 1; top >= 0: std_error, lo and
  * hi only for the top components of largest estimate, listed in index (select_top). */
 static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, const ulam_guard *g, double *x,
@@ -741,7 +855,8 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     int64_t n = M->nrows;
     double t0 = ulam_now(), alpha = g->abs.colsum_max, D1 = 1.0 / (1.0 - alpha);
     plan pl = {.alpha = alpha, .E = o->rel_err, .delta = o->min_value > 0 ? o->min_value : 1.0 / (double)n,
-               .visits = D1, .step_cost = o->step_cost > 0 ? o->step_cost : ULAM__FPUSH_STEP_COST, .fixed = o->walks};
+               .visits = D1, .step_cost = o->step_cost > 0 ? o->step_cost : ULAM__FPUSH_STEP_COST, .fixed = o->walks,
+               .llo = top > 0 && top < n ? log((double)n / (double)top) : 0.0};
     info->mean_visits = D1;
     memset(x, 0, (size_t)n * sizeof *x);
     size_t bytes = (size_t)n * sizeof(double); /* r, and cs and mx (filled whole by the pull sweeps' set-up) */
@@ -754,12 +869,30 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the residual");
     }
     int64_t cap = 100 * ulam_csr_nnz(M) + 1000000;
-    int status = ulam__sweep_push_pull(M, Mt, o->source, o->rmax, o->rmax > 0 ? NULL : walk_work, &pl, cap, x, r, w.cs,
-                                       w.mx, swi);
+    int status = ULAM_OK, local = 0;
+    if (top > 0 && top < n && !(o->rmax > 0) && o->walks <= 0) /* the top-K target: a local push, the floor planned */
+        status = push_top(Mt, o->source, top, o->min_value, &pl, cap, x, r, swi, &local);
+    int topk = top > 0 && top < n && !(o->min_value > 0) && o->walks <= 0; /* the floor planned from the push */
+    pl.p = x, pl.n = n, pl.K = top, pl.last = 1.0;
+    if (!status && !local)
+        status = ulam__sweep_push_pull(M, Mt, o->source, o->rmax, o->rmax > 0 ? NULL : topk ? walk_work_top : walk_work, &pl,
+                                       cap, x, r, w.cs, w.mx, swi);
+    free(pl.buf), pl.buf = NULL, pl.cap = 0;
     if (status == ULAM_ENOCONV) status = ULAM_OK; /* ||M||_1 < 1: the cap only ends the push; the walks take the rest */
     if (status) {
         free(r), free(w.cs), free(w.mx);
         return ulam__fail(err, status, 0, -1, "a push within %lld operations", (long long)cap);
+    }
+    int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 */
+    for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
+    int mpos = !sgn; /* M >= 0, so x >= 0 */
+    if (!status && topk) { /* the walks' floor, certified: M >= 0 gives x_i >= p_i + r_i+ - r_neg / (1 - alpha) (the
+                              over-relaxed sweeps' negative residual: R-MAT 2^20, source 101, 2.2e-4, floor 3.3e-4
+                              where the plan's was 1.8e-3) */
+        double f = 1.0 / (double)n;
+        if (mpos) f = fmax(f, raise_floor(x, r, n, top, swi->r_neg * D1, &pl.buf, &pl.cap) - swi->r_neg * D1);
+        pl.delta = f;
+        free(pl.buf), pl.buf = NULL, pl.cap = 0;
     }
     /* a negative residual small beside the target (roundings; what over-relaxed sweeps left, R-MAT) is
      * cut from r: x_i = p_i + ((I - M)^-1 r+)_i - [0, cut], lower ends lowered by cut; a larger one is
@@ -779,9 +912,6 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     info->residual_bound = swi->r_sum * D1 + cut;
     w.k = swi->support, w.pre = swi->nonneg;
     double *bsum = NULL;
-    int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 */
-    for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
-    int mpos = !sgn; /* M >= 0, so x >= 0 */
     for (int64_t j = 0; j < n && !sgn; j++) sgn = r[j] < 0;
     double R = sgn ? 2.0 * R0 : R0; /* the scores' range */
     int64_t N = 0;
@@ -878,6 +1008,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     free(key), free(pv);
     free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.hit), free(w.hc), free(w.slot), free(w.known);
     free(r), free(kept), free(kept_lo), free(S.q), free(S.prev);
+    info->rel_err = pl.E, info->min_value = pl.delta;
     info->seconds = ulam_now() - t0;
     return status;
 }

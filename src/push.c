@@ -36,13 +36,14 @@ ulam_push *ulam__push_free(ulam_push *w)
     return NULL;
 }
 
-/* A workspace for pushes on the square matrix M (borrowed until freed). */
-int ulam__push_alloc(const ulam_csr *M, ulam_push **out)
+/* A workspace for pushes on the square matrix M (borrowed until freed), M's structure checked
+ * whole first when check is set. */
+static int alloc(const ulam_csr *M, int check, ulam_push **out)
 {
     if (!M || !out) return ULAM_EINVAL;
     *out = NULL;
     if (M->nrows != M->ncols) return ULAM_ENOTSQUARE;
-    int bad = ulam__csr_check_structure(M, NULL); /* src/check.c */
+    int bad = check ? ulam__csr_check_structure(M, NULL) : ULAM_OK; /* src/check.c */
     if (bad) return bad;
     ulam_push *w = calloc(1, sizeof *w);
     if (!w) return ULAM_ENOMEM;
@@ -59,6 +60,18 @@ int ulam__push_alloc(const ulam_csr *M, ulam_push **out)
     }
     *out = w;
     return ULAM_OK;
+}
+
+/* A workspace for pushes on the square matrix M (borrowed until freed), its structure checked. */
+int ulam__push_alloc(const ulam_csr *M, ulam_push **out)
+{
+    return alloc(M, 1, out);
+}
+
+/* A workspace for pushes on M whose caller vouches for its structure: no pass over M. */
+int ulam__push_alloc_trusted(const ulam_csr *M, ulam_push **out)
+{
+    return alloc(M, 0, out);
 }
 
 /* Add state j to the touched list if it is not there. */
@@ -162,6 +175,13 @@ void ulam__push_report(const ulam_push *w, ulam_push_info *info)
         info->r_max = fmax(info->r_max, a);
         info->support += a > 0;
     }
+}
+
+/* The states whose p or r may be nonzero (*count of them). */
+const int32_t *ulam__push_touched(const ulam_push *w, int64_t *count)
+{
+    *count = w->ntouched;
+    return w->touched;
 }
 
 /* The matrix a workspace pushes on. */

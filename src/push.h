@@ -16,6 +16,13 @@ uint64_t ulam__push_stamp(const ulam_push *w);
 /* A workspace for pushes on the square matrix M, which is borrowed until the workspace is freed. */
 int ulam__push_alloc(const ulam_csr *M, ulam_push **out);
 
+/* The same for an M whose caller vouches for its structure (rows it reads stay in bounds): no
+ * pass over M, so a push that stays local reads only the rows it pushes. */
+int ulam__push_alloc_trusted(const ulam_csr *M, ulam_push **out);
+
+/* The states whose p or r may be nonzero (*count of them; the rest are 0). */
+const int32_t *ulam__push_touched(const ulam_push *w, int64_t *count);
+
 /* Free a workspace; accepts and returns NULL. */
 ulam_push *ulam__push_free(ulam_push *w);
 

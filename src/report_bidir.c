@@ -200,6 +200,9 @@ static void table_head(FILE *f, const ulam_bidir_report *p)
                "most %.3g)\n", t->rmax, (long long)t->push.ops, (long long)t->push.support, t->push.r_sum,
             p->pagerank > 0 ? "pi_i" : "x_i", t->residual_bound);
     fprintf(f, "walks           %lld (%lld steps)\n", (long long)t->walks, (long long)t->steps);
+    if (t->min_value > 0)
+        fprintf(f, "target          every 95%% interval honest; planned for relative error %.3g at values >= %.3g\n",
+                t->rel_err, t->min_value);
     if (t->push.support > 0 && !isfinite(t->residual_bound)) /* the queue path (src/fpush.c) */
         fprintf(f, "intervals       the source's alone: with ||M||_1 >= 1 the other components' walk parts have no "
                    "certified range (none printed)\n");
@@ -241,6 +244,7 @@ static void table_json(FILE *f, const ulam_bidir_report *p)
     fprintf(f, "\"push_ops\": %lld, \"walks\": %lld, \"steps\": %lld, ", (long long)t->push.ops, (long long)t->walks,
             (long long)t->steps);
     ulam_json_number(f, "residual_bound", t->residual_bound, 0);
+    if (t->min_value > 0) ulam_json_number(f, "rel_err", t->rel_err, 0), ulam_json_number(f, "min_value", t->min_value, 0);
     ulam_json_number(f, "seconds", t->seconds, 0);
     ulam_json_number(f, "push_seconds", t->push_seconds, 0);
     ulam_json_number(f, "walk_seconds", t->walk_seconds, 0);

@@ -13,6 +13,9 @@ typedef struct {
     int64_t pulls; /* sweeps made by pulling (ulam__sweep_push_pull) */
     int nonneg;    /* 1: M was read whole and has no negative entry (r >= 0 then); 0: not known */
     double r_neg;  /* the mass of r's negative entries after pull sweeps (over-relaxed ones overshoot; roundings) */
+    int64_t chain; /* > 0: the most roundings any p_i or r_i went through (a queue push: its operations), in
+                      place of the rounds' count times a row's */
+    double delta;  /* > 0: the floor the top-K target planned (fpush.c's push_top) */
 } ulam__sweep_info;
 
 /* The walks' work (push operations) a residual of mass r_sum would leave. */

@@ -227,7 +227,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
         }
     if (!rc && cli_rank == 0) {
         ulam_bidir_report *p = &rp->rep;
-        info.residual_bound *= scale; /* as the estimates: of pi, or of x */
+        info.residual_bound *= scale, info.min_value *= scale; /* as the estimates: of pi, or of x */
         p->top = &info, p->n = n, p->source = source, p->rows = shown, p->order = order, p->x = x, p->direct_x = xd;
         p->se = se, p->lo = lo, p->hi = hi, p->cpu_seconds = cpu, p->direct_seconds = dsec, p->direct_method = dm;
         report_fill(s, rp);
