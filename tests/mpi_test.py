@@ -29,7 +29,9 @@ def check_interrupt(ulam, mpirun):
     p = subprocess.Popen([mpirun, "--oversubscribe", "-np", "2", ulam, "solve", "--method", "walks", "matrices/chain4.mtx",
                           "--rhs", "matrices/chain4_b.mtx", "--index", "2", "--walks", "100000000000", "--json"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         env=dict(ENV, ULAM_TEST_STOP_AT_WALKS="1"))
+                         # mpirun's SIGKILL follows its SIGTERM after odls_base_sigkill_timeout (1 s by
+                         # default): under load the ranks' last round and rank 0's print can take longer
+                         env=dict(ENV, ULAM_TEST_STOP_AT_WALKS="1", OMPI_MCA_odls_base_sigkill_timeout="60"))
     try:
         ready = 0
         while ready < 2 and p.poll() is None:  # both ranks stopped themselves with the walks' handler set
