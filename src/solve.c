@@ -1574,6 +1574,13 @@ static double moments_estimate(const ulam_solver *s)
     return e;
 }
 
+/* The limit of |score| a range R of a single score's random part gives: the adjoint expected
+ * estimator's score0 (b_i, added to every score) plus R, or R / 2 either side of it with signs. */
+static double score_limit(const ulam_solver *s, double R)
+{
+    return fabs(s->w.score0) + (s->signs ? R / 2.0 : R);
+}
+
 /* The walks the first block's truncation is planned over: the first round's (BLOCK); at a fixed
  * count (fixed) all nplan of them, as the later blocks plan; under a time limit without a target
  * the walks the work model (ULAM_AUTO_*: a walk's expected steps, start and tallies) says the time
@@ -1635,7 +1642,7 @@ static void plan_terms(const ulam_solver *s, int grid, double *Rt, double *A, do
                at E = 0.1 took 2.0e7 walks for 2.8e6, the 12^3 Laplacian's corner at E = 0.01 2.07-2.49
                the CLT's count for 2.07-2.12) */
             double tj = X * exp2(-0.25 * j), Rj = score_range(s, X, tj / X, 0);
-            double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, n1) + tj;
+            double Aj = score_limit(s, Rj), wj = ulam__cs_range_width(Aj, n1) + tj;
             if (!isfinite(Rj) || (E > 0 && tj > E * X / 16.0)) continue;
             if (pass == 0 && wj < least) least = wj, t = tj, *Rt = Rj;
             if (pass == 1 && E > 0 && wj <= 1.05 * least) t = tj, *Rt = Rj;
@@ -1646,20 +1653,20 @@ static void plan_terms(const ulam_solver *s, int grid, double *Rt, double *A, do
            weights without a bound) hp / 8 took R to 1e9 and every later block's bet to nothing, so
            the first block's bias (139 for x = 0.57) stayed the interval's (signed forward 200:
            +-244 at 1e3 walks, +-407 at 1e5) */
-        double At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
+        double At = score_limit(s, *Rt);
         double best = isfinite(*Rt) ? ulam__cs_range_width(At, *nplan) + t : INFINITY;
         for (int j = 0; j <= 4 * log2(X / t0); j++) {
             double tj = X * exp2(-0.25 * j), Rj = score_range(s, m, tj / m, 1);
-            double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), wj = ulam__cs_range_width(Aj, *nplan) + tj;
+            double Aj = score_limit(s, Rj), wj = ulam__cs_range_width(Aj, *nplan) + tj;
             if (isfinite(Rj) && wj < best) best = wj, t = tj, *Rt = Rj;
         }
     }
     for (int j = 2; truncated && *h > 0 && j <= 6; j++) { /* rel_err: the share of h (1/4 .. 1/64) that meets it soonest */
         double tj = fmin(cap, fmax(*h / (double)(1 << j), 1e-6 * m)), Rj = score_range(s, m, tj / m, 1);
-        double Aj = fabs(s->w.score0) + (s->signs ? Rj / 2.0 : Rj), At = fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt);
+        double Aj = score_limit(s, Rj), At = score_limit(s, *Rt);
         if (ulam__cs_walks_needed(mabs, var, Aj, tj, E) < ulam__cs_walks_needed(mabs, var, At, t, E)) t = tj, *Rt = Rj;
     }
-    *A = isfinite(*Rt) ? fabs(s->w.score0) + (s->signs ? *Rt / 2.0 : *Rt) : INFINITY;
+    *A = isfinite(*Rt) ? score_limit(s, *Rt) : INFINITY;
     *b = truncated ? t : 0.0;
 }
 
