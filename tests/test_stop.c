@@ -839,7 +839,8 @@ static ulam_csr *near_one(int64_t n, uint64_t seed, double **bp, double *x0)
  * Collatz-Wielandt vector of M^ and Cauchy-Schwarz, max over rows, (1 - sqrt u)^-2: 3.5e6 on
  * signed200 forward collision against E[X^2] ~ 377, and --walks 10^5 printed +-23.7 at stderr
  * 0.061 (half-width / 1.96 se ~ 197).  Now: that half-width over 1.96 se below 6 on issue 38's
- * signed system (forward collision, 10^5 walks, seed 1).  And the intervals that stand on it
+ * signed system (forward collision, 10^5 walks, seed 1); forward expected there (whose visits
+ * score next to the index) covers over 100 seeds at 1000 and 10^4 walks.  And the intervals that stand on it
  * cover: on near_one (rho(M^) = 0.995, continuation 0.5) over 100 seeds, adjoint collision,
  * absorption and expected at 1000 and 10^4 walks, adjoint collision at --rel-err 0.1 (forward
  * walks there have rho(M^) > 1: the column sums vary; test_fixed_narrows counts signed forward runs),
@@ -862,6 +863,20 @@ static void test_v2_aimed(void **state)
         assert_true(h < 6.0 * 1.96 * r.std_error);
     }
     test_case_done();
+    for (int w = 0; w < 2; w++) { /* forward expected: a visit scores w K_{j,index} (the certificate took 1 at the index) */
+        int v[3] = {0, 0, 0}, R = 100;
+        for (int s = 0; s < R; s++) {
+            if (!test_case(13010L + 100L * w + s)) continue;
+            ulam_walk_opts o = ulam_walk_defaults();
+            o.mode = ULAM_FORWARD, o.estimator = ULAM_EXPECTED, o.query.index = 0, o.exec.seed = 1 + (uint64_t)s;
+            o.stop.max_walks = w ? 10000 : 1000;
+            ulam_walk_result r;
+            assert_int_equal(ulam_solve_walks(M, b, &o, &r, NULL), ULAM_OK);
+            v[verdict(&r, x0)]++;
+        }
+        test_case_done();
+        count(w ? "signed200 forward expected, 10^4 walks:" : "signed200 forward expected, 1000 walks:", v[1], v[2], R);
+    }
     ulam_csr_free(M), free(b);
     M = near_one(100, 7, &b, &x0);
     static const struct { int mode, est; int64_t walks; double E; const char *what; } rows[] = {
