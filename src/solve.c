@@ -463,7 +463,10 @@ static double second_moment_aimed(const ulam_csr *K, const double *fac, const do
  * with weights u^(k/2), E[X^2] <= w0^2 c z_start / (1 - sqrt u)^2 (absorption, one score a
  * walk: w0^2 c z_start / (1 - u)).  z: iterates of I + M^ from g (so it fits the states that
  * score), floored at a few shares of its largest entry, the best bound kept; INFINITY when none
- * has u < 1.  At kernel exponent != 1, M^_ij = |K_ij| fac_ij, fac the moves' own factors. */
+ * has u < 1.  At kernel exponent != 1, M^_ij = |K_ij| fac_ij, fac the moves' own factors.
+ * The bound aimed at the starts (second_moment_aimed, from the same per-visit scores) comes
+ * first and the smaller of the two is kept: it is usually far tighter (signed200 forward
+ * collision: 424.5 against 3.5e6). */
 static double second_moment(const ulam_solver *s, const ulam_csr *K, const double *fac, const char *seen, double w0,
                             int *iterations)
 {
