@@ -359,16 +359,17 @@ static double walk_part_bound(const ulam_push_info *push, const ulam_guard *g, c
 }
 
 /* The interval of x_t: the walk solver's own (its confidence sequence on the certified range of
- * one walk's score, src/stop.h, or withheld), except that, without a certified score bound, a
- * sample of one repeated score (the walks saw nothing else: its variance says nothing about what
- * they missed) gets the certified bound D of the walk part instead; either is clipped to
+ * one walk's score, src/stop.h, or withheld), except that, without a certified score bound or
+ * range (tail_bound: the length tail's clip or the second moment's), a sample of one repeated
+ * score (the walks saw nothing else: its variance says nothing about what they missed) gets the
+ * certified bound D of the walk part instead; either is clipped to
  * push_part -+ D.  Never zero-width while a residual is left unless D = 0. */
 static void honest_interval(ulam_bidir_result *res, double D, const ulam_walk_opts *wo)
 {
     const ulam_walk_result *w = &res->walks;
     double lo = res->push_part + w->ci95[0], hi = res->push_part + w->ci95[1];
     (void)wo;
-    if (!(w->walks > 0 && isfinite(w->score_bound)) && w->walks > 0 && !(w->variance > 0))
+    if (!(w->walks > 0 && (isfinite(w->score_bound) || isfinite(w->tail_bound))) && w->walks > 0 && !(w->variance > 0))
         lo = res->push_part - D, hi = res->push_part + D; /* NaN-free: D may be INFINITY (no bound) */
     if (isfinite(D)) lo = fmax(lo, res->push_part - D), hi = fmin(hi, res->push_part + D);
     if (!isfinite(lo) || !isfinite(hi)) lo = hi = NAN; /* withheld: nothing certifies one */

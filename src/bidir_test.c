@@ -709,9 +709,14 @@ static void test_bidir_reach_all(void **state)
             assert_int_equal(st, ULAM_OK);
             double z = (res.estimate - x[t]) / (res.std_error + 1e-13 * fabs(x[t]) + 1e-300);
             if (!(fabs(z) < 4))
-                print_error("case %d: estimate %.10g, LAPACK %.10g, stderr %.3g (z = %.2f)\n", 100 * k + qe, res.estimate,
-                            x[t], res.std_error, z);
-            assert_true(fabs(z) < 4);
+                print_error("case %d: estimate %.10g, LAPACK %.10g, stderr %.3g (z = %.2f), %lld walks, push support %lld\n",
+                            100 * k + qe, res.estimate, x[t], res.std_error, z, (long long)res.walks.walks,
+                            (long long)res.push.support);
+            /* walks that all scored alike (stderr 0; case 204 at rmax 0.5: 256 walks of absorption that
+             * never scored): the interval, on the certified range, must hold x_t */
+            int zero = res.std_error == 0.0 && res.ci95[0] <= x[t] && x[t] <= res.ci95[1];
+            if (!(fabs(z) < 4)) print_error("case %d: ci %.10g .. %.10g\n", 100 * k + qe, res.ci95[0], res.ci95[1]);
+            assert_true(fabs(z) < 4 || zero);
             if (!(res.push.support == 0 || res.walks.rel_err_met))
                 print_error("case %d: %lld walks, stderr %.3g, estimate %.6g, out of reach %d, cut stop %d\n",
                             100 * k + qe, (long long)res.walks.walks, res.std_error, res.estimate, res.walks.out_of_reach,
