@@ -50,6 +50,7 @@
                                       would bet as if the variance were the largest) */
 #define ULAM__FPUSH_LOCAL_SHARE 16 /* the top-K target's queue push gives way to the sweeps once its operations pass
                                       nnz / this (a sixteenth of a sweep: a queue push's operation reads at random) */
+#define ULAM__FPUSH_NEG_PASSES 32     /* passes of push_negative at most (its operations: a sweep's at most) */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
 #define ULAM__FPUSH_SKEW 16.0       /* rows drawn from by rejection up to this many tries on average, beyond by the
                                       running sums (R-MAT 2^20, source 990665, 2026-12-02, load 2.2-2.7, median of 5:
@@ -870,6 +871,32 @@ static int push_top(const ulam_csr *Mt, const ulam_system *sys, int64_t s, int64
     return status;
 }
 
+/* Push the negative residual the over-relaxed sweeps left (M >= 0): every r_j < 0 moves into p_j
+ * and along row j of M' (r_k += M'_jk r_j), a pass at a time, while its mass times d1 = 1 / (1 - alpha)
+ * is above want and the passes' operations stay within max_ops.  x = p + (I - M)^-1 r stays exact,
+ * ||r||_1 does not grow, and the negative mass shrinks by alpha a pass at least (more where it lands
+ * on a positive residual).  swi's r_neg, r_sum, support, pushes, ops and rounds (one a pass: the
+ * rounding allowance) are kept up to date. */
+static void push_negative(const ulam_csr *Mt, double *p, double *r, double d1, double want, int64_t max_ops,
+                          ulam__sweep_info *swi)
+{
+    int64_t n = Mt->nrows, ops = 0;
+    for (int pass = 0; pass < ULAM__FPUSH_NEG_PASSES && swi->r_neg * d1 > want && ops < max_ops; pass++) {
+        for (int64_t j = 0; j < n; j++) {
+            double rj = r[j];
+            if (!(rj < 0)) continue;
+            p[j] += rj, r[j] = 0.0;
+            for (int64_t e = Mt->rowptr[j]; e < Mt->rowptr[j + 1]; e++) r[Mt->colidx[e]] += Mt->val[e] * rj;
+            ops += Mt->rowptr[j + 1] - Mt->rowptr[j] + 1, swi->pushes++;
+        }
+        double neg = 0.0, sum = 0.0;
+        int64_t support = 0;
+        for (int64_t j = 0; j < n; j++) neg += r[j] < 0 ? -r[j] : 0.0, sum += fabs(r[j]), support += r[j] != 0.0;
+        swi->r_neg = neg, swi->r_sum = sum, swi->support = support, swi->rounds++;
+    }
+    swi->ops += ops;
+}
+
 /* Sweep push and terminal walks on its residual, for ||M||_1 < 1; top >= 0: std_error, lo and
  * hi only for the top components of largest estimate, listed in index (select_top). */
 static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system *lz, const ulam_fpush_opts *o,
@@ -927,6 +954,8 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     }
     for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg && !(lz && local); e++) sgn = Mt->val[e] < 0;
     int mpos = !sgn; /* M >= 0, so x >= 0 */
+    if (!status && topk && mpos && !local && swi->r_neg > 0) /* what the floor and the cut below would lose to it */
+        push_negative(Mt, x, r, D1, 0.5 * ULAM__FPUSH_CUT_SHARE * pl.E * pl.delta, ulam_csr_nnz(Mt), swi);
     if (!status && topk) { /* the walks' floor, certified: M >= 0 gives x_i >= p_i + r_i+ - r_neg / (1 - alpha) (the
                               over-relaxed sweeps' negative residual: R-MAT 2^20, source 101, 2.2e-4, floor 3.3e-4
                               where the plan's was 1.8e-3) */
@@ -1149,14 +1178,22 @@ int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opt
     return fpush(M, Mt, opts, x, -1, NULL, std_error, lo, hi, info, NULL, err);
 }
 
-/* Estimate every component of x = (I - M)^-1 e_source, and the k largest with their standard
- * errors and intervals. */
-int ulam_fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, int64_t k, double *x,
-                   int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam_error *err)
+/* ulam_fpush_top with the sweep push's counts (see src/fpush.h). */
+int ulam__fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, int64_t k, double *x,
+                    int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw,
+                    ulam_error *err)
 {
     if (k < 0) {
         ulam__clear(err);
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "k >= 0 components");
     }
-    return fpush(M, Mt, opts, x, k, index, std_error, lo, hi, info, NULL, err);
+    return fpush(M, Mt, opts, x, k, index, std_error, lo, hi, info, sw, err);
+}
+
+/* Estimate every component of x = (I - M)^-1 e_source, and the k largest with their standard
+ * errors and intervals. */
+int ulam_fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, int64_t k, double *x,
+                   int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam_error *err)
+{
+    return ulam__fpush_top(M, Mt, opts, k, x, index, std_error, lo, hi, info, NULL, err);
 }
