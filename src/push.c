@@ -10,6 +10,7 @@
 #include "check.h"
 
 #include <math.h>
+#include <string.h>
 #include <stdlib.h>
 
 struct ulam_push {
@@ -52,8 +53,10 @@ static int alloc(const ulam_csr *M, int check, ulam_push **out)
     if (!w) return ULAM_ENOMEM;
     w->M = M, w->n = M->nrows, w->target = -1, w->bad = -1;
     size_t n = (size_t)M->nrows;
-    w->p = ulam__calloc(n, sizeof *w->p);
-    w->r = ulam__calloc(n, sizeof *w->r);
+    w->p = ulam__alloc_big(n, sizeof *w->p); /* 2 MiB pages from 2 MiB up: a push reads them at random */
+    w->r = ulam__alloc_big(n, sizeof *w->r);
+    if (w->p) memset(w->p, 0, n * sizeof *w->p);
+    if (w->r) memset(w->r, 0, n * sizeof *w->r);
     w->touched = ulam__malloc(n, sizeof *w->touched);
     w->mark = ulam__calloc(n, 1);
     w->queue = ulam__malloc(n, sizeof *w->queue);
