@@ -1195,7 +1195,11 @@ typedef struct ulam_fpush_info {
  * at least min(x_i, 0) when M >= 0 (the queue path for ||M||_1 >= 1: the normal interval where the
  * walks scored two values, else p_i -+ residual_bound, NaN when there is none, and NaN everywhere
  * when the forward guard does not certify the walks' variance finite).  Mt is M's
- * transpose.  ULAM_OK, ULAM_EINVAL, ULAM_ENOCONV (queue push cap 100 nnz + 10^6), ULAM_ENOMEM,
+ * transpose.  With o->walk.policy.system (M its ulam_system_lazy matrix) and Mt NULL, the file's
+ * stored M^T (ulam prepare --transpose) is read where the push and the walks go, each block
+ * verified when first read (ulam_system_info.blocks_checked counts them); sweeps of the whole
+ * graph, a guard to compute, or a file with no M^T verify the file whole first (a damaged block:
+ * ULAM_ESYNTAX naming it).  ULAM_OK, ULAM_EINVAL, ULAM_ENOCONV (queue push cap 100 nnz + 10^6), ULAM_ENOMEM,
  * the walk solver's statuses. */
 int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, double *x, double *std_error,
                      double *lo, double *hi, ulam_fpush_info *info, ulam_error *err);

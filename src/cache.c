@@ -807,6 +807,40 @@ const double *ulam_system_rhs(const ulam_system *s, int64_t *n)
     return s && s->b && !verify_part(s, PART_B, 0, s->n, NULL) ? s->b : NULL;
 }
 
+/* Rows [first, last) of s's stored M^T verified, each block once (see src/cache.h). */
+int ulam__system_tr_verify(const ulam_system *s, int64_t first, int64_t last, ulam_error *err)
+{
+    return s && s->has_tr ? verify_part(s, PART_T, first, last, err) : ulam__fail(err, ULAM_EINVAL, 0, -1, "a stored M^T");
+}
+
+/* s's stored M^T as it is, not verified, or NULL (see src/cache.h). */
+const ulam_csr *ulam__system_tr(const ulam_system *s)
+{
+    return s && s->has_tr ? &s->tr : NULL;
+}
+
+/* Whether M's values are all >= 0, read by pread (see src/cache.h). */
+int ulam__system_nonneg(const ulam_system *s)
+{
+    int64_t nnz = s->csr.rowptr[s->n];
+    if (s->fd < 0) {
+        for (int64_t e = 0; e < nnz; e++)
+            if (s->csr.val[e] < 0) return 0;
+        return 1;
+    }
+    enum { CHUNK = 1 << 17 }; /* values a read: 1 MiB */
+    double *buf = malloc(CHUNK * sizeof *buf);
+    int v = buf ? 1 : -1;
+    for (int64_t e = 0; v == 1 && e < nnz; e += CHUNK) {
+        int64_t m = nnz - e < CHUNK ? nnz - e : CHUNK;
+        if (read_at(s, buf, (size_t)m * 8, s->off[2] + (uint64_t)e * 8)) v = -1;
+        for (int64_t q = 0; v == 1 && q < m; q++)
+            if (buf[q] < 0) v = 0;
+    }
+    free(buf);
+    return v;
+}
+
 /* The stored M^T, verified whole, or NULL. */
 const ulam_csr *ulam_system_transpose(const ulam_system *s)
 {

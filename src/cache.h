@@ -68,6 +68,16 @@ static inline int ulam__rows_verify(const ulam__rows_check *rc, int64_t first, i
 int ulam__system_rows_check(const ulam_system *s, const ulam_csr *M, const double *b, ulam__rows_check *rc,
                             ulam_error *err);
 
+/* A single-source query on a lazily read system (src/fpush.c): rows [first, last) of s's stored
+ * M^T verified, each block once (ULAM_OK, ULAM_ESYNTAX with err naming the block, ULAM_EINVAL when
+ * s holds no M^T); the stored M^T as it is, not verified (NULL: none); and whether M's values are
+ * all >= 0 (1), one is negative (0) or the file cannot be read (-1): a scan of the value array by
+ * pread, so no page of it stays mapped, and not verified -- a damaged block read later still
+ * fails its query, and a sign decides only which interval the walks' scores get. */
+int ulam__system_tr_verify(const ulam_system *s, int64_t first, int64_t last, ulam_error *err);
+const ulam_csr *ulam__system_tr(const ulam_system *s);
+int ulam__system_nonneg(const ulam_system *s);
+
 /* What a prepared system is written from checked (ulam_system_write_file's refusals: ULAM_EINVAL),
  * and its bytes written to f with the bounds R (an analysis' of d->M at the certificate's
  * continuation and exponent 1, with d->b's scores; NULL: none stored) once checked (src/cache.c;

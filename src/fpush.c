@@ -24,6 +24,7 @@
  * ulam_fpush_top's k components are chosen by their estimates: their lower ends at delta k / n
  * (lower_index). */
 #include "fpush.h"
+#include "cache.h"
 #include "defaults.h"
 #include "check.h"
 #include "push.h"
@@ -49,6 +50,7 @@
                                       would bet as if the variance were the largest) */
 #define ULAM__FPUSH_LOCAL_SHARE 16 /* the top-K target's queue push gives way to the sweeps once its operations pass
                                       nnz / this (a sixteenth of a sweep: a queue push's operation reads at random) */
+#define ULAM__FPUSH_NEG_PASSES 32     /* passes of push_negative at most (its operations: a sweep's at most) */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
 #define ULAM__FPUSH_SKEW 16.0       /* rows drawn from by rejection up to this many tries on average, beyond by the
                                       running sums (R-MAT 2^20, source 990665, 2026-12-02, load 2.2-2.7, median of 5:
@@ -287,6 +289,9 @@ typedef struct {
     int32_t *slot;      /* open addressing (linear probing) from a state to its q; -1: empty */
     int64_t nhit, hmax; /* hit and hc hold hmax states; slot has 2 hmax or more (a power of 2) */
     int64_t hcap, steps;
+    const ulam_system *sys; /* a lazily read file whose stored M^T is Mt: each row's block verified on the first visit */
+    int status;             /* ULAM_ESYNTAX once a block failed (bad: a row of it); the walks then stop */
+    int64_t bad;
 } walker;
 
 /* The slot of state j in w's table: where its q is, or the empty slot where it goes. */
@@ -458,6 +463,10 @@ static int lane_choose(walker *w, lane *L)
         w->hc[2 * q + L->neg]++;
         return 0;
     }
+    if (!(w->known[j >> 6] >> (j & 63) & 1) && w->sys && ulam__system_tr_verify(w->sys, j, j + 1, NULL)) {
+        w->status = ULAM_ESYNTAX, w->bad = j; /* a damaged block: the walk ends unscored, the run fails */
+        return 0;
+    }
     if (!(w->known[j >> 6] >> (j & 63) & 1)) row_sums(Mt, j, w->pre, w->cs, w->mx, w->known, w->cum, &w->cum_used); /* on the first visit */
     if (!(v < w->cs[j])) return 0; /* the walk dies */
     int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a, e;
@@ -521,7 +530,7 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
                 int64_t j = walk_start(w, rng);
                 L[l].on = 1, L[l].neg = w->r[j] < 0, launched++;
                 lane_arrive(w, rng, &L[l], j);
-                more = launched < count && !((launched & 1023) == 0 && interrupt && *interrupt);
+                more = launched < count && !((launched & 1023) == 0 && interrupt && *interrupt) && !w->status;
             }
             busy |= L[l].on;
         }
@@ -794,17 +803,28 @@ static double walk_work_top(double r_sum, void *ctx)
     return walk_work(r_sum, ctx);
 }
 
+/* The check of row j of a lazily read file's stored M^T before a push reads it (ulam__push_set_verify). */
+static int tr_row_ok(const void *ctx, int64_t j, int64_t *bad)
+{
+    ulam_error e;
+    int status = ulam__system_tr_verify(ctx, j, j + 1, &e);
+    if (status) *bad = e.index;
+    return status;
+}
+
 /* The top-K target's push (FORA's top-k, Wang et al. 2017): the queue push from s (src/push.c),
  * which reads only the rows it pushes, with rmax halving from 1; after each run the floor delta
  * is the K-th largest p_i (floor when given > 0 instead: the caller's min_value; at least 1 / n)
  * -- where M >= 0, x_i >= p_i, so the K-th largest x_i is at least the K-th largest p_i, and the
  * relative target at delta covers every one of the K largest x_i -- and the halving stops once
- * the push's operations reach the walks' predicted work at that delta (walk_work).  x and r
+ * the push's operations reach the walks' predicted work at that delta (walk_work), or that work is
+ * the walks' least (ULAM__STOP_N0 walks: a smaller residual saves none; a source whose mass stays
+ * in a small part of the graph stops here, not in sweeps of all of it).  x and r
  * (zero on entry) get p and the residual, swi the counts and delta; *local 0 instead (x and r
  * untouched, pl->delta the floor so far) once the push's operations pass nnz /
  * ULAM__FPUSH_LOCAL_SHARE: the residual has spread, and whole sweeps do better than a queue. */
-static int push_top(const ulam_csr *Mt, int64_t s, int64_t K, double floor, plan *pl, int64_t cap, double *x, double *r,
-                    ulam__sweep_info *swi, int *local)
+static int push_top(const ulam_csr *Mt, const ulam_system *sys, int64_t s, int64_t K, double floor, plan *pl, int64_t cap,
+                    double *x, double *r, ulam__sweep_info *swi, int *local, ulam_error *err)
 {
     int64_t m = 0, vmax = 0;
     ulam_push *w = NULL;
@@ -812,10 +832,14 @@ static int push_top(const ulam_csr *Mt, int64_t s, int64_t K, double floor, plan
     ulam_push_info pi = {0};
     int status = ulam__push_alloc_trusted(Mt, &w);
     *local = 1;
+    if (!status && sys) ulam__push_set_verify(w, tr_row_ok, sys);
     if (!status) status = ulam__push_start(w, s);
     const int32_t *t = NULL;
     while (!status) {
-        if ((status = ulam__push_run(w, rmax, cap))) break;
+        if ((status = ulam__push_run(w, rmax, cap))) {
+            if (status == ULAM_ESYNTAX && sys) ulam__system_tr_verify(sys, ulam__push_bad_row(w), ulam__push_bad_row(w) + 1, err);
+            break;
+        }
         t = ulam__push_touched(w, &m);
         ulam__push_report(w, &pi);
         if (pi.ops >= ulam_csr_nnz(Mt) / ULAM__FPUSH_LOCAL_SHARE) {
@@ -832,7 +856,8 @@ static int push_top(const ulam_csr *Mt, int64_t s, int64_t K, double floor, plan
             for (int64_t q = 0; q < m; q++) v[q] = p[t[q]] + rr[t[q]];
             pl->delta = fmax(pl->delta, m >= K ? kth_largest(v, m, K) : 0.0);
         }
-        if (pi.support == 0 || (double)pi.ops >= walk_work(pi.r_sum, pl)) break;
+        double ww = walk_work(pi.r_sum, pl);
+        if (pi.support == 0 || (double)pi.ops >= ww || ww <= walk_work(0.0, pl)) break; /* the walks at their least */
         rmax /= 2;
     }
     if (!status && *local) {
@@ -846,10 +871,36 @@ static int push_top(const ulam_csr *Mt, int64_t s, int64_t K, double floor, plan
     return status;
 }
 
+/* Push the negative residual the over-relaxed sweeps left (M >= 0): every r_j < 0 moves into p_j
+ * and along row j of M' (r_k += M'_jk r_j), a pass at a time, while its mass times d1 = 1 / (1 - alpha)
+ * is above want and the passes' operations stay within max_ops.  x = p + (I - M)^-1 r stays exact,
+ * ||r||_1 does not grow, and the negative mass shrinks by alpha a pass at least (more where it lands
+ * on a positive residual).  swi's r_neg, r_sum, support, pushes, ops and rounds (one a pass: the
+ * rounding allowance) are kept up to date. */
+static void push_negative(const ulam_csr *Mt, double *p, double *r, double d1, double want, int64_t max_ops,
+                          ulam__sweep_info *swi)
+{
+    int64_t n = Mt->nrows, ops = 0;
+    for (int pass = 0; pass < ULAM__FPUSH_NEG_PASSES && swi->r_neg * d1 > want && ops < max_ops; pass++) {
+        for (int64_t j = 0; j < n; j++) {
+            double rj = r[j];
+            if (!(rj < 0)) continue;
+            p[j] += rj, r[j] = 0.0;
+            for (int64_t e = Mt->rowptr[j]; e < Mt->rowptr[j + 1]; e++) r[Mt->colidx[e]] += Mt->val[e] * rj;
+            ops += Mt->rowptr[j + 1] - Mt->rowptr[j] + 1, swi->pushes++;
+        }
+        double neg = 0.0, sum = 0.0;
+        int64_t support = 0;
+        for (int64_t j = 0; j < n; j++) neg += r[j] < 0 ? -r[j] : 0.0, sum += fabs(r[j]), support += r[j] != 0.0;
+        swi->r_neg = neg, swi->r_sum = sum, swi->support = support, swi->rounds++;
+    }
+    swi->ops += ops;
+}
+
 /* Sweep push and terminal walks on its residual, for ||M||_1 < 1; top >= 0: std_error, lo and
  * hi only for the top components of largest estimate, listed in index (select_top). */
-static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o, const ulam_guard *g, double *x,
-                       int64_t top, int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info,
+static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system *lz, const ulam_fpush_opts *o,
+                       const ulam_guard *g, double *x, int64_t top, int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info,
                        ulam__sweep_info *swi, ulam_error *err)
 {
     int64_t n = M->nrows;
@@ -862,7 +913,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     size_t bytes = (size_t)n * sizeof(double); /* r, and cs and mx (filled whole by the pull sweeps' set-up) */
     double *r = ulam__alloc_big((size_t)n, sizeof *r); /* 2 MiB aligned: a malloc block's unaligned head stays in 4 KiB pages */
     if (r) memset(r, 0, bytes);
-    walker w = {.Mt = Mt, .r = r, .alpha = alpha};
+    walker w = {.Mt = Mt, .r = r, .alpha = alpha, .sys = lz};
     w.cs = ulam__alloc_big((size_t)n, sizeof *w.cs), w.mx = ulam__alloc_big((size_t)n, sizeof *w.mx);
     if (!r || !w.cs || !w.mx) {
         free(r), free(w.cs), free(w.mx);
@@ -871,7 +922,16 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
     int64_t cap = 100 * ulam_csr_nnz(M) + 1000000;
     int status = ULAM_OK, local = 0;
     if (top > 0 && top < n && !(o->rmax > 0) && o->walks <= 0) /* the top-K target: a local push, the floor planned */
-        status = push_top(Mt, o->source, top, o->min_value, &pl, cap, x, r, swi, &local);
+        status = push_top(Mt, lz, o->source, top, o->min_value, &pl, cap, x, r, swi, &local, err);
+    if (status == ULAM_ESYNTAX) { /* a damaged block of the file, named in err */
+        free(r), free(w.cs), free(w.mx);
+        return status;
+    }
+    if (!status && !local && lz) status = ulam_system_check(lz, err); /* the sweeps read all of M and M^T */
+    if (status == ULAM_ESYNTAX) {
+        free(r), free(w.cs), free(w.mx);
+        return status;
+    }
     int topk = top > 0 && top < n && !(o->min_value > 0) && o->walks <= 0; /* the floor planned from the push */
     pl.p = x, pl.n = n, pl.K = top, pl.last = 1.0;
     if (!status && !local)
@@ -884,8 +944,18 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
         return ulam__fail(err, status, 0, -1, "a push within %lld operations", (long long)cap);
     }
     int sgn = 0; /* the sweep push read M whole when it pulled: M >= 0 */
-    for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg; e++) sgn = Mt->val[e] < 0;
+    if (lz && local) { /* the file's values by pread: none of them mapped */
+        int v = ulam__system_nonneg(lz);
+        if (v < 0) {
+            free(r), free(w.cs), free(w.mx);
+            return ulam__fail(err, ULAM_EIO, 0, -1, "a readable prepared file");
+        }
+        sgn = !v;
+    }
+    for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg && !(lz && local); e++) sgn = Mt->val[e] < 0;
     int mpos = !sgn; /* M >= 0, so x >= 0 */
+    if (!status && topk && mpos && !local && swi->r_neg > 0) /* what the floor and the cut below would lose to it */
+        push_negative(Mt, x, r, D1, 0.5 * ULAM__FPUSH_CUT_SHARE * pl.E * pl.delta, ulam_csr_nnz(Mt), swi);
     if (!status && topk) { /* the walks' floor, certified: M >= 0 gives x_i >= p_i + r_i+ - r_neg / (1 - alpha) (the
                               over-relaxed sweeps' negative residual: R-MAT 2^20, source 101, 2.2e-4, floor 3.3e-4
                               where the plan's was 1.8e-3) */
@@ -946,6 +1016,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
             }
             if (sgn) cs_plan_all(&S, &w, x, N, R0, pl.E, pl.delta, o->walks > 0 ? (double)o->walks : 0.0);
             int64_t made = N < target ? walk_many(&w, &rng, target - N, o->walk.stop.interrupt) : 0;
+            if (w.status) {
+                status = ulam__system_tr_verify(lz, w.bad, w.bad + 1, err);
+                break;
+            }
             if (made < target - N) info->interrupted = 1, planned = 0;
             N += made;
             if (sgn && cs_add_all(&S, &w, made, R0)) {
@@ -1034,6 +1108,20 @@ static int solve_queue_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpu
     return status;
 }
 
+/* A query given opts->walk.policy.system = sys (ulam_system_lazy's M): M must be sys's, and Mt NULL
+ * takes sys's stored M^T as it is, so the push and the walks verify each block of it as they first
+ * read a row of it (src/cache.h), the sweeps and any pass over all of M the whole file first; a
+ * file with no M^T is verified whole and M transposed into *own (*Mt then).  A status. */
+static int lazy_of(const ulam_system *sys, const ulam_csr *M, const ulam_csr **Mt, ulam_csr **own, ulam_error *err)
+{
+    const ulam_csr *SM = NULL;
+    ulam_system_lazy(sys, &SM, NULL);
+    if (M != SM) return ulam__fail(err, ULAM_EINVAL, 0, -1, "the matrix of opts->walk.policy.system (ulam_system_lazy's) as M");
+    if (*Mt || (*Mt = ulam__system_tr(sys))) return ULAM_OK;
+    int status = ulam_system_check(sys, err); /* no M^T stored: M whole, transposed */
+    return status ? status : ulam_csr_transpose(M, own);
+}
+
 /* ulam__fpush_solve, or with top >= 0 ulam_fpush_top's outputs (std_error, lo, hi: top entries). */
 static int fpush(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, int64_t top,
                  int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw,
@@ -1043,22 +1131,35 @@ static int fpush(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o
     if (!M || !opts || !x || !info) return ulam__fail(err, ULAM_EINVAL, 0, -1, "M, options, x and info");
     if (top >= 0 && (top > M->nrows || (top > 0 && !index)))
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "k from 0 to n (%lld) and an index array", (long long)M->nrows);
-    int status = check(M, Mt, opts, err);
-    if (status) return status;
+    const ulam_system *sys = opts->walk.policy.system, *lz = NULL; /* a lazily read file: see lazy_of */
+    ulam_csr *own = NULL;
+    int status = sys ? lazy_of(sys, M, &Mt, &own, err) : ULAM_OK;
+    if (own) Mt = own;
+    if (!status) status = check(M, Mt, opts, err);
+    if (status) {
+        ulam_csr_free(own);
+        return status;
+    }
     memset(info, 0, sizeof *info);
     ulam__sweep_info swi = {0};
     ulam_guard g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
     if (opts->walk.policy.guard) g = *opts->walk.policy.guard;
-    else if ((status = ulam_guard_check(M, opts->walk.kernel.continue_q, &go, &g, err))) return status;
-    if (g.abs.colsum_max < 1.0)
-        status = solve_sweep(M, Mt, opts, &g, x, top, index, std_error, lo, hi, info, &swi, err);
+    else if (!sys || !(status = ulam_system_check(sys, err))) /* a pass over all of M */
+        status = ulam_guard_check(M, opts->walk.kernel.continue_q, &go, &g, err);
+    lz = !status && sys && Mt == ulam__system_tr(sys) && g.abs.colsum_max < 1.0 ? sys : NULL; /* else whole, first */
+    if (!status && sys && !lz) status = ulam_system_check(sys, err);
+    if (status)
+        ;
+    else if (g.abs.colsum_max < 1.0)
+        status = solve_sweep(M, Mt, lz, opts, &g, x, top, index, std_error, lo, hi, info, &swi, err);
     else if (top >= 0)
         status = solve_queue_top(M, Mt, opts, g, x, top, index, std_error, lo, hi, info, err);
     else
         status = solve_queue(M, Mt, opts, g, x, std_error, lo, hi, info, err);
     if (sw) *sw = swi;
+    ulam_csr_free(own);
     return status;
 }
 
@@ -1077,14 +1178,22 @@ int ulam_fpush_solve(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opt
     return fpush(M, Mt, opts, x, -1, NULL, std_error, lo, hi, info, NULL, err);
 }
 
-/* Estimate every component of x = (I - M)^-1 e_source, and the k largest with their standard
- * errors and intervals. */
-int ulam_fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, int64_t k, double *x,
-                   int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam_error *err)
+/* ulam_fpush_top with the sweep push's counts (see src/fpush.h). */
+int ulam__fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, int64_t k, double *x,
+                    int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw,
+                    ulam_error *err)
 {
     if (k < 0) {
         ulam__clear(err);
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "k >= 0 components");
     }
-    return fpush(M, Mt, opts, x, k, index, std_error, lo, hi, info, NULL, err);
+    return fpush(M, Mt, opts, x, k, index, std_error, lo, hi, info, sw, err);
+}
+
+/* Estimate every component of x = (I - M)^-1 e_source, and the k largest with their standard
+ * errors and intervals. */
+int ulam_fpush_top(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, int64_t k, double *x,
+                   int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam_error *err)
+{
+    return ulam__fpush_top(M, Mt, opts, k, x, index, std_error, lo, hi, info, NULL, err);
 }

@@ -10,6 +10,7 @@
 #include "check.h"
 
 #include <math.h>
+#include <string.h>
 #include <stdlib.h>
 
 struct ulam_push {
@@ -25,6 +26,9 @@ struct ulam_push {
     int64_t pushes, ops;
     double seconds;
     uint64_t stamp; /* changed by every start and run: what a plan made on this state recorded */
+    int (*verify)(const void *ctx, int64_t j, int64_t *bad); /* row j checked before its first push (NULL: none) */
+    const void *vctx;
+    int64_t bad; /* the row whose check failed (-1: none) */
 };
 
 /* Free a push workspace; accepts and returns NULL. */
@@ -47,10 +51,12 @@ static int alloc(const ulam_csr *M, int check, ulam_push **out)
     if (bad) return bad;
     ulam_push *w = calloc(1, sizeof *w);
     if (!w) return ULAM_ENOMEM;
-    w->M = M, w->n = M->nrows, w->target = -1;
+    w->M = M, w->n = M->nrows, w->target = -1, w->bad = -1;
     size_t n = (size_t)M->nrows;
-    w->p = ulam__calloc(n, sizeof *w->p);
-    w->r = ulam__calloc(n, sizeof *w->r);
+    w->p = ulam__alloc_big(n, sizeof *w->p); /* 2 MiB pages from 2 MiB up: a push reads them at random */
+    w->r = ulam__alloc_big(n, sizeof *w->r);
+    if (w->p) memset(w->p, 0, n * sizeof *w->p);
+    if (w->r) memset(w->r, 0, n * sizeof *w->r);
     w->touched = ulam__malloc(n, sizeof *w->touched);
     w->mark = ulam__calloc(n, 1);
     w->queue = ulam__malloc(n, sizeof *w->queue);
@@ -131,6 +137,10 @@ int ulam__push_run(ulam_push *w, double rmax, int64_t max_ops)
         w->mark[j] &= (unsigned char)~2u;
         double rj = w->r[j];
         if (!(fabs(rj) > rmax)) continue; /* signed rows can shrink a queued residual */
+        if (w->verify && w->verify(w->vctx, j, &w->bad)) { /* a damaged row: nothing of it read */
+            status = ULAM_ESYNTAX;
+            break;
+        }
         w->p[j] += rj;
         w->r[j] = 0.0;
         for (int64_t k = M->rowptr[j]; k < M->rowptr[j + 1]; k++) {
@@ -144,6 +154,18 @@ int ulam__push_run(ulam_push *w, double rmax, int64_t max_ops)
     }
     w->seconds += ulam_now() - t0;
     return status;
+}
+
+/* Check each row with verify before it is first pushed (see src/push.h). */
+void ulam__push_set_verify(ulam_push *w, int (*verify)(const void *ctx, int64_t j, int64_t *bad), const void *ctx)
+{
+    w->verify = verify, w->vctx = ctx, w->bad = -1;
+}
+
+/* The row whose check failed the last run (-1: none). */
+int64_t ulam__push_bad_row(const ulam_push *w)
+{
+    return w->bad;
 }
 
 /* The estimates p (dense, n entries). */

@@ -33,6 +33,12 @@ int ulam__push_start(ulam_push *w, int64_t target);
  * no start; ULAM_ENOCONV when the work passes max_ops (> 0; 0 is no cap), the invariant intact. */
 int ulam__push_run(ulam_push *w, double rmax, int64_t max_ops);
 
+/* Have ulam__push_run check row j with verify(ctx, j, &bad) before it pushes it (a lazily read
+ * file's block check: cheap once done); a nonzero return stops the run with ULAM_ESYNTAX and
+ * ulam__push_bad_row gives the row the check named (-1: none). */
+void ulam__push_set_verify(ulam_push *w, int (*verify)(const void *ctx, int64_t j, int64_t *bad), const void *ctx);
+int64_t ulam__push_bad_row(const ulam_push *w);
+
 /* The dense estimates p and residuals r (n entries each, owned by the workspace). */
 const double *ulam__push_estimates(const ulam_push *w);
 

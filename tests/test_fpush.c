@@ -13,6 +13,8 @@
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 
 #include <cmocka.h>
 
@@ -569,6 +571,113 @@ static void test_fpush_signed(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* M = 0.85 P' of n states in communities of 32, each state linking to 1 + (i mod 4) others of its
+ * own community: a source's push and walks stay in its community, a block or two of the file. */
+static ulam_csr *community_graph(int64_t n)
+{
+    int64_t cap = 4 * n, nz = 0;
+    int32_t *ti = malloc((size_t)cap * sizeof *ti), *tj = malloc((size_t)cap * sizeof *tj);
+    double *tx = malloc((size_t)cap * sizeof *tx);
+    for (int64_t i = 0; i < n; i++) {
+        int64_t d = 1 + i % 4, base = i / 32 * 32, local = i % 32, shift = (i * 2654435761u) % 5;
+        for (int64_t k = 0; k < d; k++) /* (local + 1 + shift + 7 k) mod 32: d distinct heads, none i itself */
+            ti[nz] = (int32_t)(base + (local + 1 + shift + 7 * k) % 32 == i ? base + (local + 31) % 32
+                                                                            : base + (local + 1 + shift + 7 * k) % 32),
+            tj[nz] = (int32_t)i, tx[nz++] = 0.85 / (double)d; /* M_ji = 0.85 / d_i for the edge i -> j */
+    }
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, nz, ti, tj, tx, &M), ULAM_OK);
+    free(ti), free(tj), free(tx);
+    return M;
+}
+
+/* One source's top 10 on a prepared file read lazily (ulam_walk_opts.policy.system, Mt NULL: the
+ * file's stored M^T): the same answer, bit for bit, as on M in memory, while the blocks verified
+ * (ulam_system_info.blocks_checked) stay a few of the file's (the command line's old route
+ * verified M and M^T whole first: every block); a damaged block the query reads fails it with
+ * ULAM_ESYNTAX naming the block, one it does not read is never seen. */
+static void test_fpush_lazy_blocks(void **state)
+{
+    (void)state;
+    int64_t n = 1 << 16, K = 10;
+    ulam_csr *M = community_graph(n), *Mt = NULL;
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    ulam_guard g;
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
+    assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
+    char path[] = "/tmp/ulam_test_lazyXXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    ulam_system_desc d = ulam_system_desc_defaults();
+    d.M = M, d.n = n, d.transpose = 1;
+    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    size_t len = (size_t)ftell(f);
+    rewind(f);
+    unsigned char *bytes = malloc(len);
+    assert_int_equal(fread(bytes, 1, len, f), len);
+    fclose(f);
+    uint64_t toff[3];
+    memcpy(toff, bytes + 8 * 17, sizeof toff); /* the header's rowptr, colidx and val of M^T */
+    double *x = malloc((size_t)n * sizeof *x), *y = malloc((size_t)n * sizeof *y);
+    double se[10], lo[10], hi[10], se2[10], lo2[10], hi2[10];
+    int64_t idx[10], idx2[10], src = 1000;
+    ulam_fpush_opts o = ulam_fpush_defaults();
+    o.source = src, o.walk.exec.seed = 7, o.walk.stop.max_walks = 0, o.walk.policy.guard = &g;
+    ulam_fpush_info info, info2;
+    ulam_error err;
+    assert_int_equal(ulam_fpush_top(M, Mt, &o, K, x, idx, se, lo, hi, &info, &err), ULAM_OK);
+    for (int c = 0; c < 3; c++) { /* intact; damaged where the query reads; damaged far from it */
+        void *q = NULL;
+        assert_int_equal(posix_memalign(&q, 4096, len), 0);
+        memcpy(q, bytes, len);
+        int64_t row = c == 1 ? src : n - 1, e; /* a row of M^T (the source's out-edges, or the last state's) */
+        memcpy(&e, (unsigned char *)q + toff[0] + 8 * (uint64_t)row, 8);
+        ((double *)((unsigned char *)q + toff[2]))[e] *= 1.0 + 1e-9; /* its first value, off by a rounding */
+        if (c == 0) memcpy(q, bytes, len);
+        ulam_system *s = NULL;
+        assert_int_equal(ulam_system_from_memory(q, len, NULL, &s, &err), ULAM_OK);
+        const ulam_csr *LM = NULL;
+        assert_int_equal(ulam_system_lazy(s, &LM, NULL), ULAM_OK);
+        ulam_fpush_opts ol = o;
+        ol.walk.policy.system = s;
+        int status = ulam_fpush_top(LM, NULL, &ol, K, y, idx2, se2, lo2, hi2, &info2, &err);
+        ulam_system_info si;
+        ulam_system_get_info(s, &si);
+        ulam_error all;
+        int whole = ulam_system_check(s, &all); /* what the old route verified first */
+        ulam_system_info sa;
+        ulam_system_get_info(s, &sa);
+        print_message("case %d: status %d, %lld walks, %lld push operations; %lld blocks verified of %lld%s%s\n", c, status,
+                      (long long)info2.walks, (long long)info2.push.ops, (long long)si.blocks_checked,
+                      (long long)sa.blocks_checked, status ? ": " : "", status ? err.msg : "");
+        assert_true(sa.blocks_checked > 500);
+        if (c == 1) {
+            assert_int_equal(status, ULAM_ESYNTAX);
+            assert_non_null(strstr(err.msg, "M^T"));
+            assert_int_equal(err.index, src / 32 * 32); /* the first row of its block (blocks of 32 rows here) */
+            assert_int_equal(whole, ULAM_ESYNTAX);
+        } else {
+            assert_int_equal(status, ULAM_OK);
+            assert_int_equal(whole, c == 0 ? ULAM_OK : ULAM_ESYNTAX);
+            assert_true(si.blocks_checked <= 4);
+            assert_true(info2.walks == info.walks && info2.push.ops == info.push.ops);
+            for (int64_t t = 0; t < K; t++)
+                assert_true(idx2[t] == idx[t] && y[idx[t]] == x[idx[t]] && se2[t] == se[t] && lo2[t] == lo[t] &&
+                            hi2[t] == hi[t]);
+        }
+        ulam_system_free(s);
+        free(q);
+    }
+    unlink(path);
+    free(bytes), free(x), free(y);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -582,6 +691,7 @@ int main(void)
         cmocka_unit_test(test_fpush_top_coverage),
         cmocka_unit_test(test_fpush_exact_push),
         cmocka_unit_test(test_fpush_signed),
+        cmocka_unit_test(test_fpush_lazy_blocks),
     };
     return test_run(tests);
 }

@@ -179,6 +179,9 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     o.rmax = bo->rmax, o.min_value = bo->min_value, o.step_cost = bo->step_cost, o.source = source - 1;
     int check = rp->check;
     rp->check = 0; /* prepare's direct value is for one index */
+    /* one source on a prepared file: read where the push and the walks go, each block verified when
+     * first read (seeds and --check read all of M; ranks share nothing of it here) */
+    s->lazy = source && !check && !cli_share && ulam_system_is_file(s->matrix_path);
     int rc = prepare(s, source, force, (ulam_bidir_opts *)bo, NULL, NULL, rp);
     if (rc) return rc;
     int64_t n = s->M->nrows;
@@ -200,10 +203,12 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     double *lo = malloc(kk * sizeof *lo), *hi = malloc(kk * sizeof *hi), *xd = NULL;
     ulam_fpush_info info;
     ulam_error err;
-    const ulam_csr *T = W == s->M && s->sys_M ? ulam_system_transpose(s->sys_M) : NULL; /* prepare --transpose's */
+    int lazy = s->lazy && W == s->M && s->sys_M; /* the library takes the file's M^T (or transposes M) */
+    const ulam_csr *T = W == s->M && s->sys_M && !lazy ? ulam_system_transpose(s->sys_M) : NULL; /* prepare --transpose's */
     if (T && (T->nrows != nw || ulam_csr_nnz(T) != ulam_csr_nnz(W))) T = NULL;
-    if (!status) status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : T ? ULAM_OK : ulam_csr_transpose(W, &Mt);
+    if (!status) status = !order || !x || !se || !lo || !hi ? ULAM_ENOMEM : T || lazy ? ULAM_OK : ulam_csr_transpose(W, &Mt);
     if (!T) T = Mt;
+    o.walk.policy.system = lazy ? s->sys_M : NULL;
     o.walk.policy.guard = &rp->g, o.walk.stop.interrupt = &cli_interrupted; /* M's guards serve M': same spectrum */
     if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
     struct timespec c0, c1;
