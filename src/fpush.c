@@ -717,39 +717,58 @@ static int ranks_before(double u, int64_t i, double v, int64_t j)
     return u > v || (u == v && i < j);
 }
 
-/* Restore the heap order below slot t of the k-entry heap (idx, key): each entry ranks after
- * neither child, so the root ranks last. */
+/* Whether slot a of the heap (idx, key) ranks before slot b (ranks_before; idx NULL: by key
+ * alone, ties equal). */
+static int slot_before(const int64_t *idx, const double *key, int64_t a, int64_t b)
+{
+    return ranks_before(key[a], idx ? idx[a] : 0, key[b], idx ? idx[b] : 0);
+}
+
+/* Restore the heap order below slot t of the k-entry heap (idx, key; idx may be NULL): each
+ * entry ranks after neither child, so the root ranks last. */
 static void sift_down(int64_t *idx, double *key, int64_t k, int64_t t)
 {
     for (;;) {
         int64_t c = 2 * t + 1;
         if (c >= k) return;
-        if (c + 1 < k && ranks_before(key[c], idx[c], key[c + 1], idx[c + 1])) c++; /* the child ranking last */
-        if (!ranks_before(key[t], idx[t], key[c], idx[c])) return;
-        int64_t ti = idx[t];
+        if (c + 1 < k && slot_before(idx, key, c, c + 1)) c++; /* the child ranking last */
+        if (!slot_before(idx, key, t, c)) return;
         double tk = key[t];
-        idx[t] = idx[c], key[t] = key[c], idx[c] = ti, key[c] = tk;
+        key[t] = key[c], key[c] = tk;
+        if (idx) {
+            int64_t ti = idx[t];
+            idx[t] = idx[c], idx[c] = ti;
+        }
         t = c;
     }
 }
 
-/* The k (<= n) components of largest x_i into index, by rank (ranks_before); key: k entries of
- * scratch.  One pass over n with a heap of the k best so far (its root the last of them), then
- * the heap sorted: O(n + changes log k). */
-static void select_top(const double *x, int64_t n, int64_t k, int64_t *index, double *key)
+/* The k (1 <= k <= n) components of largest x_i as a heap in (index, key), its root the k-th
+ * by rank (ranks_before); index NULL: the values alone, and key may be x itself (the heap then
+ * in x[0 .. k), x reordered).  One pass over n: O(n + changes log k). */
+static void heap_top(const double *x, int64_t n, int64_t k, int64_t *index, double *key)
 {
-    if (k <= 0) return;
     for (int64_t i = 0; i < n; i++) {
         double u = x[i];
         if (i < k) {
-            index[i] = i, key[i] = u;
+            key[i] = u;
+            if (index) index[i] = i;
             if (i == k - 1)
                 for (int64_t t = k / 2; t-- > 0;) sift_down(index, key, k, t);
-        } else if (ranks_before(u, i, key[0], index[0])) {
-            index[0] = i, key[0] = u;
+        } else if (ranks_before(u, index ? i : 0, key[0], index ? index[0] : 0)) {
+            key[0] = u;
+            if (index) index[0] = i;
             sift_down(index, key, k, 0);
         }
     }
+}
+
+/* The k (<= n) components of largest x_i into index, by rank (ranks_before); key: k entries of
+ * scratch.  The heap of the k best (heap_top), then sorted: O(n + changes log k + k log k). */
+static void select_top(const double *x, int64_t n, int64_t k, int64_t *index, double *key)
+{
+    if (k <= 0) return;
+    heap_top(x, n, k, index, key);
     for (int64_t m = k - 1; m > 0; m--) { /* the last-ranked to the end, each in turn */
         int64_t ti = index[0];
         double tk = key[0];
@@ -758,23 +777,12 @@ static void select_top(const double *x, int64_t n, int64_t k, int64_t *index, do
     }
 }
 
-/* The K-th largest (1 <= K <= m) of v[0 .. m), v reordered (Hoare's selection). */
+/* The K-th largest (1 <= K <= m) of v[0 .. m), v reordered: the root of the K best's heap
+ * (heap_top, in place). */
 static double kth_largest(double *v, int64_t m, int64_t K)
 {
-    int64_t lo = 0, hi = m - 1, t = K - 1;
-    while (lo < hi) {
-        double piv = v[lo + (hi - lo) / 2], tmp;
-        int64_t i = lo, j = hi;
-        while (i <= j) {
-            while (v[i] > piv) i++;
-            while (v[j] < piv) j--;
-            if (i <= j) tmp = v[i], v[i] = v[j], v[j] = tmp, i++, j--;
-        }
-        if (t <= j) hi = j;
-        else if (t >= i) lo = i;
-        else return v[t];
-    }
-    return v[t];
+    heap_top(v, m, K, NULL, v);
+    return v[0];
 }
 
 /* The K-th largest of p_i + max(r_i, 0) over the n states (r NULL: p_i alone) when above delta,
