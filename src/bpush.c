@@ -19,9 +19,9 @@
 #include <string.h>
 
 /* Push r (n entries, q alongside) on Mt, the transpose of M, until every |r_j| <= rmax or the
- * operations (nonzeros read, plus one a push) pass max_ops; *ops counts them.  ULAM_OK (the
- * invariant holds either way), ULAM_ENOMEM. */
-int ulam__bpush(const ulam_csr *Mt, double rmax, int64_t max_ops, double *q, double *r, int64_t *ops)
+ * operations (nonzeros read, plus one a push) pass max_ops; *ops counts them, *pushes the states
+ * pushed.  ULAM_OK (the invariant holds either way), ULAM_ENOMEM. */
+int ulam__bpush(const ulam_csr *Mt, double rmax, int64_t max_ops, double *q, double *r, int64_t *ops, int64_t *pushes)
 {
     int64_t n = Mt->nrows, head = 0, len = 0;
     int32_t *queue = malloc((size_t)(n > 0 ? n : 1) * sizeof *queue);
@@ -42,10 +42,22 @@ int ulam__bpush(const ulam_csr *Mt, double rmax, int64_t max_ops, double *q, dou
                 queue[at >= n ? at - n : at] = k, len++, in[k] = 1;
             }
         }
-        *ops += 1 + (Mt->rowptr[j + 1] - Mt->rowptr[j]);
+        *ops += 1 + (Mt->rowptr[j + 1] - Mt->rowptr[j]), *pushes += 1;
     }
     free(queue), free(in);
     return ULAM_OK;
+}
+
+/* What the push left in q and r (n entries) into pi: support, r_sum and r_max of r, touched the
+ * states with q_j or r_j nonzero. */
+void ulam__bpush_residual(const double *q, const double *r, int64_t n, ulam_push_info *pi)
+{
+    pi->support = pi->touched = 0, pi->r_sum = pi->r_max = 0.0;
+    for (int64_t j = 0; j < n; j++) {
+        double a = fabs(r[j]);
+        pi->support += a > 0, pi->touched += a > 0 || q[j] != 0.0;
+        pi->r_sum += a, pi->r_max = fmax(pi->r_max, a);
+    }
 }
 
 /* max |r_j|. */

@@ -182,11 +182,12 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
 {
     ulam_run *r = q->run;
     ulam_bidir_plan_info *pl = &q->ch->bidir;
-    int64_t n = q->M->nrows, ops = 0, nnz = ulam_csr_nnz(q->M), pw = 0, ps = 0;
-    double E = o->stop.rel_err, t0 = ulam_now();
+    int64_t n = q->M->nrows, ops = 0, pushes = 0, nnz = ulam_csr_nnz(q->M), pw = 0, ps = 0;
+    double E = o->stop.rel_err, t0 = ulam_now(), push_s = 0.0;
     int status = ULAM_OK;
     if (r->bq && r->br) { /* going on */
-        ops = pl->push.ops, pw = pl->pilot_walks, ps = pl->pilot_steps, t0 -= pl->seconds;
+        ops = pl->push.ops, pushes = pl->push.pushes, push_s = pl->push.seconds;
+        pw = pl->pilot_walks, ps = pl->pilot_steps, t0 -= pl->seconds;
     } else {
         memset(pl, 0, sizeof *pl);
         r->bq = calloc((size_t)n, sizeof *r->bq), r->br = malloc((size_t)n * sizeof *r->br);
@@ -194,8 +195,10 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
         if (status) return release(r), status;
         memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
     }
-    if ((status = ulam__bpush(r->Mt, rmax, max_ops, r->bq, r->br, &ops)))
+    double tp = ulam_now();
+    if ((status = ulam__bpush(r->Mt, rmax, max_ops, r->bq, r->br, &ops, &pushes)))
         return release(r), ulam__fail(err, status, 0, -1, "memory for the push on b");
+    push_s += ulam_now() - tp;
     double qi = r->bq[o->query.index];
     r->bwo = dense_walk_opts(o, c, qi);
     ulam_walk_opts po = r->bwo;
@@ -213,7 +216,8 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     double need = E > 0 ? fmax((double)ULAM__REL_MIN, fmax(wr.min_walks, wr.variance / (E * mt * E * mt)))
                         : (double)o->stop.max_walks; /* a fixed budget: fixed_predict sets it */
     pl->target = o->query.index, pl->rmax = rmax, pl->balanced = 1, pl->push_part = qi;
-    pl->push = (ulam_push_info){.target = o->query.index, .rmax = rmax, .ops = ops, .r_max = ulam__bpush_max(r->br, n)};
+    pl->push = (ulam_push_info){.target = o->query.index, .rmax = rmax, .pushes = pushes, .ops = ops, .seconds = push_s};
+    ulam__bpush_residual(r->bq, r->br, n, &pl->push);
     pl->pilot_walks = pw + wr.walks, pl->pilot_steps = ps + wr.steps, pl->mean_visits = V + 1.0;
     pl->predicted_walks = mt > 0 ? need : INFINITY, pl->step_cost = 1.0;
     pl->predicted_work = ULAM_AUTO_READ * ((double)ops + 2.0 * (double)nnz) +

@@ -1948,6 +1948,15 @@ def check_bidir(ulam):
     o = json.loads(out)
     assert rc == 0 and o["residual_support"] == 0 and o["walks"] == 0 and o["stderr"] == 0, o
     assert abs(o["estimate"] - o["direct"]) < 1e-14 and o["estimate"] > 0.3, o
+    # the push on b (docs/auto.md's x[7] example, chosen by auto) reports its push: states pushed,
+    # the residual it left (on at most n states, each |r_j| <= rmax) and its seconds (all printed
+    # as 0 before)
+    rc, out, err = run(ulam, PS + ["--rhs", M + "randsub1000_b.mtx", "--rel-err", "0.01", "--threads", "1", "--json"])
+    o = json.loads(out)
+    assert rc == 0 and o["method"] == "bidirectional" and o["b_nonzeros"] > 16 and o["push_ops"] > 0, o
+    assert 0 < o["pushes"] < o["push_ops"] and 0 < o["residual_support"] <= 1000, o
+    assert 0 < o["residual_sum"] <= o["residual_support"] * o["rmax"], o
+    assert 0 < o["push_seconds"] <= o["seconds"] and o["walk_seconds"] <= o["seconds"], o
 
 
 def substream(seed, purpose, k):

@@ -385,6 +385,17 @@ const cli_solve_route *cli_bidir_route(const void *p)
 const cli_solve_row cli_solve_bidir_row = {"bidirectional", longopts, claims, serves, sizeof(bidir_args), init, option,
                                            start_run};
 
+/* The push on b's b as its report names it: e_s (a single 1) as the source, else b's nonzeros
+ * counted into o->nb (the report reads the count alone; b_index and b_value stay NULL). */
+static void pushed_b(const cli_system *s, ulam_bidir_opts *o)
+{
+    int64_t nb = 0, at = 0;
+    for (int64_t i = 0; i < s->M->nrows; i++)
+        if (s->b[i] != 0.0) nb++, at = i;
+    if (nb == 1 && s->b[at] == 1.0) o->source = at, o->nb = 0;
+    else o->nb = nb;
+}
+
 /* Run the chosen bidirectional (cli.h). */
 int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int route, int json, int check,
                        double load_seconds)
@@ -405,6 +416,7 @@ int cli_bidir_auto_run(cli_system *s, ulam_run *run, const ulam_choice *ch, int 
     int status = ulam_run_finish(run, &a, &err);
     ulam_bidir_opts o = ch->bidir_opts;
     o.walk = a.opts;
+    if (route) pushed_b(s, &o);
     rc = status ? cli_report(s->matrix_path, &err) : answer(s, &o, &a.bidir, &rp);
     cli_flush();
     cli_release_sigint();
