@@ -195,7 +195,8 @@ enum ulam_study_report {
     ULAM_STUDY_CHART_COLLISION = 5, /* a gnuplot script (reading the CSVs in its directory): RMSE against */
     ULAM_STUDY_CHART_ABSORPTION = 6, /* seconds of one estimator's methods (nothing when none runs) */
     ULAM_STUDY_CHART_EXPECTED = 7,
-    ULAM_STUDY_CHART_WORK = 8,      /* RMSE^2 x seconds at the largest budget, from bars.csv */
+    ULAM_STUDY_CHART_WORK = 8,      /* RMSE^2 x seconds at the largest budget, from bars.csv (log
+                                       scale: nothing when none is above 0, as when every run is exact) */
     ULAM_STUDY_CHART_COVERAGE = 9   /* the coverage with its binomial interval, from bars.csv */
 };
 

@@ -126,16 +126,24 @@ static void summary_csv(FILE *f, const ulam_study *s)
         }
 }
 
+/* Method m's bar: its cell at the largest budget with runs into *last; 0 when it has none. */
+static int bar_cell(const ulam_study *s, int m, ulam_study_cell *last)
+{
+    ulam_study_cell c;
+    *last = (ulam_study_cell){0};
+    for (int b = 0; runs_on(s, m) && b < s->p.nbudgets; b++)
+        if (ulam_study_cell_get(s, m, b, &c)) *last = c;
+    return last->runs > 0;
+}
+
 /* bars.csv: per method, its largest budget with runs, with the coverage's Wilson interval. */
 static void bars_csv(FILE *f, const ulam_study *s)
 {
     char v[5][32];
     fprintf(f, "method,work,coverage,honesty,coverage_lo,coverage_hi,covered,runs\n");
     for (int m = 0; m < ULAM_STUDY_METHODS; m++) {
-        ulam_study_cell last = {0}, c;
-        for (int b = 0; runs_on(s, m) && b < s->p.nbudgets; b++)
-            if (ulam_study_cell_get(s, m, b, &c)) last = c;
-        if (!last.runs) continue;
+        ulam_study_cell last;
+        if (!bar_cell(s, m, &last)) continue;
         double lo, hi;
         int covered = (int)lround(last.coverage * last.runs);
         ulam_study_coverage_interval(covered, last.runs, &lo, &hi);
@@ -206,8 +214,26 @@ static void lapack_mark(FILE *f, const ulam_study *s)
             s->ref.direct_seconds, error, err, s->ref.direct_seconds);
 }
 
+/* Why summary.csv's cells cannot be fitted by f(x) = a / sqrt(x) (gnuplot's fit of column 4 on
+ * column 8, from a = 0), or NULL when they can: it needs two cells with a finite RMSE (one point:
+ * gnuplot's "No data to fit" fails the script), seconds above 0, and an RMSE above 0 (all 0: the
+ * fit creeps from a = 0 toward 0 for seconds). */
+static const char *no_fit(const ulam_study *s)
+{
+    int points = 0, above = 0;
+    for (int m = 0; m < ULAM_STUDY_METHODS; m++)
+        for (int b = 0; runs_on(s, m) && b < s->p.nbudgets; b++) {
+            ulam_study_cell c;
+            if (!ulam_study_cell_get(s, m, b, &c) || !isfinite(c.rmse) || !isfinite(c.seconds)) continue;
+            if (!(c.seconds > 0)) return "a cell ran in 0 s";
+            points++, above += c.rmse > 0;
+        }
+    if (points < 2) return "fewer than two cells";
+    return above ? NULL : "every RMSE is 0 (every run exact)";
+}
+
 /* The RMSE chart of estimator e's methods (at most 6, each its own colour and dash); nothing when
- * none runs. */
+ * none runs.  Its 1/sqrt(t) line is fitted to every cell (no_fit: else a note in its place). */
 static void rmse_chart(FILE *f, const ulam_study *s, int e, const ulam_study_report_opts *ro)
 {
     static const char *const est[3] = {"collision", "absorption", "expected"};
@@ -219,13 +245,17 @@ static void rmse_chart(FILE *f, const ulam_study *s, int e, const ulam_study_rep
     for (int b = 0; b < s->p.nbudgets; b++)
         snprintf(budgets + strlen(budgets), sizeof budgets - strlen(budgets), "%.17g ", s->budget[b]);
     double y0 = s->ref.exact != 0 ? 1e-9 * fabs(s->ref.exact) : 1e-12;
+    const char *why = no_fit(s);
+    char fit[200] = "set fit quiet\nset fit logfile '/dev/null'\nf(x) = a / sqrt(x)\na = 0\nfit f(x) 'summary.csv' u 8:4 via a\n";
+    if (why)
+        snprintf(fit, sizeof fit, "set label 2 'no 1/sqrt(t) fit: %s' at graph 0.02, graph 0.96 left font ',9'\n", why);
     fprintf(f,
             "set title 'ulam study: RMSE of x_{%lld} against seconds per run, %s estimator%s'\n"
             "set logscale xy\nset format x '10^{%%L}'\nset format y '10^{%%L}'\nset xlabel 'seconds per run'\n"
             "set ylabel 'RMSE (reference lines: the error of one run)'\nset key outside bottom center horizontal "
             "maxrows 4 font ',8'\n"
             "Y0 = %g\nset yrange [Y0:*]\n"
-            "set fit quiet\nset fit logfile '/dev/null'\nf(x) = a / sqrt(x)\na = 0\nfit f(x) 'summary.csv' u 8:4 via a\n"
+            "%s"
             "M = \"%s\"\n" /* at most 6 methods: 6 colours, 6 dashes */
             "C = \"#1b9e77 #d95f02 #7570b3 #e7298a #66a61e #a6761d\"\n"
             "B = \"%s\"\n" /* one point shape per budget, in the method's colour */
@@ -234,7 +264,7 @@ static void rmse_chart(FILE *f, const ulam_study *s, int e, const ulam_study_rep
             "stats 'reference.csv' u (strcol(1) ne 'lapack' && $2 > 0 ? $2 : 1/0) nooutput\n"
             "X0 = 10**floor(log10(STATS_min < X0 ? STATS_min : X0))\nX1 = 10**ceil(log10(STATS_max > X1 ? STATS_max : X1))\n"
             "set xrange [X0:X1]\n",
-            (long long)s->index + 1, est[e], ro->partial ? " (PARTIAL: interrupted)" : "", y0, names, budgets);
+            (long long)s->index + 1, est[e], ro->partial ? " (PARTIAL: interrupted)" : "", y0, fit, names, budgets);
     lapack_mark(f, s);
     fprintf(f,
             "plot for [i=1:words(M)] 'summary.csv' u (strcol(1) eq word(M, i) && $11 == 0 ? $8 : 1/0):4 w l lw 2 "
@@ -246,19 +276,27 @@ static void rmse_chart(FILE *f, const ulam_study *s, int e, const ulam_study_rep
             "'' u (strcol(1) eq 'lapack' ? lx : 1/0):(ly) w p pt 9 ps 2 lc 'web-green' t 'LAPACK dgesv', "
             "%s"
             "'' u (strcol(1) eq 'cg' || strcol(1) eq 'gmres' ? $2 : 1/0):3 w lp lw 1 pt 3 lc 'dark-cyan' t 'Krylov', "
-            "f(x) dt 4 lc 'gray30' t '1/sqrt(t)'\n",
+            "%s\n",
             s->p.time_budgets ? "%g s a run" : "%.0f walks",
             ulam_study_forward_walks(s) && ro->reference_time > 0 /* the one-run lines exist: else no legend */
                 ? "'' u (strcol(1) eq 'sequential' ? $2 : 1/0):3 w lp lw 1 pt 5 lc 'brown' t 'sequential MC (one run)', "
                   "'' u (strcol(1) eq 'mcsa' ? $2 : 1/0):3 w lp lw 1 pt 7 lc 'dark-magenta' t 'MCSA (one run)', "
-                : "");
+                : "",
+            why ? "NaN notitle" : "f(x) dt 4 lc 'gray30' t '1/sqrt(t)'");
 }
 
-/* The work chart (RMSE^2 x seconds at the largest budget) or the coverage chart (with its
- * binomial interval), from bars.csv. */
-static void bars_chart(FILE *f, int coverage, const ulam_study_report_opts *ro)
+/* The work chart (RMSE^2 x seconds at the largest budget, on a log scale: nothing when no bar is
+ * above 0, as when every run is exact) or the coverage chart (with its binomial interval), from
+ * bars.csv. */
+static void bars_chart(FILE *f, const ulam_study *s, int coverage, const ulam_study_report_opts *ro)
 {
     const char *partial = ro->partial ? " (PARTIAL: interrupted)" : "";
+    int above = 0;
+    for (int m = 0; m < ULAM_STUDY_METHODS; m++) {
+        ulam_study_cell last;
+        above += bar_cell(s, m, &last) && isfinite(last.work) && last.work > 0;
+    }
+    if (!coverage && !above) return;
     if (!coverage)
         fprintf(f, "set title 'work-normalised variance RMSE^2 x seconds at the largest budget (lower wins)%s'\n"
                    "set style data histograms\nset style fill solid 0.6\nset logscale y\nset format y '10^{%%L}'\n"
@@ -289,7 +327,7 @@ int ulam_study_fprint(FILE *f, const ulam_study *s, int kind, const ulam_study_r
     case ULAM_STUDY_CHART_ABSORPTION:
     case ULAM_STUDY_CHART_EXPECTED: rmse_chart(f, s, kind - ULAM_STUDY_CHART_COLLISION, ro); break;
     case ULAM_STUDY_CHART_WORK:
-    case ULAM_STUDY_CHART_COVERAGE: bars_chart(f, kind == ULAM_STUDY_CHART_COVERAGE, ro); break;
+    case ULAM_STUDY_CHART_COVERAGE: bars_chart(f, s, kind == ULAM_STUDY_CHART_COVERAGE, ro); break;
     default: return ULAM_EINVAL;
     }
     return ferror(f) ? ULAM_EIO : ULAM_OK;

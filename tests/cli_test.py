@@ -1595,6 +1595,33 @@ def check_study_nonfinite(ulam):
         assert all(".tmp." not in f for f in os.listdir(d)), os.listdir(d)
 
 
+def check_study_exact_charts(ulam):
+    """Every run exact (M = 0: every RMSE is 0): the RMSE chart skips its 1/sqrt(t) fit with a note
+    in the chart (gnuplot's fit started from a = 0 and crept toward 0 for ~10 s before), and the
+    work chart (RMSE^2 x s on a log scale, all 0: gnuplot failed and wrote nothing, while the
+    study listed work.png as written) is left out with a note; the coverage chart is drawn."""
+    with tempfile.TemporaryDirectory() as d:
+        rc, _, err = run(ulam, ["study", D + "zero1.mtx", "--rhs", D + "one1.mtx", "--index", "1", "--methods",
+                                "adjoint-collision-plain", "--budgets", "100", "--repeats", "3", "--out", d])
+        files = set(os.listdir(d))
+        assert rc == 0 and {"rmse-collision.png", "coverage.png"} <= files, (rc, err, files)
+        gp = open(os.path.join(d, "rmse-collision.gp")).read()
+        assert not re.search(r"^fit ", gp, re.M) and "t '1/sqrt(t)'" not in gp and "no 1/sqrt(t) fit" in gp, gp
+        wrote = re.search(r"^ulam: study: wrote .*$", err, re.M)
+        assert wrote and "work.png" not in wrote.group(0) and "work.png" not in files, (err, files)
+        assert re.search(r"work chart not drawn: .*RMSE\^2 x s", err), err
+        assert all(".tmp." not in f for f in files), files
+    # one cell (one method, one budget) on a system whose runs are not exact: gnuplot's fit has one
+    # point ("No data to fit") and failed the whole chart step before ("gnuplot failed (install
+    # gnuplot-nox): charts not drawn"); now the fit is skipped and every chart drawn
+    with tempfile.TemporaryDirectory() as d:
+        rc, _, err = run(ulam, ["study", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "2", "--methods",
+                                "adjoint-collision-plain", "--budgets", "100", "--repeats", "3", "--out", d])
+        files = set(os.listdir(d))
+        assert rc == 0 and {"rmse-collision.png", "work.png", "coverage.png"} <= files, (rc, err, files)
+        assert "gnuplot failed" not in err and "no 1/sqrt(t) fit" in open(os.path.join(d, "rmse-collision.gp")).read(), err
+
+
 def check_study(ulam):
     """study: rows per run, a summary per cell, resume without duplicates, a torn last line cut,
     refusals listed, Ctrl-C keeps finished rows."""
@@ -2289,7 +2316,7 @@ def main():
     failures, n = check_table(ulam, rows if cases else None) if part != "checks" else (0, 0)
     extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_source_fallback, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_exact_zero_no_warning, ulam), (check_adjoint_scale, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
-             (check_study, ulam), (check_study_summary, ulam), (check_study_nonfinite, ulam), (check_cache, ulam), (check_prepare, ulam),
+             (check_study, ulam), (check_study_summary, ulam), (check_study_nonfinite, ulam), (check_study_exact_charts, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),
              (check_radiosity_patches, ulam), (check_radiosity_images, ulam), (check_radiosity_image_noise, ulam),
              (check_radiosity_matrix_rel_err, ulam), (check_radiosity_grid, ulam),

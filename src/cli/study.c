@@ -346,10 +346,12 @@ static int charts(const study *st, char *drawn, size_t len)
         }
         snprintf(drawn + strlen(drawn), len - strlen(drawn), ", %s.%s", chart, st->format);
     }
-    draw(st, "work", 1000, 500, ULAM_STUDY_CHART_WORK);
-    draw(st, "coverage", 1000, 500, ULAM_STUDY_CHART_COVERAGE);
-    snprintf(drawn + strlen(drawn), len - strlen(drawn), ", work.%s, coverage.%s (and their .gp scripts)", st->format,
-             st->format);
+    int work = draw(st, "work", 1000, 500, ULAM_STUDY_CHART_WORK);
+    if (work == 1) fprintf(stderr, "ulam: study: work chart not drawn: no method's RMSE^2 x s is above 0 (every run exact)\n");
+    else if (!work) snprintf(drawn + strlen(drawn), len - strlen(drawn), ", work.%s", st->format);
+    if (!draw(st, "coverage", 1000, 500, ULAM_STUDY_CHART_COVERAGE))
+        snprintf(drawn + strlen(drawn), len - strlen(drawn), ", coverage.%s", st->format);
+    snprintf(drawn + strlen(drawn), len - strlen(drawn), " (and their .gp scripts)");
     return 0;
 }
 
