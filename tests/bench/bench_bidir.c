@@ -27,7 +27,8 @@
  * wall time is mostly waiting for a core, which swamped the ratios.
  * The transpose M' and the walks' guards on it are computed once (their times are printed apart)
  * and given to every query of both walk methods: a query never repeats them.  The bidirectional
- * queries share one push workspace with reach_all (the walks' reachability bounds over every
+ * queries share one analysis of M (ulam_analysis_bidir: its transpose, made before the clock,
+ * push workspace and plan memo) with reach_all (the walks' reachability bounds over every
  * state, made by the first query, its time counted there) and keep_kernel (kernel rows built by
  * earlier queries' walks and pilots are kept and rescored, not built again): per-graph work is
  * paid once, inside the queries' times.  The walks-alone peer builds its rows afresh each pair.
@@ -41,8 +42,7 @@
  * rank^-0.75, M = 0.85 P'), SOURCES (default 10) random sources with one target each, drawn among
  * the states with 1/n <= pi_t <= 20/n, pi = 0.15 x the personalized PageRank; the same methods.
  * Usage: bench_bidir [L [SOURCES]] (default 20 and 20: n = 1048576, 100 pairs). */
-#include "../../src/bidir.h" /* ulam__bidir_solve on a kept push workspace: the estimator alone */
-#include "../../src/push.h"
+#include "../../src/push.h" /* the push-alone peer: the reverse push has no public API (ulam_push is opaque) */
 #include "exact.h"
 #include "../zipf_graph.h"
 
@@ -86,19 +86,19 @@ static double quantile(const double *v, int n, double q)
     return s[k < 0 ? 0 : k];
 }
 
-/* A bidirectional query (rmax 0: balanced). */
-static int query(ulam_push *w, ulam__bidir *memo, const ulam_csr *Mt, const ulam_guard *g, int64_t s, int64_t t, double rmax, double cap,
-                 uint64_t seed, ulam_bidir_result *res)
+/* A bidirectional query (rmax 0: balanced) on the analysis a. */
+static int query(ulam_analysis *a, const ulam_guard *g, int64_t s, int64_t t, double rmax, double cap, uint64_t seed,
+                 ulam_bidir_result *res)
 {
     ulam_bidir_opts o = ulam_bidir_defaults();
     o.walk.policy.guard = g;
-    o.reach_all = 1;   /* the walks' bounds over every state, made at the first query, kept in memo for the rest */
-    o.keep_kernel = 1; /* the walks' (and pilot's) kernel rows kept in memo, rescored to each query's residual */
+    o.reach_all = 1;   /* the walks' bounds over every state, made at the first query, kept in a's memo for the rest */
+    o.keep_kernel = 1; /* the walks' (and pilot's) kernel rows kept in a's memo, rescored to each query's residual */
     o.source = s, o.target = t, o.rmax = rmax;
     o.walk.stop.max_walks = 0, o.walk.stop.rel_err = REL, o.walk.stop.max_seconds = cap, o.walk.exec.threads = 1, o.walk.exec.seed = seed;
     o.walk.stop.max_steps = INT64_MAX / 4;
     ulam_error err;
-    int st = ulam__bidir_solve(w, memo, Mt, &o, res, &err);
+    int st = ulam_analysis_bidir(a, &o, res, &err);
     if (st) fprintf(stderr, "bidir: pair (%lld, %lld): %s: %s\n", (long long)s, (long long)t, ulam_strerror(st), err.msg);
     return st;
 }
@@ -197,7 +197,7 @@ int main(int argc, char **argv)
     }
     double t0 = ulam_now();
     int64_t dangling = 0, maxin = 0, maxout = 0;
-    ulam_csr *M = zipf ? zipf_graph(L, 2.1, 0.75, ALPHA, 1) : bench_rmat(L, ALPHA, &dangling, &maxin, &maxout), *Mt = NULL;
+    ulam_csr *M = zipf ? zipf_graph(L, 2.1, 0.75, ALPHA, 1) : bench_rmat(L, ALPHA, &dangling, &maxin, &maxout);
     int64_t n = zipf ? L : (int64_t)1 << L;
     if (!M) return fprintf(stderr, "bidir: out of memory\n"), 1;
     if (zipf)
@@ -209,9 +209,11 @@ int main(int argc, char **argv)
                "max out-degree %lld; built in %.1f s\n", L, (long long)n, (long long)ulam_csr_nnz(M),
                (long long)dangling, (long long)maxin, (long long)maxout, ulam_now() - t0);
     t0 = ulam_now();
-    ulam_push *w = NULL;
-    ulam__bidir *memo = ulam__bidir_alloc(); /* the plan memo the queries on w share */
-    if (!memo || ulam_csr_transpose(M, &Mt) || ulam__push_alloc(M, &w)) return fprintf(stderr, "bidir: out of memory\n"), 1;
+    ulam_push *w = NULL; /* the push-alone peer's workspace */
+    ulam_analysis *an = NULL; /* the bidirectional queries' transpose, push workspace and plan memo */
+    const ulam_csr *Mt = NULL;
+    if (ulam_analysis_alloc(M, NULL, &an, NULL) || !(Mt = ulam_analysis_transpose(an, NULL)) || ulam__push_alloc(M, &w))
+        return fprintf(stderr, "bidir: out of memory\n"), 1;
     printf("transpose M' (once, for every query): %.3f s\n", ulam_now() - t0);
     ulam_guard g; /* the walks' guards on M' (adjoint kernel), once for every query of either method */
     ulam_guard_opts go = ulam_guard_defaults();
@@ -248,7 +250,7 @@ int main(int argc, char **argv)
             cand[j] = cand[q], cand[q] = t;
             ulam_bidir_result rb;
             double c0 = cpu_now();
-            if (query(w, memo, Mt, &g, s, t, 0, 0, (uint64_t)k + 1, &rb)) return 1;
+            if (query(an, &g, s, t, 0, 0, (uint64_t)k + 1, &rb)) return 1;
             bi.seconds[k] = cpu_now() - c0, bi.other[k] = rb.push.seconds, bi.walk[k] = rb.walks.seconds;
             bi.covered += rb.ci95[0] <= x[t] && x[t] <= rb.ci95[1], bi.intervals++;
             sum_push_ops += (double)rb.push.ops, sum_steps += (double)(rb.walks.steps + rb.walks.walks);
@@ -289,7 +291,7 @@ int main(int argc, char **argv)
            "pilot and the walk solver's set-up\n", quantile(bi.other, np, 0.5), quantile(bi.other, np, 0.9),
            quantile(bi.walk, np, 0.5), quantile(bi.walk, np, 0.9));
     free(x), free(old), free(b), free(e), free(cand);
-    ulam__push_free(w), ulam__bidir_free(memo);
-    ulam_csr_free(M), ulam_csr_free(Mt);
+    ulam__push_free(w), ulam_analysis_free(an);
+    ulam_csr_free(M);
     return 0;
 }

@@ -1,7 +1,8 @@
 /* Many point-source queries in one process (issue 29, point 2): `ulam solve SYSTEM --queries FILE`
  * from a prepared file of the R-MAT graph of bench_bidir (2^L states, M = 0.85 P'), against the
- * in-process figure of bench_bidir (ulam__bidir_solve on one kept push workspace with reach_all and
- * keep_kernel, the transpose and guards made before the clock), on the same pairs (bench_bidir's
+ * in-process figure of bench_bidir (ulam_analysis_bidir on one analysis of M, whose push workspace
+ * and plan memo the queries share, with reach_all and keep_kernel, the transpose and guards made
+ * before the clock), on the same pairs (bench_bidir's
  * draw: SOURCES random sources reaching at least TARGETS states of x_t >= 1/n, TARGETS of those),
  * the same seeds (pair k: seed k; the queries' --seed 1 gives query k seed k) and the same rule
  * (--rel-err 0.1, one thread, no step cap).  Per-query seconds: the CLI's JSON "seconds" (each
@@ -9,8 +10,6 @@
  * in-process ones; median and 90th percentile and the whole process.  Target: CLI per-query
  * median <= 1.5x the in-process median.  Usage: bench_queries path/to/ulam [L [SOURCES]]
  * (default 20 and 20: 100 pairs). */
-#include "../../src/bidir.h" /* ulam__bidir_solve on a kept push workspace: the estimator alone */
-#include "../../src/push.h"
 #include "exact.h"
 
 enum { SOURCES = 20, TARGETS = 5, PAIRS = SOURCES * TARGETS };
@@ -39,7 +38,7 @@ int main(int argc, char **argv)
         return 2;
     }
     int64_t dangling, maxin, maxout, n = (int64_t)1 << L;
-    ulam_csr *M = bench_rmat(L, ALPHA, &dangling, &maxin, &maxout), *Mt = NULL;
+    ulam_csr *M = bench_rmat(L, ALPHA, &dangling, &maxin, &maxout);
     double *x = malloc((size_t)n * sizeof *x), *old = malloc((size_t)n * sizeof *old), *b = malloc((size_t)n * sizeof *b);
     int64_t *cand = malloc((size_t)n * sizeof *cand), ps[PAIRS], pt[PAIRS];
     if (!M || !x || !old || !b || !cand) return fprintf(stderr, "queries: out of memory\n"), 1;
@@ -59,13 +58,14 @@ int main(int argc, char **argv)
         }
         src++;
     }
-    /* in process, as bench_bidir */
-    ulam_push *w = NULL;
+    /* in process, as bench_bidir: one analysis of M (its transpose, push workspace and plan memo) */
+    ulam_analysis *an = NULL;
+    const ulam_csr *Mt = NULL;
     ulam_guard g;
     ulam_guard_opts go = ulam_guard_defaults();
     go.need = ULAM_GUARD_ABS | ULAM_GUARD_HAT(ULAM_ADJOINT);
-    ulam__bidir *memo = ulam__bidir_alloc(); /* the plan memo the queries on w share */
-    if (!memo || ulam_csr_transpose(M, &Mt) || ulam__push_alloc(M, &w) || ulam_guard_check(Mt, 0.0, &go, &g, NULL))
+    if (ulam_analysis_alloc(M, NULL, &an, NULL) || !(Mt = ulam_analysis_transpose(an, NULL)) ||
+        ulam_guard_check(Mt, 0.0, &go, &g, NULL))
         return fprintf(stderr, "queries: set-up failed\n"), 1;
     double inproc[PAIRS], cli[PAIRS], est[PAIRS];
     for (int k = 0; k < np; k++) {
@@ -74,11 +74,10 @@ int main(int argc, char **argv)
         o.walk.stop.max_walks = 0, o.walk.stop.rel_err = REL, o.walk.exec.threads = 1, o.walk.exec.seed = (uint64_t)k + 1;
         o.walk.stop.max_steps = INT64_MAX / 4;
         ulam_bidir_result res;
-        if (ulam__bidir_solve(w, memo, Mt, &o, &res, NULL)) return fprintf(stderr, "queries: pair %d failed\n", k + 1), 1;
+        if (ulam_analysis_bidir(an, &o, &res, NULL)) return fprintf(stderr, "queries: pair %d failed\n", k + 1), 1;
         inproc[k] = res.seconds, est[k] = res.estimate;
     }
-    ulam__push_free(w), ulam__bidir_free(memo);
-    ulam_csr_free(Mt);
+    ulam_analysis_free(an);
     /* the CLI: a prepared file (certificate and stored bounds) and one process for every pair */
     char dir[] = "/tmp/ulam_bench_queriesXXXXXX", sysf[128], qf[128];
     if (!mkdtemp(dir)) return 1;

@@ -24,7 +24,7 @@
 #include <sys/wait.h>
 
 #include "gen.h"
-#include "../../src/internal.h" /* ulam__gauss_seidel_sweep: the reference solve */
+#include "../../src/internal.h" /* ulam__gauss_seidel_sweep: the Gauss-Seidel peer, timed sweep by sweep (the public ulam_outer_* iteration adds a residual product to each) */
 #include "gnuplot.h"
 
 #ifdef HAVE_UMFPACK

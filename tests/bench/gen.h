@@ -12,6 +12,38 @@
 
 #include "ulam.h"
 
+/* The reference solve by the library's Gauss-Seidel iteration (ulam_outer_*, ULAM_GAUSS_SEIDEL:
+ * sweeps on x = M x + b from x = 0, each also computing its residual) into x (n entries), until
+ * the sweep moves x by at most tol -- index < 0: every entry, by at most tol absolutely (old: n
+ * entries of scratch); else x_index, by at most tol |x_index| (old unused) -- or max_sweeps;
+ * the sweeps made, -1 when the iteration could not start (b = 0, no memory). */
+static inline int bench_gauss_seidel(const ulam_csr *M, const double *b, int64_t index, double tol, int max_sweeps,
+                                     double *x, double *old)
+{
+    ulam_outer_opts o = ulam_outer_defaults();
+    o.method = ULAM_GAUSS_SEIDEL, o.tol = 1e-300, o.max_iter = max_sweeps; /* stopped here, not by the residual */
+    ulam_outer *s = NULL;
+    ulam_outer_info info;
+    if (ulam_outer_alloc(M, b, &o, &s, NULL)) return -1;
+    ulam_outer_get_info(s, &info);
+    int64_t n = M->nrows;
+    int sweeps = 0;
+    for (int settled = 0; !settled && sweeps < max_sweeps && !ulam_outer_done(s); sweeps++) {
+        double was = info.x[index < 0 ? 0 : index], change = 0;
+        if (index < 0) memcpy(old, info.x, (size_t)n * sizeof *old);
+        ulam_outer_iterate(s, NULL);
+        if (index >= 0) {
+            settled = fabs(info.x[index] - was) <= tol * fabs(info.x[index]);
+            continue;
+        }
+        for (int64_t i = 0; i < n; i++) change = fmax(change, fabs(info.x[i] - old[i]));
+        settled = change <= tol;
+    }
+    memcpy(x, info.x, (size_t)n * sizeof *x);
+    ulam_outer_free(s);
+    return sweeps;
+}
+
 /* Radiosity-like M: n x n, 8 nonzeros a row at columns drawn uniformly (stream (n, 0)),
  * values 0.1 + U(0, 1) scaled so every row sums to 0.9, so rho(|M|) = rho(M) = 0.9 exactly
  * (the Perron root of a matrix with constant row sums). */
