@@ -133,6 +133,7 @@ typedef struct {
     ulam__slot *mem;
     double (*fac)[2]; /* the moves' own factors (kernel exponent != 1), or NULL */
     int64_t max_steps;
+    int64_t part_steps; /* the walker's */
     int window; /* roulette or splitting in force */
 } step_consts;
 
@@ -196,7 +197,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
     int lanes = w->lanes < 1 ? 1 : w->lanes > LANES ? LANES : w->lanes;
     int64_t cap = sc->stack_cap / lanes, started = 0;
     int act = 0;
-    const step_consts c = {w->k->mem, fac, w->max_steps, w->roulette > 0 || w->split > 0};
+    const step_consts c = {w->k->mem, fac, w->max_steps, w->part_steps, w->roulette > 0 || w->split > 0};
     for (; act < lanes && started < count; act++, started++) {
         L[act].st = (stack){sc->stack_s + act * cap, sc->stack_w + act * cap, 0, cap};
         lane_start(w, &L[act], r);
@@ -206,7 +207,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
         for (int l = 0; l < act; l++) {
             lane *x = &L[l];
             x->score += x->w * x->h->visit;
-            if (x->len + 1 == w->part_steps) x->part = x->score; /* the first part_steps visits */
+            if (x->len + 1 == c.part_steps) x->part = x->score; /* the first part_steps visits */
             x->s = ulam__kernel_pick(x->h, r, &x->frac);
             prefetch(x->s);
         }
