@@ -32,6 +32,11 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *o, ulam_error *err)
  * (*reads). */
 void ulam__solver_setup(const ulam_solver *s, int64_t *units, int64_t *reads);
 
+/* The bound on |sum over k > l of (K^k b)_index| from the start's signed tail (adjoint collision
+ * from one start: the bias of a score over a history's first l + 1 visits), NAN without one; *part
+ * the visits the sequence took of each history in the round planned last (0: whole scores). */
+double ulam__solver_part_bias(const ulam_solver *s, int64_t l, int64_t *part);
+
 /* The walks the rel_err rule's range term would need at estimate m and target E were every visit
  * to score at most per_visit (times the walk's weight), both signs when signs, under the
  * reachability bounds of a solver made with rel_err > 0 and b = 1 (src/solve.c; INFINITY

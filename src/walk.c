@@ -87,6 +87,7 @@ typedef struct {
     ulam__slot *s; /* the slot drawn for its next step */
     uint64_t frac;
     double w, score;
+    double part; /* the score over its first w->part_steps visits, NAN until it has made them */
     int64_t len; /* steps in this history */
     int64_t id;  /* the history's start order in its block */
     stack st;
@@ -108,6 +109,7 @@ static void lane_start(const ulam__walker *w, lane *x, ulam_rng *r)
         x->w = o < 0 ? -w->start_norm : w->start_norm;
         x->score = x->w * w->start_b[j];
     }
+    x->part = NAN;
     x->len = 0;
     x->st.top = 0;
 }
@@ -131,6 +133,7 @@ typedef struct {
     ulam__slot *mem;
     double (*fac)[2]; /* the moves' own factors (kernel exponent != 1), or NULL */
     int64_t max_steps;
+    int64_t part_steps; /* the walker's */
     int window; /* roulette or splitting in force */
 } step_consts;
 
@@ -167,13 +170,15 @@ static inline int sub_of(int64_t id)
     return id / ULAM__SUB_WALKS < ULAM__SUBS ? (int)(id / ULAM__SUB_WALKS) : ULAM__SUBS - 1;
 }
 
-/* Record history id's score (a non-finite one is counted, never averaged). */
-static void record(const ulam__walker *w, ulam__block *out, double score, int64_t id)
+/* Record history id's score (a non-finite one is counted, never averaged); the clipped moments
+ * take part in its place when it is not NAN (w->part_steps: the history made that many visits). */
+static void record(const ulam__walker *w, ulam__block *out, double score, double part, int64_t id)
 {
     if (isfinite(score)) {
+        double c = clip(isnan(part) ? score : part, w->clip);
         ulam__moments_add(&out->m, score);
-        ulam__moments_add(&out->clipped, clip(score, w->clip));
-        if (w->clip > 0) ulam__moments_add(&out->sub[sub_of(id)], clip(score, w->clip));
+        ulam__moments_add(&out->clipped, c);
+        if (w->clip > 0) ulam__moments_add(&out->sub[sub_of(id)], c);
         out->maxsq = fmax(out->maxsq, score * score);
     } else {
         out->h.nonfinite++;
@@ -192,7 +197,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
     int lanes = w->lanes < 1 ? 1 : w->lanes > LANES ? LANES : w->lanes;
     int64_t cap = sc->stack_cap / lanes, started = 0;
     int act = 0;
-    const step_consts c = {w->k->mem, fac, w->max_steps, w->roulette > 0 || w->split > 0};
+    const step_consts c = {w->k->mem, fac, w->max_steps, w->part_steps, w->roulette > 0 || w->split > 0};
     for (; act < lanes && started < count; act++, started++) {
         L[act].st = (stack){sc->stack_s + act * cap, sc->stack_w + act * cap, 0, cap};
         lane_start(w, &L[act], r);
@@ -202,6 +207,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
         for (int l = 0; l < act; l++) {
             lane *x = &L[l];
             x->score += x->w * x->h->visit;
+            if (x->len + 1 == c.part_steps) x->part = x->score; /* the first part_steps visits */
             x->s = ulam__kernel_pick(x->h, r, &x->frac);
             prefetch(x->s);
         }
@@ -211,7 +217,7 @@ static WALK_INLINE void adjoint_lanes(const ulam__walker *w, int64_t count, ulam
                 l++;
                 continue;
             }
-            record(w, &acc, x->score, x->id);
+            record(w, &acc, x->score, x->part, x->id);
             if (started < count) {
                 if ((started & 63) == 0 && w->interrupt && *w->interrupt) break;
                 lane_start(w, x, r);

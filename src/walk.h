@@ -34,6 +34,8 @@ typedef struct {
     int lanes; /* adjoint histories interleaved (1 to 32) */
     double clip; /* > 0: a block also keeps the moments of its scores clipped to [-clip, clip] (the
                     confidence sequence's, src/stop.h); 0: none */
+    int64_t part_steps; /* > 0 (adjoint, no window): those clipped moments take a history's score over its
+                           first part_steps visits (steps 0 .. part_steps - 1) in place of its whole score */
     volatile const int *interrupt;
 } ulam__walker;
 
