@@ -269,7 +269,7 @@ static int find_patches(const args *a, const ulam_scene *s, const char *arg, uns
             }
             for (int64_t p = 0; !rc && p < n; p++) want[p] |= s->group[p] == (int32_t)g;
         }
-        item = comma + 1;
+        if (comma) item = comma + 1;
     }
     free(buf);
     *count = 0;
