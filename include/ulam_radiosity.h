@@ -453,7 +453,8 @@ typedef struct ulam_rad_final_info {
     int64_t unreached[8];             /* the first unreached patches (0-based; -1 past scene.unreached) */
     int met;                          /* rel_err met on share of the lit area */
     double pilot_seconds, seconds;
-    int threads, interrupted;
+    int threads, interrupted;         /* interrupted: by opts->stop.interrupt (max_seconds is a rule:
+                                         the patches it left are NaN and unreached) */
 } ulam_rad_final_info;
 
 /* Every patch's radiosity by final gathering over a shooting pilot (the method of large scenes,

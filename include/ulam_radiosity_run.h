@@ -24,6 +24,8 @@ extern "C" {
 typedef struct ulam_rad_run_opts {
     const char *scene;      /* the OBJ file */
     const char *patch;      /* --patch: a 1-based number or a label, or NULL */
+    const char *patches;    /* --patches: --mode final's (and --list's) patches, comma-separated labels,
+                               1-based numbers and ranges K-L; NULL: every patch */
     const char *image, *out; /* --image (PNG), --out (CSV): the paths reports name and pictures go to */
     const char *pfm, *hdr;   /* the PFM and Radiance .hdr beside --image (NULL: not written) */
     double subdivide, exposure;

@@ -571,6 +571,61 @@ def check_radiosity_json_path(ulam):
         assert got == scene, out
 
 
+def check_radiosity_chosen(ulam):
+    """--patches chooses the patches --mode final answers (issue 40 point 5: the work plane of a
+    hall without paying for every patch): labels, numbers and ranges K-L, comma-separated; the run
+    gathers, reports, lists and writes those only, each with its 95% half-width, and its summary
+    counts the chosen.  The furnace cube at --subdivide 0.5 (24 patches, B = 2 exactly): the floor
+    is patches 1-4.  Bad lists are refused before any work, with no output and no file."""
+    scene = SC + "cube.obj"
+    base = ["radiosity", scene, "--subdivide", "0.5", "--mode", "final", "--walks", "64", "--seed", "3"]
+    with tempfile.TemporaryDirectory() as d:
+        csv = os.path.join(d, "p.csv")
+        rc, out, err = run(ulam, base + ["--patches", "floor,9,20-21", "--all", "--json", "--out", csv])
+        assert rc == 0, err
+        o = json.loads(out)
+        got = [r["patch"] for r in o["patches"]]
+        assert got == [1, 2, 3, 4, 9, 20, 21], got
+        assert o["chosen"]["count"] == 7 and o["chosen"]["patches"] == "floor,9,20-21", o["chosen"]
+        for r in o["patches"]:  # B = 2 exactly in the furnace: every printed interval holds it
+            assert abs(r["R"] - 2.0) <= r["R_half"] and r["R_half"] > 0, r
+        with open(csv) as f:
+            rows = f.read().splitlines()
+        assert "R_half" in rows[0].split(",") and [int(x.split(",")[0]) for x in rows[1:]] == got, rows
+        rc, out, err = run(ulam, base + ["--patches", "floor", "--rel-err", "0.05", "--walks", "100000"])
+        assert rc == 0 and re.search(r"^chosen +4 of 24 patches \(--patches floor\)", out, re.M), (out, err)
+        assert re.search(r"^rel-err +met on the chosen patches: 4 of 4 lit patches", out, re.M), out
+        assert re.search(r"^half-width +95% half-width / B over the 4 lit chosen patches: median [\d.e-]+, 90% ", out,
+                         re.M), out
+        # --time is a stopping rule, not Ctrl-C: the final gather it cut said [INTERRUPTED], exit 130, no
+        # --out (the hall's floor, 60 s); now exit 0, the rows of the patches it reached, the others empty
+        rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "20", "--mode", "final", "--patches",
+                                  "floor", "--rel-err", "0.001", "--time", "0.5", "--out", csv])
+        assert rc == 0 and "INTERRUPTED" not in out and re.search(r"^rel-err +NOT met on the chosen patches", out, re.M), \
+            (rc, out, err)
+        with open(csv) as f:
+            rows = f.read().splitlines()[1:]
+        assert len(rows) == 784 and all(r.split(",")[1] == '"floor"' for r in rows), rows[:3]
+        rc, out, err = run(ulam, ["radiosity", scene, "--subdivide", "0.5", "--list", "--patches", "2-3,ceiling"])
+        assert rc == 0 and [int(x.split()[0]) for x in out.splitlines()[1:]] == [2, 3, 5, 6, 7, 8], out
+        for bad, msg in ((["--patches", "attic"], r"--patches: 'attic' is neither a patch number, a range K-L nor a "
+                                                  r"label; labels: floor ceiling left right front back"),
+                         (["--patches", "3,25"], r"--patches: 25 is out of range 1\.\.24"),
+                         (["--patches", "0-2"], r"--patches: 0 is out of range 1\.\.24"),
+                         (["--patches", "5-2"], r"--patches: the range 5-2 is empty \(K-L needs K <= L\)"),
+                         (["--patches", "1,,2"], r"--patches: an empty item in '1,,2'"),
+                         (["--patches", ""], r"--patches: an empty item in ''")):
+            rc, out, err = run(ulam, base + bad + ["--out", csv + ".bad"])
+            assert rc == 2 and re.search(msg, err) and out == "" and not os.path.exists(csv + ".bad"), (bad, rc, out, err)
+    for extra, msg in ((["--mode", "shoot", "--walks", "100"], r"--patches chooses the patches of --mode final"),
+                       (["--patch", "1", "--walks", "100"], r"--patches chooses the patches of --mode final"),
+                       (["--mode", "final", "--patch", "1"], r"--patches and --patch: one or the other"),
+                       (["--mode", "final", "--image", "x.png"], r"--patches: not with --image"),
+                       (["--mode", "final", "--out", "x.csv", "--mesh-error", "10"], r"--patches: not with --image")):
+        rc, out, err = run(ulam, ["radiosity", scene, "--patches", "floor"] + extra)
+        assert rc == 2 and re.search(msg, err) and out == "", (extra, rc, out, err)
+
+
 def check_radiosity_progress(ulam):
     """radiosity shows its progress line on a terminal too."""
     rc, err = on_tty(ulam, ["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.003",
@@ -2323,7 +2378,7 @@ def main():
              (check_honest_verdicts, ulam), (check_study_question, ulam),
              (check_radiosity_next_event, ulam), (check_radiosity_rare_lamp, ulam), (check_radiosity_emission_scale, ulam),
              (check_bidir, ulam), (check_queries, ulam), (check_auto, ulam), (check_auto_bidir, (ulam, genmat)), (check_method_table, ulam), (check_progress, ulam),
-             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam),
+             (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam), (check_radiosity_chosen, ulam),
              (check_radiosity_zero_notes, ulam), (check_radiosity_check_side, ulam),
              (check_default_output, ulam), (check_info_bounded, ulam), (check_walks_prediction, ulam),
              (check_sparse_check, ulam), (check_json_schemas, ulam),

@@ -12,7 +12,7 @@
 #include <sys/stat.h>
 
 static const char *const usage =
-    "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot|final]\n"
+    "usage: ulam radiosity SCENE.obj [--patch K|LABEL] [--mode gather|shoot|final] [--patches LIST]\n"
     "                      [--estimator collision|absorption|next-event] [--mis power|balance|none]\n"
     "                      [--walks N] [--rel-err E] [--time S]\n"
     "                      [--seed S] [--threads T] [--max-steps K] [--subdivide L] [--ff-rays K]\n"
@@ -93,7 +93,11 @@ static const char *const usage_mesh =
     "                    --max-mem allows)\n"
     "  --share X         --mode shoot --rel-err E without --patch runs until every lit patch meets E\n"
     "                    (a particle reached it), or with X the lit patches holding X of the lit\n"
-    "                    area (0.5: the median by area), and names the patches none reached\n";
+    "                    area (0.5: the median by area), and names the patches none reached\n"
+    "  --patches LIST    --mode final (and --list) on these patches only: comma-separated o/g\n"
+    "                    labels (all of the label's patches), numbers K and ranges K-L as --list\n"
+    "                    numbers them (e.g. floor or 1-100,200); --rel-err, --share, the summary,\n"
+    "                    --all and --out count and show the chosen only\n";
 
 /* The usage's second half (a literal each stays within C99's 4095 characters). */
 static const char *const usage_points =
@@ -224,6 +228,7 @@ static int parse(int argc, char **argv, args *a, cli_photo *ph)
         {"max-patches", required_argument, 0, 'K'}, {"share", required_argument, 0, 'Y'},
         {"luminaire", required_argument, 0, 'Q'}, {"unit", required_argument, 0, 'Q'},
         {"maintenance", required_argument, 0, 'Q'}, {"en12464", required_argument, 0, 'Q'},
+        {"patches", required_argument, 0, 'U'},
         {0, 0, 0, 0}};
     const char *cmd = "radiosity";
     int c, rc, idx;
@@ -233,6 +238,7 @@ static int parse(int argc, char **argv, args *a, cli_photo *ph)
         switch (c) {
         case CLI_WALK: if ((rc = cli_walk_option(cmd, longopts[idx].name, optarg, &a->o))) return rc; break;
         case 'p': a->patch = optarg; break;
+        case 'U': a->patches = optarg; break; /* resolved on the scene (ulam_rad_run_alloc) */
         case 'Y': if ((rc = cli_parse_real(cmd, "--share", optarg, 1e-9, 1.0, &a->share))) return rc; break;
         case 'm':
             if ((a->o.mode = ulam_rad_mode_find(optarg)) < 0) /* the library's table of modes */

@@ -499,7 +499,7 @@ int ulam_rad_final_some(const ulam_tracer *t, const ulam_rad_opts *opts, int64_t
         if (nomem) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the gather");
         if (upto == cap) break;
     }
-    in.interrupted |= stop;
+    in.interrupted |= stop && opts->stop.interrupt && *opts->stop.interrupt; /* Ctrl-C; max_seconds is a rule */
     for (int64_t p = 0; p < n && !status; p++) {
         const final_acc *a = &acc[p];
         in.samples += a->k, in.rays += a->rays;

@@ -212,6 +212,75 @@ static int find_patch(const args *a, const ulam_scene *s, const char *arg, int64
     return ULAM_RAD_RUN_USAGE;
 }
 
+/* A 1-based patch number of --patches' item at *str (its digits, then end or '-' or ','), into
+ * *k; 0 when the digits are not that. */
+static int patch_number(const char *str, const char **end, long long *k)
+{
+    char *e;
+    if (*str < '0' || *str > '9') return 0;
+    *k = strtoll(str, &e, 10);
+    *end = e;
+    return *e == '\0' || *e == '-' || *e == ',';
+}
+
+/* Mark want[p] for every patch --patches names (arg: comma-separated labels, numbers K and
+ * ranges K-L, 1-based, as --list shows them) and count them; ULAM_OK, ULAM_ENOMEM or
+ * ULAM_RAD_RUN_USAGE (written: an empty item, a number out of range, an empty range, an unknown
+ * label, or a list that chooses no patch). */
+static int find_patches(const args *a, const ulam_scene *s, const char *arg, unsigned char *want, int64_t *count)
+{
+    int64_t n = s->npatches;
+    char *buf = malloc(strlen(arg) + 1);
+    if (!buf) return ULAM_ENOMEM;
+    strcpy(buf, arg);
+    memset(want, 0, (size_t)n);
+    int rc = ULAM_OK;
+    char *item = buf;
+    for (int last = 0; !rc && !last;) {
+        char *comma = strchr(item, ',');
+        last = !comma;
+        if (comma) *comma = '\0';
+        const char *end;
+        long long lo = 0, hi = 0;
+        if (!*item) {
+            ulam__run_log(a, "ulam radiosity: --patches: an empty item in '%s' (labels, numbers K and ranges K-L, "
+                             "comma-separated)\n", arg);
+            rc = ULAM_RAD_RUN_USAGE;
+        } else if (patch_number(item, &end, &lo) && (!*end || (patch_number(end + 1, &end, &hi) && !*end))) {
+            if (!strchr(item, '-')) hi = lo;
+            if (lo < 1 || lo > n || hi < 1 || hi > n) {
+                ulam__run_log(a, "ulam radiosity: --patches: %lld is out of range 1..%lld (in '%s'; see --list)\n",
+                              lo < 1 || lo > n ? lo : hi, (long long)n, arg);
+                rc = ULAM_RAD_RUN_USAGE;
+            } else if (hi < lo) {
+                ulam__run_log(a, "ulam radiosity: --patches: the range %s is empty (K-L needs K <= L)\n", item);
+                rc = ULAM_RAD_RUN_USAGE;
+            }
+            for (long long k = lo; !rc && k <= hi; k++) want[k - 1] = 1;
+        } else {
+            int64_t g = 0;
+            while (g < s->ngroups && strcmp(s->groups[g], item)) g++;
+            if (g == s->ngroups) {
+                ulam__run_log(a, "ulam radiosity: --patches: '%s' is neither a patch number, a range K-L nor a label; "
+                                 "labels:", item);
+                for (int64_t k = 0; k < s->ngroups; k++) ulam__run_log(a, " %s", s->groups[k]);
+                ulam__run_log(a, "%s\n", s->ngroups ? "" : " none (the scene has no o or g lines)");
+                rc = ULAM_RAD_RUN_USAGE;
+            }
+            for (int64_t p = 0; !rc && p < n; p++) want[p] |= s->group[p] == (int32_t)g;
+        }
+        if (comma) item = comma + 1;
+    }
+    free(buf);
+    *count = 0;
+    for (int64_t p = 0; !rc && p < n; p++) *count += want[p];
+    if (!rc && !*count) {
+        ulam__run_log(a, "ulam radiosity: --patches %s chooses no patch\n", arg);
+        rc = ULAM_RAD_RUN_USAGE;
+    }
+    return rc;
+}
+
 /* Read, adapt, check, build and light (ulam_radiosity_run.h). */
 int ulam_rad_run_alloc(const ulam_rad_run_opts *opts, ulam_rad_run **out)
 {
@@ -225,10 +294,23 @@ int ulam_rad_run_alloc(const ulam_rad_run_opts *opts, ulam_rad_run **out)
                          "(use --mode shoot --matrix-walk, or drop --matrix-walk)\n");
         return ULAM_RAD_RUN_USAGE;
     }
+    if (a->patches && ((!a->final && !a->list) || a->patch || a->image || a->mesh_walks)) { /* before the scene is read */
+        ulam__run_log(a, "ulam radiosity: %s\n", a->patch && a->final ? "--patches and --patch: one or the other"
+                                                : !a->final && !a->list ? "--patches chooses the patches of --mode final (or "
+                                                                          "of --list)"
+                                                                        : "--patches: not with --image or --mesh-error "
+                                                                          "(they need every patch)");
+        return ULAM_RAD_RUN_USAGE;
+    }
     int rc = load_scene(a, &r->s, &r->r.faces);
     if (rc || (a->mesh_target > 0 && (rc = adapt_scene(a, &r->s, &r->r)))) return rc;
     r->r.adapted = a->mesh_target > 0;
     r->r.s = r->s;
+    if (a->patches) {
+        if (!(r->want = malloc((size_t)r->s->npatches))) return fail(a, a->scene, ULAM_ENOMEM, "memory for --patches");
+        if ((rc = find_patches(a, r->s, a->patches, r->want, &r->nwant)))
+            return rc == ULAM_ENOMEM ? fail(a, a->scene, rc, "memory for --patches") : rc;
+    }
     if (a->list) return r->listed = 1, ULAM_OK;
     if (a->patch && (rc = find_patch(a, r->s, a->patch, &r->r.patch))) return rc;
     char what[512], h[2][32];
@@ -269,19 +351,47 @@ static void rel_err_warning(const args *a, const ulam_rad_result *r)
                       a->scene, a->o.stop.rel_err, r->min_walks, reach);
 }
 
-/* --mode final (ulam_rad_final): every patch; ULAM_OK or a status (written). */
-static int final_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
+/* Ascending doubles (qsort). */
+static int cmp_double(const void *x, const void *y)
+{
+    double u = *(const double *)x, v = *(const double *)y;
+    return (u > v) - (u < v);
+}
+
+/* The median and 90% quantile of half-width / B (each patch's worst channel with B > 0) over the
+ * lit patches want chooses (NULL: all) into w->half_rel (NaN when none is lit). */
+static int final_quantiles(const ulam_scene *s, const unsigned char *want, walked *w)
+{
+    double *rel = malloc((size_t)s->npatches * sizeof *rel);
+    int64_t m = 0;
+    if (!rel) return ULAM_ENOMEM;
+    for (int64_t p = 0; p < s->npatches; p++) {
+        double worst = -1.0;
+        for (int c = 0; c < 3 && (!want || want[p]); c++)
+            if (w->all[3 * p + c] > 0) worst = fmax(worst, w->half[3 * p + c] / w->all[3 * p + c]);
+        if (worst >= 0) rel[m++] = worst;
+    }
+    qsort(rel, (size_t)m, sizeof *rel, cmp_double);
+    for (int k = 0; k < 2; k++) w->half_rel[k] = m ? rel[(int64_t)ceil((k ? 0.9 : 0.5) * (double)m) - 1] : NAN;
+    free(rel);
+    return ULAM_OK;
+}
+
+/* --mode final (ulam_rad_final_some): every patch, or those --patches chose; ULAM_OK or a status
+ * (written). */
+static int final_walks(const args *a, const ulam_tracer *t, const unsigned char *want, int64_t np, walked *w)
 {
     ulam_error err;
     ulam_rad_opts ro = ulam__run_rad_opts(&a->o);
     ulam_rad_final_info in;
-    double *half = malloc((size_t)np * 3 * sizeof *half);
+    double *half = w->half = malloc((size_t)np * 3 * sizeof *half);
     w->all = malloc((size_t)np * 3 * sizeof *w->all), w->all_se = malloc((size_t)np * 3 * sizeof *w->all_se);
-    if (!half || !w->all || !w->all_se) return free(half), fail(a, a->scene, ULAM_ENOMEM, "memory for every patch");
+    if (!half || !w->all || !w->all_se) return fail(a, a->scene, ULAM_ENOMEM, "memory for every patch");
     interrupt_on(a, 1);
-    int status = ulam_rad_final(t, &ro, 0, a->share > 0 ? a->share : 1.0, w->all, w->all_se, half, &in, &err);
+    int status = ulam_rad_final_some(t, &ro, 0, a->share > 0 ? a->share : 1.0, want, w->all, w->all_se, half, &in, &err);
     interrupt_on(a, 0);
-    if (status) return free(half), ulam__run_error(a, a->scene, &err);
+    if (status) return ulam__run_error(a, a->scene, &err);
+    if (final_quantiles(ulam__tracer_scene(t), want, w)) return fail(a, a->scene, ULAM_ENOMEM, "memory for the summary");
     int64_t p = a->o.query.index;
     for (int c = 0; c < 3; c++)
         w->B[c] = w->all[3 * p + c], w->se[c] = w->se_walk[c] = w->all_se[3 * p + c],
@@ -290,14 +400,13 @@ static int final_walks(const args *a, const ulam_tracer *t, int64_t np, walked *
     w->interrupted = in.interrupted, w->rel_err_met = in.met, w->scene = in.scene;
     w->whole = a->o.stop.rel_err > 0 && !a->patch;
     memcpy(w->unreached, in.unreached, sizeof w->unreached);
-    free(half);
     return ULAM_OK;
 }
 
 /* Ray walks (gathering, shooting or --mode final); ULAM_OK or a status (written). */
-static int ray_walks(const args *a, const ulam_tracer *t, int64_t np, walked *w)
+static int ray_walks(const args *a, const ulam_tracer *t, const unsigned char *want, int64_t np, walked *w)
 {
-    if (a->final) return final_walks(a, t, np, w);
+    if (a->final) return final_walks(a, t, want, np, w);
     ulam_rad_solver *sv = NULL;
     ulam_error err;
     ulam_rad_opts ro = ulam__run_rad_opts(&a->o);
@@ -556,7 +665,7 @@ int ulam_rad_run_solve(ulam_rad_run *run, int *interrupted)
     } else if (a->patch || a->o.mode == ULAM_FORWARD) {
         rc = a->matrix_walk ? matrix_walks(a, run->s, run->F, r->ff_se_known ? r->direct_se : NULL,
                                            run->Bd && r->patch >= 0 ? run->Bd + 3 * r->patch : NULL, w)
-                            : ray_walks(a, run->t, run->s->npatches, w);
+                            : ray_walks(a, run->t, run->want, run->s->npatches, w);
         if (rc) return rc;
         int mesh = a->patch && a->o.mode == ULAM_ADJOINT && !w->interrupted && !a->no_mesh;
         r->mesh_no_time = budget > 0 && mesh && !(budget - (ulam_now() - a->started) > 0);
@@ -566,8 +675,10 @@ int ulam_rad_run_solve(ulam_rad_run *run, int *interrupted)
         if (r->patch >= 0 && !w->interrupted && ulam__run_zero(w->B, w->se))
             r->diag_known = ulam_rad_scene_diagnose(run->t, ULAM__RAD_DIAG_RAYS, a->o.exec.seed, &r->diag) == ULAM_OK;
     }
-    if (w->all) r->pv = (patch_values){w->all, w->all_se, (a->direct || a->check) ? run->Bd : NULL, r->direct_se_all, NULL};
-    else r->pv = (patch_values){run->Bd, r->direct_se_all, NULL, NULL, NULL};
+    if (w->all)
+        r->pv = (patch_values){w->all, w->all_se, (a->direct || a->check) ? run->Bd : NULL, r->direct_se_all, NULL, w->half,
+                               run->want};
+    else r->pv = (patch_values){run->Bd, r->direct_se_all, NULL, NULL, NULL, NULL, NULL};
     if (a->mesh_walks && r->pv.B && !w->interrupted && (rc = every_mesh_error(run))) return rc;
     *interrupted = w->interrupted;
     return ULAM_OK;
@@ -577,7 +688,7 @@ int ulam_rad_run_solve(ulam_rad_run *run, int *interrupted)
 void ulam_rad_run_free(ulam_rad_run *r)
 {
     if (!r) return;
-    free(r->w.all), free(r->w.all_se), free(r->Bd), free(r->r.direct_se_all), free(r->mesh_all);
+    free(r->w.all), free(r->w.all_se), free(r->w.half), free(r->want), free(r->Bd), free(r->r.direct_se_all), free(r->mesh_all);
     free(r->L), free(r->Lse), free(r->q.pts);
     ulam_csr_free(r->F);
     ulam_tracer_free(r->t);

@@ -18,17 +18,35 @@ static const char *const answer_key = "radiosity";
 static void print_scene_rule(FILE *f, const args *a, const walked *w)
 {
     const ulam_rad_scene_rule *q = &w->scene;
-    fprintf(f, "rel-err      %s on the whole scene: %lld of %lld lit patches (%.4g of the lit area; the rule: %.4g) within "
+    fprintf(f, "rel-err      %s on the %s: %lld of %lld lit patches (%.4g of the lit area; the rule: %.4g) within "
            "%g;\n             the largest relative standard error %.3g, 95%% half-width %.3g (patch %lld)\n",
-           w->rel_err_met ? "met" : "NOT met", (long long)q->met, (long long)q->lit,
+           w->rel_err_met ? "met" : "NOT met", a->patches ? "chosen patches" : "whole scene", (long long)q->met, (long long)q->lit,
            q->lit_area > 0 ? q->met_area / q->lit_area : 0.0, q->share, a->o.stop.rel_err, q->worst_se, q->worst_half,
            (long long)q->worst_patch + 1);
-    if (q->unreached) {
+    if (q->unreached && !a->final) { /* the final gather's: print_final */
         fprintf(f, "unreached    %lld patches no particle reached in %lld walks (each gets under 3/%lld of the particles, "
                "95%%):", (long long)q->unreached, (long long)w->walks, (long long)w->walks);
         for (int64_t k = 0; k < q->unreached && k < 8; k++) fprintf(f, " %lld", (long long)w->unreached[k] + 1);
         fprintf(f, "%s\n", q->unreached > 8 ? " ..." : "");
     }
+}
+
+/* --mode final's summary over the patches it answered (every patch, or --patches'): half-width /
+ * B's median and 90% quantile, the worst, and the patches no sample lit. */
+static void print_final(FILE *f, const ulam_rad_run *run)
+{
+    const walked *w = &run->w;
+    const ulam_rad_scene_rule *q = &w->scene;
+    const char *which = run->want ? " chosen" : "";
+    if (q->lit)
+        fprintf(f, "half-width   95%% half-width / B over the %lld lit%s patches: median %.3g, 90%% %.3g, largest %.3g "
+                   "(patch %lld)\n", (long long)q->lit, which, w->half_rel[0], w->half_rel[1], q->worst_half,
+                (long long)q->worst_patch + 1);
+    if (!q->unreached) return;
+    fprintf(f, "unreached    %lld%s patches that reflect got no light from the gather (none reaches them, or the stop "
+               "came first):", (long long)q->unreached, which);
+    for (int64_t k = 0; k < q->unreached && k < 8; k++) fprintf(f, " %lld", (long long)w->unreached[k] + 1);
+    fprintf(f, "%s\n", q->unreached > 8 ? " ..." : "");
 }
 
 /* Print a JSON array of three numbers under key. */
@@ -52,6 +70,7 @@ static void row_header(FILE *f, int fmt, const patch_values *v)
     for (int k = 0; v && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",%s" : " %12s", val[k]);
     for (int k = 0; v && v->Bd && k < 6; k++) fprintf(f, fmt == ROW_CSV ? ",direct_%s" : " direct_%-5s", val[k]);
     for (int k = 0; v && v->mesh && k < 3; k++) fprintf(f, fmt == ROW_CSV ? ",%s_mesh" : " %7s_mesh", val[k]);
+    for (int k = 0; v && v->half && k < 3; k++) fprintf(f, fmt == ROW_CSV ? ",%s_half" : " %7s_half", val[k]);
     fputc('\n', f);
 }
 
@@ -61,9 +80,9 @@ static void row(FILE *f, int fmt, const ulam_scene *s, int64_t p, const patch_va
 {
     static const char *const keys[] = {"x", "y", "z", "area", "R", "G", "B", "R_se", "G_se", "B_se",
                                        "direct_R", "direct_G", "direct_B", "direct_R_se", "direct_G_se", "direct_B_se",
-                                       "R_mesh", "G_mesh", "B_mesh"};
-    double x[19];
-    const char *key[19];
+                                       "R_mesh", "G_mesh", "B_mesh", "R_half", "G_half", "B_half"};
+    double x[22];
+    const char *key[22];
     int n = 4;
     ulam_scene_centroid(s, p, x);
     x[3] = s->area[p];
@@ -72,6 +91,7 @@ static void row(FILE *f, int fmt, const ulam_scene *s, int64_t p, const patch_va
     for (int k = 0; v && k < (v->Bd ? 4 : 2); k++)
         for (int c = 0; c < 3; c++) key[n] = keys[n], x[n++] = cols[k] ? cols[k][3 * p + c] : NAN;
     for (int c = 0; v && v->mesh && c < 3; c++) key[n] = keys[16 + c], x[n++] = v->mesh[3 * p + c];
+    for (int c = 0; v && v->half && c < 3; c++) key[n] = keys[19 + c], x[n++] = v->half[3 * p + c];
     int32_t g = s->group[p];
     const char *label = g >= 0 ? s->groups[g] : "";
     if (fmt == ROW_JSON) {
@@ -98,8 +118,9 @@ static void row(FILE *f, int fmt, const ulam_scene *s, int64_t p, const patch_va
 }
 
 /* --list: the patches after subdivision, as a table or a JSON array. */
-static void print_list(FILE *f, const args *a, const ulam_scene *s)
+static void print_list(FILE *f, const args *a, const ulam_scene *s, const unsigned char *want)
 {
+    int first = 1;
     if (a->json) {
         fprintf(f, "{");
         ulam_json_string(f, "scene", a->scene, 0);
@@ -107,8 +128,9 @@ static void print_list(FILE *f, const args *a, const ulam_scene *s)
     }
     else row_header(f, ROW_TEXT, NULL);
     for (int64_t p = 0; p < s->npatches; p++) {
-        if (a->json && p) fprintf(f, ", ");
-        row(f, a->json ? ROW_JSON : ROW_TEXT, s, p, NULL);
+        if (want && !want[p]) continue;
+        if (a->json && !first) fprintf(f, ", ");
+        row(f, a->json ? ROW_JSON : ROW_TEXT, s, p, NULL), first = 0;
     }
     if (a->json) fprintf(f, "]}\n");
 }
@@ -237,6 +259,9 @@ static void print_text(FILE *f, const ulam_rad_run *run)
     const args *a = run->a;
     const report *r = &run->r;
     fprintf(f, "scene        %s: %lld faces, %lld patches\n", a->scene, (long long)r->faces, (long long)r->s->npatches);
+    if (run->want)
+        fprintf(f, "chosen       %lld of %lld patches (--patches %s)\n", (long long)run->nwant, (long long)r->s->npatches,
+                a->patches);
     if (r->adapted) print_adapt(f, a, r);
     if (r->F)
         fprintf(f, "form factors %lld rays a patch, %.3f s: reciprocity error %.3g, row sums %.4f .. %.4f "
@@ -286,6 +311,7 @@ static void print_text(FILE *f, const ulam_rad_run *run)
                a->matrix_walk ? "steps" : "rays", w->seconds, w->seconds > 0 ? (double)w->steps / w->seconds / 1e6 : 0.0,
                a->matrix_walk ? "steps" : "rays", w->threads, w->interrupted ? "  [INTERRUPTED]" : "");
     if (w && w->whole) print_scene_rule(f, a, w);
+    if (w && a->final) print_final(f, run);
     for (int c = 0; w && a->matrix_walk && c < 3; c++)
         if (w->ff_limited[c])
             fprintf(f, "rel-err      NOT met in %c: the form factors' error alone is %.3g, past --rel-err %g of the "
@@ -313,12 +339,13 @@ static void print_text(FILE *f, const ulam_rad_run *run)
     for (int c = 0; r->Bdirect && r->patch >= 0 && w && c < 3; c++)
         if (fabs(zscore(a, r, c)) > 3.0) check_side(f, a, r, c);
     if (a->out && r->out_written)
-        fprintf(f, "patches      %lld rows written to %s%s\n", (long long)r->s->npatches, a->out,
+        fprintf(f, "patches      %lld rows written to %s%s\n", (long long)(run->want ? run->nwant : r->s->npatches), a->out,
                r->pv.se == r->w_all_se_conditional ? " (standard errors: walk noise only, CONDITIONAL on the sampled F)" : "");
     else if (a->out && w && w->interrupted) fprintf(f, "patches      not written: the run was interrupted\n");
     if (a->all) {
         row_header(f, ROW_TEXT, &r->pv);
-        for (int64_t p = 0; p < r->s->npatches; p++) row(f, ROW_TEXT, r->s, p, &r->pv);
+        for (int64_t p = 0; p < r->s->npatches; p++)
+            if (!run->want || run->want[p]) row(f, ROW_TEXT, r->s, p, &r->pv);
     }
     if (a->image && r->image_written) fprintf(f, "image        %s (exposure %.4g)\n", a->image, r->exposure);
     else if (a->image && w && w->interrupted) fprintf(f, "image        not written: the run was interrupted\n");
@@ -332,6 +359,11 @@ static void print_json(FILE *f, const ulam_rad_run *run)
     fprintf(f, "{");
     ulam_json_string(f, "scene", a->scene, 0); /* a path may hold quotes and backslashes */
     fprintf(f, "\"npatches\": %lld, ", (long long)r->s->npatches);
+    if (run->want) {
+        fprintf(f, "\"chosen\": {");
+        ulam_json_string(f, "patches", a->patches, 0);
+        fprintf(f, "\"count\": %lld}, ", (long long)run->nwant);
+    }
     if (r->adapted) {
         char e[2][32]; /* null: --time ran out before the first mesh was measured whole */
         for (int k = 0; k < 2; k++)
@@ -398,6 +430,16 @@ static void print_json(FILE *f, const ulam_rad_run *run)
                    (long long)w->scene.unreached, w->scene.share,
                    w->scene.lit_area > 0 ? w->scene.met_area / w->scene.lit_area : 0.0,
                    (long long)w->scene.worst_patch + 1, w->scene.worst_half, w->scene.worst_se);
+        if (a->final) { /* over the patches it answered (print_final) */
+            fprintf(f, "\"final\": {\"lit\": %lld, \"unreached\": %lld, ", (long long)w->scene.lit,
+                    (long long)w->scene.unreached);
+            ulam_json_number(f, "half_rel_median", w->half_rel[0], 0);
+            ulam_json_number(f, "half_rel_q90", w->half_rel[1], 0);
+            ulam_json_number(f, "half_rel_max", w->scene.lit ? w->scene.worst_half : NAN, 0);
+            fprintf(f, "\"unreached_patches\": [");
+            for (int64_t k = 0; k < w->scene.unreached && k < 8; k++) fprintf(f, "%s%lld", k ? ", " : "", (long long)w->unreached[k] + 1);
+            fprintf(f, "]}, ");
+        }
         if (a->o.stop.rel_err > 0 && !a->matrix_walk && a->o.mode == ULAM_ADJOINT) {
             fprintf(f, "\"rel_err_met\": %s, ", w->rel_err_met ? "true" : "false");
             ulam_json_number(f, "min_walks", w->min_walks, 0);
@@ -438,9 +480,10 @@ static void print_json(FILE *f, const ulam_rad_run *run)
     }
     if (a->all) {
         fprintf(f, "\"stderr_conditional_on_F\": %s, \"patches\": [", r->pv.se == r->w_all_se_conditional ? "true" : "false");
-        for (int64_t p = 0; p < r->s->npatches; p++) {
-            if (p) fprintf(f, ", ");
-            row(f, ROW_JSON, r->s, p, &r->pv);
+        for (int64_t p = 0, first = 1; p < r->s->npatches; p++) {
+            if (run->want && !run->want[p]) continue;
+            if (!first) fprintf(f, ", ");
+            row(f, ROW_JSON, r->s, p, &r->pv), first = 0;
         }
         fprintf(f, "], ");
     }
@@ -585,7 +628,7 @@ static void print_points(FILE *f, const ulam_rad_run *run)
 /* The report (ulam_radiosity_run.h). */
 void ulam_rad_run_print(const ulam_rad_run *r, FILE *f)
 {
-    if (r->listed) print_list(f, r->a, r->s);
+    if (r->listed) print_list(f, r->a, r->s, r->want);
     else if (r->pointed) print_points(f, r);
     else if (r->a->json) print_json(f, r);
     else print_text(f, r);
@@ -598,7 +641,8 @@ void ulam__run_write_csv(ulam_rad_run *run, FILE *f)
 {
     if (!run->pointed) {
         row_header(f, ROW_CSV, &run->r.pv);
-        for (int64_t p = 0; p < run->s->npatches; p++) row(f, ROW_CSV, run->s, p, &run->r.pv);
+        for (int64_t p = 0; p < run->s->npatches; p++)
+            if (!run->want || run->want[p]) row(f, ROW_CSV, run->s, p, &run->r.pv);
         run->r.out_written = 1;
         return;
     }

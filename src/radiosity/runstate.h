@@ -25,6 +25,9 @@ typedef struct {
     int whole;                 /* shooting --rel-err without --patch: the whole scene's rule */
     ulam_rad_scene_rule scene; /* its state at the end */
     int64_t unreached[8];      /* the first patches no particle reached */
+    double *half;              /* --mode final: every patch's 95% half-width (3 each) */
+    double half_rel[2];        /* --mode final: half-width / B (worst channel), median and 90% over the
+                                  lit chosen patches (NaN: none lit) */
 } walked;
 
 /* Every patch's values for --out and --all (NULL arrays: not known): the answer (the walks' if
@@ -33,6 +36,8 @@ typedef struct {
 typedef struct {
     const double *B, *se, *Bd, *sed;
     const double *mesh; /* --mesh-error: every patch's mesh error (3 each), or NULL */
+    const double *half; /* --mode final: every patch's 95% half-width (3 each), or NULL */
+    const unsigned char *want; /* --patches: the rows to write (NULL: every patch) */
 } patch_values;
 
 /* What the run found, as text or JSON. */
@@ -97,6 +102,8 @@ struct ulam_rad_run {
     points q;
     photo ph;
     int listed, pointed; /* --list: the mesh only; --at or --grid: points */
+    unsigned char *want; /* --patches: a flag a patch (NULL: every patch) */
+    int64_t nwant;       /* the patches chosen */
 };
 
 /* The rays scene_diagnosis casts from the fronts (and as many from the backs). */
