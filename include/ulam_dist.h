@@ -220,7 +220,8 @@ typedef struct ulam_dist_ask {
     int bound;            /* forward: also x's certified range from its residual (ulam_dist_bound) */
     double tol;           /* MCSA: the residual's target, of max |b| */
     int max_iter;         /* MCSA: its most iterations */
-    int64_t source, top;  /* single source: its 0-based row; the top components gathered to rank 0 */
+    int64_t source, top;  /* single source: its 0-based row; the top components gathered to rank 0
+                             (single source, and forward when ans->tops is given) */
     ulam_dist_opts o;
 } ulam_dist_ask;
 
@@ -237,7 +238,8 @@ typedef struct ulam_dist_answer {
                                   ranks of set 0 hold them (a rank of another set: its rows, or 0 rows) */
     ulam_dist_result *res;     /* adjoint: nq of them */
     ulam_dist_ci *ci;          /* adjoint: nq of them; forward with an index: one */
-    ulam_dist_top *tops;       /* single source: top of them; rank 0 gets the ntop largest of all */
+    ulam_dist_top *tops;       /* single source, forward (NULL: no table): top of them; rank 0 gets the
+                                  ntop largest of all (forward: lo, hi infinite without ask->bound) */
     int64_t *ranks;            /* 2 nranks: every rank's rows, then its peak resident memory (KiB) */
     int64_t n, ntop;           /* the system's order; the top table's rows (rank 0) */
     ulam_dist_result r;        /* the whole run's walks, steps, crossings, bytes, rounds and cuts
@@ -252,14 +254,15 @@ typedef struct ulam_dist_answer {
  * the mode's walks (ulam_dist_adjoint_ci, _forward, _mcsa or _source; MCSA, single source and
  * forward with ask->bound also ulam_dist_bound around x, single source's b being e_source), and
  * each rank's rows and peak memory.  ans's arrays: adjoint res and ci (nq each); forward, MCSA and
- * single source x (this rank's rows), forward and single source se, single source tops (ask->top);
+ * single source x (this rank's rows), forward and single source se, single source tops (ask->top;
+ * forward: optional, the table of the ask->top largest);
  * ranks (2 nranks) always.  An MCSA run that stops at max_iter above tol is not an error here
  * (ans->residual says so).  The same answer at any rank count and any number of sets. */
 int ulam_dist_run(const ulam_part *p, const ulam_comm *comm, const ulam_dist_ask *ask, ulam_dist_answer *ans,
                   ulam_error *err);
 
 /* Write ulam_dist_run's answer to f as `ulam solve --partition` prints it (rank 0): the answer
- * lines (each query's with its file line lines[k] and seed; single source's top table; MCSA's and
+ * lines (each query's with its file line lines[k] and seed; single source's or forward's top table; MCSA's and
  * the push's lines; the bound), then the summary (rel-err, method, variance, walks, migration,
  * seconds; verbosity 1: each rank's rows and peak memory; -1: the answers alone).  queries: the
  * query file's name (NULL: one --index), out: where x was written (NULL: nowhere).  The run's

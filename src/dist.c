@@ -222,11 +222,11 @@ typedef struct {
 
 /* Query k's bound on E X^2 of one score when the weights grow (cert.second): each step's
  * E (w_t b_s)^2 <= bmax^2 c u^t, so by Minkowski sqrt(E X^2) <= bmax sqrt(c) / (1 - sqrt u),
- * rounded up. */
+ * rounded up; or the bound aimed at the query's start (cert.v2, adjoint), the smaller. */
 static double second_moment(const seq *S, int64_t k)
 {
-    double r = 1.0 - sqrt(S->cert.u);
-    return S->cert.bmax * S->cert.bmax * S->cert.c[k] / (r * r) * (1.0 + 1e-9);
+    double r = 1.0 - sqrt(S->cert.u), v2 = S->cert.bmax * S->cert.bmax * S->cert.c[k] / (r * r) * (1.0 + 1e-9);
+    return S->cert.v2 ? fmin(v2, S->cert.v2[k]) : v2;
 }
 
 /* The clip of the next block of query k (mk: its n, mean and M2 so far): *A the limit of |score|,
@@ -438,7 +438,7 @@ static int adjoint(const ulam_part *p, const ulam_comm *comm, const int64_t *ind
         if (ci) memcpy(ci + 5 * k, m + 4 * nq + 5 * k, 5 * sizeof *ci);
     }
     free(m);
-    if (S) free(S->cert.c), free(S->cs), free(S->done);
+    if (S) free(S->cert.c), free(S->cert.v2), free(S->cs), free(S->done);
     finish(&R);
     return status;
 }
@@ -659,6 +659,6 @@ int ulam__dist_forward_ci(const ulam_part *p, const ulam_comm *comm, const ulam_
         res->estimate = m[0], res->std_error = m[1];
         *ci = (ulam_dist_ci){m[2], m[3], m[4], m[5], m[6] > 0};
     }
-    free(S0.cert.c), free(S0.cs), free(S0.done);
+    free(S0.cert.c), free(S0.cert.v2), free(S0.cs), free(S0.done);
     return status;
 }

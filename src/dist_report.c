@@ -23,8 +23,8 @@ static void estimate_fprint(FILE *f, int64_t i, double est, double se, double rh
     else fprintf(f, " +- %.3g (standard error; no certified interval for forward walks on a partition)", se);
 }
 
-/* The answer lines above the summary: each query's, single source's table, MCSA's, the push's
- * and the bound. */
+/* The answer lines above the summary: each query's, single source's (or forward mode's) top table,
+ * MCSA's, the push's and the bound. */
 static void answers_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answer *s, const char *queries,
                            const long *lines, const char *out, int verbosity)
 {
@@ -34,7 +34,7 @@ static void answers_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answ
         if (s->ci[k].met) fprintf(f, "  %lld walks,", (long long)s->res[k].walks);
         fprintf(f, "  line %ld, seed %llu\n", lines[k], (unsigned long long)own);
     }
-    for (int64_t j = 0; a->mode == ULAM_DIST_SOURCE && j < s->ntop; j++) {
+    for (int64_t j = 0; (a->mode == ULAM_DIST_SOURCE || a->mode == ULAM_DIST_FORWARD) && j < s->ntop; j++) {
         const ulam_dist_top *t = &s->tops[j];
         ulam_dist_ci ci = {t->lo, t->hi, INFINITY, 0.0, 0};
         estimate_fprint(f, t->i + 1, t->x, t->se, s->rho, isfinite(ci.lo) ? &ci : NULL), fputc('\n', f);

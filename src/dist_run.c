@@ -1,6 +1,6 @@
 /* One partitioned run as `ulam solve --partition` asks it (ulam_dist_run in ulam_dist.h): the
  * variance guard, the mode's walks, the certified range around x, single source's top table
- * gathered to rank 0 and each rank's rows and peak memory.  src/dist_report.c writes it. */
+ * (and forward mode's, when asked) gathered to rank 0 and each rank's rows and peak memory.  src/dist_report.c writes it. */
 #include "part.h"
 
 #include <math.h>
@@ -87,7 +87,9 @@ static int walks(const ulam_part *p, const ulam_comm *c, const ulam_dist_ask *a,
     ans->residual = a->mode == ULAM_DIST_MCSA ? mi.residual : si.residual;
     if (!status && (a->mode != ULAM_DIST_FORWARD || a->bound))
         status = bound(p, c, a->mode == ULAM_DIST_SOURCE ? a->source : -1, ans->x, lo, hi, &ans->worst, err);
-    if (!status && a->mode == ULAM_DIST_SOURCE &&
+    else for (int64_t i = 0; i < rows; i++) lo[i] = -INFINITY, hi[i] = INFINITY; /* forward: no range */
+    int top = a->mode == ULAM_DIST_SOURCE || (a->mode == ULAM_DIST_FORWARD && ans->tops); /* forward: tops asks */
+    if (!status && top &&
         gather_top(c, ans->x, ans->se, lo, hi, p->first, in_set0 ? rows : 0, a->top, ans->tops, &ans->ntop))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange between ranks that succeeds");
     return status;
@@ -102,7 +104,7 @@ int ulam_dist_run(const ulam_part *p, const ulam_comm *comm, const ulam_dist_ask
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, an ask of a known mode and an answer with ranks");
     int forward = ask->mode != ULAM_DIST_ADJOINT;
     if (forward ? !ans->x || (ask->mode != ULAM_DIST_MCSA && !ans->se) || (ask->mode == ULAM_DIST_SOURCE && !ans->tops) ||
-                      (ask->mode == ULAM_DIST_FORWARD && ask->index && !ans->ci)
+                      (ask->mode == ULAM_DIST_FORWARD && ask->index && !ans->ci) || (ans->tops && ask->top < 1)
                 : !ans->res || !ans->ci)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "the answer's arrays the mode fills");
     ans->n = p->n, ans->ntop = 0, ans->r = (ulam_dist_result){0};

@@ -252,19 +252,27 @@ int ulam__part_owner(const ulam_part *p, int64_t s)
     return lo;
 }
 
-/* The largest of every rank's nonnegative x (as bits, which order as the values do). */
-int ulam__dist_largest(const ulam_comm *c, double *x)
+/* The largest of every rank's nonnegative x[0 .. n), entry by entry (each rank's bits in its own
+ * slot of one sum, so exact). */
+int ulam__dist_largest_n(const ulam_comm *c, double *x, int n)
 {
     if (c->nranks == 1) return 0;
-    int64_t *v = calloc((size_t)c->nranks, sizeof *v);
+    int64_t *v = calloc((size_t)c->nranks * (size_t)n, sizeof *v);
     if (!v) return 1;
-    memcpy(&v[c->rank], x, 8);
-    int bad = c->sum(c->ctx, v, c->nranks);
-    for (int r = 0; !bad && r < c->nranks; r++) {
-        double y;
-        memcpy(&y, &v[r], 8);
-        if (y > *x) *x = y;
-    }
+    memcpy(&v[(size_t)c->rank * (size_t)n], x, (size_t)n * sizeof *x);
+    int bad = c->sum(c->ctx, v, c->nranks * n);
+    for (int r = 0; !bad && r < c->nranks; r++)
+        for (int k = 0; k < n; k++) {
+            double y;
+            memcpy(&y, &v[(size_t)r * (size_t)n + (size_t)k], 8);
+            if (y > x[k]) x[k] = y;
+        }
     free(v);
     return bad;
+}
+
+/* The largest of every rank's nonnegative x. */
+int ulam__dist_largest(const ulam_comm *c, double *x)
+{
+    return ulam__dist_largest_n(c, x, 1);
 }

@@ -37,6 +37,9 @@ int ulam__part_owner(const ulam_part *p, int64_t s);
 /* The largest of every rank's nonnegative *x, into *x on every rank; nonzero on a failed sum. */
 int ulam__dist_largest(const ulam_comm *c, double *x);
 
+/* The same for x[0 .. n) entry by entry, in one sum (src/part.c). */
+int ulam__dist_largest_n(const ulam_comm *c, double *x, int n);
+
 /* The halo of this rank's rows of A: the columns they reference that other ranks of its set own
  * (ghost, sorted), and what this rank sends each product: the offsets (into its rows) others
  * asked for, at[r] .. at[r + 1) of idx for world rank r.  A product then needs the vector at the
@@ -78,6 +81,8 @@ void ulam__halo_free(ulam__halo *h);
 typedef struct {
     double u, bmax;
     double *c;  /* per query, malloc'd */
+    double *v2; /* adjoint, second: per query, E X^2 <= v2 aimed at its start (ulam__dist_moment), malloc'd;
+                   NULL otherwise */
     int second; /* a row sums above 1: u certifies M^ = diag(max(1, S)) |M| (the weights' second moment),
                    and a score's E X^2 <= bmax^2 c / (1 - sqrt u)^2 (Minkowski over the steps) bounds
                    the clipping in place of the length */
@@ -89,6 +94,12 @@ typedef struct {
  * (second: / v at index[k]). */
 int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const int64_t *index, int64_t nq, double total,
                     ulam__dist_cert *cert, ulam_error *err);
+
+/* Each adjoint query's certified E X^2 of one collision score (analog kernel, walks from
+ * index[k]) aimed at its start, into v2[k] on every rank (INFINITY: none held): src/solve.c's
+ * second_moment_aimed on the part's rows of M, products through the halo (src/dist_moment.c). */
+int ulam__dist_moment(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq, double *v2,
+                      ulam_error *err);
 
 /* ulam_dist_forward with, for watch >= 0 (0-based), that component's estimate and standard error
  * in res and its certified 95% interval in *ci: its histories' tallies, block by block of walk ids

@@ -39,6 +39,27 @@ static int allgather(void *ctx, const void *mine, size_t bytes, void **all, size
     return 0;
 }
 
+/* Tests: ULAM_TEST_PARTITION_KILL=R:N kills rank R (SIGKILL, no word to the others) as it enters
+ * its Nth exchange, while the other ranks wait in it: the job must end with an error, not hang.
+ * kill_at is this rank's N (0: never), read once at start-up (kill_arm), not at every exchange. */
+static long kill_at;
+
+/* Read ULAM_TEST_PARTITION_KILL once, for this rank (share.rank set). */
+static void kill_arm(void)
+{
+    const char *e = getenv("ULAM_TEST_PARTITION_KILL");
+    int r;
+    long at;
+    if (e && sscanf(e, "%d:%ld", &r, &at) == 2 && r == share.rank && at > 0) kill_at = at;
+}
+
+/* Count this rank's exchanges; die at the armed one. */
+static void test_kill(void)
+{
+    static long calls;
+    if (kill_at && ++calls == kill_at) raise(SIGKILL);
+}
+
 /* Start MPI when launched by mpirun; ranks other than 0 print nothing on stdout. */
 void cli_mpi_init(int *argc, char ***argv)
 {
@@ -49,6 +70,7 @@ void cli_mpi_init(int *argc, char ***argv)
     MPI_Comm_rank(MPI_COMM_WORLD, &share.rank);
     MPI_Comm_size(MPI_COMM_WORLD, &share.nranks);
     share.allgather = allgather;
+    kill_arm();
     if (share.nranks > 1) cli_share = &share;
     cli_rank = share.rank;
     if (cli_rank && !freopen("/dev/null", "w", stdout)) fclose(stdout);
@@ -60,16 +82,6 @@ void cli_mpi_finalize(void)
     if (started) MPI_Finalize();
 }
 
-/* Tests: ULAM_TEST_PARTITION_KILL=R:N kills rank R (SIGKILL, no word to the others) as it enters
- * its Nth exchange, while the other ranks wait in it: the job must end with an error, not hang. */
-static void test_kill(void)
-{
-    static long calls;
-    const char *e = getenv("ULAM_TEST_PARTITION_KILL");
-    int r;
-    long at;
-    if (e && sscanf(e, "%d:%ld", &r, &at) == 2 && r == share.rank && ++calls == at) raise(SIGKILL);
-}
 
 /* The exchange of ulam_comm as MPI_Alltoall of the counts and MPI_Alltoallv of the bytes. */
 static int alltoallv(void *ctx, const void *send, const size_t *sendcounts, void **recv, size_t *recvcounts)

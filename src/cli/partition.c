@@ -12,7 +12,8 @@
 #include "ulam_dist.h"
 
 static const char *const help =
-    "usage: ulam solve (SYSTEM.ulam | M.mtx --rhs B.mtx) --partition (--index I | --queries FILE | --mode forward [--out X.mtx]\n"
+    "usage: ulam solve (SYSTEM.ulam | M.mtx --rhs B.mtx) --partition (--index I | --queries FILE\n"
+    "                  | --mode forward [--top K] [--out X.mtx]\n"
     "                  | --method mcsa [--tol T] [--out X.mtx] | --source S [--top K] [--out X.mtx])\n"
     "                  [--walks N | --rel-err E] [--seed S] [--max-steps N] [--batch N] [--sets K]\n"
     "\n"
@@ -35,7 +36,8 @@ static const char *const help =
     "                  a seed of its own, printed: a line answers what --index I --seed SEED answers\n"
     "  --mode forward  every x_i by forward walks; --out writes x as a Matrix Market vector, --errors\n"
     "                  their standard errors (also with --source); --index I prints x_I's line with its\n"
-    "                  interval (its histories' tallies in a confidence sequence)\n"
+    "                  interval (its histories' tallies in a confidence sequence); --top K the K largest\n"
+    "                  components, each with its range from x's residual (as --bound; M in the part too)\n"
     "  --method mcsa   every x_i by MCSA: Richardson steps (products with M across ranks) and forward\n"
     "                  walks' corrections (--walks each) to --tol (default 1e-8) of max|b|, --max-iter\n"
     "  --source S      x = (I - M)^-1 e_S: a push (products with M) to 1e-4, then forward walks; prints\n"
@@ -56,7 +58,7 @@ typedef struct {
     int forward, mcsa;
     int64_t sets, source, top, max_iter;
     double tol, rel_err;
-    int walks_given, bound;
+    int walks_given, bound, top_given;
     ulam_dist_opts o;
 } args;
 
@@ -106,7 +108,7 @@ static int option(void *p, int val, const char *name, const char *value)
     case 'T': return cli_parse_real("solve", "--tol", value, 1e-300, 1.0, &a->tol);
     case 'I': return cli_parse_int("solve", "--max-iter", value, 1, 1000000, &a->max_iter);
     case 'R': return cli_parse_int("solve", "--source", value, 1, INT32_MAX, &a->source);
-    case 'K': return cli_parse_int("solve", "--top", value, 1, 1000000, &a->top);
+    case 'K': a->top_given = 1; return cli_parse_int("solve", "--top", value, 1, 1000000, &a->top);
     case 'S': return cli_parse_int("solve", "--sets", value, 1, 1 << 20, &a->sets);
     case 'h': fputs(help, stdout); return -1;
     default:
@@ -128,6 +130,13 @@ static int check(args *a, int argc, char **argv, int first)
     if (a->bound && (!a->forward || a->mcsa || a->sets > 1))
         return cli_usage_error("solve", "--bound with --mode forward in one set (MCSA and --source print theirs)");
     if (a->errors && a->mcsa) return cli_usage_error("solve", "--errors with --mode forward or --source");
+    if (a->top_given && !a->source && !(a->forward && !a->index && !a->mcsa))
+        return cli_usage_error("solve", "--top K with --partition lists the largest components of --source S or of "
+                                        "--mode forward (not with --index, --queries or MCSA)");
+    if (a->top_given && a->forward && a->sets > 1)
+        return cli_usage_error("solve", "--top K with --mode forward in one set (its ranges come from x's residual, as "
+                                        "--bound's)");
+    if (a->top_given && a->forward) a->bound = 1; /* each top line's range: x's residual */
     const cli_file outs[] = {{"--out", a->out}, {"--errors", a->errors}},
                    ins[] = {{"the system", a->path}, {"--queries", a->queries}, {"--rhs", a->rhs}};
     int rc = cli_check_outputs("solve", outs, 2, ins, 3);
@@ -259,9 +268,9 @@ static int run(const args *a, const ulam_comm *c)
     int walks_forward = ask.mode != ULAM_DIST_ADJOINT;
     ulam_dist_answer s = {.ranks = malloc((size_t)c->nranks * 2 * sizeof(int64_t))};
     if (walks_forward) s.x = malloc(((size_t)rows + 1) * sizeof *s.x), s.se = malloc(((size_t)rows + 1) * sizeof *s.se);
-    if (a->source) s.tops = malloc(((size_t)a->top + 1) * sizeof *s.tops);
+    if (a->source || (a->forward && a->top_given)) s.tops = malloc(((size_t)a->top + 1) * sizeof *s.tops);
     if (!walks_forward || ask.index) s.res = malloc((size_t)nq * sizeof *s.res), s.ci = malloc((size_t)nq * sizeof *s.ci);
-    if (!idx || !lines || !s.ranks || (walks_forward ? !s.x || !s.se || (a->source && !s.tops) : !s.res || !s.ci) ||
+    if (!idx || !lines || !s.ranks || (walks_forward ? !s.x || !s.se || ((a->source || a->top_given) && !s.tops) : !s.res || !s.ci) ||
         (ask.index && (!s.res || !s.ci)))
         status = ULAM_ENOMEM, err.status = status, snprintf(err.msg, sizeof err.msg, "memory for the answer");
     else status = ulam_dist_run(p, c, &ask, &s, &err);
