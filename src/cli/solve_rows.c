@@ -33,17 +33,18 @@ static int union_opts(struct option *u)
     return n;
 }
 
-/* The first row that a --method value or an option it claims selects, else the last. */
-static const cli_solve_row *pick(const struct option *u, const given *g, int ng)
+/* The first row that a --method value or an option it claims selects (that option in *by), else
+ * the last (*by NULL). */
+static const cli_solve_row *pick(const struct option *u, const given *g, int ng, const given **by)
 {
     for (int r = 0; r < NROWS - 1; r++)
         for (int k = 0; k < ng; k++) {
             const char *name = g[k].opt >= 0 ? u[g[k].opt].name : "";
-            if (!strcmp(name, "method") && rows[r]->serves(g[k].value)) return rows[r];
+            if (!strcmp(name, "method") && rows[r]->serves(g[k].value)) return *by = &g[k], rows[r];
             for (const char *const *c = rows[r]->claims; c && *c; c++)
-                if (!strcmp(name, *c)) return rows[r];
+                if (!strcmp(name, *c)) return *by = &g[k], rows[r];
         }
-    return rows[NROWS - 1];
+    return *by = NULL, rows[NROWS - 1];
 }
 
 /* name's code in the row's options, or '?'. */
@@ -52,6 +53,19 @@ static int row_code(const cli_solve_row *row, const char *name)
     for (const struct option *o = row->longopts; name && o->name; o++)
         if (!strcmp(o->name, name)) return o->val;
     return '?';
+}
+
+/* A usage error for the first option given that the chosen row does not take (another row's):
+ * named with the option that chose the row.  0 or EXIT_USAGE. */
+static int foreign(const struct option *u, const given *g, int ng, const cli_solve_row *row, const given *by)
+{
+    for (int k = 0; k < ng && by; k++) {
+        const char *name = g[k].opt >= 0 ? u[g[k].opt].name : NULL;
+        if (name && row_code(row, name) == '?')
+            return cli_usage_error("solve", "--%s does not apply with --%s%s%s", name, u[by->opt].name, by->value ? " " : "",
+                                   by->value ? by->value : "");
+    }
+    return 0;
 }
 
 /* ulam solve. */
@@ -70,8 +84,9 @@ int cli_solve(int argc, char **argv)
         if (c == '?') g[ng++] = (given){.opt = optopt >= BASE ? optopt - BASE : -1, .refused = 1};
         else g[ng++] = (given){.opt = c == 'h' ? (u[idx].name ? idx : -1) : c - BASE, .value = optarg};
     }
-    const cli_solve_row *row = pick(u, g, ng);
-    int rc = cli_check_options("solve", argc, argv, row->longopts) ? EXIT_USAGE : 0;
+    const given *by;
+    const cli_solve_row *row = pick(u, g, ng, &by);
+    int rc = foreign(u, g, ng, row, by) || cli_check_options("solve", argc, argv, row->longopts) ? EXIT_USAGE : 0;
     ulam_error err;
     if (!rc && optind == argc - 1 && ulam_edgelist_is_file(argv[optind]) && cli_graph_preload(argv[optind], NULL, &err))
         rc = cli_report(argv[optind], &err); /* an edge list's ids number the states: read before the options */
