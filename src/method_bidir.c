@@ -232,6 +232,7 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     double need = E > 0 ? fmax((double)ULAM__REL_MIN, fmax(m == mt ? wr.min_walks : wr.min_walks * (mt / m) * (mt / m),
                                                            ulam__cs_var_walks(m, wr.variance, E)))
                         : (double)o->stop.max_walks; /* a fixed budget: fixed_predict sets it */
+    r->blower = m != mt;
     mt = m;
     pl->target = o->query.index, pl->rmax = rmax, pl->balanced = 1, pl->push_part = qi;
     pl->push = (ulam_push_info){.target = o->query.index, .rmax = rmax, .ops = ops, .r_max = ulam__bpush_max(r->br, n)};
@@ -409,6 +410,9 @@ static int predict_push_on_b(ulam__query *q, int k, ulam_error *err)
     if (status == ULAM_ENOMEM) return status;
     ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = q->run->bwo, ch->bidir_opts.target = q->o->query.index;
     if (status) snprintf(ch->method[k].why, sizeof ch->method[k].why, "refused: %.250s", err->msg);
+    else if (q->run->blower) /* a lower bound shows no saving over the leader, which runs either way */
+        snprintf(ch->method[k].why, sizeof ch->method[k].why, "lost: its pilot does not resolve |x|, so its prediction "
+                 "is a lower bound, no saving over the walks");
     else ch->method[k].predicted_work = ch->bidir.predicted_work;
     return ULAM_OK;
 }
