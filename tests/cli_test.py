@@ -1015,8 +1015,9 @@ def check_source_fallback(ulam):
         # 4.68e7 under docs/streams.md's), so either may run, and bidirectional only as the push on b
         rc, out, err = run(ulam, ["solve", p, "--source", "45", "--index", "21", "--rel-err", "0.1", "--verbose"])
         method = re.search(r"^method +(.*)$", out, re.M)
+        # (">= N": a plan whose residual pilot does not resolve |x| predicts a lower bound, and loses)
         assert rc == 0 and method and re.search(r"^ +\*? *bidirectional \(reverse push, walks from b\) .* predicted "
-                                                r"[0-9.e+]+ walks", out, re.M), (rc, out, err)
+                                                r"(>= )?[0-9.e+]+ walks", out, re.M), (rc, out, err)
         assert re.match(r"adjoint walks|bidirectional, the push on b", method.group(1)), out
 
 
