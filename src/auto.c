@@ -173,14 +173,17 @@ static int resolved(const ulam_auto_result *res, int k, double offset)
 /* The scale |x| candidate k's rel_err prediction is made at: its pilot mean when that resolves
  * |x|; else the largest |x| the pilots allow, min over every piloted candidate with spread of
  * |mean| + 2 standard errors (they all estimate the same x), at which the prediction is a lower
- * bound on the walks the rule needs. */
+ * bound on the walks the rule needs.  Spread of its own, not variance_of's: a forward pilot that
+ * has not tallied the component (mean 0, variance 0) gets a variance from its distance to the
+ * others' mean, and its 0 + 2 se (3.7e-5 for x = -5.1e-4, randsub1000's x_7 for sparse3_b) set
+ * every unresolved prediction 200x high once forward kernels were piloted. */
 static double scale_of(const ulam_auto_result *res, int k, double offset)
 {
     double m = fabs(res->cand[k].estimate + offset);
     if (resolved(res, k, offset)) return m;
     double cap = m + 2.0 * pilot_se(res, k);
     for (int j = 0; j < res->ncand; j++)
-        if (res->cand[j].pilot_walks > 1 && variance_of(res, j) > 0 && isfinite(res->cand[j].estimate))
+        if (res->cand[j].pilot_walks > 1 && res->cand[j].variance > 0 && isfinite(res->cand[j].estimate))
             cap = fmin(cap, fabs(res->cand[j].estimate + offset) + 2.0 * pilot_se(res, j));
     return cap;
 }
@@ -205,15 +208,15 @@ static double predict(const chooser *c, int k, double var, double *walks)
         else if (m == 0 && !(a->variance > 0)) N = INFINITY; /* a pilot that saw nothing predicts nothing */
         else {
             m = scale_of(c->res, k, off); /* unresolved: the largest |x| the pilots allow, a lower bound */
-            /* the rule's own prediction (stop.h) holds its range term: a pilot without spread */
-            N = fmax((double)ULAM__REL_MIN, var / (E * m * E * m)); /* is no evidence of a small variance */
+            /* the rule's own prediction (stop.h) holds its range term: a pilot without spread is no
+               evidence of a small variance.  The rule is the confidence sequence's (the half-width
+               at most E |m|): its variance term alone asks 2 ln(2 / delta) var / (E m)^2, 7.4 times
+               the var / (E m)^2 predicted here before (issue 38: a leader predicted >= 4.1e6 walks
+               ran 3.7e7) */
+            N = fmax((double)ULAM__REL_MIN, ulam__cs_var_walks(m, var, E));
             if (exact) N = fmax(N, c->min_walks[k]); /* the pilot's own prediction (its variance, range and bias) */
-            if (isfinite(c->range[k])) { /* the rule's at this variance: the range term shares the half-width */
-                double r = ulam__stop_walks_needed(m, var, c->range[k], 0.0, E, 1);
-                N = fmax(N, isfinite(r) ? ulam__stop_walks_needed(m, var, c->range[k], 0.0, E,
-                                                                  ulam__stop_epoch((int64_t)fmin(r, 1e18)))
-                                        : r);
-            }
+            if (isfinite(c->range[k])) /* the rule's at this variance: the range term shares the half-width */
+                N = fmax(N, ulam__cs_walks_needed(m, var, c->range[k], 0.0, E));
         }
         N = rounded_walks(N);
         if (c->base.stop.max_walks > 0) N = fmin(N, (double)c->base.stop.max_walks);

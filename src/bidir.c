@@ -179,16 +179,29 @@ static int pilot(ulam_analysis *at, const double *ones, const ulam_bidir_opts *o
     return ulam__analysis_walks(at, ones, &po, how, NULL, NULL, out, err);
 }
 
-/* Walks the stopping rule is predicted to need at threshold rmax for |x| about xhat (the
- * balance's model, ulam__bidir_plan in ulam.h); pilot: its solver (NULL: none). */
+/* Whether b's entries take both signs (then <p, b> and x_t may cancel far below 1 / n). */
+static int mixed_signs(const ulam_bidir_opts *o)
+{
+    int pos = 0, neg = 0;
+    for (int64_t j = 0; j < o->nb; j++) pos |= o->b_value[j] > 0, neg |= o->b_value[j] < 0;
+    return pos && neg;
+}
+
+/* Walks the stopping rule is predicted to need at threshold rmax for a score variance about
+ * ||b||_1 rmax E[V] min(xhat, ||b||_1 rmax E[V]) (E[score^2] <= max|score| E|score|, both at most
+ * about ||b||_1 rmax E[V]: deep pushes, where xhat alone over-predicted 18x on randsub1000's
+ * x_7 for sparse3_b at rmax 7.6e-6) and |x| about xden (the balance's model, ulam__bidir_plan in ulam.h;
+ * the rule is the confidence sequence's, stop.h: 2 ln(2 / delta) var / (E x)^2 walks for its
+ * variance term); pilot: its solver (NULL: none). */
 static double predicted_walks(const ulam_bidir_opts *o, const ulam_solver *pilot, double rmax, double visits,
-                              double xhat)
+                              double xhat, double xden)
 {
     const ulam_walk_opts *wo = &o->walk;
     if (wo->stop.rel_err <= 0 && wo->stop.max_walks > 0) return (double)wo->stop.max_walks;
     double E = wo->stop.rel_err > 0 ? wo->stop.rel_err : DEFAULT_REL_ERR;
-    double n = fmax((double)ULAM__REL_MIN, norm_b(o) * rmax * visits / (E * E * xhat));
-    double range = wo->stop.rel_err > 0 && pilot ? ulam__solver_range_walks(pilot, rmax, 0, xhat, E) : 0.0;
+    double top = norm_b(o) * rmax * visits; /* about the largest |score|, so E|score| <= it too */
+    double n = fmax((double)ULAM__REL_MIN, ulam__cs_var_walks(xden, top * fmin(xhat, top), E));
+    double range = wo->stop.rel_err > 0 && pilot ? ulam__solver_range_walks(pilot, rmax, 0, xden, E) : 0.0;
     if (isfinite(range)) n = fmax(n, range); /* else the rule bounds the score through its second moment, which
                                                depends on r: not predicted */
     return wo->stop.max_walks > 0 ? fmin(n, (double)wo->stop.max_walks) : n;
@@ -227,10 +240,15 @@ static int push(ulam_push *w, const ulam_csr *Mt, ulam__bidir *memo, const ulam_
     double rmax = o->rmax > 0 ? o->rmax : 1.0, walks, seen = 0.0;
     int fixed = o->walk.stop.rel_err <= 0 && o->walk.stop.max_walks > 0; /* walks known without V */
     int probed = fixed || !(o->walk.stop.rel_err > 0) || o->min_value > 0; /* a given min_value is the plan's */
+    int signs = mixed_signs(o) && !(o->min_value > 0);
     int status = ulam__push_run(w, rmax, cap); /* balanced: r = e_t, nothing to push yet */
     for (;;) {
         ulam__push_report(w, &plan->push);
-        walks = predicted_walks(o, pl, rmax, V, fmax(fmax(delta, seen), fabs(dot_b(p, o))));
+        /* the variance at the largest of the |x| scales; with b of both signs |x| itself at what the
+           push and the probe have seen (randsub1000's x_7 = -5.1e-4 for sparse3_b, |<p, b>| 4.3e-4, was
+           taken as 1 / n = 1e-3: the run walked 4x the walks predicted, beside the rule's 7.4x) */
+        double xhat = fmax(fmax(delta, seen), fabs(dot_b(p, o))), xs = fmax(seen, fabs(dot_b(p, o)));
+        walks = predicted_walks(o, pl, rmax, V, xhat, signs && xs > 0 ? xs : xhat);
         if (!probed && o->rmax <= 0 && !status && plan->push.support > 0 && walks > ULAM__REL_MIN &&
             (double)plan->push.ops >= ULAM__REL_MIN * V * cost) {
             probed = 1, seen = probe(Mt, w, o, memo), plan->probe = seen;

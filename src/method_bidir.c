@@ -171,6 +171,22 @@ static double rule_rmax(const double *b, int64_t n, double var, double m, double
     return isfinite(N) && N > 0 && nv > 0 ? bmax * fmin(1.0, nv / N) : bmax;
 }
 
+/* The |x| a pilot round on the residual predicts the walks at: its mean |q_i + estimate| (mt,
+ * standard error se) when that is at least 4 standard errors from 0, else the largest |x| it and
+ * the walk candidate c (NULL: none; its pilots estimate the same x) allow, the least |mean| + 2
+ * standard errors, at which the prediction is a lower bound (as src/auto.c's scale_of).  Before,
+ * a mean of noise was believed: randsub1000's x_7 for sparse3_b with the expected estimator
+ * pinned, a pilot mean of -2.3e-6 +- 5.8e-4 (x = -5.1e-4) predicted 1.2e12 walks at E = 0.02, 1.1e5
+ * times the 1.1e7 at 0.04. */
+static double pilot_scale(double mt, double se, const ulam_auto_candidate *c, double off)
+{
+    if (mt >= 4.0 * se) return mt;
+    double m = mt + 2.0 * se;
+    if (c && c->pilot_walks > 1 && c->variance > 0 && isfinite(c->estimate))
+        m = fmin(m, fabs(c->estimate + off) + 2.0 * sqrt(c->variance / (double)c->pilot_walks));
+    return m > 0 && isfinite(m) ? m : mt;
+}
+
 /* The dense route (b has more nonzeros than ulam_method_sparse_limit): the transpose, b pushed
  * down to rmax within max_ops, and a pilot round of the walks on the residual (into *wr), whose
  * rule (src/stop.c, on the residual's own range) predicts the walks; the plan in ch->bidir.  c:
@@ -213,8 +229,14 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     if (status) return status;
     if (wr_out) *wr_out = wr;
     double mt = fabs(qi + wr.estimate + o->stop.rel_err_offset), V = wr.walks ? (double)wr.steps / (double)wr.walks : 0.0;
-    double need = E > 0 ? fmax((double)ULAM__REL_MIN, fmax(wr.min_walks, wr.variance / (E * mt * E * mt)))
+    double m = pilot_scale(mt, wr.std_error, c, o->stop.rel_err_offset);
+    /* the rule's walks (the sequence's, stop.h) at scale m: the pilot's own prediction where its mean
+       resolves |x|, else at least its terms carried to m (each falls at least as (mt / m)^2) */
+    double need = E > 0 ? fmax((double)ULAM__REL_MIN, fmax(m == mt ? wr.min_walks : wr.min_walks * (mt / m) * (mt / m),
+                                                           ulam__cs_var_walks(m, wr.variance, E)))
                         : (double)o->stop.max_walks; /* a fixed budget: fixed_predict sets it */
+    r->blower = m != mt;
+    mt = m;
     pl->target = o->query.index, pl->rmax = rmax, pl->balanced = 1, pl->push_part = qi;
     pl->push = (ulam_push_info){.target = o->query.index, .rmax = rmax, .pushes = pushes, .ops = ops, .seconds = push_s};
     ulam__bpush_residual(r->bq, r->br, n, &pl->push);
@@ -392,6 +414,9 @@ static int predict_push_on_b(ulam__query *q, int k, ulam_error *err)
     if (status == ULAM_ENOMEM) return status;
     ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = q->run->bwo, ch->bidir_opts.target = q->o->query.index;
     if (status) snprintf(ch->method[k].why, sizeof ch->method[k].why, "refused: %.250s", err->msg);
+    else if (q->run->blower) /* a lower bound shows no saving over the leader, which runs either way */
+        snprintf(ch->method[k].why, sizeof ch->method[k].why, "lost: its pilot does not resolve |x|, so its prediction "
+                 "is a lower bound, no saving over the walks");
     else ch->method[k].predicted_work = ch->bidir.predicted_work;
     return ULAM_OK;
 }

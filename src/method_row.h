@@ -26,6 +26,7 @@ struct ulam_run {
     double *bq, *br;      /* bidirectional with a dense b: the push on b's q and residual r (src/bpush.c) */
     ulam_walk_opts bwo;   /* and the walks' options on r (adjoint from the index, offset q_i) */
     ulam_bidir_plan_info bplan; /* and its plan (also in the choice's bidir) */
+    int blower;           /* 1: that plan's walks are a lower bound (its pilot does not resolve |x|) */
 };
 
 /* One query's choice in progress. */

@@ -169,10 +169,13 @@ static void choice_text(FILE *f, const ulam_choice *ch, int bidir, int verbose)
                    c->state == ULAM_AUTO_DROPPED ? "  dropped" : "");
     }
     if (!bidir) return;
+    /* a plan whose pilot does not resolve |x| has no predicted work, only its plan's lower bound */
+    int lower = isnan(v->predicted_work) && isfinite(ch->bidir.predicted_work);
     fprintf(f, "  %c bidirectional (reverse push, walks from b) ", bstate == ULAM_METHOD_CHOSEN ? '*' : ' ');
     if (bstate)
-        fprintf(f, "rmax %.3g  push %lld ops  pilot %lld walks  predicted %.4g walks, %.3g units%s%s\n", ch->bidir.rmax,
-               (long long)ch->bidir.push.ops, (long long)ch->bidir.pilot_walks, ch->bidir.predicted_walks, v->predicted_work,
+        fprintf(f, "rmax %.3g  push %lld ops  pilot %lld walks  predicted %s%.4g walks, %.3g units%s%s\n", ch->bidir.rmax,
+               (long long)ch->bidir.push.ops, (long long)ch->bidir.pilot_walks, lower ? ">= " : "", ch->bidir.predicted_walks,
+               lower ? ch->bidir.predicted_work : v->predicted_work,
                bstate == ULAM_METHOD_CHOSEN ? "" : "  ", bstate == ULAM_METHOD_CHOSEN ? "" : v->why);
     else
         fprintf(f, "%s\n", v->why);

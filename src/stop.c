@@ -251,6 +251,13 @@ double ulam__cs_walks_needed(double m, double var, double A, double b, double E)
     return den > 0 ? ceil(fmax(cs_log() / den, 2.0)) : INFINITY;
 }
 
+/* The least walks a sequence tuned to E needs at variance var, whatever its range. */
+double ulam__cs_var_walks(double m, double var, double E)
+{
+    if (!(E > 0) || !(var > 0)) return 0.0;
+    return fabs(m) > 0 ? 2.0 * cs_log() * var / (E * m * E * m) : INFINITY;
+}
+
 /* The further walks that take the half-width to h. */
 double ulam__cs_walks_left(const ulam__cs *cs, double mean, double var, double extra, double h)
 {

@@ -176,6 +176,11 @@ double ulam__cs_range_width(double A, double n);
  * reaches half-width E |m|; INFINITY when it cannot (bias too large, m = 0, A infinite). */
 double ulam__cs_walks_needed(double m, double var, double A, double b, double E);
 
+/* The least walks a sequence tuned to target E needs at variance var and estimate m, whatever
+ * its range and bias: 2 ln(2 / delta) var / (E m)^2 (psi(l) >= l^2 / 2, so no bet does better;
+ * 7.4 times the var / (E m)^2 of a rule that asks stderr <= E |m|); INFINITY at m = 0. */
+double ulam__cs_var_walks(double m, double var, double E);
+
 /* The Chernoff-Hoeffding interval for the mean of n independent scores in [0, 1] (Hoeffding 1963,
  * Theorem 1: P(mean >= mu + t) <= exp(-n kl(mu + t || mu)), Bernoulli laws being the extreme
  * case; the same below): [lo, hi] = the means q with n kl(m || q) <= ln(2 / delta_k) on each
