@@ -43,7 +43,7 @@ int ulam__dist_largest_n(const ulam_comm *c, double *x, int n);
 /* The halo of this rank's rows of A: the columns they reference that other ranks of its set own
  * (ghost, sorted), and what this rank sends each product: the offsets (into its rows) others
  * asked for, at[r] .. at[r + 1) of idx for world rank r.  A product then needs the vector at the
- * halo only, not the whole O(n) vector (src/dist_radius.c). */
+ * halo only, not the whole O(n) vector (src/dist_halo.c). */
 typedef struct {
     int64_t nghost, *ghost;
     int64_t *idx, *at; /* at: nranks + 1 */
