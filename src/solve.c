@@ -1841,9 +1841,11 @@ static void round_clip(ulam_solver *s)
     s->w.clip = isfinite(A) && A > 0 ? A : 0.0, s->clip_b = b;
     /* every length route's range is per_step (l + 1) (twice with signs) for walks cut after l steps,
        whose bias bound (an E|rest| bound, or tailS's |E rest|) is at most b: the sequence may take
-       each history's first l + 1 visits, whose scores lie in [-A, A] unclipped */
+       each history's first l + 1 visits, whose scores lie in [-A, A] unclipped; only where a
+       length route set the range (b > 0: plan_terms truncated): a range from the start's reach
+       (search_reach, s->range finite) has no bias bound for the visits a part leaves out */
     double j = s->per_step * (s->signs ? 2.0 : 1.0), l1 = s->w.clip > 0 && j > 0 ? nearbyint(Rt / j) : 0.0;
-    s->w.part_steps = part_route(s) && s->w.score0 == 0.0 && l1 >= 1.0 && l1 < 1e15 && fabs(Rt - j * l1) <= 1e-9 * Rt
+    s->w.part_steps = part_route(s) && s->w.score0 == 0.0 && b > 0.0 && l1 >= 1.0 && l1 < 1e15 && fabs(Rt - j * l1) <= 1e-9 * Rt
                           ? (int64_t)l1 : 0;
 }
 
