@@ -621,6 +621,8 @@ def check_radiosity_chosen(ulam):
     for extra, msg in ((["--mode", "shoot", "--walks", "100"], r"--patches chooses the patches of --mode final"),
                        (["--patch", "1", "--walks", "100"], r"--patches chooses the patches of --mode final"),
                        (["--mode", "final", "--patch", "1"], r"--patches and --patch: one or the other"),
+                       ([], r"--patches chooses the patches of --mode final"),  # was: needs --patch K
+                       (["--list", "--patch", "1"], r"--patches and --patch: one or the other"),  # was: not with --image
                        (["--mode", "final", "--image", "x.png"], r"--patches: not with --image"),
                        (["--mode", "final", "--out", "x.csv", "--mesh-error", "10"], r"--patches: not with --image")):
         rc, out, err = run(ulam, ["radiosity", scene, "--patches", "floor"] + extra)

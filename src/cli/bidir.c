@@ -337,6 +337,9 @@ static int start_run(void *p, int argc, char **argv, int optind)
         return cli_usage_error("solve", "--source %s: a seed set is a personalisation vector: it needs --pagerank ALPHA "
                                "(a plain system takes b as --rhs b.mtx with --method bidirectional)", rp.seeds);
     if (s.pagerank > 0 && !s.rhs_path) rp.scale = 1.0 - s.pagerank, cli_answer_name = "pi"; /* b = s: pi = (1 - alpha) x */
+    if (s.rhs_path && !method && top)
+        return cli_usage_error("solve", "--top K lists the largest components of x for one source: it needs --source S "
+                               "(b = e_S) or --pagerank ALPHA, not --rhs");
     if (s.rhs_path && !method)
         return cli_usage_error("solve", "--rhs b with --rmax is a bidirectional solve: say --method bidirectional");
     if (!source && !s.rhs_path && !rp.seeds && !(s.pagerank > 0 && !s.index))

@@ -329,6 +329,8 @@ static int parse(int argc, char **argv, args *a, cli_photo *ph)
     if ((a->out || a->all) && a->o.mode == ULAM_ADJOINT && !a->direct)
         return cli_usage_error(cmd, "%s needs --mode shoot or --direct (gathering answers one patch)",
                                a->out ? "--out" : "--all");
+    if (a->patches && !a->final && !a->list)
+        return cli_usage_error(cmd, "--patches chooses the patches of --mode final (or of --list)");
     if (!a->patch && a->o.mode == ULAM_ADJOINT && !a->direct && !a->view)
         return cli_usage_error(cmd, "needs --patch K (gathering answers one patch), --mode shoot or --direct");
     if (a->check && !a->patch) return cli_usage_error(cmd, "--check needs --patch K");

@@ -62,8 +62,8 @@ static int foreign(const struct option *u, const given *g, int ng, const cli_sol
     for (int k = 0; k < ng && by; k++) {
         const char *name = g[k].opt >= 0 ? u[g[k].opt].name : NULL;
         if (name && row_code(row, name) == '?')
-            return cli_usage_error("solve", "--%s does not apply with --%s%s%s", name, u[by->opt].name, by->value ? " " : "",
-                                   by->value ? by->value : "");
+            return cli_usage_error("solve", "--%s does not apply with --%s%s%s (the %s route)", name, u[by->opt].name,
+                                   by->value ? " " : "", by->value ? by->value : "", row->name);
     }
     return 0;
 }

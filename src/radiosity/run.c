@@ -295,7 +295,7 @@ int ulam_rad_run_alloc(const ulam_rad_run_opts *opts, ulam_rad_run **out)
         return ULAM_RAD_RUN_USAGE;
     }
     if (a->patches && ((!a->final && !a->list) || a->patch || a->image || a->mesh_walks)) { /* before the scene is read */
-        ulam__run_log(a, "ulam radiosity: %s\n", a->patch && a->final ? "--patches and --patch: one or the other"
+        ulam__run_log(a, "ulam radiosity: %s\n", a->patch ? "--patches and --patch: one or the other"
                                                 : !a->final && !a->list ? "--patches chooses the patches of --mode final (or "
                                                                           "of --list)"
                                                                         : "--patches: not with --image or --mesh-error "
