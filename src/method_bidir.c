@@ -184,7 +184,8 @@ static double pilot_scale(double mt, double se, const ulam_auto_candidate *c, do
     double m = mt + 2.0 * se;
     if (c && c->pilot_walks > 1 && c->variance > 0 && isfinite(c->estimate))
         m = fmin(m, fabs(c->estimate + off) + 2.0 * sqrt(c->variance / (double)c->pilot_walks));
-    return m > 0 && isfinite(m) ? m : mt;
+    return m > 0 && isfinite(m) ? m : isfinite(se) ? mt : INFINITY; /* a pilot with no standard error
+                                                                         (no history ended): no scale, a lower bound */
 }
 
 /* The dense route (b has more nonzeros than ulam_method_sparse_limit): the transpose, b pushed
