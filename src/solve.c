@@ -1690,8 +1690,10 @@ static double score_range(const ulam_solver *s, double m, double E, int own)
  * both signs when signs, under this solver's reachability bounds, which must have been made for
  * scores of at most 1 a visit (b = 1; check_reach runs for rel_err > 0 or absorption): the
  * per-visit route of score_range, or the second moment's scaled by per_visit^2; INFINITY when
- * neither gives a bound.  For a planner that knows the scores only after these walks' set-up
- * (src/bidir.c: the push's residual). */
+ * neither gives a bound.  The walks are the confidence sequence's at variance 0 (stop.h's
+ * ulam__cs_walks_needed at the limit A = R, R / 2 with signs, as score_limit), the rule the run
+ * stops on; the empirical-Bernstein rule's range term before predicted about half of them.  For a
+ * planner that knows the scores only after these walks' set-up (src/bidir.c: the push's residual). */
 double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E)
 {
     if (!(per_visit > 0)) return 0.0;
@@ -1702,8 +1704,7 @@ double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int sign
                                           signs, m, E);
     if (!isfinite(R) && !absorb) R = ulam__moment_range(s->v2 * per_visit * per_visit, signs, m, E);
     if (!isfinite(R)) return INFINITY;
-    double n = ulam__stop_walks_needed(m, 0.0, R, 0.0, E, 1); /* the rule's range term, at the epoch it lands in */
-    return isfinite(n) ? ulam__stop_walks_needed(m, 0.0, R, 0.0, E, ulam__stop_epoch((int64_t)n)) : n;
+    return ulam__cs_walks_needed(m, 0.0, signs ? R / 2.0 : R, 0.0, E); /* the sequence's range term (score_limit's A) */
 }
 
 /* The most the walks cut at max_steps can have moved the mean (0 without cuts). */
