@@ -213,7 +213,7 @@ static double predict(const chooser *c, int k, double var, double *walks)
                at most E |m|): its variance term alone asks 2 ln(2 / delta) var / (E m)^2, 7.4 times
                the var / (E m)^2 predicted here before (issue 38: a leader predicted >= 4.1e6 walks
                ran 3.7e7) */
-            N = fmax((double)ULAM__REL_MIN, ulam__cs_var_walks(m, var, E));
+            N = fmax((double)ULAM__REL_FIRST, ulam__cs_var_walks(m, var, E)); /* the rule's first check */
             if (exact) N = fmax(N, c->min_walks[k]); /* the pilot's own prediction (its variance, range and bias) */
             if (isfinite(c->range[k])) /* the rule's at this variance: the range term shares the half-width */
                 N = fmax(N, ulam__cs_walks_needed(m, var, c->range[k], 0.0, E));

@@ -200,7 +200,7 @@ static double predicted_walks(const ulam_bidir_opts *o, const ulam_solver *pilot
     if (wo->stop.rel_err <= 0 && wo->stop.max_walks > 0) return (double)wo->stop.max_walks;
     double E = wo->stop.rel_err > 0 ? wo->stop.rel_err : DEFAULT_REL_ERR;
     double top = norm_b(o) * rmax * visits; /* about the largest |score|, so E|score| <= it too */
-    double n = fmax((double)ULAM__REL_MIN, ulam__cs_var_walks(xden, top * fmin(xhat, top), E));
+    double n = fmax((double)ULAM__REL_FIRST, ulam__cs_var_walks(xden, top * fmin(xhat, top), E));
     double range = wo->stop.rel_err > 0 && pilot ? ulam__solver_range_walks(pilot, rmax, 0, xden, E) : 0.0;
     if (isfinite(range)) n = fmax(n, range); /* else the rule bounds the score through its second moment, which
                                                depends on r: not predicted */

@@ -10,6 +10,7 @@
 #include "analysis.h"
 #include "bidir.h"
 #include "push.h"
+#include "stats.h"
 #include "testutil.h"
 #include "zipf_graph.h"
 
@@ -213,7 +214,7 @@ static void test_bidir_plan(void **state)
     assert_true(plan.balanced && plan.target == 10 && plan.rmax == pi.rmax && plan.push.ops == pi.ops && pi.ops > 0);
     assert_true(pi.r_max <= plan.rmax && plan.push_part == ulam__push_estimates(w)[3]);
     assert_true(plan.pilot_walks == 256 && plan.mean_visits == 1.0 + (double)plan.pilot_steps / 256.0);
-    assert_true(plan.predicted_walks >= 1000 && isfinite(plan.predicted_walks));
+    assert_true(plan.predicted_walks >= ULAM__REL_FIRST && isfinite(plan.predicted_walks)); /* the rule's first check */
     assert_close(plan.predicted_work, (double)plan.push.ops + plan.step_cost * ((double)(256 + plan.pilot_steps) +
                                       plan.predicted_walks * plan.mean_visits), 1e-9 * plan.predicted_work);
     ulam_bidir_result res, ref;

@@ -233,7 +233,7 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     double m = pilot_scale(mt, wr.std_error, c, o->stop.rel_err_offset);
     /* the rule's walks (the sequence's, stop.h) at scale m: the pilot's own prediction where its mean
        resolves |x|, else at least its terms carried to m (each falls at least as (mt / m)^2) */
-    double need = E > 0 ? fmax((double)ULAM__REL_MIN, fmax(m == mt ? wr.min_walks : wr.min_walks * (mt / m) * (mt / m),
+    double need = E > 0 ? fmax((double)ULAM__REL_FIRST, fmax(m == mt ? wr.min_walks : wr.min_walks * (mt / m) * (mt / m),
                                                            ulam__cs_var_walks(m, wr.variance, E)))
                         : (double)o->stop.max_walks; /* a fixed budget: fixed_predict sets it */
     r->blower = m != mt;

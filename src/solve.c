@@ -44,7 +44,7 @@ enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = ULAM
  * so the rule may stop after any round (a first round of a whole block made every run at least
  * 1024 walks, 10.7 times the CLT's count at E = 0.1 on the hub at 0.99; later rounds of at least
  * 64 walks stopped its absorption runs at 320 walks, 3.34 times, where 272 do, 2.84 times). */
-enum { REL_FIRST = 256, REL_STEP = 16 };
+enum { REL_FIRST = ULAM__REL_FIRST, REL_STEP = 16 };
 
 /* The lesser of a and b. */
 static int64_t imin64(int64_t a, int64_t b)
@@ -1180,7 +1180,7 @@ static double mean_steps(const ulam_solver *s)
 /* The push on b's cost model (src/fpush_b.c): the forward walks' predicted work on a residual of
  * l1 norm r_sum, with the bounds made on b (a forward walk's weight, and so its range and second
  * moment, scale with the l1 norm of what it starts from): the rule's range term at |x_i| ~ |q_i|
- * (ulam__solver_range_walks), at least ULAM__REL_MIN walks, each its expected steps plus a start
+ * (ulam__solver_range_walks), at least ULAM__REL_FIRST walks (the rule's first check), each its expected steps plus a start
  * and a tally a visit; 0 with nothing left to walk. */
 typedef struct {
     const ulam_solver *s;
@@ -1199,7 +1199,7 @@ static double push_cost(double r_sum, double q_i, void *ctx)
     if (r_sum == 0.0) return 0.0;
     if (c->budget > 0) return c->budget * (r_sum / c->bnorm1) * (r_sum / c->bnorm1);
     double E = c->s->o.stop.rel_err, m = fabs(q_i + c->s->o.stop.rel_err_offset);
-    return fmax((double)ULAM__REL_MIN, ulam__solver_range_walks(c->s, r_sum / c->bnorm1, 0, m, E)) * c->per_walk;
+    return fmax((double)ULAM__REL_FIRST, ulam__solver_range_walks(c->s, r_sum / c->bnorm1, 0, m, E)) * c->per_walk;
 }
 
 /* The budget a forward push is planned for: 0 under a rel_err target (its own model), else for
@@ -1499,7 +1499,7 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
 
 /* Nonzero when the rel_err rule holds for r (see ulam_solve_walks in ulam.h): the run's 95% interval
  * (stop.h) meeting ulam__stop_rel_met (stderr <= E |m|, and the whole half-width, range and bias
- * terms included, within 2 sqrt(2 L) E |m|), after ULAM__REL_MIN walks, forward with
+ * terms included, within 2 sqrt(2 L) E |m|), after ULAM__REL_FIRST walks, forward with
  * the watched component tallied, and walks cut at max_steps moving it by at most
  * ULAM__CUT_SHARE E |m|; x certified 0 (nothing that scores is reachable) meets it at once. */
 static int rel_err_met(const ulam_solver *s, const ulam_walk_result *r)
@@ -1690,8 +1690,10 @@ static double score_range(const ulam_solver *s, double m, double E, int own)
  * both signs when signs, under this solver's reachability bounds, which must have been made for
  * scores of at most 1 a visit (b = 1; check_reach runs for rel_err > 0 or absorption): the
  * per-visit route of score_range, or the second moment's scaled by per_visit^2; INFINITY when
- * neither gives a bound.  For a planner that knows the scores only after these walks' set-up
- * (src/bidir.c: the push's residual). */
+ * neither gives a bound.  The walks are the confidence sequence's at variance 0 (stop.h's
+ * ulam__cs_walks_needed at the limit A = R, R / 2 with signs, as score_limit), the rule the run
+ * stops on; the empirical-Bernstein rule's range term before predicted about half of them.  For a
+ * planner that knows the scores only after these walks' set-up (src/bidir.c: the push's residual). */
 double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int signs, double m, double E)
 {
     if (!(per_visit > 0)) return 0.0;
@@ -1702,8 +1704,7 @@ double ulam__solver_range_walks(const ulam_solver *s, double per_visit, int sign
                                           signs, m, E);
     if (!isfinite(R) && !absorb) R = ulam__moment_range(s->v2 * per_visit * per_visit, signs, m, E);
     if (!isfinite(R)) return INFINITY;
-    double n = ulam__stop_walks_needed(m, 0.0, R, 0.0, E, 1); /* the rule's range term, at the epoch it lands in */
-    return isfinite(n) ? ulam__stop_walks_needed(m, 0.0, R, 0.0, E, ulam__stop_epoch((int64_t)n)) : n;
+    return ulam__cs_walks_needed(m, 0.0, signs ? R / 2.0 : R, 0.0, E); /* the sequence's range term (score_limit's A) */
 }
 
 /* The most the walks cut at max_steps can have moved the mean (0 without cuts). */

@@ -33,8 +33,13 @@ double ulam__moments_variance_rel_error(const ulam__moments *m);
  * and n = 2. */
 void ulam__sums_moments(double n, double sum, double sumsq, double *mean, double *variance);
 
-/* The fewest walks a --rel-err run makes (the rule itself is src/stop.h's). */
+/* The fewest walks a --rel-err run makes before the rules that give up (out of reach, cuts) may
+ * stop it (the rule itself is src/stop.h's). */
 #define ULAM__REL_MIN 1000
+/* The fewest walks at which the matrix solver's rel_err rule is checked (its first round): the
+ * sequence holds at every count, so a run may meet its target there; the least walks a
+ * prediction of that rule's (auto, bidirectional, the push on b) may give. */
+#define ULAM__REL_FIRST 256
 /* A --rel-err run that still has no interval (a score past the certified range: it stays past)
  * when it has run this many times the walks the rule asks for stops, not met, instead of
  * walking on to the 1e9 cap (r500's expected estimator at E = 0.01 spun 1e9 walks, 92 s). */

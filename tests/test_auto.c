@@ -796,6 +796,15 @@ static void test_prediction_agrees(void **state)
                   ulam_method_name(ch->chosen), pred, ran, ran / pred);
     assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
     assert_true(ran <= 3.0 * pred && pred <= 3.0 * ran);
+    /* the README's run (its own b, x_7 at E = 0.01): the rule meets at its first check (256 walks)
+       after the push on b, which a floor of 1000 walks in the prediction put at 3.9x */
+    o.stop.rel_err = 0.01;
+    assert_int_equal(ulam_auto(M, b2, &o, NULL, NULL, ch, &a, NULL), ULAM_OK);
+    pred = ch->bidir.predicted_walks, ran = (double)a.walks.walks;
+    print_message("randsub1000_b, E = 0.01: %s, predicted %.4g walks, walked %.4g (ratio %.3g)\n",
+                  ulam_method_name(ch->chosen), pred, ran, ran / pred);
+    assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
+    assert_true(ran <= 3.0 * pred && pred <= 3.0 * ran);
     ulam_auto_opts ao = ulam_auto_defaults();
     ao.pin_estimator = 1, o.estimator = ULAM_EXPECTED, o.exec.threads = 2;
     double bw[2], lw[2];
