@@ -19,7 +19,7 @@ static void print_scene_rule(FILE *f, const args *a, const walked *w)
 {
     const ulam_rad_scene_rule *q = &w->scene;
     fprintf(f, "rel-err      %s on the %s: %lld of %lld lit patches (%.4g of the lit area; the rule: %.4g) within "
-           "%g;\n             the largest relative standard error %.3g, 95%% half-width %.3g (patch %lld)\n",
+           "%g;\n             the largest relative standard error %.3g, 95%% half-width / B %.3g (patch %lld)\n",
            w->rel_err_met ? "met" : "NOT met", a->patches ? "chosen patches" : "whole scene", (long long)q->met, (long long)q->lit,
            q->lit_area > 0 ? q->met_area / q->lit_area : 0.0, q->share, a->o.stop.rel_err, q->worst_se, q->worst_half,
            (long long)q->worst_patch + 1);
