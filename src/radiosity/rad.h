@@ -228,6 +228,9 @@ void ulam__point_walk(const ulam_tracer *t, const ulam__lights *L, int estimator
 /* Allocate an empty scene with room for the given counts (arrays uninitialised). */
 ulam_scene *ulam__scene_alloc(int64_t npatches, int64_t nverts, int64_t nidx, int64_t ngroups);
 
+/* The index of s's group label, or -1 (src/radiosity/scene.c). */
+int64_t ulam__scene_group(const ulam_scene *s, const char *label);
+
 /* Copy s's group labels into o (made with s->ngroups); on failure o is freed (src/radiosity/scene.c). */
 int ulam__scene_copy_groups(ulam_scene *o, const ulam_scene *s);
 

@@ -258,9 +258,8 @@ static int find_patches(const args *a, const ulam_scene *s, const char *arg, uns
             }
             for (long long k = lo; !rc && k <= hi; k++) want[k - 1] = 1;
         } else {
-            int64_t g = 0;
-            while (g < s->ngroups && strcmp(s->groups[g], item)) g++;
-            if (g == s->ngroups) {
+            int64_t g = ulam__scene_group(s, item);
+            if (g < 0) {
                 ulam__run_log(a, "ulam radiosity: --patches: '%s' is neither a patch number, a range K-L nor a label; "
                                  "labels:", item);
                 for (int64_t k = 0; k < s->ngroups; k++) ulam__run_log(a, " %s", s->groups[k]);

@@ -317,8 +317,8 @@ void ulam_scene_centroid(const ulam_scene *s, int64_t p, double c[3])
     ulam__polygon_centroid(s->vert, s->vidx + s->start[p], s->start[p + 1] - s->start[p], c);
 }
 
-/* The index of group label, or -1. */
-static int64_t group_of(const ulam_scene *s, const char *label)
+/* The index of group label, or -1 (rad.h). */
+int64_t ulam__scene_group(const ulam_scene *s, const char *label)
 {
     for (int64_t i = 0; i < s->ngroups; i++)
         if (!strcmp(s->groups[i], label)) return i;
@@ -329,7 +329,7 @@ static int64_t group_of(const ulam_scene *s, const char *label)
 int ulam_scene_label_centroid(const ulam_scene *s, const char *label, double c[3])
 {
     if (!s || !label || !c) return ULAM_EINVAL;
-    int64_t g = group_of(s, label);
+    int64_t g = ulam__scene_group(s, label);
     double A = 0.0, m[3];
     c[0] = c[1] = c[2] = 0.0;
     for (int64_t p = 0; g >= 0 && p < s->npatches; p++) {
@@ -385,7 +385,7 @@ int ulam_scene_find(const ulam_scene *s, const char *label, int64_t *patch)
     double c[3], m[3], e[3], best = INFINITY;
     int status = ulam_scene_label_centroid(s, label, c);
     if (status) return status;
-    int64_t g = group_of(s, label);
+    int64_t g = ulam__scene_group(s, label);
     for (int64_t p = 0; p < s->npatches; p++)
         if (s->group[p] == g && contains(s, p, c)) {
             *patch = p;
