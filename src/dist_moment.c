@@ -7,6 +7,7 @@
  * spectral condition), so E X^2 <= z at the query's row.  Only exact maxima cross ranks and
  * each row's sum is taken in its own order: the same bits at any rank count. */
 #include "part.h"
+#include "supersolve.h"
 
 #include <float.h>
 #include <math.h>
@@ -27,85 +28,71 @@ static void product(const ulam_part *p, const ulam__halo *h, int grow, const dou
     }
 }
 
-enum { ITER = 400, NF = 5 };
+/* What the search needs on a partition: the rank's rows of A (|M|, or M^ with grow), its
+ * halo and ghost values, and the queries whose rows' least certified values are kept. */
+typedef struct {
+    const ulam_part *p;
+    const ulam_comm *c;
+    const ulam__halo *h;
+    int grow;
+    double *gv;
+    const int64_t *idx;
+    int64_t nq;
+    double *q;
+} dist_ctx;
 
-/* A certified z >= the solution of m = r + A m (r >= 0) on this rank's rows: lazy iterates m <-
- * (m + r + A m) / 2 from r, and every fourth one the candidates m + beta e, e = res + phi max res
- * (res = r + A m - m, turning towards A's Perron vector), beta = max res / (e - A e) (src/solve.c
- * moment_solve, whose margins it keeps).  z: the candidate of least max z (its rows here); q[k]
- * (this rank's own query rows; INFINITY elsewhere): the least a candidate gave at row idx[k].
- * Stops when 40 iterates lower max z by less than 0.1% or r + A m <= m.  *any: whether a
- * candidate held.  Nonzero on a failed exchange or memory. */
+/* y = r + A v on this rank's rows, v's halo exchanged first (src/supersolve.h's product). */
+static int dist_apply(void *ctx, const double *r, const double *v, double *y)
+{
+    dist_ctx *d = ctx;
+    if (ulam__halo_swap(d->p, d->c, d->h, v, d->gv)) return 1;
+    product(d->p, d->h, d->grow, r, v, d->gv, y);
+    return 0;
+}
+
+/* x[0..k) to their largest over ranks (src/supersolve.h's largest). */
+static int dist_largest(void *ctx, double *x, int k)
+{
+    const dist_ctx *d = ctx;
+    return ulam__dist_largest_n(d->c, x, k);
+}
+
+/* The largest entry of candidate m + bb (res + phi) on this rank's rows, rounded up. */
+static double dist_worth(void *ctx, const double *m, const double *res, double phi, double bb)
+{
+    const dist_ctx *d = ctx;
+    double top = 0.0;
+    for (int64_t i = 0; i < d->p->last - d->p->first; i++) top = fmax(top, (m[i] + bb * (res[i] + phi)) * (1.0 + 1e-9));
+    return top;
+}
+
+/* Each query row of this rank's: the least value a candidate gave it. */
+static void dist_offer(void *ctx, const double *m, const double *res, double phi, double bb)
+{
+    dist_ctx *d = ctx;
+    for (int64_t k = 0; k < d->nq; k++)
+        if (d->idx[k] >= d->p->first && d->idx[k] < d->p->last) {
+            int64_t i = d->idx[k] - d->p->first;
+            d->q[k] = fmin(d->q[k], (m[i] + bb * (res[i] + phi)) * (1.0 + 1e-9));
+        }
+}
+
+/* A certified z >= the solution of m = r + A m (r >= 0) on this rank's rows (src/supersolve.c):
+ * the candidate of least max z; q[k] (this rank's own query rows; INFINITY elsewhere): the least
+ * a candidate gave at row idx[k].  *any: whether a candidate held.  Nonzero on a failed
+ * exchange or memory. */
 static int supersolve(const ulam_part *p, const ulam_comm *c, const ulam__halo *h, int grow, const double *r,
                       const int64_t *idx, int64_t nq, double *z, double *q, int *any)
 {
-    static const double phis[NF] = {0.0, 1e-12, 1e-8, 1e-4, 1e-2};
     int64_t rows = p->last - p->first;
-    size_t nr = (size_t)rows + 1, ng = (size_t)h->nghost + 1;
-    double *m = malloc(nr * sizeof *m), *y = malloc(nr * sizeof *y), *res = malloc(nr * sizeof *res);
-    double *ar = malloc(nr * sizeof *ar), *rs = malloc(nr * sizeof *rs), *one = malloc(nr * sizeof *one);
-    double *gv = malloc(ng * sizeof *gv), *g1 = malloc(ng * sizeof *g1), best = INFINITY;
-    int bad = !m || !y || !res || !ar || !rs || !one || !gv || !g1;
-    *any = 0;
+    double *gv = malloc(((size_t)h->nghost + 1) * sizeof *gv), best = INFINITY;
+    dist_ctx d = {p, c, h, grow, gv, idx, nq, q};
+    ulam__super s = {&d, rows, NULL, INFINITY, 1.0 + 1e-9, dist_apply, dist_largest, dist_worth, dist_offer};
     for (int64_t k = 0; k < nq; k++) q[k] = INFINITY;
-    for (int64_t i = 0; !bad && i < rows; i++) m[i] = r[i], one[i] = 1.0, z[i] = INFINITY;
-    for (int64_t g = 0; !bad && g < h->nghost; g++) g1[g] = 1.0;
-    if (!bad) product(p, h, grow, NULL, one, g1, rs); /* A's row sums */
-    for (int it = 0, last = 0; !bad && it < ITER && it - last < 40; it++) {
-        if ((bad = ulam__halo_swap(p, c, h, m, gv))) break;
-        product(p, h, grow, r, m, gv, y);
-        double D = 0.0;
-        for (int64_t i = 0; i < rows; i++) res[i] = fmax(y[i] * (1.0 + 1e-10) - m[i], 0.0), D = fmax(D, res[i]);
-        if (it % 4 != 3) { /* a lazy step; the check every fourth iterate */
-            for (int64_t i = 0; i < rows; i++) m[i] += res[i] / 2.0 / (1.0 + 1e-10);
-            continue;
-        }
-        if ((bad = ulam__dist_largest_n(c, &D, 1)) || !isfinite(D)) break;
-        if (!(D > 0)) { /* r + A m <= m already */
-            double top = 0.0;
-            for (int64_t i = 0; i < rows; i++) top = fmax(top, m[i]);
-            if ((bad = ulam__dist_largest_n(c, &top, 1))) break;
-            if (top < best)
-                for (int64_t i = 0; i < rows; i++) z[i] = m[i];
-            for (int64_t k = 0; k < nq; k++)
-                if (idx[k] >= p->first && idx[k] < p->last) q[k] = fmin(q[k], m[idx[k] - p->first]);
-            *any = 1;
-            break;
-        }
-        if ((bad = ulam__halo_swap(p, c, h, res, gv))) break;
-        product(p, h, grow, NULL, res, gv, ar);
-        double beta[NF] = {0}, top[NF] = {0};
-        for (int fl = 0; fl < NF; fl++) {
-            double phi = phis[fl] * D;
-            for (int64_t i = 0; i < rows && isfinite(beta[fl]); i++) {
-                double e = res[i] + phi, gap = e - (ar[i] + phi * rs[i]) * (1.0 + 1e-10);
-                if (!isfinite(m[i]) || !isfinite(e) || !isfinite(gap)) beta[fl] = INFINITY; /* overflow: none */
-                else if (res[i] > 0) beta[fl] = gap > 0 ? fmax(beta[fl], res[i] / gap) : INFINITY;
-                else if (gap < 0) beta[fl] = INFINITY;
-            }
-        }
-        if ((bad = ulam__dist_largest_n(c, beta, NF))) break;
-        for (int fl = 0; fl < NF; fl++)
-            for (int64_t i = 0; isfinite(beta[fl]) && i < rows; i++)
-                top[fl] = fmax(top[fl], (m[i] + beta[fl] * (1.0 + 1e-9) * (res[i] + phis[fl] * D)) * (1.0 + 1e-9));
-        if ((bad = ulam__dist_largest_n(c, top, NF))) break;
-        for (int fl = 0; fl < NF; fl++) {
-            if (!isfinite(beta[fl])) continue;
-            double phi = phis[fl] * D, bb = beta[fl] * (1.0 + 1e-9);
-            *any = 1;
-            for (int64_t k = 0; k < nq; k++)
-                if (idx[k] >= p->first && idx[k] < p->last) {
-                    int64_t i = idx[k] - p->first;
-                    q[k] = fmin(q[k], (m[i] + bb * (res[i] + phi)) * (1.0 + 1e-9));
-                }
-            if (!(top[fl] < best)) continue;
-            if (top[fl] < best * (1.0 - 1e-3)) last = it;
-            best = top[fl];
-            for (int64_t i = 0; i < rows; i++) z[i] = (m[i] + bb * (res[i] + phi)) * (1.0 + 1e-9);
-        }
-        for (int64_t i = 0; i < rows; i++) m[i] += res[i] / 2.0 / (1.0 + 1e-10); /* not past the solution */
-    }
-    free(m), free(y), free(res), free(ar), free(rs), free(one), free(gv), free(g1);
+    for (int64_t i = 0; i < rows; i++) z[i] = INFINITY;
+    int bad = !gv || ulam__super_solve(&s, r, z, &best, NULL);
+    *any = isfinite(best);
+    free(gv);
     return bad;
 }
 

@@ -17,6 +17,7 @@
 #include "spectral.h"
 #include "stats.h"
 #include "stop.h"
+#include "supersolve.h"
 #include "walk.h"
 
 #include <math.h>
@@ -369,68 +370,44 @@ static void moment_product(const ulam_csr *K, const double *fac, const double *f
     }
 }
 
+/* What moment_solve's search needs: A (|K|, times fac or f as in moment_product) on the seen
+ * states, and the starts pi its candidates are aimed at. */
+typedef struct {
+    const ulam_csr *K;
+    const double *fac, *f, *pi;
+    const char *seen;
+} moment_ctx;
+
+/* y = r + A v (src/supersolve.h's product). */
+static int moment_apply(void *ctx, const double *r, const double *v, double *y)
+{
+    const moment_ctx *c = ctx;
+    moment_product(c->K, c->fac, c->f, c->seen, r, v, y);
+    return 0;
+}
+
+/* pi . (m + bb (res + phi)), rounded up (src/supersolve.h's worth). */
+static double moment_worth(void *ctx, const double *m, const double *res, double phi, double bb)
+{
+    const moment_ctx *c = ctx;
+    double pm = 0.0, pe = 0.0;
+    for (int64_t i = 0; i < c->K->nrows; i++) pm += c->seen[i] ? c->pi[i] * m[i] : 0.0;
+    for (int64_t i = 0; bb > 0 && i < c->K->nrows; i++) pe += c->seen[i] ? c->pi[i] * (res[i] + phi) : 0.0;
+    return (pm + bb * pe) * (1.0 + 1e-9);
+}
+
 /* A certified upper bound on the solution m = r + A m (r >= 0, A as in moment_product) over
- * the seen states, aimed at the starts pi: a z with r + A z <= z, so z >= sum_k A^k r = m
- * (induction; no spectral condition needed).  m_k: lazy iterates m <- (m + r + A m) / 2 from r
- * (they rise to m; the lazy step settles on periodic chains); each gives z = m_k + beta e with
- * e = res + phi max(res), res = r + A m_k - m_k (the iterates' increment, which turns towards
- * A's Perron vector, so e - A e ~ (1 - rho) e and z ~ m), beta = max res / (e - A e) where
- * e > A e.  The products' rounding is covered by a relative 1e-10 on A's sums and 1e-9 on
- * beta.  The z with the least pi . z over ITER iterations (fewer: 40 bring nothing, or past
- * deadline) is kept in z, checked every fourth iterate; returns pi . z (INFINITY: none
- * certified, or out of memory). */
+ * the seen states, aimed at the starts pi: src/supersolve.c's z of least pi . z over ITER
+ * iterations (fewer: 40 bring nothing, or past deadline), kept in z; returns pi . z
+ * (INFINITY: none certified, or out of memory). */
 static double moment_solve(const ulam_csr *K, const double *fac, const double *f, const char *seen, const double *r,
                            const double *pi, double deadline, double *z, int *iterations)
 {
-    enum { ITER = 400, NF = 5 };
-    static const double phis[NF] = {0.0, 1e-12, 1e-8, 1e-4, 1e-2};
-    int64_t n = K->nrows;
-    double *m = ulam__malloc((size_t)n, sizeof *m), *y = ulam__malloc((size_t)n, sizeof *y);
-    double *res = ulam__malloc((size_t)n, sizeof *res), *ar = ulam__malloc((size_t)n, sizeof *ar);
-    double *rs = ulam__malloc((size_t)n, sizeof *rs), *one = ulam__malloc((size_t)n, sizeof *one), best = INFINITY;
-    for (int64_t i = 0; m && y && res && ar && rs && one && i < n; i++) m[i] = seen[i] ? r[i] : 0.0, one[i] = 1.0, z[i] = 0.0;
-    if (m && y && res && ar && rs && one) moment_product(K, fac, f, seen, NULL, one, rs); /* A's row sums */
-    for (int it = 0, last = 0; m && y && res && ar && rs && one && it < ITER && it - last < 40; it++) {
-        if (isfinite(best) && ulam_now() >= deadline) break;
-        moment_product(K, fac, f, seen, r, m, y);
-        double D = 0.0;
-        for (int64_t i = 0; i < n; i++) res[i] = seen[i] ? fmax(y[i] * (1.0 + 1e-10) - m[i], 0.0) : 0.0, D = fmax(D, res[i]);
-        ++*iterations;
-        double pm = 0.0;
-        for (int64_t i = 0; i < n; i++) pm += seen[i] ? pi[i] * m[i] : 0.0;
-        if (!isfinite(pm)) break;
-        if (D > 0 && it % 4 != 3) { /* the check's product every fourth iterate */
-            for (int64_t i = 0; i < n; i++)
-                if (seen[i]) m[i] += res[i] / 2.0 / (1.0 + 1e-10);
-            continue;
-        }
-        if (D > 0) moment_product(K, fac, f, seen, NULL, res, ar), ++*iterations;
-        if (!(D > 0)) { /* r + A m <= m already */
-            if (pm * (1.0 + 1e-9) < best)
-                for (int64_t i = 0; i < n; i++) z[i] = seen[i] ? m[i] : 0.0;
-            best = fmin(best, pm * (1.0 + 1e-9));
-            break;
-        }
-        for (int fl = 0; fl < NF; fl++) {
-            double beta = 0.0, pe = 0.0, phi = phis[fl] * D;
-            for (int64_t i = 0; i < n && isfinite(beta); i++) {
-                if (!seen[i]) continue;
-                double e = res[i] + phi, gap = e - (ar[i] + phi * rs[i]) * (1.0 + 1e-10);
-                if (res[i] > 0) beta = gap > 0 ? fmax(beta, res[i] / gap) : INFINITY;
-                else if (gap < 0) beta = INFINITY;
-                pe += pi[i] * e;
-            }
-            double v = (pm + beta * (1.0 + 1e-9) * pe) * (1.0 + 1e-9);
-            if (isfinite(v) && v < best) {
-                if (v < best * (1.0 - 1e-3)) last = it;
-                best = v;
-                for (int64_t i = 0; i < n; i++) z[i] = seen[i] ? m[i] + beta * (1.0 + 1e-9) * (res[i] + phi) : 0.0;
-            }
-        }
-        for (int64_t i = 0; i < n; i++)
-            if (seen[i]) m[i] += res[i] / 2.0 / (1.0 + 1e-10); /* m_{k+1} = (m + r + A m) / 2, not past it */
-    }
-    free(m), free(y), free(res), free(ar), free(rs), free(one);
+    moment_ctx c = {K, fac, f, pi, seen};
+    ulam__super s = {&c, K->nrows, seen, deadline, 1.0, moment_apply, NULL, moment_worth, NULL};
+    double best = INFINITY;
+    for (int64_t i = 0; i < K->nrows; i++) z[i] = 0.0;
+    if (ulam__super_solve(&s, r, z, &best, iterations)) return INFINITY;
     return best;
 }
 
