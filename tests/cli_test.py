@@ -613,6 +613,7 @@ def check_radiosity_chosen(ulam):
                                                   r"label; labels: floor ceiling left right front back"),
                          (["--patches", "3,25"], r"--patches: 25 is out of range 1\.\.24"),
                          (["--patches", "0-2"], r"--patches: 0 is out of range 1\.\.24"),
+                         (["--patches", "99999999999999999999"], r"--patches: '99999999999999999999' is out of range 1\.\.24"),
                          (["--patches", "5-2"], r"--patches: the range 5-2 is empty \(K-L needs K <= L\)"),
                          (["--patches", "1,,2"], r"--patches: an empty item in '1,,2'"),
                          (["--patches", ""], r"--patches: an empty item in ''")):

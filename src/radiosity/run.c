@@ -5,6 +5,7 @@
 
 #include "rad.h"
 
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -249,8 +250,13 @@ static int find_patches(const args *a, const ulam_scene *s, const char *arg, uns
         } else if (patch_number(item, &end, &lo) && (!*end || (patch_number(end + 1, &end, &hi) && !*end))) {
             if (!strchr(item, '-')) hi = lo;
             if (lo < 1 || lo > n || hi < 1 || hi > n) {
-                ulam__run_log(a, "ulam radiosity: --patches: %lld is out of range 1..%lld (in '%s'; see --list)\n",
-                              lo < 1 || lo > n ? lo : hi, (long long)n, arg);
+                long long bad = lo < 1 || lo > n ? lo : hi;
+                if (bad == LLONG_MAX) /* past long long: strtoll's clamp is not what was typed */
+                    ulam__run_log(a, "ulam radiosity: --patches: '%s' is out of range 1..%lld (see --list)\n", item,
+                                  (long long)n);
+                else
+                    ulam__run_log(a, "ulam radiosity: --patches: %lld is out of range 1..%lld (in '%s'; see --list)\n",
+                                  bad, (long long)n, arg);
                 rc = ULAM_RAD_RUN_USAGE;
             } else if (hi < lo) {
                 ulam__run_log(a, "ulam radiosity: --patches: the range %s is empty (K-L needs K <= L)\n", item);
