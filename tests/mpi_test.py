@@ -5,6 +5,7 @@ whose --out file must match byte for byte), study (runs.csv estimates) and radio
 Run from the source root: mpi_test.py path/to/ulam path/to/mpirun"""
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -302,6 +303,28 @@ def check_partition_kill(ulam, mpirun, d):
             assert p.returncode != 0 and not p.stdout and "rank 1" in p.stderr and "signal 9" in p.stderr, (at, p.returncode, p.stdout, p.stderr)
 
 
+def check_partition_stall(ulam, mpirun, d):
+    """Issue 43: a message delayed without end (rank 1 of 3 stops for good, alive and silent, as it
+    enters its 26th exchange, among the walks: the ULAM_TEST_PARTITION_STALL=rank:exchange hook of
+    src/cli/mpi.c) ends the job once the others have waited ULAM_EXCHANGE_TIMEOUT (1 s here): a
+    non-zero exit, the waiting rank's message naming what it waited for, no stdout, not a hang.  A
+    timeout that is not a number is named and the default kept (the run then ends normally).  No
+    clock in the test: the wait is the program's; the timeout here is 120 s."""
+    m, b = write_system(d, 3000, 5)
+    sysf = f"{d}/s.ulam"
+    run([ulam, "prepare", m, "--rhs", b, "--transpose", "-o", sysf])
+    cmd = [mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "1234", "--walks", "40000",
+           "--seed", "3"]
+    quiet = run(cmd)
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=120,
+                       env=dict(ENV, ULAM_TEST_PARTITION_STALL="1:26", ULAM_EXCHANGE_TIMEOUT="1"))
+    assert p.returncode != 0 and not p.stdout and re.search(r"rank [02] of 3: no message sizes from the other ranks in 1 s",
+                                                            p.stderr), (p.returncode, p.stdout, p.stderr)
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=120, env=dict(ENV, ULAM_EXCHANGE_TIMEOUT="soon"))
+    assert p.returncode == 0 and p.stdout.splitlines()[0] == quiet.splitlines()[0] and \
+        "ULAM_EXCHANGE_TIMEOUT=soon is not a number of seconds" in p.stderr, (p.returncode, p.stderr)
+
+
 def check_partition_mtx(ulam, mpirun, d):
     """Issue 43: Matrix Market read by byte ranges on a partition (--rhs): each rank parses its share
     of the lines.  A file with shuffled rows, split duplicates, an explicit zero, a comment and a blank
@@ -547,6 +570,7 @@ def main():
                             ("partition forward index", check_partition_forward_index),
                             ("partition forward top", check_partition_forward_top),
                             ("partition rank killed", check_partition_kill),
+                            ("partition rank stalled", check_partition_stall),
                             ("partition matrix market", check_partition_mtx),
                             ("partition source without b", check_partition_source_graph)):
             try:
