@@ -479,6 +479,15 @@ def check_partition_memory(ulam, mpirun, d):
     return rss
 
 
+PARTITION_CHECKS = (("partition", check_partition), ("partition rows above 1", check_partition_growing),
+                    ("partition forward index", check_partition_forward_index),
+                    ("partition forward top", check_partition_forward_top),
+                    ("partition rank killed", check_partition_kill),
+                    ("partition rank stalled", check_partition_stall),
+                    ("partition matrix market", check_partition_mtx),
+                    ("partition source without b", check_partition_source_graph))
+
+
 def main():
     ulam, mpirun = sys.argv[1], sys.argv[2]
     par = [mpirun, "--oversubscribe", "-np", "2", ulam]
@@ -566,13 +575,7 @@ def main():
             except AssertionError as e:
                 failures += 1
                 print(f"FAIL {name}: {e}")
-        for name, check in (("partition", check_partition), ("partition rows above 1", check_partition_growing),
-                            ("partition forward index", check_partition_forward_index),
-                            ("partition forward top", check_partition_forward_top),
-                            ("partition rank killed", check_partition_kill),
-                            ("partition rank stalled", check_partition_stall),
-                            ("partition matrix market", check_partition_mtx),
-                            ("partition source without b", check_partition_source_graph)):
+        for name, check in PARTITION_CHECKS:
             try:
                 check(ulam, mpirun, d)
                 print(f"ok {name}")
@@ -592,7 +595,7 @@ def main():
     except AssertionError as e:
         failures += 1
         print(f"FAIL interrupt: {e}")
-    print(f"{len(cases) + 9 - failures} passed, {failures} failed")
+    print(f"{len(cases) + len(PARTITION_CHECKS) + 2 - failures} passed, {failures} failed")  # + memory, interrupt
     return 1 if failures else 0
 
 
