@@ -235,7 +235,8 @@ static double second_moment(const seq *S, int64_t k)
  * steps or more, and E (|X| - A)_+ <= bmax sum_{j >= K} P(T >= j) <= bmax c u^K / (1 - u); K the
  * least with that at most t, t as the single-machine plan takes it (src/solve.c plan_terms): an
  * eighth of the target half-width, at most a hundredth of |x| (or of its bound bmax c / (1 - u)).
- * With growing weights (cert.second) the second moment bounds the clipping instead. */
+ * With growing weights (cert.second) the second moment bounds the clipping instead, and t is
+ * raised to where the clipping's bias and the range it leaves balance. */
 static void clip_plan(const seq *S, int64_t k, const double *mk, int64_t walks, double *A, double *b, double *h,
                       double *nplan)
 {
@@ -247,6 +248,10 @@ static void clip_plan(const seq *S, int64_t k, const double *mk, int64_t walks, 
     *h = S->E > 0 && mabs > 0 ? S->E * mabs : 0.0;
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), t = fmin(fmax(ULAM__STOP_TAIL, S->E / 4.0) * m, fmax(hp / 8.0, 1e-6 * m));
     if (S->cert.second) { /* (|X| - A)_+ <= X^2 / (4 A): past A = v2 / (4 t) clipping moves the mean at most t */
+        /* the range then adds about R / t (R: the range term of limit v2 / 4), so t + R / t is least
+           at t = sqrt R: taken when larger (at a --rel-err target, at most a quarter of it) */
+        double tb = sqrt(ulam__cs_range_width(v2 / 4.0, *nplan));
+        t = fmax(t, S->E > 0 ? fmin(tb, S->E / 4.0 * m) : tb);
         *A = v2 / (4.0 * t), *b = t * (1.0 + 1e-9);
         return;
     }

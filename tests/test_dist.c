@@ -624,8 +624,10 @@ static void make_growing(const char *path, int64_t n, uint64_t seed, double *x)
  * aimed at the query's start (src/dist_moment.c; was Minkowski over a Collatz-Wielandt vector
  * of all rows, about 90 times wider here).  Over 40 seeds at 4000 walks on 2 thread-ranks the
  * certified interval covers x_0 in at least 33 (Binomial(40, 0.95) is below 33 with probability
- * 0.0034) and its mean half-width is under 25 standard errors (it was about 2000); the interval's
- * bits are the same at 1, 2 and 3 ranks and in 2 sets of 2. */
+ * 0.0034), and in 33 of 40 at 300 walks, and its mean half-width is under 10 standard errors (it
+ * was about 2000, then 19.1 while the clip kept its bias to an eighth of the planned width and
+ * paid the range that left: 6.97 with the two balanced); the interval's bits are the same at 1,
+ * 2 and 3 ranks and in 2 sets of 2. */
 static void test_dist_interval_growing(void **state)
 {
     (void)state;
@@ -634,8 +636,14 @@ static void test_dist_interval_growing(void **state)
     int64_t n = 400;
     double *x = malloc((size_t)n * sizeof *x);
     make_growing(path, n, 5, x);
-    int cover = 0, seeds = 40;
+    int cover = 0, seeds = 40, few = 0;
     double ratio = 0.0; /* half-width / standard error, mean over the seeds */
+    for (int s = 0; s < seeds; s++) { /* a small budget: the clipping's bias is the largest share */
+        job jobs[MAXR], t = {.path = path, .walks = 300, .index = 3, .ci = 1, .seed = 1000 + (uint64_t)s};
+        run_jobs(2, &t, jobs);
+        assert_int_equal(jobs[0].status, ULAM_OK);
+        few += jobs[0].cis[0].lo <= x[3] && x[3] <= jobs[0].cis[0].hi;
+    }
     for (int s = 0; s < seeds; s++) {
         job jobs[MAXR], t = {.path = path, .walks = 4000, .index = 3, .ci = 1, .seed = (uint64_t)s};
         run_jobs(2, &t, jobs);
@@ -646,10 +654,10 @@ static void test_dist_interval_growing(void **state)
         cover += c->lo <= x[3] && x[3] <= c->hi;
         ratio += (c->hi - c->lo) / 2 / r->std_error / seeds;
     }
-    print_message("growing rows: x_3 %.6g, certified covered %d of %d, half-width %.3g standard errors on average\n", x[3],
-                  cover, seeds, ratio);
-    assert_true(cover >= 33);
-    assert_true(ratio < 25.0);
+    print_message("growing rows: x_3 %.6g, certified covered %d of %d (%d at 300 walks), half-width %.3g standard errors "
+                  "on average\n", x[3], cover, seeds, few, ratio);
+    assert_true(cover >= 33 && few >= 33);
+    assert_true(ratio < 10.0);
     ulam_dist_ci first;
     ulam_dist_result fr;
     for (int k = 1; k <= 4; k++) { /* the same bits at 1, 2, 3 ranks and 2 sets of 2 */
