@@ -281,6 +281,17 @@ def check_partition_forward_top(ulam, mpirun, d):
         assert p.returncode != 0 and not p.stdout and "--top" in p.stderr, (extra, p.returncode, p.stdout, p.stderr)
 
 
+def three_rank_query(ulam, mpirun, d):
+    """The failure checks' run: write_system's 3000 rows prepared, x[1234] by 40000 walks on 3 ranks;
+    its command and what it prints undisturbed."""
+    m, b = write_system(d, 3000, 5)
+    sysf = f"{d}/k.ulam"
+    run([ulam, "prepare", m, "--rhs", b, "--transpose", "-o", sysf])
+    cmd = [mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "1234", "--walks", "40000",
+           "--seed", "3"]
+    return cmd, run(cmd)
+
+
 def check_partition_kill(ulam, mpirun, d):
     """Issue 43: a rank killed mid-run (SIGKILL, no word to the others, while they wait in an
     exchange: the ULAM_TEST_PARTITION_KILL=rank:exchange hook of src/cli/mpi.c) ends the job with
@@ -289,12 +300,7 @@ def check_partition_kill(ulam, mpirun, d):
     ends normally); the walks' 7 rounds are exchanges 23-29, so 26 kills it among the walks and 31
     at the last (rank 0 holds the answer, unprinted).  A quiet run takes about 1.5 s here; the
     timeout is 120 s."""
-    m, b = write_system(d, 3000, 5)
-    sysf = f"{d}/k.ulam"
-    run([ulam, "prepare", m, "--rhs", b, "--transpose", "-o", sysf])
-    cmd = [mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "1234", "--walks", "40000",
-           "--seed", "3"]
-    quiet = run(cmd)
+    cmd, quiet = three_rank_query(ulam, mpirun, d)
     for at in (26, 31, 32):
         p = subprocess.run(cmd, capture_output=True, text=True, env=dict(ENV, ULAM_TEST_PARTITION_KILL=f"1:{at}"), timeout=120)
         if at == 32:
@@ -310,12 +316,7 @@ def check_partition_stall(ulam, mpirun, d):
     non-zero exit, the waiting rank's message naming what it waited for, no stdout, not a hang.  A
     timeout that is not a number is named and the default kept (the run then ends normally).  No
     clock in the test: the wait is the program's; the timeout here is 120 s."""
-    m, b = write_system(d, 3000, 5)
-    sysf = f"{d}/s.ulam"
-    run([ulam, "prepare", m, "--rhs", b, "--transpose", "-o", sysf])
-    cmd = [mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "1234", "--walks", "40000",
-           "--seed", "3"]
-    quiet = run(cmd)
+    cmd, quiet = three_rank_query(ulam, mpirun, d)
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=120,
                        env=dict(ENV, ULAM_TEST_PARTITION_STALL="1:26", ULAM_EXCHANGE_TIMEOUT="1"))
     assert p.returncode != 0 and not p.stdout and re.search(r"rank [02] of 3: no message sizes from the other ranks in 1 s",
