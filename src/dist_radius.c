@@ -131,10 +131,11 @@ int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const 
             cert->c[k] = cert->second ? vk * g / (bmax * bmax) * (1.0 + 8.0 * DBL_EPSILON) : vk / vmin * (1.0 + 4.0 * DBL_EPSILON);
     }
     if (!status && u < 1.0) cert->u = u;
-    if (!status && cert->second && !fwd && u < 1.0) { /* the second moment aimed at each start: far tighter */
+    if (!status && cert->second && u < 1.0) { /* the second moment aimed at each start (forward: at the row watched) */
         cert->v2 = malloc(((size_t)nq + 1) * sizeof *cert->v2);
-        status = cert->v2 ? ulam__dist_moment(p, comm, index, nq, cert->v2, err)
-                          : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
+        if (!cert->v2) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld queries", (long long)nq);
+        else if (!fwd) status = ulam__dist_moment(p, comm, index, nq, cert->v2, err);
+        for (int64_t k = 0; !status && fwd && k < nq; k++) status = ulam__dist_moment_forward(p, comm, index[k], &cert->v2[k], err);
     }
     free(keep), free(bits);
     return status;

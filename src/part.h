@@ -81,7 +81,8 @@ void ulam__halo_free(ulam__halo *h);
 typedef struct {
     double u, bmax;
     double *c;  /* per query, malloc'd */
-    double *v2; /* adjoint, second: per query, E X^2 <= v2 aimed at its start (ulam__dist_moment), malloc'd;
+    double *v2; /* second: per query, E X^2 <= v2 aimed at its start (adjoint, ulam__dist_moment) or at the row
+                   watched (forward, ulam__dist_moment_forward), malloc'd;
                    NULL otherwise */
     int second; /* a row sums above 1: u certifies M^ = diag(max(1, S)) |M| (the weights' second moment),
                    and a score's E X^2 <= bmax^2 c / (1 - sqrt u)^2 (Minkowski over the steps) bounds
@@ -100,6 +101,11 @@ int ulam__dist_tail(const ulam_part *p, const ulam_comm *comm, int iters, const 
  * second_moment_aimed on the part's rows of M, products through the halo (src/dist_moment.c). */
 int ulam__dist_moment(const ulam_part *p, const ulam_comm *comm, const int64_t *index, int64_t nq, double *v2,
                       ulam_error *err);
+
+/* Forward mode's watched row: the certified E X^2 of one history's tally there (analog kernel
+ * on M', starts by |b|) into *v2, the same on every rank; INFINITY where none held
+ * (src/dist_moment.c). */
+int ulam__dist_moment_forward(const ulam_part *p, const ulam_comm *comm, int64_t watch, double *v2, ulam_error *err);
 
 /* ulam_dist_forward with, for watch >= 0 (0-based), that component's estimate and standard error
  * in res and its certified 95% interval in *ci: its histories' tallies, block by block of walk ids
