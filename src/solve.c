@@ -1190,9 +1190,8 @@ typedef struct {
 /* At a fixed budget (budget > 0 units of walks' work: --walks, --time) the model is instead the
  * work that would take walks from r_sum to the half-width the budget's walks from b reach: each
  * walk's weight, and so the interval's range and standard-error terms, scales with the l1 norm
- * it starts from, so that work is the budget times (r_sum / ||b||_1)^2; a sweep is then made
- * while it saves more of it than it costs (a b of one entry 10^6: --walks 10^5 printed +-6100
- * for x = 9441 before the push served fixed budgets). */
+ * it starts from, so that work is the budget times (r_sum / ||b||_1)^2 (reported only: the
+ * sweeps are then chosen by the narrowing each buys, src/fpush_b.c). */
 static double push_cost(double r_sum, double q_i, void *ctx)
 {
     const push_ctx *c = ctx;
@@ -1215,6 +1214,16 @@ static double push_plan(const ulam_solver *s, double per_walk)
     return isfinite(w) ? w : 0.0;
 }
 
+/* The most units a push for a fixed budget may take (src/fpush_b.c): ULAM__FPUSH_B_CAP times the
+ * walks' work under max_walks, ULAM__FPUSH_B_TIME of the time's under max_seconds, the less. */
+static double push_cap(const ulam_solver *s, double per_walk)
+{
+    const ulam_stop_opts *st = &s->o.stop;
+    double c = st->max_walks > 0 ? ULAM__FPUSH_B_CAP * (double)st->max_walks * per_walk : INFINITY;
+    if (st->max_seconds > 0) c = fmin(c, ULAM__FPUSH_B_TIME * st->max_seconds / ULAM_AUTO_UNIT_SECONDS);
+    return c;
+}
+
 /* Forward walks (no weight window) with a rel_err target or a fixed budget: push b down while
  * that lowers the walks' predicted work (src/fpush_b.c; push_cost's two models), then walk from
  * the residual, its source table and score bounds made anew (*bnorm1 its l1 norm); rel_alone as
@@ -1231,8 +1240,8 @@ static int push_b(ulam_solver *s, int rel_alone, double *bnorm1, ulam_error *err
     s->pq = ulam__calloc((size_t)s->n, sizeof *s->pq), s->pr = ulam__malloc((size_t)s->n, sizeof *s->pr);
     if (!s->pq || !s->pr) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push on b");
     memcpy(s->pr, s->b, (size_t)s->n * sizeof *s->pr);
-    ulam__fpush_b(s->mt, o->query.index, push_cost, &c, plan > 0 ? plan / 2 : ULAM__REL_MIN * c.per_walk, s->pq, s->pr,
-                  &s->push);
+    ulam__fpush_b(s->mt, o->query.index, push_cost, &c, plan > 0 ? plan / 2 : ULAM__REL_MIN * c.per_walk, plan,
+                  plan > 0 ? push_cap(s, pw) : INFINITY, s->pq, s->pr, &s->push);
     s->setup_work += s->push.ops;
     if (s->push.sweeps == 0) { /* not worth a sweep: the walks start from b */
         free(s->pq), free(s->pr);
