@@ -1951,6 +1951,8 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->interrupted = s->run.interrupted;
     r->rho4 = s->rho4;
     r->fourth_finite = s->fourth;
+    r->push_sweeps = s->pq ? s->push.sweeps : 0, r->push_ops = s->pq ? s->push.ops : 0;
+    r->push_residual = s->pq && s->push.r_sum0 > 0 ? s->push.r_sum / s->push.r_sum0 : 1.0;
     if (s->bexp && !walked) { /* walked on b 2^-bexp: back to b's scale (exact) */
         int e = s->bexp;
         r->estimate = ldexp(r->estimate, e), r->std_error = ldexp(r->std_error, e);
