@@ -19,6 +19,7 @@
 #include "stop.h"
 #include "walk.h"
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -1881,6 +1882,19 @@ static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
     ulam__cs_plan4(&s->cs, run->n, run->mean, ulam__moments_variance(run), run->m3, run->m4, A, b, h > b ? h - b : 0.0, nplan);
 }
 
+/* The forward push on b's rounding at x_i (src/fpush_b.c): each of its operations rounds once or
+ * twice (q_j += r_j; r_k += M_kj r_j), at most DBL_EPSILON / 2 of what it adds, so q_i and the
+ * residual the walks start from miss x = q + (I - M)^-1 r by roundings that add up over the push;
+ * bounded as bidir.c's rounding_allowance, by the operations (+ 2 for the walks' mean and its sum
+ * with q_i) times DBL_EPSILON / 2 of |q_i| (the pushed part's size: with M of one sign every add is
+ * of q_i's sign; with cancellations it may miss).  A push to b's rounding (radiosity100,
+ * --walks 10^4: ||r||_1 / ||b||_1 = 1e-14, the walks' interval ~1e-15 of x_i) printed intervals
+ * 1-2 ulp from LAPACK's x_i without it (6 of 68 runs). */
+static double push_rounding(const ulam_solver *s, int64_t i)
+{
+    return ((double)s->push.ops + 2.0) * (DBL_EPSILON / 2.0) * fabs(s->pq[i]);
+}
+
 /* The run's 95% interval so far: the confidence sequence's (stop.h, ulam__cs), valid at every
  * walk count, widened by the cuts' bias, and the range R the next block is planned at; zero
  * width when nothing that scores is reachable (R = 0); none while the variance is not
@@ -1894,6 +1908,10 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
         double m0 = s->o.mode == ULAM_ADJOINT ? s->adj.mean : s->watched.mean, shift = r->estimate - m0;
         ulam__cs_interval(&s->cs, m0, r->cut_bound, ci);
         ci->lo += shift, ci->hi += shift; /* forward: b_i (expected) and the push's part */
+    }
+    if (s->pq && (ci->kind == ULAM__STOP_EB || ci->kind == ULAM__STOP_EXACT)) { /* the push's roundings */
+        double fp = push_rounding(s, s->o.query.index);
+        ci->lo -= fp, ci->hi += fp, ci->half += fp;
     }
     if (s->var_finite != 1 && ci->kind != ULAM__STOP_EXACT) ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
     if (ci->kind == ULAM__STOP_EB && r->estimate != 0.0 && s->maxsq < ULAM__STOP_TINY) /* a b not rescaled (a prepared

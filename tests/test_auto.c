@@ -827,6 +827,46 @@ static void test_push_b_forward_depth(void **state)
     ulam_csr_free(M);
 }
 
+/* The forward push on b taken to b's rounding at a fixed budget: radiosity100 (dense, rows of |M|
+ * summing below 0.9), forward mode pinned, 10^4 and 10^5 walks (the push reaches ||r||_1 / ||b||_1 ~
+ * 1e-14, the walks' interval ~1e-15 of x_i): the push's own roundings are then the larger error,
+ * and every printed interval must hold LAPACK's x_i, with nonzero width, over 17 components and 2
+ * seeds each. */
+static void test_push_b_forward_rounding(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M = load("radiosity100", &b);
+    int64_t n = M->nrows;
+    double *x = malloc((size_t)n * sizeof *x);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    ulam_choice *ch = malloc(sizeof *ch);
+    ulam_answer a;
+    ulam_auto_opts ao = ulam_auto_defaults();
+    ao.pin_mode = 1;
+    int bad = 0, runs = 0, pushed = 0;
+    static const int64_t W[2] = {10000, 100000};
+    for (int w = 0; w < 2; w++)
+        for (int64_t i = 0; i < n; i += 6)
+            for (uint64_t seed = 1; seed <= 2; seed++) {
+                ulam_walk_opts o = ulam_walk_defaults();
+                o.mode = ULAM_FORWARD, o.query.index = i, o.stop.max_walks = W[w], o.exec.seed = seed;
+                assert_int_equal(ulam_auto(M, b, &o, &ao, NULL, ch, &a, NULL), ULAM_OK);
+                runs++, pushed += a.walks.push_residual < 1e-12;
+                if (!(a.ci95[0] <= x[i] && x[i] <= a.ci95[1] && a.ci95[1] > a.ci95[0])) {
+                    print_message("%lld walks, seed %d: x[%lld] = %.17g: %.17g, 95%% CI %.17g .. %.17g (%d sweeps, "
+                                  "||r|| / ||b|| %.3g)\n", (long long)W[w], (int)seed, (long long)i, x[i], a.estimate,
+                                  a.ci95[0], a.ci95[1], a.walks.push_sweeps, a.walks.push_residual);
+                    bad++;
+                }
+            }
+    print_message("%d of %d runs pushed b to its rounding; %d intervals miss x_i or have zero width\n", pushed, runs, bad);
+    assert_true(pushed > runs / 2);
+    assert_int_equal(bad, 0);
+    free(ch), free(b), free(x);
+    ulam_csr_free(M);
+}
+
 /* Issue 38 ("expensive"): the planner's predictions are the rule's.  The rel_err rule is the
  * confidence sequence's (stop.h: the printed half-width at most E |x|, about 2 ln(2 / delta) =
  * 7.4 times var / (E x)^2 walks), and the predictions were var / (E x)^2's.  (1) randsub1000's x_7
@@ -885,6 +925,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_push_b_rounding),
         cmocka_unit_test(test_push_b_forward_depth),
+        cmocka_unit_test(test_push_b_forward_rounding),
         cmocka_unit_test(test_time_budget),
         cmocka_unit_test(test_push_b_sparse),
         cmocka_unit_test(test_choice),
