@@ -867,6 +867,32 @@ static void test_push_b_forward_rounding(void **state)
     ulam_csr_free(M);
 }
 
+/* A forward walk leader pushed to b's rounding is not a pilot that saw nothing (src/method_bidir.c's
+ * fixed_predict): chain4's x_3 (0-based 2), absorption pinned, seed 7, the default 10^5 walks.  Its
+ * pilot's variance (the residual's, ~1e-30) was held against 1e-12 x^2, taken for blind, and the
+ * push on b was piloted (1024 walks) only to lose at -+0.03 against the walks' -+1.6e-15; the
+ * check is now scaled by ||r||_1 / ||b||_1: bidirectional is not considered, the walks run. */
+static void test_push_b_forward_not_blind(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M = load("chain4", &b);
+    ulam_choice *ch = malloc(sizeof *ch);
+    ulam_answer a;
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.query.index = 2, o.exec.seed = 7, o.estimator = ULAM_ABSORPTION;
+    ulam_auto_opts ao = ulam_auto_defaults();
+    ao.pin_estimator = 1;
+    assert_int_equal(ulam_auto(M, b, &o, &ao, NULL, ch, &a, NULL), ULAM_OK);
+    print_message("%s, push %d sweeps; bidirectional: %s\n", ulam_method_name(a.method), a.walks.push_sweeps,
+                  ch->method[ULAM_METHOD_BIDIRECTIONAL].why);
+    assert_int_equal(a.method, ULAM_METHOD_WALKS);
+    assert_true(a.walks.push_sweeps > 0);
+    assert_non_null(strstr(ch->method[ULAM_METHOD_BIDIRECTIONAL].why, "not considered"));
+    free(ch), free(b);
+    ulam_csr_free(M);
+}
+
 /* Issue 38 ("expensive"): the planner's predictions are the rule's.  The rel_err rule is the
  * confidence sequence's (stop.h: the printed half-width at most E |x|, about 2 ln(2 / delta) =
  * 7.4 times var / (E x)^2 walks), and the predictions were var / (E x)^2's.  (1) randsub1000's x_7
@@ -926,6 +952,7 @@ int main(void)
         cmocka_unit_test(test_push_b_rounding),
         cmocka_unit_test(test_push_b_forward_depth),
         cmocka_unit_test(test_push_b_forward_rounding),
+        cmocka_unit_test(test_push_b_forward_not_blind),
         cmocka_unit_test(test_time_budget),
         cmocka_unit_test(test_push_b_sparse),
         cmocka_unit_test(test_choice),
