@@ -1,8 +1,7 @@
 /* embed: the smallest program built against an installed ulam (pkg-config --cflags --libs ulam).
  * It estimates x_0 of (I - M) x = b for a 3-state chain by the library's primary call (an
  * analysis of M, then ulam_analysis_solve: the method `ulam solve` chooses), solves the same
- * system with LAPACK, and exits 0 only when the two agree within four standard errors. */
-#include <math.h>
+ * system with LAPACK, and exits 0 only when LAPACK's x_0 lies in the printed 95% interval. */
 #include <stdio.h>
 
 #include <ulam.h>
@@ -34,8 +33,9 @@ int main(void)
         fprintf(stderr, "embed: %s\n", ulam_strerror(st));
         return 1;
     }
-    double z = (ans.estimate - x[0]) / ans.std_error;
-    printf("ulam %s: x_0 = %.6f +- %.6f by %s (%lld walks); LAPACK %.6f; z = %.2f\n", ULAM_VERSION,
-           ans.estimate, ans.std_error, ulam_method_name(ans.method), (long long)ans.walks.walks, x[0], z);
-    return fabs(z) < 4 ? 0 : 1;
+    int in = ans.ci95[0] <= x[0] && x[0] <= ans.ci95[1];
+    printf("ulam %s: x_0 = %.6f (95%% CI %.6f .. %.6f) by %s (%lld walks); LAPACK %.6f, %s\n", ULAM_VERSION,
+           ans.estimate, ans.ci95[0], ans.ci95[1], ulam_method_name(ans.method), (long long)ans.walks.walks, x[0],
+           in ? "inside" : "OUTSIDE");
+    return in ? 0 : 1;
 }

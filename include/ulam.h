@@ -770,6 +770,12 @@ typedef struct ulam_walk_result {
                           -1 unknown (also rel_err 0: not asked).  Unless 1, variance_rel_error may
                           be far too small and the rel_err rule is never met (rel_err alone is
                           refused: ULAM_EINFVAR) */
+    int push_sweeps;     /* forward: Gauss-Seidel sweeps of the push on b made before the walks (the
+                            walks then start from its residual r and every estimate adds the push's
+                            part; a rel_err target or a fixed budget of the method choice's); 0: the
+                            walks start from b */
+    int64_t push_ops;    /* their operations (a state read a sweep, a push its column's entries + 1) */
+    double push_residual; /* ||r||_1 / ||b||_1 after them (1: no push) */
 } ulam_walk_result;
 
 /* An opaque walk solver: the kernel, the statistics and the stopping state. */

@@ -320,8 +320,12 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
     /* a pilot on b that saw no score (a sparse b the walks reach rarely) has no variance and no range
        to go by, and a zero variance must not be believed: the walks' interval is then planned from the
        residual's walks below, whose range scaled by max|b| / max|r| bounds theirs */
-    int blind = wb.walks > 0 && !(wb.variance > 1e-12 * wb.estimate * wb.estimate) && q->o->stop.rel_err_offset == 0.0;
-    /* (every score alike up to rounding: a variance of 3.1e-33 against an actual 3.6e8 was believed) */
+    double scale = wb.estimate * wb.push_residual; /* a forward leader's walks start from the push's residual: */
+    int blind = wb.walks > 0 && !(wb.variance > 1e-12 * scale * scale) && q->o->stop.rel_err_offset == 0.0;
+    /* (every score alike up to rounding: a variance of 3.1e-33 against an actual 3.6e8 was believed; the
+       rounding is the residual's, ||r||_1 / ||b||_1 of b's: chain4's x_3, absorption pinned, seed 7, 10^5
+       walks, a forward leader pushed to its rounding was taken for blind, and bidirectional was piloted
+       (1024 walks) to lose at -+0.03 against the walks' -+1.6e-15) */
     if (!blind && (!(cb.range_term > cb.var_term) || !isfinite(cb.half))) {
         snprintf(v->why, sizeof v->why, "not considered: at %.3g walks the walks' interval is not led by its range "
                  "term (%.3g, variance term %.3g): a push on b would narrow it little", N, cb.range_term, cb.var_term);

@@ -91,7 +91,11 @@ void ulam_walk_result_json(FILE *f, const ulam_walk_opts *o, const ulam_walk_res
         ulam__report_verdict_json(f, "fourth_finite", r->fourth_finite);
         ulam__report_radius_json(f, "rho4", &r->rho4);
     }
-    if (mode) fprintf(f, "\"unreached\": %lld, ", (long long)r->unreached);
+    if (mode) {
+        fprintf(f, "\"unreached\": %lld, \"push_sweeps\": %d, \"push_ops\": %lld, ", (long long)r->unreached,
+                r->push_sweeps, (long long)r->push_ops);
+        ulam_json_number(f, "push_residual", r->push_residual, 0);
+    }
     ulam_json_number(f, "variance", r->variance, 0);
     fprintf(f, "\"walks\": %lld, \"steps\": %lld, \"cut\": %lld, ", (long long)r->walks, (long long)r->steps,
             (long long)r->cut);

@@ -63,9 +63,13 @@ static void brief(FILE *f, const ulam_walk_report *p)
     const ulam_walk_opts *o = p->opts;
     const ulam_walk_result *r = p->result;
     answer(f, p, 0);
-    fprintf(f, "method          %s random walks, %s estimator%s\n", ulam__report_mode_name(o->mode),
-            ulam__report_estimator_name(o->estimator), o->mode == ULAM_ADJOINT ? " (walks start at the unknown)"
-                                                                         : " (walks start from b: every unknown at once)");
+    fprintf(f, "method          %s random walks, %s estimator", ulam__report_mode_name(o->mode),
+            ulam__report_estimator_name(o->estimator));
+    if (o->mode == ULAM_ADJOINT) fputs(" (walks start at the unknown)\n", f);
+    else if (r->push_sweeps > 0)
+        fprintf(f, " (b pushed first, %d sweeps to ||r||_1 / ||b||_1 = %.3g; walks start from r: every unknown at "
+                   "once)\n", r->push_sweeps, r->push_residual);
+    else fputs(" (walks start from b: every unknown at once)\n", f);
     if (p->choice) ulam_choice_fprint(f, p->choice, 1, ULAM_REPORT_BRIEF);
     if (r->cut)
         fprintf(f, "walks           %lld (%lld cut at %lld steps: the estimate is biased by the cut)\n",
@@ -103,6 +107,10 @@ static void verbose(FILE *f, const ulam_walk_report *p)
     answer(f, p, 0);
     fprintf(f, "method          %s walks, %s estimator\n", ulam__report_mode_name(o->mode),
             ulam__report_estimator_name(o->estimator));
+    if (r->push_sweeps > 0)
+        fprintf(f, "push on b       %d Gauss-Seidel sweeps, %lld operations: ||r||_1 / ||b||_1 = %.3g (the walks start "
+                   "from the residual r; each estimate adds the pushed part)\n", r->push_sweeps, (long long)r->push_ops,
+                r->push_residual);
     fprintf(f, "walks           %lld (%lld cut at %lld steps%s)\n", (long long)r->walks, (long long)r->cut,
             (long long)o->stop.max_steps, r->cut ? ": the estimate is biased by the cut" : "");
     fprintf(f, "steps           %lld (mean walk length %.4g; kernel rows built %lld)\n", (long long)r->steps, mean_len,

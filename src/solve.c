@@ -20,6 +20,7 @@
 #include "supersolve.h"
 #include "walk.h"
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -1167,9 +1168,8 @@ typedef struct {
 /* At a fixed budget (budget > 0 units of walks' work: --walks, --time) the model is instead the
  * work that would take walks from r_sum to the half-width the budget's walks from b reach: each
  * walk's weight, and so the interval's range and standard-error terms, scales with the l1 norm
- * it starts from, so that work is the budget times (r_sum / ||b||_1)^2; a sweep is then made
- * while it saves more of it than it costs (a b of one entry 10^6: --walks 10^5 printed +-6100
- * for x = 9441 before the push served fixed budgets). */
+ * it starts from, so that work is the budget times (r_sum / ||b||_1)^2 (reported only: the
+ * sweeps are then chosen by the narrowing each buys, src/fpush_b.c). */
 static double push_cost(double r_sum, double q_i, void *ctx)
 {
     const push_ctx *c = ctx;
@@ -1192,6 +1192,16 @@ static double push_plan(const ulam_solver *s, double per_walk)
     return isfinite(w) ? w : 0.0;
 }
 
+/* The most units a push for a fixed budget may take (src/fpush_b.c): ULAM__FPUSH_B_CAP times the
+ * walks' work under max_walks, ULAM__FPUSH_B_TIME of the time's under max_seconds, the less. */
+static double push_cap(const ulam_solver *s, double per_walk)
+{
+    const ulam_stop_opts *st = &s->o.stop;
+    double c = st->max_walks > 0 ? ULAM__FPUSH_B_CAP * (double)st->max_walks * per_walk : INFINITY;
+    if (st->max_seconds > 0) c = fmin(c, ULAM__FPUSH_B_TIME * st->max_seconds / ULAM_AUTO_UNIT_SECONDS);
+    return c;
+}
+
 /* Forward walks (no weight window) with a rel_err target or a fixed budget: push b down while
  * that lowers the walks' predicted work (src/fpush_b.c; push_cost's two models), then walk from
  * the residual, its source table and score bounds made anew (*bnorm1 its l1 norm); rel_alone as
@@ -1208,8 +1218,8 @@ static int push_b(ulam_solver *s, int rel_alone, double *bnorm1, ulam_error *err
     s->pq = ulam__calloc((size_t)s->n, sizeof *s->pq), s->pr = ulam__malloc((size_t)s->n, sizeof *s->pr);
     if (!s->pq || !s->pr) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push on b");
     memcpy(s->pr, s->b, (size_t)s->n * sizeof *s->pr);
-    ulam__fpush_b(s->mt, o->query.index, push_cost, &c, plan > 0 ? plan / 2 : ULAM__REL_MIN * c.per_walk, s->pq, s->pr,
-                  &s->push);
+    ulam__fpush_b(s->mt, o->query.index, push_cost, &c, plan > 0 ? plan / 2 : ULAM__REL_MIN * c.per_walk, plan,
+                  plan > 0 ? push_cap(s, pw) : INFINITY, s->pq, s->pr, &s->push);
     s->setup_work += s->push.ops;
     if (s->push.sweeps == 0) { /* not worth a sweep: the walks start from b */
         free(s->pq), free(s->pr);
@@ -1849,6 +1859,19 @@ static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
     ulam__cs_plan4(&s->cs, run->n, run->mean, ulam__moments_variance(run), run->m3, run->m4, A, b, h > b ? h - b : 0.0, nplan);
 }
 
+/* The forward push on b's rounding at x_i (src/fpush_b.c): each of its operations rounds once or
+ * twice (q_j += r_j; r_k += M_kj r_j), at most DBL_EPSILON / 2 of what it adds, so q_i and the
+ * residual the walks start from miss x = q + (I - M)^-1 r by roundings that add up over the push;
+ * bounded as bidir.c's rounding_allowance, by the operations (+ 2 for the walks' mean and its sum
+ * with q_i) times DBL_EPSILON / 2 of |q_i| (the pushed part's size: with M of one sign every add is
+ * of q_i's sign; with cancellations it may miss).  A push to b's rounding (radiosity100,
+ * --walks 10^4: ||r||_1 / ||b||_1 = 1e-14, the walks' interval ~1e-15 of x_i) printed intervals
+ * 1-2 ulp from LAPACK's x_i without it (6 of 68 runs). */
+static double push_rounding(const ulam_solver *s, int64_t i)
+{
+    return ((double)s->push.ops + 2.0) * (DBL_EPSILON / 2.0) * fabs(s->pq[i]);
+}
+
 /* The run's 95% interval so far: the confidence sequence's (stop.h, ulam__cs), valid at every
  * walk count, widened by the cuts' bias, and the range R the next block is planned at; zero
  * width when nothing that scores is reachable (R = 0); none while the variance is not
@@ -1862,6 +1885,10 @@ static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R,
         double m0 = s->o.mode == ULAM_ADJOINT ? s->adj.mean : s->watched.mean, shift = r->estimate - m0;
         ulam__cs_interval(&s->cs, m0, r->cut_bound, ci);
         ci->lo += shift, ci->hi += shift; /* forward: b_i (expected) and the push's part */
+    }
+    if (s->pq && (ci->kind == ULAM__STOP_EB || ci->kind == ULAM__STOP_EXACT)) { /* the push's roundings */
+        double fp = push_rounding(s, s->o.query.index);
+        ci->lo -= fp, ci->hi += fp, ci->half += fp;
     }
     if (s->var_finite != 1 && ci->kind != ULAM__STOP_EXACT) ci->kind = ULAM__STOP_NONE, ci->lo = ci->hi = NAN;
     if (ci->kind == ULAM__STOP_EB && r->estimate != 0.0 && s->maxsq < ULAM__STOP_TINY) /* a b not rescaled (a prepared
@@ -1919,6 +1946,8 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->interrupted = s->run.interrupted;
     r->rho4 = s->rho4;
     r->fourth_finite = s->fourth;
+    r->push_sweeps = s->pq ? s->push.sweeps : 0, r->push_ops = s->pq ? s->push.ops : 0;
+    r->push_residual = s->pq && s->push.r_sum0 > 0 ? s->push.r_sum / s->push.r_sum0 : 1.0;
     if (s->bexp && !walked) { /* walked on b 2^-bexp: back to b's scale (exact) */
         int e = s->bexp;
         r->estimate = ldexp(r->estimate, e), r->std_error = ldexp(r->std_error, e);

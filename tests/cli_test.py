@@ -203,6 +203,15 @@ CASES += [
     (SOLVE + ["--index", "2", "--walks", "20000", "--check"], 0, r"^$", r"direct\s+2\.34009.*z = "),
     (SOLVE + ["--index", "2", "--walks", "20000", "--mode", "forward", "--estimator", "expected"], 0, r"^$",
      r"forward random walks, expected estimator"),
+    # forward walks at a fixed budget push b first, as deep as the walks that would narrow the interval as much
+    # cost more (issue 38 point 4): 4072 walks printed 4.75 (95% CI -12.6 .. 22.2) from b after 4 sweeps, and
+    # the method line said the walks start from b; the push is now said, in the text, --verbose and --json
+    (RFWD := ["solve", M + "randsub1000.mtx", "--rhs", M + "randsub1000_b.mtx", "--index", "1", "--mode", "forward",
+              "--walks", "4072", "--estimator", "collision"], 0, r"^$",
+     r"x\[1\]\s+5\.01\d+ \+- [\d.e-]+ \(95% CI 5\.0\d+ \.\. 5\.0\d+\)\nmethod\s+forward random walks, collision estimator "
+     r"\(b pushed first, \d\d sweeps to \|\|r\|\|_1 / \|\|b\|\|_1 = [\d.e-]+; walks start from r"),
+    (RFWD + ["--verbose"], 0, r"^$", r"\npush on b\s+\d\d Gauss-Seidel sweeps, \d+ operations: \|\|r\|\|_1 / \|\|b\|\|_1 = "),
+    (RFWD + ["--json"], 0, r"^$", r'"push_sweeps": \d\d, "push_ops": \d+, "push_residual": 0\.000\d+'),
 ]
 
 PS = ["solve", M + "randsub1000.mtx", "--index", "7"]

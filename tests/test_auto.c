@@ -770,6 +770,129 @@ static void test_push_b_forward_fixed(void **state)
     ulam_csr_free(M);
 }
 
+/* How deep the push on b goes for forward walks at a fixed budget (issue 38 point 4, forward
+ * mode; a newcomer's case): randsub1000 with its own b, x_1 = 5.10 (0-based), forward collision
+ * pinned.  4072 walks printed 4.70 +- 17.4 (95% half-width) where rel_err 0.01 prints +-0.048
+ * after 2491 walks: the fixed budget's push valued a sweep only against the width 4072
+ * walks from b reach and stopped after 4 sweeps at ||r||_1 / ||b||_1 = 0.46 (the rel_err run's
+ * went 35).  A sweep is now made while the walks that would narrow the interval as much cost more
+ * (its work at most ULAM__FPUSH_B_CAP times the walks'): the fixed budget's interval is no wider
+ * than the rel_err run's (it walks more; 0.0132 now), and over 40 seeds of b = 1 but b_500 = 10^6 (x_7) at
+ * 1000 and 4072 walks the intervals cover (binomial bound). */
+static void test_push_b_forward_depth(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M = load("randsub1000", &b);
+    int64_t n = M->nrows;
+    double *x = malloc((size_t)n * sizeof *x);
+    ulam_choice *ch = malloc(sizeof *ch);
+    ulam_answer a, ar;
+    ulam_auto_opts ao = ulam_auto_defaults();
+    ao.pin_mode = ao.pin_estimator = 1;
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.mode = ULAM_FORWARD, o.estimator = ULAM_COLLISION, o.query.index = 1;
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    o.stop.max_walks = 4072;
+    assert_int_equal(ulam_auto(M, b, &o, &ao, NULL, ch, &a, NULL), ULAM_OK);
+    o.stop.max_walks = 0, o.stop.rel_err = 0.01;
+    assert_int_equal(ulam_auto(M, b, &o, &ao, NULL, ch, &ar, NULL), ULAM_OK);
+    double h = 0.5 * (a.ci95[1] - a.ci95[0]), hr = 0.5 * (ar.ci95[1] - ar.ci95[0]);
+    print_message("x_1 = %.6g: 4072 walks %.6g +- %.3g; rel_err 0.01 (%lld walks) %.6g +- %.3g\n", x[1], a.estimate, h,
+                  (long long)ar.walks.walks, ar.estimate, hr);
+    assert_true(a.walks.walks == 4072 && ar.walks.rel_err_met && ar.walks.walks < 4072);
+    assert_true(a.ci95[0] <= x[1] && x[1] <= a.ci95[1] && h > 0 && h <= hr);
+    for (int64_t k = 0; k < n; k++) b[k] = k == 499 ? 1e6 : 1.0;
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    o.stop.rel_err = 0.0, o.query.index = 7;
+    int R = 40, lower = (int)ceil(0.95 * R - 4.0 * sqrt(0.95 * 0.05 * R));
+    static const int64_t W[2] = {1000, 4072};
+    for (int w = 0; w < 2; w++) {
+        int covered = 0, zero = 0;
+        double half = 0.0;
+        o.stop.max_walks = W[w];
+        for (int seed = 1; seed <= R; seed++) {
+            o.exec.seed = (uint64_t)seed;
+            assert_int_equal(ulam_auto(M, b, &o, &ao, NULL, ch, &a, NULL), ULAM_OK);
+            covered += a.ci95[0] <= x[7] && x[7] <= a.ci95[1];
+            zero += !(a.ci95[1] > a.ci95[0]);
+            half += 0.5 * (a.ci95[1] - a.ci95[0]) / R;
+        }
+        print_message("b_500 = 1e6, %lld walks: %d of %d cover (at least %d), %d zero-width; mean half-width %.3g "
+                      "(x_7 = %.6g)\n", (long long)W[w], covered, R, lower, zero, half, x[7]);
+        assert_true(covered >= lower && zero == 0);
+        if (w == 1) assert_true(half <= 0.01 * x[7]);
+    }
+    free(ch), free(b), free(x);
+    ulam_csr_free(M);
+}
+
+/* The forward push on b taken to b's rounding at a fixed budget: radiosity100 (dense, rows of |M|
+ * summing below 0.9), forward mode pinned, 10^4 and 10^5 walks (the push reaches ||r||_1 / ||b||_1 ~
+ * 1e-14, the walks' interval ~1e-15 of x_i): the push's own roundings are then the larger error,
+ * and every printed interval must hold LAPACK's x_i, with nonzero width, over 17 components and 2
+ * seeds each. */
+static void test_push_b_forward_rounding(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M = load("radiosity100", &b);
+    int64_t n = M->nrows;
+    double *x = malloc((size_t)n * sizeof *x);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    ulam_choice *ch = malloc(sizeof *ch);
+    ulam_answer a;
+    ulam_auto_opts ao = ulam_auto_defaults();
+    ao.pin_mode = 1;
+    int bad = 0, runs = 0, pushed = 0;
+    static const int64_t W[2] = {10000, 100000};
+    for (int w = 0; w < 2; w++)
+        for (int64_t i = 0; i < n; i += 6)
+            for (uint64_t seed = 1; seed <= 2; seed++) {
+                ulam_walk_opts o = ulam_walk_defaults();
+                o.mode = ULAM_FORWARD, o.query.index = i, o.stop.max_walks = W[w], o.exec.seed = seed;
+                assert_int_equal(ulam_auto(M, b, &o, &ao, NULL, ch, &a, NULL), ULAM_OK);
+                runs++, pushed += a.walks.push_residual < 1e-12;
+                if (!(a.ci95[0] <= x[i] && x[i] <= a.ci95[1] && a.ci95[1] > a.ci95[0])) {
+                    print_message("%lld walks, seed %d: x[%lld] = %.17g: %.17g, 95%% CI %.17g .. %.17g (%d sweeps, "
+                                  "||r|| / ||b|| %.3g)\n", (long long)W[w], (int)seed, (long long)i, x[i], a.estimate,
+                                  a.ci95[0], a.ci95[1], a.walks.push_sweeps, a.walks.push_residual);
+                    bad++;
+                }
+            }
+    print_message("%d of %d runs pushed b to its rounding; %d intervals miss x_i or have zero width\n", pushed, runs, bad);
+    assert_true(pushed > runs / 2);
+    assert_int_equal(bad, 0);
+    free(ch), free(b), free(x);
+    ulam_csr_free(M);
+}
+
+/* A forward walk leader pushed to b's rounding is not a pilot that saw nothing (src/method_bidir.c's
+ * fixed_predict): chain4's x_3 (0-based 2), absorption pinned, seed 7, the default 10^5 walks.  Its
+ * pilot's variance (the residual's, ~1e-30) was held against 1e-12 x^2, taken for blind, and the
+ * push on b was piloted (1024 walks) only to lose at -+0.03 against the walks' -+1.6e-15; the
+ * check is now scaled by ||r||_1 / ||b||_1: bidirectional is not considered, the walks run. */
+static void test_push_b_forward_not_blind(void **state)
+{
+    (void)state;
+    double *b;
+    ulam_csr *M = load("chain4", &b);
+    ulam_choice *ch = malloc(sizeof *ch);
+    ulam_answer a;
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.query.index = 2, o.exec.seed = 7, o.estimator = ULAM_ABSORPTION;
+    ulam_auto_opts ao = ulam_auto_defaults();
+    ao.pin_estimator = 1;
+    assert_int_equal(ulam_auto(M, b, &o, &ao, NULL, ch, &a, NULL), ULAM_OK);
+    print_message("%s, push %d sweeps; bidirectional: %s\n", ulam_method_name(a.method), a.walks.push_sweeps,
+                  ch->method[ULAM_METHOD_BIDIRECTIONAL].why);
+    assert_int_equal(a.method, ULAM_METHOD_WALKS);
+    assert_true(a.walks.push_sweeps > 0);
+    assert_non_null(strstr(ch->method[ULAM_METHOD_BIDIRECTIONAL].why, "not considered"));
+    free(ch), free(b);
+    ulam_csr_free(M);
+}
+
 /* Issue 38 ("expensive"): the planner's predictions are the rule's.  The rel_err rule is the
  * confidence sequence's (stop.h: the printed half-width at most E |x|, about 2 ln(2 / delta) =
  * 7.4 times var / (E x)^2 walks), and the predictions were var / (E x)^2's.  (1) randsub1000's x_7
@@ -827,6 +950,9 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_push_b_rounding),
+        cmocka_unit_test(test_push_b_forward_depth),
+        cmocka_unit_test(test_push_b_forward_rounding),
+        cmocka_unit_test(test_push_b_forward_not_blind),
         cmocka_unit_test(test_time_budget),
         cmocka_unit_test(test_push_b_sparse),
         cmocka_unit_test(test_choice),

@@ -409,7 +409,8 @@ def _vectors(system, d, index, scale, rel_err):
         lo[index], hi[index] = watched_ci
     rep = {"method": "walks", "mode": "forward", "walks": w["walks"], "steps": w["steps"], "seconds": w["seconds"],
            "watched": index, "unreached": w["unreached"], "variance_finite": watched_ci is not None,
-           "seed": d["opts"]["seed"]}
+           "seed": d["opts"]["seed"], "push_sweeps": w["push_sweeps"], "push_ops": w["push_ops"],
+           "push_residual": w["push_residual"]}
     if rel_err is not None:
         rep["rel_err_met"] = bool(w["rel_err_met"])
     return VectorResult("walks", x, se, lo, hi, w["walks"], rep, index, watched_ci,

@@ -253,7 +253,7 @@ static PyObject *choice(const ulam_choice *ch)
 /* A walk result as a dict (the library's field names). */
 static PyObject *walk_result(const ulam_walk_result *r)
 {
-    return Py_BuildValue("{s:d,s:d,s:d,s:L,s:L,s:L,s:L,s:d,s:i,s:d,s:d,s:d,s:d,s:i,s:d,s:i,s:i,s:L,s:d,s:i,s:i,s:N,s:i}",
+    return Py_BuildValue("{s:d,s:d,s:d,s:L,s:L,s:L,s:L,s:d,s:i,s:d,s:d,s:d,s:d,s:i,s:d,s:i,s:i,s:L,s:d,s:i,s:i,s:N,s:i,s:i,s:L,s:d}",
                          "estimate", r->estimate, "std_error", r->std_error, "variance", r->variance, "walks",
                          (long long)r->walks, "steps", (long long)r->steps, "cut", (long long)r->cut, "rows",
                          (long long)r->rows, "max_share", r->max_share, "variance_finite", r->variance_finite,
@@ -261,7 +261,8 @@ static PyObject *walk_result(const ulam_walk_result *r)
                          "variance_rel_error", r->variance_rel_error, "rel_err_met", r->rel_err_met, "cut_bound",
                          r->cut_bound, "cut_stop", r->cut_stop, "out_of_reach", r->out_of_reach, "unreached",
                          (long long)r->unreached, "seconds", r->seconds, "threads", r->threads, "interrupted",
-                         r->interrupted, "rho4", radius(&r->rho4), "fourth_finite", r->fourth_finite);
+                         r->interrupted, "rho4", radius(&r->rho4), "fourth_finite", r->fourth_finite, "push_sweeps",
+                         r->push_sweeps, "push_ops", (long long)r->push_ops, "push_residual", r->push_residual);
 }
 
 /* The kinds of JSON json_text writes: a walk result's members, the choice's "auto", a
