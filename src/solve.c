@@ -1854,16 +1854,16 @@ static void round_clip(ulam_solver *s)
                           ? (int64_t)l1 : 0;
 }
 
-/* ulam__cs_plan4 from the sample mom; under rel_err a sample with no spread (nothing has scored:
+/* ulam__cs_plan4 from the sample mom; under rel_err a sample of zeros alone (nothing has scored:
  * no estimate, so no target, and a plan for four times the walks so far) bets as one with no
  * walks, at the prior's variance alone: from the prior shrunk by the walks so far it bet near the
  * cap, and the first hits, at the range's end, each put psi(0.94) = 1.9 in the penalty to the end
  * (three clusters, absorption at E = 0.1: 35% of the final penalty from the first 3000 of 1.2e6
- * walks; walks / CLT 3.01 -> 1.97, docs/error-bars.md). */
+ * walks; walks / CLT 3.01 -> 1.96 with REL_TAIL, docs/error-bars.md). */
 static void cs_bet(ulam_solver *s, const ulam__moments *mom, double A, double b, double h, double nplan)
 {
     double var = ulam__moments_variance(mom);
-    int64_t n = s->o.stop.rel_err > 0 && !(var > 0) ? 0 : mom->n;
+    int64_t n = s->o.stop.rel_err > 0 && !(var > 0) && mom->mean == 0.0 ? 0 : mom->n; /* every score 0 */
     ulam__cs_plan4(&s->cs, n, mom->mean, var, mom->m3, mom->m4, A, b, h > b ? h - b : 0.0, nplan);
 }
 
