@@ -46,7 +46,11 @@ enum { BLOCK = 1024, ROUND = 64, STACK = 8192, CACHED = 2 << 20, COMPLETE = ULAM
  * so the rule may stop after any round (a first round of a whole block made every run at least
  * 1024 walks, 10.7 times the CLT's count at E = 0.1 on the hub at 0.99; later rounds of at least
  * 64 walks stopped its absorption runs at 320 walks, 3.34 times, where 272 do, 2.84 times). */
-enum { REL_FIRST = ULAM__REL_FIRST, REL_STEP = 16 };
+/* REL_TAIL: once the sequence predicts the stop within walks / REL_TAIL, a round is that sixty-fourth
+ * of the walks so far (rounds past the stop cost walks, never width: a round of walks / 16 stopped
+ * E = 0.01 runs at 0.98 E |x|, 4% more walks than the target asks; bench_relerr, docs/error-bars.md);
+ * a round of 8 blocks or more still runs on every thread from 2^19 walks on. */
+enum { REL_FIRST = ULAM__REL_FIRST, REL_STEP = 16, REL_TAIL = 64 };
 
 /* The lesser of a and b. */
 static int64_t imin64(int64_t a, int64_t b)
@@ -1591,7 +1595,7 @@ int ulam_solver_iterate(ulam_solver *s)
         const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
         double m = fabs(r.estimate + s->o.stop.rel_err_offset);
         double left = ulam__cs_walks_left(&s->cs, mom->mean, ulam__moments_variance(mom), r.cut_bound, s->o.stop.rel_err * m);
-        s->run.want = isfinite(left) && left > 0 ? (int64_t)fmin(fmax(fmax(left, (double)s->run.walks / 16.0), REL_STEP), 1e15)
+        s->run.want = isfinite(left) && left > 0 ? (int64_t)fmin(fmax(fmax(left, (double)s->run.walks / REL_TAIL), REL_STEP), 1e15)
                                                  : 0; /* 1e15: past any budget, inside int64_t */
         if (s->run.walks < ULAM__REL_MIN) /* at most on to the walks the rules that give up (out of reach, cuts) */
             s->run.want = s->run.want > 0 ? imin64(s->run.want, ULAM__REL_MIN - s->run.walks) /* judge from */
@@ -1837,6 +1841,19 @@ static void round_clip(ulam_solver *s)
                           ? (int64_t)l1 : 0;
 }
 
+/* ulam__cs_plan4 from the sample mom; under rel_err a sample of zeros alone (nothing has scored:
+ * no estimate, so no target, and a plan for four times the walks so far) bets as one with no
+ * walks, at the prior's variance alone: from the prior shrunk by the walks so far it bet near the
+ * cap, and the first hits, at the range's end, each put psi(0.94) = 1.9 in the penalty to the end
+ * (three clusters, absorption at E = 0.1: 35% of the final penalty from the first 3000 of 1.2e6
+ * walks; walks / CLT 3.01 -> 1.96 with REL_TAIL, docs/error-bars.md). */
+static void cs_bet(ulam_solver *s, const ulam__moments *mom, double A, double b, double h, double nplan)
+{
+    double var = ulam__moments_variance(mom);
+    int64_t n = s->o.stop.rel_err > 0 && !(var > 0) && mom->mean == 0.0 ? 0 : mom->n; /* every score 0 */
+    ulam__cs_plan4(&s->cs, n, mom->mean, var, mom->m3, mom->m4, A, b, h > b ? h - b : 0.0, nplan);
+}
+
 /* Plan the sequence's next block from the run so far (plan_terms) at the round's limit. */
 static void cs_plan(ulam_solver *s)
 {
@@ -1844,7 +1861,7 @@ static void cs_plan(ulam_solver *s)
     double Rt, A, b, h, nplan;
     plan_terms(s, 0, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
-    ulam__cs_plan4(&s->cs, mom->n, mom->mean, ulam__moments_variance(mom), mom->m3, mom->m4, A, b, h > b ? h - b : 0.0, nplan);
+    cs_bet(s, mom, A, b, h, nplan);
 }
 
 /* Plan the sequence's next part of the first block from the parts so far (run): as cs_plan, with
@@ -1856,7 +1873,7 @@ static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
     plan_terms(s, 0, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     if (!(h > 0) && E > 0 && run->n >= 2) h = E * fabs(run->mean + s->o.stop.rel_err_offset);
-    ulam__cs_plan4(&s->cs, run->n, run->mean, ulam__moments_variance(run), run->m3, run->m4, A, b, h > b ? h - b : 0.0, nplan);
+    cs_bet(s, run, A, b, h, nplan);
 }
 
 /* The forward push on b's rounding at x_i (src/fpush_b.c): each of its operations rounds once or
