@@ -509,7 +509,6 @@ int ulam_system_open(const char *path, const uint64_t tag[2], ulam_system **out,
         return status;
     }
     (*out)->map = map, (*out)->map_bytes = len, (*out)->fd = fd; /* kept: a lazy query preads its rows */
-    if (getenv("ULAM_TMP_KEEP")) (*out)->keep = (size_t)atoll(getenv("ULAM_TMP_KEEP")); /* TMP */
     return ULAM_OK;
 }
 

@@ -32,7 +32,6 @@
 #include "sweep.h"
 
 #include <float.h>
-#include <stdio.h> /* TMP */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1109,6 +1108,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
                 break;
             k++;
         }
+        ulam__system_trim(w.store_of); /* the walks done: what they mapped given back */
         if (!planned) /* stopped between checkpoints: the next index */
             k = ulam__stop_epoch(N) > k0 ? ulam__stop_epoch(N) - k0 + 2 : k + 1;
         else if (o->walks > 0)
@@ -1151,7 +1151,6 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
             }
         }
         info->walks = N, info->steps = w.steps, info->walk_seconds = ulam_now() - t1;
-        if (getenv("ULAM_TMP_DBG")) fprintf(stderr, "TMP store %lld entries, cum %lld\n", (long long)w.sused, (long long)w.cum_used); /* TMP */
     }
     free(key), free(pv);
     free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.hit), free(w.hc), free(w.slot), free(w.known);
