@@ -15,8 +15,6 @@
 #include "testutil.h"
 #include "zipf_graph.h"
 
-#include <unistd.h>
-
 /* k of N covered passes the binomial bound of the header. */
 static int coverage_ok(int64_t k, int64_t N)
 {
@@ -295,16 +293,8 @@ static void test_fpush_lazy_release(void **state)
     int64_t n = M->nrows, K = 100, s = 0, idx[100], idx2[100];
     while (Mt->rowptr[s + 1] - Mt->rowptr[s] < 2) s++; /* a state with out-edges */
     ulam_guard g;
-    ulam_guard_opts go = ulam_guard_defaults();
-    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
-    assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
     char path[] = "/tmp/ulam_test_releaseXXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
-    ulam_system_desc d = ulam_system_desc_defaults();
-    d.M = M, d.n = n, d.transpose = 1;
-    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    must_prepare(M, path, &g);
     double *x = malloc((size_t)n * sizeof *x), *y = malloc((size_t)n * sizeof *y);
     double se[100], lo[100], hi[100], se2[100], lo2[100], hi2[100];
     ulam_fpush_opts o = ulam_fpush_defaults();
