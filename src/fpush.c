@@ -52,8 +52,11 @@
                                       nnz / this (a sixteenth of a sweep: a queue push's operation reads at random) */
 #define ULAM__FPUSH_NEG_PASSES 32     /* passes of push_negative at most (its operations: a sweep's at most) */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
-#define ULAM__FPUSH_TRIM_EVERY 256  /* rows a queue push checks, or walks launched, between trims of a large file's
-                                      mapping (ulam__system_trim: a read of /proc/self/statm) */
+#define ULAM__FPUSH_TRIM_EVERY 256  /* rows a queue push checks between trims of a large file's mapping
+                                      (ulam__system_trim: a read of /proc/self/statm) */
+#define ULAM__FPUSH_TRIM_WALKS 8    /* walks launched between trims: a fault maps up to 2 MiB of a file's large
+                                      pages, and a walk visits ~7 rows (R-MAT 2^24, source 101: every 256 walks
+                                      let the mapping reach 3.3 GB, a peak RSS of 3.87 GB) */
 #define ULAM__FPUSH_STORE_ROW 64    /* a large file's rows of at most this many entries are read by pread into the walks'
                                       store on the first visit; longer ones (hubs: a visit reads one entry of
                                       thousands) in place, their pages trimmed */
@@ -559,7 +562,7 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
                 L[l].on = 1, L[l].neg = w->r[j] < 0, launched++;
                 lane_arrive(w, rng, &L[l], j);
                 more = launched < count && !((launched & 1023) == 0 && interrupt && *interrupt) && !w->status;
-                if (w->store_of && launched % ULAM__FPUSH_TRIM_EVERY == 0) ulam__system_trim(w->store_of);
+                if (w->store_of && launched % ULAM__FPUSH_TRIM_WALKS == 0) ulam__system_trim(w->store_of);
             }
             busy |= L[l].on;
         }
@@ -928,6 +931,12 @@ static void release_rows(const void *ctx, const ulam_csr *A, int64_t r0, int64_t
     ulam__system_release(ctx, A, r0, r1);
 }
 
+/* The list rounds' hook on a lazily read file (ulam__sweep_release): its mapping trimmed. */
+static void trim_file(const void *ctx)
+{
+    ulam__system_trim(ctx);
+}
+
 /* Push the negative residual the over-relaxed sweeps left (M >= 0): every r_j < 0 moves into p_j
  * and along row j of M' (r_k += M'_jk r_j), a pass at a time, while its mass times d1 = 1 / (1 - alpha)
  * is above want and the passes' operations stay within max_ops.  x = p + (I - M)^-1 r stays exact,
@@ -979,7 +988,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     }
     int64_t cap = 100 * ulam_csr_nnz(M) + 1000000;
     int status = ULAM_OK, local = 0;
-    ulam__sweep_release rel = {.fn = release_rows, .ctx = lz}; /* a large file's pages given back as passes go */
+    ulam__sweep_release rel = {.fn = release_rows, .trim = trim_file, .ctx = lz}; /* a large file's pages given back as passes go */
     const ulam__sweep_release *relp = ulam__system_releases(lz) ? &rel : NULL;
     if (top > 0 && top < n && !(o->rmax > 0) && o->walks <= 0) /* the top-K target: a local push, the floor planned */
         status = push_top(Mt, lz, o->source, top, o->min_value, &pl, cap, x, r, swi, &local, err);

@@ -174,6 +174,7 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
                 int64_t j = list[q];
                 if (!(fabs(r[j]) > thr)) continue;
                 round_ops += push_one(Mt, j, p, r, next, &nnext, mark), pushed++;
+                if (rel && rel->trim && pushed % ULAM__SWEEP_TRIM_EVERY == 0) rel->trim(rel->ctx);
             }
             for (int64_t q = 0; q < nlist; q++) /* states left under the threshold stay listed */
                 if (r[list[q]] != 0.0 && !mark[list[q]]) mark[list[q]] = 1, next[nnext++] = list[q];

@@ -20,11 +20,16 @@ typedef struct {
 
 /* A hook a whole pass calls once it is done with rows [r0, r1) of A (in stretches of
  * ULAM__SWEEP_STRETCH rows, in order): a mapped file's pages given back (src/cache.c's
- * ulam__system_release).  fn NULL: none. */
+ * ulam__system_release); and one the rounds over a list of states call every
+ * ULAM__SWEEP_TRIM_EVERY pushes (they read rows at random: src/cache.c's ulam__system_trim).
+ * NULL: none. */
 typedef struct {
     void (*fn)(const void *ctx, const ulam_csr *A, int64_t r0, int64_t r1);
+    void (*trim)(const void *ctx);
     const void *ctx;
 } ulam__sweep_release;
+
+#define ULAM__SWEEP_TRIM_EVERY 256
 
 #define ULAM__SWEEP_STRETCH ((int64_t)1 << 16)
 
