@@ -83,6 +83,7 @@ struct ulam_system {
     int fd;                /* the file, for rows read by pread (-1: borrowed memory) */
     uint64_t off[4];       /* byte offsets of rowptr, colidx, val and b in the file */
     _Atomic int64_t *checked; /* [0] blocks verified, [1] rows of M they hold */
+    size_t keep;           /* a mapping of more bytes is released as passes over it go (ulam__system_release) */
 };
 
 /* XXH3-64 of bytes p[0 .. n). */
@@ -433,7 +434,7 @@ static int parse(const unsigned char *p, size_t len, const uint64_t tag[2], ulam
     if (tag && (w[W_TAG] != tag[0] || w[W_TAG + 1] != tag[1]))
         return ulam__fail(err, ULAM_ENOTFOUND, 0, -1, "a cache of the current source file (it changed)");
     *s = (ulam_system){.n = (int64_t)n, .has_matrix = m, .has_tr = t, .omega = real(w[W_OMEGA]), .shift = (int)shift,
-                       .sums = sums, .fd = -1, .off = {w[W_OFF], w[W_OFF + 1], w[W_OFF + 2], w[W_OFF + 3]}};
+                       .sums = sums, .fd = -1, .keep = ULAM__SYSTEM_KEEP, .off = {w[W_OFF], w[W_OFF + 1], w[W_OFF + 2], w[W_OFF + 3]}};
     for (int k = 0; k < 3; k++) s->nblocks[k] = nb[k], s->first[k] = k ? s->first[k - 1] + nb[k - 1] : 0;
     if (m) {
         s->csr = csr_at(p, w + W_OFF, n, nc);
@@ -620,13 +621,23 @@ static int verify_part(const ulam_system *s, int part, int64_t first, int64_t la
     return ULAM_OK;
 }
 
+/* Rows a stretch of a whole check given back at once (a large file: ulam__system_releases). */
+#define RELEASE_ROWS ((int64_t)1 << 16)
+
 /* Verify every block. */
 int ulam_system_check(const ulam_system *s, ulam_error *err)
 {
     ulam__clear(err);
     if (!s) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a system");
     int status = ULAM_OK;
-    for (int part = 0; part < 3 && !status; part++) status = verify_part(s, part, 0, INT64_MAX, err);
+    for (int part = 0; part < 3 && !status; part++) {
+        int64_t rows = part == PART_T ? s->tr.nrows : s->n, step = ulam__system_releases(s) && part != PART_B ? RELEASE_ROWS : rows;
+        for (int64_t r0 = 0; r0 < rows && !status; r0 += step) { /* a large file given back a stretch at a time */
+            status = verify_part(s, part, r0, r0 + step, err);
+            ulam__system_release(s, part == PART_M ? &s->csr : &s->tr, r0 - (r0 & (((int64_t)1 << s->shift) - 1)),
+                                 r0 + step < rows ? r0 + step : rows);
+        }
+    }
     return status;
 }
 
@@ -817,6 +828,68 @@ int ulam__system_tr_verify(const ulam_system *s, int64_t first, int64_t last, ul
 const ulam_csr *ulam__system_tr(const ulam_system *s)
 {
     return s && s->has_tr ? &s->tr : NULL;
+}
+
+/* Whether s's mapping is released as passes go (see src/cache.h). */
+int ulam__system_releases(const ulam_system *s)
+{
+    return s && s->map && s->fd >= 0 && s->map_bytes > s->keep;
+}
+
+/* Set the bytes of mapping s keeps resident (see src/cache.h). */
+void ulam__system_set_keep(ulam_system *s, size_t bytes)
+{
+    if (s) s->keep = bytes;
+}
+
+/* Give back the pages of [p, p + bytes) of s's mapping, widened to whole pages (MADV_DONTNEED:
+ * the file's pages stay in the page cache, a later read maps them again; nothing of a read-only
+ * private mapping is lost). */
+static void release_bytes(const ulam_system *s, const void *p, size_t bytes)
+{
+    const size_t page = (size_t)2 << 20; /* whole 2 MiB spans: a huge mapping is not split */
+    uintptr_t a = (uintptr_t)p / page * page, e = ((uintptr_t)p + bytes + page - 1) / page * page;
+    uintptr_t m0 = (uintptr_t)s->map, m1 = m0 + s->map_bytes;
+    a = a < m0 ? m0 : a, e = e > m1 ? m1 : e;
+    if (a < e) madvise((void *)a, e - a, MADV_DONTNEED); /* advice: a failure leaves the pages resident, no more */
+}
+
+/* Rows [r0, r1) of A (s's M or stored M^T) given back to the page cache (see src/cache.h). */
+void ulam__system_release(const ulam_system *s, const ulam_csr *A, int64_t r0, int64_t r1)
+{
+    if (!ulam__system_releases(s) || (A != &s->csr && A != &s->tr) || r0 >= r1) return;
+    int64_t a = A->rowptr[r0], b = A->rowptr[r1];
+    release_bytes(s, A->colidx + a, (size_t)(b - a) * sizeof *A->colidx);
+    release_bytes(s, A->val + a, (size_t)(b - a) * sizeof *A->val);
+    release_bytes(s, A->rowptr + r0, (size_t)(r1 - r0) * sizeof *A->rowptr);
+}
+
+/* All of s's mapping given back once the process's file-backed resident pages pass
+ * ULAM__SYSTEM_TRIM, or its keep when smaller (see src/cache.h): /proc/self/statm's third field
+ * (none: nothing given back). */
+void ulam__system_trim(const ulam_system *s)
+{
+    if (!ulam__system_releases(s)) return;
+    char buf[128];
+    int fd = open("/proc/self/statm", O_RDONLY | O_CLOEXEC);
+    ssize_t got = fd >= 0 ? read(fd, buf, sizeof buf - 1) : -1;
+    if (fd >= 0) close(fd);
+    if (got <= 0) return;
+    buf[got] = 0;
+    unsigned long long size = 0, res = 0, shared = 0;
+    if (sscanf(buf, "%llu %llu %llu", &size, &res, &shared) == 3 &&
+        shared * (unsigned long long)sysconf(_SC_PAGESIZE) > (s->keep < ULAM__SYSTEM_TRIM ? s->keep : ULAM__SYSTEM_TRIM))
+        release_bytes(s, s->map, s->map_bytes);
+}
+
+/* Row j of s's stored M^T read by pread into col and val (see src/cache.h). */
+int ulam__system_tr_row(const ulam_system *s, int64_t j, int32_t *col, double *val)
+{
+    const ulam_csr *T = &s->tr;
+    int64_t a = T->rowptr[j], d = T->rowptr[j + 1] - a;
+    uint64_t oc = (uint64_t)((const unsigned char *)(const void *)(T->colidx + a) - (const unsigned char *)s->map);
+    uint64_t ov = (uint64_t)((const unsigned char *)(const void *)(T->val + a) - (const unsigned char *)s->map);
+    return d > 0 && (read_at(s, col, (size_t)d * 4, oc) || read_at(s, val, (size_t)d * 8, ov)) ? -1 : 0;
 }
 
 /* Whether M's values are all >= 0, read by pread (see src/cache.h). */

@@ -78,6 +78,27 @@ int ulam__system_tr_verify(const ulam_system *s, int64_t first, int64_t last, ul
 const ulam_csr *ulam__system_tr(const ulam_system *s);
 int ulam__system_nonneg(const ulam_system *s);
 
+/* A mapping larger than this many bytes is given back as passes over it go, so a query's
+ * resident set stays well under the file (issue 43: 2^24 nodes, a 6.5 GB file, within 2 GiB); a
+ * smaller one stays mapped whole, as read (R-MAT 2^22, a 1.6 GB file: given back, the query took
+ * 1.6x the CPU).  And the file-backed resident bytes past which a pass that reads at random gives
+ * all of it back (ulam__system_trim). */
+#define ULAM__SYSTEM_KEEP ((size_t)2 << 30)
+#define ULAM__SYSTEM_TRIM ((size_t)512 << 20)
+
+/* Passes over a prepared system's arrays (src/cache.c): whether s's mapping is released as they go
+ * (a mapped file of more than its keep bytes, ULAM__SYSTEM_KEEP unless set); rows [r0, r1) of A (s's
+ * M or stored M^T; else nothing) given back to the page cache (madvise: the pages leave the
+ * resident set, a later read maps them again) -- a block verified is given back so; and row j of
+ * the stored M^T read by pread into col and val (its entries' room), 0 or -1 on a failed read.
+ * ulam__system_trim: for passes that read at random (a queue push, walks), called now and then:
+ * all of the mapping given back once the process's file-backed resident set passes ULAM__SYSTEM_TRIM. */
+int ulam__system_releases(const ulam_system *s);
+void ulam__system_set_keep(ulam_system *s, size_t bytes);
+void ulam__system_release(const ulam_system *s, const ulam_csr *A, int64_t r0, int64_t r1);
+int ulam__system_tr_row(const ulam_system *s, int64_t j, int32_t *col, double *val);
+void ulam__system_trim(const ulam_system *s);
+
 /* What a prepared system is written from checked (ulam_system_write_file's refusals: ULAM_EINVAL),
  * and its bytes written to f with the bounds R (an analysis' of d->M at the certificate's
  * continuation and exponent 1, with d->b's scores; NULL: none stored) once checked (src/cache.c;

@@ -52,6 +52,14 @@
                                       nnz / this (a sixteenth of a sweep: a queue push's operation reads at random) */
 #define ULAM__FPUSH_NEG_PASSES 32     /* passes of push_negative at most (its operations: a sweep's at most) */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
+#define ULAM__FPUSH_TRIM_EVERY 256  /* rows a queue push checks between trims of a large file's mapping
+                                      (ulam__system_trim: a read of /proc/self/statm) */
+#define ULAM__FPUSH_TRIM_WALKS 8    /* walks launched between trims: a fault maps up to 2 MiB of a file's large
+                                      pages, and a walk visits ~7 rows (R-MAT 2^24, source 101: every 256 walks
+                                      let the mapping reach 3.3 GB, a peak RSS of 3.87 GB) */
+#define ULAM__FPUSH_STORE_ROW 64    /* a large file's rows of at most this many entries are read by pread into the walks'
+                                      store on the first visit; longer ones (hubs: a visit reads one entry of
+                                      thousands) in place, their pages trimmed */
 #define ULAM__FPUSH_SKEW 16.0       /* rows drawn from by rejection up to this many tries on average, beyond by the
                                       running sums (R-MAT 2^20, source 990665, 2026-12-02, load 2.2-2.7, median of 5:
                                       walk loop 121 ms at 2 (2.6e6 running sums built for 117 562 steps), 84 at 4,
@@ -246,32 +254,6 @@ static void block_sums(const double *r, int64_t n, double *bsum)
     bsum[b] = acc;
 }
 
-/* Row j of M' (column j of M) as a walk reads it: the sum and largest of its |entries| (read
- * here unless pre: the sweep push left them), its bit in known set, and when drawing an entry by
- * rejection would take more than ULAM__FPUSH_SKEW tries on average, the running sums of |entries|
- * for a binary search, appended to cum at *used (so cum's pages are touched only as far as rows
- * need it; a first touch is dear), mx_j then -1 - their offset in cum instead of the largest
- * entry (negative: sums built).  known is a bit a state (n / 8 bytes: its pages are few). */
-static void row_sums(const ulam_csr *Mt, int64_t j, int pre, double *cs, double *mx, uint64_t *known, double *cum,
-                     int64_t *used)
-{
-    int64_t a = Mt->rowptr[j], b = Mt->rowptr[j + 1];
-    if (!pre) {
-        double s = 0.0, m = 0.0;
-        for (int64_t e = a; e < b; e++) {
-            double v = fabs(Mt->val[e]);
-            s += v, m = v > m ? v : m;
-        }
-        cs[j] = s, mx[j] = m;
-    }
-    known[j >> 6] |= (uint64_t)1 << (j & 63);
-    if (mx[j] * (double)(b - a) > ULAM__FPUSH_SKEW * cs[j]) {
-        double c = 0.0, *cu = cum + *used;
-        for (int64_t e = a; e < b; e++) c += fabs(Mt->val[e]), cu[e - a] = c;
-        mx[j] = -1.0 - (double)*used, *used += b - a;
-    }
-}
-
 /* The walk state: the start's block sums, per-row sums met so far, terminal counts. */
 typedef struct {
     const ulam_csr *Mt;
@@ -290,9 +272,52 @@ typedef struct {
     int64_t nhit, hmax; /* hit and hc hold hmax states; slot has 2 hmax or more (a power of 2) */
     int64_t hcap, steps;
     const ulam_system *sys; /* a lazily read file whose stored M^T is Mt: each row's block verified on the first visit */
-    int status;             /* ULAM_ESYNTAX once a block failed (bad: a row of it); the walks then stop */
+    int status;             /* ULAM_ESYNTAX once a block failed (bad: a row of it), ULAM_EIO on a failed read; the
+                               walks then stop */
     int64_t bad;
+    const ulam_system *store_of; /* a released mapping (ulam__system_releases): each row read by pread on its first
+                                    visit into the store (scol, sval from soff[j]), so the walks' resident set is
+                                    the rows they visit, not every page near them; NULL: rows read in place */
+    int32_t *scol;
+    double *sval;
+    int64_t *soff, sused;
 } walker;
+
+/* Row j of M' (column j of M) as a walk reads it, on its first visit: read into w's store
+ * (w->store_of), the sum and largest of its |entries| (read here unless w->pre: the sweep push
+ * left them), its bit in known set, and when drawing an entry by rejection would take more than
+ * ULAM__FPUSH_SKEW tries on average, the running sums of |entries| for a binary search, appended
+ * to cum at cum_used (so cum's pages are touched only as far as rows need it; a first touch is
+ * dear), mx_j then -1 - their offset in cum instead of the largest entry (negative: sums built).
+ * known is a bit a state (n / 8 bytes: its pages are few).  0, or -1 when the read failed. */
+static int row_sums(walker *w, int64_t j)
+{
+    const ulam_csr *Mt = w->Mt;
+    int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a;
+    const double *val = Mt->val + a;
+    double *cs = w->cs, *mx = w->mx;
+    if (w->store_of && d > ULAM__FPUSH_STORE_ROW) {
+        w->soff[j] = -1; /* read in place */
+    } else if (w->store_of) {
+        if (ulam__system_tr_row(w->store_of, j, w->scol + w->sused, w->sval + w->sused)) return -1;
+        val = w->sval + w->sused, w->soff[j] = w->sused, w->sused += d;
+    }
+    if (!w->pre) {
+        double s = 0.0, m = 0.0;
+        for (int64_t e = 0; e < d; e++) {
+            double v = fabs(val[e]);
+            s += v, m = v > m ? v : m;
+        }
+        cs[j] = s, mx[j] = m;
+    }
+    w->known[j >> 6] |= (uint64_t)1 << (j & 63);
+    if (mx[j] * (double)d > ULAM__FPUSH_SKEW * cs[j]) {
+        double c = 0.0, *cu = w->cum + w->cum_used;
+        for (int64_t e = 0; e < d; e++) c += fabs(val[e]), cu[e] = c;
+        mx[j] = -1.0 - (double)w->cum_used, w->cum_used += d;
+    }
+    return 0;
+}
 
 /* The slot of state j in w's table: where its q is, or the empty slot where it goes. */
 static int64_t hit_slot(const walker *w, int64_t j)
@@ -436,7 +461,9 @@ static int64_t walk_start(const walker *w, ulam_rng *rng)
  * its next move drawn on arrival; phase 0: j's row sums prefetched; 1: the entry e of row j
  * (at a) it moves along prefetched, taken if f mx_j <= |M_ej| (rejection; f = 0: taken). */
 typedef struct {
-    int64_t j, a, e;
+    int64_t j, d, e;     /* at j, row j's d entries at col and val (in Mt or w's store) */
+    const int32_t *col;
+    const double *val;
     double u, f;
     int neg, phase, on;
 } lane;
@@ -467,9 +494,14 @@ static int lane_choose(walker *w, lane *L)
         w->status = ULAM_ESYNTAX, w->bad = j; /* a damaged block: the walk ends unscored, the run fails */
         return 0;
     }
-    if (!(w->known[j >> 6] >> (j & 63) & 1)) row_sums(Mt, j, w->pre, w->cs, w->mx, w->known, w->cum, &w->cum_used); /* on the first visit */
+    if (!(w->known[j >> 6] >> (j & 63) & 1) && row_sums(w, j)) { /* on the first visit */
+        w->status = ULAM_EIO, w->bad = j; /* an unreadable file: the walk ends unscored, the run fails */
+        return 0;
+    }
     if (!(v < w->cs[j])) return 0; /* the walk dies */
     int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a, e;
+    L->col = Mt->colidx + a, L->val = Mt->val + a, L->d = d;
+    if (w->store_of && w->soff[j] >= 0) L->col = w->scol + w->soff[j], L->val = w->sval + w->soff[j];
     if (w->mx[j] < 0) { /* the first entry whose running sum exceeds v */
         const double *cu = w->cum + (int64_t)(-1.0 - w->mx[j]);
         int64_t l = 0, h = d - 1;
@@ -485,8 +517,8 @@ static int lane_choose(walker *w, lane *L)
         if (e >= d) e = d - 1;
         L->f = t - (double)e;
     }
-    L->a = a, L->e = e, L->phase = 1;
-    __builtin_prefetch(&Mt->val[a + e]), __builtin_prefetch(&Mt->colidx[a + e]);
+    L->e = e, L->phase = 1;
+    __builtin_prefetch(&L->val[e]), __builtin_prefetch(&L->col[e]);
     return 1;
 }
 
@@ -495,18 +527,17 @@ static int lane_choose(walker *w, lane *L)
  * walk's tries overlap the other lanes' reads as its steps do. */
 static void lane_move(walker *w, ulam_rng *rng, lane *L)
 {
-    const ulam_csr *Mt = w->Mt;
-    int64_t j = L->j, a = L->a, e = L->e;
-    if (L->f * w->mx[j] > fabs(Mt->val[a + e])) {
+    int64_t j = L->j, e = L->e;
+    if (L->f * w->mx[j] > fabs(L->val[e])) {
         uint64_t frac;
-        L->e = (int64_t)ulam__rng_index(rng, (uint64_t)(Mt->rowptr[j + 1] - a), &frac);
+        L->e = (int64_t)ulam__rng_index(rng, (uint64_t)L->d, &frac);
         L->f = (double)frac * 0x1.0p-64;
-        __builtin_prefetch(&Mt->val[a + L->e]), __builtin_prefetch(&Mt->colidx[a + L->e]);
+        __builtin_prefetch(&L->val[L->e]), __builtin_prefetch(&L->col[L->e]);
         return;
     }
-    L->neg ^= Mt->val[a + e] < 0;
+    L->neg ^= L->val[e] < 0;
     w->steps++;
-    lane_arrive(w, rng, L, Mt->colidx[a + e]);
+    lane_arrive(w, rng, L, L->col[e]);
 }
 
 /* count walks, ULAM__FPUSH_LANES of them in flight (round robin, one phase each, what a lane
@@ -531,6 +562,7 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
                 L[l].on = 1, L[l].neg = w->r[j] < 0, launched++;
                 lane_arrive(w, rng, &L[l], j);
                 more = launched < count && !((launched & 1023) == 0 && interrupt && *interrupt) && !w->status;
+                if (w->store_of && launched % ULAM__FPUSH_TRIM_WALKS == 0) ulam__system_trim(w->store_of);
             }
             busy |= L[l].on;
         }
@@ -621,11 +653,15 @@ static int cs_rule_met(const cs_set *S, const walker *w, const double *p, int64_
  * queue push (swi->chain: its operations) adds nonnegative terms where M >= 0, each addition a
  * factor within 1 -+ u, and no value goes through more additions than the push made: (chain + 2) u
  * / (1 - alpha). */
-static double rounding_allowance(const ulam_csr *M, const ulam__sweep_info *swi, double alpha)
+static double rounding_allowance(const ulam_csr *M, const ulam__sweep_info *swi, double alpha,
+                                 const ulam__sweep_release *rel)
 {
     if (swi->chain > 0) return ((double)swi->chain + 2.0) * (DBL_EPSILON / 2.0) / (1.0 - alpha);
     int64_t d = 0;
-    for (int64_t i = 0; i < M->nrows; i++) d = M->rowptr[i + 1] - M->rowptr[i] > d ? M->rowptr[i + 1] - M->rowptr[i] : d;
+    for (int64_t i = 0; i < M->nrows; i++) {
+        d = M->rowptr[i + 1] - M->rowptr[i] > d ? M->rowptr[i + 1] - M->rowptr[i] : d;
+        ulam__sweep_done(rel, M, i, M->nrows);
+    }
     return ((double)swi->rounds + 1.0) * ((double)d + 2.0) * (DBL_EPSILON / 2.0) / (1.0 - alpha);
 }
 
@@ -811,12 +847,21 @@ static double walk_work_top(double r_sum, void *ctx)
     return walk_work(r_sum, ctx);
 }
 
-/* The check of row j of a lazily read file's stored M^T before a push reads it (ulam__push_set_verify). */
+/* A lazily read file as the queue push checks its rows: the rows checked so far. */
+typedef struct {
+    const ulam_system *sys;
+    int64_t calls;
+} tr_checker;
+
+/* The check of row j of a lazily read file's stored M^T before a push reads it (ulam__push_set_verify);
+ * every ULAM__FPUSH_TRIM_EVERY rows, the file's mapping trimmed (ulam__system_trim). */
 static int tr_row_ok(const void *ctx, int64_t j, int64_t *bad)
 {
+    tr_checker *c = (tr_checker *)(uintptr_t)ctx; /* push_top's own, not const */
     ulam_error e;
-    int status = ulam__system_tr_verify(ctx, j, j + 1, &e);
+    int status = ulam__system_tr_verify(c->sys, j, j + 1, &e);
     if (status) *bad = e.index;
+    if (++c->calls % ULAM__FPUSH_TRIM_EVERY == 0) ulam__system_trim(c->sys);
     return status;
 }
 
@@ -839,8 +884,9 @@ static int push_top(const ulam_csr *Mt, const ulam_system *sys, int64_t s, int64
     double *v = NULL, rmax = 1.0;
     ulam_push_info pi = {0};
     int status = ulam__push_alloc_trusted(Mt, &w);
+    tr_checker chk = {.sys = sys};
     *local = 1;
-    if (!status && sys) ulam__push_set_verify(w, tr_row_ok, sys);
+    if (!status && sys) ulam__push_set_verify(w, tr_row_ok, &chk);
     if (!status) status = ulam__push_start(w, s);
     const int32_t *t = NULL;
     while (!status) {
@@ -879,6 +925,18 @@ static int push_top(const ulam_csr *Mt, const ulam_system *sys, int64_t s, int64
     return status;
 }
 
+/* The whole passes' hook on a lazily read file (ulam__sweep_release): rows [r0, r1) of A given back. */
+static void release_rows(const void *ctx, const ulam_csr *A, int64_t r0, int64_t r1)
+{
+    ulam__system_release(ctx, A, r0, r1);
+}
+
+/* The list rounds' hook on a lazily read file (ulam__sweep_release): its mapping trimmed. */
+static void trim_file(const void *ctx)
+{
+    ulam__system_trim(ctx);
+}
+
 /* Push the negative residual the over-relaxed sweeps left (M >= 0): every r_j < 0 moves into p_j
  * and along row j of M' (r_k += M'_jk r_j), a pass at a time, while its mass times d1 = 1 / (1 - alpha)
  * is above want and the passes' operations stay within max_ops.  x = p + (I - M)^-1 r stays exact,
@@ -886,12 +944,13 @@ static int push_top(const ulam_csr *Mt, const ulam_system *sys, int64_t s, int64
  * on a positive residual).  swi's r_neg, r_sum, support, pushes, ops and rounds (one a pass: the
  * rounding allowance) are kept up to date. */
 static void push_negative(const ulam_csr *Mt, double *p, double *r, double d1, double want, int64_t max_ops,
-                          ulam__sweep_info *swi)
+                          const ulam__sweep_release *rel, ulam__sweep_info *swi)
 {
     int64_t n = Mt->nrows, ops = 0;
     for (int pass = 0; pass < ULAM__FPUSH_NEG_PASSES && swi->r_neg * d1 > want && ops < max_ops; pass++) {
         for (int64_t j = 0; j < n; j++) {
             double rj = r[j];
+            ulam__sweep_done(rel, Mt, j, n);
             if (!(rj < 0)) continue;
             p[j] += rj, r[j] = 0.0;
             for (int64_t e = Mt->rowptr[j]; e < Mt->rowptr[j + 1]; e++) r[Mt->colidx[e]] += Mt->val[e] * rj;
@@ -929,6 +988,8 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     }
     int64_t cap = 100 * ulam_csr_nnz(M) + 1000000;
     int status = ULAM_OK, local = 0;
+    ulam__sweep_release rel = {.fn = release_rows, .trim = trim_file, .ctx = lz}; /* a large file's pages given back as passes go */
+    const ulam__sweep_release *relp = ulam__system_releases(lz) ? &rel : NULL;
     if (top > 0 && top < n && !(o->rmax > 0) && o->walks <= 0) /* the top-K target: a local push, the floor planned */
         status = push_top(Mt, lz, o->source, top, o->min_value, &pl, cap, x, r, swi, &local, err);
     if (status == ULAM_ESYNTAX) { /* a damaged block of the file, named in err */
@@ -944,7 +1005,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     pl.p = x, pl.n = n, pl.K = top, pl.last = 1.0;
     if (!status && !local)
         status = ulam__sweep_push_pull(M, Mt, o->source, o->rmax, o->rmax > 0 ? NULL : topk ? walk_work_top : walk_work, &pl,
-                                       cap, x, r, w.cs, w.mx, swi);
+                                       cap, x, r, w.cs, w.mx, relp, swi);
     free(pl.buf), pl.buf = NULL, pl.cap = 0;
     if (status == ULAM_ENOCONV) status = ULAM_OK; /* ||M||_1 < 1: the cap only ends the push; the walks take the rest */
     if (status) {
@@ -963,7 +1024,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     for (int64_t e = 0; e < ulam_csr_nnz(Mt) && !sgn && !swi->nonneg && !(lz && local); e++) sgn = Mt->val[e] < 0;
     int mpos = !sgn; /* M >= 0, so x >= 0 */
     if (!status && topk && mpos && !local && swi->r_neg > 0) /* what the floor and the cut below would lose to it */
-        push_negative(Mt, x, r, D1, 0.5 * ULAM__FPUSH_CUT_SHARE * pl.E * pl.delta, ulam_csr_nnz(Mt), swi);
+        push_negative(Mt, x, r, D1, 0.5 * ULAM__FPUSH_CUT_SHARE * pl.E * pl.delta, ulam_csr_nnz(Mt), relp, swi);
     if (!status && topk) { /* the walks' floor, certified: M >= 0 gives x_i >= p_i + r_i+ - r_neg / (1 - alpha) (the
                               over-relaxed sweeps' negative residual: R-MAT 2^20, source 101, 2.2e-4, floor 3.3e-4
                               where the plan's was 1.8e-3) */
@@ -1004,7 +1065,14 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
         bsum = ulam__malloc((size_t)w.nb + 1, sizeof *bsum);
         w.cum = ulam__alloc_big((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.cum); /* filled from its start: 2 MiB pages from it */
         w.known = ulam__calloc(((size_t)n + 63) / 64, sizeof *w.known);
-        if (!bsum || !w.cum || !w.known || (sgn ? 0 : !kept || (K < n && !kept_lo)))
+        if (relp) { /* rows by pread into a store, filled from its start as rows are first visited */
+            w.store_of = lz;
+            w.scol = ulam__alloc_big((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.scol);
+            w.sval = ulam__alloc_big((size_t)ulam_csr_nnz(Mt) + 1, sizeof *w.sval);
+            w.soff = ulam__alloc_big((size_t)n, sizeof *w.soff);
+        }
+        if (!bsum || !w.cum || !w.known || (sgn ? 0 : !kept || (K < n && !kept_lo)) ||
+            (relp && (!w.scol || !w.sval || !w.soff)))
             status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks");
     }
     if (!status && w.k > 0) {
@@ -1024,6 +1092,11 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
             }
             if (sgn) cs_plan_all(&S, &w, x, N, R0, pl.E, pl.delta, o->walks > 0 ? (double)o->walks : 0.0);
             int64_t made = N < target ? walk_many(&w, &rng, target - N, o->walk.stop.interrupt) : 0;
+            if (w.status == ULAM_EIO) {
+                status = ulam__fail(err, ULAM_EIO, 0, w.bad, "a readable prepared file (row %lld of its M^T)",
+                                    (long long)w.bad + 1);
+                break;
+            }
             if (w.status) {
                 status = ulam__system_tr_verify(lz, w.bad, w.bad + 1, err);
                 break;
@@ -1044,6 +1117,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
                 break;
             k++;
         }
+        ulam__system_trim(w.store_of); /* the walks done: what they mapped given back */
         if (!planned) /* stopped between checkpoints: the next index */
             k = ulam__stop_epoch(N) > k0 ? ulam__stop_epoch(N) - k0 + 2 : k + 1;
         else if (o->walks > 0)
@@ -1055,7 +1129,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
         int klo = lower_index(sgn || kk < 0 ? k : kk, K, n);
         ends c = {.w = &w, .cs = &S, .kept = kept, .kept_lo = kept_lo, .N = N, .k = k, .kk = kk, .klo = klo, .sgn = sgn, .nonneg = mpos,
                   .R = R, .R0 = R0, .cut = cut, .D = info->residual_bound, .se0 = N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0),
-                  .fp = rounding_allowance(M, swi, alpha)};
+                  .fp = rounding_allowance(M, swi, alpha, relp)};
         if (N >= 2 && sgn) ulam__cs_interval_sides(&S.none, 0.0, 0.0, S.llo, S.lhi, &c.none);
         else if (N >= 2) ulam__stop_interval(N, 0.0, 0.0, R, 0.0, 0.0, R0, k, &c.none); /* its ends: the KL interval's, below */
         else c.none = (ulam__stop_ci){.lo = w.k > 0 ? NAN : 0.0, .hi = w.k > 0 ? NAN : 0.0};
@@ -1089,6 +1163,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     }
     free(key), free(pv);
     free(bsum), free(w.cs), free(w.mx), free(w.cum), free(w.hit), free(w.hc), free(w.slot), free(w.known);
+    free(w.scol), free(w.sval), free(w.soff);
     free(r), free(kept), free(kept_lo), free(S.q), free(S.prev);
     info->rel_err = pl.E, info->min_value = pl.delta;
     info->seconds = ulam_now() - t0;

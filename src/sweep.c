@@ -50,13 +50,20 @@ static int64_t push_one(const ulam_csr *Mt, int64_t j, double *p, double *r, int
 /* One push sweep over the states in order: push every |r_j| > thr (a residual a push adds ahead
  * of the sweep is pushed in the same sweep); the operations (n, and each push's row entries + 1),
  * the pushes in *pushed. */
-int64_t ulam__sweep_once(const ulam_csr *Mt, double thr, double *p, double *r, int64_t *pushed)
+static int64_t sweep_once(const ulam_csr *Mt, double thr, double *p, double *r, int64_t *pushed,
+                          const ulam__sweep_release *rel)
 {
     int64_t n = Mt->nrows, ops = n, k = 0;
-    for (int64_t j = 0; j < n; j++)
+    for (int64_t j = 0; j < n; j++) {
         if (fabs(r[j]) > thr) ops += push_one(Mt, j, p, r, NULL, NULL, NULL), k++;
+        ulam__sweep_done(rel, Mt, j, n);
+    }
     *pushed = k;
     return ops;
+}
+int64_t ulam__sweep_once(const ulam_csr *Mt, double thr, double *p, double *r, int64_t *pushed)
+{
+    return sweep_once(Mt, thr, p, r, pushed, NULL);
 }
 
 /* The pull sweeps' view of M: M and its column sums c (rows of Mt; kept in r's storage, which
@@ -64,6 +71,7 @@ int64_t ulam__sweep_once(const ulam_csr *Mt, double thr, double *p, double *r, i
 typedef struct {
     const ulam_csr *M;
     double *c;
+    const ulam__sweep_release *rel; /* the hook each pass over M calls (NULL: none) */
 } pull;
 
 /* (M p)_i. */
@@ -81,19 +89,21 @@ static int pull_setup(const ulam_csr *M, const ulam_csr *Mt, int64_t s, const do
                       double *cmax, pull *pl)
 {
     int64_t n = Mt->nrows;
+    const ulam__sweep_release *rel = pl->rel;
     double *c = csum ? csum : r;
     for (int64_t j = 0; j < n; j++) {
         double sum = 0.0, mx = 0.0;
         for (int64_t k = Mt->rowptr[j]; k < Mt->rowptr[j + 1]; k++) {
             double v = Mt->val[k];
             if (v < 0) {
-                for (int64_t i = 0; i < n; i++) r[i] = pull_row(M, p, i) + (i == s ? 1.0 : 0.0) - p[i];
+                for (int64_t i = 0; i < n; i++) r[i] = pull_row(M, p, i) + (i == s ? 1.0 : 0.0) - p[i], ulam__sweep_done(rel, M, i, n);
                 return 0;
             }
             sum += v, mx = v > mx ? v : mx;
         }
         c[j] = sum;
         if (cmax) cmax[j] = mx;
+        ulam__sweep_done(rel, Mt, j, n);
     }
     pl->M = M, pl->c = c;
     return 1;
@@ -108,6 +118,7 @@ static int64_t pull_sweep(const pull *pl, int64_t s, double thr, double omega, d
     double fall = 0.0;
     for (int64_t i = 0; i < n; i++) {
         double v = pull_row(pl->M, p, i) + (i == s ? 1.0 : 0.0), d = v - p[i];
+        ulam__sweep_done(pl->rel, pl->M, i, n);
         if (!(fabs(d) > thr)) continue;
         p[i] = omega > 1.0 ? p[i] + omega * d : v, pushed++;
         fall += (omega > 1.0 ? omega * d : d) * (1.0 - pl->c[i]);
@@ -124,6 +135,7 @@ static double pull_residual(const pull *pl, int64_t s, const double *p, double *
     *neg = 0.0;
     for (int64_t i = 0; i < n; i++) {
         double v = pull_row(pl->M, p, i) + (i == s ? 1.0 : 0.0) - p[i];
+        ulam__sweep_done(pl->rel, pl->M, i, n);
         r[i] = v;
         if (v < 0) *neg -= v;
         sum += fabs(v);
@@ -134,13 +146,13 @@ static double pull_residual(const pull *pl, int64_t s, const double *p, double *
 /* Forward push from s on M (given as its transpose Mt, and as itself or NULL) into p and r. */
 int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost,
                           void *ctx, int64_t max_ops, double *p, double *r, double *csum, double *cmax,
-                          ulam__sweep_info *info)
+                          const ulam__sweep_release *rel, ulam__sweep_info *info)
 {
     int64_t n = Mt->nrows, nnz = ulam_csr_nnz(Mt);
     *info = (ulam__sweep_info){0};
     int32_t *list = ulam__malloc((size_t)n, sizeof *list), *next = ulam__malloc((size_t)n, sizeof *next);
     unsigned char *mark = ulam__calloc((size_t)n, 1);
-    pull pl = {0};
+    pull pl = {.rel = rel};
     if (!list || !next || !mark) {
         free(list), free(next), free(mark);
         return ULAM_ENOMEM;
@@ -162,6 +174,7 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
                 int64_t j = list[q];
                 if (!(fabs(r[j]) > thr)) continue;
                 round_ops += push_one(Mt, j, p, r, next, &nnext, mark), pushed++;
+                if (rel && rel->trim && pushed % ULAM__SWEEP_TRIM_EVERY == 0) rel->trim(rel->ctx);
             }
             for (int64_t q = 0; q < nlist; q++) /* states left under the threshold stay listed */
                 if (r[list[q]] != 0.0 && !mark[list[q]]) mark[list[q]] = 1, next[nnext++] = list[q];
@@ -172,7 +185,7 @@ int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, doub
             round_ops = nnz + n;
             info->sweeps++, info->pulls++;
         } else {
-            round_ops = ulam__sweep_once(Mt, thr, p, r, &pushed);
+            round_ops = sweep_once(Mt, thr, p, r, &pushed, rel);
             info->sweeps++;
         }
         info->rounds++;

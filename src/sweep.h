@@ -18,6 +18,28 @@ typedef struct {
     double delta;  /* > 0: the floor the top-K target planned (fpush.c's push_top) */
 } ulam__sweep_info;
 
+/* A hook a whole pass calls once it is done with rows [r0, r1) of A (in stretches of
+ * ULAM__SWEEP_STRETCH rows, in order): a mapped file's pages given back (src/cache.c's
+ * ulam__system_release); and one the rounds over a list of states call every
+ * ULAM__SWEEP_TRIM_EVERY pushes (they read rows at random: src/cache.c's ulam__system_trim).
+ * NULL: none. */
+typedef struct {
+    void (*fn)(const void *ctx, const ulam_csr *A, int64_t r0, int64_t r1);
+    void (*trim)(const void *ctx);
+    const void *ctx;
+} ulam__sweep_release;
+
+#define ULAM__SWEEP_TRIM_EVERY 256
+
+#define ULAM__SWEEP_STRETCH ((int64_t)1 << 16)
+
+/* Call rel's hook once row i of A (n rows) is done, when i ends a stretch or A. */
+static inline void ulam__sweep_done(const ulam__sweep_release *rel, const ulam_csr *A, int64_t i, int64_t n)
+{
+    if (rel && rel->fn && ((i + 1) % ULAM__SWEEP_STRETCH == 0 || i + 1 == n))
+        rel->fn(rel->ctx, A, i / ULAM__SWEEP_STRETCH * ULAM__SWEEP_STRETCH, i + 1);
+}
+
 /* The walks' work (push operations) a residual of mass r_sum would leave. */
 typedef double (*ulam__sweep_cost)(double r_sum, void *ctx);
 
@@ -33,9 +55,9 @@ int64_t ulam__sweep_once(const ulam_csr *Mt, double thr, double *p, double *r, i
  * ULAM_ENOCONV past max_ops (> 0) operations (p and r still valid).  With M (NULL: none) and
  * M >= 0 the whole sweeps pull along M's rows (the same Gauss-Seidel sweeps, read like a matrix-vector product), r formed once
  * at the end; then (info->nonneg) csum and cmax (n entries each, or NULL) hold the sum and the
- * largest entry of each row of Mt. */
+ * largest entry of each row of Mt.  rel (may be NULL): the whole sweeps' hook (ulam__sweep_release). */
 int ulam__sweep_push_pull(const ulam_csr *M, const ulam_csr *Mt, int64_t s, double rmax, ulam__sweep_cost cost,
                           void *ctx, int64_t max_ops, double *p, double *r, double *csum, double *cmax,
-                          ulam__sweep_info *info);
+                          const ulam__sweep_release *rel, ulam__sweep_info *info);
 
 #endif

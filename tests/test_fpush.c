@@ -603,16 +603,8 @@ static void test_fpush_lazy_blocks(void **state)
     ulam_csr *M = community_graph(n), *Mt = NULL;
     assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
     ulam_guard g;
-    ulam_guard_opts go = ulam_guard_defaults();
-    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
-    assert_int_equal(ulam_guard_check(M, 0.0, &go, &g, NULL), ULAM_OK);
     char path[] = "/tmp/ulam_test_lazyXXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
-    ulam_system_desc d = ulam_system_desc_defaults();
-    d.M = M, d.n = n, d.transpose = 1;
-    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
+    must_prepare(M, path, &g);
     FILE *f = fopen(path, "rb");
     assert_non_null(f);
     fseek(f, 0, SEEK_END);

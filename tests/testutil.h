@@ -14,6 +14,7 @@
 #include <stdlib.h>
 
 #include <string.h>
+#include <unistd.h>
 
 #include "ulam.h"
 
@@ -165,6 +166,22 @@ static inline ulam_csr *must_read(const char *rel)
     if (s) print_error("%s:%ld: %s: %s\n", rel, err.line, ulam_strerror(s), err.msg);
     assert_int_equal(s, ULAM_OK);
     return A;
+}
+
+/* M written with its transpose as a prepared file at path (a mkstemp template, filled in), and M's
+ * forward guard in *g (what a query on the file is given, as the command line gives the file's
+ * certificate). */
+static inline void must_prepare(const ulam_csr *M, char *path, ulam_guard *g)
+{
+    ulam_guard_opts go = ulam_guard_defaults();
+    go.need = ULAM_GUARD_ABS | ULAM_GUARD_FORWARD;
+    assert_int_equal(ulam_guard_check(M, 0.0, &go, g, NULL), ULAM_OK);
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    ulam_system_desc d = ulam_system_desc_defaults();
+    d.M = M, d.n = M->nrows, d.transpose = 1;
+    assert_int_equal(ulam_system_write(path, &d), ULAM_OK);
 }
 
 /* Read a vector that must parse. */
