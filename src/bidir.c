@@ -402,7 +402,7 @@ static void honest_interval(ulam_bidir_result *res, double D, const ulam_walk_op
  * rounding does not print a zero-width interval beside x_t. */
 static double rounding_allowance(const ulam_push *w, const ulam_push_info *push, const ulam_bidir_opts *o)
 {
-    return ((double)push->ops + (double)o->nb + 2.0) * (DBL_EPSILON / 2.0) * dot_abs_b(ulam__push_estimates(w), o);
+    return ulam__push_rounding((double)push->ops + (double)o->nb + 2.0, dot_abs_b(ulam__push_estimates(w), o));
 }
 
 /* Estimate x_t of (I - M) x = b (e_s or a sparse b) on w with memo. */

@@ -7,6 +7,7 @@
 
 #include "ulam.h"
 
+#include <float.h>
 #include <stdarg.h>
 #include <stdlib.h>
 
@@ -54,6 +55,14 @@ static inline double ulam__factor(double S, double continue_q)
 }
 
 /* Uniform double in [0, 1) from the top 53 bits. */
+/* The rounding a push's arithmetic may leave in a value of size `size` after `count` roundings
+ * (its operations, plus the sums after it): each is at most DBL_EPSILON / 2 of what it adds (one
+ * home for the push allowances of src/bidir.c, src/method_bidir.c and src/solve.c). */
+static inline double ulam__push_rounding(double count, double size)
+{
+    return count * (DBL_EPSILON / 2.0) * size;
+}
+
 static inline double ulam__rng_uniform(ulam_rng *r)
 {
     return (double)(ulam__rng_next(r) >> 11) * 0x1.0p-53;

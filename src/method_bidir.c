@@ -539,7 +539,7 @@ static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
          * widened either side by (ops + 2) u |q_i| and the sum's own rounding u |x_i| (as bidir.c's
          * rounding_allowance), so a push taken down to rounding (residual walks' stderr ~1e-17)
          * does not print a zero-width point beside x_i */
-        double fp = ((double)r->bplan.push.ops + 2.0) * (DBL_EPSILON / 2.0) * fabs(qi) + DBL_EPSILON * fabs(br->estimate);
+        double fp = ulam__push_rounding((double)r->bplan.push.ops + 2.0, fabs(qi)) + DBL_EPSILON * fabs(br->estimate);
         br->ci95[0] = qi + br->walks.ci95[0] - fp, br->ci95[1] = qi + br->walks.ci95[1] + fp;
         br->plan = r->bplan, br->push = r->bplan.push;
         br->seconds = br->walks.seconds + r->bplan.seconds;

@@ -1886,7 +1886,7 @@ static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
  * 1-2 ulp from LAPACK's x_i without it (6 of 68 runs). */
 static double push_rounding(const ulam_solver *s, int64_t i)
 {
-    return ((double)s->push.ops + 2.0) * (DBL_EPSILON / 2.0) * fabs(s->pq[i]);
+    return ulam__push_rounding((double)s->push.ops + 2.0, fabs(s->pq[i]));
 }
 
 /* The run's 95% interval so far: the confidence sequence's (stop.h, ulam__cs), valid at every
