@@ -36,7 +36,8 @@ typedef struct {
     const ulam__halo *h;
     int grow;
     int64_t row;       /* >= 0: a candidate is worth its value at this row (its owner's, exact) */
-    const double *wt;  /* else, non-NULL: worth sum_i wt_i z_i (exact_sum), else max z */
+    const double *wt;  /* else, non-NULL: worth sum_i wt_i z_i (exact_sum, the candidate in zc), else max z */
+    double *zc;
     double *gv;
     const int64_t *idx;
     int64_t nq;
@@ -90,12 +91,8 @@ static double dist_worth(void *ctx, const double *m, const double *res, double p
         return i >= 0 && i < rows ? (m[i] + bb * (res[i] + phi)) * (1.0 + 1e-9) : 0.0;
     }
     if (d->wt) {
-        double *z = malloc(((size_t)rows + 1) * sizeof *z), v;
-        for (int64_t i = 0; z && i < rows; i++) z[i] = (m[i] + bb * (res[i] + phi)) * (1.0 + 1e-9);
-        int64_t bad = !z;
-        if (d->c->nranks > 1 && d->c->sum(d->c->ctx, &bad, 1)) bad = 1;
-        v = bad ? INFINITY : exact_sum(d->p, d->c, d->wt, z);
-        free(z);
+        for (int64_t i = 0; i < rows; i++) d->zc[i] = (m[i] + bb * (res[i] + phi)) * (1.0 + 1e-9);
+        double v = exact_sum(d->p, d->c, d->wt, d->zc);
         return v < 0 ? INFINITY : v;
     }
     double top = 0.0;
@@ -125,13 +122,16 @@ static int supersolve(const ulam_part *p, const ulam_comm *c, const ulam__rows *
 {
     int64_t rows = p->last - p->first;
     double *gv = malloc(((size_t)h->nghost + 1) * sizeof *gv), best = INFINITY;
-    dist_ctx d = {p, c, A, h, grow, row, wt, gv, idx, nq, q};
+    double *zc = wt ? malloc(((size_t)rows + 1) * sizeof *zc) : NULL; /* worth against wt: the candidate */
+    dist_ctx d = {p, c, A, h, grow, row, wt, zc, gv, idx, nq, q};
     ulam__super s = {&d, rows, NULL, INFINITY, 1.0 + 1e-9, dist_apply, dist_largest, dist_worth, dist_offer};
     for (int64_t k = 0; k < nq; k++) q[k] = INFINITY;
     for (int64_t i = 0; i < rows; i++) z[i] = INFINITY;
-    int bad = !gv || ulam__super_solve(&s, r, z, &best, NULL);
+    int64_t nomem = !gv || (wt && !zc);
+    if (c->nranks > 1 && c->sum(c->ctx, &nomem, 1)) nomem = 1; /* all stop together */
+    int bad = nomem || ulam__super_solve(&s, r, z, &best, NULL);
     *any = isfinite(best);
-    free(gv);
+    free(gv), free(zc);
     return bad;
 }
 
