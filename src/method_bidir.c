@@ -150,6 +150,10 @@ static int setup(ulam__query *q, const ulam_walk_opts *walk, ulam_error *err)
 /* Pilot walks of the dense route: one round of the walk solver on the residual; at a fixed
  * budget, at most FIXED_ROUNDS rounds of push and pilot. */
 enum { DENSE_PILOT = 1024, FIXED_ROUNDS = 4 };
+/* A fixed budget's walks led by their variance: the push on b is piloted where the range term is at least
+ * VARLED_SHARE of the variance term, its first round within 1 / VARLED_CAP of the push's cap (fixed_predict). */
+#define VARLED_SHARE 0.125
+enum { VARLED_CAP = 8 };
 
 /* The dense route's walks' options: adjoint from the index with kernel c's estimator,
  * continuation and exponent (c NULL: o's), the push part q_i as the rule's offset. */
@@ -326,17 +330,24 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
        rounding is the residual's, ||r||_1 / ||b||_1 of b's: chain4's x_3, absorption pinned, seed 7, 10^5
        walks, a forward leader pushed to its rounding was taken for blind, and bidirectional was piloted
        (1024 walks) to lose at -+0.03 against the walks' -+1.6e-15) */
-    if (!blind && (!(cb.range_term > cb.var_term) || !isfinite(cb.half))) {
+    /* led by the variance, but with a range term of at least VARLED_SHARE of it (rare large scores: the push
+       that takes the large b_j out lowers the variance too; metastable40's x_1 at 10^5 walks, range 0.034
+       against 0.098, and the push printed -+0.016 against the walks' -+0.034): one round of push at most
+       cap / VARLED_CAP operations, and on while each round narrows the predicted interval by a quarter */
+    int varled = !blind && !(cb.range_term > cb.var_term) && cb.range_term >= VARLED_SHARE * cb.var_term;
+    if (!blind && ((!(cb.range_term > cb.var_term) && !varled) || !isfinite(cb.half))) {
         snprintf(v->why, sizeof v->why, "not considered: at %.3g walks the walks' interval is not led by its range "
                  "term (%.3g, variance term %.3g): a push on b would narrow it little", N, cb.range_term, cb.var_term);
         return ULAM_OK;
     }
-    double bmax = ulam__bpush_max(q->b, q->M->nrows), rmax = blind ? 0.5 * bmax : bmax * cb.var_term / cb.range_term;
+    double bmax = ulam__bpush_max(q->b, q->M->nrows);
+    double rmax = blind ? 0.5 * bmax : varled ? bmax / 16.0 : bmax * cb.var_term / cb.range_term, prev = cb.half;
     int64_t cap = W / 2 < 1 ? 1 : W / 2 < 1e18 ? (int64_t)(W / 2) : INT64_MAX;
+    int64_t rcap = varled && cap / VARLED_CAP > 0 ? cap / VARLED_CAP : cap;
     ulam_bidir_plan_info *pl = &ch->bidir;
     for (int round = 1;; round++) { /* the push also lowers the variance: while the residual's range term still
                                        leads, on down (a pilot a round, FIXED_ROUNDS at most) */
-        if ((status = dense_plan(q, q->o, c, rmax, cap, &wr, err)) == ULAM_ENOMEM) return status;
+        if ((status = dense_plan(q, q->o, c, rmax, rcap, &wr, err)) == ULAM_ENOMEM) return status;
         ch->bidir_opts = ulam_bidir_defaults(), ch->bidir_opts.walk = q->run->bwo, ch->bidir_opts.target = q->o->query.index;
         if (status) {
             snprintf(v->why, sizeof v->why, "refused: %.250s", err->msg);
@@ -354,7 +365,12 @@ static int fixed_predict(ulam__query *q, int k, double W, ulam_error *err)
             rmax = pl->push.r_max / 16.0;
             continue;
         }
-        if (!(cr.range_term > cr.var_term)) break;
+        if (varled || !(cr.range_term > cr.var_term)) { /* led by the variance (the residual's, once its range term no
+            longer leads: metastable40 at 10^4 walks): on while a round narrows the predicted interval by a quarter */
+            if (varled && !(cr.half < 0.75 * prev)) break;
+            varled = 1, prev = cr.half, rmax = pl->push.r_max / 16.0, rcap = rcap > cap / 4 ? cap : 4 * rcap;
+            continue;
+        }
         rmax = fmin(0.5 * rmax, pl->push.r_max * cr.var_term / cr.range_term);
     }
     pl->predicted_walks = N;
