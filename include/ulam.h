@@ -313,7 +313,7 @@ int ulam_outfile_commit_all(ulam_outfile *o, int k);
 void ulam_outfile_abort(ulam_outfile *o);
 
 /* ---------------------------------------------------------------- direct solve */
-/* Primary: ulam_direct_solve.  Secondary: ulam_direct_bytes.  The sparse LU (UMFPACK) and the
+/* Primary: ulam_direct_solve.  Secondary: ulam_solution_bound (a certified range around any x), ulam_direct_bytes.  The sparse LU (UMFPACK) and the
  * choice between them: ulam_reference.h. */
 
 /* What a LAPACK direct solve reports besides the solution. */
@@ -332,6 +332,17 @@ size_t ulam_direct_bytes(int64_t n);
  * ULAM_ESINGULAR (err->index is the zero pivot).  info may be NULL. */
 int ulam_direct_solve(const ulam_csr *M, const double *b, double *x, size_t max_bytes,
                       ulam_direct_info *info, ulam_error *err);
+
+/* A certified range [lo[i], hi[i]] of the exact x*_i of (I - M) x* = b around any finite x (an
+ * outer iteration's, a Krylov peer's, a direct solve's), for every i, from x's residual r = b -
+ * (I - M) x computed with each row's rounding bounded: a Collatz-Wielandt vector v > 0 with
+ * |M| v <= u v, u < 1 (v = 1 when the rows of |M| sum below 1, else the expected lengths
+ * (I - |M|)^-1 1 solved roughly and checked by one product) gives |x*_i - x_i| <= max_j (|r_j| /
+ * v_j) v_i / (1 - u); with M >= 0 the range takes r's signs.  No sampling: the range is certain.
+ * *worst: the largest half-width.  ULAM_EDIVERGE (NaN ends, *worst INFINITY) when no such v is
+ * certified; ULAM_EINVAL for a non-square M or a non-finite x or b (err->index: its row). */
+int ulam_solution_bound(const ulam_csr *M, const double *b, const double *x, double *lo, double *hi, double *worst,
+                        ulam_error *err);
 
 /* ---------------------------------------------------------------- spectral radius */
 /* Secondary. */
@@ -1470,7 +1481,8 @@ typedef struct ulam_answer {
  * the push on b (src/bpush.c): b's large entries are pushed down to rmax deterministically and
  * adjoint walks from the index score the residual, whose smaller range the rel_err rule pays
  * for (pinned, it needs a rel_err target and plans from a pilot round of walks on b).  The rows that answer every unknown do
- * not apply to a query for one entry with an error bar (they give none); pinned, they run from
+ * not apply to a query for one entry with an error bar (they give no standard error; pinned, their
+ * ci95 is the certified range ulam_solution_bound gives from x's residual, NaN where none holds); pinned, they run from
  * ulam_outer_defaults() and the Krylov peers to its tolerance, with o's seed, threads,
  * continuation, cut, interrupt and force, and o->stop.max_walks (when set) capping one correction.
  * ch gets every row's verdict; *out the run (NULL on failure).  Statuses: ulam_auto_solver's (the walks' refusal:

@@ -67,6 +67,8 @@ typedef struct ulam_outer_report {
     int check;         /* err_direct holds the relative error against a direct solve */
     double err_direct;
     ulam_guard g;      /* the guards (their radii shown when the method walks) */
+    const double *lo, *hi; /* each x_i's certified range (ulam_solution_bound; NULL: none certified) */
+    double worst;      /* their largest half-width */
 } ulam_outer_report;
 
 /* Write r to f: its totals as text lines (format ULAM_REPORT_BRIEF or _VERBOSE; the iterations'

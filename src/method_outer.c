@@ -62,7 +62,18 @@ static ulam_outer_opts outer_opts(const ulam_walk_opts *w, int method)
     return o;
 }
 
-/* Iterate to the residual tolerance; x_index is the answer (no error bar). */
+/* x_index's certified range from x's residual into a->ci95 (ulam_solution_bound; NaN where none
+ * holds or memory is short: the answer stands without it). */
+static void certified_range(const ulam_run *r, const double *x, ulam_answer *a)
+{
+    int64_t n = r->M->nrows;
+    double *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi), worst;
+    if (lo && hi && ulam_solution_bound(r->M, r->b, x, lo, hi, &worst, NULL) == ULAM_OK)
+        a->ci95[0] = lo[r->o.query.index], a->ci95[1] = hi[r->o.query.index];
+    free(lo), free(hi);
+}
+
+/* Iterate to the residual tolerance; x_index is the answer, with its certified range. */
 static int finish_outer(ulam_run *r, ulam_answer *a, ulam_error *err)
 {
     ulam_outer_opts o = outer_opts(&r->o, r->method - ULAM_METHOD_RICHARDSON);
@@ -77,6 +88,7 @@ static int finish_outer(ulam_run *r, ulam_answer *a, ulam_error *err)
         a->iterations = st.iteration, a->residual = st.residual, histories += st.histories;
     }
     if (s) a->estimate = outer_x(s)[r->o.query.index];
+    if (s && !status) certified_range(r, outer_x(s), a);
     a->walks.walks = histories;
     ulam_outer_free(s);
     return status;
@@ -107,6 +119,7 @@ static int finish_krylov(ulam_run *r, ulam_answer *a, ulam_error *err)
     int status = r->method == ULAM_METHOD_CG ? ulam_cg(r->M, r->b, d.tol, 100000, x, &a->iterations, &a->residual)
                                              : ulam_gmres(r->M, r->b, 30, d.tol, 100000, x, &a->iterations, &a->residual);
     a->estimate = x[r->o.query.index];
+    if (!status) certified_range(r, x, a);
     free(x);
     if (status) ulam__fail(err, status, 0, -1, "a residual below %g within 100000 iterations", d.tol);
     return status;

@@ -298,8 +298,13 @@ static void print_text(FILE *f, const ulam_outer_report *p)
         fprintf(f, "guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", p->g.abs.rho,
                 ulam_verdict_word(p->g.verdict_abs), p->g.hat[ULAM_FORWARD].rho,
                 ulam_verdict_word(p->g.verdict_hat[ULAM_FORWARD]));
-    if (p->index && p->x)
-        fprintf(f, "x[%lld]%*s%.12g\n", (long long)p->index, ulam__report_pad(p->answer_name ? p->answer_name : "x", p->index, 16), "", p->x[p->index - 1]);
+    if (p->lo && p->hi)
+        fprintf(f, "range           every x_i within %.3g of x (certified from x's residual, no sampling)\n", p->worst);
+    if (p->index && p->x) {
+        fprintf(f, "x[%lld]%*s%.12g", (long long)p->index, ulam__report_pad(p->answer_name ? p->answer_name : "x", p->index, 16), "", p->x[p->index - 1]);
+        if (p->lo && p->hi) fprintf(f, " (certified range %.10g .. %.10g)", p->lo[p->index - 1], p->hi[p->index - 1]);
+        fprintf(f, "\n");
+    }
 }
 
 /* The JSON object with the history. */
@@ -329,7 +334,10 @@ static void print_json(FILE *f, const ulam_outer_report *p)
     if (p->index && p->x) {
         fprintf(f, "\"index\": %lld, ", (long long)p->index);
         ulam_json_number(f, "estimate", p->x[p->index - 1], 0);
+        if (p->lo && p->hi)
+            fprintf(f, "\"certified_range\": [%.17g, %.17g], ", p->lo[p->index - 1], p->hi[p->index - 1]);
     }
+    if (p->lo && p->hi) ulam_json_number(f, "certified_half_width", p->worst, 0);
     if (p->check) ulam_json_number(f, "relative_error", p->err_direct, 0);
     fprintf(f, "\"seed\": %llu, \"threads\": %d, \"ranks\": %d, \"history\": [", (unsigned long long)p->seed, p->threads,
             p->ranks);

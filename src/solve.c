@@ -319,7 +319,7 @@ static void length_certificate(const ulam_csr *K, const char *seen, double *u, d
     double u2, k2;
     int64_t products = 0, n = K->nrows;
     int64_t cap = 4 * (int64_t)sqrt((double)n) + 2000;
-    if (ulam__length_certificate(K, seen, (int)cap, &u2, &k2, &products) == ULAM_OK &&
+    if (ulam__length_certificate(K, seen, (int)cap, &u2, &k2, &products, NULL) == ULAM_OK &&
         tail_steps(u2, k2) < tail_steps(*u, *kappa))
         *u = u2, *kappa = k2;
     *iterations += (int)products;

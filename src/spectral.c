@@ -388,7 +388,7 @@ enum { GMRES_MAX = 1 << 20, GMRES_ITER = 1000 }; /* the most states the certific
  * is then one product with |K| in floating point, each ratio raised by a rounding allowance.
  * *u (1 when none holds) and *kappa = max h / min h; *matvecs gets the products spent. */
 int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, double *u, double *kappa,
-                             int64_t *matvecs)
+                             int64_t *matvecs, double *hout)
 {
     *u = 1.0, *kappa = INFINITY;
     int64_t n = K->nrows, m = 0, nnz = 0;
@@ -441,6 +441,7 @@ int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, 
         }
         if (ratio < 1.0) *u = ratio, *kappa = hmax / hmin;
         else status = ULAM_ENOCONV;
+        for (int64_t i = 0; hout && !status && i < n; i++) hout[i] = seen[i] ? h[at[i]] : NAN;
     }
     free(at), free(one), free(h), ulam_csr_free(A);
     return status;

@@ -18,9 +18,10 @@ int ulam__power_from(const ulam_csr *A, const double *left, const double *right,
 
 /* A Collatz-Wielandt certificate |K| v <= u v over the rows in seen (closed under K's moves)
  * from the expected lengths h = (I - |K|)^-1 1, solved roughly by CG or GMRES in at most
- * max_iter products: *u (1: none), *kappa = max h / min h; *matvecs added to (src/spectral.c). */
+ * max_iter products: *u (1: none), *kappa = max h / min h; *matvecs added to; hout (n doubles, may
+ * be NULL) gets the certified v = h over seen (NaN elsewhere) when it holds (src/spectral.c). */
 int ulam__length_certificate(const ulam_csr *K, const char *seen, int max_iter, double *u, double *kappa,
-                             int64_t *matvecs);
+                             int64_t *matvecs, double *hout);
 
 /* rho(diag(left) |A| diag(right)) by shifted power iteration with Collatz-Wielandt bounds; left
  * and right may be NULL (all ones), opts NULL (ulam_power_defaults()): the guards' iteration

@@ -26,7 +26,7 @@ CASES = [  # arguments, exit code, stderr regex, stdout regex
     (P20 + ["--method", "mcsa", "--tol", "-1e-8"], 2, r"--tol expects", r"^$"),
     (P20 + ["--method", "mcsa", "--tol", "tiny"], 2, r"--tol expects", r"^$"),
     (P20 + ["--method", "mcsa", "--max-iter", "0"], 2, r"--max-iter expects an integer from 1", r"^$"),
-    (P20 + ["--method", "gauss-seidel", "--index", "3"], 0, r"^$", r"^x\[3\]\s+[\d.]+$"),  # x_I without --out
+    (P20 + ["--method", "gauss-seidel", "--index", "3"], 0, r"^$", r"^x\[3\]\s+[\d.]+ \(certified range [\d.e-]+ \.\. [\d.e-]+\)$"),  # x_I without --out, its certified range
     (P20 + ["--method", "mcsa", "--eps1", "0"], 2, r"--eps1 expects .*strictly between 0 and 1", r"^$"),
     (P20 + ["--method", "newton"], 2, r"--method expects auto, walks, bidirectional \(with --source or a sparse b\), richardson, gauss-seidel, sequential, mcsa, cg or gmres, got .newton.", r"^$"),
     (P20 + ["--method", "mcsa", "--walks", "10"], 2, r"--walks does not apply with --method mcsa", r"^$"),

@@ -71,6 +71,63 @@ static void test_jacobi_poisson(void **state)
     ulam_csr_free(A), ulam_csr_free(M);
 }
 
+/* ulam_solution_bound: a certified range around any x holds the exact solution and is as narrow as
+ * the residual allows.  x = LAPACK's solution plus a perturbation of size d (a sine, both signs):
+ * every range holds LAPACK's x (to its rounding, 1e-12 relative), its half-width is at least d's
+ * effect and, on systems whose certificate is tight, within 100x of it.  randsub1000 (rows of |M|
+ * below 1: v = 1), poisson20 by its Jacobi splitting (interior rows of M sum to exactly 1: the
+ * expected lengths' certificate), signed200 (signed M); divergent200 (rho(|M|) = 1.1) is refused
+ * with NaN ends, a non-finite x with its row. */
+static void test_solution_bound(void **state)
+{
+    (void)state;
+    const char *names[] = {"randsub1000", "poisson20", "signed200"};
+    for (int k = 0; k < 3; k++) {
+        char mp[96], bpath[96];
+        snprintf(mp, sizeof mp, "matrices/%s.mtx", names[k]), snprintf(bpath, sizeof bpath, "matrices/%s_b.mtx", names[k]);
+        ulam_csr *M = must_read(mp);
+        int64_t n;
+        double *b = must_read_vector(bpath, &n), *bp = malloc((size_t)n * sizeof *bp);
+        if (k == 1) { /* the Jacobi splitting */
+            ulam_csr *J = NULL;
+            assert_int_equal(ulam_jacobi(M, b, 1.0, &J, bp, NULL), ULAM_OK);
+            ulam_csr_free(M), M = J;
+        } else memcpy(bp, b, (size_t)n * sizeof *bp);
+        double *x = malloc((size_t)n * sizeof *x), *y = malloc((size_t)n * sizeof *y);
+        double *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi), worst;
+        assert_int_equal(ulam_direct_solve(M, bp, x, 0, NULL, NULL), ULAM_OK);
+        for (int d = 0; d < 3; d++) {
+            double size = d == 0 ? 0.0 : d == 1 ? 1e-9 : 1e-3, top = 0.0;
+            for (int64_t i = 0; i < n; i++) y[i] = x[i] + size * sin(0.37 * (double)i + 1.0), top = fmax(top, fabs(x[i]));
+            assert_int_equal(ulam_solution_bound(M, bp, y, lo, hi, &worst, NULL), ULAM_OK);
+            int held = 0;
+            for (int64_t i = 0; i < n; i++) {
+                double slack = 1e-12 * top; /* LAPACK's own rounding */
+                held += lo[i] - slack <= x[i] && x[i] <= hi[i] + slack && lo[i] <= y[i] && y[i] <= hi[i];
+            }
+            print_message("%s, perturbation %g: every x_i within %g, %lld of %lld ranges hold x\n", names[k], size, worst,
+                          (long long)held, (long long)n);
+            assert_int_equal(held, n);
+            if (d == 2) assert_true(worst >= 0.5 * size && (k != 0 || worst <= 100.0 * size));
+        }
+        free(b), free(bp), free(x), free(y), free(lo), free(hi);
+        ulam_csr_free(M);
+    }
+    ulam_csr *M = must_read("matrices/divergent200.mtx");
+    int64_t n;
+    double *b = must_read_vector("matrices/divergent200_b.mtx", &n), *x = calloc((size_t)n, sizeof *x);
+    double *lo = malloc((size_t)n * sizeof *lo), *hi = malloc((size_t)n * sizeof *hi), worst = 0;
+    ulam_error err;
+    assert_int_equal(ulam_solution_bound(M, b, x, lo, hi, &worst, &err), ULAM_EDIVERGE);
+    assert_true(isnan(lo[0]) && isnan(hi[n - 1]) && worst == INFINITY);
+    x[5] = NAN;
+    assert_int_equal(ulam_solution_bound(M, b, x, lo, hi, &worst, &err), ULAM_EINVAL);
+    assert_int_equal(err.index, 5);
+    assert_int_equal(ulam_solution_bound(M, b, NULL, lo, hi, &worst, &err), ULAM_EINVAL);
+    free(b), free(x), free(lo), free(hi);
+    ulam_csr_free(M);
+}
+
 /* A singular I - M is reported as such, not as numbers. */
 static void test_singular(void **state)
 {
@@ -208,7 +265,7 @@ int main(void)
         cmocka_unit_test(test_jacobi_poisson), cmocka_unit_test(test_singular),
         cmocka_unit_test(test_memory_limit), cmocka_unit_test(test_not_square),
         cmocka_unit_test(test_sparse), cmocka_unit_test(test_pagerank_matrix),
-        cmocka_unit_test(test_coverage_interval),
+        cmocka_unit_test(test_coverage_interval), cmocka_unit_test(test_solution_bound),
     };
     return test_run(tests);
 }

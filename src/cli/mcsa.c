@@ -24,6 +24,8 @@ typedef struct {
     int64_t index; /* 1-based, 0: none */
     const double *x;
     double err_direct, direct_seconds, seconds;
+    const double *lo, *hi; /* each x_i's certified range (NULL: none) */
+    double worst;
     const char *direct_method; /* --check's reference: "dense LU", "sparse LU" or GMRES */
     ulam_guard g;
     ulam_error why; /* the library's sentence on how the run ended */
@@ -68,7 +70,8 @@ static void print_report(const report *p)
                            .steps = p->steps, .nsteps = p->nsteps, .iterations = p->iterations, .restart = p->restart,
                            .status = p->status, .converged = p->converged, .rejected = p->rejected,
                            .residual = p->residual, .seconds = p->seconds, .index = p->index, .x = p->x,
-                           .answer_name = cli_answer_name, .check = p->check, .err_direct = p->err_direct, .g = p->g};
+                           .answer_name = cli_answer_name, .check = p->check, .err_direct = p->err_direct, .g = p->g,
+                           .lo = p->lo, .hi = p->hi, .worst = p->worst};
     if (p->json) cli_json_done = 1;
     ulam_outer_report_fprint(stdout, &r, p->json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
 }
@@ -280,6 +283,10 @@ static int start_run(void *q, int argc, char **argv, int optind)
     double *x = NULL;
     rc = p.method >= KRYLOV_CG ? run_krylov(&s, &o, &p, &x) : run(&s, &o, &p, &steps, &x);
     p.steps = steps, p.x = x;
+    double *lo = NULL, *hi = NULL; /* the certified range of every x_i from x's residual, where one holds */
+    if (!rc && x && cli_rank == 0 && (lo = malloc((size_t)s.M->nrows * sizeof *lo)) &&
+        (hi = malloc((size_t)s.M->nrows * sizeof *hi)) && ulam_solution_bound(s.M, s.b, x, lo, hi, &p.worst, NULL) == ULAM_OK)
+        p.lo = lo, p.hi = hi;
     if (!rc && p.status && p.status != ULAM_ESTALL && p.status != ULAM_ENOCONV) {
         print_failure(&p);
         rc = cli_exit_code(p.status);
@@ -308,7 +315,7 @@ static int start_run(void *q, int argc, char **argv, int optind)
         if (!rc && cli_interrupted) rc = EXIT_INTERRUPTED;
     }
     cli_flush();
-    free(steps), free(x);
+    free(steps), free(x), free(lo), free(hi);
     cli_system_free(&s);
     return rc;
 }
