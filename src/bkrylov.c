@@ -54,3 +54,17 @@ int ulam__bkrylov(const ulam_csr *M, const double *b, double tol, int max_iter, 
     *delta = dmax;
     return ULAM_OK;
 }
+
+/* A bound on the expected visits of a walk on |M| from any state by its largest row sum S of
+ * |M|: 1 / (1 - S) when S < 1, else INFINITY (the walk solver's length tail then, if any). */
+double ulam__bkrylov_visits(const ulam_csr *M)
+{
+    double S = 0.0;
+    for (int64_t j = 0; j < M->nrows; j++) {
+        double t = 0.0;
+        for (int64_t p = M->rowptr[j]; p < M->rowptr[j + 1]; p++) t += fabs(M->val[p]);
+        S = fmax(S, t);
+    }
+    S *= 1.0 + 4.0 * DBL_EPSILON * (double)(M->ncols + 1); /* the sums' rounding, upward */
+    return S < 1.0 ? 1.0 / (1.0 - S) : INFINITY;
+}

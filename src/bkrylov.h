@@ -11,4 +11,8 @@
 int ulam__bkrylov(const ulam_csr *M, const double *b, double tol, int max_iter, double *q, double *r, double *delta,
                   int *iters);
 
+/* 1 / (1 - S) for S the largest row sum of |M| (rounded up) when below 1, else INFINITY: a bound
+ * on the expected visits of a walk on |M| (src/bkrylov.c). */
+double ulam__bkrylov_visits(const ulam_csr *M);
+
 #endif

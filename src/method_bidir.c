@@ -244,8 +244,10 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
             if ((status = ulam__bkrylov(q->M, q->b, krylov_tol(E), it, r->bq, r->br, &r->bdelta, &r->bkiters)))
                 return release(r), ulam__fail(err, status, 0, -1, "memory for the Krylov start");
             push_s += ulam_now() - tk;
+            r->bvisits = ulam__bkrylov_visits(q->M);
         }
     }
+again:;
     double tp = ulam_now();
     if ((status = ulam__bpush(r->Mt, rmax, max_ops, r->bq, r->br, &ops, &pushes)))
         return release(r), ulam__fail(err, status, 0, -1, "memory for the push on b");
@@ -263,6 +265,12 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     if (!status && r->bkiters > 0) r->bvisits = fmin(r->bvisits, ulam__solver_visits_bound(sv));
     ulam_solver_free(sv);
     if (status) return status;
+    if (r->bkiters > 0 && !isfinite(r->bdelta * r->bvisits)) { /* no bound on the start's rounding's reach (no
+        length tail, rows of |M| summing to 1 or more): the push from q = 0, as without the start */
+        memset(r->bq, 0, (size_t)n * sizeof *r->bq), memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
+        r->bkiters = 0, r->bdelta = 0.0, ops = pushes = 0;
+        goto again;
+    }
     if (wr_out) *wr_out = wr;
     double mt = fabs(qi + wr.estimate + o->stop.rel_err_offset), V = wr.walks ? (double)wr.steps / (double)wr.walks : 0.0;
     double m = pilot_scale(mt, wr.std_error, c, o->stop.rel_err_offset);
