@@ -1069,6 +1069,8 @@ typedef struct ulam_push_info {
     int64_t support; /* states with r_j != 0 */
     double r_sum, r_max; /* sum and largest of |r_j| */
     double seconds;  /* wall time pushing */
+    int64_t krylov;  /* the push on b with a symmetric M: the conjugate-gradient products that made
+                        its start q (src/bkrylov.c; 0: none, the push from q = 0) */
 } ulam_push_info;
 
 /* Bidirectional estimate of x_t of (I - M) x = b for b = e_s or a sparse b (src/bidir.c; Lofgren,

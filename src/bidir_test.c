@@ -9,6 +9,7 @@
  * the method table (ulam_analysis_solve) and ulam_analysis_bidir. */
 #include "analysis.h"
 #include "bidir.h"
+#include "bkrylov.h"
 #include "push.h"
 #include "stats.h"
 #include "testutil.h"
@@ -893,6 +894,46 @@ static void test_bidir_refusal_names_mode(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* The Krylov start's residual (src/bkrylov.c): on a symmetric M (a ring of 200 states, 0.49 to
+ * each neighbour) and a b spread over six decades, CG stopped early (20 products) gives a q whose
+ * r = b - (I - M) q, as computed, is within the stated delta of the same sums in long double at
+ * every state; and x_i = q_i + [(I - M)^-1 r]_i within delta times the visits' bound (LAPACK on
+ * both), the bound the interval is widened by. */
+static void test_bkrylov_rounding(void **state)
+{
+    (void)state;
+    enum { N = 200 };
+    int32_t ti[2 * N], tj[2 * N];
+    double tx[2 * N], b[N], q[N], r[N], x[N], y[N], delta;
+    for (int i = 0; i < N; i++) {
+        ti[2 * i] = i, tj[2 * i] = (i + 1) % N, tx[2 * i] = 0.49;
+        ti[2 * i + 1] = i, tj[2 * i + 1] = (i + N - 1) % N, tx[2 * i + 1] = 0.49;
+        b[i] = pow(10.0, -3.0 + 6.0 * (double)((i * 37) % N) / N) * (i % 3 ? 1.0 : -1.0);
+    }
+    ulam_csr *M;
+    assert_int_equal(ulam_csr_from_triplets(N, N, 2 * N, ti, tj, tx, &M), ULAM_OK);
+    int it;
+    assert_int_equal(ulam__bkrylov(M, b, 1e-12, 20, q, r, &delta, &it), ULAM_OK);
+    assert_int_equal(it, 20);
+    double worst = 0.0;
+    for (int j = 0; j < N; j++) {
+        long double s = (long double)b[j] - q[j];
+        for (int64_t p = M->rowptr[j]; p < M->rowptr[j + 1]; p++) s += (long double)M->val[p] * q[M->colidx[p]];
+        worst = fmax(worst, fabs((double)(s - r[j])));
+    }
+    double visits = ulam__bkrylov_visits(M); /* 1 / (1 - 0.98) = 50 */
+    assert_true(visits >= 50.0 && visits < 50.1);
+    assert_int_equal(ulam_direct_solve(M, b, x, 0, NULL, NULL), ULAM_OK);
+    assert_int_equal(ulam_direct_solve(M, r, y, 0, NULL, NULL), ULAM_OK);
+    double gap = 0.0, xmax = 0.0;
+    for (int j = 0; j < N; j++) gap = fmax(gap, fabs(x[j] - q[j] - y[j])), xmax = fmax(xmax, fabs(x[j]));
+    print_message("delta %.3g, largest rounding seen %.3g; |x - q - (I - M)^-1 r| %.3g against delta x visits %.3g\n",
+                  delta, worst, gap, delta * visits);
+    assert_true(worst <= delta && delta > 0);
+    assert_true(gap <= delta * visits + 1e-12 * xmax); /* LAPACK's own rounding beside it */
+    ulam_csr_free(M);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -903,7 +944,7 @@ int main(void)
         cmocka_unit_test(test_bidir_small_budgets), cmocka_unit_test(test_bidir_deterministic_walks),
         cmocka_unit_test(test_bidir_reach_all),  cmocka_unit_test(test_bidir_fixed_walks_honest),
         cmocka_unit_test(test_fpush_all_targets), cmocka_unit_test(test_bidir_rounding),
-        cmocka_unit_test(test_bidir_refusal_names_mode),
+        cmocka_unit_test(test_bidir_refusal_names_mode), cmocka_unit_test(test_bkrylov_rounding),
     };
     return test_run(tests);
 }

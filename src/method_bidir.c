@@ -9,7 +9,9 @@
  * queries, or one of the run's own. */
 #include "analysis.h"
 #include "bidir.h"
+#include "bkrylov.h"
 #include "bpush.h"
+#include "csr.h"
 #include "method_row.h"
 #include "solve.h"
 #include "stats.h"
@@ -104,6 +106,7 @@ static void release(ulam_run *r)
 {
     free(r->idx), free(r->val), free(r->bq), free(r->br);
     r->bq = r->br = NULL;
+    r->bkiters = 0, r->bdelta = 0.0, r->bvisits = INFINITY;
     if (r->own_an) ulam_analysis_free(r->an);
     r->an = NULL, r->own_an = 0, r->Mt = NULL;
     r->idx = NULL, r->val = NULL;
@@ -192,6 +195,29 @@ static double pilot_scale(double mt, double se, const ulam_auto_candidate *c, do
                                                                          (no history ended): no scale, a lower bound */
 }
 
+/* The Krylov start's tolerance on ||r||_2 / ||b||_2: E / 64 under a rel_err target E (the
+ * residual's walks then carry a small part of x's noise), 1e-6 at a fixed budget. */
+static double krylov_tol(double E)
+{
+    return E > 0 ? fmin(1e-3, E / 64.0) : 1e-6;
+}
+
+/* The work of `iters` CG products on M in matrix entries read (a product and five vector passes). */
+static double krylov_ops(const ulam_csr *M, int iters)
+{
+    return (double)iters * ((double)ulam_csr_nnz(M) + 5.0 * (double)M->nrows);
+}
+
+/* The CG products the Krylov start may spend (half the push's cap max_ops; at most 10^5), or 0
+ * for none: M not symmetric (CG asks a symmetric I - M; the push alone then), or a cap below 16
+ * products. */
+static int krylov_iters(const ulam_csr *M, int64_t max_ops)
+{
+    double per = krylov_ops(M, 1), it = (double)max_ops / per;
+    if (!(it >= 16.0) || !ulam__csr_symmetric(M)) return 0;
+    return it > 1e5 ? 100000 : (int)it;
+}
+
 /* The dense route (b has more nonzeros than ulam_method_sparse_limit): the transpose, b pushed
  * down to rmax within max_ops, and a pilot round of the walks on the residual (into *wr), whose
  * rule (src/stop.c, on the residual's own range) predicts the walks; the plan in ch->bidir.  c:
@@ -215,7 +241,17 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
         status = r->bq && r->br ? transpose(q, err) : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the transpose and the push on b");
         if (status) return release(r), status;
         memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
+        r->bkiters = 0, r->bdelta = 0.0, r->bvisits = INFINITY;
+        int it = krylov_iters(q->M, max_ops);
+        if (it > 0) { /* a Krylov start: q from CG, the push and the walks on its residual */
+            double tk = ulam_now();
+            if ((status = ulam__bkrylov(q->M, q->b, krylov_tol(E), it, r->bq, r->br, &r->bdelta, &r->bkiters)))
+                return release(r), ulam__fail(err, status, 0, -1, "memory for the Krylov start");
+            push_s += ulam_now() - tk;
+            r->bvisits = ulam__bkrylov_visits(q->M);
+        }
     }
+again:;
     double tp = ulam_now();
     if ((status = ulam__bpush(r->Mt, rmax, max_ops, r->bq, r->br, &ops, &pushes)))
         return release(r), ulam__fail(err, status, 0, -1, "memory for the push on b");
@@ -230,8 +266,15 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     status = ulam_solver_alloc(q->M, r->br, &po, &sv, err);
     while (!status && !ulam_solver_done(sv)) status = ulam_solver_iterate(sv);
     if (!status) ulam_solver_result(sv, &wr);
+    if (!status && r->bkiters > 0) r->bvisits = fmin(r->bvisits, ulam__solver_visits_bound(sv));
     ulam_solver_free(sv);
     if (status) return status;
+    if (r->bkiters > 0 && !isfinite(r->bdelta * r->bvisits)) { /* no bound on the start's rounding's reach (no
+        length tail, rows of |M| summing to 1 or more): the push from q = 0, as without the start */
+        memset(r->bq, 0, (size_t)n * sizeof *r->bq), memcpy(r->br, q->b, (size_t)n * sizeof *r->br);
+        r->bkiters = 0, r->bdelta = 0.0, ops = pushes = 0;
+        goto again;
+    }
     if (wr_out) *wr_out = wr;
     double mt = fabs(qi + wr.estimate + o->stop.rel_err_offset), V = wr.walks ? (double)wr.steps / (double)wr.walks : 0.0;
     double m = pilot_scale(mt, wr.std_error, c, o->stop.rel_err_offset);
@@ -245,9 +288,10 @@ static int dense_plan(ulam__query *q, const ulam_walk_opts *o, const ulam_auto_c
     pl->target = o->query.index, pl->rmax = rmax, pl->balanced = 1, pl->push_part = qi;
     pl->push = (ulam_push_info){.target = o->query.index, .rmax = rmax, .pushes = pushes, .ops = ops, .seconds = push_s};
     ulam__bpush_residual(r->bq, r->br, n, &pl->push);
+    pl->push.krylov = r->bkiters;
     pl->pilot_walks = pw + wr.walks, pl->pilot_steps = ps + wr.steps, pl->mean_visits = V + 1.0;
     pl->predicted_walks = mt > 0 ? need : INFINITY, pl->step_cost = 1.0;
-    pl->predicted_work = ULAM_AUTO_READ * ((double)ops + 2.0 * (double)nnz) +
+    pl->predicted_work = ULAM_AUTO_READ * ((double)ops + 2.0 * (double)nnz + krylov_ops(q->M, r->bkiters)) +
                          ((double)pl->pilot_walks + pl->predicted_walks) * (V + ULAM_AUTO_WALK);
     pl->seconds = ulam_now() - t0;
     r->bplan = *pl;
@@ -556,6 +600,8 @@ static int finish(ulam_run *r, ulam_answer *a, ulam_error *err)
          * rounding_allowance), so a push taken down to rounding (residual walks' stderr ~1e-17)
          * does not print a zero-width point beside x_i */
         double fp = ulam__push_rounding((double)r->bplan.push.ops + 2.0, fabs(qi)) + DBL_EPSILON * fabs(br->estimate);
+        if (r->bkiters > 0 && r->bdelta > 0) /* the Krylov start's residual as rounded (src/bkrylov.c) */
+            fp += r->bdelta * r->bvisits;
         br->ci95[0] = qi + br->walks.ci95[0] - fp, br->ci95[1] = qi + br->walks.ci95[1] + fp;
         br->plan = r->bplan, br->push = r->bplan.push;
         br->seconds = br->walks.seconds + r->bplan.seconds;

@@ -27,6 +27,9 @@ struct ulam_run {
     ulam_walk_opts bwo;   /* and the walks' options on r (adjoint from the index, offset q_i) */
     ulam_bidir_plan_info bplan; /* and its plan (also in the choice's bidir) */
     int blower;           /* 1: that plan's walks are a lower bound (its pilot does not resolve |x|) */
+    int bkiters;          /* with a symmetric M: the CG products of the Krylov start (src/bkrylov.c; 0: none) */
+    double bdelta;        /* and the bound on its residual's rounding a visit, */
+    double bvisits;       /* times the walks' bound on their expected visits (widens the interval) */
 };
 
 /* One query's choice in progress. */

@@ -68,9 +68,15 @@ static void dense_text(FILE *f, const ulam_bidir_report *p)
     const ulam_walk_result *w = &r->walks;
     fprintf(f, "method          bidirectional, the push on b: then %s walks from %lld scoring its residual\n",
             ulam__report_estimator_name(o->walk.estimator), node(p, o->target));
-    fprintf(f, "push            rmax %.3g: %lld operations; q_%lld = %.10g exact; residual max %.3g (b's was %.3g)\n",
-            r->push.rmax, (long long)r->push.ops, node(p, o->target), r->push_part, r->push.r_max,
-            r->plan.rmax > 0 ? p->bmax : NAN);
+    if (r->push.krylov > 0) /* a Krylov start (src/bkrylov.c): q from CG, then the push */
+        fprintf(f, "push            q from %lld conjugate-gradient products, then rmax %.3g: %lld operations; q_%lld = "
+                   "%.10g exact; residual max %.3g (b's was %.3g)\n",
+                (long long)r->push.krylov, r->push.rmax, (long long)r->push.ops, node(p, o->target), r->push_part,
+                r->push.r_max, r->plan.rmax > 0 ? p->bmax : NAN);
+    else
+        fprintf(f, "push            rmax %.3g: %lld operations; q_%lld = %.10g exact; residual max %.3g (b's was %.3g)\n",
+                r->push.rmax, (long long)r->push.ops, node(p, o->target), r->push_part, r->push.r_max,
+                r->plan.rmax > 0 ? p->bmax : NAN);
     fprintf(f, "walks           %lld (%lld cut, %lld steps, %d threads); a pilot of %lld walks predicted %.3g\n",
             (long long)w->walks, (long long)w->cut, (long long)w->steps, w->threads, (long long)r->plan.pilot_walks,
             r->plan.predicted_walks);

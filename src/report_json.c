@@ -228,8 +228,9 @@ static void choice_json(FILE *f, const ulam_choice *ch, int bidir)
         ulam_json_string(f, "mode", "bidirectional", 0);
         ulam_json_string(f, "state", bstate == ULAM_METHOD_CHOSEN ? "chosen" : bstate == 1 ? "planned" : "not_considered", 0);
         ulam_json_number(f, "rmax", bstate ? ch->bidir.rmax : NAN, 0);
-        fprintf(f, "\"push_ops\": %lld, \"pilot_walks\": %lld, ", (long long)(bstate ? ch->bidir.push.ops : 0),
-               (long long)(bstate ? ch->bidir.pilot_walks : 0));
+        fprintf(f, "\"push_ops\": %lld, \"push_krylov\": %lld, \"pilot_walks\": %lld, ",
+                (long long)(bstate ? ch->bidir.push.ops : 0), (long long)(bstate ? ch->bidir.push.krylov : 0),
+                (long long)(bstate ? ch->bidir.pilot_walks : 0));
         ulam_json_number(f, "predicted_walks", bstate ? ch->bidir.predicted_walks : NAN, 0);
         ulam_json_number(f, "predicted_work", v->predicted_work, 0);
         ulam_json_number(f, "leader_work", ch->leader_work, 1);

@@ -1159,6 +1159,17 @@ static double mean_steps(const ulam_solver *s)
     return isfinite(t) ? t : 1.0;
 }
 
+/* A bound on sum over k >= 0 of (|K|^k 1)_i at the walks' starts i (the expected visits of a walk
+ * on |K|, what a perturbation of the scores by at most d a visit moves the answer by, over d): by
+ * the length tail's certificate, or with the analog continuation by its largest q; INFINITY
+ * without either (src/bkrylov.c's rounding allowance). */
+double ulam__solver_visits_bound(const ulam_solver *s)
+{
+    double t = s->tail_u < 1.0 ? tail_steps(s->tail_u, s->kappa) + 1.0 : INFINITY;
+    if (!(s->o.kernel.continue_q > 0) && s->qmax < 1.0) t = fmin(t, 1.0 / (1.0 - s->qmax));
+    return isfinite(t) ? t : INFINITY;
+}
+
 /* The push on b's cost model (src/fpush_b.c): the forward walks' predicted work on a residual of
  * l1 norm r_sum, with the bounds made on b (a forward walk's weight, and so its range and second
  * moment, scale with the l1 norm of what it starts from): the rule's range term at |x_i| ~ |q_i|

@@ -101,6 +101,10 @@ const char *ulam__solver_reached(const ulam_solver *s);
  * of it row by row (src/solve.c: the rent-or-buy rule); the choice's work models predict it. */
 enum { ULAM__COMPLETE = 4 };
 
+/* A bound on the expected visits of a walk on |K| from s's starts (the length tail's certificate,
+ * or the analog continuation's largest q), INFINITY without one. */
+double ulam__solver_visits_bound(const ulam_solver *s);
+
 /* Iterate s until a stopping rule holds, fill result (may be NULL) and, on failure, err; free s.
  * The status (src/solve.c: the rest of ulam_solve_walks). */
 int ulam__solver_finish(ulam_solver *s, ulam_walk_result *result, ulam_error *err);

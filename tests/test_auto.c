@@ -1009,6 +1009,70 @@ static void test_prediction_agrees(void **state)
     ulam_csr_free(M);
 }
 
+/* The Jacobi splitting of the 5-point Laplacian on a g x g grid: M_ij = 1/4 between neighbours,
+ * b = 1/4 (A x = 1 with A = 4 I - adjacency). */
+static ulam_csr *poisson_jacobi(int g, double **b)
+{
+    int64_t n = (int64_t)g * g, k = 0;
+    int32_t *ti = malloc((size_t)(4 * n) * sizeof *ti), *tj = malloc((size_t)(4 * n) * sizeof *tj);
+    double *tx = malloc((size_t)(4 * n) * sizeof *tx);
+    *b = malloc((size_t)n * sizeof **b);
+    for (int y = 0; y < g; y++)
+        for (int x = 0; x < g; x++) {
+            int32_t i = y * g + x, nb[4] = {x > 0 ? i - 1 : -1, x < g - 1 ? i + 1 : -1, y > 0 ? i - g : -1,
+                                            y < g - 1 ? i + g : -1};
+            (*b)[i] = 0.25;
+            for (int q = 0; q < 4; q++)
+                if (nb[q] >= 0) ti[k] = i, tj[k] = nb[q], tx[k++] = 0.25;
+        }
+    return build(n, k, ti, tj, tx);
+}
+
+/* Issue 38 point 1, the canonical PDE: 2-D Poisson by its Jacobi splitting, b = 1, the centre
+ * unknown.  Interior rows of |M| sum to 1 and rho(M) = cos(pi / (g + 1)), so walks are long
+ * (g^2 / 4 steps from the centre) and their score's relative variance about 0.5: the walks alone
+ * need (1.96 / E)^2 / 2 times the sequence's factor (about 2) walks, and the push on b converges
+ * at the Jacobi rate.  M is symmetric: the push on b now starts from conjugate gradients' q
+ * (src/bkrylov.c), and the walks from the centre score only the residual b - (I - M) q (a control
+ * variate; q_i deterministic), its rounding allowed for.  40 x 40, E = 0.05: chosen, the first
+ * check's walks (256; the walks alone took 1801 on seed 1 before, and the push on b without the start lost to
+ * them), every interval covers x from CG to 1e-11 over 20 seeds (binomial bound), and its half-width
+ * is under E |x| (the rel_err run's promise) and under 1% of |x|. */
+static void test_krylov_start(void **state)
+{
+    (void)state;
+    int g = 40;
+    int64_t n = (int64_t)g * g, c = (g / 2) * g + g / 2;
+    double *b, *x = calloc((size_t)n, sizeof *x), res;
+    ulam_csr *M = poisson_jacobi(g, &b);
+    int it;
+    assert_int_equal(ulam_cg(M, b, 1e-11, 100000, x, &it, &res), ULAM_OK);
+    ulam_choice *ch = malloc(sizeof *ch);
+    ulam_answer a;
+    ulam_walk_opts o = ulam_walk_defaults();
+    o.query.index = c, o.stop.rel_err = 0.05, o.stop.max_walks = 0;
+    int covered = 0, R = 20, lower = (int)ceil(0.95 * R - 4.0 * sqrt(0.95 * 0.05 * R));
+    double worst = 0.0;
+    int64_t most = 0;
+    for (int seed = 1; seed <= R; seed++) {
+        o.exec.seed = (uint64_t)seed;
+        assert_int_equal(ulam_auto(M, b, &o, NULL, NULL, ch, &a, NULL), ULAM_OK);
+        if (seed == 1)
+            print_message("x_%lld = %.10g: %s, %.10g, 95%% CI %.10g .. %.10g, %lld walks\n", (long long)c, x[c],
+                          ulam_method_name(ch->chosen), a.estimate, a.ci95[0], a.ci95[1], (long long)a.walks.walks);
+        assert_int_equal(ch->chosen, ULAM_METHOD_BIDIRECTIONAL);
+        covered += a.ci95[0] <= x[c] && x[c] <= a.ci95[1];
+        worst = fmax(worst, 0.5 * (a.ci95[1] - a.ci95[0]) / x[c]);
+        most = a.walks.walks > most ? a.walks.walks : most;
+    }
+    print_message("%d of %d cover (at least %d); largest half-width %.3g of x, most walks %lld\n", covered, R, lower,
+                  worst, (long long)most);
+    assert_true(covered >= lower);
+    assert_true(worst <= 0.01 && most <= 512);
+    free(b), free(x), free(ch);
+    ulam_csr_free(M);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1029,6 +1093,7 @@ int main(void)
         cmocka_unit_test(test_push_b_fixed_budget),
         cmocka_unit_test(test_push_b_forward_fixed),
         cmocka_unit_test(test_prediction_agrees),
+        cmocka_unit_test(test_krylov_start),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -240,14 +240,14 @@ static PyObject *choice(const ulam_choice *ch)
     }
     const ulam_auto_result *w = &ch->walks;
     const ulam_bidir_plan_info *p = &ch->bidir;
-    return Py_BuildValue("{s:i,s:O,s:N,s:d,s:{s:i,s:i,s:i,s:i,s:d,s:d,s:d,s:d,s:N,s:N},s:{s:d,s:L,s:L,s:d,s:d}}",
+    return Py_BuildValue("{s:i,s:O,s:N,s:d,s:{s:i,s:i,s:i,s:i,s:d,s:d,s:d,s:d,s:N,s:N},s:{s:d,s:L,s:L,s:L,s:d,s:d}}",
                          "chosen", ch->chosen, "pinned", ch->pinned ? Py_True : Py_False, "rows", rows, "leader_work",
                          ch->leader_work, "walks", "chosen", w->chosen, "closest", w->closest, "by_work", w->by_work,
                          "stages", w->stages, "pilot_work", w->pilot_work, "reused_work", w->reused_work, "seconds",
                          w->seconds, "abs_upper", w->abs.upper, "candidates", candidates(w), "abs", radius(&w->abs),
-                         "bidirectional", "rmax", p->rmax, "push_ops", (long long)p->push.ops, "pilot_walks",
-                         (long long)p->pilot_walks, "predicted_walks", p->predicted_walks, "mean_visits",
-                         p->mean_visits);
+                         "bidirectional", "rmax", p->rmax, "push_ops", (long long)p->push.ops, "push_krylov",
+                         (long long)p->push.krylov, "pilot_walks", (long long)p->pilot_walks, "predicted_walks",
+                         p->predicted_walks, "mean_visits", p->mean_visits);
 }
 
 /* A walk result as a dict (the library's field names). */

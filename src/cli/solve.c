@@ -228,7 +228,6 @@ static int lazy_analysis(solve_args *a)
  * cannot honour), in words (NULL: nothing). */
 static const char *bidir_excluded(const solve_args *a)
 {
-    if (a->s.jacobi) return "--jacobi";
     if (a->s.lazy) return "a prepared system read only where walks go (bidirectional transposes all of M)";
     return NULL;
 }
