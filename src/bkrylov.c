@@ -15,6 +15,7 @@
  * a walk on |M| from i (the walk solver's certified length tail, ulam__solver_visits_bound):
  * the caller widens the interval by that. */
 #include "bkrylov.h"
+#include "bound.h"
 
 #include <float.h>
 #include <math.h>
@@ -33,38 +34,25 @@ int ulam__bkrylov(const ulam_csr *M, const double *b, double tol, int max_iter, 
     int status = ulam_cg(M, b, tol, max_iter, q, iters, &res);
     if (status == ULAM_ENOMEM) return status;
     if (status != ULAM_OK && status != ULAM_ENOCONV) memset(q, 0, (size_t)n * sizeof *q); /* no usable q */
-    double dmax = 0.0;
-    for (int64_t j = 0; j < n; j++) {
-        double s = b[j] - q[j], a = fabs(b[j]) + fabs(q[j]);
-        int64_t m = M->rowptr[j + 1] - M->rowptr[j];
-        for (int64_t p = M->rowptr[j]; p < M->rowptr[j + 1]; p++) {
-            double t = M->val[p] * q[M->colidx[p]];
-            s += t, a += fabs(t);
-        }
-        r[j] = s;
-        double d = 2.0 * ulam__push_rounding((double)(m + 2), a) + (double)(m + 2) * DBL_MIN;
-        if (!isfinite(s) || !isfinite(d)) { /* an overflowing q: fall back to no start */
-            memset(q, 0, (size_t)n * sizeof *q);
-            memcpy(r, b, (size_t)n * sizeof *r);
-            *delta = 0.0;
-            return ULAM_OK;
-        }
-        dmax = fmax(dmax, d);
+    double *e = ulam__malloc((size_t)n + 1, sizeof *e), dmax = 0.0;
+    if (!e) return ULAM_ENOMEM;
+    if (ulam__residual(M, b, q, r, e) < 0) { /* an overflowing q: fall back to no start */
+        memset(q, 0, (size_t)n * sizeof *q);
+        memcpy(r, b, (size_t)n * sizeof *r);
+        free(e);
+        *delta = 0.0;
+        return ULAM_OK;
     }
+    for (int64_t j = 0; j < n; j++) dmax = fmax(dmax, e[j]);
+    free(e);
     *delta = dmax;
     return ULAM_OK;
 }
 
 /* A bound on the expected visits of a walk on |M| from any state by its largest row sum S of
- * |M|: 1 / (1 - S) when S < 1, else INFINITY (the walk solver's length tail then, if any). */
+ * |M| (src/bound.c): 1 / (1 - S) when S < 1, else INFINITY (the walk solver's length tail then, if any). */
 double ulam__bkrylov_visits(const ulam_csr *M)
 {
-    double S = 0.0;
-    for (int64_t j = 0; j < M->nrows; j++) {
-        double t = 0.0;
-        for (int64_t p = M->rowptr[j]; p < M->rowptr[j + 1]; p++) t += fabs(M->val[p]);
-        S = fmax(S, t);
-    }
-    S *= 1.0 + 4.0 * DBL_EPSILON * (double)(M->ncols + 1); /* the sums' rounding, upward */
+    double S = ulam__row_sum_max(M);
     return S < 1.0 ? 1.0 / (1.0 - S) : INFINITY;
 }

@@ -1,34 +1,39 @@
 /* A certified range of the exact solution around any x, from x's residual (one machine; the
  * partitioned system's is src/dist_outer.c's ulam_dist_bound): the answer of an outer iteration,
  * a Krylov peer or a direct solve gets an interval with no sampling in it. */
-#include "internal.h"
+#include "bound.h"
 #include "spectral.h"
 
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
 
-/* The residual r = b - (I - M) x with each row's rounding e bounded: pos[i] >= max(r_i, 0) and
- * neg[i] >= max(-r_i, 0) of the exact residual; returns 1 when every entry of M is nonnegative. */
-static int residual_parts(const ulam_csr *M, const double *b, const double *x, double *pos, double *neg)
+/* r = b - (I - M) x as computed, and e[i] (may be NULL) a bound on r_i's rounding: r_i rounds its m + 1
+ * terms (b_i, x_i and the m products M_ik x_k) and their sum, so it is off from the exact residual by
+ * at most 2 (m + 2) u s_i, s_i = |b_i| + |x_i| + sum |M_ik x_k| (u = DBL_EPSILON / 2; a factor 2 past the
+ * first-order gamma_(m+2) for its higher terms, plus m + 2 of the least normal for underflow).
+ * Returns 1 when every entry of M is nonnegative, 0 when not, -1 when an r_i or e_i is not finite. */
+int ulam__residual(const ulam_csr *M, const double *b, const double *x, double *r, double *e)
 {
     int nonneg = 1;
     for (int64_t i = 0; i < M->nrows; i++) {
-        double s = 0.0, a = 0.0;
+        double s = b[i] - x[i], a = fabs(b[i]) + fabs(x[i]);
+        int64_t m = M->rowptr[i + 1] - M->rowptr[i];
         for (int64_t q = M->rowptr[i]; q < M->rowptr[i + 1]; q++) {
             double t = M->val[q] * x[M->colidx[q]];
             s += t, a += fabs(t);
             nonneg &= M->val[q] >= 0.0;
         }
-        double r = b[i] - x[i] + s; /* (len + 3) roundings, each at most DBL_EPSILON / 2 of the sizes summed */
-        double e = (double)(M->rowptr[i + 1] - M->rowptr[i] + 4) * DBL_EPSILON * (fabs(b[i]) + fabs(x[i]) + a);
-        pos[i] = fmax(r + e, 0.0) * (1.0 + DBL_EPSILON), neg[i] = fmax(e - r, 0.0) * (1.0 + DBL_EPSILON);
+        double d = 2.0 * ulam__push_rounding((double)(m + 2), a) + (double)(m + 2) * DBL_MIN;
+        if (!isfinite(s) || !isfinite(d)) return -1;
+        r[i] = s;
+        if (e) e[i] = d;
     }
     return nonneg;
 }
 
 /* The largest row sum of |M|, rounded up (a Collatz-Wielandt bound for v = 1). */
-static double row_sum_max(const ulam_csr *M)
+double ulam__row_sum_max(const ulam_csr *M)
 {
     double top = 0.0;
     for (int64_t i = 0; i < M->nrows; i++) {
@@ -60,12 +65,17 @@ int ulam_solution_bound(const ulam_csr *M, const double *b, const double *x, dou
     double *pos = ulam__malloc((size_t)n + 1, sizeof *pos), *neg = ulam__malloc((size_t)n + 1, sizeof *neg);
     double *h = NULL;
     if (!pos || !neg) return free(pos), free(neg), ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for 2 x %lld doubles", (long long)n);
-    int nonneg = residual_parts(M, b, x, pos, neg);
+    int nonneg = ulam__residual(M, b, x, pos, neg);
+    if (nonneg < 0) return free(pos), free(neg), ulam__fail(err, ULAM_EINVAL, 0, -1, "an x whose residual is finite");
+    for (int64_t i = 0; i < n; i++) { /* the exact residual's positive and negative parts, bounded above */
+        double r = pos[i], e = neg[i];
+        pos[i] = fmax(r + e, 0.0) * (1.0 + DBL_EPSILON), neg[i] = fmax(e - r, 0.0) * (1.0 + DBL_EPSILON);
+    }
     /* x* - x = sum_k M^k r.  A v > 0 with |M| v <= u v, u < 1, gives |M|^k |r| <= max_j (|r_j| / v_j) u^k v,
        so |x*_i - x_i| <= max_j (|r_j| / v_j) v_i / (1 - u); with M >= 0 the sum keeps r's signs (above
        by its positive part, below by its negative part).  v = 1 when the rows of |M| sum below 1, else the
        expected lengths' certificate (src/spectral.c: h ~ (I - |M|)^-1 1, one product checks it). */
-    double rows = row_sum_max(M), u = rows;
+    double rows = ulam__row_sum_max(M), u = rows;
     if (!(u < 1.0)) {
         char *seen = ulam__malloc((size_t)n + 1, 1);
         h = ulam__malloc((size_t)n + 1, sizeof *h);
