@@ -24,6 +24,7 @@
  * ulam_fpush_top's k components are chosen by their estimates: their lower ends at delta k / n
  * (lower_index). */
 #include "fpush.h"
+#include "fpush_dense.h"
 #include "cache.h"
 #include "defaults.h"
 #include "check.h"

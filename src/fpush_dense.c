@@ -7,7 +7,7 @@
  * point with each entry's rounding bounded (ulam__push_rounding: d_i + 3 roundings of at most
  * DBL_EPSILON / 2 of |e_s,i| + (|M| |p|)_i + |p_i|), so x = p + (I - M)^-1 r exactly and every
  * |x_i - p_i| <= ||r||_1 / (1 - ||M||_1), no walk needed. */
-#include "fpush.h"
+#include "fpush_dense.h"
 
 #include <float.h>
 #include <math.h>
