@@ -1205,6 +1205,9 @@ typedef struct ulam_fpush_info {
                                   whose interval reaches min_value (ulam_fpush_top with min_value <= 0: the
                                   k-th largest p_i + r_i after the push, which x's k-th largest is at least
                                   when M >= 0; else min_value, or 1 / n) */
+    int dense;             /* 1: x by a dense LU of I - M instead (a small system whose push would take
+                              1 / (1 - ||M||_1) sweeps an e-fold): no push, no walks; residual_bound
+                              certifies every x_i from the LU's residual (push.r_sum) */
 } ulam_fpush_info;
 
 /* Estimate every x_i of (I - M) x = e_source into x (n entries); std_error, lo and hi (each may

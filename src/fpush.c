@@ -24,6 +24,7 @@
  * ulam_fpush_top's k components are chosen by their estimates: their lower ends at delta k / n
  * (lower_index). */
 #include "fpush.h"
+#include "fpush_dense.h"
 #include "cache.h"
 #include "defaults.h"
 #include "check.h"
@@ -1205,6 +1206,36 @@ static int lazy_of(const ulam_system *sys, const ulam_csr *M, const ulam_csr **M
     return status ? status : ulam_csr_transpose(M, own);
 }
 
+/* The dense route (src/fpush_dense.c) for a small system with ||M||_1 = alpha near 1: x exact
+ * but for the LU's residual, every interval x_i -+ its certified bound, standard errors 0; top >= 0:
+ * the outputs of the top components (select_top).  ULAM_OK, or nonzero (no LAPACK, a singular LU:
+ * the push and walks run instead; info untouched but for its clearing). */
+static int solve_dense(const ulam_csr *M, const ulam_fpush_opts *o, double alpha, double *x, int64_t top, int64_t *index,
+                       double *std_error, double *lo, double *hi, ulam_fpush_info *info)
+{
+    int64_t n = M->nrows;
+    double t0 = ulam_now(), r_sum, D, *key = top > 0 ? ulam__malloc((size_t)top, sizeof *key) : NULL;
+    ulam_error e;
+    if (top > 0 && !key) return ULAM_ENOMEM;
+    int status = ulam__fpush_dense(M, o->source, alpha, x, &r_sum, &D, &e);
+    if (!status) {
+        int64_t m = top >= 0 ? top : n;
+        if (top > 0) select_top(x, n, top, index, key);
+        for (int64_t t = 0; t < m; t++) {
+            double p = x[top >= 0 ? index[t] : t];
+            if (std_error) std_error[t] = 0.0;
+            if (lo) lo[t] = p - D;
+            if (hi) hi[t] = p + D;
+        }
+        *info = (ulam_fpush_info){.dense = 1, .mean_visits = 1.0 / (1.0 - alpha), .residual_bound = D,
+                                  .rel_err = o->rel_err, .min_value = o->min_value > 0 ? o->min_value : 1.0 / (double)n,
+                                  .push = {.target = o->source, .touched = n, .r_sum = r_sum}};
+        info->seconds = info->push_seconds = info->push.seconds = ulam_now() - t0;
+    }
+    free(key);
+    return status;
+}
+
 /* ulam__fpush_solve, or with top >= 0 ulam_fpush_top's outputs (std_error, lo, hi: top entries). */
 static int fpush(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *opts, double *x, int64_t top,
                  int64_t *index, double *std_error, double *lo, double *hi, ulam_fpush_info *info, ulam__sweep_info *sw,
@@ -1234,6 +1265,10 @@ static int fpush(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_opts *o
     lz = !status && sys && Mt == ulam__system_tr(sys) && g.abs.colsum_max < 1.0 ? sys : NULL; /* else whole, first */
     if (!status && sys && !lz) status = ulam_system_check(sys, err);
     if (status)
+        ;
+    else if (g.abs.colsum_max < 1.0 && !lz && opts->walks <= 0 && !(opts->rmax > 0) &&
+             ulam__fpush_dense_pays(M->nrows, ulam_csr_nnz(M), g.abs.colsum_max) &&
+             !(status = solve_dense(M, opts, g.abs.colsum_max, x, top, index, std_error, lo, hi, info)))
         ;
     else if (g.abs.colsum_max < 1.0)
         status = solve_sweep(M, Mt, lz, opts, &g, x, top, index, std_error, lo, hi, info, &swi, err);

@@ -27,8 +27,8 @@ static void pagerank_line(FILE *f, const ulam_bidir_report *p, int64_t source)
     if (p->seeds) snprintf(who, sizeof who, "the seeds %.120s", p->seeds);
     else if (source) snprintf(who, sizeof who, "e_%lld (source %lld)", node(p, source - 1), node(p, source - 1));
     else snprintf(who, sizeof who, "uniform (global PageRank)");
-    fprintf(f, "pagerank        pi = (1 - %g) x, x of (I - %g P^T) x = s, s %s; dangling nodes' rank leaks (no "
-               "teleport): pi sums to 1 - the leak\n", a, a, who);
+    fprintf(f, "pagerank        pi = (1 - %.10g) x, x of (I - %.10g P^T) x = s, s %s; dangling nodes' rank leaks (no "
+               "teleport): pi sums to 1 - the leak\n", a, a, who); /* 0.9999999 shown, not 1 */
 }
 
 /* --check's line: the direct value, its method and seconds, and z. */
@@ -195,25 +195,35 @@ static void point_json(FILE *f, const ulam_bidir_report *p)
 static void table_head(FILE *f, const ulam_bidir_report *p)
 {
     const ulam_fpush_info *t = p->top;
-    if (p->source)
+    if (t->dense)
+        fprintf(f, "method          single source: dense LU of I - M (n = %lld: cheaper than the push's 1 / (1 - ||M||_1) = "
+                   "%.3g sweeps per e-fold of its residual, or walks of as many steps)\n", (long long)p->n, t->mean_visits);
+    else if (p->source)
         fprintf(f, "method          single source: forward push from %lld, forward walks on its residual (FORA)\n",
                 node(p, p->source - 1));
     else
         fprintf(f, "method          single source: forward push from a virtual state feeding %s, forward walks on its "
                    "residual (FORA)\n", p->seeds ? "the seeds" : "every node");
     if (p->pagerank > 0) pagerank_line(f, p, p->source);
-    fprintf(f, "push            rmax %.3g: %lld operations, residual on %lld states, sum %.3g (walk part of any %s at "
-               "most %.3g)\n", t->rmax, (long long)t->push.ops, (long long)t->push.support, t->push.r_sum,
-            p->pagerank > 0 ? "pi_i" : "x_i", t->residual_bound);
-    fprintf(f, "walks           %lld (%lld steps)\n", (long long)t->walks, (long long)t->steps);
-    if (t->min_value > 0)
+    if (t->dense)
+        fprintf(f, "residual        ||b - (I - M) x||_1 = %.3g as computed, so every %s is within %.3g of the one printed "
+                   "(rounding included; no walks)\n", t->push.r_sum, p->pagerank > 0 ? "pi_i" : "x_i", t->residual_bound);
+    else
+        fprintf(f, "push            rmax %.3g: %lld operations, residual on %lld states, sum %.3g (walk part of any %s at "
+                   "most %.3g)\n", t->rmax, (long long)t->push.ops, (long long)t->push.support, t->push.r_sum,
+                p->pagerank > 0 ? "pi_i" : "x_i", t->residual_bound);
+    if (!t->dense)
+        fprintf(f, "walks           %lld (%lld steps)%s\n", (long long)t->walks, (long long)t->steps,
+                t->interrupted ? "  [INTERRUPTED]" : "");
+    if (t->min_value > 0 && !t->dense)
         fprintf(f, "target          every 95%% interval honest; planned for relative error %.3g at values >= %.3g\n",
                 t->rel_err, t->min_value);
     if (t->push.support > 0 && !isfinite(t->residual_bound)) /* the queue path (src/fpush.c) */
         fprintf(f, "intervals       the source's alone: with ||M||_1 >= 1 the other components' walk parts have no "
                    "certified range (none printed)\n");
-    fprintf(f, "seconds         %.4f (push %.4f, walks %.4f; CPU %.4f)\n", t->seconds, t->push_seconds, t->walk_seconds,
-            p->cpu_seconds);
+    if (t->dense) fprintf(f, "seconds         %.4f (the LU; CPU %.4f)\n", t->seconds, p->cpu_seconds);
+    else fprintf(f, "seconds         %.4f (push %.4f, walks %.4f; CPU %.4f)\n", t->seconds, t->push_seconds, t->walk_seconds,
+                 p->cpu_seconds);
     if (p->direct_x)
         fprintf(f, "direct          %s, %.3g s (the column direct)\n", direct_method(p), p->direct_seconds);
     fprintf(f, "%-6s %-10s %-14s %-11s %s\n", "rank", p->node_base ? "index" : "node",
@@ -232,6 +242,7 @@ static void table_text(FILE *f, const ulam_bidir_report *p, int format)
         if (none) fprintf(f, xd ? "%-25s" : "%s", "none");
         else fprintf(f, "%-12.6g %.6g", p->lo[k], p->hi[k]);
         if (xd) fprintf(f, "%*s%.8g", none ? 0 : 13 - (int)snprintf(NULL, 0, "%.6g", p->hi[k]), "", xd[i]);
+        if (k == 0 && format == ULAM_REPORT_QUIET && p->top->interrupted) fputs("  [INTERRUPTED]", f); /* the head's mark */
         fputc('\n', f);
     }
 }
@@ -267,7 +278,7 @@ static void table_json(FILE *f, const ulam_bidir_report *p)
         if (p->direct_x) ulam_json_number(f, "direct", p->direct_x[i], 1);
         fputc('}', f);
     }
-    fputs("]}\n", f);
+    fprintf(f, "], \"dense\": %s, \"interrupted\": %s}\n", t->dense ? "true" : "false", t->interrupted ? "true" : "false");
 }
 
 /* ulam_report_fprint's ULAM_REPORT_BIDIR (src/report.h). */

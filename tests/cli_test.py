@@ -72,6 +72,10 @@ CASES += [
     # issue 42 pt 2: --pagerank (--damping) with every graph query; edge lists; pi = (1 - alpha) x
     (["solve", D + "graph7.mtx", "--pagerank", "0.85", "--source", "1", "--top", "3"], 0, r"^$",
      r"pi = \(1 - 0.85\) x(.|\n)*\nrank +index +pi .*\n1 +3 +0\.38\d* "),
+    # newuser15 pt 3: the range is open at 1, and the message says so (it said "from 1e-06 to 1, got '1'")
+    (["solve", D + "graph7.txt", "--pagerank", "1", "--top", "1"], 2,
+     r"--pagerank expects a damping factor alpha with 0 < alpha < 1 \(from 1e-06 to 1 - 1e-09; at 1 .*got '1'", r"^$"),
+    (["direct", D + "graph7.txt", "--damping", "1.0"], 2, r"0 < alpha < 1 .*got '1.0'", r"^$"),
     (["solve", D + "graph7.txt", "--damping", "0.85", "--source", "0", "--top", "3"], 0, r"^$",
      r"rank +node +pi .*\n1 +2 +0\.38\d* .*\n2 +0 +0\.31"),
     (["solve", D + "graph7.txt", "--pagerank", "0.85", "--source", "0", "--index", "3", "--check"], 0, r"^$",
@@ -741,6 +745,53 @@ def check_walks_prediction(ulam):
     assert re.search(r"warning: --walks 1000000000000 at the pace of the first \d+ \(.* s\) takes about [\d.]+ "
                      r"(hours|days|years) more", said) and p.returncode == 130, (said, p.returncode, err)
     assert out.startswith("x[1]"), out
+    # newuser15 pt 7: the interval's bets were planned for all 10^12 walks, so it is wide at the walks made: said
+    assert re.search(r"note: the interval above is [\d.e+]+ standard errors wide each side: its bets were planned for all "
+                     r"1000000000000 walks and the run stopped at \d+", err), err
+
+
+def check_pagerank_near_one(ulam):
+    """newuser15 pt 1: global PageRank at alpha = 1 - 1e-7 on 7 nodes ran 10+ minutes printing nothing (the push's
+    residual falls by e per 10^7 sweeps and each walk takes 10^7 steps); a dense LU answers with no push and no
+    walks, every interval certified from the LU's residual, around the reference.  The timeout guards a hang."""
+    for extra in (["--top", "1"], ["--source", "4", "--top", "3"], ["--source", "0,5", "--top", "2"]):
+        p = subprocess.run([ulam, "solve", D + "graph7.txt", "--pagerank", "0.9999999", "--json", "--check"] + extra,
+                           capture_output=True, text=True, timeout=120)
+        o = json.loads(p.stdout)
+        assert p.returncode == 0 and o["dense"] is True and o["walks"] == 0 and o["steps"] == 0, (extra, p.stdout, p.stderr)
+        for t in o["top"]:
+            lo, hi = t["ci95"]
+            assert lo <= t["direct"] <= hi and hi - lo < 1e-6, (extra, t)
+    p = subprocess.run([ulam, "solve", D + "graph7.txt", "--pagerank", "0.9999999", "--top", "1"], capture_output=True,
+                       text=True, timeout=120)
+    assert p.returncode == 0 and re.search(r"^method +single source: dense LU of I - M \(n = 7", p.stdout, re.M), p.stdout
+    assert re.search(r"^pagerank +pi = \(1 - 0\.9999999\) x", p.stdout, re.M) and "\nwalks " not in p.stdout, p.stdout
+    # where the push is quick it keeps the system (alpha 0.85: the push and its walks, as before)
+    rc, out, err = run(ulam, ["solve", D + "graph7.txt", "--pagerank", "0.85", "--top", "1", "--json"])
+    assert rc == 0 and json.loads(out)["dense"] is False and json.loads(out)["walks"] > 0, out
+
+
+def check_top_interrupt(ulam):
+    """newuser15 pt 2: Ctrl-C in --top mode (global, single source, seed set) prints the table so far marked
+    [INTERRUPTED] (JSON: "interrupted": true) and exits 130; it printed nothing at all."""
+    base = ["solve", D + "graph7.txt", "--pagerank", "0.85", "--walks", "1000000000", "--top", "2"]
+    for extra in ([], ["--source", "0"], ["--source", "0,4"]):
+        p = popen_walks([ulam] + base + extra, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        interrupt_when_ready(p)
+        out, err = p.communicate(timeout=120)
+        assert p.returncode == 130 and re.search(r"^walks +\d+ \(\d+ steps\)  \[INTERRUPTED\]$", out, re.M), (extra, out, err)
+        assert re.search(r"^1 +\d+ +[\d.e-]+ ", out, re.M) and re.search(r"^2 +\d+ ", out, re.M), (extra, out)
+        p = popen_walks([ulam] + base + extra + ["--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        interrupt_when_ready(p)
+        out, err = p.communicate(timeout=120)
+        o = json.loads(out)
+        assert p.returncode == 130 and o["interrupted"] is True and len(o["top"]) == 2, (extra, out, err)
+        for t in o["top"]:  # what the push certified stands: each interval holds its estimate
+            assert t["ci95"][0] <= t["estimate"] <= t["ci95"][1], (extra, t)
+    p = popen_walks([ulam] + base + ["--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    interrupt_when_ready(p)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 130 and out.splitlines()[0].endswith("[INTERRUPTED]"), (out, err)
 
 
 def check_default_output(ulam):
@@ -1612,6 +1663,10 @@ def check_prepare(ulam):
             fh.write(bytes(data))
         rc, out, err = run(ulam, ["solve", "--method", "walks", d + "/rows.ulam", "--index", "1", "--walks", "1000"])
         assert rc == code("ESYNTAX") and "block 0 of M" in err and "damaged" in err and out == "", (rc, err)
+        # newuser15 pt 4: under --method auto the damage is the only message (auto's "no candidate has a certified
+        # finite variance" warning came first, from candidates the damage had cut short)
+        rc, out, err = run(ulam, ["solve", d + "/rows.ulam", "--index", "1"])
+        assert rc == code("ESYNTAX") and len(err.splitlines()) == 1 and "damaged" in err and out == "", (rc, err)
         rc, out, err = run(ulam, ["info", d + "/rows.ulam"])
         assert rc != 0 and "damaged" in err and out == "", (rc, err)
         os.remove(d + "/rows.ulam")
@@ -2401,6 +2456,7 @@ def main():
              (check_radiosity_progress, ulam), (check_radiosity_json_path, ulam), (check_radiosity_chosen, ulam),
              (check_radiosity_zero_notes, ulam), (check_radiosity_check_side, ulam),
              (check_default_output, ulam), (check_info_bounded, ulam), (check_walks_prediction, ulam),
+             (check_pagerank_near_one, ulam), (check_top_interrupt, ulam),
              (check_sparse_check, ulam), (check_json_schemas, ulam),
              (check_systems_as_held, ulam), (check_passive_threads, ulam),
              (check_disk_full, ulam), (check_signals, ulam)]

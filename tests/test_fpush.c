@@ -670,6 +670,47 @@ static void test_fpush_lazy_blocks(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* newuser15 pt 1: a 5-cycle, M = alpha C' (x_{s+k} = alpha^k / (1 - alpha^5) exactly), at alpha = 1 - 1e-7,
+ * where the push's residual falls by e per 10^7 sweeps and a walk takes 10^7 steps: the dense LU answers
+ * with no push and no walks, every interval (ulam_fpush_solve's and ulam_fpush_top's) holds the closed form
+ * and is narrower than 1e-6 of it; at alpha = 0.5 the push and walks keep the system. */
+static void test_fpush_dense_near_one(void **state)
+{
+    (void)state;
+    int64_t n = 5, s = 2;
+    double alphas[] = {1.0 - 1e-7, 0.5};
+    for (int c = 0; c < 2; c++) {
+        double a = alphas[c], exact[5], denom = -expm1(5.0 * log1p(-(1.0 - a))); /* 1 - a^5, accurately */
+        ulam_csr *M = ulam_csr_alloc(n, n, n), *Mt = NULL;
+        for (int64_t i = 0; i < n; i++) /* x_{i+1} = e_s + a x_i: row i + 1 of M holds a at column i */
+            M->rowptr[i] = i, M->colidx[i] = (int32_t)((i + n - 1) % n), M->val[i] = a;
+        M->rowptr[n] = n;
+        assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+        for (int64_t k = 0; k < n; k++) exact[(s + k) % n] = exp((double)k * log1p(-(1.0 - a))) / denom;
+        ulam_fpush_opts o = ulam_fpush_defaults();
+        o.source = s;
+        ulam_fpush_info info;
+        ulam_error err;
+        double x[5], se[5], lo[5], hi[5], y[5], tse[2], tlo[2], thi[2];
+        int64_t idx[2];
+        assert_int_equal(ulam_fpush_solve(M, Mt, &o, x, se, lo, hi, &info, &err), ULAM_OK);
+        assert_int_equal(info.dense, c == 0);
+        if (c == 1) {
+            assert_true(info.walks > 0);
+        } else {
+            assert_int_equal(info.walks, 0), assert_int_equal(info.steps, 0);
+            for (int64_t i = 0; i < n; i++) {
+                assert_true(lo[i] <= exact[i] && exact[i] <= hi[i]);
+                assert_true(hi[i] - lo[i] < 1e-6 * exact[i] && se[i] == 0.0);
+            }
+            assert_int_equal(ulam_fpush_top(M, Mt, &o, 2, y, idx, tse, tlo, thi, &info, &err), ULAM_OK);
+            assert_int_equal(info.dense, 1), assert_int_equal(idx[0], s), assert_int_equal(idx[1], (s + 1) % n);
+            for (int t = 0; t < 2; t++) assert_true(tlo[t] <= exact[idx[t]] && exact[idx[t]] <= thi[t]);
+        }
+        ulam_csr_free(M), ulam_csr_free(Mt);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -684,6 +725,7 @@ int main(void)
         cmocka_unit_test(test_fpush_exact_push),
         cmocka_unit_test(test_fpush_signed),
         cmocka_unit_test(test_fpush_lazy_blocks),
+        cmocka_unit_test(test_fpush_dense_near_one),
     };
     return test_run(tests);
 }

@@ -447,7 +447,7 @@ def _single_source(system, source, *, walks=None, rel_err=None, seed=1, threads=
     x, se, lo, hi = d["x"] * scale, d["std_error"] * abs(scale), d["lo"] * scale, d["hi"] * scale
     if scale < 0:
         lo, hi = hi, lo
-    rep = {k: d[k] for k in ("walks", "steps", "rmax", "push_ops", "residual_bound", "seconds")}
+    rep = {k: d[k] for k in ("walks", "steps", "rmax", "push_ops", "residual_bound", "dense", "seconds")}
     rep.update({"method": "single-source", "source": source, "n": n})
     r = VectorResult("single-source", x, se, lo, hi, d["walks"], rep, interrupted=bool(d["interrupted"]))
     if r.interrupted:

@@ -24,6 +24,11 @@ int cli_auto_choose(const cli_system *s, ulam_analysis *an, ulam_walk_opts *o, c
         snprintf(v->why, sizeof v->why, "not considered: %s", excluded_why);
     const ulam_auto_result *res = &ch->walks;
     int k = res->chosen >= 0 ? res->chosen : res->closest;
+    if (*status == ULAM_ESYNTAX || *status == ULAM_EIO) { /* a damaged or unreadable file: its error alone, no
+                                                             verdict on candidates the damage cut short */
+        *run = ulam_run_free(*run);
+        return cli_report(s->matrix_path, err);
+    }
     if (k < 0 && !*status) /* no walk candidate and no refusal: never run (nor label) another row's answer */
         *status = err->status = ULAM_EINVAL, snprintf(err->msg, sizeof err->msg, "a walk candidate to run");
     if (k < 0) {

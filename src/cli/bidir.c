@@ -213,7 +213,9 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     if (status) err = (ulam_error){.status = status, .msg = "memory for every component"};
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+    cli_catch_sigint(); /* Ctrl-C stops the walks: the table so far is printed, marked [INTERRUPTED] */
     if (!status) status = ulam_fpush_top(W, T, &o, want, x, order, se, lo, hi, &info, &err);
+    cli_release_sigint();
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
     double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec); /* push and walks */
     if (status) rc = cli_report(s->matrix_path, &err);
@@ -301,7 +303,7 @@ static int option(void *p, int c, const char *name, const char *optarg)
         else if ((rc = cli_parse_node("solve", "--source", optarg, &a->source))) return rc;
         else a->rp.seeds = NULL;
         break;
-    case 'P': if ((rc = cli_parse_real("solve", "--pagerank", optarg, 1e-6, 1 - 1e-9, &a->s.pagerank))) return rc; break;
+    case 'P': if ((rc = cli_parse_damping("solve", optarg, &a->s.pagerank))) return rc; break;
     case 'M':
         if (ulam_method_find(optarg) != ULAM_METHOD_BIDIRECTIONAL)
             return cli_usage_error("solve", "--source S and --rmax go with --method bidirectional, got '%s'", optarg);

@@ -119,6 +119,10 @@ extern const char *cli_answer_name;
 /* True when a --source value is a list of node ids ("3,7,9"). */
 int cli_seeds_is_list(const char *spec);
 
+/* --pagerank ALPHA (--damping) of command into *alpha: a number with 0 < alpha < 1 (1e-6 to
+ * 1 - 1e-9); 0 or a usage error saying the range is open at 1. */
+int cli_parse_damping(const char *command, const char *s, double *alpha);
+
 /* A --source seed set (ids "3,7,9", equal weights, or a file of lines "id" or "id weight", '#'
  * comments), node ids numbered as the command line numbers them, into the personalisation vector
  * w (n entries, summing to 1); 0 or an exit code (reported, file:line for a bad line). */

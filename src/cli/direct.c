@@ -129,7 +129,7 @@ int cli_direct(int argc, char **argv)
         case 'j': s.jacobi = 1; break;
         case 'w': if ((rc = cli_parse_real("direct", "--omega", optarg, 1e-6, 2.0, &s.omega))) return rc; break;
         case 'J': json = 1; break;
-        case 'P': if ((rc = cli_parse_real("direct", "--pagerank", optarg, 1e-6, 1 - 1e-9, &s.pagerank))) return rc; break;
+        case 'P': if ((rc = cli_parse_damping("direct", optarg, &s.pagerank))) return rc; break;
         case 'L':
             if ((cli_direct_force = cli_choose("direct", "--lu", optarg, lu_names, 3, "auto, sparse or dense")) < 0)
                 return EXIT_USAGE;

@@ -17,6 +17,18 @@ int cli_seeds_is_list(const char *spec)
     return strspn(spec, "0123456789,") == strlen(spec) && strchr(spec, ',');
 }
 
+/* See cli.h. */
+int cli_parse_damping(const char *command, const char *s, double *alpha)
+{
+    char *end;
+    double v = strtod(s, &end);
+    if (end == s || *end || !(v >= 1e-6 && v <= 1 - 1e-9))
+        return cli_usage_error(command, "--pagerank expects a damping factor alpha with 0 < alpha < 1 (from 1e-06 to "
+                               "1 - 1e-09; at 1 no rank is ever teleported and I - alpha P^T is singular), got '%s'", s);
+    *alpha = v;
+    return 0;
+}
+
 /* Node id v of the command line (cli_node_base) as a 0-based state < n into *i; 0 or a usage
  * error naming where it came from. */
 static int seed_state(const char *where, long line, int64_t v, int64_t n, int64_t *i)

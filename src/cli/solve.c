@@ -153,7 +153,7 @@ static int option(void *p, int c, const char *name, const char *optarg)
         a->autom = !strcmp(optarg, "auto");
         break;
     case 'w': if ((rc = cli_parse_real("solve", "--omega", optarg, 1e-6, 2.0, &a->s.omega))) return rc; break;
-    case 'P': if ((rc = cli_parse_real("solve", "--pagerank", optarg, 1e-6, 1 - 1e-9, &a->s.pagerank))) return rc; break;
+    case 'P': if ((rc = cli_parse_damping("solve", optarg, &a->s.pagerank))) return rc; break;
     case 'c': a->check = 1; break;
     case 'J': a->json = 1; break;
     case 'F': a->force = 1; break;
@@ -454,6 +454,13 @@ static int run(solve_args *a)
             ulam_report_fprint(stdout, ULAM_REPORT_WALK, &w, ULAM_REPORT_JSON);
             cli_json_done = 1;
         }
+        if (r.interrupted && o->stop.max_walks > 4 * r.walks && r.walks > 0 && !(o->stop.rel_err > 0) &&
+            !(o->stop.max_seconds > 0) && r.std_error > 0 && isfinite(r.ci95[1] - r.ci95[0])) /* newuser15 pt 7 */
+            fprintf(stderr, "ulam: %s: note: the interval above is %.3g standard errors wide each side: its bets were "
+                            "planned for all %lld walks and the run stopped at %lld; a run of --walks %lld would "
+                            "print a narrower one (the sequence holds at every count, so it is valid, only wide)\n",
+                    s->matrix_path, 0.5 * (r.ci95[1] - r.ci95[0]) / r.std_error, (long long)o->stop.max_walks,
+                    (long long)r.walks, (long long)r.walks);
         if (r.interrupted) rc = EXIT_INTERRUPTED;
         else if (o->mode == ULAM_FORWARD && (a->out || a->errors) && cli_rank == 0)
             rc = write_vectors(sv, ro.n, a->out, a->errors, &r);
