@@ -882,14 +882,14 @@ void ulam__system_trim(const ulam_system *s)
         release_bytes(s, s->map, s->map_bytes);
 }
 
-/* Row j of s's stored M^T read by pread into col and val (see src/cache.h). */
-int ulam__system_tr_row(const ulam_system *s, int64_t j, int32_t *col, double *val)
+/* Entries [e0, e0 + cnt) of row j of s's stored M^T read by pread into col and val (see src/cache.h). */
+int ulam__system_tr_read(const ulam_system *s, int64_t j, int64_t e0, int64_t cnt, int32_t *col, double *val)
 {
     const ulam_csr *T = &s->tr;
-    int64_t a = T->rowptr[j], d = T->rowptr[j + 1] - a;
+    int64_t a = T->rowptr[j] + e0;
     uint64_t oc = (uint64_t)((const unsigned char *)(const void *)(T->colidx + a) - (const unsigned char *)s->map);
     uint64_t ov = (uint64_t)((const unsigned char *)(const void *)(T->val + a) - (const unsigned char *)s->map);
-    return d > 0 && (read_at(s, col, (size_t)d * 4, oc) || read_at(s, val, (size_t)d * 8, ov)) ? -1 : 0;
+    return cnt > 0 && ((col && read_at(s, col, (size_t)cnt * 4, oc)) || (val && read_at(s, val, (size_t)cnt * 8, ov))) ? -1 : 0;
 }
 
 /* Whether M's values are all >= 0, read by pread (see src/cache.h). */

@@ -89,14 +89,15 @@ int ulam__system_nonneg(const ulam_system *s);
 /* Passes over a prepared system's arrays (src/cache.c): whether s's mapping is released as they go
  * (a mapped file of more than its keep bytes, ULAM__SYSTEM_KEEP unless set); rows [r0, r1) of A (s's
  * M or stored M^T; else nothing) given back to the page cache (madvise: the pages leave the
- * resident set, a later read maps them again) -- a block verified is given back so; and row j of
- * the stored M^T read by pread into col and val (its entries' room), 0 or -1 on a failed read.
+ * resident set, a later read maps them again) -- a block verified is given back so; and entries
+ * [e0, e0 + cnt) of row j of the stored M^T read by pread into col and val (room for cnt entries;
+ * either NULL: not read), 0 or -1 on a failed read.
  * ulam__system_trim: for passes that read at random (a queue push, walks), called now and then:
  * all of the mapping given back once the process's file-backed resident set passes ULAM__SYSTEM_TRIM. */
 int ulam__system_releases(const ulam_system *s);
 void ulam__system_set_keep(ulam_system *s, size_t bytes);
 void ulam__system_release(const ulam_system *s, const ulam_csr *A, int64_t r0, int64_t r1);
-int ulam__system_tr_row(const ulam_system *s, int64_t j, int32_t *col, double *val);
+int ulam__system_tr_read(const ulam_system *s, int64_t j, int64_t e0, int64_t cnt, int32_t *col, double *val);
 void ulam__system_trim(const ulam_system *s);
 
 /* What a prepared system is written from checked (ulam_system_write_file's refusals: ULAM_EINVAL),

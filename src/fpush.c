@@ -55,12 +55,19 @@
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
 #define ULAM__FPUSH_TRIM_EVERY 256  /* rows a queue push checks between trims of a large file's mapping
                                       (ulam__system_trim: a read of /proc/self/statm) */
-#define ULAM__FPUSH_TRIM_WALKS 8    /* walks launched between trims: a fault maps up to 2 MiB of a file's large
-                                      pages, and a walk visits ~7 rows (R-MAT 2^24, source 101: every 256 walks
-                                      let the mapping reach 3.3 GB, a peak RSS of 3.87 GB) */
+#define ULAM__FPUSH_TRIM_WALKS 256  /* walks launched between trims: of a released file the walks map only M^T's row
+                                      pointers (8 (n + 1) bytes; every entry is read by pread), so a trim is a guard;
+                                      (R-MAT 2^24, source 101: with hubs' entries read in place through the mapping,
+                                      trims every 8 walks took the walks from 0.77 s to 55 s, each refaulting the hubs
+                                      in 2 MiB spans) */
 #define ULAM__FPUSH_STORE_ROW 64    /* a large file's rows of at most this many entries are read by pread into the walks'
-                                      store on the first visit; longer ones (hubs: a visit reads one entry of
-                                      thousands) in place, their pages trimmed */
+                                      store on the first visit; longer ones (hubs) an entry at a time by pread as a
+                                      walk draws it, until a visit count pays for reading the row whole
+                                      (ULAM__FPUSH_STORE_VISITS) while the long rows stored take at most
+                                      ULAM__FPUSH_STORE_HUBS bytes */
+#define ULAM__FPUSH_STORE_HUBS ((int64_t)512 << 20)
+#define ULAM__FPUSH_STORE_VISITS(d) (2 + (d) / 4096) /* visits of a long row of d entries before it is stored:
+                                      a pread of one entry ~5-10 us on this VM, of a row ~12 d bytes at a few GB/s */
 #define ULAM__FPUSH_SKEW 16.0       /* rows drawn from by rejection up to this many tries on average, beyond by the
                                       running sums (R-MAT 2^20, source 990665, 2026-12-02, load 2.2-2.7, median of 5:
                                       walk loop 121 ms at 2 (2.6e6 running sums built for 117 562 steps), 84 at 4,
@@ -273,15 +280,17 @@ typedef struct {
     int64_t nhit, hmax; /* hit and hc hold hmax states; slot has 2 hmax or more (a power of 2) */
     int64_t hcap, steps;
     const ulam_system *sys; /* a lazily read file whose stored M^T is Mt: each row's block verified on the first visit */
-    int status;             /* ULAM_ESYNTAX once a block failed (bad: a row of it), ULAM_EIO on a failed read; the
-                               walks then stop */
+    int status;             /* ULAM_ESYNTAX once a block failed (bad: a row of it), ULAM_EIO on a failed read,
+                               ULAM_ENOMEM; the walks then stop */
     int64_t bad;
-    const ulam_system *store_of; /* a released mapping (ulam__system_releases): each row read by pread on its first
-                                    visit into the store (scol, sval from soff[j]), so the walks' resident set is
-                                    the rows they visit, not every page near them; NULL: rows read in place */
+    const ulam_system *store_of; /* a released mapping (ulam__system_releases): rows read by pread, never through
+                                    the mapping: short ones on the first visit into the store (scol, sval from
+                                    soff[j]), long ones an entry a step until stored (store_row), so the walks'
+                                    resident set is the rows they keep, not every page near them; NULL: rows read
+                                    in place */
     int32_t *scol;
     double *sval;
-    int64_t *soff, sused;
+    int64_t *soff, sused, shub; /* shub: the entries of long rows stored */
 } walker;
 
 /* Row j of M' (column j of M) as a walk reads it, on its first visit: read into w's store
@@ -290,17 +299,27 @@ typedef struct {
  * ULAM__FPUSH_SKEW tries on average, the running sums of |entries| for a binary search, appended
  * to cum at cum_used (so cum's pages are touched only as far as rows need it; a first touch is
  * dear), mx_j then -1 - their offset in cum instead of the largest entry (negative: sums built).
- * known is a bit a state (n / 8 bytes: its pages are few).  0, or -1 when the read failed. */
+ * known is a bit a state (n / 8 bytes: its pages are few).  ULAM_OK, ULAM_EIO (a failed read) or
+ * ULAM_ENOMEM. */
 static int row_sums(walker *w, int64_t j)
 {
     const ulam_csr *Mt = w->Mt;
     int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a;
     const double *val = Mt->val + a;
-    double *cs = w->cs, *mx = w->mx;
+    double *cs = w->cs, *mx = w->mx, *tmp = NULL;
     if (w->store_of && d > ULAM__FPUSH_STORE_ROW) {
-        w->soff[j] = -1; /* read in place */
+        w->soff[j] = -1; /* its entries read by pread as walks draw them (lane_entry; -1 - soff[j] its visits,
+                            store_row), its values here only when its sums need them: never through the mapping */
+        if (!w->pre || mx[j] * (double)d > ULAM__FPUSH_SKEW * cs[j]) {
+            if (!(tmp = malloc((size_t)d * sizeof *tmp))) return ULAM_ENOMEM;
+            if (ulam__system_tr_read(w->store_of, j, 0, d, NULL, tmp)) {
+                free(tmp);
+                return ULAM_EIO;
+            }
+        }
+        val = tmp;
     } else if (w->store_of) {
-        if (ulam__system_tr_row(w->store_of, j, w->scol + w->sused, w->sval + w->sused)) return -1;
+        if (ulam__system_tr_read(w->store_of, j, 0, d, w->scol + w->sused, w->sval + w->sused)) return ULAM_EIO;
         val = w->sval + w->sused, w->soff[j] = w->sused, w->sused += d;
     }
     if (!w->pre) {
@@ -317,6 +336,18 @@ static int row_sums(walker *w, int64_t j)
         for (int64_t e = 0; e < d; e++) c += fabs(val[e]), cu[e] = c;
         mx[j] = -1.0 - (double)w->cum_used, w->cum_used += d;
     }
+    free(tmp);
+    return ULAM_OK;
+}
+
+/* A visit to long row j (d entries) of a released file not stored (w->soff[j] < 0) counted; at
+ * ULAM__FPUSH_STORE_VISITS(d) visits, room left, the row read whole into the store.  0, or -1 on a
+ * failed read. */
+static int store_row(walker *w, int64_t j, int64_t d)
+{
+    if (--w->soff[j] > -1 - ULAM__FPUSH_STORE_VISITS(d) || (w->shub + d) * 12 > ULAM__FPUSH_STORE_HUBS) return 0;
+    if (ulam__system_tr_read(w->store_of, j, 0, d, w->scol + w->sused, w->sval + w->sused)) return -1;
+    w->soff[j] = w->sused, w->sused += d, w->shub += d;
     return 0;
 }
 
@@ -467,7 +498,19 @@ typedef struct {
     const double *val;
     double u, f;
     int neg, phase, on;
+    int pr;     /* row j a released file's long row (w->soff[j] < 0): entry e read by pread into ce, ve */
+    int32_t ce;
+    double ve;
 } lane;
+
+/* Entry e of the row lane L is on made ready for lane_move: prefetched, or (L->pr) read by pread;
+ * 0, or -1 on a failed read. */
+static int lane_entry(const walker *w, lane *L)
+{
+    if (L->pr) return ulam__system_tr_read(w->store_of, L->j, L->e, 1, &L->ce, &L->ve);
+    __builtin_prefetch(&L->val[L->e]), __builtin_prefetch(&L->col[L->e]);
+    return 0;
+}
 
 /* Arrive at state j: draw the move's uniform, prefetch what the next phase reads. */
 static void lane_arrive(const walker *w, ulam_rng *rng, lane *L, int64_t j)
@@ -495,13 +538,19 @@ static int lane_choose(walker *w, lane *L)
         w->status = ULAM_ESYNTAX, w->bad = j; /* a damaged block: the walk ends unscored, the run fails */
         return 0;
     }
-    if (!(w->known[j >> 6] >> (j & 63) & 1) && row_sums(w, j)) { /* on the first visit */
-        w->status = ULAM_EIO, w->bad = j; /* an unreadable file: the walk ends unscored, the run fails */
+    int rs = !(w->known[j >> 6] >> (j & 63) & 1) ? row_sums(w, j) : ULAM_OK; /* on the first visit */
+    if (rs) {
+        w->status = rs, w->bad = j; /* an unreadable file or no memory: the walk ends unscored, the run fails */
         return 0;
     }
     if (!(v < w->cs[j])) return 0; /* the walk dies */
     int64_t a = Mt->rowptr[j], d = Mt->rowptr[j + 1] - a, e;
+    if (w->store_of && w->soff[j] < 0 && store_row(w, j, d)) {
+        w->status = ULAM_EIO, w->bad = j;
+        return 0;
+    }
     L->col = Mt->colidx + a, L->val = Mt->val + a, L->d = d;
+    L->pr = w->store_of && w->soff[j] < 0;
     if (w->store_of && w->soff[j] >= 0) L->col = w->scol + w->soff[j], L->val = w->sval + w->soff[j];
     if (w->mx[j] < 0) { /* the first entry whose running sum exceeds v */
         const double *cu = w->cum + (int64_t)(-1.0 - w->mx[j]);
@@ -519,26 +568,35 @@ static int lane_choose(walker *w, lane *L)
         L->f = t - (double)e;
     }
     L->e = e, L->phase = 1;
-    __builtin_prefetch(&L->val[e]), __builtin_prefetch(&L->col[e]);
+    if (lane_entry(w, L)) {
+        w->status = ULAM_EIO, w->bad = j;
+        return 0;
+    }
     return 1;
 }
 
 /* Phase 1: accept the entry and move along it, or (rejection: entry e with probability
  * |M_ej| / sum) draw the next candidate and its coin, prefetch it and stay in phase 1, so a
- * walk's tries overlap the other lanes' reads as its steps do. */
-static void lane_move(walker *w, ulam_rng *rng, lane *L)
+ * walk's tries overlap the other lanes' reads as its steps do.  0 when the walk ended (a failed
+ * read: w->status). */
+static int lane_move(walker *w, ulam_rng *rng, lane *L)
 {
     int64_t j = L->j, e = L->e;
-    if (L->f * w->mx[j] > fabs(L->val[e])) {
+    double v = L->pr ? L->ve : L->val[e];
+    if (L->f * w->mx[j] > fabs(v)) {
         uint64_t frac;
         L->e = (int64_t)ulam__rng_index(rng, (uint64_t)L->d, &frac);
         L->f = (double)frac * 0x1.0p-64;
-        __builtin_prefetch(&L->val[L->e]), __builtin_prefetch(&L->col[L->e]);
-        return;
+        if (lane_entry(w, L)) {
+            w->status = ULAM_EIO, w->bad = j;
+            return 0;
+        }
+        return 1;
     }
-    L->neg ^= L->val[e] < 0;
+    L->neg ^= v < 0;
     w->steps++;
-    lane_arrive(w, rng, L, L->col[e]);
+    lane_arrive(w, rng, L, L->pr ? L->ce : L->col[e]);
+    return 1;
 }
 
 /* count walks, ULAM__FPUSH_LANES of them in flight (round robin, one phase each, what a lane
@@ -556,7 +614,7 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
         for (int l = 0; l < ULAM__FPUSH_LANES; l++) {
             if (L[l].on) {
                 if (L[l].phase == 0) L[l].on = lane_choose(w, &L[l]);
-                else lane_move(w, rng, &L[l]);
+                else L[l].on = lane_move(w, rng, &L[l]);
             }
             if (!L[l].on && more) {
                 int64_t j = walk_start(w, rng);
@@ -1093,6 +1151,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
             }
             if (sgn) cs_plan_all(&S, &w, x, N, R0, pl.E, pl.delta, o->walks > 0 ? (double)o->walks : 0.0);
             int64_t made = N < target ? walk_many(&w, &rng, target - N, o->walk.stop.interrupt) : 0;
+            if (w.status == ULAM_ENOMEM) {
+                status = ulam__fail(err, ULAM_ENOMEM, 0, w.bad, "memory for row %lld of M^T's values", (long long)w.bad + 1);
+                break;
+            }
             if (w.status == ULAM_EIO) {
                 status = ulam__fail(err, ULAM_EIO, 0, w.bad, "a readable prepared file (row %lld of its M^T)",
                                     (long long)w.bad + 1);
