@@ -143,15 +143,15 @@ static void choice_text(FILE *f, const ulam_choice *ch, int bidir, int verbose)
     }
     if (bstate == ULAM_METHOD_CHOSEN)
         fprintf(f, "auto            chose bidirectional: its predicted work %.3g units is below the walk leader's %.3g "
-               "(%d walk candidates after %d pilot stages; guards and pilots %.3f s)\n", v->predicted_work, ch->leader_work,
-               res->ncand, res->stages, res->seconds);
+               "(%d walk candidates after %d pilot stage%s; guards and pilots %.3f s)\n", v->predicted_work, ch->leader_work,
+               res->ncand, res->stages, res->stages == 1 ? "" : "s", res->seconds);
     else if (res->chosen >= 0) {
         char share[96] = "no predicted work to compare the pilots with"; /* a chosen run that predicts nothing */
         if (isfinite(pilot_share(res)))
             snprintf(share, sizeof share, "the pilots' overhead is %.3g%% of the predicted work", 100 * pilot_share(res));
-        fprintf(f, "auto            chose the least predicted %s of %d candidates after %d pilot stages; %s (guards and "
+        fprintf(f, "auto            chose the least predicted %s of %d candidates after %d pilot stage%s; %s (guards and "
                "pilots %.3f s); the estimate is from fresh walks\n", res->by_work ? "work" : "variance x work a walk",
-               res->ncand, res->stages, share, res->seconds);
+               res->ncand, res->stages, res->stages == 1 ? "" : "s", share, res->seconds);
     }
     else
         fprintf(f, "auto            no certified candidate among %d: ran the closest\n", res->ncand);
