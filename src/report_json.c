@@ -278,13 +278,16 @@ static const char *outcome(const ulam_outer_report *p)
 }
 
 /* The text report's totals. */
-static void print_text(FILE *f, const ulam_outer_report *p)
+static void print_text(FILE *f, const ulam_outer_report *p, int quiet)
 {
     int walks = p->method == ULAM_METHOD_SEQUENTIAL || p->method == ULAM_METHOD_MCSA;
     int krylov = p->method == ULAM_METHOD_CG || p->method == ULAM_METHOD_GMRES;
     int64_t hist;
     double walk_s;
     totals(p, &hist, &walk_s);
+    if (p->index && p->x) /* the answer first */
+        fprintf(f, "x[%lld]%*s%.12g\n", (long long)p->index, ulam__report_pad(p->answer_name ? p->answer_name : "x", p->index, 16), "", p->x[p->index - 1]);
+    if (quiet && p->index && p->x) return; /* --quiet: the answer line */
     fprintf(f, "method          %s%s%s, tol %g%s\n", ulam_method_name(p->method), walks ? ", " : "",
             walks ? ulam__report_estimator_name(p->estimator) : "", p->tol, walks ? "" : " (no walks)");
     if (p->method == ULAM_METHOD_GMRES) fprintf(f, "restart         %d\n", p->restart);
@@ -298,8 +301,6 @@ static void print_text(FILE *f, const ulam_outer_report *p)
         fprintf(f, "guards          rho(|M|) %.6g (%s), rho(M^) %.6g (%s)\n", p->g.abs.rho,
                 ulam_verdict_word(p->g.verdict_abs), p->g.hat[ULAM_FORWARD].rho,
                 ulam_verdict_word(p->g.verdict_hat[ULAM_FORWARD]));
-    if (p->index && p->x)
-        fprintf(f, "x[%lld]%*s%.12g\n", (long long)p->index, ulam__report_pad(p->answer_name ? p->answer_name : "x", p->index, 16), "", p->x[p->index - 1]);
 }
 
 /* The JSON object with the history. */
@@ -354,5 +355,5 @@ void ulam_outer_report_fprint(FILE *f, const ulam_outer_report *r, int format)
         r->estimator > 2)
         return;
     if (format == ULAM_REPORT_JSON) print_json(f, r);
-    else print_text(f, r);
+    else print_text(f, r, format == ULAM_REPORT_QUIET);
 }
