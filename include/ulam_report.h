@@ -71,8 +71,9 @@ typedef struct ulam_outer_report {
     double worst;      /* their largest half-width */
 } ulam_outer_report;
 
-/* Write r to f: its totals as text lines (format ULAM_REPORT_BRIEF or _VERBOSE; the iterations'
- * lines are the caller's, as they end), or one JSON object with the history (ULAM_REPORT_JSON). */
+/* Write r to f: its totals as text lines, x_index first when r->index is set (format
+ * ULAM_REPORT_BRIEF or _VERBOSE; _QUIET: that line alone; the iterations' lines are the caller's,
+ * as they end), or one JSON object with the history (ULAM_REPORT_JSON). */
 void ulam_outer_report_fprint(FILE *f, const ulam_outer_report *r, int format);
 
 /* What a bidirectional solve of one x_t (ulam_analysis_bidir, or the bidirectional row of

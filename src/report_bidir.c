@@ -191,7 +191,8 @@ static void point_json(FILE *f, const ulam_bidir_report *p)
     fprintf(f, "\"interrupted\": %s}\n", w->interrupted ? "true" : "false");
 }
 
-/* The single-source table's head (not QUIET): the method, the push, the walks, the seconds. */
+/* The single-source table's details (not QUIET), below its rows: the method, the push, the walks,
+ * the seconds. */
 static void table_head(FILE *f, const ulam_bidir_report *p)
 {
     const ulam_fpush_info *t = p->top;
@@ -226,15 +227,16 @@ static void table_head(FILE *f, const ulam_bidir_report *p)
                  p->cpu_seconds);
     if (p->direct_x)
         fprintf(f, "direct          %s, %.3g s (the column direct)\n", direct_method(p), p->direct_seconds);
-    fprintf(f, "%-6s %-10s %-14s %-11s %s\n", "rank", p->node_base ? "index" : "node",
-            p->pagerank > 0 ? "pi" : "estimate", "stderr", p->direct_x ? "95% CI                    direct" : "95% CI");
 }
 
-/* The single-source table as text: its head (not QUIET), then a row for each of the largest. */
+/* The single-source table as text: the answer first (the columns' names, not QUIET, then a row for
+ * each of the largest with its interval), then its details (not QUIET). */
 static void table_text(FILE *f, const ulam_bidir_report *p, int format)
 {
     const double *xd = p->direct_x;
-    if (format != ULAM_REPORT_QUIET) table_head(f, p);
+    if (format != ULAM_REPORT_QUIET)
+        fprintf(f, "%-6s %-10s %-14s %-11s %s\n", "rank", p->node_base ? "index" : "node",
+                p->pagerank > 0 ? "pi" : "estimate", "stderr", xd ? "95% CI                    direct" : "95% CI");
     for (int64_t k = 0; k < p->rows; k++) {
         int64_t i = p->order[k];
         fprintf(f, "%-6lld %-10lld %-14.8g %-11.3g ", (long long)k + 1, node(p, i), p->x[i], p->se[k]);
@@ -245,6 +247,7 @@ static void table_text(FILE *f, const ulam_bidir_report *p, int format)
         if (k == 0 && format == ULAM_REPORT_QUIET && p->top->interrupted) fputs("  [INTERRUPTED]", f); /* the head's mark */
         fputc('\n', f);
     }
+    if (format != ULAM_REPORT_QUIET) table_head(f, p);
 }
 
 /* The single-source table as one JSON object. */

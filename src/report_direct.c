@@ -14,13 +14,13 @@ static void entry(FILE *f, const ulam_direct_report *d, int64_t i)
 /* Write the report as text. */
 static void direct_text(FILE *f, const ulam_direct_report *d)
 {
-    fprintf(f, "n          %lld\n", (long long)d->n);
-    if (d->index > 0) {
+    if (d->index > 0) { /* the answer first */
         entry(f, d, d->index - 1);
     } else if (d->list) {
         for (int64_t i = 0; i < d->n && i < 10; i++) entry(f, d, i);
         if (d->n > 10) fprintf(f, "...        (%lld more: use --out or --index)\n", (long long)(d->n - 10));
     }
+    fprintf(f, "n          %lld\n", (long long)d->n);
     fprintf(f, "method     %s\n", d->sparse ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");
     fprintf(f, "rcond      %.3e\n", d->info.rcond);
     fprintf(f, "residual   %.3e\n", d->info.residual);

@@ -143,15 +143,15 @@ static void choice_text(FILE *f, const ulam_choice *ch, int bidir, int verbose)
     }
     if (bstate == ULAM_METHOD_CHOSEN)
         fprintf(f, "auto            chose bidirectional: its predicted work %.3g units is below the walk leader's %.3g "
-               "(%d walk candidates after %d pilot stages; guards and pilots %.3f s)\n", v->predicted_work, ch->leader_work,
-               res->ncand, res->stages, res->seconds);
+               "(%d walk candidates after %d pilot stage%s; guards and pilots %.3f s)\n", v->predicted_work, ch->leader_work,
+               res->ncand, res->stages, res->stages == 1 ? "" : "s", res->seconds);
     else if (res->chosen >= 0) {
         char share[96] = "no predicted work to compare the pilots with"; /* a chosen run that predicts nothing */
         if (isfinite(pilot_share(res)))
             snprintf(share, sizeof share, "the pilots' overhead is %.3g%% of the predicted work", 100 * pilot_share(res));
-        fprintf(f, "auto            chose the least predicted %s of %d candidates after %d pilot stages; %s (guards and "
+        fprintf(f, "auto            chose the least predicted %s of %d candidates after %d pilot stage%s; %s (guards and "
                "pilots %.3f s); the estimate is from fresh walks\n", res->by_work ? "work" : "variance x work a walk",
-               res->ncand, res->stages, share, res->seconds);
+               res->ncand, res->stages, res->stages == 1 ? "" : "s", share, res->seconds);
     }
     else
         fprintf(f, "auto            no certified candidate among %d: ran the closest\n", res->ncand);
@@ -279,13 +279,19 @@ static const char *outcome(const ulam_outer_report *p)
 }
 
 /* The text report's totals. */
-static void print_text(FILE *f, const ulam_outer_report *p)
+static void print_text(FILE *f, const ulam_outer_report *p, int quiet)
 {
     int walks = p->method == ULAM_METHOD_SEQUENTIAL || p->method == ULAM_METHOD_MCSA;
     int krylov = p->method == ULAM_METHOD_CG || p->method == ULAM_METHOD_GMRES;
     int64_t hist;
     double walk_s;
     totals(p, &hist, &walk_s);
+    if (p->index && p->x) { /* the answer first, with its certified range */
+        fprintf(f, "x[%lld]%*s%.12g", (long long)p->index, ulam__report_pad(p->answer_name ? p->answer_name : "x", p->index, 16), "", p->x[p->index - 1]);
+        if (p->lo && p->hi) fprintf(f, " (certified range %.10g .. %.10g)", p->lo[p->index - 1], p->hi[p->index - 1]);
+        fprintf(f, "\n");
+    }
+    if (quiet && p->index && p->x) return; /* --quiet: the answer line */
     fprintf(f, "method          %s%s%s, tol %g%s\n", ulam_method_name(p->method), walks ? ", " : "",
             walks ? ulam__report_estimator_name(p->estimator) : "", p->tol, walks ? "" : " (no walks)");
     if (p->method == ULAM_METHOD_GMRES) fprintf(f, "restart         %d\n", p->restart);
@@ -301,11 +307,6 @@ static void print_text(FILE *f, const ulam_outer_report *p)
                 ulam_verdict_word(p->g.verdict_hat[ULAM_FORWARD]));
     if (p->lo && p->hi)
         fprintf(f, "range           every x_i within %.3g of x (certified from x's residual, no sampling)\n", p->worst);
-    if (p->index && p->x) {
-        fprintf(f, "x[%lld]%*s%.12g", (long long)p->index, ulam__report_pad(p->answer_name ? p->answer_name : "x", p->index, 16), "", p->x[p->index - 1]);
-        if (p->lo && p->hi) fprintf(f, " (certified range %.10g .. %.10g)", p->lo[p->index - 1], p->hi[p->index - 1]);
-        fprintf(f, "\n");
-    }
 }
 
 /* The JSON object with the history. */
@@ -363,5 +364,5 @@ void ulam_outer_report_fprint(FILE *f, const ulam_outer_report *r, int format)
         r->estimator > 2)
         return;
     if (format == ULAM_REPORT_JSON) print_json(f, r);
-    else print_text(f, r);
+    else print_text(f, r, format == ULAM_REPORT_QUIET);
 }

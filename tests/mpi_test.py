@@ -15,9 +15,10 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
            OMPI_MCA_plm_rsh_agent="")
 
 
-def run(cmd):
+def run(cmd, rc=0):
+    """cmd's stdout, once it exited rc (5: a --rel-err target not met, the answer printed)."""
     p = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
-    assert p.returncode == 0, (cmd, p.returncode, p.stderr)
+    assert p.returncode == rc, (cmd, p.returncode, p.stderr)
     return p.stdout
 
 
@@ -539,7 +540,8 @@ def main():
             try:
                 res = []
                 for launcher in ([ulam], par):
-                    out = run(launcher + [a.format(d=d) for a in args])
+                    # --walks 100000 stops "alpha walks" before its target: exit 5 (rel_err_met false), on both
+                    out = run(launcher + [a.format(d=d) for a in args], 5 if name == "solve adjoint alpha walks" else 0)
                     if outfile and outfile.endswith("runs.csv"):  # drop the seconds column (wall time)
                         rows = open(os.path.join(d, outfile)).read().splitlines()
                         res.append([",".join(r.split(",")[:9]) for r in rows])

@@ -389,6 +389,18 @@ def test_alpha_is_damping_only():
     assert r.kernel_alpha == 0.5
 
 
+def test_keyword_typo_did_you_mean():
+    """A misspelt keyword is a TypeError naming the closest one solve takes, as the CLI's "did you
+    mean" names the closest option (newuser15: it named the typo alone)."""
+    M, b = random_system(40, 3, 0.8, 33)
+    with pytest.raises(TypeError, match=r"'rel_er' \(did you mean 'rel_err'\?\)"):
+        ulam.solve(M=M, b=b, index=0, rel_er=0.1)
+    with pytest.raises(TypeError, match=r"'wlaks' \(did you mean 'walks'\?\)"):
+        ulam.System(M=M).solve(b, index=0, wlaks=100)
+    with pytest.raises(TypeError, match=r"'sideways'$"):
+        ulam.solve(M=M, b=b, index=0, sideways=1)
+
+
 def test_clear_type_errors():
     """A LinearOperator gets a TypeError saying the walks need M's entries (not "got 0
     dimensions"); rtol= is rel_err (scipy's name)."""

@@ -464,6 +464,17 @@ def _divergence(d, force):
                               "Neumann series of M diverges here: x has no walk estimate; solve it directly)")
 
 
+def _unknown_keyword(name):
+    """The TypeError for keyword name that solve does not take, naming the closest it does (the
+    CLI's "did you mean" for an option): its keywords are _solve's and solve's own."""
+    import difflib
+    import inspect
+    names = [k for k in inspect.signature(_solve).parameters if not k.startswith("_") and k not in
+             ("system", "unknown", "reuse")] + ["M", "A", "jacobi", "omega"]
+    near = difflib.get_close_matches(name, names, 1, 0.6)
+    raise TypeError(f"unexpected keyword argument {name!r}" + (f" (did you mean {near[0]!r}?)" if near else ""))
+
+
 def _solve(system, b, index, *, source=None, method="auto", mode=None, estimator=None, walks=None, rel_err=None,
            rtol=None, time=None, seed=1, threads=None, continue_q=None, kernel_alpha=None, roulette=None, split=None,
            max_steps=None, force=False, assume_finite_variance=False, whole_kernel=False, progress=None, reuse=False,
@@ -473,7 +484,7 @@ def _solve(system, b, index, *, source=None, method="auto", mode=None, estimator
         raise TypeError("alpha: the walk kernel's exponent is kernel_alpha= (--alpha); in ulam, alpha is "
                         "PageRank's damping (ulam.pagerank(adj, alpha=0.85))")
     if unknown:
-        raise TypeError(f"unexpected keyword argument {next(iter(unknown))!r}")
+        _unknown_keyword(next(iter(unknown)))
     if rtol is not None:
         if rel_err is not None:
             _input("rel_err= or rtol= (scipy's name for it), not both")

@@ -122,6 +122,7 @@ static int answer(const cli_system *s, const ulam_bidir_opts *o, ulam_bidir_resu
     if (!rc && rp->json) ulam_report_fprint(stdout, ULAM_REPORT_BIDIR, p, ULAM_REPORT_JSON), cli_json_done = 1;
     else if (!rc && p->check) ulam_report_fprint(stdout, ULAM_REPORT_BIDIR, p, ULAM_REPORT_CHECK);
     if (!rc && r->walks.interrupted) rc = EXIT_INTERRUPTED;
+    if (!rc && o->walk.stop.rel_err > 0 && !r->walks.rel_err_met) rc = EXIT_TARGET; /* printed "NOT met" */
     cli_flush();
     if (rc == EXIT_INTERRUPTED && check && !cli_share) { /* the reference's thread still reads the system */
         fflush(stderr);

@@ -9,9 +9,11 @@
 
 #include <getopt.h>
 
-/* Exit codes (documented in README.md): 0 success, 1 internal failure, 2 usage error,
- * 3 walks would diverge, 4 a --rel-err target with a variance not certified finite, 10 + status for a library status, 130 interrupted. */
-enum { EXIT_USAGE = 2, EXIT_DIVERGE = 3, EXIT_INFVAR = 4, EXIT_STATUS_BASE = 10, EXIT_INTERRUPTED = 130 };
+/* Exit codes (documented in README.md and docs/input.md): 0 success, 1 internal failure, 2 usage error,
+ * 3 walks would diverge, 4 a --rel-err target with a variance not certified finite, 5 a solve's
+ * --rel-err target not met when the walks stopped (--walks, --time or the cap: the estimate and its
+ * interval are printed, wider than asked), 10 + status for a library status, 130 interrupted. */
+enum { EXIT_USAGE = 2, EXIT_DIVERGE = 3, EXIT_INFVAR = 4, EXIT_TARGET = 5, EXIT_STATUS_BASE = 10, EXIT_INTERRUPTED = 130 };
 
 /* The exit code for a library status. */
 int cli_exit_code(int status);
@@ -22,6 +24,11 @@ int cli_report(const char *file, const ulam_error *err);
 /* Report a failed write of path (status ULAM_EIO: errno's message errnum, "No space left on
  * device"; ULAM_ENONFINITE: values that cannot be written) and return the exit code. */
 int cli_report_write(const char *path, int status, int errnum);
+
+/* Report the input path (what: "query file", ...) that cannot be opened or read, with errno's
+ * message errnum ("No such file or directory"), as ULAM_EIO: "ulam: PATH: error: cannot open, read
+ * or write file: expected a readable WHAT (REASON)"; the exit code (13, as for a missing matrix). */
+int cli_report_read(const char *path, const char *what, int errnum);
 
 /* fflush(stdout), remembering errno's value at the first failure (main reports it at exit: "No
  * space left on device"); 0 or that errno value. */
@@ -106,7 +113,7 @@ int cli_parse_node(const char *command, const char *opt, const char *value, int6
 int cli_load_system(cli_system *s);
 
 /* The refusal of a command given no --rhs for path: a file named .ulam or .ulamcache that is
- * not a prepared system (empty, another magic) says so; anything else needs --rhs.  An exit code. */
+ * not a prepared system (empty, another magic) says so; an edge list is told of --pagerank; anything else needs --rhs.  An exit code. */
 int cli_need_rhs(const char *command, const char *path);
 
 /* Check a mapped M and b whole (ulam_system_check) if not yet done; 0 or an exit code. */
@@ -241,6 +248,9 @@ extern int cli_verbosity, cli_json_mode, cli_json_done;
 
 /* Strip --verbose/-v and --quiet/-q from argv, note --json (then stderr keeps its last error). */
 void cli_output_begin(int *argc, char **argv);
+
+/* A usage error (EXIT_USAGE) when argv had both --verbose and --quiet (-v, -q), naming both; else 0. */
+int cli_output_conflict(const char *command);
 
 /* Under --json, a failure that printed no JSON prints {"error": message, "exit": rc}; returns rc. */
 int cli_output_finish(int rc);

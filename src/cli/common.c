@@ -355,6 +355,14 @@ int cli_report_write(const char *path, int status, int errnum)
     return cli_report(path, &err);
 }
 
+/* Report an input file that cannot be opened or read (errno's message errnum): exit 13, as a missing matrix. */
+int cli_report_read(const char *path, const char *what, int errnum)
+{
+    ulam_error err = {.status = ULAM_EIO, .line = 0, .index = -1};
+    snprintf(err.msg, sizeof err.msg, "a readable %s (%s)", what, strerror(errnum ? errnum : EIO));
+    return cli_report(path, &err);
+}
+
 static int stdout_errno; /* errno's value when a flush of stdout first failed */
 
 /* Flush stdout, remembering why it first failed. */
@@ -425,6 +433,9 @@ int cli_need_rhs(const char *command, const char *path)
         ulam_system_free(sys);
         if (status) return cli_report(path, &err);
     }
+    if (ulam_edgelist_is_file(path)) /* a graph: its system is PageRank's unless b is given */
+        return cli_usage_error(command, "needs --rhs b.mtx or, as %s is an edge list (a graph), --pagerank ALPHA "
+                               "(0.85, say) to solve its PageRank", path);
     return cli_usage_error(command, "needs --rhs b.mtx");
 }
 

@@ -59,12 +59,13 @@ int cli_seeds_parse(const char *spec, int64_t n, double *w)
         }
     } else {
         FILE *f = fopen(spec, "r");
-        if (!f)
-            return cli_usage_error("solve", "--source expects a node id, ids separated by commas (3,7,9) or a file of "
-                                   "seeds ('id' or 'id weight' a line), got '%s' (%s)", spec, strerror(errno));
+        if (!f) /* not a node id, nor a list: a file of seeds, missing (exit 13, as a missing matrix) */
+            return cli_report_read(spec, "--source seeds file (or a node id, or ids separated by commas: 3,7,9)",
+                                   errno);
         char line[512];
         long ln = 0;
         rc = 0;
+        errno = 0;
         while (!rc && fgets(line, sizeof line, f)) {
             ln++;
             char *p = line, *end;
@@ -90,6 +91,7 @@ int cli_seeds_parse(const char *spec, int64_t n, double *w)
             else if (!(rc = seed_state(spec, ln, v, n, &i)))
                 w[i] += x;
         }
+        if (!rc && ferror(f)) rc = cli_report_read(spec, "--source seeds file", errno); /* a directory: EISDIR */
         fclose(f);
         if (rc) return rc;
     }

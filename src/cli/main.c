@@ -21,6 +21,7 @@ static int dispatch(int argc, char **argv)
         printf("ulam %s\n", ULAM_VERSION);
         return 0;
     }
+    if (cli_output_conflict(argv[1])) return EXIT_USAGE;
     if (!strcmp(argv[1], "info")) return cli_info(argc - 1, argv + 1);
     if (!strcmp(argv[1], "direct")) return cli_direct(argc - 1, argv + 1);
     if (!strcmp(argv[1], "solve")) return cli_solve(argc - 1, argv + 1);

@@ -73,7 +73,7 @@ static void print_report(const report *p)
                            .answer_name = cli_answer_name, .check = p->check, .err_direct = p->err_direct, .g = p->g,
                            .lo = p->lo, .hi = p->hi, .worst = p->worst};
     if (p->json) cli_json_done = 1;
-    ulam_outer_report_fprint(stdout, &r, p->json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
+    ulam_outer_report_fprint(stdout, &r, p->json ? ULAM_REPORT_JSON : cli_verbosity < 0 ? ULAM_REPORT_QUIET : ULAM_REPORT_BRIEF);
 }
 
 /* The relative 2-norm error of x against the reference solve (cli_direct_reference: LU, or GMRES
@@ -123,6 +123,8 @@ static int run(const cli_system *s, const ulam_outer_opts *o, report *p, ulam_ou
     int status = ulam_outer_alloc(s->M, s->b, o, &it, &err), cap = 0;
     if (status) return cli_report(s->matrix_path, &err);
     double t0 = ulam_now();
+    /* the iterations' table, live, under --verbose only: by default the answer is the first line */
+    int table = !p->json && cli_rank == 0 && cli_verbosity > 0;
     cli_catch_sigint();
     while (!ulam_outer_done(it)) {
         if (p->nsteps == cap) {
@@ -135,10 +137,10 @@ static int run(const cli_system *s, const ulam_outer_opts *o, report *p, ulam_ou
         }
         status = ulam_outer_iterate(it, &(*steps)[p->nsteps]);
         p->nsteps++;
-        if (!p->json && cli_rank == 0 && shown(p->nsteps)) print_step(&(*steps)[p->nsteps - 1], walking(p->method));
+        if (table && shown(p->nsteps)) print_step(&(*steps)[p->nsteps - 1], walking(p->method));
     }
     cli_release_sigint();
-    if (!p->json && cli_rank == 0 && p->nsteps && !shown(p->nsteps)) {
+    if (table && p->nsteps && !shown(p->nsteps)) {
         printf("...\n");
         print_step(&(*steps)[p->nsteps - 1], walking(p->method));
     }

@@ -46,14 +46,24 @@ static ssize_t tee_write(void *cookie, const char *buf, size_t size)
     return (ssize_t)size;
 }
 
+/* How --verbose and --quiet were spelt (NULL: not given): both is a usage error (cli_output_conflict). */
+static const char *verbose_flag, *quiet_flag;
+
+/* See cli.h. */
+int cli_output_conflict(const char *command)
+{
+    if (!verbose_flag || !quiet_flag) return 0;
+    return cli_usage_error(command, "%s and %s contradict each other: give one", verbose_flag, quiet_flag);
+}
+
 /* Strip --verbose (-v) and --quiet (-q) from argv (the options of every command), note --json, and
  * under --json keep the last error line written to stderr for cli_output_finish. */
 void cli_output_begin(int *argc, char **argv)
 {
     int k = 1, j = 1;
     for (; k < *argc && strcmp(argv[k], "--"); k++) {
-        if (!strcmp(argv[k], "--verbose") || !strcmp(argv[k], "-v")) cli_verbosity = 1;
-        else if (!strcmp(argv[k], "--quiet") || !strcmp(argv[k], "-q")) cli_verbosity = -1;
+        if (!strcmp(argv[k], "--verbose") || !strcmp(argv[k], "-v")) cli_verbosity = 1, verbose_flag = argv[k];
+        else if (!strcmp(argv[k], "--quiet") || !strcmp(argv[k], "-q")) cli_verbosity = -1, quiet_flag = argv[k];
         else {
             cli_json_mode |= !strcmp(argv[k], "--json");
             argv[j++] = argv[k];
@@ -83,12 +93,32 @@ int cli_output_finish(int rc)
     return rc;
 }
 
+/* Options that may be given more than once (each adds one: points, luminaires). */
+static const char *const repeatable[] = {"at", "luminaire"};
+
+/* Spellings of one option (--damping is --pagerank). */
+static const char *const aliases[][2] = {{"pagerank", "damping"}, {"kernel-exponent", "alpha"}};
+
+/* The index among names[0..n) that stands for option i (its first spelling), or -1 when it may repeat. */
+static int single_valued(const char *const *names, int n, int i)
+{
+    if (cli_lookup(names[i], repeatable, (int)(sizeof repeatable / sizeof *repeatable)) >= 0) return -1;
+    for (size_t a = 0; a < sizeof aliases / sizeof *aliases; a++)
+        for (int s = 0; s < 2; s++)
+            if (!strcmp(names[i], aliases[a][s])) {
+                int k = cli_lookup(aliases[a][0], names, n);
+                return k >= 0 ? k : i;
+            }
+    return i;
+}
+
 /* Check every --name in argv against longopts before getopt_long sees them (it would take an
- * abbreviation silently): an unknown one is a usage error naming the closest option.  0 or
+ * abbreviation silently): an unknown one is a usage error naming the closest option, and so is a
+ * single-valued one given twice (getopt would keep the last silently: --index 7 --index 9).  0 or
  * EXIT_USAGE. */
 int cli_check_options(const char *command, int argc, char **argv, const struct option *longopts)
 {
-    const char *names[256];
+    const char *names[256], *given[256] = {0}, *spelt[256]; /* given[i]: option i's first value, spelt as spelt[i] */
     int n = 0;
     for (; longopts[n].name && n < 256; n++) names[n] = longopts[n].name;
     for (int k = 1; k < argc && strcmp(argv[k], "--"); k++) {
@@ -99,7 +129,15 @@ int cli_check_options(const char *command, int argc, char **argv, const struct o
         if (eq) *eq = '\0';
         int i = cli_lookup(name, names, n);
         if (i >= 0) {
-            k += longopts[i].has_arg == required_argument && !eq; /* its value may start with "--" */
+            if (longopts[i].has_arg != required_argument) continue;
+            const char *value = eq ? strchr(argv[k], '=') + 1 : k + 1 < argc ? argv[k + 1] : "";
+            k += !eq; /* its value may start with "--" */
+            int first = single_valued(names, n, i);
+            if (first < 0) continue;
+            if (given[first])
+                return cli_usage_error(command, "--%s given twice (--%s %s and --%s %s): it takes one value, give it once",
+                                       names[first], spelt[first], given[first], name, value);
+            given[first] = value, spelt[first] = names[i];
             continue;
         }
         const char *s = ulam_options_suggest(name, names, n);

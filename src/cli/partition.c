@@ -285,6 +285,11 @@ static int run(const args *a, const ulam_comm *c)
         fprintf(stderr, "ulam: %s: warning: %lld walks were cut at --max-steps %lld: the estimates and their standard "
                         "errors leave out what those walks would have scored\n", a->path, (long long)s.r.cut,
                 (long long)a->o.max_steps);
+    if (!rc && c->rank == 0 && a->rel_err > 0) { /* "NOT met" printed (the report's count): exit 5 */
+        int64_t met = 0, nq_met = ask.mode == ULAM_DIST_ADJOINT ? nq : 1;
+        for (int64_t k = 0; ask.mode == ULAM_DIST_ADJOINT && s.ci && k < nq; k++) met += s.ci[k].met;
+        if (met < nq_met) rc = EXIT_TARGET;
+    }
     if (!rc && a->mcsa && s.residual > a->tol) {
         if (c->rank == 0) fprintf(stderr, "ulam: %s: error: MCSA stopped at --max-iter %lld with residual %.3g above --tol %.3g\n",
                                   a->path, (long long)a->max_iter, s.residual, a->tol);

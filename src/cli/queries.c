@@ -12,6 +12,8 @@
  * lone run's search of its start's reach).  One result a line, flushed as it is made: Ctrl-C
  * stops the query under way and keeps the answered lines (exit 130).  The whole file is read
  * and checked before the first query runs: a bad line is an error (file:line) with no output.
+ * A line whose target (its own or --rel-err) was not met makes the exit EXIT_TARGET (5) once
+ * every line is answered.
  * The queries themselves are the library's (ulam_analysis_query, src/queries.c); this file reads
  * the file, loads the system and prints. */
 #include "cli.h"
@@ -65,14 +67,12 @@ static int parse_line(char *text, query *q, const char **why)
 int cli_read_queries(const char *path, query **out, int64_t *nq)
 {
     FILE *f = strcmp(path, "-") ? fopen(path, "r") : stdin;
-    if (!f) {
-        fprintf(stderr, "ulam: %s: error: expected a readable query file (%s)\n", path, strerror(errno));
-        return EXIT_USAGE;
-    }
+    if (!f) return cli_report_read(path, "query file", errno);
     query *q = NULL;
     int64_t cap = 0, n = 0;
     char buf[4096];
     int rc = 0;
+    errno = 0;
     for (long line = 1; !rc && fgets(buf, sizeof buf, f); line++) {
         const char *why = NULL;
         query one = {.line = line};
@@ -88,10 +88,7 @@ int cli_read_queries(const char *path, query **out, int64_t *nq)
         }
         if (!rc && got > 0) q[n++] = one;
     }
-    if (!rc && ferror(f)) {
-        fprintf(stderr, "ulam: %s: error: expected a readable query file (read failed)\n", path);
-        rc = EXIT_USAGE;
-    }
+    if (!rc && ferror(f)) rc = cli_report_read(path, "query file", errno); /* a directory: EISDIR */
     if (f != stdin) fclose(f);
     if (rc) free(q), q = NULL, n = 0;
     *out = q, *nq = n;
@@ -108,7 +105,7 @@ typedef struct {
 
 /* Run query k with options o (its seed and target set) by ulam_analysis_query and print its line;
  * 0, an exit code, or EXIT_INTERRUPTED. */
-static int run_query(shared *w, const query *q, int64_t k, const ulam_walk_opts *o, int json)
+static int run_query(shared *w, const query *q, int64_t k, const ulam_walk_opts *o, int json, int *unmet)
 {
     ulam_error err;
     int interrupted;
@@ -125,6 +122,7 @@ static int run_query(shared *w, const query *q, int64_t k, const ulam_walk_opts 
     cli_json_done |= json;
     ulam_report_fprint(stdout, ULAM_REPORT_QUERY, &a, json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
     fflush(stdout);
+    *unmet += o->stop.rel_err > 0 && !a.rel_err_met;
     return 0;
 }
 
@@ -159,11 +157,19 @@ int cli_queries(cli_system *s, const ulam_walk_opts *o, const char *path, int js
     ulam_walk_opts base = *o;
     base.policy.guard = &w.g, base.stop.interrupt = &cli_interrupted, base.mode = ULAM_ADJOINT;
     cli_catch_sigint();
+    int unmet = 0; /* lines whose target was not met: exit EXIT_TARGET once every line is answered */
     for (int64_t k = 0; !rc && k < nq; k++) {
         ulam_walk_opts ok = base;
         ok.exec.seed = ulam_rng_substream(o->exec.seed, ULAM_STREAM_QUERY, (uint64_t)k); /* printed with the answer */
         if (q[k].target > 0) ok.stop.rel_err = q[k].target, ok.stop.max_walks = walks_given ? ok.stop.max_walks : 0;
-        rc = run_query(&w, &q[k], k, &ok, json);
+        rc = run_query(&w, &q[k], k, &ok, json, &unmet);
+    }
+    if (!rc && unmet) {
+        int64_t asked = 0;
+        for (int64_t k = 0; k < nq; k++) asked += q[k].target > 0 || o->stop.rel_err > 0;
+        fprintf(stderr, "ulam: %s: %d of %lld relative-error targets NOT met (JSON: rel_err_met false): the walks "
+                        "stopped first (--walks, --time or the cap); exit %d\n", path, unmet, (long long)asked, EXIT_TARGET);
+        rc = EXIT_TARGET;
     }
     fflush(stdout);
     cli_release_sigint();

@@ -464,6 +464,7 @@ static int run(solve_args *a)
         if (r.interrupted) rc = EXIT_INTERRUPTED;
         else if (o->mode == ULAM_FORWARD && (a->out || a->errors) && cli_rank == 0)
             rc = write_vectors(sv, ro.n, a->out, a->errors, &r);
+        if (!rc && o->stop.rel_err > 0 && !r.rel_err_met) rc = EXIT_TARGET; /* printed "NOT met": say so */
     }
     cli_flush(); /* still caught: a second Ctrl-C ends a write blocked on a full pipe */
     if (left && !cli_share) { /* the reference solve's thread still reads the system: end here */

@@ -253,11 +253,25 @@ static int cut_covered(const args *a)
     return !a->matrix_walk && a->o.mode == ULAM_ADJOINT && a->o.estimator != ULAM_RAD_ABSORPTION;
 }
 
-/* Print the text report. */
+/* The answer of a patch's walks: its three channels, each with its interval. */
+static void patch_answer(FILE *f, const args *a, const report *r, const walked *w)
+{
+    for (int c = 0; c < 3; c++) {
+        fprintf(f, "radiosity %c  %.8g +- %.3g", chan[c], w->B[c], w->se[c]);
+        if (a->matrix_walk && r->ff_se_known) fprintf(f, " (walk %.3g, form factors %.3g)", w->se_walk[c], r->direct_se[c]);
+        else if (a->matrix_walk) fprintf(f, " (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
+        else if (isfinite(w->ci95[c][0])) fprintf(f, " (95%% CI %.8g .. %.8g)", w->ci95[c][0], w->ci95[c][1]);
+        else fprintf(f, " (no 95%% interval: no score range certified)");
+        fprintf(f, "%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
+    }
+}
+
+/* Print the text report: a patch's answer first, then the scene and the rest. */
 static void print_text(FILE *f, const ulam_rad_run *run)
 {
     const args *a = run->a;
     const report *r = &run->r;
+    if (r->w && r->patch >= 0) patch_answer(f, a, r, r->w);
     fprintf(f, "scene        %s: %lld faces, %lld patches\n", a->scene, (long long)r->faces, (long long)r->s->npatches);
     if (run->want)
         fprintf(f, "chosen       %lld of %lld patches (--patches %s)\n", (long long)run->nwant, (long long)r->s->npatches,
@@ -277,20 +291,12 @@ static void print_text(FILE *f, const ulam_rad_run *run)
                c[0], c[1], c[2]);
     }
     const walked *w = r->w;
-    if (w && w->cut) /* before the numbers: they are biased low */
+    if (w && w->cut) /* next to the numbers: they are biased low */
         fprintf(f, "warning      %lld of %lld walks cut at --max-steps %lld: the estimate is biased low (the light\n"
                "             beyond the cut is lost); %s (raise --max-steps)\n", (long long)w->cut, (long long)w->walks,
                (long long)a->o.stop.max_steps, cut_covered(a) ? "the interval includes the most the cut can miss"
                                                                : "the error bar does not cover the bias");
     if (w && r->patch >= 0) {
-        for (int c = 0; c < 3; c++) {
-            fprintf(f, "radiosity %c  %.8g +- %.3g", chan[c], w->B[c], w->se[c]);
-            if (a->matrix_walk && r->ff_se_known) fprintf(f, " (walk %.3g, form factors %.3g)", w->se_walk[c], r->direct_se[c]);
-            else if (a->matrix_walk) fprintf(f, " (walk noise only, CONDITIONAL on the sampled F: its noise is unknown)");
-            else if (isfinite(w->ci95[c][0])) fprintf(f, " (95%% CI %.8g .. %.8g)", w->ci95[c][0], w->ci95[c][1]);
-            else fprintf(f, " (no 95%% interval: no score range certified)");
-            fprintf(f, "%s\n", w->interrupted ? "  [INTERRUPTED]" : "");
-        }
         if (a->o.stop.rel_err > 0 && !a->matrix_walk && !w->zero)
             fprintf(f, "rel-err      %s (%g; the rule's range term wants %.3g walks)\n", w->rel_err_met ? "met" : "NOT met",
                    a->o.stop.rel_err, w->min_walks);
