@@ -4,10 +4,10 @@
  * a walk), while the LU's n^3 / 3 operations do not depend on alpha.
  *
  * Certified as the push is: p from the LU, the residual r = e_s - (I - M) p formed in floating
- * point with each entry's rounding bounded (ulam__push_rounding: d_i + 3 roundings of at most
- * DBL_EPSILON / 2 of |e_s,i| + (|M| |p|)_i + |p_i|), so x = p + (I - M)^-1 r exactly and every
+ * point with each entry's rounding bounded (src/bound.c's ulam__residual), so x = p + (I - M)^-1 r exactly and every
  * |x_i - p_i| <= ||r||_1 / (1 - ||M||_1), no walk needed. */
 #include "fpush_dense.h"
+#include "bound.h"
 
 #include <float.h>
 #include <math.h>
@@ -35,17 +35,12 @@ int ulam__fpush_dense(const ulam_csr *M, int64_t s, double alpha, double *x, dou
     if (!b) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the dense solve");
     b[s] = 1.0;
     int status = ulam_direct_solve(M, b, x, 0, NULL, err);
-    double sum = 0.0, round = 0.0;
-    for (int64_t i = 0; !status && i < n; i++) {
-        double r = b[i] - x[i], size = fabs(b[i]) + fabs(x[i]);
-        for (int64_t k = M->rowptr[i]; k < M->rowptr[i + 1]; k++) {
-            r += M->val[k] * x[M->colidx[k]];
-            size += fabs(M->val[k] * x[M->colidx[k]]);
-        }
-        sum += fabs(r);
-        round += ulam__push_rounding((double)(M->rowptr[i + 1] - M->rowptr[i]) + 3.0, size);
-    }
-    free(b);
+    double sum = 0.0, round = 0.0, *r = status ? NULL : ulam__malloc((size_t)n + 1, sizeof *r),
+           *e = status ? NULL : ulam__malloc((size_t)n + 1, sizeof *e);
+    if (!status && (!r || !e)) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the dense solve's residual");
+    if (!status && ulam__residual(M, b, x, r, e) < 0) status = ulam__fail(err, ULAM_ENONFINITE, 0, -1, "a finite dense solve");
+    for (int64_t i = 0; !status && i < n; i++) sum += fabs(r[i]), round += e[i];
+    free(b), free(r), free(e);
     if (status) return status;
     double sums = 1.0 + ulam__push_rounding(2.0 * (double)n + 4.0, 1.0); /* the two sums' and the quotient's roundings */
     *r_sum = sum;
