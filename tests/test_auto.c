@@ -308,6 +308,7 @@ static void test_table(void **state)
     assert_true(same_result(&r, &a.walks));
     ulam_solver_free(sv);
     free(b1);
+    ulam_csr_free(M);
     /* bidirectional chosen: randsub1000's x_7 for a 3-nonzero b at rel_err 0.02 (the CLI's case) */
     int64_t n;
     double *bs = must_read_vector("tests/data/sparse3_b.mtx", &n), *b2, *x2 = malloc(1000 * sizeof *x2);
