@@ -52,21 +52,41 @@ static double ratio_max(const double *p, const double *v, int64_t n)
     return top * (1.0 + 2.0 * DBL_EPSILON);
 }
 
-/* A certified range of the exact solution around x (see ulam.h). */
-int ulam_solution_bound(const ulam_csr *M, const double *b, const double *x, double *lo, double *hi, double *worst,
-                        ulam_error *err)
+/* The Collatz-Wielandt vector of the certified range: *u the row sums' bound when the rows of |M|
+ * sum below 1 (*h NULL: v = 1), else the expected lengths' certificate (src/spectral.c: h ~ (I -
+ * |M|)^-1 1, one product checks it) in a new *h; *u >= 1 when none holds; *products (may be NULL)
+ * gets the certificate's products.  ULAM_OK or ULAM_ENOMEM. */
+int ulam__bound_vector(const ulam_csr *M, double **h, double *u, int64_t *products)
 {
-    ulam__clear(err);
-    if (!M || !b || !x || !lo || !hi || !worst) return ulam__fail(err, ULAM_EINVAL, 0, -1, "M, b, x, lo, hi and worst");
-    if (M->nrows != M->ncols) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a square M");
+    int64_t n = M->nrows, spent = 0;
+    double kappa;
+    *h = NULL, *u = ulam__row_sum_max(M);
+    if (products) *products = 0;
+    if (*u < 1.0) return ULAM_OK;
+    char *seen = ulam__malloc((size_t)n + 1, 1);
+    *h = ulam__malloc((size_t)n + 1, sizeof **h);
+    if (!seen || !*h) return free(seen), free(*h), *h = NULL, ULAM_ENOMEM;
+    for (int64_t i = 0; i < n; i++) seen[i] = 1;
+    int64_t cap = 4 * (int64_t)sqrt((double)n) + 2000;
+    int status = ulam__length_certificate(M, seen, (int)cap, u, &kappa, &spent, *h);
+    free(seen);
+    if (products) *products = spent;
+    if (status == ULAM_ENOMEM) return free(*h), *h = NULL, ULAM_ENOMEM;
+    if (!(*u < 1.0)) free(*h), *h = NULL, *u = 1.0;
+    return ULAM_OK;
+}
+
+/* The certified range around x from the vector of ulam__bound_vector (h, u: u >= 1 certifies
+ * nothing: NaN ends, *worst INFINITY); 1 when certified, 0 when not, -1 when the residual is not
+ * finite, -2 without memory. */
+int ulam__bound_range(const ulam_csr *M, const double *b, const double *x, const double *h, double u, double *lo,
+                      double *hi, double *worst)
+{
     int64_t n = M->nrows;
-    for (int64_t i = 0; i < n; i++)
-        if (!isfinite(x[i]) || !isfinite(b[i])) return ulam__fail(err, ULAM_EINVAL, 0, i, "a finite x and b");
     double *pos = ulam__malloc((size_t)n + 1, sizeof *pos), *neg = ulam__malloc((size_t)n + 1, sizeof *neg);
-    double *h = NULL;
-    if (!pos || !neg) return free(pos), free(neg), ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for 2 x %lld doubles", (long long)n);
+    if (!pos || !neg) return free(pos), free(neg), -2;
     int nonneg = ulam__residual(M, b, x, pos, neg);
-    if (nonneg < 0) return free(pos), free(neg), ulam__fail(err, ULAM_EINVAL, 0, -1, "an x whose residual is finite");
+    if (nonneg < 0) return free(pos), free(neg), -1;
     for (int64_t i = 0; i < n; i++) { /* the exact residual's positive and negative parts, bounded above */
         double r = pos[i], e = neg[i];
         pos[i] = fmax(r + e, 0.0) * (1.0 + DBL_EPSILON), neg[i] = fmax(e - r, 0.0) * (1.0 + DBL_EPSILON);
@@ -74,21 +94,7 @@ int ulam_solution_bound(const ulam_csr *M, const double *b, const double *x, dou
     /* x* - x = sum_k M^k r.  A v > 0 with |M| v <= u v, u < 1, gives |M|^k |r| <= max_j (|r_j| / v_j) u^k v,
        so |x*_i - x_i| <= max_j (|r_j| / v_j) v_i / (1 - u); with M >= 0 the sum keeps r's signs (above
        by its positive part, below by its negative part).  v = 1 when the rows of |M| sum below 1, else the
-       expected lengths' certificate (src/spectral.c: h ~ (I - |M|)^-1 1, one product checks it). */
-    double rows = ulam__row_sum_max(M), u = rows;
-    if (!(u < 1.0)) {
-        char *seen = ulam__malloc((size_t)n + 1, 1);
-        h = ulam__malloc((size_t)n + 1, sizeof *h);
-        int64_t products = 0;
-        double kappa;
-        if (seen && h) {
-            for (int64_t i = 0; i < n; i++) seen[i] = 1;
-            int64_t cap = 4 * (int64_t)sqrt((double)n) + 2000;
-            if (ulam__length_certificate(M, seen, (int)cap, &u, &kappa, &products, h) == ULAM_ENOMEM) u = NAN;
-        } else u = NAN;
-        free(seen);
-        if (isnan(u)) return free(pos), free(neg), free(h), ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the certificate");
-    }
+       expected lengths' certificate (h). */
     int certified = u < 1.0;
     double k = (1.0 + 8.0 * DBL_EPSILON) / (1.0 - u);
     double above = certified ? ratio_max(pos, h, n) : INFINITY, below = certified ? ratio_max(neg, h, n) : INFINITY;
@@ -100,8 +106,28 @@ int ulam_solution_bound(const ulam_csr *M, const double *b, const double *x, dou
         hi[i] = certified ? x[i] + (above * v * k + slack) : NAN;
         *worst = certified ? fmax(*worst, 0.5 * (hi[i] - lo[i])) : INFINITY;
     }
-    free(pos), free(neg), free(h);
+    free(pos), free(neg);
+    return certified;
+}
+
+/* A certified range of the exact solution around x (see ulam.h). */
+int ulam_solution_bound(const ulam_csr *M, const double *b, const double *x, double *lo, double *hi, double *worst,
+                        ulam_error *err)
+{
+    ulam__clear(err);
+    if (!M || !b || !x || !lo || !hi || !worst) return ulam__fail(err, ULAM_EINVAL, 0, -1, "M, b, x, lo, hi and worst");
+    if (M->nrows != M->ncols) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a square M");
+    int64_t n = M->nrows;
+    for (int64_t i = 0; i < n; i++)
+        if (!isfinite(x[i]) || !isfinite(b[i])) return ulam__fail(err, ULAM_EINVAL, 0, i, "a finite x and b");
+    double *h = NULL, u;
+    if (ulam__bound_vector(M, &h, &u, NULL)) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the certificate");
+    int certified = ulam__bound_range(M, b, x, h, u, lo, hi, worst);
+    free(h);
+    if (certified == -2) return ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for 2 x %lld doubles", (long long)n);
+    if (certified < 0) return ulam__fail(err, ULAM_EINVAL, 0, -1, "an x whose residual is finite");
     return certified ? ULAM_OK
                      : ulam__fail(err, ULAM_EDIVERGE, 0, -1, "a Collatz-Wielandt vector certifying rho(|M|) below 1 (the rows "
-                                  "of |M| sum to %.6g at most, and the expected lengths' certificate did not hold)", rows);
+                                  "of |M| sum to %.6g at most, and the expected lengths' certificate did not hold)",
+                                  ulam__row_sum_max(M));
 }

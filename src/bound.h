@@ -14,4 +14,14 @@ int ulam__residual(const ulam_csr *M, const double *b, const double *x, double *
 /* The largest row sum of |M|, rounded up. */
 double ulam__row_sum_max(const ulam_csr *M);
 
+/* The Collatz-Wielandt vector of the certified range (v = 1: *h NULL, or the expected lengths'
+ * certificate in a new *h) and its factor *u (>= 1: none holds); *products (may be NULL) the
+ * certificate's.  ULAM_OK or ULAM_ENOMEM. */
+int ulam__bound_vector(const ulam_csr *M, double **h, double *u, int64_t *products);
+
+/* The certified range [lo, hi] around x and its largest half-width *worst from that vector; 1
+ * certified, 0 not (NaN ends, INFINITY), -1 a non-finite residual, -2 no memory. */
+int ulam__bound_range(const ulam_csr *M, const double *b, const double *x, const double *h, double u, double *lo,
+                      double *hi, double *worst);
+
 #endif

@@ -62,7 +62,7 @@ CASES += [
     (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--bogus"], 2, r"unknown option '--bogus'", ""),
     (["info"], 2, r"exactly one matrix", ""),
     (["frobnicate"], 2, r"unknown command 'frobnicate'", ""),
-    # issue 42 pt 5: every --check names its reference (GMRES past 4 GiB) and comes after the answer
+    # issue 42 pt 5: every --check names its reference (CG or GMRES(50) past 4 GiB) and comes after the answer
     (["solve", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--jacobi", "--method", "gmres", "--check"], 0, r"^$",
      r"outcome +converged(.|\n)*\ndirect +relative error \|\|x - x_direct\|\|_2 .* \(dense LU, [\d.]+ s\)\n\Z"),
     (["sovle"], 2, r"unknown command 'sovle' \(did you mean 'solve'\?\)", ""),  # issue 42 pt 6

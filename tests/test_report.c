@@ -176,15 +176,86 @@ static void test_reference(void **state)
     assert_int_equal(ulam_reference_plan(M, 1, 0, &plan, &err), ULAM_OK);
     assert_true(plan.sparse && isnan(plan.bytes));
     assert_int_equal(ulam_reference_plan(M, 1, 0, NULL, &err), ULAM_EINVAL);
-    assert_int_equal(ulam_reference_solve(M, b, -1, (size_t)1 << 30, 1, x, &info, &how, &err), ULAM_OK);
+    ulam_reference_goal goal = {.index = -1}; /* every component, as narrow as it gets */
+    assert_int_equal(ulam_reference_solve(M, b, -1, (size_t)1 << 30, &goal, x, &info, &how, &err), ULAM_OK);
     assert_string_equal(how, "dense LU");
     for (int i = 0; i < 2; i++) assert_true(fabs(x[i] - want[i]) < 1e-14);
-    assert_int_equal(ulam_reference_solve(M, b, 0, 16, 0, x, &info, &how, &err), ULAM_EMEMLIMIT);
-    assert_int_equal(ulam_reference_solve(M, b, 0, 16, 1, x, &info, &how, &err), ULAM_OK);
-    assert_string_equal(how, "GMRES");
+    assert_int_equal(ulam_reference_solve(M, b, 0, 16, NULL, x, &info, &how, &err), ULAM_EMEMLIMIT);
+    assert_int_equal(ulam_reference_solve(M, b, 0, 16, &goal, x, &info, &how, &err), ULAM_OK);
+    assert_string_equal(how, "GMRES(50)"); /* M is not symmetric */
+    assert_true(!goal.cg && goal.met && goal.certified && goal.reached < 1e-12 && goal.products >= 2);
     for (int i = 0; i < 2; i++) assert_true(fabs(x[i] - want[i]) < 1e-11);
     assert_true(info.residual <= 1e-12);
-    assert_int_equal(ulam_reference_solve(NULL, b, 0, 16, 1, x, &info, &how, &err), ULAM_EINVAL);
+    assert_true(plan.cg == 0 && plan.products >= 1000);
+    assert_int_equal(ulam_reference_solve(NULL, b, 0, 16, &goal, x, &info, &how, &err), ULAM_EINVAL);
+    ulam_csr_free(M);
+}
+
+/* M of the g x g five-point Poisson grid's Jacobi splitting (M = (4I - A) / 4, rho(M) = cos(pi / (g + 1))). */
+static ulam_csr *poisson_jacobi(int g)
+{
+    int64_t n = (int64_t)g * g, k = 0;
+    int32_t *ti = malloc(4 * (size_t)n * sizeof *ti), *tj = malloc(4 * (size_t)n * sizeof *tj);
+    double *tx = malloc(4 * (size_t)n * sizeof *tx);
+    for (int y = 0; y < g; y++)
+        for (int x = 0; x < g; x++) {
+            int i = y * g + x, nb[4] = {x > 0 ? i - 1 : -1, x < g - 1 ? i + 1 : -1, y > 0 ? i - g : -1, y < g - 1 ? i + g : -1};
+            for (int q = 0; q < 4; q++)
+                if (nb[q] >= 0) ti[k] = i, tj[k] = nb[q], tx[k++] = 0.25;
+        }
+    ulam_csr *M = NULL;
+    assert_int_equal(ulam_csr_from_triplets(n, n, k, ti, tj, tx, &M), ULAM_OK);
+    free(ti), free(tj), free(tx);
+    return M;
+}
+
+/* Past the LU's memory limit on a symmetric M (a 120 x 120 Poisson grid, kappa(I - M) about 5900):
+ * CG, refined until x[c]'s certified range is within the goal, that range holding a CG solution
+ * to 1e-10; a cap it cannot meet says so (ENOCONV, capped, the range it reached still certified);
+ * a goal below the rounding stops at the floor, not at the cap.  The old fallback ran GMRES(50)
+ * to a fixed 1e-12 with 10^7 iterations of cap (12 min and more on the 500 x 500 grid). */
+static void test_reference_iterative(void **state)
+{
+    (void)state;
+    int g = 120;
+    int64_t n = (int64_t)g * g, c = (int64_t)(g / 2) * g + g / 2;
+    ulam_csr *M = poisson_jacobi(g);
+    double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x), *xc = malloc((size_t)n * sizeof *xc);
+    for (int64_t i = 0; i < n; i++) b[i] = 0.25;
+    int it;
+    double res;
+    ulam_cg(M, b, 1e-10, 100000, xc, &it, &res); /* a close solution beside the certified range */
+    ulam_direct_info info;
+    ulam_error err;
+    const char *how = NULL;
+    ulam_reference_info plan;
+    assert_int_equal(ulam_reference_plan(M, 0, 0, &plan, &err), ULAM_OK);
+    assert_true(plan.cg == 1 && plan.products == (int64_t)(4e10 / (double)(M->rowptr[n] + 10 * n)));
+    ulam_reference_goal goal = {.index = c, .half_width = 1e-6 * xc[c]};
+    assert_int_equal(ulam_reference_solve(M, b, 0, 16, &goal, x, &info, &how, &err), ULAM_OK);
+    assert_string_equal(how, "CG");
+    assert_true(goal.cg && goal.met && goal.certified && !goal.capped && goal.products <= goal.cap);
+    assert_true(goal.cap == plan.products && goal.rounds >= 1 && goal.certificate > 0);
+    assert_true(goal.reached <= goal.half_width && goal.lo <= x[c] && x[c] <= goal.hi);
+    assert_true(goal.lo - 1e-9 * xc[c] <= xc[c] && xc[c] <= goal.hi + 1e-9 * xc[c]);
+    assert_true(info.residual < 1e-6 && info.seconds >= 0);
+    int64_t enough = goal.products;
+    ulam_reference_goal capped = {.index = c, .half_width = 1e-6 * xc[c], .max_products = 20};
+    assert_int_equal(ulam_reference_solve(M, b, 0, 16, &capped, x, &info, &how, &err), ULAM_ENOCONV);
+    assert_true(capped.capped && !capped.met && capped.certified && capped.products == 20 && capped.cap == 20);
+    assert_true(capped.reached > capped.half_width && isfinite(capped.reached));
+    assert_true(capped.lo <= xc[c] && xc[c] <= capped.hi);
+    assert_non_null(strstr(err.msg, "cap of 20 products"));
+    ulam_reference_goal tiny = {.index = c, .half_width = 1e-300};
+    assert_int_equal(ulam_reference_solve(M, b, 0, 16, &tiny, x, &info, &how, &err), ULAM_ENOCONV);
+    assert_true(!tiny.capped && !tiny.met && tiny.certified && tiny.products < tiny.cap);
+    assert_true(tiny.reached < goal.reached && tiny.products >= enough);
+    assert_non_null(strstr(err.msg, "rounding's floor"));
+    ulam_reference_goal all = {.index = -1}; /* every component, as narrow as it gets */
+    assert_int_equal(ulam_reference_solve(M, b, 0, 16, &all, x, &info, &how, &err), ULAM_OK);
+    assert_true(all.met && isnan(all.lo) && all.reached < 1e-6 * xc[c]);
+    for (int64_t i = 0; i < n; i++) assert_true(fabs(x[i] - xc[i]) <= all.reached + 1e-9 * xc[c]);
+    free(b), free(x), free(xc);
     ulam_csr_free(M);
 }
 
@@ -447,6 +518,7 @@ int main(void)
         cmocka_unit_test(test_choice),
         cmocka_unit_test(test_bidir),
         cmocka_unit_test(test_reference),
+        cmocka_unit_test(test_reference_iterative),
         cmocka_unit_test(test_kinds),
         cmocka_unit_test(test_walk_report),
         cmocka_unit_test(test_query_run),

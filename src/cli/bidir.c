@@ -114,7 +114,8 @@ static int answer(const cli_system *s, const ulam_bidir_opts *o, ulam_bidir_resu
         cli_flush();
     }
     if (check) {
-        rc = cli_direct_check(s, s->index - 1, &p->direct, &p->direct_seconds, &p->direct_method);
+        double hw = 0.5 * (r->ci95[1] - r->ci95[0]) / (rp->scale > 0 ? rp->scale : 1.0); /* of x, as the reference */
+        rc = cli_direct_check(s, s->index - 1, hw, &p->direct, &p->direct_seconds, &p->direct_method);
         p->direct *= rp->scale > 0 ? rp->scale : 1.0;
         p->check = !rc;
     }
@@ -223,7 +224,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     int crc = 0; /* --check's: a failed or interrupted reference still prints the table, without it */
     double dsec = 0.0;
     const char *dm = NULL;
-    if (!rc && check && cli_rank == 0) crc = cli_direct_reference(s, &xd, &dsec, &dm);
+    if (!rc && check && cli_rank == 0) crc = cli_direct_reference(s, -1, 0.0, &xd, &dsec, &dm);
     int64_t shown = 0; /* the top rows without the virtual state, scaled to pi */
     for (int64_t k = 0; !rc && k < want && shown < top; k++)
         if (order[k] < n) {

@@ -151,13 +151,18 @@ void cli_system_free(cli_system *s);
  * sets cli_direct_force: -1 auto, 0 dense, 1 sparse. */
 extern int cli_direct_force;
 
-/* x_index of the reference solve for --check, interruptible by Ctrl-C (EXIT_INTERRUPTED: its thread
- * still reads s); *method "sparse LU" or "dense LU"; 0 or an exit code. */
-int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method);
+/* x_index (from 0) of the reference solve for --check, interruptible by Ctrl-C (EXIT_INTERRUPTED:
+ * its thread still reads s); half_width is the walks' interval's: past the LU's memory limit the
+ * iterative reference stops once x_index's certified range is within a thousandth of it (<= 0 or
+ * NaN: as narrow as it gets).  *method "sparse LU", "dense LU" or what the iterative one reached;
+ * 0 or an exit code. */
+int cli_direct_check(const cli_system *s, int64_t index, double half_width, double *value, double *seconds,
+                     const char **method);
 
-/* The whole reference solve for --check into a new *x (as cli_direct_check: GMRES past the memory
- * limit, interruptible); 0 or an exit code. */
-int cli_direct_reference(const cli_system *s, double **x, double *seconds, const char **method);
+/* The whole reference solve for --check into a new *x (as cli_direct_check; index -1: every
+ * component judged, the widest range), interruptible; 0 or an exit code. */
+int cli_direct_reference(const cli_system *s, int64_t index, double half_width, double **x, double *seconds,
+                         const char **method);
 
 /* Solve the loaded system (sparse or dense LU) into a new *x; 0 or an exit code (error reported). */
 int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direct_info *info);

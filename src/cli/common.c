@@ -584,7 +584,7 @@ int cli_direct_solve(const cli_system *s, size_t max_mem, double **x, ulam_direc
 {
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
     *x = malloc((size_t)s->M->nrows * sizeof **x);
-    int status = !*x ? ULAM_ENOMEM : ulam_reference_solve(s->M, s->b, cli_direct_force, max_mem, 0, *x, info, NULL, &err);
+    int status = !*x ? ULAM_ENOMEM : ulam_reference_solve(s->M, s->b, cli_direct_force, max_mem, NULL, *x, info, NULL, &err);
     if (!status) return 0;
     free(*x);
     *x = NULL;

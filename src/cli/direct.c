@@ -6,13 +6,26 @@
 #include <pthread.h>
 #include <stdatomic.h>
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+/* The iterative reference's plan in words (past the LU's memory limit): which solver, to what, its cap. */
+static void iterative_words(char *buf, size_t size, const ulam_reference_info *p, int64_t index, double half_width)
+{
+    char what[160];
+    if (index >= 0 && half_width > 0)
+        snprintf(what, sizeof what, "until x[%lld]'s certified range is within +-%.3g (a thousandth of the walks' "
+                 "half-width)", (long long)(index + cli_node_base), half_width); /* x: PageRank's too (pi scaled) */
+    else snprintf(what, sizeof what, "until its certified range no longer narrows");
+    snprintf(buf, size, "%s %s, at most %lld products", p->cg ? "CG (M symmetric)" : "GMRES(50)", what,
+             (long long)p->products);
+}
+
 /* Before a reference solve that may take long: what it needs, on stderr (nothing when it is quick). */
-static void announce(const cli_system *s, int sparse)
+static void announce(const cli_system *s, int sparse, int64_t index, double half_width)
 {
     int64_t n = s->M->nrows, nnz = s->M->rowptr[n];
     double flops = 2.0 / 3.0 * (double)n * (double)n * (double)n, gib = (double)ulam_direct_bytes(n) / 1073741824.0;
@@ -20,11 +33,19 @@ static void announce(const cli_system *s, int sparse)
     ulam_error err;
     int est = !ulam_reference_plan(s->M, sparse, sparse && nnz + n > 200000, &p, &err);
     double bytes = p.bytes, lu_flops = p.flops;
-    if (sparse && nnz + n > 200000 && est)
+    char it[400];
+    iterative_words(it, sizeof it, &p, index, half_width);
+    if (sparse && nnz + n > 200000 && est && bytes > (double)CLI_MAX_MEM)
+        fprintf(stderr, "ulam: --check: sparse LU (UMFPACK) of n = %lld, %lld nonzeros: at most %.3g GiB (UMFPACK's "
+                        "bound), over 4 GiB, so %s instead; Ctrl-C keeps the estimate\n",
+                (long long)n, (long long)nnz, bytes / 1073741824.0, it);
+    else if (sparse && nnz + n > 200000 && est)
         fprintf(stderr, "ulam: --check: sparse LU (UMFPACK) of n = %lld, %lld nonzeros: at most %.3g GiB and %.2g flops "
-                        "(UMFPACK's bounds; at most about %.0f s at 10 Gflop/s)%s; Ctrl-C keeps the estimate\n",
-                (long long)n, (long long)nnz, bytes / 1073741824.0, lu_flops, lu_flops / 1e10,
-                bytes > (double)CLI_MAX_MEM ? ": over 4 GiB, so GMRES to a 1e-12 residual instead" : "");
+                        "(UMFPACK's bounds; at most about %.0f s at 10 Gflop/s); Ctrl-C keeps the estimate\n",
+                (long long)n, (long long)nnz, bytes / 1073741824.0, lu_flops, lu_flops / 1e10);
+    else if (!sparse && !(gib * 1073741824.0 <= (double)CLI_MAX_MEM))
+        fprintf(stderr, "ulam: --check: dense LU (LAPACK) of n = %lld: %.3g GiB, over 4 GiB%s, so %s instead; Ctrl-C "
+                        "keeps the estimate\n", (long long)n, gib, p.umfpack ? "" : " (this ulam has no UMFPACK for a sparse LU)", it);
     else if (!sparse && flops > 2e10)
         fprintf(stderr, "ulam: --check: dense LU (LAPACK) of n = %lld: %.3g GiB and 2/3 n^3 = %.2g flops (about %.0f s "
                         "at 10 Gflop/s)%s; Ctrl-C keeps the estimate\n", (long long)n, gib, flops, flops / 1e10,
@@ -35,14 +56,15 @@ static void announce(const cli_system *s, int sparse)
 typedef struct {
     const cli_system *s;
     int sparse;   /* sparse LU first (else dense) */
-    int krylov;   /* the LU would pass the memory limit: GMRES to a 1e-12 residual instead */
+    int krylov;   /* the LU would pass the memory limit: CG or GMRES(50) to the goal instead */
+    ulam_reference_goal goal;
     double *x;
     ulam_direct_info info;
     int rc;
     atomic_int done;
 } check_job;
 
-/* Run the job (thread body): the LU, or GMRES when the LU's memory passes the limit. */
+/* Run the job (thread body): the LU, or CG / GMRES(50) when the LU's memory passes the limit. */
 static void *check_run(void *p)
 {
     check_job *j = p;
@@ -50,27 +72,52 @@ static void *check_run(void *p)
     ulam_error err = {.status = ULAM_ENOMEM, .msg = "memory for the solution"};
     int status = ULAM_ENOMEM;
     const char *how = "";
-    if ((j->x = malloc((size_t)M->nrows * sizeof *j->x))) /* GMRES when the LU would pass the limit */
-        status = ulam_reference_solve(M, j->s->b, cli_direct_force, CLI_MAX_MEM, 1, j->x, &j->info, &how, &err);
-    j->krylov = !strcmp(how, "GMRES");
+    if ((j->x = malloc((size_t)M->nrows * sizeof *j->x))) /* CG or GMRES when the LU would pass the limit */
+        status = ulam_reference_solve(M, j->s->b, cli_direct_force, CLI_MAX_MEM, &j->goal, j->x, &j->info, &how, &err);
+    j->krylov = !strcmp(how, "CG") || !strcmp(how, "GMRES(50)");
+    if (j->krylov && status == ULAM_ENOCONV && j->goal.certified) { /* the range it reached is said, not hidden */
+        fprintf(stderr, "ulam: %s: warning: --check: %s\n", j->s->matrix_path, err.msg);
+        status = ULAM_OK;
+    }
     j->rc = status ? cli_report(j->s->matrix_path, &err) : 0;
     atomic_store(&j->done, 1);
     return NULL;
 }
 
+/* What the iterative reference reached, for --check's line (one check a process: a static buffer). */
+static const char *iterative_method(const check_job *j)
+{
+    static char buf[400];
+    const ulam_reference_goal *g = &j->goal;
+    const char *name = g->cg ? "CG" : "GMRES(50)";
+    if (g->met && g->half_width > 0)
+        snprintf(buf, sizeof buf, "%s to a certified range of +-%.3g, wanted +-%.3g, %lld products; the LU would "
+                 "pass 4 GiB", name, g->reached, g->half_width, (long long)g->products);
+    else if (g->met)
+        snprintf(buf, sizeof buf, "%s to a certified range of +-%.3g, as narrow as it got, %lld products; the LU "
+                 "would pass 4 GiB", name, g->reached, (long long)g->products);
+    else
+        snprintf(buf, sizeof buf, "%s %s: certified only to +-%.3g, NOT the +-%.3g wanted; the LU would pass 4 GiB",
+                 name, g->capped ? "stopped at its cap of products" : "stopped at the rounding's floor", g->reached,
+                 g->half_width);
+    return buf;
+}
+
 /* The reference solve of s for --check into a new *x (all of it), *method "sparse LU", "dense LU"
- * or "GMRES" (when the LU would pass the memory limit); the needs announced first when large; 0,
- * an exit code (reported), or EXIT_INTERRUPTED on Ctrl-C (cli_interrupted) while the solve still
- * runs in its thread (s must then stay loaded until exit). */
-int cli_direct_reference(const cli_system *s, double **x, double *seconds, const char **method)
+ * or what CG / GMRES(50) reached (when the LU would pass the memory limit); the needs announced
+ * first when large; 0, an exit code (reported), or EXIT_INTERRUPTED on Ctrl-C (cli_interrupted)
+ * while the solve still runs in its thread (s must then stay loaded until exit). */
+int cli_direct_reference(const cli_system *s, int64_t index, double half_width, double **x, double *seconds,
+                         const char **method)
 {
     *x = NULL;
     check_job *j = calloc(1, sizeof *j);
     if (!j) return cli_exit_code(ULAM_ENOMEM);
     ulam_reference_info p;
     ulam_reference_plan(s->M, cli_direct_force, 0, &p, NULL);
-    j->s = s, j->sparse = p.sparse;
-    announce(s, j->sparse);
+    double want = isfinite(half_width) && half_width > 0 ? 1e-3 * half_width : 0.0; /* enough to judge the walks */
+    j->s = s, j->sparse = p.sparse, j->goal = (ulam_reference_goal){.index = index, .half_width = want};
+    announce(s, j->sparse, index, want);
     pthread_t t;
     if (pthread_create(&t, NULL, check_run, j)) {
         check_run(j);
@@ -83,7 +130,7 @@ int cli_direct_reference(const cli_system *s, double **x, double *seconds, const
         }
         pthread_join(t, NULL);
     }
-    *method = j->krylov ? "GMRES to residual 1e-12: the LU would pass 4 GiB" : j->sparse ? "sparse LU" : "dense LU";
+    *method = j->krylov ? iterative_method(j) : j->sparse ? "sparse LU" : "dense LU";
     int rc = j->rc;
     if (!rc) *x = j->x, *seconds = j->info.seconds;
     else free(j->x);
@@ -92,10 +139,11 @@ int cli_direct_reference(const cli_system *s, double **x, double *seconds, const
 }
 
 /* x_index of the reference solve of s for --check (cli_direct_reference). */
-int cli_direct_check(const cli_system *s, int64_t index, double *value, double *seconds, const char **method)
+int cli_direct_check(const cli_system *s, int64_t index, double half_width, double *value, double *seconds,
+                     const char **method)
 {
     double *x;
-    int rc = cli_direct_reference(s, &x, seconds, method);
+    int rc = cli_direct_reference(s, index, half_width, &x, seconds, method);
     if (!rc) *value = x[index];
     free(x);
     return rc;

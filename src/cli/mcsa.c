@@ -26,7 +26,7 @@ typedef struct {
     double err_direct, direct_seconds, seconds;
     const double *lo, *hi; /* each x_i's certified range (NULL: none) */
     double worst;
-    const char *direct_method; /* --check's reference: "dense LU", "sparse LU" or GMRES */
+    const char *direct_method; /* --check's reference: "dense LU", "sparse LU" or what CG / GMRES(50) reached */
     ulam_guard g;
     ulam_error why; /* the library's sentence on how the run ended */
     int rejected;   /* corrections rejected and redone with more histories */
@@ -76,13 +76,13 @@ static void print_report(const report *p)
     ulam_outer_report_fprint(stdout, &r, p->json ? ULAM_REPORT_JSON : cli_verbosity < 0 ? ULAM_REPORT_QUIET : ULAM_REPORT_BRIEF);
 }
 
-/* The relative 2-norm error of x against the reference solve (cli_direct_reference: LU, or GMRES
- * past the memory limit; interruptible); 0 or an exit code. */
+/* The relative 2-norm error of x against the reference solve (cli_direct_reference: LU, or CG /
+ * GMRES(50) past the memory limit, as narrow as it gets; interruptible); 0 or an exit code. */
 static int direct_error(const cli_system *s, const double *x, report *p)
 {
     double *xd, num = 0, den = 0, seconds = 0.0;
     const char *method = NULL;
-    int rc = cli_direct_reference(s, &xd, &seconds, &method);
+    int rc = cli_direct_reference(s, -1, 0.0, &xd, &seconds, &method);
     if (rc) return rc;
     for (int64_t i = 0; i < s->M->nrows; i++) num += (x[i] - xd[i]) * (x[i] - xd[i]), den += xd[i] * xd[i];
     p->err_direct = den > 0 ? sqrt(num / den) : sqrt(num);
@@ -293,7 +293,7 @@ static int start_run(void *q, int argc, char **argv, int optind)
         print_failure(&p);
         rc = cli_exit_code(p.status);
     } else if (!rc) {
-        int want = p.check && cli_rank == 0, crc = 0; /* the answer first, then --check (its GMRES past 4 GiB) */
+        int want = p.check && cli_rank == 0, crc = 0; /* the answer first, then --check (its CG or GMRES past 4 GiB) */
         p.check = 0;
         if (!p.json && cli_rank == 0) print_report(&p), cli_flush(); /* a failed write of --out below cannot lose it */
         if (want) crc = direct_error(&s, x, &p);

@@ -25,10 +25,10 @@ typedef struct {
 
 /* The reference value of x_index for --check (sparse or dense LU, src/cli/direct.c), interruptible:
  * 0, EXIT_INTERRUPTED (the solve still runs: the caller must leave s alone) or an exit code. */
-static int direct_check(const cli_system *s, int64_t index, report_opts *ro)
+static int direct_check(const cli_system *s, int64_t index, const ulam_walk_result *r, report_opts *ro)
 {
     double value = NAN, seconds = NAN;
-    int rc = cli_direct_check(s, index, &value, &seconds, &ro->direct_method);
+    int rc = cli_direct_check(s, index, 0.5 * (r->ci95[1] - r->ci95[0]), &value, &seconds, &ro->direct_method);
     ro->direct = value, ro->direct_seconds = seconds;
     return rc;
 }
@@ -443,7 +443,7 @@ static int run(solve_args *a)
         cli_flush(); /* the estimate first: a check may take long, a failed write of the files below cannot lose it, and Ctrl-C keeps what is printed */
         if (ro.check && !r.interrupted && cli_rank == 0) {
             rc = cli_system_verify(&a->s);
-            rc = rc ? rc : direct_check(s, o->query.index, &ro);
+            rc = rc ? rc : direct_check(s, o->query.index, &r, &ro);
             left = rc == EXIT_INTERRUPTED;
             w = walk_report(o, &r, &ro);
             if (!ro.json && !rc) ulam_report_fprint(stdout, ULAM_REPORT_WALK, &w, ULAM_REPORT_CHECK);
