@@ -248,6 +248,9 @@ typedef struct ulam_dist_answer {
     double worst;              /* MCSA, single source, forward with bound: the largest certified half-width */
     int iterations;            /* MCSA: iterations; single source: the push's products with M */
     double residual;           /* MCSA: max |r| / max |b| at the end; single source: max |r| left to the walks */
+    int terminal;              /* single source: 1 when the walks scored only where they end (M >= 0, column
+                                  sums of M below 1): each top entry's interval is then the overlap of the
+                                  certified range and its end count's 95% interval; 0: collision walks */
 } ulam_dist_answer;
 
 /* Run ask on the part (every rank of comm together): the variance guard (ulam_dist_radius), then
