@@ -144,13 +144,13 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
     return ulam__dist_source(p, comm, source, o, tol, max_rounds, 0, x, se, NULL, NULL, NULL, info, &walks, err);
 }
 
-/* Whether terminal walks apply to the part (M >= 0 and every column sum of M below 1, over every
- * rank): then each walk scores 0 or one value at each row.  -1 on a failed exchange. */
-static int ends_apply(const ulam_part *p, const ulam_comm *c)
+/* Whether terminal walks from r apply to the part (M >= 0, r >= 0 and every column sum of M below
+ * 1, over every rank): then each walk scores 0 or one value at each row.  -1 on a failed exchange. */
+static int ends_apply(const ulam_part *p, const ulam_comm *c, const double *r)
 {
     double cmax = 0.0, neg = 0.0;
     for (int64_t i = 0; i < p->last - p->first; i++) {
-        cmax = fmax(cmax, p->t.rowsum[i]);
+        cmax = fmax(cmax, p->t.rowsum[i]), neg = r[i] < 0 ? 1.0 : neg;
         for (int64_t q = p->t.rowptr[i]; q < p->t.rowptr[i + 1]; q++) neg = p->t.val[q] < 0 ? 1.0 : neg;
     }
     if (ulam__dist_largest(c, &cmax) || ulam__dist_largest(c, &neg)) return -1;
@@ -170,7 +170,8 @@ static void ends_interval(double p, double y, double h, int64_t N, double mass, 
     *lo = p + R * a2, *hi = p + R * b;
 }
 
-/* As ulam_dist_source, the walks' counts (bytes and rounds too) into *walks; lo and hi (or NULL)
+/* As ulam_dist_source (source -1: from the system's b, max_rounds 0 for no push), the walks' counts
+ * (bytes and rounds too) into *walks; lo and hi (or NULL)
  * each x_i's 95% interval from terminal walks where they apply (ends_apply; K the components
  * a top table lists; *terminal, when given, 1 then), else -INFINITY and INFINITY. */
 int ulam__dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
@@ -182,7 +183,8 @@ int ulam__dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source,
     if (!p || !comm || !x || !se || !info || !(tol >= 0) || max_rounds < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, se, info, tol >= 0 and max_rounds >= 0");
     if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
-    if (source < 0 || source >= p->n) return ulam__fail(err, ULAM_EINVAL, 0, source, "a source in 1 .. %lld", (long long)p->n);
+    if (source < -1 || source >= p->n) return ulam__fail(err, ULAM_EINVAL, 0, source, "a source in 1 .. %lld", (long long)p->n);
+    if (source < 0 && !p->b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
     *info = (ulam_dist_source_info){0};
     int64_t rows = p->last - p->first;
     double *gv = NULL, *r = calloc((size_t)rows + 1, sizeof *r), *y = malloc(((size_t)rows + 1) * sizeof *y), mass = 0.0;
@@ -190,11 +192,13 @@ int ulam__dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source,
     ulam__halo h0 = {0};
     int status = halo_open(p, comm, &h0, &gv) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the halo and an exchange that succeeds")
                  : r && y && (h || !lo || !hi) ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push's vectors");
-    int ends = status ? 0 : h ? ends_apply(p, comm) : 0;
-    if (ends < 0) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
     memset(x, 0, (size_t)rows * sizeof *x);
     if (!status && source >= p->first && source < p->last) r[source - p->first] = 1.0;
+    if (!status && source < 0) memcpy(r, p->b, (size_t)rows * sizeof *r);
     double rmax = 1.0;
+    if (!status && source < 0 && largest_abs(p, comm, r, &rmax)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
+    int ends = status ? 0 : h ? ends_apply(p, comm, r) : 0;
+    if (ends < 0) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
     for (int k = 0; !status && k < max_rounds && rmax > tol; k++) { /* x += r, r <- M r */
         for (int64_t i = 0; i < rows; i++) x[i] += r[i];
         memcpy(y, r, (size_t)rows * sizeof *y);

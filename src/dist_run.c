@@ -72,7 +72,7 @@ static int walks(const ulam_part *p, const ulam_comm *c, const ulam_dist_ask *a,
     int64_t rows = p->last - p->first, in_set0 = c->sets <= 1 || c->rank < c->nranks / c->sets; /* set 0's ranks hold x */
     ulam_dist_mcsa_info mi = {0};
     ulam_dist_source_info si = {0};
-    double *sl = NULL, *sh = NULL; /* single source: the walks' 95% intervals */
+    double *sl = NULL, *sh = NULL; /* single source, forward's top table: the walks' 95% intervals */
     int status;
     if (a->mode == ULAM_DIST_ADJOINT) {
         status = ulam_dist_adjoint_ci(p, c, a->index, a->nq, &a->o, a->rel_err, ans->res, ans->ci, err);
@@ -80,15 +80,17 @@ static int walks(const ulam_part *p, const ulam_comm *c, const ulam_dist_ask *a,
         return status;
     }
     if (a->mode == ULAM_DIST_MCSA) status = ulam__dist_mcsa(p, c, &a->o, a->tol, a->max_iter, ans->x, &mi, &ans->r, err);
-    else if (a->mode == ULAM_DIST_SOURCE)
+    else if (a->mode == ULAM_DIST_SOURCE || (a->mode == ULAM_DIST_FORWARD && !a->index && ans->tops)) /* forward's top
+                                                                     table: walks from b, no push (source -1) */
         status = (sl = malloc(((size_t)rows + 1) * sizeof *sl)) && (sh = malloc(((size_t)rows + 1) * sizeof *sh))
-                     ? ulam__dist_source(p, c, a->source, &a->o, 1e-4, 1000, a->top, ans->x, ans->se, sl, sh, &ans->terminal, &si,
-                                         &ans->r, err)
+                     ? ulam__dist_source(p, c, a->mode == ULAM_DIST_SOURCE ? a->source : -1, &a->o, 1e-4,
+                                         a->mode == ULAM_DIST_SOURCE ? 1000 : 0, a->top, ans->x, ans->se, sl, sh,
+                                         &ans->terminal, &si, &ans->r, err)
                      : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the intervals");
     else status = ulam__dist_forward_ci(p, c, &a->o, a->index ? a->index[0] : -1, ans->x, ans->se, &ans->r,
                                         a->index ? ans->ci : NULL, err);
-    ans->iterations = a->mode == ULAM_DIST_MCSA ? mi.iterations : si.rounds;
-    ans->residual = a->mode == ULAM_DIST_MCSA ? mi.residual : si.residual;
+    ans->iterations = a->mode == ULAM_DIST_MCSA ? mi.iterations : a->mode == ULAM_DIST_SOURCE ? si.rounds : 0;
+    ans->residual = a->mode == ULAM_DIST_MCSA ? mi.residual : a->mode == ULAM_DIST_SOURCE ? si.residual : 0.0;
     if (!status && (a->mode != ULAM_DIST_FORWARD || a->bound))
         status = bound(p, c, a->mode == ULAM_DIST_SOURCE ? a->source : -1, ans->x, lo, hi, &ans->worst, err);
     else for (int64_t i = 0; i < rows; i++) lo[i] = -INFINITY, hi[i] = INFINITY; /* forward: no range */

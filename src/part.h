@@ -133,7 +133,7 @@ int ulam__dist_forward_ends(const ulam_part *p, const ulam_comm *comm, const ula
 int ulam__dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
                     double *x, ulam_dist_mcsa_info *info, ulam_dist_result *all, ulam_error *err);
 
-/* ulam_dist_source with its walks' counts in *walks and, lo and hi given, each x_i's 95% interval
+/* ulam_dist_source (source -1: from the system's b) with its walks' counts in *walks and, lo and hi given, each x_i's 95% interval
  * where terminal walks apply (M >= 0, column sums of M below 1; the lower ends for K components
  * chosen by estimate; *terminal 1 then), else -INFINITY .. INFINITY (src/dist_outer.c). */
 int ulam__dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
