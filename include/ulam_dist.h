@@ -239,7 +239,8 @@ typedef struct ulam_dist_answer {
     ulam_dist_result *res;     /* adjoint: nq of them */
     ulam_dist_ci *ci;          /* adjoint: nq of them; forward with an index: one */
     ulam_dist_top *tops;       /* single source, forward (NULL: no table): top of them; rank 0 gets the
-                                  ntop largest of all (forward: lo, hi infinite without ask->bound) */
+                                  ntop largest of all (forward: lo, hi infinite without ask->bound
+                                  unless terminal) */
     int64_t *ranks;            /* 2 nranks: every rank's rows, then its peak resident memory (KiB) */
     int64_t n, ntop;           /* the system's order; the top table's rows (rank 0) */
     ulam_dist_result r;        /* the whole run's walks, steps, crossings, bytes, rounds and cuts
@@ -248,6 +249,10 @@ typedef struct ulam_dist_answer {
     double worst;              /* MCSA, single source, forward with bound: the largest certified half-width */
     int iterations;            /* MCSA: iterations; single source: the push's products with M */
     double residual;           /* MCSA: max |r| / max |b| at the end; single source: max |r| left to the walks */
+    int terminal;              /* single source, forward's top table: 1 when the walks scored only where they
+                                  end (M >= 0, b >= 0, column sums of M below 1): each top entry's interval
+                                  is then its end count's 95% interval (overlapped with the certified range
+                                  where one is made); 0: collision walks */
 } ulam_dist_answer;
 
 /* Run ask on the part (every rank of comm together): the variance guard (ulam_dist_radius), then

@@ -50,6 +50,7 @@ typedef struct {
     const double *b;    /* forward: the sources' b at this rank's rows */
     int64_t steps, crossings, bytes, rounds, cut;
     int many;           /* a batch of two or more queries: query k walks on seed ulam_rng_substream(seed, QUERY, k) */
+    int terminal;       /* forward: a walk tallies only where it ends, its weight / (1 - min(1, S)) (S that row's sum) */
 } run;
 
 /* The defaults. */
@@ -95,13 +96,19 @@ static int advance(run *R, particle x, int forward)
 {
     const ulam_part *p = R->p;
     for (;;) {
-        if (forward) {
+        if (forward && !R->terminal) {
             tally e = {x.s, x.w, x.t, x.wt};
             if (push(&R->tallies, &e, sizeof e)) return ULAM_ENOMEM;
-        } else {
+        } else if (!forward) {
             x.score += x.wt * p->b[x.s - p->first];
         }
-        if (!move(p, forward ? &p->t : &p->m, &R->o, R->many, &x) || (x.t > R->o.max_steps && ++R->cut)) break;
+        if (!move(p, forward ? &p->t : &p->m, &R->o, R->many, &x)) {
+            double S = forward ? p->t.rowsum[x.s - p->first] : 0.0;
+            tally e = {x.s, x.w, x.t, x.wt / (1.0 - (S < 1.0 ? S : 1.0))}; /* ends here with probability 1 - min(1, S) */
+            if (forward && R->terminal && push(&R->tallies, &e, sizeof e)) return ULAM_ENOMEM;
+            break;
+        }
+        if (x.t > R->o.max_steps && ++R->cut) break;
         R->steps++;
         int own = p->nranks > 1 ? ulam__part_owner(p, x.s) : 0;
         if (own != p->rank) { /* to the rank of this set that owns the row */
@@ -590,7 +597,8 @@ int ulam_dist_forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist
 /* Forward walks from b (this rank's rows of it); with S, component watch's histories into S and
  * its moments m (n, mean, M2) at rank 0. */
 static int forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, int64_t watch,
-                   seq *S, double *m, double *x, double *se, ulam_dist_result *res, ulam_error *err)
+                   seq *S, double *m, double *x, double *se, double *hits, double *mass, ulam_dist_result *res,
+                   ulam_error *err)
 {
     ulam__clear(err);
     if (p && comm && res && !b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
@@ -600,7 +608,7 @@ static int forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
         if (!isfinite(b[i])) return ulam__fail(err, ULAM_EINVAL, 0, p->first + i, "a finite b");
     run R;
     int status = start(&R, p, comm, o, 1, err);
-    R.b = b;
+    R.b = b, R.terminal = hits != NULL;
     int64_t rows = p->last - p->first, nb = 0;
     double *sum = calloc((size_t)rows + 1, sizeof *sum), *sumsq = calloc((size_t)rows + 1, sizeof *sumsq), *P = NULL;
     if (!status && (!sum || !sumsq)) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld sums", (long long)rows);
@@ -622,7 +630,9 @@ static int forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
         double mean = sum[i] / N, var = (sumsq[i] - sum[i] * mean) / (N - 1.0);
         if (x) x[i] = mean;
         if (se) se[i] = zero_b ? 0.0 : sumsq[i] == 0.0 ? NAN : N > 1 ? sqrt(fmax(var, 0.0) / N) : NAN;
+        if (hits) hits[i] = sumsq[i] > 0 ? nearbyint(sum[i] * sum[i] / sumsq[i]) : 0.0; /* h equal tallies v: h^2 v^2 / (h v^2) */
     }
+    if (mass) *mass = P ? P[nb] : 0.0;
     if (!status && S && zero_b) m[0] = N; /* b = 0: x = 0, every history 0 */
     res->cut = cut;
     free(sum), free(sumsq), free(P);
@@ -634,19 +644,27 @@ static int forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
 int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
                         double *se, ulam_dist_result *res, ulam_error *err)
 {
-    return forward(p, comm, o, b, -1, NULL, NULL, x, se, res, err);
+    return forward(p, comm, o, b, -1, NULL, NULL, x, se, NULL, NULL, res, err);
+}
+
+/* Forward walks from b scoring where they end (part.h). */
+int ulam__dist_forward_ends(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b,
+                            double *x, double *se, double *hits, double *mass, ulam_dist_result *res, ulam_error *err)
+{
+    if (!hits || !mass) return ulam__fail(err, ULAM_EINVAL, 0, -1, "room for the hit counts and the mass");
+    return forward(p, comm, o, b, -1, NULL, NULL, x, se, hits, mass, res, err);
 }
 
 /* Forward walks with component watch's certified interval (part.h). */
 int ulam__dist_forward_ci(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, int64_t watch, double *x,
                           double *se, ulam_dist_result *res, ulam_dist_ci *ci, ulam_error *err)
 {
-    if (!ci || watch < 0) return forward(p, comm, o, p ? p->b : NULL, -1, NULL, NULL, x, se, res, err);
+    if (!ci || watch < 0) return forward(p, comm, o, p ? p->b : NULL, -1, NULL, NULL, x, se, NULL, NULL, res, err);
     if (!p || watch >= p->n) return ulam__fail(err, ULAM_EINVAL, 0, watch, "a part and an index in 1 .. %lld", p ? (long long)p->n : 0LL);
     seq S0 = {.E = 0.0};
     double m[9] = {0}, mk[3] = {0};
     S0.cs = calloc(1, sizeof *S0.cs), S0.done = calloc(1, 1);
-    int status = S0.cs && S0.done ? forward(p, comm, o, p->b, watch, &S0, mk, x, se, res, err)
+    int status = S0.cs && S0.done ? forward(p, comm, o, p->b, watch, &S0, mk, x, se, NULL, NULL, res, err)
                                   : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for an interval");
     if (!status && comm->rank == 0) {
         m[0] = mk[1], m[1] = mk[0] > 1 ? sqrt(mk[2] / (mk[0] - 1.0) / mk[0]) : NAN;

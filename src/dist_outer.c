@@ -3,6 +3,7 @@
  * what is left.  Both need the part's rows of M and of M' (ULAM_PART_BOTH).  Every norm that
  * decides a stop is a largest |entry|, the same bits whatever the split. */
 #include "part.h"
+#include "stop.h"
 
 #include <float.h>
 #include <math.h>
@@ -140,49 +141,92 @@ int ulam_dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, 
                      int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_error *err)
 {
     ulam_dist_result walks;
-    return ulam__dist_source(p, comm, source, o, tol, max_rounds, x, se, info, &walks, err);
+    return ulam__dist_source(p, comm, source, o, tol, max_rounds, 0, x, se, NULL, NULL, NULL, info, &walks, err);
 }
 
-/* As ulam_dist_source, the walks' counts (bytes and rounds too) into *walks. */
+/* Whether terminal walks from r apply to the part (M >= 0, r >= 0 and every column sum of M below
+ * 1, over every rank): then each walk scores 0 or one value at each row.  -1 on a failed exchange. */
+static int ends_apply(const ulam_part *p, const ulam_comm *c, const double *r)
+{
+    double cmax = 0.0, neg = 0.0;
+    for (int64_t i = 0; i < p->last - p->first; i++) {
+        cmax = fmax(cmax, p->t.rowsum[i]), neg = r[i] < 0 ? 1.0 : neg;
+        for (int64_t q = p->t.rowptr[i]; q < p->t.rowptr[i + 1]; q++) neg = p->t.val[q] < 0 ? 1.0 : neg;
+    }
+    if (ulam__dist_largest(c, &cmax) || ulam__dist_largest(c, &neg)) return -1;
+    return neg == 0.0 && cmax < 1.0;
+}
+
+/* The 95% interval of x_i = p_i + y_i from h of N walks ending at row i, each scoring 0 or R
+ * (y_i = h R / N; h = 0: R from mass and the row's sum S): p_i + R [a, b], b from the KL interval
+ * of a count fixed in advance, a from the one at the lower index of K chosen of n by estimate
+ * (ulam__stop_lower_index). */
+static void ends_interval(double p, double y, double h, int64_t N, double mass, double S, int64_t K, int64_t n,
+                          double *lo, double *hi)
+{
+    double R = h > 0 ? y * (double)N / h : mass / (1.0 - S), a, b, a2, b2;
+    ulam__stop_kl_interval(N, h / (double)N, 0, &a, &b);
+    ulam__stop_kl_interval(N, h / (double)N, ulam__stop_lower_index(0, K, n), &a2, &b2);
+    *lo = p + R * a2, *hi = p + R * b;
+}
+
+/* As ulam_dist_source (source -1: from the system's b, max_rounds 0 for no push), the walks' counts
+ * (bytes and rounds too) into *walks; lo and hi (or NULL)
+ * each x_i's 95% interval from terminal walks where they apply (ends_apply; K the components
+ * a top table lists; *terminal, when given, 1 then), else -INFINITY and INFINITY. */
 int ulam__dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
-                      int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_dist_result *walks,
-                      ulam_error *err)
+                      int max_rounds, int64_t K, double *x, double *se, double *lo, double *hi, int *terminal,
+                      ulam_dist_source_info *info, ulam_dist_result *walks, ulam_error *err)
 {
     ulam__clear(err);
     *walks = (ulam_dist_result){0};
     if (!p || !comm || !x || !se || !info || !(tol >= 0) || max_rounds < 0)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part, a comm, x, se, info, tol >= 0 and max_rounds >= 0");
     if (!p->m.rowptr || !p->t.rowptr) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a part holding M and M' (ULAM_PART_BOTH)");
-    if (source < 0 || source >= p->n) return ulam__fail(err, ULAM_EINVAL, 0, source, "a source in 1 .. %lld", (long long)p->n);
+    if (source < -1 || source >= p->n) return ulam__fail(err, ULAM_EINVAL, 0, source, "a source in 1 .. %lld", (long long)p->n);
+    if (source < 0 && !p->b) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a b in the prepared file (ulam prepare M.mtx --rhs b.mtx)");
     *info = (ulam_dist_source_info){0};
     int64_t rows = p->last - p->first;
-    double *gv = NULL, *r = calloc((size_t)rows + 1, sizeof *r), *y = malloc(((size_t)rows + 1) * sizeof *y);
-    ulam__halo h = {0};
-    int status = halo_open(p, comm, &h, &gv) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the halo and an exchange that succeeds")
-                 : r && y ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push's vectors");
+    double *gv = NULL, *r = calloc((size_t)rows + 1, sizeof *r), *y = malloc(((size_t)rows + 1) * sizeof *y), mass = 0.0;
+    double *h = lo && hi ? malloc(((size_t)rows + 1) * sizeof *h) : NULL;
+    ulam__halo h0 = {0};
+    int status = halo_open(p, comm, &h0, &gv) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the halo and an exchange that succeeds")
+                 : r && y && (h || !lo || !hi) ? ULAM_OK : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the push's vectors");
     memset(x, 0, (size_t)rows * sizeof *x);
     if (!status && source >= p->first && source < p->last) r[source - p->first] = 1.0;
+    if (!status && source < 0) memcpy(r, p->b, (size_t)rows * sizeof *r);
     double rmax = 1.0;
+    if (!status && source < 0 && largest_abs(p, comm, r, &rmax)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
+    int ends = status ? 0 : h ? ends_apply(p, comm, r) : 0;
+    if (ends < 0) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
     for (int k = 0; !status && k < max_rounds && rmax > tol; k++) { /* x += r, r <- M r */
         for (int64_t i = 0; i < rows; i++) x[i] += r[i];
         memcpy(y, r, (size_t)rows * sizeof *y);
-        if (matvec(p, comm, &h, y, gv, r)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
+        if (matvec(p, comm, &h0, y, gv, r)) status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
         if (!status && largest_abs(p, comm, r, &rmax)) status = ulam__fail(err, ULAM_EIO, 0, -1, "a sum over ranks");
         info->rounds = k + 1;
     }
     info->residual = rmax;
     ulam_dist_result res = {0};
-    if (!status) status = ulam__dist_forward_b(p, comm, o, r, y, se, &res, err); /* (I - M)^-1 r by walks */
-    if (!status && (from_set0(p, comm, y) || from_set0(p, comm, se)))
+    if (!status) /* (I - M)^-1 r by walks: where they end when that applies (r >= 0 too: M >= 0 and e_s) */
+        status = ends > 0 ? ulam__dist_forward_ends(p, comm, o, r, y, se, h, &mass, &res, err)
+                          : ulam__dist_forward_b(p, comm, o, r, y, se, &res, err);
+    if (!status && (from_set0(p, comm, y) || from_set0(p, comm, se) || (ends > 0 && from_set0(p, comm, h))))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
+    int64_t N = o ? o->walks : ulam_dist_defaults().walks;
     for (int64_t i = 0; !status && i < rows; i++) {
+        if (lo && hi && ends > 0 && rmax > 0.0)
+            ends_interval(x[i], y[i], h[i], N, mass, fmin(1.0, p->t.rowsum[i]), K, p->n, &lo[i], &hi[i]);
+        else if (lo && hi)
+            lo[i] = rmax == 0.0 ? x[i] : -INFINITY, hi[i] = rmax == 0.0 ? x[i] : INFINITY;
         x[i] += y[i];
         if (rmax == 0.0) se[i] = 0.0; /* nothing left to walk: the push is the answer */
     }
     info->walks = res.walks, info->steps = res.steps, info->crossings = res.crossings, info->cut = res.cut;
     *walks = res;
-    ulam__halo_free(&h);
-    free(gv), free(r), free(y);
+    if (terminal) *terminal = !status && ends > 0 && rmax > 0.0;
+    ulam__halo_free(&h0);
+    free(gv), free(r), free(y), free(h);
     return status;
 }
 

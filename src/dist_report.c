@@ -9,15 +9,16 @@
 /* "x[i]  estimate +- stderr (95% CI lo .. hi)" without a newline (i 1-based; ci NULL: forward
  * walks, whose components have no certified range on a partition; the variance is certified
  * finite, rho < 1). */
-static void estimate_fprint(FILE *f, int64_t i, double est, double se, double rho, const ulam_dist_ci *ci)
+static void estimate_fprint(FILE *f, int64_t i, double est, double se, double rho, const ulam_dist_ci *ci, int ends)
 {
+    const char *none = ends ? "no walk ended at it" : "no walk reached it: the push's part alone";
     fprintf(f, "x[%lld]%*s%.10g", (long long)i, ulam__report_pad("x", i, 16), "", est);
     int d = ci ? ulam__report_ci_digits(ci->lo, ci->hi) : 0;
     if (ci && ci->lo == ci->hi && ci->lo == est) fprintf(f, " +- 0 (95%% CI %.10g .. %.10g: b is 0, x is exactly 0)", ci->lo, ci->hi);
     else if (!(rho < 1.0)) fprintf(f, " (no standard error: rho(M^) is not certified below 1)");
     else if (isnan(se) && ci && isfinite(ci->lo))
-        fprintf(f, " (95%% CI %.*g .. %.*g; no walk reached it: the push's part alone)", d, ci->lo, d, ci->hi);
-    else if (isnan(se)) fprintf(f, " (no walk reached it: the push's part alone)");
+        fprintf(f, " (95%% CI %.*g .. %.*g; %s)", d, ci->lo, d, ci->hi, none);
+    else if (isnan(se)) fprintf(f, " (%s)", none);
     else if (ci && isfinite(ci->lo)) fprintf(f, " +- %.3g (95%% CI %.*g .. %.*g)", se, d, ci->lo, d, ci->hi);
     else if (ci) fprintf(f, " +- %.3g (standard error; no certified interval: no certified u < 1 for the walks' length tail or second moment)", se);
     else fprintf(f, " +- %.3g (standard error; no certified interval for forward walks on a partition)", se);
@@ -29,7 +30,7 @@ static void answers_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answ
                            const long *lines, const char *out, int verbosity)
 {
     for (int64_t k = 0; queries && k < a->nq; k++) {
-        estimate_fprint(f, a->index[k] + 1, s->res[k].estimate, s->res[k].std_error, s->rho, &s->ci[k]);
+        estimate_fprint(f, a->index[k] + 1, s->res[k].estimate, s->res[k].std_error, s->rho, &s->ci[k], 0);
         uint64_t own = a->nq > 1 ? ulam_rng_substream(a->o.seed, ULAM_STREAM_QUERY, (uint64_t)k) : a->o.seed; /* docs/streams.md */
         if (s->ci[k].met) fprintf(f, "  %lld walks,", (long long)s->res[k].walks);
         fprintf(f, "  line %ld, seed %llu\n", lines[k], (unsigned long long)own);
@@ -37,7 +38,7 @@ static void answers_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answ
     for (int64_t j = 0; (a->mode == ULAM_DIST_SOURCE || a->mode == ULAM_DIST_FORWARD) && j < s->ntop; j++) {
         const ulam_dist_top *t = &s->tops[j];
         ulam_dist_ci ci = {t->lo, t->hi, INFINITY, 0.0, 0};
-        estimate_fprint(f, t->i + 1, t->x, t->se, s->rho, isfinite(ci.lo) ? &ci : NULL), fputc('\n', f);
+        estimate_fprint(f, t->i + 1, t->x, t->se, s->rho, isfinite(ci.lo) ? &ci : NULL, s->terminal), fputc('\n', f);
     }
     if (a->mode == ULAM_DIST_MCSA)
         fprintf(f, "x               %lld components by MCSA%s%s\nmcsa            %d iterations, residual %.3g of max |b| "
@@ -63,7 +64,7 @@ static void summary_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answ
     if (queries) {
         if (verbosity >= 0) fprintf(f, "queries         %s, each above (walks below: each query's)\n", queries);
     } else if (adjoint || (forward && a->index)) /* forward: the watched component's line (its sequence) */
-        estimate_fprint(f, a->index[0] + 1, r->estimate, r->std_error, s->rho, adjoint ? ci : s->ci), fputc('\n', f);
+        estimate_fprint(f, a->index[0] + 1, r->estimate, r->std_error, s->rho, adjoint ? ci : s->ci, 0), fputc('\n', f);
     for (int64_t k = 0; ci && k < nq; k++) met += ci[k].met;
     if (a->rel_err > 0 && met == nq)
         fprintf(f, "rel-err         met (target %.3g)%s\n", a->rel_err, queries ? " by every query" : "");
@@ -73,9 +74,10 @@ static void summary_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answ
                 ci && isfinite(ci[0].lo) ? "" : " (no certified interval: no certified u < 1 for the walks' length tail or second moment)");
     else if (forward) fprintf(f, "x               %lld components by forward walks%s%s\n", (long long)s->n, out ? ", written to " : "", out ? out : "");
     if (verbosity < 0) return;
-    fprintf(f, "method          %s%s collision walks on %d rank%s, rows split by entries",
+    fprintf(f, "method          %s%s %s walks on %d rank%s, rows split by entries",
             a->mode == ULAM_DIST_MCSA ? "MCSA with " : a->mode == ULAM_DIST_SOURCE ? "push and " : "",
-            adjoint ? "adjoint" : "forward", nranks, nranks == 1 ? "" : "s");
+            adjoint ? "adjoint" : "forward", s->terminal ? "terminal" : "collision", nranks, nranks == 1 ? "" : "s");
+    if (s->terminal) fprintf(f, " (each interval: the certified range and the end count's 95%% interval, overlapped)");
     if (c->sets > 1) fprintf(f, " within each of %d sets", c->sets);
     fprintf(f, "\n");
     if (s->rho < 1.0) fprintf(f, "variance        finite (rho(M^) <= %.6g, certified)\n", s->rho);

@@ -72,6 +72,7 @@ static int walks(const ulam_part *p, const ulam_comm *c, const ulam_dist_ask *a,
     int64_t rows = p->last - p->first, in_set0 = c->sets <= 1 || c->rank < c->nranks / c->sets; /* set 0's ranks hold x */
     ulam_dist_mcsa_info mi = {0};
     ulam_dist_source_info si = {0};
+    double *sl = NULL, *sh = NULL; /* single source, forward's top table: the walks' 95% intervals */
     int status;
     if (a->mode == ULAM_DIST_ADJOINT) {
         status = ulam_dist_adjoint_ci(p, c, a->index, a->nq, &a->o, a->rel_err, ans->res, ans->ci, err);
@@ -79,15 +80,23 @@ static int walks(const ulam_part *p, const ulam_comm *c, const ulam_dist_ask *a,
         return status;
     }
     if (a->mode == ULAM_DIST_MCSA) status = ulam__dist_mcsa(p, c, &a->o, a->tol, a->max_iter, ans->x, &mi, &ans->r, err);
-    else if (a->mode == ULAM_DIST_SOURCE)
-        status = ulam__dist_source(p, c, a->source, &a->o, 1e-4, 1000, ans->x, ans->se, &si, &ans->r, err);
+    else if (a->mode == ULAM_DIST_SOURCE || (a->mode == ULAM_DIST_FORWARD && !a->index && ans->tops)) /* forward's top
+                                                                     table: walks from b, no push (source -1) */
+        status = (sl = malloc(((size_t)rows + 1) * sizeof *sl)) && (sh = malloc(((size_t)rows + 1) * sizeof *sh))
+                     ? ulam__dist_source(p, c, a->mode == ULAM_DIST_SOURCE ? a->source : -1, &a->o, 1e-4,
+                                         a->mode == ULAM_DIST_SOURCE ? 1000 : 0, a->top, ans->x, ans->se, sl, sh,
+                                         &ans->terminal, &si, &ans->r, err)
+                     : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the intervals");
     else status = ulam__dist_forward_ci(p, c, &a->o, a->index ? a->index[0] : -1, ans->x, ans->se, &ans->r,
                                         a->index ? ans->ci : NULL, err);
-    ans->iterations = a->mode == ULAM_DIST_MCSA ? mi.iterations : si.rounds;
-    ans->residual = a->mode == ULAM_DIST_MCSA ? mi.residual : si.residual;
+    ans->iterations = a->mode == ULAM_DIST_MCSA ? mi.iterations : a->mode == ULAM_DIST_SOURCE ? si.rounds : 0;
+    ans->residual = a->mode == ULAM_DIST_MCSA ? mi.residual : a->mode == ULAM_DIST_SOURCE ? si.residual : 0.0;
     if (!status && (a->mode != ULAM_DIST_FORWARD || a->bound))
         status = bound(p, c, a->mode == ULAM_DIST_SOURCE ? a->source : -1, ans->x, lo, hi, &ans->worst, err);
     else for (int64_t i = 0; i < rows; i++) lo[i] = -INFINITY, hi[i] = INFINITY; /* forward: no range */
+    for (int64_t i = 0; !status && sl && sh && i < rows; i++) /* the certified range and the walks' interval: their overlap */
+        if (!(sl[i] > hi[i] || sh[i] < lo[i])) lo[i] = fmax(lo[i], sl[i]), hi[i] = fmin(hi[i], sh[i]);
+    free(sl), free(sh);
     int top = a->mode == ULAM_DIST_SOURCE || (a->mode == ULAM_DIST_FORWARD && ans->tops); /* forward: tops asks */
     if (!status && top &&
         gather_top(c, ans->x, ans->se, lo, hi, p->first, in_set0 ? rows : 0, a->top, ans->tops, &ans->ntop))
@@ -108,7 +117,7 @@ int ulam_dist_run(const ulam_part *p, const ulam_comm *comm, const ulam_dist_ask
                 : !ans->res || !ans->ci)
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "the answer's arrays the mode fills");
     ans->n = p->n, ans->ntop = 0, ans->r = (ulam_dist_result){0};
-    ans->rho = ans->worst = INFINITY, ans->iterations = 0, ans->residual = 0.0;
+    ans->rho = ans->worst = INFINITY, ans->iterations = 0, ans->residual = 0.0, ans->terminal = 0;
     size_t rows = (size_t)(p->last - p->first) + 1;
     double *lo = forward ? malloc(rows * sizeof *lo) : NULL, *hi = forward ? malloc(rows * sizeof *hi) : NULL;
     int status = forward && (!lo || !hi) ? ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the bounds")

@@ -22,7 +22,7 @@
  * signs, each component's own plug-in empirical-Bernstein confidence sequence (cs_set).  A component no walk reached gets p_i + [0, about 3.7 R0 /
  * N] against the empirical-Bernstein 9.6 R0 / N, so the same accuracy takes ~2.6x fewer walks.
  * ulam_fpush_top's k components are chosen by their estimates: their lower ends at delta k / n
- * (lower_index). */
+ * (ulam__stop_lower_index). */
 #include "fpush.h"
 #include "fpush_dense.h"
 #include "cache.h"
@@ -187,7 +187,7 @@ static int solve_queue(const ulam_csr *M, const ulam_csr *Mt, const ulam_fpush_o
 /* The walks' plan: residual mass, kernel norm alpha = ||M||_1 < 1, target and costs. */
 typedef struct {
     double alpha, E, delta, visits, step_cost;
-    double llo;    /* the lower ends' extra log: ln(n / K) for ulam_fpush_top's K of n (lower_index), else 0 */
+    double llo;    /* the lower ends' extra log: ln(n / K) for ulam_fpush_top's K of n (ulam__stop_lower_index), else 0 */
     int64_t fixed; /* > 0: this many walks */
     const double *p; /* the top-K target (walk_work_top): the push's estimates, n, K, the residual at the last */
     int64_t n, K;    /* raise of the floor, and the buffer raise_floor gathers in */
@@ -235,7 +235,7 @@ static int first_epoch(double R, double E, double delta, int kl)
  * wide at stitching index 1 (the KL interval of scores 0 or R0: M >= 0 makes r >= 0), or, when
  * more, whose KL interval is within -+ E delta at a component x_i = delta whose walk part is the
  * residual's share r_sum of it (half-width sqrt(2 c w R0 / N) at w = r_sum delta, c with ln(n / K)
- * more for the lower ends of a top-K query: lower_index; R-MAT 2^22, source 101, r_sum 0.122:
+ * more for the lower ends of a top-K query: ulam__stop_lower_index; R-MAT 2^22, source 101, r_sum 0.122:
  * 54 000 walks predicted, 46 340 walked, against 15 800 without it; the range term
  * alone took R-MAT 2^22's --min-value 0.001 to 5.9e6 walks after a push left r_sum ~ 0.3), at
  * least one block (a fixed count: that count in proportion to r_sum, the accuracy it buys). */
@@ -413,27 +413,6 @@ static void hits_interval(kl_kept *c, int64_t N, int k, int64_t h, double R0, do
     *lo = R0 * a, *hi = R0 * b;
 }
 
-/* The stitching index j whose delta, delta / (j (j + 1)), is at most K / n times index k's
- * (delta itself at k = 0): the lower ends of the K components ulam_fpush_top prints (k itself
- * when K >= n, every component).  They are the K largest estimates, chosen after the walks: a
- * component whose true walk part is tiny ranks among them because a walk or two ended at it, and
- * its lower end, valid for a component named in advance, then excludes x_i (the issue's 72.8%
- * coverage at 100 walks, every miss below).  At n K / n the expected number of printed lower
- * ends that miss is at most the sum over all n components of K delta / (2 n), K delta / 2, under
- * any dependence and any selection (Benjamini and Yekutieli's false coverage rate, JASA 2005,
- * for a selection of fixed size K), so the share of printed intervals that miss below is at most
- * delta / 2.  The upper ends keep index k: ranking by a larger estimate only makes a component
- * whose walks ended at it too rarely less likely to be printed (at a fixed count, P(printed | h
- * walks ended at i) rises with h). */
-static int lower_index(int k, int64_t K, int64_t n)
-{
-    if (K >= n) return k;
-    double t = (k >= 1 ? (double)k * ((double)k + 1.0) : 1.0) * (double)n / (double)(K > 0 ? K : 1);
-    double j = ceil(0.5 * (sqrt(1.0 + 4.0 * t) - 1.0));
-    while (j * (j + 1.0) < t) j++;
-    return j < 1 ? 1 : (int)j;
-}
-
 /* Whether an interval [a, b] around est meets relative error E at delta: b < delta (x_i >= delta
  * only if the interval misses it), or est within E max(a, delta) of both ends (so within E x_i of
  * any x_i >= delta inside it). */
@@ -444,7 +423,7 @@ static int interval_met(double a, double b, double est, double E, double delta)
 
 /* rule_met for scores 0 or R0 (M, r >= 0): the KL intervals, every lower end lowered by cut
  * (the bound on the part of x_i the negative residual cut from r takes away) and taken at index
- * klo from cl (lower_index; cl NULL: c's). */
+ * klo from cl (ulam__stop_lower_index; cl NULL: c's). */
 static int rule_met_kl(const walker *w, kl_kept *c, kl_kept *cl, const double *p, int64_t N, int k, int klo, double R0,
                        double E, double delta, double cut)
 {
@@ -638,7 +617,7 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
  * count), so predictable.  Every component no walk has ended at has the same past, all zeros,
  * hence the same sequence (none); a component first ended at in a block starts from none's state
  * before that block (none's bet was its bet).  The lower ends take ln(2 n / (delta K)) (the
- * false-coverage rate of ulam_fpush_top's K of n, as lower_index), the upper ln(2 / delta). */
+ * false-coverage rate of ulam_fpush_top's K of n, as ulam__stop_lower_index), the upper ln(2 / delta). */
 typedef struct {
     ulam__cs *q;   /* per state ended at, in w's hit order */
     int32_t *prev; /* w's counts at the block's start, 2 a state */
@@ -1114,7 +1093,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     double R = sgn ? 2.0 * R0 : R0; /* the scores' range */
     int64_t N = 0;
     int k = 1, kk = -1; /* kk: the KL interval's index when not k */
-    int64_t K = top > 0 && top < n ? top : n; /* the components whose intervals are given (lower_index) */
+    int64_t K = top > 0 && top < n ? top : n; /* the components whose intervals are given (ulam__stop_lower_index) */
     cs_set S = {.llo = log(2.0 / ULAM__STOP_DELTA) + log((double)n / (double)K), .lhi = log(2.0 / ULAM__STOP_DELTA)};
     kl_kept *kept = sgn ? NULL : ulam__malloc(1, sizeof *kept), *kept_lo = sgn || K >= n ? NULL : ulam__malloc(1, sizeof *kept_lo);
     if (kept) kept->N = -1;
@@ -1176,7 +1155,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
             }
             if (!planned || o->walks > 0 || N >= cap_w) break;
             if (sgn ? cs_rule_met(&S, &w, x, N, R0, pl.E, pl.delta)
-                    : rule_met_kl(&w, kept, kept_lo, x, N, k, lower_index(k, K, n), R0, pl.E, pl.delta, cut))
+                    : rule_met_kl(&w, kept, kept_lo, x, N, k, ulam__stop_lower_index(k, K, n), R0, pl.E, pl.delta, cut))
                 break;
             k++;
         }
@@ -1189,7 +1168,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     double *key = !status && top > 0 ? ulam__malloc((size_t)top, sizeof *key) : NULL, *pv = NULL;
     if (!status && top > 0 && !key) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the top components");
     if (!status) {
-        int klo = lower_index(sgn || kk < 0 ? k : kk, K, n);
+        int klo = ulam__stop_lower_index(sgn || kk < 0 ? k : kk, K, n);
         ends c = {.w = &w, .cs = &S, .kept = kept, .kept_lo = kept_lo, .N = N, .k = k, .kk = kk, .klo = klo, .sgn = sgn, .nonneg = mpos,
                   .R = R, .R0 = R0, .cut = cut, .D = info->residual_bound, .se0 = N > 1 ? 0.0 : (w.k > 0 ? NAN : 0.0),
                   .fp = rounding_allowance(M, swi, alpha, relp)};

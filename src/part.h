@@ -122,13 +122,22 @@ int ulam__dist_cw(const ulam_part *p, const ulam_comm *comm, int iters, double *
 int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
                         double *se, ulam_dist_result *res, ulam_error *err);
 
+/* As ulam__dist_forward_b with each walk scoring only where it ends, its weight / (1 - min(1, S))
+ * (S the row's sum of |M'|): with M >= 0, b >= 0 and every S < 1 the scores at row i are 0 or one
+ * value, so hits[i] (this rank's rows) counts the walks that ended there, a binomial count whose
+ * KL interval holds x_i; *mass: ||b||_1 over every rank (the same bits at any split). */
+int ulam__dist_forward_ends(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b,
+                            double *x, double *se, double *hits, double *mass, ulam_dist_result *res, ulam_error *err);
+
 /* ulam_dist_mcsa with its corrections' walk counts summed into *all (src/dist_outer.c). */
 int ulam__dist_mcsa(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, double tol, int max_iter,
                     double *x, ulam_dist_mcsa_info *info, ulam_dist_result *all, ulam_error *err);
 
-/* ulam_dist_source with its walks' counts in *walks (src/dist_outer.c). */
+/* ulam_dist_source (source -1: from the system's b) with its walks' counts in *walks and, lo and hi given, each x_i's 95% interval
+ * where terminal walks apply (M >= 0, column sums of M below 1; the lower ends for K components
+ * chosen by estimate; *terminal 1 then), else -INFINITY .. INFINITY (src/dist_outer.c). */
 int ulam__dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source, const ulam_dist_opts *o, double tol,
-                      int max_rounds, double *x, double *se, ulam_dist_source_info *info, ulam_dist_result *walks,
-                      ulam_error *err);
+                      int max_rounds, int64_t K, double *x, double *se, double *lo, double *hi, int *terminal,
+                      ulam_dist_source_info *info, ulam_dist_result *walks, ulam_error *err);
 
 #endif

@@ -510,13 +510,6 @@ static void test_fpush_queue_certified(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
-/* The order of two doubles (qsort). */
-static int cmp_double(const void *a, const void *b)
-{
-    double u = *(const double *)a, v = *(const double *)b;
-    return u < v ? -1 : u > v;
-}
-
 /* Signed scores (issue 38 point 5): the Zipf digraph with every third entry of M negated, a
  * short push (rmax 0.02), then 256 and 4096 walks and the rel_err 0.2 rule, 8 seeds each: every
  * component's interval (each its own plug-in empirical-Bernstein sequence, valid at every walk
@@ -556,7 +549,7 @@ static void test_fpush_signed(void **state)
             assert_int_equal(ulam_fpush_top(M, Mt, &o, K, est, idx, se, lo, hi, &info, &err), ULAM_OK);
             for (int64_t t = 0; t < K; t++) Nt++, ct += lo[t] <= x[idx[t]] && x[idx[t]] <= hi[t];
         }
-        qsort(ratio, (size_t)m, sizeof *ratio, cmp_double);
+        qsort(ratio, (size_t)m, sizeof *ratio, test_cmp_double);
         print_message("signed, %lld walks (%lld in all): %lld of %lld intervals cover; half-width / 1.96 se median %.2f "
                       "(%lld components)\n", (long long)walks[c], (long long)used, (long long)covered, (long long)N,
                       m ? ratio[m / 2] : NAN, (long long)m);

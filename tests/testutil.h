@@ -135,6 +135,13 @@ static inline int test_run_(const char *group, const struct CMUnitTest *tests, s
     return rc;
 }
 
+/* The order of two doubles (qsort). */
+static inline int test_cmp_double(const void *a, const void *b)
+{
+    double u = *(const double *)a, v = *(const double *)b;
+    return u < v ? -1 : u > v;
+}
+
 /* Fail unless |a - b| <= tol (cmocka 1.1 has no assert_double_equal). */
 #define assert_close(a, b, tol) assert_close_((a), (b), (tol), #a, __FILE__, __LINE__)
 
