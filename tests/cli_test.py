@@ -123,6 +123,17 @@ CASES += [
       "1000"], 5, r"", r"^pi\[3\] (.|\n)*NOT met"),
     (["solve", D + "graph7.txt", "--pagerank", "0.85", "--queries", D + "graph7_queries.txt", "--rel-err", "1e-6",
       "--walks", "1000"], 5, r"graph7_queries.txt: \d+ of \d+ relative-error targets NOT met .*exit 5", r"^pi\["),
+    # exit17: "met" is the printed interval's.  chain4's push leaves a residual of 1.7e-19, so the
+    # interval (the walks' clipped to the walk part's certified bound, plus the push's rounding) is
+    # +-2.8e-13, within 1e-12 |x|, while the walk rule's own interval kept a bias floor of 1e-6 |x|:
+    # it said NOT met and exited 5; a push that leaves no residual (dag5) never ran the walk rule
+    # and said NOT met (the fourth moment "infinite") beside an exact x
+    (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "1", "--rel-err", "1e-12", "--method",
+      "bidirectional"], 0, r"^$", r"^x\[1\] .*95% CI 2\.93291731669\d* \.\. 2\.93291731669\d*\)\nrel-err +met \(target 1e-12\)\n"),
+    (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "1", "--rel-err", "1e-12", "--json"], 0, r"^$",
+     r'"method": "bidirectional".*"rel_err_met": true'),
+    (["solve", D + "dag5.mtx", "--index", "5", "--source", "1", "--rel-err", "0.1", "--method", "bidirectional"], 0, r"^$",
+     r"^x\[5\] +0 \+- 0 \(95% CI 0 \.\. 0\)\nrel-err +met \(target 0\.1\)\n(.|\n)*walks +none: the push left no residual"),
     # newuser15: the answer (with its interval where there is one) is the first line
     (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "gmres", "--index", "2"], 0, r"^$",
      r"\Ax\[2\] +2\.3400936\d* \(certified range 2\.34009\d* \.\. 2\.34009\d*\)\nmethod +gmres(.|\n)*\nrange +every x_i within "),
