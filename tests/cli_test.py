@@ -134,6 +134,12 @@ CASES += [
      r'"method": "bidirectional".*"rel_err_met": true'),
     (["solve", D + "dag5.mtx", "--index", "5", "--source", "1", "--rel-err", "0.1", "--method", "bidirectional"], 0, r"^$",
      r"^x\[5\] +0 \+- 0 \(95% CI 0 \.\. 0\)\nrel-err +met \(target 0\.1\)\n(.|\n)*walks +none: the push left no residual"),
+    # exit17: direct --quiet printed its whole report (n, method, rcond, residual, seconds): now the
+    # answer lines alone, as solve --quiet
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--quiet"], 0, r"^$",
+     r"\Ax\[1\] +2\.93291731669266\d*\nx\[2\] +2\.34009360374415\d*\nx\[3\] +\S+\nx\[4\] +\S+\n\Z"),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "2", "-q"], 0, r"^$",
+     r"\Ax\[2\] +2\.34009360374415\d*\n\Z"),
     # newuser15: the answer (with its interval where there is one) is the first line
     (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "gmres", "--index", "2"], 0, r"^$",
      r"\Ax\[2\] +2\.3400936\d* \(certified range 2\.34009\d* \.\. 2\.34009\d*\)\nmethod +gmres(.|\n)*\nrange +every x_i within "),
