@@ -399,9 +399,27 @@ CASES += [
      r"walks +3000 matrix gather walks.*\n +\(one walk a channel: 1000 R \+ 1000 G \+ 1000 B\)"),
 ]
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends --rel-err (it spun forever)
-    CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0,
+    CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 5,  # not met: exit 5 (exit17)
                   r"^ulam radiosity: warning: .*small_gap.obj: patch 3 is only 168 float steps across where it lies",
                   r"\Aradiosity R  0 \+- 0.*\n.*\n.*\n(.*\n)*note .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))
+# exit17: radiosity --rel-err not met exits 5, as solve does (it exited 0: a script could not tell), with
+# the line that says so; met exits 0
+CASES += [
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.01", "--walks", "2000"], 5,
+     r"the rule needs about .* walks", r"\Aradiosity R .*95% CI(.|\n)*\nrel-err +NOT met \(0\.01; "),
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.01", "--walks", "2000", "--json"], 5,
+     r"", r'"rel_err_met": false'),
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.1", "--no-mesh-error"], 0, r"^$",
+     r"\nrel-err +met \(0\.1; "),
+    (["radiosity", SC + "cornell_box.obj", "--mode", "shoot", "--rel-err", "0.01", "--walks", "2000"], 5,
+     r"the rule needs about", r"\nrel-err +NOT met on the whole scene: "),
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--matrix-walk", "--rel-err", "0.001", "--ff-rays", "100",
+      "--walks", "2000"], 5, r"", r"\nrel-err +NOT met in R: the form factors' error alone"),
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--matrix-walk", "--rel-err", "0.2", "--ff-rays", "20000",
+      "--walks", "100", "--no-mesh-error"], 5, r"", r"\nrel-err +NOT met \(0\.2; every channel's walks to its target: "),
+    (["radiosity", SC + "cube.obj", "--view-gather", "--rel-err", "0.01", "--image", "/dev/null", "--size", "16x16",
+      "--walks", "100"], 5, r"", r"\nwarning +1 seen patches stopped short of their target"),
+]
 # --max-mem that holds F but not the dense solve of F's noise: the matrix walk runs, its error bar labelled
 CASES.append((["radiosity", SC + "cube.obj", "--subdivide", "0.04", "--ff-rays", "100", "--patch", "1", "--matrix-walk",
                "--max-mem", "50M", "--walks", "20000", "--no-mesh-error"], 0, r"^$",
@@ -517,7 +535,7 @@ def check_radiosity_rare_lamp(ulam):
     for seed in range(1, 11):
         rc, out, err = run(ulam, ["radiosity", scene, "--patch", "floor", "--rel-err", "0.05", "--walks", "20000",
                                   "--estimator", "collision", "--json", "--seed", str(seed)])
-        assert rc == 0, err
+        assert rc == 5, err  # not met: exit 5 (exit17; it exited 0)
         j = json.loads(out)
         assert j["rel_err_met"] is False and j["min_walks"] > 1e6 and j["walks"] == 20000, (seed, j)
         assert "--estimator next-event samples the emitters directly" in err, (seed, err)
@@ -679,10 +697,11 @@ def check_radiosity_chosen(ulam):
         assert re.search(r"^half-width +95% half-width / B over the 4 lit chosen patches: median [\d.e-]+, 90% ", out,
                          re.M), out
         # --time is a stopping rule, not Ctrl-C: the final gather it cut said [INTERRUPTED], exit 130, no
-        # --out (the hall's floor, 60 s); now exit 0, the rows of the patches it reached, the others empty
+        # --out (the hall's floor, 60 s); now exit 5 (the target not met), the rows of the patches it reached, the
+        # others empty
         rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "20", "--mode", "final", "--patches",
                                   "floor", "--rel-err", "0.001", "--time", "0.5", "--out", csv])
-        assert rc == 0 and "INTERRUPTED" not in out and re.search(r"^rel-err +NOT met on the chosen patches", out, re.M), \
+        assert rc == 5 and "INTERRUPTED" not in out and re.search(r"^rel-err +NOT met on the chosen patches", out, re.M), \
             (rc, out, err)
         with open(csv) as f:
             rows = f.read().splitlines()[1:]
