@@ -216,7 +216,9 @@ typedef struct ulam_dist_ask {
     const int64_t *index; /* adjoint: the nq queries' 0-based rows (ulam_dist_adjoint_ci); forward:
                              NULL, or one row whose certified interval goes to ci[0] */
     int64_t nq;
-    double rel_err;       /* adjoint: the queries' stop (0: o.walks each) */
+    double rel_err;       /* adjoint: the queries' stop (0: o.walks each); forward with index: no
+                             stop (o.walks run), ci[0].met says whether the interval after them
+                             is within rel_err |estimate| */
     int bound;            /* forward: also x's certified range from its residual (ulam_dist_bound) */
     double tol;           /* MCSA: the residual's target, of max |b| */
     int max_iter;         /* MCSA: its most iterations */

@@ -101,6 +101,13 @@ int ulam_rad_run_write(ulam_rad_run *r, int what, FILE *f);
 /* The report, text or (opts->json) one JSON object, into f. */
 void ulam_rad_run_print(const ulam_rad_run *r, FILE *f);
 
+/* Whether the --rel-err target the report states was met (after ulam_rad_run_solve): 1 met, 0 NOT met
+ * (the report says so: the patch's, the whole scene's or --patches' rule, every channel of matrix
+ * walks, --view-gather's seen patches, or a zero answer that can never meet it), -1 no target or
+ * none the run states (--at, --grid, --list, --direct, forward matrix walks).  The command exits 5
+ * on 0, as ulam solve does. */
+int ulam_rad_run_rel_err_met(const ulam_rad_run *r);
+
 /* Free a run (NULL accepted). */
 void ulam_rad_run_free(ulam_rad_run *r);
 

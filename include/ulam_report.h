@@ -125,7 +125,8 @@ typedef struct ulam_info_report {
     const ulam_spectral_opts *so;  /* the options of the damped splittings' Arnoldi (NULL: defaults) */
 } ulam_info_report;
 
-/* A direct solve as ulam direct reports it (ULAM_REPORT_DIRECT). */
+/* A direct solve as ulam direct reports it (ULAM_REPORT_DIRECT): text (ULAM_REPORT_BRIEF; _QUIET: the
+ * answer lines alone) or JSON. */
 typedef struct ulam_direct_report {
     int64_t n;
     const double *x;               /* the solution */

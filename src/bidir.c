@@ -405,6 +405,21 @@ static double rounding_allowance(const ulam_push *w, const ulam_push_info *push,
     return ulam__push_rounding((double)push->ops + (double)o->nb + 2.0, dot_abs_b(ulam__push_estimates(w), o));
 }
 
+/* A rel_err target's outcome as the printed interval gives it: met when that interval is finite
+ * and its half-width is within E |x_t|.  The walk rule judged its own interval of push_part +
+ * <r, x>, whose truncation bias floors at 1e-6 |push_part + <r, x>| (plan_terms), before the clip
+ * to push_part -+ D and the rounding allowance; a push that left no residual ran no walks and no
+ * rule.  Either said NOT met beside an interval within the target (chain4 at E = 1e-12: +-2.8e-13
+ * against 2.9e-12, exit 5; dag5's exact x).  Met here, the walks' "stopped early" and predicted
+ * count no longer apply (min_walks: the walks run, which sufficed). */
+static void rel_err_outcome(ulam_bidir_result *res, double E)
+{
+    ulam_walk_result *w = &res->walks;
+    double half = 0.5 * (res->ci95[1] - res->ci95[0]);
+    w->rel_err_met = isfinite(half) && half <= E * fabs(res->estimate);
+    if (w->rel_err_met) w->out_of_reach = 0, w->min_walks = fmin(w->min_walks, (double)w->walks);
+}
+
 /* Estimate x_t of (I - M) x = b (e_s or a sparse b) on w with memo. */
 static int solve_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__bidir *memo, const ulam_bidir_opts *o,
                       ulam_bidir_result *res, ulam_error *err)
@@ -431,6 +446,7 @@ static int solve_on(const ulam_csr *M, const ulam_csr *Mt, ulam_push *w, ulam__b
     }
     double fp = rounding_allowance(w, &res->push, o);
     res->ci95[0] -= fp, res->ci95[1] += fp; /* NaN (withheld) stays NaN */
+    if (o->walk.stop.rel_err > 0) rel_err_outcome(res, o->walk.stop.rel_err);
     res->seconds = res->plan.seconds + (ulam_now() - t0);
     return ULAM_OK;
 }

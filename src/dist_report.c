@@ -60,13 +60,21 @@ static void summary_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answ
     const ulam_dist_result *r = &s->r;
     int adjoint = a->mode == ULAM_DIST_ADJOINT, forward = a->mode == ULAM_DIST_FORWARD, nranks = c->nranks;
     int64_t nq = adjoint ? a->nq : 1, met = 0;
-    const ulam_dist_ci *ci = adjoint ? s->ci : NULL;
+    const ulam_dist_ci *ci = adjoint || (forward && a->index && a->rel_err > 0) ? s->ci : NULL; /* forward: x_I's */
     if (queries) {
         if (verbosity >= 0) fprintf(f, "queries         %s, each above (walks below: each query's)\n", queries);
     } else if (adjoint || (forward && a->index)) /* forward: the watched component's line (its sequence) */
         estimate_fprint(f, a->index[0] + 1, r->estimate, r->std_error, s->rho, adjoint ? ci : s->ci, 0), fputc('\n', f);
     for (int64_t k = 0; ci && k < nq; k++) met += ci[k].met;
-    if (a->rel_err > 0 && met == nq)
+    if (a->rel_err > 0 && forward && met == nq) /* forward walks have no stop rule: a verdict after them */
+        fprintf(f, "rel-err         met (target %.3g; judged on the interval after --walks %lld: forward walks have no "
+                   "stop rule)\n", a->rel_err, (long long)a->o.walks);
+    else if (a->rel_err > 0 && forward)
+        fprintf(f, "rel-err         NOT met (target %.3g) in --walks %lld (judged on the interval after them: forward walks "
+                   "have no stop rule)%s\n", a->rel_err, (long long)a->o.walks,
+                ci && isfinite(ci[0].lo) ? "" : "; no certified interval: no certified u < 1 for the walks' length tail or "
+                                                "second moment");
+    else if (a->rel_err > 0 && met == nq)
         fprintf(f, "rel-err         met (target %.3g)%s\n", a->rel_err, queries ? " by every query" : "");
     else if (a->rel_err > 0)
         fprintf(f, "rel-err         NOT met (target %.3g) by %lld of %lld quer%s in --walks %lld%s\n", a->rel_err,

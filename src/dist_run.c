@@ -89,6 +89,10 @@ static int walks(const ulam_part *p, const ulam_comm *c, const ulam_dist_ask *a,
                      : ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the intervals");
     else status = ulam__dist_forward_ci(p, c, &a->o, a->index ? a->index[0] : -1, ans->x, ans->se, &ans->r,
                                         a->index ? ans->ci : NULL, err);
+    if (!status && a->mode == ULAM_DIST_FORWARD && a->index && a->rel_err > 0) { /* no stop rule: judged after */
+        const ulam_dist_ci *ci = ans->ci; /* the walks, on the interval the report prints */
+        ans->ci[0].met = isfinite(ci->lo) && isfinite(ci->hi) && (ci->hi - ci->lo) / 2 <= a->rel_err * fabs(ans->r.estimate);
+    }
     ans->iterations = a->mode == ULAM_DIST_MCSA ? mi.iterations : a->mode == ULAM_DIST_SOURCE ? si.rounds : 0;
     ans->residual = a->mode == ULAM_DIST_MCSA ? mi.residual : a->mode == ULAM_DIST_SOURCE ? si.residual : 0.0;
     if (!status && (a->mode != ULAM_DIST_FORWARD || a->bound))

@@ -48,7 +48,7 @@ static const struct help_row {
     "  --json       print one JSON object\n"},
     {"direct",
     "usage: ulam direct M.mtx --rhs b.mtx [--index I] [--out x.mtx] [--max-mem SIZE]\n"
-    "                   [--lu auto|sparse|dense] [--jacobi [--omega W]] [--json]\n"
+    "                   [--lu auto|sparse|dense] [--jacobi [--omega W]] [--json] [--quiet]\n"
     "\n"
     "Solve (I - M) x = b with a sparse LU factorisation (UMFPACK) for a large sparse M, else\n"
     "a dense one (LAPACKE_dgesv, OpenBLAS), and report the reciprocal condition number (dense:\n"
@@ -64,7 +64,8 @@ static const struct help_row {
     "  --jacobi        the file holds A of A x = b; solve with M = I - omega D^-1 A\n"
     "  --omega W       damping of the Jacobi splitting (default 1)\n"
     "  --pagerank A    (or --damping) the file is an adjacency matrix: solve PageRank at damping A\n"
-    "  --json          print one JSON object\n"},
+    "  --json          print one JSON object\n"
+    "  --quiet, -q     print the answer lines alone (x_I, or the first ten; nothing with --out)\n"},
     {"solve",
     "usage: ulam solve M.mtx --rhs b.mtx --index I [--mode adjoint|forward]\n"
     "                  [--estimator collision|absorption|expected] [--walks N] [--rel-err E]\n"

@@ -11,8 +11,8 @@ static void entry(FILE *f, const ulam_direct_report *d, int64_t i)
             d->x[i]);
 }
 
-/* Write the report as text. */
-static void direct_text(FILE *f, const ulam_direct_report *d)
+/* Write the report as text (quiet: the answer lines alone, as solve --quiet). */
+static void direct_text(FILE *f, const ulam_direct_report *d, int quiet)
 {
     if (d->index > 0) { /* the answer first */
         entry(f, d, d->index - 1);
@@ -20,6 +20,7 @@ static void direct_text(FILE *f, const ulam_direct_report *d)
         for (int64_t i = 0; i < d->n && i < 10; i++) entry(f, d, i);
         if (d->n > 10) fprintf(f, "...        (%lld more: use --out or --index)\n", (long long)(d->n - 10));
     }
+    if (quiet) return;
     fprintf(f, "n          %lld\n", (long long)d->n);
     fprintf(f, "method     %s\n", d->sparse ? "sparse LU (UMFPACK)" : "dense LU (LAPACK)");
     fprintf(f, "rcond      %.3e\n", d->info.rcond);
@@ -49,6 +50,6 @@ int ulam__report_direct_fprint(FILE *f, const void *report, int format)
     const ulam_direct_report *d = report;
     if (!d->x || !d->answer_name || d->n < 0 || d->index > d->n) return ULAM_EINVAL;
     if (format == ULAM_REPORT_JSON) direct_json(f, d);
-    else direct_text(f, d);
+    else direct_text(f, d, format == ULAM_REPORT_QUIET);
     return 0;
 }

@@ -123,6 +123,23 @@ CASES += [
       "1000"], 5, r"", r"^pi\[3\] (.|\n)*NOT met"),
     (["solve", D + "graph7.txt", "--pagerank", "0.85", "--queries", D + "graph7_queries.txt", "--rel-err", "1e-6",
       "--walks", "1000"], 5, r"graph7_queries.txt: \d+ of \d+ relative-error targets NOT met .*exit 5", r"^pi\["),
+    # exit17: "met" is the printed interval's.  chain4's push leaves a residual of 1.7e-19, so the
+    # interval (the walks' clipped to the walk part's certified bound, plus the push's rounding) is
+    # +-2.8e-13, within 1e-12 |x|, while the walk rule's own interval kept a bias floor of 1e-6 |x|:
+    # it said NOT met and exited 5; a push that leaves no residual (dag5) never ran the walk rule
+    # and said NOT met (the fourth moment "infinite") beside an exact x
+    (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "1", "--rel-err", "1e-12", "--method",
+      "bidirectional"], 0, r"^$", r"^x\[1\] .*95% CI 2\.93291731669\d* \.\. 2\.93291731669\d*\)\nrel-err +met \(target 1e-12\)\n"),
+    (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "1", "--rel-err", "1e-12", "--json"], 0, r"^$",
+     r'"method": "bidirectional".*"rel_err_met": true'),
+    (["solve", D + "dag5.mtx", "--index", "5", "--source", "1", "--rel-err", "0.1", "--method", "bidirectional"], 0, r"^$",
+     r"^x\[5\] +0 \+- 0 \(95% CI 0 \.\. 0\)\nrel-err +met \(target 0\.1\)\n(.|\n)*walks +none: the push left no residual"),
+    # exit17: direct --quiet printed its whole report (n, method, rcond, residual, seconds): now the
+    # answer lines alone, as solve --quiet
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--quiet"], 0, r"^$",
+     r"\Ax\[1\] +2\.93291731669266\d*\nx\[2\] +2\.34009360374415\d*\nx\[3\] +\S+\nx\[4\] +\S+\n\Z"),
+    (["direct", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "2", "-q"], 0, r"^$",
+     r"\Ax\[2\] +2\.34009360374415\d*\n\Z"),
     # newuser15: the answer (with its interval where there is one) is the first line
     (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--method", "gmres", "--index", "2"], 0, r"^$",
      r"\Ax\[2\] +2\.3400936\d* \(certified range 2\.34009\d* \.\. 2\.34009\d*\)\nmethod +gmres(.|\n)*\nrange +every x_i within "),
@@ -382,9 +399,27 @@ CASES += [
      r"walks +3000 matrix gather walks.*\n +\(one walk a channel: 1000 R \+ 1000 G \+ 1000 B\)"),
 ]
 for extra in ([], ["--mode", "shoot"], ["--matrix-walk"]):  # a zero answer ends --rel-err (it spun forever)
-    CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 0,
+    CASES.append((["radiosity", R + "small_gap.obj", "--patch", "3", "--rel-err", "0.01"] + extra, 5,  # not met: exit 5 (exit17)
                   r"^ulam radiosity: warning: .*small_gap.obj: patch 3 is only 168 float steps across where it lies",
                   r"\Aradiosity R  0 \+- 0.*\n.*\n.*\n(.*\n)*note .*exactly 0 .*after \d+ walks.*\n.*--rel-err can never be met"))
+# exit17: radiosity --rel-err not met exits 5, as solve does (it exited 0: a script could not tell), with
+# the line that says so; met exits 0
+CASES += [
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.01", "--walks", "2000"], 5,
+     r"the rule needs about .* walks", r"\Aradiosity R .*95% CI(.|\n)*\nrel-err +NOT met \(0\.01; "),
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.01", "--walks", "2000", "--json"], 5,
+     r"", r'"rel_err_met": false'),
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--rel-err", "0.1", "--no-mesh-error"], 0, r"^$",
+     r"\nrel-err +met \(0\.1; "),
+    (["radiosity", SC + "cornell_box.obj", "--mode", "shoot", "--rel-err", "0.01", "--walks", "2000"], 5,
+     r"the rule needs about", r"\nrel-err +NOT met on the whole scene: "),
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--matrix-walk", "--rel-err", "0.001", "--ff-rays", "100",
+      "--walks", "2000"], 5, r"", r"\nrel-err +NOT met in R: the form factors' error alone"),
+    (["radiosity", SC + "cornell_box.obj", "--patch", "floor", "--matrix-walk", "--rel-err", "0.2", "--ff-rays", "20000",
+      "--walks", "100", "--no-mesh-error"], 5, r"", r"\nrel-err +NOT met \(0\.2; every channel's walks to its target: "),
+    (["radiosity", SC + "cube.obj", "--view-gather", "--rel-err", "0.01", "--image", "/dev/null", "--size", "16x16",
+      "--walks", "100"], 5, r"", r"\nwarning +1 seen patches stopped short of their target"),
+]
 # --max-mem that holds F but not the dense solve of F's noise: the matrix walk runs, its error bar labelled
 CASES.append((["radiosity", SC + "cube.obj", "--subdivide", "0.04", "--ff-rays", "100", "--patch", "1", "--matrix-walk",
                "--max-mem", "50M", "--walks", "20000", "--no-mesh-error"], 0, r"^$",
@@ -483,7 +518,7 @@ def check_radiosity_next_event(ulam):
         assert j["image"] == png and not png_black(png)
         rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "150", "--view-gather",
                                   "--rel-err", "0.1", "--image", png, "--size", "16x16", "--walks", "1000"])
-        assert rc == 0 and re.search(r"^view +\d+ of \d+ patches seen", out, re.M), out
+        assert rc == 5 and re.search(r"^view +\d+ of \d+ patches seen", out, re.M), out  # not met: 5 (exit17)
         assert re.search(r"^warning +\d+ seen patches stopped short of their target", out, re.M), out
 
 
@@ -500,7 +535,7 @@ def check_radiosity_rare_lamp(ulam):
     for seed in range(1, 11):
         rc, out, err = run(ulam, ["radiosity", scene, "--patch", "floor", "--rel-err", "0.05", "--walks", "20000",
                                   "--estimator", "collision", "--json", "--seed", str(seed)])
-        assert rc == 0, err
+        assert rc == 5, err  # not met: exit 5 (exit17; it exited 0)
         j = json.loads(out)
         assert j["rel_err_met"] is False and j["min_walks"] > 1e6 and j["walks"] == 20000, (seed, j)
         assert "--estimator next-event samples the emitters directly" in err, (seed, err)
@@ -580,12 +615,13 @@ def check_radiosity_zero_notes(ulam):
             for extra in (["--patch", "1", "--rel-err", "0.05", "--no-mesh-error"], ["--at", "0.5,0.5,0"],
                           ["--grid", "0,0,0.5:1,1,0.5:0.5:0,0,1", "--walks", "1000"]):
                 rc, out, err = run(ulam, ["radiosity", scene] + extra)
-                assert rc == 0 and re.search(r"^ *note +" + want, out, re.M), (name, extra, out, err)
+                target = 5 if "--rel-err" in extra else 0  # "--rel-err can never be met by a zero estimate" (exit17)
+                assert rc == target and re.search(r"^ *note +" + want, out, re.M), (name, extra, out, err)
                 rc, out, err = run(ulam, ["radiosity", scene, "--json"] + extra)
                 o = json.loads(out)
                 why = [o.get("zero_reason")] if "--patch" in extra else [p["zero_reason"] for p in o["points"]] + \
                     [p["zero_reason"] for p in o.get("grid", {}).get("points", [])]
-                assert rc == 0 and why and set(why) == {"no_emitter" if name == "dark" else "inside_out"}, (name, extra, o)
+                assert rc == target and why and set(why) == {"no_emitter" if name == "dark" else "inside_out"}, (name, extra, o)
 
 
 def check_radiosity_check_side(ulam):
@@ -662,10 +698,11 @@ def check_radiosity_chosen(ulam):
         assert re.search(r"^half-width +95% half-width / B over the 4 lit chosen patches: median [\d.e-]+, 90% ", out,
                          re.M), out
         # --time is a stopping rule, not Ctrl-C: the final gather it cut said [INTERRUPTED], exit 130, no
-        # --out (the hall's floor, 60 s); now exit 0, the rows of the patches it reached, the others empty
+        # --out (the hall's floor, 60 s); now exit 5 (the target not met), the rows of the patches it reached, the
+        # others empty
         rc, out, err = run(ulam, ["radiosity", SC + "cornell_box.obj", "--subdivide", "20", "--mode", "final", "--patches",
                                   "floor", "--rel-err", "0.001", "--time", "0.5", "--out", csv])
-        assert rc == 0 and "INTERRUPTED" not in out and re.search(r"^rel-err +NOT met on the chosen patches", out, re.M), \
+        assert rc == 5 and "INTERRUPTED" not in out and re.search(r"^rel-err +NOT met on the chosen patches", out, re.M), \
             (rc, out, err)
         with open(csv) as f:
             rows = f.read().splitlines()[1:]
@@ -1951,7 +1988,7 @@ def check_radiosity_matrix_rel_err(ulam):
     assert all(abs(s * s - w * w - f * f) < 1e-12 for s, w, f in zip(j["stderr"], j["walk_stderr"], j["ff_stderr"])), j
     rc, out, err = run(ulam, ["radiosity", R + "black_emitter.obj", "--patch", "2", "--matrix-walk", "--rel-err", "0.05",
                               "--ff-rays", "20", "--no-mesh-error"])
-    assert rc == 0 and re.search(r"rel-err +NOT met in R: the form factors' error alone is \S+, past --rel-err 0.05", out), out
+    assert rc == 5 and re.search(r"rel-err +NOT met in R: the form factors' error alone is \S+, past --rel-err 0.05", out), out
 
 
 def check_radiosity_grid(ulam):

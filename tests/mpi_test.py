@@ -249,6 +249,33 @@ def check_partition_forward_index(ulam, mpirun, d):
             assert hi - lo < 3.0 * abs(x), lines[0]  # the length tail's: within +-150% of x (the second moment's: +-1e4)
 
 
+def check_partition_forward_rel_err(ulam, mpirun, d):
+    """exit17: --mode forward --index I --rel-err E on a partition.  Forward walks there have no stop
+    rule, yet --rel-err raised the default walks to 2^30 (chain4 at 2 ranks: still running at 120 s)
+    and the report said 'NOT met ... (no certified interval ...)' and exited 5 whatever the interval
+    (chain4 at 10^5 walks: 2.938 +- 0.0095, 95% CI 2.900 .. 3.004, within 0.05 |x|).  Now --rel-err
+    there needs --walks (a usage error naming the adjoint --index route, which stops at the target),
+    and the target is judged on x_I's printed interval after the walks: met (exit 0) or NOT met (exit 5),
+    the line saying the forward walks have no stop rule."""
+    sysf = f"{d}/c4f.ulam"
+    run([ulam, "prepare", "matrices/chain4.mtx", "--rhs", "matrices/chain4_b.mtx", "--transpose", "-o", sysf])
+    base = [mpirun, "--oversubscribe", "-np", "2", ulam, "solve", sysf, "--partition", "--mode", "forward", "--index", "1",
+            "--rel-err", "0.05"]
+    p = subprocess.run(base, capture_output=True, text=True, env=ENV, timeout=60)
+    assert p.returncode == 2 and "forward walks on a partition have no stop rule" in p.stderr and \
+        "--index I without --mode forward" in p.stderr, (p.returncode, p.stderr)
+    out = run(base + ["--walks", "100000"])
+    m = re.match(r"x\[1\] +(\S+) \+- \S+ \(95% CI (\S+) \.\. (\S+)\)\n", out)
+    assert m, out
+    est, lo, hi = (float(v) for v in m.groups())
+    assert (hi - lo) / 2 <= 0.05 * abs(est) and lo <= 2.932917317 <= hi, out
+    assert re.search(r"^rel-err +met \(target 0\.05; judged on the interval after --walks 100000: forward walks have no "
+                     r"stop rule\)$", out, re.M), out
+    out = run(base + ["--walks", "1000"], rc=5)
+    assert re.search(r"^rel-err +NOT met \(target 0\.05\) in --walks 1000 \(judged on the interval after them: forward "
+                     r"walks have no stop rule\)$", out, re.M), out
+
+
 def check_partition_forward_top(ulam, mpirun, d):
     """Issue 43: `--mode forward --top K` on a partition printed no table (--top ignored, exit 0).
     Now the K largest forward components, each with its certified range from x's residual (as
@@ -483,6 +510,7 @@ def check_partition_memory(ulam, mpirun, d):
 
 PARTITION_CHECKS = (("partition", check_partition), ("partition rows above 1", check_partition_growing),
                     ("partition forward index", check_partition_forward_index),
+                    ("partition forward rel-err", check_partition_forward_rel_err),
                     ("partition forward top", check_partition_forward_top),
                     ("partition rank killed", check_partition_kill),
                     ("partition rank stalled", check_partition_stall),

@@ -213,11 +213,12 @@ int cli_direct(int argc, char **argv)
         ulam_direct_report d = {.n = s.M->nrows, .x = x, .index = s.index, .list = !out, .sparse = plan.sparse,
                                 .info = info, .answer_name = cli_answer_name, .node_base = cli_node_base};
         cli_json_done |= json;
-        ulam_report_fprint(stdout, ULAM_REPORT_DIRECT, &d, json ? ULAM_REPORT_JSON : ULAM_REPORT_BRIEF);
+        ulam_report_fprint(stdout, ULAM_REPORT_DIRECT, &d, json ? ULAM_REPORT_JSON
+                                                           : cli_verbosity < 0 ? ULAM_REPORT_QUIET : ULAM_REPORT_BRIEF);
         cli_flush();
         if (out && (status = cli_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct")))
             rc = cli_report_write(out, status, errno);
-        else if (out && !json) printf("written    %s\n", out);
+        else if (out && !json && cli_verbosity >= 0) printf("written    %s\n", out); /* --quiet: the file is the answer */
     }
     free(x);
     cli_system_free(&s);

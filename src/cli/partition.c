@@ -45,7 +45,8 @@ static const char *const help =
     "  --walks N       histories (default 100000)       --seed S   the streams' key (default 1)\n"
     "  --rel-err E     (--index, --queries) stop a query at the first block of --batch walks whose\n"
     "                  interval's half-width is at most E |estimate|; --walks is then its most\n"
-    "                  (default 2^30)\n"
+    "                  (default 2^30).  --mode forward --index I: no stop rule; it needs --walks N\n"
+    "                  and judges x_I's interval after them (met, or NOT met: exit 5)\n"
     "  --max-steps N   cut a walk longer (default 1e6)  --batch N  walks a round starts (default 65536)\n"
     "  --sets K        the ranks in K sets, each a whole partition running its own batches (more\n"
     "                  memory a rank, no message between sets while walking; the same answer)\n"
@@ -144,6 +145,10 @@ static int check(args *a, int argc, char **argv, int first)
     if (a->rel_err > 0 && !a->index && !a->queries)
         return cli_usage_error("solve", "--rel-err with --partition and --index or --queries (forward mode, MCSA and "
                                         "--source give standard errors only)");
+    if (a->rel_err > 0 && a->forward && !a->walks_given) /* 2^30 walks (hours) for a verdict, no stop */
+        return cli_usage_error("solve", "--rel-err with --mode forward needs --walks N: forward walks on a partition have "
+                                        "no stop rule, so the target is only judged on x_I's interval after the N walks; "
+                                        "--index I without --mode forward (adjoint walks, the same x_I) stops at it");
     if (a->rel_err > 0 && !a->walks_given) a->o.walks = (int64_t)1 << 30;
     return 0;
 }
@@ -287,7 +292,7 @@ static int run(const args *a, const ulam_comm *c)
                 (long long)a->o.max_steps);
     if (!rc && c->rank == 0 && a->rel_err > 0) { /* "NOT met" printed (the report's count): exit 5 */
         int64_t met = 0, nq_met = ask.mode == ULAM_DIST_ADJOINT ? nq : 1;
-        for (int64_t k = 0; ask.mode == ULAM_DIST_ADJOINT && s.ci && k < nq; k++) met += s.ci[k].met;
+        for (int64_t k = 0; s.ci && k < nq_met; k++) met += s.ci[k].met; /* forward: x_I's, judged after the walks */
         if (met < nq_met) rc = EXIT_TARGET;
     }
     if (!rc && a->mcsa && s.residual > a->tol) {

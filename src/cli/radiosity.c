@@ -114,6 +114,7 @@ static const char *const usage_points =
     "                    a scale bar to --image; --walks and --rel-err per point, --time for all\n"
     "  --json            print one JSON object\n"
     "\n"
+    "A --rel-err target the report says is NOT met (or can never be met) exits 5, as in ulam solve.\n"
     "Ctrl-C stops the walks and prints the estimate so far (exit 130); a second Ctrl-C exits.\n";
 
 static const char *const est_names[] = {"collision", "absorption", "next-event"};
@@ -425,6 +426,7 @@ int cli_radiosity(int argc, char **argv)
     ulam_rad_run_print(run, stdout);
     cli_json_done = a.json;
     if (interrupted) rc = EXIT_INTERRUPTED;
+    else if (ulam_rad_run_rel_err_met(run) == 0) rc = EXIT_TARGET; /* printed "NOT met" (or "never"), as solve */
 done:
     ulam_rad_run_free(run);
     free((double *)a.at);

@@ -464,6 +464,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, c
     }
     int status = b && x && e && (a->o.mode == ULAM_ADJOINT || (w->all && w->all_se)) ? ULAM_OK : ULAM_ENOMEM;
     ulam_error err = {.status = status};
+    w->rel_err_met = a->o.stop.rel_err > 0 && a->o.mode == ULAM_ADJOINT; /* every channel's rule, F's error within */
     interrupt_on(a, 1);
     for (int c = 0; c < 3 && !status && !(a->o.stop.interrupt && *a->o.stop.interrupt); c++) {
         ulam_csr *M = NULL;
@@ -485,6 +486,7 @@ static int matrix_walks(const args *a, const ulam_scene *s, const ulam_csr *F, c
         ulam_solver_result(sv, &r);
         w->B[c] = r.estimate, w->se[c] = w->se_walk[c] = r.std_error;
         w->channel_walks[c] = r.walks;
+        w->rel_err_met &= r.rel_err_met && !w->ff_limited[c];
         w->walks += r.walks, w->steps += r.steps, w->seconds += r.seconds, w->cut += r.cut;
         w->threads = r.threads, w->interrupted |= r.interrupted;
         if (!status && w->all) {

@@ -300,6 +300,10 @@ static void print_text(FILE *f, const ulam_rad_run *run)
         if (a->o.stop.rel_err > 0 && !a->matrix_walk && !w->zero)
             fprintf(f, "rel-err      %s (%g; the rule's range term wants %.3g walks)\n", w->rel_err_met ? "met" : "NOT met",
                    a->o.stop.rel_err, w->min_walks);
+        else if (a->o.stop.rel_err > 0 && a->o.mode == ULAM_ADJOINT && !w->zero && !w->rel_err_met &&
+                 !(w->ff_limited[0] || w->ff_limited[1] || w->ff_limited[2])) /* (F's error past it: a line below) */
+            fprintf(f, "rel-err      NOT met (%g; every channel's walks to its target: %s)\n", a->o.stop.rel_err,
+                   w->interrupted ? "cut short" : "stopped by --walks, --time or the walk cap");
         if (w->zero)
             fprintf(f, "note         every channel is exactly 0 with zero variance after %lld walks (no walk scored):\n"
                    "             --rel-err can never be met by a zero estimate, so the walks stopped there; if the\n"
@@ -632,6 +636,19 @@ static void print_points(FILE *f, const ulam_rad_run *run)
 }
 
 /* The report (ulam_radiosity_run.h). */
+int ulam_rad_run_rel_err_met(const ulam_rad_run *run)
+{
+    const args *a = run ? run->a : NULL;
+    const walked *w = run ? run->r.w : NULL;
+    if (!a || !(a->o.stop.rel_err > 0) || run->listed || run->pointed) return -1; /* points: no rule stated */
+    if (a->view) return run->r.view.unmet ? 0 : 1; /* "stopped short of their target" */
+    if (!w) return -1;
+    if (w->zero) return 0;                                              /* "--rel-err can never be met" */
+    if (w->whole) return w->rel_err_met;                                /* the whole scene's (or --patches') rule */
+    if (run->r.patch >= 0 && (!a->matrix_walk || a->o.mode == ULAM_ADJOINT)) return w->rel_err_met;
+    return -1;
+}
+
 void ulam_rad_run_print(const ulam_rad_run *r, FILE *f)
 {
     if (r->listed) print_list(f, r->a, r->s, r->want);
