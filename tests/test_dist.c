@@ -361,6 +361,16 @@ static void test_dist_mcsa(void **state)
     unlink(path);
 }
 
+/* col = (I - M)^-1 e_s by LAPACK, M from the prepared file at path (e: n zeros on entry). */
+static void exact_column(const char *path, int64_t s, double *e, double *col)
+{
+    ulam_system *sys = NULL;
+    assert_int_equal(ulam_system_open(path, NULL, &sys, NULL), ULAM_OK);
+    e[s] = 1.0;
+    assert_int_equal(ulam_direct_solve(ulam_system_matrix(sys), e, col, 0, NULL, NULL), ULAM_OK);
+    ulam_system_free(sys);
+}
+
 /* Single source on a partition: x = (I - M)^-1 e_s within 4 standard errors of LAPACK's column
  * wherever the walks gave one (the push's own part exact), at least 90% within 1.96, the same
  * bits at 1, 2 and 3 ranks and in 2 sets of 2. */
@@ -374,11 +384,7 @@ static void test_dist_source(void **state)
     double *ref = malloc((size_t)n * sizeof *ref), *rse = malloc((size_t)n * sizeof *rse);
     double *y = malloc((size_t)n * sizeof *y), *yse = malloc((size_t)n * sizeof *yse);
     make_system(path, n, 5, 18, x);
-    ulam_system *sys = NULL;
-    assert_int_equal(ulam_system_open(path, NULL, &sys, NULL), ULAM_OK);
-    e[s] = 1.0;
-    assert_int_equal(ulam_direct_solve(ulam_system_matrix(sys), e, col, 0, NULL, NULL), ULAM_OK);
-    ulam_system_free(sys);
+    exact_column(path, s, e, col);
     for (int k = 1; k <= 4; k++) {
         job jobs[MAXR];
         memset(y, 0, (size_t)n * sizeof *y), memset(yse, 0, (size_t)n * sizeof *yse);
@@ -487,11 +493,7 @@ static void test_dist_source_interval(void **state)
     double *x = malloc((size_t)n * sizeof *x), *col = calloc((size_t)n, sizeof *col), *e = calloc((size_t)n, sizeof *e);
     double *y = malloc((size_t)n * sizeof *y), *yse = malloc((size_t)n * sizeof *yse), half[200];
     make_pagerank(path, n, 5, x);
-    ulam_system *sys = NULL;
-    assert_int_equal(ulam_system_open(path, NULL, &sys, NULL), ULAM_OK);
-    e[s] = 1.0;
-    assert_int_equal(ulam_direct_solve(ulam_system_matrix(sys), e, col, 0, NULL, NULL), ULAM_OK);
-    ulam_system_free(sys);
+    exact_column(path, s, e, col);
     for (int outer = 3; outer <= 5; outer += 2) {
         const double *exact = outer == 3 ? col : x;
         ulam_dist_top first[5];
