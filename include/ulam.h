@@ -1199,7 +1199,8 @@ typedef struct ulam_fpush_info {
     double residual_bound; /* ||r||_1 / (1 - ||M||_1): the most the walks' part of any x_i can be
                               (INFINITY: ||M||_1 >= 1, no bound) */
     int64_t walks, steps;  /* the walks and their transitions */
-    int interrupted;
+    int interrupted;       /* 1: by opts->walk.stop.interrupt; 2: walk.stop.max_seconds ended the walks (the
+                              top-K target's push takes at most a quarter of it): intervals wider than planned */
     double seconds, push_seconds, walk_seconds;
     double rel_err, min_value; /* the target the walks were planned for: relative error rel_err at every x_i
                                   whose interval reaches min_value (ulam_fpush_top with min_value <= 0: the

@@ -251,10 +251,10 @@ typedef struct ulam_dist_answer {
     double worst;              /* MCSA, single source, forward with bound: the largest certified half-width */
     int iterations;            /* MCSA: iterations; single source: the push's products with M */
     double residual;           /* MCSA: max |r| / max |b| at the end; single source: max |r| left to the walks */
-    int terminal;              /* single source, forward's top table: 1 when the walks scored only where they
-                                  end (M >= 0, b >= 0, column sums of M below 1): each top entry's interval
-                                  is then its end count's 95% interval (overlapped with the certified range
-                                  where one is made); 0: collision walks */
+    int terminal;              /* single source, forward's top table: 1 when the walks also counted where
+                                  they end (M >= 0, b >= 0, column sums of M below 1, no walk cut): each top
+                                  entry's interval is then its end count's 95% interval (overlapped with the
+                                  certified range where one is made); 0: the certified range alone */
 } ulam_dist_answer;
 
 /* Run ask on the part (every rank of comm together): the variance guard (ulam_dist_radius), then

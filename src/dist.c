@@ -50,7 +50,8 @@ typedef struct {
     const double *b;    /* forward: the sources' b at this rank's rows */
     int64_t steps, crossings, bytes, rounds, cut;
     int many;           /* a batch of two or more queries: query k walks on seed ulam_rng_substream(seed, QUERY, k) */
-    int terminal;       /* forward: a walk tallies only where it ends, its weight / (1 - min(1, S)) (S that row's sum) */
+    int terminal;       /* forward: each walk also tallies where it ends, at row -1 - s (an end count, settle) */
+    double *ends_at;    /* terminal: the walks that ended at each of this rank's rows (exact integers) */
 } run;
 
 /* The defaults. */
@@ -96,15 +97,14 @@ static int advance(run *R, particle x, int forward)
 {
     const ulam_part *p = R->p;
     for (;;) {
-        if (forward && !R->terminal) {
+        if (forward) {
             tally e = {x.s, x.w, x.t, x.wt};
             if (push(&R->tallies, &e, sizeof e)) return ULAM_ENOMEM;
-        } else if (!forward) {
+        } else {
             x.score += x.wt * p->b[x.s - p->first];
         }
         if (!move(p, forward ? &p->t : &p->m, &R->o, R->many, &x)) {
-            double S = forward ? p->t.rowsum[x.s - p->first] : 0.0;
-            tally e = {x.s, x.w, x.t, x.wt / (1.0 - (S < 1.0 ? S : 1.0))}; /* ends here with probability 1 - min(1, S) */
+            tally e = {-1 - x.s, x.w, x.t, 1.0}; /* ended here (with probability 1 - min(1, S) at each visit) */
             if (forward && R->terminal && push(&R->tallies, &e, sizeof e)) return ULAM_ENOMEM;
             break;
         }
@@ -573,6 +573,10 @@ static int settle(run *R, double *sum, double *sumsq, int64_t watch, int64_t w0,
     const tally *t = R->tallies.a;
     int64_t at = -1; /* the watched row's first total (its walks in order) */
     for (int64_t q = 0; p->set == 0 && q < R->tallies.len; q++) {
+        if (t[q].s < 0) { /* an end count (terminal: ends sorted first, rows -1 - s) */
+            R->ends_at[-1 - t[q].s - p->first] += t[q].v;
+            continue;
+        }
         sum[t[q].s - p->first] += t[q].v;
         sumsq[t[q].s - p->first] += t[q].v * t[q].v;
         if (t[q].s == watch && at < 0) at = q;
@@ -608,7 +612,8 @@ static int forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
         if (!isfinite(b[i])) return ulam__fail(err, ULAM_EINVAL, 0, p->first + i, "a finite b");
     run R;
     int status = start(&R, p, comm, o, 1, err);
-    R.b = b, R.terminal = hits != NULL;
+    R.b = b, R.terminal = hits != NULL, R.ends_at = hits;
+    if (hits) memset(hits, 0, (size_t)(p->last - p->first) * sizeof *hits);
     int64_t rows = p->last - p->first, nb = 0;
     double *sum = calloc((size_t)rows + 1, sizeof *sum), *sumsq = calloc((size_t)rows + 1, sizeof *sumsq), *P = NULL;
     if (!status && (!sum || !sumsq)) status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for %lld sums", (long long)rows);
@@ -630,7 +635,6 @@ static int forward(const ulam_part *p, const ulam_comm *comm, const ulam_dist_op
         double mean = sum[i] / N, var = (sumsq[i] - sum[i] * mean) / (N - 1.0);
         if (x) x[i] = mean;
         if (se) se[i] = zero_b ? 0.0 : sumsq[i] == 0.0 ? NAN : N > 1 ? sqrt(fmax(var, 0.0) / N) : NAN;
-        if (hits) hits[i] = sumsq[i] > 0 ? nearbyint(sum[i] * sum[i] / sumsq[i]) : 0.0; /* h equal tallies v: h^2 v^2 / (h v^2) */
     }
     if (mass) *mass = P ? P[nb] : 0.0;
     if (!status && S && zero_b) m[0] = N; /* b = 0: x = 0, every history 0 */

@@ -157,17 +157,18 @@ static int ends_apply(const ulam_part *p, const ulam_comm *c, const double *r)
     return neg == 0.0 && cmax < 1.0;
 }
 
-/* The 95% interval of x_i = p_i + y_i from h of N walks ending at row i, each scoring 0 or R
- * (y_i = h R / N; h = 0: R from mass and the row's sum S): p_i + R [a, b], b from the KL interval
- * of a count fixed in advance, a from the one at the lower index of K chosen of n by estimate
- * (ulam__stop_lower_index). */
-static void ends_interval(double p, double y, double h, int64_t N, double mass, double S, int64_t K, int64_t n,
+/* The 95% interval of x_i = p_i + y_i from h of N walks ending at row i (column sum S of M),
+ * each end worth R = mass / (1 - S): p_i + R [a, b], b from the KL interval of a count fixed in
+ * advance, a from the one at the lower index of K chosen of n by estimate
+ * (ulam__stop_lower_index); widened to hold the printed estimate x (the collision walks' y_i, from
+ * the same walks: a superset keeps the coverage). */
+static void ends_interval(double p, double x, double h, int64_t N, double mass, double S, int64_t K, int64_t n,
                           double *lo, double *hi)
 {
-    double R = h > 0 ? y * (double)N / h : mass / (1.0 - S), a, b, a2, b2;
+    double R = mass / (1.0 - S), a, b, a2, b2;
     ulam__stop_kl_interval(N, h / (double)N, 0, &a, &b);
     ulam__stop_kl_interval(N, h / (double)N, ulam__stop_lower_index(0, K, n), &a2, &b2);
-    *lo = p + R * a2, *hi = p + R * b;
+    *lo = fmin(p + R * a2, x), *hi = fmax(p + R * b, x);
 }
 
 /* As ulam_dist_source (source -1: from the system's b, max_rounds 0 for no push), the walks' counts
@@ -208,15 +209,16 @@ int ulam__dist_source(const ulam_part *p, const ulam_comm *comm, int64_t source,
     }
     info->residual = rmax;
     ulam_dist_result res = {0};
-    if (!status) /* (I - M)^-1 r by walks: where they end when that applies (r >= 0 too: M >= 0 and e_s) */
+    if (!status) /* (I - M)^-1 r by walks, their ends counted when that applies (r >= 0 too: M >= 0 and e_s) */
         status = ends > 0 ? ulam__dist_forward_ends(p, comm, o, r, y, se, h, &mass, &res, err)
                           : ulam__dist_forward_b(p, comm, o, r, y, se, &res, err);
     if (!status && (from_set0(p, comm, y) || from_set0(p, comm, se) || (ends > 0 && from_set0(p, comm, h))))
         status = ulam__fail(err, ULAM_EIO, 0, -1, "an exchange that succeeds");
     int64_t N = o ? o->walks : ulam_dist_defaults().walks;
+    if (!status && ends > 0 && res.cut > 0) ends = 0; /* a walk cut at max_steps ended nowhere: no count holds x */
     for (int64_t i = 0; !status && i < rows; i++) {
         if (lo && hi && ends > 0 && rmax > 0.0)
-            ends_interval(x[i], y[i], h[i], N, mass, fmin(1.0, p->t.rowsum[i]), K, p->n, &lo[i], &hi[i]);
+            ends_interval(x[i], x[i] + y[i], h[i], N, mass, fmin(1.0, p->t.rowsum[i]), K, p->n, &lo[i], &hi[i]);
         else if (lo && hi)
             lo[i] = rmax == 0.0 ? x[i] : -INFINITY, hi[i] = rmax == 0.0 ? x[i] : INFINITY;
         x[i] += y[i];

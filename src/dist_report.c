@@ -11,7 +11,8 @@
  * finite, rho < 1). */
 static void estimate_fprint(FILE *f, int64_t i, double est, double se, double rho, const ulam_dist_ci *ci, int ends)
 {
-    const char *none = ends ? "no walk ended at it" : "no walk reached it: the push's part alone";
+    const char *none = ends ? "no walk reached it: the estimate is the push's part, the interval its end count's"
+                            : "no walk reached it: the push's part alone";
     fprintf(f, "x[%lld]%*s%.10g", (long long)i, ulam__report_pad("x", i, 16), "", est);
     int d = ci ? ulam__report_ci_digits(ci->lo, ci->hi) : 0;
     if (ci && ci->lo == ci->hi && ci->lo == est) fprintf(f, " +- 0 (95%% CI %.10g .. %.10g: b is 0, x is exactly 0)", ci->lo, ci->hi);
@@ -84,8 +85,8 @@ static void summary_fprint(FILE *f, const ulam_dist_ask *a, const ulam_dist_answ
     if (verbosity < 0) return;
     fprintf(f, "method          %s%s %s walks on %d rank%s, rows split by entries",
             a->mode == ULAM_DIST_MCSA ? "MCSA with " : a->mode == ULAM_DIST_SOURCE ? "push and " : "",
-            adjoint ? "adjoint" : "forward", s->terminal ? "terminal" : "collision", nranks, nranks == 1 ? "" : "s");
-    if (s->terminal) fprintf(f, " (each interval: the certified range and the end count's 95%% interval, overlapped)");
+            adjoint ? "adjoint" : "forward", "collision", nranks, nranks == 1 ? "" : "s");
+    if (s->terminal) fprintf(f, " (each interval: the walks' end count's 95%% interval and the certified range, overlapped)");
     if (c->sets > 1) fprintf(f, " within each of %d sets", c->sets);
     fprintf(f, "\n");
     if (s->rho < 1.0) fprintf(f, "variance        finite (rho(M^) <= %.6g, certified)\n", s->rho);

@@ -51,6 +51,10 @@
                                       would bet as if the variance were the largest) */
 #define ULAM__FPUSH_LOCAL_SHARE 16 /* the top-K target's queue push gives way to the sweeps once its operations pass
                                       nnz / this (a sixteenth of a sweep: a queue push's operation reads at random) */
+#define ULAM__FPUSH_TIME_PUSH 0.25 /* the share of max_seconds the top-K target's queue push may take (the walks the rest) */
+#define ULAM__FPUSH_TIME_NEXT 4.0   /* a halving of rmax costs up to this many times the round before (R-MAT 2^24, source
+                                       101: 3.1e5 -> 1.4e6 operations in one halving) */
+#define ULAM__FPUSH_TIME_OPS 16     /* with a deadline the queue push stays local to nnz / ULAM__FPUSH_LOCAL_SHARE times this */
 #define ULAM__FPUSH_NEG_PASSES 32     /* passes of push_negative at most (its operations: a sweep's at most) */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
 #define ULAM__FPUSH_TRIM_EVERY 256  /* rows a queue push checks between trims of a large file's mapping
@@ -582,8 +586,8 @@ static int lane_move(walker *w, ulam_rng *rng, lane *L)
  * reads next prefetched while the others go on: their memory reads overlap, where one walk's
  * are a chain).  Every walk launched is walked to its end, and walks launch in order, so the
  * first count walks are taken whatever their lengths.  The walks made: count, or fewer when
- * *interrupt is set (checked every 1024 launches). */
-static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile int *interrupt)
+ * *interrupt is set (checked every 1024 launches) or the clock passes until (ulam_now(), every 256). */
+static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile int *interrupt, double until)
 {
     lane L[ULAM__FPUSH_LANES] = {{0}};
     int64_t launched = 0;
@@ -599,7 +603,8 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
                 int64_t j = walk_start(w, rng);
                 L[l].on = 1, L[l].neg = w->r[j] < 0, launched++;
                 lane_arrive(w, rng, &L[l], j);
-                more = launched < count && !((launched & 1023) == 0 && interrupt && *interrupt) && !w->status;
+                more = launched < count && !((launched & 1023) == 0 && interrupt && *interrupt) && !w->status &&
+                       !((launched & 255) == 0 && ulam_now() > until);
                 if (w->store_of && launched % ULAM__FPUSH_TRIM_WALKS == 0) ulam__system_trim(w->store_of);
             }
             busy |= L[l].on;
@@ -913,9 +918,12 @@ static int tr_row_ok(const void *ctx, int64_t j, int64_t *bad)
  * in a small part of the graph stops here, not in sweeps of all of it).  x and r
  * (zero on entry) get p and the residual, swi the counts and delta; *local 0 instead (x and r
  * untouched, pl->delta the floor so far) once the push's operations pass nnz /
- * ULAM__FPUSH_LOCAL_SHARE: the residual has spread, and whole sweeps do better than a queue. */
+ * ULAM__FPUSH_LOCAL_SHARE: the residual has spread, and whole sweeps do better than a queue.
+ * With a deadline (until finite: max_seconds) it stays local (a sweep cannot stop between rows)
+ * and halves no further once the next round, ULAM__FPUSH_TIME_NEXT times the last, would pass
+ * until, or its operations pass ULAM__FPUSH_TIME_OPS times that share. */
 static int push_top(const ulam_csr *Mt, const ulam_system *sys, int64_t s, int64_t K, double floor, plan *pl, int64_t cap,
-                    double *x, double *r, ulam__sweep_info *swi, int *local, ulam_error *err)
+                    double until, double *x, double *r, ulam__sweep_info *swi, int *local, ulam_error *err)
 {
     int64_t m = 0, vmax = 0;
     ulam_push *w = NULL;
@@ -928,13 +936,15 @@ static int push_top(const ulam_csr *Mt, const ulam_system *sys, int64_t s, int64
     if (!status) status = ulam__push_start(w, s);
     const int32_t *t = NULL;
     while (!status) {
+        double tr = ulam_now();
         if ((status = ulam__push_run(w, rmax, cap))) {
             if (status == ULAM_ESYNTAX && sys) ulam__system_tr_verify(sys, ulam__push_bad_row(w), ulam__push_bad_row(w) + 1, err);
             break;
         }
         t = ulam__push_touched(w, &m);
         ulam__push_report(w, &pi);
-        if (pi.ops >= ulam_csr_nnz(Mt) / ULAM__FPUSH_LOCAL_SHARE) {
+        int late = isfinite(until) && ulam_now() + ULAM__FPUSH_TIME_NEXT * (ulam_now() - tr) > until; /* the next round */
+        if (pi.ops >= ulam_csr_nnz(Mt) / ULAM__FPUSH_LOCAL_SHARE && !isfinite(until)) {
             *local = 0;
             break;
         }
@@ -950,6 +960,7 @@ static int push_top(const ulam_csr *Mt, const ulam_system *sys, int64_t s, int64
         }
         double ww = walk_work(pi.r_sum, pl);
         if (pi.support == 0 || (double)pi.ops >= ww || ww <= walk_work(0.0, pl)) break; /* the walks at their least */
+        if (late || pi.ops >= ulam_csr_nnz(Mt) / ULAM__FPUSH_LOCAL_SHARE * ULAM__FPUSH_TIME_OPS) break; /* the time's */
         rmax /= 2;
     }
     if (!status && *local) {
@@ -1028,8 +1039,10 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     int status = ULAM_OK, local = 0;
     ulam__sweep_release rel = {.fn = release_rows, .trim = trim_file, .ctx = lz}; /* a large file's pages given back as passes go */
     const ulam__sweep_release *relp = ulam__system_releases(lz) ? &rel : NULL;
+    double T = o->walk.stop.max_seconds, until = T > 0 ? t0 + T : INFINITY; /* the walks' deadline */
     if (top > 0 && top < n && !(o->rmax > 0) && o->walks <= 0) /* the top-K target: a local push, the floor planned */
-        status = push_top(Mt, lz, o->source, top, o->min_value, &pl, cap, x, r, swi, &local, err);
+        status = push_top(Mt, lz, o->source, top, o->min_value, &pl, cap, T > 0 ? t0 + ULAM__FPUSH_TIME_PUSH * T : INFINITY, x, r,
+                          swi, &local, err);
     if (status == ULAM_ESYNTAX) { /* a damaged block of the file, named in err */
         free(r), free(w.cs), free(w.mx);
         return status;
@@ -1129,7 +1142,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
                 break;
             }
             if (sgn) cs_plan_all(&S, &w, x, N, R0, pl.E, pl.delta, o->walks > 0 ? (double)o->walks : 0.0);
-            int64_t made = N < target ? walk_many(&w, &rng, target - N, o->walk.stop.interrupt) : 0;
+            int64_t made = N < target ? walk_many(&w, &rng, target - N, o->walk.stop.interrupt, until) : 0;
             if (w.status == ULAM_ENOMEM) {
                 status = ulam__fail(err, ULAM_ENOMEM, 0, w.bad, "memory for row %lld of M^T's values", (long long)w.bad + 1);
                 break;
@@ -1143,7 +1156,8 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
                 status = ulam__system_tr_verify(lz, w.bad, w.bad + 1, err);
                 break;
             }
-            if (made < target - N) info->interrupted = 1, planned = 0;
+            if (made < target - N) info->interrupted = w.status || (o->walk.stop.interrupt && *o->walk.stop.interrupt) ? 1 : 2,
+                                   planned = 0; /* 2: the deadline */
             N += made;
             if (sgn && cs_add_all(&S, &w, made, R0)) {
                 status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' sequences");

@@ -122,10 +122,11 @@ int ulam__dist_cw(const ulam_part *p, const ulam_comm *comm, int iters, double *
 int ulam__dist_forward_b(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b, double *x,
                         double *se, ulam_dist_result *res, ulam_error *err);
 
-/* As ulam__dist_forward_b with each walk scoring only where it ends, its weight / (1 - min(1, S))
- * (S the row's sum of |M'|): with M >= 0, b >= 0 and every S < 1 the scores at row i are 0 or one
- * value, so hits[i] (this rank's rows) counts the walks that ended there, a binomial count whose
- * KL interval holds x_i; *mass: ||b||_1 over every rank (the same bits at any split). */
+/* As ulam__dist_forward_b (x and se from the same collision tallies), with hits[i] the walks that
+ * ended at each of this rank's rows, counted exactly: with M >= 0, b >= 0 and every column sum S
+ * of M below 1, a walk ends at i with probability x_i (1 - S_i) / ||b||_1, so hits[i] is a binomial
+ * count whose KL interval, times ||b||_1 / (1 - S_i), holds x_i; *mass: ||b||_1 over every rank
+ * (the same bits at any split). */
 int ulam__dist_forward_ends(const ulam_part *p, const ulam_comm *comm, const ulam_dist_opts *o, const double *b,
                             double *x, double *se, double *hits, double *mass, ulam_dist_result *res, ulam_error *err);
 

@@ -65,13 +65,15 @@ static int reference_iterative(const ulam_csr *M, const double *b, double *x, ul
     int64_t n = M->nrows;
     ulam_reference_goal in = *g;
     if (in.index >= n) return ulam__fail(err, ULAM_EINVAL, 0, -1, "a goal index below n = %lld", (long long)n);
-    g->cg = ulam__csr_symmetric(M) != 0, g->cap = in.max_products > 0 ? in.max_products : reference_cap(M, g->cg);
     g->met = g->capped = g->rounds = 0, g->products = g->certificate = 0, g->lo = g->hi = NAN, g->reached = INFINITY;
     double *h = NULL, u = 1.0, target = in.half_width > 0 ? in.half_width : 0.0;
     double *r = ulam__malloc((size_t)n + 1, sizeof *r), *d = ulam__malloc((size_t)n + 1, sizeof *d);
     double *lo = ulam__malloc((size_t)n + 1, sizeof *lo), *hi = ulam__malloc((size_t)n + 1, sizeof *hi);
     double *keep = ulam__malloc((size_t)n + 1, sizeof *keep);
-    int status = r && d && lo && hi && keep ? ulam__bound_vector(M, &h, &u, &g->certificate) : ULAM_ENOMEM;
+    int status = r && d && lo && hi && keep ? ulam__bound_vector(M, &h, &u, &g->certificate) : ULAM_ENOMEM, conv = 0;
+    /* CG needs I - M positive definite: M symmetric with rho(|M|) <= u < 1 certified (else GMRES) */
+    g->cg = !status && u < 1.0 && ulam__csr_symmetric(M) != 0;
+    g->cap = in.max_products > 0 ? in.max_products : reference_cap(M, g->cg);
     double floor_tol = g->cg ? 1e-10 : 1e-8, worst, width = INFINITY;
     memset(x, 0, (size_t)n * sizeof *x);
     if (!status) {
@@ -99,7 +101,10 @@ static int reference_iterative(const ulam_csr *M, const double *b, double *x, ul
         if (s == ULAM_ENONFINITE) break; /* this round's correction is lost; x stands */
         memcpy(keep, x, (size_t)n * sizeof *x);
         for (int64_t i = 0; i < n; i++) x[i] += d[i];
-        if (!g->certified) break; /* one solve to the floor's residual: nothing to refine against */
+        if (!g->certified) { /* one solve to the floor's residual: nothing to refine against */
+            conv = s == ULAM_OK;
+            break;
+        }
         double was = width;
         int c = ulam__bound_range(M, b, x, h, u, lo, hi, &worst);
         if (c == -2) status = ULAM_ENOMEM;
@@ -123,8 +128,9 @@ static int reference_iterative(const ulam_csr *M, const double *b, double *x, ul
     free(r), free(d), free(lo), free(hi), free(keep), free(h);
     const char *name = g->cg ? "CG" : "GMRES(50)";
     if (status == ULAM_ENOMEM) return ulam__fail(err, status, 0, -1, "memory for the iterative reference (n = %lld)", (long long)n);
+    if (status == ULAM_EINVAL) return ulam__fail(err, status, 0, -1, "a square matrix for the %s reference", name);
     if (status) return ulam__fail(err, status, 0, -1, "a finite residual in the iterative reference (%s)", name);
-    if (g->met) return ULAM_OK;
+    if (g->met || (!g->certified && conv)) return ULAM_OK; /* uncertified: x to the floor's residual (g->certified 0) */
     if (!g->certified)
         return ulam__fail(err, ULAM_ENOCONV, 0, -1, "a vector certifying rho(|M|) below 1 for the %s reference's range "
                           "(it ran to a relative residual of %.3g in %lld products, uncertified)", name, info->residual,

@@ -215,10 +215,10 @@ static void table_head(FILE *f, const ulam_bidir_report *p)
                 p->pagerank > 0 ? "pi_i" : "x_i", t->residual_bound);
     if (!t->dense)
         fprintf(f, "walks           %lld (%lld steps)%s\n", (long long)t->walks, (long long)t->steps,
-                t->interrupted ? "  [INTERRUPTED]" : "");
+                t->interrupted == 1 ? "  [INTERRUPTED]" : t->interrupted ? "  (stopped at --time)" : "");
     if (t->min_value > 0 && !t->dense)
-        fprintf(f, "target          every 95%% interval honest; planned for relative error %.3g at values >= %.3g\n",
-                t->rel_err, t->min_value);
+        fprintf(f, "target          every 95%% interval honest; planned for relative error %.3g at values >= %.3g%s\n",
+                t->rel_err, t->min_value, t->interrupted == 2 ? " (--time ended the walks first: the intervals are wider)" : "");
     if (t->push.support > 0 && !isfinite(t->residual_bound)) /* the queue path (src/fpush.c) */
         fprintf(f, "intervals       the source's alone: with ||M||_1 >= 1 the other components' walk parts have no "
                    "certified range (none printed)\n");
@@ -244,7 +244,7 @@ static void table_text(FILE *f, const ulam_bidir_report *p, int format)
         if (none) fprintf(f, xd ? "%-25s" : "%s", "none");
         else fprintf(f, "%-12.6g %.6g", p->lo[k], p->hi[k]);
         if (xd) fprintf(f, "%*s%.8g", none ? 0 : 13 - (int)snprintf(NULL, 0, "%.6g", p->hi[k]), "", xd[i]);
-        if (k == 0 && format == ULAM_REPORT_QUIET && p->top->interrupted) fputs("  [INTERRUPTED]", f); /* the head's mark */
+        if (k == 0 && format == ULAM_REPORT_QUIET && p->top->interrupted == 1) fputs("  [INTERRUPTED]", f); /* the head's mark */
         fputc('\n', f);
     }
     if (format != ULAM_REPORT_QUIET) table_head(f, p);
@@ -281,7 +281,8 @@ static void table_json(FILE *f, const ulam_bidir_report *p)
         if (p->direct_x) ulam_json_number(f, "direct", p->direct_x[i], 1);
         fputc('}', f);
     }
-    fprintf(f, "], \"dense\": %s, \"interrupted\": %s}\n", t->dense ? "true" : "false", t->interrupted ? "true" : "false");
+    fprintf(f, "], \"dense\": %s, \"interrupted\": %s, \"stopped_at_time\": %s}\n", t->dense ? "true" : "false",
+            t->interrupted == 1 ? "true" : "false", t->interrupted == 2 ? "true" : "false");
 }
 
 /* ulam_report_fprint's ULAM_REPORT_BIDIR (src/report.h). */

@@ -444,6 +444,7 @@ static void test_dist_run(void **state)
         for (int r = 0; r < k; r++) rows += a->ranks[r];
         assert_int_equal(rows, n);
         assert_true(isfinite(a->worst) && a->iterations > 0 && a->r.walks == 20000 && a->r.steps > 0);
+        assert_int_equal(a->terminal, 0); /* signed M: collision walks, the certified range (no end counts) */
         if (k == 1) continue;
         run_ranks(k, path, 1, 0, 20000, fx, fx, fw); /* forward walks on the same split: their bytes a crossing */
         for (int r = 0; r < k; r++) assert_int_equal(fw[r].status, ULAM_OK);
@@ -483,7 +484,7 @@ static void make_pagerank(const char *path, int64_t n, uint64_t seed, double *x)
  * certified range alone was +-0.53 on R-MAT 2^22 where one process's intervals were 3.2e-4;
  * forward mode's top table had only that range): the same bits at 1, 2 and 3 ranks; over 40 seeds
  * at 2000 walks, of 200 top-5 intervals at least 180 hold LAPACK's x_i (at 95%, fewer than 180 has
- * probability < 0.01), and their median half-width under a tenth of the certified range's. */
+ * probability < 0.01), and their median half-width under a fifth of the certified range's. */
 static void test_dist_source_interval(void **state)
 {
     (void)state;
@@ -525,7 +526,7 @@ static void test_dist_source_interval(void **state)
         qsort(half, 200, sizeof *half, test_cmp_double);
         print_message("%s, 2000 walks: %d of 200 top-5 intervals hold x; median half-width %.3g (certified %.3g)\n",
                       outer == 3 ? "single source" : "forward", in, half[100], worst);
-        if (in < 180 || !(half[100] < 0.1 * worst))
+        if (in < 180 || !(half[100] < 0.2 * worst))
             fail_msg("%d of 200 intervals hold x; median half-width %.3g, certified %.3g", in, half[100], worst);
     }
     free(x), free(col), free(e), free(y), free(yse);

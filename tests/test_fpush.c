@@ -378,6 +378,42 @@ static void test_fpush_top_coverage(void **state)
     ulam_csr_free(M), ulam_csr_free(Mt);
 }
 
+/* A deadline (walk.stop.max_seconds) on the top-K target: before, ulam_fpush_top ignored it (R-MAT
+ * 2^24 --source 101 --top 100 --time 3 ran 109 s).  A deadline already past when the push starts
+ * (1e-9 s): the queue push stops after its first round, no whole sweep runs, the walks stop at
+ * their first check (256 launched, walked to their ends), info->interrupted is 2 (the deadline,
+ * not the interrupt flag), and over 16 seeds the 200 printed intervals of the 10 000-state
+ * digraph cover at the claimed rate. */
+static void test_fpush_top_deadline(void **state)
+{
+    (void)state;
+    int64_t n = 10000, s = 100, K = 200, N = 0, covered = 0;
+    ulam_csr *M = ba_graph(n, 4, 0.85, 1), *Mt = NULL;
+    assert_non_null(M);
+    assert_int_equal(ulam_csr_transpose(M, &Mt), ULAM_OK);
+    double *x = zipf_graph_column(M, s), *y = malloc((size_t)n * sizeof *y), *lo = malloc((size_t)K * sizeof *lo);
+    double *hi = malloc((size_t)K * sizeof *hi);
+    int64_t *idx = malloc((size_t)K * sizeof *idx);
+    for (int seed = 1; seed <= 16; seed++) {
+        if (!test_case(seed)) continue;
+        ulam_fpush_opts o = ulam_fpush_defaults();
+        o.source = s, o.walk.exec.seed = (uint64_t)seed, o.walk.stop.max_seconds = 1e-9;
+        ulam_fpush_info info;
+        ulam_error err;
+        assert_int_equal(ulam_fpush_top(M, Mt, &o, K, y, idx, NULL, lo, hi, &info, &err), ULAM_OK);
+        assert_int_equal(info.interrupted, 2);
+        assert_int_equal(info.walks, 256);
+        assert_true(info.push.ops < ulam_csr_nnz(M)); /* no whole sweep */
+        for (int64_t t = 0; t < K; t++) N++, covered += lo[t] <= x[idx[t]] && x[idx[t]] <= hi[t];
+    }
+    print_message("top %lld at a deadline (256 walks): %lld of %lld printed intervals cover\n", (long long)K,
+                  (long long)covered, (long long)N);
+    if (test_case_all()) assert_true(coverage_ok(covered, N));
+    test_case_done();
+    free(x), free(y), free(lo), free(hi), free(idx);
+    ulam_csr_free(M), ulam_csr_free(Mt);
+}
+
 /* A push that leaves no residual (a 300-state DAG numbered in topological order, M >= 0: one
  * sweep moves all the mass to p): no walk runs, and every interval still holds the exact x_i (by
  * substitution in long double), with the allowance for the push's rounding (before, [p_i, p_i]:
@@ -715,6 +751,7 @@ int main(void)
         cmocka_unit_test(test_fpush_queue_infinite),
         cmocka_unit_test(test_fpush_queue_certified),
         cmocka_unit_test(test_fpush_top_coverage),
+        cmocka_unit_test(test_fpush_top_deadline),
         cmocka_unit_test(test_fpush_exact_push),
         cmocka_unit_test(test_fpush_signed),
         cmocka_unit_test(test_fpush_lazy_blocks),

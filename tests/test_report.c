@@ -148,7 +148,7 @@ static void test_bidir(void **state)
     ulam_report_fprint(f, ULAM_REPORT_BIDIR, &q, ULAM_REPORT_JSON);
     s = written(f, &buf);
     assert_non_null(strstr(s, "\"top\": [{\"index\": 4, \"estimate\": 0.29999999999999999, "));
-    assert_non_null(strstr(s, "\"ci95\": [null, null]}], \"dense\": false, \"interrupted\": false}\n"));
+    assert_non_null(strstr(s, "\"ci95\": [null, null]}], \"dense\": false, \"interrupted\": false, \"stopped_at_time\": false}\n"));
     free(s);
     ulam_bidir_report none = {0};
     f = open_memstream(&buf, &len);

@@ -604,7 +604,8 @@ static PyObject *System_fpush(SystemObject *self, PyObject *args)
         put(d, "steps", PyLong_FromLongLong((long long)info.steps)) || put(d, "rmax", PyFloat_FromDouble(info.rmax)) ||
         put(d, "push_ops", PyLong_FromLongLong((long long)info.push.ops)) ||
         put(d, "residual_bound", PyFloat_FromDouble(info.residual_bound)) ||
-        put(d, "dense", PyBool_FromLong(info.dense)) || put(d, "interrupted", PyBool_FromLong(info.interrupted || flag)) ||
+        put(d, "dense", PyBool_FromLong(info.dense)) || put(d, "interrupted", PyBool_FromLong(info.interrupted == 1 || flag)) ||
+        put(d, "stopped_at_time", PyBool_FromLong(info.interrupted == 2)) ||
         put(d, "seconds", PyFloat_FromDouble(info.seconds)))
         goto fail_d;
     return d;

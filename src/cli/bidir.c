@@ -216,6 +216,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
     cli_catch_sigint(); /* Ctrl-C stops the walks: the table so far is printed, marked [INTERRUPTED] */
+    o.walk.stop.max_seconds = cli_time_left(bo->walk.stop.max_seconds); /* --time counts the reading and guards too */
     if (!status) status = ulam_fpush_top(W, T, &o, want, x, order, se, lo, hi, &info, &err);
     cli_release_sigint();
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
@@ -245,6 +246,7 @@ static int run_all(cli_system *s, int64_t source, int force, const ulam_bidir_op
         cli_json_done |= rp->json;
     }
     if (!rc && cli_interrupted) rc = EXIT_INTERRUPTED;
+    if (!rc && info.interrupted == 2 && bo->walk.stop.rel_err > 0) rc = EXIT_TARGET; /* --time ended it before --rel-err */
     if (!rc) rc = crc;
     if (crc == EXIT_INTERRUPTED && !cli_share) { /* the reference's thread still reads the system */
         cli_flush();

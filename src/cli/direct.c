@@ -90,16 +90,22 @@ static const char *iterative_method(const check_job *j)
     static char buf[400];
     const ulam_reference_goal *g = &j->goal;
     const char *name = g->cg ? "CG" : "GMRES(50)";
-    if (g->met && g->half_width > 0)
+    if (!g->certified)
+        snprintf(buf, sizeof buf, "%s to a relative residual of %.3g, %lld products, uncertified (no vector shows rho(|M|) "
+                 "below 1); the LU would pass 4 GiB", name, j->info.residual, (long long)g->products);
+    else if (g->met && g->half_width > 0)
         snprintf(buf, sizeof buf, "%s to a certified range of +-%.3g, wanted +-%.3g, %lld products; the LU would "
                  "pass 4 GiB", name, g->reached, g->half_width, (long long)g->products);
     else if (g->met)
         snprintf(buf, sizeof buf, "%s to a certified range of +-%.3g, as narrow as it got, %lld products; the LU "
                  "would pass 4 GiB", name, g->reached, (long long)g->products);
-    else
+    else if (g->half_width > 0)
         snprintf(buf, sizeof buf, "%s %s: certified only to +-%.3g, NOT the +-%.3g wanted; the LU would pass 4 GiB",
                  name, g->capped ? "stopped at its cap of products" : "stopped at the rounding's floor", g->reached,
                  g->half_width);
+    else
+        snprintf(buf, sizeof buf, "%s %s: certified to +-%.3g; the LU would pass 4 GiB", name,
+                 g->capped ? "stopped at its cap of products" : "stopped at the rounding's floor", g->reached);
     return buf;
 }
 
