@@ -415,8 +415,7 @@ static double rounding_allowance(const ulam_push *w, const ulam_push_info *push,
 static void rel_err_outcome(ulam_bidir_result *res, double E)
 {
     ulam_walk_result *w = &res->walks;
-    double half = 0.5 * (res->ci95[1] - res->ci95[0]);
-    w->rel_err_met = isfinite(half) && half <= E * fabs(res->estimate);
+    w->rel_err_met = ulam__stop_printed_met(res->ci95[0], res->ci95[1], res->estimate, E);
     if (w->rel_err_met) w->out_of_reach = 0, w->min_walks = fmin(w->min_walks, (double)w->walks);
 }
 

@@ -2,6 +2,7 @@
  * variance guard, the mode's walks, the certified range around x, single source's top table
  * (and forward mode's, when asked) gathered to rank 0 and each rank's rows and peak memory.  src/dist_report.c writes it. */
 #include "part.h"
+#include "stop.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -91,7 +92,7 @@ static int walks(const ulam_part *p, const ulam_comm *c, const ulam_dist_ask *a,
                                         a->index ? ans->ci : NULL, err);
     if (!status && a->mode == ULAM_DIST_FORWARD && a->index && a->rel_err > 0) { /* no stop rule: judged after */
         const ulam_dist_ci *ci = ans->ci; /* the walks, on the interval the report prints */
-        ans->ci[0].met = isfinite(ci->lo) && isfinite(ci->hi) && (ci->hi - ci->lo) / 2 <= a->rel_err * fabs(ans->r.estimate);
+        ans->ci[0].met = ulam__stop_printed_met(ci->lo, ci->hi, ans->r.estimate, a->rel_err);
     }
     ans->iterations = a->mode == ULAM_DIST_MCSA ? mi.iterations : a->mode == ULAM_DIST_SOURCE ? si.rounds : 0;
     ans->residual = a->mode == ULAM_DIST_MCSA ? mi.residual : a->mode == ULAM_DIST_SOURCE ? si.residual : 0.0;

@@ -291,3 +291,10 @@ int ulam__stop_lower_index(int k, int64_t K, int64_t n)
     while (j * (j + 1.0) < t) j++;
     return j < 1 ? 1 : (int)j;
 }
+
+/* Whether a printed interval meets relative error E. */
+int ulam__stop_printed_met(double lo, double hi, double est, double E)
+{
+    double half = 0.5 * (hi - lo);
+    return isfinite(half) && half <= E * fabs(est);
+}

@@ -191,6 +191,10 @@ double ulam__cs_var_walks(double m, double var, double E);
  * 3.7 / n), against the empirical-Bernstein range term 7 L / (3 (n - 1)) (about 9.6 / n). */
 void ulam__stop_kl_interval(int64_t n, double m, int k, double *lo, double *hi);
 
+/* Whether a printed interval [lo, hi] meets relative error E around est: finite, and its
+ * half-width within E |est| (src/stop.c). */
+int ulam__stop_printed_met(double lo, double hi, double est, double E);
+
 /* The stitching index whose delta, delta / (j (j + 1)), is at most K / n times index k's: the
  * lower ends of K components chosen of n by their estimates after the walks (src/stop.c). */
 int ulam__stop_lower_index(int k, int64_t K, int64_t n);
