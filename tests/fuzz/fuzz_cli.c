@@ -262,7 +262,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (strstr(err, "error: success")) fail("'error: success'", argv, out, err);
     if (strstr(err, "Sanitizer") || strstr(err, "runtime error:")) /* an instrumented ulam's report */
         fail("a sanitizer report", argv, out, err);
-    if (rc != 0) {
+    int rel_err = 0; /* a well-formed --rel-err asked: exit 5 (target not met) is then an answer */
+    for (int k = 1; argv[k] && argv[k + 1]; k++)
+        if (!strcmp(argv[k], "--rel-err") && strtod(argv[k + 1], NULL) > 0) rel_err = 1;
+    if (rc == 5 && !rel_err) fail("exit 5 (target not met) with no --rel-err asked", argv, out, err);
+    if (rc == 5 && !strstr(out, "\"rel_err_met\": false")) fail("exit 5 with no \"rel_err_met\": false", argv, out, err);
+    if (rc != 0 && rc != 5) {
         int known = rc == 2 || rc == 3 || rc == 4 || (rc >= 11 && rc <= 37);
         if (!known) fail("an unknown exit code", argv, out, err);
         char want[32];
