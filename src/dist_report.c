@@ -15,12 +15,13 @@ static void estimate_fprint(FILE *f, int64_t i, double est, double se, double rh
                             : "no walk reached it: the push's part alone";
     fprintf(f, "x[%lld]%*s%.10g", (long long)i, ulam__report_pad("x", i, 16), "", est);
     int d = ci ? ulam__report_ci_digits(ci->lo, ci->hi) : 0;
-    if (ci && ci->lo == ci->hi && ci->lo == est) fprintf(f, " +- 0 (95%% CI %.10g .. %.10g: b is 0, x is exactly 0)", ci->lo, ci->hi);
+    if (ci && ci->lo == ci->hi && ci->lo == est)
+        fprintf(f, " +- 0 (95%% CI %.10g .. %.10g: %s)", ci->lo, ci->hi, est == 0 ? "b is 0, x is exactly 0" : "exact");
     else if (!(rho < 1.0)) fprintf(f, " (no standard error: rho(M^) is not certified below 1)");
     else if (isnan(se) && ci && isfinite(ci->lo))
         fprintf(f, " (95%% CI %.*g .. %.*g; %s)", d, ci->lo, d, ci->hi, none);
     else if (isnan(se)) fprintf(f, " (%s)", none);
-    else if (ci && isfinite(ci->lo)) fprintf(f, " +- %.3g (95%% CI %.*g .. %.*g)", se, d, ci->lo, d, ci->hi);
+    else if (ci && isfinite(ci->lo)) ulam__report_pm_fprint(f, est, se, ci->lo, ci->hi);
     else if (ci) fprintf(f, " +- %.3g (standard error; no certified interval: no certified u < 1 for the walks' length tail or second moment)", se);
     else fprintf(f, " +- %.3g (standard error; no certified interval for forward walks on a partition)", se);
 }

@@ -21,6 +21,20 @@ int ulam__report_ci_digits(double lo, double hi)
     return p;
 }
 
+/* Write " +- H (95% CI lo .. hi)": H the standard error se, or, where a side of the interval is
+ * over ULAM__REPORT_PM_WIDE standard errors (a range term leads it: a push's certified residual, a
+ * score bound at few walks), that side's width, the standard error then named inside the
+ * parentheses: the first line's +- is never far narrower than the interval it stands beside. */
+void ulam__report_pm_fprint(FILE *f, double est, double se, double lo, double hi)
+{
+    int d = ulam__report_ci_digits(lo, hi);
+    double h = fmax(hi - est, est - lo);
+    if (h > ULAM__REPORT_PM_WIDE * se)
+        fprintf(f, " +- %.3g (95%% CI %.*g .. %.*g; standard error %.3g)", h, d, lo, d, hi, se);
+    else
+        fprintf(f, " +- %.3g (95%% CI %.*g .. %.*g)", se, d, lo, d, hi);
+}
+
 /* A radius in words: six decimals from 1e-4 to 1e6 (and 0, inf), six significant digits past them
  * (1e-23 is not 0.000000, 1e99 not a hundred digits); buf holds 32 characters. */
 const char *ulam__report_radius_str(char *buf, double x)

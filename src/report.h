@@ -15,6 +15,14 @@ int ulam__report_pad(const char *name, int64_t index, int column);
 /* The significant digits (10 to 17) that print an interval's ends lo < hi as two numbers. */
 int ulam__report_ci_digits(double lo, double hi);
 
+/* Standard errors a side of an interval may span before the answer line's +- shows that side instead. */
+#define ULAM__REPORT_PM_WIDE 10.0
+
+/* Write " +- H (95% CI lo .. hi)" for an estimate with standard error se and a finite interval: H
+ * is se, or the interval's wider side when that passes ULAM__REPORT_PM_WIDE se (then "; standard
+ * error se" inside the parentheses). */
+void ulam__report_pm_fprint(FILE *f, double est, double se, double lo, double hi);
+
 /* A radius in words: six decimals from 1e-4 to 1e6 (and 0, inf), else six significant digits;
  * buf holds 32 characters, returned. */
 const char *ulam__report_radius_str(char *buf, double x);

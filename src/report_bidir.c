@@ -49,9 +49,9 @@ static void answer_line(FILE *f, const ulam_bidir_report *p)
     long long t = node(p, o->target);
     int pad = ulam__report_pad(name, t, 16);
     if (isfinite(r->ci95[0]) && isfinite(r->ci95[1])) {
-        int d = ulam__report_ci_digits(r->ci95[0], r->ci95[1]);
-        fprintf(f, "%s[%lld]%*s%.10g +- %.3g (95%% CI %.*g .. %.*g)%s\n", name, t, pad, "", r->estimate, r->std_error, d,
-                r->ci95[0], d, r->ci95[1], stop);
+        fprintf(f, "%s[%lld]%*s%.10g", name, t, pad, "", r->estimate);
+        ulam__report_pm_fprint(f, r->estimate, r->std_error, r->ci95[0], r->ci95[1]);
+        fprintf(f, "%s\n", stop);
     } else {
         fprintf(f, "%s[%lld]%*s%.10g +- %.3g (no confidence interval: %s)%s\n", name, t, pad, "", r->estimate,
                 r->std_error, r->walks.variance > 0 ? "no certified range of the walk part's score"

@@ -28,12 +28,9 @@ static void query_text(FILE *f, const ulam_query_report *q)
 {
     char src[32] = "";
     if (q->source >= 0) snprintf(src, sizeof src, " (source %lld)", (long long)(q->source + q->node_base));
-    fprintf(f, "%s[%lld]%s %.10g +- %.3g", q->answer_name, (long long)(q->index + q->node_base), src, q->estimate,
-            q->std_error);
-    if (!isnan(q->ci95[0])) {
-        int p = ulam__report_ci_digits(q->ci95[0], q->ci95[1]);
-        fprintf(f, " (95%% CI %.*g .. %.*g)", p, q->ci95[0], p, q->ci95[1]);
-    }
+    fprintf(f, "%s[%lld]%s %.10g", q->answer_name, (long long)(q->index + q->node_base), src, q->estimate);
+    if (!isnan(q->ci95[0])) ulam__report_pm_fprint(f, q->estimate, q->std_error, q->ci95[0], q->ci95[1]);
+    else fprintf(f, " +- %.3g", q->std_error);
     fprintf(f, "  walks %lld, %.4f s, seed %llu\n", (long long)q->walks, q->seconds, (unsigned long long)q->seed);
 }
 

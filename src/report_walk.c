@@ -44,9 +44,8 @@ static void answer(FILE *f, const ulam_walk_report *p, int quiet)
                 : !isfinite(r->tail_bound) && r->estimate != 0 ? "no certified range of a single walk's score"
                 : "no certified range yet, or a score past the certified one", stop);
     else if (r->variance_finite == 1)
-        fprintf(f, "%s[%lld]%*s%.10g +- %.3g (95%% CI %.*g .. %.*g)%s\n", name(p), i, pad, "", r->estimate,
-                r->std_error, ulam__report_ci_digits(r->ci95[0], r->ci95[1]), r->ci95[0],
-                ulam__report_ci_digits(r->ci95[0], r->ci95[1]), r->ci95[1], stop);
+        fprintf(f, "%s[%lld]%*s%.10g", name(p), i, pad, "", r->estimate),
+            ulam__report_pm_fprint(f, r->estimate, r->std_error, r->ci95[0], r->ci95[1]), fprintf(f, "%s\n", stop);
     else
         fprintf(f, "%s[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
                    "means nothing)%s\n", name(p), i, pad, "", r->estimate,

@@ -265,7 +265,7 @@ def check_partition_forward_rel_err(ulam, mpirun, d):
     assert p.returncode == 2 and "forward walks on a partition have no stop rule" in p.stderr and \
         "--index I without --mode forward" in p.stderr, (p.returncode, p.stderr)
     out = run(base + ["--walks", "100000"])
-    m = re.match(r"x\[1\] +(\S+) \+- \S+ \(95% CI (\S+) \.\. (\S+)\)\n", out)
+    m = re.match(r"x\[1\] +(\S+) \+- \S+ \(95% CI (\S+) \.\. ([^;)\s]+)(?:; standard error \S+)?\)\n", out)
     assert m, out
     est, lo, hi = (float(v) for v in m.groups())
     assert (hi - lo) / 2 <= 0.05 * abs(est) and lo <= 2.932917317 <= hi, out

@@ -109,6 +109,14 @@ static void test_bidir(void **state)
     ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_QUIET);
     assert_string_equal(written(f, &buf), "pi[7]           0.25 +- 0.001 (95% CI 0.248 .. 0.252)\n");
     free(buf);
+    /* a side over 10 standard errors (the push's certified range leading, Poisson 200x200 --jacobi: +- 0.000919
+       beside 2975.88 .. 2976.55): the +- is that side, the standard error named; on 6d7184d the line read +- 0.001 */
+    r.ci95[0] = 0.2, r.ci95[1] = 0.27;
+    f = open_memstream(&buf, &len);
+    ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_QUIET);
+    assert_string_equal(written(f, &buf), "pi[7]           0.25 +- 0.05 (95% CI 0.2 .. 0.27; standard error 0.001)\n");
+    free(buf);
+    r.ci95[0] = 0.248, r.ci95[1] = 0.252;
     f = open_memstream(&buf, &len);
     ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_BRIEF);
     char *s = written(f, &buf);
