@@ -51,12 +51,16 @@
                                       would bet as if the variance were the largest) */
 #define ULAM__FPUSH_LOCAL_SHARE 16 /* the top-K target's queue push gives way to the sweeps once its operations pass
                                       nnz / this (a sixteenth of a sweep: a queue push's operation reads at random) */
-#define ULAM__FPUSH_TIME_PUSH 0.25 /* the share of max_seconds the top-K target's queue push may take (the walks the rest) */
+#define ULAM__FPUSH_TIME_PUSH 0.25 /* the share of the time left after the set-up that the top-K target's queue push may take (the walks the rest) */
 #define ULAM__FPUSH_TIME_NEXT 4.0   /* a halving of rmax costs up to this many times the round before (R-MAT 2^24, source
                                        101: 3.1e5 -> 1.4e6 operations in one halving) */
 #define ULAM__FPUSH_TIME_OPS 16     /* with a deadline the queue push stays local to nnz / ULAM__FPUSH_LOCAL_SHARE times this */
 #define ULAM__FPUSH_NEG_PASSES 32     /* passes of push_negative at most (its operations: a sweep's at most) */
 #define ULAM__FPUSH_LANES 16        /* walks in flight at once (walk_many) */
+#define ULAM__FPUSH_HIT_FIRST 4096  /* walks' ends a block's hit table first has room for; walk_many doubles it as
+                                       walks end at new states (a block planned for 10^7 walks on R-MAT 2^24 set a
+                                       2^25-slot table, 128 MiB, before its first walk: half of a --time 3 run's
+                                       walking second went to that memset) */
 #define ULAM__FPUSH_TRIM_EVERY 256  /* rows a queue push checks between trims of a large file's mapping
                                       (ulam__system_trim: a read of /proc/self/statm) */
 #define ULAM__FPUSH_TRIM_WALKS 256  /* walks launched between trims: of a released file the walks map only M^T's row
@@ -599,6 +603,10 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
                 if (L[l].phase == 0) L[l].on = lane_choose(w, &L[l]);
                 else L[l].on = lane_move(w, rng, &L[l]);
             }
+            if (!L[l].on && more && w->nhit + ULAM__FPUSH_LANES >= w->hmax && w->hmax < w->n &&
+                hit_room(w, w->hmax + ULAM__FPUSH_LANES)) { /* room for every walk in flight to end somewhere new */
+                w->status = ULAM_ENOMEM, w->bad = -1, more = 0;
+            }
             if (!L[l].on && more) {
                 int64_t j = walk_start(w, rng);
                 L[l].on = 1, L[l].neg = w->r[j] < 0, launched++;
@@ -1013,6 +1021,15 @@ static void push_negative(const ulam_csr *Mt, double *p, double *r, double d1, d
     swi->ops += ops;
 }
 
+/* The queue push's deadline: ULAM__FPUSH_TIME_PUSH of the time left before the walks' deadline
+ * until, counted from now (after the set-up, which under load can take a quarter of --time: the
+ * push then stopped before its first operation and the walks carried the whole residual). */
+static double push_until(double until)
+{
+    double now = ulam_now();
+    return isfinite(until) ? now + ULAM__FPUSH_TIME_PUSH * fmax(0.0, until - now) : INFINITY;
+}
+
 /* Sweep push and terminal walks on its residual, for ||M||_1 < 1; top >= 0: std_error, lo and
  * hi only for the top components of largest estimate, listed in index (select_top). */
 static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system *lz, const ulam_fpush_opts *o,
@@ -1041,8 +1058,7 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
     const ulam__sweep_release *relp = ulam__system_releases(lz) ? &rel : NULL;
     double T = o->walk.stop.max_seconds, until = T > 0 ? t0 + T : INFINITY; /* the walks' deadline */
     if (top > 0 && top < n && !(o->rmax > 0) && o->walks <= 0) /* the top-K target: a local push, the floor planned */
-        status = push_top(Mt, lz, o->source, top, o->min_value, &pl, cap, T > 0 ? t0 + ULAM__FPUSH_TIME_PUSH * T : INFINITY, x, r,
-                          swi, &local, err);
+        status = push_top(Mt, lz, o->source, top, o->min_value, &pl, cap, push_until(until), x, r, swi, &local, err);
     if (status == ULAM_ESYNTAX) { /* a damaged block of the file, named in err */
         free(r), free(w.cs), free(w.mx);
         return status;
@@ -1137,12 +1153,16 @@ static int solve_sweep(const ulam_csr *M, const ulam_csr *Mt, const ulam_system 
         for (;;) { /* checkpoint k (stitching index) at the end of epoch k0 + k - 1 */
             int64_t target = o->walks > 0 ? o->walks >> seg : epoch_end(k0 + k - 1);
             if (target > cap_w) target = cap_w, planned = o->walks > 0 && o->walks == cap_w;
-            if (N < target && hit_room(&w, target - N)) {
+            if (N < target && hit_room(&w, target - N < ULAM__FPUSH_HIT_FIRST ? target - N : ULAM__FPUSH_HIT_FIRST)) {
                 status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' ends");
                 break;
             }
             if (sgn) cs_plan_all(&S, &w, x, N, R0, pl.E, pl.delta, o->walks > 0 ? (double)o->walks : 0.0);
             int64_t made = N < target ? walk_many(&w, &rng, target - N, o->walk.stop.interrupt, until) : 0;
+            if (w.status == ULAM_ENOMEM && w.bad < 0) {
+                status = ulam__fail(err, ULAM_ENOMEM, 0, -1, "memory for the walks' ends");
+                break;
+            }
             if (w.status == ULAM_ENOMEM) {
                 status = ulam__fail(err, ULAM_ENOMEM, 0, w.bad, "memory for row %lld of M^T's values", (long long)w.bad + 1);
                 break;
