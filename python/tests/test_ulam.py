@@ -54,6 +54,23 @@ def test_spsolve_4sigma():
             assert r.ci95[0] < r.estimate < r.ci95[1] and r.walks >= 256  # a rel_err run's first round
 
 
+def test_repr_pm_not_narrower():
+    """A Result's repr, as the CLI's answer line: its +- is never under a tenth of the interval's wider
+    side (a signed system at 64 walks: the interval's side is 13.8 standard errors; the repr printed
+    the standard error beside it)."""
+    M, b = random_system(200, 6, 0.9, 4, signed=True)
+    wide = 0
+    for seed in range(1, 6):
+        r = ulam.solve(M=M, b=b, index=5, walks=64, seed=seed, method="walks")
+        assert r.ci95 is not None, r
+        side = max(r.ci95[1] - r.estimate, r.estimate - r.ci95[0])
+        pm = float(repr(r).split(" +- ")[1].split(" ")[0])
+        assert pm >= side / 10.0 * (1 - 1e-3), (repr(r), side)
+        wide += side > 10.0 * r.stderr
+        assert ("standard error" in repr(r)) == (side > 10.0 * r.stderr), repr(r)
+    assert wide >= 1  # the case this asserts happens here
+
+
 def coverage_bound(n):
     """The least number of covering 95% intervals of n that is not rejected at 1e-6."""
     return int(binom.ppf(1e-6, n, 0.95))

@@ -235,8 +235,15 @@ class Result:
         self.report = _report(d, index, b_nonzeros, source, scale)
 
     def __repr__(self):
-        ci = f"95% CI {self.ci95[0]:.10g} .. {self.ci95[1]:.10g}" if self.ci95 else "no confidence interval"
-        return (f"<ulam.Result x[{self.index}] = {self.estimate:.10g} +- {self.stderr:.3g} ({ci}), "
+        # the CLI's answer line (src/report.c ulam__report_pm_fprint): where a side of the interval passes
+        # 10 standard errors (ULAM__REPORT_PM_WIDE), the +- is that side and the standard error is named
+        pm, ci = self.stderr, "no confidence interval"
+        if self.ci95:
+            ci = f"95% CI {self.ci95[0]:.10g} .. {self.ci95[1]:.10g}"
+            side = max(self.ci95[1] - self.estimate, self.estimate - self.ci95[0])
+            if side > 10.0 * self.stderr:
+                pm, ci = side, ci + f"; standard error {self.stderr:.3g}"
+        return (f"<ulam.Result x[{self.index}] = {self.estimate:.10g} +- {pm:.3g} ({ci}), "
                 f"{self.walks} walks, method {self.method}>")
 
 
