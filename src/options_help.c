@@ -142,9 +142,9 @@ static const struct help_row {
     "  --queries FILE     many queries in one process ('-': stdin), one a line: 'I' (x_I), or\n"
     "                     'S I' (x_I with b = e_S, bidirectional), either optionally followed\n"
     "                     by a target like 0.01 for that line's --rel-err; one answer a line\n"
-    "                     (--json: JSON lines) with the seed it walked on: --index I --seed\n"
-    "                     SEED reruns it (docs/streams.md); the guards, bounds and kernel rows\n"
-    "                     are kept across them (docs/queries.md)\n"
+    "                     (--json: JSON lines) with the seed it walked on: --method walks\n"
+    "                     --index I --seed SEED reruns it (docs/streams.md); the guards,\n"
+    "                     bounds and kernel rows are kept across them (docs/queries.md)\n"
     "  --partition        the rows of a prepared SYSTEM.ulam split across mpirun's ranks, walks\n"
     "                     that migrate (its own options: ulam solve --partition --help;\n"
     "                     docs/distributed.md)\n"    "  --method walks     the single method the options name, defaults for the rest (adjoint,\n"
@@ -193,7 +193,8 @@ static const struct help_row {
     "                     'id' or 'id weight'); --top K alone: global PageRank's K largest\n"
     "  --step-cost C      push operations one walk visit costs, for the balance (default 1.3;\n"
     "                     bench_bidir measures it: docs/bidirectional.md)\n"
-    "  --rel-err E        stop once the 95% interval's half-width <= E |x_I estimate| (>= 1000 walks)\n"
+    "  --rel-err E        stop once the 95% interval's half-width <= E |x_I estimate| (checked\n"
+    "                     from the pilot's walks on: a run may stop after a few hundred)\n"
     "  the other options are those of 'ulam solve'; the walks are walks on M' from b, so the\n"
     "  guards reported are those of the forward kernel\n"},
     {"mcsa",

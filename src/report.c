@@ -136,7 +136,9 @@ void ulam__report_rel_err_fprint(FILE *f, const ulam_walk_opts *o, const ulam_wa
     else if (o->stop.rel_err > 0 && r->min_walks > 0 && (verbose || !r->rel_err_met))
         fprintf(f, "rel-err         %s (target %.3g; the rule asks for %.4g walks at this estimate and variance%s)\n",
                r->rel_err_met ? "met" : "NOT met", o->stop.rel_err, r->min_walks,
-               !r->out_of_reach ? "" : o->stop.max_walks > 0 ? ", more than --walks: stopped early, the estimate so far above"
+               !r->out_of_reach ? (o->stop.max_walks > 0 && !r->rel_err_met && r->min_walks > (double)o->stop.max_walks
+                                       ? ", more than --walks: the interval above is the budget's" : "")
+               : o->stop.max_walks > 0 ? ", more than --walks: stopped early, the estimate so far above"
                                                         : ", beyond the 1e9 cap: stopped early, the estimate so far above");
     else if (o->stop.rel_err > 0)
         fprintf(f, "rel-err         %s (target %.3g)\n", r->rel_err_met ? "met" : "NOT met", o->stop.rel_err);

@@ -136,6 +136,11 @@ struct ulam_solver {
     int64_t steps, cut;
     double maxsq; /* the largest single score^2 (forward: of the reported component) */
     int met, cut_stop, out_of_reach;
+    int walks_given; /* the caller set stop.max_walks: its budget is walked even when the rel_err target is
+                        out of its reach (that stop is for the 1e9 cap), unless no walk has scored yet and
+                        the budget is too short to see a score (then more walks would show nothing) */
+    int budget_plan; /* walks_given and the target past the budget: the next blocks' bets are planned for the
+                        budget, as a fixed count's (plan_terms), not for a width it cannot reach */
     int epoch; /* the last epoch (stop.h) the rel_err rule was checked at */
     ulam__cs cs; /* the confidence sequence (stop.h), fed a block at a time in block order */
     double clip_b; /* the bias bound of the round's clipped scores (their limit: w.clip) */
@@ -1294,6 +1299,7 @@ static int solver_alloc(const ulam_csr *M, const double *b, const ulam_walk_opts
         ulam_solver_free(s);
         return status;
     }
+    s->walks_given = o.stop.max_walks > 0;
     s->o.stop.max_walks = ulam__walk_cap(&o);
     s->threads = ulam__threads(o.exec.threads);
     const ulam_csr *K = M;
@@ -1615,6 +1621,9 @@ int ulam_solver_iterate(ulam_solver *s)
     int k = ulam__stop_epoch(s->run.walks), check = k > s->epoch; /* the rule checks once an epoch (stop.h) */
     if (check && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN) s->epoch = k;
     if (check) zero_bound(s, &r);
+    if (check && s->walks_given && s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && isfinite(r.min_walks) &&
+        r.min_walks > (double)s->o.stop.max_walks)
+        s->budget_plan = 1; /* the target past --walks: its walks planned as a fixed count's from here (predictable) */
     if (rel_err_met(s, &r)) s->run.done = s->met = 1; /* every round: the sequence holds at every count */
     else if (check && s->o.stop.rel_err > 0 && s->hit_walks > (double)s->o.stop.max_walks && s->maxsq == 0.0 &&
              r.estimate + s->o.stop.rel_err_offset == 0.0 && !(s->o.stop.max_seconds > 0))
@@ -1623,6 +1632,7 @@ int ulam_solver_iterate(ulam_solver *s)
              !(r.cut_bound <= ULAM__CUT_SHARE * s->o.stop.rel_err * fabs(r.estimate + s->o.stop.rel_err_offset)))
         s->run.done = s->cut_stop = 1; /* the cuts' bias may exceed the target: more walks cannot help */
     else if (s->o.stop.rel_err > 0 && s->var_finite == 1 && s->run.walks >= ULAM__REL_MIN && !(s->o.stop.max_seconds > 0) &&
+             !s->walks_given &&
              fabs(r.estimate + s->o.stop.rel_err_offset) > 0 && isfinite(r.tail_bound) && r.min_walks > (double)s->o.stop.max_walks)
         s->run.done = s->out_of_reach = 1; /* the walks the target needs are past the budget or the cap */
     else if (s->o.stop.rel_err > 0 && s->run.walks >= ULAM__REL_MIN && !isfinite(r.ci95[0]) && r.min_walks > 0 &&
@@ -1775,16 +1785,18 @@ static double first_walks(const ulam_solver *s, double nplan, int fixed)
  * score: a loose bound on |x| would give the first blocks a bias that outweighs the rest); and the limit A of |score| (the adjoint expected estimator adds b_i,
  * score0, to every score, so a score past |b_i| + R, not R, is past the range).  grid 0: h and
  * nplan alone are asked for (a block's bet: its limit and bias are the round's), the grids'
- * searches skipped (4-5% of a run's instructions when made for every block). */
-static void plan_terms(const ulam_solver *s, int grid, double *Rt, double *A, double *b, double *h, double *nplan)
+ * searches skipped (4-5% of a run's instructions when made for every block).  target 1: the
+ * target's plan even after a --walks budget took over the bets (budget_plan): the walks the
+ * target needs (min_walks) are the target's, whatever the blocks were bet for. */
+static void plan_terms(const ulam_solver *s, int grid, int target, double *Rt, double *A, double *b, double *h, double *nplan)
 {
     const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
     double E = s->o.stop.rel_err > 0 ? s->o.stop.rel_err : 0.0, mabs = fabs(moments_estimate(s) + s->o.stop.rel_err_offset);
     double m = mabs > 0 ? mabs : fmin(bias_scale(s, 0.0), s->per_step), var = ulam__moments_variance(mom), N = (double)mom->n;
     int truncated = !(s->bound == 0.0 || s->per_step == 0.0 || isfinite(s->range));
-    int fixed = !(E > 0) && !(s->o.stop.max_seconds > 0) && s->o.stop.max_walks > 0;
+    int fixed = (!(E > 0) || (s->budget_plan && !target)) && !(s->o.stop.max_seconds > 0) && s->o.stop.max_walks > 0;
     *nplan = fixed ? (double)s->o.stop.max_walks : fmax(4.0 * N, 4096.0);
-    *h = E > 0 && mabs > 0 ? E * mabs : 0.0;
+    *h = E > 0 && mabs > 0 && !fixed ? E * mabs : 0.0;
     double hp = *h > 0 ? *h : 2.7 * sqrt(var / *nplan), cap = fmax(ULAM__STOP_TAIL, E / 4.0) * m;
     double t = truncated && isfinite(m) && m > 0 ? fmin(cap, fmax(hp / 8.0, 1e-6 * m)) : 0.0;
     *Rt = !truncated ? score_range(s, 1.0, 1.0, 1) : t > 0 ? score_range(s, m, t / m, 1) : INFINITY;
@@ -1840,7 +1852,7 @@ static void plan_terms(const ulam_solver *s, int grid, double *Rt, double *A, do
 static void round_clip(ulam_solver *s)
 {
     double Rt, A, b, h, nplan;
-    plan_terms(s, 1, &Rt, &A, &b, &h, &nplan);
+    plan_terms(s, 1, 0, &Rt, &A, &b, &h, &nplan);
     s->w.clip = isfinite(A) && A > 0 ? A : 0.0, s->clip_b = b;
     /* every length route's range is per_step (l + 1) (twice with signs) for walks cut after l steps,
        whose bias bound (an E|rest| bound, or tailS's |E rest|) is at most b: the sequence may take
@@ -1870,7 +1882,7 @@ static void cs_plan(ulam_solver *s)
 {
     const ulam__moments *mom = s->o.mode == ULAM_ADJOINT ? &s->adj : &s->watched;
     double Rt, A, b, h, nplan;
-    plan_terms(s, 0, &Rt, &A, &b, &h, &nplan);
+    plan_terms(s, 0, 0, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     cs_bet(s, mom, A, b, h, nplan);
 }
@@ -1881,7 +1893,7 @@ static void cs_plan(ulam_solver *s)
 static void cs_plan_from(ulam_solver *s, const ulam__moments *run)
 {
     double Rt, A, b, h, nplan, E = s->o.stop.rel_err;
-    plan_terms(s, 0, &Rt, &A, &b, &h, &nplan);
+    plan_terms(s, 0, 0, &Rt, &A, &b, &h, &nplan);
     A = s->w.clip > 0 ? s->w.clip : INFINITY, b = s->clip_b;
     if (!(h > 0) && E > 0 && run->n >= 2) h = E * fabs(run->mean + s->o.stop.rel_err_offset);
     cs_bet(s, run, A, b, h, nplan);
@@ -1907,7 +1919,7 @@ static double push_rounding(const ulam_solver *s, int64_t i)
 static void interval(const ulam_solver *s, const ulam_walk_result *r, double *R, ulam__stop_ci *ci)
 {
     double A, b, h, nplan;
-    plan_terms(s, 1, R, &A, &b, &h, &nplan);
+    plan_terms(s, 1, 0, R, &A, &b, &h, &nplan);
     if (*R == 0.0) ulam__stop_interval(r->walks, r->estimate, 0.0, 0.0, 0.0, 0.0, 0.0, 0, ci);
     else {
         double m0 = s->o.mode == ULAM_ADJOINT ? s->adj.mean : s->watched.mean, shift = r->estimate - m0;
@@ -1956,7 +1968,7 @@ static void result(const ulam_solver *s, ulam_walk_result *r, int count_unreache
     r->tail_bound = R == 0.0 ? 0.0 : N > 0 && m > 0 ? R / (N * m) : INFINITY;
     if (s->o.stop.rel_err > 0) { /* a sequence tuned to the target from the start, at the planned range */
         double E = s->o.stop.rel_err, A, b, h, nplan, Rp;
-        plan_terms(s, 1, &Rp, &A, &b, &h, &nplan);
+        plan_terms(s, 1, 1, &Rp, &A, &b, &h, &nplan);
         r->min_walks = R == 0.0 ? 0.0 : ulam__cs_walks_needed(m, r->variance, A, b + r->cut_bound, E);
         if (s->met) r->min_walks = fmin(r->min_walks, (double)r->walks); /* it held there */
         if (m == 0 && s->maxsq == 0.0 && s->hit_walks > 0 && ci.kind != ULAM__STOP_EXACT)
@@ -2146,6 +2158,7 @@ int ulam__solver_rerun(ulam_solver *s, const ulam_walk_opts *opts, ulam_error *e
         return ulam__fail(err, ULAM_EINVAL, 0, -1, "a solver that owns its kernel to change the estimator");
     s->o = o;
     if ((status = check_verdicts(s->M, s, err))) return status;
+    s->walks_given = o.stop.max_walks > 0;
     s->o.stop.max_walks = ulam__walk_cap(&o);
     if (rescore && (status = ulam__kernel_rescore(s->k, o.estimator))) return kernel_failure(s->k, s->o.policy.system, err);
     if (rescore && o.mode == ULAM_ADJOINT) { /* the start row current (rescoring may leave rows to the walks) */

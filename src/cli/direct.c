@@ -222,6 +222,8 @@ int cli_direct(int argc, char **argv)
         ulam_report_fprint(stdout, ULAM_REPORT_DIRECT, &d, json ? ULAM_REPORT_JSON
                                                            : cli_verbosity < 0 ? ULAM_REPORT_QUIET : ULAM_REPORT_BRIEF);
         cli_flush();
+        const char *hint = s.jacobi || json ? "" : cli_system_hint(s.M); /* the answer is (I - M)'s: say what M looks like */
+        if (*hint) fprintf(stderr, "ulam: %s: note: this solves (I - M) x = b for M as read.%s\n", s.matrix_path, hint);
         if (out && (status = cli_write_vector(out, x, s.M->nrows, "solution of (I - M) x = b by ulam direct")))
             rc = cli_report_write(out, status, errno);
         else if (out && !json && cli_verbosity >= 0) printf("written    %s\n", out); /* --quiet: the file is the answer */

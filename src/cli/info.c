@@ -70,6 +70,8 @@ int cli_info(int argc, char **argv)
     if (status) rc = cli_report(s.matrix_path, &err);
     else if ((cli_json_done |= json, status = ulam_report_fprint(stdout, ULAM_REPORT_INFO, &ir, json ? ULAM_REPORT_JSON : 0)))
         rc = cli_exit_code(status); /* the damping table's Arnoldi */
+    const char *hint = !rc && !json && !s.jacobi && ir.g.verdict_abs == ULAM_VERDICT_FAIL ? cli_system_hint(s.M) : "";
+    if (*hint) fprintf(stderr, "ulam: %s: note:%s\n", s.matrix_path, hint); /* as solve's refusal says (newuser18) */
     ulam_csr_free(A);
     cli_system_free(&s);
     return rc;
