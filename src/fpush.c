@@ -590,7 +590,8 @@ static int lane_move(walker *w, ulam_rng *rng, lane *L)
  * reads next prefetched while the others go on: their memory reads overlap, where one walk's
  * are a chain).  Every walk launched is walked to its end, and walks launch in order, so the
  * first count walks are taken whatever their lengths.  The walks made: count, or fewer when
- * *interrupt is set (checked every 1024 launches) or the clock passes until (ulam_now(), every 256). */
+ * *interrupt is set (checked every 1024 launches) or the clock passes until (ulam_now(), every 16: a
+ * walk whose rows are read cold can take milliseconds). */
 static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile int *interrupt, double until)
 {
     lane L[ULAM__FPUSH_LANES] = {{0}};
@@ -612,7 +613,7 @@ static int64_t walk_many(walker *w, ulam_rng *rng, int64_t count, const volatile
                 L[l].on = 1, L[l].neg = w->r[j] < 0, launched++;
                 lane_arrive(w, rng, &L[l], j);
                 more = launched < count && !((launched & 1023) == 0 && interrupt && *interrupt) && !w->status &&
-                       !((launched & 255) == 0 && ulam_now() > until);
+                       !((launched & 15) == 0 && ulam_now() > until);
                 if (w->store_of && launched % ULAM__FPUSH_TRIM_WALKS == 0) ulam__system_trim(w->store_of);
             }
             busy |= L[l].on;
