@@ -81,7 +81,9 @@ void ulam__report_z_fprint(FILE *f, double estimate, double direct, double std_e
 {
     double z = ulam__report_z(estimate, direct, std_error);
     fprintf(f, "z = %.3f", z);
-    if (fabs(z) > 4.0) fprintf(f, " (direct %s the 95%% interval)", lo <= direct && direct <= hi ? "inside" : "OUTSIDE");
+    if (fabs(z) > 4.0 && lo <= direct && direct <= hi) /* newuser18: z = 17043 beside a push's certified range */
+        fprintf(f, " (direct inside the 95%% interval: z counts the standard error alone, the interval also its range terms)");
+    else if (fabs(z) > 4.0) fprintf(f, " (direct OUTSIDE the 95%% interval)");
     fputc('\n', f);
 }
 

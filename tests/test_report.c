@@ -134,6 +134,19 @@ static void test_bidir(void **state)
     ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_CHECK);
     assert_string_equal(written(f, &buf), "direct          0.2515 (dense LU, 0.5 s), z = -1.500\n");
     free(buf);
+    /* z past 4 with direct inside the interval (a range term leads it): said, not left as a bare z = 50 */
+    p.direct = 0.2, r.ci95[0] = 0.19, r.ci95[1] = 0.3;
+    f = open_memstream(&buf, &len);
+    ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_CHECK);
+    assert_string_equal(written(f, &buf), "direct          0.2 (dense LU, 0.5 s), z = 50.000 (direct inside the 95% interval: "
+                                          "z counts the standard error alone, the interval also its range terms)\n");
+    free(buf);
+    p.direct = 0.3515, r.ci95[0] = 0.248, r.ci95[1] = 0.252;
+    f = open_memstream(&buf, &len);
+    ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_CHECK);
+    assert_string_equal(written(f, &buf), "direct          0.3515 (dense LU, 0.5 s), z = -101.500 (direct OUTSIDE the 95% interval)\n");
+    free(buf);
+    p.direct = 0.2515;
     f = open_memstream(&buf, &len);
     ulam_report_fprint(f, ULAM_REPORT_BIDIR, &p, ULAM_REPORT_JSON);
     s = written(f, &buf);
