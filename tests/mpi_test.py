@@ -15,6 +15,15 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
            OMPI_MCA_plm_rsh_agent="")
 
 
+def answer(line):
+    """estimate, standard error, 95% interval of an answer line 'x[i] E +- H (95% CI lo .. hi[; standard error se])':
+    H is the standard error, or the interval's wider side past 10 of them, the standard error then named."""
+    m = re.match(r"\S+\s+(\S+) \+- (\S+) \(95% CI (\S+) \.\. ([^;)\s]+)(?:; standard error (\S+))?\)", line)
+    assert m, line
+    est, pm, lo, hi, se = m.groups()
+    return float(est), float(se if se is not None else pm), float(lo), float(hi)
+
+
 def run(cmd, rc=0):
     """cmd's stdout, once it exited rc (5: a --rel-err target not met, the answer printed)."""
     p = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
@@ -106,7 +115,7 @@ def check_partition(ulam, mpirun, d):
     files.append(open(x, "rb").read())
     assert lines[0] == lines[1] == lines[2], lines
     assert files[0] == files[1] == files[2] == files[3], "forward --out files differ across rank counts or sets"
-    est, se = float(lines[0].split()[1]), float(lines[0].split()[3])
+    est, se = answer(lines[0])[:2]
     assert abs(est - exact[1233]) < 4 * se, (lines[0], exact[1233])
     outer = []  # MCSA (x file) and single source (top-10 table) at 1 and 3 ranks: byte for byte
     for k in (1, 3):
@@ -164,12 +173,12 @@ def check_partition(ulam, mpirun, d):
     lone = run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "1234", "--walks",
                 "40000", "--seed", own, "-q"])
     assert qs[0] == qs[1] and own != "3" and first == lone.splitlines()[0], (qs, lone)
-    est, lo, hi = (float(lines[0].split()[i].rstrip(")")) for i in (1, 6, 8))  # the certified 95% interval holds x
+    est, _, lo, hi = answer(lines[0])  # the certified 95% interval holds x
     assert lo <= exact[1233] <= hi and lo <= est <= hi, (lines[0], exact[1233])
     rel = [run([mpirun, "--oversubscribe", "-np", str(k), ulam, "solve", sysf, "--partition", "--index", "1234",
                 "--rel-err", "0.01", "--batch", "8192", "--seed", "3", "-q"]) for k in (1, 3)]
     assert rel[0] == rel[1] and "rel-err         met" in rel[0], rel  # --rel-err on a partition: the same bits
-    est, lo, hi = (float(rel[0].split()[i].rstrip(")")) for i in (1, 6, 8))
+    est, _, lo, hi = answer(rel[0])
     assert lo <= exact[1233] <= hi and hi - lo <= 0.02 * abs(est), rel[0]
     p = subprocess.run([mpirun, "--oversubscribe", "-np", "3", ulam, "solve", sysf, "--partition", "--index", "5"],
                        capture_output=True, text=True, env=dict(ENV, ULAM_TEST_PARTITION_DIE="1"), timeout=120)
@@ -207,7 +216,7 @@ def check_partition_growing(ulam, mpirun, d):
                       "--walks", "100000", "--seed", str(seed), "-q"]).splitlines()[0] for k in (1, 2, 3)]
         assert lines[0] == lines[1] == lines[2], lines
         assert "95% CI" in lines[0], lines[0]
-        est, se, lo, hi = (float(lines[0].split()[i].rstrip(")")) for i in (1, 3, 6, 8))
+        est, se, lo, hi = answer(lines[0])
         x = exact[idx - 1]
         assert abs(est - x) < 4 * se and lo <= x <= hi and lo <= est <= hi, (lines[0], x)
 
@@ -242,7 +251,7 @@ def check_partition_forward_index(ulam, mpirun, d):
             files.append(open(f"{d}/f{k}.mtx").read())
         assert len(set(lines)) == 1 and len(set(files)) == 1, (mm, lines)
         assert lines[0].startswith("x[1234]") and "95% CI" in lines[0], lines[0]
-        est, se, lo, hi = (float(lines[0].split()[i].rstrip(")")) for i in (1, 3, 6, 8))
+        est, se, lo, hi = answer(lines[0])
         x = exact[1233]
         assert abs(est - x) < 4 * se and lo <= x <= hi and lo <= est <= hi, (mm, lines[0], x)
         if mm == t:
@@ -300,7 +309,7 @@ def check_partition_forward_top(ulam, mpirun, d):
     want = sorted(range(n), key=lambda i: (-x[i], i))[:k]
     for line, i in zip(tops[0], want):
         assert line.startswith(f"x[{i + 1}]") and "95% CI" in line, (line, i)
-        est, se, lo, hi = (float(line.split()[j].rstrip(")")) for j in (1, 3, 6, 8))
+        est, se, lo, hi = answer(line)
         assert est == float("%.10g" % x[i]) and abs(est - exact[i]) < 4 * se and lo <= exact[i] <= hi, (line, exact[i])
     for extra in (["--index", "7", "--top", "3"], ["--mode", "forward", "--index", "7", "--top", "3"],
                   ["--method", "mcsa", "--top", "3"], ["--mode", "forward", "--top", "3", "--sets", "2"]):
@@ -471,7 +480,7 @@ def check_partition_source_graph(ulam, mpirun, d):
     import re
     for line in tops[0].splitlines():  # within 4 standard errors, or 1e-3 of it where no walk reached it
         i, est = int(re.match(r"x\[(\d+)\]", line).group(1)) - 1, float(line.split()[1])
-        se = re.search(r"\+- (\S+)", line)
+        se = re.search(r"standard error (\S+)\)", line) or re.search(r"\+- (\S+)", line)
         assert abs(est - exact[i]) < (4 * float(se.group(1)) if se else 1e-3 * exact[i]), (line, exact[i])
         ci = re.search(r"CI (\S+) \.\. ([^;)\s]+)", line)  # the l1 range (||M||_1 = 0.85): none was certified before
         assert ci and float(ci.group(1)) <= exact[i] <= float(ci.group(2)), (line, exact[i])
