@@ -184,6 +184,9 @@ CASES += [
      r"^ulam: \S+poisson20\.mtx: note: this solves \(I - M\) x = b for M as read\. The diagonal is large .*add --jacobi",
      r"^x\[3\]"),
     (["direct", M + "poisson20.mtx", "--rhs", M + "poisson20_b.mtx", "--index", "3", "--jacobi"], 0, r"^$", r"^x\[3\]"),
+    # newuser18: a last option missing its value printed getopt's line and then 'unknown option': one line now
+    (["solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "1", "--rel-err"], 2,
+     r"\Aulam solve: --rel-err needs a value \(--rel-err VALUE\)[^\n]*\n\Z", r"^$"),
     (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(M\)\s+0\.98883"),
     (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"rho\(\|M\|\)\s+0\.988[78]"),
     (["info", M + "poisson20.mtx", "--jacobi"], 0, r"^$", r"0\.50\s+0\.9944\d+\s+0\.994[34]\d+\s+converges"),
@@ -1082,6 +1085,22 @@ def run(ulam, args):
     # solve takes tens of seconds, and more than 120 s with the machine loaded)
     p = subprocess.run([ulam] + args, capture_output=True, text=True, timeout=600)
     return p.returncode, p.stdout, p.stderr
+
+
+def check_mpi_absent(ulam):
+    """Started by mpirun, a build without MPI says so once, on rank 0 (newuser18: 'mpirun -n 2 ulam solve ...
+    --partition' printed the whole answer twice, each 'on 1 rank', in silence).  An MPI build is not run with a
+    made-up environment (its MPI_Init would look for the launcher): tests/mpi_test.py covers it."""
+    p = subprocess.run(["ldd", ulam], capture_output=True, text=True, timeout=600)
+    if "libmpi" in p.stdout:
+        return
+    args = [ulam, "solve", M + "chain4.mtx", "--rhs", M + "chain4_b.mtx", "--index", "1", "--walks", "1000"]
+    for rank, warned in (("0", True), ("1", False)):
+        q = subprocess.run(args, capture_output=True, text=True, timeout=600,
+                           env=dict(os.environ, OMPI_COMM_WORLD_SIZE="2", OMPI_COMM_WORLD_RANK=rank))
+        assert q.returncode == 0 and q.stdout.startswith("x[1] "), (q.returncode, q.stderr)
+        said = "started as one of 2 processes (mpirun), but this ulam was built without MPI" in q.stderr
+        assert said == warned, (rank, q.stderr)
 
 
 def check_table(ulam, only=None):
@@ -2542,7 +2561,7 @@ def main():
         return 2
     part = "table" if "--table" in flags else "checks" if "--checks" in flags else None  # meson runs the halves apart
     failures, n = check_table(ulam, rows if cases else None) if part != "checks" else (0, 0)
-    extra = [(check_json, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_source_fallback, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_exact_zero_no_warning, ulam), (check_adjoint_scale, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
+    extra = [(check_json, ulam), (check_mpi_absent, ulam), (check_info_neumann, ulam), (check_rel_err_stops, ulam), (check_source_fallback, ulam), (check_cancellation_stops, ulam), (check_zero_estimate_stops, ulam), (check_exact_zero_no_warning, ulam), (check_adjoint_scale, ulam), (check_outputs, ulam), (check_genmat, genmat), (check_solve_json, ulam), (check_alpha, ulam),
              (check_forward_files, ulam), (check_interrupt, ulam), (check_second_interrupt, ulam),
              (check_study, ulam), (check_study_summary, ulam), (check_study_nonfinite, ulam), (check_study_exact_charts, ulam), (check_cache, ulam), (check_prepare, ulam),
              (check_radiosity, ulam), (check_radiosity_json_paths, ulam), (check_radiosity_interrupt, ulam),

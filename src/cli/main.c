@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Run the subcommand. */
@@ -49,6 +50,15 @@ int main(int argc, char **argv)
     cli_started = ulam_now();
 #ifdef ULAM_MPI
     cli_mpi_init(&argc, &argv);
+#endif
+#ifndef ULAM_MPI
+    { /* started by mpirun, built without MPI: each process runs the whole command alone; say so once (newuser18) */
+        const char *size = getenv("OMPI_COMM_WORLD_SIZE"), *rank = getenv("OMPI_COMM_WORLD_RANK");
+        if (!size) size = getenv("PMI_SIZE"), rank = getenv("PMI_RANK");
+        if (size && atoi(size) > 1 && (!rank || atoi(rank) == 0))
+            fprintf(stderr, "ulam: warning: started as one of %d processes (mpirun), but this ulam was built without MPI "
+                            "(meson setup -Dmpi=enabled, docs/distributed.md): each runs the whole command alone\n", atoi(size));
+    }
 #endif
     cli_signals_init(); /* temporary files removed on SIGINT, SIGTERM, SIGHUP */
     cli_output_begin(&argc, argv);

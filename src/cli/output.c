@@ -130,6 +130,8 @@ int cli_check_options(const char *command, int argc, char **argv, const struct o
         int i = cli_lookup(name, names, n);
         if (i >= 0) {
             if (longopts[i].has_arg != required_argument) continue;
+            if (!eq && k + 1 >= argc) /* getopt would print its own line, then ours: one line instead (newuser18) */
+                return cli_usage_error(command, "--%s needs a value (--%s VALUE)", names[i], names[i]);
             const char *value = eq ? strchr(argv[k], '=') + 1 : k + 1 < argc ? argv[k + 1] : "";
             k += !eq; /* its value may start with "--" */
             int first = single_valued(names, n, i);
