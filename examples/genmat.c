@@ -102,7 +102,7 @@ static void all(const char *dir)
 
 int main(int argc, char **argv)
 {
-    if (argc == 2) {
+    if (argc == 2 && argv[1][0] != '-') { /* an option is not a folder (genmat --help wrote --help/poisson20_b.mtx) */
         all(argv[1]);
         return 0;
     }
@@ -135,6 +135,8 @@ int main(int argc, char **argv)
         if (st) fprintf(stderr, "genmat: %s\n", ulam_strerror(st));
         return st ? 1 : 0;
     }
-    fprintf(stderr, "usage: genmat OUTDIR | genmat --radiosity N OUT.mtx OUT_b.mtx | genmat --sparse N K S OUT.mtx OUT_b.mtx\n");
-    return 2;
+    int help = argc == 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"));
+    fprintf(help ? stdout : stderr,
+            "usage: genmat OUTDIR | genmat --radiosity N OUT.mtx OUT_b.mtx | genmat --sparse N K S OUT.mtx OUT_b.mtx\n");
+    return help ? 0 : 2;
 }

@@ -2544,6 +2544,9 @@ def check_genmat(genmat):
         assert len(made) == 14, made
         for f in made:
             assert open(os.path.join(d, f), "rb").read() == open(M + f, "rb").read(), f
+        # newuser18: --help was taken for a folder (it wrote --help/poisson20_b.mtx): usage on stdout, exit 0, nothing written
+        p = subprocess.run([os.path.abspath(genmat), "--help"], capture_output=True, text=True, timeout=120, cwd=d)
+        assert p.returncode == 0 and p.stdout.startswith("usage: genmat OUTDIR") and sorted(os.listdir(d)) == made, (p, os.listdir(d))
 
 
 def main():
