@@ -2077,7 +2077,7 @@ static void reset(ulam_solver *s)
     s->steps = s->cut = 0;
     s->maxsq = 0.0;
     ulam__run_reset(&s->run);
-    s->met = s->cut_stop = s->out_of_reach = s->epoch = 0;
+    s->met = s->cut_stop = s->out_of_reach = s->epoch = s->budget_plan = 0;
     s->cs = (ulam__cs){0};
     free(s->hitv), free(s->hitt), free(s->hits); /* made for this b and estimator */
     s->hitv = NULL, s->hitt = NULL, s->hits = NULL, s->nhits = 0, s->hit_reads = 0, s->hit_sweep = s->hit_done = 0, s->hit_walks = 0.0;

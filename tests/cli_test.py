@@ -1365,6 +1365,11 @@ def check_cancellation_stops(ulam):
         args = ["solve", p, "--rhs", pb, "--index", "1", "--rel-err", "0.1"]
         rc, out, err = run(ulam, args)
         assert rc == 5, (rc, err)  # newuser15: the target not met exits 5 (was 0)
+        # auto's run is its route's fresh walks: the pinned route prints the same line (a pilot's --walks budget
+        # plan, left set on the reused solver, bet auto's run for 1e9 walks: +-3.13 against the route's +-0.434)
+        route = re.search(r"^method +adjoint random walks, (\w+) estimator", out, re.M)
+        rc2, out2, err2 = run(ulam, args + ["--method", "walks", "--estimator", route.group(1)])
+        assert rc2 == 5 and out2.splitlines()[0] == out.splitlines()[0], (out, out2)
         m = re.search(r"^x\[1\] +(\S+) \+- \S+ \(95% CI (\S+) \.\. ([^;)\s]+)", out, re.M)
         assert m and float(m.group(2)) <= 1e-3 <= float(m.group(3)), out
         assert re.search(r"^rel-err +NOT met \(target 0\.1; the rule asks for [\d.e+]+ walks at this estimate and "
