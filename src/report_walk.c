@@ -43,10 +43,11 @@ static void answer(FILE *f, const ulam_walk_report *p, int quiet)
                                                     "(a prepared file's b is not rescaled)"
                 : !isfinite(r->tail_bound) && r->estimate != 0 ? "no certified range of a single walk's score"
                 : "no certified range yet, or a score past the certified one", stop);
-    else if (r->variance_finite == 1)
-        fprintf(f, "%s[%lld]%*s%.10g", name(p), i, pad, "", r->estimate),
-            ulam__report_pm_fprint(f, r->estimate, r->std_error, r->ci95[0], r->ci95[1]), fprintf(f, "%s\n", stop);
-    else
+    else if (r->variance_finite == 1) {
+        fprintf(f, "%s[%lld]%*s%.10g", name(p), i, pad, "", r->estimate);
+        ulam__report_pm_fprint(f, r->estimate, r->std_error, r->ci95[0], r->ci95[1]);
+        fprintf(f, "%s\n", stop);
+    } else
         fprintf(f, "%s[%lld]%*s%.10g (no confidence interval: the variance is %s; the sample stderr %.3g "
                    "means nothing)%s\n", name(p), i, pad, "", r->estimate,
                 r->variance_finite == 0 ? "infinite, rho(M^) >= 1" : "not certified finite, rho(M^) straddles 1",
